@@ -1,0 +1,37 @@
+# camtool: `make demo` runs the main job on a bundled sample; `make test` runs the checks.
+# Both create .venv and install camtool into it when missing.
+PYTHON ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed
+
+.PHONY: demo test lint typecheck unit bench clean
+
+$(STAMP): pyproject.toml
+	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e '.[test]'
+	touch $(STAMP)
+
+demo: $(STAMP)
+	mkdir -p out
+	$(BIN)/camtool post samples/logo.dxf --target pic-mmh -o out/logo.pic
+	@echo "demo: the pic-mmh program for samples/logo.dxf is in out/logo.pic"
+
+lint: $(STAMP)
+	$(BIN)/ruff check camtool tests samples
+	$(BIN)/ruff format --check camtool tests samples
+
+typecheck: $(STAMP)
+	$(BIN)/mypy
+
+unit: $(STAMP)
+	$(BIN)/pytest
+
+test: lint typecheck unit
+
+bench: $(STAMP)
+	for b in tests/benchmarks/bench_*.py; do $(BIN)/python $$b || exit 1; done
+
+clean:
+	rm -rf $(VENV) out .pytest_cache .mypy_cache .ruff_cache

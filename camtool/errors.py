@@ -1,0 +1,49 @@
+"""One error tree for camtool; each error carries the process exit code.
+
+Exit codes (the CLI contract in DESIGN.md): 0 ok, 1 error, 2 usage, 3 unreadable
+or invalid input, 4 verified error over the limit. Errors mix in the builtin they
+resemble, as ezdxf does (``DXFValueError(DXFError, ValueError)``).
+"""
+
+from __future__ import annotations
+
+
+class CamtoolError(Exception):
+    """Base of every error camtool raises on purpose. Exit code 1."""
+
+    exit_code = 1
+
+
+class UsageError(CamtoolError, ValueError):
+    """An option value or combination of options is invalid. Exit code 2."""
+
+    exit_code = 2
+
+
+class InputError(CamtoolError, ValueError):
+    """An input file is missing, unreadable or holds nothing usable. Exit code 3."""
+
+    exit_code = 3
+
+
+class ToolpathError(CamtoolError, ValueError):
+    """A toolpath cannot be planned (e.g. an offset fails). Exit code 1."""
+
+
+class DialectError(CamtoolError, ValueError):
+    """A program cannot be expressed in a target's dialect. Exit code 1.
+
+    Raised for a value that does not fit its field, a feed outside the feed
+    table, a point outside the machine's work area, or a move the dialect has no
+    word for. The message names the contour and block.
+    """
+
+
+class ParseError(InputError):
+    """Code in a target's dialect cannot be read back. Exit code 3."""
+
+
+class VerifyLimitError(CamtoolError):
+    """The predicted machining error exceeds the requested limit. Exit code 4."""
+
+    exit_code = 4

@@ -1,0 +1,291 @@
+"""Drawing geometry: Line, Arc, Contour, Drawing. Immutable, mm, Y up, arcs exact.
+
+Conventions:
+- Points are ``(x, y)`` tuples of floats in mm, Y up (the drawing's up is +Y).
+- An :class:`Arc` is exact: start point, end point, centre and direction.
+  ``clockwise=True`` is G02 (clockwise seen from +Z), ``False`` is G03.
+  An arc whose start equals its end is a full circle.
+- Angles are radians, counter-clockwise from +X.
+- Signed areas are positive for counter-clockwise closed contours.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from typing import TypeAlias
+
+Point: TypeAlias = tuple[float, float]
+BBox: TypeAlias = tuple[float, float, float, float]
+"""``(xmin, ymin, xmax, ymax)`` in mm."""
+
+TAU = 2.0 * math.pi
+_FULL_CIRCLE_EPS = 1e-12
+
+
+def distance(a: Point, b: Point) -> float:
+    """Euclidean distance between two points, mm."""
+    return math.hypot(b[0] - a[0], b[1] - a[1])
+
+
+def bbox_union(boxes: Iterator[BBox] | list[BBox]) -> BBox:
+    """Smallest box holding every box of ``boxes``.
+
+    Raises:
+        ValueError: ``boxes`` is empty.
+    """
+    boxes = list(boxes)
+    if not boxes:
+        raise ValueError("bbox of nothing")
+    return (
+        min(b[0] for b in boxes),
+        min(b[1] for b in boxes),
+        max(b[2] for b in boxes),
+        max(b[3] for b in boxes),
+    )
+
+
+@dataclass(frozen=True)
+class Line:
+    """A straight segment from ``start`` to ``end`` (mm)."""
+
+    start: Point
+    end: Point
+
+    @property
+    def length(self) -> float:
+        """Length in mm."""
+        return distance(self.start, self.end)
+
+    def reversed(self) -> Line:
+        """The same segment traversed from end to start."""
+        return Line(self.end, self.start)
+
+    def bbox(self) -> BBox:
+        """Bounding box ``(xmin, ymin, xmax, ymax)``, mm."""
+        (x0, y0), (x1, y1) = self.start, self.end
+        return (min(x0, x1), min(y0, y1), max(x0, x1), max(y0, y1))
+
+    def points(self, tolerance: float) -> list[Point]:
+        """Polyline approximation: ``[start, end]`` (exact)."""
+        del tolerance
+        return [self.start, self.end]
+
+    def transformed(self, scale: float, dx: float, dy: float) -> Line:
+        """Uniformly scaled about the origin (``scale`` > 0), then translated."""
+        return Line(_tf(self.start, scale, dx, dy), _tf(self.end, scale, dx, dy))
+
+
+@dataclass(frozen=True)
+class Arc:
+    """A circular arc, exact: start, end, centre (mm) and direction.
+
+    ``clockwise=True`` is clockwise seen from +Z (G02). The radius is the
+    distance from the centre to ``start``; ``end`` is expected on the same
+    circle (importers guarantee it to within their tolerance). An arc whose
+    ``start == end`` is a full circle (sweep 2π).
+    """
+
+    start: Point
+    end: Point
+    centre: Point
+    clockwise: bool
+
+    @property
+    def radius(self) -> float:
+        """Radius in mm, measured from the centre to the start point."""
+        return distance(self.centre, self.start)
+
+    @property
+    def start_angle(self) -> float:
+        """Angle of the start point seen from the centre, radians CCW from +X."""
+        return math.atan2(self.start[1] - self.centre[1], self.start[0] - self.centre[0])
+
+    @property
+    def end_angle(self) -> float:
+        """Angle of the end point seen from the centre, radians CCW from +X."""
+        return math.atan2(self.end[1] - self.centre[1], self.end[0] - self.centre[0])
+
+    @property
+    def is_full_circle(self) -> bool:
+        """True when start and end coincide (sweep 2π)."""
+        return distance(self.start, self.end) <= _FULL_CIRCLE_EPS * max(1.0, self.radius)
+
+    @property
+    def sweep(self) -> float:
+        """Signed sweep angle in radians: > 0 counter-clockwise, < 0 clockwise.
+
+        Its magnitude lies in (0, 2π]; a full circle has magnitude 2π.
+        """
+        if self.is_full_circle:
+            return -TAU if self.clockwise else TAU
+        ccw = (self.end_angle - self.start_angle) % TAU
+        if ccw == 0.0:
+            ccw = TAU
+        return -(TAU - ccw) if self.clockwise else ccw
+
+    @property
+    def length(self) -> float:
+        """Arc length in mm."""
+        return abs(self.sweep) * self.radius
+
+    def point_at(self, fraction: float) -> Point:
+        """The point a ``fraction`` (0…1) of the way along the arc."""
+        a = self.start_angle + self.sweep * fraction
+        r = self.radius
+        return (self.centre[0] + r * math.cos(a), self.centre[1] + r * math.sin(a))
+
+    def reversed(self) -> Arc:
+        """The same arc traversed from end to start (direction flips)."""
+        return Arc(self.end, self.start, self.centre, not self.clockwise)
+
+    def split(self, parts: int) -> list[Arc]:
+        """Split into ``parts`` arcs of equal sweep; the ends are kept exact."""
+        pts = [self.start] + [self.point_at(k / parts) for k in range(1, parts)] + [self.end]
+        return [Arc(pts[k], pts[k + 1], self.centre, self.clockwise) for k in range(parts)]
+
+    def bbox(self) -> BBox:
+        """Bounding box, including the extreme points of the circle the arc passes."""
+        xs = [self.start[0], self.end[0]]
+        ys = [self.start[1], self.end[1]]
+        cx, cy = self.centre
+        r = self.radius
+        a0, sweep = self.start_angle, self.sweep
+        for k in range(4):
+            quad = k * math.pi / 2
+            # distance travelled along the sweep direction to reach angle `quad`
+            delta = (quad - a0) % TAU if sweep > 0 else (a0 - quad) % TAU
+            if delta <= abs(sweep):
+                xs.append(cx + r * math.cos(quad))
+                ys.append(cy + r * math.sin(quad))
+        return (min(xs), min(ys), max(xs), max(ys))
+
+    def points(self, tolerance: float) -> list[Point]:
+        """Polyline through the arc whose chords deviate by at most ``tolerance`` mm."""
+        n = chord_count(self.radius, abs(self.sweep), tolerance)
+        return [self.start] + [self.point_at(k / n) for k in range(1, n)] + [self.end]
+
+    def transformed(self, scale: float, dx: float, dy: float) -> Arc:
+        """Uniformly scaled about the origin (``scale`` > 0), then translated."""
+        return Arc(
+            _tf(self.start, scale, dx, dy),
+            _tf(self.end, scale, dx, dy),
+            _tf(self.centre, scale, dx, dy),
+            self.clockwise,
+        )
+
+
+Segment: TypeAlias = Line | Arc
+
+
+def chord_count(radius: float, sweep: float, tolerance: float) -> int:
+    """Number of equal chords so that each deviates from the arc by ≤ ``tolerance``.
+
+    The sagitta of a chord spanning angle θ is ``r·(1 − cos(θ/2))``.
+
+    Args:
+        radius: arc radius, mm.
+        sweep: unsigned sweep, radians.
+        tolerance: largest allowed chord error, mm (> 0).
+    """
+    if tolerance <= 0:
+        raise ValueError(f"chord tolerance must be > 0 mm, got {tolerance!r}")
+    if tolerance >= radius:
+        return max(1, math.ceil(sweep / math.pi))
+    max_angle = 2.0 * math.acos(1.0 - tolerance / radius)
+    return max(1, math.ceil(sweep / max_angle - 1e-9))
+
+
+def _tf(p: Point, scale: float, dx: float, dy: float) -> Point:
+    return (p[0] * scale + dx, p[1] * scale + dy)
+
+
+@dataclass(frozen=True)
+class Contour:
+    """A chain of segments, each starting where the previous one ended.
+
+    ``closed`` contours end where they start. ``layer`` is the drawing layer the
+    contour came from; ``source`` names where it came from for messages (e.g.
+    ``"LWPOLYLINE #2A"``).
+    """
+
+    segments: tuple[Segment, ...]
+    closed: bool
+    layer: str = "0"
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        if not self.segments:
+            raise ValueError("a contour needs at least one segment")
+
+    @property
+    def start(self) -> Point:
+        """First point, mm."""
+        return self.segments[0].start
+
+    @property
+    def end(self) -> Point:
+        """Last point, mm."""
+        return self.segments[-1].end
+
+    @property
+    def length(self) -> float:
+        """Total length, mm."""
+        return sum(s.length for s in self.segments)
+
+    def bbox(self) -> BBox:
+        """Bounding box ``(xmin, ymin, xmax, ymax)``, mm."""
+        return bbox_union([s.bbox() for s in self.segments])
+
+    def reversed(self) -> Contour:
+        """The same contour traversed the other way."""
+        segs = tuple(s.reversed() for s in reversed(self.segments))
+        return Contour(segs, self.closed, self.layer, self.source)
+
+    def points(self, tolerance: float) -> list[Point]:
+        """Polyline through the contour within ``tolerance`` mm (arcs as chords)."""
+        out: list[Point] = [self.start]
+        for seg in self.segments:
+            out.extend(seg.points(tolerance)[1:])
+        return out
+
+    def signed_area(self, tolerance: float = 1e-4) -> float:
+        """Signed area in mm² (> 0 counter-clockwise); 0 for open contours."""
+        if not self.closed:
+            return 0.0
+        pts = self.points(tolerance)
+        return 0.5 * sum(
+            x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(pts, pts[1:] + pts[:1], strict=True)
+        )
+
+    def transformed(self, scale: float, dx: float, dy: float) -> Contour:
+        """Uniformly scaled about the origin (``scale`` > 0), then translated."""
+        segs = tuple(s.transformed(scale, dx, dy) for s in self.segments)
+        return Contour(segs, self.closed, self.layer, self.source)
+
+
+@dataclass(frozen=True)
+class Drawing:
+    """What an importer read: contours in mm, Y up, plus what it had to say.
+
+    ``warnings`` are messages for the user (skipped entity types, assumed
+    units); the CLI prints them on stderr. ``source`` is the file name.
+    """
+
+    contours: tuple[Contour, ...]
+    source: str = ""
+    warnings: tuple[str, ...] = field(default=())
+
+    def bbox(self) -> BBox:
+        """Bounding box of every contour, mm.
+
+        Raises:
+            ValueError: the drawing is empty.
+        """
+        return bbox_union([c.bbox() for c in self.contours])
+
+    def transformed(self, scale: float, dx: float = 0.0, dy: float = 0.0) -> Drawing:
+        """Uniformly scaled about the origin (``scale`` > 0), then translated."""
+        contours = tuple(c.transformed(scale, dx, dy) for c in self.contours)
+        return Drawing(contours, self.source, self.warnings)

@@ -1,0 +1,71 @@
+"""The main job as one library call: drawing file → toolpath → code for a target."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from camtool.geometry import Drawing
+from camtool.importers import read_drawing
+from camtool.post.base import PostResult, Target
+from camtool.post.registry import load_target
+from camtool.program import Program
+from camtool.toolpath.plan import PlanOptions, plan
+
+
+@dataclass(frozen=True)
+class PostJob:
+    """Everything one ``post`` produced.
+
+    Attributes:
+        drawing: what was imported.
+        program: the planned, machine-neutral program.
+        target: the target it was written for.
+        result: the emitted code and its warnings.
+    """
+
+    drawing: Drawing
+    program: Program
+    target: Target
+    result: PostResult
+
+    @property
+    def warnings(self) -> tuple[str, ...]:
+        """Warnings of every stage, in pipeline order, without repeats."""
+        return tuple(dict.fromkeys(self.program.warnings + self.result.warnings))
+
+
+def post_file(
+    path: str | Path,
+    target_name: str,
+    *,
+    offset: str = "on",
+    tool_diameter: float = 0.0,
+    feed_mm_min: float | None = None,
+    tolerance: float = 0.001,
+    machine_file: Path | None = None,
+) -> PostJob:
+    """Import a drawing, plan it and post it for a target.
+
+    Args:
+        path: the drawing file (DXF).
+        target_name: a built-in target or a target ``.toml`` path.
+        offset: ``on``, ``outside`` or ``inside`` (see :mod:`camtool.toolpath.plan`).
+        tool_diameter: tool diameter, mm.
+        feed_mm_min: cutting feed, mm/min; ``None`` takes the target's default.
+        tolerance: chaining tolerance, mm.
+        machine_file: TOML file replacing the target's machine profile.
+
+    Raises:
+        CamtoolError: from any stage, with its exit code.
+    """
+    target = load_target(target_name, machine_file=machine_file)
+    drawing = read_drawing(path)
+    options = PlanOptions(
+        offset=offset,
+        tool_diameter=tool_diameter,
+        feed_mm_min=target.default_feed_mm_min if feed_mm_min is None else feed_mm_min,
+        tolerance=tolerance,
+    )
+    program = plan(drawing, options)
+    return PostJob(drawing, program, target, target.emit(program))

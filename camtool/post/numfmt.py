@@ -1,0 +1,91 @@
+"""All number formatting of every dialect, in one place.
+
+A :class:`NumberFormat` says how one word's value is written: scale from mm,
+decimals, zero padding of the integer part, sign policy. Rounding is half away
+from zero on the decimal value (``Decimal`` of the float's shortest repr), so
+``2.969 mm`` at 1000 units/mm is exactly ``2969.00``. ``-0`` never appears: a
+value that rounds to zero is written without a sign.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from decimal import ROUND_HALF_UP, Decimal
+
+from camtool.errors import DialectError
+
+SIGN_POLICIES = ("negative", "always")
+"""``negative``: ``-`` only before negatives (seed-000 L1731); ``always``: ``+`` too."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class NumberFormat:
+    """How a word's value is written.
+
+    Attributes:
+        scale: units written per mm (1000 for µm, 10 for 0.1 mm, 1 for mm).
+        decimals: digits after the decimal point (0 writes no point).
+        int_digits: zero-pad the integer part to this many digits; values whose
+            integer part needs more digits do not fit. ``None`` pads nothing and
+            has no limit.
+        sign: one of :data:`SIGN_POLICIES`.
+    """
+
+    scale: float = 1.0
+    decimals: int = 3
+    int_digits: int | None = None
+    sign: str = "negative"
+
+    def __post_init__(self) -> None:
+        if self.sign not in SIGN_POLICIES:
+            raise ValueError(f"unknown sign policy {self.sign!r}; choose {SIGN_POLICIES}")
+        if self.decimals < 0 or (self.int_digits is not None and self.int_digits < 1):
+            raise ValueError("decimals must be ≥ 0 and int_digits ≥ 1")
+
+    def quantize(self, value_mm: float) -> Decimal:
+        """The value in written units, rounded to ``decimals`` (half away from zero)."""
+        exp = Decimal(1).scaleb(-self.decimals)
+        q = (Decimal(repr(float(value_mm))) * Decimal(repr(float(self.scale)))).quantize(
+            exp, rounding=ROUND_HALF_UP
+        )
+        return q if q != 0 else Decimal(0).quantize(exp)
+
+    def resolution_mm(self) -> float:
+        """The smallest step this format can write, mm."""
+        return 10.0 ** (-self.decimals) / self.scale
+
+    def format(self, value_mm: float) -> str:
+        """Write ``value_mm`` (mm) in this format.
+
+        Raises:
+            DialectError: the integer part needs more than ``int_digits`` digits.
+        """
+        q = self.quantize(value_mm)
+        magnitude = abs(q)
+        text = f"{magnitude:.{self.decimals}f}"
+        int_part = text.split(".")[0]
+        if self.int_digits is not None:
+            if len(int_part) > self.int_digits:
+                raise DialectError(
+                    f"{q} does not fit {self.int_digits} integer digits "
+                    f"(largest {'9' * self.int_digits})"
+                )
+            text = text.rjust(len(text) - len(int_part) + self.int_digits, "0")
+        if q < 0:
+            return "-" + text
+        return ("+" + text) if self.sign == "always" else text
+
+    def parse(self, text: str) -> float:
+        """Read a value written in this format back to mm (signs optional)."""
+        return float(Decimal(text) / Decimal(repr(float(self.scale))))
+
+
+def format_int(value: int, digits: int, *, what: str) -> str:
+    """Zero-pad a non-negative integer code (feed code, tool number) to ``digits``.
+
+    Raises:
+        DialectError: ``value`` is negative or needs more digits.
+    """
+    if value < 0 or len(str(value)) > digits:
+        raise DialectError(f"{what} {value} does not fit {digits} digits")
+    return str(value).zfill(digits)

@@ -1,0 +1,132 @@
+"""Program: the machine-neutral move list between the planner and the dialects.
+
+A program is an immutable sequence of moves in absolute mm, Y up:
+
+- :class:`Rapid` — positioning at the machine's rapid rate (G00);
+- :class:`Linear` — a straight cut at ``feed_mm_min`` (G01);
+- :class:`ArcMove` — a circular cut (G02 when ``clockwise``, G03 otherwise)
+  around the ABSOLUTE centre ``(cx, cy)``.
+
+Every move carries its end point; the start of a move is the end of the one
+before it (or :attr:`Program.origin` for the first). ``z`` is ``None`` when the
+move does not change Z (2D machines never set it). ``contour`` is the 1-based
+number of the toolpath contour a move belongs to (0 for none), used by
+messages such as "contour 3, block 12".
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from typing import TypeAlias
+
+from camtool.geometry import Arc, BBox, Line, Point, Segment, bbox_union
+
+
+@dataclass(frozen=True)
+class Rapid:
+    """Rapid positioning to ``(x, y[, z])``, mm."""
+
+    x: float
+    y: float
+    z: float | None = None
+    contour: int = 0
+
+
+@dataclass(frozen=True)
+class Linear:
+    """Straight cut to ``(x, y[, z])`` at ``feed_mm_min`` (mm/min)."""
+
+    x: float
+    y: float
+    feed_mm_min: float
+    z: float | None = None
+    contour: int = 0
+
+
+@dataclass(frozen=True)
+class ArcMove:
+    """Circular cut to ``(x, y)`` around the absolute centre ``(cx, cy)``, mm.
+
+    ``clockwise=True`` is G02 seen from +Z. An arc whose end equals its start is
+    a full circle. ``feed_mm_min`` is the feed along the arc, mm/min.
+    """
+
+    x: float
+    y: float
+    cx: float
+    cy: float
+    clockwise: bool
+    feed_mm_min: float
+    z: float | None = None
+    contour: int = 0
+
+
+Move: TypeAlias = Rapid | Linear | ArcMove
+
+
+@dataclass(frozen=True)
+class Program:
+    """An immutable list of moves, absolute mm, Y up.
+
+    ``origin`` is where the machine stands before the first move (the part zero
+    unless said otherwise). ``warnings`` carry what the planner or reader had to
+    tell the user.
+    """
+
+    moves: tuple[Move, ...]
+    origin: Point = (0.0, 0.0)
+    warnings: tuple[str, ...] = field(default=())
+
+    def with_moves(self, moves: tuple[Move, ...]) -> Program:
+        """A copy holding ``moves`` instead."""
+        return Program(moves, self.origin, self.warnings)
+
+    def steps(self) -> Iterator[tuple[Point, Move]]:
+        """Each move with the XY point it starts from."""
+        here = self.origin
+        for move in self.moves:
+            yield here, move
+            here = (move.x, move.y)
+
+    def segments(self) -> Iterator[tuple[Move, Segment]]:
+        """Each move with its XY path as a geometry segment (rapids as lines)."""
+        for start, move in self.steps():
+            if isinstance(move, ArcMove):
+                yield move, Arc(start, (move.x, move.y), (move.cx, move.cy), move.clockwise)
+            else:
+                yield move, Line(start, (move.x, move.y))
+
+    def bbox(self, *, cutting_only: bool = False) -> BBox:
+        """Bounding box of the XY path (arcs by their extremes), mm.
+
+        Raises:
+            ValueError: the program has no moves.
+        """
+        boxes = [
+            seg.bbox()
+            for move, seg in self.segments()
+            if not (cutting_only and isinstance(move, Rapid))
+        ]
+        return bbox_union(boxes)
+
+    def cut_length(self) -> float:
+        """Length of the cutting moves (not rapids), mm."""
+        return sum(seg.length for move, seg in self.segments() if not isinstance(move, Rapid))
+
+    def cutting_time_s(self) -> float:
+        """Time of the cutting moves at their programmed feeds, s (rapids excluded)."""
+        total = 0.0
+        for move, seg in self.segments():
+            if isinstance(move, Rapid) or move.feed_mm_min <= 0:
+                continue
+            total += seg.length / move.feed_mm_min * 60.0
+        return total
+
+
+def arc_radius_mismatch(start: Point, move: ArcMove) -> float:
+    """|r_end − r_start| of an arc move, mm: how far its end is off its circle."""
+    r0 = math.hypot(start[0] - move.cx, start[1] - move.cy)
+    r1 = math.hypot(move.x - move.cx, move.y - move.cy)
+    return abs(r1 - r0)

@@ -1,0 +1,1 @@
+"""Built-in target files (``<name>.toml``): a dialect plus a machine profile."""

@@ -1,0 +1,1 @@
+"""Toolpath planning: chain, offset, order, and turn contours into a Program."""

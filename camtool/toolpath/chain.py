@@ -1,0 +1,131 @@
+"""Chaining: join contours whose ends meet within a tolerance into longer contours.
+
+The importers give one contour per entity; a drawing made of separate LINE and
+ARC entities becomes closed contours here. A joint within ``tolerance`` is
+snapped: the later segment starts exactly where the earlier one ends, so the
+emitted code has no gaps. A contour whose ends meet within ``tolerance`` is
+closed.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+from collections.abc import Iterable, Sequence
+
+from camtool.geometry import Arc, Contour, Line, Point, Segment, distance
+
+
+def chain(contours: Sequence[Contour], tolerance: float) -> list[Contour]:
+    """Join open contours end to end where their ends meet within ``tolerance`` mm.
+
+    Closed contours pass through unchanged. Open contours are extended forwards
+    then backwards, reversing a neighbour where its far end is the one that
+    meets; the first contour of a chain keeps its drawn direction. Layers and
+    sources of the joined pieces are kept from the first piece.
+
+    Args:
+        contours: contours as read, mm.
+        tolerance: largest gap, mm, that still counts as a joint (> 0).
+
+    Returns:
+        The chained contours, in the order their first pieces were given.
+    """
+    if tolerance <= 0:
+        raise ValueError(f"chaining tolerance must be > 0 mm, got {tolerance!r}")
+    result: list[Contour] = []
+    grid = _EndGrid(tolerance)
+    pieces = list(contours)
+    for index, contour in enumerate(pieces):
+        if not contour.closed:
+            grid.add(index, contour)
+    used: set[int] = set()
+    for index, contour in enumerate(pieces):
+        if contour.closed:
+            result.append(contour)
+            continue
+        if index in used:
+            continue
+        used.add(index)
+        segs = list(contour.segments)
+        _extend(segs, pieces, grid, used, tolerance, forward=True)
+        _extend(segs, pieces, grid, used, tolerance, forward=False)
+        closed = len(segs) > 1 and distance(segs[-1].end, segs[0].start) <= tolerance
+        if closed:
+            segs[-1] = _with_end(segs[-1], segs[0].start)
+        result.append(Contour(tuple(segs), closed, contour.layer, contour.source))
+    return result
+
+
+def _extend(
+    segs: list[Segment],
+    pieces: Sequence[Contour],
+    grid: _EndGrid,
+    used: set[int],
+    tolerance: float,
+    *,
+    forward: bool,
+) -> None:
+    while True:
+        here = segs[-1].end if forward else segs[0].start
+        if not forward and distance(here, segs[-1].end) <= tolerance and len(segs) > 1:
+            return  # already closed
+        found = grid.nearest(here, used)
+        if found is None:
+            return
+        index, at_start = found
+        used.add(index)
+        piece = pieces[index]
+        if forward:
+            nxt = piece if at_start else piece.reversed()
+            new = list(nxt.segments)
+            new[0] = _with_start(new[0], here)
+            segs.extend(new)
+        else:
+            prv = piece.reversed() if at_start else piece
+            new = list(prv.segments)
+            new[-1] = _with_end(new[-1], here)
+            segs[:0] = new
+
+
+def _with_start(seg: Segment, p: Point) -> Segment:
+    if isinstance(seg, Line):
+        return Line(p, seg.end)
+    return Arc(p, seg.end, seg.centre, seg.clockwise)
+
+
+def _with_end(seg: Segment, p: Point) -> Segment:
+    if isinstance(seg, Line):
+        return Line(seg.start, p)
+    return Arc(seg.start, p, seg.centre, seg.clockwise)
+
+
+class _EndGrid:
+    """Spatial hash of open-contour ends, cell size = tolerance."""
+
+    def __init__(self, tolerance: float) -> None:
+        self.tolerance = tolerance
+        self.cells: dict[tuple[int, int], list[tuple[int, bool, Point]]] = defaultdict(list)
+
+    def _cell(self, p: Point) -> tuple[int, int]:
+        return (math.floor(p[0] / self.tolerance), math.floor(p[1] / self.tolerance))
+
+    def add(self, index: int, contour: Contour) -> None:
+        for at_start, p in ((True, contour.start), (False, contour.end)):
+            self.cells[self._cell(p)].append((index, at_start, p))
+
+    def _near(self, p: Point) -> Iterable[tuple[int, bool, Point]]:
+        cx, cy = self._cell(p)
+        for dx in (-1, 0, 1):
+            for dy in (-1, 0, 1):
+                yield from self.cells.get((cx + dx, cy + dy), ())
+
+    def nearest(self, p: Point, used: set[int]) -> tuple[int, bool] | None:
+        best: tuple[float, int, bool] | None = None
+        for index, at_start, q in self._near(p):
+            d = distance(p, q)
+            if index in used or d > self.tolerance:
+                continue
+            if best is None or (d, index) < (best[0], best[1]):
+                best = (d, index, at_start)
+        return None if best is None else (best[1], best[2])

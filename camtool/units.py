@@ -1,0 +1,44 @@
+"""Units: mm is the one internal unit; conversions on the way in and out.
+
+Every length inside camtool is a float in millimetres, Y up. Importers convert
+on the way in, dialects on the way out. Names carry their unit when it is not mm
+(``feed_mm_min``, ``backlash_um``, ``step_um``).
+"""
+
+from __future__ import annotations
+
+from typing import Final
+
+MM: Final = 1.0
+UM: Final = 0.001
+"""One micrometre in mm."""
+TENTH_MM: Final = 0.1
+"""0.1 mm in mm (the unit of seed-002 point lists and of the pic-mmh feed word)."""
+INCH: Final = 25.4
+PX: Final = 25.4 / 96.0
+"""One CSS pixel (1/96 in) in mm."""
+PT: Final = 25.4 / 72.0
+CM: Final = 10.0
+
+LENGTH_UNITS: Final[dict[str, float]] = {
+    "mm": MM,
+    "um": UM,
+    "cm": CM,
+    "m": 1000.0,
+    "in": INCH,
+    "ft": 12 * INCH,
+    "pt": PT,
+    "px": PX,
+    "0.1mm": TENTH_MM,
+}
+"""Length units accepted by name, as mm per unit."""
+
+
+def mm_to_um(value_mm: float) -> float:
+    """Convert mm to µm."""
+    return value_mm * 1000.0
+
+
+def um_to_mm(value_um: float) -> float:
+    """Convert µm to mm."""
+    return value_um / 1000.0

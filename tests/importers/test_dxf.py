@@ -1,0 +1,116 @@
+"""DXF import: entities, bulges, OCS, units, warnings and bad input."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from camtool.errors import InputError
+from camtool.geometry import Arc, Line
+from camtool.importers import read_drawing
+from camtool.importers.dxf import read_dxf
+from tests.shapes import rectangle_dxf, write_dxf
+
+
+def test_line_arc_circle(tmp_path: Path) -> None:
+    def build(msp: Any) -> None:
+        msp.add_line((0, 0), (1, 0))
+        msp.add_arc((0, 0), 2.0, 0, 90)
+        msp.add_circle((5, 5), 1.5)
+
+    d = read_dxf(write_dxf(tmp_path / "a.dxf", build))
+    line, arc, circle = (c.segments[0] for c in d.contours)
+    assert line == Line((0.0, 0.0), (1.0, 0.0))
+    assert isinstance(arc, Arc) and not arc.clockwise
+    assert arc.start == pytest.approx((2.0, 0.0)) and arc.end == pytest.approx((0.0, 2.0))
+    assert arc.sweep == pytest.approx(math.pi / 2)
+    assert isinstance(circle, Arc) and circle.is_full_circle and circle.radius == 1.5
+    assert d.contours[2].closed and not d.contours[0].closed
+
+
+def test_bulge_sign_gives_direction(tmp_path: Path) -> None:
+    # bulge = tan(sweep/4); +1 is a CCW half circle, -1 a CW one (DXF reference).
+    def build(msp: Any) -> None:
+        msp.add_lwpolyline([(0, 0, 1.0), (2, 0, 0)], format="xyb")
+        msp.add_lwpolyline([(0, 0, -1.0), (2, 0, 0)], format="xyb")
+
+    ccw, cw = (c.segments[0] for c in read_dxf(write_dxf(tmp_path / "b.dxf", build)).contours)
+    assert isinstance(ccw, Arc) and isinstance(cw, Arc)
+    assert not ccw.clockwise and cw.clockwise
+    assert ccw.centre == pytest.approx((1.0, 0.0)) and ccw.radius == pytest.approx(1.0)
+    # CCW from (0,0) to (2,0) about (1,0) passes below the chord: y_min = -1
+    assert ccw.bbox()[1] == pytest.approx(-1.0) and cw.bbox()[3] == pytest.approx(1.0)
+
+
+def test_polyline2d_with_bulge_and_closed_flag(tmp_path: Path) -> None:
+    def build(msp: Any) -> None:
+        p = msp.add_polyline2d([(0, 0), (4, 0), (4, 2)], close=True)
+        p.vertices[1].dxf.bulge = 0.5
+
+    (contour,) = read_dxf(write_dxf(tmp_path / "p.dxf", build)).contours
+    assert contour.closed and len(contour.segments) == 3
+    assert isinstance(contour.segments[1], Arc)
+
+
+def test_mirrored_ocs_arc_runs_clockwise(tmp_path: Path) -> None:
+    # An ARC with extrusion (0,0,-1) is seen mirrored from +Z: OCS x → WCS -x.
+    def build(msp: Any) -> None:
+        msp.add_arc((1, 0), 1.0, 0, 90, dxfattribs={"extrusion": (0, 0, -1)})
+
+    (contour,) = read_dxf(write_dxf(tmp_path / "m.dxf", build)).contours
+    arc = contour.segments[0]
+    assert isinstance(arc, Arc) and arc.clockwise
+    assert arc.centre == pytest.approx((-1.0, 0.0))
+    assert arc.start == pytest.approx((-2.0, 0.0)) and arc.end == pytest.approx((-1.0, 1.0))
+
+
+def test_inches_are_scaled_by_25_4(tmp_path: Path) -> None:
+    d = read_dxf(rectangle_dxf(tmp_path / "in.dxf", 1.0, 0.5, insunits=1))
+    x0, y0, x1, y1 = d.bbox()
+    assert (x0, y0) == (25.4, 25.4)
+    assert x1 - x0 == pytest.approx(25.4) and y1 - y0 == pytest.approx(12.7)
+
+
+def test_unitless_drawing_is_taken_as_mm_with_a_warning(tmp_path: Path) -> None:
+    d = read_dxf(rectangle_dxf(tmp_path / "u.dxf", insunits=0))
+    assert d.bbox() == (1.0, 1.0, 11.0, 6.0)
+    assert any("assuming mm" in w for w in d.warnings)
+
+
+def test_other_entities_skipped_with_one_warning_per_type(tmp_path: Path) -> None:
+    def build(msp: Any) -> None:
+        msp.add_line((0, 0), (1, 0))
+        for k in range(3):
+            msp.add_text(f"t{k}")
+        msp.add_point((1, 1))
+
+    d = read_dxf(write_dxf(tmp_path / "s.dxf", build))
+    assert len(d.contours) == 1
+    assert sum("3 TEXT entities" in w for w in d.warnings) == 1
+    assert sum("1 POINT entity" in w for w in d.warnings) == 1
+
+
+def test_missing_file(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match="no such file"):
+        read_drawing(tmp_path / "nope.dxf")
+
+
+def test_not_a_dxf(tmp_path: Path) -> None:
+    bad = tmp_path / "bad.dxf"
+    bad.write_text("this is not a drawing\n")
+    with pytest.raises(InputError, match=r"bad\.dxf"):
+        read_drawing(bad)
+
+
+def test_no_usable_entity(tmp_path: Path) -> None:
+    path = write_dxf(tmp_path / "empty.dxf", lambda msp: msp.add_text("only text"))
+    with pytest.raises(InputError, match="no usable entity"):
+        read_drawing(path)
+
+
+def test_unknown_suffix(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match=r"cannot read '\.stl'"):
+        read_drawing(tmp_path / "part.stl")

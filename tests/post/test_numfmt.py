@@ -1,0 +1,48 @@
+"""Table tests of the one number-formatting module (STYLE 8)."""
+
+from __future__ import annotations
+
+import pytest
+
+from camtool.errors import DialectError
+from camtool.post.numfmt import NumberFormat, format_int
+
+UM52 = NumberFormat(scale=1000.0, decimals=2, int_digits=5)
+
+
+@pytest.mark.parametrize(
+    ("value_mm", "fmt", "text"),
+    [
+        (2.969, UM52, "02969.00"),  # seed-000 L1731
+        (3.4, UM52, "03400.00"),
+        (-0.15, UM52, "-00150.00"),  # S000-03 example X-00150.00
+        (0.0, UM52, "00000.00"),
+        (-0.000001, UM52, "00000.00"),  # rounds to zero: never "-0"
+        (0.000005, UM52, "00000.01"),  # half away from zero
+        (-0.000005, UM52, "-00000.01"),
+        (99.99999, UM52, "99999.99"),
+        (2.969, NumberFormat(scale=1000.0, decimals=2, int_digits=5, sign="always"), "+02969.00"),
+        (0.0, NumberFormat(scale=1000.0, decimals=2, int_digits=5, sign="always"), "+00000.00"),
+        (1.0, NumberFormat(decimals=1), "1.0"),
+        (-1.25, NumberFormat(decimals=3), "-1.250"),
+        (12.5, NumberFormat(scale=10.0, decimals=0), "125"),
+    ],
+)
+def test_format_table(value_mm: float, fmt: NumberFormat, text: str) -> None:
+    assert fmt.format(value_mm) == text
+
+
+def test_overflow_is_a_dialect_error() -> None:
+    with pytest.raises(DialectError, match="5 integer digits"):
+        UM52.format(100.0)  # 100000 µm needs 6 digits
+
+
+@pytest.mark.parametrize("text", ["02969.00", "-00150.00", "+00001.50"])
+def test_parse_inverts_format(text: str) -> None:
+    assert UM52.format(UM52.parse(text)).lstrip("+") == text.lstrip("+")
+
+
+def test_format_int() -> None:
+    assert format_int(8, 2, what="feed code") == "08"
+    with pytest.raises(DialectError):
+        format_int(100, 2, what="feed code")

@@ -1,0 +1,136 @@
+"""The CLI as a user runs it: exit codes, stdout/stderr separation, files."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from camtool.cli import main
+from tests.shapes import golden_arc_dxf, rectangle_dxf, write_dxf
+
+SAMPLES = Path(__file__).parents[1] / "samples"
+
+
+def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    code = main(args)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_post_to_stdout_carries_only_code(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _err = run(["post", str(SAMPLES / "logo.dxf"), "--target", "pic-mmh"], capsys)
+    assert code == 0
+    assert out.startswith("G54;\nG90;\n") and out.endswith("M30;\n")
+    assert "camtool" not in out
+
+
+def test_post_to_file_says_where(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    dest = tmp_path / "logo.pic"
+    code, out, err = run(
+        ["post", str(SAMPLES / "logo.dxf"), "-t", "pic-mmh", "-o", str(dest)], capsys
+    )
+    assert code == 0 and out == ""
+    assert str(dest) in err
+    assert dest.read_text().startswith("G54;")
+
+
+def test_feed_option(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = golden_arc_dxf(tmp_path / "g.dxf")
+    code, out, _ = run(["post", str(path), "-t", "pic-mmh", "--feed", "0.8"], capsys)
+    assert code == 0 and "G02X02969.00Y03400.00I03012.00J03040.00F08;" in out
+
+
+@pytest.mark.parametrize(
+    ("make", "args", "exit_code", "message"),
+    [
+        (None, [], 3, "no such file"),
+        ("text", [], 3, "not a readable DXF"),
+        ("empty", [], 3, "no usable entity"),
+        ("rect", ["--target", "nope"], 2, "unknown target 'nope'; choose one of: pic-mmh"),
+        ("big", [], 1, "outside the 10 × 7 mm work area"),
+        ("rect", ["--feed", "20"], 1, "outside F01–F99"),
+        ("rect", ["--offset", "outside"], 2, "needs --tool-diameter"),
+        ("rect", ["--offset", "sideways"], 2, "Invalid value for '--offset'"),
+    ],
+)
+def test_exit_code_matrix(
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    make: str | None,
+    args: list[str],
+    exit_code: int,
+    message: str,
+) -> None:
+    path = tmp_path / "in.dxf"
+    if make == "text":
+        path.write_text("hello\n")
+    elif make == "empty":
+        write_dxf(path, lambda msp: msp.add_text("x"))
+    elif make == "rect":
+        rectangle_dxf(path, 2, 1)
+    elif make == "big":
+        rectangle_dxf(path, 20, 1)
+    dest = tmp_path / "out.pic"
+    argv = [
+        "post",
+        str(path),
+        "-o",
+        str(dest),
+        *(args if "--target" in args else ["--target", "pic-mmh", *args]),
+    ]
+    code, out, err = run(argv, capsys)
+    assert code == exit_code
+    assert message in err
+    assert "Traceback" not in err and out == ""
+    assert not dest.exists()  # nothing half-written
+    assert list(tmp_path.glob(".out.pic.*")) == []
+
+
+def test_failed_run_keeps_the_previous_output(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    dest = tmp_path / "out.pic"
+    dest.write_text("previous\n")
+    code, _, _ = run(
+        ["post", str(rectangle_dxf(tmp_path / "b.dxf", 20, 1)), "-t", "pic-mmh", "-o", str(dest)],
+        capsys,
+    )
+    assert code == 1 and dest.read_text() == "previous\n"
+
+
+def test_help_explains_units(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run(["post", "--help"], capsys)
+    assert code == 0
+    for text in ("--tool-diameter MM", "--feed MM_PER_MIN", "--tolerance MM", "mm/min"):
+        assert text in out
+
+
+def test_targets_json(capsys: pytest.CaptureFixture[str]) -> None:
+    import json
+
+    code, out, _ = run(["targets", "--json"], capsys)
+    assert code == 0
+    assert {"pic-mmh"} <= {t["name"] for t in json.loads(out)}
+
+
+def test_console_script_runs_as_a_process(tmp_path: Path) -> None:
+    proc = subprocess.run(
+        [sys.executable, "-m", "camtool", "post", str(tmp_path / "missing.dxf"), "-t", "pic-mmh"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert proc.returncode == 3
+    assert proc.stdout == "" and "no such file" in proc.stderr and "Traceback" not in proc.stderr
+
+
+def test_version_does_not_load_opencascade() -> None:
+    code = (
+        "import sys; from camtool.cli import main; main(['--version']); "
+        "main(['targets']); print('build123d' in sys.modules, 'OCP' in sys.modules)"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert proc.stdout.strip().endswith("False False")

@@ -1,0 +1,134 @@
+"""Chaining, offsets and ordering, against analytic expectations."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from camtool.errors import ToolpathError, UsageError
+from camtool.geometry import Arc, Contour, Drawing, Line
+from camtool.importers.dxf import read_dxf
+from camtool.program import ArcMove, Rapid
+from camtool.toolpath.chain import chain
+from camtool.toolpath.offset import offset_contour
+from camtool.toolpath.order import nesting, order_contours
+from camtool.toolpath.plan import PlanOptions, plan
+from tests.shapes import rectangle_dxf, write_dxf
+
+
+def _rect(x0: float, y0: float, x1: float, y1: float) -> Contour:
+    pts = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
+    return Contour(tuple(Line(pts[i], pts[(i + 1) % 4]) for i in range(4)), True)
+
+
+def _circle(cx: float, cy: float, r: float) -> Contour:
+    return Contour((Arc((cx + r, cy), (cx + r, cy), (cx, cy), False),), True)
+
+
+def test_rectangle_outside_1mm_tool(tmp_path: Path) -> None:
+    # Issue 2 §6: 10 × 5 rectangle, 1 mm tool outside → four r = 0.5 corner arcs, 11 × 6 box.
+    out = offset_contour(_rect(0, 0, 10, 5), 0.5)
+    arcs = [s for s in out.segments if isinstance(s, Arc)]
+    assert len(arcs) == 4 and len(out.segments) == 8
+    assert all(a.radius == pytest.approx(0.5) for a in arcs)
+    x0, y0, x1, y1 = out.bbox()
+    assert (x1 - x0, y1 - y0) == (pytest.approx(11.0), pytest.approx(6.0))
+
+
+def test_rectangle_inside_1mm_tool() -> None:
+    out = offset_contour(_rect(0, 0, 10, 5), -0.5)
+    assert all(isinstance(s, Line) for s in out.segments)
+    x0, y0, x1, y1 = out.bbox()
+    assert (x1 - x0, y1 - y0) == (pytest.approx(9.0), pytest.approx(4.0))
+
+
+def test_offset_keeps_orientation_and_start() -> None:
+    cw = _rect(0, 0, 10, 5).reversed()
+    out = offset_contour(cw, 0.5)
+    assert out.signed_area() < 0
+    assert math.dist(out.start, cw.start) <= 0.5 + 1e-9
+
+
+def test_circle_offsets_stay_exact_arcs() -> None:
+    # A 10 mm circle offset by 1 mm has radius 6 mm (STYLE 12), and 4 mm inside.
+    for amount, radius in ((1.0, 6.0), (-1.0, 4.0)):
+        out = offset_contour(_circle(0, 0, 5), amount)
+        assert all(isinstance(s, Arc) and s.radius == pytest.approx(radius) for s in out.segments)
+        assert sum(abs(s.sweep) for s in out.segments if isinstance(s, Arc)) == pytest.approx(
+            2 * math.pi
+        )
+
+
+def test_offset_too_deep_is_reported_with_location() -> None:
+    with pytest.raises(ToolpathError, match=r"starting at \(0.0000, 0.0000\)"):
+        offset_contour(_rect(0, 0, 1, 1), -0.6)
+
+
+def test_chain_joins_lines_within_tolerance_and_closes() -> None:
+    gap = 0.0005
+    pieces = [
+        Contour((Line((0, 0), (1, 0)),), False),
+        Contour((Line((1, 1), (1 + gap, 0)),), False),  # drawn backwards, end meets with a gap
+        Contour((Line((1, 1), (0, 0 + gap)),), False),
+    ]
+    (c,) = chain(pieces, 0.001)
+    assert c.closed and len(c.segments) == 3
+    for a, b in zip(c.segments, c.segments[1:] + c.segments[:1], strict=True):
+        assert a.end == b.start  # snapped exactly
+
+
+def test_chain_leaves_far_ends_apart() -> None:
+    pieces = [Contour((Line((0, 0), (1, 0)),), False), Contour((Line((1.01, 0), (2, 0)),), False)]
+    assert len(chain(pieces, 0.001)) == 2
+
+
+def test_inside_contours_are_cut_first() -> None:
+    outer, hole, other = _rect(0, 0, 10, 10), _circle(5, 5, 1), _rect(20, 0, 21, 1)
+    contours = [outer, hole, other]
+    nest = nesting(contours)
+    assert nest.parents == ((), (0,), ())
+    order = order_contours(contours, nest, (0.0, 0.0))
+    assert order.index(1) < order.index(0)
+
+
+def test_outside_compensates_holes_inwards(tmp_path: Path) -> None:
+    def build(msp: Any) -> None:
+        msp.add_lwpolyline([(1, 1), (9, 1), (9, 6), (1, 6)], close=True)
+        msp.add_circle((5, 3.5), 1.0)
+
+    drawing = read_dxf(write_dxf(tmp_path / "h.dxf", build))
+    program = plan(drawing, PlanOptions(offset="outside", tool_diameter=0.4, feed_mm_min=1.0))
+    radii = {
+        round(math.dist((m.x, m.y), (m.cx, m.cy)), 6)
+        for m in program.moves
+        if isinstance(m, ArcMove) and m.contour == 1
+    }
+    assert radii == {0.8}  # the hole (cut first) shrinks by the tool radius
+    x0, y0, x1, y1 = program.bbox(cutting_only=True)
+    assert (x0, y0, x1, y1) == pytest.approx((0.8, 0.8, 9.2, 6.2))
+
+
+def test_plan_one_rapid_per_contour(tmp_path: Path) -> None:
+    drawing = read_dxf(rectangle_dxf(tmp_path / "r.dxf"))
+    program = plan(drawing, PlanOptions(feed_mm_min=1.0))
+    assert [type(m) for m in program.moves].count(Rapid) == 1
+    assert program.cut_length() == pytest.approx(30.0)
+
+
+def test_open_contours_with_a_side_warn(tmp_path: Path) -> None:
+    drawing = Drawing((Contour((Line((0, 0), (1, 0)),), False),))
+    program = plan(drawing, PlanOptions(offset="outside", tool_diameter=1.0, feed_mm_min=1.0))
+    assert any("open contour" in w for w in program.warnings)
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [{"offset": "outside"}, {"offset": "sideways"}, {"feed_mm_min": 0.0}, {"tolerance": 0.0}],
+)
+def test_plan_options_validated(kwargs: dict[str, Any]) -> None:
+    base: dict[str, Any] = {"feed_mm_min": 1.0}
+    with pytest.raises(UsageError):
+        PlanOptions(**(base | kwargs))
