@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint typecheck unit bench clean
+.PHONY: demo test lint typecheck unit bench docs clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -19,8 +19,8 @@ demo: $(STAMP)
 	@echo "demo: the pic-mmh program for samples/logo.dxf is in out/logo.pic"
 
 lint: $(STAMP)
-	$(BIN)/ruff check camtool tests samples
-	$(BIN)/ruff format --check camtool tests samples
+	$(BIN)/ruff check camtool tests samples docs
+	$(BIN)/ruff format --check camtool tests samples docs
 
 typecheck: $(STAMP)
 	$(BIN)/mypy
@@ -35,3 +35,6 @@ bench: $(STAMP)
 
 clean:
 	rm -rf $(VENV) out .pytest_cache .mypy_cache .ruff_cache
+
+docs: $(STAMP)
+	$(BIN)/python docs/make_docs.py

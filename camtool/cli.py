@@ -9,12 +9,16 @@ from __future__ import annotations
 import json
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import click
 
 from camtool import __version__
 from camtool.errors import CamtoolError
 from camtool.toolpath.plan import OFFSET_MODES
+
+if TYPE_CHECKING:
+    from camtool.geometry import Drawing
 
 
 def _warn(messages: tuple[str, ...] | list[str]) -> None:
@@ -47,7 +51,7 @@ def cli() -> None:
 
 
 @cli.command()
-@click.argument("drawing", type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("drawing", metavar="DRAWING")
 @click.option(
     "--target",
     "-t",
@@ -93,6 +97,22 @@ def cli() -> None:
     help="Entity ends closer than this (mm) are chained into one contour.",
 )
 @click.option(
+    "--scale",
+    type=float,
+    default=1.0,
+    show_default=True,
+    metavar="K",
+    help="Scale the drawing by K about its origin (unitless factor).",
+)
+@click.option(
+    "--fit",
+    "fit_mm",
+    type=(float, float),
+    default=None,
+    metavar="W H",
+    help="Scale the drawing uniformly to fit W x H mm, about its lower-left corner.",
+)
+@click.option(
     "--machine",
     "machine_file",
     type=click.Path(dir_okay=False, path_type=Path),
@@ -100,34 +120,27 @@ def cli() -> None:
     metavar="FILE",
     help="TOML machine profile replacing the target's.",
 )
-def post(
-    drawing: Path,
-    target: str,
-    output: str,
-    offset: str,
-    tool_diameter: float,
-    feed: float | None,
-    tolerance: float,
-    machine_file: Path | None,
-) -> None:
-    """Import DRAWING, plan the toolpath and write it in a target's dialect."""
-    from camtool.pipeline import post_file
+def post(drawing: str, target: str, output: str, machine_file: Path | None, **options: Any) -> None:
+    """Import DRAWING (a .dxf file, or '-' for stdin), plan it, write it for a target."""
+    from camtool.pipeline import post_drawing
+    from camtool.post.registry import load_target
 
-    job = post_file(
-        drawing,
-        target,
-        offset=offset,
-        tool_diameter=tool_diameter,
-        feed_mm_min=feed,
-        tolerance=tolerance,
-        machine_file=machine_file,
-    )
+    chosen = load_target(target, machine_file=machine_file)
+    job = post_drawing(_read_input(drawing), chosen, feed_mm_min=options.pop("feed"), **options)
     _warn(job.warnings)
     _write(job.result.code, output)
     if output != "-":
         click.echo(
-            f"camtool: wrote {job.result.blocks} blocks for {job.target.name} to {output}", err=True
+            f"camtool: wrote {job.result.blocks} blocks for {chosen.name} to {output}", err=True
         )
+
+
+def _read_input(name: str) -> Drawing:
+    from camtool.importers import read_drawing, read_drawing_bytes
+
+    if name == "-":
+        return read_drawing_bytes(sys.stdin.buffer.read())
+    return read_drawing(name)
 
 
 @cli.command()

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from camtool.geometry import Drawing
 from camtool.importers import read_drawing
@@ -35,37 +36,49 @@ class PostJob:
         return tuple(dict.fromkeys(self.program.warnings + self.result.warnings))
 
 
-def post_file(
-    path: str | Path,
-    target_name: str,
+def post_file(path: str | Path, target_name: str, **options: Any) -> PostJob:
+    """Import the drawing at ``path``, plan it and post it (see :func:`post_drawing`).
+
+    Raises:
+        CamtoolError: from any stage, with its exit code.
+    """
+    target = load_target(target_name, machine_file=options.pop("machine_file", None))
+    return post_drawing(read_drawing(path), target, **options)
+
+
+def post_drawing(
+    drawing: Drawing,
+    target: Target,
     *,
     offset: str = "on",
     tool_diameter: float = 0.0,
     feed_mm_min: float | None = None,
     tolerance: float = 0.001,
-    machine_file: Path | None = None,
+    scale: float = 1.0,
+    fit_mm: tuple[float, float] | None = None,
 ) -> PostJob:
-    """Import a drawing, plan it and post it for a target.
+    """Plan a drawing and post it for a target.
 
     Args:
-        path: the drawing file (DXF).
-        target_name: a built-in target or a target ``.toml`` path.
+        drawing: the imported drawing, mm.
+        target: the target (see :func:`camtool.post.registry.load_target`).
         offset: ``on``, ``outside`` or ``inside`` (see :mod:`camtool.toolpath.plan`).
         tool_diameter: tool diameter, mm.
         feed_mm_min: cutting feed, mm/min; ``None`` takes the target's default.
         tolerance: chaining tolerance, mm.
-        machine_file: TOML file replacing the target's machine profile.
+        scale: uniform scale of the drawing about its origin.
+        fit_mm: scale the drawing to fit ``(width, height)`` mm instead.
 
     Raises:
         CamtoolError: from any stage, with its exit code.
     """
-    target = load_target(target_name, machine_file=machine_file)
-    drawing = read_drawing(path)
     options = PlanOptions(
         offset=offset,
         tool_diameter=tool_diameter,
         feed_mm_min=target.default_feed_mm_min if feed_mm_min is None else feed_mm_min,
         tolerance=tolerance,
+        scale=scale,
+        fit_mm=fit_mm,
     )
     program = plan(drawing, options)
     return PostJob(drawing, program, target, target.emit(program))

@@ -101,10 +101,49 @@ def test_failed_run_keeps_the_previous_output(
     assert code == 1 and dest.read_text() == "previous\n"
 
 
+def test_drawing_from_stdin(tmp_path: Path) -> None:
+    data = golden_arc_dxf(tmp_path / "g.dxf").read_bytes()
+    proc = subprocess.run(
+        [sys.executable, "-m", "camtool", "post", "-", "-t", "pic-mmh"],
+        input=data,
+        capture_output=True,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert b"G02X02969.00Y03400.00I03012.00J03040.00F08;" in proc.stdout
+
+
+def test_garbage_on_stdin_is_named(capsys: pytest.CaptureFixture[str]) -> None:
+    proc = subprocess.run(
+        [sys.executable, "-m", "camtool", "post", "-", "-t", "pic-mmh"],
+        input=b"not a drawing",
+        capture_output=True,
+        check=False,
+    )
+    assert proc.returncode == 3
+    assert b"<stdin>: not a readable DXF" in proc.stderr and b"Traceback" not in proc.stderr
+
+
+def test_fit_brings_a_large_drawing_into_the_work_area(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    big = str(rectangle_dxf(tmp_path / "big.dxf", 20, 1))
+    assert run(["post", big, "-t", "pic-mmh"], capsys)[0] == 1
+    code, out, _ = run(["post", big, "-t", "pic-mmh", "--fit", "8", "5"], capsys)
+    assert code == 0 and "G01X09000.00Y01000.00F08;" in out  # 1 + 8 mm
+
+
 def test_help_explains_units(capsys: pytest.CaptureFixture[str]) -> None:
     code, out, _ = run(["post", "--help"], capsys)
     assert code == 0
-    for text in ("--tool-diameter MM", "--feed MM_PER_MIN", "--tolerance MM", "mm/min"):
+    for text in (
+        "--tool-diameter MM",
+        "--feed MM_PER_MIN",
+        "--tolerance MM",
+        "mm/min",
+        "--fit W H",
+        "--scale K",
+    ):
         assert text in out
 
 

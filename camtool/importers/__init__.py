@@ -24,7 +24,32 @@ def read_drawing(path: str | Path) -> Drawing:
         from camtool.importers.dxf import read_dxf
 
         return read_dxf(path)
+    if suffix == "" and str(path) == "-":
+        raise InputError("'-' (stdin) must be read with read_drawing_bytes")
     raise InputError(
         f"{path}: cannot read {suffix or 'files without an ending'!r}; "
         f"camtool reads {', '.join(DRAWING_SUFFIXES)}"
     )
+
+
+def read_drawing_bytes(data: bytes, *, name: str = "<stdin>", suffix: str = ".dxf") -> Drawing:
+    """Read a drawing given as bytes (e.g. piped on stdin), of the kind ``suffix`` names.
+
+    The bytes go through a temporary file so that each importer detects the
+    encoding as it does for files; messages name ``name``.
+
+    Raises:
+        InputError: as :func:`read_drawing`.
+    """
+    import dataclasses
+    import tempfile
+
+    with tempfile.TemporaryDirectory(prefix="camtool-") as tmp:
+        path = Path(tmp) / f"stdin{suffix}"
+        path.write_bytes(data)
+        try:
+            drawing = read_drawing(path)
+        except InputError as exc:
+            raise InputError(str(exc).replace(str(path), name)) from exc
+    warnings = tuple(w.replace(str(path), name) for w in drawing.warnings)
+    return dataclasses.replace(drawing, source=name, warnings=warnings)

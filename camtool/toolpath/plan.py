@@ -15,6 +15,7 @@ warning when a side was asked for.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -38,6 +39,10 @@ class PlanOptions:
         feed_mm_min: cutting feed, mm/min (> 0).
         tolerance: chaining tolerance, mm (> 0): ends closer than this meet.
         origin: tool position before the program, mm.
+        scale: uniform scale applied to the drawing about its origin (> 0).
+        fit_mm: ``(width, height)``: scale the drawing uniformly, about the
+            lower-left corner of its bounding box, to the largest size that fits
+            this box. Excludes ``scale``.
     """
 
     offset: str = "on"
@@ -45,6 +50,8 @@ class PlanOptions:
     feed_mm_min: float
     tolerance: float = 0.001
     origin: Point = (0.0, 0.0)
+    scale: float = 1.0
+    fit_mm: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
         if self.offset not in OFFSET_MODES:
@@ -59,6 +66,13 @@ class PlanOptions:
             raise UsageError(f"feed must be > 0 mm/min, got {self.feed_mm_min!r}")
         if self.tolerance <= 0:
             raise UsageError(f"tolerance must be > 0 mm, got {self.tolerance!r}")
+        if self.scale <= 0:
+            raise UsageError(f"scale must be > 0, got {self.scale!r}")
+        if self.fit_mm is not None:
+            if self.scale != 1.0:
+                raise UsageError("give either --scale or --fit, not both")
+            if min(self.fit_mm) <= 0:
+                raise UsageError(f"--fit needs a width and height > 0 mm, got {self.fit_mm!r}")
 
 
 def plan(drawing: Drawing, options: PlanOptions) -> Program:
@@ -72,7 +86,7 @@ def plan(drawing: Drawing, options: PlanOptions) -> Program:
         UsageError: invalid options.
         ToolpathError: an offset fails or leaves nothing.
     """
-    contours = chain(drawing.contours, options.tolerance)
+    contours = chain(place(drawing, options).contours, options.tolerance)
     nest = nesting(contours)
     warnings = list(drawing.warnings)
     paths = list(contours)
@@ -83,6 +97,18 @@ def plan(drawing: Drawing, options: PlanOptions) -> Program:
     for number, index in enumerate(order, start=1):
         moves.extend(_contour_moves(paths[index], number, options.feed_mm_min))
     return Program(tuple(moves), options.origin, tuple(warnings))
+
+
+def place(drawing: Drawing, options: PlanOptions) -> Drawing:
+    """The drawing scaled as ``options.scale`` or ``options.fit_mm`` ask (mm)."""
+    if options.fit_mm is None:
+        return drawing if options.scale == 1.0 else drawing.transformed(options.scale)
+    x0, y0, x1, y1 = drawing.bbox()
+    w, h = options.fit_mm
+    k = min(w / (x1 - x0) if x1 > x0 else math.inf, h / (y1 - y0) if y1 > y0 else math.inf)
+    if math.isinf(k):
+        return drawing
+    return drawing.transformed(k, x0 * (1 - k), y0 * (1 - k))
 
 
 def _compensate(

@@ -132,3 +132,22 @@ def test_plan_options_validated(kwargs: dict[str, Any]) -> None:
     base: dict[str, Any] = {"feed_mm_min": 1.0}
     with pytest.raises(UsageError):
         PlanOptions(**(base | kwargs))
+
+
+def test_fit_scales_uniformly_about_the_lower_left_corner(tmp_path: Path) -> None:
+    drawing = read_dxf(rectangle_dxf(tmp_path / "r.dxf", 10, 5))  # (1,1)–(11,6)
+    program = plan(drawing, PlanOptions(feed_mm_min=1.0, fit_mm=(4.0, 4.0)))
+    assert program.bbox(cutting_only=True) == pytest.approx(
+        (1.0, 1.0, 5.0, 3.0)
+    )  # limited by the width
+
+
+def test_scale_about_the_origin(tmp_path: Path) -> None:
+    drawing = read_dxf(rectangle_dxf(tmp_path / "r.dxf", 10, 5))
+    program = plan(drawing, PlanOptions(feed_mm_min=1.0, scale=0.5))
+    assert program.bbox(cutting_only=True) == pytest.approx((0.5, 0.5, 5.5, 3.0))
+
+
+def test_scale_and_fit_exclude_each_other() -> None:
+    with pytest.raises(UsageError, match="either --scale or --fit"):
+        PlanOptions(feed_mm_min=1.0, scale=2.0, fit_mm=(1.0, 1.0))
