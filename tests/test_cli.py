@@ -173,3 +173,37 @@ def test_version_does_not_load_opencascade() -> None:
     )
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert proc.stdout.strip().endswith("False False")
+
+
+BIG_MACHINE = """
+[machine]
+name = "MMH on a big table"
+steps_per_mm = [7142.857, 7142.857, 7142.857]
+work_area_mm = [0.0, 0.0, 200.0, 200.0]
+has_z = false
+"""
+
+
+def test_value_over_its_field_names_contour_and_block(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # 151 mm = 151000.00 µm needs 6 integer digits; the pic-mmh field has 5 (S000-07).
+    machine = tmp_path / "big.toml"
+    machine.write_text(BIG_MACHINE)
+    drawing = str(rectangle_dxf(tmp_path / "r.dxf", 150, 1))
+    dest = tmp_path / "out.pic"
+    code, out, err = run(
+        ["post", drawing, "-t", "pic-mmh", "--machine", str(machine), "-o", str(dest)], capsys
+    )
+    assert code == 1 and out == "" and not dest.exists()
+    assert "contour 1, block 4: X = 151000.00 does not fit 5 integer digits" in err
+
+
+def test_machine_file_with_an_unknown_key(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    machine = tmp_path / "bad.toml"
+    machine.write_text(BIG_MACHINE + "backlash_typo = 3\n")
+    drawing = str(rectangle_dxf(tmp_path / "r.dxf", 2, 1))
+    code, _, err = run(["post", drawing, "-t", "pic-mmh", "--machine", str(machine)], capsys)
+    assert code == 3 and "unknown machine key(s) ['backlash_typo']" in err

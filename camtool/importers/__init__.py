@@ -26,9 +26,9 @@ def read_drawing(path: str | Path) -> Drawing:
         return read_dxf(path)
     if suffix == "" and str(path) == "-":
         raise InputError("'-' (stdin) must be read with read_drawing_bytes")
+    kind = f"{suffix!r} files" if suffix else "a file without a name ending"
     raise InputError(
-        f"{path}: cannot read {suffix or 'files without an ending'!r}; "
-        f"camtool reads {', '.join(DRAWING_SUFFIXES)}"
+        f"{path}: cannot read {kind}; camtool reads {', '.join(DRAWING_SUFFIXES)} drawings"
     )
 
 

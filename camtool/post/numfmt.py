@@ -66,10 +66,7 @@ class NumberFormat:
         int_part = text.split(".")[0]
         if self.int_digits is not None:
             if len(int_part) > self.int_digits:
-                raise DialectError(
-                    f"{q} does not fit {self.int_digits} integer digits "
-                    f"(largest {'9' * self.int_digits})"
-                )
+                raise DialectError(f"{q} does not fit {self.int_digits} integer digits")
             text = text.rjust(len(text) - len(int_part) + self.int_digits, "0")
         if q < 0:
             return "-" + text

@@ -110,7 +110,9 @@ class PicMmhPost(PostProcessor):
         try:
             return letter + self.coord.format(value_mm)
         except DialectError as exc:
-            raise DialectError(f"{w.where(move)}: {letter} = {exc} µm") from exc
+            raise DialectError(
+                f"{w.where(move)}: {letter} = {exc} (µm; at most 99999.99 = 99.99999 mm)"
+            ) from exc
 
     def _xy(self, x: float, y: float, move: Move, w: _Writer) -> str:
         return self._word("X", x, move, w) + self._word("Y", y, move, w)

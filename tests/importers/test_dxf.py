@@ -112,5 +112,5 @@ def test_no_usable_entity(tmp_path: Path) -> None:
 
 
 def test_unknown_suffix(tmp_path: Path) -> None:
-    with pytest.raises(InputError, match=r"cannot read '\.stl'"):
+    with pytest.raises(InputError, match=r"cannot read '\.stl' files"):
         read_drawing(tmp_path / "part.stl")
