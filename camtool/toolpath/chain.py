@@ -50,7 +50,10 @@ def chain(contours: Sequence[Contour], tolerance: float) -> list[Contour]:
         segs = list(contour.segments)
         _extend(segs, pieces, grid, used, tolerance, forward=True)
         _extend(segs, pieces, grid, used, tolerance, forward=False)
-        closed = len(segs) > 1 and distance(segs[-1].end, segs[0].start) <= tolerance
+        # One line cannot close on itself (zero-length lines are dropped on import);
+        # one arc can: a full circle drawn as an ARC from 0° to 360°.
+        meets = distance(segs[-1].end, segs[0].start) <= tolerance
+        closed = meets and (len(segs) > 1 or isinstance(segs[0], Arc))
         if closed:
             segs[-1] = _with_end(segs[-1], segs[0].start)
         result.append(Contour(tuple(segs), closed, contour.layer, contour.source))

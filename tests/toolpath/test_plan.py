@@ -151,3 +151,11 @@ def test_scale_about_the_origin(tmp_path: Path) -> None:
 def test_scale_and_fit_exclude_each_other() -> None:
     with pytest.raises(UsageError, match="either --scale or --fit"):
         PlanOptions(feed_mm_min=1.0, scale=2.0, fit_mm=(1.0, 1.0))
+
+
+def test_a_single_arc_whose_ends_meet_is_closed() -> None:
+    # Regression: an ARC drawn from 0° to 360° (or an OCCT full-circle edge) was left open.
+    almost = Arc((2.0, 0.0), (2.0, 0.0004), (0.0, 0.0), False)
+    (c,) = chain([Contour((almost,), False)], 0.001)
+    assert c.closed
+    assert isinstance(c.segments[0], Arc) and c.segments[0].is_full_circle
