@@ -164,12 +164,9 @@ def _polyline(
     from ezdxf.math import bulge_center
 
     ocs = entity.ocs()
-    elevation = entity.dxf.get("elevation", 0.0)
-    z = (
-        elevation[2]
-        if isinstance(elevation, tuple | list) or hasattr(elevation, "z")
-        else elevation
-    )
+    # The extrusion is ±Z here (tilted ones are skipped), so the elevation never
+    # changes X or Y in the WCS: z = 0 is exact for the 2D result.
+    z = 0.0
     flipped = entity.dxf.get("extrusion", (0.0, 0.0, 1.0))[2] < 0
     pairs = list(itertools.pairwise(vertices))
     if closed and len(vertices) > 1:
