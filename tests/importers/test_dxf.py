@@ -67,6 +67,21 @@ def test_mirrored_ocs_arc_runs_clockwise(tmp_path: Path) -> None:
     assert arc.start == pytest.approx((-2.0, 0.0)) and arc.end == pytest.approx((-1.0, 1.0))
 
 
+def test_mirrored_lwpolyline_bulge_flips(tmp_path: Path) -> None:
+    # OCS (0,0,-1): x → -x. A CCW half circle below the chord (0,0)→(2,0) becomes a
+    # half circle from (0,0) to (-2,0), still below, now run clockwise.
+    def build(msp: Any) -> None:
+        msp.add_lwpolyline(
+            [(0, 0, 1.0), (2, 0, 0)], format="xyb", dxfattribs={"extrusion": (0, 0, -1)}
+        )
+
+    (contour,) = read_dxf(write_dxf(tmp_path / "ml.dxf", build)).contours
+    arc = contour.segments[0]
+    assert isinstance(arc, Arc) and arc.clockwise
+    assert arc.end == pytest.approx((-2.0, 0.0)) and arc.centre == pytest.approx((-1.0, 0.0))
+    assert arc.bbox()[1] == pytest.approx(-1.0)
+
+
 def test_inches_are_scaled_by_25_4(tmp_path: Path) -> None:
     d = read_dxf(rectangle_dxf(tmp_path / "in.dxf", 1.0, 0.5, insunits=1))
     x0, y0, x1, y1 = d.bbox()
