@@ -16,7 +16,6 @@ messages such as "contour 3, block 12".
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import TypeAlias
@@ -93,10 +92,7 @@ class Program:
     def segments(self) -> Iterator[tuple[Move, Segment]]:
         """Each move with its XY path as a geometry segment (rapids as lines)."""
         for start, move in self.steps():
-            if isinstance(move, ArcMove):
-                yield move, Arc(start, (move.x, move.y), (move.cx, move.cy), move.clockwise)
-            else:
-                yield move, Line(start, (move.x, move.y))
+            yield move, segment_of(start, move)
 
     def bbox(self, *, cutting_only: bool = False) -> BBox:
         """Bounding box of the XY path (arcs by their extremes), mm.
@@ -125,8 +121,8 @@ class Program:
         return total
 
 
-def arc_radius_mismatch(start: Point, move: ArcMove) -> float:
-    """|r_end − r_start| of an arc move, mm: how far its end is off its circle."""
-    r0 = math.hypot(start[0] - move.cx, start[1] - move.cy)
-    r1 = math.hypot(move.x - move.cx, move.y - move.cy)
-    return abs(r1 - r0)
+def segment_of(start: Point, move: Move) -> Segment:
+    """The XY path of ``move`` from ``start``: an :class:`Arc` for arc moves, else a Line."""
+    if isinstance(move, ArcMove):
+        return Arc(start, (move.x, move.y), (move.cx, move.cy), move.clockwise)
+    return Line(start, (move.x, move.y))

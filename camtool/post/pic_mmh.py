@@ -29,7 +29,7 @@ from camtool.geometry import distance
 from camtool.machine import Machine
 from camtool.post.base import PostProcessor, PostResult
 from camtool.post.numfmt import NumberFormat, format_int
-from camtool.program import ArcMove, Linear, Move, Program, Rapid
+from camtool.program import ArcMove, Linear, Move, Program, Rapid, segment_of
 
 _COORD = r"([+-]?\d{5}\.\d{2})"
 _BLOCK = re.compile(rf"^G0(?P<g>[0-3])X{_COORD}Y{_COORD}(?:I{_COORD}J{_COORD})?(?:F(?P<f>\d\d))?;$")
@@ -138,8 +138,7 @@ class PicMmhPost(PostProcessor):
 
     @staticmethod
     def _check_area(start: tuple[float, float], move: Move, machine: Machine, w: _Writer) -> None:
-        seg = next(Program((move,), origin=start).segments())[1]
-        box = (move.x, move.y, move.x, move.y) if isinstance(move, Rapid) else seg.bbox()
+        box = segment_of(start, move).bbox()
         if machine.outside_work_area(box):
             x0, y0, x1, y1 = machine.work_area_mm
             raise DialectError(
