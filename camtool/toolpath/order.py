@@ -42,31 +42,21 @@ def nesting(contours: Sequence[Contour]) -> Nesting:
     Returns:
         The containment relation, indexed like ``contours``.
     """
-    from shapely import LineString, Polygon, prepare
+    from shapely import LineString, Polygon, STRtree
 
-    shapes = []
-    for c in contours:
-        pts = c.points(_NEST_TOLERANCE_MM)
-        if c.closed and len(pts) >= 4:
-            shapes.append(Polygon(pts).buffer(0))
-        else:
-            shapes.append(LineString(pts) if len(pts) > 1 else None)
-    closed = [i for i, c in enumerate(contours) if c.closed and shapes[i] is not None]
-    for i in closed:
-        prepare(shapes[i])
+    # Closed contours as filled polygons (buffer(0) repairs self-touching outlines);
+    # any contour, open or closed, is tested by its outline.
+    outlines = [LineString(c.points(_NEST_TOLERANCE_MM)) for c in contours]
+    closed = [i for i, c in enumerate(contours) if c.closed]
+    polygons = [Polygon(outlines[i].coords).buffer(0) for i in closed]
+    areas = {i: poly.area for i, poly in zip(closed, polygons, strict=True)}
+    tree = STRtree(polygons)
     parents: list[tuple[int, ...]] = []
-    for i, shape in enumerate(shapes):
-        inner = shape.exterior if contours[i].closed and hasattr(shape, "exterior") else shape
-        parents.append(
-            tuple(
-                j
-                for j in closed
-                if j != i
-                and inner is not None
-                and abs(shapes[j].area) > abs(getattr(shape, "area", 0.0))
-                and shapes[j].covers(inner)
-            )
-        )
+    for i, outline in enumerate(outlines):
+        around = (closed[k] for k in tree.query(outline, predicate="covered_by"))
+        # A polygon covers its own outline and that of an identical duplicate: a
+        # parent must also be strictly larger.
+        parents.append(tuple(sorted(j for j in around if areas[j] > areas.get(i, 0.0))))
     return Nesting(tuple(parents))
 
 

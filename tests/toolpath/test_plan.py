@@ -159,3 +159,12 @@ def test_a_single_arc_whose_ends_meet_is_closed() -> None:
     (c,) = chain([Contour((almost,), False)], 0.001)
     assert c.closed
     assert isinstance(c.segments[0], Arc) and c.segments[0].is_full_circle
+
+
+def test_nesting_of_open_contours_and_duplicates() -> None:
+    square, twin = _rect(0, 0, 4, 4), _rect(0, 0, 4, 4)
+    slot = Contour((Line((1, 1), (3, 1)),), False)
+    outside = Contour((Line((5, 1), (6, 1)),), False)
+    nest = nesting([square, twin, slot, outside])
+    assert nest.parents == ((), (), (0, 1), ())  # duplicates never contain each other
+    assert [nest.depth(i) for i in range(4)] == [0, 0, 2, 0]
