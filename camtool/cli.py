@@ -83,6 +83,7 @@ def cli() -> None:
 )
 @click.option(
     "--feed",
+    "feed_mm_min",
     type=float,
     default=None,
     metavar="MM_PER_MIN",
@@ -126,7 +127,7 @@ def post(drawing: str, target: str, output: str, machine_file: Path | None, **op
     from camtool.post.registry import load_target
 
     chosen = load_target(target, machine_file=machine_file)
-    job = post_drawing(_read_input(drawing), chosen, feed_mm_min=options.pop("feed"), **options)
+    job = post_drawing(_read_input(drawing), chosen, **options)
     _warn(job.warnings)
     _write(job.result.code, output)
     if output != "-":

@@ -36,13 +36,21 @@ class PostJob:
         return tuple(dict.fromkeys(self.program.warnings + self.result.warnings))
 
 
-def post_file(path: str | Path, target_name: str, **options: Any) -> PostJob:
+def post_file(
+    path: str | Path, target_name: str, *, machine_file: Path | None = None, **options: Any
+) -> PostJob:
     """Import the drawing at ``path``, plan it and post it (see :func:`post_drawing`).
+
+    Args:
+        path: the drawing file.
+        target_name: a built-in target or a target ``.toml`` path.
+        machine_file: TOML file replacing the target's machine profile.
+        **options: the keyword options of :func:`post_drawing`.
 
     Raises:
         CamtoolError: from any stage, with its exit code.
     """
-    target = load_target(target_name, machine_file=options.pop("machine_file", None))
+    target = load_target(target_name, machine_file=machine_file)
     return post_drawing(read_drawing(path), target, **options)
 
 

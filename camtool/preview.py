@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from xml.sax.saxutils import escape
 
-from camtool.geometry import Arc, BBox, bbox_union
+from camtool.geometry import Arc, BBox, Segment, bbox_union
 from camtool.program import Program, Rapid
 
 CUT_COLOUR = "#1f4fd1"
@@ -81,7 +81,7 @@ def _moves(program: Program, stroke: float) -> list[str]:
     for move, seg in program.segments():
         sx, sy = seg.start
         if isinstance(move, Rapid):
-            rapids.append(f"M{_n(sx)} {_n(-sy)}L{_n(seg.end[0])} {_n(-seg.end[1])}")
+            rapids.append(_straight(seg))
         elif isinstance(seg, Arc):
             pieces = seg.split(2) if seg.is_full_circle else [seg]
             d = f"M{_n(sx)} {_n(-sy)}"
@@ -94,13 +94,18 @@ def _moves(program: Program, stroke: float) -> list[str]:
                 d += f"A{r} {r} 0 {large} {sweep} {_n(a.end[0])} {_n(-a.end[1])}"
             cuts.append(d)
         else:
-            cuts.append(f"M{_n(sx)} {_n(-sy)}L{_n(seg.end[0])} {_n(-seg.end[1])}")
+            cuts.append(_straight(seg))
     return [
         f'<path id="rapids" d="{"".join(rapids)}" fill="none" stroke="{RAPID_COLOUR}" '
         f'stroke-width="{_n(stroke)}" stroke-dasharray="{_n(stroke * 3)}"/>',
         f'<path id="cuts" d="{"".join(cuts)}" fill="none" stroke="{CUT_COLOUR}" '
         f'stroke-width="{_n(stroke * 1.5)}" stroke-linejoin="round"/>',
     ]
+
+
+def _straight(seg: Segment) -> str:
+    """SVG path data of a straight segment (page Y = −drawing Y)."""
+    return f"M{_n(seg.start[0])} {_n(-seg.start[1])}L{_n(seg.end[0])} {_n(-seg.end[1])}"
 
 
 def _starts(program: Program, stroke: float, size: float) -> list[str]:
@@ -130,13 +135,13 @@ def _starts(program: Program, stroke: float, size: float) -> list[str]:
     return out
 
 
-def _tangent(seg: object) -> tuple[float, float]:
+def _tangent(seg: Segment) -> tuple[float, float]:
     """Unit direction of travel at a segment's start."""
     if isinstance(seg, Arc):
         rx, ry = seg.start[0] - seg.centre[0], seg.start[1] - seg.centre[1]
         tx, ty = (ry, -rx) if seg.clockwise else (-ry, rx)
     else:
-        (x0, y0), (x1, y1) = seg.start, seg.end  # type: ignore[attr-defined]
+        (x0, y0), (x1, y1) = seg.start, seg.end
         tx, ty = x1 - x0, y1 - y0
     length = math.hypot(tx, ty) or 1.0
     return tx / length, ty / length

@@ -41,13 +41,14 @@ def generated() -> dict[Path, str]:
 
 def main(argv: list[str]) -> int:
     """Write the generated docs, or with ``--check`` list the stale ones."""
-    stale = [p for p, text in generated().items() if not p.exists() or p.read_text("utf-8") != text]
+    files = generated()
+    stale = [p for p, text in files.items() if not p.exists() or p.read_text("utf-8") != text]
     if "--check" in argv:
         for p in stale:
             print(f"stale: {p.relative_to(ROOT)} (run make docs)", file=sys.stderr)
         return 1 if stale else 0
-    for p, text in generated().items():
-        p.write_text(text, encoding="utf-8")
+    for p in stale:
+        p.write_text(files[p], encoding="utf-8")
     print(f"docs: wrote {len(stale)} changed file(s)")
     return 0
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import re
 from pathlib import Path
 
@@ -11,7 +12,7 @@ from camtool.errors import DialectError, ParseError
 from camtool.pipeline import post_file
 from camtool.post.pic_mmh import PicMmhPost
 from camtool.post.registry import load_target
-from camtool.program import ArcMove, Linear, Program, Rapid
+from camtool.program import ArcMove, Linear, Move, Program, Rapid
 from tests.shapes import golden_arc_dxf
 
 SAMPLES = Path(__file__).parents[2] / "samples"
@@ -117,16 +118,27 @@ def test_step_rate_warning_above_166_hz() -> None:
 
 
 def test_round_trip_logo() -> None:
+    # post → parse gives every move back within the 5.2 µm field's resolution (0.01 µm);
+    # a full circle comes back as two halves, the first ending at the diametrically
+    # opposite point (analytic: 2·centre − start).
     job = post_file(SAMPLES / "logo.dxf", "pic-mmh")
-    back = PicMmhPost().parse(str(job.result.code))
-    sent = [m for m in job.program.moves]
-    # full circles come back as two halves; compare end points of every non-full-circle move
-    ends_sent = {(round(m.x, 5), round(m.y, 5)) for m in sent}
-    ends_back = {(round(m.x, 5), round(m.y, 5)) for m in back.moves}
-    assert ends_sent <= ends_back
-    for m in back.moves:
-        if isinstance(m, ArcMove):
-            assert m.feed_mm_min == pytest.approx(0.8)
+    expected: list[Move] = []
+    for start, move in job.program.steps():
+        if isinstance(move, ArcMove) and math.dist(start, (move.x, move.y)) < 1e-9:
+            ox, oy = 2 * move.cx - start[0], 2 * move.cy - start[1]
+            expected.append(ArcMove(ox, oy, move.cx, move.cy, move.clockwise, move.feed_mm_min))
+        expected.append(move)
+    back = PicMmhPost().parse(str(job.result.code)).moves
+    assert [type(m) for m in back] == [type(m) for m in expected]
+    resolution = 0.5e-5  # half of 0.01 µm, in mm
+    for got, want in zip(back, expected, strict=True):
+        assert abs(got.x - want.x) <= resolution and abs(got.y - want.y) <= resolution
+        if isinstance(want, ArcMove):
+            assert isinstance(got, ArcMove) and got.clockwise == want.clockwise
+            assert abs(got.cx - want.cx) <= resolution and abs(got.cy - want.cy) <= resolution
+        if not isinstance(want, Rapid):
+            assert not isinstance(got, Rapid)
+            assert got.feed_mm_min == pytest.approx(want.feed_mm_min)
 
 
 @pytest.mark.parametrize(
