@@ -2,23 +2,50 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 from camtool.errors import InputError
 from camtool.geometry import Drawing
 
+
+@dataclass(frozen=True, kw_only=True)
+class ImportOptions:
+    """What the user asked of an importer (the CLI's ``--layers``, ``--units`` ...).
+
+    Attributes:
+        layers: layer names to keep (DXF layers, Inkscape layers); ``None`` keeps all.
+            A name that matches no layer is an error that lists the layers there are.
+        tolerance: largest distance, mm, between a curve (spline, ellipse, Bézier)
+            and the arcs and lines fitted to it.
+        units: unit of unitless inputs (point lists): ``mm``, ``cm``, ``in``, ``um``
+            or ``0.1mm``; ``None`` is each importer's documented default (mm).
+        hatch_boundaries: take HATCH boundary paths as contours (DXF).
+    """
+
+    layers: tuple[str, ...] | None = None
+    tolerance: float = 0.001
+    units: str | None = None
+    hatch_boundaries: bool = False
+
+
 DRAWING_SUFFIXES = (".dxf",)
 """File name endings the importers read, lowercase."""
 
 
-def read_drawing(path: str | Path) -> Drawing:
+def read_drawing(path: str | Path, options: ImportOptions | None = None) -> Drawing:
     """Read the drawing at ``path``, choosing the importer by the file name ending.
+
+    Args:
+        path: the drawing file.
+        options: importer options; ``None`` takes the defaults.
 
     Raises:
         InputError: the file is missing, unreadable, of an unknown kind, or holds
             no usable entity.
     """
     path = Path(path)
+    options = options or ImportOptions()
     suffix = path.suffix.lower()
     if suffix == ".dxf":
         from camtool.importers.dxf import read_dxf
@@ -32,7 +59,13 @@ def read_drawing(path: str | Path) -> Drawing:
     )
 
 
-def read_drawing_bytes(data: bytes, *, name: str = "<stdin>", suffix: str = ".dxf") -> Drawing:
+def read_drawing_bytes(
+    data: bytes,
+    *,
+    name: str = "<stdin>",
+    suffix: str = ".dxf",
+    options: ImportOptions | None = None,
+) -> Drawing:
     """Read a drawing given as bytes (e.g. piped on stdin), of the kind ``suffix`` names.
 
     The bytes go through a temporary file so that each importer detects the
@@ -48,7 +81,7 @@ def read_drawing_bytes(data: bytes, *, name: str = "<stdin>", suffix: str = ".dx
         path = Path(tmp) / f"stdin{suffix}"
         path.write_bytes(data)
         try:
-            drawing = read_drawing(path)
+            drawing = read_drawing(path, options)
         except InputError as exc:
             raise InputError(str(exc).replace(str(path), name)) from exc
     warnings = tuple(w.replace(str(path), name) for w in drawing.warnings)
