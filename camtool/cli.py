@@ -14,11 +14,14 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from camtool import __version__
-from camtool.errors import CamtoolError
+from camtool.errors import CamtoolError, InputError, VerifyLimitError
 from camtool.toolpath.plan import OFFSET_MODES
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
     from camtool.geometry import Drawing
+    from camtool.verify.verifier import Verification
 
 
 def _warn(messages: tuple[str, ...] | list[str]) -> None:
@@ -39,6 +42,29 @@ def _write(data: str | bytes, out: str) -> None:
         write_atomic(out, data)
     except OSError as exc:
         raise CamtoolError(f"{out}: cannot write ({exc.strerror or exc})") from exc
+
+
+def _verify_outputs(command: Callable[..., None]) -> Callable[..., None]:
+    """The options every verifying command shares: --report, --preview, --max-error-um."""
+    command = click.option(
+        "--max-error-um",
+        type=click.FloatRange(min=0),
+        default=None,
+        metavar="N",
+        help="Exit with code 4 when the predicted error exceeds N µm (for CI).",
+    )(command)
+    command = click.option(
+        "--preview",
+        default=None,
+        metavar="P.png|P.svg",
+        help="Draw the nominal path and the simulated one, coloured by deviation.",
+    )(command)
+    return click.option(
+        "--report",
+        default=None,
+        metavar="R.json",
+        help="Write the verify report as JSON ('-' for stdout).",
+    )(command)
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -119,11 +145,27 @@ def cli() -> None:
     type=click.Path(dir_okay=False, path_type=Path),
     default=None,
     metavar="FILE",
-    help="TOML machine profile replacing the target's.",
+    help="TOML machine profile laid over the target's, key by key.",
 )
-def post(drawing: str, target: str, output: str, machine_file: Path | None, **options: Any) -> None:
-    """Import DRAWING (a .dxf file, or '-' for stdin), plan it, write it for a target."""
-    from camtool.pipeline import post_drawing
+@click.option("--verify", "verify_too", is_flag=True, help="Verify the emitted code (see verify).")
+@_verify_outputs
+def post(
+    drawing: str,
+    target: str,
+    output: str,
+    machine_file: Path | None,
+    verify_too: bool,
+    report: str | None,
+    preview: str | None,
+    max_error_um: float | None,
+    **options: Any,
+) -> None:
+    """Import DRAWING (a .dxf file, or '-' for stdin), plan it, write it for a target.
+
+    With --verify (implied by --report, --preview or --max-error-um) the written
+    code is read back and simulated on the target's machine, as `verify` does.
+    """
+    from camtool.pipeline import post_drawing, verify_job
     from camtool.post.registry import load_target
 
     chosen = load_target(target, machine_file=machine_file)
@@ -133,6 +175,97 @@ def post(drawing: str, target: str, output: str, machine_file: Path | None, **op
     if output != "-":
         click.echo(
             f"camtool: wrote {job.result.blocks} blocks for {chosen.name} to {output}", err=True
+        )
+    if verify_too or report or preview or max_error_um is not None:
+        _finish_verification(verify_job(job), report, preview, max_error_um)
+
+
+@cli.command()
+@click.argument("code", metavar="CODE")
+@click.option(
+    "--target", "-t", required=True, metavar="NAME", help="The target CODE was written for."
+)
+@click.option(
+    "--against",
+    metavar="DRAWING",
+    default=None,
+    help="Compare the machined edge with this drawing (same coordinates as the code).",
+)
+@click.option(
+    "--tool-diameter",
+    type=float,
+    default=0.0,
+    show_default=True,
+    metavar="MM",
+    help="Tool diameter; the machined edge is the simulated path swept by half of it.",
+)
+@click.option(
+    "--machine",
+    "machine_file",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    metavar="FILE",
+    help="TOML machine profile laid over the target's (e.g. a measured backlash).",
+)
+@_verify_outputs
+def verify(
+    code: str,
+    target: str,
+    against: str | None,
+    tool_diameter: float,
+    machine_file: Path | None,
+    report: str | None,
+    preview: str | None,
+    max_error_um: float | None,
+) -> None:
+    """Read CODE (a program file, or '-' for stdin) back and predict the machined error.
+
+    The code is parsed with the target's reader, turned into motor steps, run
+    through the machine's own interpolator, backlash and compensation, and the
+    simulated tool path is measured against the programmed one (and the drawing).
+    A one-screen summary goes to stderr.
+    """
+    from camtool.post.registry import load_target
+    from camtool.verify.verifier import verify_code
+
+    chosen = load_target(target, machine_file=machine_file)
+    text = _read_code(code)
+    drawing = _read_input(against) if against is not None else None
+    v = verify_code(text, chosen, source=code, against=drawing, tool_diameter=tool_diameter)
+    _finish_verification(v, report, preview, max_error_um)
+
+
+def _read_code(name: str) -> str:
+    if name == "-":
+        return sys.stdin.read()
+    try:
+        return Path(name).read_text(encoding="ascii", errors="strict")
+    except FileNotFoundError as exc:
+        raise InputError(f"{name}: no such file") from exc
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{name}: not a text program (byte {exc.start} is not ASCII)") from exc
+    except OSError as exc:
+        raise InputError(f"{name}: cannot read ({exc.strerror or exc})") from exc
+
+
+def _finish_verification(
+    v: Verification, report: str | None, preview: str | None, max_error_um: float | None
+) -> None:
+    """Summary to stderr, then the report and preview files, then the limit check."""
+    from camtool.verify.verifier import report_dict, summary_lines
+
+    _warn(v.warnings)
+    for line in summary_lines(v):
+        click.echo(f"camtool: {line}", err=True)
+    if report is not None:
+        _write(json.dumps(report_dict(v), indent=2) + "\n", report)
+    if preview is not None:
+        from camtool.preview_trace import write_trace_preview
+
+        _write(write_trace_preview(v, preview), preview)
+    if max_error_um is not None and v.max_error_um > max_error_um:
+        raise VerifyLimitError(
+            f"predicted error {v.max_error_um:.2f} µm exceeds --max-error-um {max_error_um:g}"
         )
 
 

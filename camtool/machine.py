@@ -1,19 +1,139 @@
 """Machine profile: what a target's machine can do and how it moves.
 
-Loaded from the ``[machine]`` table of a target's TOML file (and overridable
-with ``--machine FILE.toml``). Lengths in mm unless the name says otherwise.
+Loaded from the ``[machine]`` table of a target's TOML file and overridable,
+key by key, with ``--machine FILE.toml`` (see :func:`merge_tables`). Lengths in
+mm unless the name says otherwise. The verifier (:mod:`camtool.verify`) reads
+everything below; the post-processors read the work area, Z and step rate.
+
+Profile layout (every key optional except ``name``, ``steps_per_mm`` and
+``work_area_mm``; unknown keys and wrong types are errors naming the key)::
+
+    [machine]
+    name, steps_per_mm = [x, y, z]      # what the controller assumes (nominal)
+    true_steps_per_mm = [x, y, z]       # what the mechanics do (default: nominal)
+    work_area_mm = [xmin, ymin, xmax, ymax], has_z, max_step_rate_hz, source
+    [machine.motion]    line, arc, chords, chord_tolerance_mm, chord_segments,
+                        chord_angle_deg, rounding
+    [machine.backlash]  true_um = [x, y, z], compensation_um = [x, y, z]
+    [[machine.backlash.regions]]  axis, x_mm = [lo, hi], y_mm = [lo, hi], true_um
+    [machine.timing]    model and the model's own parameters (checked by the verifier)
 """
 
 from __future__ import annotations
 
+import math
 import tomllib
 from collections.abc import Mapping
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any
 
 from camtool.errors import InputError
 from camtool.geometry import BBox
+
+LINE_INTERPOLATORS: dict[str, str] = {
+    "dda": "linear DDA of the GMM PIC (seed-000 §4.2, annex A.3)",
+    "accumulator-dda": "accumulator DDA of ValCNC (seed-004 §4.1, Table 8)",
+    "bresenham": "Bresenham/AMASS stepping of GRBL and LinuxCNC",
+    "corte-recto": "diagonal, then the longer axis alone (seed-003 §4.1-4.2)",
+    "timer": "millisecond-timer stepping of the LMM VB6 application (seed-001 §4.7, R11)",
+}
+"""Line interpolators a profile may name, with where each comes from."""
+
+ARC_INTERPOLATORS: dict[str, str] = {
+    "dsm": "direct search method (seed-000 §4.5, annex A.6)",
+    "staircase": "incremental staircase (seed-000 §4.4, annex A.5)",
+    "circular-dda": "circular DDA (seed-000 §4.3, annex A.4)",
+    "chords": "chords executed by the line interpolator (seed-001 §4.4, seed-004 §4.2, GRBL)",
+}
+"""Arc interpolators a profile may name."""
+
+CHORD_RULES: dict[str, str] = {
+    "sagitta": "fewest equal chords within chord_tolerance_mm",
+    "grbl": "GRBL 1.1 mc_arc with arc_tolerance = chord_tolerance_mm",
+    "flashcut": "chord_segments equal chords per arc (seed-001 §4.4)",
+    "valcnc": "chords of chord_angle_deg (seed-004 §4.2)",
+}
+"""How ``arc = "chords"`` cuts an arc into chords."""
+
+ROUNDINGS = ("half_even", "half_up", "floor", "trunc")
+"""mm → steps rounding rules (:func:`camtool.verify.quantize.steps_from_mm`)."""
+
+AXES = ("x", "y", "z")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Motion:
+    """How the controller turns blocks into motor steps.
+
+    Attributes:
+        line: a key of :data:`LINE_INTERPOLATORS`.
+        arc: a key of :data:`ARC_INTERPOLATORS`.
+        chords: a key of :data:`CHORD_RULES` (used when ``arc == "chords"``).
+        chord_tolerance_mm: largest chord sagitta, mm (``sagitta``, ``grbl``).
+        chord_segments: chords per arc (``flashcut``; the thesis does not say).
+        chord_angle_deg: chord angle β, degrees (``valcnc``; not given).
+        rounding: mm → steps rounding of the controller, one of :data:`ROUNDINGS`.
+            Positions are converted absolutely (no drift), seed-001 §4.5.
+    """
+
+    line: str = "dda"
+    arc: str = "dsm"
+    chords: str = "sagitta"
+    chord_tolerance_mm: float = 0.002
+    chord_segments: int = 16
+    chord_angle_deg: float = 5.0
+    rounding: str = "half_up"
+
+
+@dataclass(frozen=True, kw_only=True)
+class BacklashRegion:
+    """True backlash of one axis inside a rectangle of the work area (seed-000 Tabla 13).
+
+    Attributes:
+        axis: ``"x"`` or ``"y"``.
+        x_mm: ``(lo, hi)`` extent in X, mm.
+        y_mm: ``(lo, hi)`` extent in Y, mm.
+        true_um: true backlash of ``axis`` there, µm.
+    """
+
+    axis: str
+    x_mm: tuple[float, float]
+    y_mm: tuple[float, float]
+    true_um: float
+
+    def contains(self, x_mm: float, y_mm: float) -> bool:
+        """True when ``(x_mm, y_mm)`` lies in the rectangle (edges included)."""
+        return self.x_mm[0] <= x_mm <= self.x_mm[1] and self.y_mm[0] <= y_mm <= self.y_mm[1]
+
+
+@dataclass(frozen=True, kw_only=True)
+class Backlash:
+    """Mechanical backlash and the controller's compensation (seed-000 §5, seed-001 §5).
+
+    A reversal of an axis takes up the true backlash before the carriage moves;
+    the controller adds ``compensation_um`` (as whole steps, rounded) in the new
+    direction on every reversal, not counted in its logical position.
+
+    Attributes:
+        true_um: true backlash per axis ``(x, y, z)``, µm.
+        compensation_um: compensation per axis ``(x, y, z)``, µm (0 = none).
+        regions: where the true backlash differs from ``true_um``; the first
+            region of the axis containing the carriage at the reversal applies.
+    """
+
+    true_um: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    compensation_um: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    regions: tuple[BacklashRegion, ...] = ()
+
+    def true_at(self, axis: int, x_mm: float, y_mm: float) -> float:
+        """True backlash of ``axis`` (0 = x, 1 = y, 2 = z) at ``(x_mm, y_mm)``, µm."""
+        name = AXES[axis]
+        for region in self.regions:
+            if region.axis == name and region.contains(x_mm, y_mm):
+                return region.true_um
+        return self.true_um[axis]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -23,12 +143,19 @@ class Machine:
     Attributes:
         name: profile name, e.g. ``"MMH-1 (GMM)"``.
         steps_per_mm: motor steps per mm per axis ``(x, y, z)`` as the controller
-            assumes them.
+            assumes them (nominal).
         work_area_mm: ``(xmin, ymin, xmax, ymax)`` reachable by the tool, mm.
         has_z: whether programs may move Z.
         max_step_rate_hz: highest step frequency the controller sustains, Hz
             (0 = no limit known).
         source: where the numbers come from (a thesis section).
+        true_steps_per_mm: steps per mm the mechanics really make (seed-001 R14:
+            1.9 µm assumed, 1.88 µm real); ``None`` means the nominal values.
+        motion: interpolators and arc handling.
+        backlash: true backlash and compensation.
+        timing: the ``[machine.timing]`` table as written: ``model`` (a model of
+            :data:`camtool.verify.timing.MODELS`) and its parameters; the
+            verifier checks it (:func:`camtool.verify.timing.timing_model_from_table`).
     """
 
     name: str
@@ -37,6 +164,15 @@ class Machine:
     has_z: bool = True
     max_step_rate_hz: float = 0.0
     source: str = ""
+    true_steps_per_mm: tuple[float, float, float] | None = None
+    motion: Motion = field(default_factory=Motion)
+    backlash: Backlash = field(default_factory=Backlash)
+    timing: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
+
+    @property
+    def real_steps_per_mm(self) -> tuple[float, float, float]:
+        """Steps per mm the mechanics make: ``true_steps_per_mm`` or the nominal ones."""
+        return self.true_steps_per_mm or self.steps_per_mm
 
     def step_rate_hz(self, feed_mm_min: float) -> float:
         """Step frequency of the fastest axis moving alone at ``feed_mm_min``, Hz.
@@ -60,27 +196,250 @@ def machine_from_table(table: Mapping[str, Any], *, where: str) -> Machine:
     """Build a :class:`Machine` from a TOML ``[machine]`` table.
 
     Raises:
-        InputError: an unknown key or a value of the wrong shape, naming ``where``.
+        InputError: an unknown key or a value of the wrong type or shape, naming
+            ``where`` and the key (``machine.backlash.true_um``).
     """
-    known = {f.name for f in fields(Machine)}
-    unknown = sorted(set(table) - known)
-    if unknown:
-        raise InputError(f"{where}: unknown machine key(s) {unknown}; known: {sorted(known)}")
-    try:
-        steps = tuple(float(v) for v in table["steps_per_mm"])
-        area = tuple(float(v) for v in table["work_area_mm"])
-        if len(steps) != 3 or len(area) != 4:
-            raise ValueError("steps_per_mm needs 3 values and work_area_mm 4")
-        return Machine(
-            name=str(table["name"]),
-            steps_per_mm=(steps[0], steps[1], steps[2]),
-            work_area_mm=(area[0], area[1], area[2], area[3]),
-            has_z=bool(table.get("has_z", True)),
-            max_step_rate_hz=float(table.get("max_step_rate_hz", 0.0)),
-            source=str(table.get("source", "")),
+    r = _Reader(table, "machine", where)
+    x0, y0, x1, y1 = r.floats("work_area_mm", 4, required=True)
+    true_steps = r.triple("true_steps_per_mm", positive=True)
+    machine = Machine(
+        name=r.text("name", required=True),
+        steps_per_mm=r.triple("steps_per_mm", required=True, positive=True),
+        work_area_mm=(x0, y0, x1, y1),
+        has_z=r.flag("has_z", True),
+        max_step_rate_hz=r.number("max_step_rate_hz", 0.0),
+        source=r.text("source"),
+        true_steps_per_mm=true_steps if "true_steps_per_mm" in table else None,
+        motion=_motion(r.table("motion")),
+        backlash=_backlash(r.table("backlash")),
+        timing=r.raw_table("timing"),
+    )
+    r.done()
+    return machine
+
+
+def _motion(r: _Reader) -> Motion:
+    d = Motion()
+    motion = Motion(
+        line=r.choice("line", LINE_INTERPOLATORS, d.line),
+        arc=r.choice("arc", ARC_INTERPOLATORS, d.arc),
+        chords=r.choice("chords", CHORD_RULES, d.chords),
+        chord_tolerance_mm=r.number("chord_tolerance_mm", d.chord_tolerance_mm, positive=True),
+        chord_segments=int(r.number("chord_segments", d.chord_segments, positive=True)),
+        chord_angle_deg=r.number("chord_angle_deg", d.chord_angle_deg, positive=True),
+        rounding=r.choice("rounding", dict.fromkeys(ROUNDINGS, ""), d.rounding),
+    )
+    r.done()
+    return motion
+
+
+def _backlash(r: _Reader) -> Backlash:
+    regions = []
+    for sub in r.tables("regions"):
+        regions.append(
+            BacklashRegion(
+                axis=sub.choice("axis", {"x": "", "y": ""}, None),
+                x_mm=sub.pair("x_mm"),
+                y_mm=sub.pair("y_mm"),
+                true_um=sub.number("true_um", None, nonnegative=True),
+            )
         )
-    except (KeyError, TypeError, ValueError) as exc:
-        raise InputError(f"{where}: invalid machine profile ({exc})") from exc
+        sub.done()
+    backlash = Backlash(
+        true_um=r.triple("true_um", nonnegative=True),
+        compensation_um=r.triple("compensation_um", nonnegative=True),
+        regions=tuple(regions),
+    )
+    r.done()
+    return backlash
+
+
+class _Reader:
+    """Strict reader of one TOML table: every key read once, unknown keys an error."""
+
+    def __init__(self, table: Mapping[str, Any], path: str, where: str) -> None:
+        if not isinstance(table, Mapping):
+            raise InputError(f"{where}: {path} must be a table, got {table!r}")
+        self.data, self.path, self.where = table, path, where
+        self.seen: set[str] = set()
+
+    def _fail(self, key: str, want: str, value: Any) -> InputError:
+        return InputError(f"{self.where}: {self.path}.{key} must be {want}, got {value!r}")
+
+    def _get(self, key: str, required: bool) -> Any:
+        self.seen.add(key)
+        if key not in self.data:
+            if required:
+                raise InputError(f"{self.where}: {self.path}.{key} is missing")
+            return None
+        return self.data[key]
+
+    def text(self, key: str, *, required: bool = False) -> str:
+        value = self._get(key, required)
+        if value is None:
+            return ""
+        if not isinstance(value, str):
+            raise self._fail(key, "a string", value)
+        return value
+
+    def choice(self, key: str, choices: Mapping[str, object], default: str | None) -> str:
+        value = self._get(key, default is None)
+        if value is None:
+            return str(default)
+        if value not in choices:
+            raise self._fail(key, f"one of {sorted(choices)}", value)
+        return str(value)
+
+    def flag(self, key: str, default: bool) -> bool:
+        value = self._get(key, False)
+        if value is None:
+            return default
+        if not isinstance(value, bool):
+            raise self._fail(key, "true or false", value)
+        return value
+
+    def number(
+        self,
+        key: str,
+        default: float | None,
+        *,
+        positive: bool = False,
+        nonnegative: bool = False,
+    ) -> float:
+        value = self._get(key, default is None)
+        if value is None:
+            return float(default)  # type: ignore[arg-type]
+        return self._check(key, value, positive, nonnegative)
+
+    def _check(self, key: str, value: Any, positive: bool, nonnegative: bool) -> float:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise self._fail(key, "a number", value)
+        number = float(value)
+        if not math.isfinite(number) or (positive and number <= 0) or (nonnegative and number < 0):
+            want = "a positive number" if positive else "a number >= 0" if nonnegative else "finite"
+            raise self._fail(key, want, value)
+        return number
+
+    def floats(
+        self,
+        key: str,
+        count: int,
+        *,
+        required: bool = False,
+        positive: bool = False,
+        nonnegative: bool = False,
+    ) -> tuple[float, ...]:
+        value = self._get(key, required)
+        if value is None:
+            return (0.0,) * count
+        if not isinstance(value, list) or len(value) != count:
+            raise self._fail(key, f"a list of {count} numbers", value)
+        return tuple(self._check(key, v, positive, nonnegative) for v in value)
+
+    def pair(self, key: str) -> tuple[float, float]:
+        lo, hi = self.floats(key, 2, required=True)
+        if lo > hi:
+            raise self._fail(key, "[lo, hi] with lo <= hi", [lo, hi])
+        return (lo, hi)
+
+    def triple(
+        self,
+        key: str,
+        *,
+        required: bool = False,
+        positive: bool = False,
+        nonnegative: bool = False,
+    ) -> tuple[float, float, float]:
+        x, y, z = self.floats(key, 3, required=required, positive=positive, nonnegative=nonnegative)
+        return (x, y, z)
+
+    def table(self, key: str) -> _Reader:
+        value = self._get(key, False)
+        return _Reader({} if value is None else value, f"{self.path}.{key}", self.where)
+
+    def raw_table(self, key: str) -> Mapping[str, Any]:
+        value = self._get(key, False)
+        if value is None:
+            return MappingProxyType({})
+        if not isinstance(value, Mapping):
+            raise self._fail(key, "a table", value)
+        return MappingProxyType(dict(value))
+
+    def tables(self, key: str) -> list[_Reader]:
+        value = self._get(key, False)
+        if value is None:
+            return []
+        if not isinstance(value, list):
+            raise self._fail(key, "an array of tables ([[...]])", value)
+        return [_Reader(v, f"{self.path}.{key}[{i}]", self.where) for i, v in enumerate(value)]
+
+    def done(self, hint: str = "") -> None:
+        unknown = sorted(set(self.data) - self.seen)
+        if unknown:
+            known = hint or f"known: {sorted(self.seen)}"
+            raise InputError(f"{self.where}: unknown key(s) {unknown} in [{self.path}]; {known}")
+
+
+def merge_tables(base: Mapping[str, Any], override: Mapping[str, Any]) -> dict[str, Any]:
+    """``override`` laid over ``base``, sub-tables merged key by key.
+
+    How ``--machine FILE`` changes a target's profile: a file that only says
+    ``[machine.backlash] true_um = [...]`` keeps every other value of the target.
+    Arrays (including arrays of tables) are replaced, not merged.
+    """
+    merged = dict(base)
+    for key, value in override.items():
+        if isinstance(value, Mapping) and isinstance(merged.get(key), Mapping):
+            merged[key] = merge_tables(merged[key], value)
+        else:
+            merged[key] = value
+    return merged
+
+
+def machine_names() -> list[str]:
+    """Names of the built-in machine profiles (``camtool/machines/*.toml``), sorted."""
+    from importlib import resources
+
+    files = resources.files("camtool.machines").iterdir()
+    return sorted(f.name.removesuffix(".toml") for f in files if f.name.endswith(".toml"))
+
+
+def machine_table(name: str) -> tuple[dict[str, Any], str]:
+    """The profile table called ``name`` (built in) or at path ``name`` (``.toml``).
+
+    A profile file holds the machine keys at its top level or in a ``[machine]``
+    table. Returns the table and the name to use in messages.
+
+    Raises:
+        InputError: no such profile or file, or not valid TOML.
+    """
+    if name.endswith(".toml") or Path(name).is_file():
+        table = load_toml(Path(name))
+        where = name
+    elif name in machine_names():
+        from importlib import resources
+
+        text = resources.files("camtool.machines").joinpath(f"{name}.toml").read_text("utf-8")
+        table, where = tomllib.loads(text), f"machines/{name}.toml"
+    else:
+        raise InputError(
+            f"unknown machine profile {name!r}; give a .toml file or one of: "
+            f"{', '.join(machine_names())}"
+        )
+    inner = table.get("machine", table)
+    if not isinstance(inner, Mapping):
+        raise InputError(f"{where}: [machine] must be a table")
+    return dict(inner), where
+
+
+def load_machine(name: str) -> Machine:
+    """The machine profile called ``name`` or at path ``name`` (see :func:`machine_table`).
+
+    Raises:
+        InputError: no such profile, or an invalid one.
+    """
+    table, where = machine_table(name)
+    return machine_from_table(table, where=where)
 
 
 def load_toml(path: Path) -> dict[str, Any]:

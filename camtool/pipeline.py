@@ -4,14 +4,17 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from camtool.geometry import Drawing
 from camtool.importers import read_drawing
 from camtool.post.base import PostResult, Target
 from camtool.post.registry import load_target
 from camtool.program import Program
-from camtool.toolpath.plan import PlanOptions, plan
+from camtool.toolpath.plan import PlanOptions, place, plan
+
+if TYPE_CHECKING:
+    from camtool.verify.verifier import Verification
 
 
 @dataclass(frozen=True)
@@ -23,12 +26,18 @@ class PostJob:
         program: the planned, machine-neutral program.
         target: the target it was written for.
         result: the emitted code and its warnings.
+        placed: the drawing as placed on the machine (after ``scale``/``fit_mm``),
+            in the program's coordinates.
+        edge_radius_mm: how far the cut edge lies from the tool path: half the tool
+            diameter for ``outside``/``inside`` offsets, 0 for paths on the line.
     """
 
     drawing: Drawing
     program: Program
     target: Target
     result: PostResult
+    placed: Drawing
+    edge_radius_mm: float = 0.0
 
     @property
     def warnings(self) -> tuple[str, ...]:
@@ -89,4 +98,23 @@ def post_drawing(
         fit_mm=fit_mm,
     )
     program = plan(drawing, options)
-    return PostJob(drawing, program, target, target.emit(program))
+    edge = tool_diameter / 2.0 if offset != "on" else 0.0
+    return PostJob(drawing, program, target, target.emit(program), place(drawing, options), edge)
+
+
+def verify_job(job: PostJob) -> Verification:
+    """Verify what ``job`` emitted: read its code back and simulate it against its drawing.
+
+    Raises:
+        CamtoolError: the target cannot read its own code back, or its machine
+            profile is invalid for the verifier.
+    """
+    from camtool.verify.verifier import verify_code
+
+    return verify_code(
+        str(job.result.code),
+        job.target,
+        source=f"<{job.target.name} code>",
+        against=job.placed,
+        tool_diameter=2.0 * job.edge_radius_mm,
+    )

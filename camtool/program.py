@@ -71,16 +71,22 @@ class Program:
 
     ``origin`` is where the machine stands before the first move (the part zero
     unless said otherwise). ``warnings`` carry what the planner or reader had to
-    tell the user.
+    tell the user. ``lines`` gives, for a program read from code, the 1-based
+    source line of each move (empty otherwise), so reports can point at a block.
     """
 
     moves: tuple[Move, ...]
     origin: Point = (0.0, 0.0)
     warnings: tuple[str, ...] = field(default=())
+    lines: tuple[int, ...] = field(default=())
 
     def with_moves(self, moves: tuple[Move, ...]) -> Program:
-        """A copy holding ``moves`` instead."""
+        """A copy holding ``moves`` instead (source lines dropped)."""
         return Program(moves, self.origin, self.warnings)
+
+    def line_of(self, index: int) -> int | None:
+        """Source line of move ``index``, or None when the program was not read from code."""
+        return self.lines[index] if 0 <= index < len(self.lines) else None
 
     def steps(self) -> Iterator[tuple[Point, Move]]:
         """Each move with the XY point it starts from."""

@@ -206,4 +206,4 @@ def test_machine_file_with_an_unknown_key(
     machine.write_text(BIG_MACHINE + "backlash_typo = 3\n")
     drawing = str(rectangle_dxf(tmp_path / "r.dxf", 2, 1))
     code, _, err = run(["post", drawing, "-t", "pic-mmh", "--machine", str(machine)], capsys)
-    assert code == 3 and "unknown machine key(s) ['backlash_typo']" in err
+    assert code == 3 and "unknown key(s) ['backlash_typo'] in [machine]" in err

@@ -160,6 +160,7 @@ class PicMmhPost(PostProcessor):
                 before any feed, naming ``source`` and the line number.
         """
         moves: list[Move] = []
+        lines: list[int] = []
         contour = 0
         for number, raw in enumerate(code.splitlines(), start=1):
             line = raw.strip()
@@ -169,8 +170,9 @@ class PicMmhPost(PostProcessor):
             if m is None:
                 raise ParseError(f"{source}:{number}: not a pic-mmh block: {line!r}")
             moves.append(self._move(m, number, source, contour + (m["g"] == "0")))
+            lines.append(number)
             contour += m["g"] == "0"
-        return Program(tuple(moves))
+        return Program(tuple(moves), lines=tuple(lines))
 
     def _move(self, m: re.Match[str], number: int, source: str, contour: int) -> Move:
         g = int(m["g"])

@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from camtool.errors import InputError, UsageError
-from camtool.machine import load_toml, machine_from_table
+from camtool.machine import load_toml, machine_from_table, machine_table, merge_tables
 from camtool.post.base import PostProcessor, Target
 
 _TOP_KEYS = {"name", "description", "source", "dialect", "default_feed_mm_min", "machine"}
@@ -40,8 +40,9 @@ def load_target(name: str, *, machine_file: Path | None = None) -> Target:
 
     Args:
         name: a built-in target name, or a path to a target ``.toml`` file.
-        machine_file: a TOML file whose ``[machine]`` table (or top level)
-            replaces the target's machine profile.
+        machine_file: a TOML file whose ``[machine]`` table (or top level) is
+            laid over the target's machine profile, key by key
+            (:func:`camtool.machine.merge_tables`).
 
     Raises:
         UsageError: no such target (the message lists the valid names).
@@ -75,13 +76,14 @@ def _target_from_table(
     options = table.get("dialect_options", {})
     if dialect not in DIALECTS:
         raise InputError(f"{where}: unknown dialect {dialect!r}; known: {sorted(DIALECTS)}")
-    machine_table = table.get("machine", {})
+    machine = table.get("machine", {})
+    where_machine = where
+    if isinstance(machine, str):
+        machine, where_machine = machine_table(machine)
     if machine_file is not None:
-        override = load_toml(machine_file)
-        machine_table = override.get("machine", override)
-        where_machine = str(machine_file)
-    else:
-        where_machine = where
+        override, where_override = machine_table(str(machine_file))
+        machine = merge_tables(machine, override)
+        where_machine = f"{where_override} (over {where_machine})"
     try:
         post = DIALECTS[dialect](options)
     except TypeError as exc:
@@ -90,7 +92,7 @@ def _target_from_table(
         name=str(table.get("name", Path(where).stem)),
         description=str(table.get("description", "")),
         post=post,
-        machine=machine_from_table(machine_table, where=where_machine),
+        machine=machine_from_table(machine, where=where_machine),
         default_feed_mm_min=float(table.get("default_feed_mm_min", 100.0)),
         source=str(table.get("source", "")),
     )

@@ -1,0 +1,1 @@
+"""Built-in machine profiles (``<name>.toml``), loaded by :func:`camtool.machine.load_machine`."""

@@ -1,0 +1,73 @@
+"""Estimated machining time of a simulated program: the machine's timing model per block.
+
+Builds the per-block :class:`~camtool.verify.timing.BlockKinematics` from a
+:class:`~camtool.verify.simulate.StepTrace` and hands it to the model named in
+the profile's ``[machine.timing]`` table (:data:`camtool.verify.timing.MODELS`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+
+from camtool.machine import Machine
+from camtool.program import Program, Rapid
+from camtool.verify.simulate import StepTrace
+from camtool.verify.timing import BlockKinematics, timing_model_from_table
+
+
+def block_kinematics(trace: StepTrace, program: Program) -> BlockKinematics:
+    """Per-block quantities of a simulated program (see :class:`BlockKinematics`)."""
+    moves = program.moves
+    steps = trace.block_steps
+    rows = np.diff(trace.block_start) if len(trace.block_start) else np.zeros(0, np.int64)
+    return BlockKinematics.build(
+        dominant_steps=np.max(steps[:, :2], axis=1) if len(steps) else np.zeros(0, np.int64),
+        is_rapid=[isinstance(m, Rapid) for m in moves],
+        feed_mm_min=[0.0 if isinstance(m, Rapid) else m.feed_mm_min for m in moves],
+        length_mm=[segment.length for _, segment in program.segments()],
+        iterations=rows - trace.block_compensation,
+        steps=steps,
+        compensation_steps=trace.block_compensation,
+    )
+
+
+def block_times_s(trace: StepTrace, program: Program, machine: Machine) -> npt.NDArray[np.float64]:
+    """Seconds each move takes on ``machine``, ``(B,)`` float64.
+
+    A profile without a ``[machine.timing]`` table is timed at the programmed
+    feed (rapids at the fastest feed of the program), which is what a controller
+    with ideal acceleration would do.
+
+    Raises:
+        InputError: the ``[machine.timing]`` table names an unknown model or key.
+    """
+    if not machine.timing:
+        return _at_feed(program)
+    where = f"machine {machine.name!r} [machine.timing]"
+    model = timing_model_from_table(_with_machine(machine), where=where)
+    return np.asarray(model.block_time_s(block_kinematics(trace, program)), dtype=np.float64)
+
+
+def _with_machine(machine: Machine) -> dict[str, object]:
+    """The timing table, completed from the profile.
+
+    The profile's steps/mm and step-rate cap go in where the model takes them and
+    the table does not say, so that ``--machine`` changes reach the time model.
+    """
+    table = dict(machine.timing)
+    if table.get("model") == "pic-mmh":
+        table.setdefault("steps_per_mm", max(machine.steps_per_mm[:2]))
+        if machine.max_step_rate_hz > 0:
+            table.setdefault("max_step_rate_hz", machine.max_step_rate_hz)
+    return table
+
+
+def _at_feed(program: Program) -> npt.NDArray[np.float64]:
+    feeds = [m.feed_mm_min for m in program.moves if not isinstance(m, Rapid)]
+    rapid = max(feeds, default=1.0)
+    out = [
+        segment.length / ((rapid if isinstance(move, Rapid) else move.feed_mm_min) / 60.0)
+        for move, segment in program.segments()
+    ]
+    return np.asarray(out, dtype=np.float64)

@@ -1,0 +1,343 @@
+"""Measure a simulated trace against the nominal toolpath and the drawing.
+
+All inputs in mm, results in µm. A *trace* is the carriage (tool-centre)
+position after each simulated iteration, ``(N, 2) float64``, with the index of
+the program move each point belongs to. The nominal path of a move is its own
+segment (line or arc) of the program read back from the code, so the
+deviation of a point is its distance to the segment its block was cutting
+(the contour error a machinist measures, seed-000 §6 and seed-001 R16).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from camtool.geometry import Arc, BBox, Drawing, Line, Point, Segment, bbox_union
+from camtool.program import ArcMove, Program, Rapid, segment_of
+
+FloatArray = npt.NDArray[np.float64]
+IntArray = npt.NDArray[np.int64]
+
+
+@dataclass(frozen=True)
+class Deviation:
+    """Largest and RMS distance of the trace from the nominal path.
+
+    Attributes:
+        max_um: largest distance, µm (0 when nothing was cut).
+        rms_um: root mean square over the cutting points, µm.
+        at_mm: ``(x, y)`` of the worst point, mm.
+        block: index of the program move of the worst point (-1 when none).
+        points: how many trace points were measured.
+    """
+
+    max_um: float
+    rms_um: float
+    at_mm: Point
+    block: int
+    points: int
+
+
+@dataclass(frozen=True)
+class ContourMeasure:
+    """One cut contour (a run of cutting moves between rapids), as machined.
+
+    Attributes:
+        number: 1-based, in cutting order.
+        blocks: ``(first, last)`` program move indices.
+        closed: the nominal contour ends where it starts.
+        closure_um: ``(dx, dy)`` carriage end minus carriage start, µm (closed only).
+        size_um: nominal bounding-box ``(width, height)``, µm.
+        size_error_um: machined minus nominal ``(width, height)``, µm.
+        circle: for a full circle, ``(nominal_diameter_mm, fitted_diameter_mm,
+            horizontal_mm, vertical_mm)`` (least-squares fit, Kåsa 1976; extents
+            as seed-001 R16 measures them), else ``None``.
+    """
+
+    number: int
+    blocks: tuple[int, int]
+    closed: bool
+    closure_um: tuple[float, float] | None
+    size_um: tuple[float, float]
+    size_error_um: tuple[float, float]
+    circle: tuple[float, float, float, float] | None
+
+
+def nominal_arrays(program: Program) -> dict[str, FloatArray]:
+    """Per-move nominal geometry as arrays of shape ``(B,)`` (mm; ``kind`` 0 line, 1 arc, 2 rapid).
+
+    Keys: ``kind, x0, y0, x1, y1, cx, cy, r, a0, sweep``; ``a0`` is the start
+    angle and ``sweep`` the signed sweep of arcs (radians, CCW positive).
+    """
+    rows = []
+    start = program.origin
+    for move in program.moves:
+        end = (move.x, move.y)
+        if isinstance(move, ArcMove):
+            arc = segment_of(start, move)
+            assert isinstance(arc, Arc)
+            a0 = math.atan2(start[1] - move.cy, start[0] - move.cx)
+            rows.append((1, *start, *end, move.cx, move.cy, arc.radius, a0, arc.sweep))
+        else:
+            kind = 2 if isinstance(move, Rapid) else 0
+            rows.append((kind, *start, *end, 0.0, 0.0, 0.0, 0.0, 0.0))
+        start = end
+    table = np.asarray(rows, dtype=np.float64).reshape(-1, 10)
+    names = ("kind", "x0", "y0", "x1", "y1", "cx", "cy", "r", "a0", "sweep")
+    return {name: table[:, i] for i, name in enumerate(names)}
+
+
+def point_distances(
+    points: FloatArray, blocks: IntArray, nominal: dict[str, FloatArray]
+) -> FloatArray:
+    """Distance of each point to the nominal segment of its block, mm.
+
+    Args:
+        points: ``(N, 2)`` float64, mm.
+        blocks: ``(N,)`` int64 move index of each point.
+        nominal: :func:`nominal_arrays` of the program.
+
+    Returns:
+        ``(N,)`` float64 distances, mm (lines: to the segment; arcs: to the arc,
+        i.e. the radial error inside the sweep, else to the nearer end point).
+    """
+    g = {k: v[blocks] for k, v in nominal.items()}
+    px, py = points[:, 0], points[:, 1]
+    # straight segments (and rapids)
+    dx, dy = g["x1"] - g["x0"], g["y1"] - g["y0"]
+    length2 = dx * dx + dy * dy
+    with np.errstate(invalid="ignore", divide="ignore"):
+        t = np.where(length2 > 0, ((px - g["x0"]) * dx + (py - g["y0"]) * dy) / length2, 0.0)
+    t = np.clip(t, 0.0, 1.0)
+    line = np.hypot(px - (g["x0"] + t * dx), py - (g["y0"] + t * dy))
+    # arcs
+    ux, uy = px - g["cx"], py - g["cy"]
+    radial = np.abs(np.hypot(ux, uy) - g["r"])
+    angle = np.arctan2(uy, ux) - g["a0"]
+    along = np.where(g["sweep"] >= 0, np.mod(angle, math.tau), np.mod(-angle, math.tau))
+    inside = along <= np.abs(g["sweep"]) + 1e-12
+    ends = np.minimum(np.hypot(px - g["x0"], py - g["y0"]), np.hypot(px - g["x1"], py - g["y1"]))
+    arc = np.where(inside, radial, ends)
+    return np.where(g["kind"] == 1, arc, line)
+
+
+def deviation(points: FloatArray, blocks: IntArray, program: Program) -> Deviation:
+    """Deviation of the cutting points of a trace from the program's nominal path.
+
+    Points of rapid moves are not measured (a rapid has no nominal path).
+
+    Args:
+        points: ``(N, 2)`` float64 trace, mm.
+        blocks: ``(N,)`` int64 move index of each point.
+        program: the program the trace executed.
+    """
+    nominal = nominal_arrays(program)
+    cutting = nominal["kind"][blocks] != 2 if len(blocks) else np.zeros(0, dtype=bool)
+    pts, blk = points[cutting], blocks[cutting]
+    if len(pts) == 0:
+        return Deviation(0.0, 0.0, (0.0, 0.0), -1, 0)
+    dist = point_distances(pts, blk, nominal)
+    worst = int(np.argmax(dist))
+    return Deviation(
+        max_um=float(dist[worst]) * 1000.0,
+        rms_um=float(np.sqrt(np.mean(dist * dist))) * 1000.0,
+        at_mm=(float(pts[worst, 0]), float(pts[worst, 1])),
+        block=int(blk[worst]),
+        points=len(pts),
+    )
+
+
+def contour_runs(program: Program) -> list[tuple[int, int]]:
+    """``(first, last)`` move indices of each run of cutting moves between rapids."""
+    runs: list[tuple[int, int]] = []
+    first = None
+    for i, move in enumerate(program.moves):
+        if isinstance(move, Rapid):
+            if first is not None:
+                runs.append((first, i - 1))
+            first = None
+        elif first is None:
+            first = i
+    if first is not None:
+        runs.append((first, len(program.moves) - 1))
+    return runs
+
+
+def measure_contours(
+    points: FloatArray, block_start: IntArray, start_mm: Point, program: Program
+) -> list[ContourMeasure]:
+    """Closure, size error and circle fit of every cut contour.
+
+    Args:
+        points: ``(N, 2)`` float64 trace, mm.
+        block_start: ``(B + 1,)`` offsets of each move's points in ``points``.
+        start_mm: the carriage position before the first point.
+        program: the program the trace executed.
+    """
+    measures = []
+    starts = [program.origin] + [(m.x, m.y) for m in program.moves]
+    for number, (first, last) in enumerate(contour_runs(program), start=1):
+        lo, hi = int(block_start[first]), int(block_start[last + 1])
+        before = points[lo - 1] if lo > 0 else np.asarray(start_mm)
+        run = np.vstack([before, points[lo:hi]])
+        segments = [segment_of(starts[i], program.moves[i]) for i in range(first, last + 1)]
+        box: BBox = bbox_union(s.bbox() for s in segments)
+        nominal_size = (box[2] - box[0], box[3] - box[1])
+        size = (float(np.ptp(run[:, 0])), float(np.ptp(run[:, 1])))
+        closed = math.dist(starts[first], starts[last + 1]) <= 1e-6
+        closure = (
+            (float(run[-1, 0] - run[0, 0]) * 1000.0, float(run[-1, 1] - run[0, 1]) * 1000.0)
+            if closed
+            else None
+        )
+        measures.append(
+            ContourMeasure(
+                number=number,
+                blocks=(first, last),
+                closed=closed,
+                closure_um=closure,
+                size_um=(nominal_size[0] * 1000.0, nominal_size[1] * 1000.0),
+                size_error_um=(
+                    (size[0] - nominal_size[0]) * 1000.0,
+                    (size[1] - nominal_size[1]) * 1000.0,
+                ),
+                circle=_circle(segments, run, size) if closed else None,
+            )
+        )
+    return measures
+
+
+def _circle(
+    segments: list[Segment], run: FloatArray, size: tuple[float, float]
+) -> tuple[float, float, float, float] | None:
+    """Nominal and fitted diameter of a contour made of arcs of one circle, else None."""
+    if not segments or not all(isinstance(s, Arc) for s in segments):
+        return None
+    arcs = [s for s in segments if isinstance(s, Arc)]
+    c0, r0 = arcs[0].centre, arcs[0].radius
+    same = all(math.dist(a.centre, c0) <= 1e-6 and abs(a.radius - r0) <= 1e-6 for a in arcs)
+    if not same or abs(abs(sum(a.sweep for a in arcs)) - math.tau) > 1e-6 or len(run) < 3:
+        return None
+    return (2.0 * r0, 2.0 * fit_circle(run)[2], size[0], size[1])
+
+
+def fit_circle(points: FloatArray) -> tuple[float, float, float]:
+    """Least-squares circle through points (Kåsa 1976): ``(cx, cy, r)``, mm.
+
+    Args:
+        points: ``(N, 2)`` float64, N >= 3, not collinear.
+    """
+    x, y = points[:, 0], points[:, 1]
+    mx, my = float(x.mean()), float(y.mean())
+    u, v = x - mx, y - my
+    a = np.column_stack([u, v, np.ones_like(u)])
+    b = u * u + v * v
+    (p, q, s), *_ = np.linalg.lstsq(a, b, rcond=None)
+    cx, cy = p / 2.0, q / 2.0
+    return (mx + cx, my + cy, math.sqrt(s + cx * cx + cy * cy))
+
+
+@dataclass(frozen=True)
+class Against:
+    """The machined edge compared with the drawing.
+
+    The machined edge is the trace swept by the tool radius r: a drawing point q
+    is off by ``d(q, trace) − r`` (> 0: material left, < 0: cut too deep), and a
+    trace point p gouges the drawing by ``r − d(p, drawing)`` where that is > 0.
+
+    Attributes:
+        max_um: largest |d(q, trace) − r| over the sampled drawing, µm.
+        rms_um: RMS of the same, µm.
+        at_mm: drawing point where the max occurs.
+        overcut_um: largest gouge of the drawing, µm (0 when none).
+        samples: drawing points measured.
+    """
+
+    max_um: float
+    rms_um: float
+    at_mm: Point
+    overcut_um: float
+    samples: int
+
+
+def against_drawing(
+    points: FloatArray, drawing: Drawing, tool_radius_mm: float, *, spacing_mm: float = 0.005
+) -> Against:
+    """Compare a cutting trace with the drawing it was made from (shapely nearest queries).
+
+    Args:
+        points: ``(N, 2)`` float64 cutting trace (rapids left out), mm, in the
+            drawing's coordinates.
+        drawing: the drawing.
+        tool_radius_mm: tool radius; 0 for a scribing point or an engraving on the line.
+        spacing_mm: largest distance between sampled drawing points, mm.
+    """
+    import shapely
+
+    samples = _sample_drawing(drawing, spacing_mm)
+    if len(points) < 2 or len(samples) == 0:
+        return Against(0.0, 0.0, (0.0, 0.0), 0.0, 0)
+    trace = _thin(points, 400_000)
+    trace_lines = shapely.linestrings(np.stack([trace[:-1], trace[1:]], axis=1))
+    tree = shapely.STRtree(trace_lines)
+    q = shapely.points(samples)
+    _, d_q = tree.query_nearest(q, return_distance=True, all_matches=False)
+    off = np.asarray(d_q, dtype=np.float64) - tool_radius_mm
+    worst = int(np.argmax(np.abs(off)))
+    overcut = 0.0
+    if tool_radius_mm > 0:
+        chords = shapely.linestrings(np.stack([samples[:-1], samples[1:]], axis=1))
+        drawing_tree = shapely.STRtree(chords[_same_contour(drawing, spacing_mm)])
+        _, d_p = drawing_tree.query_nearest(
+            shapely.points(trace), return_distance=True, all_matches=False
+        )
+        overcut = max(0.0, float(tool_radius_mm - np.min(d_p))) * 1000.0
+    return Against(
+        max_um=float(abs(off[worst])) * 1000.0,
+        rms_um=float(np.sqrt(np.mean(off * off))) * 1000.0,
+        at_mm=(float(samples[worst, 0]), float(samples[worst, 1])),
+        overcut_um=overcut,
+        samples=len(samples),
+    )
+
+
+def _sample_drawing(drawing: Drawing, spacing_mm: float) -> FloatArray:
+    """Points along every contour, at most ``spacing_mm`` apart, contour after contour."""
+    chunks = [_sample_contour(c.segments, spacing_mm) for c in drawing.contours]
+    return np.vstack(chunks) if chunks else np.zeros((0, 2))
+
+
+def _sample_contour(segments: tuple[Segment, ...], spacing_mm: float) -> FloatArray:
+    pts: list[Point] = []
+    for seg in segments:
+        n = max(1, math.ceil(seg.length / spacing_mm))
+        if isinstance(seg, Line):
+            (x0, y0), (x1, y1) = seg.start, seg.end
+            pts.extend((x0 + (x1 - x0) * k / n, y0 + (y1 - y0) * k / n) for k in range(n))
+        else:
+            pts.extend(seg.point_at(k / n) for k in range(n))
+    pts.append(segments[-1].end)
+    return np.asarray(pts, dtype=np.float64)
+
+
+def _same_contour(drawing: Drawing, spacing_mm: float) -> npt.NDArray[np.bool_]:
+    """Mask of the sample chords that join two points of the same contour."""
+    sizes = [len(_sample_contour(c.segments, spacing_mm)) for c in drawing.contours]
+    mask = np.ones(sum(sizes) - 1, dtype=bool)
+    edge = 0
+    for size in sizes[:-1]:
+        edge += size
+        mask[edge - 1] = False
+    return mask
+
+
+def _thin(points: FloatArray, limit: int) -> FloatArray:
+    """Every k-th point (and the last) so that at most about ``limit`` remain."""
+    k = max(1, math.ceil(len(points) / limit))
+    if k == 1:
+        return points
+    return np.vstack([points[::k], points[-1:]])
