@@ -203,7 +203,7 @@ class _Controller:
             rows = _ARCS[motion.arc](*self.pos, *end, *centre, move.clockwise)
             return rows, []
         points = self._chord_points(start_mm, move)
-        lattice = [self.pos] + [(self.to_steps(x, 0), self.to_steps(y, 1)) for x, y in points[1:]]
+        lattice = [self.pos] + [(self.to_steps(x, 0), self.to_steps(y, 1)) for x, y in points]
         lattice[-1] = end
         parts, starts, offset = [], [], 0
         for (x0, y0), (x1, y1) in itertools.pairwise(lattice):
@@ -296,7 +296,7 @@ class _Controller:
 
 
 def _sagitta_points(start: Point, move: ArcMove, tolerance_mm: float) -> list[Point]:
-    """Equal chords of an arc within ``tolerance_mm`` (its start and end included)."""
+    """End points of equal chords of an arc within ``tolerance_mm`` (the last is its end)."""
     cx, cy = move.cx, move.cy
     radius = math.hypot(start[0] - cx, start[1] - cy)
     a0 = math.atan2(start[1] - cy, start[0] - cx)
@@ -311,8 +311,8 @@ def _sagitta_points(start: Point, move: ArcMove, tolerance_mm: float) -> list[Po
         (cx + radius * math.cos(a0 + sweep * k / n), cy + radius * math.sin(a0 + sweep * k / n))
         for k in range(n + 1)
     ]
-    points[0], points[-1] = start, (move.x, move.y)
-    return points
+    points[-1] = (move.x, move.y)
+    return points[1:]
 
 
 def _start_mm(origin_steps: tuple[int, int], machine: Machine) -> Point:

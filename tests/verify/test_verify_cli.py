@@ -1,0 +1,160 @@
+"""`camtool verify` and `post --verify` as a user runs them: exit codes, report, preview."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from camtool.cli import main
+
+SAMPLES = Path(__file__).parents[2] / "samples"
+LOGO = str(SAMPLES / "logo.dxf")
+DESIGN_KEYS = {
+    "target",
+    "blocks",
+    "steps",
+    "iterations",
+    "reversals",
+    "compensations",
+    "deviation_um",
+    "closure_um",
+    "size_error_um",
+    "time_s",
+    "warnings",
+}  # ../shared/DESIGN.md, "Verify report"
+
+
+def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    code = main(args)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.fixture
+def logo_pic(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> Path:
+    dest = tmp_path / "logo.pic"
+    assert run(["post", LOGO, "-t", "pic-mmh", "-o", str(dest)], capsys)[0] == 0
+    return dest
+
+
+def test_verify_writes_a_report_with_the_design_keys(
+    logo_pic: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    report = tmp_path / "r.json"
+    code, out, err = run(
+        ["verify", str(logo_pic), "-t", "pic-mmh", "--report", str(report)], capsys
+    )
+    assert code == 0 and out == ""
+    data = json.loads(report.read_text())
+    assert set(data) >= DESIGN_KEYS
+    assert set(data["steps"]) == {"x", "y", "z"} and set(data["reversals"]) == {"x", "y"}
+    assert {"max", "rms"} <= set(data["deviation_um"])
+    assert data["blocks"] == 22 and data["target"] == "pic-mmh"
+    # the worst point names the program line it is on
+    at = data["deviation_um"]["at"]
+    line = logo_pic.read_text().splitlines()[at["line"] - 1]
+    assert line.startswith("G0")
+    assert "deviation from the path: max" in err and "estimated time" in err
+
+
+def test_report_to_stdout(logo_pic: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run(["verify", str(logo_pic), "-t", "pic-mmh", "--report", "-"], capsys)
+    assert code == 0 and json.loads(out)["target"] == "pic-mmh"
+
+
+def test_over_the_limit_exits_4_after_writing_the_report(
+    logo_pic: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    report = tmp_path / "r.json"
+    args = ["verify", str(logo_pic), "-t", "pic-mmh", "--report", str(report)]
+    code, _, err = run([*args, "--max-error-um", "1"], capsys)
+    assert code == 4 and "exceeds --max-error-um 1" in err
+    assert json.loads(report.read_text())["deviation_um"]["max"] > 1
+    assert run([*args, "--max-error-um", "1000"], capsys)[0] == 0
+
+
+def test_against_the_drawing(logo_pic: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run(
+        ["verify", str(logo_pic), "-t", "pic-mmh", "--against", LOGO, "--report", "-"], capsys
+    )
+    against = json.loads(out)["against"]
+    assert code == 0 and against["samples"] > 100
+    # a scribed path (no offset) lies on the drawing up to the backlash residuals (<= 20 µm)
+    assert 0 < against["max_um"] < 20.0
+
+
+def test_post_verify_matches_verify(
+    logo_pic: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    a, b = tmp_path / "a.json", tmp_path / "b.json"
+    assert run(["post", LOGO, "-t", "pic-mmh", "-o", "-", "--report", str(a)], capsys)[0] == 0
+    assert run(["verify", str(logo_pic), "-t", "pic-mmh", "--report", str(b)], capsys)[0] == 0
+    ra, rb = json.loads(a.read_text()), json.loads(b.read_text())
+    assert ra["deviation_um"]["max"] == rb["deviation_um"]["max"]
+    assert ra["against"] is not None and rb["against"] is None
+
+
+def test_machine_override_changes_the_prediction(
+    logo_pic: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Compensation equal to a uniform true backlash: only interpolation error remains."""
+    exact = tmp_path / "exact.toml"
+    exact.write_text(
+        "[machine.backlash]\n"
+        "true_um = [204, 178, 0]\ncompensation_um = [204, 178, 0]\nregions = []\n"
+    )
+    code, out, _ = run(
+        ["verify", str(logo_pic), "-t", "pic-mmh", "--machine", str(exact), "--report", "-"],
+        capsys,
+    )
+    assert code == 0
+    assert json.loads(out)["deviation_um"]["max"] < 0.5  # under 4 steps of 140 nm
+
+
+@pytest.mark.parametrize("suffix", [".png", ".svg"])
+def test_preview_files(
+    logo_pic: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], suffix: str
+) -> None:
+    first, second = tmp_path / f"a{suffix}", tmp_path / f"b{suffix}"
+    for dest in (first, second):
+        assert (
+            run(["verify", str(logo_pic), "-t", "pic-mmh", "--preview", str(dest)], capsys)[0] == 0
+        )
+    assert first.read_bytes() == second.read_bytes()  # deterministic, CI can diff
+    if suffix == ".svg":
+        text = first.read_text()
+        assert "deviation from the path" in text and "max 14." in text
+
+
+@pytest.mark.parametrize(
+    ("args", "exit_code", "message"),
+    [
+        (["verify", "missing.pic", "-t", "pic-mmh"], 3, "missing.pic: no such file"),
+        (["verify", "{pic}", "-t", "nope"], 2, "unknown target 'nope'"),
+        (["verify", "{bad}", "-t", "pic-mmh"], 3, ":3: not a pic-mmh block"),
+        (
+            ["verify", "{pic}", "-t", "pic-mmh", "--preview", "x.gif"],
+            2,
+            "a preview is .png or .svg",
+        ),
+        (["verify", "{pic}", "-t", "pic-mmh", "--machine", "nope"], 3, "unknown machine profile"),
+        (["verify", "{pic}", "-t", "pic-mmh", "--max-error-um", "-1"], 2, "-1"),
+    ],
+)
+def test_exit_codes(
+    args: list[str],
+    exit_code: int,
+    message: str,
+    logo_pic: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    bad = tmp_path / "bad.pic"
+    bad.write_text("G54;\nG90;\nG01X1Y1;\n")
+    args = [a.format(pic=logo_pic, bad=bad) for a in args]
+    code, out, err = run(args, capsys)
+    assert code == exit_code and out == ""
+    assert message in err
+    assert "Traceback" not in err
