@@ -22,7 +22,7 @@ def block_kinematics(trace: StepTrace, program: Program) -> BlockKinematics:
     steps = trace.block_steps
     rows = np.diff(trace.block_start) if len(trace.block_start) else np.zeros(0, np.int64)
     return BlockKinematics.build(
-        dominant_steps=np.max(steps[:, :2], axis=1) if len(steps) else np.zeros(0, np.int64),
+        dominant_steps=trace.block_dominant,
         is_rapid=[isinstance(m, Rapid) for m in moves],
         feed_mm_min=[0.0 if isinstance(m, Rapid) else m.feed_mm_min for m in moves],
         length_mm=[segment.length for _, segment in program.segments()],

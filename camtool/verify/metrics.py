@@ -105,24 +105,42 @@ def point_distances(
         ``(N,)`` float64 distances, mm (lines: to the segment; arcs: to the arc,
         i.e. the radial error inside the sweep, else to the nearer end point).
     """
-    g = {k: v[blocks] for k, v in nominal.items()}
-    px, py = points[:, 0], points[:, 1]
-    # straight segments (and rapids)
-    dx, dy = g["x1"] - g["x0"], g["y1"] - g["y0"]
+    out = np.empty(len(points), dtype=np.float64)
+    is_arc = nominal["kind"][blocks] == 1
+    for mask, measure in ((~is_arc, _to_lines), (is_arc, _to_arcs)):
+        if mask.any():
+            out[mask] = measure(points[mask], blocks[mask], nominal)
+    return out
+
+
+def _to_lines(points: FloatArray, blocks: IntArray, nominal: dict[str, FloatArray]) -> FloatArray:
+    """Distance of each point to its block's straight segment, mm."""
+    x0, y0 = nominal["x0"][blocks], nominal["y0"][blocks]
+    dx, dy = nominal["x1"][blocks] - x0, nominal["y1"][blocks] - y0
+    px, py = points[:, 0] - x0, points[:, 1] - y0
     length2 = dx * dx + dy * dy
     with np.errstate(invalid="ignore", divide="ignore"):
-        t = np.where(length2 > 0, ((px - g["x0"]) * dx + (py - g["y0"]) * dy) / length2, 0.0)
-    t = np.clip(t, 0.0, 1.0)
-    line = np.hypot(px - (g["x0"] + t * dx), py - (g["y0"] + t * dy))
-    # arcs
-    ux, uy = px - g["cx"], py - g["cy"]
-    radial = np.abs(np.hypot(ux, uy) - g["r"])
-    angle = np.arctan2(uy, ux) - g["a0"]
-    along = np.where(g["sweep"] >= 0, np.mod(angle, math.tau), np.mod(-angle, math.tau))
-    inside = along <= np.abs(g["sweep"]) + 1e-12
-    ends = np.minimum(np.hypot(px - g["x0"], py - g["y0"]), np.hypot(px - g["x1"], py - g["y1"]))
-    arc = np.where(inside, radial, ends)
-    return np.where(g["kind"] == 1, arc, line)
+        t = np.where(length2 > 0, (px * dx + py * dy) / length2, 0.0)
+    np.clip(t, 0.0, 1.0, out=t)
+    return np.hypot(px - t * dx, py - t * dy)
+
+
+def _to_arcs(points: FloatArray, blocks: IntArray, nominal: dict[str, FloatArray]) -> FloatArray:
+    """Distance of each point to its block's arc: radial inside the sweep, else to an end."""
+    ux, uy = points[:, 0] - nominal["cx"][blocks], points[:, 1] - nominal["cy"][blocks]
+    radial = np.abs(np.hypot(ux, uy) - nominal["r"][blocks])
+    sweep = nominal["sweep"][blocks]
+    angle = np.arctan2(uy, ux) - nominal["a0"][blocks]
+    along = np.where(sweep >= 0, np.mod(angle, math.tau), np.mod(-angle, math.tau))
+    inside = along <= np.abs(sweep) + 1e-12
+    if inside.all():
+        return radial
+    px, py = points[:, 0], points[:, 1]
+    ends = np.minimum(
+        np.hypot(px - nominal["x0"][blocks], py - nominal["y0"][blocks]),
+        np.hypot(px - nominal["x1"][blocks], py - nominal["y1"][blocks]),
+    )
+    return np.where(inside, radial, ends)
 
 
 def deviation(points: FloatArray, blocks: IntArray, program: Program) -> Deviation:
@@ -265,9 +283,19 @@ class Against:
 
 
 def against_drawing(
-    points: FloatArray, drawing: Drawing, tool_radius_mm: float, *, spacing_mm: float = 0.005
+    points: FloatArray,
+    drawing: Drawing,
+    tool_radius_mm: float,
+    *,
+    spacing_mm: float = 0.005,
+    resolution_mm: float = 0.0005,
 ) -> Against:
     """Compare a cutting trace with the drawing it was made from (shapely nearest queries).
+
+    The trace is a polyline through its points, thinned to points about
+    ``resolution_mm`` apart (never more than 400 000): a thinned-out point lies
+    within about that distance of the polyline, so it bounds the error of this
+    measure (the step-level deviation from the path is :func:`deviation`).
 
     Args:
         points: ``(N, 2)`` float64 cutting trace (rapids left out), mm, in the
@@ -275,13 +303,17 @@ def against_drawing(
         drawing: the drawing.
         tool_radius_mm: tool radius; 0 for a scribing point or an engraving on the line.
         spacing_mm: largest distance between sampled drawing points, mm.
+        resolution_mm: spacing of the thinned trace, mm.
     """
     import shapely
 
     samples = _sample_drawing(drawing, spacing_mm)
     if len(points) < 2 or len(samples) == 0:
         return Against(0.0, 0.0, (0.0, 0.0), 0.0, 0)
-    trace = _thin(points, 400_000)
+    head = np.diff(points[: min(len(points), 2000)], axis=0)
+    step = float(np.median(np.hypot(head[:, 0], head[:, 1]))) if len(head) else 0.0
+    every = max(1, int(resolution_mm / step)) if step > 0 else 1
+    trace = _thin(points, min(400_000, math.ceil(len(points) / every)))
     trace_lines = shapely.linestrings(np.stack([trace[:-1], trace[1:]], axis=1))
     tree = shapely.STRtree(trace_lines)
     q = shapely.points(samples)

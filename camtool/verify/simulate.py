@@ -76,7 +76,11 @@ class StepTrace:
         start_mm: carriage position before the first row, mm.
         logical_end: ``(B, 2) int64``, the controller's logical position after each
             move, steps.
-        block_steps: ``(B, 3) int64``, programmed steps per move and axis (|x|, |y|, |z|).
+        block_steps: ``(B, 3) int64``, motor steps (pulses) per move and axis, without
+            compensation: ``(x, y, z)``.
+        block_dominant: ``(B,) int64``, steps of the dominant axis of each executed line
+            (summed over the chords of a chord arc; iterations for a native arc), what
+            per-step time models count (seed-001 R15).
         block_compensation: ``(B,) int64``, compensation steps inserted in each move.
         reversals: reversals of the commanded X and Y directions.
         compensations: compensation events (axis reversals the controller
@@ -91,6 +95,7 @@ class StepTrace:
     start_mm: Point
     logical_end: IntArray
     block_steps: IntArray
+    block_dominant: IntArray
     block_compensation: IntArray
     reversals: tuple[int, int]
     compensations: int
@@ -146,6 +151,7 @@ class _Controller:
         self.counts: list[int] = []
         self.logical: list[tuple[int, int]] = []
         self.steps: list[tuple[int, int, int]] = []
+        self.dominant: list[int] = []
         self.block_comp: list[int] = []
         self.reversals = [0, 0]
         self.compensations = 0
@@ -179,40 +185,44 @@ class _Controller:
             z_steps = abs(zs - self.z_pos) if self.z_pos is not None else 0
             self.z_pos = zs
         if isinstance(move, ArcMove):
-            rows, line_starts = self._arc(start_mm, move, end)
+            rows, line_starts, dominant = self._arc(start_mm, move, end)
         else:
-            rows, line_starts = self.line(end[0] - self.pos[0], end[1] - self.pos[1]), [0]
+            dx, dy = end[0] - self.pos[0], end[1] - self.pos[1]
+            rows, line_starts, dominant = self.line(dx, dy), [0], max(abs(dx), abs(dy))
+        pulses = np.abs(rows).sum(axis=0, dtype=np.int64) if len(rows) else (0, 0)
+        self.steps.append((int(pulses[0]), int(pulses[1]), z_steps))
+        self.dominant.append(dominant)
         rows, comp = self._compensate(rows, line_starts)
         self.parts.append(rows)
         self.comp_parts.append(comp)
         self.counts.append(len(rows))
-        self.steps.append((abs(end[0] - self.pos[0]), abs(end[1] - self.pos[1]), z_steps))
         self.block_comp.append(int(comp.sum()))
         self.logical.append(end)
         self.pos = end
 
     def _arc(
         self, start_mm: Point, move: ArcMove, end: tuple[int, int]
-    ) -> tuple[StepArray, list[int]]:
+    ) -> tuple[StepArray, list[int], int]:
         motion = self.machine.motion
         if motion.arc in _ARCS:
             centre = (self.to_steps(move.cx, 0), self.to_steps(move.cy, 1))
             full = distance(start_mm, (move.x, move.y)) <= 1e-9
             if end == self.pos and not full:  # an arc shorter than a step: a line
-                return self.line(0, 0), [0]
+                return self.line(0, 0), [0], 0
             rows = _ARCS[motion.arc](*self.pos, *end, *centre, move.clockwise)
-            return rows, []
+            return rows, [], len(rows)
         points = self._chord_points(start_mm, move)
         lattice = [self.pos] + [(self.to_steps(x, 0), self.to_steps(y, 1)) for x, y in points]
         lattice[-1] = end
-        parts, starts, offset = [], [], 0
+        parts, starts, offset, dominant = [], [], 0, 0
         for (x0, y0), (x1, y1) in itertools.pairwise(lattice):
             rows = self.line(x1 - x0, y1 - y0)
             parts.append(rows)
             starts.append(offset)
             offset += len(rows)
+            dominant += max(abs(x1 - x0), abs(y1 - y0))
         joined = np.concatenate(parts) if parts else np.zeros((0, 2), STEP_DTYPE)
-        return joined, starts
+        return joined, starts, dominant
 
     def _chord_points(self, start_mm: Point, move: ArcMove) -> FloatArray:
         motion = self.machine.motion
@@ -289,6 +299,7 @@ class _Controller:
             start_mm=_start_mm(self.origin_steps, self.machine),
             logical_end=_frozen(np.asarray(self.logical, dtype=np.int64).reshape(-1, 2)),
             block_steps=_frozen(np.asarray(self.steps, dtype=np.int64).reshape(-1, 3)),
+            block_dominant=_frozen(np.asarray(self.dominant, dtype=np.int64)),
             block_compensation=_frozen(np.asarray(self.block_comp, dtype=np.int64)),
             reversals=(self.reversals[0], self.reversals[1]),
             compensations=self.compensations,
