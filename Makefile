@@ -15,8 +15,9 @@ $(STAMP): pyproject.toml
 
 demo: $(STAMP)
 	mkdir -p out
-	$(BIN)/camtool post samples/logo.dxf --target pic-mmh -o out/logo.pic
-	@echo "demo: the pic-mmh program for samples/logo.dxf is in out/logo.pic"
+	$(BIN)/camtool post samples/logo.dxf --target pic-mmh -o out/logo.pic \
+		--verify --report out/logo-verify.json --preview out/logo-verify.png
+	@echo "demo: out/logo.pic (pic-mmh program), out/logo-verify.json and .png (predicted error)"
 
 lint: $(STAMP)
 	$(BIN)/ruff check camtool tests samples docs
