@@ -38,6 +38,7 @@ LINE_INTERPOLATORS: dict[str, str] = {
     "bresenham": "Bresenham/AMASS stepping of GRBL and LinuxCNC",
     "corte-recto": "diagonal, then the longer axis alone (seed-003 §4.1-4.2)",
     "timer": "millisecond-timer stepping of the LMM VB6 application (seed-001 §4.7, R11)",
+    "servo": "per-axis DC servo loops, no coordination, stop at every vertex (seed-002 §4-5)",
 }
 """Line interpolators a profile may name, with where each comes from."""
 

@@ -42,6 +42,8 @@ def block_times_s(trace: StepTrace, program: Program, machine: Machine) -> npt.N
     Raises:
         InputError: the ``[machine.timing]`` table names an unknown model or key.
     """
+    if trace.block_time_s is not None:
+        return np.asarray(trace.block_time_s, dtype=np.float64)
     if not machine.timing:
         return _at_feed(program)
     where = f"machine {machine.name!r} [machine.timing]"

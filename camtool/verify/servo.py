@@ -96,7 +96,8 @@ class RouterMachine:
         first_point_speed: Speed of the move to the first point, counts/Ts (L4796).
         decel_start_counts: Remaining counts at which ``Tabla`` takes over (L5673).
         decel_beta: β of ``Tabla[q] = floor(√(2βq))``, counts/Ts², ``>= 0.5`` (a
-            zero entry before the count would hang the firmware).
+            zero entry before the count would hang the firmware). Default
+            115.2 = 480²/(2·1000), i.e. 180 mm/s²: ``Tabla[1000] = 480``.
         decel: One of :data:`DECELS`.
         plants: X, Y, Z plants (default: the thesis plant on all; see
             :func:`~camtool.verify.servo_plant.per_axis_plants`).
@@ -416,7 +417,7 @@ def simulate_job(xy_01mm: npt.ArrayLike, machine: RouterMachine | None = None) -
             ax.idle(n_hs)
         s = len(axes[0].out) - 1
         plans = _segment_plans(m, arrays, i, axes, warnings)
-        ticks = [ax.move(pl, m) if pl else 0 for ax, pl in zip(axes, plans, strict=True)]
+        ticks = [0 if pl is None else ax.move(pl, m) for ax, pl in zip(axes, plans, strict=True)]
         done = (s + ticks[0], s + ticks[1] + (1 if frac > 0 and ticks[1] else 0))
         for ax in axes:
             ax.idle(max(done) - (len(ax.out) - 1))

@@ -85,6 +85,8 @@ class StepTrace:
         reversals: reversals of the commanded X and Y directions.
         compensations: compensation events (axis reversals the controller
             compensated; 0 when the profile compensates nothing).
+        block_time_s: ``(B,) float64`` time of each move when the simulation itself
+            gives it (the servo router), else ``None`` (the timing model decides).
     """
 
     rows: StepArray
@@ -99,6 +101,7 @@ class StepTrace:
     block_compensation: IntArray
     reversals: tuple[int, int]
     compensations: int
+    block_time_s: FloatArray | None = None
 
 
 _LINES: dict[str, Callable[[int, int], StepArray]] = {

@@ -122,7 +122,12 @@ def verify_program(
     """
     if tool_diameter < 0:
         raise UsageError(f"tool diameter must be >= 0 mm, got {tool_diameter!r}")
-    trace = simulate_steps(program, machine)
+    if machine.motion.line == "servo":
+        from camtool.verify.simulate_servo import simulate_servo
+
+        trace = simulate_servo(program, machine)
+    else:
+        trace = simulate_steps(program, machine)
     points, blocks = trace.carriage_mm, trace.block_of_row
     dev = deviation(points, blocks, program)
     contours = tuple(measure_contours(points, trace.block_start, trace.start_mm, program))

@@ -294,3 +294,35 @@ def test_fit_circle_recovers_centre_and_radius() -> None:
     angles = np.linspace(0.0, math.tau, 50, endpoint=False)
     pts = np.column_stack([3 + 2 * np.cos(angles), -1 + 2 * np.sin(angles)])
     assert fit_circle(pts) == pytest.approx((3.0, -1.0, 2.0))
+
+
+# ------------------------------------------------------------ seed-002, the servo router
+
+STAR_01MM = [
+    (151, 86),
+    (400, 265),
+    (630, 86),
+    (575, 431),
+    (815, 639),
+    (501, 642),
+    (400, 999),
+    (294, 645),
+    (6, 665),
+    (220, 428),
+    (153, 86),
+]  # seed-002 §3, the GUI's 11-point star, 0.1 mm
+
+
+def test_star_on_the_router_closes_off_by_the_chunk_flooring() -> None:
+    """seed-002 §8 R14: with the floor(d/2) chunk rule the star ends (+0.4, -0.2) mm from its
+    first point (it was drawn ending at (+0.2, 0)); its cruise time is ~79 s (R14e) plus ten
+    150 ms handshakes and the speed loops' lag."""
+    moves = [Rapid(STAR_01MM[0][0] / 10, STAR_01MM[0][1] / 10)]
+    moves += [Linear(x / 10, y / 10, 225.0) for x, y in STAR_01MM[1:]]
+    v = verify_program(Program(tuple(moves)), profile("router-2011"))
+    trace = v.trace
+    end = trace.carriage_mm[-1] - np.asarray(STAR_01MM[0]) / 10
+    assert end == pytest.approx((0.4, -0.2), abs=1e-6)
+    cutting = v.block_time_s[1:].sum()
+    assert 78.83 + 1.5 <= cutting <= 78.83 + 1.5 + 1.0
+    assert len(v.contours) == 1 and v.contours[0].closure_um is None  # drawn open
