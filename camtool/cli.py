@@ -14,13 +14,14 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from camtool import __version__
-from camtool.errors import CamtoolError, InputError, VerifyLimitError
+from camtool.errors import CamtoolError, InputError, UsageError, VerifyLimitError
 from camtool.toolpath.plan import OFFSET_MODES
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
     from camtool.geometry import Drawing
+    from camtool.program import Program
     from camtool.verify.verifier import Verification
 
 
@@ -162,14 +163,22 @@ def post(
 ) -> None:
     """Import DRAWING (a .dxf file, or '-' for stdin), plan it, write it for a target.
 
+    DRAWING may also be an existing G-code program (.ngc, .nc, .gcode, .tap ...):
+    it is already a toolpath, so it is re-posted as it is, only --feed applies.
+
     With --verify (implied by --report, --preview or --max-error-um) the written
     code is read back and simulated on the target's machine, as `verify` does.
     """
-    from camtool.pipeline import post_drawing, verify_job
+    from camtool.pipeline import is_program_file, post_drawing, post_program, verify_job
     from camtool.post.registry import load_target
 
     chosen = load_target(target, machine_file=machine_file)
-    job = post_drawing(_read_input(drawing), chosen, **options)
+    if is_program_file(drawing):
+        job = post_program(
+            _read_program(drawing, options), chosen, feed_mm_min=options["feed_mm_min"]
+        )
+    else:
+        job = post_drawing(_read_input(drawing), chosen, **options)
     _warn(job.warnings)
     _write(job.result.code, output)
     if output != "-":
@@ -233,6 +242,28 @@ def verify(
     drawing = _read_input(against) if against is not None else None
     v = verify_code(text, chosen, source=code, against=drawing, tool_diameter=tool_diameter)
     _finish_verification(v, report, preview, max_error_um)
+
+
+def _read_program(name: str, options: dict[str, Any]) -> Program:
+    """An existing G-code program; drawing-only options are refused, not ignored."""
+    from camtool.importers.gcode import read_gcode
+
+    given = [
+        flag
+        for flag, key, default in (
+            ("--offset", "offset", "on"),
+            ("--tool-diameter", "tool_diameter", 0.0),
+            ("--scale", "scale", 1.0),
+            ("--fit", "fit_mm", None),
+        )
+        if options.get(key, default) != default
+    ]
+    if given:
+        raise UsageError(
+            f"{name} is already a toolpath (G-code): {', '.join(given)} only apply to "
+            "drawings; offset or scale it in the program that wrote it"
+        )
+    return read_gcode(name)
 
 
 def _read_code(name: str) -> str:

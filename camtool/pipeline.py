@@ -22,7 +22,7 @@ class PostJob:
     """Everything one ``post`` produced.
 
     Attributes:
-        drawing: what was imported.
+        drawing: what was imported (``None`` when the input was already a program).
         program: the planned, machine-neutral program.
         target: the target it was written for.
         result: the emitted code and its warnings.
@@ -32,11 +32,11 @@ class PostJob:
             diameter for ``outside``/``inside`` offsets, 0 for paths on the line.
     """
 
-    drawing: Drawing
+    drawing: Drawing | None
     program: Program
     target: Target
     result: PostResult
-    placed: Drawing
+    placed: Drawing | None
     edge_radius_mm: float = 0.0
 
     @property
@@ -61,6 +61,66 @@ def post_file(
     """
     target = load_target(target_name, machine_file=machine_file)
     return post_drawing(read_drawing(path), target, **options)
+
+
+PROGRAM_SUFFIXES = (".ngc", ".nc", ".gcode", ".tap", ".cnc", ".gc", ".g")
+"""File endings read as existing G-code programs (re-posted, not planned)."""
+
+
+def is_program_file(name: str | Path) -> bool:
+    """True when ``name`` is a G-code program by its ending (see :data:`PROGRAM_SUFFIXES`)."""
+    return Path(name).suffix.lower() in PROGRAM_SUFFIXES
+
+
+def post_program(program: Program, target: Target, *, feed_mm_min: float | None = None) -> PostJob:
+    """Re-post an existing program (e.g. G-code another CAM wrote) for a target.
+
+    No planning: the program is already a toolpath. ``feed_mm_min``, when given,
+    replaces the feed of every cutting move (the program's own feeds are kept
+    otherwise). For a target without a Z axis (depth set by hand, seed-000
+    S000-08) Z is dropped with a warning: Z-only moves go, XY moves keep their
+    kind, as the thesis users edited VisiCAM output by hand (seed-000 §3.8).
+
+    Raises:
+        CamtoolError: whatever the target cannot express (names the block).
+    """
+    import dataclasses
+
+    from camtool.program import Rapid
+
+    if feed_mm_min is not None:
+        moves = tuple(
+            m if isinstance(m, Rapid) else dataclasses.replace(m, feed_mm_min=feed_mm_min)
+            for m in program.moves
+        )
+        program = dataclasses.replace(program, moves=moves)
+    if not target.machine.has_z:
+        program = _flatten(program, target.name)
+    return PostJob(None, program, target, target.emit(program), None, 0.0)
+
+
+def _flatten(program: Program, target: str) -> Program:
+    """The program without Z (see :func:`post_program`); unchanged when it has none."""
+    import dataclasses
+
+    depths = {m.z for m in program.moves if m.z is not None}
+    if not depths:
+        return program
+    here = program.origin
+    moves = []
+    for move in program.moves:
+        if (move.x, move.y) == here and not hasattr(move, "cx"):
+            continue  # a Z-only move
+        moves.append(dataclasses.replace(move, z=None))
+        here = (move.x, move.y)
+    dropped = len(program.moves) - len(moves)
+    warning = (
+        f"{target} has no Z axis: {dropped} Z-only move(s) dropped and Z removed from the "
+        f"others ({len(depths)} Z level(s) in the program); set the depth by hand"
+    )
+    return dataclasses.replace(
+        program, moves=tuple(moves), warnings=(*program.warnings, warning), lines=()
+    )
 
 
 def post_drawing(

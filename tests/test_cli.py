@@ -207,3 +207,32 @@ def test_machine_file_with_an_unknown_key(
     drawing = str(rectangle_dxf(tmp_path / "r.dxf", 2, 1))
     code, _, err = run(["post", drawing, "-t", "pic-mmh", "--machine", str(machine)], capsys)
     assert code == 3 and "unknown key(s) ['backlash_typo'] in [machine]" in err
+
+
+DATA = Path(__file__).parent / "data"
+
+
+def test_post_existing_gcode_reposts_it(capsys: pytest.CaptureFixture[str]) -> None:
+    """seed-001 §3.3: the FlashCut examples, re-posted for pic-mmh (I/J become absolute)."""
+    code, out, err = run(["post", str(DATA / "flashcut-seed001.nc"), "-t", "pic-mmh"], capsys)
+    assert code == 0
+    assert "G02X03000.00Y03000.00I02000.00J02000.00F30;" in out.splitlines()
+    assert "no G20/G21" in err
+
+
+def test_gcode_with_z_on_a_2d_target_drops_z_with_a_warning(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    ngc = tmp_path / "part.ngc"
+    ngc.write_text("G21\nG0 Z5\nG0 X1 Y1\nG1 Z-1 F0.5\nG1 X3 Y1 F0.8\nG2 X3 Y3 I0 J1\nG0 Z5\nM2\n")
+    code, out, err = run(["post", str(ngc), "-t", "pic-mmh"], capsys)
+    assert code == 0
+    assert "Z" not in out.replace("G", "")
+    assert "3 Z-only move(s) dropped" in err and "2 Z level(s)" in err
+
+
+def test_drawing_options_on_gcode_are_refused(capsys: pytest.CaptureFixture[str]) -> None:
+    args = ["post", str(DATA / "flashcut-seed001.nc"), "-t", "pic-mmh", "--offset", "outside"]
+    code, out, err = run(args, capsys)
+    assert code == 2 and out == ""
+    assert "already a toolpath" in err and "--offset" in err

@@ -1,0 +1,449 @@
+"""G-code importer: RS-274 programs as CAM programs write them, read into a Program.
+
+Reads G0/G1/G2/G3 (I/J centre and R-form arcs, G90.1/G91.1), G17, G20/G21,
+G90/G91, F, S, T, M3/M4/M5/M2/M30, N-words, comments, ``%`` lines, modal motion
+and modal words — including the FlashCut programs of seed-001 §3 (R1–R5) and
+the Inkscape Gcodetools ``.ngc`` files of seed-004 §3.3 (S004-R07). Lines are
+split into words by :mod:`camtool.importers.gcode_lexer`; the codes and what is
+done with each are in :mod:`camtool.importers.gcode_codes`. User docs:
+``docs/importers/gcode.md``.
+
+Rules (RS-274/NGC as LinuxCNC documents them, unless said otherwise):
+
+- mm inside: G20 numbers (X Y Z I J R F) are × 25.4; a G20/G21 applies to every
+  number of its own block. No G20/G21 before the first move: mm, with a warning
+  (seed-001 §3.3: FlashCut programs carry none and are in mm).
+- F is modal, in units per minute, converted to mm/min when read (so a later
+  unit change keeps the physical feed); G0 may carry F and keeps it modal.
+- A missing axis word keeps its value (lenient, standard RS-274); seed-001 R4's
+  "X and Y both required" strictness of the FlashCut app is not replicated.
+- Arcs: I/J are incremental from the start (G91.1, the default, seed-001 R2) or
+  absolute (G90.1, both required). The arc is refused when the radii to start and
+  end differ by more than 0.5 mm (0.05 in), or by more than 0.005 mm (0.0005 in)
+  and 0.1 % of the radius (LinuxCNC, "G2 G3 Arcs"); within that the programmed
+  centre and end are kept. R-form: R > 0 the short way (≤ 180°), R < 0 the long
+  way; a full circle in R-form is refused. A centre-form arc without X/Y is a
+  full circle.
+- Z: a move carries ``z`` when its Z word changes Z (an arc with such a Z is a
+  helix). Z starts unknown: the first Z word is always carried, an incremental Z
+  before any absolute Z is refused.
+- Contours: 1-based; a rapid after cutting moves starts the next contour.
+- ``Program.origin`` is (0, 0): the program's own zero. ``Program.lines`` holds
+  the 1-based file line of each move.
+- G28/G30: an intermediate point, if given, becomes a rapid; the move to the
+  stored home is not in the program (warning), so the axes it moves become
+  unknown and the next moves must give them absolutely.
+- After M2/M30 nothing is read; remaining lines with words are warned about.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+from camtool.errors import InputError
+from camtool.geometry import Point
+from camtool.importers.gcode_codes import BlockWords, Notes
+from camtool.importers.gcode_lexer import Block, Word, lex_line
+from camtool.program import ArcMove, Linear, Move, Program, Rapid
+from camtool.units import INCH
+
+_ARC_TOL_MM = (0.005, 0.5)
+"""LinuxCNC arc end tolerance in mm: (with 0.1 % of the radius, absolute ceiling)."""
+_ARC_TOL_IN = (0.0005, 0.05)
+"""The same in inches (G20)."""
+
+
+def read_gcode(path: str | Path, *, source_name: str | None = None) -> Program:
+    """Read a G-code file (``.ngc``, ``.nc``, ``.tap``, ``.gcode`` …) into a program.
+
+    Args:
+        path: the file. UTF-8 (with or without BOM), else read as Latin-1.
+        source_name: the name messages give the file (default: ``path``).
+
+    Returns:
+        The moves in absolute mm, Y up, feeds in mm/min, with the warnings for
+        what was converted or dropped (one per kind, with count and first line).
+
+    Raises:
+        InputError: the file cannot be read, holds no move, or uses a construct
+            camtool refuses (see :func:`parse_gcode`); the message names the
+            file, the line and the construct.
+    """
+    path = Path(path)
+    source = source_name or str(path)
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise InputError(f"{source}: cannot read the file ({exc.strerror or exc})") from exc
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        text = data.decode("latin-1")
+    return parse_gcode(text, source=source)
+
+
+def parse_gcode(text: str, *, source: str) -> Program:
+    """Read G-code text into a program (the rules are in this module's docstring).
+
+    Args:
+        text: the program; lines end with LF, CR LF or CR.
+        source: the name messages give it; line numbers are 1-based file lines.
+
+    Raises:
+        InputError: O-words, ``#`` parameters, ``[ ]`` expressions, G41/G42,
+            G18/G19, canned cycles, G93/G95, coordinate-offset codes, unknown
+            G/M codes or letters, two codes of one modal group, a repeated word,
+            a word no code uses, a cut before any F, an arc without centre or
+            whose end is off its circle beyond tolerance, or no move at all.
+    """
+    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+    reader = _Reader(source)
+    for number, raw in enumerate(lines, start=1):
+        block = lex_line(raw, number, source)
+        if block is not None and reader.run(block):
+            reader.after_end(lines[number:], number)
+            break
+    return reader.program()
+
+
+class _Reader:
+    """The modal state of the interpreter and the moves read so far."""
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+        self.notes = Notes(source)
+        self.moves: list[Move] = []
+        self.lines: list[int] = []
+        self.line = 0
+        self.x: float | None = 0.0
+        self.y: float | None = 0.0
+        self.z: float | None = None
+        self.motion: str | None = None
+        self.absolute = True
+        self.arc_absolute = False
+        self.inch = False
+        self.units_seen = False
+        self.feed_mm_min: float | None = None
+        self.coord: str | None = None
+        self.home = ""
+        self.contour = 1
+        self.cut_in_contour = False
+
+    @property
+    def scale(self) -> float:
+        """Millimetres per unit of the numbers in the current block."""
+        return INCH if self.inch else 1.0
+
+    def where(self) -> str:
+        return f"{self.source}:{self.line}"
+
+    def run(self, block: Block) -> bool:
+        """Execute one block; True when it ends the program (M2/M30)."""
+        self.line = block.line
+        if block.block_delete:
+            self.notes.add(
+                "/", block.line, "'/' block delete: the line is read as if the switch were off"
+            )
+        words = BlockWords(block, self.where())
+        self._modes(words)
+        used = self._motion(words)
+        self._check_unused(words, used)
+        stop = words.m.get("stop")
+        return stop is not None and stop.name in ("M2", "M30")
+
+    def after_end(self, rest: list[str], end_line: int) -> None:
+        """Warn about lines with words after M2/M30 on ``end_line``."""
+        count, first = 0, 0
+        for number, raw in enumerate(rest, start=end_line + 1):
+            try:
+                has_words = lex_line(raw, number, self.source) is not None
+            except InputError:
+                has_words = True
+            if has_words:
+                count += 1
+                first = first or number
+        if count:
+            plural = "line" if count == 1 else "lines"
+            self.notes.add(
+                "end", first, f"{count} {plural} after the program end on line {end_line} not read"
+            )
+
+    def program(self) -> Program:
+        """The program read, or InputError if it has no move."""
+        if not self.moves:
+            raise InputError(
+                f"{self.source}: no move (G0, G1, G2, G3) found; is this a G-code program?"
+            )
+        return Program(
+            tuple(self.moves), (0.0, 0.0), self.notes.warnings(), lines=tuple(self.lines)
+        )
+
+    # -- modes -------------------------------------------------------------------
+
+    def _modes(self, w: BlockWords) -> None:
+        """Everything a block sets before its motion (RS-274/NGC order of execution)."""
+        if (units := w.g_name("units")) is not None:
+            self.inch, self.units_seen = units == "G20", True
+        if (f := w.args.get("F")) is not None:
+            if f.value < 0:
+                raise InputError(f"{self.where()}: negative feed {f}; feeds are > 0")
+            self.feed_mm_min = f.value * self.scale
+        for letter, what in (("S", "spindle speed S"), ("T", "tool number T")):
+            if letter in w.args:
+                self.notes.add(
+                    letter, self.line, f"{what} ignored (the program has no {what[:-2]})"
+                )
+        for code in (*w.m.values(), *w.g.values()):
+            if code.action == "warn":
+                self.notes.add(code.name, self.line, code.note)
+        if w.g_name("nonmodal") == "G4" and ("P" not in w.args or w.args["P"].value < 0):
+            raise InputError(f"{self.where()}: G4 dwell needs a P word (seconds, ≥ 0)")
+        if (coord := w.g_name("coord")) is not None:
+            if self.coord not in (None, coord):
+                raise InputError(
+                    f"{self.where()}: {coord} after {self.coord}: camtool assumes one work "
+                    "offset (the part zero); split the program at the change"
+                )
+            self.coord = coord
+        if (distance := w.g_name("distance")) is not None:
+            self.absolute = distance == "G90"
+        if (arc_distance := w.g_name("arc_distance")) is not None:
+            self.arc_absolute = arc_distance == "G90.1"
+
+    def _check_unused(self, w: BlockWords, used: set[str]) -> None:
+        """Refuse words that no code in the block uses (LinuxCNC does the same)."""
+        if "H" in w.args and w.g_name("length") == "G43":
+            used.add("H")
+        for letter in "XYZIJRPHK":
+            word = w.args.get(letter)
+            if word is None or letter in used:
+                continue
+            if letter == "K":
+                raise InputError(
+                    f"{self.where()}: {word}: camtool reads arcs in the XY plane (G17) only, "
+                    "which take I and J"
+                )
+            hint = {
+                "X": "axis words need G0, G1, G2 or G3 (or modal motion) before them",
+                "Y": "axis words need G0, G1, G2 or G3 (or modal motion) before them",
+                "Z": "axis words need G0, G1, G2 or G3 (or modal motion) before them",
+                "P": "P belongs to G4 (dwell) or G2/G3 (turns)",
+                "H": "H belongs to G43",
+            }.get(letter, "I, J and R belong to G2/G3 arcs")
+            raise InputError(f"{self.where()}: {word} has no code to use it; {hint}")
+
+    # -- motion ------------------------------------------------------------------
+
+    def _motion(self, w: BlockWords) -> set[str]:
+        """Execute G28/G30 or the motion of the block; the letters it used."""
+        used = {"P"} if w.g_name("nonmodal") == "G4" else set()
+        axes = {letter for letter in "XYZ" if letter in w.args}
+        motion = w.g_name("motion")
+        if motion is not None:
+            self.motion = None if motion == "G80" else motion
+        home = w.g_name("nonmodal")
+        if home in ("G28", "G30"):
+            if axes and motion not in (None, "G80"):
+                raise InputError(
+                    f"{self.where()}: {home} and {motion} both use the axis words; "
+                    "put them in separate blocks"
+                )
+            self._home(home, w.args)
+            return used | axes
+        if self.motion in ("G2", "G3"):
+            arc_words = {letter for letter in "XYZIJRP" if letter in w.args}
+            if arc_words - {"P"}:
+                self._arc(w.args)
+                return used | arc_words
+        elif self.motion is not None and axes:
+            self._line(w.args)
+            return used | axes
+        return used
+
+    def _target(self, args: dict[str, Word]) -> tuple[float | None, float | None, float | None]:
+        """The end point of a move in mm; ``None`` for an axis whose position is unknown."""
+        out: list[float | None] = []
+        for letter, here in (("X", self.x), ("Y", self.y), ("Z", self.z)):
+            word = args.get(letter)
+            if word is None:
+                out.append(here)
+            elif self.absolute:
+                out.append(word.value * self.scale)
+            elif here is not None:
+                out.append(here + word.value * self.scale)
+            elif word.value == 0:
+                out.append(None)
+            else:
+                after = f"after {self.home}" if self.home and letter != "Z" else "yet"
+                raise InputError(
+                    f"{self.where()}: incremental {word} (G91) but the {letter} position is not "
+                    f"known {after}; give an absolute {letter} (G90) first"
+                )
+        return out[0], out[1], out[2]
+
+    def _end_xy(self, args: dict[str, Word], name: str) -> tuple[float, float, float | None]:
+        """Target of a motion block, whose XY must be known."""
+        tx, ty, tz = self._target(args)
+        if tx is None or ty is None:
+            raise InputError(
+                f"{self.where()}: {name} ends at an unknown position after {self.home}; "
+                "give absolute X and Y (G90)"
+            )
+        return tx, ty, tz
+
+    def _start_xy(self, name: str) -> Point:
+        """Start of a cutting move, which must be known."""
+        if self.x is None or self.y is None:
+            raise InputError(
+                f"{self.where()}: {name} starts from the position after {self.home}, which "
+                "camtool does not know; move there first with G0 and absolute X and Y"
+            )
+        return self.x, self.y
+
+    def _z_out(self, args: dict[str, Word], tz: float | None) -> float | None:
+        """The ``z`` a move carries: its Z when the Z word changes Z, else None."""
+        return tz if "Z" in args and tz is not None and tz != self.z else None
+
+    def _feed(self, name: str) -> float:
+        if self.feed_mm_min is None:
+            raise InputError(
+                f"{self.where()}: {name} before any F word; set the feed (e.g. F100) first"
+            )
+        if self.feed_mm_min == 0:
+            raise InputError(f"{self.where()}: {name} with feed F0; set a feed above 0")
+        return self.feed_mm_min
+
+    def _push(self, move: Move, tx: float | None, ty: float | None, tz: float | None) -> None:
+        """Append ``move`` (its contour set here) and make its end the current position."""
+        if not self.units_seen:
+            self.units_seen = True
+            self.notes.add(
+                "units", self.line, "no G20/G21 before the first move: coordinates read as mm"
+            )
+        if isinstance(move, Rapid):
+            if self.cut_in_contour:
+                self.contour += 1
+            self.cut_in_contour = False
+        else:
+            self.cut_in_contour = True
+        self.moves.append(dataclasses.replace(move, contour=self.contour))
+        self.lines.append(self.line)
+        self.x, self.y, self.z = tx, ty, tz
+
+    def _line(self, args: dict[str, Word]) -> None:
+        name = self.motion or "G1"
+        tx, ty, tz = self._end_xy(args, name)
+        z = self._z_out(args, tz)
+        if name == "G0":
+            self._push(Rapid(tx, ty, z), tx, ty, tz)
+            return
+        feed = self._feed(name)
+        self._start_xy(name)
+        self._push(Linear(tx, ty, feed, z), tx, ty, tz)
+
+    def _arc(self, args: dict[str, Word]) -> None:
+        name = self.motion or "G2"
+        feed = self._feed(name)
+        start = self._start_xy(name)
+        tx, ty, tz = self._end_xy(args, name)
+        turns = args.get("P")
+        if turns is not None and turns.value != 1:
+            raise InputError(
+                f"{self.where()}: {name} {turns}: multi-turn arcs are not supported; "
+                "write each turn as its own G2/G3"
+            )
+        clockwise = name == "G2"
+        if "R" in args:
+            if "I" in args or "J" in args:
+                raise InputError(f"{self.where()}: {name} with both R and I/J; keep one form")
+            cx, cy = self._centre_r(args["R"], start, (tx, ty), clockwise, name)
+        else:
+            cx, cy = self._centre_ij(args, start, (tx, ty), name)
+        arc = ArcMove(tx, ty, cx, cy, clockwise, feed, self._z_out(args, tz))
+        self._push(arc, tx, ty, tz)
+
+    def _tolerance(self) -> tuple[float, float]:
+        small, large = _ARC_TOL_IN if self.inch else _ARC_TOL_MM
+        return small * self.scale, large * self.scale
+
+    def _centre_ij(self, args: dict[str, Word], start: Point, end: Point, name: str) -> Point:
+        i, j = args.get("I"), args.get("J")
+        if i is None and j is None:
+            raise InputError(f"{self.where()}: {name} without a centre; give I and J (or R) words")
+        di = i.value * self.scale if i is not None else 0.0
+        dj = j.value * self.scale if j is not None else 0.0
+        if self.arc_absolute:
+            if i is None or j is None:
+                raise InputError(
+                    f"{self.where()}: {name} in G90.1 (absolute centre) needs both I and J"
+                )
+            centre = (di, dj)
+        else:
+            centre = (start[0] + di, start[1] + dj)
+        self._check_radius(start, end, centre, name)
+        return centre
+
+    def _check_radius(self, start: Point, end: Point, centre: Point, name: str) -> None:
+        r_start, r_end = math.dist(start, centre), math.dist(end, centre)
+        if r_start == 0:
+            raise InputError(f"{self.where()}: {name} centre is its start point (radius 0)")
+        small, large = self._tolerance()
+        off = abs(r_start - r_end)
+        if off > large or (off > small and off > 0.001 * r_start):
+            mode = "absolute (G90.1)" if self.arc_absolute else "incremental from the start (G91.1)"
+            raise InputError(
+                f"{self.where()}: {name} end point is {off:.4g} mm off its circle (radius "
+                f"{r_start:.4f} mm at the start, {r_end:.4f} mm at the end; the limit is "
+                f"{small:g} mm and 0.1 % of the radius); I/J are read as {mode}: check them "
+                "or export with more decimals"
+            )
+
+    def _centre_r(
+        self, r_word: Word, start: Point, end: Point, clockwise: bool, name: str
+    ) -> Point:
+        r = r_word.value * self.scale
+        chord = math.dist(start, end)
+        if chord == 0:
+            raise InputError(
+                f"{self.where()}: {name} {r_word} ends where it starts; a full circle cannot "
+                "be written with R: use I and J"
+            )
+        if r == 0:
+            raise InputError(f"{self.where()}: {name} with R0; give the arc's radius")
+        half = chord / 2
+        if abs(r) < half - self._tolerance()[0]:
+            raise InputError(
+                f"{self.where()}: {name} {r_word}: radius {abs(r):.4f} mm is less than half "
+                f"the distance to the end point ({half:.4f} mm); check R"
+            )
+        h = math.sqrt(max(r * r - half * half, 0.0))
+        # The centre lies right of the chord for G2 with R > 0 (the short way).
+        side = (1.0 if clockwise else -1.0) * (1.0 if r > 0 else -1.0)
+        ux, uy = (end[0] - start[0]) / chord, (end[1] - start[1]) / chord
+        mx, my = (start[0] + end[0]) / 2, (start[1] + end[1]) / 2
+        return mx + side * h * uy, my - side * h * ux
+
+    def _home(self, name: str, args: dict[str, Word]) -> None:
+        """G28/G30: a rapid to the intermediate point, then the axes are unknown."""
+        axes = [letter for letter in "XYZ" if letter in args]
+        if axes:
+            tx, ty, tz = self._target(args)
+            z = self._z_out(args, tz)
+            if (
+                tx is not None
+                and ty is not None
+                and ((tx, ty) != (self.x, self.y) or z is not None)
+            ):
+                self._push(Rapid(tx, ty, z), tx, ty, tz)
+        for letter in axes or "XYZ":
+            setattr(self, letter.lower(), None)
+        self.home = f"{name} on line {self.line}"
+        self.notes.add(
+            name,
+            self.line,
+            f"{name} return to the machine's stored position: that move is not in the "
+            "program (camtool does not know the position); moves after it must give "
+            "absolute X and Y",
+        )

@@ -1,0 +1,169 @@
+"""RS-274 lexer: one text line of G-code into a :class:`Block` of words.
+
+What a line may hold (RS-274/NGC as LinuxCNC documents it, and the FlashCut
+and Gcodetools programs of seed-001 §3 and seed-004 §3.3):
+
+- words: a letter and a number, case-insensitive, spaces anywhere outside
+  comments (``G01X1.Y2`` = ``g1 x 1 y 2``); numbers like ``.5``, ``-0.``, ``+1``;
+- comments in parentheses (not nested) and from ``;`` to the end of the line;
+- ``%`` tape-marker lines, blank lines;
+- a leading ``/`` (block delete; the line is read as if the switch were off);
+- a RepRap checksum ``*NN`` at the end: the XOR of every byte before ``*``,
+  which is verified.
+
+Refused with an :class:`~camtool.errors.InputError` naming the line: O-words
+(subroutines and flow control), ``#`` parameters, ``[ ]`` expressions, a
+letter without a number, any other character, unclosed or nested comments
+and a wrong checksum.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from camtool.errors import InputError
+
+_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)")
+_CHECKSUM = re.compile(r"\*(\d+)$")
+
+
+@dataclass(frozen=True)
+class Word:
+    """One word: ``letter`` (upper case) and its ``value`` as written (file units).
+
+    ``text`` is the number as it stood in the file, for messages.
+    """
+
+    letter: str
+    value: float
+    text: str
+
+    def __str__(self) -> str:
+        return f"{self.letter}{self.text}"
+
+
+@dataclass(frozen=True)
+class Block:
+    """The words of one line; ``line`` is the 1-based line number in the file."""
+
+    line: int
+    words: tuple[Word, ...]
+    block_delete: bool = False
+
+
+def lex_line(raw: str, line: int, source: str) -> Block | None:
+    """Split one line into words; ``None`` for a line without words.
+
+    A line with only comments, blanks or a ``%`` tape marker gives ``None``.
+
+    Args:
+        raw: the line, without its end-of-line characters.
+        line: its 1-based number in the file, for messages.
+        source: the file name, for messages.
+
+    Raises:
+        InputError: a construct camtool does not read, or a malformed line;
+            the message names ``source:line`` and the construct.
+    """
+    where = f"{source}:{line}"
+    code, star_at = _strip_comments(raw, where)
+    code = code.strip()
+    if code.startswith("%"):
+        if code[1:].strip():
+            raise InputError(f"{where}: text after the '%' tape marker: {code!r}; remove it")
+        return None
+    if star_at is not None:
+        code = _check_checksum(raw, code, star_at, where)
+    block_delete = code.startswith("/")
+    if block_delete:
+        code = code[1:]
+    code = "".join(code.split()).upper()
+    words = _words(code, where)
+    if not words:
+        if block_delete:
+            return Block(line, (), True)
+        return None
+    return Block(line, tuple(words), block_delete)
+
+
+def _strip_comments(raw: str, where: str) -> tuple[str, int | None]:
+    """The line without comments, and the index in ``raw`` of a ``*`` outside them."""
+    kept: list[str] = []
+    star_at: int | None = None
+    i = 0
+    while i < len(raw):
+        c = raw[i]
+        if c == ";":
+            break
+        if c == "(":
+            close = raw.find(")", i + 1)
+            nested = raw.find("(", i + 1)
+            if close < 0:
+                raise InputError(f"{where}: comment '(' is not closed; add ')' on the same line")
+            if 0 <= nested < close:
+                raise InputError(f"{where}: nested comment '(... (...' is not allowed; remove it")
+            kept.append(" ")
+            i = close + 1
+            continue
+        if c == ")":
+            raise InputError(f"{where}: ')' without '('; remove it or open the comment")
+        if c == "*" and star_at is None:
+            star_at = i
+        kept.append(c)
+        i += 1
+    return "".join(kept), star_at
+
+
+def _check_checksum(raw: str, code: str, star_at: int, where: str) -> str:
+    """Verify a RepRap ``*NN`` checksum and return ``code`` without it."""
+    m = _CHECKSUM.search(code)
+    if m is None:
+        raise InputError(
+            f"{where}: '*' must end the line followed by a checksum (e.g. '*71'): {code!r}"
+        )
+    expected = 0
+    for byte in raw[:star_at].encode("latin-1", errors="replace"):
+        expected ^= byte
+    if int(m[1]) != expected:
+        raise InputError(
+            f"{where}: checksum *{m[1]} does not match the line (computed *{expected}); "
+            "the line was damaged: export the program again"
+        )
+    return code[: m.start()]
+
+
+def _words(code: str, where: str) -> list[Word]:
+    """Words of a comment-free, upper-case line without blanks."""
+    words: list[Word] = []
+    i = 0
+    while i < len(code):
+        c = code[i]
+        _refuse_special(c, code, where)
+        if not ("A" <= c <= "Z"):
+            raise InputError(f"{where}: unexpected character {c!r} in {code!r}")
+        if c == "O":
+            raise InputError(
+                f"{where}: O-word {code!r} (subroutines, loops, conditions) is not supported; "
+                "expand the program in your CAM (a Fanuc program number line can be deleted)"
+            )
+        m = _NUMBER.match(code, i + 1)
+        if m is None:
+            _refuse_special(code[i + 1 : i + 2], code, where)
+            raise InputError(f"{where}: letter {c!r} is not followed by a number in {code!r}")
+        words.append(Word(c, float(m[0]), m[0]))
+        i = m.end()
+    return words
+
+
+def _refuse_special(c: str, code: str, where: str) -> None:
+    """Raise for the parameter and expression characters of RS-274/NGC."""
+    if c == "#":
+        raise InputError(
+            f"{where}: '#' parameters are not supported ({code!r}); "
+            "write plain numbers (post the program again without variables)"
+        )
+    if c and c in "[]":
+        raise InputError(
+            f"{where}: '[ ]' expressions are not supported ({code!r}); write plain numbers"
+        )

@@ -1,0 +1,478 @@
+"""G-code import: RS-274 as CAM programs write it, FlashCut (seed-001 §3), Gcodetools (seed-004)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from camtool.errors import InputError
+from camtool.geometry import Arc
+from camtool.importers.gcode import parse_gcode, read_gcode
+from camtool.post.registry import load_target
+from camtool.program import ArcMove, Linear, Move, Program, Rapid
+
+DATA = Path(__file__).parents[1] / "data"
+SQRT2 = math.sqrt(2.0)
+
+
+def parse(text: str) -> Program:
+    return parse_gcode(text, source="t.ngc")
+
+
+def arcs(program: Program) -> list[Arc]:
+    return [seg for _, seg in program.segments() if isinstance(seg, Arc)]
+
+
+def rows(moves: tuple[Move, ...]) -> list[tuple[object, ...]]:
+    """Moves as (kind, fields...) rows, for pytest.approx on inch-converted numbers."""
+    return [(type(m).__name__, *dataclasses.astuple(m)) for m in moves]
+
+
+def refused(text: str) -> str:
+    with pytest.raises(InputError) as info:
+        parse(text)
+    return str(info.value)
+
+
+# -- seed-001 (FlashCut, Yáñez Soto 2007) --------------------------------------------------
+
+
+def test_seed001_r2_g02_golden_arc() -> None:
+    # seed-001 §10 R2 / §3.3 (L1004-1005): centre (2,2), r = √2, CW sweep −180°,
+    # passing through (2−√2, 2).
+    program = parse("G01 X1.0 Y1.0 F3.0\nG02 X3.0 Y3.0 I1.0 J1.0\n")
+    line, arc_move = program.moves
+    assert line == Linear(1.0, 1.0, 3.0, contour=1)
+    assert arc_move == ArcMove(3.0, 3.0, 2.0, 2.0, True, 3.0, contour=1)  # F modal (R3)
+    (arc,) = arcs(program)
+    assert arc.radius == pytest.approx(SQRT2)
+    assert arc.sweep == pytest.approx(-math.pi)
+    # 225° → 180° is a quarter of the sweep
+    assert arc.point_at(0.25) == pytest.approx((2.0 - SQRT2, 2.0))
+
+
+def test_seed001_r2_g03_golden_arc() -> None:
+    # seed-001 §10 R2 / §3.3 (L1020-1021): centre (1,2), CCW +180°, through (1+√2, 2).
+    program = parse("G01 X2.0 Y1.0 F8.0\nG03 X0.0 Y3.0 I-1.0 J1.0\n")
+    assert program.moves[1] == ArcMove(0.0, 3.0, 1.0, 2.0, False, 8.0, contour=1)
+    (arc,) = arcs(program)
+    assert arc.radius == pytest.approx(SQRT2)
+    assert arc.sweep == pytest.approx(math.pi)
+    assert arc.point_at(0.25) == pytest.approx((1.0 + SQRT2, 2.0))
+
+
+def test_flashcut_file_with_the_four_literal_examples() -> None:
+    # tests/data/flashcut-seed001.nc: seed-001 §3.3's four lines in one file (CR LF ends);
+    # no units anywhere (mm implied, §3.3) → one warning naming line 1.
+    program = read_gcode(DATA / "flashcut-seed001.nc")
+    assert program.moves == (
+        Linear(1.0, 1.0, 3.0, contour=1),
+        ArcMove(3.0, 3.0, 2.0, 2.0, True, 3.0, contour=1),
+        Linear(2.0, 1.0, 8.0, contour=1),
+        ArcMove(0.0, 3.0, 1.0, 2.0, False, 8.0, contour=1),
+    )
+    assert program.origin == (0.0, 0.0)
+    (warning,) = program.warnings
+    assert warning.startswith(f"{DATA / 'flashcut-seed001.nc'}:1: no G20/G21")
+
+
+def test_flashcut_n_words_comments_and_m_codes_are_tolerated() -> None:
+    # seed-001 R1 (M00/M02/M03/M04/M05/M30) and R5 (N-words, comments): the program loads.
+    program = parse(
+        "%\n"
+        "N1 (LMM logo) M03\n"
+        "N2 G00 X1.0 Y1.0 ; start\n"
+        "N3 G01 X2.0 Y1.0 F3.0\n"
+        "N4 M00\n"
+        "N5 M04\n"
+        "N6 G01 X2.0 Y2.0\n"
+        "N7 M05\n"
+        "N8 M30\n"
+        "%\n"
+    )
+    assert [type(m) for m in program.moves] == [Rapid, Linear, Linear]
+    assert program.moves[-1] == Linear(2.0, 2.0, 3.0, contour=1)
+    assert any(w.startswith("t.ngc:5: M0 program pause dropped") for w in program.warnings)
+
+
+def test_flashcut_missing_axis_word_keeps_its_value() -> None:
+    # seed-001 R4: the app refused `G01 X2.0` without Y; camtool reads leniently (RS-274).
+    program = parse("G21 G01 X1.0 Y1.0 F3.0\nG01 X2.0\nG00 Y5.0\n")
+    assert program.moves[1] == Linear(2.0, 1.0, 3.0, contour=1)
+    assert program.moves[2] == Rapid(2.0, 5.0, contour=2)
+
+
+def test_g20_g21_have_their_modern_meaning() -> None:
+    # seed-001 R6: G20/G21 are inch/mm, not the textbook's interpolation codes.
+    program = parse("G20 G1 X1 Y2 F10\nG21 G1 X1 Y2\n")
+    assert program.moves[0] == Linear(25.4, 50.8, 254.0, contour=1)
+    assert program.moves[1] == Linear(1.0, 2.0, 254.0, contour=1)  # feed stays physical
+
+
+# -- seed-004 (Gcodetools .ngc, S004-R07) -------------------------------------------------
+
+
+def test_gcodetools_ngc_file() -> None:
+    # tests/data/gcodetools-circle.ngc, written as Gcodetools 0.7 writes (header/footer
+    # comments, G21, G00 Z5 retracts, G01 Z-1 F100 (Penetrate), G02 X Y Z I J F400, M2).
+    # seed-004 §3.3: cut depth Z = −1 mm.
+    program = read_gcode(DATA / "gcodetools-circle.ngc", source_name="logo.ngc")
+    assert program.moves == (
+        Rapid(0.0, 0.0, 5.0, contour=1),
+        Rapid(5.0, 10.0, contour=1),
+        Linear(5.0, 10.0, 100.0, -1.0, contour=1),
+        ArcMove(15.0, 10.0, 10.0, 10.0, True, 400.0, contour=1),  # Z-1 unchanged: no z
+        ArcMove(5.0, 10.0, 10.0, 10.0, True, 400.0, contour=1),
+        Linear(5.0, 20.0, 400.0, contour=1),
+        Rapid(5.0, 20.0, 5.0, contour=2),
+        Rapid(0.0, 0.0, contour=2),
+    )
+    assert program.warnings == ()
+    assert program.lines == (12, 13, 15, 16, 17, 18, 19, 26)  # 1-based file lines
+    assert sum(arc.length for arc in arcs(program)) == pytest.approx(2 * math.pi * 5.0)
+
+
+def test_linuxcnc_inch_file_with_absolute_centres_and_r_arcs() -> None:
+    # tests/data/linuxcnc-inch.tap: G20, G90.1 absolute I/J, R-form, N-words, preamble codes.
+    program = read_gcode(DATA / "linuxcnc-inch.tap", source_name="p.tap")
+    expected = (
+        Rapid(0.0, 0.0, 2.54, contour=1),
+        Rapid(0.0, 0.0, contour=1),
+        Linear(0.0, 0.0, 50.8, -0.254, contour=1),
+        Linear(25.4, 0.0, 254.0, contour=1),
+        ArcMove(38.1, 12.7, 25.4, 12.7, False, 254.0, contour=1),  # centre (1, 0.5) in
+        ArcMove(50.8, 25.4, 50.8, 12.7, True, 254.0, contour=1),  # R0.5 → centre (2, 0.5) in
+        Rapid(50.8, 25.4, 2.54, contour=2),
+    )
+    assert rows(program.moves) == [pytest.approx(row, abs=1e-12) for row in rows(expected)]
+    assert program.warnings == (
+        "p.tap:3: G40 (cutter compensation off) read as a no-op",
+        "p.tap:3: G49 (tool length offset off) read as a no-op",
+        "p.tap:3: G54 work offset assumed 0: coordinates are taken from the part zero",
+    )
+
+
+# -- RS-274 rules ---------------------------------------------------------------------------
+
+
+def test_r_form_positive_and_negative() -> None:
+    # LinuxCNC "G2 G3 Arcs", radius format: R > 0 turns ≤ 180°, R < 0 more than 180°.
+    r = repr(SQRT2)
+    program = parse(f"G21 G1 X0 Y0 F10\nG2 X2 Y0 R{r}\nG2 X0 Y0 R-{r}\nG3 X2 Y0 R{r}\n")
+    short_cw, long_cw, short_ccw = arcs(program)
+    assert short_cw.centre == pytest.approx((1.0, -1.0))
+    assert short_cw.sweep == pytest.approx(-math.pi / 2)
+    assert long_cw.centre == pytest.approx((1.0, -1.0))
+    assert long_cw.sweep == pytest.approx(-3 * math.pi / 2)
+    assert short_ccw.centre == pytest.approx((1.0, 1.0))
+    assert short_ccw.sweep == pytest.approx(math.pi / 2)
+
+
+def test_g90_1_absolute_and_g91_1_incremental_centres() -> None:
+    program = parse("G21 G0 X4 Y1\nG90.1 G3 X6 Y3 I4 J3 F5\nG91.1 G2 X8 Y5 I2 J0\n")
+    first, second = program.moves[1:]
+    assert isinstance(first, ArcMove) and (first.cx, first.cy) == (4.0, 3.0)
+    assert isinstance(second, ArcMove) and (second.cx, second.cy) == (8.0, 3.0)
+
+
+def test_g91_incremental_xy_and_modal_motion() -> None:
+    program = parse("G21 G91 G1 X1 Y1 F100\nX1 Y1\nX-2\nG90 X5 Y5\n")
+    assert [(m.x, m.y) for m in program.moves] == [(1, 1), (2, 2), (0, 2), (5, 5)]
+    assert all(isinstance(m, Linear) and m.feed_mm_min == 100.0 for m in program.moves)
+
+
+def test_full_circle_without_axis_words() -> None:
+    # LinuxCNC centre format: an arc ending where it starts is a full circle.
+    program = parse("G21 G0 X5 Y0\nG3 I-5 J0 F60\n")
+    (circle,) = arcs(program)
+    assert circle.is_full_circle and circle.centre == (0.0, 0.0)
+    assert circle.length == pytest.approx(2 * math.pi * 5)
+
+
+def test_g0_with_f_keeps_f_modal() -> None:
+    # seed-001 R3: G00 ignores F for its own speed, but F stays set.
+    program = parse("G21 G0 X1 Y0 F50\nG1 X2\n")
+    assert program.moves == (Rapid(1.0, 0.0, contour=1), Linear(2.0, 0.0, 50.0, contour=1))
+
+
+@pytest.mark.parametrize(
+    ("text", "x", "y"),
+    [
+        ("G01X1.Y2", 1.0, 2.0),
+        ("g1 x.5 y-0.", 0.5, 0.0),
+        ("G1 X+1 Y-.25", 1.0, -0.25),
+        ("G 0 1 X 1 . 5 Y 2", 1.5, 2.0),
+        ("N0010G01X1Y2(comment)", 1.0, 2.0),
+        ("/G1 X1 Y2", 1.0, 2.0),
+    ],
+)
+def test_word_syntax(text: str, x: float, y: float) -> None:
+    (move,) = parse(f"G21 F1\n{text}\n").moves
+    assert (move.x, move.y) == (x, y)
+
+
+def test_z_is_carried_when_it_changes_and_helix() -> None:
+    program = parse("G21 G0 Z0\nG1 Z0 F10\nG1 Z-1 X1\nG2 X3 Y0 I1 J0 Z-2\nG1 X4 Z-2\n")
+    assert [m.z for m in program.moves] == [0.0, None, -1.0, -2.0, None]
+    assert isinstance(program.moves[3], ArcMove)
+
+
+def test_contours_start_at_rapids_after_cutting() -> None:
+    program = parse("G21 G0 X1 Y1\nG0 Z1\nG1 X2 F9\nG1 X3\nG0 Z5\nG0 X0\nG1 Y1\nG0 X9\n")
+    assert [m.contour for m in program.moves] == [1, 1, 1, 1, 2, 2, 2, 3]
+
+
+def test_checksum_is_verified() -> None:
+    line = "N1 G1 X1 Y1 F10"
+    checksum = 0
+    for c in line.encode():
+        checksum ^= c
+    (move,) = parse(f"G21\n{line}*{checksum}\n").moves
+    assert (move.x, move.y) == (1.0, 1.0)
+    message = refused(f"G21\n{line}*{(checksum + 1) % 256}\n")
+    assert message.startswith("t.ngc:2: checksum") and "damaged" in message
+
+
+def test_arc_radius_tolerance_of_linuxcnc() -> None:
+    # LinuxCNC: error when |r_start − r_end| > 0.005 mm and > 0.1 % of r (or > 0.5 mm).
+    ok = parse("G21 G1 X0 Y0 F1\nG2 X20.004 Y0 I10 J0\n")  # 0.004 mm off: accepted as written
+    assert ok.moves[1] == ArcMove(20.004, 0.0, 10.0, 0.0, True, 1.0, contour=1)
+    assert parse("G21 G1 X0 Y0 F1\nG2 X20.009 Y0 I10 J0\n").moves  # 0.009 < 0.1 % of 10 mm
+    message = refused("G21 G1 X0 Y0 F1\nG2 X2.006 Y0 I1 J0\n")  # 0.006 mm and 0.6 %
+    assert message.startswith("t.ngc:2: G2 end point is 0.006 mm off its circle")
+    assert "G91.1" in message
+    big = refused("G21 G1 X0 Y0 F1\nG2 X1000.6 Y0 I500 J0\n")  # 0.6 mm > 0.5 mm
+    assert big.startswith("t.ngc:2: G2 end point is 0.6 mm off")
+    # in inches the limit is 0.0005 in: 0.0004 in is accepted
+    assert parse("G20 G1 X0 Y0 F1\nG2 X2.0004 Y0 I1 J0\n").moves
+
+
+def test_after_program_end_nothing_is_read() -> None:
+    program = parse("G21 G0 X1 Y1\nM2\nG0 X5 Y5\n(comment)\nG0 X6 Y6\n")
+    assert program.moves == (Rapid(1.0, 1.0, contour=1),)
+    assert program.warnings == ("t.ngc:3: 2 lines after the program end on line 2 not read",)
+
+
+def test_g28_intermediate_point_then_unknown_position() -> None:
+    program = parse("G21 G0 X1 Y1\nG28 X0 Y0\nG0 X5 Y5\nG1 X6 F10\n")
+    assert program.moves == (
+        Rapid(1.0, 1.0, contour=1),
+        Rapid(0.0, 0.0, contour=1),
+        Rapid(5.0, 5.0, contour=1),
+        Linear(6.0, 5.0, 10.0, contour=1),
+    )
+    assert program.warnings[0].startswith("t.ngc:2: G28 return to the machine's stored position")
+    message = refused("G21 G0 X1 Y1\nG28\nG1 X6 Y6 F10\n")
+    assert message.startswith("t.ngc:3: G1 starts from the position after G28 on line 2")
+    message = refused("G21 G0 X1 Y1\nG28\nG91 G0 X6 Y6\n")
+    assert message.startswith("t.ngc:3: incremental X6 (G91)")
+
+
+@pytest.mark.parametrize("home", ["G28", "G30"])
+def test_typical_footer_g91_g28_z0(home: str) -> None:
+    text = f"G21 G0 Z5\nG0 X1 Y1\nG1 Z-1 F10\nG0 Z5\nG91 {home} Z0\n{home} X0 Y0\nM30\n"
+    program = parse(text)
+    assert len(program.moves) == 4  # incremental 0: no intermediate move
+    (warning,) = program.warnings
+    assert warning.startswith(f"t.ngc:5: {home} return") and warning.endswith("(2 times)")
+
+
+def test_g80_alone_is_a_no_op() -> None:
+    program = parse("G21 G80\nG0 X1 Y1\n")
+    assert program.moves == (Rapid(1.0, 1.0, contour=1),)
+
+
+# -- safe conversions: one warning per kind, with count and first line ---------------------
+
+
+@pytest.mark.parametrize(
+    ("block", "expected"),
+    [
+        ("G4 P0.5", "G4 dwell dropped"),
+        ("G40", "G40 (cutter compensation off) read as a no-op"),
+        ("G43 H1", "G43 tool length offset assumed 0"),
+        ("G49", "G49 (tool length offset off) read as a no-op"),
+        ("G54", "G54 work offset assumed 0"),
+        ("G55", "G55 work offset assumed 0"),
+        ("G61", "G61 path control mode ignored"),
+        ("G64", "G64 path control mode ignored"),
+        ("G98", "G98 canned-cycle return mode ignored"),
+        ("G97 S1000", "G97 spindle speed mode ignored"),
+        ("M0", "M0 program pause dropped"),
+        ("M1", "M1 program pause dropped"),
+        ("T1 M6", "M6 tool change ignored"),
+        ("M7", "coolant M7 ignored"),
+        ("M8", "coolant M8 ignored"),
+        ("M9", "coolant M9 ignored"),
+        ("S12000 M3", "spindle speed S ignored"),
+        ("T2", "tool number T ignored"),
+        ("/M5", "'/' block delete: the line is read"),
+    ],
+)
+def test_safe_conversion_warns_once_with_count_and_first_line(block: str, expected: str) -> None:
+    program = parse(f"G21 G0 X1 Y1\n{block}\nG1 X2 F10\n{block}\n")
+    assert len(program.moves) == 2
+    (warning,) = [w for w in program.warnings if expected in w]
+    assert warning.startswith(f"t.ngc:2: {expected}")
+    assert warning.endswith("(2 times)")
+
+
+# -- refused constructs: the message names the line and the construct ----------------------
+
+
+@pytest.mark.parametrize(
+    ("block", "construct"),
+    [
+        ("O100 sub", "O-word"),
+        ("G1 X#1 F10", "'#' parameters"),
+        ("#1 = 5", "'#' parameters"),
+        ("G1 X[1+2] F10", "'[ ]' expressions"),
+        ("G41 D1", "G41 (cutter radius compensation)"),
+        ("G42", "G42 (cutter radius compensation)"),
+        ("G18", "G18 selects another arc plane"),
+        ("G19", "G19 selects another arc plane"),
+        ("G81 X1 Y1 Z-1 R1", "G81 is a canned cycle"),
+        ("G83 X1 Y1 Z-1 R1 Q1", "G83 is a canned cycle"),
+        ("G93", "G93 (inverse-time / per-revolution feed)"),
+        ("G95", "G95 (inverse-time / per-revolution feed)"),
+        ("G92 X0 Y0", "G92 changes the coordinate offsets"),
+        ("G53 G0 X0", "G53 moves in machine coordinates"),
+        ("G5.1 X1 Y1 I1 J1", "G5.1 splines"),
+        ("G12 X1", "unknown or unsupported code G12"),
+        ("M98 P100", "unknown or unsupported code M98"),
+        ("G2 X3 Y1 F10", "G2 without a centre"),
+        ("G2 X4 Y1 I1 J0 F10", "G2 end point is 1 mm off its circle"),
+        ("G0 G1 X2", "G0 and G1 are both motion codes"),
+        ("G90 G91", "G90 and G91 are both distance codes"),
+        ("G1 X2 X3 F1", "two X words (X2, X3)"),
+        ("G2 X1 Y1 R1 F10", "G2 R1 ends where it starts"),
+        ("G3 X5 Y1 R1 F10", "radius 1.0000 mm is less than half"),
+        ("G90.1 G2 X3 Y1 I2 F10", "G2 in G90.1 (absolute centre) needs both I and J"),
+        ("G2 X3 Y1 I1 J0 R1 F10", "both R and I/J"),
+        ("G2 X3 Y1 I1 P2 F10", "multi-turn arcs"),
+        ("G2 X3 Y1 I1 K0 F10", "K0: camtool reads arcs in the XY plane"),
+        ("G1 X2 Y1", "G1 before any F word"),
+        ("G1 X2 Y1 F0", "G1 with feed F0"),
+        ("G0 X2 I1", "I1 has no code to use it"),
+        ("G4", "G4 dwell needs a P word"),
+        ("G1 X2 E0.5 F10", "E0.5 is a 3D-printer extrusion word"),
+        ("G0 A90", "A90 is an axis camtool does not have"),
+        ("G0 X1 (open", "comment '(' is not closed"),
+        ("G0 X1 (a (b) c)", "nested comment"),
+        ("G0 X1 @", "unexpected character '@'"),
+        ("G0 X", "letter 'X' is not followed by a number"),
+        ("G1 X1 F-5", "negative feed F-5"),
+        ("G80 X1", "X1 has no code to use it"),
+        ("G28 G1 X0 Y0", "G28 and G1 both use the axis words"),
+        ("G91 Z-1", "incremental Z-1 (G91) but the Z position is not known yet"),
+        ("G55", "G55 after G54"),
+    ],
+)
+def test_refused_construct_names_line_and_construct(block: str, construct: str) -> None:
+    message = refused(f"G21 G54\nG0 X1 Y1\n{block}\n")
+    assert message.startswith("t.ngc:3: ")
+    assert construct in message
+
+
+def test_axis_words_before_any_motion_mode() -> None:
+    assert refused("G21\nX1 Y1\n").startswith("t.ngc:2: X1 has no code to use it")
+
+
+def test_program_without_moves() -> None:
+    assert "no move" in refused("%\n(only a header)\nG21 M3\nM2\n%\n")
+
+
+def test_read_gcode_errors_and_encodings(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match=r"missing\.nc: cannot read"):
+        read_gcode(tmp_path / "missing.nc")
+    latin = tmp_path / "pieza.nc"
+    latin.write_bytes("(pieza maquinada en el LMM: ñ)\nG0 X1 Y1\n".encode("latin-1"))
+    assert read_gcode(latin, source_name="-").moves == (Rapid(1.0, 1.0, contour=1),)
+    with pytest.raises(InputError, match=r"^<stdin>:2: G41"):
+        bad = tmp_path / "bad.nc"
+        bad.write_text("G21\r\nG41\r\n")
+        read_gcode(bad, source_name="<stdin>")
+
+
+# -- properties (seed-004 S004-R03: G91 and R-form read to the same points) ---------------
+
+coords = st.integers(-50_000, 50_000).map(lambda n: n / 1000)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.tuples(coords, coords), min_size=1, max_size=8))
+def test_g91_reads_like_g90(points: list[tuple[float, float]]) -> None:
+    absolute = "G21 G90 F100\n" + "".join(f"G1 X{x:.3f} Y{y:.3f}\n" for x, y in points)
+    steps, here = [], (0.0, 0.0)
+    for x, y in points:
+        steps.append(f"G1 X{x - here[0]:.3f} Y{y - here[1]:.3f}\n")
+        here = (x, y)
+    incremental = "G21 G91 F100\n" + "".join(steps)
+    a, b = parse(absolute).moves, parse(incremental).moves
+    assert [v for m in b for v in (m.x, m.y)] == pytest.approx([v for m in a for v in (m.x, m.y)])
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    cx=coords,
+    cy=coords,
+    r=st.integers(100, 20_000).map(lambda n: n / 1000),
+    start=st.floats(-math.pi, math.pi),
+    sweep=st.floats(0.1, 2 * math.pi - 0.1).filter(lambda s: abs(s - math.pi) > 0.1),
+    clockwise=st.booleans(),
+)
+def test_r_form_reads_like_ij(
+    cx: float, cy: float, r: float, start: float, sweep: float, clockwise: bool
+) -> None:
+    sx, sy = cx + r * math.cos(start), cy + r * math.sin(start)
+    end = start - sweep if clockwise else start + sweep
+    ex, ey = cx + r * math.cos(end), cy + r * math.sin(end)
+    g = "G2" if clockwise else "G3"
+    head = f"G21 G0 X{sx:.10f} Y{sy:.10f}\n"
+    signed_r = r if sweep < math.pi else -r
+    ij = parse(f"{head}{g} X{ex:.10f} Y{ey:.10f} I{cx - sx:.10f} J{cy - sy:.10f} F1\n").moves[1]
+    rf = parse(f"{head}{g} X{ex:.10f} Y{ey:.10f} R{signed_r:.10f} F1\n").moves[1]
+    assert isinstance(ij, ArcMove) and isinstance(rf, ArcMove)
+    assert (rf.cx, rf.cy) == pytest.approx((ij.cx, ij.cy), abs=1e-6)
+    assert rf.clockwise == ij.clockwise == clockwise
+
+
+# -- round trip through the pic-mmh dialect ---------------------------------------------------
+
+
+def _same(a: Move, b: Move) -> bool:
+    tol = 1e-5  # 0.01 µm
+    if type(a) is not type(b) or abs(a.x - b.x) > tol or abs(a.y - b.y) > tol:
+        return False
+    if isinstance(a, ArcMove) and isinstance(b, ArcMove):
+        centre = abs(a.cx - b.cx) <= tol and abs(a.cy - b.cy) <= tol
+        return centre and a.clockwise == b.clockwise and a.feed_mm_min == b.feed_mm_min
+    if isinstance(a, Linear) and isinstance(b, Linear):
+        return a.feed_mm_min == b.feed_mm_min
+    return True
+
+
+def test_round_trip_through_pic_mmh() -> None:
+    # Z-free, inside the pic-mmh 10 × 7 mm work area (seed-000 L2359-L2360), feeds on the
+    # F01-F99 grid of 0.1 mm/min (S000-05).
+    program = parse(
+        "G21 G90 G17\n"
+        "G0 X1 Y1\n"
+        "G1 X4 Y1 F0.8\n"
+        "G3 X6 Y3 I0 J2\n"
+        "G2 X7.12345 Y4.5 R2.5\n"
+        "G1 X1.00001 Y6.99999\n"
+        "G0 X2 Y2\n"
+        "G91 G1 X1.5 F1.5\n"
+        "G90 G2 X2.5 Y2 I-0.5 J0\n"
+        "M30\n"
+    )
+    target = load_target("pic-mmh")
+    back = target.post.parse(str(target.emit(program).code))
+    assert len(back.moves) == len(program.moves)
+    assert all(_same(a, b) for a, b in zip(program.moves, back.moves, strict=True))
