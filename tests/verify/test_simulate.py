@@ -326,3 +326,40 @@ def test_star_on_the_router_closes_off_by_the_chunk_flooring() -> None:
     cutting = v.block_time_s[1:].sum()
     assert 78.83 + 1.5 <= cutting <= 78.83 + 1.5 + 1.0
     assert len(v.contours) == 1 and v.contours[0].closure_um is None  # drawn open
+
+
+@pytest.mark.parametrize("name", ["mmh-gmm", "mmh-lmm", "i8751", "valcnc", "grbl", "linuxcnc"])
+def test_every_built_in_profile_verifies_a_square_and_a_circle(name: str) -> None:
+    """Every step profile loads and measures: the 2 mm square closes within its compensation
+    residual, the circle's fitted diameter is within a few steps of 2 mm, time is positive."""
+    machine = profile(name)
+    x, y = 3.0, 3.0
+    program = Program(
+        (
+            *square(x, y, 2.0, feed=50.0).moves,
+            Rapid(x + 5.0, y + 1.0),
+            ArcMove(x + 3.0, y + 1.0, x + 4.0, y + 1.0, True, 50.0),  # two halves, as posted
+            ArcMove(x + 5.0, y + 1.0, x + 4.0, y + 1.0, True, 50.0),
+        )
+    )
+    v = verify_program(program, machine)
+    step_mm = 1.0 / min(machine.real_steps_per_mm[:2])
+    true = machine.backlash.true_um
+    residual_um = max(
+        abs(c - t) for c, t in zip(machine.backlash.compensation_um, true, strict=True)
+    )
+    square_m, circle_m = v.contours
+    assert square_m.closure_um is not None
+    assert math.hypot(*square_m.closure_um) <= residual_um * 1.5 + 3000 * step_mm + 20
+    assert circle_m.circle is not None
+    assert circle_m.circle[1] == pytest.approx(2.0, abs=4 * step_mm + residual_um / 500)
+    assert v.time_s > 0
+
+
+def test_valcnc_does_not_move_on_a_full_circle_in_one_block() -> None:
+    """seed-004 §4.2: alpha = 2 asin(C / 2R) is 0 when start == end, so nothing moves (the
+    valcnc dialect must split full circles, S004-R05); the verifier shows it."""
+    program = Program((Rapid(5.0, 4.0), ArcMove(5.0, 4.0, 4.0, 4.0, True, 100.0)))
+    v = verify_program(program, profile("valcnc"))
+    assert v.trace.block_steps[1].tolist() == [0, 0, 0]
+    assert v.contours[0].size_error_um == pytest.approx((-2000.0, -2000.0))
