@@ -21,6 +21,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable
 
     from camtool.geometry import Drawing
+    from camtool.importers import ImportOptions
     from camtool.program import Program
     from camtool.verify.verifier import Verification
 
@@ -43,6 +44,43 @@ def _write(data: str | bytes, out: str) -> None:
         write_atomic(out, data)
     except OSError as exc:
         raise CamtoolError(f"{out}: cannot write ({exc.strerror or exc})") from exc
+
+
+def _import_options(command: Callable[..., None]) -> Callable[..., None]:
+    """Options of the importers: --layers, --units, --hatch-boundaries."""
+    from camtool.units import LENGTH_UNITS
+
+    command = click.option(
+        "--hatch-boundaries",
+        is_flag=True,
+        help="Use DXF HATCH boundary paths as contours (skipped otherwise).",
+    )(command)
+    command = click.option(
+        "--units",
+        type=click.Choice(list(LENGTH_UNITS)),
+        default=None,
+        help="Unit of unitless inputs (point lists; default mm, Matlab xy files 0.1mm).",
+    )(command)
+    return click.option(
+        "--layers",
+        default=None,
+        metavar="A,B",
+        help="Only these layers (DXF layers, Inkscape layers), comma-separated.",
+    )(command)
+
+
+def _import_settings(options: dict[str, Any]) -> ImportOptions:
+    """Pop the importer options out of a command's keyword options."""
+    from camtool.importers import ImportOptions
+
+    layers = options.pop("layers", None)
+    names = tuple(n.strip() for n in layers.split(",") if n.strip()) if layers else None
+    return ImportOptions(
+        layers=names,
+        tolerance=options.get("tolerance", 0.001),
+        units=options.pop("units", None),
+        hatch_boundaries=options.pop("hatch_boundaries", False),
+    )
 
 
 def _verify_outputs(command: Callable[..., None]) -> Callable[..., None]:
@@ -148,6 +186,7 @@ def cli() -> None:
     metavar="FILE",
     help="TOML machine profile laid over the target's, key by key.",
 )
+@_import_options
 @click.option("--verify", "verify_too", is_flag=True, help="Verify the emitted code (see verify).")
 @_verify_outputs
 def post(
@@ -173,12 +212,13 @@ def post(
     from camtool.post.registry import load_target
 
     chosen = load_target(target, machine_file=machine_file)
+    settings = _import_settings(options)
     if is_program_file(drawing):
         job = post_program(
             _read_program(drawing, options), chosen, feed_mm_min=options["feed_mm_min"]
         )
     else:
-        job = post_drawing(_read_input(drawing), chosen, **options)
+        job = post_drawing(_read_input(drawing, settings), chosen, **options)
     _warn(job.warnings)
     _write(job.result.code, output)
     if output != "-":
@@ -300,12 +340,40 @@ def _finish_verification(
         )
 
 
-def _read_input(name: str) -> Drawing:
+def _read_input(name: str, settings: ImportOptions | None = None) -> Drawing:
     from camtool.importers import read_drawing, read_drawing_bytes
 
     if name == "-":
-        return read_drawing_bytes(sys.stdin.buffer.read())
-    return read_drawing(name)
+        return read_drawing_bytes(sys.stdin.buffer.read(), options=settings)
+    return read_drawing(name, settings)
+
+
+@cli.command()
+@click.argument("drawing", metavar="DRAWING")
+@click.option("--json", "as_json", is_flag=True, help="Write the report as JSON.")
+@click.option(
+    "--tolerance",
+    type=float,
+    default=0.001,
+    show_default=True,
+    metavar="MM",
+    help="Chaining tolerance (and curve-fit tolerance), mm.",
+)
+@_import_options
+def inspect(drawing: str, as_json: bool, **options: Any) -> None:
+    """Lint DRAWING before cutting (the report goes to stdout).
+
+    Entities and contours by type and layer, bounding box, units, and what a
+    machinist must fix: open contours, duplicates, zero-length and tiny segments,
+    gaps just above the chaining tolerance, with their locations.
+    """
+    from camtool.importers.lint import inspect_drawing
+
+    report = inspect_drawing(drawing, _import_settings(options))
+    if as_json:
+        click.echo(json.dumps(report.to_json(), indent=2))
+    else:
+        click.echo(report.text(), nl=False)
 
 
 @cli.command()

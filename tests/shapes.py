@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
 import ezdxf
+import numpy as np
+
+from camtool.geometry import Line, Point, Segment
 
 # seed-000 L1731: G02X02969.00Y03400.00I03012.00J03040.00F08;
 GOLDEN_CENTRE = (3.012, 3.040)
@@ -50,3 +53,84 @@ def rectangle_dxf(path: Path, w: float = 10.0, h: float = 5.0, *, insunits: int 
         msp.add_lwpolyline([(1, 1), (1 + w, 1), (1 + w, 1 + h), (1, 1 + h)], close=True)
 
     return write_dxf(path, build, insunits=insunits)
+
+
+def segment_samples(segments: Sequence[Segment], per_segment: int = 64) -> np.ndarray:
+    """``(N, 2)`` points along lines and arcs (both ends included), mm."""
+    pts: list[Point] = []
+    for seg in segments:
+        if isinstance(seg, Line):
+            (x0, y0), (x1, y1) = seg.start, seg.end
+            pts += [
+                (x0 + (x1 - x0) * k / per_segment, y0 + (y1 - y0) * k / per_segment)
+                for k in range(per_segment + 1)
+            ]
+        else:
+            pts += [seg.point_at(k / per_segment) for k in range(per_segment + 1)]
+    return np.array(pts, dtype=np.float64)
+
+
+def two_sided_error(
+    point_at: Callable[[float], Point],
+    t0: float,
+    t1: float,
+    segments: Sequence[Segment],
+    tolerance: float,
+    n: int = 5000,
+) -> tuple[float, float]:
+    """Distances between a true curve and the segments fitted to it, both ways, mm.
+
+    The curve ``point_at(t)``, ``t0 <= t <= t1``, is sampled at ``n + 1`` equally spaced
+    parameters and at the ``n`` mid-parameters. Returns ``(curve -> segments,
+    segments -> curve)``:
+
+    - the first is exact for all those samples (distance to the lines and arcs);
+    - for the second, each point along the segments gets an upper bound of its distance
+      to the curve: its distance to the nearest chord between samples plus the chords'
+      own largest distance from the curve (measured at the mid-parameters). Where that
+      bound exceeds ``tolerance`` the point is measured again exactly, by golden-section
+      search over each sample interval that can hold its nearest curve point (chords
+      within twice the chord error of the nearest one).
+    """
+    import shapely
+
+    from camtool.toolpath.arcfit import distances
+
+    ts = np.linspace(t0, t1, n + 1)
+    curve = np.array([point_at(float(t)) for t in ts], dtype=np.float64)
+    mids = np.array([point_at(float(t)) for t in (ts[:-1] + ts[1:]) / 2], dtype=np.float64)
+    forward = float(np.max(distances(np.vstack([curve, mids]), segments)))
+    chords = shapely.linestrings(np.stack([curve[:-1], curve[1:]], axis=1))
+    tree = shapely.STRtree(chords)
+    sag = float(np.max(shapely.distance(shapely.points(mids), chords)))  # each to its own
+    out = shapely.points(segment_samples(segments))
+    (index, _), dist = tree.query_nearest(out, return_distance=True, all_matches=False)
+    bound = np.full(len(out), np.inf)
+    np.minimum.at(bound, index, dist + sag)
+    for k in np.flatnonzero(bound > tolerance):
+        near = tree.query(out[k], predicate="dwithin", distance=bound[k] + 2 * sag)
+        q = shapely.get_coordinates(out[k])[0]
+        exact = min(_distance_to_curve(point_at, q, ts[i], ts[i + 1]) for i in near)
+        bound[k] = min(bound[k], exact)
+    return forward, float(np.max(bound))
+
+
+def _distance_to_curve(
+    point_at: Callable[[float], Point], q: np.ndarray, a: float, b: float
+) -> float:
+    """Smallest distance from ``q`` to ``point_at(t)``, ``a <= t <= b`` (golden section)."""
+
+    def dist(t: float) -> float:
+        p = point_at(t)
+        return math.hypot(p[0] - q[0], p[1] - q[1])
+
+    g = (math.sqrt(5) - 1) / 2
+    c, d = b - g * (b - a), a + g * (b - a)
+    for _ in range(50):
+        if dist(c) < dist(d):
+            b, d = d, c
+            c = b - g * (b - a)
+        else:
+            a, c = c, d
+            d = a + g * (b - a)
+    return min(dist(a), dist(b), dist(0.5 * (a + b)))

@@ -236,3 +236,26 @@ def test_drawing_options_on_gcode_are_refused(capsys: pytest.CaptureFixture[str]
     code, out, err = run(args, capsys)
     assert code == 2 and out == ""
     assert "already a toolpath" in err and "--offset" in err
+
+
+def test_inspect_lists_layers_and_problems(capsys: pytest.CaptureFixture[str]) -> None:
+    import json
+
+    code, out, _ = run(["inspect", str(SAMPLES / "logo.dxf")], capsys)
+    assert code == 0 and "open contours: 2" in out and "LWPOLYLINE" in out
+    code, out, _ = run(["inspect", str(SAMPLES / "logo.dxf"), "--json"], capsys)
+    assert code == 0 and json.loads(out)["source"].endswith("logo.dxf")
+    code, out, err = run(["inspect", "missing.dxf"], capsys)
+    assert code == 3 and out == "" and "missing.dxf" in err
+
+
+def test_layers_and_units_reach_the_importers(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    svg = str(DATA / "inkscape-layers.svg")
+    code, out, err = run(["post", svg, "-t", "pic-mmh", "--layers", "nope"], capsys)
+    assert code == 3 and "no layer named 'nope'" in err
+    points = tmp_path / "p.csv"
+    points.write_text("x,y\n100,100\n300,100\n300,200\n100,100\n")
+    code, out, _ = run(["post", str(points), "-t", "pic-mmh", "--units", "um"], capsys)
+    assert code == 0 and "G01X00300.00Y00100.00F08;" in out.splitlines()

@@ -29,7 +29,7 @@ class ImportOptions:
     hatch_boundaries: bool = False
 
 
-DRAWING_SUFFIXES = (".dxf",)
+DRAWING_SUFFIXES = (".dxf", ".svg", ".csv", ".txt", ".xy", ".m")
 """File name endings the importers read, lowercase."""
 
 
@@ -50,7 +50,15 @@ def read_drawing(path: str | Path, options: ImportOptions | None = None) -> Draw
     if suffix == ".dxf":
         from camtool.importers.dxf import read_dxf
 
-        return read_dxf(path)
+        return read_dxf(path, options)
+    if suffix == ".svg":
+        from camtool.importers.svg import read_svg
+
+        return read_svg(path, options)
+    if suffix in (".csv", ".txt", ".xy", ".m"):
+        from camtool.importers.points import read_points
+
+        return read_points(path, options)
     if suffix == "" and str(path) == "-":
         raise InputError("'-' (stdin) must be read with read_drawing_bytes")
     kind = f"{suffix!r} files" if suffix else "a file without a name ending"

@@ -1,24 +1,34 @@
-"""DXF importer (ezdxf): LINE, ARC, CIRCLE, LWPOLYLINE and 2D POLYLINE, arcs kept exact.
+"""DXF importer (ezdxf): model space as contours in mm, arcs kept exact, curves fitted.
 
-Model space only. Each entity becomes one contour (polylines keep their own
-closed flag); chaining entities whose ends meet is the planner's job
-(:mod:`camtool.toolpath.chain`). Bulges become exact arcs (bulge > 0 is
-counter-clockwise in the entity's OCS). Entities with an extrusion of
-(0, 0, −1) are mirrored into the WCS, which flips their arcs' direction.
-``$INSUNITS`` is converted to mm; a unitless drawing is taken as mm with a
-warning. Other entity types are skipped with one warning per type and count.
+Read: LINE, ARC, CIRCLE, LWPOLYLINE and 2D POLYLINE exactly (bulges become arcs; bulge > 0
+is counter-clockwise); ELLIPSE and SPLINE as biarcs within the tolerance
+(:mod:`camtool.importers.dxf_curves`); INSERT/MINSERT expanded with their full transform,
+nested blocks included (:mod:`camtool.importers.dxf_blocks`); HATCH boundary paths when
+asked (``hatch_boundaries``). Entities with an extrusion of (0, 0, −1) are mirrored into
+the WCS, which flips their arcs' direction. Each entity becomes one contour; chaining
+entities whose ends meet is the planner's job (:mod:`camtool.toolpath.chain`).
+
+``$INSUNITS`` is converted to mm exactly; a unitless drawing is taken as mm with a
+warning. Everything else (text, dimensions, images, points, 3D entities, HATCH without
+the option) is skipped with one warning per type and reason, giving the count. A file
+ezdxf cannot read is tried again with :func:`ezdxf.recover.readfile`, with a warning
+saying what was repaired. Model space only: paper space is ignored.
 """
 
 from __future__ import annotations
 
-import itertools
+import logging
 from collections import Counter
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from camtool.errors import InputError
-from camtool.geometry import Arc, Contour, Drawing, Line, Point, Segment, distance
+from camtool.errors import InputError, UsageError
+from camtool.geometry import Contour, Drawing, Point
 from camtool.units import INCH
+
+if TYPE_CHECKING:
+    from camtool.importers import ImportOptions
 
 # Exact mm per unit for the $INSUNITS codes a shop meets (ezdxf's own factors
 # carry rounding noise, e.g. 25.400000000101603 for inches).
@@ -34,153 +44,322 @@ _INSUNITS_MM: dict[int, tuple[str, float]] = {
     13: ("µm", 1e-3),
     14: ("dm", 100.0),
 }
-_SUPPORTED = ("LINE", "ARC", "CIRCLE", "LWPOLYLINE", "POLYLINE")
-_ZERO_LENGTH_MM = 1e-9
+
+_TEXT = "text is not cut; explode it to curves in the CAD program"
+_THREE_D = "3D entity; camtool cuts 2D contours"
+_SKIP_REASONS: dict[str, str] = {
+    **dict.fromkeys(("TEXT", "MTEXT", "ATTRIB", "ATTDEF", "RTEXT"), _TEXT),
+    **dict.fromkeys(
+        ("DIMENSION", "ARC_DIMENSION", "LEADER", "MULTILEADER", "MLEADER", "TOLERANCE"),
+        "annotation, not a contour",
+    ),
+    **dict.fromkeys(
+        ("IMAGE", "WIPEOUT", "PDFUNDERLAY", "DWFUNDERLAY", "DGNUNDERLAY", "OLE2FRAME"),
+        "picture or underlay, not a contour",
+    ),
+    "POINT": "a point has no path to cut",
+    **dict.fromkeys(
+        ("3DFACE", "3DSOLID", "MESH", "BODY", "REGION", "SURFACE", "POLYFACE", "POLYMESH"),
+        _THREE_D,
+    ),
+    **dict.fromkeys(("SOLID", "TRACE"), "filled area; draw its outline to cut it"),
+    "HATCH": "a fill; use --hatch-boundaries to cut its boundary paths",
+}
 
 
-def read_dxf(path: str | Path) -> Drawing:
+@dataclass(frozen=True)
+class DxfNote:
+    """One entity the reader dropped, and where it is (for ``camtool inspect``).
+
+    Attributes:
+        source: the entity, e.g. ``"LINE #2A"`` or ``"LINE #1A in INSERT #3B (block 'B')"``.
+        layer: its effective layer.
+        reason: why it was dropped (``"zero length"``, ``"text is not cut; ..."``).
+        location: a point of it in mm (WCS, Y up), or None when it has none.
+    """
+
+    source: str
+    layer: str
+    reason: str
+    location: Point | None = None
+
+
+@dataclass(frozen=True)
+class DxfImport:
+    """What :func:`import_dxf` read: the drawing plus what ``camtool inspect`` reports.
+
+    Attributes:
+        drawing: the contours in mm and the user warnings.
+        units: the drawing unit, e.g. ``"in"``; ``"mm (assumed)"`` without $INSUNITS.
+        mm_per_unit: scale applied to the drawing's coordinates.
+        entity_counts: ``(type, layer, count)`` of the model-space entities, all layers,
+            sorted; INSERTs count once each.
+        block_entity_counts: ``(type, layer, count)`` of the entities the INSERTs place,
+            by effective layer, sorted.
+        notes: the entities that were dropped, each with its location.
+        recovered: the file was damaged and read by ezdxf's recover mode.
+    """
+
+    drawing: Drawing
+    units: str
+    mm_per_unit: float
+    entity_counts: tuple[tuple[str, str, int], ...] = field(default=())
+    block_entity_counts: tuple[tuple[str, str, int], ...] = field(default=())
+    notes: tuple[DxfNote, ...] = field(default=())
+    recovered: bool = False
+
+
+def read_dxf(path: str | Path, options: ImportOptions | None = None) -> Drawing:
     """Read the model space of a DXF file into a drawing in mm.
 
     Args:
         path: the DXF file.
+        options: layers to keep, curve fitting tolerance (mm), HATCH boundaries;
+            ``None`` takes the defaults.
 
     Returns:
-        A :class:`Drawing` with one contour per usable entity, in mm, Y up, and
-        the warnings a user should see (assumed units, skipped entity types).
+        A :class:`Drawing` with one contour per usable entity (per boundary path for a
+        HATCH), in mm, Y up, and the warnings a user should see (assumed units, skipped
+        entity types, a repaired file).
 
     Raises:
-        InputError: the file is missing, is not a DXF file, is damaged beyond
-            reading, uses an unknown ``$INSUNITS`` code, or holds no LINE, ARC,
-            CIRCLE, LWPOLYLINE or 2D POLYLINE in model space.
+        InputError: the file is missing, empty, not a DXF file or damaged beyond
+            recovery; it uses an unknown ``$INSUNITS`` code; ``options.layers`` names a
+            layer the drawing does not have; or model space (on the selected layers)
+            holds nothing camtool can cut. The message names the file.
+        UsageError: ``options.tolerance`` is not > 0.
     """
+    return import_dxf(path, options).drawing
+
+
+def import_dxf(path: str | Path, options: ImportOptions | None = None) -> DxfImport:
+    """Read a DXF file like :func:`read_dxf` and also count its entities by type and layer.
+
+    Raises:
+        InputError: as :func:`read_dxf`.
+        UsageError: ``options.tolerance`` is not > 0.
+    """
+    from camtool.importers import ImportOptions
+
     path = Path(path)
-    doc = _open(path)
-    warnings: list[str] = []
-    scale = _units_scale(path, doc.header.get("$INSUNITS", 0), warnings)
-    contours: list[Contour] = []
-    skipped: Counter[str] = Counter()
-    for entity in doc.modelspace():
-        kind = entity.dxftype()
-        contour = _read_entity(entity, skipped) if kind in _SUPPORTED else None
-        if kind not in _SUPPORTED:
-            skipped[kind] += 1
-        if contour is not None:
-            contours.append(contour.transformed(scale, 0.0, 0.0) if scale != 1.0 else contour)
-    for kind, count in sorted(skipped.items()):
+    options = options or ImportOptions()
+    if not options.tolerance > 0:
+        raise UsageError(f"the tolerance must be > 0 mm, got {options.tolerance!r}")
+    doc, warnings = _open(path)
+    recovered = bool(warnings)
+    units, scale = _units(path, doc.header.get("$INSUNITS", 0), warnings)
+    msp = doc.modelspace()
+    if len(msp) == 0:
+        _refuse_empty(path, doc, warnings)
+    keep = _layer_filter(path, doc, options.layers)
+    reader = _Reader(options.tolerance / scale, options.hatch_boundaries, keep)
+    for entity in msp:
+        reader.read(entity)
+    for (kind, reason), count in sorted(reader.skipped.items()):
         plural = "entity" if count == 1 else "entities"
-        warnings.append(f"{path}: skipped {count} {kind} {plural} (not a 2D contour camtool cuts)")
-    if not contours:
+        warnings.append(f"{path}: skipped {count} {kind} {plural} ({reason})")
+    if not reader.contours:
+        on = f" on layers {', '.join(options.layers)}" if options.layers else ""
         raise InputError(
-            f"{path}: no usable entity in model space; camtool cuts LINE, ARC, CIRCLE, "
-            "LWPOLYLINE and 2D POLYLINE entities"
+            f"{path}: no usable entity in model space{on}; camtool cuts LINE, ARC, CIRCLE, "
+            "ELLIPSE, SPLINE, LWPOLYLINE and 2D POLYLINE entities (also inside blocks)"
+            + "".join(f"\n  {w}" for w in warnings)
         )
-    return Drawing(tuple(contours), str(path), tuple(warnings))
+    contours = tuple(c.transformed(scale, 0.0, 0.0) if scale != 1.0 else c for c in reader.contours)
+    notes = tuple(
+        DxfNote(n.source, n.layer, n.reason, _scaled(n.location, scale)) for n in reader.notes
+    )
+    return DxfImport(
+        drawing=Drawing(contours, str(path), tuple(warnings)),
+        units=units,
+        mm_per_unit=scale,
+        entity_counts=_rows(reader.counts),
+        block_entity_counts=_rows(reader.block_counts),
+        notes=notes,
+        recovered=recovered,
+    )
 
 
-def _open(path: Path) -> Any:
+class _Reader:
+    """Walks model space once; collects contours, skip counts, notes and entity counts."""
+
+    def __init__(self, tolerance: float, hatch: bool, keep: Any) -> None:
+        self.tolerance = tolerance  # drawing units
+        self.hatch = hatch
+        self.keep = keep
+        self.contours: list[Contour] = []
+        self.skipped: Counter[tuple[str, str]] = Counter()
+        self.notes: list[DxfNote] = []
+        self.counts: Counter[tuple[str, str]] = Counter()
+        self.block_counts: Counter[tuple[str, str]] = Counter()
+
+    def read(self, entity: Any) -> None:
+        from camtool.importers.dxf_blocks import Skip, expand_insert
+        from camtool.importers.dxf_entities import Item
+
+        kind = entity.dxftype()
+        layer = entity.dxf.get("layer", "0")
+        self.counts[(kind, layer)] += 1
+        if kind != "INSERT":
+            self._item(Item(entity, f"{kind} #{entity.dxf.handle}", layer))
+            return
+        for placed in expand_insert(entity, layer):
+            if isinstance(placed, Skip):
+                self.block_counts[(placed.kind, placed.layer)] += 1
+                if self.keep(placed.layer):
+                    self._skip(
+                        placed.kind, placed.reason, placed.label, placed.layer, placed.location
+                    )
+            else:
+                self.block_counts[(placed.entity.dxftype(), placed.layer)] += 1
+                self._item(placed)
+
+    def _item(self, item: Any) -> None:
+        from camtool.importers.dxf_curves import Unsupported
+        from camtool.importers.dxf_entities import CONVERTED, convert, location
+
+        if not self.keep(item.layer):
+            return
+        kind = _kind(item.entity)
+        where = item.at if item.at is not None else location(item.entity)
+        if kind not in CONVERTED or (kind == "HATCH" and not self.hatch):
+            reason = _SKIP_REASONS.get(kind, "not a 2D contour camtool cuts")
+            self._skip(kind, reason, item.label, item.layer, where)
+            return
+        try:
+            self.contours.extend(convert(item, self.tolerance))
+        except Unsupported as exc:
+            detail = exc.reason + (f": {exc.detail}" if exc.detail else "")
+            self._skip(kind, exc.reason, item.label, item.layer, where, detail)
+
+    def _skip(
+        self,
+        kind: str,
+        reason: str,
+        label: str,
+        layer: str,
+        where: Point | None,
+        detail: str | None = None,
+    ) -> None:
+        self.skipped[(kind, reason)] += 1
+        self.notes.append(DxfNote(label, layer, detail or reason, where))
+
+
+def _kind(entity: Any) -> str:
+    """DXF type, with polyface and polygon mesh POLYLINEs told apart from 2D/3D ones."""
+    kind = entity.dxftype()
+    if kind == "POLYLINE" and entity.is_poly_face_mesh:
+        return "POLYFACE"
+    if kind == "POLYLINE" and entity.is_polygon_mesh:
+        return "POLYMESH"
+    return kind
+
+
+def _open(path: Path) -> tuple[Any, list[str]]:
+    """The document, and a warning when it had to be recovered."""
     import ezdxf
+    from ezdxf import recover
 
     if not path.is_file():
         raise InputError(f"{path}: no such file")
+    if path.stat().st_size == 0:
+        raise InputError(f"{path}: empty file; export the drawing again from the CAD program")
     try:
-        return ezdxf.readfile(str(path))
-    except ezdxf.DXFStructureError as exc:
-        raise InputError(
-            f"{path}: damaged DXF file ({exc}); re-save it from the CAD program"
-        ) from exc
-    except (OSError, UnicodeDecodeError, ValueError) as exc:
-        raise InputError(f"{path}: not a readable DXF file ({exc})") from exc
+        return ezdxf.readfile(str(path)), []
+    except OSError as exc:
+        if exc.errno is not None:  # a system error; ezdxf's "is not a DXF file" has none
+            raise InputError(f"{path}: cannot read the file ({exc.strerror})") from exc
+        first: Exception = exc
+    except (ezdxf.DXFError, UnicodeDecodeError, ValueError) as exc:
+        first = exc
+    with _captured_log("ezdxf") as messages:
+        try:
+            doc, auditor = recover.readfile(str(path))
+        except (ezdxf.DXFError, UnicodeDecodeError, ValueError, OSError) as exc:
+            raise InputError(
+                f"{path}: not a readable DXF file ({first}); even ezdxf's recover mode "
+                f"failed ({exc}); re-save or export it as DXF from the CAD program"
+            ) from exc
+    fixes = [f.message for f in auditor.fixes]
+    repaired = messages + fixes
+    shown = "; ".join(repaired[:5]) + (
+        f"; and {len(repaired) - 5} more" if len(repaired) > 5 else ""
+    )
+    warning = (
+        f"{path}: damaged DXF file ({first}); read in recover mode with "
+        f"{len(fixes)} fixes and {len(auditor.errors)} unfixed errors"
+        + (f": {shown}" if shown else "")
+        + "; check the result, or re-save the file from the CAD program"
+    )
+    return doc, [warning]
 
 
-def _units_scale(path: Path, code: int, warnings: list[str]) -> float:
+class _captured_log:
+    """Collect a logger's warnings (ezdxf logs what recover mode repaired) while active."""
+
+    def __init__(self, name: str) -> None:
+        self.logger = logging.getLogger(name)
+        self.messages: list[str] = []
+        self.handler = logging.Handler(logging.WARNING)
+        self.handler.emit = lambda record: self.messages.append(record.getMessage())  # type: ignore[method-assign]
+
+    def __enter__(self) -> list[str]:
+        self.logger.addHandler(self.handler)
+        self.propagate, self.logger.propagate = self.logger.propagate, False
+        return self.messages
+
+    def __exit__(self, *exc: object) -> None:
+        self.logger.removeHandler(self.handler)
+        self.logger.propagate = self.propagate
+
+
+def _units(path: Path, code: int, warnings: list[str]) -> tuple[str, float]:
     if code == 0:
         warnings.append(f"{path}: drawing has no units ($INSUNITS = 0); assuming mm")
-        return 1.0
+        return "mm (assumed)", 1.0
     if code not in _INSUNITS_MM:
         known = ", ".join(f"{c} ({n})" for c, (n, _) in sorted(_INSUNITS_MM.items()))
         raise InputError(f"{path}: unsupported $INSUNITS {code}; camtool knows {known}")
-    return _INSUNITS_MM[code][1]
+    return _INSUNITS_MM[code]
 
 
-def _label(entity: Any) -> str:
-    return f"{entity.dxftype()} #{entity.dxf.handle}"
+def _refuse_empty(path: Path, doc: Any, warnings: list[str]) -> None:
+    """Model space is empty: say whether the drawing is in paper space instead."""
+    layouts = [lay for lay in doc.layouts if not lay.is_modelspace and len(lay)]
+    if layouts:
+        names = ", ".join(repr(lay.name) for lay in layouts)
+        raise InputError(
+            f"{path}: model space is empty; the drawing is in paper space (layout {names}), "
+            "which camtool does not read; move it to model space in the CAD program"
+        )
+    raise InputError(
+        f"{path}: the drawing is empty (no entity in model space)"
+        + "".join(f"\n  {w}" for w in warnings)
+    )
 
 
-def _read_entity(entity: Any, skipped: Counter[str]) -> Contour | None:
-    """One supported entity as a contour, or None (counted in ``skipped``)."""
-    kind = entity.dxftype()
-    extrusion = entity.dxf.get("extrusion", (0.0, 0.0, 1.0))
-    if kind != "LINE" and (abs(extrusion[0]) > 1e-9 or abs(extrusion[1]) > 1e-9):
-        skipped[f"{kind} (not parallel to XY)"] += 1
-        return None
-    layer = entity.dxf.get("layer", "0")
-    if kind == "LINE":
-        segs: list[Segment] = [Line(_xy(entity.dxf.start), _xy(entity.dxf.end))]
-        closed = False
-    elif kind in ("ARC", "CIRCLE"):
-        segs, closed = [_arc(entity)], kind == "CIRCLE"
-    elif kind == "LWPOLYLINE":
-        vertices = [(x, y, b) for x, y, b in entity.get_points("xyb")]
-        segs, closed = _polyline(entity, vertices, entity.closed), entity.closed
-    else:
-        if not entity.is_2d_polyline:
-            skipped["POLYLINE (3D or mesh)"] += 1
-            return None
-        vertices = [(v.dxf.location[0], v.dxf.location[1], v.dxf.bulge) for v in entity.vertices]
-        segs, closed = _polyline(entity, vertices, entity.is_closed), entity.is_closed
-    segs = [s for s in segs if s.length > _ZERO_LENGTH_MM]
-    if not segs:
-        skipped[f"{kind} (zero length)"] += 1
-        return None
-    return Contour(tuple(segs), closed, layer, _label(entity))
+def _layer_filter(path: Path, doc: Any, layers: tuple[str, ...] | None) -> Any:
+    """A predicate on effective layer names; unknown names are an error listing the layers."""
+    if layers is None:
+        return lambda layer: True
+    present = {layer.dxf.name for layer in doc.layers} | {
+        e.dxf.get("layer", "0") for e in doc.modelspace()
+    }
+    by_key = {name.casefold(): name for name in present}
+    unknown = [name for name in layers if name.casefold() not in by_key]
+    if unknown:
+        listed = ", ".join(repr(n) for n in unknown)
+        raise InputError(
+            f"{path}: no layer {listed} in the drawing; its layers are "
+            + ", ".join(sorted(present, key=str.casefold))
+        )
+    wanted = {name.casefold() for name in layers}
+    return lambda layer: layer.casefold() in wanted
 
 
-def _xy(p: Any) -> Point:
-    return (float(p[0]), float(p[1]))
+def _rows(counts: Counter[tuple[str, str]]) -> tuple[tuple[str, str, int], ...]:
+    return tuple((kind, layer, n) for (kind, layer), n in sorted(counts.items()))
 
 
-def _arc(entity: Any) -> Arc:
-    """ARC or CIRCLE in WCS; OCS arcs run counter-clockwise, mirrored ones clockwise."""
-    import math
-
-    ocs = entity.ocs()
-    flipped = entity.dxf.get("extrusion", (0.0, 0.0, 1.0))[2] < 0
-    centre = _xy(ocs.to_wcs(entity.dxf.center))
-    r = float(entity.dxf.radius)
-    if entity.dxftype() == "CIRCLE":
-        start = (centre[0] + r, centre[1])
-        return Arc(start, start, centre, flipped)
-    a0, a1 = math.radians(entity.dxf.start_angle), math.radians(entity.dxf.end_angle)
-    c = entity.dxf.center
-    p0 = ocs.to_wcs((c[0] + r * math.cos(a0), c[1] + r * math.sin(a0), c[2]))
-    p1 = ocs.to_wcs((c[0] + r * math.cos(a1), c[1] + r * math.sin(a1), c[2]))
-    return Arc(_xy(p0), _xy(p1), centre, flipped)
-
-
-def _polyline(
-    entity: Any, vertices: list[tuple[float, float, float]], closed: bool
-) -> list[Segment]:
-    """Segments of an (LW)POLYLINE; a vertex's bulge shapes the segment after it."""
-    from ezdxf.math import bulge_center
-
-    ocs = entity.ocs()
-    # The extrusion is ±Z here (tilted ones are skipped), so the elevation never
-    # changes X or Y in the WCS: z = 0 is exact for the 2D result.
-    z = 0.0
-    flipped = entity.dxf.get("extrusion", (0.0, 0.0, 1.0))[2] < 0
-    pairs = list(itertools.pairwise(vertices))
-    if closed and len(vertices) > 1:
-        pairs.append((vertices[-1], vertices[0]))
-    segs: list[Segment] = []
-    for (x0, y0, bulge), (x1, y1, _) in pairs:
-        p0 = _xy(ocs.to_wcs((x0, y0, z)))
-        p1 = _xy(ocs.to_wcs((x1, y1, z)))
-        if distance(p0, p1) <= _ZERO_LENGTH_MM:
-            continue
-        if abs(bulge) < 1e-12:
-            segs.append(Line(p0, p1))
-            continue
-        c = bulge_center((x0, y0), (x1, y1), bulge)
-        centre = _xy(ocs.to_wcs((c[0], c[1], z)))
-        segs.append(Arc(p0, p1, centre, (bulge < 0) != flipped))
-    return segs
+def _scaled(p: Point | None, scale: float) -> Point | None:
+    return None if p is None else (p[0] * scale, p[1] * scale)

@@ -1,0 +1,298 @@
+"""One DXF entity (or a transformed copy of one from a block) as contours, in drawing units.
+
+LINE, ARC, CIRCLE, LWPOLYLINE and 2D POLYLINE are exact (bulges become arcs; bulge > 0 is
+counter-clockwise in the entity's OCS). ELLIPSE and SPLINE are fitted
+(:mod:`camtool.importers.dxf_curves`). HATCH boundary paths become closed contours.
+Entities with an extrusion of (0, 0, −1) are mirrored into the WCS, which flips their arcs'
+direction; entities tilted out of the XY plane are refused.
+
+Source: AutoCAD DXF Reference (entities section; OCS and the arbitrary axis algorithm).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from camtool.geometry import Arc, Contour, Line, Point, Segment, distance
+from camtool.importers.dxf_curves import Unsupported, ellipse_segments, spline_segments
+
+CONVERTED = ("LINE", "ARC", "CIRCLE", "LWPOLYLINE", "POLYLINE", "ELLIPSE", "SPLINE", "HATCH")
+"""Entity types that become contours (HATCH only with ``hatch_boundaries``)."""
+
+ZERO_LENGTH = 1e-9
+"""Drawing units: segments shorter than this are dropped as zero-length."""
+
+# Entities whose centre or insertion point is stored in their OCS (DXF reference).
+_OCS_POINTS = frozenset({"ARC", "CIRCLE", "TEXT", "ATTRIB", "INSERT", "SHAPE"})
+
+
+@dataclass(frozen=True)
+class Item:
+    """An entity ready to convert: the (possibly virtual, transformed) entity and its names.
+
+    Attributes:
+        entity: the ezdxf entity, already in WCS drawing units.
+        label: how messages name it, e.g. ``"LINE #1A in INSERT #3B (block 'BOLT')"``.
+        layer: its effective layer (block content on layer ``0`` takes the INSERT's).
+        parts: for an entity that had to be exploded to be transformed (a polyline with
+            bulges under a non-uniform scale), its transformed pieces in order; the
+            contour is joined from them (:func:`join_pieces`).
+        at: where the entity is in WCS drawing units, for messages, when ``entity`` was
+            not transformed (block content that is only counted); else None.
+    """
+
+    entity: Any
+    label: str
+    layer: str
+    parts: tuple[Any, ...] = field(default=())
+    at: Point | None = None
+
+
+def convert(item: Item, tolerance: float) -> list[Contour]:
+    """The contours of one entity, in drawing units, Y up.
+
+    Args:
+        item: the entity and its names; its type must be one of :data:`CONVERTED`.
+        tolerance: fitting and joining tolerance, drawing units (> 0).
+
+    Returns:
+        One contour, or for a HATCH one per boundary path.
+
+    Raises:
+        Unsupported: the entity is tilted out of XY, 3D, empty or has zero length.
+    """
+    entity = item.entity
+    kind = entity.dxftype()
+    if item.parts:
+        pieces = [_piece(part, tolerance) for part in item.parts]
+        return [
+            Contour(tuple(segs), shut, item.layer, item.label)
+            for segs, shut in join_pieces(pieces, tolerance)
+        ]
+    if kind == "HATCH":
+        return _hatch(item, tolerance)
+    segs, closed = _segments(entity, tolerance)
+    return [Contour(tuple(segs), closed, item.layer, item.label)]
+
+
+def location(entity: Any) -> Point | None:
+    """A representative WCS point of an entity (start, centre or first vertex), or None."""
+    for name in ("start", "center", "insert", "location"):
+        if entity.dxf.hasattr(name):
+            p = entity.dxf.get(name)
+            if entity.dxftype() in _OCS_POINTS:
+                p = entity.ocs().to_wcs(p)
+            return (float(p[0]), float(p[1]))
+    kind = entity.dxftype()
+    if kind == "SPLINE":
+        pts = entity.control_points if entity.control_point_count() else entity.fit_points
+        return _xy(pts[0]) if len(pts) else None
+    if kind == "LWPOLYLINE" and len(entity):
+        return _xy(entity.ocs().to_wcs((*entity[0][:2], 0.0)))
+    if kind == "POLYLINE" and len(entity.vertices):
+        return _xy(entity.ocs().to_wcs(entity.vertices[0].dxf.location))
+    return None
+
+
+def join_pieces(
+    pieces: Sequence[Sequence[Segment]], tolerance: float
+) -> list[tuple[list[Segment], bool]]:
+    """Join pieces given in path order into runs, reversing a piece drawn the other way.
+
+    Hatch edges and exploded polylines come in order but not always in direction (an
+    ARC always runs counter-clockwise). A piece joins the run when one of its ends is
+    within ``tolerance`` of the run's end (a run of one piece may be turned round for
+    that); the joint is snapped. A run whose ends meet within ``tolerance`` is closed.
+
+    Returns:
+        ``[(segments, closed), ...]``, one per run, in order.
+    """
+    runs: list[list[Segment]] = []
+    single = False  # the last run is one piece so far and may still be turned round
+    for piece in pieces:
+        segs = [s for s in piece if s.length > ZERO_LENGTH]
+        if not segs:
+            continue
+        if runs:
+            run = runs[-1]
+            ends = (segs[0].start, segs[-1].end)
+            if (
+                single
+                and _near(run[0].start, tolerance, *ends)
+                and not _near(run[-1].end, tolerance, *ends)
+            ):
+                run[:] = _reverse(run)
+            if (
+                distance(run[-1].end, segs[0].start)
+                > tolerance
+                >= distance(run[-1].end, segs[-1].end)
+            ):
+                segs = _reverse(segs)
+            if distance(run[-1].end, segs[0].start) <= tolerance:
+                run.extend([_with_start(segs[0], run[-1].end), *segs[1:]])
+                single = False
+                continue
+        runs.append(list(segs))
+        single = True
+    out: list[tuple[list[Segment], bool]] = []
+    for run in runs:
+        closed = distance(run[-1].end, run[0].start) <= tolerance and (
+            len(run) > 1 or isinstance(run[0], Arc)
+        )
+        if closed:
+            run[-1] = _with_end(run[-1], run[0].start)
+        out.append((run, closed))
+    return out
+
+
+def _near(p: Point, tolerance: float, *others: Point) -> bool:
+    return any(distance(p, q) <= tolerance for q in others)
+
+
+def _reverse(segs: Sequence[Segment]) -> list[Segment]:
+    return [s.reversed() for s in reversed(segs)]
+
+
+def _segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool]:
+    """Segments (zero-length ones dropped) and the closed flag of one curve entity."""
+    kind = entity.dxftype()
+    if kind == "ELLIPSE":
+        segs, closed = ellipse_segments(entity, tolerance)
+    elif kind == "SPLINE":
+        segs, closed = spline_segments(entity, tolerance)
+    else:
+        _check_flat(entity)
+        if kind == "LINE":
+            segs, closed = [Line(_xy(entity.dxf.start), _xy(entity.dxf.end))], False
+        elif kind in ("ARC", "CIRCLE"):
+            segs, closed = [_arc(entity)], kind == "CIRCLE"
+        elif kind == "LWPOLYLINE":
+            vertices = [(x, y, b) for x, y, b in entity.get_points("xyb")]
+            segs, closed = _polyline(entity, vertices, entity.closed), bool(entity.closed)
+        elif kind == "POLYLINE":
+            segs, closed = _polyline2d(entity), bool(entity.is_closed)
+        else:  # pragma: no cover - callers pass CONVERTED types only
+            raise Unsupported("not a 2D contour camtool cuts")
+    segs = [s for s in segs if s.length > ZERO_LENGTH]
+    if not segs:
+        raise Unsupported("zero length")
+    return segs, closed
+
+
+def _piece(entity: Any, tolerance: float) -> list[Segment]:
+    """Segments of one piece of a joined path; a zero-length piece is no segment."""
+    try:
+        return _segments(entity, tolerance)[0]
+    except Unsupported as exc:
+        if exc.reason != "zero length":
+            raise
+        return []
+
+
+def _check_flat(entity: Any) -> None:
+    if entity.dxftype() == "LINE":
+        return
+    ex, ey, _ = entity.dxf.get("extrusion", (0.0, 0.0, 1.0))
+    if abs(ex) > 1e-9 or abs(ey) > 1e-9:
+        raise Unsupported("not parallel to XY")
+
+
+def _polyline2d(entity: Any) -> list[Segment]:
+    """A 2D POLYLINE, or a 3D one that lies flat (all vertices at one Z) as lines.
+
+    Spline-fit frame vertices (flag 16) are not on the curve and are left out.
+    """
+    vertices = [v.dxf.location for v in entity.vertices if not v.dxf.flags & 16]
+    if not entity.is_2d_polyline:
+        zs = [float(v[2]) for v in vertices]
+        if zs and max(zs) - min(zs) > 1e-9 * max(1.0, *(abs(z) for z in zs)):
+            raise Unsupported("3D entity; camtool cuts 2D contours")
+        segs: list[Segment] = [Line(_xy(a), _xy(b)) for a, b in itertools.pairwise(vertices)]
+        if entity.is_closed and len(vertices) > 2:
+            segs.append(Line(_xy(vertices[-1]), _xy(vertices[0])))
+        return [s for s in segs if s.length > ZERO_LENGTH]
+    bulges = [v.dxf.bulge for v in entity.vertices if not v.dxf.flags & 16]
+    points = [(v[0], v[1], b) for v, b in zip(vertices, bulges, strict=True)]
+    return _polyline(entity, points, entity.is_closed)
+
+
+def _hatch(item: Item, tolerance: float) -> list[Contour]:
+    """Each boundary path of a HATCH as contours (normally one closed contour per path)."""
+    from camtool.importers.dxf_hatch import boundary_entities
+
+    hatch = item.entity
+    _check_flat(hatch)
+    contours: list[Contour] = []
+    for number, path in enumerate(boundary_entities(hatch), start=1):
+        pieces = [_piece(edge, tolerance) for edge in path]
+        label = f"{item.label} path {number}"
+        for segs, closed in join_pieces(pieces, tolerance):
+            contours.append(Contour(tuple(segs), closed, item.layer, label))
+    if not contours:
+        raise Unsupported("no boundary path")
+    return contours
+
+
+def _xy(p: Any) -> Point:
+    return (float(p[0]), float(p[1]))
+
+
+def _arc(entity: Any) -> Arc:
+    """ARC or CIRCLE in WCS; OCS arcs run counter-clockwise, mirrored ones clockwise."""
+    ocs = entity.ocs()
+    flipped = entity.dxf.get("extrusion", (0.0, 0.0, 1.0))[2] < 0
+    centre = _xy(ocs.to_wcs(entity.dxf.center))
+    r = float(entity.dxf.radius)
+    if entity.dxftype() == "CIRCLE":
+        start = (centre[0] + r, centre[1])
+        return Arc(start, start, centre, flipped)
+    a0, a1 = math.radians(entity.dxf.start_angle), math.radians(entity.dxf.end_angle)
+    c = entity.dxf.center
+    p0 = ocs.to_wcs((c[0] + r * math.cos(a0), c[1] + r * math.sin(a0), c[2]))
+    p1 = ocs.to_wcs((c[0] + r * math.cos(a1), c[1] + r * math.sin(a1), c[2]))
+    return Arc(_xy(p0), _xy(p1), centre, flipped)
+
+
+def _polyline(
+    entity: Any, vertices: list[tuple[float, float, float]], closed: bool
+) -> list[Segment]:
+    """Segments of an (LW)POLYLINE; a vertex's bulge shapes the segment after it."""
+    from ezdxf.math import bulge_center
+
+    ocs = entity.ocs()
+    # The extrusion is ±Z here (tilted ones are refused), so the elevation never
+    # changes X or Y in the WCS: z = 0 is exact for the 2D result.
+    z = 0.0
+    flipped = entity.dxf.get("extrusion", (0.0, 0.0, 1.0))[2] < 0
+    pairs = list(itertools.pairwise(vertices))
+    if closed and len(vertices) > 1:
+        pairs.append((vertices[-1], vertices[0]))
+    segs: list[Segment] = []
+    for (x0, y0, bulge), (x1, y1, _) in pairs:
+        p0 = _xy(ocs.to_wcs((x0, y0, z)))
+        p1 = _xy(ocs.to_wcs((x1, y1, z)))
+        if distance(p0, p1) <= ZERO_LENGTH:
+            continue
+        if abs(bulge) < 1e-12:
+            segs.append(Line(p0, p1))
+            continue
+        c = bulge_center((x0, y0), (x1, y1), bulge)
+        centre = _xy(ocs.to_wcs((c[0], c[1], z)))
+        segs.append(Arc(p0, p1, centre, (bulge < 0) != flipped))
+    return segs
+
+
+def _with_start(seg: Segment, p: Point) -> Segment:
+    return Line(p, seg.end) if isinstance(seg, Line) else Arc(p, seg.end, seg.centre, seg.clockwise)
+
+
+def _with_end(seg: Segment, p: Point) -> Segment:
+    return (
+        Line(seg.start, p)
+        if isinstance(seg, Line)
+        else Arc(seg.start, p, seg.centre, seg.clockwise)
+    )

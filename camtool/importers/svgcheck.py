@@ -1,0 +1,147 @@
+"""Strict checks of SVG attribute syntax: path data, transforms, lengths, point lists.
+
+svgelements, which the SVG importer builds on, reads malformed path data up to the first error
+and silently drops the rest, and fails with a bare ``IndexError`` on a malformed transform.
+These checks run first so that a malformed drawing is an error naming the element and the
+place, never a silently different part. Each function returns ``None`` or raises
+``ValueError`` with a lowercase message the importer prefixes with file and element.
+
+Sources: SVG 1.1 §8.3.9 (path data grammar), §7.6.1 (transform list), §4.2 (lengths),
+§9.7.1 (points).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+_SEPARATORS = " \t\r\n\f,"
+_ARITY = {"m": 2, "l": 2, "h": 1, "v": 1, "c": 6, "s": 4, "q": 4, "t": 2, "a": 7, "z": 0}
+_LENGTH = re.compile(
+    r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(mm|cm|in|pt|pc|px|em|ex|%)?\s*"
+)
+_TRANSFORM_ARGS = {
+    "matrix": (6,),
+    "translate": (1, 2),
+    "scale": (1, 2),
+    "rotate": (1, 3),
+    "skewX": (1,),
+    "skewY": (1,),
+}
+_TRANSFORM_ITEM = re.compile(r"[\s,]*([A-Za-z]+)\s*\(([^()]*)\)[\s,]*")
+
+
+def check_path_data(d: str) -> None:
+    """Check ``d`` against the SVG path data grammar, arc flags included.
+
+    Raises:
+        ValueError: the data does not start with a moveto, holds an unknown command, a
+            number that cannot be read, or a count of numbers its command cannot take.
+    """
+    pos, n = 0, len(d)
+    command: str | None = None
+    args = 0
+
+    def close_command() -> None:
+        if command is None:
+            return
+        arity = _ARITY[command.lower()]
+        if (arity == 0 and args) or (arity and (args == 0 or args % arity)):
+            need = "no numbers" if arity == 0 else f"a multiple of {arity} numbers"
+            raise ValueError(f"command {command!r} takes {need}, got {args} (near character {pos})")
+
+    while True:
+        while pos < n and d[pos] in _SEPARATORS:
+            pos += 1
+        if pos >= n:
+            break
+        char = d[pos]
+        if char.isalpha() and char not in "eE":
+            if char.lower() not in _ARITY:
+                raise ValueError(f"unknown command {char!r} at character {pos}")
+            if command is None and char not in "Mm":
+                raise ValueError(f"path data must start with M or m, not {char!r}")
+            close_command()
+            command, args, pos = char, 0, pos + 1
+            continue
+        if command is None:
+            raise ValueError(f"path data must start with M or m, not {char!r}")
+        if command in "Aa" and args % 7 in (3, 4):  # flags: one digit, separators optional
+            if char not in "01":
+                raise ValueError(f"arc flag must be 0 or 1, got {char!r} at character {pos}")
+            pos, args = pos + 1, args + 1
+            continue
+        match = _NUMBER.match(d, pos)
+        if match is None:
+            raise ValueError(f"cannot read a number at character {pos} ({d[pos : pos + 12]!r})")
+        pos, args = match.end(), args + 1
+    close_command()
+
+
+def check_transform(text: str) -> None:
+    """Check a ``transform`` attribute: a list of matrix/translate/scale/rotate/skewX/skewY.
+
+    Raises:
+        ValueError: an unknown function, a wrong number of arguments or unreadable text.
+    """
+    pos = 0
+    while pos < len(text):
+        match = _TRANSFORM_ITEM.match(text, pos)
+        if match is None or match.end() == pos:
+            if text[pos:].strip(_SEPARATORS) == "":
+                return
+            raise ValueError(f"cannot read the transform at character {pos}")
+        name, body = match.group(1), match.group(2)
+        if name not in _TRANSFORM_ARGS:
+            known = ", ".join(_TRANSFORM_ARGS)
+            raise ValueError(f"unknown transform function {name!r}; SVG has {known}")
+        numbers = _numbers(body, f"{name}()")
+        if len(numbers) not in _TRANSFORM_ARGS[name]:
+            counts = " or ".join(str(c) for c in _TRANSFORM_ARGS[name])
+            raise ValueError(f"{name}() takes {counts} numbers, got {len(numbers)}")
+        pos = match.end()
+
+
+def check_length(text: str, *, negative: bool = True) -> None:
+    """Check a length attribute: a finite number with a unit camtool knows (mm cm in pt pc px %).
+
+    Args:
+        text: the attribute's value.
+        negative: whether a negative value is allowed (coordinates yes, sizes and radii no).
+
+    Raises:
+        ValueError: anything else, font-relative units (em, ex) included.
+    """
+    match = _LENGTH.fullmatch(text)
+    if match is None or not math.isfinite(float(match.group(1))):
+        raise ValueError("must be a number with an optional unit (mm, cm, in, pt, pc, px, %)")
+    if match.group(2) in ("em", "ex"):
+        raise ValueError("font-relative units (em, ex) are not supported; use mm, px or %")
+    if not negative and float(match.group(1)) < 0:
+        raise ValueError("must not be negative")
+
+
+def check_points(text: str) -> None:
+    """Check a ``points`` attribute (polyline, polygon): an even count of numbers.
+
+    Raises:
+        ValueError: a token is not a number, or the count is odd.
+    """
+    count = len(_numbers(text, "points"))
+    if count % 2:
+        raise ValueError(f"points must be x,y pairs, got an odd count of numbers ({count})")
+
+
+def _numbers(text: str, what: str) -> list[str]:
+    tokens = [t for t in re.split(r"[\s,]+", text.strip()) if t]
+    out: list[str] = []
+    for token in tokens:
+        pos = 0
+        while pos < len(token):  # "1-2" and "1.5.5" are two numbers each
+            match = _NUMBER.match(token, pos)
+            if match is None:
+                raise ValueError(f"{what}: cannot read a number in {token!r}")
+            out.append(match.group())
+            pos = match.end()
+    return out

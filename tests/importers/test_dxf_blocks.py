@@ -1,0 +1,303 @@
+"""DXF INSERT/MINSERT: block content placed with the full transform, nested, mirrored.
+
+Expected positions are computed here from the insert's parameters (p' = T + R·S·p, the
+DXF reference's definition of INSERT), not with ezdxf's matrices.
+
+The property test runs a few examples; set CAMTOOL_INSERT_EXAMPLES=300 for a deeper search (a
+few hundred passed when this was written).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import os
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import ezdxf
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from camtool.errors import InputError
+from camtool.geometry import Arc, Contour, Line, Point, Segment
+from camtool.importers import ImportOptions
+from camtool.importers.dxf import read_dxf
+from camtool.toolpath.arcfit import distances
+from tests.shapes import segment_samples, write_dxf
+
+TOL = 0.001
+
+
+def _placer(at: Point, rotation_deg: float = 0.0, sx: float = 1.0, sy: float = 1.0) -> Any:
+    """The INSERT transform p' = at + R(rotation)·diag(sx, sy)·p, for expected values."""
+    c, s = math.cos(math.radians(rotation_deg)), math.sin(math.radians(rotation_deg))
+
+    def place(p: Point) -> Point:
+        x, y = p[0] * sx, p[1] * sy
+        return (at[0] + c * x - s * y, at[1] + s * x + c * y)
+
+    return place
+
+
+def _same_segment(a: Segment, b: Segment, tol: float = 1e-9) -> bool:
+    """Same line or arc, in either direction."""
+    if type(a) is not type(b):
+        return False
+    if isinstance(a, Arc) and isinstance(b, Arc):
+        if math.dist(a.centre, b.centre) > tol:
+            return False
+        fwd = a.clockwise == b.clockwise and math.dist(a.start, b.start) <= tol
+        fwd = fwd and math.dist(a.end, b.end) <= tol
+        return fwd or (
+            a.clockwise != b.clockwise
+            and math.dist(a.start, b.end) <= tol
+            and math.dist(a.end, b.start) <= tol
+        )
+    fwd = math.dist(a.start, b.start) <= tol and math.dist(a.end, b.end) <= tol
+    return fwd or (math.dist(a.start, b.end) <= tol and math.dist(a.end, b.start) <= tol)
+
+
+def _same_contour(a: Contour, b: Contour) -> bool:
+    if a.closed != b.closed or len(a.segments) != len(b.segments):
+        return False
+    for cand in (b, b.reversed()):
+        if all(_same_segment(x, y) for x, y in zip(a.segments, cand.segments, strict=True)):
+            return True
+    return False
+
+
+def _mirrored(seg: Segment, sx: float, sy: float) -> Segment:
+    def m(p: Point) -> Point:
+        return (p[0] * sx, p[1] * sy)
+
+    if isinstance(seg, Line):
+        return Line(m(seg.start), m(seg.end))
+    flips = sx * sy < 0
+    return Arc(m(seg.start), m(seg.end), m(seg.centre), seg.clockwise != flips)
+
+
+_c = st.floats(-40, 40, allow_nan=False).map(lambda v: round(v, 3))
+_line = st.tuples(st.just("line"), _c, _c, _c, _c)
+_arc = st.tuples(st.just("arc"), _c, _c, st.floats(0.5, 20), st.floats(0, 359), st.floats(1, 359))
+_poly = st.tuples(
+    st.just("poly"),
+    st.lists(
+        st.tuples(_c, _c, st.floats(-2, 2).map(lambda v: round(v, 3))), min_size=2, max_size=5
+    ),
+    st.booleans(),
+)
+
+
+def _draw(layout: Any, items: list[tuple[Any, ...]]) -> None:
+    for item in items:
+        if item[0] == "line":
+            layout.add_line(item[1:3], item[3:5])
+        elif item[0] == "arc":
+            _, x, y, r, a0, sweep = item
+            layout.add_arc((x, y), r, a0, a0 + sweep)
+        else:
+            layout.add_lwpolyline(item[1], format="xyb", close=item[2])
+
+
+@settings(max_examples=int(os.environ.get("CAMTOOL_INSERT_EXAMPLES", "30")), deadline=None)
+@given(
+    items=st.lists(st.one_of(_line, _arc, _poly), min_size=1, max_size=5),
+    scales=st.sampled_from([(-1.0, 1.0), (1.0, -1.0), (-1.0, -1.0)]),
+)
+def test_property_insert_scaled_by_minus_one_is_the_mirrored_drawing(
+    items: list[tuple[Any, ...]], scales: tuple[float, float]
+) -> None:
+    sx, sy = scales
+    with tempfile.TemporaryDirectory() as tmp:
+
+        def plain(msp: Any) -> None:
+            _draw(msp, items)
+
+        def inserted(msp: Any) -> None:
+            _draw(msp.doc.blocks.new("PART"), items)
+            msp.add_blockref("PART", (0, 0), dxfattribs={"xscale": sx, "yscale": sy})
+
+        try:
+            original = read_dxf(write_dxf(Path(tmp) / "a.dxf", plain)).contours
+        except InputError:  # every generated entity has zero length: nothing to compare
+            return
+        placed = read_dxf(write_dxf(Path(tmp) / "b.dxf", inserted)).contours
+    assert len(placed) == len(original)
+    for got, want in zip(placed, original, strict=True):
+        mirrored = Contour(
+            tuple(_mirrored(s, sx, sy) for s in want.segments), want.closed, want.layer
+        )
+        assert _same_contour(got, mirrored), (got, mirrored)
+        assert all(isinstance(s, type(w)) for s, w in zip(got.segments, want.segments, strict=True))
+
+
+def test_rotation_and_non_uniform_scale(tmp_path: Path) -> None:
+    place = _placer((10.0, 5.0), 30.0, 2.0, 0.5)
+
+    def build(msp: Any) -> None:
+        block = msp.doc.blocks.new("B")
+        block.add_line((0, 0), (4, 0))
+        block.add_arc((0, 0), 3.0, 0, 120)  # becomes an elliptical arc
+        block.add_lwpolyline([(0, 0, 0.0), (4, 0, 1.0), (4, 4, 0.0)], format="xyb", close=True)
+        msp.add_blockref("B", (10, 5), dxfattribs={"rotation": 30, "xscale": 2, "yscale": 0.5})
+
+    line, arc, poly = read_dxf(write_dxf(tmp_path / "r.dxf", build)).contours
+    (seg,) = line.segments
+    assert isinstance(seg, Line)
+    assert seg.start == pytest.approx(place((0, 0))) and seg.end == pytest.approx(place((4, 0)))
+    # the elliptical arc: true points p(θ) = place(3 cos θ, 3 sin θ), both ways within TOL
+    true = [place((3 * math.cos(t), 3 * math.sin(t))) for t in _range(0, 2 * math.pi / 3)]
+    _assert_close(true, arc.segments)
+    # the polyline stays one closed contour; its bulge (half circle centre (4, 2),
+    # radius 2, from (4, 0) to (4, 4) counter-clockwise) is an elliptical arc now
+    assert poly.closed and poly.source.startswith("LWPOLYLINE #")
+    half = [
+        place((4 + 2 * math.cos(t), 2 + 2 * math.sin(t))) for t in _range(-math.pi / 2, math.pi / 2)
+    ]
+    edges = [place(p) for p in _polyline_points([(4, 4), (0, 0), (4, 0)])]
+    _assert_close(half + edges, poly.segments)
+
+
+def _range(a: float, b: float, n: int = 2000) -> list[float]:
+    return [a + (b - a) * k / n for k in range(n + 1)]
+
+
+def _polyline_points(pts: list[Point], n: int = 200) -> list[Point]:
+    out = []
+    for (x0, y0), (x1, y1) in itertools.pairwise(pts):
+        out += [(x0 + (x1 - x0) * k / n, y0 + (y1 - y0) * k / n) for k in range(n + 1)]
+    return out
+
+
+def _assert_close(true: list[Point], segments: tuple[Segment, ...]) -> None:
+    """Every true point within TOL of the segments, every segment point near a true one."""
+    import numpy as np
+
+    assert float(np.max(distances(np.array(true), segments))) <= TOL
+    fitted = segment_samples(segments)
+    true_arr = np.array(true)
+    gaps = [float(np.min(np.hypot(*(true_arr - p).T))) for p in fitted]
+    spacing = float(np.max(np.hypot(*np.diff(true_arr, axis=0).T)))
+    assert max(gaps) <= TOL + spacing
+
+
+def test_minsert_rows_and_columns(tmp_path: Path) -> None:
+    def build(msp: Any) -> None:
+        msp.doc.blocks.new("HOLE").add_circle((0, 0), 1.0)
+        msp.add_blockref(
+            "HOLE",
+            (100, 50),
+            dxfattribs={
+                "row_count": 3,
+                "column_count": 4,
+                "row_spacing": 10.0,
+                "column_spacing": 5.0,
+                "rotation": 90.0,
+            },
+        )
+
+    contours = read_dxf(write_dxf(tmp_path / "m.dxf", build)).contours
+    assert len(contours) == 12
+    # the grid turns with the insert: column offset (5 c, 0) → (0, 5 c); row (0, 10 r) → (−10 r, 0)
+    want = {(100.0 - 10 * r, 50.0 + 5 * c) for r in range(3) for c in range(4)}
+    got = set()
+    for contour in contours:
+        (arc,) = contour.segments
+        assert isinstance(arc, Arc) and arc.is_full_circle and arc.radius == pytest.approx(1.0)
+        got.add((round(arc.centre[0], 9), round(arc.centre[1], 9)))
+    assert got == want
+    assert "row 3 column 4" in contours[-1].source
+
+
+def test_nested_blocks_two_levels_with_layer_zero_inheritance(tmp_path: Path) -> None:
+    def build(msp: Any) -> None:
+        nut = msp.doc.blocks.new("NUT")
+        nut.add_line((0, 0), (1, 0))  # layer 0: takes the layer of the INSERT chain
+        nut.add_circle((0, 0), 0.25, dxfattribs={"layer": "HOLES"})  # keeps its layer
+        bolt = msp.doc.blocks.new("BOLT")
+        bolt.add_blockref("NUT", (5, 0), dxfattribs={"rotation": 90})  # on layer 0 too
+        msp.add_blockref("BOLT", (100, 0), dxfattribs={"xscale": 2, "yscale": 2, "layer": "PARTS"})
+
+    path = write_dxf(tmp_path / "n.dxf", build)
+    line, hole = read_dxf(path).contours
+    # NUT: (0,0)-(1,0) rotated 90° → (0,0)-(0,1), at (5,0) → (5,0)-(5,1); BOLT ×2 at (100,0)
+    (seg,) = line.segments
+    assert seg.start == pytest.approx((110.0, 0.0)) and seg.end == pytest.approx((110.0, 2.0))
+    assert line.layer == "PARTS" and hole.layer == "HOLES"
+    (arc,) = hole.segments
+    assert isinstance(arc, Arc) and arc.radius == pytest.approx(0.5)
+    doc = ezdxf.readfile(path)
+    nut_line = doc.blocks.get("NUT").query("LINE")[0].dxf.handle
+    nut_ref = doc.blocks.get("BOLT").query("INSERT")[0].dxf.handle
+    bolt_ref = doc.modelspace().query("INSERT")[0].dxf.handle
+    assert line.source == (
+        f"LINE #{nut_line} in INSERT #{nut_ref} (block 'NUT') in INSERT #{bolt_ref} (block 'BOLT')"
+    )
+    only_parts = read_dxf(path, ImportOptions(layers=("parts",))).contours
+    assert [c.layer for c in only_parts] == ["PARTS"]
+
+
+def test_mirrored_ocs_entities_inside_a_block(tmp_path: Path) -> None:
+    # Block content with extrusion (0,0,-1) is seen mirrored (x → −x) before the insert
+    # moves it; a mirrored INSERT mirrors it back to counter-clockwise.
+    def build(msp: Any) -> None:
+        block = msp.doc.blocks.new("M")
+        block.add_arc((1, 0), 1.0, 0, 90, dxfattribs={"extrusion": (0, 0, -1)})
+        block.add_lwpolyline(
+            [(0, 0, 1.0), (2, 0, 0)], format="xyb", dxfattribs={"extrusion": (0, 0, -1)}
+        )
+        msp.add_blockref("M", (10, 10))
+        msp.add_blockref("M", (20, 10), dxfattribs={"xscale": -1})
+
+    arc, half, arc_back, half_back = read_dxf(write_dxf(tmp_path / "o.dxf", build)).contours
+    a = arc.segments[0]
+    assert isinstance(a, Arc) and a.clockwise
+    assert a.centre == pytest.approx((9.0, 10.0))  # OCS centre (1, 0) → WCS (−1, 0), then +(10, 10)
+    assert a.start == pytest.approx((8.0, 10.0)) and a.end == pytest.approx((9.0, 11.0))
+    h = half.segments[0]
+    assert isinstance(h, Arc) and h.clockwise and h.end == pytest.approx((8.0, 10.0))
+    b = arc_back.segments[0]
+    assert isinstance(b, Arc) and not b.clockwise and b.centre == pytest.approx((21.0, 10.0))
+    assert _same_segment(
+        half_back.segments[0], Arc((20.0, 10.0), (22.0, 10.0), (21.0, 10.0), False)
+    )
+
+
+def test_block_base_point_is_the_insertion_point(tmp_path: Path) -> None:
+    def build(msp: Any) -> None:
+        block = msp.doc.blocks.new("BP", base_point=(5, 5))
+        block.add_line((5, 5), (6, 5))
+        msp.add_blockref("BP", (0, 0))
+
+    (line,) = read_dxf(write_dxf(tmp_path / "bp.dxf", build)).contours
+    assert line.segments[0] == Line((0.0, 0.0), (1.0, 0.0))
+
+
+def test_ellipse_in_a_rotated_scaled_insert_holds_tolerance(tmp_path: Path) -> None:
+    place = _placer((3.0, -2.0), 50.0, 1.5, 0.75)
+
+    def build(msp: Any) -> None:
+        block = msp.doc.blocks.new("E")
+        block.add_ellipse((1, 1), (8, 2, 0), 0.3, 0.3, 4.0)
+        msp.add_blockref("E", (3, -2), dxfattribs={"rotation": 50, "xscale": 1.5, "yscale": 0.75})
+
+    (contour,) = read_dxf(write_dxf(tmp_path / "e.dxf", build)).contours
+    # block ellipse: c + M cos t + m sin t with M = (8, 2), m = z × M · 0.3 = (−0.6, 2.4)
+    true = [
+        place((1 + 8 * math.cos(t) - 0.6 * math.sin(t), 1 + 2 * math.cos(t) + 2.4 * math.sin(t)))
+        for t in _range(0.3, 4.0)
+    ]
+    _assert_close(true, contour.segments)
+
+
+def test_missing_block_is_skipped_with_a_warning(tmp_path: Path) -> None:
+    def build(msp: Any) -> None:
+        msp.add_line((0, 0), (1, 0))
+        msp.add_blockref("GONE", (0, 0))  # no block of that name
+
+    d = read_dxf(write_dxf(tmp_path / "g.dxf", build))
+    assert len(d.contours) == 1
+    assert any("INSERT" in w and "is missing" in w for w in d.warnings), d.warnings

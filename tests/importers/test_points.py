@@ -1,0 +1,230 @@
+"""Point-list importer: CSV/TXT/XY rows and the thesis GUI's Matlab xy matrices (seed-002 §3)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from camtool.errors import InputError, UsageError
+from camtool.geometry import Contour, Line
+from camtool.importers import DRAWING_SUFFIXES, ImportOptions, read_drawing
+from camtool.importers.points import read_points
+
+ROOT = Path(__file__).resolve().parents[2]
+DATA = ROOT / "tests" / "data"
+
+# seed-002 §3, "Worked example (verbatim, L3183-L3228)": the star's xy matrix in 0.1 mm
+STAR_X = (151, 400, 630, 575, 815, 501, 400, 294, 6, 220, 153)
+STAR_Y = (86, 265, 86, 431, 639, 642, 999, 645, 665, 428, 86)
+STAR_MM = [(15.1, 8.6), (40.0, 26.5), (63.0, 8.6), (57.5, 43.1), (81.5, 63.9), (50.1, 64.2),
+           (40.0, 99.9), (29.4, 64.5), (0.6, 66.5), (22.0, 42.8), (15.3, 8.6)]  # fmt: skip
+
+
+def vertices(contour: Contour) -> list[tuple[float, float]]:
+    assert all(isinstance(s, Line) for s in contour.segments)
+    return [contour.start, *(s.end for s in contour.segments)]
+
+
+def write(tmp_path: Path, name: str, text: str) -> Path:
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+# ------------------------------------------------------------------ the thesis star
+
+
+def test_star_csv_sample_has_the_eleven_thesis_points() -> None:
+    # seed-002 §3: "esta figura consta de 11 puntos (10 líneas)"; xy/10 in mm
+    drawing = read_points(ROOT / "samples" / "star.csv")
+    assert len(drawing.contours) == 1
+    star = drawing.contours[0]
+    assert vertices(star) == STAR_MM
+    assert [(x / 10, y / 10) for x, y in zip(STAR_X, STAR_Y, strict=True)] == STAR_MM
+    assert len(star.segments) == 10
+    # seed-002 §3: "it starts at (151,86) and ends at (153,86)" - not closed
+    assert not star.closed
+    assert drawing.warnings == ()
+
+
+def test_star_matlab_text_equals_the_csv() -> None:
+    # tests/data/star.m is the thesis's printed xy/lxy/velxy block, verbatim (seed-002 §3)
+    from_m = read_points(DATA / "star.m")
+    from_csv = read_points(ROOT / "samples" / "star.csv")
+    assert [c.segments for c in from_m.contours] == [c.segments for c in from_csv.contours]
+    assert from_m.contours[0].source == "stroke 1 (line 1)"
+
+
+def test_star_reads_through_read_drawing() -> None:
+    for suffix in (".csv", ".txt", ".xy", ".m"):
+        assert suffix in DRAWING_SUFFIXES
+    assert vertices(read_drawing(ROOT / "samples" / "star.csv").contours[0]) == STAR_MM
+
+
+# ------------------------------------------------------------------ text rows
+
+
+@pytest.mark.parametrize(
+    "row",
+    ["1,2", "1;2", "1\t2", "1 2", "  1 ,  2  ", "1, 2", "1;  2"],
+)
+def test_separators(tmp_path: Path, row: str) -> None:
+    text = f"{row}\n{row.replace('1', '4').replace('2', '6')}\n"
+    drawing = read_points(write(tmp_path, "p.csv", text))
+    assert vertices(drawing.contours[0]) == [(1.0, 2.0), (4.0, 6.0)]
+
+
+def test_header_blank_lines_nan_rows_and_comments_split_strokes(tmp_path: Path) -> None:
+    text = (
+        "# exported by hand\n"
+        "X;Y\n"
+        "0;0\n1;0\n\n"  # blank line ends stroke 1
+        "5;5\n6;5\nNaN;NaN\n"  # NaN row ends stroke 2
+        "0;9\n1;9\nnan\n"
+        "\n\n"
+    )
+    drawing = read_points(write(tmp_path, "p.txt", text))
+    assert [vertices(c) for c in drawing.contours] == [
+        [(0.0, 0.0), (1.0, 0.0)],
+        [(5.0, 5.0), (6.0, 5.0)],
+        [(0.0, 9.0), (1.0, 9.0)],
+    ]
+    assert [c.source for c in drawing.contours] == [
+        "stroke 1 (line 3)",
+        "stroke 2 (line 6)",
+        "stroke 3 (line 9)",
+    ]
+    assert all(c.layer == "0" for c in drawing.contours)
+
+
+def test_closed_when_last_point_equals_first_and_repeats_dropped(tmp_path: Path) -> None:
+    text = "0,0\n10,0\n10,0\n10,10\n0,0\n"
+    contour = read_points(write(tmp_path, "sq.xy", text)).contours[0]
+    assert contour.closed
+    assert vertices(contour) == [(0.0, 0.0), (10.0, 0.0), (10.0, 10.0), (0.0, 0.0)]
+    assert contour.signed_area() == pytest.approx(50.0)
+
+
+@pytest.mark.parametrize(
+    ("units", "factor"),
+    [(None, 1.0), ("mm", 1.0), ("cm", 10.0), ("in", 25.4), ("um", 0.001), ("0.1mm", 0.1)],
+)
+def test_units(tmp_path: Path, units: str | None, factor: float) -> None:
+    path = write(tmp_path, "p.csv", "0,0\n3,4\n")
+    end = read_points(path, ImportOptions(units=units)).contours[0].end
+    assert end == pytest.approx((3 * factor, 4 * factor), rel=1e-15)
+
+
+def test_tenth_mm_is_exact_like_the_decimal_text(tmp_path: Path) -> None:
+    # 151 * 0.1 != 15.1 in binary floating point; the importer divides by 10 instead
+    path = write(tmp_path, "p.csv", "151,86\n400,265\n")
+    contour = read_points(path, ImportOptions(units="0.1mm")).contours[0]
+    assert vertices(contour) == [(15.1, 8.6), (40.0, 26.5)]
+
+
+def test_constant_z_is_dropped_quietly_varying_z_warns(tmp_path: Path) -> None:
+    flat = read_points(write(tmp_path, "flat.csv", "0,0,-1\n1,0,-1\n"))
+    assert flat.warnings == ()
+    assert vertices(flat.contours[0]) == [(0.0, 0.0), (1.0, 0.0)]
+    ramp = read_points(write(tmp_path, "ramp.csv", "x,y,z\n0,0,0\n1,0,-0.5\n2,0,-1\n"))
+    assert len(ramp.warnings) == 1
+    assert "Z varies from -1 to 0" in ramp.warnings[0]
+    assert "X and Y only" in ramp.warnings[0]
+
+
+def test_single_point_stroke_is_skipped_with_a_warning(tmp_path: Path) -> None:
+    drawing = read_points(write(tmp_path, "p.csv", "5,5\n\n0,0\n1,1\n"))
+    assert len(drawing.contours) == 1
+    assert drawing.warnings == (f"{tmp_path / 'p.csv'}: line 1: a stroke of one point was skipped",)
+
+
+# ------------------------------------------------------------------ text errors
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("0,0\n1,x\n", "line 2: 'x' is not a number"),
+        ("x,y\n0,0\nx,y\n", "line 3: 'x' is not a number"),
+        ("0,0\n1,2,3,4\n", "line 2: 4 numbers; rows are X,Y or X,Y,Z"),
+        ("0,0\n1\n", "line 2: 1 numbers; rows are X,Y or X,Y,Z"),
+        ("0,0\n1,2,3\n", "line 2: 3 numbers where the rows above have 2"),
+        ("0,0\nNaN,1\n", "line 2: NaN in only some columns"),
+        ("0,0\ninf,1\n", "line 2: infinite coordinate"),
+        ("15,1;8,6\n", "line 1: 4 numbers"),
+        ("x,y\n\n", "no stroke of two or more points"),
+        ("", "no stroke of two or more points"),
+        ("3,3\n", "no stroke of two or more points"),
+    ],
+)
+def test_bad_rows_name_file_and_line(tmp_path: Path, text: str, message: str) -> None:
+    path = write(tmp_path, "bad.csv", text)
+    with pytest.raises(InputError) as err:
+        read_points(path)
+    assert str(err.value).startswith(f"{path}: ")
+    assert message in str(err.value)
+
+
+def test_unknown_unit_is_a_usage_error_listing_units(tmp_path: Path) -> None:
+    path = write(tmp_path, "p.csv", "0,0\n1,1\n")
+    with pytest.raises(UsageError, match=r"unknown unit 'furlong'; use one of mm, um, cm"):
+        read_points(path, ImportOptions(units="furlong"))
+
+
+def test_missing_and_binary_files(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match="no such file"):
+        read_points(tmp_path / "nope.csv")
+    binary = tmp_path / "b.csv"
+    binary.write_bytes(b"\xff\xfe\x00\x81garbage")
+    with pytest.raises(InputError, match="not a UTF-8 text file"):
+        read_points(binary)
+
+
+# ------------------------------------------------------------------ Matlab files
+
+
+def test_matlab_single_line_commas_comments_and_several_strokes(tmp_path: Path) -> None:
+    text = (
+        "% two strokes drawn with the thesis GUI\n"
+        "xy = [10, 20, 30; 5, 5, 15];\n"
+        "lxy = [10 10; 0 10];  % ignored\n"
+        "xy = [ 0 10 10 0\n"
+        "       0  0 10 0 ];\n"
+    )
+    drawing = read_points(write(tmp_path, "two.m", text))
+    assert [vertices(c) for c in drawing.contours] == [
+        [(1.0, 0.5), (2.0, 0.5), (3.0, 1.5)],
+        [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 0.0)],
+    ]
+    assert [c.closed for c in drawing.contours] == [False, True]
+    assert [c.source for c in drawing.contours] == ["stroke 1 (line 2)", "stroke 2 (line 4)"]
+
+
+def test_matlab_units_option_overrides_tenth_mm(tmp_path: Path) -> None:
+    path = write(tmp_path, "mm.m", "xy = [1 2; 3 4]\n")
+    assert read_points(path, ImportOptions(units="mm")).contours[0].end == (2.0, 4.0)
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("n = 10;\n", "line 1: unexpected variable 'n'; camtool reads 'xy'"),
+        ("xy = [1 2; 3 4]\nplot(xy)\n", "line 2: expected 'xy = [ x ...; y ... ]', got 'plot(xy)'"),
+        ("xy = xy*100;\n", "line 1: expected 'xy = [ x ...; y ... ]'"),
+        ("xy = [1 2; 3 4\n", "line 1: expected 'xy = [ x ...; y ... ]'"),
+        ("xy = [1 2 3]\n", "line 1: xy has 1 rows; it must have 2"),
+        ("\n\nxy = [1 2; 3 4; 5 6]\n", "line 3: xy has 3 rows"),
+        ("xy = [1 2 3; 4 5]\n", "xy rows have 3 and 2 numbers"),
+        ("xy = [1 a; 3 4]\n", "'a' in xy is not a number"),
+        ("xy = [1 NaN; 3 4]\n", "xy holds NaN or infinity"),
+        ("lxy = [1 2; 3 4]\n", "no 'xy = [ ... ]' matrix"),
+        ("% nothing\n", "no 'xy = [ ... ]' matrix"),
+    ],
+)
+def test_matlab_errors(tmp_path: Path, text: str, message: str) -> None:
+    path = write(tmp_path, "bad.m", text)
+    with pytest.raises(InputError) as err:
+        read_points(path)
+    assert str(err.value).startswith(f"{path}: ")
+    assert message in str(err.value)

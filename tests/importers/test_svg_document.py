@@ -1,0 +1,401 @@
+"""SVG importer documents: page units, Inkscape layers, visibility, use, skipped kinds, errors.
+
+Files written by Inkscape 1.2.2 are in tests/data (tests/data/README-svg.md says how).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from camtool.errors import InputError, UsageError
+from camtool.geometry import Arc
+from camtool.importers import ImportOptions, read_drawing, read_drawing_bytes
+from camtool.importers.svg import read_svg
+from tests.importers.svgutil import (
+    DATA,
+    HALF,
+    assert_arc,
+    one,
+    svg,
+    true_curve,
+    two_sided_error,
+    vertices,
+)
+
+# ------------------------------------------------------------------ units and page
+
+
+@pytest.mark.parametrize(
+    ("root", "mm_per_unit"),
+    [
+        ('width="10mm" height="10mm" viewBox="0 0 100 100"', 0.1),
+        ('width="2in" height="2in" viewBox="0 0 2 2"', 25.4),
+        ('width="1cm" height="1cm" viewBox="0 0 1 1"', 10.0),
+        ('width="72pt" height="72pt" viewBox="0 0 72 72"', 25.4 / 72),
+        ('width="6pc" height="6pc" viewBox="0 0 1 1"', 25.4),
+        ('width="96px" height="96px" viewBox="0 0 96 96"', 25.4 / 96),
+        ('width="96" height="96"', 25.4 / 96),
+        ('width="50mm" height="20mm"', 25.4 / 96),  # no viewBox: user units are px
+    ],
+)
+def test_units(tmp_path: Path, root: str, mm_per_unit: float) -> None:
+    drawing = read_svg(svg(tmp_path, '<path d="M 0 0 L 1 0 L 1 1"/>', root))
+    a, b, c = vertices(one(drawing))
+    assert b[0] - a[0] == pytest.approx(mm_per_unit, rel=1e-12)
+    assert c[1] - b[1] == pytest.approx(-mm_per_unit, rel=1e-12)  # Y flipped
+    assert drawing.warnings == ()
+
+
+def test_width_10mm_viewbox_100_is_scale_0_1_with_page_flip(tmp_path: Path) -> None:
+    root = 'width="10mm" height="20mm" viewBox="0 0 100 200"'
+    contour = one(read_svg(svg(tmp_path, '<path d="M 0 0 L 100 0 L 100 200"/>', root)))
+    assert np.allclose(vertices(contour), [(0, 20), (10, 20), (10, 0)], rtol=0, atol=1e-12)
+
+
+def test_viewbox_offset_and_preserve_aspect_ratio(tmp_path: Path) -> None:
+    # page 200 x 100 mm, viewBox 50 x 50 from (10, 10): meet -> 2 mm/unit, centred in x
+    root = 'width="200mm" height="100mm" viewBox="10 10 50 50"'
+    contour = one(read_svg(svg(tmp_path, '<path d="M 10 10 L 60 60"/>', root)))
+    assert np.allclose(vertices(contour), [(50, 100), (150, 0)], rtol=0, atol=1e-12)
+    root_none = root + ' preserveAspectRatio="none"'
+    contour = one(read_svg(svg(tmp_path, '<path d="M 10 10 L 60 60"/>', root_none)))
+    assert np.allclose(vertices(contour), [(0, 100), (200, 0)], rtol=0, atol=1e-12)
+    root_slice = root + ' preserveAspectRatio="xMinYMin slice"'
+    contour = one(read_svg(svg(tmp_path, '<path d="M 10 10 L 60 60"/>', root_slice)))
+    assert np.allclose(vertices(contour), [(0, 100), (200, -100)], rtol=0, atol=1e-12)
+
+
+def test_one_size_missing_is_taken_from_the_viewbox(tmp_path: Path) -> None:
+    root = 'width="50mm" viewBox="0 0 100 200"'
+    contour = one(read_svg(svg(tmp_path, '<path d="M 0 0 L 100 200"/>', root)))
+    assert np.allclose(vertices(contour), [(0, 100), (50, 0)], rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("root", "warning"),
+    [
+        ('viewBox="0 0 96 96"', "no width/height; user units taken as px (1/96 in)"),
+        ("", "no width/height; user units taken as px (1/96 in)"),
+        (
+            'width="100%" height="100%" viewBox="0 0 96 96"',
+            "relative size width='100%' x height='100%'",
+        ),
+    ],
+)
+def test_no_absolute_size_means_px_with_a_warning(tmp_path: Path, root: str, warning: str) -> None:
+    drawing = read_svg(svg(tmp_path, '<path d="M 0 0 L 96 0"/>', root))
+    a, b = vertices(one(drawing))
+    assert b[0] - a[0] == pytest.approx(25.4, rel=1e-12)
+    assert len(drawing.warnings) == 1
+    assert warning in drawing.warnings[0]
+
+
+# ------------------------------------------------------------------ layers, visibility
+
+
+def test_inkscape_layers_name_the_contours(tmp_path: Path) -> None:
+    drawing = read_svg(DATA / "inkscape-layers.svg")
+    assert [(c.source, c.layer) for c in drawing.contours] == [
+        ("rect#plate", "Cut"),
+        ("circle#hole", "Cut"),
+        ("ellipse#oval", "Engrave"),
+        ("path#wave", "Engrave"),
+    ]
+
+
+def test_select_one_layer(tmp_path: Path) -> None:
+    drawing = read_svg(DATA / "inkscape-layers.svg", ImportOptions(layers=("Engrave",)))
+    assert [c.layer for c in drawing.contours] == ["Engrave", "Engrave"]
+    by_id = read_svg(DATA / "inkscape-layers.svg", ImportOptions(layers=("layer1",)))
+    assert [c.source for c in by_id.contours] == ["rect#plate", "circle#hole"]
+
+
+def test_unknown_layer_lists_the_layers() -> None:
+    with pytest.raises(InputError) as err:
+        read_svg(DATA / "inkscape-layers.svg", ImportOptions(layers=("Cut", "Nope")))
+    assert str(err.value) == (
+        f"{DATA / 'inkscape-layers.svg'}: no layer named 'Nope'; "
+        "its layers are 'Cut', 'Engrave', 'Guides'"
+    )
+
+
+def test_layers_asked_of_a_file_without_layers(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match="no layer named 'Cut'; it has no Inkscape layers"):
+        read_svg(svg(tmp_path, HALF), ImportOptions(layers=("Cut",)))
+
+
+def test_hidden_layer_is_skipped_with_a_warning_and_read_when_named() -> None:
+    path = DATA / "inkscape-layers.svg"
+    drawing = read_svg(path)
+    assert "Guides" not in {c.layer for c in drawing.contours}
+    assert f"{path}: layer 'Guides' is hidden and was skipped; name it with --layers to cut it" in (
+        drawing.warnings
+    )
+    guides = read_svg(path, ImportOptions(layers=("Guides",)))
+    assert [(c.source, c.layer) for c in guides.contours] == [("path#guide", "Guides")]
+    assert vertices(guides.contours[0]) == [(0, 20), (60, 20)]
+
+
+def test_sublayer_selection_and_innermost_layer_name(tmp_path: Path) -> None:
+    body = (
+        '<g inkscape:groupmode="layer" inkscape:label="Top" style="display:none">'
+        '<path id="a" d="M 0 0 L 1 0"/>'
+        '<g inkscape:groupmode="layer" inkscape:label="Sub"><path id="b" d="M 0 0 L 2 0"/></g>'
+        "</g>"
+        '<path id="c" d="M 0 0 L 3 0"/>'
+    )
+    path = svg(tmp_path, body)
+    sub = read_svg(path, ImportOptions(layers=("Sub",)))
+    assert [(c.source, c.layer) for c in sub.contours] == [("path#b", "Sub")]
+    top = read_svg(path, ImportOptions(layers=("Top",)))
+    assert [(c.source, c.layer) for c in top.contours] == [("path#a", "Top"), ("path#b", "Sub")]
+    everything = read_svg(path)
+    assert [(c.source, c.layer) for c in everything.contours] == [("path#c", "0")]
+
+
+def test_display_none_and_visibility_hidden_are_skipped(tmp_path: Path) -> None:
+    body = (
+        "<style>.off { display: none }</style>"
+        '<path id="inline" d="M 0 0 L 1 0" style="display:none"/>'
+        '<path id="attr" d="M 0 0 L 1 0" display="none"/>'
+        '<path id="css" d="M 0 0 L 1 0" class="off"/>'
+        '<g style="display:none"><path id="child" d="M 0 0 L 1 0" style="display:inline"/></g>'
+        '<path id="ghost" d="M 0 0 L 1 0" visibility="hidden"/>'
+        '<g style="visibility:hidden">'
+        '<path id="shown" d="M 0 0 L 1 0" style="visibility:visible"/></g>'
+        '<path id="kept" d="M 0 0 L 1 0"/>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.source for c in drawing.contours] == ["path#shown", "path#kept"]
+    assert drawing.warnings == (f"{tmp_path / 't.svg'}: skipped 1 element with visibility:hidden",)
+
+
+# ------------------------------------------------------------------ use, skipped constructs
+
+
+def test_use_places_a_definition_and_names_both(tmp_path: Path) -> None:
+    body = (
+        '<defs><path id="d1" d="M 0 0 L 10 0"/></defs><use id="u1" xlink:href="#d1" x="5" y="7"/>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    contour = one(drawing)
+    assert vertices(contour) == [(5, 93), (15, 93)]
+    assert contour.source == "use#u1 > path#d1"
+    assert drawing.warnings == (
+        f"{tmp_path / 't.svg'}: skipped 1 <defs> element (definitions are cut only where a "
+        "<use> places them)",
+    )
+
+
+@pytest.mark.parametrize(
+    ("body", "warning"),
+    [
+        (
+            '<text x="1" y="1">hi</text><text>2</text>',
+            "skipped 2 <text> elements (convert text to paths",
+        ),
+        (
+            '<flowRoot><flowRegion><rect width="9" height="9"/></flowRegion>'
+            "<flowPara>x</flowPara></flowRoot>",
+            "skipped 1 <text> element",
+        ),
+        (
+            '<image width="5" height="5" href="data:image/png;base64,AAAA"/>',
+            "skipped 1 <image> element (raster images",
+        ),
+        (
+            '<clipPath id="c"><rect width="5" height="5"/></clipPath>',
+            "skipped 1 <clipPath> element (clipping is not applied: clipped shapes are cut whole)",
+        ),
+        (
+            '<mask id="m"><rect width="5" height="5"/></mask>',
+            "skipped 1 <mask> element (masks are not applied)",
+        ),
+        (
+            '<symbol id="s" viewBox="0 0 1 1"><path d="M 0 0 L 1 1"/></symbol>'
+            '<use href="#s" width="9" height="9"/>',
+            "skipped 1 <use> element (a <use> of a <symbol> with a viewBox is not supported",
+        ),
+    ],
+)
+def test_skipped_constructs_warn_once_per_kind(tmp_path: Path, body: str, warning: str) -> None:
+    drawing = read_svg(svg(tmp_path, body + HALF))
+    assert [c.source for c in drawing.contours] == [drawing.contours[0].source]  # only HALF
+    assert isinstance(drawing.contours[0].segments[0], Arc)
+    assert len(drawing.warnings) == 1
+    assert drawing.warnings[0].startswith(f"{tmp_path / 't.svg'}: {warning}")
+
+
+def test_symbol_without_viewbox_is_placed(tmp_path: Path) -> None:
+    body = '<symbol id="s"><path d="M 0 0 L 1 0"/></symbol><use href="#s" x="3" y="4"/>'
+    assert vertices(one(read_svg(svg(tmp_path, body)))) == [(3, 96), (4, 96)]
+
+
+def test_links_and_nested_svg_viewports(tmp_path: Path) -> None:
+    body = (
+        '<a href="#x"><path d="M 0 0 L 10 0" transform="translate(1 1)"/></a>'
+        '<svg x="10" y="10" width="20" height="20" viewBox="0 0 2 2"><path d="M 0 0 L 1 0"/></svg>'
+    )
+    link, nested = read_svg(svg(tmp_path, body)).contours
+    assert vertices(link) == [(1, 99), (11, 99)]
+    assert vertices(nested) == [(10, 90), (20, 90)]  # 10 mm per unit inside the inner viewport
+
+
+def test_path_without_data_draws_nothing(tmp_path: Path) -> None:
+    drawing = read_svg(svg(tmp_path, '<path id="empty"/><path d=""/>' + HALF))
+    assert [c.source for c in drawing.contours] == ["path[3]"]
+
+
+def test_element_labels_count_in_document_order(tmp_path: Path) -> None:
+    body = '<path d="M 0 0 L 1 0"/><g><path id="named" d="M 0 0 L 2 0"/><path d="M 0 0 L 3 0"/></g>'
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.source for c in drawing.contours] == ["path[1]", "path#named", "path[3]"]
+
+
+# ------------------------------------------------------------------ files written by Inkscape
+
+
+def test_inkscape_saved_shapes(tmp_path: Path) -> None:
+    # tests/data/README-svg.md: Inkscape 1.2.2 re-saved inkscape-source.svg (60 x 40 mm page)
+    drawing = read_svg(DATA / "inkscape-layers.svg")
+    plate, hole, oval, wave = drawing.contours
+    assert plate.bbox() == pytest.approx((5, 5, 55, 35))
+    assert [isinstance(s, Arc) for s in plate.segments].count(True) == 4
+    (circle,) = hole.segments
+    assert_arc(circle, (15.0, 20.0), 5.0, True)
+    assert oval.bbox() == pytest.approx((32, 16, 48, 24), abs=1e-9)
+    assert wave.start == (28.0, 10.0) and wave.end == (52.0, 10.0)
+    assert f"{DATA / 'inkscape-layers.svg'}: skipped 1 <text> element" in drawing.warnings[1]
+
+
+def test_inkscape_object_to_path_plain_svg(tmp_path: Path) -> None:
+    # Inkscape wrote the circle as four 'a' commands and the rounded corners as Béziers
+    tol = 0.001
+    drawing = read_svg(DATA / "inkscape-paths-plain.svg", ImportOptions(tolerance=tol))
+    plate, hole, oval, wave = drawing.contours
+    assert {c.layer for c in drawing.contours} == {"0"}  # plain SVG drops inkscape:groupmode
+    (circle,) = hole.segments
+    arc = assert_arc(circle, (15.0, 20.0), 5.0, True)
+    assert arc.is_full_circle
+    d = (
+        "m 9,5 h 42 c 2.216,0 4,1.784 4,4 v 22 c 0,2.216 -1.784,4 -4,4 H 9 "
+        "C 6.784,35 5,33.216 5,31 V 9 C 5,6.784 6.784,5 9,5 Z"
+    )  # path#plate as Inkscape wrote it; the page is 40 mm high with viewBox 0 0 60 40
+    curve = true_curve(d, lambda xy: np.column_stack([xy[:, 0], 40.0 - xy[:, 1]]), 20001)
+    there, back = two_sided_error([plate], curve)
+    assert max(there, back) <= tol + 1e-6
+    saved = read_svg(DATA / "inkscape-layers.svg")
+    for a, b in zip(drawing.contours, saved.contours, strict=True):
+        assert a.bbox() == pytest.approx(b.bbox(), abs=0.01)  # the 0.554 corner Béziers
+    # the ellipse and the untouched Bézier wave give the same contours either way
+    assert oval.segments == saved.contours[2].segments
+    assert wave.segments == saved.contours[3].segments
+
+
+def test_svg_bytes_from_stdin_are_named_stdin() -> None:
+    data = (DATA / "inkscape-layers.svg").read_bytes()
+    drawing = read_drawing_bytes(data, suffix=".svg", options=ImportOptions(layers=("Cut",)))
+    assert drawing.source == "<stdin>"
+    with pytest.raises(InputError, match=r"^<stdin>: no layer named 'X'"):
+        read_drawing_bytes(data, suffix=".svg", options=ImportOptions(layers=("X",)))
+
+
+def test_read_drawing_dispatches_svg() -> None:
+    drawing = read_drawing(DATA / "inkscape-layers.svg", ImportOptions(layers=("Cut",)))
+    assert [c.source for c in drawing.contours] == ["rect#plate", "circle#hole"]
+
+
+# ------------------------------------------------------------------ bad input
+
+
+@pytest.mark.parametrize(
+    ("body", "message"),
+    [
+        (
+            '<path id="p" d="M 0 0 L 10"/>',
+            "path#p: bad path data: command 'L' takes a multiple of 2 numbers, got 1",
+        ),
+        ('<path d="M 0 0 X 5 5"/>', "path[1]: bad path data: unknown command 'X' at character 6"),
+        ('<path d="L 5 5"/>', "path[1]: bad path data: path data must start with M or m, not 'L'"),
+        ('<path d="M 0 0 A 5 5 0 2 1 9 9"/>', "bad path data: arc flag must be 0 or 1, got '2'"),
+        ('<path d="M 0 0 L 1 1 Z 5"/>', "bad path data: command 'Z' takes no numbers, got 1"),
+        ('<path d="M 0 0 L 1 #"/>', "bad path data: cannot read a number at character 10"),
+        (
+            '<g id="g" transform="rotate(abc)"><path d="M0 0 L1 1"/></g>',
+            "g#g: bad transform 'rotate(abc)'",
+        ),
+        ('<path transform="spin(3)" d="M0 0 L1 1"/>', "unknown transform function 'spin'"),
+        ('<path transform="scale(1 2 3)" d="M0 0 L1 1"/>', "scale() takes 1 or 2 numbers, got 3"),
+        ('<circle r="abc"/>', "circle[1]: bad r 'abc': must be a number with an optional unit"),
+        ('<polygon points="0 0 1 1 2"/>', "polygon[1]: points must be x,y pairs, got an odd count"),
+        (
+            "",
+            "nothing to cut; camtool reads path, rect, circle, ellipse, line, polyline and polygon",
+        ),
+        ("<text>only text</text>", "nothing to cut"),
+        ('<rect width="5em" height="1"/>', "bad width '5em': font-relative units (em, ex)"),
+        ('<circle r="-5"/>', "circle[1]: bad r '-5': must not be negative"),
+        ('<rect x="1e400" width="1" height="1"/>', "rect[1]: bad x '1e400': must be a number"),
+        ('<g id="g"><use id="u" href="#g"/></g>', "use#u: <use> places itself; remove the loop"),
+        ('<use id="a" href="#b"/><use id="b" href="#a"/>', "use#a: <use> places itself"),
+        (
+            '<g transform="scale(1e10)"><path d="M 0 0 L 1e300 0"/></g>',
+            "path[1]: coordinates too large (not finite in mm)",
+        ),
+    ],
+)
+def test_bad_input_names_file_and_element(tmp_path: Path, body: str, message: str) -> None:
+    path = svg(tmp_path, body)
+    with pytest.raises(InputError) as err:
+        read_svg(path)
+    assert str(err.value).startswith(f"{path}: ")
+    assert message in str(err.value)
+
+
+@pytest.mark.parametrize(
+    ("root", "message"),
+    [
+        (
+            'width="10em" height="10mm"',
+            "<svg> width '10em': unit 'em' unknown; use mm, cm, in, pt, px, pc",
+        ),
+        ('width="wide" height="10mm"', "<svg> width 'wide' is not a length"),
+        ('width="-5mm" height="10mm"', "<svg> width '-5mm' must be positive"),
+        ('viewBox="0 0 10"', "viewBox '0 0 10' must be four numbers"),
+        ('viewBox="0 0 0 10"', "viewBox '0 0 0 10' must have a positive width and height"),
+        (
+            'width="1mm" height="1mm" viewBox="0 0 1 1" preserveAspectRatio="middle"',
+            "preserveAspectRatio",
+        ),
+    ],
+)
+def test_bad_page_attributes(tmp_path: Path, root: str, message: str) -> None:
+    path = svg(tmp_path, HALF, root)
+    with pytest.raises(InputError) as err:
+        read_svg(path)
+    assert str(err.value).startswith(f"{path}: ")
+    assert message in str(err.value)
+
+
+def test_bad_tolerance_is_a_usage_error(tmp_path: Path) -> None:
+    with pytest.raises(UsageError, match=r"tolerance must be a positive number of mm, got 0\.0"):
+        read_svg(svg(tmp_path, HALF), ImportOptions(tolerance=0.0))
+
+
+def test_malformed_xml_names_line_and_column(tmp_path: Path) -> None:
+    path = tmp_path / "broken.svg"
+    path.write_text('<svg xmlns="http://www.w3.org/2000/svg">\n<path d="M 0 0 L 1 1">\n</svg>\n')
+    with pytest.raises(InputError, match=r"broken.svg: malformed XML at line 3, column 3"):
+        read_svg(path)
+
+
+def test_not_svg_and_missing_file(tmp_path: Path) -> None:
+    path = tmp_path / "x.svg"
+    path.write_text("<html><body/></html>")
+    with pytest.raises(InputError, match=r"not an SVG document \(the root element is <html>\)"):
+        read_svg(path)
+    with pytest.raises(InputError, match=r"nope\.svg: no such file"):
+        read_svg(tmp_path / "nope.svg")
