@@ -46,6 +46,17 @@ def _write(data: str | bytes, out: str) -> None:
         raise CamtoolError(f"{out}: cannot write ({exc.strerror or exc})") from exc
 
 
+_MACHINE = click.option(
+    "--machine",
+    "machine_file",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    metavar="FILE|NAME",
+    help="Machine profile (a TOML file or a built-in name) laid over the target's, key by "
+    "key, e.g. a measured backlash.",
+)
+
+
 def _import_options(command: Callable[..., None]) -> Callable[..., None]:
     """Options of the importers: --layers, --units, --hatch-boundaries."""
     from camtool.units import LENGTH_UNITS
@@ -178,14 +189,7 @@ def cli() -> None:
     metavar="W H",
     help="Scale the drawing uniformly to fit W x H mm, about its lower-left corner.",
 )
-@click.option(
-    "--machine",
-    "machine_file",
-    type=click.Path(dir_okay=False, path_type=Path),
-    default=None,
-    metavar="FILE",
-    help="TOML machine profile laid over the target's, key by key.",
-)
+@_MACHINE
 @_import_options
 @click.option("--verify", "verify_too", is_flag=True, help="Verify the emitted code (see verify).")
 @_verify_outputs
@@ -248,14 +252,7 @@ def post(
     metavar="MM",
     help="Tool diameter; the machined edge is the simulated path swept by half of it.",
 )
-@click.option(
-    "--machine",
-    "machine_file",
-    type=click.Path(dir_okay=False, path_type=Path),
-    default=None,
-    metavar="FILE",
-    help="TOML machine profile laid over the target's (e.g. a measured backlash).",
-)
+@_MACHINE
 @_verify_outputs
 def verify(
     code: str,
