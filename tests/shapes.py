@@ -134,3 +134,11 @@ def _distance_to_curve(
             a, c = c, d
             d = a + g * (b - a)
     return min(dist(a), dist(b), dist(0.5 * (a + b)))
+
+
+# seed-002 §3, L3196–L3200: the Matlab GUI's 11-point star, as the thesis prints ``xy``:
+# row 1 x, row 2 y, in 0.1 mm.
+STAR_XY_01MM = (
+    (151, 400, 630, 575, 815, 501, 400, 294, 6, 220, 153),
+    (86, 265, 86, 431, 639, 642, 999, 645, 665, 428, 86),
+)

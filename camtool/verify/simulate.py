@@ -31,7 +31,6 @@ import itertools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -55,7 +54,7 @@ from camtool.verify.interpolators import (
 )
 from camtool.verify.interpolators_timer import timer_line
 from camtool.verify.quantize import Rounding, steps_from_mm
-from camtool.verify.steparray import STEP_DTYPE, StepArray
+from camtool.verify.steparray import STEP_DTYPE, StepArray, read_only
 
 IntArray = npt.NDArray[np.int64]
 FloatArray = npt.NDArray[np.float64]
@@ -243,7 +242,7 @@ class _Controller:
             beta = math.radians(motion.chord_angle_deg)
             pts = valcnc_arc_points(start_mm, end, centre, move.clockwise, beta_rad=beta)
         else:
-            pts = _sagitta_points(start_mm, move, motion.chord_tolerance_mm)
+            pts = sagitta_chord_points(start_mm, move, motion.chord_tolerance_mm)
         return np.asarray(pts, dtype=np.float64).reshape(-1, 2)
 
     def _compensate(
@@ -294,22 +293,22 @@ class _Controller:
         block_of_row = np.repeat(np.arange(blocks, dtype=np.int64), counts)
         carriage = _carriage(rows, self.origin_steps, self.machine)
         return StepTrace(
-            rows=_frozen(rows),
-            compensation=_frozen(comp),
-            block_of_row=_frozen(block_of_row),
-            block_start=_frozen(block_start),
-            carriage_mm=_frozen(carriage),
+            rows=read_only(rows),
+            compensation=read_only(comp),
+            block_of_row=read_only(block_of_row),
+            block_start=read_only(block_start),
+            carriage_mm=read_only(carriage),
             start_mm=_start_mm(self.origin_steps, self.machine),
-            logical_end=_frozen(np.asarray(self.logical, dtype=np.int64).reshape(-1, 2)),
-            block_steps=_frozen(np.asarray(self.steps, dtype=np.int64).reshape(-1, 3)),
-            block_dominant=_frozen(np.asarray(self.dominant, dtype=np.int64)),
-            block_compensation=_frozen(np.asarray(self.block_comp, dtype=np.int64)),
+            logical_end=read_only(np.asarray(self.logical, dtype=np.int64).reshape(-1, 2)),
+            block_steps=read_only(np.asarray(self.steps, dtype=np.int64).reshape(-1, 3)),
+            block_dominant=read_only(np.asarray(self.dominant, dtype=np.int64)),
+            block_compensation=read_only(np.asarray(self.block_comp, dtype=np.int64)),
             reversals=(self.reversals[0], self.reversals[1]),
             compensations=self.compensations,
         )
 
 
-def _sagitta_points(start: Point, move: ArcMove, tolerance_mm: float) -> list[Point]:
+def sagitta_chord_points(start: Point, move: ArcMove, tolerance_mm: float) -> list[Point]:
     """End points of equal chords of an arc within ``tolerance_mm`` (the last is its end)."""
     cx, cy = move.cx, move.cy
     radius = math.hypot(start[0] - cx, start[1] - cy)
@@ -383,11 +382,3 @@ def _play(
         out[lo:hi] = values
         current = float(values[-1])
     return out - c0 + start
-
-
-_A = TypeVar("_A", bound=np.ndarray)
-
-
-def _frozen(array: _A) -> _A:
-    array.flags.writeable = False
-    return array

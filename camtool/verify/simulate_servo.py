@@ -24,8 +24,8 @@ from camtool.machine import Machine
 from camtool.post.router_arrays import points_01mm
 from camtool.program import ArcMove, Move, Program
 from camtool.verify.servo import RouterMachine, simulate_job
-from camtool.verify.simulate import StepTrace, _frozen, _sagitta_points
-from camtool.verify.steparray import STEP_DTYPE
+from camtool.verify.simulate import StepTrace, sagitta_chord_points
+from camtool.verify.steparray import STEP_DTYPE, read_only
 
 
 def simulate_servo(program: Program, machine: Machine) -> StepTrace:
@@ -75,19 +75,19 @@ def simulate_servo(program: Program, machine: Machine) -> StepTrace:
     counts = np.bincount(block_of_row, minlength=len(program.moves)).astype(np.int64)
     n = len(carriage)
     return StepTrace(
-        rows=_frozen(np.zeros((n, 2), dtype=STEP_DTYPE)),
-        compensation=_frozen(np.zeros(n, dtype=np.bool_)),
-        block_of_row=_frozen(block_of_row),
-        block_start=_frozen(np.concatenate(([0], np.cumsum(counts))).astype(np.int64)),
-        carriage_mm=_frozen(carriage),
+        rows=read_only(np.zeros((n, 2), dtype=STEP_DTYPE)),
+        compensation=read_only(np.zeros(n, dtype=np.bool_)),
+        block_of_row=read_only(block_of_row),
+        block_start=read_only(np.concatenate(([0], np.cumsum(counts))).astype(np.int64)),
+        carriage_mm=read_only(carriage),
         start_mm=program.origin,
-        logical_end=_frozen(np.zeros((len(program.moves), 2), dtype=np.int64)),
-        block_steps=_frozen(steps),
-        block_dominant=_frozen(np.zeros(len(program.moves), dtype=np.int64)),
-        block_compensation=_frozen(np.zeros(len(program.moves), dtype=np.int64)),
+        logical_end=read_only(np.zeros((len(program.moves), 2), dtype=np.int64)),
+        block_steps=read_only(steps),
+        block_dominant=read_only(np.zeros(len(program.moves), dtype=np.int64)),
+        block_compensation=read_only(np.zeros(len(program.moves), dtype=np.int64)),
         reversals=(0, 0),
         compensations=0,
-        block_time_s=_frozen(times),
+        block_time_s=read_only(times),
     )
 
 
@@ -106,7 +106,7 @@ def _vertices(
     here = start
     for index, move in enumerate(moves):
         if isinstance(move, ArcMove):
-            chords = _sagitta_points(here, move, machine.motion.chord_tolerance_mm)
+            chords = sagitta_chord_points(here, move, machine.motion.chord_tolerance_mm)
         else:
             chords = [(move.x, move.y)]
         for point in chords:

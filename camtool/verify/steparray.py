@@ -12,6 +12,8 @@ coordinates (mm inside camtool, Y up).
 
 from __future__ import annotations
 
+from typing import TypeVar
+
 import numpy as np
 import numpy.typing as npt
 
@@ -20,6 +22,15 @@ STEP_DTYPE = np.int8
 
 StepArray = npt.NDArray[np.int8]
 """Type alias of a step array: ``(N, 2) int8``, read-only."""
+
+
+_Array = TypeVar("_Array", bound=np.ndarray)
+
+
+def read_only(array: _Array) -> _Array:
+    """Mark ``array`` read-only and return it (the array itself, not a copy)."""
+    array.flags.writeable = False
+    return array
 
 
 def freeze(rows: npt.ArrayLike) -> StepArray:

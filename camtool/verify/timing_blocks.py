@@ -17,6 +17,7 @@ import numpy as np
 import numpy.typing as npt
 
 from camtool.errors import UsageError
+from camtool.verify.steparray import read_only
 
 FloatArray = npt.NDArray[np.float64]
 """``(B,) float64`` array."""
@@ -26,10 +27,8 @@ BoolArray = npt.NDArray[np.bool_]
 """``(B,) bool`` array."""
 
 
-def frozen(arr: npt.NDArray[np.generic]) -> npt.NDArray[np.generic]:
-    """Mark ``arr`` read-only and return it (the array itself, not a copy)."""
-    arr.flags.writeable = False
-    return arr
+frozen = read_only
+"""Mark an array read-only and return it (:func:`camtool.verify.steparray.read_only`)."""
 
 
 def seconds(values: npt.ArrayLike) -> FloatArray:

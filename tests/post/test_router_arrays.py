@@ -18,14 +18,9 @@ from camtool.post.router_arrays import (
     points_01mm,
     router_arrays,
 )
+from tests.shapes import STAR_XY_01MM
 
-# seed-002 §3, L3196–L3200: the 11-point star, 0.1 mm; rows x, y as the thesis prints them.
-STAR_XY = np.array(
-    [
-        [151, 400, 630, 575, 815, 501, 400, 294, 6, 220, 153],
-        [86, 265, 86, 431, 639, 642, 999, 645, 665, 428, 86],
-    ]
-)
+STAR_XY = np.array(STAR_XY_01MM)  # seed-002 §3, L3196–L3200
 # seed-002 §3, L3212–L3228, verbatim.
 STAR_LXY = [
     [249, 230, 55, 240, 314, 101, 106, 288, 214, 67],

@@ -42,14 +42,9 @@ from camtool.verify.servo_plant import (
     per_axis_plants,
     plant_from_gains,
 )
+from tests.shapes import STAR_XY_01MM
 
-# seed-002 §3, L3196–L3200: the star, (N, 2) in 0.1 mm.
-STAR = np.array(
-    [
-        [151, 400, 630, 575, 815, 501, 400, 294, 6, 220, 153],
-        [86, 265, 86, 431, 639, 642, 999, 645, 665, 428, 86],
-    ]
-).T
+STAR = np.array(STAR_XY_01MM).T  # seed-002 §3, L3196–L3200, (N, 2) in 0.1 mm
 CPM = 25_600  # counts per mm on X/Y (seed-002 §2.2, R8)
 
 

@@ -17,6 +17,7 @@ from camtool.program import ArcMove, Linear, Program, Rapid
 from camtool.verify.metrics import fit_circle, nominal_arrays, point_distances
 from camtool.verify.simulate import StepTrace, simulate_steps
 from camtool.verify.verifier import verify_program
+from tests.shapes import STAR_XY_01MM
 
 
 def profile(name: str, **override: Any) -> Machine:
@@ -298,19 +299,7 @@ def test_fit_circle_recovers_centre_and_radius() -> None:
 
 # ------------------------------------------------------------ seed-002, the servo router
 
-STAR_01MM = [
-    (151, 86),
-    (400, 265),
-    (630, 86),
-    (575, 431),
-    (815, 639),
-    (501, 642),
-    (400, 999),
-    (294, 645),
-    (6, 665),
-    (220, 428),
-    (153, 86),
-]  # seed-002 §3, the GUI's 11-point star, 0.1 mm
+STAR_01MM = list(zip(*STAR_XY_01MM, strict=True))  # seed-002 §3: (x, y) per point, 0.1 mm
 
 
 def test_star_on_the_router_closes_off_by_the_chunk_flooring() -> None:
