@@ -22,6 +22,7 @@ if TYPE_CHECKING:
 
     from camtool.geometry import Drawing
     from camtool.importers import ImportOptions
+    from camtool.post.registry import TargetEntry
     from camtool.program import Program
     from camtool.verify.verifier import Verification
 
@@ -189,6 +190,22 @@ def cli() -> None:
     metavar="W H",
     help="Scale the drawing uniformly to fit W x H mm, about its lower-left corner.",
 )
+@click.option(
+    "--format",
+    "fmt",
+    default=None,
+    metavar="NAME",
+    help="Output format of the target's dialect (e.g. matlab-router 'wire', i8751 'dump'); "
+    "see `camtool targets`.",
+)
+@click.option(
+    "--spindle-rpm",
+    type=click.FloatRange(min=0),
+    default=None,
+    metavar="RPM",
+    help="Spindle on (M03) at RPM before the first move and off (M05) after the last; "
+    "0 writes no spindle commands [default: the target's].",
+)
 @_MACHINE
 @_import_options
 @click.option("--verify", "verify_too", is_flag=True, help="Verify the emitted code (see verify).")
@@ -216,10 +233,15 @@ def post(
     from camtool.post.registry import load_target
 
     chosen = load_target(target, machine_file=machine_file)
+    chosen.post.check_format(options["fmt"])
     settings = _import_settings(options)
     if is_program_file(drawing):
         job = post_program(
-            _read_program(drawing, options), chosen, feed_mm_min=options["feed_mm_min"]
+            _read_program(drawing, options),
+            chosen,
+            feed_mm_min=options["feed_mm_min"],
+            fmt=options["fmt"],
+            spindle_rpm=options["spindle_rpm"],
         )
     else:
         job = post_drawing(_read_input(drawing, settings), chosen, **options)
@@ -275,7 +297,7 @@ def verify(
     from camtool.verify.verifier import verify_code
 
     chosen = load_target(target, machine_file=machine_file)
-    text = _read_code(code)
+    text = _read_code(code, binary=chosen.post.binary)
     drawing = _read_input(against) if against is not None else None
     v = verify_code(text, chosen, source=code, against=drawing, tool_diameter=tool_diameter)
     _finish_verification(v, report, preview, max_error_um)
@@ -303,7 +325,14 @@ def _read_program(name: str, options: dict[str, Any]) -> Program:
     return read_gcode(name)
 
 
-def _read_code(name: str) -> str:
+def _read_code(name: str, *, binary: bool = False) -> str | bytes:
+    if binary:
+        try:
+            return sys.stdin.buffer.read() if name == "-" else Path(name).read_bytes()
+        except FileNotFoundError as exc:
+            raise InputError(f"{name}: no such file") from exc
+        except OSError as exc:
+            raise InputError(f"{name}: cannot read ({exc.strerror or exc})") from exc
     if name == "-":
         return sys.stdin.read()
     try:
@@ -376,17 +405,41 @@ def inspect(drawing: str, as_json: bool, **options: Any) -> None:
 @cli.command()
 @click.option("--json", "as_json", is_flag=True, help="Write the list as JSON.")
 def targets(as_json: bool) -> None:
-    """List the targets camtool can write for."""
-    from camtool.post.registry import load_target, target_names
+    """List the targets camtool can write for (built in, then plugins).
 
-    rows = [load_target(name) for name in target_names()]
+    A plugin that fails to load is listed as broken with the reason.
+    """
+    from camtool.post.registry import list_targets
+
+    rows = list_targets()
     if as_json:
-        data = [{"name": t.name, "description": t.description, "source": t.source} for t in rows]
-        click.echo(json.dumps(data, indent=2))
+        click.echo(json.dumps([_target_json(e) for e in rows], indent=2, ensure_ascii=False))
         return
-    width = max(len(t.name) for t in rows)
-    for t in rows:
-        click.echo(f"{t.name:<{width}}  {t.description}")
+    width = max(len(e.name) for e in rows)
+    for e in rows:
+        if e.target is None:
+            click.echo(f"{e.name:<{width}}  BROKEN: {e.error}")
+            continue
+        line = f"{e.name:<{width}}  {e.target.description}"
+        click.echo(line if e.origin == "builtin" else f"{line} [{e.origin}]")
+
+
+def _target_json(entry: TargetEntry) -> dict[str, Any]:
+    """One ``camtool targets --json`` row."""
+    t = entry.target
+    if t is None:
+        return {"name": entry.name, "origin": entry.origin, "broken": entry.error}
+    return {
+        "name": entry.name,
+        "description": t.description,
+        "source": t.source,
+        "origin": entry.origin,
+        "machine": t.machine.name,
+        "formats": dict(t.post.formats),
+        "has_z": t.machine.has_z,
+        "work_area_mm": list(t.machine.work_area_mm),
+        "default_feed_mm_min": t.default_feed_mm_min,
+    }
 
 
 def main(argv: list[str] | None = None) -> int:

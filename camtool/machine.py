@@ -157,6 +157,8 @@ class Machine:
         timing: the ``[machine.timing]`` table as written: ``model`` (a model of
             :data:`camtool.verify.timing.MODELS`) and its parameters; the
             verifier checks it (:func:`camtool.verify.timing.timing_model_from_table`).
+        table: the ``[machine]`` table it was built from (empty when built in
+            code), so that ``--machine`` can be laid over any profile.
     """
 
     name: str
@@ -169,6 +171,9 @@ class Machine:
     motion: Motion = field(default_factory=Motion)
     backlash: Backlash = field(default_factory=Backlash)
     timing: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
+    table: Mapping[str, Any] = field(
+        default_factory=lambda: MappingProxyType({}), compare=False, repr=False
+    )
 
     @property
     def real_steps_per_mm(self) -> tuple[float, float, float]:
@@ -214,6 +219,7 @@ def machine_from_table(table: Mapping[str, Any], *, where: str) -> Machine:
         motion=_motion(r.table("motion")),
         backlash=_backlash(r.table("backlash")),
         timing=r.raw_table("timing"),
+        table=MappingProxyType(dict(table)),
     )
     r.done()
     return machine

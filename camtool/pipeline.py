@@ -10,7 +10,7 @@ from camtool.geometry import Drawing
 from camtool.importers import read_drawing
 from camtool.post.base import PostResult, Target
 from camtool.post.registry import load_target
-from camtool.program import Program
+from camtool.program import Move, Program
 from camtool.toolpath.plan import PlanOptions, place, plan
 
 if TYPE_CHECKING:
@@ -72,7 +72,14 @@ def is_program_file(name: str | Path) -> bool:
     return Path(name).suffix.lower() in PROGRAM_SUFFIXES
 
 
-def post_program(program: Program, target: Target, *, feed_mm_min: float | None = None) -> PostJob:
+def post_program(
+    program: Program,
+    target: Target,
+    *,
+    feed_mm_min: float | None = None,
+    fmt: str | None = None,
+    spindle_rpm: float | None = None,
+) -> PostJob:
     """Re-post an existing program (e.g. G-code another CAM wrote) for a target.
 
     No planning: the program is already a toolpath. ``feed_mm_min``, when given,
@@ -80,6 +87,9 @@ def post_program(program: Program, target: Target, *, feed_mm_min: float | None 
     otherwise). For a target without a Z axis (depth set by hand, seed-000
     S000-08) Z is dropped with a warning: Z-only moves go, XY moves keep their
     kind, as the thesis users edited VisiCAM output by hand (seed-000 §3.8).
+    ``fmt`` is the dialect's output format (default: its first);
+    ``spindle_rpm`` > 0 starts the spindle before the first move and stops it
+    after the last (when the program has no spindle commands of its own).
 
     Raises:
         CamtoolError: whatever the target cannot express (names the block).
@@ -96,7 +106,17 @@ def post_program(program: Program, target: Target, *, feed_mm_min: float | None 
         program = dataclasses.replace(program, moves=moves)
     if not target.machine.has_z:
         program = _flatten(program, target.name)
-    return PostJob(None, program, target, target.emit(program), None, 0.0)
+    program = _with_spindle(program, spindle_rpm)
+    return PostJob(None, program, target, target.emit(program, fmt=fmt), None, 0.0)
+
+
+def _with_spindle(program: Program, rpm: float | None) -> Program:
+    """``program`` with spindle on/off around it when ``rpm`` > 0 and it has none."""
+    from camtool.program import Spindle
+
+    if not rpm or any(isinstance(c, Spindle) for _, c in program.commands):
+        return program
+    return program.with_spindle(rpm)
 
 
 def _flatten(program: Program, target: str) -> Program:
@@ -107,19 +127,27 @@ def _flatten(program: Program, target: str) -> Program:
     if not depths:
         return program
     here = program.origin
-    moves = []
+    moves: list[Move] = []
+    new_index = []  # old move index -> index in the flattened program
     for move in program.moves:
+        new_index.append(len(moves))
         if (move.x, move.y) == here and not hasattr(move, "cx"):
             continue  # a Z-only move
         moves.append(dataclasses.replace(move, z=None))
         here = (move.x, move.y)
+    new_index.append(len(moves))
+    commands = tuple((new_index[i], c) for i, c in program.commands)
     dropped = len(program.moves) - len(moves)
     warning = (
         f"{target} has no Z axis: {dropped} Z-only move(s) dropped and Z removed from the "
         f"others ({len(depths)} Z level(s) in the program); set the depth by hand"
     )
     return dataclasses.replace(
-        program, moves=tuple(moves), warnings=(*program.warnings, warning), lines=()
+        program,
+        moves=tuple(moves),
+        warnings=(*program.warnings, warning),
+        lines=(),
+        commands=commands,
     )
 
 
@@ -133,6 +161,8 @@ def post_drawing(
     tolerance: float = 0.001,
     scale: float = 1.0,
     fit_mm: tuple[float, float] | None = None,
+    fmt: str | None = None,
+    spindle_rpm: float | None = None,
 ) -> PostJob:
     """Plan a drawing and post it for a target.
 
@@ -145,6 +175,9 @@ def post_drawing(
         tolerance: chaining tolerance, mm.
         scale: uniform scale of the drawing about its origin.
         fit_mm: scale the drawing to fit ``(width, height)`` mm instead.
+        fmt: the dialect's output format (``None``: its default).
+        spindle_rpm: spindle speed, rev/min; ``None`` takes the target's
+            ``spindle_rpm`` (which may be none), 0 programs no spindle.
 
     Raises:
         CamtoolError: from any stage, with its exit code.
@@ -158,8 +191,10 @@ def post_drawing(
         fit_mm=fit_mm,
     )
     program = plan(drawing, options)
+    program = _with_spindle(program, target.spindle_rpm if spindle_rpm is None else spindle_rpm)
     edge = tool_diameter / 2.0 if offset != "on" else 0.0
-    return PostJob(drawing, program, target, target.emit(program), place(drawing, options), edge)
+    result = target.emit(program, fmt=fmt)
+    return PostJob(drawing, program, target, result, place(drawing, options), edge)
 
 
 def verify_job(job: PostJob) -> Verification:
@@ -172,7 +207,7 @@ def verify_job(job: PostJob) -> Verification:
     from camtool.verify.verifier import verify_code
 
     return verify_code(
-        str(job.result.code),
+        job.result.code,
         job.target,
         source=f"<{job.target.name} code>",
         against=job.placed,

@@ -12,13 +12,18 @@ before it (or :attr:`Program.origin` for the first). ``z`` is ``None`` when the
 move does not change Z (2D machines never set it). ``contour`` is the 1-based
 number of the toolpath contour a move belongs to (0 for none), used by
 messages such as "contour 3, block 12".
+
+Non-motion instructions (spindle, dwell, tool change, return to machine zero)
+are :data:`Command` values held beside the moves in :attr:`Program.commands`,
+each with the index of the move it comes before; motion consumers (planner,
+simulator, metrics) never see them.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass, field
-from typing import TypeAlias
+from typing import Literal, TypeAlias
 
 from camtool.geometry import Arc, BBox, Line, Point, Segment, bbox_union
 
@@ -64,6 +69,48 @@ class ArcMove:
 
 Move: TypeAlias = Rapid | Linear | ArcMove
 
+SpindleDirection: TypeAlias = Literal["cw", "ccw", "off"]
+
+
+@dataclass(frozen=True)
+class Spindle:
+    """Spindle on clockwise (M03), counter-clockwise (M04) or off (M05).
+
+    ``rpm`` is the programmed speed, rev/min (ignored when ``direction`` is "off").
+    """
+
+    direction: SpindleDirection
+    rpm: float = 0.0
+
+
+@dataclass(frozen=True)
+class Dwell:
+    """Wait ``seconds`` before the next move (G04)."""
+
+    seconds: float
+
+
+@dataclass(frozen=True)
+class ToolChange:
+    """Change to tool (magazine position) ``tool`` (M06 T)."""
+
+    tool: int
+
+
+@dataclass(frozen=True)
+class Home:
+    """Return to machine zero on ``axes`` ("XY", "Z" or "XYZ") at rapid speed (G28).
+
+    Machine zero is not the part zero, so a program's XY path after a Home is
+    only known again from its next absolute move.
+    """
+
+    axes: str = "XY"
+
+
+Command: TypeAlias = Spindle | Dwell | ToolChange | Home
+"""A non-motion instruction (see :attr:`Program.commands`)."""
+
 
 @dataclass(frozen=True)
 class Program:
@@ -73,16 +120,50 @@ class Program:
     unless said otherwise). ``warnings`` carry what the planner or reader had to
     tell the user. ``lines`` gives, for a program read from code, the 1-based
     source line of each move (empty otherwise), so reports can point at a block.
+    ``commands`` holds ``(index, command)`` pairs in program order: ``command``
+    runs before ``moves[index]`` (``index == len(moves)``: after the last move).
     """
 
     moves: tuple[Move, ...]
     origin: Point = (0.0, 0.0)
     warnings: tuple[str, ...] = field(default=())
     lines: tuple[int, ...] = field(default=())
+    commands: tuple[tuple[int, Command], ...] = field(default=())
+
+    def __post_init__(self) -> None:
+        indices = [i for i, _ in self.commands]
+        if indices != sorted(indices) or any(not 0 <= i <= len(self.moves) for i in indices):
+            raise ValueError(f"command indices must be sorted within 0..{len(self.moves)}")
 
     def with_moves(self, moves: tuple[Move, ...]) -> Program:
-        """A copy holding ``moves`` instead (source lines dropped)."""
+        """A copy holding ``moves`` instead (source lines and commands dropped)."""
         return Program(moves, self.origin, self.warnings)
+
+    def commands_before(self, index: int) -> tuple[Command, ...]:
+        """The commands that run before ``moves[index]`` (or after the last, ``len(moves)``)."""
+        return tuple(c for i, c in self.commands if i == index)
+
+    def items(self) -> Iterator[Move | Command]:
+        """Moves and commands interleaved in program order (what a dialect writes)."""
+        pending = list(self.commands)
+        for index, move in enumerate(self.moves):
+            while pending and pending[0][0] == index:
+                yield pending.pop(0)[1]
+            yield move
+        for _, command in pending:
+            yield command
+
+    def with_spindle(self, rpm: float, direction: SpindleDirection = "cw") -> Program:
+        """A copy that starts the spindle before the first move and stops it after the last.
+
+        Raises:
+            ValueError: ``rpm`` is not positive or ``direction`` is "off".
+        """
+        if rpm <= 0 or direction == "off":
+            raise ValueError("spindle speed must be > 0 rev/min and the direction cw or ccw")
+        end = len(self.moves)
+        commands = ((0, Spindle(direction, rpm)), *self.commands, (end, Spindle("off")))
+        return Program(self.moves, self.origin, self.warnings, self.lines, commands)
 
     def line_of(self, index: int) -> int | None:
         """Source line of move ``index``, or None when the program was not read from code."""

@@ -1,7 +1,15 @@
 """Regenerate the generated parts of docs/ from samples/ (run: ``make docs``).
 
-For each target page it writes the sample program between the markers
-``<!-- sample:begin -->`` / ``<!-- sample:end -->`` and the preview picture
+Every target page ``docs/targets/<target>.md`` names its bundled sample in
+its marker, with optional ``post`` options::
+
+    <!-- sample:begin logo.dxf scale=2 format=dump -->
+    (generated)
+    <!-- sample:end -->
+
+(options: ``scale``, ``feed``, ``format``, ``offset``, ``tool_diameter``,
+``fit=WxH``). The page gets the posted program between the markers (at most
+:data:`MAX_LINES` lines) and the preview picture
 ``docs/targets/<target>-<sample>.svg``; for docs/verify.md the verify summary of
 the pic-mmh sample between ``<!-- verify:begin -->`` / ``<!-- verify:end -->``
 and its preview ``docs/targets/pic-mmh-logo-verify.png``. ``--check`` only
@@ -17,13 +25,15 @@ import sys
 from pathlib import Path
 
 from camtool.pipeline import post_file, verify_job
+from camtool.post.registry import target_names
 from camtool.preview import program_svg
 from camtool.preview_trace import write_trace_preview
 from camtool.verify.verifier import summary_lines
 
 ROOT = Path(__file__).resolve().parents[1]
-SAMPLES = {"pic-mmh": "logo.dxf"}
-_BLOCK = re.compile(r"(<!-- sample:begin -->\n).*?(<!-- sample:end -->)", re.S)
+MAX_LINES = 60
+"""Longest example shown on a target page; longer ones are cut with a note."""
+_BLOCK = re.compile(r"(<!-- sample:begin ([^>]*?) -->\n).*?(<!-- sample:end -->)", re.S)
 _VERIFY = re.compile(r"(<!-- verify:begin -->\n).*?(<!-- verify:end -->)", re.S)
 VERIFY_PNG = ROOT / "docs" / "targets" / "pic-mmh-logo-verify.png"
 
@@ -31,8 +41,16 @@ VERIFY_PNG = ROOT / "docs" / "targets" / "pic-mmh-logo-verify.png"
 def generated() -> dict[Path, str]:
     """Every generated docs file with its current content."""
     files: dict[Path, str] = {}
-    for target, sample in SAMPLES.items():
-        job = post_file(ROOT / "samples" / sample, target)
+    for target in target_names():
+        page = ROOT / "docs" / "targets" / f"{target}.md"
+        text = page.read_text(encoding="utf-8")
+        marker = _BLOCK.search(text)
+        if marker is None:
+            raise SystemExit(f"{page}: no <!-- sample:begin SAMPLE [options] --> marker")
+        sample, *words = marker[2].split()
+        options = dict(word.split("=", 1) for word in words)
+        fmt = options.pop("format", None)
+        job = post_file(ROOT / "samples" / sample, target, fmt=fmt, **_options(options))
         stem = Path(sample).stem
         svg = program_svg(
             job.program,
@@ -40,16 +58,43 @@ def generated() -> dict[Path, str]:
             title=f"samples/{sample} → {target}",
         )
         files[ROOT / "docs" / "targets" / f"{target}-{stem}.svg"] = svg
-        page = ROOT / "docs" / "targets" / f"{target}.md"
-        block = f"```\n{job.result.code}```\n"
-        text = page.read_text(encoding="utf-8")
-        files[page] = _BLOCK.sub(lambda m, block=block: m[1] + block + m[2], text)
+        block = f"```\n{_shown(job.result.code)}```\n"
+        files[page] = text[: marker.start()] + marker[1] + block + marker[3] + text[marker.end() :]
     job = post_file(ROOT / "samples" / "logo.dxf", "pic-mmh")
     lines = "".join(f"camtool: {line}\n" for line in summary_lines(verify_job(job)))
     page = ROOT / "docs" / "verify.md"
     text = page.read_text(encoding="utf-8")
     files[page] = _VERIFY.sub(lambda m: m[1] + f"```\n{lines}```\n" + m[2], text)
     return files
+
+
+def _options(words: dict[str, str]) -> dict[str, object]:
+    """``post_drawing`` keyword options from a marker's ``key=value`` words."""
+    out: dict[str, object] = {}
+    for key, value in words.items():
+        if key == "fit":
+            w, h = value.lower().split("x")
+            out["fit_mm"] = (float(w), float(h))
+        elif key == "offset":
+            out[key] = value
+        elif key in ("scale", "tool_diameter"):
+            out[key] = float(value)
+        elif key == "feed":
+            out["feed_mm_min"] = float(value)
+        else:
+            raise SystemExit(f"unknown sample option {key!r}")
+    return out
+
+
+def _shown(code: str | bytes) -> str:
+    """The example as shown on a page: text, cut after :data:`MAX_LINES` lines."""
+    if isinstance(code, bytes):
+        raise SystemExit("a binary format cannot be shown on a page: use format=dump")
+    lines = code.splitlines(keepends=True)
+    if len(lines) <= MAX_LINES:
+        return code
+    rest = len(lines) - MAX_LINES
+    return "".join(lines[:MAX_LINES]) + f"… ({rest} more lines)\n"
 
 
 def verify_png() -> bytes:

@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 from typing import ClassVar
 
+from camtool.errors import UsageError
 from camtool.machine import Machine
 from camtool.program import Program
 
@@ -15,14 +18,17 @@ class PostResult:
     """Emitted code and what the post-processor had to say.
 
     Attributes:
-        code: the program in the dialect (``str`` for text dialects).
-        blocks: number of blocks (lines) written.
+        code: the program in the dialect (``str`` for text formats, ``bytes``
+            for binary ones).
+        blocks: number of blocks (lines, packets, jobs) written.
         warnings: messages for the user (rounded feeds, rate limits...).
+        format: the output format written (a key of ``PostProcessor.formats``).
     """
 
     code: str | bytes
     blocks: int
     warnings: tuple[str, ...] = ()
+    format: str = "code"
 
 
 class PostProcessor(ABC):
@@ -33,25 +39,48 @@ class PostProcessor(ABC):
     resolution.
     """
 
-    suffix: ClassVar[str] = ".nc"
-    """File name ending for programs in this dialect."""
+    formats: ClassVar[Mapping[str, str]] = MappingProxyType({"code": ".nc"})
+    """Output formats this dialect writes (``--format``), each with its file
+    ending; the first is the default. ``parse`` reads every one of them."""
+
+    binary: ClassVar[bool] = False
+    """True when code files are read as bytes (``parse`` gets ``bytes``)."""
+
+    @property
+    def suffix(self) -> str:
+        """File name ending of the default format."""
+        return next(iter(self.formats.values()))
+
+    def check_format(self, fmt: str | None) -> str:
+        """``fmt`` (``None``: the default format) checked against :attr:`formats`.
+
+        Raises:
+            UsageError: this dialect has no such format (the message lists them).
+        """
+        if fmt is None:
+            return next(iter(self.formats))
+        if fmt not in self.formats:
+            known = ", ".join(self.formats)
+            raise UsageError(f"unknown format {fmt!r}; this target writes: {known}")
+        return fmt
 
     @abstractmethod
-    def emit(self, program: Program, machine: Machine) -> PostResult:
-        """Write ``program`` for ``machine``.
+    def emit(self, program: Program, machine: Machine, *, fmt: str | None = None) -> PostResult:
+        """Write ``program`` for ``machine`` in format ``fmt`` (default: the first).
 
         Raises:
             DialectError: something the dialect or the machine cannot express,
                 naming the contour and block.
+            UsageError: ``fmt`` is not one of :attr:`formats`.
         """
 
     @abstractmethod
-    def parse(self, code: str, *, source: str = "<code>") -> Program:
-        """Read code in this dialect back into a program.
+    def parse(self, code: str | bytes, *, source: str = "<code>") -> Program:
+        """Read code in this dialect (any of its formats) back into a program.
 
         Raises:
             ParseError: a block does not follow the dialect, naming ``source``
-                and the line.
+                and the line (or byte offset).
         """
 
 
@@ -66,6 +95,9 @@ class Target:
         machine: the machine profile.
         default_feed_mm_min: feed used when ``--feed`` is not given, mm/min.
         source: the thesis section the target comes from.
+        spindle_rpm: spindle speed programmed when ``--spindle-rpm`` is not
+            given, rev/min; ``None`` programs no spindle commands.
+        origin: where the target was found: "builtin", "plugin" or a file path.
     """
 
     name: str
@@ -74,7 +106,9 @@ class Target:
     machine: Machine
     default_feed_mm_min: float
     source: str = ""
+    spindle_rpm: float | None = None
+    origin: str = "builtin"
 
-    def emit(self, program: Program) -> PostResult:
-        """Write ``program`` in this target's dialect for its machine."""
-        return self.post.emit(program, self.machine)
+    def emit(self, program: Program, *, fmt: str | None = None) -> PostResult:
+        """Write ``program`` in this target's dialect for its machine (format ``fmt``)."""
+        return self.post.emit(program, self.machine, fmt=fmt)

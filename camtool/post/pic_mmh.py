@@ -22,7 +22,10 @@ block, verbatim from the thesis (L1731)::
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import ClassVar
 
 from camtool.errors import DialectError, ParseError
 from camtool.geometry import distance
@@ -56,7 +59,7 @@ class PicMmhPost(PostProcessor):
         feed_unit_mm_min: mm/min per unit of the F word (default 0.1, S000-05).
     """
 
-    suffix = ".pic"
+    formats: ClassVar[Mapping[str, str]] = MappingProxyType({"code": ".pic"})
 
     def __init__(self, *, sign: str = "negative", feed_unit_mm_min: float = 0.1) -> None:
         self.coord = NumberFormat(scale=1000.0, decimals=2, int_digits=5, sign=sign)
@@ -64,7 +67,7 @@ class PicMmhPost(PostProcessor):
 
     # -- writing ---------------------------------------------------------------
 
-    def emit(self, program: Program, machine: Machine) -> PostResult:
+    def emit(self, program: Program, machine: Machine, *, fmt: str | None = None) -> PostResult:
         """Write ``program`` as pic-mmh blocks.
 
         Raises:
@@ -72,6 +75,7 @@ class PicMmhPost(PostProcessor):
                 outside F01–F99, or a point (arcs by their extremes) outside the
                 machine's work area; the message names the contour and block.
         """
+        self.check_format(fmt)
         w = _Writer(["G54;", "G90;"])
         fast_feeds: set[str] = set()
         for start, move in program.steps():
@@ -149,7 +153,7 @@ class PicMmhPost(PostProcessor):
 
     # -- reading ---------------------------------------------------------------
 
-    def parse(self, code: str, *, source: str = "<code>") -> Program:
+    def parse(self, code: str | bytes, *, source: str = "<code>") -> Program:
         """Read pic-mmh blocks back into moves (the grammar of seed-000 §3.6).
 
         ``G04``, ``G28``, ``G54``, ``G90``, ``M03/M04/M05/M06`` and ``M30`` are
@@ -159,6 +163,8 @@ class PicMmhPost(PostProcessor):
             ParseError: a line that is not a pic-mmh block, or a G01–G03 block
                 before any feed, naming ``source`` and the line number.
         """
+        if isinstance(code, bytes):
+            code = code.decode("ascii", errors="replace")
         moves: list[Move] = []
         lines: list[int] = []
         contour = 0

@@ -81,7 +81,7 @@ class Verification:
 
 
 def verify_code(
-    code: str,
+    code: str | bytes,
     target: Target,
     *,
     source: str = "<code>",
