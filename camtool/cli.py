@@ -442,6 +442,11 @@ def _target_json(entry: TargetEntry) -> dict[str, Any]:
     }
 
 
+# -- preview command (camtool/cli_preview.py) --
+
+# -- batch command (camtool/cli_batch.py) --
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; turn every error into a message and an exit code, never a traceback."""
     try:
