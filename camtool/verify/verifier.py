@@ -16,7 +16,7 @@ import numpy as np
 from camtool.errors import UsageError
 from camtool.geometry import Drawing
 from camtool.machine import Machine
-from camtool.program import Program, Rapid
+from camtool.program import Dwell, Home, Program, Rapid
 from camtool.verify.metrics import (
     Against,
     ContourMeasure,
@@ -63,9 +63,14 @@ class Verification:
     warnings: tuple[str, ...] = field(default=())
 
     @property
+    def dwell_s(self) -> float:
+        """Time the program's dwells (G04) add, s."""
+        return sum(c.seconds for _, c in self.program.commands if isinstance(c, Dwell))
+
+    @property
     def time_s(self) -> float:
-        """Estimated machining time, s."""
-        return float(self.block_time_s.sum())
+        """Estimated machining time, s: every move's time plus the dwells."""
+        return float(self.block_time_s.sum()) + self.dwell_s
 
     @property
     def max_error_um(self) -> float:
@@ -159,6 +164,12 @@ def block_times(trace: StepTrace, program: Program, machine: Machine) -> np.ndar
 
 def _warnings(program: Program, trace: StepTrace) -> list[str]:
     out = list(program.warnings)
+    homes = sum(isinstance(c, Home) for _, c in program.commands)
+    if homes:
+        out.append(
+            f"{homes} return(s) to machine zero (G28) not simulated: machine zero is not "
+            "the part zero, so the move after each is simulated from where the one before ended"
+        )
     box = program.bbox(cutting_only=True)
     size = max(box[2] - box[0], box[3] - box[1])
     if trace.compensations > MAX_COMPENSATIONS_SMALL and size < SMALL_PART_MM:
