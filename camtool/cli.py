@@ -246,6 +246,11 @@ def post(
     else:
         job = post_drawing(_read_input(drawing, settings), chosen, **options)
     _warn(job.warnings)
+    if isinstance(job.result.code, bytes) and output == "-" and sys.stdout.isatty():
+        raise UsageError(
+            f"{chosen.name} writes binary code: give -o FILE{chosen.post.suffix} or "
+            "pipe stdout (or choose a text --format)"
+        )
     _write(job.result.code, output)
     if output != "-":
         click.echo(

@@ -25,7 +25,7 @@ import sys
 from pathlib import Path
 
 from camtool.pipeline import post_file, verify_job
-from camtool.post.registry import target_names
+from camtool.post.registry import load_target, target_names
 from camtool.preview import program_svg
 from camtool.preview_trace import write_trace_preview
 from camtool.verify.verifier import summary_lines
@@ -34,6 +34,7 @@ ROOT = Path(__file__).resolve().parents[1]
 MAX_LINES = 60
 """Longest example shown on a target page; longer ones are cut with a note."""
 _BLOCK = re.compile(r"(<!-- sample:begin ([^>]*?) -->\n).*?(<!-- sample:end -->)", re.S)
+_TARGETS = re.compile(r"(<!-- targets:begin -->\n).*?(<!-- targets:end -->)", re.S)
 _VERIFY = re.compile(r"(<!-- verify:begin -->\n).*?(<!-- verify:end -->)", re.S)
 VERIFY_PNG = ROOT / "docs" / "targets" / "pic-mmh-logo-verify.png"
 
@@ -60,12 +61,29 @@ def generated() -> dict[Path, str]:
         files[ROOT / "docs" / "targets" / f"{target}-{stem}.svg"] = svg
         block = f"```\n{_shown(job.result.code)}```\n"
         files[page] = text[: marker.start()] + marker[1] + block + marker[3] + text[marker.end() :]
+    index = ROOT / "docs" / "targets" / "index.md"
+    table = targets_table()
+    text = index.read_text(encoding="utf-8")
+    files[index] = _TARGETS.sub(lambda m: m[1] + table + m[2], text)
     job = post_file(ROOT / "samples" / "logo.dxf", "pic-mmh")
     lines = "".join(f"camtool: {line}\n" for line in summary_lines(verify_job(job)))
     page = ROOT / "docs" / "verify.md"
     text = page.read_text(encoding="utf-8")
     files[page] = _VERIFY.sub(lambda m: m[1] + f"```\n{lines}```\n" + m[2], text)
     return files
+
+
+def targets_table() -> str:
+    """The Markdown table of the built-in targets for docs/targets/index.md."""
+    rows = [
+        "| target | machine | formats | from |",
+        "|---|---|---|---|",
+    ]
+    for name in target_names():
+        t = load_target(name)
+        formats = ", ".join(f"`{f}` ({suffix})" for f, suffix in t.post.formats.items())
+        rows.append(f"| [`{name}`]({name}.md) | {t.machine.name} | {formats} | {t.source} |")
+    return "\n".join(rows) + "\n"
 
 
 def _options(words: dict[str, str]) -> dict[str, object]:
