@@ -1,7 +1,7 @@
 """G-code importer: RS-274 programs as CAM programs write them, read into a Program.
 
 Reads G0/G1/G2/G3 (I/J centre and R-form arcs, G90.1/G91.1), G17, G20/G21,
-G90/G91, F, S, T, M3/M4/M5/M2/M30, N-words, comments, ``%`` lines, modal motion
+G90/G91, F, S, T, M3/M4/M5/M6, G4, G28, M2/M30, N-words, comments, ``%`` lines, modal motion
 and modal words — including the FlashCut programs of seed-001 §3 (R1–R5) and
 the Inkscape Gcodetools ``.ngc`` files of seed-004 §3.3 (S004-R07). Lines are
 split into words by :mod:`camtool.importers.gcode_lexer`; the codes and what is
@@ -30,9 +30,12 @@ Rules (RS-274/NGC as LinuxCNC documents them, unless said otherwise):
 - Contours: 1-based; a rapid after cutting moves starts the next contour.
 - ``Program.origin`` is (0, 0): the program's own zero. ``Program.lines`` holds
   the 1-based file line of each move.
-- G28/G30: an intermediate point, if given, becomes a rapid; the move to the
-  stored home is not in the program (warning), so the axes it moves become
-  unknown and the next moves must give them absolutely.
+- S, M3/M4/M5, T with M6, G4 P (seconds) and G28 are kept as
+  :attr:`Program.commands` (:mod:`camtool.importers.gcode_commands`).
+- G28/G30: an intermediate point, if given, becomes a rapid; G28 is then kept
+  as a ``Home`` command on the axes it names (all when none), G30 is not kept;
+  camtool does not know the stored position (warning), so the axes it moves
+  become unknown and the next moves must give them absolutely.
 - After M2/M30 nothing is read; remaining lines with words are warned about.
 """
 
@@ -45,8 +48,9 @@ from pathlib import Path
 from camtool.errors import InputError
 from camtool.geometry import Point
 from camtool.importers.gcode_codes import BlockWords, Notes
+from camtool.importers.gcode_commands import CommandReader
 from camtool.importers.gcode_lexer import Block, Word, lex_line
-from camtool.program import ArcMove, Linear, Move, Program, Rapid
+from camtool.program import ArcMove, Home, Linear, Move, Program, Rapid
 from camtool.units import INCH
 
 _ARC_TOL_MM = (0.005, 0.5)
@@ -114,6 +118,7 @@ class _Reader:
     def __init__(self, source: str) -> None:
         self.source = source
         self.notes = Notes(source)
+        self.commands = CommandReader(self.notes)
         self.moves: list[Move] = []
         self.lines: list[int] = []
         self.line = 0
@@ -172,12 +177,17 @@ class _Reader:
 
     def program(self) -> Program:
         """The program read, or InputError if it has no move."""
+        self.commands.finish()
         if not self.moves:
             raise InputError(
                 f"{self.source}: no move (G0, G1, G2, G3) found; is this a G-code program?"
             )
         return Program(
-            tuple(self.moves), (0.0, 0.0), self.notes.warnings(), lines=tuple(self.lines)
+            tuple(self.moves),
+            (0.0, 0.0),
+            self.notes.warnings(),
+            lines=tuple(self.lines),
+            commands=tuple(self.commands.commands),
         )
 
     # -- modes -------------------------------------------------------------------
@@ -190,16 +200,10 @@ class _Reader:
             if f.value < 0:
                 raise InputError(f"{self.where()}: negative feed {f}; feeds are > 0")
             self.feed_mm_min = f.value * self.scale
-        for letter, what in (("S", "spindle speed S"), ("T", "tool number T")):
-            if letter in w.args:
-                self.notes.add(
-                    letter, self.line, f"{what} ignored (the program has no {what[:-2]})"
-                )
+        self.commands.block(w, len(self.moves), self.line, self.where())
         for code in (*w.m.values(), *w.g.values()):
             if code.action == "warn":
                 self.notes.add(code.name, self.line, code.note)
-        if w.g_name("nonmodal") == "G4" and ("P" not in w.args or w.args["P"].value < 0):
-            raise InputError(f"{self.where()}: G4 dwell needs a P word (seconds, ≥ 0)")
         if (coord := w.g_name("coord")) is not None:
             if self.coord not in (None, coord):
                 raise InputError(
@@ -426,7 +430,11 @@ class _Reader:
         return mx + side * h * uy, my - side * h * ux
 
     def _home(self, name: str, args: dict[str, Word]) -> None:
-        """G28/G30: a rapid to the intermediate point, then the axes are unknown."""
+        """G28/G30: a rapid to the intermediate point, then the axes are unknown.
+
+        G28 is kept as a :class:`Home` command on the axes it names (all three
+        when it names none); G30 (a second stored position) is not a command.
+        """
         axes = [letter for letter in "XYZ" if letter in args]
         if axes:
             tx, ty, tz = self._target(args)
@@ -440,10 +448,17 @@ class _Reader:
         for letter in axes or "XYZ":
             setattr(self, letter.lower(), None)
         self.home = f"{name} on line {self.line}"
+        if name == "G28":
+            self.commands.add(len(self.moves), Home("".join(axes) or "XYZ"))
+            kept = (
+                "kept as a return-to-machine-zero command, but camtool does not know that "
+                "position, so the verifier does not simulate the move"
+            )
+        else:
+            kept = "that move is not in the program (camtool does not know the position)"
         self.notes.add(
             name,
             self.line,
-            f"{name} return to the machine's stored position: that move is not in the "
-            "program (camtool does not know the position); moves after it must give "
-            "absolute X and Y",
+            f"{name} return to the machine's stored position: {kept}; moves after it must "
+            "give absolute X and Y",
         )

@@ -2,9 +2,10 @@
 
 Three actions (docs/importers/gcode.md lists them for users):
 
-- ``read``: part of the program camtool reads (motion, units, distance modes…);
+- ``read``: part of the program camtool reads (motion, units, distance modes…,
+  and spindle, dwell, tool change and G28, kept as program commands);
 - ``warn``: harmless for the XY(Z) path, converted or dropped with one warning per
-  code (count and first line) — dwell, coolant, work offset assumed 0…;
+  code (count and first line) — program pauses, coolant, work offset assumed 0…;
 - ``error``: would change the path in a way camtool cannot represent (cutter
   compensation, canned cycles, other planes…); refused naming the line.
 
@@ -75,7 +76,7 @@ G_CODES = MappingProxyType(
         ("G90.1 G91.1", "arc_distance", "read", ""),
         ("G94", "feed_mode", "read", ""),
         ("G20 G21", "units", "read", ""),
-        ("G4", "nonmodal", "warn", "G4 dwell dropped: the program carries no pauses"),
+        ("G4", "nonmodal", "read", ""),
         ("G28 G30", "nonmodal", "read", ""),
         ("G40", "cutter", "warn", "G40 (cutter compensation off) read as a no-op"),
         ("G43", "length", "warn", "G43 tool length offset assumed 0: Z is read as written"),
@@ -148,18 +149,13 @@ M_CODES = MappingProxyType(
         ("M2 M30", "stop", "read", ""),
         ("M3 M4 M5", "spindle", "read", ""),
         ("M0 M1", "stop", "warn", "{code} program pause dropped: the program carries no stops"),
-        (
-            "M6",
-            "tool",
-            "warn",
-            "M6 tool change ignored: camtool cuts the whole program with one tool",
-        ),
+        ("M6", "tool", "read", ""),
         ("M7 M8 M9", "coolant", "warn", "coolant {code} ignored"),
     )
 )
 """M codes by number, read-only."""
 
-READ_CODES = "G0 G1 G2 G3 G17 G20 G21 G28 G30 G80 G90 G91 G90.1 G91.1 G94 M2 M3 M4 M5 M30"
+READ_CODES = "G0 G1 G2 G3 G4 G17 G20 G21 G28 G30 G80 G90 G91 G90.1 G91.1 G94 M2 M3 M4 M5 M6 M30"
 """What camtool reads, for messages about unknown codes."""
 
 WORD_LETTERS = frozenset("GMNXYZIJKRFSTPH")

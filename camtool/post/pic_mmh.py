@@ -11,176 +11,327 @@ block, verbatim from the thesis (L1731)::
   for negatives (or ``+`` too with ``sign = "always"``), 5 zero-padded integer
   digits, ``.``, 2 decimals (S000-02, S000-03);
 - ``I``/``J`` are the ABSOLUTE arc centre, same format (S000-04);
-- ``F`` is two zero-padded digits in units of 0.1 mm/min: ``F08`` = 0.8 mm/min
-  (S000-05); F01…F99 only;
-- programs open with ``G54;`` ``G90;`` and close with ``M30;`` (S000-06);
+- ``F`` is two zero-padded digits; by default in units of 0.1 mm/min (``F08``
+  = 0.8 mm/min), or an explicit code table (S000-05,
+  :mod:`camtool.post.pic_mmh_feeds`);
+- programs open with ``G54;`` ``G90;`` and close with ``M30;``; the commands of
+  :attr:`Program.commands` are ``M03S####;`` / ``M04S####;`` / ``M05;``,
+  ``G04P##;``, ``M06T##;`` and ``G28X0Y0;`` / ``G28Z0;`` (S000-06, Tablas 21–22);
 - no Z words (S000-08): a program that moves Z is refused;
 - a full circle is written as two half arcs (the firmware takes the start from
   its current position; a zero-length G02 is ambiguous, seed-000 §3.7 item 7).
+
+The mode strings of the host link (``JX+;``, ``BX200;`` …) are in
+:mod:`camtool.post.pic_mmh_modes`.
 """
 
 from __future__ import annotations
 
+import math
 import re
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
+from decimal import ROUND_HALF_UP, Decimal
 from types import MappingProxyType
-from typing import ClassVar
+from typing import Any, ClassVar
 
 from camtool.errors import DialectError, ParseError
 from camtool.geometry import distance
 from camtool.machine import Machine
 from camtool.post.base import PostProcessor, PostResult
 from camtool.post.numfmt import NumberFormat, format_int
-from camtool.program import ArcMove, Linear, Move, Program, Rapid, segment_of
+from camtool.post.pic_mmh_feeds import FeedTable
+from camtool.program import (
+    ArcMove,
+    Command,
+    Dwell,
+    Home,
+    Linear,
+    Move,
+    Program,
+    Rapid,
+    Spindle,
+    ToolChange,
+    segment_of,
+)
 
 _COORD = r"([+-]?\d{5}\.\d{2})"
 _BLOCK = re.compile(rf"^G0(?P<g>[0-3])X{_COORD}Y{_COORD}(?:I{_COORD}J{_COORD})?(?:F(?P<f>\d\d))?;$")
-_AUX = re.compile(r"^(?:G54|G90|M30|M05|G04P\d\d|G28X0Y0|G28Z0|M0[34]S\d{4}|M06T\d\d);$")
+_FRAME = frozenset({"G54;", "G90;", "M30;"})
+_FIXED: Mapping[str, Command] = MappingProxyType(
+    {"M05;": Spindle("off"), "G28X0Y0;": Home("XY"), "G28Z0;": Home("Z")}
+)
+_ARGS = re.compile(r"^(?:G04P(?P<p>\d\d)|M0(?P<m>[34])S(?P<s>\d{4})|M06T(?P<t>\d\d));$")
+
+MAX_DWELL_S = 99
+"""Longest dwell of one ``G04P##;`` block, s (2 digits, seed-000 L3359–L3366)."""
+MAX_RPM = 9999
+"""Highest spindle speed of ``M03S####;``, rev/min (4 digits, seed-000 L3418–L3436)."""
+MAX_TOOL = 99
+"""Highest magazine position of ``M06T##;`` (2 digits, seed-000 L3455–L3464)."""
+BUFFER_CHARS = 35
+"""The firmware's receive vector ``CadenaControl`` (seed-000 L1739–L1744, S000-07)."""
 
 
 @dataclass
 class _Writer:
-    """Accumulates blocks; knows the contour and block number for messages."""
+    """Accumulates blocks and notes; knows the contour and block number for messages."""
 
     lines: list[str] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
+    notes: dict[str, tuple[str, int]] = field(default_factory=dict)
+    fast: dict[int, list[tuple[int, int]]] = field(default_factory=dict)
 
-    def where(self, move: Move) -> str:
+    def where(self, contour: int) -> str:
         block = len(self.lines) + 1
-        return f"contour {move.contour}, block {block}" if move.contour else f"block {block}"
+        return f"contour {contour}, block {block}" if contour else f"block {block}"
+
+    def note(self, kind: str, message: str) -> None:
+        """Count one conversion of ``kind``; the first message of a kind is kept."""
+        first, count = self.notes.get(kind, (message, 0))
+        self.notes[kind] = (first, count + 1)
+
+    def all_warnings(self) -> tuple[str, ...]:
+        counted = [m + (f" ({n} times)" if n > 1 else "") for m, n in self.notes.values()]
+        return (*self.warnings, *counted)
 
 
 class PicMmhPost(PostProcessor):
     """Writer and reader of the pic-mmh dialect (seed-000 §3).
 
     Args:
-        sign: ``"negative"`` (default, as the thesis example) or ``"always"``.
-        feed_unit_mm_min: mm/min per unit of the F word (default 0.1, S000-05).
+        sign: ``"negative"`` (default, as the thesis example L1731: ``-`` only)
+            or ``"always"`` (``+`` before positives too, as the templates
+            ``X±`` show; S000-03). The issue's ``always_sign = true`` is
+            ``sign = "always"``.
+        feed_unit_mm_min: mm/min per unit of the F word: codes F01–F99 mean
+            1–99 units (default 0.1, S000-05). Not with ``feed_codes``.
+        feed_codes: an explicit table code → mm/min (``{"08": 0.8, ...}``) for a
+            firmware that maps F codes to its own speeds
+            (:meth:`FeedTable.from_option`). Not with ``feed_unit_mm_min``.
+        max_line_chars: warn about blocks longer than this many characters,
+            ``;`` included (S000-07 suggests 35, the receive buffer; off by
+            default because the thesis's own G02 example has 43).
+
+    Raises:
+        ValueError: an unknown sign policy, a feed unit that is not > 0, a bad
+            feed table, both feed options, or ``max_line_chars`` not an int ≥ 1.
     """
 
     formats: ClassVar[Mapping[str, str]] = MappingProxyType({"code": ".pic"})
 
-    def __init__(self, *, sign: str = "negative", feed_unit_mm_min: float = 0.1) -> None:
+    def __init__(
+        self,
+        *,
+        sign: str = "negative",
+        feed_unit_mm_min: float | None = None,
+        feed_codes: Mapping[Any, Any] | None = None,
+        max_line_chars: int | None = None,
+    ) -> None:
         self.coord = NumberFormat(scale=1000.0, decimals=2, int_digits=5, sign=sign)
-        self.feed_unit_mm_min = feed_unit_mm_min
+        if feed_codes is not None and feed_unit_mm_min is not None:
+            raise ValueError("give feed_unit_mm_min or feed_codes, not both")
+        if feed_codes is not None:
+            self.feeds = FeedTable.from_option(feed_codes)
+        elif feed_unit_mm_min is not None:
+            self.feeds = FeedTable.linear(feed_unit_mm_min)
+        else:
+            self.feeds = FeedTable.linear()
+        if max_line_chars is not None and (
+            isinstance(max_line_chars, bool)
+            or not isinstance(max_line_chars, int)
+            or max_line_chars < 1
+        ):
+            raise ValueError(f"max_line_chars must be a whole number ≥ 1, not {max_line_chars!r}")
+        self.max_line_chars = max_line_chars
 
     # -- writing ---------------------------------------------------------------
 
     def emit(self, program: Program, machine: Machine, *, fmt: str | None = None) -> PostResult:
-        """Write ``program`` as pic-mmh blocks.
+        """Write ``program`` (moves and commands) as pic-mmh blocks.
 
         Raises:
             DialectError: a Z move, a coordinate over 5 integer digits, a feed
-                outside F01–F99, or a point (arcs by their extremes) outside the
-                machine's work area; the message names the contour and block.
+                beyond the feed table, a point (arcs by their extremes) outside
+                the machine's work area, a cut right after ``G28X0Y0;``, or a
+                command out of its field (spindle 1–9999 rev/min, tool 0–99, a
+                negative dwell, a Home on axes other than XY, Z or XYZ); the
+                message names the contour and block.
         """
         self.check_format(fmt)
         w = _Writer(["G54;", "G90;"])
-        fast_feeds: set[str] = set()
-        for start, move in program.steps():
-            if move.z is not None:
-                raise DialectError(
-                    f"{w.where(move)}: pic-mmh has no Z word (seed-000 S000-08); "
-                    "set the depth by hand or use a target with a Z axis"
-                )
-            self._check_area(start, move, machine, w)
-            if isinstance(move, Rapid):
-                w.lines.append(f"G00{self._xy(move.x, move.y, move, w)};")
+        homed = False
+        for start, move, commands in _steps(program):
+            for command in commands:
+                homed = self._command(command, move.contour if move else 0, w) or homed
+            if move is None:
                 continue
-            f = self._feed(move, w)
-            if machine.max_step_rate_hz and machine.step_rate_hz(move.feed_mm_min) > (
-                machine.max_step_rate_hz
-            ):
-                fast_feeds.add(f)
-            if isinstance(move, Linear):
-                w.lines.append(f"G01{self._xy(move.x, move.y, move, w)}F{f};")
-            else:
-                for half in _halves(start, move):
-                    g = "G02" if half.clockwise else "G03"
-                    xy = self._xy(half.x, half.y, half, w)
-                    ij = self._word("I", half.cx, half, w) + self._word("J", half.cy, half, w)
-                    w.lines.append(f"{g}{xy}{ij}F{f};")
+            self._check_move(start, move, machine, w, homed)
+            homed = homed and not isinstance(move, Rapid)
+            self._move(start, move, machine, w)
         w.lines.append("M30;")
-        for f in sorted(fast_feeds):
-            rate = machine.step_rate_hz(int(f) * self.feed_unit_mm_min)
-            w.warnings.append(
-                f"F{f} needs {rate:.0f} steps/s but the serial link limits the machine to "
-                f"{machine.max_step_rate_hz:.0f} Hz (seed-000 S000-05); it will run slower"
+        self._rate_warnings(machine, w)
+        self._length_warning(w)
+        return PostResult("\n".join(w.lines) + "\n", len(w.lines), w.all_warnings())
+
+    def _check_move(
+        self, start: tuple[float, float], move: Move, machine: Machine, w: _Writer, homed: bool
+    ) -> None:
+        where = w.where(move.contour)
+        if move.z is not None:
+            raise DialectError(
+                f"{where}: pic-mmh has no Z word (seed-000 S000-08); "
+                "set the depth by hand or use a target with a Z axis"
             )
-        return PostResult("\n".join(w.lines) + "\n", len(w.lines), tuple(w.warnings))
+        if homed and not isinstance(move, Rapid):
+            raise DialectError(
+                f"{where}: a cut right after G28X0Y0; would start from machine zero, which "
+                "camtool does not know (the part zero is set by G54); go to the start of the "
+                "cut with a rapid (G00) first"
+            )
+        box = segment_of(start, move).bbox()
+        if machine.outside_work_area(box):
+            x0, y0, x1, y1 = machine.work_area_mm
+            raise DialectError(
+                f"{where}: reaches ({box[0]:.4f}, {box[1]:.4f})–({box[2]:.4f}, "
+                f"{box[3]:.4f}) mm, outside the {x1 - x0:g} × {y1 - y0:g} mm work area "
+                f"of {machine.name}; move the drawing or use --fit"
+            )
+
+    def _move(self, start: tuple[float, float], move: Move, machine: Machine, w: _Writer) -> None:
+        if isinstance(move, Rapid):
+            w.lines.append(f"G00{self._xy(move.x, move.y, move, w)};")
+            return
+        code, feed = self._feed(move, w)
+        if machine.max_step_rate_hz and machine.step_rate_hz(feed) > machine.max_step_rate_hz:
+            w.fast.setdefault(code, []).append((len(w.lines) + 1, move.contour))
+        f = format_int(code, 2, what="feed code")
+        if isinstance(move, Linear):
+            w.lines.append(f"G01{self._xy(move.x, move.y, move, w)}F{f};")
+            return
+        for half in _halves(start, move):
+            g = "G02" if half.clockwise else "G03"
+            xy = self._xy(half.x, half.y, half, w)
+            ij = self._word("I", half.cx, half, w) + self._word("J", half.cy, half, w)
+            w.lines.append(f"{g}{xy}{ij}F{f};")
 
     def _word(self, letter: str, value_mm: float, move: Move, w: _Writer) -> str:
         try:
             return letter + self.coord.format(value_mm)
         except DialectError as exc:
             raise DialectError(
-                f"{w.where(move)}: {letter} = {exc} (µm; at most 99999.99 = 99.99999 mm)"
+                f"{w.where(move.contour)}: {letter} = {exc} (µm; at most 99999.99 = 99.99999 mm)"
             ) from exc
 
     def _xy(self, x: float, y: float, move: Move, w: _Writer) -> str:
         return self._word("X", x, move, w) + self._word("Y", y, move, w)
 
-    def _feed(self, move: Linear | ArcMove, w: _Writer) -> str:
-        exact = move.feed_mm_min / self.feed_unit_mm_min
-        code = int(exact + 0.5)
-        if not 1 <= code <= 99:
-            lo, hi = self.feed_unit_mm_min, 99 * self.feed_unit_mm_min
+    def _feed(self, move: Linear | ArcMove, w: _Writer) -> tuple[int, float]:
+        """The feed code written for ``move`` and the feed it means, mm/min."""
+        found = self.feeds.nearest(move.feed_mm_min)
+        if found is None:
+            (lo, lo_feed), (hi, hi_feed) = self.feeds.lowest, self.feeds.highest
             raise DialectError(
-                f"{w.where(move)}: feed {move.feed_mm_min:g} mm/min is outside F01–F99 "
-                f"({lo:g}–{hi:g} mm/min)"
+                f"{w.where(move.contour)}: feed {move.feed_mm_min:g} mm/min is outside "
+                f"F{lo:02d}–F{hi:02d} ({lo_feed:g}–{hi_feed:g} mm/min)"
             )
-        text = format_int(code, 2, what="feed code")
-        if abs(exact - code) > 1e-6:
-            msg = (
-                f"feed {move.feed_mm_min:g} mm/min rounded to F{text} "
-                f"({code * self.feed_unit_mm_min:g} mm/min)"
-            )
+        code, feed = found
+        if abs(feed - move.feed_mm_min) > 1e-9 * max(1.0, feed):
+            msg = f"feed {move.feed_mm_min:g} mm/min rounded to F{code:02d} ({feed:g} mm/min)"
             if msg not in w.warnings:
                 w.warnings.append(msg)
-        return text
+        return code, feed
 
-    @staticmethod
-    def _check_area(start: tuple[float, float], move: Move, machine: Machine, w: _Writer) -> None:
-        box = segment_of(start, move).bbox()
-        if machine.outside_work_area(box):
-            x0, y0, x1, y1 = machine.work_area_mm
-            raise DialectError(
-                f"{w.where(move)}: reaches ({box[0]:.4f}, {box[1]:.4f})–({box[2]:.4f}, "
-                f"{box[3]:.4f}) mm, outside the {x1 - x0:g} × {y1 - y0:g} mm work area "
-                f"of {machine.name}; move the drawing or use --fit"
+    def _rate_warnings(self, machine: Machine, w: _Writer) -> None:
+        """S000-05: one warning per feed code whose step rate is over the machine's cap."""
+        cap = machine.max_step_rate_hz
+        for code, where in sorted(w.fast.items()):
+            feed = self.feeds.feed_of(code) or 0.0
+            capped_feed = cap * 60.0 / max(machine.steps_per_mm[:2])
+            blocks = _listing("block", [b for b, _ in where])
+            contours = _listing("contour", sorted({c for _, c in where if c}))
+            in_contours = f" ({contours})" if contours else ""
+            w.warnings.append(
+                f"F{code:02d} = {feed:g} mm/min needs {machine.step_rate_hz(feed):.1f} steps/s "
+                f"but the serial link limits the machine to {cap:g} Hz (seed-000 S000-05, "
+                f"L3195–L3199): {blocks}{in_contours} will run at about "
+                f"{capped_feed:.3g} mm/min"
             )
+
+    def _length_warning(self, w: _Writer) -> None:
+        """S000-07: blocks longer than ``max_line_chars`` (``;`` included)."""
+        limit = self.max_line_chars
+        if limit is None:
+            return
+        long = [(n, len(line)) for n, line in enumerate(w.lines, start=1) if len(line) > limit]
+        if long:
+            w.warnings.append(
+                f"{len(long)} block(s) longer than {limit} characters (the firmware's receive "
+                f"buffer holds {BUFFER_CHARS}, seed-000 L1739–L1744, S000-07): "
+                f"{_listing('block', [n for n, _ in long])}; the longest has "
+                f"{max(c for _, c in long)}"
+            )
+
+    # -- commands --------------------------------------------------------------
+
+    def _command(self, command: Command, contour: int, w: _Writer) -> bool:
+        """Write ``command``; True when it homes X and Y (the position becomes unknown)."""
+        where = w.where(contour)
+        if isinstance(command, Spindle):
+            w.lines.extend(block for block in [_spindle(command, where, w)] if block)
+        elif isinstance(command, Dwell):
+            w.lines.extend(_dwell(command, where, w))
+        elif isinstance(command, ToolChange):
+            if not 0 <= command.tool <= MAX_TOOL:
+                raise DialectError(
+                    f"{where}: tool {command.tool} does not fit M06T## (0–{MAX_TOOL}, "
+                    "seed-000 Tabla 22, L3455–L3464)"
+                )
+            w.lines.append(f"M06T{format_int(command.tool, 2, what='tool')};")
+        else:
+            blocks = _home(command, where)
+            w.lines.extend(blocks)
+            return "G28X0Y0;" in blocks
+        return False
 
     # -- reading ---------------------------------------------------------------
 
     def parse(self, code: str | bytes, *, source: str = "<code>") -> Program:
-        """Read pic-mmh blocks back into moves (the grammar of seed-000 §3.6).
+        """Read pic-mmh blocks back into moves and commands (the grammar of seed-000 §3.6).
 
-        ``G04``, ``G28``, ``G54``, ``G90``, ``M03/M04/M05/M06`` and ``M30`` are
-        accepted and carry no motion in the returned program.
+        ``G54;``, ``G90;`` and ``M30;`` carry nothing; ``M03S####;`` /
+        ``M04S####;`` / ``M05;``, ``G04P##;``, ``M06T##;``, ``G28X0Y0;`` and
+        ``G28Z0;`` become :attr:`Program.commands` before the next move.
+        ``Program.lines`` holds each move's 1-based line.
 
         Raises:
-            ParseError: a line that is not a pic-mmh block, or a G01–G03 block
-                before any feed, naming ``source`` and the line number.
+            ParseError: a line that is not a pic-mmh block, a G01–G03 block
+                without F, or an F code not in the feed table, naming ``source``
+                and the line number.
         """
         if isinstance(code, bytes):
             code = code.decode("ascii", errors="replace")
         moves: list[Move] = []
         lines: list[int] = []
+        commands: list[tuple[int, Command]] = []
         contour = 0
         for number, raw in enumerate(code.splitlines(), start=1):
             line = raw.strip()
-            if not line or _AUX.match(line):
+            if not line or line in _FRAME:
+                continue
+            command = _read_command(line)
+            if command is not None:
+                commands.append((len(moves), command))
                 continue
             m = _BLOCK.match(line)
             if m is None:
                 raise ParseError(f"{source}:{number}: not a pic-mmh block: {line!r}")
-            moves.append(self._move(m, number, source, contour + (m["g"] == "0")))
+            moves.append(self._read_move(m, number, source, contour + (m["g"] == "0")))
             lines.append(number)
             contour += m["g"] == "0"
-        return Program(tuple(moves), lines=tuple(lines))
+        return Program(tuple(moves), lines=tuple(lines), commands=tuple(commands))
 
-    def _move(self, m: re.Match[str], number: int, source: str, contour: int) -> Move:
+    def _read_move(self, m: re.Match[str], number: int, source: str, contour: int) -> Move:
         g = int(m["g"])
         x, y = self.coord.parse(m[2]), self.coord.parse(m[3])
         has_centre = m[4] is not None
@@ -192,11 +343,32 @@ class PicMmhPost(PostProcessor):
             return Rapid(x, y, contour=contour)
         if m["f"] is None:
             raise ParseError(f"{source}:{number}: G0{g} needs an F word (two digits)")
-        feed = int(m["f"]) * self.feed_unit_mm_min
+        feed = self.feeds.feed_of(int(m["f"]))
+        if feed is None:
+            (lo, _), (hi, _) = self.feeds.lowest, self.feeds.highest
+            codes = f"F{lo:02d}–F{hi:02d}" if hi - lo + 1 == len(self.feeds.codes) else "its codes"
+            raise ParseError(
+                f"{source}:{number}: F{m['f']} is not in the feed table ({codes}): {m[0]!r}"
+            )
         if g == 1:
             return Linear(x, y, feed, contour=contour)
         cx, cy = self.coord.parse(m[4]), self.coord.parse(m[5])
         return ArcMove(x, y, cx, cy, g == 2, feed, contour=contour)
+
+
+def _steps(
+    program: Program,
+) -> Iterator[tuple[tuple[float, float], Move | None, tuple[Command, ...]]]:
+    """``(start, move, commands before it)``; last ``(end, None, trailing commands)``."""
+    pending = list(program.commands)
+    here = program.origin
+    for index, move in enumerate(program.moves):
+        before = []
+        while pending and pending[0][0] == index:
+            before.append(pending.pop(0)[1])
+        yield here, move, tuple(before)
+        here = (move.x, move.y)
+    yield here, None, tuple(c for _, c in pending)
 
 
 def _halves(start: tuple[float, float], move: ArcMove) -> list[ArcMove]:
@@ -208,3 +380,93 @@ def _halves(start: tuple[float, float], move: ArcMove) -> list[ArcMove]:
         *opposite, move.cx, move.cy, move.clockwise, move.feed_mm_min, None, move.contour
     )
     return [first, move]
+
+
+def _spindle(command: Spindle, where: str, w: _Writer) -> str | None:
+    """``M03S####;`` / ``M04S####;`` (rev/min rounded half up), ``M05;``, or ``None``.
+
+    ``None`` (with a warning) for a spindle started without a speed (0 rev/min).
+    """
+    if command.direction == "off":
+        return "M05;"
+    rpm = command.rpm
+    if rpm == 0:
+        w.note(
+            "rpm-none",
+            f"{where}: spindle on without a speed (0 rev/min, e.g. a bare M3) dropped: "
+            "M03S####/M04S#### needs 1–9999 rev/min; give the speed with S in the program",
+        )
+        return None
+    finite = math.isfinite(rpm) and rpm > 0
+    whole = int(Decimal(repr(float(rpm))).quantize(Decimal(1), ROUND_HALF_UP)) if finite else 0
+    if not 1 <= whole <= MAX_RPM:
+        raise DialectError(
+            f"{where}: spindle speed {rpm:g} rev/min does not fit M03S####/M04S#### "
+            f"(1–{MAX_RPM} rev/min, 4 digits, seed-000 Tabla 22, L3418–L3436)"
+        )
+    if whole != rpm:
+        w.note("rpm", f"spindle speed {rpm:g} rev/min rounded to S{whole:04d} (whole rev/min)")
+    m = "M03" if command.direction == "cw" else "M04"
+    return f"{m}S{format_int(whole, 4, what='spindle speed')};"
+
+
+def _dwell(command: Dwell, where: str, w: _Writer) -> list[str]:
+    """``G04P##;`` blocks of whole seconds: rounded up, split into 99 s pieces."""
+    seconds = command.seconds
+    if not (math.isfinite(seconds) and seconds >= 0):
+        raise DialectError(f"{where}: dwell of {seconds:g} s; G04P## takes 0–99 whole seconds")
+    whole = math.ceil(seconds - 1e-9)
+    if whole - seconds > 1e-9:
+        w.note(
+            "dwell-round",
+            f"{where}: dwell {seconds:g} s rounded up to {whole} s "
+            "(G04P## takes whole seconds, seed-000 L3359–L3366)",
+        )
+    pieces = [MAX_DWELL_S] * (whole // MAX_DWELL_S)
+    if whole % MAX_DWELL_S or not pieces:
+        pieces.append(whole % MAX_DWELL_S)
+    if len(pieces) > 1:
+        w.note(
+            "dwell-split",
+            f"{where}: dwell {whole} s written as {len(pieces)} G04 blocks of at most "
+            f"{MAX_DWELL_S} s (P has 2 digits, seed-000 L3359–L3366)",
+        )
+    return [f"G04P{format_int(p, 2, what='dwell')};" for p in pieces]
+
+
+def _home(command: Home, where: str) -> list[str]:
+    """``G28X0Y0;`` / ``G28Z0;``; XYZ homes Z first (seed-000 §7: Z, then X, then Y)."""
+    axes = set(command.axes.upper())
+    if axes == {"X", "Y"} and len(command.axes) == 2:
+        return ["G28X0Y0;"]
+    if command.axes.upper() == "Z":
+        return ["G28Z0;"]
+    if axes == {"X", "Y", "Z"} and len(command.axes) == 3:
+        return ["G28Z0;", "G28X0Y0;"]
+    raise DialectError(
+        f"{where}: cannot return to machine zero on {command.axes!r}: pic-mmh homes X and Y "
+        "together (G28X0Y0;) or Z (G28Z0;) (seed-000 Tabla 21, L3375–L3386)"
+    )
+
+
+def _read_command(line: str) -> Command | None:
+    """The command of an auxiliary block, or ``None`` when ``line`` is not one."""
+    if line in _FIXED:
+        return _FIXED[line]
+    m = _ARGS.match(line)
+    if m is None:
+        return None
+    if m["p"] is not None:
+        return Dwell(float(m["p"]))
+    if m["t"] is not None:
+        return ToolChange(int(m["t"]))
+    return Spindle("cw" if m["m"] == "3" else "ccw", float(m["s"]))
+
+
+def _listing(noun: str, numbers: list[int], most: int = 6) -> str:
+    """``"block 4"``, ``"blocks 4, 5, 9"`` or ``"blocks 4, 5, 9, 12, 13, 15 … (9 in all)"``."""
+    if not numbers:
+        return ""
+    text = ", ".join(str(n) for n in numbers[:most])
+    more = f" … ({len(numbers)} in all)" if len(numbers) > most else ""
+    return f"{noun}{'s' if len(numbers) > 1 else ''} {text}{more}"
