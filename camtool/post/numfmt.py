@@ -29,30 +29,51 @@ class NumberFormat:
             integer part needs more digits do not fit. ``None`` pads nothing and
             has no limit.
         sign: one of :data:`SIGN_POLICIES`.
+        min_decimals: ``None`` writes all ``decimals`` digits; a number trims
+            trailing zeros down to that many decimals (FlashCut's ``X1.0`` and
+            ``X2.969`` with ``decimals=3, min_decimals=1``, seed-001 R7; with 0
+            a whole number is written without a point).
+        pad: ``False`` makes ``int_digits`` a limit only (no zero padding).
+        grid_mm: round the value to a multiple of this many mm before scaling
+            (a machine's step grid, seed-004 S004-R10); ``None``: no grid.
     """
 
     scale: float = 1.0
     decimals: int = 3
     int_digits: int | None = None
     sign: str = "negative"
+    min_decimals: int | None = None
+    pad: bool = True
+    grid_mm: float | None = None
 
     def __post_init__(self) -> None:
         if self.sign not in SIGN_POLICIES:
             raise ValueError(f"unknown sign policy {self.sign!r}; choose {SIGN_POLICIES}")
         if self.decimals < 0 or (self.int_digits is not None and self.int_digits < 1):
             raise ValueError("decimals must be ≥ 0 and int_digits ≥ 1")
+        if self.min_decimals is not None and not 0 <= self.min_decimals <= self.decimals:
+            raise ValueError("min_decimals must lie between 0 and decimals")
+        if self.grid_mm is not None and not self.grid_mm > 0:
+            raise ValueError("grid_mm must be > 0")
 
     def quantize(self, value_mm: float) -> Decimal:
-        """The value in written units, rounded to ``decimals`` (half away from zero)."""
+        """The value in written units, rounded to ``decimals`` (half away from zero).
+
+        With ``grid_mm`` the value is first rounded (half away from zero) to the
+        nearest multiple of ``grid_mm``.
+        """
         exp = Decimal(1).scaleb(-self.decimals)
-        q = (Decimal(repr(float(value_mm))) * Decimal(repr(float(self.scale)))).quantize(
-            exp, rounding=ROUND_HALF_UP
-        )
+        value = Decimal(repr(float(value_mm)))
+        if self.grid_mm is not None:
+            grid = Decimal(repr(float(self.grid_mm)))
+            value = (value / grid).quantize(Decimal(1), rounding=ROUND_HALF_UP) * grid
+        q = (value * Decimal(repr(float(self.scale)))).quantize(exp, rounding=ROUND_HALF_UP)
         return q if q != 0 else Decimal(0).quantize(exp)
 
     def resolution_mm(self) -> float:
-        """The smallest step this format can write, mm."""
-        return 10.0 ** (-self.decimals) / self.scale
+        """The smallest step this format can write, mm (the grid when coarser)."""
+        step = 10.0 ** (-self.decimals) / self.scale
+        return max(step, self.grid_mm) if self.grid_mm is not None else step
 
     def format(self, value_mm: float) -> str:
         """Write ``value_mm`` (mm) in this format.
@@ -63,11 +84,16 @@ class NumberFormat:
         q = self.quantize(value_mm)
         magnitude = abs(q)
         text = f"{magnitude:.{self.decimals}f}"
+        if self.min_decimals is not None and self.decimals > self.min_decimals:
+            whole, frac = text.split(".")
+            frac = frac.rstrip("0").ljust(self.min_decimals, "0")
+            text = f"{whole}.{frac}" if frac else whole
         int_part = text.split(".")[0]
         if self.int_digits is not None:
             if len(int_part) > self.int_digits:
                 raise DialectError(f"{q} does not fit {self.int_digits} integer digits")
-            text = text.rjust(len(text) - len(int_part) + self.int_digits, "0")
+            if self.pad:
+                text = text.rjust(len(text) - len(int_part) + self.int_digits, "0")
         if q < 0:
             return "-" + text
         return ("+" + text) if self.sign == "always" else text

@@ -1,0 +1,96 @@
+"""Word-address dialects declared in TOML: one writer and one reader for all of them.
+
+A target file with ``dialect = "word-address"`` describes its G-code in its
+``[dialect_options]`` table (every key: docs/dialects.md); no Python is needed.
+The built-in ``flashcut``, ``valcnc``, ``grbl`` and ``linuxcnc`` targets are
+such files (camtool/targets/*.toml), for example ValCNC (seed-004 §3.4)::
+
+    [dialect_options]
+    separator = ""                       # the firmware strips spaces (S004-R02)
+    max_block_bytes = 127                # under 128 bytes with its line end
+    max_arc_deg = 180.0                  # split reflex arcs (S004-R05)
+    full_circle = "split"
+    modal = []
+    motion_codes = { rapid = "G00", linear = "G01", cw = "G02", ccw = "G03" }
+    [dialect_options.words.XYZIJ]
+    decimals = 2
+    min_decimals = 0
+    grid_mm = 0.04                       # the 25 steps/mm grid (S004-R10)
+
+- :mod:`camtool.post.wordaddress_spec` — :class:`WordAddressSpec` and its strict
+  loader (errors name the file and the key path);
+- :mod:`camtool.post.wordaddress_write` — the writer;
+- :mod:`camtool.post.wordaddress_read` — the reader, derived from the same spec.
+
+Numbers are formatted by :mod:`camtool.post.numfmt` only.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from types import MappingProxyType
+from typing import Any
+
+from camtool.machine import Machine
+from camtool.post.base import PostProcessor, PostResult
+from camtool.post.wordaddress_read import BlockReader
+from camtool.post.wordaddress_spec import WordAddressSpec, WordSpec, load_spec
+from camtool.post.wordaddress_write import BlockWriter
+from camtool.program import Program
+
+__all__ = ["WordAddressPost", "WordAddressSpec", "WordSpec", "load_spec", "word_address_dialect"]
+
+
+class WordAddressPost(PostProcessor):
+    """Writer and reader of one word-address dialect.
+
+    Args:
+        spec: the dialect (see :func:`load_spec`).
+
+    The one output format is ``"code"``, with the file ending ``spec.suffix``.
+    """
+
+    def __init__(self, spec: WordAddressSpec) -> None:
+        self.spec = spec
+        # formats is a class attribute elsewhere; each spec has its own file ending.
+        vars(self)["formats"] = MappingProxyType({"code": spec.suffix})
+
+    def emit(self, program: Program, machine: Machine, *, fmt: str | None = None) -> PostResult:
+        """Write ``program`` for ``machine`` (rules: :mod:`camtool.post.wordaddress_write`).
+
+        Raises:
+            DialectError: a Z move without a Z word, a helix the dialect cannot
+                write, a point outside the work area, a number over its field, a
+                block over ``max_block_bytes`` or an arc the controller's check
+                cannot accept; the message names the contour and block.
+            UsageError: ``fmt`` is not ``"code"``.
+        """
+        self.check_format(fmt)
+        writer = BlockWriter(self.spec, machine)
+        code = writer.write(program)
+        return PostResult(code, len(writer.lines), tuple(writer.warnings), "code")
+
+    def parse(self, code: str | bytes, *, source: str = "<code>") -> Program:
+        """Read code of this dialect (rules: :mod:`camtool.post.wordaddress_read`).
+
+        ``Program.lines`` holds the 1-based source line of each move. Feeds of
+        a dialect without an F word read as 0 (the machine's own speed).
+
+        Raises:
+            ParseError: a block that is not in the dialect, naming ``source`` and
+                the line.
+        """
+        return BlockReader(self.spec, source).read(code)
+
+
+def word_address_dialect(options: Mapping[str, Any], where: str) -> WordAddressPost:
+    """The dialect a target file's ``[dialect_options]`` table declares.
+
+    Args:
+        options: the ``[dialect_options]`` table.
+        where: the target file's name, for messages.
+
+    Raises:
+        InputError: an unknown key or a bad value, naming ``where`` and the key.
+    """
+    return WordAddressPost(load_spec(options, where))

@@ -1,0 +1,314 @@
+"""The reader of word-address dialects: code back into a Program, by the same spec.
+
+Strict: every block must be one the writer of the dialect could have written.
+
+- words are split by the dialect's separator (``""``: no whitespace at all;
+  ``" "``: exactly one space between words) and each block ends with
+  ``block_end``; a block longer than ``max_block_bytes`` is refused;
+- a value word must be written exactly as the writer writes it (its number
+  format, re-formatted, gives the same text: no ``-0``, no missing decimals,
+  no padding where there is none); a code (G/M word) must be one of the
+  dialect's codes spelled as the dialect spells it; each letter once per block;
+- modal per RS-274: letters in ``modal`` keep their value when absent (the
+  motion code ``G`` included); the others are required in every block that
+  uses them; F (the feed) is always remembered;
+- a block is one instruction: a motion (motion code, axis words, I/J for arcs,
+  F), a spindle code (with S when the dialect has S), a dwell (with P), a tool
+  change (with T), the preamble/postamble codes, or an end code (nothing may
+  follow it);
+- arcs: I/J incremental from the start or absolute as the spec says; with
+  ``arc_check`` the controller's own arc check is applied and an arc it would
+  refuse is a ParseError.
+
+``Program.lines`` holds the 1-based source line of each move; a rapid after
+cutting moves starts the next contour (1-based).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+from dataclasses import dataclass, field
+
+from camtool.errors import DialectError, ParseError
+from camtool.geometry import Point
+from camtool.post.wordaddress_spec import WordAddressSpec
+from camtool.program import (
+    ArcMove,
+    Command,
+    Dwell,
+    Linear,
+    Move,
+    Program,
+    Rapid,
+    Spindle,
+    SpindleDirection,
+    ToolChange,
+)
+
+_WORD = re.compile(r"([A-Za-z])([^A-Za-z]*)")
+_UPPER_WORD = re.compile(r"[A-Z][^A-Za-z]*")
+_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)")
+
+
+@dataclass
+class _State:
+    """The modal state of the controller while reading."""
+
+    x: float = 0.0
+    y: float = 0.0
+    z: float | None = None
+    motion: str | None = None
+    feed: float | None = None
+    moves: list[Move] = field(default_factory=list)
+    lines: list[int] = field(default_factory=list)
+    commands: list[tuple[int, Command]] = field(default_factory=list)
+    contour: int = 1
+    cut_in_contour: bool = False
+    ended: int = 0
+
+
+class BlockReader:
+    """Reads code of one dialect (see the module docstring for the rules).
+
+    Args:
+        spec: the dialect.
+        source: the name messages give the code.
+    """
+
+    def __init__(self, spec: WordAddressSpec, source: str) -> None:
+        self.spec, self.source = spec, source
+        self.state = _State()
+        self.line = 0
+        rapid, linear, cw, ccw = spec.motion_codes
+        self.motions = {rapid: "rapid", linear: "linear", cw: "cw", ccw: "ccw"}
+        pairs: tuple[tuple[str | None, SpindleDirection], ...] = (
+            (spec.spindle_cw, "cw"),
+            (spec.spindle_ccw, "ccw"),
+            (spec.spindle_off, "off"),
+        )
+        self.spindle = {code: direction for code, direction in pairs if code}
+        self.static = spec.static_codes()
+        self.codes = set(self.motions) | set(self.spindle) | set(spec.end) | self.static
+        self.codes |= {c for c in (spec.dwell, spec.tool_change) if c}
+
+    def fail(self, text: str) -> ParseError:
+        """A ParseError naming the source and line."""
+        return ParseError(f"{self.source}:{self.line}: {text}")
+
+    def read(self, code: str | bytes) -> Program:
+        """The program in ``code``.
+
+        Raises:
+            ParseError: a block that is not in the dialect, naming the line.
+        """
+        if isinstance(code, bytes):
+            try:
+                code = code.decode("ascii")
+            except UnicodeDecodeError as exc:
+                raise ParseError(f"{self.source}: byte {exc.start} is not ASCII text") from exc
+        for number, raw in enumerate(code.splitlines(), start=1):
+            self.line = number
+            if raw.strip():
+                self.block(raw)
+        s = self.state
+        return Program(tuple(s.moves), lines=tuple(s.lines), commands=tuple(s.commands))
+
+    # -- one block ---------------------------------------------------------------
+
+    def block(self, raw: str) -> None:
+        """Read one non-blank line."""
+        spec, s = self.spec, self.state
+        if s.ended:
+            raise self.fail(f"{raw!r} after the program end on line {s.ended}")
+        size = len((raw + spec.line_end).encode("ascii", errors="replace"))
+        if spec.max_block_bytes is not None and size > spec.max_block_bytes:
+            raise self.fail(
+                f"block is {size} bytes with its line end; {spec.name} takes at most "
+                f"{spec.max_block_bytes}"
+            )
+        codes, values = self.words(raw)
+        if not codes and not values:
+            raise self.fail(f"no word in {raw!r}")
+        static = self.static
+        key = next((c for c in codes if c not in self.motions and c not in static), None)
+        if key in spec.end:
+            self._only(codes, values, key, "the program end")
+            s.ended = self.line
+        elif key in self.spindle:
+            direction = self.spindle[key]
+            needs = "S" if direction != "off" and spec.has("S") else ""
+            self._only(codes, values, key, "a spindle", needs=needs)
+            s.commands.append((len(s.moves), Spindle(direction, values.get("S", 0.0))))
+        elif key is not None and key == spec.dwell:
+            self._only(codes, values, key, "a dwell", needs="P")
+            s.commands.append((len(s.moves), Dwell(values["P"])))
+        elif key is not None and key == spec.tool_change:
+            self._only(codes, values, key, "a tool change", needs="T")
+            s.commands.append((len(s.moves), ToolChange(round(values["T"]))))
+        elif codes and all(c in static for c in codes):
+            if values:
+                raise self.fail(f"{', '.join(values)} in a setup block ({' '.join(codes)})")
+        else:
+            self._motion(codes, values)
+
+    def words(self, raw: str) -> tuple[list[str], dict[str, float]]:
+        """The codes and the value words of a line, each checked against the spec."""
+        spec = self.spec
+        body = raw
+        if spec.block_end:
+            if not raw.endswith(spec.block_end):
+                raise self.fail(f"block does not end with {spec.block_end!r}: {raw!r}")
+            body = raw[: -len(spec.block_end)]
+        if spec.separator:
+            tokens = body.split(spec.separator)
+        else:
+            tokens = [m.group(0) for m in _WORD.finditer(body)]
+            if "".join(tokens) != body:
+                raise self.fail(f"{spec.name} writes no spaces or other characters: {raw!r}")
+        for token in tokens:
+            glued = len(_UPPER_WORD.findall(token)) > 1
+            if not token or glued or any(c.isspace() for c in token):
+                raise self.fail(f"words must be separated by one space: {raw!r}")
+            if not _WORD.fullmatch(token):
+                raise self.fail(f"{token!r} is not a word (a letter and a number) in {raw!r}")
+        codes: list[str] = []
+        values: dict[str, float] = {}
+        for token in tokens:
+            letter, text = token[0], token[1:]
+            if letter in values or (letter in "GM" and token in codes):
+                raise self.fail(f"{letter} appears twice in {raw!r}")
+            if letter in "GM":
+                if token not in self.codes:
+                    known = " ".join(sorted(self.codes))
+                    raise self.fail(f"unknown code {token!r}; {spec.name} knows: {known}")
+                codes.append(token)
+            else:
+                values[letter] = self.value(letter, text)
+        return codes, values
+
+    def value(self, letter: str, text: str) -> float:
+        """The value of word ``letter`` written as ``text``, mm (or its word's unit)."""
+        spec = self.spec.word(letter)
+        if spec is None:
+            known = " ".join(sorted(self.spec.words))
+            raise self.fail(f"unknown word {letter}{text}; {self.spec.name} has: {known}")
+        number = spec.number
+        try:
+            if not _NUMBER.fullmatch(text):
+                raise ValueError(text)
+            value = number.parse(text)
+            ok = number.format(value) == text
+        except (ValueError, ArithmeticError, DialectError):
+            ok = False
+        if not ok:
+            example = number.format(-12.5 if letter in "XYZIJ" else 12.5)
+            raise self.fail(
+                f"{letter}{text} is not in the format of {letter} (e.g. {letter}{example})"
+            )
+        return value
+
+    def _only(
+        self, codes: list[str], values: dict[str, float], key: str, what: str, *, needs: str = ""
+    ) -> None:
+        """Check a non-motion block holds ``key``, the word ``needs`` and nothing else."""
+        extra = [c for c in codes if c != key] + [k for k in values if k != needs]
+        if extra:
+            extras = ", ".join(extra)
+            raise self.fail(f"{extras} in {what} block ({key}); one instruction per block")
+        if needs and needs not in values:
+            raise self.fail(f"{key} needs a {needs} word")
+
+    # -- motion ------------------------------------------------------------------
+
+    def _motion(self, codes: list[str], values: dict[str, float]) -> None:
+        spec, s = self.spec, self.state
+        moving = [c for c in codes if c in self.motions]
+        if len(moving) != len(codes) or len(codes) > 1:
+            raise self.fail(f"{' '.join(codes)}: one instruction per block")
+        if codes:
+            s.motion = self.motions[codes[0]]
+        elif "G" not in spec.modal or s.motion is None:
+            raise self.fail("a block without a motion code (" + " ".join(spec.motion_codes) + ")")
+        assert s.motion is not None
+        allowed = set("XYZF") | (set("IJ") if s.motion in ("cw", "ccw") else set())
+        extra = sorted(set(values) - allowed)
+        if extra:
+            raise self.fail(f"{', '.join(extra)} not allowed in a {s.motion} motion block")
+        x, y, z = self._axes(values, s.motion)
+        feed = self._feed(values, s.motion)
+        if s.motion == "rapid":
+            self._push(Rapid(x, y, z))
+        elif s.motion == "linear":
+            self._push(Linear(x, y, feed, z))
+        else:
+            centre = self._centre(values, (x, y))
+            self._push(ArcMove(x, y, centre[0], centre[1], s.motion == "cw", feed, z))
+
+    def _axes(self, values: dict[str, float], motion: str) -> tuple[float, float, float | None]:
+        spec, s = self.spec, self.state
+        has_xy = "X" in values or "Y" in values
+        if "Z" in values and motion in ("cw", "ccw") and not spec.helix:
+            raise self.fail(f"{spec.name} arcs take no Z word (no helix)")
+        if spec.z_moves == "own-block" and "Z" in values and has_xy:
+            raise self.fail(f"{spec.name} moves Z in blocks of its own (no X or Y with Z)")
+        z_only = "Z" in values and not has_xy and motion in ("rapid", "linear")
+        if not z_only:
+            for letter in "XY":
+                needed = letter not in spec.modal or motion in ("cw", "ccw")
+                if letter not in values and needed:
+                    raise self.fail(f"missing {letter} word ({spec.name} needs X and Y)")
+        x, y = values.get("X", s.x), values.get("Y", s.y)
+        return x, y, values.get("Z")
+
+    def _feed(self, values: dict[str, float], motion: str) -> float:
+        spec, s = self.spec, self.state
+        if motion == "rapid":
+            if "F" in values:
+                raise self.fail("F in a rapid block; the writer puts F on cutting moves only")
+            return 0.0
+        if not spec.has("F"):
+            return 0.0
+        if "F" in values:
+            if values["F"] <= 0:
+                raise self.fail("F must be > 0")
+            s.feed = values["F"]
+        elif "F" not in spec.modal:
+            raise self.fail(f"missing F word ({spec.name} writes F in every cutting block)")
+        if s.feed is None:
+            raise self.fail("a cutting move before any F word")
+        return s.feed
+
+    def _centre(self, values: dict[str, float], end: Point) -> Point:
+        spec, s = self.spec, self.state
+        for letter in "IJ":
+            if letter not in values:
+                raise self.fail(f"missing {letter} word (arcs need I and J)")
+        if spec.arc_centre == "absolute":
+            centre = (values["I"], values["J"])
+        else:
+            centre = (s.x + values["I"], s.y + values["J"])
+        if centre == (s.x, s.y):
+            raise self.fail("the arc's centre is its start point (radius 0)")
+        if spec.arc_check != "none":
+            from camtool.post.arccheck import arc_error
+
+            reason = arc_error((s.x, s.y), end, centre, rule=spec.arc_check)
+            if reason is not None:
+                raise self.fail(f"{spec.arc_check} refuses this arc: {reason}")
+        return centre
+
+    def _push(self, move: Move) -> None:
+        s = self.state
+        if isinstance(move, Rapid):
+            if s.cut_in_contour:
+                s.contour += 1
+            s.cut_in_contour = False
+        else:
+            s.cut_in_contour = True
+        move = dataclasses.replace(move, contour=s.contour)
+        s.moves.append(move)
+        s.lines.append(self.line)
+        s.x, s.y = move.x, move.y
+        if move.z is not None:
+            s.z = move.z

@@ -1,0 +1,426 @@
+"""The word-address dialect specification and its strict TOML loader.
+
+A :class:`WordAddressSpec` is everything a plain word-address dialect needs:
+how each word's number is written (:class:`WordSpec`, formatted by
+:mod:`camtool.post.numfmt`), how blocks are put together, which codes exist,
+and how arcs, Z moves and commands are expressed. It is read from the
+``[dialect_options]`` table of a target file (``dialect = "word-address"``);
+every key is documented in docs/dialects.md.
+
+The loader is strict: an unknown key, a wrong type or an impossible
+combination is an :class:`~camtool.errors.InputError` naming the file and the
+full key path, e.g. ``valcnc.toml: dialect_options.words.X.decimals: expected
+an integer, got "3"``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+from camtool.errors import InputError
+from camtool.post.numfmt import SIGN_POLICIES, NumberFormat
+
+WORD_LETTERS = "XYZIJFSPT"
+"""Value words a dialect may have: axes X Y Z (mm), arc centre I J (mm), feed F
+(mm/min), spindle speed S (rev/min), dwell P (s), tool number T."""
+
+MOTIONS = ("rapid", "linear", "cw", "ccw")
+"""Keys of ``motion_codes``: G0, G1, G2 (clockwise) and G3 (counter-clockwise)."""
+
+MODAL_LETTERS = "GXYZF"
+"""Letters ``modal`` may name (``G`` = the motion code)."""
+
+ARC_CENTRES = ("incremental", "absolute")
+FULL_CIRCLES = ("one-block", "split")
+Z_MOVES = ("own-block", "with-xy", "none")
+ARC_CHECKS = ("none", "grbl", "linuxcnc")
+LINE_ENDS = ("\n", "\r\n")
+
+_CODE = re.compile(r"[GM]\d+(?:\.\d+)?")
+_BLOCK_END = re.compile(r"[^\sA-Za-z0-9.+-]{0,4}")
+_SUFFIX = re.compile(r"\.[A-Za-z0-9]{1,8}")
+
+
+@dataclass(frozen=True)
+class WordSpec:
+    """How one value word is written.
+
+    Attributes:
+        letter: the address letter (one of :data:`WORD_LETTERS`).
+        number: its number format: ``scale`` is units written per mm (X Y Z I
+            J), per mm/min (F), per rev/min (S), per second (P) or per tool (T).
+    """
+
+    letter: str
+    number: NumberFormat
+
+
+@dataclass(frozen=True)
+class WordAddressSpec:
+    """A word-address dialect (see docs/dialects.md for every field and its default).
+
+    Attributes:
+        name: the dialect's name in messages (the target file's stem).
+        words: the value words the dialect has, by letter. A letter that is
+            absent is a word the dialect lacks: no F drops feeds, no S drops
+            spindle speeds (each with one warning), no Z makes Z moves errors.
+        separator: between words: ``""`` (``G01X1Y2``) or ``" "``.
+        block_end: written after the last word of every block (``";"``).
+        line_end: LF or CR LF (:data:`LINE_ENDS`).
+        suffix: file name ending of the code, e.g. ``".nc"``.
+        preamble: blocks written before the first move, each a tuple of codes.
+        postamble: blocks written after the last move, before the end code.
+        motion_codes: spellings of rapid, linear, clockwise and
+            counter-clockwise motion, e.g. ``("G00", "G01", "G02", "G03")``.
+        arc_centre: ``"incremental"`` (I/J from the arc start, RS-274) or
+            ``"absolute"``.
+        max_arc_deg: arcs sweeping more than this are split into equal pieces.
+        full_circle: ``"one-block"`` or ``"split"`` (into
+            ``max(2, ceil(360 / max_arc_deg))`` equal arcs).
+        z_moves: ``"own-block"`` (Z alone in its block, seed-001 R7),
+            ``"with-xy"`` or ``"none"`` (no Z word).
+        helix: whether an arc may carry a Z word (``with-xy`` only).
+        max_block_bytes: longest block in bytes with its block end and line
+            end; ``None``: no limit.
+        modal: letters written only when their value changes (``G`` for the
+            motion code); the others are written in every block that uses them.
+        arc_check: ``"none"``, ``"grbl"`` or ``"linuxcnc"``: arcs are written
+            so that the rounded numbers pass that controller's check
+            (:mod:`camtool.post.arccheck`).
+        spindle_cw: code that starts the spindle clockwise (``None``: none).
+        spindle_ccw: code that starts it counter-clockwise.
+        spindle_off: code that stops it.
+        dwell: dwell code, followed by the P word (seconds).
+        tool_change: tool change code, followed by the T word.
+        end: program-end codes; the writer ends with the first, the reader
+            accepts any of them.
+    """
+
+    name: str
+    words: Mapping[str, WordSpec]
+    separator: str = " "
+    block_end: str = ""
+    line_end: str = "\n"
+    suffix: str = ".nc"
+    preamble: tuple[tuple[str, ...], ...] = ()
+    postamble: tuple[tuple[str, ...], ...] = ()
+    motion_codes: tuple[str, str, str, str] = ("G0", "G1", "G2", "G3")
+    arc_centre: str = "incremental"
+    max_arc_deg: float = 360.0
+    full_circle: str = "one-block"
+    z_moves: str = "with-xy"
+    helix: bool = False
+    max_block_bytes: int | None = None
+    modal: frozenset[str] = frozenset("F")
+    arc_check: str = "none"
+    spindle_cw: str | None = None
+    spindle_ccw: str | None = None
+    spindle_off: str | None = None
+    dwell: str | None = None
+    tool_change: str | None = None
+    end: tuple[str, ...] = ()
+
+    def word(self, letter: str) -> WordSpec | None:
+        """The word ``letter``, or ``None`` when the dialect lacks it."""
+        return self.words.get(letter)
+
+    def has(self, letter: str) -> bool:
+        """True when the dialect has the value word ``letter``."""
+        return letter in self.words
+
+    def quantum_mm(self) -> float:
+        """The coarsest written step of X, Y, I and J, mm: the grid arcs must land on."""
+        return max(self.words[c].number.resolution_mm() for c in "XYIJ" if c in self.words)
+
+    def static_codes(self) -> frozenset[str]:
+        """Codes of the preamble and postamble (no effect on the path when read)."""
+        return frozenset(code for block in self.preamble + self.postamble for code in block)
+
+
+def _show(value: Any) -> str:
+    """A value as a TOML user would recognise it in a message."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return json.dumps(value, ensure_ascii=False)
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(_show(v) for v in value) + "]"
+    if isinstance(value, Mapping):
+        return "a table"
+    return repr(value)
+
+
+class _Table:
+    """Strict reader of one TOML table: typed getters, unknown keys an error."""
+
+    def __init__(self, data: Any, path: str, where: str) -> None:
+        self.path, self.where = path, where
+        if not isinstance(data, Mapping):
+            raise self.error("", f"expected a table, got {_show(data)}")
+        self.data: Mapping[str, Any] = data
+        self.seen: set[str] = set()
+
+    def error(self, key: str, text: str) -> InputError:
+        path = f"{self.path}.{key}" if key else self.path
+        return InputError(f"{self.where}: {path}: {text}")
+
+    def get(self, key: str) -> Any:
+        self.seen.add(key)
+        return self.data.get(key)
+
+    def string(self, key: str, default: str | None, *, choices: tuple[str, ...] = ()) -> Any:
+        value = self.get(key)
+        if value is None:
+            return default
+        if not isinstance(value, str):
+            raise self.error(key, f"expected a string, got {_show(value)}")
+        if choices and value not in choices:
+            raise self.error(key, f"expected one of {_show(list(choices))}, got {_show(value)}")
+        return value
+
+    def integer(self, key: str, default: int | None, *, low: int = 0) -> int | None:
+        value = self.get(key)
+        if value is None:
+            return default
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise self.error(key, f"expected an integer, got {_show(value)}")
+        if value < low:
+            raise self.error(key, f"expected an integer >= {low}, got {value}")
+        return value
+
+    def number(self, key: str, default: float | None) -> float | None:
+        value = self.get(key)
+        if value is None:
+            return default
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise self.error(key, f"expected a number, got {_show(value)}")
+        if not math.isfinite(value) or value <= 0:
+            raise self.error(key, f"expected a positive number, got {_show(value)}")
+        return float(value)
+
+    def flag(self, key: str, default: bool) -> bool:
+        value = self.get(key)
+        if value is None:
+            return default
+        if not isinstance(value, bool):
+            raise self.error(key, f"expected true or false, got {_show(value)}")
+        return value
+
+    def strings(self, key: str) -> list[str]:
+        value = self.get(key)
+        if value is None:
+            return []
+        if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+            raise self.error(key, f"expected a list of strings, got {_show(value)}")
+        return list(value)
+
+    def table(self, key: str) -> _Table:
+        value = self.get(key)
+        return _Table({} if value is None else value, f"{self.path}.{key}", self.where)
+
+    def done(self) -> None:
+        unknown = sorted(set(self.data) - self.seen)
+        if unknown:
+            known = ", ".join(sorted(self.seen))
+            raise self.error(
+                "", f"unknown key(s) {', '.join(_show(k) for k in unknown)}; known: {known}"
+            )
+
+
+def load_spec(options: Mapping[str, Any], where: str) -> WordAddressSpec:
+    """Build a :class:`WordAddressSpec` from a target's ``[dialect_options]`` table.
+
+    Args:
+        options: the table as TOML gives it.
+        where: the target file's name, for messages (its stem names the dialect).
+
+    Raises:
+        InputError: an unknown key, a value of the wrong type, or options that
+            contradict each other, naming ``where`` and the key path.
+    """
+    t = _Table(options, "dialect_options", where)
+    words = _words(t.table("words"))
+    codes = _codes(t)
+    z_default = "with-xy" if "Z" in words else "none"
+    spec = WordAddressSpec(
+        name=Path(where).stem or "word-address",
+        words=MappingProxyType(words),
+        separator=t.string("separator", " ", choices=("", " ")),
+        block_end=_pattern(t, "block_end", "", _BLOCK_END, "up to 4 punctuation characters"),
+        line_end=t.string("line_end", "\n", choices=LINE_ENDS),
+        suffix=_pattern(t, "suffix", ".nc", _SUFFIX, 'a file ending such as ".nc"'),
+        preamble=_blocks(t, "preamble"),
+        postamble=_blocks(t, "postamble"),
+        arc_centre=t.string("arc_centre", "incremental", choices=ARC_CENTRES),
+        max_arc_deg=_max_arc(t),
+        full_circle=t.string("full_circle", "one-block", choices=FULL_CIRCLES),
+        z_moves=t.string("z_moves", z_default, choices=Z_MOVES),
+        helix=t.flag("helix", False),
+        max_block_bytes=t.integer("max_block_bytes", None, low=8),
+        modal=_modal(t, words),
+        arc_check=t.string("arc_check", "none", choices=ARC_CHECKS),
+        **codes,
+    )
+    t.done()
+    _check(spec, t)
+    return spec
+
+
+def _pattern(t: _Table, key: str, default: str, pattern: re.Pattern[str], want: str) -> str:
+    value: str = t.string(key, default)
+    if not pattern.fullmatch(value):
+        raise t.error(key, f"expected {want}, got {_show(value)}")
+    return value
+
+
+def _max_arc(t: _Table) -> float:
+    value = t.number("max_arc_deg", 360.0)
+    assert value is not None
+    if not 1.0 <= value <= 360.0:
+        raise t.error("max_arc_deg", f"expected a number from 1 to 360, got {_show(value)}")
+    return value
+
+
+def _code(t: _Table, key: str, value: Any) -> str:
+    if not isinstance(value, str) or not _CODE.fullmatch(value):
+        raise t.error(key, f'expected a code such as "G01" or "M30", got {_show(value)}')
+    return value
+
+
+def _codes(t: _Table) -> dict[str, Any]:
+    """The code keys: motion codes, spindle, dwell, tool change and end."""
+    motion = t.table("motion_codes")
+    defaults = dict(zip(MOTIONS, ("G0", "G1", "G2", "G3"), strict=True))
+    given = {m: motion.get(m) for m in MOTIONS}
+    spelled = tuple(_code(motion, m, defaults[m] if v is None else v) for m, v in given.items())
+    motion.done()
+    for m, code in zip(MOTIONS, spelled, strict=True):
+        if not code.startswith("G"):
+            raise motion.error(m, f"a motion code is a G code, got {_show(code)}")
+    out: dict[str, Any] = {"motion_codes": spelled}
+    for key in ("spindle_cw", "spindle_ccw", "spindle_off", "dwell", "tool_change"):
+        value = t.get(key)
+        out[key] = None if value is None else _code(t, key, value)
+    out["end"] = tuple(_code(t, "end", v) for v in t.strings("end"))
+    return out
+
+
+def _blocks(t: _Table, key: str) -> tuple[tuple[str, ...], ...]:
+    blocks = []
+    for i, text in enumerate(t.strings(key)):
+        codes = tuple(text.split())
+        if not codes or not all(_CODE.fullmatch(c) for c in codes):
+            raise t.error(
+                f"{key}[{i}]",
+                f'expected codes separated by spaces (such as "G21 G90 G17"), got {_show(text)}',
+            )
+        blocks.append(codes)
+    return tuple(blocks)
+
+
+def _modal(t: _Table, words: Mapping[str, WordSpec]) -> frozenset[str]:
+    value = t.get("modal")
+    letters = ["F"] if value is None else t.strings("modal")
+    for letter in letters:
+        if letter not in MODAL_LETTERS:
+            raise t.error(
+                "modal", f"expected letters among {_show(list(MODAL_LETTERS))}, got {_show(letter)}"
+            )
+        if letter != "G" and letter not in words and value is not None:
+            raise t.error("modal", f"{_show(letter)} is not a word of this dialect (see words)")
+    return frozenset(letters) & (frozenset("G") | frozenset(words))
+
+
+def _words(t: _Table) -> dict[str, WordSpec]:
+    """The ``words`` table; a key of several letters (``XYIJ``) sets each of them."""
+    words: dict[str, WordSpec] = {}
+    for key in list(t.data):
+        sub = t.table(key)
+        if not key or any(c not in WORD_LETTERS for c in key):
+            raise t.error(key, f"unknown word; words are among {_show(list(WORD_LETTERS))}")
+        number = _number_format(sub)
+        for letter in key:
+            if letter in words:
+                raise t.error(key, f"word {letter} is defined twice")
+            words[letter] = WordSpec(letter, number)
+    t.done()
+    for letter in "XY":
+        if letter not in words:
+            raise t.error("", f"the X and Y words are required, {letter} is missing")
+    if "T" in words and words["T"].number.decimals != 0:
+        raise t.error("T.decimals", "a tool number is an integer: use decimals = 0")
+    return words
+
+
+def _number_format(t: _Table) -> NumberFormat:
+    decimals = t.integer("decimals", 3)
+    min_decimals = t.integer("min_decimals", None)
+    assert decimals is not None
+    if min_decimals is not None and min_decimals > decimals:
+        raise t.error("min_decimals", f"expected at most decimals ({decimals}), got {min_decimals}")
+    number = NumberFormat(
+        scale=t.number("scale", 1.0) or 1.0,
+        decimals=decimals,
+        int_digits=t.integer("int_digits", None, low=1),
+        sign=t.string("sign", "negative", choices=SIGN_POLICIES),
+        min_decimals=min_decimals,
+        pad=t.flag("zero_pad", False),
+        grid_mm=t.number("grid_mm", None),
+    )
+    t.done()
+    if number.grid_mm is not None:
+        step = 10.0 ** (-decimals) / number.scale
+        if abs(number.grid_mm / step - round(number.grid_mm / step)) > 1e-6:
+            raise t.error(
+                "grid_mm",
+                f"{number.grid_mm:g} mm is not a multiple of the {step:g} mm the word can write",
+            )
+    return number
+
+
+def _check(spec: WordAddressSpec, t: _Table) -> None:
+    """Cross-key rules (each error names the key to change)."""
+    if spec.arc_check != "none" or "I" in spec.words or "J" in spec.words:
+        for letter in "IJ":
+            if letter not in spec.words:
+                raise t.error("words", f"arcs need both I and J words; {letter} is missing")
+    if spec.has("Z") != (spec.z_moves != "none"):
+        want = '"own-block" or "with-xy"' if spec.has("Z") else '"none" (there is no Z word)'
+        raise t.error("z_moves", f"expected {want}, got {_show(spec.z_moves)}")
+    if spec.helix and spec.z_moves != "with-xy":
+        raise t.error("helix", 'a helix needs z_moves = "with-xy"')
+    if spec.dwell and not spec.has("P"):
+        raise t.error("dwell", "a dwell code needs a P word (seconds) in words")
+    if spec.tool_change and not spec.has("T"):
+        raise t.error("tool_change", "a tool change code needs a T word in words")
+    roles = [*spec.motion_codes, *spec.end]
+    roles += [c for c in (spec.spindle_cw, spec.spindle_ccw, spec.spindle_off) if c]
+    roles += [c for c in (spec.dwell, spec.tool_change) if c]
+    if len(set(roles)) != len(roles):
+        twice = sorted({c for c in roles if roles.count(c) > 1})
+        raise t.error("", f"code(s) {', '.join(twice)} given two meanings")
+    for key, blocks in (("preamble", spec.preamble), ("postamble", spec.postamble)):
+        for code in (c for block in blocks for c in block):
+            _check_static(t, key, code, spec, set(roles))
+
+
+def _check_static(t: _Table, key: str, code: str, spec: WordAddressSpec, roles: set[str]) -> None:
+    """A preamble or postamble code must not move the tool or contradict the spec."""
+    value = float(code[1:])
+    if code in roles:
+        raise t.error(key, f"{code} has its own key; the {key} holds setup codes only")
+    if code[0] == "G" and value in (0, 1, 2, 3):
+        raise t.error(key, f"{code} is a motion code; the {key} holds setup codes only")
+    if code[0] == "G" and value == 91:
+        raise t.error(key, "G91 (incremental coordinates): camtool writes absolute coordinates")
+    if code[0] == "G" and value == 90.1 and spec.arc_centre != "absolute":
+        raise t.error(key, 'G90.1 (absolute arc centre) needs arc_centre = "absolute"')
+    if code[0] == "G" and value == 91.1 and spec.arc_centre != "incremental":
+        raise t.error(key, 'G91.1 (incremental arc centre) needs arc_centre = "incremental"')

@@ -1,0 +1,577 @@
+"""The word-address dialect engine: strict spec loading, formatting, writer and reader rules.
+
+The thesis targets built on it are tested in test_flashcut.py, test_valcnc.py and
+test_grbl_linuxcnc.py; here a dialect is whatever a [dialect_options] table says.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from camtool.errors import DialectError, InputError, ParseError
+from camtool.machine import Machine
+from camtool.post.registry import load_target
+from camtool.post.wordaddress import WordAddressPost, word_address_dialect
+from camtool.program import (
+    ArcMove,
+    Dwell,
+    Home,
+    Linear,
+    Move,
+    Program,
+    Rapid,
+    Spindle,
+    ToolChange,
+)
+
+BIG = Machine(name="test bench", steps_per_mm=(1000.0,) * 3, work_area_mm=(-900, -900, 900, 900))
+"""A machine that never limits the dialect (work area ±900 mm, Z axis)."""
+
+RS274: dict[str, Any] = {
+    "preamble": ["G21 G90 G17"],
+    "spindle_cw": "M3",
+    "spindle_ccw": "M4",
+    "spindle_off": "M5",
+    "dwell": "G4",
+    "tool_change": "M6",
+    "end": ["M2", "M30"],
+    "helix": True,
+    "words": {
+        "XYZIJ": {"decimals": 3},
+        "F": {"decimals": 1, "min_decimals": 0},
+        "S": {"decimals": 0},
+        "P": {"decimals": 3, "min_decimals": 0},
+        "T": {"decimals": 0},
+    },
+}
+"""A plain RS-274 dialect: the defaults plus spindle, dwell, tool change and end codes."""
+
+
+def post(options: dict[str, Any], where: str = "toy.toml") -> WordAddressPost:
+    return word_address_dialect(options, where)
+
+
+def emit(
+    options: dict[str, Any], moves: tuple[Move, ...], **program: Any
+) -> tuple[list[str], tuple[str, ...]]:
+    result = post(options).emit(Program(moves, **program), BIG)
+    return str(result.code).splitlines(), result.warnings
+
+
+# -- strict loading: every error names the file and the full key path ---------------------
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        (
+            {"words": {"XY": {"decimals": "3"}}},
+            'toy.toml: dialect_options.words.XY.decimals: expected an integer, got "3"',
+        ),
+        (
+            {"words": {"XY": {}}, "seperator": ""},
+            r'dialect_options: unknown key\(s\) "seperator"; known: .*separator',
+        ),
+        (
+            {"words": {"XY": {"decimal": 2}}},
+            r'words.XY: unknown key\(s\) "decimal"; known: .*decimals',
+        ),
+        ({"words": {"XYQ": {}}}, "dialect_options.words.XYQ: unknown word; words are among"),
+        (
+            {"words": {"X": {}}},
+            "dialect_options.words: the X and Y words are required, Y is missing",
+        ),
+        ({"words": {"XY": {}, "X": {}}}, "dialect_options.words.X: word X is defined twice"),
+        ({"words": 3}, "dialect_options.words: expected a table, got 3"),
+        (
+            {"words": {"XY": {}}, "separator": ","},
+            r'separator: expected one of \["", " "\], got ","',
+        ),
+        (
+            {"words": {"XY": {}}, "z_moves": "own-block"},
+            'z_moves: expected "none" .there is no Z word',
+        ),
+        ({"words": {"XYZ": {}}, "z_moves": "none"}, 'z_moves: expected "own-block" or "with-xy"'),
+        ({"words": {"XYZIJ": {}}, "helix": True, "z_moves": "own-block"}, "helix: a helix needs"),
+        ({"words": {"XY": {}}, "dwell": "G4"}, "dwell: a dwell code needs a P word"),
+        ({"words": {"XY": {}}, "tool_change": "M6"}, "tool_change: a tool change code needs a T"),
+        ({"words": {"XYT": {"decimals": 3}}}, "words.T.decimals: a tool number is an integer"),
+        ({"words": {"XYI": {}}}, "words: arcs need both I and J words; J is missing"),
+        ({"words": {"XY": {}}, "modal": ["I"]}, 'modal: expected letters among .*, got "I"'),
+        ({"words": {"XY": {}}, "modal": ["F"]}, 'modal: "F" is not a word of this dialect'),
+        ({"words": {"XY": {}}, "preamble": ["G01"]}, r"preamble: G01 is a motion code"),
+        ({"words": {"XY": {}}, "preamble": ["G1"]}, r"preamble: G1 has its own key"),
+        ({"words": {"XY": {}}, "preamble": ["G91"]}, r"preamble: G91 .incremental coordinates"),
+        (
+            {"words": {"XY": {}}, "preamble": ["G21 X1"]},
+            r'preamble\[0\]: expected codes .*"G21 X1"',
+        ),
+        (
+            {"words": {"XY": {}}, "preamble": ["M30"], "end": ["M30"]},
+            "preamble: M30 has its own key",
+        ),
+        (
+            {"words": {"XYIJ": {}}, "preamble": ["G90.1"]},
+            'preamble: G90.1 .absolute arc centre. needs arc_centre = "absolute"',
+        ),
+        (
+            {"words": {"XY": {}}, "motion_codes": {"cw": "M3"}},
+            "motion_codes.cw: a motion code is a G",
+        ),
+        (
+            {"words": {"XY": {}}, "motion_codes": {"cw": 2}},
+            "motion_codes.cw: expected a code such as",
+        ),
+        (
+            {"words": {"XY": {}}, "motion_codes": {"arc": "G2"}},
+            r'motion_codes: unknown key\(s\) "arc"',
+        ),
+        ({"words": {"XY": {}}, "spindle_off": "M30", "end": ["M30"]}, r"code\(s\) M30 given two"),
+        ({"words": {"XY": {}}, "max_arc_deg": 400}, "max_arc_deg: expected a number from 1 to 360"),
+        ({"words": {"XY": {}}, "max_block_bytes": 4.5}, "max_block_bytes: expected an integer"),
+        ({"words": {"XY": {}}, "full_circle": "both"}, "full_circle: expected one of"),
+        ({"words": {"XY": {}}, "helix": "yes"}, 'helix: expected true or false, got "yes"'),
+        ({"words": {"XY": {}}, "block_end": "ab"}, "block_end: expected up to 4 punctuation"),
+        ({"words": {"XY": {"decimals": 1, "grid_mm": 0.04}}}, "grid_mm: 0.04 mm is not a multiple"),
+        ({"words": {"XY": {"decimals": 1, "min_decimals": 2}}}, "min_decimals: expected at most"),
+        (
+            {"words": {"XY": {"sign": "plus"}}},
+            'words.XY.sign: expected one of \\["negative", "always"\\]',
+        ),
+        ({"words": {"XY": {"scale": -1}}}, "words.XY.scale: expected a positive number, got -1"),
+    ],
+)
+def test_spec_errors_name_file_and_key(options: dict[str, Any], message: str) -> None:
+    with pytest.raises(InputError, match=message) as info:
+        post(options)
+    assert str(info.value).startswith("toy.toml: dialect_options")
+
+
+def test_a_bad_target_file_names_itself_and_the_key(tmp_path: Path) -> None:
+    bad = tmp_path / "mine.toml"
+    bad.write_text(
+        'name = "mine"\ndialect = "word-address"\nmachine = "grbl"\n'
+        "[dialect_options.words.XY]\ndecimals = 3\nsign = 1\n",
+        encoding="utf-8",
+    )
+    with pytest.raises(InputError, match=rf"{re.escape(str(bad))}: dialect_options.words.XY.sign"):
+        load_target(str(bad))
+
+
+# -- formatting (all through camtool.post.numfmt) -----------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("word", "value", "text"),
+    [
+        ({"decimals": 3, "min_decimals": 1}, 1.0, "1.0"),  # FlashCut X1.0 (seed-001 L1004, R7)
+        ({"decimals": 3, "min_decimals": 1}, -1.0, "-1.0"),  # I-1.0 (seed-001 L1021)
+        ({"decimals": 3, "min_decimals": 1}, 2.969, "2.969"),
+        ({"decimals": 3, "min_decimals": 1}, 1.25, "1.25"),
+        ({"decimals": 3, "min_decimals": 1}, -0.0004, "0.0"),  # never -0
+        ({"decimals": 3}, -0.0004, "0.000"),
+        ({"decimals": 3}, 0.0005, "0.001"),  # half away from zero
+        ({"decimals": 3, "sign": "always"}, 1.0, "+1.000"),
+        ({"decimals": 2, "min_decimals": 0}, 12.0, "12"),
+        ({"decimals": 2, "min_decimals": 0, "grid_mm": 0.04}, 0.05, "0.04"),  # 25 steps/mm
+        ({"decimals": 2, "min_decimals": 0, "grid_mm": 0.04}, 0.07, "0.08"),
+        ({"decimals": 0, "scale": 25.0}, 8.0, "200"),  # steps: 8 mm = 200 steps (S004-R08)
+        ({"decimals": 2, "scale": 1000.0, "int_digits": 5, "zero_pad": True}, 2.969, "02969.00"),
+        ({"decimals": 3, "int_digits": 4}, 1.5, "1.500"),  # a limit without padding
+    ],
+)
+def test_word_format_table(word: dict[str, Any], value: float, text: str) -> None:
+    lines, _ = emit({"words": {"XY": word}, "modal": []}, (Rapid(value, value),))
+    assert lines == [f"G0 X{text} Y{text}"]
+
+
+def test_the_pic_mmh_block_can_be_declared_in_toml() -> None:
+    # seed-000 L1731, verbatim: fixed-width µm, absolute centre, F in 0.1 mm/min, ';'.
+    um = {"scale": 1000.0, "decimals": 2, "int_digits": 5, "zero_pad": True}
+    options = {
+        "separator": "",
+        "block_end": ";",
+        "arc_centre": "absolute",
+        "modal": [],
+        "motion_codes": {"rapid": "G00", "linear": "G01", "cw": "G02", "ccw": "G03"},
+        "words": {
+            "XYIJ": um,
+            "F": {"scale": 10.0, "decimals": 0, "int_digits": 2, "zero_pad": True},
+        },
+    }
+    r = math.dist((2.969, 3.400), (3.012, 3.040))
+    start = (3.012 - r, 3.040)
+    lines, _ = emit(options, (Rapid(*start), ArcMove(2.969, 3.4, 3.012, 3.04, True, 0.8)))
+    assert lines[1] == "G02X02969.00Y03400.00I03012.00J03040.00F08;"
+    back = post(options).parse("\n".join(lines))
+    assert back.moves[1] == ArcMove(2.969, 3.4, 3.012, 3.04, True, 0.8, contour=1)
+
+
+def test_number_over_its_field_names_the_block() -> None:
+    with pytest.raises(DialectError, match=r"contour 2, block 2: X = 123.000 does not fit 2"):
+        emit(
+            {"words": {"XY": {"int_digits": 2}}}, (Rapid(1, 1, contour=1), Rapid(123, 1, contour=2))
+        )
+
+
+# -- the writer ----------------------------------------------------------------------------
+
+
+def test_rs274_program_with_every_command() -> None:
+    moves = (Rapid(0, 0, z=5.0), Rapid(10, 0), Linear(10, 0, 120.0, z=-1.0), Linear(20, 0, 120.0))
+    commands = ((0, Spindle("cw", 12000)), (1, ToolChange(3)), (2, Dwell(0.5)), (4, Spindle("off")))
+    lines, warnings = emit(RS274, moves, commands=commands)
+    assert lines == [
+        "G21 G90 G17",
+        "M3 S12000",
+        "G0 X0.000 Y0.000 Z5.000",
+        "M6 T3",
+        "G0 X10.000 Y0.000",
+        "G4 P0.5",
+        "G1 X10.000 Y0.000 Z-1.000 F120",
+        "G1 X20.000 Y0.000",  # F is modal (default modal = ["F"])
+        "M5",
+        "M2",
+    ]
+    assert warnings == ()
+
+
+def test_what_the_dialect_lacks_is_dropped_with_one_warning_per_kind() -> None:
+    moves = (Rapid(0, 0), Linear(1, 0, 100.0), Linear(1, 1, 100.0))
+    commands = ((0, Spindle("cw", 1000)), (2, Dwell(1.0)), (2, Home("XY")), (3, Spindle("off")))
+    lines, warnings = emit({"words": {"XY": {}}}, moves, commands=commands)
+    assert lines == ["G0 X0.000 Y0.000", "G1 X1.000 Y0.000", "G1 X1.000 Y1.000"]
+    assert len(warnings) == 4
+    assert "toy has no F word: the feed of 2 cutting block(s)" in warnings[0]
+    assert "toy has no spindle command: 2 spindle command(s) dropped" in warnings[1]
+    assert "toy has no dwell: 1 pause(s) dropped" in warnings[2]
+    assert "1 G28-style return(s)" in warnings[3]
+
+
+def test_spindle_without_s_word_keeps_the_code_and_warns() -> None:
+    options = {"words": {"XY": {}}, "spindle_cw": "M03", "spindle_off": "M05"}
+    lines, warnings = emit(options, (Rapid(0, 0),), commands=((0, Spindle("cw", 500)),))
+    assert lines[0] == "M03"
+    assert warnings == (
+        "toy's M03 takes no S word: 1 spindle speed(s) not written; set the speed on the machine",
+    )
+
+
+def test_feed_rounding_is_warned_once() -> None:
+    options = {"words": {"XY": {}, "F": {"decimals": 0}}}
+    lines, warnings = emit(options, (Rapid(0, 0), Linear(1, 0, 99.6), Linear(2, 0, 99.6)))
+    assert lines[1] == "G1 X1.000 Y0.000 F100"
+    assert warnings == ("feed 99.6 mm/min written as F100 (100 mm/min)",)
+
+
+def test_feed_that_rounds_to_zero_is_an_error() -> None:
+    with pytest.raises(DialectError, match=r"block 2: feed 0.4 mm/min rounds to F0"):
+        emit({"words": {"XY": {}, "F": {"decimals": 0}}}, (Rapid(0, 0), Linear(1, 0, 0.4)))
+
+
+def test_modal_axes_and_motion_omit_unchanged_words() -> None:
+    options = {"words": {"XY": {}, "F": {"decimals": 0}}, "modal": ["G", "X", "Y", "F"]}
+    moves = (Rapid(0, 0), Linear(5, 0, 100.0), Linear(5, 3, 100.0), Linear(5, 3, 100.0))
+    lines, _ = emit(options, moves)
+    assert lines == ["G0 X0.000 Y0.000", "G1 X5.000 F100", "Y3.000", "X5.000 Y3.000"]
+    back = post(options).parse("\n".join(lines)).moves
+    assert [(m.x, m.y) for m in back] == [(0, 0), (5, 0), (5, 3), (5, 3)]
+
+
+def test_z_own_block_splits_rising_first_and_plunging_last() -> None:
+    # seed-001 R7: Z moves in their own blocks.
+    options = {"words": {"XYZ": {"decimals": 1}}, "z_moves": "own-block", "modal": []}
+    moves = (Rapid(0, 0, z=5.0), Rapid(2, 0, z=1.0), Rapid(4, 0, z=6.0), Linear(4, 0, 9.0, z=3.0))
+    lines, warnings = emit(options, moves)
+    assert lines == [
+        "G0 Z5.0",  # at the origin already: a Z-only move is one block
+        "G0 X2.0 Y0.0",  # plunging (5 → 1): XY first, then Z
+        "G0 Z1.0",
+        "G0 Z6.0",  # rising (1 → 6): Z first, then XY
+        "G0 X4.0 Y0.0",
+        "G1 Z3.0",
+    ]
+    assert any(w.startswith("2 move(s) changing XY and Z together") for w in warnings)
+
+
+def test_z_without_a_z_word_is_an_error() -> None:
+    with pytest.raises(DialectError, match=r"block 1: toy has no Z axis \(z = -1 mm\)"):
+        emit({"words": {"XY": {}}}, (Linear(1, 1, 100.0, z=-1.0),))
+
+
+def test_a_helix_needs_helix() -> None:
+    options: dict[str, Any] = {"words": {"XYZIJ": {}}}
+    with pytest.raises(DialectError, match=r"an arc that moves Z .a helix. cannot be written"):
+        emit(options, (Rapid(1, 0), ArcMove(-1, 0, 0, 0, False, 100.0, z=-1.0)))
+
+
+def test_helix_split_interpolates_z() -> None:
+    options = {**RS274, "max_arc_deg": 180.0, "full_circle": "split"}
+    moves = (Rapid(1, 0, z=0.0), ArcMove(1, 0, 0, 0, False, 100.0, z=-2.0))
+    lines, _ = emit(options, moves)
+    assert lines[2:4] == [
+        "G3 X-1.000 Y0.000 Z-1.000 I-1.000 J0.000 F100",
+        "G3 X1.000 Y0.000 Z-2.000 I1.000 J0.000",
+    ]
+
+
+def test_block_over_max_block_bytes_names_block_and_limit() -> None:
+    options = {"words": {"XY": {}}, "max_block_bytes": 17}
+    with pytest.raises(
+        DialectError, match=r"block 2: 'G0 X100.000 Y1.000' is 19 bytes .* at most 17"
+    ):
+        emit(options, (Rapid(1, 1), Rapid(100, 1)))
+
+
+@pytest.mark.parametrize(
+    ("limit", "full", "sweep_deg", "pieces"),
+    [
+        (360.0, "one-block", 360, 1),
+        (360.0, "split", 360, 2),
+        (180.0, "split", 360, 2),
+        (90.0, "split", 360, 4),
+        (180.0, "one-block", 270, 2),
+        (100.0, "one-block", 270, 3),
+        (180.0, "one-block", 180, 1),
+    ],
+)
+def test_arcs_split_by_max_arc_deg_and_full_circle(
+    limit: float, full: str, sweep_deg: int, pieces: int
+) -> None:
+    options = {"words": {"XYIJ": {}}, "max_arc_deg": limit, "full_circle": full}
+    a = math.radians(sweep_deg)
+    end = (round(10 * math.cos(a), 9), round(10 * math.sin(a), 9))
+    lines, _ = emit(options, (Rapid(10, 0), ArcMove(*end, 0, 0, False, 100.0)))
+    arcs = lines[1:]
+    assert len(arcs) == pieces
+    back = post(options).parse("\n".join(lines)).moves[1:]
+    per_piece = sweep_deg / pieces  # equal pieces (analytic)
+    start = (10.0, 0.0)
+    for move in back:
+        assert isinstance(move, ArcMove)
+        swept = (
+            math.degrees(
+                (math.atan2(move.y - move.cy, move.x - move.cx) - math.atan2(start[1], start[0]))
+                % (2 * math.pi)
+            )
+            or 360.0
+        )
+        assert swept == pytest.approx(per_piece, abs=0.01)
+        start = (move.x, move.y)
+
+
+def test_arc_too_small_for_the_resolution_becomes_a_line() -> None:
+    # r = 0.0003 mm at 3 decimals: the centre rounds onto the start.
+    options: dict[str, Any] = {"words": {"XYIJ": {}}}
+    lines, warnings = emit(options, (Rapid(1, 1), ArcMove(1.0006, 1, 1.0003, 1, True, 100.0)))
+    assert lines[1] == "G1 X1.001 Y1.000"
+    assert "1 arc(s) too small for the 0.001 mm" in warnings[-1]
+
+
+def test_an_arc_whose_ends_print_the_same_is_a_tiny_arc_or_a_full_circle() -> None:
+    options = {"words": {"XYIJ": {}}, "full_circle": "split"}
+    # 359.99999° (the end 6e-8 mm from the start): a full circle as printed → two halves.
+    near = (5.0, 5.0 - 6e-8)
+    lines, _ = emit(options, (Rapid(5, 5), ArcMove(*near, 4.5, near[1], False, 100.0)))
+    assert lines[1:] == ["G3 X4.000 Y5.000 I-0.500 J0.000", "G3 X5.000 Y5.000 I0.500 J0.000"]
+    # 0.0001° of a 10 mm radius: nothing to print but a line to the same point.
+    tiny = (10 * math.cos(1e-6), 10 * math.sin(1e-6))
+    lines, warnings = emit(options, (Rapid(10, 0), ArcMove(*tiny, 0, 0, False, 100.0)))
+    assert lines[1:] == ["G1 X10.000 Y0.000"] and "1 arc(s) too small" in warnings[-1]
+
+
+def test_absolute_and_incremental_centres_read_to_the_same_arc() -> None:
+    moves = (Rapid(1, 0), ArcMove(0, 1, 0, 0, False, 100.0))
+    for centre in ("incremental", "absolute"):
+        options = {"words": {"XYIJ": {}, "F": {"decimals": 0}}, "arc_centre": centre}
+        lines, _ = emit(options, moves)
+        assert lines[1] == (
+            "G3 X0.000 Y1.000 I-1.000 J0.000 F100"
+            if centre == "incremental"
+            else "G3 X0.000 Y1.000 I0.000 J0.000 F100"
+        )
+        assert post(options).parse("\n".join(lines)).moves[1] == ArcMove(
+            0, 1, 0, 0, False, 100.0, contour=1
+        )
+
+
+# -- the reader ----------------------------------------------------------------------------
+
+FLASHLIKE: dict[str, Any] = {
+    "motion_codes": {"rapid": "G00", "linear": "G01", "cw": "G02", "ccw": "G03"},
+    "z_moves": "own-block",
+    "spindle_cw": "M03",
+    "spindle_off": "M05",
+    "end": ["M30"],
+    "words": {"XYZIJ": {"decimals": 3, "min_decimals": 1}, "F": {"decimals": 1, "min_decimals": 1}},
+}
+
+
+@pytest.mark.parametrize(
+    ("line", "why"),
+    [
+        ("G01 X1 Y1.0", "X1 is not in the format of X"),  # at least one decimal (R7)
+        ("G01 X1.00 Y1.0", "X1.00 is not in the format"),  # trailing zero beyond min_decimals
+        ("G01 X-0.0 Y1.0", "X-0.0 is not in the format"),  # never -0
+        ("G01 X+1.0 Y1.0", "X\\+1.0 is not in the format"),
+        ("G01 X1e3 Y1.0", "'X1e3' is not a word"),
+        ("G01  X1.0 Y1.0", "separated by one space"),
+        ("G01X1.0 Y1.0", "separated by one space"),
+        ("G01 X1.0", "missing Y word"),  # both X and Y (seed-001 R4)
+        ("G1 X1.0 Y1.0", "unknown code 'G1'"),
+        ("G17", "unknown code 'G17'"),
+        ("G01 X1.0 Y1.0 Q1.0", "unknown word Q1.0"),
+        ("G01 X1.0 Y1.0 X2.0", "X appears twice"),
+        ("G02 X1.0 Y1.0 I1.0", "missing J word"),
+        ("G00 X1.0 Y1.0 F3.0", "F in a rapid block"),
+        ("G01 X1.0 Y1.0 M03", "G01, X, Y in a spindle block"),
+        ("X1.0 Y1.0", "without a motion code"),
+        ("G01 X1.0 Z1.0", "moves Z in blocks of its own"),
+        ("G02 X2.0 Y0.0 I0.0 J0.0", "centre is its start point"),
+        ("M05 S100.0", "unknown word S100.0"),
+        ("g01 x1.0 y1.0", "unknown word g01"),
+    ],
+)
+def test_reader_is_strict(line: str, why: str) -> None:
+    with pytest.raises(ParseError, match=rf"prog.nc:2: .*{why}"):
+        post(FLASHLIKE).parse(f"G01 X0.0 Y0.0 F3.0\n{line}\n", source="prog.nc")
+
+
+def test_nothing_after_the_end_code() -> None:
+    with pytest.raises(
+        ParseError, match=r"prog.nc:3: 'G00 X1.0 Y1.0' after the program end on line 2"
+    ):
+        post(FLASHLIKE).parse("G00 X0.0 Y0.0\nM30\nG00 X1.0 Y1.0\n", source="prog.nc")
+
+
+def test_reader_refuses_blocks_over_the_byte_limit() -> None:
+    options = {"words": {"XY": {}}, "separator": "", "max_block_bytes": 20}
+    with pytest.raises(
+        ParseError, match="p:1: block is 21 bytes with its line end; toy takes at most 20"
+    ):
+        post(options).parse("G0X100.000Y100.00000\n", source="p")
+
+
+def test_reader_block_end_and_no_spaces() -> None:
+    options = {"words": {"XY": {}}, "separator": "", "block_end": ";"}
+    assert post(options).parse("G0X1.000Y2.000;\n").moves == (Rapid(1, 2, contour=1),)
+    for bad in ("G0X1.000Y2.000", "G0 X1.000Y2.000;"):
+        with pytest.raises(ParseError, match="<code>:1"):
+            post(options).parse(bad)
+
+
+def test_reader_fills_lines_commands_and_contours() -> None:
+    code = "\n".join(
+        [
+            "G21 G90 G17",
+            "M3 S1000",
+            "G0 X0.000 Y0.000 Z5.000",
+            "G1 X1.000 Y0.000 Z-1.000 F100",
+            "G4 P0.25",
+            "G2 X-1.000 Y0.000 I-1.000 J0.000",
+            "G0 X5.000 Y5.000",
+            "M6 T2",
+            "G1 X6.000 Y5.000",
+            "M5",
+            "M30",
+        ]
+    )
+    program = post(RS274).parse(code, source="p.ngc")
+    assert program.moves == (
+        Rapid(0, 0, 5.0, contour=1),
+        Linear(1, 0, 100.0, -1.0, contour=1),
+        ArcMove(-1, 0, 0, 0, True, 100.0, contour=1),
+        Rapid(5, 5, contour=2),
+        Linear(6, 5, 100.0, contour=2),  # F is modal
+    )
+    assert program.lines == (3, 4, 6, 7, 9)
+    assert program.commands == (
+        (0, Spindle("cw", 1000.0)),
+        (2, Dwell(0.25)),
+        (4, ToolChange(2)),
+        (5, Spindle("off")),
+    )
+
+
+def test_reader_modal_motion_and_axes_per_rs274() -> None:
+    options = {"words": {"XYIJ": {}, "F": {"decimals": 0}}, "modal": ["G", "X", "Y", "F"]}
+    code = (
+        "G1 X1.000 Y1.000 F50\nX2.000\nG2 X3.000 Y2.000 I0.000 J1.000\nX4.000 Y1.000 I0.000 J-1.000"
+    )
+    moves = post(options).parse(code).moves
+    assert moves == (
+        Linear(1, 1, 50.0, contour=1),
+        Linear(2, 1, 50.0, contour=1),
+        ArcMove(3, 2, 2, 2, True, 50.0, contour=1),
+        ArcMove(4, 1, 3, 1, True, 50.0, contour=1),  # G2 carries, I/J from the new start
+    )
+
+
+def test_reader_needs_f_where_f_is_not_modal() -> None:
+    options = {"words": {"XY": {}, "F": {"decimals": 0}}, "modal": []}
+    with pytest.raises(ParseError, match=":2: missing F word"):
+        post(options).parse("G1 X1.000 Y1.000 F50\nG1 X2.000 Y1.000")
+    with pytest.raises(ParseError, match=":1: a cutting move before any F word"):
+        post({"words": {"XY": {}, "F": {}}}).parse("G1 X1.000 Y1.000")
+
+
+def test_reader_without_f_word_reads_feed_zero() -> None:
+    assert post({"words": {"XY": {}}}).parse("G1 X1.000 Y1.000").moves[0].feed_mm_min == 0.0  # type: ignore[union-attr]
+
+
+def test_a_user_dialect_file_is_a_target(tmp_path: Path) -> None:
+    # What docs/dialects.md shows: a Fanuc-like dialect with N-less blocks, ';' and inches.
+    path = tmp_path / "my-router.toml"
+    path.write_text(
+        """
+name = "my-router"
+description = "my router: inch G-code with ';' block ends"
+dialect = "word-address"
+default_feed_mm_min = 254.0
+machine = "grbl"
+
+[dialect_options]
+suffix = ".tap"
+block_end = ";"
+preamble = ["G20 G90"]
+motion_codes = { rapid = "G00", linear = "G01", cw = "G02", ccw = "G03" }
+spindle_cw = "M03"
+spindle_off = "M05"
+end = ["M30"]
+
+[dialect_options.words.XYIJ]
+scale = 0.03937007874015748   # inches per mm
+decimals = 4
+
+[dialect_options.words.F]
+scale = 0.03937007874015748   # inches/min per mm/min
+decimals = 1
+""",
+        encoding="utf-8",
+    )
+    target = load_target(str(path))
+    assert target.name == "my-router" and target.post.formats == {"code": ".tap"}
+    program = Program(
+        (Rapid(25.4, 0.0), Linear(50.8, 0.0, 254.0), ArcMove(76.2, 25.4, 50.8, 25.4, False, 254.0)),
+        commands=((0, Spindle("cw", 9000)), (3, Spindle("off"))),
+    )
+    result = target.emit(program)
+    assert str(result.code).splitlines() == [
+        "G20 G90;",
+        "M03;",
+        "G00 X1.0000 Y0.0000;",
+        "G01 X2.0000 Y0.0000 F10.0;",
+        "G03 X3.0000 Y1.0000 I0.0000 J1.0000;",
+        "M05;",
+        "M30;",
+    ]
+    assert "my-router's M03 takes no S word" in result.warnings[0]
+    back = target.post.parse(result.code)
+    for got, want in zip(back.moves, program.moves, strict=True):
+        assert math.dist((got.x, got.y), (want.x, want.y)) < 1e-9
+    assert back.commands == ((0, Spindle("cw", 0.0)), (3, Spindle("off")))
