@@ -63,6 +63,10 @@ def simulate_servo(program: Program, machine: Machine) -> StepTrace:
         if first:
             rapid = np.abs(trace.first_point_mm - position)
             times[first - 1] += float(rapid.sum()) / first_speed_mm_s  # X, then Y (R13)
+            # where the positioning left the carriage: the rapid's one trace row, so the
+            # stroke's measures start there (not at the end of the stroke before)
+            points.append(np.asarray(trace.first_point_mm, dtype=np.float64).reshape(1, 2))
+            blocks.append(np.full(1, first - 1, dtype=np.int64))
         for i, block in enumerate(owner):
             hi = int(trace.segment_end_sample[i])
             lo = int(trace.segment_end_sample[i - 1]) if i else 0

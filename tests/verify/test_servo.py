@@ -411,3 +411,25 @@ def test_backlash_has_no_effect_when_the_job_ends_moving_plus() -> None:
 def test_negative_backlash_is_rejected(star_trace) -> None:  # type: ignore[no-untyped-def]
     with pytest.raises(UsageError):
         closure_mm(star_trace, backlash_mm=(-0.01, 0.0))
+
+
+def test_each_strokes_measures_start_where_the_positioning_left_the_carriage() -> None:
+    """Two squares 30 mm apart: the second's closure and size are its own, not the gap.
+
+    The router moves to each job's first point X then Y (seed-002 R13); that point,
+    not the end of the stroke before, is where the second contour starts.
+    """
+    from camtool.machine import load_machine
+    from camtool.program import Linear, Program, Rapid
+    from camtool.verify.verifier import verify_program
+
+    def square(x: float) -> list[Rapid | Linear]:
+        corners = [(x + 10, 10.0), (x + 10, 20.0), (x, 20.0), (x, 10.0)]
+        return [Rapid(x, 10.0), *(Linear(cx, cy, 225.0) for cx, cy in corners)]
+
+    v = verify_program(Program((*square(10.0), *square(40.0))), load_machine("router-2011"))
+    assert len(v.contours) == 2
+    for contour in v.contours:
+        assert contour.closure_um is not None
+        assert max(abs(c) for c in contour.closure_um) <= 800.0  # 4 sides, ≤ 0.2 mm floor each
+        assert max(abs(e) for e in contour.size_error_um) <= 400.0
