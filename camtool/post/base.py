@@ -74,6 +74,14 @@ class PostProcessor(ABC):
             UsageError: ``fmt`` is not one of :attr:`formats`.
         """
 
+    def for_machine(self, machine: Machine) -> PostProcessor:
+        """This dialect bound to ``machine`` (every :class:`Target` binds its own).
+
+        A dialect whose code is in machine units (motor steps) needs the
+        machine's steps/mm to read code back; the default returns ``self``.
+        """
+        return self
+
     @abstractmethod
     def parse(self, code: str | bytes, *, source: str = "<code>") -> Program:
         """Read code in this dialect (any of its formats) back into a program.
@@ -108,6 +116,10 @@ class Target:
     source: str = ""
     spindle_rpm: float | None = None
     origin: str = "builtin"
+
+    def __post_init__(self) -> None:
+        if isinstance(self.post, PostProcessor):  # a broken plugin's is reported later
+            object.__setattr__(self, "post", self.post.for_machine(self.machine))
 
     def emit(self, program: Program, *, fmt: str | None = None) -> PostResult:
         """Write ``program`` in this target's dialect for its machine (format ``fmt``)."""

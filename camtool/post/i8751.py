@@ -1,0 +1,451 @@
+"""The ``i8751`` dialect: binary packets for the 8751 serial stepper interface.
+
+Source: seed-003 §3.7 (the byte protocol, :mod:`camtool.post.i8751_stream`),
+§4.1–4.4 (motion) and requirements R1–R7 (reference/seed-003.md). The PC
+sends relative step counts per motor; the interface runs X and Y by "corte
+recto" (both motors together, then the longer one alone), waits T1 seconds,
+runs Z, waits T2 seconds, and goes on with the next move.
+
+How a :class:`~camtool.program.Program` is written:
+
+- every end point is rounded to whole steps ABSOLUTELY (half away from zero,
+  with the machine's steps/mm), and the record carries the difference from the
+  previous rounded point, so rounding never accumulates (R1);
+- a move of more than 65 535 steps on an axis is split into records of at most
+  65 535 steps on its longest axis, the others at the nearest step of the
+  segment (R3: 70 000 → 65 535 + 4 465);
+- X/Y then Z in one record (R4, R11): a move that changes X/Y and Z together
+  runs X/Y first, then Z, with a warning; a Z-only move right after an
+  X/Y-only move joins its record (a dwell between them becomes T1), as in the
+  thesis's worked example;
+- arcs: the interface has none (§4.1) → equal chords within the machine's
+  ``chord_tolerance_mm``, with a warning giving the chord count and error;
+- feeds: the thesis has no feed code; every move runs the same delay-loop ramp
+  (8 Hz start, ≈104 Hz cruise, §4.4), so feeds are not expressible and a
+  warning says so;
+- rapids: the interface has no rapid and no pen-up; with ``lift_mm`` > 0 and a
+  program without Z, Z is raised by ``lift_mm`` before each run of rapids and
+  lowered after it (03H on motor 3 taken as +Z, up), else rapids are ordinary
+  moves and a warning says the tool cuts along them;
+- dwells: whole seconds in T2 of the move before (T1 is written 0), extra
+  records with no motion for more than 255 s or a dwell before the first move;
+- spindle, tool change and home commands are not in the protocol: dropped with
+  one warning per kind.
+
+The reader gives absolute mm from the summed steps, counted from where the
+machine stood (X = Y = Z = 0). A record that moves X/Y and Z is read as two
+moves (X/Y, then Z), as the machine runs it; ``Program.lines`` holds the
+1-based move number (record) in the stream, as the dump notes count them. A
+move that ends with the tool above Z = 0 (the part surface) is read as a rapid,
+any other as a cut at the machine's cruise feed (for reports only).
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from collections import Counter
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from types import MappingProxyType
+from typing import ClassVar
+
+from camtool.errors import DialectError, UsageError
+from camtool.geometry import Arc, Point
+from camtool.machine import Machine
+from camtool.post.base import PostProcessor, PostResult
+from camtool.post.i8751_read import cruise_feed, is_text, program_from_records
+from camtool.post.i8751_stream import (
+    ACCESS_KEY,
+    MAX_STEPS,
+    MAX_WAIT_S,
+    Record,
+    binary_locator,
+    decode_stream,
+    dump_stream,
+    encode_stream,
+    packets,
+    undump,
+)
+from camtool.post.numfmt import NumberFormat
+from camtool.program import (
+    ArcMove,
+    Command,
+    Dwell,
+    Home,
+    Linear,
+    Move,
+    Program,
+    Rapid,
+    Spindle,
+    ToolChange,
+    segment_of,
+)
+
+_DROPPED = {
+    Spindle: "spindle command(s): the interface drives only the three axis motors",
+    ToolChange: "tool change(s): the interface has no tool changer",
+    Home: "home command(s): homing is only proposed in the thesis (seed-003 §6)",
+}
+
+
+def _round_steps(value: float, scale: float) -> int:
+    """``value`` × ``scale`` rounded half away from zero (numfmt's rule)."""
+    return int(NumberFormat(scale=scale, decimals=0).quantize(value))
+
+
+def _share(part: int, whole: int, total: int) -> int:
+    """``total · part / whole`` rounded half away from zero, in integers."""
+    q = (2 * abs(total) * part + whole) // (2 * whole)
+    return q if total >= 0 else -q
+
+
+def split_xy(dx: int, dy: int) -> list[tuple[int, int]]:
+    """An X/Y move of ``(dx, dy)`` steps as pieces of at most 65 535 steps per axis.
+
+    The longest axis advances 65 535 steps per piece (the last takes the rest,
+    seed-003 R3); the other axis goes to the nearest step of the segment.
+    Returns ``[]`` for no move.
+    """
+    n = max(abs(dx), abs(dy))
+    pieces, here = [], (0, 0)
+    for k in range(1, math.ceil(n / MAX_STEPS) + 1):
+        d = min(k * MAX_STEPS, n)
+        there = (_share(d, n, dx), _share(d, n, dy))
+        pieces.append((there[0] - here[0], there[1] - here[1]))
+        here = there
+    return pieces
+
+
+def split_count(n: int) -> list[int]:
+    """A signed count as chunks of at most 65 535 (``[]`` for 0)."""
+    sign = 1 if n > 0 else -1
+    full, rest = divmod(abs(n), MAX_STEPS)
+    return [sign * MAX_STEPS] * full + ([sign * rest] if rest else [])
+
+
+@dataclass
+class _Writer:
+    """The records of one emit and what to warn about (local to one call)."""
+
+    spm: tuple[float, float, float]
+    lift_steps: int
+    records: list[Record] = field(default_factory=list)
+    pos: list[int] = field(default_factory=lambda: [0, 0, 0])
+    lifted: bool = False
+    counts: Counter[str] = field(default_factory=Counter)
+    feeds: set[float] = field(default_factory=set)
+    chord_error_mm: float = 0.0
+
+    def where(self, move: Move) -> str:
+        block = len(self.records) + 1
+        return f"contour {move.contour}, block {block}" if move.contour else f"block {block}"
+
+    def steps(self, value_mm: float, axis: int) -> int:
+        return _round_steps(value_mm, self.spm[axis])
+
+    def goto(self, x: float, y: float, z: float | None) -> None:
+        """Records from the current position to ``(x, y[, z])``: X/Y pieces, then Z."""
+        target = [self.steps(x, 0), self.steps(y, 1)]
+        target.append(self.pos[2] if z is None else self.steps(z, 2))
+        dx, dy, dz = (t - p for t, p in zip(target, self.pos, strict=True))
+        xy = split_xy(dx, dy)
+        zs = split_count(dz)
+        if len(xy) > 1 or len(zs) > 1:
+            self.counts["split"] += 1
+        if xy and zs:
+            self.counts["xyz"] += 1
+        records = [Record((px, py, 0)) for px, py in xy]
+        if records and zs:
+            records[-1] = Record((*records[-1].steps[:2], zs.pop(0)))
+        for record in records + [Record((0, 0, n)) for n in zs]:
+            self.append(record)
+        self.pos = target
+
+    def append(self, record: Record) -> None:
+        """Add ``record``; a Z-only one joins a record that moved only X/Y (R4).
+
+        The thesis's move is "X/Y, wait T1, Z, wait T2" (seed-003 §3.7): a dwell
+        between the two (held in the earlier record's T2) becomes T1.
+        """
+        last = self.records[-1] if self.records else None
+        if (
+            last is not None
+            and record.steps[:2] == (0, 0)
+            and record.wait_t1_s == 0
+            and last.steps[2] == 0
+            and any(last.steps[:2])
+        ):
+            steps = (last.steps[0], last.steps[1], record.steps[2])
+            self.records[-1] = Record(steps, last.wait_t2_s, record.wait_t2_s)
+            return
+        self.records.append(record)
+
+    def lift(self, up: bool) -> None:
+        self.append(Record((0, 0, self.lift_steps if up else -self.lift_steps)))
+        self.pos[2] += self.lift_steps if up else -self.lift_steps
+        self.lifted = up
+        self.counts["lifts"] += up
+
+    def dwell(self, seconds: float) -> None:
+        whole = int(NumberFormat(decimals=0).quantize(seconds))
+        if whole != seconds:
+            self.counts["dwell_rounded"] += 1
+        if whole <= 0:
+            self.counts["dwell_dropped"] += 1
+            return
+        if self.records and self.records[-1].wait_t2_s < MAX_WAIT_S:
+            last = self.records[-1]
+            put = min(MAX_WAIT_S - last.wait_t2_s, whole)
+            self.records[-1] = replace(last, wait_t2_s=last.wait_t2_s + put)
+            whole -= put
+        while whole > 0:
+            put = min(MAX_WAIT_S, whole)
+            self.records.append(Record((0, 0, 0), 0, put))
+            whole -= put
+
+
+class I8751Post(PostProcessor):
+    """Writer and reader of the i8751 binary protocol (seed-003 §3.7).
+
+    Args:
+        lift_mm: raise Z by this much around each run of rapids of a program
+            that has no Z of its own (0: no lift; rapids then cut), mm, ≥ 0.
+        placeholder_steps_per_mm: the ``(x, y, z)`` steps/mm of the profile's
+            documented placeholder; posting or reading with exactly these
+            warns that the step counts assume them (the thesis gives none).
+            Empty: no warning.
+
+    Attributes:
+        machine: the machine whose steps/mm :meth:`parse` uses (``None`` until
+            bound by :meth:`for_machine`, which every Target does).
+
+    Raises:
+        ValueError: a negative or non-finite ``lift_mm``, or a placeholder that
+            is not three positive numbers.
+    """
+
+    formats: ClassVar[Mapping[str, str]] = MappingProxyType({"bin": ".bin", "dump": ".txt"})
+    binary: ClassVar[bool] = True
+
+    def __init__(
+        self, *, lift_mm: float = 0.0, placeholder_steps_per_mm: Sequence[float] = ()
+    ) -> None:
+        if isinstance(lift_mm, bool) or not (math.isfinite(lift_mm) and lift_mm >= 0):
+            raise ValueError(f"lift_mm must be a number of mm >= 0, not {lift_mm!r}")
+        placeholder = tuple(float(v) for v in placeholder_steps_per_mm)
+        if placeholder and (len(placeholder) != 3 or min(placeholder) <= 0):
+            raise ValueError(
+                f"placeholder_steps_per_mm must be [x, y, z] > 0, not {placeholder_steps_per_mm!r}"
+            )
+        self.lift_mm = float(lift_mm)
+        self.placeholder_steps_per_mm = placeholder
+        self.machine: Machine | None = None
+
+    def for_machine(self, machine: Machine) -> I8751Post:
+        """A copy that reads code with ``machine``'s steps/mm (see :meth:`parse`)."""
+        bound = copy.copy(self)
+        bound.machine = machine
+        return bound
+
+    # -- writing ---------------------------------------------------------------
+
+    def emit(self, program: Program, machine: Machine, *, fmt: str | None = None) -> PostResult:
+        """Write ``program`` as an 8751 session: raw bytes (``bin``) or a dump (``dump``).
+
+        Returns:
+            ``code`` is ``bytes`` for ``bin`` and ``str`` for ``dump``;
+            ``blocks`` is the number of move records written.
+
+        Raises:
+            DialectError: a point (arcs by their extremes) outside the machine's
+                work area, or a Z move on a machine without Z; the message names
+                the contour and block (the 1-based move record).
+            UsageError: an unknown ``fmt``.
+        """
+        fmt = self.check_format(fmt)
+        has_z = any(m.z is not None for m in program.moves)
+        lift = self.lift_mm if machine.has_z and not has_z else 0.0
+        w = _Writer(machine.steps_per_mm, _round_steps(lift, machine.steps_per_mm[2]))
+        w.pos = [w.steps(program.origin[0], 0), w.steps(program.origin[1], 1), 0]
+        start = program.origin
+        for item in program.items():
+            if isinstance(item, Rapid | Linear | ArcMove):
+                self._move(w, start, item, machine)
+                start = (item.x, item.y)
+            else:
+                self._command(w, item)
+        warnings = self._warnings(w, program, machine)
+        if fmt == "bin":
+            return PostResult(encode_stream(w.records), len(w.records), warnings, fmt)
+        text = dump_stream(w.records, machine.steps_per_mm, self._header(w, machine))
+        return PostResult(text, len(w.records), warnings, fmt)
+
+    def _move(self, w: _Writer, start: Point, move: Move, machine: Machine) -> None:
+        box = segment_of(start, move).bbox()
+        if machine.outside_work_area(box):
+            x0, y0, x1, y1 = machine.work_area_mm
+            raise DialectError(
+                f"{w.where(move)}: reaches ({box[0]:.4f}, {box[1]:.4f})–({box[2]:.4f}, "
+                f"{box[3]:.4f}) mm, outside the {x1 - x0:g} × {y1 - y0:g} mm work area "
+                f"of {machine.name}; move the drawing or use --fit"
+            )
+        if move.z is not None and not machine.has_z:
+            raise DialectError(f"{w.where(move)}: Z = {move.z:g} mm but {machine.name} has no Z")
+        if isinstance(move, Rapid):
+            w.counts["rapids"] += 1
+            if w.lift_steps and not w.lifted:
+                w.lift(True)
+        else:
+            if w.lifted:
+                w.lift(False)
+            w.feeds.add(move.feed_mm_min)
+        before = len(w.records)
+        points = [(move.x, move.y)]
+        if isinstance(move, ArcMove):
+            points = self._chords(w, start, move, machine.motion.chord_tolerance_mm)
+        for k, (x, y) in enumerate(points, start=1):
+            w.goto(x, y, move.z if k == len(points) else None)
+        if len(w.records) == before:
+            w.counts["tiny"] += 1
+
+    @staticmethod
+    def _chords(w: _Writer, start: Point, move: ArcMove, tolerance_mm: float) -> list[Point]:
+        arc = Arc(start, (move.x, move.y), (move.cx, move.cy), move.clockwise)
+        points = arc.points(tolerance_mm)[1:]
+        angle = abs(arc.sweep) / len(points)
+        w.chord_error_mm = max(w.chord_error_mm, arc.radius * (1.0 - math.cos(angle / 2.0)))
+        w.counts["arcs"] += 1
+        w.counts["chords"] += len(points)
+        return points
+
+    @staticmethod
+    def _command(w: _Writer, command: Command) -> None:
+        if isinstance(command, Dwell):
+            w.dwell(command.seconds)
+        else:
+            w.counts[type(command).__name__] += 1
+
+    def _warnings(self, w: _Writer, program: Program, machine: Machine) -> tuple[str, ...]:
+        c, out = w.counts, []
+        spm = machine.steps_per_mm
+        if self.placeholder_steps_per_mm and tuple(spm) == self.placeholder_steps_per_mm:
+            out.append(
+                f"step counts assume {_spm(spm)} steps/mm (X, Y, Z), a placeholder: the thesis "
+                "gives no steps/mm; set yours with --machine my.toml "
+                "([machine] steps_per_mm = [x, y, z])"
+            )
+        if program.origin != (0.0, 0.0):
+            out.append(
+                f"the program starts at {program.origin} mm: the stream is relative and is read "
+                "back from (0, 0)"
+            )
+        if w.feeds:
+            feeds = ", ".join(f"{f:g}" for f in sorted(w.feeds)[:4])
+            out.append(
+                f"feeds are not expressible: the 8751 runs every move at its delay-loop ramp "
+                f"(8 Hz start, {cruise_feed(machine):.1f} mm/min cruise, seed-003 §4.4); "
+                f"feed(s) {feeds} mm/min ignored"
+            )
+        if c["rapids"]:
+            how = (
+                f"Z raised {self.lift_mm:g} mm around them ({c['lifts']} lift(s), lift_mm)"
+                if c["lifts"]
+                else "the tool stays down and cuts along them (raise Z in the program or set "
+                "lift_mm in [dialect_options])"
+            )
+            out.append(
+                f"{c['rapids']} rapid(s) written as ordinary moves (the 8751 has no rapid); {how}"
+            )
+        if c["arcs"]:
+            out.append(
+                f"{c['arcs']} arc(s) written as {c['chords']} chords (the 8751 has no arcs, "
+                f"seed-003 §4.1): largest chord error {w.chord_error_mm:.4f} mm "
+                f"(chord_tolerance_mm {machine.motion.chord_tolerance_mm:g})"
+            )
+        out += _count_warnings(c)
+        return tuple(out)
+
+    def _header(self, w: _Writer, machine: Machine) -> list[str]:
+        n = len(packets(w.records))
+        return [
+            f"i8751 session (seed-003, section 3.7): access key {ACCESS_KEY:02X}H, packets of <= 5 "
+            "moves ended by 45H, end of data 54H",
+            "move = M1 D PH PL | M2 D PH PL | 00 T1 | M3 D PH PL | 00 T2; D 03H +, 04H -, "
+            "05H no move (no PH PL); steps = PH*256+PL; T1, T2 in s",
+            f"machine: {machine.name}, {_spm(machine.steps_per_mm)} steps/mm (X, Y, Z); "
+            f"{len(w.records)} move(s) in {n} packet(s); positions in mm from the start",
+        ]
+
+    # -- reading ---------------------------------------------------------------
+
+    def parse(self, code: str | bytes, *, source: str = "<code>") -> Program:
+        """Read a session (raw bytes or a dump, as ``str`` or ``bytes``) back into moves.
+
+        Bytes that start with the access key 13H, or that are not UTF-8 text
+        without control characters, are read as the binary stream; anything
+        else as a dump. Positions
+        are the summed steps divided by the bound machine's steps/mm, from
+        (0, 0, 0). ``Program.lines`` holds each move's 1-based record number.
+
+        Raises:
+            ParseError: anything off the grammar of
+                :mod:`camtool.post.i8751_stream`, naming ``source`` and the byte
+                offset (and the dump line).
+            UsageError: the dialect is not bound to a machine (use a Target, or
+                :meth:`for_machine`).
+        """
+        if self.machine is None:
+            raise UsageError(
+                "the i8751 reader needs the machine's steps/mm: read through a target "
+                "(camtool.post.registry.load_target) or I8751Post().for_machine(machine)"
+            )
+        if isinstance(code, bytes) and not is_text(code):
+            records = decode_stream(code, binary_locator(source))
+        else:
+            text = code.decode("utf-8") if isinstance(code, bytes) else code
+            data, locate = undump(text, source)
+            records = decode_stream(data, locate)
+        return program_from_records(records, self.machine, self._reading_warnings(self.machine))
+
+    def _reading_warnings(self, machine: Machine) -> tuple[str, ...]:
+        spm = machine.steps_per_mm
+        if self.placeholder_steps_per_mm and tuple(spm) == self.placeholder_steps_per_mm:
+            return (
+                f"steps read as mm with {_spm(spm)} steps/mm (X, Y, Z), a placeholder: give "
+                "the --machine the code was posted with",
+            )
+        return ()
+
+
+def _count_warnings(c: Counter[str]) -> list[str]:
+    """Warnings for the counted conversions and drops of one emit."""
+    out = []
+    if c["xyz"]:
+        out.append(
+            f"{c['xyz']} move(s) change X/Y and Z together: the 8751 runs X/Y first, then Z "
+            "(seed-003 §4.3, R11); they read back as two moves"
+        )
+    if c["split"]:
+        out.append(
+            f"{c['split']} move(s) over {MAX_STEPS} steps on an axis split into several "
+            "records (seed-003 R3)"
+        )
+    if c["tiny"]:
+        out.append(f"{c['tiny']} move(s) shorter than half a step written as nothing")
+    if c["dwell_rounded"]:
+        out.append(
+            f"{c['dwell_rounded']} dwell(s) rounded to whole seconds (the 8751 waits in 1 s "
+            "units, seed-003 §3.7)"
+        )
+    if c["dwell_dropped"]:
+        out.append(f"{c['dwell_dropped']} dwell(s) of 0 s (after rounding) dropped")
+    for kind, why in _DROPPED.items():
+        if c[kind.__name__]:
+            out.append(f"{c[kind.__name__]} {why}: dropped")
+    return out
+
+
+def _spm(spm: Sequence[float]) -> str:
+    fmt = NumberFormat(decimals=4)
+    return ", ".join(fmt.format(v).rstrip("0").rstrip(".") for v in spm)
