@@ -257,7 +257,14 @@ def post(
             f"camtool: wrote {job.result.blocks} blocks for {chosen.name} to {output}", err=True
         )
     if verify_too or report or preview or max_error_um is not None:
-        _finish_verification(verify_job(job), report, preview, max_error_um)
+        _finish_verification(
+            verify_job(job),
+            report,
+            preview,
+            max_error_um,
+            drawing=job.placed,
+            edge_radius_mm=job.edge_radius_mm,
+        )
 
 
 @cli.command()
@@ -305,7 +312,9 @@ def verify(
     text = _read_code(code, binary=chosen.post.binary)
     drawing = _read_input(against) if against is not None else None
     v = verify_code(text, chosen, source=code, against=drawing, tool_diameter=tool_diameter)
-    _finish_verification(v, report, preview, max_error_um)
+    _finish_verification(
+        v, report, preview, max_error_um, drawing=drawing, edge_radius_mm=tool_diameter / 2.0
+    )
 
 
 def _read_program(name: str, options: dict[str, Any]) -> Program:
@@ -351,7 +360,13 @@ def _read_code(name: str, *, binary: bool = False) -> str | bytes:
 
 
 def _finish_verification(
-    v: Verification, report: str | None, preview: str | None, max_error_um: float | None
+    v: Verification,
+    report: str | None,
+    preview: str | None,
+    max_error_um: float | None,
+    *,
+    drawing: Drawing | None = None,
+    edge_radius_mm: float = 0.0,
 ) -> None:
     """Summary to stderr, then the report and preview files, then the limit check."""
     from camtool.verify.verifier import report_dict, summary_lines
@@ -364,7 +379,8 @@ def _finish_verification(
     if preview is not None:
         from camtool.preview_trace import write_trace_preview
 
-        _write(write_trace_preview(v, preview), preview)
+        picture = write_trace_preview(v, preview, drawing=drawing, edge_radius_mm=edge_radius_mm)
+        _write(picture, preview)
     if max_error_um is not None and v.max_error_um > max_error_um:
         raise VerifyLimitError(
             f"predicted error {v.max_error_um:.2f} µm exceeds --max-error-um {max_error_um:g}"
@@ -447,15 +463,19 @@ def _target_json(entry: TargetEntry) -> dict[str, Any]:
     }
 
 
-# -- preview command (camtool/cli_preview.py) --
+from camtool.cli_preview import preview  # noqa: E402
 
-# -- batch command (camtool/cli_batch.py) --
+cli.add_command(preview)
+
+from camtool.cli_batch import batch  # noqa: E402
+
+cli.add_command(batch)
 
 
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; turn every error into a message and an exit code, never a traceback."""
     try:
-        cli.main(args=argv, prog_name="camtool", standalone_mode=False)
+        code = cli.main(args=argv, prog_name="camtool", standalone_mode=False)
     except click.exceptions.Exit as exc:
         return int(exc.exit_code)
     except click.ClickException as exc:
@@ -472,7 +492,7 @@ def main(argv: list[str] | None = None) -> int:
             f"camtool: internal error: {type(exc).__name__}: {exc} (please report it)", err=True
         )
         return 1
-    return 0
+    return code if isinstance(code, int) else 0  # a command's ctx.exit(n) returns n here
 
 
 if __name__ == "__main__":

@@ -12,7 +12,8 @@ its marker, with optional ``post`` options::
 :data:`MAX_LINES` lines) and the preview picture
 ``docs/targets/<target>-<sample>.svg``; for docs/verify.md the verify summary of
 the pic-mmh sample between ``<!-- verify:begin -->`` / ``<!-- verify:end -->``
-and its preview ``docs/targets/pic-mmh-logo-verify.png``. ``--check`` only
+and its preview ``docs/targets/pic-mmh-logo-verify.png``; docs/gallery.md and
+its verified pictures (``make_gallery.py``). ``--check`` only
 reports whether the committed docs are current (exit 1 if not; the PNG, drawn
 by matplotlib whose bytes vary between versions, only has to exist); the tests
 run it.
@@ -24,9 +25,9 @@ import re
 import sys
 from pathlib import Path
 
-from camtool.pipeline import post_file, verify_job
+from camtool.pipeline import PostJob, post_file, verify_job
 from camtool.post.registry import load_target, target_names
-from camtool.preview import program_svg
+from camtool.preview import render_preview
 from camtool.preview_trace import write_trace_preview
 from camtool.verify.verifier import summary_lines
 
@@ -43,22 +44,16 @@ def generated() -> dict[Path, str]:
     """Every generated docs file with its current content."""
     files: dict[Path, str] = {}
     for target in target_names():
-        page = ROOT / "docs" / "targets" / f"{target}.md"
-        text = page.read_text(encoding="utf-8")
-        marker = _BLOCK.search(text)
-        if marker is None:
-            raise SystemExit(f"{page}: no <!-- sample:begin SAMPLE [options] --> marker")
-        sample, *words = marker[2].split()
-        options = dict(word.split("=", 1) for word in words)
-        fmt = options.pop("format", None)
-        job = post_file(ROOT / "samples" / sample, target, fmt=fmt, **_options(options))
+        found = page_sample(target)
+        if found is None:
+            raise SystemExit(f"docs/targets/{target}.md: no <!-- sample:begin SAMPLE --> marker")
+        page, text, marker = found
+        sample = marker[2].split()[0]
+        job = post_sample(target, marker[2])
         stem = Path(sample).stem
-        svg = program_svg(
-            job.program,
-            work_area=job.target.machine.work_area_mm,
-            title=f"samples/{sample} → {target}",
-        )
-        files[ROOT / "docs" / "targets" / f"{target}-{stem}.svg"] = svg
+        title = f"samples/{sample} → {target}"
+        svg = render_preview(".svg", program=job.program, target=job.target, title=title)
+        files[ROOT / "docs" / "targets" / f"{target}-{stem}.svg"] = svg.decode("utf-8")
         block = f"```\n{_shown(job.result.code)}```\n"
         files[page] = text[: marker.start()] + marker[1] + block + marker[3] + text[marker.end() :]
     index = ROOT / "docs" / "targets" / "index.md"
@@ -70,6 +65,9 @@ def generated() -> dict[Path, str]:
     page = ROOT / "docs" / "verify.md"
     text = page.read_text(encoding="utf-8")
     files[page] = _VERIFY.sub(lambda m: m[1] + f"```\n{lines}```\n" + m[2], text)
+    from make_gallery import gallery_files
+
+    files.update(gallery_files())
     return files
 
 
@@ -84,6 +82,24 @@ def targets_table() -> str:
         formats = ", ".join(f"`{f}` ({suffix})" for f, suffix in t.post.formats.items())
         rows.append(f"| [`{name}`]({name}.md) | {t.machine.name} | {formats} | {t.source} |")
     return "\n".join(rows) + "\n"
+
+
+def page_sample(target: str) -> tuple[Path, str, re.Match[str]] | None:
+    """A target's page, its text and its sample marker; ``None`` when either is missing."""
+    page = ROOT / "docs" / "targets" / f"{target}.md"
+    if not page.is_file():
+        return None
+    text = page.read_text(encoding="utf-8")
+    marker = _BLOCK.search(text)
+    return None if marker is None else (page, text, marker)
+
+
+def post_sample(target: str, spec: str) -> PostJob:
+    """Post the sample a marker names (``SAMPLE key=value ...``) for ``target``."""
+    sample, *words = spec.split()
+    options = dict(word.split("=", 1) for word in words)
+    fmt = options.pop("format", None)
+    return post_file(ROOT / "samples" / sample, target, fmt=fmt, **_options(options))
 
 
 def _options(words: dict[str, str]) -> dict[str, object]:

@@ -1,0 +1,493 @@
+"""Many inputs, one target: post every file in a process pool and summarise.
+
+:func:`plan_batch` expands the inputs (:mod:`camtool.batch_inputs`), loads the
+target and checks everything that can be checked before any work starts: the
+options, that every input matches something, that no two files write the same
+output, that no output is one of the inputs, and that no output exists already
+unless ``force``. :func:`run_batch` then posts each file — in a
+``concurrent.futures.ProcessPoolExecutor`` of ``jobs`` workers, or in this
+process for ``jobs=1`` — and returns one :class:`BatchRow` per file, in input
+order. A file that fails (any exception) becomes an ``error`` row; it never
+stops the others, and it leaves no output behind: each file's outputs are
+computed in memory and written (atomically) only when all of them are ready.
+
+Outputs keep the path below the input's root: ``drawings/a/b.dxf`` gives
+``OUT/a/b.pic`` (the target's ending), ``OUT/a/b.json`` (the verify report,
+when verified) and ``OUT/a/b.png`` or ``.svg`` (the preview).
+
+The batch's exit code (:func:`batch_exit_code`) is 0 when every file is ok,
+otherwise the *smallest* non-zero per-file code: 1 (an error: the target cannot
+express a drawing, a write failed, a bug), then 2 (an option a file cannot
+take), then 3 (an unreadable or invalid input), then 4 (posted and verified,
+but the predicted error is over ``max_error_um``). So 4 means "everything
+posted; only the accuracy limit failed", 3 "some inputs are bad and nothing
+worse happened".
+
+This module never prints; progress goes through a callback. The report and
+table live in :mod:`camtool.batch_report`.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from camtool.batch_inputs import BatchInput, expand_inputs
+from camtool.errors import CamtoolError, UsageError
+
+if TYPE_CHECKING:
+    from concurrent.futures import Future
+
+    from camtool.importers import ImportOptions
+    from camtool.pipeline import PostJob
+    from camtool.verify.verifier import Verification
+
+PREVIEW_FORMATS = ("png", "svg")
+"""Preview picture formats (``--preview``)."""
+STATUSES = ("ok", "error", "over-limit")
+"""Values of :attr:`BatchRow.status`."""
+SHOWN_EXISTING = 5
+"""Existing outputs named in the refusal to overwrite (the rest are counted)."""
+
+Progress = Callable[[int, int, "BatchRow"], None]
+"""``progress(done, total, row)``: called in the calling process as each file finishes."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class BatchOptions:
+    """What every file of a batch is posted with (the ``post`` options) and what is kept.
+
+    Attributes:
+        target: a target name or target ``.toml`` path (see ``camtool targets``).
+        output_dir: where the outputs go (created when missing).
+        machine_file: machine profile laid over the target's (file or built-in name).
+        offset: ``on``, ``outside`` or ``inside`` (:data:`camtool.toolpath.plan.OFFSET_MODES`).
+        tool_diameter: mm.
+        feed_mm_min: cutting feed, mm/min; ``None``: the target's default.
+        tolerance: chaining and curve-fit tolerance, mm.
+        scale: uniform scale about the drawing's origin.
+        fit_mm: ``(width, height)`` mm to fit each drawing into instead of ``scale``.
+        fmt: the dialect's output format (``None``: its default).
+        spindle_rpm: rev/min; ``None``: the target's; 0: no spindle commands.
+        layers: layers to keep (``None``: all).
+        units: unit of unitless inputs (point lists).
+        hatch_boundaries: use DXF HATCH boundaries as contours.
+        verify: verify each file and write its report (``OUT/<name>.json``).
+        preview: ``"png"`` or ``"svg"``: draw each file (``OUT/<name>.png``): the
+            program, and when verified the simulated trace and its worst point.
+        max_error_um: predicted error limit, µm: a file over it is ``over-limit``
+            (implies ``verify``).
+        force: overwrite existing outputs.
+        jobs: worker processes; ``None``: ``os.cpu_count()``; 1: in this process.
+        report: the batch report's path (``"-"``: stdout), checked like an output.
+
+    Raises:
+        UsageError: ``preview`` is not one of :data:`PREVIEW_FORMATS`, ``jobs`` < 1
+            or ``max_error_um`` < 0.
+    """
+
+    target: str
+    output_dir: Path
+    machine_file: Path | None = None
+    offset: str = "on"
+    tool_diameter: float = 0.0
+    feed_mm_min: float | None = None
+    tolerance: float = 0.001
+    scale: float = 1.0
+    fit_mm: tuple[float, float] | None = None
+    fmt: str | None = None
+    spindle_rpm: float | None = None
+    layers: tuple[str, ...] | None = None
+    units: str | None = None
+    hatch_boundaries: bool = False
+    verify: bool = False
+    preview: str | None = None
+    max_error_um: float | None = None
+    force: bool = False
+    jobs: int | None = None
+    report: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.preview is not None and self.preview not in PREVIEW_FORMATS:
+            raise UsageError(
+                f"unknown preview format {self.preview!r}; choose one of "
+                f"{', '.join(PREVIEW_FORMATS)}"
+            )
+        if self.jobs is not None and self.jobs < 1:
+            raise UsageError(f"--jobs must be at least 1, got {self.jobs}")
+        if self.max_error_um is not None and self.max_error_um < 0:
+            raise UsageError(f"--max-error-um must be >= 0, got {self.max_error_um:g}")
+
+    @property
+    def verifying(self) -> bool:
+        """True when each file is verified (``verify``, or implied by ``max_error_um``)."""
+        return self.verify or self.max_error_um is not None
+
+    def import_options(self) -> ImportOptions:
+        """The importer options of every drawing."""
+        from camtool.importers import ImportOptions
+
+        return ImportOptions(
+            layers=self.layers,
+            tolerance=self.tolerance,
+            units=self.units,
+            hatch_boundaries=self.hatch_boundaries,
+        )
+
+    def post_options(self) -> dict[str, Any]:
+        """Keyword options of :func:`camtool.pipeline.post_drawing`."""
+        return {
+            "offset": self.offset,
+            "tool_diameter": self.tool_diameter,
+            "feed_mm_min": self.feed_mm_min,
+            "tolerance": self.tolerance,
+            "scale": self.scale,
+            "fit_mm": self.fit_mm,
+            "fmt": self.fmt,
+            "spindle_rpm": self.spindle_rpm,
+        }
+
+
+@dataclass(frozen=True)
+class BatchTask:
+    """One file's work, given to a worker (picklable).
+
+    Attributes:
+        file: the input file, as the user will see it named.
+        code_path: where its code goes.
+        report_path: where its verify report goes (``None``: not verified).
+        preview_path: where its preview goes (``None``: no preview).
+    """
+
+    file: str
+    code_path: str
+    report_path: str | None = None
+    preview_path: str | None = None
+
+    @property
+    def outputs(self) -> tuple[str, ...]:
+        """Every path this task writes."""
+        paths = (self.code_path, self.report_path, self.preview_path)
+        return tuple(p for p in paths if p is not None)
+
+
+@dataclass(frozen=True)
+class BatchPlan:
+    """A checked batch, ready to run: its options and one task per file, in order."""
+
+    options: BatchOptions
+    tasks: tuple[BatchTask, ...]
+
+
+@dataclass(frozen=True, kw_only=True)
+class BatchRow:
+    """What became of one file (picklable).
+
+    Attributes:
+        file: the input file.
+        status: one of :data:`STATUSES`.
+        exit_code: the code ``camtool post`` would have exited with for it (0 ok).
+        blocks: blocks written (``None`` when posting failed).
+        max_error_um: predicted error, µm (``None`` when not verified).
+        time_s: machining time, s: predicted by the verifier when ``verified``,
+            else the cutting moves at their programmed feeds (rapids excluded).
+        verified: whether the file was verified.
+        code_path, report_path, preview_path: the files written (``None``: not written).
+        warnings: warnings of every stage, without repeats.
+        error: why the file failed or is over the limit ("" when ok).
+    """
+
+    file: str
+    status: str
+    exit_code: int
+    blocks: int | None = None
+    max_error_um: float | None = None
+    time_s: float | None = None
+    verified: bool = False
+    code_path: str | None = None
+    report_path: str | None = None
+    preview_path: str | None = None
+    warnings: tuple[str, ...] = ()
+    error: str = ""
+
+
+@dataclass(frozen=True)
+class BatchResult:
+    """A finished batch: its options and one row per file, in input order."""
+
+    options: BatchOptions
+    rows: tuple[BatchRow, ...]
+
+    @property
+    def exit_code(self) -> int:
+        """The batch's exit code (see :func:`batch_exit_code`)."""
+        return batch_exit_code(self.rows)
+
+
+def batch_exit_code(rows: Sequence[BatchRow]) -> int:
+    """0 when every row is ok, else the smallest non-zero per-file exit code.
+
+    The order 1 < 2 < 3 < 4 ranks a general error above a bad option, a bad
+    input and an accuracy limit (see the module docstring).
+    """
+    codes = [row.exit_code for row in rows if row.exit_code]
+    return min(codes) if codes else 0
+
+
+def plan_batch(inputs: Sequence[str], options: BatchOptions) -> BatchPlan:
+    """Expand ``inputs`` and check the whole batch before any work starts.
+
+    Raises:
+        UsageError: unknown target or format, invalid post options, two files
+            writing the same output, an output that is an input, or existing
+            outputs without ``force`` (the first :data:`SHOWN_EXISTING` named).
+        InputError: an input matches nothing, or the target/machine file is invalid.
+    """
+    from camtool.post.registry import load_target
+    from camtool.toolpath.plan import PlanOptions
+
+    target = load_target(options.target, machine_file=options.machine_file)
+    fmt = target.post.check_format(options.fmt)
+    PlanOptions(  # validates the post options once, before any file
+        offset=options.offset,
+        tool_diameter=options.tool_diameter,
+        feed_mm_min=(
+            target.default_feed_mm_min if options.feed_mm_min is None else options.feed_mm_min
+        ),
+        tolerance=options.tolerance,
+        scale=options.scale,
+        fit_mm=options.fit_mm,
+    )
+    if options.output_dir.exists() and not options.output_dir.is_dir():
+        raise UsageError(f"{options.output_dir}: exists and is not a directory (-o OUTDIR)")
+    items = expand_inputs(inputs, exclude=options.output_dir)
+    tasks = tuple(_task(item, options, target.post.formats[fmt]) for item in items)
+    _check_outputs(items, tasks, options)
+    return BatchPlan(options, tasks)
+
+
+def _task(item: BatchInput, options: BatchOptions, suffix: str) -> BatchTask:
+    base = options.output_dir / item.relative
+    return BatchTask(
+        file=str(item.path),
+        code_path=str(base.with_suffix(suffix)),
+        report_path=str(base.with_suffix(".json")) if options.verifying else None,
+        preview_path=str(base.with_suffix(f".{options.preview}")) if options.preview else None,
+    )
+
+
+def _check_outputs(
+    items: Sequence[BatchInput], tasks: Sequence[BatchTask], options: BatchOptions
+) -> None:
+    """No output written twice, none an input, none existing unless ``force``."""
+    inputs = {item.path.resolve() for item in items}
+    owners: dict[Path, tuple[str, str]] = {}  # resolved output -> (who writes it, as named)
+    if options.report is not None and options.report != "-":
+        owners[Path(options.report).resolve()] = ("the batch report", options.report)
+    for task in tasks:
+        for out in task.outputs:
+            key = Path(out).resolve()
+            if key in inputs:
+                raise UsageError(
+                    f"{out} would overwrite an input (from {task.file}); choose another -o"
+                )
+            if key in owners:
+                raise UsageError(
+                    f"{owners[key][0]} and {task.file} would both write {out}; post them in "
+                    "separate batches or rename one"
+                )
+            owners[key] = (task.file, out)
+    existing = sorted(out for key, (_, out) in owners.items() if key.exists())
+    if existing and not options.force:
+        shown = ", ".join(existing[:SHOWN_EXISTING])
+        more = len(existing) - SHOWN_EXISTING
+        rest = f" and {more} more" if more > 0 else ""
+        raise UsageError(
+            f"{len(existing)} output(s) exist already: {shown}{rest}; "
+            "use --force to overwrite them, or another -o"
+        )
+
+
+def run_batch(plan: BatchPlan, *, progress: Progress | None = None) -> BatchResult:
+    """Post every file of ``plan``; one file's failure never stops the others.
+
+    Args:
+        plan: from :func:`plan_batch`.
+        progress: called in this process as each file finishes, in finishing order.
+
+    Returns:
+        The rows in the plan's (sorted input) order.
+    """
+    tasks, options = plan.tasks, plan.options
+    jobs = min(options.jobs or os.cpu_count() or 1, len(tasks))
+    if jobs <= 1:
+        rows = []
+        for done, task in enumerate(tasks, start=1):
+            rows.append(post_one(task, options))
+            if progress is not None:
+                progress(done, len(tasks), rows[-1])
+        return BatchResult(options, tuple(rows))
+    return BatchResult(options, _run_pool(tasks, options, jobs, progress))
+
+
+def _run_pool(
+    tasks: Sequence[BatchTask], options: BatchOptions, jobs: int, progress: Progress | None
+) -> tuple[BatchRow, ...]:
+    """Run ``tasks`` in a pool of ``jobs`` processes; rows in task order."""
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    rows: dict[int, BatchRow] = {}
+    with ProcessPoolExecutor(max_workers=jobs) as pool:
+        futures = {pool.submit(post_one, task, options): i for i, task in enumerate(tasks)}
+        try:
+            for done, future in enumerate(as_completed(futures), start=1):
+                index = futures[future]
+                rows[index] = _collect(future, tasks[index])
+                if progress is not None:
+                    progress(done, len(tasks), rows[index])
+        except BaseException:  # Ctrl-C or a failing callback: stop the pool, then re-raise
+            pool.shutdown(wait=False, cancel_futures=True)
+            raise
+    return tuple(rows[i] for i in range(len(tasks)))
+
+
+def _collect(future: Future[BatchRow], task: BatchTask) -> BatchRow:
+    """The row a worker returned, or an error row when the worker itself failed."""
+    try:
+        return future.result()
+    except Exception as exc:  # e.g. a worker killed (BrokenProcessPool): that file's error
+        return _error_row(task, 1, f"worker failed: {type(exc).__name__}: {exc}")
+
+
+def post_one(task: BatchTask, options: BatchOptions) -> BatchRow:
+    """Post (and verify, and draw) one file: the worker of a batch.
+
+    Never raises for the file's own problems: a :class:`CamtoolError` becomes an
+    ``error`` row with its exit code, any other exception an ``error`` row with
+    exit code 1 ("internal error").
+    """
+    try:
+        return _post_one(task, options)
+    except CamtoolError as exc:
+        return _error_row(task, exc.exit_code, str(exc))
+    except Exception as exc:  # a bug on one file must not stop the batch
+        return _error_row(task, 1, f"internal error: {type(exc).__name__}: {exc}")
+
+
+def _error_row(task: BatchTask, code: int, message: str) -> BatchRow:
+    return BatchRow(file=task.file, status="error", exit_code=code, error=message)
+
+
+def _post_one(task: BatchTask, options: BatchOptions) -> BatchRow:
+    job = _post_job(task.file, options)
+    files: list[tuple[str, str | bytes]] = [(task.code_path, job.result.code)]
+    warnings = job.warnings
+    error_um: float | None = None
+    time_s = job.program.cutting_time_s()
+    v = None
+    if options.verifying:
+        from camtool.pipeline import verify_job
+        from camtool.verify.verifier import report_dict
+
+        v = verify_job(job)
+        error_um, time_s = v.max_error_um, v.time_s
+        warnings = tuple(dict.fromkeys(warnings + v.warnings))
+        if task.report_path is not None:
+            files.append((task.report_path, json.dumps(report_dict(v), indent=2) + "\n"))
+    if task.preview_path is not None:
+        files.append((task.preview_path, preview_bytes(job, v, task.preview_path, task.file)))
+    for path, data in files:
+        _write(path, data)
+    over = options.max_error_um is not None and (error_um or 0.0) > options.max_error_um
+    return BatchRow(
+        file=task.file,
+        status="over-limit" if over else "ok",
+        exit_code=4 if over else 0,
+        blocks=job.result.blocks,
+        max_error_um=error_um,
+        time_s=time_s,
+        verified=options.verifying,
+        code_path=task.code_path,
+        report_path=task.report_path,
+        preview_path=task.preview_path,
+        warnings=warnings,
+        error=(
+            f"predicted error {error_um:.2f} µm exceeds --max-error-um {options.max_error_um:g}"
+            if over
+            else ""
+        ),
+    )
+
+
+def _post_job(file: str, options: BatchOptions) -> PostJob:
+    """Import and post one file: a drawing is planned, a G-code program re-posted."""
+    from camtool.importers import read_drawing
+    from camtool.pipeline import is_program_file, post_drawing, post_program
+    from camtool.post.registry import load_target
+
+    target = load_target(options.target, machine_file=options.machine_file)
+    if not is_program_file(file):
+        drawing = read_drawing(file, options.import_options())
+        return post_drawing(drawing, target, **options.post_options())
+    from camtool.importers.gcode import read_gcode
+
+    given = [
+        flag
+        for flag, changed in (
+            ("--offset", options.offset != "on"),
+            ("--tool-diameter", options.tool_diameter != 0.0),
+            ("--scale", options.scale != 1.0),
+            ("--fit", options.fit_mm is not None),
+        )
+        if changed
+    ]
+    if given:
+        raise UsageError(
+            f"{file} is already a toolpath (G-code): {', '.join(given)} only apply to "
+            "drawings; post programs in a batch of their own"
+        )
+    return post_program(
+        read_gcode(file),
+        target,
+        feed_mm_min=options.feed_mm_min,
+        fmt=options.fmt,
+        spindle_rpm=options.spindle_rpm,
+    )
+
+
+def preview_bytes(job: PostJob, v: Verification | None, path: str, title: str) -> bytes:
+    """The preview of one file, PNG or SVG by ``path``'s ending (the one place a batch draws).
+
+    The program over the drawing as placed, the tool width of an offset cut and
+    the target's work area; with a verification ``v`` also the simulated trace
+    coloured by its deviation and the worst point (:func:`camtool.preview.render_preview`).
+
+    Raises:
+        UsageError: the ending is neither ``.png`` nor ``.svg``.
+    """
+    from camtool.preview import render_preview
+
+    return render_preview(
+        path,
+        program=job.program,
+        drawing=job.placed,
+        verification=v,
+        target=job.target,
+        edge_radius_mm=job.edge_radius_mm,
+        title=title,
+    )
+
+
+def _write(path: str, data: str | bytes) -> None:
+    """Write one output atomically, creating its directory."""
+    from camtool.output import write_atomic
+
+    try:
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
+        write_atomic(path, data)
+    except OSError as exc:
+        raise CamtoolError(f"{path}: cannot write ({exc.strerror or exc})") from exc

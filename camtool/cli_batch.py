@@ -1,0 +1,205 @@
+"""``camtool batch``: post many drawings for one target, in parallel, with a summary.
+
+A thin click wrapper over :mod:`camtool.batch` (see docs/batch.md). Progress
+goes to stderr — a bar on a terminal, one plain line per finished file
+otherwise — then the summary table; stdout carries only ``--report -``.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import click
+
+from camtool.errors import CamtoolError, InputError, UsageError, VerifyLimitError
+from camtool.toolpath.plan import OFFSET_MODES
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from camtool.batch import BatchPlan, BatchResult, BatchRow
+
+_PREVIEW_FORMATS = ("png", "svg")  # camtool.batch.PREVIEW_FORMATS, validated there too
+_ERRORS: dict[int, type[CamtoolError]] = {2: UsageError, 3: InputError, 4: VerifyLimitError}
+"""The error a failed batch exits with, by its exit code (others: CamtoolError, 1)."""
+
+
+def _post_options(command: Callable[..., None]) -> Callable[..., None]:
+    """The options of ``camtool post`` that shape each file (copied from camtool.cli)."""
+    from camtool.units import LENGTH_UNITS
+
+    for decorator in reversed(
+        (
+            click.option(
+                "--offset",
+                type=click.Choice(OFFSET_MODES),
+                default="on",
+                show_default=True,
+                help="Tool-centre side: 'on' follows the drawing; 'outside'/'inside' "
+                "compensate by half the tool diameter.",
+            ),
+            click.option(
+                "--tool-diameter", type=float, default=0.0, metavar="MM", help="Tool diameter, mm."
+            ),
+            click.option(
+                "--feed",
+                "feed_mm_min",
+                type=float,
+                default=None,
+                metavar="MM_PER_MIN",
+                help="Cutting feed in mm/min [default: the target's].",
+            ),
+            click.option(
+                "--tolerance",
+                type=float,
+                default=0.001,
+                show_default=True,
+                metavar="MM",
+                help="Chaining and curve-fit tolerance, mm.",
+            ),
+            click.option(
+                "--scale",
+                type=float,
+                default=1.0,
+                show_default=True,
+                metavar="K",
+                help="Scale each drawing by K about its origin.",
+            ),
+            click.option(
+                "--fit",
+                "fit_mm",
+                type=(float, float),
+                default=None,
+                metavar="W H",
+                help="Scale each drawing uniformly to fit W x H mm.",
+            ),
+            click.option(
+                "--format", "fmt", default=None, metavar="NAME", help="The dialect's output format."
+            ),
+            click.option(
+                "--spindle-rpm",
+                type=click.FloatRange(min=0),
+                default=None,
+                metavar="RPM",
+                help="Spindle speed; 0 writes no spindle commands [default: the target's].",
+            ),
+            click.option(
+                "--machine",
+                "machine_file",
+                type=click.Path(dir_okay=False, path_type=Path),
+                default=None,
+                metavar="FILE|NAME",
+                help="Machine profile laid over the target's, key by key.",
+            ),
+            click.option("--layers", default=None, metavar="A,B", help="Only these layers."),
+            click.option(
+                "--units",
+                type=click.Choice(list(LENGTH_UNITS)),
+                default=None,
+                help="Unit of unitless inputs (point lists).",
+            ),
+            click.option(
+                "--hatch-boundaries", is_flag=True, help="Use DXF HATCH boundaries as contours."
+            ),
+        )
+    ):
+        command = decorator(command)
+    return command
+
+
+@click.command()
+@click.argument("inputs", nargs=-1, required=True, metavar="INPUTS...")
+@click.option("--target", "-t", required=True, metavar="NAME", help="See `camtool targets`.")
+@click.option(
+    "-o",
+    "--output-dir",
+    required=True,
+    type=click.Path(file_okay=False, path_type=Path),
+    metavar="OUTDIR",
+    help="Where the outputs go, keeping each file's path below its input.",
+)
+@click.option(
+    "--jobs",
+    "-j",
+    type=click.IntRange(min=1),
+    default=None,
+    metavar="N",
+    help="Worker processes [default: all cores]; 1 runs in this process.",
+)
+@click.option("--verify", "verify_too", is_flag=True, help="Verify each file; write its report.")
+@click.option(
+    "--preview",
+    type=click.Choice(_PREVIEW_FORMATS),
+    default=None,
+    help="Draw each file (with --verify: its simulated cut and worst point too).",
+)
+@click.option(
+    "--max-error-um",
+    type=click.FloatRange(min=0),
+    default=None,
+    metavar="N",
+    help="A file whose predicted error exceeds N µm is over the limit: exit code 4 "
+    "(implies --verify).",
+)
+@click.option("--report", default=None, metavar="BATCH.json", help="Batch report ('-': stdout).")
+@click.option("--force", is_flag=True, help="Overwrite existing outputs.")
+@_post_options
+def batch(inputs: tuple[str, ...], layers: str | None, verify_too: bool, **options: Any) -> None:
+    """Post every drawing of INPUTS (files, directories, quoted globs with **) for a target.
+
+    Each file is posted as `camtool post` would, in parallel; one bad file never
+    stops the others. Outputs keep the path below their input (drawings/a/b.dxf
+    → OUTDIR/a/b.<ending>, .json when verified, .png/.svg with --preview) and are never
+    overwritten without --force. Exit code: 0 all ok, else the smallest per-file
+    code (1 error, 2 usage, 3 unreadable input, 4 over --max-error-um).
+    """
+    from camtool.batch import BatchOptions, plan_batch
+    from camtool.batch_report import batch_report, failure_line, summary_table
+
+    names = tuple(n.strip() for n in layers.split(",") if n.strip()) if layers else None
+    plan = plan_batch(inputs, BatchOptions(layers=names, verify=verify_too, **options))
+    result = _run(plan)
+    click.echo(summary_table(result), err=True, nl=False)
+    if options["report"] is not None:
+        text = json.dumps(batch_report(result), indent=2, ensure_ascii=False)
+        _write_report(text + "\n", options["report"])
+    if result.exit_code:
+        raise _ERRORS.get(result.exit_code, CamtoolError)(failure_line(result))
+
+
+def _run(plan: BatchPlan) -> BatchResult:
+    """Run the batch with progress on stderr: a bar on a terminal, else a line per file."""
+    from camtool.batch import run_batch
+    from camtool.batch_report import progress_line
+
+    if not sys.stderr.isatty():
+        return run_batch(
+            plan, progress=lambda done, n, row: click.echo(progress_line(done, n, row), err=True)
+        )
+    with click.progressbar(
+        length=len(plan.tasks),
+        label="camtool batch",
+        file=sys.stderr,
+        item_show_func=_row_name,
+    ) as bar:
+        return run_batch(plan, progress=lambda _done, _n, row: bar.update(1, row))
+
+
+def _row_name(row: BatchRow | None) -> str | None:
+    return row.file if row is not None else None
+
+
+def _write_report(text: str, out: str) -> None:
+    if out == "-":
+        click.echo(text, nl=False)
+        return
+    from camtool.output import write_atomic
+
+    try:
+        Path(out).parent.mkdir(parents=True, exist_ok=True)
+        write_atomic(out, text)
+    except OSError as exc:
+        raise CamtoolError(f"{out}: cannot write ({exc.strerror or exc})") from exc

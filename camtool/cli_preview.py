@@ -1,0 +1,216 @@
+"""``camtool preview``: draw a drawing, a program, or a program over a drawing (SVG or PNG).
+
+INPUT is read by its ending: a drawing (``.dxf .svg .csv .txt .xy .m``), or a
+program. A program is read with the ``--target``'s own reader when its ending
+is one that target writes or is not a G-code ending (``logo.pic``), else a
+G-code file (``.ngc .nc .gcode .tap ...``) goes through the G-code importer
+(no target needed). ``-`` reads code in the target's dialect from stdin.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import click
+
+from camtool.errors import CamtoolError, InputError, UsageError
+
+if TYPE_CHECKING:
+    from camtool.geometry import Drawing
+    from camtool.post.base import Target
+    from camtool.program import Program
+    from camtool.verify.verifier import Verification
+
+
+@click.command()
+@click.argument("input_name", metavar="INPUT")
+@click.option(
+    "-o",
+    "--output",
+    default=None,
+    metavar="P.svg|P.png|-",
+    help="Picture to write; the ending picks SVG or PNG, '-' writes SVG to stdout "
+    "[default: INPUT's name with .preview.svg, beside it].",
+)
+@click.option("--target", "-t", default=None, metavar="NAME", help="The machine and dialect.")
+@click.option(
+    "--program",
+    "program_name",
+    default=None,
+    metavar="CODE",
+    help="A program to draw over the drawing INPUT (same coordinates).",
+)
+@click.option("--verify", "verify_too", is_flag=True, help="Simulate the program on the target.")
+@click.option(
+    "--machine",
+    "machine_file",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    metavar="FILE|NAME",
+    help="Machine profile laid over the target's, key by key.",
+)
+@click.option(
+    "--tool-diameter",
+    type=click.FloatRange(min=0),
+    default=0.0,
+    metavar="MM",
+    help="Draw the tool width along the cuts (and sweep the trace with it for --verify).",
+)
+@click.option("--title", default=None, metavar="TEXT", help="First title line [default: INPUT].")
+def preview(
+    input_name: str,
+    output: str | None,
+    target: str | None,
+    program_name: str | None,
+    verify_too: bool,
+    machine_file: Path | None,
+    tool_diameter: float,
+    title: str | None,
+) -> None:
+    """Draw INPUT (a drawing or a program) as a picture a person can check before cutting.
+
+    Cuts in blue, rapids dashed yellow, each contour's start, direction and
+    order, the tool width, the target's work area, a scale bar and a title with
+    the part size and the estimated time. With --verify the program is simulated
+    on the target and the picture adds the tool-centre trace coloured by its
+    deviation in µm, the worst point and a zoom inset on it.
+    """
+    from camtool.preview import preview_format, render_preview
+
+    out = output or _default_output(input_name)
+    preview_format(".svg" if out == "-" else out)
+    _refuse_overwrite(out, [input_name, program_name])
+    chosen = _target(target, machine_file)
+    drawing, program = _read_inputs(input_name, program_name, chosen)
+    verification = _verify(program, drawing, chosen, tool_diameter) if verify_too else None
+    shown = title or (f"{program_name} over {input_name}" if program_name else input_name)
+    data = render_preview(
+        ".svg" if out == "-" else out,
+        program=program,
+        drawing=drawing,
+        verification=verification,
+        target=chosen,
+        edge_radius_mm=tool_diameter / 2.0,
+        title=shown,
+    )
+    _write(data, out)
+    if out != "-":
+        click.echo(f"camtool: wrote preview {out}", err=True)
+
+
+def _default_output(input_name: str) -> str:
+    """``part.dxf`` → ``part.preview.svg`` beside it (never the input itself); ``-`` → stdout."""
+    if input_name == "-":
+        return "-"
+    path = Path(input_name)
+    return str(path.with_name(f"{path.stem}.preview.svg"))
+
+
+def _refuse_overwrite(out: str, inputs: list[str | None]) -> None:
+    if out == "-":
+        return
+    for name in inputs:
+        if name and name != "-" and Path(name).resolve() == Path(out).resolve():
+            raise UsageError(f"-o {out} would overwrite the input {name}; choose another name")
+
+
+def _target(name: str | None, machine_file: Path | None) -> Target | None:
+    if name is None:
+        if machine_file is not None:
+            raise UsageError("--machine needs --target (the profile is laid over the target's)")
+        return None
+    from camtool.post.registry import load_target
+
+    return load_target(name, machine_file=machine_file)
+
+
+def _read_inputs(
+    input_name: str, program_name: str | None, target: Target | None
+) -> tuple[Drawing | None, Program | None]:
+    """The drawing and the program to draw, read as the module docstring says."""
+    from camtool.importers import DRAWING_SUFFIXES, read_drawing
+
+    if input_name != "-" and Path(input_name).suffix.lower() in DRAWING_SUFFIXES:
+        if not Path(input_name).is_file():
+            raise InputError(f"{input_name}: no such file")
+        drawing = read_drawing(input_name)
+        program = _read_program(program_name, target) if program_name else None
+        return drawing, program
+    if program_name is not None:
+        raise UsageError(
+            f"--program draws a program over a drawing, but INPUT {input_name} is not a "
+            "drawing (.dxf, .svg, point list)"
+        )
+    return None, _read_program(input_name, target)
+
+
+def _read_program(name: str, target: Target | None) -> Program:
+    """A program by its ending: the target's dialect, or G-code through the importer."""
+    from camtool.pipeline import PROGRAM_SUFFIXES, is_program_file
+
+    if name != "-" and not Path(name).is_file():
+        raise InputError(f"{name}: no such file")
+    suffix = Path(name).suffix.lower()
+    if target is not None and (not is_program_file(name) or suffix in target.post.formats.values()):
+        return target.post.parse(_read_code(name, binary=target.post.binary), source=name)
+    if name != "-" and is_program_file(name):
+        from camtool.importers.gcode import read_gcode
+
+        return read_gcode(name)
+    raise UsageError(
+        f"{name} is not a drawing nor a G-code program ({', '.join(PROGRAM_SUFFIXES)}): "
+        "give --target NAME to read it as that target's code"
+    )
+
+
+def _verify(
+    program: Program | None, drawing: Drawing | None, target: Target | None, tool_diameter: float
+) -> Verification:
+    if target is None or program is None:
+        raise UsageError(
+            "--verify simulates a program on a machine: give a program (INPUT or --program) "
+            "and --target NAME"
+        )
+    from camtool.verify.verifier import verify_program
+
+    v = verify_program(
+        program, target.machine, name=target.name, against=drawing, tool_diameter=tool_diameter
+    )
+    for message in v.warnings:
+        click.echo(f"camtool: warning: {message}", err=True)
+    click.echo(
+        f"camtool: verified on {target.name}: max deviation {v.deviation.max_um:.2f} µm, "
+        f"≈ {v.time_s:.1f} s",
+        err=True,
+    )
+    return v
+
+
+def _read_code(name: str, *, binary: bool) -> str | bytes:
+    """The code file (or stdin for ``-``), bytes for a binary dialect, else ASCII text."""
+    try:
+        if binary:
+            return sys.stdin.buffer.read() if name == "-" else Path(name).read_bytes()
+        return sys.stdin.read() if name == "-" else Path(name).read_text(encoding="ascii")
+    except FileNotFoundError as exc:
+        raise InputError(f"{name}: no such file") from exc
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{name}: not a text program (byte {exc.start} is not ASCII)") from exc
+    except OSError as exc:
+        raise InputError(f"{name}: cannot read ({exc.strerror or exc})") from exc
+
+
+def _write(data: bytes, out: str) -> None:
+    """``data`` to ``out`` atomically, or to stdout for ``-``."""
+    if out == "-":
+        sys.stdout.buffer.write(data)
+        sys.stdout.flush()
+        return
+    from camtool.output import write_atomic
+
+    try:
+        write_atomic(out, data)
+    except OSError as exc:
+        raise CamtoolError(f"{out}: cannot write ({exc.strerror or exc})") from exc

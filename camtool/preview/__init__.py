@@ -1,0 +1,150 @@
+"""Previews a person can read: a program, a drawing, or a verification, as SVG or PNG.
+
+:func:`render_preview` draws what a machinist checks before cutting (seed-000
+S000-24 colours): cutting moves in blue and rapids in dashed yellow, each
+contour's start with an arrow along its direction and its number in cutting
+order, the tool width where the cut was offset, the target's work area, a scale
+bar in mm and a title with the target, the part size and the estimated time.
+For a verification it adds the simulated tool centre coloured by its deviation
+from the programmed path (µm, with a colour scale), the worst point marked and
+annotated with its µm and code line, and an inset zoomed on it: on a 5 mm part
+a 20 µm error is invisible at full scale.
+
+The picture is laid out once (:mod:`camtool.preview.layout`) and written
+either as direct SVG (:mod:`camtool.preview.svg`: exact arcs, 1 unit = 1 mm,
+same input → same bytes) or as PNG through matplotlib's Agg backend
+(:mod:`camtool.preview.raster`, no display needed). In the SVG every layer is a
+group with a stable id: ``drawing``, ``work-area``, ``tool-width``, ``trace``,
+``rapids``, ``cuts``, ``starts``, ``order``, ``worst`` in the ``main`` panel;
+``title``, ``scale-bar``, ``legend``, ``colour-scale``, ``inset-labels`` on
+the page; ``inset`` (with ``inset-trace``, ``inset-cuts``, ``inset-worst``).
+Layers with nothing to draw are left out.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from camtool.errors import UsageError
+from camtool.geometry import BBox, Drawing
+from camtool.preview.program_layers import AREA_COLOUR, CUT_COLOUR, RAPID_COLOUR
+from camtool.program import Program
+
+if TYPE_CHECKING:
+    from camtool.post.base import Target
+    from camtool.verify.verifier import Verification
+
+__all__ = [
+    "AREA_COLOUR",
+    "CUT_COLOUR",
+    "FORMATS",
+    "RAPID_COLOUR",
+    "preview_format",
+    "program_svg",
+    "render_preview",
+]
+
+FORMATS = (".png", ".svg")
+"""Preview file endings."""
+WIDTH_PX = 900
+"""Default picture width, pixels."""
+
+
+def preview_format(path_or_suffix: str | Path) -> str:
+    """``".png"`` or ``".svg"``: the preview format a file name (or a bare ending) asks for.
+
+    Raises:
+        UsageError: any other ending (the message lists the valid ones).
+    """
+    text = str(path_or_suffix)
+    suffix = text.lower() if text.startswith(".") and "/" not in text else Path(text).suffix.lower()
+    if suffix not in FORMATS:
+        got = repr(suffix) if suffix else "no ending"
+        raise UsageError(f"{text}: a preview is {' or '.join(FORMATS)}, not {got}")
+    return suffix
+
+
+def render_preview(
+    path_or_suffix: str | Path,
+    *,
+    program: Program | None = None,
+    drawing: Drawing | None = None,
+    verification: Verification | None = None,
+    target: Target | None = None,
+    edge_radius_mm: float = 0.0,
+    title: str | None = None,
+    work_area: BBox | None = None,
+    width_px: int = WIDTH_PX,
+) -> bytes:
+    """Draw a preview and return the file's bytes (the caller writes them, atomically).
+
+    Args:
+        path_or_suffix: the intended file name or just its ending: ``.svg`` or ``.png``.
+        program: the moves to draw, mm (default: the verification's program).
+        drawing: a drawing in the program's coordinates, drawn under it (mm).
+        verification: adds the simulated trace, the worst point and the inset.
+        target: gives the work area, the name and the timing model of the time
+            estimate (a verification brings its own machine and name).
+        edge_radius_mm: tool radius of an offset cut, mm; > 0 draws the swept tool.
+        title: a first title line (e.g. the input's name); the facts follow.
+        work_area: ``(xmin, ymin, xmax, ymax)`` mm, instead of the target's.
+        width_px: picture width in pixels (the height keeps the page's aspect).
+
+    Returns:
+        SVG text encoded as UTF-8, or PNG bytes. Same input, same SVG bytes.
+
+    Raises:
+        UsageError: the ending is neither ``.png`` nor ``.svg``, or there is
+            nothing to draw.
+        CamtoolError: the target's machine cannot be simulated for the time estimate.
+    """
+    from camtool.preview.facts import estimated_time
+    from camtool.preview.layout import Content, compose
+
+    suffix = preview_format(path_or_suffix)
+    if program is None and verification is not None:
+        program = verification.program
+    machine = verification.machine if verification is not None else None
+    if machine is None and target is not None:
+        machine = target.machine
+    name = verification.target if verification is not None else target.name if target else ""
+    if work_area is None and machine is not None:
+        work_area = machine.work_area_mm
+    if (program is None or not program.moves) and (drawing is None or not drawing.contours):
+        raise UsageError("nothing to preview: the program has no moves and there is no drawing")
+    content = Content(
+        program=program,
+        drawing=drawing,
+        verification=verification,
+        work_area=work_area,
+        target_name=name,
+        time=estimated_time(program, machine, verification),
+        edge_radius_mm=edge_radius_mm,
+        title=title,
+        width_px=width_px,
+    )
+    scene = compose(content)
+    if suffix == ".svg":
+        from camtool.preview.svg import scene_svg
+
+        return scene_svg(scene).encode("utf-8")
+    from camtool.preview.raster import scene_png
+
+    return scene_png(scene)
+
+
+def program_svg(program: Program, *, work_area: BBox | None = None, title: str = "") -> str:
+    """Draw ``program`` as an SVG document (see :func:`render_preview`); time at programmed feeds.
+
+    Args:
+        program: the program to draw.
+        work_area: the machine's ``(xmin, ymin, xmax, ymax)`` in mm, drawn as a
+            dashed frame; ``None`` draws none.
+        title: a first title line.
+
+    Raises:
+        UsageError: the program has no moves.
+    """
+    data = render_preview(".svg", program=program, work_area=work_area, title=title or None)
+    return data.decode("utf-8")

@@ -1,0 +1,320 @@
+"""Page layout of a preview: title band, main panel, right column (inset, colour scale), legend.
+
+Sizes are in ``u`` = 1/100 of the main view's larger side (mm), so every part
+gets the same proportions. The main view holds the program (rapids included)
+and the drawing, and the machine's work area when it is at most
+:data:`AREA_IN_VIEW` times the part's extent (a 5 mm logo on a 10 × 7 mm
+micro machine shows it whole; on a 300 mm router only the edges near the part
+show, and the title gives its size).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, TypeAlias
+
+from camtool.geometry import BBox, Drawing, Line, bbox_union
+from camtool.preview import program_layers as pl
+from camtool.preview import trace_layers as tl
+from camtool.preview.facts import duration, size_text
+from camtool.preview.scene import (
+    Circle,
+    Layer,
+    Panel,
+    Path,
+    Polylines,
+    Rect,
+    Scene,
+    Shape,
+    Style,
+    Text,
+    expand,
+    nice_length,
+    polyline,
+    ramp_colour,
+    text_width,
+)
+from camtool.program import Program, Rapid
+
+if TYPE_CHECKING:
+    from camtool.verify.verifier import Verification
+
+AREA_IN_VIEW = 4.0
+"""Largest work-area / part extent ratio at which the whole work area is in view."""
+
+
+@dataclass(frozen=True)
+class Content:
+    """What to draw (see :func:`camtool.preview.render_preview`)."""
+
+    program: Program | None
+    drawing: Drawing | None
+    verification: Verification | None
+    work_area: BBox | None
+    target_name: str
+    time: tuple[float, str] | None
+    edge_radius_mm: float
+    title: str | None
+    width_px: int
+
+
+def part_box(c: Content) -> BBox:
+    """What the title gives the size of: the cutting moves, else the drawing, else all moves."""
+    if c.program is not None and any(not isinstance(m, Rapid) for m in c.program.moves):
+        return c.program.bbox(cutting_only=True)
+    if c.drawing is not None and c.drawing.contours:
+        return c.drawing.bbox()
+    if c.program is not None and c.program.moves:
+        return c.program.bbox()
+    raise ValueError("nothing to draw: no moves and no contours")
+
+
+def view_box(c: Content) -> tuple[BBox, bool]:
+    """The main view (mm) and whether the whole work area is in it."""
+    boxes = [part_box(c)]
+    if c.program is not None and c.program.moves:
+        boxes.append(c.program.bbox())
+    if c.drawing is not None and c.drawing.contours:
+        boxes.append(c.drawing.bbox())
+    view = bbox_union(boxes)
+    area = c.work_area
+    if area is None:
+        return view, False
+    extent = max(view[2] - view[0], view[3] - view[1], 1e-6)
+    if max(area[2] - area[0], area[3] - area[1]) <= AREA_IN_VIEW * extent:
+        return bbox_union([view, area]), True
+    return view, False
+
+
+def compose(c: Content) -> Scene:
+    """The whole preview scene of ``c``.
+
+    Raises:
+        ValueError: there is nothing to draw.
+    """
+    view = view_box(c)[0]
+    u = max(view[2] - view[0], view[3] - view[1], 1e-3) / 100.0
+    frame = expand(view, 6.0 * u)
+    frame = _at_least(frame, 30.0 * u)  # a flat part still gets a readable strip
+    v = c.verification
+    worst = v is not None and v.deviation.block >= 0
+    column = 56.0 * u if worst else 0.0
+    lines = _title_lines(c)
+    title_h = 3.0 * u + 5.5 * u * len(lines)
+    right = frame[2] + column
+    scale_bar, legend, legend_h = _legend(c, frame, u, right - frame[0])
+    column_h = 90.0 * u if worst else 0.0
+    bottom = min(frame[1] - legend_h, frame[3] - column_h)
+    page = (frame[0] - 2 * u, bottom - 2 * u, right + 2 * u, frame[3] + title_h + 2 * u)
+    furniture = [
+        Layer("background", (Rect(page, Style(fill="#ffffff")),)),
+        _title(lines, page, frame[3] + 3.0 * u, u),
+        scale_bar,
+        legend,
+    ]
+    panels = [Panel("main", frame, frame, tuple(_main_layers(c, u, frame)), border=None)]
+    if worst and v is not None:
+        inset, labels = _column(v, frame, u)
+        furniture.extend(labels)
+        panels.append(inset)
+    page_panel = Panel("page", page, page, tuple(furniture), clip=False)
+    return Scene(page, c.width_px, (page_panel, *panels))
+
+
+def _at_least(box: BBox, size: float) -> BBox:
+    """``box`` widened and heightened about its centre to at least ``size``."""
+    x0, y0, x1, y1 = box
+    dx, dy = max(0.0, size - (x1 - x0)) / 2, max(0.0, size - (y1 - y0)) / 2
+    return (x0 - dx, y0 - dy, x1 + dx, y1 + dy)
+
+
+def _main_layers(c: Content, u: float, frame: BBox) -> list[Layer]:
+    layers: list[Layer] = []
+    if c.work_area is not None:
+        layers.append(pl.work_area_layer(c.work_area, u))
+    if c.drawing is not None and c.drawing.contours:
+        layers.append(pl.drawing_layer(c.drawing, u))
+    program = []
+    if c.program is not None:
+        program = pl.program_layers(c.program, u, edge_radius_mm=c.edge_radius_mm)
+    layers.extend(layer for layer in program if layer.id == "tool-width")
+    v = c.verification
+    if v is not None:
+        points, run, dev_um = tl.cutting_trace(v)
+        pieces = tl.binned_polylines(points, run, dev_um, tolerance=u / 5.0, top_um=tl.top_um(v))
+        layers.append(tl.trace_layer("trace", pieces, 1.1 * u))
+    layers.extend(layer for layer in program if layer.id != "tool-width")
+    if v is not None and v.deviation.block >= 0:
+        layers.append(tl.worst_layer("worst", v, u, view=frame))
+    return [layer for layer in layers if layer.shapes]
+
+
+def _title_lines(c: Content) -> list[str]:
+    facts = [c.target_name] if c.target_name else []
+    facts.append(size_text(part_box(c)))
+    if c.time is not None:
+        facts.append(f"≈ {duration(c.time[0])} {c.time[1]}")
+    lines = [c.title] if c.title else []
+    lines.append(" · ".join(facts))
+    v = c.verification
+    if v is not None:
+        text = f"verified: max deviation {v.deviation.max_um:.2f} µm"
+        if v.deviation.block >= 0:
+            text += f" ({tl.worst_label(v).split(', ', 1)[1]})"
+        text += f", rms {v.deviation.rms_um:.2f} µm"
+        if v.against is not None:
+            text += f"; against the drawing max {v.against.max_um:.2f} µm"
+        lines.append(text)
+    return lines
+
+
+def _title(lines: list[str], page: BBox, base: float, u: float) -> Layer:
+    """Title lines, the first bold, shrunk to fit the page width."""
+    width = page[2] - page[0] - 4 * u
+    shapes = []
+    y = base + 5.5 * u * (len(lines) - 1) + u
+    for i, line in enumerate(lines):
+        size = 3.6 * u if i == 0 else 3.0 * u
+        size = min(size, size * width / max(text_width(line, size, bold=i == 0), 1e-9))
+        shapes.append(Text((page[0] + 2 * u, y), line, size, bold=i == 0))
+        y -= 5.5 * u
+    return Layer("title", tuple(shapes))
+
+
+def _legend(c: Content, frame: BBox, u: float, width: float) -> tuple[Layer, Layer, float]:
+    """The scale bar, then the legend entries flowing in rows under the main panel.
+
+    Returns:
+        The ``scale-bar`` and ``legend`` layers and the height they take below the frame.
+    """
+    bar = nice_length(20.0 * u)
+    x0, y = frame[0] + u, frame[1] - 5.0 * u
+    label = f"{bar:g} mm"
+    scale = Layer(
+        "scale-bar",
+        (
+            Path(((_line((x0, y), (x0 + bar, y)),),), Style("#000000", 0.5 * u)),
+            Path(
+                (
+                    (_line((x0, y - u), (x0, y + u)),),
+                    (_line((x0 + bar, y - u), (x0 + bar, y + u)),),
+                ),
+                Style("#000000", 0.3 * u),
+            ),
+            Text((x0 + bar + 1.5 * u, y - u), label, 2.8 * u),
+        ),
+    )
+    shapes: list[Shape] = []
+    x = x0 + bar + 4.5 * u + text_width(label, 2.8 * u)
+    for glyph, text in _entries(c, u):
+        need = 6.0 * u + text_width(text, 2.6 * u) + 3.0 * u
+        if x + need > frame[0] + width:
+            x, y = x0, y - 5.0 * u
+        shapes.extend(glyph(x, y))
+        shapes.append(Text((x + 6.0 * u, y - 0.9 * u), text, 2.6 * u, "#333333"))
+        x += need
+    return scale, Layer("legend", tuple(shapes)), frame[1] - y + 3.0 * u
+
+
+def _line(a: tuple[float, float], b: tuple[float, float]) -> Line:
+    return Line(a, b)
+
+
+Glyph: TypeAlias = Callable[[float, float], tuple[Shape, ...]]
+
+
+def _entries(c: Content, u: float) -> list[tuple[Glyph, str]]:
+    """Legend entries for what the picture holds: ``(glyph at (x, y), label)``."""
+
+    def stroke(style: Style) -> Glyph:
+        return lambda x, y: (Path(((_line((x, y), (x + 4.5 * u, y)),),), style),)
+
+    def start(x: float, y: float) -> tuple[Shape, ...]:
+        fill = Style(fill=pl.START_COLOUR)
+        arrow = polyline([(x + 1.5 * u, y + 0.5 * u), (x + 4.5 * u, y), (x + 1.5 * u, y - 0.5 * u)])
+        return (Circle((x + 0.8 * u, y), 0.8 * u, fill), Polylines((arrow,), fill, closed=True))
+
+    def band(x: float, y: float) -> tuple[Shape, ...]:
+        style = Style(fill=pl.TOOL_COLOUR, opacity=pl.TOOL_OPACITY)
+        return (Rect((x, y - 1.2 * u, x + 4.5 * u, y + 1.2 * u), style),)
+
+    def ramp(x: float, y: float) -> tuple[Shape, ...]:
+        return tuple(
+            Path(
+                ((_line((x + i * 1.5 * u, y), (x + (i + 1) * 1.5 * u, y)),),),
+                Style(ramp_colour(i / 2), 1.1 * u),
+            )
+            for i in range(3)
+        )
+
+    out: list[tuple[Glyph, str]] = []
+    p = c.program
+    if p is not None and any(not isinstance(m, Rapid) for m in p.moves):
+        out.append((stroke(Style(pl.CUT_COLOUR, 0.5 * u)), "cut"))
+    if p is not None and any(isinstance(m, Rapid) for m in p.moves):
+        out.append((stroke(Style(pl.RAPID_COLOUR, 0.4 * u, dash=(1.2 * u, 0.9 * u))), "rapid"))
+    if p is not None and any(not isinstance(m, Rapid) for m in p.moves):
+        out.append((start, "start, direction, order"))
+    if c.edge_radius_mm > 0 and p is not None:
+        out.append((band, f"tool width (r = {c.edge_radius_mm:g} mm)"))
+    if c.drawing is not None:
+        out.append((stroke(Style(pl.DRAWING_COLOUR, 0.4 * u)), "drawing"))
+    if c.work_area is not None:
+        label = (
+            "work area" if view_box(c)[1] else f"work area {size_text(c.work_area)}, partly shown"
+        )
+        out.append((stroke(Style(pl.AREA_COLOUR, 0.4 * u, dash=(1.5 * u, u))), label))
+    if c.verification is not None:
+        out.append((ramp, "simulated tool centre"))
+    return out
+
+
+def _column(v: Verification, frame: BBox, u: float) -> tuple[Panel, list[Layer]]:
+    """The zoom inset on the worst point, its scale bar and the deviation colour scale."""
+    side = 48.0 * u
+    x0 = frame[2] + 5.0 * u
+    top = frame[3] - 6.0 * u
+    box = (x0, top - side, x0 + side, top)
+    window = tl.inset_window(v)
+    inset = Panel(
+        "inset",
+        box,
+        window,
+        tl.inset_layers(v, window),
+        background="#ffffff",
+        border=Style("#555555", 0.3 * u),
+    )
+    zoom = side / (window[2] - window[0])
+    window_um = (window[2] - window[0]) * 1000.0
+    bar_um = nice_length(window_um / 4.0)
+    bar = bar_um / 1000.0 * zoom
+    y = box[1] - 5.0 * u
+    labels = Layer(
+        "inset-labels",
+        (
+            Text((x0, top + 2.0 * u), f"zoom × {zoom:.0f} on the worst point", 2.8 * u, bold=True),
+            Path(((_line((x0, y), (x0 + bar, y)),),), Style("#000000", 0.5 * u)),
+            Text((x0 + bar + 1.5 * u, y - u), f"{bar_um:g} µm", 2.8 * u),
+            Text((x0, y - 5.0 * u), "blue: programmed path", 2.4 * u, "#333333"),
+            Text((x0, y - 8.5 * u), "colour: simulated tool centre", 2.4 * u, "#333333"),
+        ),
+    )
+    return inset, [labels, _colour_scale(v, x0, y - 16.0 * u, side, u)]
+
+
+def _colour_scale(v: Verification, x0: float, y: float, width: float, u: float) -> Layer:
+    """The deviation scale: one box per colour class, ticks in µm, a caption."""
+    top = tl.top_um(v)
+    w = width / tl.BINS
+    shapes: list[Shape] = [
+        Rect(
+            (x0 + i * w, y - 3.0 * u, x0 + (i + 1) * w + 1e-9, y),
+            Style(fill=ramp_colour((i + 0.5) / tl.BINS)),
+        )
+        for i in range(tl.BINS)
+    ]
+    for f, anchor in ((0.0, "start"), (0.5, "middle"), (1.0, "end")):
+        shapes.append(Text((x0 + f * width, y - 6.5 * u), f"{f * top:.3g}", 2.6 * u, anchor=anchor))
+    shapes.append(Text((x0, y + 1.5 * u), "deviation from the path (µm)", 2.4 * u))
+    return Layer("colour-scale", tuple(shapes))

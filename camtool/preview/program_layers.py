@@ -1,0 +1,164 @@
+"""Layers of a program and its drawing: cuts, rapids, tool width, starts, order, work area.
+
+Colours of the thesis GUI (seed-000 S000-24): cutting moves blue, rapids dashed
+yellow. Each contour's start is a red dot with an arrow along the direction of
+travel and its number in cutting order. Sizes are given in ``u``, 1/100 of the
+main view's larger side, so the picture reads the same for a 5 mm logo and a
+300 mm plate.
+"""
+
+from __future__ import annotations
+
+import math
+
+from camtool.geometry import Arc, BBox, Drawing, Point, Segment
+from camtool.preview.scene import Circle, Layer, Path, Polylines, Rect, Style, Text, polyline
+from camtool.program import Program, Rapid
+
+CUT_COLOUR = "#1f4fd1"
+"""Cutting moves (blue, S000-24)."""
+RAPID_COLOUR = "#d4a900"
+"""Rapids (dashed yellow, S000-24)."""
+AREA_COLOUR = "#9a9a9a"
+"""The machine's work area (dashed grey)."""
+START_COLOUR = "#c0392b"
+"""Start dots, direction arrows and order numbers."""
+DRAWING_COLOUR = "#6b6b6b"
+"""The drawing under the program."""
+TOOL_COLOUR = "#1f4fd1"
+"""Tool width (translucent)."""
+TOOL_OPACITY = 0.18
+
+
+def cut_runs(program: Program) -> list[list[Segment]]:
+    """The cutting moves as runs, in cutting order: a run ends at a rapid or a new contour.
+
+    Returns:
+        One list of segments per run (the numbers on the picture are 1-based
+        positions in this list).
+    """
+    runs: list[list[Segment]] = []
+    contour, open_run = None, False
+    for move, seg in program.segments():
+        if isinstance(move, Rapid):
+            open_run = False
+            continue
+        if not open_run or (move.contour and move.contour != contour):
+            runs.append([])
+            open_run = True
+        contour = move.contour
+        runs[-1].append(seg)
+    return runs
+
+
+def program_layers(program: Program, u: float, *, edge_radius_mm: float = 0.0) -> list[Layer]:
+    """Tool width, rapids, cuts, starts and order of ``program`` (empty layers left out).
+
+    Args:
+        program: the moves, mm.
+        u: the picture's size unit, mm (1/100 of the view).
+        edge_radius_mm: tool radius of an offset cut; > 0 draws the swept tool.
+    """
+    runs = cut_runs(program)
+    rapids = tuple((seg,) for move, seg in program.segments() if isinstance(move, Rapid))
+    layers = [
+        Layer("tool-width", tool_width(runs, edge_radius_mm, u)),
+        Layer(
+            "rapids",
+            (Path(rapids, Style(RAPID_COLOUR, 0.25 * u, dash=(1.2 * u, 0.9 * u))),)
+            if rapids
+            else (),
+        ),
+        Layer(
+            "cuts",
+            (Path(tuple(tuple(r) for r in runs), Style(CUT_COLOUR, 0.35 * u)),) if runs else (),
+        ),
+        Layer("starts", tuple(s for run in runs for s in _start_marker(run, u))),
+        Layer("order", tuple(_number(i + 1, run, u) for i, run in enumerate(runs))),
+    ]
+    return [layer for layer in layers if layer.shapes]
+
+
+def drawing_layer(drawing: Drawing, u: float) -> Layer:
+    """The drawing's contours as thin grey strokes."""
+    chains = tuple(c.segments for c in drawing.contours)
+    return Layer("drawing", (Path(chains, Style(DRAWING_COLOUR, 0.25 * u)),))
+
+
+def work_area_layer(area: BBox, u: float) -> Layer:
+    """The machine's work area as a dashed grey frame."""
+    return Layer("work-area", (Rect(area, Style(AREA_COLOUR, 0.25 * u, dash=(1.5 * u, u))),))
+
+
+def tool_width(runs: list[list[Segment]], radius: float, u: float) -> tuple[Polylines, ...]:
+    """The area the tool sweeps along the cuts (shapely buffer by ``radius``), translucent.
+
+    Returns no shape when ``radius`` <= 0 or nothing is cut. Rings are
+    oriented (outer counter-clockwise, holes clockwise), so any fill rule works.
+    """
+    if radius <= 0 or not runs:
+        return ()
+    import shapely
+    from shapely.geometry import LineString, Polygon
+    from shapely.geometry import Point as ShapelyPoint
+    from shapely.geometry.polygon import orient
+
+    tolerance = min(radius / 20.0, u / 10.0)
+    pieces = []
+    for run in runs:
+        pts = [run[0].start]
+        for seg in run:
+            pts.extend(seg.points(tolerance)[1:])
+        line = LineString(pts) if len(pts) > 1 else ShapelyPoint(pts[0])
+        pieces.append(line.buffer(radius, quad_segs=16))
+    area = shapely.unary_union(pieces)
+    polygons = [g for g in getattr(area, "geoms", [area]) if isinstance(g, Polygon)]
+    rings = []
+    for polygon in polygons:
+        oriented = orient(polygon, 1.0)
+        rings.append(polyline(oriented.exterior.coords))
+        rings.extend(polyline(hole.coords) for hole in oriented.interiors)
+    style = Style(fill=TOOL_COLOUR, opacity=TOOL_OPACITY)
+    return (Polylines(tuple(rings), style, closed=True),)
+
+
+def _start_marker(run: list[Segment], u: float) -> tuple[Circle, Polylines]:
+    """A dot at the run's start and an arrow along its direction of travel."""
+    sx, sy = run[0].start
+    tx, ty = start_tangent(run)
+    a = 3.2 * u
+    tip = (sx + tx * a, sy + ty * a)
+    base = (sx + tx * a * 0.45, sy + ty * a * 0.45)
+    w = 0.55 * u
+    left = (base[0] - ty * w, base[1] + tx * w)
+    right = (base[0] + ty * w, base[1] - tx * w)
+    style = Style(fill=START_COLOUR)
+    return (
+        Circle((sx, sy), 0.8 * u, style),
+        Polylines((polyline([(sx, sy), left, tip, right]),), style, closed=True),
+    )
+
+
+def _number(number: int, run: list[Segment], u: float) -> Text:
+    """The run's number beside its start, on the left of the direction of travel."""
+    sx, sy = run[0].start
+    tx, ty = start_tangent(run)
+    # left normal (-ty, tx), a little behind the start; baseline lowered by a third of the size
+    size = 3.0 * u
+    x = sx - ty * 2.6 * u - tx * 1.2 * u
+    y = sy + tx * 2.6 * u - ty * 1.2 * u - size / 3.0
+    return Text((x, y), str(number), size, START_COLOUR, anchor="middle", bold=True)
+
+
+def start_tangent(run: list[Segment]) -> Point:
+    """Unit direction of travel at the start of the first segment of ``run`` that has one."""
+    for seg in run:
+        if isinstance(seg, Arc):
+            rx, ry = seg.start[0] - seg.centre[0], seg.start[1] - seg.centre[1]
+            tx, ty = (ry, -rx) if seg.clockwise else (-ry, rx)
+        else:
+            tx, ty = seg.end[0] - seg.start[0], seg.end[1] - seg.start[1]
+        length = math.hypot(tx, ty)
+        if length > 0:
+            return tx / length, ty / length
+    return 1.0, 0.0

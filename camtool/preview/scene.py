@@ -1,0 +1,193 @@
+"""What a preview draws, independent of the file format: panels of layers of shapes.
+
+Every coordinate is in mm with +Y up: the page itself is laid out in the
+drawing's own millimetres around the part (the main panel shows the part at
+1:1 in those units), so a shape's numbers are the part's coordinates. A
+:class:`Panel` maps a *window* of the world onto a *frame* of the page; the
+main panel and the page furniture use the identity (frame == window), the
+zoom inset a small window around the worst point. Widths and sizes of shapes
+are in the units of their panel's window. The two writers,
+:mod:`camtool.preview.svg` (direct SVG, exact arcs) and
+:mod:`camtool.preview.raster` (matplotlib Agg, PNG), draw the same scene.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TypeAlias
+
+import numpy as np
+import numpy.typing as npt
+
+from camtool.geometry import BBox, Point, Segment
+
+
+@dataclass(frozen=True)
+class Style:
+    """How a shape is stroked and filled.
+
+    Attributes:
+        stroke: line colour ``#rrggbb``, ``None`` for no outline.
+        width: line width in the panel's window units (mm on the page).
+        fill: fill colour, ``None`` for no fill.
+        opacity: 0..1 for the whole shape.
+        dash: on/off lengths of a dashed line, window units; empty for solid.
+    """
+
+    stroke: str | None = None
+    width: float = 0.0
+    fill: str | None = None
+    opacity: float = 1.0
+    dash: tuple[float, ...] = ()
+
+
+@dataclass(frozen=True)
+class Path:
+    """Chains of lines and exact arcs; each chain is drawn as one continuous stroke."""
+
+    chains: tuple[tuple[Segment, ...], ...]
+    style: Style
+
+
+@dataclass(frozen=True, eq=False)
+class Polylines:
+    """Polylines, each an ``(N, 2) float64`` array (mm, read-only).
+
+    ``closed`` ones are rings; filled rings use the even-odd rule (holes are
+    rings inside rings).
+    """
+
+    lines: tuple[npt.NDArray[np.float64], ...]
+    style: Style
+    closed: bool = False
+
+
+@dataclass(frozen=True)
+class Circle:
+    """A circle of ``radius`` around ``centre``."""
+
+    centre: Point
+    radius: float
+    style: Style
+
+
+@dataclass(frozen=True)
+class Rect:
+    """An axis-aligned rectangle ``box = (xmin, ymin, xmax, ymax)``."""
+
+    box: BBox
+    style: Style
+
+
+@dataclass(frozen=True)
+class Text:
+    """One line of text; ``at`` is the start of its baseline (or middle/end, by ``anchor``).
+
+    ``size`` is the font size (height of the em) in window units; ``halo`` draws
+    a white outline under the letters so they read over lines.
+    """
+
+    at: Point
+    text: str
+    size: float
+    colour: str = "#000000"
+    anchor: str = "start"
+    bold: bool = False
+    halo: bool = False
+
+
+Shape: TypeAlias = Path | Polylines | Circle | Rect | Text
+
+
+@dataclass(frozen=True)
+class Layer:
+    """A named group of shapes (an SVG ``<g id=...>``), drawn in order."""
+
+    id: str
+    shapes: tuple[Shape, ...]
+
+
+@dataclass(frozen=True)
+class Panel:
+    """Layers seen through ``window`` (world) and drawn into ``frame`` (page), same aspect.
+
+    ``clip`` cuts what falls outside the frame; ``background`` fills the frame
+    first and ``border`` outlines it (page units).
+    """
+
+    id: str
+    frame: BBox
+    window: BBox
+    layers: tuple[Layer, ...]
+    clip: bool = True
+    background: str | None = None
+    border: Style | None = None
+
+    @property
+    def scale(self) -> float:
+        """Page mm per window unit (1 for the identity panels)."""
+        return (self.frame[2] - self.frame[0]) / (self.window[2] - self.window[0])
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A whole preview: the page box, its width in pixels, and panels drawn in order."""
+
+    page: BBox
+    width_px: int
+    panels: tuple[Panel, ...]
+
+    @property
+    def height_px(self) -> int:
+        """Picture height in pixels (the page's aspect ratio kept)."""
+        w, h = self.page[2] - self.page[0], self.page[3] - self.page[1]
+        return max(1, round(self.width_px * h / w))
+
+
+def polyline(points: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    """``points`` as a read-only ``(N, 2) float64`` array."""
+    arr = np.array(points, dtype=np.float64).reshape(-1, 2)
+    arr.setflags(write=False)
+    return arr
+
+
+# The "plasma" colour map of matplotlib (CC0, van der Walt & Smith) sampled at
+# 0, 0.2, ... 1: the trace colours are interpolated from these anchors so that
+# the SVG does not depend on the installed matplotlib.
+_RAMP = (
+    (13, 8, 135),
+    (106, 0, 168),
+    (177, 42, 144),
+    (225, 100, 98),
+    (252, 166, 54),
+    (240, 249, 33),
+)
+
+
+def ramp_colour(t: float) -> str:
+    """Colour of the deviation scale at ``t`` in [0, 1] (dark blue → yellow), ``#rrggbb``."""
+    t = min(max(t, 0.0), 1.0) * (len(_RAMP) - 1)
+    i = min(math.floor(t), len(_RAMP) - 2)
+    f = t - i
+    rgb = (round(a + (b - a) * f) for a, b in zip(_RAMP[i], _RAMP[i + 1], strict=True))
+    return "#" + "".join(f"{c:02x}" for c in rgb)
+
+
+def nice_length(target: float) -> float:
+    """The 1-2-5 number (×10^k) at or just below ``target`` (> 0): scale bar lengths."""
+    k = math.floor(math.log10(target))
+    for m in (5.0, 2.0, 1.0):
+        if m * 10.0**k <= target * (1 + 1e-9):
+            return m * 10.0**k
+    return 10.0**k
+
+
+def text_width(text: str, size: float, *, bold: bool = False) -> float:
+    """Approximate width of ``text`` at font ``size`` (DejaVu Sans), for layout only."""
+    return (0.68 if bold else 0.58) * size * len(text)
+
+
+def expand(box: BBox, margin: float) -> BBox:
+    """``box`` grown by ``margin`` on every side."""
+    return (box[0] - margin, box[1] - margin, box[2] + margin, box[3] + margin)
