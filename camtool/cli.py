@@ -14,85 +14,25 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from camtool import __version__
-from camtool.errors import CamtoolError, InputError, UsageError, VerifyLimitError
-from camtool.toolpath.plan import OFFSET_MODES
+from camtool.cli_common import (
+    MACHINE,
+    import_options,
+    import_settings,
+    post_options,
+    read_code,
+    read_input,
+    warn,
+    write_output,
+)
+from camtool.errors import CamtoolError, UsageError, VerifyLimitError
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
     from camtool.geometry import Drawing
-    from camtool.importers import ImportOptions
     from camtool.post.registry import TargetEntry
     from camtool.program import Program
     from camtool.verify.verifier import Verification
-
-
-def _warn(messages: tuple[str, ...] | list[str]) -> None:
-    for message in messages:
-        click.echo(f"camtool: warning: {message}", err=True)
-
-
-def _write(data: str | bytes, out: str) -> None:
-    if out == "-":
-        if isinstance(data, bytes):
-            sys.stdout.buffer.write(data)
-        else:
-            click.echo(data, nl=False)
-        return
-    from camtool.output import write_atomic
-
-    try:
-        write_atomic(out, data)
-    except OSError as exc:
-        raise CamtoolError(f"{out}: cannot write ({exc.strerror or exc})") from exc
-
-
-_MACHINE = click.option(
-    "--machine",
-    "machine_file",
-    type=click.Path(dir_okay=False, path_type=Path),
-    default=None,
-    metavar="FILE|NAME",
-    help="Machine profile (a TOML file or a built-in name) laid over the target's, key by "
-    "key, e.g. a measured backlash.",
-)
-
-
-def _import_options(command: Callable[..., None]) -> Callable[..., None]:
-    """Options of the importers: --layers, --units, --hatch-boundaries."""
-    from camtool.units import LENGTH_UNITS
-
-    command = click.option(
-        "--hatch-boundaries",
-        is_flag=True,
-        help="Use DXF HATCH boundary paths as contours (skipped otherwise).",
-    )(command)
-    command = click.option(
-        "--units",
-        type=click.Choice(list(LENGTH_UNITS)),
-        default=None,
-        help="Unit of unitless inputs (point lists; default mm, Matlab xy files 0.1mm).",
-    )(command)
-    return click.option(
-        "--layers",
-        default=None,
-        metavar="A,B",
-        help="Only these layers (DXF layers, Inkscape layers), comma-separated.",
-    )(command)
-
-
-def _import_settings(options: dict[str, Any]) -> ImportOptions:
-    """Pop the importer options out of a command's keyword options."""
-    from camtool.importers import ImportOptions
-
-    layers = options.pop("layers", None)
-    names = tuple(n.strip() for n in layers.split(",") if n.strip()) if layers else None
-    return ImportOptions(
-        layers=names,
-        tolerance=options.get("tolerance", 0.001),
-        units=options.pop("units", None),
-        hatch_boundaries=options.pop("hatch_boundaries", False),
-    )
 
 
 def _verify_outputs(command: Callable[..., None]) -> Callable[..., None]:
@@ -143,71 +83,9 @@ def cli() -> None:
     metavar="FILE",
     help="Where to write the program; '-' (default) is stdout.",
 )
-@click.option(
-    "--offset",
-    type=click.Choice(OFFSET_MODES),
-    default="on",
-    show_default=True,
-    help="Tool-centre side: 'on' follows the drawing (scribing point); 'outside'/"
-    "'inside' compensate by half the tool diameter.",
-)
-@click.option(
-    "--tool-diameter",
-    type=float,
-    default=0.0,
-    metavar="MM",
-    help="Tool diameter in mm (needed by --offset outside|inside).",
-)
-@click.option(
-    "--feed",
-    "feed_mm_min",
-    type=float,
-    default=None,
-    metavar="MM_PER_MIN",
-    help="Cutting feed in mm/min [default: the target's, 0.8 for pic-mmh].",
-)
-@click.option(
-    "--tolerance",
-    type=float,
-    default=0.001,
-    show_default=True,
-    metavar="MM",
-    help="Entity ends closer than this (mm) are chained into one contour.",
-)
-@click.option(
-    "--scale",
-    type=float,
-    default=1.0,
-    show_default=True,
-    metavar="K",
-    help="Scale the drawing by K about its origin (unitless factor).",
-)
-@click.option(
-    "--fit",
-    "fit_mm",
-    type=(float, float),
-    default=None,
-    metavar="W H",
-    help="Scale the drawing uniformly to fit W x H mm, about its lower-left corner.",
-)
-@click.option(
-    "--format",
-    "fmt",
-    default=None,
-    metavar="NAME",
-    help="Output format of the target's dialect (e.g. matlab-router 'wire', i8751 'dump'); "
-    "see `camtool targets`.",
-)
-@click.option(
-    "--spindle-rpm",
-    type=click.FloatRange(min=0),
-    default=None,
-    metavar="RPM",
-    help="Spindle on (M03) at RPM before the first move and off (M05) after the last; "
-    "0 writes no spindle commands [default: the target's].",
-)
-@_MACHINE
-@_import_options
+@post_options
+@MACHINE
+@import_options
 @click.option("--verify", "verify_too", is_flag=True, help="Verify the emitted code (see verify).")
 @_verify_outputs
 def post(
@@ -234,7 +112,7 @@ def post(
 
     chosen = load_target(target, machine_file=machine_file)
     chosen.post.check_format(options["fmt"])
-    settings = _import_settings(options)
+    settings = import_settings(options)
     if is_program_file(drawing):
         job = post_program(
             _read_program(drawing, options),
@@ -244,14 +122,14 @@ def post(
             spindle_rpm=options["spindle_rpm"],
         )
     else:
-        job = post_drawing(_read_input(drawing, settings), chosen, **options)
-    _warn(job.warnings)
+        job = post_drawing(read_input(drawing, settings), chosen, **options)
+    warn(job.warnings)
     if isinstance(job.result.code, bytes) and output == "-" and sys.stdout.isatty():
         raise UsageError(
             f"{chosen.name} writes binary code: give -o FILE{chosen.post.suffix} or "
             "pipe stdout (or choose a text --format)"
         )
-    _write(job.result.code, output)
+    write_output(job.result.code, output)
     if output != "-":
         click.echo(
             f"camtool: wrote {job.result.blocks} blocks for {chosen.name} to {output}", err=True
@@ -286,7 +164,7 @@ def post(
     metavar="MM",
     help="Tool diameter; the machined edge is the simulated path swept by half of it.",
 )
-@_MACHINE
+@MACHINE
 @_verify_outputs
 def verify(
     code: str,
@@ -309,8 +187,8 @@ def verify(
     from camtool.verify.verifier import verify_code
 
     chosen = load_target(target, machine_file=machine_file)
-    text = _read_code(code, binary=chosen.post.binary)
-    drawing = _read_input(against) if against is not None else None
+    text = read_code(code, binary=chosen.post.binary)
+    drawing = read_input(against) if against is not None else None
     v = verify_code(text, chosen, source=code, against=drawing, tool_diameter=tool_diameter)
     _finish_verification(
         v, report, preview, max_error_um, drawing=drawing, edge_radius_mm=tool_diameter / 2.0
@@ -339,26 +217,6 @@ def _read_program(name: str, options: dict[str, Any]) -> Program:
     return read_gcode(name)
 
 
-def _read_code(name: str, *, binary: bool = False) -> str | bytes:
-    if binary:
-        try:
-            return sys.stdin.buffer.read() if name == "-" else Path(name).read_bytes()
-        except FileNotFoundError as exc:
-            raise InputError(f"{name}: no such file") from exc
-        except OSError as exc:
-            raise InputError(f"{name}: cannot read ({exc.strerror or exc})") from exc
-    if name == "-":
-        return sys.stdin.read()
-    try:
-        return Path(name).read_text(encoding="ascii", errors="strict")
-    except FileNotFoundError as exc:
-        raise InputError(f"{name}: no such file") from exc
-    except UnicodeDecodeError as exc:
-        raise InputError(f"{name}: not a text program (byte {exc.start} is not ASCII)") from exc
-    except OSError as exc:
-        raise InputError(f"{name}: cannot read ({exc.strerror or exc})") from exc
-
-
 def _finish_verification(
     v: Verification,
     report: str | None,
@@ -371,28 +229,20 @@ def _finish_verification(
     """Summary to stderr, then the report and preview files, then the limit check."""
     from camtool.verify.verifier import report_dict, summary_lines
 
-    _warn(v.warnings)
+    warn(v.warnings)
     for line in summary_lines(v):
         click.echo(f"camtool: {line}", err=True)
     if report is not None:
-        _write(json.dumps(report_dict(v), indent=2) + "\n", report)
+        write_output(json.dumps(report_dict(v), indent=2) + "\n", report)
     if preview is not None:
         from camtool.preview_trace import write_trace_preview
 
         picture = write_trace_preview(v, preview, drawing=drawing, edge_radius_mm=edge_radius_mm)
-        _write(picture, preview)
+        write_output(picture, preview)
     if max_error_um is not None and v.max_error_um > max_error_um:
         raise VerifyLimitError(
             f"predicted error {v.max_error_um:.2f} µm exceeds --max-error-um {max_error_um:g}"
         )
-
-
-def _read_input(name: str, settings: ImportOptions | None = None) -> Drawing:
-    from camtool.importers import read_drawing, read_drawing_bytes
-
-    if name == "-":
-        return read_drawing_bytes(sys.stdin.buffer.read(), options=settings)
-    return read_drawing(name, settings)
 
 
 @cli.command()
@@ -406,7 +256,7 @@ def _read_input(name: str, settings: ImportOptions | None = None) -> Drawing:
     metavar="MM",
     help="Chaining tolerance (and curve-fit tolerance), mm.",
 )
-@_import_options
+@import_options
 def inspect(drawing: str, as_json: bool, **options: Any) -> None:
     """Lint DRAWING before cutting (the report goes to stdout).
 
@@ -416,7 +266,7 @@ def inspect(drawing: str, as_json: bool, **options: Any) -> None:
     """
     from camtool.importers.lint import inspect_drawing
 
-    report = inspect_drawing(drawing, _import_settings(options))
+    report = inspect_drawing(drawing, import_settings(options))
     if as_json:
         click.echo(json.dumps(report.to_json(), indent=2))
     else:

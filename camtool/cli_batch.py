@@ -14,8 +14,8 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
+from camtool.cli_common import MACHINE, import_options, post_options, write_output
 from camtool.errors import CamtoolError, InputError, UsageError, VerifyLimitError
-from camtool.toolpath.plan import OFFSET_MODES
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -28,86 +28,8 @@ _ERRORS: dict[int, type[CamtoolError]] = {2: UsageError, 3: InputError, 4: Verif
 
 
 def _post_options(command: Callable[..., None]) -> Callable[..., None]:
-    """The options of ``camtool post`` that shape each file (copied from camtool.cli)."""
-    from camtool.units import LENGTH_UNITS
-
-    for decorator in reversed(
-        (
-            click.option(
-                "--offset",
-                type=click.Choice(OFFSET_MODES),
-                default="on",
-                show_default=True,
-                help="Tool-centre side: 'on' follows the drawing; 'outside'/'inside' "
-                "compensate by half the tool diameter.",
-            ),
-            click.option(
-                "--tool-diameter", type=float, default=0.0, metavar="MM", help="Tool diameter, mm."
-            ),
-            click.option(
-                "--feed",
-                "feed_mm_min",
-                type=float,
-                default=None,
-                metavar="MM_PER_MIN",
-                help="Cutting feed in mm/min [default: the target's].",
-            ),
-            click.option(
-                "--tolerance",
-                type=float,
-                default=0.001,
-                show_default=True,
-                metavar="MM",
-                help="Chaining and curve-fit tolerance, mm.",
-            ),
-            click.option(
-                "--scale",
-                type=float,
-                default=1.0,
-                show_default=True,
-                metavar="K",
-                help="Scale each drawing by K about its origin.",
-            ),
-            click.option(
-                "--fit",
-                "fit_mm",
-                type=(float, float),
-                default=None,
-                metavar="W H",
-                help="Scale each drawing uniformly to fit W x H mm.",
-            ),
-            click.option(
-                "--format", "fmt", default=None, metavar="NAME", help="The dialect's output format."
-            ),
-            click.option(
-                "--spindle-rpm",
-                type=click.FloatRange(min=0),
-                default=None,
-                metavar="RPM",
-                help="Spindle speed; 0 writes no spindle commands [default: the target's].",
-            ),
-            click.option(
-                "--machine",
-                "machine_file",
-                type=click.Path(dir_okay=False, path_type=Path),
-                default=None,
-                metavar="FILE|NAME",
-                help="Machine profile laid over the target's, key by key.",
-            ),
-            click.option("--layers", default=None, metavar="A,B", help="Only these layers."),
-            click.option(
-                "--units",
-                type=click.Choice(list(LENGTH_UNITS)),
-                default=None,
-                help="Unit of unitless inputs (point lists).",
-            ),
-            click.option(
-                "--hatch-boundaries", is_flag=True, help="Use DXF HATCH boundaries as contours."
-            ),
-        )
-    ):
-        command = decorator(command)
-    return command
+    """The options of ``camtool post`` that shape each file (machine and importers too)."""
+    return post_options(MACHINE(import_options(command)))
 
 
 @click.command()
@@ -193,13 +115,9 @@ def _row_name(row: BatchRow | None) -> str | None:
 
 
 def _write_report(text: str, out: str) -> None:
-    if out == "-":
-        click.echo(text, nl=False)
-        return
-    from camtool.output import write_atomic
-
-    try:
-        Path(out).parent.mkdir(parents=True, exist_ok=True)
-        write_atomic(out, text)
-    except OSError as exc:
-        raise CamtoolError(f"{out}: cannot write ({exc.strerror or exc})") from exc
+    if out != "-":
+        try:
+            Path(out).parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise CamtoolError(f"{out}: cannot write ({exc.strerror or exc})") from exc
+    write_output(text, out)

@@ -9,13 +9,13 @@ G-code file (``.ngc .nc .gcode .tap ...``) goes through the G-code importer
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import click
 
-from camtool.errors import CamtoolError, InputError, UsageError
+from camtool.cli_common import MACHINE, read_code, warn, write_output
+from camtool.errors import InputError, UsageError
 
 if TYPE_CHECKING:
     from camtool.geometry import Drawing
@@ -43,14 +43,7 @@ if TYPE_CHECKING:
     help="A program to draw over the drawing INPUT (same coordinates).",
 )
 @click.option("--verify", "verify_too", is_flag=True, help="Simulate the program on the target.")
-@click.option(
-    "--machine",
-    "machine_file",
-    type=click.Path(dir_okay=False, path_type=Path),
-    default=None,
-    metavar="FILE|NAME",
-    help="Machine profile laid over the target's, key by key.",
-)
+@MACHINE
 @click.option(
     "--tool-diameter",
     type=click.FloatRange(min=0),
@@ -95,7 +88,7 @@ def preview(
         edge_radius_mm=tool_diameter / 2.0,
         title=shown,
     )
-    _write(data, out)
+    write_output(data, out)
     if out != "-":
         click.echo(f"camtool: wrote preview {out}", err=True)
 
@@ -154,7 +147,7 @@ def _read_program(name: str, target: Target | None) -> Program:
         raise InputError(f"{name}: no such file")
     suffix = Path(name).suffix.lower()
     if target is not None and (not is_program_file(name) or suffix in target.post.formats.values()):
-        return target.post.parse(_read_code(name, binary=target.post.binary), source=name)
+        return target.post.parse(read_code(name, binary=target.post.binary), source=name)
     if name != "-" and is_program_file(name):
         from camtool.importers.gcode import read_gcode
 
@@ -178,39 +171,10 @@ def _verify(
     v = verify_program(
         program, target.machine, name=target.name, against=drawing, tool_diameter=tool_diameter
     )
-    for message in v.warnings:
-        click.echo(f"camtool: warning: {message}", err=True)
+    warn(v.warnings)
     click.echo(
         f"camtool: verified on {target.name}: max deviation {v.deviation.max_um:.2f} µm, "
         f"≈ {v.time_s:.1f} s",
         err=True,
     )
     return v
-
-
-def _read_code(name: str, *, binary: bool) -> str | bytes:
-    """The code file (or stdin for ``-``), bytes for a binary dialect, else ASCII text."""
-    try:
-        if binary:
-            return sys.stdin.buffer.read() if name == "-" else Path(name).read_bytes()
-        return sys.stdin.read() if name == "-" else Path(name).read_text(encoding="ascii")
-    except FileNotFoundError as exc:
-        raise InputError(f"{name}: no such file") from exc
-    except UnicodeDecodeError as exc:
-        raise InputError(f"{name}: not a text program (byte {exc.start} is not ASCII)") from exc
-    except OSError as exc:
-        raise InputError(f"{name}: cannot read ({exc.strerror or exc})") from exc
-
-
-def _write(data: bytes, out: str) -> None:
-    """``data`` to ``out`` atomically, or to stdout for ``-``."""
-    if out == "-":
-        sys.stdout.buffer.write(data)
-        sys.stdout.flush()
-        return
-    from camtool.output import write_atomic
-
-    try:
-        write_atomic(out, data)
-    except OSError as exc:
-        raise CamtoolError(f"{out}: cannot write ({exc.strerror or exc})") from exc
