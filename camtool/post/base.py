@@ -8,9 +8,33 @@ from dataclasses import dataclass
 from types import MappingProxyType
 from typing import ClassVar
 
-from camtool.errors import UsageError
+from camtool.errors import DialectError, UsageError
+from camtool.geometry import Point
 from camtool.machine import Machine
-from camtool.program import Program
+from camtool.program import Move, Program, segment_of
+
+
+def check_work_area(start: Point, move: Move, machine: Machine, where: str) -> None:
+    """Refuse a move (an arc by its extremes) that leaves the machine's work area.
+
+    Args:
+        start: where the move starts, mm.
+        move: the move.
+        machine: the machine profile (``work_area_mm``).
+        where: the contour and block for the message ("contour 3, block 12").
+
+    Raises:
+        DialectError: the move reaches outside the work area, naming ``where``,
+            the move's extent and the work area.
+    """
+    box = segment_of(start, move).bbox()
+    if machine.outside_work_area(box):
+        x0, y0, x1, y1 = machine.work_area_mm
+        raise DialectError(
+            f"{where}: reaches ({box[0]:.4f}, {box[1]:.4f})–({box[2]:.4f}, "
+            f"{box[3]:.4f}) mm, outside the {x1 - x0:g} × {y1 - y0:g} mm work area "
+            f"of {machine.name}; move the drawing or use --fit"
+        )
 
 
 @dataclass(frozen=True)

@@ -53,7 +53,7 @@ from typing import ClassVar
 from camtool.errors import DialectError, UsageError
 from camtool.geometry import Arc, Point
 from camtool.machine import Machine
-from camtool.post.base import PostProcessor, PostResult
+from camtool.post.base import PostProcessor, PostResult, check_work_area
 from camtool.post.i8751_read import cruise_feed, is_text, program_from_records
 from camtool.post.i8751_stream import (
     ACCESS_KEY,
@@ -79,7 +79,6 @@ from camtool.program import (
     Rapid,
     Spindle,
     ToolChange,
-    segment_of,
 )
 
 _DROPPED = {
@@ -282,14 +281,7 @@ class I8751Post(PostProcessor):
         return PostResult(text, len(w.records), warnings, fmt)
 
     def _move(self, w: _Writer, start: Point, move: Move, machine: Machine) -> None:
-        box = segment_of(start, move).bbox()
-        if machine.outside_work_area(box):
-            x0, y0, x1, y1 = machine.work_area_mm
-            raise DialectError(
-                f"{w.where(move)}: reaches ({box[0]:.4f}, {box[1]:.4f})–({box[2]:.4f}, "
-                f"{box[3]:.4f}) mm, outside the {x1 - x0:g} × {y1 - y0:g} mm work area "
-                f"of {machine.name}; move the drawing or use --fit"
-            )
+        check_work_area(start, move, machine, w.where(move))
         if move.z is not None and not machine.has_z:
             raise DialectError(f"{w.where(move)}: Z = {move.z:g} mm but {machine.name} has no Z")
         if isinstance(move, Rapid):

@@ -56,7 +56,7 @@ import numpy as np
 from camtool.errors import DialectError, UsageError
 from camtool.geometry import Arc, Point
 from camtool.machine import Machine
-from camtool.post.base import PostProcessor, PostResult
+from camtool.post.base import PostProcessor, PostResult, check_work_area
 from camtool.post.matlab_router_read import (
     INT16_MAX,
     major_axis_feed_mm_min,
@@ -65,7 +65,7 @@ from camtool.post.matlab_router_read import (
 from camtool.post.matlab_router_warnings import WriterNotes, jobs_warnings, notes_warnings
 from camtool.post.numfmt import NumberFormat
 from camtool.post.router_arrays import DEFAULT_SPEED, RouterArrays, points_01mm, router_arrays
-from camtool.program import ArcMove, Linear, Move, Program, Rapid, segment_of
+from camtool.program import ArcMove, Linear, Move, Program, Rapid
 
 FIRMWARE_MAX_SEGMENTS = 128
 """Segments (lines) one job holds: the master's ``X_ROUTE[128]`` … arrays (L4625–L4635)."""
@@ -395,14 +395,7 @@ def _check_move(here: Point, move: Move, index: int, machine: Machine) -> None:
             "the tool by a fixed 100 units at each job's start, seed-002 §2.8 L6544); "
             "set the depth by hand"
         )
-    box = segment_of(here, move).bbox()
-    if machine.outside_work_area(box):
-        x0, y0, x1, y1 = machine.work_area_mm
-        raise DialectError(
-            f"{where}: reaches ({box[0]:.4f}, {box[1]:.4f})–({box[2]:.4f}, {box[3]:.4f}) mm, "
-            f"outside the {x1 - x0:g} × {y1 - y0:g} mm work area of {machine.name}; "
-            "move the drawing or use --fit"
-        )
+    check_work_area(here, move, machine, where)
 
 
 def _chords(here: Point, move: ArcMove, tolerance: float, notes: WriterNotes) -> list[Point]:

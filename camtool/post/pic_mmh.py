@@ -38,7 +38,7 @@ from typing import Any, ClassVar
 from camtool.errors import DialectError, ParseError
 from camtool.geometry import distance
 from camtool.machine import Machine
-from camtool.post.base import PostProcessor, PostResult
+from camtool.post.base import PostProcessor, PostResult, check_work_area
 from camtool.post.numfmt import NumberFormat, format_int
 from camtool.post.pic_mmh_feeds import FeedTable
 from camtool.program import (
@@ -52,7 +52,6 @@ from camtool.program import (
     Rapid,
     Spindle,
     ToolChange,
-    segment_of,
 )
 
 _COORD = r"([+-]?\d{5}\.\d{2})"
@@ -189,14 +188,7 @@ class PicMmhPost(PostProcessor):
                 "camtool does not know (the part zero is set by G54); go to the start of the "
                 "cut with a rapid (G00) first"
             )
-        box = segment_of(start, move).bbox()
-        if machine.outside_work_area(box):
-            x0, y0, x1, y1 = machine.work_area_mm
-            raise DialectError(
-                f"{where}: reaches ({box[0]:.4f}, {box[1]:.4f})–({box[2]:.4f}, "
-                f"{box[3]:.4f}) mm, outside the {x1 - x0:g} × {y1 - y0:g} mm work area "
-                f"of {machine.name}; move the drawing or use --fit"
-            )
+        check_work_area(start, move, machine, where)
 
     def _move(self, start: tuple[float, float], move: Move, machine: Machine, w: _Writer) -> None:
         if isinstance(move, Rapid):

@@ -30,6 +30,7 @@ from collections import Counter
 from camtool.errors import DialectError
 from camtool.geometry import Arc, Point
 from camtool.machine import Machine
+from camtool.post.base import check_work_area
 from camtool.post.wordaddress_spec import WordAddressSpec
 from camtool.program import (
     ArcMove,
@@ -42,7 +43,6 @@ from camtool.program import (
     Rapid,
     Spindle,
     ToolChange,
-    segment_of,
 )
 
 _SAME_MM = 1e-9
@@ -182,14 +182,7 @@ class BlockWriter:
         return self.text("Z", z) == self.text("Z", self.z)
 
     def _check_area(self, start: Point, move: Move) -> None:
-        box = segment_of(start, move).bbox()
-        if self.machine.outside_work_area(box):
-            x0, y0, x1, y1 = self.machine.work_area_mm
-            raise DialectError(
-                f"{self.where()}: reaches ({box[0]:.4f}, {box[1]:.4f})–({box[2]:.4f}, "
-                f"{box[3]:.4f}) mm, outside the {x1 - x0:g} × {y1 - y0:g} mm work area "
-                f"of {self.machine.name}; move the drawing or use --fit"
-            )
+        check_work_area(start, move, self.machine, self.where())
 
     def _check_z(self, move: Move) -> None:
         if not self.spec.has("Z") or not self.machine.has_z:
