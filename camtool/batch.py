@@ -425,37 +425,14 @@ def _post_one(task: BatchTask, options: BatchOptions) -> BatchRow:
 
 def _post_job(file: str, options: BatchOptions) -> PostJob:
     """Import and post one file: a drawing is planned, a G-code program re-posted."""
-    from camtool.importers import read_drawing
-    from camtool.pipeline import is_program_file, post_drawing, post_program
-    from camtool.post.registry import load_target
+    from camtool.pipeline import post_file
 
-    target = load_target(options.target, machine_file=options.machine_file)
-    if not is_program_file(file):
-        drawing = read_drawing(file, options.import_options())
-        return post_drawing(drawing, target, **options.post_options())
-    from camtool.importers.gcode import read_gcode
-
-    given = [
-        flag
-        for flag, changed in (
-            ("--offset", options.offset != "on"),
-            ("--tool-diameter", options.tool_diameter != 0.0),
-            ("--scale", options.scale != 1.0),
-            ("--fit", options.fit_mm is not None),
-        )
-        if changed
-    ]
-    if given:
-        raise UsageError(
-            f"{file} is already a toolpath (G-code): {', '.join(given)} only apply to "
-            "drawings; post programs in a batch of their own"
-        )
-    return post_program(
-        read_gcode(file),
-        target,
-        feed_mm_min=options.feed_mm_min,
-        fmt=options.fmt,
-        spindle_rpm=options.spindle_rpm,
+    return post_file(
+        file,
+        options.target,
+        machine_file=options.machine_file,
+        import_options=options.import_options(),
+        **options.post_options(),
     )
 
 

@@ -31,7 +31,6 @@ if TYPE_CHECKING:
 
     from camtool.geometry import Drawing
     from camtool.post.registry import TargetEntry
-    from camtool.program import Program
     from camtool.verify.verifier import Verification
 
 
@@ -107,22 +106,16 @@ def post(
     With --verify (implied by --report, --preview or --max-error-um) the written
     code is read back and simulated on the target's machine, as `verify` does.
     """
-    from camtool.pipeline import is_program_file, post_drawing, post_program, verify_job
+    from camtool.pipeline import post_drawing, post_path, verify_job
     from camtool.post.registry import load_target
 
     chosen = load_target(target, machine_file=machine_file)
     chosen.post.check_format(options["fmt"])
     settings = import_settings(options)
-    if is_program_file(drawing):
-        job = post_program(
-            _read_program(drawing, options),
-            chosen,
-            feed_mm_min=options["feed_mm_min"],
-            fmt=options["fmt"],
-            spindle_rpm=options["spindle_rpm"],
-        )
-    else:
+    if drawing == "-":
         job = post_drawing(read_input(drawing, settings), chosen, **options)
+    else:
+        job = post_path(drawing, chosen, import_options=settings, **options)
     warn(job.warnings)
     if isinstance(job.result.code, bytes) and output == "-" and sys.stdout.isatty():
         raise UsageError(
@@ -193,28 +186,6 @@ def verify(
     _finish_verification(
         v, report, preview, max_error_um, drawing=drawing, edge_radius_mm=tool_diameter / 2.0
     )
-
-
-def _read_program(name: str, options: dict[str, Any]) -> Program:
-    """An existing G-code program; drawing-only options are refused, not ignored."""
-    from camtool.importers.gcode import read_gcode
-
-    given = [
-        flag
-        for flag, key, default in (
-            ("--offset", "offset", "on"),
-            ("--tool-diameter", "tool_diameter", 0.0),
-            ("--scale", "scale", 1.0),
-            ("--fit", "fit_mm", None),
-        )
-        if options.get(key, default) != default
-    ]
-    if given:
-        raise UsageError(
-            f"{name} is already a toolpath (G-code): {', '.join(given)} only apply to "
-            "drawings; offset or scale it in the program that wrote it"
-        )
-    return read_gcode(name)
 
 
 def _finish_verification(

@@ -6,8 +6,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from camtool.errors import UsageError
 from camtool.geometry import Drawing
-from camtool.importers import read_drawing
+from camtool.importers import ImportOptions, read_drawing
 from camtool.post.base import PostResult, Target
 from camtool.post.registry import load_target
 from camtool.program import Move, Program
@@ -46,21 +47,78 @@ class PostJob:
 
 
 def post_file(
-    path: str | Path, target_name: str, *, machine_file: Path | None = None, **options: Any
+    path: str | Path,
+    target_name: str,
+    *,
+    machine_file: Path | None = None,
+    import_options: ImportOptions | None = None,
+    **options: Any,
 ) -> PostJob:
-    """Import the drawing at ``path``, plan it and post it (see :func:`post_drawing`).
+    """Load the target called ``target_name`` and post the file at ``path`` (see :func:`post_path`).
 
     Args:
-        path: the drawing file.
+        path: a drawing, or an existing G-code program.
         target_name: a built-in target or a target ``.toml`` path.
-        machine_file: TOML file replacing the target's machine profile.
+        machine_file: TOML file laid over the target's machine profile.
+        import_options: how the drawing is read (layers, units…).
         **options: the keyword options of :func:`post_drawing`.
 
     Raises:
         CamtoolError: from any stage, with its exit code.
     """
     target = load_target(target_name, machine_file=machine_file)
-    return post_drawing(read_drawing(path), target, **options)
+    return post_path(path, target, import_options=import_options, **options)
+
+
+_DRAWING_ONLY = (
+    ("--offset", "offset", "on"),
+    ("--tool-diameter", "tool_diameter", 0.0),
+    ("--scale", "scale", 1.0),
+    ("--fit", "fit_mm", None),
+)
+"""Options that shape a drawing's toolpath: (flag, keyword, default)."""
+
+
+def post_path(
+    path: str | Path,
+    target: Target,
+    *,
+    import_options: ImportOptions | None = None,
+    **options: Any,
+) -> PostJob:
+    """Post the file at ``path``: a drawing is planned, a G-code program re-posted.
+
+    A program (by its ending, :func:`is_program_file`) is already a toolpath:
+    only ``feed_mm_min``, ``fmt`` and ``spindle_rpm`` apply (:func:`post_program`).
+
+    Args:
+        path: a drawing (DXF, SVG, points) or an existing G-code program.
+        target: the target to write for.
+        import_options: how the drawing is read (layers, units…).
+        **options: the keyword options of :func:`post_drawing`.
+
+    Raises:
+        UsageError: a drawing-only option (offset, tool diameter, scale, fit)
+            given for a program; it is refused, not ignored.
+        CamtoolError: from any stage, with its exit code.
+    """
+    if not is_program_file(path):
+        return post_drawing(read_drawing(path, import_options), target, **options)
+    given = [flag for flag, key, default in _DRAWING_ONLY if options.get(key, default) != default]
+    if given:
+        raise UsageError(
+            f"{path} is already a toolpath (G-code): {', '.join(given)} only apply to "
+            "drawings; offset or scale it in the program that wrote it"
+        )
+    from camtool.importers.gcode import read_gcode
+
+    return post_program(
+        read_gcode(path),
+        target,
+        feed_mm_min=options.get("feed_mm_min"),
+        fmt=options.get("fmt"),
+        spindle_rpm=options.get("spindle_rpm"),
+    )
 
 
 PROGRAM_SUFFIXES = (".ngc", ".nc", ".gcode", ".tap", ".cnc", ".gc", ".g")
