@@ -23,7 +23,7 @@ from camtool.post.registry import load_target
 from camtool.post.router_arrays import matlab_round, router_arrays
 from camtool.program import ArcMove, Dwell, Linear, Move, Program, Rapid, Spindle
 from camtool.verify.verifier import verify_code
-from tests.shapes import STAR_XY_01MM
+from tests.shapes import STAR_LXY, STAR_VELXY, STAR_XY_01MM
 
 SAMPLES = Path(__file__).parents[2] / "samples"
 GOLDEN = Path(__file__).parents[1] / "golden" / "matlab-router"
@@ -31,15 +31,6 @@ TARGET = load_target("matlab-router")
 MACHINE = TARGET.machine
 FEED = 225.0  # R7: 480 counts / 5 ms at 25 600 counts/mm = 3.75 mm/s on the major axis
 
-# seed-002 §3, L3214–L3228, verbatim (the star's lxy and velxy).
-STAR_LXY = [
-    [249, 230, 55, 240, 314, 101, 106, 288, 214, 67],
-    [179, 179, 345, 208, 3, 357, 354, 20, 237, 342],
-]
-STAR_VELXY = [
-    [480, 480, -77, 480, -480, -136, -144, -480, 433, -94],
-    [345, -374, 480, 416, 5, 480, -480, 33, -480, -480],
-]
 # seed-002 §3, thesis text lines as printed: the velxy block and the first rows of xy, lxy.
 THESIS_LINES = [
     "[   151   400   630   575   815   501   400   294     6   220   153; ",  # L3198

@@ -18,18 +18,9 @@ from camtool.post.router_arrays import (
     points_01mm,
     router_arrays,
 )
-from tests.shapes import STAR_XY_01MM
+from tests.shapes import STAR_LXY, STAR_VELXY, STAR_XY_01MM
 
 STAR_XY = np.array(STAR_XY_01MM)  # seed-002 §3, L3196–L3200
-# seed-002 §3, L3212–L3228, verbatim.
-STAR_LXY = [
-    [249, 230, 55, 240, 314, 101, 106, 288, 214, 67],
-    [179, 179, 345, 208, 3, 357, 354, 20, 237, 342],
-]
-STAR_VELXY = [
-    [480, 480, -77, 480, -480, -136, -144, -480, 433, -94],
-    [345, -374, 480, 416, 5, 480, -480, 33, -480, -480],
-]
 
 
 def test_star_reproduces_the_thesis_arrays_exactly() -> None:
