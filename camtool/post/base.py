@@ -70,6 +70,20 @@ class PostProcessor(ABC):
     binary: ClassVar[bool] = False
     """True when code files are read as bytes (``parse`` gets ``bytes``)."""
 
+    arcs: ClassVar[bool] = True
+    """True when the dialect writes arcs as arcs (G02/G03); False when every arc
+    becomes chords in the code (matlab-router, i8751)."""
+
+    @property
+    def z_with_xy(self) -> bool:
+        """True when one block may move X, Y and Z together (a ramp or a helix)."""
+        return False
+
+    @property
+    def helix(self) -> bool:
+        """True when an arc may move Z (a helical arc)."""
+        return False
+
     @property
     def suffix(self) -> str:
         """File name ending of the default format."""

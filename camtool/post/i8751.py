@@ -224,6 +224,9 @@ class I8751Post(PostProcessor):
             is not three positive numbers.
     """
 
+    arcs: ClassVar[bool] = False
+    """Arcs are written as chords."""
+
     formats: ClassVar[Mapping[str, str]] = MappingProxyType({"bin": ".bin", "dump": ".txt"})
     binary: ClassVar[bool] = True
 

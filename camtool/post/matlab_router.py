@@ -138,6 +138,9 @@ class MatlabRouterPost(PostProcessor):
         UsageError: an option out of range or of the wrong type.
     """
 
+    arcs: ClassVar[bool] = False
+    """Arcs are written as chords."""
+
     formats: ClassVar[Mapping[str, str]] = MappingProxyType({"script": ".m", "wire": ".txt"})
     binary: ClassVar[bool] = True
     """Code files are read as bytes: the wire's CR terminators must reach the reader

@@ -55,6 +55,16 @@ class WordAddressPost(PostProcessor):
         # formats is a class attribute elsewhere; each spec has its own file ending.
         vars(self)["formats"] = MappingProxyType({"code": spec.suffix})
 
+    @property
+    def z_with_xy(self) -> bool:
+        """True when the spec writes Z in the XY block (``z_moves = "with-xy"``)."""
+        return self.spec.z_moves == "with-xy"
+
+    @property
+    def helix(self) -> bool:
+        """True when the spec lets an arc carry a Z word (``helix = true``)."""
+        return self.spec.helix
+
     def emit(self, program: Program, machine: Machine, *, fmt: str | None = None) -> PostResult:
         """Write ``program`` for ``machine`` (rules: :mod:`camtool.post.wordaddress_write`).
 
