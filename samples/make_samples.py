@@ -9,6 +9,12 @@ the thesis cut. It uses every entity kind the first importer reads:
 - a "C": an ARC with two LINE serifs that chain to one open contour;
 - a cutter point: a triangle of three LINEs that chain to one closed contour;
 - a base mark: a 2D POLYLINE with a bulge (a shallow "smile").
+
+``plate.dxf`` is a 40 × 30 mm bracket for profile cutting (``--offset outside``): an
+outline with a 10 × 8 mm notch (two inside corners no round tool can reach), four ø4 mm
+holes, a 12 × 4 mm slot with round ends and a 2 × 2 mm square hole narrower than a 3 mm
+tool. ``pocket.dxf`` is a 30 × 20 mm pocket with 3 mm corner radii around two islands,
+a ø6 mm boss and a 5 × 5 mm block, for ``--offset pocket``.
 """
 
 from __future__ import annotations
@@ -55,6 +61,49 @@ def make_logo(path: Path) -> None:
     doc.saveas(path)
 
 
+def make_plate(path: Path) -> None:
+    """Write the bracket plate to ``path`` (units: mm)."""
+    doc = ezdxf.new("R2010", setup=False)
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    outline = [(0, 0), (40, 0), (40, 30), (25, 30), (25, 22), (15, 22), (15, 30), (0, 30)]
+    msp.add_lwpolyline(outline, close=True)
+    for x, y in ((5, 5), (35, 5), (5, 25), (35, 25)):
+        msp.add_circle((x, y), 2.0)
+    # Slot 12 × 4: straight sides joined by semicircles (bulge 1 = 180°).
+    msp.add_lwpolyline(
+        [(16, 8, 0.0), (24, 8, 1.0), (24, 12, 0.0), (16, 12, 1.0)], format="xyb", close=True
+    )
+    msp.add_lwpolyline([(8, 14), (10, 14), (10, 16), (8, 16)], close=True)
+    doc.saveas(path)
+
+
+def make_pocket(path: Path) -> None:
+    """Write the pocket with two islands to ``path`` (units: mm)."""
+    doc = ezdxf.new("R2010", setup=False)
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    r, b = 3.0, math.tan(math.pi / 8)  # corner radius; bulge of a 90° CCW arc
+    msp.add_lwpolyline(
+        [
+            (r, 0, 0.0), (30 - r, 0, b), (30, r, 0.0), (30, 20 - r, b),
+            (30 - r, 20, 0.0), (r, 20, b), (0, 20 - r, 0.0), (0, r, b),
+        ],
+        format="xyb",
+        close=True,
+    )  # fmt: skip
+    msp.add_circle((9.0, 10.0), 3.0)
+    msp.add_lwpolyline([(18.5, 7.5), (23.5, 7.5), (23.5, 12.5), (18.5, 12.5)], close=True)
+    doc.saveas(path)
+
+
+SAMPLES = {"logo.dxf": make_logo, "plate.dxf": make_plate, "pocket.dxf": make_pocket}
+"""Each bundled drawing and the function that writes it."""
+
+
 if __name__ == "__main__":
-    make_logo(HERE / "logo.dxf")
-    print(f"wrote {HERE / 'logo.dxf'}")
+    import sys
+
+    for name in sys.argv[1:] or SAMPLES:
+        SAMPLES[name](HERE / name)
+        print(f"wrote {HERE / name}")
