@@ -4,7 +4,8 @@ The importers give one contour per entity; a drawing made of separate LINE and
 ARC entities becomes closed contours here. A joint within ``tolerance`` is
 snapped: the later segment starts exactly where the earlier one ends, so the
 emitted code has no gaps. A contour whose ends meet within ``tolerance`` is
-closed.
+closed. :func:`close_gaps` then closes contours whose ends nearly meet (a larger
+gap, reported).
 """
 
 from __future__ import annotations
@@ -14,6 +15,9 @@ from collections import defaultdict
 from collections.abc import Iterable, Sequence
 
 from camtool.geometry import Arc, Contour, Line, Point, Segment, distance
+from camtool.toolpath.cuts import Finding, where
+
+_GAP_SHARE = 0.1  # a gap closed by close_gaps is shorter than this share of the contour
 
 
 def chain(contours: Sequence[Contour], tolerance: float) -> list[Contour]:
@@ -132,3 +136,53 @@ class _EndGrid:
             if best is None or (d, index) < (best[0], best[1]):
                 best = (d, index, at_start)
         return None if best is None else (best[1], best[2])
+
+
+def close_gaps(
+    contours: Sequence[Contour], max_gap: float, tolerance: float
+) -> tuple[list[Contour], list[Finding]]:
+    """Close open contours whose ends nearly meet, with a straight line across the gap.
+
+    An open contour is closed when its ends are more than ``tolerance`` but at
+    most ``max_gap`` apart and the gap is under a tenth of the contour's length
+    (a deliberate "C" stays open). The drawn segments are kept exactly; one
+    :class:`~camtool.geometry.Line` from the end back to the start is appended.
+    Every closure is reported: the drawing is probably wrong there.
+
+    Args:
+        contours: chained contours, mm (see :func:`chain`).
+        max_gap: largest gap closed, mm (≥ 0); 0 closes nothing.
+        tolerance: the chaining tolerance, mm: gaps up to it were closed by
+            :func:`chain` already.
+
+    Returns:
+        The contours in the same order (unchanged objects where nothing was
+        closed) and one ``closed-gap`` :class:`~camtool.toolpath.cuts.Finding` per
+        closure (``at`` the gap's midpoint, ``value`` the gap in mm).
+    """
+    out: list[Contour] = []
+    findings: list[Finding] = []
+    for contour in contours:
+        gap = distance(contour.end, contour.start)
+        if (
+            contour.closed
+            or max_gap <= 0
+            or not tolerance < gap <= max_gap
+            or gap >= _GAP_SHARE * contour.length
+        ):
+            out.append(contour)
+            continue
+        bridge = Line(contour.end, contour.start)
+        out.append(Contour((*contour.segments, bridge), True, contour.layer, contour.source))
+        mid = ((contour.start[0] + contour.end[0]) / 2, (contour.start[1] + contour.end[1]) / 2)
+        findings.append(
+            Finding(
+                "closed-gap",
+                f"{where(contour)}: closed a {gap:.4g} mm gap between its ends at "
+                f"({mid[0]:.4f}, {mid[1]:.4f}) mm with a straight line; check the drawing "
+                "(--close-gap 0 keeps it open)",
+                mid,
+                gap,
+            )
+        )
+    return out, findings

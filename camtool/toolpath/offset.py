@@ -1,24 +1,56 @@
-"""Arc-preserving 2D offsets of closed contours (build123d / OpenCASCADE).
+"""Arc-preserving 2D offsets of closed contours (build123d / OpenCASCADE), with a fallback.
 
-The only module that touches OpenCASCADE; build123d is imported lazily so that
-``camtool --version`` and ``camtool targets`` never load it. Straight edges stay
-lines, arcs stay arcs and convex corners become arcs of the offset radius
-(``Kind.ARC``), so the toolpath keeps exact G02/G03 moves.
+The only module that touches OpenCASCADE; build123d (and its OCP bindings) are
+imported lazily so that ``camtool --version`` and ``camtool targets`` never load
+them. Straight edges stay lines, arcs stay arcs and convex corners become arcs of
+the offset radius (``Kind.ARC``, OCCT's ``GeomAbs_Arc`` join), so the toolpath
+keeps exact G02/G03 moves.
+
+:func:`offset_checked` checks OCCT's answer against shapely's buffer of the same
+polygon (closed pieces, the area grows or shrinks as asked, Hausdorff distance)
+and, where OCCT fails, uses the buffer fitted with arcs (:func:`buffer_pieces`).
+
+Conventions: mm, Y up; ``amount > 0`` grows the enclosed area, ``< 0`` shrinks it,
+whatever the contour's orientation. The pieces of an offset keep the contour's
+orientation (clockwise stays clockwise); a hole of the offset region (a grown
+"C" whose mouth closes) runs the other way, so the region lies on the same side
+of travel as for the drawn contour.
 """
 
 from __future__ import annotations
 
-from typing import Any
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 from camtool.errors import ToolpathError
 from camtool.geometry import Arc, Contour, Line, Point, Segment, distance
 from camtool.toolpath.chain import chain
 
+if TYPE_CHECKING:
+    from shapely.geometry.base import BaseGeometry
+
 _JOIN_MM = 1e-6
+_MAX_QUAD_SEGS = 4096
+
+
+@dataclass(frozen=True)
+class OffsetResult:
+    """An offset and how it was made.
+
+    Attributes:
+        pieces: closed contours, mm, oriented as described in the module
+            docstring; empty when the offset leaves nothing.
+        fallback: why OpenCASCADE's result was not used (the pieces are
+            shapely's buffer fitted with arcs), ``None`` when they are exact.
+    """
+
+    pieces: tuple[Contour, ...]
+    fallback: str | None = None
 
 
 def offset_contour(contour: Contour, amount: float) -> Contour:
-    """Offset a closed contour by ``amount`` mm: > 0 grows it, < 0 shrinks it.
+    """Offset a closed contour by ``amount`` mm into exactly one piece (OpenCASCADE).
 
     The result keeps the contour's orientation (clockwise stays clockwise) and
     starts at the vertex nearest the contour's own start.
@@ -32,42 +64,212 @@ def offset_contour(contour: Contour, amount: float) -> Contour:
 
     Raises:
         ToolpathError: the contour is open, OpenCASCADE cannot offset it, the
-            offset leaves nothing (a region narrower than the tool), or the
-            offset holds curves other than lines and arcs.
+            offset leaves nothing (a region narrower than the tool), splits into
+            several pieces, or holds curves other than lines and arcs.
+    """
+    if amount == 0:
+        if not contour.closed:
+            raise ToolpathError(f"{_where(contour)}: only closed contours can be offset")
+        return contour
+    pieces = offset_pieces(contour, amount)
+    if not pieces:
+        raise ToolpathError(
+            f"{_where(contour)}: offset by {amount:+.4g} mm leaves nothing; the region is "
+            "narrower than the tool"
+        )
+    if len(pieces) > 1:
+        raise ToolpathError(
+            f"{_where(contour)}: offset by {amount:+.4g} mm splits into {len(pieces)} pieces; "
+            "camtool cuts one piece per contour (use a smaller tool)"
+        )
+    return pieces[0]
+
+
+def offset_pieces(contour: Contour, amount: float) -> list[Contour]:
+    """Offset a closed contour by ``amount`` mm with OpenCASCADE, every piece kept.
+
+    A shrink can split a region at a waist narrower than ``2·|amount|`` (a
+    dumbbell) into several pieces, or leave nothing; a grow can close a "C" and
+    leave a hole in the offset region. Each piece starts at its vertex nearest
+    the contour's start.
+
+    Args:
+        contour: a closed contour, mm.
+        amount: offset distance, mm; positive is away from the enclosed area.
+
+    Returns:
+        The closed pieces, oriented as described in the module docstring
+        (``[contour]`` for ``amount == 0``, ``[]`` when nothing is left).
+
+    Raises:
+        ToolpathError: the contour is open, OpenCASCADE fails, a piece does
+            not close, or the offset holds curves other than lines and arcs.
     """
     if not contour.closed:
         raise ToolpathError(f"{_where(contour)}: only closed contours can be offset")
     if amount == 0:
-        return contour
-    original_area = contour.signed_area()
-    wire = _to_wire(contour)
+        return [contour]
     try:
-        result = wire.offset_2d(amount, kind=_kind_arc())
+        wires = _occt_offset(contour, amount)
     except Exception as exc:  # OCCT's StdFail_* types share no base below Exception
         raise ToolpathError(
             f"{_where(contour)}: offset by {amount:+.4g} mm failed ({exc}); the region may "
             "be narrower than the tool"
         ) from exc
-    pieces = [_from_edge(e, contour) for e in result.edges()]
-    joined = chain(
-        [Contour((p,), False, contour.layer, contour.source) for p in pieces],
-        _JOIN_MM,
-    )
-    if len(joined) != 1 or not joined[0].closed:
-        raise ToolpathError(
-            f"{_where(contour)}: offset by {amount:+.4g} mm splits into {len(joined)} pieces; "
-            "camtool cuts one piece per contour (use a smaller tool)"
+    pieces: list[Contour] = []
+    for wire in wires:
+        edges = [_from_edge(e, contour) for e in wire.edges()]
+        joined = chain(
+            [Contour((e,), False, contour.layer, contour.source) for e in edges], _JOIN_MM
         )
-    out = joined[0]
-    area = out.signed_area()
-    if (amount < 0 and abs(area) >= abs(original_area)) or abs(area) < 1e-12:
-        raise ToolpathError(
-            f"{_where(contour)}: offset by {amount:+.4g} mm leaves nothing; the region is "
-            "narrower than the tool"
-        )
-    if (area > 0) != (original_area > 0):
-        out = out.reversed()
-    return _start_near(out, contour.start)
+        if any(not j.closed for j in joined):
+            raise ToolpathError(
+                f"{_where(contour)}: offset by {amount:+.4g} mm gives pieces that do not close"
+            )
+        pieces.extend(joined)
+    pieces = [p for p in pieces if abs(p.signed_area()) > 1e-12]
+    return _oriented(pieces, contour)
+
+
+def offset_checked(contour: Contour, amount: float, tolerance: float) -> OffsetResult:
+    """Offset with OpenCASCADE, checked against shapely; fall back to the buffer.
+
+    OCCT's pieces are used when they close, hold only lines and arcs, change
+    the area the way ``amount`` asks (grow: larger, shrink: smaller) and lie
+    within ``10·tolerance + 1e-3`` mm (Hausdorff distance) of shapely's buffer
+    of the contour's polygon. Otherwise :func:`buffer_pieces` replaces them and
+    :attr:`OffsetResult.fallback` says why. Both agree that nothing is left when
+    the buffer is empty or nowhere wider than ``tolerance``.
+
+    Args:
+        contour: a closed contour, mm.
+        amount: offset distance, mm; positive grows the enclosed area.
+        tolerance: chord and fitting tolerance, mm (> 0).
+
+    Raises:
+        ToolpathError: the contour is open.
+    """
+    if not contour.closed:
+        raise ToolpathError(f"{_where(contour)}: only closed contours can be offset")
+    if amount == 0:
+        return OffsetResult((contour,))
+    reference = _buffer(contour, amount, tolerance)
+    try:
+        pieces = offset_pieces(contour, amount)
+        reason = _disagreement(pieces, contour, amount, reference, tolerance)
+    except ToolpathError as exc:  # OCCT failed or gave curves other than lines and arcs
+        reason = str(exc).split(": ", 1)[-1]
+    if reason is None:
+        return OffsetResult(tuple(pieces))
+    return OffsetResult(tuple(_fitted(reference, contour, tolerance)), reason)
+
+
+def buffer_pieces(contour: Contour, amount: float, tolerance: float) -> list[Contour]:
+    """Offset by shapely's buffer, each ring fitted with lines and arcs.
+
+    The contour's polygon (chords within ``tolerance/4``) is buffered with
+    enough segments per quarter circle that the buffer's chords stay within
+    ``tolerance/4`` of its round joins, and each ring is fitted with
+    :func:`~camtool.toolpath.arcfit.fit_polyline` within ``tolerance/2``: the
+    result lies within ``tolerance`` of the exact offset. Regions nowhere wider
+    than ``tolerance`` are dropped.
+
+    Args:
+        contour: a closed contour, mm.
+        amount: offset distance, mm; positive grows the enclosed area.
+        tolerance: largest distance from the exact offset, mm (> 0).
+
+    Returns:
+        The closed pieces, oriented as :func:`offset_pieces` orients them.
+    """
+    return _fitted(_buffer(contour, amount, tolerance), contour, tolerance)
+
+
+def quad_segs(radius: float, chord_error: float) -> int:
+    """Segments per quarter circle so a buffer's chords stay within ``chord_error`` mm.
+
+    A chord spanning angle θ of a circle of ``radius`` deviates from it by the
+    sagitta ``r·(1 − cos(θ/2))``; a quarter circle in ``q`` chords has
+    ``θ = π/(2q)``. At least 8 (shapely's default), at most 4096.
+    """
+    if chord_error >= radius:
+        return 8
+    half = math.acos(1.0 - chord_error / radius)
+    return max(8, min(_MAX_QUAD_SEGS, math.ceil(math.pi / (4.0 * half))))
+
+
+def _buffer(contour: Contour, amount: float, tolerance: float) -> BaseGeometry:
+    """The shapely buffer of the contour's polygon, slivers narrower than ``tolerance`` dropped."""
+    from shapely import MultiPolygon, Polygon
+
+    poly = Polygon(contour.points(tolerance / 4)).buffer(0)
+    buf = poly.buffer(amount, quad_segs=quad_segs(abs(amount), tolerance / 4))
+    parts = [p for p in getattr(buf, "geoms", [buf]) if _wider_than(p, tolerance)]
+    return MultiPolygon(parts)
+
+
+def _wider_than(poly: Any, width: float) -> bool:
+    """True when the polygon's mean width (2·area / perimeter) exceeds ``width`` mm."""
+    return bool(not poly.is_empty and 2.0 * poly.area > width * poly.length)
+
+
+def _disagreement(
+    pieces: list[Contour], contour: Contour, amount: float, reference: Any, tolerance: float
+) -> str | None:
+    """Why OCCT's pieces disagree with the buffer ``reference``, or ``None``."""
+    from shapely import MultiLineString
+
+    if not pieces:
+        return None if reference.is_empty else "it left nothing where shapely's buffer did not"
+    if reference.is_empty:
+        return "it left pieces where shapely's buffer left nothing"
+    area = _region_area(pieces)
+    original = abs(contour.signed_area())
+    if (amount > 0) != (area > original):
+        return f"the area went from {original:.4g} to {area:.4g} mm² for {amount:+.4g} mm"
+    rings = MultiLineString([p.points(tolerance / 4) for p in pieces])
+    gap = rings.hausdorff_distance(reference.boundary)
+    if gap > 10 * tolerance + 1e-3:
+        return f"it lies up to {gap:.4g} mm from shapely's buffer"
+    return None
+
+
+def _region_area(pieces: list[Contour]) -> float:
+    """Area enclosed by oriented pieces (holes run against the outer rings), mm²."""
+    if not pieces:
+        return 0.0
+    outer = max(pieces, key=lambda p: abs(p.signed_area()))
+    sign = 1.0 if outer.signed_area() > 0 else -1.0
+    return sign * sum(p.signed_area() for p in pieces)
+
+
+def _fitted(region: Any, contour: Contour, tolerance: float) -> list[Contour]:
+    """Each ring of a (multi)polygon fitted with lines and arcs within ``tolerance/2``."""
+    from camtool.toolpath.arcfit import fit_polyline
+
+    pieces: list[Contour] = []
+    for poly in getattr(region, "geoms", [region]):
+        for ring in (poly.exterior, *poly.interiors):
+            segs = fit_polyline(list(ring.coords), tolerance / 2, closed=True)
+            pieces.append(Contour(tuple(segs), True, contour.layer, contour.source))
+    return _oriented(pieces, contour)
+
+
+def _oriented(pieces: list[Contour], contour: Contour) -> list[Contour]:
+    """Orient pieces like ``contour`` (holes of the region the other way); start near it."""
+    from shapely import Point as ShapelyPoint
+    from shapely import Polygon
+
+    ccw = contour.signed_area() > 0
+    polys = [Polygon(p.points(1e-3)) for p in pieces]
+    out: list[Contour] = []
+    for k, piece in enumerate(pieces):
+        probe = ShapelyPoint(piece.start)
+        depth = sum(1 for j, poly in enumerate(polys) if j != k and poly.contains(probe))
+        want_ccw = ccw == (depth % 2 == 0)
+        turned = piece if (piece.signed_area() > 0) == want_ccw else piece.reversed()
+        out.append(_start_near(turned, contour.start))
+    return out
 
 
 def _where(contour: Contour) -> str:
@@ -76,16 +278,36 @@ def _where(contour: Contour) -> str:
     return f"contour {src}starting at ({x:.4f}, {y:.4f}) mm"
 
 
-def _kind_arc() -> Any:
-    from build123d import Kind
+def _occt_offset(contour: Contour, amount: float) -> list[Any]:
+    """OCCT's offset wires (build123d ``Wire`` objects); several when the region splits."""
+    from build123d import Wire
+    from OCP.BRepOffsetAPI import BRepOffsetAPI_MakeOffset
+    from OCP.GeomAbs import GeomAbs_JoinType
+    from OCP.TopAbs import TopAbs_WIRE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
 
-    return Kind.ARC
+    builder = BRepOffsetAPI_MakeOffset()
+    builder.Init(GeomAbs_JoinType.GeomAbs_Arc)
+    builder.AddWire(_to_wire(contour).wrapped)
+    builder.Perform(amount)
+    if not builder.IsDone():
+        raise ToolpathError(f"OpenCASCADE's 2D offset by {amount:+.4g} mm did not finish")
+    wires = []
+    explorer = TopExp_Explorer(builder.Shape(), TopAbs_WIRE)
+    while explorer.More():
+        wires.append(Wire(TopoDS.Wire(explorer.Current())))
+        explorer.Next()
+    return wires
 
 
 def _to_wire(contour: Contour) -> Any:
     from build123d import Wire
 
-    return Wire([_to_edge(seg) for seg in contour.segments])
+    segs: list[Segment] = list(contour.segments)
+    if len(segs) == 1 and isinstance(segs[0], Arc):
+        segs = list(segs[0].split(2))  # one-edge wires offset badly (see build123d offset_2d)
+    return Wire([_to_edge(seg) for seg in segs])
 
 
 def _to_edge(seg: Segment) -> Any:

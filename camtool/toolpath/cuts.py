@@ -1,0 +1,128 @@
+"""The planner's intermediate forms: cuts before ordering, and what planning found.
+
+Planning runs in stages (see :mod:`camtool.toolpath.plan`): chain and close the
+drawing's contours, compensate them for the tool (:mod:`~camtool.toolpath.compensate`)
+or clear pockets (:mod:`~camtool.toolpath.pocket`), giving :class:`Cut` objects; order
+the cuts (:mod:`~camtool.toolpath.order`); then emit moves with depth passes, tabs and
+lead-ins (:mod:`~camtool.toolpath.passes`). Each stage returns its findings as
+:class:`Finding` objects that the plan report collects (never printed by the library).
+
+Conventions: mm, Y up. A path's *material side* is the side of the direction of
+travel on which the material that must stay lies: ``"right"`` for climb milling
+with a clockwise (M03) spindle, ``"left"`` for conventional milling.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from camtool.geometry import Contour, Point
+
+CUT_KINDS = ("profile", "open", "pocket")
+"""Kinds of :class:`Cut`: a closed profile, an open contour cut on the line, a pocket path."""
+
+SIDES = ("left", "right")
+"""Values of :attr:`Cut.material_side`."""
+
+
+@dataclass(frozen=True)
+class Cut:
+    """One continuous tool-centre path, cut at one depth before ordering and passes.
+
+    Attributes:
+        path: the tool-centre path, mm. Closed for profiles and pocket rings; a
+            pocket's linked rings form one open path.
+        group: index of the (chained) drawing contour the cut comes from; the
+            ordering keeps "inside before outside" by the nesting of groups.
+        kind: one of :data:`CUT_KINDS`.
+        may_reverse: the ordering may traverse the path backwards (the direction
+            was not fixed by ``--direction`` on a compensated contour).
+        may_rotate: the ordering may start the (closed) path at another vertex.
+        outside_profile: an outer boundary of material cut on its outside: tabs
+            and lead-ins go on these.
+        material_side: ``"left"``/``"right"`` of the travel direction on which the
+            material that stays lies, ``None`` when unknown (paths on the line).
+            Reversing the path swaps it.
+    """
+
+    path: Contour
+    group: int
+    kind: str = "profile"
+    may_reverse: bool = True
+    may_rotate: bool = True
+    outside_profile: bool = False
+    material_side: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.kind not in CUT_KINDS:
+            raise ValueError(f"unknown cut kind {self.kind!r}")
+        if self.material_side is not None and self.material_side not in SIDES:
+            raise ValueError(f"unknown material side {self.material_side!r}")
+        if self.may_rotate and not self.path.closed:
+            raise ValueError("only a closed path may start at another vertex")
+
+    def reversed(self) -> Cut:
+        """The same cut traversed the other way (material side swapped)."""
+        side = {"left": "right", "right": "left"}.get(self.material_side or "")
+        return Cut(
+            self.path.reversed(),
+            self.group,
+            self.kind,
+            self.may_reverse,
+            self.may_rotate,
+            self.outside_profile,
+            side,
+        )
+
+
+FINDING_KINDS = (
+    "closed-gap",
+    "offset-fallback",
+    "offset-vanished",
+    "tight-corner",
+    "uncut",
+    "gouge",
+    "open-on-line",
+    "arc-fit",
+    "ordering",
+)
+"""Kinds of :class:`Finding`, the keys of the plan report's ``findings`` counts."""
+
+
+@dataclass(frozen=True)
+class Finding:
+    """Something planning found that the user must know: where, what, how much.
+
+    Attributes:
+        kind: one of :data:`FINDING_KINDS`.
+        message: one line for the user, naming the contour (its source entity
+            and a location in mm) and what to do.
+        at: a representative location, mm (a corner, a gap, an uncut region's
+            centroid), ``None`` when the finding has no single place.
+        value: the finding's size in the unit its kind implies (gap mm, corner
+            radius mm, area mm², ...), ``None`` when it has none.
+    """
+
+    kind: str
+    message: str
+    at: Point | None = None
+    value: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.kind not in FINDING_KINDS:
+            raise ValueError(f"unknown finding kind {self.kind!r}")
+
+
+@dataclass(frozen=True)
+class Stage:
+    """A stage's output: cuts and what it found."""
+
+    cuts: tuple[Cut, ...]
+    findings: tuple[Finding, ...] = field(default=())
+
+
+def where(contour: Contour) -> str:
+    """``"contour LINE #2A at (x, y) mm"``: how messages name a contour."""
+    x, y = contour.start
+    src = f"{contour.source} " if contour.source else ""
+    return f"contour {src}at ({x:.4f}, {y:.4f}) mm"

@@ -1,0 +1,252 @@
+"""Planning options: every ``post`` option that shapes a drawing's toolpath, checked once.
+
+Each field maps to one command-line option (``--offset`` → ``offset``, ``--step-down``
+→ ``step_down``...). Invalid combinations raise :class:`~camtool.errors.UsageError`
+naming the option, before any file is read (``batch`` validates once for all files).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from camtool.errors import UsageError
+from camtool.geometry import Point
+
+OFFSET_MODES = ("on", "outside", "inside", "pocket")
+"""Valid values of ``PlanOptions.offset``."""
+
+DIRECTIONS = ("climb", "conventional")
+"""Valid values of ``PlanOptions.direction``."""
+
+POCKET_STYLES = ("concentric", "zigzag")
+"""Valid values of ``PlanOptions.pocket``."""
+
+ORDERS = ("travel", "reversals", "mirror")
+"""Valid values of ``PlanOptions.order``."""
+
+_FLAG_NAMES = {
+    "fit_mm": "--fit",
+    "plunge_feed_mm_min": "--plunge-feed",
+    "ramp_angle_deg": "--ramp",
+    "pocket_angle_deg": "--pocket-angle",
+    "lead_in_mm": "--lead-in",
+    "fit_arcs": "--no-fit-arcs",
+    "feed_mm_min": "--feed",
+}
+
+
+def flag(field_name: str) -> str:
+    """The command-line flag of a :class:`PlanOptions` field (``step_down`` → ``--step-down``)."""
+    return _FLAG_NAMES.get(field_name, "--" + field_name.replace("_", "-"))
+
+
+def drawing_only(options: dict[str, object]) -> list[str]:
+    """Flags of the planning options in ``options`` that differ from their defaults.
+
+    Feed and tolerance are left out: they apply to re-posted programs too. Used to
+    refuse, not ignore, toolpath options given for an existing G-code program.
+    """
+    import dataclasses
+
+    given = []
+    for f in dataclasses.fields(PlanOptions):
+        if f.name in ("feed_mm_min", "tolerance", "origin") or f.name not in options:
+            continue
+        if options[f.name] != f.default:
+            given.append(flag(f.name))
+    return given
+
+
+@dataclass(frozen=True, kw_only=True)
+class PlanOptions:
+    """How to turn a drawing into a toolpath.
+
+    Attributes:
+        offset: one of :data:`OFFSET_MODES` (see :mod:`camtool.toolpath.plan`).
+        tool_diameter: tool diameter, mm (needed for every offset but ``on``).
+        feed_mm_min: cutting feed, mm/min (> 0).
+        tolerance: chaining and arc-fitting tolerance, mm (> 0): ends closer than
+            this meet; fitted arcs stay this close to what they replace.
+        close_gap: contours whose ends are further apart than ``tolerance`` but
+            at most this far (mm), and less than a tenth of their length, are
+            closed with a warning; 0 closes nothing.
+        origin: tool position before the program, mm.
+        scale: uniform scale applied to the drawing about its origin (> 0).
+        fit_mm: ``(width, height)``: scale the drawing uniformly, about the
+            lower-left corner of its bounding box, to the largest size that fits
+            this box. Excludes ``scale``.
+        direction: ``climb`` or ``conventional`` for closed contours with a
+            material side (a clockwise M03 spindle: climb keeps the material on
+            the right of travel). ``None``: climb when compensating, the drawn
+            direction for ``offset="on"``.
+        stepover: pocket step-over as a fraction of the tool diameter, (0, 1].
+        pocket: pocket style, one of :data:`POCKET_STYLES`.
+        pocket_angle_deg: zigzag line angle, degrees CCW from +X.
+        depth: final cut depth below the top (Z = 0), mm (> 0); ``None`` writes
+            no Z (2D program).
+        step_down: depth of each pass, mm (> 0); ``None``: one pass at ``depth``.
+        safe_z: height of every rapid when a depth is given, mm (> 0).
+        plunge_feed_mm_min: feed of Z moves into the material, mm/min;
+            ``None``: half of ``feed_mm_min``.
+        ramp_angle_deg: enter each pass along the path descending at this angle
+            from the horizontal, degrees in (0, 90); ``None`` plunges straight.
+        tabs: number of holding tabs on each outside profile (0 = none).
+        tab_width: tab length along the part edge, mm.
+        tab_height: tab height above the final depth, mm (< ``depth``).
+        order: cutting order, one of :data:`ORDERS`.
+        lead_in_mm: radius of tangent lead-in/lead-out arcs on closed profiles,
+            mm (0 = none).
+        fit_arcs: fit arcs to dense polylines within ``tolerance``.
+    """
+
+    offset: str = "on"
+    tool_diameter: float = 0.0
+    feed_mm_min: float
+    tolerance: float = 0.001
+    close_gap: float = 0.02
+    origin: Point = (0.0, 0.0)
+    scale: float = 1.0
+    fit_mm: tuple[float, float] | None = None
+    direction: str | None = None
+    stepover: float = 0.4
+    pocket: str = "concentric"
+    pocket_angle_deg: float = 0.0
+    depth: float | None = None
+    step_down: float | None = None
+    safe_z: float = 2.0
+    plunge_feed_mm_min: float | None = None
+    ramp_angle_deg: float | None = None
+    tabs: int = 0
+    tab_width: float = 2.0
+    tab_height: float = 0.5
+    order: str = "travel"
+    lead_in_mm: float = 0.0
+    fit_arcs: bool = True
+
+    def __post_init__(self) -> None:
+        self._check_choices()
+        self._check_tool()
+        self._check_placement()
+        self._check_depth()
+        self._check_tabs()
+
+    @property
+    def radius(self) -> float:
+        """Tool radius, mm."""
+        return self.tool_diameter / 2.0
+
+    @property
+    def plunge_feed(self) -> float:
+        """Feed of Z moves into the material, mm/min."""
+        if self.plunge_feed_mm_min is None:
+            return self.feed_mm_min / 2.0
+        return self.plunge_feed_mm_min
+
+    def _check_choices(self) -> None:
+        for name, value, choices in (
+            ("--offset", self.offset, OFFSET_MODES),
+            ("--pocket", self.pocket, POCKET_STYLES),
+            ("--order", self.order, ORDERS),
+        ):
+            if value not in choices:
+                raise UsageError(f"unknown {name} {value!r}; choose one of {', '.join(choices)}")
+        if self.direction is not None and self.direction not in DIRECTIONS:
+            raise UsageError(
+                f"unknown --direction {self.direction!r}; choose one of {', '.join(DIRECTIONS)}"
+            )
+
+    def _check_tool(self) -> None:
+        if self.tool_diameter < 0:
+            raise UsageError(f"tool diameter must be ≥ 0 mm, got {self.tool_diameter!r}")
+        if self.offset != "on" and self.tool_diameter <= 0:
+            raise UsageError(f"--offset {self.offset} needs --tool-diameter MM (> 0)")
+        if self.feed_mm_min <= 0:
+            raise UsageError(f"feed must be > 0 mm/min, got {self.feed_mm_min!r}")
+        if self.tolerance <= 0:
+            raise UsageError(f"tolerance must be > 0 mm, got {self.tolerance!r}")
+        if self.close_gap < 0:
+            raise UsageError(f"--close-gap must be ≥ 0 mm, got {self.close_gap!r}")
+        if not 0 < self.stepover <= 1:
+            raise UsageError(
+                f"--stepover is a fraction of the tool diameter in (0, 1], got {self.stepover!r}"
+            )
+        if self.lead_in_mm < 0:
+            raise UsageError(f"--lead-in must be ≥ 0 mm, got {self.lead_in_mm!r}")
+        if self.lead_in_mm > 0 and self.offset in ("on", "pocket"):
+            raise UsageError(
+                "--lead-in needs a side to approach from: use --offset outside or inside"
+            )
+
+    def _check_placement(self) -> None:
+        if self.scale <= 0:
+            raise UsageError(f"scale must be > 0, got {self.scale!r}")
+        if self.fit_mm is not None:
+            if self.scale != 1.0:
+                raise UsageError("give either --scale or --fit, not both")
+            if min(self.fit_mm) <= 0:
+                raise UsageError(f"--fit needs a width and height > 0 mm, got {self.fit_mm!r}")
+
+    def _check_depth(self) -> None:
+        if self.depth is None:
+            given = [
+                flag
+                for flag, value in (
+                    ("--step-down", self.step_down),
+                    ("--plunge-feed", self.plunge_feed_mm_min),
+                    ("--ramp", self.ramp_angle_deg),
+                )
+                if value is not None
+            ]
+            if given:
+                raise UsageError(f"{', '.join(given)} need(s) --depth MM")
+            return
+        if self.depth <= 0:
+            raise UsageError(
+                f"--depth is measured down from the top: give a value > 0 mm, got {self.depth!r}"
+            )
+        if self.step_down is not None and self.step_down <= 0:
+            raise UsageError(f"--step-down must be > 0 mm, got {self.step_down!r}")
+        if self.safe_z <= 0:
+            raise UsageError(f"--safe-z must be above the top (> 0 mm), got {self.safe_z!r}")
+        if self.plunge_feed_mm_min is not None and self.plunge_feed_mm_min <= 0:
+            raise UsageError(f"--plunge-feed must be > 0 mm/min, got {self.plunge_feed_mm_min!r}")
+        if self.ramp_angle_deg is not None and not 0 < self.ramp_angle_deg < 90:
+            raise UsageError(
+                f"--ramp is an angle in (0, 90) degrees from the horizontal, got "
+                f"{self.ramp_angle_deg!r}"
+            )
+
+    def _check_tabs(self) -> None:
+        if self.tabs < 0:
+            raise UsageError(f"--tabs must be ≥ 0, got {self.tabs!r}")
+        if self.tabs == 0:
+            return
+        if self.depth is None:
+            raise UsageError("--tabs need --depth MM: a tab is material left above the depth")
+        if self.offset != "outside":
+            raise UsageError("--tabs go on outside profiles: use --offset outside")
+        if self.tab_width <= 0 or self.tab_height <= 0:
+            raise UsageError(
+                f"--tab-width and --tab-height must be > 0 mm, got {self.tab_width!r}, "
+                f"{self.tab_height!r}"
+            )
+        if self.tab_height >= self.depth:
+            raise UsageError(
+                f"--tab-height {self.tab_height:g} mm must be below --depth {self.depth:g} mm"
+            )
+
+    @property
+    def uses_z(self) -> bool:
+        """True when the plan writes Z (a depth was given)."""
+        return self.depth is not None
+
+    def z_options(self) -> list[str]:
+        """The depth options given, as flags (for the 2D-target error)."""
+        flags = [("--depth", self.depth is not None), ("--tabs", self.tabs > 0)]
+        return [flag for flag, given in flags if given]
+
+
+PLAN_FIELDS = frozenset(
+    f for f in PlanOptions.__dataclass_fields__ if f not in ("feed_mm_min", "tolerance")
+)
+"""Planning options other than feed and tolerance (which re-posted programs use too)."""

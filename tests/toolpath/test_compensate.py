@@ -1,0 +1,325 @@
+"""Closing gaps, tool compensation, exact offsets, fallback and findings, against analytic values.
+
+The expected numbers are geometry, not thesis figures (STYLE 12: "a 10 mm circle offset by
+1 mm has radius 6 mm"): an offset by the tool radius r moves every edge by r, turns convex
+corners into arcs of radius r and keeps concave corners sharp.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from typing import Any
+
+import numpy as np
+import pytest
+
+from camtool.errors import ToolpathError
+from camtool.geometry import Arc, Contour, Line
+from camtool.toolpath import offset as offset_module
+from camtool.toolpath.chain import close_gaps
+from camtool.toolpath.compensate import compensate, tight_corners
+from camtool.toolpath.cuts import Stage
+from camtool.toolpath.offset import offset_checked, offset_contour, offset_pieces
+from camtool.toolpath.options import PlanOptions
+from camtool.toolpath.order import nesting
+from tests.shapes import segment_samples
+from tests.toolpath.contours import (
+    ccw,
+    circle,
+    dumbbell,
+    l_shape,
+    radius_of,
+    rect,
+    stadium,
+    two_way_distance,
+)
+
+TOL = 0.001
+
+
+def _run(contours: list[Contour], offset: str, diameter: float = 2.0, **kw: Any) -> Stage:
+    options = PlanOptions(offset=offset, tool_diameter=diameter, feed_mm_min=100.0, **kw)
+    return compensate(contours, nesting(contours), options)
+
+
+def _kinds(stage: Stage) -> list[str]:
+    return [f.kind for f in stage.findings]
+
+
+# --- close_gaps ------------------------------------------------------------------------------
+
+
+def _open_square(gap: float) -> Contour:
+    """A 1 × 1 square drawn open: it ends ``gap`` mm short of its start."""
+    pts = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0), (0.0, gap)]
+    return Contour(tuple(Line(a, b) for a, b in itertools.pairwise(pts)), False)
+
+
+def test_a_gap_within_the_default_is_closed_with_a_line_and_reported() -> None:
+    contour = _open_square(0.01)
+    (closed,), (finding,) = close_gaps([contour], 0.02, TOL)
+    assert closed.closed and closed.segments[:4] == contour.segments  # drawn segments exact
+    assert closed.segments[-1] == Line((0.0, 0.01), (0.0, 0.0))
+    assert finding.kind == "closed-gap"
+    assert finding.value == pytest.approx(0.01)
+    assert finding.at == pytest.approx((0.0, 0.005))
+    assert "0.01 mm" in finding.message and "--close-gap 0" in finding.message
+
+
+@pytest.mark.parametrize("gap, max_gap", [(0.03, 0.02), (0.01, 0.0), (0.0005, 0.02)])
+def test_gaps_outside_the_window_stay_open(gap: float, max_gap: float) -> None:
+    contour = _open_square(gap)
+    out, found = close_gaps([contour], max_gap, TOL)
+    assert out == [contour] and found == []
+
+
+def test_a_c_shape_is_not_closed() -> None:
+    # A "C" of radius 0.02 mm over 300°: its 0.02 mm gap is 19 % of its 0.105 mm length.
+    r = 0.02
+    a, b = math.radians(30), math.radians(330)
+    arc = Arc((r * math.cos(a), r * math.sin(a)), (r * math.cos(b), r * math.sin(b)), (0, 0), False)
+    contour = Contour((arc,), False)
+    out, found = close_gaps([contour], 0.02, TOL)
+    assert out == [contour] and found == []
+
+
+# --- exact offsets ---------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("offset, radius", [("outside", 6.0), ("inside", 4.0)])
+def test_circle_offset_by_the_tool_radius(offset: str, radius: float) -> None:
+    (cut,) = _run([circle(0, 0, 5)], offset).cuts
+    assert all(isinstance(s, Arc) and s.radius == pytest.approx(radius) for s in cut.path.segments)
+    assert sum(abs(s.sweep) for s in cut.path.segments if isinstance(s, Arc)) == pytest.approx(
+        2 * math.pi
+    )
+
+
+def test_rectangle_outside_has_corner_arcs_and_grows_by_the_diameter() -> None:
+    (cut,) = _run([rect(0, 0, 10, 5)], "outside", 2.0).cuts
+    arcs = [s for s in cut.path.segments if isinstance(s, Arc)]
+    assert len(arcs) == 4 and all(a.radius == pytest.approx(1.0) for a in arcs)
+    x0, y0, x1, y1 = cut.path.bbox()
+    assert (x1 - x0, y1 - y0) == (pytest.approx(12.0), pytest.approx(7.0))
+    # area of a rectangle grown by r: w·h + 2r(w + h) + π r²
+    assert abs(cut.path.signed_area()) == pytest.approx(50 + 2 * 15 + math.pi, abs=1e-3)
+
+
+def test_rectangle_inside_shrinks_by_the_diameter_with_sharp_corners() -> None:
+    (cut,) = _run([rect(0, 0, 10, 5)], "inside", 2.0).cuts
+    assert all(isinstance(s, Line) for s in cut.path.segments)
+    assert cut.path.bbox() == pytest.approx((1.0, 1.0, 9.0, 4.0))
+
+
+@pytest.mark.parametrize("offset, r_end", [("outside", 4.0), ("inside", 2.0)])
+def test_slot_offsets_keep_straight_sides_and_round_ends(offset: str, r_end: float) -> None:
+    (cut,) = _run([stadium(0, 20, 0, 3)], offset, 2.0).cuts
+    lines = [s for s in cut.path.segments if isinstance(s, Line)]
+    arcs = [s for s in cut.path.segments if isinstance(s, Arc)]
+    assert sorted(s.length for s in lines) == pytest.approx([20.0, 20.0])
+    assert all(a.radius == pytest.approx(r_end) for a in arcs)
+    assert sum(abs(a.sweep) for a in arcs) == pytest.approx(2 * math.pi)
+
+
+def _part_with_hole(**kw: Any) -> Stage:
+    return _run([rect(0, 0, 20, 10), circle(10, 5, 3)], "outside", 2.0, **kw)
+
+
+def test_outer_grows_hole_shrinks_climb_runs_outer_cw_hole_ccw() -> None:
+    outer, hole = _part_with_hole().cuts
+    assert outer.path.bbox() == pytest.approx((-1, -1, 21, 11))
+    assert {round(radius_of(s), 9) for s in hole.path.segments} == {2.0}
+    assert not ccw(outer.path) and ccw(hole.path)
+    assert (outer.material_side, hole.material_side) == ("right", "right")
+    assert (outer.outside_profile, hole.outside_profile) == (True, False)
+    assert not outer.may_reverse and outer.may_rotate and (outer.group, hole.group) == (0, 1)
+
+
+def test_conventional_runs_the_other_way() -> None:
+    outer, hole = _part_with_hole(direction="conventional").cuts
+    assert ccw(outer.path) and not ccw(hole.path)
+    assert (outer.material_side, hole.material_side) == ("left", "left")
+
+
+def test_inside_swaps_the_sides() -> None:
+    outer, hole = _run([rect(0, 0, 20, 10), circle(10, 5, 3)], "inside", 2.0).cuts
+    assert outer.path.bbox() == pytest.approx((1, 1, 19, 9))
+    assert {round(radius_of(s), 9) for s in hole.path.segments} == {4.0}
+    # climb: material (outside the outer boundary, inside the hole) on the right
+    assert ccw(outer.path) and not ccw(hole.path)
+    assert not outer.outside_profile
+
+
+def test_on_keeps_the_drawn_direction_unless_one_is_asked() -> None:
+    drawn = [rect(0, 0, 20, 10), circle(10, 5, 3).reversed()]
+    free = _run(drawn, "on", 0.0).cuts
+    assert [c.path for c in free] == drawn
+    assert all(c.may_reverse and c.material_side is None for c in free)
+    climb = _run(drawn, "on", 0.0, direction="climb").cuts
+    assert [ccw(c.path) for c in climb] == [False, True]  # as for outside
+    assert all(not c.may_reverse and c.material_side == "right" for c in climb)
+
+
+def test_open_contours_are_cut_on_the_line_and_counted() -> None:
+    line = Contour((Line((30, 0), (40, 0)),), False)
+    stage = _run([rect(0, 0, 10, 10), line], "outside")
+    cut = stage.cuts[1]
+    assert (cut.kind, cut.path, cut.may_rotate, cut.may_reverse) == ("open", line, False, True)
+    (finding,) = [f for f in stage.findings if f.kind == "open-on-line"]
+    assert finding.message.startswith("1 open contour(s) cut on the line: --offset outside")
+    assert "open-on-line" not in _kinds(_run([line], "on", 0.0))
+
+
+# --- split and vanished offsets --------------------------------------------------------------
+
+
+def test_dumbbell_shrunk_past_its_waist_gives_two_pieces() -> None:
+    # Waist 2 mm wide, shrunk by r = 1.2 mm: two 7.6 × 7.6 mm squares, each with a bump
+    # toward the waist bounded by circles of r around the waist corners (10, 4) and (10, 6):
+    # bump = 2·∫₀¹ (r − √(r² − t²)) dt.
+    pieces = offset_pieces(dumbbell(), -1.2)
+    assert len(pieces) == 2 and all(ccw(p) for p in pieces)
+    r = 1.2
+    segment = 0.5 * math.sqrt(r * r - 1) + r * r / 2 * math.asin(1 / r)  # ∫₀¹ √(r² − t²) dt
+    for p in pieces:
+        assert p.signed_area(1e-8) == pytest.approx(7.6 * 7.6 + 2 * (r - segment), abs=1e-6)
+    with pytest.raises(ToolpathError, match="splits into 2 pieces"):
+        offset_contour(dumbbell(), -1.2)
+    stage = _run([dumbbell()], "inside", 2.4)
+    assert len(stage.cuts) == 2 and {c.group for c in stage.cuts} == {0}
+
+
+def test_a_slot_narrower_than_the_tool_vanishes_with_its_location() -> None:
+    slot = stadium(30, 40, 5, 1.0)  # 2 mm wide, a hole in the part, tool 3 mm
+    stage = _run([rect(0, 0, 50, 10), slot], "outside", 3.0)
+    assert [c.group for c in stage.cuts] == [0]  # the part is still cut
+    (finding,) = [f for f in stage.findings if f.kind == "offset-vanished"]
+    assert finding.at == pytest.approx((35.0, 5.0), abs=1e-6)
+    assert finding.value == pytest.approx(2.0, abs=2 * TOL)
+    assert "(35.0000, 5.0000)" in finding.message and "3 mm tool" in finding.message
+
+
+def test_when_everything_vanishes_planning_stops_with_the_reason() -> None:
+    with pytest.raises(ToolpathError, match=r"nothing left to cut.*narrower than the 3 mm tool"):
+        _run([stadium(30, 40, 5, 1.0)], "inside", 3.0)
+
+
+# --- fallback --------------------------------------------------------------------------------
+
+
+def _occt_fails(*args: Any) -> Any:
+    raise RuntimeError("StdFail_NotDone")
+
+
+@pytest.mark.parametrize(
+    "contour, amount",
+    [(circle(0, 0, 5), 1.0), (rect(0, 0, 10, 5), 0.5), (l_shape(), 1.0), (dumbbell(), -1.2)],
+)
+def test_fallback_is_within_tolerance_of_the_exact_offset(
+    monkeypatch: pytest.MonkeyPatch, contour: Contour, amount: float
+) -> None:
+    exact = offset_pieces(contour, amount)
+    monkeypatch.setattr(offset_module, "_occt_offset", _occt_fails)
+    result = offset_checked(contour, amount, TOL)
+    assert result.fallback is not None and "StdFail_NotDone" in result.fallback
+    assert len(result.pieces) == len(exact)
+    assert [ccw(p) for p in result.pieces] == [ccw(p) for p in exact]
+    assert two_way_distance(result.pieces, exact) <= TOL
+    assert any(isinstance(s, Arc) for p in result.pieces for s in p.segments)
+
+
+def test_fallback_is_reported(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(offset_module, "_occt_offset", _occt_fails)
+    stage = _run([circle(0, 0, 5)], "outside", 2.0)
+    (finding,) = stage.findings
+    assert finding.kind == "offset-fallback" and finding.at == (5, 0)
+    assert "OpenCASCADE could not offset it (" in finding.message
+    assert "within 0.001 mm" in finding.message
+    (cut,) = stage.cuts
+    radii = np.hypot(*segment_samples(cut.path.segments).T)
+    assert np.all(np.abs(radii - 6.0) <= TOL)  # the 10 mm circle grown by 1 mm
+
+
+def test_an_offset_that_does_not_grow_is_replaced(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(offset_module, "offset_pieces", lambda c, a: [c])
+    result = offset_checked(rect(0, 0, 10, 5), 0.5, TOL)
+    assert result.fallback is not None and "area" in result.fallback
+    assert abs(result.pieces[0].signed_area()) == pytest.approx(50 + 15 + math.pi / 4, abs=0.01)
+
+
+# --- tight corners ---------------------------------------------------------------------------
+
+
+def _notched() -> Contour:
+    """A 10 × 10 square with a semicircular notch of radius 0.5 in its top edge."""
+    segs = (
+        Line((0, 0), (10, 0)),
+        Line((10, 0), (10, 10)),
+        Line((10, 10), (5.5, 10)),
+        Arc((5.5, 10), (4.5, 10), (5, 10), True),  # dips into the square
+        Line((4.5, 10), (0, 10)),
+        Line((0, 10), (0, 0)),
+    )
+    return Contour(segs, True)
+
+
+@pytest.mark.parametrize(
+    "contours, offset, count",
+    [
+        ([l_shape()], "outside", 1),
+        ([rect(0, 0, 20, 20), rect(5, 5, 10, 10)], "outside", 4),  # the tool is in the hole
+        ([rect(0, 0, 10, 5)], "outside", 0),
+        ([rect(0, 0, 30, 10), stadium(5, 15, 5, 2.0)], "outside", 0),  # ends r 2 > 1
+        ([_notched()], "outside", 1),  # the notch's r 0.5 < 1
+        ([rect(0, 0, 10, 5)], "inside", 4),
+    ],
+)
+def test_tight_corners_are_counted_once_per_contour(
+    contours: list[Contour], offset: str, count: int
+) -> None:
+    stage = _run(contours, offset, 2.0)
+    found = [f for f in stage.findings if f.kind == "tight-corner"]
+    assert sum(f.value or 0 for f in found) == count
+    assert len(found) == (1 if count else 0)
+
+
+def test_tight_corner_names_the_first_corner_and_the_radius() -> None:
+    (finding,) = _run([l_shape()], "outside", 3.0).findings
+    assert finding.at == (3, 3)
+    assert "1 inside corner tighter than the 1.5 mm tool radius (first at (3.0000, 3.0000)" in (
+        finding.message
+    )
+    assert tight_corners(l_shape(), inside=True, radius=1.5, tolerance=TOL) == [
+        (0, 0), (10, 0), (10, 3), (3, 10), (0, 10)
+    ]  # fmt: skip
+
+
+# --- gouge -----------------------------------------------------------------------------------
+
+
+def test_parts_closer_than_the_tool_are_gouged() -> None:
+    # Two 10 mm squares 2 mm apart, tool 3 mm: each path sweeps 3 mm from its square, 1 mm
+    # into the other one: a 1 × 10 mm band (10 mm²) on each side of the gap.
+    stage = _run([rect(0, 0, 10, 10), rect(12, 0, 22, 10)], "outside", 3.0)
+    gouges = sorted((f for f in stage.findings if f.kind == "gouge"), key=lambda f: f.at or ())
+    assert [g.at for g in gouges] == [pytest.approx((9.5, 5)), pytest.approx((12.5, 5))]
+    assert [g.value for g in gouges] == [pytest.approx(10, rel=1e-3)] * 2
+    assert "cuts into the part around (9.5000, 5.0000)" in gouges[0].message
+
+
+def test_a_wall_between_holes_thinner_than_the_tool_is_gouged_inside() -> None:
+    # Holes 1 mm apart cut inside (holes grow): each 3 mm tool sweeps 2 mm into the other.
+    holes = [rect(-20, -20, 40, 30), rect(0, 0, 10, 10), rect(11, 0, 21, 10)]
+    stage = _run(holes, "inside", 3.0)
+    areas = [f.value for f in stage.findings if f.kind == "gouge"]
+    assert len(areas) == 2 and all(a == pytest.approx(20, rel=1e-3) for a in areas)
+
+
+def test_correct_offsets_do_not_gouge() -> None:
+    # walls and gaps of 3 mm or more, tool 2.5 mm
+    l_part = l_shape().transformed(1.0, 30, 0)
+    contours = [rect(0, 0, 10, 10), rect(14, 0, 24, 10), rect(3, 3, 7, 7), l_part]
+    for offset in ("outside", "inside"):
+        kinds = _kinds(_run(contours, offset, 2.5))
+        assert "gouge" not in kinds and "offset-fallback" not in kinds
