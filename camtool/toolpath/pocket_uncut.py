@@ -1,0 +1,217 @@
+"""What a pocket's tool paths leave uncut, and which of it the user must hear about.
+
+The swept area of the cuts is the union of their polylines buffered by the tool
+radius (shapely); ``uncut = region − swept``. Every round tool leaves a fillet of its
+radius in each sharp corner of the pocket: those pieces are counted in one
+``tight-corner`` finding. Every other piece larger than ``(0.01·d)²`` mm² (``d`` the
+tool diameter) is reported with its location and area (``uncut``, up to five, then a
+count): a part of the pocket narrower than the tool when the tool cannot reach it at all
+(it lies outside the opening ``(region ⊖ r) ⊕ r``), otherwise material left between
+passes (a step-over too large for the shape).
+
+A piece is a corner fillet when it lies within the corner zones of the region's
+convex vertices: a vertex where the boundary turns by ``T`` (summed over the boundary
+within one tool radius, so the chords of a small rounded corner count as one corner)
+has the zone of radius ``1.1·r·tan(T/2)`` around it, the reach of the fillet a tool of
+radius ``r`` leaves in a corner of that angle. Turns of 150° or more (slot ends, spikes)
+are not corners: what stays there is narrower than the tool.
+
+Conventions: mm, mm², Y up.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+import shapely
+from shapely import LineString, Polygon
+from shapely.geometry.base import BaseGeometry
+from shapely.geometry.polygon import orient
+
+from camtool.geometry import Contour, Point
+from camtool.toolpath.cuts import Cut, Finding, where
+from camtool.toolpath.options import PlanOptions
+
+__all__ = ["polygons", "quad_segs", "swept_area", "uncut_findings"]
+
+MAX_REPORTED = 5
+"""Uncut pieces reported one by one per pocket; the rest are counted."""
+
+_MIN_QUAD_SEGS = 8
+_MAX_QUAD_SEGS = 1024
+_CORNER_CAP = math.radians(150.0)  # a turn this sharp is a slot end, not a corner
+_ZONE_SLACK = 1.1
+
+
+def polygons(geom: BaseGeometry) -> list[Polygon]:
+    """The non-empty polygons of a shapely geometry (polygon, multi or collection)."""
+    if geom.is_empty:
+        return []
+    if isinstance(geom, Polygon):
+        return [geom]
+    return [g for part in getattr(geom, "geoms", ()) for g in polygons(part)]
+
+
+def quad_segs(radius: float, tolerance: float) -> int:
+    """Buffer segments per quarter circle so chords of ``radius`` deviate ≤ ``tolerance / 4``."""
+    sagitta = tolerance / 4
+    if sagitta >= radius:
+        return _MIN_QUAD_SEGS
+    chord_angle = 2.0 * math.acos(1.0 - sagitta / radius)
+    return min(_MAX_QUAD_SEGS, max(_MIN_QUAD_SEGS, math.ceil(math.pi / 2 / chord_angle)))
+
+
+def swept_area(paths: Sequence[Contour], radius: float, tolerance: float) -> BaseGeometry:
+    """Area a round tool of ``radius`` mm sweeps along ``paths`` (arcs as chords), mm²."""
+    quad = quad_segs(radius, tolerance)
+    lines = [LineString(p.points(tolerance / 4)) for p in paths]
+    return shapely.union_all([line.buffer(radius, quad_segs=quad) for line in lines])
+
+
+def uncut_findings(
+    area: Polygon, boundary: Contour, cuts: Sequence[Cut], options: PlanOptions
+) -> list[Finding]:
+    """Findings for what ``cuts`` leave of ``area``: narrow pieces and corner fillets.
+
+    Args:
+        area: the pocket region, mm (exterior and holes).
+        boundary: the pocket's boundary contour (names it in the messages).
+        cuts: the region's cuts; none when the region is narrower than the tool.
+        options: the tool diameter and tolerance are used.
+
+    Returns:
+        ``uncut`` findings (``at`` a point inside the piece, ``value`` its area
+        mm²) and at most one ``tight-corner`` finding (``value`` the tool radius).
+    """
+    d, tol = options.tool_diameter, options.tolerance
+    if not cuts:
+        x, y = _at(area)
+        return [
+            Finding(
+                "uncut",
+                f"{where(boundary)}: the whole pocket ({area.area:.3g} mm² around "
+                f"({x:.3f}, {y:.3f}) mm) is narrower than the {d:g} mm tool; use a smaller "
+                "tool to clear it",
+                (x, y),
+                area.area,
+            )
+        ]
+    swept = swept_area([c.path for c in cuts], options.radius + tol, tol)
+    threshold = (0.01 * d) ** 2
+    pieces = [p for p in polygons(area.difference(swept)) if p.area > threshold]
+    centres, zone = _corners(area, options.radius)
+    fillets = [p for p in pieces if _is_fillet(p, centres, zone, threshold)]
+    narrow = sorted((p for p in pieces if not any(p is f for f in fillets)), key=lambda p: -p.area)
+    reach = _reachable(area, options) if narrow else area
+    findings = [
+        _missed(p, boundary, options)
+        if p.difference(reach).area <= threshold
+        else _narrow(p, boundary, d)
+        for p in narrow[:MAX_REPORTED]
+    ]
+    rest = narrow[MAX_REPORTED:]
+    if rest:
+        findings.append(
+            Finding(
+                "uncut",
+                f"{where(boundary)}: and {len(rest)} more uncut region(s) "
+                f"({sum(p.area for p in rest):.3g} mm²) narrower than the {d:g} mm tool or "
+                "between passes",
+                None,
+                sum(p.area for p in rest),
+            )
+        )
+    if fillets:
+        findings.append(_corner_finding(fillets, boundary, options.radius))
+    return findings
+
+
+def _at(piece: Polygon) -> Point:
+    p = piece.representative_point()
+    return (float(p.x), float(p.y))
+
+
+def _reachable(area: Polygon, options: PlanOptions) -> BaseGeometry:
+    """Where a tool of the plan's radius can reach at all (the opening of ``area``), mm²."""
+    r, tol = options.radius, options.tolerance
+    quad = quad_segs(r, tol)
+    return area.buffer(-r, quad_segs=quad).buffer(r + tol, quad_segs=quad)
+
+
+def _missed(piece: Polygon, boundary: Contour, options: PlanOptions) -> Finding:
+    x, y = _at(piece)
+    return Finding(
+        "uncut",
+        f"{where(boundary)}: {piece.area:.3g} mm² left uncut between passes at "
+        f"({x:.3f}, {y:.3f}) mm; reduce --stepover (now {options.stepover:g})",
+        (x, y),
+        piece.area,
+    )
+
+
+def _narrow(piece: Polygon, boundary: Contour, d: float) -> Finding:
+    x, y = _at(piece)
+    return Finding(
+        "uncut",
+        f"{where(boundary)}: {piece.area:.3g} mm² left uncut at ({x:.3f}, {y:.3f}) mm, "
+        f"narrower than the {d:g} mm tool; use a smaller tool to clear it",
+        (x, y),
+        piece.area,
+    )
+
+
+def _corner_finding(fillets: Sequence[Polygon], boundary: Contour, r: float) -> Finding:
+    total = sum(p.area for p in fillets)
+    return Finding(
+        "tight-corner",
+        f"{where(boundary)}: {len(fillets)} pocket corner(s) keep the {r:g} mm tool radius "
+        f"({total:.3g} mm² uncut in all); a round tool cannot cut sharper inside corners",
+        _at(fillets[0]),
+        r,
+    )
+
+
+def _corners(area: Polygon, r: float) -> tuple[np.ndarray, np.ndarray]:
+    """Convex vertices of ``area`` ``(N, 2)`` and the reach of their fillet zones ``(N,)``, mm."""
+    area = orient(area, 1.0)  # interior on the left of every ring
+    found_xy: list[np.ndarray] = []
+    found_reach: list[np.ndarray] = []
+    for ring in (area.exterior, *area.interiors):
+        xy = np.asarray(ring.coords, dtype=np.float64)[:-1]
+        if len(xy) < 3:
+            continue
+        e_out = np.roll(xy, -1, axis=0) - xy
+        e_in = xy - np.roll(xy, 1, axis=0)
+        cross = e_in[:, 0] * e_out[:, 1] - e_in[:, 1] * e_out[:, 0]
+        dot = np.einsum("ij,ij->i", e_in, e_out)
+        turn = np.arctan2(cross, dot)
+        total = _window_sum(turn, np.hypot(e_out[:, 0], e_out[:, 1]), r)
+        keep = (turn > 0) & (total > 0) & (total < _CORNER_CAP)
+        found_xy.append(xy[keep])
+        found_reach.append(_ZONE_SLACK * r * np.tan(total[keep] / 2))
+    if not found_xy:
+        return np.zeros((0, 2)), np.zeros(0)
+    return np.vstack(found_xy), np.concatenate(found_reach)
+
+
+def _window_sum(turn: np.ndarray, edge: np.ndarray, w: float) -> np.ndarray:
+    """For each vertex of a closed ring, the sum of the turns within ``w`` along the ring."""
+    n = len(turn)
+    pos = np.concatenate([[0.0], np.cumsum(np.tile(edge, 3))])[: 3 * n] - edge.sum()
+    turns = np.concatenate([[0.0], np.cumsum(np.tile(turn, 3))])
+    middle = pos[n : 2 * n]
+    lo = np.searchsorted(pos, middle - w, side="left")
+    hi = np.searchsorted(pos, middle + w, side="right")
+    return np.asarray(turns[hi] - turns[lo])
+
+
+def _is_fillet(piece: Polygon, centres: np.ndarray, reach: np.ndarray, slack: float) -> bool:
+    if not len(centres):
+        return False
+    near = shapely.distance(shapely.points(centres), piece) <= reach
+    if not near.any():
+        return False
+    zones = shapely.buffer(shapely.points(centres[near]), reach[near], quad_segs=16)
+    return bool(piece.difference(shapely.union_all(zones)).area <= slack)
