@@ -1,0 +1,382 @@
+"""Emit the moves of ordered cuts: depth passes, safe Z, plunges or ramps, tabs, lead arcs.
+
+The last planning stage (see :mod:`camtool.toolpath.plan`). Cuts arrive in their
+final cutting order, each already rotated and reversed as it will be cut; this
+module turns them into :mod:`camtool.program` moves.
+
+**2D** (no ``depth``): per cut a rapid to its start (kept even when the tool is
+already there, so every contour begins with a positioning block, as the goldens
+expect), then one cutting move per segment; no Z anywhere.
+
+**Depth**: passes from the top (Z = 0) down (:func:`pass_depths`). Every rapid
+with XY motion is at ``safe_z``; the tool rises to ``safe_z`` by a Z-only rapid
+before it travels, goes down by a Z-only :class:`~camtool.program.Linear` at the
+plunge feed, and rises to ``safe_z`` after the last pass of each cut, so the
+program ends at safe Z. Feeds: cutting moves at ``feed_mm_min``, downward Z moves
+at ``plunge_feed``, the rise onto a tab at ``feed_mm_min``.
+
+- closed cut: all passes in a row without retracting;
+- open cut: if it ``may_reverse``, the next pass cuts back the other way from
+  where the last one ended (no retract, no air travel); otherwise retract,
+  rapid back to its start and go down again;
+- consecutive ``pocket`` cuts of the same group are cut level by level (every
+  ring or path at pass 1, then every one at pass 2...), retracting between cuts.
+
+**Ramp** (``ramp_angle_deg``): instead of a vertical plunge the tool descends
+along the path over ``L = Δz / tan(angle)``; arcs descend as helical arc moves
+(or, with ``helix=False``, chords within ``tolerance`` over which Z falls evenly
+per arc length: a chord is steeper than the angle by the factor arc/chord, at
+most about ``1 + tolerance/(3·radius)``). On a closed path the ramp
+runs on round the loop (a helix when the loop is shorter than ``L``), then a whole
+loop is cut at the new depth, so the pass ends where the ramp ended and the next
+pass ramps on from there. On an open path (and on a lead-in arc) it zigzags back
+and forth from the start until the depth is reached, goes back to the start at
+that depth and cuts the whole path.
+
+**Tabs** on closed outside profiles (:mod:`~camtool.toolpath.tabs`): on passes
+below the tab top ``z_tab = −depth + tab_height`` the tool rises to ``z_tab`` at
+each tab start (at the cutting feed), crosses the tab at ``z_tab`` and goes down
+at its end (at the plunge feed); a ramp crossing a tab stays at or above ``z_tab``.
+
+**Lead arcs** (``lead_in_mm``, closed profiles with a material side,
+:mod:`~camtool.toolpath.leads`): the tool travels to the lead-in's start (off the
+part), goes down there (or ramps along the lead-in), cuts the lead-in, the loop
+and the lead-out at the pass depth, and rises; each pass is entered the same way.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from itertools import pairwise
+
+from camtool.geometry import Arc, Segment
+from camtool.program import ArcMove, Linear, Move, Rapid
+from camtool.toolpath.cuts import Cut, where
+from camtool.toolpath.leads import has_leads, lead_arcs
+from camtool.toolpath.options import PlanOptions
+from camtool.toolpath.split import MIN_PIECE, Track
+from camtool.toolpath.tabs import tab_spans
+
+Z_EPS = 1e-9
+"""Z values closer than this (mm) are the same height: no Z move is written between them."""
+
+
+def pass_depths(depth: float, step: float | None) -> tuple[float, ...]:
+    """The Z of each pass, top down: ``−step, −2·step, …, −depth``, mm.
+
+    The passes are ``n = ceil(depth/step − 1e-9)``: all but the last are exactly
+    ``k·step`` deep and the last is exactly ``depth`` (it is the shallower one
+    when ``step`` does not divide ``depth``). The ``1e-9`` keeps a float ratio
+    such as ``0.3/0.1 = 2.9999999999999996`` or ``3.0000000000000004`` from
+    adding a pass a few nanometres thick; equal passes (``depth/n`` each) were not
+    chosen because ``--step-down`` is the depth the user asked each pass to take.
+
+    Args:
+        depth: final depth below the top, mm (> 0).
+        step: depth of each pass, mm (> 0); ``None``: one pass.
+    """
+    if step is None or step >= depth:
+        return (-depth,)
+    n = max(1, math.ceil(depth / step - 1e-9))
+    return (*(-k * step for k in range(1, n)), -depth)
+
+
+def emit_moves(cuts: Sequence[Cut], options: PlanOptions, *, helix: bool = True) -> list[Move]:
+    """The moves that cut ``cuts`` in order, with passes, tabs, ramps and lead arcs.
+
+    Args:
+        cuts: tool-centre paths in cutting order, each already rotated and
+            reversed as it will be cut. Cut ``i`` gets contour number ``i + 1``
+            on its moves.
+        options: feeds (``feed_mm_min``, ``plunge_feed``), ``depth``,
+            ``step_down``, ``safe_z``, ``ramp_angle_deg``, ``tabs``/``tab_width``/
+            ``tab_height``/``tool_diameter``, ``lead_in_mm``, ``tolerance``,
+            ``origin`` (where the tool is before the first move).
+        helix: the target can write helical arcs (an arc move with Z). ``False``:
+            the descending part of an arc in a ramp becomes chords within
+            ``options.tolerance``, each a :class:`~camtool.program.Linear` with Z.
+
+    Returns:
+        Rapid/Linear/ArcMove moves, absolute mm; ``z`` is ``None`` on every move
+        of a 2D plan, and in a depth plan on cutting moves that keep Z.
+
+    Raises:
+        ToolpathError: the tabs do not fit on a profile (names the contour).
+    """
+    writer = _Writer(options, helix)
+    if options.depth is None:
+        for number, cut in enumerate(cuts, start=1):
+            writer.number = number
+            _cut_2d(writer, cut)
+        return writer.moves
+    levels = pass_depths(options.depth, options.step_down)
+    i = 0
+    while i < len(cuts):
+        j = i + 1
+        if cuts[i].kind == "pocket":
+            while j < len(cuts) and cuts[j].kind == "pocket" and cuts[j].group == cuts[i].group:
+                j += 1
+            _pocket_batch(writer, cuts[i:j], i + 1, levels)
+        elif cuts[i].path.closed:
+            writer.number = i + 1
+            _cut_closed(writer, cuts[i], levels)
+        else:
+            writer.number = i + 1
+            _cut_open(writer, cuts[i], levels)
+        i = j
+    return writer.moves
+
+
+class _Writer:
+    """Builds the move list and tracks the tool's position (local to one emit)."""
+
+    def __init__(self, options: PlanOptions, helix: bool) -> None:
+        self.options = options
+        self.helix = helix
+        self.moves: list[Move] = []
+        self.x, self.y = options.origin
+        self.z: float | None = None
+        self.number = 0
+        ramp = options.ramp_angle_deg
+        self.slope = None if ramp is None else math.tan(math.radians(ramp))
+
+    def travel(self, x: float, y: float) -> None:
+        """Rapid to ``(x, y)``: in 2D directly, with a depth at safe Z (rising first)."""
+        if self.options.depth is None:
+            self.moves.append(Rapid(x, y, contour=self.number))
+        else:
+            self.retract()
+            self.moves.append(Rapid(x, y, self.options.safe_z, contour=self.number))
+        self.x, self.y = x, y
+
+    def retract(self) -> None:
+        """Z-only rapid up to safe Z, unless already there."""
+        safe = self.options.safe_z
+        if self.z is None or abs(self.z - safe) > Z_EPS:
+            self.moves.append(Rapid(self.x, self.y, safe, contour=self.number))
+            self.z = safe
+
+    def vertical(self, z: float) -> None:
+        """Z-only feed move: down at the plunge feed, up (onto a tab) at the cutting feed."""
+        if self.z is not None and abs(z - self.z) <= Z_EPS:
+            return
+        up = self.z is not None and z > self.z
+        feed = self.options.feed_mm_min if up else self.options.plunge_feed
+        self.moves.append(Linear(self.x, self.y, feed, z, contour=self.number))
+        self.z = z
+
+    def cut(self, seg: Segment, z: float | None) -> None:
+        """Cut along ``seg`` (starting where the tool is), descending to ``z`` if it differs."""
+        feed = self.options.feed_mm_min
+        if z is not None and self.z is not None and abs(z - self.z) <= Z_EPS:
+            z = None
+        x, y = seg.end
+        if isinstance(seg, Arc):
+            if z is not None and not self.helix:
+                self._chords(seg, z)
+                return
+            self.moves.append(ArcMove(x, y, *seg.centre, seg.clockwise, feed, z, self.number))
+        else:
+            self.moves.append(Linear(x, y, feed, z, contour=self.number))
+        self.x, self.y = x, y
+        if z is not None:
+            self.z = z
+
+    def _chords(self, arc: Arc, z: float) -> None:
+        z0 = self.z if self.z is not None else z
+        points = arc.points(self.options.tolerance)
+        n = len(points) - 1
+        for k, (x, y) in enumerate(points[1:], start=1):
+            zk = z if k == n else z0 + (z - z0) * k / n
+            self.moves.append(Linear(x, y, self.options.feed_mm_min, zk, contour=self.number))
+        self.x, self.y = arc.end
+        self.z = z
+
+    def run(
+        self,
+        track: Track,
+        s0: float,
+        s1: float,
+        z0: float,
+        z1: float,
+        spans: Sequence[tuple[float, float]] = (),
+    ) -> None:
+        """Cut ``track`` from arc length ``s0`` to ``s1``, Z linear from ``z0`` to ``z1``.
+
+        Over ``spans`` (tab intervals on a closed track, repeated every lap) Z is
+        held at or above the tab top; the tool rises at a tab's start and goes
+        down at its end when the run is below it there.
+        """
+        if s1 - s0 <= MIN_PIECE:
+            return
+        ztab = self._tab_top()
+        deep = ztab is not None and min(z0, z1) < ztab - Z_EPS
+        raised = _unrolled(track, s0, s1, spans) if deep else []
+        stops = {s0, s1}
+        for a, b in raised:
+            stops.update(s for s in (a, b) if s0 < s < s1)
+            if z0 != z1 and ztab is not None:
+                sc = s0 + (ztab - z0) / (z1 - z0) * (s1 - s0)
+                if max(a, s0) < sc < min(b, s1):
+                    stops.add(sc)
+
+        def z_at(s: float, up: bool) -> float:
+            z = z1 if s == s1 else z0 + (z1 - z0) * (s - s0) / (s1 - s0)
+            return max(z, ztab) if up and ztab is not None else z
+
+        for u, v in pairwise(sorted(stops)):
+            if v - u <= MIN_PIECE:
+                continue
+            up = any(a < (u + v) / 2 < b for a, b in raised)
+            zu, zv = z_at(u, up), z_at(v, up)
+            self.vertical(zu)
+            for seg, s_end in track.pieces(u, v):
+                self.cut(seg, zv if s_end >= v else zu + (zv - zu) * (s_end - u) / (v - u))
+
+    def _tab_top(self) -> float | None:
+        o = self.options
+        return None if o.depth is None or o.tabs == 0 else -o.depth + o.tab_height
+
+
+def _unrolled(
+    track: Track, s0: float, s1: float, spans: Sequence[tuple[float, float]]
+) -> list[tuple[float, float]]:
+    """The ``spans`` of a closed track, repeated every lap, that overlap ``(s0, s1)``."""
+    if not spans or not track.closed:
+        return []
+    total = track.length
+    out = []
+    for lap in range(math.floor(s0 / total), math.floor(s1 / total) + 1):
+        for a, b in spans:
+            a2, b2 = a + lap * total, b + lap * total
+            if b2 > s0 and a2 < s1:
+                out.append((a2, b2))
+    return out
+
+
+def _cut_2d(w: _Writer, cut: Cut) -> None:
+    """What the planner always wrote for a 2D cut, plus lead arcs when asked."""
+    leads = lead_arcs(cut, w.options.lead_in_mm) if has_leads(cut, w.options.lead_in_mm) else None
+    segments = list(cut.path.segments)
+    if leads is not None:
+        segments = [leads[0], *segments, leads[1]]
+    w.travel(*segments[0].start)
+    for seg in segments:
+        w.cut(seg, None)
+
+
+def _enter_open(w: _Writer, track: Track, z_from: float, z_to: float) -> None:
+    """Go down from ``z_from`` to ``z_to`` at ``track``'s start and cut all of it at ``z_to``.
+
+    With a ramp: zigzag along the track descending at the ramp angle until
+    ``z_to`` is reached, return to the start at ``z_to``, then cut the track.
+    """
+    total = track.length
+    if w.slope is None or total <= MIN_PIECE or z_from - z_to <= Z_EPS:
+        w.vertical(z_to)
+        w.run(track, 0.0, total, z_to, z_to)
+        return
+    w.vertical(z_from)
+    back = track.reversed()
+    left = (z_from - z_to) / w.slope
+    pos, forward, z = 0.0, True, z_from
+    while left > MIN_PIECE:
+        step = min(total - pos if forward else pos, left)
+        z_next = z_to if step >= left else z - step * w.slope
+        if forward:
+            w.run(track, pos, pos + step, z, z_next)
+        else:
+            w.run(back, total - pos, total - pos + step, z, z_next)
+        pos += step if forward else -step
+        left, z = left - step, z_next
+        if left > MIN_PIECE:
+            forward = not forward
+    w.run(back, total - pos, total, z_to, z_to)
+    w.run(track, 0.0, total, z_to, z_to)
+
+
+def _closed_pass(
+    w: _Writer,
+    track: Track,
+    s: float,
+    z_from: float,
+    z_to: float,
+    spans: Sequence[tuple[float, float]] = (),
+) -> float:
+    """One pass round a closed track from arc length ``s``; returns where it ended.
+
+    Without a ramp: go down at ``s`` and cut one loop at ``z_to``. With one: ramp
+    round the loop from ``s`` over ``L = Δz/tan(angle)``, then cut a whole loop at
+    ``z_to`` from there (the ramped stretch is cut again at full depth).
+    """
+    total = track.length
+    if w.slope is not None and z_from - z_to > Z_EPS:
+        ramp = (z_from - z_to) / w.slope
+        w.run(track, s, s + ramp, z_from, z_to, spans)
+        s += ramp
+    else:
+        w.vertical(z_to)
+    w.run(track, s, s + total, z_to, z_to, spans)
+    return (s + total) % total
+
+
+def _cut_closed(w: _Writer, cut: Cut, levels: Sequence[float]) -> None:
+    """All passes of one closed cut (with lead arcs and tabs when asked)."""
+    o = w.options
+    track = Track.of(cut.path)
+    if not track.segments:
+        return
+    spans: tuple[tuple[float, float], ...] = ()
+    if o.tabs > 0 and cut.outside_profile and cut.kind == "profile":
+        spans = tab_spans(track.length, o.tabs, o.tab_width + o.tool_diameter, where(cut.path))
+    if has_leads(cut, o.lead_in_mm):
+        lead_in, lead_out = lead_arcs(cut, o.lead_in_mm)
+        lead = Track.from_segments([lead_in], closed=False)
+        for z_from, z_to in pairwise((0.0, *levels)):
+            w.travel(*lead_in.start)
+            _enter_open(w, lead, z_from, z_to)
+            w.run(track, 0.0, track.length, z_to, z_to, spans)
+            w.cut(lead_out, None)
+            w.retract()
+        return
+    w.travel(*track.start)
+    if w.slope is not None:
+        w.vertical(0.0)
+    s = 0.0
+    for z_from, z_to in pairwise((0.0, *levels)):
+        s = _closed_pass(w, track, s, z_from, z_to, spans)
+    w.retract()
+
+
+def _cut_open(w: _Writer, cut: Cut, levels: Sequence[float]) -> None:
+    """All passes of one open cut: back and forth if it may be reversed, else from its start."""
+    track = Track.of(cut.path)
+    if not track.segments:
+        return
+    w.travel(*track.start)
+    for k, (z_from, z_to) in enumerate(pairwise((0.0, *levels))):
+        if k and cut.may_reverse:
+            track = track.reversed()
+        elif k:
+            w.travel(*track.start)
+        _enter_open(w, track, z_from, z_to)
+    w.retract()
+
+
+def _pocket_batch(w: _Writer, cuts: Sequence[Cut], first: int, levels: Sequence[float]) -> None:
+    """Pocket cuts of one group, level by level, re-entering each cut from safe Z."""
+    for z_from, z_to in pairwise((0.0, *levels)):
+        for number, cut in enumerate(cuts, start=first):
+            w.number = number
+            track = Track.of(cut.path)
+            if not track.segments:
+                continue
+            w.travel(*track.start)
+            if track.closed:
+                if w.slope is not None:
+                    w.vertical(z_from)
+                _closed_pass(w, track, 0.0, z_from, z_to)
+            else:
+                _enter_open(w, track, z_from, z_to)
+            w.retract()
