@@ -31,8 +31,8 @@ from __future__ import annotations
 
 import json
 import os
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -65,12 +65,11 @@ class BatchOptions:
         target: a target name or target ``.toml`` path (see ``camtool targets``).
         output_dir: where the outputs go (created when missing).
         machine_file: machine profile laid over the target's (file or built-in name).
-        offset: ``on``, ``outside`` or ``inside`` (:data:`camtool.toolpath.plan.OFFSET_MODES`).
-        tool_diameter: mm.
         feed_mm_min: cutting feed, mm/min; ``None``: the target's default.
         tolerance: chaining and curve-fit tolerance, mm.
-        scale: uniform scale about the drawing's origin.
-        fit_mm: ``(width, height)`` mm to fit each drawing into instead of ``scale``.
+        plan: the other planning options, as
+            :class:`~camtool.toolpath.options.PlanOptions` fields (``offset``,
+            ``tool_diameter``, ``scale``, ``fit_mm``, ``depth``, ``order``...).
         fmt: the dialect's output format (``None``: its default).
         spindle_rpm: rev/min; ``None``: the target's; 0: no spindle commands.
         layers: layers to keep (``None``: all).
@@ -93,12 +92,9 @@ class BatchOptions:
     target: str
     output_dir: Path
     machine_file: Path | None = None
-    offset: str = "on"
-    tool_diameter: float = 0.0
     feed_mm_min: float | None = None
     tolerance: float = 0.001
-    scale: float = 1.0
-    fit_mm: tuple[float, float] | None = None
+    plan: Mapping[str, Any] = field(default_factory=dict)
     fmt: str | None = None
     spindle_rpm: float | None = None
     layers: tuple[str, ...] | None = None
@@ -141,12 +137,9 @@ class BatchOptions:
     def post_options(self) -> dict[str, Any]:
         """Keyword options of :func:`camtool.pipeline.post_drawing`."""
         return {
-            "offset": self.offset,
-            "tool_diameter": self.tool_diameter,
+            **self.plan,
             "feed_mm_min": self.feed_mm_min,
             "tolerance": self.tolerance,
-            "scale": self.scale,
-            "fit_mm": self.fit_mm,
             "fmt": self.fmt,
             "spindle_rpm": self.spindle_rpm,
         }
@@ -247,20 +240,14 @@ def plan_batch(inputs: Sequence[str], options: BatchOptions) -> BatchPlan:
             outputs without ``force`` (the first :data:`SHOWN_EXISTING` named).
         InputError: an input matches nothing, or the target/machine file is invalid.
     """
+    from camtool.pipeline import plan_options
     from camtool.post.registry import load_target
-    from camtool.toolpath.plan import PlanOptions
 
     target = load_target(options.target, machine_file=options.machine_file)
     fmt = target.post.check_format(options.fmt)
-    PlanOptions(  # validates the post options once, before any file
-        offset=options.offset,
-        tool_diameter=options.tool_diameter,
-        feed_mm_min=(
-            target.default_feed_mm_min if options.feed_mm_min is None else options.feed_mm_min
-        ),
-        tolerance=options.tolerance,
-        scale=options.scale,
-        fit_mm=options.fit_mm,
+    plan_options(  # validates the post options once, before any file
+        target,
+        **{k: v for k, v in options.post_options().items() if k not in ("fmt", "spindle_rpm")},
     )
     if options.output_dir.exists() and not options.output_dir.is_dir():
         raise UsageError(f"{options.output_dir}: exists and is not a directory (-o OUTDIR)")

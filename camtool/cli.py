@@ -31,6 +31,7 @@ if TYPE_CHECKING:
 
     from camtool.geometry import Drawing
     from camtool.post.registry import TargetEntry
+    from camtool.toolpath.plan import PlanReport
     from camtool.verify.verifier import Verification
 
 
@@ -117,6 +118,9 @@ def post(
     else:
         job = post_path(drawing, chosen, import_options=settings, **options)
     warn(job.warnings)
+    if job.plan is not None:
+        for line in job.plan.notes():
+            click.echo(f"camtool: {line}", err=True)
     if isinstance(job.result.code, bytes) and output == "-" and sys.stdout.isatty():
         raise UsageError(
             f"{chosen.name} writes binary code: give -o FILE{chosen.post.suffix} or "
@@ -135,6 +139,7 @@ def post(
             max_error_um,
             drawing=job.placed,
             edge_radius_mm=job.edge_radius_mm,
+            plan=job.plan,
         )
 
 
@@ -196,15 +201,22 @@ def _finish_verification(
     *,
     drawing: Drawing | None = None,
     edge_radius_mm: float = 0.0,
+    plan: PlanReport | None = None,
 ) -> None:
-    """Summary to stderr, then the report and preview files, then the limit check."""
+    """Summary to stderr, then the report and preview files, then the limit check.
+
+    The report gets a ``plan`` key (what planning found) when the code was planned here.
+    """
     from camtool.verify.verifier import report_dict, summary_lines
 
     warn(v.warnings)
     for line in summary_lines(v):
         click.echo(f"camtool: {line}", err=True)
     if report is not None:
-        write_output(json.dumps(report_dict(v), indent=2) + "\n", report)
+        data = report_dict(v)
+        if plan is not None:
+            data["plan"] = plan.to_json()
+        write_output(json.dumps(data, indent=2) + "\n", report)
     if preview is not None:
         from camtool.preview_trace import write_trace_preview
 

@@ -80,9 +80,13 @@ def batch(inputs: tuple[str, ...], layers: str | None, verify_too: bool, **optio
     """
     from camtool.batch import BatchOptions, plan_batch
     from camtool.batch_report import batch_report, failure_line, summary_table
+    from camtool.toolpath.options import PLAN_FIELDS
 
     names = tuple(n.strip() for n in layers.split(",") if n.strip()) if layers else None
-    plan = plan_batch(inputs, BatchOptions(layers=names, verify=verify_too, **options))
+    planning = {k: options.pop(k) for k in list(options) if k in PLAN_FIELDS}
+    plan = plan_batch(
+        inputs, BatchOptions(layers=names, verify=verify_too, plan=planning, **options)
+    )
     result = _run(plan)
     click.echo(summary_table(result), err=True, nl=False)
     if options["report"] is not None:

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from camtool.errors import CamtoolError, InputError
-from camtool.toolpath.plan import OFFSET_MODES
+from camtool.toolpath.options import DIRECTIONS, OFFSET_MODES, ORDERS, POCKET_STYLES
 
 if TYPE_CHECKING:
     from camtool.geometry import Drawing
@@ -109,14 +109,141 @@ _POST_OPTIONS = (
         default="on",
         show_default=True,
         help="Tool-centre side: 'on' follows the drawing (scribing point); 'outside'/"
-        "'inside' compensate by half the tool diameter.",
+        "'inside' compensate by half the tool diameter (holes to their correct side); "
+        "'pocket' clears the inside of closed contours around their islands.",
     ),
     click.option(
         "--tool-diameter",
         type=float,
         default=0.0,
         metavar="MM",
-        help="Tool diameter in mm (needed by --offset outside|inside).",
+        help="Tool diameter in mm (needed by every --offset but 'on').",
+    ),
+    click.option(
+        "--direction",
+        type=click.Choice(DIRECTIONS),
+        default=None,
+        help="Cutting direction of closed contours for a clockwise (M03) spindle "
+        "[default: climb when compensating; the drawn direction with --offset on].",
+    ),
+    click.option(
+        "--stepover",
+        type=float,
+        default=0.4,
+        show_default=True,
+        metavar="FRACTION",
+        help="Pocket step-over as a fraction of the tool diameter.",
+    ),
+    click.option(
+        "--pocket",
+        type=click.Choice(POCKET_STYLES),
+        default="concentric",
+        show_default=True,
+        help="Pocket style: concentric offsets (wall first, innermost last) or zigzag lines.",
+    ),
+    click.option(
+        "--pocket-angle",
+        "pocket_angle_deg",
+        type=float,
+        default=0.0,
+        show_default=True,
+        metavar="DEG",
+        help="Angle of the zigzag lines, degrees counter-clockwise from +X.",
+    ),
+    click.option(
+        "--depth",
+        type=float,
+        default=None,
+        metavar="MM",
+        help="Cut depth below the top (Z 0), mm; Z targets only. Without it no Z is written.",
+    ),
+    click.option(
+        "--step-down",
+        type=float,
+        default=None,
+        metavar="MM",
+        help="Depth of each pass, mm [default: one pass at --depth].",
+    ),
+    click.option(
+        "--safe-z",
+        type=float,
+        default=2.0,
+        show_default=True,
+        metavar="MM",
+        help="Height of every rapid when --depth is given, mm above the top.",
+    ),
+    click.option(
+        "--plunge-feed",
+        "plunge_feed_mm_min",
+        type=float,
+        default=None,
+        metavar="MM_PER_MIN",
+        help="Feed of Z moves into the material [default: half the cutting feed].",
+    ),
+    click.option(
+        "--ramp",
+        "ramp_angle_deg",
+        type=float,
+        default=None,
+        metavar="DEG",
+        help="Enter each pass descending along the path at DEG from the horizontal, "
+        "instead of plunging (targets that move X, Y and Z together).",
+    ),
+    click.option(
+        "--tabs",
+        type=click.IntRange(min=0),
+        default=0,
+        show_default=True,
+        metavar="N",
+        help="Holding tabs per outside profile (needs --depth and --offset outside).",
+    ),
+    click.option(
+        "--tab-width",
+        type=float,
+        default=2.0,
+        show_default=True,
+        metavar="MM",
+        help="Tab length along the part edge, mm.",
+    ),
+    click.option(
+        "--tab-height",
+        type=float,
+        default=0.5,
+        show_default=True,
+        metavar="MM",
+        help="Tab height above the final depth, mm.",
+    ),
+    click.option(
+        "--order",
+        type=click.Choice(ORDERS),
+        default="travel",
+        show_default=True,
+        help="Cutting order (holes always before the contour around them): 'travel' "
+        "shortens rapids; 'reversals' minimises axis reversals weighted by the machine's "
+        "backlash; 'mirror' cuts a symmetric part half by half from one shared point.",
+    ),
+    click.option(
+        "--lead-in",
+        "lead_in_mm",
+        type=float,
+        default=0.0,
+        show_default=True,
+        metavar="MM",
+        help="Radius of tangent lead-in/lead-out arcs on closed profiles (targets with arcs).",
+    ),
+    click.option(
+        "--close-gap",
+        type=float,
+        default=0.02,
+        show_default=True,
+        metavar="MM",
+        help="Close contours whose ends are at most this far apart (with a warning); 0: never.",
+    ),
+    click.option(
+        "--fit-arcs/--no-fit-arcs",
+        default=True,
+        show_default=True,
+        help="Fit arcs to dense polylines within --tolerance (G02/G03 instead of many G01).",
     ),
     click.option(
         "--feed",
@@ -132,7 +259,8 @@ _POST_OPTIONS = (
         default=0.001,
         show_default=True,
         metavar="MM",
-        help="Entity ends closer than this (mm) are chained into one contour.",
+        help="Entity ends closer than this (mm) are chained into one contour; fitted arcs "
+        "stay this close to what they replace.",
     ),
     click.option(
         "--scale",

@@ -12,7 +12,8 @@ from camtool.importers import ImportOptions, read_drawing
 from camtool.post.base import PostResult, Target
 from camtool.post.registry import load_target
 from camtool.program import Move, Program
-from camtool.toolpath.plan import PlanOptions, place, plan
+from camtool.toolpath.options import drawing_only
+from camtool.toolpath.plan import PlanOptions, PlanReport, place, plan_drawing
 
 if TYPE_CHECKING:
     from camtool.verify.verifier import Verification
@@ -30,7 +31,8 @@ class PostJob:
         placed: the drawing as placed on the machine (after ``scale``/``fit_mm``),
             in the program's coordinates.
         edge_radius_mm: how far the cut edge lies from the tool path: half the tool
-            diameter for ``outside``/``inside`` offsets, 0 for paths on the line.
+            diameter for ``outside``/``inside``/``pocket``, 0 for paths on the line.
+        plan: what planning did and found (``None`` for a re-posted program).
     """
 
     drawing: Drawing | None
@@ -39,6 +41,7 @@ class PostJob:
     result: PostResult
     placed: Drawing | None
     edge_radius_mm: float = 0.0
+    plan: PlanReport | None = None
 
     @property
     def warnings(self) -> tuple[str, ...]:
@@ -70,15 +73,6 @@ def post_file(
     return post_path(path, target, import_options=import_options, **options)
 
 
-_DRAWING_ONLY = (
-    ("--offset", "offset", "on"),
-    ("--tool-diameter", "tool_diameter", 0.0),
-    ("--scale", "scale", 1.0),
-    ("--fit", "fit_mm", None),
-)
-"""Options that shape a drawing's toolpath: (flag, keyword, default)."""
-
-
 def post_path(
     path: str | Path,
     target: Target,
@@ -104,11 +98,11 @@ def post_path(
     """
     if not is_program_file(path):
         return post_drawing(read_drawing(path, import_options), target, **options)
-    given = [flag for flag, key, default in _DRAWING_ONLY if options.get(key, default) != default]
+    given = drawing_only(options)
     if given:
         raise UsageError(
             f"{path} is already a toolpath (G-code): {', '.join(given)} only apply to "
-            "drawings; offset or scale it in the program that wrote it"
+            "drawings; plan it in the program that wrote it"
         )
     from camtool.importers.gcode import read_gcode
 
@@ -209,50 +203,72 @@ def _flatten(program: Program, target: str) -> Program:
     )
 
 
+def plan_options(target: Target, **options: Any) -> PlanOptions:
+    """The :class:`PlanOptions` for ``target``: its default feed, checked against what it can do.
+
+    Args:
+        target: the target the plan is for.
+        **options: :class:`PlanOptions` fields; ``feed_mm_min`` ``None`` (or left
+            out) takes the target's default feed.
+
+    Raises:
+        UsageError: invalid options, or options the target cannot carry out:
+            depth options for a machine without Z, lead-in arcs on a target that
+            writes arcs as chords, a ramp on a target that moves Z in its own block.
+    """
+    feed = options.pop("feed_mm_min", None)
+    plan = PlanOptions(feed_mm_min=target.default_feed_mm_min if feed is None else feed, **options)
+    if plan.z_options() and not target.machine.has_z:
+        raise UsageError(
+            f"{', '.join(plan.z_options())}: {target.name} has no programmable Z axis "
+            f"({target.machine.name} is 2D); set the depth by hand on the machine and "
+            "leave these options out"
+        )
+    if plan.lead_in_mm > 0 and not target.post.arcs:
+        raise UsageError(
+            f"--lead-in: {target.name} writes arcs as chords; lead-in arcs are for targets "
+            "with arcs (leave --lead-in out)"
+        )
+    if plan.ramp_angle_deg is not None and not target.post.z_with_xy:
+        raise UsageError(
+            f"--ramp: {target.name} moves Z in a block of its own, so it cannot descend "
+            "along the path; leave --ramp out (the tool plunges straight down)"
+        )
+    return plan
+
+
 def post_drawing(
     drawing: Drawing,
     target: Target,
     *,
-    offset: str = "on",
-    tool_diameter: float = 0.0,
-    feed_mm_min: float | None = None,
-    tolerance: float = 0.001,
-    scale: float = 1.0,
-    fit_mm: tuple[float, float] | None = None,
     fmt: str | None = None,
     spindle_rpm: float | None = None,
+    **options: Any,
 ) -> PostJob:
     """Plan a drawing and post it for a target.
 
     Args:
         drawing: the imported drawing, mm.
         target: the target (see :func:`camtool.post.registry.load_target`).
-        offset: ``on``, ``outside`` or ``inside`` (see :mod:`camtool.toolpath.plan`).
-        tool_diameter: tool diameter, mm.
-        feed_mm_min: cutting feed, mm/min; ``None`` takes the target's default.
-        tolerance: chaining tolerance, mm.
-        scale: uniform scale of the drawing about its origin.
-        fit_mm: scale the drawing to fit ``(width, height)`` mm instead.
         fmt: the dialect's output format (``None``: its default).
         spindle_rpm: spindle speed, rev/min; ``None`` takes the target's
             ``spindle_rpm`` (which may be none), 0 programs no spindle.
+        **options: :class:`~camtool.toolpath.options.PlanOptions` fields
+            (``offset``, ``tool_diameter``, ``feed_mm_min`` — ``None`` takes the
+            target's —, ``tolerance``, ``scale``, ``fit_mm``, ``depth``, ``order``...).
 
     Raises:
         CamtoolError: from any stage, with its exit code.
     """
-    options = PlanOptions(
-        offset=offset,
-        tool_diameter=tool_diameter,
-        feed_mm_min=target.default_feed_mm_min if feed_mm_min is None else feed_mm_min,
-        tolerance=tolerance,
-        scale=scale,
-        fit_mm=fit_mm,
+    plan = plan_options(target, **options)
+    planned = plan_drawing(drawing, plan, target.machine, helix=target.post.helix)
+    program = _with_spindle(
+        planned.program, target.spindle_rpm if spindle_rpm is None else spindle_rpm
     )
-    program = plan(drawing, options)
-    program = _with_spindle(program, target.spindle_rpm if spindle_rpm is None else spindle_rpm)
-    edge = tool_diameter / 2.0 if offset != "on" else 0.0
+    edge = plan.radius if plan.offset != "on" else 0.0
     result = target.emit(program, fmt=fmt)
-    return PostJob(drawing, program, target, result, place(drawing, options), edge)
+    placed = place(drawing, plan)
+    return PostJob(drawing, program, target, result, placed, edge, planned.report)
 
 
 def verify_job(job: PostJob) -> Verification:

@@ -1,18 +1,36 @@
-"""Cutting order: contours inside others first, otherwise nearest first.
+"""Cutting order: nesting of contours, and the order, starts and directions of the cuts.
 
 Nesting is found with shapely on the contours' polylines (arcs as chords within
 a fine tolerance): a contour lies inside a closed contour when the closed
-contour's polygon contains it. Among the contours whose inner contours are all
-cut, the one whose start is nearest the tool goes next (greedy nearest
-neighbour from the origin). Each contour keeps its drawn direction and start.
+contour's polygon contains it. Every order cuts a contour's inner contours
+before it (inside before outside) and keeps the pocket stage's order of one
+group's pocket cuts (:func:`camtool.toolpath.travel.precedence`).
+
+:func:`order_cuts` offers three orders (``--order``):
+
+- ``travel``: short rapids, nearest neighbour then 2-opt
+  (:mod:`camtool.toolpath.travel`);
+- ``reversals``: few axis direction reversals weighted by the machine's
+  backlash, seed-000 §5.3 (:mod:`camtool.toolpath.reversals`);
+- ``mirror``: symmetric parts cut half by half from a shared point, seed-000
+  S000-20 (:mod:`camtool.toolpath.mirror`).
+
+and reports the reversal counts and rapid travel of the drawn order, the travel
+order and the planned one.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Any
 
 from camtool.geometry import Contour, Point, distance
+from camtool.toolpath.cuts import Cut, Finding
+from camtool.toolpath.options import PlanOptions
+from camtool.toolpath.reversals import count_reversals, reversal_order
+from camtool.toolpath.travel import Step, drawn_order, oriented, precedence, travel_order
 
 _NEST_TOLERANCE_MM = 1e-4
 
@@ -60,31 +78,155 @@ def nesting(contours: Sequence[Contour]) -> Nesting:
     return Nesting(tuple(parents))
 
 
-def order_contours(
-    contours: Sequence[Contour], nest: Nesting, start: Point = (0.0, 0.0)
-) -> list[int]:
-    """Indices of ``contours`` in cutting order.
+SMALL_PART_MM = 1.0
+"""Parts smaller than this (bounding box of the cuts) fail after about 16 compensations."""
+MAX_REVERSALS_SMALL = 16
+"""Reversals above which a small part is warned about (seed-000 S000-19, L3205–L3211)."""
 
-    A contour is cut only after every contour inside it; among those ready, the
-    one whose start point is nearest the current tool position goes next (ties
-    to the earlier index).
+ORDER_KEYS = ("drawn", "travel", "planned")
+"""Keys of :attr:`Ordering.reversals` and :attr:`Ordering.travel_mm`."""
+
+
+@dataclass(frozen=True)
+class Ordering:
+    """The cutting order and what it costs.
+
+    Attributes:
+        cuts: cuts in cutting order, each rotated/reversed (or split, for
+            ``mirror``) as it will be cut.
+        mode: the ``--order`` that made it.
+        reversals: ``(x, y)`` axis reversals (:func:`~camtool.toolpath.reversals.count_reversals`,
+            rapids included) for the ``"drawn"`` order (as given, inside before
+            outside), the ``"travel"`` order and the ``"planned"`` one.
+        travel_mm: rapid travel of the same three, mm (origin → first start included).
+        mirror_axis: the mirror line for ``mirror`` (``"x = 5.0000"``, mm), else ``None``.
+        mirror_point: the shared start point Ie of ``mirror``, mm, else ``None``.
+        findings: what the user must know about the order.
+    """
+
+    cuts: tuple[Cut, ...]
+    mode: str
+    reversals: Mapping[str, tuple[int, int]]
+    travel_mm: Mapping[str, float]
+    mirror_axis: str | None = None
+    mirror_point: Point | None = None
+    findings: tuple[Finding, ...] = field(default=())
+
+    def summary(self) -> list[str]:
+        """One or two lines for stderr: reversals and rapids before and after."""
+        d, t, p = (self.reversals[k] for k in ORDER_KEYS)
+        rapids = f"rapids {self.travel_mm['drawn']:.3f} → {self.travel_mm['planned']:.3f} mm"
+        if self.mode == "travel":
+            return [f"order travel: {rapids}; X/Y reversals {p[0]}/{p[1]}"]
+        text = (
+            f"order {self.mode}: X/Y reversals {d[0]}/{d[1]} → {p[0]}/{p[1]} "
+            f"(travel order {t[0]}/{t[1]}); {rapids}"
+        )
+        if self.mirror_point is None:
+            return [text]
+        x, y = self.mirror_point
+        return [text, f"  mirror about {self.mirror_axis} mm from ({x:.4f}, {y:.4f}) mm"]
+
+    def to_json(self) -> dict[str, Any]:
+        """``{"mode", "reversals": {key: {"x", "y"}}, "travel_mm": {key: mm}, "mirror_axis"}``."""
+        return {
+            "mode": self.mode,
+            "reversals": {k: {"x": v[0], "y": v[1]} for k, v in self.reversals.items()},
+            "travel_mm": dict(self.travel_mm),
+            "mirror_axis": self.mirror_axis,
+            "mirror_point": self.mirror_point,
+        }
+
+
+def order_cuts(
+    cuts: Sequence[Cut], nest: Nesting, options: PlanOptions, backlash_um: tuple[float, float]
+) -> Ordering:
+    """Order the cuts as ``options.order`` asks, inside before outside.
 
     Args:
-        contours: contours in mm.
-        nest: their containment, from :func:`nesting`.
-        start: tool position before the first contour, mm.
+        cuts: the compensated or pocket cuts, mm; ``cut.group`` indexes ``nest``.
+        nest: containment of the groups (:func:`nesting`).
+        options: ``order``, ``origin`` (tool position before the first cut, mm)
+            and ``tolerance`` (how far a mirror image may be, mm) are used.
+        backlash_um: ``(bx, by)`` reversal weight of each axis, µm (the machine's
+            backlash; both 0 when unknown: every reversal weighs 1).
+
+    Returns:
+        The order, with the reversal counts and rapids of the drawn, travel and
+        planned orders, and a finding when a part under 1 mm still needs more
+        than 16 reversals outside mirror order (seed-000 S000-19).
+
+    Raises:
+        ToolpathError: ``mirror`` on a drawing symmetric about neither axis.
     """
-    inside: list[set[int]] = [set() for _ in contours]
-    for i, parents in enumerate(nest.parents):
-        for j in parents:
-            inside[j].add(i)
-    done: set[int] = set()
-    order: list[int] = []
-    here = start
-    while len(order) < len(contours):
-        ready = [i for i in range(len(contours)) if i not in done and inside[i] <= done]
-        nxt = min(ready, key=lambda i: (distance(here, contours[i].start), i))
-        order.append(nxt)
-        done.add(nxt)
-        here = contours[nxt].end
-    return order
+    origin = options.origin
+    before = precedence(cuts, nest.parents)
+    drawn_seq = drawn_order(cuts, before)
+    travel_seq = travel_order(cuts, before, origin)
+    sequences = {"drawn": _cuts(cuts, drawn_seq), "travel": _cuts(cuts, travel_seq)}
+    axis: str | None = None
+    point: Point | None = None
+    findings: list[Finding] = []
+    if options.order == "travel":
+        sequences["planned"] = sequences["travel"]
+    elif options.order == "reversals":
+        allowed = [drawn_seq]
+        if not any(rev and not cuts[i].path.closed for i, _, rev in travel_seq):
+            allowed.append(travel_seq)
+        planned = reversal_order(cuts, before, origin, backlash_um, allowed)
+        sequences["planned"] = _cuts(cuts, planned)
+    else:
+        from camtool.toolpath.mirror import mirror_order
+
+        depth = [nest.depth(cut.group) for cut in cuts]
+        plan = mirror_order(cuts, before, depth, origin, options.tolerance)
+        sequences["planned"] = plan.cuts
+        axis, point = plan.axis, plan.point
+        findings.extend(plan.findings)
+    reversals = {k: count_reversals(v, origin) for k, v in sequences.items()}
+    travel = {k: _rapids(v, origin) for k, v in sequences.items()}
+    findings.extend(_small_part(sequences["planned"], reversals["planned"], options.order))
+    return Ordering(
+        tuple(sequences["planned"]),
+        options.order,
+        MappingProxyType(reversals),
+        MappingProxyType(travel),
+        axis,
+        point,
+        tuple(findings),
+    )
+
+
+def _cuts(cuts: Sequence[Cut], seq: Sequence[Step]) -> tuple[Cut, ...]:
+    return tuple(oriented(cuts[i], k, rev) for i, k, rev in seq)
+
+
+def _rapids(cuts: Sequence[Cut], origin: Point) -> float:
+    here, total = origin, 0.0
+    for cut in cuts:
+        total += distance(here, cut.path.start)
+        here = cut.path.end
+    return total
+
+
+def _small_part(cuts: Sequence[Cut], counts: tuple[int, int], mode: str) -> list[Finding]:
+    """seed-000 S000-19 (L3205–L3211): a part under 1 mm fails after about 16 compensations."""
+    if not cuts or mode == "mirror" or sum(counts) <= MAX_REVERSALS_SMALL:
+        return []
+    boxes = [c.path.bbox() for c in cuts]
+    x0, y0 = min(b[0] for b in boxes), min(b[1] for b in boxes)
+    x1, y1 = max(b[2] for b in boxes), max(b[3] for b in boxes)
+    size = max(x1 - x0, y1 - y0)
+    if size >= SMALL_PART_MM:
+        return []
+    better = "--order mirror" if mode == "reversals" else "--order reversals or --order mirror"
+    return [
+        Finding(
+            "ordering",
+            f"order {mode}: {sum(counts)} axis reversals (X {counts[0]}, Y {counts[1]}) on a "
+            f"part of {size:.3f} mm: parts under {SMALL_PART_MM:g} mm fail after about "
+            f"{MAX_REVERSALS_SMALL} backlash compensations (seed-000 §5.3); try {better}",
+            None,
+            float(sum(counts)),
+        )
+    ]

@@ -1,4 +1,4 @@
-"""Plan a drawing into a Program: chain, offset for the tool, order, emit moves.
+"""Plan a drawing into a Program: chain, close, fit, compensate or pocket, order, emit.
 
 Offset modes (the ``--offset`` option):
 
@@ -6,97 +6,164 @@ Offset modes (the ``--offset`` option):
   a point, seed-000 §6; S000-09);
 - ``outside``: cut outside the material. Material is the even-odd region of the
   closed contours: an outer boundary (even nesting depth) grows by the tool
-  radius, a hole (odd depth) shrinks by it;
-- ``inside``: the opposite side: outer boundaries shrink, holes grow.
+  radius, a hole (odd depth) shrinks by it (:mod:`~camtool.toolpath.compensate`);
+- ``inside``: the opposite side: outer boundaries shrink, holes grow;
+- ``pocket``: clear the inside of each outer boundary down to its islands
+  (:mod:`~camtool.toolpath.pocket`).
 
 Open contours cannot be compensated to a side; they are cut on the line with a
-warning when a side was asked for.
+warning when a side was asked for. The stages report what they found (closed gaps,
+offsets that vanished, corners the tool cannot reach, uncut pocket area, reversals
+before and after ordering) in :class:`PlanReport`.
 """
 
 from __future__ import annotations
 
 import math
+from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 from camtool.errors import UsageError
-from camtool.geometry import Arc, Contour, Drawing, Point
-from camtool.program import ArcMove, Linear, Move, Program, Rapid
-from camtool.toolpath.chain import chain
-from camtool.toolpath.order import Nesting, nesting, order_contours
+from camtool.geometry import Contour, Drawing, Line, Segment
+from camtool.program import Program
+from camtool.toolpath.arcfit import FitStats, fit_polyline, fit_stats
+from camtool.toolpath.chain import chain, close_gaps
+from camtool.toolpath.cuts import Finding, Stage
+from camtool.toolpath.options import OFFSET_MODES, PlanOptions
+from camtool.toolpath.order import Ordering, nesting, order_cuts
 
-OFFSET_MODES = ("on", "outside", "inside")
-"""Valid values of ``PlanOptions.offset``."""
+if TYPE_CHECKING:
+    from camtool.machine import Machine
+
+__all__ = ["OFFSET_MODES", "Plan", "PlanOptions", "PlanReport", "place", "plan", "plan_drawing"]
+
+MIN_FIT_RUN = 6
+"""Shortest run of consecutive lines (edges) that arc fitting tries to replace."""
 
 
-@dataclass(frozen=True, kw_only=True)
-class PlanOptions:
-    """How to turn a drawing into a toolpath.
+@dataclass(frozen=True)
+class PlanReport:
+    """What planning did and found (the ``plan`` key of the verify report).
 
     Attributes:
-        offset: one of :data:`OFFSET_MODES`.
-        tool_diameter: tool diameter, mm (needed for ``outside``/``inside``).
-        feed_mm_min: cutting feed, mm/min (> 0).
-        tolerance: chaining tolerance, mm (> 0): ends closer than this meet.
-        origin: tool position before the program, mm.
-        scale: uniform scale applied to the drawing about its origin (> 0).
-        fit_mm: ``(width, height)``: scale the drawing uniformly, about the
-            lower-left corner of its bounding box, to the largest size that fits
-            this box. Excludes ``scale``.
+        contours: contours after chaining and closing.
+        cuts: tool paths after compensation or pocketing (before passes).
+        findings: everything the user must know, in stage order.
+        ordering: the cutting order and its reversal and travel counts.
+        fit: what arc fitting of dense polylines saved (``None`` when off).
     """
 
-    offset: str = "on"
-    tool_diameter: float = 0.0
-    feed_mm_min: float
-    tolerance: float = 0.001
-    origin: Point = (0.0, 0.0)
-    scale: float = 1.0
-    fit_mm: tuple[float, float] | None = None
+    contours: int
+    cuts: int
+    findings: tuple[Finding, ...]
+    ordering: Ordering
+    fit: FitStats | None
 
-    def __post_init__(self) -> None:
-        if self.offset not in OFFSET_MODES:
-            raise UsageError(
-                f"unknown offset {self.offset!r}; choose one of {', '.join(OFFSET_MODES)}"
-            )
-        if self.offset != "on" and self.tool_diameter <= 0:
-            raise UsageError(f"--offset {self.offset} needs --tool-diameter MM (> 0)")
-        if self.tool_diameter < 0:
-            raise UsageError(f"tool diameter must be ≥ 0 mm, got {self.tool_diameter!r}")
-        if self.feed_mm_min <= 0:
-            raise UsageError(f"feed must be > 0 mm/min, got {self.feed_mm_min!r}")
-        if self.tolerance <= 0:
-            raise UsageError(f"tolerance must be > 0 mm, got {self.tolerance!r}")
-        if self.scale <= 0:
-            raise UsageError(f"scale must be > 0, got {self.scale!r}")
-        if self.fit_mm is not None:
-            if self.scale != 1.0:
-                raise UsageError("give either --scale or --fit, not both")
-            if min(self.fit_mm) <= 0:
-                raise UsageError(f"--fit needs a width and height > 0 mm, got {self.fit_mm!r}")
+    def notes(self) -> list[str]:
+        """The ordering and arc-fit summaries, for stderr (the findings are warnings)."""
+        lines = list(self.ordering.summary())
+        if self.fit is not None and self.fit.replaced > self.fit.segments:
+            lines.append(f"{self.fit.summary()}: {self.fit.saved} fewer moves")
+        return lines
+
+    def to_json(self) -> dict[str, Any]:
+        """A JSON-ready dict: counts per finding kind, the findings, order, fit."""
+        fit = None
+        if self.fit is not None:
+            fit = {"replaced": self.fit.replaced, "arcs": self.fit.arcs, "lines": self.fit.lines}
+        return {
+            "contours": self.contours,
+            "cuts": self.cuts,
+            "counts": dict(Counter(f.kind for f in self.findings)),
+            "findings": [
+                {"kind": f.kind, "message": f.message, "at": f.at, "value": f.value}
+                for f in self.findings
+            ],
+            "order": self.ordering.to_json(),
+            "arc_fit": fit,
+        }
 
 
-def plan(drawing: Drawing, options: PlanOptions) -> Program:
-    """Turn a drawing into a program of rapids and cuts.
+@dataclass(frozen=True)
+class Plan:
+    """A planned program and its report."""
 
-    Contours are chained within ``options.tolerance``, compensated for the tool
-    (see the module docstring), ordered inside-first then nearest-first, and
-    each is reached by one rapid to its start.
+    program: Program
+    report: PlanReport
+
+
+def plan(drawing: Drawing, options: PlanOptions, machine: Machine | None = None) -> Program:
+    """Turn a drawing into a program of rapids and cuts (see :func:`plan_drawing`)."""
+    return plan_drawing(drawing, options, machine).program
+
+
+def plan_drawing(
+    drawing: Drawing,
+    options: PlanOptions,
+    machine: Machine | None = None,
+    *,
+    helix: bool = True,
+) -> Plan:
+    """Turn a drawing into a program and say what planning found.
+
+    Contours are placed (scale/fit), chained and closed within the tolerances,
+    dense polylines fitted with arcs, compensated for the tool or pocketed,
+    ordered (inside before outside always) and emitted with depth passes, tabs
+    and lead-ins. The findings also become the program's warnings.
+
+    Args:
+        drawing: the imported drawing, mm.
+        options: the planning options.
+        machine: the target's machine: its backlash weighs ``--order reversals``
+            and a machine without Z refuses the depth options.
+        helix: the target writes arcs that move Z; ``False`` ramps down arcs as
+            chords within the tolerance.
 
     Raises:
-        UsageError: invalid options.
-        ToolpathError: an offset fails or leaves nothing.
+        UsageError: invalid options, or depth options for a machine without Z.
+        ToolpathError: a stage cannot plan the drawing (names the contour).
     """
+    from camtool.toolpath.passes import emit_moves
+
+    if machine is not None and not machine.has_z and options.z_options():
+        raise UsageError(
+            f"{', '.join(options.z_options())}: the {machine.name} has no programmable Z "
+            "axis (2D target); set the depth by hand on the machine and leave these out"
+        )
     contours = chain(place(drawing, options).contours, options.tolerance)
+    contours, found = close_gaps(contours, options.close_gap, options.tolerance)
+    findings = list(found)
+    stats = None
+    if options.fit_arcs:
+        contours, stats = fit_dense(contours, options.tolerance)
     nest = nesting(contours)
-    warnings = list(drawing.warnings)
-    paths = list(contours)
-    if options.offset != "on":
-        paths = _compensate(contours, nest, options, warnings)
-    order = order_contours(paths, nest, options.origin)
-    moves: list[Move] = []
-    for number, index in enumerate(order, start=1):
-        moves.extend(_contour_moves(paths[index], number, options.feed_mm_min))
-    return Program(tuple(moves), options.origin, tuple(warnings))
+    stage = _stage(contours, nest, options)
+    findings.extend(stage.findings)
+    backlash = (0.0, 0.0) if machine is None else _backlash_weights(machine)
+    ordering = order_cuts(stage.cuts, nest, options, backlash)
+    findings.extend(ordering.findings)
+    moves = emit_moves(ordering.cuts, options, helix=helix)
+    report = PlanReport(len(contours), len(stage.cuts), tuple(findings), ordering, stats)
+    warnings = tuple(dict.fromkeys((*drawing.warnings, *(f.message for f in findings))))
+    return Plan(Program(tuple(moves), options.origin, warnings), report)
+
+
+def _stage(contours: Sequence[Contour], nest: Any, options: PlanOptions) -> Stage:
+    if options.offset == "pocket":
+        from camtool.toolpath.pocket import pocket
+
+        return pocket(contours, nest, options)
+    from camtool.toolpath.compensate import compensate
+
+    return compensate(contours, nest, options)
+
+
+def _backlash_weights(machine: Machine) -> tuple[float, float]:
+    """Per-axis weight of a reversal: the larger of true backlash and compensation, µm."""
+    b = machine.backlash
+    return (max(b.true_um[0], b.compensation_um[0]), max(b.true_um[1], b.compensation_um[1]))
 
 
 def place(drawing: Drawing, options: PlanOptions) -> Drawing:
@@ -111,36 +178,45 @@ def place(drawing: Drawing, options: PlanOptions) -> Drawing:
     return drawing.transformed(k, x0 * (1 - k), y0 * (1 - k))
 
 
-def _compensate(
-    contours: Sequence[Contour], nest: Nesting, options: PlanOptions, warnings: list[str]
-) -> list[Contour]:
-    from camtool.toolpath.offset import offset_contour
+def fit_dense(contours: Sequence[Contour], tolerance: float) -> tuple[list[Contour], FitStats]:
+    """Replace runs of :data:`MIN_FIT_RUN` or more lines by arcs and lines within ``tolerance``.
 
-    radius = options.tool_diameter / 2.0
+    A run's end points stay exact (they are corners or meet arcs); corners inside a
+    run are kept by :func:`~camtool.toolpath.arcfit.fit_polyline`. A run is replaced
+    only when the fit has fewer segments.
+
+    Returns:
+        The contours (unchanged objects where nothing was saved) and the total
+        :class:`FitStats` (``replaced`` counts the lines of the replaced runs).
+    """
+    total = FitStats(0, 0, 0)
     out: list[Contour] = []
-    open_count = 0
-    for i, c in enumerate(contours):
-        if not c.closed:
-            open_count += 1
-            out.append(c)
-            continue
-        outer = nest.depth(i) % 2 == 0
-        grow = outer == (options.offset == "outside")
-        out.append(offset_contour(c, radius if grow else -radius))
-    if open_count:
-        warnings.append(
-            f"{open_count} open contour(s) cut on the line: --offset {options.offset} needs "
-            "closed contours"
+    for contour in contours:
+        segs: list[Segment] = []
+        run: list[Line] = []
+        for seg in (*contour.segments, None):
+            if isinstance(seg, Line):
+                run.append(seg)
+                continue
+            total += _fit_run(run, tolerance, segs)
+            run = []
+            if seg is not None:
+                segs.append(seg)
+        same = len(segs) == len(contour.segments)
+        out.append(
+            contour if same else Contour(tuple(segs), contour.closed, contour.layer, contour.source)
         )
-    return out
+    return out, total
 
 
-def _contour_moves(contour: Contour, number: int, feed: float) -> list[Move]:
-    moves: list[Move] = [Rapid(*contour.start, contour=number)]
-    for seg in contour.segments:
-        x, y = seg.end
-        if isinstance(seg, Arc):
-            moves.append(ArcMove(x, y, *seg.centre, seg.clockwise, feed, contour=number))
-        else:
-            moves.append(Linear(x, y, feed, contour=number))
-    return moves
+def _fit_run(run: list[Line], tolerance: float, out: list[Segment]) -> FitStats:
+    if len(run) < MIN_FIT_RUN:
+        out.extend(run)
+        return FitStats(0, 0, 0)
+    points = [run[0].start, *(s.end for s in run)]
+    fitted = fit_polyline(points, tolerance)
+    if len(fitted) >= len(run):
+        out.extend(run)
+        return FitStats(0, 0, 0)
+    out.extend(fitted)
+    return fit_stats(len(run), fitted)

@@ -13,8 +13,9 @@ from camtool.geometry import Arc, Contour, Drawing, Line
 from camtool.importers.dxf import read_dxf
 from camtool.program import ArcMove, Rapid
 from camtool.toolpath.chain import chain
+from camtool.toolpath.compensate import compensate
 from camtool.toolpath.offset import offset_contour
-from camtool.toolpath.order import nesting, order_contours
+from camtool.toolpath.order import nesting, order_cuts
 from camtool.toolpath.plan import PlanOptions, plan
 from tests.shapes import rectangle_dxf, write_dxf
 
@@ -90,8 +91,10 @@ def test_inside_contours_are_cut_first() -> None:
     contours = [outer, hole, other]
     nest = nesting(contours)
     assert nest.parents == ((), (0,), ())
-    order = order_contours(contours, nest, (0.0, 0.0))
-    assert order.index(1) < order.index(0)
+    options = PlanOptions(feed_mm_min=1.0)
+    ordering = order_cuts(compensate(contours, nest, options).cuts, nest, options, (0.0, 0.0))
+    groups = [cut.group for cut in ordering.cuts]
+    assert groups.index(1) < groups.index(0)
 
 
 def test_outside_compensates_holes_inwards(tmp_path: Path) -> None:

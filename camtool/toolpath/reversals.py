@@ -1,0 +1,383 @@
+"""Axis direction reversals of a cutting sequence, and an order that needs few of them.
+
+The model (seed-000 §5.1, L1707–L1709: the controller compensates backlash
+"whenever any axis changes direction", on rapids as well as cuts):
+
+- each axis (X, Y) has a current direction, +1 or -1, unknown before the first
+  motion; the first motion of an axis sets it without counting;
+- a line moving an axis (by more than :data:`MOVE_EPS_MM`) against the axis's
+  current direction counts one reversal of that axis; an axis a line does not
+  move keeps its direction;
+- an arc moves X with the sign of ``dx/dt`` of its tangent, which changes at the
+  circle's left and right extreme points, and Y with the sign of ``dy/dt``, which
+  changes at the top and bottom: X reverses at each left/right extreme the arc
+  passes through, Y at each top/bottom; the arc's first direction on each axis is
+  the tangent's at its start (just after it when the start is an extreme point);
+- the rapid from the tool position to each cut's start is a line.
+
+:func:`count_reversals` counts them for cuts as given; :func:`reversal_order`
+chooses an order, start vertices and directions that minimise the weighted count
+``bx·rx + by·ry`` (``bx``, ``by`` the machine's per-axis backlash, µm; ``rx + ry``
+when both are 0), rapid travel breaking ties.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from camtool.geometry import TAU, Arc, Line, Point, Segment
+from camtool.toolpath.cuts import Cut
+from camtool.toolpath.travel import Step, ends, oriented, rapid_mm, travel_order
+
+MOVE_EPS_MM = 1e-9
+"""A line moving an axis by less than this does not move it."""
+
+_ANGLE_EPS = 1e-9
+IMPROVE_MAX_CUTS = 40
+"""Neighbour swaps (each re-running the variant choice) only up to this many cuts."""
+IMPROVE_PASSES = 4
+"""Bound on the neighbour-swap passes."""
+_TRAVEL_PER_REVERSAL_MM = 1e6
+"""Travel worth one unit-weight reversal in the combined key (reversals dominate)."""
+
+
+def segment_signs(seg: Segment) -> tuple[list[int], list[int]]:
+    """Successive directions (+1/-1) in which ``seg`` moves X and Y (see the module)."""
+    if isinstance(seg, Line):
+        dx, dy = seg.end[0] - seg.start[0], seg.end[1] - seg.start[1]
+        return ([_sign(dx)] if abs(dx) > MOVE_EPS_MM else []), (
+            [_sign(dy)] if abs(dy) > MOVE_EPS_MM else []
+        )
+    return _arc_signs(seg, 0.0), _arc_signs(seg, math.pi / 2)
+
+
+def _sign(v: float) -> int:
+    return 1 if v > 0 else -1
+
+
+def _arc_signs(arc: Arc, phase: float) -> list[int]:
+    """Directions of one axis along ``arc``: X for ``phase`` 0, Y for π/2.
+
+    The coordinate is ``c + r·cos(θ - phase)``; it turns where ``θ = phase + kπ``.
+    """
+    a0, sweep = arc.start_angle, arc.sweep
+    s = 1.0 if sweep > 0 else -1.0
+    total = abs(sweep)
+    turns = sorted(
+        d
+        for q in (phase, phase + math.pi)
+        for d in ((s * (q - a0)) % TAU,)
+        if _ANGLE_EPS < d < total - _ANGLE_EPS
+    )
+    bounds = [0.0, *turns, total]
+    out: list[int] = []
+    for lo, hi in itertools.pairwise(bounds):
+        theta = a0 + s * (lo + hi) / 2
+        v = -s * math.sin(theta - phase)  # d/dt of cos(θ - phase) with dθ/dt = s
+        out.append(_sign(v))
+    return out
+
+
+def _path_signs(segments: Sequence[Segment]) -> tuple[list[tuple[int, int]], list[tuple[int, int]]]:
+    """Per axis: ``(segment index, sign)`` of every motion piece, in path order."""
+    xs: list[tuple[int, int]] = []
+    ys: list[tuple[int, int]] = []
+    for g, seg in enumerate(segments):
+        sx, sy = segment_signs(seg)
+        xs.extend((g, v) for v in sx)
+        ys.extend((g, v) for v in sy)
+    return xs, ys
+
+
+def count_reversals(cuts: Sequence[Cut], start: Point) -> tuple[int, int]:
+    """Axis direction reversals ``(rx, ry)`` of cutting ``cuts`` in the order given.
+
+    Counts the rapids (start → first cut, each cut's end → next start) as lines
+    and each cut's path as given (its start, its direction), with the model of
+    this module: the first motion of each axis sets its direction without
+    counting; an axis that does not move keeps its direction; arcs reverse X at
+    their left/right extreme points and Y at their top/bottom ones.
+
+    Args:
+        cuts: cuts in cutting order, paths in mm.
+        start: tool position before the first rapid, mm.
+
+    Returns:
+        ``(rx, ry)``: reversals of X and of Y. On a machine that compensates
+        every reversal (pic-mmh, seed-000 §5.1) this is the compensation count.
+    """
+    state = [0, 0]
+    count = [0, 0]
+    here = start
+    for cut in cuts:
+        moves: list[Segment] = [Line(here, cut.path.start), *cut.path.segments]
+        for seg in moves:
+            for axis, signs in enumerate(segment_signs(seg)):
+                for v in signs:
+                    if state[axis] and v != state[axis]:
+                        count[axis] += 1
+                    state[axis] = v
+        here = cut.path.end
+    return count[0], count[1]
+
+
+@dataclass(frozen=True)
+class _Variants:
+    """The allowed variants of one cut and their reversal summary.
+
+    ``first``, ``last``: ``(V, 2)`` first and last direction of X and Y (0: the
+    axis does not move); ``inner``: ``(V, 2)`` reversals within the path;
+    ``start``, ``end``: ``(V, 2)`` mm.
+    """
+
+    steps: list[Step]
+    first: npt.NDArray[np.int64]
+    last: npt.NDArray[np.int64]
+    inner: npt.NDArray[np.int64]
+    start: npt.NDArray[np.float64]
+    end: npt.NDArray[np.float64]
+
+
+def _axis_summary(pieces: list[tuple[int, int]], k: int, closed: bool) -> tuple[int, int, int]:
+    """(first, last, reversals) of one axis when the path starts at vertex ``k``."""
+    m = len(pieces)
+    if m == 0:
+        return 0, 0, 0
+    signs = [v for _, v in pieces]
+    if not closed:
+        changes = sum(a != b for a, b in itertools.pairwise(signs))
+        return signs[0], signs[-1], changes
+    cyclic = sum(signs[i] != signs[(i + 1) % m] for i in range(m))
+    p = next((i for i, (g, _) in enumerate(pieces) if g >= k), 0)
+    return signs[p], signs[p - 1], cyclic - (signs[p - 1] != signs[p])
+
+
+def _variants(cut: Cut, flip_open: bool) -> _Variants:
+    path = cut.path
+    n = len(path.segments)
+    ks = range(n) if path.closed and cut.may_rotate else range(1)
+    directions = [False]
+    if cut.may_reverse and (path.closed or flip_open):
+        directions.append(True)
+    fwd = _path_signs(path.segments)
+    back = _path_signs(path.reversed().segments)
+    steps, first, last, inner, start, end = [], [], [], [], [], []
+    for rev in directions:
+        pieces = back if rev else fwd
+        for k in ks:
+            kk = (n - k) % n if (rev and path.closed) else k
+            sx, sy = (
+                _axis_summary(pieces[0], kk, path.closed),
+                _axis_summary(pieces[1], kk, path.closed),
+            )
+            steps.append((0, k, rev))
+            first.append((sx[0], sy[0]))
+            last.append((sx[1], sy[1]))
+            inner.append((sx[2], sy[2]))
+            s, e = ends(cut, k, rev)
+            start.append(s)
+            end.append(e)
+    return _Variants(
+        steps,
+        np.asarray(first, dtype=np.int64),
+        np.asarray(last, dtype=np.int64),
+        np.asarray(inner, dtype=np.int64),
+        np.asarray(start, dtype=np.float64),
+        np.asarray(end, dtype=np.float64),
+    )
+
+
+def weights(backlash_um: tuple[float, float]) -> tuple[float, float]:
+    """Per-axis weight of a reversal: the backlash, µm, or 1 each when both are 0."""
+    bx, by = backlash_um
+    if bx <= 0 and by <= 0:
+        return 1.0, 1.0
+    return max(bx, 0.0), max(by, 0.0)
+
+
+def weighted(counts: tuple[int, int], w: tuple[float, float]) -> float:
+    """``wx·rx + wy·ry``."""
+    return w[0] * counts[0] + w[1] * counts[1]
+
+
+def _enter(
+    state: npt.NDArray[np.int64], here: npt.NDArray[np.float64], var: _Variants
+) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64], npt.NDArray[np.float64]]:
+    """Reversals of the rapid into and the path of each variant, from ``state`` at ``here``.
+
+    ``state``, ``here`` broadcast against the variants' ``(V, 2)`` arrays.
+    Returns ``(reversals (.., 2), state after (.., 2), rapid length (..))``.
+    """
+    delta = var.start - here
+    rapid = np.where(np.abs(delta) > MOVE_EPS_MM, np.sign(delta).astype(np.int64), 0)
+    count = ((state != 0) & (rapid != 0) & (rapid != state)).astype(np.int64)
+    state = np.where(rapid != 0, rapid, state)
+    count = count + ((state != 0) & (var.first != 0) & (var.first != state)) + var.inner
+    state = np.where(var.last != 0, var.last, state)
+    return count, state, np.hypot(delta[..., 0], delta[..., 1])
+
+
+def reversal_order(
+    cuts: Sequence[Cut],
+    before: Sequence[Sequence[int]],
+    origin: Point,
+    backlash_um: tuple[float, float],
+    candidates: Sequence[Sequence[Step]] = (),
+) -> list[Step]:
+    """A sequence with few weighted axis reversals (rapid travel breaks ties).
+
+    Greedy from the origin on (added weighted reversals, rapid) over the variants
+    of the cuts whose predecessors are cut; then, for that order, the travel order
+    and each of ``candidates`` (e.g. the drawn order), start vertices and
+    directions re-chosen by dynamic programming over the variants, and
+    neighbouring cuts swapped where that helps (small jobs). The best of all
+    by (:func:`count_reversals` weighted, rapid travel) is returned, so it is never
+    worse than a candidate whose variants are allowed here (open cuts keep their
+    direction).
+
+    Args:
+        cuts: the cuts, mm.
+        before: precedence (:func:`camtool.toolpath.travel.precedence`).
+        origin: tool position before the first cut, mm.
+        backlash_um: ``(bx, by)`` reversal weights, µm (see :func:`weights`).
+        candidates: other valid sequences to improve and compare.
+    """
+    if not cuts:
+        return []
+    w = weights(backlash_um)
+    unit = min(v for v in w if v > 0)
+    wn = (w[0] / unit, w[1] / unit)
+    variants = [_variants(cut, flip_open=False) for cut in cuts]
+    greedy = _greedy(variants, before, origin, wn)
+    options: list[Sequence[Step]] = [greedy, *candidates]
+    if len(cuts) > 1:
+        options.append(travel_order(cuts, before, origin, flip_open=False))
+    options += [_improve(variants, before, seq, origin, wn) for seq in options]
+
+    def key(seq: Sequence[Step]) -> tuple[float, float]:
+        done = [oriented(cuts[i], k, rev) for i, k, rev in seq]
+        return weighted(count_reversals(done, origin), w), rapid_mm(cuts, seq, origin)
+
+    return list(options[min(range(len(options)), key=lambda m: key(options[m]))])
+
+
+def _greedy(
+    variants: Sequence[_Variants],
+    before: Sequence[Sequence[int]],
+    origin: Point,
+    w: tuple[float, float],
+) -> list[Step]:
+    wv = np.asarray(w, dtype=np.float64)
+    every = _Variants(
+        [(i, *st[1:]) for i, v in enumerate(variants) for st in v.steps],
+        np.concatenate([v.first for v in variants]),
+        np.concatenate([v.last for v in variants]),
+        np.concatenate([v.inner for v in variants]),
+        np.concatenate([v.start for v in variants]),
+        np.concatenate([v.end for v in variants]),
+    )
+    owner = np.asarray([st[0] for st in every.steps], dtype=np.int64)
+    # a cut's least internal cost is spent whatever its turn: rank by what is added to it
+    least = np.full(len(variants), np.inf)
+    np.minimum.at(least, owner, every.inner @ wv)
+    waiting = np.asarray([len(b) for b in before])
+    after: list[list[int]] = [[] for _ in variants]
+    for a, bs in enumerate(before):
+        for b in bs:
+            after[b].append(a)
+    active = waiting[owner] == 0
+    state = np.zeros(2, dtype=np.int64)
+    here = np.asarray(origin, dtype=np.float64)
+    out: list[Step] = []
+    for _ in range(len(variants)):
+        idx = np.flatnonzero(active)
+        sub = _Variants(
+            [],
+            every.first[idx],
+            every.last[idx],
+            every.inner[idx],
+            every.start[idx],
+            every.end[idx],
+        )
+        count, after_state, rapid = _enter(state, here, sub)
+        key = (count @ wv - least[owner[idx]]) * _TRAVEL_PER_REVERSAL_MM
+        m = int(np.argmin(key + rapid))  # first minimum: lowest cut, then variant
+        p = int(idx[m])
+        i = int(owner[p])
+        state, here = after_state[m], every.end[p]
+        out.append(every.steps[p])
+        active[owner == i] = False
+        for a in after[i]:
+            waiting[a] -= 1
+            if waiting[a] == 0:
+                active[owner == a] = True
+    return out
+
+
+def _improve(
+    variants: Sequence[_Variants],
+    before: Sequence[Sequence[int]],
+    seq: Sequence[Step],
+    origin: Point,
+    w: tuple[float, float],
+) -> list[Step]:
+    """Swap neighbours where precedence allows and the best variants then cost less.
+
+    Each try re-runs :func:`_dp`, so this runs only for up to :data:`IMPROVE_MAX_CUTS`
+    cuts and :data:`IMPROVE_PASSES` passes.
+    """
+    order = [c for c, _, _ in seq]
+    best, cost = _dp(variants, order, origin, w)
+    if len(order) > IMPROVE_MAX_CUTS:
+        return best
+    for _ in range(IMPROVE_PASSES):
+        better = False
+        for p in range(len(order) - 1):
+            if order[p] in before[order[p + 1]]:
+                continue
+            trial = [*order[:p], order[p + 1], order[p], *order[p + 2 :]]
+            steps, trial_cost = _dp(variants, trial, origin, w)
+            if trial_cost < cost - 1e-9:
+                order, best, cost, better = trial, steps, trial_cost, True
+        if not better:
+            break
+    return best
+
+
+def _dp(
+    variants: Sequence[_Variants], order: Sequence[int], origin: Point, w: tuple[float, float]
+) -> tuple[list[Step], float]:
+    """Variants for a fixed order by dynamic programming on (weighted reversals, rapid).
+
+    The state is the variant of the last cut; its exit direction is the one along
+    the best path to it (exact whenever the rapid and path into each cut move
+    both axes, as they do for any closed cut).
+    """
+    wv = np.asarray(w, dtype=np.float64)
+    var = variants[order[0]]
+    count, state, rapid = _enter(np.zeros(2, dtype=np.int64), np.asarray(origin), var)
+    cost = (count @ wv) * _TRAVEL_PER_REVERSAL_MM + rapid
+    back: list[npt.NDArray[np.int64]] = []
+    for i in order[1:]:
+        prev, var = var, variants[i]
+        count, new_state, rapid = _enter(state[:, None, :], prev.end[:, None, :], var)
+        total = cost[:, None] + (count @ wv) * _TRAVEL_PER_REVERSAL_MM + rapid  # (U, V)
+        pick = np.argmin(total, axis=0)
+        cols = np.arange(len(var.steps))
+        cost = total[pick, cols]
+        state = new_state[pick, cols]
+        back.append(pick)
+    m = int(np.argmin(cost))
+    chosen = [m]
+    for pick in reversed(back):
+        m = int(pick[m])
+        chosen.append(m)
+    chosen.reverse()
+    steps = [(i, *variants[i].steps[m][1:]) for i, m in zip(order, chosen, strict=True)]
+    return steps, float(cost.min())

@@ -1,0 +1,122 @@
+"""The planner end to end: options a target cannot carry out, arc-fit savings, depth on Z targets.
+
+Stage-level tests live beside this file (test_compensate, test_pocket, test_order,
+test_passes); here the stages run together through :func:`camtool.pipeline.post_drawing`.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from camtool.errors import UsageError
+from camtool.geometry import Arc, Contour, Drawing, Line
+from camtool.pipeline import post_drawing, post_file
+from camtool.post.registry import load_target
+from camtool.program import ArcMove, Linear, Rapid
+from camtool.toolpath.plan import PlanOptions, fit_dense, plan_drawing
+
+
+def _rect(x0: float, y0: float, x1: float, y1: float) -> Contour:
+    pts = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
+    return Contour(tuple(Line(pts[i], pts[(i + 1) % 4]) for i in range(4)), True)
+
+
+def _plate() -> Drawing:
+    """A 30 × 20 mm plate with a ø6 mm hole."""
+    hole = Contour((Arc((18.0, 10.0), (18.0, 10.0), (15.0, 10.0), False),), True)
+    return Drawing((_rect(0, 0, 30, 20), hole), "plate").transformed(1.0, 5.0, 5.0)
+
+
+@pytest.mark.parametrize("target", ["pic-mmh", "matlab-router"])
+@pytest.mark.parametrize("option", [{"depth": 1.0}, {"depth": 1.0, "step_down": 0.5}])
+def test_2d_targets_refuse_depth_options(target: str, option: dict[str, Any]) -> None:
+    # Issue 4 "Depth": for 2D-only targets depth options are a clear error, not ignored.
+    with pytest.raises(UsageError, match=r"--depth.*no programmable Z"):
+        post_drawing(_plate(), load_target(target), **option)
+
+
+def test_depth_sub_options_need_a_depth() -> None:
+    with pytest.raises(UsageError, match=r"--step-down.*need"):
+        PlanOptions(feed_mm_min=100.0, step_down=0.5)
+
+
+def test_lead_in_refused_on_a_chord_only_target() -> None:
+    with pytest.raises(UsageError, match="--lead-in: i8751 writes arcs as chords"):
+        post_drawing(
+            _plate(), load_target("i8751"), offset="outside", tool_diameter=1.0, lead_in_mm=1.0
+        )
+
+
+def test_ramp_refused_where_z_has_its_own_block() -> None:
+    # flashcut writes "G01 Z…" alone (seed-001 R7): it cannot descend along the path.
+    with pytest.raises(UsageError, match="--ramp: flashcut moves Z in a block of its own"):
+        post_drawing(_plate(), load_target("flashcut"), depth=0.2, ramp_angle_deg=5.0)
+
+
+def test_gcode_input_refuses_planning_options(tmp_path: Path) -> None:
+    code = tmp_path / "p.ngc"
+    code.write_text("G21 G90\nG0 X0 Y0\nG1 X5 Y0 F100\nM2\n")
+    with pytest.raises(UsageError, match="--depth, --order only apply to drawings"):
+        post_file(code, "grbl", depth=1.0, order="reversals")
+
+
+def test_dense_polyline_becomes_arcs_and_the_saving_is_reported() -> None:
+    # A circle of radius 10 drawn as a 360-gon: sagitta 10·(1 − cos 0.5°) = 0.38 µm, well
+    # inside the 1 µm tolerance, so a few arcs replace the 360 lines.
+    n = 360
+    pts = [
+        (10 * math.cos(2 * math.pi * k / n), 10 * math.sin(2 * math.pi * k / n)) for k in range(n)
+    ]
+    gon = Contour(tuple(Line(pts[k], pts[(k + 1) % n]) for k in range(n)), True)
+    (fitted,), stats = fit_dense([gon], 0.001)
+    assert stats.replaced == n
+    assert stats.arcs >= 1 and stats.segments == len(fitted.segments) < 10
+    for seg in fitted.segments:
+        assert isinstance(seg, Arc) and seg.radius == pytest.approx(10.0, abs=1e-3)
+    planned = plan_drawing(Drawing((gon,)), PlanOptions(feed_mm_min=100.0))
+    assert planned.report.fit is not None and planned.report.fit.replaced == n
+    assert any("arc fitting replaced 360 segments" in line for line in planned.report.notes())
+    off = plan_drawing(Drawing((gon,)), PlanOptions(feed_mm_min=100.0, fit_arcs=False))
+    assert sum(isinstance(m, Linear) for m in off.program.moves) == n
+
+
+def test_sharp_polygons_are_not_fitted() -> None:
+    # The seed-002 star keeps its ten straight edges (its lxy arrays are golden values).
+    (rect,), stats = fit_dense([_rect(0, 0, 10, 5)], 0.001)
+    assert stats.replaced == 0 and len(rect.segments) == 4
+
+
+def test_grbl_depth_passes_and_tabs_verify(tmp_path: Path) -> None:
+    # 1.5 mm deep in 0.5 mm passes (3 levels), 2 tabs on the outside profile, verified on grbl.
+    from camtool.pipeline import verify_job
+
+    job = post_drawing(
+        _plate(),
+        load_target("grbl"),
+        offset="outside",
+        tool_diameter=2.0,
+        depth=1.5,
+        step_down=0.5,
+        tabs=2,
+        tab_width=3.0,
+        tab_height=0.5,
+        feed_mm_min=300.0,
+    )
+    moves = job.program.moves
+    cutting_z = {
+        round(m.z, 6) for m in moves if isinstance(m, Linear | ArcMove) and m.z is not None
+    }
+    assert {-0.5, -1.0, -1.5} <= cutting_z
+    assert -1.0 in cutting_z  # the tab top: −1.5 + 0.5
+    assert all(m.z == pytest.approx(2.0) for m in moves if isinstance(m, Rapid) and m.z is not None)
+    from camtool.verify.verifier import report_dict
+
+    report = report_dict(verify_job(job))
+    # Z travel: 2 mm down to the top and 1.5 mm on into the part, and back, at least.
+    assert report["steps"]["z"] >= 2 * 3.5 * job.target.machine.steps_per_mm[2]
+    assert job.plan is not None
+    assert job.plan.to_json()["cuts"] == 2
