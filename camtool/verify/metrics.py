@@ -289,6 +289,7 @@ def against_drawing(
     *,
     spacing_mm: float = 0.005,
     resolution_mm: float = 0.0005,
+    runs: IntArray | None = None,
 ) -> Against:
     """Compare a cutting trace with the drawing it was made from (shapely nearest queries).
 
@@ -304,6 +305,9 @@ def against_drawing(
         tool_radius_mm: tool radius; 0 for a scribing point or an engraving on the line.
         spacing_mm: largest distance between sampled drawing points, mm.
         resolution_mm: spacing of the thinned trace, mm.
+        runs: ``(N,)`` id of the continuous cut each point belongs to (the rows
+            between two rapids); the trace is not joined across two runs, so a
+            rapid never counts as cutting. ``None``: one run.
     """
     import shapely
 
@@ -313,8 +317,14 @@ def against_drawing(
     head = np.diff(points[: min(len(points), 2000)], axis=0)
     step = float(np.median(np.hypot(head[:, 0], head[:, 1]))) if len(head) else 0.0
     every = max(1, int(resolution_mm / step)) if step > 0 else 1
-    trace = _thin(points, min(400_000, math.ceil(len(points) / every)))
-    trace_lines = shapely.linestrings(np.stack([trace[:-1], trace[1:]], axis=1))
+    keep = _thin_index(len(points), min(400_000, math.ceil(len(points) / every)), runs)
+    trace = points[keep]
+    joined = (
+        np.ones(len(keep) - 1, dtype=bool) if runs is None else runs[keep][1:] == runs[keep][:-1]
+    )
+    if not joined.any():
+        joined[:] = True  # single points only: their nearest distances still count
+    trace_lines = shapely.linestrings(np.stack([trace[:-1], trace[1:]], axis=1)[joined])
     tree = shapely.STRtree(trace_lines)
     q = shapely.points(samples)
     _, d_q = tree.query_nearest(q, return_distance=True, all_matches=False)
@@ -367,9 +377,11 @@ def _same_contour(drawing: Drawing, spacing_mm: float) -> npt.NDArray[np.bool_]:
     return mask
 
 
-def _thin(points: FloatArray, limit: int) -> FloatArray:
-    """Every k-th point (and the last) so that at most about ``limit`` remain."""
-    k = max(1, math.ceil(len(points) / limit))
-    if k == 1:
-        return points
-    return np.vstack([points[::k], points[-1:]])
+def _thin_index(n: int, limit: int, runs: IntArray | None) -> IntArray:
+    """Indices of every k-th of ``n`` points, the last, and each run's first and last."""
+    k = max(1, math.ceil(n / limit))
+    picked = [np.arange(0, n, k), np.array([n - 1])]
+    if runs is not None and n > 1:
+        change = np.flatnonzero(runs[1:] != runs[:-1])
+        picked += [change, change + 1]
+    return np.unique(np.concatenate(picked))

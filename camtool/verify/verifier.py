@@ -140,7 +140,8 @@ def verify_program(
     if against is not None:
         rapid = np.asarray([isinstance(m, Rapid) for m in program.moves], dtype=bool)
         cutting = ~rapid[blocks] if len(blocks) else np.zeros(0, dtype=bool)
-        compared = against_drawing(points[cutting], against, tool_diameter / 2.0)
+        runs = np.cumsum(~cutting)[cutting]  # a new id after every rapid row
+        compared = against_drawing(points[cutting], against, tool_diameter / 2.0, runs=runs)
     times = block_times(trace, program, machine)
     return Verification(
         target=name or machine.name,
