@@ -4,7 +4,10 @@ The tool reaches a closed profile along a quarter circle that ends at the path's
 start tangent to its first segment, and leaves it along the mirror-image quarter
 circle that starts at the path's end tangent to its last segment. Both lie on the
 side of the path away from the material (the waste), so the tool never dwells or
-plunges against the finished wall.
+plunges against the finished wall. Where a quarter circle of the asked radius would
+cross the path into the material (a hole smaller than the lead, a start in a concave
+corner), the radius is halved until the arcs stay on the waste side, at most
+:data:`MAX_HALVINGS` times; a profile where none fits gets no lead arcs.
 
 Conventions: mm, Y up; a cut's ``material_side`` is the side of the travel
 direction on which the material stays (:mod:`camtool.toolpath.cuts`). Material on
@@ -18,24 +21,63 @@ from camtool.geometry import Arc, Point
 from camtool.toolpath.cuts import Cut
 from camtool.toolpath.split import Track, end_tangent, start_tangent
 
+MAX_HALVINGS = 6
+"""A lead radius is halved at most this often (to 1/64 of ``--lead-in``) to fit."""
+
+_SAMPLES = 16  # points per lead arc checked against the waste side
+_CHORD_MM = 1e-4  # chord error of the path polygon
+_NEAR_MM = 1e-3  # sample points this close to the path count as touching it
+
 
 def has_leads(cut: Cut, radius: float) -> bool:
-    """True when ``cut`` gets lead arcs: a closed profile with a material side, ``radius`` > 0."""
+    """True when ``cut`` gets lead arcs.
+
+    That is a closed profile with a material side, ``radius`` > 0 and a lead radius
+    that fits on the waste side (see :func:`fitted_radius`).
+    """
     return (
         radius > 0
         and cut.kind == "profile"
         and cut.path.closed
         and cut.material_side is not None
         and bool(Track.of(cut.path).segments)
+        and fitted_radius(cut, radius) > 0
     )
 
 
+def fitted_radius(cut: Cut, radius: float) -> float:
+    """The largest of ``radius``, ``radius/2``, … whose lead arcs stay on the waste side; 0: none.
+
+    The waste side is the inside of the closed path's polygon when the material
+    lies outside it (the right of a counter-clockwise path), else the outside;
+    every sampled point of both arcs farther than 1 µm from the path must lie there.
+    """
+    import shapely
+
+    polygon = shapely.Polygon(cut.path.points(_CHORD_MM))
+    shapely.prepare(polygon)
+    material_right = cut.material_side == "right"
+    waste_inside = (cut.path.signed_area() > 0) == material_right
+    for _ in range(MAX_HALVINGS + 1):
+        lead_in, lead_out = _arcs(cut, radius)
+        fractions = [k / _SAMPLES for k in range(_SAMPLES)]  # lead-in: all but its end
+        points = [lead_in.point_at(f) for f in fractions]
+        points += [lead_out.point_at(1.0 - f) for f in fractions]
+        xy = shapely.points(points)
+        clear = shapely.distance(polygon.exterior, xy) > _NEAR_MM  # off the path itself
+        wrong = shapely.contains(polygon, xy) != waste_inside
+        if not bool((wrong & clear).any()):
+            return radius
+        radius /= 2.0
+    return 0.0
+
+
 def lead_arcs(cut: Cut, radius: float) -> tuple[Arc, Arc]:
-    """The lead-in and lead-out arcs of a closed profile.
+    """The lead-in and lead-out arcs of a closed profile, at :func:`fitted_radius`.
 
     Args:
         cut: a closed cut with ``material_side`` set (see :func:`has_leads`).
-        radius: lead arc radius, mm (> 0); each arc sweeps 90°.
+        radius: asked lead arc radius, mm (> 0); each arc sweeps 90°.
 
     Returns:
         ``(lead_in, lead_out)``: ``lead_in`` ends at the path's start, tangent to
@@ -47,6 +89,12 @@ def lead_arcs(cut: Cut, radius: float) -> tuple[Arc, Arc]:
     """
     if cut.material_side is None:
         raise ValueError("lead arcs need the cut's material side")
+    fitted = fitted_radius(cut, radius)
+    return _arcs(cut, fitted if fitted > 0 else radius)
+
+
+def _arcs(cut: Cut, radius: float) -> tuple[Arc, Arc]:
+    """Both quarter-circle lead arcs of ``radius`` (no fitting)."""
     track = Track.of(cut.path)
     p0, p1 = track.start, track.end
     left = cut.material_side == "right"  # the waste lies left of travel

@@ -238,6 +238,18 @@ def test_lead_arcs_in_a_hole_stay_in_the_hole() -> None:
     assert waste.contains(LineString(_samples(lead_out)))
 
 
+def test_lead_arcs_shrink_to_fit_a_small_hole() -> None:
+    # The plate sample's ø4 mm holes with a 3 mm tool leave a tool path of radius 0.5 mm: a
+    # 2 mm lead arc would swing across the hole into its wall. Halving 2 → 1 → 0.5 mm gives
+    # the first quarter circle that stays inside (internally tangent at radius 0.5).
+    hole = _circle(0, 0, 0.5, clockwise=False)
+    cut = Cut(hole, 0, material_side="right")
+    lead_in, lead_out = lead_arcs(cut, 2.0)
+    _check_lead(lead_in, lead_out, hole, 0.5)
+    for arc in (lead_in, lead_out):
+        assert all(math.hypot(x, y) <= 0.5 + 1e-9 for x, y in _samples(arc))
+
+
 def test_lead_arcs_follow_the_material_side() -> None:
     # Conventional milling of the same outline (counter-clockwise, part on the left).
     path = _rounded_rect().reversed()
