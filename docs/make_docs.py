@@ -13,7 +13,8 @@ its marker, with optional ``post`` options::
 ``docs/targets/<target>-<sample>.svg``; for docs/verify.md the verify summary of
 the pic-mmh sample between ``<!-- verify:begin -->`` / ``<!-- verify:end -->``
 and its preview ``docs/targets/pic-mmh-logo-verify.png``; docs/gallery.md and
-its verified pictures (``make_gallery.py``). ``--check`` only
+its verified pictures (``make_gallery.py``); the planning examples of
+docs/toolpaths.md and their pictures (``make_toolpaths.py``). ``--check`` only
 reports whether the committed docs are current (exit 1 if not; the PNG, drawn
 by matplotlib whose bytes vary between versions, only has to exist); the tests
 run it.
@@ -68,6 +69,9 @@ def generated() -> dict[Path, str]:
     from make_gallery import gallery_files
 
     files.update(gallery_files())
+    from make_toolpaths import toolpath_files
+
+    files.update(toolpath_files())
     return files
 
 
