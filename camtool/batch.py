@@ -384,7 +384,7 @@ def _post_one(task: BatchTask, options: BatchOptions) -> BatchRow:
         error_um, time_s = v.max_error_um, v.time_s
         warnings = tuple(dict.fromkeys(warnings + v.warnings))
         if task.report_path is not None:
-            files.append((task.report_path, json.dumps(report_dict(v), indent=2) + "\n"))
+            files.append((task.report_path, json.dumps(report_dict(v, job.plan), indent=2) + "\n"))
     if task.preview_path is not None:
         files.append((task.preview_path, preview_bytes(job, v, task.preview_path, task.file)))
     for path, data in files:

@@ -213,10 +213,7 @@ def _finish_verification(
     for line in summary_lines(v):
         click.echo(f"camtool: {line}", err=True)
     if report is not None:
-        data = report_dict(v)
-        if plan is not None:
-            data["plan"] = plan.to_json()
-        write_output(json.dumps(data, indent=2) + "\n", report)
+        write_output(json.dumps(report_dict(v, plan), indent=2) + "\n", report)
     if preview is not None:
         from camtool.preview_trace import write_trace_preview
 

@@ -29,6 +29,7 @@ from camtool.verify.simulate import StepTrace, simulate_steps
 
 if TYPE_CHECKING:
     from camtool.post.base import Target
+    from camtool.toolpath.plan import PlanReport
 
 SMALL_PART_MM = 1.0
 """Parts under this size suffer most from compensations (seed-000 §5.3, S000-19)."""
@@ -216,8 +217,15 @@ def summary_lines(v: Verification) -> list[str]:
     return lines
 
 
-def report_dict(v: Verification) -> dict[str, Any]:
-    """The verify report (keys of ../shared/DESIGN.md, plus details), JSON-ready."""
+def report_dict(v: Verification, plan: PlanReport | None = None) -> dict[str, Any]:
+    """The verify report (keys of ../shared/DESIGN.md, plus details), JSON-ready.
+
+    ``plan``, what planning found when the code was planned in the same run, goes
+    under the ``plan`` key (:meth:`camtool.toolpath.plan.PlanReport.to_json`).
+    """
     from camtool.verify.report import build_report
 
-    return build_report(v)
+    report = build_report(v)
+    if plan is not None:
+        report["plan"] = plan.to_json()
+    return report

@@ -120,3 +120,28 @@ def test_grbl_depth_passes_and_tabs_verify(tmp_path: Path) -> None:
     assert report["steps"]["z"] >= 2 * 3.5 * job.target.machine.steps_per_mm[2]
     assert job.plan is not None
     assert job.plan.to_json()["cuts"] == 2
+
+
+def test_cli_reports_what_planning_found(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # samples/plate.dxf with a 3 mm tool outside: the notch's two inside corners keep the
+    # 1.5 mm tool radius, and the 2 × 2 mm square hole is narrower than the tool.
+    import json
+
+    from camtool.cli import main
+
+    root = Path(__file__).parents[2]
+    report = tmp_path / "r.json"
+    args = ["post", str(root / "samples" / "plate.dxf"), "-t", "grbl", "--offset", "outside"]
+    args += ["--tool-diameter", "3", "-o", str(tmp_path / "p.gcode"), "--report", str(report)]
+    assert main(args) == 0
+    err = capsys.readouterr().err
+    assert "2 inside corners tighter than the 1.5 mm tool radius" in err
+    assert "about 2 mm wide, narrower than the 3 mm tool" in err
+    assert "order travel: rapids" in err
+    plan = json.loads(report.read_text())["plan"]
+    assert plan["counts"] == {"tight-corner": 1, "offset-vanished": 1}
+    vanished = next(f for f in plan["findings"] if f["kind"] == "offset-vanished")
+    assert vanished["at"] == pytest.approx([14.0, 20.0])
+    assert plan["order"]["mode"] == "travel"
