@@ -10,11 +10,12 @@ the thesis cut. It uses every entity kind the first importer reads:
 - a cutter point: a triangle of three LINEs that chain to one closed contour;
 - a base mark: a 2D POLYLINE with a bulge (a shallow "smile").
 
-``plate.dxf`` is a 40 × 30 mm bracket, drawn from (5, 5), for profile cutting (``--offset outside``): an
-outline with a 10 × 8 mm notch (two inside corners no round tool can reach), four ø4 mm
-holes, a 12 × 4 mm slot with round ends and a 2 × 2 mm square hole narrower than a 3 mm
-tool. ``pocket.dxf`` is a 30 × 20 mm pocket with 3 mm corner radii around two islands,
-a ø6 mm boss and a 5 × 5 mm block, for ``--offset pocket``.
+``plate.dxf`` is a 40 × 30 mm bracket, drawn from (5, 5), for profile cutting
+(``--offset outside``): an outline with a 10 × 8 mm notch (two inside corners no round
+tool can reach), four ø4 mm holes, a 12 × 4 mm slot with round ends and a 2 × 2 mm
+square hole narrower than a 3 mm tool. ``pocket.dxf`` is a 30 × 20 mm pocket with 3 mm
+corner radii around two islands, a ø6 mm boss and a 5 × 5 mm block, for
+``--offset pocket``.
 """
 
 from __future__ import annotations
