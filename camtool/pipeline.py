@@ -13,7 +13,7 @@ from camtool.post.base import PostResult, Target
 from camtool.post.registry import load_target
 from camtool.program import Move, Program
 from camtool.toolpath.options import drawing_only
-from camtool.toolpath.plan import PlanOptions, PlanReport, place, plan_drawing
+from camtool.toolpath.plan import PlanOptions, PlanReport, plan_drawing
 
 if TYPE_CHECKING:
     from camtool.verify.verifier import Verification
@@ -92,7 +92,7 @@ def post_path(
         **options: the keyword options of :func:`post_drawing`.
 
     Raises:
-        UsageError: a drawing-only option (offset, tool diameter, scale, fit)
+        UsageError: a planning option (offset, tool diameter, scale, depth, order...)
             given for a program; it is refused, not ignored.
         CamtoolError: from any stage, with its exit code.
     """
@@ -218,12 +218,7 @@ def plan_options(target: Target, **options: Any) -> PlanOptions:
     """
     feed = options.pop("feed_mm_min", None)
     plan = PlanOptions(feed_mm_min=target.default_feed_mm_min if feed is None else feed, **options)
-    if plan.z_options() and not target.machine.has_z:
-        raise UsageError(
-            f"{', '.join(plan.z_options())}: {target.name} has no programmable Z axis "
-            f"({target.machine.name} is 2D); set the depth by hand on the machine and "
-            "leave these options out"
-        )
+    plan.check_machine(target.machine, target.name)
     if plan.lead_in_mm > 0 and not target.post.arcs:
         raise UsageError(
             f"--lead-in: {target.name} writes arcs as chords; lead-in arcs are for targets "
@@ -267,8 +262,7 @@ def post_drawing(
     )
     edge = plan.radius if plan.offset != "on" else 0.0
     result = target.emit(program, fmt=fmt)
-    placed = place(drawing, plan)
-    return PostJob(drawing, program, target, result, placed, edge, planned.report)
+    return PostJob(drawing, program, target, result, planned.placed, edge, planned.report)
 
 
 def verify_job(job: PostJob) -> Verification:

@@ -8,9 +8,13 @@ naming the option, before any file is read (``batch`` validates once for all fil
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from camtool.errors import UsageError
 from camtool.geometry import Point
+
+if TYPE_CHECKING:
+    from camtool.machine import Machine
 
 OFFSET_MODES = ("on", "outside", "inside", "pocket")
 """Valid values of ``PlanOptions.offset``."""
@@ -244,6 +248,19 @@ class PlanOptions:
         """The depth options given, as flags (for the 2D-target error)."""
         flags = [("--depth", self.depth is not None), ("--tabs", self.tabs > 0)]
         return [flag for flag, given in flags if given]
+
+    def check_machine(self, machine: Machine, name: str) -> None:
+        """Refuse depth options for a machine without Z (``name``: the target, for the message).
+
+        Raises:
+            UsageError: a depth option was given and ``machine.has_z`` is false.
+        """
+        if self.z_options() and not machine.has_z:
+            raise UsageError(
+                f"{', '.join(self.z_options())}: {name} has no programmable Z axis "
+                f"({machine.name} is 2D); set the depth by hand on the machine and "
+                "leave these options out"
+            )
 
 
 PLAN_FIELDS = frozenset(

@@ -25,7 +25,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from camtool.errors import UsageError
 from camtool.geometry import Contour, Drawing, Line, Segment
 from camtool.program import Program
 from camtool.toolpath.arcfit import FitStats, fit_polyline, fit_stats
@@ -88,10 +87,11 @@ class PlanReport:
 
 @dataclass(frozen=True)
 class Plan:
-    """A planned program and its report."""
+    """A planned program, its report, and the drawing as placed (scale/fit, mm)."""
 
     program: Program
     report: PlanReport
+    placed: Drawing
 
 
 def plan(drawing: Drawing, options: PlanOptions, machine: Machine | None = None) -> Program:
@@ -127,12 +127,10 @@ def plan_drawing(
     """
     from camtool.toolpath.passes import emit_moves
 
-    if machine is not None and not machine.has_z and options.z_options():
-        raise UsageError(
-            f"{', '.join(options.z_options())}: the {machine.name} has no programmable Z "
-            "axis (2D target); set the depth by hand on the machine and leave these out"
-        )
-    contours = chain(place(drawing, options).contours, options.tolerance)
+    if machine is not None:
+        options.check_machine(machine, machine.name)
+    placed = place(drawing, options)
+    contours = chain(placed.contours, options.tolerance)
     contours, found = close_gaps(contours, options.close_gap, options.tolerance)
     findings = list(found)
     stats = None
@@ -147,7 +145,7 @@ def plan_drawing(
     moves = emit_moves(ordering.cuts, options, helix=helix)
     report = PlanReport(len(contours), len(stage.cuts), tuple(findings), ordering, stats)
     warnings = tuple(dict.fromkeys((*drawing.warnings, *(f.message for f in findings))))
-    return Plan(Program(tuple(moves), options.origin, warnings), report)
+    return Plan(Program(tuple(moves), options.origin, warnings), report, placed)
 
 
 def _stage(contours: Sequence[Contour], nest: Any, options: PlanOptions) -> Stage:
