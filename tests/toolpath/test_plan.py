@@ -18,20 +18,12 @@ from camtool.toolpath.offset import offset_contour
 from camtool.toolpath.order import nesting, order_cuts
 from camtool.toolpath.plan import PlanOptions, plan
 from tests.shapes import rectangle_dxf, write_dxf
-
-
-def _rect(x0: float, y0: float, x1: float, y1: float) -> Contour:
-    pts = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
-    return Contour(tuple(Line(pts[i], pts[(i + 1) % 4]) for i in range(4)), True)
-
-
-def _circle(cx: float, cy: float, r: float) -> Contour:
-    return Contour((Arc((cx + r, cy), (cx + r, cy), (cx, cy), False),), True)
+from tests.toolpath.contours import circle, rect
 
 
 def test_rectangle_outside_1mm_tool(tmp_path: Path) -> None:
     # Issue 2 §6: 10 × 5 rectangle, 1 mm tool outside → four r = 0.5 corner arcs, 11 × 6 box.
-    out = offset_contour(_rect(0, 0, 10, 5), 0.5)
+    out = offset_contour(rect(0, 0, 10, 5), 0.5)
     arcs = [s for s in out.segments if isinstance(s, Arc)]
     assert len(arcs) == 4 and len(out.segments) == 8
     assert all(a.radius == pytest.approx(0.5) for a in arcs)
@@ -40,14 +32,14 @@ def test_rectangle_outside_1mm_tool(tmp_path: Path) -> None:
 
 
 def test_rectangle_inside_1mm_tool() -> None:
-    out = offset_contour(_rect(0, 0, 10, 5), -0.5)
+    out = offset_contour(rect(0, 0, 10, 5), -0.5)
     assert all(isinstance(s, Line) for s in out.segments)
     x0, y0, x1, y1 = out.bbox()
     assert (x1 - x0, y1 - y0) == (pytest.approx(9.0), pytest.approx(4.0))
 
 
 def test_offset_keeps_orientation_and_start() -> None:
-    cw = _rect(0, 0, 10, 5).reversed()
+    cw = rect(0, 0, 10, 5).reversed()
     out = offset_contour(cw, 0.5)
     assert out.signed_area() < 0
     assert math.dist(out.start, cw.start) <= 0.5 + 1e-9
@@ -56,7 +48,7 @@ def test_offset_keeps_orientation_and_start() -> None:
 def test_circle_offsets_stay_exact_arcs() -> None:
     # A 10 mm circle offset by 1 mm has radius 6 mm (STYLE 12), and 4 mm inside.
     for amount, radius in ((1.0, 6.0), (-1.0, 4.0)):
-        out = offset_contour(_circle(0, 0, 5), amount)
+        out = offset_contour(circle(0, 0, 5), amount)
         assert all(isinstance(s, Arc) and s.radius == pytest.approx(radius) for s in out.segments)
         assert sum(abs(s.sweep) for s in out.segments if isinstance(s, Arc)) == pytest.approx(
             2 * math.pi
@@ -65,7 +57,7 @@ def test_circle_offsets_stay_exact_arcs() -> None:
 
 def test_offset_too_deep_is_reported_with_location() -> None:
     with pytest.raises(ToolpathError, match=r"starting at \(0.0000, 0.0000\)"):
-        offset_contour(_rect(0, 0, 1, 1), -0.6)
+        offset_contour(rect(0, 0, 1, 1), -0.6)
 
 
 def test_chain_joins_lines_within_tolerance_and_closes() -> None:
@@ -87,7 +79,7 @@ def test_chain_leaves_far_ends_apart() -> None:
 
 
 def test_inside_contours_are_cut_first() -> None:
-    outer, hole, other = _rect(0, 0, 10, 10), _circle(5, 5, 1), _rect(20, 0, 21, 1)
+    outer, hole, other = rect(0, 0, 10, 10), circle(5, 5, 1), rect(20, 0, 21, 1)
     contours = [outer, hole, other]
     nest = nesting(contours)
     assert nest.parents == ((), (0,), ())
@@ -165,7 +157,7 @@ def test_a_single_arc_whose_ends_meet_is_closed() -> None:
 
 
 def test_nesting_of_open_contours_and_duplicates() -> None:
-    square, twin = _rect(0, 0, 4, 4), _rect(0, 0, 4, 4)
+    square, twin = rect(0, 0, 4, 4), rect(0, 0, 4, 4)
     slot = Contour((Line((1, 1), (3, 1)),), False)
     outside = Contour((Line((5, 1), (6, 1)),), False)
     nest = nesting([square, twin, slot, outside])

@@ -6,6 +6,7 @@ test_passes); here the stages run together through :func:`camtool.pipeline.post_
 
 from __future__ import annotations
 
+import itertools
 import math
 from pathlib import Path
 from typing import Any
@@ -17,18 +18,15 @@ from camtool.geometry import Arc, Contour, Drawing, Line
 from camtool.pipeline import post_drawing, post_file
 from camtool.post.registry import load_target
 from camtool.program import ArcMove, Linear, Rapid
-from camtool.toolpath.plan import PlanOptions, fit_dense, plan_drawing
-
-
-def _rect(x0: float, y0: float, x1: float, y1: float) -> Contour:
-    pts = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
-    return Contour(tuple(Line(pts[i], pts[(i + 1) % 4]) for i in range(4)), True)
+from camtool.toolpath.plan import MIN_FIT_RUN, PlanOptions, fit_dense, plan_drawing
+from tests.shapes import STAR_XY_01MM
+from tests.toolpath.contours import rect
 
 
 def _plate() -> Drawing:
     """A 30 × 20 mm plate with a ø6 mm hole."""
     hole = Contour((Arc((18.0, 10.0), (18.0, 10.0), (15.0, 10.0), False),), True)
-    return Drawing((_rect(0, 0, 30, 20), hole), "plate").transformed(1.0, 5.0, 5.0)
+    return Drawing((rect(0, 0, 30, 20), hole), "plate").transformed(1.0, 5.0, 5.0)
 
 
 @pytest.mark.parametrize("target", ["pic-mmh", "matlab-router"])
@@ -85,9 +83,15 @@ def test_dense_polyline_becomes_arcs_and_the_saving_is_reported() -> None:
 
 
 def test_sharp_polygons_are_not_fitted() -> None:
-    # The seed-002 star keeps its ten straight edges (its lxy arrays are golden values).
-    (rect,), stats = fit_dense([_rect(0, 0, 10, 5)], 0.001)
-    assert stats.replaced == 0 and len(rect.segments) == 4
+    # The seed-002 star (§3, L3196–L3200) keeps its ten straight edges: ten lines are a run
+    # long enough to be tried, but every vertex turns far more than the corner angle, and
+    # its lxy arrays (L3212–L3228) are golden values of the matlab-router tests.
+    xs, ys = STAR_XY_01MM
+    pts = [(x / 10.0, y / 10.0) for x, y in zip(xs, ys, strict=True)]
+    star = Contour(tuple(Line(a, b) for a, b in itertools.pairwise(pts)), True)
+    assert len(star.segments) >= MIN_FIT_RUN
+    (fitted,), stats = fit_dense([star], 0.001)
+    assert stats.replaced == 0 and fitted.segments == star.segments
 
 
 def test_grbl_depth_passes_and_tabs_verify(tmp_path: Path) -> None:

@@ -20,27 +20,15 @@ from shapely import Point as ShapelyPoint
 from shapely.geometry.base import BaseGeometry
 
 from camtool.errors import ToolpathError
-from camtool.geometry import Arc, Contour, Line, Point, Segment
+from camtool.geometry import Arc, Contour, Line, Segment
 from camtool.toolpath.cuts import Cut, Stage
 from camtool.toolpath.offset import offset_contour
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.order import nesting
 from camtool.toolpath.pocket import pocket
+from tests.toolpath.contours import circle, polygon, rect
 
 TOL = 0.001
-
-
-def _poly(points: Sequence[Point]) -> Contour:
-    n = len(points)
-    return Contour(tuple(Line(points[i], points[(i + 1) % n]) for i in range(n)), True)
-
-
-def _rect(x0: float, y0: float, x1: float, y1: float) -> Contour:
-    return _poly([(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
-
-
-def _circle(cx: float, cy: float, r: float) -> Contour:
-    return Contour((Arc((cx + r, cy), (cx + r, cy), (cx, cy), False),), True)
 
 
 def _plan(contours: Sequence[Contour], tool: float = 2.0, **kw: object) -> Stage:
@@ -88,7 +76,7 @@ def test_rectangle_rings_distances_and_one_cut() -> None:
     # d = 1, 1.8, 2.6, 3.4, 4.2 (the next, 5.0, reaches the middle line and is empty).
     r, s, inradius = 1.0, 0.8, 5.0
     expected = [r + k * s for k in range(10) if r + k * s < inradius - 1e-9]
-    stage = _plan([_rect(0, 0, 20, 10)])
+    stage = _plan([rect(0, 0, 20, 10)])
     assert [c.kind for c in stage.cuts] == ["pocket"]  # linked: no retracts
     cut = stage.cuts[0]
     assert not cut.may_reverse and not cut.may_rotate
@@ -101,17 +89,17 @@ def test_rectangle_rings_distances_and_one_cut() -> None:
     # the wall ring is the exact inside offset: four lines, the 18 × 8 box
     wall = rings[0]
     assert len(wall) == 4 and all(isinstance(seg, Line) for seg in wall)
-    exact = offset_contour(_rect(0, 0, 20, 10), -1.0)
+    exact = offset_contour(rect(0, 0, 20, 10), -1.0)
     assert _signed_area(wall) == pytest.approx(abs(exact.signed_area()), abs=1e-9)
     # every link, swept by the tool, stays inside the pocket
-    region = _shape(_rect(0, 0, 20, 10)).buffer(TOL)
+    region = _shape(rect(0, 0, 20, 10)).buffer(TOL)
     for link in links:
         assert region.covers(LineString([link.start, link.end]).buffer(r))
 
 
 def test_rectangle_swept_area_leaves_only_the_corner_fillets() -> None:
-    stage = _plan([_rect(0, 0, 20, 10)])
-    uncovered = _shape(_rect(0, 0, 20, 10)).difference(_swept(stage.cuts, 1.0))
+    stage = _plan([rect(0, 0, 20, 10)])
+    uncovered = _shape(rect(0, 0, 20, 10)).difference(_swept(stage.cuts, 1.0))
     assert uncovered.area == pytest.approx(4 * FILLET, abs=0.01)
     assert not [f for f in stage.findings if f.kind == "uncut"]
     (corners,) = [f for f in stage.findings if f.kind == "tight-corner"]
@@ -122,7 +110,7 @@ def test_circle_rings_are_concentric_arcs_and_the_centre_is_cut() -> None:
     # R = 10, r = 1, s = 0.8: ring radii R − r − k·s > 0: 9, 8.2, ..., 0.2 (12 rings).
     big_r, r, s = 10.0, 1.0, 0.8
     radii = [big_r - r - k * s for k in range(20) if big_r - r - k * s > 1e-9]
-    stage = _plan([_circle(0, 0, big_r)])
+    stage = _plan([circle(0, 0, big_r)])
     assert len(stage.cuts) == 1
     rings, links = _loops(stage.cuts[0].path)
     assert len(rings) == len(radii) == 12
@@ -137,7 +125,7 @@ def test_circle_rings_are_concentric_arcs_and_the_centre_is_cut() -> None:
     assert all(link.length == pytest.approx(s, abs=TOL) for link in links)  # radial links
     swept = _swept(stage.cuts, r)
     assert swept.covers(ShapelyPoint(0, 0))
-    disc = _shape(_circle(0, 0, big_r))
+    disc = _shape(circle(0, 0, big_r))
     assert disc.difference(swept).area < TOL * disc.length  # chords of the buffers only
     assert not stage.findings
 
@@ -145,14 +133,14 @@ def test_circle_rings_are_concentric_arcs_and_the_centre_is_cut() -> None:
 def test_large_stepover_adds_a_ring_so_the_middle_is_cut() -> None:
     # s = 0.9·2 = 1.8: rings at radius 9, 7.2, 5.4, 3.6, 1.8; the middle lies 1.8 > r from
     # the last ring, so one more ring goes round it (r/2 inside the deepest point).
-    stage = _plan([_circle(0, 0, 10.0)], stepover=0.9)
+    stage = _plan([circle(0, 0, 10.0)], stepover=0.9)
     rings, _ = _loops(stage.cuts[0].path)
     assert len(rings) == 6
     last = rings[-1][0]
     assert isinstance(last, Arc) and last.radius < 1.0
     swept = _swept(stage.cuts, 1.0)
     assert swept.covers(ShapelyPoint(0, 0))
-    disc = _shape(_circle(0, 0, 10.0))
+    disc = _shape(circle(0, 0, 10.0))
     assert disc.difference(swept).area < TOL * disc.length
     assert not stage.findings
 
@@ -160,11 +148,11 @@ def test_large_stepover_adds_a_ring_so_the_middle_is_cut() -> None:
 @pytest.mark.parametrize("style", ["concentric", "zigzag"])
 @pytest.mark.parametrize(
     "island",
-    [_circle(12, 10, 4), _rect(8, 6, 16, 14), _rect(6, 9.2, 24, 10.8)],
+    [circle(12, 10, 4), rect(8, 6, 16, 14), rect(6, 9.2, 24, 10.8)],
     ids=["circle", "square", "bar"],
 )
 def test_islands_and_outer_wall_are_never_cut_into(style: str, island: Contour) -> None:
-    outer = _rect(0, 0, 30, 20)
+    outer = rect(0, 0, 30, 20)
     stage = _plan([outer, island], pocket=style, pocket_angle_deg=30.0)
     assert stage.cuts and all(c.kind == "pocket" and c.group == 0 for c in stage.cuts)
     swept = _swept(stage.cuts, 1.0)
@@ -181,7 +169,7 @@ def test_islands_and_outer_wall_are_never_cut_into(style: str, island: Contour) 
 
 @pytest.mark.parametrize("angle", [0.0, 45.0])
 def test_zigzag_lines_follow_the_angle_at_the_stepover(angle: float) -> None:
-    stage = _plan([_rect(0, 0, 20, 10)], pocket="zigzag", pocket_angle_deg=angle)
+    stage = _plan([rect(0, 0, 20, 10)], pocket="zigzag", pocket_angle_deg=angle)
     first = stage.cuts[0]
     rings, _ = _loops(Contour(first.path.segments[:4], True))
     assert len(rings) == 1  # the wall ring comes first
@@ -200,13 +188,13 @@ def test_zigzag_lines_follow_the_angle_at_the_stepover(angle: float) -> None:
     assert count >= len(offsets) >= 8
     gaps = [b - a for a, b in itertools.pairwise(offsets)]
     assert gaps == pytest.approx([0.8] * len(gaps), abs=1e-6)
-    uncovered = _shape(_rect(0, 0, 20, 10)).difference(_swept(stage.cuts, 1.0))
+    uncovered = _shape(rect(0, 0, 20, 10)).difference(_swept(stage.cuts, 1.0))
     assert uncovered.area < 4 * FILLET + 0.05
     assert not [f for f in stage.findings if f.kind == "uncut"]
 
 
 def test_zigzag_rows_alternate_direction() -> None:
-    stage = _plan([_rect(0, 0, 20, 10)], pocket="zigzag")
+    stage = _plan([rect(0, 0, 20, 10)], pocket="zigzag")
     assert len(stage.cuts) == 1  # every row linked to the next along the wall
     rows = [s for s in stage.cuts[0].path.segments[4:] if isinstance(s, Line) and s.length > 5]
     directions = [math.copysign(1.0, s.end[0] - s.start[0]) for s in rows]
@@ -216,7 +204,7 @@ def test_zigzag_rows_alternate_direction() -> None:
 def test_slot_narrower_than_the_tool_is_reported_where_it_is() -> None:
     # A 20 × 10 pocket with a 1 mm wide, 6 mm long arm to the right; 2 mm tool.
     outline = [(0, 0), (20, 0), (20, 4.5), (26, 4.5), (26, 5.5), (20, 5.5), (20, 10), (0, 10)]
-    stage = _plan([_poly(outline)])
+    stage = _plan([polygon(outline)])
     uncut = [f for f in stage.findings if f.kind == "uncut"]
     assert len(uncut) == 1
     (finding,) = uncut
@@ -232,7 +220,7 @@ def test_stepover_too_large_for_square_corners_is_reported_between_passes() -> N
     # sides but leave a cusp at each corner between two rings: the square r × r beyond both
     # sweeps minus the quarter disc of the inner ring's corner, r² − πr²/4. 4 gaps × 4
     # corners, less the corner each diagonal link sweeps: 12 cusps.
-    stage = _plan([_rect(0, 0, 20, 20)], stepover=1.0)
+    stage = _plan([rect(0, 0, 20, 20)], stepover=1.0)
     uncut = [f for f in stage.findings if f.kind == "uncut"]
     single, more = uncut[:5], uncut[5:]
     assert len(single) == 5 and len(more) == 1
@@ -246,7 +234,7 @@ def test_stepover_too_large_for_square_corners_is_reported_between_passes() -> N
 
 
 def test_pocket_entirely_narrower_than_the_tool_is_a_finding() -> None:
-    stage = _plan([_rect(0, 0, 20, 10), _rect(30, 0, 40, 1.5)])
+    stage = _plan([rect(0, 0, 20, 10), rect(30, 0, 40, 1.5)])
     assert {c.group for c in stage.cuts} == {0}
     (finding,) = [f for f in stage.findings if f.kind == "uncut"]
     assert finding.value == pytest.approx(15.0, rel=1e-6)
@@ -256,13 +244,13 @@ def test_pocket_entirely_narrower_than_the_tool_is_a_finding() -> None:
 
 def test_nothing_to_pocket_raises() -> None:
     with pytest.raises(ToolpathError, match="narrower than the 2 mm tool"):
-        _plan([_rect(0, 0, 10, 1)])
+        _plan([rect(0, 0, 10, 1)])
     with pytest.raises(ToolpathError, match="needs closed contours"):
         _plan([Contour((Line((0, 0), (5, 0)),), False)])
 
 
 def test_direction_climb_and_conventional_are_opposite() -> None:
-    contours = [_rect(0, 0, 30, 20), _circle(15, 10, 3)]
+    contours = [rect(0, 0, 30, 20), circle(15, 10, 3)]
     orientations = {}
     for direction in ("climb", "conventional"):
         stage = _plan(contours, direction=direction)
@@ -278,7 +266,7 @@ def test_direction_climb_and_conventional_are_opposite() -> None:
 
 def test_island_inside_an_island_is_a_new_pocket() -> None:
     # depth 0 pocket, depth 1 island, depth 2 pocket inside the island
-    contours = [_rect(0, 0, 40, 30), _rect(10, 5, 30, 25), _rect(15, 10, 25, 20)]
+    contours = [rect(0, 0, 40, 30), rect(10, 5, 30, 25), rect(15, 10, 25, 20)]
     stage = _plan(contours)
     assert {c.group for c in stage.cuts} == {0, 2}
     inner = _swept([c for c in stage.cuts if c.group == 2], 1.0)
@@ -287,7 +275,7 @@ def test_island_inside_an_island_is_a_new_pocket() -> None:
 
 def test_open_contours_are_cut_on_the_line() -> None:
     line = Contour((Line((50, 0), (60, 0)),), False)
-    stage = _plan([_rect(0, 0, 20, 10), line])
+    stage = _plan([rect(0, 0, 20, 10), line])
     opened = [c for c in stage.cuts if c.kind == "open"]
     assert [(c.path, c.group, c.may_rotate) for c in opened] == [(line, 1, False)]
     (finding,) = [f for f in stage.findings if f.kind == "open-on-line"]
@@ -310,7 +298,7 @@ def test_random_star_pockets_never_gouge(
         (rho * math.cos(math.tau * k / n), rho * math.sin(math.tau * k / n))
         for k, rho in enumerate(radii)
     ]
-    outer, hole = _poly(points), _circle(0.0, 0.0, island)
+    outer, hole = polygon(points), circle(0.0, 0.0, island)
     stage = _plan([outer, hole], pocket=style, pocket_angle_deg=angle)
     region = _shape(outer).difference(_shape(hole))
     swept = _swept(stage.cuts, 1.0)
@@ -318,8 +306,8 @@ def test_random_star_pockets_never_gouge(
 
 
 def test_a_large_pocket_with_two_islands_plans_fast() -> None:
-    contours = [_rect(0, 0, 100, 60), _circle(30, 30, 10), _rect(60, 20, 80, 40)]
-    _plan([_rect(0, 0, 10, 10)])  # load OpenCASCADE first: timed is the planning only
+    contours = [rect(0, 0, 100, 60), circle(30, 30, 10), rect(60, 20, 80, 40)]
+    _plan([rect(0, 0, 10, 10)])  # load OpenCASCADE first: timed is the planning only
     for style in ("concentric", "zigzag"):
         t0 = time.perf_counter()
         stage = _plan(contours, tool=3.0, pocket=style)
