@@ -29,20 +29,19 @@ _CHORD_MM = 1e-4  # chord error of the path polygon
 _NEAR_MM = 1e-3  # sample points this close to the path count as touching it
 
 
-def has_leads(cut: Cut, radius: float) -> bool:
-    """True when ``cut`` gets lead arcs.
+def leads_for(cut: Cut, radius: float) -> tuple[Arc, Arc] | None:
+    """The lead arcs ``cut`` gets for ``--lead-in radius``, or ``None``.
 
-    That is a closed profile with a material side, ``radius`` > 0 and a lead radius
-    that fits on the waste side (see :func:`fitted_radius`).
+    A cut gets them when it is a closed profile with a material side, ``radius``
+    is > 0 and a lead radius fits on the waste side (:func:`fitted_radius`; the
+    arcs are computed once, at that radius).
     """
-    return (
-        radius > 0
-        and cut.kind == "profile"
-        and cut.path.closed
-        and cut.material_side is not None
-        and bool(Track.of(cut.path).segments)
-        and fitted_radius(cut, radius) > 0
-    )
+    if radius <= 0 or cut.kind != "profile" or not cut.path.closed:
+        return None
+    if cut.material_side is None or not Track.of(cut.path).segments:
+        return None
+    fitted = fitted_radius(cut, radius)
+    return _arcs(cut, fitted) if fitted > 0 else None
 
 
 def fitted_radius(cut: Cut, radius: float) -> float:
@@ -76,7 +75,7 @@ def lead_arcs(cut: Cut, radius: float) -> tuple[Arc, Arc]:
     """The lead-in and lead-out arcs of a closed profile, at :func:`fitted_radius`.
 
     Args:
-        cut: a closed cut with ``material_side`` set (see :func:`has_leads`).
+        cut: a closed cut with ``material_side`` set.
         radius: asked lead arc radius, mm (> 0); each arc sweeps 90°.
 
     Returns:
@@ -85,12 +84,14 @@ def lead_arcs(cut: Cut, radius: float) -> tuple[Arc, Arc]:
         tangent to the last segment. Both curve away from the material side.
 
     Raises:
-        ValueError: the cut has no material side.
+        ValueError: the cut has no material side, or no lead radius fits.
     """
     if cut.material_side is None:
         raise ValueError("lead arcs need the cut's material side")
     fitted = fitted_radius(cut, radius)
-    return _arcs(cut, fitted if fitted > 0 else radius)
+    if fitted <= 0:
+        raise ValueError(f"no lead radius up to {radius:g} mm fits on the waste side")
+    return _arcs(cut, fitted)
 
 
 def _arcs(cut: Cut, radius: float) -> tuple[Arc, Arc]:

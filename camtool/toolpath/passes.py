@@ -53,7 +53,7 @@ from itertools import pairwise
 from camtool.geometry import Arc, Segment
 from camtool.program import ArcMove, Linear, Move, Rapid
 from camtool.toolpath.cuts import Cut, where
-from camtool.toolpath.leads import has_leads, lead_arcs
+from camtool.toolpath.leads import leads_for
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.split import MIN_PIECE, Track
 from camtool.toolpath.tabs import tab_spans
@@ -257,7 +257,7 @@ def _unrolled(
 
 def _cut_2d(w: _Writer, cut: Cut) -> None:
     """What the planner always wrote for a 2D cut, plus lead arcs when asked."""
-    leads = lead_arcs(cut, w.options.lead_in_mm) if has_leads(cut, w.options.lead_in_mm) else None
+    leads = leads_for(cut, w.options.lead_in_mm)
     segments = list(cut.path.segments)
     if leads is not None:
         segments = [leads[0], *segments, leads[1]]
@@ -330,8 +330,9 @@ def _cut_closed(w: _Writer, cut: Cut, levels: Sequence[float]) -> None:
     spans: tuple[tuple[float, float], ...] = ()
     if o.tabs > 0 and cut.outside_profile and cut.kind == "profile":
         spans = tab_spans(track.length, o.tabs, o.tab_width + o.tool_diameter, where(cut.path))
-    if has_leads(cut, o.lead_in_mm):
-        lead_in, lead_out = lead_arcs(cut, o.lead_in_mm)
+    leads = leads_for(cut, o.lead_in_mm)
+    if leads is not None:
+        lead_in, lead_out = leads
         lead = Track.from_segments([lead_in], closed=False)
         for z_from, z_to in pairwise((0.0, *levels)):
             w.travel(*lead_in.start)
