@@ -47,18 +47,17 @@ def flag(field_name: str) -> str:
 def drawing_only(options: dict[str, object]) -> list[str]:
     """Flags of the planning options in ``options`` that differ from their defaults.
 
-    Feed and tolerance are left out: they apply to re-posted programs too. Used to
-    refuse, not ignore, toolpath options given for an existing G-code program.
+    Only :data:`PLAN_FIELDS` count (feed and tolerance apply to re-posted programs
+    too), in the order :class:`PlanOptions` declares them. Used to refuse, not
+    ignore, toolpath options given for an existing G-code program.
     """
     import dataclasses
 
-    given = []
-    for f in dataclasses.fields(PlanOptions):
-        if f.name in ("feed_mm_min", "tolerance", "origin") or f.name not in options:
-            continue
-        if options[f.name] != f.default:
-            given.append(flag(f.name))
-    return given
+    return [
+        flag(f.name)
+        for f in dataclasses.fields(PlanOptions)
+        if f.name in PLAN_FIELDS and f.name in options and options[f.name] != f.default
+    ]
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -105,10 +105,10 @@ def uncut_findings(
     fillets = [p for p in pieces if _is_fillet(p, centres, zone, threshold)]
     narrow = sorted((p for p in pieces if not any(p is f for f in fillets)), key=lambda p: -p.area)
     reach = _reachable(area, options) if narrow else area
+    missed = f"between passes; reduce --stepover (now {options.stepover:g})"
+    too_narrow = f"narrower than the {d:g} mm tool; use a smaller tool to clear it"
     findings = [
-        _missed(p, boundary, options)
-        if p.difference(reach).area <= threshold
-        else _narrow(p, boundary, d)
+        _uncut(p, boundary, missed if p.difference(reach).area <= threshold else too_narrow)
         for p in narrow[:MAX_REPORTED]
     ]
     rest = narrow[MAX_REPORTED:]
@@ -140,23 +140,12 @@ def _reachable(area: Polygon, options: PlanOptions) -> BaseGeometry:
     return area.buffer(-r, quad_segs=quad).buffer(r + tol, quad_segs=quad)
 
 
-def _missed(piece: Polygon, boundary: Contour, options: PlanOptions) -> Finding:
+def _uncut(piece: Polygon, boundary: Contour, why: str) -> Finding:
+    """The finding for one uncut ``piece`` of the pocket ``boundary``, ``why`` it is left."""
     x, y = _at(piece)
     return Finding(
         "uncut",
-        f"{where(boundary)}: {piece.area:.3g} mm² left uncut between passes at "
-        f"({x:.3f}, {y:.3f}) mm; reduce --stepover (now {options.stepover:g})",
-        (x, y),
-        piece.area,
-    )
-
-
-def _narrow(piece: Polygon, boundary: Contour, d: float) -> Finding:
-    x, y = _at(piece)
-    return Finding(
-        "uncut",
-        f"{where(boundary)}: {piece.area:.3g} mm² left uncut at ({x:.3f}, {y:.3f}) mm, "
-        f"narrower than the {d:g} mm tool; use a smaller tool to clear it",
+        f"{where(boundary)}: {piece.area:.3g} mm² left uncut at ({x:.3f}, {y:.3f}) mm, {why}",
         (x, y),
         piece.area,
     )
