@@ -72,6 +72,7 @@ class BatchOptions:
             ``tool_diameter``, ``scale``, ``fit_mm``, ``depth``, ``order``...).
         fmt: the dialect's output format (``None``: its default).
         spindle_rpm: rev/min; ``None``: the target's; 0: no spindle commands.
+        spindle_dwell_s: pause after the spindle starts, s (``--spindle-dwell``).
         layers: layers to keep (``None``: all).
         units: unit of unitless inputs (point lists).
         hatch_boundaries: use DXF HATCH boundaries as contours.
@@ -97,6 +98,7 @@ class BatchOptions:
     plan: Mapping[str, Any] = field(default_factory=dict)
     fmt: str | None = None
     spindle_rpm: float | None = None
+    spindle_dwell_s: float = 0.0
     layers: tuple[str, ...] | None = None
     units: str | None = None
     hatch_boundaries: bool = False
@@ -142,6 +144,7 @@ class BatchOptions:
             "tolerance": self.tolerance,
             "fmt": self.fmt,
             "spindle_rpm": self.spindle_rpm,
+            "spindle_dwell_s": self.spindle_dwell_s,
         }
 
 
@@ -247,7 +250,11 @@ def plan_batch(inputs: Sequence[str], options: BatchOptions) -> BatchPlan:
     fmt = target.post.check_format(options.fmt)
     plan_options(  # validates the post options once, before any file
         target,
-        **{k: v for k, v in options.post_options().items() if k not in ("fmt", "spindle_rpm")},
+        **{
+            k: v
+            for k, v in options.post_options().items()
+            if k not in ("fmt", "spindle_rpm", "spindle_dwell_s")
+        },
     )
     if options.output_dir.exists() and not options.output_dir.is_dir():
         raise UsageError(f"{options.output_dir}: exists and is not a directory (-o OUTDIR)")

@@ -16,8 +16,10 @@ import click
 from camtool import __version__
 from camtool.cli_common import (
     MACHINE,
+    NUMBER,
     import_options,
     import_settings,
+    number_range,
     post_options,
     read_code,
     read_input,
@@ -39,7 +41,7 @@ def _verify_outputs(command: Callable[..., None]) -> Callable[..., None]:
     """The options every verifying command shares: --report, --preview, --max-error-um."""
     command = click.option(
         "--max-error-um",
-        type=click.FloatRange(min=0),
+        type=number_range(min=0),
         default=None,
         metavar="N",
         help="Exit with code 4 when the predicted error exceeds N µm (for CI).",
@@ -156,7 +158,7 @@ def post(
 )
 @click.option(
     "--tool-diameter",
-    type=float,
+    type=NUMBER,
     default=0.0,
     show_default=True,
     metavar="MM",
@@ -230,7 +232,7 @@ def _finish_verification(
 @click.option("--json", "as_json", is_flag=True, help="Write the report as JSON.")
 @click.option(
     "--tolerance",
-    type=float,
+    type=NUMBER,
     default=0.001,
     show_default=True,
     metavar="MM",

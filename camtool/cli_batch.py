@@ -14,7 +14,13 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
-from camtool.cli_common import MACHINE, import_options, post_options, write_output
+from camtool.cli_common import (
+    MACHINE,
+    import_options,
+    number_range,
+    post_options,
+    write_output,
+)
 from camtool.errors import CamtoolError, InputError, UsageError, VerifyLimitError
 
 if TYPE_CHECKING:
@@ -60,7 +66,7 @@ def _post_options(command: Callable[..., None]) -> Callable[..., None]:
 )
 @click.option(
     "--max-error-um",
-    type=click.FloatRange(min=0),
+    type=number_range(min=0),
     default=None,
     metavar="N",
     help="A file whose predicted error exceeds N µm is over the limit: exit code 4 "

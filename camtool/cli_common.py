@@ -6,6 +6,7 @@ every command; the helpers keep stdout for data and stderr for messages.
 
 from __future__ import annotations
 
+import math
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -14,11 +15,53 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from camtool.errors import CamtoolError, InputError
-from camtool.toolpath.options import DIRECTIONS, OFFSET_MODES, ORDERS, POCKET_STYLES
+from camtool.toolpath.options import (
+    DEFAULT_CHAIN_TOLERANCE,
+    DIRECTIONS,
+    OFFSET_MODES,
+    ORDERS,
+    PLACEMENTS,
+    POCKET_STYLES,
+)
 
 if TYPE_CHECKING:
     from camtool.geometry import Drawing
     from camtool.importers import ImportOptions
+
+
+class FiniteFloat(click.FloatRange):
+    """A float option that refuses NaN and ±inf, within an optional range.
+
+    click's float takes both, and ``x <= 0`` is false for NaN, so a range check alone
+    lets NaN through. Every numeric option of every command uses it (:data:`NUMBER`,
+    :func:`number_range`), so a non-finite value is refused at the boundary, naming
+    the option.
+    """
+
+    name = "number"
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        """The value as a finite float in range, or a usage error naming the option."""
+        if isinstance(value, str) and "_" in value:
+            self.fail(f"{value!r} is not a number", param, ctx)
+        rv = super().convert(value, param, ctx)
+        if not math.isfinite(rv):
+            self.fail(f"{value!r} is not a finite number", param, ctx)
+        return rv
+
+
+NUMBER = FiniteFloat()
+"""Any finite float (see :class:`FiniteFloat`)."""
+
+
+def number_range(
+    min: float | None = None,
+    max: float | None = None,
+    *,
+    min_open: bool = False,
+) -> FiniteFloat:
+    """A finite float in ``[min, max]`` (``min_open``: excluding ``min``)."""
+    return FiniteFloat(min=min, max=max, min_open=min_open)
 
 
 def warn(messages: tuple[str, ...] | list[str]) -> None:
@@ -114,7 +157,7 @@ _POST_OPTIONS = (
     ),
     click.option(
         "--tool-diameter",
-        type=float,
+        type=NUMBER,
         default=0.0,
         metavar="MM",
         help="Tool diameter in mm (needed by every --offset but 'on').",
@@ -128,7 +171,7 @@ _POST_OPTIONS = (
     ),
     click.option(
         "--stepover",
-        type=float,
+        type=NUMBER,
         default=0.4,
         show_default=True,
         metavar="FRACTION",
@@ -144,7 +187,7 @@ _POST_OPTIONS = (
     click.option(
         "--pocket-angle",
         "pocket_angle_deg",
-        type=float,
+        type=NUMBER,
         default=0.0,
         show_default=True,
         metavar="DEG",
@@ -152,21 +195,21 @@ _POST_OPTIONS = (
     ),
     click.option(
         "--depth",
-        type=float,
+        type=NUMBER,
         default=None,
         metavar="MM",
         help="Cut depth below the top (Z 0), mm; Z targets only. Without it no Z is written.",
     ),
     click.option(
         "--step-down",
-        type=float,
+        type=NUMBER,
         default=None,
         metavar="MM",
         help="Depth of each pass, mm [default: one pass at --depth].",
     ),
     click.option(
         "--safe-z",
-        type=float,
+        type=NUMBER,
         default=2.0,
         show_default=True,
         metavar="MM",
@@ -175,7 +218,7 @@ _POST_OPTIONS = (
     click.option(
         "--plunge-feed",
         "plunge_feed_mm_min",
-        type=float,
+        type=NUMBER,
         default=None,
         metavar="MM_PER_MIN",
         help="Feed of Z moves into the material [default: half the cutting feed].",
@@ -183,7 +226,7 @@ _POST_OPTIONS = (
     click.option(
         "--ramp",
         "ramp_angle_deg",
-        type=float,
+        type=NUMBER,
         default=None,
         metavar="DEG",
         help="Enter each pass descending along the path at DEG from the horizontal, "
@@ -199,7 +242,7 @@ _POST_OPTIONS = (
     ),
     click.option(
         "--tab-width",
-        type=float,
+        type=NUMBER,
         default=2.0,
         show_default=True,
         metavar="MM",
@@ -207,7 +250,7 @@ _POST_OPTIONS = (
     ),
     click.option(
         "--tab-height",
-        type=float,
+        type=NUMBER,
         default=0.5,
         show_default=True,
         metavar="MM",
@@ -225,7 +268,7 @@ _POST_OPTIONS = (
     click.option(
         "--lead-in",
         "lead_in_mm",
-        type=float,
+        type=NUMBER,
         default=0.0,
         show_default=True,
         metavar="MM",
@@ -233,7 +276,7 @@ _POST_OPTIONS = (
     ),
     click.option(
         "--close-gap",
-        type=float,
+        type=NUMBER,
         default=0.02,
         show_default=True,
         metavar="MM",
@@ -248,14 +291,14 @@ _POST_OPTIONS = (
     click.option(
         "--feed",
         "feed_mm_min",
-        type=float,
+        type=NUMBER,
         default=None,
         metavar="MM_PER_MIN",
         help="Cutting feed in mm/min [default: the target's, 0.8 for pic-mmh].",
     ),
     click.option(
         "--tolerance",
-        type=float,
+        type=NUMBER,
         default=0.001,
         show_default=True,
         metavar="MM",
@@ -264,7 +307,7 @@ _POST_OPTIONS = (
     ),
     click.option(
         "--scale",
-        type=float,
+        type=NUMBER,
         default=1.0,
         show_default=True,
         metavar="K",
@@ -273,10 +316,65 @@ _POST_OPTIONS = (
     click.option(
         "--fit",
         "fit_mm",
-        type=(float, float),
+        type=(NUMBER, NUMBER),
         default=None,
         metavar="W H",
         help="Scale the drawing uniformly to fit W x H mm, about its lower-left corner.",
+    ),
+    click.option(
+        "--origin",
+        "placement",
+        type=click.Choice(PLACEMENTS),
+        default="drawing",
+        show_default=True,
+        help="Where the work zero (X0 Y0) lies: 'drawing' keeps the drawing's coordinates; "
+        "'lower-left'/'center' put it at the toolpath's lower-left corner / centre "
+        "(tool radius, lead-ins and tabs included). Applied after --scale/--fit.",
+    ),
+    click.option(
+        "--translate",
+        type=(NUMBER, NUMBER),
+        default=(0.0, 0.0),
+        metavar="DX DY",
+        help="Move the program by DX DY mm, after --origin.",
+    ),
+    click.option(
+        "--chain-tolerance",
+        type=number_range(min=0),
+        default=DEFAULT_CHAIN_TOLERANCE,
+        show_default=True,
+        metavar="MM",
+        help="Entity ends closer than this are joined into one contour (real CAD files "
+        "leave gaps of a few µm).",
+    ),
+    click.option(
+        "--clearance-z",
+        type=NUMBER,
+        default=None,
+        metavar="MM",
+        help="Height of the first and last moves and of travel between parts, mm above "
+        "the top [default: the larger of 5 mm and --safe-z]. Z targets only.",
+    ),
+    click.option(
+        "--end-position",
+        type=(NUMBER, NUMBER),
+        default=None,
+        metavar="X Y",
+        help="Rapid to X Y at clearance height at the end of the program.",
+    ),
+    click.option(
+        "--reverse-open",
+        is_flag=True,
+        help="Let the cutting order cut open contours backwards (default: as drawn).",
+    ),
+    click.option(
+        "--spindle-dwell",
+        "spindle_dwell_s",
+        type=number_range(min=0),
+        default=0.0,
+        show_default=True,
+        metavar="S",
+        help="Wait S seconds after starting the spindle, before the first move (G4).",
     ),
     click.option(
         "--format",
@@ -288,7 +386,7 @@ _POST_OPTIONS = (
     ),
     click.option(
         "--spindle-rpm",
-        type=click.FloatRange(min=0),
+        type=number_range(min=0),
         default=None,
         metavar="RPM",
         help="Spindle on (M03) at RPM before the first move and off (M05) after the last; "

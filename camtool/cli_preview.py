@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import click
 
-from camtool.cli_common import MACHINE, read_code, warn, write_output
+from camtool.cli_common import MACHINE, number_range, read_code, warn, write_output
 from camtool.errors import InputError, UsageError
 
 if TYPE_CHECKING:
@@ -46,7 +46,7 @@ if TYPE_CHECKING:
 @MACHINE
 @click.option(
     "--tool-diameter",
-    type=click.FloatRange(min=0),
+    type=number_range(min=0),
     default=0.0,
     metavar="MM",
     help="Draw the tool width along the cuts (and sweep the trace with it for --verify).",

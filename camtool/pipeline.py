@@ -112,6 +112,7 @@ def post_path(
         feed_mm_min=options.get("feed_mm_min"),
         fmt=options.get("fmt"),
         spindle_rpm=options.get("spindle_rpm"),
+        spindle_dwell_s=options.get("spindle_dwell_s", 0.0),
     )
 
 
@@ -131,6 +132,7 @@ def post_program(
     feed_mm_min: float | None = None,
     fmt: str | None = None,
     spindle_rpm: float | None = None,
+    spindle_dwell_s: float = 0.0,
 ) -> PostJob:
     """Re-post an existing program (e.g. G-code another CAM wrote) for a target.
 
@@ -141,7 +143,8 @@ def post_program(
     kind, as the thesis users edited VisiCAM output by hand (seed-000 §3.8).
     ``fmt`` is the dialect's output format (default: its first);
     ``spindle_rpm`` > 0 starts the spindle before the first move and stops it
-    after the last (when the program has no spindle commands of its own).
+    after the last (when the program has no spindle commands of its own), waiting
+    ``spindle_dwell_s`` seconds after it starts.
 
     Raises:
         CamtoolError: whatever the target cannot express (names the block).
@@ -158,17 +161,20 @@ def post_program(
         program = dataclasses.replace(program, moves=moves)
     if not target.machine.has_z:
         program = _flatten(program, target.name)
-    program = _with_spindle(program, spindle_rpm)
+    program = _with_spindle(program, spindle_rpm, spindle_dwell_s)
     return PostJob(None, program, target, target.emit(program, fmt=fmt), None, 0.0)
 
 
-def _with_spindle(program: Program, rpm: float | None) -> Program:
-    """``program`` with spindle on/off around it when ``rpm`` > 0 and it has none."""
+def _with_spindle(program: Program, rpm: float | None, dwell_s: float = 0.0) -> Program:
+    """``program`` with spindle on/off around it when ``rpm`` > 0 and it has none.
+
+    ``dwell_s`` > 0 waits after the spindle starts (``--spindle-dwell``).
+    """
     from camtool.program import Spindle
 
     if not rpm or any(isinstance(c, Spindle) for _, c in program.commands):
         return program
-    return program.with_spindle(rpm)
+    return program.with_spindle(rpm, dwell_s=dwell_s)
 
 
 def _flatten(program: Program, target: str) -> Program:
@@ -238,6 +244,7 @@ def post_drawing(
     *,
     fmt: str | None = None,
     spindle_rpm: float | None = None,
+    spindle_dwell_s: float = 0.0,
     **options: Any,
 ) -> PostJob:
     """Plan a drawing and post it for a target.
@@ -248,6 +255,7 @@ def post_drawing(
         fmt: the dialect's output format (``None``: its default).
         spindle_rpm: spindle speed, rev/min; ``None`` takes the target's
             ``spindle_rpm`` (which may be none), 0 programs no spindle.
+        spindle_dwell_s: wait this long after the spindle starts, s.
         **options: :class:`~camtool.toolpath.options.PlanOptions` fields
             (``offset``, ``tool_diameter``, ``feed_mm_min`` — ``None`` takes the
             target's —, ``tolerance``, ``scale``, ``fit_mm``, ``depth``, ``order``...).
@@ -258,7 +266,9 @@ def post_drawing(
     plan = plan_options(target, **options)
     planned = plan_drawing(drawing, plan, target.machine, helix=target.post.helix)
     program = _with_spindle(
-        planned.program, target.spindle_rpm if spindle_rpm is None else spindle_rpm
+        planned.program,
+        target.spindle_rpm if spindle_rpm is None else spindle_rpm,
+        spindle_dwell_s,
     )
     edge = plan.radius if plan.offset != "on" else 0.0
     result = target.emit(program, fmt=fmt)

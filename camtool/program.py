@@ -153,16 +153,24 @@ class Program:
         for _, command in pending:
             yield command
 
-    def with_spindle(self, rpm: float, direction: SpindleDirection = "cw") -> Program:
+    def with_spindle(
+        self, rpm: float, direction: SpindleDirection = "cw", *, dwell_s: float = 0.0
+    ) -> Program:
         """A copy that starts the spindle before the first move and stops it after the last.
 
+        ``dwell_s`` > 0 waits that long after the spindle starts (spin-up), before the
+        first move.
+
         Raises:
-            ValueError: ``rpm`` is not positive or ``direction`` is "off".
+            ValueError: ``rpm`` is not positive, ``direction`` is "off" or ``dwell_s`` < 0.
         """
-        if rpm <= 0 or direction == "off":
+        if not rpm > 0 or direction == "off" or not dwell_s >= 0:
             raise ValueError("spindle speed must be > 0 rev/min and the direction cw or ccw")
         end = len(self.moves)
-        commands = ((0, Spindle(direction, rpm)), *self.commands, (end, Spindle("off")))
+        start: tuple[tuple[int, Command], ...] = ((0, Spindle(direction, rpm)),)
+        if dwell_s > 0:
+            start = (*start, (0, Dwell(dwell_s)))
+        commands = (*start, *self.commands, (end, Spindle("off")))
         return Program(self.moves, self.origin, self.warnings, self.lines, commands)
 
     def line_of(self, index: int) -> int | None:

@@ -42,3 +42,17 @@ def mm_to_um(value_mm: float) -> float:
 def um_to_mm(value_um: float) -> float:
     """Convert µm to mm."""
     return value_um / 1000.0
+
+
+def fmt_num(value: float, decimals: int = 4) -> str:
+    """``value`` with ``decimals`` decimals for messages, never ``-0.0000``.
+
+    A value that rounds to zero prints unsigned (``-0.00001`` → ``"0.0000"``).
+    """
+    text = f"{value:.{decimals}f}"
+    return text[1:] if text.startswith("-") and not text.strip("-0.") else text
+
+
+def fmt_point(point: tuple[float, float], decimals: int = 4) -> str:
+    """``(x, y)`` for messages with :func:`fmt_num` (``"(1.5000, 0.0000)"``)."""
+    return f"({fmt_num(point[0], decimals)}, {fmt_num(point[1], decimals)})"

@@ -123,6 +123,7 @@ class Stage:
 
 def where(contour: Contour) -> str:
     """``"contour LINE #2A at (x, y) mm"``: how messages name a contour."""
-    x, y = contour.start
+    from camtool.units import fmt_point
+
     src = f"{contour.source} " if contour.source else ""
-    return f"contour {src}at ({x:.4f}, {y:.4f}) mm"
+    return f"contour {src}at {fmt_point(contour.start)} mm"

@@ -7,6 +7,7 @@ naming the option, before any file is read (``batch`` validates once for all fil
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -28,6 +29,23 @@ POCKET_STYLES = ("concentric", "zigzag")
 ORDERS = ("travel", "reversals", "mirror")
 """Valid values of ``PlanOptions.order``."""
 
+PLACEMENTS = ("drawing", "lower-left", "center")
+"""Valid values of ``PlanOptions.placement`` (the ``--origin`` option): where the work
+zero (X0 Y0 of the program) lies: the drawing's own origin, the toolpath's lower-left
+corner, or its centre."""
+
+DEFAULT_CHAIN_TOLERANCE = 0.01
+"""Default distance (mm) within which entity ends are joined into one contour.
+
+Real CAD files leave gaps of a few µm between entities that should meet (0.002 mm is
+common). 0.01 mm is dxf2gcode's ``point_tolerance`` default and FreeCAD Path's default
+geometry tolerance; it is far below any tool or machine resolution camtool targets
+except pic-mmh's 140 nm step, where a gap of 10 µm is still below the scribed line."""
+
+DEFAULT_CLEARANCE_Z = 5.0
+"""Clearance height (mm above the top) when ``--clearance-z`` is not given: the larger of
+this and ``--safe-z``."""
+
 _FLAG_NAMES = {
     "fit_mm": "--fit",
     "plunge_feed_mm_min": "--plunge-feed",
@@ -36,6 +54,8 @@ _FLAG_NAMES = {
     "lead_in_mm": "--lead-in",
     "fit_arcs": "--no-fit-arcs",
     "feed_mm_min": "--feed",
+    "placement": "--origin",
+    "reverse_open": "--reverse-open",
 }
 
 
@@ -100,6 +120,22 @@ class PlanOptions:
         lead_in_mm: radius of tangent lead-in/lead-out arcs on closed profiles,
             mm (0 = none).
         fit_arcs: fit arcs to dense polylines within ``tolerance``.
+        placement: where the work zero lies, one of :data:`PLACEMENTS` (``--origin``):
+            ``drawing`` keeps the drawing's coordinates, ``lower-left``/``center`` move
+            the program so that the lower-left corner / the centre of the toolpath's
+            extent (tool radius, lead-ins and tabs included) is X0 Y0.
+        translate: ``(dx, dy)`` mm added to every position after ``placement``.
+            Order: ``scale``/``fit_mm`` on the drawing, then planning, then
+            ``placement``, then ``translate``.
+        chain_tolerance: entity ends closer than this (mm) are joined into one
+            contour (:data:`DEFAULT_CHAIN_TOLERANCE`).
+        clearance_z: height (mm above the top) of the first and last moves and of
+            travel between parts; ``None``: the larger of :data:`DEFAULT_CLEARANCE_Z`
+            and ``safe_z``. Must be ≥ ``safe_z``.
+        end_position: ``(x, y)`` mm to rapid to at clearance height at the end of the
+            program; ``None`` stays above the last cut.
+        reverse_open: let the ordering cut open contours backwards (default: open
+            contours are cut in their drawn direction).
     """
 
     offset: str = "on"
@@ -125,13 +161,27 @@ class PlanOptions:
     order: str = "travel"
     lead_in_mm: float = 0.0
     fit_arcs: bool = True
+    placement: str = "drawing"
+    translate: tuple[float, float] = (0.0, 0.0)
+    chain_tolerance: float = DEFAULT_CHAIN_TOLERANCE
+    clearance_z: float | None = None
+    end_position: tuple[float, float] | None = None
+    reverse_open: bool = False
 
     def __post_init__(self) -> None:
+        self._check_numbers()
         self._check_choices()
         self._check_tool()
         self._check_placement()
         self._check_depth()
         self._check_tabs()
+
+    @property
+    def clearance(self) -> float:
+        """Clearance height, mm above the top (see ``clearance_z``)."""
+        if self.clearance_z is None:
+            return max(DEFAULT_CLEARANCE_Z, self.safe_z)
+        return self.clearance_z
 
     @property
     def radius(self) -> float:
@@ -145,11 +195,37 @@ class PlanOptions:
             return self.feed_mm_min / 2.0
         return self.plunge_feed_mm_min
 
+    def _check_numbers(self) -> None:
+        """Every number finite and of a sane magnitude, named by its flag (NaN fails ``x <= 0``)."""
+        for name, value in _numbers(self):
+            if not math.isfinite(value):
+                raise UsageError(f"{flag(name)} must be a finite number, got {value!r}")
+            limit = MAX_SCALE if name == "scale" else MAX_LENGTH_MM
+            if name.endswith("_deg") or name == "stepover":
+                continue  # checked against their own ranges below
+            if abs(value) > limit:
+                raise UsageError(
+                    f"{flag(name)} {value:g} is beyond ±{limit:g}"
+                    f"{'' if name == 'scale' else ' mm'}: no machine camtool writes for is "
+                    "that large; check the value and its unit"
+                )
+        if self.scale < 1.0 / MAX_SCALE:
+            raise UsageError(f"--scale must be at least {1.0 / MAX_SCALE:g}, got {self.scale!r}")
+        if self.depth is not None and self.step_down is not None and self.step_down > 0:
+            passes = self.depth / self.step_down
+            if passes > MAX_PASSES:
+                raise UsageError(
+                    f"--depth {self.depth:g} with --step-down {self.step_down:g} mm makes "
+                    f"{passes:.0f} passes, more than the limit of {MAX_PASSES}; give a larger "
+                    "--step-down"
+                )
+
     def _check_choices(self) -> None:
         for name, value, choices in (
             ("--offset", self.offset, OFFSET_MODES),
             ("--pocket", self.pocket, POCKET_STYLES),
             ("--order", self.order, ORDERS),
+            ("--origin", self.placement, PLACEMENTS),
         ):
             if value not in choices:
                 raise UsageError(f"unknown {name} {value!r}; choose one of {', '.join(choices)}")
@@ -181,6 +257,8 @@ class PlanOptions:
             )
 
     def _check_placement(self) -> None:
+        if self.chain_tolerance < 0:
+            raise UsageError(f"--chain-tolerance must be ≥ 0 mm, got {self.chain_tolerance!r}")
         if self.scale <= 0:
             raise UsageError(f"scale must be > 0, got {self.scale!r}")
         if self.fit_mm is not None:
@@ -190,6 +268,14 @@ class PlanOptions:
                 raise UsageError(f"--fit needs a width and height > 0 mm, got {self.fit_mm!r}")
 
     def _check_depth(self) -> None:
+        if self.safe_z <= 0:
+            raise UsageError(f"--safe-z must be above the top (> 0 mm), got {self.safe_z!r}")
+        if self.clearance_z is not None and self.clearance_z < self.safe_z:
+            raise UsageError(
+                f"--clearance-z {self.clearance_z:g} mm is below --safe-z {self.safe_z:g} mm: "
+                "clearance is the higher of the two (start, end and between parts); raise it "
+                "or lower --safe-z"
+            )
         if self.depth is None:
             given = [
                 flag
@@ -209,8 +295,6 @@ class PlanOptions:
             )
         if self.step_down is not None and self.step_down <= 0:
             raise UsageError(f"--step-down must be > 0 mm, got {self.step_down!r}")
-        if self.safe_z <= 0:
-            raise UsageError(f"--safe-z must be above the top (> 0 mm), got {self.safe_z!r}")
         if self.plunge_feed_mm_min is not None and self.plunge_feed_mm_min <= 0:
             raise UsageError(f"--plunge-feed must be > 0 mm/min, got {self.plunge_feed_mm_min!r}")
         if self.ramp_angle_deg is not None and not 0 < self.ramp_angle_deg < 90:
@@ -260,6 +344,32 @@ class PlanOptions:
                 f"({machine.name} is 2D); set the depth by hand on the machine and "
                 "leave these options out"
             )
+
+
+MAX_LENGTH_MM = 1e6
+"""Largest length (mm) any option may give: 1 km, beyond every machine camtool targets."""
+
+MAX_SCALE = 1e6
+"""Largest ``--scale`` factor (and 1/this the smallest)."""
+
+MAX_PASSES = 10_000
+"""Most depth passes a plan may have (``--depth`` / ``--step-down``)."""
+
+
+def _numbers(options: PlanOptions) -> list[tuple[str, float]]:
+    """Every number of ``options`` with its field name (pairs give two entries)."""
+    import dataclasses
+
+    out: list[tuple[str, float]] = []
+    for f in dataclasses.fields(options):
+        value = getattr(options, f.name)
+        if isinstance(value, bool) or value is None or isinstance(value, str):
+            continue
+        if isinstance(value, tuple):
+            out.extend((f.name, float(v)) for v in value)
+        elif isinstance(value, int | float):
+            out.append((f.name, float(value)))
+    return out
 
 
 PLAN_FIELDS = frozenset(

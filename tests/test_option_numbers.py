@@ -1,0 +1,118 @@
+"""Every numeric option refuses NaN, ±inf and absurd magnitudes, naming the option (issue 14)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+from camtool.cli import main
+from camtool.errors import UsageError
+from camtool.toolpath.options import MAX_PASSES, PlanOptions
+from camtool.units import fmt_num, fmt_point
+
+SAMPLES = Path(__file__).resolve().parents[1] / "samples"
+
+
+@pytest.mark.parametrize(
+    ("args", "flag"),
+    [
+        (
+            [
+                "--tab-height",
+                "nan",
+                "--tabs",
+                "2",
+                "--depth",
+                "3",
+                "--offset",
+                "outside",
+                "--tool-diameter",
+                "3",
+            ],
+            "--tab-height",
+        ),
+        (
+            [
+                "--tab-width",
+                "nan",
+                "--tabs",
+                "2",
+                "--depth",
+                "3",
+                "--offset",
+                "outside",
+                "--tool-diameter",
+                "3",
+            ],
+            "--tab-width",
+        ),
+        (["--lead-in", "nan"], "--lead-in"),
+        (["--close-gap", "nan"], "--close-gap"),
+        (["--fit", "inf", "inf"], "--fit"),
+        (["--scale", "inf"], "--scale"),
+        (["--tool-diameter", "-inf"], "--tool-diameter"),
+        (["--feed", "nan"], "--feed"),
+        (["--spindle-rpm", "inf"], "--spindle-rpm"),
+        (["--translate", "nan", "0"], "--translate"),
+        (["--tolerance", "1_0"], "--tolerance"),
+    ],
+)
+def test_non_finite_option_is_a_usage_error_naming_it(
+    args: list[str], flag: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "p.gcode"
+    code = main(["post", str(SAMPLES / "plate.dxf"), "-t", "grbl", "-o", str(out), *args])
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert flag in err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [
+        ("tab_height", math.nan),
+        ("lead_in_mm", math.nan),
+        ("close_gap", math.nan),
+        ("safe_z", math.inf),
+        ("tolerance", math.nan),
+        ("stepover", math.nan),
+        ("ramp_angle_deg", math.nan),
+    ],
+)
+def test_plan_options_refuse_non_finite(field: str, value: float) -> None:
+    extra = {"depth": 3.0} if field == "ramp_angle_deg" else {}
+    with pytest.raises(UsageError, match="finite"):
+        PlanOptions(feed_mm_min=100.0, **extra, **{field: value})
+
+
+def test_fit_with_infinite_box_is_refused() -> None:
+    with pytest.raises(UsageError, match="--fit"):
+        PlanOptions(feed_mm_min=100.0, fit_mm=(math.inf, math.inf))
+
+
+def test_pass_count_is_bounded() -> None:
+    # 3 mm at 1 nm per pass would be 3e9 passes; the limit is MAX_PASSES
+    with pytest.raises(UsageError, match="--step-down"):
+        PlanOptions(feed_mm_min=100.0, depth=3.0, step_down=1e-9)
+    PlanOptions(feed_mm_min=100.0, depth=3.0, step_down=3.0 / MAX_PASSES)
+
+
+def test_clearance_below_safe_z_is_refused() -> None:
+    with pytest.raises(UsageError, match="--clearance-z"):
+        PlanOptions(feed_mm_min=100.0, safe_z=3.0, clearance_z=2.0)
+    assert PlanOptions(feed_mm_min=100.0, safe_z=2.0).clearance == 5.0
+    assert PlanOptions(feed_mm_min=100.0, safe_z=8.0).clearance == 8.0
+
+
+@pytest.mark.parametrize(
+    ("value", "text"), [(-0.0, "0.0000"), (-1e-7, "0.0000"), (-0.5, "-0.5000"), (2.25, "2.2500")]
+)
+def test_fmt_num_never_negative_zero(value: float, text: str) -> None:
+    assert fmt_num(value) == text
+
+
+def test_fmt_point() -> None:
+    assert fmt_point((-0.0, 1.5), 2) == "(0.00, 1.50)"
