@@ -97,7 +97,8 @@ def post_path(
         CamtoolError: from any stage, with its exit code.
     """
     if not is_program_file(path):
-        return post_drawing(read_drawing(path, import_options), target, **options)
+        drawing = read_drawing(path, import_options)
+        return post_drawing(_note_units(drawing, path, import_options), target, **options)
     given = drawing_only(options)
     if given:
         raise UsageError(
@@ -114,6 +115,23 @@ def post_path(
         spindle_rpm=options.get("spindle_rpm"),
         spindle_dwell_s=options.get("spindle_dwell_s", 0.0),
     )
+
+
+POINT_SUFFIXES = (".csv", ".txt", ".xy", ".m")
+"""File endings of unitless point lists, the only inputs ``--units`` applies to."""
+
+
+def _note_units(drawing: Drawing, path: str | Path, options: ImportOptions | None) -> Drawing:
+    """``drawing`` with a warning when ``--units`` was given for a file that carries its own."""
+    import dataclasses
+
+    if options is None or options.units is None or Path(path).suffix.lower() in POINT_SUFFIXES:
+        return drawing
+    note = (
+        f"--units {options.units} has no effect on {Path(path).name}: DXF and SVG files carry "
+        "their own units (--units is for point lists)"
+    )
+    return dataclasses.replace(drawing, warnings=(*drawing.warnings, note))
 
 
 PROGRAM_SUFFIXES = (".ngc", ".nc", ".gcode", ".tap", ".cnc", ".gc", ".g")

@@ -64,7 +64,8 @@ def compensate(contours: Sequence[Contour], nest: Nesting, options: PlanOptions)
     profiles have ``may_reverse=False``, ``may_rotate=True``, ``material_side``
     ``"right"`` for climb (``"left"`` conventional) and ``outside_profile`` for
     outer boundaries cut ``outside``. A contour whose offset splits gives one
-    cut per piece. Open contours give ``kind="open"`` cuts on the line.
+    cut per piece. Open contours give ``kind="open"`` cuts on the line, in their
+    drawn direction (``may_reverse`` only with ``options.reverse_open``).
 
     Args:
         contours: chained, closed-where-possible contours, mm.
@@ -89,7 +90,8 @@ def compensate(contours: Sequence[Contour], nest: Nesting, options: PlanOptions)
     for i, contour in enumerate(contours):
         if not contour.closed:
             open_count += 1
-            cuts.append(Cut(contour, i, "open", may_reverse=True, may_rotate=False))
+            # drawn direction unless --reverse-open: a drawn arc is a G02 or G03 as drawn
+            cuts.append(Cut(contour, i, "open", may_reverse=options.reverse_open, may_rotate=False))
         elif options.offset == "on":
             cuts.append(_on_line(contour, i, nest, options))
         else:

@@ -83,6 +83,8 @@ FINDING_KINDS = (
     "uncut",
     "gouge",
     "open-on-line",
+    "open-gap",
+    "option",
     "arc-fit",
     "ordering",
 )

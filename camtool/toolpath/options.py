@@ -16,6 +16,7 @@ from camtool.geometry import Point
 
 if TYPE_CHECKING:
     from camtool.machine import Machine
+    from camtool.toolpath.cuts import Finding
 
 OFFSET_MODES = ("on", "outside", "inside", "pocket")
 """Valid values of ``PlanOptions.offset``."""
@@ -321,6 +322,33 @@ class PlanOptions:
             raise UsageError(
                 f"--tab-height {self.tab_height:g} mm must be below --depth {self.depth:g} mm"
             )
+
+    def ineffective(self) -> list[Finding]:
+        """Options given that have no effect in this combination, as ``option`` findings.
+
+        Each says why, so a user who expected an effect knows what to add or drop.
+        """
+        from camtool.toolpath.cuts import Finding
+
+        notes: list[str] = []
+        if self.offset == "on" and self.tool_diameter > 0:
+            notes.append(
+                f"--tool-diameter {self.tool_diameter:g} has no effect with --offset on (the "
+                "tool centre follows the drawn line); add --offset outside, inside or pocket "
+                "to compensate for the tool"
+            )
+        pocket_only = self._changed("stepover", "pocket", "pocket_angle_deg")
+        if self.offset != "pocket" and pocket_only:
+            notes.append(f"{', '.join(pocket_only)} only apply to --offset pocket: no effect here")
+        tab_only = self._changed("tab_width", "tab_height")
+        if self.tabs == 0 and tab_only:
+            notes.append(f"{', '.join(tab_only)} have no effect without --tabs N")
+        return [Finding("option", note) for note in notes]
+
+    def _changed(self, *names: str) -> list[str]:
+        """Flags of the fields among ``names`` that differ from their defaults."""
+        fields = type(self).__dataclass_fields__
+        return [flag(n) for n in names if getattr(self, n) != fields[n].default]
 
     @property
     def uses_z(self) -> bool:

@@ -30,6 +30,7 @@ from camtool.program import Program
 from camtool.toolpath.arcfit import FitStats, fit_polyline, fit_stats
 from camtool.toolpath.chain import chain, close_gaps
 from camtool.toolpath.cuts import Finding, Stage
+from camtool.toolpath.gaps import MIN_JOINT_MM, open_gaps
 from camtool.toolpath.options import OFFSET_MODES, PlanOptions
 from camtool.toolpath.order import Ordering, nesting, order_cuts
 
@@ -130,9 +131,10 @@ def plan_drawing(
     if machine is not None:
         options.check_machine(machine, machine.name)
     placed = place(drawing, options)
-    contours = chain(placed.contours, options.tolerance)
-    contours, found = close_gaps(contours, options.close_gap, options.tolerance)
-    findings = list(found)
+    joint = max(options.chain_tolerance, MIN_JOINT_MM)
+    contours = chain(placed.contours, joint)
+    contours, found = close_gaps(contours, options.close_gap, joint)
+    findings = [*options.ineffective(), *found, *open_gaps(contours, options)]
     stats = None
     if options.fit_arcs:
         contours, stats = fit_dense(contours, options.tolerance)

@@ -165,7 +165,9 @@ def test_open_contours_are_cut_on_the_line_and_counted() -> None:
     line = Contour((Line((30, 0), (40, 0)),), False)
     stage = _run([rect(0, 0, 10, 10), line], "outside")
     cut = stage.cuts[1]
-    assert (cut.kind, cut.path, cut.may_rotate, cut.may_reverse) == ("open", line, False, True)
+    # drawn direction by default: an open path is never reversed by the ordering
+    assert (cut.kind, cut.path, cut.may_rotate, cut.may_reverse) == ("open", line, False, False)
+    assert _run([rect(0, 0, 10, 10), line], "outside", reverse_open=True).cuts[1].may_reverse
     (finding,) = [f for f in stage.findings if f.kind == "open-on-line"]
     assert finding.message.startswith("1 open contour(s) cut on the line: --offset outside")
     assert "open-on-line" not in _kinds(_run([line], "on", 0.0))
