@@ -293,7 +293,7 @@ def _check_outputs(
         )
         if path is not None and os.path.isfile(path)
     ]
-    outputs: list[tuple[str, str | Path | None]] = [("the batch report", options.report)]
+    outputs: list[tuple[str, str | Path | None]] = [("--report", options.report)]
     outputs += [(f"{task.file} →", out) for task in tasks for out in task.outputs]
     check_outputs(inputs, outputs, hint="post them in separate batches or rename one")
     if not options.force:
@@ -309,8 +309,8 @@ def _check_inside(tasks: Sequence[BatchTask], output_dir: Path) -> None:
             if real != root and not real.startswith(root.rstrip(os.sep) + os.sep):
                 raise UsageError(
                     f"{task.file} → {out} would be written outside -o {output_dir} "
-                    f"(it resolves to {real}); name the inputs without '..' or symlinks "
-                    "out of the output folder"
+                    f"(it resolves to {real}); remove the symlink that leads out of the "
+                    "output folder, or name the inputs without '..'"
                 )
 
 
