@@ -66,8 +66,11 @@ def check_outputs(
         UsageError: an output would overwrite an input (never allowed, not even with
             ``--force``), or two outputs name the same file (or both stdout).
     """
-    seen_inputs = [(label, str(path), _identity(path)) for label, path in _named(inputs)]
-    seen_outputs: list[tuple[str, str, tuple[str, tuple[int, int] | None]]] = []
+    known_inputs = _Index()
+    for label, path in _named(inputs):
+        if path != "-":
+            known_inputs.add(path, (label, path))
+    known_outputs = _Index()
     stdout: str | None = None
     for label, path in _named(outputs):
         if path == "-":
@@ -78,18 +81,35 @@ def check_outputs(
             stdout = label
             continue
         key = _identity(path)
-        for in_label, in_path, in_key in seen_inputs:
-            if _same(key, in_key):
-                raise UsageError(
-                    f"{label} {path} would overwrite {in_label} {in_path}; choose another "
-                    "name (camtool never overwrites an input, not even with --force)"
-                )
-        for out_label, out_path, out_key in seen_outputs:
-            if _same(key, out_key):
-                raise UsageError(
-                    f"{out_label} {out_path} and {label} {path} are the same file; {hint}"
-                )
-        seen_outputs.append((label, str(path), key))
+        if (found := known_inputs.find(key)) is not None:
+            raise UsageError(
+                f"{label} {path} would overwrite {found[0]} {found[1]}; choose another "
+                "name (camtool never overwrites an input, not even with --force)"
+            )
+        if (found := known_outputs.find(key)) is not None:
+            raise UsageError(f"{found[0]} {found[1]} and {label} {path} are the same file; {hint}")
+        known_outputs.add(path, (label, path), key)
+
+
+class _Index:
+    """Named paths by real path and by (device, inode): a clash is found in O(1)."""
+
+    def __init__(self) -> None:
+        self.by_path: dict[str, tuple[str, str]] = {}
+        self.by_inode: dict[tuple[int, int], tuple[str, str]] = {}
+
+    def add(self, path: str, named: tuple[str, str], key: _Key | None = None) -> None:
+        real, inode = key or _identity(path)
+        self.by_path.setdefault(real, named)
+        if inode is not None:
+            self.by_inode.setdefault(inode, named)
+
+    def find(self, key: _Key) -> tuple[str, str] | None:
+        real, inode = key
+        found = self.by_path.get(real)
+        if found is None and inode is not None:
+            found = self.by_inode.get(inode)
+        return found
 
 
 def _named(items: Iterable[Named]) -> Iterator[tuple[str, str]]:
@@ -98,21 +118,17 @@ def _named(items: Iterable[Named]) -> Iterator[tuple[str, str]]:
             yield label, str(path)
 
 
-def _identity(path: str | Path) -> tuple[str, tuple[int, int] | None]:
-    """``(realpath, (device, inode) or None)`` of ``path``; stdin ``-`` is nothing."""
-    if str(path) == "-":
-        return ("", None)
+_Key = tuple[str, tuple[int, int] | None]
+"""A path's identity: its real path, and its (device, inode) when it exists."""
+
+
+def _identity(path: str | Path) -> _Key:
+    """``(realpath, (device, inode) or None)`` of ``path``."""
     try:
         st = os.stat(path)
     except (OSError, ValueError):  # missing, or a name the OS refuses: compared by name
         return (os.path.realpath(path), None)
     return (os.path.realpath(path), (st.st_dev, st.st_ino))
-
-
-def _same(a: tuple[str, tuple[int, int] | None], b: tuple[str, tuple[int, int] | None]) -> bool:
-    if not a[0] or not b[0]:
-        return False
-    return a[0] == b[0] or (a[1] is not None and a[1] == b[1])
 
 
 def write_atomic(path: str | Path, data: str | bytes) -> None:
