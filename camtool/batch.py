@@ -86,7 +86,9 @@ class BatchOptions:
             (implies ``verify``).
         force: overwrite existing outputs.
         jobs: worker processes; ``None``: ``os.cpu_count()``; 1: in this process.
-        report: the batch report's path (``"-"``: stdout), checked like an output.
+        report: the batch report's path, checked like an output and written by
+            :func:`run_batch` before it releases the output folder (``"-"``: stdout,
+            left to the caller).
 
     Raises:
         UsageError: ``preview`` is not one of :data:`PREVIEW_FORMATS`, ``jobs`` < 1
