@@ -2,14 +2,18 @@
 
 :func:`plan_batch` expands the inputs (:mod:`camtool.batch_inputs`), loads the
 target and checks everything that can be checked before any work starts: the
-options, that every input matches something, that no two files write the same
-output, that no output is one of the inputs, and that no output exists already
-unless ``force``. :func:`run_batch` then posts each file — in a
+options, that every input matches something, that every output stays inside the
+output folder, that no two files write the same output, that no output is one of
+the inputs (:func:`camtool.output.check_outputs`), and that no output exists
+already unless ``force``. :func:`run_batch` claims the output folder for the run
+(a second batch into it is refused), then posts each file — in a
 ``concurrent.futures.ProcessPoolExecutor`` of ``jobs`` workers, or in this
 process for ``jobs=1`` — and returns one :class:`BatchRow` per file, in input
 order. A file that fails (any exception) becomes an ``error`` row; it never
 stops the others, and it leaves no output behind: each file's outputs are
 computed in memory and written (atomically) only when all of them are ready.
+
+Workers die with the batch process, even when it is killed with ``kill -9``.
 
 Outputs keep the path below the input's root: ``drawings/a/b.dxf`` gives
 ``OUT/a/b.pic`` (the target's ending), ``OUT/a/b.json`` (the verify report,
@@ -83,7 +87,9 @@ class BatchOptions:
             (implies ``verify``).
         force: overwrite existing outputs.
         jobs: worker processes; ``None``: ``os.cpu_count()``; 1: in this process.
-        report: the batch report's path (``"-"``: stdout), checked like an output.
+        report: the batch report's path, checked like an output and written by
+            :func:`run_batch` before it releases the output folder (``"-"``: stdout,
+            left to the caller).
 
     Raises:
         UsageError: ``preview`` is not one of :data:`PREVIEW_FORMATS`, ``jobs`` < 1
@@ -238,9 +244,11 @@ def plan_batch(inputs: Sequence[str], options: BatchOptions) -> BatchPlan:
     """Expand ``inputs`` and check the whole batch before any work starts.
 
     Raises:
-        UsageError: unknown target or format, invalid post options, two files
-            writing the same output, an output that is an input, or existing
-            outputs without ``force`` (the first :data:`SHOWN_EXISTING` named).
+        UsageError: unknown target or format, invalid post options, an output
+            that would land outside the output folder (inputs named through ``..``
+            or a symlink), two files writing the same output, an output that is an
+            input (even with ``force``), or existing outputs without ``force`` (the
+            first :data:`SHOWN_EXISTING` named).
         InputError: an input matches nothing, or the target/machine file is invalid.
     """
     from camtool.pipeline import plan_options
@@ -277,26 +285,50 @@ def _task(item: BatchInput, options: BatchOptions, suffix: str) -> BatchTask:
 def _check_outputs(
     items: Sequence[BatchInput], tasks: Sequence[BatchTask], options: BatchOptions
 ) -> None:
-    """No output written twice, none an input, none existing unless ``force``."""
-    inputs = {item.path.resolve() for item in items}
-    owners: dict[Path, tuple[str, str]] = {}  # resolved output -> (who writes it, as named)
-    if options.report is not None and options.report != "-":
-        owners[Path(options.report).resolve()] = ("the batch report", options.report)
+    """Every output inside ``-o``, none an input or another output, none existing unless forced.
+
+    Raises:
+        UsageError: as :func:`plan_batch` says.
+    """
+    from camtool.output import check_outputs
+
+    _check_inside(tasks, options.output_dir)
+    inputs: list[tuple[str, str | Path | None]] = [("the input", i.path) for i in items]
+    inputs += [
+        (label, path)
+        for label, path in (
+            ("the target file", options.target),
+            ("the --machine file", options.machine_file),
+        )
+        if path is not None and os.path.isfile(path)
+    ]
+    outputs: list[tuple[str, str | Path | None]] = [("--report", options.report)]
+    outputs += [(f"{task.file} →", out) for task in tasks for out in task.outputs]
+    check_outputs(inputs, outputs, hint="post them in separate batches or rename one")
+    if not options.force:
+        _refuse_existing(tasks, options)
+
+
+def _check_inside(tasks: Sequence[BatchTask], output_dir: Path) -> None:
+    """Every output resolves (symlinks and ``..`` followed) to a path inside ``output_dir``."""
+    root = os.path.realpath(output_dir)
     for task in tasks:
         for out in task.outputs:
-            key = Path(out).resolve()
-            if key in inputs:
+            real = os.path.realpath(out)
+            if real != root and not real.startswith(root.rstrip(os.sep) + os.sep):
                 raise UsageError(
-                    f"{out} would overwrite an input (from {task.file}); choose another -o"
+                    f"{task.file} → {out} would be written outside -o {output_dir} "
+                    f"(it resolves to {real}); remove the symlink that leads out of the "
+                    "output folder, or name the inputs without '..'"
                 )
-            if key in owners:
-                raise UsageError(
-                    f"{owners[key][0]} and {task.file} would both write {out}; post them in "
-                    "separate batches or rename one"
-                )
-            owners[key] = (task.file, out)
-    existing = sorted(out for key, (_, out) in owners.items() if key.exists())
-    if existing and not options.force:
+
+
+def _refuse_existing(tasks: Sequence[BatchTask], options: BatchOptions) -> None:
+    """Without ``force``, outputs of a previous run (the first few named) are refused."""
+    named = [t for t in (options.report,) if t is not None and t != "-"]
+    named += [out for task in tasks for out in task.outputs]
+    existing = sorted(out for out in named if os.path.lexists(out))
+    if existing:
         shown = ", ".join(existing[:SHOWN_EXISTING])
         more = len(existing) - SHOWN_EXISTING
         rest = f" and {more} more" if more > 0 else ""
@@ -309,33 +341,80 @@ def _check_outputs(
 def run_batch(plan: BatchPlan, *, progress: Progress | None = None) -> BatchResult:
     """Post every file of ``plan``; one file's failure never stops the others.
 
+    The output folder is claimed for the whole run
+    (:func:`camtool.output.lock_directory`), so two batches never write into one
+    folder at once; under the claim, outputs that appeared since :func:`plan_batch`
+    are refused again (unless ``force``), stale temporary files of killed runs are
+    removed, and at the end the batch report is written (when ``options.report``
+    names a file; ``"-"`` is left to the caller).
+
     Args:
         plan: from :func:`plan_batch`.
         progress: called in this process as each file finishes, in finishing order.
 
     Returns:
         The rows in the plan's (sorted input) order.
+
+    Raises:
+        CamtoolError: another run holds the output folder, or the batch report
+            cannot be written.
+        UsageError: outputs appeared since the plan was checked (without ``force``).
     """
+    from camtool.output import lock_directory
+
     tasks, options = plan.tasks, plan.options
-    jobs = min(options.jobs or os.cpu_count() or 1, len(tasks))
-    if jobs <= 1:
-        rows = []
-        for done, task in enumerate(tasks, start=1):
-            rows.append(post_one(task, options))
-            if progress is not None:
-                progress(done, len(tasks), rows[-1])
-        return BatchResult(options, tuple(rows))
-    return BatchResult(options, _run_pool(tasks, options, jobs, progress))
+    with lock_directory(options.output_dir):
+        if not options.force:
+            _refuse_existing(tasks, options)
+        _remove_stale_temps(tasks)
+        jobs = min(options.jobs or os.cpu_count() or 1, len(tasks))
+        if jobs <= 1:
+            rows = []
+            for done, task in enumerate(tasks, start=1):
+                rows.append(post_one(task, options))
+                if progress is not None:
+                    progress(done, len(tasks), rows[-1])
+            result = BatchResult(options, tuple(rows))
+        else:
+            result = BatchResult(options, _run_pool(tasks, options, jobs, progress))
+        if options.report is not None and options.report != "-":
+            _write_report(result, options.report)
+    return result
+
+
+def _remove_stale_temps(tasks: Sequence[BatchTask]) -> None:
+    """Temporary files left by killed runs, in every folder this batch writes into."""
+    from camtool.output import reason, remove_stale_temps
+
+    for folder in sorted({Path(out).parent for task in tasks for out in task.outputs}):
+        try:
+            remove_stale_temps(folder)
+        except OSError as exc:
+            raise CamtoolError(f"{folder}: cannot write ({reason(exc)})") from exc
+
+
+def _write_report(result: BatchResult, path: str) -> None:
+    """The batch report (:func:`camtool.batch_report.batch_report`) as UTF-8 JSON."""
+    from camtool.batch_report import batch_report
+
+    text = json.dumps(batch_report(result), indent=2, ensure_ascii=False) + "\n"
+    _write(path, text)
 
 
 def _run_pool(
     tasks: Sequence[BatchTask], options: BatchOptions, jobs: int, progress: Progress | None
 ) -> tuple[BatchRow, ...]:
-    """Run ``tasks`` in a pool of ``jobs`` processes; rows in task order."""
+    """Run ``tasks`` in a pool of ``jobs`` processes; rows in task order.
+
+    The workers die with this process (:func:`_worker_init`), so killing a batch
+    (even with ``kill -9``) leaves no worker writing or holding its pipes.
+    """
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
     rows: dict[int, BatchRow] = {}
-    with ProcessPoolExecutor(max_workers=jobs) as pool:
+    with ProcessPoolExecutor(
+        max_workers=jobs, initializer=_worker_init, initargs=(os.getpid(),)
+    ) as pool:
         futures = {pool.submit(post_one, task, options): i for i, task in enumerate(tasks)}
         try:
             for done, future in enumerate(as_completed(futures), start=1):
@@ -347,6 +426,40 @@ def _run_pool(
             pool.shutdown(wait=False, cancel_futures=True)
             raise
     return tuple(rows[i] for i in range(len(tasks)))
+
+
+PARENT_POLL_S = 0.5
+"""How often a worker checks that the batch that started it is still alive, s."""
+
+
+def _worker_init(parent_pid: int) -> None:
+    """Make a pool worker die with the batch process ``parent_pid``.
+
+    On Linux the kernel sends the worker SIGKILL when its parent dies
+    (``prctl(PR_SET_PDEATHSIG)``, prctl(2)); everywhere a daemon thread also polls
+    the parent pid every :data:`PARENT_POLL_S` and exits the worker when the worker
+    has been re-parented. A parent already gone ends the worker at once.
+    """
+    import sys
+    import threading
+
+    if sys.platform.startswith("linux"):
+        import ctypes
+        import signal
+
+        pr_set_pdeathsig = 1  # <linux/prctl.h>
+        ctypes.CDLL(None, use_errno=True).prctl(pr_set_pdeathsig, signal.SIGKILL, 0, 0, 0)
+    if os.getppid() != parent_pid:
+        os._exit(1)
+
+    def watch() -> None:
+        import time
+
+        while os.getppid() == parent_pid:
+            time.sleep(PARENT_POLL_S)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="camtool-parent-watch", daemon=True).start()
 
 
 def _collect(future: Future[BatchRow], task: BatchTask) -> BatchRow:
@@ -455,10 +568,10 @@ def preview_bytes(job: PostJob, v: Verification | None, path: str, title: str) -
 
 def _write(path: str, data: str | bytes) -> None:
     """Write one output atomically, creating its directory."""
-    from camtool.output import write_atomic
+    from camtool.output import reason, write_atomic
 
     try:
         Path(path).parent.mkdir(parents=True, exist_ok=True)
         write_atomic(path, data)
     except OSError as exc:
-        raise CamtoolError(f"{path}: cannot write ({exc.strerror or exc})") from exc
+        raise CamtoolError(f"{path}: cannot write ({reason(exc)})") from exc

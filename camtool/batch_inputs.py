@@ -16,8 +16,10 @@ An input is, in this order:
 Every found file keeps its path relative to its input's root — the directory,
 the glob's leading part without wildcards, or the file's own directory — so
 ``drawings/a/b.dxf`` found through ``drawings`` is ``a/b.dxf`` in the output
-directory. The result is sorted by path and free of repeats (the same file
-found twice keeps its first relative path).
+directory. A glob whose ``..`` climbs above its leading part (``a/*/../../x/*.dxf``)
+names its files below the deepest folder that holds them all, never with ``..``.
+The result is sorted by path and free of repeats (the same file found twice keeps
+its first relative path).
 """
 
 from __future__ import annotations
@@ -98,12 +100,31 @@ def _expand_one(text: str, skip: Path | None) -> list[BatchInput]:
     elif not _MAGIC.search(text):
         raise InputError(f"{text}: no such file or directory")
     else:
-        items = _glob(text, skip)
+        items = _rebase(_glob(text, skip))
     if not items:
         endings = ", ".join(readable_suffixes())
         what = "holds" if path.is_dir() else "matches"
         raise InputError(f"{text}: {what} no file camtool reads ({endings})")
     return items
+
+
+def _rebase(items: list[BatchInput]) -> list[BatchInput]:
+    """Relative paths below the files' common folder when one would climb out with ``..``.
+
+    A glob such as ``a/*/../../x/*.dxf`` matches ``a/s/../../x/f.dxf``, which is
+    ``../x/f.dxf`` below the glob's leading part ``a``: written below ``-o`` as it is,
+    it would land outside. Such a glob's files are named below the deepest folder
+    that holds them all instead (``f.dxf``); :func:`camtool.batch.plan_batch` still
+    checks every output resolves inside ``-o``.
+    """
+    if not any(item.relative.parts[:1] == ("..",) for item in items):
+        return items
+    absolute = [os.path.normpath(os.path.abspath(item.path)) for item in items]
+    common = os.path.commonpath([os.path.dirname(a) for a in absolute])
+    return [
+        BatchInput(item.path, Path(os.path.relpath(a, common)))
+        for item, a in zip(items, absolute, strict=True)
+    ]
 
 
 def _glob(pattern: str, skip: Path | None) -> list[BatchInput]:

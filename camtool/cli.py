@@ -17,6 +17,7 @@ from camtool import __version__
 from camtool.cli_common import (
     MACHINE,
     NUMBER,
+    check_paths,
     import_options,
     import_settings,
     number_range,
@@ -112,6 +113,12 @@ def post(
     from camtool.pipeline import post_drawing, post_path, verify_job
     from camtool.post.registry import load_target
 
+    check_paths(
+        [("the input", drawing)],
+        [("-o", output), ("--report", report), ("--preview", preview)],
+        target=target,
+        machine_file=machine_file,
+    )
     chosen = load_target(target, machine_file=machine_file)
     chosen.post.check_format(options["fmt"])
     settings = import_settings(options)
@@ -186,6 +193,12 @@ def verify(
     from camtool.post.registry import load_target
     from camtool.verify.verifier import verify_code
 
+    check_paths(
+        [("the program", code), ("the --against drawing", against)],
+        [("--report", report), ("--preview", preview)],
+        target=target,
+        machine_file=machine_file,
+    )
     chosen = load_target(target, machine_file=machine_file)
     text = read_code(code, binary=chosen.post.binary)
     drawing = read_input(against) if against is not None else None

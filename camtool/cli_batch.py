@@ -95,9 +95,9 @@ def batch(inputs: tuple[str, ...], layers: str | None, verify_too: bool, **optio
     )
     result = _run(plan)
     click.echo(summary_table(result), err=True, nl=False)
-    if options["report"] is not None:
+    if options["report"] == "-":  # a report file is written by run_batch, in its claim
         text = json.dumps(batch_report(result), indent=2, ensure_ascii=False)
-        _write_report(text + "\n", options["report"])
+        write_output(text + "\n", "-")
     if result.exit_code:
         raise _ERRORS.get(result.exit_code, CamtoolError)(failure_line(result))
 
@@ -122,12 +122,3 @@ def _run(plan: BatchPlan) -> BatchResult:
 
 def _row_name(row: BatchRow | None) -> str | None:
     return row.file if row is not None else None
-
-
-def _write_report(text: str, out: str) -> None:
-    if out != "-":
-        try:
-            Path(out).parent.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise CamtoolError(f"{out}: cannot write ({exc.strerror or exc})") from exc
-    write_output(text, out)

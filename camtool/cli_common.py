@@ -7,6 +7,7 @@ every command; the helpers keep stdout for data and stderr for messages.
 from __future__ import annotations
 
 import math
+import os
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -71,23 +72,77 @@ def warn(messages: tuple[str, ...] | list[str]) -> None:
 
 
 def write_output(data: str | bytes, out: str) -> None:
-    """``data`` to the file ``out`` atomically, or to stdout for ``-``.
+    """``data`` to the file ``out`` (see :func:`camtool.output.write_atomic`), or stdout for ``-``.
+
+    Before a file is written, stale temporary files of killed runs beside it are
+    removed (:func:`camtool.output.remove_stale_temps`).
 
     Raises:
-        CamtoolError: the file cannot be written (nothing is left behind).
+        CamtoolError: the file cannot be written, naming it and why (``x.pic: cannot
+            write (no space left on device)``); for stdout ``stdout: no space left on
+            device`` (or ``broken pipe``), after which stdout is silenced so that
+            Python's own flush at exit does not fail again.
     """
-    if out == "-":
-        if isinstance(data, bytes):
-            sys.stdout.buffer.write(data)
-        else:
-            click.echo(data, nl=False)
-        return
-    from camtool.output import write_atomic
+    from camtool.output import reason, remove_stale_temps, write_atomic
 
+    if out == "-":
+        _write_stdout(data)
+        return
     try:
+        if os.path.isfile(out) or not os.path.lexists(out):  # not a device, FIFO or directory
+            remove_stale_temps(Path(os.path.realpath(out)).parent)
         write_atomic(out, data)
     except OSError as exc:
-        raise CamtoolError(f"{out}: cannot write ({exc.strerror or exc})") from exc
+        raise CamtoolError(f"{out}: cannot write ({reason(exc)})") from exc
+
+
+def check_paths(
+    inputs: list[tuple[str, str | None]],
+    outputs: list[tuple[str, str | None]],
+    *,
+    target: str | None = None,
+    machine_file: Path | None = None,
+) -> None:
+    """Refuse outputs that are inputs or each other (:func:`camtool.output.check_outputs`).
+
+    A ``--target`` or ``--machine`` that names an existing file (not a built-in name)
+    counts as an input too. Called first thing by every command that writes.
+
+    Raises:
+        UsageError: an output would overwrite an input, or two outputs are one file.
+    """
+    from camtool.output import check_outputs
+
+    extra = [("the target file", target), ("the --machine file", machine_file)]
+    files = [(label, str(p)) for label, p in extra if p is not None and os.path.isfile(p)]
+    check_outputs([*inputs, *files], outputs)
+
+
+def _write_stdout(data: str | bytes) -> None:
+    """``data`` to stdout, flushed; a failed write or flush is a :class:`CamtoolError`."""
+    from camtool.output import reason
+
+    try:
+        if isinstance(data, bytes):
+            sys.stdout.flush()
+            sys.stdout.buffer.write(data)
+            sys.stdout.buffer.flush()
+        else:
+            click.echo(data, nl=False)  # flushes
+    except OSError as exc:
+        _silence_stdout()
+        raise CamtoolError(f"stdout: {reason(exc)}") from exc
+
+
+def _silence_stdout() -> None:
+    """Point file descriptor 1 at /dev/null: what could not be written is dropped at exit."""
+    try:
+        fd = sys.stdout.fileno()
+    except (OSError, ValueError):  # not a real file (a test's capture): nothing to silence
+        return
+    null = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(null, fd)
+    os.close(null)
 
 
 MACHINE = click.option(

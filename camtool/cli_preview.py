@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import click
 
-from camtool.cli_common import MACHINE, number_range, read_code, warn, write_output
+from camtool.cli_common import MACHINE, check_paths, number_range, read_code, warn, write_output
 from camtool.errors import InputError, UsageError
 
 if TYPE_CHECKING:
@@ -74,7 +74,12 @@ def preview(
 
     out = output or _default_output(input_name)
     preview_format(".svg" if out == "-" else out)
-    _refuse_overwrite(out, [input_name, program_name])
+    check_paths(
+        [("the input", input_name), ("the --program", program_name)],
+        [("-o", out)],
+        target=target,
+        machine_file=machine_file,
+    )
     chosen = _target(target, machine_file)
     drawing, program = _read_inputs(input_name, program_name, chosen)
     verification = _verify(program, drawing, chosen, tool_diameter) if verify_too else None
@@ -99,14 +104,6 @@ def _default_output(input_name: str) -> str:
         return "-"
     path = Path(input_name)
     return str(path.with_name(f"{path.stem}.preview.svg"))
-
-
-def _refuse_overwrite(out: str, inputs: list[str | None]) -> None:
-    if out == "-":
-        return
-    for name in inputs:
-        if name and name != "-" and Path(name).resolve() == Path(out).resolve():
-            raise UsageError(f"-o {out} would overwrite the input {name}; choose another name")
 
 
 def _target(name: str | None, machine_file: Path | None) -> Target | None:

@@ -1,36 +1,335 @@
-"""Atomic file output: a failed run never leaves a half-written file."""
+"""Safe file output: nothing an input, nothing half-written, nothing replaced that is not a file.
+
+Every command goes through this module for what it writes (see docs/cli.md, "Safety"):
+
+- :func:`check_outputs` refuses, before anything is read or written, an output that is
+  one of the run's inputs or another of its outputs (after symlinks and ``..``, and by
+  inode for files that exist: a hard link is the same file);
+- :func:`write_atomic` writes a regular file through a temporary file renamed into
+  place, follows a symlink and replaces its *target*, and writes straight through to
+  anything that is not a regular file (a device such as ``/dev/null``, a FIFO), which
+  it never replaces;
+- temporary files are named ``.NAME.camtool-PID.tmp``, so one left by a killed run
+  says what it is, and :func:`remove_stale_temps` removes those whose process is gone;
+- :func:`lock_directory` claims an output folder for one run (``flock`` on
+  ``.camtool.lock`` in it, removed at the end), so two batches never write into one
+  folder at once.
+
+Paths are POSIX paths; the lock and the liveness test of a temporary file's process
+assume one host (a folder shared over NFS by two hosts is not protected).
+"""
 
 from __future__ import annotations
 
+import errno
 import os
-import tempfile
+import re
+import stat
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
+
+from camtool.errors import CamtoolError, UsageError
+
+LOCK_NAME = ".camtool.lock"
+"""The lock file :func:`lock_directory` keeps in a claimed folder while it runs."""
+TEMP_PATTERN = re.compile(r"^\.(?P<name>.+)\.camtool-(?P<pid>[0-9]+)\.tmp$")
+"""Name of a temporary file: ``.NAME.camtool-PID.tmp`` beside the output ``NAME``."""
+
+Named = tuple[str, str | Path | None]
+"""``(label, path)``: how a message names a path (``"-o"``, ``"the input"``) and the path.
+
+``None`` is skipped; ``"-"`` is stdin (an input, skipped) or stdout (an output).
+"""
+
+
+def check_outputs(
+    inputs: Iterable[Named],
+    outputs: Iterable[Named],
+    *,
+    hint: str = "give each output its own name",
+) -> None:
+    """Refuse an output that is an input, or that another output of the same run names.
+
+    Two paths are the same file when their :func:`os.path.realpath` (symlinks and
+    ``..`` resolved) are equal, or, when both exist, when they share device and inode
+    (:func:`os.path.samefile`: hard links too). Two ``"-"`` outputs both name stdout.
+    Nothing is read or written; run it before anything else.
+
+    Args:
+        inputs: ``(label, path)`` of every file the run reads, e.g.
+            ``("the input", "part.dxf")``, ``("the --machine file", "m.toml")``.
+        outputs: ``(label, path)`` of every file the run writes, e.g. ``("-o", "p.pic")``.
+        hint: what to do about two outputs that are one file (the message's end).
+
+    Raises:
+        UsageError: an output would overwrite an input (never allowed, not even with
+            ``--force``), or two outputs name the same file (or both stdout).
+    """
+    known_inputs = _Index()
+    for label, path in _named(inputs):
+        if path != "-":
+            known_inputs.add(path, (label, path))
+    known_outputs = _Index()
+    stdout: str | None = None
+    for label, path in _named(outputs):
+        if path == "-":
+            if stdout is not None:
+                raise UsageError(
+                    f"{stdout} - and {label} - both write to stdout; send one of them to a file"
+                )
+            stdout = label
+            continue
+        key = _identity(path)
+        if (found := known_inputs.find(key)) is not None:
+            raise UsageError(
+                f"{label} {path} would overwrite {found[0]} {found[1]}; choose another "
+                "name (camtool never overwrites an input, not even with --force)"
+            )
+        if (found := known_outputs.find(key)) is not None:
+            raise UsageError(f"{found[0]} {found[1]} and {label} {path} are the same file; {hint}")
+        known_outputs.add(path, (label, path), key)
+
+
+class _Index:
+    """Named paths by real path and by (device, inode): a clash is found in O(1)."""
+
+    def __init__(self) -> None:
+        self.by_path: dict[str, tuple[str, str]] = {}
+        self.by_inode: dict[tuple[int, int], tuple[str, str]] = {}
+
+    def add(self, path: str, named: tuple[str, str], key: _Key | None = None) -> None:
+        real, inode = key or _identity(path)
+        self.by_path.setdefault(real, named)
+        if inode is not None:
+            self.by_inode.setdefault(inode, named)
+
+    def find(self, key: _Key) -> tuple[str, str] | None:
+        real, inode = key
+        found = self.by_path.get(real)
+        if found is None and inode is not None:
+            found = self.by_inode.get(inode)
+        return found
+
+
+def _named(items: Iterable[Named]) -> Iterator[tuple[str, str]]:
+    for label, path in items:
+        if path is not None and str(path) != "":
+            yield label, str(path)
+
+
+_Key = tuple[str, tuple[int, int] | None]
+"""A path's identity: its real path, and its (device, inode) when it exists."""
+
+
+def _identity(path: str | Path) -> _Key:
+    """``(realpath, (device, inode) or None)`` of ``path``."""
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError):  # missing, or a name the OS refuses: compared by name
+        return (os.path.realpath(path), None)
+    return (os.path.realpath(path), (st.st_dev, st.st_ino))
 
 
 def write_atomic(path: str | Path, data: str | bytes) -> None:
-    r"""Write ``data`` to ``path`` through a temporary file renamed into place.
+    r"""Write ``data`` to ``path``; a reader never sees a half-written regular file.
 
-    Text is written as UTF-8 with ``\\n`` line ends. The directory must exist.
-    The file gets the permissions ``open()`` would give it (0666 less the umask).
+    Text is written as UTF-8 with ``\\n`` line ends. What ``path`` is decides how:
+
+    - a regular file, or nothing yet: a temporary ``.NAME.camtool-PID.tmp`` in the same
+      directory, written, flushed to disk (``fsync``) and renamed over ``path``. A new
+      file gets the permissions ``open()`` would give it (0666 less the umask); a
+      replaced one keeps its own;
+    - a symlink: the same, at its target (the link stays a link);
+    - anything else that exists (a character or block device such as ``/dev/null`` or
+      ``/dev/stdout``, a FIFO): opened and written through, never replaced. Opening a
+      FIFO waits for its reader, as a shell redirection does.
+
+    The directory must exist.
 
     Raises:
-        OSError: the directory is missing or not writable (nothing is left behind).
+        OSError: the directory is missing or not writable, ``path`` is a directory,
+            or the write fails (``ENOSPC`` on a full disk or ``/dev/full``); a
+            temporary file is removed again.
     """
-    path = Path(path)
     payload = data.encode("utf-8") if isinstance(data, str) else data
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent or ".")
     try:
-        os.fchmod(fd, 0o666 & ~_umask())  # mkstemp makes 0600; a plain open() would not
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(payload)
-        os.replace(tmp, path)
+        st: os.stat_result | None = os.stat(path)
+    except FileNotFoundError:
+        st = None
+    if st is not None and stat.S_ISDIR(st.st_mode):
+        raise IsADirectoryError(errno.EISDIR, "is a directory", str(path))
+    if st is not None and not stat.S_ISREG(st.st_mode):
+        _write_through(path, payload)
+        return
+    mode = stat.S_IMODE(st.st_mode) if st is not None else None
+    _replace(Path(os.path.realpath(path)), payload, mode)
+
+
+def _write_through(path: str | Path, payload: bytes) -> None:
+    """Open ``path`` (a device or FIFO) for writing and write all of ``payload``."""
+    fd = os.open(path, os.O_WRONLY | os.O_CLOEXEC)
+    try:
+        view = memoryview(payload)
+        while view:
+            view = view[os.write(fd, view) :]
+    finally:
+        os.close(fd)
+
+
+def _replace(target: Path, payload: bytes, mode: int | None) -> None:
+    """Write ``payload`` to a temporary file beside ``target`` and rename it over it."""
+    tmp = temp_path(target)
+    fd = _create(tmp)
+    try:
+        try:
+            if mode is not None:
+                os.fchmod(fd, mode)
+            view = memoryview(payload)
+            while view:
+                view = view[os.write(fd, view) :]
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+        os.replace(tmp, target)
     except BaseException:
-        Path(tmp).unlink(missing_ok=True)
+        tmp.unlink(missing_ok=True)
         raise
 
 
-def _umask() -> int:
-    """The process's umask (read by setting and restoring it)."""
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
+def temp_path(target: Path) -> Path:
+    """The temporary file of this process for ``target``: ``.NAME.camtool-PID.tmp`` beside it."""
+    return target.with_name(f".{target.name}.camtool-{os.getpid()}.tmp")
+
+
+def _create(tmp: Path) -> int:
+    """Create ``tmp`` exclusively (mode 0666 less the umask); an old one of our pid is stale."""
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC
+    try:
+        return os.open(tmp, flags, 0o666)
+    except FileExistsError:  # left by a dead process that had our pid: this process is not
+        tmp.unlink()  # writing it (one output at a time), so it is stale
+        return os.open(tmp, flags, 0o666)
+
+
+def remove_stale_temps(directory: str | Path) -> tuple[Path, ...]:
+    """Remove the temporary files in ``directory`` whose writing process is gone.
+
+    A file named like :data:`TEMP_PATTERN` is camtool's; it is stale when no process
+    with its PID exists on this host (a run killed with ``kill -9`` or by a power
+    cut). Files of a live process (or of a PID now reused) are left alone. A missing
+    directory has none.
+
+    Returns:
+        The files removed.
+
+    Raises:
+        OSError: the directory cannot be listed or a stale file removed (permissions).
+    """
+    try:
+        entries = list(os.scandir(directory))
+    except (FileNotFoundError, NotADirectoryError):
+        return ()
+    removed = []
+    for entry in entries:
+        match = TEMP_PATTERN.match(entry.name)
+        if match and entry.is_file(follow_symlinks=False) and not _alive(int(match["pid"])):
+            Path(entry.path).unlink(missing_ok=True)
+            removed.append(Path(entry.path))
+    return tuple(removed)
+
+
+def _alive(pid: int) -> bool:
+    """True when a process ``pid`` exists (this one counts; a zombie does not)."""
+    if pid == os.getpid():
+        return True
+    if pid <= 0:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # someone else's process: alive
+        return True
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except (OSError, IndexError):
+        return True  # no /proc (not Linux): it answered the signal
+    return fields[0] != "Z"
+
+
+@contextmanager
+def lock_directory(directory: str | Path, *, what: str = "-o") -> Iterator[Path]:
+    """Claim ``directory`` for this run: an exclusive ``flock`` on its :data:`LOCK_NAME`.
+
+    The folder is created when missing. The lock file holds this process's PID (for
+    the message another run shows) and is removed when the block ends; a run killed
+    with ``kill -9`` leaves it, unlocked, and the next run takes it over (the kernel
+    drops a dead process's locks).
+
+    Args:
+        directory: the output folder.
+        what: the option that named it, for the message.
+
+    Yields:
+        The lock file.
+
+    Raises:
+        CamtoolError: another run holds the folder (not even ``--force`` overrides it),
+            or the folder or its lock file cannot be created.
+    """
+    import fcntl
+
+    folder = Path(directory)
+    lock = folder / LOCK_NAME
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise CamtoolError(f"{folder}: cannot write ({reason(exc)})") from exc
+    fd = _take_lock(lock, what)
+    try:
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, f"{os.getpid()}\n".encode("ascii"), 0)
+        yield lock
+    finally:
+        lock.unlink(missing_ok=True)  # still locked: a run that opened it retries
+        fcntl.flock(fd, fcntl.LOCK_UN)
+        os.close(fd)
+
+
+def _take_lock(lock: Path, what: str) -> int:
+    """An open, ``flock``-ed descriptor of ``lock`` that is still the file at that name.
+
+    A run releasing the lock unlinks the file first, so a lock taken on a file that
+    is no longer ``lock`` is worthless: try again on the new one.
+    """
+    import fcntl
+
+    while True:
+        try:
+            fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o666)
+        except OSError as exc:
+            raise CamtoolError(f"{lock}: cannot write ({reason(exc)})") from exc
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            owner = os.pread(fd, 32, 0).decode("ascii", "replace").strip()
+            os.close(fd)
+            by = f" (pid {owner})" if owner.isdigit() else ""
+            raise CamtoolError(
+                f"{what} {lock.parent}: another camtool run{by} is writing into this folder; "
+                f"wait for it to finish, or choose another {what}"
+            ) from None
+        try:
+            same = os.path.samestat(os.fstat(fd), os.stat(lock))
+        except FileNotFoundError:
+            same = False
+        if same:
+            return fd
+        os.close(fd)
+
+
+def reason(exc: OSError) -> str:
+    """Why ``exc`` happened, for a message: ``no space left on device``."""
+    text = exc.strerror or str(exc)
+    return text[:1].lower() + text[1:]

@@ -6,9 +6,15 @@ rectangle at (1, 1) and an L of two axis-parallel lines as a G-code program.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
+import os
 import shutil
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -21,7 +27,8 @@ from camtool.errors import InputError, UsageError
 from camtool.pipeline import post_file
 from tests.shapes import rectangle_dxf
 
-SAMPLES = Path(__file__).parents[1] / "samples"
+ROOT = Path(__file__).parents[1]
+SAMPLES = ROOT / "samples"
 # An L along the axes at the pic-mmh feed F08 = 0.8 mm/min (seed-000 L1731).
 L_PROGRAM = "G21 G90\nG0 X1 Y1\nG1 X2 Y1 F0.8\nG1 X2 Y2\nM30\n"
 HALF_STEP_UM = 0.07  # ½ BLU of the 140 nm step (seed-000 §2.1; DDA lines, §4.2, §4.7)
@@ -141,14 +148,17 @@ def test_the_refusal_lists_only_the_first_few(tree: Path) -> None:
 
 def test_two_files_writing_one_output_are_refused(tree: Path) -> None:
     (tree / "rect.csv").write_text("x_mm,y_mm\n1,1\n2,1\n2,2\n")
-    with pytest.raises(UsageError, match=r"would both write out/rect\.pic"):
+    with pytest.raises(
+        UsageError,
+        match=r"rect\.csv → out/rect\.pic and .*rect\.dxf → out/rect\.pic are the same file",
+    ):
         plan_batch(["drawings"], BatchOptions(target="pic-mmh", output_dir=Path("out")))
 
 
 def test_an_output_never_overwrites_an_input_even_forced(tree: Path) -> None:
     shutil.copy(tree / "rect.dxf", tree / "rect.svg")  # its preview would be drawings/rect.svg
     options = BatchOptions(target="pic-mmh", output_dir=tree, preview="svg", force=True)
-    with pytest.raises(UsageError, match="would overwrite an input"):
+    with pytest.raises(UsageError, match=r"rect\.svg would overwrite the input .*rect\.svg"):
         plan_batch([str(tree / "rect.dxf"), str(tree / "rect.svg")], options)
 
 
@@ -394,3 +404,143 @@ def test_preview_is_written_per_file(tree: Path) -> None:
     verified = dataclasses.replace(options, verify=True, force=True)
     (row,) = run_batch(plan_batch(["drawings/rect.dxf"], verified)).rows
     assert row.verified and 'id="trace"' in Path(row.preview_path or "").read_text()
+
+
+# -- nothing lost -------------------------------------------------------------------------------
+
+
+def test_a_report_naming_an_input_is_refused_even_forced(
+    tree: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    before = (tree / "rect.dxf").read_bytes()
+    for force in ([], ["--force"]):
+        args = ["drawings", "-t", "pic-mmh", "-o", "out", "--report", "drawings/rect.dxf"]
+        code, _, err = run([*args, *force], capsys)
+        assert code == 2, err
+        assert "--report drawings/rect.dxf would overwrite the input drawings/rect.dxf" in err
+        assert "use --force" not in err
+        assert (tree / "rect.dxf").read_bytes() == before and not Path("out").exists()
+
+
+def test_a_report_naming_an_output_is_refused(
+    tree: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    args = ["drawings", "-t", "pic-mmh", "-o", "out", "--report", "out/rect.pic", "--force"]
+    code, _, err = run(args, capsys)
+    assert code == 2 and "--report out/rect.pic and drawings/rect.dxf → out/rect.pic" in err
+
+
+def test_a_folder_another_batch_writes_into_is_refused(
+    tree: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from camtool.output import lock_directory
+
+    with lock_directory("out"):
+        for force in ([], ["--force"]):
+            code, _, err = run(["drawings", "-t", "pic-mmh", "-o", "out", *force], capsys)
+            assert code == 1
+            assert f"-o out: another camtool run (pid {os.getpid()}) is writing" in err
+            assert sorted(p.name for p in Path("out").iterdir()) == [".camtool.lock"]
+    assert run(["drawings", "-t", "pic-mmh", "-o", "out", "-j", "1"], capsys)[0] == 0
+    assert not Path("out/.camtool.lock").exists()
+
+
+def test_two_batches_started_together_never_both_write(tree: Path) -> None:
+    """Exactly one run posts; the other says why it did not; every output is whole."""
+    for i in range(12):
+        rectangle_dxf(tree / f"r{i:02}.dxf", 1 + i % 5, 1)
+    argv = [sys.executable, "-m", "camtool", "batch", "drawings", "-t", "pic-mmh", "-o", "out"]
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    runs = [
+        subprocess.Popen([*argv, "-j", "2"], stderr=subprocess.PIPE, text=True, env=env)
+        for _ in range(2)
+    ]
+    results = [(proc.wait(timeout=300), proc.stderr.read() if proc.stderr else "") for proc in runs]
+    codes = sorted(code for code, _ in results)
+    assert codes[0] == 0 and codes[1] in (1, 2), results
+    loser = next(err for code, err in results if code)
+    assert "another camtool run" in loser or "exist already" in loser, loser
+    for item in expand_inputs(["drawings"]):
+        code_path = Path("out") / item.relative.with_suffix(".pic")
+        assert code_path.read_text() == post_file(item.path, "pic-mmh").result.code
+    assert [p for p in Path("out").rglob(".*")] == []  # no temp file, no lock left
+
+
+def test_workers_die_with_a_killed_batch(tree: Path) -> None:
+    """kill -9 of `batch -j 2` must not leave its workers running (and holding its pipes)."""
+    shutil.rmtree(tree)
+    tree.mkdir()
+    for name in ("a.ngc", "b.ngc"):
+        os.mkfifo(tree / name)  # a worker reading a FIFO waits for a writer: busy forever
+    argv = [sys.executable, "-m", "camtool", "batch", "drawings", "-t", "pic-mmh", "-o", "out"]
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    parent = subprocess.Popen([*argv, "-j", "2"], stderr=subprocess.DEVNULL, env=env)
+    workers: list[int] = []
+    try:
+        deadline = time.monotonic() + 60
+        while len(workers) < 2 and time.monotonic() < deadline:
+            time.sleep(0.2)
+            workers = children(parent.pid)
+        assert len(workers) == 2, "the batch did not start its workers"
+        parent.kill()
+        parent.wait()
+        deadline = time.monotonic() + 5
+        while any(alive(pid) for pid in workers) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not [pid for pid in workers if alive(pid)]
+    finally:
+        for pid in workers:
+            if alive(pid):
+                os.kill(pid, signal.SIGKILL)
+        parent.kill()
+
+
+def children(pid: int) -> list[int]:
+    """Child pids of ``pid`` (Linux /proc)."""
+    found: list[int] = []
+    for task in Path(f"/proc/{pid}/task").glob("*"):
+        with contextlib.suppress(OSError):
+            found += [int(c) for c in (task / "children").read_text().split()]
+    return found
+
+
+def alive(pid: int) -> bool:
+    """True while ``pid`` runs (a zombie waiting to be reaped has stopped running)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except (OSError, IndexError):
+        return False
+    return state != "Z"
+
+
+def test_a_glob_climbing_out_with_dotdot_writes_inside_the_output_folder(tree: Path) -> None:
+    Path("other").mkdir()
+    rectangle_dxf(Path("other/o.dxf"), 1, 1)
+    options = BatchOptions(target="pic-mmh", output_dir=Path("out"), jobs=1)
+    plan = plan_batch(["drawings/*/../../other/*.dxf"], options)
+    assert [Path(t.code_path) for t in plan.tasks] == [Path("out/o.pic")]
+    assert run_batch(plan).exit_code == 0
+    assert sorted(p.as_posix() for p in Path(".").rglob("*.pic")) == ["out/o.pic"]
+
+
+def test_an_output_resolving_outside_the_output_folder_is_refused(tree: Path) -> None:
+    Path("elsewhere").mkdir()
+    Path("out").mkdir()
+    Path("out/parts").symlink_to(Path("elsewhere").resolve())
+    options = BatchOptions(target="pic-mmh", output_dir=Path("out"), force=True)
+    outside = r"out/parts/deep/small\.pic would be written outside -o out"
+    with pytest.raises(UsageError, match=outside):
+        plan_batch(["drawings"], options)
+    assert list(Path("elsewhere").iterdir()) == []
+
+
+def test_a_batch_removes_temp_files_of_killed_runs(tree: Path) -> None:
+    proc = subprocess.Popen([sys.executable, "-c", "pass"])
+    proc.wait()
+    Path("out/parts").mkdir(parents=True)
+    stale = Path(f"out/parts/.l.pic.camtool-{proc.pid}.tmp")
+    stale.write_text("half\n")
+    options = BatchOptions(target="pic-mmh", output_dir=Path("out"), jobs=1)
+    assert run_batch(plan_batch(["drawings"], options)).exit_code == 0
+    assert not stale.exists()
+    assert [p for p in Path("out").rglob(".*")] == []

@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import os
+import stat
 import subprocess
 import sys
+import threading
 from pathlib import Path
 
 import pytest
@@ -259,3 +262,112 @@ def test_layers_and_units_reach_the_importers(
     points.write_text("x,y\n100,100\n300,100\n300,200\n100,100\n")
     code, out, _ = run(["post", str(points), "-t", "pic-mmh", "--units", "um"], capsys)
     assert code == 0 and "G01X00300.00Y00100.00F08;" in out.splitlines()
+
+
+# -- nothing lost: outputs that are inputs, devices, FIFOs, symlinks, a full disk ---------------
+
+
+@pytest.fixture
+def part(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """tmp_path as the working directory: part.dxf, its program part.pic, sub/, link.dxf."""
+    monkeypatch.chdir(tmp_path)
+    rectangle_dxf(tmp_path / "part.dxf", 2, 1)
+    assert main(["post", "part.dxf", "-t", "pic-mmh", "-o", "part.pic"]) == 0
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "link.dxf").symlink_to("part.dxf")
+    (tmp_path / "m.toml").write_text(BIG_MACHINE)
+    return tmp_path
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["post", "part.dxf", "-o", "part.dxf"], "-o part.dxf would overwrite the input"),
+        (["post", "part.dxf", "-o", "./sub/../part.dxf"], "would overwrite the input part.dxf"),
+        (["post", "part.dxf", "-o", "link.dxf"], "-o link.dxf would overwrite the input"),
+        (["post", "link.dxf", "-o", "part.dxf"], "-o part.dxf would overwrite the input"),
+        (["post", "part.dxf", "--preview", "part.dxf"], "--preview part.dxf would overwrite"),
+        (["post", "part.dxf", "-o", "a.pic", "--report", "part.dxf"], "--report part.dxf would"),
+        (["post", "part.dxf", "-o", "m.toml", "--machine", "m.toml"], "the --machine file m.toml"),
+        (["post", "part.dxf", "-o", "r.json", "--report", "r.json"], "are the same file"),
+        (["post", "part.dxf", "--report", "-"], "-o - and --report - both write to stdout"),
+        (["verify", "part.pic", "--report", "part.pic"], "overwrite the program part.pic"),
+        (["verify", "part.pic", "--preview", "./part.pic"], "overwrite the program part.pic"),
+        (["verify", "part.pic", "--against", "part.dxf", "--report", "link.dxf"], "--against"),
+        (["preview", "part.pic", "-o", "a.svg", "--program", "a.svg"], "overwrite the --program"),
+    ],
+)
+def test_an_output_naming_an_input_or_another_output_is_refused(
+    part: Path, capsys: pytest.CaptureFixture[str], args: list[str], message: str
+) -> None:
+    before = {p.name: p.read_bytes() for p in part.iterdir() if p.is_file()}
+    code, out, err = run([*args, "-t", "pic-mmh"], capsys)
+    assert code == 2, err
+    assert message in err and out == "" and "Traceback" not in err
+    assert {p.name: p.read_bytes() for p in part.iterdir() if p.is_file()} == before
+
+
+def test_preview_of_a_drawing_onto_itself_is_refused(
+    part: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    drawing = part / "d.svg"
+    drawing.write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" width="10mm" height="10mm" '
+        'viewBox="0 0 10 10"><path d="M1 1 H4 V3 H1 Z"/></svg>'
+    )
+    before = drawing.read_bytes()
+    code, _, err = run(["preview", "d.svg", "-o", "./sub/../d.svg"], capsys)
+    assert code == 2 and "-o ./sub/../d.svg would overwrite the input d.svg" in err
+    assert drawing.read_bytes() == before
+
+
+def test_post_to_a_full_stdout_is_an_error_not_a_crash(part: Path) -> None:
+    with open("/dev/full", "wb") as full:
+        proc = subprocess.run(
+            [sys.executable, "-m", "camtool", "post", "part.dxf", "-t", "pic-mmh"],
+            stdout=full,
+            stderr=subprocess.PIPE,
+            text=True,
+            check=False,
+        )
+    assert proc.returncode == 1
+    assert "camtool: error: stdout: no space left on device" in proc.stderr
+    assert "internal error" not in proc.stderr and "Exception ignored" not in proc.stderr
+
+
+def test_post_to_a_full_device_names_it(part: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = run(["post", "part.dxf", "-t", "pic-mmh", "-o", "/dev/full"], capsys)
+    assert code == 1 and "/dev/full: cannot write (no space left on device)" in err
+    assert stat.S_ISCHR(os.stat("/dev/full").st_mode)
+
+
+def test_post_to_dev_null_leaves_it_a_device(
+    part: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, _, err = run(["post", "part.dxf", "-t", "pic-mmh", "-o", "/dev/null"], capsys)
+    assert code == 0, err
+    assert stat.S_ISCHR(os.stat("/dev/null").st_mode)
+    assert os.stat("/dev/null").st_rdev == os.makedev(1, 3)  # Linux: mem major 1, minor 3
+
+
+def test_post_into_a_fifo_writes_through(part: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    os.mkfifo("fifo.pic")
+    got: list[bytes] = []
+    reader = threading.Thread(target=lambda: got.append(Path("fifo.pic").read_bytes()))
+    reader.start()
+    code, _, err = run(["post", "part.dxf", "-t", "pic-mmh", "-o", "fifo.pic"], capsys)
+    reader.join(timeout=20)
+    assert code == 0, err
+    assert got == [Path("part.pic").read_bytes()]
+    assert stat.S_ISFIFO(os.lstat("fifo.pic").st_mode)
+
+
+def test_post_through_a_symlink_replaces_its_target(
+    part: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    Path("sub/prog.pic").write_text("previous\n")
+    Path("prog.pic").symlink_to("sub/prog.pic")
+    code, _, err = run(["post", "part.dxf", "-t", "pic-mmh", "-o", "prog.pic"], capsys)
+    assert code == 0, err
+    assert Path("prog.pic").is_symlink() and os.readlink("prog.pic") == "sub/prog.pic"
+    assert Path("sub/prog.pic").read_bytes() == Path("part.pic").read_bytes()
