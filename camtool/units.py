@@ -42,3 +42,16 @@ def mm_to_um(value_mm: float) -> float:
 def um_to_mm(value_um: float) -> float:
     """Convert µm to mm."""
     return value_um / 1000.0
+
+
+def fmt_num(value: float, decimals: int = 4) -> str:
+    """``value`` with ``decimals`` decimals for messages; a negative zero prints as ``0``.
+
+    ``fmt_num(-0.00001, 4)`` is ``"0.0000"``, never ``"-0.0000"`` (STYLE.md §8:
+    ``-0`` never appears); ``fmt_num(-1.25, 1)`` is ``"-1.2"`` (Python rounds
+    half to even on the binary value). ``decimals`` >= 0.
+    """
+    text = f"{value:.{decimals}f}"
+    if text.startswith("-") and not text.strip("-0."):
+        return text[1:]
+    return text
