@@ -507,8 +507,9 @@ def _stretches(
 ) -> list[IntArray]:
     """Runs of consecutive flagged samples of one contour (joined across a closed one's seam)."""
     out: list[IntArray] = []
-    for c in np.unique(contour_of):
-        idx = np.flatnonzero(contour_of == c)
+    cuts = np.flatnonzero(np.diff(contour_of)) + 1  # samples come contour after contour
+    for lo, hi in zip([0, *cuts.tolist()], [*cuts.tolist(), len(contour_of)], strict=True):
+        idx = np.arange(lo, hi)
         f = flagged[idx]
         if not f.any():
             continue

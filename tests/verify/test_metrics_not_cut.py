@@ -114,3 +114,18 @@ def test_not_cut_text_counts_and_units() -> None:
     assert not_cut_text(a).startswith("1 feature not cut as drawn with this tool: ")
     assert "tight corner at (0, 27) mm" in not_cut_text(a)  # never "-0"
     assert "max 621.30 µm" in not_cut_text(a)
+
+
+def test_a_stretch_across_a_closed_contours_seam_is_one_feature() -> None:
+    import numpy as np
+
+    from camtool.verify.metrics import _stretches
+
+    # a closed square sampled from its corner (0, 0): the flagged corner region wraps around
+    ring = np.array([(0, 0), (1, 0), (2, 0), (2, 2), (0, 2), (0, 1), (0, 0)], dtype=np.float64)
+    line = np.array([(5, 5), (6, 5), (7, 5)], dtype=np.float64)
+    samples = np.vstack([ring, line])
+    contour_of = np.array([0] * 7 + [1] * 3)
+    flagged = np.array([1, 1, 0, 0, 0, 1, 1, 1, 0, 1], dtype=bool)
+    got = [sorted(s.tolist()) for s in _stretches(samples, contour_of, flagged)]
+    assert got == [[0, 1, 5, 6], [7], [9]]  # the open line's ends stay apart
