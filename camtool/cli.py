@@ -28,6 +28,7 @@ from camtool.cli_common import (
     write_output,
 )
 from camtool.errors import CamtoolError, UsageError, VerifyLimitError
+from camtool.units import fmt_num
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -39,13 +40,20 @@ if TYPE_CHECKING:
 
 
 def _verify_outputs(command: Callable[..., None]) -> Callable[..., None]:
-    """The options every verifying command shares: --report, --preview, --max-error-um."""
+    """The options every verifying command shares: --report, --preview, --max-error-um, --strict."""
+    command = click.option(
+        "--strict",
+        is_flag=True,
+        help="--max-error-um also counts the features the planner reported it cannot cut "
+        "as drawn with this tool (tight corners, regions narrower than the tool).",
+    )(command)
     command = click.option(
         "--max-error-um",
         type=number_range(min=0),
         default=None,
         metavar="N",
-        help="Exit with code 4 when the predicted error exceeds N µm (for CI).",
+        help="Exit with code 4 when the predicted error of what was cut exceeds N µm (for CI); "
+        "also when a drawing given to compare with does not overlap the program.",
     )(command)
     command = click.option(
         "--preview",
@@ -100,6 +108,7 @@ def post(
     report: str | None,
     preview: str | None,
     max_error_um: float | None,
+    strict: bool,
     **options: Any,
 ) -> None:
     """Import DRAWING (a .dxf file, or '-' for stdin), plan it, write it for a target.
@@ -149,6 +158,7 @@ def post(
             drawing=job.placed,
             edge_radius_mm=job.edge_radius_mm,
             plan=job.plan,
+            strict=strict,
         )
 
 
@@ -182,6 +192,7 @@ def verify(
     report: str | None,
     preview: str | None,
     max_error_um: float | None,
+    strict: bool,
 ) -> None:
     """Read CODE (a program file, or '-' for stdin) back and predict the machined error.
 
@@ -204,7 +215,13 @@ def verify(
     drawing = read_input(against) if against is not None else None
     v = verify_code(text, chosen, source=code, against=drawing, tool_diameter=tool_diameter)
     _finish_verification(
-        v, report, preview, max_error_um, drawing=drawing, edge_radius_mm=tool_diameter / 2.0
+        v,
+        report,
+        preview,
+        max_error_um,
+        drawing=drawing,
+        edge_radius_mm=tool_diameter / 2.0,
+        strict=strict,
     )
 
 
@@ -217,10 +234,14 @@ def _finish_verification(
     drawing: Drawing | None = None,
     edge_radius_mm: float = 0.0,
     plan: PlanReport | None = None,
+    strict: bool = False,
 ) -> None:
     """Summary to stderr, then the report and preview files, then the limit check.
 
     The report gets a ``plan`` key (what planning found) when the code was planned here.
+    The limit judges what was cut as drawn; ``strict`` adds the features the planner
+    reported it cannot cut with this tool. A drawing that was given but not compared
+    (it does not overlap the program) fails the limit: it cannot pass unjudged.
     """
     from camtool.verify.verifier import report_dict, summary_lines
 
@@ -234,9 +255,19 @@ def _finish_verification(
 
         picture = write_trace_preview(v, preview, drawing=drawing, edge_radius_mm=edge_radius_mm)
         write_output(picture, preview)
-    if max_error_um is not None and v.max_error_um > max_error_um:
+    if max_error_um is None:
+        return
+    if v.against_skipped is not None:
         raise VerifyLimitError(
-            f"predicted error {v.max_error_um:.2f} µm exceeds --max-error-um {max_error_um:g}"
+            f"--max-error-um {max_error_um:g} cannot be judged: the drawing was not compared "
+            "(it does not overlap the program; see the warning above)"
+        )
+    error = v.strict_error_um if strict else v.max_error_um
+    if error > max_error_um:
+        hint = "" if strict or v.strict_error_um == v.max_error_um else " (what was cut)"
+        raise VerifyLimitError(
+            f"predicted error {fmt_num(error, 2)} µm{hint} exceeds --max-error-um "
+            f"{max_error_um:g}" + (" with --strict" if strict else "")
         )
 
 

@@ -296,6 +296,9 @@ def post_drawing(
 def verify_job(job: PostJob) -> Verification:
     """Verify what ``job`` emitted: read its code back and simulate it against its drawing.
 
+    The plan's findings go along, so features the planner reported it cannot cut
+    with this tool are measured apart (:func:`camtool.verify.verifier.verify_program`).
+
     Raises:
         CamtoolError: the target cannot read its own code back, or its machine
             profile is invalid for the verifier.
@@ -308,4 +311,5 @@ def verify_job(job: PostJob) -> Verification:
         source=f"<{job.target.name} code>",
         against=job.placed,
         tool_diameter=2.0 * job.edge_radius_mm,
+        findings=job.plan.findings if job.plan is not None else (),
     )

@@ -126,7 +126,7 @@ def test_title_gives_size_and_time_at_programmed_feeds() -> None:
     line = Program((Linear(10.0, 0.0, 60.0, contour=1), Linear(10.0, 5.0, 60.0, contour=1)))
     texts = [t.text for t in _groups(render_preview(".svg", program=line))["title"]]
     # 15 mm at 60 mm/min = 15 s
-    assert texts == ["10 × 5 mm · ≈ 15 s at programmed feeds, cuts only"]
+    assert texts == ["toolpath 10 × 5 mm, X 0…10 Y 0…5 mm · ≈ 15 s at programmed feeds, cuts only"]
 
 
 def test_title_time_by_the_pic_mmh_timing_model() -> None:
@@ -135,7 +135,9 @@ def test_title_time_by_the_pic_mmh_timing_model() -> None:
     one_mm = Program((Linear(1.0, 0.0, 0.8, contour=1),))
     svg = render_preview(".svg", program=one_mm, target=load_target("pic-mmh"))
     texts = [t.text for t in _groups(svg)["title"]]
-    assert texts == ["pic-mmh · 1 × 0 mm · ≈ 1 min 15 s by the pic-mmh timing model"]
+    assert texts == [
+        "pic-mmh · toolpath 1 × 0 mm, X 0…1 Y 0…0 mm · ≈ 1 min 15 s by the pic-mmh timing model"
+    ]
 
 
 def test_drawing_alone_and_program_over_drawing() -> None:

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, TypeAlias
 from camtool.geometry import BBox, Drawing, Line, bbox_union
 from camtool.preview import program_layers as pl
 from camtool.preview import trace_layers as tl
-from camtool.preview.facts import duration, size_text
+from camtool.preview.facts import duration, length, size_text
 from camtool.preview.scene import (
     Circle,
     Layer,
@@ -36,6 +36,8 @@ from camtool.preview.scene import (
     text_width,
 )
 from camtool.program import Program, Rapid
+from camtool.units import fmt_num
+from camtool.verify.verifier import error_text
 
 if TYPE_CHECKING:
     from camtool.verify.verifier import Verification
@@ -145,28 +147,68 @@ def _main_layers(c: Content, u: float, frame: BBox) -> list[Layer]:
         pieces = tl.binned_polylines(points, run, dev_um, tolerance=u / 5.0, top_um=tl.top_um(v))
         layers.append(tl.trace_layer("trace", pieces, 1.1 * u))
     layers.extend(layer for layer in program if layer.id != "tool-width")
+    layers.append(pl.zero_layer(frame, u))
+    if v is not None and v.against is not None and v.against.not_cut:
+        layers.append(tl.not_cut_layer("not-cut", v.against.not_cut, u))
     if v is not None and v.deviation.block >= 0:
         layers.append(tl.worst_layer("worst", v, u, view=frame))
     return [layer for layer in layers if layer.shapes]
 
 
+def extent_text(c: Content) -> str:
+    """The part's size and the toolpath's extent, apart.
+
+    ``"part 100 × 60 mm, toolpath X −1.5…101.5 Y −1.5…61.5 mm"`` with a drawing;
+    ``"toolpath 103 × 63 mm, X −1.5…101.5 Y −1.5…61.5 mm"`` without one (an
+    offset toolpath is not the part); ``"part 100 × 60 mm"`` for a drawing alone.
+    """
+    parts = []
+    has_drawing = c.drawing is not None and bool(c.drawing.contours)
+    if c.drawing is not None and has_drawing:
+        parts.append(f"part {size_text(c.drawing.bbox())}")
+    cutting = c.program is not None and any(not isinstance(m, Rapid) for m in c.program.moves)
+    if c.program is not None and cutting:
+        box = c.program.bbox(cutting_only=True)
+        x0, y0, x1, y1 = (length(v).replace("-", "−") for v in box)
+        span = f"X {x0}…{x1} Y {y0}…{y1} mm"
+        parts.append(f"toolpath {span}" if has_drawing else f"toolpath {size_text(box)}, {span}")
+    return ", ".join(parts) or size_text(part_box(c))
+
+
 def _title_lines(c: Content) -> list[str]:
     facts = [c.target_name] if c.target_name else []
-    facts.append(size_text(part_box(c)))
+    facts.append(extent_text(c))
     if c.time is not None:
         facts.append(f"≈ {duration(c.time[0])} {c.time[1]}")
     lines = [c.title] if c.title else []
     lines.append(" · ".join(facts))
     v = c.verification
     if v is not None:
-        text = f"verified: max deviation {v.deviation.max_um:.2f} µm"
+        text = f"verified: max deviation {fmt_num(v.deviation.max_um, 2)} µm"
         if v.deviation.block >= 0:
             text += f" ({tl.worst_label(v).split(', ', 1)[1]})"
-        text += f", rms {v.deviation.rms_um:.2f} µm"
-        if v.against is not None:
-            text += f"; against the drawing max {v.against.max_um:.2f} µm"
+        text += f", rms {fmt_num(v.deviation.rms_um, 2)} µm"
         lines.append(text)
+        against = _against_line(v)
+        if against:
+            lines.append(against)
     return lines
+
+
+def _against_line(v: Verification) -> str:
+    """The title line of the drawing comparison ("" when no drawing was given)."""
+    a = v.against
+    if a is None:
+        return "" if v.against_skipped is None else "the drawing does not overlap: not compared"
+    text = f"against the drawing: max {fmt_num(a.max_um, 2)} µm"
+    if a.not_cut:
+        n = len(a.not_cut)
+        worst = max(f.error_um for f in a.not_cut)
+        text += (
+            f" where cut as drawn; {n} feature{'s' if n > 1 else ''} not cut as drawn "
+            f"with this tool (max {error_text(worst)})"
+        )
+    return text
 
 
 def _title(lines: list[str], page: BBox, base: float, u: float) -> Layer:
@@ -239,6 +281,9 @@ def _entries(c: Content, u: float) -> list[tuple[Glyph, str]]:
         style = Style(fill=pl.TOOL_COLOUR, opacity=pl.TOOL_OPACITY)
         return (Rect((x, y - 1.2 * u, x + 4.5 * u, y + 1.2 * u), style),)
 
+    def marker(x: float, y: float) -> tuple[Shape, ...]:
+        return tl.not_cut_marker((x + 2.2 * u, y), u)
+
     def ramp(x: float, y: float) -> tuple[Shape, ...]:
         return tuple(
             Path(
@@ -265,8 +310,13 @@ def _entries(c: Content, u: float) -> list[tuple[Glyph, str]]:
             "work area" if view_box(c)[1] else f"work area {size_text(c.work_area)}, partly shown"
         )
         out.append((stroke(Style(pl.AREA_COLOUR, 0.4 * u, dash=(1.5 * u, u))), label))
+    if p is not None and pl.tab_segments(p):
+        out.append((stroke(Style(pl.TAB_COLOUR, 1.0 * u)), "tab"))
     if c.verification is not None:
         out.append((ramp, "simulated tool centre"))
+    v = c.verification
+    if v is not None and v.against is not None and v.against.not_cut:
+        out.append((marker, "not cut as drawn with this tool"))
     return out
 
 

@@ -11,8 +11,18 @@ from __future__ import annotations
 
 import math
 
-from camtool.geometry import Arc, BBox, Drawing, Point, Segment
-from camtool.preview.scene import Circle, Layer, Path, Polylines, Rect, Style, Text, polyline
+from camtool.geometry import Arc, BBox, Drawing, Line, Point, Segment
+from camtool.preview.scene import (
+    Circle,
+    Layer,
+    Path,
+    Polylines,
+    Rect,
+    Style,
+    Text,
+    place_labels,
+    polyline,
+)
 from camtool.program import Program, Rapid
 
 CUT_COLOUR = "#1f4fd1"
@@ -28,6 +38,12 @@ DRAWING_COLOUR = "#6b6b6b"
 TOOL_COLOUR = "#1f4fd1"
 """Tool width (translucent)."""
 TOOL_OPACITY = 0.18
+TAB_COLOUR = "#2ca02c"
+"""Moves that rise onto a holding tab (green)."""
+ZERO_COLOUR = "#000000"
+"""The work zero's cross."""
+Z_EPS = 1e-6
+"""Z difference, mm, below which two heights are the same."""
 
 
 def cut_runs(program: Program) -> list[list[Segment]]:
@@ -73,10 +89,70 @@ def program_layers(program: Program, u: float, *, edge_radius_mm: float = 0.0) -
             "cuts",
             (Path(tuple(tuple(r) for r in runs), Style(CUT_COLOUR, 0.35 * u)),) if runs else (),
         ),
+        Layer("tabs", tab_shapes(tab_segments(program), u)),
         Layer("starts", tuple(s for run in runs for s in _start_marker(run, u))),
-        Layer("order", tuple(_number(i + 1, run, u) for i, run in enumerate(runs))),
+        Layer("order", tuple(place_labels([_number(i + 1, run, u) for i, run in enumerate(runs)]))),
     ]
     return [layer for layer in layers if layer.shapes]
+
+
+def tab_segments(program: Program) -> list[Segment]:
+    """The XY cutting moves that cross a holding tab, mm.
+
+    A tab is crossed at a height above the pass depth around it: a move with
+    XY travel at a constant ``z`` inside a run of cutting moves (between two
+    rapids) where some earlier move of the run cut below ``z`` and some later
+    one goes below it again (as :mod:`camtool.toolpath.passes` writes a tab:
+    rise onto the tab top, cross it, go down). A first, shallower pass of a multi-pass
+    run is not a tab: nothing before it was deeper. Programs without Z have none.
+    """
+    rows: list[list[tuple[Segment, float, float]]] = []
+    z_here: float | None = None
+    fresh = True
+    for move, seg in program.segments():
+        z0 = z_here
+        z_here = move.z if move.z is not None else z_here
+        if isinstance(move, Rapid):
+            fresh = True
+            continue
+        if z0 is None or z_here is None:
+            continue
+        if fresh:
+            rows.append([])
+            fresh = False
+        rows[-1].append((seg, z0, z_here))
+    out: list[Segment] = []
+    for run in rows:
+        ends = [z1 for _, _, z1 in run]
+        starts = [z0 for _, z0, _ in run]
+        for i, (seg, z0, z1) in enumerate(run):
+            if abs(z1 - z0) > Z_EPS or (seg.start == seg.end and not isinstance(seg, Arc)):
+                continue
+            before = min([starts[0], *ends[:i]])
+            after = min(ends[i + 1 :], default=math.inf)
+            if before < z1 - Z_EPS and after < z1 - Z_EPS:
+                out.append(seg)
+    return out
+
+
+def tab_shapes(segments: list[Segment], u: float) -> tuple[Path, ...]:
+    """The tab crossings as thick green strokes over the cuts."""
+    if not segments:
+        return ()
+    return (Path(tuple((s,) for s in segments), Style(TAB_COLOUR, 1.0 * u)),)
+
+
+def zero_layer(view: BBox, u: float) -> Layer:
+    """A cross on the work zero (0, 0) when it is in ``view``, labelled ``0, 0``."""
+    if not (view[0] <= 0.0 <= view[2] and view[1] <= 0.0 <= view[3]):
+        return Layer("zero", ())
+    a = 2.5 * u
+    cross = Path(
+        ((Line((-a, 0.0), (a, 0.0)),), (Line((0.0, -a), (0.0, a)),)),
+        Style(ZERO_COLOUR, 0.3 * u),
+    )
+    label = Text((0.6 * u, -2.6 * u), "0, 0", 2.2 * u, ZERO_COLOUR, halo=True)
+    return Layer("zero", (cross, label))
 
 
 def drawing_layer(drawing: Drawing, u: float) -> Layer:

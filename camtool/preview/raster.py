@@ -21,6 +21,8 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
 DPI = 100
+ARC_TOLERANCE_PX = 0.1
+"""Largest distance, pixels, of an arc's chords from the arc: arcs look round at any size."""
 _ANCHOR = {"start": "left", "middle": "center", "end": "right"}
 
 
@@ -98,7 +100,8 @@ def _shape(ax: Axes, shape: Shape, pt: float, z: int, *, clip: bool) -> None:
         ax.add_patch(patches.PathPatch(path, **_patch(shape.style, pt, z)))
     else:
         if isinstance(shape, Path):
-            tolerance = (ax.get_xlim()[1] - ax.get_xlim()[0]) / 2000.0
+            # arcs as chords within a tenth of a pixel (pt points per unit, DPI/72 px per point)
+            tolerance = ARC_TOLERANCE_PX * 72.0 / (pt * DPI)
             lines = [line for chain in shape.chains for line in _chain_lines(chain, tolerance)]
         else:
             lines = [np.asarray(line) for line in shape.lines]

@@ -191,3 +191,55 @@ def text_width(text: str, size: float, *, bold: bool = False) -> float:
 def expand(box: BBox, margin: float) -> BBox:
     """``box`` grown by ``margin`` on every side."""
     return (box[0] - margin, box[1] - margin, box[2] + margin, box[3] + margin)
+
+
+MAX_LABELS = 60
+"""Most labels of one kind a picture shows; past it every k-th is kept (first and last too)."""
+
+
+def text_box(t: Text) -> BBox:
+    """Approximate ink box of ``t`` (window units), from :func:`text_width`."""
+    w = text_width(t.text, t.size, bold=t.bold)
+    x = t.at[0] - {"start": 0.0, "middle": w / 2, "end": w}.get(t.anchor, 0.0)
+    return (x, t.at[1] - 0.25 * t.size, x + w, t.at[1] + 0.8 * t.size)
+
+
+def place_labels(
+    labels: list[Text], *, limit: int = MAX_LABELS, taken: list[BBox] | None = None
+) -> list[Text]:
+    """Labels that do not pile up: at most ``limit``, none overlapping another.
+
+    Past ``limit`` every k-th label is kept (the first and the last always). Each
+    kept label goes where it was asked, else moved up, down, left or right by
+    about its own size, else it is hidden. ``taken`` holds boxes already used
+    (by other labels); the placed labels' boxes are added to it.
+    """
+    n = len(labels)
+    if n > limit:
+        k = math.ceil(n / max(limit - 1, 1))
+        keep = sorted({*range(0, n, k), n - 1})[:limit]
+        labels = [labels[i] for i in keep]
+    boxes = taken if taken is not None else []
+    placed: list[Text] = []
+    for label in labels:
+        s, w = label.size, text_width(label.text, label.size, bold=label.bold)
+        for dx, dy in ((0.0, 0.0), (0.0, 1.1 * s), (0.0, -1.1 * s), (-w - 0.3 * s, 0.0)):
+            moved = Text(
+                (label.at[0] + dx, label.at[1] + dy),
+                label.text,
+                s,
+                label.colour,
+                label.anchor,
+                label.bold,
+                label.halo,
+            )
+            box = text_box(moved)
+            if not any(_overlap(box, other) for other in boxes):
+                boxes.append(box)
+                placed.append(moved)
+                break
+    return placed
+
+
+def _overlap(a: BBox, b: BBox) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]

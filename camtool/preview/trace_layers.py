@@ -16,18 +16,34 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
-from camtool.geometry import BBox
+from camtool.geometry import BBox, Point
 from camtool.preview.program_layers import CUT_COLOUR, cut_runs
-from camtool.preview.scene import Circle, Layer, Path, Polylines, Style, Text, polyline, ramp_colour
+from camtool.preview.scene import (
+    Circle,
+    Layer,
+    Path,
+    Polylines,
+    Style,
+    Text,
+    place_labels,
+    polyline,
+    ramp_colour,
+)
 from camtool.program import Rapid
+from camtool.units import fmt_num
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from camtool.verify.metrics import NotCut
     from camtool.verify.verifier import Verification
 
 BINS = 16
 """Colour classes of the deviation scale."""
 WORST_COLOUR = "#d62728"
 """The worst point's marker and annotation."""
+NOT_CUT_COLOUR = "#e67e22"
+"""Markers of the features not cut as drawn (orange)."""
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -123,7 +139,32 @@ def worst_label(v: Verification) -> str:
     """``"max 14.07 µm, line 12"``: the worst deviation and where it is in the code."""
     line = v.program.line_of(v.deviation.block)
     where = f"line {line}" if line is not None else f"block {v.deviation.block + 1}"
-    return f"max {v.deviation.max_um:.2f} µm, {where}"
+    return f"max {fmt_num(v.deviation.max_um, 2)} µm, {where}"
+
+
+def not_cut_marker(at: Point, u: float) -> tuple[Polylines, ...]:
+    """An orange diamond on ``at`` (mm), 2.4 u across."""
+    x, y, a = at[0], at[1], 1.2 * u
+    ring = polyline([(x - a, y), (x, y + a), (x + a, y), (x, y - a)])
+    return (Polylines((ring,), Style("#ffffff", 0.5 * u, fill=NOT_CUT_COLOUR), closed=True),)
+
+
+def not_cut_layer(layer_id: str, features: Sequence[NotCut], u: float) -> Layer:
+    """A diamond and a short label (``"tight corner"``) on each feature not cut as drawn.
+
+    Labels are thinned and moved apart (:func:`camtool.preview.scene.place_labels`).
+    """
+    shapes: list[Polylines | Text] = []
+    labels = []
+    for f in features:
+        shapes.extend(not_cut_marker(f.at, u))
+        labels.append(
+            Text(
+                (f.at[0] + 1.8 * u, f.at[1] + 1.2 * u), f.label, 2.4 * u, NOT_CUT_COLOUR, halo=True
+            )
+        )
+    shapes.extend(place_labels(labels, limit=12))
+    return Layer(layer_id, tuple(shapes))
 
 
 def worst_layer(layer_id: str, v: Verification, u: float, *, view: BBox | None) -> Layer:

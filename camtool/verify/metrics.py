@@ -11,13 +11,16 @@ deviation of a point is its distance to the segment its block was cutting
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 import numpy.typing as npt
 
 from camtool.geometry import Arc, BBox, Drawing, Line, Point, Segment, bbox_union
 from camtool.program import ArcMove, Program, Rapid, segment_of
+from camtool.units import fmt_num
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -259,6 +262,53 @@ def fit_circle(points: FloatArray) -> tuple[float, float, float]:
     return (mx + cx, my + cy, math.sqrt(s + cx * cx + cy * cy))
 
 
+NOT_CUT_KINDS = ("tight-corner", "offset-vanished", "uncut")
+"""Plan finding kinds that say a feature cannot be cut as drawn with this tool."""
+
+
+@dataclass(frozen=True)
+class NotCut:
+    """A feature of the drawing the planner reported it cannot cut as drawn.
+
+    Attributes:
+        kind: the plan finding's kind (one of :data:`NOT_CUT_KINDS`).
+        at: where the feature is, mm: the drawing point farthest from the
+            programmed path (a tight corner's vertex) or the finding's location.
+        error_um: largest |d(q, trace) − r| over the drawing points of the feature, µm.
+        samples: drawing points counted in this feature (left out of the main figure).
+        value: the finding's size (a region's width mm, an area mm², ...), or ``None``.
+    """
+
+    kind: str
+    at: Point
+    error_um: float
+    samples: int
+    value: float | None = None
+
+    @property
+    def label(self) -> str:
+        """A short name: ``"tight corner"``, ``"2 mm wide region"``, ``"uncut region"``."""
+        if self.kind == "tight-corner":
+            return "tight corner"
+        if self.kind == "offset-vanished" and self.value is not None:
+            return f"{fmt_num(self.value, 3).rstrip('0').rstrip('.')} mm wide region"
+        return "uncut region" if self.kind == "uncut" else "region narrower than the tool"
+
+
+class FindingLike(Protocol):
+    """What :func:`against_drawing` reads of a plan finding.
+
+    :class:`camtool.toolpath.cuts.Finding` is one.
+    """
+
+    @property
+    def kind(self) -> str: ...  # noqa: D102
+    @property
+    def at(self) -> Point | None: ...  # noqa: D102
+    @property
+    def value(self) -> float | None: ...  # noqa: D102
+
+
 @dataclass(frozen=True)
 class Against:
     """The machined edge compared with the drawing.
@@ -266,13 +316,17 @@ class Against:
     The machined edge is the trace swept by the tool radius r: a drawing point q
     is off by ``d(q, trace) − r`` (> 0: material left, < 0: cut too deep), and a
     trace point p gouges the drawing by ``r − d(p, drawing)`` where that is > 0.
+    Drawing points of features the planner reported as impossible with this
+    tool (:data:`NOT_CUT_KINDS`) are measured apart, in ``not_cut``.
 
     Attributes:
-        max_um: largest |d(q, trace) − r| over the sampled drawing, µm.
+        max_um: largest |d(q, trace) − r| over the sampled drawing that was cut
+            as drawn (``not_cut`` features left out), µm.
         rms_um: RMS of the same, µm.
         at_mm: drawing point where the max occurs.
         overcut_um: largest gouge of the drawing, µm (0 when none).
-        samples: drawing points measured.
+        samples: drawing points measured (all, features included).
+        not_cut: the features not cut as drawn, each with its own error.
     """
 
     max_um: float
@@ -280,6 +334,12 @@ class Against:
     at_mm: Point
     overcut_um: float
     samples: int
+    not_cut: tuple[NotCut, ...] = ()
+
+    @property
+    def strict_max_um(self) -> float:
+        """The largest error over the whole drawing, features not cut as drawn included, µm."""
+        return max([self.max_um, *(f.error_um for f in self.not_cut)])
 
 
 def against_drawing(
@@ -290,6 +350,8 @@ def against_drawing(
     spacing_mm: float = 0.005,
     resolution_mm: float = 0.0005,
     runs: IntArray | None = None,
+    nominal: Sequence[FloatArray] = (),
+    findings: Sequence[FindingLike] = (),
 ) -> Against:
     """Compare a cutting trace with the drawing it was made from (shapely nearest queries).
 
@@ -297,6 +359,9 @@ def against_drawing(
     ``resolution_mm`` apart (never more than 400 000): a thinned-out point lies
     within about that distance of the polyline, so it bounds the error of this
     measure (the step-level deviation from the path is :func:`deviation`).
+
+    With ``findings`` and the ``nominal`` path, the drawing points the planner
+    could not cut as drawn (:func:`not_cut_mask`) are measured apart.
 
     Args:
         points: ``(N, 2)`` float64 cutting trace (rapids left out), mm, in the
@@ -308,6 +373,10 @@ def against_drawing(
         runs: ``(N,)`` id of the continuous cut each point belongs to (the rows
             between two rapids); the trace is not joined across two runs, so a
             rapid never counts as cutting. ``None``: one run.
+        nominal: the programmed cutting path, one ``(M, 2)`` polyline (mm) per
+            run of cutting moves.
+        findings: the plan's findings; those of :data:`NOT_CUT_KINDS` with a
+            location name the features measured apart.
     """
     import shapely
 
@@ -329,7 +398,27 @@ def against_drawing(
     q = shapely.points(samples)
     _, d_q = tree.query_nearest(q, return_distance=True, all_matches=False)
     off = np.asarray(d_q, dtype=np.float64) - tool_radius_mm
-    worst = int(np.argmax(np.abs(off)))
+    features: list[NotCut] = []
+    main = np.ones(len(samples), dtype=bool)
+    if nominal and any(f.kind in NOT_CUT_KINDS and f.at is not None for f in findings):
+        nominal_off = _distance_to(samples, nominal) - tool_radius_mm
+        groups = not_cut_groups(
+            samples, _contour_ids(drawing, spacing_mm), nominal_off, findings, tool_radius_mm
+        )
+        for finding, index, at in groups:
+            main[index] = False
+            features.append(
+                NotCut(
+                    kind=finding.kind,
+                    at=at,
+                    error_um=float(np.max(np.abs(off[index]))) * 1000.0,
+                    samples=len(index),
+                    value=finding.value,
+                )
+            )
+    kept = off[main] if main.any() else np.zeros(1)
+    kept_at = samples[main] if main.any() else np.zeros((1, 2))
+    worst = int(np.argmax(np.abs(kept)))
     overcut = 0.0
     if tool_radius_mm > 0:
         chords = shapely.linestrings(np.stack([samples[:-1], samples[1:]], axis=1))
@@ -339,12 +428,150 @@ def against_drawing(
         )
         overcut = max(0.0, float(tool_radius_mm - np.min(d_p))) * 1000.0
     return Against(
-        max_um=float(abs(off[worst])) * 1000.0,
-        rms_um=float(np.sqrt(np.mean(off * off))) * 1000.0,
-        at_mm=(float(samples[worst, 0]), float(samples[worst, 1])),
+        max_um=float(abs(kept[worst])) * 1000.0,
+        rms_um=float(np.sqrt(np.mean(kept * kept))) * 1000.0,
+        at_mm=(float(kept_at[worst, 0]), float(kept_at[worst, 1])),
         overcut_um=overcut,
         samples=len(samples),
+        not_cut=tuple(features),
     )
+
+
+PLAN_TOLERANCE_MM = 0.002
+"""Least distance of the programmed edge from the drawing that counts as "not as drawn", mm."""
+
+
+def not_cut_groups(
+    samples: FloatArray,
+    contour_of: IntArray,
+    nominal_off: FloatArray,
+    findings: Sequence[FindingLike],
+    tool_radius_mm: float,
+) -> list[tuple[FindingLike, IntArray, Point]]:
+    """The drawing points of each feature the plan reported as not cut as drawn.
+
+    A feature is a stretch of one drawing contour where even the *programmed*
+    edge (the nominal path swept by the tool) lies off the drawing by more than
+    a threshold: ``max(PLAN_TOLERANCE_MM, 3 × the median such distance)`` (the
+    median absorbs the dialect's rounding). A stretch belongs to a finding that
+    names its contour: a ``tight-corner`` finding every stretch of the contour
+    through its corner whose peak exceeds ``max(2 × threshold, r / 100)`` (the
+    finding locates only the first of its corners), an ``offset-vanished`` one
+    the stretches of the smallest contour around its location, an ``uncut`` one
+    those within ``max(2r, 2√area)`` of its location on the nearest contour.
+    Stretches no finding names stay in the main figure: the planner did not
+    say why they are off.
+
+    Args:
+        samples: ``(S, 2)`` drawing points, mm, contour after contour.
+        contour_of: ``(S,)`` index of the contour of each sample.
+        nominal_off: ``(S,)`` distance of each sample from the programmed path
+            minus the tool radius, mm.
+        findings: plan findings; only :data:`NOT_CUT_KINDS` with a location count.
+        tool_radius_mm: tool radius, mm.
+
+    Returns:
+        ``(finding, sample indices, location mm)`` per feature, in finding order.
+    """
+    size = np.abs(nominal_off)
+    threshold = max(PLAN_TOLERANCE_MM, 3.0 * float(np.median(size)))
+    stretches = _stretches(samples, contour_of, size > threshold)
+    taken = [False] * len(stretches)
+    out: list[tuple[FindingLike, IntArray, Point]] = []
+    for finding in findings:
+        if finding.kind not in NOT_CUT_KINDS or finding.at is None:
+            continue
+        at = np.asarray(finding.at, dtype=np.float64)
+        contour = _named_contour(samples, contour_of, at, inside=finding.kind == "offset-vanished")
+        for k, index in enumerate(stretches):
+            if taken[k] or contour_of[index[0]] != contour:
+                continue
+            peak = int(index[np.argmax(size[index])])
+            if finding.kind == "tight-corner":
+                if size[peak] <= max(2.0 * threshold, tool_radius_mm / 100.0):
+                    continue
+                where = (float(samples[peak, 0]), float(samples[peak, 1]))
+            else:
+                if finding.kind == "uncut":
+                    reach = max(2.0 * tool_radius_mm, 2.0 * math.sqrt(max(finding.value or 0, 0)))
+                    if np.min(np.hypot(*(samples[index] - at).T)) > reach:
+                        continue
+                where = (float(at[0]), float(at[1]))
+            taken[k] = True
+            out.append((finding, index, where))
+    return out
+
+
+def _stretches(
+    samples: FloatArray, contour_of: IntArray, flagged: npt.NDArray[np.bool_]
+) -> list[IntArray]:
+    """Runs of consecutive flagged samples of one contour (joined across a closed one's seam)."""
+    out: list[IntArray] = []
+    cuts = np.flatnonzero(np.diff(contour_of)) + 1  # samples come contour after contour
+    for lo, hi in zip([0, *cuts.tolist()], [*cuts.tolist(), len(contour_of)], strict=True):
+        idx = np.arange(lo, hi)
+        f = flagged[idx]
+        if not f.any():
+            continue
+        if f.all():
+            out.append(idx)
+            continue
+        edges = np.flatnonzero(np.diff(f.astype(np.int8)))
+        starts = [0, *(edges + 1).tolist()]
+        pieces = [idx[a:b] for a, b in zip(starts, [*starts[1:], len(idx)], strict=True)]
+        pieces = [p for p in pieces if flagged[p[0]]]
+        closed = math.dist(samples[idx[0]], samples[idx[-1]]) <= 1e-9
+        if (
+            closed and f[0] and f[-1] and len(pieces) > 1
+        ):  # the seam of a closed contour splits one run
+            pieces = [np.concatenate([pieces[-1], pieces[0]]), *pieces[1:-1]]
+        out.extend(pieces)
+    return out
+
+
+def _named_contour(
+    samples: FloatArray, contour_of: IntArray, at: FloatArray, *, inside: bool
+) -> int:
+    """The contour a finding at ``at`` names: the smallest closed one around it, or the nearest."""
+    if inside:
+        import shapely
+
+        best, best_area = -1, math.inf
+        point = shapely.Point(at)
+        for c in np.unique(contour_of):
+            ring = samples[contour_of == c]
+            if len(ring) < 4 or math.dist(ring[0], ring[-1]) > 1e-9:
+                continue
+            polygon = shapely.Polygon(ring)
+            if polygon.is_valid and polygon.area < best_area and polygon.contains(point):
+                best, best_area = int(c), polygon.area
+        if best >= 0:
+            return best
+    return int(contour_of[np.argmin(np.hypot(*(samples - at).T))])
+
+
+def _distance_to(samples: FloatArray, lines: Sequence[FloatArray]) -> FloatArray:
+    """Distance of each sample to the nearest of ``lines`` (polylines ``(M, 2)``), mm."""
+    import shapely
+
+    chords = [np.stack([p[:-1], p[1:]], axis=1) for p in lines if len(p) > 1]
+    singles = [p for p in lines if len(p) == 1]
+    parts = []
+    if chords:
+        parts.append(shapely.linestrings(np.concatenate(chords)))
+    if singles:
+        parts.append(shapely.points(np.concatenate(singles)))
+    if not parts:
+        return np.full(len(samples), np.inf)
+    tree = shapely.STRtree(np.concatenate(parts))
+    _, d = tree.query_nearest(shapely.points(samples), return_distance=True, all_matches=False)
+    return np.asarray(d, dtype=np.float64)
+
+
+def _contour_ids(drawing: Drawing, spacing_mm: float) -> IntArray:
+    """``(S,)`` index of the contour of each point of :func:`_sample_drawing`."""
+    sizes = [len(_sample_contour(c.segments, spacing_mm)) for c in drawing.contours]
+    return np.repeat(np.arange(len(sizes), dtype=np.int64), sizes)
 
 
 def _sample_drawing(drawing: Drawing, spacing_mm: float) -> FloatArray:

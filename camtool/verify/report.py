@@ -6,7 +6,11 @@ Stable keys other tools read: ``target``, ``blocks``, ``steps`` {x, y, z},
 ``size_error_um`` (one ``[dx, dy]`` per contour, bounding box), ``time_s``,
 ``warnings``. Added here: ``machine``, ``compensation_steps``, the location of
 the worst deviation, ``contours`` (every measure per contour, circles with
-their fitted diameter) and ``against`` (the drawing comparison). Numbers are
+their fitted diameter), ``against`` (the drawing comparison, over what was
+cut as drawn), ``not_cut_as_drawn`` (the features the planner reported it
+cannot cut with this tool, each ``{kind, label, at: {x_mm, y_mm}, error_um,
+samples, value}``), ``strict_error_um`` (the largest error with them) and
+``against_skipped`` (why a drawing given was not compared, else null). Numbers are
 rounded (µm to 4 decimals, mm to 6) so the same input gives the same bytes.
 """
 
@@ -23,11 +27,11 @@ from camtool.verify.verifier import Verification
 
 
 def _um(value: float) -> float:
-    return round(float(value), 4)
+    return round(float(value), 4) + 0.0  # + 0.0 turns a -0.0 into 0.0
 
 
 def _mm(value: float) -> float:
-    return round(float(value), 6)
+    return round(float(value), 6) + 0.0
 
 
 def build_report(v: Verification) -> dict[str, Any]:
@@ -64,6 +68,10 @@ def build_report(v: Verification) -> dict[str, Any]:
         "size_error_um": [[_um(c.size_error_um[0]), _um(c.size_error_um[1])] for c in v.contours],
         "contours": [_contour(c) for c in v.contours],
         "against": None,
+        "not_cut_as_drawn": [],
+        "against_skipped": v.against_skipped,
+        "max_error_um": _um(v.max_error_um),
+        "strict_error_um": _um(v.strict_error_um),
         "time_s": round(v.time_s, 3),
         "warnings": list(v.warnings),
     }
@@ -76,6 +84,17 @@ def build_report(v: Verification) -> dict[str, Any]:
             "overcut_um": _um(a.overcut_um),
             "samples": a.samples,
         }
+        report["not_cut_as_drawn"] = [
+            {
+                "kind": f.kind,
+                "label": f.label,
+                "at": {"x_mm": _mm(f.at[0]), "y_mm": _mm(f.at[1])},
+                "error_um": _um(f.error_um),
+                "samples": f.samples,
+                "value": None if f.value is None else _mm(f.value),
+            }
+            for f in a.not_cut
+        ]
     return report
 
 

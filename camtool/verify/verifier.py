@@ -8,19 +8,22 @@ program on a machine profile and measures the result (see
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from camtool.errors import UsageError
-from camtool.geometry import Drawing
+from camtool.geometry import BBox, Drawing
 from camtool.machine import Machine
 from camtool.program import Dwell, Home, Program, Rapid
+from camtool.units import fmt_num
 from camtool.verify.metrics import (
     Against,
     ContourMeasure,
     Deviation,
+    FindingLike,
     against_drawing,
     deviation,
     measure_contours,
@@ -35,6 +38,9 @@ SMALL_PART_MM = 1.0
 """Parts under this size suffer most from compensations (seed-000 §5.3, S000-19)."""
 MAX_COMPENSATIONS_SMALL = 16
 """Compensations above which a small part is warned about (the puma: 15-16; the logo: 45)."""
+MIN_OVERLAP = 0.1
+"""Least overlap of the program's and the drawing's boxes (of the larger box's area) for
+``--against`` to compare them; below it they are in different places or scales."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -51,6 +57,9 @@ class Verification:
         against: trace swept by the tool vs the drawing, when one was given.
         block_time_s: ``(B,)`` float64 estimated time of each move, s.
         warnings: what a machinist should know before cutting.
+        against_skipped: why a drawing that was given was not compared (the
+            program and the drawing do not overlap), else ``None``; then
+            ``against`` is ``None`` and no limit can be judged against it.
     """
 
     target: str
@@ -62,6 +71,7 @@ class Verification:
     against: Against | None
     block_time_s: np.ndarray
     warnings: tuple[str, ...] = field(default=())
+    against_skipped: str | None = None
 
     @property
     def dwell_s(self) -> float:
@@ -78,11 +88,21 @@ class Verification:
         """The predicted error a limit is checked against, µm.
 
         The largest of the deviation from the nominal path and, when a drawing
-        was given, the machined edge's distance from it and its overcut.
+        was given, the machined edge's distance from it and its overcut, over
+        what was cut as drawn (features the planner reported it cannot cut
+        with this tool are left out: see :attr:`strict_error_um`).
         """
         worst = self.deviation.max_um
         if self.against is not None:
             worst = max(worst, self.against.max_um, self.against.overcut_um)
+        return worst
+
+    @property
+    def strict_error_um(self) -> float:
+        """:attr:`max_error_um` with the features not cut as drawn included, µm."""
+        worst = self.max_error_um
+        if self.against is not None:
+            worst = max(worst, self.against.strict_max_um)
         return worst
 
 
@@ -93,15 +113,23 @@ def verify_code(
     source: str = "<code>",
     against: Drawing | None = None,
     tool_diameter: float = 0.0,
+    findings: Sequence[FindingLike] = (),
 ) -> Verification:
     """Read ``code`` with ``target``'s reader and verify it on ``target``'s machine.
+
+    ``findings`` are the plan's (see :func:`verify_program`).
 
     Raises:
         ParseError: the code is not valid in the target's dialect (names the line).
     """
     program = target.post.parse(code, source=source)
     return verify_program(
-        program, target.machine, name=target.name, against=against, tool_diameter=tool_diameter
+        program,
+        target.machine,
+        name=target.name,
+        against=against,
+        tool_diameter=tool_diameter,
+        findings=findings,
     )
 
 
@@ -112,6 +140,7 @@ def verify_program(
     name: str = "",
     against: Drawing | None = None,
     tool_diameter: float = 0.0,
+    findings: Sequence[FindingLike] = (),
 ) -> Verification:
     """Simulate ``program`` on ``machine`` and measure the machined error.
 
@@ -122,6 +151,14 @@ def verify_program(
         against: the drawing to compare the machined edge with (same coordinates).
         tool_diameter: tool diameter, mm; the machined edge is the trace swept by
             half of it (0: a scribing point, or a path on the line).
+        findings: what planning found (:class:`camtool.toolpath.cuts.Finding`):
+            features it reported as impossible with this tool (a tight corner, a
+            region narrower than the tool) are measured apart from the rest of
+            the drawing (:func:`camtool.verify.metrics.not_cut_groups`).
+
+    A drawing whose box does not overlap the program's (less than
+    :data:`MIN_OVERLAP`) is not compared: ``against`` is ``None``,
+    ``against_skipped`` and a warning say why.
 
     Raises:
         UsageError: a negative tool diameter, or an inconsistent machine profile.
@@ -138,11 +175,22 @@ def verify_program(
     dev = deviation(points, blocks, program)
     contours = tuple(measure_contours(points, trace.block_start, trace.start_mm, program))
     compared = None
-    if against is not None:
+    warnings = _warnings(program, trace)
+    skipped = None if against is None else _no_overlap(program, against, tool_diameter / 2.0)
+    if skipped is not None:
+        warnings.append(skipped)
+    elif against is not None:
         rapid = np.asarray([isinstance(m, Rapid) for m in program.moves], dtype=bool)
         cutting = ~rapid[blocks] if len(blocks) else np.zeros(0, dtype=bool)
         runs = np.cumsum(~cutting)[cutting]  # a new id after every rapid row
-        compared = against_drawing(points[cutting], against, tool_diameter / 2.0, runs=runs)
+        compared = against_drawing(
+            points[cutting],
+            against,
+            tool_diameter / 2.0,
+            runs=runs,
+            nominal=_nominal_lines(program) if findings else (),
+            findings=findings,
+        )
     times = block_times(trace, program, machine)
     return Verification(
         target=name or machine.name,
@@ -153,8 +201,71 @@ def verify_program(
         contours=contours,
         against=compared,
         block_time_s=times,
-        warnings=tuple(_warnings(program, trace)),
+        warnings=tuple(warnings),
+        against_skipped=skipped,
     )
+
+
+def _nominal_lines(program: Program) -> list[np.ndarray]:
+    """The programmed cutting path as polylines ``(M, 2)`` mm, one per run between rapids."""
+    lines: list[list[tuple[float, float]]] = []
+    fresh = True
+    for move, seg in program.segments():
+        if isinstance(move, Rapid):
+            fresh = True
+            continue
+        pts = seg.points(0.0002)
+        if fresh:
+            lines.append(list(pts))
+            fresh = False
+        else:
+            lines[-1].extend(pts[1:])
+    return [np.asarray(p, dtype=np.float64) for p in lines]
+
+
+def _no_overlap(program: Program, drawing: Drawing, radius_mm: float) -> str | None:
+    """Why the program and the drawing cannot be compared (boxes apart), or ``None``.
+
+    Both boxes are grown by the tool radius and 1 % of their size (so a line
+    still has an area); they overlap when the shared area is at least
+    :data:`MIN_OVERLAP` of the larger box's.
+    """
+    if not drawing.contours or not any(not isinstance(m, Rapid) for m in program.moves):
+        return None
+    cut, drawn = program.bbox(cutting_only=True), drawing.bbox()
+    a, b = _grown(cut, radius_mm), _grown(drawn, radius_mm)
+    w = min(a[2], b[2]) - max(a[0], b[0])
+    h = min(a[3], b[3]) - max(a[1], b[1])
+    shared = max(w, 0.0) * max(h, 0.0)
+    larger = max(_area(a), _area(b))
+    if shared >= MIN_OVERLAP * larger:
+        return None
+    return (
+        f"the program ({_span(cut)}) and the drawing ({_span(drawn)}) do not overlap: "
+        "different scale or origin? post with the same --origin/--scale (--against takes "
+        "the drawing in the program's coordinates); not compared"
+    )
+
+
+def _grown(box: BBox, radius_mm: float) -> BBox:
+    m = radius_mm + 0.01 * max(box[2] - box[0], box[3] - box[1], 1e-3)
+    return (box[0] - m, box[1] - m, box[2] + m, box[3] + m)
+
+
+def _area(box: BBox) -> float:
+    return (box[2] - box[0]) * (box[3] - box[1])
+
+
+def _span(box: BBox) -> str:
+    """``"X 0…100 Y -1.5…60 mm"``: a box's extent for messages."""
+    x0, y0, x1, y1 = (_short(v) for v in box)
+    return f"X {x0}…{x1} Y {y0}…{y1} mm"
+
+
+def _short(value: float) -> str:
+    """At most 3 decimals, trailing zeros dropped, never ``-0``."""
+    text = fmt_num(value, 3).rstrip("0").rstrip(".")
+    return "0" if text in ("-0", "") else text
 
 
 def block_times(trace: StepTrace, program: Program, machine: Machine) -> np.ndarray:
@@ -184,37 +295,66 @@ def _warnings(program: Program, trace: StepTrace) -> list[str]:
 
 
 def summary_lines(v: Verification) -> list[str]:
-    """A one-screen text summary of a verification (for stderr)."""
+    """A one-screen text summary of a verification (for stderr); never prints ``-0``."""
     t = v.trace
     steps = t.block_steps.sum(axis=0) if len(t.block_steps) else np.zeros(3, dtype=np.int64)
+    dev = v.deviation
     lines = [
         f"verified {len(v.program.moves)} moves on {v.target} ({v.machine.name})",
         f"  steps x {steps[0]}, y {steps[1]}, z {steps[2]}; "
         f"{int((~t.compensation).sum())} iterations",
         f"  reversals x {t.reversals[0]}, y {t.reversals[1]}; "
         f"{t.compensations} compensations ({int(t.compensation.sum())} steps)",
-        f"  deviation from the path: max {v.deviation.max_um:.2f} µm at "
-        f"({v.deviation.at_mm[0]:.4f}, {v.deviation.at_mm[1]:.4f}) mm, "
-        f"rms {v.deviation.rms_um:.2f} µm",
+        f"  deviation from the path: max {fmt_num(dev.max_um, 2)} µm at "
+        f"({fmt_num(dev.at_mm[0])}, {fmt_num(dev.at_mm[1])}) mm, "
+        f"rms {fmt_num(dev.rms_um, 2)} µm",
     ]
     for c in v.contours:
         ex, ey = c.size_error_um
-        text = f"  contour {c.number}: size error {ex:+.1f} x {ey:+.1f} µm"
+        text = f"  contour {c.number}: size error {_signed(ex)} x {_signed(ey)} µm"
         if c.closure_um is not None:
-            text += f", closure gap ({c.closure_um[0]:+.1f}, {c.closure_um[1]:+.1f}) µm"
+            text += f", closure gap ({_signed(c.closure_um[0])}, {_signed(c.closure_um[1])}) µm"
         if c.circle is not None:
-            text += f", diameter {c.circle[1]:.4f} mm (nominal {c.circle[0]:.4f})"
+            text += f", diameter {fmt_num(c.circle[1])} mm (nominal {fmt_num(c.circle[0])})"
         lines.append(text)
         if len(lines) > 14:
             lines.append(f"  ... {len(v.contours) - c.number} more contours in the report")
             break
     if v.against is not None:
+        a = v.against
         lines.append(
-            f"  against the drawing: max {v.against.max_um:.2f} µm, rms {v.against.rms_um:.2f} µm, "
-            f"overcut {v.against.overcut_um:.2f} µm"
+            f"  against the drawing: max {fmt_num(a.max_um, 2)} µm, rms {fmt_num(a.rms_um, 2)} µm, "
+            f"overcut {fmt_num(a.overcut_um, 2)} µm"
+            + (" (where it was cut as drawn)" if a.not_cut else "")
         )
-    lines.append(f"  estimated time {v.time_s:.1f} s")
+        if a.not_cut:
+            lines.append("  " + not_cut_text(a))
+    lines.append(f"  estimated time {fmt_num(v.time_s, 1)} s")
     return lines
+
+
+def not_cut_text(a: Against) -> str:
+    """``"2 features not cut as drawn: tight corner at (20, 27) mm, ...; max 7.8 mm"``."""
+    n = len(a.not_cut)
+    shown = [f"{f.label} at ({_short(f.at[0])}, {_short(f.at[1])}) mm" for f in a.not_cut[:6]]
+    if n > 6:
+        shown.append(f"{n - 6} more")
+    worst = max(f.error_um for f in a.not_cut)
+    return (
+        f"{n} feature{'s' if n > 1 else ''} not cut as drawn with this tool: "
+        f"{', '.join(shown)}; max {error_text(worst)} (--strict counts them)"
+    )
+
+
+def error_text(um: float) -> str:
+    """An error for people: ``"4.95 µm"`` under 1 mm, ``"7.8 mm"`` from 1 mm on."""
+    return f"{fmt_num(um, 2)} µm" if um < 1000.0 else f"{fmt_num(um / 1000.0, 1)} mm"
+
+
+def _signed(value: float, decimals: int = 1) -> str:
+    """``"+1.5"``, ``"-0.3"``, ``"+0.0"`` (a negative zero gets the plus sign)."""
+    text = fmt_num(value, decimals)
+    return text if text.startswith("-") else "+" + text
 
 
 def report_dict(v: Verification, plan: PlanReport | None = None) -> dict[str, Any]:

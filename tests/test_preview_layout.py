@@ -1,0 +1,173 @@
+"""Previews that say what matters: titles, labels that never pile up, round PNG arcs, tabs, zero."""
+
+from __future__ import annotations
+
+import io
+import math
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+
+from camtool.geometry import Arc, Contour, Drawing, Line
+from camtool.preview import render_preview
+from camtool.preview.program_layers import tab_segments
+from camtool.preview.raster import scene_png
+from camtool.preview.scene import (
+    MAX_LABELS,
+    Layer,
+    Panel,
+    Path,
+    Rect,
+    Scene,
+    Style,
+    Text,
+    place_labels,
+    text_box,
+)
+from camtool.program import Linear, Program, Rapid
+
+NS = "{http://www.w3.org/2000/svg}"
+
+
+def _groups(svg: bytes) -> dict[str, ET.Element]:
+    root = ET.fromstring(svg)
+    return {g.get("id", ""): g for g in root.iter() if g.get("id")}
+
+
+def _title(svg: bytes) -> list[str]:
+    return [t.text or "" for t in _groups(svg)["title"]]
+
+
+def _rectangle(x0: float, y0: float, x1: float, y1: float) -> Contour:
+    pts = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
+    return Contour(tuple(Line(a, b) for a, b in zip(pts, [*pts[1:], pts[0]], strict=True)), True)
+
+
+def test_title_gives_part_size_and_toolpath_extent_apart() -> None:
+    # a 100 × 60 mm part cut on its outside with a 3 mm tool: the path is 1.5 mm outside it
+    part = Drawing((_rectangle(0.0, 0.0, 100.0, 60.0),))
+    corners = [(-1.5, -1.5), (101.5, -1.5), (101.5, 61.5), (-1.5, 61.5), (-1.5, -1.5)]
+    path = Program((Rapid(-1.5, -1.5), *(Linear(x, y, 600.0, contour=1) for x, y in corners[1:])))
+    title = _title(render_preview(".svg", program=path, drawing=part))
+    assert title[0].startswith("part 100 × 60 mm, toolpath X −1.5…101.5 Y −1.5…61.5 mm · ")
+    alone = _title(render_preview(".svg", program=path))
+    assert alone[0].startswith("toolpath 103 × 63 mm, X −1.5…101.5 Y −1.5…61.5 mm · ")
+    drawing_only = _title(render_preview(".svg", drawing=part))
+    assert drawing_only == ["part 100 × 60 mm"]
+
+
+def test_500_labels_are_thinned_and_never_overlap() -> None:
+    labels = [Text((0.01 * i, 0.0), str(i + 1), 1.0) for i in range(500)]
+    placed = place_labels(labels)
+    assert 0 < len(placed) <= MAX_LABELS
+    boxes = [text_box(t) for t in placed]
+    for i, a in enumerate(boxes):
+        for b in boxes[i + 1 :]:
+            assert not (a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3])
+    assert placed[0].text == "1"  # the first run's number is kept
+
+
+def test_colliding_labels_are_moved_not_stacked() -> None:
+    two = place_labels([Text((0.0, 0.0), "12", 1.0), Text((0.0, 0.0), "13", 1.0)])
+    assert [t.text for t in two] == ["12", "13"]
+    assert two[0].at != two[1].at
+
+
+def test_500_contours_show_at_most_max_labels_order_numbers() -> None:
+    moves = []
+    for i in range(500):
+        x, y = float(i % 25) * 2.0, float(i // 25) * 2.0
+        moves += [Rapid(x, y), Linear(x + 1.0, y, 100.0, contour=i + 1)]
+    svg = render_preview(".svg", program=Program(tuple(moves)))
+    numbers = list(_groups(svg)["order"].iter(f"{NS}text"))
+    assert 0 < len(numbers) <= MAX_LABELS
+
+
+def test_png_circle_is_round() -> None:
+    # A circle of radius 90 mm on a 200 mm page 2000 px wide: 900 px radius. Every inked
+    # pixel must lie within half the line (1 px) and a pixel's diagonal of the true circle.
+    r, width_px = 90.0, 2000
+    page = (-100.0, -100.0, 100.0, 100.0)
+    circle = Arc((r, 0.0), (r, 0.0), (0.0, 0.0), False)
+    line_mm = 0.1  # 1 px
+    layers = (
+        Layer("bg", (Rect(page, Style(fill="#ffffff")),)),
+        Layer("c", (Path(((circle,),), Style("#000000", line_mm)),)),
+    )
+    png = scene_png(Scene(page, width_px, (Panel("main", page, page, layers),)))
+    from matplotlib.image import imread
+
+    img = imread(io.BytesIO(png))[..., :3].mean(axis=2)
+    rows, cols = np.nonzero(img < 0.5)
+    px_per_mm = width_px / 200.0
+    x = (cols + 0.5) - width_px / 2
+    y = (rows + 0.5) - img.shape[0] / 2
+    error_px = np.abs(np.hypot(x, y) - r * px_per_mm)
+    assert len(rows) > 2 * math.pi * r * px_per_mm * 0.9  # the whole circle is there
+    assert float(error_px.max()) <= line_mm * px_per_mm / 2 + math.sqrt(0.5) + 0.05
+
+
+def _tabbed() -> Program:
+    # one run: plunge to -1, a first pass, down to -3, rise to -2.5 over a tab (x 4…6), down
+    return Program(
+        (
+            Rapid(0.0, 0.0, 5.0),
+            Linear(0.0, 0.0, 300.0, z=-1.0, contour=1),
+            Linear(10.0, 0.0, 300.0, z=-1.0, contour=1),
+            Linear(10.0, 0.0, 300.0, z=-3.0, contour=1),
+            Linear(6.0, 0.0, 300.0, z=-3.0, contour=1),
+            Linear(6.0, 0.0, 300.0, z=-2.5, contour=1),
+            Linear(4.0, 0.0, 300.0, z=-2.5, contour=1),
+            Linear(4.0, 0.0, 300.0, z=-3.0, contour=1),
+            Linear(0.0, 0.0, 300.0, z=-3.0, contour=1),
+            Rapid(0.0, 0.0, 5.0),
+        )
+    )
+
+
+def test_tab_crossings_are_found_and_drawn() -> None:
+    tabs = tab_segments(_tabbed())
+    assert [(s.start, s.end) for s in tabs] == [((6.0, 0.0), (4.0, 0.0))]  # not the -1 pass
+    groups = _groups(render_preview(".svg", program=_tabbed()))
+    assert "tabs" in groups
+    assert "tab" in [t.text for t in groups["legend"].iter(f"{NS}text")]
+
+
+def test_no_tabs_on_a_plain_multi_pass_cut() -> None:
+    plain = Program(
+        (
+            Rapid(0.0, 0.0, 5.0),
+            Linear(0.0, 0.0, 300.0, z=-1.0, contour=1),
+            Linear(10.0, 0.0, 300.0, z=-1.0, contour=1),
+            Linear(10.0, 0.0, 300.0, z=-2.0, contour=1),
+            Linear(0.0, 0.0, 300.0, z=-2.0, contour=1),
+        )
+    )
+    assert tab_segments(plain) == []
+
+
+def test_work_zero_is_marked_when_in_view() -> None:
+    near = Program((Rapid(1.0, 1.0), Linear(5.0, 1.0, 100.0, contour=1)))
+    assert "zero" in _groups(render_preview(".svg", program=near))
+    far = Program((Linear(105.0, 100.0, 100.0, contour=1),), origin=(100.0, 100.0))
+    assert "zero" not in _groups(render_preview(".svg", program=far))
+
+
+@pytest.mark.parametrize("suffix", [".svg", ".png"])
+def test_not_cut_features_are_marked(suffix: str) -> None:
+    from camtool.pipeline import post_drawing, verify_job
+    from camtool.post.registry import load_target
+    from tests.verify.test_metrics_not_cut import R, plate
+
+    job = post_drawing(plate(), load_target("grbl"), offset="outside", tool_diameter=2 * R)
+    v = verify_job(job)
+    data = render_preview(suffix, verification=v, drawing=job.placed, edge_radius_mm=R)
+    if suffix == ".png":
+        assert data[:4] == b"\x89PNG"
+        return
+    groups = _groups(data)
+    labels = sorted(t.text or "" for t in groups["not-cut"].iter(f"{NS}text"))
+    assert labels == ["2 mm wide region", "tight corner", "tight corner"]
+    title = _title(data)
+    assert any("3 features not cut as drawn with this tool (max 12.0 mm)" in t for t in title)

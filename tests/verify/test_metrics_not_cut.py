@@ -1,0 +1,131 @@
+"""Features the planner reported it cannot cut as drawn are measured apart from the rest.
+
+The drawing (then moved by (5, 5) mm): a 40 × 30 mm plate cut on its outside
+with a 3 mm tool, a notch 10 × 3 mm at the top (two 90° inside corners) and a
+2 mm wide slot inside. The expected numbers come from the geometry, not from
+camtool:
+
+- a 90° inside corner keeps the tool radius r = 1.5 mm: the drawn vertex is
+  r·(√2 − 1) = 621.32 µm from the fillet;
+- the 2 mm slot is narrower than the tool, so nothing cuts it: its drawn edge
+  is as far from the cut edge as the nearest other cut allows. The outside
+  path is the plate grown by r; the slot's top edge y = 12 at x >= 12 is
+  12 + r = 13.5 mm from the path's bottom line y = −r and farther from every
+  other side (x + r, 31.5 − 12, 41.5 − x), the farthest any slot point is,
+  so 13.5 − r = 12 mm from the machined edge.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from camtool.geometry import Contour, Drawing, Line, Point
+from camtool.pipeline import post_drawing, verify_job
+from camtool.post.registry import load_target
+from camtool.verify.metrics import NotCut
+from camtool.verify.verifier import not_cut_text, summary_lines
+
+R = 1.5
+CORNER_UM = R * (math.sqrt(2.0) - 1.0) * 1000.0  # 621.32 µm
+SLOT_UM = (13.5 - R) * 1000.0
+
+
+def _polygon(points: list[Point], source: str) -> Contour:
+    pairs = zip(points, [*points[1:], points[0]], strict=True)
+    return Contour(tuple(Line(a, b) for a, b in pairs), True, source=source)
+
+
+def plate() -> Drawing:
+    """The plate, notch and slot above, moved by (5, 5) mm into the work area."""
+    outline = [(0, 0), (40, 0), (40, 30), (30, 30), (30, 27), (20, 27), (20, 30), (0, 30)]
+    slot = [(5, 10), (15, 10), (15, 12), (5, 12)]
+    return Drawing(
+        (
+            _polygon([(x + 5.0, y + 5.0) for x, y in outline], "outline"),
+            _polygon([(x + 5.0, y + 5.0) for x, y in slot], "slot"),
+        )
+    )
+
+
+@pytest.fixture(scope="module")
+def verified():  # type: ignore[no-untyped-def]
+    job = post_drawing(plate(), load_target("grbl"), offset="outside", tool_diameter=2 * R)
+    kinds = sorted(f.kind for f in job.plan.findings) if job.plan else []
+    assert kinds == ["offset-vanished", "tight-corner"]
+    return verify_job(job)
+
+
+def test_main_figure_is_what_was_cut(verified) -> None:  # type: ignore[no-untyped-def]
+    a = verified.against
+    # grbl steps are 4 µm (250 steps/mm); the cut part is within a few steps of the drawing.
+    assert a.max_um < 12.0
+    assert verified.max_error_um < 12.0
+
+
+def test_features_apart_with_their_geometry(verified) -> None:  # type: ignore[no-untyped-def]
+    found = {(f.kind, round(f.at[0]), round(f.at[1])): f for f in verified.against.not_cut}
+    assert set(found) == {
+        ("tight-corner", 25, 32),
+        ("tight-corner", 35, 32),
+        ("offset-vanished", 15, 16),
+    }
+    for key in (("tight-corner", 25, 32), ("tight-corner", 35, 32)):
+        assert found[key].error_um == pytest.approx(CORNER_UM, abs=10.0)
+        assert found[key].at == pytest.approx((key[1], key[2]), abs=0.01)  # the drawn vertex
+    slot = found[("offset-vanished", 15, 16)]
+    assert slot.error_um == pytest.approx(SLOT_UM, abs=10.0)
+    assert slot.value == pytest.approx(2.0, abs=0.01)
+    assert slot.label == "2 mm wide region"
+    # the whole slot outline (24 mm at 5 µm) is in it
+    assert slot.samples >= 24 / 0.005
+    assert verified.strict_error_um == pytest.approx(SLOT_UM, abs=10.0)
+
+
+def test_summary_names_the_features(verified) -> None:  # type: ignore[no-untyped-def]
+    text = "\n".join(summary_lines(verified))
+    assert "3 features not cut as drawn" in text
+    assert "tight corner at (25, 32) mm" in text
+    assert "2 mm wide region at (15, 16) mm" in text
+    assert "max 12.0 mm" in text
+
+
+def test_without_findings_everything_is_the_main_figure() -> None:
+    job = post_drawing(plate(), load_target("grbl"), offset="outside", tool_diameter=2 * R)
+    from camtool.verify.verifier import verify_code
+
+    v = verify_code(job.result.code, job.target, against=job.placed, tool_diameter=2 * R)
+    assert v.against is not None and v.against.not_cut == ()
+    assert v.against.max_um == pytest.approx(SLOT_UM, abs=10.0)
+
+
+def test_not_cut_text_counts_and_units() -> None:
+    from camtool.verify.metrics import Against
+
+    a = Against(
+        1.0,
+        1.0,
+        (0.0, 0.0),
+        0.0,
+        10,
+        (NotCut("tight-corner", (-0.00001, 27.0), 621.3, 5, 2.0),),
+    )
+    assert not_cut_text(a).startswith("1 feature not cut as drawn with this tool: ")
+    assert "tight corner at (0, 27) mm" in not_cut_text(a)  # never "-0"
+    assert "max 621.30 µm" in not_cut_text(a)
+
+
+def test_a_stretch_across_a_closed_contours_seam_is_one_feature() -> None:
+    import numpy as np
+
+    from camtool.verify.metrics import _stretches
+
+    # a closed square sampled from its corner (0, 0): the flagged corner region wraps around
+    ring = np.array([(0, 0), (1, 0), (2, 0), (2, 2), (0, 2), (0, 1), (0, 0)], dtype=np.float64)
+    line = np.array([(5, 5), (6, 5), (7, 5)], dtype=np.float64)
+    samples = np.vstack([ring, line])
+    contour_of = np.array([0] * 7 + [1] * 3)
+    flagged = np.array([1, 1, 0, 0, 0, 1, 1, 1, 0, 1], dtype=bool)
+    got = [sorted(s.tolist()) for s in _stretches(samples, contour_of, flagged)]
+    assert got == [[0, 1, 5, 6], [7], [9]]  # the open line's ends stay apart
