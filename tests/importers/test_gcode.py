@@ -477,3 +477,50 @@ def test_round_trip_through_pic_mmh() -> None:
     back = target.post.parse(str(target.emit(program).code))
     assert len(back.moves) == len(program.moves)
     assert all(_same(a, b) for a, b in zip(program.moves, back.moves, strict=True))
+
+
+# -- program ends, truncation and absurd numbers (issues 13 §4, 14) -------------------------
+
+
+def test_percent_delimited_program_ends_at_the_closing_percent() -> None:
+    program = parse("(header)\n%\nG21 G1 X1 Y1 F10\n%\nG1 X5 Y5\n")
+    assert program.moves == (Linear(1.0, 1.0, 10.0, contour=1),)
+    assert program.warnings == ("t.ngc:5: 1 line after the program end on line 4 not read",)
+
+
+def test_missing_end_warns_once_naming_the_last_block() -> None:
+    program = parse("G21\nG1 X1 Y1 F10\nG1 X2\n(trailing comment)\n\n")
+    assert program.warnings == (
+        "t.ngc:3: no M2/M30 (nor a closing '%'): the file may be truncated; check that its "
+        "last moves are all there",
+    )
+
+
+def test_percent_after_the_first_block_does_not_open_a_program() -> None:
+    # LinuxCNC takes '%' as a delimiter only on the first line; later it changes nothing here
+    program = parse("G21\n%\nG1 X1 Y1 F10\nM2\n")
+    assert program.warnings == ()
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("G21\nG1 X1 Y1 F10\nG1 X2.", "t.ngc:3: the file ends in the middle of a word ('X2.'"),
+        ("G21\nG1 X1 Y1 F10\nG1 X2 Y", "t.ngc:3: the file ends in the middle of a word ('Y'"),
+        ("G21\nG1 X1 Y1 F10\nG1 X-", "t.ngc:3: the file ends in the middle of a word ('X-'"),
+        ("G21\nG1 X1 Y1 F1e3\nM2\n", "t.ngc:2: E3 is a 3D-printer extrusion word, or an exponent"),
+        ("G21\nG1 X1 Y-1000000000 F10\n", "t.ngc:2: Y-1000000000 is out of range"),
+        ("G21\nG1 X1 Y1 F1" + "0" * 400 + "\n", "t.ngc:2: F100000000000... (401 characters)"),
+    ],
+)
+def test_truncated_and_absurd_input_is_refused(text: str, message: str) -> None:
+    assert refused(text).startswith(message)
+
+
+@pytest.mark.parametrize("last", ["G1 X2", "G1 X2 (to X)", "G1 X2 ; Y", "G1 X2. "])
+def test_complete_last_line_without_end_of_line_is_read(last: str) -> None:
+    assert parse(f"G21\nG1 X1 Y1 F10\n{last}").moves[-1] == Linear(2.0, 1.0, 10.0, contour=1)
+
+
+def test_unclosed_comment_on_a_cut_last_line_stays_a_comment_error() -> None:
+    assert "comment '(' is not closed" in refused("G21\nG1 X1 Y1 F10\nG1 X2 (cut X")
