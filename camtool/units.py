@@ -20,6 +20,12 @@ PX: Final = 25.4 / 96.0
 PT: Final = 25.4 / 72.0
 CM: Final = 10.0
 
+LARGEST_VALUE: Final = 1e9
+"""Largest magnitude (exclusive) of a number read from an input file: a length in mm
+(1000 km), a feed, a speed. Anything larger is an absurd value (``1e308``, a corrupt
+file), refused where it enters with the file and line named; below it a float64 still
+holds a length to better than 1 nm."""
+
 LENGTH_UNITS: Final[dict[str, float]] = {
     "mm": MM,
     "um": UM,

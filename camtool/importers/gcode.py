@@ -37,6 +37,11 @@ Rules (RS-274/NGC as LinuxCNC documents them, unless said otherwise):
   camtool does not know the stored position (warning), so the axes it moves
   become unknown and the next moves must give them absolutely.
 - After M2/M30 nothing is read; remaining lines with words are warned about.
+  A ``%`` line before the first block opens the program and the next ``%``
+  ends it the same way (LinuxCNC). A program with neither end is read with a
+  warning (it may be truncated); a last line without an end of line that
+  stops inside a word (``X12.``, ``X-``) is refused as truncated.
+- A program without any cutting move (G1/G2/G3) is refused: nothing to cut.
 """
 
 from __future__ import annotations
@@ -49,7 +54,7 @@ from camtool.errors import InputError
 from camtool.geometry import Point
 from camtool.importers.gcode_codes import BlockWords, Notes
 from camtool.importers.gcode_commands import CommandReader
-from camtool.importers.gcode_lexer import Block, Word, lex_line
+from camtool.importers.gcode_lexer import Block, Word, cut_mid_word, lex_line
 from camtool.program import ArcMove, Home, Linear, Move, Program, Rapid
 from camtool.units import INCH
 
@@ -100,15 +105,41 @@ def parse_gcode(text: str, *, source: str) -> Program:
             G18/G19, canned cycles, G93/G95, coordinate-offset codes, unknown
             G/M codes or letters, two codes of one modal group, a repeated word,
             a word no code uses, a cut before any F, an arc without centre or
-            whose end is off its circle beyond tolerance, or no move at all.
+            whose end is off its circle beyond tolerance, a number out of range,
+            a last line cut in the middle of a word, no move at all, or no
+            cutting move.
     """
     lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
     reader = _Reader(source)
+    opened = False  # a '%' line before the first block: the next '%' ends the program
+    ended = False
     for number, raw in enumerate(lines, start=1):
+        if number == len(lines) and (cut := cut_mid_word(raw)) is not None:
+            raise InputError(
+                f"{source}:{number}: the file ends in the middle of a word ({cut!r}, with no "
+                "end of line after it): the last line is incomplete, the file looks "
+                "truncated; copy or export the program again"
+            )
         block = lex_line(raw, number, source)
-        if block is not None and reader.run(block):
+        if block is None:
+            if raw.lstrip().startswith("%"):
+                if opened:
+                    reader.after_end(lines[number:], number)
+                    ended = True
+                    break
+                opened = not reader.line
+            continue
+        if reader.run(block):
             reader.after_end(lines[number:], number)
+            ended = True
             break
+    if not ended and reader.line:
+        reader.notes.add(
+            "end",
+            reader.line,
+            "no M2/M30 (nor a closing '%'): the file may be truncated; check that its last "
+            "moves are all there",
+        )
     return reader.program()
 
 
@@ -176,11 +207,16 @@ class _Reader:
             )
 
     def program(self) -> Program:
-        """The program read, or InputError if it has no move."""
+        """The program read, or InputError if it has no move or no cutting move."""
         self.commands.finish()
         if not self.moves:
             raise InputError(
                 f"{self.source}: no move (G0, G1, G2, G3) found; is this a G-code program?"
+            )
+        if all(isinstance(move, Rapid) for move in self.moves):
+            raise InputError(
+                f"{self.source}: no cutting move (G1, G2, G3): the program only moves in "
+                f"rapids (G0, {len(self.moves)} of them), so there is nothing to cut"
             )
         return Program(
             tuple(self.moves),
@@ -220,7 +256,9 @@ class _Reader:
         """Refuse words that no code in the block uses (LinuxCNC does the same)."""
         if "H" in w.args and w.g_name("length") == "G43":
             used.add("H")
-        for letter in "XYZIJRPHK":
+        if w.g_name("path") == "G64":
+            used |= {"P", "Q"}  # blending tolerances, ignored with G64 (LinuxCNC "G64")
+        for letter in "XYZIJRPHKQ":
             word = w.args.get(letter)
             if word is None or letter in used:
                 continue
@@ -233,8 +271,9 @@ class _Reader:
                 "X": "axis words need G0, G1, G2 or G3 (or modal motion) before them",
                 "Y": "axis words need G0, G1, G2 or G3 (or modal motion) before them",
                 "Z": "axis words need G0, G1, G2 or G3 (or modal motion) before them",
-                "P": "P belongs to G4 (dwell) or G2/G3 (turns)",
+                "P": "P belongs to G4 (dwell), G2/G3 (turns) or G64 (tolerance)",
                 "H": "H belongs to G43",
+                "Q": "Q belongs to G64 here (canned cycles are not read)",
             }.get(letter, "I, J and R belong to G2/G3 arcs")
             raise InputError(f"{self.where()}: {word} has no code to use it; {hint}")
 

@@ -88,10 +88,17 @@ G_CODES = MappingProxyType(
             "{code} work offset assumed 0: coordinates are taken from the part zero",
         ),
         (
-            "G61 G61.1 G64",
+            "G61 G61.1",
             "path",
             "warn",
             "{code} path control mode ignored (the verifier simulates the target's own)",
+        ),
+        (
+            "G64",
+            "path",
+            "warn",
+            "G64 path blending (with its P/Q tolerances, if any) ignored: the verifier "
+            "simulates the target's own path control",
         ),
         ("G98 G99", "retract", "warn", "{code} canned-cycle return mode ignored (no cycles)"),
         ("G97", "spindle_mode", "warn", "G97 spindle speed mode ignored"),
@@ -117,6 +124,13 @@ G_CODES = MappingProxyType(
             "error",
             "{code} changes the coordinate offsets, which camtool cannot follow; "
             "write the program in part coordinates",
+        ),
+        (
+            "G54.1",
+            "coord",
+            "error",
+            "G54.1 (extended work offsets G54.1 P…) is not supported; use one of G54–G59, "
+            "which camtool reads as the part zero",
         ),
         (
             "G53",
@@ -158,16 +172,18 @@ M_CODES = MappingProxyType(
 READ_CODES = "G0 G1 G2 G3 G4 G17 G20 G21 G28 G30 G80 G90 G91 G90.1 G91.1 G94 M2 M3 M4 M5 M6 M30"
 """What camtool reads, for messages about unknown codes."""
 
-WORD_LETTERS = frozenset("GMNXYZIJKRFSTPH")
+WORD_LETTERS = frozenset("GMNXYZIJKRFSTPHQ")
 """Word letters the reader knows (others are refused, see :data:`OTHER_LETTERS`)."""
 
 OTHER_LETTERS = MappingProxyType(
     {
         **dict.fromkeys("ABCUVW", "is an axis camtool does not have (it reads X, Y and Z)"),
-        "E": "is a 3D-printer extrusion word; camtool reads CNC milling programs",
+        "E": (
+            "is a 3D-printer extrusion word, or an exponent (G-code numbers are plain "
+            "decimals: write 1000, not 1e3); camtool reads CNC milling programs"
+        ),
         "D": "is a cutter compensation register, used only with G41/G42",
         "L": "is a repeat/table word (G10, canned cycles) camtool does not read",
-        "Q": "is a canned-cycle word camtool does not read",
     }
 )
 """Why letters outside :data:`WORD_LETTERS` are refused."""

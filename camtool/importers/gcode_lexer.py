@@ -4,8 +4,13 @@ What a line may hold (RS-274/NGC as LinuxCNC documents it, and the FlashCut
 and Gcodetools programs of seed-001 §3 and seed-004 §3.3):
 
 - words: a letter and a number, case-insensitive, spaces anywhere outside
-  comments (``G01X1.Y2`` = ``g1 x 1 y 2``); numbers like ``.5``, ``-0.``, ``+1``;
-- comments in parentheses (not nested) and from ``;`` to the end of the line;
+  comments (``G01X1.Y2`` = ``g1 x 1 y 2``); numbers like ``.5``, ``-0.``, ``+1``
+  (plain decimals: no exponent, as in RS-274/NGC), of magnitude below
+  :data:`~camtool.units.LARGEST_VALUE`;
+- comments in parentheses (not nested; ``(MSG, ...)``, ``(PRINT, ...)`` and
+  ``(DEBUG, ...)`` are comments too) and from ``;`` to the end of the line, a
+  ``;`` inside parentheses being part of that comment (LinuxCNC
+  ``Interp::close_and_downcase``);
 - ``%`` tape-marker lines, blank lines;
 - a leading ``/`` (block delete; the line is read as if the switch were off);
 - a RepRap checksum ``*NN`` at the end: the XOR of every byte before ``*``,
@@ -13,8 +18,9 @@ and Gcodetools programs of seed-001 §3 and seed-004 §3.3):
 
 Refused with an :class:`~camtool.errors.InputError` naming the line: O-words
 (subroutines and flow control), ``#`` parameters, ``[ ]`` expressions, a
-letter without a number, any other character, unclosed or nested comments
-and a wrong checksum.
+letter without a number, any other character, unclosed or nested comments,
+a wrong checksum, an absurd number (``1`` followed by 400 zeros), and a last
+line cut in the middle of a word (:func:`cut_mid_word`).
 """
 
 from __future__ import annotations
@@ -23,9 +29,12 @@ import re
 from dataclasses import dataclass
 
 from camtool.errors import InputError
+from camtool.units import LARGEST_VALUE
 
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)")
 _CHECKSUM = re.compile(r"\*(\d+)$")
+_CUT = re.compile(r"[A-Za-z]\s*[+-]?\s*(?:\d[\d\s]*)?\.$|[A-Za-z]\s*[+-]?$")
+"""The end of a line cut inside a word: ``X12.``, ``X-``, ``Y`` (spaces may sit inside)."""
 
 
 @dataclass(frozen=True)
@@ -151,9 +160,38 @@ def _words(code: str, where: str) -> list[Word]:
         if m is None:
             _refuse_special(code[i + 1 : i + 2], code, where)
             raise InputError(f"{where}: letter {c!r} is not followed by a number in {code!r}")
-        words.append(Word(c, float(m[0]), m[0]))
+        value = float(m[0])
+        if not abs(value) < LARGEST_VALUE:
+            shown = m[0] if len(m[0]) <= 20 else f"{m[0][:12]}... ({len(m[0])} characters)"
+            raise InputError(
+                f"{where}: {c}{shown} is out of range (a number's magnitude must be below "
+                f"{LARGEST_VALUE:.0e}); the file is damaged or not in mm/inch: check the line"
+            )
+        words.append(Word(c, value, m[0]))
         i = m.end()
     return words
+
+
+def cut_mid_word(raw: str) -> str | None:
+    """The unfinished word a line ends with (``"X12."``, ``"X-"``, ``"Y"``), else ``None``.
+
+    Meant for the last line of a file that has no end of line after it: a
+    program cut while it was being copied or written stops inside a word.
+    LinuxCNC refuses a letter without its number ("bad number format"); a
+    number ending in its decimal point is refused here too, as it is where a
+    cut ``X12.5`` stops. A line ending in a comment, a blank or a complete
+    number (``X12``) is not cut (a complete last block needs no end of line).
+    """
+    in_comment = False
+    for c in raw:
+        if c == ";" and not in_comment:
+            return None  # the line ends in a ';' comment
+        if c in "()":
+            in_comment = c == "("
+    if in_comment or raw.endswith(")"):
+        return None
+    m = _CUT.search(raw)
+    return m[0].replace(" ", "") if m else None
 
 
 def _refuse_special(c: str, code: str, where: str) -> None:

@@ -11,6 +11,12 @@ by a comma, semicolon, tab or spaces; a blank line or a row of ``NaN`` ends a st
 header line (no numbers) may come first; lines starting with ``#`` are comments. Units: the
 ``--units`` option, default mm.
 
+Numbers are plain decimals (:data:`NUMBER`: optional sign, digits, optional fraction, optional
+exponent), as CSV writers and Matlab print them: Python's ``float`` is not used to decide,
+since it also takes ``1_000``, ``inf`` and ``infinity``. ``NaN`` is a stroke break, never a
+coordinate. A value whose magnitude in mm reaches :data:`~camtool.units.LARGEST_VALUE` is
+refused. Errors name the file, the line and the column of the bad field.
+
 Matlab files (``.m``): ``xy = [ x1 x2 ...; y1 y2 ... ]`` as the Matlab GUI of seed-002 §3 shows
 it (row 1 x, row 2 y, in 0.1 mm unless ``--units`` says otherwise), over as many lines as it
 likes; ``lxy`` and ``velxy`` (the GUI's derived arrays) are ignored; several ``xy``
@@ -28,7 +34,7 @@ from pathlib import Path
 from camtool.errors import InputError, UsageError
 from camtool.geometry import Contour, Drawing, Line, Point
 from camtool.importers import ImportOptions
-from camtool.units import LENGTH_UNITS
+from camtool.units import LARGEST_VALUE, LENGTH_UNITS
 
 TEXT_SUFFIXES = (".csv", ".txt", ".xy")
 MATLAB_SUFFIX = ".m"
@@ -40,7 +46,12 @@ de una decima de milímetro")."""
 LAYER = "0"
 """Contour.layer of every stroke (point lists have no layers)."""
 
-_SEPARATOR = re.compile(r"\s*[,;\t]\s*|\s+")
+NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+"""A number as point lists write it: ``12``, ``-1.5``, ``.5``, ``3.``, ``1e-3``."""
+_FIELD = re.compile(r"[^,;\s]+")
+"""A field: what lies between separators (comma, semicolon, tab, spaces)."""
+_NAN = "nan"
+"""A field that breaks a stroke (any case: ``NaN``, ``nan``), as Matlab writes it."""
 _IGNORED_MATLAB = ("lxy", "velxy")
 
 
@@ -75,7 +86,10 @@ def read_points(path: str | Path, options: ImportOptions | None = None) -> Drawi
     scale = unit_factor(options.units or (MATLAB_UNITS if matlab else DEFAULT_UNITS))
     text = _read_text(path)
     warnings: list[str] = []
-    strokes = _matlab_strokes(text, path) if matlab else _text_strokes(text, path, warnings)
+    if matlab:
+        strokes = _matlab_strokes(text, path, scale)
+    else:
+        strokes = _text_strokes(text, path, warnings, scale)
     contours: list[Contour] = []
     for k, stroke in enumerate(strokes, start=1):
         pts = [(_scale(x, scale), _scale(y, scale)) for x, y in stroke.xy]
@@ -137,7 +151,7 @@ def _contour(pts: list[Point], source: str) -> Contour | None:
 # ---------------------------------------------------------------------------- text files
 
 
-def _text_strokes(text: str, path: Path, warnings: list[str]) -> list[_Stroke]:
+def _text_strokes(text: str, path: Path, warnings: list[str], scale: float) -> list[_Stroke]:
     strokes: list[_Stroke] = []
     current: list[tuple[float, float]] = []
     start = 0
@@ -145,11 +159,10 @@ def _text_strokes(text: str, path: Path, warnings: list[str]) -> list[_Stroke]:
     z_range: list[float] = []
     seen_data = False
     for number, raw in enumerate(text.splitlines(), start=1):
-        line = raw.strip()
-        if line.startswith("#"):
+        if raw.strip().startswith("#"):
             continue
-        fields = [f for f in _SEPARATOR.split(line) if f] if line else []
-        values = _row(fields, path, number, header_allowed=not seen_data)
+        fields = [(m[0], m.start() + 1) for m in _FIELD.finditer(raw)]
+        values = _row(fields, _Where(path, number, scale), header_allowed=not seen_data)
         if values is None:  # the header
             seen_data = True
             continue
@@ -185,38 +198,83 @@ def _text_strokes(text: str, path: Path, warnings: list[str]) -> list[_Stroke]:
     return strokes
 
 
-def _row(fields: list[str], path: Path, number: int, *, header_allowed: bool) -> list[float] | None:
-    """The numbers of one row; ``None`` for a header; ``[]`` for a blank row.
+@dataclass(frozen=True)
+class _Where:
+    """The file and line being read, and mm per file unit (for the range check)."""
+
+    path: Path
+    line: int
+    scale: float
+
+    def fail(self, column: int, text: str) -> InputError:
+        return InputError(f"{self.path}: line {self.line}, column {column}: {text}")
+
+
+def _row(
+    fields: list[tuple[str, int]], where: _Where, *, header_allowed: bool
+) -> list[float] | None:
+    """The numbers of one row of ``(text, 1-based column)`` fields.
+
+    Returns ``None`` for a header, ``[]`` for a blank row, NaNs for a stroke break.
 
     Raises:
         InputError: a field that is not a number (after the header), a partly NaN row,
-            infinity, or a count other than 2 or 3.
+            a value out of range, or a count other than 2 or 3.
     """
     if not fields:
         return []
-    try:
-        values = [float(f) for f in fields]
-    except ValueError:
-        if header_allowed and not any(_is_number(f) for f in fields):
+    nan = [text.lower() == _NAN for text, _ in fields]
+    bad = [(text, col) for (text, col), n in zip(fields, nan, strict=True) if not n]
+    bad = [(text, col) for text, col in bad if not NUMBER.fullmatch(text)]
+    if bad:
+        if header_allowed and not any(_loose_number(text) for text, _ in fields):
             return None
-        bad = next(f for f in fields if not _is_number(f))
-        raise InputError(
-            f"{path}: line {number}: {bad!r} is not a number; rows are X,Y or X,Y,Z "
-            "separated by a comma, semicolon, tab or spaces (decimal point, not comma)"
-        ) from None
-    nan = [math.isnan(v) for v in values]
+        text, col = bad[0]
+        raise where.fail(col, f"{_quote(text)} is not a number; {_why_not(text)}")
     if any(nan) and not all(nan):
+        col = fields[nan.index(True)][1]
+        raise where.fail(col, "NaN in only some columns; a NaN row ends a stroke")
+    if all(nan):
+        return [math.nan] * len(fields)
+    if len(fields) not in (2, 3):
         raise InputError(
-            f"{path}: line {number}: NaN in only some columns; a NaN row ends a stroke"
+            f"{where.path}: line {where.line}: {len(fields)} numbers; rows are X,Y or X,Y,Z"
         )
-    if len(values) not in (2, 3) and not all(nan):
-        raise InputError(f"{path}: line {number}: {len(values)} numbers; rows are X,Y or X,Y,Z")
-    if any(math.isinf(v) for v in values):
-        raise InputError(f"{path}: line {number}: infinite coordinate")
-    return values
+    return [_in_range(text, col, where) for text, col in fields]
 
 
-def _is_number(field: str) -> bool:
+def _in_range(text: str, column: int, where: _Where) -> float:
+    """The value of a number field, refused when it is absurd (at least LARGEST_VALUE mm)."""
+    value = float(text)
+    if not abs(value) * where.scale < LARGEST_VALUE:
+        raise where.fail(
+            column,
+            f"{_quote(text)} is out of range (at most {LARGEST_VALUE:.0e} mm); "
+            "the file is damaged or the unit is wrong (--units)",
+        )
+    return value
+
+
+def _quote(text: str) -> str:
+    return repr(text) if len(text) <= 24 else f"{text[:16]!r}... ({len(text)} characters)"
+
+
+def _why_not(text: str) -> str:
+    """What to do about a field that is not a plain decimal number."""
+    if "_" in text and _loose_number(text):
+        return "write digits without '_' (1000, not 1_000)"
+    if text.lower().lstrip("+-") in ("inf", "infinity"):
+        return "infinity is not a coordinate"
+    if text.lower().startswith(("0x", "-0x", "+0x")):
+        return "write decimal numbers, not hexadecimal"
+    return (
+        "rows are X,Y or X,Y,Z separated by a comma, semicolon, tab or spaces "
+        "(decimal point, not comma)"
+    )
+
+
+def _loose_number(field: str) -> bool:
+    """Whether Python's ``float`` takes ``field`` (so it is not a header word)."""
     try:
         float(field)
     except ValueError:
@@ -231,7 +289,7 @@ _ASSIGN = re.compile(r"([A-Za-z_]\w*)\s*=\s*")
 _MATRIX = re.compile(r"\[([^\]\[]*)\]\s*[;,]?")
 
 
-def _matlab_strokes(text: str, path: Path) -> list[_Stroke]:
+def _matlab_strokes(text: str, path: Path, scale: float) -> list[_Stroke]:
     """Strokes from every ``xy = [ ... ]`` assignment of a Matlab script (seed-002 §3)."""
     code = re.sub(r"%[^\n]*", "", text)  # comments; the file holds no strings
     strokes: list[_Stroke] = []
@@ -257,15 +315,36 @@ def _matlab_strokes(text: str, path: Path) -> list[_Stroke]:
             )
         pos = matrix.end()
         if assign.group(1) == "xy":
-            strokes.append(_Stroke(_matrix(matrix.group(1), path, line), line))
+            strokes.append(
+                _Stroke(_matrix(code, matrix.start(1), matrix.end(1), path, scale), line)
+            )
     if not strokes:
         raise InputError(f"{path}: no 'xy = [ ... ]' matrix")
     return strokes
 
 
-def _matrix(body: str, path: Path, line: int) -> tuple[tuple[float, float], ...]:
-    """Columns ``(x, y)`` of a 2-row matrix body; rows end at ';' or a line break."""
-    rows = [r.split() for r in re.split(r"[;\n]", body.replace(",", " ")) if r.strip()]
+def _matrix(
+    code: str, start: int, end: int, path: Path, scale: float
+) -> tuple[tuple[float, float], ...]:
+    """Columns ``(x, y)`` of the 2-row matrix body ``code[start:end]``.
+
+    Rows end at ';' or a line break; numbers are separated by blanks or commas. Messages
+    give the line of the matrix, and the line and column of a bad number in it.
+    """
+    line = code.count("\n", 0, start) + 1
+    rows: list[list[float]] = [[]]
+    for m in re.finditer(r"[;\n]|[^\s,;]+", code[start:end]):
+        if m[0] in ";\n":
+            rows.append([])
+            continue
+        offset = start + m.start()
+        where = _Where(path, code.count("\n", 0, offset) + 1, scale)
+        column = offset - code.rfind("\n", 0, offset)
+        if not NUMBER.fullmatch(m[0]):
+            why = "; NaN and Inf are not coordinates" if m[0].lower() in ("nan", "inf") else ""
+            raise where.fail(column, f"{_quote(m[0])} in xy is not a number{why}")
+        rows[-1].append(_in_range(m[0], column, where))
+    rows = [r for r in rows if r]
     if len(rows) != 2:
         raise InputError(
             f"{path}: line {line}: xy has {len(rows)} rows; it must have 2 (x, then y)"
@@ -275,11 +354,4 @@ def _matrix(body: str, path: Path, line: int) -> tuple[tuple[float, float], ...]
             f"{path}: line {line}: xy rows have {len(rows[0])} and {len(rows[1])} numbers; "
             "x and y need one number per point each"
         )
-    try:
-        xs, ys = ([float(v) for v in row] for row in rows)
-    except ValueError:
-        bad = next(v for row in rows for v in row if not _is_number(v))
-        raise InputError(f"{path}: line {line}: {bad!r} in xy is not a number") from None
-    if not all(math.isfinite(v) for v in (*xs, *ys)):
-        raise InputError(f"{path}: line {line}: xy holds NaN or infinity")
-    return tuple(zip(xs, ys, strict=True))
+    return tuple(zip(rows[0], rows[1], strict=True))

@@ -253,6 +253,12 @@ class _Reader:
             if token in ";\n":
                 rows.append([])
             elif _INT.fullmatch(token):
+                if len(token) > 6 or abs(int(token)) > INT16_MAX:  # before numpy's int64
+                    shown = token if len(token) <= 20 else f"{token[:12]}... ({len(token)} digits)"
+                    raise self.fail(
+                        line_at(offset),
+                        f"{name}: {shown} does not fit the master's int16 (±{INT16_MAX})",
+                    )
                 rows[-1].append(_Number(int(token), line_at(offset)))
             else:
                 raise self.fail(line_at(offset), f"{name}: {token!r} is not a whole number")

@@ -5,12 +5,17 @@ decimals, zero padding of the integer part, sign policy. Rounding is half away
 from zero on the decimal value (``Decimal`` of the float's shortest repr), so
 ``2.969 mm`` at 1000 units/mm is exactly ``2969.00``. ``-0`` never appears: a
 value that rounds to zero is written without a sign.
+
+Every value is checked: NaN and infinity are a :class:`DialectError` naming the
+value, and a finite value of any size is written exactly (the decimal context
+is as wide as the number), so no float reaches the code unchecked.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
-from decimal import ROUND_HALF_UP, Decimal
+from decimal import ROUND_HALF_UP, Decimal, InvalidOperation, localcontext
 
 from camtool.errors import DialectError
 
@@ -47,27 +52,40 @@ class NumberFormat:
     grid_mm: float | None = None
 
     def __post_init__(self) -> None:
+        if not (math.isfinite(self.scale) and self.scale > 0):
+            raise ValueError(f"scale must be a finite number > 0, got {self.scale!r}")
         if self.sign not in SIGN_POLICIES:
             raise ValueError(f"unknown sign policy {self.sign!r}; choose {SIGN_POLICIES}")
         if self.decimals < 0 or (self.int_digits is not None and self.int_digits < 1):
             raise ValueError("decimals must be ≥ 0 and int_digits ≥ 1")
         if self.min_decimals is not None and not 0 <= self.min_decimals <= self.decimals:
             raise ValueError("min_decimals must lie between 0 and decimals")
-        if self.grid_mm is not None and not self.grid_mm > 0:
-            raise ValueError("grid_mm must be > 0")
+        if self.grid_mm is not None and not (math.isfinite(self.grid_mm) and self.grid_mm > 0):
+            raise ValueError(f"grid_mm must be a finite number > 0, got {self.grid_mm!r}")
 
     def quantize(self, value_mm: float) -> Decimal:
         """The value in written units, rounded to ``decimals`` (half away from zero).
 
         With ``grid_mm`` the value is first rounded (half away from zero) to the
         nearest multiple of ``grid_mm``.
+
+        Raises:
+            DialectError: ``value_mm`` is NaN or infinite.
         """
+        value_mm = float(value_mm)
+        if not math.isfinite(value_mm):
+            raise DialectError(f"cannot write {value_mm!r}: the value is not a finite number")
         exp = Decimal(1).scaleb(-self.decimals)
-        value = Decimal(repr(float(value_mm)))
-        if self.grid_mm is not None:
-            grid = Decimal(repr(float(self.grid_mm)))
-            value = (value / grid).quantize(Decimal(1), rounding=ROUND_HALF_UP) * grid
-        q = (value * Decimal(repr(float(self.scale)))).quantize(exp, rounding=ROUND_HALF_UP)
+        value = Decimal(repr(value_mm))
+        scale = Decimal(repr(float(self.scale)))
+        with localcontext() as ctx:
+            # Wide enough for every digit of the result: 1e308 mm in µm with 2
+            # decimals has 313 digits, which the default 28-digit context refuses.
+            ctx.prec = max(28, value.adjusted() + scale.adjusted() + self.decimals + 8)
+            if self.grid_mm is not None:
+                grid = Decimal(repr(float(self.grid_mm)))
+                value = (value / grid).quantize(Decimal(1), rounding=ROUND_HALF_UP) * grid
+            q = (value * scale).quantize(exp, rounding=ROUND_HALF_UP)
         return q if q != 0 else Decimal(0).quantize(exp)
 
     def resolution_mm(self) -> float:
@@ -79,7 +97,8 @@ class NumberFormat:
         """Write ``value_mm`` (mm) in this format.
 
         Raises:
-            DialectError: the integer part needs more than ``int_digits`` digits.
+            DialectError: ``value_mm`` is NaN or infinite, or the integer part
+                needs more than ``int_digits`` digits.
         """
         q = self.quantize(value_mm)
         magnitude = abs(q)
@@ -91,7 +110,7 @@ class NumberFormat:
         int_part = text.split(".")[0]
         if self.int_digits is not None:
             if len(int_part) > self.int_digits:
-                raise DialectError(f"{q} does not fit {self.int_digits} integer digits")
+                raise DialectError(f"{_short(q)} does not fit {self.int_digits} integer digits")
             if self.pad:
                 text = text.rjust(len(text) - len(int_part) + self.int_digits, "0")
         if q < 0:
@@ -99,8 +118,30 @@ class NumberFormat:
         return ("+" + text) if self.sign == "always" else text
 
     def parse(self, text: str) -> float:
-        """Read a value written in this format back to mm (signs optional)."""
-        return float(Decimal(text) / Decimal(repr(float(self.scale))))
+        """Read a value written in this format back to mm (signs optional).
+
+        Raises:
+            DialectError: ``text`` is not a finite decimal number, or is too
+                large for a float once in mm.
+        """
+        try:
+            number = Decimal(text)
+        except InvalidOperation:
+            raise DialectError(f"{text[:20]!r} is not a number") from None
+        if not number.is_finite():
+            raise DialectError(f"{text[:20]!r} is not a finite number")
+        with localcontext() as ctx:
+            ctx.prec = max(28, len(number.as_tuple().digits) + 8)
+            value = float(number / Decimal(repr(float(self.scale))))
+        if not math.isfinite(value):
+            raise DialectError(f"{_short(number)} is too large")
+        return value
+
+
+def _short(number: Decimal) -> str:
+    """``number`` for a message: as written up to 20 characters, else ``1.00000e+308``."""
+    text = str(number)
+    return text if len(text) <= 20 else f"{number:.5e}"
 
 
 def format_int(value: int, digits: int, *, what: str) -> str:

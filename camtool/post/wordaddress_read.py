@@ -2,6 +2,14 @@
 
 Strict: every block must be one the writer of the dialect could have written.
 
+- with ``comments`` (GRBL, LinuxCNC) comments are removed first, as those
+  controllers do: ``( ... )`` (not nested, closed on its line) and ``;`` to
+  the end of the line, a ``;`` inside parentheses being part of that comment
+  (LinuxCNC ``Interp::close_and_downcase``, GRBL ``protocol.c``); the blanks
+  on either side of a removed comment go with it, and a line left empty is
+  skipped. Without ``comments`` a ``(`` or ``;`` is an error, as the machine
+  would refuse it;
+
 - words are split by the dialect's separator (``""``: no whitespace at all;
   ``" "``: exactly one space between words) and each block ends with
   ``block_end``; a block longer than ``max_block_bytes`` is refused;
@@ -109,10 +117,37 @@ class BlockReader:
                 raise ParseError(f"{self.source}: byte {exc.start} is not ASCII text") from exc
         for number, raw in enumerate(code.splitlines(), start=1):
             self.line = number
-            if raw.strip():
-                self.block(raw)
+            text = self.uncomment(raw) if self.spec.comments else raw
+            if text.strip():
+                self.block(text)
         s = self.state
         return Program(tuple(s.moves), lines=tuple(s.lines), commands=tuple(s.commands))
+
+    def uncomment(self, raw: str) -> str:
+        """``raw`` without its comments (see the module docstring).
+
+        Raises:
+            ParseError: a nested or unclosed ``(``, or a ``)`` without ``(``.
+        """
+        pieces: list[str] = []
+        start = i = 0
+        while i < len(raw) and raw[i] != ";":
+            if raw[i] == ")":
+                raise self.fail(f"')' without '(' in {raw!r}")
+            if raw[i] != "(":
+                i += 1
+                continue
+            end = raw.find(")", i + 1)
+            if end < 0:
+                raise self.fail(f"comment '(' is not closed on its line: {raw!r}")
+            if "(" in raw[i + 1 : end]:
+                raise self.fail(f"nested comment '(... (...' in {raw!r}")
+            pieces.append(raw[start:i])
+            start = i = end + 1
+        if start == 0 and i == len(raw):
+            return raw  # no comment
+        pieces.append(raw[start:i])
+        return " ".join(p.strip() for p in pieces if p.strip())
 
     # -- one block ---------------------------------------------------------------
 
@@ -203,8 +238,9 @@ class BlockReader:
             ok = False
         if not ok:
             example = number.format(-12.5 if letter in "XYZIJ" else 12.5)
+            shown = text if len(text) <= 24 else f"{text[:16]}... ({len(text)} characters)"
             raise self.fail(
-                f"{letter}{text} is not in the format of {letter} (e.g. {letter}{example})"
+                f"{letter}{shown} is not in the format of {letter} (e.g. {letter}{example})"
             )
         return value
 

@@ -89,6 +89,9 @@ class WordAddressSpec:
         helix: whether an arc may carry a Z word (``with-xy`` only).
         max_block_bytes: longest block in bytes with its block end and line
             end; ``None``: no limit.
+        comments: whether the controller skips comments, as RS-274/NGC
+            controllers (GRBL, LinuxCNC) do: ``( ... )`` and ``;`` to the end of
+            the line. The writer writes none; the reader removes them first.
         modal: letters written only when their value changes (``G`` for the
             motion code); the others are written in every block that uses them.
         arc_check: ``"none"``, ``"grbl"`` or ``"linuxcnc"``: arcs are written
@@ -118,6 +121,7 @@ class WordAddressSpec:
     z_moves: str = "with-xy"
     helix: bool = False
     max_block_bytes: int | None = None
+    comments: bool = False
     modal: frozenset[str] = frozenset("F")
     arc_check: str = "none"
     spindle_cw: str | None = None
@@ -264,6 +268,7 @@ def load_spec(options: Mapping[str, Any], where: str) -> WordAddressSpec:
         z_moves=t.string("z_moves", z_default, choices=Z_MOVES),
         helix=t.flag("helix", False),
         max_block_bytes=t.integer("max_block_bytes", None, low=8),
+        comments=t.flag("comments", False),
         modal=_modal(t, words),
         arc_check=t.string("arc_check", "none", choices=ARC_CHECKS),
         **codes,

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from camtool.errors import UsageError
+from camtool.errors import InputError, UsageError
 from camtool.geometry import BBox, Drawing
 from camtool.machine import Machine
 from camtool.program import Dwell, Home, Program, Rapid
@@ -121,8 +121,15 @@ def verify_code(
 
     Raises:
         ParseError: the code is not valid in the target's dialect (names the line).
+        InputError: the code holds no cutting move (nothing to verify).
     """
     program = target.post.parse(code, source=source)
+    if all(isinstance(move, Rapid) for move in program.moves):
+        moves = f"only {len(program.moves)} rapid move(s)" if program.moves else "no move"
+        raise InputError(
+            f"{source}: no cutting move in the code ({moves}): nothing to verify; "
+            f"is this the whole program for {target.name}?"
+        )
     return verify_program(
         program,
         target.machine,

@@ -68,7 +68,8 @@ def test_seed001_r2_g03_golden_arc() -> None:
 
 def test_flashcut_file_with_the_four_literal_examples() -> None:
     # tests/data/flashcut-seed001.nc: seed-001 §3.3's four lines in one file (CR LF ends);
-    # no units anywhere (mm implied, §3.3) → one warning naming line 1.
+    # no units anywhere (mm implied, §3.3) → a warning naming line 1; no M2/M30 either (the
+    # thesis shows four lines, not a whole program) → a warning naming the last block.
     program = read_gcode(DATA / "flashcut-seed001.nc")
     assert program.moves == (
         Linear(1.0, 1.0, 3.0, contour=1),
@@ -77,8 +78,9 @@ def test_flashcut_file_with_the_four_literal_examples() -> None:
         ArcMove(0.0, 3.0, 1.0, 2.0, False, 8.0, contour=1),
     )
     assert program.origin == (0.0, 0.0)
-    (warning,) = program.warnings
-    assert warning.startswith(f"{DATA / 'flashcut-seed001.nc'}:1: no G20/G21")
+    units, end = program.warnings
+    assert units.startswith(f"{DATA / 'flashcut-seed001.nc'}:1: no G20/G21")
+    assert end.startswith(f"{DATA / 'flashcut-seed001.nc'}:4: no M2/M30")
 
 
 def test_flashcut_n_words_comments_and_m_codes_are_tolerated() -> None:
@@ -253,8 +255,8 @@ def test_arc_radius_tolerance_of_linuxcnc() -> None:
 
 
 def test_after_program_end_nothing_is_read() -> None:
-    program = parse("G21 G0 X1 Y1\nM2\nG0 X5 Y5\n(comment)\nG0 X6 Y6\n")
-    assert program.moves == (Rapid(1.0, 1.0, contour=1),)
+    program = parse("G21 G1 X1 Y1 F10\nM2\nG0 X5 Y5\n(comment)\nG0 X6 Y6\n")
+    assert program.moves == (Linear(1.0, 1.0, 10.0, contour=1),)
     assert program.warnings == ("t.ngc:3: 2 lines after the program end on line 2 not read",)
 
 
@@ -283,8 +285,9 @@ def test_typical_footer_g91_g28_z0(home: str) -> None:
 
 
 def test_g80_alone_is_a_no_op() -> None:
-    program = parse("G21 G80\nG0 X1 Y1\n")
-    assert program.moves == (Rapid(1.0, 1.0, contour=1),)
+    program = parse("G21 G80\nG1 X1 Y1 F10\nM2\n")
+    assert program.moves == (Linear(1.0, 1.0, 10.0, contour=1),)
+    assert program.warnings == ()
 
 
 # -- safe conversions: one warning per kind, with count and first line ---------------------
@@ -299,7 +302,8 @@ def test_g80_alone_is_a_no_op() -> None:
         ("G54", "G54 work offset assumed 0"),
         ("G55", "G55 work offset assumed 0"),
         ("G61", "G61 path control mode ignored"),
-        ("G64", "G64 path control mode ignored"),
+        ("G64", "G64 path blending (with its P/Q tolerances, if any) ignored"),
+        ("G64 P0.01 Q0.01", "G64 path blending (with its P/Q tolerances, if any) ignored"),
         ("G98", "G98 canned-cycle return mode ignored"),
         ("G97 S1000", "G97 spindle speed mode ignored"),
         ("M0", "M0 program pause dropped"),
@@ -388,8 +392,8 @@ def test_read_gcode_errors_and_encodings(tmp_path: Path) -> None:
     with pytest.raises(InputError, match=r"missing\.nc: cannot read"):
         read_gcode(tmp_path / "missing.nc")
     latin = tmp_path / "pieza.nc"
-    latin.write_bytes("(pieza maquinada en el LMM: ñ)\nG0 X1 Y1\n".encode("latin-1"))
-    assert read_gcode(latin, source_name="-").moves == (Rapid(1.0, 1.0, contour=1),)
+    latin.write_bytes("(pieza maquinada en el LMM: ñ)\nG1 X1 Y1 F9\nM2\n".encode("latin-1"))
+    assert read_gcode(latin, source_name="-").moves == (Linear(1.0, 1.0, 9.0, contour=1),)
     with pytest.raises(InputError, match=r"^<stdin>:2: G41"):
         bad = tmp_path / "bad.nc"
         bad.write_text("G21\r\nG41\r\n")
@@ -473,3 +477,50 @@ def test_round_trip_through_pic_mmh() -> None:
     back = target.post.parse(str(target.emit(program).code))
     assert len(back.moves) == len(program.moves)
     assert all(_same(a, b) for a, b in zip(program.moves, back.moves, strict=True))
+
+
+# -- program ends, truncation and absurd numbers (issues 13 §4, 14) -------------------------
+
+
+def test_percent_delimited_program_ends_at_the_closing_percent() -> None:
+    program = parse("(header)\n%\nG21 G1 X1 Y1 F10\n%\nG1 X5 Y5\n")
+    assert program.moves == (Linear(1.0, 1.0, 10.0, contour=1),)
+    assert program.warnings == ("t.ngc:5: 1 line after the program end on line 4 not read",)
+
+
+def test_missing_end_warns_once_naming_the_last_block() -> None:
+    program = parse("G21\nG1 X1 Y1 F10\nG1 X2\n(trailing comment)\n\n")
+    assert program.warnings == (
+        "t.ngc:3: no M2/M30 (nor a closing '%'): the file may be truncated; check that its "
+        "last moves are all there",
+    )
+
+
+def test_percent_after_the_first_block_does_not_open_a_program() -> None:
+    # LinuxCNC takes '%' as a delimiter only on the first line; later it changes nothing here
+    program = parse("G21\n%\nG1 X1 Y1 F10\nM2\n")
+    assert program.warnings == ()
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("G21\nG1 X1 Y1 F10\nG1 X2.", "t.ngc:3: the file ends in the middle of a word ('X2.'"),
+        ("G21\nG1 X1 Y1 F10\nG1 X2 Y", "t.ngc:3: the file ends in the middle of a word ('Y'"),
+        ("G21\nG1 X1 Y1 F10\nG1 X-", "t.ngc:3: the file ends in the middle of a word ('X-'"),
+        ("G21\nG1 X1 Y1 F1e3\nM2\n", "t.ngc:2: E3 is a 3D-printer extrusion word, or an exponent"),
+        ("G21\nG1 X1 Y-1000000000 F10\n", "t.ngc:2: Y-1000000000 is out of range"),
+        ("G21\nG1 X1 Y1 F1" + "0" * 400 + "\n", "t.ngc:2: F100000000000... (401 characters)"),
+    ],
+)
+def test_truncated_and_absurd_input_is_refused(text: str, message: str) -> None:
+    assert refused(text).startswith(message)
+
+
+@pytest.mark.parametrize("last", ["G1 X2", "G1 X2 (to X)", "G1 X2 ; Y", "G1 X2. "])
+def test_complete_last_line_without_end_of_line_is_read(last: str) -> None:
+    assert parse(f"G21\nG1 X1 Y1 F10\n{last}").moves[-1] == Linear(2.0, 1.0, 10.0, contour=1)
+
+
+def test_unclosed_comment_on_a_cut_last_line_stays_a_comment_error() -> None:
+    assert "comment '(' is not closed" in refused("G21\nG1 X1 Y1 F10\nG1 X2 (cut X")

@@ -45,7 +45,7 @@ def test_spindle_dwell_and_tool_change_before_the_next_move() -> None:
 def test_order_of_execution_within_a_block() -> None:
     # RS-274/NGC (LinuxCNC "Order of Execution"): S, T, M6, M3/M4/M5, G4, then G28 and
     # motion (G4 and G28 are both non-modal: one block takes one of them).
-    program = parse("G21 G0 X1 Y1\nG4 P1 M3 S500 M6 T2\nM5 S600 G28 X0 Y0\nG0 X3 Y3\n")
+    program = parse("G21 G0 X1 Y1\nG4 P1 M3 S500 M6 T2\nM5 S600 G28 X0 Y0\nG0 X3 Y3\nG1 X4 F9\n")
     assert program.commands == (
         (1, ToolChange(2)),
         (1, Spindle("cw", 500.0)),
@@ -57,7 +57,7 @@ def test_order_of_execution_within_a_block() -> None:
 
 
 def test_s_changes_a_turning_spindle_only() -> None:
-    program = parse("G21 S100\nG0 X1 Y1\nS200\nM3\nG0 X2\nS300\nS300\nM5\nS400\nG0 X3\n")
+    program = parse("G21 S100\nG0 X1 Y1\nS200\nM3\nG0 X2\nS300\nS300\nM5\nS400\nG1 X3 F9\nM2\n")
     assert program.commands == (
         (1, Spindle("cw", 200.0)),  # S100 then S200 while off: M3 takes the last
         (2, Spindle("cw", 300.0)),  # S300 while on: a new speed (the repeat changes nothing)
@@ -73,7 +73,9 @@ def test_bare_m3_has_no_speed_and_no_warning() -> None:
 
 
 def test_g28_is_a_home_command_on_the_axes_it_names() -> None:
-    program = parse("G21 G0 X1 Y1 Z1\nG91 G28 Z0\nG90 G28\nG28 X0 Y0\nG0 X2 Y2\nG30\nG0 X3 Y3\n")
+    program = parse(
+        "G21 G0 X1 Y1 Z1\nG91 G28 Z0\nG90 G28\nG28 X0 Y0\nG0 X2 Y2\nG30\nG0 X3 Y3\nG1 X4 F9\nM2\n"
+    )
     assert program.commands == (
         (1, Home("Z")),  # incremental 0: no intermediate move
         (1, Home("XYZ")),
@@ -86,12 +88,12 @@ def test_g28_is_a_home_command_on_the_axes_it_names() -> None:
 
 
 def test_tool_selection_without_m6_and_m6_without_tool_warn() -> None:
-    program = parse("G21 T4\nG0 X1 Y1\nT5\nM6\nT6\nG0 X2\nM6\nT7\n")
+    program = parse("G21 T4\nG0 X1 Y1\nT5\nM6\nT6\nG1 X2 F9\nM6\nT7\nM2\n")
     assert program.commands == ((1, ToolChange(5)), (2, ToolChange(6)))
     assert program.warnings == (
         "t.ngc:1: tool number T ignored: no M6 after it changes to that tool (2 times)",
     )  # T4 (replaced by T5) and T7 (the program ends)
-    lonely = parse("G21 M6\nG0 X1 Y1\n")
+    lonely = parse("G21 M6\nG1 X1 Y1 F9\nM2\n")
     assert lonely.commands == ()
     assert lonely.warnings == ("t.ngc:1: M6 without a T word: no tool selected, ignored",)
 

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pytest
 
+from camtool.cli import main
 from camtool.errors import InputError, UsageError
 from camtool.geometry import Contour, Line
 from camtool.importers import DRAWING_SUFFIXES, ImportOptions, read_drawing
@@ -145,13 +146,22 @@ def test_single_point_stroke_is_skipped_with_a_warning(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("text", "message"),
     [
-        ("0,0\n1,x\n", "line 2: 'x' is not a number"),
-        ("x,y\n0,0\nx,y\n", "line 3: 'x' is not a number"),
+        ("0,0\n1,x\n", "line 2, column 3: 'x' is not a number"),
+        ("x,y\n0,0\nx,y\n", "line 3, column 1: 'x' is not a number"),
         ("0,0\n1,2,3,4\n", "line 2: 4 numbers; rows are X,Y or X,Y,Z"),
         ("0,0\n1\n", "line 2: 1 numbers; rows are X,Y or X,Y,Z"),
         ("0,0\n1,2,3\n", "line 2: 3 numbers where the rows above have 2"),
-        ("0,0\nNaN,1\n", "line 2: NaN in only some columns"),
-        ("0,0\ninf,1\n", "line 2: infinite coordinate"),
+        ("0,0\n1, NaN\n", "line 2, column 4: NaN in only some columns"),
+        ("0,0\ninf,1\n", "line 2, column 1: 'inf' is not a number; infinity is not a"),
+        # issue 14: Python's float() takes these; a point list does not
+        ("0,0\n1_000,0\n", "line 2, column 1: '1_000' is not a number; write digits without"),
+        ("1_000,2_000\n", "line 1, column 1: '1_000' is not a number"),  # not a header
+        ("0,0\n 2.5\t-Infinity\n", "line 2, column 6: '-Infinity' is not a number; infinity"),
+        ("0,0\n0x10,0\n", "line 2, column 1: '0x10' is not a number; write decimal numbers"),
+        # absurd values (1e400 is inf as a float): out of range, naming the column
+        ("0,0\n1e308,0\n", "line 2, column 1: '1e308' is out of range (at most 1e+09 mm)"),
+        ("0,0\n1,1e400\n", "line 2, column 3: '1e400' is out of range"),
+        ("0,0\n1,-1000000000\n", "line 2, column 3: '-1000000000' is out of range"),
         ("15,1;8,6\n", "line 1: 4 numbers"),
         ("x,y\n\n", "no stroke of two or more points"),
         ("", "no stroke of two or more points"),
@@ -217,7 +227,9 @@ def test_matlab_units_option_overrides_tenth_mm(tmp_path: Path) -> None:
         ("\n\nxy = [1 2; 3 4; 5 6]\n", "line 3: xy has 3 rows"),
         ("xy = [1 2 3; 4 5]\n", "xy rows have 3 and 2 numbers"),
         ("xy = [1 a; 3 4]\n", "'a' in xy is not a number"),
-        ("xy = [1 NaN; 3 4]\n", "xy holds NaN or infinity"),
+        ("xy = [1 NaN; 3 4]\n", "line 1, column 9: 'NaN' in xy is not a number; NaN and Inf"),
+        ("xy = [1 2;\n 3 1_0]\n", "line 2, column 4: '1_0' in xy is not a number"),
+        ("% c\nxy = [1 2; 3 1e400] % big\n", "line 2, column 14: '1e400' is out of range"),
         ("lxy = [1 2; 3 4]\n", "no 'xy = [ ... ]' matrix"),
         ("% nothing\n", "no 'xy = [ ... ]' matrix"),
     ],
@@ -228,3 +240,37 @@ def test_matlab_errors(tmp_path: Path, text: str, message: str) -> None:
         read_points(path)
     assert str(err.value).startswith(f"{path}: ")
     assert message in str(err.value)
+
+
+def test_limit_applies_in_mm_after_the_unit(tmp_path: Path) -> None:
+    # 1 000 000 mm is in range; the same number in metres is 1e9 mm: out of range
+    path = write(tmp_path, "p.csv", "0,0\n1000000,1\n")
+    assert read_points(path).contours[0].end == (1e6, 1.0)
+    with pytest.raises(InputError, match=r"line 2, column 1: '1000000' is out of range"):
+        read_points(path, ImportOptions(units="m"))
+
+
+def test_plain_decimals_and_exponents_still_read(tmp_path: Path) -> None:
+    path = write(tmp_path, "p.csv", "x,y\n+1.,-.5\n1e1,2.5E-1\nNAN,nan\n0,0\n3,0\n")
+    first, second = read_points(path).contours
+    assert vertices(first) == [(1.0, -0.5), (10.0, 0.25)]
+    assert vertices(second) == [(0.0, 0.0), (3.0, 0.0)]
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("0,0\n1_000,0\n", "line 2, column 1: '1_000' is not a number"),
+        ("0,0\n1e308,0\n", "line 2, column 1: '1e308' is out of range"),
+        ("0,0\nnan,1\n", "line 2, column 1: NaN in only some columns"),
+        ("0,0\n1,inf\n", "line 2, column 3: 'inf' is not a number"),
+    ],
+)
+def test_cli_exit_3_names_file_line_and_column(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], text: str, message: str
+) -> None:
+    path = write(tmp_path, "p.csv", text)
+    assert main(["post", str(path), "-t", "grbl"]) == 3
+    out, err = capsys.readouterr()
+    assert out == ""
+    assert f"camtool: error: {path}: {message}" in err

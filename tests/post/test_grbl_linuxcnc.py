@@ -188,7 +188,10 @@ def test_every_arc_passes_the_controller_check_after_rounding(
 ) -> None:
     code = code_of(target, program, BIG)
     _check_arcs(code, target, 0.001, program)
-    parse_gcode(code, source=target)  # LinuxCNC's documented rule, independent reader
+    if any(block.startswith(("G1 ", "G2 ", "G3 ")) for block in code.splitlines()):
+        # LinuxCNC's documented rule, independent reader (which refuses a program with no
+        # cut: an arc shorter than the rounding is not written)
+        parse_gcode(code, source=target)
     load_target(target).post.parse(code)
 
 
