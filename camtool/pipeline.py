@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -114,6 +115,7 @@ def post_path(
         fmt=options.get("fmt"),
         spindle_rpm=options.get("spindle_rpm"),
         spindle_dwell_s=options.get("spindle_dwell_s", 0.0),
+        source=str(path),
     )
 
 
@@ -151,6 +153,7 @@ def post_program(
     fmt: str | None = None,
     spindle_rpm: float | None = None,
     spindle_dwell_s: float = 0.0,
+    source: str = "",
 ) -> PostJob:
     """Re-post an existing program (e.g. G-code another CAM wrote) for a target.
 
@@ -162,7 +165,9 @@ def post_program(
     ``fmt`` is the dialect's output format (default: its first);
     ``spindle_rpm`` > 0 starts the spindle before the first move and stops it
     after the last (when the program has no spindle commands of its own), waiting
-    ``spindle_dwell_s`` seconds after it starts.
+    ``spindle_dwell_s`` seconds after it starts. ``source`` (the input's file
+    name) goes into the job notes (:func:`job_notes`) unless the program has notes.
+    Nothing is added to the program's motion: no move to X0 Y0, no clearance move.
 
     Raises:
         CamtoolError: whatever the target cannot express (names the block).
@@ -179,6 +184,8 @@ def post_program(
         program = dataclasses.replace(program, moves=moves)
     if not target.machine.has_z:
         program = _flatten(program, target.name)
+    if not program.notes:
+        program = dataclasses.replace(program, notes=job_notes(source, target))
     program = _with_spindle(program, spindle_rpm, spindle_dwell_s)
     return PostJob(None, program, target, target.emit(program, fmt=fmt), None, 0.0)
 
@@ -283,14 +290,71 @@ def post_drawing(
     """
     plan = plan_options(target, **options)
     planned = plan_drawing(drawing, plan, target.machine, helix=target.post.helix)
-    program = _with_spindle(
+    program = dataclasses.replace(
         planned.program,
+        notes=job_notes(drawing.source, target, plan),
+        tolerance_mm=plan.tolerance,
+        warnings=(*planned.program.warnings, *_surface_warning(plan, target)),
+    )
+    program = _with_spindle(
+        program,
         target.spindle_rpm if spindle_rpm is None else spindle_rpm,
         spindle_dwell_s,
     )
     edge = plan.radius if plan.offset != "on" else 0.0
     result = target.emit(program, fmt=fmt)
     return PostJob(drawing, program, target, result, planned.placed, edge, planned.report)
+
+
+NO_DEPTH_WARNING = (
+    "no --depth: cutting at Z 0, the top of the stock — a pen, a drag knife or an engraving "
+    "at the surface; give --depth MM to cut into it"
+)
+"""What a plan without ``--depth`` for a machine with Z says (rapids stay at safe Z)."""
+
+
+def _surface_warning(plan: PlanOptions, target: Target) -> tuple[str, ...]:
+    """:data:`NO_DEPTH_WARNING` when ``target`` has Z and ``plan`` no depth."""
+    return (NO_DEPTH_WARNING,) if plan.depth is None and target.machine.has_z else ()
+
+
+def job_notes(source: str, target: Target, plan: PlanOptions | None = None) -> tuple[str, ...]:
+    """The job, in a few lines for the top of the program (comments where the dialect has them).
+
+    Input file name (without its folder), target, camtool version, and for a
+    planned drawing the tool, offset, depth and heights, mm. Nothing varies
+    between two runs of the same job (no date, no absolute path).
+
+    Args:
+        source: the input's file name (``""`` or ``"-"``: standard input).
+        target: the target the program is for.
+        plan: the planning options (``None``: a re-posted program).
+    """
+    from camtool import __version__
+
+    name = Path(source).name if source and source != "-" else "stdin"
+    notes = [f"camtool {__version__}: {name} for {target.name}"]
+    if plan is None:
+        return (*notes, "re-posted program: moves as the input gives them")
+    tool = f"tool diameter {plan.tool_diameter:g} mm, offset {plan.offset}"
+    if plan.offset == "on":
+        tool = "offset on: the tool centre follows the drawing"
+        if plan.tool_diameter > 0:
+            tool += f" (tool diameter {plan.tool_diameter:g} mm)"
+    elif plan.offset == "pocket":
+        tool += f" ({plan.pocket}, stepover {plan.stepover:g})"
+    notes.append(tool)
+    if not target.machine.has_z:
+        notes.append("no Z axis: set the depth by hand")
+        return tuple(notes)
+    if plan.depth is None:
+        depth = "depth none: cuts at Z 0, the top of the stock"
+    else:
+        step = "" if plan.step_down is None else f" in passes of {plan.step_down:g} mm"
+        depth = f"depth {plan.depth:g} mm{step}"
+    notes.append(depth)
+    notes.append(f"safe Z {plan.safe_z:g} mm, clearance Z {plan.clearance:g} mm above the top")
+    return tuple(notes)
 
 
 def verify_job(job: PostJob) -> Verification:

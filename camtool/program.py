@@ -21,6 +21,7 @@ simulator, metrics) never see them.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Literal, TypeAlias
@@ -122,6 +123,14 @@ class Program:
     source line of each move (empty otherwise), so reports can point at a block.
     ``commands`` holds ``(index, command)`` pairs in program order: ``command``
     runs before ``moves[index]`` (``index == len(moves)``: after the last move).
+
+    ``notes`` are lines about the job for whoever reads the code (input file,
+    target, tool, depth, camtool version), machine-neutral: a dialect with
+    comments writes them as comments at the top, one without drops them. They
+    never hold a timestamp (output stays byte-for-byte reproducible).
+    ``tolerance_mm`` is the largest chord error (mm) a dialect may use when it
+    must write an arc as straight lines (``--tolerance``); ``None``: the
+    machine's ``motion.chord_tolerance_mm``.
     """
 
     moves: tuple[Move, ...]
@@ -129,6 +138,8 @@ class Program:
     warnings: tuple[str, ...] = field(default=())
     lines: tuple[int, ...] = field(default=())
     commands: tuple[tuple[int, Command], ...] = field(default=())
+    notes: tuple[str, ...] = field(default=())
+    tolerance_mm: float | None = None
 
     def __post_init__(self) -> None:
         indices = [i for i, _ in self.commands]
@@ -137,7 +148,9 @@ class Program:
 
     def with_moves(self, moves: tuple[Move, ...]) -> Program:
         """A copy holding ``moves`` instead (source lines and commands dropped)."""
-        return Program(moves, self.origin, self.warnings)
+        return Program(
+            moves, self.origin, self.warnings, notes=self.notes, tolerance_mm=self.tolerance_mm
+        )
 
     def commands_before(self, index: int) -> tuple[Command, ...]:
         """The commands that run before ``moves[index]`` (or after the last, ``len(moves)``)."""
@@ -171,7 +184,7 @@ class Program:
         if dwell_s > 0:
             start = (*start, (0, Dwell(dwell_s)))
         commands = (*start, *self.commands, (end, Spindle("off")))
-        return Program(self.moves, self.origin, self.warnings, self.lines, commands)
+        return dataclasses.replace(self, commands=commands)
 
     def line_of(self, index: int) -> int | None:
         """Source line of move ``index``, or None when the program was not read from code."""

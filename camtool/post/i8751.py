@@ -346,6 +346,8 @@ class I8751Post(PostProcessor):
             how = (
                 f"Z raised {self.lift_mm:g} mm around them ({c['lifts']} lift(s), lift_mm)"
                 if c["lifts"]
+                else "they run at the heights the program gives (its own Z)"
+                if any(m.z is not None for m in program.moves)
                 else "the tool stays down and cuts along them (raise Z in the program or set "
                 "lift_mm in [dialect_options])"
             )

@@ -19,7 +19,12 @@ block, verbatim from the thesis (L1731)::
   ``G04P##;``, ``M06T##;`` and ``G28X0Y0;`` / ``G28Z0;`` (S000-06, Tablas 21–22);
 - no Z words (S000-08): a program that moves Z is refused;
 - a full circle is written as two half arcs (the firmware takes the start from
-  its current position; a zero-length G02 is ambiguous, seed-000 §3.7 item 7).
+  its current position; a zero-length G02 is ambiguous, seed-000 §3.7 item 7);
+- an arc whose absolute centre does not fit the I/J field (±99999.99 µm: a
+  large radius, e.g. a nearly straight DXF bulge) is written as G01 chords
+  within the program's ``tolerance_mm`` (``--tolerance``; else the machine's
+  ``chord_tolerance_mm``), with one warning giving how many arcs and chords. An
+  end point that does not fit X/Y is still an error.
 
 The mode strings of the host link (``JX+;``, ``BX200;`` …) are in
 :mod:`camtool.post.pic_mmh_modes`.
@@ -36,7 +41,7 @@ from types import MappingProxyType
 from typing import Any, ClassVar
 
 from camtool.errors import DialectError, ParseError
-from camtool.geometry import distance
+from camtool.geometry import Arc, distance
 from camtool.machine import Machine
 from camtool.post.base import PostProcessor, PostResult, check_work_area
 from camtool.post.numfmt import NumberFormat, format_int
@@ -80,6 +85,8 @@ class _Writer:
     warnings: list[str] = field(default_factory=list)
     notes: dict[str, tuple[str, int]] = field(default_factory=dict)
     fast: dict[int, list[tuple[int, int]]] = field(default_factory=dict)
+    chorded: list[int] = field(default_factory=lambda: [0, 0])
+    """Arcs written as chords (centre beyond I/J) and the chords written."""
 
     def where(self, contour: int) -> str:
         block = len(self.lines) + 1
@@ -167,10 +174,17 @@ class PicMmhPost(PostProcessor):
                 continue
             self._check_move(start, move, machine, w, homed)
             homed = homed and not isinstance(move, Rapid)
-            self._move(start, move, machine, w)
+            self._move(start, move, machine, w, _tolerance(program, machine))
         w.lines.append("M30;")
         self._rate_warnings(machine, w)
         self._length_warning(w)
+        if w.chorded[0]:
+            tol = _tolerance(program, machine)
+            w.warnings.append(
+                f"{w.chorded[0]} arc(s) with a centre beyond the I/J field (±99.99999 mm, "
+                f"5 integer digits of µm) written as {w.chorded[1]} G01 chords within "
+                f"{tol:g} mm"
+            )
         return PostResult("\n".join(w.lines) + "\n", len(w.lines), w.all_warnings())
 
     def _check_move(
@@ -190,7 +204,14 @@ class PicMmhPost(PostProcessor):
             )
         check_work_area(start, move, machine, where)
 
-    def _move(self, start: tuple[float, float], move: Move, machine: Machine, w: _Writer) -> None:
+    def _move(
+        self,
+        start: tuple[float, float],
+        move: Move,
+        machine: Machine,
+        w: _Writer,
+        tolerance: float,
+    ) -> None:
         if isinstance(move, Rapid):
             w.lines.append(f"G00{self._xy(move.x, move.y, move, w)};")
             return
@@ -201,11 +222,31 @@ class PicMmhPost(PostProcessor):
         if isinstance(move, Linear):
             w.lines.append(f"G01{self._xy(move.x, move.y, move, w)}F{f};")
             return
+        here = start
         for half in _halves(start, move):
-            g = "G02" if half.clockwise else "G03"
             xy = self._xy(half.x, half.y, half, w)
-            ij = self._word("I", half.cx, half, w) + self._word("J", half.cy, half, w)
-            w.lines.append(f"{g}{xy}{ij}F{f};")
+            if not (self._fits(half.cx) and self._fits(half.cy)):
+                points = Arc(here, (half.x, half.y), (half.cx, half.cy), half.clockwise).points(
+                    tolerance
+                )
+                for x, y in points[1:-1]:
+                    w.lines.append(f"G01{self._xy(x, y, half, w)}F{f};")
+                w.lines.append(f"G01{xy}F{f};")
+                w.chorded[0] += 1
+                w.chorded[1] += len(points) - 1
+            else:
+                g = "G02" if half.clockwise else "G03"
+                ij = self._word("I", half.cx, half, w) + self._word("J", half.cy, half, w)
+                w.lines.append(f"{g}{xy}{ij}F{f};")
+            here = (half.x, half.y)
+
+    def _fits(self, value_mm: float) -> bool:
+        """True when ``value_mm`` fits the 5-integer-digit µm field."""
+        try:
+            self.coord.format(value_mm)
+        except DialectError:
+            return False
+        return True
 
     def _word(self, letter: str, value_mm: float, move: Move, w: _Writer) -> str:
         try:
@@ -346,6 +387,13 @@ class PicMmhPost(PostProcessor):
             return Linear(x, y, feed, contour=contour)
         cx, cy = self.coord.parse(m[4]), self.coord.parse(m[5])
         return ArcMove(x, y, cx, cy, g == 2, feed, contour=contour)
+
+
+def _tolerance(program: Program, machine: Machine) -> float:
+    """Chord tolerance, mm: the program's (``--tolerance``) or the machine's."""
+    if program.tolerance_mm is not None:
+        return program.tolerance_mm
+    return machine.motion.chord_tolerance_mm
 
 
 def _steps(

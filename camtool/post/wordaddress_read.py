@@ -1,6 +1,9 @@
 """The reader of word-address dialects: code back into a Program, by the same spec.
 
 Strict: every block must be one the writer of the dialect could have written.
+Whole-line comments in the dialect's own ``comment`` syntax (the job notes the
+writer puts at the top) and the ``%`` tape marks of ``header``/``footer`` are
+skipped.
 
 - with ``comments`` (GRBL, LinuxCNC) comments are removed first, as those
   controllers do: ``( ... )`` (not nested, closed on its line) and ``;`` to
@@ -117,6 +120,8 @@ class BlockReader:
                 raise ParseError(f"{self.source}: byte {exc.start} is not ASCII text") from exc
         for number, raw in enumerate(code.splitlines(), start=1):
             self.line = number
+            if self.spec.is_comment(raw):
+                continue  # the writer's own notes and tape marks
             text = self.uncomment(raw) if self.spec.comments else raw
             if text.strip():
                 self.block(text)
@@ -172,8 +177,9 @@ class BlockReader:
             s.ended = self.line
         elif key in self.spindle:
             direction = self.spindle[key]
-            needs = "S" if direction != "off" and spec.has("S") else ""
-            self._only(codes, values, key, "a spindle", needs=needs)
+            self._only(codes, values, key, "a spindle", needs="S" if "S" in values else "")
+            if direction == "off" and "S" in values:
+                raise self.fail(f"S in a spindle-off block ({key})")
             s.commands.append((len(s.moves), Spindle(direction, values.get("S", 0.0))))
         elif key is not None and key == spec.dwell:
             self._only(codes, values, key, "a dwell", needs="P")

@@ -42,6 +42,10 @@ FULL_CIRCLES = ("one-block", "split")
 Z_MOVES = ("own-block", "with-xy", "none")
 ARC_CHECKS = ("none", "grbl", "linuxcnc")
 LINE_ENDS = ("\n", "\r\n")
+COMMENTS = ("()", ";")
+"""Values of ``comment``: ``"()"`` writes ``(text)`` (RS-274), ``";"`` writes ``; text``."""
+TAPE_MARK = "%"
+"""The one non-comment line ``header``/``footer`` may hold (RS-274 tape start/end)."""
 
 _CODE = re.compile(r"[GM]\d+(?:\.\d+)?")
 _BLOCK_END = re.compile(r"[^\sA-Za-z0-9.+-]{0,4}")
@@ -104,6 +108,12 @@ class WordAddressSpec:
         tool_change: tool change code, followed by the T word.
         end: program-end codes; the writer ends with the first, the reader
             accepts any of them.
+        comment: how the dialect writes a comment line (:data:`COMMENTS`):
+            ``"()"`` or ``";"``; ``None``: it has no comments, and the job notes
+            (:attr:`Program.notes <camtool.program.Program.notes>`) are not written.
+        header: lines written verbatim first, before the job notes and the
+            preamble; each is ``"%"`` or a comment in the ``comment`` syntax.
+        footer: lines written verbatim after the end code, the same kinds.
     """
 
     name: str
@@ -130,6 +140,9 @@ class WordAddressSpec:
     dwell: str | None = None
     tool_change: str | None = None
     end: tuple[str, ...] = ()
+    comment: str | None = None
+    header: tuple[str, ...] = ()
+    footer: tuple[str, ...] = ()
 
     def word(self, letter: str) -> WordSpec | None:
         """The word ``letter``, or ``None`` when the dialect lacks it."""
@@ -143,9 +156,42 @@ class WordAddressSpec:
         """The coarsest written step of X, Y, I and J, mm: the grid arcs must land on."""
         return max(self.words[c].number.resolution_mm() for c in "XYIJ" if c in self.words)
 
+    def comment_line(self, text: str) -> str | None:
+        """``text`` as one comment line of this dialect, ``None`` without comments.
+
+        Characters a comment cannot hold are replaced: anything outside printable
+        ASCII by ``?``, and ``(``/``)`` by ``[``/``]`` (RS-274 comments do not
+        nest). The line is cut (ending ``...``) to fit ``max_block_bytes`` with its
+        line end.
+        """
+        if self.comment is None:
+            return None
+        clean = "".join(c if " " <= c <= "~" else "?" for c in text)
+        clean = clean.replace("(", "[").replace(")", "]").strip()
+        wrap = ("(", ")") if self.comment == "()" else ("; ", "")
+        room = None
+        if self.max_block_bytes is not None:
+            room = self.max_block_bytes - len(self.line_end) - sum(map(len, wrap))
+        if room is not None and len(clean) > room:
+            clean = clean[: max(0, room - 3)] + "..."
+        return wrap[0] + clean + wrap[1]
+
+    def is_comment(self, line: str) -> bool:
+        """True when ``line`` is a whole-line comment of this dialect (or ``%``)."""
+        if line == TAPE_MARK and (TAPE_MARK in self.header or TAPE_MARK in self.footer):
+            return True
+        if self.comment is None:
+            return False
+        return _comment_pattern(self.comment).fullmatch(line) is not None
+
     def static_codes(self) -> frozenset[str]:
         """Codes of the preamble and postamble (no effect on the path when read)."""
         return frozenset(code for block in self.preamble + self.postamble for code in block)
+
+
+def _comment_pattern(style: str) -> re.Pattern[str]:
+    """A whole-line comment in ``style`` (one of :data:`COMMENTS`), printable ASCII."""
+    return re.compile(r"\([ -'*-~]*\)" if style == "()" else r";[ -~]*")
 
 
 def _show(value: Any) -> str:
@@ -271,6 +317,9 @@ def load_spec(options: Mapping[str, Any], where: str) -> WordAddressSpec:
         comments=t.flag("comments", False),
         modal=_modal(t, words),
         arc_check=t.string("arc_check", "none", choices=ARC_CHECKS),
+        comment=t.string("comment", None, choices=COMMENTS),
+        header=tuple(t.strings("header")),
+        footer=tuple(t.strings("footer")),
         **codes,
     )
     t.done()
@@ -414,6 +463,25 @@ def _check(spec: WordAddressSpec, t: _Table) -> None:
     for key, blocks in (("preamble", spec.preamble), ("postamble", spec.postamble)):
         for code in (c for block in blocks for c in block):
             _check_static(t, key, code, spec, set(roles))
+    for key, lines in (("header", spec.header), ("footer", spec.footer)):
+        for i, line in enumerate(lines):
+            _check_frame_line(t, f"{key}[{i}]", line, spec)
+
+
+def _check_frame_line(t: _Table, key: str, line: str, spec: WordAddressSpec) -> None:
+    """A header or footer line is ``%`` or a comment the reader skips: it cannot move."""
+    if line == TAPE_MARK:
+        return
+    if spec.comment is None:
+        raise t.error(
+            key, f'expected "%" (the dialect has no comment syntax: see comment), got {_show(line)}'
+        )
+    if not spec.is_comment(line):
+        example = "(text)" if spec.comment == "()" else "; text"
+        raise t.error(key, f'expected "%" or a comment such as {_show(example)}, got {_show(line)}')
+    size = len((line + spec.line_end).encode("ascii"))
+    if spec.max_block_bytes is not None and size > spec.max_block_bytes:
+        raise t.error(key, f"{size} bytes with its line end, over max_block_bytes")
 
 
 def _check_static(t: _Table, key: str, code: str, spec: WordAddressSpec, roles: set[str]) -> None:

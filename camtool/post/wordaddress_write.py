@@ -12,6 +12,10 @@ Rules (docs/dialects.md explains them for users):
 - an arc too small for the written resolution (its written end is its written
   start, or its centre rounds onto its start) becomes a straight line, with a
   warning;
+- a move that changes Z and not XY (where the tool is, or the program's origin for
+  the first move) is a Z-only block (``G0 Z5``): no X or Y word, so the first
+  block of a program never moves XY from wherever the machine stands, and a
+  re-posted program gets no X/Y it did not have;
 - with ``z_moves = "own-block"`` a move that changes XY and Z is written as two
   blocks (Z first when rising, last when plunging), with a warning;
 - what the dialect lacks (F, S, spindle, dwell, tool change, return home) is
@@ -72,13 +76,22 @@ class BlockWriter:
     # -- the program -------------------------------------------------------------
 
     def write(self, program: Program) -> str:
-        """The whole program as text (preamble, moves and commands, postamble, end).
+        """The whole program as text.
+
+        In order: the ``header`` lines, the program's notes as comments (when the
+        dialect has comments), the preamble, the moves and commands, the
+        postamble, the end code and the ``footer`` lines.
 
         Raises:
             DialectError: see the module docstring; the message names the block.
         """
         self.here = program.origin
         self.written = (self._round("X", program.origin[0]), self._round("Y", program.origin[1]))
+        self.lines.extend(self.spec.header)
+        for note in program.notes:
+            comment = self.spec.comment_line(note)
+            if comment is not None:
+                self.lines.append(comment)
         for codes in self.spec.preamble:
             self.block(list(codes))
         for item in program.items():
@@ -90,6 +103,7 @@ class BlockWriter:
             self.block(list(codes))
         if self.spec.end:
             self.block([self.spec.end[0]])
+        self.lines.extend(self.spec.footer)
         self.warnings.extend(self._summary())
         end = self.spec.line_end
         return end.join(self.lines) + end if self.lines else ""
@@ -197,11 +211,11 @@ class BlockWriter:
             )
 
     def _straight(self, start: Point, move: Rapid | Linear) -> None:
+        if move.z is not None and math.dist(start, (move.x, move.y)) <= _SAME_MM:
+            self._line(move, None, move.z)  # a Z-only move: no X or Y word (module docstring)
+            return
         if move.z is None or self.spec.z_moves == "with-xy":
             self._line(move, (move.x, move.y), move.z)
-            return
-        if math.dist(start, (move.x, move.y)) <= _SAME_MM:
-            self._line(move, None, move.z)
             return
         self.dropped["z-split"] += 1
         if self.z is not None and move.z < self.z:
@@ -360,8 +374,8 @@ class BlockWriter:
                 self.dropped["spindle"] += 1
                 return
             words = [code]
-            if command.direction != "off" and spec.has("S"):
-                words.append("S" + self.text("S", command.rpm))
+            if command.direction != "off" and spec.has("S") and command.rpm > 0:
+                words.append("S" + self.text("S", command.rpm))  # rpm 0: speed not given
             elif command.direction != "off" and command.rpm > 0:
                 self.dropped["speed"] += 1
             self.block(words)

@@ -4,16 +4,37 @@ The last planning stage (see :mod:`camtool.toolpath.plan`). Cuts arrive in their
 final cutting order, each already rotated and reversed as it will be cut; this
 module turns them into :mod:`camtool.program` moves.
 
-**2D** (no ``depth``): per cut a rapid to its start (kept even when the tool is
-already there, so every contour begins with a positioning block, as the goldens
-expect), then one cutting move per segment; no Z anywhere.
+**2D** (a machine without Z, no ``depth``): per cut a rapid to its start (kept
+even when the tool is already there, so every contour begins with a positioning
+block, as the goldens expect), then one cutting move per segment; no Z anywhere.
 
-**Depth**: passes from the top (Z = 0) down (:func:`pass_depths`). Every rapid
-with XY motion is at ``safe_z``; the tool rises to ``safe_z`` by a Z-only rapid
-before it travels, goes down by a Z-only :class:`~camtool.program.Linear` at the
-plunge feed, and rises to ``safe_z`` after the last pass of each cut, so the
-program ends at safe Z. Feeds: cutting moves at ``feed_mm_min``, downward Z moves
-at ``plunge_feed``, the rise onto a tab at ``feed_mm_min``.
+**Z machine** (``depth``, or ``z_axis`` without a depth: one pass at Z 0, the top
+of the stock, for a pen, a drag knife or an engraving at the surface): passes
+from the top (Z = 0) down (:func:`pass_depths`). No move ever changes XY and Z
+together except a cut that descends along the path (a ramp):
+
+- **start**: a Z-only rapid up to the clearance height
+  (:attr:`~camtool.toolpath.options.PlanOptions.clearance`) where the tool stands
+  (``origin``), then XY at clearance to the first cut, a Z-only rapid down to
+  ``safe_z``, and a Z-only :class:`~camtool.program.Linear` at the plunge feed
+  into the material. The machine's XY position before the program is not known,
+  so nothing rapids in XY before Z is at clearance.
+- **between cuts of one part**: Z-only rapid up to ``safe_z``, XY rapid at
+  ``safe_z``, plunge; **between parts**: up to clearance instead, XY at
+  clearance, rapid down to ``safe_z``, plunge. A *part* is an outermost closed
+  cut path and every cut nested inside it (its holes, pockets and engravings,
+  :func:`parts`); a cut inside no closed path is a part of its own.
+- **end**: a Z-only rapid up to clearance, then, with ``end_position``, an XY
+  rapid there at clearance. (The pipeline stops the spindle after the last move.)
+
+Every rapid that moves XY is at ``safe_z`` or above. Feeds: cutting moves at
+``feed_mm_min``, downward Z moves at ``plunge_feed``, the rise onto a tab at
+``feed_mm_min``.
+
+**Move limit**: a plan of more than :data:`MAX_MOVES` moves is refused with a
+:class:`~camtool.errors.UsageError` (a hostile ``--ramp 0.0001`` would otherwise
+write kilometres of helix); a ramp is checked against the path length before any
+move is written.
 
 - closed cut: all passes in a row without retracting;
 - open cut: if it ``may_reverse``, the next pass cuts back the other way from
@@ -50,6 +71,7 @@ import math
 from collections.abc import Sequence
 from itertools import pairwise
 
+from camtool.errors import UsageError
 from camtool.geometry import Arc, Segment
 from camtool.program import ArcMove, Linear, Move, Rapid
 from camtool.toolpath.cuts import Cut, where
@@ -60,6 +82,15 @@ from camtool.toolpath.tabs import tab_spans
 
 Z_EPS = 1e-9
 """Z values closer than this (mm) are the same height: no Z move is written between them."""
+
+MAX_MOVES = 5_000_000
+"""Most moves one plan may emit (``camtool.toolpath.passes.MAX_MOVES``): a few hundred MB
+of G-code, hours of streaming; beyond it an option is almost surely a typo."""
+
+MAX_RAMP_LAPS = 1000.0
+"""Most laps of a closed path (or legs of an open one) a ramp may take to descend one
+pass (``camtool.toolpath.passes.MAX_RAMP_LAPS``). A 3 mm tool in a 4 mm hole follows a
+3.1 mm loop: 1 mm down at 1° is 18 laps; a thousand laps is a typo in ``--ramp``."""
 
 
 def pass_depths(depth: float, step: float | None) -> tuple[float, ...]:
@@ -82,7 +113,9 @@ def pass_depths(depth: float, step: float | None) -> tuple[float, ...]:
     return (*(-k * step for k in range(1, n)), -depth)
 
 
-def emit_moves(cuts: Sequence[Cut], options: PlanOptions, *, helix: bool = True) -> list[Move]:
+def emit_moves(
+    cuts: Sequence[Cut], options: PlanOptions, *, helix: bool = True, z_axis: bool = False
+) -> list[Move]:
     """The moves that cut ``cuts`` in order, with passes, tabs, ramps and lead arcs.
 
     Args:
@@ -90,30 +123,42 @@ def emit_moves(cuts: Sequence[Cut], options: PlanOptions, *, helix: bool = True)
             reversed as it will be cut. Cut ``i`` gets contour number ``i + 1``
             on its moves.
         options: feeds (``feed_mm_min``, ``plunge_feed``), ``depth``,
-            ``step_down``, ``safe_z``, ``ramp_angle_deg``, ``tabs``/``tab_width``/
-            ``tab_height``/``tool_diameter``, ``lead_in_mm``, ``tolerance``,
-            ``origin`` (where the tool is before the first move).
+            ``step_down``, ``safe_z``, ``clearance``, ``end_position``,
+            ``ramp_angle_deg``, ``tabs``/``tab_width``/``tab_height``/
+            ``tool_diameter``, ``lead_in_mm``, ``tolerance``, ``origin`` (where
+            the tool is before the first move).
         helix: the target can write helical arcs (an arc move with Z). ``False``:
             the descending part of an arc in a ramp becomes chords within
             ``options.tolerance``, each a :class:`~camtool.program.Linear` with Z.
+        z_axis: the machine has a programmable Z axis. Without a ``depth`` such a
+            machine gets a Z program cutting at Z 0 (rapids at ``safe_z``); a
+            machine without one (``False``, the default) gets a 2D program.
+            With a ``depth`` the plan has Z either way.
 
     Returns:
         Rapid/Linear/ArcMove moves, absolute mm; ``z`` is ``None`` on every move
-        of a 2D plan, and in a depth plan on cutting moves that keep Z.
+        of a 2D plan, and in a Z plan on cutting moves that keep Z.
 
     Raises:
         ToolpathError: the tabs do not fit on a profile (names the contour).
+        UsageError: the plan would need more than :data:`MAX_MOVES` moves (names
+            the option that made it so, e.g. a ``--ramp`` far too shallow).
     """
-    writer = _Writer(options, helix)
-    if options.depth is None:
+    uses_z = options.depth is not None or z_axis
+    writer = _Writer(options, helix, uses_z)
+    if not uses_z:
         for number, cut in enumerate(cuts, start=1):
             writer.number = number
             _cut_2d(writer, cut)
+        writer.finish()
         return writer.moves
-    levels = pass_depths(options.depth, options.step_down)
+    levels = (0.0,) if options.depth is None else pass_depths(options.depth, options.step_down)
+    check_ramp(cuts, options, levels)
+    part_of = parts(cuts)
     i = 0
     while i < len(cuts):
         j = i + 1
+        writer.part = part_of[i]
         if cuts[i].kind == "pocket":
             while j < len(cuts) and cuts[j].kind == "pocket" and cuts[j].group == cuts[i].group:
                 j += 1
@@ -125,37 +170,187 @@ def emit_moves(cuts: Sequence[Cut], options: PlanOptions, *, helix: bool = True)
             writer.number = i + 1
             _cut_open(writer, cuts[i], levels)
         i = j
+    writer.finish()
     return writer.moves
+
+
+def parts(cuts: Sequence[Cut]) -> list[int]:
+    """The part of each cut: the index of its outermost enclosing closed cut (or its own).
+
+    A *part* is what comes off the stock in one piece: an outermost closed cut path
+    and every cut whose path lies inside it (holes, pockets, engravings). Cuts of one
+    drawing contour (``group``, e.g. the rings of a pocket) are in one part even when
+    none of them encloses the others. Containment is tested on the cut paths
+    themselves (:func:`camtool.toolpath.order.nesting`), so it is the same before
+    and after tool compensation.
+
+    Returns:
+        ``(len(cuts),)`` part keys: equal keys, same part.
+    """
+    from camtool.toolpath.order import nesting
+
+    if not cuts:
+        return []
+    nest = nesting([c.path for c in cuts])
+    first_of_group: dict[int, int] = {}
+    out: list[int] = []
+    for i in range(len(cuts)):
+        around = nest.parents[i]
+        outer = max(around, key=lambda j: (_bbox_area(cuts[j]), -j)) if around else i
+        key = cuts[outer].group
+        out.append(first_of_group.setdefault(key, outer))
+    return out
+
+
+def _bbox_area(cut: Cut) -> float:
+    x0, y0, x1, y1 = cut.path.bbox()
+    return (x1 - x0) * (y1 - y0)
+
+
+def check_ramp(cuts: Sequence[Cut], options: PlanOptions, levels: Sequence[float]) -> None:
+    """Refuse a ramp so shallow that the plan would exceed :data:`MAX_MOVES` moves.
+
+    A ramp descends ``Δz`` over ``L = Δz / tan(angle)`` of path: on a closed path of
+    length ``P`` that is ``L / P`` laps, each as many moves as the path has segments;
+    on an open path as many zigzag legs. The estimate is made before any move is
+    written, with the deepest pass's ``Δz``.
+
+    Raises:
+        UsageError: the estimate is over :data:`MAX_MOVES`, or one path needs more
+            than :data:`MAX_RAMP_LAPS` laps, naming ``--ramp``, the ramp length per
+            pass and what to do.
+    """
+    angle = options.ramp_angle_deg
+    if angle is None or not cuts:
+        return
+    dz = max(a - b for a, b in pairwise((0.0, *levels)))
+    ramp = dz / math.tan(math.radians(angle))
+    total = 0.0
+    worst = (0.0, 0.0)
+    for cut in cuts:
+        track = Track.of(cut.path)
+        if not track.segments:
+            continue
+        laps = ramp / max(track.length, MIN_PIECE)
+        total += len(levels) * (laps + 1.0) * len(track.segments)
+        worst = max(worst, (laps, track.length))
+    laps, length = worst
+    if total > MAX_MOVES or laps > MAX_RAMP_LAPS:
+        limit = (
+            f"more than camtool.toolpath.passes.MAX_MOVES = {MAX_MOVES} moves"
+            if total > MAX_MOVES
+            else f"more than camtool.toolpath.passes.MAX_RAMP_LAPS = {MAX_RAMP_LAPS:g} laps"
+        )
+        raise UsageError(
+            f"--ramp {angle:g}° needs {_length(ramp)} of ramp per pass ({dz:g} mm down at "
+            f"{angle:g}°): {laps:.3g} laps of a {length:.4g} mm path, about {total:.3g} moves, "
+            f"{limit}; give a steeper --ramp (e.g. --ramp {_steeper(dz, length):g}) or leave "
+            "it out"
+        )
+
+
+def _length(mm: float) -> str:
+    """A length for a message: mm, or m / km when it is long."""
+    if mm >= 1e6:
+        return f"{mm / 1e6:.3g} km"
+    if mm >= 1e3:
+        return f"{mm / 1e3:.3g} m"
+    return f"{mm:.3g} mm"
+
+
+def _steeper(dz: float, length: float) -> float:
+    """A ramp angle (degrees, rounded up to 0.1°) that descends ``dz`` within ``length``."""
+    if length <= 0:
+        return 45.0
+    return min(45.0, math.ceil(math.degrees(math.atan2(dz, length)) * 10.0) / 10.0)
 
 
 class _Writer:
     """Builds the move list and tracks the tool's position (local to one emit)."""
 
-    def __init__(self, options: PlanOptions, helix: bool) -> None:
+    def __init__(self, options: PlanOptions, helix: bool, uses_z: bool) -> None:
         self.options = options
         self.helix = helix
+        self.uses_z = uses_z
         self.moves: list[Move] = []
         self.x, self.y = options.origin
         self.z: float | None = None
         self.number = 0
+        self.part: int | None = None
+        self._part_here: int | None = None
+        self._lift_at: int | None = None
         ramp = options.ramp_angle_deg
         self.slope = None if ramp is None else math.tan(math.radians(ramp))
 
+    def add(self, move: Move) -> None:
+        """Append ``move``.
+
+        Raises:
+            UsageError: the plan has reached :data:`MAX_MOVES` moves.
+        """
+        if len(self.moves) >= MAX_MOVES:
+            raise UsageError(
+                f"the plan needs more than camtool.toolpath.passes.MAX_MOVES = {MAX_MOVES} "
+                f"moves (reached at contour {self.number}); check --step-down, --ramp, "
+                "--tolerance and --stepover, or split the drawing"
+            )
+        self.moves.append(move)
+
     def travel(self, x: float, y: float) -> None:
-        """Rapid to ``(x, y)``: in 2D directly, with a depth at safe Z (rising first)."""
-        if self.options.depth is None:
-            self.moves.append(Rapid(x, y, contour=self.number))
-        else:
-            self.retract()
-            self.moves.append(Rapid(x, y, self.options.safe_z, contour=self.number))
+        """Rapid to ``(x, y)``: in 2D directly; with Z at safe Z (clearance between parts).
+
+        With Z the tool first rises by a Z-only rapid (to ``clearance`` at the start
+        and when :attr:`part` changes, else to ``safe_z``), moves in XY at that
+        height and comes down by a Z-only rapid to ``safe_z``.
+        """
+        if not self.uses_z:
+            self.add(Rapid(x, y, contour=self.number))
+            self.x, self.y = x, y
+            return
+        o = self.options
+        new_part = self._part_here is None or self.part != self._part_here
+        self.lift(o.clearance if new_part else o.safe_z)
+        self._part_here = self.part
+        if (x, y) != (self.x, self.y):
+            self.add(Rapid(x, y, self.z, contour=self.number))
+            self._lift_at = None
         self.x, self.y = x, y
+        if self.z is not None and self.z > o.safe_z + Z_EPS:
+            self.add(Rapid(x, y, o.safe_z, contour=self.number))
+            self.z = o.safe_z
 
     def retract(self) -> None:
-        """Z-only rapid up to safe Z, unless already there."""
-        safe = self.options.safe_z
-        if self.z is None or abs(self.z - safe) > Z_EPS:
-            self.moves.append(Rapid(self.x, self.y, safe, contour=self.number))
-            self.z = safe
+        """Z-only rapid up to safe Z, unless already there or above."""
+        self.lift(self.options.safe_z)
+
+    def lift(self, z: float) -> None:
+        """Z-only rapid up to ``z`` (none when at or above it).
+
+        A lift right after another lift (the retract at the end of a cut, then the
+        rise to clearance before the next part) is merged into one move.
+        """
+        if self.z is not None and self.z >= z - Z_EPS:
+            return
+        move = Rapid(self.x, self.y, z, contour=self.number)
+        if self._lift_at is not None and self._lift_at == len(self.moves) - 1:
+            self.moves[-1] = move
+        else:
+            self.add(move)
+            self._lift_at = len(self.moves) - 1
+        self.z = z
+
+    def finish(self) -> None:
+        """The end of the program: up to clearance, then to ``end_position`` (if given)."""
+        o = self.options
+        if not self.moves:
+            return
+        if self.uses_z:
+            self.lift(o.clearance)
+        if o.end_position is not None:
+            x, y = o.end_position
+            self.number = 0
+            self.add(Rapid(x, y, self.z, contour=0))
+            self.x, self.y = x, y
 
     def vertical(self, z: float) -> None:
         """Z-only feed move: down at the plunge feed, up (onto a tab) at the cutting feed."""
@@ -163,7 +358,7 @@ class _Writer:
             return
         up = self.z is not None and z > self.z
         feed = self.options.feed_mm_min if up else self.options.plunge_feed
-        self.moves.append(Linear(self.x, self.y, feed, z, contour=self.number))
+        self.add(Linear(self.x, self.y, feed, z, contour=self.number))
         self.z = z
 
     def cut(self, seg: Segment, z: float | None) -> None:
@@ -176,9 +371,9 @@ class _Writer:
             if z is not None and not self.helix:
                 self._chords(seg, z)
                 return
-            self.moves.append(ArcMove(x, y, *seg.centre, seg.clockwise, feed, z, self.number))
+            self.add(ArcMove(x, y, *seg.centre, seg.clockwise, feed, z, self.number))
         else:
-            self.moves.append(Linear(x, y, feed, z, contour=self.number))
+            self.add(Linear(x, y, feed, z, contour=self.number))
         self.x, self.y = x, y
         if z is not None:
             self.z = z
@@ -189,7 +384,7 @@ class _Writer:
         n = len(points) - 1
         for k, (x, y) in enumerate(points[1:], start=1):
             zk = z if k == n else z0 + (z - z0) * k / n
-            self.moves.append(Linear(x, y, self.options.feed_mm_min, zk, contour=self.number))
+            self.add(Linear(x, y, self.options.feed_mm_min, zk, contour=self.number))
         self.x, self.y = arc.end
         self.z = z
 

@@ -144,7 +144,8 @@ def plan_drawing(
     backlash = (0.0, 0.0) if machine is None else _backlash_weights(machine)
     ordering = order_cuts(stage.cuts, nest, options, backlash)
     findings.extend(ordering.findings)
-    moves = emit_moves(ordering.cuts, options, helix=helix)
+    z_axis = machine is not None and machine.has_z
+    moves = emit_moves(ordering.cuts, options, helix=helix, z_axis=z_axis)
     report = PlanReport(len(contours), len(stage.cuts), tuple(findings), ordering, stats)
     warnings = tuple(dict.fromkeys((*drawing.warnings, *(f.message for f in findings))))
     return Plan(Program(tuple(moves), options.origin, warnings), report, placed)

@@ -16,6 +16,7 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
+from camtool import __version__
 from camtool.errors import ParseError
 from camtool.importers.gcode import parse_gcode
 from camtool.machine import Machine
@@ -65,10 +66,17 @@ def test_logo_golden(target: str, update_golden: bool) -> None:
         golden.write_text(code)
     assert code == golden.read_text()
     lines = code.splitlines()
-    # The RS-274 frame: G21/G90/G17 preamble, spindle S/M3 … M5, M2 at the end.
-    assert lines[0] == "G21 G90 G17"
-    assert re.fullmatch(r"M3 S\d+", lines[1])
-    assert lines[-2:] == ["M5", "M2"]
+    # The RS-274 frame: the job as comments, the modal safety line (mm, absolute, feed per
+    # minute, XY plane; LinuxCNC also compensation, length offset and canned cycle off),
+    # spindle S/M3 … M5, M2 at the end.
+    notes = [line for line in lines if line.startswith("(")]
+    assert lines[: len(notes)] == notes
+    assert notes[0] == f"(camtool {__version__}: logo.dxf for {target})"
+    safety = "G21 G90 G94 G17" + (" G40 G49 G80" if target == "linuxcnc" else "")
+    assert lines[len(notes)] == safety
+    assert re.fullmatch(r"M3 S\d+", lines[len(notes) + 1])
+    assert lines[len(notes) + 2] == "G0 Z5.000"  # first move: Z only, up to clearance
+    assert lines[-3:] == ["G0 Z5.000", "M5", "M2"]  # up to clearance, then spindle off
     assert all(len(line) + 1 <= (80 if target == "grbl" else 255) for line in lines)
 
 
@@ -96,7 +104,7 @@ def test_dwell_tool_change_and_helix() -> None:
         "M6 T2",
         "G0 X10.000 Y10.000 Z5.000",
         "G4 P0.5",
-        "G1 X10.000 Y10.000 Z0.000 F200",
+        "G1 Z0.000 F200",
         "G2 X10.000 Y10.000 Z-1.000 I5.000 J0.000",  # a full-circle helix, one block
     ]
     result = load_target("grbl").emit(program)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 from pathlib import Path
@@ -547,3 +548,41 @@ def test_logo_with_commands_verifies_and_dwell_counts_in_the_time() -> None:
     assert dwelling.time_s == pytest.approx(plain.time_s + 5.0)
     assert math.isfinite(plain.max_error_um)
     assert dwelling.max_error_um == plain.max_error_um
+
+
+@pytest.mark.parametrize("tolerance", [0.001, 0.0001])
+def test_large_radius_arc_becomes_chords_with_a_warning(tolerance: float) -> None:
+    # From (1, 3) to (9, 3) mm clockwise round (5, −200) mm: r = √(4² + 203²) ≈ 203.04 mm,
+    # sagitta 4²/(2r) ≈ 0.039 mm. J = −200 000.00 µm needs 6 integer digits: no G02 can
+    # hold it, so the arc is written as n = ceil(sweep / (2·acos(1 − t/r))) G01 chords.
+    target = load_target("pic-mmh")
+    r = math.hypot(4.0, 203.0)
+    sweep = 2 * math.asin(4.0 / r)
+    n = math.ceil(sweep / (2 * math.acos(1 - tolerance / r)))
+    program = Program((Rapid(1, 3), ArcMove(9, 3, 5, -200, True, 0.8)), tolerance_mm=tolerance)
+    result = target.post.emit(program, target.machine)
+    lines = str(result.code).splitlines()
+    chords = [line for line in lines if line.startswith("G01")]
+    assert len(chords) == n and lines[-2] == "G01X09000.00Y03000.00F08;"
+    assert not any(line.startswith(("G02", "G03")) for line in lines)
+    assert result.warnings == (
+        f"1 arc(s) with a centre beyond the I/J field (±99.99999 mm, 5 integer digits of µm) "
+        f"written as {n} G01 chords within {tolerance:g} mm",
+    )
+    back = target.post.parse(result.code).moves
+    points = [(1.0, 3.0)] + [(m.x, m.y) for m in back[1:]]
+    q = 0.5e-5 * math.sqrt(2)  # half the 0.01 µm written step on each axis, mm
+    for a, b in itertools.pairwise(points):  # every chord within t of the circle
+        mid = ((a[0] + b[0]) / 2, (a[1] + b[1]) / 2)
+        assert r - math.dist(mid, (5, -200)) <= tolerance + q
+        assert abs(math.dist(b, (5, -200)) - r) <= q
+
+
+def test_arc_with_a_centre_in_the_field_stays_an_arc() -> None:
+    # The thesis block (seed-000 L1731): centre (3.012, 3.040) mm fits; no chords, no warning.
+    r = math.dist((2.969, 3.400), (3.012, 3.040))
+    program = Program((Rapid(3.012 - r, 3.04), ArcMove(2.969, 3.4, 3.012, 3.04, True, 0.8)))
+    target = load_target("pic-mmh")
+    result = target.post.emit(program, target.machine)
+    assert "G02X02969.00Y03400.00I03012.00J03040.00F08;" in str(result.code).splitlines()
+    assert result.warnings == ()

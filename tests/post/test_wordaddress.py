@@ -229,11 +229,11 @@ def test_rs274_program_with_every_command() -> None:
     assert lines == [
         "G21 G90 G17",
         "M3 S12000",
-        "G0 X0.000 Y0.000 Z5.000",
+        "G0 Z5.000",  # Z only: the program adds no X0 Y0
         "M6 T3",
         "G0 X10.000 Y0.000",
         "G4 P0.5",
-        "G1 X10.000 Y0.000 Z-1.000 F120",
+        "G1 Z-1.000 F120",
         "G1 X20.000 Y0.000",  # F is modal (default modal = ["F"])
         "M5",
         "M2",
@@ -470,7 +470,7 @@ def test_reader_fills_lines_commands_and_contours() -> None:
         [
             "G21 G90 G17",
             "M3 S1000",
-            "G0 X0.000 Y0.000 Z5.000",
+            "G0 Z5.000",  # Z only: the program adds no X0 Y0
             "G1 X1.000 Y0.000 Z-1.000 F100",
             "G4 P0.25",
             "G2 X-1.000 Y0.000 I-1.000 J0.000",
@@ -575,3 +575,70 @@ decimals = 1
     for got, want in zip(back.moves, program.moves, strict=True):
         assert math.dist((got.x, got.y), (want.x, want.y)) < 1e-9
     assert back.commands == ((0, Spindle("cw", 0.0)), (3, Spindle("off")))
+
+
+# -- comments, header and footer (job notes) ------------------------------------------------
+
+
+def test_notes_become_comments_and_read_back() -> None:
+    options = {**RS274, "comment": "()", "header": ["%"], "footer": ["%"], "max_block_bytes": 40}
+    notes = ("camtool 0.1.0: a (b).dxf for toy", "an ä and a very long note " + "x" * 40)
+    lines, _ = emit(options, (Rapid(0, 0, 5.0), Rapid(1, 2)), notes=notes)
+    assert lines == [
+        "%",
+        "(camtool 0.1.0: a [b].dxf for toy)",  # RS-274 comments do not nest
+        "(an ? and a very long note xxxxxxxx...)",  # 39 bytes + LF = 40: cut to fit
+        "G21 G90 G17",
+        "G0 Z5.000",
+        "G0 X1.000 Y2.000",
+        "M2",
+        "%",
+    ]
+    assert all(len(line) + 1 <= 40 for line in lines)
+    back = post(options).parse("\n".join(lines) + "\n")
+    assert back.moves == (Rapid(0, 0, 5.0, contour=1), Rapid(1, 2, contour=1))
+    assert back.lines == (5, 6)
+
+
+def test_semicolon_comments_and_a_dialect_without_comments_drops_notes() -> None:
+    semi, _ = emit({**RS274, "comment": ";"}, (Rapid(1, 1),), notes=("job",))
+    assert semi[:2] == ["; job", "G21 G90 G17"]
+    assert post({**RS274, "comment": ";"}).parse("; job\nG0 X1.000 Y1.000\n").moves == (
+        Rapid(1, 1, contour=1),
+    )
+    none, warnings = emit(RS274, (Rapid(1, 1),), notes=("job",))
+    assert none[0] == "G21 G90 G17" and warnings == ()
+    with pytest.raises(ParseError, match="is not a word"):  # no comment syntax: not skipped
+        post(RS274).parse("(job)\nG0 X1.000 Y1.000\n", source="p")
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        ({"comment": "#"}, r'comment: expected one of \["\(\)", ";"\]'),
+        ({"header": ["G0 X0"]}, r'header\[0\]: expected "%" \(the dialect has no comment'),
+        ({"comment": "()", "footer": ["G0 X0"]}, r'footer\[0\]: expected "%" or a comment'),
+        ({"comment": "()", "header": ["(a (b))"]}, r"header\[0\]: expected"),
+        ({"comment": ";", "header": ["(x)"]}, r'header\[0\]: expected "%" or a comment'),
+    ],
+)
+def test_header_and_footer_hold_only_comments_and_tape_marks(
+    options: dict[str, Any], message: str
+) -> None:
+    with pytest.raises(InputError, match=rf"toy.toml: dialect_options.{message}"):
+        post({"words": {"XY": {}}, **options})
+
+
+def test_a_z_only_move_writes_no_x_or_y() -> None:
+    # From the origin (where the machine stands) and mid-program: Z only, never X0 Y0.
+    moves = (Rapid(0, 0, 5.0), Rapid(3, 4), Rapid(3, 4, 1.0), Linear(3, 4, 50.0, -1.0))
+    lines, _ = emit({"words": {"XYZ": {}, "F": {}}}, moves)
+    assert lines == ["G0 Z5.000", "G0 X3.000 Y4.000", "G0 Z1.000", "G1 Z-1.000 F50.000"]
+
+
+def test_a_spindle_without_a_speed_writes_no_s0() -> None:
+    # A re-posted "M3" (speed left to the machine) is not turned into "M3 S0" (spindle at 0).
+    lines, _ = emit(RS274, (Rapid(1, 1),), commands=((0, Spindle("cw")),))
+    assert lines[1] == "M3"
+    back = post(RS274).parse("\n".join(lines) + "\n")
+    assert back.commands[0] == (0, Spindle("cw", 0.0))

@@ -286,36 +286,41 @@ def test_lead_moves_2d_and_with_depth() -> None:
 # --- depth passes and safe Z -------------------------------------------------------------
 
 
-def _check_safe(moves: Sequence[Move], safe_z: float) -> list[Stroke]:
-    """The depth-plan rules every program keeps; returns the strokes."""
+def _check_safe(
+    moves: Sequence[Move], safe_z: float, clearance: float | None = None, plunge: float = PLUNGE
+) -> list[Stroke]:
+    """The Z-plan rules every program keeps; returns the strokes.
+
+    It starts with a Z-only rapid up to clearance where the tool stands (X0 Y0),
+    every rapid is at safe Z or above (XY travel at safe Z or clearance, never
+    diagonal), a Z-only rapid goes down only to safe Z, cutting moves stay at or
+    below the top, and the program ends at clearance.
+    """
+    clear = max(5.0, safe_z) if clearance is None else clearance
     ss = strokes(moves)
-    assert (
-        isinstance(moves[0], Rapid)
-        and moves[0].z == safe_z
-        and (moves[0].x, moves[0].y)
-        == (
-            0.0,
-            0.0,
-        )
-    )
+    first = moves[0]
+    assert isinstance(first, Rapid) and first.z == clear and (first.x, first.y) == (0.0, 0.0)
     for s in ss:
         if isinstance(s.move, Rapid):
-            if s.xy_length > 0:  # travel: only at safe Z
-                assert s.z0 == safe_z and s.z1 == safe_z
-            else:  # a retract: Z only, upwards
+            assert s.z1 is not None and s.z1 >= safe_z  # no rapid below safe Z
+            if s.xy_length > 0:  # travel: flat, at safe Z or clearance
+                assert s.z0 == s.z1 and s.z1 in (safe_z, clear)
+            elif s.z0 is not None and s.z1 < s.z0:  # down from clearance: only to safe Z
                 assert s.z1 == safe_z
+            else:  # a retract: Z only, upwards
+                assert s.z1 in (safe_z, clear)
             continue
         assert s.z1 is not None and s.z0 is not None
         if s.xy_length == 0:
             assert s.z1 != s.z0
-            feed = PLUNGE if s.z1 < s.z0 else FEED
+            feed = plunge if s.z1 < s.z0 else FEED
             assert s.move.feed_mm_min == feed
             assert s.z1 <= 0
         else:
             assert s.move.feed_mm_min == FEED
             assert s.z0 <= 1e-12 and s.z1 <= 1e-12  # no cutting move above the top
             assert s.z1 <= s.z0 + 1e-12  # only Z-only moves go up (onto a tab)
-    assert ss[-1].z1 == safe_z
+    assert ss[-1].z1 == clear
     return ss
 
 
@@ -324,7 +329,8 @@ def test_closed_cut_passes_in_a_row() -> None:
     o = _options(depth=1.5, step_down=0.5, safe_z=3.0)
     ss = _check_safe(emit_moves([Cut(path, 0)], o), 3.0)
     rapids = [s for s in ss if isinstance(s.move, Rapid)]
-    assert len(rapids) == 3  # up, travel, final retract: no retract between passes
+    # up to clearance, travel, down to safe Z, final rise: no retract between passes
+    assert len(rapids) == 4
     plunges = [s for s in ss if s.xy_length == 0 and not isinstance(s.move, Rapid)]
     assert [s.z1 for s in plunges] == [-0.5, -1.0, -1.5]
     assert all((s.move.x, s.move.y) == path.start for s in plunges)
@@ -522,3 +528,96 @@ def test_tabs_only_on_outside_profiles() -> None:
     hole = Cut(_rect_cw(0, 0, 10, 5).reversed(), 0, material_side="right")
     ss = _check_safe(emit_moves([hole], o), o.safe_z)
     assert all(s.z1 == -2.0 for s in _xy_moves(ss) if not isinstance(s.move, Rapid))
+
+
+# --- start, end, clearance and parts (issue 13 §2) ------------------------------------------
+
+
+def _travel_heights(ss: Sequence[Stroke]) -> list[tuple[int, float | None]]:
+    return [(s.move.contour, s.z1) for s in ss if isinstance(s.move, Rapid) and s.xy_length > 0]
+
+
+def test_start_is_z_only_to_clearance_then_xy_then_down() -> None:
+    # The machine's XY before the program is unknown: the first move may only be vertical.
+    path = _rect_cw(3, 4, 8, 6)
+    o = _options(depth=1.0, safe_z=2.0, clearance_z=7.0)
+    moves = emit_moves([Cut(path, 0)], o)
+    assert moves[:4] == [
+        Rapid(0.0, 0.0, 7.0, contour=1),  # Z only, where the tool stands
+        Rapid(3.0, 4.0, 7.0, contour=1),  # XY at clearance
+        Rapid(3.0, 4.0, 2.0, contour=1),  # rapid down to safe Z only
+        Linear(3.0, 4.0, PLUNGE, -1.0, contour=1),  # into the material at the plunge feed
+    ]
+    assert moves[-1] == Rapid(3.0, 4.0, 7.0, contour=1)  # Z only, up to clearance
+    _check_safe(moves, 2.0, 7.0)
+
+
+def test_clearance_between_parts_safe_z_within_a_part() -> None:
+    # Two plates side by side, each with a hole: hole, plate, hole, plate (inside first).
+    # A part is the outer profile and what lies inside it.
+    plate_a, hole_a = _rect_cw(0, 0, 10, 10), _circle(5, 5, 1)
+    plate_b, hole_b = _rect_cw(20, 0, 30, 10), _circle(25, 5, 1)
+    cuts = [Cut(hole_a, 1), Cut(plate_a, 0), Cut(hole_b, 3), Cut(plate_b, 2)]
+    o = _options(depth=1.0, safe_z=1.0)  # clearance: max(5, 1) = 5
+    ss = _check_safe(emit_moves(cuts, o), 1.0)
+    assert _travel_heights(ss) == [(1, 5.0), (2, 1.0), (3, 5.0), (4, 1.0)]
+    # the retract after plate A and the rise to clearance are one move
+    lifts = [
+        (s.move.contour, s.z0, s.z1)
+        for s in ss[1:]
+        if isinstance(s.move, Rapid) and s.xy_length == 0 and s.z1 > s.z0
+    ]
+    # (the merged lift is numbered with the travel it starts: contour 3)
+    assert lifts == [(1, -1.0, 1.0), (3, -1.0, 5.0), (3, -1.0, 1.0), (4, -1.0, 5.0)]
+
+
+def test_parts_group_nested_cuts_and_pocket_rings() -> None:
+    from camtool.toolpath.passes import parts
+
+    plate, hole, far = _rect_cw(0, 0, 10, 10), _circle(5, 5, 1), _rect_cw(20, 0, 22, 2)
+    ring_a = Cut(_rect_cw(21, 21, 22, 22), 7, "pocket")
+    ring_b = Cut(_rect_cw(24, 24, 25, 25), 7, "pocket")  # beside ring_a, same contour
+    keys = parts([Cut(hole, 1), Cut(plate, 0), Cut(far, 2), ring_a, ring_b])
+    assert keys[0] == keys[1] and len({keys[1], keys[2], keys[3]}) == 3 and keys[3] == keys[4]
+
+
+def test_end_position_at_clearance_after_the_rise() -> None:
+    o = _options(depth=0.5, end_position=(-3.0, 40.0))
+    moves = emit_moves([Cut(_rect_cw(1, 1, 2, 2), 0)], o)
+    assert moves[-2:] == [Rapid(1.0, 1.0, 5.0, contour=1), Rapid(-3.0, 40.0, 5.0, contour=0)]
+    _check_safe(moves, o.safe_z)
+    flat = emit_moves([Cut(_rect_cw(1, 1, 2, 2), 0)], _options(end_position=(0.0, 0.0)))
+    assert flat[-1] == Rapid(0.0, 0.0) and all(m.z is None for m in flat)  # 2D: no Z at all
+
+
+def test_no_depth_on_a_z_machine_cuts_at_the_top_with_rapids_at_safe_z() -> None:
+    path = _rounded_rect()
+    o = _options(safe_z=2.0)
+    moves = emit_moves([Cut(path, 0), Cut(_circle(20, 0, 2), 1)], o, z_axis=True)
+    ss = _check_safe(moves, 2.0, plunge=FEED / 2)  # no --plunge-feed without --depth
+    cutting = [s for s in _xy_moves(ss) if not isinstance(s.move, Rapid)]
+    assert cutting and all(s.z0 == 0.0 and s.z1 == 0.0 for s in cutting)
+    plunges = [s for s in ss if s.xy_length == 0 and not isinstance(s.move, Rapid)]
+    assert [(s.z0, s.z1, s.move.feed_mm_min) for s in plunges] == [(2.0, 0.0, FEED / 2)] * 2
+    # the same cuts for a machine without Z: the 2D program, unchanged
+    assert all(m.z is None for m in emit_moves([Cut(path, 0)], o))
+
+
+def test_a_hostile_ramp_is_refused_before_any_move() -> None:
+    # 1 mm down at 0.0001°: L = 1 / tan(0.0001°) = 572 958 mm ≈ 573 m per pass; round a
+    # 31.6 mm loop of 9 segments that is 18 000 laps, 163 000 moves a pass, 2000 passes
+    # (--step-down 0.001 of 2 mm) → 3.3e8 moves.
+    from camtool.errors import UsageError
+
+    o = _options(depth=2.0, step_down=1.0, ramp_angle_deg=0.0001)
+    with pytest.raises(UsageError, match=r"--ramp 0\.0001° needs 573 m of ramp per pass"):
+        emit_moves([Cut(_rounded_rect(), 0)] * 40, o)
+
+
+def test_the_move_limit_is_named(monkeypatch: pytest.MonkeyPatch) -> None:
+    from camtool.errors import UsageError
+    from camtool.toolpath import passes
+
+    monkeypatch.setattr(passes, "MAX_MOVES", 10)
+    with pytest.raises(UsageError, match=r"camtool\.toolpath\.passes\.MAX_MOVES = 10"):
+        emit_moves([Cut(_rounded_rect(), 0)], _options(depth=1.0, step_down=0.5))
