@@ -142,6 +142,7 @@ def post(
             drawing=job.placed,
             edge_radius_mm=job.edge_radius_mm,
             plan=job.plan,
+            said=job.warnings,
         )
 
 
@@ -204,14 +205,16 @@ def _finish_verification(
     drawing: Drawing | None = None,
     edge_radius_mm: float = 0.0,
     plan: PlanReport | None = None,
+    said: tuple[str, ...] = (),
 ) -> None:
     """Summary to stderr, then the report and preview files, then the limit check.
 
-    The report gets a ``plan`` key (what planning found) when the code was planned here.
+    The report gets a ``plan`` key (what planning found) when the code was planned here;
+    warnings in ``said`` (already printed by ``post``) are not printed again.
     """
     from camtool.verify.verifier import report_dict, summary_lines
 
-    warn(v.warnings)
+    warn([w for w in v.warnings if w not in said])
     for line in summary_lines(v):
         click.echo(f"camtool: {line}", err=True)
     if report is not None:
