@@ -18,6 +18,7 @@ demo: $(STAMP)
 	$(BIN)/camtool post samples/logo.dxf --target pic-mmh -o out/logo.pic \
 		--verify --report out/logo-verify.json --preview out/logo-verify.png
 	$(BIN)/camtool post samples/plate.dxf --target grbl --offset outside --tool-diameter 3 \
+		--origin lower-left \
 		--depth 3 --step-down 1 --tabs 3 --lead-in 2 -o out/plate.gcode --preview out/plate.png
 	@echo "demo: out/logo.pic (pic-mmh program), out/logo-verify.json and .png (predicted error)"
 	@echo "demo: out/plate.gcode (GRBL: outside profile, 3 passes, tabs, lead-ins), out/plate.png"

@@ -159,6 +159,7 @@ def post(
             edge_radius_mm=job.edge_radius_mm,
             plan=job.plan,
             strict=strict,
+            said=job.warnings,
         )
 
 
@@ -235,17 +236,19 @@ def _finish_verification(
     edge_radius_mm: float = 0.0,
     plan: PlanReport | None = None,
     strict: bool = False,
+    said: tuple[str, ...] = (),
 ) -> None:
     """Summary to stderr, then the report and preview files, then the limit check.
 
-    The report gets a ``plan`` key (what planning found) when the code was planned here.
+    The report gets a ``plan`` key (what planning found) when the code was planned here;
+    warnings in ``said`` (already printed by ``post``) are not printed again.
     The limit judges what was cut as drawn; ``strict`` adds the features the planner
     reported it cannot cut with this tool. A drawing that was given but not compared
     (it does not overlap the program) fails the limit: it cannot pass unjudged.
     """
     from camtool.verify.verifier import report_dict, summary_lines
 
-    warn(v.warnings)
+    warn([w for w in v.warnings if w not in said])
     for line in summary_lines(v):
         click.echo(f"camtool: {line}", err=True)
     if report is not None:

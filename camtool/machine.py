@@ -11,7 +11,8 @@ Profile layout (every key optional except ``name``, ``steps_per_mm`` and
     [machine]
     name, steps_per_mm = [x, y, z]      # what the controller assumes (nominal)
     true_steps_per_mm = [x, y, z]       # what the mechanics do (default: nominal)
-    work_area_mm = [xmin, ymin, xmax, ymax], has_z, max_step_rate_hz, source
+    work_area_mm = [xmin, ymin, xmax, ymax], coordinates = "work" | "machine",
+    has_z, max_step_rate_hz, source
     [machine.motion]    line, arc, chords, chord_tolerance_mm, chord_segments,
                         chord_angle_deg, rounding
     [machine.backlash]  true_um = [x, y, z], compensation_um = [x, y, z]
@@ -62,6 +63,14 @@ ROUNDINGS = ("half_even", "half_up", "floor", "trunc")
 """mm → steps rounding rules (:func:`camtool.verify.quantize.steps_from_mm`)."""
 
 AXES = ("x", "y", "z")
+
+COORDINATES: dict[str, str] = {
+    "work": "the controller runs programs relative to a work zero the operator sets "
+    "(G54 or zeroing at the current position): only the program's size must fit the travel",
+    "machine": "the controller runs programs relative to its home: every position must lie "
+    "inside work_area_mm",
+}
+"""What the numbers of a program mean on a machine (``coordinates`` key of a profile)."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -145,7 +154,12 @@ class Machine:
         name: profile name, e.g. ``"MMH-1 (GMM)"``.
         steps_per_mm: motor steps per mm per axis ``(x, y, z)`` as the controller
             assumes them (nominal).
-        work_area_mm: ``(xmin, ymin, xmax, ymax)`` reachable by the tool, mm.
+        work_area_mm: ``(xmin, ymin, xmax, ymax)`` reachable by the tool, mm. In
+            work coordinates only its size (the travel) matters.
+        coordinates: ``"work"`` or ``"machine"`` (:data:`COORDINATES`): whether a
+            program's X0 Y0 is a work zero the operator sets (GRBL/LinuxCNC G54, the
+            thesis controllers that store a part zero or start from where the tool
+            stands) or the machine's home.
         has_z: whether programs may move Z.
         max_step_rate_hz: highest step frequency the controller sustains, Hz
             (0 = no limit known).
@@ -164,6 +178,7 @@ class Machine:
     name: str
     steps_per_mm: tuple[float, float, float]
     work_area_mm: BBox
+    coordinates: str = "work"
     has_z: bool = True
     max_step_rate_hz: float = 0.0
     source: str = ""
@@ -187,6 +202,12 @@ class Machine:
         """
         return max(self.steps_per_mm[:2]) * feed_mm_min / 60.0
 
+    @property
+    def travel_mm(self) -> tuple[float, float]:
+        """Travel ``(x, y)`` of the work area, mm."""
+        x0, y0, x1, y1 = self.work_area_mm
+        return (x1 - x0, y1 - y0)
+
     def outside_work_area(self, box: BBox, eps_mm: float = 1e-9) -> bool:
         """True when ``box`` reaches beyond the work area by more than ``eps_mm``."""
         x0, y0, x1, y1 = self.work_area_mm
@@ -207,11 +228,18 @@ def machine_from_table(table: Mapping[str, Any], *, where: str) -> Machine:
     """
     r = _Reader(table, "machine", where)
     x0, y0, x1, y1 = r.floats("work_area_mm", 4, required=True)
+    if not (x0 < x1 and y0 < y1):
+        raise r._fail(
+            "work_area_mm",
+            "[xmin, ymin, xmax, ymax] with xmin < xmax and ymin < ymax",
+            [x0, y0, x1, y1],
+        )
     true_steps = r.triple("true_steps_per_mm", positive=True)
     machine = Machine(
         name=r.text("name", required=True),
         steps_per_mm=r.triple("steps_per_mm", required=True, positive=True),
         work_area_mm=(x0, y0, x1, y1),
+        coordinates=r.choice("coordinates", COORDINATES, "work"),
         has_z=r.flag("has_z", True),
         max_step_rate_hz=r.number("max_step_rate_hz", 0.0),
         source=r.text("source"),

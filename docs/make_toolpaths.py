@@ -34,6 +34,7 @@ EXAMPLES: dict[str, tuple[str, str, dict[str, Any]]] = {
             "step_down": 1.0,
             "tabs": 3,
             "lead_in_mm": 2.0,
+            "placement": "lower-left",
         },
     ),
     "pocket-concentric": ("pocket.dxf", "grbl", {"offset": "pocket", "tool_diameter": 2.0}),

@@ -10,7 +10,7 @@ the thesis cut. It uses every entity kind the first importer reads:
 - a cutter point: a triangle of three LINEs that chain to one closed contour;
 - a base mark: a 2D POLYLINE with a bulge (a shallow "smile").
 
-``plate.dxf`` is a 40 × 30 mm bracket, drawn from (5, 5), for profile cutting
+``plate.dxf`` is a 40 × 30 mm bracket, drawn from the origin as parts are drawn, for profile cutting
 (``--offset outside``): an outline with a 10 × 8 mm notch (two inside corners no round
 tool can reach), four ø4 mm holes, a 12 × 4 mm slot with round ends and a 2 × 2 mm
 square hole narrower than a 3 mm tool. ``pocket.dxf`` is a 30 × 20 mm pocket with 3 mm
@@ -67,16 +67,17 @@ def make_plate(path: Path) -> None:
     doc = ezdxf.new("R2010", setup=False)
     doc.header["$INSUNITS"] = 4
     msp = doc.modelspace()
-    # Drawn 5 mm from the origin, so that a tool cutting outside stays at X, Y >= 0.
-    outline = [(5, 5), (45, 5), (45, 35), (30, 35), (30, 27), (20, 27), (20, 35), (5, 35)]
+    # Drawn from the origin: a tool cutting outside runs at X, Y < 0 (work coordinates; use
+    # --origin lower-left to put the work zero at the toolpath's corner instead).
+    outline = [(0, 0), (40, 0), (40, 30), (25, 30), (25, 22), (15, 22), (15, 30), (0, 30)]
     msp.add_lwpolyline(outline, close=True)
-    for x, y in ((10, 10), (40, 10), (10, 30), (40, 30)):
+    for x, y in ((5, 5), (35, 5), (5, 25), (35, 25)):
         msp.add_circle((x, y), 2.0)
     # Slot 12 × 4: straight sides joined by semicircles (bulge 1 = 180°).
     msp.add_lwpolyline(
-        [(21, 13, 0.0), (29, 13, 1.0), (29, 17, 0.0), (21, 17, 1.0)], format="xyb", close=True
+        [(16, 8, 0.0), (24, 8, 1.0), (24, 12, 0.0), (16, 12, 1.0)], format="xyb", close=True
     )
-    msp.add_lwpolyline([(13, 19), (15, 19), (15, 21), (13, 21)], close=True)
+    msp.add_lwpolyline([(8, 14), (10, 14), (10, 16), (8, 16)], close=True)
     doc.saveas(path)
 
 

@@ -242,7 +242,7 @@ def test_progress_is_called_once_per_file(tree: Path) -> None:
     [
         (None, [], 0, "3 file(s): 3 ok"),
         ("corrupt", [], 3, "not a readable DXF"),
-        ("corrupt+big", [], 1, "outside the 10 × 7 mm work area"),  # seed-000 §2.1
+        ("corrupt+big", [], 1, "larger than the 10 × 7 mm travel"),  # seed-000 §2.1
         (None, ["--target", "nope"], 2, "unknown target 'nope'"),
         (None, ["--jobs", "0"], 2, "Invalid value for '--jobs'"),
         (None, ["--preview", "gif"], 2, "Invalid value for '--preview'"),

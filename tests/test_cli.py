@@ -53,7 +53,7 @@ def test_feed_option(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None
         ("text", [], 3, "not a readable DXF"),
         ("empty", [], 3, "no usable entity"),
         ("rect", ["--target", "nope"], 2, "unknown target 'nope'; choose one of: "),
-        ("big", [], 1, "outside the 10 × 7 mm work area"),
+        ("big", [], 1, "larger than the 10 × 7 mm travel"),
         ("rect", ["--feed", "20"], 1, "outside F01–F99"),
         ("rect", ["--offset", "outside"], 2, "needs --tool-diameter"),
         ("rect", ["--offset", "sideways"], 2, "Invalid value for '--offset'"),

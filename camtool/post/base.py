@@ -9,32 +9,67 @@ from types import MappingProxyType
 from typing import ClassVar
 
 from camtool.errors import DialectError, UsageError
-from camtool.geometry import Point
+from camtool.geometry import Point, bbox_union
 from camtool.machine import Machine
 from camtool.program import Move, Program, segment_of
+from camtool.toolpath.placement import (
+    EPS_MM,
+    check_travel,
+    outside_text,
+    place_remedy,
+    too_large,
+    toolpath_extent,
+)
+from camtool.units import fmt_num
 
 
-def check_work_area(start: Point, move: Move, machine: Machine, where: str) -> None:
-    """Refuse a move (an arc by its extremes) that leaves the machine's work area.
+def check_work_area(
+    start: Point, move: Move, machine: Machine, where: str, program: Program
+) -> None:
+    """Machine coordinates: refuse a move (an arc by its extremes) outside the work area.
+
+    A machine in work coordinates (``machine.coordinates == "work"``) runs any
+    position: there only the program's size counts (:func:`check_placement`).
 
     Args:
         start: where the move starts, mm.
         move: the move.
-        machine: the machine profile (``work_area_mm``).
+        machine: the machine profile (``work_area_mm``, ``coordinates``).
         where: the contour and block for the message ("contour 3, block 12").
+        program: the whole program, for the remedy (by how much to move it).
 
     Raises:
         DialectError: the move reaches outside the work area, naming ``where``,
-            the move's extent and the work area.
+            the move's extent, the work area and options that move the program in.
     """
+    if machine.coordinates == "work":
+        return
     box = segment_of(start, move).bbox()
-    if machine.outside_work_area(box):
-        x0, y0, x1, y1 = machine.work_area_mm
+    if machine.outside_work_area(box, EPS_MM):
+        whole = toolpath_extent(program) or box
+        too_large(whole, machine, None)
         raise DialectError(
-            f"{where}: reaches ({box[0]:.4f}, {box[1]:.4f})–({box[2]:.4f}, "
-            f"{box[3]:.4f}) mm, outside the {x1 - x0:g} × {y1 - y0:g} mm work area "
-            f"of {machine.name}; move the drawing or use --fit"
+            f"{where}: reaches X {fmt_num(box[0])}…{fmt_num(box[2])}, Y {fmt_num(box[1])}…"
+            f"{fmt_num(box[3])} mm, {outside_text(machine)}; "
+            f"{place_remedy(bbox_union([whole, box]), machine, None)}"
         )
+
+
+def check_placement(program: Program, machine: Machine) -> tuple[str, ...]:
+    """The work-coordinate rule for a program about to be written (or verified).
+
+    The toolpath must be no larger than the machine's travel; where its work zero
+    needs care the returned warnings say so (see
+    :func:`camtool.toolpath.placement.check_travel`). A machine in machine
+    coordinates is checked move by move instead (:func:`check_work_area`, which
+    names the block).
+
+    Raises:
+        DialectError: the toolpath is larger than the travel (both sizes named).
+    """
+    if machine.coordinates == "machine":
+        return ()
+    return check_travel(program, machine)
 
 
 @dataclass(frozen=True)

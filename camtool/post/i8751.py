@@ -53,7 +53,7 @@ from typing import ClassVar
 from camtool.errors import DialectError, UsageError
 from camtool.geometry import Arc, Point
 from camtool.machine import Machine
-from camtool.post.base import PostProcessor, PostResult, check_work_area
+from camtool.post.base import PostProcessor, PostResult, check_placement, check_work_area
 from camtool.post.i8751_read import cruise_feed, is_text, program_from_records
 from camtool.post.i8751_stream import (
     ACCESS_KEY,
@@ -273,18 +273,20 @@ class I8751Post(PostProcessor):
         start = program.origin
         for item in program.items():
             if isinstance(item, Rapid | Linear | ArcMove):
-                self._move(w, start, item, machine)
+                self._move(w, start, item, machine, program)
                 start = (item.x, item.y)
             else:
                 self._command(w, item)
-        warnings = self._warnings(w, program, machine)
+        warnings = (*check_placement(program, machine), *self._warnings(w, program, machine))
         if fmt == "bin":
             return PostResult(encode_stream(w.records), len(w.records), warnings, fmt)
         text = dump_stream(w.records, machine.steps_per_mm, self._header(w, machine))
         return PostResult(text, len(w.records), warnings, fmt)
 
-    def _move(self, w: _Writer, start: Point, move: Move, machine: Machine) -> None:
-        check_work_area(start, move, machine, w.where(move))
+    def _move(
+        self, w: _Writer, start: Point, move: Move, machine: Machine, program: Program
+    ) -> None:
+        check_work_area(start, move, machine, w.where(move), program)
         if move.z is not None and not machine.has_z:
             raise DialectError(f"{w.where(move)}: Z = {move.z:g} mm but {machine.name} has no Z")
         if isinstance(move, Rapid):

@@ -56,7 +56,7 @@ import numpy as np
 from camtool.errors import DialectError, UsageError
 from camtool.geometry import Arc, Point
 from camtool.machine import Machine
-from camtool.post.base import PostProcessor, PostResult, check_work_area
+from camtool.post.base import PostProcessor, PostResult, check_placement, check_work_area
 from camtool.post.matlab_router_read import (
     INT16_MAX,
     major_axis_feed_mm_min,
@@ -216,7 +216,8 @@ class MatlabRouterPost(PostProcessor):
                 "nothing to cut: a matlab-router job needs at least one segment of 0.1 mm or "
                 "more (rapids alone are not written)"
             )
-        warnings = notes.warnings + notes_warnings(notes, self.speed, self._tolerance(machine))
+        warnings = [*check_placement(program, machine), *notes.warnings]
+        warnings += notes_warnings(notes, self.speed, self._tolerance(machine))
         return jobs, warnings + jobs_warnings(jobs, self.max_segments)
 
     def _tolerance(self, machine: Machine) -> float:
@@ -236,7 +237,7 @@ class MatlabRouterPost(PostProcessor):
                 continue
             index += 1
             move: Move = item
-            _check_move(here, move, index, machine)
+            _check_move(here, move, index, machine, program)
             if isinstance(move, Rapid):
                 current, here = None, (move.x, move.y)
                 notes.trailing_rapid = here
@@ -389,7 +390,7 @@ def _matrix(name: str, arr: np.ndarray) -> list[str]:
     return [f"{name} = ", f"[{x}; ", f" {y} ] "]
 
 
-def _check_move(here: Point, move: Move, index: int, machine: Machine) -> None:
+def _check_move(here: Point, move: Move, index: int, machine: Machine, program: Program) -> None:
     """Z and work-area checks of one move (``index`` 0-based)."""
     where = _place((move.contour,), f"block {index + 1}")
     if move.z is not None:
@@ -398,7 +399,7 @@ def _check_move(here: Point, move: Move, index: int, machine: Machine) -> None:
             "the tool by a fixed 100 units at each job's start, seed-002 §2.8 L6544); "
             "set the depth by hand"
         )
-    check_work_area(here, move, machine, where)
+    check_work_area(here, move, machine, where, program)
 
 
 def _chords(here: Point, move: ArcMove, tolerance: float, notes: WriterNotes) -> list[Point]:

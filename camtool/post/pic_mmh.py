@@ -43,7 +43,7 @@ from typing import Any, ClassVar
 from camtool.errors import DialectError, ParseError
 from camtool.geometry import Arc, distance
 from camtool.machine import Machine
-from camtool.post.base import PostProcessor, PostResult, check_work_area
+from camtool.post.base import PostProcessor, PostResult, check_placement, check_work_area
 from camtool.post.numfmt import NumberFormat, format_int
 from camtool.post.pic_mmh_feeds import FeedTable
 from camtool.program import (
@@ -166,6 +166,7 @@ class PicMmhPost(PostProcessor):
         """
         self.check_format(fmt)
         w = _Writer(["G54;", "G90;"])
+        w.warnings.extend(check_placement(program, machine))
         homed = False
         for start, move, commands in _steps(program):
             for command in commands:
@@ -173,6 +174,7 @@ class PicMmhPost(PostProcessor):
             if move is None:
                 continue
             self._check_move(start, move, machine, w, homed)
+            check_work_area(start, move, machine, w.where(move.contour), program)
             homed = homed and not isinstance(move, Rapid)
             self._move(start, move, machine, w, _tolerance(program, machine))
         w.lines.append("M30;")
@@ -202,7 +204,6 @@ class PicMmhPost(PostProcessor):
                 "camtool does not know (the part zero is set by G54); go to the start of the "
                 "cut with a rapid (G00) first"
             )
-        check_work_area(start, move, machine, where)
 
     def _move(
         self,

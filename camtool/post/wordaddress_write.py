@@ -34,7 +34,7 @@ from collections import Counter
 from camtool.errors import DialectError
 from camtool.geometry import Arc, Point
 from camtool.machine import Machine
-from camtool.post.base import check_work_area
+from camtool.post.base import check_placement, check_work_area
 from camtool.post.wordaddress_spec import WordAddressSpec
 from camtool.program import (
     ArcMove,
@@ -72,6 +72,7 @@ class BlockWriter:
         self.last: dict[str, str] = {}
         self.contour = 0
         self.grid_error_mm = 0.0
+        self.program = Program(())
 
     # -- the program -------------------------------------------------------------
 
@@ -86,6 +87,8 @@ class BlockWriter:
             DialectError: see the module docstring; the message names the block.
         """
         self.here = program.origin
+        self.program = program
+        self.warnings.extend(check_placement(program, self.machine))
         self.written = (self._round("X", program.origin[0]), self._round("Y", program.origin[1]))
         self.lines.extend(self.spec.header)
         for note in program.notes:
@@ -196,7 +199,7 @@ class BlockWriter:
         return self.text("Z", z) == self.text("Z", self.z)
 
     def _check_area(self, start: Point, move: Move) -> None:
-        check_work_area(start, move, self.machine, self.where())
+        check_work_area(start, move, self.machine, self.where(), self.program)
 
     def _check_z(self, move: Move) -> None:
         if not self.spec.has("Z") or not self.machine.has_z:

@@ -19,6 +19,7 @@ before and after ordering) in :class:`PlanReport`.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections import Counter
 from collections.abc import Sequence
@@ -33,11 +34,27 @@ from camtool.toolpath.cuts import Finding, Stage
 from camtool.toolpath.gaps import MIN_JOINT_MM, open_gaps
 from camtool.toolpath.options import OFFSET_MODES, PlanOptions
 from camtool.toolpath.order import Ordering, nesting, order_cuts
+from camtool.toolpath.placement import (
+    Placing,
+    check_travel,
+    placement_shift,
+    shift_program,
+    toolpath_extent,
+)
 
 if TYPE_CHECKING:
     from camtool.machine import Machine
 
-__all__ = ["OFFSET_MODES", "Plan", "PlanOptions", "PlanReport", "place", "plan", "plan_drawing"]
+__all__ = [
+    "OFFSET_MODES",
+    "Plan",
+    "PlanOptions",
+    "PlanReport",
+    "place",
+    "place_program",
+    "plan",
+    "plan_drawing",
+]
 
 MIN_FIT_RUN = 6
 """Shortest run of consecutive lines (edges) that arc fitting tries to replace."""
@@ -88,7 +105,11 @@ class PlanReport:
 
 @dataclass(frozen=True)
 class Plan:
-    """A planned program, its report, and the drawing as placed (scale/fit, mm)."""
+    """A planned program, its report, and the drawing as placed (mm).
+
+    ``placed`` is the drawing after ``--scale``/``--fit`` and moved with the program
+    by ``--origin``/``--translate``: it lies in the program's work coordinates.
+    """
 
     program: Program
     report: PlanReport
@@ -112,7 +133,9 @@ def plan_drawing(
     Contours are placed (scale/fit), chained and closed within the tolerances,
     dense polylines fitted with arcs, compensated for the tool or pocketed,
     ordered (inside before outside always) and emitted with depth passes, tabs
-    and lead-ins. The findings also become the program's warnings.
+    and lead-ins; the program is then moved to its work zero (``--origin``, then
+    ``--translate``: :func:`place_program`) and checked against the machine's
+    travel. The findings also become the program's warnings.
 
     Args:
         drawing: the imported drawing, mm.
@@ -125,6 +148,7 @@ def plan_drawing(
     Raises:
         UsageError: invalid options, or depth options for a machine without Z.
         ToolpathError: a stage cannot plan the drawing (names the contour).
+        DialectError: the toolpath does not fit the machine (:func:`place_program`).
     """
     from camtool.toolpath.passes import emit_moves
 
@@ -148,7 +172,10 @@ def plan_drawing(
     moves = emit_moves(ordering.cuts, options, helix=helix, z_axis=z_axis)
     report = PlanReport(len(contours), len(stage.cuts), tuple(findings), ordering, stats)
     warnings = tuple(dict.fromkeys((*drawing.warnings, *(f.message for f in findings))))
-    return Plan(Program(tuple(moves), options.origin, warnings), report, placed)
+    program, placed = place_program(
+        Program(tuple(moves), options.origin, warnings), placed, options, machine
+    )
+    return Plan(program, report, placed)
 
 
 def _stage(contours: Sequence[Contour], nest: Any, options: PlanOptions) -> Stage:
@@ -177,6 +204,48 @@ def place(drawing: Drawing, options: PlanOptions) -> Drawing:
     if math.isinf(k):
         return drawing
     return drawing.transformed(k, x0 * (1 - k), y0 * (1 - k))
+
+
+def place_program(
+    program: Program, placed: Drawing, options: PlanOptions, machine: Machine | None = None
+) -> tuple[Program, Drawing]:
+    """The placement stage: move the program so that its work zero lies where asked.
+
+    ``options.placement`` (``--origin``) then ``options.translate`` (``--translate``)
+    shift the program's moves (:func:`~camtool.toolpath.placement.shift_program`; the
+    start position stays) and the placed drawing alike, so that ``verify --against``
+    and previews still line up. With a machine, the program is then checked against
+    its travel (:func:`~camtool.toolpath.placement.check_travel`); its warnings join
+    the program's (the post-processor applies the same rule again as a backstop, but
+    cannot know how work zero was chosen, so it only refuses).
+
+    Returns:
+        The program and the drawing, both in work coordinates (mm).
+
+    Raises:
+        DialectError: the toolpath is larger than the machine's travel, or outside
+            the work area of a machine in machine coordinates; the message names
+            options that fix it as written.
+    """
+    dx, dy = placement_shift(program, options.placement, options.translate)
+    program = shift_program(program, dx, dy)
+    if dx or dy:
+        placed = placed.transformed(1.0, dx, dy)
+    if machine is not None:
+        said = check_travel(program, machine, _placing(program, placed, options))
+        if said:
+            program = dataclasses.replace(program, warnings=(*program.warnings, *said))
+    return program, placed
+
+
+def _placing(program: Program, placed: Drawing, options: PlanOptions) -> Placing:
+    """How ``options`` placed ``program``, and its toolpath's margin over the drawing."""
+    margin = (0.0, 0.0)
+    box = toolpath_extent(program)
+    if box is not None and placed.contours:
+        d = placed.bbox()
+        margin = ((box[2] - box[0]) - (d[2] - d[0]), (box[3] - box[1]) - (d[3] - d[1]))
+    return Placing(options.placement, options.translate, margin)
 
 
 def fit_dense(contours: Sequence[Contour], tolerance: float) -> tuple[list[Contour], FitStats]:

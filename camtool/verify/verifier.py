@@ -169,9 +169,11 @@ def verify_program(
 
     Raises:
         UsageError: a negative tool diameter, or an inconsistent machine profile.
+        DialectError: the program does not fit the machine (:func:`check_area`).
     """
     if tool_diameter < 0:
         raise UsageError(f"tool diameter must be >= 0 mm, got {tool_diameter!r}")
+    placement = check_area(program, machine)
     if machine.motion.line == "servo":
         from camtool.verify.simulate_servo import simulate_servo
 
@@ -208,7 +210,7 @@ def verify_program(
         contours=contours,
         against=compared,
         block_time_s=times,
-        warnings=tuple(warnings),
+        warnings=tuple(dict.fromkeys((*warnings, *placement))),
         against_skipped=skipped,
     )
 
@@ -273,6 +275,24 @@ def _short(value: float) -> str:
     """At most 3 decimals, trailing zeros dropped, never ``-0``."""
     text = fmt_num(value, 3).rstrip("0").rstrip(".")
     return "0" if text in ("-0", "") else text
+
+
+def check_area(program: Program, machine: Machine) -> tuple[str, ...]:
+    """The rule ``post`` applies (:func:`camtool.post.base.check_placement`), on read code.
+
+    Work coordinates: the toolpath must fit the travel (warnings where work zero needs
+    care); machine coordinates: every move inside the work area, named by its line.
+
+    Raises:
+        DialectError: the program cannot run on ``machine`` (with the remedy).
+    """
+    from camtool.post.base import check_placement, check_work_area
+
+    for index, (start, move) in enumerate(program.steps()):
+        line = program.line_of(index)
+        where = f"line {line}" if line is not None else f"move {index + 1}"
+        check_work_area(start, move, machine, where, program)
+    return check_placement(program, machine)
 
 
 def block_times(trace: StepTrace, program: Program, machine: Machine) -> np.ndarray:

@@ -114,11 +114,14 @@ def test_full_circle_is_written_as_two_halves() -> None:
 
 
 def test_r8_work_area_20_by_35_mm() -> None:
-    # L620: 20 mm of travel in X, 35 mm in Y.
+    # L620: 20 mm of travel in X, 35 mm in Y, from the "Cero de programa" the operator sets
+    # (§7.6): work coordinates, so a toolpath of 20 × 35 mm fits wherever it lies, and one
+    # 20.5 mm long does not.
     assert TARGET.machine.work_area_mm == (0.0, 0.0, 20.0, 35.0)
-    emit((Rapid(20, 35),))
-    with pytest.raises(DialectError, match=r"block 1: .*outside the 20 × 35 mm work area"):
-        emit((Rapid(20.5, 1),))
+    assert TARGET.machine.coordinates == "work"
+    emit((Rapid(-10, -5), Linear(10, 30, 3.0)))
+    with pytest.raises(DialectError, match=r"20.5 × 1 mm, larger than the 20 × 35 mm travel"):
+        emit((Rapid(0, 0), Linear(20.5, 1, 3.0)))
 
 
 def test_r8_r11_a_10_by_5_mm_line_is_5263_steps_and_2763_at_20_ms() -> None:

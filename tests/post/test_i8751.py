@@ -313,10 +313,11 @@ def test_placeholder_steps_per_mm_warn_and_yours_do_not(tmp_path: Path) -> None:
     assert target.post.parse(result.code).moves[0].x == 1.0  # read with 200 steps/mm too
 
 
-def test_outside_the_work_area_names_contour_and_block() -> None:
+def test_a_toolpath_larger_than_the_travel_names_both_sizes() -> None:
+    # Relative packets from where the tool stands (work coordinates): 1 … 700 mm is 699 mm.
     post, machine = _target()
     program = Program((Rapid(1, 1, contour=1), Linear(2, 1, 60, contour=1), Linear(700, 1, 60)))
-    with pytest.raises(DialectError, match=r"block 4: .*outside the 655.35 × 655.35 mm"):
+    with pytest.raises(DialectError, match=r"699 × 0 mm, larger than the 655.35 × 655.35 mm"):
         post.emit(program, machine)
 
 

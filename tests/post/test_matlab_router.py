@@ -289,7 +289,8 @@ def test_z_moves_are_refused() -> None:
 
 def test_point_outside_the_work_area_names_contour_and_block() -> None:
     # router-2011: the GUI's drawable 20 × 20 cm (axis([0 20 0 20]), L4406).
-    with pytest.raises(DialectError, match=r"contour 3, block 2: .*outside the 200 × 200 mm"):
+    where = r"contour 3, block 2: .*outside the work area X 0…200, Y 0…200 mm"
+    with pytest.raises(DialectError, match=where + r".*--translate moved by -1 0 mm"):
         _emit((Rapid(150, 150, contour=3), Linear(201, 150, FEED, contour=3)))
     with pytest.raises(DialectError, match="outside"):  # an arc bulging past y = 200
         _emit((Rapid(150, 195), ArcMove(170, 195, 160, 195, True, FEED)))

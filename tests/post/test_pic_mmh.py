@@ -109,15 +109,17 @@ def test_feed_outside_f01_f99_is_an_error(feed: float) -> None:
         _emit((Rapid(1, 1, contour=2), Linear(2, 1, feed, contour=2)))
 
 
-def test_point_outside_the_work_area_names_contour_and_block() -> None:
-    with pytest.raises(DialectError, match=r"contour 1, block 4: .*outside the 10 × 7 mm"):
-        _emit((Rapid(1, 1, contour=1), Linear(11, 1, 0.8, contour=1)))
+def test_a_toolpath_longer_than_the_travel_is_an_error() -> None:
+    # G54 part zero (S000-02): any position, but 1 … 11.5 mm is longer than the 10 mm of X.
+    _emit((Rapid(-1, -1, contour=1), Linear(9, 6, 0.8, contour=1)))
+    with pytest.raises(DialectError, match=r"10.5 × 0 mm, larger than the 10 × 7 mm travel"):
+        _emit((Rapid(1, 1, contour=1), Linear(11.5, 1, 0.8, contour=1)))
 
 
-def test_arc_bulging_outside_the_area_is_an_error() -> None:
-    # Ends inside the area, but the arc passes y = 7.5 (centre (5, 5), r = 2.5).
-    with pytest.raises(DialectError, match="outside"):
-        _emit((Rapid(2.5, 5), ArcMove(7.5, 5, 5, 5, True, 0.8)))
+def test_a_circle_taller_than_the_travel_is_an_error() -> None:
+    # Starts and ends at (1.4, 3.6), but the full circle of r = 3.6 is 7.2 mm tall > 7 mm.
+    with pytest.raises(DialectError, match=r"7.2 × 7.2 mm, larger than the 10 × 7 mm"):
+        _emit((Rapid(1.4, 3.6), ArcMove(1.4, 3.6, 5, 3.6, True, 0.8)))
 
 
 def test_z_moves_are_refused() -> None:

@@ -112,9 +112,13 @@ def test_r05_reflex_arcs_split_at_180_degrees() -> None:
 
 
 def test_r09_soft_limits() -> None:
-    # S004-R09: a point at X = 500 is rejected (the profile's envelope is 300 × 300 mm).
-    with pytest.raises(DialectError, match=r"block 1: .*outside the 300 × 300 mm work area"):
-        emit((Rapid(500, 10),))
+    # S004-R09: the envelope is 300 × 300 mm. The firmware counts from where it started (no
+    # homing, §2 L1010): a toolpath longer than 300 mm is rejected; one that lies 500 mm
+    # from the start is flagged (its zero must be set outside the travel).
+    with pytest.raises(DialectError, match=r"500 × 0 mm, larger than the 300 × 300 mm travel"):
+        emit((Rapid(0, 10), Linear(500, 10, 100.0)))
+    _, warnings = emit((Rapid(500, 10),))
+    assert "work zero cannot be a point the tool reaches" in warnings[0]
 
 
 def test_r10_coordinates_on_the_step_grid_with_the_rounding_reported() -> None:

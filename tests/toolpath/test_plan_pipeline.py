@@ -148,5 +148,5 @@ def test_cli_reports_what_planning_found(
     plan = json.loads(report.read_text())["plan"]
     assert plan["counts"] == {"tight-corner": 1, "offset-vanished": 1}
     vanished = next(f for f in plan["findings"] if f["kind"] == "offset-vanished")
-    assert vanished["at"] == pytest.approx([14.0, 20.0])
+    assert vanished["at"] == pytest.approx([9.0, 15.0])
     assert plan["order"]["mode"] == "travel"

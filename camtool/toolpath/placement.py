@@ -1,0 +1,346 @@
+"""Work coordinates and placement: where a program's X0 Y0 lies and whether it fits a machine.
+
+A program is written in **work coordinates**: X0 Y0 is the work zero the operator sets
+on the machine (``G54`` and touch-off on GRBL/LinuxCNC, ``Q;``/``G54;`` on the GMM PIC,
+"Cero de programa" on the LMM, the start position on controllers that count from where
+the tool stands). Such a controller runs negative numbers as a matter of course, so the
+only hard limit is the program's **size**: its extent must fit the travel of the
+machine. A controller in **machine coordinates** (``coordinates = "machine"``: the
+seed-002 router counts from its home switches) can only reach positions inside its
+``work_area_mm``.
+
+Placement (``--origin`` and ``--translate``) moves the finished program so that the work
+zero lies where the user wants it (:func:`placement_shift`, :func:`shift_program`). The
+order is: ``--scale``/``--fit`` on the drawing, then planning, then ``--origin``, then
+``--translate``. :func:`check_travel` applies the rule above and says how to fix a
+program that does not fit, with options that work as written (``--origin lower-left``,
+``--translate DX DY`` with the numbers, ``--fit W H`` with the toolpath's margin taken
+off the travel).
+
+Sign convention: a shift ``(dx, dy)`` is added to every position (mm).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from camtool.errors import DialectError
+from camtool.geometry import BBox, Point, bbox_union
+from camtool.program import ArcMove, Move, Program, Rapid, segment_of
+from camtool.units import fmt_num
+
+if TYPE_CHECKING:
+    from camtool.machine import Machine
+
+EPS_MM = 1e-6
+"""Positions closer than this to a limit or to the work zero count as on it, mm (1 nm:
+below every machine's step, above the rounding noise of the offset stages)."""
+
+
+def toolpath_extent(program: Program) -> BBox | None:
+    """XY extent of the toolpath: the cuts and the travel between and after them, mm.
+
+    The travel before the first cut (the rapids from :attr:`Program.origin`, where the
+    machine stands before the program, and the Z moves there) is left out: it says
+    where the machine starts, not where the part is. The first cut's start is in.
+    Arcs count by their extremes. A program without cuts: the ends of its rapids
+    but those that stay at the start position.
+
+    Returns:
+        ``(xmin, ymin, xmax, ymax)``, mm; ``None`` for a program with nothing to place.
+    """
+    moves = program.moves
+    first = next((i for i, m in enumerate(moves) if not isinstance(m, Rapid)), None)
+    if first is None:
+        ends = [(m.x, m.y) for m in moves[_at_start(program) :]]
+        return bbox_union([(x, y, x, y) for x, y in ends]) if ends else None
+    start = program.origin if first == 0 else (moves[first - 1].x, moves[first - 1].y)
+    boxes = []
+    for move in moves[first:]:
+        boxes.append(segment_of(start, move).bbox())
+        start = (move.x, move.y)
+    return bbox_union(boxes)
+
+
+def placement_shift(program: Program, placement: str, translate: Point) -> Point:
+    """The shift ``(dx, dy)`` (mm) that ``--origin placement`` then ``--translate`` ask for.
+
+    ``drawing`` keeps the coordinates; ``lower-left``/``center`` put X0 Y0 at the
+    lower-left corner / the centre of :func:`toolpath_extent` (tool radius, lead-ins
+    and tabs included). ``translate`` is added after.
+
+    Raises:
+        ValueError: ``placement`` is not one of
+            :data:`~camtool.toolpath.options.PLACEMENTS`.
+    """
+    box = toolpath_extent(program)
+    if placement == "drawing" or box is None:
+        ref = (0.0, 0.0)
+    elif placement == "lower-left":
+        ref = (box[0], box[1])
+    elif placement == "center":
+        ref = ((box[0] + box[2]) / 2.0, (box[1] + box[3]) / 2.0)
+    else:
+        raise ValueError(f"unknown placement {placement!r}")
+    return (translate[0] - ref[0], translate[1] - ref[1])
+
+
+def shift_program(program: Program, dx: float, dy: float) -> Program:
+    """``program`` moved by ``(dx, dy)`` mm: move ends and arc centres.
+
+    The start position (:attr:`Program.origin`) stays where the machine stands, and so
+    do the leading rapids that do not leave it (a lift to clearance height before any
+    travel): moving them would drag the tool sideways from wherever it stands. When
+    the path itself began at the start position (a cut from there), one rapid to its
+    new start is put before it, at the height the tool is at. Commands keep their
+    place (those before the first shifted move stay before that rapid).
+    """
+    if dx == 0.0 and dy == 0.0:
+        return program
+    k = _at_start(program)
+    moves: list[Move] = list(program.moves[:k])
+    moves += [_shifted(m, dx, dy) for m in program.moves[k:]]
+    commands, lines = program.commands, program.lines
+    if k < len(program.moves) and not isinstance(program.moves[k], Rapid):
+        x, y = program.origin
+        moves.insert(k, Rapid(x + dx, y + dy, contour=program.moves[k].contour))
+        commands = tuple((i + (i > k), c) for i, c in commands)
+        if lines:
+            lines = (*lines[:k], lines[k], *lines[k:])
+    return dataclasses.replace(program, moves=tuple(moves), commands=commands, lines=lines)
+
+
+def _at_start(program: Program) -> int:
+    """How many leading moves are rapids that stay at the start position (XY)."""
+    ox, oy = program.origin
+    k = 0
+    for move in program.moves:
+        if not (isinstance(move, Rapid) and move.x == ox and move.y == oy):
+            break
+        k += 1
+    return k
+
+
+def _shifted(move: Move, dx: float, dy: float) -> Move:
+    if isinstance(move, Rapid):
+        return dataclasses.replace(move, x=move.x + dx, y=move.y + dy)
+    if isinstance(move, ArcMove):
+        return dataclasses.replace(
+            move, x=move.x + dx, y=move.y + dy, cx=move.cx + dx, cy=move.cy + dy
+        )
+    return dataclasses.replace(move, x=move.x + dx, y=move.y + dy)
+
+
+@dataclass(frozen=True)
+class Placing:
+    """How the program was placed, so that a remedy can be printed that works as written.
+
+    Attributes:
+        placement: the ``--origin`` used.
+        translate: the ``--translate`` used, mm.
+        margin_mm: ``(w, h)`` by which the toolpath's extent is larger than the
+            drawing's (twice the tool radius plus the lead arcs for an outside
+            profile; negative inside), mm: ``--fit`` scales the drawing, so the
+            travel less this margin is what the drawing may measure.
+    """
+
+    placement: str = "drawing"
+    translate: Point = (0.0, 0.0)
+    margin_mm: Point = (0.0, 0.0)
+
+
+def check_travel(
+    program: Program, machine: Machine, placing: Placing | None = None
+) -> tuple[str, ...]:
+    """Refuse a program ``machine`` cannot run; warn where its work zero needs care.
+
+    Work coordinates (``machine.coordinates == "work"``): the toolpath
+    (:func:`toolpath_extent`) must be no larger than the travel; where it lies is the
+    operator's choice of work zero. A warning when it lies on both sides of the work
+    zero on an axis (the tool goes below X0 or Y0: zero must be set that far inside
+    the travel) unless ``--origin``/``--translate`` placed it there or the code came
+    from elsewhere (``placing`` None), or when the work zero and the far side of the
+    toolpath are further apart than the travel (a zero set by touching the work cannot
+    be used).
+
+    Machine coordinates: every position must lie inside ``work_area_mm``.
+
+    Args:
+        program: the program, mm.
+        machine: the machine profile.
+        placing: how the program was placed (``None``: not planned here, a program
+            read from code); the remedy names options that work as written.
+
+    Returns:
+        Warnings for the user (empty when nothing needs care).
+
+    Raises:
+        DialectError: the toolpath is larger than the travel, or (machine
+            coordinates) reaches outside the work area; the message gives both sizes
+            and a remedy.
+    """
+    box = toolpath_extent(program)
+    if box is None:
+        return ()
+    too_large(box, machine, placing)
+    if machine.coordinates == "machine":
+        if machine.outside_work_area(box, EPS_MM):
+            raise DialectError(
+                f"the toolpath spans {_span(box)} mm, {outside_text(machine)}; "
+                f"{place_remedy(box, machine, placing)}"
+            )
+        return ()
+    # work zero as drawn is worth a word; one the user placed (--origin, --translate) or
+    # one another program chose (code read back, placing None) is what was asked for
+    chosen = placing is None or placing.placement != "drawing" or placing.translate != (0.0, 0.0)
+    return _zero_warnings(box, machine, chosen=chosen)
+
+
+def too_large(box: BBox, machine: Machine, placing: Placing | None) -> None:
+    """Refuse a toolpath extent ``box`` larger than the travel of ``machine``.
+
+    Raises:
+        DialectError: naming both sizes, ``--fit W H`` that makes it fit (when the
+            program was planned here) and a larger machine.
+    """
+    w, h = box[2] - box[0], box[3] - box[1]
+    tw, th = machine.travel_mm
+    if w <= tw + EPS_MM and h <= th + EPS_MM:
+        return
+    fit = _fit_remedy(machine, placing, w, h)
+    raise DialectError(
+        f"the toolpath is {_mm(w)} × {_mm(h)} mm, larger than the {_mm(tw)} × {_mm(th)} mm "
+        f"travel of {machine.name}; {fit}use a larger machine (--machine FILE.toml "
+        "with its work_area_mm)"
+    )
+
+
+def outside_text(machine: Machine) -> str:
+    """``outside the work area X a…b, Y c…d mm of NAME, which …`` for messages."""
+    x0, y0, x1, y1 = machine.work_area_mm
+    return (
+        f"outside the work area X {_mm(x0)}…{_mm(x1)}, Y {_mm(y0)}…{_mm(y1)} mm of "
+        f"{machine.name}, which runs programs in machine coordinates (from its home)"
+    )
+
+
+def place_remedy(box: BBox, machine: Machine, placing: Placing | None) -> str:
+    """How to bring a toolpath of extent ``box`` (no larger than the travel) inside the area.
+
+    ``--origin lower-left`` (with ``--translate`` to the area's corner when it is not
+    at 0, 0 or a translation was given) and ``--translate DX DY`` with the numbers (the
+    one given plus the shift), both complete option values that replace those given.
+    For code read back (``placing`` is ``None``) the shift is said as such.
+    """
+    x0, y0, _, _ = machine.work_area_mm
+    lower_left = "--origin lower-left"
+    used = placing.translate if placing is not None else (0.0, 0.0)
+    if (x0, y0) != (0.0, 0.0) or used != (0.0, 0.0):
+        lower_left += f" --translate {_num(x0)} {_num(y0)}"
+    move = _inside_shift(box, machine)
+    if placing is None:  # read from code: the options it was posted with are not known
+        text = f"post it again with {lower_left}"
+        if move is not None:
+            text += f", or with its --translate moved by {_num(move[0])} {_num(move[1])} mm"
+        return text
+    text = f"place it with {lower_left}"
+    if move is not None:
+        tx, ty = used[0] + move[0], used[1] + move[1]
+        text += f", or move it with --translate {_num(tx)} {_num(ty)}"
+    return text
+
+
+def _inside_shift(box: BBox, machine: Machine) -> Point | None:
+    """A shift that brings ``box`` inside the work area, or ``None`` if none prints exactly.
+
+    Each axis moves by the least whole µm that brings it inside (within
+    :data:`EPS_MM`), so that the printed number still does.
+    """
+    shift = []
+    for lo, hi, a0, a1 in (
+        (box[0], box[2], machine.work_area_mm[0], machine.work_area_mm[2]),
+        (box[1], box[3], machine.work_area_mm[1], machine.work_area_mm[3]),
+    ):
+        if lo < a0:
+            d = math.ceil((a0 - lo - EPS_MM / 2) * 1000.0) / 1000.0
+        elif hi > a1:
+            d = -math.ceil((hi - a1 - EPS_MM / 2) * 1000.0) / 1000.0
+        else:
+            d = 0.0
+        if lo + d < a0 - EPS_MM or hi + d > a1 + EPS_MM:
+            return None
+        shift.append(d)
+    return (shift[0], shift[1])
+
+
+def _fit_remedy(machine: Machine, placing: Placing | None, w: float, h: float) -> str:
+    """``scale it with --fit W H …, or `` when a planned drawing can be scaled to fit."""
+    if placing is None:
+        return ""
+    tw, th = machine.travel_mm
+    mx, my = placing.margin_mm
+    fw, fh = (math.floor((t - m) * 100.0 - 1.0) / 100.0 for t, m in ((tw, mx), (th, my)))
+    if fw <= 0 or fh <= 0:
+        return ""
+    text = f"scale it with --fit {_num(fw)} {_num(fh)}"
+    if machine.coordinates == "machine":
+        x0, y0, _, _ = machine.work_area_mm
+        text += f" --origin lower-left --translate {_num(x0)} {_num(y0)}"
+    elif placing.placement == "drawing":  # --fit keeps the lower-left corner where it was
+        text += " --origin lower-left"
+    return text + " or "
+
+
+def _zero_warnings(box: BBox, machine: Machine, *, chosen: bool) -> tuple[str, ...]:
+    """The work-coordinate warnings of :func:`check_travel` (one message).
+
+    ``chosen``: the user placed work zero (``--origin center``, ``--translate``), so a
+    toolpath on both sides of it is what was asked for: no warning for that.
+    """
+    across = [
+        (axis, lo, hi)
+        for axis, lo, hi in (("X", box[0], box[2]), ("Y", box[1], box[3]))
+        if lo < -EPS_MM and hi > EPS_MM
+    ]
+    far = [
+        (axis, lo, hi, t)
+        for (axis, lo, hi), t in zip(
+            (("X", box[0], box[2]), ("Y", box[1], box[3])), machine.travel_mm, strict=True
+        )
+        if max(hi, 0.0) - min(lo, 0.0) > t + EPS_MM
+    ]
+    tw, th = machine.travel_mm
+    if far:
+        axis, lo, hi, t = far[0]
+        return (
+            f"the toolpath spans {axis} {_mm(lo)}…{_mm(hi)} mm, so work zero (X0 Y0) lies "
+            f"{_mm(max(hi, 0.0) - min(lo, 0.0))} mm from its far side, more than the "
+            f"{_mm(t)} mm {axis} travel of {machine.name}: work zero cannot be a point the "
+            "tool reaches; use --origin lower-left or set it with an offset",
+        )
+    if across and not chosen:
+        spans = ", ".join(f"{axis} {_mm(lo)}…{_mm(hi)}" for axis, lo, hi in across)
+        return (
+            f"the toolpath spans {spans} mm, on both sides of work zero (X0 Y0): set work "
+            f"zero so that this fits the {_mm(tw)} × {_mm(th)} mm travel of {machine.name}, "
+            "or use --origin lower-left",
+        )
+    return ()
+
+
+def _span(box: BBox) -> str:
+    return f"X {_mm(box[0])}…{_mm(box[2])}, Y {_mm(box[1])}…{_mm(box[3])}"
+
+
+def _mm(value: float, decimals: int = 3) -> str:
+    """A length for messages: at most ``decimals`` decimals, no trailing zeros, never ``-0``."""
+    text = fmt_num(value, decimals)
+    return text.rstrip("0").rstrip(".") if "." in text else text
+
+
+def _num(value: float) -> str:
+    """An option value for a remedy: within 1 nm of ``value`` (6 decimals, no ``-0``)."""
+    return _mm(value, 6)

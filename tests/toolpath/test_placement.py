@@ -1,0 +1,268 @@
+"""Placement (--origin, --translate) and the work-area rule, run as a user runs camtool.
+
+The expected numbers are hand-checked: a 100 × 60 mm plate drawn from the origin, cut
+outside with a 3 mm tool, has a tool-centre path 1.5 mm outside every edge: X −1.5…101.5,
+Y −1.5…61.5 (103 × 63 mm).
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import ezdxf
+import pytest
+
+from camtool.cli import main
+from camtool.program import ArcMove, Dwell, Linear, Program, Rapid, Spindle
+from camtool.toolpath.placement import placement_shift, shift_program, toolpath_extent
+
+OUTSIDE = ["--offset", "outside", "--tool-diameter", "3"]
+
+
+def plate(path: Path, x0: float = 0.0, y0: float = 0.0) -> Path:
+    """A 100 × 60 mm rectangle from (x0, y0), a DXF in mm ($INSUNITS = 4)."""
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4
+    corners = [(x0, y0), (x0 + 100, y0), (x0 + 100, y0 + 60), (x0, y0 + 60)]
+    doc.modelspace().add_lwpolyline(corners, close=True)
+    doc.saveas(path)
+    return path
+
+
+def post(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str]:
+    code = main(["post", *args])
+    return code, capsys.readouterr().err
+
+
+def cut_extent(gcode: str) -> tuple[float, float, float, float]:
+    """Extent of the X/Y words of the cutting blocks (G1/G2/G3) of GRBL code."""
+    xs, ys = [], []
+    for line in gcode.splitlines():
+        if re.match(r"G[123]\b", line):
+            xs += [float(v) for v in re.findall(r"X(-?[\d.]+)", line)]
+            ys += [float(v) for v in re.findall(r"Y(-?[\d.]+)", line)]
+    return (min(xs), min(ys), max(xs), max(ys))
+
+
+@pytest.mark.parametrize(
+    ("options", "extent"),
+    [
+        ([], (-1.5, -1.5, 101.5, 61.5)),
+        (["--origin", "lower-left"], (0.0, 0.0, 103.0, 63.0)),
+        (["--origin", "center"], (-51.5, -31.5, 51.5, 31.5)),
+        (["--translate", "10", "5"], (8.5, 3.5, 111.5, 66.5)),
+        (["--origin", "lower-left", "--translate", "10", "5"], (10.0, 5.0, 113.0, 68.0)),
+    ],
+)
+def test_plate_at_the_origin_posts_for_grbl_where_asked(
+    options: list[str],
+    extent: tuple[float, float, float, float],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    out = tmp_path / "p.gcode"
+    code, err = post(
+        [str(plate(tmp_path / "p.dxf")), "-t", "grbl", *OUTSIDE, *options, "-o", str(out)], capsys
+    )
+    assert code == 0, err
+    assert cut_extent(out.read_text()) == pytest.approx(extent, abs=1e-9)
+
+
+def test_a_toolpath_across_work_zero_is_warned_about_once(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    dxf = str(plate(tmp_path / "p.dxf"))
+    # post warns, and --verify (which applies the same rule to the code) does not repeat it.
+    argv = [dxf, "-t", "grbl", *OUTSIDE, "-o", str(tmp_path / "a.gcode"), "--verify"]
+    code, err = post(argv, capsys)
+    assert code == 0
+    warning = "the toolpath spans X -1.5…101.5, Y -1.5…61.5 mm, on both sides of work zero"
+    assert err.count(warning) == 1
+    assert "use --origin lower-left" in err
+    options = ["--origin", "lower-left", "-o", str(tmp_path / "b.gcode")]
+    code, err = post([dxf, "-t", "grbl", *OUTSIDE, *options], capsys)
+    assert code == 0
+    assert "work zero" not in err
+
+
+def test_the_start_position_and_the_lift_there_stay(tmp_path: Path) -> None:
+    out = tmp_path / "p.gcode"
+    args = [str(plate(tmp_path / "p.dxf")), "-t", "grbl", *OUTSIDE, "--depth", "1"]
+    assert main(["post", *args, "--origin", "center", "-o", str(out)]) == 0
+    moves = [line for line in out.read_text().splitlines() if line.startswith("G")]
+    # The lift at the start position is not dragged sideways (a Z-only rise to clearance);
+    # travel follows at that height.
+    assert moves[1] == "G0 Z5.000"
+    assert moves[2] == "G0 X-51.500 Y-30.000"
+
+
+def remedies(message: str) -> list[list[str]]:
+    """Each option set a message suggests ("--origin lower-left --translate 0 0", …)."""
+    value = r" (?:-?[\d.]+|lower-left|center|drawing)"
+    found = re.findall(rf"((?:--(?:origin|translate|fit)(?:{value})+ ?)+)", message)
+    return [f.split() for f in found]
+
+
+def replaced(argv: list[str], remedy: list[str]) -> list[str]:
+    """``argv`` with the options of ``remedy`` instead of the same options it has."""
+    widths = {"--origin": 1, "--translate": 2, "--fit": 2}
+    given = {flag for flag in remedy if flag in widths}
+    out, i = [], 0
+    while i < len(argv):
+        if argv[i] in given:
+            i += 1 + widths[argv[i]]
+            continue
+        out.append(argv[i])
+        i += 1
+    return out + remedy
+
+
+@pytest.mark.parametrize(
+    "placing",
+    [[], ["--origin", "center", "--translate", "5", "5"], ["--translate", "-20", "300"]],
+)
+def test_machine_coordinates_refuse_with_remedies_that_work(
+    placing: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # The seed-002 router counts from its home: X 0…200, Y 0…200 mm.
+    argv = [str(plate(tmp_path / "p.dxf")), "-t", "matlab-router", *OUTSIDE, *placing]
+    code, err = post([*argv, "-o", str(tmp_path / "refused.m")], capsys)
+    assert code == 1
+    assert "outside the work area X 0…200, Y 0…200 mm of Router (seed-002, 2011)" in err
+    assert "machine coordinates" in err
+    suggested = remedies(err)
+    assert len(suggested) == 2, err
+    assert suggested[0][:2] == ["--origin", "lower-left"]
+    for n, remedy in enumerate(suggested):
+        code, again = post([*replaced(argv, remedy), "-o", str(tmp_path / f"{n}.m")], capsys)
+        assert code == 0, (remedy, again)
+
+
+def test_the_suggested_translation_is_the_one_hand_computed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = [str(plate(tmp_path / "p.dxf")), "-t", "matlab-router", *OUTSIDE, "-o", "-"]
+    code, err = post(argv, capsys)
+    assert code == 1
+    assert "place it with --origin lower-left, or move it with --translate 1.5 1.5" in err
+
+
+@pytest.mark.parametrize(
+    ("target", "area", "size"),
+    [
+        ("grbl", "[0.0, 0.0, 100.0, 50.0]", "100 × 50"),
+        ("matlab-router", "[0, 0, 80, 40]", "80 × 40"),
+    ],
+)
+def test_a_toolpath_larger_than_the_travel_names_both_sizes_and_a_fit_that_works(
+    target: str, area: str, size: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    machine = tmp_path / "small.toml"
+    machine.write_text(f"[machine]\nwork_area_mm = {area}\n")
+    argv = [str(plate(tmp_path / "p.dxf")), "-t", target, *OUTSIDE, "--machine", str(machine)]
+    code, err = post([*argv, "-o", str(tmp_path / "refused")], capsys)
+    assert code == 1
+    assert f"the toolpath is 103 × 63 mm, larger than the {size} mm travel of" in err
+    assert "use a larger machine (--machine FILE.toml" in err
+    (remedy,) = remedies(err)
+    assert remedy[0] == "--fit"
+    code, again = post([*replaced(argv, remedy), "-o", str(tmp_path / "fits")], capsys)
+    assert code == 0, again
+    assert "work zero" not in again
+
+
+def test_verify_runs_negative_work_coordinates(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "p.gcode"
+    assert (
+        main(["post", str(plate(tmp_path / "p.dxf")), "-t", "grbl", *OUTSIDE, "-o", str(out)]) == 0
+    )
+    capsys.readouterr()
+    assert main(["verify", str(out), "-t", "grbl"]) == 0
+    # code read back does not say how its work zero was chosen: nothing to second-guess
+    assert "work zero" not in capsys.readouterr().err
+
+
+def test_verify_refuses_machine_coordinates_outside_with_the_post_remedy(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Posted for a 400 × 400 mm router at X 148.5…251.5, Y 148.5…211.5: outside 200 × 200.
+    wide = tmp_path / "wide.toml"
+    wide.write_text("[machine]\nwork_area_mm = [0, 0, 400, 400]\n")
+    code = tmp_path / "p.m"
+    argv = ["post", str(plate(tmp_path / "p.dxf")), "-t", "matlab-router", *OUTSIDE]
+    assert main([*argv, "--translate", "150", "150", "-o", str(code), "--machine", str(wide)]) == 0
+    capsys.readouterr()
+    assert main(["verify", str(code), "-t", "matlab-router"]) == 1
+    err = capsys.readouterr().err
+    assert "outside the work area X 0…200, Y 0…200 mm" in err
+    assert "post it again with --origin lower-left, or with its --translate moved by " in err
+    dx, dy = (float(v) for v in re.findall(r"moved by (\S+) (\S+) mm", err)[0])
+    assert (dx, dy) == (-51.5, -11.5)
+    for remedy in (["--origin", "lower-left"], ["--translate", str(150 + dx), str(150 + dy)]):
+        assert main([*argv, *remedy, "-o", str(code)]) == 0
+        assert main(["verify", str(code), "-t", "matlab-router"]) == 0
+
+
+def test_every_target_posts_a_part_drawn_around_the_origin_or_names_a_remedy_that_works(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from camtool.post.registry import target_names
+
+    dxf = str(plate(tmp_path / "p.dxf", -50, -30))
+    for target in target_names():
+        argv = [dxf, "-t", target, *OUTSIDE, "-o", str(tmp_path / f"{target}.out")]
+        code, err = post(argv, capsys)
+        if code == 0:
+            continue
+        suggested = remedies(err)
+        assert code == 1 and suggested, (target, err)
+        code, again = post(replaced(argv, suggested[0]), capsys)
+        assert code == 0, (target, suggested[0], again)
+
+
+# -- the stage itself ------------------------------------------------------------------
+
+
+def test_extent_leaves_out_the_travel_from_the_start_position() -> None:
+    program = Program(
+        (Rapid(0, 0, z=5), Rapid(10, 10), Linear(10, 10, 100, z=-1), Linear(20, 10, 100)),
+        origin=(0.0, 0.0),
+    )
+    assert toolpath_extent(program) == (10, 10, 20, 10)
+
+
+def test_extent_counts_arcs_by_their_extremes() -> None:
+    program = Program((Rapid(1, 0), ArcMove(1, 0, 0, 0, False, 100)))
+    assert toolpath_extent(program) == pytest.approx((-1, -1, 1, 1))
+
+
+def test_shift_moves_ends_and_centres_but_not_the_start() -> None:
+    program = Program((Rapid(0, 0, z=5), Rapid(1, 0), ArcMove(1, 0, 0, 0, False, 100, z=None)))
+    assert placement_shift(program, "lower-left", (0.0, 0.0)) == (1.0, 1.0)
+    moved = shift_program(program, 1.0, 1.0)
+    assert moved.moves == (Rapid(0, 0, z=5), Rapid(2, 1), ArcMove(2, 1, 1, 1, False, 100))
+    assert moved.origin == (0.0, 0.0)
+
+
+def test_a_cut_from_the_start_position_is_reached_by_a_rapid_after_the_shift() -> None:
+    program = Program(
+        (Linear(5, 0, 100), Linear(5, 5, 100)),
+        commands=((0, Spindle("cw", 1000)), (1, Dwell(1.0))),
+    )
+    moved = shift_program(program, 2.0, 3.0)
+    assert moved.moves == (Rapid(2, 3), Linear(7, 3, 100), Linear(7, 8, 100))
+    # The spindle still starts first; the dwell stays before the second cut.
+    assert moved.commands == ((0, Spindle("cw", 1000)), (2, Dwell(1.0)))
+
+
+def test_a_chosen_work_zero_inside_the_part_is_not_warned_about(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    args = [str(plate(tmp_path / "p.dxf")), "-t", "grbl", *OUTSIDE, "-o", str(tmp_path / "o")]
+    assert main(["post", *args]) == 0
+    assert "on both sides of work zero" in capsys.readouterr().err  # as drawn: worth a word
+    assert main(["post", *args, "--origin", "center"]) == 0
+    assert "on both sides of work zero" not in capsys.readouterr().err  # asked for
