@@ -34,6 +34,14 @@ class Unsupported(Exception):
         self.detail = detail
 
 
+class BadEntity(ValueError):
+    """An entity holds a number camtool refuses; the message names the entity and value.
+
+    Raised by :func:`camtool.importers.dxf_entities.check_numbers`; the DXF importer
+    turns it into an :class:`~camtool.errors.InputError` naming the file.
+    """
+
+
 def ellipse_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool]:
     """An ELLIPSE as lines and arcs within ``tolerance``, and whether it is closed.
 
@@ -54,6 +62,8 @@ def ellipse_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool
     Raises:
         Unsupported: the ellipse is not parallel to XY, or has zero size.
     """
+    if not math.hypot(*entity.dxf.major_axis) > 0.0:
+        raise Unsupported("zero size")  # ezdxf's construction tool refuses a null axis
     ce = entity.construction_tool()
     ex, ey, ez = ce.extrusion
     if abs(ex) > 1e-9 or abs(ey) > 1e-9 or abs(ce.major_axis[2]) > 1e-9 * ce.major_axis.magnitude:
