@@ -396,3 +396,26 @@ def test_a_deep_block_chain_does_not_recurse(tmp_path: Path) -> None:
 def test_max_entities_must_be_positive() -> None:
     with pytest.raises(UsageError, match="--max-entities"):
         ImportOptions(max_entities=0)
+
+
+# ---------------------------------------------------------------------------- the CLI option
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["post", "-t", "grbl", "-o", "{out}/o.nc"],
+        ["inspect"],
+        ["preview", "-o", "{out}/p.svg"],
+        ["batch", "-t", "grbl", "-o", "{out}/b", "-j", "1"],
+    ],
+)
+def test_max_entities_on_every_command_that_reads_drawings(
+    tmp_path: Path, command: list[str], capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = write_dxf(tmp_path / "small.dxf", _laugh(4, 2))  # 47 entities placed
+    args = [a.format(out=tmp_path) for a in command]
+    args.insert(1, str(path))
+    assert main([*args, "--max-entities", "46"]) == 3
+    assert "more than 46 entities" in capsys.readouterr().err
+    assert main([*args, "--max-entities", "47", *(["--force"] if "batch" in args else [])]) == 0
