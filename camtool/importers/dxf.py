@@ -17,16 +17,21 @@ saying what was repaired. Model space only: paper space is ignored.
 
 from __future__ import annotations
 
+import gc
 import logging
+import math
 from collections import Counter
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from camtool.errors import InputError, UsageError
-from camtool.geometry import Contour, Drawing, Point
+from camtool.geometry import Contour, Drawing, Line, Point
 from camtool.importers import MAX_COORDINATE_MM
 from camtool.importers.dxf_curves import BadEntity
+from camtool.importers.dxf_entities import ZERO_LENGTH
 from camtool.units import INCH
 
 if TYPE_CHECKING:
@@ -150,6 +155,11 @@ def import_dxf(path: str | Path, options: ImportOptions | None = None) -> DxfImp
     options = options or ImportOptions()
     if not options.tolerance > 0:
         raise UsageError(f"the tolerance must be > 0 mm, got {options.tolerance!r}")
+    with _gc_paused():
+        return _import(path, options)
+
+
+def _import(path: Path, options: ImportOptions) -> DxfImport:
     doc, damage, repairs = _open(path)
     recovered = damage is not None
     warnings = [] if damage is None else [_damaged(path, damage, repairs)]
@@ -203,10 +213,29 @@ def _check_size(path: Path, msp: Any, max_entities: int) -> Any:
 
     if len(msp) > max_entities:
         raise too_many_entities(str(path), max_entities)
-    graph = block_graph(msp, max_entities)
-    if expanded_count(msp, graph, max_entities) > max_entities:
+    inserts = [e for e in msp if e.dxftype() == "INSERT"]
+    graph = block_graph(inserts, max_entities)
+    if expanded_count(inserts, len(msp) - len(inserts), graph, max_entities) > max_entities:
         raise too_many_entities(str(path), max_entities)
     return graph
+
+
+@contextmanager
+def _gc_paused() -> Iterator[None]:
+    """Pause Python's cyclic garbage collector while a drawing is read.
+
+    Reading allocates a few objects per entity (ezdxf's and camtool's) and frees almost
+    none, which makes the collector rescan the whole growing heap again and again:
+    for 10⁵ LINEs it took 1.1 of 4.5 s of CPU. Reference counting still frees
+    everything acyclic; the collector is re-enabled (if it was) on the way out.
+    """
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()
 
 
 class _Reader:
@@ -229,10 +258,14 @@ class _Reader:
         from camtool.importers.dxf_entities import Item
 
         kind = entity.dxftype()
-        layer = entity.dxf.get("layer", "0")
+        dxf = entity.dxf
+        layer = dxf.get("layer", "0")
         self.counts[(kind, layer)] += 1
+        if kind == "LINE" and not dxf.hasattr("extrusion"):
+            self._line(entity, layer)
+            return
         if kind != "INSERT":
-            self._item(Item(entity, f"{kind} #{entity.dxf.handle}", layer))
+            self._item(Item(entity, f"{kind} #{dxf.handle}", layer))
             return
         for placed in expand_insert(entity, layer, self.limit, self.cyclic):
             if isinstance(placed, Skip):
@@ -244,6 +277,35 @@ class _Reader:
             else:
                 self.block_counts[(placed.entity.dxftype(), placed.layer)] += 1
                 self._item(placed)
+
+    def _line(self, entity: Any, layer: str) -> None:
+        """A model-space LINE, read as ``_item`` would read it, without its machinery.
+
+        LINEs are the bulk of large drawings; this skips the Item, the generic number
+        check and the converter (10⁵ LINEs: 2.3 s of CPU before, 0.6 s after).
+        """
+        if not self.keep(layer):
+            return
+        dxf = entity.dxf
+        s, e = dxf.start, dxf.end
+        limit = self.limit
+        if not (
+            abs(s.x) <= limit
+            and abs(s.y) <= limit
+            and abs(s.z) <= limit
+            and abs(e.x) <= limit
+            and abs(e.y) <= limit
+            and abs(e.z) <= limit
+        ):
+            from camtool.importers.dxf_entities import check_numbers
+
+            check_numbers(entity, f"LINE #{dxf.handle}", layer, limit)  # raises
+        start, end = (s.x, s.y), (e.x, e.y)
+        label = f"LINE #{dxf.handle}"
+        if math.hypot(end[0] - start[0], end[1] - start[1]) <= ZERO_LENGTH:
+            self._skip("LINE", "zero length", label, layer, start)
+            return
+        self.contours.append(Contour((Line(start, end),), False, layer, label))
 
     def _item(self, item: Any) -> None:
         from camtool.importers.dxf_curves import Unsupported

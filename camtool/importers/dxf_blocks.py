@@ -226,7 +226,7 @@ class BlockGraph:
     sizes: dict[str, int]
 
 
-def block_graph(entities: Iterable[Any], limit: int) -> BlockGraph:
+def block_graph(inserts: Iterable[Any], limit: int) -> BlockGraph:
     """Analyse the blocks model space references, without expanding any of them.
 
     Each block is visited once (a "billion laughs" of blocks, a block placing the
@@ -234,12 +234,12 @@ def block_graph(entities: Iterable[Any], limit: int) -> BlockGraph:
     chain of thousands of nested blocks is fine).
 
     Args:
-        entities: the model-space entities.
+        inserts: the model-space INSERTs.
         limit: the entity count above which the caller refuses the drawing.
     """
     children: dict[str, list[Any]] = {}  # block name -> its INSERT entities
     contents: dict[str, int] = {}  # block name -> its other entities (ATTDEFs left out)
-    todo = [e for e in entities if e.dxftype() == "INSERT"]
+    todo = list(inserts)
     while todo:
         insert = todo.pop()
         name = insert.dxf.name
@@ -273,15 +273,19 @@ def insert_size(insert: Any, sizes: dict[str, int], cyclic: Iterable[str], cap: 
     return min(cap, own + min(cap, rows * cols) * sizes[name])
 
 
-def expanded_count(entities: Iterable[Any], graph: BlockGraph, limit: int) -> int:
-    """How many entities model space expands to (at most ``limit + 1``)."""
+def expanded_count(inserts: Iterable[Any], others: int, graph: BlockGraph, limit: int) -> int:
+    """How many entities model space expands to (at most ``limit + 1``).
+
+    Args:
+        inserts: the model-space INSERTs.
+        others: how many other entities model space holds.
+        graph: the block analysis of :func:`block_graph`.
+        limit: the entity count above which the caller refuses the drawing.
+    """
     cap = limit + 1
-    total = 0
-    for entity in entities:
-        if entity.dxftype() == "INSERT":
-            total = min(cap, total + insert_size(entity, graph.sizes, graph.cyclic, cap))
-        else:
-            total = min(cap, total + 1)
+    total = min(cap, others)
+    for insert in inserts:
+        total = min(cap, total + insert_size(insert, graph.sizes, graph.cyclic, cap))
     return total
 
 
