@@ -31,7 +31,7 @@ from camtool.errors import InputError, UsageError
 from camtool.geometry import Contour, Drawing, Line, Point
 from camtool.importers import MAX_COORDINATE_MM
 from camtool.importers.dxf_curves import BadEntity
-from camtool.importers.dxf_entities import ZERO_LENGTH
+from camtool.importers.dxf_entities import ZERO_LENGTH, layer_of
 from camtool.units import INCH
 
 if TYPE_CHECKING:
@@ -259,7 +259,7 @@ class _Reader:
 
         kind = entity.dxftype()
         dxf = entity.dxf
-        layer = dxf.get("layer", "0")
+        layer = layer_of(entity)
         self.counts[(kind, layer)] += 1
         if kind == "LINE" and not dxf.hasattr("extrusion"):
             self._line(entity, layer)
@@ -359,7 +359,15 @@ def _kind(entity: Any) -> str:
     return kind
 
 
-_PARSER_ERRORS = (UnicodeDecodeError, ValueError, StopIteration, EOFError, IndexError, KeyError)
+_PARSER_ERRORS = (
+    UnicodeDecodeError,
+    ValueError,
+    ArithmeticError,  # int(float("inf")) of an integer group code: OverflowError
+    StopIteration,
+    EOFError,
+    IndexError,
+    KeyError,
+)
 """What ezdxf's reader raises on damaged files besides DXFError (a DXF cut short in its
 HEADER ends ezdxf's ``dxf_info`` scan with a bare StopIteration)."""
 
@@ -505,9 +513,7 @@ def _layer_filter(path: Path, doc: Any, layers: tuple[str, ...] | None) -> Any:
     """A predicate on effective layer names; unknown names are an error listing the layers."""
     if layers is None:
         return lambda layer: True
-    present = {layer.dxf.name for layer in doc.layers} | {
-        e.dxf.get("layer", "0") for e in doc.modelspace()
-    }
+    present = {layer.dxf.name for layer in doc.layers} | {layer_of(e) for e in doc.modelspace()}
     by_key = {name.casefold(): name for name in present}
     unknown = [name for name in layers if name.casefold() not in by_key]
     if unknown:

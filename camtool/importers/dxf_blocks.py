@@ -23,7 +23,7 @@ from typing import Any
 
 from camtool.geometry import Point
 from camtool.importers.dxf_curves import Unsupported
-from camtool.importers.dxf_entities import CONVERTED, Item, check_numbers, location
+from camtool.importers.dxf_entities import CONVERTED, Item, check_numbers, layer_of, location
 
 MAX_NESTING = 32
 """Deepest block nesting followed; deeper is refused (a block that contains itself, too)."""
@@ -119,7 +119,7 @@ def _place(
     kind = entity.dxftype()
     if kind == "ATTDEF":
         return
-    own = entity.dxf.get("layer", "0")
+    own = layer_of(entity)
     eff = layer if own == "0" else own
     if kind == "INSERT":
         yield from _expand(entity, eff, matrix, chain, names, limits)

@@ -218,6 +218,17 @@ def convert(item: Item, tolerance: float, limit: float = math.inf) -> list[Conto
     return [Contour(tuple(segs), closed, item.layer, item.label)]
 
 
+def layer_of(entity: Any) -> str:
+    """The entity's own layer name; ``"0"`` when it has none.
+
+    An entity may leave out group code 8 (R12 files do), and an entity of a type ezdxf
+    does not know has no ``layer`` attribute at all (asking raises DXFAttributeError).
+    """
+    if not entity.dxf.is_supported("layer"):
+        return "0"
+    return str(entity.dxf.get("layer", "0"))
+
+
 def location(entity: Any) -> Point | None:
     """A representative WCS point of an entity (start, centre or first vertex), or None."""
     for name in ("start", "center", "insert", "location"):

@@ -419,3 +419,27 @@ def test_max_entities_on_every_command_that_reads_drawings(
     assert main([*args, "--max-entities", "46"]) == 3
     assert "more than 46 entities" in capsys.readouterr().err
     assert main([*args, "--max-entities", "47", *(["--force"] if "batch" in args else [])]) == 0
+
+
+# ---------------------------------------------------------------------------- found by fuzzing
+
+
+def test_an_infinite_integer_group_code_is_an_input_error(tmp_path: Path) -> None:
+    # was: an internal OverflowError (int(float("inf"))) from ezdxf's tag compiler
+    path = _text_dxf(tmp_path / "a.dxf", header=_insunits(4))
+    path.write_text(path.read_text().replace("  8\n0\n", "  8\n0\n 62\ninf\n"))
+    with pytest.raises(InputError, match="not a readable DXF file") as info:
+        read_dxf(path)
+    assert "\n" not in str(info.value)
+
+
+def test_an_entity_of_an_unknown_type_without_a_layer_is_skipped(tmp_path: Path) -> None:
+    # was: an internal DXFAttributeError ("layer" is no attribute of an unknown entity)
+    path = _text_dxf(tmp_path / "a.dxf", header=_insunits(4))
+    widget = "  0\nWIDGET\n  5\n1F\n 10\n1.0\n 20\n1.0\n"
+    path.write_text(path.read_text().replace("  0\nLINE\n", widget + "  0\nLINE\n"))
+    read = import_dxf(path)
+    assert not read.recovered
+    assert len(read.drawing.contours) == 1
+    assert ("WIDGET", "0", 1) in read.entity_counts
+    assert any("skipped 1 WIDGET entity" in w for w in read.drawing.warnings)
