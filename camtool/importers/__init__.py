@@ -19,6 +19,31 @@ No machine camtool drives has a travel near it; numbers past it come from damage
 hostile files, and would make curve fitting and code formatting misbehave."""
 
 
+MAX_CURVE_RATIO = 1e8
+"""Largest ratio of a fitted curve's size to the fitting tolerance (100 m at 1 µm; a
+1 m part at 1 µm is 10⁶). Fitting cost grows with it (an ellipse 10⁷ mm across at
+0.001 mm takes 6 400 arcs and seconds); a curve beyond it is refused before fitting."""
+
+
+def check_curve_size(extent: float, tolerance: float) -> None:
+    """Refuse a curve too large to fit within ``tolerance`` at a bounded cost.
+
+    Args:
+        extent: the size of the curve (of its control polygon), same unit as ``tolerance``.
+        tolerance: the fitting tolerance, > 0.
+
+    Raises:
+        ValueError: ``extent / tolerance`` is above :data:`MAX_CURVE_RATIO` (or not finite);
+            the caller names the entity.
+    """
+    if not extent <= MAX_CURVE_RATIO * tolerance:
+        raise ValueError(
+            f"a curve {extent:g} across, more than {MAX_CURVE_RATIO:g} times the fitting "
+            f"tolerance {tolerance:g}, would need too many arcs; scale the drawing or "
+            "raise --tolerance"
+        )
+
+
 def too_many_entities(name: str, limit: int) -> InputError:
     """The error for a drawing that expands to more than ``limit`` entities."""
     return InputError(

@@ -323,6 +323,10 @@ class _Reader:
             check_numbers(part, item.label, item.layer, self.limit)
         try:
             contours = convert(item, self.tolerance, self.limit)
+        except BadEntity as exc:  # the converters do not know the entity's name
+            if str(exc).startswith(item.label):
+                raise
+            raise BadEntity(f"{item.label} on layer {item.layer!r}: {exc}") from None
         except Unsupported as exc:
             detail = exc.reason + (f": {exc.detail}" if exc.detail else "")
             self._skip(kind, exc.reason, item.label, item.layer, self._where(item), detail)

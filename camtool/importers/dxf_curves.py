@@ -72,6 +72,7 @@ def ellipse_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool
     a, b = math.hypot(mx, my), math.hypot(nx, ny)
     if a <= 0.0 or b <= 0.0:
         raise Unsupported("zero size")
+    _check_size(2.0 * max(a, b), tolerance)
     t0 = float(ce.start_param)
     t1 = float(ce.end_param)
     if t1 <= t0:
@@ -133,6 +134,8 @@ def spline_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool]
     if not t1 > t0:
         raise Unsupported("invalid spline data", "empty parameter range")
     breaks = [t0, *_corner_knots(knots, p, t0, t1), t1]
+    xs, ys = [q[0] for q in pts], [q[1] for q in pts]
+    _check_size(max(max(xs) - min(xs), max(ys) - min(ys)), tolerance)
 
     def point_at(t: float) -> Point:
         return _xy(spline.point(t))
@@ -142,6 +145,15 @@ def spline_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool]
     return _fit(point_at, lambda t: _xy(spline.derivative(t, 1)[1]), breaks, tolerance, closed), (
         closed
     )
+
+
+def _check_size(extent: float, tolerance: float) -> None:
+    from camtool.importers import check_curve_size
+
+    try:
+        check_curve_size(extent, tolerance)
+    except ValueError as exc:
+        raise BadEntity(f"{exc} (drawing units)") from None
 
 
 def _construction(entity: Any) -> Any:

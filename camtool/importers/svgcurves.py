@@ -24,7 +24,7 @@ import svgelements as se
 
 from camtool.errors import InputError
 from camtool.geometry import TAU, Arc, Line, Point, Segment, distance
-from camtool.importers import MAX_COORDINATE_MM
+from camtool.importers import MAX_COORDINATE_MM, check_curve_size
 from camtool.toolpath.arcfit import fit_curve
 
 Affine: TypeAlias = tuple[float, float, float, float, float, float]
@@ -142,9 +142,11 @@ def segment(seg: Any, p0: Point, m: Affine, tolerance: float) -> list[Segment]:
         return _line(p0, _pt(m, seg.end))
     if isinstance(seg, se.CubicBezier):
         ctrl = (p0, _pt(m, seg.control1), _pt(m, seg.control2), _pt(m, seg.end))
+        _check_size(ctrl, tolerance)
         return _fit(*_cubic(ctrl), tolerance)
     if isinstance(seg, se.QuadraticBezier):
         ctrl3 = (p0, _pt(m, seg.control), _pt(m, seg.end))
+        _check_size(ctrl3, tolerance)
         return _fit(*_quadratic(ctrl3), tolerance)
     if isinstance(seg, se.Arc):
         return _arc(seg, p0, m, tolerance)
@@ -154,6 +156,15 @@ def segment(seg: Any, p0: Point, m: Affine, tolerance: float) -> list[Segment]:
 def _pt(m: Affine, p: Any) -> Point:
     """``p`` mapped to mm, checked to be finite and within the bound."""
     return _check(apply(m, float(p.x), float(p.y)), "a point")
+
+
+def _check_size(points: Iterable[Point], tolerance: float) -> None:
+    """Refuse a curve whose control points span too much for ``tolerance`` (InputError)."""
+    xs, ys = zip(*points, strict=True)
+    try:
+        check_curve_size(2.0 * max(max(xs) - min(xs), max(ys) - min(ys)), tolerance)
+    except ValueError as exc:
+        raise InputError(str(exc).replace(" across", " mm across", 1)) from None
 
 
 def _check(p: Point, what: str) -> Point:
@@ -243,6 +254,9 @@ def _arc(seg: Any, p0: Point, m: Affine, tolerance: float) -> list[Segment]:
     cross = big_a[0] * big_b[1] - big_a[1] * big_b[0]
     if _axes_gap(big_a, big_b, cross) <= 0.1 * tolerance:
         return _circular(p0, p1, centre, ccw=cross * sweep > 0.0, sweep=sweep)
+    _check(centre, "an ellipse centre")
+    _check_size([centre, (centre[0] + big_a[0], centre[1] + big_a[1]),
+                 (centre[0] + big_b[0], centre[1] + big_b[1]), p0, p1], tolerance)  # fmt: skip
     return _fit(*_ellipse(centre, big_a, big_b, t0, sweep, p0, p1), tolerance)
 
 

@@ -136,6 +136,10 @@ def _parse(path: Path) -> ET.Element:
         ) from exc
     except OSError as exc:
         raise InputError(f"{path}: cannot read the file ({exc})") from exc
+    except LookupError as exc:  # <?xml encoding="..."?> names no codec Python knows
+        raise InputError(
+            f"{path}: the XML declaration names an {exc}; save the file as UTF-8"
+        ) from exc
     if local_name(root) != "svg":
         raise InputError(f"{path}: not an SVG document (the root element is <{root.tag}>)")
     return root

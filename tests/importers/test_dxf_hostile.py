@@ -443,3 +443,15 @@ def test_an_entity_of_an_unknown_type_without_a_layer_is_skipped(tmp_path: Path)
     assert len(read.drawing.contours) == 1
     assert ("WIDGET", "0", 1) in read.entity_counts
     assert any("skipped 1 WIDGET entity" in w for w in read.drawing.warnings)
+
+
+def test_a_curve_too_large_for_the_tolerance_is_refused(tmp_path: Path) -> None:
+    # 1e9 mm across within ±1e9 mm, but 1e12 times the 0.001 mm tolerance: fitting it
+    # would take minutes; 1e8 times (100 m at 1 µm) is the bound
+    def build(msp: Any) -> None:
+        msp.add_ellipse((0, 0), (5e8, 0), ratio=0.5)
+
+    start = time.perf_counter()
+    with pytest.raises(InputError, match=r"ELLIPSE #\w+ on layer '0': a curve 1e\+09 across"):
+        read_dxf(write_dxf(tmp_path / "e.dxf", build))
+    assert time.perf_counter() - start < 5

@@ -102,3 +102,21 @@ def test_post_of_a_hostile_svg_exits_3_with_one_line(
     assert main(["post", str(path), "-t", "grbl", "-o", str(tmp_path / "o.nc")]) == 3
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("camtool: error: ")
+
+
+def test_an_unknown_xml_encoding_is_an_input_error(tmp_path: Path) -> None:
+    # was: an internal LookupError from the XML parser (found by fuzzing)
+    path = tmp_path / "enc.svg"
+    path.write_text(
+        '<?xml version="1.0" encoding="UTF1e-320"?>\n<svg xmlns="http://www.w3.org/2000/svg"/>'
+    )
+    message = _refused(path)
+    assert "unknown encoding" in message and "UTF-8" in message
+
+
+def test_an_elliptical_arc_too_large_for_the_tolerance_is_refused(tmp_path: Path) -> None:
+    # radii 8:4 scaled up to a 1e9 chord: every point is within ±1e9 mm, but fitting it
+    # within 0.001 mm took minutes (an ellipse 1e7 mm across already needs 6 400 arcs)
+    path = svg(tmp_path, '<path id="oval" d="m 48,20 a 8,4 0 0 1 -8,1e9"/>')
+    message = _refused(path)
+    assert "path#oval: a curve" in message and "raise --tolerance" in message
