@@ -80,6 +80,8 @@ class BatchOptions:
         layers: layers to keep (``None``: all).
         units: unit of unitless inputs (point lists).
         hatch_boundaries: use DXF HATCH boundaries as contours.
+        max_entities: most entities a drawing may expand to (``None``: the importers'
+            default, :data:`camtool.importers.MAX_ENTITIES`).
         verify: verify each file and write its report (``OUT/<name>.json``).
         preview: ``"png"`` or ``"svg"``: draw each file (``OUT/<name>.png``): the
             program, and when verified the simulated trace and its worst point.
@@ -108,6 +110,7 @@ class BatchOptions:
     layers: tuple[str, ...] | None = None
     units: str | None = None
     hatch_boundaries: bool = False
+    max_entities: int | None = None
     verify: bool = False
     preview: str | None = None
     max_error_um: float | None = None
@@ -135,11 +138,13 @@ class BatchOptions:
         """The importer options of every drawing."""
         from camtool.importers import ImportOptions
 
+        limit = {} if self.max_entities is None else {"max_entities": self.max_entities}
         return ImportOptions(
             layers=self.layers,
             tolerance=self.tolerance,
             units=self.units,
             hatch_boundaries=self.hatch_boundaries,
+            **limit,
         )
 
     def post_options(self) -> dict[str, Any]:

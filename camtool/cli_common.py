@@ -157,9 +157,17 @@ MACHINE = click.option(
 
 
 def import_options(command: Callable[..., None]) -> Callable[..., None]:
-    """Options of the importers: --layers, --units, --hatch-boundaries."""
+    """Options of the importers: --layers, --units, --hatch-boundaries, --max-entities."""
     from camtool.units import LENGTH_UNITS
 
+    command = click.option(
+        "--max-entities",
+        type=click.IntRange(min=1),
+        default=None,
+        metavar="N",
+        help="Refuse a drawing that expands to more than N entities (DXF blocks and "
+        "MINSERT grids, SVG <use> clones, counted before expanding) [default: 5000000].",
+    )(command)
     command = click.option(
         "--hatch-boundaries",
         is_flag=True,
@@ -190,7 +198,13 @@ def import_settings(options: dict[str, Any]) -> ImportOptions:
         tolerance=options.get("tolerance", 0.001),
         units=options.pop("units", None),
         hatch_boundaries=options.pop("hatch_boundaries", False),
+        **_given(max_entities=options.pop("max_entities", None)),
     )
+
+
+def _given(**values: Any) -> dict[str, Any]:
+    """The keyword options that were given (not ``None``), so defaults stay in one place."""
+    return {k: v for k, v in values.items() if v is not None}
 
 
 def post_options(command: Callable[..., None]) -> Callable[..., None]:

@@ -10,15 +10,25 @@ G-code file (``.ngc .nc .gcode .tap ...``) goes through the G-code importer
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import click
 
-from camtool.cli_common import MACHINE, check_paths, number_range, read_code, warn, write_output
+from camtool.cli_common import (
+    MACHINE,
+    check_paths,
+    import_options,
+    import_settings,
+    number_range,
+    read_code,
+    warn,
+    write_output,
+)
 from camtool.errors import InputError, UsageError
 
 if TYPE_CHECKING:
     from camtool.geometry import Drawing
+    from camtool.importers import ImportOptions
     from camtool.post.base import Target
     from camtool.program import Program
     from camtool.verify.verifier import Verification
@@ -52,6 +62,7 @@ if TYPE_CHECKING:
     help="Draw the tool width along the cuts (and sweep the trace with it for --verify).",
 )
 @click.option("--title", default=None, metavar="TEXT", help="First title line [default: INPUT].")
+@import_options
 def preview(
     input_name: str,
     output: str | None,
@@ -61,6 +72,7 @@ def preview(
     machine_file: Path | None,
     tool_diameter: float,
     title: str | None,
+    **options: Any,
 ) -> None:
     """Draw INPUT (a drawing or a program) as a picture a person can check before cutting.
 
@@ -81,7 +93,7 @@ def preview(
         machine_file=machine_file,
     )
     chosen = _target(target, machine_file)
-    drawing, program = _read_inputs(input_name, program_name, chosen)
+    drawing, program = _read_inputs(input_name, program_name, chosen, import_settings(options))
     verification = _verify(program, drawing, chosen, tool_diameter) if verify_too else None
     shown = title or (f"{program_name} over {input_name}" if program_name else input_name)
     data = render_preview(
@@ -117,7 +129,7 @@ def _target(name: str | None, machine_file: Path | None) -> Target | None:
 
 
 def _read_inputs(
-    input_name: str, program_name: str | None, target: Target | None
+    input_name: str, program_name: str | None, target: Target | None, settings: ImportOptions
 ) -> tuple[Drawing | None, Program | None]:
     """The drawing and the program to draw, read as the module docstring says."""
     from camtool.importers import DRAWING_SUFFIXES, read_drawing
@@ -125,7 +137,7 @@ def _read_inputs(
     if input_name != "-" and Path(input_name).suffix.lower() in DRAWING_SUFFIXES:
         if not Path(input_name).is_file():
             raise InputError(f"{input_name}: no such file")
-        drawing = read_drawing(input_name)
+        drawing = read_drawing(input_name, settings)
         program = _read_program(program_name, target) if program_name else None
         return drawing, program
     if program_name is not None:

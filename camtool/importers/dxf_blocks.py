@@ -17,13 +17,13 @@ An entity on layer ``0`` inside a block takes the layer of the INSERT that place
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
 from camtool.geometry import Point
 from camtool.importers.dxf_curves import Unsupported
-from camtool.importers.dxf_entities import CONVERTED, Item, location
+from camtool.importers.dxf_entities import CONVERTED, Item, check_numbers, layer_of, location
 
 MAX_NESTING = 32
 """Deepest block nesting followed; deeper is refused (a block that contains itself, too)."""
@@ -48,12 +48,21 @@ class Skip:
     location: Point | None = None
 
 
-def expand_insert(insert: Any, layer: str) -> Iterator[Item | Skip]:
+def expand_insert(
+    insert: Any, layer: str, limit: float, cyclic: frozenset[str] = frozenset()
+) -> Iterator[Item | Skip]:
     """Every leaf entity a model-space INSERT (or MINSERT) places, in WCS drawing units.
+
+    Each INSERT on the way and each block entity is checked by
+    :func:`~camtool.importers.dxf_entities.check_numbers` before it is used, so a NaN
+    scale or an infinite coordinate is an error naming the entity, not a skip.
 
     Args:
         insert: an ezdxf ``Insert`` from model space.
         layer: the INSERT's effective layer (its own layer in model space).
+        limit: largest number accepted, drawing units.
+        cyclic: blocks on a reference cycle (:attr:`BlockGraph.cyclic`); their INSERTs
+            are skipped whole.
 
     Yields:
         :class:`~camtool.importers.dxf_entities.Item` for each placed entity (types in
@@ -62,16 +71,23 @@ def expand_insert(insert: Any, layer: str) -> Iterator[Item | Skip]:
         missing block, a block that contains itself, an entity the transform refuses.
         ATTRIBs of the INSERTs are yielded as items too (text, to be counted and
         skipped); ATTDEFs (attribute templates) are not.
+
+    Raises:
+        BadEntity: an INSERT or a block entity holds a NaN, infinite or huge number.
     """
-    yield from _expand(insert, layer, None, "", ())
+    yield from _expand(insert, layer, None, "", (), (limit, cyclic))
+
+
+_Limits = tuple[float, frozenset[str]]  # (largest number, cyclic block names)
 
 
 def _expand(
-    insert: Any, layer: str, parent: Any, within: str, names: tuple[str, ...]
+    insert: Any, layer: str, parent: Any, within: str, names: tuple[str, ...], limits: _Limits
 ) -> Iterator[Item | Skip]:
-    """``names``: the blocks around this INSERT, outermost first (to catch cycles)."""
+    """``names``: the blocks around this INSERT, outermost first (to count the depth)."""
     name = insert.dxf.name
     label = f"INSERT #{insert.dxf.handle}{within}"
+    check_numbers(insert, label, layer, limits[0])
     for attrib in insert.attribs:
         at = _moved(location(attrib), parent)
         yield Item(attrib, f"ATTRIB #{attrib.dxf.handle} of {label}", layer, at=at)
@@ -79,7 +95,7 @@ def _expand(
     reason = ""
     if block is None:
         reason = f"block {name!r} is missing"
-    elif name in names:
+    elif name in names or name in limits[1]:
         reason = f"block {name!r} contains itself"
     elif len(names) >= MAX_NESTING:
         reason = f"blocks nested deeper than {MAX_NESTING} levels"
@@ -93,25 +109,26 @@ def _expand(
             matrix = Matrix44.chain(matrix, parent)
         chain = f" in INSERT #{insert.dxf.handle} (block {name!r}{cell}){within}"
         for entity in block:
-            yield from _place(entity, matrix, layer, chain, (*names, name))
+            yield from _place(entity, matrix, layer, chain, (*names, name), limits)
 
 
 def _place(
-    entity: Any, matrix: Any, layer: str, chain: str, names: tuple[str, ...]
+    entity: Any, matrix: Any, layer: str, chain: str, names: tuple[str, ...], limits: _Limits
 ) -> Iterator[Item | Skip]:
     """One entity of a block under ``matrix``; ``chain`` names the INSERTs around it."""
     kind = entity.dxftype()
     if kind == "ATTDEF":
         return
-    own = entity.dxf.get("layer", "0")
+    own = layer_of(entity)
     eff = layer if own == "0" else own
     if kind == "INSERT":
-        yield from _expand(entity, eff, matrix, chain, names)
+        yield from _expand(entity, eff, matrix, chain, names, limits)
         return
     label = f"{kind} #{entity.dxf.handle}{chain}"
     if kind not in CONVERTED:
         yield Item(entity, label, eff, at=_moved(location(entity), matrix))
         return
+    check_numbers(entity, label, eff, limits[0])
     try:
         placed, parts = _transformed(entity, matrix)
     except Unsupported as exc:
@@ -138,9 +155,11 @@ def _transformed(entity: Any, matrix: Any) -> tuple[Any, tuple[Any, ...]]:
     except NonUniformScalingError:
         kind = entity.dxftype()
         if kind in ("ARC", "CIRCLE"):
-            if entity.dxf.radius <= 0:
+            if entity.dxf.radius == 0:
                 raise Unsupported("zero length") from None
-            return Ellipse.from_arc(entity).transform(matrix), ()
+            circle = entity.copy()
+            circle.dxf.radius = abs(entity.dxf.radius)  # AutoCAD ignores the sign
+            return Ellipse.from_arc(circle).transform(matrix), ()
         if kind in ("LWPOLYLINE", "POLYLINE"):
             parts = tuple(_transformed(part, matrix)[0] for part in entity.virtual_entities())
             return entity, parts
@@ -159,15 +178,12 @@ def _grid(insert: Any) -> Iterator[tuple[Any, str]]:
     from ezdxf.math import Matrix44, Vec3
 
     base = insert.matrix44()
-    rows = int(insert.dxf.get("row_count", 1))
-    cols = int(insert.dxf.get("column_count", 1))
-    if rows * cols <= 1:
+    rows, cols = _rows_columns(insert)
+    if (rows, cols) == (1, 1):
         yield base, ""
         return
     row_step = float(insert.dxf.get("row_spacing", 0.0))
     col_step = float(insert.dxf.get("column_spacing", 0.0))
-    rows = rows if row_step else 1
-    cols = cols if col_step else 1
     ocs = insert.ocs()
     rotation = float(insert.dxf.get("rotation", 0.0))
     for row in range(rows):
@@ -178,3 +194,167 @@ def _grid(insert: Any) -> Iterator[tuple[Any, str]]:
                 Matrix44.chain(base, Matrix44.translate(*shift)),
                 f", row {row + 1} column {col + 1}",
             )
+
+
+def _rows_columns(insert: Any) -> tuple[int, int]:
+    """MINSERT grid size as :func:`_grid` expands it; ``(1, 1)`` for a plain INSERT."""
+    rows = int(insert.dxf.get("row_count", 1))
+    cols = int(insert.dxf.get("column_count", 1))
+    if rows * cols <= 1:
+        return 1, 1
+    rows = max(rows, 0) if insert.dxf.get("row_spacing", 0.0) else 1
+    cols = max(cols, 0) if insert.dxf.get("column_spacing", 0.0) else 1
+    return rows, cols
+
+
+@dataclass(frozen=True)
+class BlockGraph:
+    """Which blocks model space reaches, which of them lie on a reference cycle, and sizes.
+
+    Attributes:
+        cyclic: names of the blocks that contain themselves, directly or through other
+            blocks (the strongly connected components of the block reference graph with a
+            cycle). An INSERT of such a block is skipped whole, wherever it is: expanding
+            "up to the cycle" would give a size that depends on the way in, which the
+            entity count below could not bound.
+        sizes: per reached block, how many entities one placement of it expands to
+            (nested INSERTs, their ATTRIBs and MINSERT cells included), saturated at
+            ``limit + 1``.
+    """
+
+    cyclic: frozenset[str]
+    sizes: dict[str, int]
+
+
+def block_graph(inserts: Iterable[Any], limit: int) -> BlockGraph:
+    """Analyse the blocks model space references, without expanding any of them.
+
+    Each block is visited once (a "billion laughs" of blocks, a block placing the
+    previous one 10 times 30 levels deep, is 30 visits, not 10³⁰), without recursion (a
+    chain of thousands of nested blocks is fine).
+
+    Args:
+        inserts: the model-space INSERTs.
+        limit: the entity count above which the caller refuses the drawing.
+    """
+    children: dict[str, list[Any]] = {}  # block name -> its INSERT entities
+    contents: dict[str, int] = {}  # block name -> its other entities (ATTDEFs left out)
+    todo = list(inserts)
+    while todo:
+        insert = todo.pop()
+        name = insert.dxf.name
+        if name in children:
+            continue
+        block = insert.block()
+        inserts = [] if block is None else [e for e in block if e.dxftype() == "INSERT"]
+        children[name] = inserts
+        contents[name] = (
+            0 if block is None else sum(1 for e in block if e.dxftype() not in ("INSERT", "ATTDEF"))
+        )
+        todo.extend(inserts)
+    cyclic = _cyclic({n: [i.dxf.name for i in inserts] for n, inserts in children.items()})
+    cap = limit + 1
+    sizes: dict[str, int] = {}
+    for name in _bottom_up(children, cyclic):
+        total = contents[name]
+        for insert in children[name]:
+            total = min(cap, total + insert_size(insert, sizes, cyclic, cap))
+        sizes[name] = total
+    return BlockGraph(frozenset(cyclic), sizes)
+
+
+def insert_size(insert: Any, sizes: dict[str, int], cyclic: Iterable[str], cap: int) -> int:
+    """Entities one INSERT stands for: itself, its ATTRIBs and each cell's block content."""
+    name = insert.dxf.name
+    own = 1 + len(insert.attribs)
+    if name in cyclic or name not in sizes:
+        return own
+    rows, cols = _rows_columns(insert)
+    return min(cap, own + min(cap, rows * cols) * sizes[name])
+
+
+def expanded_count(inserts: Iterable[Any], others: int, graph: BlockGraph, limit: int) -> int:
+    """How many entities model space expands to (at most ``limit + 1``).
+
+    Args:
+        inserts: the model-space INSERTs.
+        others: how many other entities model space holds.
+        graph: the block analysis of :func:`block_graph`.
+        limit: the entity count above which the caller refuses the drawing.
+    """
+    cap = limit + 1
+    total = min(cap, others)
+    for insert in inserts:
+        total = min(cap, total + insert_size(insert, graph.sizes, graph.cyclic, cap))
+    return total
+
+
+def _bottom_up(children: dict[str, list[Any]], cyclic: set[str]) -> list[str]:
+    """The acyclic block names, each after every block it places (post-order, iterative)."""
+    order: list[str] = []
+    seen: set[str] = set()
+    for root in children:
+        if root in seen or root in cyclic:
+            continue
+        seen.add(root)
+        stack = [(root, iter(children[root]))]
+        while stack:
+            name, it = stack[-1]
+            for insert in it:
+                child = insert.dxf.name
+                if child not in seen and child not in cyclic and child in children:
+                    seen.add(child)
+                    stack.append((child, iter(children[child])))
+                    break
+            else:
+                stack.pop()
+                order.append(name)
+    return order
+
+
+def _cyclic(graph: dict[str, list[str]]) -> set[str]:
+    """Nodes on a cycle: members of strongly connected components with a cycle.
+
+    Tarjan's algorithm (1972), iterative.
+    """
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    on_stack: set[str] = set()
+    stack: list[str] = []
+    out: set[str] = set()
+    for root in graph:
+        if root in index:
+            continue
+        work = [(root, iter(graph[root]))]
+        index[root] = low[root] = len(index)
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            node, it = work[-1]
+            for child in it:
+                if child not in graph:
+                    continue
+                if child not in index:
+                    index[child] = low[child] = len(index)
+                    stack.append(child)
+                    on_stack.add(child)
+                    work.append((child, iter(graph[child])))
+                    break
+                if child in on_stack:
+                    low[node] = min(low[node], index[child])
+            else:
+                work.pop()
+                if work:
+                    parent = work[-1][0]
+                    low[parent] = min(low[parent], low[node])
+                if low[node] == index[node]:
+                    component = []
+                    while True:
+                        member = stack.pop()
+                        on_stack.discard(member)
+                        component.append(member)
+                        if member == node:
+                            break
+                    if len(component) > 1 or node in graph[node]:
+                        out.update(component)
+    return out

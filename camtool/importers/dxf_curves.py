@@ -34,6 +34,14 @@ class Unsupported(Exception):
         self.detail = detail
 
 
+class BadEntity(ValueError):
+    """An entity holds a number camtool refuses; the message names the entity and value.
+
+    Raised by :func:`camtool.importers.dxf_entities.check_numbers`; the DXF importer
+    turns it into an :class:`~camtool.errors.InputError` naming the file.
+    """
+
+
 def ellipse_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool]:
     """An ELLIPSE as lines and arcs within ``tolerance``, and whether it is closed.
 
@@ -54,6 +62,8 @@ def ellipse_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool
     Raises:
         Unsupported: the ellipse is not parallel to XY, or has zero size.
     """
+    if not math.hypot(*entity.dxf.major_axis) > 0.0:
+        raise Unsupported("zero size")  # ezdxf's construction tool refuses a null axis
     ce = entity.construction_tool()
     ex, ey, ez = ce.extrusion
     if abs(ex) > 1e-9 or abs(ey) > 1e-9 or abs(ce.major_axis[2]) > 1e-9 * ce.major_axis.magnitude:
@@ -62,6 +72,7 @@ def ellipse_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool
     a, b = math.hypot(mx, my), math.hypot(nx, ny)
     if a <= 0.0 or b <= 0.0:
         raise Unsupported("zero size")
+    _check_size(2.0 * max(a, b), tolerance)
     t0 = float(ce.start_param)
     t1 = float(ce.end_param)
     if t1 <= t0:
@@ -123,6 +134,8 @@ def spline_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool]
     if not t1 > t0:
         raise Unsupported("invalid spline data", "empty parameter range")
     breaks = [t0, *_corner_knots(knots, p, t0, t1), t1]
+    xs, ys = [q[0] for q in pts], [q[1] for q in pts]
+    _check_size(max(max(xs) - min(xs), max(ys) - min(ys)), tolerance)
 
     def point_at(t: float) -> Point:
         return _xy(spline.point(t))
@@ -132,6 +145,15 @@ def spline_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool]
     return _fit(point_at, lambda t: _xy(spline.derivative(t, 1)[1]), breaks, tolerance, closed), (
         closed
     )
+
+
+def _check_size(extent: float, tolerance: float) -> None:
+    from camtool.importers import check_curve_size
+
+    try:
+        check_curve_size(extent, tolerance)
+    except ValueError as exc:
+        raise BadEntity(f"{exc} (drawing units)") from None
 
 
 def _construction(entity: Any) -> Any:

@@ -17,8 +17,15 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from camtool.geometry import Arc, Contour, Line, Point, Segment, distance
-from camtool.importers.dxf_curves import Unsupported, ellipse_segments, spline_segments
+from camtool.importers.dxf_curves import (
+    BadEntity,
+    Unsupported,
+    ellipse_segments,
+    spline_segments,
+)
 
 CONVERTED = ("LINE", "ARC", "CIRCLE", "LWPOLYLINE", "POLYLINE", "ELLIPSE", "SPLINE", "HATCH")
 """Entity types that become contours (HATCH only with ``hatch_boundaries``)."""
@@ -28,6 +35,135 @@ ZERO_LENGTH = 1e-9
 
 # Entities whose centre or insertion point is stored in their OCS (DXF reference).
 _OCS_POINTS = frozenset({"ARC", "CIRCLE", "TEXT", "ATTRIB", "INSERT", "SHAPE"})
+_MAX_RATIO = 1.0 + 1e-9  # ELLIPSE minor/major axis ratio, (0, 1] in the DXF reference
+
+
+def check_numbers(entity: Any, label: str, layer: str, limit: float) -> None:
+    """Refuse an entity with a number that is NaN, infinite or beyond ``±limit``.
+
+    Every float attribute (points, radius, angles, scales, bulges, ratio, extrusion ...)
+    and the vertex, control point, fit point, knot and weight arrays are checked, so the
+    converters downstream can trust them. Also refused: a zero extrusion vector (no
+    plane) and an ELLIPSE axis ratio above 1 (the DXF reference allows (0, 1]; ezdxf's
+    auditor would clamp it, silently changing the part).
+
+    Args:
+        entity: an ezdxf entity (model space, block content, or a virtual one).
+        label: how messages name it, e.g. ``"LINE #2A"``.
+        layer: its effective layer, for the message.
+        limit: largest magnitude accepted, drawing units (the importer passes
+            :data:`~camtool.importers.MAX_COORDINATE_MM` converted to drawing units).
+
+    Raises:
+        BadEntity: the message names the entity, its layer, the attribute and the value.
+    """
+    what = _bad_number(entity, limit)
+    if what is not None:
+        raise BadEntity(
+            f"{label} on layer {layer!r}: {what}, not a finite number within ±{_short(limit)} "
+            "(drawing units); the file is damaged: fix or delete the entity in the CAD "
+            "program and export again"
+        )
+    what = _bad_shape(entity)
+    if what is not None:
+        raise BadEntity(
+            f"{label} on layer {layer!r}: {what}; the file is damaged: fix or delete the "
+            "entity in the CAD program and export again"
+        )
+
+
+def _bad_number(entity: Any, limit: float) -> str | None:
+    """``"<attribute> <value>"`` of the first number out of range, else None."""
+    from ezdxf.math import Vec2, Vec3
+
+    kind = entity.dxftype()
+    if kind == "LINE":  # the bulk of large drawings: four numbers, checked directly
+        s, e = entity.dxf.start, entity.dxf.end
+        inside = (  # not max(): max() drops a NaN that is not its first argument
+            abs(s.x) <= limit
+            and abs(s.y) <= limit
+            and abs(s.z) <= limit
+            and abs(e.x) <= limit
+            and abs(e.y) <= limit
+            and abs(e.z) <= limit
+        )
+        if inside and not entity.dxf.hasattr("extrusion"):
+            return None
+    for name, value in entity.dxf.all_existing_dxf_attribs().items():
+        if isinstance(value, float):
+            if not abs(value) <= limit:
+                return f"{name} {value:g}"
+        elif (
+            isinstance(value, tuple | Vec2 | Vec3)
+            and all(isinstance(v, float) for v in value)
+            and not all(abs(v) <= limit for v in value)
+        ):
+            return f"{name} ({', '.join(f'{v:g}' for v in value)})"
+    for name, rows in _arrays(entity):
+        values = np.asarray(rows, dtype=float)
+        if values.size and not bool((np.abs(values) <= limit).all()):
+            values = values.reshape(len(values), -1)
+            k = int(np.flatnonzero(~(np.abs(values) <= limit).all(axis=1))[0])
+            shown = ", ".join(f"{v:g}" for v in values[k])
+            return f"{name} {k + 1} ({shown})"
+    if kind == "POLYLINE":
+        for k, vertex in enumerate(entity.vertices, start=1):
+            what = _bad_number(vertex, limit)
+            if what is not None:
+                return f"vertex {k} {what}"
+    return None
+
+
+def _short(value: float) -> str:
+    """``1e9`` rather than ``1e+09``."""
+    return f"{value:g}".replace("e+0", "e").replace("e+", "e")
+
+
+def _arrays(entity: Any) -> list[tuple[str, Any]]:
+    """Name and rows of the number arrays an entity keeps outside its DXF attributes."""
+    kind = entity.dxftype()
+    if kind == "LWPOLYLINE":
+        return [("vertex (x, y, start width, end width, bulge)", entity.lwpoints.values)]
+    if kind == "SPLINE":
+        return [
+            ("control point", entity.control_points.values),
+            ("fit point", entity.fit_points.values),
+            ("knot", entity.knots),
+            ("weight", entity.weights),
+        ]
+    return []
+
+
+def _bad_shape(entity: Any) -> str | None:
+    """What makes the entity's numbers meaningless though finite, else None."""
+    extrusion = entity.dxf.get("extrusion", None)
+    if extrusion is not None and not math.hypot(*extrusion) > 1e-12:
+        return f"extrusion {tuple(float(v) for v in extrusion)} is not a direction"
+    if entity.dxftype() == "ELLIPSE" and not abs(entity.dxf.get("ratio", 1.0)) <= _MAX_RATIO:
+        return f"axis ratio {entity.dxf.ratio:g} is above 1 (the DXF range is (0, 1])"
+    return None
+
+
+def check_centres(contours: Sequence[Contour], layer: str, limit: float) -> None:
+    """Refuse arcs whose centre lies beyond ``±limit`` (a huge radius from a bulge).
+
+    The ends of every segment come from numbers :func:`check_numbers` bounded; a centre
+    is derived and can still be far away (a bulge of 1e-8 on a long chord).
+
+    Raises:
+        BadEntity: naming the contour's entity and the centre.
+    """
+    for contour in contours:
+        for seg in contour.segments:
+            if isinstance(seg, Arc) and not (
+                abs(seg.centre[0]) <= limit and abs(seg.centre[1]) <= limit
+            ):
+                x, y = seg.centre
+                raise BadEntity(
+                    f"{contour.source} on layer {layer!r}: an arc of it has its centre at "
+                    f"({x:g}, {y:g}), beyond ±{_short(limit)} (drawing units): a radius or bulge "
+                    "too large to cut; fix the entity in the CAD program"
+                )
 
 
 @dataclass(frozen=True)
@@ -52,18 +188,21 @@ class Item:
     at: Point | None = None
 
 
-def convert(item: Item, tolerance: float) -> list[Contour]:
+def convert(item: Item, tolerance: float, limit: float = math.inf) -> list[Contour]:
     """The contours of one entity, in drawing units, Y up.
 
     Args:
-        item: the entity and its names; its type must be one of :data:`CONVERTED`.
+        item: the entity and its names; its type must be one of :data:`CONVERTED`;
+            its numbers already checked (:func:`check_numbers`).
         tolerance: fitting and joining tolerance, drawing units (> 0).
+        limit: largest number accepted in a HATCH's boundary edges, drawing units.
 
     Returns:
         One contour, or for a HATCH one per boundary path.
 
     Raises:
         Unsupported: the entity is tilted out of XY, 3D, empty or has zero length.
+        BadEntity: a HATCH boundary edge holds a number beyond ``limit``.
     """
     entity = item.entity
     kind = entity.dxftype()
@@ -74,9 +213,20 @@ def convert(item: Item, tolerance: float) -> list[Contour]:
             for segs, shut in join_pieces(pieces, tolerance)
         ]
     if kind == "HATCH":
-        return _hatch(item, tolerance)
+        return _hatch(item, tolerance, limit)
     segs, closed = _segments(entity, tolerance)
     return [Contour(tuple(segs), closed, item.layer, item.label)]
+
+
+def layer_of(entity: Any) -> str:
+    """The entity's own layer name; ``"0"`` when it has none.
+
+    An entity may leave out group code 8 (R12 files do), and an entity of a type ezdxf
+    does not know has no ``layer`` attribute at all (asking raises DXFAttributeError).
+    """
+    if not entity.dxf.is_supported("layer"):
+        return "0"
+    return str(entity.dxf.get("layer", "0"))
 
 
 def location(entity: Any) -> Point | None:
@@ -220,16 +370,25 @@ def _polyline2d(entity: Any) -> list[Segment]:
     return _polyline(entity, points, entity.is_closed)
 
 
-def _hatch(item: Item, tolerance: float) -> list[Contour]:
+def _hatch(item: Item, tolerance: float, limit: float) -> list[Contour]:
     """Each boundary path of a HATCH as contours (normally one closed contour per path)."""
     from camtool.importers.dxf_hatch import boundary_entities
 
     hatch = item.entity
     _check_flat(hatch)
     contours: list[Contour] = []
-    for number, path in enumerate(boundary_entities(hatch), start=1):
-        pieces = [_piece(edge, tolerance) for edge in path]
+    try:
+        paths = boundary_entities(hatch)
+    except (ValueError, ArithmeticError) as exc:  # e.g. an infinite ellipse edge angle
+        raise BadEntity(
+            f"{item.label} on layer {item.layer!r}: its boundary path data cannot be read "
+            f"({exc}); the file is damaged: fix or delete the hatch in the CAD program"
+        ) from None
+    for number, path in enumerate(paths, start=1):
         label = f"{item.label} path {number}"
+        for edge in path:
+            check_numbers(edge, label, item.layer, limit)
+        pieces = [_piece(edge, tolerance) for edge in path]
         for segs, closed in join_pieces(pieces, tolerance):
             contours.append(Contour(tuple(segs), closed, item.layer, label))
     if not contours:
@@ -246,7 +405,7 @@ def _arc(entity: Any) -> Arc:
     ocs = entity.ocs()
     flipped = entity.dxf.get("extrusion", (0.0, 0.0, 1.0))[2] < 0
     centre = _xy(ocs.to_wcs(entity.dxf.center))
-    r = float(entity.dxf.radius)
+    r = abs(float(entity.dxf.radius))  # AutoCAD ignores the sign (ezdxf's Circle.vertices)
     if entity.dxftype() == "CIRCLE":
         start = (centre[0] + r, centre[1])
         return Arc(start, start, centre, flipped)
@@ -277,7 +436,7 @@ def _polyline(
         p1 = _xy(ocs.to_wcs((x1, y1, z)))
         if distance(p0, p1) <= ZERO_LENGTH:
             continue
-        if abs(bulge) < 1e-12:
+        if abs(bulge) * distance(p0, p1) <= 2 * ZERO_LENGTH:  # sagitta ≈ bulge · chord / 2
             segs.append(Line(p0, p1))
             continue
         c = bulge_center((x0, y0), (x1, y1), bulge)

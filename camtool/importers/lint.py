@@ -5,8 +5,9 @@ options), chains it at the same tolerance and reports: entity counts by type and
 (DXF), contour counts by layer, the bounding box, the units, the importer's warnings and
 the findings of :mod:`camtool.importers.lint_checks` (open contours, gaps just above the
 tolerance, duplicates and overlaps, zero-length and tiny segments, dropped entities),
-each with its location. :class:`InspectReport` gives a text for people and a JSON
-object for scripts (``--json``).
+each with its location, and for a damaged DXF what ezdxf's recover mode repaired (the
+importer's warning only counts the repairs). :class:`InspectReport` gives a text for
+people and a JSON object for scripts (``--json``).
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ _KIND_TITLES = {
     "zero-length": "zero-length segments or entities",
     "tiny-segment": "tiny segments",
     "skipped": "entities not read",
+    "repaired": "repairs made to read a damaged file (ezdxf recover mode)",
 }
 
 
@@ -185,6 +187,7 @@ def inspect_drawing(
         drawing, units = read.drawing, read.units
         entities, block_entities = read.entity_counts, read.block_entity_counts
         notes = [_note_finding(n) for n in read.notes]
+        notes += [Finding("repaired", r, None) for r in read.repairs]
     else:
         drawing = read_drawing(path, options)
     chained, findings = check_drawing(drawing, options.tolerance, tiny_mm=tiny_mm)

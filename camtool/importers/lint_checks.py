@@ -41,7 +41,8 @@ class Finding:
 
     Attributes:
         kind: ``open-contour``, ``gap``, ``duplicate``, ``overlap``, ``zero-length``,
-            ``tiny-segment`` or ``skipped`` (an entity the importer dropped).
+            ``tiny-segment``, ``skipped`` (an entity the importer dropped) or ``repaired``
+            (what ezdxf's recover mode repaired, or could not, in a damaged DXF file).
         message: a sentence for the user, lowercase, with numbers in mm.
         location: where, mm (WCS, Y up), or None when the importer gave no point.
         sources: the entities or contours involved (``Contour.source`` values).

@@ -26,7 +26,6 @@ Rules (docs/importers/svg.md for the user's view):
 from __future__ import annotations
 
 import io
-import math
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -73,7 +72,7 @@ def read_svg(path: str | Path, options: ImportOptions | None = None) -> Drawing:
     path = Path(path)
     options = options or ImportOptions()
     check_tolerance(options.tolerance)
-    prepared = prepare(path, options.layers)
+    prepared = prepare(path, options.layers, max_entities=options.max_entities)
     svg = _parse(path, prepared)
     warnings = list(prepared.warnings)
     contours: list[Contour] = []
@@ -137,11 +136,8 @@ def _contours(path: Path, shape: Any, page: Affine, tolerance: float) -> list[Co
     m = compose(page, affine_of(shape.transform))
     try:
         subpaths = convert(shape.segments(transformed=False), m, tolerance)
-    except ToolpathError as exc:
+    except (ToolpathError, InputError) as exc:
         raise InputError(f"{path}: {label}: {exc}") from exc
-    ends = [p for segs, _ in subpaths for seg in segs for p in (seg.start, seg.end)]
-    if not all(math.isfinite(v) for p in ends for v in p):
-        raise InputError(f"{path}: {label}: coordinates too large (not finite in mm)")
     many = len(subpaths) > 1
     return [
         Contour(segs, closed, layer, f"{label} subpath {k}" if many else label)

@@ -22,7 +22,9 @@ from typing import Any, TypeAlias
 
 import svgelements as se
 
+from camtool.errors import InputError
 from camtool.geometry import TAU, Arc, Line, Point, Segment, distance
+from camtool.importers import MAX_COORDINATE_MM, check_curve_size
 from camtool.toolpath.arcfit import fit_curve
 
 Affine: TypeAlias = tuple[float, float, float, float, float, float]
@@ -88,6 +90,9 @@ def convert(segments: Iterable[Any], m: Affine, tolerance: float) -> list[Subpat
 
     Raises:
         ToolpathError: a curve could not be fitted (from :func:`fit_curve`).
+        InputError: a point, control point or arc centre is NaN, infinite or beyond
+            ±:data:`~camtool.importers.MAX_COORDINATE_MM` once mapped to mm (checked
+            before any fitting, which would spin on a control point at 1e20).
     """
     out: list[Subpath] = []
     current: list[Segment] = []
@@ -106,10 +111,10 @@ def convert(segments: Iterable[Any], m: Affine, tolerance: float) -> list[Subpat
     for seg in segments:
         if isinstance(seg, se.Move):
             flush(False)
-            start = cursor = apply(m, seg.end.x, seg.end.y)
+            start = cursor = _pt(m, seg.end)
             continue
         if cursor is None or start is None:  # svgelements always starts with Move
-            start = cursor = apply(m, seg.start.x, seg.start.y)
+            start = cursor = _pt(m, seg.start)
         if isinstance(seg, se.Close):
             if distance(cursor, start) > ZERO_LENGTH_MM:
                 current.append(Line(cursor, start))
@@ -117,6 +122,9 @@ def convert(segments: Iterable[Any], m: Affine, tolerance: float) -> list[Subpat
             cursor = start
             continue
         new = segment(seg, cursor, m, tolerance)
+        for piece in new:
+            if isinstance(piece, Arc):
+                _check(piece.centre, "an arc centre")
         current.extend(new)
         if new:
             cursor = new[-1].end
@@ -131,12 +139,14 @@ def segment(seg: Any, p0: Point, m: Affine, tolerance: float) -> list[Segment]:
         ValueError: ``seg`` is of a kind svgelements does not produce in a path.
     """
     if isinstance(seg, se.Line):
-        return _line(p0, apply(m, seg.end.x, seg.end.y))
+        return _line(p0, _pt(m, seg.end))
     if isinstance(seg, se.CubicBezier):
         ctrl = (p0, _pt(m, seg.control1), _pt(m, seg.control2), _pt(m, seg.end))
+        _check_size(ctrl, tolerance)
         return _fit(*_cubic(ctrl), tolerance)
     if isinstance(seg, se.QuadraticBezier):
         ctrl3 = (p0, _pt(m, seg.control), _pt(m, seg.end))
+        _check_size(ctrl3, tolerance)
         return _fit(*_quadratic(ctrl3), tolerance)
     if isinstance(seg, se.Arc):
         return _arc(seg, p0, m, tolerance)
@@ -144,7 +154,27 @@ def segment(seg: Any, p0: Point, m: Affine, tolerance: float) -> list[Segment]:
 
 
 def _pt(m: Affine, p: Any) -> Point:
-    return apply(m, float(p.x), float(p.y))
+    """``p`` mapped to mm, checked to be finite and within the bound."""
+    return _check(apply(m, float(p.x), float(p.y)), "a point")
+
+
+def _check_size(points: Iterable[Point], tolerance: float) -> None:
+    """Refuse a curve whose control points span too much for ``tolerance`` (InputError)."""
+    xs, ys = zip(*points, strict=True)
+    try:
+        check_curve_size(2.0 * max(max(xs) - min(xs), max(ys) - min(ys)), tolerance)
+    except ValueError as exc:
+        raise InputError(str(exc).replace(" across", " mm across", 1)) from None
+
+
+def _check(p: Point, what: str) -> Point:
+    x, y = p
+    if not (abs(x) <= MAX_COORDINATE_MM and abs(y) <= MAX_COORDINATE_MM):
+        raise InputError(
+            f"{what} at ({x:g}, {y:g}) mm, not a finite number within ±1e9 mm; the "
+            "path data, a transform or the viewBox holds a number far too large"
+        )
+    return p
 
 
 def _line(p0: Point, p1: Point) -> list[Segment]:
@@ -224,6 +254,9 @@ def _arc(seg: Any, p0: Point, m: Affine, tolerance: float) -> list[Segment]:
     cross = big_a[0] * big_b[1] - big_a[1] * big_b[0]
     if _axes_gap(big_a, big_b, cross) <= 0.1 * tolerance:
         return _circular(p0, p1, centre, ccw=cross * sweep > 0.0, sweep=sweep)
+    _check(centre, "an ellipse centre")
+    _check_size([centre, (centre[0] + big_a[0], centre[1] + big_a[1]),
+                 (centre[0] + big_b[0], centre[1] + big_b[1]), p0, p1], tolerance)  # fmt: skip
     return _fit(*_ellipse(centre, big_a, big_b, t0, sweep, p0, p1), tolerance)
 
 

@@ -30,12 +30,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from camtool.errors import InputError
-from camtool.importers import svgcheck
+from camtool.importers import MAX_ENTITIES, svgcheck
 from camtool.importers.svgcurves import Affine
 from camtool.importers.svgtree import (
     SOURCE_ATTR,
     SVG_NS,
     USE_ATTR,
+    check_size,
     check_use_cycles,
     count_skipped,
     hold_undrawn,
@@ -79,17 +80,24 @@ class Prepared:
     warnings: tuple[str, ...]
 
 
-def prepare(path: Path, layers: tuple[str, ...] | None) -> Prepared:
+def prepare(
+    path: Path, layers: tuple[str, ...] | None, *, max_entities: int = MAX_ENTITIES
+) -> Prepared:
     """Read, check and prepare the SVG file at ``path`` (see the module docstring).
 
     Args:
         path: the SVG file.
         layers: Inkscape layer names (labels or ids) to keep; ``None`` keeps everything.
+        max_entities: most elements the document may expand to, ``<use>`` clones
+            included (:func:`camtool.importers.svgtree.check_size`).
 
     Raises:
         InputError: the file is missing, is not well-formed XML, is not an SVG document,
-            has malformed path data, transforms, lengths, points, size or viewBox, or a
-            name in ``layers`` matches no layer (the message lists the layers there are).
+            has malformed path data, transforms, lengths, points, size or viewBox, a
+            name in ``layers`` matches no layer (the message lists the layers there are),
+            a ``<use>`` that places itself, nesting deeper than
+            :data:`~camtool.importers.svgtree.MAX_DEPTH` or more than ``max_entities``
+            elements.
     """
     root = _parse(path)
     warnings: list[str] = []
@@ -97,6 +105,7 @@ def prepare(path: Path, layers: tuple[str, ...] | None) -> Prepared:
     parents = {child: parent for parent in root.iter() for child in parent}
     _label_and_check(root, str(path))
     check_use_cycles(root, str(path))
+    check_size(root, str(path), max_entities)
     hold = ET.SubElement(root, _tag(root, "defs"))
     parents[hold] = root
     counts: Counter[str] = Counter()
@@ -127,6 +136,10 @@ def _parse(path: Path) -> ET.Element:
         ) from exc
     except OSError as exc:
         raise InputError(f"{path}: cannot read the file ({exc})") from exc
+    except LookupError as exc:  # <?xml encoding="..."?> names no codec Python knows
+        raise InputError(
+            f"{path}: the XML declaration names an {exc}; save the file as UTF-8"
+        ) from exc
     if local_name(root) != "svg":
         raise InputError(f"{path}: not an SVG document (the root element is <{root.tag}>)")
     return root

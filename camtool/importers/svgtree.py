@@ -273,3 +273,62 @@ def count_skipped(root: ET.Element, hold: ET.Element, counts: Counter[str]) -> N
             walk(child, drawn and kind not in _NOT_DRAWN)
 
     walk(root, True)
+
+
+MAX_DEPTH = 256
+"""Deepest element nesting read, ``<use>`` clones followed (drawing programs nest a few
+dozen levels); deeper is refused before anything walks the tree recursively."""
+
+
+def check_size(root: ET.Element, name: str, max_entities: int) -> None:
+    """Refuse a document nested too deep or expanding to too many elements.
+
+    Every element counts once per place it is drawn: a ``<use>`` counts itself plus
+    what it places, so a "billion laughs" of ``<use>`` (a group cloning the previous
+    one 10 times, 30 levels deep) is counted, without being expanded, as 10³⁰. Sizes
+    and depths are computed once per element, bottom-up, without recursion. Call after
+    :func:`check_use_cycles`.
+
+    Raises:
+        InputError: nesting deeper than :data:`MAX_DEPTH`, or more than
+            ``max_entities`` elements once ``<use>`` clones are expanded (the message
+            names the ``--max-entities`` option).
+    """
+    from camtool.importers import too_many_entities
+
+    ids = {e.get("id"): e for e in root.iter() if e.get("id")}
+    cap = max_entities + 1
+    size: dict[ET.Element, int] = {}
+    depth: dict[ET.Element, int] = {}
+
+    def below(element: ET.Element) -> list[ET.Element]:
+        kids = list(element)
+        if local_name(element) == "use":
+            href = element.get(XLINK_HREF) or element.get("href") or ""
+            target = ids.get(href[1:]) if href.startswith("#") else None
+            if target is not None:
+                kids.append(target)
+        return kids
+
+    stack: list[tuple[ET.Element, list[ET.Element]]] = [(root, below(root))]
+    size[root] = 0  # in progress
+    while stack:
+        element, kids = stack[-1]
+        if kids:
+            kid = kids.pop()
+            if kid not in size:
+                size[kid] = 0
+                stack.append((kid, below(kid)))
+            continue
+        stack.pop()
+        kids = below(element)
+        size[element] = min(cap, 1 + sum(size[k] for k in kids))
+        depth[element] = 1 + max((depth.get(k, 0) for k in kids), default=0)
+        if depth[element] > MAX_DEPTH:
+            label = element.get(SOURCE_ATTR, local_name(element) or "element")
+            raise InputError(
+                f"{name}: {label}: elements nested deeper than {MAX_DEPTH} levels "
+                "(<use> clones followed); flatten the groups in the drawing program"
+            )
+    if size[root] > max_entities:
+        raise too_many_entities(name, max_entities)

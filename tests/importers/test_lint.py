@@ -172,3 +172,19 @@ def _fitted_segments(path: Path) -> tuple[Any, ...]:
     from camtool.importers.dxf import read_dxf
 
     return read_dxf(path).contours[0].segments
+
+
+def test_inspect_lists_the_repairs_of_a_damaged_dxf(tmp_path: Path) -> None:
+    # the importer's warning is one line with counts; the repairs themselves are findings
+    path = tmp_path / "part.dxf"
+    path.write_text(  # no EOF: read in recover mode, whose auditor fixes the axis ratio 2
+        "  0\nSECTION\n  2\nENTITIES\n  0\nELLIPSE\n  8\n0\n 10\n0.0\n 20\n0.0\n 30\n0.0\n"
+        " 11\n10.0\n 21\n0.0\n 31\n0.0\n 40\n2.0\n 41\n0.0\n 42\n6.283185307179586\n"
+        "  0\nENDSEC\n"
+    )
+    report = inspect_drawing(path)
+    (warning,) = [w for w in report.warnings if "damaged" in w]
+    assert "\n" not in warning and "1 fixes" in warning and "camtool inspect" in warning
+    (repaired,) = [f for f in report.findings if f.kind == "repaired"]
+    assert repaired.message.startswith("fixed: ") and "axis-ratio" in repaired.message
+    assert "repairs made to read a damaged file" in report.text()

@@ -343,7 +343,7 @@ def test_read_drawing_dispatches_svg() -> None:
         ('<use id="a" href="#b"/><use id="b" href="#a"/>', "use#a: <use> places itself"),
         (
             '<g transform="scale(1e10)"><path d="M 0 0 L 1e300 0"/></g>',
-            "path[1]: coordinates too large (not finite in mm)",
+            "path[1]: a point at (inf, 100) mm, not a finite number within ±1e9 mm",
         ),
     ],
 )

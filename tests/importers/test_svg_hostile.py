@@ -1,0 +1,122 @@
+"""Hostile SVG files: NaN and huge numbers, deep nesting, ``<use>`` laughs.
+
+One regression test per class of failure found by trying hostile inputs (issues 13, 14):
+a CPU spin in curve fitting (a Bézier control point at 1e20), an internal
+ZeroDivisionError (one at 1e12), a RecursionError (2 000 nested groups), a hang (a
+``<use>`` "billion laughs"), and a 1e300 coordinate posted into an error message 300
+digits long. Each must end quickly with one clear InputError (exit 3).
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import pytest
+
+from camtool.cli import main
+from camtool.errors import InputError
+from camtool.importers import MAX_ENTITIES, ImportOptions
+from camtool.importers.svg import read_svg
+from camtool.importers.svgtree import MAX_DEPTH
+from tests.importers.svgutil import svg
+
+
+def _refused(path: Path, options: ImportOptions | None = None) -> str:
+    start = time.perf_counter()
+    with pytest.raises(InputError) as info:
+        read_svg(path, options)
+    assert time.perf_counter() - start < 5
+    message = str(info.value)
+    assert message.startswith(f"{path}: ") and "\n" not in message
+    return message
+
+
+@pytest.mark.parametrize(
+    ("d", "shown"),
+    [
+        ("M 0 0 C 1e20 0 5 5 10 10", "(1e+20, 100)"),  # was: a CPU spin in fitting
+        ("M 0 0 C 1e12 0 5 5 10 10", "(1e+12, 100)"),  # was: internal ZeroDivisionError
+        ("M 0 0 L 1e300 5", "(1e+300, 95)"),  # was: posted, then a 300-digit message
+        ("M 0 0 L 1e400 5", "(inf, nan)"),
+    ],
+)
+def test_huge_path_numbers_are_refused_before_fitting(tmp_path: Path, d: str, shown: str) -> None:
+    message = _refused(svg(tmp_path, f'<path d="{d}"/>'))
+    assert f"path[1]: a point at {shown} mm" in message
+    assert "±1e9 mm" in message
+
+
+def test_a_huge_transform_is_refused(tmp_path: Path) -> None:
+    message = _refused(svg(tmp_path, '<path transform="scale(1e200)" d="M 1 1 L 5 5"/>'))
+    assert "path[1]: a point at (1e+200, -1e+200) mm" in message
+
+
+def test_nan_in_path_data_is_refused(tmp_path: Path) -> None:
+    message = _refused(svg(tmp_path, '<path d="M 0 0 L nan 5"/>'))
+    assert "path[1]: bad path data" in message
+
+
+def test_deep_nesting_is_refused_not_a_recursion_error(tmp_path: Path) -> None:
+    body = "<g>" * 2000 + '<path d="M 0 0 L 5 5"/>' + "</g>" * 2000
+    message = _refused(svg(tmp_path, body))
+    assert f"nested deeper than {MAX_DEPTH} levels" in message
+
+
+def test_nesting_within_the_limit_is_read(tmp_path: Path) -> None:
+    levels = MAX_DEPTH - 3  # <svg>, the path and camtool's own <defs> come on top
+    body = "<g>" * levels + '<path d="M 0 0 L 5 5"/>' + "</g>" * levels
+    assert len(read_svg(svg(tmp_path, body)).contours) == 1
+
+
+def _use_laugh(levels: int, copies: int) -> str:
+    """Group ``a{k}`` clones ``a{k-1}`` ``copies`` times: copies**levels paths drawn."""
+    defs = '<defs><path id="a0" d="M 0 0 L 1 1"/>'
+    for k in range(1, levels + 1):
+        uses = "".join(f'<use xlink:href="#a{k - 1}"/>' for _ in range(copies))
+        defs += f'<g id="a{k}">{uses}</g>'
+    return defs + f'</defs><use xlink:href="#a{levels}"/>'
+
+
+@pytest.mark.parametrize(("levels", "copies"), [(30, 10), (30, 2)])
+def test_a_use_laugh_is_refused_before_expanding(tmp_path: Path, levels: int, copies: int) -> None:
+    message = _refused(svg(tmp_path, _use_laugh(levels, copies)))
+    assert f"more than {MAX_ENTITIES:,} entities" in message
+    assert "--max-entities" in message
+
+
+def test_the_use_count_is_exact_and_can_be_raised(tmp_path: Path) -> None:
+    # Each element counts once per place it is drawn, a <use> plus what it places:
+    # path a0 = 1, a use of it 2, g a1 = 1 + 2·2 = 5, a use of a1 6, a2 = 1 + 2·6 = 13,
+    # a3 = 1 + 2·14 = 29, the last use 30, <defs> 1 + 1 + 5 + 13 + 29 = 49, and the root
+    # <svg> 1 + 49 + 30 = 80. 2^3 = 8 paths are drawn.
+    path = svg(tmp_path, _use_laugh(3, 2))
+    assert len(read_svg(path, ImportOptions(max_entities=80)).contours) == 8
+    _refused(path, ImportOptions(max_entities=79))
+
+
+def test_post_of_a_hostile_svg_exits_3_with_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = svg(tmp_path, '<path d="M 0 0 C 1e20 0 5 5 10 10"/>')
+    assert main(["post", str(path), "-t", "grbl", "-o", str(tmp_path / "o.nc")]) == 3
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("camtool: error: ")
+
+
+def test_an_unknown_xml_encoding_is_an_input_error(tmp_path: Path) -> None:
+    # was: an internal LookupError from the XML parser (found by fuzzing)
+    path = tmp_path / "enc.svg"
+    path.write_text(
+        '<?xml version="1.0" encoding="UTF1e-320"?>\n<svg xmlns="http://www.w3.org/2000/svg"/>'
+    )
+    message = _refused(path)
+    assert "unknown encoding" in message and "UTF-8" in message
+
+
+def test_an_elliptical_arc_too_large_for_the_tolerance_is_refused(tmp_path: Path) -> None:
+    # radii 8:4 scaled up to a 1e9 chord: every point is within ±1e9 mm, but fitting it
+    # within 0.001 mm took minutes (an ellipse 1e7 mm across already needs 6 400 arcs)
+    path = svg(tmp_path, '<path id="oval" d="m 48,20 a 8,4 0 0 1 -8,1e9"/>')
+    message = _refused(path)
+    assert "path#oval: a curve" in message and "raise --tolerance" in message
