@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint typecheck unit bench docs clean
+.PHONY: demo test lint typecheck unit bench docs clean corpus
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -40,6 +40,12 @@ bench: $(STAMP)
 
 clean:
 	rm -rf $(VENV) out .pytest_cache .mypy_cache .ruff_cache
+
+# Fetch the real-drawing corpus and LinuxCNC's rs274 (Debian packages, cached in .corpus/),
+# then post every sampled drawing on every target; CAMTOOL_CORPUS=full for all of it.
+corpus: $(STAMP)
+	$(BIN)/python tests/corpus/fetch_corpus.py
+	$(BIN)/pytest tests/corpus -rf
 
 docs: $(STAMP)
 	$(BIN)/python docs/make_docs.py

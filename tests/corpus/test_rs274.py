@@ -1,0 +1,171 @@
+"""LinuxCNC's own interpreter, ``rs274``, judges camtool's linuxcnc programs.
+
+``rs274`` is LinuxCNC's stand-alone RS-274/NGC interpreter (Debian ``linuxcnc-uspace``,
+``usr/bin/rs274``); fetch_corpus.py extracts it with ``dpkg-deb -x`` together with the one
+library a plain Debian system lacks (``libboost-python1.74.0``) and runs it with
+``LD_LIBRARY_PATH`` set, no root and no install needed. ``rs274 -t TOOL.TBL -g FILE``
+interprets FILE in batch mode and prints the canonical machining calls it would make
+(``STRAIGHT_TRAVERSE(x, y, z, a, b, c)``, ``STRAIGHT_FEED(...)``, ``ARC_FEED(first_end,
+second_end, first_axis, second_axis, rotation, axis_end_point, a, b, c)`` — in the XY plane
+first/second are X/Y, the axes are the centre, rotation > 0 is counter-clockwise); on an
+error it prints the message and the offending block on stderr and exits 1. Without ``-t``
+it looks for a tool table of a sample configuration that is not installed, so one is given.
+
+Two checks: every linuxcnc program of the corpus run (test_corpus.py, shared per session)
+is accepted, and for a few of them rs274's end points, arc centres and directions equal
+those of the program camtool planned (``camtool.pipeline.post_file``), within the 0.0005 mm
+that the 3-decimal output rounds to.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from camtool.pipeline import post_file
+from camtool.program import ArcMove, Linear, Rapid
+from tests.corpus.conftest import (
+    CORPUS,
+    case_id,
+    corpus_files,
+    load_manifest,
+    outcome_for,
+    skip_reason,
+)
+
+MANIFEST = load_manifest()
+FILES = corpus_files(MANIFEST)
+KNOWN_GOOD = "G21 G90 G17\nG0 X1 Y2\nG1 X5 Y2 F100\nG2 X7 Y4 I0 J2\nM2\n"
+CANON = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED)\(([^)]*)\)")
+ROUND_MM = 0.0005 + 1e-9  # the linuxcnc dialect writes 3 decimals
+
+
+def rs274(program: Path) -> subprocess.CompletedProcess[str]:
+    """Run rs274 in batch mode on PROGRAM (mm tool table from the manifest)."""
+    assert MANIFEST is not None
+    entry = MANIFEST["rs274"]
+    env = dict(
+        os.environ,
+        LD_LIBRARY_PATH=os.pathsep.join(str(CORPUS / d) for d in entry["ld_library_path"]),
+    )
+    cmd = [str(CORPUS / entry["exe"]), "-t", str(CORPUS / entry["tool_table"]), "-g"]
+    return subprocess.run(
+        [*cmd, str(program)], capture_output=True, text=True, env=env, timeout=120, check=False
+    )
+
+
+def rs274_problem() -> str | None:
+    """Why rs274 cannot judge here (None when it can)."""
+    if MANIFEST is None:
+        return skip_reason()
+    if "rs274" not in MANIFEST:
+        return f"rs274 was not fetched: {'; '.join(MANIFEST.get('notes', []))}"
+    probe = CORPUS / "rs274-probe.ngc"
+    probe.write_text(KNOWN_GOOD)
+    try:
+        done = rs274(probe)
+    except OSError as exc:
+        return f"rs274 cannot run: {exc}"
+    if done.returncode != 0 or "ARC_FEED(7.0000, 4.0000, 5.0000, 4.0000, -1" not in done.stdout:
+        return f"rs274 fails on a known-good program: {done.stderr.strip()[-300:]}"
+    return None
+
+
+PROBLEM = rs274_problem()
+needs_rs274 = pytest.mark.skipif(PROBLEM is not None, reason=PROBLEM or "")
+
+
+def canon_moves(stdout: str) -> list[tuple[str, tuple[float, ...]]]:
+    """(kind, numbers) of rs274's motion calls, in order: 'rapid', 'line' or 'arc'.
+
+    rapid/line: (x, y, z); arc: (x, y, cx, cy, rotation, z).
+    """
+    moves = []
+    for name, args in CANON.findall(stdout):
+        v = tuple(float(a) for a in args.split(","))
+        if name == "ARC_FEED":
+            moves.append(("arc", (v[0], v[1], v[2], v[3], v[4], v[5])))
+        else:
+            moves.append(("rapid" if name == "STRAIGHT_TRAVERSE" else "line", v[:3]))
+    return moves
+
+
+def planned_moves(program_moves: tuple[object, ...]) -> list[tuple[str, tuple[float, ...]]]:
+    """The same shape for camtool's planned moves (z None is taken as 0, the start height)."""
+    moves: list[tuple[str, tuple[float, ...]]] = []
+    z = 0.0
+    for m in program_moves:
+        if isinstance(m, Rapid | Linear | ArcMove):
+            z = m.z if m.z is not None else z
+        if isinstance(m, Rapid):
+            moves.append(("rapid", (m.x, m.y, z)))
+        elif isinstance(m, Linear):
+            moves.append(("line", (m.x, m.y, z)))
+        elif isinstance(m, ArcMove):
+            moves.append(("arc", (m.x, m.y, m.cx, m.cy, -1.0 if m.clockwise else 1.0, z)))
+    return moves
+
+
+@needs_rs274
+def test_rs274_rejects_a_wrong_arc_as_linuxcnc_would(tmp_path: Path) -> None:
+    # the judge must be able to say no: an arc whose end is off its circle
+    bad = tmp_path / "bad.ngc"
+    bad.write_text(KNOWN_GOOD.replace("I0 J2", "I9 J2"))
+    done = rs274(bad)
+    assert done.returncode != 0
+    assert "Radius to end of arc differs" in done.stderr
+
+
+@needs_rs274
+@pytest.mark.parametrize("rel", FILES or ["<none>"], ids=case_id)
+def test_rs274_accepts_every_linuxcnc_program(rel: str) -> None:
+    outcome = outcome_for(rel, "linuxcnc")
+    if outcome.final.rc != 0:
+        pytest.skip(f"no linuxcnc program to judge (see test_corpus): {outcome.final.error}")
+    done = rs274(outcome.final.output)
+    errors = [ln for ln in done.stderr.splitlines() if ln.strip() != "executing"]
+    assert done.returncode == 0 and not errors, (
+        f"rs274 -g {outcome.final.output} (from {outcome.final.command()}): "
+        f"exit {done.returncode}: {' / '.join(errors)}"
+    )
+    assert canon_moves(done.stdout), "rs274 saw no motion in the program"
+
+
+# First-try linuxcnc programs (lines, arcs, several contours) compared move by move.
+COMPARED = [
+    "pkg/tango-icon-theme/usr/share/icons/Tango/scalable/places/folder.svg",
+    "pkg/tango-icon-theme/usr/share/icons/Tango/scalable/actions/media-seek-forward.svg",
+    "pkg/librecad-data/usr/share/librecad/library/elektro/connector-iso/Junction-up2.dxf",
+]
+
+
+@needs_rs274
+@pytest.mark.parametrize("rel", COMPARED, ids=case_id)
+def test_rs274_moves_equal_the_planned_program(rel: str) -> None:
+    if not (CORPUS / rel).exists():
+        pytest.skip(f"{rel} is not in this corpus")
+    outcome = outcome_for(rel, "linuxcnc")
+    assert outcome.final.rc == 0, outcome.problems
+    extra = outcome.final.args[6:]  # the remedy flags followed, if any
+    assert extra == [] or extra[0] != "-o"
+    job = post_file(CORPUS / rel, "linuxcnc", **_options(extra))
+    done = rs274(outcome.final.output)
+    assert done.returncode == 0, done.stderr
+    theirs = canon_moves(done.stdout)
+    ours = planned_moves(job.program.moves)
+    assert [k for k, _ in theirs] == [k for k, _ in ours]
+    for i, ((kind, a), (_, b)) in enumerate(zip(theirs, ours, strict=True)):
+        assert a == pytest.approx(b, abs=ROUND_MM), f"move {i} ({kind}): rs274 {a} planned {b}"
+
+
+def _options(extra: list[str]) -> dict[str, object]:
+    """post_file keywords for the remedy flags a comparison file needed (only --fit here)."""
+    if not extra:
+        return {}
+    if extra[0] == "--fit" and len(extra) == 3:
+        return {"fit_mm": (float(extra[1]), float(extra[2]))}
+    pytest.skip(f"comparison with flags {extra} is not mapped to post_file keywords")
