@@ -31,6 +31,7 @@ from collections.abc import Mapping
 from types import MappingProxyType
 from typing import Any
 
+from camtool.errors import ParseError
 from camtool.machine import Machine
 from camtool.post.base import PostProcessor, PostResult
 from camtool.post.wordaddress_read import BlockReader
@@ -86,11 +87,25 @@ class WordAddressPost(PostProcessor):
         ``Program.lines`` holds the 1-based source line of each move. Feeds of
         a dialect without an F word read as 0 (the machine's own speed).
 
+        A dialect with ``rs274`` (its controller runs any RS-274 program) reads code
+        the strict reader refuses with the RS-274 reader of
+        :mod:`camtool.importers.gcode`: another CAM's program verifies as the
+        controller would run it.
+
         Raises:
             ParseError: a block that is not in the dialect, naming ``source`` and
                 the line.
+            InputError: (``rs274``) what the RS-274 reader refuses too, naming the line.
         """
-        return BlockReader(self.spec, source).read(code)
+        try:
+            return BlockReader(self.spec, source).read(code)
+        except ParseError:
+            if not self.spec.rs274:
+                raise
+        from camtool.importers.gcode import parse_gcode
+
+        text = code.decode("ascii", errors="replace") if isinstance(code, bytes) else code
+        return parse_gcode(text, source=source)
 
 
 def word_address_dialect(options: Mapping[str, Any], where: str) -> WordAddressPost:

@@ -96,6 +96,11 @@ class WordAddressSpec:
         comments: whether the controller skips comments, as RS-274/NGC
             controllers (GRBL, LinuxCNC) do: ``( ... )`` and ``;`` to the end of
             the line. The writer writes none; the reader removes them first.
+        rs274: the controller runs any RS-274 program, not only camtool's own
+            spelling of it (GRBL, LinuxCNC): code the strict reader refuses (another
+            CAM's ``X0`` for ``X0.000``, modal codes, comments anywhere) is read
+            by the RS-274 reader of :mod:`camtool.importers.gcode` instead, so
+            ``camtool verify other.gcode -t grbl`` works.
         modal: letters written only when their value changes (``G`` for the
             motion code); the others are written in every block that uses them.
         arc_check: ``"none"``, ``"grbl"`` or ``"linuxcnc"``: arcs are written
@@ -132,6 +137,7 @@ class WordAddressSpec:
     helix: bool = False
     max_block_bytes: int | None = None
     comments: bool = False
+    rs274: bool = False
     modal: frozenset[str] = frozenset("F")
     arc_check: str = "none"
     spindle_cw: str | None = None
@@ -315,6 +321,7 @@ def load_spec(options: Mapping[str, Any], where: str) -> WordAddressSpec:
         helix=t.flag("helix", False),
         max_block_bytes=t.integer("max_block_bytes", None, low=8),
         comments=t.flag("comments", False),
+        rs274=t.flag("rs274", False),
         modal=_modal(t, words),
         arc_check=t.string("arc_check", "none", choices=ARC_CHECKS),
         comment=t.string("comment", None, choices=COMMENTS),
