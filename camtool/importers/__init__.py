@@ -7,12 +7,13 @@ from pathlib import Path
 
 from camtool.errors import InputError, UsageError
 from camtool.geometry import Drawing
+from camtool.units import LARGEST_VALUE
 
 MAX_ENTITIES = 5_000_000
 """Default :attr:`ImportOptions.max_entities`: 10 × the largest real job camtool was
 measured on (10⁵–10⁶ LINEs); block "laughs" expand to 10³⁰ and are refused before expanding."""
 
-MAX_COORDINATE_MM = 1e9
+MAX_COORDINATE_MM = LARGEST_VALUE
 """Largest coordinate magnitude, mm (1000 km), an importer accepts; beyond it (and for
 NaN or infinity) the drawing is refused with an :class:`InputError` naming the entity.
 No machine camtool drives has a travel near it; numbers past it come from damaged or
