@@ -84,6 +84,7 @@ FINDING_KINDS = (
     "gouge",
     "open-on-line",
     "open-gap",
+    "lead-in",
     "option",
     "arc-fit",
     "ordering",

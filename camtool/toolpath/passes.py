@@ -74,7 +74,7 @@ from itertools import pairwise
 from camtool.errors import UsageError
 from camtool.geometry import Arc, Segment
 from camtool.program import ArcMove, Linear, Move, Rapid
-from camtool.toolpath.cuts import Cut, where
+from camtool.toolpath.cuts import Cut, Finding, where
 from camtool.toolpath.leads import leads_for
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.split import MIN_PIECE, Track
@@ -116,6 +116,13 @@ def pass_depths(depth: float, step: float | None) -> tuple[float, ...]:
 def emit_moves(
     cuts: Sequence[Cut], options: PlanOptions, *, helix: bool = True, z_axis: bool = False
 ) -> list[Move]:
+    """The moves of :func:`emit` (without its findings)."""
+    return emit(cuts, options, helix=helix, z_axis=z_axis)[0]
+
+
+def emit(
+    cuts: Sequence[Cut], options: PlanOptions, *, helix: bool = True, z_axis: bool = False
+) -> tuple[list[Move], list[Finding]]:
     """The moves that cut ``cuts`` in order, with passes, tabs, ramps and lead arcs.
 
     Args:
@@ -137,7 +144,9 @@ def emit_moves(
 
     Returns:
         Rapid/Linear/ArcMove moves, absolute mm; ``z`` is ``None`` on every move
-        of a 2D plan, and in a Z plan on cutting moves that keep Z.
+        of a 2D plan, and in a Z plan on cutting moves that keep Z. And the
+        findings of this stage: ``lead-in`` where a lead arc had to be shortened
+        (or left out) to stay on the waste side.
 
     Raises:
         ToolpathError: the tabs do not fit on a profile (names the contour).
@@ -151,7 +160,7 @@ def emit_moves(
             writer.number = number
             _cut_2d(writer, cut)
         writer.finish()
-        return writer.moves
+        return writer.moves, writer.findings
     levels = (0.0,) if options.depth is None else pass_depths(options.depth, options.step_down)
     check_ramp(cuts, options, levels)
     part_of = parts(cuts)
@@ -171,7 +180,7 @@ def emit_moves(
             _cut_open(writer, cuts[i], levels)
         i = j
     writer.finish()
-    return writer.moves
+    return writer.moves, writer.findings
 
 
 def parts(cuts: Sequence[Cut]) -> list[int]:
@@ -279,8 +288,34 @@ class _Writer:
         self.part: int | None = None
         self._part_here: int | None = None
         self._lift_at: int | None = None
+        self.findings: list[Finding] = []
         ramp = options.ramp_angle_deg
         self.slope = None if ramp is None else math.tan(math.radians(ramp))
+
+    def leads(self, cut: Cut) -> tuple[Arc, Arc] | None:
+        """The lead arcs of ``cut`` (:func:`leads_for`), saying when they had to shrink."""
+        asked = self.options.lead_in_mm
+        leads = leads_for(cut, asked)
+        if asked <= 0 or cut.kind != "profile" or cut.material_side is None:
+            return leads
+        got = 0.0 if leads is None else leads[0].radius
+        if got < asked - 1e-9:
+            from camtool.units import fmt_num
+
+            what = (
+                f"lead-in and lead-out arcs shortened to {fmt_num(got, 3)} mm radius"
+                if got > 0
+                else "no room for lead-in and lead-out arcs: the tool enters on the path"
+            )
+            self.findings.append(
+                Finding(
+                    "lead-in",
+                    f"{where(cut.path)}: {what} (--lead-in {asked:g}) to stay off the part",
+                    cut.path.start,
+                    got,
+                )
+            )
+        return leads
 
     def add(self, move: Move) -> None:
         """Append ``move``.
@@ -452,7 +487,7 @@ def _unrolled(
 
 def _cut_2d(w: _Writer, cut: Cut) -> None:
     """What the planner always wrote for a 2D cut, plus lead arcs when asked."""
-    leads = leads_for(cut, w.options.lead_in_mm)
+    leads = w.leads(cut)
     segments = list(cut.path.segments)
     if leads is not None:
         segments = [leads[0], *segments, leads[1]]
@@ -525,7 +560,7 @@ def _cut_closed(w: _Writer, cut: Cut, levels: Sequence[float]) -> None:
     spans: tuple[tuple[float, float], ...] = ()
     if o.tabs > 0 and cut.outside_profile and cut.kind == "profile":
         spans = tab_spans(track.length, o.tabs, o.tab_width + o.tool_diameter, where(cut.path))
-    leads = leads_for(cut, o.lead_in_mm)
+    leads = w.leads(cut)
     if leads is not None:
         lead_in, lead_out = leads
         lead = Track.from_segments([lead_in], closed=False)

@@ -150,7 +150,7 @@ def plan_drawing(
         ToolpathError: a stage cannot plan the drawing (names the contour).
         DialectError: the toolpath does not fit the machine (:func:`place_program`).
     """
-    from camtool.toolpath.passes import emit_moves
+    from camtool.toolpath.passes import emit
 
     if machine is not None:
         options.check_machine(machine, machine.name)
@@ -169,7 +169,8 @@ def plan_drawing(
     ordering = order_cuts(stage.cuts, nest, options, backlash)
     findings.extend(ordering.findings)
     z_axis = machine is not None and machine.has_z
-    moves = emit_moves(ordering.cuts, options, helix=helix, z_axis=z_axis)
+    moves, emitted = emit(ordering.cuts, options, helix=helix, z_axis=z_axis)
+    findings.extend(emitted)
     report = PlanReport(len(contours), len(stage.cuts), tuple(findings), ordering, stats)
     warnings = tuple(dict.fromkeys((*drawing.warnings, *(f.message for f in findings))))
     program, placed = place_program(
