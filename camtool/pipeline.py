@@ -344,6 +344,7 @@ def job_notes(source: str, target: Target, plan: PlanOptions | None = None) -> t
     elif plan.offset == "pocket":
         tool += f" ({plan.pocket}, stepover {plan.stepover:g})"
     notes.append(tool)
+    notes.append(_work_zero(plan))
     if not target.machine.has_z:
         notes.append("no Z axis: set the depth by hand")
         return tuple(notes)
@@ -355,6 +356,18 @@ def job_notes(source: str, target: Target, plan: PlanOptions | None = None) -> t
     notes.append(depth)
     notes.append(f"safe Z {plan.safe_z:g} mm, clearance Z {plan.clearance:g} mm above the top")
     return tuple(notes)
+
+
+def _work_zero(plan: PlanOptions) -> str:
+    """Where X0 Y0 of the program lies, for the job notes (``--origin``, ``--translate``)."""
+    where = {
+        "drawing": "the drawing's origin",
+        "lower-left": "the toolpath's lower-left corner",
+        "center": "the toolpath's centre",
+    }[plan.placement]
+    dx, dy = plan.translate
+    moved = f", moved by X{dx:g} Y{dy:g} mm" if (dx, dy) != (0.0, 0.0) else ""
+    return f"work zero X0 Y0: {where}{moved}"
 
 
 def verify_job(job: PostJob) -> Verification:

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from camtool.geometry import Contour, Drawing, Line, Segment
-from camtool.program import Program
+from camtool.program import Move, Program
 from camtool.toolpath.arcfit import FitStats, fit_polyline, fit_stats
 from camtool.toolpath.chain import chain, close_gaps
 from camtool.toolpath.cuts import Finding, Stage
@@ -214,7 +214,8 @@ def place_program(
 
     ``options.placement`` (``--origin``) then ``options.translate`` (``--translate``)
     shift the program's moves (:func:`~camtool.toolpath.placement.shift_program`; the
-    start position stays) and the placed drawing alike, so that ``verify --against``
+    start position and the ``--end-position`` rapid, given in work coordinates, stay)
+    and the placed drawing alike, so that ``verify --against``
     and previews still line up. With a machine, the program is then checked against
     its travel (:func:`~camtool.toolpath.placement.check_travel`); its warnings join
     the program's (the post-processor applies the same rule again as a backstop, but
@@ -228,8 +229,13 @@ def place_program(
             the work area of a machine in machine coordinates; the message names
             options that fix it as written.
     """
+    end: tuple[Move, ...] = ()
+    if options.end_position is not None and program.moves:
+        # the end position is given in work coordinates: it stays where it was asked
+        end, program = program.moves[-1:], dataclasses.replace(program, moves=program.moves[:-1])
     dx, dy = placement_shift(program, options.placement, options.translate)
     program = shift_program(program, dx, dy)
+    program = dataclasses.replace(program, moves=(*program.moves, *end))
     if dx or dy:
         placed = placed.transformed(1.0, dx, dy)
     if machine is not None:

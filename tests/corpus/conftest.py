@@ -168,6 +168,7 @@ def _post_options() -> dict[str, click.Option]:
 
 OPTION = re.compile(r"--[a-z][a-z0-9-]*")
 STRIP = "`'\"“”‘’()[]{},;:."
+PLACEHOLDER = re.compile(r"[A-Z][A-Z0-9_]*(\.[a-z]+)?")
 
 
 def suggested_flags(message: str) -> list[list[str]] | str:
@@ -192,6 +193,8 @@ def suggested_flags(message: str) -> list[list[str]] | str:
             found.append([name])
             continue
         words = [w.strip(STRIP) for w in message[match.end() :].split()][: option.nargs]
+        if any(PLACEHOLDER.fullmatch(w) for w in words):
+            continue  # "--machine FILE.toml": a pointer to an option, not a value to use
         try:
             if len(words) < option.nargs or any(w.startswith("--") for w in words):
                 raise click.BadParameter("too few values")

@@ -266,3 +266,13 @@ def test_a_chosen_work_zero_inside_the_part_is_not_warned_about(
     assert "on both sides of work zero" in capsys.readouterr().err  # as drawn: worth a word
     assert main(["post", *args, "--origin", "center"]) == 0
     assert "on both sides of work zero" not in capsys.readouterr().err  # asked for
+
+
+def test_the_end_position_is_in_work_coordinates(tmp_path: Path) -> None:
+    out = tmp_path / "p.gcode"
+    args = [str(plate(tmp_path / "p.dxf")), "-t", "grbl", *OUTSIDE, "--depth", "1"]
+    place = ["--origin", "lower-left", "--end-position", "0", "0", "-o", str(out)]
+    assert main(["post", *args, *place]) == 0
+    lines = out.read_text().splitlines()
+    # the park move goes to the work zero the user set, not to the drawing's origin shifted
+    assert lines[-4:] == ["G0 Z5.000", "G0 X0.000 Y0.000", "M5", "M2"]
