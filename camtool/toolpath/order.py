@@ -183,8 +183,12 @@ def order_cuts(
         sequences["planned"] = plan.cuts
         axis, point = plan.axis, plan.point
         findings.extend(plan.findings)
-    reversals = {k: count_reversals(v, origin) for k, v in sequences.items()}
-    travel = {k: _rapids(v, origin) for k, v in sequences.items()}
+    reversals: dict[str, tuple[int, int]] = {}
+    travel: dict[str, float] = {}
+    for k, v in sequences.items():
+        same = next((j for j in reversals if sequences[j] is v), None)  # planned = travel
+        reversals[k] = reversals[same] if same else count_reversals(v, origin)
+        travel[k] = travel[same] if same else _rapids(v, origin)
     findings.extend(_small_part(sequences["planned"], reversals["planned"], options.order))
     return Ordering(
         tuple(sequences["planned"]),
@@ -213,9 +217,12 @@ def _small_part(cuts: Sequence[Cut], counts: tuple[int, int], mode: str) -> list
     """seed-000 S000-19 (L3205–L3211): a part under 1 mm fails after about 16 compensations."""
     if not cuts or mode == "mirror" or sum(counts) <= MAX_REVERSALS_SMALL:
         return []
-    boxes = [c.path.bbox() for c in cuts]
-    x0, y0 = min(b[0] for b in boxes), min(b[1] for b in boxes)
-    x1, y1 = max(b[2] for b in boxes), max(b[3] for b in boxes)
+    x0, y0, x1, y1 = cuts[0].path.bbox()
+    for cut in cuts[1:]:
+        if max(x1 - x0, y1 - y0) >= SMALL_PART_MM:
+            return []  # large already: the other boxes cannot make it small
+        b = cut.path.bbox()
+        x0, y0, x1, y1 = min(x0, b[0]), min(y0, b[1]), max(x1, b[2]), max(y1, b[3])
     size = max(x1 - x0, y1 - y0)
     if size >= SMALL_PART_MM:
         return []
