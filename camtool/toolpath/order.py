@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any
 
+from camtool.errors import UsageError
 from camtool.geometry import Contour, Point, distance
 from camtool.toolpath.cuts import Cut, Finding
 from camtool.toolpath.options import PlanOptions
@@ -77,6 +78,10 @@ def nesting(contours: Sequence[Contour]) -> Nesting:
         parents.append(tuple(sorted(j for j in around if areas[j] > areas.get(i, 0.0))))
     return Nesting(tuple(parents))
 
+
+MAX_SEARCH_CUTS = 5000
+"""Most cuts ``--order reversals`` and ``--order mirror`` plan (their searches grow with the
+square of the count; the parts they are for have tens of cuts). ``travel`` has no limit."""
 
 SMALL_PART_MM = 1.0
 """Parts smaller than this (bounding box of the cuts) fail after about 16 compensations."""
@@ -158,8 +163,14 @@ def order_cuts(
 
     Raises:
         ToolpathError: ``mirror`` on a drawing symmetric about neither axis.
+        UsageError: ``reversals`` or ``mirror`` on more than :data:`MAX_SEARCH_CUTS` cuts.
     """
     origin = options.origin
+    if options.order != "travel" and len(cuts) > MAX_SEARCH_CUTS:
+        raise UsageError(
+            f"--order {options.order} plans at most {MAX_SEARCH_CUTS} cuts and this drawing "
+            f"has {len(cuts)}; use --order travel, or plan part of it (--layers)"
+        )
     before = precedence(cuts, nest.parents)
     drawn_seq = drawn_order(cuts, before)
     travel_seq = travel_order(cuts, before, origin)
