@@ -17,6 +17,7 @@ from collections.abc import Sequence
 from camtool.errors import ToolpathError
 from camtool.geometry import Arc, Contour, Line, Point, Segment, distance
 from camtool.toolpath.cuts import Finding, where
+from camtool.units import fmt_point
 
 _GAP_SHARE = 0.1  # a gap closed by close_gaps is shorter than this share of the contour
 _MAX_CELLS = 2.0**40
@@ -201,7 +202,7 @@ def close_gaps(
             Finding(
                 "closed-gap",
                 f"{where(contour)}: closed a {gap:.4g} mm gap between its ends at "
-                f"({mid[0]:.4f}, {mid[1]:.4f}) mm with a straight line; check the drawing "
+                f"{fmt_point(mid)} mm with a straight line; check the drawing "
                 "(--close-gap 0 keeps it open)",
                 mid,
                 gap,

@@ -32,6 +32,7 @@ from camtool.toolpath.cuts import Cut, Finding
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.reversals import count_reversals, reversal_order
 from camtool.toolpath.travel import Step, drawn_order, oriented, precedence, travel_order
+from camtool.units import fmt_point
 
 _NEST_TOLERANCE_MM = 1e-4
 
@@ -129,8 +130,8 @@ class Ordering:
         )
         if self.mirror_point is None:
             return [text]
-        x, y = self.mirror_point
-        return [text, f"  mirror about {self.mirror_axis} mm from ({x:.4f}, {y:.4f}) mm"]
+        point = fmt_point(self.mirror_point)
+        return [text, f"  mirror about {self.mirror_axis} mm from {point} mm"]
 
     def to_json(self) -> dict[str, Any]:
         """``{"mode", "reversals": {key: {"x", "y"}}, "travel_mm": {key: mm}, "mirror_axis"}``."""

@@ -17,7 +17,7 @@ from camtool.cli import main
 from camtool.errors import InputError, ToolpathError, UsageError
 from camtool.geometry import MAX_CHORDS, Contour, Line, chord_count
 from camtool.toolpath import offset, pocket_uncut
-from camtool.toolpath.chain import chain
+from camtool.toolpath.chain import chain, close_gaps
 from camtool.toolpath.pocket import MAX_POCKET_PATHS
 from camtool.toolpath.polyfit import fit_polyline
 
@@ -121,3 +121,11 @@ def test_pocket_refuses_more_rings_than_the_limit(
     assert f"limit of {MAX_POCKET_PATHS} per pocket" in err
     assert "--stepover" in err and "internal error" not in err
     assert not out.exists()
+
+
+def test_closed_gap_message_never_prints_minus_zero() -> None:
+    # gap from (-1e-5, 0.01) back to (0, 0): midpoint (-5e-6, 0.005) rounds to 0.0000
+    drawn = _open((0.0, 0.0), (10.0, 0.0), (10.0, 10.0), (-1e-5, 0.01))
+    _, findings = close_gaps([drawn], 0.02, 0.001)
+    assert "at (0.0000, 0.0050) mm" in findings[0].message
+    assert "-0.0000" not in findings[0].message
