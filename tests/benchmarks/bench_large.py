@@ -15,8 +15,19 @@ has to find every joint):
 - ``chains``: long polylines of 1000 LINEs each, a dense wave (arc fitting runs
   on them) next to a zigzag (nothing to fit).
 
-Measured on the 2-core dev machine: see the report of the planner-at-scale work
-(issue 14) and ``docs/`` for the figures.
+Measured on the 2-core dev machine (CPU seconds of the whole ``post``, shared with other
+jobs), before → after the O(n) travel order (issue 14):
+
+=========  ==========================  =============  ==========
+N LINEs    disjoint (N cuts)           squares (N/4)  chains
+=========  ==========================  =============  ==========
+10⁴        116 → 3                     7.2 → 1.8      1.4 → 1.5
+10⁵        hours (O(n²) 2-opt) → 23    → 15           → 12
+10⁶        → 188 (2·10⁶ blocks)        → 147          → 109
+=========  ==========================  =============  ==========
+
+At 10⁵ disjoint lines (profiled) the importer takes about 27 %, planning 52 % (ordering
+30 %, chaining 9 %, nesting 7 %, emission 3 %) and the grbl writer 20 %.
 """
 
 from __future__ import annotations
