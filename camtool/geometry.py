@@ -16,6 +16,9 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import TypeAlias
 
+from camtool.errors import ToolpathError, UsageError
+from camtool.units import fmt_num
+
 Point: TypeAlias = tuple[float, float]
 BBox: TypeAlias = tuple[float, float, float, float]
 """``(xmin, ymin, xmax, ymax)`` in mm."""
@@ -179,22 +182,53 @@ class Arc:
 Segment: TypeAlias = Line | Arc
 
 
+MAX_CHORDS = 1_000_000
+"""Most chords one arc may become (a 1 m radius within 1 nm needs about 70 000)."""
+_SMALL_RATIO = 1e-6  # below this tolerance/radius, acos(1 − x) loses digits: use the asin form
+
+
 def chord_count(radius: float, sweep: float, tolerance: float) -> int:
     """Number of equal chords so that each deviates from the arc by ≤ ``tolerance``.
 
-    The sagitta of a chord spanning angle θ is ``r·(1 − cos(θ/2))``.
+    The sagitta of a chord spanning angle θ is ``r·(1 − cos(θ/2))``, so the
+    widest chord spans ``2·acos(1 − t/r)`` = ``4·asin(√(t/2r))`` (the second form
+    for t/r under 1e-6, where the first rounds to 0).
 
     Args:
-        radius: arc radius, mm.
-        sweep: unsigned sweep, radians.
-        tolerance: largest allowed chord error, mm (> 0).
+        radius: arc radius, mm (≥ 0, finite).
+        sweep: unsigned sweep, radians (finite).
+        tolerance: largest allowed chord error, mm (> 0, finite).
+
+    Raises:
+        ToolpathError: ``radius`` or ``sweep`` is not finite (importers refuse such
+            drawings: an internal check).
+        UsageError: ``tolerance`` is not a finite number > 0, or the arc would need
+            more than :data:`MAX_CHORDS` chords (the tolerance is far too small
+            for the radius).
     """
-    if tolerance <= 0:
-        raise ValueError(f"chord tolerance must be > 0 mm, got {tolerance!r}")
+    if not (math.isfinite(radius) and math.isfinite(sweep)):
+        raise ToolpathError(
+            f"an arc has radius {radius!r} mm and sweep {sweep!r} rad; both must be finite"
+        )
+    if not (tolerance > 0 and math.isfinite(tolerance)):
+        raise UsageError(
+            f"chord tolerance must be a finite number > 0 mm (--tolerance), got {tolerance!r}"
+        )
     if tolerance >= radius:
         return max(1, math.ceil(sweep / math.pi))
-    max_angle = 2.0 * math.acos(1.0 - tolerance / radius)
-    return max(1, math.ceil(sweep / max_angle - 1e-9))
+    ratio = tolerance / radius
+    if ratio > _SMALL_RATIO:
+        max_angle = 2.0 * math.acos(1.0 - ratio)
+    else:
+        max_angle = 4.0 * math.asin(math.sqrt(ratio / 2.0))
+    count = sweep / max_angle if max_angle > 0 else math.inf
+    if count > MAX_CHORDS:
+        raise UsageError(
+            f"an arc of radius {fmt_num(radius)} mm would need {count:.3g} chords to stay "
+            f"within {tolerance:g} mm, more than the limit of {MAX_CHORDS}; give a larger "
+            "--tolerance"
+        )
+    return max(1, math.ceil(count - 1e-9))
 
 
 def _tf(p: Point, scale: float, dx: float, dy: float) -> Point:

@@ -34,10 +34,10 @@ from typing import Any
 from camtool.errors import ParseError
 from camtool.machine import Machine
 from camtool.post.base import PostProcessor, PostResult
-from camtool.post.wordaddress_read import BlockReader
+from camtool.post.wordaddress_read import BlockReader, ControllerRefusal
 from camtool.post.wordaddress_spec import WordAddressSpec, WordSpec, load_spec
 from camtool.post.wordaddress_write import BlockWriter
-from camtool.program import Program
+from camtool.program import ArcMove, Program
 
 __all__ = ["WordAddressPost", "WordAddressSpec", "WordSpec", "load_spec", "word_address_dialect"]
 
@@ -99,13 +99,39 @@ class WordAddressPost(PostProcessor):
         """
         try:
             return BlockReader(self.spec, source).read(code)
+        except ControllerRefusal:
+            raise
         except ParseError:
             if not self.spec.rs274:
                 raise
         from camtool.importers.gcode import parse_gcode
 
         text = code.decode("ascii", errors="replace") if isinstance(code, bytes) else code
-        return parse_gcode(text, source=source)
+        program = parse_gcode(text, source=source)
+        self._check_arcs(program, source)
+        return program
+
+    def _check_arcs(self, program: Program, source: str) -> None:
+        """Hold code read by the RS-274 reader to the controller's own arc check.
+
+        Raises:
+            ControllerRefusal: an arc the controller refuses, naming the line.
+        """
+        if self.spec.arc_check == "none":
+            return
+        from camtool.post.arccheck import arc_error
+
+        for index, (start, move) in enumerate(program.steps()):
+            if not isinstance(move, ArcMove):
+                continue
+            reason = arc_error(
+                start, (move.x, move.y), (move.cx, move.cy), rule=self.spec.arc_check
+            )
+            if reason is not None:
+                line = program.line_of(index)
+                raise ControllerRefusal(
+                    f"{source}:{line}: {self.spec.arc_check} refuses this arc: {reason}"
+                )
 
 
 def word_address_dialect(options: Mapping[str, Any], where: str) -> WordAddressPost:

@@ -79,6 +79,13 @@ class _State:
     ended: int = 0
 
 
+class ControllerRefusal(ParseError):
+    """A block in the dialect's spelling that the controller itself refuses (its arc check).
+
+    Not a matter of spelling: an RS-274 reader would not accept it either.
+    """
+
+
 class BlockReader:
     """Reads code of one dialect (see the module docstring for the rules).
 
@@ -337,7 +344,8 @@ class BlockReader:
 
             reason = arc_error((s.x, s.y), end, centre, rule=spec.arc_check)
             if reason is not None:
-                raise self.fail(f"{spec.arc_check} refuses this arc: {reason}")
+                refused = f"{spec.arc_check} refuses this arc: {reason}"
+                raise ControllerRefusal(f"{self.source}:{self.line}: {refused}")
         return centre
 
     def _push(self, move: Move) -> None:

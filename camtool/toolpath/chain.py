@@ -12,12 +12,16 @@ from __future__ import annotations
 
 import math
 from collections import defaultdict
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 
+from camtool.errors import ToolpathError
 from camtool.geometry import Arc, Contour, Line, Point, Segment, distance
 from camtool.toolpath.cuts import Finding, where
+from camtool.units import fmt_point
 
 _GAP_SHARE = 0.1  # a gap closed by close_gaps is shorter than this share of the contour
+_MAX_CELLS = 2.0**40
+"""Largest cell number of the end hash (keeps cell numbers small ints on huge drawings)."""
 
 
 def chain(contours: Sequence[Contour], tolerance: float) -> list[Contour]:
@@ -30,16 +34,21 @@ def chain(contours: Sequence[Contour], tolerance: float) -> list[Contour]:
 
     Args:
         contours: contours as read, mm.
-        tolerance: largest gap, mm, that still counts as a joint (> 0).
+        tolerance: largest gap, mm, that still counts as a joint (≥ 0; 0: ends
+            must coincide).
 
     Returns:
         The chained contours, in the order their first pieces were given.
+
+    Raises:
+        ToolpathError: an open contour's end is not finite (importers refuse
+            those; huge finite coordinates are fine).
     """
-    if tolerance <= 0:
-        raise ValueError(f"chaining tolerance must be > 0 mm, got {tolerance!r}")
+    if not tolerance >= 0:
+        raise ValueError(f"chaining tolerance must be ≥ 0 mm, got {tolerance!r}")
     result: list[Contour] = []
-    grid = _EndGrid(tolerance)
     pieces = list(contours)
+    grid = _EndGrid(tolerance, [c for c in pieces if not c.closed])
     for index, contour in enumerate(pieces):
         if not contour.closed:
             grid.add(index, contour)
@@ -108,33 +117,47 @@ def _with_end(seg: Segment, p: Point) -> Segment:
 
 
 class _EndGrid:
-    """Spatial hash of open-contour ends, cell size = tolerance."""
+    """Spatial hash of open-contour ends in square cells of at least ``tolerance``.
 
-    def __init__(self, tolerance: float) -> None:
+    Ends within ``tolerance`` of a point lie in its cell or the 8 around it. The
+    cell is ``tolerance`` wide unless the drawing is so large that cell numbers
+    would pass :data:`_MAX_CELLS` (then wider: any width ≥ ``tolerance`` works).
+
+    Raises:
+        ToolpathError: an end is not a finite point (the importers refuse those).
+    """
+
+    def __init__(self, tolerance: float, pieces: Sequence[Contour]) -> None:
+        reach = max((max(abs(v) for v in (*c.start, *c.end)) for c in pieces), default=0.0)
+        if not math.isfinite(reach):
+            bad = next(c for c in pieces if not all(map(math.isfinite, (*c.start, *c.end))))
+            raise ToolpathError(f"{where(bad)}: an end point is not finite; check the drawing")
+        self.size = max(tolerance, reach / _MAX_CELLS) or 1.0  # 1.0: every end at (0, 0)
         self.tolerance = tolerance
         self.cells: dict[tuple[int, int], list[tuple[int, bool, Point]]] = defaultdict(list)
 
     def _cell(self, p: Point) -> tuple[int, int]:
-        return (math.floor(p[0] / self.tolerance), math.floor(p[1] / self.tolerance))
+        return (math.floor(p[0] / self.size), math.floor(p[1] / self.size))
 
     def add(self, index: int, contour: Contour) -> None:
         for at_start, p in ((True, contour.start), (False, contour.end)):
             self.cells[self._cell(p)].append((index, at_start, p))
 
-    def _near(self, p: Point) -> Iterable[tuple[int, bool, Point]]:
+    def nearest(self, p: Point, used: set[int]) -> tuple[int, bool] | None:
         cx, cy = self._cell(p)
+        cells, tol = self.cells, self.tolerance
+        px, py = p
+        best: tuple[float, int, bool] | None = None
         for dx in (-1, 0, 1):
             for dy in (-1, 0, 1):
-                yield from self.cells.get((cx + dx, cy + dy), ())
-
-    def nearest(self, p: Point, used: set[int]) -> tuple[int, bool] | None:
-        best: tuple[float, int, bool] | None = None
-        for index, at_start, q in self._near(p):
-            d = distance(p, q)
-            if index in used or d > self.tolerance:
-                continue
-            if best is None or (d, index) < (best[0], best[1]):
-                best = (d, index, at_start)
+                for index, at_start, q in cells.get((cx + dx, cy + dy), ()):
+                    if index in used:
+                        continue
+                    d = math.hypot(q[0] - px, q[1] - py)
+                    if d > tol:
+                        continue
+                    if best is None or (d, index) < (best[0], best[1]):
+                        best = (d, index, at_start)
         return None if best is None else (best[1], best[2])
 
 
@@ -179,7 +202,7 @@ def close_gaps(
             Finding(
                 "closed-gap",
                 f"{where(contour)}: closed a {gap:.4g} mm gap between its ends at "
-                f"({mid[0]:.4f}, {mid[1]:.4f}) mm with a straight line; check the drawing "
+                f"{fmt_point(mid)} mm with a straight line; check the drawing "
                 "(--close-gap 0 keeps it open)",
                 mid,
                 gap,

@@ -195,6 +195,8 @@ def quad_segs(radius: float, chord_error: float) -> int:
     if chord_error >= radius:
         return 8
     half = math.acos(1.0 - chord_error / radius)
+    if half <= 0.0:  # chord_error / radius below float resolution: as fine as allowed
+        return _MAX_QUAD_SEGS
     return max(8, min(_MAX_QUAD_SEGS, math.ceil(math.pi / (4.0 * half))))
 
 

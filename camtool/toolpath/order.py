@@ -26,11 +26,13 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any
 
+from camtool.errors import UsageError
 from camtool.geometry import Contour, Point, distance
 from camtool.toolpath.cuts import Cut, Finding
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.reversals import count_reversals, reversal_order
 from camtool.toolpath.travel import Step, drawn_order, oriented, precedence, travel_order
+from camtool.units import fmt_point
 
 _NEST_TOLERANCE_MM = 1e-4
 
@@ -78,6 +80,10 @@ def nesting(contours: Sequence[Contour]) -> Nesting:
     return Nesting(tuple(parents))
 
 
+MAX_SEARCH_CUTS = 5000
+"""Most cuts ``--order reversals`` and ``--order mirror`` plan (their searches grow with the
+square of the count; the parts they are for have tens of cuts). ``travel`` has no limit."""
+
 SMALL_PART_MM = 1.0
 """Parts smaller than this (bounding box of the cuts) fail after about 16 compensations."""
 MAX_REVERSALS_SMALL = 16
@@ -124,8 +130,8 @@ class Ordering:
         )
         if self.mirror_point is None:
             return [text]
-        x, y = self.mirror_point
-        return [text, f"  mirror about {self.mirror_axis} mm from ({x:.4f}, {y:.4f}) mm"]
+        point = fmt_point(self.mirror_point)
+        return [text, f"  mirror about {self.mirror_axis} mm from {point} mm"]
 
     def to_json(self) -> dict[str, Any]:
         """``{"mode", "reversals": {key: {"x", "y"}}, "travel_mm": {key: mm}, "mirror_axis"}``."""
@@ -158,8 +164,14 @@ def order_cuts(
 
     Raises:
         ToolpathError: ``mirror`` on a drawing symmetric about neither axis.
+        UsageError: ``reversals`` or ``mirror`` on more than :data:`MAX_SEARCH_CUTS` cuts.
     """
     origin = options.origin
+    if options.order != "travel" and len(cuts) > MAX_SEARCH_CUTS:
+        raise UsageError(
+            f"--order {options.order} plans at most {MAX_SEARCH_CUTS} cuts and this drawing "
+            f"has {len(cuts)}; use --order travel, or plan part of it (--layers)"
+        )
     before = precedence(cuts, nest.parents)
     drawn_seq = drawn_order(cuts, before)
     travel_seq = travel_order(cuts, before, origin)
@@ -183,8 +195,12 @@ def order_cuts(
         sequences["planned"] = plan.cuts
         axis, point = plan.axis, plan.point
         findings.extend(plan.findings)
-    reversals = {k: count_reversals(v, origin) for k, v in sequences.items()}
-    travel = {k: _rapids(v, origin) for k, v in sequences.items()}
+    reversals: dict[str, tuple[int, int]] = {}
+    travel: dict[str, float] = {}
+    for k, v in sequences.items():
+        same = next((j for j in reversals if sequences[j] is v), None)  # planned = travel
+        reversals[k] = reversals[same] if same else count_reversals(v, origin)
+        travel[k] = travel[same] if same else _rapids(v, origin)
     findings.extend(_small_part(sequences["planned"], reversals["planned"], options.order))
     return Ordering(
         tuple(sequences["planned"]),
@@ -213,9 +229,12 @@ def _small_part(cuts: Sequence[Cut], counts: tuple[int, int], mode: str) -> list
     """seed-000 S000-19 (L3205–L3211): a part under 1 mm fails after about 16 compensations."""
     if not cuts or mode == "mirror" or sum(counts) <= MAX_REVERSALS_SMALL:
         return []
-    boxes = [c.path.bbox() for c in cuts]
-    x0, y0 = min(b[0] for b in boxes), min(b[1] for b in boxes)
-    x1, y1 = max(b[2] for b in boxes), max(b[3] for b in boxes)
+    x0, y0, x1, y1 = cuts[0].path.bbox()
+    for cut in cuts[1:]:
+        if max(x1 - x0, y1 - y0) >= SMALL_PART_MM:
+            return []  # large already: the other boxes cannot make it small
+        b = cut.path.bbox()
+        x0, y0, x1, y1 = min(x0, b[0]), min(y0, b[1]), max(x1, b[2]), max(y1, b[3])
     size = max(x1 - x0, y1 - y0)
     if size >= SMALL_PART_MM:
         return []

@@ -32,6 +32,7 @@ circle ``tolerance / 4`` (:mod:`~camtool.toolpath.pocket_rings`); in the worst c
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -40,7 +41,7 @@ from shapely import Point as ShapelyPoint
 from shapely.geometry.base import BaseGeometry
 from shapely.geometry.polygon import orient
 
-from camtool.errors import ToolpathError
+from camtool.errors import ToolpathError, UsageError
 from camtool.geometry import Contour, Line, Point, Segment, distance
 from camtool.toolpath.cuts import Cut, Finding, Stage, where
 from camtool.toolpath.offset import offset_contour
@@ -49,12 +50,16 @@ from camtool.toolpath.order import Nesting
 from camtool.toolpath.pocket_rings import fit_ring, nearest_on, start_near
 from camtool.toolpath.pocket_uncut import polygons, quad_segs, uncut_findings
 from camtool.toolpath.pocket_zigzag import order_lines, zigzag_lines
+from camtool.units import fmt_num
 
 __all__ = ["Region", "pocket", "regions"]
 
 Ring = tuple[tuple[Segment, ...], bool]
 """A closed tool path (segments, start == end) and whether it goes around an island."""
 
+MAX_POCKET_PATHS = 100_000
+"""Most rings (concentric) or lines (zigzag) one pocket region may need; a real job
+(a 1 m pocket with a 10 µm step-over) stays under it."""
 _ZIGZAG_MARGIN = 0.05  # zigzag lines stop this share of the diameter short of the wall pass
 
 
@@ -179,6 +184,7 @@ def _pocket_region(region: Region, options: PlanOptions) -> tuple[list[Cut], lis
     step = options.stepover * options.tool_diameter
     climb = options.direction != "conventional"
     zigzag = options.pocket == "zigzag"
+    _check_path_count(region, step, options)
     levels = _levels(region.area, r, step, tol, 1 if zigzag else None)
     if not levels:
         return [], uncut_findings(region.area, region.boundary, [], options)
@@ -193,6 +199,31 @@ def _pocket_region(region: Region, options: PlanOptions) -> tuple[list[Cut], lis
     cuts = _link(paths, region, r, tol, "right" if climb else "left")
     findings.extend(uncut_findings(region.area, region.boundary, cuts, options))
     return cuts, findings
+
+
+def _check_path_count(region: Region, step: float, options: PlanOptions) -> None:
+    """Refuse a pocket needing more than :data:`MAX_POCKET_PATHS` rings or lines, before any.
+
+    Rings: at most half the region's smaller bounding-box side over the step-over;
+    zigzag lines: at most its diagonal over the step-over.
+
+    Raises:
+        UsageError: the bound exceeds the limit (names --stepover, --tool-diameter).
+    """
+    x0, y0, x1, y1 = region.area.bounds
+    w, h = x1 - x0, y1 - y0
+    zigzag = options.pocket == "zigzag"
+    span = math.hypot(w, h) if zigzag else max(0.0, min(w, h) / 2 - options.radius)
+    count = span / step
+    if count <= MAX_POCKET_PATHS:
+        return
+    what = "zigzag lines" if zigzag else "rings"
+    raise UsageError(
+        f"{where(region.boundary)}: a {fmt_num(w, 3)} × {fmt_num(h, 3)} mm pocket would need "
+        f"about {count:.3g} {what} at a step-over of {step:g} mm (--stepover "
+        f"{options.stepover:g} × --tool-diameter {options.tool_diameter:g} mm), more than the "
+        f"limit of {MAX_POCKET_PATHS} per pocket; give a larger --stepover or tool"
+    )
 
 
 def _buffer(area: Polygon, amount: float, tol: float) -> list[Polygon]:

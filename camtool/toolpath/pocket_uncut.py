@@ -60,6 +60,8 @@ def quad_segs(radius: float, tolerance: float) -> int:
     if sagitta >= radius:
         return _MIN_QUAD_SEGS
     chord_angle = 2.0 * math.acos(1.0 - sagitta / radius)
+    if chord_angle <= 0.0:  # sagitta / radius below float resolution: as fine as allowed
+        return _MAX_QUAD_SEGS
     return min(_MAX_QUAD_SEGS, max(_MIN_QUAD_SEGS, math.ceil(math.pi / 2 / chord_angle)))
 
 

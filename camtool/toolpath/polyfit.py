@@ -87,6 +87,8 @@ def _clean(points: ArrayLike, closed: bool) -> FloatArray:
         xy = np.array(points, dtype=np.float64)
     except (TypeError, ValueError) as exc:
         raise InputError(f"polyline points must be numbers: {exc}") from exc
+    if xy.size == 0:
+        raise InputError("a polyline needs 2 distinct points, got none")
     if xy.ndim != 2 or xy.shape[1] != 2:
         raise InputError(f"polyline points must be an (N, 2) array, got shape {xy.shape}")
     if not np.all(np.isfinite(xy)):

@@ -16,6 +16,11 @@ alternating with a re-choice of each cut's start vertex (or direction) for its
 neighbours. The drawn order is improved the same way as a second seed and the shorter
 result wins, so the travel order is never longer than the drawing's own. Deterministic:
 ties go to the lower cut index, then vertex.
+
+Above :data:`FULL_SEARCH_MAX_CUTS` cuts the same steps run in O(n) each
+(:mod:`camtool.toolpath.travel_large`): a grid nearest neighbour, 2-opt runs of at
+most :data:`~camtool.toolpath.travel_large.TWO_OPT_WINDOW` cuts, and the drawn
+order compared but not improved.
 """
 
 from __future__ import annotations
@@ -36,6 +41,9 @@ Step = tuple[int, int, bool]
 
 MAX_SWEEPS = 8
 """Bound on the 2-opt / vertex re-choice sweeps of :func:`travel_order`."""
+FULL_SEARCH_MAX_CUTS = 2000
+"""Up to this many cuts :func:`travel_order` searches fully (O(n²) per 2-opt sweep);
+above it, the windowed O(n) search of :mod:`camtool.toolpath.travel_large`."""
 
 _GAIN_MM = 1e-9
 
@@ -185,10 +193,26 @@ def travel_order(
     """
     if not cuts:
         return []
+    if len(cuts) > FULL_SEARCH_MAX_CUTS:
+        return _large_travel_order(cuts, before, origin, flip_open)
     seeds = (_nearest_neighbour(cuts, before, origin, flip_open), drawn_order(cuts, before))
     improved = [_improve(cuts, before, seed, origin, flip_open) for seed in seeds]
     # The drawn order is a seed too, so the result is never longer than the drawing's own.
     return min(improved, key=lambda seq: rapid_mm(cuts, seq, origin))
+
+
+def _large_travel_order(
+    cuts: Sequence[Cut], before: Sequence[Sequence[int]], origin: Point, flip_open: bool
+) -> list[Step]:
+    from camtool.toolpath import travel_large as large
+
+    table, steps = large.entries(cuts, flip_open)
+    seq = large.nearest_neighbour(table, before, origin)
+    seq = large.improve(table, before, seq, origin, MAX_SWEEPS)
+    drawn = table.first[[i for i, _, _ in drawn_order(cuts, before)]]
+    if large.rapid(table, drawn, origin) < large.rapid(table, seq, origin):
+        seq = drawn
+    return [steps[p] for p in seq.tolist()]
 
 
 def _improve(

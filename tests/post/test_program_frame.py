@@ -118,9 +118,10 @@ def test_header_names_the_job_and_two_runs_are_byte_identical(
     _, second, _ = _run(target, args, tmp_path, capsys)
     assert first == second
     lines = first.decode().splitlines()
-    assert lines[:6] == [
+    assert lines[:7] == [
         f"(camtool {__version__}: logo.dxf for {target})",
         "(tool diameter 3 mm, offset outside)",
+        "(work zero X0 Y0: the drawing's origin)",
         "(depth 2 mm in passes of 1 mm)",
         "(safe Z 2 mm, clearance Z 5 mm above the top)",
         "G21 G90 G94 G17" + (" G40 G49 G80" if target == "linuxcnc" else ""),

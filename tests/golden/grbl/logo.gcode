@@ -1,5 +1,6 @@
 (camtool 0.1.0: logo.dxf for grbl)
 (offset on: the tool centre follows the drawing)
+(work zero X0 Y0: the drawing's origin)
 (depth none: cuts at Z 0, the top of the stock)
 (safe Z 2 mm, clearance Z 5 mm above the top)
 G21 G90 G94 G17
