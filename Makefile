@@ -31,6 +31,7 @@ typecheck: $(STAMP)
 	$(BIN)/mypy
 
 unit: $(STAMP)
+	$(BIN)/python tests/corpus/fetch_corpus.py
 	$(BIN)/pytest
 
 test: lint typecheck unit

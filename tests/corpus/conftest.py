@@ -184,25 +184,35 @@ def suggested_flags(message: str) -> list[list[str]] | str:
     options = _post_options()
     found: list[list[str]] = []
     why: list[str] = []
+    joined_at = -1  # where the last option's values ended: an option right after it joins it
     for match in OPTION.finditer(message):
         name = match.group(0)
         option = options.get(name)
         if option is None:
             continue
         if option.is_flag:
-            found.append([name])
-            continue
-        words = [w.strip(STRIP) for w in message[match.end() :].split()][: option.nargs]
-        if any(PLACEHOLDER.fullmatch(w) for w in words):
-            continue  # "--machine FILE.toml": a pointer to an option, not a value to use
-        try:
-            if len(words) < option.nargs or any(w.startswith("--") for w in words):
-                raise click.BadParameter("too few values")
-            option.type_cast_value(None, words if option.nargs > 1 else words[0])  # type: ignore[arg-type]
-        except click.BadParameter:
-            why.append(f"{name!r} without usable values (next words {words!r})")
-            continue
-        found.append([name, *words])
+            words: list[str] = []
+        else:
+            words = [w.strip(STRIP) for w in message[match.end() :].split()][: option.nargs]
+            if any(PLACEHOLDER.fullmatch(w) for w in words):
+                continue  # "--machine FILE.toml": a pointer to an option, not a value to use
+            try:
+                if len(words) < option.nargs or any(w.startswith("--") for w in words):
+                    raise click.BadParameter("too few values")
+                option.type_cast_value(None, words if option.nargs > 1 else words[0])  # type: ignore[arg-type]
+            except click.BadParameter:
+                why.append(f"{name!r} without usable values (next words {words!r})")
+                continue
+        # "--fit 10 7 --origin lower-left" is one remedy: options written one after the other
+        between = message[joined_at : match.start()] if joined_at >= 0 else "x"
+        if found and not between.strip(" `'\"“”‘’"):
+            found[-1] += [name, *words]
+        else:
+            found.append([name, *words])
+        end = match.end()
+        for word in words:
+            end = message.index(word, end) + len(word)
+        joined_at = end
     if found:
         return found
     if why:

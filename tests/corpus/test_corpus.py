@@ -53,6 +53,11 @@ def test_posts_first_try_or_after_the_suggested_remedy(rel: str, target: str) ->
             [["--offset", "outside"], ["--fit", "9.5", "7"]],
         ),
         ("camtool: error: x; use --hatch-boundaries to cut it", [["--hatch-boundaries"]]),
+        (
+            "camtool: error: too large; scale it with --fit 199.99 199.99 --origin lower-left "
+            "--translate 0 0 or use a larger machine (--machine FILE.toml)",
+            [["--fit", "199.99", "199.99", "--origin", "lower-left", "--translate", "0", "0"]],
+        ),
         ("camtool: error: gap 0.3 mm; try --tolerance 0.5.", [["--tolerance", "0.5"]]),
     ],
 )
