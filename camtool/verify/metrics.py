@@ -235,13 +235,19 @@ def measure_contours(
 def _circle(
     segments: list[Segment], run: FloatArray, size: tuple[float, float]
 ) -> tuple[float, float, float, float] | None:
-    """Nominal and fitted diameter of a contour made of arcs of one circle, else None."""
-    if not segments or not all(isinstance(s, Arc) for s in segments):
+    """Nominal and fitted diameter of a contour made of arcs of one circle, else None.
+
+    Z-only moves (a plunge, a rise onto a tab: no XY length) do not count, and a circle
+    cut in several depth passes (sweeps adding up to a whole number of turns) is one.
+    """
+    cuts = [s for s in segments if not (isinstance(s, Line) and s.length <= 1e-9)]
+    if not cuts or not all(isinstance(s, Arc) for s in cuts):
         return None
-    arcs = [s for s in segments if isinstance(s, Arc)]
+    arcs = [s for s in cuts if isinstance(s, Arc)]
     c0, r0 = arcs[0].centre, arcs[0].radius
     same = all(math.dist(a.centre, c0) <= 1e-6 and abs(a.radius - r0) <= 1e-6 for a in arcs)
-    if not same or abs(abs(sum(a.sweep for a in arcs)) - math.tau) > 1e-6 or len(run) < 3:
+    turns = abs(sum(a.sweep for a in arcs)) / math.tau
+    if not same or turns < 0.5 or abs(turns - round(turns)) > 1e-6 or len(run) < 3:
         return None
     return (2.0 * r0, 2.0 * fit_circle(run)[2], size[0], size[1])
 
