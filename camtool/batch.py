@@ -87,6 +87,8 @@ class BatchOptions:
             program, and when verified the simulated trace and its worst point.
         max_error_um: predicted error limit, µm: a file over it is ``over-limit``
             (implies ``verify``).
+        strict: ``max_error_um`` also judges the features the planner reported it
+            cannot cut as drawn with this tool (``--strict``).
         force: overwrite existing outputs.
         jobs: worker processes; ``None``: ``os.cpu_count()``; 1: in this process.
         report: the batch report's path, checked like an output and written by
@@ -114,6 +116,7 @@ class BatchOptions:
     verify: bool = False
     preview: str | None = None
     max_error_um: float | None = None
+    strict: bool = False
     force: bool = False
     jobs: int | None = None
     report: str | None = None
@@ -514,7 +517,10 @@ def _post_one(task: BatchTask, options: BatchOptions) -> BatchRow:
         files.append((task.preview_path, preview_bytes(job, v, task.preview_path, task.file)))
     for path, data in files:
         _write(path, data)
-    over = options.max_error_um is not None and (error_um or 0.0) > options.max_error_um
+    problem = None
+    if v is not None and options.max_error_um is not None:
+        problem = v.over_limit(options.max_error_um, strict=options.strict)
+    over = problem is not None
     return BatchRow(
         file=task.file,
         status="over-limit" if over else "ok",
@@ -527,11 +533,7 @@ def _post_one(task: BatchTask, options: BatchOptions) -> BatchRow:
         report_path=task.report_path,
         preview_path=task.preview_path,
         warnings=warnings,
-        error=(
-            f"predicted error {error_um:.2f} µm exceeds --max-error-um {options.max_error_um:g}"
-            if over
-            else ""
-        ),
+        error=problem or "",
     )
 
 

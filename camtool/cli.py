@@ -28,7 +28,6 @@ from camtool.cli_common import (
     write_output,
 )
 from camtool.errors import CamtoolError, UsageError, VerifyLimitError
-from camtool.units import fmt_num
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -258,20 +257,9 @@ def _finish_verification(
 
         picture = write_trace_preview(v, preview, drawing=drawing, edge_radius_mm=edge_radius_mm)
         write_output(picture, preview)
-    if max_error_um is None:
-        return
-    if v.against_skipped is not None:
-        raise VerifyLimitError(
-            f"--max-error-um {max_error_um:g} cannot be judged: the drawing was not compared "
-            "(it does not overlap the program; see the warning above)"
-        )
-    error = v.strict_error_um if strict else v.max_error_um
-    if error > max_error_um:
-        hint = "" if strict or v.strict_error_um == v.max_error_um else " (what was cut)"
-        raise VerifyLimitError(
-            f"predicted error {fmt_num(error, 2)} µm{hint} exceeds --max-error-um "
-            f"{max_error_um:g}" + (" with --strict" if strict else "")
-        )
+    problem = None if max_error_um is None else v.over_limit(max_error_um, strict=strict)
+    if problem is not None:
+        raise VerifyLimitError(problem)
 
 
 @cli.command()

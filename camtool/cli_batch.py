@@ -72,6 +72,12 @@ def _post_options(command: Callable[..., None]) -> Callable[..., None]:
     help="A file whose predicted error exceeds N µm is over the limit: exit code 4 "
     "(implies --verify).",
 )
+@click.option(
+    "--strict",
+    is_flag=True,
+    help="--max-error-um also counts the features the planner reported it cannot cut "
+    "as drawn with this tool (tight corners, regions narrower than the tool).",
+)
 @click.option("--report", default=None, metavar="BATCH.json", help="Batch report ('-': stdout).")
 @click.option("--force", is_flag=True, help="Overwrite existing outputs.")
 @_post_options

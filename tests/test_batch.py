@@ -544,3 +544,18 @@ def test_a_batch_removes_temp_files_of_killed_runs(tree: Path) -> None:
     assert run_batch(plan_batch(["drawings"], options)).exit_code == 0
     assert not stale.exists()
     assert [p for p in Path("out").rglob(".*")] == []
+
+
+def test_batch_judges_the_limit_as_post_does_with_and_without_strict(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the plate's 2 mm hole and notch corners cannot be cut as drawn with a 3 mm tool: the
+    # limit judges what was cut unless --strict (the same rule as `camtool post`)
+    from camtool.cli import main
+
+    plate = str(Path(__file__).resolve().parents[1] / "samples" / "plate.dxf")
+    args = ["batch", plate, "-t", "grbl", "--offset", "outside", "--tool-diameter", "3"]
+    limit = ["--max-error-um", "50", "--jobs", "1"]
+    assert main([*args, *limit, "-o", str(tmp_path / "a")]) == 0
+    assert main([*args, *limit, "--strict", "-o", str(tmp_path / "b")]) == 4
+    assert "with --strict" in capsys.readouterr().err

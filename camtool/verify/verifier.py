@@ -105,6 +105,27 @@ class Verification:
             worst = max(worst, self.against.strict_max_um)
         return worst
 
+    def over_limit(self, limit_um: float, *, strict: bool = False) -> str | None:
+        """Why this verification fails ``--max-error-um limit_um``, or ``None`` when it passes.
+
+        The limit judges what was cut as drawn (``strict``: also the features the
+        planner reported it cannot cut with this tool). A drawing that was given but
+        not compared (it does not overlap the program) fails: it cannot pass unjudged.
+        """
+        if self.against_skipped is not None:
+            return (
+                f"--max-error-um {limit_um:g} cannot be judged: the drawing was not compared "
+                "(it does not overlap the program; see the warning above)"
+            )
+        error = self.strict_error_um if strict else self.max_error_um
+        if error <= limit_um:
+            return None
+        hint = "" if strict or self.strict_error_um == self.max_error_um else " (what was cut)"
+        return (
+            f"predicted error {fmt_num(error, 2)} µm{hint} exceeds --max-error-um "
+            f"{limit_um:g}" + (" with --strict" if strict else "")
+        )
+
 
 def verify_code(
     code: str | bytes,
