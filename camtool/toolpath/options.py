@@ -110,8 +110,8 @@ class PlanOptions:
             no Z (2D program).
         step_down: depth of each pass, mm (> 0); ``None``: one pass at ``depth``.
         safe_z: height of every rapid when a depth is given, mm (> 0).
-        plunge_feed_mm_min: feed of Z moves into the material, mm/min;
-            ``None``: half of ``feed_mm_min``.
+        plunge_feed_mm_min: feed of Z moves into the material (and, on a Z machine
+            without ``depth``, down to Z 0), mm/min; ``None``: half of ``feed_mm_min``.
         ramp_angle_deg: enter each pass along the path descending at this angle
             from the horizontal, degrees in (0, 90); ``None`` plunges straight.
         tabs: number of holding tabs on each outside profile (0 = none).
@@ -242,8 +242,11 @@ class PlanOptions:
             raise UsageError(f"--offset {self.offset} needs --tool-diameter MM (> 0)")
         if self.feed_mm_min <= 0:
             raise UsageError(f"feed must be > 0 mm/min, got {self.feed_mm_min!r}")
-        if self.tolerance <= 0:
-            raise UsageError(f"tolerance must be > 0 mm, got {self.tolerance!r}")
+        if self.tolerance < MIN_TOLERANCE_MM:
+            raise UsageError(
+                f"--tolerance must be at least {MIN_TOLERANCE_MM:g} mm (1 nm, below every "
+                f"machine step camtool writes for), got {self.tolerance!r}"
+            )
         if self.close_gap < 0:
             raise UsageError(f"--close-gap must be ≥ 0 mm, got {self.close_gap!r}")
         if not 0 < self.stepover <= 1:
@@ -282,7 +285,6 @@ class PlanOptions:
                 flag
                 for flag, value in (
                     ("--step-down", self.step_down),
-                    ("--plunge-feed", self.plunge_feed_mm_min),
                     ("--ramp", self.ramp_angle_deg),
                 )
                 if value is not None
@@ -379,6 +381,9 @@ MAX_LENGTH_MM = 1e6
 
 MAX_SCALE = 1e6
 """Largest ``--scale`` factor (and 1/this the smallest)."""
+
+MIN_TOLERANCE_MM = 1e-6
+"""Smallest ``--tolerance`` (mm): chords and fitted arcs finer than 1 nm only cost time."""
 
 MAX_PASSES = 10_000
 """Most depth passes a plan may have (``--depth`` / ``--step-down``)."""
