@@ -289,6 +289,7 @@ class _Writer:
         self._part_here: int | None = None
         self._lift_at: int | None = None
         self.findings: list[Finding] = []
+        self._positioned = False
         ramp = options.ramp_angle_deg
         self.slope = None if ramp is None else math.tan(math.radians(ramp))
 
@@ -346,9 +347,12 @@ class _Writer:
         new_part = self._part_here is None or self.part != self._part_here
         self.lift(o.clearance if new_part else o.safe_z)
         self._part_here = self.part
-        if (x, y) != (self.x, self.y):
-            self.add(Rapid(x, y, self.z, contour=self.number))
+        if (x, y) != (self.x, self.y) or not self._positioned:
+            # XY only (Z stays): the first one is written even at the start position,
+            # since where the machine stands when the program starts is not known
+            self.add(Rapid(x, y, contour=self.number))
             self._lift_at = None
+            self._positioned = True
         self.x, self.y = x, y
         if self.z is not None and self.z > o.safe_z + Z_EPS:
             self.add(Rapid(x, y, o.safe_z, contour=self.number))

@@ -114,11 +114,16 @@ def shift_program(program: Program, dx: float, dy: float) -> Program:
 
 
 def _at_start(program: Program) -> int:
-    """How many leading moves are rapids that stay at the start position (XY)."""
+    """How many leading moves are Z-only rapids at the start position (lifts).
+
+    An XY rapid (``z`` None) to the start position is positioning, not a lift: it moves
+    with the program.
+    """
     ox, oy = program.origin
     k = 0
     for move in program.moves:
-        if not (isinstance(move, Rapid) and move.x == ox and move.y == oy):
+        lift = isinstance(move, Rapid) and move.z is not None
+        if not (lift and move.x == ox and move.y == oy):
             break
         k += 1
     return k

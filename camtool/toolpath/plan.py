@@ -26,8 +26,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+from camtool.errors import InputError
 from camtool.geometry import Contour, Drawing, Line, Segment
-from camtool.program import Move, Program
+from camtool.program import Move, Program, Rapid
 from camtool.toolpath.arcfit import FitStats, fit_polyline, fit_stats
 from camtool.toolpath.chain import chain, close_gaps
 from camtool.toolpath.cuts import Finding, Stage
@@ -41,6 +42,7 @@ from camtool.toolpath.placement import (
     shift_program,
     toolpath_extent,
 )
+from camtool.toolpath.split import MIN_PIECE
 
 if TYPE_CHECKING:
     from camtool.machine import Machine
@@ -171,6 +173,12 @@ def plan_drawing(
     z_axis = machine is not None and machine.has_z
     moves, emitted = emit(ordering.cuts, options, helix=helix, z_axis=z_axis)
     findings.extend(emitted)
+    if not any(not isinstance(m, Rapid) for m in moves):
+        raise InputError(
+            f"{drawing.source or 'the drawing'}: nothing to cut: {len(contours)} contour(s), "
+            f"none longer than {MIN_PIECE:g} mm after planning; check the drawing's units "
+            "(or --scale it)"
+        )
     report = PlanReport(len(contours), len(stage.cuts), tuple(findings), ordering, stats)
     warnings = tuple(dict.fromkeys((*drawing.warnings, *(f.message for f in findings))))
     program, placed = place_program(

@@ -544,7 +544,7 @@ def test_start_is_z_only_to_clearance_then_xy_then_down() -> None:
     moves = emit_moves([Cut(path, 0)], o)
     assert moves[:4] == [
         Rapid(0.0, 0.0, 7.0, contour=1),  # Z only, where the tool stands
-        Rapid(3.0, 4.0, 7.0, contour=1),  # XY at clearance
+        Rapid(3.0, 4.0, contour=1),  # XY at clearance (Z unchanged)
         Rapid(3.0, 4.0, 2.0, contour=1),  # rapid down to safe Z only
         Linear(3.0, 4.0, PLUNGE, -1.0, contour=1),  # into the material at the plunge feed
     ]
