@@ -388,5 +388,5 @@ def verify_job(job: PostJob) -> Verification:
         source=f"<{job.target.name} code>",
         against=job.placed,
         tool_diameter=2.0 * job.edge_radius_mm,
-        findings=job.plan.findings if job.plan is not None else (),
+        findings=job.plan.placed_findings() if job.plan is not None else (),
     )

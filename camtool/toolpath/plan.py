@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from camtool.errors import InputError
-from camtool.geometry import Contour, Drawing, Line, Segment
+from camtool.geometry import Contour, Drawing, Line, Point, Segment
 from camtool.program import Move, Program, Rapid
 from camtool.toolpath.arcfit import FitStats, fit_polyline, fit_stats
 from camtool.toolpath.chain import chain, close_gaps
@@ -72,6 +72,10 @@ class PlanReport:
         findings: everything the user must know, in stage order.
         ordering: the cutting order and its reversal and travel counts.
         fit: what arc fitting of dense polylines saved (``None`` when off).
+        work_shift: ``(dx, dy)`` mm that ``--origin``/``--translate`` moved the program
+            by. Findings locate features in the drawing's coordinates (after
+            ``--scale``/``--fit``), as their messages say; :meth:`placed_findings`
+            gives them in the program's work coordinates.
     """
 
     contours: int
@@ -79,6 +83,17 @@ class PlanReport:
     findings: tuple[Finding, ...]
     ordering: Ordering
     fit: FitStats | None
+    work_shift: Point = (0.0, 0.0)
+
+    def placed_findings(self) -> tuple[Finding, ...]:
+        """The findings with ``at`` in the program's work coordinates (mm)."""
+        dx, dy = self.work_shift
+        if dx == 0.0 and dy == 0.0:
+            return self.findings
+        return tuple(
+            f if f.at is None else dataclasses.replace(f, at=(f.at[0] + dx, f.at[1] + dy))
+            for f in self.findings
+        )
 
     def notes(self) -> list[str]:
         """The ordering and arc-fit summaries, for stderr (the findings are warnings)."""
@@ -179,11 +194,11 @@ def plan_drawing(
             f"none longer than {MIN_PIECE:g} mm after planning; check the drawing's units "
             "(or --scale it)"
         )
-    report = PlanReport(len(contours), len(stage.cuts), tuple(findings), ordering, stats)
     warnings = tuple(dict.fromkeys((*drawing.warnings, *(f.message for f in findings))))
-    program, placed = place_program(
+    program, placed, shift = place_program(
         Program(tuple(moves), options.origin, warnings), placed, options, machine
     )
+    report = PlanReport(len(contours), len(stage.cuts), tuple(findings), ordering, stats, shift)
     return Plan(program, report, placed)
 
 
@@ -217,7 +232,7 @@ def place(drawing: Drawing, options: PlanOptions) -> Drawing:
 
 def place_program(
     program: Program, placed: Drawing, options: PlanOptions, machine: Machine | None = None
-) -> tuple[Program, Drawing]:
+) -> tuple[Program, Drawing, Point]:
     """The placement stage: move the program so that its work zero lies where asked.
 
     ``options.placement`` (``--origin``) then ``options.translate`` (``--translate``)
@@ -230,7 +245,8 @@ def place_program(
     cannot know how work zero was chosen, so it only refuses).
 
     Returns:
-        The program and the drawing, both in work coordinates (mm).
+        The program and the drawing, both in work coordinates (mm), and the shift
+        ``(dx, dy)`` that placed them, mm.
 
     Raises:
         DialectError: the toolpath is larger than the machine's travel, or outside
@@ -250,7 +266,7 @@ def place_program(
         said = check_travel(program, machine, _placing(program, placed, options))
         if said:
             program = dataclasses.replace(program, warnings=(*program.warnings, *said))
-    return program, placed
+    return program, placed, (dx, dy)
 
 
 def _placing(program: Program, placed: Drawing, options: PlanOptions) -> Placing:

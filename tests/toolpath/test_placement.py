@@ -276,3 +276,18 @@ def test_the_end_position_is_in_work_coordinates(tmp_path: Path) -> None:
     lines = out.read_text().splitlines()
     # the park move goes to the work zero the user set, not to the drawing's origin shifted
     assert lines[-4:] == ["G0 Z5.000", "G0 X0.000 Y0.000", "M5", "M2"]
+
+
+@pytest.mark.parametrize("origin", ["drawing", "lower-left"])
+def test_features_not_cut_follow_the_placed_program(origin: str, tmp_path: Path) -> None:
+    # regression: with --origin lower-left the plan's findings stayed in drawing
+    # coordinates, so the 2 mm hole the 3 mm tool cannot cut counted in the main figure
+    import json
+
+    sample = Path(__file__).resolve().parents[2] / "samples" / "plate.dxf"
+    report = tmp_path / "r.json"
+    argv = ["post", str(sample), "-t", "grbl", *OUTSIDE, "--origin", origin]
+    assert main([*argv, "-o", str(tmp_path / "p.gcode"), "--report", str(report)]) == 0
+    data = json.loads(report.read_text())
+    assert len(data["not_cut_as_drawn"]) == 3  # two tight corners and the 2 mm hole
+    assert data["max_error_um"] < 50  # what was cut: a few µm of 4 µm steps
