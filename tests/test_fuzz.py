@@ -37,6 +37,7 @@ import pytest
 
 from camtool.cli import main
 from camtool.post.registry import load_target
+from tests.targets import EXTENSIONS, TARGETS
 
 ROOT = Path(__file__).resolve().parents[1]
 SEED = int(os.environ.get("CAMTOOL_FUZZ_SEED", "20251121"))
@@ -44,16 +45,6 @@ MUTANTS = int(os.environ.get("CAMTOOL_FUZZ_MUTANTS", "4"))
 CPU_S = 20  # a case may use this much CPU time: a refusal is quick, an endless loop is not
 WALL_S = 300.0  # backstop for a child that sleeps or deadlocks (CPU time does not grow)
 FAILURES = ROOT / ".corpus" / "fuzz-failures"  # failing mutants are kept here (git-ignored)
-TARGETS = ("pic-mmh", "flashcut", "matlab-router", "i8751", "valcnc", "grbl", "linuxcnc")
-EXTENSIONS = {
-    "pic-mmh": ".pic",
-    "flashcut": ".nc",
-    "matlab-router": ".m",
-    "i8751": ".bin",
-    "valcnc": ".ngc",
-    "grbl": ".gcode",
-    "linuxcnc": ".ngc",
-}
 INPUT_SUFFIXES = {".dxf", ".svg", ".csv", ".nc", ".ngc", ".tap", ".m"}
 HOSTILE_NUMBERS = [
     "nan", "NaN", "inf", "-inf", "1e308", "-1e308", "1e400", "-0", "-0.0", "0",

@@ -31,7 +31,7 @@ from camtool.errors import InputError, UsageError
 from camtool.geometry import Contour, Drawing, Line, Point
 from camtool.importers import MAX_COORDINATE_MM
 from camtool.importers.dxf_curves import BadEntity
-from camtool.importers.dxf_entities import ZERO_LENGTH, layer_of
+from camtool.importers.dxf_entities import ZERO_LENGTH, check_numbers, layer_of, line_inside
 from camtool.units import INCH
 
 if TYPE_CHECKING:
@@ -288,18 +288,8 @@ class _Reader:
             return
         dxf = entity.dxf
         s, e = dxf.start, dxf.end
-        limit = self.limit
-        if not (
-            abs(s.x) <= limit
-            and abs(s.y) <= limit
-            and abs(s.z) <= limit
-            and abs(e.x) <= limit
-            and abs(e.y) <= limit
-            and abs(e.z) <= limit
-        ):
-            from camtool.importers.dxf_entities import check_numbers
-
-            check_numbers(entity, f"LINE #{dxf.handle}", layer, limit)  # raises
+        if not line_inside(entity, self.limit):
+            check_numbers(entity, f"LINE #{dxf.handle}", layer, self.limit)  # raises
         start, end = (s.x, s.y), (e.x, e.y)
         label = f"LINE #{dxf.handle}"
         if math.hypot(end[0] - start[0], end[1] - start[1]) <= ZERO_LENGTH:

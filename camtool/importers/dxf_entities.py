@@ -38,6 +38,23 @@ _OCS_POINTS = frozenset({"ARC", "CIRCLE", "TEXT", "ATTRIB", "INSERT", "SHAPE"})
 _MAX_RATIO = 1.0 + 1e-9  # ELLIPSE minor/major axis ratio, (0, 1] in the DXF reference
 
 
+def line_inside(entity: Any, limit: float) -> bool:
+    """True when both ends of a LINE are finite and within ``limit`` (drawing units).
+
+    Not ``max()``: ``max()`` drops a NaN that is not its first argument; every
+    comparison with NaN is false, so a NaN end is never inside.
+    """
+    s, e = entity.dxf.start, entity.dxf.end
+    return (
+        abs(s.x) <= limit
+        and abs(s.y) <= limit
+        and abs(s.z) <= limit
+        and abs(e.x) <= limit
+        and abs(e.y) <= limit
+        and abs(e.z) <= limit
+    )
+
+
 def check_numbers(entity: Any, label: str, layer: str, limit: float) -> None:
     """Refuse an entity with a number that is NaN, infinite or beyond ``±limit``.
 
@@ -78,15 +95,7 @@ def _bad_number(entity: Any, limit: float) -> str | None:
 
     kind = entity.dxftype()
     if kind == "LINE":  # the bulk of large drawings: four numbers, checked directly
-        s, e = entity.dxf.start, entity.dxf.end
-        inside = (  # not max(): max() drops a NaN that is not its first argument
-            abs(s.x) <= limit
-            and abs(s.y) <= limit
-            and abs(s.z) <= limit
-            and abs(e.x) <= limit
-            and abs(e.y) <= limit
-            and abs(e.z) <= limit
-        )
+        inside = line_inside(entity, limit)
         if inside and not entity.dxf.hasattr("extrusion"):
             return None
     for name, value in entity.dxf.all_existing_dxf_attribs().items():

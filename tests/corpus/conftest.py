@@ -29,22 +29,12 @@ import click
 
 from camtool.cli import cli, main
 from camtool.post.registry import load_target
+from tests.targets import EXTENSIONS, TARGETS
 
 ROOT = Path(__file__).resolve().parents[2]
 CORPUS = Path(os.environ.get("CAMTOOL_CORPUS_DIR", ROOT / ".corpus"))
 MANIFEST = CORPUS / "manifest.json"
 MODE = os.environ.get("CAMTOOL_CORPUS", "sample")
-TARGETS = ("pic-mmh", "flashcut", "matlab-router", "i8751", "valcnc", "grbl", "linuxcnc")
-# first output format's extension per target (`camtool targets --json`)
-EXTENSIONS = {
-    "pic-mmh": ".pic",
-    "flashcut": ".nc",
-    "matlab-router": ".m",
-    "i8751": ".bin",
-    "valcnc": ".ngc",
-    "grbl": ".gcode",
-    "linuxcnc": ".ngc",
-}
 DEADLINE_S = float(os.environ.get("CAMTOOL_CORPUS_DEADLINE", "60"))
 MAX_REMEDIES = 3  # a remedy may lead to a second message with a second remedy
 # An input with no geometry (text, images, filters only: several Inkscape examples) is
