@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import itertools
 import math
-import time
 from collections.abc import Sequence
 
 import pytest
@@ -305,13 +304,11 @@ def test_random_star_pockets_never_gouge(
     assert swept.difference(region).area < TOL * region.boundary.length
 
 
-def test_a_large_pocket_with_two_islands_plans_fast() -> None:
+def test_a_large_pocket_with_two_islands_keeps_off_them() -> None:
+    # its planning time is measured in tests/benchmarks/bench_planning.py, not here
     contours = [rect(0, 0, 100, 60), circle(30, 30, 10), rect(60, 20, 80, 40)]
-    _plan([rect(0, 0, 10, 10)])  # load OpenCASCADE first: timed is the planning only
     for style in ("concentric", "zigzag"):
-        t0 = time.perf_counter()
         stage = _plan(contours, tool=3.0, pocket=style)
-        assert time.perf_counter() - t0 < 1.0
         swept = _swept(stage.cuts, 1.5)
         for island in contours[1:]:
             assert swept.intersection(_shape(island)).area < TOL * _shape(island).length
