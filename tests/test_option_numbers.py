@@ -13,41 +13,14 @@ from camtool.toolpath.options import MAX_PASSES, PlanOptions
 from camtool.units import fmt_num, fmt_point
 
 SAMPLES = Path(__file__).resolve().parents[1] / "samples"
+TABS = ["--tabs", "2", "--depth", "3", "--offset", "outside", "--tool-diameter", "3"]
 
 
 @pytest.mark.parametrize(
     ("args", "flag"),
     [
-        (
-            [
-                "--tab-height",
-                "nan",
-                "--tabs",
-                "2",
-                "--depth",
-                "3",
-                "--offset",
-                "outside",
-                "--tool-diameter",
-                "3",
-            ],
-            "--tab-height",
-        ),
-        (
-            [
-                "--tab-width",
-                "nan",
-                "--tabs",
-                "2",
-                "--depth",
-                "3",
-                "--offset",
-                "outside",
-                "--tool-diameter",
-                "3",
-            ],
-            "--tab-width",
-        ),
+        (["--tab-height", "nan", *TABS], "--tab-height"),
+        (["--tab-width", "nan", *TABS], "--tab-width"),
         (["--lead-in", "nan"], "--lead-in"),
         (["--close-gap", "nan"], "--close-gap"),
         (["--fit", "inf", "inf"], "--fit"),

@@ -156,6 +156,7 @@ class _Reader:
         self.x: float | None = 0.0
         self.y: float | None = 0.0
         self.z: float | None = None
+        self.positioned = False  # no X or Y word yet: the machine's XY is the program's guess
         self.motion: str | None = None
         self.absolute = True
         self.arc_absolute = False
@@ -379,6 +380,11 @@ class _Reader:
         name = self.motion or "G1"
         tx, ty, tz = self._end_xy(args, name)
         z = self._z_out(args, tz)
+        gives_xy = "X" in args or "Y" in args
+        if gives_xy and not self.positioned and z is not None and (tx, ty) == (self.x, self.y):
+            self._first_positioning(name, tx, ty, tz, z)
+            return
+        self.positioned = self.positioned or gives_xy
         if name == "G0":
             self._push(Rapid(tx, ty, z), tx, ty, tz)
             return
@@ -386,11 +392,37 @@ class _Reader:
         self._start_xy(name)
         self._push(Linear(tx, ty, feed, z), tx, ty, tz)
 
+    def _first_positioning(
+        self, name: str, tx: float, ty: float, tz: float | None, z: float
+    ) -> None:
+        """A first ``X Y Z`` block to the assumed start position: keep its XY explicit.
+
+        Before any X or Y word the machine's XY is not known (the reader assumes the
+        program's zero); an explicit ``G0 X0 Y0 Z5`` there must not become a Z-only move
+        when written again. It is read as two moves, Z first when rising, XY first when
+        going down (with Z not yet known: above Z 0 counts as rising), so the XY
+        travel is not made lower than the program made it.
+        """
+        self.positioned = True
+        feed = None if name == "G0" else self._feed(name)
+
+        def xy() -> Move:
+            return Rapid(tx, ty) if feed is None else Linear(tx, ty, feed)
+
+        def up_down() -> Move:
+            return Rapid(tx, ty, z) if feed is None else Linear(tx, ty, feed, z)
+
+        rising = z > 0.0 if self.z is None else z >= self.z  # unknown Z: above the top rises
+        first, second = (up_down(), xy()) if rising else (xy(), up_down())
+        self._push(first, tx, ty, tz if rising else self.z)
+        self._push(second, tx, ty, tz)
+
     def _arc(self, args: dict[str, Word]) -> None:
         name = self.motion or "G2"
         feed = self._feed(name)
         start = self._start_xy(name)
         tx, ty, tz = self._end_xy(args, name)
+        self.positioned = True
         turns = args.get("P")
         if turns is not None and turns.value != 1:
             raise InputError(

@@ -206,3 +206,26 @@ def test_absurd_numbers_in_gcode_are_refused_naming_the_line(
     assert (code, out) == (3, "")
     assert "h.ngc:3:" in err and message in err
     assert "internal error" not in err and len(err) < 400
+
+
+# -- the first positioning stays explicit ---------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("first", "expected"),
+    [
+        # rising: Z first, then the XY the program gave; plunging: XY first, then Z
+        ("G0 X0 Y0 Z5", ["G0 Z5.000", "G0 X0.000 Y0.000"]),
+        ("G0 X0 Y0 Z-1", ["G0 X0.000 Y0.000", "G0 Z-1.000"]),
+    ],
+)
+def test_a_first_move_to_x0_y0_keeps_its_xy_when_reposted(
+    first: str, expected: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # regression: "G0 X0 Y0 Z5" was re-posted as "G0 Z5": the XY positioning was lost and
+    # the next plunge went down wherever the machine stood
+    path = write(tmp_path, "p.ngc", f"G21 G90\n{first}\nG1 Z-1 F100\nG1 X10 F300\nM2\n")
+    code, out, _ = run(["post", path, "-t", "grbl"], capsys)
+    assert code == 0
+    moves = [b for b in out.splitlines() if b.startswith(("G0 ", "G1 "))]
+    assert moves[:2] == expected
