@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 from camtool.errors import UsageError
 from camtool.geometry import Drawing
-from camtool.importers import ImportOptions, read_drawing
+from camtool.importers import POINT_SUFFIXES, ImportOptions, read_drawing
 from camtool.post.base import PostResult, Target
 from camtool.post.registry import load_target
 from camtool.program import Move, Program
@@ -117,10 +117,6 @@ def post_path(
         spindle_dwell_s=options.get("spindle_dwell_s", 0.0),
         source=str(path),
     )
-
-
-POINT_SUFFIXES = (".csv", ".txt", ".xy", ".m")
-"""File endings of unitless point lists, the only inputs ``--units`` applies to."""
 
 
 def _note_units(drawing: Drawing, path: str | Path, options: ImportOptions | None) -> Drawing:

@@ -89,7 +89,10 @@ class ImportOptions:
             )
 
 
-DRAWING_SUFFIXES = (".dxf", ".svg", ".csv", ".txt", ".xy", ".m")
+POINT_SUFFIXES = (".csv", ".txt", ".xy", ".m")
+"""File endings of unitless point lists, the only inputs ``--units`` applies to."""
+
+DRAWING_SUFFIXES = (".dxf", ".svg", *POINT_SUFFIXES)
 """File name endings the importers read, lowercase."""
 
 
@@ -115,7 +118,7 @@ def read_drawing(path: str | Path, options: ImportOptions | None = None) -> Draw
         from camtool.importers.svg import read_svg
 
         return read_svg(path, options)
-    if suffix in (".csv", ".txt", ".xy", ".m"):
+    if suffix in POINT_SUFFIXES:
         from camtool.importers.points import read_points
 
         return read_points(path, options)
