@@ -7,7 +7,7 @@ import sys
 
 def run() -> None:
     """Entry point: run the CLI and exit with its code."""
-    from camtool.cli import main
+    from camtool.cli.main import main
 
     sys.exit(main())
 

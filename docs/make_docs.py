@@ -26,10 +26,10 @@ import re
 import sys
 from pathlib import Path
 
-from camtool.pipeline import PostJob, post_file, verify_job
+from camtool.jobs.pipeline import PostJob, post_file, verify_job
+from camtool.jobs.preview_trace import write_trace_preview
 from camtool.post.registry import load_target, target_names
 from camtool.preview import render_preview
-from camtool.preview_trace import write_trace_preview
 from camtool.verify.verifier import summary_lines
 
 ROOT = Path(__file__).resolve().parents[1]

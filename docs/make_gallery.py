@@ -17,8 +17,8 @@ from pathlib import Path
 
 from make_docs import ROOT, page_sample, post_sample
 
-from camtool.errors import CamtoolError
-from camtool.pipeline import verify_job
+from camtool.jobs.pipeline import verify_job
+from camtool.model.errors import CamtoolError
 from camtool.post.registry import target_names
 from camtool.preview import render_preview
 

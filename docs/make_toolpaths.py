@@ -16,7 +16,7 @@ from typing import Any
 
 from make_docs import ROOT
 
-from camtool.pipeline import post_file
+from camtool.jobs.pipeline import post_file
 from camtool.preview import render_preview
 
 PAGE = ROOT / "docs" / "toolpaths.md"

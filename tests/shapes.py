@@ -10,7 +10,7 @@ from typing import Any
 import ezdxf
 import numpy as np
 
-from camtool.geometry import Line, Point, Segment
+from camtool.model.shapes import Line, Point, Segment
 
 # seed-000 L1731: G02X02969.00Y03400.00I03012.00J03040.00F08;
 GOLDEN_CENTRE = (3.012, 3.040)
@@ -94,7 +94,7 @@ def two_sided_error(
     """
     import shapely
 
-    from camtool.toolpath.arcfit import distances
+    from camtool.geometry.arcfit import distances
 
     ts = np.linspace(t0, t1, n + 1)
     curve = np.array([point_at(float(t)) for t in ts], dtype=np.float64)

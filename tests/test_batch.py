@@ -19,12 +19,19 @@ from pathlib import Path
 
 import pytest
 
-from camtool.batch import BatchOptions, BatchRow, batch_exit_code, plan_batch, post_one, run_batch
-from camtool.batch_inputs import expand_inputs
-from camtool.batch_report import batch_report, progress_line, summary_table
-from camtool.cli import main
-from camtool.errors import InputError, UsageError
-from camtool.pipeline import post_file
+from camtool.cli.main import main
+from camtool.jobs.batch import (
+    BatchOptions,
+    BatchRow,
+    batch_exit_code,
+    plan_batch,
+    post_one,
+    run_batch,
+)
+from camtool.jobs.batch_inputs import expand_inputs
+from camtool.jobs.batch_report import batch_report, progress_line, summary_table
+from camtool.jobs.pipeline import post_file
+from camtool.model.errors import InputError, UsageError
 from tests.shapes import rectangle_dxf
 
 ROOT = Path(__file__).parents[1]
@@ -194,12 +201,12 @@ def test_blocks_match_camtool_post(tree: Path) -> None:
 def test_a_worker_exception_becomes_that_files_error_row(
     tree: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    import camtool.batch
+    import camtool.jobs.batch
 
     def boom(file: str, options: BatchOptions) -> None:
         raise RuntimeError(f"bug on {file}")
 
-    monkeypatch.setattr(camtool.batch, "_post_job", boom)
+    monkeypatch.setattr(camtool.jobs.batch, "_post_job", boom)
     plan = plan_batch(["drawings/rect.dxf"], BatchOptions(target="pic-mmh", output_dir=Path("o")))
     row = post_one(plan.tasks[0], plan.options)
     assert (row.status, row.exit_code) == ("error", 1)
@@ -377,7 +384,7 @@ def test_non_tty_progress_lines(tree: Path, capsys: pytest.CaptureFixture[str]) 
 
 
 def test_summary_table_columns() -> None:
-    from camtool.batch import BatchResult
+    from camtool.jobs.batch import BatchResult
 
     rows = (
         BatchRow(
@@ -433,7 +440,7 @@ def test_a_report_naming_an_output_is_refused(
 def test_a_folder_another_batch_writes_into_is_refused(
     tree: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from camtool.output import lock_directory
+    from camtool.jobs.output import lock_directory
 
     with lock_directory("out"):
         for force in ([], ["--force"]):
@@ -551,7 +558,7 @@ def test_batch_judges_the_limit_as_post_does_with_and_without_strict(
 ) -> None:
     # the plate's 2 mm hole and notch corners cannot be cut as drawn with a 3 mm tool: the
     # limit judges what was cut unless --strict (the same rule as `camtool post`)
-    from camtool.cli import main
+    from camtool.cli.main import main
 
     plate = str(Path(__file__).resolve().parents[1] / "samples" / "plate.dxf")
     args = ["batch", plate, "-t", "grbl", "--offset", "outside", "--tool-diameter", "3"]

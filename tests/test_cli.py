@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from camtool.cli import main
+from camtool.cli.main import main
 from tests.shapes import golden_arc_dxf, rectangle_dxf, write_dxf
 
 SAMPLES = Path(__file__).parents[1] / "samples"
@@ -171,7 +171,7 @@ def test_console_script_runs_as_a_process(tmp_path: Path) -> None:
 
 def test_version_does_not_load_opencascade() -> None:
     code = (
-        "import sys; from camtool.cli import main; main(['--version']); "
+        "import sys; from camtool.cli.main import main; main(['--version']); "
         "main(['targets']); print('build123d' in sys.modules, 'OCP' in sys.modules)"
     )
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)

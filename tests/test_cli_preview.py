@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from camtool.cli import main
+from camtool.cli.main import main
 from tests.test_preview import INJECTED_CODE, NS
 
 ROOT = Path(__file__).parents[1]

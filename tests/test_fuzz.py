@@ -4,7 +4,7 @@ The inputs are the bundled drawings and programs (samples/, tests/data/), mutate
 seeded loop: byte flips, truncation, numbers replaced by nan/inf/1e308/-0/huge values,
 duplicated lines and deleted sections. Hostile options (``--tool-diameter nan``,
 ``--step-down 1e-9``, ``--fit inf inf``...) are given to good inputs. Each case runs
-``camtool.cli.main`` in a forked child (so a hang or a crash is contained) and must:
+``camtool.cli.main.main`` in a forked child (so a hang or a crash is contained) and must:
 
 - answer within CPU_S seconds of CPU time (a refusal is an answer; an endless loop is the bug);
 - exit 0, 2 or 3 — or 1 for a planning or dialect error of a drawing that is still valid
@@ -35,7 +35,7 @@ from pathlib import Path
 
 import pytest
 
-from camtool.cli import main
+from camtool.cli.main import main
 from camtool.post.registry import load_target
 from tests.targets import EXTENSIONS, TARGETS
 
@@ -182,7 +182,7 @@ def _child(args: list[str], conn: multiprocessing.connection.Connection) -> None
 
 
 def run_forked(args: list[str]) -> tuple[int | None, str]:
-    """(exit code, stderr) of ``camtool.cli.main(ARGS)`` in a forked child; None: no answer.
+    """(exit code, stderr) of ``camtool.cli.main.main(ARGS)`` in a forked child; None: no answer.
 
     The child may use CPU_S seconds of CPU (RLIMIT_CPU: the kernel stops it with SIGXCPU),
     which a loaded machine does not shorten as it would a wall-clock timeout.

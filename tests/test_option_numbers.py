@@ -7,10 +7,10 @@ from pathlib import Path
 
 import pytest
 
-from camtool.cli import main
-from camtool.errors import UsageError
+from camtool.cli.main import main
+from camtool.model.errors import UsageError
+from camtool.model.units import fmt_num, fmt_point
 from camtool.toolpath.options import MAX_PASSES, PlanOptions
-from camtool.units import fmt_num, fmt_point
 
 SAMPLES = Path(__file__).resolve().parents[1] / "samples"
 TABS = ["--tabs", "2", "--depth", "3", "--offset", "outside", "--tool-diameter", "3"]

@@ -13,9 +13,8 @@ from pathlib import Path
 
 import pytest
 
-from camtool.cli import main
-from camtool.errors import CamtoolError, UsageError
-from camtool.output import (
+from camtool.cli.main import main
+from camtool.jobs.output import (
     LOCK_NAME,
     TEMP_PATTERN,
     check_outputs,
@@ -24,6 +23,7 @@ from camtool.output import (
     temp_path,
     write_atomic,
 )
+from camtool.model.errors import CamtoolError, UsageError
 
 ROOT = Path(__file__).parents[1]
 
@@ -195,7 +195,7 @@ def test_a_killed_write_is_cleaned_by_the_next_run(tmp_path: Path) -> None:
     """kill -9 in the middle of a write: the next write beside it removes the leftover."""
     out = tmp_path / "big.pic"
     script = (
-        "import os, sys; from camtool import output\n"
+        "import os, sys; from camtool.jobs import output\n"
         "def stop(fd): os.kill(os.getpid(), 9)\n"
         "os.fsync = stop\n"
         f"output.write_atomic({str(out)!r}, 'G0 X1\\n' * 1000)\n"
@@ -230,7 +230,7 @@ def test_a_locked_folder_is_refused_and_released(tmp_path: Path) -> None:
 def test_the_lock_of_a_killed_run_is_taken_over(tmp_path: Path) -> None:
     folder = tmp_path / "out"
     script = (
-        "import os; from camtool.output import lock_directory\n"
+        "import os; from camtool.jobs.output import lock_directory\n"
         f"with lock_directory({str(folder)!r}): os.kill(os.getpid(), 9)\n"
     )
     proc = subprocess.run([sys.executable, "-c", script], check=False, cwd=ROOT)

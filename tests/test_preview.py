@@ -11,12 +11,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from camtool.errors import UsageError
-from camtool.geometry import Contour, Drawing, Line
-from camtool.machine import Backlash
+from camtool.model.errors import UsageError
+from camtool.model.machine import Backlash
+from camtool.model.program import ArcMove, Linear, Program, Rapid
+from camtool.model.shapes import Contour, Drawing, Line
 from camtool.post.registry import load_target
 from camtool.preview import CUT_COLOUR, RAPID_COLOUR, program_svg, render_preview
-from camtool.program import ArcMove, Linear, Program, Rapid
 from camtool.verify.verifier import Verification, verify_program
 
 NS = "{http://www.w3.org/2000/svg}"

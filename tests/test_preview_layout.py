@@ -9,7 +9,8 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from camtool.geometry import Arc, Contour, Drawing, Line
+from camtool.model.program import Linear, Program, Rapid
+from camtool.model.shapes import Arc, Contour, Drawing, Line
 from camtool.preview import render_preview
 from camtool.preview.program_layers import tab_segments
 from camtool.preview.raster import scene_png
@@ -25,7 +26,6 @@ from camtool.preview.scene import (
     place_labels,
     text_box,
 )
-from camtool.program import Linear, Program, Rapid
 
 NS = "{http://www.w3.org/2000/svg}"
 
@@ -156,7 +156,7 @@ def test_work_zero_is_marked_when_in_view() -> None:
 
 @pytest.mark.parametrize("suffix", [".svg", ".png"])
 def test_not_cut_features_are_marked(suffix: str) -> None:
-    from camtool.pipeline import post_drawing, verify_job
+    from camtool.jobs.pipeline import post_drawing, verify_job
     from camtool.post.registry import load_target
     from tests.verify.test_metrics_not_cut import R, plate
 

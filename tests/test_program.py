@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from camtool.pipeline import post_program
+from camtool.jobs.pipeline import post_program
+from camtool.model.program import Dwell, Home, Linear, Program, Rapid, Spindle, ToolChange
 from camtool.post.registry import load_target
-from camtool.program import Dwell, Home, Linear, Program, Rapid, Spindle, ToolChange
 
 MOVES = (Rapid(1.0, 1.0), Linear(2.0, 1.0, 0.8), Rapid(3.0, 3.0), Linear(4.0, 3.0, 0.8))
 

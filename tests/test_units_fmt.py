@@ -1,10 +1,10 @@
-"""`camtool.units.fmt_num`: fixed decimals, never a negative zero (STYLE.md §8)."""
+"""`camtool.model.units.fmt_num`: fixed decimals, never a negative zero (STYLE.md §8)."""
 
 from __future__ import annotations
 
 import pytest
 
-from camtool.units import fmt_num
+from camtool.model.units import fmt_num
 
 
 @pytest.mark.parametrize(

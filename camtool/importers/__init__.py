@@ -1,13 +1,13 @@
-"""Importers: read a drawing file into a :class:`~camtool.geometry.Drawing` (mm, Y up)."""
+"""Importers: read a drawing file into a :class:`~camtool.model.shapes.Drawing` (mm, Y up)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
 
-from camtool.errors import InputError, UsageError
-from camtool.geometry import Drawing
-from camtool.units import LARGEST_VALUE
+from camtool.model.errors import InputError, UsageError
+from camtool.model.shapes import Drawing
+from camtool.model.units import LARGEST_VALUE
 
 MAX_ENTITIES = 5_000_000
 """Default :attr:`ImportOptions.max_entities`: 10 × the largest real job camtool was

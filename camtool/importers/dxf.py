@@ -27,12 +27,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from camtool.errors import InputError, UsageError
-from camtool.geometry import Contour, Drawing, Line, Point
 from camtool.importers import MAX_COORDINATE_MM
 from camtool.importers.dxf_curves import BadEntity
 from camtool.importers.dxf_entities import ZERO_LENGTH, check_numbers, layer_of, line_inside
-from camtool.units import INCH
+from camtool.model.errors import InputError, UsageError
+from camtool.model.shapes import Contour, Drawing, Line, Point
+from camtool.model.units import INCH
 
 if TYPE_CHECKING:
     from camtool.importers import ImportOptions

@@ -21,9 +21,9 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
-from camtool.geometry import Point
 from camtool.importers.dxf_curves import Unsupported
 from camtool.importers.dxf_entities import CONVERTED, Item, check_numbers, layer_of, location
+from camtool.model.shapes import Point
 
 MAX_NESTING = 32
 """Deepest block nesting followed; deeper is refused (a block that contains itself, too)."""

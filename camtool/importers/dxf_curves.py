@@ -2,7 +2,7 @@
 
 Both entities live in the WCS. Their true curve is evaluated with ezdxf's construction
 tools (:class:`ezdxf.math.ConstructionEllipse`, :class:`ezdxf.math.BSpline`) and fitted by
-the shared fitter :func:`camtool.toolpath.arcfit.fit_curve`, so the output lies within the
+the shared fitter :func:`camtool.geometry.arcfit.fit_curve`, so the output lies within the
 tolerance of the curve and the curve within the tolerance of the output. A circular
 ellipse (both axes equal) is returned as exact arcs, without fitting.
 
@@ -17,9 +17,9 @@ import math
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from camtool.errors import ToolpathError
-from camtool.geometry import TAU, Arc, Line, Point, Segment, distance
-from camtool.toolpath.arcfit import fit_curve
+from camtool.geometry.arcfit import fit_curve
+from camtool.model.errors import ToolpathError
+from camtool.model.shapes import TAU, Arc, Line, Point, Segment, distance
 
 _RELATIVE = 1e-9  # times the size: a z spread that is still planar, ends that coincide
 _CIRCULAR = 1e-3  # an ellipse whose axes differ by < this share of the tolerance is a circle
@@ -38,7 +38,7 @@ class BadEntity(ValueError):
     """An entity holds a number camtool refuses; the message names the entity and value.
 
     Raised by :func:`camtool.importers.dxf_entities.check_numbers`; the DXF importer
-    turns it into an :class:`~camtool.errors.InputError` naming the file.
+    turns it into an :class:`~camtool.model.errors.InputError` naming the file.
     """
 
 

@@ -19,13 +19,13 @@ from typing import Any
 
 import numpy as np
 
-from camtool.geometry import Arc, Contour, Line, Point, Segment, distance
 from camtool.importers.dxf_curves import (
     BadEntity,
     Unsupported,
     ellipse_segments,
     spline_segments,
 )
+from camtool.model.shapes import Arc, Contour, Line, Point, Segment, distance
 
 CONVERTED = ("LINE", "ARC", "CIRCLE", "LWPOLYLINE", "POLYLINE", "ELLIPSE", "SPLINE", "HATCH")
 """Entity types that become contours (HATCH only with ``hatch_boundaries``)."""

@@ -50,13 +50,13 @@ import dataclasses
 import math
 from pathlib import Path
 
-from camtool.errors import InputError
-from camtool.geometry import Point
 from camtool.importers.gcode_codes import BlockWords, Notes
 from camtool.importers.gcode_commands import CommandReader
 from camtool.importers.gcode_lexer import Block, Word, cut_mid_word, lex_line
-from camtool.program import ArcMove, Home, Linear, Move, Program, Rapid
-from camtool.units import INCH
+from camtool.model.errors import InputError
+from camtool.model.program import ArcMove, Home, Linear, Move, Program, Rapid
+from camtool.model.shapes import Point
+from camtool.model.units import INCH
 
 _ARC_TOL_MM = (0.005, 0.5)
 """LinuxCNC arc end tolerance in mm: (with 0.1 % of the radius, absolute ceiling)."""

@@ -20,8 +20,8 @@ from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Literal
 
-from camtool.errors import InputError
 from camtool.importers.gcode_lexer import Block, Word
+from camtool.model.errors import InputError
 
 Action = Literal["read", "warn", "error"]
 

@@ -1,4 +1,4 @@
-"""The non-motion words of a G-code block kept as :data:`camtool.program.Command` values.
+"""The non-motion words of a G-code block kept as :data:`camtool.model.program.Command` values.
 
 Spindle (``S``, ``M3``/``M4``/``M5``), dwell (``G4 P``), tool change (``T``,
 ``M6``) and return to machine zero (``G28``) become :attr:`Program.commands`,
@@ -22,9 +22,9 @@ Rules:
 
 from __future__ import annotations
 
-from camtool.errors import InputError
 from camtool.importers.gcode_codes import BlockWords, Notes
-from camtool.program import Command, Dwell, Spindle, SpindleDirection, ToolChange
+from camtool.model.errors import InputError
+from camtool.model.program import Command, Dwell, Spindle, SpindleDirection, ToolChange
 
 
 class CommandReader:

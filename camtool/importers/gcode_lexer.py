@@ -6,7 +6,7 @@ and Gcodetools programs of seed-001 §3 and seed-004 §3.3):
 - words: a letter and a number, case-insensitive, spaces anywhere outside
   comments (``G01X1.Y2`` = ``g1 x 1 y 2``); numbers like ``.5``, ``-0.``, ``+1``
   (plain decimals: no exponent, as in RS-274/NGC), of magnitude below
-  :data:`~camtool.units.LARGEST_VALUE`;
+  :data:`~camtool.model.units.LARGEST_VALUE`;
 - comments in parentheses (not nested; ``(MSG, ...)``, ``(PRINT, ...)`` and
   ``(DEBUG, ...)`` are comments too) and from ``;`` to the end of the line, a
   ``;`` inside parentheses being part of that comment (LinuxCNC
@@ -16,7 +16,7 @@ and Gcodetools programs of seed-001 §3 and seed-004 §3.3):
 - a RepRap checksum ``*NN`` at the end: the XOR of every byte before ``*``,
   which is verified.
 
-Refused with an :class:`~camtool.errors.InputError` naming the line: O-words
+Refused with an :class:`~camtool.model.errors.InputError` naming the line: O-words
 (subroutines and flow control), ``#`` parameters, ``[ ]`` expressions, a
 letter without a number, any other character, unclosed or nested comments,
 a wrong checksum, an absurd number (``1`` followed by 400 zeros), and a last
@@ -28,8 +28,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from camtool.errors import InputError
-from camtool.units import LARGEST_VALUE
+from camtool.model.errors import InputError
+from camtool.model.units import LARGEST_VALUE
 
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)")
 _CHECKSUM = re.compile(r"\*(\d+)$")

@@ -17,8 +17,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from camtool.geometry import Arc, BBox, Contour
 from camtool.importers.lint_checks import Finding, check_drawing
+from camtool.model.shapes import Arc, BBox, Contour
 
 if TYPE_CHECKING:
     from camtool.importers import ImportOptions

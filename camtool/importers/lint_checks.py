@@ -1,6 +1,6 @@
 """Drawing checks a machinist wants before cutting (the geometry half of ``camtool inspect``).
 
-Each check works on any :class:`~camtool.geometry.Drawing` (mm, Y up) and returns
+Each check works on any :class:`~camtool.model.shapes.Drawing` (mm, Y up) and returns
 :class:`Finding` records with a location, so the report can say where to look:
 
 - ``open-contour``: a contour still open after chaining at the tolerance;
@@ -25,7 +25,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from camtool.geometry import TAU, Arc, Contour, Drawing, Line, Point, Segment, distance
+from camtool.model.shapes import TAU, Arc, Contour, Drawing, Line, Point, Segment, distance
 
 GAP_FACTOR = 10.0
 """Open ends closer than this many tolerances (but farther than one) are reported as gaps."""

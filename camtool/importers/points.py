@@ -1,7 +1,7 @@
 """Point-list importer: X,Y(,Z) text files and the thesis GUI's Matlab ``xy`` matrices.
 
 Each stroke becomes one contour of straight lines through its points (no fitting here: turning
-dense strokes into arcs is a planning step, :func:`~camtool.toolpath.arcfit.fit_polyline`). A
+dense strokes into arcs is a planning step, :func:`~camtool.geometry.arcfit.fit_polyline`). A
 stroke whose last point equals its first is closed. Points in a row that repeat the previous
 point are dropped. The drawing is 2D: a Z column is read, kept out of the drawing, and a
 warning says so when it is not constant.
@@ -14,7 +14,7 @@ header line (no numbers) may come first; lines starting with ``#`` are comments.
 Numbers are plain decimals (:data:`NUMBER`: optional sign, digits, optional fraction, optional
 exponent), as CSV writers and Matlab print them: Python's ``float`` is not used to decide,
 since it also takes ``1_000``, ``inf`` and ``infinity``. ``NaN`` is a stroke break, never a
-coordinate. A value whose magnitude in mm reaches :data:`~camtool.units.LARGEST_VALUE` is
+coordinate. A value whose magnitude in mm reaches :data:`~camtool.model.units.LARGEST_VALUE` is
 refused. Errors name the file, the line and the column of the bad field.
 
 Matlab files (``.m``): ``xy = [ x1 x2 ...; y1 y2 ... ]`` as the Matlab GUI of seed-002 §3 shows
@@ -31,10 +31,10 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from camtool.errors import InputError, UsageError
-from camtool.geometry import Contour, Drawing, Line, Point
 from camtool.importers import ImportOptions
-from camtool.units import LARGEST_VALUE, LENGTH_UNITS
+from camtool.model.errors import InputError, UsageError
+from camtool.model.shapes import Contour, Drawing, Line, Point
+from camtool.model.units import LARGEST_VALUE, LENGTH_UNITS
 
 TEXT_SUFFIXES = (".csv", ".txt", ".xy")
 MATLAB_SUFFIX = ".m"
@@ -68,7 +68,7 @@ def read_points(path: str | Path, options: ImportOptions | None = None) -> Drawi
 
     Args:
         path: the file.
-        options: ``units`` (a name of :data:`camtool.units.LENGTH_UNITS`; default mm for
+        options: ``units`` (a name of :data:`camtool.model.units.LENGTH_UNITS`; default mm for
             text files, 0.1 mm for ``.m`` files) is used; layers and tolerance do not apply.
 
     Returns:
@@ -104,7 +104,7 @@ def read_points(path: str | Path, options: ImportOptions | None = None) -> Drawi
 
 
 def unit_factor(unit: str) -> float:
-    """Millimetres per ``unit``, a name of :data:`camtool.units.LENGTH_UNITS`.
+    """Millimetres per ``unit``, a name of :data:`camtool.model.units.LENGTH_UNITS`.
 
     Raises:
         UsageError: ``unit`` is not one of them (the message lists them).

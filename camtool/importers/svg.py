@@ -7,7 +7,7 @@ segments. Around it, :mod:`camtool.importers.svgdoc` reads the page size and vie
 exactly, checks syntax, selects Inkscape layers and counts what is skipped (with
 :mod:`camtool.importers.svgtree`), and
 :mod:`camtool.importers.svgcurves` maps each segment to mm: circular arcs (after the full
-transform) become exact :class:`~camtool.geometry.Arc` objects, Béziers and elliptical arcs
+transform) become exact :class:`~camtool.model.shapes.Arc` objects, Béziers and elliptical arcs
 are biarc-fitted within the tolerance.
 
 Rules (docs/importers/svg.md for the user's view):
@@ -32,13 +32,13 @@ from typing import Any
 
 import svgelements as se
 
-from camtool.errors import InputError, ToolpathError
-from camtool.geometry import Contour, Drawing
+from camtool.geometry.fitgeom import check_tolerance
 from camtool.importers import ImportOptions
 from camtool.importers.svgcurves import Affine, affine_of, compose, convert
 from camtool.importers.svgdoc import Prepared, prepare
 from camtool.importers.svgtree import LAYER_ATTR, SOURCE_ATTR, USE_ATTR
-from camtool.toolpath.fitgeom import check_tolerance
+from camtool.model.errors import InputError, ToolpathError
+from camtool.model.shapes import Contour, Drawing
 
 DEFAULT_LAYER = "0"
 """Contour.layer of shapes outside any Inkscape layer (the DXF default layer's name)."""

@@ -11,7 +11,7 @@ of ``[A B]`` agree; a circle under a non-uniform scale or a skew is an ellipse a
 Sources: SVG 1.1 §8.3 (path data) and implementation notes F.6 (elliptical arcs);
 segments are parsed by svgelements (``Move``, ``Line``, ``Close``, ``Arc``,
 ``QuadraticBezier``, ``CubicBezier``); curves are fitted by
-:func:`camtool.toolpath.arcfit.fit_curve`.
+:func:`camtool.geometry.arcfit.fit_curve`.
 """
 
 from __future__ import annotations
@@ -22,10 +22,10 @@ from typing import Any, TypeAlias
 
 import svgelements as se
 
-from camtool.errors import InputError
-from camtool.geometry import TAU, Arc, Line, Point, Segment, distance
+from camtool.geometry.arcfit import fit_curve
 from camtool.importers import MAX_COORDINATE_MM, check_curve_size
-from camtool.toolpath.arcfit import fit_curve
+from camtool.model.errors import InputError
+from camtool.model.shapes import TAU, Arc, Line, Point, Segment, distance
 
 Affine: TypeAlias = tuple[float, float, float, float, float, float]
 """``(a, b, c, d, e, f)``: ``x' = a·x + c·y + e``, ``y' = b·x + d·y + f`` (SVG's ``matrix()``)."""

@@ -29,7 +29,6 @@ from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
-from camtool.errors import InputError
 from camtool.importers import MAX_ENTITIES, svgcheck
 from camtool.importers.svgcurves import Affine
 from camtool.importers.svgtree import (
@@ -43,7 +42,8 @@ from camtool.importers.svgtree import (
     local_name,
     select_layers,
 )
-from camtool.units import LENGTH_UNITS, PX
+from camtool.model.errors import InputError
+from camtool.model.units import LENGTH_UNITS, PX
 
 _LENGTH_ATTRS = {
     "rect": ("x", "y", "width", "height", "rx", "ry"),

@@ -1,1 +1,1 @@
-"""Built-in machine profiles (``<name>.toml``), loaded by :func:`camtool.machine.load_machine`."""
+"""Built-in machine profiles (``<name>.toml``), read by :mod:`camtool.model.machine`."""

@@ -55,7 +55,7 @@ so the rounded centre is kept unless the path would stray more than
 arc split. Two different radii on a grid of step ``q`` differ by at least about
 ``q²/(2r)``, so below ``r ≈ q²/(2·0.005 mm)`` (1 mm at 0.1 mm) GRBL accepts
 only exactly equal grid radii and a small arc may have no printable form
-(:class:`~camtool.errors.DialectError`).
+(:class:`~camtool.model.errors.DialectError`).
 """
 
 from __future__ import annotations
@@ -65,8 +65,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from camtool.errors import DialectError
-from camtool.geometry import Point
+from camtool.model.errors import DialectError
+from camtool.model.shapes import Point
 from camtool.post.arccheck_rules import (
     GRBL_ANGULAR_EPSILON,
     GRBL_CEILING_MM,
@@ -158,7 +158,7 @@ def conform_arc(
         quantum_mm: the writer's resolution, mm (``0.001`` for 3 decimals in mm).
         exact_start: the exact start before rounding, mm. Pass it whenever
             ``start`` was rounded: the arc is a full circle exactly when it equals
-            ``end`` (the :class:`~camtool.program.ArcMove` convention), and an
+            ``end`` (the :class:`~camtool.model.program.ArcMove` convention), and an
             arc whose ends print the same but that is not a full circle gives no
             block. Without it ``start`` is taken as the exact start (a full
             circle is then ``end == start``), and an ``end`` that prints as

@@ -12,8 +12,8 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from camtool.errors import UsageError
-from camtool.geometry import Point
+from camtool.model.errors import UsageError
+from camtool.model.shapes import Point
 
 RULES = ("grbl", "linuxcnc")
 """The controllers whose arc check is known (the ``rule`` argument)."""

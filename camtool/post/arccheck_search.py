@@ -17,8 +17,8 @@ from decimal import ROUND_HALF_UP, Decimal
 import numpy as np
 import numpy.typing as npt
 
-from camtool.errors import UsageError
-from camtool.geometry import Point
+from camtool.model.errors import UsageError
+from camtool.model.shapes import Point
 from camtool.post.arccheck_rules import arc_error, max_difference, rule_ok, travel
 
 DEVIATION_QUANTA = 1.5

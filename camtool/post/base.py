@@ -8,10 +8,11 @@ from dataclasses import dataclass
 from types import MappingProxyType
 from typing import ClassVar
 
-from camtool.errors import DialectError, UsageError
-from camtool.geometry import Point, bbox_union
-from camtool.machine import Machine
-from camtool.program import Move, Program, segment_of
+from camtool.model.errors import DialectError, UsageError
+from camtool.model.machine import Machine
+from camtool.model.program import Move, Program, segment_of
+from camtool.model.shapes import Point, bbox_union
+from camtool.model.units import fmt_num
 from camtool.toolpath.placement import (
     EPS_MM,
     check_travel,
@@ -20,7 +21,6 @@ from camtool.toolpath.placement import (
     too_large,
     toolpath_extent,
 )
-from camtool.units import fmt_num
 
 
 def check_work_area(

@@ -6,7 +6,7 @@ sends relative step counts per motor; the interface runs X and Y by "corte
 recto" (both motors together, then the longer one alone), waits T1 seconds,
 runs Z, waits T2 seconds, and goes on with the next move.
 
-How a :class:`~camtool.program.Program` is written:
+How a :class:`~camtool.model.program.Program` is written:
 
 - every end point is rounded to whole steps ABSOLUTELY (half away from zero,
   with the machine's steps/mm), and the record carries the difference from the
@@ -50,9 +50,21 @@ from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import ClassVar
 
-from camtool.errors import DialectError, UsageError
-from camtool.geometry import Arc, Point
-from camtool.machine import Machine
+from camtool.model.errors import DialectError, UsageError
+from camtool.model.machine import Machine
+from camtool.model.program import (
+    ArcMove,
+    Command,
+    Dwell,
+    Home,
+    Linear,
+    Move,
+    Program,
+    Rapid,
+    Spindle,
+    ToolChange,
+)
+from camtool.model.shapes import Arc, Point
 from camtool.post.base import PostProcessor, PostResult, check_placement, check_work_area
 from camtool.post.i8751_read import cruise_feed, is_text, program_from_records
 from camtool.post.i8751_stream import (
@@ -68,18 +80,6 @@ from camtool.post.i8751_stream import (
     undump,
 )
 from camtool.post.numfmt import NumberFormat
-from camtool.program import (
-    ArcMove,
-    Command,
-    Dwell,
-    Home,
-    Linear,
-    Move,
-    Program,
-    Rapid,
-    Spindle,
-    ToolChange,
-)
 
 _DROPPED = {
     Spindle: "spindle command(s): the interface drives only the three axis motors",

@@ -8,9 +8,9 @@ ends with the tool above Z = 0 is a rapid, any other a cut at the cruise feed.
 
 from __future__ import annotations
 
-from camtool.machine import Machine
+from camtool.model.machine import Machine
+from camtool.model.program import Command, Dwell, Linear, Move, Program, Rapid
 from camtool.post.i8751_stream import ACCESS_KEY, Record
-from camtool.program import Command, Dwell, Linear, Move, Program, Rapid
 
 CRUISE_HZ = 104.0
 """Cruise step rate of the firmware ramp, X = 11H (seed-003 §4.4), used when the

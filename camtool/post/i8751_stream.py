@@ -32,7 +32,7 @@ import re
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
-from camtool.errors import ParseError
+from camtool.model.errors import ParseError
 from camtool.post.numfmt import NumberFormat
 
 ACCESS_KEY = 0x13

@@ -53,9 +53,10 @@ from typing import ClassVar
 
 import numpy as np
 
-from camtool.errors import DialectError, UsageError
-from camtool.geometry import Arc, Point
-from camtool.machine import Machine
+from camtool.model.errors import DialectError, UsageError
+from camtool.model.machine import Machine
+from camtool.model.program import ArcMove, Linear, Move, Program, Rapid
+from camtool.model.shapes import Arc, Point
 from camtool.post.base import PostProcessor, PostResult, check_placement, check_work_area
 from camtool.post.matlab_router_read import (
     INT16_MAX,
@@ -65,7 +66,6 @@ from camtool.post.matlab_router_read import (
 from camtool.post.matlab_router_warnings import WriterNotes, jobs_warnings, notes_warnings
 from camtool.post.numfmt import NumberFormat
 from camtool.post.router_arrays import DEFAULT_SPEED, RouterArrays, points_01mm, router_arrays
-from camtool.program import ArcMove, Linear, Move, Program, Rapid
 
 FIRMWARE_MAX_SEGMENTS = 128
 """Segments (lines) one job holds: the master's ``X_ROUTE[128]`` … arrays (L4625–L4635)."""

@@ -2,9 +2,9 @@
 
 Both formats are written by :class:`camtool.post.matlab_router.MatlabRouterPost`
 (seed-002 §3, §2.7, R2–R4) and read back here, strictly, into a
-:class:`~camtool.program.Program` of absolute mm, Y up: each job becomes a
-:class:`~camtool.program.Rapid` to its first point (the master homes and goes
-there, §2.8 st=0/st=1) followed by one :class:`~camtool.program.Linear` per
+:class:`~camtool.model.program.Program` of absolute mm, Y up: each job becomes a
+:class:`~camtool.model.program.Rapid` to its first point (the master homes and goes
+there, §2.8 st=0/st=1) followed by one :class:`~camtool.model.program.Linear` per
 segment (``contour`` = the job number).
 
 **What is the truth.** The firmware never sees ``xy``: the master replays the
@@ -14,7 +14,7 @@ with the GUI's own rule (:func:`~camtool.post.router_arrays.router_arrays`), so 
 file whose arrays disagree with that rule cannot be simulated as the firmware
 would run it: every ``lxy``/``velxy`` entry must be exactly what the GUI
 computes from the vertices at the dialect's ``speed``, else a
-:class:`~camtool.errors.ParseError` names the job, the array, the column
+:class:`~camtool.model.errors.ParseError` names the job, the array, the column
 (segment) and the value expected. A segment that moves an axis at speed 0 is
 refused (the slave never reaches its count and the job hangs, §4.2; on the wire
 its direction is lost).
@@ -34,9 +34,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from camtool.errors import ParseError
+from camtool.model.errors import ParseError
+from camtool.model.program import Linear, Move, Program, Rapid
 from camtool.post.router_arrays import RouterArrays, router_arrays
-from camtool.program import Linear, Move, Program, Rapid
 
 COUNTS_PER_MM = 25_600
 """Encoder counts per mm on X and Y: 1024 × 75 / 3 mm (seed-002 §2.2, R8)."""

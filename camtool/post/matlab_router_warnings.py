@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from camtool.geometry import Point
+from camtool.model.shapes import Point
 from camtool.post.matlab_router_read import major_axis_feed_mm_min
 
 if TYPE_CHECKING:
@@ -28,7 +28,7 @@ COMMAND_REASONS = {
     "ToolChange": "the router has one tool, changed by hand",
     "Home": "every job homes Z, X and Y before it starts (seed-002 §2.8 st=0)",
 }
-"""Why each kind of :data:`~camtool.program.Command` is not written."""
+"""Why each kind of :data:`~camtool.model.program.Command` is not written."""
 
 
 @dataclass

@@ -17,7 +17,7 @@ import math
 from dataclasses import dataclass
 from decimal import ROUND_HALF_UP, Decimal, InvalidOperation, localcontext
 
-from camtool.errors import DialectError
+from camtool.model.errors import DialectError
 
 SIGN_POLICIES = ("negative", "always")
 """``negative``: ``-`` only before negatives (seed-000 L1731); ``always``: ``+`` too."""

@@ -40,13 +40,9 @@ from decimal import ROUND_HALF_UP, Decimal
 from types import MappingProxyType
 from typing import Any, ClassVar
 
-from camtool.errors import DialectError, ParseError
-from camtool.geometry import Arc, distance
-from camtool.machine import Machine
-from camtool.post.base import PostProcessor, PostResult, check_placement, check_work_area
-from camtool.post.numfmt import NumberFormat, format_int
-from camtool.post.pic_mmh_feeds import FeedTable
-from camtool.program import (
+from camtool.model.errors import DialectError, ParseError
+from camtool.model.machine import Machine
+from camtool.model.program import (
     ArcMove,
     Command,
     Dwell,
@@ -58,6 +54,10 @@ from camtool.program import (
     Spindle,
     ToolChange,
 )
+from camtool.model.shapes import Arc, distance
+from camtool.post.base import PostProcessor, PostResult, check_placement, check_work_area
+from camtool.post.numfmt import NumberFormat, format_int
+from camtool.post.pic_mmh_feeds import FeedTable
 
 _COORD = r"([+-]?\d{5}\.\d{2})"
 _BLOCK = re.compile(rf"^G0(?P<g>[0-3])X{_COORD}Y{_COORD}(?:I{_COORD}J{_COORD})?(?:F(?P<f>\d\d))?;$")

@@ -42,8 +42,8 @@ from dataclasses import dataclass
 from decimal import ROUND_HALF_UP, Decimal
 from typing import ClassVar, Literal, TypeAlias, cast
 
-from camtool.errors import DialectError, ParseError
-from camtool.machine import Machine
+from camtool.model.errors import DialectError, ParseError
+from camtool.model.machine import Machine
 
 Axis: TypeAlias = Literal["X", "Y", "Z"]
 """An axis letter of the mode strings (seed-000 §3.6 ``axis``)."""

@@ -4,7 +4,7 @@ A target file (``camtool/targets/<name>.toml`` or any ``--target path.toml``)
 holds ``name``, ``description``, ``source``, ``dialect`` (a key of
 :data:`DIALECTS`), ``default_feed_mm_min``, optional ``spindle_rpm``, a
 ``[dialect_options]`` table for that dialect and ``machine`` (a built-in
-profile name or a ``[machine]`` table, :mod:`camtool.machine`). Every field is
+profile name or a ``[machine]`` table, :mod:`camtool.model.machine`). Every field is
 documented in docs/targets/index.md and docs/dialects.md.
 
 Third-party Python targets register under the entry-point group
@@ -23,8 +23,8 @@ from importlib import metadata, resources
 from pathlib import Path
 from typing import Any
 
-from camtool.errors import InputError, UsageError
-from camtool.machine import load_toml, machine_from_table, machine_table, merge_tables
+from camtool.model.errors import InputError, UsageError
+from camtool.model.machine import load_toml, machine_from_table, machine_table, merge_tables
 from camtool.post.base import PostProcessor, Target
 
 ENTRY_POINT_GROUP = "camtool.postprocessors"
@@ -148,7 +148,7 @@ def load_target(name: str, *, machine_file: Path | str | None = None) -> Target:
             ``.toml`` file.
         machine_file: a TOML file (or built-in profile name) whose ``[machine]``
             table is laid over the target's machine profile, key by key
-            (:func:`camtool.machine.merge_tables`).
+            (:func:`camtool.model.machine.merge_tables`).
 
     Raises:
         UsageError: no such target (the message lists the valid names).

@@ -27,7 +27,7 @@ from typing import overload
 import numpy as np
 import numpy.typing as npt
 
-from camtool.errors import DialectError, UsageError
+from camtool.model.errors import DialectError, UsageError
 
 DEFAULT_SPEED = 480
 """Major-axis speed of a segment, encoder counts per 5 ms (seed-002 §2.3, R7, L4458)."""

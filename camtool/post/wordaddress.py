@@ -31,13 +31,13 @@ from collections.abc import Mapping
 from types import MappingProxyType
 from typing import Any
 
-from camtool.errors import ParseError
-from camtool.machine import Machine
+from camtool.model.errors import ParseError
+from camtool.model.machine import Machine
+from camtool.model.program import ArcMove, Program
 from camtool.post.base import PostProcessor, PostResult
 from camtool.post.wordaddress_read import BlockReader, ControllerRefusal
 from camtool.post.wordaddress_spec import WordAddressSpec, WordSpec, load_spec
 from camtool.post.wordaddress_write import BlockWriter
-from camtool.program import ArcMove, Program
 
 __all__ = ["WordAddressPost", "WordAddressSpec", "WordSpec", "load_spec", "word_address_dialect"]
 

@@ -41,10 +41,8 @@ import dataclasses
 import re
 from dataclasses import dataclass, field
 
-from camtool.errors import DialectError, ParseError
-from camtool.geometry import Point
-from camtool.post.wordaddress_spec import WordAddressSpec
-from camtool.program import (
+from camtool.model.errors import DialectError, ParseError
+from camtool.model.program import (
     ArcMove,
     Command,
     Dwell,
@@ -56,6 +54,8 @@ from camtool.program import (
     SpindleDirection,
     ToolChange,
 )
+from camtool.model.shapes import Point
+from camtool.post.wordaddress_spec import WordAddressSpec
 
 _WORD = re.compile(r"([A-Za-z])([^A-Za-z]*)")
 _UPPER_WORD = re.compile(r"[A-Z][^A-Za-z]*")

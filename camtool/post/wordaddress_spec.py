@@ -8,7 +8,7 @@ and how arcs, Z moves and commands are expressed. It is read from the
 every key is documented in docs/dialects.md.
 
 The loader is strict: an unknown key, a wrong type or an impossible
-combination is an :class:`~camtool.errors.InputError` naming the file and the
+combination is an :class:`~camtool.model.errors.InputError` naming the file and the
 full key path, e.g. ``valcnc.toml: dialect_options.words.X.decimals: expected
 an integer, got "3"``.
 """
@@ -24,7 +24,7 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
-from camtool.errors import InputError
+from camtool.model.errors import InputError
 from camtool.post.numfmt import SIGN_POLICIES, NumberFormat
 
 WORD_LETTERS = "XYZIJFSPT"
@@ -115,7 +115,7 @@ class WordAddressSpec:
             accepts any of them.
         comment: how the dialect writes a comment line (:data:`COMMENTS`):
             ``"()"`` or ``";"``; ``None``: it has no comments, and the job notes
-            (:attr:`Program.notes <camtool.program.Program.notes>`) are not written.
+            (:attr:`Program.notes <camtool.model.program.Program.notes>`) are not written.
         header: lines written verbatim first, before the job notes and the
             preamble; each is ``"%"`` or a comment in the ``comment`` syntax.
         footer: lines written verbatim after the end code, the same kinds.

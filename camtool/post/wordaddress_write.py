@@ -31,12 +31,9 @@ import dataclasses
 import math
 from collections import Counter
 
-from camtool.errors import DialectError
-from camtool.geometry import Arc, Point
-from camtool.machine import Machine
-from camtool.post.base import check_placement, check_work_area
-from camtool.post.wordaddress_spec import WordAddressSpec
-from camtool.program import (
+from camtool.model.errors import DialectError
+from camtool.model.machine import Machine
+from camtool.model.program import (
     ArcMove,
     Command,
     Dwell,
@@ -48,6 +45,9 @@ from camtool.program import (
     Spindle,
     ToolChange,
 )
+from camtool.model.shapes import Arc, Point
+from camtool.post.base import check_placement, check_work_area
+from camtool.post.wordaddress_spec import WordAddressSpec
 
 _SAME_MM = 1e-9
 """Exact XY closer than this is the same point (a Z-only move)."""

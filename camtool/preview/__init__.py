@@ -26,10 +26,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from camtool.errors import UsageError
-from camtool.geometry import BBox, Drawing
+from camtool.model.errors import UsageError
+from camtool.model.program import Program
+from camtool.model.shapes import BBox, Drawing
 from camtool.preview.program_layers import AREA_COLOUR, CUT_COLOUR, RAPID_COLOUR
-from camtool.program import Program
 
 if TYPE_CHECKING:
     from camtool.post.base import Target

@@ -7,18 +7,18 @@ The time is the best estimate available, and the title says which it is:
 - for a program with a target: the same model, run on a step simulation of the
   program (no measurement);
 - otherwise the cutting moves at their programmed feeds
-  (:meth:`camtool.program.Program.cutting_time_s`; rapids not counted).
+  (:meth:`camtool.model.program.Program.cutting_time_s`; rapids not counted).
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from camtool.geometry import BBox
-from camtool.program import Program, Rapid
+from camtool.model.program import Program, Rapid
+from camtool.model.shapes import BBox
 
 if TYPE_CHECKING:
-    from camtool.machine import Machine
+    from camtool.model.machine import Machine
     from camtool.verify.simulate import StepTrace
     from camtool.verify.verifier import Verification
 

@@ -14,7 +14,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, TypeAlias
 
-from camtool.geometry import BBox, Drawing, Line, bbox_union
+from camtool.model.program import Program, Rapid
+from camtool.model.shapes import BBox, Drawing, Line, bbox_union
+from camtool.model.units import fmt_num
 from camtool.preview import program_layers as pl
 from camtool.preview import trace_layers as tl
 from camtool.preview.facts import duration, length, size_text
@@ -35,8 +37,6 @@ from camtool.preview.scene import (
     ramp_colour,
     text_width,
 )
-from camtool.program import Program, Rapid
-from camtool.units import fmt_num
 from camtool.verify.verifier import error_text
 
 if TYPE_CHECKING:

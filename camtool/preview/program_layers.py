@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import math
 
-from camtool.geometry import Arc, BBox, Drawing, Line, Point, Segment
+from camtool.model.program import Program, Rapid
+from camtool.model.shapes import Arc, BBox, Drawing, Line, Point, Segment
 from camtool.preview.scene import (
     Circle,
     Layer,
@@ -23,7 +24,6 @@ from camtool.preview.scene import (
     place_labels,
     polyline,
 )
-from camtool.program import Program, Rapid
 
 CUT_COLOUR = "#1f4fd1"
 """Cutting moves (blue, S000-24)."""

@@ -14,7 +14,7 @@ from __future__ import annotations
 import io
 from typing import TYPE_CHECKING, Any
 
-from camtool.geometry import Point, Segment
+from camtool.model.shapes import Point, Segment
 from camtool.preview.scene import Circle, Panel, Path, Polylines, Rect, Scene, Shape, Style, Text
 
 if TYPE_CHECKING:

@@ -20,7 +20,7 @@ from typing import TypeAlias
 import numpy as np
 import numpy.typing as npt
 
-from camtool.geometry import BBox, Point, Segment
+from camtool.model.shapes import BBox, Point, Segment
 
 
 @dataclass(frozen=True)

@@ -16,7 +16,7 @@ from xml.sax.saxutils import escape, quoteattr
 import numpy as np
 import numpy.typing as npt
 
-from camtool.geometry import Arc, BBox, Segment
+from camtool.model.shapes import Arc, BBox, Segment
 from camtool.preview.scene import (
     Circle,
     Layer,

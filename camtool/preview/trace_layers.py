@@ -16,7 +16,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
-from camtool.geometry import BBox, Point
+from camtool.model.program import Rapid
+from camtool.model.shapes import BBox, Point
+from camtool.model.units import fmt_num
 from camtool.preview.program_layers import CUT_COLOUR, cut_runs
 from camtool.preview.scene import (
     Circle,
@@ -29,8 +31,6 @@ from camtool.preview.scene import (
     polyline,
     ramp_colour,
 )
-from camtool.program import Rapid
-from camtool.units import fmt_num
 
 if TYPE_CHECKING:
     from collections.abc import Sequence

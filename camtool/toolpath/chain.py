@@ -14,10 +14,10 @@ import math
 from collections import defaultdict
 from collections.abc import Sequence
 
-from camtool.errors import ToolpathError
-from camtool.geometry import Arc, Contour, Line, Point, Segment, distance
+from camtool.model.errors import ToolpathError
+from camtool.model.shapes import Arc, Contour, Line, Point, Segment, distance
+from camtool.model.units import fmt_point
 from camtool.toolpath.cuts import Finding, where
-from camtool.units import fmt_point
 
 _GAP_SHARE = 0.1  # a gap closed by close_gaps is shorter than this share of the contour
 _MAX_CELLS = 2.0**40
@@ -169,7 +169,7 @@ def close_gaps(
     An open contour is closed when its ends are more than ``tolerance`` but at
     most ``max_gap`` apart and the gap is under a tenth of the contour's length
     (a deliberate "C" stays open). The drawn segments are kept exactly; one
-    :class:`~camtool.geometry.Line` from the end back to the start is appended.
+    :class:`~camtool.model.shapes.Line` from the end back to the start is appended.
     Every closure is reported: the drawing is probably wrong there.
 
     Args:

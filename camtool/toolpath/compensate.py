@@ -25,8 +25,8 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from camtool.errors import ToolpathError
-from camtool.geometry import Arc, Contour, Line, Point, Segment
+from camtool.model.errors import ToolpathError
+from camtool.model.shapes import Arc, Contour, Line, Point, Segment
 from camtool.toolpath.cuts import Cut, Finding, Stage, where
 from camtool.toolpath.gouge import gouges
 from camtool.toolpath.options import PlanOptions

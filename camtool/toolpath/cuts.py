@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from camtool.geometry import Contour, Point
+from camtool.model.shapes import Contour, Point
 
 CUT_KINDS = ("profile", "open", "pocket")
 """Kinds of :class:`Cut`: a closed profile, an open contour cut on the line, a pocket path."""
@@ -126,7 +126,7 @@ class Stage:
 
 def where(contour: Contour) -> str:
     """``"contour LINE #2A at (x, y) mm"``: how messages name a contour."""
-    from camtool.units import fmt_point
+    from camtool.model.units import fmt_point
 
     src = f"{contour.source} " if contour.source else ""
     return f"contour {src}at {fmt_point(contour.start)} mm"

@@ -12,10 +12,10 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from camtool.geometry import Contour, Point
+from camtool.model.shapes import Contour, Point
+from camtool.model.units import fmt_num, fmt_point
 from camtool.toolpath.cuts import Finding, where
 from camtool.toolpath.options import PlanOptions
-from camtool.units import fmt_num, fmt_point
 
 MIN_JOINT_MM = 1e-9
 """Joint distance used for ``--chain-tolerance 0`` (only coincident ends meet)."""

@@ -19,7 +19,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
-from camtool.geometry import Contour
+from camtool.model.shapes import Contour
 from camtool.toolpath.cuts import Cut, Finding, where
 from camtool.toolpath.offset import quad_segs
 from camtool.toolpath.options import PlanOptions

@@ -17,7 +17,7 @@ along both arcs (clockwise for material on the left).
 
 from __future__ import annotations
 
-from camtool.geometry import Arc, Point
+from camtool.model.shapes import Arc, Point
 from camtool.toolpath.cuts import Cut
 from camtool.toolpath.split import Track, end_tangent, start_tangent
 

@@ -29,8 +29,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 import numpy.typing as npt
 
-from camtool.errors import ToolpathError
-from camtool.geometry import TAU, Arc, Contour, Line, Point, Segment, distance
+from camtool.model.errors import ToolpathError
+from camtool.model.shapes import TAU, Arc, Contour, Line, Point, Segment, distance
 from camtool.toolpath.cuts import Cut, Finding, where
 from camtool.toolpath.travel import oriented
 

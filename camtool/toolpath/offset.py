@@ -23,8 +23,8 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from camtool.errors import ToolpathError
-from camtool.geometry import Arc, Contour, Line, Point, Segment, distance
+from camtool.model.errors import ToolpathError
+from camtool.model.shapes import Arc, Contour, Line, Point, Segment, distance
 from camtool.toolpath.chain import chain
 
 if TYPE_CHECKING:
@@ -170,7 +170,7 @@ def buffer_pieces(contour: Contour, amount: float, tolerance: float) -> list[Con
     The contour's polygon (chords within ``tolerance/4``) is buffered with
     enough segments per quarter circle that the buffer's chords stay within
     ``tolerance/4`` of its round joins, and each ring is fitted with
-    :func:`~camtool.toolpath.arcfit.fit_polyline` within ``tolerance/2``: the
+    :func:`~camtool.geometry.arcfit.fit_polyline` within ``tolerance/2``: the
     result lies within ``tolerance`` of the exact offset. Regions nowhere wider
     than ``tolerance`` are dropped.
 
@@ -247,7 +247,7 @@ def _region_area(pieces: list[Contour]) -> float:
 
 def _fitted(region: Any, contour: Contour, tolerance: float) -> list[Contour]:
     """Each ring of a (multi)polygon fitted with lines and arcs within ``tolerance/2``."""
-    from camtool.toolpath.arcfit import fit_polyline
+    from camtool.geometry.arcfit import fit_polyline
 
     pieces: list[Contour] = []
     for poly in getattr(region, "geoms", [region]):

@@ -1,7 +1,7 @@
 """Planning options: every ``post`` option that shapes a drawing's toolpath, checked once.
 
 Each field maps to one command-line option (``--offset`` → ``offset``, ``--step-down``
-→ ``step_down``...). Invalid combinations raise :class:`~camtool.errors.UsageError`
+→ ``step_down``...). Invalid combinations raise :class:`~camtool.model.errors.UsageError`
 naming the option, before any file is read (``batch`` validates once for all files).
 """
 
@@ -11,11 +11,11 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from camtool.errors import UsageError
-from camtool.geometry import Point
+from camtool.model.errors import UsageError
+from camtool.model.shapes import Point
 
 if TYPE_CHECKING:
-    from camtool.machine import Machine
+    from camtool.model.machine import Machine
     from camtool.toolpath.cuts import Finding
 
 OFFSET_MODES = ("on", "outside", "inside", "pocket")

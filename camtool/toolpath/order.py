@@ -26,13 +26,13 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any
 
-from camtool.errors import UsageError
-from camtool.geometry import Contour, Point, distance
+from camtool.model.errors import UsageError
+from camtool.model.shapes import Contour, Point, distance
+from camtool.model.units import fmt_point
 from camtool.toolpath.cuts import Cut, Finding
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.reversals import count_reversals, reversal_order
 from camtool.toolpath.travel import Step, drawn_order, oriented, precedence, travel_order
-from camtool.units import fmt_point
 
 _NEST_TOLERANCE_MM = 1e-4
 

@@ -2,7 +2,7 @@
 
 The last planning stage (see :mod:`camtool.toolpath.plan`). Cuts arrive in their
 final cutting order, each already rotated and reversed as it will be cut; this
-module turns them into :mod:`camtool.program` moves.
+module turns them into :mod:`camtool.model.program` moves.
 
 **2D** (a machine without Z, no ``depth``): per cut a rapid to its start (kept
 even when the tool is already there, so every contour begins with a positioning
@@ -16,7 +16,7 @@ together except a cut that descends along the path (a ramp):
 - **start**: a Z-only rapid up to the clearance height
   (:attr:`~camtool.toolpath.options.PlanOptions.clearance`) where the tool stands
   (``origin``), then XY at clearance to the first cut, a Z-only rapid down to
-  ``safe_z``, and a Z-only :class:`~camtool.program.Linear` at the plunge feed
+  ``safe_z``, and a Z-only :class:`~camtool.model.program.Linear` at the plunge feed
   into the material. The machine's XY position before the program is not known,
   so nothing rapids in XY before Z is at clearance.
 - **between cuts of one part**: Z-only rapid up to ``safe_z``, XY rapid at
@@ -32,7 +32,7 @@ Every rapid that moves XY is at ``safe_z`` or above. Feeds: cutting moves at
 ``feed_mm_min``.
 
 **Move limit**: a plan of more than :data:`MAX_MOVES` moves is refused with a
-:class:`~camtool.errors.UsageError` (a hostile ``--ramp 0.0001`` would otherwise
+:class:`~camtool.model.errors.UsageError` (a hostile ``--ramp 0.0001`` would otherwise
 write kilometres of helix); a ramp is checked against the path length before any
 move is written.
 
@@ -71,9 +71,9 @@ import math
 from collections.abc import Sequence
 from itertools import pairwise
 
-from camtool.errors import UsageError
-from camtool.geometry import Arc, Segment
-from camtool.program import ArcMove, Linear, Move, Rapid
+from camtool.model.errors import UsageError
+from camtool.model.program import ArcMove, Linear, Move, Rapid
+from camtool.model.shapes import Arc, Segment
 from camtool.toolpath.cuts import Cut, Finding, where
 from camtool.toolpath.leads import leads_for
 from camtool.toolpath.options import PlanOptions
@@ -136,7 +136,7 @@ def emit(
             the tool is before the first move).
         helix: the target can write helical arcs (an arc move with Z). ``False``:
             the descending part of an arc in a ramp becomes chords within
-            ``options.tolerance``, each a :class:`~camtool.program.Linear` with Z.
+            ``options.tolerance``, each a :class:`~camtool.model.program.Linear` with Z.
         z_axis: the machine has a programmable Z axis. Without a ``depth`` such a
             machine gets a Z program cutting at Z 0 (rapids at ``safe_z``); a
             machine without one (``False``, the default) gets a 2D program.
@@ -301,7 +301,7 @@ class _Writer:
             return leads
         got = 0.0 if leads is None else leads[0].radius
         if got < asked - 1e-9:
-            from camtool.units import fmt_num
+            from camtool.model.units import fmt_num
 
             what = (
                 f"lead-in and lead-out arcs shortened to {fmt_num(got, 3)} mm radius"

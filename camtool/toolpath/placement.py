@@ -27,13 +27,13 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from camtool.errors import DialectError
-from camtool.geometry import BBox, Point, bbox_union
-from camtool.program import ArcMove, Move, Program, Rapid, segment_of
-from camtool.units import fmt_num
+from camtool.model.errors import DialectError
+from camtool.model.program import ArcMove, Move, Program, Rapid, segment_of
+from camtool.model.shapes import BBox, Point, bbox_union
+from camtool.model.units import fmt_num
 
 if TYPE_CHECKING:
-    from camtool.machine import Machine
+    from camtool.model.machine import Machine
 
 EPS_MM = 1e-6
 """Positions closer than this to a limit or to the work zero count as on it, mm (1 nm:

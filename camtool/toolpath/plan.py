@@ -26,10 +26,10 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from camtool.errors import InputError
-from camtool.geometry import Contour, Drawing, Line, Point, Segment
-from camtool.program import Move, Program, Rapid
-from camtool.toolpath.arcfit import FitStats, fit_polyline, fit_stats
+from camtool.geometry.arcfit import FitStats, fit_polyline, fit_stats
+from camtool.model.errors import InputError
+from camtool.model.program import Move, Program, Rapid
+from camtool.model.shapes import Contour, Drawing, Line, Point, Segment
 from camtool.toolpath.chain import chain, close_gaps
 from camtool.toolpath.cuts import Finding, Stage
 from camtool.toolpath.gaps import MIN_JOINT_MM, open_gaps
@@ -45,7 +45,7 @@ from camtool.toolpath.placement import (
 from camtool.toolpath.split import MIN_PIECE
 
 if TYPE_CHECKING:
-    from camtool.machine import Machine
+    from camtool.model.machine import Machine
 
 __all__ = [
     "OFFSET_MODES",
@@ -283,7 +283,7 @@ def fit_dense(contours: Sequence[Contour], tolerance: float) -> tuple[list[Conto
     """Replace runs of :data:`MIN_FIT_RUN` or more lines by arcs and lines within ``tolerance``.
 
     A run's end points stay exact (they are corners or meet arcs); corners inside a
-    run are kept by :func:`~camtool.toolpath.arcfit.fit_polyline`. A run is replaced
+    run are kept by :func:`~camtool.geometry.arcfit.fit_polyline`. A run is replaced
     only when the fit has fewer segments.
 
     Returns:

@@ -12,7 +12,7 @@ Two styles (``--pocket``):
   and innermost last. The wall ring is the exact OpenCASCADE offset when each boundary
   offsets on its own (:func:`~camtool.toolpath.offset.offset_contour`); the other rings
   are shapely buffers fitted with arcs and lines
-  (:func:`~camtool.toolpath.arcfit.fit_polyline`). Where a ring splits around islands
+  (:func:`~camtool.geometry.arcfit.fit_polyline`). Where a ring splits around islands
   the rings form a tree, cut depth first so each sub-pocket is finished before the next.
 - ``zigzag``: the wall ring, then parallel lines at spacing ``s`` and the angle
   ``--pocket-angle`` (:mod:`~camtool.toolpath.pocket_zigzag`).
@@ -41,8 +41,9 @@ from shapely import Point as ShapelyPoint
 from shapely.geometry.base import BaseGeometry
 from shapely.geometry.polygon import orient
 
-from camtool.errors import ToolpathError, UsageError
-from camtool.geometry import Contour, Line, Point, Segment, distance
+from camtool.model.errors import ToolpathError, UsageError
+from camtool.model.shapes import Contour, Line, Point, Segment, distance
+from camtool.model.units import fmt_num
 from camtool.toolpath.cuts import Cut, Finding, Stage, where
 from camtool.toolpath.offset import offset_contour
 from camtool.toolpath.options import PlanOptions
@@ -50,7 +51,6 @@ from camtool.toolpath.order import Nesting
 from camtool.toolpath.pocket_rings import fit_ring, nearest_on, start_near
 from camtool.toolpath.pocket_uncut import polygons, quad_segs, uncut_findings
 from camtool.toolpath.pocket_zigzag import order_lines, zigzag_lines
-from camtool.units import fmt_num
 
 __all__ = ["Region", "pocket", "regions"]
 

@@ -2,7 +2,7 @@
 
 Used by :mod:`camtool.toolpath.pocket`. A ring is a closed sequence of segments
 (start == end). :func:`fit_ring` turns a shapely buffer ring into arcs and lines
-(:func:`~camtool.toolpath.arcfit.fit_polyline` within ``tolerance / 2``) and then
+(:func:`~camtool.geometry.arcfit.fit_polyline` within ``tolerance / 2``) and then
 merges neighbours that lie on one circle, so a circular ring comes out as one full
 circle rather than two half arcs and a left-over chord. :func:`start_near` rotates a
 ring to start at its point nearest the tool, splitting a segment there.
@@ -17,9 +17,9 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from camtool.errors import InputError
-from camtool.geometry import TAU, Arc, Line, Point, Segment, distance
-from camtool.toolpath.arcfit import fit_polyline
+from camtool.geometry.arcfit import fit_polyline
+from camtool.model.errors import InputError
+from camtool.model.shapes import TAU, Arc, Line, Point, Segment, distance
 
 __all__ = ["fit_ring", "nearest_on", "start_near"]
 

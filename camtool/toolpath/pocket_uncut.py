@@ -30,7 +30,7 @@ from shapely import LineString, Polygon
 from shapely.geometry.base import BaseGeometry
 from shapely.geometry.polygon import orient
 
-from camtool.geometry import Contour, Point
+from camtool.model.shapes import Contour, Point
 from camtool.toolpath.cuts import Cut, Finding, where
 from camtool.toolpath.options import PlanOptions
 

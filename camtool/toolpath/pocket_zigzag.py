@@ -20,7 +20,7 @@ import shapely
 from shapely import affinity
 from shapely.geometry.base import BaseGeometry
 
-from camtool.geometry import Line, Point
+from camtool.model.shapes import Line, Point
 
 __all__ = ["order_lines", "zigzag_lines"]
 

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from camtool.geometry import TAU, Arc, Line, Point, Segment
+from camtool.model.shapes import TAU, Arc, Line, Point, Segment
 from camtool.toolpath.cuts import Cut
 from camtool.toolpath.travel import Step, ends, oriented, rapid_mm, travel_order
 

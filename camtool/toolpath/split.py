@@ -17,7 +17,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from camtool.geometry import Arc, Contour, Line, Point, Segment
+from camtool.model.shapes import Arc, Contour, Line, Point, Segment
 
 MIN_PIECE = 1e-9
 """Pieces shorter than this (mm) are dropped: a zero-length arc would read as a full circle."""

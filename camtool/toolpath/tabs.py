@@ -12,7 +12,7 @@ and last 5 % hold the entry (plunge or ramp start) and are left free.
 
 from __future__ import annotations
 
-from camtool.errors import ToolpathError
+from camtool.model.errors import ToolpathError
 
 ENTRY_MARGIN = 0.05
 """Fraction of the path length kept free of tabs at each end (the entry)."""

@@ -33,7 +33,7 @@ from dataclasses import replace
 import numpy as np
 import numpy.typing as npt
 
-from camtool.geometry import Contour, Point, distance
+from camtool.model.shapes import Contour, Point, distance
 from camtool.toolpath.cuts import Cut
 
 Step = tuple[int, int, bool]

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from camtool.geometry import Point
+from camtool.model.shapes import Point
 from camtool.toolpath.cuts import Cut
 
 TWO_OPT_WINDOW = 32

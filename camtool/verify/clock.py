@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from camtool.machine import Machine
-from camtool.program import Program, Rapid
+from camtool.model.machine import Machine
+from camtool.model.program import Program, Rapid
 from camtool.verify.simulate import StepTrace
 from camtool.verify.timing import BlockKinematics, timing_model_from_table
 

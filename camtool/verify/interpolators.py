@@ -28,7 +28,7 @@ from collections.abc import Callable
 import numpy as np
 import numpy.typing as npt
 
-from camtool.errors import UsageError
+from camtool.model.errors import UsageError
 from camtool.verify.interpolators_arc import circular_dda_arc, dsm_arc, staircase_arc
 from camtool.verify.interpolators_chord import (
     chord_sagitta,

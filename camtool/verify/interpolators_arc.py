@@ -50,7 +50,7 @@ from collections.abc import Callable
 import numpy as np
 import numpy.typing as npt
 
-from camtool.errors import InputError, UsageError
+from camtool.model.errors import InputError, UsageError
 from camtool.verify.steparray import StepArray, concatenate, empty_steps, freeze
 
 # Move codes of the inner loops, in magnitudes: X step, Y step, both, none.

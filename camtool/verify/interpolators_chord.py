@@ -18,7 +18,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from camtool.errors import InputError, UsageError
+from camtool.model.errors import InputError, UsageError
 
 Point = tuple[float, float]
 """A point ``(x, y)`` in mm."""

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from camtool.errors import UsageError
+from camtool.model.errors import UsageError
 from camtool.verify.steparray import STEP_DTYPE, StepArray, freeze
 from camtool.verify.timing import timer_period_ms
 

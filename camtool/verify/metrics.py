@@ -18,9 +18,9 @@ from typing import Protocol
 import numpy as np
 import numpy.typing as npt
 
-from camtool.geometry import Arc, BBox, Drawing, Line, Point, Segment, bbox_union
-from camtool.program import ArcMove, Program, Rapid, segment_of
-from camtool.units import fmt_num
+from camtool.model.program import ArcMove, Program, Rapid, segment_of
+from camtool.model.shapes import Arc, BBox, Drawing, Line, Point, Segment, bbox_union
+from camtool.model.units import fmt_num
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]

@@ -10,7 +10,7 @@ import math
 from decimal import ROUND_FLOOR, ROUND_HALF_EVEN, ROUND_HALF_UP, Decimal
 from typing import Literal
 
-from camtool.errors import UsageError
+from camtool.model.errors import UsageError
 
 Rounding = Literal["half_even", "half_up", "floor", "trunc"]
 ROUNDINGS: tuple[str, ...] = ("half_even", "half_up", "floor", "trunc")

@@ -39,9 +39,9 @@ from typing import Literal
 import numpy as np
 import numpy.typing as npt
 
-from camtool.errors import ToolpathError, UsageError
+from camtool.model.errors import ToolpathError, UsageError
+from camtool.model.units import TENTH_MM
 from camtool.post.router_arrays import RouterArrays, router_arrays
-from camtool.units import TENTH_MM
 from camtool.verify.servo_plant import (
     FIRMWARE_GAINS,
     LAWS,

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from camtool.errors import UsageError
+from camtool.model.errors import UsageError
 from camtool.verify.servo import ServoTrace
 
 FloatArray = npt.NDArray[np.float64]

@@ -24,7 +24,7 @@ from typing import Literal
 import numpy as np
 import numpy.typing as npt
 
-from camtool.errors import UsageError
+from camtool.model.errors import UsageError
 
 TS_S = 0.005
 """Servo sample period, s (seed-002 §2.6: ``#define Ts 0.005``, Timer5 preload 53036)."""

@@ -35,10 +35,10 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from camtool.errors import UsageError
-from camtool.geometry import Point, distance
-from camtool.machine import Machine
-from camtool.program import ArcMove, Move, Program
+from camtool.model.errors import UsageError
+from camtool.model.machine import Machine
+from camtool.model.program import ArcMove, Move, Program
+from camtool.model.shapes import Point, distance
 from camtool.verify.interpolators import (
     accumulator_dda_line,
     bresenham_line,

@@ -19,10 +19,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from camtool.geometry import distance
-from camtool.machine import Machine
+from camtool.model.machine import Machine
+from camtool.model.program import ArcMove, Move, Program
+from camtool.model.shapes import distance
 from camtool.post.router_arrays import points_01mm
-from camtool.program import ArcMove, Move, Program
 from camtool.verify.servo import RouterMachine, simulate_job
 from camtool.verify.simulate import StepTrace, sagitta_chord_points
 from camtool.verify.steparray import STEP_DTYPE, read_only

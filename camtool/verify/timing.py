@@ -39,7 +39,7 @@ from dataclasses import fields
 from types import MappingProxyType
 from typing import Any
 
-from camtool.errors import InputError, UsageError
+from camtool.model.errors import InputError, UsageError
 from camtool.verify.timing_accel import (
     GRBL_DEFAULT_ACCELERATION_MM_S2,
     GRBL_DEFAULT_JUNCTION_DEVIATION_MM,

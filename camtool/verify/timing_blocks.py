@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from camtool.errors import UsageError
+from camtool.model.errors import UsageError
 from camtool.verify.steparray import read_only
 
 FloatArray = npt.NDArray[np.float64]

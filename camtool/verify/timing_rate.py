@@ -13,7 +13,7 @@ from typing import ClassVar
 import numpy as np
 import numpy.typing as npt
 
-from camtool.errors import UsageError
+from camtool.model.errors import UsageError
 from camtool.verify.timing_blocks import (
     BlockKinematics,
     FloatArray,

@@ -14,11 +14,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from camtool.errors import InputError, UsageError
-from camtool.geometry import BBox, Drawing
-from camtool.machine import Machine
-from camtool.program import Dwell, Home, Program, Rapid
-from camtool.units import fmt_num
+from camtool.model.errors import InputError, UsageError
+from camtool.model.machine import Machine
+from camtool.model.program import Dwell, Home, Program, Rapid
+from camtool.model.shapes import BBox, Drawing
+from camtool.model.units import fmt_num
 from camtool.verify.metrics import (
     Against,
     ContourMeasure,

@@ -18,7 +18,7 @@ from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
-from camtool.geometry import Arc, Contour, Drawing, Line
+from camtool.model.shapes import Arc, Contour, Drawing, Line
 from camtool.toolpath.plan import PlanOptions, plan_drawing
 
 

@@ -19,8 +19,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
-from camtool.machine import Machine, load_machine
-from camtool.program import ArcMove, Linear, Move, Program, Rapid
+from camtool.model.machine import Machine, load_machine
+from camtool.model.program import ArcMove, Linear, Move, Program, Rapid
 from camtool.verify.simulate import _play, simulate_steps
 from camtool.verify.verifier import verify_program
 
@@ -96,7 +96,7 @@ def main() -> None:
         f"backlash play, X axis: numpy runs {fast / 1e6:7.1f} M rows/s | pure-Python loop "
         f"{slow / 1e6:5.2f} M rows/s | ratio {fast / slow:5.1f}x"
     )
-    from camtool.pipeline import post_file, verify_job
+    from camtool.jobs.pipeline import post_file, verify_job
 
     job = post_file(Path(__file__).parents[2] / "samples" / "logo.dxf", "pic-mmh")
     t0 = time.perf_counter()

@@ -27,7 +27,7 @@ from typing import Any
 
 import click
 
-from camtool.cli import cli, main
+from camtool.cli.main import cli, main
 from camtool.post.registry import load_target
 from tests.targets import EXTENSIONS, TARGETS
 

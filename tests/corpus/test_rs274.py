@@ -13,7 +13,7 @@ it looks for a tool table of a sample configuration that is not installed, so on
 
 Two checks: every linuxcnc program of the corpus run (test_corpus.py, shared per session)
 is accepted, and for a few of them rs274's end points, arc centres and directions equal
-those of the program camtool planned (``camtool.pipeline.post_file``), within the 0.0005 mm
+those of the program camtool planned (``camtool.jobs.pipeline.post_file``), within the 0.0005 mm
 that the 3-decimal output rounds to.
 """
 
@@ -26,8 +26,8 @@ from pathlib import Path
 
 import pytest
 
-from camtool.pipeline import post_file
-from camtool.program import ArcMove, Linear, Rapid
+from camtool.jobs.pipeline import post_file
+from camtool.model.program import ArcMove, Linear, Rapid
 from tests.corpus.conftest import (
     CORPUS,
     case_id,

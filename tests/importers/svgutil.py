@@ -15,7 +15,7 @@ import pytest
 import shapely
 from svgpathtools import parse_path
 
-from camtool.geometry import Arc, Contour, Drawing, Line
+from camtool.model.shapes import Arc, Contour, Drawing, Line
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 INK = 'xmlns:inkscape="http://www.inkscape.org/namespaces/inkscape"'

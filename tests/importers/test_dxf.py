@@ -8,10 +8,10 @@ from typing import Any
 
 import pytest
 
-from camtool.errors import InputError
-from camtool.geometry import Arc, Line
 from camtool.importers import read_drawing
 from camtool.importers.dxf import read_dxf
+from camtool.model.errors import InputError
+from camtool.model.shapes import Arc, Line
 from tests.shapes import rectangle_dxf, write_dxf
 
 

@@ -21,11 +21,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from camtool.errors import InputError
-from camtool.geometry import Arc, Contour, Line, Point, Segment
+from camtool.geometry.arcfit import distances
 from camtool.importers import ImportOptions
 from camtool.importers.dxf import read_dxf
-from camtool.toolpath.arcfit import distances
+from camtool.model.errors import InputError
+from camtool.model.shapes import Arc, Contour, Line, Point, Segment
 from tests.shapes import segment_samples, write_dxf
 
 TOL = 0.001

@@ -24,10 +24,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from camtool.errors import InputError
-from camtool.geometry import Arc, Contour
 from camtool.importers import ImportOptions
 from camtool.importers.dxf import read_dxf
+from camtool.model.errors import InputError
+from camtool.model.shapes import Arc, Contour
 from tests.shapes import two_sided_error, write_dxf
 
 TOL = 0.001  # mm, the default --tolerance
@@ -118,7 +118,7 @@ def test_fit_point_spline(tmp_path: Path) -> None:
     assert spline.control_point_count() == 0  # really a fit-point-only spline
     _assert_fits(_spline_curve(path), contour)
     # the curve passes through every fit point (the definition of a fit point)
-    from camtool.toolpath.arcfit import distances
+    from camtool.geometry.arcfit import distances
 
     assert float(np.max(distances(np.array(fit, float), contour.segments))) <= TOL
 

@@ -17,10 +17,10 @@ from typing import Any
 import ezdxf
 import pytest
 
-from camtool.cli import main
-from camtool.errors import InputError, UsageError
+from camtool.cli.main import main
 from camtool.importers import MAX_ENTITIES, ImportOptions
 from camtool.importers.dxf import import_dxf, read_dxf
+from camtool.model.errors import InputError, UsageError
 from tests.shapes import write_dxf
 
 _ENTITIES = """\

@@ -9,10 +9,10 @@ from typing import Any
 import ezdxf
 import pytest
 
-from camtool.errors import InputError
-from camtool.geometry import Arc, Line
 from camtool.importers import ImportOptions, read_drawing
 from camtool.importers.dxf import import_dxf, read_dxf
+from camtool.model.errors import InputError
+from camtool.model.shapes import Arc, Line
 from tests.shapes import write_dxf
 
 

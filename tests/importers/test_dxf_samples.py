@@ -12,10 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from camtool.geometry import Arc, Contour, Line
+from camtool.geometry.arcfit import distances
 from camtool.importers.dxf import import_dxf
 from camtool.importers.lint import inspect_drawing
-from camtool.toolpath.arcfit import distances
+from camtool.model.shapes import Arc, Contour, Line
 from camtool.toolpath.chain import chain
 
 DATA = Path(__file__).parents[1] / "data"

@@ -10,11 +10,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from camtool.errors import InputError
-from camtool.geometry import Arc
 from camtool.importers.gcode import parse_gcode, read_gcode
+from camtool.model.errors import InputError
+from camtool.model.program import ArcMove, Linear, Move, Program, Rapid
+from camtool.model.shapes import Arc
 from camtool.post.registry import load_target
-from camtool.program import ArcMove, Linear, Move, Program, Rapid
 
 DATA = Path(__file__).parents[1] / "data"
 SQRT2 = math.sqrt(2.0)

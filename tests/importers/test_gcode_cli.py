@@ -1,7 +1,7 @@
 """Real programs through the CLI: comments, program ends, truncation, absurd numbers.
 
 Each class of problem (issues 13 §4 and 14) is run as a user runs camtool
-(``camtool.cli.main`` returns the exit code): 0 with a warning, or 3 with a message
+(``camtool.cli.main.main`` returns the exit code): 0 with a warning, or 3 with a message
 that names the file and the line.
 """
 
@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from camtool.cli import main
+from camtool.cli.main import main
 
 GRBL_SQUARE = (
     "G21 G90 G17 (mm, absolute, XY)\n"

@@ -6,11 +6,11 @@ from pathlib import Path
 
 import pytest
 
-from camtool.errors import InputError
 from camtool.importers.gcode import parse_gcode, read_gcode
-from camtool.pipeline import post_program
+from camtool.jobs.pipeline import post_program
+from camtool.model.errors import InputError
+from camtool.model.program import Dwell, Home, Linear, Program, Rapid, Spindle, ToolChange
 from camtool.post.registry import load_target
-from camtool.program import Dwell, Home, Linear, Program, Rapid, Spindle, ToolChange
 
 DATA = Path(__file__).parents[1] / "data"
 

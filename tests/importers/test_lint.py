@@ -9,10 +9,10 @@ from typing import Any
 
 import pytest
 
-from camtool.geometry import Arc, Contour, Drawing, Line
 from camtool.importers import ImportOptions
 from camtool.importers.lint import inspect_drawing
 from camtool.importers.lint_checks import check_drawing
+from camtool.model.shapes import Arc, Contour, Drawing, Line
 from tests.shapes import write_dxf
 
 TOL = 0.001  # mm, the default --tolerance

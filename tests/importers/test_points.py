@@ -6,11 +6,11 @@ from pathlib import Path
 
 import pytest
 
-from camtool.cli import main
-from camtool.errors import InputError, UsageError
-from camtool.geometry import Contour, Line
+from camtool.cli.main import main
 from camtool.importers import DRAWING_SUFFIXES, ImportOptions, read_drawing
 from camtool.importers.points import read_points
+from camtool.model.errors import InputError, UsageError
+from camtool.model.shapes import Contour, Line
 
 ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT / "tests" / "data"

@@ -15,9 +15,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from camtool.geometry import Arc, Line
 from camtool.importers import ImportOptions
 from camtool.importers.svg import read_svg
+from camtool.model.shapes import Arc, Line
 from tests.importers.svgutil import (
     HALF,
     Map,

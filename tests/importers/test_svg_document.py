@@ -10,10 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from camtool.errors import InputError, UsageError
-from camtool.geometry import Arc
 from camtool.importers import ImportOptions, read_drawing, read_drawing_bytes
 from camtool.importers.svg import read_svg
+from camtool.model.errors import InputError, UsageError
+from camtool.model.shapes import Arc
 from tests.importers.svgutil import (
     DATA,
     HALF,

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from camtool.cli import main
+from camtool.cli.main import main
 
 BIG = "1" + "0" * 400  # 1e400 written out: float() of it is inf
 

@@ -19,7 +19,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from camtool.errors import DialectError, UsageError
+from camtool.model.errors import DialectError, UsageError
 from camtool.post.arccheck import (
     DEVIATION_QUANTA,
     GRBL_TOLERANCE_MM,

@@ -10,11 +10,11 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from camtool.errors import DialectError, ParseError
-from camtool.geometry import Arc
-from camtool.pipeline import post_file, verify_job
+from camtool.jobs.pipeline import post_file, verify_job
+from camtool.model.errors import DialectError, ParseError
+from camtool.model.program import ArcMove, Linear, Move, Program, Rapid, Spindle
+from camtool.model.shapes import Arc
 from camtool.post.registry import load_target
-from camtool.program import ArcMove, Linear, Move, Program, Rapid, Spindle
 from camtool.verify.verifier import verify_code
 
 ROOT = Path(__file__).parents[2]

@@ -17,14 +17,14 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from camtool import __version__
-from camtool.errors import ParseError
 from camtool.importers.gcode import parse_gcode
-from camtool.machine import Machine
-from camtool.pipeline import post_file, verify_job
+from camtool.jobs.pipeline import post_file, verify_job
+from camtool.model.errors import ParseError
+from camtool.model.machine import Machine
+from camtool.model.program import ArcMove, Dwell, Linear, Move, Program, Rapid, ToolChange
 from camtool.post.arccheck import arc_error
 from camtool.post.registry import load_target
 from camtool.post.wordaddress import WordAddressPost, word_address_dialect
-from camtool.program import ArcMove, Dwell, Linear, Move, Program, Rapid, ToolChange
 
 ROOT = Path(__file__).parents[2]
 TARGETS = ("grbl", "linuxcnc")

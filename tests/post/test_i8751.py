@@ -13,14 +13,24 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from camtool.cli import main
-from camtool.errors import DialectError, InputError, ParseError, UsageError
-from camtool.machine import Machine
-from camtool.pipeline import post_file, verify_job
+from camtool.cli.main import main
+from camtool.jobs.pipeline import post_file, verify_job
+from camtool.model.errors import DialectError, InputError, ParseError, UsageError
+from camtool.model.machine import Machine
+from camtool.model.program import (
+    ArcMove,
+    Dwell,
+    Home,
+    Linear,
+    Move,
+    Program,
+    Rapid,
+    Spindle,
+    ToolChange,
+)
 from camtool.post.i8751 import I8751Post, split_count, split_xy
 from camtool.post.i8751_stream import Record, encode_block, encode_stream
 from camtool.post.registry import load_target
-from camtool.program import ArcMove, Dwell, Home, Linear, Move, Program, Rapid, Spindle, ToolChange
 from camtool.verify.interpolators import corte_recto_max_deviation
 from camtool.verify.verifier import verify_code
 

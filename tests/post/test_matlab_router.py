@@ -15,13 +15,13 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from camtool.errors import DialectError, InputError, ParseError, UsageError
 from camtool.importers.points import read_points
-from camtool.pipeline import post_file
+from camtool.jobs.pipeline import post_file
+from camtool.model.errors import DialectError, InputError, ParseError, UsageError
+from camtool.model.program import ArcMove, Dwell, Linear, Move, Program, Rapid, Spindle
 from camtool.post.matlab_router import MatlabRouterPost
 from camtool.post.registry import load_target
 from camtool.post.router_arrays import matlab_round, router_arrays
-from camtool.program import ArcMove, Dwell, Linear, Move, Program, Rapid, Spindle
 from camtool.verify.verifier import verify_code
 from tests.shapes import STAR_LXY, STAR_VELXY, STAR_XY_01MM
 
@@ -455,7 +455,7 @@ def test_cli_post_wire_then_verify(tmp_path: Path) -> None:
     # The CLI reads matlab-router code as bytes (binary = True), so the CRs survive.
     from click.testing import CliRunner
 
-    from camtool.cli import cli
+    from camtool.cli.main import cli
 
     out = tmp_path / "star.txt"
     runner = CliRunner()

@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from camtool.errors import DialectError
+from camtool.model.errors import DialectError
 from camtool.post.numfmt import NumberFormat, format_int
 
 UM52 = NumberFormat(scale=1000.0, decimals=2, int_digits=5)

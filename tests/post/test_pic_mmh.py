@@ -12,13 +12,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from camtool.errors import DialectError, InputError, ParseError
-from camtool.pipeline import post_file
-from camtool.post.base import PostResult
-from camtool.post.pic_mmh import PicMmhPost
-from camtool.post.pic_mmh_feeds import FeedTable
-from camtool.post.registry import load_target
-from camtool.program import (
+from camtool.jobs.pipeline import post_file
+from camtool.model.errors import DialectError, InputError, ParseError
+from camtool.model.program import (
     ArcMove,
     Command,
     Dwell,
@@ -30,6 +26,10 @@ from camtool.program import (
     Spindle,
     ToolChange,
 )
+from camtool.post.base import PostResult
+from camtool.post.pic_mmh import PicMmhPost
+from camtool.post.pic_mmh_feeds import FeedTable
+from camtool.post.registry import load_target
 from camtool.verify.verifier import verify_code
 from tests.shapes import golden_arc_dxf
 

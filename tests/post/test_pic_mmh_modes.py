@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from camtool.errors import DialectError, ParseError
+from camtool.model.errors import DialectError, ParseError
 from camtool.post.pic_mmh_modes import (
     AXES,
     Backlash,

@@ -19,11 +19,11 @@ from pathlib import Path
 
 import pytest
 
-from camtool.cli import main
+from camtool.cli.main import main
 from camtool.importers.gcode import read_gcode
-from camtool.pipeline import NO_DEPTH_WARNING
+from camtool.jobs.pipeline import NO_DEPTH_WARNING
+from camtool.model.program import Program, Rapid, Spindle
 from camtool.post.registry import load_target
-from camtool.program import Program, Rapid, Spindle
 
 ROOT = Path(__file__).parents[2]
 LOGO = ROOT / "samples" / "logo.dxf"

@@ -11,16 +11,16 @@ from pathlib import Path
 
 import pytest
 
-from camtool.errors import InputError, UsageError
+from camtool.model.errors import InputError, UsageError
+from camtool.model.program import Linear, Program, Rapid
 from camtool.post.registry import ENTRY_POINT_GROUP, list_targets, load_target, target_names
-from camtool.program import Linear, Program, Rapid
 
 ROOT = Path(__file__).parents[2]
 
 PLUGIN = '''
-from camtool.machine import load_machine
+from camtool.model.machine import load_machine
 from camtool.post.base import PostProcessor, PostResult, Target
-from camtool.program import Linear, Program, Rapid
+from camtool.model.program import Linear, Program, Rapid
 
 
 class Plotter(PostProcessor):

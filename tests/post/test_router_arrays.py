@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from camtool.errors import DialectError, UsageError
+from camtool.model.errors import DialectError, UsageError
 from camtool.post.router_arrays import (
     DEFAULT_SPEED,
     matlab_round,

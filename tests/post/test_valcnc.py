@@ -10,12 +10,12 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from camtool.errors import DialectError, ParseError
 from camtool.importers.gcode import read_gcode
-from camtool.pipeline import post_file, post_program, verify_job
+from camtool.jobs.pipeline import post_file, post_program, verify_job
+from camtool.model.errors import DialectError, ParseError
+from camtool.model.program import ArcMove, Linear, Move, Program, Rapid, Spindle
 from camtool.post.registry import load_target
 from camtool.post.wordaddress import word_address_dialect
-from camtool.program import ArcMove, Linear, Move, Program, Rapid, Spindle
 from camtool.verify.verifier import verify_code
 
 ROOT = Path(__file__).parents[2]

@@ -13,11 +13,9 @@ from typing import Any
 
 import pytest
 
-from camtool.errors import DialectError, InputError, ParseError
-from camtool.machine import Machine
-from camtool.post.registry import load_target
-from camtool.post.wordaddress import WordAddressPost, word_address_dialect
-from camtool.program import (
+from camtool.model.errors import DialectError, InputError, ParseError
+from camtool.model.machine import Machine
+from camtool.model.program import (
     ArcMove,
     Dwell,
     Home,
@@ -28,6 +26,8 @@ from camtool.program import (
     Spindle,
     ToolChange,
 )
+from camtool.post.registry import load_target
+from camtool.post.wordaddress import WordAddressPost, word_address_dialect
 
 BIG = Machine(name="test bench", steps_per_mm=(1000.0,) * 3, work_area_mm=(-900, -900, 900, 900))
 """A machine that never limits the dialect (work area ±900 mm, Z axis)."""

@@ -7,8 +7,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from camtool.geometry import Arc, Contour, Line, Point, Segment
-from camtool.toolpath.arcfit import distances
+from camtool.geometry.arcfit import distances
+from camtool.model.shapes import Arc, Contour, Line, Point, Segment
 from tests.shapes import segment_samples
 
 

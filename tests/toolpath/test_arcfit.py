@@ -1,6 +1,6 @@
 """Arc fitting: analytic shapes, two-sided tolerance properties, corners, stats.
 
-Distances here are computed independently of camtool.toolpath.arcfit: the exact distance from
+Distances here are computed independently of camtool.geometry.arcfit: the exact distance from
 a point to a line or arc, and from a point to the TRUE curve as the distance to a real curve
 point, found near the nearest chord of a dense polyline by golden-section search.
 """
@@ -17,9 +17,7 @@ import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from camtool.errors import InputError, ToolpathError, UsageError
-from camtool.geometry import Arc, Line, Segment
-from camtool.toolpath.arcfit import (
+from camtool.geometry.arcfit import (
     MAX_SWEEP,
     FitStats,
     chord_equivalent,
@@ -27,6 +25,8 @@ from camtool.toolpath.arcfit import (
     fit_polyline,
     fit_stats,
 )
+from camtool.model.errors import InputError, ToolpathError, UsageError
+from camtool.model.shapes import Arc, Line, Segment
 
 VecCurve = Callable[[np.ndarray], np.ndarray]  # (N,) params -> (N, 2) points, mm
 SLACK = 1e-9

@@ -14,8 +14,8 @@ from typing import Any
 import numpy as np
 import pytest
 
-from camtool.errors import ToolpathError
-from camtool.geometry import Arc, Contour, Line
+from camtool.model.errors import ToolpathError
+from camtool.model.shapes import Arc, Contour, Line
 from camtool.toolpath import offset as offset_module
 from camtool.toolpath.chain import close_gaps
 from camtool.toolpath.compensate import compensate, tight_corners

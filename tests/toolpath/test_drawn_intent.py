@@ -12,8 +12,8 @@ from typing import Any
 
 import pytest
 
-from camtool.cli import main
-from camtool.geometry import Contour, Drawing, Line
+from camtool.cli.main import main
+from camtool.model.shapes import Contour, Drawing, Line
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.plan import plan_drawing
 from tests.shapes import GOLDEN_CENTRE, GOLDEN_END, write_dxf
@@ -122,7 +122,7 @@ def test_units_on_a_dxf_is_named_as_without_effect(
 
 
 def test_a_lead_in_shortened_to_fit_is_named() -> None:
-    from camtool.geometry import Arc
+    from camtool.model.shapes import Arc
 
     # a ø4 mm hole cut inside with a 3 mm tool: the tool centre runs on a 0.5 mm radius
     # circle, far too small for 2 mm lead arcs on the waste side (the hole's middle)

@@ -13,13 +13,13 @@ from pathlib import Path
 
 import pytest
 
-from camtool.cli import main
-from camtool.errors import InputError, ToolpathError, UsageError
-from camtool.geometry import MAX_CHORDS, Contour, Line, chord_count
+from camtool.cli.main import main
+from camtool.geometry.polyfit import fit_polyline
+from camtool.model.errors import InputError, ToolpathError, UsageError
+from camtool.model.shapes import MAX_CHORDS, Contour, Line, chord_count
 from camtool.toolpath import offset, pocket_uncut
 from camtool.toolpath.chain import chain, close_gaps
 from camtool.toolpath.pocket import MAX_POCKET_PATHS
-from camtool.toolpath.polyfit import fit_polyline
 
 
 def _open(*points: tuple[float, float]) -> Contour:

@@ -14,8 +14,8 @@ import random
 import numpy as np
 import pytest
 
-from camtool.errors import UsageError
-from camtool.geometry import Contour, Line
+from camtool.model.errors import UsageError
+from camtool.model.shapes import Contour, Line
 from camtool.toolpath import travel
 from camtool.toolpath import travel_large as large
 from camtool.toolpath.cuts import Cut

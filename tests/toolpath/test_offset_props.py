@@ -17,8 +17,8 @@ import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from camtool.errors import ToolpathError
-from camtool.geometry import Contour
+from camtool.model.errors import ToolpathError
+from camtool.model.shapes import Contour
 from camtool.toolpath.compensate import compensate
 from camtool.toolpath.cuts import Stage
 from camtool.toolpath.options import PlanOptions

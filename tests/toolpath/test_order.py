@@ -16,10 +16,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from camtool.errors import ToolpathError
-from camtool.geometry import Arc, Contour, Line, Point
+from camtool.model.errors import ToolpathError
+from camtool.model.program import ArcMove, Linear, Move, Program, Rapid
+from camtool.model.shapes import Arc, Contour, Line, Point
 from camtool.post.registry import load_target
-from camtool.program import ArcMove, Linear, Move, Program, Rapid
 from camtool.toolpath.cuts import Cut
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.order import Nesting, Ordering, nesting, order_cuts

@@ -16,9 +16,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from shapely.geometry import LineString, Point, Polygon
 
-from camtool.errors import ToolpathError
-from camtool.geometry import Arc, Contour, Line, Segment
-from camtool.program import ArcMove, Linear, Move, Rapid, segment_of
+from camtool.model.errors import ToolpathError
+from camtool.model.program import ArcMove, Linear, Move, Rapid, segment_of
+from camtool.model.shapes import Arc, Contour, Line, Segment
 from camtool.toolpath.cuts import Cut
 from camtool.toolpath.leads import lead_arcs
 from camtool.toolpath.options import PlanOptions
@@ -607,7 +607,7 @@ def test_a_hostile_ramp_is_refused_before_any_move() -> None:
     # 1 mm down at 0.0001°: L = 1 / tan(0.0001°) = 572 958 mm ≈ 573 m per pass; round a
     # 31.6 mm loop of 9 segments that is 18 000 laps, 163 000 moves a pass, 2000 passes
     # (--step-down 0.001 of 2 mm) → 3.3e8 moves.
-    from camtool.errors import UsageError
+    from camtool.model.errors import UsageError
 
     o = _options(depth=2.0, step_down=1.0, ramp_angle_deg=0.0001)
     with pytest.raises(UsageError, match=r"--ramp 0\.0001° needs 573 m of ramp per pass"):
@@ -615,7 +615,7 @@ def test_a_hostile_ramp_is_refused_before_any_move() -> None:
 
 
 def test_the_move_limit_is_named(monkeypatch: pytest.MonkeyPatch) -> None:
-    from camtool.errors import UsageError
+    from camtool.model.errors import UsageError
     from camtool.toolpath import passes
 
     monkeypatch.setattr(passes, "MAX_MOVES", 10)

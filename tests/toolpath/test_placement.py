@@ -13,8 +13,8 @@ from pathlib import Path
 import ezdxf
 import pytest
 
-from camtool.cli import main
-from camtool.program import ArcMove, Dwell, Linear, Program, Rapid, Spindle
+from camtool.cli.main import main
+from camtool.model.program import ArcMove, Dwell, Linear, Program, Rapid, Spindle
 from camtool.toolpath.placement import placement_shift, shift_program, toolpath_extent
 
 OUTSIDE = ["--offset", "outside", "--tool-diameter", "3"]

@@ -8,10 +8,10 @@ from typing import Any
 
 import pytest
 
-from camtool.errors import ToolpathError, UsageError
-from camtool.geometry import Arc, Contour, Drawing, Line
 from camtool.importers.dxf import read_dxf
-from camtool.program import ArcMove, Rapid
+from camtool.model.errors import ToolpathError, UsageError
+from camtool.model.program import ArcMove, Rapid
+from camtool.model.shapes import Arc, Contour, Drawing, Line
 from camtool.toolpath.chain import chain
 from camtool.toolpath.compensate import compensate
 from camtool.toolpath.offset import offset_contour

@@ -1,7 +1,7 @@
 """The planner end to end: options a target cannot carry out, arc-fit savings, depth on Z targets.
 
 Stage-level tests live beside this file (test_compensate, test_pocket, test_order,
-test_passes); here the stages run together through :func:`camtool.pipeline.post_drawing`.
+test_passes); here the stages run together through :func:`camtool.jobs.pipeline.post_drawing`.
 """
 
 from __future__ import annotations
@@ -13,11 +13,11 @@ from typing import Any
 
 import pytest
 
-from camtool.errors import UsageError
-from camtool.geometry import Arc, Contour, Drawing, Line
-from camtool.pipeline import post_drawing, post_file
+from camtool.jobs.pipeline import post_drawing, post_file
+from camtool.model.errors import UsageError
+from camtool.model.program import ArcMove, Linear, Rapid
+from camtool.model.shapes import Arc, Contour, Drawing, Line
 from camtool.post.registry import load_target
-from camtool.program import ArcMove, Linear, Rapid
 from camtool.toolpath.plan import MIN_FIT_RUN, PlanOptions, fit_dense, plan_drawing
 from tests.shapes import STAR_XY_01MM
 from tests.toolpath.contours import rect
@@ -96,7 +96,7 @@ def test_sharp_polygons_are_not_fitted() -> None:
 
 def test_grbl_depth_passes_and_tabs_verify(tmp_path: Path) -> None:
     # 1.5 mm deep in 0.5 mm passes (3 levels), 2 tabs on the outside profile, verified on grbl.
-    from camtool.pipeline import verify_job
+    from camtool.jobs.pipeline import verify_job
 
     job = post_drawing(
         _plate(),
@@ -134,7 +134,7 @@ def test_cli_reports_what_planning_found(
     # 1.5 mm tool radius, and the 2 × 2 mm square hole is narrower than the tool.
     import json
 
-    from camtool.cli import main
+    from camtool.cli.main import main
 
     root = Path(__file__).parents[2]
     report = tmp_path / "r.json"

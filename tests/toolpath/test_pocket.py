@@ -18,8 +18,8 @@ from shapely import LineString, Polygon, union_all
 from shapely import Point as ShapelyPoint
 from shapely.geometry.base import BaseGeometry
 
-from camtool.errors import ToolpathError
-from camtool.geometry import Arc, Contour, Line, Segment
+from camtool.model.errors import ToolpathError
+from camtool.model.shapes import Arc, Contour, Line, Segment
 from camtool.toolpath.cuts import Cut, Stage
 from camtool.toolpath.offset import offset_contour
 from camtool.toolpath.options import PlanOptions

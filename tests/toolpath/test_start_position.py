@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from camtool.cli import main
+from camtool.cli.main import main
 
 
 @pytest.mark.parametrize(

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from camtool.geometry import Contour, Drawing, Line
+from camtool.model.shapes import Contour, Drawing, Line
 from camtool.verify.metrics import against_drawing
 
 

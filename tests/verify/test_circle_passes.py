@@ -11,7 +11,7 @@ from typing import Any
 
 import pytest
 
-from camtool.cli import main
+from camtool.cli.main import main
 from tests.shapes import write_dxf
 
 

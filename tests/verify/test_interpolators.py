@@ -13,7 +13,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from camtool.errors import InputError, UsageError
+from camtool.model.errors import InputError, UsageError
 from camtool.verify.interpolators import (
     accumulator_dda_line,
     accumulator_dda_reference,

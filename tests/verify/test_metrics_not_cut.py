@@ -21,8 +21,8 @@ import math
 
 import pytest
 
-from camtool.geometry import Contour, Drawing, Line, Point
-from camtool.pipeline import post_drawing, verify_job
+from camtool.jobs.pipeline import post_drawing, verify_job
+from camtool.model.shapes import Contour, Drawing, Line, Point
 from camtool.post.registry import load_target
 from camtool.verify.metrics import NotCut
 from camtool.verify.verifier import not_cut_text, summary_lines

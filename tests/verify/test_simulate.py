@@ -12,8 +12,8 @@ from typing import Any
 import numpy as np
 import pytest
 
-from camtool.machine import Machine, machine_from_table, machine_table, merge_tables
-from camtool.program import ArcMove, Linear, Program, Rapid
+from camtool.model.machine import Machine, machine_from_table, machine_table, merge_tables
+from camtool.model.program import ArcMove, Linear, Program, Rapid
 from camtool.verify.metrics import fit_circle, nominal_arrays, point_distances
 from camtool.verify.simulate import StepTrace, simulate_steps
 from camtool.verify.verifier import verify_program

@@ -13,7 +13,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from camtool.errors import InputError, UsageError
+from camtool.model.errors import InputError, UsageError
 from camtool.verify.interpolators import accumulator_dda_line, dda_iterations, steps_from_mm
 from camtool.verify.timing import (
     BlockKinematics,

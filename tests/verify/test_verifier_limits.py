@@ -1,6 +1,6 @@
 """`--max-error-um` judges what was cut, `--strict` the rest; a drawing apart from the program.
 
-Run as a user runs camtool (`camtool.cli.main`). samples/plate.dxf cut on its
+Run as a user runs camtool (`camtool.cli.main.main`). samples/plate.dxf cut on its
 outside with a 3 mm tool has two 90° inside corners (the notch) and a 2 mm
 square hole the tool cannot enter: the planner reports both, the corners keep
 r·(√2 − 1) = 621 µm of material and the hole is millimetres from any cut.
@@ -13,8 +13,8 @@ from pathlib import Path
 
 import pytest
 
-from camtool.cli import main
-from camtool.geometry import Contour, Drawing, Line
+from camtool.cli.main import main
+from camtool.model.shapes import Contour, Drawing, Line
 from camtool.post.registry import load_target
 from camtool.verify.verifier import verify_code
 from tests.shapes import rectangle_dxf

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from camtool.cli import main
+from camtool.cli.main import main
 
 SAMPLES = Path(__file__).parents[2] / "samples"
 LOGO = str(SAMPLES / "logo.dxf")

@@ -1,6 +1,6 @@
 """Polyline fitting: a dense polyline becomes lines and arcs within a tolerance.
 
-Split out of :mod:`camtool.toolpath.arcfit`, which re-exports :func:`fit_polyline`. The planner
+Split out of :mod:`camtool.geometry.arcfit`, which re-exports :func:`fit_polyline`. The planner
 turns dense polylines (buffers, point lists) into G02/G03-ready arcs with it.
 
 Conventions: mm, Y up, arcs exact (``clockwise=True`` is G02). The tolerance is checked both
@@ -17,15 +17,15 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from camtool.errors import InputError
-from camtool.geometry import TAU, Arc, Line, Point, Segment
-from camtool.toolpath.fitgeom import (
+from camtool.geometry.fitgeom import (
     MAX_SWEEP,
     FloatArray,
     check_tolerance,
     dist_arc,
     dist_line,
 )
+from camtool.model.errors import InputError
+from camtool.model.shapes import TAU, Arc, Line, Point, Segment
 
 CORNER_ANGLE_DEG = 30.0
 """Default turn, degrees, above which :func:`fit_polyline` keeps a vertex as a corner."""

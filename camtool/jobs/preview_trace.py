@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 from camtool.preview import FORMATS, render_preview
 
 if TYPE_CHECKING:
-    from camtool.geometry import Drawing
+    from camtool.model.shapes import Drawing
     from camtool.verify.verifier import Verification
 
 __all__ = ["FORMATS", "write_trace_preview"]

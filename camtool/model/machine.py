@@ -30,8 +30,8 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
-from camtool.errors import InputError
-from camtool.geometry import BBox
+from camtool.model.errors import InputError
+from camtool.model.shapes import BBox
 
 LINE_INTERPOLATORS: dict[str, str] = {
     "dda": "linear DDA of the GMM PIC (seed-000 §4.2, annex A.3)",

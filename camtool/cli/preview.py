@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
-from camtool.cli_common import (
+from camtool.cli.common import (
     MACHINE,
     check_paths,
     import_options,
@@ -24,13 +24,13 @@ from camtool.cli_common import (
     warn,
     write_output,
 )
-from camtool.errors import InputError, UsageError
+from camtool.model.errors import InputError, UsageError
 
 if TYPE_CHECKING:
-    from camtool.geometry import Drawing
     from camtool.importers import ImportOptions
+    from camtool.model.program import Program
+    from camtool.model.shapes import Drawing
     from camtool.post.base import Target
-    from camtool.program import Program
     from camtool.verify.verifier import Verification
 
 
@@ -150,7 +150,7 @@ def _read_inputs(
 
 def _read_program(name: str, target: Target | None) -> Program:
     """A program by its ending: the target's dialect, or G-code through the importer."""
-    from camtool.pipeline import PROGRAM_SUFFIXES, is_program_file
+    from camtool.jobs.pipeline import PROGRAM_SUFFIXES, is_program_file
 
     if name != "-" and not Path(name).is_file():
         raise InputError(f"{name}: no such file")

@@ -1,10 +1,10 @@
 """Many inputs, one target: post every file in a process pool and summarise.
 
-:func:`plan_batch` expands the inputs (:mod:`camtool.batch_inputs`), loads the
+:func:`plan_batch` expands the inputs (:mod:`camtool.jobs.batch_inputs`), loads the
 target and checks everything that can be checked before any work starts: the
 options, that every input matches something, that every output stays inside the
 output folder, that no two files write the same output, that no output is one of
-the inputs (:func:`camtool.output.check_outputs`), and that no output exists
+the inputs (:func:`camtool.jobs.output.check_outputs`), and that no output exists
 already unless ``force``. :func:`run_batch` claims the output folder for the run
 (a second batch into it is refused), then posts each file — in a
 ``concurrent.futures.ProcessPoolExecutor`` of ``jobs`` workers, or in this
@@ -28,7 +28,7 @@ posted; only the accuracy limit failed", 3 "some inputs are bad and nothing
 worse happened".
 
 This module never prints; progress goes through a callback. The report and
-table live in :mod:`camtool.batch_report`.
+table live in :mod:`camtool.jobs.batch_report`.
 """
 
 from __future__ import annotations
@@ -40,14 +40,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from camtool.batch_inputs import BatchInput, expand_inputs
-from camtool.errors import CamtoolError, UsageError
+from camtool.jobs.batch_inputs import BatchInput, expand_inputs
+from camtool.model.errors import CamtoolError, UsageError
 
 if TYPE_CHECKING:
     from concurrent.futures import Future
 
     from camtool.importers import ImportOptions
-    from camtool.pipeline import PostJob
+    from camtool.jobs.pipeline import PostJob
     from camtool.verify.verifier import Verification
 
 PREVIEW_FORMATS = ("png", "svg")
@@ -151,7 +151,7 @@ class BatchOptions:
         )
 
     def post_options(self) -> dict[str, Any]:
-        """Keyword options of :func:`camtool.pipeline.post_drawing`."""
+        """Keyword options of :func:`camtool.jobs.pipeline.post_drawing`."""
         return {
             **self.plan,
             "feed_mm_min": self.feed_mm_min,
@@ -259,7 +259,7 @@ def plan_batch(inputs: Sequence[str], options: BatchOptions) -> BatchPlan:
             first :data:`SHOWN_EXISTING` named).
         InputError: an input matches nothing, or the target/machine file is invalid.
     """
-    from camtool.pipeline import plan_options
+    from camtool.jobs.pipeline import plan_options
     from camtool.post.registry import load_target
 
     target = load_target(options.target, machine_file=options.machine_file)
@@ -298,7 +298,7 @@ def _check_outputs(
     Raises:
         UsageError: as :func:`plan_batch` says.
     """
-    from camtool.output import check_outputs
+    from camtool.jobs.output import check_outputs
 
     _check_inside(tasks, options.output_dir)
     inputs: list[tuple[str, str | Path | None]] = [("the input", i.path) for i in items]
@@ -350,7 +350,7 @@ def run_batch(plan: BatchPlan, *, progress: Progress | None = None) -> BatchResu
     """Post every file of ``plan``; one file's failure never stops the others.
 
     The output folder is claimed for the whole run
-    (:func:`camtool.output.lock_directory`), so two batches never write into one
+    (:func:`camtool.jobs.output.lock_directory`), so two batches never write into one
     folder at once; under the claim, outputs that appeared since :func:`plan_batch`
     are refused again (unless ``force``), stale temporary files of killed runs are
     removed, and at the end the batch report is written (when ``options.report``
@@ -368,7 +368,7 @@ def run_batch(plan: BatchPlan, *, progress: Progress | None = None) -> BatchResu
             cannot be written.
         UsageError: outputs appeared since the plan was checked (without ``force``).
     """
-    from camtool.output import lock_directory
+    from camtool.jobs.output import lock_directory
 
     tasks, options = plan.tasks, plan.options
     with lock_directory(options.output_dir):
@@ -392,7 +392,7 @@ def run_batch(plan: BatchPlan, *, progress: Progress | None = None) -> BatchResu
 
 def _remove_stale_temps(tasks: Sequence[BatchTask]) -> None:
     """Temporary files left by killed runs, in every folder this batch writes into."""
-    from camtool.output import reason, remove_stale_temps
+    from camtool.jobs.output import reason, remove_stale_temps
 
     for folder in sorted({Path(out).parent for task in tasks for out in task.outputs}):
         try:
@@ -402,8 +402,8 @@ def _remove_stale_temps(tasks: Sequence[BatchTask]) -> None:
 
 
 def _write_report(result: BatchResult, path: str) -> None:
-    """The batch report (:func:`camtool.batch_report.batch_report`) as UTF-8 JSON."""
-    from camtool.batch_report import batch_report
+    """The batch report (:func:`camtool.jobs.batch_report.batch_report`) as UTF-8 JSON."""
+    from camtool.jobs.batch_report import batch_report
 
     text = json.dumps(batch_report(result), indent=2, ensure_ascii=False) + "\n"
     _write(path, text)
@@ -505,7 +505,7 @@ def _post_one(task: BatchTask, options: BatchOptions) -> BatchRow:
     time_s = job.program.cutting_time_s()
     v = None
     if options.verifying:
-        from camtool.pipeline import verify_job
+        from camtool.jobs.pipeline import verify_job
         from camtool.verify.verifier import report_dict
 
         v = verify_job(job)
@@ -539,7 +539,7 @@ def _post_one(task: BatchTask, options: BatchOptions) -> BatchRow:
 
 def _post_job(file: str, options: BatchOptions) -> PostJob:
     """Import and post one file: a drawing is planned, a G-code program re-posted."""
-    from camtool.pipeline import post_file
+    from camtool.jobs.pipeline import post_file
 
     return post_file(
         file,
@@ -575,7 +575,7 @@ def preview_bytes(job: PostJob, v: Verification | None, path: str, title: str) -
 
 def _write(path: str, data: str | bytes) -> None:
     """Write one output atomically, creating its directory."""
-    from camtool.output import reason, write_atomic
+    from camtool.jobs.output import reason, write_atomic
 
     try:
         Path(path).parent.mkdir(parents=True, exist_ok=True)

@@ -7,12 +7,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from camtool.errors import UsageError
-from camtool.geometry import Drawing
 from camtool.importers import POINT_SUFFIXES, ImportOptions, read_drawing
+from camtool.model.errors import UsageError
+from camtool.model.program import Move, Program
+from camtool.model.shapes import Drawing
 from camtool.post.base import PostResult, Target
 from camtool.post.registry import load_target
-from camtool.program import Move, Program
 from camtool.toolpath.options import drawing_only
 from camtool.toolpath.plan import PlanOptions, PlanReport, plan_drawing
 
@@ -170,7 +170,7 @@ def post_program(
     """
     import dataclasses
 
-    from camtool.program import Rapid
+    from camtool.model.program import Rapid
 
     if feed_mm_min is not None:
         moves = tuple(
@@ -191,7 +191,7 @@ def _with_spindle(program: Program, rpm: float | None, dwell_s: float = 0.0) -> 
 
     ``dwell_s`` > 0 waits after the spindle starts (``--spindle-dwell``).
     """
-    from camtool.program import Spindle
+    from camtool.model.program import Spindle
 
     if not rpm or any(isinstance(c, Spindle) for _, c in program.commands):
         return program

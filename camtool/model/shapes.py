@@ -16,8 +16,8 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import TypeAlias
 
-from camtool.errors import ToolpathError, UsageError
-from camtool.units import fmt_num
+from camtool.model.errors import ToolpathError, UsageError
+from camtool.model.units import fmt_num
 
 Point: TypeAlias = tuple[float, float]
 BBox: TypeAlias = tuple[float, float, float, float]

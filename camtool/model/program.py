@@ -26,7 +26,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Literal, TypeAlias
 
-from camtool.geometry import Arc, BBox, Line, Point, Segment, bbox_union
+from camtool.model.shapes import Arc, BBox, Line, Point, Segment, bbox_union
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
-from camtool.errors import CamtoolError, InputError
+from camtool.model.errors import CamtoolError, InputError
 from camtool.toolpath.options import (
     DEFAULT_CHAIN_TOLERANCE,
     DIRECTIONS,
@@ -26,8 +26,8 @@ from camtool.toolpath.options import (
 )
 
 if TYPE_CHECKING:
-    from camtool.geometry import Drawing
     from camtool.importers import ImportOptions
+    from camtool.model.shapes import Drawing
 
 
 class FiniteFloat(click.FloatRange):
@@ -72,10 +72,10 @@ def warn(messages: tuple[str, ...] | list[str]) -> None:
 
 
 def write_output(data: str | bytes, out: str) -> None:
-    """``data`` to the file ``out`` (see :func:`camtool.output.write_atomic`), or stdout for ``-``.
+    """``data`` to the file ``out`` (:func:`camtool.jobs.output.write_atomic`), or stdout for ``-``.
 
     Before a file is written, stale temporary files of killed runs beside it are
-    removed (:func:`camtool.output.remove_stale_temps`).
+    removed (:func:`camtool.jobs.output.remove_stale_temps`).
 
     Raises:
         CamtoolError: the file cannot be written, naming it and why (``x.pic: cannot
@@ -83,7 +83,7 @@ def write_output(data: str | bytes, out: str) -> None:
             device`` (or ``broken pipe``), after which stdout is silenced so that
             Python's own flush at exit does not fail again.
     """
-    from camtool.output import reason, remove_stale_temps, write_atomic
+    from camtool.jobs.output import reason, remove_stale_temps, write_atomic
 
     if out == "-":
         _write_stdout(data)
@@ -103,7 +103,7 @@ def check_paths(
     target: str | None = None,
     machine_file: Path | None = None,
 ) -> None:
-    """Refuse outputs that are inputs or each other (:func:`camtool.output.check_outputs`).
+    """Refuse outputs that are inputs or each other (:func:`camtool.jobs.output.check_outputs`).
 
     A ``--target`` or ``--machine`` that names an existing file (not a built-in name)
     counts as an input too. Called first thing by every command that writes.
@@ -111,7 +111,7 @@ def check_paths(
     Raises:
         UsageError: an output would overwrite an input, or two outputs are one file.
     """
-    from camtool.output import check_outputs
+    from camtool.jobs.output import check_outputs
 
     extra = [("the target file", target), ("the --machine file", machine_file)]
     files = [(label, str(p)) for label, p in extra if p is not None and os.path.isfile(p)]
@@ -120,7 +120,7 @@ def check_paths(
 
 def _write_stdout(data: str | bytes) -> None:
     """``data`` to stdout, flushed; a failed write or flush is a :class:`CamtoolError`."""
-    from camtool.output import reason
+    from camtool.jobs.output import reason
 
     try:
         if isinstance(data, bytes):
@@ -158,7 +158,7 @@ MACHINE = click.option(
 
 def import_options(command: Callable[..., None]) -> Callable[..., None]:
     """Options of the importers: --layers, --units, --hatch-boundaries, --max-entities."""
-    from camtool.units import LENGTH_UNITS
+    from camtool.model.units import LENGTH_UNITS
 
     command = click.option(
         "--max-entities",

@@ -3,8 +3,8 @@
 The one fitter the project shares. Importers fit SVG Béziers, DXF splines and ellipses with
 :func:`fit_curve`; the planner turns dense polylines (buffers, point lists) into G02/G03-ready
 arcs with :func:`fit_polyline`; :class:`FitStats` says how many segments a fit saved.
-:func:`fit_polyline` lives in :mod:`camtool.toolpath.polyfit` and the shared distance
-functions in :mod:`camtool.toolpath.fitgeom`; both are re-exported here.
+:func:`fit_polyline` lives in :mod:`camtool.geometry.polyfit` and the shared distance
+functions in :mod:`camtool.geometry.fitgeom`; both are re-exported here.
 
 Conventions: mm, Y up, arcs exact (``clockwise=True`` is G02). A tolerance is a distance in
 mm checked both ways: every input point lies within it of the output and every output point
@@ -24,9 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from camtool.errors import ToolpathError, UsageError
-from camtool.geometry import Arc, Line, Point, Segment, chord_count
-from camtool.toolpath.fitgeom import (
+from camtool.geometry.fitgeom import (
     MAX_SWEEP,
     FloatArray,
     check_tolerance,
@@ -37,7 +35,9 @@ from camtool.toolpath.fitgeom import (
     pairwise_dist_line,
     sample_segment,
 )
-from camtool.toolpath.polyfit import CORNER_ANGLE_DEG, fit_polyline
+from camtool.geometry.polyfit import CORNER_ANGLE_DEG, fit_polyline
+from camtool.model.errors import ToolpathError, UsageError
+from camtool.model.shapes import Arc, Line, Point, Segment, chord_count
 
 __all__ = [
     "CORNER_ANGLE_DEG",
@@ -131,7 +131,7 @@ def fit_curve(
     """Fit a smooth parametric curve with biarcs and lines within ``tolerance`` mm.
 
     The range is split at midpoint parameters until each piece fits: first as one
-    :class:`~camtool.geometry.Line` (every sample within tolerance of the chord), else as a
+    :class:`~camtool.model.shapes.Line` (every sample within tolerance of the chord), else as a
     biarc through the piece's ends tangent to the curve there, its junction chosen by the
     equal-tangent-length rule (d1 = d2, Bolton 1975). The error is sampled at 65 parameters
     per piece both ways (curve -> arcs exactly, arcs -> curve against the sampled polyline plus

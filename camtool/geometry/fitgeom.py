@@ -1,7 +1,7 @@
 """Geometry the arc fitters share: distances to lines and arcs, samples, tolerance checks.
 
-Split out of :mod:`camtool.toolpath.arcfit` so that :mod:`~camtool.toolpath.arcfit` (curves) and
-:mod:`~camtool.toolpath.polyfit` (polylines) share one set of exact distance functions.
+Split out of :mod:`camtool.geometry.arcfit` so that :mod:`~camtool.geometry.arcfit` (curves) and
+:mod:`~camtool.geometry.polyfit` (polylines) share one set of exact distance functions.
 Conventions: mm, Y up; arrays of points are ``(N, 2)`` float64.
 """
 
@@ -14,8 +14,8 @@ from typing import TypeAlias
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from camtool.errors import UsageError
-from camtool.geometry import TAU, Arc, Line, Point, Segment
+from camtool.model.errors import UsageError
+from camtool.model.shapes import TAU, Arc, Line, Point, Segment
 
 FloatArray: TypeAlias = NDArray[np.float64]
 

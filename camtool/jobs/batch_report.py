@@ -4,7 +4,7 @@ Pure functions returning data or text; the CLI decides where they go.
 
 The report (``camtool batch --report batch.json``), keys other tools may read:
 
-- ``camtool``: the version; ``exit_code``: the batch's (:func:`camtool.batch.batch_exit_code`);
+- ``camtool``: the version; ``exit_code``: the batch's (:func:`camtool.jobs.batch.batch_exit_code`);
 - ``options``: every option that shapes the outputs (``target``, ``output_dir``,
   ``machine_file``, ``offset``, ``tool_diameter``, ``feed_mm_min``, ``tolerance``,
   ``scale``, ``fit_mm``, ``fmt``, ``spindle_rpm``, ``layers``, ``units``,
@@ -30,7 +30,7 @@ from pathlib import Path
 from typing import Any
 
 from camtool import __version__
-from camtool.batch import BatchOptions, BatchResult, BatchRow
+from camtool.jobs.batch import BatchOptions, BatchResult, BatchRow
 
 FILE_COLUMN_MAX = 48
 """Widest file column of the summary table; longer names keep their end."""

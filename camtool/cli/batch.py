@@ -1,6 +1,6 @@
 """``camtool batch``: post many drawings for one target, in parallel, with a summary.
 
-A thin click wrapper over :mod:`camtool.batch` (see docs/batch.md). Progress
+A thin click wrapper over :mod:`camtool.jobs.batch` (see docs/batch.md). Progress
 goes to stderr — a bar on a terminal, one plain line per finished file
 otherwise — then the summary table; stdout carries only ``--report -``.
 """
@@ -14,21 +14,21 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
-from camtool.cli_common import (
+from camtool.cli.common import (
     MACHINE,
     import_options,
     number_range,
     post_options,
     write_output,
 )
-from camtool.errors import CamtoolError, InputError, UsageError, VerifyLimitError
+from camtool.model.errors import CamtoolError, InputError, UsageError, VerifyLimitError
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from camtool.batch import BatchPlan, BatchResult, BatchRow
+    from camtool.jobs.batch import BatchPlan, BatchResult, BatchRow
 
-_PREVIEW_FORMATS = ("png", "svg")  # camtool.batch.PREVIEW_FORMATS, validated there too
+_PREVIEW_FORMATS = ("png", "svg")  # camtool.jobs.batch.PREVIEW_FORMATS, validated there too
 _ERRORS: dict[int, type[CamtoolError]] = {2: UsageError, 3: InputError, 4: VerifyLimitError}
 """The error a failed batch exits with, by its exit code (others: CamtoolError, 1)."""
 
@@ -90,8 +90,8 @@ def batch(inputs: tuple[str, ...], layers: str | None, verify_too: bool, **optio
     overwritten without --force. Exit code: 0 all ok, else the smallest per-file
     code (1 error, 2 usage, 3 unreadable input, 4 over --max-error-um).
     """
-    from camtool.batch import BatchOptions, plan_batch
-    from camtool.batch_report import batch_report, failure_line, summary_table
+    from camtool.jobs.batch import BatchOptions, plan_batch
+    from camtool.jobs.batch_report import batch_report, failure_line, summary_table
     from camtool.toolpath.options import PLAN_FIELDS
 
     names = tuple(n.strip() for n in layers.split(",") if n.strip()) if layers else None
@@ -110,8 +110,8 @@ def batch(inputs: tuple[str, ...], layers: str | None, verify_too: bool, **optio
 
 def _run(plan: BatchPlan) -> BatchResult:
     """Run the batch with progress on stderr: a bar on a terminal, else a line per file."""
-    from camtool.batch import run_batch
-    from camtool.batch_report import progress_line
+    from camtool.jobs.batch import run_batch
+    from camtool.jobs.batch_report import progress_line
 
     if not sys.stderr.isatty():
         return run_batch(

@@ -31,8 +31,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from camtool.errors import InputError, UsageError
 from camtool.importers import DRAWING_SUFFIXES
+from camtool.model.errors import InputError, UsageError
 
 _MAGIC = re.compile(r"[*?[]")
 
@@ -41,9 +41,9 @@ def readable_suffixes() -> tuple[str, ...]:
     """File endings a batch picks up in directories and globs, lowercase.
 
     The drawing endings of :data:`camtool.importers.DRAWING_SUFFIXES` and the
-    G-code endings of :data:`camtool.pipeline.PROGRAM_SUFFIXES`.
+    G-code endings of :data:`camtool.jobs.pipeline.PROGRAM_SUFFIXES`.
     """
-    from camtool.pipeline import PROGRAM_SUFFIXES
+    from camtool.jobs.pipeline import PROGRAM_SUFFIXES
 
     return DRAWING_SUFFIXES + PROGRAM_SUFFIXES
 
@@ -114,7 +114,7 @@ def _rebase(items: list[BatchInput]) -> list[BatchInput]:
     A glob such as ``a/*/../../x/*.dxf`` matches ``a/s/../../x/f.dxf``, which is
     ``../x/f.dxf`` below the glob's leading part ``a``: written below ``-o`` as it is,
     it would land outside. Such a glob's files are named below the deepest folder
-    that holds them all instead (``f.dxf``); :func:`camtool.batch.plan_batch` still
+    that holds them all instead (``f.dxf``); :func:`camtool.jobs.batch.plan_batch` still
     checks every output resolves inside ``-o``.
     """
     if not any(item.relative.parts[:1] == ("..",) for item in items):

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from camtool import __version__
-from camtool.cli_common import (
+from camtool.cli.common import (
     MACHINE,
     NUMBER,
     check_paths,
@@ -27,12 +27,12 @@ from camtool.cli_common import (
     warn,
     write_output,
 )
-from camtool.errors import CamtoolError, UsageError, VerifyLimitError
+from camtool.model.errors import CamtoolError, UsageError, VerifyLimitError
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from camtool.geometry import Drawing
+    from camtool.model.shapes import Drawing
     from camtool.post.registry import TargetEntry
     from camtool.toolpath.plan import PlanReport
     from camtool.verify.verifier import Verification
@@ -118,7 +118,7 @@ def post(
     With --verify (implied by --report, --preview or --max-error-um) the written
     code is read back and simulated on the target's machine, as `verify` does.
     """
-    from camtool.pipeline import post_drawing, post_path, verify_job
+    from camtool.jobs.pipeline import post_drawing, post_path, verify_job
     from camtool.post.registry import load_target
 
     check_paths(
@@ -253,7 +253,7 @@ def _finish_verification(
     if report is not None:
         write_output(json.dumps(report_dict(v, plan), indent=2) + "\n", report)
     if preview is not None:
-        from camtool.preview_trace import write_trace_preview
+        from camtool.jobs.preview_trace import write_trace_preview
 
         picture = write_trace_preview(v, preview, drawing=drawing, edge_radius_mm=edge_radius_mm)
         write_output(picture, preview)
@@ -330,11 +330,11 @@ def _target_json(entry: TargetEntry) -> dict[str, Any]:
     }
 
 
-from camtool.cli_preview import preview  # noqa: E402
+from camtool.cli.preview import preview  # noqa: E402
 
 cli.add_command(preview)
 
-from camtool.cli_batch import batch  # noqa: E402
+from camtool.cli.batch import batch  # noqa: E402
 
 cli.add_command(batch)
 

@@ -29,7 +29,7 @@ from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from camtool.errors import CamtoolError, UsageError
+from camtool.model.errors import CamtoolError, UsageError
 
 LOCK_NAME = ".camtool.lock"
 """The lock file :func:`lock_directory` keeps in a claimed folder while it runs."""

@@ -1,0 +1,1 @@
+"""Geometry algorithms shared by importers and planner: curve and arc fitting, chords."""

@@ -1,0 +1,1 @@
+"""Job runners: one drawing through the pipeline, batches, atomic output."""
