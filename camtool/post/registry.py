@@ -230,3 +230,26 @@ def _number(table: Mapping[str, Any], key: str, where: str, default: Any) -> Any
     if isinstance(value, bool) or not isinstance(value, int | float) or value <= 0:
         raise InputError(f"{where}: {key} must be a positive number, not {value!r}")
     return float(value)
+
+
+def motion_hooks() -> list[tuple[str, Any]]:
+    """The ``MOTION`` object of every target that declares one, as ``(target name, MOTION)``.
+
+    A target's motion model for the verifier (interpolators, chord rules, timing
+    models, simulators it adds to :mod:`camtool.verify`'s generic library) is the
+    ``MOTION`` attribute of its module ``<package>.<stem>_motion`` (or, for a
+    one-module plugin, of ``<package>.<stem>``). Modules are imported on the
+    first call only (the verifier asks; listing targets does not).
+    """
+    found: list[tuple[str, Any]] = []
+    for name in target_names():
+        stem = name.replace("-", "_")
+        for module in (f"camtool_postprocessors.{stem}_motion", f"camtool_postprocessors.{stem}"):
+            try:
+                hooks = getattr(importlib.import_module(module), "MOTION", None)
+            except ModuleNotFoundError:
+                continue
+            if hooks is not None:
+                found.append((name, hooks))
+                break
+    return found

@@ -1,0 +1,20 @@
+"""The wheel ships every package: pyproject's explicit list equals the folders on disk."""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_every_package_is_listed_in_pyproject() -> None:
+    config = tomllib.loads((ROOT / "pyproject.toml").read_text("utf-8"))["tool"]["setuptools"]
+    listed = set(config["packages"])
+    on_disk = {
+        ".".join(p.parent.relative_to(ROOT).parts) for p in (ROOT / "camtool").rglob("__init__.py")
+    }
+    on_disk.add("camtool_postprocessors")
+    assert config["package-dir"] == {"camtool_postprocessors": "postprocessors"}
+    assert (ROOT / "postprocessors" / "__init__.py").is_file()
+    assert listed == on_disk
