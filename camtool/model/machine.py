@@ -13,8 +13,8 @@ Profile layout (every key optional except ``name``, ``steps_per_mm`` and
     true_steps_per_mm = [x, y, z]       # what the mechanics do (default: nominal)
     work_area_mm = [xmin, ymin, xmax, ymax], coordinates = "work" | "machine",
     has_z, max_step_rate_hz, source
-    [machine.motion]    line, arc, chords, chord_tolerance_mm, chord_segments,
-                        chord_angle_deg, rounding
+    [machine.motion]    line, arc, chords (names the verifier looks up),
+                        chord_tolerance_mm, chord_segments, chord_angle_deg, rounding
     [machine.backlash]  true_um = [x, y, z], compensation_um = [x, y, z]
     [[machine.backlash.regions]]  axis, x_mm = [lo, hi], y_mm = [lo, hi], true_um
     [machine.timing]    model and the model's own parameters (checked by the verifier)
@@ -32,32 +32,6 @@ from typing import Any
 
 from camtool.model.errors import InputError
 from camtool.model.shapes import BBox
-
-LINE_INTERPOLATORS: dict[str, str] = {
-    "dda": "linear DDA of the GMM PIC (seed-000 §4.2, annex A.3)",
-    "accumulator-dda": "accumulator DDA of ValCNC (seed-004 §4.1, Table 8)",
-    "bresenham": "Bresenham/AMASS stepping of GRBL and LinuxCNC",
-    "corte-recto": "diagonal, then the longer axis alone (seed-003 §4.1-4.2)",
-    "timer": "millisecond-timer stepping of the LMM VB6 application (seed-001 §4.7, R11)",
-    "servo": "per-axis DC servo loops, no coordination, stop at every vertex (seed-002 §4-5)",
-}
-"""Line interpolators a profile may name, with where each comes from."""
-
-ARC_INTERPOLATORS: dict[str, str] = {
-    "dsm": "direct search method (seed-000 §4.5, annex A.6)",
-    "staircase": "incremental staircase (seed-000 §4.4, annex A.5)",
-    "circular-dda": "circular DDA (seed-000 §4.3, annex A.4)",
-    "chords": "chords executed by the line interpolator (seed-001 §4.4, seed-004 §4.2, GRBL)",
-}
-"""Arc interpolators a profile may name."""
-
-CHORD_RULES: dict[str, str] = {
-    "sagitta": "fewest equal chords within chord_tolerance_mm",
-    "grbl": "GRBL 1.1 mc_arc with arc_tolerance = chord_tolerance_mm",
-    "flashcut": "chord_segments equal chords per arc (seed-001 §4.4)",
-    "valcnc": "chords of chord_angle_deg (seed-004 §4.2)",
-}
-"""How ``arc = "chords"`` cuts an arc into chords."""
 
 ROUNDINGS = ("half_even", "half_up", "floor", "trunc")
 """mm → steps rounding rules (:func:`camtool.verify.quantize.steps_from_mm`)."""
@@ -77,10 +51,16 @@ COORDINATES: dict[str, str] = {
 class Motion:
     """How the controller turns blocks into motor steps.
 
+    The names are open: the verifier looks each up in its generic library, then in
+    every installed target's motion model (:mod:`camtool.verify.motion`), and an
+    unknown name is an error there, listing the valid ones.
+
     Attributes:
-        line: a key of :data:`LINE_INTERPOLATORS`.
-        arc: a key of :data:`ARC_INTERPOLATORS`.
-        chords: a key of :data:`CHORD_RULES` (used when ``arc == "chords"``).
+        line: line interpolator name (e.g. ``"dda"``, ``"bresenham"``), or the name
+            of a whole simulator a target brings.
+        arc: arc interpolator name (e.g. ``"dsm"``), or ``"chords"``: chords run
+            by the line interpolator.
+        chords: chord rule name (e.g. ``"sagitta"``; used when ``arc == "chords"``).
         chord_tolerance_mm: largest chord sagitta, mm (``sagitta``, ``grbl``).
         chord_segments: chords per arc (``flashcut``; the thesis does not say).
         chord_angle_deg: chord angle β, degrees (``valcnc``; not given).
@@ -168,9 +148,9 @@ class Machine:
             1.9 µm assumed, 1.88 µm real); ``None`` means the nominal values.
         motion: interpolators and arc handling.
         backlash: true backlash and compensation.
-        timing: the ``[machine.timing]`` table as written: ``model`` (a model of
-            :data:`camtool.verify.timing.MODELS`) and its parameters; the
-            verifier checks it (:func:`camtool.verify.timing.timing_model_from_table`).
+        timing: the ``[machine.timing]`` table as written: ``model`` (a timing model
+            name) and its parameters; the verifier looks it up and checks it
+            (:func:`camtool.verify.motion.timing_model_from_table`).
         table: the ``[machine]`` table it was built from (empty when built in
             code), so that ``--machine`` can be laid over any profile.
     """
@@ -256,9 +236,9 @@ def machine_from_table(table: Mapping[str, Any], *, where: str) -> Machine:
 def _motion(r: _Reader) -> Motion:
     d = Motion()
     motion = Motion(
-        line=r.choice("line", LINE_INTERPOLATORS, d.line),
-        arc=r.choice("arc", ARC_INTERPOLATORS, d.arc),
-        chords=r.choice("chords", CHORD_RULES, d.chords),
+        line=r.name("line", d.line),
+        arc=r.name("arc", d.arc),
+        chords=r.name("chords", d.chords),
         chord_tolerance_mm=r.number("chord_tolerance_mm", d.chord_tolerance_mm, positive=True),
         chord_segments=int(r.number("chord_segments", d.chord_segments, positive=True)),
         chord_angle_deg=r.number("chord_angle_deg", d.chord_angle_deg, positive=True),
@@ -315,6 +295,15 @@ class _Reader:
             return ""
         if not isinstance(value, str):
             raise self._fail(key, "a string", value)
+        return value
+
+    def name(self, key: str, default: str) -> str:
+        """A non-empty name (checked where it is used, e.g. an interpolator's)."""
+        value = self._get(key, False)
+        if value is None:
+            return default
+        if not isinstance(value, str) or not value:
+            raise self._fail(key, "a name (a non-empty string)", value)
         return value
 
     def choice(self, key: str, choices: Mapping[str, object], default: str | None) -> str:

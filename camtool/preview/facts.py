@@ -19,7 +19,7 @@ from camtool.model.shapes import BBox
 
 if TYPE_CHECKING:
     from camtool.model.machine import Machine
-    from camtool.verify.simulate import StepTrace
+    from camtool.verify.motion import StepTrace
     from camtool.verify.verifier import Verification
 
 
@@ -39,17 +39,10 @@ def machine_time(program: Program, machine: Machine) -> tuple[float, str]:
     Raises:
         CamtoolError: the machine profile is invalid for the simulator.
     """
-    from camtool.verify.clock import block_times_s
+    from camtool.verify.verifier import block_times, simulate
 
-    if machine.motion.line == "servo":
-        from camtool.verify.simulate_servo import simulate_servo
-
-        trace = simulate_servo(program, machine)
-    else:
-        from camtool.verify.simulate import simulate_steps
-
-        trace = simulate_steps(program, machine)
-    return float(block_times_s(trace, program, machine).sum()), time_basis(machine, trace)
+    trace = simulate(program, machine)
+    return float(block_times(trace, program, machine).sum()), time_basis(machine, trace)
 
 
 def estimated_time(

@@ -1,8 +1,10 @@
 """Estimated machining time of a simulated program: the machine's timing model per block.
 
 Builds the per-block :class:`~camtool.verify.timing.BlockKinematics` from a
-:class:`~camtool.verify.simulate.StepTrace` and hands it to the model named in
-the profile's ``[machine.timing]`` table (:data:`camtool.verify.timing.MODELS`).
+:class:`~camtool.verify.motion.StepTrace` and hands it to the model named in
+the profile's ``[machine.timing]`` table (looked up by
+:meth:`camtool.verify.motion.Library.timing`: the generic library, then the
+targets' ``MOTION``; the model may complete the table from the profile).
 """
 
 from __future__ import annotations
@@ -12,8 +14,8 @@ import numpy.typing as npt
 
 from camtool.model.machine import Machine
 from camtool.model.program import Program, Rapid
-from camtool.verify.simulate import StepTrace
-from camtool.verify.timing import BlockKinematics, timing_model_from_table
+from camtool.verify.motion import StepTrace, timing_model_from_table
+from camtool.verify.timing import BlockKinematics
 
 
 def block_kinematics(trace: StepTrace, program: Program) -> BlockKinematics:
@@ -47,22 +49,8 @@ def block_times_s(trace: StepTrace, program: Program, machine: Machine) -> npt.N
     if not machine.timing:
         return _at_feed(program)
     where = f"machine {machine.name!r} [machine.timing]"
-    model = timing_model_from_table(_with_machine(machine), where=where)
+    model = timing_model_from_table(machine.timing, where=where, machine=machine)
     return np.asarray(model.block_time_s(block_kinematics(trace, program)), dtype=np.float64)
-
-
-def _with_machine(machine: Machine) -> dict[str, object]:
-    """The timing table, completed from the profile.
-
-    The profile's steps/mm and step-rate cap go in where the model takes them and
-    the table does not say, so that ``--machine`` changes reach the time model.
-    """
-    table = dict(machine.timing)
-    if table.get("model") == "pic-mmh":
-        table.setdefault("steps_per_mm", max(machine.steps_per_mm[:2]))
-        if machine.max_step_rate_hz > 0:
-            table.setdefault("max_step_rate_hz", machine.max_step_rate_hz)
-    return table
 
 
 def _at_feed(program: Program) -> npt.NDArray[np.float64]:

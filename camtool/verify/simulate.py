@@ -6,7 +6,7 @@ rounding and field widths are already in it. For each block the controller:
 1. converts the end point (and arc centre) to integer steps with its nominal
    steps/mm and rounding, absolutely (no drift, seed-001 §4.5);
 2. runs its line or arc interpolator from its logical position
-   (:mod:`camtool.verify.interpolators`): one row per iteration;
+   (looked up by name, :mod:`camtool.verify.motion`): one row per iteration;
 3. on a reversal of an axis adds the backlash compensation steps in the new
    direction, not counted in its logical position (seed-000 §5.1, seed-001 §5):
    before the move for a line (and before each chord of a chord arc), where the
@@ -28,88 +28,19 @@ tool-centre path); Z backlash is not modelled.
 from __future__ import annotations
 
 import itertools
-import math
-from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
-from camtool.model.errors import UsageError
 from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Move, Program
 from camtool.model.shapes import Point, distance
-from camtool.verify.interpolators import (
-    accumulator_dda_line,
-    bresenham_line,
-    circular_dda_arc,
-    corte_recto_line,
-    dda_line,
-    dsm_arc,
-    flashcut_arc_points,
-    grbl_arc_points,
-    segments_for_sagitta,
-    staircase_arc,
-    valcnc_arc_points,
-)
-from camtool.verify.interpolators_timer import timer_line
+from camtool.verify.motion import StepTrace, library
 from camtool.verify.quantize import Rounding, steps_from_mm
 from camtool.verify.steparray import STEP_DTYPE, StepArray, read_only
 
 IntArray = npt.NDArray[np.int64]
 FloatArray = npt.NDArray[np.float64]
-
-
-@dataclass(frozen=True, eq=False)
-class StepTrace:
-    """What the motors and the carriage did, row by row.
-
-    Attributes:
-        rows: ``(N, 2) int8`` motor steps per iteration, compensation included.
-        compensation: ``(N,) bool``, True for a backlash-compensation row.
-        block_of_row: ``(N,) int64``, index of the program move each row belongs to.
-        block_start: ``(B + 1,) int64`` row offsets: move ``b`` owns rows
-            ``block_start[b]:block_start[b + 1]``.
-        carriage_mm: ``(N, 2) float64``, carriage (tool-centre) position after each
-            row, mm, machine coordinates.
-        start_mm: carriage position before the first row, mm.
-        logical_end: ``(B, 2) int64``, the controller's logical position after each
-            move, steps.
-        block_steps: ``(B, 3) int64``, motor steps (pulses) per move and axis, without
-            compensation: ``(x, y, z)``.
-        block_dominant: ``(B,) int64``, steps of the dominant axis of each executed line
-            (summed over the chords of a chord arc; iterations for a native arc), what
-            per-step time models count (seed-001 R15).
-        block_compensation: ``(B,) int64``, compensation steps inserted in each move.
-        reversals: reversals of the commanded X and Y directions.
-        compensations: compensation events (axis reversals the controller
-            compensated; 0 when the profile compensates nothing).
-        block_time_s: ``(B,) float64`` time of each move when the simulation itself
-            gives it (the servo router), else ``None`` (the timing model decides).
-    """
-
-    rows: StepArray
-    compensation: npt.NDArray[np.bool_]
-    block_of_row: IntArray
-    block_start: IntArray
-    carriage_mm: FloatArray
-    start_mm: Point
-    logical_end: IntArray
-    block_steps: IntArray
-    block_dominant: IntArray
-    block_compensation: IntArray
-    reversals: tuple[int, int]
-    compensations: int
-    block_time_s: FloatArray | None = None
-
-
-_LINES: dict[str, Callable[[int, int], StepArray]] = {
-    "dda": dda_line,
-    "accumulator-dda": accumulator_dda_line,
-    "bresenham": bresenham_line,
-    "corte-recto": corte_recto_line,
-}
-_ARCS = {"dsm": dsm_arc, "staircase": staircase_arc, "circular-dda": circular_dda_arc}
 
 
 def simulate_steps(program: Program, machine: Machine) -> StepTrace:
@@ -124,7 +55,8 @@ def simulate_steps(program: Program, machine: Machine) -> StepTrace:
 
     Raises:
         UsageError: the profile names a line model that needs parameters it lacks.
-        InputError: an arc whose start is its centre (radius 0 steps).
+        InputError: an unknown interpolator or chord rule name (listing the valid
+            ones), or an arc whose start is its centre (radius 0 steps).
     """
     sim = _Controller(machine, program.origin)
     start = program.origin
@@ -157,26 +89,13 @@ class _Controller:
         self.block_comp: list[int] = []
         self.reversals = [0, 0]
         self.compensations = 0
-        self.line = self._line_interpolator()
+        lib = library()
+        self.line = lib.line(machine)
+        self.arc = lib.arc(machine)
+        self.chord_rule = lib.chord_rule(machine) if self.arc is None else None
 
     def to_steps(self, value_mm: float, axis: int) -> int:
         return steps_from_mm(value_mm, 1.0 / self.spm[axis], self.rounding)
-
-    def _line_interpolator(self) -> Callable[[int, int], StepArray]:
-        name = self.machine.motion.line
-        if name == "timer":
-            from camtool.verify.timing import FlashcutTiming, timing_model_from_table
-
-            where = f"machine {self.machine.name!r} [machine.timing]"
-            model = timing_model_from_table(self.machine.timing, where=where)
-            if not isinstance(model, FlashcutTiming):
-                raise UsageError(
-                    f"{where}: line = 'timer' steps by the seed-001 half period; "
-                    "it needs model = 'flashcut'"
-                )
-            period = model.half_period_ms
-            return lambda dx, dy: timer_line(dx, dy, period)
-        return _LINES[name]
 
     def block(self, start_mm: Point, move: Move) -> None:
         end = (self.to_steps(move.x, 0), self.to_steps(move.y, 1))
@@ -205,13 +124,12 @@ class _Controller:
     def _arc(
         self, start_mm: Point, move: ArcMove, end: tuple[int, int]
     ) -> tuple[StepArray, list[int], int]:
-        motion = self.machine.motion
-        if motion.arc in _ARCS:
+        if self.arc is not None:
             centre = (self.to_steps(move.cx, 0), self.to_steps(move.cy, 1))
             full = distance(start_mm, (move.x, move.y)) <= 1e-9
             if end == self.pos and not full:  # an arc shorter than a step: a line
                 return self.line(0, 0), [0], 0
-            rows = _ARCS[motion.arc](*self.pos, *end, *centre, move.clockwise)
+            rows = self.arc(*self.pos, *end, *centre, move.clockwise)
             return rows, [], len(rows)
         points = self._chord_points(start_mm, move)
         lattice = [self.pos] + [(self.to_steps(x, 0), self.to_steps(y, 1)) for x, y in points]
@@ -227,22 +145,8 @@ class _Controller:
         return joined, starts, dominant
 
     def _chord_points(self, start_mm: Point, move: ArcMove) -> FloatArray:
-        motion = self.machine.motion
-        end, centre = (move.x, move.y), (move.cx, move.cy)
-        pts: FloatArray | list[Point]
-        if motion.chords == "grbl":
-            pts = grbl_arc_points(
-                start_mm, end, centre, move.clockwise, arc_tolerance_mm=motion.chord_tolerance_mm
-            )
-        elif motion.chords == "flashcut":
-            pts = flashcut_arc_points(
-                start_mm, end, centre, move.clockwise, segments=motion.chord_segments
-            )
-        elif motion.chords == "valcnc":
-            beta = math.radians(motion.chord_angle_deg)
-            pts = valcnc_arc_points(start_mm, end, centre, move.clockwise, beta_rad=beta)
-        else:
-            pts = sagitta_chord_points(start_mm, move, motion.chord_tolerance_mm)
+        assert self.chord_rule is not None  # arc = "chords"
+        pts = self.chord_rule(start_mm, move, self.machine.motion)
         return np.asarray(pts, dtype=np.float64).reshape(-1, 2)
 
     def _compensate(
@@ -306,26 +210,6 @@ class _Controller:
             reversals=(self.reversals[0], self.reversals[1]),
             compensations=self.compensations,
         )
-
-
-def sagitta_chord_points(start: Point, move: ArcMove, tolerance_mm: float) -> list[Point]:
-    """End points of equal chords of an arc within ``tolerance_mm`` (the last is its end)."""
-    cx, cy = move.cx, move.cy
-    radius = math.hypot(start[0] - cx, start[1] - cy)
-    a0 = math.atan2(start[1] - cy, start[0] - cx)
-    a1 = math.atan2(move.y - cy, move.x - cx)
-    sweep = a1 - a0
-    turn = -math.tau if move.clockwise else math.tau
-    sweep = sweep % turn or turn
-    if distance(start, (move.x, move.y)) > 1e-9 and abs(abs(sweep) - math.tau) < 1e-12:
-        sweep = 0.0
-    n = segments_for_sagitta(radius, sweep, tolerance_mm) if radius > 0 else 1
-    points = [
-        (cx + radius * math.cos(a0 + sweep * k / n), cy + radius * math.sin(a0 + sweep * k / n))
-        for k in range(n + 1)
-    ]
-    points[-1] = (move.x, move.y)
-    return points[1:]
 
 
 def _start_mm(origin_steps: tuple[int, int], machine: Machine) -> Point:

@@ -1,203 +1,433 @@
-"""Machining-time models of the targets' controllers: seconds per block.
+"""Generic machining-time library: per-block kinematics and the rest-to-rest trapezoid.
 
-The verifier simulates emitted code block by block; these pure, vectorised
-functions turn what it knows per block (:class:`BlockKinematics`: iterations,
-dominant steps, compensation steps, length, feed, rapid flag) into ``(B,)``
-float64 seconds, read-only. One function and one frozen parameter dataclass per
-controller; every dataclass has ``block_time_s(blocks)`` and a ``model`` name,
-and :func:`timing_model_from_table` builds one from a TOML ``[timing]`` table.
+The verifier simulates emitted code block by block; a *timing model* turns what it
+knows per block (:class:`BlockKinematics`: iterations, dominant steps,
+compensation steps, length, feed, rapid flag) into ``(B,)`` float64 seconds,
+read-only. Every model is a frozen parameter dataclass with
+``block_time_s(blocks)`` (:class:`TimingModel`), built from a profile's
+``[machine.timing]`` table by :func:`timing_from_table`; which class a ``model``
+name means is resolved by :mod:`camtool.verify.motion` (this library's
+``trapezoid``, or a target's ``MOTION.timing``). The helpers here validate and
+freeze arrays for every model, generic or a target's.
 
-- ``pic-mmh``: :func:`pic_mmh_block_time_s`, :class:`PicMmhTiming`; seed-000
-  §4.9, §5.1, S000-17 (module ``timing_rate``).
-- ``flashcut``: :func:`flashcut_block_time_s`, :class:`FlashcutTiming`; seed-001
-  §2.6, §4.7, R15, R21 (``timing_rate``).
-- ``i8751``: :func:`i8751_block_time_s`, :class:`I8751Timing`; seed-003
-  §4.3–4.4, R11–R12 (``timing_ramp``).
-- ``valcnc``: :func:`valcnc_block_time_s`, :class:`ValcncTiming`; seed-004 §2.8,
-  §4.1, §4.3, S004-R13 (``timing_rate``).
-- ``grbl`` / ``linuxcnc``: :func:`grbl_block_time_s`, :class:`TrapezoidTiming`;
-  rest-to-rest trapezoids, conservative (``timing_accel``).
+The rest-to-rest trapezoid (:func:`trapezoid_time_s`, :class:`TrapezoidTiming`):
+each block runs at its programmed feed ``F`` (capped at the machine's maximum
+rate; rapids at the maximum rate) with constant acceleration ``a`` up to and
+down from that speed. For a block of length ``L`` entered at ``v0`` and left at
+``v1`` with nominal speed ``v`` (all mm/s)::
 
-Everything is re-exported here; import from this module.
+    d_acc = (v² − v0²)/(2a),   d_dec = (v² − v1²)/(2a)
+    trapezoid (d_acc + d_dec ≤ L):  t = (v − v0)/a + (v − v1)/a + (L − d_acc − d_dec)/v
+    triangle  (otherwise):          v_p = √((2aL + v0² + v1²)/2),  t = (v_p − v0)/a + (v_p − v1)/a
 
-The seed-002 router's time comes from its servo simulation, not from here.
+The block-time model is **conservative**: every block starts and ends at rest
+(``v0 = v1 = 0``, so ``t = L/v + v/a`` or ``t = 2√(L/a)``). That is exact for a
+controller in exact-stop mode (RS-274 G61.1) but longer than the real time of a
+planner that blends blocks (junction look-ahead slows down only at corners; a
+target that models its planner passes entry/exit speeds to
+:func:`trapezoid_time_s`).
 
-This module also keeps the seed-001 timer-firing helpers (§4.7, R11): the VB6
-application of the LMM machine steps each axis from a millisecond timer
-(``timeGetTime``); an axis fires when ``now − last > period``. With a 1 ms
-timer an axis of period T ms therefore fires every ``floor(T) + 1`` ms. The
-dominant axis has the configured half-period P (so P + 1 ms); the other axis is
-scheduled at ``P·N_dom/N_other`` and is **not** count-limited: it keeps firing
-until the dominant axis has done its steps, which over-steps it.
+Per-axis limits: a controller limits a block's acceleration and maximum rate by
+every moving axis (``min_i a_i/|u_i|`` over the unit vector ``u``); pass such a
+per-block value as a ``(B,)`` array if axes differ. The defaults are the generic
+``defaults.h`` of GRBL 1.1: ``$110`` = 500 mm/min and ``$120`` = 10 mm/s².
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import fields
-from types import MappingProxyType
-from typing import Any
+from dataclasses import dataclass, fields
+from typing import Any, ClassVar, Protocol
+
+import numpy as np
+import numpy.typing as npt
 
 from camtool.model.errors import InputError, UsageError
-from camtool.verify.timing_accel import (
-    GRBL_DEFAULT_ACCELERATION_MM_S2,
-    GRBL_DEFAULT_JUNCTION_DEVIATION_MM,
-    GRBL_DEFAULT_MAX_RATE_MM_MIN,
-    TrapezoidTiming,
-    grbl_block_time_s,
-    grbl_junction_speed_mm_s,
-    trapezoid_time_s,
-)
-from camtool.verify.timing_blocks import BlockKinematics
-from camtool.verify.timing_ramp import (
-    CRUISES,
-    I8751Timing,
-    i8751_block_time_s,
-    i8751_cruise_x,
-    i8751_delay_s,
-    i8751_move_time_s,
-    i8751_step_delays_s,
-)
-from camtool.verify.timing_rate import (
-    FLASHCUT_MIN_HALF_PERIOD_MS,
-    PIC_MMH_MAX_STEP_RATE_HZ,
-    PIC_MMH_STEPS_PER_MM,
-    VALCNC_STEP_DELAY_US,
-    FlashcutTiming,
-    PicMmhTiming,
-    ValcncTiming,
-    flashcut_block_time_s,
-    pic_mmh_block_time_s,
-    pic_mmh_step_rate_hz,
-    serial_time_s,
-    valcnc_block_time_s,
-)
+from camtool.verify.steparray import read_only
 
-__all__ = [
-    "CRUISES",
-    "FLASHCUT_MIN_HALF_PERIOD_MS",
-    "GRBL_DEFAULT_ACCELERATION_MM_S2",
-    "GRBL_DEFAULT_JUNCTION_DEVIATION_MM",
-    "GRBL_DEFAULT_MAX_RATE_MM_MIN",
-    "MODELS",
-    "PIC_MMH_MAX_STEP_RATE_HZ",
-    "PIC_MMH_STEPS_PER_MM",
-    "VALCNC_STEP_DELAY_US",
-    "BlockKinematics",
-    "FlashcutTiming",
-    "I8751Timing",
-    "PicMmhTiming",
-    "TimingModel",
-    "TrapezoidTiming",
-    "ValcncTiming",
-    "flashcut_block_time_s",
-    "flashcut_line_steps",
-    "grbl_block_time_s",
-    "grbl_junction_speed_mm_s",
-    "i8751_block_time_s",
-    "i8751_cruise_x",
-    "i8751_delay_s",
-    "i8751_move_time_s",
-    "i8751_step_delays_s",
-    "pic_mmh_block_time_s",
-    "pic_mmh_step_rate_hz",
-    "serial_time_s",
-    "timer_period_ms",
-    "timing_model_from_table",
-    "trapezoid_time_s",
-    "valcnc_block_time_s",
-]
+FloatArray = npt.NDArray[np.float64]
+"""``(B,) float64`` array."""
+IntArray = npt.NDArray[np.int64]
+"""``(B,) int64`` array."""
+BoolArray = npt.NDArray[np.bool_]
+"""``(B,) bool`` array."""
 
 
-def timer_period_ms(period_ms: float, timer_ms: int = 1) -> int:
-    """Effective firing period of ``now − last > period`` on a ``timer_ms`` clock, ms.
+frozen = read_only
+"""Mark an array read-only and return it (:func:`camtool.verify.steparray.read_only`)."""
 
-    Args:
-        period_ms: Scheduled period, ms, ``> 0``.
-        timer_ms: Timer resolution, ms (seed-001 §2.6: ``timeBeginPeriod 1``).
 
-    Returns:
-        The smallest multiple of ``timer_ms`` strictly greater than ``period_ms``.
+def seconds(values: npt.ArrayLike) -> FloatArray:
+    """Return ``values`` as a new read-only float64 array of seconds."""
+    out = np.array(values, dtype=np.float64)
+    out.flags.writeable = False
+    return out
+
+
+def _whole(name: str, arr: npt.NDArray[np.generic]) -> IntArray:
+    """``arr`` as int64 after checking that it holds whole numbers.
 
     Raises:
-        UsageError: If ``period_ms`` or ``timer_ms`` is not positive.
+        UsageError: If it holds non-finite or fractional values.
     """
-    if not (period_ms > 0 and timer_ms > 0):
-        raise UsageError(f"periods must be > 0 ms, got {period_ms!r} and {timer_ms!r}")
-    return (math.floor(period_ms / timer_ms) + 1) * timer_ms
+    if arr.size and not np.issubdtype(arr.dtype, np.integer):
+        f = arr.astype(np.float64)
+        if not np.all(np.isfinite(f)) or np.any(f != np.round(f)):
+            raise UsageError(f"{name} must hold whole numbers of steps, got {arr.dtype}")
+    return arr.astype(np.int64)
 
 
-def flashcut_line_steps(
-    n_dominant: int, n_other: int, half_period_ms: int, *, timer_ms: int = 1
-) -> int:
-    """Steps the non-dominant axis really makes in one seed-001 ``funcionXYH`` line.
-
-    The move lasts ``n_dominant·(P + 1)`` ms (dominant period ``P + 1``); the other
-    axis fires every ``floor(P·n_dominant/n_other) + 1`` ms until then.
-    seed-001 §4.7 Table 3.8: a 10 × 5 mm line (5263 × 2632 steps) gives 2763,
-    2719 and 2697 Y steps at P = 20, 30 and 40 ms.
-
-    Args:
-        n_dominant: Steps of the axis with more steps (exact, count-limited).
-        n_other: Programmed steps of the other axis, ``<= n_dominant``.
-        half_period_ms: Configured "Período medio de la señal" P, ms.
-        timer_ms: Timer resolution, ms.
-
-    Returns:
-        Steps the other axis makes (``0`` if it has none programmed).
+def counts(name: str, values: npt.ArrayLike) -> IntArray:
+    """Return ``values`` as a 1-D int64 array of non-negative counts.
 
     Raises:
-        UsageError: If the counts are negative or ``n_other > n_dominant``, or a
-            period is not positive.
+        UsageError: If ``values`` is not 1-D, holds non-integers or negatives.
     """
-    if not 0 <= n_other <= n_dominant:
-        raise UsageError(f"need 0 <= other <= dominant steps, got {n_other!r}, {n_dominant!r}")
-    if n_other == 0:
-        return 0
-    duration = n_dominant * timer_period_ms(half_period_ms, timer_ms)
-    return duration // timer_period_ms(half_period_ms * n_dominant / n_other, timer_ms)
+    arr = np.asarray(values)
+    if arr.ndim != 1:
+        raise UsageError(f"{name} must be a (B,) array, got shape {arr.shape}")
+    out = _whole(name, arr)
+    if np.any(out < 0):
+        i = int(np.flatnonzero(out < 0)[0])
+        raise UsageError(f"{name} must be >= 0; block {i} has {int(out[i])}")
+    return out
 
 
-# --------------------------------------------------------------------- TOML profiles
+def floats(name: str, values: npt.ArrayLike, *, minimum: float = 0.0) -> FloatArray:
+    """Return ``values`` as a 1-D float64 array of finite values ``>= minimum``.
 
-TimingModel = PicMmhTiming | FlashcutTiming | I8751Timing | ValcncTiming | TrapezoidTiming
-"""Any of the time-model parameter dataclasses."""
-
-MODELS: Mapping[str, type[TimingModel]] = MappingProxyType(
-    {
-        "pic-mmh": PicMmhTiming,
-        "flashcut": FlashcutTiming,
-        "i8751": I8751Timing,
-        "valcnc": ValcncTiming,
-        "grbl": TrapezoidTiming,
-        "linuxcnc": TrapezoidTiming,
-    }
-)
-"""Model names accepted in a ``[timing]`` table and their parameter classes (read-only)."""
+    Raises:
+        UsageError: If ``values`` is not 1-D, not finite or below ``minimum``.
+    """
+    arr = np.asarray(values, dtype=np.float64)
+    if arr.ndim != 1:
+        raise UsageError(f"{name} must be a (B,) array, got shape {arr.shape}")
+    bad = ~np.isfinite(arr) | (arr < minimum)
+    if np.any(bad):
+        i = int(np.flatnonzero(bad)[0])
+        raise UsageError(f"{name} must be finite and >= {minimum}; block {i} has {arr[i]!r}")
+    return arr
 
 
-def timing_model_from_table(table: Mapping[str, Any], *, where: str) -> TimingModel:
-    """Build a time model from a TOML ``[timing]`` table.
+def flags(name: str, values: npt.ArrayLike) -> BoolArray:
+    """Return ``values`` as a 1-D bool array.
 
-    The table holds ``model`` (one of :data:`MODELS`) and any of that model's
-    dataclass fields, e.g. ``model = "flashcut"`` and ``half_period_ms = 20``.
+    Raises:
+        UsageError: If ``values`` is not 1-D.
+    """
+    arr = np.asarray(values, dtype=np.bool_)
+    if arr.ndim != 1:
+        raise UsageError(f"{name} must be a (B,) array, got shape {arr.shape}")
+    return arr
+
+
+def same_length(**arrays: npt.NDArray[np.generic]) -> int:
+    """Common length ``B`` of 1-D arrays.
+
+    Raises:
+        UsageError: If the lengths differ (the message lists them).
+    """
+    sizes = {name: len(a) for name, a in arrays.items()}
+    if len(set(sizes.values())) > 1:
+        raise UsageError(f"per-block arrays differ in length: {sizes}")
+    return next(iter(sizes.values()), 0)
+
+
+def per_block(name: str, value: float | npt.ArrayLike, b: int, *, minimum: float) -> FloatArray:
+    """Broadcast a scalar or ``(B,)`` parameter to ``(B,)`` float64, checked ``>= minimum``.
+
+    Raises:
+        UsageError: If it cannot be broadcast to ``(b,)`` or is out of range.
+    """
+    arr = np.asarray(value, dtype=np.float64)
+    if arr.ndim > 1 or (arr.ndim == 1 and len(arr) != b):
+        raise UsageError(f"{name} must be a number or a ({b},) array, got shape {arr.shape}")
+    return floats(name, np.broadcast_to(arr, (b,)), minimum=minimum)
+
+
+def positive(name: str, value: float) -> float:
+    """Return ``value`` as a float after checking it is finite and ``> 0``.
+
+    Raises:
+        UsageError: If it is not.
+    """
+    v = float(value)
+    if not (math.isfinite(v) and v > 0):
+        raise UsageError(f"{name} must be a finite number > 0, got {value!r}")
+    return v
+
+
+@dataclass(frozen=True, kw_only=True)
+class BlockKinematics:
+    """Per-block quantities the simulator hands to a time model; all arrays read-only.
+
+    Construct with :meth:`build`, which fills the optional arrays; direct
+    construction needs every array. The arrays are copied, checked and frozen.
+
+    Attributes:
+        dominant_steps: ``(B,) int64``, ``max(|x steps|, |y steps|)`` of the block.
+        is_rapid: ``(B,) bool``, True for G00-style moves (feed ignored).
+        feed_mm_min: ``(B,) float64``, programmed feed, mm/min (0 for a rapid).
+        length_mm: ``(B,) float64``, path length of the block, mm (an arc's arc length).
+        iterations: ``(B,) int64``, interpolator iterations (including iterations
+            without a pulse).
+        steps: ``(B, 3) int64``, signed steps per axis ``(x, y, z)``.
+        compensation_steps: ``(B,) int64``, backlash compensation steps the
+            controller inserted in the block.
+        block_bytes: ``(B,) int64``, bytes the host sends for the block (for
+            serial-time models).
+
+    Raises:
+        UsageError: If an array has the wrong shape, a count is negative or not
+            whole, a feed or length is negative, or the lengths differ.
+    """
+
+    dominant_steps: IntArray
+    is_rapid: BoolArray
+    feed_mm_min: FloatArray
+    length_mm: FloatArray
+    iterations: IntArray
+    steps: IntArray
+    compensation_steps: IntArray
+    block_bytes: IntArray
+
+    def __post_init__(self) -> None:
+        values = {
+            "dominant_steps": counts("dominant_steps", self.dominant_steps),
+            "is_rapid": flags("is_rapid", self.is_rapid),
+            "feed_mm_min": floats("feed_mm_min", self.feed_mm_min),
+            "length_mm": floats("length_mm", self.length_mm),
+            "iterations": counts("iterations", self.iterations),
+            "compensation_steps": counts("compensation_steps", self.compensation_steps),
+            "block_bytes": counts("block_bytes", self.block_bytes),
+        }
+        b = same_length(**values)
+        values["steps"] = _axis_steps(self.steps, b)
+        for name, arr in values.items():
+            object.__setattr__(self, name, frozen(arr.copy()))
+
+    @classmethod
+    def build(
+        cls,
+        *,
+        dominant_steps: npt.ArrayLike,
+        is_rapid: npt.ArrayLike,
+        feed_mm_min: npt.ArrayLike,
+        length_mm: npt.ArrayLike,
+        iterations: npt.ArrayLike | None = None,
+        steps: npt.ArrayLike | None = None,
+        compensation_steps: npt.ArrayLike | None = None,
+        block_bytes: npt.ArrayLike | None = None,
+    ) -> BlockKinematics:
+        """Build from array-likes, filling the optional arrays.
+
+        ``iterations`` defaults to ``dominant_steps``; ``steps`` may be
+        ``(B, 2)`` or ``(B, 3)`` and defaults to zeros, as do the other counts.
+
+        Raises:
+            UsageError: As the class does.
+        """
+        dom = counts("dominant_steps", dominant_steps)
+        zeros = np.zeros(len(dom), dtype=np.int64)
+
+        def arr(value: npt.ArrayLike | None, default: IntArray) -> IntArray:
+            return default if value is None else np.asarray(value)
+
+        return cls(
+            dominant_steps=dom,
+            is_rapid=np.asarray(is_rapid),
+            feed_mm_min=np.asarray(feed_mm_min),
+            length_mm=np.asarray(length_mm),
+            iterations=arr(iterations, dom),
+            steps=arr(steps, np.zeros((len(dom), 3), dtype=np.int64)),
+            compensation_steps=arr(compensation_steps, zeros),
+            block_bytes=arr(block_bytes, zeros),
+        )
+
+    def __len__(self) -> int:
+        return len(self.dominant_steps)
+
+
+def _axis_steps(steps: npt.ArrayLike, b: int) -> IntArray:
+    """``(B, 3) int64`` signed axis steps from a ``(B, 2)`` or ``(B, 3)`` array."""
+    arr = np.asarray(steps)
+    if arr.ndim != 2 or arr.shape[0] != b or arr.shape[1] not in (2, 3):
+        raise UsageError(f"steps must be a ({b}, 2) or ({b}, 3) array, got shape {arr.shape}")
+    out = np.zeros((b, 3), dtype=np.int64)
+    out[:, : arr.shape[1]] = _whole("steps", arr)
+    return out
+
+
+# ----------------------------------------------------- rest-to-rest trapezoid
+
+DEFAULT_MAX_RATE_MM_MIN = 500.0
+"""Default maximum (and rapid) rate, mm/min: GRBL 1.1's ``$110``/``$111`` (``defaults.h``)."""
+DEFAULT_ACCELERATION_MM_S2 = 10.0
+"""Default acceleration, mm/s²: GRBL 1.1's generic ``$120``/``$121`` (``defaults.h``)."""
+
+
+def trapezoid_time_s(
+    length_mm: npt.ArrayLike,
+    speed_mm_s: npt.ArrayLike,
+    acceleration_mm_s2: float | npt.ArrayLike,
+    *,
+    entry_mm_s: float | npt.ArrayLike = 0.0,
+    exit_mm_s: float | npt.ArrayLike = 0.0,
+) -> FloatArray:
+    """Duration of trapezoidal (or triangular) speed profiles, s (module docstring formula).
+
+    Entry and exit speeds above the nominal speed are lowered to it.
 
     Args:
+        length_mm: ``(B,)`` path lengths, mm, ``>= 0``.
+        speed_mm_s: ``(B,)`` nominal (cruise) speeds, mm/s, ``> 0`` where the
+            length is not 0.
+        acceleration_mm_s2: Acceleration, mm/s², scalar or ``(B,)``, ``> 0``.
+        entry_mm_s: Speed at the block start, mm/s, scalar or ``(B,)``.
+        exit_mm_s: Speed at the block end, mm/s, scalar or ``(B,)``.
+
+    Returns:
+        ``(B,) float64`` seconds, read-only; 0 for a zero length.
+
+    Raises:
+        UsageError: If lengths differ, a value is negative, a moving block has
+            no speed, or the exit speed cannot be reached from the entry speed
+            within the length (``|v1² − v0²| > 2aL``).
+    """
+    length = floats("length_mm", length_mm)
+    v = floats("speed_mm_s", speed_mm_s)
+    b = same_length(length_mm=length, speed_mm_s=v)
+    a = per_block("acceleration_mm_s2", acceleration_mm_s2, b, minimum=0.0)
+    if np.any(a <= 0):
+        raise UsageError("acceleration_mm_s2 must be > 0")
+    moving = length > 0
+    if np.any(moving & (v <= 0)):
+        i = int(np.flatnonzero(moving & (v <= 0))[0])
+        raise UsageError(f"block {i} moves {length[i]!r} mm at speed 0; give a feed > 0")
+    v0 = np.minimum(per_block("entry_mm_s", entry_mm_s, b, minimum=0.0), v)
+    v1 = np.minimum(per_block("exit_mm_s", exit_mm_s, b, minimum=0.0), v)
+    unreachable = np.abs(v1**2 - v0**2) > 2.0 * a * length * (1 + 1e-12) + 1e-18
+    if np.any(unreachable):
+        i = int(np.flatnonzero(unreachable)[0])
+        raise UsageError(
+            f"block {i}: cannot go from {v0[i]!r} to {v1[i]!r} mm/s in {length[i]!r} mm"
+        )
+    d_acc = (v**2 - v0**2) / (2.0 * a)
+    d_dec = (v**2 - v1**2) / (2.0 * a)
+    cruise = length - d_acc - d_dec
+    v_safe = np.where(v > 0, v, 1.0)
+    t_trap = (2.0 * v - v0 - v1) / a + np.maximum(cruise, 0.0) / v_safe
+    vp = np.sqrt(np.maximum((2.0 * a * length + v0**2 + v1**2) / 2.0, 0.0))
+    t_tri = (2.0 * vp - v0 - v1) / a
+    t = np.where(cruise >= 0, t_trap, t_tri)
+    return seconds(np.where(moving, t, 0.0))
+
+
+def trapezoid_block_time_s(
+    length_mm: npt.ArrayLike,
+    feed_mm_min: npt.ArrayLike,
+    is_rapid: npt.ArrayLike,
+    *,
+    acceleration_mm_s2: float | npt.ArrayLike = DEFAULT_ACCELERATION_MM_S2,
+    max_rate_mm_min: float | npt.ArrayLike = DEFAULT_MAX_RATE_MM_MIN,
+) -> FloatArray:
+    """Conservative block time: rest-to-rest trapezoid at min(F, max rate), s.
+
+    Rapids run at ``max_rate_mm_min``; feed moves at the programmed feed capped
+    by it. No junction look-ahead, so the sum over blocks is an upper bound of
+    a blending planner's real time (module docstring).
+
+    Args:
+        length_mm: ``(B,)`` path lengths, mm (arc length for arcs).
+        feed_mm_min: ``(B,)`` programmed feeds, mm/min (ignored for rapids).
+        is_rapid: ``(B,)`` True for G00.
+        acceleration_mm_s2: Acceleration along the path, mm/s², scalar or ``(B,)``.
+        max_rate_mm_min: Maximum rate, mm/min, scalar or ``(B,)``.
+
+    Returns:
+        ``(B,) float64`` seconds, read-only.
+
+    Raises:
+        UsageError: If lengths differ, a value is negative or not finite, a
+            feed move of non-zero length has feed 0, or a limit is not positive.
+    """
+    length = floats("length_mm", length_mm)
+    feed = floats("feed_mm_min", feed_mm_min)
+    rapid = flags("is_rapid", is_rapid)
+    b = same_length(length_mm=length, feed_mm_min=feed, is_rapid=rapid)
+    cap = per_block("max_rate_mm_min", max_rate_mm_min, b, minimum=0.0)
+    if np.any(cap <= 0):
+        raise UsageError("max_rate_mm_min must be > 0")
+    speed = np.where(rapid, cap, np.minimum(feed, cap)) / 60.0
+    return trapezoid_time_s(length, speed, acceleration_mm_s2)
+
+
+@dataclass(frozen=True, kw_only=True)
+class TrapezoidTiming:
+    """Parameters of the rest-to-rest trapezoid time model (:func:`trapezoid_block_time_s`).
+
+    Attributes:
+        acceleration_mm_s2: Acceleration along the path, mm/s² (GRBL ``$120``).
+        max_rate_mm_min: Maximum rate, also the rapid rate, mm/min (GRBL ``$110``).
+
+    Raises:
+        UsageError: If a value is not a finite number > 0.
+    """
+
+    model: ClassVar[str] = "trapezoid"
+    acceleration_mm_s2: float = DEFAULT_ACCELERATION_MM_S2
+    max_rate_mm_min: float = DEFAULT_MAX_RATE_MM_MIN
+
+    def __post_init__(self) -> None:
+        positive("acceleration_mm_s2", self.acceleration_mm_s2)
+        positive("max_rate_mm_min", self.max_rate_mm_min)
+
+    def block_time_s(self, blocks: BlockKinematics) -> FloatArray:
+        """Seconds per block, ``(B,) float64`` read-only."""
+        return trapezoid_block_time_s(
+            blocks.length_mm,
+            blocks.feed_mm_min,
+            blocks.is_rapid,
+            acceleration_mm_s2=self.acceleration_mm_s2,
+            max_rate_mm_min=self.max_rate_mm_min,
+        )
+
+
+class TimingModel(Protocol):
+    """A timing model: parameters (a frozen dataclass) and the seconds each block takes.
+
+    ``model`` names it as a ``[machine.timing]`` table does; ``block_time_s`` returns
+    ``(B,) float64`` seconds, read-only, for the ``B`` blocks of ``blocks``.
+    """
+
+    model: ClassVar[str]
+
+    def block_time_s(self, blocks: BlockKinematics) -> FloatArray:
+        """Seconds per block, ``(B,) float64`` read-only."""
+        ...
+
+
+def timing_from_table(cls: type[Any], table: Mapping[str, Any], *, where: str) -> Any:
+    """Build the parameter dataclass ``cls`` from a TOML ``[timing]`` table.
+
+    The table holds ``model`` (ignored here: the caller resolved it to ``cls``) and
+    any of ``cls``'s dataclass fields, numbers, except ``cruise``, taken as written
+    (e.g. ``model = "trapezoid"`` and ``acceleration_mm_s2 = 500``).
+
+    Args:
+        cls: A frozen parameter dataclass (every field a number, or ``cruise``).
         table: The parsed table.
-        where: What to name in messages, e.g. ``"flashcut.toml [timing]"``.
+        where: What to name in messages, e.g. ``"machine.toml [timing]"``.
 
     Returns:
-        The parameter dataclass of the model.
+        ``cls(**parameters)``.
 
     Raises:
-        InputError: An unknown model or key, or a value of the wrong type or
-            out of range, naming ``where`` and the valid choices.
+        InputError: An unknown key, or a value of the wrong type or out of range,
+            naming ``where`` and the known keys.
     """
     name = table.get("model")
-    if not isinstance(name, str) or name not in MODELS:
-        raise InputError(f"{where}: unknown timing model {name!r}; valid: {', '.join(MODELS)}")
-    cls = MODELS[name]
     known = {f.name for f in fields(cls)}
     unknown = sorted(set(table) - known - {"model"})
     if unknown:

@@ -1,24 +1,43 @@
-"""The verifier: emitted code → program → simulated machine → measured error.
+"""The verifier: emitted code → program → simulated machine → measured error → report.
 
 :func:`verify_code` reads code with the target's own reader (so rounding and
 field widths are part of the prediction), :func:`verify_program` simulates a
-program on a machine profile and measures the result (see
-:mod:`camtool.verify.simulate` and :mod:`camtool.verify.metrics`).
+program on a machine profile (:func:`simulate`: the step simulator of
+:mod:`camtool.verify.simulate`, or the simulator a target's ``MOTION`` brings for
+the profile's line name, :mod:`camtool.verify.motion`) and measures the result
+(:mod:`camtool.verify.metrics`); :func:`report_dict` is the JSON report.
+
+The verify report: a JSON-ready dict with the keys of ../shared/DESIGN.md.
+Stable keys other tools read: ``target``, ``blocks``, ``steps`` {x, y, z},
+``iterations``, ``reversals`` {x, y}, ``compensations``, ``deviation_um``
+{max, rms}, ``closure_um`` (one value per closed contour, the gap's length),
+``size_error_um`` (one ``[dx, dy]`` per contour, bounding box), ``time_s``,
+``warnings``. Added here: ``machine``, ``compensation_steps``, the location of
+the worst deviation, ``contours`` (every measure per contour, circles with
+their fitted diameter), ``against`` (the drawing comparison, over what was
+cut as drawn), ``not_cut_as_drawn`` (the features the planner reported it
+cannot cut with this tool, each ``{kind, label, at: {x_mm, y_mm}, error_um,
+samples, value}``), ``strict_error_um`` (the largest error with them) and
+``against_skipped`` (why a drawing given was not compared, else null). Numbers are
+rounded (µm to 4 decimals, mm to 6) so the same input gives the same bytes.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from camtool import __version__
 from camtool.model.errors import InputError, UsageError
 from camtool.model.machine import Machine
 from camtool.model.program import Dwell, Home, Program, Rapid
 from camtool.model.shapes import BBox, Drawing
 from camtool.model.units import fmt_num
+from camtool.verify.clock import block_times_s
 from camtool.verify.metrics import (
     Against,
     ContourMeasure,
@@ -28,7 +47,8 @@ from camtool.verify.metrics import (
     deviation,
     measure_contours,
 )
-from camtool.verify.simulate import StepTrace, simulate_steps
+from camtool.verify.motion import StepTrace, library
+from camtool.verify.simulate import simulate_steps
 
 if TYPE_CHECKING:
     from camtool.post.base import Target
@@ -190,17 +210,14 @@ def verify_program(
 
     Raises:
         UsageError: a negative tool diameter, or an inconsistent machine profile.
+        InputError: the profile names an unknown interpolator, chord rule or
+            timing model (the message lists the valid names).
         DialectError: the program does not fit the machine (:func:`check_area`).
     """
     if tool_diameter < 0:
         raise UsageError(f"tool diameter must be >= 0 mm, got {tool_diameter!r}")
     placement = check_area(program, machine)
-    if machine.motion.line == "servo":
-        from camtool.verify.simulate_servo import simulate_servo
-
-        trace = simulate_servo(program, machine)
-    else:
-        trace = simulate_steps(program, machine)
+    trace = simulate(program, machine)
     points, blocks = trace.carriage_mm, trace.block_of_row
     dev = deviation(points, blocks, program)
     contours = tuple(measure_contours(points, trace.block_start, trace.start_mm, program))
@@ -234,6 +251,24 @@ def verify_program(
         warnings=tuple(dict.fromkeys((*warnings, *placement))),
         against_skipped=skipped,
     )
+
+
+def simulate(program: Program, machine: Machine) -> StepTrace:
+    """Simulate ``program`` on ``machine``: the simulator its ``line`` name selects.
+
+    A ``line`` name that a target's ``MOTION.simulators`` holds runs that simulator
+    (:meth:`camtool.verify.motion.Library.simulator`); any other runs the step
+    simulator (:func:`camtool.verify.simulate.simulate_steps`) with the named
+    interpolators.
+
+    Raises:
+        InputError: an unknown interpolator or chord rule name.
+        UsageError: the profile lacks a parameter its line model needs.
+    """
+    run = library().simulator(machine.motion.line)
+    if run is not None:
+        return run(program, machine)
+    return simulate_steps(program, machine)
 
 
 def _nominal_lines(program: Program) -> list[np.ndarray]:
@@ -317,9 +352,7 @@ def check_area(program: Program, machine: Machine) -> tuple[str, ...]:
 
 
 def block_times(trace: StepTrace, program: Program, machine: Machine) -> np.ndarray:
-    """Estimated time of each move, s (the machine's timing model)."""
-    from camtool.verify.clock import block_times_s
-
+    """Estimated time of each move, s (:func:`camtool.verify.clock.block_times_s`)."""
     return block_times_s(trace, program, machine)
 
 
@@ -411,9 +444,104 @@ def report_dict(v: Verification, plan: PlanReport | None = None) -> dict[str, An
     ``plan``, what planning found when the code was planned in the same run, goes
     under the ``plan`` key (:meth:`camtool.toolpath.plan.PlanReport.to_json`).
     """
-    from camtool.verify.report import build_report
-
     report = build_report(v)
     if plan is not None:
         report["plan"] = plan.to_json()
     return report
+
+
+def _um(value: float) -> float:
+    return round(float(value), 4) + 0.0  # + 0.0 turns a -0.0 into 0.0
+
+
+def _mm(value: float) -> float:
+    return round(float(value), 6) + 0.0
+
+
+def build_report(v: Verification) -> dict[str, Any]:
+    """The report of a verification (see the module docstring for the keys)."""
+    t = v.trace
+    steps = t.block_steps.sum(axis=0) if len(t.block_steps) else np.zeros(3, dtype=np.int64)
+    comp_rows = t.rows[t.compensation]
+    dev = v.deviation
+    at = None
+    if dev.block >= 0:
+        at = {
+            "x_mm": _mm(dev.at_mm[0]),
+            "y_mm": _mm(dev.at_mm[1]),
+            "block": dev.block + 1,
+            "line": v.program.line_of(dev.block),
+        }
+    report: dict[str, Any] = {
+        "camtool": __version__,
+        "target": v.target,
+        "machine": v.machine.name,
+        "blocks": len(v.program.moves),
+        "steps": {"x": int(steps[0]), "y": int(steps[1]), "z": int(steps[2])},
+        "iterations": int((~t.compensation).sum()),
+        "compensation_steps": {
+            "x": int(np.abs(comp_rows[:, 0]).sum()),
+            "y": int(np.abs(comp_rows[:, 1]).sum()),
+        },
+        "reversals": {"x": t.reversals[0], "y": t.reversals[1]},
+        "compensations": t.compensations,
+        "deviation_um": {"max": _um(dev.max_um), "rms": _um(dev.rms_um), "at": at},
+        "closure_um": [
+            _um(math.hypot(*c.closure_um)) for c in v.contours if c.closure_um is not None
+        ],
+        "size_error_um": [[_um(c.size_error_um[0]), _um(c.size_error_um[1])] for c in v.contours],
+        "contours": [_contour(c) for c in v.contours],
+        "against": None,
+        "not_cut_as_drawn": [],
+        "against_skipped": v.against_skipped,
+        "max_error_um": _um(v.max_error_um),
+        "strict_error_um": _um(v.strict_error_um),
+        "time_s": round(v.time_s, 3),
+        "warnings": list(v.warnings),
+    }
+    if v.against is not None:
+        a = v.against
+        report["against"] = {
+            "max_um": _um(a.max_um),
+            "rms_um": _um(a.rms_um),
+            "at": {"x_mm": _mm(a.at_mm[0]), "y_mm": _mm(a.at_mm[1])},
+            "overcut_um": _um(a.overcut_um),
+            "samples": a.samples,
+        }
+        report["not_cut_as_drawn"] = [
+            {
+                "kind": f.kind,
+                "label": f.label,
+                "at": {"x_mm": _mm(f.at[0]), "y_mm": _mm(f.at[1])},
+                "error_um": _um(f.error_um),
+                "samples": f.samples,
+                "value": None if f.value is None else _mm(f.value),
+            }
+            for f in a.not_cut
+        ]
+    return report
+
+
+def _contour(c: ContourMeasure) -> dict[str, Any]:
+    out: dict[str, Any] = {
+        "number": c.number,
+        "blocks": [c.blocks[0] + 1, c.blocks[1] + 1],
+        "closed": c.closed,
+        "closure_um": None,
+        "size_um": [_um(c.size_um[0]), _um(c.size_um[1])],
+        "size_error_um": [_um(c.size_error_um[0]), _um(c.size_error_um[1])],
+        "circle": None,
+    }
+    if c.closure_um is not None:
+        dx, dy = c.closure_um
+        out["closure_um"] = {"dx": _um(dx), "dy": _um(dy), "gap": _um(math.hypot(dx, dy))}
+    if c.circle is not None:
+        nominal, fitted, horizontal, vertical = c.circle
+        out["circle"] = {
+            "nominal_diameter_mm": _mm(nominal),
+            "fitted_diameter_mm": _mm(fitted),
+            "diameter_error_um": _um((fitted - nominal) * 1000.0),
+            "horizontal_mm": _mm(horizontal),
+            "vertical_mm": _mm(vertical),
+        }
+    return out

@@ -20,7 +20,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
 from camtool.verify import interpolators as itp
-from camtool.verify.interpolators_arc import dsm_arc_reference
+from camtool.verify.interpolators import dsm_arc_reference
 
 TOTAL = 10_000_000
 """Iterations simulated per interpolator (at least)."""

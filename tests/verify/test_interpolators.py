@@ -29,18 +29,13 @@ from camtool.verify.interpolators import (
     dda_line,
     dda_line_reference,
     dsm_arc,
-    flashcut_arc_points,
-    grbl_arc_points,
-    grbl_arc_segments,
+    dsm_arc_reference,
     polyline_steps,
     segments_for_sagitta,
     staircase_arc,
-    steps_from_mm,
-    valcnc_arc_points,
 )
-from camtool.verify.interpolators_arc import dsm_arc_reference
+from camtool.verify.quantize import steps_from_mm
 from camtool.verify.steparray import positions
-from camtool.verify.timing import flashcut_line_steps, timer_period_ms
 
 LINES = [dda_line, dda_line_reference, accumulator_dda_line, accumulator_dda_reference,
          bresenham_line, bresenham_reference, corte_recto_line, corte_recto_reference]  # fmt: skip
@@ -464,89 +459,6 @@ def test_arc_rejects_bad_input(arc):
 # --------------------------------------------------------------------------- chord arcs
 
 
-def test_grbl_segment_count_formula():
-    # GRBL 1.1 motion_control.c: floor(|½·θ·r| / √(tol·(2r − tol))); r = 10 mm full
-    # circle at the default $12 = 0.002 mm
-    expected = math.floor(0.5 * 2 * math.pi * 10 / math.sqrt(0.002 * (20 - 0.002)))
-    assert grbl_arc_segments(10.0, -2 * math.pi, 0.002) == expected == 157
-
-
-def test_grbl_arc_points_geometry():
-    pts = grbl_arc_points((10.0, 0.0), (0.0, 10.0), (0.0, 0.0), False)
-    n = grbl_arc_segments(10.0, math.pi / 2, 0.002)
-    assert pts.shape == (n, 2) and not pts.flags.writeable
-    assert tuple(pts[-1]) == (0.0, 10.0)  # GRBL: last segment goes to the target
-    # analytic: points on the circle (GRBL's 3rd-order rotation drifts far below 1 µm)
-    assert np.abs(np.hypot(pts[:, 0], pts[:, 1]) - 10.0).max() < 1e-4
-    # analytic: CCW quarter from +X to +Y stays in the first quadrant, angle increasing
-    assert np.all(np.diff(np.arctan2(pts[:, 1], pts[:, 0])) > 0)
-    # analytic: chord error ≈ c²/8r grows with the square of the chord; floor() makes
-    # chords at most (n+1)/n longer than the tolerance chord
-    chords = np.diff(np.vstack(([[10.0, 0.0]], pts)), axis=0)
-    beta = 2 * np.arcsin(np.hypot(chords[:, 0], chords[:, 1]) / 20.0)
-    assert max(chord_sagitta(10.0, b) for b in beta) <= 0.002 * ((n + 1) / n) ** 2 + 1e-9
-
-
-def test_grbl_full_circle_and_invalid_target():
-    # GRBL: start == end is a full circle (angular travel −2π for G02)
-    pts = grbl_arc_points((5.0, 0.0), (5.0, 0.0), (0.0, 0.0), True)
-    assert len(pts) == grbl_arc_segments(5.0, 2 * math.pi, 0.002)
-    assert pts[len(pts) // 4, 1] < 0  # G02 from +X goes through −Y first
-    # GRBL gcode.c: end radius off by > 0.005 mm and > 0.1 % of r → error 33
-    with pytest.raises(InputError):
-        grbl_arc_points((5.0, 0.0), (0.0, 5.1), (0.0, 0.0), True)
-    with pytest.raises(UsageError):
-        grbl_arc_points((5.0, 0.0), (0.0, 5.0), (0.0, 0.0), True, arc_tolerance_mm=0.0)
-
-
-def test_flashcut_arc_points_r2_examples():
-    # seed-001 §10 R2: G01 X1.0 Y1.0 then G02 X3.0 Y3.0 I1.0 J1.0 → centre (2, 2),
-    # r = √2, CW sweep −180°, passing through (2 − √2, 2)
-    # (45° of sweep from the start at −135°, i.e. the first of four chords)
-    pts = flashcut_arc_points((1.0, 1.0), (3.0, 3.0), (2.0, 2.0), True, segments=4)
-    assert pts[0] == pytest.approx((2 - math.sqrt(2), 2.0))
-    assert pts[-1] == pytest.approx((3.0, 3.0))
-    # seed-001 §10 R2: G01 X2.0 Y1.0 then G03 X0.0 Y3.0 I-1.0 J1.0 → centre (1, 2),
-    # CCW +180°, passing through (1 + √2, 2)
-    pts = flashcut_arc_points((2.0, 1.0), (0.0, 3.0), (1.0, 2.0), False, segments=4)
-    assert pts[0] == pytest.approx((1 + math.sqrt(2), 2.0))
-
-
-def test_flashcut_full_circle_assumption():
-    # seed-001 §4.4 (reconstructed routine): start == end is taken as a full circle
-    pts = flashcut_arc_points((1.0, 0.0), (1.0, 0.0), (0.0, 0.0), True, segments=4)
-    assert pts == pytest.approx(np.array([[0, -1], [-1, 0], [0, 1], [1, 0]]), abs=1e-12)
-    with pytest.raises(UsageError):
-        flashcut_arc_points((1.0, 0.0), (1.0, 0.0), (0.0, 0.0), True, segments=0)
-
-
-def test_valcnc_arc_points():
-    # seed-004 §4.2: θ0 = atan2(−j, −i); α = 2·asin(C/2R); G02 subtracts β, G03 adds it
-    beta = math.radians(10)
-    pts = valcnc_arc_points((10.0, 0.0), (0.0, 10.0), (0.0, 0.0), False, beta_rad=beta)
-    assert len(pts) == 9  # 90° in 10° chords: 8 interior points + the end
-    assert pts[0] == pytest.approx((10 * math.cos(beta), 10 * math.sin(beta)))
-    assert tuple(pts[-1]) == (0.0, 10.0)
-    # seed-004 §4.2 Consideración 2: the same end point clockwise is a reflex 270° sweep
-    assert len(valcnc_arc_points((10.0, 0.0), (0.0, 10.0), (0.0, 0.0), True, beta_rad=beta)) == 27
-    # seed-004 §4.2 pitfall: start == end gives C = 0, α = 0, nothing moves
-    full = valcnc_arc_points((10.0, 0.0), (10.0, 0.0), (0.0, 0.0), True, beta_rad=beta)
-    assert full.tolist() == [[10.0, 0.0]]
-
-
-def test_valcnc_quarter_arc_through_the_line_dda():
-    # seed-004 §8 S004-R12: quarter arc R = 10 mm, β for sagitta ≤ 0.02 mm, chords run
-    # by the line DDA at 0.04 mm/step stay within 0.02 + 0.04 mm of the true circle
-    n = segments_for_sagitta(10.0, math.pi / 2, 0.02)
-    beta = (math.pi / 2) / n
-    assert chord_sagitta(10.0, beta) <= 0.02
-    pts = valcnc_arc_points((10.0, 0.0), (0.0, 10.0), (0.0, 0.0), False, beta_rad=beta)
-    lattice = [[250, 0]] + [[steps_from_mm(x, 0.04), steps_from_mm(y, 0.04)] for x, y in pts]
-    steps = polyline_steps(np.array(lattice), accumulator_dda_line)
-    pos_mm = positions(steps, (250, 0)) * 0.04
-    assert np.abs(np.hypot(pos_mm[:, 0], pos_mm[:, 1]) - 10.0).max() <= 0.06
-
-
 def test_segments_for_sagitta():
     # analytic: the returned count meets the tolerance and one fewer does not
     n = segments_for_sagitta(5.0, math.pi, 0.01)
@@ -562,22 +474,3 @@ def test_polyline_steps_joins_lines():
     assert tuple(positions(steps)[-1]) == (13, 7)
     with pytest.raises(UsageError):
         polyline_steps(np.array([[0.0, 0.0], [1.0, 1.0]]))
-
-
-# ------------------------------------------------------------------ timer model, seed-001
-
-
-@pytest.mark.parametrize(("period", "y_steps"), [(20, 2763), (30, 2719), (40, 2697)])
-def test_flashcut_timer_model_table_3_8(period, y_steps):
-    # seed-001 §4.7 Table 3.8 / §10 R11: 10 × 5 mm line, theoretical 5263 × 2632 steps
-    assert flashcut_line_steps(5263, 2632, period) == y_steps
-
-
-def test_flashcut_timer_model_rules():
-    # seed-001 §4.7: "X differs by 1 ms" — dominant half-period P becomes P + 1
-    assert timer_period_ms(3) == 4
-    assert timer_period_ms(39.99) == 40  # non-dominant 2P − ε fires at 2P
-    assert flashcut_line_steps(5263, 5263, 20) == 5263  # analytic: equal counts, same period
-    assert flashcut_line_steps(5263, 0, 20) == 0
-    with pytest.raises(UsageError):
-        flashcut_line_steps(10, 11, 20)

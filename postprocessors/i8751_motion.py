@@ -1,4 +1,7 @@
-"""Time model of the seed-003 8751 stepper interface (``i8751``): a delay-loop speed ramp.
+"""Motion model of the seed-003 8751 stepper interface (``i8751``): a delay-loop speed ramp.
+
+Its line is the generic "corte recto" (:func:`camtool.verify.interpolators.corte_recto_line`,
+``corte-recto``); what is the 8751's own is its time model, ``i8751`` (:class:`I8751Timing`).
 
 seed-003 §4.4 (R12): each step is followed by a software delay loop whose
 length is set by the register X (RAM 28H)::
@@ -37,7 +40,8 @@ import numpy as np
 import numpy.typing as npt
 
 from camtool.model.errors import UsageError
-from camtool.verify.timing_blocks import (
+from camtool.verify.motion import MotionHooks, timing_class
+from camtool.verify.timing import (
     BlockKinematics,
     FloatArray,
     counts,
@@ -222,3 +226,7 @@ class I8751Timing:
             wait_t1_s=self.wait_t1_s,
             wait_t2_s=self.wait_t2_s,
         )
+
+
+MOTION = MotionHooks(timing={"i8751": timing_class(I8751Timing)})
+"""What ``i8751`` adds to the verifier: its ramp timing model."""

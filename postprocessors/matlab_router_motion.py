@@ -1,4 +1,4 @@
-"""Run a program on the seed-002 DC-servo router: one servo simulation per stroke.
+"""Motion model of the seed-002 DC-servo router (``matlab-router``): its ``servo`` simulator.
 
 The router has no coordinated interpolator (seed-002 §4): each stroke is a job
 of straight segments between vertices in whole 0.1 mm, every axis at its own
@@ -6,7 +6,7 @@ pre-scaled speed, moves floored to 0.2 mm chunks, a stop at every vertex
 (:func:`camtool.verify.servo.simulate_job`). Here a program is cut into strokes
 at its rapids; arcs (which the router's dialect never writes) become chords
 within ``[motion] chord_tolerance_mm``. The result has the shape of a
-:class:`~camtool.verify.simulate.StepTrace` so that the same measures apply: one
+:class:`~camtool.verify.motion.StepTrace` so that the same measures apply: one
 "row" per 5 ms servo sample (no motor steps: ``rows`` are zeros, ``iterations``
 counts samples), positions from the simulated encoders.
 
@@ -18,13 +18,15 @@ its rapid is timed as that dog-leg (R13).
 from __future__ import annotations
 
 import numpy as np
+from camtool_postprocessors.matlab_router_motion_servo import RouterMachine, simulate_job
 
 from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Move, Program
 from camtool.model.shapes import distance
 from camtool.post.router_arrays import points_01mm
-from camtool.verify.servo import RouterMachine, simulate_job
-from camtool.verify.simulate import StepTrace, sagitta_chord_points
+from camtool.verify.interpolators import sagitta_chord_points
+from camtool.verify.metrics import contour_runs
+from camtool.verify.motion import MotionHooks, StepTrace
 from camtool.verify.steparray import STEP_DTYPE, read_only
 
 
@@ -97,8 +99,6 @@ def simulate_servo(program: Program, machine: Machine) -> StepTrace:
 
 def _strokes(program: Program) -> list[tuple[int, int]]:
     """``(first, last)`` indices of the runs of cutting moves."""
-    from camtool.verify.metrics import contour_runs
-
     return contour_runs(program)
 
 
@@ -119,3 +119,7 @@ def _vertices(
                 owner.append(index)
         here = (move.x, move.y)
     return vertices, owner
+
+
+MOTION = MotionHooks(simulators={"servo": simulate_servo})
+"""What ``matlab-router`` adds to the verifier: the ``servo`` line, a whole simulator."""

@@ -1,0 +1,338 @@
+"""Motion models: what a simulator produces, the pieces a target adds, and name lookup.
+
+Every simulator produces a :class:`StepTrace` (the step simulator of
+:mod:`camtool.verify.simulate`, or a target's own), which the measures read.
+
+A machine profile names its motion model in ``[machine.motion]`` (``line``,
+``arc``, ``chords``) and ``[machine.timing]`` (``model``). Each name is looked
+up first in the generic library (:data:`GENERIC`: the algorithms of
+:mod:`camtool.verify.interpolators` and :mod:`camtool.verify.timing`, named by
+algorithm), then in the ``MOTION`` of every installed target
+(:func:`camtool.post.registry.motion_hooks`), so any profile may use a piece any
+target brings. A target adds pieces with a :class:`MotionHooks`; the verifier
+itself names no machine.
+
+Piece types (all pure; lengths mm, steps integer motor steps, Y up):
+
+- :data:`LineFactory`: ``machine -> (dx, dy) -> StepArray``. The factory gets the
+  profile so that a line that needs parameters (a timer period) can read them;
+  :func:`fixed_line` wraps a plain interpolator.
+- :data:`ArcInterpolator`: ``(x0, y0, x1, y1, cx, cy, clockwise) -> StepArray``,
+  absolute steps, ``clockwise`` is G02.
+- :data:`ChordRule`: ``(start_mm, arc move, motion parameters) -> (N, 2)`` chord
+  end points in mm (the start not included, the last normally the arc's end);
+  used when a profile says ``arc = "chords"``.
+- :data:`TimingFactory`: ``(timing table, machine or None, where) -> TimingModel``;
+  the machine lets a model take defaults from the profile (steps/mm, step-rate
+  cap) that the table does not state; :func:`timing_class` wraps a plain
+  parameter dataclass.
+- :data:`Simulator`: ``(program, machine) -> StepTrace``, a whole simulator that
+  replaces the step simulator for a ``line`` name (a servo loop, say).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Any, TypeVar
+
+import numpy as np
+import numpy.typing as npt
+
+from camtool.model.errors import InputError
+from camtool.model.machine import Machine, Motion
+from camtool.model.program import ArcMove, Program
+from camtool.model.shapes import Point
+from camtool.verify.interpolators import (
+    accumulator_dda_line,
+    bresenham_line,
+    circular_dda_arc,
+    corte_recto_line,
+    dda_line,
+    dsm_arc,
+    sagitta_chord_points,
+    staircase_arc,
+)
+from camtool.verify.steparray import StepArray
+from camtool.verify.timing import TimingModel, TrapezoidTiming, timing_from_table
+
+IntArray = npt.NDArray[np.int64]
+FloatArray = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True, eq=False)
+class StepTrace:
+    """What the motors and the carriage did, row by row.
+
+    Attributes:
+        rows: ``(N, 2) int8`` motor steps per iteration, compensation included.
+        compensation: ``(N,) bool``, True for a backlash-compensation row.
+        block_of_row: ``(N,) int64``, index of the program move each row belongs to.
+        block_start: ``(B + 1,) int64`` row offsets: move ``b`` owns rows
+            ``block_start[b]:block_start[b + 1]``.
+        carriage_mm: ``(N, 2) float64``, carriage (tool-centre) position after each
+            row, mm, machine coordinates.
+        start_mm: carriage position before the first row, mm.
+        logical_end: ``(B, 2) int64``, the controller's logical position after each
+            move, steps.
+        block_steps: ``(B, 3) int64``, motor steps (pulses) per move and axis, without
+            compensation: ``(x, y, z)``.
+        block_dominant: ``(B,) int64``, steps of the dominant axis of each executed line
+            (summed over the chords of a chord arc; iterations for a native arc), what
+            per-step time models count (seed-001 R15).
+        block_compensation: ``(B,) int64``, compensation steps inserted in each move.
+        reversals: reversals of the commanded X and Y directions.
+        compensations: compensation events (axis reversals the controller
+            compensated; 0 when the profile compensates nothing).
+        block_time_s: ``(B,) float64`` time of each move when the simulation itself
+            gives it (a target's own simulator), else ``None`` (the timing model decides).
+    """
+
+    rows: StepArray
+    compensation: npt.NDArray[np.bool_]
+    block_of_row: IntArray
+    block_start: IntArray
+    carriage_mm: FloatArray
+    start_mm: Point
+    logical_end: IntArray
+    block_steps: IntArray
+    block_dominant: IntArray
+    block_compensation: IntArray
+    reversals: tuple[int, int]
+    compensations: int
+    block_time_s: FloatArray | None = None
+
+
+LineInterpolator = Callable[[int, int], StepArray]
+"""``(dx, dy)`` signed steps → step array ``(N, 2) int8``."""
+LineFactory = Callable[[Machine], LineInterpolator]
+"""A line interpolator made for one machine profile (may read its parameters).
+
+Raises:
+    UsageError or InputError: the profile lacks what the interpolator needs.
+"""
+ArcInterpolator = Callable[[int, int, int, int, int, int, bool], StepArray]
+"""``(x0, y0, x1, y1, cx, cy, clockwise)`` absolute steps → step array ending at ``(x1, y1)``."""
+ChordRule = Callable[[Point, ArcMove, Motion], "npt.ArrayLike"]
+"""``(start_mm, move, motion)`` → chord end points ``(N, 2)`` mm, start excluded.
+
+``motion`` carries the profile's chord parameters (``chord_tolerance_mm``,
+``chord_segments``, ``chord_angle_deg``)."""
+TimingFactory = Callable[[Mapping[str, Any], "Machine | None", str], TimingModel]
+"""``(table, machine, where)`` → timing model; raises InputError naming ``where``."""
+Simulator = Callable[[Program, Machine], StepTrace]
+"""``(program, machine)`` → the trace the verifier measures (replaces the step simulator)."""
+
+CHORDS = "chords"
+"""The ``arc`` name that cuts arcs into chords (by the ``chords`` rule) run as lines."""
+
+T = TypeVar("T")
+
+
+def _frozen(mapping: Mapping[str, T] | None = None) -> Mapping[str, T]:
+    return MappingProxyType(dict(mapping or {}))
+
+
+@dataclass(frozen=True, kw_only=True)
+class MotionHooks:
+    """Named pieces a target (or the generic library) adds to the verifier.
+
+    A target's module ``<stem>_motion`` defines ``MOTION = MotionHooks(...)``; a
+    profile then names a piece by its key. Every mapping is read-only.
+
+    Attributes:
+        lines: ``line`` name → :data:`LineFactory`.
+        arcs: ``arc`` name → :data:`ArcInterpolator` (``"chords"`` is reserved).
+        chords: ``chords`` name → :data:`ChordRule`.
+        timing: ``[machine.timing] model`` name → :data:`TimingFactory`.
+        simulators: ``line`` name → :data:`Simulator` run instead of the step
+            simulator.
+    """
+
+    lines: Mapping[str, LineFactory] = field(default_factory=_frozen)
+    arcs: Mapping[str, ArcInterpolator] = field(default_factory=_frozen)
+    chords: Mapping[str, ChordRule] = field(default_factory=_frozen)
+    timing: Mapping[str, TimingFactory] = field(default_factory=_frozen)
+    simulators: Mapping[str, Simulator] = field(default_factory=_frozen)
+
+    def __post_init__(self) -> None:
+        for name in ("lines", "arcs", "chords", "timing", "simulators"):
+            object.__setattr__(self, name, _frozen(getattr(self, name)))
+
+
+def fixed_line(line: LineInterpolator) -> LineFactory:
+    """A :data:`LineFactory` for an interpolator that needs no profile parameter."""
+
+    def factory(machine: Machine) -> LineInterpolator:
+        return line
+
+    return factory
+
+
+def timing_class(cls: type[Any]) -> TimingFactory:
+    """A :data:`TimingFactory` building the parameter dataclass ``cls`` from the table alone.
+
+    See :func:`camtool.verify.timing.timing_from_table` for the accepted keys.
+    """
+
+    def factory(table: Mapping[str, Any], machine: Machine | None, where: str) -> TimingModel:
+        model: TimingModel = timing_from_table(cls, table, where=where)
+        return model
+
+    return factory
+
+
+def _sagitta(start: Point, move: ArcMove, motion: Motion) -> npt.ArrayLike:
+    return sagitta_chord_points(start, move, motion.chord_tolerance_mm)
+
+
+GENERIC = MotionHooks(
+    lines={
+        "dda": fixed_line(dda_line),
+        "accumulator-dda": fixed_line(accumulator_dda_line),
+        "bresenham": fixed_line(bresenham_line),
+        "corte-recto": fixed_line(corte_recto_line),
+    },
+    arcs={"dsm": dsm_arc, "staircase": staircase_arc, "circular-dda": circular_dda_arc},
+    chords={"sagitta": _sagitta},
+    timing={"trapezoid": timing_class(TrapezoidTiming)},
+)
+"""The generic library, named by algorithm (:mod:`camtool.verify.interpolators`,
+:mod:`camtool.verify.timing`)."""
+
+
+@dataclass(frozen=True)
+class Library:
+    """The pieces a profile may name: the generic library, then every target's ``MOTION``.
+
+    Attributes:
+        sources: :data:`GENERIC` first, then each installed target's hooks; the
+            first source that has a name wins.
+    """
+
+    sources: tuple[MotionHooks, ...]
+
+    def _find(
+        self, pick: Callable[[MotionHooks], Mapping[str, T]], name: str, what: str, where: str
+    ) -> T:
+        for hooks in self.sources:
+            table = pick(hooks)
+            if name in table:
+                return table[name]
+        raise InputError(f"{where}: unknown {what} {name!r}; valid: {', '.join(self.names(pick))}")
+
+    def names(self, pick: Callable[[MotionHooks], Mapping[str, Any]]) -> list[str]:
+        """Every name of one kind of piece, in lookup order (``pick`` selects the kind)."""
+        return list(dict.fromkeys(key for hooks in self.sources for key in pick(hooks)))
+
+    def simulator(self, line: str) -> Simulator | None:
+        """The whole simulator a ``line`` name selects, or ``None`` for the step simulator."""
+        for hooks in self.sources:
+            if line in hooks.simulators:
+                return hooks.simulators[line]
+        return None
+
+    def line(self, machine: Machine) -> LineInterpolator:
+        """The line interpolator of ``machine``'s ``[machine.motion] line``.
+
+        Raises:
+            InputError: an unknown name (the message lists the valid ones).
+            UsageError: the profile lacks a parameter the interpolator needs.
+        """
+        name = machine.motion.line
+        for hooks in self.sources:
+            if name in hooks.lines:
+                return hooks.lines[name](machine)
+        valid = self.names(lambda h: {**h.lines, **h.simulators})
+        raise InputError(
+            f"{_where(machine, 'motion')}: unknown line interpolator {name!r}; "
+            f"valid: {', '.join(valid)}"
+        )
+
+    def arc(self, machine: Machine) -> ArcInterpolator | None:
+        """The arc interpolator of ``machine``, or ``None`` for ``arc = "chords"``.
+
+        Raises:
+            InputError: an unknown name (the message lists the valid ones).
+        """
+        name = machine.motion.arc
+        if name == CHORDS:
+            return None
+        for hooks in self.sources:
+            if name in hooks.arcs:
+                return hooks.arcs[name]
+        valid = [*self.names(lambda h: h.arcs), CHORDS]
+        raise InputError(
+            f"{_where(machine, 'motion')}: unknown arc interpolator {name!r}; "
+            f"valid: {', '.join(valid)}"
+        )
+
+    def chord_rule(self, machine: Machine) -> ChordRule:
+        """The chord rule of ``machine``'s ``[machine.motion] chords``.
+
+        Raises:
+            InputError: an unknown name (the message lists the valid ones).
+        """
+        where = _where(machine, "motion")
+        return self._find(lambda h: h.chords, machine.motion.chords, "chord rule", where)
+
+    def timing(
+        self, table: Mapping[str, Any], *, where: str, machine: Machine | None = None
+    ) -> TimingModel:
+        """The timing model a ``[machine.timing]`` table names, with its parameters.
+
+        Raises:
+            InputError: an unknown model or key, or a bad value, naming ``where``.
+        """
+        name = table.get("model")
+        if not isinstance(name, str):
+            valid = ", ".join(self.names(lambda h: h.timing))
+            raise InputError(f"{where}: unknown timing model {name!r}; valid: {valid}")
+        factory = self._find(lambda h: h.timing, name, "timing model", where)
+        return factory(table, machine, where)
+
+    def check(self, machine: Machine) -> None:
+        """Resolve every name ``machine`` uses (not the timing table).
+
+        Raises:
+            InputError: the first unknown name, listing the valid ones.
+        """
+        if self.simulator(machine.motion.line) is None:
+            self.line(machine)
+        if self.arc(machine) is None:
+            self.chord_rule(machine)
+
+
+def _where(machine: Machine, table: str) -> str:
+    return f"machine {machine.name!r} [machine.{table}]"
+
+
+def library() -> Library:
+    """The generic library and every installed target's ``MOTION``, looked up now.
+
+    Targets' modules are imported on the first call
+    (:func:`camtool.post.registry.motion_hooks`); a ``MOTION`` that is not a
+    :class:`MotionHooks` is ignored.
+    """
+    from camtool.post.registry import motion_hooks
+
+    installed = tuple(h for _, h in motion_hooks() if isinstance(h, MotionHooks))
+    return Library((GENERIC, *installed))
+
+
+def timing_model_from_table(
+    table: Mapping[str, Any], *, where: str, machine: Machine | None = None
+) -> TimingModel:
+    """Build the timing model a TOML ``[timing]`` table names (:meth:`Library.timing`).
+
+    The table holds ``model`` (a name of the generic library or of a target's
+    ``MOTION.timing``) and that model's parameters, e.g. ``model = "trapezoid"``
+    and ``acceleration_mm_s2 = 500``. ``machine``, when given, lets the model take
+    defaults from the profile.
+
+    Raises:
+        InputError: An unknown model or key, or a value of the wrong type or
+            out of range, naming ``where`` and the valid choices.
+    """
+    return library().timing(table, where=where, machine=machine)

@@ -1,0 +1,107 @@
+"""Tests of the seed-004 valcnc motion model: timing and β chords
+(camtool_postprocessors.valcnc_motion).
+
+Every expected value names its source: a section/requirement of
+../shared/reference/seed-00N.md, or "analytic" for a property of the model's formula.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from camtool_postprocessors.valcnc_motion import (
+    ValcncTiming,
+    serial_time_s,
+    valcnc_arc_points,
+    valcnc_block_time_s,
+)
+
+from camtool.verify.interpolators import (
+    accumulator_dda_line,
+    chord_sagitta,
+    polyline_steps,
+    segments_for_sagitta,
+)
+from camtool.verify.quantize import steps_from_mm
+from camtool.verify.steparray import positions
+from camtool.verify.timing import BlockKinematics
+
+FALSE = np.array([False])
+TRUE = np.array([True])
+
+
+def assert_seconds(t: np.ndarray, b: int) -> None:
+    assert t.dtype == np.float64 and t.shape == (b,)
+    assert not t.flags.writeable
+
+
+def blocks() -> BlockKinematics:
+    return BlockKinematics.build(
+        dominant_steps=[100, 2000, 0],
+        is_rapid=[False, True, False],
+        feed_mm_min=[0.8, 0.0, 0.0],
+        length_mm=[0.5, 3.0, 0.0],
+        iterations=[120, 2000, 0],
+        steps=[[100, -40, 0], [-2000, 300, 0], [0, 0, -250]],
+        compensation_steps=[1457, 0, 0],
+    )
+
+
+def test_model_calls_its_function():
+    # the timing model's dataclass runs its block-time function (was parametrized in
+    # tests/verify/test_timing.py::test_models_call_their_functions)
+    model, direct = ValcncTiming(), lambda b: valcnc_block_time_s(b.iterations)
+    b = blocks()
+    t = model.block_time_s(b)
+    assert_seconds(t, 3)
+    assert np.array_equal(t, direct(b))
+
+
+def test_valcnc_ten_mm_is_41_7_ms():
+    # seed-004 S004-R13: 10 mm at 25 steps/mm = 250 steps = 41.7 ms, and the 10×10
+    # diagonal (250 accumulator-DDA iterations) takes the same time
+    n = steps_from_mm(10.0, 0.04)
+    iterations = [len(accumulator_dda_line(n, 0)), len(accumulator_dda_line(n, n))]
+    t = valcnc_block_time_s(iterations)
+    assert_seconds(t, 2)
+    assert t == pytest.approx([0.0417, 0.0417], abs=5e-5)
+
+
+def test_valcnc_serial_time_at_9600_baud():
+    # seed-004 S004-R13: ≈ 1.04 ms per byte at 9600 baud; a 27-byte block ≈ 28 ms
+    assert float(serial_time_s([1], baud=9600)[0]) == pytest.approx(1.04e-3, abs=5e-6)
+    t = valcnc_block_time_s([25], block_bytes=[27], serial_baud=9600)
+    assert float(t[0]) == pytest.approx(27 * 10 / 9600 + 25 * 166.667e-6)
+    assert float(valcnc_block_time_s([25], block_bytes=[27])[0]) == pytest.approx(25 * 166.667e-6)
+
+
+# ------------------------------------------------------------------------ chords
+
+
+def test_valcnc_arc_points():
+    # seed-004 §4.2: θ0 = atan2(−j, −i); α = 2·asin(C/2R); G02 subtracts β, G03 adds it
+    beta = math.radians(10)
+    pts = valcnc_arc_points((10.0, 0.0), (0.0, 10.0), (0.0, 0.0), False, beta_rad=beta)
+    assert len(pts) == 9  # 90° in 10° chords: 8 interior points + the end
+    assert pts[0] == pytest.approx((10 * math.cos(beta), 10 * math.sin(beta)))
+    assert tuple(pts[-1]) == (0.0, 10.0)
+    # seed-004 §4.2 Consideración 2: the same end point clockwise is a reflex 270° sweep
+    assert len(valcnc_arc_points((10.0, 0.0), (0.0, 10.0), (0.0, 0.0), True, beta_rad=beta)) == 27
+    # seed-004 §4.2 pitfall: start == end gives C = 0, α = 0, nothing moves
+    full = valcnc_arc_points((10.0, 0.0), (10.0, 0.0), (0.0, 0.0), True, beta_rad=beta)
+    assert full.tolist() == [[10.0, 0.0]]
+
+
+def test_valcnc_quarter_arc_through_the_line_dda():
+    # seed-004 §8 S004-R12: quarter arc R = 10 mm, β for sagitta ≤ 0.02 mm, chords run
+    # by the line DDA at 0.04 mm/step stay within 0.02 + 0.04 mm of the true circle
+    n = segments_for_sagitta(10.0, math.pi / 2, 0.02)
+    beta = (math.pi / 2) / n
+    assert chord_sagitta(10.0, beta) <= 0.02
+    pts = valcnc_arc_points((10.0, 0.0), (0.0, 10.0), (0.0, 0.0), False, beta_rad=beta)
+    lattice = [[250, 0]] + [[steps_from_mm(x, 0.04), steps_from_mm(y, 0.04)] for x, y in pts]
+    steps = polyline_steps(np.array(lattice), accumulator_dda_line)
+    pos_mm = positions(steps, (250, 0)) * 0.04
+    assert np.abs(np.hypot(pos_mm[:, 0], pos_mm[:, 1]) - 10.0).max() <= 0.06
