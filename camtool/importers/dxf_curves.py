@@ -18,7 +18,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from camtool.geometry.arcfit import fit_curve
-from camtool.model.errors import ToolpathError
+from camtool.model.errors import GeometryError
 from camtool.model.shapes import TAU, Arc, Line, Point, Segment, distance
 
 _RELATIVE = 1e-9  # times the size: a z spread that is still planar, ends that coincide
@@ -229,7 +229,7 @@ def _fit(
 
         try:
             segs.extend(fit_curve(point_at, tangent, a, b, tolerance))
-        except ToolpathError as exc:
+        except GeometryError as exc:
             raise Unsupported("curve could not be fitted", str(exc)) from exc
     if not segs:
         raise Unsupported("zero length")

@@ -32,12 +32,12 @@ from typing import Any
 
 import svgelements as se
 
-from camtool.geometry.fitgeom import check_tolerance
+from camtool.geometry.arcfit import check_tolerance
 from camtool.importers import ImportOptions
 from camtool.importers.svgcurves import Affine, affine_of, compose, convert
 from camtool.importers.svgdoc import Prepared, prepare
 from camtool.importers.svgtree import LAYER_ATTR, SOURCE_ATTR, USE_ATTR
-from camtool.model.errors import InputError, ToolpathError
+from camtool.model.errors import GeometryError, InputError
 from camtool.model.shapes import Contour, Drawing
 
 DEFAULT_LAYER = "0"
@@ -136,7 +136,7 @@ def _contours(path: Path, shape: Any, page: Affine, tolerance: float) -> list[Co
     m = compose(page, affine_of(shape.transform))
     try:
         subpaths = convert(shape.segments(transformed=False), m, tolerance)
-    except (ToolpathError, InputError) as exc:
+    except (GeometryError, InputError) as exc:
         raise InputError(f"{path}: {label}: {exc}") from exc
     many = len(subpaths) > 1
     return [

@@ -89,7 +89,7 @@ def convert(segments: Iterable[Any], m: Affine, tolerance: float) -> list[Subpat
         ``(segments, closed)`` per subpath that draws something.
 
     Raises:
-        ToolpathError: a curve could not be fitted (from :func:`fit_curve`).
+        GeometryError: a curve could not be fitted (from :func:`fit_curve`).
         InputError: a point, control point or arc centre is NaN, infinite or beyond
             ±:data:`~camtool.importers.MAX_COORDINATE_MM` once mapped to mm (checked
             before any fitting, which would spin on a control point at 1e20).

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from camtool.cli.main import main
-from camtool.geometry.polyfit import fit_polyline
+from camtool.geometry.arcfit import fit_polyline
 from camtool.model.errors import InputError, ToolpathError, UsageError
 from camtool.model.shapes import MAX_CHORDS, Contour, Line, chord_count
 from camtool.toolpath import offset, pocket_uncut
