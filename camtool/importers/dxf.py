@@ -6,7 +6,7 @@ is counter-clockwise); ELLIPSE and SPLINE as biarcs within the tolerance
 nested blocks included (:mod:`camtool.importers.dxf_blocks`); HATCH boundary paths when
 asked (``hatch_boundaries``). Entities with an extrusion of (0, 0, −1) are mirrored into
 the WCS, which flips their arcs' direction. Each entity becomes one contour; chaining
-entities whose ends meet is the planner's job (:mod:`camtool.toolpath.chain`).
+entities whose ends meet is the planner's job (:mod:`camtool.geometry.chain`).
 
 ``$INSUNITS`` is converted to mm exactly; a unitless drawing is taken as mm with a
 warning. Everything else (text, dimensions, images, points, 3D entities, HATCH without

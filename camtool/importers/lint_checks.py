@@ -13,7 +13,7 @@ Each check works on any :class:`~camtool.model.shapes.Drawing` (mm, Y up) and re
 - ``zero-length`` and ``tiny-segment``: segments of no length, or shorter than the tiny
   limit (many tiny moves slow a controller down and can stall a step generator).
 
-Chaining is :func:`camtool.toolpath.chain.chain`, the planner's own, so an open contour
+Chaining is :func:`camtool.geometry.chain.chain`, the planner's own, so an open contour
 here is an open contour there.
 """
 
@@ -78,7 +78,7 @@ def check_drawing(
     Returns:
         ``(chained contours, findings)``; findings ordered by kind, then as found.
     """
-    from camtool.toolpath.chain import chain
+    from camtool.geometry.chain import chain
 
     tiny = TINY_FACTOR * tolerance if tiny_mm is None else tiny_mm
     chained = chain(drawing.contours, tolerance)
