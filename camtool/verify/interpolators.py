@@ -35,7 +35,6 @@ from camtool.verify.interpolators_chord import (
     flashcut_arc_points,
     grbl_arc_points,
     grbl_arc_segments,
-    segments_for_sagitta,
     valcnc_arc_points,
 )
 from camtool.verify.quantize import steps_from_mm
@@ -60,7 +59,6 @@ __all__ = [
     "grbl_arc_points",
     "grbl_arc_segments",
     "polyline_steps",
-    "segments_for_sagitta",
     "staircase_arc",
     "steps_from_mm",
     "valcnc_arc_points",

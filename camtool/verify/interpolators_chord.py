@@ -64,30 +64,6 @@ def chord_sagitta(radius_mm: float, angle_rad: float) -> float:
     return radius_mm * (1.0 - math.cos(abs(angle_rad) / 2.0))
 
 
-def segments_for_sagitta(radius_mm: float, sweep_rad: float, tolerance_mm: float) -> int:
-    """Fewest equal chords over ``sweep_rad`` whose sagitta is at most ``tolerance_mm``.
-
-    Args:
-        radius_mm: Radius, mm, ``> 0``.
-        sweep_rad: Swept angle, rad (sign ignored).
-        tolerance_mm: Largest chord error allowed, mm, ``> 0``.
-
-    Returns:
-        Segment count, ``>= 1``.
-
-    Raises:
-        UsageError: If ``radius_mm`` or ``tolerance_mm`` is not positive.
-    """
-    if not (radius_mm > 0 and tolerance_mm > 0):
-        raise UsageError(
-            f"radius and tolerance must be > 0 mm, got {radius_mm!r} and {tolerance_mm!r}"
-        )
-    if tolerance_mm >= radius_mm:
-        return 1
-    beta_max = 2.0 * math.acos(1.0 - tolerance_mm / radius_mm)
-    return max(1, math.ceil(abs(sweep_rad) / beta_max - 1e-12))
-
-
 # ------------------------------------------------------------------------------ GRBL
 
 
@@ -202,7 +178,7 @@ def flashcut_arc_points(
     notes). Points at ``a0 + k·sweep/n``, k = 1..n, on the radius from the start;
     the last one is not snapped to the programmed end (not stated). The thesis
     gives no point count ("un determinado número de puntos"), hence ``segments``
-    (see :func:`segments_for_sagitta` to derive it from a chord tolerance).
+    (see :func:`camtool.model.shapes.chord_count` to derive it from a chord tolerance).
 
     Args:
         start: Arc start, mm.

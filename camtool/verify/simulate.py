@@ -38,7 +38,7 @@ import numpy.typing as npt
 from camtool.model.errors import UsageError
 from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Move, Program
-from camtool.model.shapes import Point, distance
+from camtool.model.shapes import Point, chord_count, distance
 from camtool.verify.interpolators import (
     accumulator_dda_line,
     bresenham_line,
@@ -48,7 +48,6 @@ from camtool.verify.interpolators import (
     dsm_arc,
     flashcut_arc_points,
     grbl_arc_points,
-    segments_for_sagitta,
     staircase_arc,
     valcnc_arc_points,
 )
@@ -319,7 +318,7 @@ def sagitta_chord_points(start: Point, move: ArcMove, tolerance_mm: float) -> li
     sweep = sweep % turn or turn
     if distance(start, (move.x, move.y)) > 1e-9 and abs(abs(sweep) - math.tau) < 1e-12:
         sweep = 0.0
-    n = segments_for_sagitta(radius, sweep, tolerance_mm) if radius > 0 else 1
+    n = chord_count(radius, abs(sweep), tolerance_mm) if radius > 0 else 1
     points = [
         (cx + radius * math.cos(a0 + sweep * k / n), cy + radius * math.sin(a0 + sweep * k / n))
         for k in range(n + 1)

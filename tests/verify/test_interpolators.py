@@ -14,6 +14,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from camtool.model.errors import InputError, UsageError
+from camtool.model.shapes import chord_count
 from camtool.verify.interpolators import (
     accumulator_dda_line,
     accumulator_dda_reference,
@@ -33,7 +34,6 @@ from camtool.verify.interpolators import (
     grbl_arc_points,
     grbl_arc_segments,
     polyline_steps,
-    segments_for_sagitta,
     staircase_arc,
     steps_from_mm,
     valcnc_arc_points,
@@ -537,7 +537,7 @@ def test_valcnc_arc_points():
 def test_valcnc_quarter_arc_through_the_line_dda():
     # seed-004 §8 S004-R12: quarter arc R = 10 mm, β for sagitta ≤ 0.02 mm, chords run
     # by the line DDA at 0.04 mm/step stay within 0.02 + 0.04 mm of the true circle
-    n = segments_for_sagitta(10.0, math.pi / 2, 0.02)
+    n = chord_count(10.0, math.pi / 2, 0.02)
     beta = (math.pi / 2) / n
     assert chord_sagitta(10.0, beta) <= 0.02
     pts = valcnc_arc_points((10.0, 0.0), (0.0, 10.0), (0.0, 0.0), False, beta_rad=beta)
@@ -547,12 +547,12 @@ def test_valcnc_quarter_arc_through_the_line_dda():
     assert np.abs(np.hypot(pos_mm[:, 0], pos_mm[:, 1]) - 10.0).max() <= 0.06
 
 
-def test_segments_for_sagitta():
+def test_chord_count():
     # analytic: the returned count meets the tolerance and one fewer does not
-    n = segments_for_sagitta(5.0, math.pi, 0.01)
+    n = chord_count(5.0, math.pi, 0.01)
     assert chord_sagitta(5.0, math.pi / n) <= 0.01 < chord_sagitta(5.0, math.pi / (n - 1))
     with pytest.raises(UsageError):
-        segments_for_sagitta(5.0, math.pi, 0.0)
+        chord_count(5.0, math.pi, 0.0)
 
 
 def test_polyline_steps_joins_lines():
