@@ -272,7 +272,7 @@ def flashcut_arc_points(
     notes). Points at ``a0 + k·sweep/n``, k = 1..n, on the radius from the start;
     the last one is not snapped to the programmed end (not stated). The thesis
     gives no point count ("un determinado número de puntos"), hence ``segments``
-    (see :func:`camtool.verify.interpolators.segments_for_sagitta` to derive it
+    (see :func:`camtool.model.shapes.chord_count` to derive it
     from a chord tolerance).
 
     Args:

@@ -1,14 +1,15 @@
 """Arc fitting: smooth curves and dense polylines become arcs and lines within a tolerance.
 
 The one fitter the project shares. Importers fit SVG Béziers, DXF splines and ellipses with
-:func:`fit_curve`; the planner turns dense polylines (buffers, point lists) into G02/G03-ready
-arcs with :func:`fit_polyline`; :class:`FitStats` says how many segments a fit saved.
-:func:`fit_polyline` lives in :mod:`camtool.geometry.polyfit` and the shared distance
-functions in :mod:`camtool.geometry.fitgeom`; both are re-exported here.
+:func:`fit_curve` (biarcs); the planner turns dense polylines (buffers, point lists) into
+G02/G03-ready arcs with :func:`fit_polyline` (least-squares circles); :class:`FitStats` says
+how many segments a fit saved. Both fitters check their output with the same exact distance
+functions (:func:`distances`, :func:`dist_line`, :func:`dist_arc`, ...), kept here with them.
 
-Conventions: mm, Y up, arcs exact (``clockwise=True`` is G02). A tolerance is a distance in
-mm checked both ways: every input point lies within it of the output and every output point
-lies within it of the input. Consecutive output segments share end points bit for bit.
+Conventions: mm, Y up, arcs exact (``clockwise=True`` is G02); arrays of points are ``(N, 2)``
+float64. A tolerance is a distance in mm checked both ways: every input point lies within it
+of the output and every output point lies within it of the input. Consecutive output segments
+share end points bit for bit.
 
 Sources: biarcs with equal tangent lengths (d1 = d2) after K. M. Bolton, "Biarc curves",
 Computer-Aided Design 7(2), 1975, and R. Juckett, "Biarc interpolation", 2010; circle fit
@@ -18,26 +19,17 @@ Meas. 25(1), 1976, constrained here to pass through the run's two end points.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
+from typing import TypeAlias
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
-from camtool.geometry.fitgeom import (
-    MAX_SWEEP,
-    FloatArray,
-    check_tolerance,
-    dist_line,
-    dist_polyline,
-    dist_segment,
-    distances,
-    pairwise_dist_line,
-    sample_segment,
-)
-from camtool.geometry.polyfit import CORNER_ANGLE_DEG, fit_polyline
-from camtool.model.errors import ToolpathError, UsageError
-from camtool.model.shapes import Arc, Line, Point, Segment, chord_count
+from camtool.model.errors import GeometryError, InputError, UsageError
+from camtool.model.shapes import TAU, Arc, Line, Point, Segment, chord_count
 
 __all__ = [
     "CORNER_ANGLE_DEG",
@@ -51,6 +43,98 @@ __all__ = [
     "fit_stats",
 ]
 
+FloatArray: TypeAlias = NDArray[np.float64]
+
+MAX_SWEEP = math.pi
+"""Largest sweep of one output arc, radians: 180° arcs are safe in every dialect (I/J or R)."""
+
+
+def check_tolerance(tolerance: float) -> float:
+    """``tolerance`` as a float, mm.
+
+    Raises:
+        UsageError: it is not a positive finite number.
+    """
+    tol = float(tolerance)
+    if not (math.isfinite(tol) and tol > 0):
+        raise UsageError(
+            f"arc fitting tolerance must be a positive number of mm, got {tolerance!r}"
+        )
+    return tol
+
+
+def distances(xy: ArrayLike, segments: Sequence[Segment]) -> FloatArray:
+    """Distance from each point to the nearest of ``segments`` (exact for lines and arcs).
+
+    Args:
+        xy: ``(N, 2)`` float64 points, mm.
+        segments: at least one line or arc.
+
+    Returns:
+        ``(N,)`` float64 distances, mm.
+    """
+    pts = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+    return np.min([dist_segment(pts, s) for s in segments], axis=0)
+
+
+def sample_segment(seg: Segment, n: int) -> FloatArray:
+    """``(n + 1, 2)`` points evenly along ``seg``, ends included."""
+    u = np.linspace(0.0, 1.0, n + 1)
+    if isinstance(seg, Line):
+        (x0, y0), (x1, y1) = seg.start, seg.end
+        return np.column_stack([x0 + u * (x1 - x0), y0 + u * (y1 - y0)])
+    a = seg.start_angle + seg.sweep * u
+    r = seg.radius
+    return np.column_stack([seg.centre[0] + r * np.cos(a), seg.centre[1] + r * np.sin(a)])
+
+
+def dist_segment(xy: FloatArray, seg: Segment) -> FloatArray:
+    """``(N,)`` distances from ``xy`` ``(N, 2)`` to one line or arc, mm."""
+    return dist_line(xy, seg.start, seg.end) if isinstance(seg, Line) else dist_arc(xy, seg)
+
+
+def dist_line(xy: FloatArray, a: Point, b: Point) -> FloatArray:
+    """``(N,)`` distances from ``xy`` ``(N, 2)`` to the segment ``a``–``b``."""
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    rx, ry = xy[:, 0] - a[0], xy[:, 1] - a[1]
+    ll = dx * dx + dy * dy
+    u = np.clip((rx * dx + ry * dy) / ll, 0.0, 1.0) if ll > 0 else np.zeros(len(xy))
+    return np.hypot(rx - u * dx, ry - u * dy)
+
+
+def dist_arc(xy: FloatArray, arc: Arc) -> FloatArray:
+    """``(N,)`` distances from ``xy`` ``(N, 2)`` to ``arc``: radial inside the sweep, else ends."""
+    rx, ry = xy[:, 0] - arc.centre[0], xy[:, 1] - arc.centre[1]
+    sweep = arc.sweep
+    ang = np.arctan2(ry, rx) - arc.start_angle
+    inside = np.mod(ang if sweep > 0 else -ang, TAU) <= abs(sweep)
+    ends = np.minimum(
+        np.hypot(xy[:, 0] - arc.start[0], xy[:, 1] - arc.start[1]),
+        np.hypot(xy[:, 0] - arc.end[0], xy[:, 1] - arc.end[1]),
+    )
+    return np.where(inside, np.abs(np.hypot(rx, ry) - arc.radius), ends)
+
+
+def pairwise_dist_line(xy: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
+    """``(N,)`` distance from ``xy[i]`` to the segment ``a[i]``–``b[i]`` (all ``(N, 2)``)."""
+    d = b - a
+    r = xy - a
+    ll = np.einsum("ij,ij->i", d, d)
+    u = np.clip(np.einsum("ij,ij->i", r, d) / np.where(ll > 0, ll, 1.0), 0.0, 1.0)
+    return np.hypot(*(r - u[:, None] * d).T)
+
+
+def dist_polyline(xy: FloatArray, poly: FloatArray) -> FloatArray:
+    """``(N,)`` distances from ``xy`` ``(N, 2)`` to the polyline through ``poly`` ``(M, 2)``."""
+    a, d = poly[:-1], np.diff(poly, axis=0)  # (M-1, 2)
+    r = xy[:, None, :] - a[None, :, :]  # (N, M-1, 2)
+    ll = np.einsum("ij,ij->i", d, d)
+    u = np.clip(np.einsum("nij,ij->ni", r, d) / np.where(ll > 0, ll, 1.0), 0.0, 1.0)
+    gap = r - u[:, :, None] * d[None, :, :]
+    return np.min(np.hypot(gap[..., 0], gap[..., 1]), axis=1)
+
+
+# ---------------------------------------------------------------------------- fit stats
 
 MAX_DEPTH = 40
 """Default limit of midpoint subdivisions in :func:`fit_curve` (2**-40 of the range)."""
@@ -158,7 +242,7 @@ def fit_curve(
 
     Raises:
         UsageError: bad ``tolerance`` or parameter range.
-        ToolpathError: a curve point is not finite, or the fit needs more than ``max_depth``
+        GeometryError: a curve point is not finite, or the fit needs more than ``max_depth``
             subdivisions (the message gives the parameter where).
     """
     tol = check_tolerance(tolerance)
@@ -223,7 +307,7 @@ def _fit_piece(c: _Curve, ta: float, pa: Point, tb: float, pb: Point, depth: int
         if error <= c.tol:
             return [_Piece(segs, error)]
     if depth >= c.max_depth:
-        raise ToolpathError(
+        raise GeometryError(
             f"arc fitting did not converge near t={ta!r}..{tb!r} after {depth} subdivisions "
             f"at tolerance {c.user_tol!r} mm; is the curve continuous?"
         )
@@ -360,7 +444,211 @@ def _as_point(value: Iterable[float], what: str) -> Point:
     try:
         x, y = (float(v) for v in value)
     except (TypeError, ValueError) as exc:
-        raise ToolpathError(f"{what} must be two numbers, got {value!r}") from exc
+        raise GeometryError(f"{what} must be two numbers, got {value!r}") from exc
     if not (math.isfinite(x) and math.isfinite(y)):
-        raise ToolpathError(f"{what} is not finite: ({x!r}, {y!r})")
+        raise GeometryError(f"{what} is not finite: ({x!r}, {y!r})")
     return (x, y)
+
+
+# ---------------------------------------------------------------------------- fit_polyline
+
+CORNER_ANGLE_DEG = 30.0
+"""Default turn, degrees, above which :func:`fit_polyline` keeps a vertex as a corner."""
+
+_CORNER_SPAN = 5.0  # polyline corners are judged over this many tolerances of length
+_DUPLICATE = 1e-9  # mm: polyline points closer than this to the previous one are dropped
+
+
+def fit_polyline(
+    points: ArrayLike,
+    tolerance: float,
+    *,
+    closed: bool = False,
+    corner_angle_deg: float = CORNER_ANGLE_DEG,
+) -> list[Segment]:
+    """Turn a dense polyline into lines and arcs within ``tolerance`` mm of it.
+
+    Corners are kept: a vertex whose turn over ±5 tolerances of length exceeds
+    ``corner_angle_deg`` (the sharpest in that neighbourhood, so noise and dense sampling
+    near a corner give one corner), or whose own turn does so with both edges longer than the
+    tolerance. A buffer with shapely's default 8 segments per quarter turns 11.25° per vertex
+    and stays smooth. Between corners, segments grow greedily (doubling, then bisection) to
+    the longest run that fits one Line (every point within tolerance of the chord) or one Arc
+    through the run's end points, its centre fitted by least squares (Kåsa, constrained to
+    the chord bisector) and verified: every point within tolerance, points in order along
+    the sweep, each edge's sagitta plus radial error within tolerance, sweep ≤ :data:`MAX_SWEEP`.
+    Points closer than 1e-9 mm to the previous one are dropped.
+
+    Args:
+        points: ``(N, 2)`` float64 vertices, mm; for ``closed`` the last may repeat the first.
+        tolerance: largest distance between polyline and output, both ways, mm (> 0).
+        closed: the polyline returns from the last vertex to the first.
+        corner_angle_deg: turn in degrees above which a vertex is a corner.
+
+    Returns:
+        Segments from the first vertex through the last exactly (back to the first when
+        ``closed``), each starting at the end of the one before.
+
+    Raises:
+        InputError: points are not ``(N, 2)`` finite numbers, or fewer than 2 distinct
+            (3 when ``closed``).
+        UsageError: bad ``tolerance``.
+    """
+    tol = check_tolerance(tolerance)
+    xy = _clean(points, closed)
+    tp = [(float(x), float(y)) for x, y in xy]
+    if closed:
+        tp[-1] = tp[0]
+    breaks = _breaks(xy, tol, math.radians(corner_angle_deg), closed)
+    out: list[Segment] = []
+    for a, b in itertools.pairwise(breaks):
+        out.extend(_fit_run(xy, tp, a, b, tol))
+    return out
+
+
+def _clean(points: ArrayLike, closed: bool) -> FloatArray:
+    """Finite ``(M, 2)`` vertices without repeats; for ``closed`` the first is appended."""
+    try:
+        xy = np.array(points, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"polyline points must be numbers: {exc}") from exc
+    if xy.size == 0:
+        raise InputError("a polyline needs 2 distinct points, got none")
+    if xy.ndim != 2 or xy.shape[1] != 2:
+        raise InputError(f"polyline points must be an (N, 2) array, got shape {xy.shape}")
+    if not np.all(np.isfinite(xy)):
+        raise InputError("polyline points must be finite, found NaN or infinity")
+    keep = np.ones(len(xy), dtype=bool)
+    keep[1:] = np.hypot(*np.diff(xy, axis=0).T) > _DUPLICATE
+    xy = xy[keep]
+    if closed:
+        while len(xy) > 1 and math.dist(xy[-1], xy[0]) <= _DUPLICATE:
+            xy = xy[:-1]
+        if len(xy) < 3:
+            raise InputError(f"a closed polyline needs 3 distinct points, got {len(xy)}")
+        xy = np.vstack([xy, xy[:1]])
+    elif len(xy) < 2:
+        raise InputError(f"a polyline needs 2 distinct points, got {len(xy)}")
+    xy.setflags(write=False)
+    return xy
+
+
+def _breaks(xy: FloatArray, tol: float, corner: float, closed: bool) -> list[int]:
+    """Sorted vertex indices where runs end: both ends and the corners.
+
+    A closed ring is tripled so that turns and neighbourhoods near vertex 0 wrap around;
+    its corners are read from the middle copy.
+    """
+    ring = xy[:-1] if closed else xy
+    n = len(ring)
+    ext = np.vstack([ring, ring, ring]) if closed else ring
+    idx = np.arange(1, len(ext) - 1)
+    if len(idx) == 0:
+        return [0, len(xy) - 1]
+    edge = np.hypot(*np.diff(ext, axis=0).T)
+    s = np.concatenate([[0.0], np.cumsum(edge)])
+    span = _CORNER_SPAN * tol
+    back = np.minimum(np.searchsorted(s, s[idx] - span, side="right") - 1, idx - 1)
+    ahead = np.maximum(np.searchsorted(s, s[idx] + span, side="left"), idx + 1)
+    back, ahead = np.maximum(back, 0), np.minimum(ahead, len(ext) - 1)
+    wide = _turn(ext[idx] - ext[back], ext[ahead] - ext[idx])
+    near = _turn(ext[idx] - ext[idx - 1], ext[idx + 1] - ext[idx])
+    sharp = (near > corner) & (np.minimum(edge[idx - 1], edge[idx]) > tol)
+    corners = set(idx[sharp].tolist())
+    cand = np.flatnonzero(wide > corner)
+    where = s[idx[cand]]
+    for k, pos in zip(cand, where, strict=True):  # the sharpest within ±span (ties: the first)
+        lo, hi = np.searchsorted(where, [pos - span, pos + span])
+        window = cand[lo:hi]
+        if window[np.argmax(wide[window])] == k:
+            corners.add(int(idx[k]))
+    if closed:
+        corners = {i - n for i in corners if n <= i < 2 * n}
+    inner = sorted(i for i in corners if 0 < i < len(xy) - 1)
+    return [0, *inner, len(xy) - 1]
+
+
+def _turn(u: FloatArray, v: FloatArray) -> FloatArray:
+    """Unsigned angle (radians) between direction rows ``u`` and ``v``, both ``(N, 2)``."""
+    cross = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
+    dot = u[:, 0] * v[:, 0] + u[:, 1] * v[:, 1]
+    return np.abs(np.arctan2(cross, dot))
+
+
+def _fit_run(xy: FloatArray, tp: list[Point], a: int, b: int, tol: float) -> list[Segment]:
+    """Greedy longest segments from vertex ``a`` to vertex ``b``."""
+    out: list[Segment] = []
+    s = a
+    while s < b:
+        ok, seg = s + 1, _try(xy, tp, s, s + 1, tol)
+        fail = None
+        step = 2
+        while ok < b:  # doubling ...
+            e = min(s + step, b)
+            got = _try(xy, tp, s, e, tol)
+            if got is None:
+                fail = e
+                break
+            ok, seg, step = e, got, 2 * step
+        while fail is not None and fail - ok > 1:  # ... then bisection
+            mid = (ok + fail) // 2
+            got = _try(xy, tp, s, mid, tol)
+            if got is None:
+                fail = mid
+            else:
+                ok, seg = mid, got
+        assert seg is not None  # two vertices always make a line
+        out.append(seg)
+        s = ok
+    return out
+
+
+def _try(xy: FloatArray, tp: list[Point], s: int, e: int, tol: float) -> Segment | None:
+    """A Line (preferred) or an Arc from vertex ``s`` to ``e`` within ``tol``, else None."""
+    if e == s + 1:
+        return Line(tp[s], tp[e])
+    if math.dist(tp[s], tp[e]) <= _DUPLICATE:  # a loop back to its start is two segments
+        return None
+    pts = xy[s : e + 1]
+    if float(np.max(dist_line(pts, tp[s], tp[e]))) <= tol:
+        return Line(tp[s], tp[e])
+    return _fit_arc(pts, tp[s], tp[e], tol)
+
+
+def _fit_arc(pts: FloatArray, a: Point, b: Point, tol: float) -> Arc | None:
+    """Arc from ``a`` to ``b`` (the ends of ``pts``) fitted to ``pts`` and verified."""
+    rel = pts - pts[0]
+    vx, vy = rel[-1]
+    chord = math.hypot(vx, vy)
+    nx, ny = -vy / chord, vx / chord
+    # centre c = v/2 + lam n (origin at a): |r_i - c|² - |c|² = |r_i|² - r_i·v - 2 lam n·r_i
+    rhs = np.einsum("ij,ij->i", rel, rel) - (rel[:, 0] * vx + rel[:, 1] * vy)
+    coef = 2.0 * (rel[:, 0] * nx + rel[:, 1] * ny)
+    den = float(coef @ coef)
+    side = float(np.sum(vx * rel[:, 1] - vy * rel[:, 0]))
+    if den == 0.0 or side == 0.0:
+        return None
+    lam = float(rhs @ coef) / den
+    centre = (a[0] + 0.5 * vx + lam * nx, a[1] + 0.5 * vy + lam * ny)
+    arc = Arc(a, b, centre, side > 0)  # points right of the chord: counter-clockwise
+    if abs(arc.sweep) > MAX_SWEEP + 1e-9 or not _arc_fits(arc, pts, tol):
+        return None
+    return arc
+
+
+def _arc_fits(arc: Arc, pts: FloatArray, tol: float) -> bool:
+    """Every point within ``tol``, in order along the sweep, every edge's bulge within ``tol``."""
+    if float(np.max(dist_arc(pts, arc))) > tol:
+        return False
+    r, sweep = arc.radius, abs(arc.sweep)
+    rel = pts - np.asarray(arc.centre)
+    ang = np.arctan2(rel[:, 1], rel[:, 0]) - arc.start_angle
+    delta = np.mod(-ang if arc.clockwise else ang, TAU)
+    delta = np.where(delta > 0.5 * (sweep + TAU), delta - TAU, delta)  # just before the start
+    slack = tol / r
+    if np.any(delta < np.maximum.accumulate(delta) - slack):
+        return False
+    radial = np.abs(np.hypot(rel[:, 0], rel[:, 1]) - r)
+    step = np.minimum(np.abs(np.diff(delta)), math.pi)
+    bulge = 2.0 * r * np.sin(0.25 * step) ** 2 + np.maximum(radial[:-1], radial[1:])
+    return bool(np.max(bulge) <= tol)

@@ -2,11 +2,11 @@
 
 Read: LINE, ARC, CIRCLE, LWPOLYLINE and 2D POLYLINE exactly (bulges become arcs; bulge > 0
 is counter-clockwise); ELLIPSE and SPLINE as biarcs within the tolerance
-(:mod:`camtool.importers.dxf_curves`); INSERT/MINSERT expanded with their full transform,
+(:mod:`camtool.importers.dxf_entities`); INSERT/MINSERT expanded with their full transform,
 nested blocks included (:mod:`camtool.importers.dxf_blocks`); HATCH boundary paths when
 asked (``hatch_boundaries``). Entities with an extrusion of (0, 0, −1) are mirrored into
 the WCS, which flips their arcs' direction. Each entity becomes one contour; chaining
-entities whose ends meet is the planner's job (:mod:`camtool.toolpath.chain`).
+entities whose ends meet is the planner's job (:mod:`camtool.geometry.chain`).
 
 ``$INSUNITS`` is converted to mm exactly; a unitless drawing is taken as mm with a
 warning. Everything else (text, dimensions, images, points, 3D entities, HATCH without
@@ -28,8 +28,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from camtool.importers import MAX_COORDINATE_MM
-from camtool.importers.dxf_curves import BadEntity
-from camtool.importers.dxf_entities import ZERO_LENGTH, check_numbers, layer_of, line_inside
+from camtool.importers.dxf_entities import (
+    ZERO_LENGTH,
+    BadEntity,
+    check_numbers,
+    layer_of,
+    line_inside,
+)
 from camtool.model.errors import InputError, UsageError
 from camtool.model.shapes import Contour, Drawing, Line, Point
 from camtool.model.units import INCH
@@ -298,8 +303,13 @@ class _Reader:
         self.contours.append(Contour((Line(start, end),), False, layer, label))
 
     def _item(self, item: Any) -> None:
-        from camtool.importers.dxf_curves import Unsupported
-        from camtool.importers.dxf_entities import CONVERTED, check_centres, check_numbers, convert
+        from camtool.importers.dxf_entities import (
+            CONVERTED,
+            Unsupported,
+            check_centres,
+            check_numbers,
+            convert,
+        )
 
         if not self.keep(item.layer):
             return

@@ -21,8 +21,14 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
-from camtool.importers.dxf_curves import Unsupported
-from camtool.importers.dxf_entities import CONVERTED, Item, check_numbers, layer_of, location
+from camtool.importers.dxf_entities import (
+    CONVERTED,
+    Item,
+    Unsupported,
+    check_numbers,
+    layer_of,
+    location,
+)
 from camtool.model.shapes import Point
 
 MAX_NESTING = 32

@@ -1,31 +1,68 @@
 """One DXF entity (or a transformed copy of one from a block) as contours, in drawing units.
 
 LINE, ARC, CIRCLE, LWPOLYLINE and 2D POLYLINE are exact (bulges become arcs; bulge > 0 is
-counter-clockwise in the entity's OCS). ELLIPSE and SPLINE are fitted
-(:mod:`camtool.importers.dxf_curves`). HATCH boundary paths become closed contours.
+counter-clockwise in the entity's OCS). HATCH boundary paths become closed contours.
 Entities with an extrusion of (0, 0, −1) are mirrored into the WCS, which flips their arcs'
 direction; entities tilted out of the XY plane are refused.
 
-Source: AutoCAD DXF Reference (entities section; OCS and the arbitrary axis algorithm).
+ELLIPSE and SPLINE have no exact arc form. Both live in the WCS. Their true curve is
+evaluated with ezdxf's construction tools (:class:`ezdxf.math.ConstructionEllipse`,
+:class:`ezdxf.math.BSpline`) and fitted by the shared fitter
+(:func:`camtool.geometry.curves.fit_pieces`, built on
+:func:`camtool.geometry.arcfit.fit_curve`), so the output lies within the tolerance of the
+curve and the curve within the tolerance of the output. A circular ellipse (both axes equal)
+is returned as exact arcs, without fitting.
+
+A HATCH is an OCS entity: its boundary paths are 2D, in the plane of its extrusion at its
+elevation. A polyline path (vertices with bulges) becomes a virtual LWPOLYLINE; an edge
+path's LINE, ARC, ELLIPSE and SPLINE edges become virtual entities of those types (arc
+and ellipse angles are stored counter-clockwise by ezdxf whatever the edge's direction).
+Each is converted like a drawn entity and the pieces of a path are joined, in order, into
+closed contours (:func:`join_pieces`).
+
+Everything here is in drawing units (the caller scales to mm afterwards), so the
+tolerance passed in must already be in drawing units.
+
+Sources: AutoCAD DXF Reference (entities section; OCS and the arbitrary axis algorithm;
+HATCH boundary path data); the mapping of hatch edges to entities follows ezdxf's
+``explode.virtual_boundary_path_entities``.
 """
 
 from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from camtool.importers.dxf_curves import (
-    BadEntity,
-    Unsupported,
-    ellipse_segments,
-    spline_segments,
-)
-from camtool.model.shapes import Arc, Contour, Line, Point, Segment, distance
+from camtool.geometry.chain import with_end, with_start
+from camtool.geometry.curves import corner_knots, ellipse, fit_pieces
+from camtool.model.errors import GeometryError
+from camtool.model.shapes import TAU, Arc, Contour, Line, Point, Segment, distance
+
+_RELATIVE = 1e-9  # times the size: a z spread that is still planar, ends that coincide
+_CIRCULAR = 1e-3  # an ellipse whose axes differ by < this share of the tolerance is a circle
+
+
+class Unsupported(Exception):
+    """An entity that cannot become a contour; ``reason`` is the user-facing why."""
+
+    def __init__(self, reason: str, detail: str = "") -> None:
+        super().__init__(reason)
+        self.reason = reason
+        self.detail = detail
+
+
+class BadEntity(ValueError):
+    """An entity holds a number camtool refuses; the message names the entity and value.
+
+    Raised by :func:`camtool.importers.dxf_entities.check_numbers`; the DXF importer
+    turns it into an :class:`~camtool.model.errors.InputError` naming the file.
+    """
+
 
 CONVERTED = ("LINE", "ARC", "CIRCLE", "LWPOLYLINE", "POLYLINE", "ELLIPSE", "SPLINE", "HATCH")
 """Entity types that become contours (HATCH only with ``hatch_boundaries``)."""
@@ -292,7 +329,7 @@ def join_pieces(
             ):
                 segs = _reverse(segs)
             if distance(run[-1].end, segs[0].start) <= tolerance:
-                run.extend([_with_start(segs[0], run[-1].end), *segs[1:]])
+                run.extend([with_start(segs[0], run[-1].end), *segs[1:]])
                 single = False
                 continue
         runs.append(list(segs))
@@ -303,7 +340,7 @@ def join_pieces(
             len(run) > 1 or isinstance(run[0], Arc)
         )
         if closed:
-            run[-1] = _with_end(run[-1], run[0].start)
+            run[-1] = with_end(run[-1], run[0].start)
         out.append((run, closed))
     return out
 
@@ -381,8 +418,6 @@ def _polyline2d(entity: Any) -> list[Segment]:
 
 def _hatch(item: Item, tolerance: float, limit: float) -> list[Contour]:
     """Each boundary path of a HATCH as contours (normally one closed contour per path)."""
-    from camtool.importers.dxf_hatch import boundary_entities
-
     hatch = item.entity
     _check_flat(hatch)
     contours: list[Contour] = []
@@ -454,13 +489,249 @@ def _polyline(
     return segs
 
 
-def _with_start(seg: Segment, p: Point) -> Segment:
-    return Line(p, seg.end) if isinstance(seg, Line) else Arc(p, seg.end, seg.centre, seg.clockwise)
+# ------------------------------------------------------------------ ELLIPSE and SPLINE
 
 
-def _with_end(seg: Segment, p: Point) -> Segment:
-    return (
-        Line(seg.start, p)
-        if isinstance(seg, Line)
-        else Arc(seg.start, p, seg.centre, seg.clockwise)
+def ellipse_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool]:
+    """An ELLIPSE as lines and arcs within ``tolerance``, and whether it is closed.
+
+    The curve is ``c + M cos t + m sin t`` for ``t`` from ``start_param`` to
+    ``end_param`` counter-clockwise about the extrusion, with ``M`` the major axis and
+    ``m = extrusion × M · ratio`` (DXF reference, ELLIPSE); an extrusion of (0, 0, −1)
+    therefore runs clockwise seen from +Z. An ellipse sweeping more than half a turn
+    whose two ends meet within the tolerance is closed (full): CAD programs that round
+    ``end_param`` to 6.28318 still give a closed contour.
+
+    Args:
+        entity: an ezdxf ``Ellipse`` (WCS), possibly a virtual one from a block.
+        tolerance: largest distance between curve and output, drawing units (> 0).
+
+    Returns:
+        ``(segments, closed)`` in drawing units, Y up.
+
+    Raises:
+        Unsupported: the ellipse is not parallel to XY, or has zero size.
+    """
+    if not math.hypot(*entity.dxf.major_axis) > 0.0:
+        raise Unsupported("zero size")  # ezdxf's construction tool refuses a null axis
+    ce = entity.construction_tool()
+    ex, ey, ez = ce.extrusion
+    if abs(ex) > 1e-9 or abs(ey) > 1e-9 or abs(ce.major_axis[2]) > 1e-9 * ce.major_axis.magnitude:
+        raise Unsupported("not parallel to XY")
+    (cx, cy), (mx, my), (nx, ny) = _xy(ce.center), _xy(ce.major_axis), _xy(ce.minor_axis)
+    a, b = math.hypot(mx, my), math.hypot(nx, ny)
+    if a <= 0.0 or b <= 0.0:
+        raise Unsupported("zero size")
+    _check_size(2.0 * max(a, b), tolerance)
+    t0 = float(ce.start_param)
+    t1 = float(ce.end_param)
+    if t1 <= t0:
+        t1 += TAU * math.ceil((t0 - t1) / TAU + 1e-15)
+    t1 = min(t1, t0 + TAU)
+
+    point_at, tangent_at = ellipse((cx, cy), (mx, my), (nx, ny))
+    closed = t1 - t0 >= TAU or (
+        t1 - t0 > math.pi and distance(point_at(t0), point_at(t1)) <= tolerance
     )
+    if closed:
+        t1 = t0 + TAU
+    if abs(a - b) <= _CIRCULAR * tolerance:
+        start = point_at(t0)
+        end = start if closed else point_at(t1)
+        return [Arc(start, end, (cx, cy), ez < 0)], closed
+    return _fit(point_at, tangent_at, [t0, t1], tolerance, closed), closed
+
+
+def spline_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool]:
+    """A SPLINE (any degree, rational or not, control or fit points) as lines and arcs.
+
+    The curve is the B-spline over its valid domain ``[u_p, u_n]`` (p the degree,
+    n the control point count; the same as ``[0, max_t]`` for clamped splines, the
+    periodic part for closed unclamped ones). It is fitted piecewise between knots
+    of multiplicity ≥ p, where the curve may have a corner. Splines given by fit points
+    only are rebuilt as AutoCAD does (:func:`ezdxf.math.fit_points_to_cad_cv`, with the
+    stored end tangents); a closed one is closed through its first fit point. The contour
+    is closed when the spline's ends coincide, or when it is flagged closed and its ends
+    meet within the tolerance.
+
+    Args:
+        entity: an ezdxf ``Spline`` (WCS), possibly a virtual one from a block.
+        tolerance: largest distance between curve and output, drawing units (> 0).
+
+    Returns:
+        ``(segments, closed)`` in drawing units, Y up.
+
+    Raises:
+        Unsupported: invalid spline data, a spline not parallel to XY, or one whose
+            curve is a single point.
+    """
+    spline = _construction(entity)
+    pts = spline.control_points
+    zs = [p[2] for p in pts]
+    size = max(1.0, *(max(abs(p[0]), abs(p[1])) for p in pts))
+    if max(zs) - min(zs) > _RELATIVE * size:
+        raise Unsupported("not parallel to XY")
+    p, n = spline.degree, spline.count
+    knots = spline.knots()
+    t0, t1 = float(knots[p]), float(knots[n])
+    if not t1 > t0:
+        raise Unsupported("invalid spline data", "empty parameter range")
+    breaks = [t0, *corner_knots(knots, p, t0, t1), t1]
+    xs, ys = [q[0] for q in pts], [q[1] for q in pts]
+    _check_size(max(max(xs) - min(xs), max(ys) - min(ys)), tolerance)
+
+    def point_at(t: float) -> Point:
+        return _xy(spline.point(t))
+
+    gap = distance(point_at(t0), point_at(t1))
+    closed = gap <= _RELATIVE * size or (bool(entity.closed) and gap <= tolerance)
+    return _fit(point_at, lambda t: _xy(spline.derivative(t, 1)[1]), breaks, tolerance, closed), (
+        closed
+    )
+
+
+def _check_size(extent: float, tolerance: float) -> None:
+    from camtool.importers import check_curve_size
+
+    try:
+        check_curve_size(extent, tolerance)
+    except ValueError as exc:
+        raise BadEntity(f"{exc} (drawing units)") from None
+
+
+def _construction(entity: Any) -> Any:
+    """The entity's BSpline, with AutoCAD-style periodic knot vectors unwrapped."""
+    from ezdxf.math import BSpline, fit_points_to_cad_cv
+
+    try:
+        if entity.control_point_count() == 0 and entity.fit_point_count() > 0 and entity.closed:
+            fit = [tuple(v) for v in entity.fit_points]
+            if distance(_xy(fit[0]), _xy(fit[-1])) > 0.0:
+                fit.append(fit[0])
+            tangents = None
+            if entity.dxf.hasattr("start_tangent") and entity.dxf.hasattr("end_tangent"):
+                tangents = [entity.dxf.start_tangent, entity.dxf.end_tangent]
+            return fit_points_to_cad_cv(fit, tangents=tangents)
+        count = entity.control_point_count()
+        if entity.closed and count and len(entity.knots) == count + 1:
+            cps, knots, weights = _unwrap_periodic(
+                [tuple(v) for v in entity.control_points],
+                list(entity.knots),
+                list(entity.weights),
+                int(entity.dxf.degree),
+            )
+            return BSpline(cps, int(entity.dxf.degree) + 1, knots, weights or None)
+        return entity.construction_tool()
+    except (ValueError, IndexError, ZeroDivisionError) as exc:  # ezdxf's DXFValueError too
+        raise Unsupported("invalid spline data", str(exc)) from exc
+
+
+def _unwrap_periodic(
+    cps: list[tuple[float, ...]], knots: list[float], weights: list[float], p: int
+) -> tuple[list[tuple[float, ...]], list[float], list[float]]:
+    """Periodic spline stored with ``n + 1`` knots (ObjectARX style) as an unclamped one.
+
+    The ``n`` knot intervals repeat with the period; the first ``p`` control points (and
+    weights) are appended, and ``p`` knots are added on each side, so that the valid
+    domain ``[u_p, u_n]`` of the result is the stored ``[k_0, k_n]``.
+    """
+    n = len(cps)
+    d = [knots[i + 1] - knots[i] for i in range(n)]
+    left = [knots[0]]
+    for i in range(p):
+        left.insert(0, left[0] - d[(n - 1 - i) % n])
+    right = [knots[n] + (knots[i] - knots[0]) for i in range(1, p + 1)]
+    full = left[:-1] + knots + right
+    return cps + cps[:p], full, (weights + weights[:p]) if weights else []
+
+
+def _fit(
+    point_at: Callable[[float], Point],
+    tangent_at: Callable[[float], Point],
+    breaks: Sequence[float],
+    tolerance: float,
+    closed: bool,
+) -> list[Segment]:
+    """:func:`camtool.geometry.curves.fit_pieces`, its failures as :class:`Unsupported`."""
+    try:
+        segs = fit_pieces(point_at, tangent_at, breaks, tolerance, closed)
+    except GeometryError as exc:
+        raise Unsupported("curve could not be fitted", str(exc)) from exc
+    if not segs:
+        raise Unsupported("zero length")
+    return segs
+
+
+# ------------------------------------------------------------------ HATCH boundary paths
+
+
+def boundary_entities(hatch: Any) -> list[list[Any]]:
+    """Per boundary path, its pieces as virtual ezdxf entities in WCS drawing units.
+
+    Args:
+        hatch: an ezdxf ``Hatch`` (or ``MPolygon``), possibly a virtual one from a block.
+
+    Returns:
+        One list per path, the pieces in path order.
+    """
+    from ezdxf.entities import LWPolyline
+    from ezdxf.entities.boundary_paths import EdgePath, PolylinePath
+
+    ocs = hatch.ocs()
+    elevation = float(hatch.dxf.elevation[2])
+    extrusion = hatch.dxf.get("extrusion", (0.0, 0.0, 1.0))
+    paths: list[list[Any]] = []
+    for path in hatch.paths:
+        if isinstance(path, PolylinePath):
+            poly = LWPolyline.new(dxfattribs={"extrusion": extrusion, "elevation": elevation})
+            poly.set_points([tuple(v) for v in path.vertices], format="xyb")
+            poly.closed = path.is_closed
+            paths.append([poly])
+        elif isinstance(path, EdgePath):
+            paths.append([_edge(edge, ocs, elevation, extrusion) for edge in path.edges])
+    return paths
+
+
+def _edge(edge: Any, ocs: Any, elevation: float, extrusion: Any) -> Any:
+    from ezdxf.entities import Arc, Ellipse, Line, Spline
+    from ezdxf.entities.boundary_paths import ArcEdge, EllipseEdge, LineEdge
+    from ezdxf.math import Vec3
+
+    def wcs(v: Any) -> Any:
+        return ocs.to_wcs(Vec3(v).replace(z=elevation))
+
+    if isinstance(edge, LineEdge):
+        return Line.new(dxfattribs={"start": wcs(edge.start), "end": wcs(edge.end)})
+    if isinstance(edge, ArcEdge):
+        return Arc.new(
+            dxfattribs={
+                "center": Vec3(edge.center).replace(z=elevation),
+                "radius": edge.radius,
+                "start_angle": edge.start_angle,
+                "end_angle": edge.end_angle,
+                "extrusion": extrusion,
+            }
+        )
+    if isinstance(edge, EllipseEdge):
+        return Ellipse.new(
+            dxfattribs={
+                "center": wcs(edge.center),
+                "major_axis": ocs.to_wcs(Vec3(edge.major_axis)),
+                "ratio": edge.ratio,
+                "start_param": edge.start_param,
+                "end_param": edge.end_param,
+                "extrusion": extrusion,
+            }
+        )
+    spline = Spline.new(dxfattribs={"degree": edge.degree})
+    spline.control_points = [wcs(v) for v in edge.control_points]
+    if edge.knot_values:
+        spline.knots = edge.knot_values
+    if edge.weights:
+        spline.weights = edge.weights
+    if edge.fit_points:
+        spline.fit_points = [wcs(v) for v in edge.fit_points]
+    if edge.start_tangent is not None and edge.end_tangent is not None:
+        spline.dxf.start_tangent = ocs.to_wcs(Vec3(edge.start_tangent))
+        spline.dxf.end_tangent = ocs.to_wcs(Vec3(edge.end_tangent))
+    return spline

@@ -3,22 +3,43 @@
 :func:`inspect_drawing` reads a drawing like ``camtool post`` does (same importer, same
 options), chains it at the same tolerance and reports: entity counts by type and layer
 (DXF), contour counts by layer, the bounding box, the units, the importer's warnings and
-the findings of :mod:`camtool.importers.lint_checks` (open contours, gaps just above the
+the findings of :func:`check_drawing` (open contours, gaps just above the
 tolerance, duplicates and overlaps, zero-length and tiny segments, dropped entities),
 each with its location, and for a damaged DXF what ezdxf's recover mode repaired (the
 importer's warning only counts the repairs). :class:`InspectReport` gives a text for
 people and a JSON object for scripts (``--json``).
+
+The drawing checks (:func:`check_drawing`, the geometry half of ``camtool inspect``) are
+what a machinist wants before cutting.
+
+Each check works on any :class:`~camtool.model.shapes.Drawing` (mm, Y up) and returns
+:class:`Finding` records with a location, so the report can say where to look:
+
+- ``open-contour``: a contour still open after chaining at the tolerance;
+- ``gap``: two open ends farther apart than the tolerance (so not joined) but within
+  :data:`GAP_FACTOR` times it: almost certainly meant to meet;
+- ``duplicate``: two segments that are the same within the tolerance, either direction
+  (cut twice);
+- ``overlap``: collinear lines, or arcs on one circle, that share more than the
+  tolerance of length without being duplicates;
+- ``zero-length`` and ``tiny-segment``: segments of no length, or shorter than the tiny
+  limit (many tiny moves slow a controller down and can stall a step generator).
+
+Chaining is :func:`camtool.geometry.chain.chain`, the planner's own, so an open contour
+here is an open contour there.
 """
 
 from __future__ import annotations
 
-from collections import Counter
+import math
+from collections import Counter, defaultdict
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
-from camtool.importers.lint_checks import Finding, check_drawing
-from camtool.model.shapes import Arc, BBox, Contour
+from camtool.geometry.chain import chain
+from camtool.model.shapes import TAU, Arc, BBox, Contour, Drawing, Line, Point, Segment, distance
 
 if TYPE_CHECKING:
     from camtool.importers import ImportOptions
@@ -243,3 +264,245 @@ def _layer_table(layers: tuple[LayerContours, ...]) -> list[str]:
         for lay in layers
     ]
     return out
+
+
+# ------------------------------------------------------------------ drawing checks
+
+GAP_FACTOR = 10.0
+"""Open ends closer than this many tolerances (but farther than one) are reported as gaps."""
+TINY_FACTOR = 10.0
+"""Default tiny-segment limit, in tolerances."""
+ZERO_LENGTH_MM = 1e-9
+"""Segments shorter than this are zero-length."""
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One thing to look at before cutting.
+
+    Attributes:
+        kind: ``open-contour``, ``gap``, ``duplicate``, ``overlap``, ``zero-length``,
+            ``tiny-segment``, ``skipped`` (an entity the importer dropped) or ``repaired``
+            (what ezdxf's recover mode repaired, or could not, in a damaged DXF file).
+        message: a sentence for the user, lowercase, with numbers in mm.
+        location: where, mm (WCS, Y up), or None when the importer gave no point.
+        sources: the entities or contours involved (``Contour.source`` values).
+    """
+
+    kind: str
+    message: str
+    location: Point | None
+    sources: tuple[str, ...] = ()
+
+    def to_json(self) -> dict[str, object]:
+        """``{"kind", "message", "location": [x, y] | null, "sources": [...]}``."""
+        where = None if self.location is None else [self.location[0], self.location[1]]
+        return {
+            "kind": self.kind,
+            "message": self.message,
+            "location": where,
+            "sources": list(self.sources),
+        }
+
+
+def check_drawing(
+    drawing: Drawing, tolerance: float, *, tiny_mm: float | None = None
+) -> tuple[list[Contour], list[Finding]]:
+    """Chain the drawing's contours and run every check.
+
+    Args:
+        drawing: contours in mm, one per entity as read.
+        tolerance: the chaining tolerance, mm (> 0), as ``--tolerance``.
+        tiny_mm: segments shorter than this are ``tiny-segment``; ``None`` is
+            :data:`TINY_FACTOR` × ``tolerance``.
+
+    Returns:
+        ``(chained contours, findings)``; findings ordered by kind, then as found.
+    """
+    tiny = TINY_FACTOR * tolerance if tiny_mm is None else tiny_mm
+    chained = chain(drawing.contours, tolerance)
+    findings = [
+        *open_contours(chained),
+        *gaps(chained, tolerance),
+        *duplicates(drawing.contours, tolerance),
+        *short_segments(drawing.contours, tiny),
+    ]
+    return chained, findings
+
+
+def open_contours(chained: Sequence[Contour]) -> list[Finding]:
+    """An ``open-contour`` finding per open contour, located at its start."""
+    out = []
+    for c in chained:
+        if not c.closed:
+            msg = (
+                f"open contour from {_pt(c.start)} to {_pt(c.end)}, {c.length:.4g} mm long; "
+                "an inside/outside offset or a pocket needs it closed"
+            )
+            out.append(Finding("open-contour", msg, c.start, (_name(c),)))
+    return out
+
+
+def gaps(chained: Sequence[Contour], tolerance: float) -> list[Finding]:
+    """Pairs of open ends ``tolerance < d ≤ GAP_FACTOR · tolerance`` apart, at their midpoint.
+
+    A contour's own two ends count too, unless it is a single line (whose ends are
+    its length apart).
+    """
+    limit = GAP_FACTOR * tolerance
+    ends: list[tuple[Point, int]] = []
+    for i, c in enumerate(chained):
+        if not c.closed:
+            ends += [(c.start, i), (c.end, i)]
+    cells: dict[tuple[int, int], list[int]] = defaultdict(list)
+    for k, (p, _) in enumerate(ends):
+        cells[(math.floor(p[0] / limit), math.floor(p[1] / limit))].append(k)
+    out = []
+    for k, (p, i) in enumerate(ends):
+        cx, cy = math.floor(p[0] / limit), math.floor(p[1] / limit)
+        for dx in (-1, 0, 1):
+            for dy in (-1, 0, 1):
+                for m in cells.get((cx + dx, cy + dy), ()):
+                    q, j = ends[m]
+                    d = distance(p, q)
+                    own_line = i == j and len(chained[i].segments) == 1
+                    if m > k and tolerance < d <= limit and not own_line:
+                        mid = ((p[0] + q[0]) / 2, (p[1] + q[1]) / 2)
+                        msg = (
+                            f"gap of {d:.4g} mm at {_pt(mid)}: above the chaining tolerance "
+                            f"{tolerance:g} mm, so these ends are not joined"
+                        )
+                        srcs = tuple(dict.fromkeys((_name(chained[i]), _name(chained[j]))))
+                        out.append(Finding("gap", msg, mid, srcs))
+    return out
+
+
+def duplicates(contours: Sequence[Contour], tolerance: float) -> list[Finding]:
+    """Duplicate segments (either direction) and overlapping collinear / co-circular ones.
+
+    Findings are grouped per pair of contours (two copies of a fitted spline give one
+    ``duplicate`` finding that counts its segments), located at the first one found.
+    """
+    import numpy as np
+    from shapely import STRtree, box
+
+    segs = [(s, k) for k, c in enumerate(contours) for s in c.segments]
+    if len(segs) < 2:
+        return []
+    boxes = [box(*_grow(s.bbox(), tolerance)) for s, _ in segs]
+    pairs = np.transpose(STRtree(boxes).query(boxes, predicate="intersects"))
+    groups: dict[tuple[int, int, str], list[Any]] = {}
+    for i, j in sorted((int(i), int(j)) for i, j in pairs if i < j):
+        (a, ka), (b, kb) = segs[i], segs[j]
+        if _same(a, b, tolerance):
+            kind, length, where = "duplicate", a.length, a.start
+        else:
+            shared = _overlap(a, b, tolerance)
+            if shared is None:
+                continue
+            kind, (length, where) = "overlap", shared
+        group = groups.setdefault((min(ka, kb), max(ka, kb), kind), [0, 0.0, where, _kind(a)])
+        group[0] += 1
+        group[1] += length
+    out = []
+    for (ka, kb, kind), (count, length, where, seg) in groups.items():
+        names = tuple(dict.fromkeys((_name(contours[ka]), _name(contours[kb]))))
+        if kind == "duplicate":
+            what = f"duplicate {seg}" if count == 1 else f"{count} duplicate segments"
+            msg = f"{what} at {_pt(where)}, {length:.4g} mm: cut twice"
+        else:
+            what = f"overlapping {seg}s share" if count == 1 else f"{count} overlaps share"
+            msg = f"{what} {length:.4g} mm at {_pt(where)}"
+        out.append(Finding(kind, msg, where, names))
+    return out
+
+
+def short_segments(contours: Sequence[Contour], tiny_mm: float) -> list[Finding]:
+    """``zero-length`` and ``tiny-segment`` findings, located at the segment's start."""
+    out = []
+    for c in contours:
+        for s in c.segments:
+            if s.length <= ZERO_LENGTH_MM:
+                msg = f"zero-length {_kind(s)} at {_pt(s.start)}"
+                out.append(Finding("zero-length", msg, s.start, (_name(c),)))
+            elif s.length < tiny_mm:
+                msg = f"tiny {_kind(s)} of {s.length:.3g} mm at {_pt(s.start)} (< {tiny_mm:g} mm)"
+                out.append(Finding("tiny-segment", msg, s.start, (_name(c),)))
+    return out
+
+
+def _same(a: Segment, b: Segment, tol: float) -> bool:
+    if type(a) is not type(b):
+        return False
+    if isinstance(a, Arc) and isinstance(b, Arc):
+        if distance(a.centre, b.centre) > tol or abs(a.radius - b.radius) > tol:
+            return False
+        if a.is_full_circle or b.is_full_circle:
+            return a.is_full_circle and b.is_full_circle
+        b = b if a.clockwise == b.clockwise else b.reversed()
+        return distance(a.start, b.start) <= tol and distance(a.end, b.end) <= tol
+    fwd = distance(a.start, b.start) <= tol and distance(a.end, b.end) <= tol
+    return fwd or (distance(a.start, b.end) <= tol and distance(a.end, b.start) <= tol)
+
+
+def _overlap(a: Segment, b: Segment, tol: float) -> tuple[float, Point] | None:
+    """Shared length (> ``tol``) and a point of it, for collinear lines or co-circular arcs."""
+    if isinstance(a, Line) and isinstance(b, Line):
+        return _line_overlap(a, b, tol)
+    if isinstance(a, Arc) and isinstance(b, Arc):
+        return _arc_overlap(a, b, tol)
+    return None
+
+
+def _line_overlap(a: Line, b: Line, tol: float) -> tuple[float, Point] | None:
+    long, short = (a, b) if a.length >= b.length else (b, a)
+    (x0, y0), (x1, y1) = long.start, long.end
+    ux, uy = (x1 - x0) / long.length, (y1 - y0) / long.length
+    off = [(p[0] - x0) * -uy + (p[1] - y0) * ux for p in (short.start, short.end)]
+    if max(abs(o) for o in off) > tol:
+        return None
+    ts = sorted((p[0] - x0) * ux + (p[1] - y0) * uy for p in (short.start, short.end))
+    lo, hi = max(0.0, ts[0]), min(long.length, ts[1])
+    if hi - lo <= tol:
+        return None
+    mid = (lo + hi) / 2
+    return hi - lo, (x0 + ux * mid, y0 + uy * mid)
+
+
+def _arc_overlap(a: Arc, b: Arc, tol: float) -> tuple[float, Point] | None:
+    if distance(a.centre, b.centre) > tol or abs(a.radius - b.radius) > tol:
+        return None
+    (s1, e1), (s2, e2) = _ccw_span(a), _ccw_span(b)
+    best = (0.0, 0.0)
+    for k in (-1, 0, 1):
+        lo, hi = max(s1, s2 + k * TAU), min(s1 + e1, s2 + e2 + k * TAU)
+        if hi - lo > best[0]:
+            best = (hi - lo, (lo + hi) / 2)
+    length = best[0] * a.radius
+    if length <= tol:
+        return None
+    ang = best[1]
+    return length, (a.centre[0] + a.radius * math.cos(ang), a.centre[1] + a.radius * math.sin(ang))
+
+
+def _ccw_span(arc: Arc) -> tuple[float, float]:
+    """The arc as a counter-clockwise interval ``(start angle in [0, 2π), extent)``."""
+    sweep = arc.sweep
+    start = arc.start_angle if sweep > 0 else arc.start_angle + sweep
+    return start % TAU, abs(sweep)
+
+
+def _grow(b: tuple[float, float, float, float], d: float) -> tuple[float, float, float, float]:
+    return (b[0] - d, b[1] - d, b[2] + d, b[3] + d)
+
+
+def _kind(s: Segment) -> str:
+    return "arc" if isinstance(s, Arc) else "line"
+
+
+def _name(c: Contour) -> str:
+    return c.source or f"contour on layer {c.layer!r}"
+
+
+def _pt(p: Point) -> str:
+    return f"({p[0]:.4f}, {p[1]:.4f})"

@@ -3,12 +3,19 @@
 Built on svgelements (https://github.com/meerk40t/svgelements), which resolves CSS (``style``
 attributes and ``<style>`` sheets), ``<use>``, nested transforms and every path command
 (M L H V C S Q T A Z, absolute and relative, with ``S``/``T`` control-point reflection) into
-segments. Around it, :mod:`camtool.importers.svgdoc` reads the page size and viewBox
-exactly, checks syntax, selects Inkscape layers and counts what is skipped (with
-:mod:`camtool.importers.svgtree`), and
-:mod:`camtool.importers.svgcurves` maps each segment to mm: circular arcs (after the full
-transform) become exact :class:`~camtool.model.shapes.Arc` objects, Béziers and elliptical arcs
-are biarc-fitted within the tolerance.
+segments. Before it, :mod:`camtool.importers.svgdoc` reads the page size and viewBox
+exactly, checks syntax, selects Inkscape layers and counts what is skipped; after it,
+:func:`convert` maps each segment to mm: circular arcs (after the full transform) become
+exact :class:`~camtool.model.shapes.Arc` objects, Béziers and elliptical arcs are
+biarc-fitted within the tolerance (:mod:`camtool.geometry.curves`).
+
+Each shape's segments are mapped with the full affine map from its own (local) coordinates
+to mm with Y up. Every curve is mapped exactly before it is judged: a Bézier's control points
+map to the control points of the image curve, and an elliptical arc ``c + a·cos t + b·sin t``
+maps to ``C + A·cos t + B·sin t`` with ``A``, ``B`` the images of its conjugate
+semi-diameters ``a``, ``b``. The image is a circle when ``A`` and ``B`` are perpendicular and
+of equal length, i.e. when the two singular values of ``[A B]`` agree; a circle under a
+non-uniform scale or a skew is an ellipse and is fitted.
 
 Rules (docs/importers/svg.md for the user's view):
 
@@ -21,24 +28,46 @@ Rules (docs/importers/svg.md for the user's view):
 - Contour.layer is the innermost Inkscape layer's name (``"0"`` outside any layer);
   Contour.source names the element: ``path#id`` or ``path[3]`` (the third ``<path>``), with
   ``use#u1 > path#p`` for a clone and `` subpath 2`` when an element has several.
+
+Sources: SVG 1.1 §8.3 (path data) and implementation notes F.6 (elliptical arcs);
+segments are parsed by svgelements (``Move``, ``Line``, ``Close``, ``Arc``,
+``QuadraticBezier``, ``CubicBezier``); curves are fitted by
+:func:`camtool.geometry.arcfit.fit_curve`.
 """
 
 from __future__ import annotations
 
 import io
-from collections.abc import Iterator
+import math
+from collections.abc import Iterable, Iterator
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeAlias
 
 import svgelements as se
 
-from camtool.geometry.fitgeom import check_tolerance
-from camtool.importers import ImportOptions
-from camtool.importers.svgcurves import Affine, affine_of, compose, convert
-from camtool.importers.svgdoc import Prepared, prepare
-from camtool.importers.svgtree import LAYER_ATTR, SOURCE_ATTR, USE_ATTR
-from camtool.model.errors import InputError, ToolpathError
-from camtool.model.shapes import Contour, Drawing
+from camtool.geometry.arcfit import check_tolerance, fit_curve
+from camtool.geometry.chain import with_end
+from camtool.geometry.curves import (
+    PointFn,
+    cubic_bezier,
+    ellipse_arc,
+    merge_arcs,
+    quadratic_bezier,
+    semi_axes_gap,
+)
+from camtool.importers import MAX_COORDINATE_MM, ImportOptions, check_curve_size
+from camtool.importers.svgdoc import (
+    LAYER_ATTR,
+    SOURCE_ATTR,
+    USE_ATTR,
+    Affine,
+    Prepared,
+    apply,
+    compose,
+    prepare,
+)
+from camtool.model.errors import GeometryError, InputError
+from camtool.model.shapes import TAU, Arc, Contour, Drawing, Line, Point, Segment, distance
 
 DEFAULT_LAYER = "0"
 """Contour.layer of shapes outside any Inkscape layer (the DXF default layer's name)."""
@@ -136,10 +165,200 @@ def _contours(path: Path, shape: Any, page: Affine, tolerance: float) -> list[Co
     m = compose(page, affine_of(shape.transform))
     try:
         subpaths = convert(shape.segments(transformed=False), m, tolerance)
-    except (ToolpathError, InputError) as exc:
+    except (GeometryError, InputError) as exc:
         raise InputError(f"{path}: {label}: {exc}") from exc
     many = len(subpaths) > 1
     return [
         Contour(segs, closed, layer, f"{label} subpath {k}" if many else label)
         for k, (segs, closed) in enumerate(subpaths, start=1)
     ]
+
+
+# ------------------------------------------------------------------ path segments to mm
+
+ZERO_LENGTH_MM = 1e-9
+"""Segments shorter than this (mm) are dropped; ends closer than this are one point."""
+_SEMI = 1e-7  # a centre this close (× chord) to the chord midpoint is a half ellipse
+
+
+def affine_of(matrix: Any) -> Affine:
+    """An svgelements ``Matrix`` as an :data:`Affine`."""
+    return (
+        float(matrix.a),
+        float(matrix.b),
+        float(matrix.c),
+        float(matrix.d),
+        float(matrix.e),
+        float(matrix.f),
+    )
+
+
+Subpath: TypeAlias = tuple[tuple[Segment, ...], bool]
+"""One subpath's segments (each starting where the previous ended) and whether it is closed."""
+
+
+def convert(segments: Iterable[Any], m: Affine, tolerance: float) -> list[Subpath]:
+    """Turn svgelements path segments (local coordinates) into subpaths in mm, Y up.
+
+    Each ``Move`` starts a subpath; ``Close`` draws the line back to the subpath's start
+    (unless already there) and closes it. A subpath whose last point is within 1e-9 mm of
+    its first is closed too. Zero-length segments are dropped; consecutive arcs on one
+    circle (a ``<circle>``'s quarters, an arc split in two) are merged.
+
+    Args:
+        segments: svgelements segments of one shape, untransformed.
+        m: local coordinates to mm, Y up.
+        tolerance: largest distance, mm, between a Bézier or a non-circular elliptical arc
+            and the arcs and lines fitted to it (> 0).
+
+    Returns:
+        ``(segments, closed)`` per subpath that draws something.
+
+    Raises:
+        GeometryError: a curve could not be fitted (from :func:`fit_curve`).
+        InputError: a point, control point or arc centre is NaN, infinite or beyond
+            ±:data:`~camtool.importers.MAX_COORDINATE_MM` once mapped to mm (checked
+            before any fitting, which would spin on a control point at 1e20).
+    """
+    out: list[Subpath] = []
+    current: list[Segment] = []
+    start: Point | None = None
+    cursor: Point | None = None
+
+    def flush(closed: bool) -> None:
+        if current:
+            segs = merge_arcs(current)
+            if start is not None and distance(segs[-1].end, start) <= ZERO_LENGTH_MM:
+                segs[-1] = with_end(segs[-1], start)
+                closed = True
+            out.append((tuple(segs), closed))
+        current.clear()
+
+    for seg in segments:
+        if isinstance(seg, se.Move):
+            flush(False)
+            start = cursor = _pt(m, seg.end)
+            continue
+        if cursor is None or start is None:  # svgelements always starts with Move
+            start = cursor = _pt(m, seg.start)
+        if isinstance(seg, se.Close):
+            if distance(cursor, start) > ZERO_LENGTH_MM:
+                current.append(Line(cursor, start))
+            flush(True)
+            cursor = start
+            continue
+        new = segment(seg, cursor, m, tolerance)
+        for piece in new:
+            if isinstance(piece, Arc):
+                _check(piece.centre, "an arc centre")
+        current.extend(new)
+        if new:
+            cursor = new[-1].end
+    flush(False)
+    return out
+
+
+def segment(seg: Any, p0: Point, m: Affine, tolerance: float) -> list[Segment]:
+    """One svgelements drawing segment from ``p0`` (mm, already mapped) as lines and arcs.
+
+    Raises:
+        ValueError: ``seg`` is of a kind svgelements does not produce in a path.
+    """
+    if isinstance(seg, se.Line):
+        return _line(p0, _pt(m, seg.end))
+    if isinstance(seg, se.CubicBezier):
+        ctrl = (p0, _pt(m, seg.control1), _pt(m, seg.control2), _pt(m, seg.end))
+        _check_size(ctrl, tolerance)
+        return _fit(*cubic_bezier(ctrl), tolerance)
+    if isinstance(seg, se.QuadraticBezier):
+        ctrl3 = (p0, _pt(m, seg.control), _pt(m, seg.end))
+        _check_size(ctrl3, tolerance)
+        return _fit(*quadratic_bezier(ctrl3), tolerance)
+    if isinstance(seg, se.Arc):
+        return _arc(seg, p0, m, tolerance)
+    raise ValueError(f"unexpected path segment {type(seg).__name__}")
+
+
+def _pt(m: Affine, p: Any) -> Point:
+    """``p`` mapped to mm, checked to be finite and within the bound."""
+    return _check(apply(m, float(p.x), float(p.y)), "a point")
+
+
+def _check_size(points: Iterable[Point], tolerance: float) -> None:
+    """Refuse a curve whose control points span too much for ``tolerance`` (InputError)."""
+    xs, ys = zip(*points, strict=True)
+    try:
+        check_curve_size(2.0 * max(max(xs) - min(xs), max(ys) - min(ys)), tolerance)
+    except ValueError as exc:
+        raise InputError(str(exc).replace(" across", " mm across", 1)) from None
+
+
+def _check(p: Point, what: str) -> Point:
+    x, y = p
+    if not (abs(x) <= MAX_COORDINATE_MM and abs(y) <= MAX_COORDINATE_MM):
+        raise InputError(
+            f"{what} at ({x:g}, {y:g}) mm, not a finite number within ±1e9 mm; the "
+            "path data, a transform or the viewBox holds a number far too large"
+        )
+    return p
+
+
+def _line(p0: Point, p1: Point) -> list[Segment]:
+    return [Line(p0, p1)] if distance(p0, p1) > ZERO_LENGTH_MM else []
+
+
+def _fit(point_at: PointFn, tangent_at: PointFn, tolerance: float) -> list[Segment]:
+    segs = fit_curve(point_at, tangent_at, 0.0, 1.0, tolerance)
+    return segs if sum(s.length for s in segs) > ZERO_LENGTH_MM else []
+
+
+def _arc(seg: Any, p0: Point, m: Affine, tolerance: float) -> list[Segment]:
+    """An svgelements elliptical arc: an exact Arc where its image is a circle, else fitted.
+
+    svgelements keeps the arc as centre ``c``, ``prx`` (the point at t = 0), ``pry`` (at
+    t = π/2) and a signed ``sweep`` in t, so the local curve is ``c + a cos t + b sin t``
+    with ``a = prx - c``, ``b = pry - c``.
+    """
+    p1 = _pt(m, seg.end)
+    sweep = float(seg.sweep or 0.0)
+    (cx, cy), (sx, sy), (ex, ey) = _xy(seg.center), _xy(seg.start), _xy(seg.end)
+    ax, ay = float(seg.prx.x) - cx, float(seg.prx.y) - cy
+    bx, by = float(seg.pry.x) - cx, float(seg.pry.y) - cy
+    det = ax * by - ay * bx
+    if sweep == 0.0 or not math.isfinite(det) or abs(det) <= 1e-300:
+        return _line(p0, p1)  # SVG F.6.2: a zero radius makes a straight line
+    # svgelements takes the centre from sqrt(max-radius-correction), which leaves ~1e-8
+    # of noise on half ellipses (radii scaled up to fit the chord); put them back exactly
+    mx, my = 0.5 * (sx + ex), 0.5 * (sy + ey)
+    if math.hypot(cx - mx, cy - my) <= _SEMI * math.hypot(ex - sx, ey - sy):
+        cx, cy, sweep = mx, my, math.copysign(math.pi, sweep)
+    dx, dy = sx - cx, sy - cy
+    t0 = math.atan2((ax * dy - ay * dx) / det, (dx * by - dy * bx) / det)
+    centre = apply(m, cx, cy)
+    big_a = (m[0] * ax + m[2] * ay, m[1] * ax + m[3] * ay)
+    big_b = (m[0] * bx + m[2] * by, m[1] * bx + m[3] * by)
+    cross = big_a[0] * big_b[1] - big_a[1] * big_b[0]
+    if semi_axes_gap(big_a, big_b, cross) <= 0.1 * tolerance:
+        return _circular(p0, p1, centre, ccw=cross * sweep > 0.0, sweep=sweep)
+    _check(centre, "an ellipse centre")
+    _check_size([centre, (centre[0] + big_a[0], centre[1] + big_a[1]),
+                 (centre[0] + big_b[0], centre[1] + big_b[1]), p0, p1], tolerance)  # fmt: skip
+    return _fit(*ellipse_arc(centre, big_a, big_b, t0, sweep, p0, p1), tolerance)
+
+
+def _xy(p: Any) -> Point:
+    return (float(p.x), float(p.y))
+
+
+def _circular(p0: Point, p1: Point, centre: Point, *, ccw: bool, sweep: float) -> list[Segment]:
+    if distance(p0, p1) <= ZERO_LENGTH_MM:
+        if abs(abs(sweep) - TAU) > 1e-9:
+            return []  # SVG F.6.2: an arc whose ends coincide is omitted
+        return [Arc(p0, p0, centre, not ccw)]
+    # centre exactly on the bisector of the chord, so both ends are on one circle
+    (x0, y0), (x1, y1) = p0, p1
+    mx, my = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
+    chord = math.hypot(x1 - x0, y1 - y0)
+    nx, ny = -(y1 - y0) / chord, (x1 - x0) / chord
+    lam = (centre[0] - mx) * nx + (centre[1] - my) * ny
+    return [Arc(p0, p1, (mx + lam * nx, my + lam * ny), not ccw)]

@@ -30,6 +30,17 @@ class ToolpathError(CamtoolError, ValueError):
     """A toolpath cannot be planned (e.g. an offset fails). Exit code 1."""
 
 
+class GeometryError(ToolpathError):
+    """A shared geometry algorithm cannot give a result. Exit code 1.
+
+    Raised by :mod:`camtool.geometry` and the model's shapes: a curve fit that does not
+    converge, a curve point or an arc that is not finite, an end point that cannot be
+    chained. Importers catch this one (never :class:`ToolpathError`) to name the entity;
+    it stays a :class:`ToolpathError` so that the planner, which calls the same
+    functions, reports it as it always did (same exit code, same message).
+    """
+
+
 class DialectError(CamtoolError, ValueError):
     """A program cannot be expressed in a target's dialect. Exit code 1.
 

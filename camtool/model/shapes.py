@@ -16,7 +16,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import TypeAlias
 
-from camtool.model.errors import ToolpathError, UsageError
+from camtool.model.errors import GeometryError, UsageError
 from camtool.model.units import fmt_num
 
 Point: TypeAlias = tuple[float, float]
@@ -188,26 +188,44 @@ _SMALL_RATIO = 1e-6  # below this tolerance/radius, acos(1 − x) loses digits: 
 
 
 def chord_count(radius: float, sweep: float, tolerance: float) -> int:
-    """Number of equal chords so that each deviates from the arc by ≤ ``tolerance``.
+    """Fewest equal chords over an arc so that each deviates from it by ≤ ``tolerance``.
 
-    The sagitta of a chord spanning angle θ is ``r·(1 − cos(θ/2))``, so the
-    widest chord spans ``2·acos(1 − t/r)`` = ``4·asin(√(t/2r))`` (the second form
-    for t/r under 1e-6, where the first rounds to 0).
+    The one chord rule of camtool: the planner and the writers (:meth:`Arc.points`), the
+    fitter's statistics (:func:`camtool.geometry.arcfit.chord_equivalent`) and the
+    verifier's ``sagitta`` chord model (machines with ``chords = "sagitta"``) all count
+    chords here. The sagitta of a chord spanning angle θ is ``r·(1 − cos(θ/2))``
+    (seed-004 §4.2, "chord error per segment"), so the widest chord spans
+    ``2·acos(1 − t/r)`` and the count is ``⌈sweep / that⌉`` (less 1e-9, so that an exact
+    quotient is not rounded up).
+
+    Edge cases:
+
+    - ``tolerance ≥ radius``: any chord is within the tolerance; ``⌈sweep/π⌉`` chords (at
+      least 1), so that an arc over half a turn (a full circle) still goes round rather than
+      becoming one chord from its start back to its start.
+    - tiny ratio: for ``t/r`` under 1e-6, ``acos(1 − t/r)`` loses its digits (1 − t/r
+      rounds), so the equal form ``4·asin(√(t/2r))`` is used.
+    - zero sweep: 1 chord (from start to end; ``max(1, …)``).
+    - the count is capped at :data:`MAX_CHORDS`: more is a tolerance far too small for the
+      radius and raises instead of building millions of points.
 
     Args:
         radius: arc radius, mm (≥ 0, finite).
-        sweep: unsigned sweep, radians (finite).
+        sweep: unsigned sweep, radians (finite; a negative sweep gives 1 chord).
         tolerance: largest allowed chord error, mm (> 0, finite).
 
+    Returns:
+        Chord count, ``≥ 1``.
+
     Raises:
-        ToolpathError: ``radius`` or ``sweep`` is not finite (importers refuse such
+        GeometryError: ``radius`` or ``sweep`` is not finite (importers refuse such
             drawings: an internal check).
         UsageError: ``tolerance`` is not a finite number > 0, or the arc would need
             more than :data:`MAX_CHORDS` chords (the tolerance is far too small
             for the radius).
     """
     if not (math.isfinite(radius) and math.isfinite(sweep)):
-        raise ToolpathError(
+        raise GeometryError(
             f"an arc has radius {radius!r} mm and sweep {sweep!r} rad; both must be finite"
         )
     if not (tolerance > 0 and math.isfinite(tolerance)):

@@ -1,6 +1,6 @@
 """Open contours that nearly meet: say how far apart their ends are and what would join them.
 
-Real CAD files leave gaps between entities that should meet. :func:`~camtool.toolpath.chain.chain`
+Real CAD files leave gaps between entities that should meet. :func:`~camtool.geometry.chain.chain`
 joins ends within ``--chain-tolerance`` and :func:`~camtool.toolpath.chain.close_gaps` closes a
 contour whose own ends are within ``--close-gap``; what stays open is reported here, with the
 value of the option that would join it, so that the user can decide (a deliberate open path

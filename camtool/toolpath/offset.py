@@ -23,9 +23,9 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+from camtool.geometry.chain import chain
 from camtool.model.errors import ToolpathError
 from camtool.model.shapes import Arc, Contour, Line, Point, Segment, distance
-from camtool.toolpath.chain import chain
 
 if TYPE_CHECKING:
     from shapely.geometry.base import BaseGeometry

@@ -27,10 +27,11 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from camtool.geometry.arcfit import FitStats, fit_polyline, fit_stats
+from camtool.geometry.chain import chain
 from camtool.model.errors import InputError
 from camtool.model.program import Move, Program, Rapid
 from camtool.model.shapes import Contour, Drawing, Line, Point, Segment
-from camtool.toolpath.chain import chain, close_gaps
+from camtool.toolpath.chain import close_gaps
 from camtool.toolpath.cuts import Finding, Stage
 from camtool.toolpath.gaps import MIN_JOINT_MM, open_gaps
 from camtool.toolpath.options import OFFSET_MODES, PlanOptions

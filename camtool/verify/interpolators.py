@@ -23,7 +23,7 @@ Arc interpolators on the step lattice (``arc = ...``), seed-000 §4.3–4.7:
 Chords (``arc = "chords"``): the rule ``sagitta`` (:func:`sagitta_chord_points`,
 the fewest equal chords within a tolerance) and the helpers every chord rule
 shares (:func:`arc_offsets`, :func:`freeze_points`, :func:`chord_sagitta`,
-:func:`segments_for_sagitta`); each chord is run by the line interpolator.
+:func:`camtool.model.shapes.chord_count`); each chord is run by the line interpolator.
 
 mm → steps rounding is :func:`~camtool.verify.quantize.steps_from_mm`.
 
@@ -79,7 +79,7 @@ import numpy.typing as npt
 
 from camtool.model.errors import InputError, UsageError
 from camtool.model.program import ArcMove
-from camtool.model.shapes import distance
+from camtool.model.shapes import chord_count, distance
 from camtool.verify.steparray import StepArray, concatenate, empty_steps, freeze
 
 _TIE_WINDOW = 1e-7
@@ -912,35 +912,11 @@ def chord_sagitta(radius_mm: float, angle_rad: float) -> float:
     return radius_mm * (1.0 - math.cos(abs(angle_rad) / 2.0))
 
 
-def segments_for_sagitta(radius_mm: float, sweep_rad: float, tolerance_mm: float) -> int:
-    """Fewest equal chords over ``sweep_rad`` whose sagitta is at most ``tolerance_mm``.
-
-    Args:
-        radius_mm: Radius, mm, ``> 0``.
-        sweep_rad: Swept angle, rad (sign ignored).
-        tolerance_mm: Largest chord error allowed, mm, ``> 0``.
-
-    Returns:
-        Segment count, ``>= 1``.
-
-    Raises:
-        UsageError: If ``radius_mm`` or ``tolerance_mm`` is not positive.
-    """
-    if not (radius_mm > 0 and tolerance_mm > 0):
-        raise UsageError(
-            f"radius and tolerance must be > 0 mm, got {radius_mm!r} and {tolerance_mm!r}"
-        )
-    if tolerance_mm >= radius_mm:
-        return 1
-    beta_max = 2.0 * math.acos(1.0 - tolerance_mm / radius_mm)
-    return max(1, math.ceil(abs(sweep_rad) / beta_max - 1e-12))
-
-
 def sagitta_chord_points(start: Point, move: ArcMove, tolerance_mm: float) -> list[Point]:
     """End points of equal chords of an arc within ``tolerance_mm``: the ``sagitta`` chord rule.
 
     The fewest equal chords whose sagitta is at most ``tolerance_mm``
-    (:func:`segments_for_sagitta`), radius from the start point; the last point is
+    (:func:`camtool.model.shapes.chord_count`), radius from the start point; the last point is
     the programmed end. A start equal to the end is a full circle.
 
     Args:
@@ -960,7 +936,7 @@ def sagitta_chord_points(start: Point, move: ArcMove, tolerance_mm: float) -> li
     sweep = sweep % turn or turn
     if distance(start, (move.x, move.y)) > 1e-9 and abs(abs(sweep) - math.tau) < 1e-12:
         sweep = 0.0
-    n = segments_for_sagitta(radius, sweep, tolerance_mm) if radius > 0 else 1
+    n = chord_count(radius, abs(sweep), tolerance_mm) if radius > 0 else 1
     points = [
         (cx + radius * math.cos(a0 + sweep * k / n), cy + radius * math.sin(a0 + sweep * k / n))
         for k in range(n + 1)

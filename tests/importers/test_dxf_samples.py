@@ -13,10 +13,10 @@ import numpy as np
 import pytest
 
 from camtool.geometry.arcfit import distances
+from camtool.geometry.chain import chain
 from camtool.importers.dxf import import_dxf
 from camtool.importers.lint import inspect_drawing
 from camtool.model.shapes import Arc, Contour, Line
-from camtool.toolpath.chain import chain
 
 DATA = Path(__file__).parents[1] / "data"
 TOL = 0.001

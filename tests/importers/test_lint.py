@@ -10,8 +10,7 @@ from typing import Any
 import pytest
 
 from camtool.importers import ImportOptions
-from camtool.importers.lint import inspect_drawing
-from camtool.importers.lint_checks import check_drawing
+from camtool.importers.lint import check_drawing, inspect_drawing
 from camtool.model.shapes import Arc, Contour, Drawing, Line
 from tests.shapes import write_dxf
 

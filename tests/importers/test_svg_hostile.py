@@ -17,7 +17,7 @@ import pytest
 from camtool.cli.main import main
 from camtool.importers import MAX_ENTITIES, ImportOptions
 from camtool.importers.svg import read_svg
-from camtool.importers.svgtree import MAX_DEPTH
+from camtool.importers.svgdoc import MAX_DEPTH
 from camtool.model.errors import InputError
 from tests.importers.svgutil import svg
 

@@ -18,11 +18,11 @@ from camtool_postprocessors.valcnc_motion import (
     valcnc_block_time_s,
 )
 
+from camtool.model.shapes import chord_count
 from camtool.verify.interpolators import (
     accumulator_dda_line,
     chord_sagitta,
     polyline_steps,
-    segments_for_sagitta,
 )
 from camtool.verify.quantize import steps_from_mm
 from camtool.verify.steparray import positions
@@ -97,7 +97,7 @@ def test_valcnc_arc_points():
 def test_valcnc_quarter_arc_through_the_line_dda():
     # seed-004 §8 S004-R12: quarter arc R = 10 mm, β for sagitta ≤ 0.02 mm, chords run
     # by the line DDA at 0.04 mm/step stay within 0.02 + 0.04 mm of the true circle
-    n = segments_for_sagitta(10.0, math.pi / 2, 0.02)
+    n = chord_count(10.0, math.pi / 2, 0.02)
     beta = (math.pi / 2) / n
     assert chord_sagitta(10.0, beta) <= 0.02
     pts = valcnc_arc_points((10.0, 0.0), (0.0, 10.0), (0.0, 0.0), False, beta_rad=beta)

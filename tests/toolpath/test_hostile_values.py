@@ -14,11 +14,12 @@ from pathlib import Path
 import pytest
 
 from camtool.cli.main import main
-from camtool.geometry.polyfit import fit_polyline
+from camtool.geometry.arcfit import fit_polyline
+from camtool.geometry.chain import chain
 from camtool.model.errors import InputError, ToolpathError, UsageError
 from camtool.model.shapes import MAX_CHORDS, Contour, Line, chord_count
 from camtool.toolpath import offset, pocket_uncut
-from camtool.toolpath.chain import chain, close_gaps
+from camtool.toolpath.chain import close_gaps
 from camtool.toolpath.pocket import MAX_POCKET_PATHS
 
 

@@ -8,11 +8,11 @@ from typing import Any
 
 import pytest
 
+from camtool.geometry.chain import chain
 from camtool.importers.dxf import read_dxf
 from camtool.model.errors import ToolpathError, UsageError
 from camtool.model.program import ArcMove, Rapid
 from camtool.model.shapes import Arc, Contour, Drawing, Line
-from camtool.toolpath.chain import chain
 from camtool.toolpath.compensate import compensate
 from camtool.toolpath.offset import offset_contour
 from camtool.toolpath.order import nesting, order_cuts

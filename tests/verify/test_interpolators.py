@@ -14,6 +14,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from camtool.model.errors import InputError, UsageError
+from camtool.model.shapes import chord_count
 from camtool.verify.interpolators import (
     accumulator_dda_line,
     accumulator_dda_reference,
@@ -31,7 +32,6 @@ from camtool.verify.interpolators import (
     dsm_arc,
     dsm_arc_reference,
     polyline_steps,
-    segments_for_sagitta,
     staircase_arc,
 )
 from camtool.verify.quantize import steps_from_mm
@@ -459,12 +459,12 @@ def test_arc_rejects_bad_input(arc):
 # --------------------------------------------------------------------------- chord arcs
 
 
-def test_segments_for_sagitta():
+def test_chord_count():
     # analytic: the returned count meets the tolerance and one fewer does not
-    n = segments_for_sagitta(5.0, math.pi, 0.01)
+    n = chord_count(5.0, math.pi, 0.01)
     assert chord_sagitta(5.0, math.pi / n) <= 0.01 < chord_sagitta(5.0, math.pi / (n - 1))
     with pytest.raises(UsageError):
-        segments_for_sagitta(5.0, math.pi, 0.0)
+        chord_count(5.0, math.pi, 0.0)
 
 
 def test_polyline_steps_joins_lines():

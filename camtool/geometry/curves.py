@@ -1,0 +1,202 @@
+"""Smooth curves as lines and arcs: Béziers and ellipses evaluated, fitted piece by piece.
+
+The importers read curves (SVG Béziers and elliptical arcs, DXF ELLIPSE and SPLINE) and hand
+their parametric form to this module: :func:`cubic_bezier`, :func:`quadratic_bezier`,
+:func:`ellipse` and :func:`ellipse_arc` give ``(point_at, tangent_at)`` pairs, and
+:func:`fit_pieces` fits a curve between its possible corners with the shared biarc fitter
+(:func:`camtool.geometry.arcfit.fit_curve`), so the output lies within the tolerance of the
+curve and the curve within the tolerance of the output. :func:`semi_axes_gap` tells an ellipse
+that is really a circle (then the importer writes one exact arc), :func:`corner_knots` where a
+B-spline may have a corner, :func:`merge_arcs` joins neighbouring arcs of one circle.
+
+Conventions: any length unit (the importers work in drawing units or mm; the tolerance must
+be in the same unit), Y up, arcs exact (``clockwise=True`` is G02). An ellipse is
+``c + a·cos t + b·sin t`` with ``a``, ``b`` conjugate semi-diameters (DXF reference, ELLIPSE;
+SVG 1.1 implementation notes F.6).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Callable, Sequence
+from typing import TypeAlias
+
+from camtool.geometry.arcfit import fit_curve
+from camtool.geometry.chain import snap
+from camtool.model.shapes import Arc, Line, Point, Segment, distance
+
+PointFn: TypeAlias = Callable[[float], Point]
+"""A curve point (or derivative) at a parameter."""
+
+
+def cubic_bezier(p: tuple[Point, Point, Point, Point]) -> tuple[PointFn, PointFn]:
+    """Point and derivative of the cubic Bézier with control points ``p``, for u in [0, 1]."""
+    (x0, y0), (x1, y1), (x2, y2), (x3, y3) = p
+
+    def point_at(u: float) -> Point:
+        v = 1.0 - u
+        w0, w1, w2, w3 = v * v * v, 3.0 * v * v * u, 3.0 * v * u * u, u * u * u
+        return (w0 * x0 + w1 * x1 + w2 * x2 + w3 * x3, w0 * y0 + w1 * y1 + w2 * y2 + w3 * y3)
+
+    def tangent_at(u: float) -> Point:
+        v = 1.0 - u
+        w0, w1, w2 = 3.0 * v * v, 6.0 * v * u, 3.0 * u * u
+        return (
+            w0 * (x1 - x0) + w1 * (x2 - x1) + w2 * (x3 - x2),
+            w0 * (y1 - y0) + w1 * (y2 - y1) + w2 * (y3 - y2),
+        )
+
+    return point_at, tangent_at
+
+
+def quadratic_bezier(p: tuple[Point, Point, Point]) -> tuple[PointFn, PointFn]:
+    """Point and derivative of the quadratic Bézier with control points ``p``, u in [0, 1]."""
+    (x0, y0), (x1, y1), (x2, y2) = p
+
+    def point_at(u: float) -> Point:
+        v = 1.0 - u
+        w0, w1, w2 = v * v, 2.0 * v * u, u * u
+        return (w0 * x0 + w1 * x1 + w2 * x2, w0 * y0 + w1 * y1 + w2 * y2)
+
+    def tangent_at(u: float) -> Point:
+        v = 1.0 - u
+        return (
+            2.0 * (v * (x1 - x0) + u * (x2 - x1)),
+            2.0 * (v * (y1 - y0) + u * (y2 - y1)),
+        )
+
+    return point_at, tangent_at
+
+
+def ellipse(centre: Point, a: Point, b: Point) -> tuple[PointFn, PointFn]:
+    """Point and derivative of ``c + a·cos t + b·sin t`` at the angle parameter ``t``, rad.
+
+    With ``a`` the major axis and ``b`` the minor one this is a DXF ELLIPSE (``b`` is the
+    extrusion × major axis × ratio, so an extrusion of (0, 0, −1) runs clockwise).
+    """
+    cx, cy = centre
+    mx, my = a
+    nx, ny = b
+
+    def point_at(t: float) -> Point:
+        c, s = math.cos(t), math.sin(t)
+        return (cx + mx * c + nx * s, cy + my * c + ny * s)
+
+    def tangent_at(t: float) -> Point:
+        c, s = math.cos(t), math.sin(t)
+        return (-mx * s + nx * c, -my * s + ny * c)
+
+    return point_at, tangent_at
+
+
+def ellipse_arc(
+    centre: Point, a: Point, b: Point, t0: float, sweep: float, p0: Point, p1: Point
+) -> tuple[PointFn, PointFn]:
+    """The arc of ``c + a·cos t + b·sin t`` from ``t0`` over ``sweep`` rad, for u in [0, 1].
+
+    ``t = t0 + sweep·u``; the ends are exactly ``p0`` (u ≤ 0) and ``p1`` (u ≥ 1), the end
+    points the path data gives (SVG elliptical arcs), whatever the rounding of the form.
+    """
+    cx, cy = centre
+
+    def point_at(u: float) -> Point:
+        if u <= 0.0:
+            return p0
+        if u >= 1.0:
+            return p1
+        t = t0 + sweep * u
+        c, s = math.cos(t), math.sin(t)
+        return (cx + a[0] * c + b[0] * s, cy + a[1] * c + b[1] * s)
+
+    def tangent_at(u: float) -> Point:
+        t = t0 + sweep * u
+        c, s = math.cos(t), math.sin(t)
+        return (sweep * (b[0] * c - a[0] * s), sweep * (b[1] * c - a[1] * s))
+
+    return point_at, tangent_at
+
+
+def semi_axes_gap(a: Point, b: Point, cross: float) -> float:
+    """Difference of the semi-axes (singular values) of the ellipse with semi-diameters a, b.
+
+    With s1, s2 the singular values of ``[a b]``: s1² + s2² = |a|² + |b|², s1·s2 = |a × b|,
+    so (s1 - s2)² = |a|² + |b|² - 2|a × b|. ``cross`` is ``a × b``. Zero for a circle.
+    """
+    return math.sqrt(max(0.0, a[0] ** 2 + a[1] ** 2 + b[0] ** 2 + b[1] ** 2 - 2.0 * abs(cross)))
+
+
+def corner_knots(knots: Sequence[float], p: int, t0: float, t1: float) -> list[float]:
+    """Inner knots of multiplicity ≥ p (the B-spline of degree p is only C0 there), ascending."""
+    inner = [float(k) for k in knots if t0 < k < t1]
+    return [k for k, run in itertools.groupby(inner) if len(list(run)) >= p]
+
+
+def fit_pieces(
+    point_at: PointFn,
+    tangent_at: PointFn,
+    breaks: Sequence[float],
+    tolerance: float,
+    closed: bool,
+) -> list[Segment]:
+    """Fit each piece between ``breaks``; tangents at a piece's end are taken from inside.
+
+    A closed curve's last point is snapped onto its first (they are within the
+    tolerance; for full ellipses and periodic splines within rounding).
+
+    Args:
+        point_at: curve point at a parameter in ``[breaks[0], breaks[-1]]``.
+        tangent_at: curve derivative there (any length, towards increasing parameter).
+        breaks: ascending parameters: both ends and the possible corners between.
+        tolerance: largest distance between curve and output, both ways (> 0).
+        closed: the curve ends where it starts.
+
+    Returns:
+        Segments each starting exactly where the one before ends; empty when the curve is
+        one point.
+
+    Raises:
+        GeometryError: a piece could not be fitted (from
+            :func:`~camtool.geometry.arcfit.fit_curve`).
+        UsageError: bad ``tolerance`` or parameter range.
+    """
+    segs: list[Segment] = []
+    for a, b in itertools.pairwise(breaks):
+        inside = math.nextafter(b, -math.inf)
+
+        def tangent(t: float, inside: float = inside) -> Point:
+            return tangent_at(min(t, inside))
+
+        segs.extend(fit_curve(point_at, tangent, a, b, tolerance))
+    if not segs:
+        return segs
+    segs = snap(segs)
+    if closed and segs[-1].end != segs[0].start:
+        last = segs[-1]
+        segs[-1] = (
+            Line(last.start, segs[0].start)
+            if isinstance(last, Line)
+            else Arc(last.start, segs[0].start, last.centre, last.clockwise)
+        )
+    return segs
+
+
+def merge_arcs(segs: list[Segment]) -> list[Segment]:
+    """Join neighbouring arcs of one circle and direction (total sweep up to a full turn).
+
+    Centres and radii must agree within 1e-9 × max(1, radius) and the sweeps must add up:
+    arcs that were one arc before the drawing split them (a circle's quarters).
+    """
+    out: list[Segment] = []
+    for seg in segs:
+        prev = out[-1] if out else None
+        if isinstance(prev, Arc) and isinstance(seg, Arc) and prev.clockwise == seg.clockwise:
+            r = max(1.0, prev.radius)
+            same = distance(prev.centre, seg.centre) <= 1e-9 * r
+            if same and abs(prev.radius - seg.radius) <= 1e-9 * r:
+                joined = Arc(prev.start, seg.end, prev.centre, prev.clockwise)
+                if abs(joined.sweep - prev.sweep - seg.sweep) <= 1e-9:
+                    out[-1] = joined
+                    continue
+        out.append(seg)
+    return out
