@@ -38,10 +38,10 @@ from typing import Literal
 
 import numpy as np
 import numpy.typing as npt
+from camtool_postprocessors.matlab_router_arrays import RouterArrays, router_arrays
 
 from camtool.model.errors import ToolpathError, UsageError
 from camtool.model.units import TENTH_MM
-from camtool.post.router_arrays import RouterArrays, router_arrays
 from camtool.verify.servo_plant import (
     FIRMWARE_GAINS,
     LAWS,

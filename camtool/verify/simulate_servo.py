@@ -18,11 +18,11 @@ its rapid is timed as that dog-leg (R13).
 from __future__ import annotations
 
 import numpy as np
+from camtool_postprocessors.matlab_router_arrays import points_01mm
 
 from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Move, Program
 from camtool.model.shapes import distance
-from camtool.post.router_arrays import points_01mm
 from camtool.verify.servo import RouterMachine, simulate_job
 from camtool.verify.simulate import StepTrace, sagitta_chord_points
 from camtool.verify.steparray import STEP_DTYPE, read_only

@@ -11,11 +11,11 @@ import time
 
 import numpy as np
 import pytest
+from camtool_postprocessors.matlab_router_arrays import router_arrays
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from camtool.model.errors import UsageError
-from camtool.post.router_arrays import router_arrays
 from camtool.verify.servo import (
     RouterMachine,
     ServoTrace,
@@ -419,8 +419,8 @@ def test_each_strokes_measures_start_where_the_positioning_left_the_carriage() -
     The router moves to each job's first point X then Y (seed-002 R13); that point,
     not the end of the stroke before, is where the second contour starts.
     """
-    from camtool.model.machine import load_machine
     from camtool.model.program import Linear, Program, Rapid
+    from camtool.post.registry import load_machine
     from camtool.verify.verifier import verify_program
 
     def square(x: float) -> list[Rapid | Linear]:
