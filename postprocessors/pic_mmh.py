@@ -205,19 +205,87 @@ def _positive(name: str, value: Any) -> float:
 
 # -- pic_mmh ------------------------------------------------------------
 
-_COORD = r"([+-]?\d{5}\.\d{2})"
-_BLOCK = re.compile(rf"^G0(?P<g>[0-3])X{_COORD}Y{_COORD}(?:I{_COORD}J{_COORD})?(?:F(?P<f>\d\d))?;$")
+
+@dataclass(frozen=True)
+class Word:
+    """One word of the fixed-width pic-mmh grammar: a letter and a zero-padded number.
+
+    Both the writer (:meth:`format`, :meth:`coordinate`) and the reader
+    (:meth:`pattern`) are derived from it (seed-000 §3, S000-02…05).
+
+    Attributes:
+        letter: the address letter.
+        digits: integer digits, zero-padded (``X02969.00``: 5; ``F08``: 2).
+        decimals: digits after the point (0: an integer code without a point).
+        what: the value's name in messages ("feed code").
+        scale: code units per mm (coordinates: µm); 1 for codes.
+    """
+
+    letter: str
+    digits: int
+    decimals: int = 0
+    what: str = ""
+    scale: float = 1.0
+
+    @property
+    def largest(self) -> int:
+        """Largest integer code the word holds (``99`` for 2 digits)."""
+        return 10**self.digits - 1
+
+    def pattern(self, group: str) -> str:
+        """The regex of the word, its number captured as ``group`` (a sign only on decimals)."""
+        if self.decimals:
+            number = rf"[+-]?\d{{{self.digits}}}\.\d{{{self.decimals}}}"
+        else:
+            number = rf"\d{{{self.digits}}}"
+        return rf"{self.letter}(?P<{group}>{number})"
+
+    def coordinate(self, sign: str) -> NumberFormat:
+        """The number format of a coordinate word, with the sign policy ``sign``."""
+        return NumberFormat(
+            scale=self.scale, decimals=self.decimals, int_digits=self.digits, sign=sign
+        )
+
+    def format(self, code: int) -> str:
+        """The word of integer ``code`` (``F08``).
+
+        Raises:
+            DialectError: ``code`` is negative or needs more digits.
+        """
+        return self.letter + format_int(code, self.digits, what=self.what)
+
+
+WORDS: Mapping[str, Word] = MappingProxyType(
+    {
+        **{a: Word(a, 5, 2, "coordinate", 1000.0) for a in "XYIJ"},  # µm, ±5.2 (S000-02/03)
+        "F": Word("F", 2, what="feed code"),  # S000-05
+        "P": Word("P", 2, what="dwell"),  # G04P##, seconds (L3359–L3366)
+        "S": Word("S", 4, what="spindle speed"),  # M03S####, rev/min (Tabla 22)
+        "T": Word("T", 2, what="tool"),  # M06T## (L3455–L3464)
+    }
+)
+"""The grammar of every numbered word, declared once: the writer formats and the
+reader's patterns are built from it."""
+
+_W = WORDS
+_BLOCK = re.compile(
+    rf"^G0(?P<g>[0-3]){_W['X'].pattern('x')}{_W['Y'].pattern('y')}"
+    rf"(?:{_W['I'].pattern('i')}{_W['J'].pattern('j')})?(?:{_W['F'].pattern('f')})?;$"
+)
 _FRAME = frozenset({"G54;", "G90;", "M30;"})
 _FIXED: Mapping[str, Command] = MappingProxyType(
     {"M05;": Spindle("off"), "G28X0Y0;": Home("XY"), "G28Z0;": Home("Z")}
 )
-_ARGS = re.compile(r"^(?:G04P(?P<p>\d\d)|M0(?P<m>[34])S(?P<s>\d{4})|M06T(?P<t>\d\d));$")
+_ARGS = re.compile(
+    rf"^(?:G04{_W['P'].pattern('p')}|M0(?P<m>[34]){_W['S'].pattern('s')}"
+    rf"|M06{_W['T'].pattern('t')});$"
+)
 
-MAX_DWELL_S = 99
+MAX_DWELL_S = WORDS["P"].largest
 """Longest dwell of one ``G04P##;`` block, s (2 digits, seed-000 L3359–L3366)."""
-MAX_RPM = 9999
+MAX_RPM = WORDS["S"].largest
 """Highest spindle speed of ``M03S####;``, rev/min (4 digits, seed-000 L3418–L3436)."""
-MAX_TOOL = 99
+MAX_TOOL = WORDS["T"].largest
 """Highest magazine position of ``M06T##;`` (2 digits, seed-000 L3455–L3464)."""
 BUFFER_CHARS = 35
 """The firmware's receive vector ``CadenaControl`` (seed-000 L1739–L1744, S000-07)."""
@@ -280,7 +348,7 @@ class PicMmhPost(PostProcessor):
         feed_codes: Mapping[Any, Any] | None = None,
         max_line_chars: int | None = None,
     ) -> None:
-        self.coord = NumberFormat(scale=1000.0, decimals=2, int_digits=5, sign=sign)
+        self.coord = WORDS["X"].coordinate(sign)
         if feed_codes is not None and feed_unit_mm_min is not None:
             raise ValueError("give feed_unit_mm_min or feed_codes, not both")
         if feed_codes is not None:
@@ -365,9 +433,9 @@ class PicMmhPost(PostProcessor):
         code, feed = self._feed(move, w)
         if machine.max_step_rate_hz and machine.step_rate_hz(feed) > machine.max_step_rate_hz:
             w.fast.setdefault(code, []).append((len(w.lines) + 1, move.contour))
-        f = format_int(code, 2, what="feed code")
+        f = WORDS["F"].format(code)
         if isinstance(move, Linear):
-            w.lines.append(f"G01{self._xy(move.x, move.y, move, w)}F{f};")
+            w.lines.append(f"G01{self._xy(move.x, move.y, move, w)}{f};")
             return
         here = start
         for half in _halves(start, move):
@@ -377,14 +445,14 @@ class PicMmhPost(PostProcessor):
                     tolerance
                 )
                 for x, y in points[1:-1]:
-                    w.lines.append(f"G01{self._xy(x, y, half, w)}F{f};")
-                w.lines.append(f"G01{xy}F{f};")
+                    w.lines.append(f"G01{self._xy(x, y, half, w)}{f};")
+                w.lines.append(f"G01{xy}{f};")
                 w.chorded[0] += 1
                 w.chorded[1] += len(points) - 1
             else:
                 g = "G02" if half.clockwise else "G03"
                 ij = self._word("I", half.cx, half, w) + self._word("J", half.cy, half, w)
-                w.lines.append(f"{g}{xy}{ij}F{f};")
+                w.lines.append(f"{g}{xy}{ij}{f};")
             here = (half.x, half.y)
 
     def _fits(self, value_mm: float) -> bool:
@@ -467,7 +535,7 @@ class PicMmhPost(PostProcessor):
                     f"{where}: tool {command.tool} does not fit M06T## (0–{MAX_TOOL}, "
                     "seed-000 Tabla 22, L3455–L3464)"
                 )
-            w.lines.append(f"M06T{format_int(command.tool, 2, what='tool')};")
+            w.lines.append(f"M06{WORDS['T'].format(command.tool)};")
         else:
             blocks = _home(command, where)
             w.lines.extend(blocks)
@@ -513,8 +581,8 @@ class PicMmhPost(PostProcessor):
 
     def _read_move(self, m: re.Match[str], number: int, source: str, contour: int) -> Move:
         g = int(m["g"])
-        x, y = self.coord.parse(m[2]), self.coord.parse(m[3])
-        has_centre = m[4] is not None
+        x, y = self.coord.parse(m["x"]), self.coord.parse(m["y"])
+        has_centre = m["i"] is not None
         if (g >= 2) != has_centre:
             raise ParseError(f"{source}:{number}: G0{g} {'needs' if g >= 2 else 'takes no'} I/J")
         if g == 0:
@@ -532,7 +600,7 @@ class PicMmhPost(PostProcessor):
             )
         if g == 1:
             return Linear(x, y, feed, contour=contour)
-        cx, cy = self.coord.parse(m[4]), self.coord.parse(m[5])
+        cx, cy = self.coord.parse(m["i"]), self.coord.parse(m["j"])
         return ArcMove(x, y, cx, cy, g == 2, feed, contour=contour)
 
 
@@ -594,7 +662,7 @@ def _spindle(command: Spindle, where: str, w: _Writer) -> str | None:
     if whole != rpm:
         w.note("rpm", f"spindle speed {rpm:g} rev/min rounded to S{whole:04d} (whole rev/min)")
     m = "M03" if command.direction == "cw" else "M04"
-    return f"{m}S{format_int(whole, 4, what='spindle speed')};"
+    return f"{m}{WORDS['S'].format(whole)};"
 
 
 def _dwell(command: Dwell, where: str, w: _Writer) -> list[str]:
@@ -618,7 +686,7 @@ def _dwell(command: Dwell, where: str, w: _Writer) -> list[str]:
             f"{where}: dwell {whole} s written as {len(pieces)} G04 blocks of at most "
             f"{MAX_DWELL_S} s (P has 2 digits, seed-000 L3359–L3366)",
         )
-    return [f"G04P{format_int(p, 2, what='dwell')};" for p in pieces]
+    return [f"G04{WORDS['P'].format(p)};" for p in pieces]
 
 
 def _home(command: Home, where: str) -> list[str]:
