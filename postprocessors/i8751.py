@@ -79,6 +79,7 @@ from camtool.model.program import (
 )
 from camtool.model.shapes import Arc, Point
 from camtool.post.base import (
+    ContourCounter,
     PostProcessor,
     PostResult,
     check_placement,
@@ -138,17 +139,15 @@ def program_from_records(
     moves: list[Move] = []
     lines: list[int] = []
     commands: list[tuple[int, Command]] = []
-    contour = 0
+    contours = ContourCounter()
 
     def add(number: int, z: float | None) -> None:
-        nonlocal contour
         x, y = pos[0] / spm[0], pos[1] / spm[1]
         move: Move
         if pos[2] > 0:
-            contour += not (moves and isinstance(moves[-1], Rapid))
-            move = Rapid(x, y, z, contour=contour)
+            move = Rapid(x, y, z, contour=contours.next(True))
         else:
-            move = Linear(x, y, feed, z, contour=contour)
+            move = Linear(x, y, feed, z, contour=contours.next(False))
         moves.append(move)
         lines.append(number)
 

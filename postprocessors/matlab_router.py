@@ -67,6 +67,7 @@ from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Linear, Move, Program, Rapid
 from camtool.model.shapes import Arc, Point
 from camtool.post.base import (
+    ContourCounter,
     PostProcessor,
     PostResult,
     check_placement,
@@ -195,11 +196,13 @@ def _program(jobs: list[_Job], speed: int) -> Program:
     feed = major_axis_feed_mm_min(speed)
     moves: list[Move] = []
     lines: list[int] = []
-    for number, job in enumerate(jobs, start=1):
+    contours = ContourCounter()
+    for job in jobs:
         (x0, y0), *rest = job.xy.tolist()
-        moves.append(Rapid(x0 / UNITS_PER_MM, y0 / UNITS_PER_MM, contour=number))
+        moves.append(Rapid(x0 / UNITS_PER_MM, y0 / UNITS_PER_MM, contour=contours.next(True)))
         moves.extend(
-            Linear(x / UNITS_PER_MM, y / UNITS_PER_MM, feed, contour=number) for x, y in rest
+            Linear(x / UNITS_PER_MM, y / UNITS_PER_MM, feed, contour=contours.next(False))
+            for x, y in rest
         )
         lines.extend(job.lines)
     return Program(tuple(moves), lines=tuple(lines))

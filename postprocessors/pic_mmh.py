@@ -57,6 +57,7 @@ from camtool.model.program import (
 )
 from camtool.model.shapes import Arc, distance
 from camtool.post.base import (
+    ContourCounter,
     PostProcessor,
     PostResult,
     check_placement,
@@ -562,7 +563,7 @@ class PicMmhPost(PostProcessor):
         moves: list[Move] = []
         lines: list[int] = []
         commands: list[tuple[int, Command]] = []
-        contour = 0
+        contours = ContourCounter()
         for number, raw in enumerate(code.splitlines(), start=1):
             line = raw.strip()
             if not line or line in _FRAME:
@@ -574,9 +575,8 @@ class PicMmhPost(PostProcessor):
             m = _BLOCK.match(line)
             if m is None:
                 raise ParseError(f"{source}:{number}: not a pic-mmh block: {line!r}")
-            moves.append(self._read_move(m, number, source, contour + (m["g"] == "0")))
+            moves.append(self._read_move(m, number, source, contours.next(m["g"] == "0")))
             lines.append(number)
-            contour += m["g"] == "0"
         return Program(tuple(moves), lines=tuple(lines), commands=tuple(commands))
 
     def _read_move(self, m: re.Match[str], number: int, source: str, contour: int) -> Move:

@@ -72,6 +72,30 @@ def check_placement(program: Program, machine: Machine) -> tuple[str, ...]:
     return check_travel(program, machine)
 
 
+class ContourCounter:
+    """The contour-numbering rule of every dialect reader (word-address, pic-mmh, i8751, ...).
+
+    Contour 1 from the start; a rapid after a cut starts the next contour (a run
+    of rapids starts one). Writers start a contour where the planner's toolpath
+    does, with the rapid to its start; read-back programs number their moves the
+    same way.
+    """
+
+    def __init__(self) -> None:
+        self.contour = 1
+        self.cut = False
+
+    def next(self, rapid: bool) -> int:
+        """The contour of the next move (``rapid``: whether it is a rapid)."""
+        if rapid:
+            if self.cut:
+                self.contour += 1
+            self.cut = False
+        else:
+            self.cut = True
+        return self.contour
+
+
 @dataclass(frozen=True)
 class PostResult:
     """Emitted code and what the post-processor had to say.
