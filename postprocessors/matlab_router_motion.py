@@ -18,12 +18,12 @@ its rapid is timed as that dog-leg (R13).
 from __future__ import annotations
 
 import numpy as np
+from camtool_postprocessors.matlab_router_arrays import points_01mm
 from camtool_postprocessors.matlab_router_motion_servo import RouterMachine, simulate_job
 
 from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Move, Program
 from camtool.model.shapes import distance
-from camtool.post.router_arrays import points_01mm
 from camtool.verify.interpolators import sagitta_chord_points
 from camtool.verify.metrics import contour_runs
 from camtool.verify.motion import MotionHooks, StepTrace

@@ -2,7 +2,7 @@
 
 The router has no coordinated interpolator (seed-002 §4.1). For each segment the
 master PIC sends every axis slave an absolute distance (0.1 mm) and a signed
-speed (counts per 5 ms) from the GUI's arrays (:mod:`camtool.post.router_arrays`),
+speed (counts per 5 ms) from the GUI's arrays (:mod:`camtool_postprocessors.matlab_router_arrays`),
 starts X then Y (one I²C frame apart, R13) and waits until both report done:
 a stop at every vertex (§2.8). Each slave runs ``MOVIMIENTO_X`` (Appendix A.3.1,
 L5589–L5729; §4.2, R12) on top of its 5 ms IP speed loop (§4.5, R10):
@@ -49,6 +49,7 @@ from typing import Literal
 
 import numpy as np
 import numpy.typing as npt
+from camtool_postprocessors.matlab_router_arrays import RouterArrays, router_arrays
 from camtool_postprocessors.matlab_router_motion_plant import (
     FIRMWARE_GAINS,
     LAWS,
@@ -65,7 +66,6 @@ from camtool_postprocessors.matlab_router_motion_plant import (
 
 from camtool.model.errors import ToolpathError, UsageError
 from camtool.model.units import TENTH_MM
-from camtool.post.router_arrays import RouterArrays, router_arrays
 
 Chunking = Literal["faithful", "fixed"]
 CHUNKINGS: tuple[str, ...] = ("faithful", "fixed")

@@ -9,6 +9,7 @@ Profile layout (every key optional except ``name``, ``steps_per_mm`` and
 ``work_area_mm``; unknown keys and wrong types are errors naming the key)::
 
     [machine]
+    profile                             # the profile's short name ("mmh-gmm")
     name, steps_per_mm = [x, y, z]      # what the controller assumes (nominal)
     true_steps_per_mm = [x, y, z]       # what the mechanics do (default: nominal)
     work_area_mm = [xmin, ymin, xmax, ymax], coordinates = "work" | "machine",
@@ -132,6 +133,8 @@ class Machine:
 
     Attributes:
         name: profile name, e.g. ``"MMH-1 (GMM)"``.
+        profile: the short name a built-in profile is chosen by (``--machine
+            mmh-gmm``, a target file's ``machine = "mmh-gmm"``); "" for others.
         steps_per_mm: motor steps per mm per axis ``(x, y, z)`` as the controller
             assumes them (nominal).
         work_area_mm: ``(xmin, ymin, xmax, ymax)`` reachable by the tool, mm. In
@@ -163,6 +166,7 @@ class Machine:
     max_step_rate_hz: float = 0.0
     source: str = ""
     true_steps_per_mm: tuple[float, float, float] | None = None
+    profile: str = ""
     motion: Motion = field(default_factory=Motion)
     backlash: Backlash = field(default_factory=Backlash)
     timing: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
@@ -224,6 +228,7 @@ def machine_from_table(table: Mapping[str, Any], *, where: str) -> Machine:
         max_step_rate_hz=r.number("max_step_rate_hz", 0.0),
         source=r.text("source"),
         true_steps_per_mm=true_steps if "true_steps_per_mm" in table else None,
+        profile=r.text("profile"),
         motion=_motion(r.table("motion")),
         backlash=_backlash(r.table("backlash")),
         timing=r.raw_table("timing"),
@@ -418,52 +423,6 @@ def merge_tables(base: Mapping[str, Any], override: Mapping[str, Any]) -> dict[s
         else:
             merged[key] = value
     return merged
-
-
-def machine_names() -> list[str]:
-    """Names of the built-in machine profiles (``camtool/machines/*.toml``), sorted."""
-    from importlib import resources
-
-    files = resources.files("camtool.machines").iterdir()
-    return sorted(f.name.removesuffix(".toml") for f in files if f.name.endswith(".toml"))
-
-
-def machine_table(name: str) -> tuple[dict[str, Any], str]:
-    """The profile table called ``name`` (built in) or at path ``name`` (``.toml``).
-
-    A profile file holds the machine keys at its top level or in a ``[machine]``
-    table. Returns the table and the name to use in messages.
-
-    Raises:
-        InputError: no such profile or file, or not valid TOML.
-    """
-    if name.endswith(".toml") or Path(name).is_file():
-        table = load_toml(Path(name))
-        where = name
-    elif name in machine_names():
-        from importlib import resources
-
-        text = resources.files("camtool.machines").joinpath(f"{name}.toml").read_text("utf-8")
-        table, where = tomllib.loads(text), f"machines/{name}.toml"
-    else:
-        raise InputError(
-            f"unknown machine profile {name!r}; give a .toml file or one of: "
-            f"{', '.join(machine_names())}"
-        )
-    inner = table.get("machine", table)
-    if not isinstance(inner, Mapping):
-        raise InputError(f"{where}: [machine] must be a table")
-    return dict(inner), where
-
-
-def load_machine(name: str) -> Machine:
-    """The machine profile called ``name`` or at path ``name`` (see :func:`machine_table`).
-
-    Raises:
-        InputError: no such profile, or an invalid one.
-    """
-    table, where = machine_table(name)
-    return machine_from_table(table, where=where)
 
 
 def load_toml(path: Path) -> dict[str, Any]:

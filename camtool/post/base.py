@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Mapping
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import ClassVar
+from typing import Any, ClassVar
 
-from camtool.model.errors import DialectError, UsageError
+from camtool.model.errors import DialectError, InputError, UsageError
 from camtool.model.machine import Machine
 from camtool.model.program import Move, Program, segment_of
 from camtool.model.shapes import Point, bbox_union
@@ -70,6 +70,30 @@ def check_placement(program: Program, machine: Machine) -> tuple[str, ...]:
     if machine.coordinates == "machine":
         return ()
     return check_travel(program, machine)
+
+
+class ContourCounter:
+    """The contour-numbering rule of every dialect reader (word-address, pic-mmh, i8751, ...).
+
+    Contour 1 from the start; a rapid after a cut starts the next contour (a run
+    of rapids starts one). Writers start a contour where the planner's toolpath
+    does, with the rapid to its start; read-back programs number their moves the
+    same way.
+    """
+
+    def __init__(self) -> None:
+        self.contour = 1
+        self.cut = False
+
+    def next(self, rapid: bool) -> int:
+        """The contour of the next move (``rapid``: whether it is a rapid)."""
+        if rapid:
+            if self.cut:
+                self.contour += 1
+            self.cut = False
+        else:
+            self.cut = True
+        return self.contour
 
 
 @dataclass(frozen=True)
@@ -165,9 +189,30 @@ class PostProcessor(ABC):
         """
 
 
+def from_options(
+    post_class: Callable[..., PostProcessor], options: Mapping[str, Any], where: str
+) -> PostProcessor:
+    """A dialect class built from a target file's ``[dialect_options]`` (keyword arguments).
+
+    What a target module's ``post_processor(options, where)`` factory usually
+    returns (see :class:`camtool.post.registry.TomlTargets`).
+
+    Raises:
+        InputError: an unknown option or a bad value, naming ``where``.
+    """
+    try:
+        return post_class(**options)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{where}: invalid dialect_options ({exc})") from exc
+
+
 @dataclass(frozen=True)
 class Target:
-    """A machine and its dialect, as ``camtool targets`` lists them.
+    """One machine: its dialect (write and read back), its machine profile, its motion model.
+
+    Built by a provider (:class:`camtool.post.registry.TomlTargets`) from a
+    ``<name>.toml`` and its module, or given whole by a plugin; listed by
+    ``camtool targets``.
 
     Attributes:
         name: the name given to ``--target``.
@@ -179,6 +224,9 @@ class Target:
         spindle_rpm: spindle speed programmed when ``--spindle-rpm`` is not
             given, rev/min; ``None`` programs no spindle commands.
         origin: where the target was found: "builtin", "plugin" or a file path.
+        motion_hook: returns the target's motion model for the verifier (the
+            ``MOTION`` object of its module, or ``None``); called only when
+            :attr:`motion` is read, so listing targets imports no verifier code.
     """
 
     name: str
@@ -189,6 +237,7 @@ class Target:
     source: str = ""
     spindle_rpm: float | None = None
     origin: str = "builtin"
+    motion_hook: Callable[[], Any] | None = field(default=None, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         if isinstance(self.post, PostProcessor):  # a broken plugin's is reported later
@@ -197,3 +246,15 @@ class Target:
     def emit(self, program: Program, *, fmt: str | None = None) -> PostResult:
         """Write ``program`` in this target's dialect for its machine (format ``fmt``)."""
         return self.post.emit(program, self.machine, fmt=fmt)
+
+    def parse(self, code: str | bytes, *, source: str = "<code>") -> Program:
+        """Read code of this target back into a program (see :meth:`PostProcessor.parse`)."""
+        return self.post.parse(code, source=source)
+
+    @property
+    def motion(self) -> Any:
+        """The target's motion model for the verifier (its module's ``MOTION``), or ``None``.
+
+        Loaded on first use (the provider caches it).
+        """
+        return self.motion_hook() if self.motion_hook is not None else None

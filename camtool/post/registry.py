@@ -1,34 +1,55 @@
-"""Targets by name: built-in TOML files, target files, and plugins.
+"""Targets by name: providers of target files, target files, and plugins.
 
-A target file (``camtool/targets/<name>.toml`` or any ``--target path.toml``)
-holds ``name``, ``description``, ``source``, ``dialect`` (a key of
-:data:`DIALECTS`), ``default_feed_mm_min``, optional ``spindle_rpm``, a
-``[dialect_options]`` table for that dialect and ``machine`` (a built-in
-profile name or a ``[machine]`` table, :mod:`camtool.model.machine`). Every field is
-documented in docs/targets/index.md and docs/dialects.md.
+A target file (``postprocessors/<name>.toml`` or any ``--target path.toml``)
+holds ``name``, ``description``, ``source``, ``dialect``, ``default_feed_mm_min``,
+optional ``spindle_rpm``, a ``[dialect_options]`` table for that dialect and
+``machine``: a ``[machine]`` table (:mod:`camtool.model.machine`) or the name of
+a machine profile (the ``profile`` key of a built-in target's ``[machine]``
+table, e.g. ``"mmh-gmm"``). Every field is documented in docs/targets/index.md
+and docs/dialects.md.
 
-Third-party Python targets register under the entry-point group
-:data:`ENTRY_POINT_GROUP`; the object an entry point names is a
-:class:`~camtool.post.base.Target` or a callable returning one. A plugin that
-fails to load is listed by :func:`list_targets` as broken with the reason, and
-choosing it is a clear error; it never crashes the CLI.
+Dialects: ``word-address`` is the framework's own family
+(:mod:`camtool.post.wordaddress`, described wholly in TOML); any other dialect
+name is provided by the module of the target whose TOML declares it, through
+its ``post_processor(options, where)`` factory (:class:`TomlTargets`).
+
+Every target, built-in or third-party, registers under the entry-point group
+:data:`ENTRY_POINT_GROUP`. The object an entry point names is either a
+provider (:class:`TomlTargets`: a package of ``<name>.toml`` files, each with an
+optional sibling module ``<stem>.py``) or a single
+:class:`~camtool.post.base.Target` (or a callable returning one). camtool's own
+targets are the provider of its ``camtool_postprocessors`` package (the
+``postprocessors/`` folder); they win over plugins of the same name. A plugin
+that fails to load is listed by :func:`list_targets` as broken with the reason,
+and choosing it is a clear error; it never crashes the CLI.
 """
 
 from __future__ import annotations
 
+import copy
+import functools
 import importlib
-from collections.abc import Callable, Mapping
+import importlib.util
+import tomllib
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, replace
 from importlib import metadata, resources
 from pathlib import Path
+from types import ModuleType
 from typing import Any
 
 from camtool.model.errors import InputError, UsageError
-from camtool.model.machine import load_toml, machine_from_table, machine_table, merge_tables
+from camtool.model.machine import Machine, load_toml, machine_from_table, merge_tables
 from camtool.post.base import PostProcessor, Target
 
 ENTRY_POINT_GROUP = "camtool.postprocessors"
-"""Entry-point group of third-party targets (pyproject ``[project.entry-points]``)."""
+"""Entry-point group of every target provider and plugin (pyproject ``[project.entry-points]``)."""
+
+WORD_ADDRESS = "word-address"
+"""The framework's dialect family: a target file declares it wholly in ``[dialect_options]``."""
+
+_DISTRIBUTION = "camtool"
+"""Entry points of this distribution are the built-in targets."""
 
 _TOP_KEYS = {
     "name",
@@ -46,38 +67,115 @@ DialectFactory = Callable[[Mapping[str, Any], str], PostProcessor]
 (for messages). Raises :class:`InputError` naming the bad key."""
 
 
-def _class_factory(module: str, cls: str) -> DialectFactory:
-    """A factory for a dialect class taking its options as keyword arguments."""
+class TomlTargets:
+    """A target provider: the ``<name>.toml`` files of a package, with their modules.
 
-    def build(options: Mapping[str, Any], where: str) -> PostProcessor:
-        post_class = getattr(importlib.import_module(module), cls)
-        try:
-            post: PostProcessor = post_class(**options)
-        except (TypeError, ValueError) as exc:
-            raise InputError(f"{where}: invalid dialect_options ({exc})") from exc
-        return post
+    Each ``<name>.toml`` is one target (dialect and machine together). Its
+    Python, if it needs any, is the sibling module ``<package>.<stem>``
+    (``<stem>`` = the name with ``-`` → ``_``); a module whose target declares a
+    ``dialect`` other than ``word-address`` provides that dialect through a
+    ``post_processor(options, where) -> PostProcessor`` factory. The verifier's
+    motion model is the ``MOTION`` object of ``<package>.<stem>_motion`` or of
+    ``<package>.<stem>``. Modules are imported only when a target needs them.
 
-    return build
+    Args:
+        package: the import name of the package holding the files, e.g.
+            ``"camtool_postprocessors"`` (pyproject: ``[project.entry-points.
+            "camtool.postprocessors"] builtin = "camtool_postprocessors:TARGETS"``).
+    """
+
+    def __init__(self, package: str) -> None:
+        self.package = package
+
+    def __repr__(self) -> str:
+        return f"TomlTargets({self.package!r})"
+
+    @functools.cached_property
+    def _files(self) -> dict[str, str]:
+        found = resources.files(self.package).iterdir()
+        return {f.name.removesuffix(".toml"): f.name for f in found if f.name.endswith(".toml")}
+
+    def names(self) -> list[str]:
+        """Names of the targets, sorted."""
+        return sorted(self._files)
+
+    def table(self, name: str) -> dict[str, Any]:
+        """The parsed ``<name>.toml`` of target ``name`` (a fresh copy).
+
+        Raises:
+            InputError: the file is not valid TOML.
+        """
+        return copy.deepcopy(_parse_toml(self.package, self._files[name]))
+
+    def module(self, name: str, suffix: str = "") -> ModuleType | None:
+        """The module ``<package>.<stem><suffix>`` of target ``name``, or ``None`` if none."""
+        module = f"{self.package}.{name.replace('-', '_')}{suffix}"
+        if importlib.util.find_spec(module) is None:
+            return None
+        return importlib.import_module(module)
+
+    def dialect(self, dialect: str) -> DialectFactory | None:
+        """The factory of ``dialect`` if a target of this package declares and provides it."""
+        for name in self.names():
+            if self.table(name).get("dialect") == dialect:
+                module = self.module(name)
+                factory = getattr(module, "post_processor", None) if module else None
+                if callable(factory):
+                    return factory
+        return None
+
+    def dialects(self) -> set[str]:
+        """Names of the dialects the targets of this package declare."""
+        return {str(self.table(n).get("dialect")) for n in self.names()}
+
+    def profiles(self) -> dict[str, str]:
+        """Machine profile name → the target whose ``[machine]`` table declares it."""
+        found: dict[str, str] = {}
+        for name in self.names():
+            machine = self.table(name).get("machine")
+            if isinstance(machine, Mapping) and isinstance(machine.get("profile"), str):
+                found.setdefault(machine["profile"], name)
+        return found
+
+    def motion(self, name: str) -> Any:
+        """The ``MOTION`` object of target ``name`` (``None`` when it has none)."""
+        for suffix in ("_motion", ""):
+            module = self.module(name, suffix)
+            hooks = getattr(module, "MOTION", None) if module else None
+            if hooks is not None:
+                return hooks
+        return None
+
+    def target(
+        self, name: str, *, machine_file: Path | str | None = None, origin: str = "builtin"
+    ) -> Target:
+        """Target ``name`` built from its TOML and its module.
+
+        Raises:
+            InputError: the file, its machine or its dialect options are invalid.
+        """
+        return _target_from_table(
+            self.table(name),
+            where=f"{name}.toml",
+            machine_file=machine_file,
+            origin=origin,
+            provider=self,
+            motion=functools.partial(_cached_motion, self, name),
+        )
 
 
-def _spec_factory(module: str, function: str) -> DialectFactory:
-    """A factory for a dialect built by ``module.function(options, where)``."""
+@functools.cache
+def _parse_toml(package: str, file: str) -> dict[str, Any]:
+    text = resources.files(package).joinpath(file).read_text("utf-8")
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{file}: not valid TOML ({exc})") from exc
 
-    def build(options: Mapping[str, Any], where: str) -> PostProcessor:
-        post: PostProcessor = getattr(importlib.import_module(module), function)(options, where)
-        return post
 
-    return build
-
-
-DIALECTS: dict[str, DialectFactory] = {
-    "pic-mmh": _class_factory("camtool.post.pic_mmh", "PicMmhPost"),
-    "matlab-router": _class_factory("camtool.post.matlab_router", "MatlabRouterPost"),
-    "i8751": _class_factory("camtool.post.i8751", "I8751Post"),
-    "word-address": _spec_factory("camtool.post.wordaddress", "word_address_dialect"),
-}
-"""Dialects by the name a target file gives in ``dialect``. Modules are imported
-only when a target uses them."""
+@functools.cache
+def _cached_motion(provider: TomlTargets, name: str) -> Any:
+    return provider.motion(name)
 
 
 @dataclass(frozen=True)
@@ -97,28 +195,51 @@ class TargetEntry:
     error: str = ""
 
 
-def target_names() -> list[str]:
-    """Names of the built-in targets, sorted."""
-    files = resources.files("camtool.targets").iterdir()
-    return sorted(f.name.removesuffix(".toml") for f in files if f.name.endswith(".toml"))
+def _entry_points() -> tuple[list[metadata.EntryPoint], list[metadata.EntryPoint]]:
+    """Entry points of :data:`ENTRY_POINT_GROUP`: (camtool's own, third-party), by name."""
+    found = sorted(metadata.entry_points(group=ENTRY_POINT_GROUP), key=lambda ep: ep.name)
+    own = [ep for ep in found if ep.dist is not None and ep.dist.name == _DISTRIBUTION]
+    return own, [ep for ep in found if ep not in own]
 
 
-def _plugins() -> dict[str, metadata.EntryPoint]:
-    """Entry points of :data:`ENTRY_POINT_GROUP` by name (built-in names win)."""
-    builtin = set(target_names())
-    found = metadata.entry_points(group=ENTRY_POINT_GROUP)
-    return {ep.name: ep for ep in found if ep.name not in builtin}
-
-
-def _load_plugin(ep: metadata.EntryPoint) -> Target:
-    """The target a plugin entry point provides.
+@functools.cache
+def _builtin_providers() -> tuple[TomlTargets, ...]:
+    """The providers camtool itself registers (its ``camtool_postprocessors`` package).
 
     Raises:
-        InputError: the plugin cannot be imported, raises, or gives no Target.
+        InputError: camtool is installed without its entry points (reinstall it).
+    """
+    own, _ = _entry_points()
+    providers = tuple(p for ep in own if isinstance(p := ep.load(), TomlTargets))
+    if not providers:
+        raise InputError(
+            f"camtool's built-in targets are not registered (no {ENTRY_POINT_GROUP!r} entry "
+            "point of the camtool distribution); reinstall camtool (pip install -e .)"
+        )
+    return providers
+
+
+def _builtin(name: str) -> TomlTargets | None:
+    """The built-in provider of target ``name``, if any."""
+    return next((p for p in _builtin_providers() if name in p.names()), None)
+
+
+def target_names() -> list[str]:
+    """Names of the built-in targets, sorted."""
+    return sorted({n for p in _builtin_providers() for n in p.names()})
+
+
+def _load_entry(ep: metadata.EntryPoint) -> TomlTargets | Target:
+    """What a plugin entry point names: a provider, or the single target it gives.
+
+    Raises:
+        InputError: the plugin cannot be imported, raises, or gives neither.
     """
     where = f"plugin {ep.name!r} ({ep.value})"
     try:
         obj = ep.load()
+        if isinstance(obj, TomlTargets):
+            return obj
         target = obj() if callable(obj) and not isinstance(obj, Target) else obj
     except Exception as exc:  # a third party's bug must not crash the CLI
         raise InputError(f"{where} is broken: {type(exc).__name__}: {exc}") from exc
@@ -126,18 +247,51 @@ def _load_plugin(ep: metadata.EntryPoint) -> Target:
         raise InputError(f"{where} is broken: it gives {type(target).__name__}, not a Target")
     if not isinstance(target.post, PostProcessor):
         raise InputError(f"{where} is broken: its post is not a PostProcessor")
-    return replace(target, origin=f"plugin {ep.value}")
+    motion = target.motion_hook or functools.partial(_module_motion, ep.module)
+    return replace(target, origin=f"plugin {ep.value}", motion_hook=motion)
+
+
+def _module_motion(module: str) -> Any:
+    """The ``MOTION`` object of a one-module plugin (``None`` when it has none)."""
+    return getattr(importlib.import_module(module), "MOTION", None)
+
+
+def _plugin_providers() -> Iterator[tuple[metadata.EntryPoint, TomlTargets]]:
+    """Third-party providers that load (broken plugins are skipped here)."""
+    for ep in _entry_points()[1]:
+        try:
+            loaded = _load_entry(ep)
+        except InputError:
+            continue
+        if isinstance(loaded, TomlTargets):
+            yield ep, loaded
 
 
 def list_targets() -> list[TargetEntry]:
     """Every target camtool knows: built-ins, then plugins (broken ones included), by name."""
-    entries = [TargetEntry(name, "builtin", load_target(name)) for name in target_names()]
-    for name, ep in sorted(_plugins().items()):
+    builtin = target_names()
+    entries = [TargetEntry(name, "builtin", load_target(name)) for name in builtin]
+    plugins: list[TargetEntry] = []
+    for ep in _entry_points()[1]:
+        origin = f"plugin {ep.value}"
         try:
-            entries.append(TargetEntry(name, f"plugin {ep.value}", _load_plugin(ep)))
+            loaded = _load_entry(ep)
         except InputError as exc:
-            entries.append(TargetEntry(name, f"plugin {ep.value}", None, str(exc)))
-    return entries
+            if ep.name not in builtin:
+                plugins.append(TargetEntry(ep.name, origin, None, str(exc)))
+            continue
+        if isinstance(loaded, Target):
+            if ep.name not in builtin:
+                plugins.append(TargetEntry(ep.name, origin, loaded))
+            continue
+        for name in loaded.names():
+            if name in builtin:
+                continue
+            try:
+                plugins.append(TargetEntry(name, origin, loaded.target(name, origin=origin)))
+            except InputError as exc:
+                plugins.append(TargetEntry(name, origin, None, f"{origin}: {exc}"))
+    return entries + sorted(plugins, key=lambda e: e.name)
 
 
 def load_target(name: str, *, machine_file: Path | str | None = None) -> Target:
@@ -160,30 +314,59 @@ def load_target(name: str, *, machine_file: Path | str | None = None) -> Target:
         return _target_from_table(
             load_toml(path), where=str(path), machine_file=machine_file, origin=str(path)
         )
-    if name in target_names():
-        return _target_from_table(
-            _builtin(name), where=f"{name}.toml", machine_file=machine_file, origin="builtin"
-        )
-    plugins = _plugins()
-    if name in plugins:
-        target = _load_plugin(plugins[name])
-        if machine_file is not None:
-            override, where_override = machine_table(str(machine_file))
-            base = target.machine.table
-            machine = machine_from_table(merge_tables(base, override), where=where_override)
-            target = replace(target, machine=machine)
-        return target
-    names = [*target_names(), *sorted(plugins)]
+    provider = _builtin(name)
+    if provider is not None:
+        return provider.target(name, machine_file=machine_file)
+    others = _entry_points()[1]
+    for ep in others:
+        if ep.name == name:
+            loaded = _load_entry(ep)
+            if isinstance(loaded, Target):
+                return _with_machine_file(loaded, machine_file)
+    names = [*target_names(), *(ep.name for ep in others)]
+    for ep, plugin in _plugin_providers():
+        if name in plugin.names():
+            return plugin.target(name, machine_file=machine_file, origin=f"plugin {ep.value}")
+        names += plugin.names()
+    known = sorted(set(names) - set(target_names()), key=names.index)
     raise UsageError(
-        f"unknown target {name!r}; choose one of: {', '.join(names)} (or a target .toml file)"
+        f"unknown target {name!r}; choose one of: {', '.join([*target_names(), *known])} "
+        "(or a target .toml file)"
     )
 
 
-def _builtin(name: str) -> dict[str, Any]:
-    import tomllib
+def _with_machine_file(target: Target, machine_file: Path | str | None) -> Target:
+    """``target`` with the ``[machine]`` table of ``machine_file`` laid over its machine."""
+    if machine_file is None:
+        return target
+    override, where_override = machine_table(str(machine_file))
+    machine = machine_from_table(merge_tables(target.machine.table, override), where=where_override)
+    return replace(target, machine=machine)
 
-    text = resources.files("camtool.targets").joinpath(f"{name}.toml").read_text("utf-8")
-    return tomllib.loads(text)
+
+def _dialect(dialect: Any, where: str, provider: TomlTargets | None) -> DialectFactory:
+    """The factory of ``dialect``: the framework's word-address family, or a provider's.
+
+    The provider of the target file itself is asked first, then camtool's own
+    targets, then third-party providers.
+
+    Raises:
+        InputError: no provider offers ``dialect`` (the message lists the known ones).
+    """
+    if dialect == WORD_ADDRESS:
+        from camtool.post.wordaddress import word_address_dialect
+
+        return word_address_dialect
+    if isinstance(dialect, str):
+        providers = [*([provider] if provider else []), *_builtin_providers()]
+        for p in providers:
+            if dialect in p.dialects() and (factory := p.dialect(dialect)):
+                return factory
+        for _, p in _plugin_providers():
+            if dialect in p.dialects() and (factory := p.dialect(dialect)):
+                return factory
+    known = {WORD_ADDRESS} | {d for p in _builtin_providers() for d in p.dialects()}
+    raise InputError(f"{where}: unknown dialect {dialect!r}; known: {sorted(known)}")
 
 
 def _target_from_table(
@@ -192,14 +375,14 @@ def _target_from_table(
     where: str,
     machine_file: Path | str | None,
     origin: str,
+    provider: TomlTargets | None = None,
+    motion: Callable[[], Any] | None = None,
 ) -> Target:
     unknown = sorted(set(table) - _TOP_KEYS)
     if unknown:
         raise InputError(f"{where}: unknown key(s) {unknown}; known: {sorted(_TOP_KEYS)}")
-    dialect = table.get("dialect")
     options = table.get("dialect_options", {})
-    if dialect not in DIALECTS:
-        raise InputError(f"{where}: unknown dialect {dialect!r}; known: {sorted(DIALECTS)}")
+    factory = _dialect(table.get("dialect"), where, provider)
     if not isinstance(options, Mapping):
         raise InputError(f"{where}: dialect_options must be a table")
     machine = table.get("machine", {})
@@ -210,7 +393,7 @@ def _target_from_table(
         override, where_override = machine_table(str(machine_file))
         machine = merge_tables(machine, override)
         where_machine = f"{where_override} (over {where_machine})"
-    post = DIALECTS[dialect](options, where)
+    post = factory(options, where)
     return Target(
         name=str(table.get("name", Path(where).stem)),
         description=str(table.get("description", "")),
@@ -220,6 +403,7 @@ def _target_from_table(
         source=str(table.get("source", "")),
         spindle_rpm=_number(table, "spindle_rpm", where, None),
         origin=origin,
+        motion_hook=motion,
     )
 
 
@@ -232,24 +416,79 @@ def _number(table: Mapping[str, Any], key: str, where: str, default: Any) -> Any
     return float(value)
 
 
+def machine_names() -> list[str]:
+    """Names of the built-in machine profiles (``profile`` of built-in targets), sorted."""
+    return sorted({m for p in _builtin_providers() for m in p.profiles()})
+
+
+def machine_table(name: str) -> tuple[dict[str, Any], str]:
+    """The profile table called ``name`` (built in) or at path ``name`` (``.toml``).
+
+    A profile file holds the machine keys at its top level or in a ``[machine]``
+    table. A built-in profile is the ``[machine]`` table of the built-in target
+    that declares it (``profile = "mmh-gmm"`` in ``postprocessors/pic-mmh.toml``).
+    Returns the table and the name to use in messages.
+
+    Raises:
+        InputError: no such profile or file, or not valid TOML.
+    """
+    if name.endswith(".toml") or Path(name).is_file():
+        table = load_toml(Path(name))
+        where = name
+    else:
+        for provider in _builtin_providers():
+            target = provider.profiles().get(name)
+            if target is not None:
+                table, where = provider.table(target), f"{target}.toml"
+                break
+        else:
+            raise InputError(
+                f"unknown machine profile {name!r}; give a .toml file or one of: "
+                f"{', '.join(machine_names())}"
+            )
+    inner = table.get("machine", table)
+    if not isinstance(inner, Mapping):
+        raise InputError(f"{where}: [machine] must be a table")
+    return dict(inner), where
+
+
+def load_machine(name: str) -> Machine:
+    """The machine profile called ``name`` or at path ``name`` (see :func:`machine_table`).
+
+    Raises:
+        InputError: no such profile, or an invalid one.
+    """
+    table, where = machine_table(name)
+    return machine_from_table(table, where=where)
+
+
 def motion_hooks() -> list[tuple[str, Any]]:
     """The ``MOTION`` object of every target that declares one, as ``(target name, MOTION)``.
 
     A target's motion model for the verifier (interpolators, chord rules, timing
     models, simulators it adds to :mod:`camtool.verify`'s generic library) is the
     ``MOTION`` attribute of its module ``<package>.<stem>_motion`` (or, for a
-    one-module plugin, of ``<package>.<stem>``). Modules are imported on the
-    first call only (the verifier asks; listing targets does not).
+    one-module plugin, of ``<package>.<stem>``; for a plugin naming a single
+    target, of the entry point's module). Built-in targets come first, then
+    plugins (a plugin of a built-in's name is skipped; a broken one too).
+    Modules are imported on the first call only (the verifier asks; listing
+    targets does not).
     """
     found: list[tuple[str, Any]] = []
-    for name in target_names():
-        stem = name.replace("-", "_")
-        for module in (f"camtool_postprocessors.{stem}_motion", f"camtool_postprocessors.{stem}"):
-            try:
-                hooks = getattr(importlib.import_module(module), "MOTION", None)
-            except ModuleNotFoundError:
-                continue
-            if hooks is not None:
+    for provider in _builtin_providers():
+        found += [(n, h) for n in provider.names() if (h := _cached_motion(provider, n))]
+    seen = {name for name, _ in found} | set(target_names())
+    for ep in _entry_points()[1]:
+        try:
+            loaded = _load_entry(ep)
+            if isinstance(loaded, Target):
+                pairs = [(ep.name, loaded.motion)]
+            else:
+                pairs = [(n, _cached_motion(loaded, n)) for n in loaded.names()]
+        except Exception:
+            continue
+        for name, hooks in pairs:
+            if hooks is not None and name not in seen:
                 found.append((name, hooks))
-                break
+                seen.add(name)
     return found

@@ -55,6 +55,7 @@ from camtool.model.program import (
     ToolChange,
 )
 from camtool.model.shapes import Point
+from camtool.post.base import ContourCounter
 from camtool.post.wordaddress_spec import WordAddressSpec
 
 _WORD = re.compile(r"([A-Za-z])([^A-Za-z]*)")
@@ -74,8 +75,7 @@ class _State:
     moves: list[Move] = field(default_factory=list)
     lines: list[int] = field(default_factory=list)
     commands: list[tuple[int, Command]] = field(default_factory=list)
-    contour: int = 1
-    cut_in_contour: bool = False
+    contours: ContourCounter = field(default_factory=ContourCounter)
     ended: int = 0
 
 
@@ -350,13 +350,7 @@ class BlockReader:
 
     def _push(self, move: Move) -> None:
         s = self.state
-        if isinstance(move, Rapid):
-            if s.cut_in_contour:
-                s.contour += 1
-            s.cut_in_contour = False
-        else:
-            s.cut_in_contour = True
-        move = dataclasses.replace(move, contour=s.contour)
+        move = dataclasses.replace(move, contour=s.contours.next(isinstance(move, Rapid)))
         s.moves.append(move)
         s.lines.append(self.line)
         s.x, s.y = move.x, move.y

@@ -19,8 +19,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
-from camtool.model.machine import Machine, load_machine
+from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Linear, Move, Program, Rapid
+from camtool.post.registry import load_machine
 from camtool.verify.simulate import _play, simulate_steps
 from camtool.verify.verifier import verify_program
 

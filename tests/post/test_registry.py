@@ -18,7 +18,7 @@ from camtool.post.registry import ENTRY_POINT_GROUP, list_targets, load_target, 
 ROOT = Path(__file__).parents[2]
 
 PLUGIN = '''
-from camtool.model.machine import load_machine
+from camtool.post.registry import load_machine
 from camtool.post.base import PostProcessor, PostResult, Target
 from camtool.model.program import Linear, Program, Rapid
 

@@ -5,9 +5,10 @@ from __future__ import annotations
 import pytest
 
 from camtool.model.errors import DialectError, InputError
-from camtool.model.machine import load_machine, machine_from_table, machine_names
+from camtool.model.machine import machine_from_table
 from camtool.model.program import Linear, Program, Rapid
 from camtool.post.base import check_placement
+from camtool.post.registry import load_machine, machine_names
 
 BASE = {"name": "bench", "steps_per_mm": [100, 100, 100], "work_area_mm": [0, 0, 100, 50]}
 

@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 import pytest
+from camtool_postprocessors.matlab_router_arrays import router_arrays
 from camtool_postprocessors.matlab_router_motion_plant import (
     TABLE_4_1,
     THESIS_PLANT,
@@ -38,7 +39,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from camtool.model.errors import UsageError
-from camtool.post.router_arrays import router_arrays
 from tests.shapes import STAR_XY_01MM
 
 STAR = np.array(STAR_XY_01MM).T  # seed-002 §3, L3196–L3200, (N, 2) in 0.1 mm
@@ -417,8 +417,8 @@ def test_each_strokes_measures_start_where_the_positioning_left_the_carriage() -
     The router moves to each job's first point X then Y (seed-002 R13); that point,
     not the end of the stroke before, is where the second contour starts.
     """
-    from camtool.model.machine import load_machine
     from camtool.model.program import Linear, Program, Rapid
+    from camtool.post.registry import load_machine
     from camtool.verify.verifier import verify_program
 
     def square(x: float) -> list[Rapid | Linear]:

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from camtool.model.machine import load_machine
 from camtool.model.program import Dwell, Home, Linear, Program, Rapid
+from camtool.post.registry import load_machine
 from camtool.verify.verifier import verify_program
 
 SQUARE = (Rapid(1.0, 1.0), Linear(2.0, 1.0, 300.0), Linear(2.0, 2.0, 300.0))

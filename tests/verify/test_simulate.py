@@ -1,7 +1,7 @@
 """The step simulation of emitted programs: the thesis figures, end to end.
 
 Expected values come from ../shared/reference/ (the section is named in each test);
-machine profiles are the built-in ones in camtool/machines/.
+machine profiles are the built-in ones in postprocessors/*.toml ([machine] tables).
 """
 
 from __future__ import annotations
@@ -12,8 +12,9 @@ from typing import Any
 import numpy as np
 import pytest
 
-from camtool.model.machine import Machine, machine_from_table, machine_table, merge_tables
+from camtool.model.machine import Machine, machine_from_table, merge_tables
 from camtool.model.program import ArcMove, Linear, Program, Rapid
+from camtool.post.registry import machine_table
 from camtool.verify.metrics import fit_circle, nominal_arrays, point_distances
 from camtool.verify.motion import StepTrace
 from camtool.verify.simulate import simulate_steps

@@ -1,6 +1,6 @@
 """The ``i8751`` dialect: binary packets for the 8751 serial stepper interface.
 
-Source: seed-003 §3.7 (the byte protocol, :mod:`camtool.post.i8751_stream`),
+Source: seed-003 §3.7 (the byte protocol, :mod:`camtool_postprocessors.i8751_packets`),
 §4.1–4.4 (motion) and requirements R1–R7 (reference/seed-003.md). The PC
 sends relative step counts per motor; the interface runs X and Y by "corte
 recto" (both motors together, then the longer one alone), waits T1 seconds,
@@ -48,7 +48,20 @@ from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
-from typing import ClassVar
+from typing import Any, ClassVar
+
+from camtool_postprocessors.i8751_packets import (
+    ACCESS_KEY,
+    MAX_STEPS,
+    MAX_WAIT_S,
+    Record,
+    binary_locator,
+    decode_stream,
+    dump_stream,
+    encode_stream,
+    packets,
+    undump,
+)
 
 from camtool.model.errors import DialectError, UsageError
 from camtool.model.machine import Machine
@@ -65,21 +78,104 @@ from camtool.model.program import (
     ToolChange,
 )
 from camtool.model.shapes import Arc, Point
-from camtool.post.base import PostProcessor, PostResult, check_placement, check_work_area
-from camtool.post.i8751_read import cruise_feed, is_text, program_from_records
-from camtool.post.i8751_stream import (
-    ACCESS_KEY,
-    MAX_STEPS,
-    MAX_WAIT_S,
-    Record,
-    binary_locator,
-    decode_stream,
-    dump_stream,
-    encode_stream,
-    packets,
-    undump,
+from camtool.post.base import (
+    ContourCounter,
+    PostProcessor,
+    PostResult,
+    check_placement,
+    check_work_area,
+    from_options,
 )
 from camtool.post.numfmt import NumberFormat
+
+# -- i8751_read ------------------------------------------------------------
+# Reading the i8751 stream back: records → a Program (see :mod:`camtool_postprocessors.i8751`).
+#
+# The reader sums the steps from X = Y = Z = 0 and divides by the machine's
+# steps/mm; a record that moves X/Y and Z gives two moves (X/Y, then Z), as the
+# interface runs them (seed-003 §4.3, R11); waits T1/T2 give dwells. A move that
+# ends with the tool above Z = 0 is a rapid, any other a cut at the cruise feed.
+
+CRUISE_HZ = 104.0
+"""Cruise step rate of the firmware ramp, X = 11H (seed-003 §4.4), used when the
+machine profile gives no ``max_step_rate_hz``."""
+
+
+def cruise_feed(machine: Machine) -> float:
+    """Feed of the firmware's cruise on the faster-stepping axis, mm/min."""
+    rate = machine.max_step_rate_hz or CRUISE_HZ
+    return rate * 60.0 / max(machine.steps_per_mm[:2])
+
+
+def is_text(code: bytes) -> bool:
+    """True when ``code`` reads as a dump: UTF-8 without control characters but tab, CR, LF."""
+    if not code or code[0] == ACCESS_KEY:
+        return False
+    try:
+        text = code.decode("utf-8")
+    except UnicodeDecodeError:
+        return False
+    return all(c >= " " or c in "\t\r\n" for c in text)
+
+
+def program_from_records(
+    records: list[Record], machine: Machine, warnings: tuple[str, ...]
+) -> Program:
+    """The program a session's records describe (see the module docstring).
+
+    Args:
+        records: the decoded moves, in stream order.
+        machine: gives steps/mm (positions, mm = steps / steps_per_mm) and the
+            cruise rate (the feed of cuts, :func:`cruise_feed`).
+        warnings: carried into ``Program.warnings``.
+
+    Returns:
+        Moves in absolute mm from (0, 0, 0); ``lines`` = the 1-based record
+        number of each move; ``commands`` = one Dwell per run of waits.
+    """
+    spm = machine.steps_per_mm
+    feed = cruise_feed(machine)
+    pos = [0, 0, 0]
+    moves: list[Move] = []
+    lines: list[int] = []
+    commands: list[tuple[int, Command]] = []
+    contours = ContourCounter()
+
+    def add(number: int, z: float | None) -> None:
+        x, y = pos[0] / spm[0], pos[1] / spm[1]
+        move: Move
+        if pos[2] > 0:
+            move = Rapid(x, y, z, contour=contours.next(True))
+        else:
+            move = Linear(x, y, feed, z, contour=contours.next(False))
+        moves.append(move)
+        lines.append(number)
+
+    def wait(seconds: int) -> None:
+        if not seconds:
+            return
+        if commands and commands[-1][0] == len(moves):
+            index, last = commands[-1]
+            if isinstance(last, Dwell):
+                commands[-1] = (index, Dwell(last.seconds + seconds))
+                return
+        commands.append((len(moves), Dwell(float(seconds))))
+
+    for number, record in enumerate(records, start=1):
+        dx, dy, dz = record.steps
+        if dx or dy:
+            pos[0] += dx
+            pos[1] += dy
+            add(number, None)
+        wait(record.wait_t1_s)
+        if dz:
+            pos[2] += dz
+            add(number, pos[2] / spm[2])
+        wait(record.wait_t2_s)
+    return Program(tuple(moves), warnings=warnings, lines=tuple(lines), commands=tuple(commands))
+
+
+# -- i8751 ------------------------------------------------------------
 
 _DROPPED = {
     Spindle: "spindle command(s): the interface drives only the three axis motors",
@@ -389,7 +485,7 @@ class I8751Post(PostProcessor):
 
         Raises:
             ParseError: anything off the grammar of
-                :mod:`camtool.post.i8751_stream`, naming ``source`` and the byte
+                :mod:`camtool_postprocessors.i8751_packets`, naming ``source`` and the byte
                 offset (and the dump line).
             UsageError: the dialect is not bound to a machine (use a Target, or
                 :meth:`for_machine`).
@@ -448,3 +544,12 @@ def _count_warnings(c: Counter[str]) -> list[str]:
 def _spm(spm: Sequence[float]) -> str:
     fmt = NumberFormat(decimals=4)
     return ", ".join(fmt.format(v).rstrip("0").rstrip(".") for v in spm)
+
+
+def post_processor(options: Mapping[str, Any], where: str) -> PostProcessor:
+    """The ``i8751`` dialect built from a target file's ``[dialect_options]``.
+
+    Raises:
+        InputError: an unknown option or a bad value, naming ``where``.
+    """
+    return from_options(I8751Post, options, where)

@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from camtool_postprocessors.pic_mmh import FeedTable, PicMmhPost
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -27,14 +28,12 @@ from camtool.model.program import (
     ToolChange,
 )
 from camtool.post.base import PostResult
-from camtool.post.pic_mmh import PicMmhPost
-from camtool.post.pic_mmh_feeds import FeedTable
 from camtool.post.registry import load_target
 from camtool.verify.verifier import verify_code
 from tests.shapes import golden_arc_dxf
 
 SAMPLES = Path(__file__).parents[2] / "samples"
-GOLDEN = Path(__file__).parents[1] / "golden"
+GOLDEN = Path(__file__).parents[1] / "golden" / "pic-mmh"
 
 # seed-000 §3.6, the inferred grammar, for the blocks a toolpath uses.
 COORD = r"[+-]?\d{5}\.\d{2}"

@@ -19,7 +19,7 @@ store part zero            ``Q;``            :class:`StorePartZero`
 =========================  ================  =====================================
 
 G and M lines (the "line / program" mode) are written and read by
-:class:`camtool.post.pic_mmh.PicMmhPost`, not here.
+:class:`camtool_postprocessors.pic_mmh.PicMmhPost`, not here.
 
 The parser :func:`parse_mode` reads as the firmware does (§3.1): the first
 character alone selects the mode, the fields follow in a fixed order, the

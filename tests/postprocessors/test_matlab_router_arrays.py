@@ -1,4 +1,4 @@
-"""Tests of the seed-002 Matlab GUI arrays (camtool.post.router_arrays).
+"""Tests of the seed-002 Matlab GUI arrays (camtool_postprocessors.matlab_router_arrays).
 
 Golden numbers: reference/seed-002.md §3 (the star worked example, thesis L3183–L3235)
 and §8 R1–R2, R7. Other expectations are analytic (the algorithm's definition).
@@ -8,16 +8,16 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given
-from hypothesis import strategies as st
-
-from camtool.model.errors import DialectError, UsageError
-from camtool.post.router_arrays import (
+from camtool_postprocessors.matlab_router_arrays import (
     DEFAULT_SPEED,
     matlab_round,
     points_01mm,
     router_arrays,
 )
+from hypothesis import given
+from hypothesis import strategies as st
+
+from camtool.model.errors import DialectError, UsageError
 from tests.shapes import STAR_LXY, STAR_VELXY, STAR_XY_01MM
 
 STAR_XY = np.array(STAR_XY_01MM)  # seed-002 §3, L3196–L3200

@@ -10,6 +10,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from camtool_postprocessors.i8751 import I8751Post, split_count, split_xy
+from camtool_postprocessors.i8751_packets import Record, encode_block, encode_stream
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -28,15 +30,13 @@ from camtool.model.program import (
     Spindle,
     ToolChange,
 )
-from camtool.post.i8751 import I8751Post, split_count, split_xy
-from camtool.post.i8751_stream import Record, encode_block, encode_stream
 from camtool.post.registry import load_target
 from camtool.verify.interpolators import corte_recto_max_deviation
 from camtool.verify.verifier import verify_code
 
 SAMPLES = Path(__file__).parents[2] / "samples"
 GOLDEN = Path(__file__).parents[1] / "golden" / "i8751"
-SPM = 100.0  # machines/i8751.toml: the documented placeholder, 0.01 mm per step
+SPM = 100.0  # postprocessors/i8751.toml: the documented placeholder, 0.01 mm per step
 
 
 def _target(**machine: object) -> tuple[I8751Post, Machine]:
@@ -578,6 +578,6 @@ def test_cli_post_bytes_to_stdout_and_verify_from_stdin() -> None:
 
 
 def _records(code: bytes) -> list[Record]:
-    from camtool.post.i8751_stream import binary_locator, decode_stream
+    from camtool_postprocessors.i8751_packets import binary_locator, decode_stream
 
     return decode_stream(code, binary_locator("<stdout>"))

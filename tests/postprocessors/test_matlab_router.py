@@ -12,6 +12,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from camtool_postprocessors.matlab_router import MatlabRouterPost
+from camtool_postprocessors.matlab_router_arrays import matlab_round, router_arrays
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
@@ -19,9 +21,7 @@ from camtool.importers.points import read_points
 from camtool.jobs.pipeline import post_file
 from camtool.model.errors import DialectError, InputError, ParseError, UsageError
 from camtool.model.program import ArcMove, Dwell, Linear, Move, Program, Rapid, Spindle
-from camtool.post.matlab_router import MatlabRouterPost
 from camtool.post.registry import load_target
-from camtool.post.router_arrays import matlab_round, router_arrays
 from camtool.verify.verifier import verify_code
 from tests.shapes import STAR_LXY, STAR_VELXY, STAR_XY_01MM
 

@@ -13,7 +13,7 @@ block, verbatim from the thesis (L1731)::
 - ``I``/``J`` are the ABSOLUTE arc centre, same format (S000-04);
 - ``F`` is two zero-padded digits; by default in units of 0.1 mm/min (``F08``
   = 0.8 mm/min), or an explicit code table (S000-05,
-  :mod:`camtool.post.pic_mmh_feeds`);
+  :mod:`camtool_postprocessors.pic_mmh`);
 - programs open with ``G54;`` ``G90;`` and close with ``M30;``; the commands of
   :attr:`Program.commands` are ``M03S####;`` / ``M04S####;`` / ``M05;``,
   ``G04P##;``, ``M06T##;`` and ``G28X0Y0;`` / ``G28Z0;`` (S000-06, Tablas 21–22);
@@ -27,11 +27,12 @@ block, verbatim from the thesis (L1731)::
   end point that does not fit X/Y is still an error.
 
 The mode strings of the host link (``JX+;``, ``BX200;`` …) are in
-:mod:`camtool.post.pic_mmh_modes`.
+:mod:`camtool_postprocessors.pic_mmh_link`.
 """
 
 from __future__ import annotations
 
+import bisect
 import math
 import re
 from collections.abc import Iterator, Mapping
@@ -55,23 +56,237 @@ from camtool.model.program import (
     ToolChange,
 )
 from camtool.model.shapes import Arc, distance
-from camtool.post.base import PostProcessor, PostResult, check_placement, check_work_area
+from camtool.post.base import (
+    ContourCounter,
+    PostProcessor,
+    PostResult,
+    check_placement,
+    check_work_area,
+    from_options,
+)
 from camtool.post.numfmt import NumberFormat, format_int
-from camtool.post.pic_mmh_feeds import FeedTable
 
-_COORD = r"([+-]?\d{5}\.\d{2})"
-_BLOCK = re.compile(rf"^G0(?P<g>[0-3])X{_COORD}Y{_COORD}(?:I{_COORD}J{_COORD})?(?:F(?P<f>\d\d))?;$")
+# -- pic_mmh_feeds ------------------------------------------------------------
+# The F word of the pic-mmh dialect: two-digit feed codes and the feed each one means.
+#
+# Source: seed-000 §4.1 and §4.9, S000-05. The firmware reads F with its
+# "obtención de 2 dígitos" routine into the variable ``Avance`` (L1839–L1845) and
+# *computes* the interpolator period from it, it does not look it up in a table:
+# ``FCIAALGORITMO = (PPR * AVANCE) / 60``, ``PDOALGORITMO = 1000000 / FCIAALGORITMO``
+# with ``PPR = 1000 / RESOL`` steps/mm (annex A.5, L3662–L3664; Eq. 3.1
+# reconstructed as ``f = d·F·0.1/60``). So the default table is linear: code
+# ``n`` means ``n × 0.1`` mm/min, F01–F99 = 0.1–9.9 mm/min (F08 = 0.8 mm/min, the
+# thesis example, L1731). A firmware that maps F codes to a table of step delays
+# instead is described by an explicit ``feed_codes`` table.
+
+DEFAULT_FEED_UNIT_MM_MIN = 0.1
+"""mm/min per unit of F under the default, linear table (seed-000 §4.9, S000-05)."""
+
+MAX_CODE = 99
+"""F has two digits (seed-000 Tabla 21, L3297–L3358); F00 would divide by zero
+in the firmware's period ``1000000 / FCIAALGORITMO`` (L3664), so codes are 1–99."""
+
+
+@dataclass(frozen=True)
+class FeedTable:
+    """The feed codes a pic-mmh controller knows, each with its feed in mm/min.
+
+    Attributes:
+        codes: ``(code, feed_mm_min)`` pairs sorted by code; codes are 1–99 and
+            the feeds strictly increase with the code (a faster code is never
+            slower), each > 0 mm/min.
+    """
+
+    codes: tuple[tuple[int, float], ...]
+
+    def __post_init__(self) -> None:
+        if not self.codes:
+            raise ValueError("feed_codes is empty; give at least one code = mm/min pair")
+        previous: tuple[int, float] | None = None
+        for code, feed in self.codes:
+            if not 1 <= code <= MAX_CODE:
+                raise ValueError(f"feed code {code} is not F01–F{MAX_CODE} (two digits, not F00)")
+            if not (math.isfinite(feed) and feed > 0):
+                raise ValueError(f"feed code {code}: {feed!r} mm/min must be a number > 0")
+            if previous is not None and (code <= previous[0] or feed <= previous[1]):
+                raise ValueError(
+                    f"feed codes must be sorted with feeds strictly increasing: "
+                    f"F{previous[0]:02d} = {previous[1]:g} then F{code:02d} = {feed:g} mm/min"
+                )
+            previous = (code, feed)
+
+    @classmethod
+    def linear(cls, unit_mm_min: float = DEFAULT_FEED_UNIT_MM_MIN) -> FeedTable:
+        """Codes 1–99 meaning ``code × unit_mm_min`` mm/min (the firmware's formula).
+
+        Raises:
+            ValueError: ``unit_mm_min`` is not a finite number > 0.
+        """
+        unit = _positive("feed_unit_mm_min", unit_mm_min)
+        return cls(tuple((n, n * unit) for n in range(1, MAX_CODE + 1)))
+
+    @classmethod
+    def from_option(cls, table: Mapping[Any, Any]) -> FeedTable:
+        """The table of a ``[dialect_options] feed_codes`` TOML table.
+
+        Keys are the codes as written (``"8"`` or ``"08"``; ints from Python),
+        values the feed each code runs, mm/min.
+
+        Raises:
+            ValueError: ``table`` is not a table, a key is not a code 1–99 written
+                with at most two digits, a value is not a number > 0, two keys
+                name one code, or the feeds do not increase with the code.
+        """
+        if not isinstance(table, Mapping):
+            raise ValueError(f"feed_codes must be a table of code = mm/min, not {table!r}")
+        pairs: dict[int, float] = {}
+        for key, value in table.items():
+            code = _code(key)
+            if code in pairs:
+                raise ValueError(f"feed_codes names code {code} twice")
+            pairs[code] = _positive(f"feed_codes[{key!r}]", value)
+        return cls(tuple(sorted(pairs.items())))
+
+    @property
+    def lowest(self) -> tuple[int, float]:
+        """The slowest ``(code, feed_mm_min)``."""
+        return self.codes[0]
+
+    @property
+    def highest(self) -> tuple[int, float]:
+        """The fastest ``(code, feed_mm_min)``."""
+        return self.codes[-1]
+
+    def feed_of(self, code: int) -> float | None:
+        """The feed of ``code``, mm/min, or ``None`` when the table has no such code."""
+        i = bisect.bisect_left(self.codes, (code, -math.inf))
+        return self.codes[i][1] if i < len(self.codes) and self.codes[i][0] == code else None
+
+    def nearest(self, feed_mm_min: float) -> tuple[int, float] | None:
+        """The code whose feed is nearest ``feed_mm_min`` (ties go to the faster code).
+
+        Returns ``None`` when the feed is not finite or lies beyond either end of
+        the table by more than half the gap to its neighbour (for the linear
+        table: outside 0.05–9.95 mm/min, i.e. what would round to F00 or F100).
+        """
+        if not math.isfinite(feed_mm_min):
+            return None
+        feeds = [f for _, f in self.codes]
+        i = bisect.bisect_left(feeds, feed_mm_min)
+        candidates = [j for j in (i - 1, i) if 0 <= j < len(feeds)]
+        best = min(candidates, key=lambda j: (abs(feeds[j] - feed_mm_min), -j))
+        tol = 1e-9 * max(1.0, abs(feed_mm_min))
+        lo_gap = (feeds[1] - feeds[0]) / 2 if len(feeds) > 1 else 0.0
+        hi_gap = (feeds[-1] - feeds[-2]) / 2 if len(feeds) > 1 else 0.0
+        if feed_mm_min < feeds[0] - lo_gap - tol or feed_mm_min > feeds[-1] + hi_gap + tol:
+            return None
+        return self.codes[best]
+
+
+def _code(key: Any) -> int:
+    """A feed code from a table key: an int, or a string of one or two digits."""
+    if isinstance(key, bool):
+        raise ValueError(f"feed code {key!r} is not a number")
+    if isinstance(key, int):
+        return key
+    if isinstance(key, str) and key.isascii() and key.isdigit() and 1 <= len(key) <= 2:
+        return int(key)
+    raise ValueError(f"feed code {key!r} is not a code of one or two digits (1–{MAX_CODE})")
+
+
+def _positive(name: str, value: Any) -> float:
+    """``value`` as a finite float > 0 (bools refused)."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ValueError(f"{name} must be a number of mm/min > 0, not {value!r}")
+    number = float(value)
+    if not (math.isfinite(number) and number > 0):
+        raise ValueError(f"{name} must be a number of mm/min > 0, not {value!r}")
+    return number
+
+
+# -- pic_mmh ------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Word:
+    """One word of the fixed-width pic-mmh grammar: a letter and a zero-padded number.
+
+    Both the writer (:meth:`format`, :meth:`coordinate`) and the reader
+    (:meth:`pattern`) are derived from it (seed-000 §3, S000-02…05).
+
+    Attributes:
+        letter: the address letter.
+        digits: integer digits, zero-padded (``X02969.00``: 5; ``F08``: 2).
+        decimals: digits after the point (0: an integer code without a point).
+        what: the value's name in messages ("feed code").
+        scale: code units per mm (coordinates: µm); 1 for codes.
+    """
+
+    letter: str
+    digits: int
+    decimals: int = 0
+    what: str = ""
+    scale: float = 1.0
+
+    @property
+    def largest(self) -> int:
+        """Largest integer code the word holds (``99`` for 2 digits)."""
+        return 10**self.digits - 1
+
+    def pattern(self, group: str) -> str:
+        """The regex of the word, its number captured as ``group`` (a sign only on decimals)."""
+        if self.decimals:
+            number = rf"[+-]?\d{{{self.digits}}}\.\d{{{self.decimals}}}"
+        else:
+            number = rf"\d{{{self.digits}}}"
+        return rf"{self.letter}(?P<{group}>{number})"
+
+    def coordinate(self, sign: str) -> NumberFormat:
+        """The number format of a coordinate word, with the sign policy ``sign``."""
+        return NumberFormat(
+            scale=self.scale, decimals=self.decimals, int_digits=self.digits, sign=sign
+        )
+
+    def format(self, code: int) -> str:
+        """The word of integer ``code`` (``F08``).
+
+        Raises:
+            DialectError: ``code`` is negative or needs more digits.
+        """
+        return self.letter + format_int(code, self.digits, what=self.what)
+
+
+WORDS: Mapping[str, Word] = MappingProxyType(
+    {
+        **{a: Word(a, 5, 2, "coordinate", 1000.0) for a in "XYIJ"},  # µm, ±5.2 (S000-02/03)
+        "F": Word("F", 2, what="feed code"),  # S000-05
+        "P": Word("P", 2, what="dwell"),  # G04P##, seconds (L3359–L3366)
+        "S": Word("S", 4, what="spindle speed"),  # M03S####, rev/min (Tabla 22)
+        "T": Word("T", 2, what="tool"),  # M06T## (L3455–L3464)
+    }
+)
+"""The grammar of every numbered word, declared once: the writer formats and the
+reader's patterns are built from it."""
+
+_W = WORDS
+_BLOCK = re.compile(
+    rf"^G0(?P<g>[0-3]){_W['X'].pattern('x')}{_W['Y'].pattern('y')}"
+    rf"(?:{_W['I'].pattern('i')}{_W['J'].pattern('j')})?(?:{_W['F'].pattern('f')})?;$"
+)
 _FRAME = frozenset({"G54;", "G90;", "M30;"})
 _FIXED: Mapping[str, Command] = MappingProxyType(
     {"M05;": Spindle("off"), "G28X0Y0;": Home("XY"), "G28Z0;": Home("Z")}
 )
-_ARGS = re.compile(r"^(?:G04P(?P<p>\d\d)|M0(?P<m>[34])S(?P<s>\d{4})|M06T(?P<t>\d\d));$")
+_ARGS = re.compile(
+    rf"^(?:G04{_W['P'].pattern('p')}|M0(?P<m>[34]){_W['S'].pattern('s')}"
+    rf"|M06{_W['T'].pattern('t')});$"
+)
 
-MAX_DWELL_S = 99
+MAX_DWELL_S = WORDS["P"].largest
 """Longest dwell of one ``G04P##;`` block, s (2 digits, seed-000 L3359–L3366)."""
-MAX_RPM = 9999
+MAX_RPM = WORDS["S"].largest
 """Highest spindle speed of ``M03S####;``, rev/min (4 digits, seed-000 L3418–L3436)."""
-MAX_TOOL = 99
+MAX_TOOL = WORDS["T"].largest
 """Highest magazine position of ``M06T##;`` (2 digits, seed-000 L3455–L3464)."""
 BUFFER_CHARS = 35
 """The firmware's receive vector ``CadenaControl`` (seed-000 L1739–L1744, S000-07)."""
@@ -134,7 +349,7 @@ class PicMmhPost(PostProcessor):
         feed_codes: Mapping[Any, Any] | None = None,
         max_line_chars: int | None = None,
     ) -> None:
-        self.coord = NumberFormat(scale=1000.0, decimals=2, int_digits=5, sign=sign)
+        self.coord = WORDS["X"].coordinate(sign)
         if feed_codes is not None and feed_unit_mm_min is not None:
             raise ValueError("give feed_unit_mm_min or feed_codes, not both")
         if feed_codes is not None:
@@ -219,9 +434,9 @@ class PicMmhPost(PostProcessor):
         code, feed = self._feed(move, w)
         if machine.max_step_rate_hz and machine.step_rate_hz(feed) > machine.max_step_rate_hz:
             w.fast.setdefault(code, []).append((len(w.lines) + 1, move.contour))
-        f = format_int(code, 2, what="feed code")
+        f = WORDS["F"].format(code)
         if isinstance(move, Linear):
-            w.lines.append(f"G01{self._xy(move.x, move.y, move, w)}F{f};")
+            w.lines.append(f"G01{self._xy(move.x, move.y, move, w)}{f};")
             return
         here = start
         for half in _halves(start, move):
@@ -231,14 +446,14 @@ class PicMmhPost(PostProcessor):
                     tolerance
                 )
                 for x, y in points[1:-1]:
-                    w.lines.append(f"G01{self._xy(x, y, half, w)}F{f};")
-                w.lines.append(f"G01{xy}F{f};")
+                    w.lines.append(f"G01{self._xy(x, y, half, w)}{f};")
+                w.lines.append(f"G01{xy}{f};")
                 w.chorded[0] += 1
                 w.chorded[1] += len(points) - 1
             else:
                 g = "G02" if half.clockwise else "G03"
                 ij = self._word("I", half.cx, half, w) + self._word("J", half.cy, half, w)
-                w.lines.append(f"{g}{xy}{ij}F{f};")
+                w.lines.append(f"{g}{xy}{ij}{f};")
             here = (half.x, half.y)
 
     def _fits(self, value_mm: float) -> bool:
@@ -321,7 +536,7 @@ class PicMmhPost(PostProcessor):
                     f"{where}: tool {command.tool} does not fit M06T## (0–{MAX_TOOL}, "
                     "seed-000 Tabla 22, L3455–L3464)"
                 )
-            w.lines.append(f"M06T{format_int(command.tool, 2, what='tool')};")
+            w.lines.append(f"M06{WORDS['T'].format(command.tool)};")
         else:
             blocks = _home(command, where)
             w.lines.extend(blocks)
@@ -348,7 +563,7 @@ class PicMmhPost(PostProcessor):
         moves: list[Move] = []
         lines: list[int] = []
         commands: list[tuple[int, Command]] = []
-        contour = 0
+        contours = ContourCounter()
         for number, raw in enumerate(code.splitlines(), start=1):
             line = raw.strip()
             if not line or line in _FRAME:
@@ -360,15 +575,14 @@ class PicMmhPost(PostProcessor):
             m = _BLOCK.match(line)
             if m is None:
                 raise ParseError(f"{source}:{number}: not a pic-mmh block: {line!r}")
-            moves.append(self._read_move(m, number, source, contour + (m["g"] == "0")))
+            moves.append(self._read_move(m, number, source, contours.next(m["g"] == "0")))
             lines.append(number)
-            contour += m["g"] == "0"
         return Program(tuple(moves), lines=tuple(lines), commands=tuple(commands))
 
     def _read_move(self, m: re.Match[str], number: int, source: str, contour: int) -> Move:
         g = int(m["g"])
-        x, y = self.coord.parse(m[2]), self.coord.parse(m[3])
-        has_centre = m[4] is not None
+        x, y = self.coord.parse(m["x"]), self.coord.parse(m["y"])
+        has_centre = m["i"] is not None
         if (g >= 2) != has_centre:
             raise ParseError(f"{source}:{number}: G0{g} {'needs' if g >= 2 else 'takes no'} I/J")
         if g == 0:
@@ -386,7 +600,7 @@ class PicMmhPost(PostProcessor):
             )
         if g == 1:
             return Linear(x, y, feed, contour=contour)
-        cx, cy = self.coord.parse(m[4]), self.coord.parse(m[5])
+        cx, cy = self.coord.parse(m["i"]), self.coord.parse(m["j"])
         return ArcMove(x, y, cx, cy, g == 2, feed, contour=contour)
 
 
@@ -448,7 +662,7 @@ def _spindle(command: Spindle, where: str, w: _Writer) -> str | None:
     if whole != rpm:
         w.note("rpm", f"spindle speed {rpm:g} rev/min rounded to S{whole:04d} (whole rev/min)")
     m = "M03" if command.direction == "cw" else "M04"
-    return f"{m}S{format_int(whole, 4, what='spindle speed')};"
+    return f"{m}{WORDS['S'].format(whole)};"
 
 
 def _dwell(command: Dwell, where: str, w: _Writer) -> list[str]:
@@ -472,7 +686,7 @@ def _dwell(command: Dwell, where: str, w: _Writer) -> list[str]:
             f"{where}: dwell {whole} s written as {len(pieces)} G04 blocks of at most "
             f"{MAX_DWELL_S} s (P has 2 digits, seed-000 L3359–L3366)",
         )
-    return [f"G04P{format_int(p, 2, what='dwell')};" for p in pieces]
+    return [f"G04{WORDS['P'].format(p)};" for p in pieces]
 
 
 def _home(command: Home, where: str) -> list[str]:
@@ -511,3 +725,12 @@ def _listing(noun: str, numbers: list[int], most: int = 6) -> str:
     text = ", ".join(str(n) for n in numbers[:most])
     more = f" … ({len(numbers)} in all)" if len(numbers) > most else ""
     return f"{noun}{'s' if len(numbers) > 1 else ''} {text}{more}"
+
+
+def post_processor(options: Mapping[str, Any], where: str) -> PostProcessor:
+    """The ``pic-mmh`` dialect built from a target file's ``[dialect_options]``.
+
+    Raises:
+        InputError: an unknown option or a bad value, naming ``where``.
+    """
+    return from_options(PicMmhPost, options, where)

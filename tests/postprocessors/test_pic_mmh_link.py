@@ -3,11 +3,7 @@
 from __future__ import annotations
 
 import pytest
-from hypothesis import given
-from hypothesis import strategies as st
-
-from camtool.model.errors import DialectError, ParseError
-from camtool.post.pic_mmh_modes import (
+from camtool_postprocessors.pic_mmh_link import (
     AXES,
     Backlash,
     Faster,
@@ -24,6 +20,10 @@ from camtool.post.pic_mmh_modes import (
     backlash_commands,
     parse_mode,
 )
+from hypothesis import given
+from hypothesis import strategies as st
+
+from camtool.model.errors import DialectError, ParseError
 from camtool.post.registry import load_target
 
 # Every string example of the reference, verbatim, with what it means.

@@ -1,1 +1,0 @@
-"""Built-in machine profiles (``<name>.toml``), read by :mod:`camtool.model.machine`."""

@@ -1,1 +1,0 @@
-"""Built-in target files (``<name>.toml``): a dialect plus a machine profile."""

@@ -1,0 +1,943 @@
+"""The ``matlab-router`` dialect: the seed-002 wood router's Matlab GUI arrays.
+
+Source: seed-002 §3 (the GUI, verbatim code in Appendix A.1), §2.7 (the USB
+stream), §2.8 (the master's job), §8 R1–R7 (reference/seed-002.md).
+
+The GUI turns clicked vertices into three integer arrays per figure
+(:mod:`camtool_postprocessors.matlab_router_arrays`): ``xy`` (``2 × N`` absolute vertices, 0.1 mm),
+``lxy`` (``2 × n`` absolute increments, 0.1 mm, ``n = N − 1``) and ``velxy``
+(``2 × n`` signed speeds, encoder counts per 5 ms: the major axis at ±``speed``,
+480 by default, the other scaled so both end together). Two formats:
+
+- ``script`` (``.m``): the arrays in the thesis's display format (L3196–L3228),
+  one ``xy``/``lxy``/``velxy`` triple per job, ``%`` comments naming the job,
+  stroke and contour. Each matrix is ``name = `` on one line, then
+  ``[`` + the x row (values right-aligned in 6 columns) + ``; `` and `` `` + the y
+  row + `` ] ``. This is the thesis's ``velxy`` block character for character
+  and the first row of every block; the thesis's second rows of ``xy`` and
+  ``lxy`` sit one column further left (typed by hand), which camtool does not
+  copy. camtool's points importer reads these files back as strokes.
+- ``wire`` (``.txt``): the bytes the GUI sent the master over the USB-CDC port
+  (``pushbutton2_Callback``, L4292–L4360): per job ``n``, ``x1``, ``y1``, then
+  ``lx(1..n)``, ``ly(1..n)``, ``velx(1..n)``, ``vely(1..n)``, each as Matlab
+  ``fprintf(s,'%d',v)`` followed by CR (char 13): ``3 + 4n`` values, no other
+  byte. The GUI's pauses (10 ms after the header values, 1 ms after the
+  others) are not bytes and are not written. ``first_pointy_as_char`` reproduces
+  the GUI's ``fprintf(s,'%c',first_pointy)`` bug (L4306): ``y1`` as one character.
+
+Jobs. The router has no travel inside a job (R6): a stroke (the cutting moves
+between two rapids) is one job, which the master runs as home (Z, X, Y) → first
+point (X then Y at speed 500) → tool down → segments, stopping at every vertex →
+tool off; then it idles (seed-002 §2.8; multi-stroke figures in §6, L3938–L3966).
+A rapid is therefore a job boundary, never written. A stroke of more than
+``max_segments`` (128: the master's ``X_ROUTE[128]``, L4625) segments is split
+into jobs that continue from the same vertex: the thesis machine can do that (it
+is how it cut multi-stroke lettering), at the price of a tool lift, re-homing and
+a re-plunge at the joint; camtool warns.
+
+Rounding (R1): vertices are ``round(x_mm · 10)`` with Matlab's ``round`` (half
+away from zero), as the GUI's ``round(xy*100)`` in cm. A vertex that rounds onto
+the previous one is dropped (reported). Arcs become equal chords within
+``chord_tolerance_mm`` (default: the machine's ``motion.chord_tolerance_mm``),
+reported with the chord count and the largest sagitta measured.
+"""
+
+from __future__ import annotations
+
+import bisect
+import itertools
+import math
+import re
+from collections import Counter
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Any, ClassVar
+
+import numpy as np
+from camtool_postprocessors.matlab_router_arrays import (
+    DEFAULT_SPEED,
+    RouterArrays,
+    points_01mm,
+    router_arrays,
+)
+
+from camtool.model.errors import DialectError, ParseError, UsageError
+from camtool.model.machine import Machine
+from camtool.model.program import ArcMove, Linear, Move, Program, Rapid
+from camtool.model.shapes import Arc, Point
+from camtool.post.base import (
+    ContourCounter,
+    PostProcessor,
+    PostResult,
+    check_placement,
+    check_work_area,
+    from_options,
+)
+from camtool.post.numfmt import NumberFormat
+
+# -- matlab_router_read ------------------------------------------------------------
+# Reader of the ``matlab-router`` dialect: the GUI's ``.m`` script and its USB wire stream.
+#
+# Both formats are written by :class:`camtool_postprocessors.matlab_router.MatlabRouterPost`
+# (seed-002 §3, §2.7, R2–R4) and read back here, strictly, into a
+# :class:`~camtool.model.program.Program` of absolute mm, Y up: each job becomes a
+# :class:`~camtool.model.program.Rapid` to its first point (the master homes and goes
+# there, §2.8 st=0/st=1) followed by one :class:`~camtool.model.program.Linear` per
+# segment (``contour`` = the job number).
+#
+# **What is the truth.** The firmware never sees ``xy``: the master replays the
+# first point, ``lxy`` (distances) and ``velxy`` (signed speeds, whose signs are the
+# directions, L3229–L3231). The verifier recomputes the speeds from the vertices
+# with the GUI's own rule (:func:`~camtool_postprocessors.matlab_router_arrays.router_arrays`), so a
+# file whose arrays disagree with that rule cannot be simulated as the firmware
+# would run it: every ``lxy``/``velxy`` entry must be exactly what the GUI
+# computes from the vertices at the dialect's ``speed``, else a
+# :class:`~camtool.model.errors.ParseError` names the job, the array, the column
+# (segment) and the value expected. A segment that moves an axis at speed 0 is
+# refused (the slave never reaches its count and the job hangs, §4.2; on the wire
+# its direction is lost).
+#
+# ``Program.lines`` holds, per move, a 1-based line: in the script, the line of
+# that vertex's ``x`` in the ``xy`` matrix; in the wire stream, the record number
+# (each value ends with CR, which editors show as a line break) of ``x1`` for a
+# job's rapid and of ``lx(i)`` for segment ``i``.
+
+COUNTS_PER_MM = 25_600
+"""Encoder counts per mm on X and Y: 1024 × 75 / 3 mm (seed-002 §2.2, R8)."""
+TS_S = 0.005
+"""Servo sample period of the slaves' speed loops, s (seed-002 §2.6)."""
+INT16_MAX = 32_767
+"""Largest value the master's ``signed int16`` arrays hold (L4625–L4643)."""
+WIRE_MAX_CHARS = 6
+"""Characters per wire value: ``get_string_usb(s, 7)`` keeps 6 and a NUL (L5009–L5021)."""
+UNITS_PER_MM = 10
+"""GUI units (0.1 mm) per mm (seed-002 §3, L3202–L3204)."""
+ARRAYS = ("xy", "lxy", "velxy")
+"""The variables of a job, in the order the script holds them."""
+
+_INT = re.compile(r"0|-?[1-9]\d*")
+"""A whole number as Matlab writes it: no leading zeros, no ``-0``."""
+_WIRE_START = re.compile(r"-?\d")
+"""A wire stream starts with its ``n``; a script with a comment or a variable."""
+_ASSIGN = re.compile(r"([A-Za-z_]\w*)[ \t]*=[ \t]*")
+
+
+def major_axis_feed_mm_min(speed: int) -> float:
+    """Feed of the major axis at ``speed`` counts per 5 ms, mm/min (R7: 480 → 3.75 mm/s).
+
+    ``speed · 200 / 25 600`` mm/s (seed-002 §2.3, R7), so 480 gives 225 mm/min.
+    """
+    return speed / COUNTS_PER_MM / TS_S * 60.0
+
+
+@dataclass(frozen=True)
+class _Number:
+    """One integer of the code with the 1-based line (or record) it sits on."""
+
+    value: int
+    line: int
+
+
+@dataclass(frozen=True)
+class _Job:
+    """One job as read: vertices and the 1-based line of each move."""
+
+    xy: np.ndarray  # (N, 2) int64, 0.1 mm
+    lines: tuple[int, ...]  # N: the rapid's line, then one per segment
+
+
+def read_router_code(
+    code: str | bytes,
+    *,
+    source: str,
+    speed: int,
+    max_segments: int,
+    first_pointy_as_char: bool,
+) -> Program:
+    """Read a script or a wire stream (autodetected) back into a program.
+
+    A wire stream starts with a digit (its ``n``); anything else is read as a
+    script. Bytes are decoded as UTF-8 (the wire is ASCII).
+
+    Args:
+        code: the code, text or bytes.
+        source: file name for messages.
+        speed: the major-axis speed the arrays must have been made with, counts/5 ms.
+        max_segments: most segments a job may hold (the master's arrays, 128).
+        first_pointy_as_char: the wire's ``y1`` is one character (the GUI's
+            ``'%c'`` bug, L4306) instead of a decimal number.
+
+    Returns:
+        Rapid + Linear moves in mm, ``contour`` = job number, with ``lines``.
+
+    Raises:
+        ParseError: anything not written by the dialect, naming ``source``, the
+            line (record) and the text, or an array that disagrees with the GUI's
+            rule (naming the job, array and column).
+    """
+    if isinstance(code, bytes):
+        try:
+            code = code.decode("utf-8")
+        except UnicodeDecodeError as exc:
+            raise ParseError(
+                f"{source}: byte {exc.start} is not text; matlab-router code is ASCII"
+            ) from exc
+    if not code.strip():
+        raise ParseError(f"{source}: empty; expected a matlab-router script or wire stream")
+    reader = _Reader(source, speed, max_segments)
+    wire = _WIRE_START.match(code) is not None
+    jobs = reader.wire(code, first_pointy_as_char) if wire else reader.script(code)
+    return _program(jobs, speed)
+
+
+def _program(jobs: list[_Job], speed: int) -> Program:
+    """Rapid to each job's first point, then its segments, mm."""
+    feed = major_axis_feed_mm_min(speed)
+    moves: list[Move] = []
+    lines: list[int] = []
+    contours = ContourCounter()
+    for job in jobs:
+        (x0, y0), *rest = job.xy.tolist()
+        moves.append(Rapid(x0 / UNITS_PER_MM, y0 / UNITS_PER_MM, contour=contours.next(True)))
+        moves.extend(
+            Linear(x / UNITS_PER_MM, y / UNITS_PER_MM, feed, contour=contours.next(False))
+            for x, y in rest
+        )
+        lines.extend(job.lines)
+    return Program(tuple(moves), lines=tuple(lines))
+
+
+class _Reader:
+    """Parsing state shared by both formats: where, speed, capacity."""
+
+    def __init__(self, source: str, speed: int, max_segments: int) -> None:
+        self.source, self.speed, self.max_segments = source, speed, max_segments
+
+    def fail(self, line: int, message: str) -> ParseError:
+        return ParseError(f"{self.source}:{line}: {message}")
+
+    # -- checks common to both formats ----------------------------------------
+
+    def check_job(
+        self, job: int, xy: np.ndarray, line: int, speed_line: Callable[[int, int], int]
+    ) -> RouterArrays:
+        """Capacity, ranges, and the arrays the GUI computes from ``xy`` ((N, 2), 0.1 mm).
+
+        ``line`` is the job's line; ``speed_line(axis, segment)`` the line of a speed.
+        """
+        n = len(xy) - 1
+        if not 1 <= n <= self.max_segments:
+            raise self.fail(
+                line,
+                f"job {job}: n = {n} segments; a job holds 1 to {self.max_segments} "
+                "(the master's arrays X_ROUTE[128]..., seed-002 §2.7 L4625)",
+            )
+        if xy[0, 0] < 0 or xy[0, 1] < 0:
+            raise self.fail(
+                line,
+                f"job {job}: first point ({xy[0, 0]}, {xy[0, 1]}) is negative; the master "
+                "goes there as an unsigned distance from home (L4792)",
+            )
+        if np.abs(xy).max() > INT16_MAX:
+            raise self.fail(line, f"job {job}: a coordinate does not fit int16 (±{INT16_MAX})")
+        arrays = router_arrays(xy, speed=self.speed)
+        hang = (arrays.lxy > 0) & (arrays.velxy == 0)
+        if hang.any():
+            axis, col = (int(i[0]) for i in np.nonzero(hang))
+            raise self.fail(
+                speed_line(axis, col),
+                f"job {job}, segment {col + 1}: {'XY'[axis]} moves {arrays.lxy[axis, col]} "
+                "(0.1 mm) at speed 0: the slave never reaches its count and the job hangs "
+                "(seed-002 §4.2)",
+            )
+        return arrays
+
+    def compare(self, job: int, name: str, got: list[_Number], want: np.ndarray, hint: str) -> None:
+        """``got`` (row-major 2 × n) must equal ``want`` (2, n); else name the column."""
+        n = want.shape[1]
+        for k, number in enumerate(got):
+            row, col = divmod(k, n)
+            if number.value != want[row, col]:
+                raise self.fail(
+                    number.line,
+                    f"job {job}, {name} column {col + 1} (segment {col + 1}), row {row + 1} "
+                    f"({'xy'[row]}): {number.value} where the GUI's rule gives "
+                    f"{want[row, col]} ({hint})",
+                )
+
+    # -- the script --------------------------------------------------------------
+
+    def script(self, text: str) -> list[_Job]:
+        """Jobs of a script: ``xy``, ``lxy``, ``velxy`` assignments in turn, ``%`` comments."""
+        code = re.sub(r"%[^\n]*", "", text)
+        starts = [0] + [i + 1 for i, c in enumerate(code) if c == "\n"]
+
+        def line_at(offset: int) -> int:
+            return bisect.bisect_right(starts, offset)
+
+        found: list[tuple[str, list[_Number]]] = []
+        pos = _skip_blank(code, 0)
+        while pos < len(code):
+            name, numbers, pos = self._assignment(code, pos, line_at)
+            found.append((name, numbers))
+            pos = _skip_blank(code, pos)
+        if not found:
+            raise self.fail(1, "no 'xy = [ ... ]' matrix; expected xy, lxy, velxy per job")
+        jobs = []
+        for j in range(0, len(found), 3):
+            group = found[j : j + 3]
+            names = [name for name, _ in group]
+            if names != list(ARRAYS):
+                bad = next((k for k, n in enumerate(names) if n != ARRAYS[k]), len(names) - 1)
+                raise self.fail(
+                    group[bad][1][0].line,
+                    f"job {j // 3 + 1}: found {', '.join(names)}; each job is xy, lxy, "
+                    "velxy in that order",
+                )
+            jobs.append(self._script_job(j // 3 + 1, [numbers for _, numbers in group]))
+        return jobs
+
+    def _assignment(
+        self, code: str, pos: int, line_at: Callable[[int], int]
+    ) -> tuple[str, list[_Number], int]:
+        """``name = [ row ; row ]`` at ``pos``: the name, its numbers row-major, the end."""
+        line = line_at(pos)
+        assign = _ASSIGN.match(code, pos)
+        if assign is None or assign.group(1) not in ARRAYS:
+            snippet = code[pos:].split("\n", 1)[0].strip()[:40]
+            raise self.fail(
+                line, f"expected 'xy = ', 'lxy = ' or 'velxy = ' and a matrix, got {snippet!r}"
+            )
+        name = assign.group(1)
+        start = _skip_blank(code, assign.end())
+        end = code.find("]", start)
+        if start >= len(code) or code[start] != "[" or end < 0 or "[" in code[start + 1 : end]:
+            raise self.fail(line, f"{name}: expected a matrix '[ ...; ... ]' after '{name} ='")
+        rows: list[list[_Number]] = [[]]
+        for m in re.finditer(r"[^\s,;]+|[;\n]", code[start + 1 : end]):
+            token, offset = m.group(0), start + 1 + m.start()
+            if token in ";\n":
+                rows.append([])
+            elif _INT.fullmatch(token):
+                if len(token) > 6 or abs(int(token)) > INT16_MAX:  # before numpy's int64
+                    shown = token if len(token) <= 20 else f"{token[:12]}... ({len(token)} digits)"
+                    raise self.fail(
+                        line_at(offset),
+                        f"{name}: {shown} does not fit the master's int16 (±{INT16_MAX})",
+                    )
+                rows[-1].append(_Number(int(token), line_at(offset)))
+            else:
+                raise self.fail(line_at(offset), f"{name}: {token!r} is not a whole number")
+        rows = [r for r in rows if r]
+        if len(rows) != 2 or len(rows[0]) != len(rows[1]):
+            lengths = " and ".join(str(len(r)) for r in rows) or "no"
+            raise self.fail(
+                line,
+                f"{name}: {lengths} numbers in {len(rows)} row(s); it needs 2 rows (x, then y) "
+                "of equal length",
+            )
+        end = _skip_blank(code, end + 1)
+        return name, rows[0] + rows[1], end + code.startswith(";", end)
+
+    def _script_job(self, job: int, group: list[list[_Number]]) -> _Job:
+        xy_numbers, lxy, velxy = group
+        count = len(xy_numbers) // 2
+        xy = np.array([n.value for n in xy_numbers], dtype=np.int64).reshape(2, count).T
+        line = xy_numbers[0].line
+        if count < 2:
+            raise self.fail(line, f"job {job}: xy has {count} point(s); a job needs 2 or more")
+        for name, numbers in (("lxy", lxy), ("velxy", velxy)):
+            if len(numbers) != 2 * (count - 1):
+                raise self.fail(
+                    numbers[0].line,
+                    f"job {job}: {name} has {len(numbers) // 2} columns; xy has {count} "
+                    f"points, so {count - 1} segments",
+                )
+        arrays = self.check_job(job, xy, line, lambda a, i: velxy[a * (count - 1) + i].line)
+        why = "the firmware replays lxy and velxy, not xy, so they must agree with it"
+        self.compare(job, "lxy", lxy, arrays.lxy, f"|xy(i+1) - xy(i)|; {why}")
+        self.compare(job, "velxy", velxy, arrays.velxy, f"at speed {self.speed}; {why}")
+        return _Job(xy, tuple(n.line for n in xy_numbers[:count]))
+
+    # -- the wire stream ---------------------------------------------------------
+
+    def wire(self, text: str, as_char: bool) -> list[_Job]:
+        """Jobs of a wire stream: ``n, x1, y1, lx…, ly…, velx…, vely…`` each ended by CR."""
+        records = text.split("\r")
+        if records[-1] != "":
+            raise self.fail(
+                len(records),
+                f"{records[-1][:20]!r} does not end with CR (13); every wire value does",
+            )
+        records.pop()
+        jobs: list[_Job] = []
+        k = 0
+        while k < len(records):
+            job = len(jobs) + 1
+            n = self._value(records, k, f"job {job}: n")
+            if not 1 <= n <= self.max_segments:
+                raise self.fail(
+                    k + 1,
+                    f"job {job}: n = {n}; a job holds 1 to {self.max_segments} segments "
+                    "(the master's arrays, seed-002 §2.7 L4625)",
+                )
+            if len(records) < k + 3 + 4 * n:
+                raise self.fail(
+                    len(records),
+                    f"job {job}: the stream ends after {len(records) - k} of its "
+                    f"3 + 4·{n} = {3 + 4 * n} values",
+                )
+            jobs.append(self._wire_job(job, records, k, n, as_char))
+            k += 3 + 4 * n
+        return jobs
+
+    def _value(self, records: list[str], k: int, what: str) -> int:
+        text = records[k]
+        if not _INT.fullmatch(text) or len(text) > WIRE_MAX_CHARS:
+            raise self.fail(
+                k + 1,
+                f"{what}: {text[:20]!r} is not a decimal integer of at most "
+                f"{WIRE_MAX_CHARS} characters ended by CR (Matlab fprintf '%d', then char 13)",
+            )
+        value = int(text)
+        if abs(value) > INT16_MAX:
+            raise self.fail(k + 1, f"{what}: {value} does not fit the master's int16")
+        return value
+
+    def _wire_job(self, job: int, records: list[str], k: int, n: int, as_char: bool) -> _Job:
+        x1 = self._value(records, k + 1, f"job {job}: x1")
+        if as_char:
+            if len(records[k + 2]) != 1:
+                raise self.fail(
+                    k + 3,
+                    f"job {job}: y1 {records[k + 2][:20]!r} is not one character "
+                    "(first_pointy_as_char: the GUI sent fprintf(s,'%c',first_pointy), L4306)",
+                )
+            y1 = ord(records[k + 2])
+        else:
+            y1 = self._value(records, k + 2, f"job {job}: y1")
+        base = k + 3
+        names = ("lx", "ly", "velx", "vely")
+        values = [
+            [
+                self._value(records, base + a * n + i, f"job {job}: {names[a]}({i + 1})")
+                for i in range(n)
+            ]
+            for a in range(4)
+        ]
+        lx, ly, velx, vely = (np.array(v, dtype=np.int64) for v in values)
+        for name, d, a in (("lx", lx, 0), ("ly", ly, 1)):
+            if (d < 0).any():
+                i = int(np.argmax(d < 0))
+                raise self.fail(
+                    base + a * n + i + 1,
+                    f"job {job}: {name}({i + 1}) = {d[i]}; distances are absolute values "
+                    "(the direction is the sign of the speed)",
+                )
+        steps = np.stack([lx * np.where(velx < 0, -1, 1), ly * np.where(vely < 0, -1, 1)])
+        first = np.array([[x1], [y1]], dtype=np.int64)
+        xy = np.concatenate([first, first + np.cumsum(steps, axis=1)], axis=1).T
+        arrays = self.check_job(job, xy, k + 2, lambda a, i: base + (2 + a) * n + i + 1)
+        got = [
+            _Number(int(v), base + 2 * n + a * n + i + 1)
+            for a, row in enumerate((velx, vely))
+            for i, v in enumerate(row)
+        ]
+        why = "the verifier derives the speeds from the vertices by that rule"
+        self.compare(job, "velxy", got, arrays.velxy, f"at speed {self.speed}; {why}")
+        return _Job(xy, (k + 2, *(base + i + 1 for i in range(n))))
+
+
+def _skip_blank(code: str, pos: int) -> int:
+    """Index of the first character at or after ``pos`` that is not white space."""
+    while pos < len(code) and code[pos] in " \t\r\n":
+        pos += 1
+    return pos
+
+
+# -- matlab_router_warnings ------------------------------------------------------------
+# The warnings of the ``matlab-router`` writer: one per kind of conversion.
+#
+# Gathered in a :class:`WriterNotes` while :class:`MatlabRouterPost`
+# writes, then worded here (seed-002 §2.8, §3, §4.2 for the reasons given).
+
+FIRST_POINT_SPEED = 500
+"""Speed of the move from home to a job's first point, counts per 5 ms (L4796)."""
+
+COMMAND_REASONS = {
+    "Spindle": "the Z slave switches the Dremel on at the first segment and off at the end "
+    "of every job by itself (seed-002 §2.8, L6556–L6560)",
+    "Dwell": "the GUI has no pause; the master stops at every vertex anyway",
+    "ToolChange": "the router has one tool, changed by hand",
+    "Home": "every job homes Z, X and Y before it starts (seed-002 §2.8 st=0)",
+}
+"""Why each kind of :data:`~camtool.model.program.Command` is not written."""
+
+
+@dataclass
+class WriterNotes:
+    """What the writer has to tell the user, gathered while writing (one warning per kind).
+
+    Attributes:
+        warnings: warnings already worded (strokes that round to one point).
+        commands: commands not written, by kind (``Spindle``, ``Dwell``...).
+        arcs: arcs turned into chords.
+        chords: chords written for them.
+        sagitta_mm: largest chord sagitta measured, mm (before rounding to 0.1 mm).
+        merged: where vertices that rounded onto the previous one were dropped.
+        feeds: programmed feeds other than the router's, mm/min.
+        trailing_rapid: end of a rapid after the last cut (not written), mm.
+    """
+
+    warnings: list[str] = field(default_factory=list)
+    commands: Counter[str] = field(default_factory=Counter)
+    arcs: int = 0
+    chords: int = 0
+    sagitta_mm: float = 0.0
+    merged: list[str] = field(default_factory=list)
+    feeds: set[float] = field(default_factory=set)
+    trailing_rapid: Point | None = None
+
+
+def notes_warnings(notes: WriterNotes, speed: int, tolerance: float) -> list[str]:
+    """One warning per kind of conversion the writer made (commands, feeds, arcs, merges)."""
+    w = [
+        f"{count} {kind} command(s) not written: {COMMAND_REASONS.get(kind, 'no word for it')}"
+        for kind, count in sorted(notes.commands.items())
+    ]
+    if notes.feeds:
+        feeds = ", ".join(f"{f:g}" for f in sorted(notes.feeds))
+        w.append(
+            f"feeds ignored ({feeds} mm/min): the router runs the longer axis of every segment "
+            f"at {speed} counts per 5 ms = {major_axis_feed_mm_min(speed):g} mm/min and scales "
+            "the other (seed-002 §3, R7)"
+        )
+    if notes.arcs:
+        w.append(
+            f"{notes.arcs} arc(s) written as {notes.chords} chords within {tolerance:g} mm "
+            f"(largest sagitta {notes.sagitta_mm:.4f} mm), then rounded to 0.1 mm: the router "
+            "has straight segments only (seed-002 §4.1)"
+        )
+    if notes.merged:
+        w.append(
+            f"{len(notes.merged)} vertex(es) rounded onto the previous one at 0.1 mm and dropped "
+            f"(first: {notes.merged[0]})"
+        )
+    if notes.trailing_rapid is not None:
+        x, y = notes.trailing_rapid
+        w.append(
+            f"the final rapid to ({x:g}, {y:g}) mm is not written: after a job the master "
+            "idles with the tool where the job ended (seed-002 §2.8 st=3)"
+        )
+    return w
+
+
+def jobs_warnings(jobs: list[RouterJob], max_segments: int) -> list[str]:
+    """Warnings about the jobs themselves: splits, several jobs, firmware hazards."""
+    w = []
+    split = [j for j in jobs if j.part == 2]
+    if split:
+        joints = "; ".join(
+            f"stroke {j.stroke} at ({j.arrays.xy[0, 0] / 10:g}, {j.arrays.xy[1, 0] / 10:g}) mm"
+            for j in split[:3]
+        )
+        w.append(
+            f"{len(split)} stroke(s) longer than {max_segments} segments split into jobs that "
+            f"continue from the same vertex ({joints}): the master holds {max_segments} per job "
+            "(L4625); the tool lifts, homes and re-plunges at each joint"
+        )
+    if len(jobs) > 1:
+        w.append(
+            f"{len(jobs)} jobs: the router has no travel inside a job; each job homes Z, X, Y, "
+            f"goes to its first point X then Y at speed {FIRST_POINT_SPEED} and lowers the tool, "
+            "and the master idles after it (seed-002 §2.8, §6 L3938–L3966): send the jobs "
+            "one at a time, resetting the master in between"
+        )
+    ones = [
+        f"{j.where(int(c))} {'XY'[a]}"
+        for j in jobs
+        for a, c in zip(*np.nonzero(j.arrays.lxy == 1), strict=True)
+    ]
+    if ones:
+        w.append(
+            f"{len(ones)} segment(s) move an axis by 0.1 mm (first: {ones[0]}): the thesis "
+            "slave's chunk counter underflows on a distance of 1 (factor - 1 = 65535, "
+            "seed-002 §4.2) and that axis runs away; check the slave firmware or snap the "
+            "drawing to 0.2 mm"
+        )
+    return w
+
+
+# -- matlab_router ------------------------------------------------------------
+
+FIRMWARE_MAX_SEGMENTS = 128
+"""Segments (lines) one job holds: the master's ``X_ROUTE[128]`` … arrays (L4625–L4635)."""
+PROSE_MAX_SEGMENTS = 255
+"""The prose's limit, "256 puntos (255 líneas)" (L3175–L3181); needs another firmware."""
+_INTEGER = NumberFormat(scale=1.0, decimals=0)
+"""Every value of both formats: whole numbers (0.1 mm, counts per 5 ms), ``-`` if negative."""
+
+
+@dataclass(frozen=True)
+class RouterJob:
+    """One job: the arrays the GUI sends for (part of) one stroke.
+
+    Attributes:
+        arrays: ``xy``, ``lxy``, ``velxy`` (read-only ``int64``, 0.1 mm and counts/5 ms).
+        stroke: 1-based number of the stroke (run of cutting moves) it comes from.
+        part: 1-based part of the stroke (``> 1`` when a long stroke was split).
+        parts: number of jobs the stroke was split into.
+        first_segment: 1-based number, within the stroke, of the job's first segment.
+        contours: the program contours the job cuts.
+        blocks: 1-based program move number of each segment (arcs give several).
+    """
+
+    arrays: RouterArrays
+    stroke: int
+    part: int
+    parts: int
+    first_segment: int
+    contours: tuple[int, ...]
+    blocks: tuple[int, ...]
+
+    def where(self, segment: int | None = None) -> str:
+        """Where in the program, for messages: ``"contour 2, block 7 (stroke 1, segment 4)"``.
+
+        ``segment`` is 0-based within the job; ``None`` names the job's stroke only.
+        """
+        part = f" part {self.part} of {self.parts}" if self.parts > 1 else ""
+        stroke = f"stroke {self.stroke}{part}"
+        if segment is None:
+            return _place(self.contours, stroke)
+        number = self.first_segment + segment
+        return _place(self.contours, f"block {self.blocks[segment]} ({stroke}, segment {number})")
+
+
+@dataclass
+class _Stroke:
+    """Vertices of one stroke in mm and the move index that produced each after the first."""
+
+    number: int
+    points: list[Point]
+    owners: list[int] = field(default_factory=list)
+
+
+class MatlabRouterPost(PostProcessor):
+    """Writer and reader of the seed-002 router's Matlab GUI arrays (seed-002 §3, R1–R7).
+
+    Args:
+        speed: major-axis speed of every segment, encoder counts per 5 ms (R7;
+            480 in the GUI, L4458): a whole number 1–32767.
+        max_segments: segments per job, 1–255: 128 is the thesis master's array
+            size (L4625); up to 255 (the prose, L3175) for a modified firmware.
+        chord_tolerance_mm: largest chord sagitta when arcs become chords, mm
+            (``None``: the machine's ``motion.chord_tolerance_mm``).
+        first_pointy_as_char: write ``y1`` on the wire as one character, as the
+            GUI's ``fprintf(s,'%c',first_pointy)`` did (L4306); ``y1`` must then
+            be 1–127 and not 10 or 13. Default: a decimal number, as the master
+            parses it (``atol``, L5017).
+
+    Raises:
+        UsageError: an option out of range or of the wrong type.
+    """
+
+    arcs: ClassVar[bool] = False
+    """Arcs are written as chords."""
+
+    formats: ClassVar[Mapping[str, str]] = MappingProxyType({"script": ".m", "wire": ".txt"})
+    binary: ClassVar[bool] = True
+    """Code files are read as bytes: the wire's CR terminators must reach the reader
+    untouched (text mode would turn them into line feeds)."""
+
+    def __init__(
+        self,
+        *,
+        speed: int = DEFAULT_SPEED,
+        max_segments: int = FIRMWARE_MAX_SEGMENTS,
+        chord_tolerance_mm: float | None = None,
+        first_pointy_as_char: bool = False,
+    ) -> None:
+        if isinstance(speed, bool) or not isinstance(speed, int) or not 1 <= speed <= INT16_MAX:
+            raise UsageError(
+                f"speed must be a whole number 1–{INT16_MAX} (counts per 5 ms), got {speed!r}"
+            )
+        if (
+            isinstance(max_segments, bool)
+            or not isinstance(max_segments, int)
+            or not 1 <= max_segments <= PROSE_MAX_SEGMENTS
+        ):
+            raise UsageError(
+                f"max_segments must be a whole number 1–{PROSE_MAX_SEGMENTS} (the thesis master "
+                f"holds {FIRMWARE_MAX_SEGMENTS}), got {max_segments!r}"
+            )
+        if chord_tolerance_mm is not None and (
+            isinstance(chord_tolerance_mm, bool)
+            or not isinstance(chord_tolerance_mm, int | float)
+            or not chord_tolerance_mm > 0
+        ):
+            raise UsageError(f"chord_tolerance_mm must be > 0 mm, got {chord_tolerance_mm!r}")
+        if not isinstance(first_pointy_as_char, bool):
+            raise UsageError(
+                f"first_pointy_as_char must be true or false, got {first_pointy_as_char!r}"
+            )
+        self.speed = speed
+        self.max_segments = max_segments
+        self.chord_tolerance_mm = None if chord_tolerance_mm is None else float(chord_tolerance_mm)
+        self.first_pointy_as_char = first_pointy_as_char
+
+    # -- writing ---------------------------------------------------------------
+
+    def emit(self, program: Program, machine: Machine, *, fmt: str | None = None) -> PostResult:
+        """Write ``program`` as one job per stroke, in the ``script`` or ``wire`` format.
+
+        Returns:
+            The code (text; the wire's values end with CR) with ``blocks`` = the
+            number of jobs, and one warning per kind of conversion.
+
+        Raises:
+            DialectError: a Z move, a point (arcs by their extremes) outside the
+                machine's work area or beyond int16, a segment whose minor-axis
+                speed rounds to 0 (the job would hang), nothing to cut, or on the
+                wire a ``y1`` that cannot be one character; the message names
+                contour and block.
+            UsageError: ``fmt`` is not ``script`` or ``wire``.
+        """
+        fmt = self.check_format(fmt)
+        jobs, warnings = self.jobs(program, machine)
+        code = "".join(self._wire(job) for job in jobs) if fmt == "wire" else self._script(jobs)
+        return PostResult(code, len(jobs), tuple(warnings), fmt)
+
+    def jobs(self, program: Program, machine: Machine) -> tuple[list[RouterJob], list[str]]:
+        """The jobs ``program`` becomes, in order, and the warnings (errors: see :meth:`emit`)."""
+        notes = WriterNotes()
+        strokes = self._strokes(program, machine, notes)
+        jobs: list[RouterJob] = []
+        for stroke in strokes:
+            jobs.extend(self._stroke_jobs(stroke, program, notes))
+        if not jobs:
+            raise DialectError(
+                "nothing to cut: a matlab-router job needs at least one segment of 0.1 mm or "
+                "more (rapids alone are not written)"
+            )
+        warnings = [*check_placement(program, machine), *notes.warnings]
+        warnings += notes_warnings(notes, self.speed, self._tolerance(machine))
+        return jobs, warnings + jobs_warnings(jobs, self.max_segments)
+
+    def _tolerance(self, machine: Machine) -> float:
+        return self.chord_tolerance_mm or machine.motion.chord_tolerance_mm
+
+    def _strokes(self, program: Program, machine: Machine, notes: WriterNotes) -> list[_Stroke]:
+        """Runs of cutting moves (mm, arcs as chords); rapids only end them."""
+        strokes: list[_Stroke] = []
+        current: _Stroke | None = None
+        here = program.origin
+        feed = major_axis_feed_mm_min(self.speed)
+        tolerance = self._tolerance(machine)
+        index = -1
+        for item in program.items():
+            if not isinstance(item, Rapid | Linear | ArcMove):
+                notes.commands[type(item).__name__] += 1
+                continue
+            index += 1
+            move: Move = item
+            _check_move(here, move, index, machine, program)
+            if isinstance(move, Rapid):
+                current, here = None, (move.x, move.y)
+                notes.trailing_rapid = here
+                continue
+            notes.trailing_rapid = None
+            if current is None:
+                current = _Stroke(len(strokes) + 1, [here])
+                strokes.append(current)
+            if not math.isclose(move.feed_mm_min, feed, rel_tol=1e-9):
+                notes.feeds.add(move.feed_mm_min)
+            points = (
+                _chords(here, move, tolerance, notes)
+                if isinstance(move, ArcMove)
+                else [(move.x, move.y)]
+            )
+            current.points.extend(points)
+            current.owners.extend([index] * len(points))
+            here = (move.x, move.y)
+        return strokes
+
+    def _stroke_jobs(
+        self, stroke: _Stroke, program: Program, notes: WriterNotes
+    ) -> list[RouterJob]:
+        """Quantise a stroke, drop repeated vertices, split it into jobs of ≤ max_segments."""
+        xy = points_01mm(np.asarray(stroke.points, dtype=np.float64))
+        keep = np.ones(len(xy), dtype=bool)
+        keep[1:] = (np.diff(xy, axis=0) != 0).any(axis=1)
+        owners = [o for o, k in zip(stroke.owners, keep[1:], strict=True) if k]
+        contours = tuple(sorted({program.moves[o].contour for o in stroke.owners}))
+        for i in np.nonzero(~keep)[0]:
+            move = program.moves[stroke.owners[i - 1]]
+            block = f"block {stroke.owners[i - 1] + 1}"
+            notes.merged.append(
+                _place((move.contour,), f"{block} ({xy[i, 0] / 10:g}, {xy[i, 1] / 10:g}) mm")
+            )
+        xy = xy[keep]
+        if len(xy) < 2:
+            notes.warnings.append(
+                f"{_place(contours, f'stroke {stroke.number}')} rounds to the "
+                f"single point ({xy[0, 0] / 10:g}, {xy[0, 1] / 10:g}) mm at 0.1 mm and is not "
+                "written (a job needs a segment)"
+            )
+            return []
+        if xy.min() < 0 or xy.max() > INT16_MAX:
+            raise DialectError(
+                f"{_place(contours, f'stroke {stroke.number}')} has a coordinate outside "
+                f"0–{INT16_MAX} (0.1 mm): the master's int16 distances from home (L4639)"
+            )
+        n = len(xy) - 1
+        parts = math.ceil(n / self.max_segments)
+        jobs = []
+        for part in range(parts):
+            lo, hi = part * self.max_segments, min(n, (part + 1) * self.max_segments)
+            job = RouterJob(
+                arrays=router_arrays(xy[lo : hi + 1], speed=self.speed),
+                stroke=stroke.number,
+                part=part + 1,
+                parts=parts,
+                first_segment=lo + 1,
+                contours=tuple(sorted({program.moves[o].contour for o in owners[lo:hi]})),
+                blocks=tuple(o + 1 for o in owners[lo:hi]),
+            )
+            _check_speeds(job)
+            jobs.append(job)
+        return jobs
+
+    # -- formatting --------------------------------------------------------------
+
+    def _script(self, jobs: list[RouterJob]) -> str:
+        """The thesis display format, one ``xy``/``lxy``/``velxy`` triple per job."""
+        lines = [
+            "% camtool matlab-router: the seed-002 Matlab GUI arrays (thesis display format)",
+            f"% xy, lxy in 0.1 mm; velxy in encoder counts per 5 ms, major axis {self.speed}",
+            f"% {len(jobs)} job(s); each job homes, goes to its first point and lowers the tool",
+        ]
+        for number, job in enumerate(jobs, start=1):
+            a = job.arrays
+            part = (
+                f" (part {job.part} of {job.parts}, segments {job.first_segment}-"
+                f"{job.first_segment + a.n - 1})"
+                if job.parts > 1
+                else ""
+            )
+            x1, y1 = a.first_point
+            lines += [
+                "",
+                f"% job {number} of {len(jobs)}: stroke {job.stroke}{part}, contour "
+                f"{', '.join(map(str, job.contours))}, n = {_int(a.n)}, first point "
+                f"x = {_int(x1)}, y = {_int(y1)}",
+            ]
+            lines += [*_matrix("xy", a.xy), "", *_matrix("lxy", a.lxy), ""]
+            lines += _matrix("velxy", a.velxy)
+        return "\n".join(lines) + "\n"
+
+    def _wire(self, job: RouterJob) -> str:
+        """One job's bytes: ``n, x1, y1, lx…, ly…, velx…, vely…``, each ended by CR."""
+        a = job.arrays
+        x1, y1 = a.first_point
+        arrays = (*a.lxy[0], *a.lxy[1], *a.velxy[0], *a.velxy[1])
+        values = [_int(v) for v in (a.n, x1, y1, *arrays)]
+        if self.first_pointy_as_char:
+            if not 1 <= y1 <= 127 or y1 in (10, 13):
+                raise DialectError(
+                    f"{job.where()}: y1 = {y1} cannot be sent as one character "
+                    "(first_pointy_as_char: 1–127 with 7 data bits, not LF or CR, L4276/L4306); "
+                    "set first_pointy_as_char = false"
+                )
+            values[2] = chr(y1)
+        return "".join(f"{v}\r" for v in values)
+
+    # -- reading ---------------------------------------------------------------
+
+    def parse(self, code: str | bytes, *, source: str = "<code>") -> Program:
+        """Read a script or a wire stream (autodetected) back into Rapid + Linear moves.
+
+        See :mod:`camtool_postprocessors.matlab_router`: each job is a Rapid to its
+        first point and a Linear per segment (feed: the major axis's
+        ``speed`` in mm/min); the arrays must be exactly the GUI's for the
+        vertices at this dialect's ``speed``.
+
+        Raises:
+            ParseError: anything the dialect does not write, naming ``source``,
+                the line (wire: the record) and the job, array and column.
+        """
+        return read_router_code(
+            code,
+            source=source,
+            speed=self.speed,
+            max_segments=self.max_segments,
+            first_pointy_as_char=self.first_pointy_as_char,
+        )
+
+
+def _place(contours: tuple[int, ...], rest: str) -> str:
+    """``"contour 2, " + rest`` for messages; no contour when the moves have none (0)."""
+    named = [str(c) for c in contours if c]
+    return f"contour {', '.join(named)}, {rest}" if named else rest
+
+
+def _int(value: int) -> str:
+    """A whole number as Matlab's ``%d`` writes it (``-`` for negatives only, never ``-0``)."""
+    return _INTEGER.format(float(value))
+
+
+def _matrix(name: str, arr: np.ndarray) -> list[str]:
+    """``name = `` then the two rows as the thesis prints them (L3196–L3228), ``arr`` (2, n)."""
+    rows = [[_int(v) for v in row] for row in arr.tolist()]
+    width = max(6, 1 + max(len(v) for row in rows for v in row))
+    x, y = ("".join(v.rjust(width) for v in row) for row in rows)
+    return [f"{name} = ", f"[{x}; ", f" {y} ] "]
+
+
+def _check_move(here: Point, move: Move, index: int, machine: Machine, program: Program) -> None:
+    """Z and work-area checks of one move (``index`` 0-based)."""
+    where = _place((move.contour,), f"block {index + 1}")
+    if move.z is not None:
+        raise DialectError(
+            f"{where}: matlab-router has no Z (the Matlab GUI is 2D; the Z slave only lowers "
+            "the tool by a fixed 100 units at each job's start, seed-002 §2.8 L6544); "
+            "set the depth by hand"
+        )
+    check_work_area(here, move, machine, where, program)
+
+
+def _chords(here: Point, move: ArcMove, tolerance: float, notes: WriterNotes) -> list[Point]:
+    """Equal chords of an arc within ``tolerance``; records the count and measured sagitta."""
+    arc = Arc(here, (move.x, move.y), (move.cx, move.cy), move.clockwise)
+    points = arc.points(tolerance)
+    cx, cy = arc.centre
+    for (ax, ay), (bx, by) in itertools.pairwise(points):
+        mid = math.hypot((ax + bx) / 2 - cx, (ay + by) / 2 - cy)
+        notes.sagitta_mm = max(notes.sagitta_mm, arc.radius - mid)
+    notes.arcs += 1
+    notes.chords += len(points) - 1
+    return points[1:]
+
+
+def _check_speeds(job: RouterJob) -> None:
+    """A moving axis whose speed rounds to 0 hangs the job (seed-002 §3, §4.2)."""
+    a = job.arrays
+    hang = (a.lxy > 0) & (a.velxy == 0)
+    if hang.any():
+        axis, col = (int(i[0]) for i in np.nonzero(hang))
+        raise DialectError(
+            f"{job.where(col)}: {'XY'[axis]} moves {a.lxy[axis, col] / 10:g} mm while the other "
+            f"axis moves {a.lxy[1 - axis, col] / 10:g} mm: its speed {a.speed}·"
+            f"{a.lxy[axis, col]}/{a.lxy[1 - axis, col]} rounds to 0 and the slave never reaches "
+            "its count, so the job would hang (seed-002 §3, §4.2); straighten the segment or "
+            "split it"
+        )
+
+
+def post_processor(options: Mapping[str, Any], where: str) -> PostProcessor:
+    """The ``matlab-router`` dialect built from a target file's ``[dialect_options]``.
+
+    Raises:
+        InputError: an unknown option or a bad value, naming ``where``.
+    """
+    return from_options(MatlabRouterPost, options, where)
