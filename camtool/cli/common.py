@@ -23,10 +23,12 @@ from camtool.toolpath.options import (
     ORDERS,
     PLACEMENTS,
     POCKET_STYLES,
+    PlanOptions,
 )
 
 if TYPE_CHECKING:
     from camtool.importers import ImportOptions
+    from camtool.jobs.pipeline import OutputOptions
     from camtool.model.shapes import Drawing
 
 
@@ -200,6 +202,24 @@ def import_settings(options: dict[str, Any]) -> ImportOptions:
         hatch_boundaries=options.pop("hatch_boundaries", False),
         **_given(max_entities=options.pop("max_entities", None)),
     )
+
+
+def plan_settings(options: dict[str, Any]) -> PlanOptions:
+    """Pop the planning options out of a command's keyword options, checked.
+
+    Raises:
+        UsageError: invalid planning options (:class:`~camtool.toolpath.options.PlanOptions`).
+    """
+    fields = PlanOptions.__dataclass_fields__
+    return PlanOptions(**{k: options.pop(k) for k in list(options) if k in fields})
+
+
+def output_settings(options: dict[str, Any]) -> OutputOptions:
+    """Pop the output options (``--format``, ``--spindle-rpm``, ``--spindle-dwell``)."""
+    from camtool.jobs.pipeline import OutputOptions
+
+    fields = OutputOptions.__dataclass_fields__
+    return OutputOptions(**{k: options.pop(k) for k in list(options) if k in fields})
 
 
 def _given(**values: Any) -> dict[str, Any]:

@@ -21,6 +21,8 @@ from camtool.cli.common import (
     import_options,
     import_settings,
     number_range,
+    output_settings,
+    plan_settings,
     post_options,
     read_code,
     read_input,
@@ -118,8 +120,15 @@ def post(
     With --verify (implied by --report, --preview or --max-error-um) the written
     code is read back and simulated on the target's machine, as `verify` does.
     """
-    from camtool.jobs.pipeline import post_drawing, post_path, verify_job
+    from camtool.jobs.pipeline import (
+        is_program_file,
+        post_drawing,
+        post_path,
+        refuse_planning,
+        verify_job,
+    )
     from camtool.post.registry import load_target
+    from camtool.toolpath.options import drawing_only
 
     check_paths(
         [("the input", drawing)],
@@ -128,12 +137,16 @@ def post(
         machine_file=machine_file,
     )
     chosen = load_target(target, machine_file=machine_file)
-    chosen.post.check_format(options["fmt"])
+    output_options = output_settings(options)
+    chosen.post.check_format(output_options.fmt)
     settings = import_settings(options)
+    if drawing != "-" and is_program_file(drawing):
+        refuse_planning(drawing, drawing_only(options))  # before checking them
+    plan = plan_settings(options)
     if drawing == "-":
-        job = post_drawing(read_input(drawing, settings), chosen, **options)
+        job = post_drawing(read_input(drawing, settings), chosen, plan, output_options)
     else:
-        job = post_path(drawing, chosen, import_options=settings, **options)
+        job = post_path(drawing, chosen, plan, output_options, import_options=settings)
     warn(job.warnings)
     if job.plan is not None:
         for line in job.plan.notes():
@@ -253,9 +266,11 @@ def _finish_verification(
     if report is not None:
         write_output(json.dumps(report_dict(v, plan), indent=2) + "\n", report)
     if preview is not None:
-        from camtool.jobs.preview_trace import write_trace_preview
+        from camtool.preview import render_preview
 
-        picture = write_trace_preview(v, preview, drawing=drawing, edge_radius_mm=edge_radius_mm)
+        picture = render_preview(
+            preview, verification=v, drawing=drawing, edge_radius_mm=edge_radius_mm
+        )
         write_output(picture, preview)
     problem = None if max_error_um is None else v.over_limit(max_error_um, strict=strict)
     if problem is not None:

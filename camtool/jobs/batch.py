@@ -35,13 +35,15 @@ from __future__ import annotations
 
 import json
 import os
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from camtool.jobs.batch_inputs import BatchInput, expand_inputs
+from camtool.jobs.pipeline import OutputOptions
 from camtool.model.errors import CamtoolError, UsageError
+from camtool.toolpath.options import PlanOptions
 
 if TYPE_CHECKING:
     from concurrent.futures import Future
@@ -69,14 +71,11 @@ class BatchOptions:
         target: a target name or target ``.toml`` path (see ``camtool targets``).
         output_dir: where the outputs go (created when missing).
         machine_file: machine profile laid over the target's (file or built-in name).
-        feed_mm_min: cutting feed, mm/min; ``None``: the target's default.
-        tolerance: chaining and curve-fit tolerance, mm.
-        plan: the other planning options, as
-            :class:`~camtool.toolpath.options.PlanOptions` fields (``offset``,
-            ``tool_diameter``, ``scale``, ``fit_mm``, ``depth``, ``order``...).
-        fmt: the dialect's output format (``None``: its default).
-        spindle_rpm: rev/min; ``None``: the target's; 0: no spindle commands.
-        spindle_dwell_s: pause after the spindle starts, s (``--spindle-dwell``).
+        plan: the planning options (``offset``, ``tool_diameter``, ``feed_mm_min`` —
+            ``None``: the target's default —, ``tolerance`` (also the importers'
+            chaining and curve-fit tolerance), ``scale``, ``depth``, ``order``...).
+        output: the output format and spindle (``fmt``, ``spindle_rpm``,
+            ``spindle_dwell_s``).
         layers: layers to keep (``None``: all).
         units: unit of unitless inputs (point lists).
         hatch_boundaries: use DXF HATCH boundaries as contours.
@@ -103,12 +102,8 @@ class BatchOptions:
     target: str
     output_dir: Path
     machine_file: Path | None = None
-    feed_mm_min: float | None = None
-    tolerance: float = 0.001
-    plan: Mapping[str, Any] = field(default_factory=dict)
-    fmt: str | None = None
-    spindle_rpm: float | None = None
-    spindle_dwell_s: float = 0.0
+    plan: PlanOptions = field(default_factory=PlanOptions)
+    output: OutputOptions = field(default_factory=OutputOptions)
     layers: tuple[str, ...] | None = None
     units: str | None = None
     hatch_boundaries: bool = False
@@ -144,22 +139,11 @@ class BatchOptions:
         limit = {} if self.max_entities is None else {"max_entities": self.max_entities}
         return ImportOptions(
             layers=self.layers,
-            tolerance=self.tolerance,
+            tolerance=self.plan.tolerance,
             units=self.units,
             hatch_boundaries=self.hatch_boundaries,
             **limit,
         )
-
-    def post_options(self) -> dict[str, Any]:
-        """Keyword options of :func:`camtool.jobs.pipeline.post_drawing`."""
-        return {
-            **self.plan,
-            "feed_mm_min": self.feed_mm_min,
-            "tolerance": self.tolerance,
-            "fmt": self.fmt,
-            "spindle_rpm": self.spindle_rpm,
-            "spindle_dwell_s": self.spindle_dwell_s,
-        }
 
 
 @dataclass(frozen=True)
@@ -263,15 +247,8 @@ def plan_batch(inputs: Sequence[str], options: BatchOptions) -> BatchPlan:
     from camtool.post.registry import load_target
 
     target = load_target(options.target, machine_file=options.machine_file)
-    fmt = target.post.check_format(options.fmt)
-    plan_options(  # validates the post options once, before any file
-        target,
-        **{
-            k: v
-            for k, v in options.post_options().items()
-            if k not in ("fmt", "spindle_rpm", "spindle_dwell_s")
-        },
-    )
+    fmt = target.post.check_format(options.output.fmt)
+    plan_options(target, options.plan)  # checks the options for the target once, before any file
     if options.output_dir.exists() and not options.output_dir.is_dir():
         raise UsageError(f"{options.output_dir}: exists and is not a directory (-o OUTDIR)")
     items = expand_inputs(inputs, exclude=options.output_dir)
@@ -544,9 +521,10 @@ def _post_job(file: str, options: BatchOptions) -> PostJob:
     return post_file(
         file,
         options.target,
+        options.plan,
+        options.output,
         machine_file=options.machine_file,
         import_options=options.import_options(),
-        **options.post_options(),
     )
 
 

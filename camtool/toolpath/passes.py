@@ -396,13 +396,13 @@ class _Writer:
         if self.z is not None and abs(z - self.z) <= Z_EPS:
             return
         up = self.z is not None and z > self.z
-        feed = self.options.feed_mm_min if up else self.options.plunge_feed
+        feed = self.options.feed if up else self.options.plunge_feed
         self.add(Linear(self.x, self.y, feed, z, contour=self.number))
         self.z = z
 
     def cut(self, seg: Segment, z: float | None) -> None:
         """Cut along ``seg`` (starting where the tool is), descending to ``z`` if it differs."""
-        feed = self.options.feed_mm_min
+        feed = self.options.feed
         if z is not None and self.z is not None and abs(z - self.z) <= Z_EPS:
             z = None
         x, y = seg.end
@@ -423,7 +423,7 @@ class _Writer:
         n = len(points) - 1
         for k, (x, y) in enumerate(points[1:], start=1):
             zk = z if k == n else z0 + (z - z0) * k / n
-            self.add(Linear(x, y, self.options.feed_mm_min, zk, contour=self.number))
+            self.add(Linear(x, y, self.options.feed, zk, contour=self.number))
         self.x, self.y = arc.end
         self.z = z
 
