@@ -14,21 +14,20 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from camtool import __version__
+from camtool.cli.batch import batch
 from camtool.cli.common import (
     MACHINE,
     NUMBER,
-    check_paths,
     import_options,
     import_settings,
     number_range,
     output_settings,
     plan_settings,
     post_options,
-    read_code,
-    read_input,
     warn,
     write_output,
 )
+from camtool.cli.preview import preview
 from camtool.model.errors import CamtoolError, UsageError, VerifyLimitError
 
 if TYPE_CHECKING:
@@ -120,13 +119,9 @@ def post(
     With --verify (implied by --report, --preview or --max-error-um) the written
     code is read back and simulated on the target's machine, as `verify` does.
     """
-    from camtool.jobs.pipeline import (
-        is_program_file,
-        post_drawing,
-        post_path,
-        refuse_planning,
-        verify_job,
-    )
+    from camtool.jobs.inputs import is_program_file, read_input
+    from camtool.jobs.output import check_paths
+    from camtool.jobs.pipeline import post_drawing, post_path, refuse_planning, verify_job
     from camtool.post.registry import load_target
     from camtool.toolpath.options import drawing_only
 
@@ -214,6 +209,8 @@ def verify(
     simulated tool path is measured against the programmed one (and the drawing).
     A one-screen summary goes to stderr.
     """
+    from camtool.jobs.inputs import read_code, read_input
+    from camtool.jobs.output import check_paths
     from camtool.post.registry import load_target
     from camtool.verify.verifier import verify_code
 
@@ -258,13 +255,14 @@ def _finish_verification(
     reported it cannot cut with this tool. A drawing that was given but not compared
     (it does not overlap the program) fails the limit: it cannot pass unjudged.
     """
-    from camtool.verify.verifier import report_dict, summary_lines
+    from camtool.jobs.pipeline import report_json
+    from camtool.verify.verifier import summary_lines
 
     warn([w for w in v.warnings if w not in said])
     for line in summary_lines(v):
         click.echo(f"camtool: {line}", err=True)
     if report is not None:
-        write_output(json.dumps(report_dict(v, plan), indent=2) + "\n", report)
+        write_output(report_json(v, plan), report)
     if preview is not None:
         from camtool.preview import render_preview
 
@@ -345,12 +343,7 @@ def _target_json(entry: TargetEntry) -> dict[str, Any]:
     }
 
 
-from camtool.cli.preview import preview  # noqa: E402
-
 cli.add_command(preview)
-
-from camtool.cli.batch import batch  # noqa: E402
-
 cli.add_command(batch)
 
 

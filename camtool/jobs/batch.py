@@ -1,6 +1,6 @@
 """Many inputs, one target: post every file in a process pool and summarise.
 
-:func:`plan_batch` expands the inputs (:mod:`camtool.jobs.batch_inputs`), loads the
+:func:`plan_batch` expands the inputs (:func:`camtool.jobs.inputs.expand_inputs`), loads the
 target and checks everything that can be checked before any work starts: the
 options, that every input matches something, that every output stays inside the
 output folder, that no two files write the same output, that no output is one of
@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from camtool.jobs.batch_inputs import BatchInput, expand_inputs
+from camtool.jobs.inputs import BatchInput, expand_inputs
 from camtool.jobs.pipeline import OutputOptions
 from camtool.model.errors import CamtoolError, UsageError
 from camtool.toolpath.options import PlanOptions
@@ -275,19 +275,12 @@ def _check_outputs(
     Raises:
         UsageError: as :func:`plan_batch` says.
     """
-    from camtool.jobs.output import check_outputs
+    from camtool.jobs.output import Named, check_outputs, definition_inputs
 
     _check_inside(tasks, options.output_dir)
-    inputs: list[tuple[str, str | Path | None]] = [("the input", i.path) for i in items]
-    inputs += [
-        (label, path)
-        for label, path in (
-            ("the target file", options.target),
-            ("the --machine file", options.machine_file),
-        )
-        if path is not None and os.path.isfile(path)
-    ]
-    outputs: list[tuple[str, str | Path | None]] = [("--report", options.report)]
+    inputs: list[Named] = [("the input", i.path) for i in items]
+    inputs += definition_inputs(options.target, options.machine_file)
+    outputs: list[Named] = [("--report", options.report)]
     outputs += [(f"{task.file} →", out) for task in tasks for out in task.outputs]
     check_outputs(inputs, outputs, hint="post them in separate batches or rename one")
     if not options.force:
@@ -482,14 +475,13 @@ def _post_one(task: BatchTask, options: BatchOptions) -> BatchRow:
     time_s = job.program.cutting_time_s()
     v = None
     if options.verifying:
-        from camtool.jobs.pipeline import verify_job
-        from camtool.verify.verifier import report_dict
+        from camtool.jobs.pipeline import report_json, verify_job
 
         v = verify_job(job)
         error_um, time_s = v.max_error_um, v.time_s
         warnings = tuple(dict.fromkeys(warnings + v.warnings))
         if task.report_path is not None:
-            files.append((task.report_path, json.dumps(report_dict(v, job.plan), indent=2) + "\n"))
+            files.append((task.report_path, report_json(v, job.plan)))
     if task.preview_path is not None:
         files.append((task.preview_path, preview_bytes(job, v, task.preview_path, task.file)))
     for path, data in files:

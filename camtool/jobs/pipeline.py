@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from camtool.importers import POINT_SUFFIXES, ImportOptions, read_drawing
+from camtool.jobs.inputs import is_program_file
 from camtool.model.errors import UsageError
 from camtool.model.program import Move, Program
 from camtool.model.shapes import Drawing
@@ -106,7 +107,7 @@ def post_path(
 ) -> PostJob:
     """Post the file at ``path``: a drawing is planned, a G-code program re-posted.
 
-    A program (by its ending, :func:`is_program_file`) is already a toolpath:
+    A program (by its ending, :func:`camtool.jobs.inputs.is_program_file`) is already a toolpath:
     only ``plan.feed_mm_min`` and ``output`` apply (:func:`post_program`).
 
     Args:
@@ -155,15 +156,6 @@ def _note_units(drawing: Drawing, path: str | Path, options: ImportOptions | Non
         "their own units (--units is for point lists)"
     )
     return dataclasses.replace(drawing, warnings=(*drawing.warnings, note))
-
-
-PROGRAM_SUFFIXES = (".ngc", ".nc", ".gcode", ".tap", ".cnc", ".gc", ".g")
-"""File endings read as existing G-code programs (re-posted, not planned)."""
-
-
-def is_program_file(name: str | Path) -> bool:
-    """True when ``name`` is a G-code program by its ending (see :data:`PROGRAM_SUFFIXES`)."""
-    return Path(name).suffix.lower() in PROGRAM_SUFFIXES
 
 
 def post_program(
@@ -404,3 +396,16 @@ def verify_job(job: PostJob) -> Verification:
         tool_diameter=2.0 * job.edge_radius_mm,
         findings=job.plan.placed_findings() if job.plan is not None else (),
     )
+
+
+def report_json(v: Verification, plan: PlanReport | None = None) -> str:
+    """The verify report of ``v`` as indented JSON text with a final newline.
+
+    ``plan`` (what planning found, when the code was planned here) adds a ``plan``
+    key (:func:`camtool.verify.verifier.report_dict`).
+    """
+    import json
+
+    from camtool.verify.verifier import report_dict
+
+    return json.dumps(report_dict(v, plan), indent=2) + "\n"
