@@ -1,3 +1,158 @@
-"""camtool: CAD/CAM for small, home-built and legacy CNC machines."""
+"""camtool: CAD/CAM for small, home-built and legacy CNC machines.
+
+The public API (docs/api.md): read a drawing, plan it, post it for a target,
+verify the code by simulating it on the target's machine::
+
+    import camtool
+
+    drawing = camtool.read_drawing("samples/plate.dxf")
+    job = camtool.post_drawing(drawing, camtool.load_target("grbl"))
+    v = camtool.verify_job(job)
+
+Every name in :data:`__all__` is imported from its module on first use (PEP 562
+module ``__getattr__``), so ``import camtool`` (and ``camtool --version``) loads
+none of the stages: no OCCT, no matplotlib, no numpy.
+"""
+
+from __future__ import annotations
+
+from importlib import import_module
+from typing import TYPE_CHECKING, Any
 
 __version__ = "0.1.0"
+
+_HOMES: dict[str, str] = {
+    # the model: shapes and programs in mm, machines, errors
+    "Drawing": "camtool.model.shapes",
+    "Contour": "camtool.model.shapes",
+    "Line": "camtool.model.shapes",
+    "Arc": "camtool.model.shapes",
+    "Program": "camtool.model.program",
+    "Rapid": "camtool.model.program",
+    "Linear": "camtool.model.program",
+    "ArcMove": "camtool.model.program",
+    "Machine": "camtool.model.machine",
+    "CamtoolError": "camtool.model.errors",
+    "UsageError": "camtool.model.errors",
+    "InputError": "camtool.model.errors",
+    "ParseError": "camtool.model.errors",
+    "ToolpathError": "camtool.model.errors",
+    "DialectError": "camtool.model.errors",
+    "VerifyLimitError": "camtool.model.errors",
+    # read
+    "read_drawing": "camtool.importers",
+    "ImportOptions": "camtool.importers",
+    # plan
+    "PlanOptions": "camtool.toolpath.options",
+    "plan_drawing": "camtool.toolpath.plan",
+    "Plan": "camtool.toolpath.plan",
+    "PlanReport": "camtool.toolpath.plan",
+    # targets
+    "Target": "camtool.post.base",
+    "load_target": "camtool.post.registry",
+    "list_targets": "camtool.post.registry",
+    # post
+    "OutputOptions": "camtool.jobs.pipeline",
+    "PostJob": "camtool.jobs.pipeline",
+    "plan_options": "camtool.jobs.pipeline",
+    "post_drawing": "camtool.jobs.pipeline",
+    "post_path": "camtool.jobs.pipeline",
+    "post_file": "camtool.jobs.pipeline",
+    "post_program": "camtool.jobs.pipeline",
+    "verify_job": "camtool.jobs.pipeline",
+    # verify
+    "Verification": "camtool.verify.verifier",
+    "verify_code": "camtool.verify.verifier",
+    "verify_program": "camtool.verify.verifier",
+}
+"""Each public name → the module that defines it."""
+
+__all__ = [
+    "Arc",
+    "ArcMove",
+    "CamtoolError",
+    "Contour",
+    "DialectError",
+    "Drawing",
+    "ImportOptions",
+    "InputError",
+    "Line",
+    "Linear",
+    "Machine",
+    "OutputOptions",
+    "ParseError",
+    "Plan",
+    "PlanOptions",
+    "PlanReport",
+    "PostJob",
+    "Program",
+    "Rapid",
+    "Target",
+    "ToolpathError",
+    "UsageError",
+    "Verification",
+    "VerifyLimitError",
+    "__version__",
+    "list_targets",
+    "load_target",
+    "plan_drawing",
+    "plan_options",
+    "post_drawing",
+    "post_file",
+    "post_path",
+    "post_program",
+    "read_drawing",
+    "verify_code",
+    "verify_job",
+    "verify_program",
+]
+"""The public API: each name is defined in the module :data:`_HOMES` gives."""
+
+
+def __getattr__(name: str) -> Any:
+    """The public ``name``, imported from its module on first use (PEP 562).
+
+    Raises:
+        AttributeError: ``name`` is not public (nor a submodule already imported).
+    """
+    home = _HOMES.get(name)
+    if home is None:
+        raise AttributeError(f"module 'camtool' has no attribute {name!r}")
+    value = getattr(import_module(home), name)
+    globals()[name] = value  # the next lookup is an ordinary attribute
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_HOMES})
+
+
+if TYPE_CHECKING:  # the names as type checkers and editors see them
+    from camtool.importers import ImportOptions, read_drawing
+    from camtool.jobs.pipeline import (
+        OutputOptions,
+        PostJob,
+        plan_options,
+        post_drawing,
+        post_file,
+        post_path,
+        post_program,
+        verify_job,
+    )
+    from camtool.model.errors import (
+        CamtoolError,
+        DialectError,
+        InputError,
+        ParseError,
+        ToolpathError,
+        UsageError,
+        VerifyLimitError,
+    )
+    from camtool.model.machine import Machine
+    from camtool.model.program import ArcMove, Linear, Program, Rapid
+    from camtool.model.shapes import Arc, Contour, Drawing, Line
+    from camtool.post.base import Target
+    from camtool.post.registry import list_targets, load_target
+    from camtool.toolpath.options import PlanOptions
+    from camtool.toolpath.plan import Plan, PlanReport, plan_drawing
+    from camtool.verify.verifier import Verification, verify_code, verify_program

@@ -26,10 +26,10 @@ import re
 import sys
 from pathlib import Path
 
-from camtool.jobs.pipeline import PostJob, post_file, verify_job
-from camtool.jobs.preview_trace import write_trace_preview
+from camtool.jobs.pipeline import OutputOptions, PostJob, post_file, verify_job
 from camtool.post.registry import load_target, target_names
 from camtool.preview import render_preview
+from camtool.toolpath.options import PlanOptions
 from camtool.verify.verifier import summary_lines
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -103,11 +103,13 @@ def post_sample(target: str, spec: str) -> PostJob:
     sample, *words = spec.split()
     options = dict(word.split("=", 1) for word in words)
     fmt = options.pop("format", None)
-    return post_file(ROOT / "samples" / sample, target, fmt=fmt, **_options(options))
+    return post_file(
+        ROOT / "samples" / sample, target, PlanOptions(**_options(options)), OutputOptions(fmt=fmt)
+    )
 
 
 def _options(words: dict[str, str]) -> dict[str, object]:
-    """``post_drawing`` keyword options from a marker's ``key=value`` words."""
+    """:class:`PlanOptions` fields from a marker's ``key=value`` words."""
     out: dict[str, object] = {}
     for key, value in words.items():
         if key == "fit":
@@ -138,7 +140,7 @@ def _shown(code: str | bytes) -> str:
 def verify_png() -> bytes:
     """The verify preview of samples/logo.dxf on pic-mmh."""
     job = post_file(ROOT / "samples" / "logo.dxf", "pic-mmh")
-    return write_trace_preview(verify_job(job), VERIFY_PNG)
+    return render_preview(VERIFY_PNG, verification=verify_job(job))
 
 
 def main(argv: list[str]) -> int:

@@ -18,6 +18,7 @@ from make_docs import ROOT
 
 from camtool.jobs.pipeline import post_file
 from camtool.preview import render_preview
+from camtool.toolpath.options import PlanOptions
 
 PAGE = ROOT / "docs" / "toolpaths.md"
 PICTURES = ROOT / "docs" / "toolpaths"
@@ -45,7 +46,7 @@ EXAMPLES: dict[str, tuple[str, str, dict[str, Any]]] = {
     ),
     "logo-reversals": ("logo.dxf", "pic-mmh", {"order": "reversals"}),
 }
-"""Example name → (sample, target, ``post_file`` keyword options)."""
+"""Example name → (sample, target, :class:`PlanOptions` fields)."""
 
 
 def toolpath_files() -> dict[Path, str]:
@@ -58,7 +59,7 @@ def toolpath_files() -> dict[Path, str]:
         if name not in EXAMPLES:
             raise SystemExit(f"docs/toolpaths.md: unknown example {name!r}")
         sample, target, options = EXAMPLES[name]
-        job = post_file(ROOT / "samples" / sample, target, **options)
+        job = post_file(ROOT / "samples" / sample, target, PlanOptions(**options))
         svg = render_preview(
             ".svg",
             program=job.program,

@@ -28,8 +28,8 @@ from camtool.jobs.batch import (
     post_one,
     run_batch,
 )
-from camtool.jobs.batch_inputs import expand_inputs
 from camtool.jobs.batch_report import batch_report, progress_line, summary_table
+from camtool.jobs.inputs import expand_inputs
 from camtool.jobs.pipeline import post_file
 from camtool.model.errors import InputError, UsageError
 from tests.shapes import rectangle_dxf

@@ -158,9 +158,12 @@ def test_work_zero_is_marked_when_in_view() -> None:
 def test_not_cut_features_are_marked(suffix: str) -> None:
     from camtool.jobs.pipeline import post_drawing, verify_job
     from camtool.post.registry import load_target
+    from camtool.toolpath.options import PlanOptions
     from tests.verify.test_metrics_not_cut import R, plate
 
-    job = post_drawing(plate(), load_target("grbl"), offset="outside", tool_diameter=2 * R)
+    job = post_drawing(
+        plate(), load_target("grbl"), PlanOptions(offset="outside", tool_diameter=2 * R)
+    )
     v = verify_job(job)
     data = render_preview(suffix, verification=v, drawing=job.placed, edge_radius_mm=R)
     if suffix == ".png":

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from camtool.jobs.pipeline import post_program
+from camtool.jobs.pipeline import OutputOptions, post_program
 from camtool.model.program import Dwell, Home, Linear, Program, Rapid, Spindle, ToolChange
 from camtool.post.registry import load_target
 
@@ -72,7 +72,9 @@ def test_post_program_adds_the_spindle_only_when_asked_and_absent() -> None:
     target = load_target("pic-mmh")
     program = Program(MOVES[:2])
     assert post_program(program, target).program.commands == ()
-    wrapped = post_program(program, target, spindle_rpm=1000).program
+    wrapped = post_program(program, target, OutputOptions(spindle_rpm=1000)).program
     assert wrapped.commands == ((0, Spindle("cw", 1000)), (2, Spindle("off")))
     own = Program(MOVES[:2], commands=((0, Spindle("ccw", 500)),))
-    assert post_program(own, target, spindle_rpm=1000).program.commands == own.commands
+    assert (
+        post_program(own, target, OutputOptions(spindle_rpm=1000)).program.commands == own.commands
+    )

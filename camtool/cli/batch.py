@@ -18,6 +18,8 @@ from camtool.cli.common import (
     MACHINE,
     import_options,
     number_range,
+    output_settings,
+    plan_settings,
     post_options,
     write_output,
 )
@@ -92,12 +94,12 @@ def batch(inputs: tuple[str, ...], layers: str | None, verify_too: bool, **optio
     """
     from camtool.jobs.batch import BatchOptions, plan_batch
     from camtool.jobs.batch_report import batch_report, failure_line, summary_table
-    from camtool.toolpath.options import PLAN_FIELDS
 
     names = tuple(n.strip() for n in layers.split(",") if n.strip()) if layers else None
-    planning = {k: options.pop(k) for k in list(options) if k in PLAN_FIELDS}
+    planning, output = plan_settings(options), output_settings(options)
     plan = plan_batch(
-        inputs, BatchOptions(layers=names, verify=verify_too, plan=planning, **options)
+        inputs,
+        BatchOptions(layers=names, verify=verify_too, plan=planning, output=output, **options),
     )
     result = _run(plan)
     click.echo(summary_table(result), err=True, nl=False)

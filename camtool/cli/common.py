@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
-from camtool.model.errors import CamtoolError, InputError
+from camtool.model.errors import CamtoolError
 from camtool.toolpath.options import (
     DEFAULT_CHAIN_TOLERANCE,
     DIRECTIONS,
@@ -23,11 +23,12 @@ from camtool.toolpath.options import (
     ORDERS,
     PLACEMENTS,
     POCKET_STYLES,
+    PlanOptions,
 )
 
 if TYPE_CHECKING:
     from camtool.importers import ImportOptions
-    from camtool.model.shapes import Drawing
+    from camtool.jobs.pipeline import OutputOptions
 
 
 class FiniteFloat(click.FloatRange):
@@ -72,10 +73,7 @@ def warn(messages: tuple[str, ...] | list[str]) -> None:
 
 
 def write_output(data: str | bytes, out: str) -> None:
-    """``data`` to the file ``out`` (:func:`camtool.jobs.output.write_atomic`), or stdout for ``-``.
-
-    Before a file is written, stale temporary files of killed runs beside it are
-    removed (:func:`camtool.jobs.output.remove_stale_temps`).
+    """``data`` to the file ``out`` (:func:`camtool.jobs.output.write_file`), or stdout for ``-``.
 
     Raises:
         CamtoolError: the file cannot be written, naming it and why (``x.pic: cannot
@@ -83,39 +81,12 @@ def write_output(data: str | bytes, out: str) -> None:
             device`` (or ``broken pipe``), after which stdout is silenced so that
             Python's own flush at exit does not fail again.
     """
-    from camtool.jobs.output import reason, remove_stale_temps, write_atomic
+    from camtool.jobs.output import write_file
 
     if out == "-":
         _write_stdout(data)
         return
-    try:
-        if os.path.isfile(out) or not os.path.lexists(out):  # not a device, FIFO or directory
-            remove_stale_temps(Path(os.path.realpath(out)).parent)
-        write_atomic(out, data)
-    except OSError as exc:
-        raise CamtoolError(f"{out}: cannot write ({reason(exc)})") from exc
-
-
-def check_paths(
-    inputs: list[tuple[str, str | None]],
-    outputs: list[tuple[str, str | None]],
-    *,
-    target: str | None = None,
-    machine_file: Path | None = None,
-) -> None:
-    """Refuse outputs that are inputs or each other (:func:`camtool.jobs.output.check_outputs`).
-
-    A ``--target`` or ``--machine`` that names an existing file (not a built-in name)
-    counts as an input too. Called first thing by every command that writes.
-
-    Raises:
-        UsageError: an output would overwrite an input, or two outputs are one file.
-    """
-    from camtool.jobs.output import check_outputs
-
-    extra = [("the target file", target), ("the --machine file", machine_file)]
-    files = [(label, str(p)) for label, p in extra if p is not None and os.path.isfile(p)]
-    check_outputs([*inputs, *files], outputs)
+    write_file(out, data)
 
 
 def _write_stdout(data: str | bytes) -> None:
@@ -200,6 +171,24 @@ def import_settings(options: dict[str, Any]) -> ImportOptions:
         hatch_boundaries=options.pop("hatch_boundaries", False),
         **_given(max_entities=options.pop("max_entities", None)),
     )
+
+
+def plan_settings(options: dict[str, Any]) -> PlanOptions:
+    """Pop the planning options out of a command's keyword options, checked.
+
+    Raises:
+        UsageError: invalid planning options (:class:`~camtool.toolpath.options.PlanOptions`).
+    """
+    fields = PlanOptions.__dataclass_fields__
+    return PlanOptions(**{k: options.pop(k) for k in list(options) if k in fields})
+
+
+def output_settings(options: dict[str, Any]) -> OutputOptions:
+    """Pop the output options (``--format``, ``--spindle-rpm``, ``--spindle-dwell``)."""
+    from camtool.jobs.pipeline import OutputOptions
+
+    fields = OutputOptions.__dataclass_fields__
+    return OutputOptions(**{k: options.pop(k) for k in list(options) if k in fields})
 
 
 def _given(**values: Any) -> dict[str, Any]:
@@ -462,41 +451,3 @@ _POST_OPTIONS = (
         "0 writes no spindle commands [default: the target's].",
     ),
 )
-
-
-def read_code(name: str, *, binary: bool = False) -> str | bytes:
-    """A code file (``-``: stdin): bytes for a binary dialect, else ASCII text.
-
-    Raises:
-        InputError: missing, unreadable, or (text) not ASCII, naming the file.
-    """
-    if binary:
-        try:
-            return sys.stdin.buffer.read() if name == "-" else Path(name).read_bytes()
-        except FileNotFoundError as exc:
-            raise InputError(f"{name}: no such file") from exc
-        except OSError as exc:
-            raise InputError(f"{name}: cannot read ({exc.strerror or exc})") from exc
-    if name == "-":
-        return sys.stdin.read()
-    try:
-        return Path(name).read_text(encoding="ascii", errors="strict")
-    except FileNotFoundError as exc:
-        raise InputError(f"{name}: no such file") from exc
-    except UnicodeDecodeError as exc:
-        raise InputError(f"{name}: not a text program (byte {exc.start} is not ASCII)") from exc
-    except OSError as exc:
-        raise InputError(f"{name}: cannot read ({exc.strerror or exc})") from exc
-
-
-def read_input(name: str, settings: ImportOptions | None = None) -> Drawing:
-    """The drawing at ``name`` (``-``: stdin), read by its ending.
-
-    Raises:
-        InputError: the drawing cannot be read (see :mod:`camtool.importers`).
-    """
-    from camtool.importers import read_drawing, read_drawing_bytes
-
-    if name == "-":
-        return read_drawing_bytes(sys.stdin.buffer.read(), options=settings)
-    return read_drawing(name, settings)

@@ -14,19 +14,20 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from camtool import __version__
+from camtool.cli.batch import batch
 from camtool.cli.common import (
     MACHINE,
     NUMBER,
-    check_paths,
     import_options,
     import_settings,
     number_range,
+    output_settings,
+    plan_settings,
     post_options,
-    read_code,
-    read_input,
     warn,
     write_output,
 )
+from camtool.cli.preview import preview
 from camtool.model.errors import CamtoolError, UsageError, VerifyLimitError
 
 if TYPE_CHECKING:
@@ -118,8 +119,11 @@ def post(
     With --verify (implied by --report, --preview or --max-error-um) the written
     code is read back and simulated on the target's machine, as `verify` does.
     """
-    from camtool.jobs.pipeline import post_drawing, post_path, verify_job
+    from camtool.jobs.inputs import is_program_file, read_input
+    from camtool.jobs.output import check_paths
+    from camtool.jobs.pipeline import post_drawing, post_path, refuse_planning, verify_job
     from camtool.post.registry import load_target
+    from camtool.toolpath.options import drawing_only
 
     check_paths(
         [("the input", drawing)],
@@ -128,12 +132,16 @@ def post(
         machine_file=machine_file,
     )
     chosen = load_target(target, machine_file=machine_file)
-    chosen.post.check_format(options["fmt"])
+    output_options = output_settings(options)
+    chosen.post.check_format(output_options.fmt)
     settings = import_settings(options)
+    if drawing != "-" and is_program_file(drawing):
+        refuse_planning(drawing, drawing_only(options))  # before checking them
+    plan = plan_settings(options)
     if drawing == "-":
-        job = post_drawing(read_input(drawing, settings), chosen, **options)
+        job = post_drawing(read_input(drawing, settings), chosen, plan, output_options)
     else:
-        job = post_path(drawing, chosen, import_options=settings, **options)
+        job = post_path(drawing, chosen, plan, output_options, import_options=settings)
     warn(job.warnings)
     if job.plan is not None:
         for line in job.plan.notes():
@@ -201,6 +209,8 @@ def verify(
     simulated tool path is measured against the programmed one (and the drawing).
     A one-screen summary goes to stderr.
     """
+    from camtool.jobs.inputs import read_code, read_input
+    from camtool.jobs.output import check_paths
     from camtool.post.registry import load_target
     from camtool.verify.verifier import verify_code
 
@@ -245,17 +255,20 @@ def _finish_verification(
     reported it cannot cut with this tool. A drawing that was given but not compared
     (it does not overlap the program) fails the limit: it cannot pass unjudged.
     """
-    from camtool.verify.verifier import report_dict, summary_lines
+    from camtool.jobs.pipeline import report_json
+    from camtool.verify.verifier import summary_lines
 
     warn([w for w in v.warnings if w not in said])
     for line in summary_lines(v):
         click.echo(f"camtool: {line}", err=True)
     if report is not None:
-        write_output(json.dumps(report_dict(v, plan), indent=2) + "\n", report)
+        write_output(report_json(v, plan), report)
     if preview is not None:
-        from camtool.jobs.preview_trace import write_trace_preview
+        from camtool.preview import render_preview
 
-        picture = write_trace_preview(v, preview, drawing=drawing, edge_radius_mm=edge_radius_mm)
+        picture = render_preview(
+            preview, verification=v, drawing=drawing, edge_radius_mm=edge_radius_mm
+        )
         write_output(picture, preview)
     problem = None if max_error_um is None else v.over_limit(max_error_um, strict=strict)
     if problem is not None:
@@ -330,12 +343,7 @@ def _target_json(entry: TargetEntry) -> dict[str, Any]:
     }
 
 
-from camtool.cli.preview import preview  # noqa: E402
-
 cli.add_command(preview)
-
-from camtool.cli.batch import batch  # noqa: E402
-
 cli.add_command(batch)
 
 

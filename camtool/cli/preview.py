@@ -1,10 +1,11 @@
 """``camtool preview``: draw a drawing, a program, or a program over a drawing (SVG or PNG).
 
 INPUT is read by its ending: a drawing (``.dxf .svg .csv .txt .xy .m``), or a
-program. A program is read with the ``--target``'s own reader when its ending
-is one that target writes or is not a G-code ending (``logo.pic``), else a
-G-code file (``.ngc .nc .gcode .tap ...``) goes through the G-code importer
-(no target needed). ``-`` reads code in the target's dialect from stdin.
+program (:func:`camtool.jobs.inputs.preview_inputs`). A program is read with the
+``--target``'s own reader when its ending is one that target writes or is not a
+G-code ending (``logo.pic``), else a G-code file (``.ngc .nc .gcode .tap ...``)
+goes through the G-code importer (no target needed). ``-`` reads code in the
+target's dialect from stdin.
 """
 
 from __future__ import annotations
@@ -16,18 +17,15 @@ import click
 
 from camtool.cli.common import (
     MACHINE,
-    check_paths,
     import_options,
     import_settings,
     number_range,
-    read_code,
     warn,
     write_output,
 )
-from camtool.model.errors import InputError, UsageError
+from camtool.model.errors import UsageError
 
 if TYPE_CHECKING:
-    from camtool.importers import ImportOptions
     from camtool.model.program import Program
     from camtool.model.shapes import Drawing
     from camtool.post.base import Target
@@ -82,9 +80,11 @@ def preview(
     on the target and the picture adds the tool-centre trace coloured by its
     deviation in µm, the worst point and a zoom inset on it.
     """
+    from camtool.jobs.inputs import default_preview_path, preview_inputs
+    from camtool.jobs.output import check_paths
     from camtool.preview import preview_format, render_preview
 
-    out = output or _default_output(input_name)
+    out = output or default_preview_path(input_name)
     preview_format(".svg" if out == "-" else out)
     check_paths(
         [("the input", input_name), ("the --program", program_name)],
@@ -93,7 +93,7 @@ def preview(
         machine_file=machine_file,
     )
     chosen = _target(target, machine_file)
-    drawing, program = _read_inputs(input_name, program_name, chosen, import_settings(options))
+    drawing, program = preview_inputs(input_name, program_name, chosen, import_settings(options))
     verification = _verify(program, drawing, chosen, tool_diameter) if verify_too else None
     shown = title or (f"{program_name} over {input_name}" if program_name else input_name)
     data = render_preview(
@@ -110,14 +110,6 @@ def preview(
         click.echo(f"camtool: wrote preview {out}", err=True)
 
 
-def _default_output(input_name: str) -> str:
-    """``part.dxf`` → ``part.preview.svg`` beside it (never the input itself); ``-`` → stdout."""
-    if input_name == "-":
-        return "-"
-    path = Path(input_name)
-    return str(path.with_name(f"{path.stem}.preview.svg"))
-
-
 def _target(name: str | None, machine_file: Path | None) -> Target | None:
     if name is None:
         if machine_file is not None:
@@ -126,45 +118,6 @@ def _target(name: str | None, machine_file: Path | None) -> Target | None:
     from camtool.post.registry import load_target
 
     return load_target(name, machine_file=machine_file)
-
-
-def _read_inputs(
-    input_name: str, program_name: str | None, target: Target | None, settings: ImportOptions
-) -> tuple[Drawing | None, Program | None]:
-    """The drawing and the program to draw, read as the module docstring says."""
-    from camtool.importers import DRAWING_SUFFIXES, read_drawing
-
-    if input_name != "-" and Path(input_name).suffix.lower() in DRAWING_SUFFIXES:
-        if not Path(input_name).is_file():
-            raise InputError(f"{input_name}: no such file")
-        drawing = read_drawing(input_name, settings)
-        program = _read_program(program_name, target) if program_name else None
-        return drawing, program
-    if program_name is not None:
-        raise UsageError(
-            f"--program draws a program over a drawing, but INPUT {input_name} is not a "
-            "drawing (.dxf, .svg, point list)"
-        )
-    return None, _read_program(input_name, target)
-
-
-def _read_program(name: str, target: Target | None) -> Program:
-    """A program by its ending: the target's dialect, or G-code through the importer."""
-    from camtool.jobs.pipeline import PROGRAM_SUFFIXES, is_program_file
-
-    if name != "-" and not Path(name).is_file():
-        raise InputError(f"{name}: no such file")
-    suffix = Path(name).suffix.lower()
-    if target is not None and (not is_program_file(name) or suffix in target.post.formats.values()):
-        return target.post.parse(read_code(name, binary=target.post.binary), source=name)
-    if name != "-" and is_program_file(name):
-        from camtool.importers.gcode import read_gcode
-
-        return read_gcode(name)
-    raise UsageError(
-        f"{name} is not a drawing nor a G-code program ({', '.join(PROGRAM_SUFFIXES)}): "
-        "give --target NAME to read it as that target's code"
-    )
 
 
 def _verify(

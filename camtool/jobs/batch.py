@@ -1,6 +1,6 @@
 """Many inputs, one target: post every file in a process pool and summarise.
 
-:func:`plan_batch` expands the inputs (:mod:`camtool.jobs.batch_inputs`), loads the
+:func:`plan_batch` expands the inputs (:func:`camtool.jobs.inputs.expand_inputs`), loads the
 target and checks everything that can be checked before any work starts: the
 options, that every input matches something, that every output stays inside the
 output folder, that no two files write the same output, that no output is one of
@@ -35,13 +35,15 @@ from __future__ import annotations
 
 import json
 import os
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
-from camtool.jobs.batch_inputs import BatchInput, expand_inputs
+from camtool.jobs.inputs import BatchInput, expand_inputs
+from camtool.jobs.pipeline import OutputOptions
 from camtool.model.errors import CamtoolError, UsageError
+from camtool.toolpath.options import PlanOptions
 
 if TYPE_CHECKING:
     from concurrent.futures import Future
@@ -69,14 +71,11 @@ class BatchOptions:
         target: a target name or target ``.toml`` path (see ``camtool targets``).
         output_dir: where the outputs go (created when missing).
         machine_file: machine profile laid over the target's (file or built-in name).
-        feed_mm_min: cutting feed, mm/min; ``None``: the target's default.
-        tolerance: chaining and curve-fit tolerance, mm.
-        plan: the other planning options, as
-            :class:`~camtool.toolpath.options.PlanOptions` fields (``offset``,
-            ``tool_diameter``, ``scale``, ``fit_mm``, ``depth``, ``order``...).
-        fmt: the dialect's output format (``None``: its default).
-        spindle_rpm: rev/min; ``None``: the target's; 0: no spindle commands.
-        spindle_dwell_s: pause after the spindle starts, s (``--spindle-dwell``).
+        plan: the planning options (``offset``, ``tool_diameter``, ``feed_mm_min`` —
+            ``None``: the target's default —, ``tolerance`` (also the importers'
+            chaining and curve-fit tolerance), ``scale``, ``depth``, ``order``...).
+        output: the output format and spindle (``fmt``, ``spindle_rpm``,
+            ``spindle_dwell_s``).
         layers: layers to keep (``None``: all).
         units: unit of unitless inputs (point lists).
         hatch_boundaries: use DXF HATCH boundaries as contours.
@@ -103,12 +102,8 @@ class BatchOptions:
     target: str
     output_dir: Path
     machine_file: Path | None = None
-    feed_mm_min: float | None = None
-    tolerance: float = 0.001
-    plan: Mapping[str, Any] = field(default_factory=dict)
-    fmt: str | None = None
-    spindle_rpm: float | None = None
-    spindle_dwell_s: float = 0.0
+    plan: PlanOptions = field(default_factory=PlanOptions)
+    output: OutputOptions = field(default_factory=OutputOptions)
     layers: tuple[str, ...] | None = None
     units: str | None = None
     hatch_boundaries: bool = False
@@ -144,22 +139,11 @@ class BatchOptions:
         limit = {} if self.max_entities is None else {"max_entities": self.max_entities}
         return ImportOptions(
             layers=self.layers,
-            tolerance=self.tolerance,
+            tolerance=self.plan.tolerance,
             units=self.units,
             hatch_boundaries=self.hatch_boundaries,
             **limit,
         )
-
-    def post_options(self) -> dict[str, Any]:
-        """Keyword options of :func:`camtool.jobs.pipeline.post_drawing`."""
-        return {
-            **self.plan,
-            "feed_mm_min": self.feed_mm_min,
-            "tolerance": self.tolerance,
-            "fmt": self.fmt,
-            "spindle_rpm": self.spindle_rpm,
-            "spindle_dwell_s": self.spindle_dwell_s,
-        }
 
 
 @dataclass(frozen=True)
@@ -263,15 +247,8 @@ def plan_batch(inputs: Sequence[str], options: BatchOptions) -> BatchPlan:
     from camtool.post.registry import load_target
 
     target = load_target(options.target, machine_file=options.machine_file)
-    fmt = target.post.check_format(options.fmt)
-    plan_options(  # validates the post options once, before any file
-        target,
-        **{
-            k: v
-            for k, v in options.post_options().items()
-            if k not in ("fmt", "spindle_rpm", "spindle_dwell_s")
-        },
-    )
+    fmt = target.post.check_format(options.output.fmt)
+    plan_options(target, options.plan)  # checks the options for the target once, before any file
     if options.output_dir.exists() and not options.output_dir.is_dir():
         raise UsageError(f"{options.output_dir}: exists and is not a directory (-o OUTDIR)")
     items = expand_inputs(inputs, exclude=options.output_dir)
@@ -298,19 +275,12 @@ def _check_outputs(
     Raises:
         UsageError: as :func:`plan_batch` says.
     """
-    from camtool.jobs.output import check_outputs
+    from camtool.jobs.output import Named, check_outputs, definition_inputs
 
     _check_inside(tasks, options.output_dir)
-    inputs: list[tuple[str, str | Path | None]] = [("the input", i.path) for i in items]
-    inputs += [
-        (label, path)
-        for label, path in (
-            ("the target file", options.target),
-            ("the --machine file", options.machine_file),
-        )
-        if path is not None and os.path.isfile(path)
-    ]
-    outputs: list[tuple[str, str | Path | None]] = [("--report", options.report)]
+    inputs: list[Named] = [("the input", i.path) for i in items]
+    inputs += definition_inputs(options.target, options.machine_file)
+    outputs: list[Named] = [("--report", options.report)]
     outputs += [(f"{task.file} →", out) for task in tasks for out in task.outputs]
     check_outputs(inputs, outputs, hint="post them in separate batches or rename one")
     if not options.force:
@@ -505,14 +475,13 @@ def _post_one(task: BatchTask, options: BatchOptions) -> BatchRow:
     time_s = job.program.cutting_time_s()
     v = None
     if options.verifying:
-        from camtool.jobs.pipeline import verify_job
-        from camtool.verify.verifier import report_dict
+        from camtool.jobs.pipeline import report_json, verify_job
 
         v = verify_job(job)
         error_um, time_s = v.max_error_um, v.time_s
         warnings = tuple(dict.fromkeys(warnings + v.warnings))
         if task.report_path is not None:
-            files.append((task.report_path, json.dumps(report_dict(v, job.plan), indent=2) + "\n"))
+            files.append((task.report_path, report_json(v, job.plan)))
     if task.preview_path is not None:
         files.append((task.preview_path, preview_bytes(job, v, task.preview_path, task.file)))
     for path, data in files:
@@ -544,9 +513,10 @@ def _post_job(file: str, options: BatchOptions) -> PostJob:
     return post_file(
         file,
         options.target,
+        options.plan,
+        options.output,
         machine_file=options.machine_file,
         import_options=options.import_options(),
-        **options.post_options(),
     )
 
 

@@ -31,10 +31,13 @@ from typing import Any
 
 from camtool import __version__
 from camtool.jobs.batch import BatchOptions, BatchResult, BatchRow
+from camtool.toolpath.options import PLAN_FIELDS
 
 FILE_COLUMN_MAX = 48
 """Widest file column of the summary table; longer names keep their end."""
 _NOT_OPTIONS = ("jobs", "force", "report")
+_NOT_PLAN_OPTIONS = ("origin",)
+"""Planning fields that are no option of ``batch`` (the tool's position before the program)."""
 
 
 def batch_report(result: BatchResult) -> dict[str, Any]:
@@ -54,13 +57,29 @@ def _options(options: BatchOptions) -> dict[str, Any]:
         if f.name in _NOT_OPTIONS:
             continue
         value = getattr(options, f.name)
-        if isinstance(value, Path):
-            value = value.as_posix()
-        elif isinstance(value, tuple):
-            value = list(value)
-        out[f.name] = value
+        if f.name == "plan":
+            out["feed_mm_min"] = value.feed_mm_min
+            out["tolerance"] = value.tolerance
+            out["plan"] = {
+                k: _json(getattr(value, k))
+                for k in type(value).__dataclass_fields__
+                if k in PLAN_FIELDS and k not in _NOT_PLAN_OPTIONS
+            }
+        elif f.name == "output":
+            out.update(dataclasses.asdict(value))
+        else:
+            out[f.name] = _json(value)
     out["verify"] = options.verifying  # also when implied by preview or max_error_um
     return out
+
+
+def _json(value: Any) -> Any:
+    """An option's value as JSON: paths POSIX, tuples lists."""
+    if isinstance(value, Path):
+        return value.as_posix()
+    if isinstance(value, tuple):
+        return list(value)
+    return value
 
 
 def row_dict(row: BatchRow) -> dict[str, Any]:

@@ -91,6 +91,50 @@ def check_outputs(
         known_outputs.add(path, (label, path), key)
 
 
+def definition_inputs(target: str | None, machine_file: str | Path | None) -> list[Named]:
+    """A ``--target`` or ``--machine`` that names an existing file (not a built-in name).
+
+    Such a file is an input of the run like the drawing: no output may overwrite it.
+    """
+    named = [("the target file", target), ("the --machine file", machine_file)]
+    return [(label, path) for label, path in named if path is not None and os.path.isfile(path)]
+
+
+def check_paths(
+    inputs: Iterable[Named],
+    outputs: Iterable[Named],
+    *,
+    target: str | None = None,
+    machine_file: str | Path | None = None,
+) -> None:
+    """:func:`check_outputs` with the target and machine files as inputs too.
+
+    Called first thing by every command that writes (:func:`definition_inputs`).
+
+    Raises:
+        UsageError: an output would overwrite an input, or two outputs are one file.
+    """
+    check_outputs([*inputs, *definition_inputs(target, machine_file)], outputs)
+
+
+def write_file(path: str | Path, data: str | bytes) -> None:
+    """``data`` to the file ``path`` (:func:`write_atomic`), stale temporary files removed.
+
+    Temporary files of killed runs beside ``path`` go first (:func:`remove_stale_temps`),
+    unless ``path`` is a device, FIFO or directory.
+
+    Raises:
+        CamtoolError: the file cannot be written, naming it and why (``x.pic: cannot
+            write (no space left on device)``).
+    """
+    try:
+        if os.path.isfile(path) or not os.path.lexists(path):  # not a device, FIFO or directory
+            remove_stale_temps(Path(os.path.realpath(path)).parent)
+        write_atomic(path, data)
+    except OSError as exc:
+        raise CamtoolError(f"{path}: cannot write ({reason(exc)})") from exc
+
+
 class _Index:
     """Named paths by real path and by (device, inode): a clash is found in O(1)."""
 

@@ -5,16 +5,17 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from camtool.importers import POINT_SUFFIXES, ImportOptions, read_drawing
+from camtool.jobs.inputs import is_program_file
 from camtool.model.errors import UsageError
 from camtool.model.program import Move, Program
 from camtool.model.shapes import Drawing
 from camtool.post.base import PostResult, Target
 from camtool.post.registry import load_target
-from camtool.toolpath.options import drawing_only
-from camtool.toolpath.plan import PlanOptions, PlanReport, plan_drawing
+from camtool.toolpath.options import PlanOptions, drawing_only
+from camtool.toolpath.plan import PlanReport, plan_drawing
 
 if TYPE_CHECKING:
     from camtool.verify.verifier import Verification
@@ -50,79 +51,104 @@ class PostJob:
         return tuple(dict.fromkeys(self.program.warnings + self.result.warnings))
 
 
+@dataclass(frozen=True, kw_only=True)
+class OutputOptions:
+    """How the planned program is written: the options that are not planning options.
+
+    They apply to a re-posted program too (:func:`post_program`).
+
+    Attributes:
+        fmt: the dialect's output format (``None``: its first, see ``camtool targets``).
+        spindle_rpm: spindle speed, rev/min; ``None`` takes the target's
+            ``spindle_rpm`` for a planned drawing (which may be none), 0 programs no
+            spindle; a re-posted program gets spindle commands only when > 0 and it
+            has none of its own.
+        spindle_dwell_s: wait this long after the spindle starts, s (``--spindle-dwell``).
+    """
+
+    fmt: str | None = None
+    spindle_rpm: float | None = None
+    spindle_dwell_s: float = 0.0
+
+
 def post_file(
     path: str | Path,
     target_name: str,
+    plan: PlanOptions | None = None,
+    output: OutputOptions | None = None,
     *,
     machine_file: Path | None = None,
     import_options: ImportOptions | None = None,
-    **options: Any,
 ) -> PostJob:
     """Load the target called ``target_name`` and post the file at ``path`` (see :func:`post_path`).
 
     Args:
         path: a drawing, or an existing G-code program.
         target_name: a built-in target or a target ``.toml`` path.
+        plan: the planning options (``None``: the defaults, the target's feed).
+        output: how the program is written (``None``: the defaults).
         machine_file: TOML file laid over the target's machine profile.
         import_options: how the drawing is read (layers, units…).
-        **options: the keyword options of :func:`post_drawing`.
 
     Raises:
         CamtoolError: from any stage, with its exit code.
     """
     target = load_target(target_name, machine_file=machine_file)
-    return post_path(path, target, import_options=import_options, **options)
+    return post_path(path, target, plan, output, import_options=import_options)
 
 
 def post_path(
     path: str | Path,
     target: Target,
+    plan: PlanOptions | None = None,
+    output: OutputOptions | None = None,
     *,
     import_options: ImportOptions | None = None,
-    **options: Any,
 ) -> PostJob:
     """Post the file at ``path``: a drawing is planned, a G-code program re-posted.
 
-    A program (by its ending, :func:`is_program_file`) is already a toolpath:
-    only ``feed_mm_min``, ``fmt`` and ``spindle_rpm`` apply (:func:`post_program`).
+    A program (by its ending, :func:`camtool.jobs.inputs.is_program_file`) is already a toolpath:
+    only ``plan.feed_mm_min`` and ``output`` apply (:func:`post_program`).
 
     Args:
         path: a drawing (DXF, SVG, points) or an existing G-code program.
         target: the target to write for.
+        plan: the planning options (``None``: the defaults, the target's feed).
+        output: how the program is written (``None``: the defaults).
         import_options: how the drawing is read (layers, units…).
-        **options: the keyword options of :func:`post_drawing`.
 
     Raises:
         UsageError: a planning option (offset, tool diameter, scale, depth, order...)
             given for a program; it is refused, not ignored.
         CamtoolError: from any stage, with its exit code.
     """
+    plan = plan if plan is not None else PlanOptions()
     if not is_program_file(path):
         drawing = read_drawing(path, import_options)
-        return post_drawing(_note_units(drawing, path, import_options), target, **options)
-    given = drawing_only(options)
+        return post_drawing(_note_units(drawing, path, import_options), target, plan, output)
+    refuse_planning(path, drawing_only(plan.given()))
+    from camtool.importers.gcode import read_gcode
+
+    return post_program(
+        read_gcode(path), target, output, feed_mm_min=plan.feed_mm_min, source=str(path)
+    )
+
+
+def refuse_planning(path: str | Path, given: list[str]) -> None:
+    """Refuse planning options (``given``: their flags) for the G-code program at ``path``.
+
+    Raises:
+        UsageError: ``given`` is not empty; the message names the options.
+    """
     if given:
         raise UsageError(
             f"{path} is already a toolpath (G-code): {', '.join(given)} only apply to "
             "drawings; plan it in the program that wrote it"
         )
-    from camtool.importers.gcode import read_gcode
-
-    return post_program(
-        read_gcode(path),
-        target,
-        feed_mm_min=options.get("feed_mm_min"),
-        fmt=options.get("fmt"),
-        spindle_rpm=options.get("spindle_rpm"),
-        spindle_dwell_s=options.get("spindle_dwell_s", 0.0),
-        source=str(path),
-    )
 
 
 def _note_units(drawing: Drawing, path: str | Path, options: ImportOptions | None) -> Drawing:
     """``drawing`` with a warning when ``--units`` was given for a file that carries its own."""
-    import dataclasses
-
     if options is None or options.units is None or Path(path).suffix.lower() in POINT_SUFFIXES:
         return drawing
     note = (
@@ -132,23 +158,12 @@ def _note_units(drawing: Drawing, path: str | Path, options: ImportOptions | Non
     return dataclasses.replace(drawing, warnings=(*drawing.warnings, note))
 
 
-PROGRAM_SUFFIXES = (".ngc", ".nc", ".gcode", ".tap", ".cnc", ".gc", ".g")
-"""File endings read as existing G-code programs (re-posted, not planned)."""
-
-
-def is_program_file(name: str | Path) -> bool:
-    """True when ``name`` is a G-code program by its ending (see :data:`PROGRAM_SUFFIXES`)."""
-    return Path(name).suffix.lower() in PROGRAM_SUFFIXES
-
-
 def post_program(
     program: Program,
     target: Target,
+    output: OutputOptions | None = None,
     *,
     feed_mm_min: float | None = None,
-    fmt: str | None = None,
-    spindle_rpm: float | None = None,
-    spindle_dwell_s: float = 0.0,
     source: str = "",
 ) -> PostJob:
     """Re-post an existing program (e.g. G-code another CAM wrote) for a target.
@@ -158,20 +173,19 @@ def post_program(
     otherwise). For a target without a Z axis (depth set by hand, seed-000
     S000-08) Z is dropped with a warning: Z-only moves go, XY moves keep their
     kind, as the thesis users edited VisiCAM output by hand (seed-000 §3.8).
-    ``fmt`` is the dialect's output format (default: its first);
-    ``spindle_rpm`` > 0 starts the spindle before the first move and stops it
+    ``output.fmt`` is the dialect's output format (default: its first);
+    ``output.spindle_rpm`` > 0 starts the spindle before the first move and stops it
     after the last (when the program has no spindle commands of its own), waiting
-    ``spindle_dwell_s`` seconds after it starts. ``source`` (the input's file
+    ``output.spindle_dwell_s`` seconds after it starts. ``source`` (the input's file
     name) goes into the job notes (:func:`job_notes`) unless the program has notes.
     Nothing is added to the program's motion: no move to X0 Y0, no clearance move.
 
     Raises:
         CamtoolError: whatever the target cannot express (names the block).
     """
-    import dataclasses
-
     from camtool.model.program import Rapid
 
+    output = output if output is not None else OutputOptions()
     if feed_mm_min is not None:
         moves = tuple(
             m if isinstance(m, Rapid) else dataclasses.replace(m, feed_mm_min=feed_mm_min)
@@ -182,8 +196,8 @@ def post_program(
         program = _flatten(program, target.name)
     if not program.notes:
         program = dataclasses.replace(program, notes=job_notes(source, target))
-    program = _with_spindle(program, spindle_rpm, spindle_dwell_s)
-    return PostJob(None, program, target, target.emit(program, fmt=fmt), None, 0.0)
+    program = _with_spindle(program, output.spindle_rpm, output.spindle_dwell_s)
+    return PostJob(None, program, target, target.emit(program, fmt=output.fmt), None, 0.0)
 
 
 def _with_spindle(program: Program, rpm: float | None, dwell_s: float = 0.0) -> Program:
@@ -200,8 +214,6 @@ def _with_spindle(program: Program, rpm: float | None, dwell_s: float = 0.0) -> 
 
 def _flatten(program: Program, target: str) -> Program:
     """The program without Z (see :func:`post_program`); unchanged when it has none."""
-    import dataclasses
-
     depths = {m.z for m in program.moves if m.z is not None}
     if not depths:
         return program
@@ -230,21 +242,23 @@ def _flatten(program: Program, target: str) -> Program:
     )
 
 
-def plan_options(target: Target, **options: Any) -> PlanOptions:
-    """The :class:`PlanOptions` for ``target``: its default feed, checked against what it can do.
+def plan_options(target: Target, plan: PlanOptions | None = None) -> PlanOptions:
+    """``plan`` for ``target``: its default feed filled in, checked against what it can do.
 
     Args:
         target: the target the plan is for.
-        **options: :class:`PlanOptions` fields; ``feed_mm_min`` ``None`` (or left
-            out) takes the target's default feed.
+        plan: the planning options (``None``: the defaults); ``feed_mm_min`` ``None``
+            takes the target's default feed.
 
     Raises:
-        UsageError: invalid options, or options the target cannot carry out:
-            depth options for a machine without Z, lead-in arcs on a target that
-            writes arcs as chords, a ramp on a target that moves Z in its own block.
+        UsageError: options the target cannot carry out: depth options for a machine
+            without Z, lead-in arcs on a target that writes arcs as chords, a ramp on
+            a target that moves Z in its own block (the options themselves are
+            checked when the :class:`PlanOptions` is made).
     """
-    feed = options.pop("feed_mm_min", None)
-    plan = PlanOptions(feed_mm_min=target.default_feed_mm_min if feed is None else feed, **options)
+    plan = plan if plan is not None else PlanOptions()
+    if plan.feed_mm_min is None:
+        plan = dataclasses.replace(plan, feed_mm_min=target.default_feed_mm_min)
     plan.check_machine(target.machine, target.name)
     if plan.lead_in_mm > 0 and not target.post.arcs:
         raise UsageError(
@@ -262,29 +276,25 @@ def plan_options(target: Target, **options: Any) -> PlanOptions:
 def post_drawing(
     drawing: Drawing,
     target: Target,
-    *,
-    fmt: str | None = None,
-    spindle_rpm: float | None = None,
-    spindle_dwell_s: float = 0.0,
-    **options: Any,
+    plan: PlanOptions | None = None,
+    output: OutputOptions | None = None,
 ) -> PostJob:
     """Plan a drawing and post it for a target.
 
     Args:
         drawing: the imported drawing, mm.
         target: the target (see :func:`camtool.post.registry.load_target`).
-        fmt: the dialect's output format (``None``: its default).
-        spindle_rpm: spindle speed, rev/min; ``None`` takes the target's
-            ``spindle_rpm`` (which may be none), 0 programs no spindle.
-        spindle_dwell_s: wait this long after the spindle starts, s.
-        **options: :class:`~camtool.toolpath.options.PlanOptions` fields
-            (``offset``, ``tool_diameter``, ``feed_mm_min`` — ``None`` takes the
-            target's —, ``tolerance``, ``scale``, ``fit_mm``, ``depth``, ``order``...).
+        plan: the planning options (``offset``, ``tool_diameter``, ``feed_mm_min`` —
+            ``None`` takes the target's —, ``tolerance``, ``scale``, ``fit_mm``,
+            ``depth``, ``order``...); ``None``: the defaults.
+        output: the output format and spindle (``None``: the defaults; the spindle
+            speed then is the target's ``spindle_rpm``, which may be none).
 
     Raises:
         CamtoolError: from any stage, with its exit code.
     """
-    plan = plan_options(target, **options)
+    output = output if output is not None else OutputOptions()
+    plan = plan_options(target, plan)
     planned = plan_drawing(drawing, plan, target.machine, helix=target.post.helix)
     program = dataclasses.replace(
         planned.program,
@@ -294,11 +304,11 @@ def post_drawing(
     )
     program = _with_spindle(
         program,
-        target.spindle_rpm if spindle_rpm is None else spindle_rpm,
-        spindle_dwell_s,
+        target.spindle_rpm if output.spindle_rpm is None else output.spindle_rpm,
+        output.spindle_dwell_s,
     )
     edge = plan.radius if plan.offset != "on" else 0.0
-    result = target.emit(program, fmt=fmt)
+    result = target.emit(program, fmt=output.fmt)
     return PostJob(drawing, program, target, result, planned.placed, edge, planned.report)
 
 
@@ -386,3 +396,16 @@ def verify_job(job: PostJob) -> Verification:
         tool_diameter=2.0 * job.edge_radius_mm,
         findings=job.plan.placed_findings() if job.plan is not None else (),
     )
+
+
+def report_json(v: Verification, plan: PlanReport | None = None) -> str:
+    """The verify report of ``v`` as indented JSON text with a final newline.
+
+    ``plan`` (what planning found, when the code was planned here) adds a ``plan``
+    key (:func:`camtool.verify.verifier.report_dict`).
+    """
+    import json
+
+    from camtool.verify.verifier import report_dict
+
+    return json.dumps(report_dict(v, plan), indent=2) + "\n"

@@ -99,8 +99,7 @@ def render_preview(
             nothing to draw.
         CamtoolError: the target's machine cannot be simulated for the time estimate.
     """
-    from camtool.preview.facts import estimated_time
-    from camtool.preview.layout import Content, compose
+    from camtool.preview.layout import Content, compose, estimated_time
 
     suffix = preview_format(path_or_suffix)
     if program is None and verification is not None:

@@ -15,6 +15,8 @@ from camtool.model.errors import UsageError
 from camtool.model.shapes import Point
 
 if TYPE_CHECKING:
+    from collections.abc import Mapping
+
     from camtool.model.machine import Machine
     from camtool.toolpath.cuts import Finding
 
@@ -65,19 +67,21 @@ def flag(field_name: str) -> str:
     return _FLAG_NAMES.get(field_name, "--" + field_name.replace("_", "-"))
 
 
-def drawing_only(options: dict[str, object]) -> list[str]:
-    """Flags of the planning options in ``options`` that differ from their defaults.
+def drawing_only(values: Mapping[str, object]) -> list[str]:
+    """Flags of the planning options in ``values`` that differ from their defaults.
 
     Only :data:`PLAN_FIELDS` count (feed and tolerance apply to re-posted programs
     too), in the order :class:`PlanOptions` declares them. Used to refuse, not
-    ignore, toolpath options given for an existing G-code program.
+    ignore, toolpath options given for an existing G-code program; ``values`` may be
+    a command's raw options (checked before they are validated) or
+    :meth:`PlanOptions.given`.
     """
     import dataclasses
 
     return [
         flag(f.name)
         for f in dataclasses.fields(PlanOptions)
-        if f.name in PLAN_FIELDS and f.name in options and options[f.name] != f.default
+        if f.name in PLAN_FIELDS and f.name in values and values[f.name] != f.default
     ]
 
 
@@ -85,10 +89,15 @@ def drawing_only(options: dict[str, object]) -> list[str]:
 class PlanOptions:
     """How to turn a drawing into a toolpath.
 
+    The fields are declared in the order of ``camtool post --help`` (the batch
+    report lists them so), ``origin`` last.
+
     Attributes:
         offset: one of :data:`OFFSET_MODES` (see :mod:`camtool.toolpath.plan`).
         tool_diameter: tool diameter, mm (needed for every offset but ``on``).
-        feed_mm_min: cutting feed, mm/min (> 0).
+        feed_mm_min: cutting feed, mm/min (> 0); ``None``: the target's default,
+            filled in by :func:`camtool.jobs.pipeline.plan_options` before planning
+            (:attr:`feed` refuses to plan without one).
         tolerance: chaining and arc-fitting tolerance, mm (> 0): ends closer than
             this meet; fitted arcs stay this close to what they replace.
         close_gap: contours whose ends are further apart than ``tolerance`` but
@@ -141,12 +150,6 @@ class PlanOptions:
 
     offset: str = "on"
     tool_diameter: float = 0.0
-    feed_mm_min: float
-    tolerance: float = 0.001
-    close_gap: float = 0.02
-    origin: Point = (0.0, 0.0)
-    scale: float = 1.0
-    fit_mm: tuple[float, float] | None = None
     direction: str | None = None
     stepover: float = 0.4
     pocket: str = "concentric"
@@ -161,13 +164,19 @@ class PlanOptions:
     tab_height: float = 0.5
     order: str = "travel"
     lead_in_mm: float = 0.0
+    close_gap: float = 0.02
     fit_arcs: bool = True
+    feed_mm_min: float | None = None
+    tolerance: float = 0.001
+    scale: float = 1.0
+    fit_mm: tuple[float, float] | None = None
     placement: str = "drawing"
     translate: tuple[float, float] = (0.0, 0.0)
     chain_tolerance: float = DEFAULT_CHAIN_TOLERANCE
     clearance_z: float | None = None
     end_position: tuple[float, float] | None = None
     reverse_open: bool = False
+    origin: Point = (0.0, 0.0)
 
     def __post_init__(self) -> None:
         self._check_numbers()
@@ -190,11 +199,29 @@ class PlanOptions:
         return self.tool_diameter / 2.0
 
     @property
+    def feed(self) -> float:
+        """Cutting feed, mm/min.
+
+        Raises:
+            UsageError: ``feed_mm_min`` is ``None`` (no target filled in its default).
+        """
+        if self.feed_mm_min is None:
+            raise UsageError(
+                "no cutting feed: give --feed MM_PER_MIN (camtool.jobs.pipeline.plan_options "
+                "fills in the target's default)"
+            )
+        return self.feed_mm_min
+
+    @property
     def plunge_feed(self) -> float:
         """Feed of Z moves into the material, mm/min."""
         if self.plunge_feed_mm_min is None:
-            return self.feed_mm_min / 2.0
+            return self.feed / 2.0
         return self.plunge_feed_mm_min
+
+    def given(self) -> dict[str, object]:
+        """Every field by name (for :func:`drawing_only`)."""
+        return {name: getattr(self, name) for name in type(self).__dataclass_fields__}
 
     def _check_numbers(self) -> None:
         """Every number finite and of a sane magnitude, named by its flag (NaN fails ``x <= 0``)."""
@@ -240,7 +267,7 @@ class PlanOptions:
             raise UsageError(f"tool diameter must be ≥ 0 mm, got {self.tool_diameter!r}")
         if self.offset != "on" and self.tool_diameter <= 0:
             raise UsageError(f"--offset {self.offset} needs --tool-diameter MM (> 0)")
-        if self.feed_mm_min <= 0:
+        if self.feed_mm_min is not None and self.feed_mm_min <= 0:
             raise UsageError(f"feed must be > 0 mm/min, got {self.feed_mm_min!r}")
         if self.tolerance < MIN_TOLERANCE_MM:
             raise UsageError(

@@ -54,7 +54,7 @@ pass ramps on from there. On an open path (and on a lead-in arc) it zigzags back
 and forth from the start until the depth is reached, goes back to the start at
 that depth and cuts the whole path.
 
-**Tabs** on closed outside profiles (:mod:`~camtool.toolpath.tabs`): on passes
+**Tabs** on closed outside profiles (see *Tab placement* below): on passes
 below the tab top ``z_tab = −depth + tab_height`` the tool rises to ``z_tab`` at
 each tab start (at the cutting feed), crosses the tab at ``z_tab`` and goes down
 at its end (at the plunge feed); a ramp crossing a tab stays at or above ``z_tab``.
@@ -63,6 +63,16 @@ at its end (at the plunge feed); a ramp crossing a tab stays at or above ``z_tab
 :mod:`~camtool.toolpath.leads`): the tool travels to the lead-in's start (off the
 part), goes down there (or ramps along the lead-in), cuts the lead-in, the loop
 and the lead-out at the pass depth, and rises; each pass is entered the same way.
+
+Tab placement (:func:`tab_spans`, ``--tabs N --tab-width MM --tab-height MM``): a tab is
+material left standing between the part and the stock so the part does not come loose on
+the last pass. Along the tool-centre path the tool must stay up over the tab's width
+*plus its own diameter*: the tool's edge, not its centre, defines the tab, so a stretch
+of path ``tab_width + tool_diameter`` long leaves a tab ``tab_width`` wide at the part
+(for a straight edge).
+
+Tabs are spaced evenly by arc length over the middle 90 % of the path: the first
+and last 5 % hold the entry (plunge or ramp start) and are left free.
 """
 
 from __future__ import annotations
@@ -71,14 +81,13 @@ import math
 from collections.abc import Sequence
 from itertools import pairwise
 
-from camtool.model.errors import UsageError
+from camtool.model.errors import ToolpathError, UsageError
 from camtool.model.program import ArcMove, Linear, Move, Rapid
 from camtool.model.shapes import Arc, Segment
 from camtool.toolpath.cuts import Cut, Finding, where
 from camtool.toolpath.leads import leads_for
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.split import MIN_PIECE, Track
-from camtool.toolpath.tabs import tab_spans
 
 Z_EPS = 1e-9
 """Z values closer than this (mm) are the same height: no Z move is written between them."""
@@ -396,13 +405,13 @@ class _Writer:
         if self.z is not None and abs(z - self.z) <= Z_EPS:
             return
         up = self.z is not None and z > self.z
-        feed = self.options.feed_mm_min if up else self.options.plunge_feed
+        feed = self.options.feed if up else self.options.plunge_feed
         self.add(Linear(self.x, self.y, feed, z, contour=self.number))
         self.z = z
 
     def cut(self, seg: Segment, z: float | None) -> None:
         """Cut along ``seg`` (starting where the tool is), descending to ``z`` if it differs."""
-        feed = self.options.feed_mm_min
+        feed = self.options.feed
         if z is not None and self.z is not None and abs(z - self.z) <= Z_EPS:
             z = None
         x, y = seg.end
@@ -423,7 +432,7 @@ class _Writer:
         n = len(points) - 1
         for k, (x, y) in enumerate(points[1:], start=1):
             zk = z if k == n else z0 + (z - z0) * k / n
-            self.add(Linear(x, y, self.options.feed_mm_min, zk, contour=self.number))
+            self.add(Linear(x, y, self.options.feed, zk, contour=self.number))
         self.x, self.y = arc.end
         self.z = z
 
@@ -615,3 +624,40 @@ def _pocket_batch(w: _Writer, cuts: Sequence[Cut], first: int, levels: Sequence[
             else:
                 _enter_open(w, track, z_from, z_to)
             w.retract()
+
+
+ENTRY_MARGIN = 0.05
+"""Fraction of the path length kept free of tabs at each end (the entry)."""
+
+
+def tab_spans(
+    length: float, count: int, span: float, where: str = ""
+) -> tuple[tuple[float, float], ...]:
+    """Where the tool rises over the tabs, as arc-length intervals along a closed path.
+
+    Args:
+        length: the path's length, mm (> 0).
+        count: number of tabs (≥ 1).
+        span: length of path over each tab, mm: ``tab_width + tool_diameter``.
+        where: the contour's name for the error message (see
+            :func:`camtool.toolpath.cuts.where`).
+
+    Returns:
+        ``count`` intervals ``(start, end)`` in mm from the path's start, in
+        order, each ``span`` long, centred at ``5 % + (k + ½)·90 %/count`` of the
+        length, so none overlaps another or the first/last 5 %.
+
+    Raises:
+        ToolpathError: the tabs do not fit (``span`` is not shorter than the
+            spacing ``0.9·length/count``).
+    """
+    spacing = (1.0 - 2.0 * ENTRY_MARGIN) * length / count
+    if span >= spacing:
+        raise ToolpathError(
+            f"{count} tab(s) do not fit on {where or 'a contour'} ({length:.3f} mm long): "
+            f"each needs {span:.3f} mm of path (tab width + tool diameter) and they are "
+            f"{spacing:.3f} mm apart; use fewer --tabs or a smaller --tab-width"
+        )
+    margin = ENTRY_MARGIN * length
+    centres = [margin + (k + 0.5) * spacing for k in range(count)]
+    return tuple((c - span / 2.0, c + span / 2.0) for c in centres)

@@ -164,12 +164,15 @@ def plan_drawing(
             chords within the tolerance.
 
     Raises:
-        UsageError: invalid options, or depth options for a machine without Z.
+        UsageError: invalid options, no feed (``options.feed_mm_min`` is ``None``:
+            :func:`camtool.jobs.pipeline.plan_options` fills in the target's), or depth
+            options for a machine without Z.
         ToolpathError: a stage cannot plan the drawing (names the contour).
         DialectError: the toolpath does not fit the machine (:func:`place_program`).
     """
     from camtool.toolpath.passes import emit
 
+    _ = options.feed  # no feed (the target's not filled in): refused before any work
     if machine is not None:
         options.check_machine(machine, machine.name)
     placed = place(drawing, options)

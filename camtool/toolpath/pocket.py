@@ -15,7 +15,7 @@ Two styles (``--pocket``):
   (:func:`~camtool.geometry.arcfit.fit_polyline`). Where a ring splits around islands
   the rings form a tree, cut depth first so each sub-pocket is finished before the next.
 - ``zigzag``: the wall ring, then parallel lines at spacing ``s`` and the angle
-  ``--pocket-angle`` (:mod:`~camtool.toolpath.pocket_zigzag`).
+  ``--pocket-angle`` (see *Zigzag lines* below).
 
 Consecutive paths are linked by a straight feed move when the tool, moving along it,
 stays inside the region (it cuts only material that is removed anyway); elsewhere a new
@@ -26,31 +26,50 @@ What the tool cannot reach is reported by :mod:`~camtool.toolpath.pocket_uncut`.
 
 Error budget of a fitted ring against the true offset: region chords ``tolerance / 4``,
 buffer chords ``tolerance / 4``, arc fit ``tolerance / 2`` and the joining of arcs on one
-circle ``tolerance / 4`` (:mod:`~camtool.toolpath.pocket_rings`); in the worst case
+circle ``tolerance / 4`` (see *Rings* below); in the worst case
 ``1.25·tolerance``, usually well within ``tolerance``.
+
+Rings as exact arcs and lines (:func:`fit_ring`): a ring is a closed sequence of segments
+(start == end). A shapely buffer ring is fitted with arcs and lines
+(:func:`~camtool.geometry.arcfit.fit_polyline` within ``tolerance / 2``), then neighbours
+that lie on one circle are merged, so a circular ring comes out as one full circle rather
+than two half arcs and a left-over chord. :func:`start_near` rotates a ring to start at
+its point nearest the tool, splitting a segment there.
+
+Zigzag lines (:func:`zigzag_lines`, :func:`order_lines`): after the wall ring, the area
+the tool centre may reach (the region shrunk by the tool radius and a small margin) is
+crossed by lines at the step-over spacing and the ``--pocket-angle``. Lines that an
+island interrupts become separate pieces; the pieces are ordered greedily, each starting
+at its end nearest the tool (which gives the back-and-forth of a zigzag row after row,
+and finishes one side of an island before the other).
+
+Conventions: mm, Y up; ``Arc.clockwise`` is G02; angles in degrees counter-clockwise
+from +X.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from shapely import LineString, Polygon, prepared
+import numpy as np
+import shapely
+from shapely import LineString, Polygon, affinity, prepared
 from shapely import Point as ShapelyPoint
 from shapely.geometry.base import BaseGeometry
 from shapely.geometry.polygon import orient
 
-from camtool.model.errors import ToolpathError, UsageError
-from camtool.model.shapes import Contour, Line, Point, Segment, distance
+from camtool.geometry.arcfit import fit_polyline
+from camtool.model.errors import InputError, ToolpathError, UsageError
+from camtool.model.shapes import TAU, Arc, Contour, Line, Point, Segment, distance
 from camtool.model.units import fmt_num
 from camtool.toolpath.cuts import Cut, Finding, Stage, where
 from camtool.toolpath.offset import offset_contour
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.order import Nesting
-from camtool.toolpath.pocket_rings import fit_ring, nearest_on, start_near
 from camtool.toolpath.pocket_uncut import polygons, quad_segs, uncut_findings
-from camtool.toolpath.pocket_zigzag import order_lines, zigzag_lines
 
 __all__ = ["Region", "pocket", "regions"]
 
@@ -392,3 +411,241 @@ def _cut(group: list[_Path], region: Region, side: str) -> Cut:
         may_rotate=False,
         material_side=side if all(p.ring for p in group) else None,
     )
+
+
+def fit_ring(coords: Sequence[tuple[float, float]], tolerance: float) -> tuple[Segment, ...]:
+    """A closed polyline ``(N, 2)`` mm as arcs and lines within ``tolerance`` mm.
+
+    The fit uses half the tolerance; neighbours on one circle (within a quarter of
+    it) are then joined into arcs of equal sweep (≤ 180°), or one full circle when
+    the whole ring is one. A sliver too thin to fit keeps its own edges.
+    """
+    try:
+        segs = fit_polyline(list(coords), tolerance / 2, closed=True)
+    except InputError:  # a degenerate sliver: follow it with its own edges
+        pts = [(float(x), float(y)) for x, y in coords]
+        return tuple(Line(a, b) for a, b in itertools.pairwise(pts) if a != b)
+    return tuple(_merge_circles([_clean(s) for s in segs], tolerance / 4))
+
+
+def _clean(seg: Segment) -> Segment:
+    """The segment with plain float coordinates (the fitter may return numpy scalars)."""
+    if isinstance(seg, Line):
+        return seg
+    return Arc(seg.start, seg.end, (float(seg.centre[0]), float(seg.centre[1])), seg.clockwise)
+
+
+@dataclass(frozen=True)
+class _Run:
+    """Consecutive segments on one circle: from ``start`` to ``end``, ``sweep`` radians."""
+
+    start: Point
+    end: Point
+    centre: Point
+    radius: float
+    sweep: float
+
+
+def _merge_circles(segs: list[Segment], tol: float) -> list[Segment]:
+    first_arc = next((k for k, s in enumerate(segs) if isinstance(s, Arc)), None)
+    if first_arc is None or len(segs) < 2:
+        return segs
+    segs = segs[first_arc:] + segs[:first_arc]
+    items: list[Segment | _Run] = []
+    for seg in segs:
+        last = items[-1] if items else None
+        run = _extend(last, seg, tol) if isinstance(last, (_Run, Arc)) else None
+        if run is not None:
+            items[-1] = run
+        else:
+            items.append(seg)
+    if len(items) > 1 and isinstance(items[0], (_Run, Arc)):
+        head = _extend(items[-1], items[0], tol) if isinstance(items[-1], (_Run, Arc)) else None
+        if head is not None:
+            items = [head, *items[1:-1]]
+    if len(items) == 1 and isinstance(items[0], _Run) and abs(items[0].sweep) > math.pi:
+        run = items[0]
+        return [Arc(run.start, run.start, run.centre, run.sweep < 0)]
+    out: list[Segment] = []
+    for item in items:
+        out.extend(_arcs(item) if isinstance(item, _Run) else [item])
+    return out
+
+
+def _as_run(seg: _Run | Arc) -> _Run:
+    if isinstance(seg, _Run):
+        return seg
+    return _Run(seg.start, seg.end, seg.centre, seg.radius, seg.sweep)
+
+
+def _extend(prev: _Run | Arc | Segment, seg: _Run | Segment, tol: float) -> _Run | None:
+    """``prev`` and ``seg`` as one run on ``prev``'s circle, or ``None`` when they are not."""
+    if not isinstance(prev, (_Run, Arc)):
+        return None
+    run = _as_run(prev)
+    c, r = run.centre, run.radius
+    if isinstance(seg, (_Run, Arc)):
+        other = _as_run(seg)
+        same = distance(other.centre, c) <= tol and abs(other.radius - r) <= tol
+        if not same or (other.sweep > 0) != (run.sweep > 0):
+            return None
+        sweep = other.sweep
+    else:
+        mid = (0.5 * (seg.start[0] + seg.end[0]), 0.5 * (seg.start[1] + seg.end[1]))
+        if any(abs(distance(p, c) - r) > tol for p in (seg.start, seg.end, mid)):
+            return None
+        sweep = _angle(c, seg.start, seg.end)
+        if sweep == 0.0 or (sweep > 0) != (run.sweep > 0):
+            return None
+    return _Run(run.start, seg.end, c, r, run.sweep + sweep)
+
+
+def _angle(c: Point, a: Point, b: Point) -> float:
+    """Signed angle from ``a`` to ``b`` seen from ``c``, radians (> 0 counter-clockwise)."""
+    ux, uy = a[0] - c[0], a[1] - c[1]
+    vx, vy = b[0] - c[0], b[1] - c[1]
+    return math.atan2(ux * vy - uy * vx, ux * vx + uy * vy)
+
+
+def _arcs(run: _Run) -> list[Segment]:
+    """The run as arcs of equal sweep, each at most 180°; its ends kept exactly."""
+    parts = max(1, math.ceil(abs(run.sweep) / math.pi - 1e-9))
+    cx, cy = run.centre
+    r = distance(run.centre, run.start)
+    a0 = math.atan2(run.start[1] - cy, run.start[0] - cx)
+    pts = [run.start]
+    for k in range(1, parts):
+        a = a0 + run.sweep * k / parts
+        pts.append((cx + r * math.cos(a), cy + r * math.sin(a)))
+    pts.append(run.end)
+    return [Arc(p, q, run.centre, run.sweep < 0) for p, q in itertools.pairwise(pts)]
+
+
+def start_near(segs: Sequence[Segment], p: Point, snap: float) -> tuple[Segment, ...]:
+    """The closed ring rotated to start at its point nearest ``p``.
+
+    The segment holding that point is split there unless a vertex lies within
+    ``snap`` mm (then the ring starts at the vertex); a full circle starts anywhere.
+    """
+    dists = [nearest_on(s, p) for s in segs]
+    i = min(range(len(segs)), key=lambda k: dists[k][0])
+    seg, q = segs[i], dists[i][1]
+    if isinstance(seg, Arc) and seg.is_full_circle:
+        return (Arc(q, q, seg.centre, seg.clockwise),)
+    if distance(q, seg.end) <= snap:
+        i = (i + 1) % len(segs)
+        seg, q = segs[i], segs[i].start
+    if distance(q, seg.start) <= snap:
+        return (*segs[i:], *segs[:i])
+    head, tail = _split(seg, q)
+    return (tail, *segs[i + 1 :], *segs[:i], head)
+
+
+def _split(seg: Segment, q: Point) -> tuple[Segment, Segment]:
+    if isinstance(seg, Line):
+        return Line(seg.start, q), Line(q, seg.end)
+    return Arc(seg.start, q, seg.centre, seg.clockwise), Arc(q, seg.end, seg.centre, seg.clockwise)
+
+
+def nearest_on(seg: Segment, p: Point) -> tuple[float, Point]:
+    """Distance from ``p`` to ``seg`` and the nearest point of ``seg``, mm."""
+    if isinstance(seg, Line):
+        (x0, y0), (x1, y1) = seg.start, seg.end
+        dx, dy = x1 - x0, y1 - y0
+        ll = dx * dx + dy * dy
+        u = 0.0 if ll == 0 else min(1.0, max(0.0, ((p[0] - x0) * dx + (p[1] - y0) * dy) / ll))
+        q = (x0 + u * dx, y0 + u * dy)
+        return distance(p, q), q
+    cx, cy = seg.centre
+    a = math.atan2(p[1] - cy, p[0] - cx)
+    travel = (seg.start_angle - a) % TAU if seg.clockwise else (a - seg.start_angle) % TAU
+    if seg.is_full_circle or travel <= abs(seg.sweep):
+        q = (cx + seg.radius * math.cos(a), cy + seg.radius * math.sin(a))
+        return distance(p, q), q
+    return min((distance(p, seg.start), seg.start), (distance(p, seg.end), seg.end))
+
+
+def zigzag_lines(area: BaseGeometry, spacing: float, angle_deg: float) -> list[Line]:
+    """Lines at ``angle_deg`` and ``spacing`` mm apart, clipped to ``area``.
+
+    The lines are centred across the area (the outermost ones at most ``spacing / 2``
+    from its edge). Each returned line runs in the direction of ``angle_deg``.
+
+    Args:
+        area: where the tool centre may go (polygon or multipolygon), mm.
+        spacing: distance between neighbouring lines, mm (> 0).
+        angle_deg: line direction, degrees CCW from +X.
+
+    Returns:
+        The pieces, row by row; empty when ``area`` is empty.
+    """
+    if area.is_empty:
+        return []
+    flat = affinity.rotate(area, -angle_deg, origin=(0.0, 0.0))
+    x0, y0, x1, y1 = flat.bounds
+    height = y1 - y0
+    count = max(1, math.ceil(height / spacing - 1e-9))
+    first = y0 + 0.5 * (height - (count - 1) * spacing)
+    ys = first + spacing * np.arange(count)
+    rows = shapely.linestrings(
+        np.stack(
+            [
+                np.column_stack([np.full(count, x0 - 1.0), ys]),
+                np.column_stack([np.full(count, x1 + 1.0), ys]),
+            ],
+            axis=1,
+        )
+    )
+    cos_a, sin_a = math.cos(math.radians(angle_deg)), math.sin(math.radians(angle_deg))
+
+    def back(x: float, y: float) -> Point:
+        return (x * cos_a - y * sin_a, x * sin_a + y * cos_a)
+
+    out: list[Line] = []
+    for row, y in zip(shapely.intersection(rows, flat), ys, strict=True):
+        spans = sorted(
+            (min(p[0] for p in g.coords), max(p[0] for p in g.coords)) for g in _lines_of(row)
+        )
+        out.extend(Line(back(a, float(y)), back(b, float(y))) for a, b in spans if b > a)
+    return out
+
+
+def _lines_of(geom: BaseGeometry) -> list[BaseGeometry]:
+    if geom.is_empty:
+        return []
+    if geom.geom_type == "LineString":
+        return [geom]
+    return [g for part in getattr(geom, "geoms", ()) for g in _lines_of(part)]
+
+
+def order_lines(lines: Sequence[Line], start: Point) -> list[Line]:
+    """Greedy nearest-end order: each line starts at its end nearest the previous end.
+
+    Args:
+        lines: the line pieces, mm.
+        start: the tool position before the first line, mm.
+
+    Returns:
+        The lines in cutting order, each possibly reversed.
+    """
+    if not lines:
+        return []
+    ends = np.array([[*ln.start, *ln.end] for ln in lines], dtype=np.float64)
+    left = np.ones(len(lines), dtype=bool)
+    out: list[Line] = []
+    here = np.array(start, dtype=np.float64)
+    for _ in range(len(lines)):
+        d_start = np.hypot(ends[:, 0] - here[0], ends[:, 1] - here[1])
+        d_end = np.hypot(ends[:, 2] - here[0], ends[:, 3] - here[1])
+        d_start[~left] = np.inf
+        d_end[~left] = np.inf
+        k_start, k_end = int(np.argmin(d_start)), int(np.argmin(d_end))
+        if d_end[k_end] < d_start[k_start]:
+            line = lines[k_end].reversed()
+            left[k_end] = False
+        else:
+            line = lines[k_start]
+            left[k_start] = False
+        out.append(line)
+        here = np.array(line.end, dtype=np.float64)
+    return out

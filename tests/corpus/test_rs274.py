@@ -28,6 +28,7 @@ import pytest
 
 from camtool.jobs.pipeline import post_file
 from camtool.model.program import ArcMove, Linear, Rapid
+from camtool.toolpath.options import PlanOptions
 from tests.corpus.conftest import (
     CORPUS,
     case_id,
@@ -152,7 +153,7 @@ def test_rs274_moves_equal_the_planned_program(rel: str) -> None:
     assert outcome.final.rc == 0, outcome.problems
     extra = outcome.final.args[6:]  # the remedy flags followed, if any
     assert extra == [] or extra[0] != "-o"
-    job = post_file(CORPUS / rel, "linuxcnc", **_options(extra))
+    job = post_file(CORPUS / rel, "linuxcnc", _options(extra))
     done = rs274(outcome.final.output)
     assert done.returncode == 0, done.stderr
     theirs = canon_moves(done.stdout)
@@ -162,10 +163,10 @@ def test_rs274_moves_equal_the_planned_program(rel: str) -> None:
         assert a == pytest.approx(b, abs=ROUND_MM), f"move {i} ({kind}): rs274 {a} planned {b}"
 
 
-def _options(extra: list[str]) -> dict[str, object]:
-    """post_file keywords for the remedy flags a comparison file needed (only --fit here)."""
+def _options(extra: list[str]) -> PlanOptions:
+    """post_file planning options for the remedy flags a comparison file needed (only --fit)."""
     if not extra:
-        return {}
+        return PlanOptions()
     if extra[0] == "--fit" and len(extra) == 3:
-        return {"fit_mm": (float(extra[1]), float(extra[2]))}
-    pytest.skip(f"comparison with flags {extra} is not mapped to post_file keywords")
+        return PlanOptions(fit_mm=(float(extra[1]), float(extra[2])))
+    pytest.skip(f"comparison with flags {extra} is not mapped to planning options")

@@ -25,6 +25,7 @@ from camtool.model.program import ArcMove, Dwell, Linear, Move, Program, Rapid, 
 from camtool.post.arccheck import arc_error
 from camtool.post.registry import load_target
 from camtool.post.wordaddress import WordAddressPost, word_address_dialect
+from camtool.toolpath.options import PlanOptions
 
 ROOT = Path(__file__).parents[2]
 TARGETS = ("grbl", "linuxcnc")
@@ -58,7 +59,7 @@ def rounded_arcs(
 
 @pytest.mark.parametrize("target", TARGETS)
 def test_logo_golden(target: str, update_golden: bool) -> None:
-    job = post_file(ROOT / "samples" / "logo.dxf", target, scale=20.0)
+    job = post_file(ROOT / "samples" / "logo.dxf", target, PlanOptions(scale=20.0))
     code = str(job.result.code)
     golden = ROOT / "tests" / "golden" / target / f"logo{SUFFIX[target]}"
     if update_golden:
@@ -82,7 +83,9 @@ def test_logo_golden(target: str, update_golden: bool) -> None:
 
 @pytest.mark.parametrize("target", TARGETS)
 def test_independent_reader_reads_the_same_moves(target: str) -> None:
-    code = str(post_file(ROOT / "samples" / "logo.dxf", target, scale=20.0).result.code)
+    code = str(
+        post_file(ROOT / "samples" / "logo.dxf", target, PlanOptions(scale=20.0)).result.code
+    )
     ours = load_target(target).post.parse(code).moves
     theirs = parse_gcode(code, source="logo").moves
     assert len(ours) == len(theirs)
@@ -261,7 +264,7 @@ def test_logo_verified_end_to_end(target: str, step_um: float, chord_um: float) 
     # GRBL $100 = 250 steps/mm (4 µm), $12 = 0.002 mm; linuxcnc.toml 200 steps/mm (5 µm),
     # chords of 1 µm: the path is followed within a step diagonal + the chord error + the
     # 0.5 µm print rounding. (Scale 5, a 25 mm logo, keeps the step simulation short.)
-    v = verify_job(post_file(ROOT / "samples" / "logo.dxf", target, scale=5.0))
+    v = verify_job(post_file(ROOT / "samples" / "logo.dxf", target, PlanOptions(scale=5.0)))
     assert 0.0 < v.deviation.max_um <= step_um * math.sqrt(2) + chord_um + 0.5
 
 

@@ -31,6 +31,7 @@ from camtool.model.program import (
     ToolChange,
 )
 from camtool.post.registry import load_target
+from camtool.toolpath.options import PlanOptions
 from camtool.verify.interpolators import corte_recto_max_deviation
 from camtool.verify.verifier import verify_code
 
@@ -477,7 +478,7 @@ def _distance_to_path(points: np.ndarray, program: Program) -> np.ndarray:
 def test_round_trip_logo_sample() -> None:
     # Every point read back lies on the planned path within the chord tolerance (0.01 mm)
     # plus half a step per axis; every planned end point comes back to the nearest step.
-    job = post_file(SAMPLES / "logo.dxf", "i8751", scale=10)
+    job = post_file(SAMPLES / "logo.dxf", "i8751", PlanOptions(scale=10))
     post = job.target.post
     back = post.parse(job.result.code)
     xy = np.asarray([(m.x, m.y) for m in back.moves])
@@ -512,7 +513,7 @@ def test_verify_corte_recto_golden_r10() -> None:
 def test_verify_logo_end_to_end() -> None:
     # The predicted error is the corte-recto error of the moves as written: at most the
     # largest b(a − b)/√(a² + b²) of any record (§4.2), times 10 µm per step.
-    job = post_file(SAMPLES / "logo.dxf", "i8751", scale=4)
+    job = post_file(SAMPLES / "logo.dxf", "i8751", PlanOptions(scale=4))
     v = verify_job(job)
     back = v.program
     bound = 0.0

@@ -18,7 +18,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from camtool.importers.points import read_points
-from camtool.jobs.pipeline import post_file
+from camtool.jobs.pipeline import OutputOptions, post_file
 from camtool.model.errors import DialectError, InputError, ParseError, UsageError
 from camtool.model.program import ArcMove, Dwell, Linear, Move, Program, Rapid, Spindle
 from camtool.post.registry import load_target
@@ -94,7 +94,9 @@ def test_star_script_shows_the_thesis_text() -> None:
 
 def test_star_wire_is_the_byte_stream_the_gui_sent() -> None:
     # §2.7 / R4: n, x1, y1, lx(1..n), ly(1..n), velx(1..n), vely(1..n), each '%d' then CR.
-    code = post_file(SAMPLES / "star.csv", "matlab-router", fmt="wire").result.code
+    code = post_file(
+        SAMPLES / "star.csv", "matlab-router", output=OutputOptions(fmt="wire")
+    ).result.code
     values = [10, 151, 86, *STAR_LXY[0], *STAR_LXY[1], *STAR_VELXY[0], *STAR_VELXY[1]]
     assert code == "".join(f"{v}\r" for v in values)
     assert len(values) == 3 + 4 * 10
@@ -102,7 +104,9 @@ def test_star_wire_is_the_byte_stream_the_gui_sent() -> None:
 
 @pytest.mark.parametrize(("fmt", "name"), [("script", "star.m"), ("wire", "star.txt")])
 def test_star_golden_files(fmt: str, name: str, update_golden: bool) -> None:
-    code = str(post_file(SAMPLES / "star.csv", "matlab-router", fmt=fmt).result.code)
+    code = str(
+        post_file(SAMPLES / "star.csv", "matlab-router", output=OutputOptions(fmt=fmt)).result.code
+    )
     golden = GOLDEN / name
     if update_golden:
         golden.parent.mkdir(parents=True, exist_ok=True)
@@ -115,7 +119,11 @@ def test_star_verifies_end_to_end_with_the_chunk_closure() -> None:
     # floor(d/2) 0.2 mm chunks); the GUI commanded (+0.2, 0). The code is read as the CLI
     # reads it (bytes, CR kept), for both formats.
     for fmt in ("script", "wire"):
-        code = str(post_file(SAMPLES / "star.csv", "matlab-router", fmt=fmt).result.code)
+        code = str(
+            post_file(
+                SAMPLES / "star.csv", "matlab-router", output=OutputOptions(fmt=fmt)
+            ).result.code
+        )
         v = verify_code(code.encode("ascii"), TARGET)
         end = v.trace.carriage_mm[-1] - np.array([15.1, 8.6])
         assert end == pytest.approx((0.4, -0.2), abs=1e-6)

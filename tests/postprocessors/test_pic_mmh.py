@@ -13,7 +13,7 @@ from camtool_postprocessors.pic_mmh import FeedTable, PicMmhPost
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from camtool.jobs.pipeline import post_file
+from camtool.jobs.pipeline import OutputOptions, post_file
 from camtool.model.errors import DialectError, InputError, ParseError
 from camtool.model.program import (
     ArcMove,
@@ -29,6 +29,7 @@ from camtool.model.program import (
 )
 from camtool.post.base import PostResult
 from camtool.post.registry import load_target
+from camtool.toolpath.options import PlanOptions
 from camtool.verify.verifier import verify_code
 from tests.shapes import golden_arc_dxf
 
@@ -47,7 +48,7 @@ GRAMMAR = re.compile(
 
 def test_golden_block_seed000_l1731(tmp_path: Path) -> None:
     # seed-000 L1731 / S000-04: CW arc centred (3.012, 3.040) mm ending (2.969, 3.400) mm, F08.
-    job = post_file(golden_arc_dxf(tmp_path / "arc.dxf"), "pic-mmh", feed_mm_min=0.8)
+    job = post_file(golden_arc_dxf(tmp_path / "arc.dxf"), "pic-mmh", PlanOptions(feed_mm_min=0.8))
     lines = str(job.result.code).splitlines()
     assert "G02X02969.00Y03400.00I03012.00J03040.00F08;" in lines
 
@@ -332,7 +333,7 @@ def test_spindle_without_a_speed_is_dropped_with_one_warning() -> None:
 
 
 def test_target_spindle_rpm_wraps_the_logo() -> None:
-    job = post_file(SAMPLES / "logo.dxf", "pic-mmh", spindle_rpm=3000)
+    job = post_file(SAMPLES / "logo.dxf", "pic-mmh", output=OutputOptions(spindle_rpm=3000))
     lines = str(job.result.code).splitlines()
     assert lines[:3] == ["G54;", "G90;", "M03S3000;"]
     assert lines[-2:] == ["M05;", "M30;"]

@@ -16,6 +16,7 @@ from camtool.model.errors import DialectError, ParseError
 from camtool.model.program import ArcMove, Linear, Move, Program, Rapid, Spindle
 from camtool.post.registry import load_target
 from camtool.post.wordaddress import word_address_dialect
+from camtool.toolpath.options import PlanOptions
 from camtool.verify.verifier import verify_code
 
 ROOT = Path(__file__).parents[2]
@@ -37,7 +38,9 @@ def emit(moves: tuple[Move, ...], **program: object) -> tuple[list[str], tuple[s
 
 
 def _logo() -> str:
-    return str(post_file(ROOT / "samples" / "logo.dxf", "valcnc", scale=20.0).result.code)
+    return str(
+        post_file(ROOT / "samples" / "logo.dxf", "valcnc", PlanOptions(scale=20.0)).result.code
+    )
 
 
 def test_r01_r02_every_block_matches_and_is_under_128_bytes() -> None:
@@ -176,7 +179,9 @@ def _assert_round_trip(program: Program) -> None:
 
 
 def test_round_trip_logo() -> None:
-    _assert_round_trip(post_file(ROOT / "samples" / "logo.dxf", "valcnc", scale=20.0).program)
+    _assert_round_trip(
+        post_file(ROOT / "samples" / "logo.dxf", "valcnc", PlanOptions(scale=20.0)).program
+    )
 
 
 @st.composite
@@ -208,7 +213,7 @@ def test_logo_verified_end_to_end() -> None:
     # Chords of β = 5° (valcnc.toml; β is not in the thesis) on the largest arc
     # (r = √(28² + 138.6²) = 141.4 mm) leave a sagitta of r·(1 − cos 2.5°) = 0.135 mm; the
     # accumulator DDA lags by up to a step (0.04 mm, Table 8) and the grid rounds by 0.02 mm.
-    job = post_file(ROOT / "samples" / "logo.dxf", "valcnc", scale=20.0)
+    job = post_file(ROOT / "samples" / "logo.dxf", "valcnc", PlanOptions(scale=20.0))
     v = verify_job(job)
     sagitta = math.hypot(28, 138.6) * (1 - math.cos(math.radians(2.5)))
     assert 0.0 < v.deviation.max_um <= (sagitta + STEP + STEP / 2) * 1000

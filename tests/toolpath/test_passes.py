@@ -22,9 +22,8 @@ from camtool.model.shapes import Arc, Contour, Line, Segment
 from camtool.toolpath.cuts import Cut
 from camtool.toolpath.leads import lead_arcs
 from camtool.toolpath.options import PlanOptions
-from camtool.toolpath.passes import emit_moves, pass_depths
+from camtool.toolpath.passes import emit_moves, pass_depths, tab_spans
 from camtool.toolpath.split import Track, end_tangent, start_tangent, sub_segment
-from camtool.toolpath.tabs import tab_spans
 
 FEED = 300.0
 PLUNGE = 60.0

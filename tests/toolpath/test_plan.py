@@ -163,3 +163,10 @@ def test_nesting_of_open_contours_and_duplicates() -> None:
     nest = nesting([square, twin, slot, outside])
     assert nest.parents == ((), (), (0, 1), ())  # duplicates never contain each other
     assert [nest.depth(i) for i in range(4)] == [0, 0, 2, 0]
+
+
+def test_plan_without_a_feed_is_refused_before_any_work(tmp_path: Path) -> None:
+    # feed_mm_min None means "the target's": only camtool.jobs.pipeline.plan_options knows it.
+    drawing = read_dxf(rectangle_dxf(tmp_path / "r.dxf"))
+    with pytest.raises(UsageError, match="no cutting feed: give --feed"):
+        plan(drawing, PlanOptions())

@@ -34,7 +34,7 @@ def _plate() -> Drawing:
 def test_2d_targets_refuse_depth_options(target: str, option: dict[str, Any]) -> None:
     # Issue 4 "Depth": for 2D-only targets depth options are a clear error, not ignored.
     with pytest.raises(UsageError, match=r"--depth.*no programmable Z"):
-        post_drawing(_plate(), load_target(target), **option)
+        post_drawing(_plate(), load_target(target), PlanOptions(**option))
 
 
 def test_depth_sub_options_need_a_depth() -> None:
@@ -45,21 +45,23 @@ def test_depth_sub_options_need_a_depth() -> None:
 def test_lead_in_refused_on_a_chord_only_target() -> None:
     with pytest.raises(UsageError, match="--lead-in: i8751 writes arcs as chords"):
         post_drawing(
-            _plate(), load_target("i8751"), offset="outside", tool_diameter=1.0, lead_in_mm=1.0
+            _plate(),
+            load_target("i8751"),
+            PlanOptions(offset="outside", tool_diameter=1.0, lead_in_mm=1.0),
         )
 
 
 def test_ramp_refused_where_z_has_its_own_block() -> None:
     # flashcut writes "G01 Z…" alone (seed-001 R7): it cannot descend along the path.
     with pytest.raises(UsageError, match="--ramp: flashcut moves Z in a block of its own"):
-        post_drawing(_plate(), load_target("flashcut"), depth=0.2, ramp_angle_deg=5.0)
+        post_drawing(_plate(), load_target("flashcut"), PlanOptions(depth=0.2, ramp_angle_deg=5.0))
 
 
 def test_gcode_input_refuses_planning_options(tmp_path: Path) -> None:
     code = tmp_path / "p.ngc"
     code.write_text("G21 G90\nG0 X0 Y0\nG1 X5 Y0 F100\nM2\n")
     with pytest.raises(UsageError, match="--depth, --order only apply to drawings"):
-        post_file(code, "grbl", depth=1.0, order="reversals")
+        post_file(code, "grbl", PlanOptions(depth=1.0, order="reversals"))
 
 
 def test_dense_polyline_becomes_arcs_and_the_saving_is_reported() -> None:
@@ -101,14 +103,16 @@ def test_grbl_depth_passes_and_tabs_verify(tmp_path: Path) -> None:
     job = post_drawing(
         _plate(),
         load_target("grbl"),
-        offset="outside",
-        tool_diameter=2.0,
-        depth=1.5,
-        step_down=0.5,
-        tabs=2,
-        tab_width=3.0,
-        tab_height=0.5,
-        feed_mm_min=300.0,
+        PlanOptions(
+            offset="outside",
+            tool_diameter=2.0,
+            depth=1.5,
+            step_down=0.5,
+            tabs=2,
+            tab_width=3.0,
+            tab_height=0.5,
+            feed_mm_min=300.0,
+        ),
     )
     moves = job.program.moves
     cutting_z = {

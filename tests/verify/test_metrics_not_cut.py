@@ -24,6 +24,7 @@ import pytest
 from camtool.jobs.pipeline import post_drawing, verify_job
 from camtool.model.shapes import Contour, Drawing, Line, Point
 from camtool.post.registry import load_target
+from camtool.toolpath.options import PlanOptions
 from camtool.verify.metrics import NotCut
 from camtool.verify.verifier import not_cut_text, summary_lines
 
@@ -51,7 +52,9 @@ def plate() -> Drawing:
 
 @pytest.fixture(scope="module")
 def verified():  # type: ignore[no-untyped-def]
-    job = post_drawing(plate(), load_target("grbl"), offset="outside", tool_diameter=2 * R)
+    job = post_drawing(
+        plate(), load_target("grbl"), PlanOptions(offset="outside", tool_diameter=2 * R)
+    )
     kinds = sorted(f.kind for f in job.plan.findings) if job.plan else []
     assert kinds == ["offset-vanished", "tight-corner"]
     return verify_job(job)
@@ -92,7 +95,9 @@ def test_summary_names_the_features(verified) -> None:  # type: ignore[no-untype
 
 
 def test_without_findings_everything_is_the_main_figure() -> None:
-    job = post_drawing(plate(), load_target("grbl"), offset="outside", tool_diameter=2 * R)
+    job = post_drawing(
+        plate(), load_target("grbl"), PlanOptions(offset="outside", tool_diameter=2 * R)
+    )
     from camtool.verify.verifier import verify_code
 
     v = verify_code(job.result.code, job.target, against=job.placed, tool_diameter=2 * R)

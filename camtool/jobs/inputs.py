@@ -1,6 +1,12 @@
-"""Which files a batch posts: files, directories and shell-style globs, expanded.
+"""A job's inputs: what a name reads as, and which files a batch posts.
 
-An input is, in this order:
+A name is read by its ending (:func:`read_input`, :func:`read_code`,
+:func:`read_program`): a drawing (:data:`camtool.importers.DRAWING_SUFFIXES`), or a
+G-code program (:data:`PROGRAM_SUFFIXES`), which is already a toolpath and is
+re-posted, not planned; ``-`` is standard input.
+
+A batch's inputs (:func:`expand_inputs`) are files, directories and shell-style
+globs, expanded. An input is, in this order:An input is, in this order:
 
 - an existing directory: every file below it (recursively) whose ending camtool
   reads (:data:`READABLE_SUFFIXES`: drawings and G-code programs); hidden files
@@ -27,24 +33,136 @@ from __future__ import annotations
 import glob
 import os
 import re
+import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from camtool.importers import DRAWING_SUFFIXES
+from camtool.importers import DRAWING_SUFFIXES, read_drawing, read_drawing_bytes
 from camtool.model.errors import InputError, UsageError
 
+if TYPE_CHECKING:
+    from camtool.importers import ImportOptions
+    from camtool.model.program import Program
+    from camtool.model.shapes import Drawing
+    from camtool.post.base import Target
+
 _MAGIC = re.compile(r"[*?[]")
+
+PROGRAM_SUFFIXES = (".ngc", ".nc", ".gcode", ".tap", ".cnc", ".gc", ".g")
+"""File endings read as existing G-code programs (re-posted, not planned)."""
+
+
+def is_program_file(name: str | Path) -> bool:
+    """True when ``name`` is a G-code program by its ending (see :data:`PROGRAM_SUFFIXES`)."""
+    return Path(name).suffix.lower() in PROGRAM_SUFFIXES
+
+
+def read_input(name: str, settings: ImportOptions | None = None) -> Drawing:
+    """The drawing at ``name`` (``-``: stdin), read by its ending.
+
+    Raises:
+        InputError: the drawing cannot be read (see :mod:`camtool.importers`).
+    """
+    if name == "-":
+        return read_drawing_bytes(sys.stdin.buffer.read(), options=settings)
+    return read_drawing(name, settings)
+
+
+def read_code(name: str, *, binary: bool = False) -> str | bytes:
+    """A code file (``-``: stdin): bytes for a binary dialect, else ASCII text.
+
+    Raises:
+        InputError: missing, unreadable, or (text) not ASCII, naming the file.
+    """
+    if binary:
+        try:
+            return sys.stdin.buffer.read() if name == "-" else Path(name).read_bytes()
+        except FileNotFoundError as exc:
+            raise InputError(f"{name}: no such file") from exc
+        except OSError as exc:
+            raise InputError(f"{name}: cannot read ({exc.strerror or exc})") from exc
+    if name == "-":
+        return sys.stdin.read()
+    try:
+        return Path(name).read_text(encoding="ascii", errors="strict")
+    except FileNotFoundError as exc:
+        raise InputError(f"{name}: no such file") from exc
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{name}: not a text program (byte {exc.start} is not ASCII)") from exc
+    except OSError as exc:
+        raise InputError(f"{name}: cannot read ({exc.strerror or exc})") from exc
+
+
+def read_program(name: str, target: Target | None) -> Program:
+    """A program by its ending: the target's dialect, or G-code through the importer.
+
+    Read with the ``target``'s own reader when its ending is one that target writes
+    or is not a G-code ending (``logo.pic``); else a G-code file (``.ngc .nc .gcode
+    .tap ...``) goes through the G-code importer (no target needed). ``-`` reads code
+    in the target's dialect from stdin.
+
+    Raises:
+        InputError: no such file, or the code cannot be read.
+        UsageError: neither a G-code ending nor a target to read it with.
+    """
+    if name != "-" and not Path(name).is_file():
+        raise InputError(f"{name}: no such file")
+    suffix = Path(name).suffix.lower()
+    if target is not None and (not is_program_file(name) or suffix in target.post.formats.values()):
+        return target.post.parse(read_code(name, binary=target.post.binary), source=name)
+    if name != "-" and is_program_file(name):
+        from camtool.importers.gcode import read_gcode
+
+        return read_gcode(name)
+    raise UsageError(
+        f"{name} is not a drawing nor a G-code program ({', '.join(PROGRAM_SUFFIXES)}): "
+        "give --target NAME to read it as that target's code"
+    )
+
+
+def preview_inputs(
+    input_name: str, program_name: str | None, target: Target | None, settings: ImportOptions
+) -> tuple[Drawing | None, Program | None]:
+    """The drawing and the program ``camtool preview`` draws.
+
+    ``input_name`` is a drawing by its ending (then ``program_name``, if given, is
+    drawn over it), else a program (:func:`read_program`).
+
+    Raises:
+        InputError: a file is missing or unreadable.
+        UsageError: ``program_name`` given while ``input_name`` is not a drawing, or a
+            program that cannot be read without a target.
+    """
+    if input_name != "-" and Path(input_name).suffix.lower() in DRAWING_SUFFIXES:
+        if not Path(input_name).is_file():
+            raise InputError(f"{input_name}: no such file")
+        drawing = read_drawing(input_name, settings)
+        program = read_program(program_name, target) if program_name else None
+        return drawing, program
+    if program_name is not None:
+        raise UsageError(
+            f"--program draws a program over a drawing, but INPUT {input_name} is not a "
+            "drawing (.dxf, .svg, point list)"
+        )
+    return None, read_program(input_name, target)
+
+
+def default_preview_path(input_name: str) -> str:
+    """``part.dxf`` → ``part.preview.svg`` beside it (never the input itself); ``-`` → stdout."""
+    if input_name == "-":
+        return "-"
+    path = Path(input_name)
+    return str(path.with_name(f"{path.stem}.preview.svg"))
 
 
 def readable_suffixes() -> tuple[str, ...]:
     """File endings a batch picks up in directories and globs, lowercase.
 
     The drawing endings of :data:`camtool.importers.DRAWING_SUFFIXES` and the
-    G-code endings of :data:`camtool.jobs.pipeline.PROGRAM_SUFFIXES`.
+    G-code endings of :data:`PROGRAM_SUFFIXES`.
     """
-    from camtool.jobs.pipeline import PROGRAM_SUFFIXES
-
     return DRAWING_SUFFIXES + PROGRAM_SUFFIXES
 
 
@@ -64,7 +182,7 @@ class BatchInput:
 
 
 def expand_inputs(inputs: Sequence[str], *, exclude: Path | None = None) -> tuple[BatchInput, ...]:
-    """Expand files, directories and globs into the files to post (see the module docstring).
+    """Expand a batch's files, directories and globs into the files to post (module docstring).
 
     Args:
         inputs: what the user gave, in order.
