@@ -24,8 +24,9 @@ demo: $(STAMP)
 	@echo "demo: out/plate.gcode (GRBL: outside profile, 3 passes, tabs, lead-ins), out/plate.png"
 
 lint: $(STAMP)
-	$(BIN)/ruff check camtool tests samples docs
-	$(BIN)/ruff format --check camtool tests samples docs
+	$(BIN)/ruff check camtool postprocessors tests samples docs
+	$(BIN)/ruff format --check camtool postprocessors tests samples docs
+	$(BIN)/lint-imports
 
 typecheck: $(STAMP)
 	$(BIN)/mypy
