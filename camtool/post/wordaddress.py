@@ -55,7 +55,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections import Counter
 from collections.abc import Mapping
 from types import MappingProxyType
 from typing import Any
@@ -75,7 +74,13 @@ from camtool.model.program import (
     ToolChange,
 )
 from camtool.model.shapes import Arc, Point
-from camtool.post.base import PostProcessor, PostResult, check_placement, check_work_area
+from camtool.post.base import (
+    PostProcessor,
+    PostResult,
+    WriterState,
+    check_placement,
+    check_work_area,
+)
 from camtool.post.wordaddress_read import BlockReader, ControllerRefusal
 from camtool.post.wordaddress_spec import WordAddressSpec, load_spec
 
@@ -117,7 +122,7 @@ class WordAddressPost(PostProcessor):
         self.check_format(fmt)
         writer = BlockWriter(self.spec, machine)
         code = writer.write(program)
-        return PostResult(code, len(writer.lines), tuple(writer.warnings), "code")
+        return PostResult(code, len(writer.blocks), tuple(writer.warnings), "code")
 
     def parse(self, code: str | bytes, *, source: str = "<code>") -> Program:
         """Read code of this dialect (rules: :mod:`camtool.post.wordaddress_read`).
@@ -191,24 +196,31 @@ _SAME_MM = 1e-9
 """Exact XY closer than this is the same point (a Z-only move)."""
 
 
-class BlockWriter:
+class BlockWriter(WriterState[str]):
     """Writes one program; holds the controller's state as the written code sets it.
+
+    The lines written are :attr:`blocks` (header and comment lines included:
+    block numbers in messages are line numbers); what the dialect lacks is
+    counted in :attr:`counts` by kind (``"feed"``, ``"spindle"``, ``"z-split"``,
+    ``"tiny-arc"``...) and worded once at the end.
 
     Args:
         spec: the dialect.
         machine: the machine the program is for (work area, Z axis).
+
+    Attributes:
+        z: the Z the controller is at, mm (``None``: not set yet).
+        written: the XY the controller holds, as written (rounded), mm.
+        last: the last text of each word letter (modal words).
+        grid_error_mm: largest change of a coordinate rounded to a step grid, mm.
     """
 
     def __init__(self, spec: WordAddressSpec, machine: Machine) -> None:
+        super().__init__()
         self.spec, self.machine = spec, machine
-        self.lines: list[str] = []
-        self.warnings: list[str] = []
-        self.dropped: Counter[str] = Counter()
-        self.here: Point = (0.0, 0.0)
         self.z: float | None = None
         self.written: Point = (0.0, 0.0)
         self.last: dict[str, str] = {}
-        self.contour = 0
         self.grid_error_mm = 0.0
         self.program = Program(())
 
@@ -228,11 +240,11 @@ class BlockWriter:
         self.program = program
         self.warnings.extend(check_placement(program, self.machine))
         self.written = (self._round("X", program.origin[0]), self._round("Y", program.origin[1]))
-        self.lines.extend(self.spec.header)
+        self.blocks.extend(self.spec.header)
         for note in program.notes:
             comment = self.spec.comment_line(note)
             if comment is not None:
-                self.lines.append(comment)
+                self.blocks.append(comment)
         for codes in self.spec.preamble:
             self.block(list(codes))
         for item in program.items():
@@ -244,15 +256,10 @@ class BlockWriter:
             self.block(list(codes))
         if self.spec.end:
             self.block([self.spec.end[0]])
-        self.lines.extend(self.spec.footer)
+        self.blocks.extend(self.spec.footer)
         self.warnings.extend(self._summary())
         end = self.spec.line_end
-        return end.join(self.lines) + end if self.lines else ""
-
-    def where(self) -> str:
-        """``contour C, block B`` of the block about to be written."""
-        block = len(self.lines) + 1
-        return f"contour {self.contour}, block {block}" if self.contour else f"block {block}"
+        return end.join(self.blocks) + end if self.blocks else ""
 
     def block(self, words: list[str]) -> None:
         """Append one block made of ``words``.
@@ -268,7 +275,7 @@ class BlockWriter:
                 f"{self.where()}: {text!r} is {size} bytes with its line end; "
                 f"{self.spec.name} takes at most {limit} (max_block_bytes)"
             )
-        self.lines.append(text)
+        self.blocks.append(text)
 
     # -- numbers -----------------------------------------------------------------
 
@@ -358,7 +365,7 @@ class BlockWriter:
         if move.z is None or self.spec.z_moves == "with-xy":
             self._line(move, (move.x, move.y), move.z)
             return
-        self.dropped["z-split"] += 1
+        self.counts["z-split"] += 1
         if self.z is not None and move.z < self.z:
             self._line(move, (move.x, move.y), None)
             self._line(move, None, move.z)
@@ -387,7 +394,7 @@ class BlockWriter:
     def _feed(self, move: Linear | ArcMove, words: list[str]) -> None:
         spec = self.spec.word("F")
         if spec is None:
-            self.dropped["feed"] += 1
+            self.counts["feed"] += 1
             return
         text = self.text("F", move.feed_mm_min)
         written = spec.number.parse(text)
@@ -398,8 +405,7 @@ class BlockWriter:
             )
         if abs(written - move.feed_mm_min) > 1e-9 * max(1.0, move.feed_mm_min):
             msg = f"feed {move.feed_mm_min:g} mm/min written as F{text} ({written:g} mm/min)"
-            if msg not in self.warnings:
-                self.warnings.append(msg)
+            self.warn(msg)
         self._word("F", text, words)
 
     # -- arcs --------------------------------------------------------------------
@@ -458,7 +464,7 @@ class BlockWriter:
                 raise DialectError(f"{self.where()}: {exc}") from exc
             return [(piece.end, None)]
         if not out:
-            self.dropped["tiny-arc"] += 1  # rounds away to nothing within a quantum
+            self.counts["tiny-arc"] += 1  # rounds away to nothing within a quantum
         return [(p.end, p.centre) for p in out]
 
     def _arc_block(
@@ -483,7 +489,7 @@ class BlockWriter:
             i, j = self.spec.words["I"].number.parse(ti), self.spec.words["J"].number.parse(tj)
             tiny = tiny or (i + ox, j + oy) == self.written
         if tiny:
-            self.dropped["tiny-arc"] += 1
+            self.counts["tiny-arc"] += 1
             linear = Linear(end[0], end[1], move.feed_mm_min, contour=move.contour)
             self._line(linear, end, z)
             return
@@ -512,30 +518,30 @@ class BlockWriter:
                 command.direction
             ]
             if code is None:
-                self.dropped["spindle"] += 1
+                self.counts["spindle"] += 1
                 return
             words = [code]
             if command.direction != "off" and spec.has("S") and command.rpm > 0:
                 words.append("S" + self.text("S", command.rpm))  # rpm 0: speed not given
             elif command.direction != "off" and command.rpm > 0:
-                self.dropped["speed"] += 1
+                self.counts["speed"] += 1
             self.block(words)
         elif isinstance(command, Dwell):
             if spec.dwell is None:
-                self.dropped["dwell"] += 1
+                self.counts["dwell"] += 1
                 return
             self.block([spec.dwell, "P" + self.text("P", command.seconds)])
         elif isinstance(command, ToolChange):
             if spec.tool_change is None:
-                self.dropped["tool"] += 1
+                self.counts["tool"] += 1
                 return
             self.block([spec.tool_change, "T" + self.text("T", float(command.tool))])
         elif isinstance(command, Home):
-            self.dropped["home"] += 1
+            self.counts["home"] += 1
 
     def _summary(self) -> list[str]:
         """One warning per kind of thing dropped or converted."""
-        name, d = self.spec.name, self.dropped
+        name, d = self.spec.name, self.counts
         texts = {
             "feed": f"{name} has no F word: the feed of {d['feed']} cutting block(s) is not "
             "written; the machine moves at its own speed",
