@@ -46,7 +46,7 @@ import copy
 import math
 from collections import Counter
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from types import MappingProxyType
 from typing import Any, ClassVar
 
@@ -82,6 +82,7 @@ from camtool.post.base import (
     ContourCounter,
     PostProcessor,
     PostResult,
+    WriterState,
     check_placement,
     check_work_area,
     from_options,
@@ -219,22 +220,31 @@ def split_count(n: int) -> list[int]:
     return [sign * MAX_STEPS] * full + ([sign * rest] if rest else [])
 
 
-@dataclass
-class _Writer:
-    """The records of one emit and what to warn about (local to one call)."""
+class _Writer(WriterState[Record]):
+    """The records of one emit and what to warn about (:class:`WriterState`, local to one call).
 
-    spm: tuple[float, float, float]
-    lift_steps: int
-    records: list[Record] = field(default_factory=list)
-    pos: list[int] = field(default_factory=lambda: [0, 0, 0])
-    lifted: bool = False
-    counts: Counter[str] = field(default_factory=Counter)
-    feeds: set[float] = field(default_factory=set)
-    chord_error_mm: float = 0.0
+    :attr:`blocks` are the move records; :attr:`counts` counts the conversions
+    (``"rapids"``, ``"lifts"``, ``"split"``, ``"xyz"``, ``"tiny"``, the dwells)
+    and the commands not written.
 
-    def where(self, move: Move) -> str:
-        block = len(self.records) + 1
-        return f"contour {move.contour}, block {block}" if move.contour else f"block {block}"
+    Args:
+        spm: the machine's ``(x, y, z)`` steps/mm.
+        lift_steps: Z lift around runs of rapids, steps (0: none).
+        here: where the program starts, mm.
+
+    Attributes:
+        pos: where the records have brought the axes, steps ``[x, y, z]``.
+        lifted: True while Z is raised by :attr:`lift_steps`.
+    """
+
+    def __init__(
+        self, spm: tuple[float, float, float], lift_steps: int, here: Point = (0.0, 0.0)
+    ) -> None:
+        super().__init__(here=here)
+        self.spm = spm
+        self.lift_steps = lift_steps
+        self.pos = [self.steps(here[0], 0), self.steps(here[1], 1), 0]
+        self.lifted = False
 
     def steps(self, value_mm: float, axis: int) -> int:
         return _round_steps(value_mm, self.spm[axis])
@@ -263,7 +273,7 @@ class _Writer:
         The thesis's move is "X/Y, wait T1, Z, wait T2" (seed-003 §3.7): a dwell
         between the two (held in the earlier record's T2) becomes T1.
         """
-        last = self.records[-1] if self.records else None
+        last = self.blocks[-1] if self.blocks else None
         if (
             last is not None
             and record.steps[:2] == (0, 0)
@@ -272,9 +282,9 @@ class _Writer:
             and any(last.steps[:2])
         ):
             steps = (last.steps[0], last.steps[1], record.steps[2])
-            self.records[-1] = Record(steps, last.wait_t2_s, record.wait_t2_s)
+            self.blocks[-1] = Record(steps, last.wait_t2_s, record.wait_t2_s)
             return
-        self.records.append(record)
+        self.blocks.append(record)
 
     def lift(self, up: bool) -> None:
         self.append(Record((0, 0, self.lift_steps if up else -self.lift_steps)))
@@ -289,14 +299,14 @@ class _Writer:
         if whole <= 0:
             self.counts["dwell_dropped"] += 1
             return
-        if self.records and self.records[-1].wait_t2_s < MAX_WAIT_S:
-            last = self.records[-1]
+        if self.blocks and self.blocks[-1].wait_t2_s < MAX_WAIT_S:
+            last = self.blocks[-1]
             put = min(MAX_WAIT_S - last.wait_t2_s, whole)
-            self.records[-1] = replace(last, wait_t2_s=last.wait_t2_s + put)
+            self.blocks[-1] = replace(last, wait_t2_s=last.wait_t2_s + put)
             whole -= put
         while whole > 0:
             put = min(MAX_WAIT_S, whole)
-            self.records.append(Record((0, 0, 0), 0, put))
+            self.blocks.append(Record((0, 0, 0), 0, put))
             whole -= put
 
 
@@ -364,27 +374,25 @@ class I8751Post(PostProcessor):
         fmt = self.check_format(fmt)
         has_z = any(m.z is not None for m in program.moves)
         lift = self.lift_mm if machine.has_z and not has_z else 0.0
-        w = _Writer(machine.steps_per_mm, _round_steps(lift, machine.steps_per_mm[2]))
-        w.pos = [w.steps(program.origin[0], 0), w.steps(program.origin[1], 1), 0]
-        start = program.origin
+        lift_steps = _round_steps(lift, machine.steps_per_mm[2])
+        w = _Writer(machine.steps_per_mm, lift_steps, program.origin)
         for item in program.items():
             if isinstance(item, Rapid | Linear | ArcMove):
-                self._move(w, start, item, machine, program)
-                start = (item.x, item.y)
+                self._move(w, item, machine, program)
+                w.here = (item.x, item.y)
             else:
                 self._command(w, item)
         warnings = (*check_placement(program, machine), *self._warnings(w, program, machine))
         if fmt == "bin":
-            return PostResult(encode_stream(w.records), len(w.records), warnings, fmt)
-        text = dump_stream(w.records, machine.steps_per_mm, self._header(w, machine))
-        return PostResult(text, len(w.records), warnings, fmt)
+            return PostResult(encode_stream(w.blocks), len(w.blocks), warnings, fmt)
+        text = dump_stream(w.blocks, machine.steps_per_mm, self._header(w, machine))
+        return PostResult(text, len(w.blocks), warnings, fmt)
 
-    def _move(
-        self, w: _Writer, start: Point, move: Move, machine: Machine, program: Program
-    ) -> None:
-        check_work_area(start, move, machine, w.where(move), program)
+    def _move(self, w: _Writer, move: Move, machine: Machine, program: Program) -> None:
+        start, w.contour = w.here, move.contour
+        check_work_area(start, move, machine, w.where(), program)
         if move.z is not None and not machine.has_z:
-            raise DialectError(f"{w.where(move)}: Z = {move.z:g} mm but {machine.name} has no Z")
+            raise DialectError(f"{w.where()}: Z = {move.z:g} mm but {machine.name} has no Z")
         if isinstance(move, Rapid):
             w.counts["rapids"] += 1
             if w.lift_steps and not w.lifted:
@@ -393,13 +401,13 @@ class I8751Post(PostProcessor):
             if w.lifted:
                 w.lift(False)
             w.feeds.add(move.feed_mm_min)
-        before = len(w.records)
+        before = len(w.blocks)
         points = [(move.x, move.y)]
         if isinstance(move, ArcMove):
             points = self._chords(w, start, move, machine.motion.chord_tolerance_mm)
         for k, (x, y) in enumerate(points, start=1):
             w.goto(x, y, move.z if k == len(points) else None)
-        if len(w.records) == before:
+        if len(w.blocks) == before:
             w.counts["tiny"] += 1
 
     @staticmethod
@@ -407,9 +415,7 @@ class I8751Post(PostProcessor):
         arc = Arc(start, (move.x, move.y), (move.cx, move.cy), move.clockwise)
         points = arc.points(tolerance_mm)[1:]
         angle = abs(arc.sweep) / len(points)
-        w.chord_error_mm = max(w.chord_error_mm, arc.radius * (1.0 - math.cos(angle / 2.0)))
-        w.counts["arcs"] += 1
-        w.counts["chords"] += len(points)
+        w.chorded(len(points), arc.radius * (1.0 - math.cos(angle / 2.0)))
         return points
 
     @staticmethod
@@ -417,7 +423,7 @@ class I8751Post(PostProcessor):
         if isinstance(command, Dwell):
             w.dwell(command.seconds)
         else:
-            w.counts[type(command).__name__] += 1
+            w.drop(command)
 
     def _warnings(self, w: _Writer, program: Program, machine: Machine) -> tuple[str, ...]:
         c, out = w.counts, []
@@ -452,9 +458,9 @@ class I8751Post(PostProcessor):
             out.append(
                 f"{c['rapids']} rapid(s) written as ordinary moves (the 8751 has no rapid); {how}"
             )
-        if c["arcs"]:
+        if w.arcs:
             out.append(
-                f"{c['arcs']} arc(s) written as {c['chords']} chords (the 8751 has no arcs, "
+                f"{w.arcs} arc(s) written as {w.chords} chords (the 8751 has no arcs, "
                 f"seed-003 §4.1): largest chord error {w.chord_error_mm:.4f} mm "
                 f"(chord_tolerance_mm {machine.motion.chord_tolerance_mm:g})"
             )
@@ -462,14 +468,14 @@ class I8751Post(PostProcessor):
         return tuple(out)
 
     def _header(self, w: _Writer, machine: Machine) -> list[str]:
-        n = len(packets(w.records))
+        n = len(packets(w.blocks))
         return [
             f"i8751 session (seed-003, section 3.7): access key {ACCESS_KEY:02X}H, packets of <= 5 "
             "moves ended by 45H, end of data 54H",
             "move = M1 D PH PL | M2 D PH PL | 00 T1 | M3 D PH PL | 00 T2; D 03H +, 04H -, "
             "05H no move (no PH PL); steps = PH*256+PL; T1, T2 in s",
             f"machine: {machine.name}, {_spm(machine.steps_per_mm)} steps/mm (X, Y, Z); "
-            f"{len(w.records)} move(s) in {n} packet(s); positions in mm from the start",
+            f"{len(w.blocks)} move(s) in {n} packet(s); positions in mm from the start",
         ]
 
     # -- reading ---------------------------------------------------------------

@@ -48,7 +48,6 @@ import bisect
 import itertools
 import math
 import re
-from collections import Counter
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
@@ -70,6 +69,7 @@ from camtool.post.base import (
     ContourCounter,
     PostProcessor,
     PostResult,
+    WriterState,
     check_placement,
     check_work_area,
     from_options,
@@ -459,7 +459,7 @@ def _skip_blank(code: str, pos: int) -> int:
 # -- matlab_router_warnings ------------------------------------------------------------
 # The warnings of the ``matlab-router`` writer: one per kind of conversion.
 #
-# Gathered in a :class:`WriterNotes` while :class:`MatlabRouterPost`
+# Gathered in a :class:`RouterWriter` (below) while :class:`MatlabRouterPost`
 # writes, then worded here (seed-002 §2.8, §3, §4.2 for the reasons given).
 
 FIRST_POINT_SPEED = 500
@@ -475,36 +475,11 @@ COMMAND_REASONS = {
 """Why each kind of :data:`~camtool.model.program.Command` is not written."""
 
 
-@dataclass
-class WriterNotes:
-    """What the writer has to tell the user, gathered while writing (one warning per kind).
-
-    Attributes:
-        warnings: warnings already worded (strokes that round to one point).
-        commands: commands not written, by kind (``Spindle``, ``Dwell``...).
-        arcs: arcs turned into chords.
-        chords: chords written for them.
-        sagitta_mm: largest chord sagitta measured, mm (before rounding to 0.1 mm).
-        merged: where vertices that rounded onto the previous one were dropped.
-        feeds: programmed feeds other than the router's, mm/min.
-        trailing_rapid: end of a rapid after the last cut (not written), mm.
-    """
-
-    warnings: list[str] = field(default_factory=list)
-    commands: Counter[str] = field(default_factory=Counter)
-    arcs: int = 0
-    chords: int = 0
-    sagitta_mm: float = 0.0
-    merged: list[str] = field(default_factory=list)
-    feeds: set[float] = field(default_factory=set)
-    trailing_rapid: Point | None = None
-
-
-def notes_warnings(notes: WriterNotes, speed: int, tolerance: float) -> list[str]:
+def notes_warnings(notes: RouterWriter, speed: int, tolerance: float) -> list[str]:
     """One warning per kind of conversion the writer made (commands, feeds, arcs, merges)."""
     w = [
         f"{count} {kind} command(s) not written: {COMMAND_REASONS.get(kind, 'no word for it')}"
-        for kind, count in sorted(notes.commands.items())
+        for kind, count in notes.dropped()
     ]
     if notes.feeds:
         feeds = ", ".join(f"{f:g}" for f in sorted(notes.feeds))
@@ -516,13 +491,13 @@ def notes_warnings(notes: WriterNotes, speed: int, tolerance: float) -> list[str
     if notes.arcs:
         w.append(
             f"{notes.arcs} arc(s) written as {notes.chords} chords within {tolerance:g} mm "
-            f"(largest sagitta {notes.sagitta_mm:.4f} mm), then rounded to 0.1 mm: the router "
+            f"(largest sagitta {notes.chord_error_mm:.4f} mm), then rounded to 0.1 mm: the router "
             "has straight segments only (seed-002 §4.1)"
         )
-    if notes.merged:
+    if notes.counts["merged"]:
         w.append(
-            f"{len(notes.merged)} vertex(es) rounded onto the previous one at 0.1 mm and dropped "
-            f"(first: {notes.merged[0]})"
+            f"{notes.counts['merged']} vertex(es) rounded onto the previous one at 0.1 mm and "
+            f"dropped (first: {notes.notes['merged']})"
         )
     if notes.trailing_rapid is not None:
         x, y = notes.trailing_rapid
@@ -612,6 +587,25 @@ class RouterJob:
             return _place(self.contours, stroke)
         number = self.first_segment + segment
         return _place(self.contours, f"block {self.blocks[segment]} ({stroke}, segment {number})")
+
+
+class RouterWriter(WriterState[RouterJob]):
+    """What the writer has made and has to tell the user (:class:`WriterState`).
+
+    :attr:`blocks` are the jobs written; :attr:`warnings` the warnings already
+    worded (strokes that round to one point); :attr:`counts` the commands not
+    written by kind and, as the ``"merged"`` :meth:`note`, where vertices that
+    rounded onto the previous one were dropped; the chord tally (largest
+    sagitta measured, before rounding to 0.1 mm) and :attr:`feeds` (programmed
+    feeds other than the router's, mm/min) come with the base.
+
+    Attributes:
+        trailing_rapid: end of a rapid after the last cut (not written), mm.
+    """
+
+    def __init__(self, here: Point = (0.0, 0.0)) -> None:
+        super().__init__(here=here)
+        self.trailing_rapid: Point | None = None
 
 
 @dataclass
@@ -710,11 +704,11 @@ class MatlabRouterPost(PostProcessor):
 
     def jobs(self, program: Program, machine: Machine) -> tuple[list[RouterJob], list[str]]:
         """The jobs ``program`` becomes, in order, and the warnings (errors: see :meth:`emit`)."""
-        notes = WriterNotes()
+        notes = RouterWriter(program.origin)
         strokes = self._strokes(program, machine, notes)
-        jobs: list[RouterJob] = []
         for stroke in strokes:
-            jobs.extend(self._stroke_jobs(stroke, program, notes))
+            notes.blocks.extend(self._stroke_jobs(stroke, program, notes))
+        jobs = notes.blocks
         if not jobs:
             raise DialectError(
                 "nothing to cut: a matlab-router job needs at least one segment of 0.1 mm or "
@@ -727,43 +721,42 @@ class MatlabRouterPost(PostProcessor):
     def _tolerance(self, machine: Machine) -> float:
         return self.chord_tolerance_mm or machine.motion.chord_tolerance_mm
 
-    def _strokes(self, program: Program, machine: Machine, notes: WriterNotes) -> list[_Stroke]:
+    def _strokes(self, program: Program, machine: Machine, notes: RouterWriter) -> list[_Stroke]:
         """Runs of cutting moves (mm, arcs as chords); rapids only end them."""
         strokes: list[_Stroke] = []
         current: _Stroke | None = None
-        here = program.origin
         feed = major_axis_feed_mm_min(self.speed)
         tolerance = self._tolerance(machine)
         index = -1
         for item in program.items():
             if not isinstance(item, Rapid | Linear | ArcMove):
-                notes.commands[type(item).__name__] += 1
+                notes.drop(item)
                 continue
             index += 1
             move: Move = item
-            _check_move(here, move, index, machine, program)
+            _check_move(notes, move, index, machine, program)
             if isinstance(move, Rapid):
-                current, here = None, (move.x, move.y)
-                notes.trailing_rapid = here
+                current, notes.here = None, (move.x, move.y)
+                notes.trailing_rapid = notes.here
                 continue
             notes.trailing_rapid = None
             if current is None:
-                current = _Stroke(len(strokes) + 1, [here])
+                current = _Stroke(len(strokes) + 1, [notes.here])
                 strokes.append(current)
             if not math.isclose(move.feed_mm_min, feed, rel_tol=1e-9):
                 notes.feeds.add(move.feed_mm_min)
             points = (
-                _chords(here, move, tolerance, notes)
+                _chords(notes.here, move, tolerance, notes)
                 if isinstance(move, ArcMove)
                 else [(move.x, move.y)]
             )
             current.points.extend(points)
             current.owners.extend([index] * len(points))
-            here = (move.x, move.y)
+            notes.here = (move.x, move.y)
         return strokes
 
     def _stroke_jobs(
-        self, stroke: _Stroke, program: Program, notes: WriterNotes
+        self, stroke: _Stroke, program: Program, notes: RouterWriter
     ) -> list[RouterJob]:
         """Quantise a stroke, drop repeated vertices, split it into jobs of ≤ max_segments."""
         xy = points_01mm(np.asarray(stroke.points, dtype=np.float64))
@@ -773,10 +766,8 @@ class MatlabRouterPost(PostProcessor):
         contours = tuple(sorted({program.moves[o].contour for o in stroke.owners}))
         for i in np.nonzero(~keep)[0]:
             move = program.moves[stroke.owners[i - 1]]
-            block = f"block {stroke.owners[i - 1] + 1}"
-            notes.merged.append(
-                _place((move.contour,), f"{block} ({xy[i, 0] / 10:g}, {xy[i, 1] / 10:g}) mm")
-            )
+            block = notes.where(move.contour, stroke.owners[i - 1] + 1)
+            notes.note("merged", f"{block} ({xy[i, 0] / 10:g}, {xy[i, 1] / 10:g}) mm")
         xy = xy[keep]
         if len(xy) < 2:
             notes.warnings.append(
@@ -894,28 +885,30 @@ def _matrix(name: str, arr: np.ndarray) -> list[str]:
     return [f"{name} = ", f"[{x}; ", f" {y} ] "]
 
 
-def _check_move(here: Point, move: Move, index: int, machine: Machine, program: Program) -> None:
-    """Z and work-area checks of one move (``index`` 0-based)."""
-    where = _place((move.contour,), f"block {index + 1}")
+def _check_move(
+    notes: RouterWriter, move: Move, index: int, machine: Machine, program: Program
+) -> None:
+    """Z and work-area checks of one move from ``notes.here`` (``index`` 0-based)."""
+    where = notes.where(move.contour, index + 1)
     if move.z is not None:
         raise DialectError(
             f"{where}: matlab-router has no Z (the Matlab GUI is 2D; the Z slave only lowers "
             "the tool by a fixed 100 units at each job's start, seed-002 §2.8 L6544); "
             "set the depth by hand"
         )
-    check_work_area(here, move, machine, where, program)
+    check_work_area(notes.here, move, machine, where, program)
 
 
-def _chords(here: Point, move: ArcMove, tolerance: float, notes: WriterNotes) -> list[Point]:
+def _chords(here: Point, move: ArcMove, tolerance: float, notes: RouterWriter) -> list[Point]:
     """Equal chords of an arc within ``tolerance``; records the count and measured sagitta."""
     arc = Arc(here, (move.x, move.y), (move.cx, move.cy), move.clockwise)
     points = arc.points(tolerance)
     cx, cy = arc.centre
+    sagitta = 0.0
     for (ax, ay), (bx, by) in itertools.pairwise(points):
         mid = math.hypot((ax + bx) / 2 - cx, (ay + by) / 2 - cy)
-        notes.sagitta_mm = max(notes.sagitta_mm, arc.radius - mid)
-    notes.arcs += 1
-    notes.chords += len(points) - 1
+        sagitta = max(sagitta, arc.radius - mid)
+    notes.chorded(len(points) - 1, sagitta)
     return points[1:]
 
 

@@ -36,7 +36,7 @@ import bisect
 import math
 import re
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from decimal import ROUND_HALF_UP, Decimal
 from types import MappingProxyType
 from typing import Any, ClassVar
@@ -60,6 +60,7 @@ from camtool.post.base import (
     ContourCounter,
     PostProcessor,
     PostResult,
+    WriterState,
     check_placement,
     check_work_area,
     from_options,
@@ -292,29 +293,17 @@ BUFFER_CHARS = 35
 """The firmware's receive vector ``CadenaControl`` (seed-000 L1739–L1744, S000-07)."""
 
 
-@dataclass
-class _Writer:
-    """Accumulates blocks and notes; knows the contour and block number for messages."""
+class _Writer(WriterState[str]):
+    """The blocks of one emit and what to warn about (:class:`WriterState`).
 
-    lines: list[str] = field(default_factory=list)
-    warnings: list[str] = field(default_factory=list)
-    notes: dict[str, tuple[str, int]] = field(default_factory=dict)
-    fast: dict[int, list[tuple[int, int]]] = field(default_factory=dict)
-    chorded: list[int] = field(default_factory=lambda: [0, 0])
-    """Arcs written as chords (centre beyond I/J) and the chords written."""
+    Attributes:
+        fast: blocks over the machine's step rate by feed code:
+            ``code → [(block, contour), ...]`` (S000-05).
+    """
 
-    def where(self, contour: int) -> str:
-        block = len(self.lines) + 1
-        return f"contour {contour}, block {block}" if contour else f"block {block}"
-
-    def note(self, kind: str, message: str) -> None:
-        """Count one conversion of ``kind``; the first message of a kind is kept."""
-        first, count = self.notes.get(kind, (message, 0))
-        self.notes[kind] = (first, count + 1)
-
-    def all_warnings(self) -> tuple[str, ...]:
-        counted = [m + (f" ({n} times)" if n > 1 else "") for m, n in self.notes.values()]
-        return (*self.warnings, *counted)
+    def __init__(self, blocks: list[str], here: tuple[float, float]) -> None:
+        super().__init__(blocks, here=here)
+        self.fast: dict[int, list[tuple[int, int]]] = {}
 
 
 class PicMmhPost(PostProcessor):
@@ -380,29 +369,32 @@ class PicMmhPost(PostProcessor):
                 message names the contour and block.
         """
         self.check_format(fmt)
-        w = _Writer(["G54;", "G90;"])
+        w = _Writer(["G54;", "G90;"], program.origin)
         w.warnings.extend(check_placement(program, machine))
         homed = False
-        for start, move, commands in _steps(program):
+        for move, commands in _steps(program):
             for command in commands:
                 homed = self._command(command, move.contour if move else 0, w) or homed
             if move is None:
                 continue
+            start = w.here
             self._check_move(start, move, machine, w, homed)
             check_work_area(start, move, machine, w.where(move.contour), program)
             homed = homed and not isinstance(move, Rapid)
             self._move(start, move, machine, w, _tolerance(program, machine))
-        w.lines.append("M30;")
+            w.here = (move.x, move.y)
+        w.blocks.append("M30;")
         self._rate_warnings(machine, w)
         self._length_warning(w)
-        if w.chorded[0]:
+        if w.arcs:
             tol = _tolerance(program, machine)
             w.warnings.append(
-                f"{w.chorded[0]} arc(s) with a centre beyond the I/J field (±99.99999 mm, "
-                f"5 integer digits of µm) written as {w.chorded[1]} G01 chords within "
+                f"{w.arcs} arc(s) with a centre beyond the I/J field (±99.99999 mm, "
+                f"5 integer digits of µm) written as {w.chords} G01 chords within "
                 f"{tol:g} mm"
             )
-        return PostResult("\n".join(w.lines) + "\n", len(w.lines), w.all_warnings())
+        code = "\n".join(w.blocks) + "\n"
+        return PostResult(code, len(w.blocks), (*w.warnings, *w.noted()))
 
     def _check_move(
         self, start: tuple[float, float], move: Move, machine: Machine, w: _Writer, homed: bool
@@ -429,14 +421,14 @@ class PicMmhPost(PostProcessor):
         tolerance: float,
     ) -> None:
         if isinstance(move, Rapid):
-            w.lines.append(f"G00{self._xy(move.x, move.y, move, w)};")
+            w.blocks.append(f"G00{self._xy(move.x, move.y, move, w)};")
             return
         code, feed = self._feed(move, w)
         if machine.max_step_rate_hz and machine.step_rate_hz(feed) > machine.max_step_rate_hz:
-            w.fast.setdefault(code, []).append((len(w.lines) + 1, move.contour))
+            w.fast.setdefault(code, []).append((len(w.blocks) + 1, move.contour))
         f = WORDS["F"].format(code)
         if isinstance(move, Linear):
-            w.lines.append(f"G01{self._xy(move.x, move.y, move, w)}{f};")
+            w.blocks.append(f"G01{self._xy(move.x, move.y, move, w)}{f};")
             return
         here = start
         for half in _halves(start, move):
@@ -446,14 +438,13 @@ class PicMmhPost(PostProcessor):
                     tolerance
                 )
                 for x, y in points[1:-1]:
-                    w.lines.append(f"G01{self._xy(x, y, half, w)}{f};")
-                w.lines.append(f"G01{xy}{f};")
-                w.chorded[0] += 1
-                w.chorded[1] += len(points) - 1
+                    w.blocks.append(f"G01{self._xy(x, y, half, w)}{f};")
+                w.blocks.append(f"G01{xy}{f};")
+                w.chorded(len(points) - 1)
             else:
                 g = "G02" if half.clockwise else "G03"
                 ij = self._word("I", half.cx, half, w) + self._word("J", half.cy, half, w)
-                w.lines.append(f"{g}{xy}{ij}{f};")
+                w.blocks.append(f"{g}{xy}{ij}{f};")
             here = (half.x, half.y)
 
     def _fits(self, value_mm: float) -> bool:
@@ -487,8 +478,7 @@ class PicMmhPost(PostProcessor):
         code, feed = found
         if abs(feed - move.feed_mm_min) > 1e-9 * max(1.0, feed):
             msg = f"feed {move.feed_mm_min:g} mm/min rounded to F{code:02d} ({feed:g} mm/min)"
-            if msg not in w.warnings:
-                w.warnings.append(msg)
+            w.warn(msg)
         return code, feed
 
     def _rate_warnings(self, machine: Machine, w: _Writer) -> None:
@@ -512,7 +502,7 @@ class PicMmhPost(PostProcessor):
         limit = self.max_line_chars
         if limit is None:
             return
-        long = [(n, len(line)) for n, line in enumerate(w.lines, start=1) if len(line) > limit]
+        long = [(n, len(line)) for n, line in enumerate(w.blocks, start=1) if len(line) > limit]
         if long:
             w.warnings.append(
                 f"{len(long)} block(s) longer than {limit} characters (the firmware's receive "
@@ -527,19 +517,19 @@ class PicMmhPost(PostProcessor):
         """Write ``command``; True when it homes X and Y (the position becomes unknown)."""
         where = w.where(contour)
         if isinstance(command, Spindle):
-            w.lines.extend(block for block in [_spindle(command, where, w)] if block)
+            w.blocks.extend(block for block in [_spindle(command, where, w)] if block)
         elif isinstance(command, Dwell):
-            w.lines.extend(_dwell(command, where, w))
+            w.blocks.extend(_dwell(command, where, w))
         elif isinstance(command, ToolChange):
             if not 0 <= command.tool <= MAX_TOOL:
                 raise DialectError(
                     f"{where}: tool {command.tool} does not fit M06T## (0–{MAX_TOOL}, "
                     "seed-000 Tabla 22, L3455–L3464)"
                 )
-            w.lines.append(f"M06{WORDS['T'].format(command.tool)};")
+            w.blocks.append(f"M06{WORDS['T'].format(command.tool)};")
         else:
             blocks = _home(command, where)
-            w.lines.extend(blocks)
+            w.blocks.extend(blocks)
             return "G28X0Y0;" in blocks
         return False
 
@@ -611,19 +601,15 @@ def _tolerance(program: Program, machine: Machine) -> float:
     return machine.motion.chord_tolerance_mm
 
 
-def _steps(
-    program: Program,
-) -> Iterator[tuple[tuple[float, float], Move | None, tuple[Command, ...]]]:
-    """``(start, move, commands before it)``; last ``(end, None, trailing commands)``."""
+def _steps(program: Program) -> Iterator[tuple[Move | None, tuple[Command, ...]]]:
+    """``(move, commands before it)``; last ``(None, trailing commands)``."""
     pending = list(program.commands)
-    here = program.origin
     for index, move in enumerate(program.moves):
         before = []
         while pending and pending[0][0] == index:
             before.append(pending.pop(0)[1])
-        yield here, move, tuple(before)
-        here = (move.x, move.y)
-    yield here, None, tuple(c for _, c in pending)
+        yield move, tuple(before)
+    yield None, tuple(c for _, c in pending)
 
 
 def _halves(start: tuple[float, float], move: ArcMove) -> list[ArcMove]:

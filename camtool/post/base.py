@@ -1,16 +1,24 @@
-"""PostProcessor (a dialect: ``emit`` and ``parse``) and Target (dialect + machine)."""
+"""The dialect framework: PostProcessor (``emit`` and ``parse``), WriterState, Target.
+
+- :class:`PostProcessor` — a dialect: writes a program, reads its own code back;
+- :class:`WriterState` — what every dialect writer keeps while it writes one
+  program (the blocks, where it is, the warnings and the counted notes);
+- :class:`ContourCounter` — the contour-numbering rule of every reader;
+- :class:`Target` — one machine: a dialect bound to a machine profile.
+"""
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Callable, Mapping
+from collections import Counter
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Generic, TypeVar, get_args
 
 from camtool.model.errors import DialectError, InputError, UsageError
 from camtool.model.machine import Machine
-from camtool.model.program import Move, Program, segment_of
+from camtool.model.program import Command, Move, Program, segment_of
 from camtool.model.shapes import Point, bbox_union
 from camtool.model.units import fmt_num
 from camtool.toolpath.placement import (
@@ -94,6 +102,99 @@ class ContourCounter:
         else:
             self.cut = True
         return self.contour
+
+
+B = TypeVar("B")
+"""What a writer emits one of: a text line, a binary record, a job."""
+
+COMMAND_KINDS = frozenset(kind.__name__ for kind in get_args(Command))
+"""The kinds of :data:`~camtool.model.program.Command` by class name (``"Spindle"``, ...)."""
+
+
+class WriterState(Generic[B]):
+    """What a dialect writer keeps while it writes one program (one ``emit`` call).
+
+    Every writer (word-address, pic-mmh, i8751, matlab-router) subclasses it
+    with its own dialect state (modal words, step positions, feed codes...);
+    this holds what they share. Messages name the place with :meth:`where`;
+    conversions are counted while writing and worded once at the end (one
+    warning per kind, "12 arc(s) written as 80 chords").
+
+    Args:
+        blocks: blocks already written (e.g. a fixed preamble).
+        here: where the program starts, mm (``Program.origin``).
+
+    Attributes:
+        blocks: what has been emitted, in order: text lines, binary records or
+            jobs, the dialect's unit of :attr:`PostResult.blocks`; the next
+            one is block ``len(blocks) + 1``.
+        warnings: messages already worded, in order.
+        counts: conversions and drops counted by kind (the writer's own kinds;
+            commands not written under their class name, :meth:`drop`).
+        notes: the first message of each kind counted by :meth:`note`, in the
+            order the kinds first occurred.
+        here: where the program has reached, mm (the end of the last move
+            written).
+        contour: the contour of the move being written (0: the moves have none).
+        arcs: arcs written as chords.
+        chords: chords written for them.
+        chord_error_mm: largest chord error (sagitta) of those chords, mm.
+        feeds: programmed feeds the dialect cannot write, mm/min.
+    """
+
+    def __init__(self, blocks: Iterable[B] = (), *, here: Point = (0.0, 0.0)) -> None:
+        self.blocks: list[B] = list(blocks)
+        self.warnings: list[str] = []
+        self.counts: Counter[str] = Counter()
+        self.notes: dict[str, str] = {}
+        self.here: Point = here
+        self.contour = 0
+        self.arcs = 0
+        self.chords = 0
+        self.chord_error_mm = 0.0
+        self.feeds: set[float] = set()
+
+    def where(self, contour: int | None = None, block: int | None = None) -> str:
+        """The place for a message: ``"contour C, block B"``, or ``"block B"`` without a contour.
+
+        Args:
+            contour: the contour (``None``: :attr:`contour`; 0: none).
+            block: the 1-based block (``None``: the one about to be written).
+        """
+        contour = self.contour if contour is None else contour
+        block = len(self.blocks) + 1 if block is None else block
+        return f"contour {contour}, block {block}" if contour else f"block {block}"
+
+    def warn(self, message: str) -> None:
+        """Add ``message`` to :attr:`warnings` unless it is there already."""
+        if message not in self.warnings:
+            self.warnings.append(message)
+
+    def note(self, kind: str, message: str) -> None:
+        """Count one conversion of ``kind``; the first message of a kind is kept."""
+        self.notes.setdefault(kind, message)
+        self.counts[kind] += 1
+
+    def noted(self) -> list[str]:
+        """The :meth:`note` messages, one per kind, with ``" (N times)"`` when N > 1."""
+        return [
+            message + (f" ({self.counts[kind]} times)" if self.counts[kind] > 1 else "")
+            for kind, message in self.notes.items()
+        ]
+
+    def drop(self, command: Command) -> None:
+        """Count ``command`` as not written (under its class name, e.g. ``"Dwell"``)."""
+        self.counts[type(command).__name__] += 1
+
+    def dropped(self) -> list[tuple[str, int]]:
+        """The commands not written: ``(class name, count)`` sorted by name."""
+        return sorted((kind, n) for kind, n in self.counts.items() if kind in COMMAND_KINDS)
+
+    def chorded(self, chords: int, error_mm: float = 0.0) -> None:
+        """Count one arc written as ``chords`` chords whose largest error is ``error_mm``."""
+        self.arcs += 1
+        self.chords += chords
+        self.chord_error_mm = max(self.chord_error_mm, error_mm)
 
 
 @dataclass(frozen=True)

@@ -3,7 +3,7 @@
 A target file with ``dialect = "word-address"`` describes its G-code in its
 ``[dialect_options]`` table (every key: docs/dialects.md); no Python is needed.
 The built-in ``flashcut``, ``valcnc``, ``grbl`` and ``linuxcnc`` targets are
-such files (camtool/targets/*.toml), for example ValCNC (seed-004 §3.4)::
+such files (postprocessors/*.toml), for example ValCNC (seed-004 §3.4)::
 
     [dialect_options]
     separator = ""                       # the firmware strips spaces (S004-R02)
@@ -17,29 +17,72 @@ such files (camtool/targets/*.toml), for example ValCNC (seed-004 §3.4)::
     min_decimals = 0
     grid_mm = 0.04                       # the 25 steps/mm grid (S004-R10)
 
-- :mod:`camtool.post.wordaddress_spec` — :class:`WordAddressSpec` and its strict
-  loader (errors name the file and the key path);
-- :mod:`camtool.post.wordaddress_write` — the writer;
-- :mod:`camtool.post.wordaddress_read` — the reader, derived from the same spec.
+This module is the dialect (:class:`WordAddressPost`, built by
+:func:`word_address_dialect`) and its writer (:class:`BlockWriter`); the
+grammar both directions share is :mod:`camtool.post.wordaddress_spec`
+(:class:`WordAddressSpec` and its strict loader: errors name the file and the
+key path), and the reader, derived from the same spec, is
+:mod:`camtool.post.wordaddress_read`.
+
+Writing rules (docs/dialects.md explains them for users):
+
+- coordinates are absolute; I/J are written from the start point *as written*
+  (the rounded position the controller holds), so the centre the controller
+  computes is the exact centre to within one written step;
+- arcs sweeping more than ``max_arc_deg`` are split into equal arcs, full
+  circles too when ``full_circle = "split"``; with ``arc_check`` each arc goes
+  through :func:`camtool.post.arccheck.conform_arc` so that the rounded numbers
+  pass the controller's own check;
+- an arc too small for the written resolution (its written end is its written
+  start, or its centre rounds onto its start) becomes a straight line, with a
+  warning;
+- a move that changes Z and not XY (where the tool is, or the program's origin for
+  the first move) is a Z-only block (``G0 Z5``): no X or Y word, so the first
+  block of a program never moves XY from wherever the machine stands, and a
+  re-posted program gets no X/Y it did not have;
+- with ``z_moves = "own-block"`` a move that changes XY and Z is written as two
+  blocks (Z first when rising, last when plunging), with a warning;
+- what the dialect lacks (F, S, spindle, dwell, tool change, return home) is
+  dropped with one warning per kind saying how many; a Z move without a Z word,
+  a helix without ``helix``, a point outside the work area, a number over its
+  field or a block over ``max_block_bytes`` is a DialectError naming the
+  contour and block.
 
 Numbers are formatted by :mod:`camtool.post.numfmt` only.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from collections.abc import Mapping
 from types import MappingProxyType
 from typing import Any
 
-from camtool.model.errors import ParseError
+from camtool.model.errors import DialectError, ParseError
 from camtool.model.machine import Machine
-from camtool.model.program import ArcMove, Program
-from camtool.post.base import PostProcessor, PostResult
+from camtool.model.program import (
+    ArcMove,
+    Command,
+    Dwell,
+    Home,
+    Linear,
+    Move,
+    Program,
+    Rapid,
+    Spindle,
+    ToolChange,
+)
+from camtool.model.shapes import Arc, Point
+from camtool.post.base import (
+    PostProcessor,
+    PostResult,
+    WriterState,
+    check_placement,
+    check_work_area,
+)
 from camtool.post.wordaddress_read import BlockReader, ControllerRefusal
-from camtool.post.wordaddress_spec import WordAddressSpec, WordSpec, load_spec
-from camtool.post.wordaddress_write import BlockWriter
-
-__all__ = ["WordAddressPost", "WordAddressSpec", "WordSpec", "load_spec", "word_address_dialect"]
+from camtool.post.wordaddress_spec import WordAddressSpec, load_spec
 
 
 class WordAddressPost(PostProcessor):
@@ -67,7 +110,7 @@ class WordAddressPost(PostProcessor):
         return self.spec.helix
 
     def emit(self, program: Program, machine: Machine, *, fmt: str | None = None) -> PostResult:
-        """Write ``program`` for ``machine`` (rules: :mod:`camtool.post.wordaddress_write`).
+        """Write ``program`` for ``machine`` (rules: the module docstring).
 
         Raises:
             DialectError: a Z move without a Z word, a helix the dialect cannot
@@ -79,7 +122,7 @@ class WordAddressPost(PostProcessor):
         self.check_format(fmt)
         writer = BlockWriter(self.spec, machine)
         code = writer.write(program)
-        return PostResult(code, len(writer.lines), tuple(writer.warnings), "code")
+        return PostResult(code, len(writer.blocks), tuple(writer.warnings), "code")
 
     def parse(self, code: str | bytes, *, source: str = "<code>") -> Program:
         """Read code of this dialect (rules: :mod:`camtool.post.wordaddress_read`).
@@ -145,3 +188,385 @@ def word_address_dialect(options: Mapping[str, Any], where: str) -> WordAddressP
         InputError: an unknown key or a bad value, naming ``where`` and the key.
     """
     return WordAddressPost(load_spec(options, where))
+
+
+# -- the writer ------------------------------------------------------------------
+
+_SAME_MM = 1e-9
+"""Exact XY closer than this is the same point (a Z-only move)."""
+
+
+class BlockWriter(WriterState[str]):
+    """Writes one program; holds the controller's state as the written code sets it.
+
+    The lines written are :attr:`blocks` (header and comment lines included:
+    block numbers in messages are line numbers); what the dialect lacks is
+    counted in :attr:`counts` by kind (``"feed"``, ``"spindle"``, ``"z-split"``,
+    ``"tiny-arc"``...) and worded once at the end.
+
+    Args:
+        spec: the dialect.
+        machine: the machine the program is for (work area, Z axis).
+
+    Attributes:
+        z: the Z the controller is at, mm (``None``: not set yet).
+        written: the XY the controller holds, as written (rounded), mm.
+        last: the last text of each word letter (modal words).
+        grid_error_mm: largest change of a coordinate rounded to a step grid, mm.
+    """
+
+    def __init__(self, spec: WordAddressSpec, machine: Machine) -> None:
+        super().__init__()
+        self.spec, self.machine = spec, machine
+        self.z: float | None = None
+        self.written: Point = (0.0, 0.0)
+        self.last: dict[str, str] = {}
+        self.grid_error_mm = 0.0
+        self.program = Program(())
+
+    # -- the program -------------------------------------------------------------
+
+    def write(self, program: Program) -> str:
+        """The whole program as text.
+
+        In order: the ``header`` lines, the program's notes as comments (when the
+        dialect has comments), the preamble, the moves and commands, the
+        postamble, the end code and the ``footer`` lines.
+
+        Raises:
+            DialectError: see the module docstring; the message names the block.
+        """
+        self.here = program.origin
+        self.program = program
+        self.warnings.extend(check_placement(program, self.machine))
+        self.written = (self._round("X", program.origin[0]), self._round("Y", program.origin[1]))
+        self.blocks.extend(self.spec.header)
+        for note in program.notes:
+            comment = self.spec.comment_line(note)
+            if comment is not None:
+                self.blocks.append(comment)
+        for codes in self.spec.preamble:
+            self.block(list(codes))
+        for item in program.items():
+            if isinstance(item, Rapid | Linear | ArcMove):
+                self.move(item)
+            else:
+                self.command(item)
+        for codes in self.spec.postamble:
+            self.block(list(codes))
+        if self.spec.end:
+            self.block([self.spec.end[0]])
+        self.blocks.extend(self.spec.footer)
+        self.warnings.extend(self._summary())
+        end = self.spec.line_end
+        return end.join(self.blocks) + end if self.blocks else ""
+
+    def block(self, words: list[str]) -> None:
+        """Append one block made of ``words``.
+
+        Raises:
+            DialectError: the block is longer than ``max_block_bytes``.
+        """
+        text = self.spec.separator.join(words) + self.spec.block_end
+        size = len((text + self.spec.line_end).encode("ascii"))
+        limit = self.spec.max_block_bytes
+        if limit is not None and size > limit:
+            raise DialectError(
+                f"{self.where()}: {text!r} is {size} bytes with its line end; "
+                f"{self.spec.name} takes at most {limit} (max_block_bytes)"
+            )
+        self.blocks.append(text)
+
+    # -- numbers -----------------------------------------------------------------
+
+    def text(self, letter: str, value: float) -> str:
+        """``value`` written in word ``letter``'s format (without the letter).
+
+        Raises:
+            DialectError: the number does not fit the word's integer digits.
+        """
+        number = self.spec.words[letter].number
+        try:
+            text = number.format(value)
+        except DialectError as exc:
+            raise DialectError(
+                f"{self.where()}: {letter} = {exc} (value {value:g}); "
+                f"{self.spec.name} writes at most {number.int_digits} integer digits"
+            ) from exc
+        if number.grid_mm is not None:
+            self.grid_error_mm = max(self.grid_error_mm, abs(number.parse(text) - value))
+        return text
+
+    def _round(self, letter: str, value: float) -> float:
+        """``value`` as the controller reads it back after writing."""
+        number = self.spec.words[letter].number
+        return number.parse(number.format(value))
+
+    def _word(self, letter: str, text: str, words: list[str], *, force: bool = False) -> None:
+        """Add ``letter`` + ``text`` unless modal and unchanged; remember it."""
+        if force or letter not in self.spec.modal or self.last.get(letter) != text:
+            words.append(letter + text)
+        self.last[letter] = text
+
+    def _code(self, code: str, words: list[str]) -> None:
+        if "G" not in self.spec.modal or self.last.get("G") != code:
+            words.append(code)
+        self.last["G"] = code
+
+    # -- moves -------------------------------------------------------------------
+
+    def move(self, move: Move) -> None:
+        """Write one move (one or more blocks).
+
+        Raises:
+            DialectError: see the module docstring.
+        """
+        if move.contour:
+            self.contour = move.contour
+        start = self.here
+        self._check_area(start, move)
+        if move.z is not None and self._same_z(move.z):
+            move = dataclasses.replace(move, z=None)  # Z does not change as written
+        if move.z is not None:
+            self._check_z(move)
+        if isinstance(move, ArcMove):
+            self._arc(start, move)
+        else:
+            self._straight(start, move)
+        self.here = (move.x, move.y)
+        if move.z is not None:
+            self.z = move.z
+
+    def _same_z(self, z: float) -> bool:
+        """True when ``z`` prints as the Z the controller is at."""
+        if self.z is None or not self.spec.has("Z"):
+            return False
+        return self.text("Z", z) == self.text("Z", self.z)
+
+    def _check_area(self, start: Point, move: Move) -> None:
+        check_work_area(start, move, self.machine, self.where(), self.program)
+
+    def _check_z(self, move: Move) -> None:
+        if not self.spec.has("Z") or not self.machine.has_z:
+            raise DialectError(
+                f"{self.where()}: {self.spec.name} has no Z axis (z = {move.z:g} mm); "
+                "set the depth by hand or use a target with a Z axis"
+            )
+        if isinstance(move, ArcMove) and not self.spec.helix:
+            raise DialectError(
+                f"{self.where()}: an arc that moves Z (a helix) cannot be written in "
+                f"{self.spec.name}; cut the arc at one depth and move Z in its own move"
+            )
+
+    def _straight(self, start: Point, move: Rapid | Linear) -> None:
+        if move.z is not None and math.dist(start, (move.x, move.y)) <= _SAME_MM:
+            self._line(move, None, move.z)  # a Z-only move: no X or Y word (module docstring)
+            return
+        if move.z is None or self.spec.z_moves == "with-xy":
+            self._line(move, (move.x, move.y), move.z)
+            return
+        self.counts["z-split"] += 1
+        if self.z is not None and move.z < self.z:
+            self._line(move, (move.x, move.y), None)
+            self._line(move, None, move.z)
+        else:
+            self._line(move, None, move.z)
+            self._line(move, (move.x, move.y), None)
+
+    def _line(self, move: Rapid | Linear, xy: Point | None, z: float | None) -> None:
+        """A G0/G1 block to ``xy`` (``None``: a Z-only block) and/or ``z``."""
+        rapid, linear, _, _ = self.spec.motion_codes
+        words: list[str] = []
+        self._code(rapid if isinstance(move, Rapid) else linear, words)
+        if xy is not None:
+            tx, ty = self.text("X", xy[0]), self.text("Y", xy[1])
+            unchanged = self.last.get("X") == tx and self.last.get("Y") == ty
+            force = unchanged and z is None
+            self._word("X", tx, words, force=force)
+            self._word("Y", ty, words, force=force)
+            self.written = self._parsed(tx, ty)
+        if z is not None:
+            self._word("Z", self.text("Z", z), words, force=xy is None)
+        if isinstance(move, Linear):
+            self._feed(move, words)
+        self.block(words)
+
+    def _feed(self, move: Linear | ArcMove, words: list[str]) -> None:
+        spec = self.spec.word("F")
+        if spec is None:
+            self.counts["feed"] += 1
+            return
+        text = self.text("F", move.feed_mm_min)
+        written = spec.number.parse(text)
+        if written <= 0:
+            raise DialectError(
+                f"{self.where()}: feed {move.feed_mm_min:g} mm/min rounds to F{text}; "
+                f"the smallest feed {self.spec.name} writes is {spec.number.resolution_mm():g}"
+            )
+        if abs(written - move.feed_mm_min) > 1e-9 * max(1.0, move.feed_mm_min):
+            msg = f"feed {move.feed_mm_min:g} mm/min written as F{text} ({written:g} mm/min)"
+            self.warn(msg)
+        self._word("F", text, words)
+
+    # -- arcs --------------------------------------------------------------------
+
+    def _arc(self, start: Point, move: ArcMove) -> None:
+        arc = Arc(start, (move.x, move.y), (move.cx, move.cy), move.clockwise)
+        end_prints = self._parsed(self.text("X", move.x), self.text("Y", move.y))
+        if end_prints == self.written and abs(arc.sweep) > math.pi:
+            # within the resolution of a full circle: the controller reads one
+            arc = Arc(start, start, arc.centre, arc.clockwise)
+        blocks: list[tuple[Point, Point | None, bool]] = []
+        for piece in arc.split(self._parts(arc)):
+            conformed = self._conformed(piece)
+            full = piece.is_full_circle and len(conformed) == 1
+            blocks += [(end, centre, full) for end, centre in conformed]
+        for k, (end, centre, full) in enumerate(blocks, start=1):
+            z = move.z  # a helix climbs evenly over the blocks it is written in
+            if move.z is not None and self.z is not None:
+                z = self.z + (move.z - self.z) * k / len(blocks)
+            self._arc_block(move, (end, centre), z, full=full)
+
+    def _parts(self, arc: Arc) -> int:
+        """How many equal arcs ``arc`` is written as (``max_arc_deg``, ``full_circle``)."""
+        limit = self.spec.max_arc_deg
+        sweep = math.degrees(abs(arc.sweep))
+        parts = max(1, math.ceil(sweep / limit - 1e-9))
+        if arc.is_full_circle and self.spec.full_circle == "split":
+            parts = max(2, parts)
+        elif arc.is_full_circle:
+            parts = 1
+        return parts
+
+    def _conformed(self, piece: Arc) -> list[tuple[Point, Point | None]]:
+        """End and absolute centre of each block of ``piece`` (after the arc check).
+
+        A centre of ``None`` asks for a straight line: the arc is a few quanta
+        across and no printable centre passes the controller's check.
+        """
+        if self.spec.arc_check == "none":
+            return [(piece.end, piece.centre)]
+        from camtool.post.arccheck import conform_arc
+
+        quantum = self.spec.quantum_mm()
+        try:
+            out = conform_arc(
+                self.written,
+                piece.end,
+                piece.centre,
+                piece.clockwise,
+                rule=self.spec.arc_check,
+                quantum_mm=quantum,
+                exact_start=piece.start,
+            )
+        except DialectError as exc:
+            if piece.radius > 10 * quantum:
+                raise DialectError(f"{self.where()}: {exc}") from exc
+            return [(piece.end, None)]
+        if not out:
+            self.counts["tiny-arc"] += 1  # rounds away to nothing within a quantum
+        return [(p.end, p.centre) for p in out]
+
+    def _arc_block(
+        self, move: ArcMove, end_centre: tuple[Point, Point | None], z: float | None, *, full: bool
+    ) -> None:
+        """One G2/G3 block, or a G1 block when the arc vanishes at this resolution.
+
+        ``full`` says the arc is meant as a full circle (its written end is its
+        written start); any other arc whose written end is its written start, or
+        whose written centre is its start (or no centre, see :meth:`_conformed`),
+        is too small to write.
+        """
+        end, centre = end_centre
+        _, _, cw, ccw = self.spec.motion_codes
+        tx, ty = self.text("X", end[0]), self.text("Y", end[1])
+        written = self._parsed(tx, ty)
+        ox, oy = (0.0, 0.0) if self.spec.arc_centre == "absolute" else self.written
+        ti = tj = ""
+        tiny = centre is None or (written == self.written and not full)
+        if centre is not None:
+            ti, tj = self.text("I", centre[0] - ox), self.text("J", centre[1] - oy)
+            i, j = self.spec.words["I"].number.parse(ti), self.spec.words["J"].number.parse(tj)
+            tiny = tiny or (i + ox, j + oy) == self.written
+        if tiny:
+            self.counts["tiny-arc"] += 1
+            linear = Linear(end[0], end[1], move.feed_mm_min, contour=move.contour)
+            self._line(linear, end, z)
+            return
+        words: list[str] = []
+        self._code(cw if move.clockwise else ccw, words)
+        self._word("X", tx, words, force=True)
+        self._word("Y", ty, words, force=True)
+        if z is not None:
+            self._word("Z", self.text("Z", z), words)
+        words += ["I" + ti, "J" + tj]
+        self.written = written
+        self._feed(move, words)
+        self.block(words)
+
+    def _parsed(self, tx: str, ty: str) -> Point:
+        """The XY the controller reads from the texts of X and Y."""
+        return self.spec.words["X"].number.parse(tx), self.spec.words["Y"].number.parse(ty)
+
+    # -- commands ----------------------------------------------------------------
+
+    def command(self, command: Command) -> None:
+        """Write a spindle, dwell or tool-change command, or count it as dropped."""
+        spec = self.spec
+        if isinstance(command, Spindle):
+            code = {"cw": spec.spindle_cw, "ccw": spec.spindle_ccw, "off": spec.spindle_off}[
+                command.direction
+            ]
+            if code is None:
+                self.counts["spindle"] += 1
+                return
+            words = [code]
+            if command.direction != "off" and spec.has("S") and command.rpm > 0:
+                words.append("S" + self.text("S", command.rpm))  # rpm 0: speed not given
+            elif command.direction != "off" and command.rpm > 0:
+                self.counts["speed"] += 1
+            self.block(words)
+        elif isinstance(command, Dwell):
+            if spec.dwell is None:
+                self.counts["dwell"] += 1
+                return
+            self.block([spec.dwell, "P" + self.text("P", command.seconds)])
+        elif isinstance(command, ToolChange):
+            if spec.tool_change is None:
+                self.counts["tool"] += 1
+                return
+            self.block([spec.tool_change, "T" + self.text("T", float(command.tool))])
+        elif isinstance(command, Home):
+            self.counts["home"] += 1
+
+    def _summary(self) -> list[str]:
+        """One warning per kind of thing dropped or converted."""
+        name, d = self.spec.name, self.counts
+        texts = {
+            "feed": f"{name} has no F word: the feed of {d['feed']} cutting block(s) is not "
+            "written; the machine moves at its own speed",
+            "spindle": f"{name} has no spindle command: {d['spindle']} spindle command(s) "
+            "dropped; switch the spindle (or tool) on and off by hand",
+            "speed": f"{name}'s {self.spec.spindle_cw or self.spec.spindle_ccw} takes no S "
+            f"word: {d['speed']} spindle speed(s) not written; set the speed on the machine",
+            "dwell": f"{name} has no dwell: {d['dwell']} pause(s) dropped",
+            "tool": f"{name} has no tool change: {d['tool']} tool change(s) dropped; change "
+            "tools by hand",
+            "home": f"{name} has no return to machine zero: {d['home']} G28-style return(s) "
+            "dropped",
+            "z-split": f"{d['z-split']} move(s) changing XY and Z together written as a Z block "
+            f"and an XY block (Z first when rising, last when plunging): {name} puts Z moves in "
+            "blocks of their own",
+            "tiny-arc": f"{d['tiny-arc']} arc(s) too small for the "
+            f"{self.spec.quantum_mm():g} mm the dialect writes were written as straight lines "
+            "(or left out when both ends print the same)",
+        }
+        out = [texts[kind] for kind in texts if d[kind]]
+        if self.grid_error_mm > 0:
+            grids = {w.number.grid_mm for w in self.spec.words.values() if w.number.grid_mm}
+            grid = ", ".join(f"{g:g}" for g in sorted(grids))
+            out.append(
+                f"coordinates rounded to the {grid} mm step grid of {name}: largest change "
+                f"{self.grid_error_mm:.4f} mm"
+            )
+        return out
