@@ -89,7 +89,7 @@ from camtool.post.base import (
 )
 from camtool.post.numfmt import NumberFormat
 
-# -- i8751_read ------------------------------------------------------------
+# -- the reader -------------------------------------------------------------------------
 # Reading the i8751 stream back: records → a Program (see :mod:`camtool_postprocessors.i8751`).
 #
 # The reader sums the steps from X = Y = Z = 0 and divides by the machine's
@@ -176,7 +176,7 @@ def program_from_records(
     return Program(tuple(moves), warnings=warnings, lines=tuple(lines), commands=tuple(commands))
 
 
-# -- i8751 ------------------------------------------------------------
+# -- the writer -------------------------------------------------------------------------
 
 _DROPPED = {
     Spindle: "spindle command(s): the interface drives only the three axis motors",

@@ -76,7 +76,7 @@ from camtool.post.base import (
 )
 from camtool.post.numfmt import NumberFormat
 
-# -- matlab_router_read ------------------------------------------------------------
+# -- the reader -------------------------------------------------------------------------
 # Reader of the ``matlab-router`` dialect: the GUI's ``.m`` script and its USB wire stream.
 #
 # Both formats are written by :class:`camtool_postprocessors.matlab_router.MatlabRouterPost`
@@ -456,7 +456,7 @@ def _skip_blank(code: str, pos: int) -> int:
     return pos
 
 
-# -- matlab_router_warnings ------------------------------------------------------------
+# -- warnings: one per kind of conversion ----------------------------------------------
 # The warnings of the ``matlab-router`` writer: one per kind of conversion.
 #
 # Gathered in a :class:`RouterWriter` (below) while :class:`MatlabRouterPost`
@@ -544,7 +544,7 @@ def jobs_warnings(jobs: list[RouterJob], max_segments: int) -> list[str]:
     return w
 
 
-# -- matlab_router ------------------------------------------------------------
+# -- the writer -------------------------------------------------------------------------
 
 FIRMWARE_MAX_SEGMENTS = 128
 """Segments (lines) one job holds: the master's ``X_ROUTE[128]`` … arrays (L4625–L4635)."""

@@ -67,7 +67,7 @@ from camtool.post.base import (
 )
 from camtool.post.numfmt import NumberFormat, format_int
 
-# -- pic_mmh_feeds ------------------------------------------------------------
+# -- the feed table ---------------------------------------------------------------------
 # The F word of the pic-mmh dialect: two-digit feed codes and the feed each one means.
 #
 # Source: seed-000 §4.1 and §4.9, S000-05. The firmware reads F with its
@@ -205,7 +205,7 @@ def _positive(name: str, value: Any) -> float:
     return number
 
 
-# -- pic_mmh ------------------------------------------------------------
+# -- the dialect ------------------------------------------------------------------------
 
 
 @dataclass(frozen=True)
