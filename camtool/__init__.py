@@ -19,7 +19,7 @@ from __future__ import annotations
 from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
-__version__ = "0.1.0"
+from camtool.model.version import __version__
 
 _HOMES: dict[str, str] = {
     # the model: shapes and programs in mm, machines, errors

@@ -29,8 +29,8 @@ import dataclasses
 from pathlib import Path
 from typing import Any
 
-from camtool import __version__
 from camtool.jobs.batch import BatchOptions, BatchResult, BatchRow
+from camtool.model.version import __version__
 from camtool.toolpath.options import PLAN_FIELDS
 
 FILE_COLUMN_MAX = 48

@@ -336,7 +336,7 @@ def job_notes(source: str, target: Target, plan: PlanOptions | None = None) -> t
         target: the target the program is for.
         plan: the planning options (``None``: a re-posted program).
     """
-    from camtool import __version__
+    from camtool.model.version import __version__
 
     name = Path(source).name if source and source != "-" else "stdin"
     notes = [f"camtool {__version__}: {name} for {target.name}"]
