@@ -62,6 +62,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from camtool.importers.options import ImportOptions
 from camtool.jobs.inputs import BatchInput, expand_inputs
 from camtool.jobs.pipeline import OutputOptions
 from camtool.model.errors import CamtoolError, UsageError
@@ -71,7 +72,6 @@ from camtool.toolpath.options import PLAN_FIELDS, PlanOptions
 if TYPE_CHECKING:
     from concurrent.futures import Future
 
-    from camtool.importers import ImportOptions
     from camtool.jobs.pipeline import PostJob
     from camtool.verify.verifier import Verification
 
@@ -103,7 +103,7 @@ class BatchOptions:
         units: unit of unitless inputs (point lists).
         hatch_boundaries: use DXF HATCH boundaries as contours.
         max_entities: most entities a drawing may expand to (``None``: the importers'
-            default, :data:`camtool.importers.MAX_ENTITIES`).
+            default, :data:`camtool.importers.options.MAX_ENTITIES`).
         verify: verify each file and write its report (``OUT/<name>.json``).
         preview: ``"png"`` or ``"svg"``: draw each file (``OUT/<name>.png``): the
             program, and when verified the simulated trace and its worst point.
@@ -157,8 +157,6 @@ class BatchOptions:
 
     def import_options(self) -> ImportOptions:
         """The importer options of every drawing."""
-        from camtool.importers import ImportOptions
-
         limit = {} if self.max_entities is None else {"max_entities": self.max_entities}
         return ImportOptions(
             layers=self.layers,

@@ -7,7 +7,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from camtool.importers import POINT_SUFFIXES, ImportOptions, read_drawing
+from camtool.importers import POINT_SUFFIXES, read_drawing
+from camtool.importers.options import ImportOptions
 from camtool.jobs.inputs import is_program_file
 from camtool.model.errors import UsageError
 from camtool.model.program import Move, Program
