@@ -19,7 +19,7 @@ from __future__ import annotations
 from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
-__version__ = "0.1.0"
+from camtool.model.version import __version__
 
 _HOMES: dict[str, str] = {
     # the model: shapes and programs in mm, machines, errors
@@ -41,7 +41,7 @@ _HOMES: dict[str, str] = {
     "VerifyLimitError": "camtool.model.errors",
     # read
     "read_drawing": "camtool.importers",
-    "ImportOptions": "camtool.importers",
+    "ImportOptions": "camtool.importers.options",
     # plan
     "PlanOptions": "camtool.toolpath.options",
     "plan_drawing": "camtool.toolpath.plan",
@@ -128,7 +128,8 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:  # the names as type checkers and editors see them
-    from camtool.importers import ImportOptions, read_drawing
+    from camtool.importers import read_drawing
+    from camtool.importers.options import ImportOptions
     from camtool.jobs.pipeline import (
         OutputOptions,
         PostJob,

@@ -92,8 +92,13 @@ def batch(inputs: tuple[str, ...], layers: str | None, verify_too: bool, **optio
     overwritten without --force. Exit code: 0 all ok, else the smallest per-file
     code (1 error, 2 usage, 3 unreadable input, 4 over --max-error-um).
     """
-    from camtool.jobs.batch import BatchOptions, plan_batch
-    from camtool.jobs.batch_report import batch_report, failure_line, summary_table
+    from camtool.jobs.batch import (
+        BatchOptions,
+        batch_report,
+        failure_line,
+        plan_batch,
+        summary_table,
+    )
 
     names = tuple(n.strip() for n in layers.split(",") if n.strip()) if layers else None
     planning, output = plan_settings(options), output_settings(options)
@@ -112,8 +117,7 @@ def batch(inputs: tuple[str, ...], layers: str | None, verify_too: bool, **optio
 
 def _run(plan: BatchPlan) -> BatchResult:
     """Run the batch with progress on stderr: a bar on a terminal, else a line per file."""
-    from camtool.jobs.batch import run_batch
-    from camtool.jobs.batch_report import progress_line
+    from camtool.jobs.batch import progress_line, run_batch
 
     if not sys.stderr.isatty():
         return run_batch(

@@ -27,7 +27,7 @@ from camtool.toolpath.options import (
 )
 
 if TYPE_CHECKING:
-    from camtool.importers import ImportOptions
+    from camtool.importers.options import ImportOptions
     from camtool.jobs.pipeline import OutputOptions
 
 
@@ -160,7 +160,7 @@ def import_options(command: Callable[..., None]) -> Callable[..., None]:
 
 def import_settings(options: dict[str, Any]) -> ImportOptions:
     """Pop the importer options out of a command's keyword options."""
-    from camtool.importers import ImportOptions
+    from camtool.importers.options import ImportOptions
 
     layers = options.pop("layers", None)
     names = tuple(n.strip() for n in layers.split(",") if n.strip()) if layers else None

@@ -13,7 +13,6 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
-from camtool import __version__
 from camtool.cli.batch import batch
 from camtool.cli.common import (
     MACHINE,
@@ -29,6 +28,7 @@ from camtool.cli.common import (
 )
 from camtool.cli.preview import preview
 from camtool.model.errors import CamtoolError, UsageError, VerifyLimitError
+from camtool.model.version import __version__
 
 if TYPE_CHECKING:
     from collections.abc import Callable

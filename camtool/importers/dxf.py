@@ -25,9 +25,8 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
-from camtool.importers import MAX_COORDINATE_MM
 from camtool.importers.dxf_entities import (
     ZERO_LENGTH,
     BadEntity,
@@ -35,12 +34,10 @@ from camtool.importers.dxf_entities import (
     layer_of,
     line_inside,
 )
+from camtool.importers.options import MAX_COORDINATE_MM, ImportOptions, too_many_entities
 from camtool.model.errors import InputError, UsageError
 from camtool.model.shapes import Contour, Drawing, Line, Point
 from camtool.model.units import INCH
-
-if TYPE_CHECKING:
-    from camtool.importers import ImportOptions
 
 # Exact mm per unit for the $INSUNITS codes a shop meets (ezdxf's own factors
 # carry rounding noise, e.g. 25.400000000101603 for inches).
@@ -154,8 +151,6 @@ def import_dxf(path: str | Path, options: ImportOptions | None = None) -> DxfImp
         InputError: as :func:`read_dxf`.
         UsageError: ``options.tolerance`` is not > 0.
     """
-    from camtool.importers import ImportOptions
-
     path = Path(path)
     options = options or ImportOptions()
     if not options.tolerance > 0:
@@ -213,7 +208,6 @@ def _check_size(path: Path, msp: Any, max_entities: int) -> Any:
     Raises:
         InputError: more than ``max_entities`` entities once blocks are expanded.
     """
-    from camtool.importers import too_many_entities
     from camtool.importers.dxf_blocks import block_graph, expanded_count
 
     if len(msp) > max_entities:

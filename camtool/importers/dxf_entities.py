@@ -40,6 +40,7 @@ import numpy as np
 
 from camtool.geometry.chain import with_end, with_start
 from camtool.geometry.curves import corner_knots, ellipse, fit_pieces
+from camtool.importers.options import check_curve_size
 from camtool.model.errors import GeometryError
 from camtool.model.shapes import TAU, Arc, Contour, Line, Point, Segment, distance
 
@@ -106,7 +107,7 @@ def check_numbers(entity: Any, label: str, layer: str, limit: float) -> None:
         label: how messages name it, e.g. ``"LINE #2A"``.
         layer: its effective layer, for the message.
         limit: largest magnitude accepted, drawing units (the importer passes
-            :data:`~camtool.importers.MAX_COORDINATE_MM` converted to drawing units).
+            :data:`~camtool.importers.options.MAX_COORDINATE_MM` converted to drawing units).
 
     Raises:
         BadEntity: the message names the entity, its layer, the attribute and the value.
@@ -591,8 +592,6 @@ def spline_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool]
 
 
 def _check_size(extent: float, tolerance: float) -> None:
-    from camtool.importers import check_curve_size
-
     try:
         check_curve_size(extent, tolerance)
     except ValueError as exc:

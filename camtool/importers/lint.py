@@ -39,10 +39,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from camtool.geometry.chain import chain
+from camtool.importers import read_drawing
+from camtool.importers.options import ImportOptions
 from camtool.model.shapes import TAU, Arc, BBox, Contour, Drawing, Line, Point, Segment, distance
 
 if TYPE_CHECKING:
-    from camtool.importers import ImportOptions
     from camtool.importers.dxf import DxfNote
 
 SHOWN_PER_KIND = 10
@@ -193,8 +194,6 @@ def inspect_drawing(
     Raises:
         InputError: the drawing cannot be read (as :func:`camtool.importers.read_drawing`).
     """
-    from camtool.importers import ImportOptions, read_drawing
-
     options = options or ImportOptions()
     path = Path(path)
     notes: list[Finding] = []

@@ -31,7 +31,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from camtool.importers import ImportOptions
+from camtool.importers.options import ImportOptions
 from camtool.model.errors import InputError, UsageError
 from camtool.model.shapes import Contour, Drawing, Line, Point
 from camtool.model.units import LARGEST_VALUE, LENGTH_UNITS

@@ -55,7 +55,7 @@ from camtool.geometry.curves import (
     quadratic_bezier,
     semi_axes_gap,
 )
-from camtool.importers import MAX_COORDINATE_MM, ImportOptions, check_curve_size
+from camtool.importers.options import MAX_COORDINATE_MM, ImportOptions, check_curve_size
 from camtool.importers.svgdoc import (
     LAYER_ATTR,
     SOURCE_ATTR,
@@ -217,7 +217,7 @@ def convert(segments: Iterable[Any], m: Affine, tolerance: float) -> list[Subpat
     Raises:
         GeometryError: a curve could not be fitted (from :func:`fit_curve`).
         InputError: a point, control point or arc centre is NaN, infinite or beyond
-            ±:data:`~camtool.importers.MAX_COORDINATE_MM` once mapped to mm (checked
+            ±:data:`~camtool.importers.options.MAX_COORDINATE_MM` once mapped to mm (checked
             before any fitting, which would spin on a control point at 1e20).
     """
     out: list[Subpath] = []

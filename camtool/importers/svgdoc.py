@@ -38,7 +38,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TypeAlias
 
-from camtool.importers import MAX_ENTITIES, svgcheck
+from camtool.importers import svgcheck
+from camtool.importers.options import MAX_ENTITIES, too_many_entities
 from camtool.model.errors import InputError
 from camtool.model.shapes import Point
 from camtool.model.units import LENGTH_UNITS, PX
@@ -338,8 +339,6 @@ def check_size(root: ET.Element, name: str, max_entities: int) -> None:
             ``max_entities`` elements once ``<use>`` clones are expanded (the message
             names the ``--max-entities`` option).
     """
-    from camtool.importers import too_many_entities
-
     ids = {e.get("id"): e for e in root.iter() if e.get("id")}
     cap = max_entities + 1
     size: dict[ET.Element, int] = {}

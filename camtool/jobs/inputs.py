@@ -43,7 +43,7 @@ from camtool.importers import DRAWING_SUFFIXES, read_drawing, read_drawing_bytes
 from camtool.model.errors import InputError, UsageError
 
 if TYPE_CHECKING:
-    from camtool.importers import ImportOptions
+    from camtool.importers.options import ImportOptions
     from camtool.model.program import Program
     from camtool.model.shapes import Drawing
     from camtool.post.base import Target

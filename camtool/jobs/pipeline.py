@@ -7,7 +7,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from camtool.importers import POINT_SUFFIXES, ImportOptions, read_drawing
+from camtool.importers import POINT_SUFFIXES, read_drawing
+from camtool.importers.options import ImportOptions
 from camtool.jobs.inputs import is_program_file
 from camtool.model.errors import UsageError
 from camtool.model.program import Move, Program
@@ -336,7 +337,7 @@ def job_notes(source: str, target: Target, plan: PlanOptions | None = None) -> t
         target: the target the program is for.
         plan: the planning options (``None``: a re-posted program).
     """
-    from camtool import __version__
+    from camtool.model.version import __version__
 
     name = Path(source).name if source and source != "-" else "stdin"
     notes = [f"camtool {__version__}: {name} for {target.name}"]

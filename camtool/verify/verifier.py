@@ -31,12 +31,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from camtool import __version__
 from camtool.model.errors import InputError, UsageError
 from camtool.model.machine import Machine
 from camtool.model.program import Dwell, Home, Program, Rapid
 from camtool.model.shapes import BBox, Drawing
 from camtool.model.units import fmt_num
+from camtool.model.version import __version__
 from camtool.verify.clock import block_times_s
 from camtool.verify.metrics import (
     Against,

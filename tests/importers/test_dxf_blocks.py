@@ -22,8 +22,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from camtool.geometry.arcfit import distances
-from camtool.importers import ImportOptions
 from camtool.importers.dxf import read_dxf
+from camtool.importers.options import ImportOptions
 from camtool.model.errors import InputError
 from camtool.model.shapes import Arc, Contour, Line, Point, Segment
 from tests.shapes import segment_samples, write_dxf

@@ -24,8 +24,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from camtool.importers import ImportOptions
 from camtool.importers.dxf import read_dxf
+from camtool.importers.options import ImportOptions
 from camtool.model.errors import InputError
 from camtool.model.shapes import Arc, Contour
 from tests.shapes import two_sided_error, write_dxf

@@ -18,8 +18,8 @@ import ezdxf
 import pytest
 
 from camtool.cli.main import main
-from camtool.importers import MAX_ENTITIES, ImportOptions
 from camtool.importers.dxf import import_dxf, read_dxf
+from camtool.importers.options import MAX_ENTITIES, ImportOptions
 from camtool.model.errors import InputError, UsageError
 from tests.shapes import write_dxf
 

@@ -9,8 +9,9 @@ from typing import Any
 import ezdxf
 import pytest
 
-from camtool.importers import ImportOptions, read_drawing
+from camtool.importers import read_drawing
 from camtool.importers.dxf import import_dxf, read_dxf
+from camtool.importers.options import ImportOptions
 from camtool.model.errors import InputError
 from camtool.model.shapes import Arc, Line
 from tests.shapes import write_dxf

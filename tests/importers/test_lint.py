@@ -9,8 +9,8 @@ from typing import Any
 
 import pytest
 
-from camtool.importers import ImportOptions
 from camtool.importers.lint import check_drawing, inspect_drawing
+from camtool.importers.options import ImportOptions
 from camtool.model.shapes import Arc, Contour, Drawing, Line
 from tests.shapes import write_dxf
 

@@ -7,7 +7,8 @@ from pathlib import Path
 import pytest
 
 from camtool.cli.main import main
-from camtool.importers import DRAWING_SUFFIXES, ImportOptions, read_drawing
+from camtool.importers import DRAWING_SUFFIXES, read_drawing
+from camtool.importers.options import ImportOptions
 from camtool.importers.points import read_points
 from camtool.model.errors import InputError, UsageError
 from camtool.model.shapes import Contour, Line

@@ -15,7 +15,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from camtool.importers import ImportOptions
+from camtool.importers.options import ImportOptions
 from camtool.importers.svg import read_svg
 from camtool.model.shapes import Arc, Line
 from tests.importers.svgutil import (

@@ -10,7 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from camtool.importers import ImportOptions, read_drawing, read_drawing_bytes
+from camtool.importers import read_drawing, read_drawing_bytes
+from camtool.importers.options import ImportOptions
 from camtool.importers.svg import read_svg
 from camtool.model.errors import InputError, UsageError
 from camtool.model.shapes import Arc

@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 
 from camtool.cli.main import main
-from camtool.importers import MAX_ENTITIES, ImportOptions
+from camtool.importers.options import MAX_ENTITIES, ImportOptions
 from camtool.importers.svg import read_svg
 from camtool.importers.svgdoc import MAX_DEPTH
 from camtool.model.errors import InputError

@@ -1,4 +1,4 @@
-"""Travel order of large jobs (camtool.toolpath.travel_large) and the order-mode limit.
+"""Travel order of large jobs (camtool.toolpath.travel, windowed search) and the order-mode limit.
 
 The grid nearest neighbour must choose exactly what the full scan chooses (same
 distances, ties to the lower entry); the windowed search must give a valid order
@@ -17,7 +17,6 @@ import pytest
 from camtool.model.errors import UsageError
 from camtool.model.shapes import Contour, Line
 from camtool.toolpath import travel
-from camtool.toolpath import travel_large as large
 from camtool.toolpath.cuts import Cut
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.order import MAX_SEARCH_CUTS, Nesting, order_cuts
@@ -48,8 +47,8 @@ def test_grid_nearest_neighbour_chooses_as_the_full_scan() -> None:
     cuts = _mixed_cuts(1200, seed=1)
     before = _before(len(cuts))
     full = travel._nearest_neighbour(cuts, before, (0.0, 0.0), True)
-    table, steps = large.entries(cuts, True)
-    grid = large.nearest_neighbour(table, before, (0.0, 0.0))
+    table, steps = travel.entries(cuts, True)
+    grid = travel.grid_nearest_neighbour(table, before, (0.0, 0.0))
     assert [steps[p] for p in grid.tolist()] == full
 
 
@@ -57,8 +56,8 @@ def test_grid_nearest_neighbour_takes_the_lower_entry_on_ties() -> None:
     # four identical squares: every vertex of every square is a tie; the full scan takes
     # cut 0 vertex 0 first, then cut 1 at the vertex where cut 0 ended, and so on
     cuts = [Cut(rect(10, 10, 12, 12), i) for i in range(4)]
-    table, steps = large.entries(cuts, True)
-    grid = large.nearest_neighbour(table, [()] * 4, (10.0, 10.0))
+    table, steps = travel.entries(cuts, True)
+    grid = travel.grid_nearest_neighbour(table, [()] * 4, (10.0, 10.0))
     assert [steps[p] for p in grid.tolist()] == [(i, 0, False) for i in range(4)]
 
 
@@ -102,9 +101,9 @@ def test_large_order_of_a_shuffled_row_is_the_row(monkeypatch: pytest.MonkeyPatc
 
 def test_reversing_runs_turns_open_cuts_round() -> None:
     cuts = _mixed_cuts(6, seed=4)
-    table, _ = large.entries(cuts, True)
+    table, _ = travel.entries(cuts, True)
     seq = table.first[:-1].copy()
-    out = large._reverse_runs(table, seq, np.asarray([1]), np.asarray([3]))
+    out = travel._reverse_runs(table, seq, np.asarray([1]), np.asarray([3]))
     assert table.owner[out].tolist() == [0, 3, 2, 1, 4, 5]
     assert out[1] == table.partner[seq[3]]  # cut 3 (open, reversible) now runs backwards
     assert out[2] == seq[2]  # cut 2 (closed) keeps its entry

@@ -12,12 +12,12 @@ from pathlib import Path
 import pytest
 
 from camtool.cli.main import main
-from tests.test_preview import INJECTED_CODE, NS
+from tests.preview.test_preview import INJECTED_CODE, NS
 
-ROOT = Path(__file__).parents[1]
+ROOT = Path(__file__).parents[2]
 LOGO = ROOT / "samples" / "logo.dxf"
 NGC = ROOT / "tests" / "data" / "gcodetools-circle.ngc"
-# 100 µm of X backlash the controller does not compensate (see tests/test_preview.py).
+# 100 µm of X backlash the controller does not compensate (see tests/preview/test_preview.py).
 LASH_TOML = """[machine.backlash]
 true_um = [100.0, 0.0, 0.0]
 compensation_um = [0.0, 0.0, 0.0]
@@ -131,7 +131,7 @@ def test_verify_with_a_machine_file_marks_the_injected_error(
     root = ET.fromstring(out.read_bytes())
     worst = next(g for g in root.iter(f"{NS}g") if g.get("id") == "worst")
     ring = next(worst.iter(f"{NS}circle"))
-    # the carriage stays at X = 4 while Y reaches 2 (tests/test_preview.py works it out)
+    # the carriage stays at X = 4 while Y reaches 2 (tests/preview/test_preview.py works it out)
     assert (float(ring.get("cx", "")), -float(ring.get("cy", ""))) == pytest.approx(
         (4.0, 2.0), abs=1e-3
     )

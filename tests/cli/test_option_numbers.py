@@ -12,7 +12,7 @@ from camtool.model.errors import UsageError
 from camtool.model.units import fmt_num, fmt_point
 from camtool.toolpath.options import MAX_PASSES, PlanOptions
 
-SAMPLES = Path(__file__).resolve().parents[1] / "samples"
+SAMPLES = Path(__file__).resolve().parents[2] / "samples"
 TABS = ["--tabs", "2", "--depth", "3", "--offset", "outside", "--tool-diameter", "3"]
 
 

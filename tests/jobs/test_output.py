@@ -25,7 +25,7 @@ from camtool.jobs.output import (
 )
 from camtool.model.errors import CamtoolError, UsageError
 
-ROOT = Path(__file__).parents[1]
+ROOT = Path(__file__).parents[2]
 
 
 def test_written_files_get_the_permissions_open_would_give(tmp_path: Path) -> None:

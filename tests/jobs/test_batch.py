@@ -24,17 +24,19 @@ from camtool.jobs.batch import (
     BatchOptions,
     BatchRow,
     batch_exit_code,
+    batch_report,
     plan_batch,
     post_one,
+    progress_line,
     run_batch,
+    summary_table,
 )
-from camtool.jobs.batch_report import batch_report, progress_line, summary_table
 from camtool.jobs.inputs import expand_inputs
 from camtool.jobs.pipeline import post_file
 from camtool.model.errors import InputError, UsageError
 from tests.shapes import rectangle_dxf
 
-ROOT = Path(__file__).parents[1]
+ROOT = Path(__file__).parents[2]
 SAMPLES = ROOT / "samples"
 # An L along the axes at the pic-mmh feed F08 = 0.8 mm/min (seed-000 L1731).
 L_PROGRAM = "G21 G90\nG0 X1 Y1\nG1 X2 Y1 F0.8\nG1 X2 Y2\nM30\n"
@@ -560,7 +562,7 @@ def test_batch_judges_the_limit_as_post_does_with_and_without_strict(
     # limit judges what was cut unless --strict (the same rule as `camtool post`)
     from camtool.cli.main import main
 
-    plate = str(Path(__file__).resolve().parents[1] / "samples" / "plate.dxf")
+    plate = str(Path(__file__).resolve().parents[2] / "samples" / "plate.dxf")
     args = ["batch", plate, "-t", "grbl", "--offset", "outside", "--tool-diameter", "3"]
     limit = ["--max-error-um", "50", "--jobs", "1"]
     assert main([*args, *limit, "-o", str(tmp_path / "a")]) == 0

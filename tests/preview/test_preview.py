@@ -20,7 +20,7 @@ from camtool.preview import CUT_COLOUR, RAPID_COLOUR, program_svg, render_previe
 from camtool.verify.verifier import Verification, verify_program
 
 NS = "{http://www.w3.org/2000/svg}"
-GOLDEN_PNG = Path(__file__).parent / "golden" / "preview-small.png"
+GOLDEN_PNG = Path(__file__).parents[1] / "golden" / "preview-small.png"
 
 # An X reversal of exactly the injected backlash (0.1 mm) while Y travels 2 mm:
 # the X motor turns but the carriage stays at X = 4, so the tool leaves the

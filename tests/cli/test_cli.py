@@ -14,7 +14,7 @@ import pytest
 from camtool.cli.main import main
 from tests.shapes import golden_arc_dxf, rectangle_dxf, write_dxf
 
-SAMPLES = Path(__file__).parents[1] / "samples"
+SAMPLES = Path(__file__).parents[2] / "samples"
 
 
 def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
@@ -212,7 +212,7 @@ def test_machine_file_with_an_unknown_key(
     assert code == 3 and "unknown key(s) ['backlash_typo'] in [machine]" in err
 
 
-DATA = Path(__file__).parent / "data"
+DATA = Path(__file__).parents[1] / "data"
 
 
 def test_post_existing_gcode_reposts_it(capsys: pytest.CaptureFixture[str]) -> None:
