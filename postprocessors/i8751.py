@@ -50,19 +50,6 @@ from dataclasses import replace
 from types import MappingProxyType
 from typing import Any, ClassVar
 
-from camtool_postprocessors.i8751_packets import (
-    ACCESS_KEY,
-    MAX_STEPS,
-    MAX_WAIT_S,
-    Record,
-    binary_locator,
-    decode_stream,
-    dump_stream,
-    encode_stream,
-    packets,
-    undump,
-)
-
 from camtool.model.errors import DialectError, UsageError
 from camtool.model.machine import Machine
 from camtool.model.program import (
@@ -88,6 +75,18 @@ from camtool.post.base import (
     from_options,
 )
 from camtool.post.numfmt import NumberFormat
+from camtool_postprocessors.i8751_packets import (
+    ACCESS_KEY,
+    MAX_STEPS,
+    MAX_WAIT_S,
+    Record,
+    binary_locator,
+    decode_stream,
+    dump_stream,
+    encode_stream,
+    packets,
+    undump,
+)
 
 # -- the reader -------------------------------------------------------------------------
 # Reading the i8751 stream back: records → a Program (see :mod:`camtool_postprocessors.i8751`).

@@ -54,12 +54,6 @@ from types import MappingProxyType
 from typing import Any, ClassVar
 
 import numpy as np
-from camtool_postprocessors.matlab_router_arrays import (
-    DEFAULT_SPEED,
-    RouterArrays,
-    points_01mm,
-    router_arrays,
-)
 
 from camtool.model.errors import DialectError, ParseError, UsageError
 from camtool.model.machine import Machine
@@ -75,6 +69,12 @@ from camtool.post.base import (
     from_options,
 )
 from camtool.post.numfmt import NumberFormat
+from camtool_postprocessors.matlab_router_arrays import (
+    DEFAULT_SPEED,
+    RouterArrays,
+    points_01mm,
+    router_arrays,
+)
 
 # -- the reader -------------------------------------------------------------------------
 # Reader of the ``matlab-router`` dialect: the GUI's ``.m`` script and its USB wire stream.

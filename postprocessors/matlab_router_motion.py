@@ -18,8 +18,6 @@ its rapid is timed as that dog-leg (R13).
 from __future__ import annotations
 
 import numpy as np
-from camtool_postprocessors.matlab_router_arrays import points_01mm
-from camtool_postprocessors.matlab_router_motion_servo import RouterMachine, simulate_job
 
 from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Move, Program
@@ -28,6 +26,8 @@ from camtool.verify.interpolators import sagitta_chord_points
 from camtool.verify.metrics import contour_runs
 from camtool.verify.motion import MotionHooks, StepTrace
 from camtool.verify.steparray import STEP_DTYPE, read_only
+from camtool_postprocessors.matlab_router_arrays import points_01mm
+from camtool_postprocessors.matlab_router_motion_servo import RouterMachine, simulate_job
 
 
 def simulate_servo(program: Program, machine: Machine) -> StepTrace:

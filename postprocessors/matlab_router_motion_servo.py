@@ -49,6 +49,9 @@ from typing import Literal
 
 import numpy as np
 import numpy.typing as npt
+
+from camtool.model.errors import ToolpathError, UsageError
+from camtool.model.units import TENTH_MM
 from camtool_postprocessors.matlab_router_arrays import RouterArrays, router_arrays
 from camtool_postprocessors.matlab_router_motion_plant import (
     FIRMWARE_GAINS,
@@ -63,9 +66,6 @@ from camtool_postprocessors.matlab_router_motion_plant import (
     Plant,
     make_controller,
 )
-
-from camtool.model.errors import ToolpathError, UsageError
-from camtool.model.units import TENTH_MM
 
 Chunking = Literal["faithful", "fixed"]
 CHUNKINGS: tuple[str, ...] = ("faithful", "fixed")

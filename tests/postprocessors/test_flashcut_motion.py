@@ -11,6 +11,12 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from camtool.model.errors import UsageError
+from camtool.verify.quantize import steps_from_mm
+from camtool.verify.timing import BlockKinematics
 from camtool_postprocessors.flashcut_motion import (
     FlashcutTiming,
     flashcut_arc_points,
@@ -18,12 +24,6 @@ from camtool_postprocessors.flashcut_motion import (
     flashcut_line_steps,
     timer_period_ms,
 )
-from hypothesis import given, settings
-from hypothesis import strategies as st
-
-from camtool.model.errors import UsageError
-from camtool.verify.quantize import steps_from_mm
-from camtool.verify.timing import BlockKinematics
 
 FALSE = np.array([False])
 TRUE = np.array([True])

@@ -11,14 +11,14 @@ import math
 
 import numpy as np
 import pytest
+
+from camtool.model.errors import InputError, UsageError
+from camtool.verify.interpolators import chord_sagitta
 from camtool_postprocessors.grbl_motion import (
     grbl_arc_points,
     grbl_arc_segments,
     grbl_junction_speed_mm_s,
 )
-
-from camtool.model.errors import InputError, UsageError
-from camtool.verify.interpolators import chord_sagitta
 
 
 def test_grbl_segment_count_formula():

@@ -10,8 +10,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from camtool_postprocessors.i8751 import I8751Post, split_count, split_xy
-from camtool_postprocessors.i8751_packets import Record, encode_block, encode_stream
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -34,6 +32,8 @@ from camtool.post.registry import load_target
 from camtool.toolpath.options import PlanOptions
 from camtool.verify.interpolators import corte_recto_max_deviation
 from camtool.verify.verifier import verify_code
+from camtool_postprocessors.i8751 import I8751Post, split_count, split_xy
+from camtool_postprocessors.i8751_packets import Record, encode_block, encode_stream
 
 SAMPLES = Path(__file__).parents[2] / "samples"
 GOLDEN = Path(__file__).parents[1] / "golden" / "i8751"

@@ -8,6 +8,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from camtool.model.errors import UsageError
+from camtool.verify.timing import BlockKinematics
 from camtool_postprocessors.i8751_motion import (
     I8751Timing,
     i8751_block_time_s,
@@ -16,11 +21,6 @@ from camtool_postprocessors.i8751_motion import (
     i8751_move_time_s,
     i8751_step_delays_s,
 )
-from hypothesis import given, settings
-from hypothesis import strategies as st
-
-from camtool.model.errors import UsageError
-from camtool.verify.timing import BlockKinematics
 
 FALSE = np.array([False])
 TRUE = np.array([True])

@@ -8,16 +8,16 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from camtool.model.errors import DialectError, UsageError
 from camtool_postprocessors.matlab_router_arrays import (
     DEFAULT_SPEED,
     matlab_round,
     points_01mm,
     router_arrays,
 )
-from hypothesis import given
-from hypothesis import strategies as st
-
-from camtool.model.errors import DialectError, UsageError
 from tests.shapes import STAR_LXY, STAR_VELXY, STAR_XY_01MM
 
 STAR_XY = np.array(STAR_XY_01MM)  # seed-002 §3, L3196–L3200

@@ -10,6 +10,10 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from camtool.model.errors import UsageError
 from camtool_postprocessors.matlab_router_arrays import router_arrays
 from camtool_postprocessors.matlab_router_motion_plant import (
     TABLE_4_1,
@@ -35,10 +39,6 @@ from camtool_postprocessors.matlab_router_motion_servo import (
     simulate_job,
     tracking_deviation_mm,
 )
-from hypothesis import given, settings
-from hypothesis import strategies as st
-
-from camtool.model.errors import UsageError
 from tests.shapes import STAR_XY_01MM
 
 STAR = np.array(STAR_XY_01MM).T  # seed-002 §3, L3196–L3200, (N, 2) in 0.1 mm

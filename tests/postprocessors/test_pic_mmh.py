@@ -9,7 +9,6 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from camtool_postprocessors.pic_mmh import FeedTable, PicMmhPost
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -31,6 +30,7 @@ from camtool.post.base import PostResult
 from camtool.post.registry import load_target
 from camtool.toolpath.options import PlanOptions
 from camtool.verify.verifier import verify_code
+from camtool_postprocessors.pic_mmh import FeedTable, PicMmhPost
 from tests.shapes import golden_arc_dxf
 
 SAMPLES = Path(__file__).parents[2] / "samples"

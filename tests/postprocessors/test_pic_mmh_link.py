@@ -3,6 +3,11 @@
 from __future__ import annotations
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from camtool.model.errors import DialectError, ParseError
+from camtool.post.registry import load_target
 from camtool_postprocessors.pic_mmh_link import (
     AXES,
     Backlash,
@@ -20,11 +25,6 @@ from camtool_postprocessors.pic_mmh_link import (
     backlash_commands,
     parse_mode,
 )
-from hypothesis import given
-from hypothesis import strategies as st
-
-from camtool.model.errors import DialectError, ParseError
-from camtool.post.registry import load_target
 
 # Every string example of the reference, verbatim, with what it means.
 THESIS_STRINGS: list[tuple[str, ModeString, str]] = [

@@ -8,16 +8,16 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from camtool_postprocessors.pic_mmh_motion import (
-    PicMmhTiming,
-    pic_mmh_block_time_s,
-    pic_mmh_step_rate_hz,
-)
 
 from camtool.model.errors import UsageError
 from camtool.verify.interpolators import dda_iterations
 from camtool.verify.quantize import steps_from_mm
 from camtool.verify.timing import BlockKinematics
+from camtool_postprocessors.pic_mmh_motion import (
+    PicMmhTiming,
+    pic_mmh_block_time_s,
+    pic_mmh_step_rate_hz,
+)
 
 FALSE = np.array([False])
 TRUE = np.array([True])

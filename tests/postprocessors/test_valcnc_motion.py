@@ -11,12 +11,6 @@ import math
 
 import numpy as np
 import pytest
-from camtool_postprocessors.valcnc_motion import (
-    ValcncTiming,
-    serial_time_s,
-    valcnc_arc_points,
-    valcnc_block_time_s,
-)
 
 from camtool.model.shapes import chord_count
 from camtool.verify.interpolators import (
@@ -27,6 +21,12 @@ from camtool.verify.interpolators import (
 from camtool.verify.quantize import steps_from_mm
 from camtool.verify.steparray import positions
 from camtool.verify.timing import BlockKinematics
+from camtool_postprocessors.valcnc_motion import (
+    ValcncTiming,
+    serial_time_s,
+    valcnc_arc_points,
+    valcnc_block_time_s,
+)
 
 FALSE = np.array([False])
 TRUE = np.array([True])

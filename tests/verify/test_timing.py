@@ -12,7 +12,6 @@ import math
 
 import numpy as np
 import pytest
-from camtool_postprocessors.flashcut_motion import FlashcutTiming
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -24,6 +23,7 @@ from camtool.verify.timing import (
     trapezoid_block_time_s,
     trapezoid_time_s,
 )
+from camtool_postprocessors.flashcut_motion import FlashcutTiming
 
 FALSE = np.array([False])
 TRUE = np.array([True])
