@@ -121,8 +121,13 @@ def post(
     """
     from camtool.jobs.inputs import is_program_file, read_input
     from camtool.jobs.output import check_paths
-    from camtool.jobs.pipeline import post_drawing, post_path, refuse_planning, verify_job
-    from camtool.post.registry import load_target
+    from camtool.jobs.pipeline import (
+        load_target_checked,
+        post_drawing,
+        post_path,
+        refuse_planning,
+        verify_job,
+    )
     from camtool.toolpath.options import drawing_only
 
     check_paths(
@@ -131,7 +136,7 @@ def post(
         target=target,
         machine_file=machine_file,
     )
-    chosen = load_target(target, machine_file=machine_file)
+    chosen = load_target_checked(target, machine_file=machine_file)
     output_options = output_settings(options)
     chosen.post.check_format(output_options.fmt)
     settings = import_settings(options)
@@ -211,7 +216,7 @@ def verify(
     """
     from camtool.jobs.inputs import read_code, read_input
     from camtool.jobs.output import check_paths
-    from camtool.post.registry import load_target
+    from camtool.jobs.pipeline import load_target_checked
     from camtool.verify.verifier import verify_code
 
     check_paths(
@@ -220,7 +225,7 @@ def verify(
         target=target,
         machine_file=machine_file,
     )
-    chosen = load_target(target, machine_file=machine_file)
+    chosen = load_target_checked(target, machine_file=machine_file)
     text = read_code(code, binary=chosen.post.binary)
     drawing = read_input(against) if against is not None else None
     v = verify_code(text, chosen, source=code, against=drawing, tool_diameter=tool_diameter)

@@ -115,9 +115,9 @@ def _target(name: str | None, machine_file: Path | None) -> Target | None:
         if machine_file is not None:
             raise UsageError("--machine needs --target (the profile is laid over the target's)")
         return None
-    from camtool.post.registry import load_target
+    from camtool.jobs.pipeline import load_target_checked
 
-    return load_target(name, machine_file=machine_file)
+    return load_target_checked(name, machine_file=machine_file)
 
 
 def _verify(

@@ -264,10 +264,9 @@ def plan_batch(inputs: Sequence[str], options: BatchOptions) -> BatchPlan:
             first :data:`SHOWN_EXISTING` named).
         InputError: an input matches nothing, or the target/machine file is invalid.
     """
-    from camtool.jobs.pipeline import plan_options
-    from camtool.post.registry import load_target
+    from camtool.jobs.pipeline import load_target_checked, plan_options
 
-    target = load_target(options.target, machine_file=options.machine_file)
+    target = load_target_checked(options.target, machine_file=options.machine_file)
     fmt = target.post.check_format(options.output.fmt)
     plan_options(target, options.plan)  # checks the options for the target once, before any file
     if options.output_dir.exists() and not options.output_dir.is_dir():

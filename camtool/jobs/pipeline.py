@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 from camtool.importers import POINT_SUFFIXES, read_drawing
 from camtool.importers.options import ImportOptions
 from camtool.jobs.inputs import is_program_file
-from camtool.model.errors import UsageError
+from camtool.model.errors import InputError, UsageError
 from camtool.model.program import Move, Program
 from camtool.model.shapes import Drawing
 from camtool.post.base import PostResult, Target
@@ -72,6 +72,32 @@ class OutputOptions:
     spindle_dwell_s: float = 0.0
 
 
+def load_target_checked(name: str, *, machine_file: Path | str | None = None) -> Target:
+    """The target ``name`` (:func:`camtool.post.registry.load_target`), its motion names checked.
+
+    Every name the machine profile gives in ``[machine.motion]`` (``line``,
+    ``arc``, ``chords``) is resolved now, in the verifier's library and every
+    installed target's ``MOTION``, so that a misspelt name in a target file or a
+    ``--machine`` file is refused before any code is written, not only when the
+    code is verified. (Profiles take any name since targets bring their own.)
+
+    Raises:
+        UsageError: no such target.
+        InputError: the target or machine file is invalid, or names an unknown
+            interpolator or chord rule (the message names the file and lists the
+            valid names).
+    """
+    from camtool.verify.motion import library
+
+    target = load_target(name, machine_file=machine_file)
+    try:
+        library().check(target.machine)
+    except InputError as exc:
+        source = machine_file if machine_file is not None else name
+        raise InputError(f"{source}: {exc}") from exc
+    return target
+
+
 def post_file(
     path: str | Path,
     target_name: str,
@@ -94,7 +120,7 @@ def post_file(
     Raises:
         CamtoolError: from any stage, with its exit code.
     """
-    target = load_target(target_name, machine_file=machine_file)
+    target = load_target_checked(target_name, machine_file=machine_file)
     return post_path(path, target, plan, output, import_options=import_options)
 
 
