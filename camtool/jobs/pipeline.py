@@ -79,7 +79,9 @@ def load_target_checked(name: str, *, machine_file: Path | str | None = None) ->
     ``arc``, ``chords``) is resolved now, in the verifier's library and every
     installed target's ``MOTION``, so that a misspelt name in a target file or a
     ``--machine`` file is refused before any code is written, not only when the
-    code is verified. (Profiles take any name since targets bring their own.)
+    code is verified. (Profiles take any name since targets bring their own.) A
+    built-in target without ``machine_file`` is not re-checked: its profile is
+    tested with camtool.
 
     Raises:
         UsageError: no such target.
@@ -90,6 +92,8 @@ def load_target_checked(name: str, *, machine_file: Path | str | None = None) ->
     from camtool.verify.motion import library
 
     target = load_target(name, machine_file=machine_file)
+    if target.origin == "builtin" and machine_file is None:
+        return target
     try:
         library().check(target.machine)
     except InputError as exc:
