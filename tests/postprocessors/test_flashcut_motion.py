@@ -16,7 +16,6 @@ from hypothesis import strategies as st
 
 from camtool.model.errors import UsageError
 from camtool.verify.quantize import steps_from_mm
-from camtool.verify.timing import BlockKinematics
 from camtool_postprocessors.flashcut_motion import (
     FlashcutTiming,
     flashcut_arc_points,
@@ -24,26 +23,7 @@ from camtool_postprocessors.flashcut_motion import (
     flashcut_line_steps,
     timer_period_ms,
 )
-
-FALSE = np.array([False])
-TRUE = np.array([True])
-
-
-def assert_seconds(t: np.ndarray, b: int) -> None:
-    assert t.dtype == np.float64 and t.shape == (b,)
-    assert not t.flags.writeable
-
-
-def blocks() -> BlockKinematics:
-    return BlockKinematics.build(
-        dominant_steps=[100, 2000, 0],
-        is_rapid=[False, True, False],
-        feed_mm_min=[0.8, 0.0, 0.0],
-        length_mm=[0.5, 3.0, 0.0],
-        iterations=[120, 2000, 0],
-        steps=[[100, -40, 0], [-2000, 300, 0], [0, 0, -250]],
-        compensation_steps=[1457, 0, 0],
-    )
+from tests.kinematics import FALSE, assert_seconds, blocks
 
 
 def test_model_calls_its_function():

@@ -12,7 +12,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from camtool.model.errors import UsageError
-from camtool.verify.timing import BlockKinematics
 from camtool_postprocessors.i8751_motion import (
     I8751Timing,
     i8751_block_time_s,
@@ -21,26 +20,7 @@ from camtool_postprocessors.i8751_motion import (
     i8751_move_time_s,
     i8751_step_delays_s,
 )
-
-FALSE = np.array([False])
-TRUE = np.array([True])
-
-
-def assert_seconds(t: np.ndarray, b: int) -> None:
-    assert t.dtype == np.float64 and t.shape == (b,)
-    assert not t.flags.writeable
-
-
-def blocks() -> BlockKinematics:
-    return BlockKinematics.build(
-        dominant_steps=[100, 2000, 0],
-        is_rapid=[False, True, False],
-        feed_mm_min=[0.8, 0.0, 0.0],
-        length_mm=[0.5, 3.0, 0.0],
-        iterations=[120, 2000, 0],
-        steps=[[100, -40, 0], [-2000, 300, 0], [0, 0, -250]],
-        compensation_steps=[1457, 0, 0],
-    )
+from tests.kinematics import assert_seconds, blocks
 
 
 def test_model_calls_its_function():

@@ -12,32 +12,12 @@ import pytest
 from camtool.model.errors import UsageError
 from camtool.verify.interpolators import dda_iterations
 from camtool.verify.quantize import steps_from_mm
-from camtool.verify.timing import BlockKinematics
 from camtool_postprocessors.pic_mmh_motion import (
     PicMmhTiming,
     pic_mmh_block_time_s,
     pic_mmh_step_rate_hz,
 )
-
-FALSE = np.array([False])
-TRUE = np.array([True])
-
-
-def assert_seconds(t: np.ndarray, b: int) -> None:
-    assert t.dtype == np.float64 and t.shape == (b,)
-    assert not t.flags.writeable
-
-
-def blocks() -> BlockKinematics:
-    return BlockKinematics.build(
-        dominant_steps=[100, 2000, 0],
-        is_rapid=[False, True, False],
-        feed_mm_min=[0.8, 0.0, 0.0],
-        length_mm=[0.5, 3.0, 0.0],
-        iterations=[120, 2000, 0],
-        steps=[[100, -40, 0], [-2000, 300, 0], [0, 0, -250]],
-        compensation_steps=[1457, 0, 0],
-    )
+from tests.kinematics import FALSE, assert_seconds, blocks
 
 
 def test_model_calls_its_function():

@@ -24,15 +24,7 @@ from camtool.verify.timing import (
     trapezoid_time_s,
 )
 from camtool_postprocessors.flashcut_motion import FlashcutTiming
-
-FALSE = np.array([False])
-TRUE = np.array([True])
-
-
-def assert_seconds(t: np.ndarray, b: int) -> None:
-    assert t.dtype == np.float64 and t.shape == (b,)
-    assert not t.flags.writeable
-
+from tests.kinematics import FALSE, assert_seconds, blocks
 
 # ------------------------------------------------------------- rest-to-rest trapezoid, analytic
 
@@ -96,18 +88,6 @@ def test_trapezoid_properties(length, v, a, split):
 
 
 # ----------------------------------------------------------------- models and profiles
-
-
-def blocks() -> BlockKinematics:
-    return BlockKinematics.build(
-        dominant_steps=[100, 2000, 0],
-        is_rapid=[False, True, False],
-        feed_mm_min=[0.8, 0.0, 0.0],
-        length_mm=[0.5, 3.0, 0.0],
-        iterations=[120, 2000, 0],
-        steps=[[100, -40, 0], [-2000, 300, 0], [0, 0, -250]],
-        compensation_steps=[1457, 0, 0],
-    )
 
 
 def test_block_kinematics_validates_and_freezes():
