@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
+from camtool.model.errors import InputError
 from camtool.model.machine import Machine
 from camtool.model.program import Program, Rapid
 from camtool.verify.motion import StepTrace, timing_model_from_table
@@ -42,19 +43,26 @@ def block_times_s(trace: StepTrace, program: Program, machine: Machine) -> npt.N
     with ideal acceleration would do.
 
     Raises:
-        InputError: the ``[machine.timing]`` table names an unknown model or key.
+        InputError: the ``[machine.timing]`` table names an unknown model or key,
+            or there is no table and a cutting move has no feed to be timed at.
     """
     if trace.block_time_s is not None:
         return np.asarray(trace.block_time_s, dtype=np.float64)
     if not machine.timing:
-        return _at_feed(program)
+        return _at_feed(program, machine)
     where = f"machine {machine.name!r} [machine.timing]"
     model = timing_model_from_table(machine.timing, where=where, machine=machine)
     return np.asarray(model.block_time_s(block_kinematics(trace, program)), dtype=np.float64)
 
 
-def _at_feed(program: Program) -> npt.NDArray[np.float64]:
+def _at_feed(program: Program, machine: Machine) -> npt.NDArray[np.float64]:
     feeds = [m.feed_mm_min for m in program.moves if not isinstance(m, Rapid)]
+    if any(not feed > 0 for feed in feeds):
+        raise InputError(
+            f"machine {machine.name!r} has no [machine.timing] table and the program has "
+            "cutting moves without a feed (a dialect without an F word): name a timing model "
+            "in [machine.timing] to time it"
+        )
     rapid = max(feeds, default=1.0)
     out = [
         segment.length / ((rapid if isinstance(move, Rapid) else move.feed_mm_min) / 60.0)
