@@ -412,11 +412,12 @@ def timing_from_table(cls: type[Any], table: Mapping[str, Any], *, where: str) -
     """Build the parameter dataclass ``cls`` from a TOML ``[timing]`` table.
 
     The table holds ``model`` (ignored here: the caller resolved it to ``cls``) and
-    any of ``cls``'s dataclass fields, numbers, except ``cruise``, taken as written
+    any of ``cls``'s dataclass fields: numbers, or names where the field's default
+    is a string (i8751's ``cruise``), passed as written for the model to check
     (e.g. ``model = "trapezoid"`` and ``acceleration_mm_s2 = 500``).
 
     Args:
-        cls: A frozen parameter dataclass (every field a number, or ``cruise``).
+        cls: A frozen parameter dataclass (every field a number or a name).
         table: The parsed table.
         where: What to name in messages, e.g. ``"machine.toml [timing]"``.
 
@@ -428,19 +429,24 @@ def timing_from_table(cls: type[Any], table: Mapping[str, Any], *, where: str) -
             naming ``where`` and the known keys.
     """
     name = table.get("model")
-    known = {f.name for f in fields(cls)}
-    unknown = sorted(set(table) - known - {"model"})
+    by_name = {f.name: f for f in fields(cls)}
+    unknown = sorted(set(table) - set(by_name) - {"model"})
     if unknown:
-        raise InputError(f"{where}: unknown {name} timing key(s) {unknown}; known: {sorted(known)}")
+        raise InputError(
+            f"{where}: unknown {name} timing key(s) {unknown}; known: {sorted(by_name)}"
+        )
     kwargs: dict[str, Any] = {}
     for key, value in table.items():
-        if key in ("model", "cruise"):
+        if key == "model":
             continue
-        if isinstance(value, bool) or not isinstance(value, int | float):
+        if isinstance(by_name[key].default, str):  # a choice by name, checked by the model
+            if not isinstance(value, str):
+                raise InputError(f"{where}: {key} must be a name, got {value!r}")
+            kwargs[key] = value
+        elif isinstance(value, bool) or not isinstance(value, int | float):
             raise InputError(f"{where}: {key} must be a number, got {value!r}")
-        kwargs[key] = float(value)
-    if "cruise" in table:
-        kwargs["cruise"] = table["cruise"]
+        else:
+            kwargs[key] = float(value)
     try:
         return cls(**kwargs)
     except UsageError as exc:
