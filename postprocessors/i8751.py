@@ -15,7 +15,8 @@ How a :class:`~camtool.model.program.Program` is written:
   65 535 steps on its longest axis, the others at the nearest step of the
   segment (R3: 70 000 → 65 535 + 4 465);
 - X/Y then Z in one record (R4, R11): a move that changes X/Y and Z together
-  runs X/Y first, then Z, with a warning; a Z-only move right after an
+  runs X/Y first, then Z, with a warning, except a rapid that rises: it goes up
+  first, so no rapid travels at the depth it leaves; a Z-only move right after an
   X/Y-only move joins its record (a dwell between them becomes T1), as in the
   thesis's worked example;
 - arcs: the interface has none (§4.1) → equal chords within the machine's
@@ -248,8 +249,13 @@ class _Writer(WriterState[Record]):
     def steps(self, value_mm: float, axis: int) -> int:
         return _round_steps(value_mm, self.spm[axis])
 
-    def goto(self, x: float, y: float, z: float | None) -> None:
-        """Records from the current position to ``(x, y[, z])``: X/Y pieces, then Z."""
+    def goto(self, x: float, y: float, z: float | None, *, rapid: bool = False) -> None:
+        """Records from the current position to ``(x, y[, z])``: X/Y pieces, then Z.
+
+        A record runs X/Y before Z (seed-003 §3.7), so a move that also changes Z
+        runs its X/Y at the old height. A *rapid* that rises goes up first (Z-only
+        records, then X/Y), so it never travels at the cutting depth it leaves.
+        """
         target = [self.steps(x, 0), self.steps(y, 1)]
         target.append(self.pos[2] if z is None else self.steps(z, 2))
         dx, dy, dz = (t - p for t, p in zip(target, self.pos, strict=True))
@@ -260,9 +266,13 @@ class _Writer(WriterState[Record]):
         if xy and zs:
             self.counts["xyz"] += 1
         records = [Record((px, py, 0)) for px, py in xy]
-        if records and zs:
-            records[-1] = Record((*records[-1].steps[:2], zs.pop(0)))
-        for record in records + [Record((0, 0, n)) for n in zs]:
+        if rapid and dz > 0:
+            records = [Record((0, 0, n)) for n in zs] + records
+        else:
+            if records and zs:
+                records[-1] = Record((*records[-1].steps[:2], zs.pop(0)))
+            records += [Record((0, 0, n)) for n in zs]
+        for record in records:
             self.append(record)
         self.pos = target
 
@@ -405,7 +415,7 @@ class I8751Post(PostProcessor):
         if isinstance(move, ArcMove):
             points = self._chords(w, start, move, machine.motion.chord_tolerance_mm)
         for k, (x, y) in enumerate(points, start=1):
-            w.goto(x, y, move.z if k == len(points) else None)
+            w.goto(x, y, move.z if k == len(points) else None, rapid=isinstance(move, Rapid))
         if len(w.blocks) == before:
             w.counts["tiny"] += 1
 
@@ -524,7 +534,7 @@ def _count_warnings(c: Counter[str]) -> list[str]:
     if c["xyz"]:
         out.append(
             f"{c['xyz']} move(s) change X/Y and Z together: the 8751 runs X/Y first, then Z "
-            "(seed-003 §4.3, R11); they read back as two moves"
+            "(seed-003 §4.3, R11; a rising rapid goes up first); they read back as two moves"
         )
     if c["split"]:
         out.append(

@@ -412,7 +412,8 @@ _sub = st.floats(min_value=-0.45, max_value=0.45)
 @st.composite
 def _programs(draw: st.DrawFn) -> tuple[Program, list[tuple[int, int, int]]]:
     """Random moves in the work area, each at least one step from the last on the axes it
-    moves; and the step positions the reader must give back (X/Y, then Z, per move)."""
+    moves; and the step positions the reader must give back (X/Y, then Z, per move; Z, then
+    X/Y for a rapid that rises)."""
     moves: list[Move] = []
     expected: list[tuple[int, int, int]] = []
     here = [0, 0, 0]
@@ -427,6 +428,11 @@ def _programs(draw: st.DrawFn) -> tuple[Program, list[tuple[int, int, int]]]:
         zmm = None if z is None else (z + draw(_sub)) / SPM
         kind = draw(st.sampled_from(["rapid", "line"]))
         moves.append(Rapid(xmm, ymm, zmm) if kind == "rapid" else Linear(xmm, ymm, 60.0, zmm))
+        if kind == "rapid" and z is not None and z > here[2] and (x, y) != tuple(here[:2]):
+            # a rising rapid goes up first, then across (never across at the old depth)
+            expected += [(here[0], here[1], z), (x, y, z)]
+            here = [x, y, z]
+            continue
         if (x, y) != tuple(here[:2]):
             expected.append((x, y, here[2]))
         if z is not None:
@@ -582,3 +588,23 @@ def _records(code: bytes) -> list[Record]:
     from camtool_postprocessors.i8751_packets import binary_locator, decode_stream
 
     return decode_stream(code, binary_locator("<stdout>"))
+
+
+def test_a_rising_rapid_goes_up_before_it_travels() -> None:
+    # Safety: re-posted G-code may rise and travel in one rapid (G0 X20 Y20 Z5 after a cut
+    # at Z-1). The record order is X/Y then Z (R4), so written as one record the tool would
+    # cross 20 mm at the cutting depth; it must go up first, then across.
+    post, machine = _target()
+    program = Program(
+        (Linear(0.0, 0.0, 60.0, z=-1.0), Linear(10.0, 0.0, 60.0), Rapid(20.0, 20.0, z=5.0))
+    )
+    back = post.parse(post.emit(program, machine).code).moves
+    z = 0.0
+    at_depth = []
+    for m in back:
+        if m.z is None and z < 0:
+            at_depth.append((m.x, m.y))
+        z = z if m.z is None else m.z
+    assert at_depth == [(10.0, 0.0)]  # only the cut travels below the surface
+    assert (back[-2].x, back[-2].y, back[-2].z) == (10.0, 0.0, 5.0)  # up where the cut ended
+    assert (back[-1].x, back[-1].y) == (20.0, 20.0)
