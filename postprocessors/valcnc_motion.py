@@ -104,10 +104,13 @@ class ValcncTiming:
     Attributes:
         step_delay_us: Delay per DDA iteration, µs (166.667, seed-004 L1336).
         serial_baud: Serial speed for adding each block's send time, baud
-            (9600 in the thesis); 0 leaves it out (the default).
+            (9600 in the thesis); 0 leaves it out, the only value accepted for
+            now: the verifier does not yet count the bytes of each block, so a
+            speed would be silently ignored (:func:`valcnc_block_time_s` takes
+            both when a caller has them).
 
     Raises:
-        UsageError: If ``step_delay_us`` is not > 0 or ``serial_baud`` < 0.
+        UsageError: If ``step_delay_us`` is not > 0 or ``serial_baud`` is not 0.
     """
 
     model: ClassVar[str] = "valcnc"
@@ -117,6 +120,11 @@ class ValcncTiming:
     def __post_init__(self) -> None:
         positive("step_delay_us", self.step_delay_us)
         per_block("serial_baud", self.serial_baud, 1, minimum=0.0)
+        if self.serial_baud != 0:
+            raise UsageError(
+                f"serial_baud = {self.serial_baud:g} is not modelled yet: the verifier does not "
+                "count the bytes of each block, so the send time cannot be added; remove it"
+            )
 
     def block_time_s(self, blocks: BlockKinematics) -> FloatArray:
         """Seconds per block, ``(B,) float64`` read-only."""

@@ -85,3 +85,15 @@ def test_valcnc_quarter_arc_through_the_line_dda():
     steps = polyline_steps(np.array(lattice), accumulator_dda_line)
     pos_mm = positions(steps, (250, 0)) * 0.04
     assert np.abs(np.hypot(pos_mm[:, 0], pos_mm[:, 1]) - 10.0).max() <= 0.06
+
+
+def test_a_serial_speed_is_refused_while_block_bytes_are_not_counted() -> None:
+    # The verifier builds no per-block byte counts, so a serial_baud in a profile would add
+    # 0 s and look honoured; it is refused with the reason instead (the function above
+    # takes both when a caller has the bytes).
+    from camtool.model.errors import InputError
+    from camtool.verify.motion import timing_model_from_table
+
+    with pytest.raises(InputError, match="serial_baud = 9600 is not modelled yet"):
+        timing_model_from_table({"model": "valcnc", "serial_baud": 9600}, where="v.toml")
+    assert timing_model_from_table({"model": "valcnc", "serial_baud": 0}, where="v.toml")
