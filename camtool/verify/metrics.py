@@ -367,7 +367,7 @@ def against_drawing(
     measure (the step-level deviation from the path is :func:`deviation`).
 
     With ``findings`` and the ``nominal`` path, the drawing points the planner
-    could not cut as drawn (:func:`not_cut_mask`) are measured apart.
+    could not cut as drawn (:func:`not_cut_groups`) are measured apart.
 
     Args:
         points: ``(N, 2)`` float64 cutting trace (rapids left out), mm, in the
@@ -386,7 +386,7 @@ def against_drawing(
     """
     import shapely
 
-    samples = _sample_drawing(drawing, spacing_mm)
+    samples, sizes = _sample_drawing(drawing, spacing_mm)
     if len(points) < 2 or len(samples) == 0:
         return Against(0.0, 0.0, (0.0, 0.0), 0.0, 0)
     head = np.diff(points[: min(len(points), 2000)], axis=0)
@@ -408,9 +408,7 @@ def against_drawing(
     main = np.ones(len(samples), dtype=bool)
     if nominal and any(f.kind in NOT_CUT_KINDS and f.at is not None for f in findings):
         nominal_off = _distance_to(samples, nominal) - tool_radius_mm
-        groups = not_cut_groups(
-            samples, _contour_ids(drawing, spacing_mm), nominal_off, findings, tool_radius_mm
-        )
+        groups = not_cut_groups(samples, _contour_ids(sizes), nominal_off, findings, tool_radius_mm)
         for finding, index, at in groups:
             main[index] = False
             features.append(
@@ -428,7 +426,7 @@ def against_drawing(
     overcut = 0.0
     if tool_radius_mm > 0:
         chords = shapely.linestrings(np.stack([samples[:-1], samples[1:]], axis=1))
-        drawing_tree = shapely.STRtree(chords[_same_contour(drawing, spacing_mm)])
+        drawing_tree = shapely.STRtree(chords[_same_contour(sizes)])
         _, d_p = drawing_tree.query_nearest(
             shapely.points(trace), return_distance=True, all_matches=False
         )
@@ -574,16 +572,19 @@ def _distance_to(samples: FloatArray, lines: Sequence[FloatArray]) -> FloatArray
     return np.asarray(d, dtype=np.float64)
 
 
-def _contour_ids(drawing: Drawing, spacing_mm: float) -> IntArray:
+def _contour_ids(sizes: list[int]) -> IntArray:
     """``(S,)`` index of the contour of each point of :func:`_sample_drawing`."""
-    sizes = [len(_sample_contour(c.segments, spacing_mm)) for c in drawing.contours]
     return np.repeat(np.arange(len(sizes), dtype=np.int64), sizes)
 
 
-def _sample_drawing(drawing: Drawing, spacing_mm: float) -> FloatArray:
-    """Points along every contour, at most ``spacing_mm`` apart, contour after contour."""
+def _sample_drawing(drawing: Drawing, spacing_mm: float) -> tuple[FloatArray, list[int]]:
+    """Points along every contour, at most ``spacing_mm`` apart, and the count per contour.
+
+    Contour after contour; the counts feed :func:`_contour_ids` and :func:`_same_contour`.
+    """
     chunks = [_sample_contour(c.segments, spacing_mm) for c in drawing.contours]
-    return np.vstack(chunks) if chunks else np.zeros((0, 2))
+    sizes = [len(c) for c in chunks]
+    return (np.vstack(chunks) if chunks else np.zeros((0, 2))), sizes
 
 
 def _sample_contour(segments: tuple[Segment, ...], spacing_mm: float) -> FloatArray:
@@ -599,9 +600,11 @@ def _sample_contour(segments: tuple[Segment, ...], spacing_mm: float) -> FloatAr
     return np.asarray(pts, dtype=np.float64)
 
 
-def _same_contour(drawing: Drawing, spacing_mm: float) -> npt.NDArray[np.bool_]:
-    """Mask of the sample chords that join two points of the same contour."""
-    sizes = [len(_sample_contour(c.segments, spacing_mm)) for c in drawing.contours]
+def _same_contour(sizes: list[int]) -> npt.NDArray[np.bool_]:
+    """Mask of the sample chords that join two points of the same contour.
+
+    ``sizes``: points per contour, as :func:`_sample_drawing` gives them.
+    """
     mask = np.ones(sum(sizes) - 1, dtype=bool)
     edge = 0
     for size in sizes[:-1]:
