@@ -602,14 +602,15 @@ def _tolerance(program: Program, machine: Machine) -> float:
 
 
 def _steps(program: Program) -> Iterator[tuple[Move | None, tuple[Command, ...]]]:
-    """``(move, commands before it)``; last ``(None, trailing commands)``."""
-    pending = list(program.commands)
-    for index, move in enumerate(program.moves):
-        before = []
-        while pending and pending[0][0] == index:
-            before.append(pending.pop(0)[1])
-        yield move, tuple(before)
-    yield None, tuple(c for _, c in pending)
+    """``(move, commands before it)``, from :meth:`Program.items`; last ``(None, trailing)``."""
+    before: list[Command] = []
+    for item in program.items():
+        if isinstance(item, Rapid | Linear | ArcMove):
+            yield item, tuple(before)
+            before = []
+        else:
+            before.append(item)
+    yield None, tuple(before)
 
 
 def _halves(start: tuple[float, float], move: ArcMove) -> list[ArcMove]:

@@ -158,12 +158,13 @@ class Program:
 
     def items(self) -> Iterator[Move | Command]:
         """Moves and commands interleaved in program order (what a dialect writes)."""
-        pending = list(self.commands)
+        commands, k = self.commands, 0
         for index, move in enumerate(self.moves):
-            while pending and pending[0][0] == index:
-                yield pending.pop(0)[1]
+            while k < len(commands) and commands[k][0] == index:
+                yield commands[k][1]
+                k += 1
             yield move
-        for _, command in pending:
+        for _, command in commands[k:]:
             yield command
 
     def with_spindle(
