@@ -518,7 +518,7 @@ class BlockWriter(WriterState[str]):
                 command.direction
             ]
             if code is None:
-                self.counts["spindle"] += 1
+                self.drop(command)
                 return
             words = [code]
             if command.direction != "off" and spec.has("S") and command.rpm > 0:
@@ -528,16 +528,16 @@ class BlockWriter(WriterState[str]):
             self.block(words)
         elif isinstance(command, Dwell):
             if spec.dwell is None:
-                self.counts["dwell"] += 1
+                self.drop(command)
                 return
             self.block([spec.dwell, "P" + self.text("P", command.seconds)])
         elif isinstance(command, ToolChange):
             if spec.tool_change is None:
-                self.counts["tool"] += 1
+                self.drop(command)
                 return
             self.block([spec.tool_change, "T" + self.text("T", float(command.tool))])
         elif isinstance(command, Home):
-            self.counts["home"] += 1
+            self.drop(command)
 
     def _summary(self) -> list[str]:
         """One warning per kind of thing dropped or converted."""
@@ -545,14 +545,14 @@ class BlockWriter(WriterState[str]):
         texts = {
             "feed": f"{name} has no F word: the feed of {d['feed']} cutting block(s) is not "
             "written; the machine moves at its own speed",
-            "spindle": f"{name} has no spindle command: {d['spindle']} spindle command(s) "
+            "Spindle": f"{name} has no spindle command: {d['Spindle']} spindle command(s) "
             "dropped; switch the spindle (or tool) on and off by hand",
             "speed": f"{name}'s {self.spec.spindle_cw or self.spec.spindle_ccw} takes no S "
             f"word: {d['speed']} spindle speed(s) not written; set the speed on the machine",
-            "dwell": f"{name} has no dwell: {d['dwell']} pause(s) dropped",
-            "tool": f"{name} has no tool change: {d['tool']} tool change(s) dropped; change "
-            "tools by hand",
-            "home": f"{name} has no return to machine zero: {d['home']} G28-style return(s) "
+            "Dwell": f"{name} has no dwell: {d['Dwell']} pause(s) dropped",
+            "ToolChange": f"{name} has no tool change: {d['ToolChange']} tool change(s) "
+            "dropped; change tools by hand",
+            "Home": f"{name} has no return to machine zero: {d['Home']} G28-style return(s) "
             "dropped",
             "z-split": f"{d['z-split']} move(s) changing XY and Z together written as a Z block "
             f"and an XY block (Z first when rising, last when plunging): {name} puts Z moves in "
