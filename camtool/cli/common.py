@@ -196,6 +196,18 @@ def _given(**values: Any) -> dict[str, Any]:
     return {k: v for k, v in values.items() if v is not None}
 
 
+chain_tolerance_option = click.option(
+    "--chain-tolerance",
+    type=number_range(min=0),
+    default=DEFAULT_CHAIN_TOLERANCE,
+    show_default=True,
+    metavar="MM",
+    help="Entity ends closer than this are joined into one contour (real CAD files "
+    "leave gaps of a few µm).",
+)
+"""``--chain-tolerance``, the same for ``post``/``batch`` (planning) and ``inspect``."""
+
+
 def post_options(command: Callable[..., None]) -> Callable[..., None]:
     """The options that shape how a drawing is posted (``post`` and ``batch``)."""
     for decorator in reversed(_POST_OPTIONS):
@@ -360,8 +372,8 @@ _POST_OPTIONS = (
         default=0.001,
         show_default=True,
         metavar="MM",
-        help="Entity ends closer than this (mm) are chained into one contour; fitted arcs "
-        "stay this close to what they replace.",
+        help="Curves are fitted, and fitted arcs stay, this close to what they replace, mm "
+        "(entity ends are joined within --chain-tolerance).",
     ),
     click.option(
         "--scale",
@@ -396,15 +408,7 @@ _POST_OPTIONS = (
         metavar="DX DY",
         help="Move the program by DX DY mm, after --origin.",
     ),
-    click.option(
-        "--chain-tolerance",
-        type=number_range(min=0),
-        default=DEFAULT_CHAIN_TOLERANCE,
-        show_default=True,
-        metavar="MM",
-        help="Entity ends closer than this are joined into one contour (real CAD files "
-        "leave gaps of a few µm).",
-    ),
+    chain_tolerance_option,
     click.option(
         "--clearance-z",
         type=NUMBER,

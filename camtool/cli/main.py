@@ -17,6 +17,7 @@ from camtool.cli.batch import batch
 from camtool.cli.common import (
     MACHINE,
     NUMBER,
+    chain_tolerance_option,
     import_options,
     import_settings,
     number_range,
@@ -289,19 +290,23 @@ def _finish_verification(
     default=0.001,
     show_default=True,
     metavar="MM",
-    help="Chaining tolerance (and curve-fit tolerance), mm.",
+    help="Curve-fit tolerance, and the limit of the duplicate, overlap and tiny-segment "
+    "checks, mm.",
 )
+@chain_tolerance_option
 @import_options
-def inspect(drawing: str, as_json: bool, **options: Any) -> None:
+def inspect(drawing: str, as_json: bool, chain_tolerance: float, **options: Any) -> None:
     """Lint DRAWING before cutting (the report goes to stdout).
 
     Entities and contours by type and layer, bounding box, units, and what a
     machinist must fix: open contours, duplicates, zero-length and tiny segments,
-    gaps just above the chaining tolerance, with their locations.
+    gaps just above the chaining tolerance, with their locations. Ends are chained
+    as ``camtool post`` chains them (same --chain-tolerance).
     """
     from camtool.importers.lint import inspect_drawing
 
-    report = inspect_drawing(drawing, import_settings(options))
+    settings = import_settings(options)
+    report = inspect_drawing(drawing, settings, chain_tolerance=chain_tolerance)
     if as_json:
         click.echo(json.dumps(report.to_json(), indent=2))
     else:

@@ -7,6 +7,8 @@ exactly where the earlier one ends, so the emitted code has no gaps. A contour w
 ends meet within ``tolerance`` is closed. :func:`snap` does the same for the pieces of
 one fitted curve; :func:`with_start` and :func:`with_end` move one end of a segment.
 Closing larger gaps (reported) is the planner's :func:`camtool.toolpath.chain.close_gaps`.
+:func:`joint_distance` turns a ``--chain-tolerance`` into the ``tolerance`` to chain at,
+one rule for the planner and ``camtool inspect``.
 
 Conventions: mm, Y up; an arc moved to a new end keeps its centre and direction.
 """
@@ -23,6 +25,20 @@ from camtool.model.units import fmt_point
 
 _MAX_CELLS = 2.0**40
 """Largest cell number of the end hash (keeps cell numbers small ints on huge drawings)."""
+
+MIN_JOINT_MM = 1e-9
+"""Joint distance used for ``--chain-tolerance 0`` (only coincident ends meet)."""
+
+
+def joint_distance(chain_tolerance: float) -> float:
+    """The distance, mm, within which ends are joined for a ``--chain-tolerance`` in mm.
+
+    ``max(chain_tolerance, MIN_JOINT_MM)``: 0 joins only ends that coincide to
+    :data:`MIN_JOINT_MM`. The planner (:func:`camtool.toolpath.plan.plan_drawing`) and
+    ``camtool inspect`` (:func:`camtool.importers.lint.inspect_drawing`) both chain at
+    this distance, so what one calls closed the other does too.
+    """
+    return max(chain_tolerance, MIN_JOINT_MM)
 
 
 def chain(contours: Sequence[Contour], tolerance: float) -> list[Contour]:

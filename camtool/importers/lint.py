@@ -1,10 +1,12 @@
 """``camtool inspect``: what a drawing holds and what to fix before cutting it.
 
 :func:`inspect_drawing` reads a drawing like ``camtool post`` does (same importer, same
-options), chains it at the same tolerance and reports: entity counts by type and layer
-(DXF), contour counts by layer, the bounding box, the units, the importer's warnings and
-the findings of :func:`check_drawing` (open contours, gaps just above the
-tolerance, duplicates and overlaps, zero-length and tiny segments, dropped entities),
+options), chains it as the planner does (ends within ``--chain-tolerance`` are joined, by
+the planner's rule :func:`camtool.geometry.chain.joint_distance`) and reports: entity
+counts by type and layer (DXF), contour counts by layer, the bounding box, the units, the
+importer's warnings and the findings of :func:`check_drawing` (open contours, gaps just
+above the chaining tolerance, duplicates and overlaps, zero-length and tiny segments,
+dropped entities),
 each with its location, and for a damaged DXF what ezdxf's recover mode repaired (the
 importer's warning only counts the repairs). :class:`InspectReport` gives a text for
 people and a JSON object for scripts (``--json``).
@@ -15,9 +17,9 @@ what a machinist wants before cutting.
 Each check works on any :class:`~camtool.model.shapes.Drawing` (mm, Y up) and returns
 :class:`Finding` records with a location, so the report can say where to look:
 
-- ``open-contour``: a contour still open after chaining at the tolerance;
-- ``gap``: two open ends farther apart than the tolerance (so not joined) but within
-  :data:`GAP_FACTOR` times it: almost certainly meant to meet;
+- ``open-contour``: a contour still open after chaining at the chaining tolerance;
+- ``gap``: two open ends farther apart than the chaining tolerance (so not joined) but
+  within :data:`GAP_FACTOR` times it: almost certainly meant to meet;
 - ``duplicate``: two segments that are the same within the tolerance, either direction
   (cut twice);
 - ``overlap``: collinear lines, or arcs on one circle, that share more than the
@@ -25,8 +27,13 @@ Each check works on any :class:`~camtool.model.shapes.Drawing` (mm, Y up) and re
 - ``zero-length`` and ``tiny-segment``: segments of no length, or shorter than the tiny
   limit (many tiny moves slow a controller down and can stall a step generator).
 
-Chaining is :func:`camtool.geometry.chain.chain`, the planner's own, so an open contour
-here is an open contour there.
+The tolerance is the importer's (``--tolerance``, 0.001 mm by default). The chaining
+tolerance is ``--chain-tolerance`` (0.01 mm by default, as for ``camtool post``); the
+library functions chain at the tolerance when no chaining tolerance is given. Chaining is
+:func:`camtool.geometry.chain.chain` at
+:func:`~camtool.geometry.chain.joint_distance` of the chaining tolerance, the planner's
+own, so an open contour here is an open contour there (the planner may still close it
+with ``--close-gap``, with a warning).
 """
 
 from __future__ import annotations
@@ -38,9 +45,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from camtool.geometry.chain import chain
+from camtool.geometry.chain import chain, joint_distance
 from camtool.importers import read_drawing
 from camtool.importers.options import ImportOptions
+from camtool.model.errors import UsageError
 from camtool.model.shapes import TAU, Arc, BBox, Contour, Drawing, Line, Point, Segment, distance
 
 if TYPE_CHECKING:
@@ -80,13 +88,16 @@ class InspectReport:
         source: the file name.
         units: the drawing's unit as the importer read it (``"in"``, ``"mm (assumed)"``),
             or None when the importer has no unit to report.
-        tolerance: the chaining tolerance used, mm.
+        tolerance: the importer's tolerance (``--tolerance``): curve fitting, duplicates,
+            overlaps and the default tiny-segment limit, mm.
         bbox: ``(xmin, ymin, xmax, ymax)`` of all contours, mm.
         entities: ``(type, layer, count)`` of the model-space entities (DXF), sorted.
         block_entities: ``(type, layer, count)`` of entities placed by INSERTs (DXF).
         layers: contour counts per layer after chaining, sorted by layer.
         warnings: the importer's warnings (skipped types, assumed units, repairs).
         findings: the checks' findings, by kind.
+        chain_tolerance: ends closer than this are joined into one contour
+            (``--chain-tolerance``), mm; None: the ends were joined within ``tolerance``.
     """
 
     source: str
@@ -98,6 +109,12 @@ class InspectReport:
     layers: tuple[LayerContours, ...] = field(default=())
     warnings: tuple[str, ...] = field(default=())
     findings: tuple[Finding, ...] = field(default=())
+    chain_tolerance: float | None = None
+
+    @property
+    def joined_within(self) -> float:
+        """The chaining tolerance, mm: ``chain_tolerance``, or ``tolerance`` when None."""
+        return self.tolerance if self.chain_tolerance is None else self.chain_tolerance
 
     def counts(self) -> dict[str, int]:
         """Number of findings of each kind, e.g. ``{"gap": 2}`` (kinds with none left out)."""
@@ -106,7 +123,8 @@ class InspectReport:
     def to_json(self) -> dict[str, object]:
         """The report as JSON-ready data (keys are a contract for scripts: add, never rename).
 
-        ``source``, ``units``, ``tolerance_mm``, ``bbox_mm`` ``[xmin, ymin, xmax, ymax]``,
+        ``source``, ``units``, ``tolerance_mm``, ``chain_tolerance_mm`` (see
+        :attr:`joined_within`), ``bbox_mm`` ``[xmin, ymin, xmax, ymax]``,
         ``size_mm`` ``[w, h]``, ``entities`` and ``block_entities`` (lists of
         ``{type, layer, count}``), ``contours`` ``{total, closed, open, by_layer: [{layer,
         closed, open, lines, arcs}]}``, ``warnings`` (strings), ``findings`` (list of
@@ -121,6 +139,7 @@ class InspectReport:
             "source": self.source,
             "units": self.units,
             "tolerance_mm": self.tolerance,
+            "chain_tolerance_mm": self.joined_within,
             "bbox_mm": [x0, y0, x1, y1],
             "size_mm": [x1 - x0, y1 - y0],
             "entities": rows(self.entities),
@@ -144,7 +163,7 @@ class InspectReport:
         lines = [
             f"{self.source}",
             f"  units: {self.units or 'as the importer read them'}; coordinates in mm; "
-            f"chaining tolerance {self.tolerance:g} mm",
+            f"chaining tolerance {self.joined_within:g} mm",
             f"  size: {x1 - x0:.4f} x {y1 - y0:.4f} mm, "
             f"from ({x0:.4f}, {y0:.4f}) to ({x1:.4f}, {y1:.4f})",
             f"  contours: {closed + opened} ({closed} closed, {opened} open)",
@@ -176,7 +195,11 @@ class InspectReport:
 
 
 def inspect_drawing(
-    path: str | Path, options: ImportOptions | None = None, *, tiny_mm: float | None = None
+    path: str | Path,
+    options: ImportOptions | None = None,
+    *,
+    tiny_mm: float | None = None,
+    chain_tolerance: float | None = None,
 ) -> InspectReport:
     """Read a drawing and report its contents and the problems to fix before cutting.
 
@@ -186,13 +209,18 @@ def inspect_drawing(
 
     Args:
         path: the drawing file.
-        options: importer options (``layers``, ``tolerance`` in mm: also the chaining
-            tolerance the checks use, ``hatch_boundaries``); ``None`` takes the defaults.
+        options: importer options (``layers``, ``tolerance`` in mm: also the limit of
+            the duplicate and overlap checks, ``hatch_boundaries``); ``None`` takes the
+            defaults.
         tiny_mm: segments shorter than this are reported as tiny; ``None`` is 10 × the
             tolerance.
+        chain_tolerance: ends closer than this (mm, ≥ 0) are joined, as ``camtool post
+            --chain-tolerance`` joins them (:func:`camtool.geometry.chain.joint_distance`);
+            ``None`` joins ends within ``options.tolerance``.
 
     Raises:
         InputError: the drawing cannot be read (as :func:`camtool.importers.read_drawing`).
+        UsageError: ``chain_tolerance`` is negative or NaN.
     """
     options = options or ImportOptions()
     path = Path(path)
@@ -210,7 +238,9 @@ def inspect_drawing(
         notes += [Finding("repaired", r, None) for r in read.repairs]
     else:
         drawing = read_drawing(path, options)
-    chained, findings = check_drawing(drawing, options.tolerance, tiny_mm=tiny_mm)
+    chained, findings = check_drawing(
+        drawing, options.tolerance, tiny_mm=tiny_mm, chain_tolerance=chain_tolerance
+    )
     order = list(_KIND_TITLES)
     every = sorted(
         [*findings, *notes], key=lambda f: order.index(f.kind) if f.kind in order else 99
@@ -225,6 +255,7 @@ def inspect_drawing(
         layers=_by_layer(chained),
         warnings=drawing.warnings,
         findings=tuple(every),
+        chain_tolerance=chain_tolerance,
     )
 
 
@@ -305,24 +336,38 @@ class Finding:
 
 
 def check_drawing(
-    drawing: Drawing, tolerance: float, *, tiny_mm: float | None = None
+    drawing: Drawing,
+    tolerance: float,
+    *,
+    tiny_mm: float | None = None,
+    chain_tolerance: float | None = None,
 ) -> tuple[list[Contour], list[Finding]]:
     """Chain the drawing's contours and run every check.
 
     Args:
         drawing: contours in mm, one per entity as read.
-        tolerance: the chaining tolerance, mm (> 0), as ``--tolerance``.
+        tolerance: the tolerance of the duplicate and overlap checks, mm (> 0), as
+            ``--tolerance``; also the chaining tolerance when ``chain_tolerance`` is None.
         tiny_mm: segments shorter than this are ``tiny-segment``; ``None`` is
             :data:`TINY_FACTOR` × ``tolerance``.
+        chain_tolerance: the chaining tolerance, mm (≥ 0), as ``--chain-tolerance``:
+            contours are chained, and gaps judged, at
+            :func:`~camtool.geometry.chain.joint_distance` of it, as the planner does.
 
     Returns:
         ``(chained contours, findings)``; findings ordered by kind, then as found.
+
+    Raises:
+        UsageError: ``chain_tolerance`` is negative or NaN.
     """
+    if chain_tolerance is not None and not chain_tolerance >= 0:
+        raise UsageError(f"--chain-tolerance must be ≥ 0 mm, got {chain_tolerance!r}")
     tiny = TINY_FACTOR * tolerance if tiny_mm is None else tiny_mm
-    chained = chain(drawing.contours, tolerance)
+    joint = tolerance if chain_tolerance is None else joint_distance(chain_tolerance)
+    chained = chain(drawing.contours, joint)
     findings = [
         *open_contours(chained),
-        *gaps(chained, tolerance),
+        *gaps(chained, joint),
         *duplicates(drawing.contours, tolerance),
         *short_segments(drawing.contours, tiny),
     ]

@@ -12,13 +12,11 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+from camtool.geometry.chain import joint_distance
 from camtool.model.shapes import Contour, Point
 from camtool.model.units import fmt_num, fmt_point
 from camtool.toolpath.cuts import Finding, where
 from camtool.toolpath.options import PlanOptions
-
-MIN_JOINT_MM = 1e-9
-"""Joint distance used for ``--chain-tolerance 0`` (only coincident ends meet)."""
 
 NEAR_GAP_FACTOR = 100.0
 """Ends further apart than this many chaining tolerances (and than 0.1 mm) are not reported:
@@ -54,7 +52,7 @@ def open_gaps(contours: Sequence[Contour], options: PlanOptions) -> list[Finding
             ends += [(index, contour.start), (index, contour.end)]
     if len(ends) < 2:
         return []
-    joint = max(options.chain_tolerance, MIN_JOINT_MM)
+    joint = joint_distance(options.chain_tolerance)
     near = max(0.1, NEAR_GAP_FACTOR * joint)
     xy = np.array([p for _, p in ends], dtype=np.float64)
     points = shapely.points(xy)

@@ -152,8 +152,10 @@ def order_cuts(
     Args:
         cuts: the compensated or pocket cuts, mm; ``cut.group`` indexes ``nest``.
         nest: containment of the groups (:func:`nesting`).
-        options: ``order``, ``origin`` (tool position before the first cut, mm)
-            and ``tolerance`` (how far a mirror image may be, mm) are used.
+        options: ``order``, ``origin`` (tool position before the first cut, mm),
+            ``reverse_open`` (``reversals`` may cut open cuts with ``may_reverse``
+            backwards, as ``travel`` does) and ``tolerance`` (how far a mirror image may
+            be, mm) are used.
         backlash_um: ``(bx, by)`` reversal weight of each axis, µm (the machine's
             backlash; both 0 when unknown: every reversal weighs 1).
 
@@ -183,9 +185,12 @@ def order_cuts(
         sequences["planned"] = sequences["travel"]
     elif options.order == "reversals":
         allowed = [drawn_seq]
-        if not any(rev and not cuts[i].path.closed for i, _, rev in travel_seq):
+        flips = any(rev and not cuts[i].path.closed for i, _, rev in travel_seq)
+        if options.reverse_open or not flips:
             allowed.append(travel_seq)
-        planned = reversal_order(cuts, before, origin, backlash_um, allowed)
+        planned = reversal_order(
+            cuts, before, origin, backlash_um, allowed, flip_open=options.reverse_open
+        )
         sequences["planned"] = _cuts(cuts, planned)
     else:
         from camtool.toolpath.mirror import mirror_order

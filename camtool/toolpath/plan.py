@@ -27,13 +27,13 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from camtool.geometry.arcfit import FitStats, fit_polyline, fit_stats
-from camtool.geometry.chain import chain
+from camtool.geometry.chain import chain, joint_distance
 from camtool.model.errors import InputError
 from camtool.model.program import Move, Program, Rapid
 from camtool.model.shapes import Contour, Drawing, Line, Point, Segment
 from camtool.toolpath.chain import close_gaps
 from camtool.toolpath.cuts import Finding, Stage
-from camtool.toolpath.gaps import MIN_JOINT_MM, open_gaps
+from camtool.toolpath.gaps import open_gaps
 from camtool.toolpath.options import OFFSET_MODES, PlanOptions
 from camtool.toolpath.order import Ordering, nesting, order_cuts
 from camtool.toolpath.placement import (
@@ -176,7 +176,7 @@ def plan_drawing(
     if machine is not None:
         options.check_machine(machine, machine.name)
     placed = place(drawing, options)
-    joint = max(options.chain_tolerance, MIN_JOINT_MM)
+    joint = joint_distance(options.chain_tolerance)
     contours = chain(placed.contours, joint)
     contours, found = close_gaps(contours, options.close_gap, joint)
     findings = [*options.ineffective(), *found, *open_gaps(contours, options)]

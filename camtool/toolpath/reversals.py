@@ -229,6 +229,8 @@ def reversal_order(
     origin: Point,
     backlash_um: tuple[float, float],
     candidates: Sequence[Sequence[Step]] = (),
+    *,
+    flip_open: bool = False,
 ) -> list[Step]:
     """A sequence with few weighted axis reversals (rapid travel breaks ties).
 
@@ -239,7 +241,7 @@ def reversal_order(
     neighbouring cuts swapped where that helps (small jobs). The best of all
     by (:func:`count_reversals` weighted, rapid travel) is returned, so it is never
     worse than a candidate whose variants are allowed here (open cuts keep their
-    direction).
+    direction unless ``flip_open``).
 
     Args:
         cuts: the cuts, mm.
@@ -247,17 +249,19 @@ def reversal_order(
         origin: tool position before the first cut, mm.
         backlash_um: ``(bx, by)`` reversal weights, µm (see :func:`weights`).
         candidates: other valid sequences to improve and compare.
+        flip_open: open cuts with ``may_reverse`` may be cut backwards (``--reverse-open``);
+            ``False`` keeps every open cut's drawn direction.
     """
     if not cuts:
         return []
     w = weights(backlash_um)
     unit = min(v for v in w if v > 0)
     wn = (w[0] / unit, w[1] / unit)
-    variants = [_variants(cut, flip_open=False) for cut in cuts]
+    variants = [_variants(cut, flip_open=flip_open) for cut in cuts]
     greedy = _greedy(variants, before, origin, wn)
     options: list[Sequence[Step]] = [greedy, *candidates]
     if len(cuts) > 1:
-        options.append(travel_order(cuts, before, origin, flip_open=False))
+        options.append(travel_order(cuts, before, origin, flip_open=flip_open))
     options += [_improve(variants, before, seq, origin, wn) for seq in options]
 
     def key(seq: Sequence[Step]) -> tuple[float, float]:

@@ -252,6 +252,39 @@ def test_inspect_lists_layers_and_problems(capsys: pytest.CaptureFixture[str]) -
     assert code == 3 and out == "" and "missing.dxf" in err
 
 
+def _square_with_a_gap(path: Path) -> Path:
+    """A 10 mm square of four LINEs whose corner at (10, 0) has a 0.005 mm gap."""
+    sides = [((0, 0), (10, 0)), ((10, 0.005), (10, 10)), ((10, 10), (0, 10)), ((0, 10), (0, 0))]
+    return write_dxf(path, lambda msp: [msp.add_line(a, b) for a, b in sides])
+
+
+def test_inspect_joins_the_gaps_post_joins(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # 0.005 mm: within the default --chain-tolerance (0.01 mm), above 0.001 mm
+    import json
+
+    path = str(_square_with_a_gap(tmp_path / "gap.dxf"))
+    code, out, _ = run(["inspect", path], capsys)
+    assert code == 0 and "contours: 1 (1 closed, 0 open)" in out and "no problems found" in out
+    assert "chaining tolerance 0.01 mm" in out
+    code, out, _ = run(["inspect", path, "--json"], capsys)
+    data = json.loads(out)
+    assert data["contours"]["closed"] == 1 and data["finding_counts"] == {}
+    assert data["tolerance_mm"] == 0.001 and data["chain_tolerance_mm"] == 0.01
+    code, _, err = run(["post", path, "-t", "grbl", "-o", str(tmp_path / "a.nc")], capsys)
+    assert code == 0 and "mm gap" not in err and "stays open" not in err
+    # at --chain-tolerance 0.001 both call it open: the chain's own ends stay 0.005 mm apart
+    code, out, _ = run(["inspect", path, "--chain-tolerance", "0.001"], capsys)
+    assert code == 0 and "contours: 1 (0 closed, 1 open)" in out and "open contours: 1" in out
+    assert "gap of 0.005 mm at (10.0000, 0.0025): above the chaining tolerance 0.001 mm" in out
+    post = ["post", path, "-t", "grbl", "-o", str(tmp_path / "b.nc"), "--chain-tolerance", "0.001"]
+    code, _, err = run(post, capsys)
+    assert code == 0 and "closed a 0.005 mm gap between its ends at (10.0000, 0.0025)" in err
+    code, _, err = run([*post, "--close-gap", "0"], capsys)
+    assert code == 0 and "stays open: its ends are 0.0050 mm apart" in err
+
+
 def test_layers_and_units_reach_the_importers(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -11,6 +11,7 @@ import pytest
 
 from camtool.importers.lint import check_drawing, inspect_drawing
 from camtool.importers.options import ImportOptions
+from camtool.model.errors import UsageError
 from camtool.model.shapes import Arc, Contour, Drawing, Line
 from tests.shapes import write_dxf
 
@@ -109,6 +110,26 @@ def test_gap_just_within_the_tolerance_is_joined_not_reported() -> None:
     chained, findings = check_drawing(drawing, TOL)
     assert len(chained) == 2
     assert not [f for f in findings if f.kind == "gap"]
+
+
+def test_a_chain_tolerance_chains_and_judges_gaps_as_the_planner_does() -> None:
+    # the 0.0015 mm corner gap of the problem drawing's L, and 0.02 mm to the third line
+    drawing = Drawing(
+        (
+            Contour((Line((0, 0), (10, 0)),), False, "0", "a"),
+            Contour((Line((10, 0.0015), (10, 10)),), False, "0", "b"),
+            Contour((Line((10, 10.02), (0, 10.02)),), False, "0", "c"),
+        )
+    )
+    chained, findings = check_drawing(drawing, TOL, chain_tolerance=0.01)
+    assert len(chained) == 2  # a + b joined (0.0015 ≤ 0.01); c is 0.02 mm away: a gap
+    (gap,) = [f for f in findings if f.kind == "gap"]
+    assert gap.location == pytest.approx((10.0, 10.01)) and "0.01 mm" in gap.message
+    # 0: only coincident ends meet (joint_distance: 1e-9 mm), so nothing is joined
+    chained, _ = check_drawing(drawing, TOL, chain_tolerance=0.0)
+    assert len(chained) == 3
+    with pytest.raises(UsageError, match="--chain-tolerance"):
+        check_drawing(drawing, TOL, chain_tolerance=-0.01)
 
 
 def test_overlapping_collinear_lines_and_arcs() -> None:

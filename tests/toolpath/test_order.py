@@ -298,6 +298,23 @@ def test_open_cuts_flip_only_in_travel_mode() -> None:
     assert reversals.cuts[0].path.start == (5, 0)
 
 
+@pytest.mark.parametrize("reverse_open", [False, True])
+def test_reversals_flip_open_cuts_with_reverse_open(reverse_open: bool) -> None:
+    # From (0, 0): drawn, the rapid (10, 0) → (0, 1) goes -X between two +X lines:
+    # X/Y reversals 2/0, rapids √101 mm. Cutting the second line back from (10, 1)
+    # reverses X once (the +Y rapid sets Y): 1/0, rapids 1 mm. Second line first is
+    # 2/1 either way.
+    lines = [Contour((Line((0, 0), (10, 0)),), False), Contour((Line((0, 1), (10, 1)),), False)]
+    cuts = [Cut(c, i, "open", may_rotate=False) for i, c in enumerate(lines)]
+    opts = PlanOptions(feed_mm_min=0.8, order="reversals", reverse_open=reverse_open)
+    got = order_cuts(cuts, Nesting(((), ())), opts, (0.0, 0.0))
+    assert [c.path.start for c in got.cuts] == [(0, 0), (10, 1) if reverse_open else (0, 1)]
+    assert got.reversals["drawn"] == (2, 0)
+    assert got.reversals["planned"] == ((1, 0) if reverse_open else (2, 0))
+    assert got.travel_mm["planned"] == pytest.approx(1.0 if reverse_open else math.sqrt(101))
+    assert sum(got.reversals["planned"]) <= sum(got.reversals["drawn"])
+
+
 # ------------------------------------------------------------------ report
 
 
