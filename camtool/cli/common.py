@@ -51,6 +51,12 @@ class FiniteFloat(click.FloatRange):
             self.fail(f"{value!r} is not a finite number", param, ctx)
         return rv
 
+    def _describe_range(self) -> str:
+        """The range for ``--help`` ("" without bounds: click would print ``x<=None``)."""
+        if self.min is None and self.max is None:
+            return ""
+        return super()._describe_range()
+
 
 NUMBER = FiniteFloat()
 """Any finite float (see :class:`FiniteFloat`)."""

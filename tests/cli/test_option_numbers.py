@@ -89,3 +89,11 @@ def test_fmt_num_never_negative_zero(value: float, text: str) -> None:
 
 def test_fmt_point() -> None:
     assert fmt_point((-0.0, 1.5), 2) == "(0.00, 1.50)"
+
+
+def test_help_shows_no_empty_range(capsys) -> None:
+    # a number option without bounds printed "[x<=None]" (click's range text for no bounds)
+    assert main(["post", "--help"]) == 0
+    out = capsys.readouterr().out
+    assert "None]" not in out and "x<=None" not in out
+    assert "x>=0" in out  # a bounded option still shows its range
