@@ -360,8 +360,8 @@ _POST_OPTIONS = (
         default=0.001,
         show_default=True,
         metavar="MM",
-        help="Entity ends closer than this (mm) are chained into one contour; fitted arcs "
-        "stay this close to what they replace.",
+        help="Curve tolerance (mm): fitted arcs, flattened curves and chords stay this "
+        "close to what they replace (chaining uses --chain-tolerance).",
     ),
     click.option(
         "--scale",
