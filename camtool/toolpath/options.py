@@ -98,9 +98,10 @@ class PlanOptions:
         feed_mm_min: cutting feed, mm/min (> 0); ``None``: the target's default,
             filled in by :func:`camtool.jobs.pipeline.plan_options` before planning
             (:attr:`feed` refuses to plan without one).
-        tolerance: chaining and arc-fitting tolerance, mm (> 0): ends closer than
-            this meet; fitted arcs stay this close to what they replace.
-        close_gap: contours whose ends are further apart than ``tolerance`` but
+        tolerance: curve tolerance, mm (> 0): fitted arcs, offsets and chords stay
+            this close to what they replace. Chaining uses ``chain_tolerance``
+            (``--chain-tolerance``), not this.
+        close_gap: contours whose ends are further apart than ``chain_tolerance`` but
             at most this far (mm), and less than a tenth of their length, are
             closed with a warning; 0 closes nothing.
         origin: tool position before the program, mm.
