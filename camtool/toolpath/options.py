@@ -59,6 +59,7 @@ _FLAG_NAMES = {
     "feed_mm_min": "--feed",
     "placement": "--origin",
     "reverse_open": "--reverse-open",
+    "origin": "the start position (PlanOptions.origin)",  # API only: --origin is placement
 }
 
 
@@ -379,11 +380,6 @@ class PlanOptions:
         """Flags of the fields among ``names`` that differ from their defaults."""
         fields = type(self).__dataclass_fields__
         return [flag(n) for n in names if getattr(self, n) != fields[n].default]
-
-    @property
-    def uses_z(self) -> bool:
-        """True when the plan writes Z (a depth was given)."""
-        return self.depth is not None
 
     def z_options(self) -> list[str]:
         """The depth options given, as flags (for the 2D-target error)."""
