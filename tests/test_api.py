@@ -8,6 +8,7 @@ allows (see :func:`test_docs_example_posts_and_verifies_plate_for_grbl`).
 
 from __future__ import annotations
 
+import ast
 import math
 import os
 import re
@@ -111,3 +112,17 @@ def test_docs_example_posts_and_verifies_plate_for_grbl(
     again = camtool.verify_code(ns["code"], target)
     assert again.deviation.max_um == pytest.approx(v.deviation.max_um)
     assert v.time_s > 0 and job.result.blocks > 0
+
+
+def test_the_type_checking_imports_are_the_public_names() -> None:
+    # __all__ derives from _HOMES; the TYPE_CHECKING block must name the same homes
+    tree = ast.parse((ROOT / "camtool" / "__init__.py").read_text(encoding="utf-8"))
+    block = next(n for n in tree.body if isinstance(n, ast.If))
+    seen = {
+        alias.name: node.module
+        for node in block.body
+        if isinstance(node, ast.ImportFrom)
+        for alias in node.names
+        if alias.asname == alias.name
+    }
+    assert seen == camtool._HOMES
