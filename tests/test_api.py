@@ -39,7 +39,8 @@ def test_every_public_name_imports() -> None:
 def _loaded_after(code: str) -> set[str]:
     """Top-level packages loaded by a fresh interpreter after running ``code``."""
     probe = f"{code}\nimport sys\nprint(' '.join(sorted({{m.split('.')[0] for m in sys.modules}})))"
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    paths = [str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])]  # a checkout's own first
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(paths)}
     proc = subprocess.run(
         [sys.executable, "-c", probe], capture_output=True, text=True, check=True, env=env
     )
@@ -54,6 +55,12 @@ def test_import_camtool_loads_nothing_heavy() -> None:
 def test_targets_through_the_api_load_no_occt() -> None:
     loaded = _loaded_after("import camtool\ncamtool.list_targets()\ncamtool.load_target('grbl')")
     assert not loaded & {"build123d", "OCP", "matplotlib"}
+
+
+def test_listing_targets_loads_no_numpy() -> None:
+    # `camtool targets` builds every dialect: the matlab-router one imports numpy on use
+    loaded = _loaded_after("import camtool\ncamtool.list_targets()")
+    assert not loaded & set(HEAVY), sorted(loaded & set(HEAVY))
 
 
 def _docs_example() -> dict[str, Any]:
