@@ -67,45 +67,7 @@ _HOMES: dict[str, str] = {
 }
 """Each public name → the module that defines it."""
 
-__all__ = [
-    "Arc",
-    "ArcMove",
-    "CamtoolError",
-    "Contour",
-    "DialectError",
-    "Drawing",
-    "ImportOptions",
-    "InputError",
-    "Line",
-    "Linear",
-    "Machine",
-    "OutputOptions",
-    "ParseError",
-    "Plan",
-    "PlanOptions",
-    "PlanReport",
-    "PostJob",
-    "Program",
-    "Rapid",
-    "Target",
-    "ToolpathError",
-    "UsageError",
-    "Verification",
-    "VerifyLimitError",
-    "__version__",
-    "list_targets",
-    "load_target",
-    "plan_drawing",
-    "plan_options",
-    "post_drawing",
-    "post_file",
-    "post_path",
-    "post_program",
-    "read_drawing",
-    "verify_code",
-    "verify_job",
-    "verify_program",
-]
+__all__ = ["__version__", *_HOMES]
 """The public API: each name is defined in the module :data:`_HOMES` gives."""
 
 
@@ -127,33 +89,40 @@ def __dir__() -> list[str]:
     return sorted({*globals(), *_HOMES})
 
 
-if TYPE_CHECKING:  # the names as type checkers and editors see them
-    from camtool.importers import read_drawing
-    from camtool.importers.options import ImportOptions
-    from camtool.jobs.pipeline import (
-        OutputOptions,
-        PostJob,
-        plan_options,
-        post_drawing,
-        post_file,
-        post_path,
-        post_program,
-        verify_job,
-    )
-    from camtool.model.errors import (
-        CamtoolError,
-        DialectError,
-        InputError,
-        ParseError,
-        ToolpathError,
-        UsageError,
-        VerifyLimitError,
-    )
-    from camtool.model.machine import Machine
-    from camtool.model.program import ArcMove, Linear, Program, Rapid
-    from camtool.model.shapes import Arc, Contour, Drawing, Line
-    from camtool.post.base import Target
-    from camtool.post.registry import list_targets, load_target
-    from camtool.toolpath.options import PlanOptions
-    from camtool.toolpath.plan import Plan, PlanReport, plan_drawing
-    from camtool.verify.verifier import Verification, verify_code, verify_program
+if TYPE_CHECKING:  # the names as type checkers see them (``X as X``: exported, PEP 484)
+    from camtool.importers import read_drawing as read_drawing
+    from camtool.importers.options import ImportOptions as ImportOptions
+    from camtool.jobs.pipeline import OutputOptions as OutputOptions
+    from camtool.jobs.pipeline import PostJob as PostJob
+    from camtool.jobs.pipeline import plan_options as plan_options
+    from camtool.jobs.pipeline import post_drawing as post_drawing
+    from camtool.jobs.pipeline import post_file as post_file
+    from camtool.jobs.pipeline import post_path as post_path
+    from camtool.jobs.pipeline import post_program as post_program
+    from camtool.jobs.pipeline import verify_job as verify_job
+    from camtool.model.errors import CamtoolError as CamtoolError
+    from camtool.model.errors import DialectError as DialectError
+    from camtool.model.errors import InputError as InputError
+    from camtool.model.errors import ParseError as ParseError
+    from camtool.model.errors import ToolpathError as ToolpathError
+    from camtool.model.errors import UsageError as UsageError
+    from camtool.model.errors import VerifyLimitError as VerifyLimitError
+    from camtool.model.machine import Machine as Machine
+    from camtool.model.program import ArcMove as ArcMove
+    from camtool.model.program import Linear as Linear
+    from camtool.model.program import Program as Program
+    from camtool.model.program import Rapid as Rapid
+    from camtool.model.shapes import Arc as Arc
+    from camtool.model.shapes import Contour as Contour
+    from camtool.model.shapes import Drawing as Drawing
+    from camtool.model.shapes import Line as Line
+    from camtool.post.base import Target as Target
+    from camtool.post.registry import list_targets as list_targets
+    from camtool.post.registry import load_target as load_target
+    from camtool.toolpath.options import PlanOptions as PlanOptions
+    from camtool.toolpath.plan import Plan as Plan
+    from camtool.toolpath.plan import PlanReport as PlanReport
+    from camtool.toolpath.plan import plan_drawing as plan_drawing
+    from camtool.verify.verifier import Verification as Verification
+    from camtool.verify.verifier import verify_code as verify_code
+    from camtool.verify.verifier import verify_program as verify_program

@@ -51,9 +51,7 @@ import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any, ClassVar
-
-import numpy as np
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from camtool.model.errors import DialectError, ParseError, UsageError
 from camtool.model.machine import Machine
@@ -75,6 +73,9 @@ from camtool_postprocessors.matlab_router_arrays import (
     points_01mm,
     router_arrays,
 )
+
+if TYPE_CHECKING:  # numpy is imported where it is used: `camtool targets` loads this module
+    import numpy as np
 
 # -- the reader -------------------------------------------------------------------------
 # Reader of the ``matlab-router`` dialect: the GUI's ``.m`` script and its USB wire stream.
@@ -226,6 +227,8 @@ class _Reader:
 
         ``line`` is the job's line; ``speed_line(axis, segment)`` the line of a speed.
         """
+        import numpy as np
+
         n = len(xy) - 1
         if not 1 <= n <= self.max_segments:
             raise self.fail(
@@ -341,6 +344,8 @@ class _Reader:
         return name, rows[0] + rows[1], end + code.startswith(";", end)
 
     def _script_job(self, job: int, group: list[list[_Number]]) -> _Job:
+        import numpy as np
+
         xy_numbers, lxy, velxy = group
         count = len(xy_numbers) // 2
         xy = np.array([n.value for n in xy_numbers], dtype=np.int64).reshape(2, count).T
@@ -406,6 +411,8 @@ class _Reader:
         return value
 
     def _wire_job(self, job: int, records: list[str], k: int, n: int, as_char: bool) -> _Job:
+        import numpy as np
+
         x1 = self._value(records, k + 1, f"job {job}: x1")
         if as_char:
             if len(records[k + 2]) != 1:
@@ -510,6 +517,8 @@ def notes_warnings(notes: RouterWriter, speed: int, tolerance: float) -> list[st
 
 def jobs_warnings(jobs: list[RouterJob], max_segments: int) -> list[str]:
     """Warnings about the jobs themselves: splits, several jobs, firmware hazards."""
+    import numpy as np
+
     w = []
     split = [j for j in jobs if j.part == 2]
     if split:
@@ -759,6 +768,8 @@ class MatlabRouterPost(PostProcessor):
         self, stroke: _Stroke, program: Program, notes: RouterWriter
     ) -> list[RouterJob]:
         """Quantise a stroke, drop repeated vertices, split it into jobs of ≤ max_segments."""
+        import numpy as np
+
         xy = points_01mm(np.asarray(stroke.points, dtype=np.float64))
         keep = np.ones(len(xy), dtype=bool)
         keep[1:] = (np.diff(xy, axis=0) != 0).any(axis=1)
@@ -914,6 +925,8 @@ def _chords(here: Point, move: ArcMove, tolerance: float, notes: RouterWriter) -
 
 def _check_speeds(job: RouterJob) -> None:
     """A moving axis whose speed rounds to 0 hangs the job (seed-002 §3, §4.2)."""
+    import numpy as np
+
     a = job.arrays
     hang = (a.lxy > 0) & (a.velxy == 0)
     if hang.any():

@@ -22,17 +22,18 @@ writer's job.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import overload
-
-import numpy as np
-import numpy.typing as npt
+from typing import TYPE_CHECKING, TypeAlias, overload
 
 from camtool.model.errors import DialectError, UsageError
 
+if TYPE_CHECKING:  # numpy is imported where it is used: `camtool targets` loads this module
+    import numpy as np
+    import numpy.typing as npt
+
+    IntArray: TypeAlias = npt.NDArray[np.int64]
+
 DEFAULT_SPEED = 480
 """Major-axis speed of a segment, encoder counts per 5 ms (seed-002 §2.3, R7, L4458)."""
-
-IntArray = npt.NDArray[np.int64]
 
 
 @overload
@@ -60,6 +61,8 @@ def matlab_round(x: float | npt.NDArray[np.floating] | npt.NDArray[np.integer]) 
     Raises:
         UsageError: If a value is not finite.
     """
+    import numpy as np
+
     arr = np.asarray(x, dtype=np.float64)
     if not np.all(np.isfinite(arr)):
         raise UsageError(f"cannot round non-finite value(s): {x!r}")
@@ -84,6 +87,8 @@ def points_01mm(xy_mm: npt.ArrayLike) -> IntArray:
         DialectError: If the array is not ``(N, 2)``.
         UsageError: If a coordinate is not finite.
     """
+    import numpy as np
+
     arr = np.asarray(xy_mm, dtype=np.float64)
     if arr.ndim != 2 or arr.shape[1] != 2:
         raise DialectError(f"router vertices must be an (N, 2) array of mm, got shape {arr.shape}")
@@ -122,6 +127,8 @@ class RouterArrays:
     @property
     def increments(self) -> IntArray:
         """Signed increments ``(Δx, Δy)`` per segment: ``(2, n) int64``, 0.1 mm, read-only."""
+        import numpy as np
+
         out = np.diff(self.xy, axis=1)
         out.flags.writeable = False
         return out
@@ -129,6 +136,8 @@ class RouterArrays:
 
 def _vertices(xy_01mm: npt.ArrayLike) -> IntArray:
     """Validate ``(N, 2)`` whole-number vertices and return them as ``(2, N) int64``."""
+    import numpy as np
+
     arr = np.asarray(xy_01mm)
     if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] < 2:
         raise DialectError(
@@ -162,6 +171,8 @@ def router_arrays(xy_01mm: npt.ArrayLike, *, speed: int = DEFAULT_SPEED) -> Rout
             whole numbers.
         UsageError: If ``speed`` is not a positive integer.
     """
+    import numpy as np
+
     if isinstance(speed, bool) or not isinstance(speed, int | np.integer) or speed <= 0:
         raise UsageError(
             f"router speed must be a positive integer (counts per 5 ms), got {speed!r}"

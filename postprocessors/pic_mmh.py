@@ -378,7 +378,7 @@ class PicMmhPost(PostProcessor):
             if move is None:
                 continue
             start = w.here
-            self._check_move(start, move, machine, w, homed)
+            self._check_move(move, w, homed)
             check_work_area(start, move, machine, w.where(move.contour), program)
             homed = homed and not isinstance(move, Rapid)
             self._move(start, move, machine, w, _tolerance(program, machine))
@@ -396,9 +396,7 @@ class PicMmhPost(PostProcessor):
         code = "\n".join(w.blocks) + "\n"
         return PostResult(code, len(w.blocks), (*w.warnings, *w.noted()))
 
-    def _check_move(
-        self, start: tuple[float, float], move: Move, machine: Machine, w: _Writer, homed: bool
-    ) -> None:
+    def _check_move(self, move: Move, w: _Writer, homed: bool) -> None:
         where = w.where(move.contour)
         if move.z is not None:
             raise DialectError(

@@ -8,6 +8,7 @@ allows (see :func:`test_docs_example_posts_and_verifies_plate_for_grbl`).
 
 from __future__ import annotations
 
+import ast
 import math
 import os
 import re
@@ -38,7 +39,8 @@ def test_every_public_name_imports() -> None:
 def _loaded_after(code: str) -> set[str]:
     """Top-level packages loaded by a fresh interpreter after running ``code``."""
     probe = f"{code}\nimport sys\nprint(' '.join(sorted({{m.split('.')[0] for m in sys.modules}})))"
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    paths = [str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])]  # a checkout's own first
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(paths)}
     proc = subprocess.run(
         [sys.executable, "-c", probe], capture_output=True, text=True, check=True, env=env
     )
@@ -53,6 +55,12 @@ def test_import_camtool_loads_nothing_heavy() -> None:
 def test_targets_through_the_api_load_no_occt() -> None:
     loaded = _loaded_after("import camtool\ncamtool.list_targets()\ncamtool.load_target('grbl')")
     assert not loaded & {"build123d", "OCP", "matplotlib"}
+
+
+def test_listing_targets_loads_no_numpy() -> None:
+    # `camtool targets` builds every dialect: the matlab-router one imports numpy on use
+    loaded = _loaded_after("import camtool\ncamtool.list_targets()")
+    assert not loaded & set(HEAVY), sorted(loaded & set(HEAVY))
 
 
 def _docs_example() -> dict[str, Any]:
@@ -111,3 +119,17 @@ def test_docs_example_posts_and_verifies_plate_for_grbl(
     again = camtool.verify_code(ns["code"], target)
     assert again.deviation.max_um == pytest.approx(v.deviation.max_um)
     assert v.time_s > 0 and job.result.blocks > 0
+
+
+def test_the_type_checking_imports_are_the_public_names() -> None:
+    # __all__ derives from _HOMES; the TYPE_CHECKING block must name the same homes
+    tree = ast.parse((ROOT / "camtool" / "__init__.py").read_text(encoding="utf-8"))
+    block = next(n for n in tree.body if isinstance(n, ast.If))
+    seen = {
+        alias.name: node.module
+        for node in block.body
+        if isinstance(node, ast.ImportFrom)
+        for alias in node.names
+        if alias.asname == alias.name
+    }
+    assert seen == camtool._HOMES

@@ -15,7 +15,7 @@ duplicated lines and deleted sections. Hostile options (``--tool-diameter nan``,
 - when the exit is 0, have written a program that the target's own reader reads back
   (``load_target(name).post.parse(code)``) and that holds no nan/inf number.
 
-``CAMTOOL_FUZZ_SEED`` and ``CAMTOOL_FUZZ_MUTANTS`` (mutants per input, default 6) change the
+``CAMTOOL_FUZZ_SEED`` and ``CAMTOOL_FUZZ_MUTANTS`` (mutants per input, default 4) change the
 run; failures print the exact command and, for a mutant, where its input was written.
 """
 

@@ -378,8 +378,8 @@ _POST_OPTIONS = (
         default=0.001,
         show_default=True,
         metavar="MM",
-        help="Curves are fitted, and fitted arcs stay, this close to what they replace, mm "
-        "(entity ends are joined within --chain-tolerance).",
+        help="Curve tolerance (mm): fitted arcs, flattened curves and chords stay this "
+        "close to what they replace (chaining uses --chain-tolerance).",
     ),
     click.option(
         "--scale",

@@ -197,10 +197,6 @@ def snap(segs: Sequence[Segment]) -> list[Segment]:
     for seg in segs[1:]:
         prev = out[-1].end
         if seg.start != prev:
-            seg = (
-                Line(prev, seg.end)
-                if isinstance(seg, Line)
-                else Arc(prev, seg.end, seg.centre, seg.clockwise)
-            )
+            seg = with_start(seg, prev)
         out.append(seg)
     return out

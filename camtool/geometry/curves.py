@@ -23,8 +23,8 @@ from collections.abc import Callable, Sequence
 from typing import TypeAlias
 
 from camtool.geometry.arcfit import fit_curve
-from camtool.geometry.chain import snap
-from camtool.model.shapes import Arc, Line, Point, Segment, distance
+from camtool.geometry.chain import snap, with_end
+from camtool.model.shapes import Arc, Point, Segment, distance
 
 PointFn: TypeAlias = Callable[[float], Point]
 """A curve point (or derivative) at a parameter."""
@@ -172,12 +172,7 @@ def fit_pieces(
         return segs
     segs = snap(segs)
     if closed and segs[-1].end != segs[0].start:
-        last = segs[-1]
-        segs[-1] = (
-            Line(last.start, segs[0].start)
-            if isinstance(last, Line)
-            else Arc(last.start, segs[0].start, last.centre, last.clockwise)
-        )
+        segs[-1] = with_end(segs[-1], segs[0].start)
     return segs
 
 

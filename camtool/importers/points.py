@@ -36,7 +36,6 @@ from camtool.model.errors import InputError, UsageError
 from camtool.model.shapes import Contour, Drawing, Line, Point
 from camtool.model.units import LARGEST_VALUE, LENGTH_UNITS
 
-TEXT_SUFFIXES = (".csv", ".txt", ".xy")
 MATLAB_SUFFIX = ".m"
 DEFAULT_UNITS = "mm"
 """Unit of text point lists when ``--units`` is not given."""

@@ -96,7 +96,8 @@ class BatchOptions:
         machine_file: machine profile laid over the target's (file or built-in name).
         plan: the planning options (``offset``, ``tool_diameter``, ``feed_mm_min`` —
             ``None``: the target's default —, ``tolerance`` (also the importers'
-            chaining and curve-fit tolerance), ``scale``, ``depth``, ``order``...).
+            curve-fit tolerance; chaining uses ``chain_tolerance``), ``scale``,
+            ``depth``, ``order``...).
         output: the output format and spindle (``fmt``, ``spindle_rpm``,
             ``spindle_dwell_s``).
         layers: layers to keep (``None``: all).

@@ -6,7 +6,7 @@ G-code program (:data:`PROGRAM_SUFFIXES`), which is already a toolpath and is
 re-posted, not planned; ``-`` is standard input.
 
 A batch's inputs (:func:`expand_inputs`) are files, directories and shell-style
-globs, expanded. An input is, in this order:An input is, in this order:
+globs, expanded. An input is, in this order:
 
 - an existing directory: every file below it (recursively) whose ending camtool
   reads (:data:`READABLE_SUFFIXES`: drawings and G-code programs); hidden files

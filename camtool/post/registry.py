@@ -30,6 +30,7 @@ import copy
 import functools
 import importlib
 import importlib.util
+import itertools
 import tomllib
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, replace
@@ -107,6 +108,10 @@ class TomlTargets:
         """
         return copy.deepcopy(_parse_toml(self.package, self._files[name]))
 
+    def _parsed(self, name: str) -> Mapping[str, Any]:
+        """The cached parse of ``<name>.toml``, shared: read it, never modify it."""
+        return _parse_toml(self.package, self._files[name])
+
     def module(self, name: str, suffix: str = "") -> ModuleType | None:
         """The module ``<package>.<stem><suffix>`` of target ``name``, or ``None`` if none."""
         module = f"{self.package}.{name.replace('-', '_')}{suffix}"
@@ -117,7 +122,7 @@ class TomlTargets:
     def dialect(self, dialect: str) -> DialectFactory | None:
         """The factory of ``dialect`` if a target of this package declares and provides it."""
         for name in self.names():
-            if self.table(name).get("dialect") == dialect:
+            if self._parsed(name).get("dialect") == dialect:
                 module = self.module(name)
                 factory = getattr(module, "post_processor", None) if module else None
                 if callable(factory):
@@ -126,13 +131,13 @@ class TomlTargets:
 
     def dialects(self) -> set[str]:
         """Names of the dialects the targets of this package declare."""
-        return {str(self.table(n).get("dialect")) for n in self.names()}
+        return {str(self._parsed(n).get("dialect")) for n in self.names()}
 
     def profiles(self) -> dict[str, str]:
         """Machine profile name → the target whose ``[machine]`` table declares it."""
         found: dict[str, str] = {}
         for name in self.names():
-            machine = self.table(name).get("machine")
+            machine = self._parsed(name).get("machine")
             if isinstance(machine, Mapping) and isinstance(machine.get("profile"), str):
                 found.setdefault(machine["profile"], name)
         return found
@@ -339,9 +344,25 @@ def _with_machine_file(target: Target, machine_file: Path | str | None) -> Targe
     """``target`` with the ``[machine]`` table of ``machine_file`` laid over its machine."""
     if machine_file is None:
         return target
+    table, where = _machine_over(target.machine.table, target.origin, machine_file)
+    return replace(target, machine=machine_from_table(table, where=where))
+
+
+def _machine_over(
+    machine: Mapping[str, Any], where: str, machine_file: Path | str | None
+) -> tuple[Mapping[str, Any], str]:
+    """``machine`` (a ``[machine]`` table from ``where``) with ``machine_file`` laid over it.
+
+    Returns the table and where it comes from, for messages: ``where`` alone without
+    a machine file, else ``"<machine file> (over <where>)"``.
+
+    Raises:
+        InputError: the machine file is unknown, unreadable or not valid TOML.
+    """
+    if machine_file is None:
+        return machine, where
     override, where_override = machine_table(str(machine_file))
-    machine = machine_from_table(merge_tables(target.machine.table, override), where=where_override)
-    return replace(target, machine=machine)
+    return merge_tables(machine, override), f"{where_override} (over {where})"
 
 
 def _dialect(dialect: Any, where: str, provider: TomlTargets | None) -> DialectFactory:
@@ -359,11 +380,8 @@ def _dialect(dialect: Any, where: str, provider: TomlTargets | None) -> DialectF
         return word_address_dialect
     if isinstance(dialect, str):
         providers = [*([provider] if provider else []), *_builtin_providers()]
-        for p in providers:
-            if dialect in p.dialects() and (factory := p.dialect(dialect)):
-                return factory
-        for _, p in _plugin_providers():
-            if dialect in p.dialects() and (factory := p.dialect(dialect)):
+        for p in itertools.chain(providers, (p for _, p in _plugin_providers())):
+            if factory := p.dialect(dialect):
                 return factory
     known = {WORD_ADDRESS} | {d for p in _builtin_providers() for d in p.dialects()}
     raise InputError(f"{where}: unknown dialect {dialect!r}; known: {sorted(known)}")
@@ -389,10 +407,7 @@ def _target_from_table(
     where_machine = where
     if isinstance(machine, str):
         machine, where_machine = machine_table(machine)
-    if machine_file is not None:
-        override, where_override = machine_table(str(machine_file))
-        machine = merge_tables(machine, override)
-        where_machine = f"{where_override} (over {where_machine})"
+    machine, where_machine = _machine_over(machine, where_machine, machine_file)
     post = factory(options, where)
     return Target(
         name=str(table.get("name", Path(where).stem)),

@@ -13,7 +13,9 @@ from camtool.model.shapes import Contour, Line, distance
 from camtool.model.units import fmt_point
 from camtool.toolpath.cuts import Finding, where
 
-_GAP_SHARE = 0.1  # a gap closed by close_gaps is shorter than this share of the contour
+GAP_SHARE = 0.1
+"""A gap :func:`close_gaps` closes is shorter than this share of its contour's length;
+a longer one is a deliberate "C" (:func:`camtool.toolpath.gaps.open_gaps` skips it too)."""
 
 
 def close_gaps(
@@ -46,7 +48,7 @@ def close_gaps(
             contour.closed
             or max_gap <= 0
             or not tolerance < gap <= max_gap
-            or gap >= _GAP_SHARE * contour.length
+            or gap >= GAP_SHARE * contour.length
         ):
             out.append(contour)
             continue

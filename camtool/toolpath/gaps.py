@@ -15,6 +15,7 @@ from collections.abc import Sequence
 from camtool.geometry.chain import joint_distance
 from camtool.model.shapes import Contour, Point
 from camtool.model.units import fmt_num, fmt_point
+from camtool.toolpath.chain import GAP_SHARE
 from camtool.toolpath.cuts import Finding, where
 from camtool.toolpath.options import PlanOptions
 
@@ -67,7 +68,7 @@ def open_gaps(contours: Sequence[Contour], options: PlanOptions) -> list[Finding
             best[(int(a), int(b))] = gap
     found: list[tuple[float, Finding]] = []
     for (a, b), gap in sorted(best.items(), key=lambda item: item[1]):
-        if ends[a][0] == ends[b][0] and gap >= 0.1 * contours[ends[a][0]].length:
+        if ends[a][0] == ends[b][0] and gap >= GAP_SHARE * contours[ends[a][0]].length:
             continue  # a "C": drawn open on purpose (close_gaps leaves it too)
         found.append((gap, _finding(contours, ends[a], ends[b], gap, options)))
     out = [f for _, f in found[:MAX_REPORTED]]

@@ -59,6 +59,7 @@ _FLAG_NAMES = {
     "feed_mm_min": "--feed",
     "placement": "--origin",
     "reverse_open": "--reverse-open",
+    "origin": "the start position (PlanOptions.origin)",  # API only: --origin is placement
 }
 
 
@@ -98,9 +99,10 @@ class PlanOptions:
         feed_mm_min: cutting feed, mm/min (> 0); ``None``: the target's default,
             filled in by :func:`camtool.jobs.pipeline.plan_options` before planning
             (:attr:`feed` refuses to plan without one).
-        tolerance: chaining and arc-fitting tolerance, mm (> 0): ends closer than
-            this meet; fitted arcs stay this close to what they replace.
-        close_gap: contours whose ends are further apart than ``tolerance`` but
+        tolerance: curve tolerance, mm (> 0): fitted arcs, offsets and chords stay
+            this close to what they replace. Chaining uses ``chain_tolerance``
+            (``--chain-tolerance``), not this.
+        close_gap: contours whose ends are further apart than ``chain_tolerance`` but
             at most this far (mm), and less than a tenth of their length, are
             closed with a warning; 0 closes nothing.
         origin: tool position before the program, mm.
@@ -378,11 +380,6 @@ class PlanOptions:
         """Flags of the fields among ``names`` that differ from their defaults."""
         fields = type(self).__dataclass_fields__
         return [flag(n) for n in names if getattr(self, n) != fields[n].default]
-
-    @property
-    def uses_z(self) -> bool:
-        """True when the plan writes Z (a depth was given)."""
-        return self.depth is not None
 
     def z_options(self) -> list[str]:
         """The depth options given, as flags (for the 2D-target error)."""

@@ -20,6 +20,7 @@ from camtool.model.errors import InputError, ToolpathError, UsageError
 from camtool.model.shapes import MAX_CHORDS, Contour, Line, chord_count
 from camtool.toolpath import offset, pocket_uncut
 from camtool.toolpath.chain import close_gaps
+from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.pocket import MAX_POCKET_PATHS
 
 
@@ -130,3 +131,12 @@ def test_closed_gap_message_never_prints_minus_zero() -> None:
     _, findings = close_gaps([drawn], 0.02, 0.001)
     assert "at (0.0000, 0.0050) mm" in findings[0].message
     assert "-0.0000" not in findings[0].message
+
+
+def test_a_bad_start_position_is_not_called_the_origin_option() -> None:
+    # PlanOptions.origin is the API's start position; --origin sets PlanOptions.placement
+    with pytest.raises(UsageError) as caught:
+        PlanOptions(origin=(math.nan, 0.0))
+    message = str(caught.value)
+    assert "--origin" not in message
+    assert "PlanOptions.origin" in message

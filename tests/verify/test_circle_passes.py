@@ -6,6 +6,7 @@ circle once per pass; the circle fit must see through both.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Any
 
@@ -27,3 +28,6 @@ def test_a_circle_in_three_passes_has_its_diameter_measured(
     err = capsys.readouterr().err
     # one circle of 10 mm, cut on the line (GRBL's 4 µm steps: within a few µm)
     assert "nominal 10.0000" in err
+    fitted = re.search(r"diameter (\d+\.\d+) mm \(nominal 10\.0000\)", err)
+    assert fitted is not None, err
+    assert abs(float(fitted[1]) - 10.0) < 0.01  # mm (9.9973 today: 2.7 µm)

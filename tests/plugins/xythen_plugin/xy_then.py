@@ -7,16 +7,14 @@ with no edit in ``camtool/``; its profile is ``xy-then.toml`` beside this file.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import ClassVar
 
 import numpy as np
 
-from camtool.model.machine import Machine
-from camtool.verify.motion import MotionHooks, fixed_line
+from camtool.verify.motion import MotionHooks, fixed_line, timing_class
 from camtool.verify.steparray import STEP_DTYPE, StepArray, freeze
-from camtool.verify.timing import BlockKinematics, FloatArray, positive, seconds, timing_from_table
+from camtool.verify.timing import BlockKinematics, FloatArray, positive, seconds
 
 
 def x_then_y(dx: int, dy: int) -> StepArray:
@@ -42,9 +40,7 @@ class FixedBlockTiming:
         return seconds(np.full(len(blocks), self.seconds_per_block))
 
 
-def _timing(table: Mapping[str, Any], machine: Machine | None, where: str) -> FixedBlockTiming:
-    model: FixedBlockTiming = timing_from_table(FixedBlockTiming, table, where=where)
-    return model
-
-
-MOTION = MotionHooks(lines={"x-then-y": fixed_line(x_then_y)}, timing={"fixed-block": _timing})
+MOTION = MotionHooks(
+    lines={"x-then-y": fixed_line(x_then_y)},
+    timing={"fixed-block": timing_class(FixedBlockTiming)},
+)
