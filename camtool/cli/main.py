@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from camtool.cli.batch import batch
+from camtool.cli.calibrate import calibrate
 from camtool.cli.common import (
     MACHINE,
     NUMBER,
@@ -355,6 +356,7 @@ def _target_json(entry: TargetEntry) -> dict[str, Any]:
 
 cli.add_command(preview)
 cli.add_command(batch)
+cli.add_command(calibrate)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,0 +1,82 @@
+"""Calibration: a coupon that measures what a machine profile models, and a least-squares fit.
+
+:mod:`camtool.calibrate.coupon` lays out the test features (seed-000 §5: the U pattern per axis
+and backlash region, 2.5 mm squares, ø6/4/2 circles; a long move per axis for steps/mm) and
+turns them into a program for a target; :mod:`camtool.calibrate.predict` measures each feature
+on the verifier's simulation exactly as the sheet tells a machinist to;
+:mod:`camtool.calibrate.sheet` writes the measurement sheet and reads it back filled in;
+:mod:`camtool.calibrate.fit` fits the profile's parameters to the measurements and writes a
+``--machine`` overlay.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from camtool.calibrate.coupon import Coupon
+    from camtool.calibrate.fit import FitResult
+    from camtool.post.base import Target
+
+
+@dataclass(frozen=True)
+class CouponFiles:
+    """What ``camtool calibrate coupon`` writes.
+
+    Attributes:
+        coupon: the coupon (features and program).
+        code: the program in the target's dialect (``bytes`` for a binary one).
+        markdown: the sheet to print (:func:`camtool.calibrate.sheet.sheet_markdown`).
+        csv: the template to fill in (:func:`camtool.calibrate.sheet.sheet_csv`).
+        warnings: what the post-processor said.
+    """
+
+    coupon: Coupon
+    code: str | bytes
+    markdown: str
+    csv: str
+    warnings: tuple[str, ...]
+
+
+def make_coupon(
+    target: Target, *, code_name: str = "the coupon program", csv_name: str = "coupon.csv"
+) -> CouponFiles:
+    """The default coupon of ``target``, posted and read back through it, and its sheet.
+
+    Raises:
+        UsageError: the travel is too small for a coupon.
+        DialectError: the target cannot write a feature or does not keep it.
+    """
+    from camtool.calibrate.coupon import build_coupon
+    from camtool.calibrate.predict import read_back
+    from camtool.calibrate.sheet import sheet_csv, sheet_markdown
+
+    coupon = build_coupon(target)
+    result = target.emit(coupon.program)
+    target.parse(result.code, source=code_name)  # the coupon reads back with the target's reader
+    read_back(coupon, target)  # and every feature keeps its strokes
+    return CouponFiles(
+        coupon,
+        result.code,
+        sheet_markdown(coupon, target.machine, code=code_name, csv=csv_name),
+        sheet_csv(coupon, target.machine),
+        result.warnings,
+    )
+
+
+def fit_sheet(target: Target, text: str, *, source: str) -> FitResult:
+    """Fit ``target``'s profile to a filled-in sheet of its default coupon.
+
+    Raises:
+        InputError: the sheet is not valid (names ``source``, line and column), holds no
+            measured value, or is of another coupon.
+    """
+    from camtool.calibrate.coupon import build_coupon
+    from camtool.calibrate.fit import fit
+    from camtool.calibrate.predict import read_back
+    from camtool.calibrate.sheet import read_measurements
+
+    coupon = build_coupon(target)
+    observations = read_measurements(text, coupon, source=source)
+    return fit(read_back(coupon, target), target.machine, observations, target=target.name)

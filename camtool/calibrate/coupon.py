@@ -1,0 +1,616 @@
+"""The calibration coupon: test features that measure what a machine profile models.
+
+Every feature is the seed-000 §5 procedure or a direct extension of it (seed-000 §5.2, Tablas
+13-15; seed-001 §5 and §6.1; seed-004 §5.1):
+
+- **U pattern** per axis (and per backlash region where the profile has regions, seed-000
+  Tabla 13): a line along the axis, a short step across, the line back. The first line is cut
+  after an approach that takes up the play, so its length measures the scale; the second is
+  cut after a reversal, so the difference measures the backlash left after compensation.
+- **Squares** (seed-000 Tabla 14, 2.5 mm): cut counter-clockwise from the lower-left corner;
+  the top edge is cut after the X reversal and the left edge after the Y reversal, so their
+  lengths carry each axis's scale and backlash residual.
+- **Circles** of three sizes, concentric, cut clockwise from the top (seed-000 Tabla 15,
+  ø6/4/2 mm): the mean of eight diameters, every 22.5°.
+- **Long moves** per axis (seed-004 Tables 14-16, ten moves of 8 mm): ten equal segments in
+  the + direction, each end marked; the distance of each mark from the start measures steps/mm.
+
+Every feature starts with an **approach**: a short cut towards its first point in the direction
+of its first stroke on both axes, longer than the profile's backlash, so the play is taken up
+before the first stroke (seed-001 §5: "approach the start point moving in the same direction as
+the first line"). Features are laid out in the work area (:func:`build_coupon`) and scaled with
+the travel; the coupon program is posted through the target like any program.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
+
+from camtool.model.errors import UsageError
+from camtool.model.machine import AXES, Machine
+from camtool.model.program import ArcMove, Linear, Move, Program, Rapid
+from camtool.model.shapes import BBox, Point
+
+if TYPE_CHECKING:
+    from camtool.post.base import Target
+
+DIAMETER_ANGLES_DEG: tuple[float, ...] = tuple(22.5 * k for k in range(8))
+"""Directions of the eight diameters of a circle (seed-000 Tabla 15 measured ø1-ø8; the angles
+are only in the lost Fig. 54, so every 22.5° is our choice)."""
+SEGMENTS = 10
+"""Segments of a long move (seed-004 §5.1: "10 tramos de 8mm")."""
+SAFE_Z_MM = 2.0
+"""Height of the rapids between features on a machine with Z, mm above the work."""
+MIN_STEPS = 40
+"""Fewest motor steps across the smallest feature (a ø2 circle at scale 1) for it to be
+measurable; a smaller travel is refused."""
+MAX_CIRCLE_STEPS = 2_000_000
+"""Most motor steps around the largest circle (the simulation's size)."""
+SCALES: tuple[float, ...] = (10, 8, 6, 5, 4, 3, 2.5, 2, 1.5, 1.2, 1, 0.8, 0.6, 0.5, 0.4, 0.3)
+"""Coupon scales tried, largest first (1 = the seed-000 sizes: U 2.5/1.2 mm, squares 2.5 mm,
+circles ø6/4/2 mm)."""
+
+
+@dataclass(frozen=True)
+class Measure:
+    """One number a machinist measures on the coupon.
+
+    Attributes:
+        id: the feature id and the measure (``"UX-2.back"``): the sheet's row key.
+        what: what to measure, for the sheet.
+        at_mm: where, mm (work coordinates): the middle of the mark.
+        nominal_mm: the value if the machine were perfect, mm.
+        kind: ``"length"`` (extent along ``axis`` of the marks of ``strokes``),
+            ``"diameter"`` (mean width of the marks of ``strokes`` across the
+            directions ``angles_deg``) or ``"position"`` (distance along ``axis`` from
+            the start of the first stroke to the end of ``strokes[-1]``).
+        axis: 0 = X, 1 = Y, 2 = Z (``length``, ``position``); -1 for ``diameter``.
+        strokes: indices into the feature's :attr:`Feature.strokes`.
+        angles_deg: directions of the diameters (``diameter``), degrees from +X.
+    """
+
+    id: str
+    what: str
+    at_mm: Point
+    nominal_mm: float
+    kind: str
+    axis: int
+    strokes: tuple[int, ...]
+    angles_deg: tuple[float, ...] = DIAMETER_ANGLES_DEG
+
+
+@dataclass(frozen=True)
+class Feature:
+    """A test feature: its lead-in, its strokes and what is measured on them.
+
+    Attributes:
+        id: short id (``"UX-2"``, ``"SQ1"``, ``"C6"``, ``"LX"``).
+        title: one line for the sheet.
+        origin_mm: where the tool stands before ``lead`` (the approach's start), mm.
+        lead: the approach moves (take up the play; not measured).
+        strokes: the measured moves, in order.
+        measures: what is measured.
+        region: the backlash region the feature measures, ``""`` for none
+            (``"x: y 2.333…4.667 mm"``).
+    """
+
+    id: str
+    title: str
+    origin_mm: Point
+    lead: tuple[Move, ...]
+    strokes: tuple[Move, ...]
+    measures: tuple[Measure, ...]
+    region: str = ""
+
+    @property
+    def moves(self) -> tuple[Move, ...]:
+        """Lead and strokes, in order."""
+        return (*self.lead, *self.strokes)
+
+    def program(self) -> Program:
+        """The feature alone, from its origin (what :mod:`camtool.calibrate.predict` runs)."""
+        return Program(self.moves, origin=self.origin_mm)
+
+    def bbox(self) -> BBox:
+        """Footprint in XY (origin, lead and strokes, arcs by their extremes), mm."""
+        return self.program().bbox()
+
+    def moved(self, dx: float, dy: float) -> Feature:
+        """The feature translated by ``(dx, dy)`` mm."""
+        return replace(
+            self,
+            origin_mm=(self.origin_mm[0] + dx, self.origin_mm[1] + dy),
+            lead=tuple(translated(m, dx, dy) for m in self.lead),
+            strokes=tuple(translated(m, dx, dy) for m in self.strokes),
+            measures=tuple(
+                replace(m, at_mm=(m.at_mm[0] + dx, m.at_mm[1] + dy)) for m in self.measures
+            ),
+        )
+
+
+def translated(move: Move, dx: float, dy: float) -> Move:
+    """``move`` translated by ``(dx, dy)`` mm (an arc's centre too)."""
+    if isinstance(move, ArcMove):
+        return replace(move, x=move.x + dx, y=move.y + dy, cx=move.cx + dx, cy=move.cy + dy)
+    return replace(move, x=move.x + dx, y=move.y + dy)
+
+
+@dataclass(frozen=True)
+class Coupon:
+    """A coupon for one target.
+
+    Attributes:
+        target: the target's name.
+        scale: size of the features against seed-000's (1: U 2.5/1.2 mm, squares 2.5 mm,
+            circles ø6/4/2 mm); ``0`` for a coupon of hand-made features.
+        features: the features, in cutting order.
+        program: the coupon program (every feature with rapids between), mm.
+    """
+
+    target: str
+    scale: float
+    features: tuple[Feature, ...]
+    program: Program
+
+    @property
+    def measures(self) -> tuple[Measure, ...]:
+        """Every measure of every feature, in sheet order."""
+        return tuple(m for f in self.features for m in f.measures)
+
+
+# --- features (local builders, absolute mm) -------------------------------------------------
+
+
+def u_pattern(
+    fid: str, axis: int, start: Point, length: float, gap: float, approach: float, feed: float
+) -> Feature:
+    """The seed-000 §5.2 U pattern along ``axis`` (0 = X, 1 = Y) from ``start``.
+
+    Out along +axis by ``length``, across by ``gap`` (+ the other axis), back by ``length``.
+    Measures: ``out`` and ``back`` lengths (seed-000 Tabla 13: their difference is the backlash).
+    """
+    other = 1 - axis
+    x0, y0 = start
+    name = AXES[axis].upper()
+
+    def at(along: float, across: float) -> Point:
+        p = [0.0, 0.0]
+        p[axis], p[other] = along, across
+        return (x0 + p[0], y0 + p[1])
+
+    strokes = (
+        Linear(*at(length, 0.0), feed),
+        Linear(*at(length, gap), feed),
+        Linear(*at(0.0, gap), feed),
+    )
+    measures = (
+        Measure(
+            f"{fid}.out",
+            f"length of the first {name} line (cut in +{name}), end to end",
+            at(length / 2, 0.0),
+            length,
+            "length",
+            axis,
+            (0,),
+        ),
+        Measure(
+            f"{fid}.back",
+            f"length of the second {name} line (cut in -{name}, after the reversal), end to end",
+            at(length / 2, gap),
+            length,
+            "length",
+            axis,
+            (2,),
+        ),
+    )
+    return Feature(
+        fid,
+        f"U pattern along {name}: {length:g} mm lines {gap:g} mm apart",
+        _before(start, (1.0, 1.0), approach),
+        (Linear(x0, y0, feed),),
+        strokes,
+        measures,
+    )
+
+
+def rectangle(
+    fid: str, corner: Point, size: tuple[float, float], approach: float, feed: float
+) -> Feature:
+    """A rectangle cut counter-clockwise from its lower-left ``corner`` (seed-000 Tabla 14).
+
+    Measures: ``dx``, the top edge (cut in -X after the X reversal), and ``dy``, the left
+    edge (cut in -Y after the Y reversal), each end to end.
+    """
+    x0, y0 = corner
+    w, h = size
+    strokes = (
+        Linear(x0 + w, y0, feed),
+        Linear(x0 + w, y0 + h, feed),
+        Linear(x0, y0 + h, feed),
+        Linear(x0, y0, feed),
+    )
+    measures = (
+        Measure(
+            f"{fid}.dx",
+            "length of the top edge (cut in -X), from the top-right corner to the end of the mark",
+            (x0 + w / 2, y0 + h),
+            w,
+            "length",
+            0,
+            (2,),
+        ),
+        Measure(
+            f"{fid}.dy",
+            "length of the left edge (cut in -Y), from the top-left corner to the end of the mark",
+            (x0, y0 + h / 2),
+            h,
+            "length",
+            1,
+            (3,),
+        ),
+    )
+    kind = "square" if w == h else "rectangle"
+    return Feature(
+        fid,
+        f"{w:g} x {h:g} mm {kind}, counter-clockwise from the lower-left corner",
+        _before(corner, (1.0, 1.0), approach),
+        (Linear(x0, y0, feed),),
+        strokes,
+        measures,
+    )
+
+
+def circle(fid: str, centre: Point, diameter: float, approach: float, feed: float) -> Feature:
+    """A full circle cut clockwise from its top (seed-000 Tabla 15).
+
+    Measures: ``h`` and ``v``, the horizontal and vertical diameters (seed-001 §6.2), and
+    ``mean``, the mean of eight diameters every 22.5° (:data:`DIAMETER_ANGLES_DEG`, seed-000
+    Tabla 15).
+    """
+    cx, cy = centre
+    r = diameter / 2.0
+    top = (cx, cy + r)
+    across = "from the centre line of the mark to the centre line opposite"
+    measures = (
+        Measure(
+            f"{fid}.h",
+            f"horizontal diameter (along X), {across}",
+            centre,
+            diameter,
+            "diameter",
+            -1,
+            (0,),
+            (0.0,),
+        ),
+        Measure(
+            f"{fid}.v",
+            f"vertical diameter (along Y), {across}",
+            centre,
+            diameter,
+            "diameter",
+            -1,
+            (0,),
+            (90.0,),
+        ),
+        Measure(
+            f"{fid}.mean",
+            f"mean of 8 diameters every 22.5° from the X axis, {across}",
+            centre,
+            diameter,
+            "diameter",
+            -1,
+            (0,),
+        ),
+    )
+    return Feature(
+        fid,
+        f"ø{diameter:g} mm circle, clockwise from the top",
+        _before(top, (1.0, -1.0), approach),
+        (Linear(*top, feed),),
+        (ArcMove(cx, cy + r, cx, cy, True, feed),),
+        measures,
+    )
+
+
+def long_move(
+    fid: str, axis: int, start: Point, segment: float, approach: float, feed: float
+) -> Feature:
+    """A long move along +``axis`` (0 = X, 1 = Y) in :data:`SEGMENTS` equal segments.
+
+    Measures ``p1`` … ``p10``: travel from the start to the end of each segment, measured on the
+    carriage (seed-004 Tables 14-16: a vernier after each move of 8 mm).
+    """
+    name = AXES[axis].upper()
+    direction = (1.0, 0.0) if axis == 0 else (0.0, 1.0)
+    x0, y0 = start
+    strokes = []
+    measures = []
+    for i in range(1, SEGMENTS + 1):
+        end = (x0 + direction[0] * segment * i, y0 + direction[1] * segment * i)
+        strokes.append(Linear(*end, feed))
+        measures.append(
+            Measure(
+                f"{fid}.p{i}",
+                f"travel along {name} from the start to the end of segment {i} (the carriage "
+                "against a vernier or dial indicator, as seed-004 measured it)",
+                end,
+                segment * i,
+                "position",
+                axis,
+                tuple(range(i)),
+            )
+        )
+    return Feature(
+        fid,
+        f"long move along +{name}: {SEGMENTS} segments of {segment:g} mm",
+        _before(start, (1.0, 1.0), approach),
+        (Linear(x0, y0, feed),),
+        tuple(strokes),
+        tuple(measures),
+    )
+
+
+def long_move_z(fid: str, at: Point, segment: float, approach: float, feed: float) -> Feature:
+    """A long move along +Z (up from the work) in :data:`SEGMENTS` segments (seed-004 Table 14).
+
+    Measures ``p1`` … ``p10`` with a height gauge or the vernier's depth rod: the height of
+    each stop above the first.
+    """
+    x, y = at
+    strokes = [Linear(x, y, feed, z=approach + segment * i) for i in range(1, SEGMENTS + 1)]
+    measures = tuple(
+        Measure(
+            f"{fid}.p{i}",
+            f"height of stop {i} above the start (Z), e.g. with a dial gauge on the spindle",
+            at,
+            segment * i,
+            "position",
+            2,
+            tuple(range(i)),
+        )
+        for i in range(1, SEGMENTS + 1)
+    )
+    return Feature(
+        fid,
+        f"long move along +Z: {SEGMENTS} segments of {segment:g} mm (no mark: measure the stops)",
+        at,
+        (Linear(x, y, feed, z=0.0), Linear(x, y, feed, z=approach)),
+        tuple(strokes),
+        measures,
+    )
+
+
+def _before(point: Point, direction: tuple[float, float], approach: float) -> Point:
+    """Where an approach of ``approach`` mm towards ``point`` along ``direction`` starts."""
+    return (point[0] - direction[0] * approach, point[1] - direction[1] * approach)
+
+
+# --- the coupon -------------------------------------------------------------------------------
+
+
+def coupon_from_features(
+    target: Target, features: Sequence[Feature], *, scale: float = 0.0
+) -> Coupon:
+    """A coupon of ``features`` (in cutting order) for ``target``: its program joins them.
+
+    Between features: a rapid to the next origin (on a machine with Z, up to
+    :data:`SAFE_Z_MM` first and down to Z 0 there).
+
+    Raises:
+        UsageError: two features share an id.
+    """
+    ids = [f.id for f in features]
+    if len(set(ids)) != len(ids):
+        raise UsageError(f"coupon features must have distinct ids, got {ids}")
+    has_z = target.machine.has_z
+    feed = target.default_feed_mm_min
+    moves: list[Move] = []
+    here = features[0].origin_mm if features else (0.0, 0.0)
+    for feature in features:
+        ox, oy = feature.origin_mm
+        if has_z:
+            moves.append(Rapid(*here, z=SAFE_Z_MM))
+            moves.append(Rapid(ox, oy))
+            first = feature.lead[0] if feature.lead else None
+            if not (isinstance(first, Linear) and first.z == 0.0):
+                moves.append(Linear(ox, oy, feed, z=0.0))
+        elif moves:
+            moves.append(Rapid(ox, oy))
+        moves.extend(feature.moves)
+        last = feature.moves[-1]
+        here = (last.x, last.y)
+    if has_z:
+        moves.append(Rapid(*here, z=SAFE_Z_MM))
+    origin = features[0].origin_mm if features else (0.0, 0.0)
+    notes = (
+        f"calibration coupon for {target.name}: {len(features)} features "
+        f"({', '.join(ids)}); measure them as the sheet says",
+    )
+    program = Program(tuple(moves), origin=origin, notes=notes)
+    return Coupon(target.name, scale, tuple(features), program)
+
+
+def approach_mm(machine: Machine) -> float:
+    """Length of every feature's approach, mm: longer than any backlash the profile knows.
+
+    1.5 × the largest true or compensated backlash of X and Y (regions included), at least
+    2 % of the shorter travel and 20 motor steps.
+    """
+    b = machine.backlash
+    largest = max(
+        [*b.true_um[:2], *b.compensation_um[:2], *(r.true_um for r in b.regions)], default=0.0
+    )
+    travel = min(machine.travel_mm)
+    return max(1.5 * largest / 1000.0, 0.02 * travel, 20.0 / min(machine.steps_per_mm[:2]))
+
+
+def build_coupon(target: Target) -> Coupon:
+    """The default coupon of ``target``, laid out in its work area at the largest scale that fits.
+
+    Scale 1 is seed-000's sizes; a machine with a larger travel gets a larger coupon (up to
+    10×, and no circle of more than :data:`MAX_CIRCLE_STEPS` steps), a smaller one a smaller
+    coupon. Features: a long move along X and along Y (and Z on a machine with Z), a U pattern
+    per axis and per backlash region of the profile (one per axis when it has none), three
+    squares and three concentric circles.
+
+    Raises:
+        UsageError: the travel is too small for a measurable coupon (names the size needed).
+    """
+    machine = target.machine
+    spm = min(machine.steps_per_mm[:2])
+    largest = min(10.0, MAX_CIRCLE_STEPS / (math.pi * 6.0 * spm))
+    smallest = MIN_STEPS / (2.0 * spm)
+    for scale in SCALES:
+        if scale > largest or scale < smallest:
+            continue
+        features = _layout(target, scale)
+        if features is not None:
+            return coupon_from_features(target, features, scale=scale)
+    w, h = machine.travel_mm
+    raise UsageError(
+        f"the travel of {target.name} ({w:g} x {h:g} mm) is too small for a calibration coupon "
+        f"(the smallest, at scale {max(smallest, SCALES[-1]):g}, needs about "
+        f"{10 * max(smallest, SCALES[-1]) + 2:g} x {7 * max(smallest, SCALES[-1]) + 2:g} mm); "
+        "give the real work_area_mm with --machine"
+    )
+
+
+def _layout(target: Target, scale: float) -> list[Feature] | None:
+    """The default features placed in the work area at ``scale``, or ``None`` if they do not fit."""
+    machine = target.machine
+    feed = target.default_feed_mm_min
+    a = approach_mm(machine)
+    x0, y0, x1, y1 = machine.work_area_mm
+    margin = a + 0.02 * min(machine.travel_mm)
+    packer = _Packer((x0 + margin, y0 + margin, x1 - margin, y1 - margin), gap=a)
+    out: list[Feature] = []
+    w, h = packer.width, packer.height
+    seg_x = _nice_floor((w - a) / SEGMENTS)
+    if seg_x <= 0:
+        return None
+    for make in (
+        lambda: long_move("LX", 0, (0.0, 0.0), seg_x, a, feed),
+        lambda: long_move("LY", 1, (0.0, 0.0), _nice_floor((h - 3 * a) / SEGMENTS), a, feed),
+    ):
+        feature = make()
+        placed = packer.place(feature)
+        if placed is None:
+            return None
+        out.append(placed)
+    regions = machine.backlash.regions
+    for axis, length in ((0, 2.5 * scale), (1, 1.2 * scale)):
+        gap = 0.3 * scale
+        mine = [r for r in regions if r.axis == AXES[axis]]
+        name = "UX" if axis == 0 else "UY"
+        for i, region in enumerate(mine or [None], start=1):
+            fid = f"{name}-{i}" if region is not None else name
+            feature = u_pattern(fid, axis, (0.0, 0.0), length, gap, a, feed)
+            bounds = None
+            if region is not None:
+                bounds = (region.x_mm[0], region.y_mm[0], region.x_mm[1], region.y_mm[1])
+                feature = replace(feature, region=_region_text(region.x_mm, region.y_mm))
+            placed = packer.place(feature, within=bounds)
+            if placed is None:
+                return None
+            out.append(placed)
+    for i in range(1, 4):
+        placed = packer.place(rectangle(f"SQ{i}", (0.0, 0.0), (2.5 * scale,) * 2, a, feed))
+        if placed is None:
+            return None
+        out.append(placed)
+    rings = [circle(f"C{d:g}", (0.0, 0.0), d * scale, a, feed) for d in (6, 4, 2)]
+    shift = packer.place_group(rings)
+    if shift is None:
+        return None
+    out.extend(shift)
+    if machine.has_z:
+        seg_z = _nice_floor(min(20.0, 0.1 * min(machine.travel_mm)) / SEGMENTS)
+        spot = packer.place(long_move_z("LZ", (0.0, 0.0), seg_z, a, feed))
+        if spot is None:
+            return None
+        out.append(spot)
+    return out
+
+
+def _region_text(x_mm: tuple[float, float], y_mm: tuple[float, float]) -> str:
+    parts = []
+    if x_mm[0] > -999 or x_mm[1] < 999:
+        parts.append(f"X {x_mm[0]:g}…{x_mm[1]:g}")
+    if y_mm[0] > -999 or y_mm[1] < 999:
+        parts.append(f"Y {y_mm[0]:g}…{y_mm[1]:g}")
+    return " ".join(parts) + " mm" if parts else "everywhere"
+
+
+def _nice_floor(value: float) -> float:
+    """The largest of 1, 1.2, 1.5, 2, 2.5, 3, 4, 5, 6, 8 × 10^k not above ``value`` (0 if <= 0)."""
+    if value <= 0:
+        return 0.0
+    power = 10.0 ** math.floor(math.log10(value))
+    for m in (8.0, 6.0, 5.0, 4.0, 3.0, 2.5, 2.0, 1.5, 1.2, 1.0):
+        if m * power <= value * (1 + 1e-12):
+            return m * power
+    return power
+
+
+class _Packer:
+    """Bottom-left placement of footprints in a box without overlaps (local to one layout)."""
+
+    def __init__(self, box: BBox, *, gap: float) -> None:
+        self.box, self.gap = box, gap
+        self.placed: list[BBox] = []
+
+    @property
+    def width(self) -> float:
+        return self.box[2] - self.box[0]
+
+    @property
+    def height(self) -> float:
+        return self.box[3] - self.box[1]
+
+    def place(self, feature: Feature, *, within: BBox | None = None) -> Feature | None:
+        group = self.place_group([feature], within=within)
+        return None if group is None else group[0]
+
+    def place_group(
+        self, features: Sequence[Feature], *, within: BBox | None = None
+    ) -> list[Feature] | None:
+        """The features moved together to the lowest, then leftmost, free spot (``None``: none)."""
+        boxes = [f.bbox() for f in features]
+        fx0 = min(b[0] for b in boxes)
+        fy0 = min(b[1] for b in boxes)
+        fw = max(b[2] for b in boxes) - fx0
+        fh = max(b[3] for b in boxes) - fy0
+        area = self.box
+        if within is not None:
+            area = (
+                max(area[0], within[0]),
+                max(area[1], within[1]),
+                min(area[2], within[2]),
+                min(area[3], within[3]),
+            )
+        xs = {area[0], *(b[2] + self.gap for b in self.placed)}
+        ys = {area[1], *(b[3] + self.gap for b in self.placed)}
+        for y in sorted(ys):
+            for x in sorted(xs):
+                spot = (x, y, x + fw, y + fh)
+                if spot[2] > area[2] + 1e-9 or spot[3] > area[3] + 1e-9:
+                    continue
+                if x < area[0] - 1e-9 or y < area[1] - 1e-9:
+                    continue
+                if any(_overlap(spot, b, self.gap) for b in self.placed):
+                    continue
+                self.placed.append(spot)
+                return [f.moved(x - fx0, y - fy0) for f in features]
+        return None
+
+
+def _overlap(a: BBox, b: BBox, gap: float) -> bool:
+    return not (
+        a[2] + gap <= b[0] + 1e-9
+        or b[2] + gap <= a[0] + 1e-9
+        or a[3] + gap <= b[1] + 1e-9
+        or b[3] + gap <= a[1] + 1e-9
+    )

@@ -1,0 +1,93 @@
+"""``camtool calibrate``: a coupon to cut and measure, and a fit of the machine profile to it."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from camtool.cli.common import MACHINE, warn, write_output
+from camtool.model.errors import InputError, UsageError
+
+TARGET = click.option(
+    "--target",
+    "-t",
+    required=True,
+    metavar="NAME",
+    help="Machine and dialect (see `camtool targets`), or a target .toml file.",
+)
+
+
+@click.group()
+def calibrate() -> None:
+    """Calibrate a machine profile: cut a coupon, measure it, fit the profile to it."""
+
+
+@calibrate.command()
+@TARGET
+@click.option("-o", "--output", required=True, metavar="FILE", help="The coupon program.")
+@click.option(
+    "--sheet",
+    default=None,
+    metavar="FILE",
+    help="Where the measurement sheet goes: FILE.md and FILE.csv (default: next to -o).",
+)
+@MACHINE
+def coupon(target: str, output: str, sheet: str | None, machine_file: Path | None) -> None:
+    """Write a calibration coupon for a target and its measurement sheet (.md and .csv)."""
+    from camtool.calibrate import make_coupon
+    from camtool.jobs.output import check_paths
+    from camtool.jobs.pipeline import load_target_checked
+
+    if sheet is None and output == "-":
+        raise UsageError("-o - writes the coupon to stdout: give --sheet FILE for the sheet")
+    stem = Path(sheet if sheet is not None else output).with_suffix("")
+    md, csv = f"{stem}.md", f"{stem}.csv"
+    check_paths(
+        [],
+        [("-o", output), ("--sheet", md), ("--sheet", csv)],
+        target=target,
+        machine_file=machine_file,
+    )
+    files = make_coupon(
+        load_target_checked(target, machine_file=machine_file),
+        code_name=Path(output).name if output != "-" else "the coupon program",
+        csv_name=Path(csv).name,
+    )
+    warn(list(files.warnings))
+    write_output(files.code, output)
+    write_output(files.markdown, md)
+    write_output(files.csv, csv)
+    click.echo(
+        f"camtool: coupon of {len(files.coupon.features)} features, "
+        f"{len(files.coupon.measures)} measures; sheet {md}, {csv}",
+        err=True,
+    )
+
+
+@calibrate.command()
+@TARGET
+@click.argument("measured", metavar="MEASURED.csv")
+@click.option("-o", "--output", required=True, metavar="M.toml", help="The --machine overlay.")
+@MACHINE
+def fit(target: str, measured: str, output: str, machine_file: Path | None) -> None:
+    """Fit the target's profile to a filled-in sheet; write a --machine overlay."""
+    from camtool.calibrate import fit_sheet
+    from camtool.calibrate.fit import overlay_toml, summary_lines
+    from camtool.jobs.output import check_paths
+    from camtool.jobs.pipeline import load_target_checked
+
+    check_paths(
+        [("the sheet", measured)], [("-o", output)], target=target, machine_file=machine_file
+    )
+    try:
+        text = Path(measured).read_text("utf-8-sig")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(
+            f"{measured}: cannot read ({getattr(exc, 'strerror', None) or exc})"
+        ) from exc
+    chosen = load_target_checked(target, machine_file=machine_file)
+    result = fit_sheet(chosen, text, source=measured)
+    for line in summary_lines(result):
+        click.echo(line, err=True)
+    write_output(overlay_toml(result, source=Path(measured).name), output)
