@@ -29,6 +29,7 @@ from camtool.cli.common import (
     write_output,
 )
 from camtool.cli.preview import preview
+from camtool.cli.send import send, simulate_device
 from camtool.model.errors import CamtoolError, UsageError, VerifyLimitError
 from camtool.model.version import __version__
 
@@ -357,6 +358,8 @@ def _target_json(entry: TargetEntry) -> dict[str, Any]:
 cli.add_command(preview)
 cli.add_command(batch)
 cli.add_command(calibrate)
+cli.add_command(send)
+cli.add_command(simulate_device)
 
 
 def main(argv: list[str] | None = None) -> int:

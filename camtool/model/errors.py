@@ -58,3 +58,13 @@ class VerifyLimitError(CamtoolError):
     """The predicted machining error exceeds the requested limit. Exit code 4."""
 
     exit_code = 4
+
+
+class LinkError(CamtoolError):
+    """Sending a program to a machine failed or stopped. Exit code 1.
+
+    Raised by :mod:`camtool.link`: the port cannot be opened or disappeared, the
+    controller reported an error or an alarm, it did not answer in time, or the
+    operator stopped the job. The message names the port, the block and its
+    source line, the controller's own words, and the ``--from-line`` to resume.
+    """

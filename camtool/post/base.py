@@ -328,6 +328,12 @@ class Target:
         motion_hook: returns the target's motion model for the verifier (the
             ``MOTION`` object of its module, or ``None``); called only when
             :attr:`motion` is read, so listing targets imports no verifier code.
+        link_table: the target file's ``[link]`` table as written (read and
+            checked by :mod:`camtool.link` when a program is sent; empty: the
+            target declares no link).
+        link_hook: returns the target's link hooks for ``camtool send`` (the
+            ``LINK`` object of its module ``<stem>_link``, or ``None``); called
+            only when :attr:`link` is read.
     """
 
     name: str
@@ -339,6 +345,10 @@ class Target:
     spindle_rpm: float | None = None
     origin: str = "builtin"
     motion_hook: Callable[[], Any] | None = field(default=None, compare=False, repr=False)
+    link_table: Mapping[str, Any] = field(
+        default_factory=lambda: MappingProxyType({}), compare=False, repr=False
+    )
+    link_hook: Callable[[], Any] | None = field(default=None, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         if isinstance(self.post, PostProcessor):  # a broken plugin's is reported later
@@ -359,3 +369,11 @@ class Target:
         Loaded on first use (the provider caches it).
         """
         return self.motion_hook() if self.motion_hook is not None else None
+
+    @property
+    def link(self) -> Any:
+        """The target's link hooks for ``camtool send`` (its module's ``LINK``), or ``None``.
+
+        Loaded on first use (the provider caches it), like :attr:`motion`.
+        """
+        return self.link_hook() if self.link_hook is not None else None

@@ -36,7 +36,7 @@ from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, replace
 from importlib import metadata, resources
 from pathlib import Path
-from types import ModuleType
+from types import MappingProxyType, ModuleType
 from typing import Any
 
 from camtool.model.errors import InputError, UsageError
@@ -61,6 +61,7 @@ _TOP_KEYS = {
     "default_feed_mm_min",
     "spindle_rpm",
     "machine",
+    "link",
 }
 
 DialectFactory = Callable[[Mapping[str, Any], str], PostProcessor]
@@ -151,6 +152,19 @@ class TomlTargets:
                 return hooks
         return None
 
+    def link(self, name: str) -> Any:
+        """The ``LINK`` object of target ``name`` (``None`` when it has none).
+
+        Found in ``<package>.<stem>_link``, then ``<package>.<stem>``, as
+        :meth:`motion` finds ``MOTION``; :mod:`camtool.link` reads it.
+        """
+        for suffix in ("_link", ""):
+            module = self.module(name, suffix)
+            hooks = getattr(module, "LINK", None) if module else None
+            if hooks is not None:
+                return hooks
+        return None
+
     def target(
         self, name: str, *, machine_file: Path | str | None = None, origin: str = "builtin"
     ) -> Target:
@@ -166,6 +180,7 @@ class TomlTargets:
             origin=origin,
             provider=self,
             motion=functools.partial(_cached_motion, self, name),
+            link=functools.partial(_cached_link, self, name),
         )
 
 
@@ -181,6 +196,11 @@ def _parse_toml(package: str, file: str) -> dict[str, Any]:
 @functools.cache
 def _cached_motion(provider: TomlTargets, name: str) -> Any:
     return provider.motion(name)
+
+
+@functools.cache
+def _cached_link(provider: TomlTargets, name: str) -> Any:
+    return provider.link(name)
 
 
 @dataclass(frozen=True)
@@ -252,13 +272,14 @@ def _load_entry(ep: metadata.EntryPoint) -> TomlTargets | Target:
         raise InputError(f"{where} is broken: it gives {type(target).__name__}, not a Target")
     if not isinstance(target.post, PostProcessor):
         raise InputError(f"{where} is broken: its post is not a PostProcessor")
-    motion = target.motion_hook or functools.partial(_module_motion, ep.module)
-    return replace(target, origin=f"plugin {ep.value}", motion_hook=motion)
+    motion = target.motion_hook or functools.partial(_module_hook, ep.module, "MOTION")
+    link = target.link_hook or functools.partial(_module_hook, ep.module, "LINK")
+    return replace(target, origin=f"plugin {ep.value}", motion_hook=motion, link_hook=link)
 
 
-def _module_motion(module: str) -> Any:
-    """The ``MOTION`` object of a one-module plugin (``None`` when it has none)."""
-    return getattr(importlib.import_module(module), "MOTION", None)
+def _module_hook(module: str, name: str) -> Any:
+    """The ``MOTION`` (or ``LINK``) object of a one-module plugin (``None`` when it has none)."""
+    return getattr(importlib.import_module(module), name, None)
 
 
 def _plugin_providers() -> Iterator[tuple[metadata.EntryPoint, TomlTargets]]:
@@ -395,6 +416,7 @@ def _target_from_table(
     origin: str,
     provider: TomlTargets | None = None,
     motion: Callable[[], Any] | None = None,
+    link: Callable[[], Any] | None = None,
 ) -> Target:
     unknown = sorted(set(table) - _TOP_KEYS)
     if unknown:
@@ -409,6 +431,9 @@ def _target_from_table(
         machine, where_machine = machine_table(machine)
     machine, where_machine = _machine_over(machine, where_machine, machine_file)
     post = factory(options, where)
+    link_table = table.get("link", {})
+    if not isinstance(link_table, Mapping):
+        raise InputError(f"{where}: [link] must be a table")
     return Target(
         name=str(table.get("name", Path(where).stem)),
         description=str(table.get("description", "")),
@@ -419,6 +444,8 @@ def _target_from_table(
         spindle_rpm=_number(table, "spindle_rpm", where, None),
         origin=origin,
         motion_hook=motion,
+        link_table=MappingProxyType(dict(link_table)),
+        link_hook=link,
     )
 
 

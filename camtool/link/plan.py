@@ -1,0 +1,285 @@
+"""Before anything is sent: read the program back, check it, frame it, time it.
+
+:func:`prepare_send` is what ``camtool send`` (and ``--dry-run``) does before it
+opens a port, as seed-004 S004-R20 asks of a sender: the code is read back with
+the target's own reader; every move must lie in the machine's travel or work
+area (:func:`camtool.verify.verifier.check_area`); no Z may go deeper than the
+link's ``max_depth_mm``; with ``verify`` the verifier predicts the machined
+error and ``max_error_um`` is a hard limit. The code is framed into wire blocks
+with their source lines, and each block gets its estimated time from the
+verifier's timing model (:func:`camtool.verify.verifier.block_times`) plus the
+time its bytes take on the wire.
+"""
+
+from __future__ import annotations
+
+import bisect
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from camtool.link.spec import LinkHooks, LinkSpec, WireBlock, frame_lines, link_hooks, link_spec
+from camtool.model.errors import DialectError, InputError, UsageError, VerifyLimitError
+from camtool.model.program import Dwell, Program
+from camtool.model.units import fmt_num
+
+if TYPE_CHECKING:
+    from camtool.post.base import Target
+    from camtool.verify.verifier import Verification
+
+
+@dataclass(frozen=True)
+class SendPlan:
+    """A checked program ready to go on the wire.
+
+    Attributes:
+        target: the target name.
+        spec: its link.
+        hooks: its link hooks.
+        source: the program's file name, for messages.
+        blocks: the blocks to send, in order: modal restore blocks first
+            (``index`` 0) when resuming, then the program's from ``from_line``.
+        block_time_s: estimated motion time of each of :attr:`blocks`, s.
+        total_blocks: blocks in the whole program.
+        skipped: program blocks before ``from_line`` (not sent).
+        program: the program as read back (the whole file).
+        warnings: what the operator should know before the job starts.
+        verification: the verifier's result with ``verify``, else ``None``.
+    """
+
+    target: str
+    spec: LinkSpec
+    hooks: LinkHooks
+    source: str
+    blocks: tuple[WireBlock, ...]
+    block_time_s: tuple[float, ...]
+    total_blocks: int
+    skipped: int
+    program: Program
+    warnings: tuple[str, ...] = ()
+    verification: Verification | None = None
+
+    @property
+    def total_bytes(self) -> int:
+        """Bytes to send (real-time and start-up bytes not counted)."""
+        return sum(len(b.data) for b in self.blocks)
+
+    def wire_time_s(self, block: WireBlock) -> float:
+        """Seconds ``block`` takes on the wire."""
+        return self.spec.wire_time_s(len(block.data))
+
+    @property
+    def estimated_time_s(self) -> float:
+        """Motion time of the blocks to send plus their wire time, s."""
+        return sum(self.block_time_s) + sum(self.wire_time_s(b) for b in self.blocks)
+
+    def time_left_s(self, done: int) -> float:
+        """Estimated time of the blocks after the first ``done`` of :attr:`blocks`, s."""
+        rest = self.blocks[done:]
+        return sum(self.block_time_s[done:]) + sum(self.wire_time_s(b) for b in rest)
+
+    def describe(self) -> list[str]:
+        """The protocol plan, one line per item: what ``--dry-run`` prints on stdout."""
+        spec = self.spec
+        flow = {
+            "char-count": f"character counting ({spec.rx_buffer_bytes}-byte receive buffer)",
+            "ack": f"one block per answer {spec.ack!r}" if not spec.echo else "echo per block",
+            "timed": "one block at a time, no answer: each waits its estimated time",
+        }[spec.flow]
+        first = next((b.line for b in self.blocks if b.index), 0)
+        out = [
+            f"target: {self.target} ({spec.source})" if spec.source else f"target: {self.target}",
+            f"link: {spec.baud} baud 8N1, blocks end with {spec.block_end!r}, {flow}",
+        ]
+        if spec.startup:
+            out.append(f"start-up: send {spec.startup!r}")
+        if spec.banner:
+            out.append(f"start-up: wait for the banner {spec.banner!r}")
+        out += [
+            f"blocks: {len(self.blocks)} ({self.total_bytes} bytes) of {self.total_blocks}, "
+            f"from line {first}" + (f" ({self.skipped} skipped)" if self.skipped else ""),
+            f"estimated time: {duration(self.estimated_time_s)}",
+        ]
+        for block, seconds in zip(self.blocks, self.block_time_s, strict=True):
+            where = f"block {block.index} line {block.line}" if block.index else "restore"
+            text = block.text.replace("\r", " ")
+            text = text if len(text) <= 60 else text[:57] + "..."
+            out.append(f"{where}: {len(block.data)} bytes, {fmt_num(seconds, 3)} s: {text}")
+        return out
+
+
+def duration(seconds: float) -> str:
+    """``"1 h 02 min"``, ``"3 min 12 s"`` or ``"4.2 s"``."""
+    if seconds < 60:
+        return f"{seconds:.1f} s"
+    minutes, secs = divmod(round(seconds), 60)
+    if minutes < 60:
+        return f"{minutes} min {secs:02d} s"
+    return f"{minutes // 60} h {minutes % 60:02d} min"
+
+
+def prepare_send(
+    code: str | bytes,
+    target: Target,
+    *,
+    source: str = "<code>",
+    from_line: int | None = None,
+    verify: bool = False,
+    max_error_um: float | None = None,
+    max_depth_mm: float | None = None,
+) -> SendPlan:
+    """Read ``code`` back, check it and frame it for ``target``'s link.
+
+    Args:
+        code: the program file's contents (text is sent as UTF-8).
+        target: the target whose link and reader to use.
+        source: the file name for messages.
+        from_line: resume at this 1-based source line (it must start a block).
+        verify: run the verifier and keep its result.
+        max_error_um: with ``verify``, refuse a predicted error above it, µm.
+        max_depth_mm: deepest Z below 0 allowed, mm (default: the link's).
+
+    Raises:
+        LinkError: the target has no link camtool can speak.
+        ParseError: the code is not the target's (named by line).
+        DialectError: a move outside the machine's area, or deeper than allowed.
+        UsageError: ``from_line`` is outside the program or inside a block,
+            or ``max_error_um`` without ``verify``.
+        VerifyLimitError: the predicted error exceeds ``max_error_um``.
+    """
+    spec, hooks = link_spec(target), link_hooks(target)
+    data = code.encode("utf-8") if isinstance(code, str) else code
+    if not data:
+        raise InputError(f"{source}: empty; nothing to send")
+    if max_error_um is not None and not verify:
+        raise UsageError("--max-error-um needs --verify")
+    program = _read_back(data, target, source)
+    from camtool.verify.verifier import check_area
+
+    warnings = [*spec.warnings, *check_area(program, target.machine)]
+    _check_depth(program, max_depth_mm if max_depth_mm is not None else spec.max_depth_mm, source)
+    verification, move_times = _times(program, target, verify, max_error_um)
+    move_times = _with_z(program, target, move_times)
+    frame = hooks.frame or frame_lines
+    blocks = frame(data, spec, source)
+    times = _block_times(blocks, program, move_times)
+    first = _first_block(blocks, from_line, source)
+    sent = list(blocks[first:])
+    sent_times = list(times[first:])
+    if first and hooks.resume is not None:
+        restore = hooks.resume(blocks[:first], blocks[first], spec)
+        sent[:0], sent_times[:0] = restore, [0.0] * len(restore)
+    return SendPlan(
+        target=target.name,
+        spec=spec,
+        hooks=hooks,
+        source=source,
+        blocks=tuple(sent),
+        block_time_s=tuple(sent_times),
+        total_blocks=len(blocks),
+        skipped=first,
+        program=program,
+        warnings=tuple(dict.fromkeys(warnings)),
+        verification=verification,
+    )
+
+
+def _read_back(data: bytes, target: Target, source: str) -> Program:
+    if target.post.binary:
+        return target.parse(data, source=source)
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{source}: byte {exc.start} is not UTF-8 text") from exc
+    return target.parse(text, source=source)
+
+
+def _check_depth(program: Program, max_depth_mm: float | None, source: str) -> None:
+    """Refuse a Z below ``-max_depth_mm`` (S004-R20), naming the line."""
+    if max_depth_mm is None:
+        return
+    for index, move in enumerate(program.moves):
+        if move.z is not None and move.z < -max_depth_mm - 1e-9:
+            line = program.line_of(index)
+            where = f"line {line}" if line is not None else f"move {index + 1}"
+            raise DialectError(
+                f"{source}, {where}: Z {move.z:g} mm is deeper than the "
+                f"{max_depth_mm:g} mm this link allows (seed-004 S004-R20); "
+                "give --max-depth MM if the machine and tool can take it"
+            )
+
+
+def _times(
+    program: Program, target: Target, verify: bool, max_error_um: float | None
+) -> tuple[Verification | None, list[float]]:
+    """The verifier's result (with ``verify``) and each move's estimated time, s."""
+    from camtool.verify.verifier import block_times, simulate, verify_program
+
+    if not program.moves:
+        return None, []
+    if verify:
+        v = verify_program(program, target.machine, name=target.name)
+        if max_error_um is not None:
+            over = v.over_limit(max_error_um)
+            if over:
+                raise VerifyLimitError(f"not sent: {over}")
+        return v, [float(t) for t in v.block_time_s]
+    trace = simulate(program, target.machine)
+    return None, [float(t) for t in block_times(trace, program, target.machine)]
+
+
+def _with_z(program: Program, target: Target, move_times: list[float]) -> list[float]:
+    """Each move's time with its Z travel added at the machine's step rate, s.
+
+    The verifier simulates XY; a timed link must not send the next block while
+    Z still moves. Adding Z at ``max_step_rate_hz`` (when the profile has one)
+    is the conservative reading: it assumes Z moves after XY, not with it (for
+    ValCNC the thesis does not say, seed-004 open question 5). Z starts at 0.
+    """
+    machine = target.machine
+    if not machine.max_step_rate_hz > 0:
+        return move_times
+    out, z = [], 0.0
+    for move, seconds in zip(program.moves, move_times, strict=False):
+        dz = 0.0 if move.z is None else abs(move.z - z)
+        z = z if move.z is None else move.z
+        out.append(seconds + dz * machine.steps_per_mm[2] / machine.max_step_rate_hz)
+    return out
+
+
+def _block_times(blocks: list[WireBlock], program: Program, move_times: list[float]) -> list[float]:
+    """Each block's time: the moves (and dwells) whose source line it holds, s."""
+    times = [0.0] * len(blocks)
+    if not blocks:
+        return times
+    starts = [b.line for b in blocks]
+
+    def block_of(move: int) -> int:
+        line = program.line_of(move)
+        if line is None:
+            return len(blocks) - 1
+        return max(0, bisect.bisect_right(starts, line) - 1)
+
+    for move, seconds in enumerate(move_times):
+        times[block_of(move)] += seconds
+    for index, command in program.commands:
+        if isinstance(command, Dwell):
+            times[block_of(min(index, len(program.moves) - 1))] += command.seconds
+    return times
+
+
+def _first_block(blocks: list[WireBlock], from_line: int | None, source: str) -> int:
+    """Index of the block that starts at ``from_line`` (0 without one)."""
+    if from_line is None:
+        return 0
+    last = blocks[-1].last_line
+    if not 1 <= from_line <= last:
+        raise UsageError(f"--from-line {from_line}: {source} has lines 1 to {last}")
+    for k, block in enumerate(blocks):
+        if block.line == from_line:
+            return k
+        if block.line < from_line <= block.last_line:
+            raise UsageError(
+                f"--from-line {from_line} is inside block {block.index} (lines {block.line}–"
+                f"{block.last_line}); a block is sent whole: resume at line {block.line}"
+            )
+    raise UsageError(f"--from-line {from_line}: no block starts there")  # pragma: no cover

@@ -1,0 +1,617 @@
+"""The host side of a link: a sans-IO stream of blocks and the driver over a serial port.
+
+:class:`Stream` is the protocol state, with no I/O: which block may go now
+(character counting against the receive buffer, one block per answer, or one
+block per estimated block time), what an answer from the controller means, and
+what was done. :func:`send_plan` drives it over a pyserial port: start-up
+(banner, start-up bytes, the controller's state), the blocks, answers, status
+polls, pause after the current block (never inside one), resume, stop, the
+operator's turn between blocks where the machine needs it, and the end of the
+job. Every byte both ways goes to the :class:`ByteLog` when one is given.
+
+Ports come from :func:`open_port` (``serial.serial_for_url``): a device
+(``/dev/ttyUSB0``, ``COM3``, a pseudo-terminal ``/dev/pts/N``) or a pyserial URL
+(``socket://host:port``, ``rfc2217://``, ``loop://``).
+
+Errors: every way a job ends early is a :class:`~camtool.model.errors.LinkError`
+whose message names the block, its source line, the controller's own words and
+the ``--from-line`` to resume with.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import time
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import IO, TYPE_CHECKING, Any, Protocol
+
+from camtool.link.spec import WireBlock
+from camtool.model.errors import LinkError
+
+if TYPE_CHECKING:
+    from camtool.link.plan import SendPlan
+
+POLL_S = 0.02
+"""Longest wait for bytes from the port in one turn of the driver, s."""
+STATUS_PERIOD_S = 0.2
+"""Status queries while waiting, at most 5 per second (GRBL interface.md)."""
+
+
+@dataclass(frozen=True)
+class Progress:
+    """Where a job is, for a progress bar.
+
+    Attributes:
+        done: blocks confirmed (answered, or sent and timed out in timed flow).
+        total: blocks to send in this run.
+        line: source line of the last block done (0: none yet).
+        time_left_s: estimated time of the rest, s.
+        in_flight: blocks sent and not yet answered.
+    """
+
+    done: int
+    total: int
+    line: int
+    time_left_s: float
+    in_flight: int = 0
+
+
+class Control(Protocol):
+    """How the operator steers a job (the CLI's prompt; tests script it)."""
+
+    pause_requested: bool
+    """Set (from a signal handler, say) to pause after the current block."""
+
+    def paused(self, progress: Progress) -> str:
+        """The job is paused between blocks: return ``"resume"`` or ``"stop"``."""
+        ...
+
+    def between_blocks(self, prompt: str, done: WireBlock, following: WireBlock) -> bool:
+        """The link needs the operator after ``done``: True to send ``following``."""
+        ...
+
+
+class StopAtPause:
+    """A :class:`Control` for no operator: a pause stops; between blocks, stop."""
+
+    def __init__(self) -> None:
+        self.pause_requested = False
+
+    def paused(self, progress: Progress) -> str:
+        """Always ``"stop"``."""
+        return "stop"
+
+    def between_blocks(self, prompt: str, done: WireBlock, following: WireBlock) -> bool:
+        """Always False."""
+        return False
+
+
+class ByteLog:
+    """Every byte exchanged, timestamped, hex and text: ``--log FILE``.
+
+    One line per read or write: seconds since the log started, ``>`` host to
+    controller or ``<`` controller to host, the bytes in hex, and as text.
+    """
+
+    def __init__(self, stream: IO[str], clock: Callable[[], float] = time.monotonic) -> None:
+        self.stream = stream
+        self.clock = clock
+        self.start = clock()
+
+    def record(self, direction: str, data: bytes) -> None:
+        """Log ``data`` going ``direction`` (``">"`` or ``"<"``)."""
+        if data:
+            text = data.decode("latin-1").encode("unicode_escape").decode("ascii")
+            stamp = self.clock() - self.start
+            self.stream.write(f"{stamp:10.6f} {direction} {data.hex(' ')} |{text}|\n")
+
+    def note(self, text: str) -> None:
+        """A line of context (``#`` …)."""
+        self.stream.write(f"{self.clock() - self.start:10.6f} # {text}\n")
+
+
+class Stream:
+    """The protocol state of one job, no I/O (see the module docstring).
+
+    Args:
+        plan: the checked blocks and their times.
+        time_scale: multiplies the waits of timed flow (1: real time; 0: no
+            waiting, for simulators and tests).
+    """
+
+    def __init__(self, plan: SendPlan, *, time_scale: float = 1.0) -> None:
+        self.plan = plan
+        self.spec = plan.spec
+        self.queue: deque[int] = deque(range(len(plan.blocks)))
+        self.in_flight: deque[int] = deque()
+        self.buffered = 0
+        self.done = 0
+        self.last_done: WireBlock | None = None
+        self.ready_at = 0.0
+        self.time_scale = time_scale
+        self.failure: str | None = None
+        self.failed_block: WireBlock | None = None
+        self.max_buffered = 0
+
+    def block(self, k: int) -> WireBlock:
+        """Block ``k`` of the plan."""
+        return self.plan.blocks[k]
+
+    def next_block(self, now: float) -> int | None:
+        """The block that may go now, or ``None`` (flow control, a failure, the end)."""
+        if not self.queue or self.failure:
+            return None
+        k = self.queue[0]
+        flow = self.spec.flow
+        if flow == "char-count":
+            size = len(self.block(k).data)
+            if self.in_flight and self.buffered + size > self.spec.rx_buffer_bytes:
+                return None
+        elif flow == "ack":
+            if self.in_flight:
+                return None
+        elif now < self.ready_at:
+            return None
+        return k
+
+    def sent(self, k: int, now: float) -> None:
+        """Block ``k`` went on the wire at ``now``."""
+        self.queue.popleft()
+        block = self.block(k)
+        if self.spec.flow == "timed":
+            wait = self.plan.block_time_s[k] * (1.0 + self.spec.pace_margin)
+            self.ready_at = now + self.time_scale * (wait + self.plan.wire_time_s(block))
+            self._done(k)
+            return
+        self.in_flight.append(k)
+        self.buffered += len(block.data)
+        self.max_buffered = max(self.max_buffered, self.buffered)
+
+    def _done(self, k: int) -> None:
+        self.done += 1
+        self.last_done = self.block(k)
+
+    def answer(self, text: str) -> str:
+        """What a line from the controller means: ``"ack"``, ``"error"``, ``"alarm"`` or ``"push"``.
+
+        An ``"error"`` or ``"alarm"`` sets :attr:`failure` (an echo that is not
+        the block sent is an error too).
+        """
+        spec = self.spec
+        if spec.alarm and text.startswith(spec.alarm):
+            self.failure = self.failure or text
+            return "alarm"
+        if not self.in_flight:
+            return "push"
+        k = self.in_flight[0]
+        if spec.echo:
+            if text == self.block(k).text:
+                self._acked()
+                return "ack"
+            if text.startswith(("<", "[")) or not text:
+                return "push"
+            self._acked(failed=f"echo {text!r} is not the block sent")
+            return "error"
+        if text == spec.ack:
+            self._acked()
+            return "ack"
+        if spec.error and text.startswith(spec.error):
+            self._acked(failed=text)
+            return "error"
+        return "push"
+
+    def _acked(self, failed: str | None = None) -> None:
+        k = self.in_flight.popleft()
+        self.buffered -= len(self.block(k).data)
+        if failed is None:
+            self._done(k)
+        elif self.failure is None:
+            self.failure, self.failed_block = failed, self.block(k)
+
+    def idle(self, now: float) -> bool:
+        """True when nothing is in flight (timed: the last block's time is over)."""
+        return not self.in_flight and now >= self.ready_at
+
+    @property
+    def finished(self) -> bool:
+        """Every block sent and done."""
+        return not self.queue and not self.in_flight
+
+    def progress(self) -> Progress:
+        """Where the job is now."""
+        line = self.last_done.line if self.last_done else 0
+        return Progress(
+            self.done,
+            len(self.plan.blocks),
+            line,
+            self.plan.time_left_s(self.done),
+            len(self.in_flight),
+        )
+
+    def resume_line(self) -> int | None:
+        """The ``--from-line`` that continues after the last block done (``None``: all done)."""
+        rest = [self.block(k) for k in (*self.in_flight, *self.queue)]
+        return next((b.line for b in rest if b.index), None)
+
+
+def open_port(port: str, baud: int) -> Any:
+    """A pyserial port for a device path or URL, 8N1, no flow control, non-blocking reads.
+
+    Raises:
+        LinkError: it cannot be opened (the message names it and says why).
+    """
+    import serial
+
+    try:
+        return serial.serial_for_url(port, baudrate=baud, timeout=0, write_timeout=10)
+    except (serial.SerialException, OSError, ValueError) as exc:
+        raise LinkError(f"cannot open port {port!r}: {exc}") from exc
+
+
+class _PortGone(LinkError):
+    """The port failed under the driver (the driver adds where the job stood)."""
+
+
+class _Wire:
+    """The port with logging and errors turned into :class:`LinkError`; reads lines."""
+
+    def __init__(self, port: Any, name: str, log: ByteLog | None) -> None:
+        self.port = port
+        self.name = name
+        self.log = log
+        self.buffer = bytearray()
+        self.last_rx = time.monotonic()
+
+    def write(self, data: bytes, where: str) -> None:
+        import serial
+
+        try:
+            self.port.write(data)
+            self.port.flush()
+        except (serial.SerialException, OSError) as exc:
+            raise _PortGone(f"port {self.name!r} disappeared {where}: {exc}") from exc
+        if self.log:
+            self.log.record(">", data)
+
+    def lines(self, timeout: float, where: str) -> list[str]:
+        """Whole lines received within ``timeout`` s (line ends stripped)."""
+        import serial
+
+        try:
+            self.port.timeout = timeout
+            data = self.port.read(max(1, self.port.in_waiting))
+        except (serial.SerialException, OSError) as exc:
+            raise _PortGone(f"port {self.name!r} disappeared {where}: {exc}") from exc
+        if data:
+            self.last_rx = time.monotonic()
+            if self.log:
+                self.log.record("<", data)
+            self.buffer += data
+        out = []
+        while (cut := self.buffer.find(b"\n")) >= 0:
+            out.append(self.buffer[:cut].decode("latin-1").strip("\r"))
+            del self.buffer[: cut + 1]
+        return [line for line in out if line]
+
+
+@dataclass(frozen=True)
+class SendResult:
+    """A job that ran to its end.
+
+    Attributes:
+        blocks: blocks sent.
+        bytes: bytes sent (blocks only).
+        elapsed_s: wall time, s.
+        max_buffered: most bytes in flight at once (character counting).
+        messages: the controller's push messages, in order.
+    """
+
+    blocks: int
+    bytes: int
+    elapsed_s: float
+    max_buffered: int
+    messages: tuple[str, ...] = ()
+
+
+def send_plan(
+    port: Any,
+    plan: SendPlan,
+    *,
+    port_name: str = "",
+    control: Control | None = None,
+    progress: Callable[[Progress], None] | None = None,
+    log: ByteLog | None = None,
+    time_scale: float = 1.0,
+    reopen: Callable[[], Any] | None = None,
+) -> SendResult:
+    """Send ``plan`` over an open ``port`` (see the module docstring).
+
+    Args:
+        port: an open pyserial port (:func:`open_port`) or anything with its
+            ``write``, ``flush``, ``read``, ``in_waiting`` and ``timeout``.
+        plan: the checked program (:func:`camtool.link.plan.prepare_send`).
+        port_name: the port's name for messages.
+        control: the operator (default: :class:`StopAtPause`).
+        progress: called after every block done.
+        log: where every byte goes.
+        time_scale: multiplies timed-flow waits (0 for simulators and tests).
+        reopen: opens the port again after the operator's turn between blocks
+            (``operator_between_blocks``: the device was reset, as the
+            matlab-router master is after every job); ``None``: keep the port.
+
+    Returns:
+        What was sent.
+
+    Raises:
+        LinkError: no banner or answer in time, the controller in alarm, an
+            error or alarm during the job, the port gone, or the operator
+            stopped; the message says where and which ``--from-line`` resumes.
+    """
+    driver = _Driver(port, plan, port_name, control or StopAtPause(), progress, log, time_scale)
+    driver.reopen = reopen
+    return driver.run()
+
+
+class _Driver:
+    def __init__(
+        self,
+        port: Any,
+        plan: SendPlan,
+        name: str,
+        control: Control,
+        progress: Callable[[Progress], None] | None,
+        log: ByteLog | None,
+        time_scale: float,
+    ) -> None:
+        self.plan, self.spec, self.control = plan, plan.spec, control
+        self.wire = _Wire(port, name or "port", log)
+        self.stream = Stream(plan, time_scale=time_scale)
+        self.report = progress or (lambda p: None)
+        self.messages: list[str] = []
+        self.last_status = 0.0
+        self.turns = 0
+        self.reopen: Callable[[], Any] | None = None
+
+    def run(self) -> SendResult:
+        start = time.monotonic()
+        try:
+            self._start_up()
+            self._stream()
+            self._finish()
+        except _PortGone as exc:
+            raise LinkError(f"{exc}; {self._lost_hint()}") from exc
+        return SendResult(
+            len(self.plan.blocks),
+            self.plan.total_bytes,
+            time.monotonic() - start,
+            self.stream.max_buffered,
+            tuple(self.messages),
+        )
+
+    # -- start-up -------------------------------------------------------------------
+
+    def _start_up(self) -> None:
+        spec = self.spec
+        if spec.banner and not self._wait_banner():
+            raise LinkError(
+                f"{spec.target}: no answer on {self.wire.name!r} (no {spec.banner!r} banner "
+                f"within {spec.banner_timeout_s:g} s): is it the {spec.target} controller, "
+                f"powered, at {spec.baud} baud?"
+            )
+        if spec.status and self.plan.hooks.status_state is not None:
+            state = self._query_state("before the job")
+            if state.startswith("Alarm"):
+                raise LinkError(
+                    f"{spec.target} is in alarm state ({state}): nothing was sent; clear it "
+                    "at the machine (home it or unlock it) and send again"
+                )
+        if spec.startup:
+            self.wire.write(spec.startup, "at start-up")
+
+    def _wait_banner(self) -> bool:
+        spec = self.spec
+        for wake in (b"", spec.wake):
+            if wake:
+                self.wire.write(wake, "at start-up")
+            deadline = time.monotonic() + spec.banner_timeout_s
+            while time.monotonic() < deadline:
+                for line in self.wire.lines(POLL_S, "at start-up"):
+                    if line.startswith(spec.banner) or (wake and self._state_of(line)):
+                        return True
+                    self.messages.append(line)
+            if not spec.wake:
+                break
+        return False
+
+    def _state_of(self, line: str) -> str | None:
+        state = self.plan.hooks.status_state
+        return state(line) if state is not None else None
+
+    def _query_state(self, where: str) -> str:
+        self.wire.write(self.spec.status, where)
+        deadline = time.monotonic() + self.spec.response_timeout_s
+        while time.monotonic() < deadline:
+            for line in self.wire.lines(POLL_S, where):
+                state = self._state_of(line)
+                if state is not None:
+                    return state
+                self._push(line)
+        raise LinkError(
+            f"{self.spec.target}: no status report on {self.wire.name!r} within "
+            f"{self.spec.response_timeout_s:g} s {where}"
+        )
+
+    # -- the blocks -------------------------------------------------------------------
+
+    def _where(self) -> str:
+        s = self.stream
+        last = s.last_done
+        done = f"after block {last.index} (line {last.line})" if last and last.index else "before"
+        return f"{done}, {s.done} of {len(self.plan.blocks)} blocks done"
+
+    def _stream(self) -> None:
+        s, control = self.stream, self.control
+        pausing = False
+        while not s.finished or not s.idle(time.monotonic()):
+            now = time.monotonic()
+            if s.failure:
+                self._fail()
+            pausing = pausing or control.pause_requested
+            if pausing or self._operator_turn():
+                if s.idle(now):
+                    pausing = self._pause(pausing)
+                else:
+                    self._read(now)
+                continue
+            k = s.next_block(now)
+            if k is not None:
+                self._send(k)
+            else:
+                self._read(now)
+
+    def _send(self, k: int) -> None:
+        s = self.stream
+        block = s.block(k)
+        self.wire.write(block.data, f"while sending block {block.index} (line {block.line})")
+        s.sent(k, time.monotonic())
+        if self.spec.flow == "timed":
+            self.report(s.progress())
+
+    def _operator_turn(self) -> bool:
+        """True when the operator must act before the next block (``operator_between_blocks``)."""
+        s = self.stream
+        last = s.last_done
+        turn = self.spec.operator_between_blocks and s.queue and last is not None and last.index
+        return bool(turn) and s.done > self.turns
+
+    def _pause(self, pausing: bool) -> bool:
+        """Ask the operator at a block boundary; returns whether still pausing."""
+        s, control = self.stream, self.control
+        if pausing:
+            control.pause_requested = False
+            if control.paused(s.progress()) == "resume":
+                return False
+            self._stop("stopped by the operator")
+        following = s.block(s.queue[0])
+        assert s.last_done is not None
+        if not control.between_blocks(self.spec.operator_between_blocks, s.last_done, following):
+            self._stop(f"{self.spec.operator_between_blocks}; then")
+        self.turns = s.done
+        if self.reopen is not None:
+            with contextlib.suppress(Exception):
+                self.wire.port.close()
+            self.wire.port = self.reopen()
+            if self.spec.startup:
+                self.wire.write(self.spec.startup, "at start-up")
+        return False
+
+    def _read(self, now: float) -> None:
+        s = self.stream
+        wait = POLL_S if s.in_flight or not s.queue else max(0.0, min(POLL_S, s.ready_at - now))
+        lines = self.wire.lines(wait, f"while sending ({self._where()})")
+        for line in lines:
+            kind = s.answer(line)
+            if kind == "ack":
+                self.report(s.progress())
+            elif kind == "push":
+                self._push(line)
+        if s.in_flight:
+            self._keep_alive()
+
+    def _push(self, line: str) -> None:
+        if self._state_of(line) is None:
+            self.messages.append(line)
+
+    def _keep_alive(self) -> None:
+        """Poll the status while waiting; a silent controller is lost after the timeout."""
+        now = time.monotonic()
+        if self.spec.status and now - self.last_status >= STATUS_PERIOD_S:
+            self.wire.write(self.spec.status, f"while sending ({self._where()})")
+            self.last_status = now
+        if now - self.wire.last_rx > self.spec.response_timeout_s + self._in_flight_time():
+            raise LinkError(
+                f"{self.spec.target} stopped answering on {self.wire.name!r} "
+                f"({self._where()}); {self._resume_hint()}"
+            )
+
+    def _in_flight_time(self) -> float:
+        s = self.stream
+        return 0.0 if self.spec.status else sum(self.plan.block_time_s[k] for k in s.in_flight)
+
+    def _drain(self) -> None:
+        """Wait for the answers of the blocks still in flight (they run on the controller)."""
+        s = self.stream
+        deadline = time.monotonic() + self.spec.response_timeout_s
+        while s.in_flight and time.monotonic() < deadline:
+            for line in self.wire.lines(POLL_S, "while finishing the blocks in flight"):
+                if s.answer(line) == "push":
+                    self._push(line)
+
+    def _fail(self) -> None:
+        s = self.stream
+        failed, message = s.failed_block, s.failure or ""
+        if failed is not None:  # an alarm empties the controller's buffer: nothing to wait for
+            self._drain()
+        decode = self.plan.hooks.decode
+        words = decode(message) if decode else message
+        if failed is not None:
+            what = f"block {failed.index} (line {failed.line}: {failed.text!r})"
+            if not failed.index:
+                what = f"the restore block {failed.text!r}"
+            head = f"{self.spec.target} refused {what}: {words}"
+        else:
+            head = f"{self.spec.target}: {words} ({self._where()})"
+        raise LinkError(f"{head}; the job stopped {self._where()}; {self._resume_hint()}")
+
+    def _resume_hint(self) -> str:
+        line = self.stream.resume_line()
+        if line is None:
+            return "every block had been sent"
+        return f"fix the cause, then resume with --from-line {line}"
+
+    def _lost_hint(self) -> str:
+        """Where a job stood when the port went: what is known to have run, what may have."""
+        s = self.stream
+        sent = [b for b in self.plan.blocks[: len(self.plan.blocks) - len(s.queue)] if b.index]
+        if not sent:
+            return "no block of the program had been sent"
+        last = sent[-1]
+        if self.spec.flow == "timed" or s.in_flight:
+            confirmed = s.last_done if self.spec.flow != "timed" else None
+            known = (
+                f"blocks up to line {confirmed.line} were confirmed; "
+                if confirmed is not None and confirmed.index
+                else ""
+            )
+            return (
+                f"{known}the last block sent was line {last.line} and camtool cannot know "
+                f"whether the blocks after the last confirmed one ran: look where the tool "
+                f"stands, then resume with --from-line {last.line} if line {last.line} did "
+                "not run, or with the line after it if it did"
+            )
+        line = s.resume_line()
+        return f"resume with --from-line {line}" if line else "every block had been sent"
+
+    def _stop(self, why: str) -> None:
+        self._drain()
+        self._wait_idle()
+        raise LinkError(f"{why} {self._where()}; {self._resume_hint()}")
+
+    # -- the end ---------------------------------------------------------------------
+
+    def _finish(self) -> None:
+        self._wait_idle()
+
+    def _wait_idle(self) -> None:
+        """With status reports: wait until the controller says its motion is over."""
+        if not (self.spec.status and self.plan.hooks.status_state is not None):
+            return
+        while True:
+            state = self._query_state("at the end of the job")
+            if state == "Idle":
+                return
+            if state.startswith("Alarm"):
+                raise LinkError(f"{self.spec.target} went into alarm ({state}) {self._where()}")
+            time.sleep(STATUS_PERIOD_S)

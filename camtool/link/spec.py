@@ -1,0 +1,300 @@
+r"""A target's link: the ``[link]`` table of its TOML, its ``LINK`` hooks, and wire blocks.
+
+Every target declares how code reaches its machine next to its dialect, in a
+``[link]`` table of ``postprocessors/<name>.toml`` (read here, once, by
+:func:`link_spec`), plus Python only where the protocol needs it: a module
+``<stem>_link.py`` exposing ``LINK = LinkHooks(...)``, found lazily as
+``<stem>_motion.py``'s ``MOTION`` is (:attr:`camtool.post.base.Target.link`).
+
+``[link]`` keys (docs/send.md has the table per target):
+
+=========================  =========================================================
+``protocol``               ``"stream"`` (camtool sends it) or ``"none"`` (no host link:
+                           ``how`` says how programs reach the machine)
+``how``                    for ``"none"``: the message ``send`` refuses with
+``source``                 where the protocol comes from (thesis section, a document)
+``baud``                   bits per second (8N1, no handshake)
+``block_end``              the byte string that ends a block (``"\\n"``, ``"\\r"``)
+``flow``                   ``"char-count"``: as many blocks as fit ``rx_buffer_bytes``,
+                           each answered by ``ack``/``error`` (GRBL); ``"ack"``: one
+                           block per answer; ``"timed"``: no answer, wait the block's
+                           estimated time (the verifier's timing model) before the next
+``rx_buffer_bytes``        ``"char-count"``: bytes the controller's receive buffer holds
+``ack`` ``error``          the answer that accepts a block; the prefix of one that
+                           rejects it (``"ok"``, ``"error:"``)
+``echo``                   the controller answers a block with the block itself
+                           (its confirmation); a different echo stops the job
+``alarm``                  prefix of a push message that stops the job (``"ALARM:"``)
+``banner``                 prefix of the line the controller prints when it starts;
+                           ``send`` waits ``banner_timeout_s`` for it, then sends
+                           ``wake`` once and waits again
+``startup``                bytes sent once the port is open (ValCNC: ``"C\\n"``)
+``status`` ``hold``        real-time bytes: status query, feed hold, cycle resume,
+``resume`` ``reset``       soft reset (GRBL ``?`` ``!`` ``~`` ``\\x18``); never counted
+                           as part of the program
+``response_timeout_s``     silence after which a controller that should answer is lost
+``pace_margin``            ``"timed"``: the wait is the block time × (1 + margin) + the
+                           time its bytes take on the wire
+``max_block_bytes``        longest block the controller takes, terminator included
+``max_depth_mm``           deepest Z below 0 the sender lets through (S004-R20)
+``operator_between_blocks``  a prompt: the operator must act after every block (the
+                           matlab-router master runs one job per reset)
+``warnings``               what to tell the operator before every job
+=========================  =========================================================
+
+Hooks (:class:`LinkHooks`), each optional: ``frame`` splits code into wire blocks
+when "one line, one block" is wrong (a matlab-router job is ``3 + 4n`` records);
+``decode`` words a controller's message (GRBL ``error:22``); ``resume`` gives
+the blocks that restore the controller's modal state before ``--from-line``;
+``device`` builds the target's simulator (:mod:`camtool.link.device`);
+``status_state`` reads a status report.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from camtool.model.errors import InputError, LinkError, UsageError
+
+if TYPE_CHECKING:
+    from camtool.post.base import Target
+
+PROTOCOLS = ("stream", "none")
+"""Values of ``[link] protocol``."""
+FLOWS = ("char-count", "ack", "timed")
+"""Values of ``[link] flow`` (see the module docstring)."""
+
+
+@dataclass(frozen=True)
+class WireBlock:
+    """One unit of the wire: what the controller takes at once.
+
+    Attributes:
+        index: 1-based block number in the program (0: a block ``send`` adds, a
+            modal restore before ``--from-line``).
+        line: 1-based source line where the block starts (0 for added blocks).
+        last_line: source line where it ends (a matlab-router job spans records).
+        data: the exact bytes, terminator included.
+    """
+
+    index: int
+    line: int
+    last_line: int
+    data: bytes
+
+    @property
+    def text(self) -> str:
+        """The block as text for messages, without its terminator."""
+        return self.data.decode("latin-1").rstrip("\r\n")
+
+
+@dataclass(frozen=True)
+class LinkSpec:
+    """A target's ``[link]`` table, checked (see the module docstring for each key).
+
+    Times in s, sizes in bytes; byte strings are the exact wire bytes.
+    """
+
+    target: str
+    protocol: str
+    how: str = ""
+    source: str = ""
+    baud: int = 9600
+    block_end: bytes = b"\n"
+    flow: str = "ack"
+    rx_buffer_bytes: int = 0
+    ack: str = ""
+    error: str = ""
+    alarm: str = ""
+    banner: str = ""
+    banner_timeout_s: float = 2.0
+    wake: bytes = b""
+    startup: bytes = b""
+    status: bytes = b""
+    hold: bytes = b""
+    resume: bytes = b""
+    reset: bytes = b""
+    response_timeout_s: float = 5.0
+    pace_margin: float = 0.1
+    max_block_bytes: int = 0
+    max_depth_mm: float | None = None
+    operator_between_blocks: str = ""
+    echo: bool = False
+    warnings: tuple[str, ...] = ()
+
+    def wire_time_s(self, nbytes: int) -> float:
+        """Seconds ``nbytes`` take on the wire at :attr:`baud`, 8N1 (10 bits a byte)."""
+        return nbytes * 10.0 / self.baud
+
+
+@dataclass(frozen=True)
+class LinkHooks:
+    """The Python a target's protocol needs beyond its ``[link]`` table (``LINK``).
+
+    Attributes:
+        frame: ``(code bytes, spec, source) -> blocks``; default :func:`frame_lines`.
+            Raises :class:`~camtool.model.errors.InputError` naming the line.
+        decode: ``controller message -> words`` ("error:22" → "undefined feed
+            rate: …"); default: the message as it came.
+        resume: ``(blocks before, first block sent, spec) -> restore blocks``:
+            what puts the controller back in the modal state the program had
+            before ``--from-line``; raises :class:`UsageError` for a line a job
+            cannot resume at. Default: nothing to restore.
+        device: ``(spec, **options) -> Device``: the target's simulator
+            (:class:`camtool.link.device.Device`); default: the generic
+            :class:`camtool.link.device.LineDevice` for the spec.
+        status_state: ``line -> state word or None``: reads a status report
+            (GRBL ``<Idle|MPos:…>`` → ``"Idle"``); ``None`` for any other line.
+            With it and a ``status`` byte, ``send`` refuses a controller in
+            ``Alarm`` before the job and waits for ``Idle`` at its end.
+    """
+
+    frame: Callable[[bytes, LinkSpec, str], list[WireBlock]] | None = None
+    decode: Callable[[str], str] | None = None
+    resume: Callable[[Sequence[WireBlock], WireBlock, LinkSpec], list[WireBlock]] | None = None
+    device: Callable[..., Any] | None = None
+    status_state: Callable[[str], str | None] | None = None
+
+
+NO_HOOKS = LinkHooks()
+
+_BYTES = ("block_end", "wake", "startup", "status", "hold", "resume", "reset")
+_TEXT = ("how", "source", "ack", "error", "alarm", "banner", "operator_between_blocks")
+_POSITIVE = ("banner_timeout_s", "response_timeout_s")
+_COUNTS = ("baud", "rx_buffer_bytes", "max_block_bytes")
+
+
+def link_spec(target: Target) -> LinkSpec:
+    """The checked ``[link]`` table of ``target``.
+
+    Raises:
+        LinkError: the target declares no link, or ``protocol = "none"`` (the
+            message says how its programs reach the machine).
+        InputError: a key is unknown or has a bad value, naming the file and key.
+    """
+    table = dict(target.link_table)
+    where = f"{target.name}: [link]"
+    if not table:
+        raise LinkError(
+            f"target {target.name!r} declares no link ([link] table): camtool cannot send "
+            "its programs; write the file with 'camtool post' and load it the machine's own way"
+        )
+    spec = _spec_from_table(table, target.name, where)
+    if spec.protocol == "none":
+        raise LinkError(
+            f"target {target.name!r} has no host link camtool can speak: {spec.how}"
+            + (f" ({spec.source})" if spec.source else "")
+        )
+    return spec
+
+
+def _spec_from_table(table: dict[str, Any], name: str, where: str) -> LinkSpec:
+    known = set(LinkSpec.__dataclass_fields__) - {"target"}
+    unknown = sorted(set(table) - known)
+    if unknown:
+        raise InputError(f"{where}: unknown key(s) {unknown}; known: {sorted(known)}")
+    values: dict[str, Any] = {"target": name}
+    for key, value in table.items():
+        values[key] = _checked(key, value, where)
+    if values.get("protocol") not in PROTOCOLS:
+        raise InputError(f"{where}: protocol must be one of {list(PROTOCOLS)}")
+    if values.get("flow", "ack") not in FLOWS:
+        raise InputError(f"{where}: flow must be one of {list(FLOWS)}")
+    if values.get("flow") == "char-count" and not values.get("rx_buffer_bytes"):
+        raise InputError(f"{where}: flow = 'char-count' needs rx_buffer_bytes")
+    answered = values.get("flow", "ack") in ("char-count", "ack")
+    unanswered = not values.get("ack") and not values.get("echo")
+    if answered and values.get("protocol") == "stream" and unanswered:
+        raise InputError(f"{where}: flow {values.get('flow', 'ack')!r} needs ack")
+    return LinkSpec(**values)
+
+
+def _checked(key: str, value: Any, where: str) -> Any:
+    """One ``[link]`` value, checked and converted (bytes as latin-1, tuples)."""
+    if key in _BYTES or key in _TEXT or key in ("protocol", "flow"):
+        if not isinstance(value, str):
+            raise InputError(f"{where}: {key} must be a string, not {value!r}")
+        return value.encode("latin-1") if key in _BYTES else value
+    if key == "echo":
+        if not isinstance(value, bool):
+            raise InputError(f"{where}: echo must be true or false, not {value!r}")
+        return value
+    if key == "warnings":
+        if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+            raise InputError(f"{where}: warnings must be a list of strings")
+        return tuple(value)
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise InputError(f"{where}: {key} must be a number, not {value!r}")
+    if key in _COUNTS:
+        if value != int(value) or value <= 0:
+            raise InputError(f"{where}: {key} must be a whole number > 0, not {value!r}")
+        return int(value)
+    if value < 0 or (key in _POSITIVE and value == 0):
+        raise InputError(f"{where}: {key} must be > 0, not {value!r}")
+    return float(value)
+
+
+def link_hooks(target: Target) -> LinkHooks:
+    """The target's ``LINK`` hooks, or none.
+
+    Raises:
+        InputError: ``LINK`` is not a :class:`LinkHooks`.
+    """
+    hooks = target.link
+    if hooks is None:
+        return NO_HOOKS
+    if not isinstance(hooks, LinkHooks):
+        raise InputError(f"target {target.name!r}: LINK is a {type(hooks).__name__}, not LinkHooks")
+    return hooks
+
+
+def frame_lines(code: bytes, spec: LinkSpec, source: str) -> list[WireBlock]:
+    """One block per line: the bytes up to and including each ``block_end``.
+
+    A last line without the terminator is a block too (it is sent as written:
+    the file's bytes, no more). Empty lines are blocks (GRBL answers them ``ok``).
+
+    Raises:
+        InputError: a block longer than ``max_block_bytes``, naming the line.
+    """
+    end = spec.block_end
+    blocks: list[WireBlock] = []
+    start = 0
+    while start < len(code):
+        cut = code.find(end, start)
+        stop = len(code) if cut < 0 else cut + len(end)
+        line = len(blocks) + 1
+        blocks.append(WireBlock(line, line, line, code[start:stop]))
+        start = stop
+    for block in blocks:
+        check_block_size(block, spec, source)
+    return blocks
+
+
+def check_block_size(block: WireBlock, spec: LinkSpec, source: str) -> None:
+    """Refuse a block the controller's line buffer cannot hold.
+
+    Raises:
+        InputError: longer than ``max_block_bytes`` (or than the receive buffer
+            in char-count flow), naming the line.
+    """
+    limit = spec.max_block_bytes or spec.rx_buffer_bytes
+    if limit and len(block.data) > limit:
+        raise InputError(
+            f"{source}, line {block.line}: block of {len(block.data)} bytes; {spec.target} "
+            f"takes at most {limit} bytes a block (terminator included); shorten the line"
+        )
+
+
+def check_port_name(port: str) -> str:
+    """``port`` checked: a device path or a pyserial URL.
+
+    Raises:
+        UsageError: empty.
+    """
+    if not port.strip():
+        raise UsageError("--port is empty; give a device (/dev/ttyUSB0, COM3) or a URL")
+    return port
