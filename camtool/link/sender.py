@@ -20,7 +20,6 @@ the ``--from-line`` to resume with.
 
 from __future__ import annotations
 
-import contextlib
 import time
 from collections import deque
 from collections.abc import Callable
@@ -202,7 +201,9 @@ class Stream:
                 return self._acked(now)
             if text.startswith(("<", "[")) or not text:
                 return "push"
+            k = self.in_flight[0]
             self._acked(now, failed=f"echo {text!r} is not the block sent")
+            self.queue.appendleft(k)  # the controller did not get it as sent: resume at it
             return "error"
         if text == (block.ack or spec.ack):
             return self._acked(now)
@@ -627,7 +628,7 @@ class _Driver:
             self.wire.write(self.spec.status, f"while sending ({self._where()})")
             self.last_status = now
         if now - self.wire.last_rx > self.spec.response_timeout_s + self._in_flight_time():
-            self._abort()
+            stopped = self._abort()
             s = self.stream
             block = s.block(s.in_flight[0])
             unsure = (
@@ -636,14 +637,31 @@ class _Driver:
             )
             raise LinkError(
                 f"{self.spec.target} stopped answering on {self.wire.name!r} "
-                f"({self._where()}); {unsure}{self._resume_hint()}"
+                f"({self._where()}){stopped}; {unsure}{self._resume_hint()}"
             )
 
-    def _abort(self) -> None:
-        """Send the link's ``abort`` bytes (the controller may be moving); ignore a lost port."""
-        if self.spec.abort:
-            with contextlib.suppress(LinkError):
-                self.wire.write(self.spec.abort, "stopping the controller")
+    def _abort(self) -> str:
+        """Send the link's ``abort`` bytes (the controller may be moving): what became of them.
+
+        With an echoing link, waits ``response_timeout_s`` for the abort's own
+        echo, the controller's word that it got the stop. Returns ``""`` when
+        the link has no abort, else a clause for the error message.
+        """
+        spec = self.spec
+        if not spec.abort:
+            return ""
+        text = spec.abort.decode("latin-1").rstrip("\r\n")
+        try:
+            self.wire.write(spec.abort, "stopping the controller")
+            if not spec.echo:
+                return f"; {text!r} sent to stop the controller"
+            deadline = time.monotonic() + spec.response_timeout_s
+            while time.monotonic() < deadline:
+                if text in self.wire.lines(POLL_S, "stopping the controller"):
+                    return f"; {text!r} sent and echoed: the controller stopped"
+        except LinkError:
+            return f"; {text!r} could not be sent: stop the machine by hand"
+        return f"; {text!r} sent but not echoed: stop the machine by hand"
 
     def _in_flight_time(self) -> float:
         s = self.stream
@@ -663,7 +681,7 @@ class _Driver:
     def _fail(self) -> None:
         s = self.stream
         failed, message = s.failed_block, s.failure or ""
-        self._abort()
+        stopped = self._abort()
         if failed is not None:  # an alarm empties the controller's buffer: nothing to wait for
             self._drain()
         decode = self.plan.hooks.decode
@@ -675,7 +693,7 @@ class _Driver:
             head = f"{self.spec.target} refused {what}: {words}"
         else:
             head = f"{self.spec.target}: {words} ({self._where()})"
-        raise LinkError(f"{head}; the job stopped {self._where()}; {self._resume_hint()}")
+        raise LinkError(f"{head}{stopped}; the job stopped {self._where()}; {self._resume_hint()}")
 
     def _resume_hint(self) -> str:
         line = self.stream.resume_line()

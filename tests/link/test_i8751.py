@@ -241,7 +241,9 @@ def test_the_cli_sends_and_dry_runs(simulate: Any, tmp_path: Path, capsys: Any) 
     log = tmp_path / "bytes.log"
     assert main(["send", str(job), "-t", "i8751", "--port", sim.path, "--log", str(log)]) == 0
     assert bytes(sim.device.received) == SESSION
-    assert "> 13" in log.read_text() and "< 46 |F|" in log.read_text()
+    logged = log.read_text()
+    assert "> 13 |" in logged and "> 54 |T|" in logged and "< 41 |A|" in logged
+    assert logged.count("F|") == 3  # 'F' after each of the 3 packets (after its 'M's)
 
 
 def test_the_cli_names_a_lost_port_with_exit_1(simulate: Any, tmp_path: Path, capsys: Any) -> None:
