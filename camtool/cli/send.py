@@ -131,6 +131,7 @@ def _run(plan: Any, port: str, baud: int | None, log: str | None) -> None:
                 control=control,
                 progress=bar.update,
                 log=byte_log,
+                reopen=lambda: open_port(port, baud or plan.spec.baud),
             )
         finally:
             bar.close()

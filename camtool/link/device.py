@@ -280,6 +280,25 @@ class PtyServer:
                 self._close()
 
     def _serve(self) -> None:
+        self._loop()
+        self._drain()
+
+    def _drain(self) -> None:
+        """On stop: take what the host wrote before it closed, and run every whole block."""
+        while not self.device.dropped:
+            ready, _, _ = select.select([self.master], [], [], 0)
+            try:
+                data = os.read(self.master, 4096) if ready else b""
+            except OSError:
+                data = b""
+            if data:
+                self._write(self.device.feed(data))
+            elif self.device.pending():
+                self._write(self.device.step())
+            else:
+                return
+
+    def _loop(self) -> None:
         connected = False
         next_block = 0.0
         while not self._stop.is_set() and not self.device.dropped:
@@ -307,4 +326,5 @@ class PtyServer:
 
     def _write(self, data: bytes) -> None:
         if data and not self.device.dropped:
-            os.write(self.master, data)
+            with contextlib.suppress(OSError):  # no host holds the port: the answer is lost
+                os.write(self.master, data)

@@ -20,6 +20,7 @@ the ``--from-line`` to resume with.
 
 from __future__ import annotations
 
+import contextlib
 import time
 from collections import deque
 from collections.abc import Callable
@@ -299,6 +300,10 @@ def open_port(port: str, baud: int) -> Any:
         raise LinkError(f"cannot open port {port!r}: {exc}") from exc
 
 
+class _PortGone(LinkError):
+    """The port failed under the driver (the driver adds where the job stood)."""
+
+
 class _Wire:
     """The port with logging and errors turned into :class:`LinkError`; reads lines."""
 
@@ -323,7 +328,7 @@ class _Wire:
             self.port.write(data)
             self.port.flush()
         except (serial.SerialException, OSError) as exc:
-            raise LinkError(f"port {self.name!r} disappeared {where}: {exc}") from exc
+            raise _PortGone(f"port {self.name!r} disappeared {where}: {exc}") from exc
         if self.log:
             self.log.record(">", data)
 
@@ -366,7 +371,7 @@ class _Wire:
             self.port.timeout = timeout
             data = self.port.read(max(1, self.port.in_waiting))
         except (serial.SerialException, OSError) as exc:
-            raise LinkError(f"port {self.name!r} disappeared {where}: {exc}") from exc
+            raise _PortGone(f"port {self.name!r} disappeared {where}: {exc}") from exc
         if data:
             self.last_rx = time.monotonic()
             if self.log:
@@ -412,6 +417,7 @@ def send_plan(
     progress: Callable[[Progress], None] | None = None,
     log: ByteLog | None = None,
     time_scale: float = 1.0,
+    reopen: Callable[[], Any] | None = None,
 ) -> SendResult:
     """Send ``plan`` over an open ``port`` (see the module docstring).
 
@@ -425,6 +431,9 @@ def send_plan(
         log: where every byte goes.
         time_scale: multiplies timed-flow waits, a block's ``busy_s`` and the silence
             allowed for the blocks in flight (0 for simulators and tests).
+        reopen: opens the port again after the operator's turn between blocks
+            (``operator_between_blocks``: the device was reset, as the
+            matlab-router master is after every job); ``None``: keep the port.
 
     Returns:
         What was sent.
@@ -434,7 +443,9 @@ def send_plan(
             error or alarm during the job, the port gone, or the operator
             stopped; the message says where and which ``--from-line`` resumes.
     """
-    return _Driver(port, plan, port_name, control or StopAtPause(), progress, log, time_scale).run()
+    driver = _Driver(port, plan, port_name, control or StopAtPause(), progress, log, time_scale)
+    driver.reopen = reopen
+    return driver.run()
 
 
 class _Driver:
@@ -456,12 +467,16 @@ class _Driver:
         self.messages: list[str] = []
         self.last_status = 0.0
         self.turns = 0
+        self.reopen: Callable[[], Any] | None = None
 
     def run(self) -> SendResult:
         start = time.monotonic()
-        self._start_up()
-        self._stream()
-        self._finish()
+        try:
+            self._start_up()
+            self._stream()
+            self._finish()
+        except _PortGone as exc:
+            raise LinkError(f"{exc}; {self._lost_hint()}") from exc
         return SendResult(
             len(self.plan.blocks),
             self.plan.total_bytes,
@@ -602,6 +617,12 @@ class _Driver:
         if not control.between_blocks(self.spec.operator_between_blocks, s.last_done, following):
             self._stop(f"{self.spec.operator_between_blocks}; then")
         self.turns = s.done
+        if self.reopen is not None:
+            with contextlib.suppress(Exception):
+                self.wire.port.close()
+            self.wire.port = self.reopen()
+            if self.spec.startup:
+                self.wire.write(self.spec.startup, "at start-up")
         return False
 
     def _read(self, now: float) -> None:
@@ -700,6 +721,29 @@ class _Driver:
         if line is None:
             return "every block had been sent"
         return f"fix the cause, then resume with --from-line {line}"
+
+    def _lost_hint(self) -> str:
+        """Where a job stood when the port went: what is known to have run, what may have."""
+        s = self.stream
+        sent = [b for b in self.plan.blocks[: len(self.plan.blocks) - len(s.queue)] if b.index]
+        if not sent:
+            return "no block of the program had been sent"
+        last = sent[-1]
+        if self.spec.flow == "timed" or s.in_flight:
+            confirmed = s.last_done if self.spec.flow != "timed" else None
+            known = (
+                f"blocks up to line {confirmed.line} were confirmed; "
+                if confirmed is not None and confirmed.index
+                else ""
+            )
+            return (
+                f"{known}the last block sent was line {last.line} and camtool cannot know "
+                f"whether the blocks after the last confirmed one ran: look where the tool "
+                f"stands, then resume with --from-line {last.line} if line {last.line} did "
+                "not run, or with the line after it if it did"
+            )
+        line = s.resume_line()
+        return f"resume with --from-line {line}" if line else "every block had been sent"
 
     def _stop(self, why: str) -> None:
         self._drain()

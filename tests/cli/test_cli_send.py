@@ -1,0 +1,129 @@
+"""``camtool send`` and ``simulate-device`` as a user runs them: exit codes, stdout, stderr."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from camtool.cli.main import main
+from tests.link.test_grbl import PROGRAM
+from tests.link.test_timed_links import VALCNC
+
+
+def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    code = main(args)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.fixture
+def job(tmp_path: Path) -> Path:
+    path = tmp_path / "job.gcode"
+    path.write_text(PROGRAM)
+    return path
+
+
+def test_dry_run_prints_the_plan_on_stdout(job: Path, capsys: Any) -> None:
+    code, out, err = run(["send", str(job), "-t", "grbl", "--dry-run"], capsys)
+    assert code == 0
+    lines = out.splitlines()
+    assert lines[1].startswith("link: 115200 baud 8N1")
+    assert "character counting (127-byte receive buffer)" in lines[1]
+    blocks = PROGRAM.count("\n")
+    assert f"blocks: {blocks} ({len(PROGRAM)} bytes) of {blocks}, from line 1" in out
+    assert lines[-1] == f"block {blocks} line {blocks}: 3 bytes, 0.000 s: M2"
+    assert err == ""
+
+
+def test_dry_run_from_line_shows_the_restore(job: Path, capsys: Any) -> None:
+    code, out, _ = run(["send", str(job), "-t", "grbl", "--dry-run", "--from-line", "8"], capsys)
+    assert code == 0
+    assert "restore: 16 bytes, 0.000 s: G21 G90 G94 G17" in out
+    assert "restore: 9 bytes, 0.000 s: M3 S1000" in out
+
+
+def test_from_line_in_an_arc_continuation_is_refused(tmp_path: Path, capsys: Any) -> None:
+    path = tmp_path / "arcs.gcode"
+    path.write_text("G21 G90\nG0 X10 Y0\nG2 X0 Y10 I-10 J0 F200\nX-10 Y0 I0 J-10\n")
+    code, _, err = run(["send", str(path), "-t", "grbl", "--dry-run", "--from-line", "4"], capsys)
+    assert code == 2
+    assert "continues the arc mode G2 of line 3" in err
+
+
+def test_a_target_without_a_link_says_how_its_code_gets_there(job: Path, capsys: Any) -> None:
+    code, _, err = run(["send", str(job), "-t", "linuxcnc", "--port", "loop://"], capsys)
+    assert code == 1
+    assert "LinuxCNC runs its own files" in err
+
+
+def test_no_port_is_a_usage_error(job: Path, capsys: Any) -> None:
+    code, _, err = run(["send", str(job), "-t", "grbl"], capsys)
+    assert code == 2 and "--port is required" in err
+
+
+def test_a_port_that_cannot_open_is_exit_1(job: Path, tmp_path: Path, capsys: Any) -> None:
+    code, _, err = run(["send", str(job), "-t", "grbl", "--port", str(tmp_path / "nope")], capsys)
+    assert code == 1 and "cannot open port" in err and "Traceback" not in err
+
+
+def test_send_to_the_simulator_and_log_every_byte(
+    job: Path, tmp_path: Path, simulate: Any, capsys: Any
+) -> None:
+    sim = simulate("grbl")
+    log = tmp_path / "job.log"
+    code, out, err = run(
+        ["send", str(job), "-t", "grbl", "--port", sim.path, "--log", str(log)], capsys
+    )
+    assert code == 0, err
+    assert out == ""
+    assert bytes(sim.device.received) == PROGRAM.encode()
+    text = log.read_text()
+    assert " > 47 32 31 20 47 39 30 20 47 39 34 20 47 31 37 0a |G21 G90 G94 G17\\n|" in text
+    assert "< " in text and "Grbl 1.1h" in text
+
+
+def test_a_port_that_disappears_is_exit_1_without_traceback(
+    job: Path, simulate: Any, capsys: Any
+) -> None:
+    sim = simulate("grbl", drop_at_block=20, block_delay_s=0.002)
+    code, _, err = run(["send", str(job), "-t", "grbl", "--port", sim.path], capsys)
+    assert code == 1
+    assert "disappeared" in err and "--from-line" in err
+    assert "Traceback" not in err
+
+
+def test_a_controller_error_is_exit_1_naming_line_and_words(
+    job: Path, simulate: Any, capsys: Any
+) -> None:
+    sim = simulate("grbl", fail_at_block=5, error="20", block_delay_s=0.002)
+    code, _, err = run(["send", str(job), "-t", "grbl", "--port", sim.path], capsys)
+    assert code == 1
+    assert "refused block 5 (line 5: 'G1 Z-0.1 F100')" in err
+    # error_codes_en_US.csv, code 20
+    assert "Unsupported command: Unsupported or invalid g-code command found in block." in err
+
+
+def test_valcnc_through_simulate_device(tmp_path: Path, capsys: Any) -> None:
+    job = tmp_path / "job.ngc"
+    job.write_text(VALCNC)
+    sim = subprocess.Popen(
+        [sys.executable, "-m", "camtool", "simulate-device", "-t", "valcnc", "--pty"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert sim.stdout is not None
+        path = sim.stdout.readline().strip()
+        assert path.startswith("/dev/")
+        code, _, err = run(["send", str(job), "-t", "valcnc", "--port", path], capsys)
+        assert code == 0, err
+        assert "one limit switch per axis" in err
+    finally:
+        sim.send_signal(2)
+        _, err = sim.communicate(timeout=10)
+    assert f"received 10 blocks ({len(VALCNC)} bytes), ran 10" in err
