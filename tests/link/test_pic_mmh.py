@@ -104,7 +104,7 @@ def test_a_posted_file_arrives_as_its_strings(simulate: Any, tmp_path: Path) -> 
     out = tmp_path / "plate.txt"
     small = ["--fit", "0.3", "0.2"]  # 0.3 mm: some 65 000 steps with the compensations
     assert main(["post", "samples/plate.dxf", "-t", "pic-mmh", *small, "-o", str(out)]) == 0
-    sim = simulate("pic-mmh")
+    sim = simulate("pic-mmh", steps_per_tick=1000)
     run(sim.path, out.read_text())
     assert bytes(sim.device.received) == out.read_bytes().replace(b"\n", b"")
     assert sim.device.aborted == []
