@@ -352,3 +352,43 @@ def decode_stream(data: bytes, locate: Locate) -> list[Record]:
     if cur.at < len(data):
         raise cur.fail(cur.at, f"{len(data) - cur.at} byte(s) after the end of data 54H")
     return records
+
+
+@dataclass(frozen=True)
+class PacketSpan:
+    """Where one packet lies in a session.
+
+    Attributes:
+        number: 1-based packet number.
+        start: offset of its first byte; ``end``: one past its 45H.
+        first_move: 1-based number of its first move (record) in the session.
+        moves: how many moves it holds (1 to :data:`MOVES_PER_PACKET`).
+    """
+
+    number: int
+    start: int
+    end: int
+    first_move: int
+    moves: int
+
+
+def packet_spans(data: bytes, locate: Locate) -> list[PacketSpan]:
+    """The packets of a session, strictly by the grammar (as :func:`decode_stream`).
+
+    Raises:
+        ParseError: as :func:`decode_stream`.
+    """
+    cur = _Cursor(data, locate)
+    key = cur.take("the access key 13H")
+    if key != ACCESS_KEY:
+        raise cur.fail(0, f"wrong access key {key:02X}H: a session starts with 13H")
+    spans: list[PacketSpan] = []
+    records: list[Record] = []
+    while cur.peek("a packet (01H) or the end of data 54H") != END_DATA:
+        start, before = cur.at, len(records)
+        _packet(cur, len(spans) + 1, records)
+        spans.append(PacketSpan(len(spans) + 1, start, cur.at, before + 1, len(records) - before))
+    cur.at += 1
+    if cur.at < len(data):
+        raise cur.fail(cur.at, f"{len(data) - cur.at} byte(s) after the end of data 54H")
+    return spans

@@ -33,17 +33,69 @@ Assumptions (the thesis does not say): the ``F`` number is a frequency in Hz,
 the ``B`` number is µm (204 and 178 µm, the final compensations, fit 3 digits;
 in steps they would not, §3.2 notes); which way "+" turns an axis is not
 documented (§4.6).
+
+The host link (``camtool send -t pic-mmh``; seed-000 §2.4, S000-11, thesis
+L1592–L1596, L1739–L1807; the ``[link]`` table of ``pic-mmh.toml``) and its
+simulator are at the end of this module (:data:`LINK`):
+
+- each block is the file's line without its line end: the ``;``-ended string
+  the GUI sent character by character (L1671, L1743). The line end is the
+  file's layout, not the protocol: sent after the ``;`` it would arrive as a
+  new string while the block moves, and abort it;
+- the PIC echoes every string (CONFIRMACIÓN, L1592–L1596); the host compares
+  the echo with what it sent, and a different echo stops the job naming the
+  block, after sending ``A;`` (stop) at once: the PIC may have started moving
+  to what it misread;
+- after each motor step the PIC sends one feedback byte, axis and direction
+  (L1792–L1799). The encoding is not in the thesis; camtool's assumption is
+  one byte per motor step, bit 7 set (never an ASCII echo character), bits
+  2–1 the axis (0 X, 1 Y, 2 Z), bit 0 the direction (1 negative):
+  :func:`feedback_byte`, 80H X+, 81H X−, 82H Y+, 83H Y−. An interpolator
+  iteration that steps X and Y sends two, X first. Backlash-compensation
+  steps are motor steps too ("cualquier avance … será transmitido") and are
+  reported;
+- a new string aborts the motion in progress (the PIC checks its receive flag
+  after every step, L1801–L1807), so the host sends the next block only when
+  the current one has finished: when as many feedback bytes have come as
+  camtool's own interpolator (the verifier's step simulation of the program,
+  compensation included) says the block takes, and ``settle_s`` has passed
+  with no more (one more step would mean the machine moves other than camtool
+  predicts: the job stops, with ``A;``). A dwell ``G04P##;`` sends no
+  feedback: the host waits its seconds. ``G28`` (home to the switches) has no
+  step count camtool can predict: a program with it is refused before
+  anything is sent (home with ``H;`` at the machine first);
+- the receive buffer ``CadenaControl`` has 35 elements (L1739–L1744), but
+  the thesis's own G02 string is 43 characters and its circles (Tabla 15)
+  were cut with such strings, so the firmware must parse fields on the fly
+  (seed-000 §2.4 flag). camtool follows that evidence: it sends strings
+  longer than 35 characters (every G02/G03 is), and the echo check stops the
+  job, naming the block, if a controller truncates one. The simulator takes
+  them by default (``on_the_fly=True``); ``on_the_fly=False`` models a strict
+  35-character buffer that loses what does not fit;
+- the baud rate is not in the thesis (S000-11: a parameter): 9600 by default,
+  ``--baud`` to change it;
+- ``--from-line``: the PIC keeps its part zero and its position; nothing is
+  restored but the spindle (the last ``M03S…``/``M04S…`` still on). Never
+  ``G54;``: it would store the current position as the part zero.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
 from decimal import ROUND_HALF_UP, Decimal
-from typing import ClassVar, Literal, TypeAlias, cast
+from typing import TYPE_CHECKING, Any, ClassVar, Literal, TypeAlias, cast
 
-from camtool.model.errors import DialectError, ParseError
+from camtool.link.device import Device
+from camtool.link.spec import LinkHooks, LinkSpec, WireBlock
+from camtool.model.errors import DialectError, InputError, ParseError
 from camtool.model.machine import Machine
+
+if TYPE_CHECKING:
+    from camtool.model.program import Program
+    from camtool.post.base import Target
 
 Axis: TypeAlias = Literal["X", "Y", "Z"]
 """An axis letter of the mode strings (seed-000 §3.6 ``axis``)."""
@@ -368,3 +420,271 @@ def backlash_commands(machine: Machine) -> tuple[str, ...]:
     """
     comp = machine.backlash.compensation_um
     return tuple(backlash_command(a, um) for a, um in zip(AXES, comp, strict=True) if um > 0)
+
+
+# -- the host link ------------------------------------------------------------------------
+
+RECEIVE_BUFFER = 35
+"""Elements of the firmware's receive vector ``CadenaControl`` (L1739–L1744)."""
+FEEDBACK = 0x80
+"""Bit 7 marks a feedback byte (camtool's assumption: the thesis gives no encoding)."""
+_DWELL = re.compile(r"G0?4P(\d+);")
+
+
+def feedback_byte(axis: int, step: int) -> int:
+    """The feedback byte of one motor step: ``axis`` 0 X, 1 Y, 2 Z; ``step`` +1 or −1.
+
+    camtool's assumption (module docstring): ``80H | axis << 1 | (step < 0)``.
+    """
+    return FEEDBACK | axis << 1 | (1 if step < 0 else 0)
+
+
+def is_feedback(answer: str) -> bool:
+    """True for a feedback byte (one motor step), False for an echo."""
+    return len(answer) == 1 and ord(answer) & 0xF8 == FEEDBACK and ord(answer) & 0x07 < 6
+
+
+def frame(code: bytes, spec: LinkSpec, source: str) -> list[WireBlock]:
+    """One block per non-empty line: the ``;``-ended string, without the line end.
+
+    Raises:
+        InputError: a line that is not one string ending with ``;``, naming it.
+    """
+    end = spec.block_end
+    blocks: list[WireBlock] = []
+    for number, raw in enumerate(code.split(b"\n"), start=1):
+        data = raw.rstrip(b"\r")
+        if not data.strip():
+            continue
+        if not data.endswith(end) or data.count(end) != 1:
+            raise InputError(
+                f"{source}, line {number}: {data.decode('latin-1')!r} is not one string ending "
+                f"with {end.decode('latin-1')!r} (seed-000 §2.4): one block per line"
+            )
+        blocks.append(WireBlock(len(blocks) + 1, number, number, data))
+    return blocks
+
+
+def split_answers(buffer: bytearray) -> list[str]:
+    """The PIC's answers in ``buffer`` (taken out): feedback bytes, and echoes up to ``;``.
+
+    Line ends between answers are skipped (the thesis does not say the echo has one).
+    """
+    out: list[str] = []
+    while buffer:
+        first = buffer[0]
+        if first & FEEDBACK or first in b"\r\n":
+            if first & FEEDBACK:
+                out.append(chr(first))
+            del buffer[0]
+            continue
+        cut = buffer.find(b";")
+        if cut < 0:
+            break
+        out.append(buffer[: cut + 1].decode("latin-1"))
+        del buffer[: cut + 1]
+    return out
+
+
+def step_events(program: Program, machine: Machine) -> dict[int, bytes]:
+    """The feedback bytes each source line's moves send, by camtool's interpolator.
+
+    The verifier's step simulation (:func:`camtool.verify.verifier.simulate`:
+    the DDA and DSM of annexes A.3/A.6, backlash compensation included) gives
+    each move's step rows; every non-zero entry is one motor step, one byte.
+    """
+    from camtool.verify.verifier import simulate
+
+    if not program.moves:
+        return {}
+    trace = simulate(program, machine)
+    out: dict[int, bytearray] = {}
+    for move in range(len(program.moves)):
+        line = program.line_of(move) or 0
+        rows = trace.rows[trace.block_start[move] : trace.block_start[move + 1]]
+        data = out.setdefault(line, bytearray())
+        for row in rows.tolist():
+            data += bytes(feedback_byte(axis, v) for axis, v in enumerate(row) if v)
+    return {line: bytes(data) for line, data in out.items()}
+
+
+def expect(blocks: list[WireBlock], program: Program, target: Target) -> list[WireBlock]:
+    """Each block with its feedback count (motor steps) and a dwell's seconds.
+
+    Raises:
+        DialectError: a ``G28`` block (homing: its step count is unknown).
+    """
+    events = step_events(program, target.machine)
+    out = []
+    for block in blocks:
+        text = block.text
+        if text.startswith("G28"):
+            raise DialectError(
+                f"line {block.line}: {text} homes to the switches: camtool cannot know its step "
+                "count, so it could not tell when the homing ends (a new string would abort "
+                "it); home at the machine ('H;') and send the program without G28"
+            )
+        dwell = _DWELL.fullmatch(text)
+        out.append(
+            replace(
+                block,
+                events=len(events.get(block.line, b"")),
+                busy_s=float(dwell.group(1)) if dwell else 0.0,
+            )
+        )
+    return out
+
+
+def resume(before: Sequence[WireBlock], first: WireBlock, spec: LinkSpec) -> list[WireBlock]:
+    """The spindle string still on before ``first`` (the PIC keeps everything else)."""
+    spindle = None
+    for block in before:
+        if block.text.startswith(("M03", "M04")):
+            spindle = block.data
+        elif block.text.startswith("M05"):
+            spindle = None
+    return [WireBlock(0, 0, 0, spindle)] if spindle else []
+
+
+class PicMmhDevice(Device):
+    """A simulated PIC18F8720 controller: echo, one feedback byte per step, abort, 35 characters.
+
+    A string (up to ``;``) is stored and echoed; a G/M line is read with
+    camtool's reader in the context of the lines run before it, and its motion
+    is the steps of camtool's interpolator for it, sent as feedback bytes
+    (:func:`feedback_byte`) ``steps_per_tick`` at a time. Anything received
+    while a motion runs aborts it (the PIC checks its receive flag after every
+    step, L1801–L1807): :attr:`aborted` lists ``(block, steps sent, steps)``.
+    ``A;`` stops a motion too (:attr:`stops`). Mode strings are echoed and
+    otherwise not modelled.
+
+    ``fail_at_block`` is a transmission error: the PIC stores that string with
+    its last digit changed (echoed and run as misread); ``drop_at_block``
+    closes the port when that string arrives.
+
+    Args:
+        spec: the pic-mmh link.
+        on_the_fly: the firmware parses fields as they arrive, so a string of
+            any length fits (the evidence of the thesis's 43-character G02);
+            False: a strict :data:`RECEIVE_BUFFER`-character buffer, the
+            characters after the 35th are lost (the ``;`` still ends the string).
+        steps_per_tick: feedback bytes sent per :meth:`step`.
+        **options: as :class:`camtool.link.device.Device`.
+    """
+
+    def __init__(
+        self,
+        spec: LinkSpec,
+        *,
+        on_the_fly: bool = True,
+        steps_per_tick: int = 40,
+        **options: Any,
+    ) -> None:
+        super().__init__(spec, **options)
+        self.on_the_fly = on_the_fly
+        self.steps_per_tick = steps_per_tick
+        self.rx = bytearray()
+        self.length = 0
+        self.motion = bytearray()
+        self.motion_steps = 0
+        self.running: bytes | None = None
+        self.aborted: list[tuple[int, int, int]] = []
+        self.stops = 0
+        self.lost = 0
+        self.longest = 0
+
+    def feed(self, data: bytes) -> bytes:
+        """Store the characters (a strict buffer loses those past the 35th); no answer."""
+        for byte in data:
+            if byte == ord(";"):
+                self.length = 0
+            elif not self.on_the_fly and self.length >= RECEIVE_BUFFER - 1:
+                self.lost += 1
+                continue
+            else:
+                self.length += 1
+            self.rx.append(byte)
+        return b""
+
+    def pending(self) -> bool:
+        """A motion runs, or a whole string waits."""
+        return bool(self.motion) or b";" in self.rx
+
+    def step(self) -> bytes:
+        """Send the next feedback bytes, or take, echo and start the next string."""
+        if self.motion:
+            if self.rx:  # a new string arrived: "Alto" (L1801-L1807)
+                self._abort()
+                return b""
+            batch = bytes(self.motion[: self.steps_per_tick])
+            del self.motion[: self.steps_per_tick]
+            if not self.motion and self.running is not None:
+                self.executed.append(self.running)
+                self.running = None
+            return batch
+        cut = self.rx.find(b";")
+        if cut < 0:
+            return b""
+        string = bytes(self.rx[: cut + 1])
+        del self.rx[: cut + 1]
+        return self._string(string)
+
+    def _abort(self) -> None:
+        done = self.motion_steps - len(self.motion)
+        self.aborted.append((len(self.blocks), done, self.motion_steps))
+        self.motion.clear()
+        self.running = None
+
+    def _string(self, string: bytes) -> bytes:
+        self.received += string
+        self.blocks.append(string)
+        self.longest = max(self.longest, len(string))
+        number = len(self.blocks)
+        if number == self.drop_at_block:
+            self.dropped = True
+            return b""
+        if number == self.fail_at_block:
+            string = _misread(string)
+        text = string.decode("latin-1")
+        if text == "A;":
+            self.stops += 1
+        elif text[:1] in ("G", "M"):
+            self._run(string)
+        return string
+
+    def _run(self, string: bytes) -> None:
+        """Start the motion of a G/M line: camtool's steps for it, after the lines run so far."""
+        assert self.target is not None
+        lines = [*(s.rstrip(b"\n") for s in self.executed), string]
+        code = b"\n".join(lines).decode("latin-1") + "\n"
+        try:
+            program = self.target.parse(code)
+        except ParseError:
+            return  # "no ejecuta tarea alguna" (L1755-L1757)
+        self.motion = bytearray(step_events(program, self.target.machine).get(len(lines), b""))
+        self.motion_steps = len(self.motion)
+        line = string + b"\n"
+        if self.motion:
+            self.running = line
+        else:
+            self.executed.append(line)
+
+
+def _misread(string: bytes) -> bytes:
+    """``string`` with its last digit changed (a transmission error the echo shows)."""
+    digits = [i for i, c in enumerate(string) if chr(c).isdigit()]
+    if not digits:
+        return string
+    i = digits[-1]
+    return string[:i] + str((int(chr(string[i])) + 1) % 10).encode() + string[i + 1 :]
+
+
+LINK = LinkHooks(
+    frame=frame,
+    split=split_answers,
+    feedback=is_feedback,
+    expect=expect,
+    resume=resume,
+    device=PicMmhDevice,
+)
+"""pic-mmh's link hooks (``camtool send -t pic-mmh``, ``camtool simulate-device -t pic-mmh``)."""

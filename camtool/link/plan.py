@@ -90,6 +90,8 @@ class SendPlan:
             f"target: {self.target} ({spec.source})" if spec.source else f"target: {self.target}",
             f"link: {spec.baud} baud 8N1, blocks end with {spec.block_end!r}, {flow}",
         ]
+        if spec.handshake:
+            out.append(f"start-up: {spec.handshake.upper()} handshake (modem lines)")
         if spec.startup:
             out.append(f"start-up: send {spec.startup!r}")
         if spec.banner:
@@ -101,9 +103,11 @@ class SendPlan:
         ]
         for block, seconds in zip(self.blocks, self.block_time_s, strict=True):
             where = f"block {block.index} line {block.line}" if block.index else "restore"
+            extra = f", {block.events} feedback events" if block.events else ""
+            extra += f", answer {block.ack!r}" if block.ack else ""
             text = block.text.replace("\r", " ")
             text = text if len(text) <= 60 else text[:57] + "..."
-            out.append(f"{where}: {len(block.data)} bytes, {fmt_num(seconds, 3)} s: {text}")
+            out.append(f"{where}: {len(block.data)} bytes, {fmt_num(seconds, 3)} s{extra}: {text}")
         return out
 
 
@@ -141,7 +145,8 @@ def prepare_send(
     Raises:
         LinkError: the target has no link camtool can speak.
         ParseError: the code is not the target's (named by line).
-        DialectError: a move outside the machine's area, or deeper than allowed.
+        DialectError: a move outside the machine's area, or deeper than allowed,
+            or a block whose end the sender could not tell (the ``expect`` hook).
         UsageError: ``from_line`` is outside the program or inside a block,
             or ``max_error_um`` without ``verify``.
         VerifyLimitError: the predicted error exceeds ``max_error_um``.
@@ -161,6 +166,8 @@ def prepare_send(
     move_times = _with_z(program, target, move_times)
     frame = hooks.frame or frame_lines
     blocks = frame(data, spec, source)
+    if hooks.expect is not None:
+        blocks = hooks.expect(blocks, program, target)
     times = _block_times(blocks, program, move_times)
     first = _first_block(blocks, from_line, source)
     sent = list(blocks[first:])

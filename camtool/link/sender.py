@@ -134,6 +134,10 @@ class Stream:
         self.failure: str | None = None
         self.failed_block: WireBlock | None = None
         self.max_buffered = 0
+        self.feedback = plan.hooks.feedback
+        self.head_acked = False
+        self.events_left = 0
+        self.events = 0
 
     def block(self, k: int) -> WireBlock:
         """Block ``k`` of the plan."""
@@ -141,7 +145,7 @@ class Stream:
 
     def next_block(self, now: float) -> int | None:
         """The block that may go now, or ``None`` (flow control, a failure, the end)."""
-        if not self.queue or self.failure:
+        if not self.queue or self.failure or now < self.ready_at:
             return None
         k = self.queue[0]
         flow = self.spec.flow
@@ -149,10 +153,7 @@ class Stream:
             size = len(self.block(k).data)
             if self.in_flight and self.buffered + size > self.spec.rx_buffer_bytes:
                 return None
-        elif flow == "ack":
-            if self.in_flight:
-                return None
-        elif now < self.ready_at:
+        elif flow == "ack" and self.in_flight:
             return None
         return k
 
@@ -173,42 +174,91 @@ class Stream:
         self.done += 1
         self.last_done = self.block(k)
 
-    def answer(self, text: str) -> str:
-        """What a line from the controller means: ``"ack"``, ``"error"``, ``"alarm"`` or ``"push"``.
+    def answer(self, text: str, now: float | None = None) -> str:
+        """What an answer from the controller means.
 
-        An ``"error"`` or ``"alarm"`` sets :attr:`failure` (an echo that is not
-        the block sent is an error too).
+        Returns ``"ack"`` (a block is done), ``"answer"`` (a block was accepted
+        and runs: its feedback events follow), ``"event"`` (one feedback event),
+        ``"ignore"`` (an answer the link only logs), ``"error"``, ``"alarm"``
+        or ``"push"`` (anything else). An ``"error"`` or ``"alarm"`` sets
+        :attr:`failure`: an echo that is not the block sent is an error, and so
+        is a feedback event when no accepted block is running (the controller
+        moves more than camtool's interpolator says the block takes).
         """
         spec = self.spec
+        now = time.monotonic() if now is None else now
         if spec.alarm and text.startswith(spec.alarm):
             self.failure = self.failure or text
             return "alarm"
-        if not self.in_flight:
+        if self.feedback is not None and self.feedback(text):
+            return self._event(text, now)
+        if text in spec.ignore:
+            return "ignore"
+        if not self.in_flight or self.head_acked:
             return "push"
-        k = self.in_flight[0]
+        block = self.block(self.in_flight[0])
         if spec.echo:
-            if text == self.block(k).text:
-                self._acked()
-                return "ack"
+            if text == block.text:
+                return self._acked(now)
             if text.startswith(("<", "[")) or not text:
                 return "push"
-            self._acked(failed=f"echo {text!r} is not the block sent")
+            k = self.in_flight[0]
+            self._acked(now, failed=f"echo {text!r} is not the block sent")
+            self.queue.appendleft(k)  # the controller did not get it as sent: resume at it
             return "error"
-        if text == spec.ack:
-            self._acked()
-            return "ack"
+        if text == (block.ack or spec.ack):
+            return self._acked(now)
         if spec.error and text.startswith(spec.error):
-            self._acked(failed=text)
+            self._acked(now, failed=text)
             return "error"
         return "push"
 
-    def _acked(self, failed: str | None = None) -> None:
+    def _acked(self, now: float, failed: str | None = None) -> str:
+        k = self.in_flight[0]
+        if failed is not None:
+            self.in_flight.popleft()
+            self.buffered -= len(self.block(k).data)
+            if self.failure is None:
+                self.failure, self.failed_block = failed, self.block(k)
+            return "error"
+        if self.block(k).events:
+            self.head_acked, self.events_left = True, self.block(k).events
+            return "answer"
+        self._complete(now)
+        return "ack"
+
+    def _event(self, text: str, now: float) -> str:
+        """One feedback event: counted against the running block's events."""
+        self.events += 1
+        if not self.in_flight or not self.head_acked:
+            last = self.last_done
+            after = (
+                f"after block {last.index} (line {last.line}) had made all its "
+                f"{last.events} reported steps"
+                if last is not None and not self.in_flight
+                else "before the controller accepted the block"
+            )
+            self.failure = self.failure or (
+                f"feedback event {text.encode('latin-1').hex()}H came {after}: the controller "
+                "moves other than camtool's interpolator predicts"
+            )
+            return "error"
+        self.events_left -= 1
+        if self.events_left:
+            return "event"
+        self._complete(now)
+        return "ack"
+
+    def _complete(self, now: float) -> None:
+        """The head block is done (answered, all its feedback in); the controller may stay busy."""
         k = self.in_flight.popleft()
-        self.buffered -= len(self.block(k).data)
-        if failed is None:
-            self._done(k)
-        elif self.failure is None:
-            self.failure, self.failed_block = failed, self.block(k)
+        block = self.block(k)
+        self.buffered -= len(block.data)
+        self.head_acked = False
+        self._done(k)
+        wait = block.busy_s * self.time_scale + (self.spec.settle_s if block.events else 0.0)
+        if wait:
+            self.ready_at = max(self.ready_at, now + wait)
 
     def idle(self, now: float) -> bool:
         """True when nothing is in flight (timed: the last block's time is over)."""
@@ -257,12 +307,19 @@ class _PortGone(LinkError):
 class _Wire:
     """The port with logging and errors turned into :class:`LinkError`; reads lines."""
 
-    def __init__(self, port: Any, name: str, log: ByteLog | None) -> None:
+    def __init__(
+        self,
+        port: Any,
+        name: str,
+        log: ByteLog | None,
+        split: Callable[[bytearray], list[str]] | None = None,
+    ) -> None:
         self.port = port
         self.name = name
         self.log = log
         self.buffer = bytearray()
         self.last_rx = time.monotonic()
+        self.split = split or split_lines
 
     def write(self, data: bytes, where: str) -> None:
         import serial
@@ -275,8 +332,39 @@ class _Wire:
         if self.log:
             self.log.record(">", data)
 
+    def modem_handshake(self, timeout: float) -> bool | None:
+        """Raise DTR and RTS, wait up to ``timeout`` s for DSR: True when it came.
+
+        ``None`` when the port has no modem lines (a pseudo-terminal answers
+        their ioctl with ENOTTY; pyserial URLs have none).
+
+        Raises:
+            LinkError: the port disappeared.
+        """
+        import errno
+
+        import serial
+
+        try:
+            self.port.dtr = True
+            self.port.rts = True
+            deadline = time.monotonic() + timeout
+            while not self.port.dsr:
+                if time.monotonic() >= deadline:
+                    return False
+                time.sleep(POLL_S)
+        except OSError as exc:
+            if exc.errno in (errno.ENOTTY, errno.EINVAL):
+                return None
+            raise LinkError(f"port {self.name!r} disappeared at start-up: {exc}") from exc
+        except serial.SerialException as exc:
+            raise LinkError(f"port {self.name!r} disappeared at start-up: {exc}") from exc
+        except (AttributeError, NotImplementedError):
+            return None
+        return True
+
     def lines(self, timeout: float, where: str) -> list[str]:
-        """Whole lines received within ``timeout`` s (line ends stripped)."""
+        """Whole answers received within ``timeout`` s (lines, line ends stripped, by default)."""
         import serial
 
         try:
@@ -289,11 +377,16 @@ class _Wire:
             if self.log:
                 self.log.record("<", data)
             self.buffer += data
-        out = []
-        while (cut := self.buffer.find(b"\n")) >= 0:
-            out.append(self.buffer[:cut].decode("latin-1").strip("\r"))
-            del self.buffer[: cut + 1]
-        return [line for line in out if line]
+        return self.split(self.buffer)
+
+
+def split_lines(buffer: bytearray) -> list[str]:
+    """The whole lines in ``buffer`` (taken out of it), line ends stripped, empty ones dropped."""
+    out = []
+    while (cut := buffer.find(b"\n")) >= 0:
+        out.append(buffer[:cut].decode("latin-1").strip("\r"))
+        del buffer[: cut + 1]
+    return [line for line in out if line]
 
 
 @dataclass(frozen=True)
@@ -336,7 +429,8 @@ def send_plan(
         control: the operator (default: :class:`StopAtPause`).
         progress: called after every block done.
         log: where every byte goes.
-        time_scale: multiplies timed-flow waits (0 for simulators and tests).
+        time_scale: multiplies timed-flow waits, a block's ``busy_s`` and the silence
+            allowed for the blocks in flight (0 for simulators and tests).
         reopen: opens the port again after the operator's turn between blocks
             (``operator_between_blocks``: the device was reset, as the
             matlab-router master is after every job); ``None``: keep the port.
@@ -366,7 +460,8 @@ class _Driver:
         time_scale: float,
     ) -> None:
         self.plan, self.spec, self.control = plan, plan.spec, control
-        self.wire = _Wire(port, name or "port", log)
+        self.wire = _Wire(port, name or "port", log, plan.hooks.split)
+        self.log = log
         self.stream = Stream(plan, time_scale=time_scale)
         self.report = progress or (lambda p: None)
         self.messages: list[str] = []
@@ -394,6 +489,8 @@ class _Driver:
 
     def _start_up(self) -> None:
         spec = self.spec
+        if spec.handshake == "dtr-dsr":
+            self._modem_handshake()
         if spec.banner and not self._wait_banner():
             raise LinkError(
                 f"{spec.target}: no answer on {self.wire.name!r} (no {spec.banner!r} banner "
@@ -409,6 +506,27 @@ class _Driver:
                 )
         if spec.startup:
             self.wire.write(spec.startup, "at start-up")
+
+    def _modem_handshake(self) -> None:
+        """DTR out, DSR back (seed-003 §3.2); skipped, with a note, on a port without them."""
+        spec, wire = self.spec, self.wire
+        answered = wire.modem_handshake(spec.response_timeout_s)
+        if answered is None:
+            note = (
+                f"{wire.name!r} has no modem lines (a pseudo-terminal or a URL): the DTR/DSR "
+                "handshake was skipped; the controller's first answer shows it is there"
+            )
+            self.messages.append(note)
+            if self.log:
+                self.log.note(note)
+        elif not answered:
+            raise LinkError(
+                f"{spec.target}: no DSR on {wire.name!r} within {spec.response_timeout_s:g} s "
+                "of raising DTR: is the interface powered, and the cable wired for DTR/DSR? "
+                "nothing was sent"
+            )
+        elif self.log:
+            self.log.note("DTR raised, DSR answered")
 
     def _wait_banner(self) -> bool:
         spec = self.spec
@@ -517,7 +635,7 @@ class _Driver:
                 self.report(s.progress())
             elif kind == "push":
                 self._push(line)
-        if s.in_flight:
+        if s.in_flight and not s.failure:
             self._keep_alive()
 
     def _push(self, line: str) -> None:
@@ -531,14 +649,46 @@ class _Driver:
             self.wire.write(self.spec.status, f"while sending ({self._where()})")
             self.last_status = now
         if now - self.wire.last_rx > self.spec.response_timeout_s + self._in_flight_time():
+            stopped = self._abort()
+            s = self.stream
+            block = s.block(s.in_flight[0])
+            unsure = (
+                f"block {block.index} (line {block.line}) was sent and not confirmed: it may "
+                "have run in part, so check where the tool stands; "
+            )
             raise LinkError(
                 f"{self.spec.target} stopped answering on {self.wire.name!r} "
-                f"({self._where()}); {self._resume_hint()}"
+                f"({self._where()}){stopped}; {unsure}{self._resume_hint()}"
             )
+
+    def _abort(self) -> str:
+        """Send the link's ``abort`` bytes (the controller may be moving): what became of them.
+
+        With an echoing link, waits ``response_timeout_s`` for the abort's own
+        echo, the controller's word that it got the stop. Returns ``""`` when
+        the link has no abort, else a clause for the error message.
+        """
+        spec = self.spec
+        if not spec.abort:
+            return ""
+        text = spec.abort.decode("latin-1").rstrip("\r\n")
+        try:
+            self.wire.write(spec.abort, "stopping the controller")
+            if not spec.echo:
+                return f"; {text!r} sent to stop the controller"
+            deadline = time.monotonic() + spec.response_timeout_s
+            while time.monotonic() < deadline:
+                if text in self.wire.lines(POLL_S, "stopping the controller"):
+                    return f"; {text!r} sent and echoed: the controller stopped"
+        except LinkError:
+            return f"; {text!r} could not be sent: stop the machine by hand"
+        return f"; {text!r} sent but not echoed: stop the machine by hand"
 
     def _in_flight_time(self) -> float:
         s = self.stream
-        return 0.0 if self.spec.status else sum(self.plan.block_time_s[k] for k in s.in_flight)
+        if self.spec.status:
+            return 0.0
+        return self.stream.time_scale * sum(self.plan.block_time_s[k] for k in s.in_flight)
 
     def _drain(self) -> None:
         """Wait for the answers of the blocks still in flight (they run on the controller)."""
@@ -552,6 +702,7 @@ class _Driver:
     def _fail(self) -> None:
         s = self.stream
         failed, message = s.failed_block, s.failure or ""
+        stopped = self._abort()
         if failed is not None:  # an alarm empties the controller's buffer: nothing to wait for
             self._drain()
         decode = self.plan.hooks.decode
@@ -563,7 +714,7 @@ class _Driver:
             head = f"{self.spec.target} refused {what}: {words}"
         else:
             head = f"{self.spec.target}: {words} ({self._where()})"
-        raise LinkError(f"{head}; the job stopped {self._where()}; {self._resume_hint()}")
+        raise LinkError(f"{head}{stopped}; the job stopped {self._where()}; {self._resume_hint()}")
 
     def _resume_hint(self) -> str:
         line = self.stream.resume_line()

@@ -40,6 +40,15 @@ Every target declares how code reaches its machine next to its dialect, in a
 ``operator_between_blocks``  a prompt: the operator must act after every block (the
                            matlab-router master runs one job per reset)
 ``warnings``               what to tell the operator before every job
+``handshake``              ``"dtr-dsr"``: raise DTR (and RTS) and wait
+                           ``response_timeout_s`` for DSR before anything is sent
+                           (seed-003's power-on handshake); a port without modem
+                           lines (a pseudo-terminal, a URL) skips it, with a note
+``ignore``                 answers the sender only logs (per-byte confirmations)
+``abort``                  bytes that stop the controller at once, sent when a job
+                           fails while the controller may be moving (pic-mmh ``A;``)
+``settle_s``               after a block's last feedback event, the quiet time before
+                           the next block; an event in it stops the job
 =========================  =========================================================
 
 Hooks (:class:`LinkHooks`), each optional: ``frame`` splits code into wire blocks
@@ -47,7 +56,11 @@ when "one line, one block" is wrong (a matlab-router job is ``3 + 4n`` records);
 ``decode`` words a controller's message (GRBL ``error:22``); ``resume`` gives
 the blocks that restore the controller's modal state before ``--from-line``;
 ``device`` builds the target's simulator (:mod:`camtool.link.device`);
-``status_state`` reads a status report.
+``status_state`` reads a status report; ``split`` cuts the controller's bytes
+into answers when they are not lines (single bytes, ``;``-ended echoes);
+``feedback`` tells a feedback event (one motor step) from an answer;
+``expect`` fills in, from the program read back, what the controller will
+report for each block (its feedback events, a dwell it is busy for).
 """
 
 from __future__ import annotations
@@ -78,17 +91,31 @@ class WireBlock:
         line: 1-based source line where the block starts (0 for added blocks).
         last_line: source line where it ends (a matlab-router job spans records).
         data: the exact bytes, terminator included.
+        ack: the answer that accepts this block when it is not the link's
+            ``ack`` (the i8751 answers a packet 'F' and the end of data 'A');
+            ``""``: the link's.
+        events: feedback events the controller sends after its answer while it
+            runs the block (pic-mmh: one per motor step); the block is done when
+            the last has come.
+        busy_s: seconds the controller stays busy after that with nothing to
+            say (a dwell); the next block waits them.
+        note: how messages show the block when its bytes are not text (a
+            binary packet); ``""``: the bytes.
     """
 
     index: int
     line: int
     last_line: int
     data: bytes
+    ack: str = ""
+    events: int = 0
+    busy_s: float = 0.0
+    note: str = ""
 
     @property
     def text(self) -> str:
-        """The block as text for messages, without its terminator."""
-        return self.data.decode("latin-1").rstrip("\r\n")
+        """The block as text for messages, without its terminator (or its note)."""
+        return self.note or self.data.decode("latin-1").rstrip("\r\n")
 
 
 @dataclass(frozen=True)
@@ -124,6 +151,10 @@ class LinkSpec:
     operator_between_blocks: str = ""
     echo: bool = False
     warnings: tuple[str, ...] = ()
+    handshake: str = ""
+    ignore: tuple[str, ...] = ()
+    abort: bytes = b""
+    settle_s: float = 0.0
 
     def wire_time_s(self, nbytes: int) -> float:
         """Seconds ``nbytes`` take on the wire at :attr:`baud`, 8N1 (10 bits a byte)."""
@@ -150,6 +181,17 @@ class LinkHooks:
             (GRBL ``<Idle|MPos:…>`` → ``"Idle"``); ``None`` for any other line.
             With it and a ``status`` byte, ``send`` refuses a controller in
             ``Alarm`` before the job and waits for ``Idle`` at its end.
+        split: ``buffer -> answers``: takes the whole answers out of the bytes
+            received so far (it deletes what it takes from ``buffer``, a
+            ``bytearray``) and returns them as latin-1 text; default: lines,
+            line ends stripped, empty lines dropped.
+        feedback: ``answer -> bool``: True for a feedback event (counted
+            against :attr:`WireBlock.events`, never an answer).
+        expect: ``(blocks, program, target) -> blocks``: the blocks with what
+            the controller will report for each (``events``, ``busy_s``), from
+            the program as the target's reader read it back. Raises
+            :class:`~camtool.model.errors.DialectError` for a block whose end
+            the sender could not tell.
     """
 
     frame: Callable[[bytes, LinkSpec, str], list[WireBlock]] | None = None
@@ -157,12 +199,17 @@ class LinkHooks:
     resume: Callable[[Sequence[WireBlock], WireBlock, LinkSpec], list[WireBlock]] | None = None
     device: Callable[..., Any] | None = None
     status_state: Callable[[str], str | None] | None = None
+    split: Callable[[bytearray], list[str]] | None = None
+    feedback: Callable[[str], bool] | None = None
+    expect: Callable[[list[WireBlock], Any, Any], list[WireBlock]] | None = None
 
 
 NO_HOOKS = LinkHooks()
 
-_BYTES = ("block_end", "wake", "startup", "status", "hold", "resume", "reset")
+_BYTES = ("block_end", "wake", "startup", "status", "hold", "resume", "reset", "abort")
 _TEXT = ("how", "source", "ack", "error", "alarm", "banner", "operator_between_blocks")
+HANDSHAKES = ("", "dtr-dsr")
+"""Values of ``[link] handshake``."""
 _POSITIVE = ("banner_timeout_s", "response_timeout_s")
 _COUNTS = ("baud", "rx_buffer_bytes", "max_block_bytes")
 
@@ -201,6 +248,8 @@ def _spec_from_table(table: dict[str, Any], name: str, where: str) -> LinkSpec:
         values[key] = _checked(key, value, where)
     if values.get("protocol") not in PROTOCOLS:
         raise InputError(f"{where}: protocol must be one of {list(PROTOCOLS)}")
+    if values.get("handshake", "") not in HANDSHAKES:
+        raise InputError(f"{where}: handshake must be one of {list(HANDSHAKES)}")
     if values.get("flow", "ack") not in FLOWS:
         raise InputError(f"{where}: flow must be one of {list(FLOWS)}")
     if values.get("flow") == "char-count" and not values.get("rx_buffer_bytes"):
@@ -214,7 +263,7 @@ def _spec_from_table(table: dict[str, Any], name: str, where: str) -> LinkSpec:
 
 def _checked(key: str, value: Any, where: str) -> Any:
     """One ``[link]`` value, checked and converted (bytes as latin-1, tuples)."""
-    if key in _BYTES or key in _TEXT or key in ("protocol", "flow"):
+    if key in _BYTES or key in _TEXT or key in ("protocol", "flow", "handshake"):
         if not isinstance(value, str):
             raise InputError(f"{where}: {key} must be a string, not {value!r}")
         return value.encode("latin-1") if key in _BYTES else value
@@ -222,9 +271,9 @@ def _checked(key: str, value: Any, where: str) -> Any:
         if not isinstance(value, bool):
             raise InputError(f"{where}: echo must be true or false, not {value!r}")
         return value
-    if key == "warnings":
+    if key in ("warnings", "ignore"):
         if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
-            raise InputError(f"{where}: warnings must be a list of strings")
+            raise InputError(f"{where}: {key} must be a list of strings")
         return tuple(value)
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
         raise InputError(f"{where}: {key} must be a number, not {value!r}")
