@@ -14,6 +14,7 @@ time its bytes take on the wire.
 from __future__ import annotations
 
 import bisect
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -270,8 +271,25 @@ def _block_times(blocks: list[WireBlock], program: Program, move_times: list[flo
         times[block_of(move)] += seconds
     for index, command in program.commands:
         if isinstance(command, Dwell):
-            times[block_of(min(index, len(program.moves) - 1))] += command.seconds
+            times[_dwell_block(index, program, blocks, block_of)] += command.seconds
     return times
+
+
+def _dwell_block(
+    index: int, program: Program, blocks: list[WireBlock], block_of: Callable[[int], int]
+) -> int:
+    """The block that holds a dwell run before ``moves[index]`` (after the last: ``len``).
+
+    A command carries no source line, but it was written after the move before it and
+    before the move after it: the last block between those two moves' blocks holds it.
+    Without a block between them (both in one block) it is the next move's block.
+    """
+    count = len(program.moves)
+    after = block_of(index - 1) + 1 if 0 < index <= count else 0
+    following = block_of(index) if index < count else len(blocks)
+    if following > after:
+        return following - 1
+    return min(following, len(blocks) - 1)
 
 
 def _first_block(blocks: list[WireBlock], from_line: int | None, source: str) -> int:

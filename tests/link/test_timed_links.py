@@ -163,3 +163,16 @@ def test_router_script_format_is_refused(tmp_path: Path) -> None:
     assert main(["post", "samples/star.csv", "-t", "matlab-router", "-o", str(out)]) == 0
     with pytest.raises(InputError, match="--format wire"):
         prepare_send(out.read_bytes(), load_target("matlab-router"))
+
+
+def test_a_dwell_is_timed_on_its_own_block_not_on_the_next_move() -> None:
+    # G4 P2 runs after the spindle starts and before the first move: the sender must wait its
+    # 2 s after the G4 block (GRBL: P is seconds, gnea/grbl doc/markdown/commands.md), and the
+    # move's block keeps only the move's own time.
+    code = "G21 G90\nM3 S1000\nG4 P2\nG1 X1 F600\nM5\n"
+    plain = prepare_send(code.replace("G4 P2\n", "(no dwell)\n"), load_target("grbl"))
+    dwell = prepare_send(code, load_target("grbl"))
+    lines = [b.line for b in dwell.blocks]
+    at = {line: t for line, t in zip(lines, dwell.block_time_s, strict=True)}
+    assert at[3] == pytest.approx(2.0)
+    assert at[4] == pytest.approx(dict(zip(lines, plain.block_time_s, strict=True))[4])
