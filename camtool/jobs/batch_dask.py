@@ -100,9 +100,11 @@ def connect(scheduler: str) -> Iterator[Client]:
     """A client of the cluster ``scheduler`` names, closed (with a local cluster) at the end.
 
     ``local:N`` starts a ``LocalCluster`` of N worker processes with one thread each
-    (its dashboard at http://localhost:8787/status when Bokeh is installed and the
-    port is free). An address connects to a running scheduler and waits up to
-    :data:`WORKER_WAIT_S` for a first worker.
+    (its dashboard at http://localhost:8787/status when Bokeh is installed — Dask
+    takes another port, and says so, when 8787 is taken —; without Bokeh its web
+    server takes a free port, so that two batches never clash on 8787). An address
+    connects to a running scheduler and waits up to :data:`WORKER_WAIT_S` for a
+    first worker.
 
     Raises:
         UsageError: ``scheduler`` is malformed, or Dask is not installed.
@@ -111,7 +113,7 @@ def connect(scheduler: str) -> Iterator[Client]:
     check_scheduler(scheduler)
     distributed = _distributed()
     if scheduler.startswith(LOCAL):
-        dashboard = ":8787" if importlib.util.find_spec("bokeh") is not None else None
+        dashboard = ":8787" if importlib.util.find_spec("bokeh") is not None else ":0"
         with (
             distributed.LocalCluster(
                 n_workers=int(scheduler.removeprefix(LOCAL)),

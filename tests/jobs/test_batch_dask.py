@@ -17,6 +17,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import time
 from collections import Counter
 from collections.abc import Iterator
 from pathlib import Path
@@ -288,6 +289,86 @@ def test_scheduler_usage_errors(
     err = capsys.readouterr().err
     assert code == 2 and message in err and "Traceback" not in err
     assert not Path("out").exists()
+
+
+def test_the_command_with_a_scheduler_address(
+    drawings: Path, client: Client, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # as on another host: `dask scheduler` prints tcp://HOST:PORT, workers joined it
+    address = client.scheduler.address
+    assert address.startswith("tcp://")
+    args = ["batch", "drawings/parts", "-t", "pic-mmh", "--report", "-"]
+    assert main([*args, "-o", "ref", "-j", "1"]) == 3
+    ref = json.loads(capsys.readouterr().out)
+    assert main([*args, "-o", "out", "--scheduler", address]) == 3
+    out, err = capsys.readouterr()
+    report = json.loads(out)
+    assert report["options"]["scheduler"] == address
+    assert sorted(line.split("]")[0] for line in err.splitlines() if line[:1] == "[") == [
+        "[1/4",
+        "[2/4",
+        "[3/4",
+        "[4/4",
+    ]
+    assert report["files"] == [
+        {
+            **row,
+            "outputs": {k: v and v.replace("ref/", "out/", 1) for k, v in row["outputs"].items()},
+        }
+        for row in ref["files"]
+    ]
+    assert tree(Path("out")) == tree(Path("ref"))
+
+
+def test_a_scheduler_without_workers_is_an_error(
+    drawings: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from camtool.jobs import batch_dask
+
+    monkeypatch.setattr(batch_dask, "WORKER_WAIT_S", 0.5)
+    with LocalCluster(n_workers=0, processes=False, dashboard_address=":0") as empty:
+        address = empty.scheduler_address
+        code = main(["batch", "drawings", "-t", "pic-mmh", "-o", "out", "--scheduler", address])
+    err = capsys.readouterr().err
+    assert code == 1 and "Traceback" not in err
+    assert f"--scheduler {address}: no worker joined the scheduler within 0.5 s; " in err
+    assert f"start one with `dask worker {address}`" in err
+    assert not Path("out").exists()  # nothing claimed, nothing written
+
+
+def test_local_workers_die_with_a_killed_batch(drawings: Path) -> None:
+    """kill -9 of `batch --scheduler local:2` must not leave its Dask workers running."""
+    from tests.jobs.test_batch import alive, children
+
+    for i in range(40):
+        shutil.copy(SAMPLES / "logo.dxf", drawings / f"logo{i}.dxf")
+    argv = [sys.executable, "-m", "camtool", "batch", "drawings", "-t", "pic-mmh", "-o", "out"]
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]),
+    }
+    parent = subprocess.Popen(
+        [*argv, "--verify", "--scheduler", "local:2"], stderr=subprocess.PIPE, env=env, text=True
+    )
+    workers: list[int] = []
+    try:
+        assert parent.stderr is not None
+        lines = iter(parent.stderr.readline, "")
+        assert any(line.startswith("[1/") for line in lines)  # a file done: the workers run
+        workers = children(parent.pid)
+        assert len(workers) >= 2
+        parent.kill()
+        parent.wait()
+        deadline = time.monotonic() + 10
+        while any(alive(pid) for pid in workers) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not [pid for pid in workers if alive(pid)]
+        assert [p for p in Path("out").rglob("*.tmp")] == []
+    finally:
+        for pid in workers:
+            if alive(pid):
+                os.kill(pid, signal.SIGKILL)
+        parent.kill()
 
 
 def _camtool(code: str) -> subprocess.CompletedProcess[str]:
