@@ -22,7 +22,6 @@ without it; ``--scheduler`` without it is refused before any work starts
 
 from __future__ import annotations
 
-import asyncio
 import contextlib
 import importlib.util
 from collections.abc import Callable, Iterator
@@ -173,7 +172,7 @@ def map_unordered(
     threads = sum(client.nthreads().values())
     ahead = max(MIN_IN_FLIGHT, IN_FLIGHT_PER_THREAD * threads)
     pending: dict[Any, int] = {}
-    done = distributed.as_completed()
+    done = distributed.as_completed(with_results=True, raise_errors=False)  # fetched as they end
     submitted = 0
 
     def submit() -> None:
@@ -186,12 +185,10 @@ def map_unordered(
     try:
         while submitted < min(ahead, count):
             submit()
-        for future in done:
+        for future, result in done:
             index = pending.pop(future)
-            try:
-                outcome: tuple[int, Any, BaseException | None] = (index, future.result(), None)
-            except (Exception, asyncio.CancelledError) as exc:  # failed or cancelled on the cluster
-                outcome = (index, None, exc)
+            failed = isinstance(result, BaseException)  # failed or cancelled on the cluster
+            outcome = (index, None, result) if failed else (index, result, None)
             future.release()
             if submitted < count:
                 submit()
