@@ -330,20 +330,20 @@ def plan_batch(inputs: Sequence[str], options: BatchOptions) -> BatchPlan:
 
         require_dask()
     several = len(options.targets) > 1
-    suffixes = {name: _suffix(name, options, several) for name in options.targets}
+    layouts = {name: _layout(name, options, several) for name in options.targets}
     if options.output_dir.exists() and not options.output_dir.is_dir():
         raise UsageError(f"{options.output_dir}: exists and is not a directory (-o OUTDIR)")
     items = expand_inputs(inputs, exclude=options.output_dir)
     tasks = tuple(
         _task(item, options, suffix, (name, folder) if several else None)
-        for name, (folder, suffix) in suffixes.items()
+        for name, (folder, suffix) in layouts.items()
         for item in items
     )
     _check_outputs(items, tasks, options)
     return BatchPlan(options, tasks)
 
 
-def _suffix(name: str, options: BatchOptions, several: bool) -> tuple[str, str]:
+def _layout(name: str, options: BatchOptions, several: bool) -> tuple[str, str]:
     """The target ``name`` checked with the options: its folder (its own name) and ending.
 
     Raises:
@@ -988,7 +988,7 @@ def progress_line(done: int, total: int, row: BatchRow) -> str:
     """One finished file, for a log: ``[3/12] ok  a.dxf → out/a.pic  41 blocks  12.3 µm  2.1 s``.
 
     An error shows its message instead of the outputs; an over-limit file shows
-    both.
+    both. In a batch of several targets the file is followed by ``for <target>``.
     """
     head = f"[{done}/{total}] {row.status}  {row.file}"
     if row.target is not None:
