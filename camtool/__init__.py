@@ -60,12 +60,14 @@ _HOMES: dict[str, str] = {
     "post_file": "camtool.jobs.pipeline",
     "post_program": "camtool.jobs.pipeline",
     "verify_job": "camtool.jobs.pipeline",
+    # many files, several targets, a process pool or a Dask cluster: camtool.batch.run(...)
+    "batch": "camtool.jobs",
     # verify
     "Verification": "camtool.verify.verifier",
     "verify_code": "camtool.verify.verifier",
     "verify_program": "camtool.verify.verifier",
 }
-"""Each public name → the module that defines it."""
+"""Each public name → the module that defines it (or the package of a public submodule)."""
 
 __all__ = ["__version__", *_HOMES]
 """The public API: each name is defined in the module :data:`_HOMES` gives."""
@@ -74,13 +76,19 @@ __all__ = ["__version__", *_HOMES]
 def __getattr__(name: str) -> Any:
     """The public ``name``, imported from its module on first use (PEP 562).
 
+    A name whose home is a package and that is none of its attributes is its
+    submodule: ``camtool.batch`` is the module :mod:`camtool.jobs.batch`.
+
     Raises:
         AttributeError: ``name`` is not public (nor a submodule already imported).
     """
     home = _HOMES.get(name)
     if home is None:
         raise AttributeError(f"module 'camtool' has no attribute {name!r}")
-    value = getattr(import_module(home), name)
+    module = import_module(home)
+    value = getattr(module, name, None)
+    if value is None:
+        value = import_module(f"{home}.{name}")
     globals()[name] = value  # the next lookup is an ordinary attribute
     return value
 
@@ -92,6 +100,7 @@ def __dir__() -> list[str]:
 if TYPE_CHECKING:  # the names as type checkers see them (``X as X``: exported, PEP 484)
     from camtool.importers import read_drawing as read_drawing
     from camtool.importers.options import ImportOptions as ImportOptions
+    from camtool.jobs import batch as batch
     from camtool.jobs.pipeline import OutputOptions as OutputOptions
     from camtool.jobs.pipeline import PostJob as PostJob
     from camtool.jobs.pipeline import plan_options as plan_options

@@ -42,7 +42,14 @@ def _post_options(command: Callable[..., None]) -> Callable[..., None]:
 
 @click.command()
 @click.argument("inputs", nargs=-1, required=True, metavar="INPUTS...")
-@click.option("--target", "-t", required=True, metavar="NAME", help="See `camtool targets`.")
+@click.option(
+    "--target",
+    "-t",
+    required=True,
+    multiple=True,
+    metavar="NAME",
+    help="See `camtool targets`. Repeat for several: each writes below OUTDIR/<NAME>/.",
+)
 @click.option(
     "-o",
     "--output-dir",
@@ -58,6 +65,13 @@ def _post_options(command: Callable[..., None]) -> Callable[..., None]:
     default=None,
     metavar="N",
     help="Worker processes [default: all cores]; 1 runs in this process.",
+)
+@click.option(
+    "--scheduler",
+    default=None,
+    metavar="ADDRESS",
+    help="Post on a Dask cluster instead: its scheduler (tcp://HOST:8786), or local:N to "
+    "start N workers here. Needs pip install 'camtool[cluster]'; not with --jobs.",
 )
 @click.option("--verify", "verify_too", is_flag=True, help="Verify each file; write its report.")
 @click.option(
@@ -86,11 +100,12 @@ def _post_options(command: Callable[..., None]) -> Callable[..., None]:
 def batch(inputs: tuple[str, ...], layers: str | None, verify_too: bool, **options: Any) -> None:
     """Post every drawing of INPUTS (files, directories, quoted globs with **) for a target.
 
-    Each file is posted as `camtool post` would, in parallel; one bad file never
-    stops the others. Outputs keep the path below their input (drawings/a/b.dxf
-    → OUTDIR/a/b.<ending>, .json when verified, .png/.svg with --preview) and are never
-    overwritten without --force. Exit code: 0 all ok, else the smallest per-file
-    code (1 error, 2 usage, 3 unreadable input, 4 over --max-error-um).
+    Each file is posted as `camtool post` would, in parallel (on this machine, or on a
+    Dask cluster with --scheduler); one bad file never stops the others. Outputs keep
+    the path below their input (drawings/a/b.dxf → OUTDIR/a/b.<ending>, .json when
+    verified, .png/.svg with --preview; OUTDIR/<target>/a/b.<ending> with several
+    targets) and are never overwritten without --force. Exit code: 0 all ok, else the
+    smallest per-file code (1 error, 2 usage, 3 unreadable input, 4 over --max-error-um).
     """
     from camtool.jobs.batch import (
         BatchOptions,

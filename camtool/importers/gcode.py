@@ -118,6 +118,19 @@ def read_gcode(path: str | Path, *, source_name: str | None = None) -> Program:
         data = path.read_bytes()
     except OSError as exc:
         raise InputError(f"{source}: cannot read the file ({exc.strerror or exc})") from exc
+    return read_gcode_bytes(data, source=source)
+
+
+def read_gcode_bytes(data: bytes, *, source: str) -> Program:
+    """Read a G-code file given as its bytes (as :func:`read_gcode` reads the file's).
+
+    Args:
+        data: the file's bytes: UTF-8 (with or without BOM), else read as Latin-1.
+        source: the name messages give the file.
+
+    Raises:
+        InputError: as :func:`parse_gcode`.
+    """
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError:

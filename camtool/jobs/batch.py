@@ -1,23 +1,33 @@
-"""Many inputs, one target: post every file in a process pool and summarise.
+"""Many inputs, one or more targets: post every file in a process pool or on Dask; summarise.
 
 :func:`plan_batch` expands the inputs (:func:`camtool.jobs.inputs.expand_inputs`), loads the
-target and checks everything that can be checked before any work starts: the
+targets and checks everything that can be checked before any work starts: the
 options, that every input matches something, that every output stays inside the
 output folder, that no two files write the same output, that no output is one of
 the inputs (:func:`camtool.jobs.output.check_outputs`), and that no output exists
 already unless ``force``. :func:`run_batch` claims the output folder for the run
 (a second batch into it is refused), then posts each file — in a
-``concurrent.futures.ProcessPoolExecutor`` of ``jobs`` workers, or in this
-process for ``jobs=1`` — and returns one :class:`BatchRow` per file, in input
-order. A file that fails (any exception) becomes an ``error`` row; it never
-stops the others, and it leaves no output behind: each file's outputs are
-computed in memory and written (atomically) only when all of them are ready.
+``concurrent.futures.ProcessPoolExecutor`` of ``jobs`` workers, in this process
+for ``jobs=1``, or on a Dask cluster (``scheduler``, or a
+``dask.distributed.Client`` passed in: :mod:`camtool.jobs.batch_dask`) — and
+returns one :class:`BatchRow` per file (and target), in input order. A file
+that fails (any exception) becomes an ``error`` row; it never stops the others,
+and it leaves no output behind: each file's outputs are computed in memory and
+written (atomically) only when all of them are ready.
 
-Workers die with the batch process, even when it is killed with ``kill -9``.
+Pool workers die with the batch process, even when it is killed with ``kill -9``.
+Dask workers get the input's bytes (a remote worker does not share this disk)
+and return the outputs' bytes and the row; only this process writes, so a
+worker lost mid-file (Dask runs its task again elsewhere) never leaves a
+partial file, and each output is written once.
 
 Outputs keep the path below the input's root: ``drawings/a/b.dxf`` gives
 ``OUT/a/b.pic`` (the target's ending), ``OUT/a/b.json`` (the verify report,
-when verified) and ``OUT/a/b.png`` or ``.svg`` (the preview).
+when verified) and ``OUT/a/b.png`` or ``.svg`` (the preview). With several
+targets each writes below a folder named after it: ``OUT/pic-mmh/a/b.pic``,
+``OUT/grbl/a/b.gcode``.
+
+:func:`run` plans and runs a batch in one call (``camtool.batch.run``).
 
 The batch's exit code (:func:`batch_exit_code`) is 0 when every file is ok,
 otherwise the *smallest* non-zero per-file code: 1 (an error: the target cannot
@@ -34,14 +44,18 @@ prints (progress goes through a callback) and the CLI decides where they go.
 The report (``camtool batch --report batch.json``), keys other tools may read:
 
 - ``camtool``: the version; ``exit_code``: the batch's (:func:`batch_exit_code`);
-- ``options``: every option that shapes the outputs (``target``, ``output_dir``,
+- ``options``: every option that shapes the outputs (``target`` — a list of
+  names with several targets —, ``output_dir``,
   ``machine_file``, ``offset``, ``tool_diameter``, ``feed_mm_min``, ``tolerance``,
   ``scale``, ``fit_mm``, ``fmt``, ``spindle_rpm``, ``layers``, ``units``,
   ``hatch_boundaries``, ``verify`` (true also when implied by ``preview`` or
-  ``max_error_um``), ``preview``, ``max_error_um``) — not ``jobs``, ``force`` or
-  ``report``, so ``--jobs 1`` and ``--jobs 8`` give the same report;
-- ``files``: one object per file, in input order: ``file``, ``status`` (``ok``,
-  ``error``, ``over-limit``), ``exit_code``, ``blocks``, ``max_error_um``,
+  ``max_error_um``), ``preview``, ``max_error_um``) and ``scheduler`` (``null``:
+  this machine's processes; else the ``--scheduler`` given or the address of the
+  client passed in) — not ``jobs``, ``force`` or ``report``, so ``--jobs 1`` and
+  ``--jobs 8`` give the same report;
+- ``files``: one object per file, in input order (with several targets, target
+  by target, and each names its ``target`` after ``file``): ``file``, ``status``
+  (``ok``, ``error``, ``over-limit``), ``exit_code``, ``blocks``, ``max_error_um``,
   ``time_s``, ``verified``, ``outputs`` {``code``, ``report``, ``preview``} (paths
   written, ``null`` when not), ``warnings`` (list), ``error`` ("" when ok);
 - ``totals``: ``files``, ``ok``, ``error``, ``over_limit``, ``blocks``, ``time_s``
@@ -54,6 +68,7 @@ or the order files finished in, so the same batch gives the same bytes.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
 import os
@@ -65,7 +80,7 @@ from typing import TYPE_CHECKING, Any
 from camtool.importers.options import ImportOptions
 from camtool.jobs.inputs import BatchInput, expand_inputs
 from camtool.jobs.pipeline import OutputOptions
-from camtool.model.errors import CamtoolError, UsageError
+from camtool.model.errors import CamtoolError, InputError, UsageError
 from camtool.model.version import __version__
 from camtool.toolpath.options import PLAN_FIELDS, PlanOptions
 
@@ -73,6 +88,7 @@ if TYPE_CHECKING:
     from concurrent.futures import Future
 
     from camtool.jobs.pipeline import PostJob
+    from camtool.post.base import Target
     from camtool.verify.verifier import Verification
 
 PREVIEW_FORMATS = ("png", "svg")
@@ -91,7 +107,9 @@ class BatchOptions:
     """What every file of a batch is posted with (the ``post`` options) and what is kept.
 
     Attributes:
-        target: a target name or target ``.toml`` path (see ``camtool targets``).
+        target: a target name or target ``.toml`` path (see ``camtool targets``), or
+            several (a sequence, kept as a tuple; one alone is kept as a string): each
+            file is posted for each, below ``output_dir/<target name>``.
         output_dir: where the outputs go (created when missing).
         machine_file: machine profile laid over the target's (file or built-in name).
         plan: the planning options (``offset``, ``tool_diameter``, ``feed_mm_min`` —
@@ -114,16 +132,20 @@ class BatchOptions:
             cannot cut as drawn with this tool (``--strict``).
         force: overwrite existing outputs.
         jobs: worker processes; ``None``: ``os.cpu_count()``; 1: in this process.
+        scheduler: run on Dask instead (:mod:`camtool.jobs.batch_dask`): a scheduler's
+            address (``tcp://HOST:8786``) or ``local:N`` (a cluster of N worker
+            processes on this machine); ``None``: the process pool.
         report: the batch report's path, checked like an output and written by
             :func:`run_batch` before it releases the output folder (``"-"``: stdout,
             left to the caller).
 
     Raises:
-        UsageError: ``preview`` is not one of :data:`PREVIEW_FORMATS`, ``jobs`` < 1
-            or ``max_error_um`` < 0.
+        UsageError: ``preview`` is not one of :data:`PREVIEW_FORMATS`, ``jobs`` < 1,
+            ``max_error_um`` < 0, no target or one named twice, a ``scheduler`` that
+            is neither an address nor ``local:N``, or both ``jobs`` and ``scheduler``.
     """
 
-    target: str
+    target: str | tuple[str, ...]
     output_dir: Path
     machine_file: Path | None = None
     plan: PlanOptions = field(default_factory=PlanOptions)
@@ -138,9 +160,11 @@ class BatchOptions:
     strict: bool = False
     force: bool = False
     jobs: int | None = None
+    scheduler: str | None = None
     report: str | None = None
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "target", _targets(self.target))
         if self.preview is not None and self.preview not in PREVIEW_FORMATS:
             raise UsageError(
                 f"unknown preview format {self.preview!r}; choose one of "
@@ -150,6 +174,20 @@ class BatchOptions:
             raise UsageError(f"--jobs must be at least 1, got {self.jobs}")
         if self.max_error_um is not None and self.max_error_um < 0:
             raise UsageError(f"--max-error-um must be >= 0, got {self.max_error_um:g}")
+        if self.scheduler is not None:
+            from camtool.jobs.batch_dask import check_scheduler
+
+            check_scheduler(self.scheduler)
+            if self.jobs is not None:
+                raise UsageError(
+                    f"--jobs {self.jobs} and --scheduler {self.scheduler} both say where "
+                    "files are posted; give one of them"
+                )
+
+    @property
+    def targets(self) -> tuple[str, ...]:
+        """The targets, in the order given (one or more)."""
+        return (self.target,) if isinstance(self.target, str) else self.target
 
     @property
     def verifying(self) -> bool:
@@ -168,6 +206,21 @@ class BatchOptions:
         )
 
 
+def _targets(target: str | Sequence[str]) -> str | tuple[str, ...]:
+    """``target`` as :class:`BatchOptions` keeps it: one name a string, several a tuple.
+
+    Raises:
+        UsageError: no target, or one named twice.
+    """
+    names = (target,) if isinstance(target, str) else tuple(target)
+    if not names:
+        raise UsageError("no --target given; name at least one (see `camtool targets`)")
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise UsageError(f"--target {twice[0]} is given twice; name each target once")
+    return names[0] if len(names) == 1 else names
+
+
 @dataclass(frozen=True)
 class BatchTask:
     """One file's work, given to a worker (picklable).
@@ -177,12 +230,15 @@ class BatchTask:
         code_path: where its code goes.
         report_path: where its verify report goes (``None``: not verified).
         preview_path: where its preview goes (``None``: no preview).
+        target: the target it is posted for when the batch has several (``None``:
+            the batch's only target).
     """
 
     file: str
     code_path: str
     report_path: str | None = None
     preview_path: str | None = None
+    target: str | None = None
 
     @property
     def outputs(self) -> tuple[str, ...]:
@@ -205,6 +261,8 @@ class BatchRow:
 
     Attributes:
         file: the input file.
+        target: the target it was posted for when the batch has several (``None``:
+            the batch's only target).
         status: one of :data:`STATUSES`.
         exit_code: the code ``camtool post`` would have exited with for it (0 ok).
         blocks: blocks written (``None`` when posting failed).
@@ -220,6 +278,7 @@ class BatchRow:
     file: str
     status: str
     exit_code: int
+    target: str | None = None
     blocks: int | None = None
     max_error_um: float | None = None
     time_s: float | None = None
@@ -258,33 +317,66 @@ def plan_batch(inputs: Sequence[str], options: BatchOptions) -> BatchPlan:
     """Expand ``inputs`` and check the whole batch before any work starts.
 
     Raises:
-        UsageError: unknown target or format, invalid post options, an output
-            that would land outside the output folder (inputs named through ``..``
-            or a symlink), two files writing the same output, an output that is an
-            input (even with ``force``), or existing outputs without ``force`` (the
-            first :data:`SHOWN_EXISTING` named).
-        InputError: an input matches nothing, or the target/machine file is invalid.
+        UsageError: unknown target or format (for any of the targets), invalid post
+            options, an output that would land outside the output folder (inputs
+            named through ``..`` or a symlink), two files writing the same output
+            (two target files of one name, too), an output that is an input (even
+            with ``force``), existing outputs without ``force`` (the first
+            :data:`SHOWN_EXISTING` named), or a ``scheduler`` without Dask installed.
+        InputError: an input matches nothing, or a target/machine file is invalid.
     """
-    from camtool.jobs.pipeline import load_target_checked, plan_options
+    if options.scheduler is not None:
+        from camtool.jobs.batch_dask import require_dask
 
-    target = load_target_checked(options.target, machine_file=options.machine_file)
-    fmt = target.post.check_format(options.output.fmt)
-    plan_options(target, options.plan)  # checks the options for the target once, before any file
+        require_dask()
+    several = len(options.targets) > 1
+    layouts = {name: _layout(name, options, several) for name in options.targets}
     if options.output_dir.exists() and not options.output_dir.is_dir():
         raise UsageError(f"{options.output_dir}: exists and is not a directory (-o OUTDIR)")
     items = expand_inputs(inputs, exclude=options.output_dir)
-    tasks = tuple(_task(item, options, target.post.formats[fmt]) for item in items)
+    tasks = tuple(
+        _task(item, options, suffix, (name, folder) if several else None)
+        for name, (folder, suffix) in layouts.items()
+        for item in items
+    )
     _check_outputs(items, tasks, options)
     return BatchPlan(options, tasks)
 
 
-def _task(item: BatchInput, options: BatchOptions, suffix: str) -> BatchTask:
-    base = options.output_dir / item.relative
+def _layout(name: str, options: BatchOptions, several: bool) -> tuple[str, str]:
+    """The target ``name`` checked with the options: its folder (its own name) and ending.
+
+    Raises:
+        UsageError: as :func:`plan_batch`; a target whose name cannot be a folder
+            (with several targets).
+    """
+    from camtool.jobs.pipeline import load_target_checked, plan_options
+
+    target = load_target_checked(name, machine_file=options.machine_file)
+    fmt = target.post.check_format(options.output.fmt)
+    plan_options(target, options.plan)  # checks the options for the target once, before any file
+    if several and (target.name in ("", ".", "..") or Path(target.name).name != target.name):
+        raise UsageError(
+            f"target {name}: its name {target.name!r} cannot name a folder of -o; "
+            "give it a plain name (name = ... in its .toml)"
+        )
+    return target.name, target.post.formats[fmt]
+
+
+def _task(
+    item: BatchInput, options: BatchOptions, suffix: str, of: tuple[str, str] | None
+) -> BatchTask:
+    """One file's task: for the batch's only target (``of`` None), or for one of several.
+
+    ``of`` is ``(target as given, its folder below -o)``.
+    """
+    base = options.output_dir / (of[1] if of else "") / item.relative
     return BatchTask(
         file=str(item.path),
         code_path=str(base.with_suffix(suffix)),
         report_path=str(base.with_suffix(".json")) if options.verifying else None,
         preview_path=str(base.with_suffix(f".{options.preview}")) if options.preview else None,
+        target=of[0] if of else None,
     )
 
 
@@ -300,7 +392,8 @@ def _check_outputs(
 
     _check_inside(tasks, options.output_dir)
     inputs: list[Named] = [("the input", i.path) for i in items]
-    inputs += definition_inputs(options.target, options.machine_file)
+    for name in options.targets:
+        inputs += definition_inputs(name, options.machine_file)
     outputs: list[Named] = [("--report", options.report)]
     outputs += [(f"{task.file} →", out) for task in tasks for out in task.outputs]
     check_outputs(inputs, outputs, hint="post them in separate batches or rename one")
@@ -337,7 +430,51 @@ def _refuse_existing(tasks: Sequence[BatchTask], options: BatchOptions) -> None:
         )
 
 
-def run_batch(plan: BatchPlan, *, progress: Progress | None = None) -> BatchResult:
+def run(
+    inputs: str | Sequence[str],
+    *,
+    targets: str | Sequence[str],
+    output_dir: str | Path,
+    client: Any = None,
+    progress: Progress | None = None,
+    **options: Any,
+) -> BatchResult:
+    """Plan and run a batch in one call: ``camtool.batch.run`` (docs/api.md, docs/batch.md).
+
+    :func:`plan_batch` then :func:`run_batch`. A pipeline that already has a Dask
+    client passes it in; the files are then posted on its cluster::
+
+        from dask.distributed import Client
+        import camtool
+
+        with Client("tcp://scheduler:8786") as client:
+            result = camtool.batch.run(["drawings"], targets=["grbl", "pic-mmh"],
+                                       output_dir="out", client=client, verify=True)
+
+    Args:
+        inputs: files, directories and globs (one as a string, or several).
+        targets: a target name (or target ``.toml`` path), or several.
+        output_dir: where the outputs go.
+        client: a ``dask.distributed.Client`` to post on (``None``: ``scheduler``, else
+            the process pool).
+        progress: called as each file finishes (see :data:`Progress`).
+        **options: any other field of :class:`BatchOptions` (``verify``, ``preview``,
+            ``max_error_um``, ``plan``, ``jobs``, ``scheduler``, ``force``, ``report``...).
+
+    Returns:
+        The finished batch; its ``exit_code`` is what ``camtool batch`` exits with.
+
+    Raises:
+        UsageError, InputError, CamtoolError: as :func:`plan_batch` and :func:`run_batch`.
+    """
+    names = [inputs] if isinstance(inputs, str) else list(inputs)
+    opts = BatchOptions(target=_targets(targets), output_dir=Path(output_dir), **options)
+    return run_batch(plan_batch(names, opts), progress=progress, client=client)
+
+
+def run_batch(
+    plan: BatchPlan, *, progress: Progress | None = None, client: Any = None
+) -> BatchResult:
     """Post every file of ``plan``; one file's failure never stops the others.
 
     The output folder is claimed for the whole run
@@ -347,38 +484,140 @@ def run_batch(plan: BatchPlan, *, progress: Progress | None = None) -> BatchResu
     removed, and at the end the batch report is written (when ``options.report``
     names a file; ``"-"`` is left to the caller).
 
+    Where the files are posted: on the Dask cluster of ``client`` when one is given
+    (the report's ``scheduler`` is its address), on ``options.scheduler``'s
+    (:func:`camtool.jobs.batch_dask.connect`), else in a process pool of
+    ``options.jobs`` (in this process for 1).
+
     Args:
         plan: from :func:`plan_batch`.
         progress: called in this process as each file finishes, in finishing order.
+        client: a ``dask.distributed.Client`` to post on (``None``: see above).
 
     Returns:
         The rows in the plan's (sorted input) order.
 
     Raises:
-        CamtoolError: another run holds the output folder, or the batch report
-            cannot be written.
-        UsageError: outputs appeared since the plan was checked (without ``force``).
+        CamtoolError: another run holds the output folder, the batch report cannot be
+            written, or the Dask scheduler cannot be reached or has no worker.
+        UsageError: outputs appeared since the plan was checked (without ``force``);
+            a ``client`` with ``jobs`` or ``scheduler``.
     """
     from camtool.jobs.output import lock_directory
 
     tasks, options = plan.tasks, plan.options
-    with lock_directory(options.output_dir):
-        if not options.force:
-            _refuse_existing(tasks, options)
-        _remove_stale_temps(tasks)
-        jobs = min(options.jobs or os.cpu_count() or 1, len(tasks))
-        if jobs <= 1:
-            rows = []
-            for done, task in enumerate(tasks, start=1):
-                rows.append(post_one(task, options))
-                if progress is not None:
-                    progress(done, len(tasks), rows[-1])
-            result = BatchResult(options, tuple(rows))
-        else:
-            result = BatchResult(options, _run_pool(tasks, options, jobs, progress))
-        if options.report is not None and options.report != "-":
-            _write_report(result, options.report)
+    if client is not None:
+        options = _with_client(options, client)
+    with contextlib.ExitStack() as stack:
+        if client is None and options.scheduler is not None:
+            from camtool.jobs.batch_dask import connect
+
+            client = stack.enter_context(connect(options.scheduler))  # before -o is touched
+        with lock_directory(options.output_dir):
+            if not options.force:
+                _refuse_existing(tasks, options)
+            _remove_stale_temps(tasks)
+            if client is not None:
+                rows = _run_dask(tasks, options, client, progress)
+            else:
+                rows = _run_here(tasks, options, progress)
+            result = BatchResult(options, rows)
+            if options.report is not None and options.report != "-":
+                _write_report(result, options.report)
     return result
+
+
+def _with_client(options: BatchOptions, client: Any) -> BatchOptions:
+    """``options`` with ``scheduler`` the address of ``client``'s scheduler (for the report).
+
+    Raises:
+        UsageError: ``options`` names ``jobs`` or a ``scheduler`` too.
+    """
+    if options.jobs is not None or options.scheduler is not None:
+        given = "jobs" if options.jobs is not None else "scheduler"
+        raise UsageError(f"a Dask client and {given} both say where files are posted; give one")
+    return dataclasses.replace(options, scheduler=str(client.scheduler.address))
+
+
+def _run_here(
+    tasks: Sequence[BatchTask], options: BatchOptions, progress: Progress | None
+) -> tuple[BatchRow, ...]:
+    """The rows of ``tasks`` posted on this machine: a process pool, or this process for 1."""
+    jobs = min(options.jobs or os.cpu_count() or 1, len(tasks))
+    if jobs > 1:
+        return _run_pool(tasks, options, jobs, progress)
+    rows = []
+    for done, task in enumerate(tasks, start=1):
+        rows.append(post_one(task, options))
+        if progress is not None:
+            progress(done, len(tasks), rows[-1])
+    return tuple(rows)
+
+
+def _run_dask(
+    tasks: Sequence[BatchTask], options: BatchOptions, client: Any, progress: Progress | None
+) -> tuple[BatchRow, ...]:
+    """The rows of ``tasks`` posted on ``client``'s cluster; the files written here.
+
+    Each task travels with the input's bytes (read here, as it is submitted) and the
+    target loaded here (so a target or ``--machine`` file need not exist on the
+    workers); each worker returns the row and the outputs' bytes
+    (:func:`post_data`), written here as for the pool (:func:`_write`). A task that
+    failed on the cluster (its workers kept dying) is that file's error row.
+    """
+    from camtool.jobs.batch_dask import map_unordered
+    from camtool.jobs.pipeline import load_target_checked
+
+    loaded = {n: load_target_checked(n, machine_file=options.machine_file) for n in options.targets}
+
+    def arguments(i: int) -> tuple[Any, ...]:
+        task = tasks[i]
+        return task, options, loaded[task.target or options.targets[0]], _read(task.file)
+
+    rows: dict[int, BatchRow] = {}
+    for done, (i, value, error) in enumerate(
+        map_unordered(client, post_data, len(tasks), arguments), start=1
+    ):
+        rows[i] = _written(tasks[i], value, error)
+        if progress is not None:
+            progress(done, len(tasks), rows[i])
+    return tuple(rows[i] for i in range(len(tasks)))
+
+
+def _read(file: str) -> bytes | CamtoolError:
+    """The bytes of the input ``file``, or the error reading it (that file's error row)."""
+    from camtool.jobs.output import reason
+
+    try:
+        return Path(file).read_bytes()
+    except FileNotFoundError:
+        return InputError(f"{file}: no such file")
+    except OSError as exc:
+        return InputError(f"{file}: cannot read ({reason(exc)})")
+
+
+Written = tuple["BatchRow", tuple[tuple[str, "str | bytes"], ...], str]
+"""What a Dask worker returns (:func:`post_data`): the row, the outputs, its camtool version."""
+
+
+def _written(task: BatchTask, value: Written | None, error: BaseException | None) -> BatchRow:
+    """The row of a Dask task, once its outputs are written here (or why not)."""
+    if error is not None or value is None:
+        return _error_row(task, 1, f"worker failed: {type(error).__name__}: {error}")
+    row, files, version = value
+    if version != __version__:
+        return _error_row(
+            task,
+            1,
+            f"the Dask worker runs camtool {version}, this camtool is {__version__}; "
+            "install the same camtool on every worker",
+        )
+    try:
+        for path, data in files:
+            _write(path, data)
+    except CamtoolError as exc:
+        return _error_row(task, exc.exit_code, str(exc))
+    return row
 
 
 def _remove_stale_temps(tasks: Sequence[BatchTask]) -> None:
@@ -468,26 +707,72 @@ def _collect(future: Future[BatchRow], task: BatchTask) -> BatchRow:
 
 
 def post_one(task: BatchTask, options: BatchOptions) -> BatchRow:
-    """Post (and verify, and draw) one file: the worker of a batch.
+    """Post (and verify, and draw) one file and write its outputs: the pool's worker.
 
     Never raises for the file's own problems: a :class:`CamtoolError` becomes an
     ``error`` row with its exit code, any other exception an ``error`` row with
     exit code 1 ("internal error").
     """
     try:
-        return _post_one(task, options)
+        row, files = _outputs(task, options, _post_job(task.file, _for(task, options)))
+        for path, data in files:
+            _write(path, data)
+        return row
     except CamtoolError as exc:
         return _error_row(task, exc.exit_code, str(exc))
     except Exception as exc:  # a bug on one file must not stop the batch
         return _error_row(task, 1, f"internal error: {type(exc).__name__}: {exc}")
 
 
+def post_data(
+    task: BatchTask, options: BatchOptions, target: Target, data: bytes | CamtoolError
+) -> Written:
+    """Post (and verify, and draw) one file given as bytes: the Dask worker of a batch.
+
+    Touches no file: ``data`` is the input's bytes (or the error reading it, which
+    becomes the row), ``target`` the target loaded by the batch; the outputs come
+    back as ``(path, text or bytes)`` for the batch to write, with this worker's
+    camtool version (a batch refuses results of another version). Errors become
+    rows as in :func:`post_one`.
+    """
+    from camtool.jobs.pipeline import post_bytes
+
+    try:
+        if isinstance(data, CamtoolError):
+            raise data
+        job = post_bytes(
+            data,
+            task.file,
+            target,
+            options.plan,
+            options.output,
+            import_options=options.import_options(),
+        )
+        row, files = _outputs(task, options, job)
+        return row, files, __version__
+    except CamtoolError as exc:
+        return _error_row(task, exc.exit_code, str(exc)), (), __version__
+    except Exception as exc:  # a bug on one file must not stop the batch
+        return _error_row(task, 1, f"internal error: {type(exc).__name__}: {exc}"), (), __version__
+
+
+def _for(task: BatchTask, options: BatchOptions) -> BatchOptions:
+    """The options ``task`` is posted with: the batch's, for the task's own target."""
+    if task.target is None or task.target == options.target:
+        return options
+    return dataclasses.replace(options, target=task.target)
+
+
 def _error_row(task: BatchTask, code: int, message: str) -> BatchRow:
-    return BatchRow(file=task.file, status="error", exit_code=code, error=message)
+    return BatchRow(
+        file=task.file, target=task.target, status="error", exit_code=code, error=message
+    )
 
 
-def _post_one(task: BatchTask, options: BatchOptions) -> BatchRow:
-    job = _post_job(task.file, options)
+def _outputs(
+    task: BatchTask, options: BatchOptions, job: PostJob
+) -> tuple[BatchRow, tuple[tuple[str, str | bytes], ...]]:
+    """The row of a posted file and its outputs ``(path, data)``, verified and drawn as asked."""
     files: list[tuple[str, str | bytes]] = [(task.code_path, job.result.code)]
     warnings = job.warnings
     error_um: float | None = None
@@ -503,14 +788,13 @@ def _post_one(task: BatchTask, options: BatchOptions) -> BatchRow:
             files.append((task.report_path, report_json(v, job.plan)))
     if task.preview_path is not None:
         files.append((task.preview_path, preview_bytes(job, v, task.preview_path, task.file)))
-    for path, data in files:
-        _write(path, data)
     problem = None
     if v is not None and options.max_error_um is not None:
         problem = v.over_limit(options.max_error_um, strict=options.strict)
     over = problem is not None
-    return BatchRow(
+    row = BatchRow(
         file=task.file,
+        target=task.target,
         status="over-limit" if over else "ok",
         exit_code=4 if over else 0,
         blocks=job.result.blocks,
@@ -523,15 +807,17 @@ def _post_one(task: BatchTask, options: BatchOptions) -> BatchRow:
         warnings=warnings,
         error=problem or "",
     )
+    return row, tuple(files)
 
 
 def _post_job(file: str, options: BatchOptions) -> PostJob:
-    """Import and post one file: a drawing is planned, a G-code program re-posted."""
+    """Import and post one file for ``options.target``: a drawing planned, a program re-posted."""
     from camtool.jobs.pipeline import post_file
 
+    (target,) = options.targets  # one: see _for
     return post_file(
         file,
-        options.target,
+        target,
         options.plan,
         options.output,
         machine_file=options.machine_file,
@@ -625,9 +911,11 @@ def _json(value: Any) -> Any:
 
 
 def row_dict(row: BatchRow) -> dict[str, Any]:
-    """One file of the report."""
+    """One file of the report (its ``target`` only in a batch of several targets)."""
+    named = {"target": row.target} if row.target is not None else {}
     return {
         "file": row.file,
+        **named,
         "status": row.status,
         "exit_code": row.exit_code,
         "blocks": row.blocks,
@@ -657,19 +945,28 @@ def totals(rows: tuple[BatchRow, ...]) -> dict[str, Any]:
 def summary_table(result: BatchResult) -> str:
     """The end-of-batch table: one line per file and a totals line (plain text).
 
-    Columns: file, status, blocks, predicted max error (µm, ``-`` when not
-    verified), time (s; verified time, else at programmed feeds), and a note
-    (the error, or the number of warnings). Each line ends with a newline.
+    Columns: file, target (only in a batch of several targets), status, blocks,
+    predicted max error (µm, ``-`` when not verified), time (s; verified time, else
+    at programmed feeds), and a note (the error, or the number of warnings). Each
+    line ends with a newline.
     """
     width = min(max([len("file")] + [len(r.file) for r in result.rows]), FILE_COLUMN_MAX)
+    named = [r.target for r in result.rows if r.target is not None]
+    tw = max([len("target"), *map(len, named)]) if named else 0
+
+    def target(text: str | None) -> str:
+        return f"{text or '':<{tw}}  " if tw else ""
+
     lines = [
-        f"{'file':<{width}}  {'status':<10}  {'blocks':>6}  {'max µm':>9}  {'time s':>9}  note"
+        f"{'file':<{width}}  {target('target')}{'status':<10}  {'blocks':>6}  {'max µm':>9}  "
+        f"{'time s':>9}  note"
     ]
     for row in result.rows:
         note = message(row) if row.error else _warning_count(row)
         lines.append(
-            f"{_shorten(row.file, width):<{width}}  {row.status:<10}  {_int(row.blocks):>6}  "
-            f"{_fixed(row.max_error_um, 2):>9}  {_fixed(row.time_s, 1):>9}  {note}".rstrip()
+            f"{_shorten(row.file, width):<{width}}  {target(row.target)}{row.status:<10}  "
+            f"{_int(row.blocks):>6}  {_fixed(row.max_error_um, 2):>9}  "
+            f"{_fixed(row.time_s, 1):>9}  {note}".rstrip()
         )
     lines.append(totals_line(result))
     return "\n".join(lines) + "\n"
@@ -691,9 +988,11 @@ def progress_line(done: int, total: int, row: BatchRow) -> str:
     """One finished file, for a log: ``[3/12] ok  a.dxf → out/a.pic  41 blocks  12.3 µm  2.1 s``.
 
     An error shows its message instead of the outputs; an over-limit file shows
-    both.
+    both. In a batch of several targets the file is followed by ``for <target>``.
     """
     head = f"[{done}/{total}] {row.status}  {row.file}"
+    if row.target is not None:
+        head += f" for {row.target}"
     if row.code_path is None:
         return f"{head}: {message(row) or 'failed'}"
     text = f"{head} → {row.code_path}  {row.blocks} blocks"

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from camtool.importers import POINT_SUFFIXES, read_drawing
+from camtool.importers import POINT_SUFFIXES, read_drawing, read_drawing_bytes
 from camtool.importers.options import ImportOptions
 from camtool.jobs.inputs import is_program_file
 from camtool.model.errors import InputError, UsageError
@@ -162,6 +162,50 @@ def post_path(
 
     return post_program(
         read_gcode(path), target, output, feed_mm_min=plan.feed_mm_min, source=str(path)
+    )
+
+
+def post_bytes(
+    data: bytes,
+    name: str,
+    target: Target,
+    plan: PlanOptions | None = None,
+    output: OutputOptions | None = None,
+    *,
+    import_options: ImportOptions | None = None,
+) -> PostJob:
+    """Post a file given as its bytes, as :func:`post_path` posts the file ``name``.
+
+    For a process that does not share the file's disk (a batch's Dask worker): the
+    kind is chosen by ``name``'s ending, and messages, warnings and the program's
+    notes name ``name``, so the job is the one :func:`post_path` makes from the file.
+
+    Args:
+        data: the file's bytes.
+        name: the file's name as the user gave it (only its ending and text are used).
+        target: the target to write for.
+        plan: the planning options (``None``: the defaults, the target's feed).
+        output: how the program is written (``None``: the defaults).
+        import_options: how the drawing is read (layers, units…).
+
+    Raises:
+        UsageError: a planning option given for a program (see :func:`post_path`).
+        CamtoolError: from any stage, with its exit code.
+    """
+    plan = plan if plan is not None else PlanOptions()
+    if not is_program_file(name):
+        suffix = Path(name).suffix
+        drawing = read_drawing_bytes(data, name=name, suffix=suffix, options=import_options)
+        return post_drawing(_note_units(drawing, name, import_options), target, plan, output)
+    refuse_planning(name, drawing_only(plan.given()))
+    from camtool.importers.gcode import read_gcode_bytes
+
+    return post_program(
+        read_gcode_bytes(data, source=name),
+        target,
+        output,
+        feed_mm_min=plan.feed_mm_min,
+        source=name,
     )
 
 
