@@ -340,6 +340,8 @@ def budget_text(v: Verification) -> str:
     if budget.skipped is not None:
         return f"error budget skipped: {budget.skipped.split(':')[0]}"
     verdict = budget.dominant_text()
+    if not budget.without:
+        return "error budget: this machine models no error source that can be switched off"
     if verdict is None:
         return "error budget: no source changes any figure"
     return f"error budget: {verdict} (one source off at a time; sources do not add)"

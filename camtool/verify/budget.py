@@ -198,8 +198,8 @@ def text_lines(b: ErrorBudget, *, limit: int = 8) -> list[str]:
         return [f"error budget skipped: {b.skipped}"]
     modelled = list(b.without)
     lines = [
-        "error budget: total with everything on; with only this one off (difference); "
-        "sources do not add"
+        "error budget, µm: total with everything on, its dominant source; then with only "
+        "this one off (difference); sources do not add"
     ]
     shown = sorted(b.total, key=lambda f: -abs(b.total[f]))[:limit]
     for name in (f for f in b.total if f in shown):
@@ -208,10 +208,14 @@ def text_lines(b: ErrorBudget, *, limit: int = 8) -> list[str]:
             d = b.difference(s, name)
             if d is not None:
                 parts.append(f"{_short_label(s)} {_um(b.without[s][name])} ({_um(d)})")
-        lines.append(f"  {name} {_um(b.total[name])} µm: " + ", ".join(parts))
+        top = b.dominant(name)
+        lead = f"  {name} {_um(b.total[name])}"
+        if top is not None:
+            lead += f", dominant {SOURCES[top]} ({_um(b.difference(top, name) or 0.0)})"
+        lines.append(f"{lead}; without: " + ", ".join(parts))
     verdict = b.dominant_text()
     if verdict:
-        lines.append(f"  {verdict}")
+        lines.append(f"  largest figure: {verdict}")
     absent = [f"{s.label} ({s.why})" for s in b.sources if s.status != "modelled"]
     if absent:
         lines.append("  not in the budget: " + "; ".join(absent))

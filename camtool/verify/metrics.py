@@ -357,7 +357,8 @@ def along_path(
         count += len(samples)
         if len(samples) == 0:
             continue
-        trace = _thinned(run)
+        move_ends = block_start[first + 1 : last + 2] - lo  # each move's last row, in ``run``
+        trace = _thinned(run, move_ends)
         if len(trace) == 1:
             geoms = shapely.points(trace)
         else:
@@ -380,10 +381,12 @@ def along_path(
     )
 
 
-def _thinned(run: FloatArray) -> FloatArray:
-    """``run``'s every k-th point and its last: about :data:`ALONG_RESOLUTION_MM` apart.
+def _thinned(run: FloatArray, keep: IntArray) -> FloatArray:
+    """``run``'s every k-th point, its last and the rows ``keep``, about 0.5 µm apart.
 
-    Never more than :data:`ALONG_MAX_TRACE` points.
+    The spacing is :data:`ALONG_RESOLUTION_MM`, never more than :data:`ALONG_MAX_TRACE`
+    points (plus ``keep``). Keeping every move's last row keeps the corners, which a
+    thinned polyline would cut.
     """
     if len(run) < 3:
         return run
@@ -393,7 +396,11 @@ def _thinned(run: FloatArray) -> FloatArray:
     every = max(every, -(-len(run) // ALONG_MAX_TRACE))
     if every == 1:
         return run
-    return np.vstack([run[::every], run[-1:]])
+    mask = np.zeros(len(run), dtype=bool)
+    mask[::every] = True
+    mask[-1] = True
+    mask[keep[(keep >= 0) & (keep < len(run))]] = True
+    return run[mask]
 
 
 def _carriage_after(
