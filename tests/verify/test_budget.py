@@ -237,3 +237,23 @@ def test_time_s_keeps_six_significant_digits() -> None:
     assert int(np.abs(v.trace.block_steps).sum()) == 7
     time_s = report_dict(v)["time_s"]
     assert time_s == pytest.approx(v.time_s, rel=1e-5) and time_s != 0.001
+
+
+def test_every_contour_has_its_end_error() -> None:
+    """Two U patterns (seed-000 §5.2), each ending 190 µm short on its return leg."""
+    target = load_target("pic-mmh")
+    lash = Backlash(true_um=(190.0, 0.0, 0.0), compensation_um=(0.0, 0.0, 0.0))
+    machine = dataclasses.replace(target.machine, backlash=lash)
+    moves: list[Linear | Rapid] = []
+    for n, y in enumerate((1.0, 4.0), start=1):
+        moves += [
+            Rapid(1.0, y, contour=n),
+            Linear(3.5, y, 0.8, contour=n),
+            Linear(3.5, y + 1.0, 0.8, contour=n),
+            Linear(1.0, y + 1.0, 0.8, contour=n),
+        ]
+    v = verify_program(Program(tuple(moves)), machine, name="pic-mmh")
+    assert v.along is not None and len(v.along.contour_end_um) == 2
+    # the second U starts with a +X move after the first ended moving −X: its first leg
+    # takes up the play (190 µm short at its start), its return leg ends 190 µm short again
+    assert v.along.contour_end_um == pytest.approx((190.0, 190.0), abs=0.2)
