@@ -39,7 +39,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from camtool.model.errors import InputError, UsageError
+from camtool.model.errors import CamtoolError, InputError, UsageError
 from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Dwell, Home, Program, Rapid
 from camtool.model.shapes import BBox, Drawing
@@ -352,7 +352,11 @@ def _budget(v: Verification) -> eb.ErrorBudget:
         program = v.program
         if name == "rounding":
             assert v.planned is not None
-            program, trace = v.planned, simulate(v.planned, v.machine)
+            try:
+                program, trace = v.planned, simulate(v.planned, v.machine)
+            except CamtoolError as exc:  # the plan is not what this machine reads: say so
+                notes.append(f"rounding not compared: the unrounded plan does not simulate ({exc})")
+                return {}
         else:
             trace = simulate(program, v.machine, sources=ALL.without(name))
         dev, along, contours, against = _measure(
