@@ -12,7 +12,9 @@ Three pieces the generic library does not have:
   over-steps it (Table 3.8: 5263 × 2632 programmed → 2763 / 2719 / 2697 Y steps at
   P = 20 / 30 / 40 ms). The step array is what the motors do; the application's
   own position counter still believes the programmed counts. The line takes P
-  from the profile's ``flashcut`` timing table.
+  from the profile's ``flashcut`` timing table. It models the ``dynamics`` error
+  source (:mod:`camtool.verify.sources`): switched off, the axes fire at their
+  exact periods (:func:`exact_timer_line`) and every axis makes its count.
 - the ``flashcut`` chord rule (:func:`flashcut_arc_points`): ``chord_segments``
   equal chords per arc (seed-001 §4.4).
 - the ``flashcut`` timing model (:class:`FlashcutTiming`): per dominant step
@@ -39,6 +41,7 @@ from camtool.verify.motion import (
     timing_class,
     timing_model_from_table,
 )
+from camtool.verify.sources import ALL, Sources
 from camtool.verify.steparray import STEP_DTYPE, StepArray, freeze
 from camtool.verify.timing import (
     BlockKinematics,
@@ -258,6 +261,38 @@ def timer_line(dx: int, dy: int, half_period_ms: float, *, timer_ms: int = 1) ->
     return freeze(rows)
 
 
+def exact_timer_line(dx: int, dy: int) -> StepArray:
+    """:func:`timer_line` on an exact clock: no firing overshoot, every axis makes its count.
+
+    The ``dynamics`` source of the ``timer`` line switched off: the dominant axis
+    fires every P and the other every ``P·N_dom/N_other`` exactly, so (in units
+    of ``P/N_other``) the dominant events fall at ``k·N_other`` and the other's at
+    ``j·N_dom``, both firing in one row where they coincide; the other axis makes
+    exactly ``N_other`` steps, by the dominant's last event.
+
+    Args:
+        dx: Programmed X steps (signed).
+        dy: Programmed Y steps (signed).
+
+    Returns:
+        Step array ``(N, 2) int8`` summing to ``(dx, dy)``.
+    """
+    ax, ay = abs(int(dx)), abs(int(dy))
+    n_dom, n_other = max(ax, ay), min(ax, ay)
+    if n_dom == 0:
+        return freeze(np.zeros((0, 2), dtype=STEP_DTYPE))
+    unit = max(n_other, 1)
+    dom_times = np.arange(1, n_dom + 1, dtype=np.int64) * unit
+    other_times = np.arange(1, n_other + 1, dtype=np.int64) * n_dom
+    events = np.union1d(dom_times, other_times)
+    rows = np.zeros((events.size, 2), dtype=STEP_DTYPE)
+    dom_axis = 0 if ax >= ay else 1
+    sign = (1 if dx >= 0 else -1, 1 if dy >= 0 else -1)
+    rows[np.searchsorted(events, dom_times), dom_axis] = sign[dom_axis]
+    rows[np.searchsorted(events, other_times), 1 - dom_axis] = sign[1 - dom_axis]
+    return freeze(rows)
+
+
 # ------------------------------------------------------------------------ chords
 
 
@@ -305,8 +340,10 @@ def flashcut_arc_points(
     )
 
 
-def _timer(machine: Machine) -> LineInterpolator:
+def _timer(machine: Machine, *, sources: Sources = ALL) -> LineInterpolator:
     """The ``timer`` line for ``machine``: P from its ``flashcut`` timing table.
+
+    With ``sources.dynamics`` off, the exact-clock line (:func:`exact_timer_line`).
 
     Raises:
         UsageError: the profile's timing model is not ``flashcut``.
@@ -320,6 +357,8 @@ def _timer(machine: Machine) -> LineInterpolator:
             "it needs model = 'flashcut'"
         )
     period = model.half_period_ms
+    if not sources.dynamics:
+        return exact_timer_line
     return lambda dx, dy: timer_line(dx, dy, period)
 
 
@@ -332,5 +371,7 @@ MOTION = MotionHooks(
     lines={"timer": _timer},
     chords={"flashcut": _chords},
     timing={"flashcut": timing_class(FlashcutTiming)},
+    honours={"timer": ("dynamics",)},
 )
-"""What ``flashcut`` adds to the verifier: timer stepping, its chords, its timing model."""
+"""What ``flashcut`` adds to the verifier: timer stepping (its overshoot is the ``dynamics``
+error source), its chords, its timing model."""

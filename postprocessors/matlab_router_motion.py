@@ -13,35 +13,118 @@ counts samples), positions from the simulated encoders.
 The move from home to each stroke's first point (homing, the X-then-Y dog-leg at
 speed 500) is not simulated: a stroke starts at rest on its first vertex, and
 its rapid is timed as that dog-leg (R13).
+
+``reversals`` are counted from the simulated positions (:func:`count_reversals`).
+A backlash in the profile (``[machine.backlash] true_um``, e.g. from a
+``--machine`` overlay) is applied to the positions as the per-axis dead band of
+R15 (:func:`~camtool_postprocessors.matlab_router_motion_servo.apply_backlash`);
+what the router cannot do is refused, never ignored: the firmware compensates
+nothing (``compensation_um`` must be 0) and the dead band is one per axis (no
+``regions``). The simulator honours the ``backlash`` error source of the budget
+(:mod:`camtool.verify.sources`).
 """
 
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 
+from camtool.model.errors import InputError
 from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Move, Program
 from camtool.model.shapes import distance
 from camtool.verify.interpolators import sagitta_chord_points
 from camtool.verify.metrics import contour_runs
 from camtool.verify.motion import MotionHooks, StepTrace
+from camtool.verify.sources import ALL, Sources
 from camtool.verify.steparray import STEP_DTYPE, read_only
 from camtool_postprocessors.matlab_router_arrays import points_01mm
-from camtool_postprocessors.matlab_router_motion_servo import RouterMachine, simulate_job
+from camtool_postprocessors.matlab_router_motion_servo import (
+    RouterMachine,
+    apply_backlash,
+    simulate_job,
+)
+
+REVERSAL_DEADBAND_MM = 0.001
+"""Travel back from an axis's furthest point that counts as a reversal, mm (1 µm, 25.6
+encoder counts): below it a servo's settling wobble is not a change of direction."""
 
 
-def simulate_servo(program: Program, machine: Machine) -> StepTrace:
+def count_reversals(positions_mm: npt.ArrayLike, deadband_mm: float = REVERSAL_DEADBAND_MM) -> int:
+    """Changes of direction of one axis along a sampled position, with a dead band.
+
+    The axis reverses when it comes back more than ``deadband_mm`` from the
+    furthest point of its current run (a hysteresis counter), so a stop at a
+    vertex or a servo's wobble of less than the band is no reversal. The first
+    run's direction is free: a program that only moves one way has 0.
+
+    Args:
+        positions_mm: ``(M,)`` positions of one axis, mm.
+        deadband_mm: hysteresis, mm, ``> 0``.
+    """
+    values = np.asarray(positions_mm, dtype=np.float64)
+    if len(values) < 2:
+        return 0
+    direction, low, high, count = 0, float(values[0]), float(values[0]), 0
+    for x in values.tolist():
+        if direction >= 0 and x > high:
+            high = x
+        if direction <= 0 and x < low:
+            low = x
+        if direction >= 0 and x < high - deadband_mm:
+            count += direction > 0
+            direction, low = -1, x
+        elif direction <= 0 and x > low + deadband_mm:
+            count += direction < 0
+            direction, high = 1, x
+    return count
+
+
+def router_backlash_mm(machine: Machine) -> tuple[float, float]:
+    """The X and Y dead bands the profile asks of the router, mm.
+
+    Raises:
+        InputError: the profile asks for what the router model cannot do: a
+            compensation (the firmware has none) or backlash regions.
+    """
+    lash = machine.backlash
+    where = f"machine {machine.name!r} [machine.backlash]"
+    if any(lash.compensation_um[:2]):
+        raise InputError(
+            f"{where} compensation_um = {list(lash.compensation_um)}: the matlab-router "
+            "firmware compensates no backlash (seed-002 R15); set compensation_um to 0 in "
+            "the --machine file (true_um alone is simulated as a dead band)"
+        )
+    if lash.regions:
+        raise InputError(
+            f"{where} regions: the matlab-router model has one dead band per axis "
+            "(seed-002 R15), not regions; give true_um = [x, y, 0] instead in the --machine file"
+        )
+    return (lash.true_um[0] / 1000.0, lash.true_um[1] / 1000.0)
+
+
+def simulate_servo(program: Program, machine: Machine, *, sources: Sources = ALL) -> StepTrace:
     """Simulate ``program`` stroke by stroke on the seed-002 router model.
 
     Args:
         program: moves in mm (rapids separate strokes).
         machine: a profile with ``[motion] line = "servo"``; its X steps/mm is the
-            encoder's counts/mm.
+            encoder's counts/mm; its ``[machine.backlash] true_um`` (X, Y) the dead
+            bands applied to the positions (R15).
+        sources: ``backlash`` off leaves the dead bands out (the error budget).
 
     Returns:
         A :class:`StepTrace` whose rows are servo samples and whose
-        ``block_time_s`` holds each move's simulated time.
+        ``block_time_s`` holds each move's simulated time; ``reversals`` counted
+        from the positions (:func:`count_reversals`).
+
+    Raises:
+        InputError: the profile asks for a backlash compensation or regions
+            (:func:`router_backlash_mm`).
     """
+    backlash = router_backlash_mm(machine)
+    if not sources.backlash:
+        backlash = (0.0, 0.0)
     router = RouterMachine(counts_per_mm=round(machine.steps_per_mm[0]))
     ts = router.ts_s
     first_speed_mm_s = router.first_point_speed * 200.0 / router.counts_per_mm
@@ -77,6 +160,8 @@ def simulate_servo(program: Program, machine: Machine) -> StepTrace:
             times[block] += (hi - lo) * ts
         position = trace.positions_mm[-1]
     carriage = np.vstack(points) if points else np.zeros((0, 2))
+    if any(backlash) and len(carriage):
+        carriage = np.asarray(apply_backlash(carriage, backlash), dtype=np.float64)
     block_of_row = np.concatenate(blocks) if blocks else np.zeros(0, dtype=np.int64)
     counts = np.bincount(block_of_row, minlength=len(program.moves)).astype(np.int64)
     n = len(carriage)
@@ -91,7 +176,7 @@ def simulate_servo(program: Program, machine: Machine) -> StepTrace:
         block_steps=read_only(steps),
         block_dominant=read_only(np.zeros(len(program.moves), dtype=np.int64)),
         block_compensation=read_only(np.zeros(len(program.moves), dtype=np.int64)),
-        reversals=(0, 0),
+        reversals=(count_reversals(carriage[:, 0]), count_reversals(carriage[:, 1])),
         compensations=0,
         block_time_s=read_only(times),
     )
@@ -121,5 +206,6 @@ def _vertices(
     return vertices, owner
 
 
-MOTION = MotionHooks(simulators={"servo": simulate_servo})
-"""What ``matlab-router`` adds to the verifier: the ``servo`` line, a whole simulator."""
+MOTION = MotionHooks(simulators={"servo": simulate_servo}, honours={"servo": ("backlash",)})
+"""What ``matlab-router`` adds to the verifier: the ``servo`` line, a whole simulator (it
+models the ``backlash`` error source)."""

@@ -149,6 +149,25 @@ class PicMmhTiming:
         positive("steps_per_mm", self.steps_per_mm)
         positive("max_step_rate_hz", self.max_step_rate_hz)
 
+    def capped_blocks(self, blocks: BlockKinematics) -> list[tuple[int, str]]:
+        """Feed moves whose step rate ``d·F/60`` is over the cap (F14 and up at 140 nm/step).
+
+        seed-000 §2.4 (L3198): the serial link limits the PIC to 166 Hz, so such
+        a move runs (and is timed) at the cap, slower than programmed.
+        """
+        rate = self.steps_per_mm * blocks.feed_mm_min / 60.0
+        over = ~blocks.is_rapid & (rate > self.max_step_rate_hz)
+        slowest = self.max_step_rate_hz * 60.0 / self.steps_per_mm
+        return [
+            (
+                int(i),
+                f"feed {blocks.feed_mm_min[i]:g} mm/min asks {rate[i]:.1f} Hz, over the "
+                f"{self.max_step_rate_hz:g} Hz step-rate cap of the pic-mmh controller (serial "
+                f"link, seed-000 §2.4): it runs and is timed at {slowest:.4g} mm/min",
+            )
+            for i in np.flatnonzero(over)
+        ]
+
     def block_time_s(self, blocks: BlockKinematics) -> FloatArray:
         """Seconds per block, ``(B,) float64`` read-only."""
         return pic_mmh_block_time_s(

@@ -43,7 +43,12 @@ if TYPE_CHECKING:
 
 
 def _verify_outputs(command: Callable[..., None]) -> Callable[..., None]:
-    """The options every verifying command shares: --report, --preview, --max-error-um, --strict."""
+    """The options every verifying command shares (--report, --preview, --max-error-um, ...)."""
+    command = click.option(
+        "--no-budget",
+        is_flag=True,
+        help="Skip the error budget (it re-simulates the program once per error source).",
+    )(command)
     command = click.option(
         "--strict",
         is_flag=True,
@@ -112,6 +117,7 @@ def post(
     preview: str | None,
     max_error_um: float | None,
     strict: bool,
+    no_budget: bool,
     **options: Any,
 ) -> None:
     """Import DRAWING (a .dxf file, or '-' for stdin), plan it, write it for a target.
@@ -166,7 +172,7 @@ def post(
         )
     if verify_too or report or preview or max_error_um is not None:
         _finish_verification(
-            verify_job(job),
+            verify_job(job, budget=not no_budget),
             report,
             preview,
             max_error_um,
@@ -209,6 +215,7 @@ def verify(
     preview: str | None,
     max_error_um: float | None,
     strict: bool,
+    no_budget: bool,
 ) -> None:
     """Read CODE (a program file, or '-' for stdin) back and predict the machined error.
 
@@ -231,7 +238,14 @@ def verify(
     chosen = load_target_checked(target, machine_file=machine_file)
     text = read_code(code, binary=chosen.post.binary)
     drawing = read_input(against) if against is not None else None
-    v = verify_code(text, chosen, source=code, against=drawing, tool_diameter=tool_diameter)
+    v = verify_code(
+        text,
+        chosen,
+        source=code,
+        against=drawing,
+        tool_diameter=tool_diameter,
+        budget=not no_budget,
+    )
     _finish_verification(
         v,
         report,

@@ -451,11 +451,13 @@ def _work_zero(plan: PlanOptions) -> str:
     return f"work zero X0 Y0: {where}{moved}"
 
 
-def verify_job(job: PostJob) -> Verification:
+def verify_job(job: PostJob, *, budget: bool = True) -> Verification:
     """Verify what ``job`` emitted: read its code back and simulate it against its drawing.
 
     The plan's findings go along, so features the planner reported it cannot cut
-    with this tool are measured apart (:func:`camtool.verify.verifier.verify_program`).
+    with this tool are measured apart (:func:`camtool.verify.verifier.verify_program`),
+    and so does the unrounded plan, so that the error budget knows what rounding
+    the emitted numbers costs (``budget=False``: no error budget).
 
     Raises:
         CamtoolError: the target cannot read its own code back, or its machine
@@ -470,6 +472,8 @@ def verify_job(job: PostJob) -> Verification:
         against=job.placed,
         tool_diameter=2.0 * job.edge_radius_mm,
         findings=job.plan.placed_findings() if job.plan is not None else (),
+        planned=job.program,
+        budget=budget,
     )
 
 

@@ -180,8 +180,9 @@ def extent_text(c: Content) -> str:
     cutting = c.program is not None and any(not isinstance(m, Rapid) for m in c.program.moves)
     if c.program is not None and cutting:
         box = c.program.bbox(cutting_only=True)
-        x0, y0, x1, y1 = (length(v).replace("-", "−") for v in box)
-        span = f"X {x0}…{x1} Y {y0}…{y1} mm"
+        small = _is_small(box)
+        x0, y0, x1, y1 = (length(v, um=small).replace("-", "−") for v in box)
+        span = f"X {x0}…{x1} Y {y0}…{y1} {'µm' if small else 'mm'}"
         parts.append(f"toolpath {span}" if has_drawing else f"toolpath {size_text(box)}, {span}")
     return ", ".join(parts) or size_text(part_box(c))
 
@@ -243,7 +244,7 @@ def _legend(c: Content, frame: BBox, u: float, width: float) -> tuple[Layer, Lay
     """
     bar = nice_length(20.0 * u)
     x0, y = frame[0] + u, frame[1] - 5.0 * u
-    label = f"{bar:g} mm"
+    label = f"{bar:g} mm" if bar >= 1.0 else f"{bar * 1000.0:.4g} µm"
     scale = Layer(
         "scale-bar",
         (
@@ -328,7 +329,22 @@ def _entries(c: Content, u: float) -> list[tuple[Glyph, str]]:
     v = c.verification
     if v is not None and v.against is not None and v.against.not_cut:
         out.append((marker, "not cut as drawn with this tool"))
+    if v is not None:
+        out.append((lambda x, y: (), budget_text(v)))
     return out
+
+
+def budget_text(v: Verification) -> str:
+    """The legend's error-budget entry: the dominant source of the largest figure, or why none."""
+    budget = v.error_budget
+    if budget.skipped is not None:
+        return f"error budget skipped: {budget.skipped.split(':')[0]}"
+    verdict = budget.dominant_text()
+    if not budget.without:
+        return "error budget: this machine models no error source that can be switched off"
+    if verdict is None:
+        return "error budget: no source changes any figure"
+    return f"error budget: {verdict} (one source off at a time; sources do not add)"
 
 
 def _column(v: Verification, frame: BBox, u: float) -> tuple[Panel, list[Layer]]:
@@ -354,9 +370,14 @@ def _column(v: Verification, frame: BBox, u: float) -> tuple[Panel, list[Layer]]
     labels = Layer(
         "inset-labels",
         (
-            Text((x0, top + 2.0 * u), f"zoom × {zoom:.0f} on the worst point", 2.8 * u, bold=True),
+            Text(
+                (x0, top + 2.0 * u),
+                f"zoom × {zoom_text(zoom)} on the worst point",
+                2.8 * u,
+                bold=True,
+            ),
             Path(((_line((x0, y), (x0 + bar, y)),),), Style("#000000", 0.5 * u)),
-            Text((x0 + bar + 1.5 * u, y - u), f"{bar_um:g} µm", 2.8 * u),
+            Text((x0 + bar + 1.5 * u, y - u), f"{bar_um:.4g} µm", 2.8 * u),
             Text((x0, y - 5.0 * u), "blue: programmed path", 2.4 * u, "#333333"),
             Text((x0, y - 8.5 * u), "colour: simulated tool centre", 2.4 * u, "#333333"),
         ),
@@ -417,7 +438,9 @@ def estimated_time(
 
 
 def duration(seconds: float) -> str:
-    """``"0.8 s"``, ``"42 s"``, ``"3 min 12 s"``, ``"2 h 05 min"``."""
+    """``"0.0735 s"``, ``"0.8 s"``, ``"42 s"``, ``"3 min 12 s"``, ``"2 h 05 min"``."""
+    if 0 < seconds < 0.1:
+        return f"{seconds:.3g} s"
     if seconds < 10:
         return f"{seconds:.1f} s"
     whole = round(seconds)
@@ -429,12 +452,28 @@ def duration(seconds: float) -> str:
     return f"{minutes // 60} h {minutes % 60:02d} min"
 
 
-def length(mm: float) -> str:
-    """A length for titles: at most 3 decimals, trailing zeros dropped (``"4.5"``)."""
-    text = f"{mm:.3f}".rstrip("0").rstrip(".")
+def zoom_text(zoom: float) -> str:
+    """A zoom factor: whole from 10 on, 2 significant digits below (``"0.42"``, never ``"0"``)."""
+    return f"{zoom:.0f}" if zoom >= 10 else f"{zoom:.2g}"
+
+
+def length(mm: float, *, um: bool = False) -> str:
+    """A length for titles: mm to at most 3 decimals (``"4.5"``); ``um``: in µm to 0.01 µm."""
+    text = f"{mm * 1000.0:.2f}" if um else f"{mm:.3f}"
+    text = text.rstrip("0").rstrip(".")
     return "0" if text in ("-0", "") else text
 
 
+SMALL_MM = 1.0
+"""Parts under this size (both sides) are labelled in µm."""
+
+
+def _is_small(box: BBox) -> bool:
+    return max(box[2] - box[0], box[3] - box[1]) < SMALL_MM
+
+
 def size_text(box: BBox) -> str:
-    """``"5 × 4.5 mm"``: width × height of ``box``."""
-    return f"{length(box[2] - box[0])} × {length(box[3] - box[1])} mm"
+    """``"5 × 4.5 mm"``: width × height of ``box``; ``"980 × 120 µm"`` for a part under 1 mm."""
+    small = _is_small(box)
+    w, h = length(box[2] - box[0], um=small), length(box[3] - box[1], um=small)
+    return f"{w} × {h} {'µm' if small else 'mm'}"

@@ -55,6 +55,38 @@ def block_times_s(trace: StepTrace, program: Program, machine: Machine) -> npt.N
     return np.asarray(model.block_time_s(block_kinematics(trace, program)), dtype=np.float64)
 
 
+def timing_warnings(trace: StepTrace, program: Program, machine: Machine) -> list[str]:
+    """Warnings for the limits the timing model applied (``capped_blocks``), by code line.
+
+    A model that caps a move (a step rate over the controller's limit, a feed over
+    the maximum rate) says which blocks in ``capped_blocks``
+    (:data:`camtool.verify.timing.CappedBlocks`); blocks with the same reason are
+    named together (the first 8 lines, then how many more).
+
+    Raises:
+        InputError: the ``[machine.timing]`` table is invalid.
+    """
+    if trace.block_time_s is not None or not machine.timing:
+        return []
+    where = f"machine {machine.name!r} [machine.timing]"
+    model = timing_model_from_table(machine.timing, where=where, machine=machine)
+    capped = getattr(model, "capped_blocks", None)
+    if capped is None:
+        return []
+    by_reason: dict[str, list[int]] = {}
+    for block, reason in capped(block_kinematics(trace, program)):
+        by_reason.setdefault(reason, []).append(block)
+    out = []
+    for reason, blocks in by_reason.items():
+        lines = [program.line_of(b) for b in blocks]
+        word, numbers = "line", [str(n) for n in lines]
+        if any(n is None for n in lines):
+            word, numbers = "move", [str(b + 1) for b in blocks]
+        shown = ", ".join(numbers[:8]) + (f" and {len(blocks) - 8} more" if len(blocks) > 8 else "")
+        out.append(f"{word}{'s' if len(blocks) > 1 else ''} {shown}: {reason}")
+    return out
+
+
 def _at_feed(program: Program, machine: Machine) -> npt.NDArray[np.float64]:
     feeds = [m.feed_mm_min for m in program.moves if not isinstance(m, Rapid)]
     if any(not feed > 0 for feed in feeds):

@@ -268,6 +268,174 @@ def fit_circle(points: FloatArray) -> tuple[float, float, float]:
     return (mx + cx, my + cy, math.sqrt(s + cx * cx + cy * cy))
 
 
+@dataclass(frozen=True)
+class AlongPath:
+    """The programmed path seen from the trace: what the tool never reached, where moves ended.
+
+    :func:`deviation` measures how far the tool strays *from* the path; a move
+    that stops short (an uncompensated backlash on a return leg) strays nowhere
+    and is invisible to it. Here the path is sampled finely and each sample's
+    distance to the trace of its own contour is taken (the directed Hausdorff
+    distance from path to trace), and the carriage is compared with the
+    programmed end of every cutting move and every contour.
+
+    Attributes:
+        shortfall_um: largest distance of the sampled cutting path from the
+            trace of its contour, µm (0 when nothing was cut).
+        shortfall_at_mm: the path point where it occurs, mm.
+        shortfall_block: index of the move of that point (-1 when none).
+        block_end_um: largest distance of the carriage, after a cutting move's
+            last row, from the move's programmed end, µm.
+        block_end_at_mm: the programmed end where it occurs, mm.
+        block_end_block: index of that move (-1 when none).
+        contour_end_um: ``(C,)`` the same at the end of each contour, µm.
+        samples: path points measured.
+    """
+
+    shortfall_um: float
+    shortfall_at_mm: Point
+    shortfall_block: int
+    block_end_um: float
+    block_end_at_mm: Point
+    block_end_block: int
+    contour_end_um: tuple[float, ...]
+    samples: int
+
+
+ALONG_SPACING_MM = 0.001
+"""Largest spacing of the programmed path's samples for :func:`along_path`, mm."""
+ALONG_MAX_SAMPLES = 400_000
+"""Most path samples :func:`along_path` measures (the spacing grows beyond it)."""
+ALONG_MAX_TRACE = 400_000
+"""Most trace points per contour :func:`along_path` keeps (every k-th beyond it)."""
+ALONG_RESOLUTION_MM = 0.0005
+"""Spacing the trace is thinned to for :func:`along_path`, mm: a thinned-out point lies
+within about this of the polyline kept, so it bounds the error of the shortfall."""
+
+
+def along_path(
+    points: FloatArray, block_start: IntArray, start_mm: Point, program: Program
+) -> AlongPath:
+    """The path-to-trace measures of a trace (see :class:`AlongPath`).
+
+    Args:
+        points: ``(N, 2)`` float64 trace, mm.
+        block_start: ``(B + 1,)`` offsets of each move's points in ``points``.
+        start_mm: the carriage position before the first point.
+        program: the program the trace executed.
+
+    The path is sampled at most :data:`ALONG_SPACING_MM` apart (wider when it
+    would take more than :data:`ALONG_MAX_SAMPLES`), every move's ends
+    included; each contour's trace is a polyline through its points (the point
+    before the contour included), thinned to points about
+    :data:`ALONG_RESOLUTION_MM` apart (never more than :data:`ALONG_MAX_TRACE`).
+    """
+    import shapely
+
+    starts = [program.origin] + [(m.x, m.y) for m in program.moves]
+    runs = contour_runs(program)
+    total = sum(
+        segment_of(starts[i], program.moves[i]).length for a, b in runs for i in range(a, b + 1)
+    )
+    spacing = max(ALONG_SPACING_MM, total / ALONG_MAX_SAMPLES)
+    start = np.asarray(start_mm, dtype=np.float64).reshape(1, 2)
+    worst = (0.0, (0.0, 0.0), -1)
+    ends: list[float] = []
+    end_worst = (0.0, (0.0, 0.0), -1)
+    count = 0
+    for first, last in runs:
+        lo, hi = int(block_start[first]), int(block_start[last + 1])
+        before = points[lo - 1 : lo] if lo > 0 else start
+        run = np.vstack([before, points[lo:hi]])
+        for b in range(first, last + 1):
+            here = _carriage_after(points, block_start, start, b)
+            gap = math.dist(here, starts[b + 1]) * 1000.0
+            if gap > end_worst[0]:
+                end_worst = (gap, starts[b + 1], b)
+        ends.append(math.dist(_carriage_after(points, block_start, start, last), starts[last + 1]))
+        samples, owner = _sample_moves(program, starts, first, last, spacing)
+        count += len(samples)
+        if len(samples) == 0:
+            continue
+        move_ends = block_start[first + 1 : last + 2] - lo  # each move's last row, in ``run``
+        trace = _thinned(run, move_ends)
+        if len(trace) == 1:
+            geoms = shapely.points(trace)
+        else:
+            geoms = shapely.linestrings(np.stack([trace[:-1], trace[1:]], axis=1))
+        tree = shapely.STRtree(geoms)
+        _, d = tree.query_nearest(shapely.points(samples), return_distance=True, all_matches=False)
+        d = np.asarray(d, dtype=np.float64)
+        k = int(np.argmax(d))
+        if d[k] * 1000.0 > worst[0]:
+            worst = (float(d[k]) * 1000.0, (float(samples[k, 0]), float(samples[k, 1])), owner[k])
+    return AlongPath(
+        shortfall_um=worst[0],
+        shortfall_at_mm=worst[1],
+        shortfall_block=int(worst[2]),
+        block_end_um=end_worst[0],
+        block_end_at_mm=(float(end_worst[1][0]), float(end_worst[1][1])),
+        block_end_block=int(end_worst[2]),
+        contour_end_um=tuple(e * 1000.0 for e in ends),
+        samples=count,
+    )
+
+
+def _thinned(run: FloatArray, keep: IntArray) -> FloatArray:
+    """``run``'s every k-th point, its last and the rows ``keep``, about 0.5 µm apart.
+
+    The spacing is :data:`ALONG_RESOLUTION_MM`, never more than :data:`ALONG_MAX_TRACE`
+    points (plus ``keep``). Keeping every move's last row keeps the corners, which a
+    thinned polyline would cut.
+    """
+    if len(run) < 3:
+        return run
+    head = np.diff(run[: min(len(run), 2000)], axis=0)
+    step = float(np.median(np.hypot(head[:, 0], head[:, 1])))
+    every = max(1, int(ALONG_RESOLUTION_MM / step) if step > 0 else 1)
+    every = max(every, -(-len(run) // ALONG_MAX_TRACE))
+    if every == 1:
+        return run
+    mask = np.zeros(len(run), dtype=bool)
+    mask[::every] = True
+    mask[-1] = True
+    mask[keep[(keep >= 0) & (keep < len(run))]] = True
+    return run[mask]
+
+
+def _carriage_after(
+    points: FloatArray, block_start: IntArray, start: FloatArray, block: int
+) -> FloatArray:
+    """Carriage position after move ``block``'s last row (or before it, when it has none)."""
+    row = int(block_start[block + 1]) - 1
+    return points[row] if row >= 0 else start[0]
+
+
+def _sample_moves(
+    program: Program, starts: list[Point], first: int, last: int, spacing: float
+) -> tuple[FloatArray, IntArray]:
+    """Points along moves ``first..last`` at most ``spacing`` apart, ends included, and owners."""
+    chunks: list[FloatArray] = []
+    owners: list[IntArray] = []
+    for b in range(first, last + 1):
+        seg = segment_of(starts[b], program.moves[b])
+        n = max(1, math.ceil(seg.length / spacing))
+        t = np.arange(n + 1, dtype=np.float64) / n
+        if isinstance(seg, Arc):
+            r, c = seg.radius, seg.centre
+            angle = math.atan2(seg.start[1] - c[1], seg.start[0] - c[0]) + seg.sweep * t
+            pts = np.column_stack((c[0] + r * np.cos(angle), c[1] + r * np.sin(angle)))
+            pts[-1] = seg.end
+        else:
+            (x0, y0), (x1, y1) = seg.start, seg.end
+            pts = np.column_stack((x0 + (x1 - x0) * t, y0 + (y1 - y0) * t))
+        chunks.append(pts)
+        owners.append(np.full(len(pts), b, dtype=np.int64))
+    if not chunks:
+        return np.zeros((0, 2)), np.zeros(0, dtype=np.int64)
+    return np.vstack(chunks), np.concatenate(owners)
+
+
 NOT_CUT_KINDS = ("tight-corner", "offset-vanished", "uncut")
 """Plan finding kinds that say a feature cannot be cut as drawn with this tool."""
 

@@ -28,6 +28,13 @@ Piece types (all pure; lengths mm, steps integer motor steps, Y up):
   parameter dataclass.
 - :data:`Simulator`: ``(program, machine) -> StepTrace``, a whole simulator that
   replaces the step simulator for a ``line`` name (a servo loop, say).
+
+A piece that models an error source of :mod:`camtool.verify.sources` (a timer's
+overshoot is ``dynamics``) names it in ``MotionHooks.honours``; the library then
+calls it with ``sources=`` (a line factory ``(machine, sources=...)``, a
+simulator ``(program, machine, sources=...)``) so that the error budget can
+switch the source off. A piece that honours nothing is called as above, and its
+sources are absent from the budget.
 """
 
 from __future__ import annotations
@@ -54,6 +61,7 @@ from camtool.verify.interpolators import (
     sagitta_chord_points,
     staircase_arc,
 )
+from camtool.verify.sources import ALL, Sources
 from camtool.verify.steparray import StepArray
 from camtool.verify.timing import TimingModel, TrapezoidTiming, timing_from_table
 
@@ -148,6 +156,9 @@ class MotionHooks:
         timing: ``[machine.timing] model`` name → :data:`TimingFactory`.
         simulators: ``line`` name → :data:`Simulator` run instead of the step
             simulator.
+        honours: piece name (a line or a simulator) → the error sources it
+            models and can switch off (names of :data:`camtool.verify.sources.SOURCES`);
+            it is then called with ``sources=``.
     """
 
     lines: Mapping[str, LineFactory] = field(default_factory=_frozen)
@@ -155,9 +166,10 @@ class MotionHooks:
     chords: Mapping[str, ChordRule] = field(default_factory=_frozen)
     timing: Mapping[str, TimingFactory] = field(default_factory=_frozen)
     simulators: Mapping[str, Simulator] = field(default_factory=_frozen)
+    honours: Mapping[str, tuple[str, ...]] = field(default_factory=_frozen)
 
     def __post_init__(self) -> None:
-        for name in ("lines", "arcs", "chords", "timing", "simulators"):
+        for name in ("lines", "arcs", "chords", "timing", "simulators", "honours"):
             object.__setattr__(self, name, _frozen(getattr(self, name)))
 
 
@@ -233,8 +245,17 @@ class Library:
                 return hooks.simulators[line]
         return None
 
-    def line(self, machine: Machine) -> LineInterpolator:
+    def honours(self, name: str) -> tuple[str, ...]:
+        """The error sources the piece ``name`` (a line or a simulator) models itself."""
+        for hooks in self.sources:
+            if name in hooks.lines or name in hooks.simulators:
+                return tuple(hooks.honours.get(name, ()))
+        return ()
+
+    def line(self, machine: Machine, *, sources: Sources = ALL) -> LineInterpolator:
         """The line interpolator of ``machine``'s ``[machine.motion] line``.
+
+        ``sources`` reach a factory that honours some (``MotionHooks.honours``).
 
         Raises:
             InputError: an unknown name (the message lists the valid ones).
@@ -243,6 +264,8 @@ class Library:
         name = machine.motion.line
         for hooks in self.sources:
             if name in hooks.lines:
+                if name in hooks.honours:
+                    return hooks.lines[name](machine, sources=sources)  # type: ignore[call-arg]
                 return hooks.lines[name](machine)
         valid = self.names(lambda h: {**h.lines, **h.simulators})
         raise InputError(

@@ -23,32 +23,55 @@ as the first line"), so only reversals inside the program cost accuracy.
 
 Z moves are counted in steps and time but not traced (the trace is the XY
 tool-centre path); Z backlash is not modelled.
+
+Error sources can be switched off (:class:`camtool.verify.sources.Sources`, for
+the error budget): ``scale`` off makes the true steps/mm the nominal ones,
+``backlash`` off removes the play and the compensation, ``chords`` off cuts
+arcs of an ``arc = "chords"`` profile into chords of 1/10 step sagitta, and
+``interpolation`` off runs the *ideal* controller (:class:`_IdealController`):
+positions in fractional steps (no rounding to steps), lines straight and arcs
+exact, sampled at :data:`IDEAL_SAMPLES_PER_STEP` points per step so that the
+play still bites where it does; a line interpolator that does not reach its
+count (a timer's overshoot) keeps its net displacement per axis.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
+import math
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
-from camtool.model.machine import Machine
+from camtool.model.machine import Backlash, Machine
 from camtool.model.program import ArcMove, Move, Program
 from camtool.model.shapes import Point, distance
+from camtool.verify.interpolators import sagitta_chord_points
 from camtool.verify.motion import StepTrace, library
 from camtool.verify.quantize import Rounding, steps_from_mm
+from camtool.verify.sources import ALL, Sources
 from camtool.verify.steparray import STEP_DTYPE, StepArray, read_only
 
 IntArray = npt.NDArray[np.int64]
 FloatArray = npt.NDArray[np.float64]
 
 
-def simulate_steps(program: Program, machine: Machine) -> StepTrace:
+IDEAL_SAMPLES_PER_STEP = 4
+"""Samples per step of the dominant axis of the ideal controller (``interpolation`` off)."""
+FINE_CHORD_STEPS = 0.1
+"""Sagitta of the chords, in steps, when the ``chords`` source is off."""
+
+
+def simulate_steps(program: Program, machine: Machine, *, sources: Sources = ALL) -> StepTrace:
     """Run ``program`` through ``machine``'s controller and mechanics.
 
     Args:
         program: moves in mm (as read back from the emitted code).
         machine: profile: nominal and true steps/mm, interpolators, backlash.
+        sources: the error sources modelled (all by default; the error budget
+            switches one off at a time, see the module docstring).
 
     Returns:
         The :class:`StepTrace`.
@@ -58,7 +81,9 @@ def simulate_steps(program: Program, machine: Machine) -> StepTrace:
         InputError: an unknown interpolator or chord rule name (listing the valid
             ones), or an arc whose start is its centre (radius 0 steps).
     """
-    sim = _Controller(machine, program.origin)
+    machine = switched_machine(machine, sources)
+    kind = _Controller if sources.interpolation else _IdealController
+    sim = kind(machine, program.origin, sources)
     start = program.origin
     for move in program.moves:
         sim.block(start, move)
@@ -66,21 +91,33 @@ def simulate_steps(program: Program, machine: Machine) -> StepTrace:
     return sim.finish(len(program.moves))
 
 
+def switched_machine(machine: Machine, sources: Sources) -> Machine:
+    """``machine`` with the ``scale`` and ``backlash`` sources switched off as ``sources`` say.
+
+    ``scale`` off: the true steps/mm are the nominal ones; ``backlash`` off: no
+    true backlash and no compensation.
+    """
+    if not sources.scale and machine.true_steps_per_mm is not None:
+        machine = dataclasses.replace(machine, true_steps_per_mm=None)
+    if not sources.backlash:
+        machine = dataclasses.replace(machine, backlash=Backlash())
+    return machine
+
+
 class _Controller:
     """The controller's state while it walks the blocks (local to one simulation)."""
 
-    def __init__(self, machine: Machine, origin: Point) -> None:
+    def __init__(self, machine: Machine, origin: Point, sources: Sources = ALL) -> None:
         self.machine = machine
+        self.sources = sources
         self.spm = machine.steps_per_mm
         self.rounding: Rounding = machine.motion.rounding  # type: ignore[assignment]
         self.pos = (self.to_steps(origin[0], 0), self.to_steps(origin[1], 1))
         self.z_pos: int | None = None
         self.origin_steps = self.pos
         self.direction = [0, 0]
-        self.comp_steps = tuple(
-            round(machine.backlash.compensation_um[a] / 1000.0 * self.spm[a]) for a in (0, 1)
-        )
-        self.parts: list[StepArray] = []
+        self.comp_steps = self.compensation_steps()
+        self.parts: list[npt.NDArray[Any]] = []
         self.comp_parts: list[npt.NDArray[np.bool_]] = []
         self.counts: list[int] = []
         self.logical: list[tuple[int, int]] = []
@@ -90,12 +127,25 @@ class _Controller:
         self.reversals = [0, 0]
         self.compensations = 0
         lib = library()
-        self.line = lib.line(machine)
+        self.line = lib.line(machine, sources=sources)
+        # a line whose piece models dynamics may not reach its count (a timer's overshoot)
+        self.inexact = sources.dynamics and "dynamics" in lib.honours(machine.motion.line)
         self.arc = lib.arc(machine)
         self.chord_rule = lib.chord_rule(machine) if self.arc is None else None
 
+    def compensation_steps(self) -> tuple[float, float]:
+        """Compensation per axis and reversal, whole steps (as the controller rounds)."""
+        um = self.machine.backlash.compensation_um
+        return (round(um[0] / 1000.0 * self.spm[0]), round(um[1] / 1000.0 * self.spm[1]))
+
     def to_steps(self, value_mm: float, axis: int) -> int:
         return steps_from_mm(value_mm, 1.0 / self.spm[axis], self.rounding)
+
+    def comp_rows(self, axis: int, sign: int) -> StepArray:
+        """The rows of one compensation of ``axis`` in direction ``sign``."""
+        comp = np.zeros((int(self.comp_steps[axis]), 2), dtype=STEP_DTYPE)
+        comp[:, axis] = sign
+        return comp
 
     def block(self, start_mm: Point, move: Move) -> None:
         end = (self.to_steps(move.x, 0), self.to_steps(move.y, 1))
@@ -132,7 +182,8 @@ class _Controller:
             rows = self.arc(*self.pos, *end, *centre, move.clockwise)
             return rows, [], len(rows)
         points = self._chord_points(start_mm, move)
-        lattice = [self.pos] + [(self.to_steps(x, 0), self.to_steps(y, 1)) for x, y in points]
+        lattice: list[tuple[int, int]] = [self.pos]
+        lattice += [(self.to_steps(x, 0), self.to_steps(y, 1)) for x, y in points]
         lattice[-1] = end
         parts, starts, offset, dominant = [], [], 0, 0
         for (x0, y0), (x1, y1) in itertools.pairwise(lattice):
@@ -146,12 +197,16 @@ class _Controller:
 
     def _chord_points(self, start_mm: Point, move: ArcMove) -> FloatArray:
         assert self.chord_rule is not None  # arc = "chords"
+        if not self.sources.chords:  # chords far below a step: the arc itself
+            tolerance = FINE_CHORD_STEPS / max(self.spm[:2])
+            fine = sagitta_chord_points(start_mm, move, tolerance)
+            return np.asarray(fine, dtype=np.float64).reshape(-1, 2)
         pts = self.chord_rule(start_mm, move, self.machine.motion)
         return np.asarray(pts, dtype=np.float64).reshape(-1, 2)
 
     def _compensate(
-        self, rows: StepArray, line_starts: list[int]
-    ) -> tuple[StepArray, npt.NDArray[np.bool_]]:
+        self, rows: npt.NDArray[Any], line_starts: list[int]
+    ) -> tuple[npt.NDArray[Any], npt.NDArray[np.bool_]]:
         """Insert compensation rows at this block's reversals; update the direction state."""
         inserts: list[tuple[int, int, int]] = []  # (row, axis, sign)
         for axis in (0, 1):
@@ -159,7 +214,7 @@ class _Controller:
             nz = np.flatnonzero(column)
             if nz.size == 0:
                 continue
-            signs = column[nz].astype(np.int64)
+            signs = np.sign(column[nz]).astype(np.int64)
             previous = np.concatenate(([self.direction[axis]], signs[:-1]))
             at = np.flatnonzero((signs != previous) & (previous != 0))
             self.reversals[axis] += int(at.size)
@@ -180,8 +235,7 @@ class _Controller:
         for row, axis, sign in inserts:
             pieces.append(rows[last:row])
             flag_pieces.append(flags[last:row])
-            comp = np.zeros((self.comp_steps[axis], 2), dtype=STEP_DTYPE)
-            comp[:, axis] = sign
+            comp = self.comp_rows(axis, sign)
             pieces.append(comp)
             flag_pieces.append(np.ones(len(comp), dtype=np.bool_))
             last = row
@@ -197,7 +251,7 @@ class _Controller:
         block_of_row = np.repeat(np.arange(blocks, dtype=np.int64), counts)
         carriage = _carriage(rows, self.origin_steps, self.machine)
         return StepTrace(
-            rows=read_only(rows),
+            rows=read_only(np.sign(rows).astype(STEP_DTYPE)),
             compensation=read_only(comp),
             block_of_row=read_only(block_of_row),
             block_start=read_only(block_start),
@@ -212,6 +266,97 @@ class _Controller:
         )
 
 
+class _IdealController(_Controller):
+    """The controller with the ``interpolation`` source off: continuous, unrounded motion.
+
+    Positions are fractional steps (no rounding), a line is a straight run of
+    equal float rows (:data:`IDEAL_SAMPLES_PER_STEP` per step of its dominant
+    axis), a native arc is sampled on its circle (the radius blended from the
+    start's to the end's), a chord arc is its chords run as such lines, and a
+    compensation is one row of the exact compensation. A line piece that models
+    ``dynamics`` still runs on the rounded counts so that a line that does not
+    reach its count (a timer's overshoot) keeps its net displacement per axis.
+    The trace's ``rows`` then hold only each sample's direction.
+    """
+
+    def compensation_steps(self) -> tuple[float, float]:
+        um = self.machine.backlash.compensation_um
+        return (um[0] / 1000.0 * self.spm[0], um[1] / 1000.0 * self.spm[1])
+
+    def to_steps(self, value_mm: float, axis: int) -> float:  # type: ignore[override]
+        return value_mm * self.spm[axis]
+
+    def comp_rows(self, axis: int, sign: int) -> StepArray:
+        comp = np.zeros((1 if self.comp_steps[axis] else 0, 2), dtype=np.float64)
+        comp[:, axis] = sign * self.comp_steps[axis]
+        return comp  # type: ignore[return-value]
+
+    def block(self, start_mm: Point, move: Move) -> None:
+        end = (self.to_steps(move.x, 0), self.to_steps(move.y, 1))
+        rows: npt.NDArray[Any]
+        if isinstance(move, ArcMove) and self.arc is not None:
+            rows = self._ideal_arc(start_mm, move)
+            line_starts: list[int] = []
+        elif isinstance(move, ArcMove):
+            points = self._chord_points(start_mm, move)
+            lattice = [self.pos] + [(x * self.spm[0], y * self.spm[1]) for x, y in points]
+            lattice[-1] = end
+            parts, line_starts, offset = [], [], 0
+            for a, b in itertools.pairwise(lattice):
+                part = self._ideal_line(a, b)
+                parts.append(part)
+                line_starts.append(offset)
+                offset += len(part)
+            rows = np.concatenate(parts) if parts else np.zeros((0, 2))
+        else:
+            rows, line_starts = self._ideal_line(self.pos, end), [0]
+        self.steps.append((0, 0, 0))
+        self.dominant.append(0)
+        rows, comp = self._compensate(rows, line_starts)
+        self.parts.append(rows)
+        self.comp_parts.append(comp)
+        self.counts.append(len(rows))
+        self.block_comp.append(int(comp.sum()))
+        self.logical.append((round(end[0]), round(end[1])))
+        self.pos = end  # type: ignore[assignment]
+
+    def _ideal_line(self, a: tuple[float, float], b: tuple[float, float]) -> FloatArray:
+        dx, dy = b[0] - a[0], b[1] - a[1]
+        counted = (
+            self.line(round(b[0]) - round(a[0]), round(b[1]) - round(a[1])) if self.inexact else ()
+        )
+        if len(counted):
+            programmed = (round(b[0]) - round(a[0]), round(b[1]) - round(a[1]))
+            net = np.asarray(counted, dtype=np.int64).sum(axis=0)
+            dx *= float(net[0]) / programmed[0] if programmed[0] else 1.0
+            dy *= float(net[1]) / programmed[1] if programmed[1] else 1.0
+        n = max(1, math.ceil(IDEAL_SAMPLES_PER_STEP * max(abs(dx), abs(dy))))
+        if dx == 0 and dy == 0:
+            return np.zeros((0, 2), dtype=np.float64)
+        return np.tile(np.asarray([[dx / n, dy / n]], dtype=np.float64), (n, 1))
+
+    def _ideal_arc(self, start_mm: Point, move: ArcMove) -> FloatArray:
+        sx, sy = self.spm[0], self.spm[1]
+        cx, cy = move.cx * sx, move.cy * sy
+        x0, y0 = self.pos
+        x1, y1 = move.x * sx, move.y * sy
+        r0, r1 = math.hypot(x0 - cx, y0 - cy), math.hypot(x1 - cx, y1 - cy)
+        a0, a1 = math.atan2(y0 - cy, x0 - cx), math.atan2(y1 - cy, x1 - cx)
+        turn = -math.tau if move.clockwise else math.tau
+        sweep = (a1 - a0) % turn or turn
+        full = distance(start_mm, (move.x, move.y)) <= 1e-9
+        if not full and math.hypot(x1 - x0, y1 - y0) < 1e-9:
+            return np.zeros((0, 2), dtype=np.float64)
+        n = max(1, math.ceil(IDEAL_SAMPLES_PER_STEP * abs(sweep) * max(r0, r1)))
+        t = np.arange(1, n + 1, dtype=np.float64) / n
+        radius = r0 + (r1 - r0) * t
+        points = np.column_stack(
+            (cx + radius * np.cos(a0 + sweep * t), cy + radius * np.sin(a0 + sweep * t))
+        )
+        points[-1] = (x1, y1)
+        return np.diff(np.vstack([[x0, y0], points]), axis=0)
+
+
 def _start_mm(origin_steps: tuple[int, int], machine: Machine) -> Point:
     """Carriage start: the program origin as the controller rounded it, in real mm."""
     true = machine.real_steps_per_mm
@@ -219,17 +364,26 @@ def _start_mm(origin_steps: tuple[int, int], machine: Machine) -> Point:
 
 
 def _carriage(rows: StepArray, origin: tuple[int, int], machine: Machine) -> FloatArray:
-    """Carriage position after each row, mm: motor steps through the backlash play."""
+    """Carriage position after each row, mm: motor steps through the backlash play.
+
+    ``rows`` are whole steps (int8) or, for the ideal controller, fractional ones (float64).
+    """
     true = machine.real_steps_per_mm
-    motor = np.cumsum(rows, axis=0, dtype=np.int64) + np.asarray(origin, dtype=np.int64)
+    kind = np.float64 if rows.dtype.kind == "f" else np.int64
+    motor = np.cumsum(rows, axis=0, dtype=kind) + np.asarray(origin, dtype=kind)
+    signs = np.sign(rows).astype(np.int8)
     out = np.empty((len(rows), 2), dtype=np.float64)
     for axis in (0, 1):
-        out[:, axis] = _play(rows[:, axis], motor, axis, origin[axis], machine) / true[axis]
+        out[:, axis] = _play(signs[:, axis], motor, axis, origin[axis], machine) / true[axis]
     return out
 
 
 def _play(
-    steps: npt.NDArray[np.int8], motor: IntArray, axis: int, start: int, machine: Machine
+    steps: npt.NDArray[np.int8],
+    motor: npt.NDArray[Any],
+    axis: int,
+    start: float,
+    machine: Machine,
 ) -> FloatArray:
     """One axis's carriage position in motor steps (play operator, band [M, M + B]).
 

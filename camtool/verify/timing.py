@@ -36,7 +36,7 @@ per-block value as a ``(B,)`` array if axes differ. The defaults are the generic
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, fields
 from typing import Any, ClassVar, Protocol
 
@@ -393,6 +393,19 @@ class TrapezoidTiming:
             max_rate_mm_min=self.max_rate_mm_min,
         )
 
+    def capped_blocks(self, blocks: BlockKinematics) -> list[tuple[int, str]]:
+        """Feed moves whose feed is over the maximum rate, timed at the rate instead."""
+        over = ~blocks.is_rapid & (blocks.feed_mm_min > self.max_rate_mm_min)
+        return [
+            (
+                int(i),
+                f"feed {blocks.feed_mm_min[i]:g} mm/min is over the maximum rate "
+                f"{self.max_rate_mm_min:g} mm/min of the {self.model} timing model "
+                "([machine.timing] max_rate_mm_min): timed at the maximum rate",
+            )
+            for i in np.flatnonzero(over)
+        ]
+
 
 class TimingModel(Protocol):
     """A timing model: parameters (a frozen dataclass) and the seconds each block takes.
@@ -406,6 +419,13 @@ class TimingModel(Protocol):
     def block_time_s(self, blocks: BlockKinematics) -> FloatArray:
         """Seconds per block, ``(B,) float64`` read-only."""
         ...
+
+
+CappedBlocks = Callable[[BlockKinematics], list[tuple[int, str]]]
+"""Optional method ``capped_blocks(blocks)`` of a timing model: every block the model
+times slower than programmed because of a limit it applies (a step-rate cap, a
+maximum rate), as ``(block index, what was capped)``; the verifier warns about
+each (:func:`camtool.verify.clock.timing_warnings`), so no cap is silent."""
 
 
 def timing_from_table(cls: type[Any], table: Mapping[str, Any], *, where: str) -> Any:

@@ -17,9 +17,16 @@ the worst deviation, ``contours`` (every measure per contour, circles with
 their fitted diameter), ``against`` (the drawing comparison, over what was
 cut as drawn), ``not_cut_as_drawn`` (the features the planner reported it
 cannot cut with this tool, each ``{kind, label, at: {x_mm, y_mm}, error_um,
-samples, value}``), ``strict_error_um`` (the largest error with them) and
-``against_skipped`` (why a drawing given was not compared, else null). Numbers are
-rounded (µm to 4 decimals, mm to 6) so the same input gives the same bytes.
+samples, value}``), ``strict_error_um`` (the largest error with them),
+``against_skipped`` (why a drawing given was not compared, else null),
+``shortfall_um`` {max, at, samples} (the part of the programmed path the tool
+never reached, :class:`camtool.verify.metrics.AlongPath`), ``block_end_um`` {max,
+at} (the carriage against every cutting move's programmed end; each contour's in
+``contours[].end_error_um``), ``max_error_um`` (what ``--max-error-um`` checks:
+deviation, shortfall and the drawing) and ``error_budget`` (every figure with
+everything on and with each source off in turn, :mod:`camtool.verify.budget`).
+Numbers are rounded (µm to 4 decimals, mm to 6, ``time_s`` to 6 significant
+digits and at least 3 decimals) so the same input gives the same bytes.
 """
 
 from __future__ import annotations
@@ -27,28 +34,33 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from camtool.model.errors import InputError, UsageError
+from camtool.model.errors import CamtoolError, InputError, UsageError
 from camtool.model.machine import Machine
-from camtool.model.program import Dwell, Home, Program, Rapid
+from camtool.model.program import ArcMove, Dwell, Home, Program, Rapid
 from camtool.model.shapes import BBox, Drawing
 from camtool.model.units import fmt_num
 from camtool.model.version import __version__
-from camtool.verify.clock import block_times_s
+from camtool.verify import budget as eb
+from camtool.verify.clock import block_times_s, timing_warnings
 from camtool.verify.metrics import (
     Against,
+    AlongPath,
     ContourMeasure,
     Deviation,
     FindingLike,
     against_drawing,
+    along_path,
     deviation,
     measure_contours,
 )
 from camtool.verify.motion import StepTrace, library
 from camtool.verify.simulate import simulate_steps
+from camtool.verify.sources import ALL, Sources
 
 if TYPE_CHECKING:
     from camtool.post.base import Target
@@ -80,6 +92,14 @@ class Verification:
         against_skipped: why a drawing that was given was not compared (the
             program and the drawing do not overlap), else ``None``; then
             ``against`` is ``None`` and no limit can be judged against it.
+        along: the programmed path seen from the trace (the shortfall, the
+            error at every move's end), ``None`` for a verification built by hand.
+        planned: the unrounded plan the code was written from, when at hand
+            (the ``rounding`` source of the error budget), else ``None``.
+        budget: whether :attr:`error_budget` re-simulates (``False``: ``--no-budget``).
+        drawing: the drawing given to compare with (the budget measures it again).
+        tool_diameter: the tool diameter the drawing was compared with, mm.
+        findings: the plan's findings the drawing was compared with.
     """
 
     target: str
@@ -92,6 +112,25 @@ class Verification:
     block_time_s: np.ndarray
     warnings: tuple[str, ...] = field(default=())
     against_skipped: str | None = None
+    along: AlongPath | None = None
+    planned: Program | None = None
+    budget: bool = True
+    drawing: Drawing | None = None
+    tool_diameter: float = 0.0
+    findings: Sequence[FindingLike] = ()
+
+    @cached_property
+    def error_budget(self) -> eb.ErrorBudget:
+        """The error budget by source (:mod:`camtool.verify.budget`), computed on first use.
+
+        Re-simulates the program once per modelled source; skipped (with the
+        reason) when :attr:`budget` is off or the trace is over
+        :data:`camtool.verify.budget.MAX_ROWS` rows.
+
+        Raises:
+            CamtoolError: a re-simulation fails (the full model did not).
+        """
+        return _budget(self)
 
     @property
     def dwell_s(self) -> float:
@@ -107,12 +146,15 @@ class Verification:
     def max_error_um(self) -> float:
         """The predicted error a limit is checked against, µm.
 
-        The largest of the deviation from the nominal path and, when a drawing
-        was given, the machined edge's distance from it and its overcut, over
-        what was cut as drawn (features the planner reported it cannot cut
-        with this tool are left out: see :attr:`strict_error_um`).
+        The largest of the deviation from the nominal path, the shortfall along
+        it (the part of the path the tool never reached, :class:`AlongPath`)
+        and, when a drawing was given, the machined edge's distance from it and
+        its overcut, over what was cut as drawn (features the planner reported
+        it cannot cut with this tool are left out: see :attr:`strict_error_um`).
         """
         worst = self.deviation.max_um
+        if self.along is not None:
+            worst = max(worst, self.along.shortfall_um)
         if self.against is not None:
             worst = max(worst, self.against.max_um, self.against.overcut_um)
         return worst
@@ -155,10 +197,13 @@ def verify_code(
     against: Drawing | None = None,
     tool_diameter: float = 0.0,
     findings: Sequence[FindingLike] = (),
+    planned: Program | None = None,
+    budget: bool = True,
 ) -> Verification:
     """Read ``code`` with ``target``'s reader and verify it on ``target``'s machine.
 
-    ``findings`` are the plan's (see :func:`verify_program`).
+    ``findings`` are the plan's, ``planned`` the unrounded plan and ``budget``
+    the error budget switch (see :func:`verify_program`).
 
     Raises:
         ParseError: the code is not valid in the target's dialect (names the line).
@@ -178,6 +223,8 @@ def verify_code(
         against=against,
         tool_diameter=tool_diameter,
         findings=findings,
+        planned=planned,
+        budget=budget,
     )
 
 
@@ -189,6 +236,8 @@ def verify_program(
     against: Drawing | None = None,
     tool_diameter: float = 0.0,
     findings: Sequence[FindingLike] = (),
+    planned: Program | None = None,
+    budget: bool = True,
 ) -> Verification:
     """Simulate ``program`` on ``machine`` and measure the machined error.
 
@@ -203,6 +252,11 @@ def verify_program(
             features it reported as impossible with this tool (a tight corner, a
             region narrower than the tool) are measured apart from the rest of
             the drawing (:func:`camtool.verify.metrics.not_cut_groups`).
+        planned: the unrounded plan ``program`` was emitted from, in the same
+            coordinates (the error budget's ``rounding`` source); ``None`` when
+            only the code is known.
+        budget: compute the error budget when it is asked for
+            (:attr:`Verification.error_budget`); ``False`` skips it.
 
     A drawing whose box does not overlap the program's (less than
     :data:`MIN_OVERLAP`) is not compared: ``against`` is ``None``,
@@ -218,27 +272,16 @@ def verify_program(
         raise UsageError(f"tool diameter must be >= 0 mm, got {tool_diameter!r}")
     placement = check_area(program, machine)
     trace = simulate(program, machine)
-    points, blocks = trace.carriage_mm, trace.block_of_row
-    dev = deviation(points, blocks, program)
-    contours = tuple(measure_contours(points, trace.block_start, trace.start_mm, program))
-    compared = None
     warnings = _warnings(program, trace)
     skipped = None if against is None else _no_overlap(program, against, tool_diameter / 2.0)
     if skipped is not None:
         warnings.append(skipped)
-    elif against is not None:
-        rapid = np.asarray([isinstance(m, Rapid) for m in program.moves], dtype=bool)
-        cutting = ~rapid[blocks] if len(blocks) else np.zeros(0, dtype=bool)
-        runs = np.cumsum(~cutting)[cutting]  # a new id after every rapid row
-        compared = against_drawing(
-            points[cutting],
-            against,
-            tool_diameter / 2.0,
-            runs=runs,
-            nominal=_nominal_lines(program) if findings else (),
-            findings=findings,
-        )
+    compared_with = against if skipped is None else None
+    dev, along, contours, compared = _measure(
+        program, trace, compared_with, tool_diameter, findings
+    )
     times = block_times(trace, program, machine)
+    warnings.extend(timing_warnings(trace, program, machine))
     return Verification(
         target=name or machine.name,
         program=program,
@@ -250,10 +293,136 @@ def verify_program(
         block_time_s=times,
         warnings=tuple(dict.fromkeys((*warnings, *placement))),
         against_skipped=skipped,
+        along=along,
+        planned=planned,
+        budget=budget,
+        drawing=compared_with,
+        tool_diameter=tool_diameter,
+        findings=tuple(findings),
     )
 
 
-def simulate(program: Program, machine: Machine) -> StepTrace:
+def _measure(
+    program: Program,
+    trace: StepTrace,
+    against: Drawing | None,
+    tool_diameter: float,
+    findings: Sequence[FindingLike],
+) -> tuple[Deviation, AlongPath, tuple[ContourMeasure, ...], Against | None]:
+    """Every measure of one trace: deviation, along the path, contours, the drawing."""
+    points, blocks = trace.carriage_mm, trace.block_of_row
+    dev = deviation(points, blocks, program)
+    along = along_path(points, trace.block_start, trace.start_mm, program)
+    contours = tuple(measure_contours(points, trace.block_start, trace.start_mm, program))
+    compared = None
+    if against is not None:
+        rapid = np.asarray([isinstance(m, Rapid) for m in program.moves], dtype=bool)
+        cutting = ~rapid[blocks] if len(blocks) else np.zeros(0, dtype=bool)
+        runs = np.cumsum(~cutting)[cutting]  # a new id after every rapid row
+        compared = against_drawing(
+            points[cutting],
+            against,
+            tool_diameter / 2.0,
+            runs=runs,
+            nominal=_nominal_lines(program) if findings else (),
+            findings=findings,
+        )
+    return dev, along, contours, compared
+
+
+def _budget(v: Verification) -> eb.ErrorBudget:
+    """The error budget of ``v`` (see :attr:`Verification.error_budget`)."""
+    total = eb.figures(v.deviation, v.along, v.contours, v.against)
+    notes = []
+    if len(v.contours) > eb.MAX_CONTOURS:
+        notes.append(
+            f"only the first {eb.MAX_CONTOURS} of {len(v.contours)} contours are in the budget"
+        )
+    if not v.budget:
+        return eb.ErrorBudget(total, skipped="switched off (--no-budget)")
+    if len(v.trace.rows) > eb.MAX_ROWS:
+        return eb.ErrorBudget(
+            total,
+            skipped=f"the trace has {len(v.trace.rows)} rows (over {eb.MAX_ROWS}): re-simulating "
+            "it once per source would take too long; verify a part of the program to see it",
+        )
+    statuses = source_statuses(v.program, v.machine, planned=v.planned)
+
+    def measure_without(name: str) -> eb.Figures:
+        program = v.program
+        if name == "rounding":
+            assert v.planned is not None
+            try:
+                program, trace = v.planned, simulate(v.planned, v.machine)
+            except CamtoolError as exc:  # the plan is not what this machine reads: say so
+                notes.append(f"rounding not compared: the unrounded plan does not simulate ({exc})")
+                return {}
+        else:
+            trace = simulate(program, v.machine, sources=ALL.without(name))
+        dev, along, contours, against = _measure(
+            program, trace, v.drawing, v.tool_diameter, v.findings
+        )
+        values = eb.figures(dev, along, contours, against)
+        if name == "rounding" and [c.blocks for c in contours] != [
+            c.blocks for c in v.contours
+        ]:  # the plan's moves are not the code's: only the whole-program figures compare
+            values = {k: x for k, x in values.items() if not k.startswith("contour ")}
+        return values
+
+    return eb.compute(total, statuses, measure_without, notes=notes)
+
+
+def source_statuses(
+    program: Program, machine: Machine, *, planned: Program | None = None
+) -> list[eb.SourceStatus]:
+    """Which error sources ``machine`` models for ``program`` (the budget's columns).
+
+    The step simulator models interpolation always, chords when the profile cuts
+    arcs into chords and the program has arcs, the scale when the true steps/mm
+    differ from the nominal ones, backlash when the profile has some (true or
+    compensated); ``dynamics`` when the machine's line piece models it. A target's
+    whole simulator models what it honours (``MotionHooks.honours``). Rounding
+    is known only with the unrounded plan.
+    """
+    lib = library()
+    line = machine.motion.line
+    whole = lib.simulator(line) is not None
+    honoured = set(lib.honours(line))
+    arcs = any(isinstance(m, ArcMove) for m in program.moves)
+    true = machine.real_steps_per_mm[:2]
+    lash = machine.backlash
+    present = {
+        "interpolation": (True, ""),
+        "chords": (
+            arcs and machine.motion.arc == "chords",
+            "no arcs in the program" if not arcs else "the controller runs arcs natively",
+        ),
+        "scale": (true != machine.steps_per_mm[:2], "the profile has no true steps/mm"),
+        "backlash": (
+            any(lash.true_um[:2]) or any(lash.compensation_um[:2]) or bool(lash.regions),
+            "the profile has no backlash",
+        ),
+        "dynamics": (
+            "dynamics" in honoured,
+            f"the {line!r} motion models no timer overshoot or servo lag",
+        ),
+    }
+    out = []
+    for name, (there, why) in present.items():
+        if whole and name not in honoured:
+            out.append(eb.SourceStatus(name, "absent", f"not modelled by the {line!r} simulator"))
+        elif there:
+            out.append(eb.SourceStatus(name, "modelled"))
+        else:
+            out.append(eb.SourceStatus(name, "absent", why))
+    if planned is None:
+        out.append(eb.SourceStatus("rounding", "unknown", "not known from the code alone"))
+    else:
+        out.append(eb.SourceStatus("rounding", "modelled"))
+    return out
+
+
+def simulate(program: Program, machine: Machine, *, sources: Sources = ALL) -> StepTrace:
     """Simulate ``program`` on ``machine``: the simulator its ``line`` name selects.
 
     A ``line`` name that a target's ``MOTION.simulators`` holds runs that simulator
@@ -261,14 +430,31 @@ def simulate(program: Program, machine: Machine) -> StepTrace:
     simulator (:func:`camtool.verify.simulate.simulate_steps`) with the named
     interpolators.
 
+    Args:
+        program: moves in mm.
+        machine: the machine profile.
+        sources: the error sources modelled (:mod:`camtool.verify.sources`); a
+            target's simulator gets them when it honours some
+            (``MotionHooks.honours``), else only the full model can run on it.
+
     Raises:
         InputError: an unknown interpolator or chord rule name.
-        UsageError: the profile lacks a parameter its line model needs.
+        UsageError: the profile lacks a parameter its line model needs, or
+            ``sources`` switch off a source the machine's simulator does not model.
     """
-    run = library().simulator(machine.motion.line)
+    lib = library()
+    run = lib.simulator(machine.motion.line)
     if run is not None:
-        return run(program, machine)
-    return simulate_steps(program, machine)
+        if sources == ALL:
+            return run(program, machine)
+        honoured = lib.honours(machine.motion.line)
+        if not set(sources.off) <= set(honoured):
+            raise UsageError(
+                f"the {machine.motion.line!r} simulator cannot switch off "
+                f"{', '.join(sorted(set(sources.off) - set(honoured)))}"
+            )
+        return run(program, machine, sources=sources)  # type: ignore[call-arg]
+    return simulate_steps(program, machine, sources=sources)
 
 
 def _nominal_lines(program: Program) -> list[np.ndarray]:
@@ -390,6 +576,8 @@ def summary_lines(v: Verification) -> list[str]:
         f"({fmt_num(dev.at_mm[0])}, {fmt_num(dev.at_mm[1])}) mm, "
         f"rms {fmt_num(dev.rms_um, 2)} µm",
     ]
+    if v.along is not None:
+        lines.append(_along_text(v, v.along))
     for c in v.contours:
         ex, ey = c.size_error_um
         text = f"  contour {c.number}: size error {_signed(ex)} x {_signed(ey)} µm"
@@ -410,8 +598,34 @@ def summary_lines(v: Verification) -> list[str]:
         )
         if a.not_cut:
             lines.append("  " + not_cut_text(a))
-    lines.append(f"  estimated time {fmt_num(v.time_s, 1)} s")
+    lines.append(f"  estimated time {time_text(v.time_s)}")
+    lines.extend(f"  {line}" for line in eb.text_lines(v.error_budget))
     return lines
+
+
+def time_text(seconds: float) -> str:
+    """``"172.5 s"``; a short program keeps 3 significant digits (``"0.0735 s"``)."""
+    if seconds >= 0.1 or seconds <= 0:
+        return f"{fmt_num(seconds, 1)} s"
+    return f"{seconds:.3g} s"
+
+
+def _along_text(v: Verification, a: AlongPath) -> str:
+    """``"  along the path: shortfall 190.00 µm at (0, 0) mm (line 7); ..."``."""
+
+    def where(block: int, at: tuple[float, float]) -> str:
+        line = v.program.line_of(block)
+        return f"({fmt_num(at[0])}, {fmt_num(at[1])}) mm" + (
+            f" (line {line})" if line is not None else f" (move {block + 1})"
+        )
+
+    text = f"  along the path: shortfall max {fmt_num(a.shortfall_um, 2)} µm"
+    if a.shortfall_block >= 0:
+        text += f" at {where(a.shortfall_block, a.shortfall_at_mm)}"
+    text += f"; move-end error max {fmt_num(a.block_end_um, 2)} µm"
+    if a.block_end_block >= 0:
+        text += f" at {where(a.block_end_block, a.block_end_at_mm)}"
+    return text
 
 
 def not_cut_text(a: Against) -> str:
@@ -486,18 +700,20 @@ def build_report(v: Verification) -> dict[str, Any]:
         "reversals": {"x": t.reversals[0], "y": t.reversals[1]},
         "compensations": t.compensations,
         "deviation_um": {"max": _um(dev.max_um), "rms": _um(dev.rms_um), "at": at},
+        **_along_json(v),
         "closure_um": [
             _um(math.hypot(*c.closure_um)) for c in v.contours if c.closure_um is not None
         ],
         "size_error_um": [[_um(c.size_error_um[0]), _um(c.size_error_um[1])] for c in v.contours],
-        "contours": [_contour(c) for c in v.contours],
+        "contours": [_contour(c, _contour_end(v, i)) for i, c in enumerate(v.contours)],
         "against": None,
         "not_cut_as_drawn": [],
         "against_skipped": v.against_skipped,
         "max_error_um": _um(v.max_error_um),
         "strict_error_um": _um(v.strict_error_um),
-        "time_s": round(v.time_s, 3),
+        "time_s": seconds_6(v.time_s),
         "warnings": list(v.warnings),
+        "error_budget": eb.to_json(v.error_budget, _um),
     }
     if v.against is not None:
         a = v.against
@@ -522,7 +738,50 @@ def build_report(v: Verification) -> dict[str, Any]:
     return report
 
 
-def _contour(c: ContourMeasure) -> dict[str, Any]:
+def seconds_6(value: float) -> float:
+    """A time to 6 significant digits, never fewer than 3 decimals (7 steps are not 0.001 s)."""
+    if value <= 0 or not math.isfinite(value):
+        return round(float(value), 3) + 0.0
+    decimals = max(3, 5 - math.floor(math.log10(value)))
+    return round(float(value), decimals) + 0.0
+
+
+def _where(v: Verification, block: int, at_mm: tuple[float, float]) -> dict[str, Any] | None:
+    if block < 0:
+        return None
+    return {
+        "x_mm": _mm(at_mm[0]),
+        "y_mm": _mm(at_mm[1]),
+        "block": block + 1,
+        "line": v.program.line_of(block),
+    }
+
+
+def _along_json(v: Verification) -> dict[str, Any]:
+    """The ``shortfall_um`` and ``block_end_um`` keys (``None`` without along-path measures)."""
+    a = v.along
+    if a is None:
+        return {"shortfall_um": None, "block_end_um": None}
+    return {
+        "shortfall_um": {
+            "max": _um(a.shortfall_um),
+            "at": _where(v, a.shortfall_block, a.shortfall_at_mm),
+            "samples": a.samples,
+        },
+        "block_end_um": {
+            "max": _um(a.block_end_um),
+            "at": _where(v, a.block_end_block, a.block_end_at_mm),
+        },
+    }
+
+
+def _contour_end(v: Verification, index: int) -> float | None:
+    if v.along is None or index >= len(v.along.contour_end_um):
+        return None
+    return _um(v.along.contour_end_um[index])
+
+
+def _contour(c: ContourMeasure, end_error_um: float | None = None) -> dict[str, Any]:
     out: dict[str, Any] = {
         "number": c.number,
         "blocks": [c.blocks[0] + 1, c.blocks[1] + 1],
@@ -530,6 +789,7 @@ def _contour(c: ContourMeasure) -> dict[str, Any]:
         "closure_um": None,
         "size_um": [_um(c.size_um[0]), _um(c.size_um[1])],
         "size_error_um": [_um(c.size_error_um[0]), _um(c.size_error_um[1])],
+        "end_error_um": end_error_um,
         "circle": None,
     }
     if c.closure_um is not None:

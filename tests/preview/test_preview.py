@@ -17,6 +17,7 @@ from camtool.model.program import ArcMove, Linear, Program, Rapid
 from camtool.model.shapes import Contour, Drawing, Line
 from camtool.post.registry import load_target
 from camtool.preview import CUT_COLOUR, RAPID_COLOUR, program_svg, render_preview
+from camtool.preview.layout import zoom_text
 from camtool.verify.verifier import Verification, verify_program
 
 NS = "{http://www.w3.org/2000/svg}"
@@ -230,3 +231,34 @@ def test_png_is_stable_and_matches_the_golden(update_golden: bool) -> None:
     # Text is rasterised by FreeType: allow small pixel shifts between machines. For scale:
     # leaving out the second contour (a 2 mm circle) makes this 0.0058, a 1.3 mm one 0.0075.
     assert float(np.abs(now[..., :3] - golden[..., :3]).mean()) < 0.002
+
+
+def _texts(svg: str | bytes, group: str) -> list[str]:
+    return ["".join(t.itertext()) for t in _groups(svg)[group].iter(f"{NS}text")]
+
+
+def test_a_part_under_1_mm_is_labelled_in_um() -> None:
+    """A 7-step line on the GMM (7 × 140 nm = 0.98 µm): no "0 × 0.001 mm", no "zoom × 0"."""
+    target = load_target("pic-mmh")
+    step = 1.0 / target.machine.steps_per_mm[0]
+    program = Program((Rapid(1.0, 1.0, contour=1), Linear(1.0 + 7 * step, 1.0, 0.8, contour=1)))
+    v = verify_program(program, target.machine, name="pic-mmh")
+    svg = render_preview(".svg", verification=v)
+    title = " ".join(_texts(svg, "title"))
+    assert "0.98 × 0 µm" in title and "0.001 mm" not in title
+    assert "X 1000…1000.98 Y 1000…1000 µm" in title
+    assert " µm" in " ".join(_texts(svg, "scale-bar"))
+    # an inset window wider than the main view (an error larger than the part) zooms out
+    assert (zoom_text(0.06), zoom_text(0.5), zoom_text(9.6), zoom_text(48.2)) == (
+        "0.06",
+        "0.5",
+        "9.6",
+        "48",
+    )
+
+
+def test_legend_names_the_dominant_error_source() -> None:
+    svg = render_preview(".svg", verification=_injected())
+    legend = " ".join(_texts(svg, "legend"))
+    assert "error budget:" in legend and "dominant backlash residual" in legend
+    assert "sources do not add" in legend
