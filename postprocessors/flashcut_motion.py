@@ -252,13 +252,7 @@ def timer_line(dx: int, dy: int, half_period_ms: float, *, timer_ms: int = 1) ->
         t_other = timer_period_ms(half_period_ms * n_dom / n_other, timer_ms)
         count = int(dom_times[-1] // t_other)
         other_times = np.arange(1, count + 1, dtype=np.int64) * t_other
-    events = np.union1d(dom_times, other_times)
-    rows = np.zeros((events.size, 2), dtype=STEP_DTYPE)
-    dom_axis = 0 if ax >= ay else 1
-    sign = (1 if dx >= 0 else -1, 1 if dy >= 0 else -1)
-    rows[np.searchsorted(events, dom_times), dom_axis] = sign[dom_axis]
-    rows[np.searchsorted(events, other_times), 1 - dom_axis] = sign[1 - dom_axis]
-    return freeze(rows)
+    return _merged_rows(dx, dy, dom_times, other_times)
 
 
 def exact_timer_line(dx: int, dy: int) -> StepArray:
@@ -284,13 +278,7 @@ def exact_timer_line(dx: int, dy: int) -> StepArray:
     unit = max(n_other, 1)
     dom_times = np.arange(1, n_dom + 1, dtype=np.int64) * unit
     other_times = np.arange(1, n_other + 1, dtype=np.int64) * n_dom
-    events = np.union1d(dom_times, other_times)
-    rows = np.zeros((events.size, 2), dtype=STEP_DTYPE)
-    dom_axis = 0 if ax >= ay else 1
-    sign = (1 if dx >= 0 else -1, 1 if dy >= 0 else -1)
-    rows[np.searchsorted(events, dom_times), dom_axis] = sign[dom_axis]
-    rows[np.searchsorted(events, other_times), 1 - dom_axis] = sign[1 - dom_axis]
-    return freeze(rows)
+    return _merged_rows(dx, dy, dom_times, other_times)
 
 
 # ------------------------------------------------------------------------ chords
@@ -375,3 +363,18 @@ MOTION = MotionHooks(
 )
 """What ``flashcut`` adds to the verifier: timer stepping (its overshoot is the ``dynamics``
 error source), its chords, its timing model."""
+
+
+def _merged_rows(dx: int, dy: int, dom_times: np.ndarray, other_times: np.ndarray) -> StepArray:
+    """The step rows of two axes firing at the given times (both in one row where they coincide).
+
+    The dominant axis steps at ``dom_times``, the other at ``other_times``; signs from
+    ``(dx, dy)``.
+    """
+    events = np.union1d(dom_times, other_times)
+    rows = np.zeros((events.size, 2), dtype=STEP_DTYPE)
+    dom_axis = 0 if abs(int(dx)) >= abs(int(dy)) else 1
+    sign = (1 if dx >= 0 else -1, 1 if dy >= 0 else -1)
+    rows[np.searchsorted(events, dom_times), dom_axis] = sign[dom_axis]
+    rows[np.searchsorted(events, other_times), 1 - dom_axis] = sign[1 - dom_axis]
+    return freeze(rows)

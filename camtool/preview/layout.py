@@ -200,10 +200,13 @@ def _title_lines(c: Content) -> list[str]:
         if v.deviation.block >= 0:
             text += f" ({tl.worst_label(v).split(', ', 1)[1]})"
         text += f", rms {fmt_num(v.deviation.rms_um, 2)} µm"
+        if v.along is not None:
+            text += f"; shortfall along the path {fmt_num(v.along.shortfall_um, 2)} µm"
         lines.append(text)
         against = _against_line(v)
         if against:
             lines.append(against)
+        lines.append(budget_text(v))
     return lines
 
 
@@ -329,13 +332,11 @@ def _entries(c: Content, u: float) -> list[tuple[Glyph, str]]:
     v = c.verification
     if v is not None and v.against is not None and v.against.not_cut:
         out.append((marker, "not cut as drawn with this tool"))
-    if v is not None:
-        out.append((lambda x, y: (), budget_text(v)))
     return out
 
 
 def budget_text(v: Verification) -> str:
-    """The legend's error-budget entry: the dominant source of the largest figure, or why none."""
+    """The title's error-budget line: the dominant source of the largest figure, or why none."""
     budget = v.error_budget
     if budget.skipped is not None:
         return f"error budget skipped: {budget.skipped.split(':')[0]}"
@@ -344,7 +345,7 @@ def budget_text(v: Verification) -> str:
         return "error budget: this machine models no error source that can be switched off"
     if verdict is None:
         return "error budget: no source changes any figure"
-    return f"error budget: {verdict} (one source off at a time; sources do not add)"
+    return f"error budget: {verdict}, one source off at a time"
 
 
 def _column(v: Verification, frame: BBox, u: float) -> tuple[Panel, list[Layer]]:

@@ -13,10 +13,10 @@ from typing import Any
 import pytest
 
 from camtool.link.plan import prepare_send
-from camtool.link.sender import Progress, StopAtPause, open_port, send_plan
-from camtool.link.spec import WireBlock
+from camtool.link.sender import StopAtPause, open_port, send_plan
 from camtool.model.errors import LinkError
 from camtool.post.registry import load_target
+from tests.link.controls import PauseAt
 
 # 13 passes over a 10 x 10 mm square, one arc per pass: the tool ends at X10 Y0 Z5.
 PASSES = "".join(
@@ -92,26 +92,6 @@ def test_from_line_after_an_error_ends_where_an_uninterrupted_run_ends(simulate:
     assert restored[1] in ("F100\n", "F300\n")
     assert "M3 S1000\n" in restored
     assert "G4 P1.5\n" in restored
-
-
-class PauseAt:
-    """Asks for a pause once ``at`` blocks are done, then resumes (or stops)."""
-
-    def __init__(self, at: int, answer: str) -> None:
-        self.at, self.answer = at, answer
-        self.pause_requested = False
-        self.pauses: list[Progress] = []
-
-    def progress(self, p: Progress) -> None:
-        if p.done == self.at:
-            self.pause_requested = True
-
-    def paused(self, progress: Progress) -> str:
-        self.pauses.append(progress)
-        return self.answer
-
-    def between_blocks(self, prompt: str, done: WireBlock, following: WireBlock) -> bool:
-        return False
 
 
 def test_pause_waits_for_every_block_in_flight_then_resumes(simulate: Any) -> None:

@@ -16,11 +16,11 @@ import pytest
 
 from camtool.link.device import make_device
 from camtool.link.plan import prepare_send
-from camtool.link.sender import Progress, open_port, send_plan
-from camtool.link.spec import WireBlock
+from camtool.link.sender import open_port, send_plan
 from camtool.model.errors import LinkError
 from camtool.post.registry import load_target
 from camtool_postprocessors.i8751_packets import Record, encode_stream
+from tests.link.controls import PauseAt
 
 # 12 moves, 3 packets (5 + 5 + 2): X +100 steps each, Y alternating +50 / -30, one Z plunge
 # and lift; at the profile's 100 steps/mm the tool ends at X 12, Y 6*0.5 - 6*0.3 = 1.2, Z 0.
@@ -97,26 +97,6 @@ def test_a_dump_is_sent_as_the_bytes_it_lists(simulate: Any, tmp_path: Path) -> 
     sim = simulate("i8751")
     run(sim.path, dump.read_bytes())
     assert bytes(sim.device.received) == binary.read_bytes()
-
-
-class PauseAt:
-    """Asks for a pause once ``at`` blocks are done, then resumes (or stops)."""
-
-    def __init__(self, at: int, answer: str) -> None:
-        self.at, self.answer = at, answer
-        self.pause_requested = False
-        self.pauses: list[Progress] = []
-
-    def progress(self, p: Progress) -> None:
-        if p.done == self.at:
-            self.pause_requested = True
-
-    def paused(self, progress: Progress) -> str:
-        self.pauses.append(progress)
-        return self.answer
-
-    def between_blocks(self, prompt: str, done: WireBlock, following: WireBlock) -> bool:
-        return False
 
 
 def test_pause_comes_between_packets_then_resumes(simulate: Any) -> None:

@@ -17,10 +17,10 @@ from typing import Any
 import pytest
 
 from camtool.link.plan import prepare_send
-from camtool.link.sender import Progress, open_port, send_plan
-from camtool.link.spec import WireBlock
+from camtool.link.sender import open_port, send_plan
 from camtool.model.errors import DialectError, LinkError
 from camtool.post.registry import load_target
+from tests.link.controls import PauseAt
 
 THESIS_G02 = "G02X02969.00Y03400.00I03012.00J03040.00F08;"  # seed-000 L1731, 43 characters
 PROGRAM = (
@@ -152,26 +152,6 @@ def test_more_steps_than_camtool_predicts_stop_the_job(simulate: Any) -> None:
         port.close()
     assert len(sim.device.blocks) == 3 + 1  # nothing after block 3 but the stop "A;"
     assert sim.device.blocks[-1] == b"A;"
-
-
-class PauseAt:
-    """Asks for a pause once ``at`` blocks are done, then resumes (or stops)."""
-
-    def __init__(self, at: int, answer: str) -> None:
-        self.at, self.answer = at, answer
-        self.pause_requested = False
-        self.pauses: list[Progress] = []
-
-    def progress(self, p: Progress) -> None:
-        if p.done == self.at:
-            self.pause_requested = True
-
-    def paused(self, progress: Progress) -> str:
-        self.pauses.append(progress)
-        return self.answer
-
-    def between_blocks(self, prompt: str, done: WireBlock, following: WireBlock) -> bool:
-        return False
 
 
 def test_pause_waits_for_the_motion_then_resumes(simulate: Any) -> None:

@@ -257,8 +257,11 @@ def test_a_part_under_1_mm_is_labelled_in_um() -> None:
     )
 
 
-def test_legend_names_the_dominant_error_source() -> None:
+def test_title_names_the_dominant_error_source() -> None:
     svg = render_preview(".svg", verification=_injected())
-    legend = " ".join(_texts(svg, "legend"))
-    assert "error budget:" in legend and "dominant backlash residual" in legend
-    assert "sources do not add" in legend
+    title = _texts(svg, "title")
+    budget = [line for line in title if line.startswith("error budget:")]
+    assert len(budget) == 1 and "dominant backlash residual" in budget[0]
+    assert "one source off at a time" in budget[0]
+    assert "shortfall along the path" in " ".join(title)
+    assert "error budget" not in " ".join(_texts(svg, "legend"))
