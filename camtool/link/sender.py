@@ -286,6 +286,22 @@ class Stream:
         return next((b.line for b in rest if b.index), None)
 
 
+def _port_errors() -> tuple[type[BaseException], ...]:
+    """What a failing port raises: pyserial's errors, OS errors and, on POSIX, ``termios.error``.
+
+    ``termios.error`` is not an ``OSError``: pyserial's ``flush()`` (``tcdrain``) raises it
+    when the other end of a pseudo-terminal or a USB adapter vanishes mid-write.
+    """
+    import serial
+
+    errors: tuple[type[BaseException], ...] = (serial.SerialException, OSError)
+    try:
+        import termios
+    except ImportError:  # not POSIX
+        return errors
+    return (*errors, termios.error)
+
+
 def open_port(port: str, baud: int) -> Any:
     """A pyserial port for a device path or URL, 8N1, no flow control, non-blocking reads.
 
@@ -322,12 +338,10 @@ class _Wire:
         self.split = split or split_lines
 
     def write(self, data: bytes, where: str) -> None:
-        import serial
-
         try:
             self.port.write(data)
             self.port.flush()
-        except (serial.SerialException, OSError) as exc:
+        except _port_errors() as exc:
             raise _PortGone(f"port {self.name!r} disappeared {where}: {exc}") from exc
         if self.log:
             self.log.record(">", data)
@@ -365,12 +379,10 @@ class _Wire:
 
     def lines(self, timeout: float, where: str) -> list[str]:
         """Whole answers received within ``timeout`` s (lines, line ends stripped, by default)."""
-        import serial
-
         try:
             self.port.timeout = timeout
             data = self.port.read(max(1, self.port.in_waiting))
-        except (serial.SerialException, OSError) as exc:
+        except _port_errors() as exc:
             raise _PortGone(f"port {self.name!r} disappeared {where}: {exc}") from exc
         if data:
             self.last_rx = time.monotonic()
