@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -302,6 +302,88 @@ class AlongPath:
     samples: int
 
 
+NEAREST_TOLERANCE_MM = 1e-5
+"""Largest error :func:`nearest_distances` accepts from its vertex bound, mm (0.01 µm)."""
+NEAREST_ENDS = 4
+"""Segment ends :func:`nearest_distances` looks at around each sample."""
+NEAREST_CHUNK = 20_000
+"""Samples :func:`nearest_distances` measures at once (memory ~ 1 kB each)."""
+
+
+def _to_segments(p: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
+    """``(N, K)`` distances of points ``p`` ``(N, 2)`` to segments ``a → b`` ``(N, K, 2)``."""
+    ab = b - a
+    ap = p[:, None, :] - a
+    length2 = np.einsum("nkj,nkj->nk", ab, ab)
+    t = np.divide(
+        np.einsum("nkj,nkj->nk", ap, ab), length2, out=np.zeros_like(length2), where=length2 > 0
+    )
+    t = np.clip(t, 0.0, 1.0)
+    off = ap - t[..., None] * ab
+    return np.sqrt(np.einsum("nkj,nkj->nk", off, off))
+
+
+def nearest_distances(samples: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
+    """Distance of each sample to the nearest segment ``a[i] → b[i]``, mm.
+
+    Exact to :data:`NEAREST_TOLERANCE_MM`. The segments owning the
+    :data:`NEAREST_ENDS` nearest segment ends (a scipy k-d tree) give a distance
+    ``d``; it is the true one when the k-th end lies farther than ``d + L/2``
+    (``L`` the longest segment: a nearer segment has an end within that), or
+    when the nearest end ``r`` bounds it tightly, ``sqrt(r² − L²/4) ≤ d``
+    (a segment whose ends are both ``r`` or more away comes no nearer than
+    that). Samples neither test settles get shapely's exact nearest query.
+
+    Args:
+        samples: ``(N, 2)`` query points, mm.
+        a: ``(M, 2)`` segment starts, mm.
+        b: ``(M, 2)`` segment ends, mm (``a[i] == b[i]``: a point).
+
+    Returns:
+        ``(N,)`` float64 distances, mm (``inf`` without segments).
+    """
+    import shapely
+    from scipy.spatial import cKDTree
+
+    if len(a) == 0:
+        return np.full(len(samples), np.inf)
+    half = float(np.max(np.hypot(*(b - a).T))) / 2.0
+    ends = cKDTree(np.concatenate([a, b]))
+    parts = [
+        _nearest_chunk(samples[i : i + NEAREST_CHUNK], a, b, ends, half)
+        for i in range(0, len(samples), NEAREST_CHUNK)
+    ]
+    d = np.concatenate([p[0] for p in parts]) if parts else np.zeros(0)
+    unsure = np.concatenate([p[1] for p in parts]) if parts else np.zeros(0, dtype=bool)
+    if unsure.any():
+        tree = shapely.STRtree(shapely.linestrings(np.stack([a, b], axis=1)))
+        _, exact = tree.query_nearest(
+            shapely.points(samples[unsure]), return_distance=True, all_matches=False
+        )
+        d[unsure] = np.asarray(exact, dtype=np.float64)
+    return d
+
+
+def _nearest_chunk(
+    samples: FloatArray, a: FloatArray, b: FloatArray, ends: Any, half: float
+) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
+    """:func:`nearest_distances` of a few samples from the k-d tree of segment ``ends``.
+
+    Returns:
+        The distances and which of them the tests could not settle.
+    """
+    k = min(NEAREST_ENDS, 2 * len(a))
+    r, index = ends.query(samples, k=k)
+    r = np.asarray(r, dtype=np.float64).reshape(len(samples), k)
+    seg = np.asarray(index).reshape(len(samples), k) % len(a)
+    d = _to_segments(samples, a[seg], b[seg]).min(axis=1)
+    lower = np.sqrt(np.maximum(r[:, 0] ** 2 - half * half, 0.0))
+    # exact where every segment that could be nearer had an end among the k found
+    # (its nearer end lies within d + L/2), or where the vertex bound is tight enough
+    sure = (d + half < r[:, -1]) | (k == 2 * len(a)) | (d - lower <= NEAREST_TOLERANCE_MM)
+    return d, ~sure
+
+
 ALONG_SPACING_MM = 0.001
 """Largest spacing of the programmed path's samples for :func:`along_path`, mm."""
 ALONG_MAX_SAMPLES = 400_000
@@ -330,8 +412,6 @@ def along_path(
     before the contour included), thinned to points about
     :data:`ALONG_RESOLUTION_MM` apart (never more than :data:`ALONG_MAX_TRACE`).
     """
-    import shapely
-
     starts = [program.origin] + [(m.x, m.y) for m in program.moves]
     runs = contour_runs(program)
     total = sum(
@@ -360,12 +440,9 @@ def along_path(
         move_ends = block_start[first + 1 : last + 2] - lo  # each move's last row, in ``run``
         trace = _thinned(run, move_ends)
         if len(trace) == 1:
-            geoms = shapely.points(trace)
+            d = nearest_distances(samples, trace, trace)
         else:
-            geoms = shapely.linestrings(np.stack([trace[:-1], trace[1:]], axis=1))
-        tree = shapely.STRtree(geoms)
-        _, d = tree.query_nearest(shapely.points(samples), return_distance=True, all_matches=False)
-        d = np.asarray(d, dtype=np.float64)
+            d = nearest_distances(samples, trace[:-1], trace[1:])
         k = int(np.argmax(d))
         if d[k] * 1000.0 > worst[0]:
             worst = (float(d[k]) * 1000.0, (float(samples[k, 0]), float(samples[k, 1])), owner[k])
@@ -552,8 +629,6 @@ def against_drawing(
         findings: the plan's findings; those of :data:`NOT_CUT_KINDS` with a
             location name the features measured apart.
     """
-    import shapely
-
     samples, sizes = _sample_drawing(drawing, spacing_mm)
     if len(points) < 2 or len(samples) == 0:
         return Against(0.0, 0.0, (0.0, 0.0), 0.0, 0)
@@ -567,11 +642,7 @@ def against_drawing(
     )
     if not joined.any():
         joined[:] = True  # single points only: their nearest distances still count
-    trace_lines = shapely.linestrings(np.stack([trace[:-1], trace[1:]], axis=1)[joined])
-    tree = shapely.STRtree(trace_lines)
-    q = shapely.points(samples)
-    _, d_q = tree.query_nearest(q, return_distance=True, all_matches=False)
-    off = np.asarray(d_q, dtype=np.float64) - tool_radius_mm
+    off = nearest_distances(samples, trace[:-1][joined], trace[1:][joined]) - tool_radius_mm
     features: list[NotCut] = []
     main = np.ones(len(samples), dtype=bool)
     if nominal and any(f.kind in NOT_CUT_KINDS and f.at is not None for f in findings):
@@ -593,11 +664,8 @@ def against_drawing(
     worst = int(np.argmax(np.abs(kept)))
     overcut = 0.0
     if tool_radius_mm > 0:
-        chords = shapely.linestrings(np.stack([samples[:-1], samples[1:]], axis=1))
-        drawing_tree = shapely.STRtree(chords[_same_contour(sizes)])
-        _, d_p = drawing_tree.query_nearest(
-            shapely.points(trace), return_distance=True, all_matches=False
-        )
+        same = _same_contour(sizes)
+        d_p = nearest_distances(trace, samples[:-1][same], samples[1:][same])
         overcut = max(0.0, float(tool_radius_mm - np.min(d_p))) * 1000.0
     return Against(
         max_um=float(abs(kept[worst])) * 1000.0,
