@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import contextlib
 import importlib.util
+import logging
 from collections.abc import Callable, Iterator
 from typing import TYPE_CHECKING, Any
 
@@ -119,6 +120,10 @@ def connect(scheduler: str) -> Iterator[Client]:
                 threads_per_worker=1,
                 processes=True,
                 dashboard_address=dashboard,
+                # a local cluster's own shutdown chatter (closed comms, heartbeats to a
+                # scheduler already gone) is not the user's business; camtool reports
+                # every task that failed itself
+                silence_logs=logging.CRITICAL,
             ) as cluster,
             distributed.Client(cluster) as client,
         ):
