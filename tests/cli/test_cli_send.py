@@ -39,6 +39,18 @@ def test_dry_run_prints_the_plan_on_stdout(job: Path, capsys: Any) -> None:
     assert err == ""
 
 
+def test_what_the_reader_could_not_honour_is_said_before_sending(
+    tmp_path: Path, capsys: Any
+) -> None:
+    # a CamBam-style header (LinuxCNC's craftsmancnc.ngc): G64 blending means nothing to the
+    # verifier's model of GRBL, and the machinist must hear it before the job starts
+    path = tmp_path / "cambam.ngc"
+    path.write_text("G21 G90 G64 P0.25 G40\nG0 Z5\nG0 X1 Y1\nG1 Z-0.5 F100\nG1 X2\nG0 Z5\nM2\n")
+    code, _, err = run(["send", str(path), "-t", "grbl", "--dry-run"], capsys)
+    assert code == 0
+    assert ":1: G64 path blending" in err
+
+
 def test_dry_run_from_line_shows_the_restore(job: Path, capsys: Any) -> None:
     code, out, _ = run(["send", str(job), "-t", "grbl", "--dry-run", "--from-line", "8"], capsys)
     assert code == 0
