@@ -33,6 +33,7 @@ from camtool.model.errors import UsageError
 from camtool.model.machine import AXES, Machine
 from camtool.model.program import ArcMove, Linear, Move, Program, Rapid
 from camtool.model.shapes import BBox, Point
+from camtool.toolpath.options import DEFAULT_CLEARANCE_Z
 
 if TYPE_CHECKING:
     from camtool.post.base import Target
@@ -396,8 +397,13 @@ def coupon_from_features(
 ) -> Coupon:
     """A coupon of ``features`` (in cutting order) for ``target``: its program joins them.
 
-    Between features: a rapid to the next origin (on a machine with Z, up to
-    :data:`SAFE_Z_MM` first and down to Z 0 there).
+    On a machine with Z it starts and ends as every planned program does
+    (:mod:`camtool.toolpath.passes`): a Z-only rise to the default clearance
+    (:data:`~camtool.toolpath.options.DEFAULT_CLEARANCE_Z`) where the tool stands,
+    XY at clearance, down to :data:`SAFE_Z_MM`; between features up to
+    :data:`SAFE_Z_MM`, XY, and down to Z 0; at the end up to clearance. The
+    target's spindle (``spindle_rpm``, when it has one) runs from the first move to
+    the last.
 
     Raises:
         UsageError: two features share an id.
@@ -409,11 +415,13 @@ def coupon_from_features(
     feed = target.default_feed_mm_min
     moves: list[Move] = []
     here = features[0].origin_mm if features else (0.0, 0.0)
-    for feature in features:
+    for n, feature in enumerate(features):
         ox, oy = feature.origin_mm
         if has_z:
-            moves.append(Rapid(*here, z=SAFE_Z_MM))
+            moves.append(Rapid(*here, z=DEFAULT_CLEARANCE_Z if n == 0 else SAFE_Z_MM))
             moves.append(Rapid(ox, oy))
+            if n == 0:
+                moves.append(Rapid(ox, oy, z=SAFE_Z_MM))
             first = feature.lead[0] if feature.lead else None
             if not (isinstance(first, Linear) and first.z == 0.0):
                 moves.append(Linear(ox, oy, feed, z=0.0))
@@ -422,14 +430,23 @@ def coupon_from_features(
         moves.extend(feature.moves)
         last = feature.moves[-1]
         here = (last.x, last.y)
-    if has_z:
-        moves.append(Rapid(*here, z=SAFE_Z_MM))
+    top = next((m.z for m in reversed(moves) if m.z is not None), None)
+    if has_z and (top is None or top < DEFAULT_CLEARANCE_Z):  # a rise, never a descent
+        moves.append(Rapid(*here, z=DEFAULT_CLEARANCE_Z))
     origin = features[0].origin_mm if features else (0.0, 0.0)
     notes = (
         f"calibration coupon for {target.name}: {len(features)} features "
         f"({', '.join(ids)}); measure them as the sheet says",
     )
+    if has_z:
+        notes = (
+            *notes,
+            f"cuts at Z 0 (set work zero Z where the tool should mark the stock); rapids at "
+            f"Z {SAFE_Z_MM:g}, clearance Z {DEFAULT_CLEARANCE_Z:g} mm",
+        )
     program = Program(tuple(moves), origin=origin, notes=notes)
+    if target.spindle_rpm:
+        program = program.with_spindle(target.spindle_rpm)
     return Coupon(target.name, scale, tuple(features), program)
 
 

@@ -12,6 +12,7 @@ from camtool.calibrate.coupon import build_coupon, u_pattern
 from camtool.calibrate.predict import predict, read_back
 from camtool.model.errors import UsageError
 from camtool.model.machine import machine_from_table, merge_tables
+from camtool.model.program import Rapid
 from camtool.post.registry import load_target
 from tests.targets import TARGETS
 
@@ -100,3 +101,29 @@ def test_a_travel_too_small_is_refused_with_the_size_needed() -> None:
 
     with pytest.raises(UsageError, match=r"too small for a calibration coupon.*--machine"):
         build_coupon(replace(target, machine=small))
+
+
+@pytest.mark.parametrize("name", ["grbl", "linuxcnc", "valcnc", "i8751", "flashcut"])
+def test_a_z_coupon_starts_and_ends_like_every_planned_program(name: str) -> None:
+    """toolpath/passes.py's convention: a Z-only rise to clearance (5 mm) where the tool
+    stands, XY at clearance, down to safe Z; nothing ever descends by a rapid below the
+    rapids' height; the last move leaves the tool at or above clearance."""
+    target = load_target(name)
+    program = build_coupon(target).program
+    first, second, third = program.moves[:3]
+    assert (first.x, first.y, first.z) == (*program.origin, 5.0)
+    assert second.z is None and third.z == 2.0
+    heights = [m.z for m in program.moves if m.z is not None]
+    assert heights[-1] >= 5.0
+    rapids_down = [m.z for m in program.moves if isinstance(m, Rapid) and m.z is not None]
+    assert min(rapids_down) == 2.0
+
+
+@pytest.mark.parametrize(("name", "rpm"), [("grbl", 1000.0), ("linuxcnc", 12000.0)])
+def test_the_spindle_runs_for_the_whole_coupon(name: str, rpm: float) -> None:
+    from camtool.model.program import Spindle
+
+    program = build_coupon(load_target(name)).program
+    spindle = [(i, c) for i, c in program.commands if isinstance(c, Spindle)]
+    assert spindle[0][0] == 0 and spindle[0][1].rpm == rpm and spindle[0][1].direction == "cw"
+    assert spindle[-1] == (len(program.moves), Spindle("off"))
