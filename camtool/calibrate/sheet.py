@@ -206,6 +206,7 @@ def _number(
     ):
         want = "> 0" if positive else ">= 0"
         raise InputError(
-            f"{source}: line {line}, column '{column}': {text!r} must be a finite number {want}"
+            f"{source}: line {line}, column '{column}': {text!r} must be a finite number {want} "
+            f"and under {LARGEST_VALUE:g}"
         )
     return value
