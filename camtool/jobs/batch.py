@@ -512,7 +512,8 @@ def run_batch(
         if client is None and options.scheduler is not None:
             from camtool.jobs.batch_dask import connect
 
-            client = stack.enter_context(connect(options.scheduler))  # before -o is touched
+            # before -o is touched; local:N starts no more workers than files, as --jobs
+            client = stack.enter_context(connect(options.scheduler, most_workers=len(tasks)))
         with lock_directory(options.output_dir):
             if not options.force:
                 _refuse_existing(tasks, options)

@@ -96,10 +96,11 @@ def _distributed() -> Any:
 
 
 @contextlib.contextmanager
-def connect(scheduler: str) -> Iterator[Client]:
+def connect(scheduler: str, *, most_workers: int | None = None) -> Iterator[Client]:
     """A client of the cluster ``scheduler`` names, closed (with a local cluster) at the end.
 
-    ``local:N`` starts a ``LocalCluster`` of N worker processes with one thread each
+    ``local:N`` starts a ``LocalCluster`` of N worker processes (no more than
+    ``most_workers``, e.g. the batch's file count, as ``--jobs`` does) with one thread each
     (its dashboard at http://localhost:8787/status when Bokeh is installed — Dask
     takes another port, and says so, when 8787 is taken —; without Bokeh its web
     server takes a free port, so that two batches never clash on 8787). An address
@@ -116,7 +117,7 @@ def connect(scheduler: str) -> Iterator[Client]:
         dashboard = ":8787" if importlib.util.find_spec("bokeh") is not None else ":0"
         with (
             distributed.LocalCluster(
-                n_workers=int(scheduler.removeprefix(LOCAL)),
+                n_workers=min(int(scheduler.removeprefix(LOCAL)), max(1, most_workers or 1 << 30)),
                 threads_per_worker=1,
                 processes=True,
                 dashboard_address=dashboard,

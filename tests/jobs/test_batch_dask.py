@@ -419,3 +419,11 @@ def test_without_dask_the_pool_works_and_scheduler_says_how_to_install(
     with pytest.raises(UsageError, match=r"pip install 'camtool\[cluster\]'"):
         run(["drawings"], targets="pic-mmh", output_dir="lib", scheduler="local:2")
     assert not Path("lib").exists()
+
+
+def test_local_n_starts_no_more_workers_than_files() -> None:
+    # a hostile local:1000 for one drawing must not start 1000 processes (--jobs caps the same way)
+    from camtool.jobs.batch_dask import connect
+
+    with connect("local:3", most_workers=1) as client:
+        assert len(client.scheduler_info()["workers"]) == 1
