@@ -434,7 +434,7 @@ def coupon_from_features(
     if has_z and (top is None or top < DEFAULT_CLEARANCE_Z):  # a rise, never a descent
         moves.append(Rapid(*here, z=DEFAULT_CLEARANCE_Z))
     origin = features[0].origin_mm if features else (0.0, 0.0)
-    notes = (
+    notes: tuple[str, ...] = (
         f"calibration coupon for {target.name}: {len(features)} features "
         f"({', '.join(ids)}); measure them as the sheet says",
     )
