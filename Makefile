@@ -37,8 +37,10 @@ unit: $(STAMP)
 
 test: lint typecheck unit
 
+# Every benchmark in tests/benchmarks/, one after the other, then one table of ratios
+# against the named peers (run it on an otherwise quiet machine).
 bench: $(STAMP)
-	for b in tests/benchmarks/bench_*.py; do $(BIN)/python $$b || exit 1; done
+	$(BIN)/python tests/benchmarks/run_all.py
 
 clean:
 	rm -rf $(VENV) out .pytest_cache .mypy_cache .ruff_cache
