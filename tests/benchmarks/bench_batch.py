@@ -1,0 +1,123 @@
+"""Benchmark of ``camtool batch`` on 1 000 real DXF files, 1 core against 2 (not collected).
+
+Run as ``python tests/benchmarks/bench_batch.py [N]`` (default 1 000). The batch is the
+first N DXF files (sorted by path) of LibreCAD's parts library in the real-drawing corpus
+(``make corpus`` fetches it into ``.corpus/``), linked into
+``$TMPDIR/camtool-bench-batch-cli/in/`` with their folders. It is posted for grbl as a user
+runs it, ``camtool batch in -t grbl -o OUT --force --jobs J`` in a subprocess, once with
+``--jobs 1`` and once with ``--jobs 2``. The goal (issue 17) is an absolute one: under
+60 s on 2 cores, and about linear in cores (the ``--jobs 1`` / ``--jobs 2`` speed-up near
+2). Both output trees must be byte-identical, and identical to the pre-work code's: the
+SHA-256 of the sorted (path, bytes) pairs is compared with :data:`EXPECTED_SHA256`, taken
+from the outputs of commit b3b77a5 (before issue 17), so a mismatch means some output
+changed. Without the corpus the row says how to get it.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parents[1]
+sys.path.insert(0, str(HERE))
+
+from table import row  # noqa: E402
+
+CORPUS = Path(os.environ.get("CAMTOOL_CORPUS_DIR", ROOT / ".corpus"))
+LIBRARY = CORPUS / "pkg/librecad-data/usr/share/librecad/library"
+GOAL_S = 60.0
+EXPECTED_SHA256 = "579708340135187f52798a0d80aaf555068b01e5e3453462c2b13824472271c0"
+"""SHA-256 of the 1 000-file output tree of commit b3b77a5 (see :func:`tree_hash`)."""
+
+
+def inputs(n: int, folder: Path) -> list[Path]:
+    """Link the first ``n`` corpus DXF files below ``folder``; the files linked."""
+    shutil.rmtree(folder, ignore_errors=True)
+    folder.mkdir(parents=True)
+    found = sorted(LIBRARY.rglob("*.dxf"))[:n]
+    for path in found:
+        link = folder / path.relative_to(LIBRARY)
+        link.parent.mkdir(parents=True, exist_ok=True)
+        link.symlink_to(path)
+    return found
+
+
+def tree_hash(folder: Path) -> str:
+    """SHA-256 over every file below ``folder``: its relative path, then its bytes, sorted."""
+    digest = hashlib.sha256()
+    for path in sorted(p for p in folder.rglob("*") if p.is_file()):
+        digest.update(str(path.relative_to(folder)).encode() + b"\0")
+        digest.update(path.read_bytes() + b"\0")
+    return digest.hexdigest()
+
+
+def batch(src: Path, out: Path, jobs: int) -> tuple[float, int]:
+    """Wall seconds and exit code of ``camtool batch`` with ``jobs`` worker processes."""
+    shutil.rmtree(out, ignore_errors=True)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), str(ROOT / ".pp")])}
+    cmd = [sys.executable, "-m", "camtool", "batch", str(src), "-t", "grbl", "-o", str(out)]
+    start = time.perf_counter()
+    done = subprocess.run(
+        [*cmd, "--force", "--jobs", str(jobs)], env=env, capture_output=True, text=True
+    )
+    seconds = time.perf_counter() - start
+    print(f"--jobs {jobs}: {seconds:.2f} s, exit {done.returncode}", flush=True)
+    if done.returncode not in (0, 1, 3):
+        print(done.stderr[-2000:], file=sys.stderr)
+    return seconds, done.returncode
+
+
+def main() -> int:
+    """Post the batch with 1 and 2 worker processes; print the times and one table row."""
+    n = int(sys.argv[1]) if len(sys.argv) > 1 else 1000
+    job = f"`camtool batch` of {n} LibreCAD DXF → grbl, --jobs 2"
+    work = Path(tempfile.gettempdir()) / "camtool-bench-batch-cli"
+    files = inputs(n, work / "in") if LIBRARY.is_dir() else []
+    if len(files) < n:
+        row(
+            job,
+            "—",
+            "—",
+            "—",
+            None,
+            "absolute",
+            f"< {GOAL_S:.0f} s",
+            False,
+            f"corpus missing or short ({len(files)} files at {LIBRARY}): run `make corpus`",
+        )
+        return 0
+    one_s, one_code = batch(work / "in", work / "out1", 1)
+    two_s, two_code = batch(work / "in", work / "out2", 2)
+    h1, h2 = tree_hash(work / "out1"), tree_hash(work / "out2")
+    same = h1 == h2 and one_code == two_code
+    expected = h2 == EXPECTED_SHA256
+    print(f"outputs: --jobs 1 {h1[:16]}, --jobs 2 {h2[:16]}; pre-work {EXPECTED_SHA256[:16]}")
+    speedup = one_s / two_s
+    note = (
+        f"--jobs 1 {one_s:.1f} s, speed-up {speedup:.2f}× on 2 cores; exit {two_code}; "
+        f"outputs {'identical' if same else 'DIFFER'} across --jobs, "
+        f"{'identical to' if expected else 'DIFFER from'} the pre-work outputs"
+    )
+    row(
+        job,
+        f"{two_s:.1f} s",
+        "—",
+        "—",
+        None,
+        "absolute",
+        f"< {GOAL_S:.0f} s, ~linear",
+        two_s < GOAL_S and same and expected,
+        note,
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
