@@ -40,6 +40,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 from camtool.jobs.batch import BatchResult, run
 from camtool.jobs.batch_dask import connect
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from table import row
+
 ROOT = Path(__file__).resolve().parents[2]
 CORPUS = Path(os.environ.get("CAMTOOL_CORPUS_DIR", ROOT / ".corpus"))
 LIBRARY = CORPUS / "pkg/librecad-data/usr/share/librecad/library"
@@ -113,6 +116,20 @@ def main() -> None:
     print(f"per file: pool {1000 * pool_s / args.n:.1f} ms, dask {1000 * dask_s / args.n:.1f} ms")
     print(f"cost of Dask per file: {per_file_ms:+.1f} ms; dask / pool = {dask_s / pool_s:.2f}")
     print(f"with the cluster's start: dask / pool = {(dask_s + started_s) / pool_s:.2f}")
+    import dask
+
+    row(
+        f"`batch --scheduler local:2` of {args.n} files → {args.target} (library)",
+        f"{dask_s:.1f} s",
+        f"camtool's own process pool (--jobs 2); dask {dask.__version__}",
+        f"{pool_s:.1f} s",
+        dask_s / pool_s,
+        "time",
+        "— (cost of Dask)",
+        same,
+        f"{per_file_ms:+.1f} ms a file; cluster start {started_s:.1f} s; "
+        f"outputs {'identical' if same else 'DIFFER'}",
+    )
 
 
 if __name__ == "__main__":
