@@ -73,12 +73,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from decimal import ROUND_HALF_UP, Decimal
+from functools import cached_property
 
 import numpy as np
 import numpy.typing as npt
 
 from camtool.model.errors import DialectError, UsageError
 from camtool.model.shapes import Point
+from camtool.post.numfmt import half_up
 
 # -- the controllers' rules ------------------------------------------------------------
 
@@ -274,8 +276,30 @@ class Grid:
         """The quantum, mm."""
         return float(self.quantum)
 
+    @cached_property
+    def decimals(self) -> int | None:
+        """``d`` when the quantum is exactly ``10**-d`` mm (``0 ≤ d ≤ 6``), else ``None``."""
+        _, digits, exponent = self.quantum.as_tuple()
+        if digits == (1,) and isinstance(exponent, int) and -6 <= exponent <= 0:
+            return -exponent
+        return None
+
     def index(self, value_mm: float) -> int:
-        """Nearest grid index, halves away from zero (as ``NumberFormat`` rounds)."""
+        """Nearest grid index, halves away from zero (as ``NumberFormat`` rounds).
+
+        On a ``10**-d`` grid the digits of the float's repr are rounded directly
+        (:func:`~camtool.post.numfmt.half_up`, the same digits as the ``Decimal``
+        division and quantize of :meth:`_index_slow`, kept for the tests).
+        """
+        d = self.decimals
+        if d is not None:
+            plain = half_up(float(value_mm), d)
+            if plain is not None:
+                k = int(plain[0].replace(".", ""))
+                return -k if plain[1] else k
+        return self._index_slow(value_mm)
+
+    def _index_slow(self, value_mm: float) -> int:
         q = Decimal(repr(float(value_mm))) / self.quantum
         return int(q.quantize(Decimal(1), rounding=ROUND_HALF_UP))
 
@@ -284,7 +308,17 @@ class Grid:
         return self.index(p[0]), self.index(p[1])
 
     def value(self, k: int) -> float:
-        """Grid index ``k`` in mm: the float of the exact decimal, so it prints as itself."""
+        """Grid index ``k`` in mm: the float of the exact decimal, so it prints as itself.
+
+        On a ``10**-d`` grid ``float("{k}e-{d}")``: the same decimal, and both
+        conversions are correctly rounded (:meth:`_value_slow` is the ``Decimal`` one).
+        """
+        d = self.decimals
+        if d is not None and -(10**20) < k < 10**20:
+            return float(f"{k}e-{d}")
+        return self._value_slow(k)
+
+    def _value_slow(self, k: int) -> float:
         return float(Decimal(k) * self.quantum)
 
     def point(self, k: Index) -> Point:

@@ -157,3 +157,25 @@ def test_whenever_the_shortcut_says_yes_the_search_passes_the_rounded_centre(rul
         assert ok[0], f"block {k}: s={s} e={e} c={c} {ref} {rule} q={q}"
     assert answered > N / 4
     print(f"{rule}: the shortcut answered {answered} of {N} blocks")
+
+
+@pytest.mark.parametrize("quantum", [0.001, 0.01, 0.1, 1.0, 0.0254, 1e-6, 2e-7])
+def test_grid_digits_equal_decimal(quantum: float) -> None:
+    grid = arccheck.Grid.of(quantum)
+    rng = np.random.default_rng(7)
+    values = [0.0, -0.0, 0.0005, -0.0005, 1e-5, 1e16, -1e22, 2.0005, 1234.5675]
+    values += [float(v) for v in rng.uniform(-2000, 2000, 3000)]
+    values += [round(float(v), int(rng.integers(0, 7))) for v in rng.uniform(-600, 600, 3000)]
+    values += [(int(k) + 0.5) * quantum for k in rng.integers(-(10**6), 10**6, 2000)]
+    for v in values:
+        assert _called(grid.index, v) == _called(grid._index_slow, v), v
+    for k in [0, 1, -1, 10**12, -(10**19), 10**21, *map(int, rng.integers(-(10**9), 10**9, 3000))]:
+        assert grid.value(k) == grid._value_slow(k), k
+
+
+def _called(call: object, arg: float) -> object:
+    """The result, or the exception's type (a value too large for Decimal's 28 digits)."""
+    try:
+        return call(arg)  # type: ignore[operator]
+    except ArithmeticError as exc:
+        return type(exc)
