@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass
+from functools import lru_cache
 from decimal import ROUND_HALF_UP, Decimal, InvalidOperation, localcontext
 
 from camtool.model.errors import DialectError
@@ -185,13 +186,16 @@ _PLAIN_DIGITS = 24
 """Longest such text :meth:`NumberFormat.parse` reads with ``float`` (mm)."""
 
 
+@lru_cache(maxsize=1 << 16)
 def half_up(value: float, decimals: int) -> tuple[str, bool] | None:
     """``|value|`` to ``decimals`` places, halves away from zero, and its sign (or ``None``).
 
     The same digits as ``Decimal(repr(value)).quantize(10**-decimals, ROUND_HALF_UP)``
     (:meth:`NumberFormat.quantize` at scale 1 without a grid): ``repr`` is the
     shortest decimal that reads back as ``value``, and rounding a decimal half up
-    looks at the first dropped digit only (≥ 5 rounds the magnitude up). Only
+    looks at the first dropped digit only (≥ 5 rounds the magnitude up). Cached:
+    a program writes the same numbers again and again (``0.0`` and ``-0.0`` share
+    an entry and give the same text). Only
     reprs without an exponent (``1e-05``, ``1e+16``, ``nan``, ``inf`` go to
     ``Decimal``); a result of zero has no sign, as ``quantize`` gives it.
 
