@@ -73,7 +73,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from decimal import ROUND_HALF_UP, Decimal
-from functools import cached_property
+from functools import cached_property, lru_cache
 
 import numpy as np
 import numpy.typing as npt
@@ -262,16 +262,16 @@ class Grid:
 
     @classmethod
     def of(cls, quantum_mm: float) -> Grid:
-        """The grid of a resolution in mm.
+        """The grid of a resolution in mm (one shared instance per resolution).
 
         Raises:
             UsageError: ``quantum_mm`` is not a positive finite number.
         """
         if not (math.isfinite(quantum_mm) and quantum_mm > 0):
             raise UsageError(f"the arc quantum must be a positive number of mm, got {quantum_mm!r}")
-        return cls(Decimal(repr(float(quantum_mm))))
+        return _grid_of(float(quantum_mm))
 
-    @property
+    @cached_property
     def mm(self) -> float:
         """The quantum, mm."""
         return float(self.quantum)
@@ -335,6 +335,11 @@ class Grid:
         if max(abs(self.value(k[0]) - p[0]), abs(self.value(k[1]) - p[1])) > 1e-6 * self.mm:
             raise ValueError(f"the arc {what} {p} is not on the {self.quantum} mm grid")
         return k
+
+
+@lru_cache(maxsize=64)
+def _grid_of(quantum_mm: float) -> Grid:
+    return Grid(Decimal(repr(quantum_mm)))
 
 
 @dataclass(frozen=True)

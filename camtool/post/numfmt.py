@@ -16,8 +16,8 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass
-from functools import lru_cache
 from decimal import ROUND_HALF_UP, Decimal, InvalidOperation, localcontext
+from functools import lru_cache
 
 from camtool.model.errors import DialectError
 
@@ -64,6 +64,9 @@ class NumberFormat:
             raise ValueError("min_decimals must lie between 0 and decimals")
         if self.grid_mm is not None and not (math.isfinite(self.grid_mm) and self.grid_mm > 0):
             raise ValueError(f"grid_mm must be a finite number > 0, got {self.grid_mm!r}")
+        # texts already written and read, by value (not fields: no part of eq, hash or repr)
+        object.__setattr__(self, "_texts", {})
+        object.__setattr__(self, "_values", {})
 
     def quantize(self, value_mm: float) -> Decimal:
         """The value in written units, rounded to ``decimals`` (half away from zero).
@@ -103,10 +106,26 @@ class NumberFormat:
         :meth:`quantize` does with ``Decimal``, without it; :meth:`_format_slow`
         is the ``Decimal`` path, kept for the tests that compare the two.
 
+        A program writes the same numbers again and again: the texts are kept by
+        value (up to :data:`_CACHED` of them; ``0.0`` and ``-0.0`` share one, both
+        are written without a sign, and errors are not kept).
+
         Raises:
             DialectError: ``value_mm`` is NaN or infinite, or the integer part
                 needs more than ``int_digits`` digits.
         """
+        value = float(value_mm)
+        texts: dict[float, str] = self._texts  # type: ignore[attr-defined]
+        text = texts.get(value)
+        if text is None:
+            text = self._format(value)
+            if len(texts) >= _CACHED:
+                texts.clear()
+            texts[value] = text
+        return text
+
+    def _format(self, value_mm: float) -> str:
+        """:meth:`format` without its cache."""
         plain = None
         if self.scale == 1.0 and self.grid_mm is None:
             plain = half_up(float(value_mm), self.decimals)
@@ -160,9 +179,17 @@ class NumberFormat:
             DialectError: ``text`` is not a finite decimal number, or is too
                 large for a float once in mm.
         """
-        if self.scale == 1.0 and len(text) <= _PLAIN_DIGITS and _PLAIN.fullmatch(text):
-            return float(text)
-        return self._parse_slow(text)
+        values: dict[str, float] = self._values  # type: ignore[attr-defined]
+        value = values.get(text)
+        if value is None:
+            if self.scale == 1.0 and len(text) <= _PLAIN_DIGITS and _PLAIN.fullmatch(text):
+                value = float(text)
+            else:
+                value = self._parse_slow(text)
+            if len(values) >= _CACHED:
+                values.clear()
+            values[text] = value
+        return value
 
     def _parse_slow(self, text: str) -> float:
         """:meth:`parse` through ``Decimal`` always (as before issue 17; for tests)."""
@@ -180,6 +207,8 @@ class NumberFormat:
         return value
 
 
+_CACHED = 1 << 16
+"""Most texts a :class:`NumberFormat` keeps (written or read), each way."""
 _PLAIN = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)")
 """A decimal without exponent, as the writers print them."""
 _PLAIN_DIGITS = 24
