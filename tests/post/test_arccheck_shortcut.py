@@ -119,20 +119,38 @@ def test_shortcut_equals_the_search_on_random_arcs(
 
 
 @pytest.mark.parametrize("rule", ["grbl", "linuxcnc"])
-def test_shortcut_equals_the_search_along_a_spiral(rule: str) -> None:
-    # arcspiral.ngc-like: consecutive arcs whose radius shrinks 2 µm per block, each
-    # starting at the previous printed end (as the writer chains them)
+def test_shortcut_equals_the_search_along_a_spiral(
+    rule: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # arcspiral.ngc (LinuxCNC's example): R-form arcs whose radius shrinks 2 thou a block,
+    # each through the previous end (its centre on the chord's bisector), written from
+    # the previous printed end as the writer chains them
+    answered = []
+    plain = arccheck.plainly_passes
+
+    def counted(*args: object) -> bool:
+        ok = plain(*args)  # type: ignore[arg-type]
+        answered.append(ok)
+        return ok
+
+    monkeypatch.setattr(arccheck, "plainly_passes", counted)
     q = 0.001
-    here = _printed((50.0, 0.0), q)
-    for k in range(400):
-        radius = 50.0 - 0.002 * k
+    exact = (50.8, 0.0)
+    here = _printed(exact, q)
+    for k in range(300):
+        radius = 50.8 - 0.0508 * k
         a = 0.05 * (k + 1)
         end = (radius * math.cos(a), radius * math.sin(a))
-        centre = (0.0, 0.0)
-        args = (here, here, end, centre, False, q)
+        half = math.dist(exact, end) / 2
+        mid = ((exact[0] + end[0]) / 2, (exact[1] + end[1]) / 2)
+        ux, uy = (end[0] - exact[0]) / (2 * half), (end[1] - exact[1]) / (2 * half)
+        h = math.sqrt(radius * radius - half * half)
+        centre = (mid[0] - uy * h, mid[1] + ux * h)  # left of the chord: counter-clockwise
+        args = (here, exact, end, centre, False, q)
         fast = _outcome(args, rule, shortcut=True)
-        assert fast == _outcome(args, rule, shortcut=False)
-        here = _printed(end, q)
+        assert fast == _outcome(args, rule, shortcut=False), k
+        exact, here = end, _printed(end, q)
+    assert sum(answered) > 250  # the shortcut answers nearly every block (the bench: all)
 
 
 @pytest.mark.parametrize("rule", ["grbl", "linuxcnc"])
