@@ -617,6 +617,8 @@ def plainly_passes(solver: Solver, s: Index, e: Index, c: Index, ref: Reference)
     if g0 + g1 + turn_gap + 2 * eta >= math.pi - SLACK_RAD:
         return False
     end_gap = math.hypot(e[0] * q - a1[0], e[1] * q - a1[1])
+    if not math.isfinite(brad + g0 + g1 + eta + end_gap):
+        return False  # max() would let a NaN through
     bound = max(brad + radius * (max(g0, g1) + SLACK_RAD), end_gap)
     return bound + SLACK_MM <= solver.limit
 
