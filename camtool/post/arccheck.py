@@ -64,7 +64,10 @@ grid point ``s`` to ``e`` gets the rounded exact centre if the controller
 accepts it and the path stays near the exact arc; else the nearby grid centres
 are tried; if none passes, the exact arc is halved and each half solved on its
 own; a part that cannot be halved into solvable halves tries the centres along
-its chord's bisector, further from the exact centre, last), and
+its chord's bisector, further from the exact centre, last), the shortcut in
+front of the search (:func:`plainly_passes`: the rounded centre tested with a
+bound, no numpy, in a few µs; the search runs only when the bound is not sure,
+and the blocks are the same: issue 17, the search was ~0.7 ms per arc), and
 :func:`conform_arc` itself.
 """
 
@@ -73,12 +76,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from decimal import ROUND_HALF_UP, Decimal
+from functools import cached_property, lru_cache
 
 import numpy as np
 import numpy.typing as npt
 
 from camtool.model.errors import DialectError, UsageError
 from camtool.model.shapes import Point
+from camtool.post.numfmt import half_up
 
 # -- the controllers' rules ------------------------------------------------------------
 
@@ -260,22 +265,44 @@ class Grid:
 
     @classmethod
     def of(cls, quantum_mm: float) -> Grid:
-        """The grid of a resolution in mm.
+        """The grid of a resolution in mm (one shared instance per resolution).
 
         Raises:
             UsageError: ``quantum_mm`` is not a positive finite number.
         """
         if not (math.isfinite(quantum_mm) and quantum_mm > 0):
             raise UsageError(f"the arc quantum must be a positive number of mm, got {quantum_mm!r}")
-        return cls(Decimal(repr(float(quantum_mm))))
+        return _grid_of(float(quantum_mm))
 
-    @property
+    @cached_property
     def mm(self) -> float:
         """The quantum, mm."""
         return float(self.quantum)
 
+    @cached_property
+    def decimals(self) -> int | None:
+        """``d`` when the quantum is exactly ``10**-d`` mm (``0 ≤ d ≤ 6``), else ``None``."""
+        _, digits, exponent = self.quantum.as_tuple()
+        if digits == (1,) and isinstance(exponent, int) and -6 <= exponent <= 0:
+            return -exponent
+        return None
+
     def index(self, value_mm: float) -> int:
-        """Nearest grid index, halves away from zero (as ``NumberFormat`` rounds)."""
+        """Nearest grid index, halves away from zero (as ``NumberFormat`` rounds).
+
+        On a ``10**-d`` grid the digits of the float's repr are rounded directly
+        (:func:`~camtool.post.numfmt.half_up`, the same digits as the ``Decimal``
+        division and quantize of :meth:`_index_slow`, kept for the tests).
+        """
+        d = self.decimals
+        if d is not None:
+            plain = half_up(float(value_mm), d)
+            if plain is not None:
+                k = int(plain[0].replace(".", ""))
+                return -k if plain[1] else k
+        return self._index_slow(value_mm)
+
+    def _index_slow(self, value_mm: float) -> int:
         q = Decimal(repr(float(value_mm))) / self.quantum
         return int(q.quantize(Decimal(1), rounding=ROUND_HALF_UP))
 
@@ -284,7 +311,17 @@ class Grid:
         return self.index(p[0]), self.index(p[1])
 
     def value(self, k: int) -> float:
-        """Grid index ``k`` in mm: the float of the exact decimal, so it prints as itself."""
+        """Grid index ``k`` in mm: the float of the exact decimal, so it prints as itself.
+
+        On a ``10**-d`` grid ``float("{k}e-{d}")``: the same decimal, and both
+        conversions are correctly rounded (:meth:`_value_slow` is the ``Decimal`` one).
+        """
+        d = self.decimals
+        if d is not None and -(10**20) < k < 10**20:
+            return float(f"{k}e-{d}")
+        return self._value_slow(k)
+
+    def _value_slow(self, k: int) -> float:
         return float(Decimal(k) * self.quantum)
 
     def point(self, k: Index) -> Point:
@@ -301,6 +338,11 @@ class Grid:
         if max(abs(self.value(k[0]) - p[0]), abs(self.value(k[1]) - p[1])) > 1e-6 * self.mm:
             raise ValueError(f"the arc {what} {p} is not on the {self.quantum} mm grid")
         return k
+
+
+@lru_cache(maxsize=64)
+def _grid_of(quantum_mm: float) -> Grid:
+    return Grid(Decimal(repr(quantum_mm)))
 
 
 @dataclass(frozen=True)
@@ -350,6 +392,9 @@ class Solver:
     rule: str
     clockwise: bool
     exact_centre: Point
+    shortcut: bool = True
+    """Test the rounded centre with :func:`plainly_passes` before the search (False: the
+    search alone, as before the shortcut; tests compare the two)."""
 
     @property
     def limit(self) -> float:
@@ -396,6 +441,10 @@ class Solver:
         and ``e`` where the radii agree within the rule, nearest the exact centre
         first (:data:`BISECTOR_QUANTA`).
         """
+        if not bisector and self.shortcut:
+            c0 = self.grid.indices(self.exact_centre)
+            if plainly_passes(self, s, e, c0, ref) and self._accepted(s, e, c0):
+                return c0  # what the search below returns first: see plainly_passes
         exact = np.array(self.exact_centre) / self.grid.mm
         rounded = np.array([self.grid.indices(self.exact_centre)], dtype=np.int64)
         tiers = (
@@ -469,6 +518,166 @@ class Solver:
         return np.abs(r1 - r0), ok
 
 
+# -- the shortcut: the rounded centre without the search ------------------------------
+
+SLACK_MM = 1e-9
+"""Room :func:`plainly_passes` leaves for the float rounding of the search's numpy (mm)."""
+SLACK_RAD = 1e-9
+"""The same for angles, rad."""
+SHORTCUT_MAX_MM = 1e4
+"""Radii beyond this (mm) always go to the search (float noise grows with the radius)."""
+
+
+def plainly_passes(solver: Solver, s: Index, e: Index, c: Index, ref: Reference) -> bool:
+    """Whether the search's tests of the rounded centre ``c`` surely pass (no numpy, ~µs).
+
+    ``True`` only when :meth:`Solver._passes` is sure to pass ``c``: then
+    :meth:`Solver.centre` (not along the bisector), whose first tier is the
+    rounded centre alone, returns ``c`` as soon as :func:`arc_error` accepts it,
+    and the caller returns the same. ``False`` means "not sure", never "fails":
+    the caller then runs the whole search, which tries ``c`` again, so the
+    result is always the search's. Each test of ``_passes`` is checked here with
+    :data:`SLACK_MM` / :data:`SLACK_RAD` to spare (numpy's ``hypot``/``arctan2``
+    may differ from ``math``'s by an ulp):
+
+    - the rule with its margin (:func:`rule_ok`), both radii > 0;
+    - the sweep (:func:`travel`; refused near its branch points ``±π`` and
+      ``±``:data:`GRBL_ANGULAR_EPSILON`, where an ulp could flip it by 2π) within
+      90° of the exact part's;
+    - the deviation, by a bound on the continuous path (the search samples it):
+      with ``d = c − C`` (``C`` the exact centre, ``δ = |d|``, ``R`` the exact
+      radius) a path point is ``P = C + d + ρ·u(θ)``, ``ρ`` the start radius
+      (GRBL) or linear from ``r0`` to ``r1`` (LinuxCNC), ``θ = θ0 + σt``. Then
+      ``|P − C| = √(f² + w²)`` with ``f = ρ + d·u`` and ``|w| = |d × u| ≤ δ``, so
+      ``f ≤ |P − C| ≤ f + δ²/(2f)`` and every point's radial distance is at
+      most ``Brad = max(fmax + δ²/(2 fmin) − R, R − fmin)``; ``f(t) = r0 + bt +
+      δ·cos(x0 + σt)`` takes its extremes at ``t = 0, 1`` or where
+      ``sin(x0 + σt) = b/(δσ)``, all evaluated. Where the search measures a point
+      against the arc's ends instead (its angle about ``C`` outside the arc), the
+      distance is at most ``Brad + R·g``, ``g`` the angle between that point and
+      the end: when ``ρ² − ρ·δ − |dρ/dθ|·δ > 0`` the path turns monotonically
+      about ``C`` (``V × V' = ρ² + ρ d·u + ρ' d × u`` with ``V = P − C``), and
+      when ``g0 + g1 + ||σ| − |Σ|| + 2·asin(δ/ρmin) < π`` (``g0``, ``g1`` the angles
+      of the path's first and last points from the arc's ends, ``Σ`` the exact
+      sweep) it does not wrap, so the points outside the arc lie within ``g0``
+      of its start or ``g1`` of its end. The last point, the printed end, is
+      within ``|e − A1|`` of the arc.
+
+    Args:
+        solver: the search it stands in for (grid, rule, direction, exact centre).
+        s: the block's start, grid indices.
+        e: its end, grid indices.
+        c: the rounded exact centre, grid indices.
+        ref: the exact arc (or part) the block follows.
+
+    Returns:
+        ``True`` when the search surely passes ``c`` (before :func:`arc_error`),
+        ``False`` when that is not sure.
+    """
+    q = solver.grid.mm
+    u0x, u0y = (s[0] - c[0]) * q, (s[1] - c[1]) * q
+    u1x, u1y = (e[0] - c[0]) * q, (e[1] - c[1]) * q
+    r0, r1 = math.hypot(u0x, u0y), math.hypot(u1x, u1y)
+    big = max(r0, r1, ref.radius)
+    if not (r0 > 0 and r1 > 0 and big < SHORTCUT_MAX_MM and _rule_room(solver.rule, r0, r1)):
+        return False
+    cross, dot = u0x * u1y - u0y * u1x, u0x * u1x + u0y * u1y
+    raw = math.atan2(cross, dot)
+    if cross == 0.0 and dot > 0.0:
+        raw = 0.0  # both atan2 give ±0 exactly: a full turn either way
+    elif abs(raw) <= 2 * GRBL_ANGULAR_EPSILON or abs(abs(raw) - math.pi) <= SLACK_RAD:
+        return False
+    if solver.clockwise:
+        sweep = raw - 2 * math.pi if raw >= -GRBL_ANGULAR_EPSILON else raw
+    else:
+        sweep = raw + 2 * math.pi if raw <= GRBL_ANGULAR_EPSILON else raw
+    turn_gap = abs(abs(sweep) - abs(ref.sweep))
+    if turn_gap > math.pi / 2 - SLACK_RAD:
+        return False
+    rho0 = r0
+    rho1 = r0 if solver.rule == "grbl" else r1
+    cx, cy = c[0] * q, c[1] * q
+    big_c = ref.centre
+    dx, dy = cx - big_c[0], cy - big_c[1]
+    delta = math.hypot(dx, dy)
+    rho_min, rho_max = min(rho0, rho1), max(rho0, rho1)
+    slope = abs(rho1 - rho0) / abs(sweep)  # |dρ/dθ|
+    if rho_min * rho_min - rho_max * delta - slope * delta <= 1e-6 * rho_min * rho_min:
+        return False  # the path may not turn monotonically about the exact centre
+    f_min, f_max = _radial_span(rho0, rho1, u0x, u0y, dx, dy, delta, sweep)
+    if f_min <= 0.0:
+        return False
+    radius = ref.radius
+    brad = max(f_max + delta * delta / (2 * f_min) - radius, radius - f_min)
+    a0, a1 = ref.at(0.0), ref.at(1.0)
+    p1 = (cx + rho1 * u1x / r1, cy + rho1 * u1y / r1)
+    g0 = _angle((s[0] * q - big_c[0], s[1] * q - big_c[1]), (a0[0] - big_c[0], a0[1] - big_c[1]))
+    g1 = _angle((p1[0] - big_c[0], p1[1] - big_c[1]), (a1[0] - big_c[0], a1[1] - big_c[1]))
+    eta = math.asin(min(1.0, delta / rho_min))
+    if g0 + g1 + turn_gap + 2 * eta >= math.pi - SLACK_RAD:
+        return False
+    end_gap = math.hypot(e[0] * q - a1[0], e[1] * q - a1[1])
+    if not math.isfinite(brad + g0 + g1 + eta + end_gap):
+        return False  # max() would let a NaN through
+    bound = max(brad + radius * (max(g0, g1) + SLACK_RAD), end_gap)
+    return bound + SLACK_MM <= solver.limit
+
+
+def _rule_room(rule: str, r0: float, r1: float) -> bool:
+    """:func:`rule_ok` on two scalar radii, :data:`SLACK_MM` inside its every bound."""
+    m = MARGIN_MM + SLACK_MM
+    delta = abs(r1 - r0)
+    if rule == "grbl":
+        relative = delta <= GRBL_CEILING_MM - m and delta <= GRBL_RELATIVE * r0 - m
+        return delta <= GRBL_TOLERANCE_MM - m or relative
+    relative = delta <= LINUXCNC_RELATIVE * max(r0, r1) - m
+    small = delta <= LINUXCNC_TOLERANCE_MM - m or relative
+    big_enough = min(r0, r1) >= LINUXCNC_MIN_RADIUS_MM + m
+    return small and delta <= LINUXCNC_CEILING_MM - m and big_enough
+
+
+def _radial_span(
+    rho0: float,
+    rho1: float,
+    u0x: float,
+    u0y: float,
+    dx: float,
+    dy: float,
+    delta: float,
+    sweep: float,
+) -> tuple[float, float]:
+    """Least and greatest ``f(t) = ρ(t) + d·u(θ(t))`` over ``t ∈ [0, 1]`` (mm, ± float noise).
+
+    ``ρ(t) = rho0 + (rho1 − rho0)·t``, ``θ(t) = θ0 + sweep·t`` (``θ0`` the angle of
+    ``u0``), ``d = (dx, dy)``: ``f = rho0 + b·t + δ·cos(x0 + sweep·t)`` with
+    ``x0 = θ0 − angle(d)``; its extremes are at the ends or where
+    ``sin(x0 + sweep·t) = b/(δ·sweep)`` (``b = rho1 − rho0``).
+    """
+    b = rho1 - rho0
+    if delta == 0.0:
+        return min(rho0, rho1), max(rho0, rho1)
+    x0 = math.atan2(u0y, u0x) - math.atan2(dy, dx)
+    values = [rho0 + delta * math.cos(x0), rho1 + delta * math.cos(x0 + sweep)]
+    k = b / (delta * sweep)
+    if abs(k) <= 1.0 + 1e-9:
+        root = math.asin(max(-1.0, min(1.0, k)))
+        lo, hi = min(x0, x0 + sweep), max(x0, x0 + sweep)
+        for base in (root, math.pi - root):
+            n = math.ceil((lo - base) / (2 * math.pi))
+            while base + 2 * math.pi * n <= hi:
+                x = base + 2 * math.pi * n
+                t = (x - x0) / sweep
+                if 0.0 < t < 1.0:
+                    values.append(rho0 + b * t + delta * math.cos(x))
+                n += 1
+    return min(values), max(values)
+
+
+def _angle(v: Point, w: Point) -> float:
+    """Unsigned angle between two vectors, rad (0…π)."""
+    return math.atan2(abs(v[0] * w[1] - v[1] * w[0]), v[0] * w[0] + v[1] * w[1])
+
+
 def _disk(rounded: IntArray, exact: FloatArray) -> IntArray:
     """Grid points ``(K, 2)`` within :data:`SEARCH_QUANTA` of the exact centre (in quanta)."""
     near = np.arange(-math.ceil(SEARCH_QUANTA), math.ceil(SEARCH_QUANTA) + 1)
@@ -525,6 +734,7 @@ def conform_arc(
     rule: str,
     quantum_mm: float,
     exact_start: Point | None = None,
+    shortcut: bool = True,
 ) -> list[ArcPiece]:
     """Arc blocks on the print grid that the controller accepts, following the exact arc.
 
@@ -557,6 +767,9 @@ def conform_arc(
             circle is then ``end == start``), and an ``end`` that prints as
             ``start`` without being equal to it is a ValueError: it cannot be
             told from a full circle.
+        shortcut: test the rounded centre without the search first
+            (:func:`plainly_passes`); the result is the same either way, False
+            runs the search alone (tests compare the two).
 
     Returns:
         The blocks in cutting order, ``[]`` when the arc rounds away to nothing
@@ -583,7 +796,7 @@ def conform_arc(
             "circle from an arc that rounds away"
         )
     ref = _reference(start, end, centre, clockwise, exact_start)
-    solver = Solver(grid, rule, clockwise, centre)
+    solver = Solver(grid, rule, clockwise, centre, shortcut)
     if e == s and abs(ref.sweep) < 2 * math.pi:
         samples = np.array([ref.at(t) for t in np.linspace(0.0, 1.0, SAMPLES)])
         if np.max(np.hypot(samples[:, 0] - start[0], samples[:, 1] - start[1])) <= solver.limit:

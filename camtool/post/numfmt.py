@@ -14,8 +14,10 @@ is as wide as the number), so no float reaches the code unchecked.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from decimal import ROUND_HALF_UP, Decimal, InvalidOperation, localcontext
+from functools import lru_cache
 
 from camtool.model.errors import DialectError
 
@@ -62,6 +64,9 @@ class NumberFormat:
             raise ValueError("min_decimals must lie between 0 and decimals")
         if self.grid_mm is not None and not (math.isfinite(self.grid_mm) and self.grid_mm > 0):
             raise ValueError(f"grid_mm must be a finite number > 0, got {self.grid_mm!r}")
+        # texts already written and read, by value (not fields: no part of eq, hash or repr)
+        object.__setattr__(self, "_texts", {})
+        object.__setattr__(self, "_values", {})
 
     def quantize(self, value_mm: float) -> Decimal:
         """The value in written units, rounded to ``decimals`` (half away from zero).
@@ -96,10 +101,56 @@ class NumberFormat:
     def format(self, value_mm: float) -> str:
         """Write ``value_mm`` (mm) in this format.
 
+        In mm (``scale`` 1, no ``grid_mm``) the digits are rounded on the
+        float's shortest repr directly (:func:`half_up`), which is what
+        :meth:`quantize` does with ``Decimal``, without it; :meth:`_format_slow`
+        is the ``Decimal`` path, kept for the tests that compare the two.
+
+        A program writes the same numbers again and again: the texts are kept by
+        value (up to :data:`_CACHED` of them; ``0.0`` and ``-0.0`` share one, both
+        are written without a sign, and errors are not kept).
+
         Raises:
             DialectError: ``value_mm`` is NaN or infinite, or the integer part
                 needs more than ``int_digits`` digits.
         """
+        value = float(value_mm)
+        texts: dict[float, str] = self._texts  # type: ignore[attr-defined]
+        text = texts.get(value)
+        if text is None:
+            text = self._format(value)
+            if len(texts) >= _CACHED:
+                texts.clear()
+            texts[value] = text
+        return text
+
+    def _format(self, value_mm: float) -> str:
+        """:meth:`format` without its cache."""
+        plain = None
+        if self.scale == 1.0 and self.grid_mm is None:
+            plain = half_up(float(value_mm), self.decimals)
+        if plain is None:
+            q = self.quantize(value_mm)
+            text, negative = f"{abs(q):.{self.decimals}f}", q < 0
+        else:
+            text, negative = plain
+        if self.min_decimals is not None and self.decimals > self.min_decimals:
+            whole, frac = text.split(".")
+            frac = frac.rstrip("0").ljust(self.min_decimals, "0")
+            text = f"{whole}.{frac}" if frac else whole
+        int_part = text.split(".")[0]
+        if self.int_digits is not None:
+            if len(int_part) > self.int_digits:
+                q = self.quantize(value_mm)
+                raise DialectError(f"{_short(q)} does not fit {self.int_digits} integer digits")
+            if self.pad:
+                text = text.rjust(len(text) - len(int_part) + self.int_digits, "0")
+        if negative:
+            return "-" + text
+        return ("+" + text) if self.sign == "always" else text
+
+    def _format_slow(self, value_mm: float) -> str:
+        """:meth:`format` through ``Decimal`` always (as before issue 17; for tests)."""
         q = self.quantize(value_mm)
         magnitude = abs(q)
         text = f"{magnitude:.{self.decimals}f}"
@@ -120,10 +171,28 @@ class NumberFormat:
     def parse(self, text: str) -> float:
         """Read a value written in this format back to mm (signs optional).
 
+        In mm (``scale`` 1) a plain decimal (``[+-]digits[.digits]``, up to
+        :data:`_PLAIN_DIGITS` characters) is read by ``float``: ``Decimal`` divided
+        by 1 is the same decimal, and both convert it correctly rounded.
+
         Raises:
             DialectError: ``text`` is not a finite decimal number, or is too
                 large for a float once in mm.
         """
+        values: dict[str, float] = self._values  # type: ignore[attr-defined]
+        value = values.get(text)
+        if value is None:
+            if self.scale == 1.0 and len(text) <= _PLAIN_DIGITS and _PLAIN.fullmatch(text):
+                value = float(text)
+            else:
+                value = self._parse_slow(text)
+            if len(values) >= _CACHED:
+                values.clear()
+            values[text] = value
+        return value
+
+    def _parse_slow(self, text: str) -> float:
+        """:meth:`parse` through ``Decimal`` always (as before issue 17; for tests)."""
         try:
             number = Decimal(text)
         except InvalidOperation:
@@ -136,6 +205,48 @@ class NumberFormat:
         if not math.isfinite(value):
             raise DialectError(f"{_short(number)} is too large")
         return value
+
+
+_CACHED = 1 << 16
+"""Most texts a :class:`NumberFormat` keeps (written or read), each way."""
+_PLAIN = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)")
+"""A decimal without exponent, as the writers print them."""
+_PLAIN_DIGITS = 24
+"""Longest such text :meth:`NumberFormat.parse` reads with ``float`` (mm)."""
+
+
+@lru_cache(maxsize=1 << 16)
+def half_up(value: float, decimals: int) -> tuple[str, bool] | None:
+    """``|value|`` to ``decimals`` places, halves away from zero, and its sign (or ``None``).
+
+    The same digits as ``Decimal(repr(value)).quantize(10**-decimals, ROUND_HALF_UP)``
+    (:meth:`NumberFormat.quantize` at scale 1 without a grid): ``repr`` is the
+    shortest decimal that reads back as ``value``, and rounding a decimal half up
+    looks at the first dropped digit only (≥ 5 rounds the magnitude up). Cached:
+    a program writes the same numbers again and again (``0.0`` and ``-0.0`` share
+    an entry and give the same text). Only
+    reprs without an exponent (``1e-05``, ``1e+16``, ``nan``, ``inf`` go to
+    ``Decimal``); a result of zero has no sign, as ``quantize`` gives it.
+
+    Returns:
+        ``(text, negative)``: the magnitude written with ``decimals`` places (no
+        point when 0) and whether a ``-`` goes before it.
+    """
+    r = repr(value)
+    if "e" in r or "n" in r:
+        return None
+    negative = r[0] == "-"
+    whole, _, frac = (r[1:] if negative else r).partition(".")
+    if len(frac) <= decimals:
+        digits = int(whole + frac.ljust(decimals, "0"))
+    else:
+        digits = int(whole + frac[:decimals]) + (frac[decimals] >= "5")
+    if decimals:
+        text = str(digits).rjust(decimals + 1, "0")
+        text = text[:-decimals] + "." + text[-decimals:]
+    else:
+        text = str(digits)
+    return text, negative and digits != 0
 
 
 def _short(number: Decimal) -> str:
