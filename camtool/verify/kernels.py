@@ -1,0 +1,181 @@
+"""Compiled inner loops of the verifier's interpolators (numba).
+
+The loops here are the same arithmetic as the pure-Python/numpy code of
+:mod:`camtool.verify.interpolators`, compiled with numba (``@njit(cache=True)``)
+so that a step costs a few nanoseconds: the linear DDA closed form (seed-000
+annex A.3, :func:`camtool.verify.interpolators.dda_line`) and the quadrant
+loops of the direct search method (A.6) and the staircase (A.5). They work on
+int64 and are only called where no value can overflow (the callers check
+:data:`SAFE_MAGNITUDE` and :data:`SAFE_SQUARE`); anything else stays on the
+exact Python path.
+
+This module imports numba, so it is imported lazily
+(:func:`camtool.verify.interpolators.compiled`), never at ``camtool --help`` time;
+without numba the callers run the numpy / Python code, which gives the same rows.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numba
+import numpy as np
+
+SAFE_MAGNITUDE = 1 << 40
+"""Largest coordinate magnitude (steps) the compiled arc loops accept: D, Δ and the
+squared terms stay far inside int64 (|D| ≤ ~2R, Δ ≤ 2R + 1)."""
+SAFE_SQUARE = 1 << 60
+"""Largest ``dx² + dy²`` (steps²) of a line the compiled DDA accepts (``n·P`` fits int64)."""
+
+
+@numba.njit(cache=True, nogil=True)
+def dda_exact(p: int, q: int, h: int, lo: int, hi: int, n_rows: int) -> Any:
+    """Rows of the A.3 DDA when HIPO is the integer ``h``, packed one ``uint16`` per row.
+
+    The literal register loop of annex A.3 on integers (``Q += P``; ``Q > HIPO`` pulses
+    and loses HIPO), which is exact here; it equals ``k(n) = (n·P − 1) // h`` of
+    ``_dda_counts``. A pulse adds ``lo`` (X: the low byte of the row) resp. ``hi``
+    (Y: the high byte), the step's int8 value already shifted into place.
+    """
+    out = np.empty(n_rows, dtype=np.uint16)
+    qx = 0
+    qy = 0
+    for i in range(n_rows):
+        v = 0
+        qx += p
+        if qx > h:
+            qx -= h
+            v += lo
+        qy += q
+        if qy > h:
+            qy -= h
+            v += hi
+        out[i] = v
+    return out
+
+
+@numba.njit(cache=True, nogil=True)
+def dda_float(cx: float, cy: float, lo: int, hi: int, n_rows: int, window: float) -> Any:
+    """Rows of the A.3 DDA by the closed form ``k(n) = floor(n·c)``, ``c = P/√s``, packed.
+
+    The same float product and truncation as the numpy ``_dda_counts``; returns the rows
+    (one ``uint16`` each, as :func:`dda_exact`) and how many estimates lie within
+    ``window`` of an integer (the caller re-checks those rows exactly, :func:`dda_ties`).
+    """
+    out = np.empty(n_rows, dtype=np.uint16)
+    ties = 0
+    kx_prev = 0
+    ky_prev = 0
+    edge = 0.5 - window
+    for i in range(n_rows):
+        n = i + 1
+        tx = n * cx
+        ty = n * cy
+        kx = int(tx)
+        ky = int(ty)
+        ties += abs((tx - kx) - 0.5) > edge
+        ties += abs((ty - ky) - 0.5) > edge
+        out[i] = (kx - kx_prev) * lo + (ky - ky_prev) * hi
+        kx_prev = kx
+        ky_prev = ky
+    return out, ties
+
+
+@numba.njit(cache=True, nogil=True)
+def dda_ties(cx: float, cy: float, n_rows: int, window: float) -> Any:
+    """Row indices (0-based) whose closed-form estimate :func:`dda_float` flags as near-ties."""
+    found = np.empty(n_rows, dtype=np.int64)
+    nt = 0
+    edge = 0.5 - window
+    for i in range(n_rows):
+        n = i + 1
+        tx = n * cx
+        ty = n * cy
+        if abs((tx - int(tx)) - 0.5) > edge or abs((ty - int(ty)) - 0.5) > edge:
+            found[nt] = i
+            nt += 1
+    return found[:nt]
+
+
+@numba.njit(cache=True, nogil=True)
+def _grow(out: Any, i: int) -> Any:
+    grown = np.empty((2 * out.shape[0] + 64, 2), dtype=np.int8)
+    grown[:i] = out[:i]
+    return grown
+
+
+@numba.njit(cache=True, nogil=True)
+def dsm_quadrant(
+    x: int, y: int, d: int, gx: int, gy: int, sx: int, sy: int, ux: int, uy: int
+) -> tuple[int, int, int, Any]:
+    """``_dsm_run`` of annex A.6 writing rows ``(ux, 0)``, ``(0, uy)``, ``(ux, uy)``."""
+    out = np.empty((2 * (x + y) + 64, 2), dtype=np.int8)
+    i = 0
+    dx = 2 * x * gx + 1
+    dy = 2 * y * gy + 1
+    while x != sx and y != sy:
+        if i == out.shape[0]:
+            out = _grow(out, i)
+        d1 = d + dx
+        d2 = d + dy
+        d3 = d1 + dy
+        a1 = d1 if d1 >= 0 else -d1
+        a2 = d2 if d2 >= 0 else -d2
+        a3 = d3 if d3 >= 0 else -d3
+        if (a2 > a3) if a1 > a2 else (a1 > a3):
+            d = d3
+            dx += 2
+            dy += 2
+            x += gx
+            y += gy
+            out[i, 0] = ux
+            out[i, 1] = uy
+        elif a1 > a2:
+            d = d2
+            dy += 2
+            y += gy
+            out[i, 0] = 0
+            out[i, 1] = uy
+        else:
+            d = d1
+            dx += 2
+            x += gx
+            out[i, 0] = ux
+            out[i, 1] = 0
+        i += 1
+    return x, y, d, out[:i]
+
+
+@numba.njit(cache=True, nogil=True)
+def staircase_quadrant(
+    x: int, y: int, d: int, gx: int, gy: int, sx: int, sy: int, ux: int, uy: int
+) -> tuple[int, int, int, Any]:
+    """``_staircase_run`` of annex A.5 writing rows ``(ux, 0)`` / ``(0, uy)``."""
+    out = np.empty((2 * (x + y) + 64, 2), dtype=np.int8)
+    i = 0
+    while x != sx and y != sy:
+        if i == out.shape[0]:
+            out = _grow(out, i)
+        if d <= 0:
+            if gx > 0:
+                d = d + 2 * x + 1
+                x += 1
+                out[i, 0] = ux
+                out[i, 1] = 0
+            else:
+                d = d + 2 * y + 1
+                y += 1
+                out[i, 0] = 0
+                out[i, 1] = uy
+        elif gx > 0:
+            d = d - 2 * y + 1
+            y -= 1
+            out[i, 0] = 0
+            out[i, 1] = uy
+        else:
+            d = d - 2 * x + 1
+            x -= 1
+            out[i, 0] = ux
+            out[i, 1] = 0
+        i += 1
+    return x, y, d, out[:i]
