@@ -189,7 +189,7 @@ def dda_line(dx: int, dy: int) -> StepArray:
     s = px * px + py * py
     if s == 0:
         return empty_steps()
-    jit = compiled()
+    jit = compiled(math.isqrt(s) + 1)
     if jit is not None and s < jit.SAFE_SQUARE:
         return _dda_line_compiled(jit, px, py, _sign(dx), _sign(dy), s)
     return dda_line_numpy(dx, dy)
@@ -255,25 +255,43 @@ def _dda_line_compiled(jit: ModuleType, px: int, py: int, sx: int, sy: int, s: i
     return out
 
 
-def compiled() -> ModuleType | None:
-    """The numba kernels (:mod:`camtool.verify.kernels`), loaded on first use.
+COMPILE_FROM = 2_000_000
+"""Rows of interpolator (and carriage) work, summed over the process, from which the
+compiled kernels are loaded: loading numba and its cache costs about 0.5–1 s once, more
+than the plain paths take for a small program (the logo: ~50 000 rows)."""
 
-    ``None`` when numba is not installed or the machine is big-endian (the packed
-    rows assume little-endian); the numpy / Python paths then give the same rows.
+
+def compiled(work: int = COMPILE_FROM) -> ModuleType | None:
+    """The numba kernels (:mod:`camtool.verify.kernels`), once the work warrants them.
+
+    ``work`` is the rows the caller is about to produce; the kernels are loaded when
+    the rows asked for so far in this process reach :data:`COMPILE_FROM` (the default
+    asks for them at once) and then used by every later call. ``None`` before that,
+    when numba is not installed, or on a big-endian machine (the packed rows assume
+    little-endian); the numpy / Python paths then give the same rows.
+
+    Args:
+        work: Rows the caller is about to compute, ``>= 0``.
+
+    Returns:
+        The kernels module, or ``None`` (use the plain path).
     """
-    if "kernels" not in _COMPILED:
-        if sys.byteorder != "little":
-            _COMPILED["kernels"] = None
-            return None
+    if "kernels" in _COMPILED:
+        return _COMPILED["kernels"]
+    _WORK[0] += work
+    if _WORK[0] < COMPILE_FROM:
+        return None
+    kernels: ModuleType | None = None
+    if sys.byteorder == "little":
         try:
             from camtool.verify import kernels
         except ImportError:
-            _COMPILED["kernels"] = None
-        else:
-            _COMPILED["kernels"] = kernels
-    return _COMPILED["kernels"]
+            kernels = None
+    _COMPILED["kernels"] = kernels
+    return kernels
 
 
+_WORK = [0]
 _COMPILED: dict[str, ModuleType | None] = {}
 
 
@@ -732,7 +750,7 @@ def _compiled_runner(run: _Runner, magnitude: int) -> Callable[..., Any] | None:
     ``None`` without numba, for a runner without a twin, or when a magnitude is
     large enough that int64 could overflow (the Python loop is exact at any size).
     """
-    jit = compiled()
+    jit = compiled(8 * magnitude)  # a full circle: up to 8R rows
     if jit is None or magnitude >= jit.SAFE_MAGNITUDE:
         return None
     if run is _dsm_run:
@@ -748,7 +766,8 @@ def _search_arc(args: tuple[int, ...], clockwise: bool, run: _Runner) -> StepArr
     cw = bool(clockwise)
     plan = _plan(u0, v0, u1, v1, cw)
     u, v, d = u0, v0, 0  # D0 = 0: R² is taken from the start point
-    kernel = _compiled_runner(run, max(abs(u0), abs(v0), abs(u1), abs(v1)))
+    magnitude = max(abs(u0), abs(v0), abs(u1), abs(v1))
+    kernel = _compiled_runner(run, magnitude)
     parts = []
     for i, q in enumerate(plan):
         gx = 1 if _grows_x(q, cw) else -1

@@ -179,3 +179,102 @@ def staircase_quadrant(
             out[i, 1] = 0
         i += 1
     return x, y, d, out[:i]
+
+
+@numba.njit(cache=True, nogil=True)
+def _count_runs(rows: Any, axis: int) -> int:
+    """Runs of equal non-zero step sign in column ``axis`` of ``rows``."""
+    count = 0
+    last = 0
+    for i in range(rows.shape[0]):
+        s = rows[i, axis]
+        if s != 0 and s != last:
+            count += 1
+            last = s
+    return count
+
+
+@numba.njit(cache=True, nogil=True)
+def _fill_runs(rows: Any, axis: int, ox: int, oy: int, starts: Any, signs: Any, at: Any) -> None:
+    """Fill the run starts, signs and motor positions of column ``axis`` (see play_runs)."""
+    k = 0
+    last = 0
+    mx = ox
+    my = oy
+    for i in range(rows.shape[0]):
+        mx += rows[i, 0]
+        my += rows[i, 1]
+        s = rows[i, axis]
+        if s != 0 and s != last:
+            starts[k] = i
+            signs[k] = s
+            at[k, 0] = mx
+            at[k, 1] = my
+            k += 1
+            last = s
+
+
+def play_runs(rows: Any, ox: int, oy: int) -> tuple[Any, ...]:
+    """Runs of equal step sign per axis, for the backlash play (``simulate._play``).
+
+    A run starts at a row whose non-zero step on that axis differs in sign from the
+    axis's previous non-zero step (or is its first). Returns, per axis, the run start
+    rows ``(R,) int64``, their signs ``(R,) int8`` (+1/-1) and the motor positions
+    ``(R, 2) int64`` after each start row (steps, absolute from ``(ox, oy)``): what the
+    band of the run is looked up with.
+    """
+    out: list[Any] = []
+    for axis in (0, 1):
+        count = _count_runs(rows, axis)
+        starts = np.empty(count, dtype=np.int64)
+        signs = np.empty(count, dtype=np.int8)
+        at = np.empty((count, 2), dtype=np.int64)
+        _fill_runs(rows, axis, ox, oy, starts, signs, at)
+        out += [starts, signs, at]
+    return tuple(out)
+
+
+@numba.njit(cache=True, nogil=True)
+def play_axis(
+    rows: Any,
+    axis: int,
+    origin: int,
+    starts: Any,
+    signs: Any,
+    bands: Any,
+    c0: float,
+    start: float,
+    true_spm: float,
+    out: Any,
+) -> None:
+    """One axis of ``simulate._carriage``: the play operator over the runs, into ``out``.
+
+    The same float operations, in the same order, as the numpy ``_play`` and
+    ``_carriage``: before the first run the carriage is ``c0``; in an up run it is
+    ``max(c, M)``, in a down run ``min(c, M + band)`` with ``c`` the value at the end
+    of the previous run and ``M`` the motor (integer steps); then ``(v − c0 + start) /
+    true_spm``. ``bands[r]`` is the band of run ``r`` in steps (unused for up runs).
+    """
+    n = rows.shape[0]
+    motor = origin
+    current = c0
+    value = c0
+    r = 0
+    runs = len(starts)
+    up = True
+    band = 0.0
+    for i in range(n):
+        motor += rows[i, axis]
+        if r < runs and i == starts[r]:
+            current = value
+            up = signs[r] > 0
+            band = bands[r]
+            r += 1
+        if r > 0:
+            m = float(motor)
+            if up:
+                value = current if current >= m else m
+            else:
+                mb = m + band
+                value = current if current <= mb else mb
+        out[i, axis] = (value - c0 + start) / true_spm

@@ -174,3 +174,62 @@ def test_plain_fixture_switches_the_kernels_off(plain: None) -> None:
     """The comparison really runs two paths: with the fixture no kernel is loaded."""
     assert itp.compiled() is None
     assert _same(itp.dda_line(3, 4), itp.dda_line_reference(3, 4))
+
+
+def _random_rows(rng: np.random.Generator, n: int) -> np.ndarray:
+    """Step rows with long runs and reversals on both axes (as a real trace has)."""
+    rows = np.zeros((n, 2), dtype=np.int8)
+    at = 0
+    while at < n:
+        length = min(int(rng.integers(1, 4000)), n - at)
+        rows[at : at + length, 0] = rng.choice((-1, 0, 1)) * (rng.random(length) < 0.9)
+        rows[at : at + length, 1] = rng.choice((-1, 0, 1)) * (rng.random(length) < 0.3)
+        at += length
+    return rows
+
+
+@pytest.mark.parametrize("profile", ["mmh-gmm", "valcnc", "grbl"])
+def test_carriage_compiled_equals_numpy(profile: str) -> None:
+    """The compiled play operator gives the numpy one's floats exactly (regions included)."""
+    from camtool.post.registry import load_machine
+    from camtool.verify import simulate
+
+    machine = load_machine(profile)
+    jit = itp.compiled()
+    rng = np.random.default_rng(3)
+    for n, origin in ((1, (0, 0)), (7, (5, -3)), (50_000, (3000, 20_000)), (200_000, (0, 0))):
+        rows = _random_rows(rng, n)
+        fast = simulate._carriage_compiled(jit, rows, origin, machine)
+        slow = simulate._carriage_numpy(rows, origin, machine)
+        assert fast.dtype == slow.dtype and np.array_equal(fast, slow), (profile, n)
+    still = np.zeros((10, 2), dtype=np.int8)  # no step at all: the start, everywhere
+    fast = simulate._carriage_compiled(jit, still, (4, 9), machine)
+    assert np.array_equal(fast, simulate._carriage_numpy(still, (4, 9), machine))
+
+
+def test_deviation_by_blocks_equals_the_gathered_form() -> None:
+    """Block-wise deviation (scalars for long lines, chunks) == the one-pass gathered form."""
+    from camtool.model.program import ArcMove, Linear, Program, Rapid
+    from camtool.verify import metrics
+
+    rng = np.random.default_rng(8)
+    moves = [Rapid(1.0, 1.0), Linear(5.0, 1.0, 100.0), ArcMove(5.0, 3.0, 5.0, 2.0, False, 100.0)]
+    moves += [Linear(5.0, 3.0, 100.0), Rapid(2.0, 2.0), Linear(2.0, 2.0, 100.0)]  # zero-length
+    moves += [Linear(1.0 + 0.001 * k, 2.0 + 0.002 * k, 100.0) for k in range(300)]
+    program = Program(tuple(moves), origin=(0.0, 0.0))
+    sizes = [int(rng.integers(0, 9000)) for _ in moves]
+    sizes[1], sizes[2] = 20_000, 6_000  # a long line, a long arc
+    blocks = np.repeat(np.arange(len(moves), dtype=np.int64), sizes)
+    points = rng.uniform(0.0, 6.0, (len(blocks), 2))
+    for chunk in (1 << 20, 1000):
+        saved = metrics.DEVIATION_CHUNK
+        metrics.DEVIATION_CHUNK = chunk
+        try:
+            fast = metrics.deviation(points, blocks, program)
+        finally:
+            metrics.DEVIATION_CHUNK = saved
+        assert fast == metrics.deviation_gathered(points, blocks, program)
+    shuffled = blocks[::-1].copy()  # not in block order: the gathered form runs
+    assert metrics.deviation(points, shuffled, program) == metrics.deviation_gathered(
+        points, shuffled, program
+    )
