@@ -278,3 +278,47 @@ def play_axis(
                 mb = m + band
                 value = current if current <= mb else mb
         out[i, axis] = (value - c0 + start) / true_spm
+
+
+@numba.njit(cache=True, nogil=True)
+def _count_reversals(rows: Any, axis: int, direction: int) -> int:
+    count = 0
+    previous = direction
+    for i in range(rows.shape[0]):
+        s = rows[i, axis]
+        if s != 0:
+            if previous != 0 and s != previous:
+                count += 1
+            previous = s
+    return count
+
+
+@numba.njit(cache=True, nogil=True)
+def _fill_reversals(rows: Any, axis: int, direction: int, at: Any, signs: Any) -> int:
+    k = 0
+    previous = direction
+    for i in range(rows.shape[0]):
+        s = rows[i, axis]
+        if s != 0:
+            if previous != 0 and s != previous:
+                at[k] = i
+                signs[k] = s
+                k += 1
+            previous = s
+    return previous
+
+
+def reversals(rows: Any, axis: int, direction: int) -> tuple[Any, Any, int]:
+    """Reversals of column ``axis`` of step rows, given the axis's direction before them.
+
+    A reversal is a non-zero step whose sign differs from the previous non-zero one
+    (``direction`` before the first row; 0: none yet, so no reversal). Returns the rows
+    ``(K,) int64`` and signs ``(K,) int8`` of the reversals and the direction after the
+    rows (``direction`` when the column has no step), as ``simulate._Controller._compensate``
+    finds them with numpy.
+    """
+    count = _count_reversals(rows, axis, direction)
+    at = np.empty(count, dtype=np.int64)
+    signs = np.empty(count, dtype=np.int8)
+    last = _fill_reversals(rows, axis, direction, at, signs)
+    return at, signs, int(last)

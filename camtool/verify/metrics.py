@@ -213,7 +213,7 @@ def deviation(points: FloatArray, blocks: IntArray, program: Program) -> Deviati
     )
 
 
-DEVIATION_CHUNK = 1 << 20
+DEVIATION_CHUNK = 1 << 18
 """Most rows :func:`deviation` measures at once (about 100 bytes of temporaries each)."""
 DEVIATION_LONG = 4096
 """Rows from which a line block is measured on its own, with scalar segment numbers."""

@@ -209,23 +209,21 @@ class _Controller:
     ) -> tuple[npt.NDArray[Any], npt.NDArray[np.bool_]]:
         """Insert compensation rows at this block's reversals; update the direction state."""
         inserts: list[tuple[int, int, int]] = []  # (row, axis, sign)
+        jit = compiled(len(rows)) if rows.dtype == STEP_DTYPE else None
         for axis in (0, 1):
-            column = rows[:, axis]
-            nz = np.flatnonzero(column)
-            if nz.size == 0:
-                continue
-            signs = np.sign(column[nz]).astype(np.int64)
-            previous = np.concatenate(([self.direction[axis]], signs[:-1]))
-            at = np.flatnonzero((signs != previous) & (previous != 0))
-            self.reversals[axis] += int(at.size)
-            self.direction[axis] = int(signs[-1])
+            if jit is not None:
+                at_rows, at_signs, self.direction[axis] = jit.reversals(
+                    rows, axis, self.direction[axis]
+                )
+            else:
+                at_rows, at_signs = self._reversals(rows[:, axis], axis)
+            self.reversals[axis] += len(at_rows)
             if self.comp_steps[axis] == 0:
                 continue
-            for i in at:
-                row = int(nz[i])
+            for row, sign in zip(at_rows.tolist(), at_signs.tolist(), strict=True):
                 if line_starts:
                     row = line_starts[int(np.searchsorted(line_starts, row, side="right")) - 1]
-                inserts.append((row, axis, int(signs[i])))
+                inserts.append((row, axis, int(sign)))
         flags = np.zeros(len(rows), dtype=np.bool_)
         if not inserts:
             return rows, flags
@@ -242,6 +240,22 @@ class _Controller:
         pieces.append(rows[last:])
         flag_pieces.append(flags[last:])
         return np.concatenate(pieces), np.concatenate(flag_pieces)
+
+    def _reversals(
+        self, column: npt.NDArray[Any], axis: int
+    ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
+        """Rows and signs of the reversals of one axis's column; updates its direction.
+
+        (numpy; :func:`camtool.verify.kernels.reversals` is the compiled twin.)
+        """
+        nz = np.flatnonzero(column)
+        if nz.size == 0:
+            return nz, nz
+        signs = np.sign(column[nz]).astype(np.int64)
+        previous = np.concatenate(([self.direction[axis]], signs[:-1]))
+        at = np.flatnonzero((signs != previous) & (previous != 0))
+        self.direction[axis] = int(signs[-1])
+        return nz[at], signs[at]
 
     def finish(self, blocks: int) -> StepTrace:
         rows = np.concatenate(self.parts) if self.parts else np.zeros((0, 2), STEP_DTYPE)
