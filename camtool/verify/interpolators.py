@@ -255,10 +255,13 @@ def _dda_line_compiled(jit: ModuleType, px: int, py: int, sx: int, sy: int, s: i
     return out
 
 
-COMPILE_FROM = 2_000_000
-"""Rows of interpolator (and carriage) work, summed over the process, from which the
-compiled kernels are loaded: loading numba and its cache costs about 0.5–1 s once, more
-than the plain paths take for a small program (the logo: ~50 000 rows)."""
+COMPILE_FROM = 10_000_000
+"""Rows the plain (numpy / Python) paths have worked through in this process — each
+interpolator call, reversal scan and carriage counts its rows, so a simulated row counts
+about three times — from which the compiled kernels are loaded. Loading numba and its
+cache costs about 0.5–1 s once, as much as the plain paths take for some 3 M simulated
+rows; a small program (the logo: 0.3 M rows, simulated about 4 times with the error
+budget) never pays it."""
 
 
 def compiled(work: int = COMPILE_FROM) -> ModuleType | None:
