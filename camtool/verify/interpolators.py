@@ -255,13 +255,14 @@ def _dda_line_compiled(jit: ModuleType, px: int, py: int, sx: int, sy: int, s: i
     return out
 
 
-COMPILE_FROM = 10_000_000
+COMPILE_FROM = 20_000_000
 """Rows the plain (numpy / Python) paths have worked through in this process — each
 interpolator call, reversal scan and carriage counts its rows, so a simulated row counts
 about three times — from which the compiled kernels are loaded. Loading numba and its
-cache costs about 0.5–1 s once, as much as the plain paths take for some 3 M simulated
-rows; a small program (the logo: 0.3 M rows, simulated about 4 times with the error
-budget) never pays it."""
+cache costs about 1 s once (measured under load), more than the plain paths take for a
+4 M-row trace (whose carriage, the costliest part, then runs in numpy: ~0.2 s per M
+rows); from about 6 M simulated rows the kernels win. A small program (the logo: 0.3 M
+rows, simulated about 4 times with the error budget) never pays it."""
 
 
 def compiled(work: int = COMPILE_FROM) -> ModuleType | None:

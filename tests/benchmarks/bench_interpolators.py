@@ -18,22 +18,22 @@ checksums show that the peer did the same work. camtool is timed in-process, bes
 pure-Python loops (``*_reference``) are timed on a smaller sample and given as notes.
 
 Measured on this 2-core machine shared with 4 other jobs (so under load), best of 3,
-camtool 38babb0 (numba 0.68.1, numpy 2.4.6, gcc 12.2.0):
+numba 0.68.1, numpy 2.4.6, gcc 12.2.0; two runs:
 
-=====================================  ==============  =============  ==============  =====
+=====================================  ==============  =============  ==============  ==========
 job                                    before (numpy)  after (numba)  C ``cc -O2``    ratio
-=====================================  ==============  =============  ==============  =====
-DDA, 75 lines, 12.0 M iterations       28.7 M it/s     344 M it/s     301 M it/s      1.14×
-DSM, full circle R = 2 M, 11.3 M it.   1.0 M it/s      163 M it/s     404 M it/s      0.40×
-=====================================  ==============  =============  ==============  =====
+=====================================  ==============  =============  ==============  ==========
+DDA, 75 lines, 12.0 M iterations       28.7 M it/s     344–545 M/s    301–304 M/s     1.1–1.8×
+DSM, full circle R = 2 M, 11.3 M it.   1.0 M it/s      89–163 M/s     210–404 M/s     0.40–0.42×
+=====================================  ==============  =============  ==============  ==========
 
 ("before" is the issue's figure; the printed rows give this run's.) The DDA matches the
 literal C loop because camtool computes its closed form (``k(n) = ⌊n·P/HIPO⌋``, near-ties
 re-checked exactly; integer HIPO: the integer register loop), which the compiler
 vectorises, while the register loop of A.3 carries a dependency from one iteration to
-the next; camtool's time includes allocating the rows of every call. First call in a
-fresh process (importing numba, loading its cache of the compiled loops): 1.0 s under
-load (0.5 s CPU); a process that must compile them (no cache yet): about 3 s, once.
+the next; camtool's time includes allocating the rows of every call. Loading the kernels
+in a fresh process (importing numba, its first call, its cache of the compiled loops):
+about 1 s under load; a process that must compile them (no cache yet): about 15 s, once.
 Target: the whole script well under 1 min.
 """
 
@@ -160,6 +160,7 @@ def first_call_s() -> float:
     code = (
         "import time; t = time.perf_counter()\n"
         "from camtool.verify import interpolators as i\n"
+        "i.compiled()\n"  # load the kernels now (a big job does so by itself)
         "i.dda_line(3, 4); i.dda_line(3, 5); i.dsm_arc(0, 30, 0, 30, 0, 0, True)\n"
         "print(time.perf_counter() - t)\n"
     )
@@ -232,6 +233,8 @@ def main() -> None:
     """Run both jobs and print their rows."""
     t0 = time.perf_counter()
     first = first_call_s()
+    if itp.compiled() is None:  # load the kernels before timing (a big job does so itself)
+        print("numba not installed: the plain numpy / Python paths are timed", file=sys.stderr)
     extra = f"first call in a fresh process (numba import + cached loops) {first:.2f} s"
     cc = compiler()
     with tempfile.TemporaryDirectory(prefix="camtool-bench-c-") as tmp:

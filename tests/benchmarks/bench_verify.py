@@ -18,22 +18,25 @@ Set ``CAMTOOL_BENCH_BASE=/path/to/old/tree`` to run the same two jobs on another
 (e.g. the code before issue 17) in the same run: its times and memory are printed, and
 the reports must be byte-identical (the row notes it).
 
-Measured on the 2-core machine shared with 4 other jobs (so under load), the big
-program (13.2 M steps):
+Measured on the 2-core machine shared with 4 other jobs (so under load; the two trees run
+one after the other in the same run, best of 2), camtool b3b77a5 (before) and this branch
+(after); C peer ``cc -O2`` (gcc 12.2.0):
 
-==================================  ==========  =========  ============  ============
-tree                                wall        peak RSS   steps/s       ratio to C
-==================================  ==========  =========  ============  ============
-before (b3b77a5)                    20.8 s      ~1.9 GB*   0.63 M/s      0.002×
-after (this branch)                 see rows    see rows   see rows      see rows
-==================================  ==========  =========  ============  ============
+=======================================  ===================  ===================  =======
+job                                      before               after                vs C
+=======================================  ===================  ===================  =======
+verify, 200 lines, 13.2 M steps          18.6 s, 2155 MB      9.3 s, 922 MB        0.005×
+  (same, heavier load)                   39.3 s               18.8 s, 907 MB       0.005×
+verify, 50 lines, 3.3 M steps            7.4 s, 567 MB        6.5 s, 407 MB        0.002×
+post --verify of the logo                5.5–15.9 s, 235 MB   6.0–14.9 s, 232 MB   —
+=======================================  ===================  ===================  =======
 
-(* the 3 M-step, 40-line program of the issue: 3.5 s, 482 MB on a quiet machine.) The
-reports of the big program and of the logo are byte-identical before and after. What
-remains is mostly outside the interpolators: ``along_path`` (the path-to-trace shortfall,
-about 40 % of the time) and the whole trace held as arrays (27 bytes per row plus the
-carriage copy ``along_path`` makes), which keep the peak memory over the 250 MB goal at
-this size; see the printed notes.
+Every report is byte-identical before and after. The goals (≥ 0.05× the C loop's
+steps/s, < 250 MB) are not met: of the 13.2 M-step verify's ~9 s, ``along_path`` (the
+path-to-trace shortfall, not part of this work) takes about 4 s, starting Python and
+numba about 1.5 s, and the whole trace is held as arrays (27 bytes a row, plus the copy of
+the carriage ``along_path`` makes per contour), which is what keeps the memory at
+~0.9 GB; see the issue-17 report for the profile.
 """
 
 from __future__ import annotations
