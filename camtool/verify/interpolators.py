@@ -85,6 +85,13 @@ from camtool.model.program import ArcMove
 from camtool.model.shapes import chord_count, distance
 from camtool.verify.steparray import StepArray, concatenate, empty_steps, freeze
 
+
+def freeze_view(rows: npt.NDArray[np.int8]) -> StepArray:
+    """``rows`` (an ``(N, 2) int8`` view) marked read-only, not copied."""
+    rows.flags.writeable = False
+    return rows
+
+
 _TIE_WINDOW = 1e-7
 """Half-width of the window around an integer in which the float estimate of the
 DDA overflow count is re-checked with exact integer arithmetic."""
@@ -773,19 +780,28 @@ def _search_arc(args: tuple[int, ...], clockwise: bool, run: _Runner) -> StepArr
     magnitude = max(abs(u0), abs(v0), abs(u1), abs(v1))
     kernel = _compiled_runner(run, magnitude)
     parts = []
+    buffer, at = np.empty((0, 2), dtype=np.int8), 0
+    if kernel is not None:  # one buffer for every quadrant (a full circle: < 8R rows)
+        buffer = np.empty((8 * magnitude + 64, 2), dtype=np.int8)
     for i, q in enumerate(plan):
         gx = 1 if _grows_x(q, cw) else -1
         x, y = abs(u), abs(v)
         sx, sy = _stops(gx, x, y, abs(u1), abs(v1), i == len(plan) - 1)
         if kernel is not None:
-            x, y, d, rows = kernel(x, y, d, gx, -gx, sx, sy, q[0] * gx, -q[1] * gx)
-            parts.append(rows)
+            x, y, d, buffer, at = kernel(
+                x, y, d, gx, -gx, sx, sy, q[0] * gx, -q[1] * gx, buffer, at
+            )
         else:
             codes = bytearray()
             x, y, d = run(x, y, d, gx, -gx, sx, sy, codes)
             parts.append(_code_rows(codes, q[0] * gx, -q[1] * gx))
         u, v = q[0] * x, q[1] * y
-    parts.append(_closing(u1 - u, v1 - v))
+    closing = _closing(u1 - u, v1 - v)
+    if kernel is not None and len(closing) == 0:
+        return freeze_view(buffer[:at])
+    if kernel is not None:
+        parts.append(buffer[:at])
+    parts.append(closing)
     return concatenate(parts)
 
 

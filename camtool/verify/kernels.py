@@ -106,11 +106,14 @@ def _grow(out: Any, i: int) -> Any:
 
 @numba.njit(cache=True, nogil=True)
 def dsm_quadrant(
-    x: int, y: int, d: int, gx: int, gy: int, sx: int, sy: int, ux: int, uy: int
-) -> tuple[int, int, int, Any]:
-    """``_dsm_run`` of annex A.6 writing rows ``(ux, 0)``, ``(0, uy)``, ``(ux, uy)``."""
-    out = np.empty((2 * (x + y) + 64, 2), dtype=np.int8)
-    i = 0
+    x: int, y: int, d: int, gx: int, gy: int, sx: int, sy: int, ux: int, uy: int, out: Any, at: int
+) -> tuple[int, int, int, Any, int]:
+    """``_dsm_run`` of annex A.6 writing rows ``(ux, 0)``, ``(0, uy)``, ``(ux, uy)``.
+
+    Rows go to ``out`` from row ``at`` on (``out`` is grown when full); returns the end
+    state, the buffer and the next free row.
+    """
+    i = at
     dx = 2 * x * gx + 1
     dy = 2 * y * gy + 1
     while x != sx and y != sy:
@@ -143,16 +146,15 @@ def dsm_quadrant(
             out[i, 0] = ux
             out[i, 1] = 0
         i += 1
-    return x, y, d, out[:i]
+    return x, y, d, out, i
 
 
 @numba.njit(cache=True, nogil=True)
 def staircase_quadrant(
-    x: int, y: int, d: int, gx: int, gy: int, sx: int, sy: int, ux: int, uy: int
-) -> tuple[int, int, int, Any]:
-    """``_staircase_run`` of annex A.5 writing rows ``(ux, 0)`` / ``(0, uy)``."""
-    out = np.empty((2 * (x + y) + 64, 2), dtype=np.int8)
-    i = 0
+    x: int, y: int, d: int, gx: int, gy: int, sx: int, sy: int, ux: int, uy: int, out: Any, at: int
+) -> tuple[int, int, int, Any, int]:
+    """``_staircase_run`` of annex A.5 writing rows ``(ux, 0)`` / ``(0, uy)`` (as dsm_quadrant)."""
+    i = at
     while x != sx and y != sy:
         if i == out.shape[0]:
             out = _grow(out, i)
@@ -178,7 +180,7 @@ def staircase_quadrant(
             out[i, 0] = ux
             out[i, 1] = 0
         i += 1
-    return x, y, d, out[:i]
+    return x, y, d, out, i
 
 
 @numba.njit(cache=True, nogil=True)
