@@ -72,7 +72,10 @@ from __future__ import annotations
 
 import math
 import operator
+import sys
 from collections.abc import Callable
+from types import ModuleType
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -81,6 +84,13 @@ from camtool.model.errors import InputError, UsageError
 from camtool.model.program import ArcMove
 from camtool.model.shapes import chord_count, distance
 from camtool.verify.steparray import StepArray, concatenate, empty_steps, freeze
+
+
+def freeze_view(rows: npt.NDArray[np.int8]) -> StepArray:
+    """``rows`` (an ``(N, 2) int8`` view) marked read-only, not copied."""
+    rows.flags.writeable = False
+    return rows
+
 
 _TIE_WINDOW = 1e-7
 """Half-width of the window around an integer in which the float estimate of the
@@ -186,8 +196,114 @@ def dda_line(dx: int, dy: int) -> StepArray:
     s = px * px + py * py
     if s == 0:
         return empty_steps()
+    jit = compiled(math.isqrt(s) + 1)
+    if jit is not None and s < jit.SAFE_SQUARE:
+        return _dda_line_compiled(jit, px, py, _sign(dx), _sign(dy), s)
+    return dda_line_numpy(dx, dy)
+
+
+def dda_line_numpy(dx: int, dy: int) -> StepArray:
+    """:func:`dda_line` by the numpy closed form (no numba); same rows.
+
+    Args:
+        dx: X move, steps, signed.
+        dy: Y move, steps, signed.
+
+    Returns:
+        Step array identical to ``dda_line(dx, dy)``.
+
+    Raises:
+        UsageError: If ``dx`` or ``dy`` is not an integer.
+    """
+    dx, dy = _as_int("dx", dx), _as_int("dy", dy)
+    px, py = abs(dx), abs(dy)
+    s = px * px + py * py
+    if s == 0:
+        return empty_steps()
     n = np.arange(1, math.isqrt(s) + 2, dtype=np.int64)
     return _rows(_sign(dx), _sign(dy), _dda_counts(px, s, n), _dda_counts(py, s, n))
+
+
+def _dda_count_at(p: int, s: int, n: int) -> int:
+    """One value of :func:`_dda_counts` (``n`` ≥ 0; ``k(0) = 0``), exact."""
+    if p == 0 or n == 0:
+        return 0
+    return int(_dda_counts(p, s, np.asarray([n], dtype=np.int64))[0])
+
+
+def _dda_line_compiled(jit: ModuleType, px: int, py: int, sx: int, sy: int, s: int) -> StepArray:
+    """:func:`dda_line` by the compiled kernels; near-ties re-checked in exact integers.
+
+    HIPO an integer: the integer register loop (exact). Else the kernel computes
+    ``k(n)`` with the same float product as :func:`_dda_counts` and counts the ``n``
+    whose estimate lies within :data:`_TIE_WINDOW` of an integer; those rows (and
+    the next, which depends on the same count) are recomputed here exactly, so
+    the rows equal :func:`dda_line_numpy`'s. Rows come packed one ``uint16`` each
+    (X in the low byte: little-endian only, see :func:`compiled`).
+    """
+    h = math.isqrt(s)
+    lo, hi = sx & 0xFF, (sy & 0xFF) << 8
+    if h * h == s:
+        packed = jit.dda_exact(px, py, h, lo, hi, h + 1)
+        ties: list[int] = []
+    else:
+        root = math.sqrt(s)
+        cx, cy = (px / root if px else 0.0), (py / root if py else 0.0)
+        packed, count = jit.dda_float(cx, cy, lo, hi, h + 1, _TIE_WINDOW)
+        ties = jit.dda_ties(cx, cy, h + 1, _TIE_WINDOW).tolist() if count else []
+    out = packed.view(np.int8).reshape(-1, 2)
+    for i in ties:
+        for row in (i, i + 1):
+            if row <= h:
+                for col, p, sign in ((0, px, sx), (1, py, sy)):
+                    k = _dda_count_at(p, s, row + 1) - _dda_count_at(p, s, row)
+                    out[row, col] = sign * k
+    out.flags.writeable = False
+    return out
+
+
+COMPILE_FROM = 20_000_000
+"""Rows the plain (numpy / Python) paths have worked through in this process — each
+interpolator call, reversal scan and carriage counts its rows, so a simulated row counts
+about three times — from which the compiled kernels are loaded. Loading numba and its
+cache costs about 1 s once (measured under load), more than the plain paths take for a
+4 M-row trace (whose carriage, the costliest part, then runs in numpy: ~0.2 s per M
+rows); from about 6 M simulated rows the kernels win. A small program (the logo: 0.3 M
+rows, simulated about 4 times with the error budget) never pays it."""
+
+
+def compiled(work: int = COMPILE_FROM) -> ModuleType | None:
+    """The numba kernels (:mod:`camtool.verify.kernels`), once the work warrants them.
+
+    ``work`` is the rows the caller is about to produce; the kernels are loaded when
+    the rows asked for so far in this process reach :data:`COMPILE_FROM` (the default
+    asks for them at once) and then used by every later call. ``None`` before that,
+    when numba is not installed, or on a big-endian machine (the packed rows assume
+    little-endian); the numpy / Python paths then give the same rows.
+
+    Args:
+        work: Rows the caller is about to compute, ``>= 0``.
+
+    Returns:
+        The kernels module, or ``None`` (use the plain path).
+    """
+    if "kernels" in _COMPILED:
+        return _COMPILED["kernels"]
+    _WORK[0] += work
+    if _WORK[0] < COMPILE_FROM:
+        return None
+    kernels: ModuleType | None = None
+    if sys.byteorder == "little":
+        try:
+            from camtool.verify import kernels
+        except ImportError:
+            kernels = None
+    _COMPILED["kernels"] = kernels
+    return kernels
+
+
+_WORK = [0]
+_COMPILED: dict[str, ModuleType | None] = {}
 
 
 def dda_line_reference(dx: int, dy: int) -> StepArray:
@@ -639,22 +755,53 @@ def _arc_checked(
     return u0, v0, u1, v1, r2
 
 
+def _compiled_runner(run: _Runner, magnitude: int) -> Callable[..., Any] | None:
+    """The compiled twin of ``run`` (same moves, rows written directly), or ``None``.
+
+    ``None`` without numba, for a runner without a twin, or when a magnitude is
+    large enough that int64 could overflow (the Python loop is exact at any size).
+    """
+    jit = compiled(8 * magnitude)  # a full circle: up to 8R rows
+    if jit is None or magnitude >= jit.SAFE_MAGNITUDE:
+        return None
+    if run is _dsm_run:
+        return jit.dsm_quadrant
+    if run is _staircase_run:
+        return jit.staircase_quadrant
+    return None
+
+
 def _search_arc(args: tuple[int, ...], clockwise: bool, run: _Runner) -> StepArray:
     """Drive a decision-variable runner (DSM or staircase) over the planned quadrants."""
     u0, v0, u1, v1, _r2 = _arc_checked(*args)
     cw = bool(clockwise)
     plan = _plan(u0, v0, u1, v1, cw)
     u, v, d = u0, v0, 0  # D0 = 0: R² is taken from the start point
+    magnitude = max(abs(u0), abs(v0), abs(u1), abs(v1))
+    kernel = _compiled_runner(run, magnitude)
     parts = []
+    buffer, at = np.empty((0, 2), dtype=np.int8), 0
+    if kernel is not None:  # one buffer for every quadrant (a full circle: < 8R rows)
+        buffer = np.empty((8 * magnitude + 64, 2), dtype=np.int8)
     for i, q in enumerate(plan):
         gx = 1 if _grows_x(q, cw) else -1
         x, y = abs(u), abs(v)
         sx, sy = _stops(gx, x, y, abs(u1), abs(v1), i == len(plan) - 1)
-        codes = bytearray()
-        x, y, d = run(x, y, d, gx, -gx, sx, sy, codes)
-        parts.append(_code_rows(codes, q[0] * gx, -q[1] * gx))
+        if kernel is not None:
+            x, y, d, buffer, at = kernel(
+                x, y, d, gx, -gx, sx, sy, q[0] * gx, -q[1] * gx, buffer, at
+            )
+        else:
+            codes = bytearray()
+            x, y, d = run(x, y, d, gx, -gx, sx, sy, codes)
+            parts.append(_code_rows(codes, q[0] * gx, -q[1] * gx))
         u, v = q[0] * x, q[1] * y
-    parts.append(_closing(u1 - u, v1 - v))
+    closing = _closing(u1 - u, v1 - v)
+    if kernel is not None and len(closing) == 0:
+        return freeze_view(buffer[:at])
+    if kernel is not None:
+        parts.append(buffer[:at])
+    parts.append(closing)
     return concatenate(parts)
 
 

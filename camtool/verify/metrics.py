@@ -11,8 +11,9 @@ deviation of a point is its distance to the segment its block was cutting
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import partial
 from typing import Any, Protocol
 
 import numpy as np
@@ -149,7 +150,12 @@ def _to_arcs(points: FloatArray, blocks: IntArray, nominal: dict[str, FloatArray
 def deviation(points: FloatArray, blocks: IntArray, program: Program) -> Deviation:
     """Deviation of the cutting points of a trace from the program's nominal path.
 
-    Points of rapid moves are not measured (a rapid has no nominal path).
+    Points of rapid moves are not measured (a rapid has no nominal path). Rows are
+    measured a block (or a run of short blocks) at a time, at most
+    :data:`DEVIATION_CHUNK` rows at once, a long line with its segment's numbers as
+    scalars: the same float operations per point as :func:`point_distances`, so the
+    same distances (:func:`deviation_gathered` is the one-pass form, kept for
+    comparison and for rows not in block order).
 
     Args:
         points: ``(N, 2)`` float64 trace, mm.
@@ -157,6 +163,92 @@ def deviation(points: FloatArray, blocks: IntArray, program: Program) -> Deviati
         program: the program the trace executed.
     """
     nominal = nominal_arrays(program)
+    bounds = _block_bounds(blocks, len(nominal["kind"]))
+    if bounds is None:
+        return _deviation_of(points, blocks, nominal)
+    cutting = nominal["kind"] != 2
+    sizes = np.diff(bounds)
+    total = int(sizes[cutting].sum())
+    if total == 0:
+        return Deviation(0.0, 0.0, (0.0, 0.0), -1, 0)
+    dist = np.empty(total, dtype=np.float64)
+    pieces: list[tuple[int, int]] = []  # (offset in dist, first row) of each measured piece
+    at = 0
+    pending = -1  # first row of a run of short cutting blocks not yet measured
+    for b in range(len(sizes) + 1):
+        lo = int(bounds[b]) if b < len(sizes) else len(blocks)
+        long_line = b < len(sizes) and cutting[b] and nominal["kind"][b] == 0
+        long_line = long_line and sizes[b] >= DEVIATION_LONG
+        flush = b == len(sizes) or not cutting[b] or long_line
+        if pending >= 0 and (flush or lo - pending >= DEVIATION_CHUNK):
+            for c in range(pending, lo, DEVIATION_CHUNK):
+                hi = min(lo, c + DEVIATION_CHUNK)
+                dist[at : at + hi - c] = point_distances(points[c:hi], blocks[c:hi], nominal)
+                pieces.append((at, c))
+                at += hi - c
+            pending = -1
+        if b == len(sizes) or not cutting[b]:
+            continue
+        hi = int(bounds[b + 1])
+        if long_line:
+            ends = tuple(nominal[k][b] for k in ("x0", "y0", "x1", "y1"))
+            for c in range(lo, hi, DEVIATION_CHUNK):
+                top = min(hi, c + DEVIATION_CHUNK)
+                dist[at : at + top - c] = _to_line(points[c:top], *ends)
+                pieces.append((at, c))
+                at += top - c
+        elif pending < 0 and hi > lo:
+            pending = lo
+    worst = int(np.argmax(dist))
+    piece = int(np.searchsorted([p[0] for p in pieces], worst, side="right")) - 1
+    row = pieces[piece][1] + worst - pieces[piece][0]
+    max_mm = float(dist[worst])
+    np.multiply(dist, dist, out=dist)
+    return Deviation(
+        max_um=max_mm * 1000.0,
+        rms_um=float(np.sqrt(np.mean(dist))) * 1000.0,
+        at_mm=(float(points[row, 0]), float(points[row, 1])),
+        block=int(blocks[row]),
+        points=total,
+    )
+
+
+DEVIATION_CHUNK = 1 << 18
+"""Most rows :func:`deviation` measures at once (about 100 bytes of temporaries each)."""
+DEVIATION_LONG = 4096
+"""Rows from which a line block is measured on its own, with scalar segment numbers."""
+
+
+def _block_bounds(blocks: IntArray, count: int) -> IntArray | None:
+    """Row offsets ``(count + 1,)`` of each block when ``blocks`` is in block order, else None."""
+    if len(blocks) and (blocks[0] < 0 or blocks[-1] >= count):
+        return None
+    if len(blocks) > 1 and bool(np.any(blocks[1:] < blocks[:-1])):
+        return None
+    return np.searchsorted(blocks, np.arange(count + 1), side="left").astype(np.int64)
+
+
+def _to_line(points: FloatArray, x0: float, y0: float, x1: float, y1: float) -> FloatArray:
+    """:func:`_to_lines` for points of one block: its numbers as scalars, same floats."""
+    dx, dy = x1 - x0, y1 - y0
+    px, py = points[:, 0] - x0, points[:, 1] - y0
+    length2 = dx * dx + dy * dy
+    t = (px * dx + py * dy) / length2 if length2 > 0 else np.zeros(len(points))
+    np.clip(t, 0.0, 1.0, out=t)
+    return np.hypot(px - t * dx, py - t * dy)
+
+
+def deviation_gathered(points: FloatArray, blocks: IntArray, program: Program) -> Deviation:
+    """:func:`deviation` in one pass over gathered per-row segment numbers (the plain form).
+
+    Same result; holds about 100 bytes per row at once.
+    """
+    return _deviation_of(points, blocks, nominal_arrays(program))
+
+
+def _deviation_of(
+    points: FloatArray, blocks: IntArray, nominal: dict[str, FloatArray]
+) -> Deviation:
     cutting = nominal["kind"][blocks] != 2 if len(blocks) else np.zeros(0, dtype=bool)
     pts, blk = points[cutting], blocks[cutting]
     if len(pts) == 0:
@@ -203,15 +295,18 @@ def measure_contours(
     starts = [program.origin] + [(m.x, m.y) for m in program.moves]
     for number, (first, last) in enumerate(contour_runs(program), start=1):
         lo, hi = int(block_start[first]), int(block_start[last + 1])
-        before = points[lo - 1] if lo > 0 else np.asarray(start_mm)
-        run = np.vstack([before, points[lo:hi]])
+        before = points[lo - 1] if lo > 0 else np.asarray(start_mm, dtype=np.float64)
         segments = [segment_of(starts[i], program.moves[i]) for i in range(first, last + 1)]
         box: BBox = bbox_union(s.bbox() for s in segments)
         nominal_size = (box[2] - box[0], box[3] - box[1])
-        size = (float(np.ptp(run[:, 0])), float(np.ptp(run[:, 1])))
+        size = _extent(before, points, lo, hi)  # np.ptp of the run, without copying it
         closed = math.dist(starts[first], starts[last + 1]) <= 1e-6
+        last_point = points[hi - 1] if hi > lo else before
         closure = (
-            (float(run[-1, 0] - run[0, 0]) * 1000.0, float(run[-1, 1] - run[0, 1]) * 1000.0)
+            (
+                float(last_point[0] - before[0]) * 1000.0,
+                float(last_point[1] - before[1]) * 1000.0,
+            )
             if closed
             else None
         )
@@ -226,16 +321,39 @@ def measure_contours(
                     (size[0] - nominal_size[0]) * 1000.0,
                     (size[1] - nominal_size[1]) * 1000.0,
                 ),
-                circle=_circle(segments, run, size) if closed else None,
+                circle=_circle(segments, partial(_run_of, before, points, lo, hi), size)
+                if closed
+                else None,
             )
         )
     return measures
 
 
+def _run_of(before: FloatArray, points: FloatArray, lo: int, hi: int) -> FloatArray:
+    """A contour's trace: ``before`` then ``points[lo:hi]``, ``(hi − lo + 1, 2)`` mm."""
+    return np.vstack([before, points[lo:hi]])
+
+
+def _extent(before: FloatArray, points: FloatArray, lo: int, hi: int) -> tuple[float, float]:
+    """``np.ptp`` per axis of ``before`` followed by ``points[lo:hi]`` (max and min are exact)."""
+    if hi <= lo:
+        return (0.0, 0.0)
+    out = []
+    for axis in (0, 1):  # column by column: a reduction over axis 0 of (N, 2) is slow
+        column = points[lo:hi, axis]
+        top = max(float(column.max()), float(before[axis]))
+        low = min(float(column.min()), float(before[axis]))
+        out.append(top - low)
+    return (out[0], out[1])
+
+
 def _circle(
-    segments: list[Segment], run: FloatArray, size: tuple[float, float]
+    segments: list[Segment], run_of: Callable[[], FloatArray], size: tuple[float, float]
 ) -> tuple[float, float, float, float] | None:
     """Nominal and fitted diameter of a contour made of arcs of one circle, else None.
+
+    ``run_of()`` gives the contour's trace (the point before it first), built only for a
+    contour of arcs.
 
     Z-only moves (a plunge, a rise onto a tab: no XY length) do not count, and a circle
     cut in several depth passes (sweeps adding up to a whole number of turns) is one.
@@ -247,7 +365,10 @@ def _circle(
     c0, r0 = arcs[0].centre, arcs[0].radius
     same = all(math.dist(a.centre, c0) <= 1e-6 and abs(a.radius - r0) <= 1e-6 for a in arcs)
     turns = abs(sum(a.sweep for a in arcs)) / math.tau
-    if not same or turns < 0.5 or abs(turns - round(turns)) > 1e-6 or len(run) < 3:
+    if not same or turns < 0.5 or abs(turns - round(turns)) > 1e-6:
+        return None
+    run = run_of()
+    if len(run) < 3:
         return None
     return (2.0 * r0, 2.0 * fit_circle(run)[2], size[0], size[1])
 

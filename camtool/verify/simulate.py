@@ -48,7 +48,7 @@ import numpy.typing as npt
 from camtool.model.machine import Backlash, Machine
 from camtool.model.program import ArcMove, Move, Program
 from camtool.model.shapes import Point, distance
-from camtool.verify.interpolators import sagitta_chord_points
+from camtool.verify.interpolators import compiled, sagitta_chord_points
 from camtool.verify.motion import StepTrace, library
 from camtool.verify.quantize import Rounding, steps_from_mm
 from camtool.verify.sources import ALL, Sources
@@ -160,7 +160,7 @@ class _Controller:
         else:
             dx, dy = end[0] - self.pos[0], end[1] - self.pos[1]
             rows, line_starts, dominant = self.line(dx, dy), [0], max(abs(dx), abs(dy))
-        pulses = np.abs(rows).sum(axis=0, dtype=np.int64) if len(rows) else (0, 0)
+        pulses = [int(np.abs(rows[:, k]).sum(dtype=np.int64)) for k in (0, 1)]  # by column: fast
         self.steps.append((int(pulses[0]), int(pulses[1]), z_steps))
         self.dominant.append(dominant)
         rows, comp = self._compensate(rows, line_starts)
@@ -209,23 +209,21 @@ class _Controller:
     ) -> tuple[npt.NDArray[Any], npt.NDArray[np.bool_]]:
         """Insert compensation rows at this block's reversals; update the direction state."""
         inserts: list[tuple[int, int, int]] = []  # (row, axis, sign)
+        jit = compiled(len(rows)) if rows.dtype == STEP_DTYPE else None
         for axis in (0, 1):
-            column = rows[:, axis]
-            nz = np.flatnonzero(column)
-            if nz.size == 0:
-                continue
-            signs = np.sign(column[nz]).astype(np.int64)
-            previous = np.concatenate(([self.direction[axis]], signs[:-1]))
-            at = np.flatnonzero((signs != previous) & (previous != 0))
-            self.reversals[axis] += int(at.size)
-            self.direction[axis] = int(signs[-1])
+            if jit is not None:
+                at_rows, at_signs, self.direction[axis] = jit.reversals(
+                    rows, axis, self.direction[axis]
+                )
+            else:
+                at_rows, at_signs = self._reversals(rows[:, axis], axis)
+            self.reversals[axis] += len(at_rows)
             if self.comp_steps[axis] == 0:
                 continue
-            for i in at:
-                row = int(nz[i])
+            for row, sign in zip(at_rows.tolist(), at_signs.tolist(), strict=True):
                 if line_starts:
                     row = line_starts[int(np.searchsorted(line_starts, row, side="right")) - 1]
-                inserts.append((row, axis, int(signs[i])))
+                inserts.append((row, axis, int(sign)))
         flags = np.zeros(len(rows), dtype=np.bool_)
         if not inserts:
             return rows, flags
@@ -243,15 +241,31 @@ class _Controller:
         flag_pieces.append(flags[last:])
         return np.concatenate(pieces), np.concatenate(flag_pieces)
 
+    def _reversals(
+        self, column: npt.NDArray[Any], axis: int
+    ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
+        """Rows and signs of the reversals of one axis's column; updates its direction.
+
+        (numpy; :func:`camtool.verify.kernels.reversals` is the compiled twin.)
+        """
+        nz = np.flatnonzero(column)
+        if nz.size == 0:
+            return nz, nz
+        signs = np.sign(column[nz]).astype(np.int64)
+        previous = np.concatenate(([self.direction[axis]], signs[:-1]))
+        at = np.flatnonzero((signs != previous) & (previous != 0))
+        self.direction[axis] = int(signs[-1])
+        return nz[at], signs[at]
+
     def finish(self, blocks: int) -> StepTrace:
         rows = np.concatenate(self.parts) if self.parts else np.zeros((0, 2), STEP_DTYPE)
         comp = np.concatenate(self.comp_parts) if self.comp_parts else np.zeros(0, np.bool_)
         counts = np.asarray(self.counts, dtype=np.int64)
         block_start = np.concatenate(([0], np.cumsum(counts))).astype(np.int64)
-        block_of_row = np.repeat(np.arange(blocks, dtype=np.int64), counts)
+        block_of_row = _block_of_row(blocks, block_start)
         carriage = _carriage(rows, self.origin_steps, self.machine)
         return StepTrace(
-            rows=read_only(np.sign(rows).astype(STEP_DTYPE)),
+            rows=read_only(rows if rows.dtype == STEP_DTYPE else np.sign(rows).astype(STEP_DTYPE)),
             compensation=read_only(comp),
             block_of_row=read_only(block_of_row),
             block_start=read_only(block_start),
@@ -357,6 +371,16 @@ class _IdealController(_Controller):
         return np.diff(np.vstack([[x0, y0], points]), axis=0)
 
 
+def _block_of_row(blocks: int, block_start: IntArray) -> IntArray:
+    """``(N,) int64`` move index of each row: ``np.repeat(arange(B), counts)``, slice by slice."""
+    if blocks > 10_000:  # many short blocks: numpy's repeat is quicker than a loop
+        return np.repeat(np.arange(blocks, dtype=np.int64), np.diff(block_start))
+    out = np.empty(int(block_start[-1]), dtype=np.int64)
+    for b in range(blocks):
+        out[block_start[b] : block_start[b + 1]] = b
+    return out
+
+
 def _start_mm(origin_steps: tuple[int, int], machine: Machine) -> Point:
     """Carriage start: the program origin as the controller rounded it, in real mm."""
     true = machine.real_steps_per_mm
@@ -368,6 +392,17 @@ def _carriage(rows: StepArray, origin: tuple[int, int], machine: Machine) -> Flo
 
     ``rows`` are whole steps (int8) or, for the ideal controller, fractional ones (float64).
     """
+    if rows.dtype == STEP_DTYPE and len(rows):
+        jit = compiled(len(rows))
+        if jit is not None:
+            return _carriage_compiled(jit, rows, origin, machine)
+    return _carriage_numpy(rows, origin, machine)
+
+
+def _carriage_numpy(
+    rows: npt.NDArray[Any], origin: tuple[int, int], machine: Machine
+) -> FloatArray:
+    """:func:`_carriage` with numpy (any row dtype); holds the motor positions whole."""
     true = machine.real_steps_per_mm
     kind = np.float64 if rows.dtype.kind == "f" else np.int64
     motor = np.cumsum(rows, axis=0, dtype=kind) + np.asarray(origin, dtype=kind)
@@ -375,6 +410,37 @@ def _carriage(rows: StepArray, origin: tuple[int, int], machine: Machine) -> Flo
     out = np.empty((len(rows), 2), dtype=np.float64)
     for axis in (0, 1):
         out[:, axis] = _play(signs[:, axis], motor, axis, origin[axis], machine) / true[axis]
+    return out
+
+
+def _carriage_compiled(
+    jit: Any, rows: StepArray, origin: tuple[int, int], machine: Machine
+) -> FloatArray:
+    """:func:`_carriage_numpy` by the compiled loops, for whole steps: the same floats.
+
+    Two passes over the rows, no motor array: the runs of each axis (their first row,
+    sign and the motor position there, :func:`camtool.verify.kernels.play_runs`), the
+    band of each run looked up as :func:`_play` does, then the play operator.
+    """
+    true = machine.real_steps_per_mm
+    runs = jit.play_runs(rows, int(origin[0]), int(origin[1]))
+    out = np.empty((len(rows), 2), dtype=np.float64)
+    for axis in (0, 1):
+        starts, signs, at = runs[3 * axis : 3 * axis + 3]
+
+        def band(k: int, axis: int = axis, at: npt.NDArray[np.int64] = at) -> float:
+            x_mm = at[k, 0] / true[0]
+            y_mm = at[k, 1] / true[1]
+            return machine.backlash.true_at(axis, x_mm, y_mm) / 1000.0 * true[axis]
+
+        bands = np.asarray(
+            [band(k) if signs[k] < 0 else 0.0 for k in range(len(starts))], dtype=np.float64
+        )
+        start = float(origin[axis])
+        c0 = start if not len(starts) or signs[0] > 0 else start + bands[0]
+        jit.play_axis(
+            rows, axis, int(origin[axis]), starts, signs, bands, c0, start, float(true[axis]), out
+        )
     return out
 
 

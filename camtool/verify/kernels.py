@@ -1,0 +1,326 @@
+"""Compiled inner loops of the verifier's interpolators (numba).
+
+The loops here are the same arithmetic as the pure-Python/numpy code of
+:mod:`camtool.verify.interpolators`, compiled with numba (``@njit(cache=True)``)
+so that a step costs a few nanoseconds: the linear DDA closed form (seed-000
+annex A.3, :func:`camtool.verify.interpolators.dda_line`) and the quadrant
+loops of the direct search method (A.6) and the staircase (A.5). They work on
+int64 and are only called where no value can overflow (the callers check
+:data:`SAFE_MAGNITUDE` and :data:`SAFE_SQUARE`); anything else stays on the
+exact Python path.
+
+This module imports numba, so it is imported lazily
+(:func:`camtool.verify.interpolators.compiled`), never at ``camtool --help`` time;
+without numba the callers run the numpy / Python code, which gives the same rows.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numba
+import numpy as np
+
+SAFE_MAGNITUDE = 1 << 40
+"""Largest coordinate magnitude (steps) the compiled arc loops accept: D, Δ and the
+squared terms stay far inside int64 (|D| ≤ ~2R, Δ ≤ 2R + 1)."""
+SAFE_SQUARE = 1 << 60
+"""Largest ``dx² + dy²`` (steps²) of a line the compiled DDA accepts (``n·P`` fits int64)."""
+
+
+@numba.njit(cache=True, nogil=True)
+def dda_exact(p: int, q: int, h: int, lo: int, hi: int, n_rows: int) -> Any:
+    """Rows of the A.3 DDA when HIPO is the integer ``h``, packed one ``uint16`` per row.
+
+    The literal register loop of annex A.3 on integers (``Q += P``; ``Q > HIPO`` pulses
+    and loses HIPO), which is exact here; it equals ``k(n) = (n·P − 1) // h`` of
+    ``_dda_counts``. A pulse adds ``lo`` (X: the low byte of the row) resp. ``hi``
+    (Y: the high byte), the step's int8 value already shifted into place.
+    """
+    out = np.empty(n_rows, dtype=np.uint16)
+    qx = 0
+    qy = 0
+    for i in range(n_rows):
+        v = 0
+        qx += p
+        if qx > h:
+            qx -= h
+            v += lo
+        qy += q
+        if qy > h:
+            qy -= h
+            v += hi
+        out[i] = v
+    return out
+
+
+@numba.njit(cache=True, nogil=True)
+def dda_float(cx: float, cy: float, lo: int, hi: int, n_rows: int, window: float) -> Any:
+    """Rows of the A.3 DDA by the closed form ``k(n) = floor(n·c)``, ``c = P/√s``, packed.
+
+    The same float product and truncation as the numpy ``_dda_counts``; returns the rows
+    (one ``uint16`` each, as :func:`dda_exact`) and how many estimates lie within
+    ``window`` of an integer (the caller re-checks those rows exactly, :func:`dda_ties`).
+    """
+    out = np.empty(n_rows, dtype=np.uint16)
+    ties = 0
+    kx_prev = 0
+    ky_prev = 0
+    edge = 0.5 - window
+    for i in range(n_rows):
+        n = i + 1
+        tx = n * cx
+        ty = n * cy
+        kx = int(tx)
+        ky = int(ty)
+        ties += abs((tx - kx) - 0.5) > edge
+        ties += abs((ty - ky) - 0.5) > edge
+        out[i] = (kx - kx_prev) * lo + (ky - ky_prev) * hi
+        kx_prev = kx
+        ky_prev = ky
+    return out, ties
+
+
+@numba.njit(cache=True, nogil=True)
+def dda_ties(cx: float, cy: float, n_rows: int, window: float) -> Any:
+    """Row indices (0-based) whose closed-form estimate :func:`dda_float` flags as near-ties."""
+    found = np.empty(n_rows, dtype=np.int64)
+    nt = 0
+    edge = 0.5 - window
+    for i in range(n_rows):
+        n = i + 1
+        tx = n * cx
+        ty = n * cy
+        if abs((tx - int(tx)) - 0.5) > edge or abs((ty - int(ty)) - 0.5) > edge:
+            found[nt] = i
+            nt += 1
+    return found[:nt]
+
+
+@numba.njit(cache=True, nogil=True)
+def _grow(out: Any, i: int) -> Any:
+    grown = np.empty((2 * out.shape[0] + 64, 2), dtype=np.int8)
+    grown[:i] = out[:i]
+    return grown
+
+
+@numba.njit(cache=True, nogil=True)
+def dsm_quadrant(
+    x: int, y: int, d: int, gx: int, gy: int, sx: int, sy: int, ux: int, uy: int, out: Any, at: int
+) -> tuple[int, int, int, Any, int]:
+    """``_dsm_run`` of annex A.6 writing rows ``(ux, 0)``, ``(0, uy)``, ``(ux, uy)``.
+
+    Rows go to ``out`` from row ``at`` on (``out`` is grown when full); returns the end
+    state, the buffer and the next free row.
+    """
+    i = at
+    dx = 2 * x * gx + 1
+    dy = 2 * y * gy + 1
+    while x != sx and y != sy:
+        if i == out.shape[0]:
+            out = _grow(out, i)
+        d1 = d + dx
+        d2 = d + dy
+        d3 = d1 + dy
+        a1 = d1 if d1 >= 0 else -d1
+        a2 = d2 if d2 >= 0 else -d2
+        a3 = d3 if d3 >= 0 else -d3
+        if (a2 > a3) if a1 > a2 else (a1 > a3):
+            d = d3
+            dx += 2
+            dy += 2
+            x += gx
+            y += gy
+            out[i, 0] = ux
+            out[i, 1] = uy
+        elif a1 > a2:
+            d = d2
+            dy += 2
+            y += gy
+            out[i, 0] = 0
+            out[i, 1] = uy
+        else:
+            d = d1
+            dx += 2
+            x += gx
+            out[i, 0] = ux
+            out[i, 1] = 0
+        i += 1
+    return x, y, d, out, i
+
+
+@numba.njit(cache=True, nogil=True)
+def staircase_quadrant(
+    x: int, y: int, d: int, gx: int, gy: int, sx: int, sy: int, ux: int, uy: int, out: Any, at: int
+) -> tuple[int, int, int, Any, int]:
+    """``_staircase_run`` of annex A.5 writing rows ``(ux, 0)`` / ``(0, uy)`` (as dsm_quadrant)."""
+    i = at
+    while x != sx and y != sy:
+        if i == out.shape[0]:
+            out = _grow(out, i)
+        if d <= 0:
+            if gx > 0:
+                d = d + 2 * x + 1
+                x += 1
+                out[i, 0] = ux
+                out[i, 1] = 0
+            else:
+                d = d + 2 * y + 1
+                y += 1
+                out[i, 0] = 0
+                out[i, 1] = uy
+        elif gx > 0:
+            d = d - 2 * y + 1
+            y -= 1
+            out[i, 0] = 0
+            out[i, 1] = uy
+        else:
+            d = d - 2 * x + 1
+            x -= 1
+            out[i, 0] = ux
+            out[i, 1] = 0
+        i += 1
+    return x, y, d, out, i
+
+
+@numba.njit(cache=True, nogil=True)
+def _count_runs(rows: Any, axis: int) -> int:
+    """Runs of equal non-zero step sign in column ``axis`` of ``rows``."""
+    count = 0
+    last = 0
+    for i in range(rows.shape[0]):
+        s = rows[i, axis]
+        if s != 0 and s != last:
+            count += 1
+            last = s
+    return count
+
+
+@numba.njit(cache=True, nogil=True)
+def _fill_runs(rows: Any, axis: int, ox: int, oy: int, starts: Any, signs: Any, at: Any) -> None:
+    """Fill the run starts, signs and motor positions of column ``axis`` (see play_runs)."""
+    k = 0
+    last = 0
+    mx = ox
+    my = oy
+    for i in range(rows.shape[0]):
+        mx += rows[i, 0]
+        my += rows[i, 1]
+        s = rows[i, axis]
+        if s != 0 and s != last:
+            starts[k] = i
+            signs[k] = s
+            at[k, 0] = mx
+            at[k, 1] = my
+            k += 1
+            last = s
+
+
+def play_runs(rows: Any, ox: int, oy: int) -> tuple[Any, ...]:
+    """Runs of equal step sign per axis, for the backlash play (``simulate._play``).
+
+    A run starts at a row whose non-zero step on that axis differs in sign from the
+    axis's previous non-zero step (or is its first). Returns, per axis, the run start
+    rows ``(R,) int64``, their signs ``(R,) int8`` (+1/-1) and the motor positions
+    ``(R, 2) int64`` after each start row (steps, absolute from ``(ox, oy)``): what the
+    band of the run is looked up with.
+    """
+    out: list[Any] = []
+    for axis in (0, 1):
+        count = _count_runs(rows, axis)
+        starts = np.empty(count, dtype=np.int64)
+        signs = np.empty(count, dtype=np.int8)
+        at = np.empty((count, 2), dtype=np.int64)
+        _fill_runs(rows, axis, ox, oy, starts, signs, at)
+        out += [starts, signs, at]
+    return tuple(out)
+
+
+@numba.njit(cache=True, nogil=True)
+def play_axis(
+    rows: Any,
+    axis: int,
+    origin: int,
+    starts: Any,
+    signs: Any,
+    bands: Any,
+    c0: float,
+    start: float,
+    true_spm: float,
+    out: Any,
+) -> None:
+    """One axis of ``simulate._carriage``: the play operator over the runs, into ``out``.
+
+    The same float operations, in the same order, as the numpy ``_play`` and
+    ``_carriage``: before the first run the carriage is ``c0``; in an up run it is
+    ``max(c, M)``, in a down run ``min(c, M + band)`` with ``c`` the value at the end
+    of the previous run and ``M`` the motor (integer steps); then ``(v − c0 + start) /
+    true_spm``. ``bands[r]`` is the band of run ``r`` in steps (unused for up runs).
+    """
+    n = rows.shape[0]
+    motor = origin
+    current = c0
+    value = c0
+    r = 0
+    runs = len(starts)
+    up = True
+    band = 0.0
+    for i in range(n):
+        motor += rows[i, axis]
+        if r < runs and i == starts[r]:
+            current = value
+            up = signs[r] > 0
+            band = bands[r]
+            r += 1
+        if r > 0:
+            m = float(motor)
+            if up:
+                value = current if current >= m else m
+            else:
+                mb = m + band
+                value = current if current <= mb else mb
+        out[i, axis] = (value - c0 + start) / true_spm
+
+
+@numba.njit(cache=True, nogil=True)
+def _count_reversals(rows: Any, axis: int, direction: int) -> int:
+    count = 0
+    previous = direction
+    for i in range(rows.shape[0]):
+        s = rows[i, axis]
+        if s != 0:
+            if previous != 0 and s != previous:
+                count += 1
+            previous = s
+    return count
+
+
+@numba.njit(cache=True, nogil=True)
+def _fill_reversals(rows: Any, axis: int, direction: int, at: Any, signs: Any) -> int:
+    k = 0
+    previous = direction
+    for i in range(rows.shape[0]):
+        s = rows[i, axis]
+        if s != 0:
+            if previous != 0 and s != previous:
+                at[k] = i
+                signs[k] = s
+                k += 1
+            previous = s
+    return previous
+
+
+def reversals(rows: Any, axis: int, direction: int) -> tuple[Any, Any, int]:
+    """Reversals of column ``axis`` of step rows, given the axis's direction before them.
+
+    A reversal is a non-zero step whose sign differs from the previous non-zero one
+    (``direction`` before the first row; 0: none yet, so no reversal). Returns the rows
+    ``(K,) int64`` and signs ``(K,) int8`` of the reversals and the direction after the
+    rows (``direction`` when the column has no step), as ``simulate._Controller._compensate``
+    finds them with numpy.
+    """
+    count = _count_reversals(rows, axis, direction)
+    at = np.empty(count, dtype=np.int64)
+    signs = np.empty(count, dtype=np.int8)
+    last = _fill_reversals(rows, axis, direction, at, signs)
+    return at, signs, int(last)
