@@ -10,6 +10,7 @@ deviation of a point is its distance to the segment its block was cutting
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -408,12 +409,13 @@ def _nearby_exact(
     near = ends.query_ball_point(samples, reach, return_length=True, workers=KD_WORKERS)
     if int(np.sum(near)) > NEARBY_MAX_PAIRS:
         return None
-    found = ends.query_ball_point(samples, reach, workers=KD_WORKERS)
-    counts = np.fromiter((len(f) for f in found), dtype=np.int64, count=len(found))
+    counts = np.asarray(near, dtype=np.int64)
     if counts.min() == 0:
         return None  # cannot happen (the segment of ``upper`` is within reach): be safe
+    found = ends.query_ball_point(samples, reach, workers=KD_WORKERS)
     owner = np.repeat(np.arange(len(samples)), counts)
-    seg = np.concatenate([np.asarray(f, dtype=np.int64) for f in found]) % len(a)
+    seg = np.fromiter(itertools.chain.from_iterable(found), dtype=np.int64, count=len(owner))
+    seg %= len(a)
     pair = np.unique(owner * len(a) + seg)  # each (sample, segment) once, sample-major
     owner, seg = pair // len(a), pair % len(a)
     used, local = np.unique(seg, return_inverse=True)
