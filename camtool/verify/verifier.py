@@ -496,8 +496,28 @@ def simulate(program: Program, machine: Machine, *, sources: Sources = ALL) -> S
     return simulate_steps(program, machine, sources=sources)
 
 
-def _nominal_lines(program: Program) -> list[np.ndarray]:
-    """The programmed cutting path as polylines ``(M, 2)`` mm, one per run between rapids."""
+_NOMINAL: list[tuple[Program, tuple[np.ndarray, ...]]] = []
+"""The last two programs' :func:`_nominal_lines` (kept, so their ``id`` is not reused)."""
+
+
+def _nominal_lines(program: Program) -> tuple[np.ndarray, ...]:
+    """The programmed cutting path as polylines ``(M, 2)`` mm, one per run between rapids.
+
+    The last two programs' lines are kept (read-only, the same tuple for the same
+    program: the error budget compares the drawing once per source with the same program).
+    """
+    for seen, lines in _NOMINAL:
+        if seen is program:
+            return lines
+    lines = _nominal_lines_now(program)
+    for line in lines:
+        line.flags.writeable = False
+    _NOMINAL[:] = [*_NOMINAL[-1:], (program, lines)]  # the code's and the plan's
+    return lines
+
+
+def _nominal_lines_now(program: Program) -> tuple[np.ndarray, ...]:
+    """:func:`_nominal_lines` without the kept copy."""
     lines: list[list[tuple[float, float]]] = []
     fresh = True
     for move, seg in program.segments():
@@ -510,7 +530,7 @@ def _nominal_lines(program: Program) -> list[np.ndarray]:
             fresh = False
         else:
             lines[-1].extend(pts[1:])
-    return [np.asarray(p, dtype=np.float64) for p in lines]
+    return tuple(np.asarray(p, dtype=np.float64) for p in lines)
 
 
 def _no_overlap(program: Program, drawing: Drawing, radius_mm: float) -> str | None:

@@ -138,3 +138,31 @@ def test_budget_reuses_the_drawing_figure_only_when_the_trace_is_the_same() -> N
     assert v.against is not None
     assert v.error_budget.without["rounding"]["distance to the drawing"] == again.max_um
     assert again.max_um == v.against.max_um
+
+
+def test_distance_to_the_path_is_kept_only_for_inputs_that_cannot_change() -> None:
+    samples = np.random.default_rng(5).uniform(0.0, 2.0, (200, 2))
+    lines = (np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 2.0]]), np.array([[0.5, 1.0]]))
+    want = metrics._distance_to_now(samples, lines)
+    open_answer = metrics._distance_to(samples, lines)  # writeable: measured, not kept
+    assert np.array_equal(open_answer, want) and open_answer.flags.writeable
+    samples.flags.writeable = False
+    for line in lines:
+        line.flags.writeable = False
+    first = metrics._distance_to(samples, lines)
+    assert metrics._distance_to(samples, lines) is first and np.array_equal(first, want)
+    copied = tuple(line.copy() for line in lines)  # other objects: measured again
+    assert metrics._distance_to(samples, copied) is not first
+
+
+def test_nominal_lines_are_kept_for_the_code_and_the_plan() -> None:
+    from camtool.verify.verifier import _nominal_lines, _nominal_lines_now
+
+    code, _ = _plate()
+    plan = dataclasses.replace(code, moves=code.moves[:-1])
+    lines = _nominal_lines(code)
+    assert _nominal_lines(plan) is not lines
+    assert _nominal_lines(code) is lines  # two kept: the code's survives the plan's
+    want = _nominal_lines_now(code)
+    assert all(np.array_equal(a, b) for a, b in zip(lines, want, strict=True))
+    assert not any(line.flags.writeable for line in lines)
