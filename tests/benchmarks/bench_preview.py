@@ -19,14 +19,23 @@ measurement (:func:`measure`):
 Each job's G-code is checked byte for byte against the sha256 the pre-work code wrote
 (b3b77a5, /work/wt/base17): a faster picture must not change the program.
 
-Measured (2 cores, shared with other engineers' jobs: under load, figures inflated):
+Measured on the 2-core development machine, 22 Nov 2026, *under load* (4 other engineers'
+jobs; load average 2.5–7), so every figure is inflated and noisy; the lead re-runs it on a
+quiet machine. Wall time and peak RSS of the CLI as this script measures them:
 
-============  ==================  ===================
-job           before (b3b77a5)    after (this branch)
-============  ==================  ===================
-part          see docstring end   see docstring end
-plate         see docstring end   see docstring end
-============  ==================  ===================
+=====================  ==========================  ===========================
+job                    before (b3b77a5)            after (branch h17view)
+=====================  ==========================  ===========================
+part (--preview)       36.0 s, 661 MB (load 2.5)   48.7–77 s wall at load 6–7
+plate (make demo)      31.4 s, 523 MB (load 2.5)   39.0 s, 519 MB (load 2.8)
+=====================  ==========================  ===========================
+
+Wall times this loaded say little; the CPU time of the verification and its error budget
+(``verify_job`` + ``error_budget``, one process, ``time.process_time``) compares better:
+part 26.0 s → 15.6 s, plate 19.0 s → 15.8 s; the preview itself is 0.7–0.9 s CPU. Planning
+alone (``post`` without ``--preview``) takes 4.7 s and 420 MB on this part, most of it
+loading OpenCascade for the offsets: the goal of 3 s and 300 MB is not met (see the
+"Speed" paragraph of docs/verify.md for what is left).
 """
 
 from __future__ import annotations
