@@ -23,13 +23,14 @@ Measured on the 2-core development machine, 22 Nov 2026, *under load* (4 other e
 jobs; load average 2.5–7), so every figure is inflated and noisy; the lead re-runs it on a
 quiet machine. Wall time and peak RSS of the CLI as this script measures them:
 
-=====================  ==========================  ===========================
-job                    before (b3b77a5)            after (branch h17view)
-=====================  ==========================  ===========================
-part (--preview)       36.0 s, 661 MB (load 2.5)   48.7–77 s wall at load 6–7
-plate (make demo)      31.4 s, 523 MB (load 2.5)   39.0 s, 519 MB (load 2.8)
-=====================  ==========================  ===========================
+=====================  ======================  ======================
+job (back to back)     before (b3b77a5)        after (branch h17view)
+=====================  ======================  ======================
+part (--preview)       31.7 s, 661 MB          22.0 s, 663 MB
+plate (make demo)      24.6 s, 522 MB          18.1 s, 525 MB
+=====================  ======================  ======================
 
+(load average 3–4.5, the two trees run one right after the other, same G-code sha256).
 Wall times this loaded say little; the CPU time of the verification and its error budget
 (``verify_job`` + ``error_budget``, one process, ``time.process_time``) compares better:
 part 26.0 s → 15.6 s, plate 19.0 s → 15.8 s; the preview itself is 0.7–0.9 s CPU. Planning
