@@ -10,6 +10,7 @@ deviation of a point is its distance to the segment its block was cutting
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -429,6 +430,9 @@ NEAREST_ENDS = 4
 """Segment ends :func:`nearest_distances` looks at around each sample."""
 NEAREST_CHUNK = 20_000
 """Samples :func:`nearest_distances` measures at once (memory ~ 1 kB each)."""
+KD_WORKERS = -1
+"""Threads of the k-d tree queries (scipy's ``workers``; -1: one per core). Each query is
+answered alone, so the distances do not depend on it; only the wall time does."""
 
 
 def _to_segments(p: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
@@ -463,7 +467,6 @@ def nearest_distances(samples: FloatArray, a: FloatArray, b: FloatArray) -> Floa
     Returns:
         ``(N,)`` float64 distances, mm (``inf`` without segments).
     """
-    import shapely
     from scipy.spatial import cKDTree
 
     if len(a) == 0:
@@ -477,12 +480,70 @@ def nearest_distances(samples: FloatArray, a: FloatArray, b: FloatArray) -> Floa
     d = np.concatenate([p[0] for p in parts]) if parts else np.zeros(0)
     unsure = np.concatenate([p[1] for p in parts]) if parts else np.zeros(0, dtype=bool)
     if unsure.any():
-        tree = shapely.STRtree(shapely.linestrings(np.stack([a, b], axis=1)))
-        _, exact = tree.query_nearest(
-            shapely.points(samples[unsure]), return_distance=True, all_matches=False
-        )
-        d[unsure] = np.asarray(exact, dtype=np.float64)
+        exact = _nearby_exact(samples[unsure], d[unsure], a, b, ends, half)
+        if exact is None:
+            exact = _all_exact(samples[unsure], a, b)
+        d[unsure] = exact
     return d
+
+
+def _all_exact(samples: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
+    """The GEOS distance (shapely) from each sample to the nearest of all segments, mm.
+
+    What :func:`nearest_distances` gave before :func:`_nearby_exact` (its fallback, and
+    the reference the tests compare it with, bit for bit).
+    """
+    import shapely
+
+    tree = shapely.STRtree(shapely.linestrings(np.stack([a, b], axis=1)))
+    _, exact = tree.query_nearest(shapely.points(samples), return_distance=True, all_matches=False)
+    return np.asarray(exact, dtype=np.float64)
+
+
+NEARBY_MAX_PAIRS = 4_000_000
+"""Most (sample, segment) pairs :func:`_nearby_exact` measures; beyond it :func:`_all_exact`."""
+
+
+def _nearby_exact(
+    samples: FloatArray, upper: FloatArray, a: FloatArray, b: FloatArray, ends: Any, half: float
+) -> FloatArray | None:
+    """:func:`_all_exact` over only the segments that can be the nearest, or ``None``.
+
+    A segment lies within ``L/2 <= half`` of one of its ends, so one whose ends are both
+    farther than ``upper + half`` from a sample lies farther than ``upper``, the distance
+    to a segment already found: it cannot be the nearest. The same GEOS distance is
+    taken over the rest, so the minimum is the one :func:`_all_exact` finds, without
+    building a tree of every segment for a few samples. ``None`` when the segments near
+    the samples are too many (over :data:`NEARBY_MAX_PAIRS` pairs).
+
+    Args:
+        samples: ``(U, 2)`` query points, mm.
+        upper: ``(U,)`` distance of each to some segment ``a → b``, mm.
+        a: ``(M, 2)`` segment starts, mm.
+        b: ``(M, 2)`` segment ends, mm.
+        ends: the k-d tree of ``concatenate([a, b])``.
+        half: half the longest segment, mm.
+    """
+    import shapely
+
+    reach = (upper + half) * (1.0 + 1e-9) + 1e-12  # a float margin: never leaves one out
+    near = ends.query_ball_point(samples, reach, return_length=True, workers=KD_WORKERS)
+    if int(np.sum(near)) > NEARBY_MAX_PAIRS:
+        return None
+    counts = np.asarray(near, dtype=np.int64)
+    if counts.min() == 0:
+        return None  # cannot happen (the segment of ``upper`` is within reach): be safe
+    found = ends.query_ball_point(samples, reach, workers=KD_WORKERS)
+    owner = np.repeat(np.arange(len(samples)), counts)
+    seg = np.fromiter(itertools.chain.from_iterable(found), dtype=np.int64, count=len(owner))
+    seg %= len(a)
+    pair = np.unique(owner * len(a) + seg)  # each (sample, segment) once, sample-major
+    owner, seg = pair // len(a), pair % len(a)
+    used, local = np.unique(seg, return_inverse=True)
+    lines = shapely.linestrings(np.stack([a[used], b[used]], axis=1))
+    dist = shapely.distance(shapely.points(samples)[owner], lines[local])
+    first = np.flatnonzero(np.r_[True, owner[1:] != owner[:-1]])
+    return np.asarray(np.minimum.reduceat(dist, first), dtype=np.float64)
 
 
 def _nearest_chunk(
@@ -494,7 +555,7 @@ def _nearest_chunk(
         The distances and which of them the tests could not settle.
     """
     k = min(NEAREST_ENDS, 2 * len(a))
-    r, index = ends.query(samples, k=k)
+    r, index = ends.query(samples, k=k, workers=KD_WORKERS)
     r = np.asarray(r, dtype=np.float64).reshape(len(samples), k)
     seg = np.asarray(index).reshape(len(samples), k) % len(a)
     d = _to_segments(samples, a[seg], b[seg]).min(axis=1)
@@ -724,6 +785,7 @@ def against_drawing(
     runs: IntArray | None = None,
     nominal: Sequence[FloatArray] = (),
     findings: Sequence[FindingLike] = (),
+    overcut: bool = True,
 ) -> Against:
     """Compare a cutting trace with the drawing it was made from (shapely nearest queries).
 
@@ -749,6 +811,8 @@ def against_drawing(
             run of cutting moves.
         findings: the plan's findings; those of :data:`NOT_CUT_KINDS` with a
             location name the features measured apart.
+        overcut: measure the overcut (``False``: ``overcut_um`` is 0, for a caller that
+            reads only the other figures, as the error budget does).
     """
     samples, sizes = _sample_drawing(drawing, spacing_mm)
     if len(points) < 2 or len(samples) == 0:
@@ -783,16 +847,16 @@ def against_drawing(
     kept = off[main] if main.any() else np.zeros(1)
     kept_at = samples[main] if main.any() else np.zeros((1, 2))
     worst = int(np.argmax(np.abs(kept)))
-    overcut = 0.0
-    if tool_radius_mm > 0:
+    overcut_um = 0.0
+    if overcut and tool_radius_mm > 0:
         same = _same_contour(sizes)
         d_p = nearest_distances(trace, samples[:-1][same], samples[1:][same])
-        overcut = max(0.0, float(tool_radius_mm - np.min(d_p))) * 1000.0
+        overcut_um = max(0.0, float(tool_radius_mm - np.min(d_p))) * 1000.0
     return Against(
         max_um=float(abs(kept[worst])) * 1000.0,
         rms_um=float(np.sqrt(np.mean(kept * kept))) * 1000.0,
         at_mm=(float(kept_at[worst, 0]), float(kept_at[worst, 1])),
-        overcut_um=overcut,
+        overcut_um=overcut_um,
         samples=len(samples),
         not_cut=tuple(features),
     )
@@ -911,8 +975,36 @@ def _named_contour(
     return int(contour_of[np.argmin(np.hypot(*(samples - at).T))])
 
 
+_DISTANCE_TO: list[tuple[FloatArray, Sequence[FloatArray], FloatArray]] = []
+"""The last :func:`_distance_to` answer, with the very arrays it was for (kept, so their
+``id`` is not reused): the error budget asks it again for the same samples and path."""
+
+
 def _distance_to(samples: FloatArray, lines: Sequence[FloatArray]) -> FloatArray:
-    """Distance of each sample to the nearest of ``lines`` (polylines ``(M, 2)``), mm."""
+    """Distance of each sample to the nearest of ``lines`` (polylines ``(M, 2)``), mm.
+
+    The same ``samples`` and ``lines`` objects as the last call, when they cannot change
+    (read-only arrays, ``lines`` a tuple: see :func:`_sample_drawing` and
+    :func:`camtool.verify.verifier._nominal_lines`), give the last answer again.
+    """
+    frozen = (
+        not samples.flags.writeable
+        and isinstance(lines, tuple)
+        and not any(line.flags.writeable for line in lines)
+    )
+    if not frozen:
+        return _distance_to_now(samples, lines)
+    for seen_samples, seen_lines, answer in _DISTANCE_TO:
+        if seen_samples is samples and seen_lines is lines:
+            return answer
+    answer = _distance_to_now(samples, lines)
+    answer.flags.writeable = False
+    _DISTANCE_TO[:] = [(samples, lines, answer)]
+    return answer
+
+
+def _distance_to_now(samples: FloatArray, lines: Sequence[FloatArray]) -> FloatArray:
+    """:func:`_distance_to` without the kept answer."""
     import shapely
 
     chords = [np.stack([p[:-1], p[1:]], axis=1) for p in lines if len(p) > 1]
@@ -934,11 +1026,28 @@ def _contour_ids(sizes: list[int]) -> IntArray:
     return np.repeat(np.arange(len(sizes), dtype=np.int64), sizes)
 
 
+_SAMPLED: list[tuple[Drawing, float, FloatArray, list[int]]] = []
+"""The last drawing :func:`_sample_drawing` sampled (the error budget compares the same
+drawing once per source): the drawing itself is kept, so its ``id`` is not reused."""
+
+
 def _sample_drawing(drawing: Drawing, spacing_mm: float) -> tuple[FloatArray, list[int]]:
     """Points along every contour, at most ``spacing_mm`` apart, and the count per contour.
 
     Contour after contour; the counts feed :func:`_contour_ids` and :func:`_same_contour`.
+    The last drawing's points are kept (read-only) and given again for the same drawing.
     """
+    for seen, spacing, samples, sizes in _SAMPLED:
+        if seen is drawing and spacing == spacing_mm:
+            return samples, list(sizes)
+    samples, sizes = _sample_drawing_now(drawing, spacing_mm)
+    samples.flags.writeable = False
+    _SAMPLED[:] = [(drawing, spacing_mm, samples, list(sizes))]
+    return samples, sizes
+
+
+def _sample_drawing_now(drawing: Drawing, spacing_mm: float) -> tuple[FloatArray, list[int]]:
+    """:func:`_sample_drawing` without the kept copy."""
     chunks = [_sample_contour(c.segments, spacing_mm) for c in drawing.contours]
     sizes = [len(c) for c in chunks]
     return (np.vstack(chunks) if chunks else np.zeros((0, 2))), sizes
@@ -971,10 +1080,17 @@ def _same_contour(sizes: list[int]) -> npt.NDArray[np.bool_]:
 
 
 def _thin_index(n: int, limit: int, runs: IntArray | None) -> IntArray:
-    """Indices of every k-th of ``n`` points, the last, and each run's first and last."""
+    """Indices of every k-th of ``n`` points, the last, and each run's first and last.
+
+    Sorted, each once (a mask: what ``np.unique`` of the picks gives, without sorting).
+    """
     k = max(1, math.ceil(n / limit))
-    picked = [np.arange(0, n, k), np.array([n - 1])]
+    picked = np.zeros(n, dtype=bool)
+    picked[::k] = True
+    if n > 0:
+        picked[n - 1] = True
     if runs is not None and n > 1:
         change = np.flatnonzero(runs[1:] != runs[:-1])
-        picked += [change, change + 1]
-    return np.unique(np.concatenate(picked))
+        picked[change] = True
+        picked[change + 1] = True
+    return np.flatnonzero(picked).astype(np.int64)

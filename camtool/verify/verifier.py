@@ -308,26 +308,61 @@ def _measure(
     against: Drawing | None,
     tool_diameter: float,
     findings: Sequence[FindingLike],
+    *,
+    overcut: bool = True,
 ) -> tuple[Deviation, AlongPath, tuple[ContourMeasure, ...], Against | None]:
-    """Every measure of one trace: deviation, along the path, contours, the drawing."""
+    """Every measure of one trace: deviation, along the path, contours, the drawing.
+
+    ``overcut=False`` leaves the drawing's overcut out (0): the error budget, which
+    re-measures once per source, has no figure of it.
+    """
     points, blocks = trace.carriage_mm, trace.block_of_row
     dev = deviation(points, blocks, program)
     along = along_path(points, trace.block_start, trace.start_mm, program)
     contours = tuple(measure_contours(points, trace.block_start, trace.start_mm, program))
     compared = None
     if against is not None:
-        rapid = np.asarray([isinstance(m, Rapid) for m in program.moves], dtype=bool)
-        cutting = ~rapid[blocks] if len(blocks) else np.zeros(0, dtype=bool)
-        runs = np.cumsum(~cutting)[cutting]  # a new id after every rapid row
+        cut, runs = _cutting_rows(program, trace)
         compared = against_drawing(
-            points[cutting],
+            cut,
             against,
             tool_diameter / 2.0,
             runs=runs,
             nominal=_nominal_lines(program) if findings else (),
             findings=findings,
+            overcut=overcut,
         )
     return dev, along, contours, compared
+
+
+def _cutting_rows(program: Program, trace: StepTrace) -> tuple[np.ndarray, np.ndarray]:
+    """The trace's cutting rows ``(N, 2)`` mm and the id of each one's run between rapids."""
+    points, blocks = trace.carriage_mm, trace.block_of_row
+    rapid = np.asarray([isinstance(m, Rapid) for m in program.moves], dtype=bool)
+    cutting = ~rapid[blocks] if len(blocks) else np.zeros(0, dtype=bool)
+    runs = np.cumsum(~cutting)[cutting]  # a new id after every rapid row
+    return points[cutting], runs
+
+
+def _same_against(v: Verification, program: Program, trace: StepTrace) -> bool:
+    """Whether :func:`against_drawing` of ``trace`` would get exactly ``v``'s inputs.
+
+    The same cutting rows, the same runs and (with findings) the same programmed path:
+    then its figures are ``v.against``'s, bit for bit, and need not be measured again
+    (the ``rounding`` source of a machine whose steps absorb the emitted rounding).
+    """
+    if v.against is None or v.drawing is None:
+        return False
+    cut, runs = _cutting_rows(program, trace)
+    cut_v, runs_v = _cutting_rows(v.program, v.trace)
+    if not (np.array_equal(cut, cut_v) and np.array_equal(runs, runs_v)):
+        return False
+    if not v.findings or program is v.program:
+        return True
+    mine, theirs = _nominal_lines(program), _nominal_lines(v.program)
+    return len(mine) == len(theirs) and all(
+        np.array_equal(a, b) for a, b in zip(mine, theirs, strict=True)
+    )
 
 
 def _budget(v: Verification) -> eb.ErrorBudget:
@@ -359,9 +394,13 @@ def _budget(v: Verification) -> eb.ErrorBudget:
                 return {}
         else:
             trace = simulate(program, v.machine, sources=ALL.without(name))
+        same = _same_against(v, program, trace)  # then the drawing is not measured again
+        drawing = None if same else v.drawing
         dev, along, contours, against = _measure(
-            program, trace, v.drawing, v.tool_diameter, v.findings
+            program, trace, drawing, v.tool_diameter, v.findings, overcut=False
         )
+        if same:
+            against = v.against
         values = eb.figures(dev, along, contours, against)
         if name == "rounding" and [c.blocks for c in contours] != [
             c.blocks for c in v.contours
@@ -457,8 +496,28 @@ def simulate(program: Program, machine: Machine, *, sources: Sources = ALL) -> S
     return simulate_steps(program, machine, sources=sources)
 
 
-def _nominal_lines(program: Program) -> list[np.ndarray]:
-    """The programmed cutting path as polylines ``(M, 2)`` mm, one per run between rapids."""
+_NOMINAL: list[tuple[Program, tuple[np.ndarray, ...]]] = []
+"""The last two programs' :func:`_nominal_lines` (kept, so their ``id`` is not reused)."""
+
+
+def _nominal_lines(program: Program) -> tuple[np.ndarray, ...]:
+    """The programmed cutting path as polylines ``(M, 2)`` mm, one per run between rapids.
+
+    The last two programs' lines are kept (read-only, the same tuple for the same
+    program: the error budget compares the drawing once per source with the same program).
+    """
+    for seen, lines in _NOMINAL:
+        if seen is program:
+            return lines
+    lines = _nominal_lines_now(program)
+    for line in lines:
+        line.flags.writeable = False
+    _NOMINAL[:] = [*_NOMINAL[-1:], (program, lines)]  # the code's and the plan's
+    return lines
+
+
+def _nominal_lines_now(program: Program) -> tuple[np.ndarray, ...]:
+    """:func:`_nominal_lines` without the kept copy."""
     lines: list[list[tuple[float, float]]] = []
     fresh = True
     for move, seg in program.segments():
@@ -471,7 +530,7 @@ def _nominal_lines(program: Program) -> list[np.ndarray]:
             fresh = False
         else:
             lines[-1].extend(pts[1:])
-    return [np.asarray(p, dtype=np.float64) for p in lines]
+    return tuple(np.asarray(p, dtype=np.float64) for p in lines)
 
 
 def _no_overlap(program: Program, drawing: Drawing, radius_mm: float) -> str | None:

@@ -1,0 +1,168 @@
+"""The faster paths of the verifier's measures equal the slow ones exactly (issue 17).
+
+Each fast path is compared with the code it replaces, kept for that purpose, on many
+random inputs: equality is bit for bit (``==`` on float64), not approximate, since the
+reports are written from these values.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from scipy.spatial import cKDTree
+
+from camtool.model.program import ArcMove, Linear, Program, Rapid
+from camtool.model.shapes import Arc, Contour, Drawing, Line
+from camtool.post.registry import load_target
+from camtool.verify import metrics
+from camtool.verify.verifier import _cutting_rows, simulate, verify_program
+
+
+def _polyline(rng: np.random.Generator, kind: int) -> np.ndarray:
+    """A staircase on a step grid (many equal distances) or a jittered arc snapped to one."""
+    n = int(rng.integers(2, 2500))
+    step = (0.004, 0.0005, 0.5)[kind % 3]
+    if kind % 2:
+        return np.cumsum(rng.choice([-step, 0.0, step], size=(n, 2)), axis=0)
+    angle = np.linspace(0.0, rng.uniform(1.0, 7.0), n)
+    radius = rng.uniform(0.1, 3.0)
+    pts = np.c_[radius * np.cos(angle), radius * np.sin(angle)] + rng.normal(0, step / 4, (n, 2))
+    return np.round(pts / step) * step
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_nearby_exact_is_the_all_segments_query_bit_for_bit(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    for kind in range(20):
+        pts = _polyline(rng, kind)
+        a, b = pts[:-1], pts[1:]
+        step = float(np.max(np.hypot(*(b - a).T))) if len(a) else 0.0
+        lo, hi = pts.min(axis=0) - 0.01, pts.max(axis=0) + 0.01
+        samples = rng.uniform(lo, hi, (300, 2))
+        on = pts[rng.integers(0, len(pts), 100)]  # on the vertices and half a step off
+        samples[:100] = on + rng.choice([0.0, step / 2, step], size=(100, 2))
+        half = step / 2.0
+        ends = cKDTree(np.concatenate([a, b]))
+        upper, _ = metrics._nearest_chunk(samples, a, b, ends, half)
+        fast = metrics._nearby_exact(samples, upper, a, b, ends, half)
+        assert fast is not None
+        assert np.array_equal(fast, metrics._all_exact(samples, a, b))
+
+
+def test_nearby_exact_gives_way_when_too_many_segments_are_near(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    pts = _polyline(np.random.default_rng(3), 1)
+    a, b = pts[:-1], pts[1:]
+    ends = cKDTree(np.concatenate([a, b]))
+    samples = pts[:50] + 0.001
+    upper, _ = metrics._nearest_chunk(samples, a, b, ends, 0.002)
+    monkeypatch.setattr(metrics, "NEARBY_MAX_PAIRS", 10)
+    assert metrics._nearby_exact(samples, upper, a, b, ends, 0.002) is None
+    monkeypatch.setattr(metrics, "NEARBY_MAX_PAIRS", 10**9)
+    got = metrics.nearest_distances(samples, a, b)
+    monkeypatch.setattr(metrics, "NEARBY_MAX_PAIRS", 0)  # every unsure sample: all segments
+    assert np.array_equal(got, metrics.nearest_distances(samples, a, b))
+
+
+def _thin_index_reference(n: int, limit: int, runs: np.ndarray | None) -> np.ndarray:
+    """The code :func:`metrics._thin_index` replaced (sorted unique of the picks)."""
+    k = max(1, -(-n // limit))
+    picked = [np.arange(0, n, k), np.array([n - 1])]
+    if runs is not None and n > 1:
+        change = np.flatnonzero(runs[1:] != runs[:-1])
+        picked += [change, change + 1]
+    return np.unique(np.concatenate(picked))
+
+
+def test_thin_index_is_the_sorted_unique_picks() -> None:
+    rng = np.random.default_rng(11)
+    for _ in range(300):
+        n = int(rng.integers(1, 3000))
+        limit = int(rng.integers(1, 4000))
+        runs = None if rng.random() < 0.3 else np.cumsum(rng.random(n) < 0.01)
+        got = metrics._thin_index(n, limit, runs)
+        want = _thin_index_reference(n, limit, runs)
+        assert got.dtype == want.dtype
+        assert np.array_equal(got, want)
+
+
+def test_drawing_samples_are_kept_for_the_same_drawing_only() -> None:
+    one = Drawing((Contour((Line((0.0, 0.0), (1.0, 0.0)),), False),))
+    two = Drawing((Contour((Line((0.0, 0.0), (2.0, 0.0)),), False),))
+    first, sizes = metrics._sample_drawing(one, 0.005)
+    again, _ = metrics._sample_drawing(one, 0.005)
+    assert again is first and not first.flags.writeable
+    other, other_sizes = metrics._sample_drawing(two, 0.005)
+    assert len(other) == 401 and other_sizes == [401] and sizes == [201]
+    assert np.array_equal(metrics._sample_drawing(one, 0.005)[0], first)
+
+
+def _plate() -> tuple[Program, Drawing]:
+    """A 6 × 4 mm rectangle at (5, 5) with a ø2 mm hole; a 0.5 mm tool outside / inside."""
+    c = [(5.0, 5.0), (11.0, 5.0), (11.0, 9.0), (5.0, 9.0)]
+    outline = Contour(tuple(Line(c[i], c[(i + 1) % 4]) for i in range(4)), True)
+    hole = Contour((Arc((10.0, 7.0), (10.0, 7.0), (9.0, 7.0), False),), True)
+    r = 0.25
+    moves = (
+        Rapid(9.75, 7.0, contour=1),
+        ArcMove(9.75, 7.0, 9.0, 7.0, False, 300.0, contour=1),
+        Rapid(5 - r, 5 - r, contour=2),
+        Linear(11 + r, 5 - r, 300.0, contour=2),
+        Linear(11 + r, 9 + r, 300.0, contour=2),
+        Linear(5 - r, 9 + r, 300.0, contour=2),
+        Linear(5 - r, 5 - r, 300.0, contour=2),
+    )
+    return Program(moves, origin=(0.0, 0.0)), Drawing((hole, outline))
+
+
+def test_budget_reuses_the_drawing_figure_only_when_the_trace_is_the_same() -> None:
+    """grbl's 4 µm steps absorb the plan's sub-µm rounding: the same trace, the same figure.
+
+    The figure the budget reuses equals the one measured again from the plan's own trace.
+    """
+    target = load_target("grbl")
+    program, drawing = _plate()
+    moved = tuple(
+        dataclasses.replace(m, x=m.x + 0.0002) if i == 3 else m for i, m in enumerate(program.moves)
+    )
+    planned = dataclasses.replace(program, moves=moved)  # 0.2 µm off: under a step
+    v = verify_program(program, target.machine, against=drawing, tool_diameter=0.5,
+                       planned=planned)  # fmt: skip
+    trace = simulate(planned, target.machine)
+    assert np.array_equal(_cutting_rows(planned, trace)[0], _cutting_rows(program, v.trace)[0])
+    cut, runs = _cutting_rows(planned, trace)
+    again = metrics.against_drawing(cut, drawing, 0.25, runs=runs)
+    assert v.against is not None
+    assert v.error_budget.without["rounding"]["distance to the drawing"] == again.max_um
+    assert again.max_um == v.against.max_um
+
+
+def test_distance_to_the_path_is_kept_only_for_inputs_that_cannot_change() -> None:
+    samples = np.random.default_rng(5).uniform(0.0, 2.0, (200, 2))
+    lines = (np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 2.0]]), np.array([[0.5, 1.0]]))
+    want = metrics._distance_to_now(samples, lines)
+    open_answer = metrics._distance_to(samples, lines)  # writeable: measured, not kept
+    assert np.array_equal(open_answer, want) and open_answer.flags.writeable
+    samples.flags.writeable = False
+    for line in lines:
+        line.flags.writeable = False
+    first = metrics._distance_to(samples, lines)
+    assert metrics._distance_to(samples, lines) is first and np.array_equal(first, want)
+    copied = tuple(line.copy() for line in lines)  # other objects: measured again
+    assert metrics._distance_to(samples, copied) is not first
+
+
+def test_nominal_lines_are_kept_for_the_code_and_the_plan() -> None:
+    from camtool.verify.verifier import _nominal_lines, _nominal_lines_now
+
+    code, _ = _plate()
+    plan = dataclasses.replace(code, moves=code.moves[:-1])
+    lines = _nominal_lines(code)
+    assert _nominal_lines(plan) is not lines
+    assert _nominal_lines(code) is lines  # two kept: the code's survives the plan's
+    want = _nominal_lines_now(code)
+    assert all(np.array_equal(a, b) for a, b in zip(lines, want, strict=True))
+    assert not any(line.flags.writeable for line in lines)
