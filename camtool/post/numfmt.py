@@ -19,6 +19,9 @@ from decimal import ROUND_HALF_UP, Decimal, InvalidOperation, localcontext
 
 from camtool.model.errors import DialectError
 
+_MEMO_SIZE = 1 << 16
+"""Most values one format remembers (then it starts afresh)."""
+
 SIGN_POLICIES = ("negative", "always")
 """``negative``: ``-`` only before negatives (seed-000 L1731); ``always``: ``+`` too."""
 
@@ -62,6 +65,11 @@ class NumberFormat:
             raise ValueError("min_decimals must lie between 0 and decimals")
         if self.grid_mm is not None and not (math.isfinite(self.grid_mm) and self.grid_mm > 0):
             raise ValueError(f"grid_mm must be a finite number > 0, got {self.grid_mm!r}")
+        # Memos of format() and parse() (not fields: equality, hashing and asdict ignore
+        # them). A program writes the same coordinates many times (the word, its read-back,
+        # the arc check); a result depends only on the value and the format's fields.
+        object.__setattr__(self, "_formatted", {})
+        object.__setattr__(self, "_parsed", {})
 
     def quantize(self, value_mm: float) -> Decimal:
         """The value in written units, rounded to ``decimals`` (half away from zero).
@@ -96,10 +104,24 @@ class NumberFormat:
     def format(self, value_mm: float) -> str:
         """Write ``value_mm`` (mm) in this format.
 
+        Results are remembered per value (the same text every time: see
+        :meth:`format_uncached`, which computes it).
+
         Raises:
             DialectError: ``value_mm`` is NaN or infinite, or the integer part
                 needs more than ``int_digits`` digits.
         """
+        memo: dict[float, str] = self._formatted  # type: ignore[attr-defined]
+        text = memo.get(value_mm)
+        if text is None:
+            text = self.format_uncached(value_mm)
+            if len(memo) >= _MEMO_SIZE:
+                memo.clear()
+            memo[value_mm] = text
+        return text
+
+    def format_uncached(self, value_mm: float) -> str:
+        """:meth:`format` computed afresh (no memo)."""
         q = self.quantize(value_mm)
         magnitude = abs(q)
         text = f"{magnitude:.{self.decimals}f}"
@@ -120,10 +142,23 @@ class NumberFormat:
     def parse(self, text: str) -> float:
         """Read a value written in this format back to mm (signs optional).
 
+        Results are remembered per text (:meth:`parse_uncached` computes them).
+
         Raises:
             DialectError: ``text`` is not a finite decimal number, or is too
                 large for a float once in mm.
         """
+        memo: dict[str, float] = self._parsed  # type: ignore[attr-defined]
+        value = memo.get(text)
+        if value is None:
+            value = self.parse_uncached(text)
+            if len(memo) >= _MEMO_SIZE:
+                memo.clear()
+            memo[text] = value
+        return value
+
+    def parse_uncached(self, text: str) -> float:
+        """:meth:`parse` computed afresh (no memo)."""
         try:
             number = Decimal(text)
         except InvalidOperation:
