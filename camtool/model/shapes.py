@@ -128,22 +128,22 @@ class Arc:
     centre: Point
     clockwise: bool
 
-    @cached_property
+    @property
     def radius(self) -> float:
         """Radius in mm, measured from the centre to the start point."""
         return distance(self.centre, self.start)
 
-    @cached_property
+    @property
     def start_angle(self) -> float:
         """Angle of the start point seen from the centre, radians CCW from +X."""
         return math.atan2(self.start[1] - self.centre[1], self.start[0] - self.centre[0])
 
-    @cached_property
+    @property
     def end_angle(self) -> float:
         """Angle of the end point seen from the centre, radians CCW from +X."""
         return math.atan2(self.end[1] - self.centre[1], self.end[0] - self.centre[0])
 
-    @cached_property
+    @property
     def is_full_circle(self) -> bool:
         """True when start and end coincide (sweep 2π)."""
         return distance(self.start, self.end) <= _FULL_CIRCLE_EPS * max(1.0, self.radius)

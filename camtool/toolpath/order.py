@@ -62,55 +62,12 @@ def nesting(contours: Sequence[Contour]) -> Nesting:
     Returns:
         The containment relation, indexed like ``contours``.
     """
-    from shapely.errors import GEOSException
-
-    points = [c.points(_NEST_TOLERANCE_MM) for c in contours]
-    closed = [i for i, c in enumerate(contours) if c.closed]
-    try:
-        return _nesting_bulk(points, closed)
-    except (ValueError, TypeError, IndexError, GEOSException):
-        return nesting_one_by_one(points, closed)  # it judges (or raises) as it always did
-
-
-def _nesting_bulk(points: Sequence[list[Point]], closed: list[int]) -> Nesting:
-    """:func:`nesting` with shapely's array functions: the same geometries, one query.
-
-    The outlines, polygons (``buffer(0)``), areas and ``covered_by`` pairs are those of
-    :func:`nesting_one_by_one` (the same coordinates go to the same GEOS operations, made
-    for all contours in one call each instead of one call per contour).
-    """
-    import numpy as np
-    import shapely
-
-    counts = np.fromiter((len(p) for p in points), dtype=np.intp, count=len(points))
-    coords = np.array([xy for pts in points for xy in pts], dtype=np.float64).reshape(-1, 2)
-    outlines = shapely.linestrings(coords, indices=np.repeat(np.arange(len(points)), counts))
-    rings = shapely.linearrings(shapely.get_coordinates(outlines[closed]), indices=np.repeat(
-        np.arange(len(closed)), counts[closed]))  # fmt: skip
-    polygons = shapely.buffer(shapely.polygons(rings), 0, quad_segs=16)  # Polygon.buffer's
-    areas = dict(zip(closed, shapely.area(polygons).tolist(), strict=True))
-    tree = shapely.STRtree(polygons)
-    which, inside = tree.query(outlines, predicate="covered_by")
-    found: list[list[int]] = [[] for _ in points]
-    for i, k in zip(which.tolist(), inside.tolist(), strict=True):
-        j = closed[k]
-        if areas[j] > areas.get(i, 0.0):
-            found[i].append(j)
-    return Nesting(tuple(tuple(sorted(js)) for js in found))
-
-
-def nesting_one_by_one(points: Sequence[list[Point]], closed: list[int]) -> Nesting:
-    """:func:`nesting` one contour at a time (the reference the bulk build is tested on).
-
-    Args:
-        points: each contour's outline, ``Contour.points(1e-4)``.
-        closed: indices of the closed contours, ascending.
-    """
     from shapely import LineString, Polygon, STRtree
 
     # Closed contours as filled polygons (buffer(0) repairs self-touching outlines);
     # any contour, open or closed, is tested by its outline.
-    outlines = [LineString(p) for p in points]
+    outlines = [LineString(c.points(_NEST_TOLERANCE_MM)) for c in contours]
+    closed = [i for i, c in enumerate(contours) if c.closed]
     polygons = [Polygon(outlines[i].coords).buffer(0) for i in closed]
     areas = {i: poly.area for i, poly in zip(closed, polygons, strict=True)}
     tree = STRtree(polygons)

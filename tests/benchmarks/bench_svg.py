@@ -37,17 +37,17 @@ noisy, under load; the lead runs it on a quiet machine). CPU seconds in one proc
 ==========================  ============  ============
 stage                       before        after
 ==========================  ============  ============
-import (svgelements + fit)  21.3 s        14.6 s
-planning (nesting)          9.7 s (2.4)   5.9 s (1.3)
-writing (GRBL arc check)    18.9 s (11.9) 17.3 s (12.0)
-whole ``post``              50.0 s        37.9 s
+import (svgelements + fit)  21.3 s        12.7 s
+planning (nesting)          9.7 s (2.4)   6.1 s (1.4)
+writing (GRBL arc check)    18.9 s (11.9) 13.7 s (9.4)
+whole ``post``              50.0 s        32.5 s
 ==========================  ============  ============
 
-``/usr/bin/time``: camtool 51.0 s user before, 37–42 s after; vpype 1.15.0 + vpype-gcode
-0.13.0: 5.3 s user, 11.4 s wall (under load). One run of this script under heavy load:
-camtool 169 s wall vs vpype 34 s (ratio 5.0×; before, 419 s wall in a worse moment);
-peak memory camtool 231 MiB, vpype 167 MiB. The goal (≤ 1.0×) is not met: the exact biarc
-fit and the arc check (helper h17gc's part of issue 17) dominate.
+``/usr/bin/time``, run one after the other: camtool 53.6 s user, 163 MB before; 32.2 s
+user, 170 MB after; vpype 1.15.0 + vpype-gcode 0.13.0: 5.0 s user, 8.6 s wall, 171 MB
+(under load). One run of this script under heavy load gave camtool 169 s wall against
+vpype 34 s (ratio 5.0×). The goal (≤ 1.0×) is not met: the exact biarc fit and the arc
+check (helper h17gc's part of issue 17) dominate.
 """
 
 from __future__ import annotations
