@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint typecheck unit bench docs clean corpus
+.PHONY: demo test lint typecheck unit bench bench-venv docs clean corpus
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -37,13 +37,26 @@ unit: $(STAMP)
 
 test: lint typecheck unit
 
+# The benchmarks' peers in their own environment, apart from camtool's: vpype and its
+# g-code plugin for tests/benchmarks/bench_svg.py (versions checked: vpype 1.15.0,
+# vpype-gcode 0.13.0).
+BENCH_VENV := .bench-venv
+BENCH_STAMP := $(BENCH_VENV)/.installed
+
+$(BENCH_STAMP):
+	test -x $(BENCH_VENV)/bin/python || $(PYTHON) -m venv $(BENCH_VENV)
+	$(BENCH_VENV)/bin/python -m pip install --quiet 'vpype>=1.14,<1.16' 'vpype-gcode>=0.13,<0.14'
+	touch $(BENCH_STAMP)
+
+bench-venv: $(BENCH_STAMP)
+
 # Every benchmark in tests/benchmarks/, one after the other, then one table of ratios
 # against the named peers (run it on an otherwise quiet machine).
-bench: $(STAMP)
+bench: $(STAMP) $(BENCH_STAMP)
 	$(BIN)/python tests/benchmarks/run_all.py
 
 clean:
-	rm -rf $(VENV) out .pytest_cache .mypy_cache .ruff_cache
+	rm -rf $(VENV) $(BENCH_VENV) out .pytest_cache .mypy_cache .ruff_cache
 
 # Fetch the real-drawing corpus and LinuxCNC's rs274 (Debian packages, cached in .corpus/),
 # then post every sampled drawing on every target; CAMTOOL_CORPUS=full for all of it.

@@ -19,6 +19,7 @@ Meas. 25(1), 1976, constrained here to pass through the run's two end points.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from collections.abc import Callable, Iterable, Sequence
@@ -44,6 +45,8 @@ __all__ = [
 ]
 
 FloatArray: TypeAlias = NDArray[np.float64]
+PointsFn: TypeAlias = Callable[[FloatArray], FloatArray]
+"""A curve evaluated at ``(N,)`` parameters: ``(N, 2)`` points (see :func:`fit_curve`)."""
 
 MAX_SWEEP = math.pi
 """Largest sweep of one output arc, radians: 180° arcs are safe in every dialect (I/J or R)."""
@@ -77,9 +80,17 @@ def distances(xy: ArrayLike, segments: Sequence[Segment]) -> FloatArray:
     return np.min([dist_segment(pts, s) for s in segments], axis=0)
 
 
+@functools.cache
+def _unit_steps(n: int) -> FloatArray:
+    """``np.linspace(0, 1, n + 1)``, made once per ``n`` (read-only)."""
+    u = np.linspace(0.0, 1.0, n + 1)
+    u.setflags(write=False)
+    return u
+
+
 def sample_segment(seg: Segment, n: int) -> FloatArray:
     """``(n + 1, 2)`` points evenly along ``seg``, ends included."""
-    u = np.linspace(0.0, 1.0, n + 1)
+    u = _unit_steps(n)
     if isinstance(seg, Line):
         (x0, y0), (x1, y1) = seg.start, seg.end
         return np.column_stack([x0 + u * (x1 - x0), y0 + u * (y1 - y0)])
@@ -211,6 +222,7 @@ def fit_curve(
     tolerance: float,
     *,
     max_depth: int = MAX_DEPTH,
+    points_at: PointsFn | None = None,
 ) -> list[Segment]:
     """Fit a smooth parametric curve with biarcs and lines within ``tolerance`` mm.
 
@@ -235,6 +247,12 @@ def fit_curve(
         t1: last parameter, ``> t0``.
         tolerance: largest distance between the curve and the output, mm (> 0).
         max_depth: subdivision limit.
+        points_at: optional, ``point_at`` on an ``(N,)`` array of parameters at once
+            (``(N, 2)``), bit for bit equal to calling ``point_at`` on each (e.g.
+            :func:`camtool.geometry.curves.cubic_bezier_points`): the 63 inner samples of
+            each piece are then evaluated in one call. The fit is the same with or without
+            it; where it gives a non-finite point the samples are taken one by one again
+            (so the error names the parameter).
 
     Returns:
         Segments from ``point_at(t0)`` to ``point_at(t1)`` (exactly), each starting at the end
@@ -248,7 +266,7 @@ def fit_curve(
     tol = check_tolerance(tolerance)
     if not (math.isfinite(t0) and math.isfinite(t1) and t1 > t0):
         raise UsageError(f"curve parameters must be finite with t1 > t0, got {t0!r}, {t1!r}")
-    curve = _Curve(point_at, tangent_at, _SAFETY * tol, max_depth, tolerance)
+    curve = _Curve(point_at, tangent_at, _SAFETY * tol, max_depth, tolerance, points_at)
     pieces = _fit_piece(curve, t0, curve.point(t0), t1, curve.point(t1), 0)
     return _merge(pieces, curve.tol)
 
@@ -268,12 +286,20 @@ class _Curve:
     tol: float  # internal tolerance (safety share applied)
     max_depth: int
     user_tol: float
+    points_at: PointsFn | None = None
 
     def point(self, t: float) -> Point:
         return _as_point(self.point_at(t), f"curve point at t={t!r}")
 
     def samples(self, ta: float, pa: Point, tb: float, pb: Point) -> FloatArray:
+        """``(2n+1, 2)`` curve points at evenly spaced parameters from ``ta`` to ``tb``."""
         ts = np.linspace(ta, tb, 2 * _SAMPLES + 1)
+        if self.points_at is not None:
+            fine = np.empty((len(ts), 2))
+            fine[1:-1] = self.points_at(ts[1:-1])
+            if np.isfinite(fine[1:-1]).all():
+                fine[0], fine[-1] = pa, pb
+                return fine
         inner = [self.point(float(t)) for t in ts[1:-1]]
         return np.array([pa, *inner, pb], dtype=np.float64)
 
@@ -303,7 +329,7 @@ def _fit_piece(c: _Curve, ta: float, pa: Point, tb: float, pb: Point, depth: int
     fine = c.samples(ta, pa, tb, pb)
     segs = _candidate(c, ta, pa, tb, pb, fine)
     if segs is not None:
-        error = _piece_error(segs, fine, pa)
+        error = _piece_error(segs, fine, pa, c.tol)
         if error <= c.tol:
             return [_Piece(segs, error)]
     if depth >= c.max_depth:
@@ -373,11 +399,20 @@ def _arc_from(p: Point, s: Point, q: Point, flat: float) -> Segment:
     return Arc(p, q, (p[0] - k * s[1], p[1] + k * s[0]), k < 0)
 
 
-def _piece_error(segs: Sequence[Segment], fine: FloatArray, pa: Point) -> float:
-    """Two-sided error between the segments and the curve samples ``fine`` ((2n+1, 2)), mm."""
+def _piece_error(
+    segs: Sequence[Segment], fine: FloatArray, pa: Point, limit: float = math.inf
+) -> float:
+    """Two-sided error between the segments and the curve samples ``fine`` ((2n+1, 2)), mm.
+
+    When the curve -> segments distance alone exceeds ``limit`` it is returned at once
+    (the error is then over ``limit`` whatever the other direction gives; the caller only
+    compares it with ``limit``). Otherwise the full two-sided error, always the same float.
+    """
     if not segs:
         return float(np.max(np.hypot(fine[:, 0] - pa[0], fine[:, 1] - pa[1])))
     forward = float(np.max(distances(fine, segs)))
+    if forward > limit:
+        return forward
     # the sampled polyline lies within its chord sagitta of the curve; the sagitta of the
     # fine chords is about a quarter of that of the coarse ones (midpoints of fine[::2])
     coarse = fine[::2]

@@ -22,7 +22,9 @@ import math
 from collections.abc import Callable, Sequence
 from typing import TypeAlias
 
-from camtool.geometry.arcfit import fit_curve
+import numpy as np
+
+from camtool.geometry.arcfit import FloatArray, PointsFn, fit_curve
 from camtool.geometry.chain import snap, with_end
 from camtool.model.shapes import Arc, Point, Segment, distance
 
@@ -50,6 +52,26 @@ def cubic_bezier(p: tuple[Point, Point, Point, Point]) -> tuple[PointFn, PointFn
     return point_at, tangent_at
 
 
+def cubic_bezier_points(p: tuple[Point, Point, Point, Point]) -> PointsFn:
+    """:func:`cubic_bezier`'s ``point_at`` on an array of parameters: ``(N,)`` -> ``(N, 2)``.
+
+    The same float operations in the same order, element by element, so every point is
+    bit for bit the one ``point_at`` gives (IEEE 754 double arithmetic in both; numpy ufuncs
+    round each operation like Python floats).
+    """
+    (x0, y0), (x1, y1), (x2, y2), (x3, y3) = p
+
+    def points_at(u: FloatArray) -> FloatArray:
+        v = 1.0 - u
+        w0, w1, w2, w3 = v * v * v, 3.0 * v * v * u, 3.0 * v * u * u, u * u * u
+        out = np.empty((len(u), 2))
+        out[:, 0] = w0 * x0 + w1 * x1 + w2 * x2 + w3 * x3
+        out[:, 1] = w0 * y0 + w1 * y1 + w2 * y2 + w3 * y3
+        return out
+
+    return points_at
+
+
 def quadratic_bezier(p: tuple[Point, Point, Point]) -> tuple[PointFn, PointFn]:
     """Point and derivative of the quadratic Bézier with control points ``p``, u in [0, 1]."""
     (x0, y0), (x1, y1), (x2, y2) = p
@@ -67,6 +89,24 @@ def quadratic_bezier(p: tuple[Point, Point, Point]) -> tuple[PointFn, PointFn]:
         )
 
     return point_at, tangent_at
+
+
+def quadratic_bezier_points(p: tuple[Point, Point, Point]) -> PointsFn:
+    """:func:`quadratic_bezier`'s ``point_at`` on an array, bit for bit.
+
+    As :func:`cubic_bezier_points`: the same operations in the same order.
+    """
+    (x0, y0), (x1, y1), (x2, y2) = p
+
+    def points_at(u: FloatArray) -> FloatArray:
+        v = 1.0 - u
+        w0, w1, w2 = v * v, 2.0 * v * u, u * u
+        out = np.empty((len(u), 2))
+        out[:, 0] = w0 * x0 + w1 * x1 + w2 * x2
+        out[:, 1] = w0 * y0 + w1 * y1 + w2 * y2
+        return out
+
+    return points_at
 
 
 def ellipse(centre: Point, a: Point, b: Point) -> tuple[PointFn, PointFn]:
@@ -115,6 +155,30 @@ def ellipse_arc(
         return (sweep * (b[0] * c - a[0] * s), sweep * (b[1] * c - a[1] * s))
 
     return point_at, tangent_at
+
+
+def ellipse_arc_points(
+    centre: Point, a: Point, b: Point, t0: float, sweep: float, p0: Point, p1: Point
+) -> PointsFn:
+    """:func:`ellipse_arc`'s ``point_at`` on an array, bit for bit.
+
+    Cosine and sine come from :mod:`math` one parameter at a time (numpy's may differ in
+    the last bit); the rest is element-wise in the same order.
+    """
+    cx, cy = centre
+
+    def points_at(u: FloatArray) -> FloatArray:
+        t = t0 + sweep * u
+        c = np.array([math.cos(x) for x in t.tolist()])
+        s = np.array([math.sin(x) for x in t.tolist()])
+        out = np.empty((len(u), 2))
+        out[:, 0] = cx + a[0] * c + b[0] * s
+        out[:, 1] = cy + a[1] * c + b[1] * s
+        out[u <= 0.0] = p0
+        out[u >= 1.0] = p1
+        return out
+
+    return points_at
 
 
 def semi_axes_gap(a: Point, b: Point, cross: float) -> float:

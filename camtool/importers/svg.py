@@ -45,14 +45,17 @@ from typing import Any, TypeAlias
 
 import svgelements as se
 
-from camtool.geometry.arcfit import check_tolerance, fit_curve
+from camtool.geometry.arcfit import PointsFn, check_tolerance, fit_curve
 from camtool.geometry.chain import with_end
 from camtool.geometry.curves import (
     PointFn,
     cubic_bezier,
+    cubic_bezier_points,
     ellipse_arc,
+    ellipse_arc_points,
     merge_arcs,
     quadratic_bezier,
+    quadratic_bezier_points,
     semi_axes_gap,
 )
 from camtool.importers.options import MAX_COORDINATE_MM, ImportOptions, check_curve_size
@@ -269,11 +272,11 @@ def segment(seg: Any, p0: Point, m: Affine, tolerance: float) -> list[Segment]:
     if isinstance(seg, se.CubicBezier):
         ctrl = (p0, _pt(m, seg.control1), _pt(m, seg.control2), _pt(m, seg.end))
         _check_size(ctrl, tolerance)
-        return _fit(*cubic_bezier(ctrl), tolerance)
+        return _fit(*cubic_bezier(ctrl), tolerance, cubic_bezier_points(ctrl))
     if isinstance(seg, se.QuadraticBezier):
         ctrl3 = (p0, _pt(m, seg.control), _pt(m, seg.end))
         _check_size(ctrl3, tolerance)
-        return _fit(*quadratic_bezier(ctrl3), tolerance)
+        return _fit(*quadratic_bezier(ctrl3), tolerance, quadratic_bezier_points(ctrl3))
     if isinstance(seg, se.Arc):
         return _arc(seg, p0, m, tolerance)
     raise ValueError(f"unexpected path segment {type(seg).__name__}")
@@ -307,8 +310,10 @@ def _line(p0: Point, p1: Point) -> list[Segment]:
     return [Line(p0, p1)] if distance(p0, p1) > ZERO_LENGTH_MM else []
 
 
-def _fit(point_at: PointFn, tangent_at: PointFn, tolerance: float) -> list[Segment]:
-    segs = fit_curve(point_at, tangent_at, 0.0, 1.0, tolerance)
+def _fit(
+    point_at: PointFn, tangent_at: PointFn, tolerance: float, points_at: PointsFn
+) -> list[Segment]:
+    segs = fit_curve(point_at, tangent_at, 0.0, 1.0, tolerance, points_at=points_at)
     return segs if sum(s.length for s in segs) > ZERO_LENGTH_MM else []
 
 
@@ -343,7 +348,8 @@ def _arc(seg: Any, p0: Point, m: Affine, tolerance: float) -> list[Segment]:
     _check(centre, "an ellipse centre")
     _check_size([centre, (centre[0] + big_a[0], centre[1] + big_a[1]),
                  (centre[0] + big_b[0], centre[1] + big_b[1]), p0, p1], tolerance)  # fmt: skip
-    return _fit(*ellipse_arc(centre, big_a, big_b, t0, sweep, p0, p1), tolerance)
+    args = (centre, big_a, big_b, t0, sweep, p0, p1)
+    return _fit(*ellipse_arc(*args), tolerance, ellipse_arc_points(*args))
 
 
 def _xy(p: Any) -> Point:

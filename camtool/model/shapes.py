@@ -12,9 +12,9 @@ Conventions:
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
-from typing import TypeAlias
+from typing import Any, Generic, TypeAlias, TypeVar, overload
 
 from camtool.model.errors import GeometryError, UsageError
 from camtool.model.units import fmt_num
@@ -25,6 +25,39 @@ BBox: TypeAlias = tuple[float, float, float, float]
 
 TAU = 2.0 * math.pi
 _FULL_CIRCLE_EPS = 1e-12
+
+_T = TypeVar("_T")
+
+
+class cached_property(Generic[_T]):
+    """A property computed once per instance and kept in its ``__dict__`` (lock-free).
+
+    ``functools.cached_property`` takes a lock on every first access in Python 3.11; arcs
+    are made by the hundred thousand and read once or twice, so that lock cost more than
+    the angle it saved. The value is the one the function returns, so the same floats
+    as a plain ``@property``; it is not a field (equality, hashing and ``repr`` ignore it).
+    """
+
+    def __init__(self, func: Callable[[Any], _T]) -> None:
+        self.func = func
+        self.name = func.__name__
+        self.__doc__ = func.__doc__
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+
+    @overload
+    def __get__(self, instance: None, owner: type | None = None) -> cached_property[_T]: ...
+
+    @overload
+    def __get__(self, instance: object, owner: type | None = None) -> _T: ...
+
+    def __get__(self, instance: object | None, owner: type | None = None) -> Any:
+        if instance is None:
+            return self
+        value = self.func(instance)
+        instance.__dict__[self.name] = value
+        return value
 
 
 def distance(a: Point, b: Point) -> float:
@@ -115,7 +148,7 @@ class Arc:
         """True when start and end coincide (sweep 2π)."""
         return distance(self.start, self.end) <= _FULL_CIRCLE_EPS * max(1.0, self.radius)
 
-    @property
+    @cached_property
     def sweep(self) -> float:
         """Signed sweep angle in radians: > 0 counter-clockwise, < 0 clockwise.
 
@@ -167,7 +200,14 @@ class Arc:
     def points(self, tolerance: float) -> list[Point]:
         """Polyline through the arc whose chords deviate by at most ``tolerance`` mm."""
         n = chord_count(self.radius, abs(self.sweep), tolerance)
-        return [self.start] + [self.point_at(k / n) for k in range(1, n)] + [self.end]
+        a0, sweep, r = self.start_angle, self.sweep, self.radius
+        cx, cy = self.centre
+        inner = [a0 + sweep * (k / n) for k in range(1, n)]  # as point_at(k / n), bit for bit
+        return [
+            self.start,
+            *((cx + r * math.cos(a), cy + r * math.sin(a)) for a in inner),
+            self.end,
+        ]
 
     def transformed(self, scale: float, dx: float, dy: float) -> Arc:
         """Uniformly scaled about the origin (``scale`` > 0), then translated."""

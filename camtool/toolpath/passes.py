@@ -212,9 +212,16 @@ def parts(cuts: Sequence[Cut]) -> list[int]:
     nest = nesting([c.path for c in cuts])
     first_of_group: dict[int, int] = {}
     out: list[int] = []
+    areas: dict[int, float] = {}  # each cut's box area, computed once
+
+    def area(j: int) -> float:
+        if j not in areas:
+            areas[j] = _bbox_area(cuts[j])
+        return areas[j]
+
     for i in range(len(cuts)):
         around = nest.parents[i]
-        outer = max(around, key=lambda j: (_bbox_area(cuts[j]), -j)) if around else i
+        outer = max(around, key=lambda j: (area(j), -j)) if around else i
         key = cuts[outer].group
         out.append(first_of_group.setdefault(key, outer))
     return out

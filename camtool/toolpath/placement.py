@@ -49,9 +49,28 @@ def toolpath_extent(program: Program) -> BBox | None:
     Arcs count by their extremes. A program without cuts: the ends of its rapids
     but those that stay at the start position.
 
+    The last result is kept: planning, placement and the writer's checks ask it of one
+    program (or of copies sharing its moves and origin) several times; a hit needs the
+    very same ``moves`` and ``origin`` objects, so the box is the one computed for them.
+
     Returns:
         ``(xmin, ymin, xmax, ymax)``, mm; ``None`` for a program with nothing to place.
     """
+    moves, origin = program.moves, program.origin
+    last = _LAST_EXTENT[0]
+    if last is not None and last[0] is moves and last[1] is origin:
+        return last[2]
+    box = _extent(program)
+    _LAST_EXTENT[0] = (moves, origin, box)
+    return box
+
+
+_LAST_EXTENT: list[tuple[tuple[Move, ...], Point, BBox | None] | None] = [None]
+"""``(moves, origin, box)`` of the last :func:`toolpath_extent` (one slot, read atomically)."""
+
+
+def _extent(program: Program) -> BBox | None:
+    """:func:`toolpath_extent` computed afresh."""
     moves = program.moves
     first = next((i for i, m in enumerate(moves) if not isinstance(m, Rapid)), None)
     if first is None:
