@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -119,6 +120,10 @@ def test_a_controller_error_is_exit_1_naming_line_and_words(
     assert "Unsupported command: Unsupported or invalid g-code command found in block." in err
 
 
+def _sigint_default() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def test_valcnc_through_simulate_device(tmp_path: Path, capsys: Any) -> None:
     job = tmp_path / "job.ngc"
     job.write_text(VALCNC)
@@ -127,6 +132,10 @@ def test_valcnc_through_simulate_device(tmp_path: Path, capsys: Any) -> None:
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        # Ctrl-C must reach it as from a terminal: a job started in the background by a
+        # non-interactive shell (a CI runner's `cmd &`) inherits SIGINT ignored, and Python
+        # then installs no KeyboardInterrupt handler
+        preexec_fn=_sigint_default,
     )
     code, err = -1, "the simulator printed no port"
     try:
