@@ -38,4 +38,18 @@ static void report(int64_t iterations, int64_t pulses, uint64_t checksum, double
     printf("%lld %lld %llu %.9f\n", (long long)iterations, (long long)pulses,
            (unsigned long long)checksum, best);
 }
+
+/* Checksum and pulse count of the rows of ``count`` cases written one after another
+ * (case k has lengths[k] rows), then the report line. */
+static void report_rows(const int8_t *rows, const int64_t *lengths, int64_t count,
+                        int64_t iterations, double best) {
+    uint64_t checksum = 0;
+    int64_t pulses = 0, at = 0;
+    for (int64_t k = 0; k < count; k++) {
+        checksum = checksum * 1000003u + rows_checksum(rows + 2 * at, lengths[k]);
+        at += lengths[k];
+    }
+    for (int64_t i = 0; i < iterations * 2; i++) pulses += rows[i] != 0;
+    report(iterations, pulses, checksum, best);
+}
 #endif

@@ -69,13 +69,6 @@ int main(int argc, char **argv) {
         if (t < best) best = t;
         iterations = at;
     }
-    uint64_t checksum = 0;
-    int64_t pulses = 0, at = 0;
-    for (int64_t c = 0; c < count; c++) {
-        checksum = checksum * 1000003u + rows_checksum(rows + 2 * at, lengths[c]);
-        at += lengths[c];
-    }
-    for (int64_t i = 0; i < iterations * 2; i++) pulses += rows[i] != 0;
-    report(iterations, pulses, checksum, best);
+    report_rows(rows, lengths, count, iterations, best);
     return 0;
 }

@@ -133,13 +133,6 @@ int main(int argc, char **argv) {
         if (t < best) best = t;
         iterations = at;
     }
-    uint64_t checksum = 0;
-    int64_t pulses = 0, at = 0;
-    for (int64_t k = 0; k < count; k++) {
-        checksum = checksum * 1000003u + rows_checksum(rows + 2 * at, lengths[k]);
-        at += lengths[k];
-    }
-    for (int64_t i = 0; i < iterations * 2; i++) pulses += rows[i] != 0;
-    report(iterations, pulses, checksum, best);
+    report_rows(rows, lengths, count, iterations, best);
     return 0;
 }
