@@ -324,3 +324,125 @@ def reversals(rows: Any, axis: int, direction: int) -> tuple[Any, Any, int]:
     signs = np.empty(count, dtype=np.int8)
     last = _fill_reversals(rows, axis, direction, at, signs)
     return at, signs, int(last)
+
+
+@numba.njit(cache=True, nogil=True)
+def play_axis_from(
+    rows: Any,
+    axis: int,
+    starts: Any,
+    signs: Any,
+    bands: Any,
+    state: Any,
+    motor0: int,
+    start: float,
+    true_spm: float,
+    out: Any,
+) -> int:
+    """:func:`play_axis` over one chunk of rows, resuming from and updating ``state``.
+
+    ``state`` is ``float64[5]``: ``c0`` (the carriage before the first run, set at the
+    first run), ``current``, ``value``, ``band``, and ``flags`` (bit 0: a run has
+    started, bit 1: the current run goes up). ``starts``/``signs``/``bands`` are the
+    runs that *start* in this chunk (a run going on from the chunk before is not one).
+    ``c0`` of the first run is ``start`` going up, ``start + band`` going down, as
+    ``simulate._carriage_compiled`` sets it. The same float operations, in the same
+    order, as :func:`play_axis` over the whole rows: the chunks' rows joined give the
+    same values. Returns the motor position after the chunk.
+    """
+    n = rows.shape[0]
+    motor = motor0
+    c0 = state[0]
+    current = state[1]
+    value = state[2]
+    band = state[3]
+    flags = int(state[4])
+    started = (flags & 1) != 0
+    up = (flags & 2) != 0
+    r = 0
+    runs = len(starts)
+    for i in range(n):
+        motor += rows[i, axis]
+        if r < runs and i == starts[r]:
+            if not started:
+                c0 = start if signs[r] > 0 else start + bands[r]
+                value = c0
+                started = True
+            current = value
+            up = signs[r] > 0
+            band = bands[r]
+            r += 1
+        if started:
+            m = float(motor)
+            if up:
+                value = current if current >= m else m
+            else:
+                mb = m + band
+                value = current if current <= mb else mb
+            out[i, axis] = (value - c0 + start) / true_spm
+        else:
+            out[i, axis] = start / true_spm
+    state[0] = c0
+    state[1] = current
+    state[2] = value
+    state[3] = band
+    state[4] = float((1 if started else 0) | (2 if up else 0))
+    return motor
+
+
+EXACT_BINS = 2048 + 64
+"""Bins of :func:`exact_sum_squares`: one per binary exponent of a double, and room for
+the carries above the largest."""
+
+
+@numba.njit(cache=True, nogil=True)
+def exact_sum_squares(values: Any, bins: Any, pending: int) -> int:
+    """Add ``values[i]²`` (each square rounded to float64, as numpy's ``d * d``) exactly.
+
+    A finite double ``x >= 0`` is ``m · 2^(e − 1074)`` with an integer ``m < 2^53`` and
+    ``e = max(exponent field − 1, 0)``; ``m`` is added to ``bins[e]`` (int64). After at
+    most 1024 additions a bin is below ``2^63``; then every bin's bits from 32 up are
+    carried into the bin 32 exponents higher (the same value), so the bins hold the
+    exact sum at all times: :func:`exact_sum` turns them into the correctly rounded
+    float. ``pending`` counts the additions since the last carry (returned updated). A
+    square that is not finite (inf, nan) sets ``bins[-1]`` to 1.
+    """
+    mask = (1 << 52) - 1
+    for k in range(values.shape[0]):
+        x = values[k] * values[k]
+        bits = np.float64(x).view(np.int64)
+        exponent = (bits >> 52) & 2047
+        if exponent == 2047:
+            bins[bins.shape[0] - 1] = 1
+            continue
+        mantissa = bits & mask
+        if exponent > 0:
+            mantissa |= 1 << 52
+            exponent -= 1
+        bins[exponent] += mantissa
+        pending += 1
+        if pending == 1024:
+            _carry(bins)
+            pending = 0
+    return pending
+
+
+@numba.njit(cache=True, nogil=True)
+def _carry(bins: Any) -> None:
+    """Move each bin's bits from 32 up into the bin 32 exponents higher (exact)."""
+    low = (1 << 32) - 1
+    for e in range(bins.shape[0] - 33):
+        high = bins[e] >> 32
+        if high:
+            bins[e] &= low
+            bins[e + 32] += high
+
+
+def exact_sum(bins: Any) -> float:
+    """The correctly rounded float of the exact sum held in ``bins``, or nan (see above)."""
+    from fractions import Fraction
+
+    if bins[-1]:
+        return float("nan")
+    total = sum(int(v) << e for e, v in enumerate(bins[:-1].tolist()) if v)
+    return float(Fraction(total, 1 << 1074))

@@ -167,20 +167,62 @@ def deviation(points: FloatArray, blocks: IntArray, program: Program) -> Deviati
     bounds = _block_bounds(blocks, len(nominal["kind"]))
     if bounds is None:
         return _deviation_of(points, blocks, nominal)
-    cutting = nominal["kind"] != 2
+    dist, pieces = _distances(points, blocks, nominal, bounds, 0)
+    if len(dist) == 0:
+        return Deviation(0.0, 0.0, (0.0, 0.0), -1, 0)
+    worst = int(np.argmax(dist))
+    row = _row_of(pieces, worst)
+    max_mm = float(dist[worst])
+    total = len(dist)
+    np.multiply(dist, dist, out=dist)
+    return Deviation(
+        max_um=max_mm * 1000.0,
+        rms_um=float(np.sqrt(np.mean(dist))) * 1000.0,
+        at_mm=(float(points[row, 0]), float(points[row, 1])),
+        block=int(blocks[row]),
+        points=total,
+    )
+
+
+def _row_of(pieces: list[tuple[int, int]], index: int) -> int:
+    """The row of ``dist[index]`` of :func:`_distances` (``pieces``: its measured pieces)."""
+    piece = int(np.searchsorted([p[0] for p in pieces], index, side="right")) - 1
+    return pieces[piece][1] + index - pieces[piece][0]
+
+
+def _distances(
+    points: FloatArray,
+    blocks: IntArray,
+    nominal: dict[str, FloatArray],
+    bounds: IntArray,
+    first: int,
+) -> tuple[FloatArray, list[tuple[int, int]]]:
+    """Distances of the cutting rows of moves ``first, first + 1, ...`` to their moves, mm.
+
+    ``bounds`` ``(b + 1,)`` are the row offsets (in ``points``) of the moves
+    ``first .. first + b - 1``; every row of ``points`` belongs to one of them. Rows are
+    measured a block (or a run of short blocks) at a time (see :func:`deviation`).
+
+    Returns:
+        The distances of the cutting rows in row order, and the measured pieces
+        ``(offset in the distances, first row)`` (:func:`_row_of`).
+    """
+    cutting = nominal["kind"][first : first + len(bounds) - 1] != 2
+    kind = nominal["kind"]
     sizes = np.diff(bounds)
     total = int(sizes[cutting].sum())
-    if total == 0:
-        return Deviation(0.0, 0.0, (0.0, 0.0), -1, 0)
     dist = np.empty(total, dtype=np.float64)
     pieces: list[tuple[int, int]] = []  # (offset in dist, first row) of each measured piece
+    if total == 0:
+        return dist, pieces
     at = 0
     pending = -1  # first row of a run of short cutting blocks not yet measured
-    for b in range(len(sizes) + 1):
-        lo = int(bounds[b]) if b < len(sizes) else len(blocks)
-        long_line = b < len(sizes) and cutting[b] and nominal["kind"][b] == 0
-        long_line = long_line and sizes[b] >= DEVIATION_LONG
-        flush = b == len(sizes) or not cutting[b] or long_line
+    for i in range(len(sizes) + 1):
+        b = first + i
+        lo = int(bounds[i]) if i < len(sizes) else len(blocks)
+        long_line = i < len(sizes) and cutting[i] and kind[b] == 0
+        long_line = long_line and sizes[i] >= DEVIATION_LONG
+        flush = i == len(sizes) or not cutting[i] or long_line
         if pending >= 0 and (flush or lo - pending >= DEVIATION_CHUNK):
             for c in range(pending, lo, DEVIATION_CHUNK):
                 hi = min(lo, c + DEVIATION_CHUNK)
@@ -188,9 +230,9 @@ def deviation(points: FloatArray, blocks: IntArray, program: Program) -> Deviati
                 pieces.append((at, c))
                 at += hi - c
             pending = -1
-        if b == len(sizes) or not cutting[b]:
+        if i == len(sizes) or not cutting[i]:
             continue
-        hi = int(bounds[b + 1])
+        hi = int(bounds[i + 1])
         if long_line:
             ends = tuple(nominal[k][b] for k in ("x0", "y0", "x1", "y1"))
             for c in range(lo, hi, DEVIATION_CHUNK):
@@ -200,18 +242,7 @@ def deviation(points: FloatArray, blocks: IntArray, program: Program) -> Deviati
                 at += top - c
         elif pending < 0 and hi > lo:
             pending = lo
-    worst = int(np.argmax(dist))
-    piece = int(np.searchsorted([p[0] for p in pieces], worst, side="right")) - 1
-    row = pieces[piece][1] + worst - pieces[piece][0]
-    max_mm = float(dist[worst])
-    np.multiply(dist, dist, out=dist)
-    return Deviation(
-        max_um=max_mm * 1000.0,
-        rms_um=float(np.sqrt(np.mean(dist))) * 1000.0,
-        at_mm=(float(points[row, 0]), float(points[row, 1])),
-        block=int(blocks[row]),
-        points=total,
-    )
+    return dist, pieces
 
 
 DEVIATION_CHUNK = 1 << 18
@@ -297,37 +328,72 @@ def measure_contours(
     for number, (first, last) in enumerate(contour_runs(program), start=1):
         lo, hi = int(block_start[first]), int(block_start[last + 1])
         before = points[lo - 1] if lo > 0 else np.asarray(start_mm, dtype=np.float64)
-        segments = [segment_of(starts[i], program.moves[i]) for i in range(first, last + 1)]
-        box: BBox = bbox_union(s.bbox() for s in segments)
-        nominal_size = (box[2] - box[0], box[3] - box[1])
         size = _extent(before, points, lo, hi)  # np.ptp of the run, without copying it
-        closed = math.dist(starts[first], starts[last + 1]) <= 1e-6
         last_point = points[hi - 1] if hi > lo else before
-        closure = (
-            (
-                float(last_point[0] - before[0]) * 1000.0,
-                float(last_point[1] - before[1]) * 1000.0,
-            )
-            if closed
-            else None
-        )
+        run_of = partial(_run_of, before, points, lo, hi)
         measures.append(
-            ContourMeasure(
-                number=number,
-                blocks=(first, last),
-                closed=closed,
-                closure_um=closure,
-                size_um=(nominal_size[0] * 1000.0, nominal_size[1] * 1000.0),
-                size_error_um=(
-                    (size[0] - nominal_size[0]) * 1000.0,
-                    (size[1] - nominal_size[1]) * 1000.0,
-                ),
-                circle=_circle(segments, partial(_run_of, before, points, lo, hi), size)
-                if closed
-                else None,
+            _contour_measure(
+                program, starts, number, (first, last), before, last_point, size, run_of
             )
         )
     return measures
+
+
+def _contour_measure(
+    program: Program,
+    starts: list[Point],
+    number: int,
+    blocks: tuple[int, int],
+    before: FloatArray,
+    last_point: FloatArray,
+    size: tuple[float, float],
+    run_of: Callable[[], FloatArray],
+) -> ContourMeasure:
+    """One contour's :class:`ContourMeasure` from its trace's extent and ends.
+
+    ``before`` is the carriage before the contour's first row, ``last_point`` after its
+    last (``before`` without rows), ``size`` the trace's extent (:func:`_extent`) and
+    ``run_of()`` its whole trace (read only for a circle).
+    """
+    first, last = blocks
+    segments = [segment_of(starts[i], program.moves[i]) for i in range(first, last + 1)]
+    box: BBox = bbox_union(s.bbox() for s in segments)
+    nominal_size = (box[2] - box[0], box[3] - box[1])
+    closed = math.dist(starts[first], starts[last + 1]) <= 1e-6
+    closure = (
+        (
+            float(last_point[0] - before[0]) * 1000.0,
+            float(last_point[1] - before[1]) * 1000.0,
+        )
+        if closed
+        else None
+    )
+    return ContourMeasure(
+        number=number,
+        blocks=(first, last),
+        closed=closed,
+        closure_um=closure,
+        size_um=(nominal_size[0] * 1000.0, nominal_size[1] * 1000.0),
+        size_error_um=(
+            (size[0] - nominal_size[0]) * 1000.0,
+            (size[1] - nominal_size[1]) * 1000.0,
+        ),
+        circle=_circle(segments, run_of, size) if closed else None,
+    )
+
+
+def _circle_candidate(segments: list[Segment]) -> float | None:
+    """The radius of a contour made of arcs of one circle (see :func:`_circle`), else None."""
+    cuts = [s for s in segments if not (isinstance(s, Line) and s.length <= 1e-9)]
+    if not cuts or not all(isinstance(s, Arc) for s in cuts):
+        return None
+    arcs = [s for s in cuts if isinstance(s, Arc)]
+    c0, r0 = arcs[0].centre, arcs[0].radius
+    same = all(math.dist(a.centre, c0) <= 1e-6 and abs(a.radius - r0) <= 1e-6 for a in arcs)
+    turns = abs(sum(a.sweep for a in arcs)) / math.tau
+    if not same or turns < 0.5 or abs(turns - round(turns)) > 1e-6:
+        return None
+    return r0
 
 
 def _run_of(before: FloatArray, points: FloatArray, lo: int, hi: int) -> FloatArray:
@@ -359,14 +425,8 @@ def _circle(
     Z-only moves (a plunge, a rise onto a tab: no XY length) do not count, and a circle
     cut in several depth passes (sweeps adding up to a whole number of turns) is one.
     """
-    cuts = [s for s in segments if not (isinstance(s, Line) and s.length <= 1e-9)]
-    if not cuts or not all(isinstance(s, Arc) for s in cuts):
-        return None
-    arcs = [s for s in cuts if isinstance(s, Arc)]
-    c0, r0 = arcs[0].centre, arcs[0].radius
-    same = all(math.dist(a.centre, c0) <= 1e-6 and abs(a.radius - r0) <= 1e-6 for a in arcs)
-    turns = abs(sum(a.sweep for a in arcs)) / math.tau
-    if not same or turns < 0.5 or abs(turns - round(turns)) > 1e-6:
+    r0 = _circle_candidate(segments)
+    if r0 is None:
         return None
     run = run_of()
     if len(run) < 3:
@@ -620,11 +680,7 @@ def along_path(
         if len(samples) == 0:
             continue
         move_ends = block_start[first + 1 : last + 2] - lo  # each move's last row, in ``run``
-        trace = _thinned(run, move_ends)
-        if len(trace) == 1:
-            d = nearest_distances(samples, trace, trace)
-        else:
-            d = nearest_distances(samples, trace[:-1], trace[1:])
+        d = _to_trace(samples, _thinned(run, move_ends))
         k = int(np.argmax(d))
         if d[k] * 1000.0 > worst[0]:
             worst = (float(d[k]) * 1000.0, (float(samples[k, 0]), float(samples[k, 1])), owner[k])
@@ -640,6 +696,13 @@ def along_path(
     )
 
 
+def _to_trace(samples: FloatArray, trace: FloatArray) -> FloatArray:
+    """Distance of each path sample to the polyline ``trace`` (one point: to it), mm."""
+    if len(trace) == 1:
+        return nearest_distances(samples, trace, trace)
+    return nearest_distances(samples, trace[:-1], trace[1:])
+
+
 def _thinned(run: FloatArray, keep: IntArray) -> FloatArray:
     """``run``'s every k-th point, its last and the rows ``keep``, about 0.5 µm apart.
 
@@ -649,10 +712,7 @@ def _thinned(run: FloatArray, keep: IntArray) -> FloatArray:
     """
     if len(run) < 3:
         return run
-    head = np.diff(run[: min(len(run), 2000)], axis=0)
-    step = float(np.median(np.hypot(head[:, 0], head[:, 1])))
-    every = max(1, int(ALONG_RESOLUTION_MM / step) if step > 0 else 1)
-    every = max(every, -(-len(run) // ALONG_MAX_TRACE))
+    every = _thin_every(run[: min(len(run), THIN_HEAD)], len(run))
     if every == 1:
         return run
     mask = np.zeros(len(run), dtype=bool)
@@ -660,6 +720,22 @@ def _thinned(run: FloatArray, keep: IntArray) -> FloatArray:
     mask[-1] = True
     mask[keep[(keep >= 0) & (keep < len(run))]] = True
     return run[mask]
+
+
+THIN_HEAD = 2000
+"""Points at the start of a contour's trace whose median spacing :func:`_thinned` reads."""
+
+
+def _thin_every(head: FloatArray, n: int) -> int:
+    """Every how many points :func:`_thinned` keeps of a trace of ``n`` (>= 3) points.
+
+    ``head`` is the trace's first ``min(n, THIN_HEAD)`` points: their median spacing
+    against :data:`ALONG_RESOLUTION_MM`, and at most :data:`ALONG_MAX_TRACE` points.
+    """
+    steps = np.diff(head, axis=0)
+    step = float(np.median(np.hypot(steps[:, 0], steps[:, 1])))
+    every = max(1, int(ALONG_RESOLUTION_MM / step) if step > 0 else 1)
+    return max(every, -(-n // ALONG_MAX_TRACE))
 
 
 def _carriage_after(
@@ -693,6 +769,362 @@ def _sample_moves(
     if not chunks:
         return np.zeros((0, 2)), np.zeros(0, dtype=np.int64)
     return np.vstack(chunks), np.concatenate(owners)
+
+
+STREAM_SAMPLES = 100_000
+"""Path samples :class:`TraceStream` measures against a contour's trace at once: the
+distance of each is found alone (:func:`nearest_distances`), so the pieces give the same
+distances as one call, with about 30 MB less held on the bench program."""
+PICTURE_ROWS = 200_000
+"""About how many rows of a streamed trace :class:`TraceStream` keeps for the picture."""
+
+
+@dataclass(frozen=True, eq=False)
+class StreamedMeasures:
+    """What :class:`TraceStream` measured on a trace seen chunk by chunk.
+
+    Attributes:
+        deviation: as :func:`deviation` of the whole trace; ``rms_um`` is the square
+            root of the exact (correctly rounded) mean of the squares (see
+            :class:`TraceStream`), which may differ in the last bits from numpy's
+            pairwise mean of the whole array.
+        along: as :func:`along_path` of the whole trace (the same figures).
+        contours: as :func:`measure_contours` of the whole trace (the same figures).
+        picture_rows: ``(K,) int64`` rows kept for the picture (every k-th row of the
+            trace, k = ceil(rows / :data:`PICTURE_ROWS`), and the worst deviation's).
+        picture_mm: ``(K, 2) float64`` the carriage at those rows, mm.
+        picture_blocks: ``(K,) int64`` their move indices.
+        picture_steps: ``(K, 2) int8`` their motor steps.
+        picture_compensation: ``(K,) bool`` whether each is a compensation row.
+        compensation_steps: compensation steps ``(x, y)`` of the whole trace.
+    """
+
+    deviation: Deviation
+    along: AlongPath
+    contours: tuple[ContourMeasure, ...]
+    picture_rows: IntArray
+    picture_mm: FloatArray
+    picture_blocks: IntArray
+    picture_steps: npt.NDArray[np.int8]
+    picture_compensation: npt.NDArray[np.bool_]
+    compensation_steps: tuple[int, int]
+
+
+class _Contour:
+    """One contour's state while :class:`TraceStream` reads its rows."""
+
+    def __init__(self, number: int, first: int, last: int, block_start: IntArray) -> None:
+        self.number, self.first, self.last = number, first, last
+        self.lo, self.hi = int(block_start[first]), int(block_start[last + 1])
+        self.n = self.hi - self.lo + 1  # the run: the point before, then the rows
+        self.keep = block_start[first + 1 : last + 2] - self.lo  # each move's last row
+        self.top = [-math.inf, -math.inf]
+        self.low = [math.inf, math.inf]
+        self.before: FloatArray = np.zeros(2)
+        self.last_point: FloatArray = np.zeros(2)
+        self.every = 1 if self.n < 3 else 0  # 0: not known before the head is read
+        self.pending: list[tuple[int, FloatArray]] = []
+        self.pending_count = 0
+        self.kept: list[FloatArray] = []
+        self.circle: list[FloatArray] | None = None
+
+    def add(self, j0: int, points: FloatArray) -> None:
+        """The run's points ``j0, j0 + 1, ...`` (run index 0 is the point before)."""
+        if self.circle is not None:
+            self.circle.append(points.copy())
+        if self.every == 0:
+            self.pending.append((j0, points))
+            self.pending_count += len(points)
+            if self.pending_count >= min(self.n, THIN_HEAD):
+                self._head_read()
+            return
+        self._select(j0, points)
+
+    def _head_read(self) -> None:
+        head = np.vstack([p for _, p in self.pending])[: min(self.n, THIN_HEAD)]
+        self.every = _thin_every(head, self.n)
+        for j0, points in self.pending:
+            self._select(j0, points)
+        self.pending = []
+
+    def _select(self, j0: int, points: FloatArray) -> None:
+        """Keep what :func:`_thinned` keeps of the run's points ``j0 ...``."""
+        if self.every == 1:
+            self.kept.append(points.copy())
+            return
+        j1 = j0 + len(points)
+        every = self.every
+        first = -(-j0 // every) * every
+        wanted = np.arange(first, j1, every, dtype=np.int64)
+        a, b = np.searchsorted(self.keep, [j0, j1])
+        extra = self.keep[a:b]
+        if j0 <= self.n - 1 < j1:
+            extra = np.append(extra, self.n - 1)
+        if len(extra):
+            wanted = np.union1d(wanted, extra)
+        self.kept.append(points[wanted - j0])
+
+    def trace(self) -> FloatArray:
+        """The thinned trace (what :func:`_thinned` gives of the whole run)."""
+        if self.every == 0:
+            self._head_read()
+        return np.vstack(self.kept) if self.kept else np.zeros((0, 2))
+
+    def extent(self) -> tuple[float, float]:
+        """:func:`_extent` of the run."""
+        if self.hi <= self.lo:
+            return (0.0, 0.0)
+        return (self.top[0] - self.low[0], self.top[1] - self.low[1])
+
+
+class TraceStream:
+    """The measures of a trace read chunk by chunk (no array of the whole trace).
+
+    Every measure of :func:`deviation`, :func:`measure_contours` and :func:`along_path`,
+    from chunks of whole moves.
+
+    Feed the chunks in order with :meth:`add` (``first`` move, global row offsets, the
+    carriage and steps of their rows), then :meth:`finish`. The figures are those of
+    the whole-trace functions, bit for bit: each point's distance is computed by the
+    same float operations, maxima and their positions compared in trace order (the
+    first of equal maxima wins), extents by ``max``/``min`` (exact), each contour's
+    trace thinned to the points :func:`_thinned` keeps of the whole contour (its
+    every-k-th, read from the contour's first :data:`THIN_HEAD` points and its known
+    length, the moves' last rows and its last point) and measured by the same
+    :func:`nearest_distances` call. A contour that is a circle keeps its whole trace for
+    the fit. The one exception is the deviation's rms: numpy's pairwise mean of the
+    whole array cannot be reproduced chunk by chunk, so it is the square root of the
+    exact sum of the squares (an integer sum of their mantissas by exponent,
+    :func:`camtool.verify.kernels.exact_sum_squares`; the squares are numpy's ``d * d``),
+    correctly rounded, divided by the count: at least as accurate, and it may differ
+    from the whole-array figure in the last bits.
+
+    Args:
+        program: the program the trace executed.
+        block_start: ``(B + 1,) int64`` row offsets of every move in the whole trace.
+        start_mm: the carriage before the first row.
+        kernels: the compiled kernels (:mod:`camtool.verify.kernels`).
+    """
+
+    def __init__(self, program: Program, block_start: IntArray, start_mm: Point, kernels: Any):
+        self.program = program
+        self.block_start = block_start
+        self.kernels = kernels
+        self.nominal = nominal_arrays(program)
+        self.start = np.asarray(start_mm, dtype=np.float64).reshape(1, 2)
+        self.prev: FloatArray = self.start[0]
+        self.starts = [program.origin] + [(m.x, m.y) for m in program.moves]
+        self.runs = contour_runs(program)
+        self.next_run = 0
+        self.open: _Contour | None = None
+        self.contours: list[ContourMeasure] = []
+        self.rows = int(block_start[-1])
+        self.every_picture = max(1, -(-self.rows // PICTURE_ROWS))
+        self.picture: list[tuple[IntArray, FloatArray, IntArray, Any, Any]] = [
+            (
+                np.zeros(0, np.int64),
+                np.zeros((0, 2)),
+                np.zeros(0, np.int64),
+                np.zeros((0, 2), np.int8),
+                np.zeros(0, np.bool_),
+            )
+        ]
+        self.comp_steps = [0, 0]
+        # deviation
+        self.dev_max = -1.0
+        self.dev_where: tuple[Point, int, int] = ((0.0, 0.0), -1, -1)  # at, block, row
+        self.dev_row: tuple[Any, bool] = (np.zeros(2, np.int8), False)  # its steps, comp
+        self.dev_count = 0
+        self.bins = np.zeros(kernels.EXACT_BINS, dtype=np.int64)
+        self.pending = 0
+        # along the path
+        total = sum(
+            segment_of(self.starts[i], program.moves[i]).length
+            for a, b in self.runs
+            for i in range(a, b + 1)
+        )
+        self.spacing = max(ALONG_SPACING_MM, total / ALONG_MAX_SAMPLES)
+        self.worst: tuple[float, Point, int] = (0.0, (0.0, 0.0), -1)
+        self.end_worst: tuple[float, Point, int] = (0.0, (0.0, 0.0), -1)
+        self.ends: list[float] = []
+        self.samples = 0
+
+    def add(
+        self,
+        first: int,
+        block_start: IntArray,
+        points: FloatArray,
+        steps: npt.NDArray[np.int8],
+        compensation: npt.NDArray[np.bool_],
+    ) -> None:
+        """Measure one chunk: moves ``first ..`` with global row offsets ``block_start``."""
+        r0 = int(block_start[0])
+        count = len(block_start) - 1
+        blocks = np.repeat(np.arange(first, first + count, dtype=np.int64), np.diff(block_start))
+        self._deviation(first, r0, block_start - r0, points, blocks, steps, compensation)
+        self._picture(r0, points, blocks, steps, compensation)
+        comp = steps[compensation]
+        for axis in (0, 1):
+            self.comp_steps[axis] += int(np.abs(comp[:, axis]).sum())
+        self._contours(first, first + count, r0, points)
+        if len(points):
+            self.prev = points[-1].copy()
+
+    def _deviation(
+        self,
+        first: int,
+        r0: int,
+        bounds: IntArray,
+        points: FloatArray,
+        blocks: IntArray,
+        steps: Any,
+        compensation: Any,
+    ) -> None:
+        dist, pieces = _distances(points, blocks, self.nominal, bounds, first)
+        if not len(dist):
+            return
+        worst = int(np.argmax(dist))
+        if float(dist[worst]) > self.dev_max:
+            row = _row_of(pieces, worst)
+            self.dev_max = float(dist[worst])
+            at = (float(points[row, 0]), float(points[row, 1]))
+            self.dev_where = (at, int(blocks[row]), r0 + row)
+            self.dev_row = (steps[row].copy(), bool(compensation[row]))
+        self.dev_count += len(dist)
+        self.pending = self.kernels.exact_sum_squares(dist, self.bins, self.pending)
+
+    def _picture(
+        self, r0: int, points: FloatArray, blocks: IntArray, steps: Any, compensation: Any
+    ) -> None:
+        every = self.every_picture
+        local = np.arange(-(-r0 // every) * every - r0, len(points), every, dtype=np.int64)
+        self.picture.append(
+            (local + r0, points[local], blocks[local], steps[local], compensation[local])
+        )
+
+    def _point(self, row: int, r0: int, points: FloatArray) -> FloatArray:
+        """The carriage after global ``row`` (in this chunk or the row before it)."""
+        return points[row - r0] if row >= r0 else self.prev
+
+    def _contours(self, first: int, stop: int, r0: int, points: FloatArray) -> None:
+        bs = self.block_start
+        while True:
+            c = self.open
+            if c is None:
+                if self.next_run >= len(self.runs) or self.runs[self.next_run][0] >= stop:
+                    return
+                a, b = self.runs[self.next_run]
+                self.next_run += 1
+                c = _Contour(self.next_run, a, b, bs)
+                c.before = self._point(c.lo - 1, r0, points).copy()
+                if (
+                    _circle_candidate(
+                        [segment_of(self.starts[i], self.program.moves[i]) for i in range(a, b + 1)]
+                    )
+                    is not None
+                    and math.dist(self.starts[a], self.starts[b + 1]) <= 1e-6
+                ):
+                    c.circle = []
+                for axis in (0, 1):
+                    c.top[axis] = c.low[axis] = float(c.before[axis])
+                c.add(0, c.before.reshape(1, 2))
+                self.open = c
+            g0, g1 = max(c.lo, r0), min(c.hi, r0 + len(points))
+            if g1 > g0:
+                part = points[g0 - r0 : g1 - r0]
+                for axis in (0, 1):
+                    column = part[:, axis]
+                    c.top[axis] = max(float(column.max()), c.top[axis])
+                    c.low[axis] = min(float(column.min()), c.low[axis])
+                c.add(g0 - c.lo + 1, part)
+            for b in range(max(c.first, first), min(c.last, stop - 1) + 1):
+                here = self._point(int(bs[b + 1]) - 1, r0, points)
+                gap = math.dist(here, self.starts[b + 1]) * 1000.0
+                if gap > self.end_worst[0]:
+                    self.end_worst = (gap, self.starts[b + 1], b)
+            if c.last >= stop:
+                return
+            c.last_point = self._point(c.hi - 1, r0, points).copy() if c.hi > c.lo else c.before
+            self._close(c)
+            self.open = None
+
+    def _close(self, c: _Contour) -> None:
+        program, starts = self.program, self.starts
+        self.ends.append(math.dist(c.last_point, starts[c.last + 1]))
+        circle = c.circle
+        run_of = (lambda: np.vstack(circle)) if circle is not None else (lambda: np.zeros((0, 2)))
+        self.contours.append(
+            _contour_measure(
+                program,
+                starts,
+                c.number,
+                (c.first, c.last),
+                c.before,
+                c.last_point,
+                c.extent(),
+                run_of,
+            )
+        )
+        samples, owner = _sample_moves(program, starts, c.first, c.last, self.spacing)
+        self.samples += len(samples)
+        trace = c.trace()
+        if len(samples) == 0:
+            return
+        for i in range(0, len(samples), STREAM_SAMPLES):  # each sample's distance is its own
+            d = _to_trace(samples[i : i + STREAM_SAMPLES], trace)
+            k = int(np.argmax(d))
+            if d[k] * 1000.0 > self.worst[0]:
+                at = (float(samples[i + k, 0]), float(samples[i + k, 1]))
+                self.worst = (float(d[k]) * 1000.0, at, int(owner[i + k]))
+
+    def finish(self) -> StreamedMeasures:
+        """The measures of the whole trace (after its last chunk)."""
+        if self.dev_count == 0:
+            dev = Deviation(0.0, 0.0, (0.0, 0.0), -1, 0)
+        else:
+            mean = self.kernels.exact_sum(self.bins) / self.dev_count
+            at, block, _ = self.dev_where
+            dev = Deviation(
+                self.dev_max * 1000.0, math.sqrt(mean) * 1000.0, at, block, self.dev_count
+            )
+        along = AlongPath(
+            shortfall_um=self.worst[0],
+            shortfall_at_mm=self.worst[1],
+            shortfall_block=int(self.worst[2]),
+            block_end_um=self.end_worst[0],
+            block_end_at_mm=(float(self.end_worst[1][0]), float(self.end_worst[1][1])),
+            block_end_block=int(self.end_worst[2]),
+            contour_end_um=tuple(e * 1000.0 for e in self.ends),
+            samples=self.samples,
+        )
+        at, block, row = self.dev_where
+        if row >= 0 and row % self.every_picture:  # the worst point, unless kept already
+            steps_row, comp_row = self.dev_row
+            self.picture.append(
+                (
+                    np.asarray([row], dtype=np.int64),
+                    np.asarray([at], dtype=np.float64),
+                    np.asarray([block], dtype=np.int64),
+                    steps_row.reshape(1, 2),
+                    np.asarray([comp_row]),
+                )
+            )
+        order = np.argsort(np.concatenate([p[0] for p in self.picture]), kind="stable")
+
+        def joined(k: int) -> Any:
+            return np.concatenate([p[k] for p in self.picture])[order]
+
+        return StreamedMeasures(
+            deviation=dev,
+            along=along,
+            contours=tuple(self.contours),
+            picture_rows=joined(0),
+            picture_mm=joined(1).reshape(-1, 2),
+            picture_blocks=joined(2),
+            picture_steps=joined(3).reshape(-1, 2),
+            picture_compensation=joined(4),
+            compensation_steps=(self.comp_steps[0], self.comp_steps[1]),
+        )
 
 
 NOT_CUT_KINDS = ("tight-corner", "offset-vanished", "uncut")

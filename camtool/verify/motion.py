@@ -111,6 +111,22 @@ class StepTrace:
     compensations: int
     block_time_s: FloatArray | None = None
 
+    @property
+    def row_count(self) -> int:
+        """Rows of the trace (iterations and compensation steps)."""
+        return len(self.rows)
+
+    @property
+    def iterations(self) -> int:
+        """Interpolator iterations: the rows that are not compensation."""
+        return int((~self.compensation).sum())
+
+    @property
+    def compensation_steps(self) -> tuple[int, int]:
+        """Compensation steps per axis ``(x, y)``."""
+        rows = self.rows[self.compensation]
+        return (int(np.abs(rows[:, 0]).sum()), int(np.abs(rows[:, 1]).sum()))
+
 
 LineInterpolator = Callable[[int, int], StepArray]
 """``(dx, dy)`` signed steps → step array ``(N, 2) int8``."""

@@ -486,3 +486,200 @@ def _play(
         out[lo:hi] = values
         current = float(values[-1])
     return out - c0 + start
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class TraceChunk:
+    """Whole moves' worth of a streamed simulation (:class:`ChunkedSimulation`).
+
+    Attributes:
+        first_block: index of the chunk's first move.
+        block_start: ``(b + 1,) int64`` row offsets of its moves, global (row numbers
+            of the whole trace): move ``first_block + i`` owns rows
+            ``block_start[i]:block_start[i + 1]``.
+        rows: ``(n, 2) int8`` motor steps of the chunk's rows, compensation included.
+        compensation: ``(n,) bool``, True for a compensation row.
+        carriage_mm: ``(n, 2) float64`` carriage after each row, mm: the same floats as
+            the whole trace's rows ``block_start[0]:block_start[-1]``.
+    """
+
+    first_block: int
+    block_start: IntArray
+    rows: StepArray
+    compensation: npt.NDArray[np.bool_]
+    carriage_mm: FloatArray
+
+    @property
+    def row0(self) -> int:
+        """Global number of the chunk's first row."""
+        return int(self.block_start[0])
+
+    def block_of_row(self) -> IntArray:
+        """``(n,) int64`` move index of each of the chunk's rows."""
+        counts = np.diff(self.block_start)
+        return np.repeat(np.arange(self.first_block, self.first_block + len(counts)), counts)
+
+
+def simulate_or_count(program: Program, machine: Machine, limit: int) -> StepTrace | IntArray:
+    """:func:`simulate_steps` (all sources) when the trace has at most ``limit`` rows.
+
+    Otherwise the rows are dropped as the moves are simulated (never more than one move's
+    rows held) and the ``(B + 1,) int64`` row offsets of the moves are returned: what
+    :class:`ChunkedSimulation` needs to stream the same trace in chunks.
+    """
+    sim = _Controller(machine, program.origin, ALL)
+    start = program.origin
+    rows = 0
+    for move in program.moves:
+        sim.block(start, move)
+        start = (move.x, move.y)
+        rows += sim.counts[-1]
+        if rows > limit:
+            sim.parts.clear()
+            sim.comp_parts.clear()
+    if rows <= limit:
+        return sim.finish(len(program.moves))
+    return np.concatenate(([0], np.cumsum(np.asarray(sim.counts, dtype=np.int64))))
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class StreamedTrace(StepTrace):
+    """The trace of a streamed verification: per-move arrays whole, rows only thinned.
+
+    ``rows``, ``compensation``, ``block_of_row`` and ``carriage_mm`` hold only the rows
+    kept for the picture (:class:`camtool.verify.metrics.StreamedMeasures`: every k-th
+    and the worst point), in trace order; ``block_start`` and the other per-move arrays
+    are the whole trace's. The whole trace's counts are :attr:`row_count`,
+    :attr:`iterations` and :attr:`compensation_steps`.
+
+    Attributes:
+        total_rows: rows of the whole trace.
+        total_compensation_steps: compensation steps ``(x, y)`` of the whole trace.
+    """
+
+    total_rows: int = 0
+    total_compensation_steps: tuple[int, int] = (0, 0)
+
+    @property
+    def row_count(self) -> int:
+        """Rows of the whole trace."""
+        return self.total_rows
+
+    @property
+    def iterations(self) -> int:
+        """Iterations of the whole trace (rows less compensation rows)."""
+        return self.total_rows - int(self.block_compensation.sum())
+
+    @property
+    def compensation_steps(self) -> tuple[int, int]:
+        """Compensation steps per axis of the whole trace."""
+        return self.total_compensation_steps
+
+
+class NotStreamable(Exception):
+    """The program cannot be simulated in chunks (rows that are not whole steps)."""
+
+
+class ChunkedSimulation:
+    """The step simulator (all sources) run in chunks of whole moves, carriage included.
+
+    :meth:`chunks` yields :class:`TraceChunk` s of at least ``chunk_rows`` rows (a move
+    is never split: a longer move is one chunk), each with the carriage the whole
+    simulation would give (the backlash play is carried from chunk to chunk,
+    :func:`camtool.verify.kernels.play_axis_from`); afterwards :meth:`trace_summary` is
+    the trace's per-move arrays. Needs the compiled kernels (``numba``).
+    """
+
+    def __init__(self, program: Program, machine: Machine, chunk_rows: int) -> None:
+        self.program = program
+        self.machine = machine
+        self.chunk_rows = max(1, int(chunk_rows))
+        self.sim = _Controller(machine, program.origin, ALL)
+        self.jit: Any = compiled()
+        if self.jit is None:
+            raise RuntimeError("the chunked simulation needs numba")  # callers check first
+
+    def chunks(self) -> Any:
+        """Yield the :class:`TraceChunk` s in order (an iterator)."""
+        sim, machine = self.sim, self.machine
+        true = machine.real_steps_per_mm
+        origin = sim.origin_steps
+        motor = [int(origin[0]), int(origin[1])]
+        last_sign = [0, 0]
+        state = [np.zeros(5, dtype=np.float64), np.zeros(5, dtype=np.float64)]
+        start = self.program.origin
+        first, row0, pending = 0, 0, 0
+        moves = self.program.moves
+        for b, move in enumerate(moves):
+            sim.block(start, move)
+            start = (move.x, move.y)
+            pending += sim.counts[-1]
+            if pending < self.chunk_rows and b + 1 < len(moves):
+                continue
+            rows = np.concatenate(sim.parts) if sim.parts else np.zeros((0, 2), STEP_DTYPE)
+            if rows.dtype != STEP_DTYPE:
+                raise NotStreamable(f"rows of dtype {rows.dtype}")
+            comp = np.concatenate(sim.comp_parts) if sim.comp_parts else np.zeros(0, np.bool_)
+            counts = np.asarray(sim.counts[first:], dtype=np.int64)
+            sim.parts.clear()
+            sim.comp_parts.clear()
+            out = np.empty((len(rows), 2), dtype=np.float64)
+            if len(rows):
+                runs = self.jit.play_runs(rows, motor[0], motor[1])
+            for axis in (0, 1):
+                if not len(rows):
+                    break
+                starts, signs, at = runs[3 * axis : 3 * axis + 3]
+                if len(starts) and int(signs[0]) == last_sign[axis]:  # the run goes on
+                    starts, signs, at = starts[1:], signs[1:], at[1:]
+                bands = np.asarray(
+                    [
+                        machine.backlash.true_at(axis, at[k, 0] / true[0], at[k, 1] / true[1])
+                        / 1000.0
+                        * true[axis]
+                        if signs[k] < 0
+                        else 0.0
+                        for k in range(len(starts))
+                    ],
+                    dtype=np.float64,
+                )
+                if len(signs):
+                    last_sign[axis] = int(signs[-1])
+                motor[axis] = int(
+                    self.jit.play_axis_from(
+                        rows,
+                        axis,
+                        starts,
+                        signs,
+                        bands,
+                        state[axis],
+                        motor[axis],
+                        float(origin[axis]),
+                        float(true[axis]),
+                        out,
+                    )
+                )
+            block_start = np.concatenate(([row0], row0 + np.cumsum(counts))).astype(np.int64)
+            yield TraceChunk(
+                first_block=first,
+                block_start=read_only(block_start),
+                rows=read_only(rows),
+                compensation=read_only(comp),
+                carriage_mm=read_only(out),
+            )
+            first, row0, pending = b + 1, int(block_start[-1]), 0
+
+    def trace_summary(self) -> dict[str, Any]:
+        """The per-move arrays and counts of the whole trace (after :meth:`chunks`)."""
+        sim = self.sim
+        counts = np.asarray(sim.counts, dtype=np.int64)
+        return {
+            "block_start": read_only(np.concatenate(([0], np.cumsum(counts))).astype(np.int64)),
+            "start_mm": _start_mm(sim.origin_steps, self.machine),
+            "logical_end": read_only(np.asarray(sim.logical, dtype=np.int64).reshape(-1, 2)),
+            "block_steps": read_only(np.asarray(sim.steps, dtype=np.int64).reshape(-1, 3)),
+            "block_dominant": read_only(np.asarray(sim.dominant, dtype=np.int64)),
+            "block_compensation": read_only(np.asarray(sim.block_comp, dtype=np.int64)),
+            "reversals": (sim.reversals[0], sim.reversals[1]),
+            "compensations": sim.compensations,
+        }

@@ -47,25 +47,41 @@ from camtool.model.units import fmt_num
 from camtool.model.version import __version__
 from camtool.verify import budget as eb
 from camtool.verify.clock import block_times_s, timing_warnings
+from camtool.verify.interpolators import compiled
 from camtool.verify.metrics import (
     Against,
     AlongPath,
     ContourMeasure,
     Deviation,
     FindingLike,
+    TraceStream,
     against_drawing,
     along_path,
     deviation,
     measure_contours,
 )
 from camtool.verify.motion import StepTrace, library
-from camtool.verify.simulate import simulate_steps
+from camtool.verify.simulate import (
+    ChunkedSimulation,
+    NotStreamable,
+    StreamedTrace,
+    simulate_or_count,
+    simulate_steps,
+)
 from camtool.verify.sources import ALL, Sources
+from camtool.verify.steparray import read_only
 
 if TYPE_CHECKING:
     from camtool.post.base import Target
     from camtool.toolpath.plan import PlanReport
 
+STREAM_ROWS = eb.MAX_ROWS
+"""Rows above which a trace is streamed (:func:`_simulate_big`); the error budget, which
+re-simulates whole traces, is skipped above the same count."""
+CHUNK_ROWS = 1 << 16
+"""Rows a streamed trace is simulated and measured at a time (a move is never split):
+with their temporaries about 130 bytes a row, ~9 MB next to Python, numpy, scipy,
+shapely and the loaded numba kernels (~160 MB)."""
 SMALL_PART_MM = 1.0
 """Parts under this size suffer most from compensations (seed-000 §5.3, S000-19)."""
 MAX_COMPENSATIONS_SMALL = 16
@@ -238,6 +254,8 @@ def verify_program(
     findings: Sequence[FindingLike] = (),
     planned: Program | None = None,
     budget: bool = True,
+    chunk_rows: int = CHUNK_ROWS,
+    stream_above: int = STREAM_ROWS,
 ) -> Verification:
     """Simulate ``program`` on ``machine`` and measure the machined error.
 
@@ -257,6 +275,9 @@ def verify_program(
             only the code is known.
         budget: compute the error budget when it is asked for
             (:attr:`Verification.error_budget`); ``False`` skips it.
+        chunk_rows: rows simulated and measured at a time when the trace is streamed.
+        stream_above: a trace of more rows than this is streamed (simulated and
+            measured ``chunk_rows`` at a time, :func:`_simulate_big`) when it can be.
 
     A drawing whose box does not overlap the program's (less than
     :data:`MIN_OVERLAP`) is not compared: ``against`` is ``None``,
@@ -271,15 +292,18 @@ def verify_program(
     if tool_diameter < 0:
         raise UsageError(f"tool diameter must be >= 0 mm, got {tool_diameter!r}")
     placement = check_area(program, machine)
-    trace = simulate(program, machine)
-    warnings = _warnings(program, trace)
     skipped = None if against is None else _no_overlap(program, against, tool_diameter / 2.0)
+    compared_with = against if skipped is None else None
+    trace, streamed = _simulate_big(program, machine, compared_with, chunk_rows, stream_above)
+    warnings = _warnings(program, trace)
     if skipped is not None:
         warnings.append(skipped)
-    compared_with = against if skipped is None else None
-    dev, along, contours, compared = _measure(
-        program, trace, compared_with, tool_diameter, findings
-    )
+    if streamed is not None:
+        dev, along, contours, compared = streamed
+    else:
+        dev, along, contours, compared = _measure(
+            program, trace, compared_with, tool_diameter, findings
+        )
     times = block_times(trace, program, machine)
     warnings.extend(timing_warnings(trace, program, machine))
     return Verification(
@@ -300,6 +324,64 @@ def verify_program(
         tool_diameter=tool_diameter,
         findings=tuple(findings),
     )
+
+
+def _simulate_big(
+    program: Program,
+    machine: Machine,
+    against: Drawing | None,
+    chunk_rows: int,
+    stream_above: int,
+) -> tuple[StepTrace, tuple[Deviation, AlongPath, tuple[ContourMeasure, ...], None] | None]:
+    """The trace of ``program``, and its measures when they were taken as it streamed.
+
+    A trace of at most ``stream_above`` rows, one from a target's own simulator, or one
+    to be compared with a drawing (which needs the cutting rows whole) is simulated whole
+    (:func:`simulate`) and measured by :func:`_measure` (then ``None``). A longer one of
+    the step simulator is simulated again in chunks of ``chunk_rows`` rows
+    (:class:`camtool.verify.simulate.ChunkedSimulation`) and measured chunk by chunk
+    (:class:`camtool.verify.metrics.TraceStream`: the same figures, the deviation's rms
+    summed exactly); the trace returned (:class:`StreamedTrace`) then holds only the rows
+    kept for the picture. Without the compiled kernels it is simulated whole.
+    """
+    if against is not None or library().simulator(machine.motion.line) is not None:
+        return simulate(program, machine), None
+    got = simulate_or_count(program, machine, stream_above)
+    if isinstance(got, StepTrace):
+        return got, None
+    kernels = compiled()
+    if kernels is None:
+        return simulate(program, machine), None
+    sim = ChunkedSimulation(program, machine, chunk_rows)
+    summary = sim.trace_summary()
+    stream = TraceStream(program, got, summary["start_mm"], kernels)
+    try:
+        for chunk in sim.chunks():
+            stream.add(
+                chunk.first_block,
+                chunk.block_start,
+                chunk.carriage_mm,
+                chunk.rows,
+                chunk.compensation,
+            )
+    except NotStreamable:
+        return simulate(program, machine), None
+    summary = sim.trace_summary()
+    if not np.array_equal(summary["block_start"], got):
+        raise RuntimeError(
+            "the chunked simulation did not repeat the first one"
+        )  # pragma: no cover
+    m = stream.finish()
+    trace = StreamedTrace(
+        rows=read_only(m.picture_steps),
+        compensation=read_only(m.picture_compensation),
+        block_of_row=read_only(m.picture_blocks),
+        carriage_mm=read_only(m.picture_mm),
+        **summary,
+        total_rows=int(got[-1]),
+        total_compensation_steps=m.compensation_steps,
+    )
+    return trace, (m.deviation, m.along, m.contours, None)
 
 
 def _measure(
@@ -375,10 +457,10 @@ def _budget(v: Verification) -> eb.ErrorBudget:
         )
     if not v.budget:
         return eb.ErrorBudget(total, skipped="switched off (--no-budget)")
-    if len(v.trace.rows) > eb.MAX_ROWS:
+    if v.trace.row_count > eb.MAX_ROWS:
         return eb.ErrorBudget(
             total,
-            skipped=f"the trace has {len(v.trace.rows)} rows (over {eb.MAX_ROWS}): re-simulating "
+            skipped=f"the trace has {v.trace.row_count} rows (over {eb.MAX_ROWS}): re-simulating "
             "it once per source would take too long; verify a part of the program to see it",
         )
     statuses = source_statuses(v.program, v.machine, planned=v.planned)
@@ -627,10 +709,9 @@ def summary_lines(v: Verification) -> list[str]:
     dev = v.deviation
     lines = [
         f"verified {len(v.program.moves)} moves on {v.target} ({v.machine.name})",
-        f"  steps x {steps[0]}, y {steps[1]}, z {steps[2]}; "
-        f"{int((~t.compensation).sum())} iterations",
+        f"  steps x {steps[0]}, y {steps[1]}, z {steps[2]}; {t.iterations} iterations",
         f"  reversals x {t.reversals[0]}, y {t.reversals[1]}; "
-        f"{t.compensations} compensations ({int(t.compensation.sum())} steps)",
+        f"{t.compensations} compensations ({t.row_count - t.iterations} steps)",
         f"  deviation from the path: max {fmt_num(dev.max_um, 2)} µm at "
         f"({fmt_num(dev.at_mm[0])}, {fmt_num(dev.at_mm[1])}) mm, "
         f"rms {fmt_num(dev.rms_um, 2)} µm",
@@ -735,7 +816,7 @@ def build_report(v: Verification) -> dict[str, Any]:
     """The report of a verification (see the module docstring for the keys)."""
     t = v.trace
     steps = t.block_steps.sum(axis=0) if len(t.block_steps) else np.zeros(3, dtype=np.int64)
-    comp_rows = t.rows[t.compensation]
+    comp_steps = t.compensation_steps
     dev = v.deviation
     at = None
     if dev.block >= 0:
@@ -751,11 +832,8 @@ def build_report(v: Verification) -> dict[str, Any]:
         "machine": v.machine.name,
         "blocks": len(v.program.moves),
         "steps": {"x": int(steps[0]), "y": int(steps[1]), "z": int(steps[2])},
-        "iterations": int((~t.compensation).sum()),
-        "compensation_steps": {
-            "x": int(np.abs(comp_rows[:, 0]).sum()),
-            "y": int(np.abs(comp_rows[:, 1]).sum()),
-        },
+        "iterations": t.iterations,
+        "compensation_steps": {"x": comp_steps[0], "y": comp_steps[1]},
         "reversals": {"x": t.reversals[0], "y": t.reversals[1]},
         "compensations": t.compensations,
         "deviation_um": {"max": _um(dev.max_um), "rms": _um(dev.rms_um), "at": at},

@@ -1,0 +1,162 @@
+"""A streamed verification (the trace simulated and measured in chunks) equals the whole one.
+
+Issue 17: a big program's trace is never held whole (:func:`camtool.verify.verifier.
+_simulate_big`). Run with a tiny chunk size and a tiny streaming threshold, the same
+programs must give the same report as the whole-array path, figure for figure; the one
+allowed exception is the deviation's rms, summed exactly instead of by numpy's pairwise
+mean (its value may differ in the last bits; the report rounds it to 0.1 nm).
+"""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+from camtool.model.program import ArcMove, Linear, Program, Rapid
+from camtool.post.registry import load_target
+from camtool.verify.simulate import ChunkedSimulation, StreamedTrace, simulate_steps
+from camtool.verify.verifier import build_report, verify_program
+
+kernels = pytest.importorskip("camtool.verify.kernels")
+
+TARGETS = ("pic-mmh", "flashcut", "valcnc", "i8751", "grbl")
+"""Targets whose profile runs the step simulator (the one that streams)."""
+
+
+def _program(seed: int) -> Program:
+    """Contours with reversals (backlash), a full circle, zero-length moves, rapids between.
+
+    Inside 0.5 … 6 mm (pic-mmh's work area is 10 × 7 mm).
+    """
+    rng = np.random.default_rng(seed)
+    moves: list[Linear | ArcMove | Rapid] = [Rapid(1.0, 1.0, contour=1)]
+    x, y = 1.0, 1.0
+    for _ in range(int(rng.integers(3, 8))):  # a zig-zag with reversals on both axes
+        x = round(float(rng.uniform(0.5, 6.0)), 3)
+        y = round(float(rng.uniform(0.5, 6.0)), 3)
+        moves.append(Linear(x, y, 300.0, contour=1))
+    moves.append(Linear(x, y, 300.0, contour=1))  # no XY length
+    moves.append(Rapid(4.5, 3.0, contour=2))  # a full circle: the fitted diameter
+    moves.append(ArcMove(4.5, 3.0, 3.5, 3.0, bool(seed % 2), 300.0, contour=2))
+    moves.append(Rapid(1.0, 1.0, contour=3))  # a closed square with an arc corner
+    moves += [
+        Linear(2.0, 1.0, 300.0, contour=3),
+        ArcMove(2.5, 1.5, 2.0, 1.5, False, 300.0, contour=3),
+        Linear(2.5, 2.5, 300.0, contour=3),
+        Linear(1.0, 2.5, 300.0, contour=3),
+        Linear(1.0, 1.0, 300.0, contour=3),
+    ]
+    moves.append(Rapid(0.5, 0.5))
+    return Program(tuple(moves), origin=(0.0, 0.0))
+
+
+@pytest.mark.parametrize("name", TARGETS)
+@pytest.mark.parametrize("chunk", [1, 37, 300])
+def test_chunked_simulation_gives_the_whole_trace(name: str, chunk: int) -> None:
+    machine = load_target(name).machine
+    program = _program(chunk)
+    whole = simulate_steps(program, machine)
+    sim = ChunkedSimulation(program, machine, chunk)
+    parts = list(sim.chunks())
+    assert len(parts) > 1
+    for key, column in (("rows", "rows"), ("carriage", "carriage_mm"), ("comp", "compensation")):
+        joined = np.concatenate([getattr(p, column) for p in parts])
+        assert np.array_equal(joined, getattr(whole, column)), key
+    assert np.array_equal(np.concatenate([p.block_of_row() for p in parts]), whole.block_of_row)
+    summary = sim.trace_summary()
+    for key, value in summary.items():
+        expected = getattr(whole, key)
+        if isinstance(value, np.ndarray):
+            assert np.array_equal(value, expected), key
+        else:
+            assert value == expected, key
+
+
+def _strip_rms(report: dict) -> dict:
+    out = dict(report)
+    out["deviation_um"] = {k: v for k, v in report["deviation_um"].items() if k != "rms"}
+    return out
+
+
+@pytest.mark.parametrize("name", TARGETS)
+@pytest.mark.parametrize("seed", range(3))
+def test_streamed_verification_reports_the_whole_figures(name: str, seed: int) -> None:
+    target = load_target(name)
+    program = _program(seed)
+    whole = verify_program(program, target.machine, name=name, budget=False)
+    assert not isinstance(whole.trace, StreamedTrace)
+    expected = build_report(whole)
+    for chunk in (1, 53, 4000):
+        v = verify_program(
+            program, target.machine, name=name, budget=False, chunk_rows=chunk, stream_above=10
+        )
+        assert isinstance(v.trace, StreamedTrace)
+        got = build_report(v)
+        assert _strip_rms(got) == _strip_rms(expected)
+        # every figure, unrounded: the same floats (the rms: to the last bits)
+        assert v.contours == whole.contours
+        assert v.along == whole.along
+        dev, ref = v.deviation, whole.deviation
+        assert (dev.max_um, dev.at_mm, dev.block, dev.points) == (
+            ref.max_um,
+            ref.at_mm,
+            ref.block,
+            ref.points,
+        )
+        assert math.isclose(dev.rms_um, ref.rms_um, rel_tol=1e-13)
+        assert v.time_s == whole.time_s and v.warnings == whole.warnings
+        assert v.trace.row_count == whole.trace.row_count
+        # the picture's rows are the whole trace's, the worst deviation among them
+        rows = np.flatnonzero(np.isin(whole.trace.carriage_mm[:, 0], v.trace.carriage_mm[:, 0]))
+        assert len(rows) >= len(v.trace.carriage_mm) > 0
+        assert tuple(dev.at_mm) in {tuple(p) for p in v.trace.carriage_mm.tolist()}
+
+
+def test_a_streamed_rms_is_the_exact_mean() -> None:
+    """The rms of a streamed trace is sqrt(exact sum of the squares / n), from first principles."""
+    target = load_target("pic-mmh")
+    program = _program(5)
+    v = verify_program(
+        program, target.machine, name="pic-mmh", budget=False, chunk_rows=100, stream_above=10
+    )
+    whole = simulate_steps(program, target.machine)
+    from camtool.verify.metrics import nominal_arrays, point_distances
+
+    nominal = nominal_arrays(program)
+    cutting = nominal["kind"][whole.block_of_row] != 2
+    d = point_distances(whole.carriage_mm[cutting], whole.block_of_row[cutting], nominal)
+    exact = sum((Fraction(float(x) * float(x)) for x in d), Fraction(0))
+    assert v.deviation.rms_um == math.sqrt(float(exact) / len(d)) * 1000.0
+
+
+def test_a_small_program_is_measured_whole() -> None:
+    target = load_target("pic-mmh")
+    v = verify_program(_program(0), target.machine, name="pic-mmh", budget=False)
+    assert not isinstance(v.trace, StreamedTrace)
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_exact_sum_squares_is_the_exact_sum(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(0, 4000))
+    values = rng.random(n) * 10.0 ** rng.uniform(-160, 150)
+    if seed % 4 == 0:
+        values[: n // 3] = 0.0
+    if seed % 5 == 0 and n:
+        values[-1] = 5e-324  # a subnormal (its square is 0)
+        values[0] = 1e-160  # a subnormal square
+    bins = np.zeros(kernels.EXACT_BINS, dtype=np.int64)
+    pending = 0
+    for i in range(0, n, 997):  # in pieces, past the carry at 1024
+        pending = kernels.exact_sum_squares(values[i : i + 997], bins, pending)
+    exact = sum((Fraction(float(x) * float(x)) for x in values), Fraction(0))
+    assert kernels.exact_sum(bins) == float(exact)
+
+
+def test_exact_sum_squares_flags_a_non_finite_square() -> None:
+    bins = np.zeros(kernels.EXACT_BINS, dtype=np.int64)
+    kernels.exact_sum_squares(np.asarray([1.0, 1e200]), bins, 0)
+    assert math.isnan(kernels.exact_sum(bins))
