@@ -196,12 +196,15 @@ def _distances(
     nominal: dict[str, FloatArray],
     bounds: IntArray,
     first: int,
+    kernels: Any = None,
 ) -> tuple[FloatArray, list[tuple[int, int]]]:
     """Distances of the cutting rows of moves ``first, first + 1, ...`` to their moves, mm.
 
     ``bounds`` ``(b + 1,)`` are the row offsets (in ``points``) of the moves
     ``first .. first + b - 1``; every row of ``points`` belongs to one of them. Rows are
-    measured a block (or a run of short blocks) at a time (see :func:`deviation`).
+    measured a block (or a run of short blocks) at a time (see :func:`deviation`); with
+    ``kernels`` (:mod:`camtool.verify.kernels`) a long line by the compiled
+    :func:`camtool.verify.kernels.to_line` (the same floats as :func:`_to_line`).
 
     Returns:
         The distances of the cutting rows in row order, and the measured pieces
@@ -237,7 +240,10 @@ def _distances(
             ends = tuple(nominal[k][b] for k in ("x0", "y0", "x1", "y1"))
             for c in range(lo, hi, DEVIATION_CHUNK):
                 top = min(hi, c + DEVIATION_CHUNK)
-                dist[at : at + top - c] = _to_line(points[c:top], *ends)
+                if kernels is not None:
+                    kernels.to_line(points[c:top], *ends, dist[at : at + top - c])
+                else:
+                    dist[at : at + top - c] = _to_line(points[c:top], *ends)
                 pieces.append((at, c))
                 at += top - c
         elif pending < 0 and hi > lo:
@@ -980,7 +986,7 @@ class TraceStream:
         steps: Any,
         compensation: Any,
     ) -> None:
-        dist, pieces = _distances(points, blocks, self.nominal, bounds, first)
+        dist, pieces = _distances(points, blocks, self.nominal, bounds, first, self.kernels)
         if not len(dist):
             return
         worst = int(np.argmax(dist))

@@ -60,6 +60,8 @@ from table import row  # noqa: E402
 
 LINES = int(os.environ.get("CAMTOOL_BENCH_LINES", "200"))
 """Long lines of the big program (``CAMTOOL_BENCH_LINES`` to change; 200 ≈ 13.2 M steps)."""
+BIG_LINES = int(os.environ.get("CAMTOOL_BENCH_BIG_LINES", "1000"))
+"""Lines of the second, bigger program (1000 ≈ 66 M steps; 0 leaves that row out)."""
 REPEATS = 2
 """Runs of each CLI job (the best wall time is kept; memory is the largest)."""
 SPM = 1e6 / 140.0
@@ -97,11 +99,11 @@ def _steps(um: int) -> int:
     return int(um / 1000.0 * SPM + 0.5)
 
 
-def measure(tree: Path, args: list[str]) -> tuple[float, int, float]:
+def measure(tree: Path, args: list[str], repeats: int = REPEATS) -> tuple[float, int, float]:
     """Best wall time (s), exit code and largest peak RSS (MB) of ``camtool ARGS`` in ``tree``."""
     env = {**os.environ, "PYTHONPATH": f"{tree}{os.pathsep}{tree / '.pp'}"}
     best, rss, rc = float("inf"), 0.0, 0
-    for _ in range(REPEATS):
+    for _ in range(repeats):
         out = subprocess.run(
             [sys.executable, "-c", RUNNER, sys.executable, "-m", "camtool", *args],
             capture_output=True,
@@ -129,66 +131,109 @@ def c_dda_rate(moves: list[tuple[int, int]], tmp: Path) -> tuple[float, str] | N
     return int(pulses) / float(secs), cc_version(cc)
 
 
+STARTUP = """
+import time
+t0 = time.perf_counter()
+import numpy as np
+import camtool.cli.main, camtool.verify.verifier, scipy.spatial, shapely
+from camtool.verify.interpolators import compiled, dda_line
+k = compiled()
+dda_line(3, 2)
+k.play_runs(np.zeros((2, 2), np.int8), 0, 0)
+k.play_axis_from(np.zeros((2, 2), np.int8), 0, np.zeros(0, np.int64), np.zeros(0, np.int8),
+                 np.zeros(0), np.zeros(5), 0, 0.0, 1.0, np.zeros((2, 2)))
+k.exact_sum_squares(np.zeros(2), np.zeros(k.EXACT_BINS, np.int64), 0)
+k.to_line(np.zeros((2, 2)), 0.0, 0.0, 1.0, 0.0, np.zeros(2))
+print(time.perf_counter() - t0)
+"""
+"""The fixed start-up of a streamed verify: Python, camtool, scipy, shapely, numba's kernels."""
+
+
+def startup_s(tree: Path) -> float:
+    """Best wall time (s) of :data:`STARTUP` (the interpreter's own start added) in ``tree``."""
+    env = {**os.environ, "PYTHONPATH": f"{tree}{os.pathsep}{tree / '.pp'}"}
+    best = float("inf")
+    for _ in range(REPEATS):
+        t0 = time.perf_counter()
+        subprocess.run(
+            [sys.executable, "-c", STARTUP], env=env, cwd=tree, check=True, capture_output=True
+        )
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def verify_row(
+    tmp: Path, lines: int, base: str | None, start: float, repeats: int = REPEATS
+) -> None:
+    """Verify the program of ``lines`` lines (and, with ``base``, on that tree too): one row."""
+    text, moves = big_program(lines)
+    program = tmp / f"big-{lines}.pic"
+    program.write_text(text)
+    trees = {"after": ROOT} | ({"before": Path(base)} if base else {})
+    results = {}
+    for label, tree in trees.items():
+        report = tmp / f"{label}-{lines}.json"
+        args = ["verify", str(program), "-t", "pic-mmh", "--report", str(report)]
+        results[label] = (*measure(tree, args, repeats), report)
+    wall, rc, rss, report = results["after"]
+    data = json.loads(report.read_text()) if rc == 0 else {}
+    steps = sum(data.get("steps", {}).values())
+    rate = steps / wall if wall else 0.0
+    per_step = (wall - start) / steps * 1e9 if steps else 0.0
+    note = (
+        f"{lines} lines, {steps:,} steps, {data.get('iterations', 0):,} iterations; "
+        f"exit {rc}; budget: {data.get('error_budget', {}).get('skipped', '—')}; "
+        f"start-up {start:.2f} s, then {per_step:.0f} ns a step "
+        f"({steps / max(wall - start, 1e-9) / 1e6:.1f} M steps/s without the start-up)"
+    )
+    if base:
+        bwall, brc, brss, breport = results["before"]
+        same = brc == rc and breport.read_bytes() == report.read_bytes()
+        note += (
+            f"; before ({base}): {bwall:.2f} s, {brss:.0f} MB, "
+            f"{steps / bwall / 1e6:.2f} M steps/s; reports " + ("identical" if same else "DIFFER")
+        )
+    peer = c_dda_rate(moves, tmp)
+    camtool = f"{wall:.2f} s, {rate / 1e6:.2f} M steps/s, {rss:.0f} MB"
+    job = f"camtool verify of a {steps / 1e6:.1f} M-step pic-mmh program (CLI)"
+    if peer is None:
+        row(
+            job,
+            camtool,
+            "C cc -O2: not installed (apt-get install gcc)",
+            "—",
+            None,
+            "speed",
+            "≥ 0.05×, < 250 MB",
+            False,
+            note,
+        )
+        return
+    c_rate, version = peer
+    ratio = rate / c_rate
+    row(
+        job,
+        camtool,
+        f"C {version} -O2, A.3 loop on the same lines",
+        f"{c_rate / 1e6:.0f} M steps/s",
+        ratio,
+        "speed",
+        "≥ 0.05×, < 250 MB",
+        rc == 0 and ratio >= 0.05 and rss < 250.0,
+        note,
+    )
+
+
 def main() -> None:
     """Run the jobs and print their rows."""
     t0 = time.perf_counter()
     base = os.environ.get("CAMTOOL_BENCH_BASE")
     with tempfile.TemporaryDirectory(prefix="camtool-bench-verify-") as name:
         tmp = Path(name)
-        text, moves = big_program(LINES)
-        program = tmp / "big.pic"
-        program.write_text(text)
-        trees = {"after": ROOT} | ({"before": Path(base)} if base else {})
-        results = {}
-        for label, tree in trees.items():
-            report = tmp / f"{label}.json"
-            args = ["verify", str(program), "-t", "pic-mmh", "--report", str(report)]
-            results[label] = (*measure(tree, args), report)
-        wall, rc, rss, report = results["after"]
-        data = json.loads(report.read_text()) if rc == 0 else {}
-        steps = sum(data.get("steps", {}).values())
-        rate = steps / wall if wall else 0.0
-        note = (
-            f"{LINES} lines, {steps:,} steps, {data.get('iterations', 0):,} iterations; "
-            f"exit {rc}; budget: {data.get('error_budget', {}).get('skipped', '—')}"
-        )
-        if base:
-            bwall, brc, brss, breport = results["before"]
-            same = brc == rc and breport.read_bytes() == report.read_bytes()
-            note += (
-                f"; before ({base}): {bwall:.2f} s, {brss:.0f} MB, "
-                f"{steps / bwall / 1e6:.2f} M steps/s; reports "
-                + ("identical" if same else "DIFFER")
-            )
-        peer = c_dda_rate(moves, tmp)
-        camtool = f"{wall:.2f} s, {rate / 1e6:.2f} M steps/s, {rss:.0f} MB"
-        job = f"camtool verify of a {steps / 1e6:.1f} M-step pic-mmh program (CLI)"
-        if peer is None:
-            row(
-                job,
-                camtool,
-                "C cc -O2: not installed (apt-get install gcc)",
-                "—",
-                None,
-                "speed",
-                "≥ 0.05×, < 250 MB",
-                False,
-                note,
-            )
-        else:
-            c_rate, version = peer
-            ratio = rate / c_rate
-            row(
-                job,
-                camtool,
-                f"C {version} -O2, A.3 loop on the same lines",
-                f"{c_rate / 1e6:.0f} M steps/s",
-                ratio,
-                "speed",
-                "≥ 0.05×, < 250 MB",
-                rc == 0 and ratio >= 0.05 and rss < 250.0,
-                note,
-            )
+        start = startup_s(ROOT)
+        verify_row(tmp, LINES, base, start)
+        if BIG_LINES:  # not on the tree before issue 17: it would hold ~10 GB
+            verify_row(tmp, BIG_LINES, None, start, repeats=1)
 
         logo = tmp / "logo.pic"
         logo_args = [

@@ -160,3 +160,23 @@ def test_exact_sum_squares_flags_a_non_finite_square() -> None:
     bins = np.zeros(kernels.EXACT_BINS, dtype=np.int64)
     kernels.exact_sum_squares(np.asarray([1.0, 1e200]), bins, 0)
     assert math.isnan(kernels.exact_sum(bins))
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_compiled_to_line_is_the_numpy_distance_bit_for_bit(seed: int) -> None:
+    from camtool.verify.metrics import _to_line
+
+    rng = np.random.default_rng(seed)
+    scale = 10.0 ** rng.uniform(-4, 3)
+    points = rng.normal(0.0, scale, (20_000, 2))
+    if seed % 3 == 0:  # on a step grid, as a trace is
+        points = np.round(points / 1.4e-4) * 1.4e-4
+    ends = rng.normal(0.0, scale, 4)
+    if seed % 4 == 0:  # a segment of no length
+        ends[2:] = ends[:2]
+    if seed % 4 == 1:  # points on the segment's ends and beyond them
+        points[:100] = ends[:2]
+        points[100:200] = ends[2:] + (ends[2:] - ends[:2])
+    out = np.empty(len(points))
+    kernels.to_line(points, *ends, out)
+    assert np.array_equal(out.view(np.int64), _to_line(points, *ends).view(np.int64))
