@@ -18,25 +18,35 @@ Set ``CAMTOOL_BENCH_BASE=/path/to/old/tree`` to run the same two jobs on another
 (e.g. the code before issue 17) in the same run: its times and memory are printed, and
 the reports must be byte-identical (the row notes it).
 
-Measured on the 2-core machine shared with 4 other jobs (so under load; the two trees run
-one after the other in the same run, best of 2), camtool b3b77a5 (before) and this branch
-(after); C peer ``cc -O2`` (gcc 12.2.0):
+A second row verifies a program of :data:`BIG_LINES` lines (66.2 M steps) on this tree
+only (the code before issue 17 would hold ~10 GB), once. The start-up (Python, camtool,
+scipy, shapely and numba's cached kernels, :data:`STARTUP`) is measured on its own, and
+each row's note gives the time per step after it.
 
-=======================================  ===================  ===================  =======
-job                                      before               after                vs C
-=======================================  ===================  ===================  =======
-verify, 200 lines, 13.2 M steps          18.6 s, 2155 MB      9.3 s, 922 MB        0.005×
-  (same, heavier load)                   39.3 s               18.8 s, 907 MB       0.005×
-verify, 50 lines, 3.3 M steps            7.4 s, 567 MB        6.5 s, 407 MB        0.002×
-post --verify of the logo                5.5–15.9 s, 235 MB   6.0–14.9 s, 232 MB   —
-=======================================  ===================  ===================  =======
+Measured on the 2-core machine shared with 4 other jobs (so under load, load average ~5;
+the trees run one after the other in the same run, best of 2), camtool b3b77a5 (before
+issue 17), main b83b9f0 (the first pass) and this branch (the trace streamed); C peer
+``cc -O2`` (gcc 12.2.0):
+
+=============================  ===============  =============  ====================  ======
+job                            before b3b77a5   first pass     now (streamed)        vs C
+=============================  ===============  =============  ====================  ======
+verify, 13.2 M steps           18.6 s, 2155 MB  7.6 s, 846 MB  7.0 s, 259 MB         0.007×
+verify, 66.2 M steps           —                —              28.8 s, 440 MB        0.008×
+start-up (imports, kernels)    —                —              3.0 s (1.5 s quiet)   —
+post --verify of the logo      5.5–15.9 s       6.0–17.0 s     12.7 s, 234 MB        —
+=============================  ===============  =============  ====================  ======
 
 Every report is byte-identical before and after. The goals (≥ 0.05× the C loop's
-steps/s, < 250 MB) are not met: of the 13.2 M-step verify's ~9 s, ``along_path`` (the
-path-to-trace shortfall, not part of this work) takes about 4 s, starting Python and
-numba about 1.5 s, and the whole trace is held as arrays (27 bytes a row, plus the copy of
-the carriage ``along_path`` makes per contour), which is what keeps the memory at
-~0.9 GB; see the issue-17 report for the profile.
+steps/s, < 250 MB) are not met. The trace is now streamed (simulated and measured in
+chunks of whole moves, never held whole: docs/verify.md "Speed and memory"), which took
+the memory from 846 to ~259 MB; what is left is the start-up (~1.5 s quiet, itself over the
+0.46 s the goal allows at 13.2 M steps) and the path-to-trace distances of the shortfall
+(``metrics.nearest_distances``, 2.4–3.5 s of CPU on 400 000 path samples against a
+390 000-point thinned trace, and ~75 MB while it runs; on the 66 M-step program most of
+its 28 s, since the thinned trace's segments are as long as the samples' spacing and far
+more samples miss the cheap vertex bound). Python, numpy, scipy, shapely and the loaded
+kernels are ~160 MB before any trace.
 """
 
 from __future__ import annotations
