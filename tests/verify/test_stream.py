@@ -180,3 +180,30 @@ def test_compiled_to_line_is_the_numpy_distance_bit_for_bit(seed: int) -> None:
     out = np.empty(len(points))
     kernels.to_line(points, *ends, out)
     assert np.array_equal(out.view(np.int64), _to_line(points, *ends).view(np.int64))
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_a_contour_thinned_on_the_fly_keeps_the_points_thinned_keeps(
+    seed: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A streamed contour keeps the points :func:`_thinned` keeps of the whole run."""
+    from camtool.verify import metrics
+
+    rng = np.random.default_rng(seed)
+    monkeypatch.setattr(metrics, "ALONG_MAX_TRACE", int(rng.integers(50, 3000)))
+    counts = rng.integers(0, 900, int(rng.integers(1, 12)))  # rows of each move
+    counts[rng.random(len(counts)) < 0.2] = 0  # moves without rows
+    rows = int(counts.sum())
+    block_start = np.concatenate(([0], np.cumsum(counts))).astype(np.int64)
+    step = float(rng.choice([0.00014, 0.0002, 0.0007, 0.0]))
+    points = np.cumsum(rng.choice([-step, 0.0, step], size=(rows, 2)), axis=0)
+    before = rng.random(2)
+    run = np.vstack([before, points])
+    expected = metrics._thinned(run, block_start[1:])
+    contour = metrics._Contour(1, 0, len(counts) - 1, block_start)
+    contour.add(0, before.reshape(1, 2))
+    cuts = np.sort(rng.integers(0, rows + 1, int(rng.integers(0, 6))))
+    for lo, hi in zip(np.r_[0, cuts], np.r_[cuts, rows], strict=True):
+        if hi > lo:
+            contour.add(int(lo) + 1, points[lo:hi])
+    assert np.array_equal(contour.trace(), expected)
