@@ -194,6 +194,8 @@ def word_address_dialect(options: Mapping[str, Any], where: str) -> WordAddressP
 
 _SAME_MM = 1e-9
 """Exact XY closer than this is the same point (a Z-only move)."""
+_CONFORMED_KEPT = 20_000
+"""Arcs whose blocks a writer keeps (:meth:`BlockWriter._conformed`); then it starts anew."""
 
 
 class BlockWriter(WriterState[str]):
@@ -232,6 +234,7 @@ class BlockWriter(WriterState[str]):
         }
         self._parses = {letter: word.number.parse for letter, word in spec.words.items()}
         self._quantum: float | None = None
+        self._conformed_arcs: dict[tuple[Any, ...], list[tuple[Point, Point | None]]] = {}
         self._feed_text: tuple[float, str] | None = None
 
     # -- the program -------------------------------------------------------------
@@ -461,8 +464,11 @@ class BlockWriter(WriterState[str]):
         ``full_circle`` is ``arc.is_full_circle``.
         """
         limit = self.spec.max_arc_deg
-        sweep = math.degrees(abs(arc.sweep))
-        parts = max(1, math.ceil(sweep / limit - 1e-9))
+        if limit >= 360.0:
+            parts = 1  # a sweep is at most 360° (the formula below gives 1 too)
+        else:
+            sweep = math.degrees(abs(arc.sweep))
+            parts = max(1, math.ceil(sweep / limit - 1e-9))
         if full_circle and self.spec.full_circle == "split":
             parts = max(2, parts)
         elif full_circle:
@@ -477,6 +483,26 @@ class BlockWriter(WriterState[str]):
         """
         if self.spec.arc_check == "none":
             return [(piece.end, piece.centre)]
+        key = (self.written, piece.end, piece.centre, piece.clockwise, piece.start)
+        # The same arc from the same written start (a program that cuts a contour again at
+        # another depth) gives the same blocks: conform_arc is a function of its arguments.
+        # Zeros are left out: -0.0 equals 0.0 as a key, but not as an angle (atan2).
+        kept = self._conformed_arcs
+        known = kept.get(key)
+        if known is not None:
+            if not known:
+                self.counts["tiny-arc"] += 1
+            return known
+        zero = 0.0 in key[0] or 0.0 in key[1] or 0.0 in key[2] or 0.0 in key[4]
+        out = self._conform(piece)
+        if not zero:
+            if len(kept) >= _CONFORMED_KEPT:
+                kept.clear()
+            kept[key] = out
+        return out
+
+    def _conform(self, piece: Arc) -> list[tuple[Point, Point | None]]:
+        """:meth:`_conformed` without its memory of the arcs already conformed."""
         from camtool.post.arccheck import conform_arc
 
         quantum = self._quantum

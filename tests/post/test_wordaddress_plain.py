@@ -1,9 +1,11 @@
 """The word-address writer's shortcuts write what its full path writes (issue 17).
 
 :class:`~camtool.post.wordaddress.BlockWriter` formats a word without a step grid with
-its number format directly (:meth:`text`) and writes the feed of the block before again
-without checking it anew (:meth:`_feed`). :class:`Reference` turns both off: every word
-goes through the full formatting and every feed through its checks, as before. On
+its number format directly (:meth:`text`), writes the feed of the block before again
+without checking it anew (:meth:`_feed`) and keeps the blocks of each arc it conformed to
+the controller's check for the same arc again (:meth:`_conformed`). :class:`Reference`
+turns all three off: every word goes through the full formatting, every feed through its
+checks and every arc through :func:`~camtool.post.arccheck.conform_arc`, as before. On
 random programs of rapids, lines and arcs (tiny, huge, full circles, reflex arcs,
 helices, feeds that round, numbers over their field) written for every built-in
 word-address target and a few dialects of other widths, the code, the warnings and the
@@ -19,6 +21,7 @@ from typing import Any
 from camtool.model.errors import CamtoolError
 from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Linear, Move, Program, Rapid
+from camtool.model.shapes import Arc, Point
 from camtool.post.registry import load_target
 from camtool.post.wordaddress import BlockWriter, WordAddressPost, word_address_dialect
 
@@ -35,6 +38,11 @@ class Reference(BlockWriter):
     def _feed(self, move: Linear | ArcMove, words: list[str]) -> None:
         self._feed_text = None
         super()._feed(move, words)
+
+    def _conformed(self, piece: Arc) -> list[tuple[Point, Point | None]]:
+        if self.spec.arc_check == "none":
+            return super()._conformed(piece)
+        return self._conform(piece)
 
 
 def written(writer: type[BlockWriter], post: WordAddressPost, program: Program) -> str:
@@ -71,6 +79,8 @@ def random_program(rng: random.Random, z: bool) -> Program:
                 tx, ty = cx + r * math.cos(a0 + sweep), cy + r * math.sin(a0 + sweep)
             moves.append(ArcMove(tx, ty, cx, cy, sweep < 0, feed, zz))
         x, y = tx, ty
+    if rng.random() < 0.5:  # the same contour again, at another depth where there is Z
+        moves += [Rapid(0.0, 0.0), *moves]
     return Program(tuple(moves))
 
 
