@@ -69,9 +69,10 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 from pathlib import Path
 
-from camtool.importers.gcode_codes import BlockWords, Notes
+from camtool.importers.gcode_codes import BlockWords, Notes, g_key
 from camtool.importers.gcode_lexer import Block, Word, cut_mid_word, lex_line
 from camtool.model.errors import InputError
 from camtool.model.program import (
@@ -88,12 +89,20 @@ from camtool.model.program import (
     ToolChange,
 )
 from camtool.model.shapes import Point
-from camtool.model.units import INCH
+from camtool.model.units import INCH, LARGEST_VALUE
 
 _ARC_TOL_MM = (0.005, 0.5)
 """LinuxCNC arc end tolerance in mm: (with 0.1 % of the radius, absolute ceiling)."""
 _ARC_TOL_IN = (0.0005, 0.05)
 """The same in inches (G20)."""
+
+_PLAIN_NUMBER = r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)"
+_PLAIN_LINE = re.compile(r"[ \t]*(?:[GXYZIJRFNgxyzijrfn]" + _PLAIN_NUMBER + r"[ \t]*)+")
+"""A plain line (:meth:`_Reader.plain`): words of these letters with ASCII numbers, blanks
+between words only; anything else (comments, other letters or characters, a blank inside a
+word, a non-ASCII digit) goes to the lexer."""
+_PLAIN_WORD = re.compile(r"([GXYZIJRFN])(" + _PLAIN_NUMBER + ")")
+_PLAIN_MOTION = {0: "G0", 10: "G1", 20: "G2", 30: "G3"}
 
 
 def read_gcode(path: str | Path, *, source_name: str | None = None) -> Program:
@@ -154,10 +163,27 @@ def parse_gcode(text: str, *, source: str) -> Program:
             a last line cut in the middle of a word, no move at all, or no
             cutting move.
     """
+    return _parse(text, source, plain=True)
+
+
+def parse_gcode_slow(text: str, *, source: str) -> Program:
+    """:func:`parse_gcode` with every line lexed into words and run block by block.
+
+    The way every line was read before issue 17; :func:`parse_gcode` reads plain
+    lines (:meth:`_Reader.plain`) without making words, to the same program with
+    the same warnings and errors (tests/importers/test_gcode_plain.py compares the two).
+    """
+    return _parse(text, source, plain=False)
+
+
+def _parse(text: str, source: str, *, plain: bool) -> Program:
+    """:func:`parse_gcode`; ``plain``: take the plain-line path where it applies."""
     lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
     reader = _Reader(source)
     opened = False  # a '%' line before the first block: the next '%' ends the program
     ended = False
+    plain_line = _PLAIN_LINE.fullmatch
+    plain_words = _PLAIN_WORD.findall
     for number, raw in enumerate(lines, start=1):
         if number == len(lines) and (cut := cut_mid_word(raw)) is not None:
             raise InputError(
@@ -165,6 +191,8 @@ def parse_gcode(text: str, *, source: str) -> Program:
                 "end of line after it): the last line is incomplete, the file looks "
                 "truncated; copy or export the program again"
             )
+        if plain and plain_line(raw) and reader.plain(plain_words(raw.upper()), number):
+            continue
         block = lex_line(raw, number, source)
         if block is None:
             if raw.lstrip().startswith("%"):
@@ -234,6 +262,176 @@ class _Reader:
         self._check_unused(words, used)
         stop = words.m.get("stop")
         return stop is not None and stop.name in ("M2", "M30")
+
+    def plain(self, words: list[tuple[str, str]], line: int) -> bool:
+        """Execute a plain line as :meth:`run` would, if it is one; False leaves all as it was.
+
+        ``words`` are the (upper-case letter, number text) pairs of a line that
+        :data:`_PLAIN_LINE` matches: G, X, Y, Z, I, J, R, F and N words. Such a line is
+        read here without making its :class:`Word` objects when it can end in
+        nothing but what :meth:`run` does without a warning or an error: each letter
+        once, numbers in range, a G word that is G0 to G3, absolute distances (G90),
+        a known position, a feed > 0 for a cut, and for an arc a centre within the
+        radius tolerance. Every other line (False, nothing changed) goes through the
+        lexer and :meth:`run`, which give its warning or error. The arithmetic is
+        :meth:`run`'s, operation for operation, so the moves are the same floats.
+        """
+        args: dict[str, float] = {}
+        for letter, text in words:
+            value = float(text)
+            if not abs(value) < LARGEST_VALUE:
+                return False
+            if letter == "N":
+                continue
+            if letter in args:
+                return False
+            args[letter] = value
+        motion = self.motion
+        g = args.pop("G", None)
+        if g is not None:
+            motion = _PLAIN_MOTION.get(g_key(g))  # type: ignore[arg-type]
+            if motion is None:
+                return False
+        f = args.pop("F", None)
+        if f is not None and f < 0:
+            return False
+        scale = INCH if self.inch else 1.0
+        feed = self.feed_mm_min if f is None else f * scale
+        if args and not self._plain_move(args, motion, feed, scale, line):
+            return False
+        self.line = line
+        self.motion = motion
+        self.feed_mm_min = feed
+        return True
+
+    def _plain_move(
+        self,
+        args: dict[str, float],
+        motion: str | None,
+        feed: float | None,
+        scale: float,
+        line: int,
+    ) -> bool:
+        """The motion of a plain line with X Y Z I J R words in ``args`` (:meth:`plain`)."""
+        if motion is None or not self.absolute or self.x is None or self.y is None:
+            return False  # without motion run() refuses the words; the rest is not plain
+        if motion in ("G2", "G3"):
+            return self._plain_arc(args, motion, feed, scale, line, (self.x, self.y))
+        if "I" in args or "J" in args or "R" in args:
+            return False  # run() refuses them
+        if "X" not in args and "Y" not in args and "Z" not in args:
+            return False
+        return self._plain_line(args, motion, feed, scale, line, (self.x, self.y))
+
+    def _plain_line(
+        self,
+        args: dict[str, float],
+        name: str,
+        feed: float | None,
+        scale: float,
+        line: int,
+        start: Point,
+    ) -> bool:
+        """:meth:`_line` for :meth:`plain`; False (nothing changed) where it would not be plain."""
+        x, y, z = args.get("X"), args.get("Y"), args.get("Z")
+        tx = start[0] if x is None else x * scale
+        ty = start[1] if y is None else y * scale
+        tz = self.z if z is None else z * scale
+        z_out = tz if z is not None and tz != self.z else None
+        gives_xy = x is not None or y is not None
+        if gives_xy and not self.positioned and z_out is not None and (tx, ty) == start:
+            return False  # _first_positioning
+        if name == "G0":
+            self.positioned = self.positioned or gives_xy
+            self._plain_push(Rapid(tx, ty, z_out, self._contour(True)), tx, ty, tz, line)
+            return True
+        if feed is None or feed == 0:
+            return False
+        self.positioned = self.positioned or gives_xy
+        move = Linear(tx, ty, feed, z_out, self._contour(False))
+        self._plain_push(move, tx, ty, tz, line)
+        return True
+
+    def _plain_arc(
+        self,
+        args: dict[str, float],
+        name: str,
+        feed: float | None,
+        scale: float,
+        line: int,
+        start: Point,
+    ) -> bool:
+        """:meth:`_arc` for :meth:`plain`; False (nothing changed) where it would not be plain."""
+        if feed is None or feed == 0:
+            return False
+        x, y, z = args.get("X"), args.get("Y"), args.get("Z")
+        tx = start[0] if x is None else x * scale
+        ty = start[1] if y is None else y * scale
+        tz = self.z if z is None else z * scale
+        end = (tx, ty)
+        small, large = _ARC_TOL_IN if self.inch else _ARC_TOL_MM
+        small, large = small * scale, large * scale
+        r_value, i, j = args.get("R"), args.get("I"), args.get("J")
+        if r_value is not None:
+            if i is not None or j is not None:
+                return False
+            r = r_value * scale
+            chord = math.dist(start, end)
+            if chord == 0 or r == 0:
+                return False
+            half = chord / 2
+            if abs(r) < half - small:
+                return False
+            h = math.sqrt(max(r * r - half * half, 0.0))
+            side = (1.0 if name == "G2" else -1.0) * (1.0 if r > 0 else -1.0)
+            ux, uy = (end[0] - start[0]) / chord, (end[1] - start[1]) / chord
+            mx, my = (start[0] + end[0]) / 2, (start[1] + end[1]) / 2
+            cx, cy = mx + side * h * uy, my - side * h * ux
+        else:
+            if i is None and j is None:
+                return False
+            di = i * scale if i is not None else 0.0
+            dj = j * scale if j is not None else 0.0
+            if self.arc_absolute:
+                if i is None or j is None:
+                    return False
+                cx, cy = di, dj
+            else:
+                cx, cy = start[0] + di, start[1] + dj
+            r_start, r_end = math.dist(start, (cx, cy)), math.dist(end, (cx, cy))
+            if r_start == 0:
+                return False
+            off = abs(r_start - r_end)
+            if off > large or (off > small and off > 0.001 * r_start):
+                return False
+        z_out = tz if z is not None and tz != self.z else None
+        self.positioned = True
+        arc = ArcMove(tx, ty, cx, cy, name == "G2", feed, z_out, self._contour(False))
+        self._plain_push(arc, tx, ty, tz, line)
+        return True
+
+    def _contour(self, rapid: bool) -> int:
+        """The contour of the next move, as :meth:`_push` counts it."""
+        if rapid:
+            if self.cut_in_contour:
+                self.contour += 1
+            self.cut_in_contour = False
+        else:
+            self.cut_in_contour = True
+        return self.contour
+
+    def _plain_push(
+        self, move: Move, tx: float | None, ty: float | None, tz: float | None, line: int
+    ) -> None:
+        """:meth:`_push` of a move whose contour is set (:meth:`_contour`)."""
+        if not self.units_seen:
+            self.units_seen = True
+            self.notes.add(
+                "units", line, "no G20/G21 before the first move: coordinates read as mm"
+            )
+        self.moves.append(move)
+        self.lines.append(line)
+        self.x, self.y, self.z = tx, ty, tz
 
     def after_end(self, rest: list[str], end_line: int) -> None:
         """Warn about lines with words after M2/M30 on ``end_line``."""

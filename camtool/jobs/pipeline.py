@@ -16,9 +16,9 @@ from camtool.model.shapes import Drawing
 from camtool.post.base import PostResult, Target
 from camtool.post.registry import load_target
 from camtool.toolpath.options import PlanOptions, drawing_only
-from camtool.toolpath.plan import PlanReport, plan_drawing
 
 if TYPE_CHECKING:
+    from camtool.toolpath.plan import PlanReport
     from camtool.verify.verifier import Verification
 
 
@@ -89,11 +89,11 @@ def load_target_checked(name: str, *, machine_file: Path | str | None = None) ->
             interpolator or chord rule (the message names the file and lists the
             valid names).
     """
-    from camtool.verify.motion import library
-
     target = load_target(name, machine_file=machine_file)
     if target.origin == "builtin" and machine_file is None:
         return target
+    from camtool.verify.motion import library
+
     try:
         library().check(target.machine)
     except InputError as exc:
@@ -370,6 +370,8 @@ def post_drawing(
     """
     output = output if output is not None else OutputOptions()
     plan = plan_options(target, plan)
+    from camtool.toolpath.plan import plan_drawing  # not needed by a re-post: numpy
+
     planned = plan_drawing(drawing, plan, target.machine, helix=target.post.helix)
     program = dataclasses.replace(
         planned.program,

@@ -194,6 +194,8 @@ def word_address_dialect(options: Mapping[str, Any], where: str) -> WordAddressP
 
 _SAME_MM = 1e-9
 """Exact XY closer than this is the same point (a Z-only move)."""
+_CONFORMED_KEPT = 20_000
+"""Arcs whose blocks a writer keeps (:meth:`BlockWriter._conformed`); then it starts anew."""
 
 
 class BlockWriter(WriterState[str]):
@@ -223,6 +225,17 @@ class BlockWriter(WriterState[str]):
         self.last: dict[str, str] = {}
         self.grid_error_mm = 0.0
         self.program = Program(())
+        # The formats of the words without a step grid (their text is the number's alone,
+        # :meth:`text`) and the readers of every word, looked up once.
+        self._formats = {
+            letter: word.number.format
+            for letter, word in spec.words.items()
+            if word.number.grid_mm is None
+        }
+        self._parses = {letter: word.number.parse for letter, word in spec.words.items()}
+        self._quantum: float | None = None
+        self._conformed_arcs: dict[tuple[Any, ...], list[tuple[Point, Point | None]]] = {}
+        self._feed_text: tuple[float, str] | None = None
 
     # -- the program -------------------------------------------------------------
 
@@ -268,8 +281,11 @@ class BlockWriter(WriterState[str]):
             DialectError: the block is longer than ``max_block_bytes``.
         """
         text = self.spec.separator.join(words) + self.spec.block_end
-        size = len((text + self.spec.line_end).encode("ascii"))
         limit = self.spec.max_block_bytes
+        if limit is None and text.isascii():
+            self.blocks.append(text)  # no limit to check (the size of ASCII text is its length)
+            return
+        size = len((text + self.spec.line_end).encode("ascii"))
         if limit is not None and size > limit:
             raise DialectError(
                 f"{self.where()}: {text!r} is {size} bytes with its line end; "
@@ -285,6 +301,12 @@ class BlockWriter(WriterState[str]):
         Raises:
             DialectError: the number does not fit the word's integer digits.
         """
+        plain = self._formats.get(letter)
+        if plain is not None:
+            try:
+                return plain(value)  # no grid: the text alone (an error is worded below)
+            except DialectError:
+                pass
         number = self.spec.words[letter].number
         try:
             text = number.format(value)
@@ -344,7 +366,8 @@ class BlockWriter(WriterState[str]):
         return self.text("Z", z) == self.text("Z", self.z)
 
     def _check_area(self, start: Point, move: Move) -> None:
-        check_work_area(start, move, self.machine, self.where(), self.program)
+        if self.machine.coordinates != "work":  # in work coordinates any position runs
+            check_work_area(start, move, self.machine, self.where(), self.program)
 
     def _check_z(self, move: Move) -> None:
         if not self.spec.has("Z") or not self.machine.has_z:
@@ -396,6 +419,10 @@ class BlockWriter(WriterState[str]):
         if spec is None:
             self.counts["feed"] += 1
             return
+        same = self._feed_text
+        if same is not None and same[0] == move.feed_mm_min:
+            self._word("F", same[1], words)  # the feed before: checked and warned about
+            return
         text = self.text("F", move.feed_mm_min)
         written = spec.number.parse(text)
         if written <= 0:
@@ -406,6 +433,7 @@ class BlockWriter(WriterState[str]):
         if abs(written - move.feed_mm_min) > 1e-9 * max(1.0, move.feed_mm_min):
             msg = f"feed {move.feed_mm_min:g} mm/min written as F{text} ({written:g} mm/min)"
             self.warn(msg)
+        self._feed_text = (move.feed_mm_min, text)
         self._word("F", text, words)
 
     # -- arcs --------------------------------------------------------------------
@@ -416,10 +444,13 @@ class BlockWriter(WriterState[str]):
         if end_prints == self.written and abs(arc.sweep) > math.pi:
             # within the resolution of a full circle: the controller reads one
             arc = Arc(start, start, arc.centre, arc.clockwise)
+        full_circle = arc.is_full_circle
+        parts = self._parts(arc, full_circle)
         blocks: list[tuple[Point, Point | None, bool]] = []
-        for piece in arc.split(self._parts(arc)):
+        for piece in [arc] if parts == 1 else arc.split(parts):  # split(1) is [arc] anew
             conformed = self._conformed(piece)
-            full = piece.is_full_circle and len(conformed) == 1
+            whole = full_circle if parts == 1 else piece.is_full_circle
+            full = whole and len(conformed) == 1
             blocks += [(end, centre, full) for end, centre in conformed]
         for k, (end, centre, full) in enumerate(blocks, start=1):
             z = move.z  # a helix climbs evenly over the blocks it is written in
@@ -427,14 +458,20 @@ class BlockWriter(WriterState[str]):
                 z = self.z + (move.z - self.z) * k / len(blocks)
             self._arc_block(move, (end, centre), z, full=full)
 
-    def _parts(self, arc: Arc) -> int:
-        """How many equal arcs ``arc`` is written as (``max_arc_deg``, ``full_circle``)."""
+    def _parts(self, arc: Arc, full_circle: bool) -> int:
+        """How many equal arcs ``arc`` is written as (``max_arc_deg``, ``full_circle``).
+
+        ``full_circle`` is ``arc.is_full_circle``.
+        """
         limit = self.spec.max_arc_deg
-        sweep = math.degrees(abs(arc.sweep))
-        parts = max(1, math.ceil(sweep / limit - 1e-9))
-        if arc.is_full_circle and self.spec.full_circle == "split":
+        if limit >= 360.0:
+            parts = 1  # a sweep is at most 360° (the formula below gives 1 too)
+        else:
+            sweep = math.degrees(abs(arc.sweep))
+            parts = max(1, math.ceil(sweep / limit - 1e-9))
+        if full_circle and self.spec.full_circle == "split":
             parts = max(2, parts)
-        elif arc.is_full_circle:
+        elif full_circle:
             parts = 1
         return parts
 
@@ -446,9 +483,31 @@ class BlockWriter(WriterState[str]):
         """
         if self.spec.arc_check == "none":
             return [(piece.end, piece.centre)]
+        key = (self.written, piece.end, piece.centre, piece.clockwise, piece.start)
+        # The same arc from the same written start (a program that cuts a contour again at
+        # another depth) gives the same blocks: conform_arc is a function of its arguments.
+        # Zeros are left out: -0.0 equals 0.0 as a key, but not as an angle (atan2).
+        kept = self._conformed_arcs
+        known = kept.get(key)
+        if known is not None:
+            if not known:
+                self.counts["tiny-arc"] += 1
+            return known
+        zero = 0.0 in key[0] or 0.0 in key[1] or 0.0 in key[2] or 0.0 in key[4]
+        out = self._conform(piece)
+        if not zero:
+            if len(kept) >= _CONFORMED_KEPT:
+                kept.clear()
+            kept[key] = out
+        return out
+
+    def _conform(self, piece: Arc) -> list[tuple[Point, Point | None]]:
+        """:meth:`_conformed` without its memory of the arcs already conformed."""
         from camtool.post.arccheck import conform_arc
 
-        quantum = self.spec.quantum_mm()
+        quantum = self._quantum
+        if quantum is None:
+            quantum = self._quantum = self.spec.quantum_mm()  # the same for every arc
         try:
             out = conform_arc(
                 self.written,
@@ -486,7 +545,7 @@ class BlockWriter(WriterState[str]):
         tiny = centre is None or (written == self.written and not full)
         if centre is not None:
             ti, tj = self.text("I", centre[0] - ox), self.text("J", centre[1] - oy)
-            i, j = self.spec.words["I"].number.parse(ti), self.spec.words["J"].number.parse(tj)
+            i, j = self._parses["I"](ti), self._parses["J"](tj)
             tiny = tiny or (i + ox, j + oy) == self.written
         if tiny:
             self.counts["tiny-arc"] += 1
@@ -495,8 +554,8 @@ class BlockWriter(WriterState[str]):
             return
         words: list[str] = []
         self._code(cw if move.clockwise else ccw, words)
-        self._word("X", tx, words, force=True)
-        self._word("Y", ty, words, force=True)
+        words += ["X" + tx, "Y" + ty]  # _word(..., force=True)
+        self.last["X"], self.last["Y"] = tx, ty
         if z is not None:
             self._word("Z", self.text("Z", z), words)
         words += ["I" + ti, "J" + tj]
@@ -506,7 +565,7 @@ class BlockWriter(WriterState[str]):
 
     def _parsed(self, tx: str, ty: str) -> Point:
         """The XY the controller reads from the texts of X and Y."""
-        return self.spec.words["X"].number.parse(tx), self.spec.words["Y"].number.parse(ty)
+        return self._parses["X"](tx), self._parses["Y"](ty)
 
     # -- commands ----------------------------------------------------------------
 
