@@ -12,7 +12,9 @@ the same place as without workers.
 
 Workers are started by ``fork`` (Linux; nothing to re-import, ~10 ms each) and only for at
 least :data:`MIN_CURVES` keys, so small files never pay for a pool; where ``fork`` is not
-available, or the pool cannot start or breaks, every fit runs here, one after the other.
+available, or the pool cannot start or breaks, or this process is itself a worker (``camtool
+batch``, Dask: the cores are busy with other files already), every fit runs here, one after
+the other.
 Forking is safe at this point: the importers run before anything starts threads of its own
 (camtool starts none; numba, whose threading layer must not be forked, is not imported on the
 import path; OpenBLAS's idle threads are re-made by its own ``pthread_atfork`` handler).
@@ -101,11 +103,21 @@ def fit_many(
     """
     workers = default_jobs() if jobs is None else max(1, jobs)
     workers = min(workers, -(-len(keys) // _CHUNK))
-    if workers > 1 and len(keys) >= MIN_CURVES:
+    if workers > 1 and len(keys) >= MIN_CURVES and not _in_worker():
         packed = _in_pool(keys, tolerance, workers)
         if packed is not None:
             return [None if p is None else _unpack(p) for p in packed]
     return [_fit_or_none(k, tolerance) for k in keys]
+
+
+def _in_worker() -> bool:
+    """Whether this process is itself a worker (``camtool batch``'s pool, a Dask worker).
+
+    A batch already keeps the cores busy with one file per worker, and a daemonic process
+    (Dask's) may not start children: there the fits run in the worker, one after the other.
+    """
+    current = multiprocessing.current_process()
+    return bool(current.daemon) or multiprocessing.parent_process() is not None
 
 
 def _in_pool(
@@ -120,7 +132,7 @@ def _in_pool(
     try:
         with ProcessPoolExecutor(workers, mp_context=context) as pool:
             return [p for chunk in pool.map(_fit_chunk, chunks) for p in chunk]
-    except (OSError, RuntimeError, EOFError):  # cannot fork, or a worker died (BrokenPool)
+    except (OSError, RuntimeError, EOFError, AssertionError):  # cannot fork, a worker died
         return None
 
 

@@ -68,3 +68,31 @@ def test_few_curves_start_no_pool(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(fitpool, "_in_pool", no_pool)
     keys = _keys(10)
     assert fit_many(keys, 0.01, jobs=4) == [fit_key(k, 0.01) for k in keys]
+
+
+def _fits_in_a_child(keys: list[CurveKey], queue: object) -> None:
+    def no_pool(*args: object) -> None:
+        raise AssertionError("a pool in a worker process")
+
+    fitpool.MIN_CURVES = 1
+    fitpool._in_pool = no_pool  # type: ignore[assignment]
+    try:
+        queue.put(repr(fit_many(keys, 0.01, jobs=2)))  # type: ignore[attr-defined]
+    except AssertionError as exc:
+        queue.put(str(exc))  # type: ignore[attr-defined]
+
+
+def test_a_worker_process_fits_serially_and_the_same(monkeypatch: pytest.MonkeyPatch) -> None:
+    """In a child process (a batch worker) no pool is started; the fits are the same."""
+    import multiprocessing
+
+    monkeypatch.setattr(fitpool, "MIN_CURVES", 1)
+    keys = _keys(12)
+    context = multiprocessing.get_context("fork")
+    queue = context.Queue()
+    child = context.Process(target=_fits_in_a_child, args=(keys, queue))
+    child.start()
+    got = queue.get(timeout=120)
+    child.join(timeout=60)
+    assert got == repr([fit_key(k, 0.01) for k in keys])
+    assert not fitpool._in_worker()
