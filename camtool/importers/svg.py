@@ -100,7 +100,7 @@ def read_svg(path: str | Path, options: ImportOptions | None = None) -> Drawing:
     warnings = list(prepared.warnings)
     contours: list[Contour] = []
     hidden = invisible = 0
-    drawn = []
+    drawn: list[tuple[Any, list[Any] | None]] = []
     for shape in _shapes(svg):
         values = shape.values
         if str(values.get("visibility", "visible")).strip().lower() in ("hidden", "collapse"):
@@ -108,7 +108,7 @@ def read_svg(path: str | Path, options: ImportOptions | None = None) -> Drawing:
         elif _none(values.get("fill")) and _none(values.get("stroke")):
             invisible += 1
         else:
-            drawn.append((shape, list(shape.segments(transformed=False))))
+            drawn.append((shape, _segments(shape)))
     fitter = _prefitted(drawn, prepared.matrix, options.tolerance)
     for shape, segments in drawn:
         contours.extend(_contours(path, shape, segments, prepared.matrix, fitter))
@@ -154,8 +154,13 @@ def _elements(count: int) -> str:
 
 
 def _contours(
-    path: Path, shape: Any, segments: list[Any], page: Affine, fitter: Fitter
+    path: Path, shape: Any, segments: list[Any] | None, page: Affine, fitter: Fitter
 ) -> list[Contour]:
+    """The shape's contours, from its ``segments`` read ahead.
+
+    ``None``: svgelements failed on them ahead, so they are asked again here, in the
+    shape's turn (the error is the one it always was).
+    """
     values = shape.values
     label = str(values.get(SOURCE_ATTR, type(shape).__name__.lower()))
     use = values.get(USE_ATTR)
@@ -164,7 +169,10 @@ def _contours(
     layer = str(values.get(LAYER_ATTR, DEFAULT_LAYER))
     m = compose(page, affine_of(shape.transform))
     try:
-        subpaths = convert(segments, m, fitter.tolerance, fitter)
+        if segments is None:
+            subpaths = convert(shape.segments(transformed=False), m, fitter.tolerance, fitter)
+        else:
+            subpaths = convert(segments, m, fitter.tolerance, fitter)
     except (GeometryError, InputError) as exc:
         raise InputError(f"{path}: {label}: {exc}") from exc
     many = len(subpaths) > 1
@@ -221,7 +229,15 @@ class _Recorder(Fitter):
 _CURVES = (se.CubicBezier, se.QuadraticBezier, se.Arc)
 
 
-def _prefitted(drawn: list[tuple[Any, list[Any]]], page: Affine, tolerance: float) -> Fitter:
+def _segments(shape: Any) -> list[Any] | None:
+    """The shape's svgelements segments, untransformed; ``None`` where svgelements fails."""
+    try:
+        return list(shape.segments(transformed=False))
+    except Exception:  # raised again when the shape's turn comes, after the shapes before it
+        return None
+
+
+def _prefitted(drawn: list[tuple[Any, list[Any] | None]], page: Affine, tolerance: float) -> Fitter:
     """A :class:`Fitter` holding the fits of the drawing's curves, made on every core.
 
     Only for at least :data:`~camtool.geometry.fitpool.MIN_CURVES` curves: the shapes are
@@ -229,11 +245,13 @@ def _prefitted(drawn: list[tuple[Any, list[Any]]], page: Affine, tolerance: floa
     fails here fails again, with its message, when converted for real), then
     :func:`~camtool.geometry.fitpool.fit_many` fits them.
     """
-    count = sum(isinstance(seg, _CURVES) for _, segments in drawn for seg in segments)
+    count = sum(isinstance(seg, _CURVES) for _, segs in drawn for seg in segs or ())
     if count < MIN_CURVES:
         return Fitter(tolerance)
     recorder = _Recorder(tolerance)
     for shape, segments in drawn:
+        if segments is None:
+            continue
         try:
             convert(segments, compose(page, affine_of(shape.transform)), tolerance, recorder)
         except Exception:  # converted again below, raising in order

@@ -70,3 +70,22 @@ def test_read_svg_with_workers_raises_the_serial_error(
     with pytest.raises(InputError) as pooled:
         read_svg(path)
     assert str(pooled.value) == str(serial.value)
+
+
+def test_a_shape_svgelements_fails_on_fails_in_its_turn(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Segments read ahead: a shape whose segments fail is asked again in its turn."""
+    path = _svg(tmp_path, 3)
+    calls: list[int] = []
+    original = svg_module._segments
+
+    def failing_once(shape: object) -> None:
+        calls.append(1)
+        return None  # as if svgelements had raised: read again, lazily, in its turn
+
+    serial = read_svg(path)
+    monkeypatch.setattr(svg_module, "_segments", failing_once)
+    assert repr(read_svg(path)) == repr(serial)
+    assert calls
+    monkeypatch.setattr(svg_module, "_segments", original)
