@@ -27,6 +27,7 @@ from dataclasses import dataclass
 from typing import TypeAlias
 
 import numpy as np
+from numpy._core import umath as _umath
 from numpy.typing import ArrayLike, NDArray
 
 from camtool.model.errors import GeometryError, InputError, UsageError
@@ -47,6 +48,9 @@ __all__ = [
 FloatArray: TypeAlias = NDArray[np.float64]
 PointsFn: TypeAlias = Callable[[FloatArray], FloatArray]
 """A curve evaluated at ``(N,)`` parameters: ``(N, 2)`` points (see :func:`fit_curve`)."""
+
+_clip = getattr(_umath, "clip", np.clip)
+"""``np.clip``'s own ufunc, without its Python wrapper (~10 µs a call): the same floats."""
 
 MAX_SWEEP = math.pi
 """Largest sweep of one output arc, radians: 180° arcs are safe in every dialect (I/J or R)."""
@@ -77,7 +81,11 @@ def distances(xy: ArrayLike, segments: Sequence[Segment]) -> FloatArray:
         ``(N,)`` float64 distances, mm.
     """
     pts = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
-    return np.min([dist_segment(pts, s) for s in segments], axis=0)
+    first, *rest = segments
+    out = dist_segment(pts, first)
+    for seg in rest:  # what np.min(..., axis=0) of the stack gives, one minimum at a time
+        out = np.minimum(out, dist_segment(pts, seg))
+    return out
 
 
 @functools.cache
@@ -91,12 +99,17 @@ def _unit_steps(n: int) -> FloatArray:
 def sample_segment(seg: Segment, n: int) -> FloatArray:
     """``(n + 1, 2)`` points evenly along ``seg``, ends included."""
     u = _unit_steps(n)
+    out = np.empty((n + 1, 2))
     if isinstance(seg, Line):
         (x0, y0), (x1, y1) = seg.start, seg.end
-        return np.column_stack([x0 + u * (x1 - x0), y0 + u * (y1 - y0)])
+        out[:, 0] = x0 + u * (x1 - x0)
+        out[:, 1] = y0 + u * (y1 - y0)
+        return out
     a = seg.start_angle + seg.sweep * u
     r = seg.radius
-    return np.column_stack([seg.centre[0] + r * np.cos(a), seg.centre[1] + r * np.sin(a)])
+    out[:, 0] = seg.centre[0] + r * np.cos(a)
+    out[:, 1] = seg.centre[1] + r * np.sin(a)
+    return out
 
 
 def dist_segment(xy: FloatArray, seg: Segment) -> FloatArray:
@@ -109,40 +122,45 @@ def dist_line(xy: FloatArray, a: Point, b: Point) -> FloatArray:
     dx, dy = b[0] - a[0], b[1] - a[1]
     rx, ry = xy[:, 0] - a[0], xy[:, 1] - a[1]
     ll = dx * dx + dy * dy
-    u = np.clip((rx * dx + ry * dy) / ll, 0.0, 1.0) if ll > 0 else np.zeros(len(xy))
+    u = _clip((rx * dx + ry * dy) / ll, 0.0, 1.0) if ll > 0 else np.zeros(len(xy))
     return np.hypot(rx - u * dx, ry - u * dy)
 
 
 def dist_arc(xy: FloatArray, arc: Arc) -> FloatArray:
     """``(N,)`` distances from ``xy`` ``(N, 2)`` to ``arc``: radial inside the sweep, else ends."""
-    rx, ry = xy[:, 0] - arc.centre[0], xy[:, 1] - arc.centre[1]
+    x, y = xy[:, 0], xy[:, 1]
+    (cx, cy), (sx, sy), (ex, ey) = arc.centre, arc.start, arc.end
+    rx, ry = x - cx, y - cy
     sweep = arc.sweep
-    ang = np.arctan2(ry, rx) - arc.start_angle
+    ang = np.arctan2(ry, rx) - math.atan2(sy - cy, sx - cx)  # Arc.start_angle
     inside = np.mod(ang if sweep > 0 else -ang, TAU) <= abs(sweep)
-    ends = np.minimum(
-        np.hypot(xy[:, 0] - arc.start[0], xy[:, 1] - arc.start[1]),
-        np.hypot(xy[:, 0] - arc.end[0], xy[:, 1] - arc.end[1]),
-    )
-    return np.where(inside, np.abs(np.hypot(rx, ry) - arc.radius), ends)
+    ends = np.minimum(np.hypot(x - sx, y - sy), np.hypot(x - ex, y - ey))
+    return np.where(inside, np.abs(np.hypot(rx, ry) - math.hypot(sx - cx, sy - cy)), ends)
 
 
 def pairwise_dist_line(xy: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
     """``(N,)`` distance from ``xy[i]`` to the segment ``a[i]``–``b[i]`` (all ``(N, 2)``)."""
-    d = b - a
-    r = xy - a
-    ll = np.einsum("ij,ij->i", d, d)
-    u = np.clip(np.einsum("ij,ij->i", r, d) / np.where(ll > 0, ll, 1.0), 0.0, 1.0)
-    return np.hypot(*(r - u[:, None] * d).T)
+    dx, dy = b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]  # by column: the same floats as einsum's
+    rx, ry = xy[:, 0] - a[:, 0], xy[:, 1] - a[:, 1]
+    ll = dx * dx + dy * dy
+    u = _clip((rx * dx + ry * dy) / np.where(ll > 0, ll, 1.0), 0.0, 1.0)
+    return np.hypot(rx - u * dx, ry - u * dy)
 
 
 def dist_polyline(xy: FloatArray, poly: FloatArray) -> FloatArray:
-    """``(N,)`` distances from ``xy`` ``(N, 2)`` to the polyline through ``poly`` ``(M, 2)``."""
-    a, d = poly[:-1], np.diff(poly, axis=0)  # (M-1, 2)
-    r = xy[:, None, :] - a[None, :, :]  # (N, M-1, 2)
-    ll = np.einsum("ij,ij->i", d, d)
-    u = np.clip(np.einsum("nij,ij->ni", r, d) / np.where(ll > 0, ll, 1.0), 0.0, 1.0)
-    gap = r - u[:, :, None] * d[None, :, :]
-    return np.min(np.hypot(gap[..., 0], gap[..., 1]), axis=1)
+    """``(N,)`` distances from ``xy`` ``(N, 2)`` to the polyline through ``poly`` ``(M, 2)``.
+
+    x and y are worked in separate ``(N, M-1)`` arrays (numpy loops over a last axis of 2
+    slowly); each element is the same float operations as before, in the same order
+    (``rx·dx + ry·dy``, ``dx·dx + dy·dy``: what ``einsum`` summed).
+    """
+    px, py = poly[:, 0], poly[:, 1]
+    ax, ay = px[:-1], py[:-1]
+    dx, dy = px[1:] - ax, py[1:] - ay  # (M-1,)
+    rx, ry = xy[:, 0, None] - ax, xy[:, 1, None] - ay  # (N, M-1)
+    ll = dx * dx + dy * dy
+    u = _clip((rx * dx + ry * dy) / np.where(ll > 0, ll, 1.0), 0.0, 1.0)
+    return np.hypot(rx - u * dx, ry - u * dy).min(axis=1)
 
 
 # ---------------------------------------------------------------------------- fit stats
@@ -293,7 +311,7 @@ class _Curve:
 
     def samples(self, ta: float, pa: Point, tb: float, pb: Point) -> FloatArray:
         """``(2n+1, 2)`` curve points at evenly spaced parameters from ``ta`` to ``tb``."""
-        ts = np.linspace(ta, tb, 2 * _SAMPLES + 1)
+        ts = _linspace(ta, tb)
         if self.points_at is not None:
             fine = np.empty((len(ts), 2))
             fine[1:-1] = self.points_at(ts[1:-1])
@@ -325,6 +343,28 @@ class _Curve:
         return None
 
 
+_STEPS = np.arange(0, 2 * _SAMPLES + 1, dtype=np.float64)
+_STEPS.setflags(write=False)
+
+
+def _linspace(ta: float, tb: float) -> FloatArray:
+    """``np.linspace(ta, tb, 2 * _SAMPLES + 1)`` without its ~20 µs of Python: its float steps.
+
+    numpy 2 computes ``arange(num) * ((tb - ta) / div) + ta`` (``/ div`` then ``* delta``
+    when the step underflows to 0) and sets the last to ``tb``; so does this.
+    """
+    delta = tb - ta
+    step = delta / (2 * _SAMPLES)
+    if step == 0:
+        y = _STEPS / (2 * _SAMPLES)
+        y *= delta
+    else:
+        y = _STEPS * step
+    y += ta
+    y[-1] = tb
+    return y
+
+
 def _fit_piece(c: _Curve, ta: float, pa: Point, tb: float, pb: Point, depth: int) -> list[_Piece]:
     fine = c.samples(ta, pa, tb, pb)
     segs = _candidate(c, ta, pa, tb, pb, fine)
@@ -346,7 +386,7 @@ def _candidate(
     c: _Curve, ta: float, pa: Point, tb: float, pb: Point, fine: FloatArray
 ) -> tuple[Segment, ...] | None:
     """One line, or a biarc, for the piece; ``None`` when it must be split first."""
-    if float(np.max(dist_line(fine, pa, pb))) <= c.tol:
+    if float(dist_line(fine, pa, pb).max()) <= c.tol:
         return () if pa == pb else (Line(pa, pb),)
     vx, vy = pb[0] - pa[0], pb[1] - pa[1]
     chord = math.hypot(vx, vy)
@@ -409,17 +449,17 @@ def _piece_error(
     compares it with ``limit``). Otherwise the full two-sided error, always the same float.
     """
     if not segs:
-        return float(np.max(np.hypot(fine[:, 0] - pa[0], fine[:, 1] - pa[1])))
-    forward = float(np.max(distances(fine, segs)))
+        return float(np.hypot(fine[:, 0] - pa[0], fine[:, 1] - pa[1]).max())
+    forward = float(distances(fine, segs).max())
     if forward > limit:
         return forward
     # the sampled polyline lies within its chord sagitta of the curve; the sagitta of the
     # fine chords is about a quarter of that of the coarse ones (midpoints of fine[::2])
     coarse = fine[::2]
     mids = fine[1::2]
-    sag = np.max(pairwise_dist_line(mids, coarse[:-1], coarse[1:])) if len(mids) else 0.0
+    sag = pairwise_dist_line(mids, coarse[:-1], coarse[1:]).max() if len(mids) else 0.0
     out = np.vstack([sample_segment(s, _SEG_SAMPLES) for s in segs])
-    backward = float(np.max(dist_polyline(out, fine))) + 0.5 * float(sag)
+    backward = float(dist_polyline(out, fine).max()) + 0.5 * float(sag)
     return max(forward, backward)
 
 
@@ -470,9 +510,9 @@ def _join(a: Segment, b: Segment, tol: float) -> Segment | None:
 
 def _hausdorff(seg: Segment, others: Sequence[Segment]) -> float:
     """Sampled two-sided distance between ``seg`` and the union of ``others``, mm."""
-    there = float(np.max(distances(sample_segment(seg, 4 * _SEG_SAMPLES), others)))
+    there = float(distances(sample_segment(seg, 4 * _SEG_SAMPLES), others).max())
     back = np.vstack([sample_segment(o, _SEG_SAMPLES) for o in others])
-    return max(there, float(np.max(dist_segment(back, seg))))
+    return max(there, float(dist_segment(back, seg).max()))
 
 
 def _as_point(value: Iterable[float], what: str) -> Point:

@@ -45,19 +45,10 @@ from typing import Any, TypeAlias
 
 import svgelements as se
 
-from camtool.geometry.arcfit import PointsFn, check_tolerance, fit_curve
+from camtool.geometry.arcfit import check_tolerance
 from camtool.geometry.chain import with_end
-from camtool.geometry.curves import (
-    PointFn,
-    cubic_bezier,
-    cubic_bezier_points,
-    ellipse_arc,
-    ellipse_arc_points,
-    merge_arcs,
-    quadratic_bezier,
-    quadratic_bezier_points,
-    semi_axes_gap,
-)
+from camtool.geometry.curves import merge_arcs, semi_axes_gap
+from camtool.geometry.fitpool import MIN_CURVES, CurveKey, fit_key, fit_many
 from camtool.importers.options import MAX_COORDINATE_MM, ImportOptions, check_curve_size
 from camtool.importers.svgdoc import (
     LAYER_ATTR,
@@ -109,6 +100,7 @@ def read_svg(path: str | Path, options: ImportOptions | None = None) -> Drawing:
     warnings = list(prepared.warnings)
     contours: list[Contour] = []
     hidden = invisible = 0
+    drawn: list[tuple[Any, list[Any] | None]] = []
     for shape in _shapes(svg):
         values = shape.values
         if str(values.get("visibility", "visible")).strip().lower() in ("hidden", "collapse"):
@@ -116,7 +108,10 @@ def read_svg(path: str | Path, options: ImportOptions | None = None) -> Drawing:
         elif _none(values.get("fill")) and _none(values.get("stroke")):
             invisible += 1
         else:
-            contours.extend(_contours(path, shape, prepared.matrix, options.tolerance))
+            drawn.append((shape, _segments(shape)))
+    fitter = _prefitted(drawn, prepared.matrix, options.tolerance)
+    for shape, segments in drawn:
+        contours.extend(_contours(path, shape, segments, prepared.matrix, fitter))
     if hidden:
         warnings.append(f"{path}: skipped {hidden} {_elements(hidden)} with visibility:hidden")
     if invisible:
@@ -158,7 +153,14 @@ def _elements(count: int) -> str:
     return "element" if count == 1 else "elements"
 
 
-def _contours(path: Path, shape: Any, page: Affine, tolerance: float) -> list[Contour]:
+def _contours(
+    path: Path, shape: Any, segments: list[Any] | None, page: Affine, fitter: Fitter
+) -> list[Contour]:
+    """The shape's contours, from its ``segments`` read ahead.
+
+    ``None``: svgelements failed on them ahead, so they are asked again here, in the
+    shape's turn (the error is the one it always was).
+    """
     values = shape.values
     label = str(values.get(SOURCE_ATTR, type(shape).__name__.lower()))
     use = values.get(USE_ATTR)
@@ -167,7 +169,10 @@ def _contours(path: Path, shape: Any, page: Affine, tolerance: float) -> list[Co
     layer = str(values.get(LAYER_ATTR, DEFAULT_LAYER))
     m = compose(page, affine_of(shape.transform))
     try:
-        subpaths = convert(shape.segments(transformed=False), m, tolerance)
+        if segments is None:
+            subpaths = convert(shape.segments(transformed=False), m, fitter.tolerance, fitter)
+        else:
+            subpaths = convert(segments, m, fitter.tolerance, fitter)
     except (GeometryError, InputError) as exc:
         raise InputError(f"{path}: {label}: {exc}") from exc
     many = len(subpaths) > 1
@@ -175,6 +180,86 @@ def _contours(path: Path, shape: Any, page: Affine, tolerance: float) -> list[Co
         Contour(segs, closed, layer, f"{label} subpath {k}" if many else label)
         for k, (segs, closed) in enumerate(subpaths, start=1)
     ]
+
+
+# ------------------------------------------------------------------ curve fits, ahead
+
+
+class Fitter:
+    """Fits curves by :data:`~camtool.geometry.fitpool.CurveKey` within ``tolerance`` mm.
+
+    ``done`` holds fits made ahead (in worker processes, :func:`_prefitted`), looked up by
+    the key's exact ``repr`` (every float's bits, ``-0.0`` apart from ``0.0``); any other
+    key, or one whose fit failed ahead, is fitted here, as without it.
+    """
+
+    def __init__(self, tolerance: float, done: dict[str, list[Segment]] | None = None):
+        self.tolerance = tolerance
+        self.done = done or {}
+
+    def __call__(self, key: CurveKey) -> list[Segment]:
+        """The fit of ``key`` (a new list), made ahead or here."""
+        if self.done:
+            segs = self.done.get(repr(key))
+            if segs is not None:
+                return list(segs)
+        return fit_key(key, self.tolerance)
+
+
+class _Recorder(Fitter):
+    """Notes the keys instead of fitting; answers a line to the curve's end.
+
+    The line stands for the fit only to carry the pen on to the next segment's key (a fit
+    ends exactly at the curve's end, unless it is dropped as of zero length: the keys that
+    follow then differ and are fitted when met, see :class:`Fitter`).
+    """
+
+    def __init__(self, tolerance: float):
+        super().__init__(tolerance)
+        self.keys: list[CurveKey] = []
+
+    def __call__(self, key: CurveKey) -> list[Segment]:
+        self.keys.append(key)
+        args = key[1]
+        if key[0] == "ellipse_arc":
+            return [Line(args[5], args[6])]
+        return [Line(args[0], args[-1])]
+
+
+_CURVES = (se.CubicBezier, se.QuadraticBezier, se.Arc)
+
+
+def _segments(shape: Any) -> list[Any] | None:
+    """The shape's svgelements segments, untransformed; ``None`` where svgelements fails."""
+    try:
+        return list(shape.segments(transformed=False))
+    except Exception:  # raised again when the shape's turn comes, after the shapes before it
+        return None
+
+
+def _prefitted(drawn: list[tuple[Any, list[Any] | None]], page: Affine, tolerance: float) -> Fitter:
+    """A :class:`Fitter` holding the fits of the drawing's curves, made on every core.
+
+    Only for at least :data:`~camtool.geometry.fitpool.MIN_CURVES` curves: the shapes are
+    converted once with a :class:`_Recorder` to collect the curves in order (a shape that
+    fails here fails again, with its message, when converted for real), then
+    :func:`~camtool.geometry.fitpool.fit_many` fits them.
+    """
+    count = sum(isinstance(seg, _CURVES) for _, segs in drawn for seg in segs or ())
+    if count < MIN_CURVES:
+        return Fitter(tolerance)
+    recorder = _Recorder(tolerance)
+    for shape, segments in drawn:
+        if segments is None:
+            continue
+        try:
+            convert(segments, compose(page, affine_of(shape.transform)), tolerance, recorder)
+        except Exception:  # converted again below, raising in order
+            continue
+    keys = list({repr(k): k for k in recorder.keys}.items())
+    fits = fit_many([k for _, k in keys], tolerance)
+    done = {text: segs for (text, _), segs in zip(keys, fits, strict=True) if segs is not None}
+    return Fitter(tolerance, done)
 
 
 # ------------------------------------------------------------------ path segments to mm
@@ -200,7 +285,9 @@ Subpath: TypeAlias = tuple[tuple[Segment, ...], bool]
 """One subpath's segments (each starting where the previous ended) and whether it is closed."""
 
 
-def convert(segments: Iterable[Any], m: Affine, tolerance: float) -> list[Subpath]:
+def convert(
+    segments: Iterable[Any], m: Affine, tolerance: float, fitter: Fitter | None = None
+) -> list[Subpath]:
     """Turn svgelements path segments (local coordinates) into subpaths in mm, Y up.
 
     Each ``Move`` starts a subpath; ``Close`` draws the line back to the subpath's start
@@ -213,6 +300,8 @@ def convert(segments: Iterable[Any], m: Affine, tolerance: float) -> list[Subpat
         m: local coordinates to mm, Y up.
         tolerance: largest distance, mm, between a Bézier or a non-circular elliptical arc
             and the arcs and lines fitted to it (> 0).
+        fitter: fits the curves (the same fits, some made ahead); ``None``: a
+            :class:`Fitter` of ``tolerance``.
 
     Returns:
         ``(segments, closed)`` per subpath that draws something.
@@ -223,6 +312,7 @@ def convert(segments: Iterable[Any], m: Affine, tolerance: float) -> list[Subpat
             ±:data:`~camtool.importers.options.MAX_COORDINATE_MM` once mapped to mm (checked
             before any fitting, which would spin on a control point at 1e20).
     """
+    fitter = fitter or Fitter(tolerance)
     out: list[Subpath] = []
     current: list[Segment] = []
     start: Point | None = None
@@ -250,7 +340,7 @@ def convert(segments: Iterable[Any], m: Affine, tolerance: float) -> list[Subpat
             flush(True)
             cursor = start
             continue
-        new = segment(seg, cursor, m, tolerance)
+        new = segment(seg, cursor, m, tolerance, fitter)
         for piece in new:
             if isinstance(piece, Arc):
                 _check(piece.centre, "an arc centre")
@@ -261,24 +351,29 @@ def convert(segments: Iterable[Any], m: Affine, tolerance: float) -> list[Subpat
     return out
 
 
-def segment(seg: Any, p0: Point, m: Affine, tolerance: float) -> list[Segment]:
+def segment(
+    seg: Any, p0: Point, m: Affine, tolerance: float, fitter: Fitter | None = None
+) -> list[Segment]:
     """One svgelements drawing segment from ``p0`` (mm, already mapped) as lines and arcs.
+
+    ``fitter`` fits its curve (``None``: a :class:`Fitter` of ``tolerance``).
 
     Raises:
         ValueError: ``seg`` is of a kind svgelements does not produce in a path.
     """
     if isinstance(seg, se.Line):
         return _line(p0, _pt(m, seg.end))
+    fitter = fitter or Fitter(tolerance)
     if isinstance(seg, se.CubicBezier):
         ctrl = (p0, _pt(m, seg.control1), _pt(m, seg.control2), _pt(m, seg.end))
         _check_size(ctrl, tolerance)
-        return _fit(*cubic_bezier(ctrl), tolerance, cubic_bezier_points(ctrl))
+        return _fit(("cubic", ctrl), fitter)
     if isinstance(seg, se.QuadraticBezier):
         ctrl3 = (p0, _pt(m, seg.control), _pt(m, seg.end))
         _check_size(ctrl3, tolerance)
-        return _fit(*quadratic_bezier(ctrl3), tolerance, quadratic_bezier_points(ctrl3))
+        return _fit(("quadratic", ctrl3), fitter)
     if isinstance(seg, se.Arc):
-        return _arc(seg, p0, m, tolerance)
+        return _arc(seg, p0, m, tolerance, fitter)
     raise ValueError(f"unexpected path segment {type(seg).__name__}")
 
 
@@ -310,14 +405,12 @@ def _line(p0: Point, p1: Point) -> list[Segment]:
     return [Line(p0, p1)] if distance(p0, p1) > ZERO_LENGTH_MM else []
 
 
-def _fit(
-    point_at: PointFn, tangent_at: PointFn, tolerance: float, points_at: PointsFn
-) -> list[Segment]:
-    segs = fit_curve(point_at, tangent_at, 0.0, 1.0, tolerance, points_at=points_at)
+def _fit(key: CurveKey, fitter: Fitter) -> list[Segment]:
+    segs = fitter(key)
     return segs if sum(s.length for s in segs) > ZERO_LENGTH_MM else []
 
 
-def _arc(seg: Any, p0: Point, m: Affine, tolerance: float) -> list[Segment]:
+def _arc(seg: Any, p0: Point, m: Affine, tolerance: float, fitter: Fitter) -> list[Segment]:
     """An svgelements elliptical arc: an exact Arc where its image is a circle, else fitted.
 
     svgelements keeps the arc as centre ``c``, ``prx`` (the point at t = 0), ``pry`` (at
@@ -348,8 +441,7 @@ def _arc(seg: Any, p0: Point, m: Affine, tolerance: float) -> list[Segment]:
     _check(centre, "an ellipse centre")
     _check_size([centre, (centre[0] + big_a[0], centre[1] + big_a[1]),
                  (centre[0] + big_b[0], centre[1] + big_b[1]), p0, p1], tolerance)  # fmt: skip
-    args = (centre, big_a, big_b, t0, sweep, p0, p1)
-    return _fit(*ellipse_arc(*args), tolerance, ellipse_arc_points(*args))
+    return _fit(("ellipse_arc", (centre, big_a, big_b, t0, sweep, p0, p1)), fitter)
 
 
 def _xy(p: Any) -> Point:

@@ -316,10 +316,21 @@ class Grid:
         On a ``10**-d`` grid ``float("{k}e-{d}")``: the same decimal, and both
         conversions are correctly rounded (:meth:`_value_slow` is the ``Decimal`` one).
         """
-        d = self.decimals
-        if d is not None and -(10**20) < k < 10**20:
-            return float(f"{k}e-{d}")
-        return self._value_slow(k)
+        memo = self._values
+        v = memo.get(k)
+        if v is None:
+            d = self.decimals
+            v = float(f"{k}e-{d}") if d is not None and -(10**20) < k < 10**20 else None
+            v = self._value_slow(k) if v is None else v
+            if len(memo) >= _MEMO_SIZE:
+                memo.clear()
+            memo[k] = v
+        return v
+
+    @cached_property
+    def _values(self) -> dict[int, float]:
+        """:meth:`value` of the indices met lately (a pure function of ``k``: the same float)."""
+        return {}
 
     def _value_slow(self, k: int) -> float:
         return float(Decimal(k) * self.quantum)
@@ -338,6 +349,10 @@ class Grid:
         if max(abs(self.value(k[0]) - p[0]), abs(self.value(k[1]) - p[1])) > 1e-6 * self.mm:
             raise ValueError(f"the arc {what} {p} is not on the {self.quantum} mm grid")
         return k
+
+
+_MEMO_SIZE = 1 << 16
+"""Most indices :meth:`Grid.value` keeps (an arc's ends and centre recur in the next arcs)."""
 
 
 @lru_cache(maxsize=64)

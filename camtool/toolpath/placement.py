@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -77,11 +78,56 @@ def _extent(program: Program) -> BBox | None:
         ends = [(m.x, m.y) for m in moves[_at_start(program) :]]
         return bbox_union([(x, y, x, y) for x, y in ends]) if ends else None
     start = program.origin if first == 0 else (moves[first - 1].x, moves[first - 1].y)
+    tail = moves[first:]
+    box = _extent_fast(start, tail)
+    return box if box is not None else _extent_slow(start, tail)
+
+
+def _extent_slow(start: Point, moves: Sequence[Move]) -> BBox:
+    """The union of every move's :meth:`~camtool.model.shapes.Arc.bbox` (or Line's), in order."""
     boxes = []
-    for move in moves[first:]:
+    for move in moves:
         boxes.append(segment_of(start, move).bbox())
         start = (move.x, move.y)
     return bbox_union(boxes)
+
+
+_QUAD_COS = tuple(math.cos(k * math.pi / 2) for k in range(4))
+_QUAD_SIN = tuple(math.sin(k * math.pi / 2) for k in range(4))
+"""``cos``/``sin`` of the quadrant angles, as :meth:`Arc.bbox` computes its extremes."""
+
+
+def _extent_fast(start: Point, moves: Sequence[Move]) -> BBox | None:
+    """:func:`_extent_slow`'s box, skipping the arcs that cannot widen it; ``None``: not sure.
+
+    The box of the end points comes first. An arc whose four circle extremes (the very floats
+    :meth:`Arc.bbox` would add: ``c + r·cos(kπ/2)``, ``c + r·sin(kπ/2)``) all lie strictly
+    inside it adds no value that could be a minimum or a maximum, so its box is not needed;
+    the others' boxes are computed as before. The union of a set of floats is the same in any
+    order but for the sign of a zero and NaN (``min`` keeps the first of equals), so a box
+    with a zero or a non-finite side is left to the slow union (``None``).
+    """
+    xs = [start[0], *(m.x for m in moves)]
+    ys = [start[1], *(m.y for m in moves)]
+    if not all(map(math.isfinite, xs)) or not all(map(math.isfinite, ys)):
+        return None
+    x0, x1, y0, y1 = min(xs), max(xs), min(ys), max(ys)
+    boxes = [(x0, y0, x1, y1)]
+    here = start
+    for move in moves:
+        if isinstance(move, ArcMove):
+            cx, cy = move.cx, move.cy
+            r = math.hypot(here[0] - cx, here[1] - cy)  # Arc.radius
+            inside = all(x0 < cx + r * c < x1 for c in _QUAD_COS) and all(
+                y0 < cy + r * s < y1 for s in _QUAD_SIN
+            )
+            if not inside:
+                boxes.append(segment_of(here, move).bbox())
+        here = (move.x, move.y)
+    box = bbox_union(boxes)
+    if not all(map(math.isfinite, box)) or 0.0 in box:
+        return None
+    return box
 
 
 def placement_shift(program: Program, placement: str, translate: Point) -> Point:

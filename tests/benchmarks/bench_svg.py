@@ -48,6 +48,36 @@ user, 170 MB after; vpype 1.15.0 + vpype-gcode 0.13.0: 5.0 s user, 8.6 s wall, 1
 (under load). One run of this script under heavy load gave camtool 169 s wall against
 vpype 34 s (ratio 5.0×). The goal (≤ 1.0×) is not met: the exact biarc fit and the arc
 check (helper h17gc's part of issue 17) dominate.
+
+Second pass (quiet machine before it: camtool 26.3 s, vpype 4.84 s, 5.4×). The fits of a
+drawing with ≥ 400 curves run in forked worker processes on every usable core
+(``camtool/geometry/fitpool.py``; looked up by exact key, so the G-code is the same), the
+fitter's distance functions work x and y in separate arrays (half the fit's CPU, the same
+floats), the toolpath extent skips arcs that cannot widen it, the arc check keeps the grid
+values it printed. ``plainly_passes`` answers 61 151 of this file's 61 463 arcs (312 go to
+the search); the whole arc check costs 2.6–3.0 s of CPU here, about as much as the rest of
+the writer's arc handling (``wordaddress._arc``: splitting, formatting; not this pass's).
+CPU seconds in one process per stage, first pass → second pass, two runs each one after
+the other, under heavy load (8–9 jobs on 2 cores; wall times meaningless):
+
+==========================  ==============  ===============================
+stage                       first pass      second pass
+==========================  ==============  ===============================
+import                      18.5–21.0 s     3.5–3.6 s + 10.1–10.4 s workers
+planning                    8.1–8.9 s       7.8–8.6 s
+writing                     6.1–7.0 s       6.5–7.2 s (noise)
+whole ``post`` (CPU)        33.6–36.0 s     28.3–29.4 s
+==========================  ==============  ===============================
+
+With the fits on 2 free cores the import's wall time falls by about 7 s of the 26.3 s, so
+the quiet-machine estimate is ~19 s against vpype's 4.8 s (~4×): the goal is still not
+met. What is left: the exact fit itself (~5 s of CPU quiet, numpy on 65-point arrays; a
+numba kernel is not used: on this AVX-512 machine numpy's ``arctan2`` differs from libm's
+``atan2`` on 22 192 of 300 000 random arguments and its ``hypot`` from ``math.hypot`` on
+1 725, so a kernel calling libm would not give the fitter's floats), svgelements' parsing
+(~1.5 s),
+nesting (shapely polygons and STRtree queries, twice), reversal counts for the summary
+line, and the writer.
 """
 
 from __future__ import annotations

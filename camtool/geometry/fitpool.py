@@ -1,0 +1,164 @@
+"""Many curve fits at once: the same biarc fits, on the machine's cores, results in order.
+
+An importer that meets thousands of Béziers (a big SVG) names each curve by a
+:data:`CurveKey` — its kind and the exact floats that define it — and asks :func:`fit_many`
+for the fits of all of them. Each fit is :func:`fit_key`, a pure function of its key and the
+tolerance (:func:`camtool.geometry.arcfit.fit_curve` on the curve the key rebuilds), so a fit
+done in a worker process is the very fit done here: the segments come back as their floats
+(pickle keeps every bit) and are rebuilt as the same :class:`~camtool.model.shapes.Line` and
+:class:`~camtool.model.shapes.Arc` objects. A key whose fit raised in a worker is answered
+``None``: the caller fits it again itself, in its own order, and so raises the same error at
+the same place as without workers.
+
+Workers are started by ``fork`` (Linux; nothing to re-import, ~10 ms each) and only for at
+least :data:`MIN_CURVES` keys, so small files never pay for a pool; where ``fork`` is not
+available, or the pool cannot start or breaks, or this process is itself a worker (``camtool
+batch``, Dask: the cores are busy with other files already), every fit runs here, one after
+the other.
+Forking is safe at this point: the importers run before anything starts threads of its own
+(camtool starts none; numba, whose threading layer must not be forked, is not imported on the
+import path; OpenBLAS's idle threads are re-made by its own ``pthread_atfork`` handler).
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+from collections.abc import Iterable, Sequence
+from concurrent.futures import ProcessPoolExecutor
+from typing import Any, TypeAlias
+
+from camtool.geometry.arcfit import fit_curve
+from camtool.geometry.curves import (
+    cubic_bezier,
+    cubic_bezier_points,
+    ellipse_arc,
+    ellipse_arc_points,
+    quadratic_bezier,
+    quadratic_bezier_points,
+)
+from camtool.model.shapes import Arc, Line, Segment
+
+__all__ = ["MIN_CURVES", "CurveKey", "default_jobs", "fit_key", "fit_many"]
+
+CurveKey: TypeAlias = tuple[str, tuple[Any, ...]]
+"""A curve by kind and exact arguments: ``("cubic", (p0, p1, p2, p3))``, ``("quadratic",
+(p0, p1, p2))`` or ``("ellipse_arc", (centre, a, b, t0, sweep, p0, p1))`` (mm, Y up), the
+arguments of :func:`~camtool.geometry.curves.cubic_bezier`, ``quadratic_bezier`` or
+``ellipse_arc``."""
+
+MIN_CURVES = 400
+"""Fewer keys than this are fitted here, without workers (a pool costs ~10 ms a worker; a
+fit ~1 ms: below a few hundred curves the pool would not pay for itself)."""
+
+_CHUNK = 48  # keys per task sent to a worker: pickling overhead vs balance between workers
+
+_BEZIERS: dict[str, tuple[Any, Any]] = {
+    "cubic": (cubic_bezier, cubic_bezier_points),
+    "quadratic": (quadratic_bezier, quadratic_bezier_points),
+}
+
+_Packed: TypeAlias = tuple[Any, ...]
+
+
+def fit_key(key: CurveKey, tolerance: float) -> list[Segment]:
+    """The biarc fit of the curve ``key`` names, over its whole range ``u`` ∈ [0, 1].
+
+    Raises:
+        KeyError: unknown kind.
+        UsageError, GeometryError: from :func:`~camtool.geometry.arcfit.fit_curve`.
+    """
+    kind, args = key
+    if kind == "ellipse_arc":
+        point_at, tangent_at = ellipse_arc(*args)
+        points_at = ellipse_arc_points(*args)
+    else:
+        make, make_points = _BEZIERS[kind]
+        point_at, tangent_at = make(args)
+        points_at = make_points(args)
+    return fit_curve(point_at, tangent_at, 0.0, 1.0, tolerance, points_at=points_at)
+
+
+def default_jobs() -> int:
+    """The CPUs this process may run on (``os.sched_getaffinity``; else ``os.cpu_count()``)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # pragma: no cover - not on Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def fit_many(
+    keys: Sequence[CurveKey], tolerance: float, jobs: int | None = None
+) -> list[list[Segment] | None]:
+    """:func:`fit_key` of every key, in order; ``None`` where that fit raised.
+
+    Args:
+        keys: the curves.
+        tolerance: mm (> 0), as for :func:`fit_key`.
+        jobs: worker processes; ``None``: :func:`default_jobs`. With 1, or fewer than
+            :data:`MIN_CURVES` keys, every fit runs in this process.
+
+    Returns:
+        One entry per key: its segments (exactly :func:`fit_key`'s), or ``None``.
+    """
+    workers = default_jobs() if jobs is None else max(1, jobs)
+    workers = min(workers, -(-len(keys) // _CHUNK))
+    if workers > 1 and len(keys) >= MIN_CURVES and not _in_worker():
+        packed = _in_pool(keys, tolerance, workers)
+        if packed is not None:
+            return [None if p is None else _unpack(p) for p in packed]
+    return [_fit_or_none(k, tolerance) for k in keys]
+
+
+def _in_worker() -> bool:
+    """Whether this process is itself a worker (``camtool batch``'s pool, a Dask worker).
+
+    A batch already keeps the cores busy with one file per worker, and a daemonic process
+    (Dask's) may not start children: there the fits run in the worker, one after the other.
+    """
+    current = multiprocessing.current_process()
+    return bool(current.daemon) or multiprocessing.parent_process() is not None
+
+
+def _in_pool(
+    keys: Sequence[CurveKey], tolerance: float, workers: int
+) -> list[_Packed | None] | None:
+    """The packed fits from ``workers`` forked processes; ``None`` if no pool can run them."""
+    try:
+        context = multiprocessing.get_context("fork")
+    except ValueError:  # pragma: no cover - no fork on this platform
+        return None
+    chunks = [(list(keys[i : i + _CHUNK]), tolerance) for i in range(0, len(keys), _CHUNK)]
+    try:
+        with ProcessPoolExecutor(workers, mp_context=context) as pool:
+            return [p for chunk in pool.map(_fit_chunk, chunks) for p in chunk]
+    except (OSError, RuntimeError, EOFError, AssertionError):  # cannot fork, a worker died
+        return None
+
+
+def _fit_chunk(task: tuple[list[CurveKey], float]) -> list[_Packed | None]:
+    keys, tolerance = task
+    out: list[_Packed | None] = []
+    for key in keys:
+        segs = _fit_or_none(key, tolerance)
+        out.append(None if segs is None else _pack(segs))
+    return out
+
+
+def _fit_or_none(key: CurveKey, tolerance: float) -> list[Segment] | None:
+    try:
+        return fit_key(key, tolerance)
+    except Exception:  # the caller fits it again and raises it in order
+        return None
+
+
+def _pack(segs: Iterable[Segment]) -> _Packed:
+    """Segments as plain tuples of floats (small pickles): ``(start, end)`` or with centre."""
+    return tuple(
+        (s.start, s.end, s.centre, s.clockwise) if isinstance(s, Arc) else (s.start, s.end)
+        for s in segs
+    )
+
+
+def _unpack(packed: _Packed) -> list[Segment]:
+    return [Arc(*p) if len(p) == 4 else Line(*p) for p in packed]

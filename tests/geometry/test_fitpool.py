@@ -1,0 +1,98 @@
+"""Curve fits in worker processes (issue 17): the very fits made here, in order.
+
+Expected values are :func:`fit_key` run in this process (the serial fit the workers stand in
+for): the pool must change the speed only, so every segment must be the same, float for float.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from camtool.geometry import fitpool
+from camtool.geometry.fitpool import CurveKey, fit_key, fit_many
+
+
+def _keys(n: int) -> list[CurveKey]:
+    rng = np.random.default_rng(1717)
+    out: list[CurveKey] = []
+    for k in range(n):
+        scale = 10.0 ** rng.uniform(-1, 2)
+        pts = tuple((float(x), float(y)) for x, y in rng.normal(0.0, scale, (4, 2)))
+        if k % 3 == 0:
+            out.append(("cubic", pts))
+        elif k % 3 == 1:
+            out.append(("quadratic", pts[:3]))
+        else:
+            a = (float(rng.normal(0, 20)), float(rng.normal(0, 20)))
+            b = (-a[1] * 0.3, a[0] * 0.3)
+            t0, sweep = float(rng.uniform(-3, 3)), float(rng.uniform(-6, 6))
+            c = pts[0]
+            p0 = (c[0] + a[0] * math.cos(t0) + b[0] * math.sin(t0),
+                  c[1] + a[1] * math.cos(t0) + b[1] * math.sin(t0))  # fmt: skip
+            t1 = t0 + sweep
+            p1 = (c[0] + a[0] * math.cos(t1) + b[0] * math.sin(t1),
+                  c[1] + a[1] * math.cos(t1) + b[1] * math.sin(t1))  # fmt: skip
+            out.append(("ellipse_arc", (c, a, b, t0, sweep, p0, p1)))
+    return out
+
+
+def test_parallel_fits_equal_serial_fits(monkeypatch: pytest.MonkeyPatch) -> None:
+    """300 random Béziers and elliptical arcs: the workers' fits are the serial fits."""
+    monkeypatch.setattr(fitpool, "MIN_CURVES", 1)
+    monkeypatch.setattr(fitpool, "_CHUNK", 7)  # many chunks, gathered in order
+    keys = _keys(300)
+    serial = [fit_key(k, 0.01) for k in keys]
+    assert repr(fit_many(keys, 0.01, jobs=2)) == repr(serial)
+    assert repr(fit_many(keys, 0.01, jobs=1)) == repr(serial)
+
+
+def test_a_fit_that_raises_is_none_and_the_others_stay(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A failing fit answers None (the caller fits it again and raises in order)."""
+    monkeypatch.setattr(fitpool, "MIN_CURVES", 1)
+    keys = _keys(20)
+    bad: CurveKey = ("cubic", ((0.0, 0.0), (1.0, 1.0), (2.0, 1.0), (3.0, 0.0)))
+    got = fit_many([*keys[:5], bad, *keys[5:]], -1.0, jobs=2)  # a bad tolerance fails all
+    assert got == [None] * 21
+    got = fit_many([*keys[:5], ("nurbs", ()), *keys[5:]], 0.01, jobs=2)
+    assert got[5] is None
+    assert got[:5] + got[6:] == [fit_key(k, 0.01) for k in keys]
+
+
+def test_few_curves_start_no_pool(monkeypatch: pytest.MonkeyPatch) -> None:
+    def no_pool(*args: object) -> None:
+        raise AssertionError("a pool for a few curves")
+
+    monkeypatch.setattr(fitpool, "_in_pool", no_pool)
+    keys = _keys(10)
+    assert fit_many(keys, 0.01, jobs=4) == [fit_key(k, 0.01) for k in keys]
+
+
+def _fits_in_a_child(keys: list[CurveKey], queue: object) -> None:
+    def no_pool(*args: object) -> None:
+        raise AssertionError("a pool in a worker process")
+
+    fitpool.MIN_CURVES = 1
+    fitpool._in_pool = no_pool  # type: ignore[assignment]
+    try:
+        queue.put(repr(fit_many(keys, 0.01, jobs=2)))  # type: ignore[attr-defined]
+    except AssertionError as exc:
+        queue.put(str(exc))  # type: ignore[attr-defined]
+
+
+def test_a_worker_process_fits_serially_and_the_same(monkeypatch: pytest.MonkeyPatch) -> None:
+    """In a child process (a batch worker) no pool is started; the fits are the same."""
+    import multiprocessing
+
+    monkeypatch.setattr(fitpool, "MIN_CURVES", 1)
+    keys = _keys(12)
+    context = multiprocessing.get_context("fork")
+    queue = context.Queue()
+    child = context.Process(target=_fits_in_a_child, args=(keys, queue))
+    child.start()
+    got = queue.get(timeout=120)
+    child.join(timeout=60)
+    assert got == repr([fit_key(k, 0.01) for k in keys])
+    assert not fitpool._in_worker()

@@ -1,0 +1,66 @@
+"""The toolpath extent without the boxes of arcs that cannot widen it (issue 17).
+
+Reference: the union of every move's box, as before (``_extent_slow``); the fast one must
+give the same four floats (compared by ``repr``: the sign of a zero too) or leave it to it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from camtool.model.program import ArcMove, Linear, Move, Rapid
+from camtool.toolpath import placement
+
+
+def _moves(rng: np.random.Generator, n: int, scale: float) -> list[Move]:
+    out: list[Move] = []
+    here = (0.0, 0.0)
+    for _ in range(n):
+        x, y = (float(v) for v in rng.normal(0.0, scale, 2))
+        kind = rng.random()
+        if kind < 0.1:
+            out.append(Rapid(x, y))
+        elif kind < 0.4:
+            out.append(Linear(x, y, 100.0))
+        else:
+            # a centre on the bisector of here → (x, y), so both ends are on one circle
+            mx, my = (here[0] + x) / 2, (here[1] + y) / 2
+            nx, ny = -(y - here[1]), x - here[0]
+            lam = float(rng.normal(0.0, 1.0))
+            full = rng.random() < 0.05
+            end = here if full else (x, y)
+            out.append(ArcMove(*end, mx + lam * nx, my + lam * ny, bool(rng.random() < 0.5), 100.0))
+        here = (out[-1].x, out[-1].y)
+    return out
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_fast_extent_is_the_union_of_every_box(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    checked = 0
+    for _ in range(300):
+        scale = 10.0 ** rng.uniform(-3, 3)
+        moves = _moves(rng, int(rng.integers(1, 40)), scale)
+        start = (float(rng.normal(0, scale)), float(rng.normal(0, scale)))
+        slow = placement._extent_slow(start, moves)
+        fast = placement._extent_fast(start, moves)
+        if fast is not None:
+            checked += 1
+            assert repr(fast) == repr(slow)
+    assert checked > 250
+
+
+def test_zero_or_non_finite_sides_go_to_the_slow_union() -> None:
+    moves: list[Move] = [Linear(0.0, 1.0, 100.0), Linear(-0.0, 2.0, 100.0)]
+    assert placement._extent_fast((1.0, 1.0), moves) is None
+    assert placement._extent_fast((1.0, 1.0), [Linear(math.nan, 1.0, 100.0)]) is None
+    arc = ArcMove(2.0, 0.0, 1.0, 0.0, True, 100.0)  # the half circle over (1, 1)
+    assert repr(placement._extent_fast((0.0, 0.0), [arc])) == "None"
+    assert placement._extent_fast(
+        (3.0, 3.0), [Linear(4.0, 4.0, 1.0), ArcMove(6.0, 4.0, 5.0, 4.0, True, 1.0)]
+    ) == placement._extent_slow(
+        (3.0, 3.0), [Linear(4.0, 4.0, 1.0), ArcMove(6.0, 4.0, 5.0, 4.0, True, 1.0)]
+    )
