@@ -539,7 +539,9 @@ def _tied(
         part = slice(i, i + TIED_CHUNK)
         found, d2, count = kernels.within(samples[part], points, boxes, offsets, kth2[part])
         cap = found.shape[1]
-        valid = np.arange(cap)[None, :] < count[:, None]
+        width = max(1, min(cap, int(count.max())))  # the columns any sample fills
+        found, d2 = found[:, :width], d2[:, :width]
+        valid = np.arange(width)[None, :] < count[:, None]
         seg = found % len(a)
         values = _to_segments(samples[part], a[seg], b[seg])
         values[~valid] = np.inf
