@@ -49,7 +49,9 @@ part (--preview)       20.5 s CPU, 606 MB      14.0 s CPU, 616 MB
 plate (make demo)      23.1 s CPU, 524 MB      12.1 s CPU, 520 MB
 =====================  ======================  ======================
 
-(wall 38.7 s → 28.0 s and 44.5 s → 24.4 s at that load.)
+(wall 38.7 s → 28.0 s and 44.5 s → 24.4 s at that load.) This script itself, at a lighter
+load (1.2–1.4), first pass then second pass right after: part 18.0 s, 593 MB → 12.5 s,
+602 MB; plate 15.4 s, 511 MB → 9.9 s, 509 MB.
 
 The offsets call OpenCASCADE's OCP bindings without build123d (its import was 2.7 s CPU
 and 160 MB of the 390 MB build123d + OCP take; OCP alone is 0.8 s and 230 MB), and the
