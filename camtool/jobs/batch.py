@@ -676,9 +676,16 @@ def _worker_init(parent_pid: int) -> None:
     (``prctl(PR_SET_PDEATHSIG)``, prctl(2)); everywhere a daemon thread also polls
     the parent pid every :data:`PARENT_POLL_S` and exits the worker when the worker
     has been re-parented. A parent already gone ends the worker at once.
+
+    The worker's k-d tree queries run on one thread (``KD_WORKERS``): the pool already
+    runs one worker per job, and the distances do not depend on it.
     """
     import sys
     import threading
+
+    from camtool.verify import metrics
+
+    metrics.KD_WORKERS = 1
 
     if sys.platform.startswith("linux"):
         import ctypes

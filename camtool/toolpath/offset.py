@@ -1,6 +1,6 @@
-"""Arc-preserving 2D offsets of closed contours (build123d / OpenCASCADE), with a fallback.
+"""Arc-preserving 2D offsets of closed contours (OpenCASCADE), with a fallback.
 
-The only module that touches OpenCASCADE; build123d (and its OCP bindings) are
+The only module that touches OpenCASCADE; its OCP bindings are
 imported lazily so that ``camtool --version`` and ``camtool targets`` never load
 them. Straight edges stay lines, arcs stay arcs and convex corners become arcs of
 the offset radius (``Kind.ARC``, OCCT's ``GeomAbs_Arc`` join), so the toolpath
@@ -118,7 +118,7 @@ def offset_pieces(contour: Contour, amount: float) -> list[Contour]:
         ) from exc
     pieces: list[Contour] = []
     for wire in wires:
-        edges = [_from_edge(e, contour) for e in wire.edges()]
+        edges = [_from_edge(e, contour) for e in _wire_edges(wire)]
         joined = chain(
             [Contour((e,), False, contour.layer, contour.source) for e in edges], _JOIN_MM
         )
@@ -281,8 +281,11 @@ def _where(contour: Contour) -> str:
 
 
 def _occt_offset(contour: Contour, amount: float) -> list[Any]:
-    """OCCT's offset wires (build123d ``Wire`` objects); several when the region splits."""
-    from build123d import Wire
+    """OCCT's offset wires (``TopoDS_Wire``); several when the region splits.
+
+    OCP (OpenCASCADE's bindings) directly: the same calls build123d makes for its
+    ``Wire``/``Edge`` (build123d 0.13, ``topology/one_d.py``), without importing it.
+    """
     from OCP.BRepOffsetAPI import BRepOffsetAPI_MakeOffset
     from OCP.GeomAbs import GeomAbs_JoinType
     from OCP.TopAbs import TopAbs_WIRE
@@ -291,54 +294,112 @@ def _occt_offset(contour: Contour, amount: float) -> list[Any]:
 
     builder = BRepOffsetAPI_MakeOffset()
     builder.Init(GeomAbs_JoinType.GeomAbs_Arc)
-    builder.AddWire(_to_wire(contour).wrapped)
+    builder.AddWire(_to_wire(contour))
     builder.Perform(amount)
     if not builder.IsDone():
         raise ToolpathError(f"OpenCASCADE's 2D offset by {amount:+.4g} mm did not finish")
     wires = []
     explorer = TopExp_Explorer(builder.Shape(), TopAbs_WIRE)
     while explorer.More():
-        wires.append(Wire(TopoDS.Wire(explorer.Current())))
+        wires.append(TopoDS.Wire(explorer.Current()))
         explorer.Next()
     return wires
 
 
+def _wire_edges(wire: Any) -> list[Any]:
+    """The edges of a ``TopoDS_Wire`` in connection order (``BRepTools_WireExplorer``)."""
+    from OCP.BRepTools import BRepTools_WireExplorer
+
+    explorer = BRepTools_WireExplorer(wire)
+    edges = []
+    while explorer.More():
+        edges.append(explorer.Current())
+        explorer.Next()
+    return edges
+
+
 def _to_wire(contour: Contour) -> Any:
-    from build123d import Wire
+    """The contour as a ``TopoDS_Wire`` (``BRepBuilderAPI_MakeWire`` of its edges)."""
+    import warnings
+
+    from OCP.BRepBuilderAPI import (
+        BRepBuilderAPI_DisconnectedWire,
+        BRepBuilderAPI_EmptyWire,
+        BRepBuilderAPI_MakeWire,
+        BRepBuilderAPI_NonManifoldWire,
+    )
+    from OCP.collections import List_TopoDS_Shape
 
     segs: list[Segment] = list(contour.segments)
     if len(segs) == 1 and isinstance(segs[0], Arc):
         segs = list(segs[0].split(2))  # one-edge wires offset badly (see build123d offset_2d)
-    return Wire([_to_edge(seg) for seg in segs])
+    edges = List_TopoDS_Shape()
+    for seg in segs:
+        edges.Append(_to_edge(seg))
+    builder = BRepBuilderAPI_MakeWire()
+    builder.Add(edges)
+    builder.Build()
+    if not builder.IsDone():  # what build123d's Wire says
+        error = builder.Error()
+        if error == BRepBuilderAPI_NonManifoldWire:
+            warnings.warn("Wire is non manifold (e.g. branching, self intersecting)", stacklevel=2)
+        elif error == BRepBuilderAPI_EmptyWire:
+            raise RuntimeError("Wire is empty")
+        elif error == BRepBuilderAPI_DisconnectedWire:
+            raise ValueError("Edges are disconnected")
+    return builder.Wire()
 
 
 def _to_edge(seg: Segment) -> Any:
-    from build123d import Edge, Plane, Vector
+    """A ``TopoDS_Edge`` of a line or an arc (a full circle: a ``gp_Circ``)."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
+    from OCP.GC import GC_MakeArcOfCircle
+    from OCP.gp import gp_Ax2, gp_Circ, gp_Dir, gp_Pnt
 
     if isinstance(seg, Line):
-        return Edge.make_line(Vector(*seg.start), Vector(*seg.end))
+        return BRepBuilderAPI_MakeEdge(_pnt(seg.start), _pnt(seg.end)).Edge()
     if seg.is_full_circle:
-        plane = Plane.XY.move(_location(seg.centre))
-        return Edge.make_circle(seg.radius, plane)
+        centre = gp_Pnt(float(seg.centre[0]), float(seg.centre[1]), 0.0)
+        axes = gp_Ax2(centre, gp_Dir(0.0, 0.0, 1.0), gp_Dir(1.0, 0.0, 0.0))  # Plane.XY moved
+        return BRepBuilderAPI_MakeEdge(gp_Circ(axes, seg.radius)).Edge()
     mid = seg.point_at(0.5)
-    return Edge.make_three_point_arc(Vector(*seg.start), Vector(*mid), Vector(*seg.end))
+    arc = GC_MakeArcOfCircle(_pnt(seg.start), _pnt(mid), _pnt(seg.end)).Value()
+    return BRepBuilderAPI_MakeEdge(arc).Edge()
 
 
-def _location(p: Point) -> Any:
-    from build123d import Location
+def _pnt(p: Point) -> Any:
+    from OCP.gp import gp_Pnt
 
-    return Location((p[0], p[1], 0.0))
+    return gp_Pnt(float(p[0]), float(p[1]), 0.0)
+
+
+_CURVE_NAMES = {
+    "GeomAbs_Line": "LINE",
+    "GeomAbs_Circle": "CIRCLE",
+    "GeomAbs_Ellipse": "ELLIPSE",
+    "GeomAbs_Hyperbola": "HYPERBOLA",
+    "GeomAbs_Parabola": "PARABOLA",
+    "GeomAbs_BezierCurve": "BEZIER",
+    "GeomAbs_BSplineCurve": "BSPLINE",
+    "GeomAbs_OffsetCurve": "OFFSET",
+    "GeomAbs_OtherCurve": "OTHER",
+}
+"""OCCT curve types by the names build123d's ``GeomType`` gives them."""
 
 
 def _from_edge(edge: Any, contour: Contour) -> Segment:
-    kind = edge.geom_type.name
-    start = _xy(edge.position_at(0.0))
-    end = _xy(edge.position_at(1.0))
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+
+    curve = BRepAdaptor_Curve(edge)
+    kind = _CURVE_NAMES.get(curve.GetType().name, "OTHER")
+    start = _position_at(edge, curve, 0.0)
+    end = _position_at(edge, curve, 1.0)
     if kind == "LINE":
         return Line(start, end)
     if kind == "CIRCLE":
-        centre = _xy(edge.arc_center)
-        a, b = _xy(edge.position_at(0.25)), _xy(edge.position_at(0.5))
+        c = curve.Circle().Position().Location()
+        centre = (float(c.X()), float(c.Y()))
+        a, b = _position_at(edge, curve, 0.25), _position_at(edge, curve, 0.5)
         turn = (a[0] - start[0]) * (b[1] - a[1]) - (a[1] - start[1]) * (b[0] - a[0])
         if distance(start, end) < _JOIN_MM:
             end = start
@@ -349,8 +410,17 @@ def _from_edge(edge: Any, contour: Contour) -> Segment:
     )
 
 
-def _xy(v: Any) -> Point:
-    return (float(v.X), float(v.Y))
+def _position_at(edge: Any, curve: Any, position: float) -> Point:
+    """build123d's ``Edge.position_at(position)``: a fraction of the length, orientation-wise."""
+    from OCP.GCPnts import GCPnts_AbscissaPoint
+    from OCP.TopAbs import TopAbs_Orientation
+
+    length = GCPnts_AbscissaPoint.Length_s(curve)
+    if edge.Orientation() != TopAbs_Orientation.TopAbs_FORWARD:
+        position = 1 - position
+    param = GCPnts_AbscissaPoint(curve, length * position, curve.FirstParameter()).Parameter()
+    p = curve.Value(param)
+    return (float(p.X()), float(p.Y()))
 
 
 def _start_near(contour: Contour, p: Point) -> Contour:

@@ -15,6 +15,7 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import partial
+from types import ModuleType
 from typing import Any, Protocol
 
 import numpy as np
@@ -525,6 +526,11 @@ def nearest_distances(samples: FloatArray, a: FloatArray, b: FloatArray) -> Floa
     (a segment whose ends are both ``r`` or more away comes no nearer than
     that). Samples neither test settles get shapely's exact nearest query.
 
+    With numba (:func:`near_kernels`), the nearest ends come from
+    :func:`camtool.verify.nearkernels.knn`, the k-d tree's answer bit for bit
+    (where it cannot say so, from the k-d tree itself); the plain form is
+    :func:`nearest_distances_kd`, kept for comparison.
+
     Args:
         samples: ``(N, 2)`` query points, mm.
         a: ``(M, 2)`` segment starts, mm.
@@ -533,6 +539,141 @@ def nearest_distances(samples: FloatArray, a: FloatArray, b: FloatArray) -> Floa
     Returns:
         ``(N,)`` float64 distances, mm (``inf`` without segments).
     """
+    kernels = near_kernels(len(samples))
+    if kernels is None or len(a) == 0 or 2 * len(a) <= NEAREST_ENDS:
+        return nearest_distances_kd(samples, a, b)
+    samples = np.ascontiguousarray(samples, dtype=np.float64)
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    b = np.ascontiguousarray(b, dtype=np.float64)
+    half = float(np.max(np.hypot(*(b - a).T))) / 2.0
+    points = np.concatenate([a, b])
+    boxes, offsets = kernels.build(points)
+    ends = _LazyTree(points)
+    d = np.empty(len(samples), dtype=np.float64)
+    unsure = np.zeros(len(samples), dtype=bool)
+    k = NEAREST_ENDS
+    for i in range(0, len(samples), NEAREST_CHUNK):
+        chunk = samples[i : i + NEAREST_CHUNK]
+        r0_2, rk_2, index, state = kernels.knn(chunk, points, boxes, offsets, k)
+        r0, rk = np.sqrt(r0_2), np.sqrt(rk_2)  # what the k-d tree gives: the same sqrt
+        seg = index % len(a)
+        near = _to_segments(chunk, a[seg], b[seg]).min(axis=1)
+        tied = state != 0
+        if tied.any():  # several ends at the k-th distance: does the k-d tree's choice matter?
+            near[tied], asks = _tied(chunk[tied], rk_2[tied], a, b, points, boxes, offsets, kernels)
+            if asks.any():  # it does: ask the k-d tree
+                rows = np.flatnonzero(tied)[asks]
+                found = ends.tree.query(chunk[rows], k=k, workers=KD_WORKERS)[1]
+                s = np.asarray(found).reshape(-1, k) % len(a)
+                near[rows] = _to_segments(chunk[rows], a[s], b[s]).min(axis=1)
+        lower = np.sqrt(np.maximum(r0**2 - half * half, 0.0))
+        sure = (near + half < rk) | (near - lower <= NEAREST_TOLERANCE_MM)
+        d[i : i + len(chunk)] = near
+        unsure[i : i + len(chunk)] = ~sure
+    if unsure.any():
+        tree = (points, boxes, offsets)
+        exact = _nearby_boxes(samples[unsure], d[unsure], a, b, tree, half, kernels)
+        if exact is None:
+            exact = _all_exact(samples[unsure], a, b)
+        d[unsure] = exact
+    return d
+
+
+def _tied(
+    samples: FloatArray,
+    kth2: FloatArray,
+    a: FloatArray,
+    b: FloatArray,
+    points: FloatArray,
+    boxes: Any,
+    offsets: Any,
+    kernels: ModuleType,
+) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
+    """The k-d tree's ``d`` where ends tie at the k-th distance, when its choice cannot matter.
+
+    The k-d tree keeps every end nearer than the k-th distance (``S``) and some of those
+    exactly at it (``T``); ``d`` is the least segment distance over what it keeps. With
+    ``V`` the least over ``S`` and ``T``: when ``S`` reaches ``V``, or so many ends of
+    ``T`` reach it that any choice keeps one, ``d`` is ``V`` whatever it chose.
+
+    Returns:
+        ``d`` ``(U,)`` and ``(U,)`` True where the choice matters (``d`` is then unset).
+    """
+    least = np.empty(len(samples), dtype=np.float64)
+    settled = np.empty(len(samples), dtype=bool)
+    for i in range(0, len(samples), TIED_CHUNK):  # ~1.5 kB per sample at once
+        part = slice(i, i + TIED_CHUNK)
+        found, d2, count = kernels.within(samples[part], points, boxes, offsets, kth2[part])
+        cap = found.shape[1]
+        width = max(1, min(cap, int(count.max())))  # the columns any sample fills
+        found, d2 = found[:, :width], d2[:, :width]
+        valid = np.arange(width)[None, :] < count[:, None]
+        seg = found % len(a)
+        values = _to_segments(samples[part], a[seg], b[seg])
+        values[~valid] = np.inf
+        nearer = valid & (d2 < kth2[part, None])
+        at = valid & (d2 == kth2[part, None])
+        low = values.min(axis=1)
+        low_nearer = np.where(nearer, values, np.inf).min(axis=1)
+        pick = NEAREST_ENDS - nearer.sum(axis=1)
+        reaching = (at & (values == low[:, None])).sum(axis=1)
+        least[part] = low
+        settled[part] = (count <= cap) & ((low_nearer == low) | (at.sum(axis=1) - reaching < pick))
+    return least, ~settled
+
+
+TIED_CHUNK = 2_000
+"""Samples :func:`_tied` measures at once."""
+
+
+class _LazyTree:
+    """scipy's k-d tree of some points, built when first asked for."""
+
+    def __init__(self, points: FloatArray) -> None:
+        self.points = points
+        self._tree: Any = None
+
+    @property
+    def tree(self) -> Any:
+        if self._tree is None:
+            from scipy.spatial import cKDTree
+
+            self._tree = cKDTree(self.points)
+        return self._tree
+
+
+NEAR_KERNELS_FROM = 500_000
+"""Samples :func:`nearest_distances` has measured in this process (this call's included)
+from which it loads the numba search: loading numba and its cache costs about 0.5 s and
+100 MB once, the search saves about 1–3 µs a sample (most far from the trace, a drawing
+point against the tool-centre path), so a small part (the logo) keeps the k-d tree."""
+_NEAR_KERNELS: dict[str, ModuleType | None] = {}
+_NEAR_WORK = [0]
+
+
+def near_kernels(work: int = NEAR_KERNELS_FROM) -> ModuleType | None:
+    """:mod:`camtool.verify.nearkernels` once the samples asked for reach the threshold.
+
+    ``work``: the samples the caller is about to measure, added to those before
+    (:data:`NEAR_KERNELS_FROM`; the default loads at once). ``None`` before that and
+    without numba; :func:`nearest_distances_kd` then answers, the same.
+    """
+    if "kernels" in _NEAR_KERNELS:
+        return _NEAR_KERNELS["kernels"]
+    _NEAR_WORK[0] += work
+    if _NEAR_WORK[0] < NEAR_KERNELS_FROM:
+        return None
+    kernels: ModuleType | None
+    try:
+        from camtool.verify import nearkernels as kernels
+    except ImportError:
+        kernels = None
+    _NEAR_KERNELS["kernels"] = kernels
+    return kernels
+
+
+def nearest_distances_kd(samples: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
+    """:func:`nearest_distances` with the nearest ends from scipy's k-d tree (the plain form)."""
     from scipy.spatial import cKDTree
 
     if len(a) == 0:
@@ -590,8 +731,6 @@ def _nearby_exact(
         ends: the k-d tree of ``concatenate([a, b])``.
         half: half the longest segment, mm.
     """
-    import shapely
-
     reach = (upper + half) * (1.0 + 1e-9) + 1e-12  # a float margin: never leaves one out
     near = ends.query_ball_point(samples, reach, return_length=True, workers=KD_WORKERS)
     if int(np.sum(near)) > NEARBY_MAX_PAIRS:
@@ -602,7 +741,49 @@ def _nearby_exact(
     found = ends.query_ball_point(samples, reach, workers=KD_WORKERS)
     owner = np.repeat(np.arange(len(samples)), counts)
     seg = np.fromiter(itertools.chain.from_iterable(found), dtype=np.int64, count=len(owner))
-    seg %= len(a)
+    return _nearby_min(samples, owner, seg, a, b)
+
+
+def _nearby_boxes(
+    samples: FloatArray,
+    upper: FloatArray,
+    a: FloatArray,
+    b: FloatArray,
+    tree: tuple[FloatArray, Any, Any],
+    half: float,
+    kernels: ModuleType,
+) -> FloatArray | None:
+    """:func:`_nearby_exact` with the ends within reach from the box tree (numba).
+
+    The same GEOS distances over the segments with an end within reach (a margin wider:
+    any set holding those gives the same minimum), so the same answer.
+
+    Args:
+        samples: ``(U, 2)`` query points, mm.
+        upper: ``(U,)`` distance of each to some segment ``a → b``, mm.
+        a: ``(M, 2)`` segment starts, mm.
+        b: ``(M, 2)`` segment ends, mm.
+        tree: ``(points, boxes, offsets)``: the ends and their box tree.
+        half: half the longest segment, mm.
+        kernels: :mod:`camtool.verify.nearkernels`.
+    """
+    reach = ((upper + half) * (1.0 + 1e-9) + 1e-12) * (1.0 + 1e-12)
+    points, boxes, offsets = tree
+    owner, seg = kernels.pairs_within(
+        np.ascontiguousarray(samples), points, boxes, offsets, reach, NEARBY_MAX_PAIRS
+    )
+    if len(owner) == 0 or len(np.unique(owner)) < len(samples):
+        return None  # over the limit (or, which cannot happen, a sample without one)
+    return _nearby_min(samples, owner, seg, a, b)
+
+
+def _nearby_min(
+    samples: FloatArray, owner: IntArray, seg: IntArray, a: FloatArray, b: FloatArray
+) -> FloatArray:
+    """The least GEOS distance of each sample over its ``(owner, end)`` pairs (sample-major)."""
+    import shapely
+
+    seg = seg % len(a)
     pair = np.unique(owner * len(a) + seg)  # each (sample, segment) once, sample-major
     owner, seg = pair // len(a), pair % len(a)
     used, local = np.unique(seg, return_inverse=True)

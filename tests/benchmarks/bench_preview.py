@@ -37,6 +37,28 @@ part 26.0 s → 15.6 s, plate 19.0 s → 15.8 s; the preview itself is 0.7–0.9
 alone (``post`` without ``--preview``) takes 4.7 s and 420 MB on this part, most of it
 loading OpenCascade for the offsets: the goal of 3 s and 300 MB is not met (see the
 "Speed" paragraph of docs/verify.md for what is left).
+
+Second pass (branch h17p, 22 Nov 2026, *under load*: load average 6–9 from the other
+engineers' jobs, so wall times say little; user + sys CPU time and peak RSS of the CLI,
+``/usr/bin/time``, the two trees run one right after the other, same G-code sha256):
+
+=====================  ======================  ======================
+job                    first pass (b83b9f0)    second pass (h17p)
+=====================  ======================  ======================
+part (--preview)       20.5 s CPU, 606 MB      14.0 s CPU, 616 MB
+plate (make demo)      23.1 s CPU, 524 MB      12.1 s CPU, 520 MB
+=====================  ======================  ======================
+
+(wall 38.7 s → 28.0 s and 44.5 s → 24.4 s at that load.) This script itself, at a lighter
+load (1.2–1.4), first pass then second pass right after: part 18.0 s, 593 MB → 12.5 s,
+602 MB; plate 15.4 s, 511 MB → 9.9 s, 509 MB.
+
+The offsets call OpenCASCADE's OCP bindings without build123d (its import was 2.7 s CPU
+and 160 MB of the 390 MB build123d + OCP take; OCP alone is 0.8 s and 230 MB), and the
+nearest-segment search of the verification runs compiled (numba: its load costs about
+0.5 s and 100–120 MB, which is why the peak did not fall). The goal of 3 s and 300 MB is
+still not met: OCP alone is 230 MB, numba 100 MB more, and the error budget still
+simulates and measures the part four times.
 """
 
 from __future__ import annotations

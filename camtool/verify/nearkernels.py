@@ -1,0 +1,373 @@
+"""Compiled nearest-end searches of :func:`camtool.verify.metrics.nearest_distances` (numba).
+
+scipy's k-d tree answers a query point 1.5 mm from a dense trace (a drawing point
+against the tool-centre path) slowly: its cells are cut by split planes only, so
+every cell of the strip between the point and the trace is visited. Here the ends
+are kept in the order they come (along the trace), in leaves of :data:`LEAF`
+consecutive points under a tree of :data:`FAN`-fold nodes, each with the *tight*
+bounding box of its points; a query visits only the boxes nearer than its current
+k-th end.
+
+The answers are the k-d tree's, bit for bit (the tests compare them): the squared
+distance of two points is scipy's (``(x − u)² + (y − v)²`` summed from 0, then its
+square root), and the set of the ``k`` nearest ends is the same wherever it is one
+set. Where several ends lie exactly at the k-th distance the k-d tree keeps some
+of them (which ones depends on its tree); :func:`knn` then says whether every such
+choice gives the same segments (coordinates, not indices: a trace cut in several
+passes repeats them) and else asks the caller to use the k-d tree.
+
+This module imports numba, so it is imported lazily
+(:func:`camtool.verify.metrics.near_kernels`), never at ``camtool --help`` time.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numba
+import numpy as np
+
+LEAF = 8
+"""Ends per leaf (consecutive in the order given)."""
+FAN = 8
+"""Children per node above the leaves."""
+CAP = 64
+"""Most ends a query keeps at its k-th distance (ties included); more: the k-d tree answers."""
+
+
+def build(points: Any) -> tuple[Any, Any]:
+    """The box tree of ``points`` ``(P, 2)``: boxes ``(nodes, 4)`` and level offsets.
+
+    Boxes are ``(xmin, ymin, xmax, ymax)``; level 0 (the leaves) comes first, the root
+    last; ``offsets[l]`` is the first node of level ``l`` and ``offsets[-1]`` the count.
+    """
+    sizes = [max(1, -(-len(points) // LEAF))]
+    while sizes[-1] > 1:
+        sizes.append(-(-sizes[-1] // FAN))
+    offsets = np.zeros(len(sizes) + 1, dtype=np.int64)
+    offsets[1:] = np.cumsum(sizes)
+    boxes = np.empty((int(offsets[-1]), 4), dtype=np.float64)
+    _fill(np.ascontiguousarray(points, dtype=np.float64), boxes, offsets)
+    return boxes, offsets
+
+
+@numba.njit(cache=True, nogil=True)
+def _fill(points: Any, boxes: Any, offsets: Any) -> None:  # pragma: no cover - compiled
+    n = len(points)
+    for node in range(offsets[1]):
+        lo = node * LEAF
+        hi = min(n, lo + LEAF)
+        x0 = y0 = np.inf
+        x1 = y1 = -np.inf
+        for i in range(lo, hi):
+            x0 = min(x0, points[i, 0])
+            y0 = min(y0, points[i, 1])
+            x1 = max(x1, points[i, 0])
+            y1 = max(y1, points[i, 1])
+        boxes[node, 0] = x0
+        boxes[node, 1] = y0
+        boxes[node, 2] = x1
+        boxes[node, 3] = y1
+    for level in range(1, len(offsets) - 1):
+        below, here = offsets[level - 1], offsets[level]
+        count_below = here - below
+        for node in range(offsets[level + 1] - here):
+            lo = node * FAN
+            hi = min(count_below, lo + FAN)
+            x0 = y0 = np.inf
+            x1 = y1 = -np.inf
+            for c in range(lo, hi):
+                x0 = min(x0, boxes[below + c, 0])
+                y0 = min(y0, boxes[below + c, 1])
+                x1 = max(x1, boxes[below + c, 2])
+                y1 = max(y1, boxes[below + c, 3])
+            boxes[here + node, 0] = x0
+            boxes[here + node, 1] = y0
+            boxes[here + node, 2] = x1
+            boxes[here + node, 3] = y1
+
+
+@numba.njit(inline="always")
+def _box2(boxes: Any, node: int, qx: float, qy: float) -> float:  # pragma: no cover
+    """Squared distance from ``(qx, qy)`` to a box: never more than to a point in it."""
+    dx = 0.0
+    if qx < boxes[node, 0]:
+        dx = boxes[node, 0] - qx
+    elif qx > boxes[node, 2]:
+        dx = qx - boxes[node, 2]
+    dy = 0.0
+    if qy < boxes[node, 1]:
+        dy = boxes[node, 1] - qy
+    elif qy > boxes[node, 3]:
+        dy = qy - boxes[node, 3]
+    return dx * dx + dy * dy
+
+
+@numba.njit(inline="always")
+def _point2(points: Any, i: int, qx: float, qy: float) -> float:  # pragma: no cover
+    """The squared distance as scipy computes it: ``0 + (x − u)² + (y − v)²``."""
+    s = 0.0
+    d = qx - points[i, 0]
+    s += d * d
+    d = qy - points[i, 1]
+    s += d * d
+    return s
+
+
+@numba.njit(inline="always")
+def _insert(best: Any, k: int, d2: float) -> None:  # pragma: no cover - compiled
+    """Put ``d2`` into the ascending ``best[:k]`` (the k smallest so far)."""
+    j = k - 1
+    while j > 0 and best[j - 1] > d2:
+        best[j] = best[j - 1]
+        j -= 1
+    best[j] = d2
+
+
+@numba.njit(cache=True, nogil=True)
+def knn(
+    samples: Any, points: Any, boxes: Any, offsets: Any, k: int
+) -> tuple[Any, Any, Any, Any]:  # pragma: no cover - compiled
+    """The ``k`` nearest of ``points`` to each sample, as scipy's k-d tree finds them.
+
+    Args:
+        samples: ``(N, 2)`` query points.
+        points: ``(P, 2)`` the ends.
+        boxes: :func:`build`'s boxes of ``points``.
+        offsets: :func:`build`'s level offsets.
+        k: neighbours, ``1 <= k <= P``.
+
+    Returns:
+        ``r0`` ``(N,)`` the nearest end's squared distance and ``rk`` ``(N,)`` the k-th's
+        (as the k-d tree computes them, before its square root), ``index`` ``(N, k)`` the
+        ``k`` nearest ends, and ``state`` ``(N,)``: 0 where they are the only ``k``
+        within ``rk`` (the k-d tree's set), 1 where more ends lie exactly at ``rk``
+        (which of them the k-d tree keeps is its own choice: see :func:`within`).
+    """
+    n = len(samples)
+    r0 = np.empty(n, dtype=np.float64)
+    rk = np.empty(n, dtype=np.float64)
+    index = np.zeros((n, k), dtype=np.int64)
+    state = np.zeros(n, dtype=np.int8)
+    top = len(offsets) - 2  # the root's level
+    stack_level = np.empty(64 * FAN, dtype=np.int64)
+    stack_node = np.empty(64 * FAN, dtype=np.int64)
+    best = np.empty(k, dtype=np.float64)
+    found = np.empty(CAP, dtype=np.int64)
+    found2 = np.empty(CAP, dtype=np.float64)
+    child = np.empty(FAN, dtype=np.int64)
+    child2 = np.empty(FAN, dtype=np.float64)
+    npts = len(points)
+    last = 0
+    for q in range(n):
+        qx = samples[q, 0]
+        qy = samples[q, 1]
+        # a bound to start from: the k-th nearest of the leaves around the last
+        # query's nearest end (queries come along a path: it is near)
+        for j in range(k):
+            best[j] = np.inf
+        leaf = last // LEAF
+        for i in range(max(0, (leaf - 1) * LEAF), min(npts, (leaf + 2) * LEAF)):
+            d2 = _point2(points, i, qx, qy)
+            if d2 < best[k - 1]:
+                _insert(best, k, d2)
+        warm = best[k - 1]  # >= the k-th smallest of all: prunes nothing it needs
+        for j in range(k):
+            best[j] = np.inf
+        nearest = -1
+        count = 0  # ends kept within the bound at the time (every one within the k-th is)
+        spill = False
+        stack_level[0] = top
+        stack_node[0] = 0
+        sp = 1
+        while sp > 0:
+            sp -= 1
+            level = stack_level[sp]
+            node = stack_node[sp]
+            bound = min(best[k - 1], warm)
+            if _box2(boxes, offsets[level] + node, qx, qy) > bound:
+                continue
+            if level == 0:
+                lo = node * LEAF
+                hi = min(npts, lo + LEAF)
+                for i in range(lo, hi):
+                    d2 = _point2(points, i, qx, qy)
+                    if d2 < best[k - 1]:
+                        if d2 < best[0]:
+                            nearest = i
+                        _insert(best, k, d2)
+                    bound = min(best[k - 1], warm)
+                    if d2 <= bound:
+                        if count == CAP:  # drop what the bound has passed
+                            kept = 0
+                            for j in range(count):
+                                if found2[j] <= bound:
+                                    found[kept] = found[j]
+                                    found2[kept] = found2[j]
+                                    kept += 1
+                            count = kept
+                        if count < CAP:
+                            found[count] = i
+                            found2[count] = d2
+                            count += 1
+                        else:
+                            spill = True
+                continue
+            below = offsets[level - 1]
+            count_below = offsets[level] - below
+            lo = node * FAN
+            hi = min(count_below, lo + FAN)
+            m = 0
+            for c in range(lo, hi):
+                c2 = _box2(boxes, below + c, qx, qy)
+                if c2 <= bound:
+                    # insertion, farthest first: the nearest child is popped first
+                    j = m
+                    while j > 0 and child2[j - 1] < c2:
+                        child2[j] = child2[j - 1]
+                        child[j] = child[j - 1]
+                        j -= 1
+                    child2[j] = c2
+                    child[j] = c
+                    m += 1
+            for j in range(m):
+                stack_level[sp] = level - 1
+                stack_node[sp] = child[j]
+                sp += 1
+        kth = best[k - 1]
+        if nearest >= 0:
+            last = nearest
+        r0[q] = best[0]
+        rk[q] = kth
+        within_k = 0
+        for j in range(count):
+            if found2[j] <= kth:
+                if within_k < k:
+                    index[q, within_k] = found[j]
+                within_k += 1
+        if spill or within_k != k:
+            state[q] = 1
+    return r0, rk, index, state
+
+
+@numba.njit(cache=True, nogil=True)
+def within(
+    samples: Any, points: Any, boxes: Any, offsets: Any, bound2: Any
+) -> tuple[Any, Any, Any]:  # pragma: no cover - compiled
+    """Every end within ``bound2[i]`` (squared distance, inclusive) of each sample.
+
+    Returns:
+        ``found`` ``(N, CAP)`` ends, ``d2`` ``(N, CAP)`` their squared distances (as
+        scipy computes them) and ``count`` ``(N,)`` how many there are (``> CAP``: only
+        the first ``CAP`` are given).
+    """
+    n = len(samples)
+    found = np.zeros((n, CAP), dtype=np.int64)
+    found2 = np.full((n, CAP), np.inf)
+    count = np.zeros(n, dtype=np.int64)
+    top = len(offsets) - 2
+    stack_level = np.empty(64 * FAN, dtype=np.int64)
+    stack_node = np.empty(64 * FAN, dtype=np.int64)
+    npts = len(points)
+    for q in range(n):
+        qx = samples[q, 0]
+        qy = samples[q, 1]
+        bound = bound2[q]
+        c = 0
+        stack_level[0] = top
+        stack_node[0] = 0
+        sp = 1
+        while sp > 0:
+            sp -= 1
+            level = stack_level[sp]
+            node = stack_node[sp]
+            if _box2(boxes, offsets[level] + node, qx, qy) > bound:
+                continue
+            if level == 0:
+                for i in range(node * LEAF, min(npts, node * LEAF + LEAF)):
+                    d2 = _point2(points, i, qx, qy)
+                    if d2 <= bound:
+                        if c < CAP:
+                            found[q, c] = i
+                            found2[q, c] = d2
+                        c += 1
+                continue
+            below = offsets[level - 1]
+            count_below = offsets[level] - below
+            for ch in range(node * FAN, min(count_below, node * FAN + FAN)):
+                if _box2(boxes, below + ch, qx, qy) <= bound:
+                    stack_level[sp] = level - 1
+                    stack_node[sp] = ch
+                    sp += 1
+        count[q] = c
+    return found, found2, count
+
+
+@numba.njit(cache=True, nogil=True)
+def pairs_within(
+    samples: Any, points: Any, boxes: Any, offsets: Any, reach: Any, limit: int
+) -> tuple[Any, Any]:  # pragma: no cover - compiled
+    """Every ``(sample, end)`` pair closer than ``reach[sample]`` (or at it), sample-major.
+
+    Args:
+        samples: ``(N, 2)`` query points.
+        points: ``(P, 2)`` the ends.
+        boxes: :func:`build`'s boxes of ``points``.
+        offsets: :func:`build`'s level offsets.
+        reach: ``(N,)`` distances.
+        limit: most pairs; beyond it none are given.
+
+    Returns:
+        ``owner`` and ``end`` ``(K,)`` of each pair; both empty when over ``limit``.
+    """
+    n = len(samples)
+    counts = np.zeros(n, dtype=np.int64)
+    total = 0
+    for fill in range(2):
+        if fill == 1:
+            owner = np.empty(total, dtype=np.int64)
+            end = np.empty(total, dtype=np.int64)
+        else:
+            owner = np.empty(0, dtype=np.int64)
+            end = np.empty(0, dtype=np.int64)
+        at = 0
+        top = len(offsets) - 2
+        stack_level = np.empty(64 * FAN, dtype=np.int64)
+        stack_node = np.empty(64 * FAN, dtype=np.int64)
+        npts = len(points)
+        for q in range(n):
+            qx = samples[q, 0]
+            qy = samples[q, 1]
+            bound = reach[q] * reach[q]
+            c = 0
+            stack_level[0] = top
+            stack_node[0] = 0
+            sp = 1
+            while sp > 0:
+                sp -= 1
+                level = stack_level[sp]
+                node = stack_node[sp]
+                if _box2(boxes, offsets[level] + node, qx, qy) > bound:
+                    continue
+                if level == 0:
+                    for i in range(node * LEAF, min(npts, node * LEAF + LEAF)):
+                        if _point2(points, i, qx, qy) <= bound:
+                            if fill == 1:
+                                owner[at] = q
+                                end[at] = i
+                                at += 1
+                            c += 1
+                    continue
+                below = offsets[level - 1]
+                count_below = offsets[level] - below
+                for ch in range(node * FAN, min(count_below, node * FAN + FAN)):
+                    if _box2(boxes, below + ch, qx, qy) <= bound:
+                        stack_level[sp] = level - 1
+                        stack_node[sp] = ch
+                        sp += 1
+            counts[q] = c
+            if fill == 0:
+                total += c
+                if total > limit:
+                    return np.empty(0, dtype=np.int64), np.empty(0, dtype=np.int64)
+    return owner, end

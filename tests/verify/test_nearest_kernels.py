@@ -1,0 +1,150 @@
+"""The compiled nearest-end search gives what the k-d tree path gives, bit for bit (issue 17).
+
+:func:`camtool.verify.metrics.nearest_distances` (numba box tree,
+:mod:`camtool.verify.nearkernels`) against :func:`~camtool.verify.metrics.nearest_distances_kd`
+(scipy's k-d tree, the code it replaces) on many random inputs built to tie: traces on a
+step grid, samples on the same grid, traces cut in several identical passes (every end
+repeated), samples far from the trace (a drawing point a tool radius away). Equality is
+``==`` of the float64 bits, not approximate: the reports are written from these values.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.spatial import cKDTree
+
+from camtool.verify import metrics
+
+nearkernels = pytest.importorskip("camtool.verify.nearkernels")
+
+
+@pytest.fixture(autouse=True)
+def _compiled() -> None:
+    """The compiled search in use from the first call (the default threshold is a load)."""
+    assert metrics.near_kernels() is nearkernels
+
+
+def _trace(rng: np.random.Generator, kind: int) -> np.ndarray:
+    """A staircase or an arc on a step grid, sometimes repeated in passes."""
+    n = int(rng.integers(3, 3000))
+    step = (0.004, 0.0005, 0.25, 0.001)[kind % 4]
+    if kind % 2:
+        pts = np.cumsum(rng.choice([-step, 0.0, step], size=(n, 2)), axis=0)
+    else:
+        angle = np.linspace(0.0, rng.uniform(1.0, 7.0), n)
+        radius = rng.uniform(0.1, 3.0)
+        pts = np.c_[radius * np.cos(angle), radius * np.sin(angle)]
+        pts = np.round((pts + rng.normal(0, step / 4, (n, 2))) / step) * step
+    passes = int(rng.integers(1, 4))
+    return np.concatenate([pts] * passes)
+
+
+def _samples(rng: np.random.Generator, pts: np.ndarray, n: int, reach: float) -> np.ndarray:
+    """Points on the trace's grid, half steps off it, a ``reach`` away and anywhere."""
+    step = float(np.min(np.abs(np.diff(pts, axis=0))[np.abs(np.diff(pts, axis=0)) > 0]))
+    pick = pts[rng.integers(0, len(pts), n)]
+    out = [
+        pick[: n // 4] + rng.integers(-3, 4, (n // 4, 2)) * step,
+        pick[n // 4 : n // 2] + rng.choice([0.0, step / 2, -step / 2], size=(n // 2 - n // 4, 2)),
+    ]
+    angle = rng.uniform(0, 2 * np.pi, n // 4)
+    out.append(pick[: n // 4] + reach * np.c_[np.cos(angle), np.sin(angle)])
+    lo, hi = pts.min(axis=0) - reach, pts.max(axis=0) + reach
+    out.append(rng.uniform(lo, hi, (n - n // 2 - n // 4, 2)))
+    samples = np.concatenate(out)
+    # queries come along a path, as the verifier makes them
+    return samples[np.argsort(samples[:, 0] + samples[:, 1], kind="stable")]
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_nearest_distances_equal_the_kd_tree_path_bit_for_bit(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    for kind in range(12):
+        pts = _trace(rng, kind)
+        a, b = pts[:-1], pts[1:]
+        samples = _samples(rng, pts, 2000, reach=float(rng.choice([0.0015, 0.1, 1.5])))
+        got = metrics.nearest_distances(samples, a, b)
+        want = metrics.nearest_distances_kd(samples, a, b)
+        assert np.array_equal(got.view(np.int64), want.view(np.int64))
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_knn_finds_the_kd_trees_ends_where_they_are_one_set(seed: int) -> None:
+    rng = np.random.default_rng(100 + seed)
+    for kind in range(12):
+        pts = _trace(rng, kind)
+        points = np.concatenate([pts[:-1], pts[1:]])
+        samples = _samples(rng, pts, 2000, reach=0.5)
+        boxes, offsets = nearkernels.build(points)
+        for k in (1, 4, 7):
+            r0, rk, index, state = nearkernels.knn(samples, points, boxes, offsets, k)
+            r, want = cKDTree(points).query(samples, k=k)
+            r = np.asarray(r).reshape(len(samples), k)
+            want = np.asarray(want).reshape(len(samples), k)
+            assert np.array_equal(np.sqrt(r0), r[:, 0])  # the k-d tree's own distances
+            assert np.array_equal(np.sqrt(rk), r[:, -1])
+            one = state == 0
+            assert np.array_equal(np.sort(index[one], axis=1), np.sort(want[one], axis=1))
+            # where not one set, every end the k-d tree chose is within the k-th distance
+            found, _, count = nearkernels.within(samples[~one], points, boxes, offsets, rk[~one])
+            for row, chosen in enumerate(want[~one]):
+                if count[row] <= found.shape[1]:
+                    assert set(chosen.tolist()) <= set(found[row, : count[row]].tolist())
+
+
+def test_knn_on_a_line_of_repeated_ends_far_away() -> None:
+    """Six copies of every end (two per vertex, three passes) 1.5 mm from the samples."""
+    x = np.arange(0.0, 20.0, 0.004)
+    line = np.c_[x, np.zeros_like(x)]
+    pts = np.concatenate([line] * 3)
+    samples = np.c_[np.arange(0.0, 20.0, 0.005), np.full(4000, 1.5)]
+    got = metrics.nearest_distances(samples, pts[:-1], pts[1:])
+    want = metrics.nearest_distances_kd(samples, pts[:-1], pts[1:])
+    assert np.array_equal(got, want)
+    assert np.allclose(got, 1.5, atol=1e-12)  # the line is 1.5 mm away everywhere
+
+
+def test_small_inputs_take_the_kd_tree_path() -> None:
+    a = np.array([[0.0, 0.0]])
+    b = np.array([[1.0, 0.0]])
+    samples = np.array([[0.5, 1.0], [2.0, 0.0]])
+    assert np.array_equal(metrics.nearest_distances(samples, a, b), [1.0, 1.0])
+    assert np.array_equal(
+        metrics.nearest_distances(samples, np.zeros((0, 2)), np.zeros((0, 2))), [np.inf] * 2
+    )
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_nearby_boxes_is_the_kd_tree_nearby_query_bit_for_bit(seed: int) -> None:
+    """The same GEOS minimum as :func:`~camtool.verify.metrics._nearby_exact`.
+
+    (Not always :func:`~camtool.verify.metrics._all_exact`'s: with a segment 2.3 mm long
+    joining two passes, GEOS's tree query and its plain distance were seen 1 ulp apart.)
+    """
+    rng = np.random.default_rng(200 + seed)
+    for kind in range(12):
+        pts = _trace(rng, kind)
+        a, b = pts[:-1], pts[1:]
+        samples = _samples(rng, pts, 400, reach=float(rng.choice([0.0015, 1.5])))
+        half = float(np.max(np.hypot(*(b - a).T))) / 2.0
+        ends = cKDTree(np.concatenate([a, b]))
+        upper, _ = metrics._nearest_chunk(samples, a, b, ends, half)
+        points = np.concatenate([a, b])
+        boxes, offsets = nearkernels.build(points)
+        tree = (points, boxes, offsets)
+        fast = metrics._nearby_boxes(samples, upper, a, b, tree, half, nearkernels)
+        assert fast is not None
+        assert np.array_equal(fast, metrics._nearby_exact(samples, upper, a, b, ends, half))
+
+
+def test_nearby_boxes_gives_way_over_the_pair_limit(monkeypatch: pytest.MonkeyPatch) -> None:
+    pts = _trace(np.random.default_rng(3), 1)
+    a, b = pts[:-1], pts[1:]
+    points = np.concatenate([a, b])
+    boxes, offsets = nearkernels.build(points)
+    samples = pts[:50] + 0.001
+    upper = np.full(50, 0.01)
+    monkeypatch.setattr(metrics, "NEARBY_MAX_PAIRS", 10)
+    tree = (points, boxes, offsets)
+    assert metrics._nearby_boxes(samples, upper, a, b, tree, 0.002, nearkernels) is None
