@@ -738,10 +738,18 @@ def _nearby_exact(
     counts = np.asarray(near, dtype=np.int64)
     if counts.min() == 0:
         return None  # cannot happen (the segment of ``upper`` is within reach): be safe
-    found = ends.query_ball_point(samples, reach, workers=KD_WORKERS)
-    owner = np.repeat(np.arange(len(samples)), counts)
-    seg = np.fromiter(itertools.chain.from_iterable(found), dtype=np.int64, count=len(owner))
-    return _nearby_min(samples, owner, seg, a, b)
+    out = np.empty(len(samples), dtype=np.float64)
+    ends_before = np.concatenate([[0], np.cumsum(counts)])
+    lo = 0
+    while lo < len(samples):  # a few samples at a time: their lists of ends are Python ints
+        hi = int(np.searchsorted(ends_before, ends_before[lo] + NEARBY_CHUNK_PAIRS, "right")) - 1
+        hi = min(max(hi, lo + 1), len(samples))
+        found = ends.query_ball_point(samples[lo:hi], reach[lo:hi], workers=KD_WORKERS)
+        owner = np.repeat(np.arange(lo, hi), counts[lo:hi])
+        seg = np.fromiter(itertools.chain.from_iterable(found), dtype=np.int64, count=len(owner))
+        out[lo:hi] = _nearby_min(samples, owner, seg, a, b)[lo:hi]
+        lo = hi
+    return out
 
 
 def _nearby_boxes(
@@ -777,10 +785,43 @@ def _nearby_boxes(
     return _nearby_min(samples, owner, seg, a, b)
 
 
+NEARBY_CHUNK_PAIRS = 50_000
+"""Most ``(sample, segment)`` pairs :func:`_nearby_min` hands GEOS at once (memory)."""
+
+
 def _nearby_min(
+    samples: FloatArray,
+    owner: IntArray,
+    seg: IntArray,
+    a: FloatArray,
+    b: FloatArray,
+    chunk: int = NEARBY_CHUNK_PAIRS,
+) -> FloatArray:
+    """The least GEOS distance of each sample over its ``(owner, end)`` pairs (sample-major).
+
+    ``owner`` is ascending and names every sample at least once. The pairs are measured
+    a few samples at a time (about ``chunk`` pairs, a sample's pairs never split), which
+    bounds the memory GEOS's points and lines take; each pair's distance and each
+    sample's minimum are the same whatever the grouping.
+    """
+    out = np.empty(len(samples), dtype=np.float64)
+    pos, count = 0, len(owner)
+    while pos < count:
+        end = min(pos + max(1, chunk), count)
+        if end < count:  # back to the first pair of the sample ``end`` falls in
+            end = int(np.searchsorted(owner, owner[end], side="left"))
+            if end <= pos:  # one sample has more pairs than ``chunk``: take them all
+                end = int(np.searchsorted(owner, owner[pos], side="right"))
+        first, last = int(owner[pos]), int(owner[end - 1])
+        out[first : last + 1] = _nearby_group(samples, owner[pos:end], seg[pos:end], a, b)
+        pos = end
+    return out
+
+
+def _nearby_group(
     samples: FloatArray, owner: IntArray, seg: IntArray, a: FloatArray, b: FloatArray
 ) -> FloatArray:
-    """The least GEOS distance of each sample over its ``(owner, end)`` pairs (sample-major)."""
+    """:func:`_nearby_min` of consecutive samples ``owner[0]..owner[-1]`` (each with a pair)."""
     import shapely
 
     seg = seg % len(a)
@@ -788,7 +829,9 @@ def _nearby_min(
     owner, seg = pair // len(a), pair % len(a)
     used, local = np.unique(seg, return_inverse=True)
     lines = shapely.linestrings(np.stack([a[used], b[used]], axis=1))
-    dist = shapely.distance(shapely.points(samples)[owner], lines[local])
+    first_sample = int(owner[0])
+    points = shapely.points(samples[first_sample : int(owner[-1]) + 1])
+    dist = shapely.distance(points[owner - first_sample], lines[local])
     first = np.flatnonzero(np.r_[True, owner[1:] != owner[:-1]])
     return np.asarray(np.minimum.reduceat(dist, first), dtype=np.float64)
 
@@ -962,8 +1005,10 @@ STREAM_SAMPLES = 100_000
 """Path samples :class:`TraceStream` measures against a contour's trace at once: the
 distance of each is found alone (:func:`nearest_distances`), so the pieces give the same
 distances as one call, with about 30 MB less held on the bench program."""
-PICTURE_ROWS = 200_000
-"""About how many rows of a streamed trace :class:`TraceStream` keeps for the picture."""
+PICTURE_ROWS = 100_000
+"""About how many rows of a streamed trace :class:`TraceStream` keeps for the picture
+(on the 10 mm wide 13 M-row benchmark program, a kept row about every 20 µm of path,
+a few pixels of a preview; the worst point is always kept)."""
 
 
 @dataclass(frozen=True, eq=False)

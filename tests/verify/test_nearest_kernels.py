@@ -148,3 +148,51 @@ def test_nearby_boxes_gives_way_over_the_pair_limit(monkeypatch: pytest.MonkeyPa
     monkeypatch.setattr(metrics, "NEARBY_MAX_PAIRS", 10)
     tree = (points, boxes, offsets)
     assert metrics._nearby_boxes(samples, upper, a, b, tree, 0.002, nearkernels) is None
+
+
+@pytest.mark.parametrize("chunk", [1, 2, 5, 37, 1000])
+def test_nearby_min_in_groups_is_the_whole_pairs_answer_bit_for_bit(chunk: int) -> None:
+    """Measuring the pairs a few samples at a time changes no distance and no minimum.
+
+    The reference is the one-group answer, computed here independently of
+    :func:`metrics._nearby_min`: GEOS's distance of every pair, the least per sample.
+    """
+    import shapely
+
+    rng = np.random.default_rng(17 + chunk)
+    samples = rng.uniform(0.0, 5.0, (60, 2))
+    a = rng.uniform(0.0, 5.0, (40, 2))
+    b = a + rng.normal(0.0, 0.3, (40, 2))
+    counts = rng.integers(1, 9, len(samples))  # every sample has a pair, some have many
+    owner = np.repeat(np.arange(len(samples)), counts)
+    seg = rng.integers(0, 2 * len(a), len(owner))  # ends of either side, repeats included
+    lines = shapely.linestrings(np.stack([a, b], axis=1))
+    pair_d = shapely.distance(shapely.points(samples)[owner], lines[seg % len(a)])
+    expected = np.array([pair_d[owner == i].min() for i in range(len(samples))])
+    got = metrics._nearby_min(samples, owner, seg, a, b, chunk=chunk)
+    assert got.tobytes() == expected.tobytes()
+
+
+@pytest.mark.parametrize("chunk", [1, 3, 50])
+def test_nearby_exact_in_groups_is_geos_over_all_segments(
+    chunk: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The k-d tree's nearby pairs, asked a few samples at a time, give GEOS's exact minimum.
+
+    The reference is :func:`metrics._all_exact` (GEOS's nearest query over every segment)
+    on a staircase trace of 1 µm steps with a far-off pass, where the upper bounds are the
+    distances to the first segment (loose, so many pairs per sample).
+    """
+    monkeypatch.setattr(metrics, "NEARBY_CHUNK_PAIRS", chunk)
+    rng = np.random.default_rng(chunk)
+    steps = rng.integers(0, 2, (400, 2)) * 0.001
+    trace = np.cumsum(steps, axis=0)
+    a, b = trace[:-1], trace[1:]
+    samples = trace[rng.integers(0, len(trace), 40)] + rng.normal(0.0, 0.002, (40, 2))
+    upper = metrics._to_segments(
+        samples, a[:1][None, :, :].repeat(40, 0), b[:1][None, :, :].repeat(40, 0)
+    )[:, 0]
+    half = float(np.max(np.hypot(*(b - a).T))) / 2.0
+    got = metrics._nearby_exact(samples, upper, a, b, cKDTree(np.concatenate([a, b])), half)
+    assert got is not None
+    assert got.tobytes() == metrics._all_exact(samples, a, b).tobytes()
