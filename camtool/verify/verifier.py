@@ -718,7 +718,7 @@ def summary_lines(v: Verification) -> list[str]:
     ]
     if v.along is not None:
         lines.append(_along_text(v, v.along))
-    for c in v.contours:
+    for shown, c in enumerate(v.contours, 1):
         ex, ey = c.size_error_um
         text = f"  contour {c.number}: size error {_signed(ex)} x {_signed(ey)} µm"
         if c.closure_um is not None:
@@ -727,7 +727,8 @@ def summary_lines(v: Verification) -> list[str]:
             text += f", diameter {fmt_num(c.circle[1])} mm (nominal {fmt_num(c.circle[0])})"
         lines.append(text)
         if len(lines) > 14:
-            lines.append(f"  ... {len(v.contours) - c.number} more contours in the report")
+            if len(v.contours) > shown:
+                lines.append(f"  ... {len(v.contours) - shown} more contours in the report")
             break
     if v.against is not None:
         a = v.against

@@ -166,3 +166,32 @@ def test_exit_codes(
     assert code == exit_code and out == ""
     assert message in err
     assert "Traceback" not in err
+
+
+def _squares(count: int) -> str:
+    """A GRBL program cutting ``count`` separate 1 mm squares, each its own contour."""
+    out = ["G21 G90 G94 G17", "G0 Z5"]
+    for k in range(count):
+        x = 3.0 * k
+        out += [f"G0 X{x:.3f} Y0", "G1 Z-0.5 F100"]
+        out += [f"G1 X{x + 1:.3f} Y0", f"G1 X{x + 1:.3f} Y1", f"G1 X{x:.3f} Y1", f"G1 X{x:.3f} Y0"]
+        out += ["G0 Z5"]
+    return "\n".join([*out, "M2"]) + "\n"
+
+
+@pytest.mark.parametrize(("count", "more"), [(10, None), (12, 2)])
+def test_summary_counts_the_contours_it_leaves_out(
+    count: int, more: int | None, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The stderr summary lists 10 contours; the rest are counted, and "0 more" is never said."""
+    program = tmp_path / "squares.gcode"
+    program.write_text(_squares(count))
+    code, _, err = run(["verify", str(program), "-t", "grbl"], capsys)
+    assert code == 0
+    listed = [line for line in err.splitlines() if line.startswith("camtool:   contour ")]
+    tail = [line for line in err.splitlines() if "more contours in the report" in line]
+    assert len(listed) == min(count, 10)
+    if more is None:
+        assert tail == []
+    else:
+        assert tail == [f"camtool:   ... {more} more contours in the report"]
