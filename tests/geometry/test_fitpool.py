@@ -7,6 +7,7 @@ for): the pool must change the speed only, so every segment must be the same, fl
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import pytest
@@ -43,10 +44,21 @@ def test_parallel_fits_equal_serial_fits(monkeypatch: pytest.MonkeyPatch) -> Non
     """300 random Béziers and elliptical arcs: the workers' fits are the serial fits."""
     monkeypatch.setattr(fitpool, "MIN_CURVES", 1)
     monkeypatch.setattr(fitpool, "_CHUNK", 7)  # many chunks, gathered in order
+    pooled: list[bool] = []
+    in_pool = fitpool._in_pool
+
+    def spy(*args: Any) -> Any:
+        out = in_pool(*args)
+        pooled.append(out is not None)
+        return out
+
+    monkeypatch.setattr(fitpool, "_in_pool", spy)
     keys = _keys(300)
     serial = [fit_key(k, 0.01) for k in keys]
     assert repr(fit_many(keys, 0.01, jobs=2)) == repr(serial)
+    assert pooled == [True]  # the workers answered (not the serial fallback)
     assert repr(fit_many(keys, 0.01, jobs=1)) == repr(serial)
+    assert pooled == [True]  # one job: no pool
 
 
 def test_a_fit_that_raises_is_none_and_the_others_stay(monkeypatch: pytest.MonkeyPatch) -> None:

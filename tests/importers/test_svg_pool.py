@@ -8,6 +8,7 @@ error the same message.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -50,7 +51,17 @@ def test_read_svg_with_workers_equals_without(
     monkeypatch.setattr(svg_module, "MIN_CURVES", 1)
     monkeypatch.setattr(fitpool, "MIN_CURVES", 1)
     monkeypatch.setattr(fitpool, "_CHUNK", 5)
+    pooled: list[bool] = []
+    in_pool = fitpool._in_pool
+
+    def spy(*args: Any) -> Any:
+        out = in_pool(*args)
+        pooled.append(out is not None)
+        return out
+
+    monkeypatch.setattr(fitpool, "_in_pool", spy)
     assert repr(read_svg(path)) == repr(serial)
+    assert pooled == [True]  # the fits came from the workers, not the serial fallback
 
 
 def test_read_svg_with_workers_raises_the_serial_error(
