@@ -745,9 +745,9 @@ def _nearby_exact(
         hi = int(np.searchsorted(ends_before, ends_before[lo] + NEARBY_CHUNK_PAIRS, "right")) - 1
         hi = min(max(hi, lo + 1), len(samples))
         found = ends.query_ball_point(samples[lo:hi], reach[lo:hi], workers=KD_WORKERS)
-        owner = np.repeat(np.arange(lo, hi), counts[lo:hi])
+        owner = np.repeat(np.arange(hi - lo), counts[lo:hi])
         seg = np.fromiter(itertools.chain.from_iterable(found), dtype=np.int64, count=len(owner))
-        out[lo:hi] = _nearby_min(samples, owner, seg, a, b)[lo:hi]
+        out[lo:hi] = _nearby_min(samples[lo:hi], owner, seg, a, b)
         lo = hi
     return out
 
