@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from functools import partial
 from types import ModuleType
@@ -1103,25 +1103,51 @@ def _sample_moves(
     program: Program, starts: list[Point], first: int, last: int, spacing: float
 ) -> tuple[FloatArray, IntArray]:
     """Points along moves ``first..last`` at most ``spacing`` apart, ends included, and owners."""
-    chunks: list[FloatArray] = []
-    owners: list[IntArray] = []
-    for b in range(first, last + 1):
-        seg = segment_of(starts[b], program.moves[b])
-        n = max(1, math.ceil(seg.length / spacing))
-        t = np.arange(n + 1, dtype=np.float64) / n
-        if isinstance(seg, Arc):
-            r, c = seg.radius, seg.centre
-            angle = math.atan2(seg.start[1] - c[1], seg.start[0] - c[0]) + seg.sweep * t
-            pts = np.column_stack((c[0] + r * np.cos(angle), c[1] + r * np.sin(angle)))
-            pts[-1] = seg.end
-        else:
-            (x0, y0), (x1, y1) = seg.start, seg.end
-            pts = np.column_stack((x0 + (x1 - x0) * t, y0 + (y1 - y0) * t))
-        chunks.append(pts)
-        owners.append(np.full(len(pts), b, dtype=np.int64))
+    chunks = [_sample_move(program, starts, b, spacing) for b in range(first, last + 1)]
     if not chunks:
         return np.zeros((0, 2)), np.zeros(0, dtype=np.int64)
+    owners = [np.full(len(pts), b, dtype=np.int64) for b, pts in enumerate(chunks, first)]
     return np.vstack(chunks), np.concatenate(owners)
+
+
+def _sample_move(program: Program, starts: list[Point], b: int, spacing: float) -> FloatArray:
+    """``(n + 1, 2)`` points along move ``b`` at most ``spacing`` apart, its ends included."""
+    seg = segment_of(starts[b], program.moves[b])
+    n = max(1, math.ceil(seg.length / spacing))
+    t = np.arange(n + 1, dtype=np.float64) / n
+    if isinstance(seg, Arc):
+        r, c = seg.radius, seg.centre
+        angle = math.atan2(seg.start[1] - c[1], seg.start[0] - c[0]) + seg.sweep * t
+        pts = np.column_stack((c[0] + r * np.cos(angle), c[1] + r * np.sin(angle)))
+        pts[-1] = seg.end
+        return pts
+    (x0, y0), (x1, y1) = seg.start, seg.end
+    return np.column_stack((x0 + (x1 - x0) * t, y0 + (y1 - y0) * t))
+
+
+def _sample_batches(
+    program: Program, starts: list[Point], first: int, last: int, spacing: float, size: int
+) -> Iterator[tuple[FloatArray, IntArray]]:
+    """:func:`_sample_moves` in consecutive pieces of ``size`` points (the last shorter).
+
+    The pieces are exactly ``samples[i : i + size]`` (and owners) of the whole arrays,
+    built move by move: never more than a piece and one move's points are held.
+    """
+    held: list[FloatArray] = []
+    owners: list[IntArray] = []
+    count = 0
+    for b in range(first, last + 1):
+        pts = _sample_move(program, starts, b, spacing)
+        held.append(pts)
+        owners.append(np.full(len(pts), b, dtype=np.int64))
+        count += len(pts)
+        while count >= size:
+            samples, owner = np.vstack(held), np.concatenate(owners)
+            yield samples[:size], owner[:size]
+            held, owners = [samples[size:]], [owner[size:]]
+            count -= size
+    if count:
+        yield np.vstack(held), np.concatenate(owners)
 
 
 STREAM_SAMPLES = 100_000
@@ -1420,17 +1446,15 @@ class TraceStream:
                 run_of,
             )
         )
-        samples, owner = _sample_moves(program, starts, c.first, c.last, self.spacing)
-        self.samples += len(samples)
         trace = c.trace()
-        if len(samples) == 0:
-            return
         ends = _trace_ends(trace)  # one k-d tree for every batch (when one is used)
-        for i in range(0, len(samples), STREAM_SAMPLES):  # each sample's distance is its own
-            far, k = _farthest_from_trace(samples[i : i + STREAM_SAMPLES], trace, ends)
+        batches = _sample_batches(program, starts, c.first, c.last, self.spacing, STREAM_SAMPLES)
+        for samples, owner in batches:  # each sample's distance is its own
+            self.samples += len(samples)
+            far, k = _farthest_from_trace(samples, trace, ends)
             if far * 1000.0 > self.worst[0]:
-                at = (float(samples[i + k, 0]), float(samples[i + k, 1]))
-                self.worst = (far * 1000.0, at, int(owner[i + k]))
+                at = (float(samples[k, 0]), float(samples[k, 1]))
+                self.worst = (far * 1000.0, at, int(owner[k]))
 
     def finish(self) -> StreamedMeasures:
         """The measures of the whole trace (after its last chunk)."""

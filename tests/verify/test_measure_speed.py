@@ -235,3 +235,23 @@ def test_farthest_nearest_measures_few_unsure_samples(monkeypatch: pytest.Monkey
     measured.clear()
     assert metrics.farthest_nearest(samples, a, b) == want == (0.5, 300)
     assert every == 299 and sum(measured) == 0
+
+
+@pytest.mark.parametrize("size", [1, 7, 100, 10_000])
+def test_sample_batches_are_the_slices_of_the_whole_samples(size: int) -> None:
+    """The streamed shortfall's path samples, built move by move, are the whole ones sliced."""
+    moves = (
+        Rapid(1.0, 1.0, contour=1),
+        Linear(3.0, 1.5, 300.0, contour=1),
+        ArcMove(3.0, 3.5, 3.0, 2.5, True, 300.0, contour=1),
+        Linear(3.0, 3.5, 300.0, contour=1),  # no length: its two ends
+        Linear(1.0, 1.0, 300.0, contour=1),
+    )
+    program = Program(moves, origin=(0.0, 0.0))
+    starts = [program.origin] + [(m.x, m.y) for m in program.moves]
+    whole, owner = metrics._sample_moves(program, starts, 1, 4, 0.01)
+    pieces = list(metrics._sample_batches(program, starts, 1, 4, 0.01, size))
+    assert [len(p) for p, _ in pieces[:-1]] == [size] * (len(pieces) - 1)
+    assert np.concatenate([p for p, _ in pieces]).tobytes() == whole.tobytes()
+    assert np.array_equal(np.concatenate([o for _, o in pieces]), owner)
+    assert set(owner.tolist()) == {1, 2, 3, 4}
