@@ -607,18 +607,13 @@ def _nearest(
     k = NEAREST_ENDS
     for i in range(0, len(samples), NEAREST_CHUNK):
         chunk = samples[i : i + NEAREST_CHUNK]
-        r0_2, rk_2, index, state = kernels.knn(chunk, points, boxes, offsets, k)
+        near, r0_2, rk_2, ask = kernels.near_segments(chunk, points, boxes, offsets, a, b, k)
         r0, rk = np.sqrt(r0_2), np.sqrt(rk_2)  # what the k-d tree gives: the same sqrt
-        seg = index % len(a)
-        near = _to_segments(chunk, a[seg], b[seg]).min(axis=1)
-        tied = state != 0
-        if tied.any():  # several ends at the k-th distance: does the k-d tree's choice matter?
-            near[tied], asks = _tied(chunk[tied], rk_2[tied], a, b, points, boxes, offsets, kernels)
-            if asks.any():  # it does: ask the k-d tree
-                rows = np.flatnonzero(tied)[asks]
-                found = ends.tree.query(chunk[rows], k=k, workers=KD_WORKERS)[1]
-                s = np.asarray(found).reshape(-1, k) % len(a)
-                near[rows] = _to_segments(chunk[rows], a[s], b[s]).min(axis=1)
+        if ask.any():  # ends tie at the k-th distance and the k-d tree's choice matters
+            rows = np.flatnonzero(ask)
+            found = ends.tree.query(chunk[rows], k=k, workers=KD_WORKERS)[1]
+            s = np.asarray(found).reshape(-1, k) % len(a)
+            near[rows] = _to_segments(chunk[rows], a[s], b[s]).min(axis=1)
         lower = np.sqrt(np.maximum(r0**2 - half * half, 0.0))
         sure = (near + half < rk) | (near - lower <= NEAREST_TOLERANCE_MM)
         d[i : i + len(chunk)] = near
@@ -631,6 +626,32 @@ def _nearest(
             exact = _all_exact_where(samples[unsure], d[unsure], a, b, need)
         d[unsure] = exact
     return d
+
+
+def _near_segments_numpy(
+    chunk: FloatArray,
+    a: FloatArray,
+    b: FloatArray,
+    points: FloatArray,
+    boxes: Any,
+    offsets: Any,
+    kernels: ModuleType,
+) -> tuple[FloatArray, FloatArray, FloatArray, npt.NDArray[np.bool_]]:
+    """:func:`camtool.verify.nearkernels.near_segments` with numpy's segment distances.
+
+    The form it replaced (its :func:`_tied` and :func:`_to_segments` in numpy), kept
+    as the tests' reference: the same ``near``, ``r0_2``, ``rk_2`` and ``ask``.
+    """
+    k = NEAREST_ENDS
+    r0_2, rk_2, index, state = kernels.knn(chunk, points, boxes, offsets, k)
+    seg = index % len(a)
+    near = _to_segments(chunk, a[seg], b[seg]).min(axis=1)
+    ask = np.zeros(len(chunk), dtype=bool)
+    tied = state != 0
+    if tied.any():
+        near[tied], asks = _tied(chunk[tied], rk_2[tied], a, b, points, boxes, offsets, kernels)
+        ask[np.flatnonzero(tied)[asks]] = True
+    return near, r0_2, rk_2, ask
 
 
 def _tied(

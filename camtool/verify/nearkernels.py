@@ -22,6 +22,7 @@ This module imports numba, so it is imported lazily
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numba
@@ -371,3 +372,133 @@ def pairs_within(
                 if total > limit:
                     return np.empty(0, dtype=np.int64), np.empty(0, dtype=np.int64)
     return owner, end
+
+
+@numba.njit(inline="always")
+def _segment(px: float, py: float, a: Any, b: Any, s: int) -> float:  # pragma: no cover - compiled
+    """Distance of ``(px, py)`` to segment ``a[s] → b[s]``, the floats of numpy's form.
+
+    :func:`camtool.verify.metrics._to_segments` step for step: ``t`` the projection
+    clipped to ``[0, 1]`` (0 for a point segment), then the length of ``ap − t·ab``;
+    each product and sum as numpy takes them (two-term sums, no fused multiply-add).
+    """
+    abx = b[s, 0] - a[s, 0]
+    aby = b[s, 1] - a[s, 1]
+    apx = px - a[s, 0]
+    apy = py - a[s, 1]
+    length2 = abx * abx + aby * aby
+    t = 0.0
+    if length2 > 0:
+        t = (apx * abx + apy * aby) / length2
+    t = min(max(t, 0.0), 1.0)
+    offx = apx - t * abx
+    offy = apy - t * aby
+    return math.sqrt(offx * offx + offy * offy)
+
+
+@numba.njit(cache=True, nogil=True)
+def near_segments(
+    samples: Any, points: Any, boxes: Any, offsets: Any, a: Any, b: Any, k: int
+) -> tuple[Any, Any, Any, Any]:  # pragma: no cover - compiled
+    """The k-d tree path's distance to the segments of the ``k`` nearest ends, in one pass.
+
+    For each sample, :func:`knn`'s ``k`` nearest ends (``points`` is ``concatenate([a,
+    b])``: end ``i`` belongs to segment ``i % len(a)``) and the least distance to their
+    segments (:func:`_segment`). Where ends tie at the k-th distance the k-d tree keeps
+    some of them; as :func:`camtool.verify.metrics._tied` does, every end within the
+    k-th distance is found (:func:`within`'s search), and when any choice the k-d tree
+    could make gives the same least distance it is that one; else ``ask`` (the caller
+    asks the k-d tree).
+
+    Returns:
+        ``near`` ``(N,)`` (unset where ``ask``), ``r0_2`` and ``rk_2`` ``(N,)`` as
+        :func:`knn` gives them, ``ask`` ``(N,)`` bool.
+    """
+    n = len(samples)
+    m = len(a)
+    r0_2, rk_2, index, state = knn(samples, points, boxes, offsets, k)
+    near = np.empty(n, dtype=np.float64)
+    ask = np.zeros(n, dtype=np.bool_)
+    top = len(offsets) - 2
+    stack_level = np.empty(64 * FAN, dtype=np.int64)
+    stack_node = np.empty(64 * FAN, dtype=np.int64)
+    npts = len(points)
+    for q in range(n):
+        qx = samples[q, 0]
+        qy = samples[q, 1]
+        if state[q] == 0:
+            least = np.inf
+            for j in range(k):
+                least = min(least, _segment(qx, qy, a, b, index[q, j] % m))
+            near[q] = least
+            continue
+        # ties at the k-th distance: every end within it, as _tied() measures them
+        kth2 = rk_2[q]
+        low = np.inf
+        low_nearer = np.inf
+        nearer = 0
+        at = 0
+        count = 0
+        stack_level[0] = top
+        stack_node[0] = 0
+        sp = 1
+        while sp > 0:
+            sp -= 1
+            level = stack_level[sp]
+            node = stack_node[sp]
+            if _box2(boxes, offsets[level] + node, qx, qy) > kth2:
+                continue
+            if level == 0:
+                for i in range(node * LEAF, min(npts, node * LEAF + LEAF)):
+                    d2 = _point2(points, i, qx, qy)
+                    if d2 <= kth2:
+                        count += 1
+                        value = _segment(qx, qy, a, b, i % m)
+                        low = min(low, value)
+                        if d2 < kth2:
+                            nearer += 1
+                            low_nearer = min(low_nearer, value)
+                        else:
+                            at += 1
+                continue
+            below = offsets[level - 1]
+            count_below = offsets[level] - below
+            for ch in range(node * FAN, min(count_below, node * FAN + FAN)):
+                if _box2(boxes, below + ch, qx, qy) <= kth2:
+                    stack_level[sp] = level - 1
+                    stack_node[sp] = ch
+                    sp += 1
+        if count > CAP:  # _tied() sees only CAP of them: it asks the k-d tree
+            ask[q] = True
+            continue
+        # the ends at the k-th distance whose segment reaches the least value
+        reaching = 0
+        if at > 0 and low_nearer != low:
+            stack_level[0] = top
+            stack_node[0] = 0
+            sp = 1
+            while sp > 0:
+                sp -= 1
+                level = stack_level[sp]
+                node = stack_node[sp]
+                if _box2(boxes, offsets[level] + node, qx, qy) > kth2:
+                    continue
+                if level == 0:
+                    for i in range(node * LEAF, min(npts, node * LEAF + LEAF)):
+                        at_kth = _point2(points, i, qx, qy) == kth2
+                        if at_kth and _segment(qx, qy, a, b, i % m) == low:
+                            reaching += 1
+                    continue
+                below = offsets[level - 1]
+                count_below = offsets[level] - below
+                for ch in range(node * FAN, min(count_below, node * FAN + FAN)):
+                    if _box2(boxes, below + ch, qx, qy) <= kth2:
+                        stack_level[sp] = level - 1
+                        stack_node[sp] = ch
+                        sp += 1
+        pick = k - nearer
+        if low_nearer == low or at - reaching < pick:
+            near[q] = low
+        else:
+            ask[q] = True
+    return near, r0_2, rk_2, ask
