@@ -239,3 +239,45 @@ def test_segment_distance_is_numpys_on_awkward_segments() -> None:
     want = metrics._to_segments(p, a[:, None, :], b[:, None, :])[:, 0]
     got = np.array([nearkernels._segment(p[i, 0], p[i, 1], a, b, i) for i in range(n)])
     assert got.tobytes() == want.tobytes()
+
+
+def _awkward_pairs(rng: np.random.Generator, n: int) -> tuple[np.ndarray, ...]:
+    """Points against segments: point segments, on the segment, its ends and extension,
+    tiny and huge scales, and a step grid (where products and sums tie)."""
+    scale = rng.choice([1e-9, 1e-3, 1.0, 1e3], size=(n, 1))
+    a = rng.normal(size=(n, 2)) * scale + rng.normal(size=(n, 2)) * 10
+    b = a + rng.normal(size=(n, 2)) * rng.choice([0.0, 1e-12, 1e-3, 10.0], size=(n, 1))
+    t = rng.choice([-1.0, 0.0, 0.5, 1.0, 2.0, 0.3, 1e-17], size=(n, 1))
+    p = a + t * (b - a) + rng.choice([0.0, 1e-15, 1e-3], size=(n, 1)) * rng.normal(size=(n, 2))
+    half = n // 2
+    a[half:], b[half:] = np.round(a[half:] / 0.004) * 0.004, np.round(b[half:] / 0.004) * 0.004
+    p[half:] = np.round(p[half:] / 0.001) * 0.001
+    return p, a, b
+
+
+def test_least_of_pairs_is_geos_distance_bit_for_bit() -> None:
+    """The compiled GEOS point-segment distance against shapely's (GEOS) on 200 000 pairs."""
+    import shapely
+
+    p, a, b = _awkward_pairs(np.random.default_rng(11), 200_000)
+    one = np.arange(len(p))
+    got = nearkernels.least_of_pairs(p, one, one, a, b)
+    want = shapely.distance(shapely.points(p), shapely.linestrings(np.stack([a, b], axis=1)))
+    assert got.tobytes() == np.asarray(want, dtype=np.float64).tobytes()
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_nearby_min_compiled_is_the_geos_grouping(
+    seed: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Each sample's least distance over its pairs: compiled, and by GEOS in groups."""
+    rng = np.random.default_rng(20 + seed)
+    p, a, b = _awkward_pairs(rng, 3000)
+    counts = rng.integers(1, 30, size=len(p))
+    owner = np.repeat(np.arange(len(p)), counts)
+    seg = rng.integers(0, 2 * len(a), size=len(owner))  # ends of a or b: seg % len(a)
+    assert metrics._pair_kernels(1) is nearkernels  # numba is loaded: the compiled form
+    compiled = metrics._nearby_min(p, owner, seg, a, b)
+    monkeypatch.setattr(metrics, "_pair_kernels", lambda pairs: None)
+    for chunk in (7, metrics.NEARBY_CHUNK_PAIRS):
+        assert metrics._nearby_min(p, owner, seg, a, b, chunk).tobytes() == compiled.tobytes()
