@@ -571,18 +571,21 @@ def farthest_nearest(
     return float(d[k]), k
 
 
-def _reaching(upper: FloatArray, settled: FloatArray) -> npt.NDArray[np.bool_]:
+def _reaching(upper: FloatArray, settled: FloatArray, samples: FloatArray) -> npt.NDArray[np.bool_]:
     """Which unsure samples (distance at most ``upper``) may reach the largest ``settled``.
 
     A sample's exact distance is at most ``upper`` (the segments of its nearest ends)
-    up to the rounding of two formulas for one distance (a few ulps, and about 1e-15 mm
-    near a segment): the margin covers both, so a sample left out is strictly below
-    the largest settled distance, which is at most the largest of all.
+    up to the rounding of two formulas for one distance: a few ulps of the distance,
+    and near a segment a few ulps of the coordinates. The margin (a billionth, plus
+    1e-12 mm and 64 ulps of the largest coordinate of ``samples``) covers both, so a
+    sample left out is strictly below the largest settled distance, which is at most
+    the largest of all.
     """
     if len(settled) == 0:
         return np.ones(len(upper), dtype=bool)
     top = float(np.max(settled))
-    return np.asarray(upper * (1.0 + 1e-9) + 1e-12 >= top)
+    slack = 1e-12 + 64.0 * float(np.spacing(np.max(np.abs(samples))))
+    return np.asarray(upper * (1.0 + 1e-9) + slack >= top)
 
 
 def _nearest(
@@ -621,7 +624,7 @@ def _nearest(
         unsure[i : i + len(chunk)] = ~sure
     if unsure.any():
         tree = (points, boxes, offsets)
-        need = _reaching(d[unsure], d[~unsure]) if only_max else None
+        need = _reaching(d[unsure], d[~unsure], samples) if only_max else None
         exact = _nearby_boxes(samples[unsure], d[unsure], a, b, tree, half, kernels, need)
         if exact is None:
             exact = _all_exact_where(samples[unsure], d[unsure], a, b, need)
@@ -768,7 +771,7 @@ def _nearest_kd(
     d = np.concatenate([p[0] for p in parts]) if parts else np.zeros(0)
     unsure = np.concatenate([p[1] for p in parts]) if parts else np.zeros(0, dtype=bool)
     if unsure.any():
-        need = _reaching(d[unsure], d[~unsure]) if only_max else None
+        need = _reaching(d[unsure], d[~unsure], samples) if only_max else None
         exact = _nearby_exact(samples[unsure], d[unsure], a, b, tree, half, need)
         if exact is None:
             exact = _all_exact_where(samples[unsure], d[unsure], a, b, need)

@@ -195,6 +195,8 @@ def test_farthest_nearest_is_the_max_of_every_distance(
     rng = np.random.default_rng(100 + seed)
     for kind in range(12):
         pts = _polyline(rng, kind)
+        if kind % 4 == 3:  # far from the origin: coordinates of a 5 m machine
+            pts = pts + 5000.0
         a, b = pts[:-1], pts[1:]
         step = float(np.max(np.hypot(*(b - a).T)))
         on = pts[rng.integers(0, len(pts), 200)]
