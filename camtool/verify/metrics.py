@@ -12,7 +12,8 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Callable, Sequence
+import sys
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from functools import partial
 from types import ModuleType
@@ -515,7 +516,9 @@ def _to_segments(p: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
     return np.sqrt(np.einsum("nkj,nkj->nk", off, off))
 
 
-def nearest_distances(samples: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
+def nearest_distances(
+    samples: FloatArray, a: FloatArray, b: FloatArray, *, ends: _LazyTree | None = None
+) -> FloatArray:
     """Distance of each sample to the nearest segment ``a[i] → b[i]``, mm.
 
     Exact to :data:`NEAREST_TOLERANCE_MM`. The segments owning the
@@ -535,48 +538,124 @@ def nearest_distances(samples: FloatArray, a: FloatArray, b: FloatArray) -> Floa
         samples: ``(N, 2)`` query points, mm.
         a: ``(M, 2)`` segment starts, mm.
         b: ``(M, 2)`` segment ends, mm (``a[i] == b[i]``: a point).
+        ends: the k-d tree of ``concatenate([a, b])`` when the caller measures several
+            batches against the same segments (built here otherwise; the same answers).
 
     Returns:
         ``(N,)`` float64 distances, mm (``inf`` without segments).
     """
+    return _nearest(samples, a, b, ends=ends, only_max=False)
+
+
+def farthest_nearest(
+    samples: FloatArray, a: FloatArray, b: FloatArray, *, ends: _LazyTree | None = None
+) -> tuple[float, int]:
+    """``max`` and first ``argmax`` of :func:`nearest_distances`, the same two numbers.
+
+    Only the largest distance is wanted (the shortfall of a path from its trace), so a
+    sample the cheap tests leave unsure is measured exactly only when it could reach
+    the largest one settled (its distance to the segments of its nearest ends is an
+    upper bound); the others cannot be the largest, nor tie with it.
+
+    Args:
+        samples: ``(N, 2)`` query points, mm, ``N >= 1``.
+        a: ``(M, 2)`` segment starts, mm.
+        b: ``(M, 2)`` segment ends, mm.
+        ends: as for :func:`nearest_distances`.
+
+    Returns:
+        ``(distance mm, index)`` of the first sample farthest from the segments.
+    """
+    d = _nearest(samples, a, b, ends=ends, only_max=True)
+    k = int(np.argmax(d))
+    return float(d[k]), k
+
+
+def _reaching(upper: FloatArray, settled: FloatArray, samples: FloatArray) -> npt.NDArray[np.bool_]:
+    """Which unsure samples (distance at most ``upper``) may reach the largest ``settled``.
+
+    A sample's exact distance is at most ``upper`` (the segments of its nearest ends)
+    up to the rounding of two formulas for one distance: a few ulps of the distance,
+    and near a segment a few ulps of the coordinates. The margin (a billionth, plus
+    1e-12 mm and 64 ulps of the largest coordinate of ``samples``) covers both, so a
+    sample left out is strictly below the largest settled distance, which is at most
+    the largest of all.
+    """
+    if len(settled) == 0:
+        return np.ones(len(upper), dtype=bool)
+    top = float(np.max(settled))
+    slack = 1e-12 + 64.0 * float(np.spacing(np.max(np.abs(samples))))
+    return np.asarray(upper * (1.0 + 1e-9) + slack >= top)
+
+
+def _nearest(
+    samples: FloatArray, a: FloatArray, b: FloatArray, *, ends: _LazyTree | None, only_max: bool
+) -> FloatArray:
+    """:func:`nearest_distances`; with ``only_max``, exact only where it can be the largest.
+
+    With ``only_max`` an unsure sample that cannot reach the largest settled distance
+    keeps its upper bound (:func:`_reaching`): the array's max and argmax are exact.
+    """
     kernels = near_kernels(len(samples))
     if kernels is None or len(a) == 0 or 2 * len(a) <= NEAREST_ENDS:
-        return nearest_distances_kd(samples, a, b)
+        return _nearest_kd(samples, a, b, ends=ends, only_max=only_max)
     samples = np.ascontiguousarray(samples, dtype=np.float64)
     a = np.ascontiguousarray(a, dtype=np.float64)
     b = np.ascontiguousarray(b, dtype=np.float64)
     half = float(np.max(np.hypot(*(b - a).T))) / 2.0
     points = np.concatenate([a, b])
     boxes, offsets = kernels.build(points)
-    ends = _LazyTree(points)
+    ends = ends or _LazyTree(points)
     d = np.empty(len(samples), dtype=np.float64)
     unsure = np.zeros(len(samples), dtype=bool)
     k = NEAREST_ENDS
     for i in range(0, len(samples), NEAREST_CHUNK):
         chunk = samples[i : i + NEAREST_CHUNK]
-        r0_2, rk_2, index, state = kernels.knn(chunk, points, boxes, offsets, k)
+        near, r0_2, rk_2, ask = kernels.near_segments(chunk, points, boxes, offsets, a, b, k)
         r0, rk = np.sqrt(r0_2), np.sqrt(rk_2)  # what the k-d tree gives: the same sqrt
-        seg = index % len(a)
-        near = _to_segments(chunk, a[seg], b[seg]).min(axis=1)
-        tied = state != 0
-        if tied.any():  # several ends at the k-th distance: does the k-d tree's choice matter?
-            near[tied], asks = _tied(chunk[tied], rk_2[tied], a, b, points, boxes, offsets, kernels)
-            if asks.any():  # it does: ask the k-d tree
-                rows = np.flatnonzero(tied)[asks]
-                found = ends.tree.query(chunk[rows], k=k, workers=KD_WORKERS)[1]
-                s = np.asarray(found).reshape(-1, k) % len(a)
-                near[rows] = _to_segments(chunk[rows], a[s], b[s]).min(axis=1)
+        if ask.any():  # ends tie at the k-th distance and the k-d tree's choice matters
+            rows = np.flatnonzero(ask)
+            found = ends.tree.query(chunk[rows], k=k, workers=KD_WORKERS)[1]
+            s = np.asarray(found).reshape(-1, k) % len(a)
+            near[rows] = _to_segments(chunk[rows], a[s], b[s]).min(axis=1)
         lower = np.sqrt(np.maximum(r0**2 - half * half, 0.0))
         sure = (near + half < rk) | (near - lower <= NEAREST_TOLERANCE_MM)
         d[i : i + len(chunk)] = near
         unsure[i : i + len(chunk)] = ~sure
     if unsure.any():
         tree = (points, boxes, offsets)
-        exact = _nearby_boxes(samples[unsure], d[unsure], a, b, tree, half, kernels)
+        need = _reaching(d[unsure], d[~unsure], samples) if only_max else None
+        exact = _nearby_boxes(samples[unsure], d[unsure], a, b, tree, half, kernels, need)
         if exact is None:
-            exact = _all_exact(samples[unsure], a, b)
+            exact = _all_exact_where(samples[unsure], d[unsure], a, b, need)
         d[unsure] = exact
     return d
+
+
+def _near_segments_numpy(
+    chunk: FloatArray,
+    a: FloatArray,
+    b: FloatArray,
+    points: FloatArray,
+    boxes: Any,
+    offsets: Any,
+    kernels: ModuleType,
+) -> tuple[FloatArray, FloatArray, FloatArray, npt.NDArray[np.bool_]]:
+    """:func:`camtool.verify.nearkernels.near_segments` with numpy's segment distances.
+
+    The form it replaced (its :func:`_tied` and :func:`_to_segments` in numpy), kept
+    as the tests' reference: the same ``near``, ``r0_2``, ``rk_2`` and ``ask``.
+    """
+    k = NEAREST_ENDS
+    r0_2, rk_2, index, state = kernels.knn(chunk, points, boxes, offsets, k)
+    seg = index % len(a)
+    near = _to_segments(chunk, a[seg], b[seg]).min(axis=1)
+    ask = np.zeros(len(chunk), dtype=bool)
+    tied = state != 0
+    if tied.any():
+        near[tied], asks = _tied(chunk[tied], rk_2[tied], a, b, points, boxes, offsets, kernels)
+        ask[np.flatnonzero(tied)[asks]] = True
+    return near, r0_2, rk_2, ask
 
 
 def _tied(
@@ -674,24 +753,46 @@ def near_kernels(work: int = NEAR_KERNELS_FROM) -> ModuleType | None:
 
 def nearest_distances_kd(samples: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
     """:func:`nearest_distances` with the nearest ends from scipy's k-d tree (the plain form)."""
-    from scipy.spatial import cKDTree
+    return _nearest_kd(samples, a, b, ends=None, only_max=False)
 
+
+def _nearest_kd(
+    samples: FloatArray, a: FloatArray, b: FloatArray, *, ends: _LazyTree | None, only_max: bool
+) -> FloatArray:
+    """:func:`nearest_distances_kd` (``ends``, ``only_max``: as for :func:`_nearest`)."""
     if len(a) == 0:
         return np.full(len(samples), np.inf)
     half = float(np.max(np.hypot(*(b - a).T))) / 2.0
-    ends = cKDTree(np.concatenate([a, b]))
+    tree = (ends or _LazyTree(np.concatenate([a, b]))).tree
     parts = [
-        _nearest_chunk(samples[i : i + NEAREST_CHUNK], a, b, ends, half)
+        _nearest_chunk(samples[i : i + NEAREST_CHUNK], a, b, tree, half)
         for i in range(0, len(samples), NEAREST_CHUNK)
     ]
     d = np.concatenate([p[0] for p in parts]) if parts else np.zeros(0)
     unsure = np.concatenate([p[1] for p in parts]) if parts else np.zeros(0, dtype=bool)
     if unsure.any():
-        exact = _nearby_exact(samples[unsure], d[unsure], a, b, ends, half)
+        need = _reaching(d[unsure], d[~unsure], samples) if only_max else None
+        exact = _nearby_exact(samples[unsure], d[unsure], a, b, tree, half, need)
         if exact is None:
-            exact = _all_exact(samples[unsure], a, b)
+            exact = _all_exact_where(samples[unsure], d[unsure], a, b, need)
         d[unsure] = exact
     return d
+
+
+def _all_exact_where(
+    samples: FloatArray,
+    upper: FloatArray,
+    a: FloatArray,
+    b: FloatArray,
+    need: npt.NDArray[np.bool_] | None,
+) -> FloatArray:
+    """:func:`_all_exact` of the samples ``need`` names (all when ``None``); ``upper`` elsewhere."""
+    if need is None:
+        return _all_exact(samples, a, b)
+    out = upper.copy()
+    if need.any():
+        out[need] = _all_exact(samples[need], a, b)  # GEOS answers each sample alone
+    return out
 
 
 def _all_exact(samples: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
@@ -712,7 +813,13 @@ NEARBY_MAX_PAIRS = 4_000_000
 
 
 def _nearby_exact(
-    samples: FloatArray, upper: FloatArray, a: FloatArray, b: FloatArray, ends: Any, half: float
+    samples: FloatArray,
+    upper: FloatArray,
+    a: FloatArray,
+    b: FloatArray,
+    ends: Any,
+    half: float,
+    need: npt.NDArray[np.bool_] | None = None,
 ) -> FloatArray | None:
     """:func:`_all_exact` over only the segments that can be the nearest, or ``None``.
 
@@ -730,6 +837,9 @@ def _nearby_exact(
         b: ``(M, 2)`` segment ends, mm.
         ends: the k-d tree of ``concatenate([a, b])``.
         half: half the longest segment, mm.
+        need: ``(U,)`` the samples to measure (``None``: all); the others keep ``upper``.
+            The limit counts the pairs of all samples, so which of the two ways gives a
+            sample's distance does not depend on ``need``.
     """
     reach = (upper + half) * (1.0 + 1e-9) + 1e-12  # a float margin: never leaves one out
     near = ends.query_ball_point(samples, reach, return_length=True, workers=KD_WORKERS)
@@ -738,6 +848,23 @@ def _nearby_exact(
     counts = np.asarray(near, dtype=np.int64)
     if counts.min() == 0:
         return None  # cannot happen (the segment of ``upper`` is within reach): be safe
+    if need is not None:
+        out = upper.copy()
+        if need.any():
+            out[need] = _nearby_pairs(samples[need], reach[need], counts[need], a, b, ends)
+        return out
+    return _nearby_pairs(samples, reach, counts, a, b, ends)
+
+
+def _nearby_pairs(
+    samples: FloatArray,
+    reach: FloatArray,
+    counts: IntArray,
+    a: FloatArray,
+    b: FloatArray,
+    ends: Any,
+) -> FloatArray:
+    """:func:`_nearby_exact`'s GEOS minimum over the ends within ``reach`` (``counts`` of them)."""
     out = np.empty(len(samples), dtype=np.float64)
     ends_before = np.concatenate([[0], np.cumsum(counts)])
     lo = 0
@@ -760,6 +887,7 @@ def _nearby_boxes(
     tree: tuple[FloatArray, Any, Any],
     half: float,
     kernels: ModuleType,
+    need: npt.NDArray[np.bool_] | None = None,
 ) -> FloatArray | None:
     """:func:`_nearby_exact` with the ends within reach from the box tree (numba).
 
@@ -774,6 +902,7 @@ def _nearby_boxes(
         tree: ``(points, boxes, offsets)``: the ends and their box tree.
         half: half the longest segment, mm.
         kernels: :mod:`camtool.verify.nearkernels`.
+        need: as for :func:`_nearby_exact` (the limit counts every sample's pairs).
     """
     reach = ((upper + half) * (1.0 + 1e-9) + 1e-12) * (1.0 + 1e-12)
     points, boxes, offsets = tree
@@ -782,7 +911,14 @@ def _nearby_boxes(
     )
     if len(owner) == 0 or len(np.unique(owner)) < len(samples):
         return None  # over the limit (or, which cannot happen, a sample without one)
-    return _nearby_min(samples, owner, seg, a, b)
+    if need is None:
+        return _nearby_min(samples, owner, seg, a, b)
+    out = upper.copy()
+    if need.any():
+        keep = need[owner]
+        renumber = np.cumsum(need) - 1  # a needed sample's place among the needed
+        out[need] = _nearby_min(samples[need], renumber[owner[keep]], seg[keep], a, b)
+    return out
 
 
 NEARBY_CHUNK_PAIRS = 50_000
@@ -802,8 +938,22 @@ def _nearby_min(
     ``owner`` is ascending and names every sample at least once. The pairs are measured
     a few samples at a time (about ``chunk`` pairs, a sample's pairs never split), which
     bounds the memory GEOS's points and lines take; each pair's distance and each
-    sample's minimum are the same whatever the grouping.
+    sample's minimum are the same whatever the grouping. With numba
+    (:func:`_pair_kernels`) the same GEOS distances are taken compiled, in one pass
+    (:func:`camtool.verify.nearkernels.least_of_pairs`).
     """
+    kernels = _pair_kernels(len(owner))
+    if kernels is not None:  # the same GEOS floats, compiled: no line objects
+        return np.asarray(
+            kernels.least_of_pairs(
+                np.ascontiguousarray(samples, dtype=np.float64),
+                np.ascontiguousarray(owner, dtype=np.int64),
+                np.ascontiguousarray(seg % len(a), dtype=np.int64),
+                np.ascontiguousarray(a, dtype=np.float64),
+                np.ascontiguousarray(b, dtype=np.float64),
+            ),
+            dtype=np.float64,
+        )
     out = np.empty(len(samples), dtype=np.float64)
     pos, count = 0, len(owner)
     while pos < count:
@@ -816,6 +966,26 @@ def _nearby_min(
         out[first : last + 1] = _nearby_group(samples, owner[pos:end], seg[pos:end], a, b)
         pos = end
     return out
+
+
+PAIR_KERNELS_FROM = 200_000
+"""Pairs from which :func:`_nearby_min` loads the compiled GEOS distance when numba is not
+loaded yet (loading it costs about 0.5 s once; GEOS through shapely ~1 µs a pair)."""
+
+
+def _pair_kernels(pairs: int) -> ModuleType | None:
+    """:mod:`camtool.verify.nearkernels` for :func:`_nearby_min`, or ``None`` (GEOS).
+
+    Loaded when numba already is (its cached kernel loads in milliseconds) or for at
+    least :data:`PAIR_KERNELS_FROM` pairs; ``None`` without numba.
+    """
+    if "numba" not in sys.modules and pairs < PAIR_KERNELS_FROM:
+        return None
+    try:
+        from camtool.verify import nearkernels
+    except ImportError:
+        return None
+    return nearkernels
 
 
 def _nearby_group(
@@ -910,10 +1080,9 @@ def along_path(
         if len(samples) == 0:
             continue
         move_ends = block_start[first + 1 : last + 2] - lo  # each move's last row, in ``run``
-        d = _to_trace(samples, _thinned(run, move_ends))
-        k = int(np.argmax(d))
-        if d[k] * 1000.0 > worst[0]:
-            worst = (float(d[k]) * 1000.0, (float(samples[k, 0]), float(samples[k, 1])), owner[k])
+        far, k = _farthest_from_trace(samples, _thinned(run, move_ends))
+        if far * 1000.0 > worst[0]:
+            worst = (far * 1000.0, (float(samples[k, 0]), float(samples[k, 1])), owner[k])
     return AlongPath(
         shortfall_um=worst[0],
         shortfall_at_mm=worst[1],
@@ -926,11 +1095,24 @@ def along_path(
     )
 
 
-def _to_trace(samples: FloatArray, trace: FloatArray) -> FloatArray:
-    """Distance of each path sample to the polyline ``trace`` (one point: to it), mm."""
+def _farthest_from_trace(
+    samples: FloatArray, trace: FloatArray, ends: _LazyTree | None = None
+) -> tuple[float, int]:
+    """Largest distance of a path sample to the polyline ``trace`` and the first sample at it.
+
+    Distances in mm, to the one point when ``trace`` has one (:func:`farthest_nearest`);
+    ``ends``: :func:`_trace_ends`, shared by the batches of one trace.
+    """
     if len(trace) == 1:
-        return nearest_distances(samples, trace, trace)
-    return nearest_distances(samples, trace[:-1], trace[1:])
+        return farthest_nearest(samples, trace, trace, ends=ends)
+    return farthest_nearest(samples, trace[:-1], trace[1:], ends=ends)
+
+
+def _trace_ends(trace: FloatArray) -> _LazyTree:
+    """The k-d tree of the segment ends of the polyline ``trace`` (built on first use)."""
+    if len(trace) == 1:
+        return _LazyTree(np.concatenate([trace, trace]))
+    return _LazyTree(np.concatenate([trace[:-1], trace[1:]]))
 
 
 def _thinned(run: FloatArray, keep: IntArray) -> FloatArray:
@@ -980,25 +1162,51 @@ def _sample_moves(
     program: Program, starts: list[Point], first: int, last: int, spacing: float
 ) -> tuple[FloatArray, IntArray]:
     """Points along moves ``first..last`` at most ``spacing`` apart, ends included, and owners."""
-    chunks: list[FloatArray] = []
-    owners: list[IntArray] = []
-    for b in range(first, last + 1):
-        seg = segment_of(starts[b], program.moves[b])
-        n = max(1, math.ceil(seg.length / spacing))
-        t = np.arange(n + 1, dtype=np.float64) / n
-        if isinstance(seg, Arc):
-            r, c = seg.radius, seg.centre
-            angle = math.atan2(seg.start[1] - c[1], seg.start[0] - c[0]) + seg.sweep * t
-            pts = np.column_stack((c[0] + r * np.cos(angle), c[1] + r * np.sin(angle)))
-            pts[-1] = seg.end
-        else:
-            (x0, y0), (x1, y1) = seg.start, seg.end
-            pts = np.column_stack((x0 + (x1 - x0) * t, y0 + (y1 - y0) * t))
-        chunks.append(pts)
-        owners.append(np.full(len(pts), b, dtype=np.int64))
+    chunks = [_sample_move(program, starts, b, spacing) for b in range(first, last + 1)]
     if not chunks:
         return np.zeros((0, 2)), np.zeros(0, dtype=np.int64)
+    owners = [np.full(len(pts), b, dtype=np.int64) for b, pts in enumerate(chunks, first)]
     return np.vstack(chunks), np.concatenate(owners)
+
+
+def _sample_move(program: Program, starts: list[Point], b: int, spacing: float) -> FloatArray:
+    """``(n + 1, 2)`` points along move ``b`` at most ``spacing`` apart, its ends included."""
+    seg = segment_of(starts[b], program.moves[b])
+    n = max(1, math.ceil(seg.length / spacing))
+    t = np.arange(n + 1, dtype=np.float64) / n
+    if isinstance(seg, Arc):
+        r, c = seg.radius, seg.centre
+        angle = math.atan2(seg.start[1] - c[1], seg.start[0] - c[0]) + seg.sweep * t
+        pts = np.column_stack((c[0] + r * np.cos(angle), c[1] + r * np.sin(angle)))
+        pts[-1] = seg.end
+        return pts
+    (x0, y0), (x1, y1) = seg.start, seg.end
+    return np.column_stack((x0 + (x1 - x0) * t, y0 + (y1 - y0) * t))
+
+
+def _sample_batches(
+    program: Program, starts: list[Point], first: int, last: int, spacing: float, size: int
+) -> Iterator[tuple[FloatArray, IntArray]]:
+    """:func:`_sample_moves` in consecutive pieces of ``size`` points (the last shorter).
+
+    The pieces are exactly ``samples[i : i + size]`` (and owners) of the whole arrays,
+    built move by move: never more than a piece and one move's points are held.
+    """
+    held: list[FloatArray] = []
+    owners: list[IntArray] = []
+    count = 0
+    for b in range(first, last + 1):
+        pts = _sample_move(program, starts, b, spacing)
+        held.append(pts)
+        owners.append(np.full(len(pts), b, dtype=np.int64))
+        count += len(pts)
+        while count >= size:
+            samples, owner = np.vstack(held), np.concatenate(owners)
+            yield samples[:size], owner[:size]
+            held, owners = [samples[size:]], [owner[size:]]
+            count -= size
+    if count:
+        yield np.vstack(held), np.concatenate(owners)
 
 
 STREAM_SAMPLES = 100_000
@@ -1297,17 +1505,15 @@ class TraceStream:
                 run_of,
             )
         )
-        samples, owner = _sample_moves(program, starts, c.first, c.last, self.spacing)
-        self.samples += len(samples)
         trace = c.trace()
-        if len(samples) == 0:
-            return
-        for i in range(0, len(samples), STREAM_SAMPLES):  # each sample's distance is its own
-            d = _to_trace(samples[i : i + STREAM_SAMPLES], trace)
-            k = int(np.argmax(d))
-            if d[k] * 1000.0 > self.worst[0]:
-                at = (float(samples[i + k, 0]), float(samples[i + k, 1]))
-                self.worst = (float(d[k]) * 1000.0, at, int(owner[i + k]))
+        ends = _trace_ends(trace)  # one k-d tree for every batch (when one is used)
+        batches = _sample_batches(program, starts, c.first, c.last, self.spacing, STREAM_SAMPLES)
+        for samples, owner in batches:  # each sample's distance is its own
+            self.samples += len(samples)
+            far, k = _farthest_from_trace(samples, trace, ends)
+            if far * 1000.0 > self.worst[0]:
+                at = (float(samples[k, 0]), float(samples[k, 1]))
+                self.worst = (far * 1000.0, at, int(owner[k]))
 
     def finish(self) -> StreamedMeasures:
         """The measures of the whole trace (after its last chunk)."""

@@ -22,6 +22,7 @@ This module imports numba, so it is imported lazily
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numba
@@ -124,6 +125,117 @@ def _insert(best: Any, k: int, d2: float) -> None:  # pragma: no cover - compile
     best[j] = d2
 
 
+@numba.njit(inline="always")
+def _scratch() -> tuple[Any, Any, Any, Any]:  # pragma: no cover - compiled
+    """The stacks of one search: node levels and numbers, a node's children and distances."""
+    return (
+        np.empty(64 * FAN, dtype=np.int64),
+        np.empty(64 * FAN, dtype=np.int64),
+        np.empty(FAN, dtype=np.int64),
+        np.empty(FAN, dtype=np.float64),
+    )
+
+
+@numba.njit(inline="always")
+def _knn_one(
+    qx: float,
+    qy: float,
+    points: Any,
+    boxes: Any,
+    offsets: Any,
+    k: int,
+    last: int,
+    best: Any,
+    found: Any,
+    found2: Any,
+    work: tuple[Any, Any, Any, Any],
+) -> tuple[int, int, bool]:  # pragma: no cover - compiled
+    """:func:`knn`'s search for one query ``(qx, qy)``.
+
+    Fills ``best[:k]`` (the k smallest squared distances, ascending) and
+    ``found[:count]``/``found2[:count]``: ends kept within the bound at the time, which
+    holds every end within the k-th distance unless ``spill`` (more than :data:`CAP`).
+    ``last`` is the previous query's nearest end (a warm start); ``work`` the scratch
+    stacks. Returns ``(nearest end or -1, count, spill)``.
+    """
+    stack_level, stack_node, child, child2 = work
+    npts = len(points)
+    top = len(offsets) - 2  # the root's level
+    # a bound to start from: the k-th nearest of the leaves around the last
+    # query's nearest end (queries come along a path: it is near)
+    for j in range(k):
+        best[j] = np.inf
+    leaf = last // LEAF
+    for i in range(max(0, (leaf - 1) * LEAF), min(npts, (leaf + 2) * LEAF)):
+        d2 = _point2(points, i, qx, qy)
+        if d2 < best[k - 1]:
+            _insert(best, k, d2)
+    warm = best[k - 1]  # >= the k-th smallest of all: prunes nothing it needs
+    for j in range(k):
+        best[j] = np.inf
+    nearest = -1
+    count = 0  # ends kept within the bound at the time (every one within the k-th is)
+    spill = False
+    stack_level[0] = top
+    stack_node[0] = 0
+    sp = 1
+    while sp > 0:
+        sp -= 1
+        level = stack_level[sp]
+        node = stack_node[sp]
+        bound = min(best[k - 1], warm)
+        if _box2(boxes, offsets[level] + node, qx, qy) > bound:
+            continue
+        if level == 0:
+            lo = node * LEAF
+            hi = min(npts, lo + LEAF)
+            for i in range(lo, hi):
+                d2 = _point2(points, i, qx, qy)
+                if d2 < best[k - 1]:
+                    if d2 < best[0]:
+                        nearest = i
+                    _insert(best, k, d2)
+                bound = min(best[k - 1], warm)
+                if d2 <= bound:
+                    if count == CAP:  # drop what the bound has passed
+                        kept = 0
+                        for j in range(count):
+                            if found2[j] <= bound:
+                                found[kept] = found[j]
+                                found2[kept] = found2[j]
+                                kept += 1
+                        count = kept
+                    if count < CAP:
+                        found[count] = i
+                        found2[count] = d2
+                        count += 1
+                    else:
+                        spill = True
+            continue
+        below = offsets[level - 1]
+        count_below = offsets[level] - below
+        lo = node * FAN
+        hi = min(count_below, lo + FAN)
+        m = 0
+        for c in range(lo, hi):
+            c2 = _box2(boxes, below + c, qx, qy)
+            if c2 <= bound:
+                # insertion, farthest first: the nearest child is popped first
+                j = m
+                while j > 0 and child2[j - 1] < c2:
+                    child2[j] = child2[j - 1]
+                    child[j] = child[j - 1]
+                    j -= 1
+                child2[j] = c2
+                child[j] = c
+                m += 1
+        for j in range(m):
+            stack_level[sp] = level - 1
+            stack_node[sp] = child[j]
+            sp += 1
+    return nearest, count, spill
+
+
 @numba.njit(cache=True, nogil=True)
 def knn(
     samples: Any, points: Any, boxes: Any, offsets: Any, k: int
@@ -149,91 +261,15 @@ def knn(
     rk = np.empty(n, dtype=np.float64)
     index = np.zeros((n, k), dtype=np.int64)
     state = np.zeros(n, dtype=np.int8)
-    top = len(offsets) - 2  # the root's level
-    stack_level = np.empty(64 * FAN, dtype=np.int64)
-    stack_node = np.empty(64 * FAN, dtype=np.int64)
     best = np.empty(k, dtype=np.float64)
     found = np.empty(CAP, dtype=np.int64)
     found2 = np.empty(CAP, dtype=np.float64)
-    child = np.empty(FAN, dtype=np.int64)
-    child2 = np.empty(FAN, dtype=np.float64)
-    npts = len(points)
+    work = _scratch()
     last = 0
     for q in range(n):
-        qx = samples[q, 0]
-        qy = samples[q, 1]
-        # a bound to start from: the k-th nearest of the leaves around the last
-        # query's nearest end (queries come along a path: it is near)
-        for j in range(k):
-            best[j] = np.inf
-        leaf = last // LEAF
-        for i in range(max(0, (leaf - 1) * LEAF), min(npts, (leaf + 2) * LEAF)):
-            d2 = _point2(points, i, qx, qy)
-            if d2 < best[k - 1]:
-                _insert(best, k, d2)
-        warm = best[k - 1]  # >= the k-th smallest of all: prunes nothing it needs
-        for j in range(k):
-            best[j] = np.inf
-        nearest = -1
-        count = 0  # ends kept within the bound at the time (every one within the k-th is)
-        spill = False
-        stack_level[0] = top
-        stack_node[0] = 0
-        sp = 1
-        while sp > 0:
-            sp -= 1
-            level = stack_level[sp]
-            node = stack_node[sp]
-            bound = min(best[k - 1], warm)
-            if _box2(boxes, offsets[level] + node, qx, qy) > bound:
-                continue
-            if level == 0:
-                lo = node * LEAF
-                hi = min(npts, lo + LEAF)
-                for i in range(lo, hi):
-                    d2 = _point2(points, i, qx, qy)
-                    if d2 < best[k - 1]:
-                        if d2 < best[0]:
-                            nearest = i
-                        _insert(best, k, d2)
-                    bound = min(best[k - 1], warm)
-                    if d2 <= bound:
-                        if count == CAP:  # drop what the bound has passed
-                            kept = 0
-                            for j in range(count):
-                                if found2[j] <= bound:
-                                    found[kept] = found[j]
-                                    found2[kept] = found2[j]
-                                    kept += 1
-                            count = kept
-                        if count < CAP:
-                            found[count] = i
-                            found2[count] = d2
-                            count += 1
-                        else:
-                            spill = True
-                continue
-            below = offsets[level - 1]
-            count_below = offsets[level] - below
-            lo = node * FAN
-            hi = min(count_below, lo + FAN)
-            m = 0
-            for c in range(lo, hi):
-                c2 = _box2(boxes, below + c, qx, qy)
-                if c2 <= bound:
-                    # insertion, farthest first: the nearest child is popped first
-                    j = m
-                    while j > 0 and child2[j - 1] < c2:
-                        child2[j] = child2[j - 1]
-                        child[j] = child[j - 1]
-                        j -= 1
-                    child2[j] = c2
-                    child[j] = c
-                    m += 1
-            for j in range(m):
-                stack_level[sp] = level - 1
-                stack_node[sp] = child[j]
-                sp += 1
+        nearest, count, spill = _knn_one(
+            samples[q, 0], samples[q, 1], points, boxes, offsets, k, last, best, found, found2, work
+        )
         kth = best[k - 1]
         if nearest >= 0:
             last = nearest
@@ -371,3 +407,203 @@ def pairs_within(
                 if total > limit:
                     return np.empty(0, dtype=np.int64), np.empty(0, dtype=np.int64)
     return owner, end
+
+
+@numba.njit(inline="always")
+def _segment(px: float, py: float, a: Any, b: Any, s: int) -> float:  # pragma: no cover - compiled
+    """Distance of ``(px, py)`` to segment ``a[s] → b[s]``, the floats of numpy's form.
+
+    :func:`camtool.verify.metrics._to_segments` step for step: ``t`` the projection
+    clipped to ``[0, 1]`` (0 for a point segment), then the length of ``ap − t·ab``;
+    each product and sum as numpy takes them (two-term sums, no fused multiply-add).
+    """
+    abx = b[s, 0] - a[s, 0]
+    aby = b[s, 1] - a[s, 1]
+    apx = px - a[s, 0]
+    apy = py - a[s, 1]
+    length2 = abx * abx + aby * aby
+    t = 0.0
+    if length2 > 0:
+        t = (apx * abx + apy * aby) / length2
+    t = min(max(t, 0.0), 1.0)
+    offx = apx - t * abx
+    offy = apy - t * aby
+    return math.sqrt(offx * offx + offy * offy)
+
+
+@numba.njit(cache=True, nogil=True)
+def near_segments(
+    samples: Any, points: Any, boxes: Any, offsets: Any, a: Any, b: Any, k: int
+) -> tuple[Any, Any, Any, Any]:  # pragma: no cover - compiled
+    """The k-d tree path's distance to the segments of the ``k`` nearest ends, in one pass.
+
+    For each sample, :func:`knn`'s ``k`` nearest ends (``points`` is ``concatenate([a,
+    b])``: end ``i`` belongs to segment ``i % len(a)``) and the least distance to their
+    segments (:func:`_segment`). Where ends tie at the k-th distance the k-d tree keeps
+    some of them; as :func:`camtool.verify.metrics._tied` does, every end within the
+    k-th distance is looked at (the search's own list, or :func:`_ends_within` when it
+    overflowed), and when any choice the k-d tree could make gives the same least
+    distance it is that one; else ``ask`` (the caller asks the k-d tree).
+
+    Returns:
+        ``near`` ``(N,)`` (unset where ``ask``), ``r0_2`` and ``rk_2`` ``(N,)`` as
+        :func:`knn` gives them, ``ask`` ``(N,)`` bool.
+    """
+    n = len(samples)
+    m = len(a)
+    r0_2 = np.empty(n, dtype=np.float64)
+    rk_2 = np.empty(n, dtype=np.float64)
+    near = np.empty(n, dtype=np.float64)
+    ask = np.zeros(n, dtype=np.bool_)
+    best = np.empty(k, dtype=np.float64)
+    found = np.empty(CAP, dtype=np.int64)
+    found2 = np.empty(CAP, dtype=np.float64)
+    work = _scratch()
+    last = 0
+    for q in range(n):
+        qx = samples[q, 0]
+        qy = samples[q, 1]
+        nearest, count, spill = _knn_one(
+            qx, qy, points, boxes, offsets, k, last, best, found, found2, work
+        )
+        kth2 = best[k - 1]
+        if nearest >= 0:
+            last = nearest
+        r0_2[q] = best[0]
+        rk_2[q] = kth2
+        if spill:  # the list overflowed: every end within the k-th distance, searched again
+            count = _ends_within(qx, qy, points, boxes, offsets, kth2, found, found2, work)
+            if count > CAP:  # _tied() sees only CAP of them: it asks the k-d tree
+                ask[q] = True
+                continue
+        # the ends within the k-th distance (the list also holds some farther ones)
+        low = np.inf
+        low_nearer = np.inf
+        nearer = 0
+        at = 0
+        for j in range(count):
+            d2 = found2[j]
+            if d2 <= kth2:
+                value = _segment(qx, qy, a, b, found[j] % m)
+                low = min(low, value)
+                if d2 < kth2:
+                    nearer += 1
+                    low_nearer = min(low_nearer, value)
+                else:
+                    at += 1
+        if nearer + at == k:  # the k nearest are one set: the k-d tree's
+            near[q] = low
+            continue
+        reaching = 0  # the ends at the k-th distance whose segment reaches the least value
+        for j in range(count):
+            if found2[j] == kth2 and _segment(qx, qy, a, b, found[j] % m) == low:
+                reaching += 1
+        if low_nearer == low or at - reaching < k - nearer:
+            near[q] = low
+        else:
+            ask[q] = True
+    return near, r0_2, rk_2, ask
+
+
+@numba.njit(inline="always")
+def _ends_within(
+    qx: float,
+    qy: float,
+    points: Any,
+    boxes: Any,
+    offsets: Any,
+    bound2: float,
+    found: Any,
+    found2: Any,
+    work: tuple[Any, Any, Any, Any],
+) -> int:  # pragma: no cover - compiled
+    """:func:`within` for one query: the ends within ``bound2`` into ``found``/``found2``.
+
+    Returns how many there are (only the first :data:`CAP` are kept).
+    """
+    stack_level, stack_node, _, _ = work
+    npts = len(points)
+    top = len(offsets) - 2
+    c = 0
+    stack_level[0] = top
+    stack_node[0] = 0
+    sp = 1
+    while sp > 0:
+        sp -= 1
+        level = stack_level[sp]
+        node = stack_node[sp]
+        if _box2(boxes, offsets[level] + node, qx, qy) > bound2:
+            continue
+        if level == 0:
+            for i in range(node * LEAF, min(npts, node * LEAF + LEAF)):
+                d2 = _point2(points, i, qx, qy)
+                if d2 <= bound2:
+                    if c < CAP:
+                        found[c] = i
+                        found2[c] = d2
+                    c += 1
+            continue
+        below = offsets[level - 1]
+        count_below = offsets[level] - below
+        for ch in range(node * FAN, min(count_below, node * FAN + FAN)):
+            if _box2(boxes, below + ch, qx, qy) <= bound2:
+                stack_level[sp] = level - 1
+                stack_node[sp] = ch
+                sp += 1
+    return c
+
+
+@numba.njit(inline="always")
+def _geos_segment(px: float, py: float, a: Any, b: Any, s: int) -> float:  # pragma: no cover
+    """GEOS's distance of ``(px, py)`` to segment ``a[s] → b[s]``, its floats exactly.
+
+    ``Distance::pointToSegment`` of GEOS (``src/algorithm/Distance.cpp``), the distance
+    ``shapely.distance`` gives between a point and a two-point line: the end's distance
+    when the projection ``r`` falls at or before one end, else ``|s| · √L²``, every
+    product and sum in GEOS's order (no fused multiply-add).
+    """
+    ax = a[s, 0]
+    ay = a[s, 1]
+    bx = b[s, 0]
+    by = b[s, 1]
+    if ax == bx and ay == by:
+        dx = px - ax
+        dy = py - ay
+        return math.sqrt(dx * dx + dy * dy)
+    length2 = (bx - ax) * (bx - ax) + (by - ay) * (by - ay)
+    r = ((px - ax) * (bx - ax) + (py - ay) * (by - ay)) / length2
+    if r <= 0.0:
+        dx = px - ax
+        dy = py - ay
+        return math.sqrt(dx * dx + dy * dy)
+    if r >= 1.0:
+        dx = px - bx
+        dy = py - by
+        return math.sqrt(dx * dx + dy * dy)
+    s_ = ((ay - py) * (bx - ax) - (ax - px) * (by - ay)) / length2
+    return abs(s_) * math.sqrt(length2)
+
+
+@numba.njit(cache=True, nogil=True)
+def least_of_pairs(
+    samples: Any, owner: Any, segment: Any, a: Any, b: Any
+) -> Any:  # pragma: no cover - compiled
+    """The least GEOS distance (:func:`_geos_segment`) of each sample over its pairs.
+
+    Args:
+        samples: ``(U, 2)`` query points.
+        owner: ``(K,)`` the sample of each pair, ascending, naming every sample.
+        segment: ``(K,)`` the segment of each pair (index into ``a``/``b``).
+        a: ``(M, 2)`` segment starts.
+        b: ``(M, 2)`` segment ends.
+
+    Returns:
+        ``(U,)`` float64 minima.
+    """
+    out = np.full(len(samples), np.inf)
+    for j in range(len(owner)):
+        q = owner[j]
+        value = _geos_segment(samples[q, 0], samples[q, 1], a, b, segment[j])
+        if value < out[q]:
+            out[q] = value
+    return out

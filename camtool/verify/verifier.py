@@ -346,6 +346,8 @@ def _simulate_big(
     """
     if against is not None or library().simulator(machine.motion.line) is not None:
         return simulate(program, machine), None
+    if _rows_at_least(program, machine) > stream_above:
+        compiled()  # it will be streamed, which needs the kernels: count with them too
     got = simulate_or_count(program, machine, stream_above)
     if isinstance(got, StepTrace):
         return got, None
@@ -382,6 +384,22 @@ def _simulate_big(
         total_compensation_steps=m.compensation_steps,
     )
     return trace, (m.deviation, m.along, m.contours, None)
+
+
+def _rows_at_least(program: Program, machine: Machine) -> int:
+    """A lower bound of the rows of ``program``'s step trace (to load the kernels early).
+
+    A row moves each motor at most one step, so a move takes at least as many rows as
+    its larger axis has steps (less one for the rounding of its ends). Rapids count
+    too. Only the speed depends on it: the kernels give the same rows as numpy.
+    """
+    sx, sy = float(machine.steps_per_mm[0]), float(machine.steps_per_mm[1])
+    x, y = program.origin
+    total = 0
+    for move in program.moves:
+        total += max(0, int(max(abs(move.x - x) * sx, abs(move.y - y) * sy)) - 1)
+        x, y = move.x, move.y
+    return total
 
 
 def _measure(

@@ -166,3 +166,94 @@ def test_nominal_lines_are_kept_for_the_code_and_the_plan() -> None:
     want = _nominal_lines_now(code)
     assert all(np.array_equal(a, b) for a, b in zip(lines, want, strict=True))
     assert not any(line.flags.writeable for line in lines)
+
+
+def _farthest_reference(samples: np.ndarray, a: np.ndarray, b: np.ndarray) -> tuple[float, int]:
+    """What the shortfall took before :func:`metrics.farthest_nearest`: every distance."""
+    d = metrics.nearest_distances(samples, a, b)
+    k = int(np.argmax(d))
+    return float(d[k]), k
+
+
+@pytest.mark.parametrize("seed", range(4))
+@pytest.mark.parametrize("compiled", [False, True])
+def test_farthest_nearest_is_the_max_of_every_distance(
+    seed: int, compiled: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The same largest distance and the same first sample at it, bit for bit.
+
+    Samples on the trace's grid, half a step off (unsure for the cheap tests), repeated
+    (ties at the largest) and far off; both nearest-end searches (the k-d tree and, with
+    numba, the box tree), and both exact stages (the pairs near each sample, and GEOS's
+    query over all segments when the pairs are over the limit).
+    """
+    if compiled:
+        if metrics.near_kernels() is None:
+            pytest.skip("numba is not installed")
+    else:
+        monkeypatch.setattr(metrics, "near_kernels", lambda work=0: None)
+    rng = np.random.default_rng(100 + seed)
+    for kind in range(12):
+        pts = _polyline(rng, kind)
+        if kind % 4 == 3:  # far from the origin: coordinates of a 5 m machine
+            pts = pts + 5000.0
+        a, b = pts[:-1], pts[1:]
+        step = float(np.max(np.hypot(*(b - a).T)))
+        on = pts[rng.integers(0, len(pts), 200)]
+        samples = on + rng.choice([0.0, step / 2, step, 3 * step], size=(200, 2))
+        if kind % 3 == 0:  # the farthest sample repeated: the first one must be named
+            far = int(rng.integers(0, 200))
+            samples = np.insert(samples, [far // 2, far], samples[far] + 5 * step, axis=0)
+        for limit in (metrics.NEARBY_MAX_PAIRS, 0):
+            monkeypatch.setattr(metrics, "NEARBY_MAX_PAIRS", limit)
+            want = _farthest_reference(samples, a, b)
+            got = metrics.farthest_nearest(samples, a, b)
+            assert got[1] == want[1]
+            assert np.float64(got[0]).tobytes() == np.float64(want[0]).tobytes()
+            ends = metrics._LazyTree(np.concatenate([a, b]))  # a tree shared by batches
+            assert metrics.farthest_nearest(samples, a, b, ends=ends) == got
+
+
+def test_farthest_nearest_measures_few_unsure_samples(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Unsure samples far below the largest settled distance are not measured exactly."""
+    monkeypatch.setattr(metrics, "near_kernels", lambda work=0: None)
+    x = np.arange(0.0, 4.0, 0.004)
+    pts = np.c_[x, np.zeros_like(x)]  # a straight trace of 4 µm steps
+    a, b = pts[:-1], pts[1:]
+    # 10 µm above each vertex: the vertex bound is loose (unsure); 0.5 mm above a
+    # segment's middle: settled by it, and the farthest
+    above = pts[:300] + np.array([0.0, 0.01])
+    samples = np.concatenate([above, [[0.002, 0.5]]])
+    measured: list[int] = []
+    real = metrics._nearby_pairs
+
+    def spy(s: np.ndarray, *args: object) -> np.ndarray:
+        measured.append(len(s))
+        return real(s, *args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(metrics, "_nearby_pairs", spy)
+    want = _farthest_reference(samples, a, b)
+    every = sum(measured)
+    measured.clear()
+    assert metrics.farthest_nearest(samples, a, b) == want == (0.5, 300)
+    assert every == 299 and sum(measured) == 0
+
+
+@pytest.mark.parametrize("size", [1, 7, 100, 10_000])
+def test_sample_batches_are_the_slices_of_the_whole_samples(size: int) -> None:
+    """The streamed shortfall's path samples, built move by move, are the whole ones sliced."""
+    moves = (
+        Rapid(1.0, 1.0, contour=1),
+        Linear(3.0, 1.5, 300.0, contour=1),
+        ArcMove(3.0, 3.5, 3.0, 2.5, True, 300.0, contour=1),
+        Linear(3.0, 3.5, 300.0, contour=1),  # no length: its two ends
+        Linear(1.0, 1.0, 300.0, contour=1),
+    )
+    program = Program(moves, origin=(0.0, 0.0))
+    starts = [program.origin] + [(m.x, m.y) for m in program.moves]
+    whole, owner = metrics._sample_moves(program, starts, 1, 4, 0.01)
+    pieces = list(metrics._sample_batches(program, starts, 1, 4, 0.01, size))
+    assert [len(p) for p, _ in pieces[:-1]] == [size] * (len(pieces) - 1)
+    assert np.concatenate([p for p, _ in pieces]).tobytes() == whole.tobytes()
+    assert np.array_equal(np.concatenate([o for _, o in pieces]), owner)
+    assert set(owner.tolist()) == {1, 2, 3, 4}

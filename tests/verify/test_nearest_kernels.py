@@ -196,3 +196,88 @@ def test_nearby_exact_in_groups_is_geos_over_all_segments(
     got = metrics._nearby_exact(samples, upper, a, b, cKDTree(np.concatenate([a, b])), half)
     assert got is not None
     assert got.tobytes() == metrics._all_exact(samples, a, b).tobytes()
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_near_segments_is_the_numpy_form_bit_for_bit(seed: int) -> None:
+    """The one-pass kernel gives the numpy form's distances, tie verdicts and asks.
+
+    The numpy form (:func:`metrics._near_segments_numpy`: :func:`metrics._to_segments`
+    and :func:`metrics._tied`) is the code the kernel replaced; on traces built to tie
+    (step grids, repeated passes, samples on the grid and a tool radius away) every
+    distance the kernel settles has the same float64 bits, and it asks the k-d tree
+    for exactly the same samples.
+    """
+    rng = np.random.default_rng(300 + seed)
+    asked = 0
+    for kind in range(12):
+        pts = _trace(rng, kind)
+        a, b = np.ascontiguousarray(pts[:-1]), np.ascontiguousarray(pts[1:])
+        points = np.concatenate([a, b])
+        boxes, offsets = nearkernels.build(points)
+        samples = _samples(rng, pts, 2000, reach=float(rng.choice([0.0015, 0.1, 1.5])))
+        want = metrics._near_segments_numpy(samples, a, b, points, boxes, offsets, nearkernels)
+        got = nearkernels.near_segments(samples, points, boxes, offsets, a, b, 4)
+        assert np.array_equal(got[3], want[3])  # the same samples ask the k-d tree
+        for g, w in zip(got[1:3], want[1:3], strict=True):
+            assert np.array_equal(g, w)
+        settled = ~want[3]
+        assert got[0][settled].tobytes() == want[0][settled].tobytes()
+        asked += int(want[3].sum())
+    assert asked > 0  # the inputs do reach the k-d tree's own choice
+
+
+def test_segment_distance_is_numpys_on_awkward_segments() -> None:
+    """Point segments, points on a segment and its extension, ends, tiny and huge scales."""
+    rng = np.random.default_rng(9)
+    n = 4000
+    a = rng.normal(size=(n, 2)) * rng.choice([1e-9, 1e-3, 1.0, 1e3], size=(n, 1))
+    b = a + rng.normal(size=(n, 2)) * rng.choice([0.0, 1e-12, 1e-3, 10.0], size=(n, 1))
+    t = rng.choice([-1.0, 0.0, 0.5, 1.0, 2.0, 0.3], size=(n, 1))
+    off = rng.choice([0.0, 1e-15, 1e-3], size=(n, 1)) * rng.normal(size=(n, 2))
+    p = a + t * (b - a) + off
+    want = metrics._to_segments(p, a[:, None, :], b[:, None, :])[:, 0]
+    got = np.array([nearkernels._segment(p[i, 0], p[i, 1], a, b, i) for i in range(n)])
+    assert got.tobytes() == want.tobytes()
+
+
+def _awkward_pairs(rng: np.random.Generator, n: int) -> tuple[np.ndarray, ...]:
+    """Points against segments: point segments, on the segment, its ends and extension,
+    tiny and huge scales, and a step grid (where products and sums tie)."""
+    scale = rng.choice([1e-9, 1e-3, 1.0, 1e3], size=(n, 1))
+    a = rng.normal(size=(n, 2)) * scale + rng.normal(size=(n, 2)) * 10
+    b = a + rng.normal(size=(n, 2)) * rng.choice([0.0, 1e-12, 1e-3, 10.0], size=(n, 1))
+    t = rng.choice([-1.0, 0.0, 0.5, 1.0, 2.0, 0.3, 1e-17], size=(n, 1))
+    p = a + t * (b - a) + rng.choice([0.0, 1e-15, 1e-3], size=(n, 1)) * rng.normal(size=(n, 2))
+    half = n // 2
+    a[half:], b[half:] = np.round(a[half:] / 0.004) * 0.004, np.round(b[half:] / 0.004) * 0.004
+    p[half:] = np.round(p[half:] / 0.001) * 0.001
+    return p, a, b
+
+
+def test_least_of_pairs_is_geos_distance_bit_for_bit() -> None:
+    """The compiled GEOS point-segment distance against shapely's (GEOS) on 200 000 pairs."""
+    import shapely
+
+    p, a, b = _awkward_pairs(np.random.default_rng(11), 200_000)
+    one = np.arange(len(p))
+    got = nearkernels.least_of_pairs(p, one, one, a, b)
+    want = shapely.distance(shapely.points(p), shapely.linestrings(np.stack([a, b], axis=1)))
+    assert got.tobytes() == np.asarray(want, dtype=np.float64).tobytes()
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_nearby_min_compiled_is_the_geos_grouping(
+    seed: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Each sample's least distance over its pairs: compiled, and by GEOS in groups."""
+    rng = np.random.default_rng(20 + seed)
+    p, a, b = _awkward_pairs(rng, 3000)
+    counts = rng.integers(1, 30, size=len(p))
+    owner = np.repeat(np.arange(len(p)), counts)
+    seg = rng.integers(0, 2 * len(a), size=len(owner))  # ends of a or b: seg % len(a)
+    assert metrics._pair_kernels(1) is nearkernels  # numba is loaded: the compiled form
+    compiled = metrics._nearby_min(p, owner, seg, a, b)
+    monkeypatch.setattr(metrics, "_pair_kernels", lambda pairs: None)
+    for chunk in (7, metrics.NEARBY_CHUNK_PAIRS):
+        assert metrics._nearby_min(p, owner, seg, a, b, chunk).tobytes() == compiled.tobytes()

@@ -207,3 +207,26 @@ def test_a_contour_thinned_on_the_fly_keeps_the_points_thinned_keeps(
         if hi > lo:
             contour.add(int(lo) + 1, points[lo:hi])
     assert np.array_equal(contour.trace(), expected)
+
+
+@pytest.mark.parametrize("name", TARGETS)
+@pytest.mark.parametrize("seed", range(4))
+def test_rows_at_least_never_overstates_the_trace(name: str, seed: int) -> None:
+    """The bound that loads the kernels before a big program is counted is a lower bound.
+
+    (A row steps each motor at most once, so a move takes at least its larger axis's
+    steps in rows; the rounding of the ends takes one off.)
+    """
+    from camtool.verify.verifier import _rows_at_least
+
+    machine = load_target(name).machine
+    program = _program(seed)
+    trace = simulate_steps(program, machine)
+    bound = _rows_at_least(program, machine)
+    assert 0 < bound <= trace.row_count
+    per_move = np.diff(trace.block_start)
+    start = program.origin
+    for move, rows in zip(program.moves, per_move, strict=True):  # move by move too
+        alone = Program((move,), origin=start)
+        assert _rows_at_least(alone, machine) <= rows
+        start = (move.x, move.y)
