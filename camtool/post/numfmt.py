@@ -236,7 +236,19 @@ def half_up(value: float, decimals: int) -> tuple[str, bool] | None:
     if "e" in r or "n" in r:
         return None
     negative = r[0] == "-"
-    whole, _, frac = (r[1:] if negative else r).partition(".")
+    if negative:
+        r = r[1:]
+    cut = r.find(".") + 1 + decimals  # r has a point: a float's repr without exponent
+    if cut < len(r) and r[cut] < "5":
+        # rounds down: the digits kept are the text (``r`` has no leading zeros but "0.")
+        text = r[: cut - 1] if decimals == 0 else r[:cut]
+        return text, negative and text.strip("0.") != ""
+    return _half_up_digits(r, decimals, negative)
+
+
+def _half_up_digits(r: str, decimals: int, negative: bool) -> tuple[str, bool]:
+    """:func:`half_up` of the repr ``r`` (no sign, no exponent) by integer arithmetic."""
+    whole, _, frac = r.partition(".")
     if len(frac) <= decimals:
         digits = int(whole + frac.ljust(decimals, "0"))
     else:
