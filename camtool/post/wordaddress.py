@@ -376,11 +376,13 @@ class BlockWriter(WriterState[str]):
         if move.contour:
             self.contour = move.contour
         start = self.here
-        self._check_area(start, move)
-        if move.z is not None and self._same_z(move.z):
-            move = dataclasses.replace(move, z=None)  # Z does not change as written
+        if self.machine.coordinates != "work":
+            self._check_area(start, move)
         if move.z is not None:
-            self._check_z(move)
+            if self._same_z(move.z):
+                move = dataclasses.replace(move, z=None)  # Z does not change as written
+            else:
+                self._check_z(move)
         if isinstance(move, ArcMove):
             self._arc(start, move)
         else:
@@ -445,13 +447,13 @@ class BlockWriter(WriterState[str]):
         self.block(words)
 
     def _feed(self, move: Linear | ArcMove, words: list[str]) -> None:
-        spec = self.spec.word("F")
-        if spec is None:
-            self.counts["feed"] += 1
-            return
         same = self._feed_text
         if same is not None and same[0] == move.feed_mm_min:
             self._word("F", same[1], words)  # the feed before: checked and warned about
+            return
+        spec = self.spec.word("F")
+        if spec is None:
+            self.counts["feed"] += 1
             return
         text = self.text("F", move.feed_mm_min)
         written = spec.number.parse(text)
@@ -608,10 +610,12 @@ class BlockWriter(WriterState[str]):
             linear = Linear(end[0], end[1], move.feed_mm_min, contour=move.contour)
             self._line(linear, end, z)
             return
-        words: list[str] = []
-        self._code(cw if move.clockwise else ccw, words)
+        code = cw if move.clockwise else ccw
+        last = self.last
+        words = [] if "G" in spec.modal and last.get("G") == code else [code]  # _code
+        last["G"] = code
         words += ["X" + tx, "Y" + ty]  # _word(..., force=True)
-        self.last["X"], self.last["Y"] = tx, ty
+        last["X"], last["Y"] = tx, ty
         if z is not None:
             self._word("Z", self.text("Z", z), words)
         words += ["I" + ti, "J" + tj]
