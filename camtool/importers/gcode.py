@@ -251,8 +251,9 @@ def _parse(text: str, source: str, *, plain: bool) -> Program:
     ended = False
     plain_line = _PLAIN_LINE.fullmatch
     plain_words = _PLAIN_WORD.findall
+    last = len(lines)
     for number, raw in enumerate(lines, start=1):
-        if number == len(lines) and (cut := cut_mid_word(raw)) is not None:
+        if number == last and (cut := cut_mid_word(raw)) is not None:
             raise InputError(
                 f"{source}:{number}: the file ends in the middle of a word ({cut!r}, with no "
                 "end of line after it): the last line is incomplete, the file looks "
@@ -366,8 +367,14 @@ class _Reader:
             return False
         scale = INCH if self.inch else 1.0
         feed = self.feed_mm_min if f is None else f * scale
-        if args and not self._plain_move(args, motion, feed, scale, line):
-            return False
+        if args:  # the motion of the X Y Z I J R words
+            if motion is None or not self.absolute or self.x is None or self.y is None:
+                return False  # without motion run() refuses the words; the rest is not plain
+            if motion == "G2" or motion == "G3":
+                if not self._plain_arc(args, motion, feed, scale, line, (self.x, self.y)):
+                    return False
+            elif not self._plain_move(args, motion, feed, scale, line, (self.x, self.y)):
+                return False
         self.line = line
         self.motion = motion
         self.feed_mm_min = feed
@@ -376,21 +383,22 @@ class _Reader:
     def _plain_move(
         self,
         args: dict[str, float],
-        motion: str | None,
+        motion: str,
         feed: float | None,
         scale: float,
         line: int,
+        start: Point,
     ) -> bool:
-        """The motion of a plain line with X Y Z I J R words in ``args`` (:meth:`plain`)."""
-        if motion is None or not self.absolute or self.x is None or self.y is None:
-            return False  # without motion run() refuses the words; the rest is not plain
-        if motion in ("G2", "G3"):
-            return self._plain_arc(args, motion, feed, scale, line, (self.x, self.y))
+        """The straight motion of a plain line with X Y Z I J R words in ``args``.
+
+        :meth:`plain` checks first that there is a motion, a known position (``start``)
+        and absolute distances, and reads arcs (G2, G3) itself.
+        """
         if "I" in args or "J" in args or "R" in args:
             return False  # run() refuses them
         if "X" not in args and "Y" not in args and "Z" not in args:
             return False
-        return self._plain_line(args, motion, feed, scale, line, (self.x, self.y))
+        return self._plain_line(args, motion, feed, scale, line, start)
 
     def _plain_line(
         self,
@@ -475,7 +483,8 @@ class _Reader:
                 return False
         z_out = tz if z is not None and tz != self.z else None
         self.positioned = True
-        arc = _arc_move(tx, ty, cx, cy, name == "G2", feed, z_out, self._contour(False))
+        self.cut_in_contour = True  # _contour(False)
+        arc = _arc_move(tx, ty, cx, cy, name == "G2", feed, z_out, self.contour)
         self._plain_push(arc, tx, ty, tz, line)
         return True
 
