@@ -239,11 +239,15 @@ def half_up(value: float, decimals: int) -> tuple[str, bool] | None:
     if negative:
         r = r[1:]
     cut = r.find(".") + 1 + decimals  # r has a point: a float's repr without exponent
-    if cut < len(r) and r[cut] < "5":
-        # rounds down: the digits kept are the text (``r`` has no leading zeros but "0.")
+    # The digits of r are the text's when none is dropped (zeros added) or the first dropped
+    # is below 5 (r has no leading zeros but the one of "0."); else a carry may ripple.
+    if cut >= len(r):
+        text = r + "0" * (cut - len(r))  # decimals > 0: r has a digit after its point
+    elif r[cut] < "5":
         text = r[: cut - 1] if decimals == 0 else r[:cut]
-        return text, negative and text.strip("0.") != ""
-    return _half_up_digits(r, decimals, negative)
+    else:
+        return _half_up_digits(r, decimals, negative)
+    return text, negative and text.strip("0.") != ""
 
 
 def _half_up_digits(r: str, decimals: int, negative: bool) -> tuple[str, bool]:
