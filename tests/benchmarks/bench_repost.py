@@ -73,8 +73,12 @@ GOAL = 2.0
 END = re.compile(r"^\s*(n\d+\s*)?m0*(2|30)\s*$", re.IGNORECASE)
 
 
-def build_program(dest: Path) -> Path | None:
-    """Write the benchmark program to ``dest`` (None when the corpus lacks the examples)."""
+def build_program(dest: Path, copies: int = COPIES) -> Path | None:
+    """Write the benchmark program to ``dest`` (None when the corpus lacks the examples).
+
+    ``copies``: how many times the three examples are repeated (1: the program without
+    the repeats, 1 995 lines, which the note of the row times too).
+    """
     bodies = []
     for name in PROGRAMS:
         path = CORPUS / "pkg" / "linuxcnc" / name
@@ -82,7 +86,7 @@ def build_program(dest: Path) -> Path | None:
             return None
         lines = path.read_text().splitlines()
         bodies.append([x for x in lines if not END.match(x) and x.strip() != "%"])
-    out = [line for _ in range(COPIES) for body in bodies for line in body]
+    out = [line for _ in range(copies) for body in bodies for line in body]
     dest.write_text("\n".join([*out, "M2"]) + "\n")
     return dest
 
@@ -171,6 +175,11 @@ def main() -> None:
         kib = peak_kib(cmd, env)
         digest = hashlib.sha256(out.read_bytes()).hexdigest()
         identical = same_input and digest == OUTPUT_SHA256
+        one = build_program(Path(tmp) / "one.ngc", copies=1)
+        assert one is not None  # the same examples as big
+        one_cmd = [*cmd[:4], str(one), "--target", "linuxcnc", "-o", str(Path(tmp) / "one.out")]
+        one_s = best_wall(one_cmd, env)
+        one_peer: float | None = None
         rs = rs274_command()
         if rs is None:
             peer, peer_s = "LinuxCNC rs274 not installed (`make corpus`): recorded figure", None
@@ -182,9 +191,12 @@ def main() -> None:
             if check.returncode != 0 or "PROGRAM_END" not in check.stdout:
                 raise SystemExit(f"rs274 refuses the program: {check.stderr.strip()[-300:]}")
             peer_s = best_wall([*rs_cmd, str(big)], rs_env, stdout=subprocess.DEVNULL)
+            one_peer = best_wall([*rs_cmd, str(one)], rs_env, stdout=subprocess.DEVNULL)
         print(
             f"camtool {camtool_s:.3f} s ({kib / 1024:.0f} MB), {peer}: "
-            f"{peer_s if peer_s is not None else RS274_RECORDED_S:.3f} s",
+            f"{peer_s if peer_s is not None else RS274_RECORDED_S:.3f} s; one copy "
+            f"(1 995 lines): camtool {one_s:.3f} s, rs274 "
+            f"{'—' if one_peer is None else f'{one_peer:.3f} s'}",
             file=sys.stderr,
         )
     reference = peer_s if peer_s is not None else RS274_RECORDED_S
@@ -192,7 +204,9 @@ def main() -> None:
     source = "" if peer_s is not None else f" (recorded {RS274_RECORDED_S} s, this docstring)"
     note = (
         f"{len(data):,} bytes; output {'identical to' if identical else 'DIFFERS from'} "
-        f"b3b77a5{'' if same_input else ' (the corpus programs changed)'}; peak {kib / 1024:.0f} MB"
+        f"b3b77a5{'' if same_input else ' (the corpus programs changed)'}; "
+        f"peak {kib / 1024:.0f} MB; the examples once (1 995 lines): camtool {one_s:.2f} s"
+        + ("" if one_peer is None else f", rs274 {one_peer:.2f} s ({one_s / one_peer:.1f}×)")
     )
     row(
         job,
