@@ -637,6 +637,8 @@ def plainly_passes(solver: Solver, s: Index, e: Index, c: Index, ref: Reference)
     slope = abs(rho1 - rho0) / abs(sweep)  # |dρ/dθ|
     if rho_min * rho_min - rho_max * delta - slope * delta <= 1e-6 * rho_min * rho_min:
         return False  # the path may not turn monotonically about the exact centre
+    if delta != 0.0 and delta * sweep == 0.0:
+        return False  # δ·σ underflows (a centre a subnormal away): _radial_span divides by it
     f_min, f_max = _radial_span(rho0, rho1, u0x, u0y, dx, dy, delta, sweep)
     if f_min <= 0.0:
         return False
