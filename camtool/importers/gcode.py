@@ -103,6 +103,73 @@ between words only; anything else (comments, other letters or characters, a blan
 word, a non-ASCII digit) goes to the lexer."""
 _PLAIN_WORD = re.compile(r"([GXYZIJRFN])(" + _PLAIN_NUMBER + ")")
 _PLAIN_MOTION = {0: "G0", 10: "G1", 20: "G2", 30: "G3"}
+_PLAIN_G = {0.0: "G0", 1.0: "G1", 2.0: "G2", 3.0: "G3"}
+""":data:`_PLAIN_MOTION` by the G word's value, for the values ``g_key`` gives those keys."""
+
+
+def _fields_are(cls: type, names: tuple[str, ...]) -> bool:
+    """True when ``cls`` is a plain frozen dataclass of the fields ``names``, in that order.
+
+    Then an object made by :func:`_new_move` is the one its ``__init__`` makes: the
+    same ``__dict__`` (the same keys in the same order), so equal, with the same hash
+    and repr. No ``__post_init__`` (nothing checked or derived) and no ``__slots__``.
+    """
+    fields = getattr(cls, "__dataclass_fields__", {})
+    return (
+        tuple(fields) == names
+        and not hasattr(cls, "__post_init__")
+        and "__slots__" not in vars(cls)
+        and "__init__" in vars(cls)
+    )
+
+
+_new_move = object.__new__
+_FAST_MOVES = (
+    _fields_are(Rapid, ("x", "y", "z", "contour"))
+    and _fields_are(Linear, ("x", "y", "feed_mm_min", "z", "contour"))
+    and _fields_are(ArcMove, ("x", "y", "cx", "cy", "clockwise", "feed_mm_min", "z", "contour"))
+)
+"""Whether the plain reader makes its moves without their (frozen, slow) ``__init__``."""
+
+
+def _rapid(x: float, y: float, z: float | None, contour: int) -> Rapid:
+    """``Rapid(x, y, z, contour)`` (without its ``__init__`` when :data:`_FAST_MOVES`)."""
+    if not _FAST_MOVES:
+        return Rapid(x, y, z, contour)
+    move = _new_move(Rapid)
+    d = move.__dict__
+    d["x"], d["y"], d["z"], d["contour"] = x, y, z, contour
+    return move
+
+
+def _linear(x: float, y: float, feed: float, z: float | None, contour: int) -> Linear:
+    """``Linear(x, y, feed, z, contour)`` (as :func:`_rapid`)."""
+    if not _FAST_MOVES:
+        return Linear(x, y, feed, z, contour)
+    move = _new_move(Linear)
+    d = move.__dict__
+    d["x"], d["y"], d["feed_mm_min"], d["z"], d["contour"] = x, y, feed, z, contour
+    return move
+
+
+def _arc_move(
+    x: float,
+    y: float,
+    cx: float,
+    cy: float,
+    clockwise: bool,
+    feed: float,
+    z: float | None,
+    contour: int,
+) -> ArcMove:
+    """``ArcMove(x, y, cx, cy, clockwise, feed, z, contour)`` (as :func:`_rapid`)."""
+    if not _FAST_MOVES:
+        return ArcMove(x, y, cx, cy, clockwise, feed, z, contour)
+    move = _new_move(ArcMove)
+    d = move.__dict__
+    d["x"], d["y"], d["cx"], d["cy"] = x, y, cx, cy
+    d["clockwise"], d["feed_mm_min"], d["z"], d["contour"] = clockwise, feed, z, contour
+    return move
 
 
 def read_gcode(path: str | Path, *, source_name: str | None = None) -> Program:
@@ -184,8 +251,9 @@ def _parse(text: str, source: str, *, plain: bool) -> Program:
     ended = False
     plain_line = _PLAIN_LINE.fullmatch
     plain_words = _PLAIN_WORD.findall
+    last = len(lines)
     for number, raw in enumerate(lines, start=1):
-        if number == len(lines) and (cut := cut_mid_word(raw)) is not None:
+        if number == last and (cut := cut_mid_word(raw)) is not None:
             raise InputError(
                 f"{source}:{number}: the file ends in the middle of a word ({cut!r}, with no "
                 "end of line after it): the last line is incomplete, the file looks "
@@ -289,16 +357,24 @@ class _Reader:
         motion = self.motion
         g = args.pop("G", None)
         if g is not None:
-            motion = _PLAIN_MOTION.get(g_key(g))  # type: ignore[arg-type]
+            motion = _PLAIN_G.get(g)
             if motion is None:
-                return False
+                motion = _PLAIN_MOTION.get(g_key(g))  # type: ignore[arg-type]
+                if motion is None:
+                    return False
         f = args.pop("F", None)
         if f is not None and f < 0:
             return False
         scale = INCH if self.inch else 1.0
         feed = self.feed_mm_min if f is None else f * scale
-        if args and not self._plain_move(args, motion, feed, scale, line):
-            return False
+        if args:  # the motion of the X Y Z I J R words
+            if motion is None or not self.absolute or self.x is None or self.y is None:
+                return False  # without motion run() refuses the words; the rest is not plain
+            if motion == "G2" or motion == "G3":
+                if not self._plain_arc(args, motion, feed, scale, line, (self.x, self.y)):
+                    return False
+            elif not self._plain_move(args, motion, feed, scale, line, (self.x, self.y)):
+                return False
         self.line = line
         self.motion = motion
         self.feed_mm_min = feed
@@ -307,21 +383,22 @@ class _Reader:
     def _plain_move(
         self,
         args: dict[str, float],
-        motion: str | None,
+        motion: str,
         feed: float | None,
         scale: float,
         line: int,
+        start: Point,
     ) -> bool:
-        """The motion of a plain line with X Y Z I J R words in ``args`` (:meth:`plain`)."""
-        if motion is None or not self.absolute or self.x is None or self.y is None:
-            return False  # without motion run() refuses the words; the rest is not plain
-        if motion in ("G2", "G3"):
-            return self._plain_arc(args, motion, feed, scale, line, (self.x, self.y))
+        """The straight motion of a plain line with X Y Z I J R words in ``args``.
+
+        :meth:`plain` checks first that there is a motion, a known position (``start``)
+        and absolute distances, and reads arcs (G2, G3) itself.
+        """
         if "I" in args or "J" in args or "R" in args:
             return False  # run() refuses them
         if "X" not in args and "Y" not in args and "Z" not in args:
             return False
-        return self._plain_line(args, motion, feed, scale, line, (self.x, self.y))
+        return self._plain_line(args, motion, feed, scale, line, start)
 
     def _plain_line(
         self,
@@ -343,12 +420,12 @@ class _Reader:
             return False  # _first_positioning
         if name == "G0":
             self.positioned = self.positioned or gives_xy
-            self._plain_push(Rapid(tx, ty, z_out, self._contour(True)), tx, ty, tz, line)
+            self._plain_push(_rapid(tx, ty, z_out, self._contour(True)), tx, ty, tz, line)
             return True
         if feed is None or feed == 0:
             return False
         self.positioned = self.positioned or gives_xy
-        move = Linear(tx, ty, feed, z_out, self._contour(False))
+        move = _linear(tx, ty, feed, z_out, self._contour(False))
         self._plain_push(move, tx, ty, tz, line)
         return True
 
@@ -406,7 +483,8 @@ class _Reader:
                 return False
         z_out = tz if z is not None and tz != self.z else None
         self.positioned = True
-        arc = ArcMove(tx, ty, cx, cy, name == "G2", feed, z_out, self._contour(False))
+        self.cut_in_contour = True  # _contour(False)
+        arc = _arc_move(tx, ty, cx, cy, name == "G2", feed, z_out, self.contour)
         self._plain_push(arc, tx, ty, tz, line)
         return True
 

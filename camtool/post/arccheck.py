@@ -77,13 +77,16 @@ import math
 from dataclasses import dataclass
 from decimal import ROUND_HALF_UP, Decimal
 from functools import cached_property, lru_cache
-
-import numpy as np
-import numpy.typing as npt
+from typing import TYPE_CHECKING
 
 from camtool.model.errors import DialectError, UsageError
 from camtool.model.shapes import Point
 from camtool.post.numfmt import half_up
+
+if TYPE_CHECKING:  # numpy is imported in the functions that use it: a re-post whose arcs
+    # all pass the shortcut (plainly_passes) never loads it (~0.1 s of CPU)
+    import numpy as np
+    import numpy.typing as npt
 
 # -- the controllers' rules ------------------------------------------------------------
 
@@ -152,6 +155,8 @@ def arc_error(start: Point, end: Point, centre: Point, *, rule: str) -> str | No
 
 def _grbl_error(start: Point, end: Point, centre: Point) -> str | None:
     """GRBL 1.1 ``gcode.c`` on float32 words (the nearest float32 of each printed number)."""
+    import numpy as np  # imported where used (see the module's imports)
+
     f32 = np.float32
     i, j = f32(centre[0] - start[0]), f32(centre[1] - start[1])
     x = (f32(end[0]) - f32(start[0])) - i
@@ -202,6 +207,8 @@ def rule_ok(
     r1: npt.NDArray[np.float64],
 ) -> npt.NDArray[np.bool_]:
     """The rule on ``(K,)`` start and end radii (mm), :data:`MARGIN_MM` inside every limit."""
+    import numpy as np  # imported where used (see the module's imports)
+
     m = MARGIN_MM
     delta = np.abs(r1 - r0)
     if rule == "grbl":
@@ -230,6 +237,8 @@ def travel(
     :data:`GRBL_ANGULAR_EPSILON` of zero a full turn; LinuxCNC's
     ``pmCircleInit`` makes an end on the start a full turn too.
     """
+    import numpy as np  # imported where used (see the module's imports)
+
     cross = u0[:, 0] * u1[:, 1] - u0[:, 1] * u1[:, 0]
     sweep = np.arctan2(cross, np.sum(u0 * u1, axis=1))
     if clockwise:
@@ -253,8 +262,9 @@ SAMPLES = 65
 """Points per block at which the path is compared with the exact arc."""
 
 Index = tuple[int, int]
-IntArray = npt.NDArray[np.int64]
-FloatArray = npt.NDArray[np.float64]
+if TYPE_CHECKING:
+    IntArray = npt.NDArray[np.int64]
+    FloatArray = npt.NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -387,6 +397,8 @@ class Reference:
 
     def distance(self, p: FloatArray) -> FloatArray:
         """Distance of points ``p`` (``(..., 2)`` mm) from this arc, mm (shape ``p[..., 0]``)."""
+        import numpy as np  # imported where used (see the module's imports)
+
         dx, dy = p[..., 0] - self.centre[0], p[..., 1] - self.centre[1]
         turned = np.arctan2(dy, dx) - self.angle
         along = np.mod(turned if self.sweep >= 0 else -turned, 2 * math.pi)
@@ -460,6 +472,8 @@ class Solver:
             c0 = self.grid.indices(self.exact_centre)
             if plainly_passes(self, s, e, c0, ref) and self._accepted(s, e, c0):
                 return c0  # what the search below returns first: see plainly_passes
+        import numpy as np  # imported where used (see the module's imports)
+
         exact = np.array(self.exact_centre) / self.grid.mm
         rounded = np.array([self.grid.indices(self.exact_centre)], dtype=np.int64)
         tiers = (
@@ -488,6 +502,8 @@ class Solver:
         of the exact centre's foot on it; empty when ``s == e`` (every centre
         equalises the radii).
         """
+        import numpy as np  # imported where used (see the module's imports)
+
         q = self.grid.mm
         chord = np.subtract(e, s).astype(np.float64)
         d = float(np.hypot(*chord))
@@ -520,6 +536,8 @@ class Solver:
         The rule with a margin, a sweep within 90° of the exact part's, and a
         path within :attr:`limit` of it.
         """
+        import numpy as np  # imported where used (see the module's imports)
+
         q = self.grid.mm
         u0 = ((np.array(s) - cands) * q).astype(np.float64)  # (K, 2) centre → start, mm
         u1 = ((np.array(e) - cands) * q).astype(np.float64)
@@ -619,6 +637,8 @@ def plainly_passes(solver: Solver, s: Index, e: Index, c: Index, ref: Reference)
     slope = abs(rho1 - rho0) / abs(sweep)  # |dρ/dθ|
     if rho_min * rho_min - rho_max * delta - slope * delta <= 1e-6 * rho_min * rho_min:
         return False  # the path may not turn monotonically about the exact centre
+    if delta != 0.0 and delta * sweep == 0.0:
+        return False  # δ·σ underflows (a centre a subnormal away): _radial_span divides by it
     f_min, f_max = _radial_span(rho0, rho1, u0x, u0y, dx, dy, delta, sweep)
     if f_min <= 0.0:
         return False
@@ -695,6 +715,8 @@ def _angle(v: Point, w: Point) -> float:
 
 def _disk(rounded: IntArray, exact: FloatArray) -> IntArray:
     """Grid points ``(K, 2)`` within :data:`SEARCH_QUANTA` of the exact centre (in quanta)."""
+    import numpy as np  # imported where used (see the module's imports)
+
     near = np.arange(-math.ceil(SEARCH_QUANTA), math.ceil(SEARCH_QUANTA) + 1)
     disk = rounded + np.array([(a, b) for a in near for b in near], dtype=np.int64)
     return disk[np.hypot(*(disk - exact).T) <= SEARCH_QUANTA]
@@ -715,6 +737,8 @@ def _path(
     (``mc_arc``); LinuxCNC changes the radius linearly with the angle, a spiral
     (``pmCirclePoint``).
     """
+    import numpy as np  # imported where used (see the module's imports)
+
     t = np.linspace(0.0, 1.0, SAMPLES)
     angle = np.arctan2(u0[:, 1], u0[:, 0])[:, None] + sweep[:, None] * t
     growth = np.zeros_like(r0) if rule == "grbl" else r1 - r0
@@ -813,6 +837,8 @@ def conform_arc(
     ref = _reference(start, end, centre, clockwise, exact_start)
     solver = Solver(grid, rule, clockwise, centre, shortcut)
     if e == s and abs(ref.sweep) < 2 * math.pi:
+        import numpy as np  # imported where used (see the module's imports)
+
         samples = np.array([ref.at(t) for t in np.linspace(0.0, 1.0, SAMPLES)])
         if np.max(np.hypot(samples[:, 0] - start[0], samples[:, 1] - start[1])) <= solver.limit:
             return []

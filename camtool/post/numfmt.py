@@ -236,7 +236,23 @@ def half_up(value: float, decimals: int) -> tuple[str, bool] | None:
     if "e" in r or "n" in r:
         return None
     negative = r[0] == "-"
-    whole, _, frac = (r[1:] if negative else r).partition(".")
+    if negative:
+        r = r[1:]
+    cut = r.find(".") + 1 + decimals  # r has a point: a float's repr without exponent
+    # The digits of r are the text's when none is dropped (zeros added) or the first dropped
+    # is below 5 (r has no leading zeros but the one of "0."); else a carry may ripple.
+    if cut >= len(r):
+        text = r + "0" * (cut - len(r))  # decimals > 0: r has a digit after its point
+    elif r[cut] < "5":
+        text = r[: cut - 1] if decimals == 0 else r[:cut]
+    else:
+        return _half_up_digits(r, decimals, negative)
+    return text, negative and text.strip("0.") != ""
+
+
+def _half_up_digits(r: str, decimals: int, negative: bool) -> tuple[str, bool]:
+    """:func:`half_up` of the repr ``r`` (no sign, no exponent) by integer arithmetic."""
+    whole, _, frac = r.partition(".")
     if len(frac) <= decimals:
         digits = int(whole + frac.ljust(decimals, "0"))
     else:

@@ -194,6 +194,8 @@ def word_address_dialect(options: Mapping[str, Any], where: str) -> WordAddressP
 
 _SAME_MM = 1e-9
 """Exact XY closer than this is the same point (a Z-only move)."""
+_PRINTED_KEPT = 1 << 16
+"""Coordinates per letter whose text a writer keeps (:meth:`BlockWriter._print`)."""
 _CONFORMED_KEPT = 20_000
 """Arcs whose blocks a writer keeps (:meth:`BlockWriter._conformed`); then it starts anew."""
 
@@ -233,6 +235,12 @@ class BlockWriter(WriterState[str]):
             if word.number.grid_mm is None
         }
         self._parses = {letter: word.number.parse for letter, word in spec.words.items()}
+        # The text and the value read back of each coordinate already written, by letter
+        # and value (:meth:`_print`): the writer prints an arc's end twice (to see whether
+        # it prints as its start, then in its block) and every end is read back.
+        self._printed: dict[str, dict[float, tuple[str, float]]] = {
+            letter: {} for letter in spec.words
+        }
         self._quantum: float | None = None
         self._conformed_arcs: dict[tuple[Any, ...], list[tuple[Point, Point | None]]] = {}
         self._feed_text: tuple[float, str] | None = None
@@ -280,12 +288,14 @@ class BlockWriter(WriterState[str]):
         Raises:
             DialectError: the block is longer than ``max_block_bytes``.
         """
-        text = self.spec.separator.join(words) + self.spec.block_end
-        limit = self.spec.max_block_bytes
-        if limit is None and text.isascii():
-            self.blocks.append(text)  # no limit to check (the size of ASCII text is its length)
+        spec = self.spec
+        text = spec.separator.join(words) + spec.block_end
+        limit = spec.max_block_bytes
+        # the size of ASCII text is its length
+        if text.isascii() and (limit is None or len(text) + len(spec.line_end) <= limit):
+            self.blocks.append(text)
             return
-        size = len((text + self.spec.line_end).encode("ascii"))
+        size = len((text + spec.line_end).encode("ascii"))
         if limit is not None and size > limit:
             raise DialectError(
                 f"{self.where()}: {text!r} is {size} bytes with its line end; "
@@ -319,6 +329,26 @@ class BlockWriter(WriterState[str]):
             self.grid_error_mm = max(self.grid_error_mm, abs(number.parse(text) - value))
         return text
 
+    def _print(self, letter: str, value: float) -> tuple[str, float]:
+        """``value``'s text in word ``letter`` and the value the controller reads from it, mm.
+
+        The same as ``(text, parse(text))`` with :meth:`text` (which is a function of
+        ``letter`` and ``value``, its step-grid error a running maximum): kept by value
+        (up to :data:`_PRINTED_KEPT` per letter; ``0.0`` and ``-0.0`` print the same).
+
+        Raises:
+            DialectError: see :meth:`text` (errors are not kept).
+        """
+        kept = self._printed[letter]
+        known = kept.get(value)
+        if known is None:
+            text = self.text(letter, value)
+            known = (text, self._parses[letter](text))
+            if len(kept) >= _PRINTED_KEPT:
+                kept.clear()
+            kept[value] = known
+        return known
+
     def _round(self, letter: str, value: float) -> float:
         """``value`` as the controller reads it back after writing."""
         number = self.spec.words[letter].number
@@ -346,11 +376,13 @@ class BlockWriter(WriterState[str]):
         if move.contour:
             self.contour = move.contour
         start = self.here
-        self._check_area(start, move)
-        if move.z is not None and self._same_z(move.z):
-            move = dataclasses.replace(move, z=None)  # Z does not change as written
+        if self.machine.coordinates != "work":
+            self._check_area(start, move)
         if move.z is not None:
-            self._check_z(move)
+            if self._same_z(move.z):
+                move = dataclasses.replace(move, z=None)  # Z does not change as written
+            else:
+                self._check_z(move)
         if isinstance(move, ArcMove):
             self._arc(start, move)
         else:
@@ -402,12 +434,12 @@ class BlockWriter(WriterState[str]):
         words: list[str] = []
         self._code(rapid if isinstance(move, Rapid) else linear, words)
         if xy is not None:
-            tx, ty = self.text("X", xy[0]), self.text("Y", xy[1])
+            (tx, px), (ty, py) = self._print("X", xy[0]), self._print("Y", xy[1])
             unchanged = self.last.get("X") == tx and self.last.get("Y") == ty
             force = unchanged and z is None
             self._word("X", tx, words, force=force)
             self._word("Y", ty, words, force=force)
-            self.written = self._parsed(tx, ty)
+            self.written = (px, py)
         if z is not None:
             self._word("Z", self.text("Z", z), words, force=xy is None)
         if isinstance(move, Linear):
@@ -415,13 +447,13 @@ class BlockWriter(WriterState[str]):
         self.block(words)
 
     def _feed(self, move: Linear | ArcMove, words: list[str]) -> None:
-        spec = self.spec.word("F")
-        if spec is None:
-            self.counts["feed"] += 1
-            return
         same = self._feed_text
         if same is not None and same[0] == move.feed_mm_min:
             self._word("F", same[1], words)  # the feed before: checked and warned about
+            return
+        spec = self.spec.word("F")
+        if spec is None:
+            self.counts["feed"] += 1
             return
         text = self.text("F", move.feed_mm_min)
         written = spec.number.parse(text)
@@ -440,18 +472,29 @@ class BlockWriter(WriterState[str]):
 
     def _arc(self, start: Point, move: ArcMove) -> None:
         arc = Arc(start, (move.x, move.y), (move.cx, move.cy), move.clockwise)
-        end_prints = self._parsed(self.text("X", move.x), self.text("Y", move.y))
-        if end_prints == self.written and abs(arc.sweep) > math.pi:
+        printed = self._printed
+        tx = printed["X"].get(move.x) or self._print("X", move.x)
+        ty = printed["Y"].get(move.y) or self._print("Y", move.y)
+        if (tx[1], ty[1]) == self.written and abs(arc.sweep) > math.pi:
             # within the resolution of a full circle: the controller reads one
             arc = Arc(start, start, arc.centre, arc.clockwise)
         full_circle = arc.is_full_circle
         parts = self._parts(arc, full_circle)
         blocks: list[tuple[Point, Point | None, bool]] = []
-        for piece in [arc] if parts == 1 else arc.split(parts):  # split(1) is [arc] anew
-            conformed = self._conformed(piece)
-            whole = full_circle if parts == 1 else piece.is_full_circle
-            full = whole and len(conformed) == 1
+        if parts == 1:
+            conformed = self._conformed(arc)
+            full = full_circle and len(conformed) == 1
+            if len(conformed) == 1 and move.z is None:  # the usual arc: one block, no helix
+                end, centre = conformed[0]
+                xy = (tx, ty) if end == (move.x, move.y) else None  # its end is printed
+                self._arc_block(move, (end, centre), None, full=full, xy=xy)
+                return
             blocks += [(end, centre, full) for end, centre in conformed]
+        else:
+            for piece in arc.split(parts):
+                conformed = self._conformed(piece)
+                full = piece.is_full_circle and len(conformed) == 1
+                blocks += [(end, centre, full) for end, centre in conformed]
         for k, (end, centre, full) in enumerate(blocks, start=1):
             z = move.z  # a helix climbs evenly over the blocks it is written in
             if move.z is not None and self.z is not None:
@@ -465,7 +508,9 @@ class BlockWriter(WriterState[str]):
         """
         limit = self.spec.max_arc_deg
         if limit >= 360.0:
-            parts = 1  # a sweep is at most 360° (the formula below gives 1 too)
+            if not full_circle:
+                return 1  # a sweep is at most 360° (the formula below gives 1 too)
+            parts = 1
         else:
             sweep = math.degrees(abs(arc.sweep))
             parts = max(1, math.ceil(sweep / limit - 1e-9))
@@ -527,45 +572,56 @@ class BlockWriter(WriterState[str]):
         return [(p.end, p.centre) for p in out]
 
     def _arc_block(
-        self, move: ArcMove, end_centre: tuple[Point, Point | None], z: float | None, *, full: bool
+        self,
+        move: ArcMove,
+        end_centre: tuple[Point, Point | None],
+        z: float | None,
+        *,
+        full: bool,
+        xy: tuple[tuple[str, float], tuple[str, float]] | None = None,
     ) -> None:
         """One G2/G3 block, or a G1 block when the arc vanishes at this resolution.
 
         ``full`` says the arc is meant as a full circle (its written end is its
         written start); any other arc whose written end is its written start, or
         whose written centre is its start (or no centre, see :meth:`_conformed`),
-        is too small to write.
+        is too small to write. ``xy``: what :meth:`_print` gives the end's X and Y,
+        when the caller has it.
         """
         end, centre = end_centre
-        _, _, cw, ccw = self.spec.motion_codes
-        tx, ty = self.text("X", end[0]), self.text("Y", end[1])
-        written = self._parsed(tx, ty)
-        ox, oy = (0.0, 0.0) if self.spec.arc_centre == "absolute" else self.written
+        spec = self.spec
+        _, _, cw, ccw = spec.motion_codes
+        if xy is None:
+            xy = self._print("X", end[0]), self._print("Y", end[1])
+        (tx, px), (ty, py) = xy
+        written = (px, py)
+        before = self.written
+        ox, oy = (0.0, 0.0) if spec.arc_centre == "absolute" else before
         ti = tj = ""
-        tiny = centre is None or (written == self.written and not full)
+        tiny = centre is None or (written == before and not full)
         if centre is not None:
-            ti, tj = self.text("I", centre[0] - ox), self.text("J", centre[1] - oy)
-            i, j = self._parses["I"](ti), self._parses["J"](tj)
-            tiny = tiny or (i + ox, j + oy) == self.written
+            printed = self._printed
+            ci, cj = centre[0] - ox, centre[1] - oy
+            ti, i = printed["I"].get(ci) or self._print("I", ci)
+            tj, j = printed["J"].get(cj) or self._print("J", cj)
+            tiny = tiny or (i + ox, j + oy) == before
         if tiny:
             self.counts["tiny-arc"] += 1
             linear = Linear(end[0], end[1], move.feed_mm_min, contour=move.contour)
             self._line(linear, end, z)
             return
-        words: list[str] = []
-        self._code(cw if move.clockwise else ccw, words)
+        code = cw if move.clockwise else ccw
+        last = self.last
+        words = [] if "G" in spec.modal and last.get("G") == code else [code]  # _code
+        last["G"] = code
         words += ["X" + tx, "Y" + ty]  # _word(..., force=True)
-        self.last["X"], self.last["Y"] = tx, ty
+        last["X"], last["Y"] = tx, ty
         if z is not None:
             self._word("Z", self.text("Z", z), words)
         words += ["I" + ti, "J" + tj]
         self.written = written
         self._feed(move, words)
         self.block(words)
-
-    def _parsed(self, tx: str, ty: str) -> Point:
-        """The XY the controller reads from the texts of X and Y."""
-        return self._parses["X"](tx), self._parses["Y"](ty)
 
     # -- commands ----------------------------------------------------------------
 

@@ -113,17 +113,27 @@ def _extent_fast(start: Point, moves: Sequence[Move]) -> BBox | None:
         return None
     x0, x1, y0, y1 = min(xs), max(xs), min(ys), max(ys)
     boxes = [(x0, y0, x1, y1)]
-    here = start
+    c0, c1, c2, c3 = _QUAD_COS
+    s0, s1, s2, s3 = _QUAD_SIN
+    hx, hy = start
     for move in moves:
         if isinstance(move, ArcMove):
             cx, cy = move.cx, move.cy
-            r = math.hypot(here[0] - cx, here[1] - cy)  # Arc.radius
-            inside = all(x0 < cx + r * c < x1 for c in _QUAD_COS) and all(
-                y0 < cy + r * s < y1 for s in _QUAD_SIN
+            r = math.hypot(hx - cx, hy - cy)  # Arc.radius
+            # the four extremes strictly inside, each the float Arc.bbox computes
+            inside = (
+                x0 < cx + r * c0 < x1
+                and x0 < cx + r * c1 < x1
+                and x0 < cx + r * c2 < x1
+                and x0 < cx + r * c3 < x1
+                and y0 < cy + r * s0 < y1
+                and y0 < cy + r * s1 < y1
+                and y0 < cy + r * s2 < y1
+                and y0 < cy + r * s3 < y1
             )
             if not inside:
-                boxes.append(segment_of(here, move).bbox())
-        here = (move.x, move.y)
+                boxes.append(segment_of((hx, hy), move).bbox())
+        hx, hy = move.x, move.y
     box = bbox_union(boxes)
     if not all(map(math.isfinite, box)) or 0.0 in box:
         return None

@@ -157,3 +157,30 @@ def test_corpus_programs_read_the_same() -> None:
             text = data.decode("latin-1")
         fast, slow = both(text)
         assert fast == slow, path
+
+
+def test_plain_moves_are_made_as_their_init_makes_them() -> None:
+    """The plain reader's moves, made without ``__init__``, equal the dataclass's own."""
+    from camtool.importers import gcode
+    from camtool.model.program import ArcMove, Linear, Rapid
+
+    assert gcode._FAST_MOVES  # the model's moves are plain frozen dataclasses
+    rng = random.Random(1717)
+    values = [0.0, -0.0, 1.5, -2.25, 1e300, math.pi]
+    for _ in range(200):
+        x, y, cx, cy, feed = (rng.choice([*values, rng.uniform(-9, 9)]) for _ in range(5))
+        z = rng.choice([None, -0.0, rng.uniform(-9, 9)])
+        contour, cw = rng.randint(0, 5), rng.random() < 0.5
+        pairs = [
+            (gcode._rapid(x, y, z, contour), Rapid(x, y, z, contour)),
+            (gcode._linear(x, y, feed, z, contour), Linear(x, y, feed, z, contour)),
+            (
+                gcode._arc_move(x, y, cx, cy, cw, feed, z, contour),
+                ArcMove(x, y, cx, cy, cw, feed, z, contour),
+            ),
+        ]
+        for fast, made in pairs:
+            assert type(fast) is type(made)
+            assert repr(fast) == repr(made)  # every field, -0.0 included
+            assert list(vars(fast).items()) == list(vars(made).items())
+            assert fast == made and hash(fast) == hash(made)

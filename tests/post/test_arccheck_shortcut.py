@@ -197,3 +197,19 @@ def _called(call: object, arg: float) -> object:
         return call(arg)  # type: ignore[operator]
     except ArithmeticError as exc:
         return type(exc)
+
+
+@pytest.mark.parametrize("rule", ["grbl", "linuxcnc"])
+def test_a_centre_a_subnormal_off_the_grid_goes_to_the_search(rule: str) -> None:
+    """δ·σ underflows to 0 (a centre 5e-324 mm from its grid point): no ZeroDivisionError.
+
+    Found by test_arccheck's hypothesis search; the blocks are the search's own.
+    """
+    centre, r, decimals = (0.0, 5e-324), math.exp(1.0625), 1
+    a0, a1 = math.radians(1.0), math.radians(30.0)
+    ex_start = (centre[0] + r * math.cos(a0), centre[1] + r * math.sin(a0))
+    ex_end = (centre[0] + r * math.cos(a1), centre[1] + r * math.sin(a1))
+    start = (round(ex_start[0], decimals), round(ex_start[1], decimals))
+    args = (start, ex_end, centre, False)
+    kw = {"rule": rule, "quantum_mm": 0.1, "exact_start": ex_start}
+    assert conform_arc(*args, **kw) == conform_arc(*args, **kw, shortcut=False)

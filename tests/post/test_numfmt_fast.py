@@ -99,3 +99,20 @@ def test_parse_fast_equals_decimal() -> None:
         texts.append(repr(v))
     for t in texts:
         assert _outcome(fmt.parse, t) == _outcome(fmt._parse_slow, t), t
+
+
+def test_half_up_equals_decimal() -> None:
+    """``half_up``'s shortcut (a repr that rounds down keeps its digits) is Decimal's rounding."""
+    from decimal import ROUND_HALF_UP, Decimal
+
+    from camtool.post.numfmt import half_up
+
+    rng = np.random.default_rng(1717)
+    for v in _values(rng, 4000):
+        for d in range(8):
+            got = half_up.__wrapped__(v, d)
+            if got is None:
+                assert "e" in repr(v) or not math.isfinite(v)
+                continue
+            q = Decimal(repr(v)).quantize(Decimal(1).scaleb(-d), rounding=ROUND_HALF_UP)
+            assert got == (f"{abs(q):.{d}f}", q < 0), (v, d)

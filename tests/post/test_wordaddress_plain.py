@@ -2,9 +2,10 @@
 
 :class:`~camtool.post.wordaddress.BlockWriter` formats a word without a step grid with
 its number format directly (:meth:`text`), writes the feed of the block before again
-without checking it anew (:meth:`_feed`) and keeps the blocks of each arc it conformed to
+without checking it anew (:meth:`_feed`), keeps the text and value read back of each
+coordinate it printed (:meth:`_print`) and keeps the blocks of each arc it conformed to
 the controller's check for the same arc again (:meth:`_conformed`). :class:`Reference`
-turns all three off: every word goes through the full formatting, every feed through its
+turns them all off: every word goes through the full formatting, every feed through its
 checks and every arc through :func:`~camtool.post.arccheck.conform_arc`, as before. On
 random programs of rapids, lines and arcs (tiny, huge, full circles, reflex arcs,
 helices, feeds that round, numbers over their field) written for every built-in
@@ -38,6 +39,10 @@ class Reference(BlockWriter):
     def _feed(self, move: Linear | ArcMove, words: list[str]) -> None:
         self._feed_text = None
         super()._feed(move, words)
+
+    def _print(self, letter: str, value: float) -> tuple[str, float]:
+        text = self.text(letter, value)
+        return text, self._parses[letter](text)
 
     def _conformed(self, piece: Arc) -> list[tuple[Point, Point | None]]:
         if self.spec.arc_check == "none":
