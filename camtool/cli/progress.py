@@ -84,6 +84,8 @@ class StageReporter:
         self._live = live
         self._shown: tuple[str, int] | None = None  # the stage line last written
         self._drawn = 0.0  # when the live line was last drawn
+        self._latest = ""  # the live line as the last step would draw it
+        self._on_screen = ""  # the live line as drawn
         self._open = False  # a live line without its newline
         self._broken = False  # writing failed once (closed stderr): stay silent
 
@@ -94,20 +96,23 @@ class StageReporter:
         now = self._clock()
         if now - self._start < self._after:
             return
-        text = stage_text(step)
         if self._shown != (step.stage, step.total):
             self.close()
             self._shown = (step.stage, step.total)
             if self._is_live():
-                self._draw(f"camtool: {text}…{_count(step)}", now)
+                self._draw(_line(step), now)
             else:
-                self._write(f"camtool: {text}…\n")
-        elif self._open and now - self._drawn >= REDRAW_S:
-            self._draw(f"camtool: {text}…{_count(step)}", now)
+                self._write(f"camtool: {stage_text(step)}…\n")
+        elif self._open:
+            self._latest = _line(step)
+            if now - self._drawn >= REDRAW_S:
+                self._draw(self._latest, now)
 
     def close(self) -> None:
-        """End a redrawn line (call before writing anything else to stderr)."""
+        """End a redrawn line, with its last count, (call before writing anything else)."""
         if self._open:
+            if self._latest != self._on_screen:
+                self._draw(self._latest, self._clock())
             self._open = False
             self._write("\n")
 
@@ -115,6 +120,7 @@ class StageReporter:
         self._write(f"\r{line}\x1b[K")  # back to the start, the line, erase what was left
         self._open = True
         self._drawn = now
+        self._latest = self._on_screen = line
 
     def _is_live(self) -> bool:
         if self._live is None:
@@ -135,6 +141,11 @@ class StageReporter:
         except (OSError, ValueError):  # stderr closed or gone: progress is not worth a failure
             self._broken = True
             self._open = False
+
+
+def _line(step: Step) -> str:
+    """The terminal's line for ``step``: what the stage does, and its count once it has one."""
+    return f"camtool: {stage_text(step)}…{_count(step)}"
 
 
 def _count(step: Step) -> str:

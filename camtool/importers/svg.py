@@ -111,8 +111,8 @@ def read_svg(
     hidden = invisible = 0
     drawn: list[tuple[Any, list[Any] | None]] = []
     shapes = list(_shapes(svg))
-    for i, shape in enumerate(shapes):
-        progress(Step("reading", i, len(shapes), path.name))
+    progress(Step("reading", 0, len(shapes), path.name))
+    for i, shape in enumerate(shapes, start=1):
         values = shape.values
         if str(values.get("visibility", "visible")).strip().lower() in ("hidden", "collapse"):
             hidden += 1
@@ -120,10 +120,12 @@ def read_svg(
             invisible += 1
         else:
             drawn.append((shape, _segments(shape)))
+        progress(Step("reading", i, len(shapes), path.name))
     fitter = _prefitted(drawn, prepared.matrix, options.tolerance, progress)
-    for i, (shape, segments) in enumerate(drawn):
-        progress(Step("contours", i, len(drawn)))
+    progress(Step("contours", 0, len(drawn)))
+    for i, (shape, segments) in enumerate(drawn, start=1):
         contours.extend(_contours(path, shape, segments, prepared.matrix, fitter))
+        progress(Step("contours", i, len(drawn)))
     if hidden:
         warnings.append(f"{path}: skipped {hidden} {_elements(hidden)} with visibility:hidden")
     if invisible:

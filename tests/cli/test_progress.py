@@ -79,6 +79,7 @@ def test_a_terminal_line_is_redrawn_at_most_four_times_a_second() -> None:
         f"\r{line} 300 of 1000 (30%)\x1b[K"  # 0.3 s after the first draw
         f"\r{line} 600 of 1000 (60%)\x1b[K"
         f"\r{line} 900 of 1000 (90%)\x1b[K"
+        f"\r{line} 1000 of 1000 (100%)\x1b[K"  # the last count, before the line ends
         "\n"  # the next stage starts its own line
         "\rcamtool: planning 40 contours…\x1b[K"
         "\n"  # closed: the terminal's line is finished before anything else is written

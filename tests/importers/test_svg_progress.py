@@ -50,15 +50,15 @@ def test_stages_of_a_large_drawing_in_order(
     assert steps[0] == Step("reading", 0, 0, "many.svg")
     reading = [s for s in steps if s.stage == "reading"][1:]
     assert [(s.done, s.total, s.name) for s in reading] == [
-        (i, PATHS, "many.svg") for i in range(PATHS)
-    ]
+        (i, PATHS, "many.svg") for i in range(PATHS + 1)
+    ]  # 0 once counted, then each shape as it is read
     fitting = [s for s in steps if s.stage == "fitting"]
     assert {s.total for s in fitting} == {CURVES}
     # the start, then one step per chunk of 7 fits as the workers answer, in order
     expected = [*range(0, CURVES, 7)[1:], CURVES]
     assert [s.done for s in fitting] == [0, *expected]
     contours = [s for s in steps if s.stage == "contours"]
-    assert [(s.done, s.total) for s in contours] == [(i, PATHS) for i in range(PATHS)]
+    assert [(s.done, s.total) for s in contours] == [(i, PATHS) for i in range(PATHS + 1)]
 
 
 def test_fits_here_count_one_by_one(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
