@@ -127,7 +127,10 @@ def post(
 
     With --verify (implied by --report, --preview or --max-error-um) the written
     code is read back and simulated on the target's machine, as `verify` does.
+
+    A job still running after 2 s says on stderr what it is doing, a line per stage.
     """
+    from camtool.cli.progress import StageReporter
     from camtool.jobs.inputs import is_program_file, read_input
     from camtool.jobs.output import check_paths
     from camtool.jobs.pipeline import (
@@ -137,6 +140,7 @@ def post(
         refuse_planning,
         verify_job,
     )
+    from camtool.model.progress import Step
     from camtool.toolpath.options import drawing_only
 
     check_paths(
@@ -152,10 +156,17 @@ def post(
     if drawing != "-" and is_program_file(drawing):
         refuse_planning(drawing, drawing_only(options))  # before checking them
     plan = plan_settings(options)
-    if drawing == "-":
-        job = post_drawing(read_input(drawing, settings), chosen, plan, output_options)
-    else:
-        job = post_path(drawing, chosen, plan, output_options, import_options=settings)
+    progress = StageReporter()
+    try:
+        if drawing == "-":
+            drawn = read_input(drawing, settings)
+            job = post_drawing(drawn, chosen, plan, output_options, progress=progress)
+        else:
+            job = post_path(
+                drawing, chosen, plan, output_options, import_options=settings, progress=progress
+            )
+    finally:
+        progress.close()
     warn(job.warnings)
     if job.plan is not None:
         for line in job.plan.notes():
@@ -171,6 +182,8 @@ def post(
             f"camtool: wrote {job.result.blocks} blocks for {chosen.name} to {output}", err=True
         )
     if verify_too or report or preview or max_error_um is not None:
+        progress(Step("verifying", 0, job.result.blocks, chosen.name))
+        progress.close()
         _finish_verification(
             verify_job(job, budget=not no_budget),
             report,

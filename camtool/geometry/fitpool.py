@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from typing import Any, TypeAlias
 
@@ -88,7 +88,11 @@ def default_jobs() -> int:
 
 
 def fit_many(
-    keys: Sequence[CurveKey], tolerance: float, jobs: int | None = None
+    keys: Sequence[CurveKey],
+    tolerance: float,
+    jobs: int | None = None,
+    *,
+    done: Callable[[int], None] | None = None,
 ) -> list[list[Segment] | None]:
     """:func:`fit_key` of every key, in order; ``None`` where that fit raised.
 
@@ -97,6 +101,9 @@ def fit_many(
         tolerance: mm (> 0), as for :func:`fit_key`.
         jobs: worker processes; ``None``: :func:`default_jobs`. With 1, or fewer than
             :data:`MIN_CURVES` keys, every fit runs in this process.
+        done: called in this process with the number of keys fitted so far, as they
+            come in (after each fit here, after each worker's chunk of keys with a pool);
+            for a progress report, it does not change the fits.
 
     Returns:
         One entry per key: its segments (exactly :func:`fit_key`'s), or ``None``.
@@ -104,10 +111,15 @@ def fit_many(
     workers = default_jobs() if jobs is None else max(1, jobs)
     workers = min(workers, -(-len(keys) // _CHUNK))
     if workers > 1 and len(keys) >= MIN_CURVES and not _in_worker():
-        packed = _in_pool(keys, tolerance, workers)
+        packed = _in_pool(keys, tolerance, workers, done)
         if packed is not None:
             return [None if p is None else _unpack(p) for p in packed]
-    return [_fit_or_none(k, tolerance) for k in keys]
+    fits = []
+    for key in keys:
+        fits.append(_fit_or_none(key, tolerance))
+        if done is not None:
+            done(len(fits))
+    return fits
 
 
 def _in_worker() -> bool:
@@ -121,9 +133,15 @@ def _in_worker() -> bool:
 
 
 def _in_pool(
-    keys: Sequence[CurveKey], tolerance: float, workers: int
+    keys: Sequence[CurveKey],
+    tolerance: float,
+    workers: int,
+    done: Callable[[int], None] | None = None,
 ) -> list[_Packed | None] | None:
-    """The packed fits from ``workers`` forked processes; ``None`` if no pool can run them."""
+    """The packed fits from ``workers`` forked processes; ``None`` if no pool can run them.
+
+    ``done`` is called here with the count of fits received, after each chunk.
+    """
     try:
         context = multiprocessing.get_context("fork")
     except ValueError:  # pragma: no cover - no fork on this platform
@@ -131,7 +149,12 @@ def _in_pool(
     chunks = [(list(keys[i : i + _CHUNK]), tolerance) for i in range(0, len(keys), _CHUNK)]
     try:
         with ProcessPoolExecutor(workers, mp_context=context) as pool:
-            return [p for chunk in pool.map(_fit_chunk, chunks) for p in chunk]
+            packed: list[_Packed | None] = []
+            for chunk in pool.map(_fit_chunk, chunks):
+                packed.extend(chunk)
+                if done is not None:
+                    done(len(packed))
+            return packed
     except (OSError, RuntimeError, EOFError, AssertionError):  # cannot fork, a worker died
         return None
 

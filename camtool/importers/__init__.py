@@ -13,6 +13,7 @@ from pathlib import Path
 
 from camtool.importers.options import ImportOptions
 from camtool.model.errors import InputError
+from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import Drawing
 
 POINT_SUFFIXES = (".csv", ".txt", ".xy", ".m")
@@ -22,12 +23,17 @@ DRAWING_SUFFIXES = (".dxf", ".svg", *POINT_SUFFIXES)
 """File name endings the importers read, lowercase."""
 
 
-def read_drawing(path: str | Path, options: ImportOptions | None = None) -> Drawing:
+def read_drawing(
+    path: str | Path, options: ImportOptions | None = None, *, progress: Progress = no_progress
+) -> Drawing:
     """Read the drawing at ``path``, choosing the importer by the file name ending.
 
     Args:
         path: the drawing file.
         options: importer options; ``None`` takes the defaults.
+        progress: told the ``reading`` stage (:class:`~camtool.model.progress.Step`),
+            and by the SVG importer its shapes and curve fits as it goes
+            (:func:`camtool.importers.svg.read_svg`).
 
     Raises:
         InputError: the file is missing, unreadable, of an unknown kind, or holds
@@ -39,14 +45,16 @@ def read_drawing(path: str | Path, options: ImportOptions | None = None) -> Draw
     if suffix == ".dxf":
         from camtool.importers.dxf import read_dxf
 
+        progress(Step("reading", name=path.name))
         return read_dxf(path, options)
     if suffix == ".svg":
         from camtool.importers.svg import read_svg
 
-        return read_svg(path, options)
+        return read_svg(path, options, progress=progress)
     if suffix in POINT_SUFFIXES:
         from camtool.importers.points import read_points
 
+        progress(Step("reading", name=path.name))
         return read_points(path, options)
     if suffix == "" and str(path) == "-":
         raise InputError("'-' (stdin) must be read with read_drawing_bytes")

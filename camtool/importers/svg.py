@@ -61,6 +61,7 @@ from camtool.importers.svgdoc import (
     prepare,
 )
 from camtool.model.errors import GeometryError, InputError
+from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import TAU, Arc, Contour, Drawing, Line, Point, Segment, distance
 
 DEFAULT_LAYER = "0"
@@ -69,7 +70,9 @@ DEFAULT_LAYER = "0"
 _SHAPES = (se.Path, se.Rect, se.Circle, se.Ellipse, se.SimpleLine, se.Polyline, se.Polygon)
 
 
-def read_svg(path: str | Path, options: ImportOptions | None = None) -> Drawing:
+def read_svg(
+    path: str | Path, options: ImportOptions | None = None, *, progress: Progress = no_progress
+) -> Drawing:
     """Read an SVG file into a drawing in mm, Y up.
 
     The page's bottom-left corner is the origin. ``width``/``height`` in mm, cm, in, pt,
@@ -81,6 +84,11 @@ def read_svg(path: str | Path, options: ImportOptions | None = None) -> Drawing:
         options: ``layers`` (Inkscape layer labels or ids; hidden layers named here are read)
             and ``tolerance`` (mm, for Béziers and ellipses) are used; ``units`` does not
             apply (SVG files carry their own units).
+        progress: told the stages (:class:`~camtool.model.progress.Step`): ``reading``
+            (the file's name; ``total``: drawn shapes once counted, ``done`` as their
+            segments are read), ``fitting`` (only when the curves are fitted ahead, see
+            :func:`_prefitted`; ``total``: distinct curves) and ``contours`` (``total``:
+            shapes). It changes nothing in the drawing.
 
     Returns:
         One contour per drawn subpath, and the warnings a user should see (assumed units,
@@ -95,13 +103,16 @@ def read_svg(path: str | Path, options: ImportOptions | None = None) -> Drawing:
     path = Path(path)
     options = options or ImportOptions()
     check_tolerance(options.tolerance)
+    progress(Step("reading", name=path.name))
     prepared = prepare(path, options.layers, max_entities=options.max_entities)
     svg = _parse(path, prepared)
     warnings = list(prepared.warnings)
     contours: list[Contour] = []
     hidden = invisible = 0
     drawn: list[tuple[Any, list[Any] | None]] = []
-    for shape in _shapes(svg):
+    shapes = list(_shapes(svg))
+    progress(Step("reading", 0, len(shapes), path.name))
+    for i, shape in enumerate(shapes, start=1):
         values = shape.values
         if str(values.get("visibility", "visible")).strip().lower() in ("hidden", "collapse"):
             hidden += 1
@@ -109,9 +120,12 @@ def read_svg(path: str | Path, options: ImportOptions | None = None) -> Drawing:
             invisible += 1
         else:
             drawn.append((shape, _segments(shape)))
-    fitter = _prefitted(drawn, prepared.matrix, options.tolerance)
-    for shape, segments in drawn:
+        progress(Step("reading", i, len(shapes), path.name))
+    fitter = _prefitted(drawn, prepared.matrix, options.tolerance, progress)
+    progress(Step("contours", 0, len(drawn)))
+    for i, (shape, segments) in enumerate(drawn, start=1):
         contours.extend(_contours(path, shape, segments, prepared.matrix, fitter))
+        progress(Step("contours", i, len(drawn)))
     if hidden:
         warnings.append(f"{path}: skipped {hidden} {_elements(hidden)} with visibility:hidden")
     if invisible:
@@ -237,13 +251,19 @@ def _segments(shape: Any) -> list[Any] | None:
         return None
 
 
-def _prefitted(drawn: list[tuple[Any, list[Any] | None]], page: Affine, tolerance: float) -> Fitter:
+def _prefitted(
+    drawn: list[tuple[Any, list[Any] | None]],
+    page: Affine,
+    tolerance: float,
+    progress: Progress = no_progress,
+) -> Fitter:
     """A :class:`Fitter` holding the fits of the drawing's curves, made on every core.
 
     Only for at least :data:`~camtool.geometry.fitpool.MIN_CURVES` curves: the shapes are
     converted once with a :class:`_Recorder` to collect the curves in order (a shape that
     fails here fails again, with its message, when converted for real), then
-    :func:`~camtool.geometry.fitpool.fit_many` fits them.
+    :func:`~camtool.geometry.fitpool.fit_many` fits them, telling ``progress`` the
+    ``fitting`` stage (``total``: the distinct curves) as the fits come in.
     """
     count = sum(isinstance(seg, _CURVES) for _, segs in drawn for seg in segs or ())
     if count < MIN_CURVES:
@@ -257,7 +277,10 @@ def _prefitted(drawn: list[tuple[Any, list[Any] | None]], page: Affine, toleranc
         except Exception:  # converted again below, raising in order
             continue
     keys = list({repr(k): k for k in recorder.keys}.items())
-    fits = fit_many([k for _, k in keys], tolerance)
+    progress(Step("fitting", 0, len(keys)))
+    fits = fit_many(
+        [k for _, k in keys], tolerance, done=lambda n: progress(Step("fitting", n, len(keys)))
+    )
     done = {text: segs for (text, _), segs in zip(keys, fits, strict=True) if segs is not None}
     return Fitter(tolerance, done)
 

@@ -12,6 +12,7 @@ from camtool.importers.options import ImportOptions
 from camtool.jobs.inputs import is_program_file
 from camtool.model.errors import InputError, UsageError
 from camtool.model.program import Move, Program
+from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import Drawing
 from camtool.post.base import PostResult, Target
 from camtool.post.registry import load_target
@@ -110,6 +111,7 @@ def post_file(
     *,
     machine_file: Path | None = None,
     import_options: ImportOptions | None = None,
+    progress: Progress = no_progress,
 ) -> PostJob:
     """Load the target called ``target_name`` and post the file at ``path`` (see :func:`post_path`).
 
@@ -120,12 +122,13 @@ def post_file(
         output: how the program is written (``None``: the defaults).
         machine_file: TOML file laid over the target's machine profile.
         import_options: how the drawing is read (layers, units…).
+        progress: told the stages as the job goes (see :func:`post_path`).
 
     Raises:
         CamtoolError: from any stage, with its exit code.
     """
     target = load_target_checked(target_name, machine_file=machine_file)
-    return post_path(path, target, plan, output, import_options=import_options)
+    return post_path(path, target, plan, output, import_options=import_options, progress=progress)
 
 
 def post_path(
@@ -135,6 +138,7 @@ def post_path(
     output: OutputOptions | None = None,
     *,
     import_options: ImportOptions | None = None,
+    progress: Progress = no_progress,
 ) -> PostJob:
     """Post the file at ``path``: a drawing is planned, a G-code program re-posted.
 
@@ -147,6 +151,11 @@ def post_path(
         plan: the planning options (``None``: the defaults, the target's feed).
         output: how the program is written (``None``: the defaults).
         import_options: how the drawing is read (layers, units…).
+        progress: told the stages (:class:`~camtool.model.progress.Step`) as the job goes:
+            ``reading`` (and for an SVG ``fitting`` and ``contours``,
+            :func:`camtool.importers.read_drawing`), ``planning`` and ``writing``
+            (:func:`post_drawing`); a program: ``reading`` and ``writing``. It changes
+            nothing in the job.
 
     Raises:
         UsageError: a planning option (offset, tool diameter, scale, depth, order...)
@@ -155,13 +164,20 @@ def post_path(
     """
     plan = plan if plan is not None else PlanOptions()
     if not is_program_file(path):
-        drawing = read_drawing(path, import_options)
-        return post_drawing(_note_units(drawing, path, import_options), target, plan, output)
+        drawing = read_drawing(path, import_options, progress=progress)
+        drawing = _note_units(drawing, path, import_options)
+        return post_drawing(drawing, target, plan, output, progress=progress)
     refuse_planning(path, drawing_only(plan.given()))
     from camtool.importers.gcode import read_gcode
 
+    progress(Step("reading", name=Path(path).name))
     return post_program(
-        read_gcode(path), target, output, feed_mm_min=plan.feed_mm_min, source=str(path)
+        read_gcode(path),
+        target,
+        output,
+        feed_mm_min=plan.feed_mm_min,
+        source=str(path),
+        progress=progress,
     )
 
 
@@ -240,6 +256,7 @@ def post_program(
     *,
     feed_mm_min: float | None = None,
     source: str = "",
+    progress: Progress = no_progress,
 ) -> PostJob:
     """Re-post an existing program (e.g. G-code another CAM wrote) for a target.
 
@@ -254,6 +271,7 @@ def post_program(
     ``output.spindle_dwell_s`` seconds after it starts. ``source`` (the input's file
     name) goes into the job notes (:func:`job_notes`) unless the program has notes.
     Nothing is added to the program's motion: no move to X0 Y0, no clearance move.
+    ``progress`` is told the ``writing`` stage (``total``: the program's moves).
 
     Raises:
         CamtoolError: whatever the target cannot express (names the block).
@@ -272,6 +290,7 @@ def post_program(
     if not program.notes:
         program = dataclasses.replace(program, notes=job_notes(source, target))
     program = _with_spindle(program, output.spindle_rpm, output.spindle_dwell_s)
+    progress(Step("writing", 0, len(program.moves), target.name))
     return PostJob(None, program, target, target.emit(program, fmt=output.fmt), None, 0.0)
 
 
@@ -353,6 +372,8 @@ def post_drawing(
     target: Target,
     plan: PlanOptions | None = None,
     output: OutputOptions | None = None,
+    *,
+    progress: Progress = no_progress,
 ) -> PostJob:
     """Plan a drawing and post it for a target.
 
@@ -364,6 +385,8 @@ def post_drawing(
             ``depth``, ``order``...); ``None``: the defaults.
         output: the output format and spindle (``None``: the defaults; the spindle
             speed then is the target's ``spindle_rpm``, which may be none).
+        progress: told the ``planning`` stage (``total``: the drawing's contours) and
+            the ``writing`` stage (``total``: the program's moves; ``name``: the target).
 
     Raises:
         CamtoolError: from any stage, with its exit code.
@@ -372,6 +395,7 @@ def post_drawing(
     plan = plan_options(target, plan)
     from camtool.toolpath.plan import plan_drawing  # not needed by a re-post: numpy
 
+    progress(Step("planning", 0, len(drawing.contours)))
     planned = plan_drawing(drawing, plan, target.machine, helix=target.post.helix)
     program = dataclasses.replace(
         planned.program,
@@ -385,6 +409,7 @@ def post_drawing(
         output.spindle_dwell_s,
     )
     edge = plan.radius if plan.offset != "on" else 0.0
+    progress(Step("writing", 0, len(program.moves), target.name))
     result = target.emit(program, fmt=output.fmt)
     return PostJob(drawing, program, target, result, planned.placed, edge, planned.report)
 

@@ -7,6 +7,10 @@ files share one run of each (file, target). The corpus comes from
 
 ``CAMTOOL_CORPUS=full`` runs every fetched file instead of the deterministic sample, and
 ``CAMTOOL_CORPUS=off`` skips the corpus (e.g. for a quick local run).
+
+The corpus is only read: the programs a run writes, and its ``results.json``, go to a
+folder of this pytest run (:func:`out_root`, under pytest's ``tmp_path_factory``), so two
+runs at once (two worktrees, CI and a developer) never write the same file.
 """
 
 from __future__ import annotations
@@ -19,6 +23,7 @@ import os
 import re
 import shlex
 import signal
+import tempfile
 import time
 from collections import Counter
 from dataclasses import dataclass, field
@@ -26,6 +31,7 @@ from pathlib import Path
 from typing import Any
 
 import click
+import pytest
 
 from camtool.cli.main import cli, main
 from camtool.post.registry import load_target
@@ -88,9 +94,14 @@ class Run:
 
     @property
     def error(self) -> str:
-        """The first error line of stderr ('' when none)."""
+        """The first error line of stderr ('' when none).
+
+        ``camtool: error:`` lines first: a progress line of a slow run (``camtool: reading
+        dialog-error.svg…``) may hold the word too.
+        """
         lines = [ln for ln in self.stderr.splitlines() if "error" in ln]
-        return lines[0] if lines else ""
+        errors = [ln for ln in lines if ln.startswith("camtool: error:")]
+        return (errors or lines or [""])[0]
 
     def command(self) -> str:
         """The run as a user types it."""
@@ -245,7 +256,7 @@ def resolve(rel: str, target: str) -> Outcome:
     """Post REL for TARGET; on failure follow the message's remedy (up to MAX_REMEDIES)."""
     src = CORPUS / rel
     digest = hashlib.sha1(rel.encode()).hexdigest()[:8]
-    outdir = CORPUS / "out" / target / f"{src.stem}-{digest}"
+    outdir = out_root() / target / f"{src.stem}-{digest}"
     outcome = Outcome(rel, target)
     extra: list[str] = []
     for attempt in range(MAX_REMEDIES + 1):
@@ -301,6 +312,25 @@ def _follow(
 
 
 _OUTCOMES: dict[tuple[str, str], Outcome] = {}
+_OUT: list[Path] = []  # this run's output folder, once made
+
+
+def out_root() -> Path:
+    """This run's folder for the programs and results.json (never inside the corpus).
+
+    Set by the :func:`_corpus_out` fixture to a folder of pytest's ``tmp_path_factory``;
+    made with :func:`tempfile.mkdtemp` when the harness is used outside pytest.
+    """
+    if not _OUT:
+        _OUT.append(Path(tempfile.mkdtemp(prefix="camtool-corpus-")))
+    return _OUT[0]
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _corpus_out(tmp_path_factory: pytest.TempPathFactory) -> None:
+    """Make :func:`out_root` a folder of this pytest run (kept as pytest keeps its temp)."""
+    if not _OUT:
+        _OUT.append(tmp_path_factory.mktemp("corpus-out"))
 
 
 def outcome_for(rel: str, target: str) -> Outcome:
@@ -312,7 +342,7 @@ def outcome_for(rel: str, target: str) -> Outcome:
 
 
 def pytest_terminal_summary(terminalreporter: Any) -> None:
-    """Print the corpus counts and keep them in .corpus/results.json."""
+    """Print the corpus counts and keep them in this run's results.json (path printed)."""
     if not _OUTCOMES:
         return
     counts = Counter(o.status for o in _OUTCOMES.values())
@@ -348,4 +378,6 @@ def pytest_terminal_summary(terminalreporter: Any) -> None:
             for o in _OUTCOMES.values()
         ],
     }
-    (CORPUS / "results.json").write_text(json.dumps(results, indent=1) + "\n")
+    kept = out_root() / "results.json"
+    kept.write_text(json.dumps(results, indent=1) + "\n")
+    terminalreporter.write_line(f"cases and programs kept in {kept.parent}")

@@ -10,7 +10,8 @@ A drawing with nothing camtool can cut (text, images or filters only) may be ref
 exit 3 and "nothing to cut; camtool reads ...": counted apart as "refused".
 
 Counts (first try / after remedy / failed) are printed at the end of the run and kept in
-``.corpus/results.json``; reproducers of failures go to the lead's findings file.
+``results.json`` in the run's own temporary folder (the summary prints where; the corpus
+itself is only read); reproducers of failures go to the lead's findings file.
 """
 
 from __future__ import annotations

@@ -22,6 +22,7 @@ from __future__ import annotations
 import os
 import re
 import subprocess
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -65,12 +66,13 @@ def rs274_problem() -> str | None:
         return skip_reason()
     if "rs274" not in MANIFEST:
         return f"rs274 was not fetched: {'; '.join(MANIFEST.get('notes', []))}"
-    probe = CORPUS / "rs274-probe.ngc"
-    probe.write_text(KNOWN_GOOD)
-    try:
-        done = rs274(probe)
-    except OSError as exc:
-        return f"rs274 cannot run: {exc}"
+    with tempfile.TemporaryDirectory(prefix="camtool-rs274-") as tmp:  # the corpus is read-only
+        probe = Path(tmp) / "rs274-probe.ngc"
+        probe.write_text(KNOWN_GOOD)
+        try:
+            done = rs274(probe)
+        except OSError as exc:
+            return f"rs274 cannot run: {exc}"
     if done.returncode != 0 or "ARC_FEED(7.0000, 4.0000, 5.0000, 4.0000, -1" not in done.stdout:
         return f"rs274 fails on a known-good program: {done.stderr.strip()[-300:]}"
     return None

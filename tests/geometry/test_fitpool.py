@@ -61,6 +61,20 @@ def test_parallel_fits_equal_serial_fits(monkeypatch: pytest.MonkeyPatch) -> Non
     assert pooled == [True]  # one job: no pool
 
 
+def test_done_counts_the_fits_as_they_come_in(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``done`` hears the count so far: per chunk from the workers, per fit here; same fits."""
+    monkeypatch.setattr(fitpool, "MIN_CURVES", 1)
+    monkeypatch.setattr(fitpool, "_CHUNK", 7)
+    keys = _keys(30)
+    serial = [fit_key(k, 0.01) for k in keys]
+    pooled: list[int] = []
+    assert repr(fit_many(keys, 0.01, jobs=2, done=pooled.append)) == repr(serial)
+    assert pooled == [7, 14, 21, 28, 30]  # five chunks of at most 7, in order
+    here: list[int] = []
+    assert repr(fit_many(keys, 0.01, jobs=1, done=here.append)) == repr(serial)
+    assert here == list(range(1, 31))
+
+
 def test_a_fit_that_raises_is_none_and_the_others_stay(monkeypatch: pytest.MonkeyPatch) -> None:
     """A failing fit answers None (the caller fits it again and raises in order)."""
     monkeypatch.setattr(fitpool, "MIN_CURVES", 1)

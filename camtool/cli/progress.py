@@ -1,0 +1,155 @@
+"""Progress of a long ``camtool post`` on stderr: quiet for short jobs, a line per stage after.
+
+The library tells where a job is through a callback (:mod:`camtool.model.progress`);
+:class:`StageReporter` is that callback for the CLI. It stays silent until the job has run
+:data:`AFTER_S` seconds, so a job that finishes sooner prints exactly what it printed
+before. After that it prints one line per stage, naming how big the work is, as the job
+enters it (or, for the stage it is in when the time is up, at once)::
+
+    camtool: reading eastern-motive-P4G.svg: 5712 shapes…
+    camtool: fitting arcs to 30576 curves…
+    camtool: making contours of 5712 shapes…
+    camtool: planning 5712 contours…
+    camtool: writing 232119 moves for grbl…
+
+On a terminal the line of the current stage is also redrawn in place (a carriage return)
+with the count and percentage done, at most :data:`REDRAW_S` apart; the line is finished
+before anything else goes to stderr. Into a file or a pipe (CI logs, ``2> log``) only the
+stage lines are written, never a redrawn line. stdout is never touched (it may carry the
+program, ``-o -``).
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections.abc import Callable
+from typing import TextIO
+
+from camtool.model.progress import Step
+
+AFTER_S = 2.0
+"""Seconds a job runs before its progress is shown (shorter jobs print nothing new)."""
+
+REDRAW_S = 0.25
+"""Least time between two redraws of a terminal's progress line, s."""
+
+
+def stage_text(step: Step) -> str:
+    """What the stage of ``step`` is doing and how big it is, without the count done.
+
+    >>> stage_text(Step("fitting", 10, 30576))
+    'fitting arcs to 30576 curves'
+    """
+    total = step.total
+    if step.stage == "reading":
+        return f"reading {step.name}: {total} shapes" if total else f"reading {step.name}"
+    if step.stage == "fitting":
+        return f"fitting arcs to {total} curves"
+    if step.stage == "contours":
+        return f"making contours of {total} shapes"
+    if step.stage == "planning":
+        return f"planning {total} contours"
+    if step.stage == "writing":
+        return f"writing {total} moves for {step.name}"
+    if step.stage == "verifying":
+        return f"verifying {total} blocks on {step.name}"
+    return step.stage
+
+
+class StageReporter:
+    """A :data:`~camtool.model.progress.Progress` callback that writes to stderr (see module).
+
+    Args:
+        after_s: seconds from its creation before anything is shown (tests pass 0).
+        stream: where to write (default: ``sys.stderr`` at each write, so that a
+            redirected stderr is honoured).
+        live: redraw the current stage's line with its count (default: whether the
+            stream is a terminal).
+        clock: seconds, monotonic (tests pass a fake one).
+    """
+
+    def __init__(
+        self,
+        *,
+        after_s: float | None = None,
+        stream: TextIO | None = None,
+        live: bool | None = None,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self._clock = clock
+        self._start = clock()
+        self._after = AFTER_S if after_s is None else after_s
+        self._stream = stream
+        self._live = live
+        self._shown: tuple[str, int] | None = None  # the stage line last written
+        self._drawn = 0.0  # when the live line was last drawn
+        self._latest = ""  # the live line as the last step would draw it
+        self._on_screen = ""  # the live line as drawn
+        self._open = False  # a live line without its newline
+        self._broken = False  # writing failed once (closed stderr): stay silent
+
+    def __call__(self, step: Step) -> None:
+        """Show ``step`` if the job has run long enough (see the module)."""
+        if self._broken:
+            return
+        now = self._clock()
+        if now - self._start < self._after:
+            return
+        if self._shown != (step.stage, step.total):
+            self.close()
+            self._shown = (step.stage, step.total)
+            if self._is_live():
+                self._draw(_line(step), now)
+            else:
+                self._write(f"camtool: {stage_text(step)}…\n")
+        elif self._open:
+            self._latest = _line(step)
+            if now - self._drawn >= REDRAW_S:
+                self._draw(self._latest, now)
+
+    def close(self) -> None:
+        """End a redrawn line, with its last count, (call before writing anything else)."""
+        if self._open:
+            if self._latest != self._on_screen:
+                self._draw(self._latest, self._clock())
+            self._open = False
+            self._write("\n")
+
+    def _draw(self, line: str, now: float) -> None:
+        self._write(f"\r{line}\x1b[K")  # back to the start, the line, erase what was left
+        self._open = True
+        self._drawn = now
+        self._latest = self._on_screen = line
+
+    def _is_live(self) -> bool:
+        if self._live is None:
+            try:
+                self._live = bool(self._out().isatty())
+            except (AttributeError, ValueError, OSError):
+                self._live = False
+        return self._live
+
+    def _out(self) -> TextIO:
+        return self._stream if self._stream is not None else sys.stderr
+
+    def _write(self, text: str) -> None:
+        try:
+            out = self._out()
+            out.write(text)
+            out.flush()
+        except (OSError, ValueError):  # stderr closed or gone: progress is not worth a failure
+            self._broken = True
+            self._open = False
+
+
+def _line(step: Step) -> str:
+    """The terminal's line for ``step``: what the stage does, and its count once it has one."""
+    return f"camtool: {stage_text(step)}…{_count(step)}"
+
+
+def _count(step: Step) -> str:
+    """`` 1200 of 30576 (3%)`` once the stage has counted some of its work, else ``""``."""
+    if step.total <= 0 or step.done <= 0:
+        return ""
+    return f" {step.done} of {step.total} ({100 * step.done // step.total}%)"

@@ -1,0 +1,151 @@
+"""Progress of a long ``camtool post`` on stderr (camtool/cli/progress.py).
+
+No timed tests: the reporter's clock is a fake one, and the CLI's threshold is forced to 0
+(every job "long") or left at its default for a small file, which must then print exactly
+what it printed before (no new line, stdout untouched).
+"""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import pytest
+
+from camtool.cli import progress as progress_module
+from camtool.cli.main import main
+from camtool.cli.progress import StageReporter, stage_text
+from camtool.model.progress import Step
+from tests.importers.test_svg_pool import _svg
+
+SAMPLES = Path(__file__).parents[2] / "samples"
+
+
+class Clock:
+    """A clock the test moves by hand, s."""
+
+    def __init__(self) -> None:
+        self.now = 100.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+def _reporter(live: bool) -> tuple[StageReporter, io.StringIO, Clock]:
+    out, clock = io.StringIO(), Clock()
+    return StageReporter(after_s=2.0, stream=out, live=live, clock=clock), out, clock
+
+
+def test_quiet_before_the_threshold_then_a_line_per_stage() -> None:
+    reporter, out, clock = _reporter(live=False)
+    reporter(Step("reading", name="big.svg"))
+    reporter(Step("reading", 10, 5712, "big.svg"))
+    clock.now += 1.9
+    reporter(Step("fitting", 0, 30576))
+    reporter(Step("fitting", 480, 30576))
+    assert out.getvalue() == ""  # 1.9 s: nothing yet
+    clock.now += 0.2
+    reporter(Step("fitting", 960, 30576))  # the stage running when the time is up
+    reporter(Step("fitting", 1440, 30576))  # same stage: no new line into a file
+    clock.now += 10.0
+    reporter(Step("contours", 0, 5712))
+    reporter(Step("planning", 0, 5712))
+    reporter(Step("writing", 0, 232119, "grbl"))
+    reporter(Step("verifying", 0, 232128, "grbl"))
+    reporter.close()
+    assert out.getvalue() == (
+        "camtool: fitting arcs to 30576 curves…\n"
+        "camtool: making contours of 5712 shapes…\n"
+        "camtool: planning 5712 contours…\n"
+        "camtool: writing 232119 moves for grbl…\n"
+        "camtool: verifying 232128 blocks on grbl…\n"
+    )
+    assert "\r" not in out.getvalue()
+
+
+def test_a_terminal_line_is_redrawn_at_most_four_times_a_second() -> None:
+    reporter, out, clock = _reporter(live=True)
+    clock.now += 3.0
+    reporter(Step("fitting", 0, 1000))
+    for done in range(100, 1001, 100):  # every 0.1 s
+        clock.now += 0.1
+        reporter(Step("fitting", done, 1000))
+    reporter(Step("planning", 0, 40))
+    reporter.close()
+    text = out.getvalue()
+    line = "camtool: fitting arcs to 1000 curves…"
+    assert text == (
+        f"\r{line}\x1b[K"
+        f"\r{line} 300 of 1000 (30%)\x1b[K"  # 0.3 s after the first draw
+        f"\r{line} 600 of 1000 (60%)\x1b[K"
+        f"\r{line} 900 of 1000 (90%)\x1b[K"
+        f"\r{line} 1000 of 1000 (100%)\x1b[K"  # the last count, before the line ends
+        "\n"  # the next stage starts its own line
+        "\rcamtool: planning 40 contours…\x1b[K"
+        "\n"  # closed: the terminal's line is finished before anything else is written
+    )
+
+
+def test_a_closed_stderr_silences_progress_without_failing() -> None:
+    out = io.StringIO()
+    reporter = StageReporter(after_s=0.0, stream=out, live=False)
+    out.close()
+    reporter(Step("planning", 0, 3))  # no ValueError: progress is not worth a failure
+    reporter.close()
+
+
+@pytest.mark.parametrize(
+    ("step", "text"),
+    [
+        (Step("reading", name="a.svg"), "reading a.svg"),
+        (Step("reading", 3, 12, "a.svg"), "reading a.svg: 12 shapes"),
+        (Step("fitting", 0, 400), "fitting arcs to 400 curves"),
+        (Step("writing", 0, 7, "valcnc"), "writing 7 moves for valcnc"),
+    ],
+)
+def test_stage_text_says_how_big_the_work_is(step: Step, text: str) -> None:
+    assert stage_text(step) == text
+
+
+def _post(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    code = main(["post", *args])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_a_short_job_prints_nothing_new(capsys: pytest.CaptureFixture[str]) -> None:
+    """Under the threshold stderr is the warnings and notes only, as before (no stage line)."""
+    code, out, err = _post([str(SAMPLES / "logo.dxf"), "-t", "grbl", "--depth", "1"], capsys)
+    assert code == 0 and out.startswith("(camtool")
+    assert "…" not in err  # the stage lines end with an ellipsis; nothing else here does
+    assert not any(
+        line.startswith(f"camtool: {stage} ") for line in err.splitlines() for stage in
+        ("reading", "fitting", "making", "planning", "writing", "verifying")
+    )  # fmt: skip
+
+
+def test_a_long_job_tells_its_stages_and_keeps_its_output(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Threshold 0: every stage's line on stderr, in order; stdout (-o -) is the same code."""
+    from camtool.importers import svg as svg_module
+
+    path = _svg(tmp_path, 12)
+    args = [str(path), "-t", "grbl", "--verify", "--no-budget"]
+    code, quiet_out, quiet_err = _post(args, capsys)
+    assert code == 0
+    monkeypatch.setattr(progress_module, "AFTER_S", 0.0)
+    monkeypatch.setattr(svg_module, "MIN_CURVES", 1)  # the fits made ahead: a fitting stage
+    code, out, err = _post(args, capsys)
+    assert code == 0
+    assert out == quiet_out
+    stages = [ln for ln in err.splitlines() if ln.endswith("…")]
+    assert [ln for ln in err.splitlines() if ln not in stages] == quiet_err.splitlines()
+    assert stages[0] == "camtool: reading many.svg…"
+    assert stages[1] == "camtool: reading many.svg: 12 shapes…"
+    assert stages[2] == f"camtool: fitting arcs to {12 * 5 + 1} curves…"
+    assert stages[3] == "camtool: making contours of 12 shapes…"
+    assert stages[4].startswith("camtool: planning ") and stages[4].endswith(" contours…")
+    assert stages[5].startswith("camtool: writing ") and stages[5].endswith(" moves for grbl…")
+    assert stages[6].startswith("camtool: verifying ") and stages[6].endswith(" blocks on grbl…")
+    assert len(stages) == 7
