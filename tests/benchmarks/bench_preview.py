@@ -59,6 +59,13 @@ nearest-segment search of the verification runs compiled (numba: its load costs 
 0.5 s and 100–120 MB, which is why the peak did not fall). The goal of 3 s and 300 MB is
 still not met: OCP alone is 230 MB, numba 100 MB more, and the error budget still
 simulates and measures the part four times.
+
+Third pass (22 Nov 2026, quiet, ``make bench`` then this script again once numba's cache of
+the new kernels was written): part 12.3 s, 600 MB; plate 9.7–10.7 s, 499–504 MB; G-code,
+report and PNG identical. The verification's distance searches are cheaper (docs/verify.md,
+"Speed and memory"); planning alone is 2.9 s and 293 MB on this part (OpenCascade), so the
+goal is still out of reach without moving the offsets out of the process and skipping or
+approximating the error budget.
 """
 
 from __future__ import annotations

@@ -47,6 +47,15 @@ the memory from 846 to ~259 MB; what is left is the start-up (~1.5 s quiet, itse
 its 28 s, since the thinned trace's segments are as long as the samples' spacing and far
 more samples miss the cheap vertex bound). Python, numpy, scipy, shapely and the loaded
 kernels are ~160 MB before any trace.
+
+Third pass (22 Nov 2026, ``make bench`` on the quiet machine): 13.2 M steps 2.53 s, 237 MB
+(MiB: this script divides ``ru_maxrss`` by 1024), 0.0096× C (547 M steps/s that run;
+start-up 1.14 s, then 105 ns a step); 66.2 M steps 6.73 s, 250 MB, 0.018× C (84 ns a step).
+Reports byte-identical. What changed: the shortfall measures exactly only the samples that
+can be the largest distance and builds one k-d tree per contour; the nearest ends and ties
+are one compiled pass; an unsure sample's exact distance is GEOS's formula compiled; the
+kernels load before a streamed program's rows are counted (docs/verify.md). The memory goal
+is met on the 13.2 M-step program; the speed goal is not (the start-up alone is over it).
 """
 
 from __future__ import annotations
