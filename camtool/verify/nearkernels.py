@@ -301,41 +301,11 @@ def within(
     found = np.zeros((n, CAP), dtype=np.int64)
     found2 = np.full((n, CAP), np.inf)
     count = np.zeros(n, dtype=np.int64)
-    top = len(offsets) - 2
-    stack_level = np.empty(64 * FAN, dtype=np.int64)
-    stack_node = np.empty(64 * FAN, dtype=np.int64)
-    npts = len(points)
+    work = _scratch()
     for q in range(n):
-        qx = samples[q, 0]
-        qy = samples[q, 1]
-        bound = bound2[q]
-        c = 0
-        stack_level[0] = top
-        stack_node[0] = 0
-        sp = 1
-        while sp > 0:
-            sp -= 1
-            level = stack_level[sp]
-            node = stack_node[sp]
-            if _box2(boxes, offsets[level] + node, qx, qy) > bound:
-                continue
-            if level == 0:
-                for i in range(node * LEAF, min(npts, node * LEAF + LEAF)):
-                    d2 = _point2(points, i, qx, qy)
-                    if d2 <= bound:
-                        if c < CAP:
-                            found[q, c] = i
-                            found2[q, c] = d2
-                        c += 1
-                continue
-            below = offsets[level - 1]
-            count_below = offsets[level] - below
-            for ch in range(node * FAN, min(count_below, node * FAN + FAN)):
-                if _box2(boxes, below + ch, qx, qy) <= bound:
-                    stack_level[sp] = level - 1
-                    stack_node[sp] = ch
-                    sp += 1
-        count[q] = c
+        row, row2 = found[q], found2[q]
+        qx, qy = samples[q, 0], samples[q, 1]
+        count[q] = _ends_within(qx, qy, points, boxes, offsets, bound2[q], row, row2, work)
     return found, found2, count
 
 
