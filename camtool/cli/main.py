@@ -36,6 +36,7 @@ from camtool.model.version import __version__
 if TYPE_CHECKING:
     from collections.abc import Callable
 
+    from camtool.cli.progress import StageReporter
     from camtool.model.shapes import Drawing
     from camtool.post.registry import TargetEntry
     from camtool.toolpath.plan import PlanReport
@@ -183,9 +184,10 @@ def post(
         )
     if verify_too or report or preview or max_error_um is not None:
         progress(Step("verifying", 0, job.result.blocks, chosen.name))
-        progress.close()
+        verified = verify_job(job, budget=not no_budget)
+        _measure_budget(verified, progress)
         _finish_verification(
-            verify_job(job, budget=not no_budget),
+            verified,
             report,
             preview,
             max_error_um,
@@ -237,6 +239,7 @@ def verify(
     simulated tool path is measured against the programmed one (and the drawing).
     A one-screen summary goes to stderr.
     """
+    from camtool.cli.progress import StageReporter
     from camtool.jobs.inputs import read_code, read_input
     from camtool.jobs.output import check_paths
     from camtool.jobs.pipeline import load_target_checked
@@ -251,6 +254,7 @@ def verify(
     chosen = load_target_checked(target, machine_file=machine_file)
     text = read_code(code, binary=chosen.post.binary)
     drawing = read_input(against) if against is not None else None
+    progress = StageReporter()
     v = verify_code(
         text,
         chosen,
@@ -259,6 +263,7 @@ def verify(
         tool_diameter=tool_diameter,
         budget=not no_budget,
     )
+    _measure_budget(v, progress)
     _finish_verification(
         v,
         report,
@@ -268,6 +273,20 @@ def verify(
         edge_radius_mm=tool_diameter / 2.0,
         strict=strict,
     )
+
+
+def _measure_budget(v: Verification, progress: StageReporter) -> None:
+    """Compute ``v``'s error budget now, its sources told to ``progress`` (a long one shows).
+
+    A budget that fails is left to fail where it did before (in the summary), so the
+    warnings and the error come out as they always have.
+    """
+    try:
+        v.measure_budget(progress)
+    except CamtoolError:
+        pass
+    finally:
+        progress.close()
 
 
 def _finish_verification(

@@ -11,6 +11,8 @@ enters it (or, for the stage it is in when the time is up, at once)::
     camtool: making contours of 5712 shapes…
     camtool: planning 5712 contours…
     camtool: writing 232119 moves for grbl…
+    camtool: verifying 232128 blocks on grbl…          (with --verify, --preview, --report)
+    camtool: error budget: re-simulating once per error source (3)…
 
 On a terminal the line of the current stage is also redrawn in place (a carriage return)
 with the count and percentage done, at most :data:`REDRAW_S` apart; the line is finished
@@ -54,6 +56,8 @@ def stage_text(step: Step) -> str:
         return f"writing {total} moves for {step.name}"
     if step.stage == "verifying":
         return f"verifying {total} blocks on {step.name}"
+    if step.stage == "budget":
+        return f"error budget: re-simulating once per error source ({total})"
     return step.stage
 
 

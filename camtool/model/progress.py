@@ -17,12 +17,13 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TypeAlias
 
-STAGES = ("reading", "fitting", "contours", "planning", "writing", "verifying")
+STAGES = ("reading", "fitting", "contours", "planning", "writing", "verifying", "budget")
 """The stages of ``camtool post``, in the order a job meets them (a job may skip some):
 reading the file (``total``: its drawn shapes, once counted), fitting arcs to its curves
 (``total``: distinct curves), making the contours of the shapes (``total``: shapes),
 planning the toolpath (``total``: contours), writing the code (``total``: moves of the
-program) and verifying it (``total``: blocks of code)."""
+program), verifying it (``total``: blocks of code) and its error budget (``total``: the
+error sources re-simulated one at a time; ``name``: the one being re-simulated)."""
 
 
 @dataclass(frozen=True)
@@ -34,7 +35,8 @@ class Step:
         done: units of the stage finished so far (0 at its start).
         total: units the stage has (0: not known yet).
         name: what the stage works on, for the message: the file's name when
-            ``reading``, the target's name when ``writing`` or ``verifying``; else ``""``.
+            ``reading``, the target's name when ``writing`` or ``verifying``, the
+            source when ``budget``; else ``""``.
     """
 
     stage: str

@@ -42,6 +42,7 @@ import numpy as np
 from camtool.model.errors import CamtoolError, InputError, UsageError
 from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Dwell, Home, Program, Rapid
+from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import BBox, Drawing
 from camtool.model.units import fmt_num
 from camtool.model.version import __version__
@@ -68,7 +69,7 @@ from camtool.verify.simulate import (
     simulate_or_count,
     simulate_steps,
 )
-from camtool.verify.sources import ALL, Sources
+from camtool.verify.sources import ALL, SOURCES, Sources
 from camtool.verify.steparray import read_only
 
 if TYPE_CHECKING:
@@ -147,6 +148,20 @@ class Verification:
             CamtoolError: a re-simulation fails (the full model did not).
         """
         return _budget(self)
+
+    def measure_budget(self, progress: Progress = no_progress) -> eb.ErrorBudget:
+        """:attr:`error_budget`, computed now if it is not yet, telling ``progress`` of it.
+
+        ``progress`` gets a ``budget`` :class:`~camtool.model.progress.Step` before each
+        source is re-simulated (``done`` the sources finished, ``total`` the modelled
+        ones), so a long verification can say what it is doing; the budget is the same.
+
+        Raises:
+            CamtoolError: as :attr:`error_budget`.
+        """
+        if "error_budget" not in self.__dict__:  # cached_property's own slot
+            self.__dict__["error_budget"] = _budget(self, progress)
+        return self.error_budget
 
     @property
     def dwell_s(self) -> float:
@@ -465,8 +480,8 @@ def _same_against(v: Verification, program: Program, trace: StepTrace) -> bool:
     )
 
 
-def _budget(v: Verification) -> eb.ErrorBudget:
-    """The error budget of ``v`` (see :attr:`Verification.error_budget`)."""
+def _budget(v: Verification, progress: Progress = no_progress) -> eb.ErrorBudget:
+    """The error budget of ``v`` (see :attr:`Verification.error_budget`), told to ``progress``."""
     total = eb.figures(v.deviation, v.along, v.contours, v.against)
     notes = []
     if len(v.contours) > eb.MAX_CONTOURS:
@@ -508,7 +523,13 @@ def _budget(v: Verification) -> eb.ErrorBudget:
             values = {k: x for k, x in values.items() if not k.startswith("contour ")}
         return values
 
-    return eb.compute(total, statuses, measure_without, notes=notes)
+    modelled = [s.name for s in statuses if s.status == "modelled"]
+
+    def told(name: str) -> eb.Figures:
+        progress(Step("budget", modelled.index(name), len(modelled), SOURCES[name]))
+        return measure_without(name)
+
+    return eb.compute(total, statuses, told, notes=notes)
 
 
 def source_statuses(

@@ -149,3 +149,24 @@ def test_a_long_job_tells_its_stages_and_keeps_its_output(
     assert stages[5].startswith("camtool: writing ") and stages[5].endswith(" moves for grbl…")
     assert stages[6].startswith("camtool: verifying ") and stages[6].endswith(" blocks on grbl…")
     assert len(stages) == 7
+
+
+def test_a_long_verification_tells_its_error_budget(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Threshold 0 and the budget on: one line for the budget after the verifying line.
+
+    grbl's profile models interpolation, chords and (post --verify) rounding for a
+    drawing with arcs: three sources. The summary is what it is without progress.
+    """
+    path = _svg(tmp_path, 3)
+    args = [str(path), "-t", "grbl", "--verify"]
+    code, quiet_out, quiet_err = _post(args, capsys)
+    assert code == 0
+    monkeypatch.setattr(progress_module, "AFTER_S", 0.0)
+    code, out, err = _post(args, capsys)
+    assert code == 0 and out == quiet_out
+    stages = [ln for ln in err.splitlines() if ln.endswith("…")]
+    assert [ln for ln in err.splitlines() if ln not in stages] == quiet_err.splitlines()
+    assert stages[-2].startswith("camtool: verifying ")
+    assert stages[-1] == "camtool: error budget: re-simulating once per error source (3)…"

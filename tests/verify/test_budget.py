@@ -257,3 +257,34 @@ def test_every_contour_has_its_end_error() -> None:
     # the second U starts with a +X move after the first ended moving −X: its first leg
     # takes up the play (190 µm short at its start), its return leg ends 190 µm short again
     assert v.along.contour_end_um == pytest.approx((190.0, 190.0), abs=0.2)
+
+
+def test_measure_budget_tells_each_source_it_re_simulates() -> None:
+    """One ``budget`` step per modelled source, before it, in order; the same budget.
+
+    The flashcut profile as shipped models five sources for the circle: interpolation,
+    chords (an arc cut in chords), the steps/mm scale (1.9 assumed, 1.88 µm real),
+    backlash (654 µm true, seed-001) and dynamics (the timer); the rounding is unknown
+    from code alone. So five steps, ``done`` 0 to 4 of 5.
+    """
+    from camtool.model.progress import Step
+
+    machine = load_target("flashcut").machine
+    told: list[Step] = []
+    v = verify_program(_circle10(), machine, name="flashcut")
+    got = v.measure_budget(told.append)
+    assert [(s.stage, s.done, s.total) for s in told] == [("budget", i, 5) for i in range(5)]
+    assert [s.name for s in told] == [SOURCES[n] for n in got.without]
+    assert v.error_budget is got  # computed once
+    again = verify_program(_circle10(), machine, name="flashcut").error_budget
+    assert got == again
+    assert v.measure_budget(told.append) is got and len(told) == 5  # not re-simulated
+
+
+def test_measure_budget_tells_nothing_when_the_budget_is_off() -> None:
+    from camtool.model.progress import Step
+
+    told: list[Step] = []
+    v = verify_program(_circle10(), load_target("flashcut").machine, name="fc", budget=False)
+    assert v.measure_budget(told.append).skipped is not None
+    assert told == []
