@@ -16,3 +16,17 @@ def pytest_addoption(parser: pytest.Parser) -> None:
 @pytest.fixture
 def update_golden(request: pytest.FixtureRequest) -> bool:
     return bool(request.config.getoption("--update-golden"))
+
+
+@pytest.fixture(autouse=True)
+def _progress_quiet(monkeypatch: pytest.MonkeyPatch) -> None:
+    """An in-process ``post`` or ``verify`` prints no progress line, however loaded the machine.
+
+    The CLI shows its stages only for a job still running after
+    :data:`camtool.cli.progress.AFTER_S` seconds; a test whose job ran that long on a busy
+    machine would see lines it did not ask for. tests/cli/test_progress.py sets its own
+    threshold where it tests them.
+    """
+    from camtool.cli import progress
+
+    monkeypatch.setattr(progress, "AFTER_S", 1e9)

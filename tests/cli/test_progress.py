@@ -113,8 +113,14 @@ def _post(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str
     return code, out, err
 
 
-def test_a_short_job_prints_nothing_new(capsys: pytest.CaptureFixture[str]) -> None:
-    """Under the threshold stderr is the warnings and notes only, as before (no stage line)."""
+def test_a_short_job_prints_nothing_new(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Under the threshold stderr is the warnings and notes only, as before (no stage line).
+
+    The threshold is set far above the job, so a loaded machine cannot make it long.
+    """
+    monkeypatch.setattr(progress_module, "AFTER_S", 1e9)
     code, out, err = _post([str(SAMPLES / "logo.dxf"), "-t", "grbl", "--depth", "1"], capsys)
     assert code == 0 and out.startswith("(camtool")
     assert "…" not in err  # the stage lines end with an ellipsis; nothing else here does
@@ -132,6 +138,7 @@ def test_a_long_job_tells_its_stages_and_keeps_its_output(
 
     path = _svg(tmp_path, 12)
     args = [str(path), "-t", "grbl", "--verify", "--no-budget"]
+    monkeypatch.setattr(progress_module, "AFTER_S", 1e9)  # quiet, however loaded the machine
     code, quiet_out, quiet_err = _post(args, capsys)
     assert code == 0
     monkeypatch.setattr(progress_module, "AFTER_S", 0.0)
@@ -161,6 +168,7 @@ def test_a_long_verification_tells_its_error_budget(
     """
     path = _svg(tmp_path, 3)
     args = [str(path), "-t", "grbl", "--verify"]
+    monkeypatch.setattr(progress_module, "AFTER_S", 1e9)  # quiet, however loaded the machine
     code, quiet_out, quiet_err = _post(args, capsys)
     assert code == 0
     monkeypatch.setattr(progress_module, "AFTER_S", 0.0)
