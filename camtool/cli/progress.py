@@ -37,28 +37,28 @@ REDRAW_S = 0.25
 """Least time between two redraws of a terminal's progress line, s."""
 
 
+_TEXTS = {
+    "fitting": "fitting arcs to {total} curves",
+    "contours": "making contours of {total} shapes",
+    "planning": "planning {total} contours",
+    "writing": "writing {total} moves for {name}",
+    "verifying": "verifying {total} blocks on {name}",
+    "budget": "error budget: re-simulating once per error source ({total})",
+}
+"""What each stage after ``reading`` says (``total`` and ``name`` of its :class:`Step`)."""
+
+
 def stage_text(step: Step) -> str:
     """What the stage of ``step`` is doing and how big it is, without the count done.
 
     >>> stage_text(Step("fitting", 10, 30576))
     'fitting arcs to 30576 curves'
     """
-    total = step.total
     if step.stage == "reading":
-        return f"reading {step.name}: {total} shapes" if total else f"reading {step.name}"
-    if step.stage == "fitting":
-        return f"fitting arcs to {total} curves"
-    if step.stage == "contours":
-        return f"making contours of {total} shapes"
-    if step.stage == "planning":
-        return f"planning {total} contours"
-    if step.stage == "writing":
-        return f"writing {total} moves for {step.name}"
-    if step.stage == "verifying":
-        return f"verifying {total} blocks on {step.name}"
-    if step.stage == "budget":
-        return f"error budget: re-simulating once per error source ({total})"
-    return step.stage
+        shapes = f": {step.total} shapes" if step.total else ""
+        return f"reading {step.name}{shapes}"
+    template = _TEXTS.get(step.stage)
+    return step.stage if template is None else template.format(total=step.total, name=step.name)
 
 
 class StageReporter:
