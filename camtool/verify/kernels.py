@@ -238,52 +238,6 @@ def play_runs(rows: Any, ox: int, oy: int) -> tuple[Any, ...]:
 
 
 @numba.njit(cache=True, nogil=True)
-def play_axis(
-    rows: Any,
-    axis: int,
-    origin: int,
-    starts: Any,
-    signs: Any,
-    bands: Any,
-    c0: float,
-    start: float,
-    true_spm: float,
-    out: Any,
-) -> None:
-    """One axis of ``simulate._carriage``: the play operator over the runs, into ``out``.
-
-    The same float operations, in the same order, as the numpy ``_play`` and
-    ``_carriage``: before the first run the carriage is ``c0``; in an up run it is
-    ``max(c, M)``, in a down run ``min(c, M + band)`` with ``c`` the value at the end
-    of the previous run and ``M`` the motor (integer steps); then ``(v − c0 + start) /
-    true_spm``. ``bands[r]`` is the band of run ``r`` in steps (unused for up runs).
-    """
-    n = rows.shape[0]
-    motor = origin
-    current = c0
-    value = c0
-    r = 0
-    runs = len(starts)
-    up = True
-    band = 0.0
-    for i in range(n):
-        motor += rows[i, axis]
-        if r < runs and i == starts[r]:
-            current = value
-            up = signs[r] > 0
-            band = bands[r]
-            r += 1
-        if r > 0:
-            m = float(motor)
-            if up:
-                value = current if current >= m else m
-            else:
-                mb = m + band
-                value = current if current <= mb else mb
-        out[i, axis] = (value - c0 + start) / true_spm
-
-
-@numba.njit(cache=True, nogil=True)
 def _count_reversals(rows: Any, axis: int, direction: int) -> int:
     count = 0
     previous = direction
@@ -340,16 +294,22 @@ def play_axis_from(
     true_spm: float,
     out: Any,
 ) -> int:
-    """:func:`play_axis` over one chunk of rows, resuming from and updating ``state``.
+    """One axis of ``simulate._carriage``, the play operator, over a chunk of rows.
+
+    The same float operations, in the same order, as the numpy ``_play`` and
+    ``_carriage``: before the first run the carriage is at ``start``; in an up run it
+    is ``max(c, M)``, in a down run ``min(c, M + band)`` with ``c`` the value at the end
+    of the previous run and ``M`` the motor (integer steps); then ``(v − c0 + start) /
+    true_spm`` into ``out``. ``bands[r]`` is the band of run ``r`` in steps (unused for
+    up runs). The whole trace is one chunk from a zero ``state``
+    (``simulate._carriage_compiled``); a streamed one resumes each chunk from the last
+    (``simulate.ChunkedSimulation``), and the chunks' rows joined give the same values.
 
     ``state`` is ``float64[5]``: ``c0`` (the carriage before the first run, set at the
-    first run), ``current``, ``value``, ``band``, and ``flags`` (bit 0: a run has
-    started, bit 1: the current run goes up). ``starts``/``signs``/``bands`` are the
-    runs that *start* in this chunk (a run going on from the chunk before is not one).
-    ``c0`` of the first run is ``start`` going up, ``start + band`` going down, as
-    ``simulate._carriage_compiled`` sets it. The same float operations, in the same
-    order, as :func:`play_axis` over the whole rows: the chunks' rows joined give the
-    same values. Returns the motor position after the chunk.
+    first run: ``start`` going up, ``start + band`` going down), ``current``, ``value``,
+    ``band``, and ``flags`` (bit 0: a run has started, bit 1: the current run goes up).
+    ``starts``/``signs``/``bands`` are the runs that *start* in this chunk (a run going
+    on from the chunk before is not one). Returns the motor position after the chunk.
     """
     n = rows.shape[0]
     motor = motor0

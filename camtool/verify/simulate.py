@@ -427,21 +427,35 @@ def _carriage_compiled(
     out = np.empty((len(rows), 2), dtype=np.float64)
     for axis in (0, 1):
         starts, signs, at = runs[3 * axis : 3 * axis + 3]
-
-        def band(k: int, axis: int = axis, at: npt.NDArray[np.int64] = at) -> float:
-            x_mm = at[k, 0] / true[0]
-            y_mm = at[k, 1] / true[1]
-            return machine.backlash.true_at(axis, x_mm, y_mm) / 1000.0 * true[axis]
-
-        bands = np.asarray(
-            [band(k) if signs[k] < 0 else 0.0 for k in range(len(starts))], dtype=np.float64
-        )
-        start = float(origin[axis])
-        c0 = start if not len(starts) or signs[0] > 0 else start + bands[0]
-        jit.play_axis(
-            rows, axis, int(origin[axis]), starts, signs, bands, c0, start, float(true[axis]), out
-        )
+        bands = _run_bands(machine, axis, signs, at)
+        fresh = np.zeros(5, dtype=np.float64)  # no run started yet: the whole trace is one chunk
+        motor0, start, spm = int(origin[axis]), float(origin[axis]), float(true[axis])
+        jit.play_axis_from(rows, axis, starts, signs, bands, fresh, motor0, start, spm, out)
     return out
+
+
+def _run_bands(
+    machine: Machine, axis: int, signs: npt.NDArray[np.int8], at: npt.NDArray[np.int64]
+) -> FloatArray:
+    """The backlash band of each run of ``axis``, motor steps (0 for an up run).
+
+    ``signs`` and ``at`` are the runs' directions and the motor position ``(x, y)`` in
+    steps where each starts (:func:`camtool.verify.kernels.play_runs`); the band is the
+    profile's true backlash there (``Backlash.true_at``, regions included), as
+    :func:`_play` takes it.
+    """
+    true = machine.real_steps_per_mm
+    return np.asarray(
+        [
+            machine.backlash.true_at(axis, at[k, 0] / true[0], at[k, 1] / true[1])
+            / 1000.0
+            * true[axis]
+            if signs[k] < 0
+            else 0.0
+            for k in range(len(signs))
+        ],
+        dtype=np.float64,
+    )
 
 
 def _play(
@@ -632,17 +646,7 @@ class ChunkedSimulation:
                 starts, signs, at = runs[3 * axis : 3 * axis + 3]
                 if len(starts) and int(signs[0]) == last_sign[axis]:  # the run goes on
                     starts, signs, at = starts[1:], signs[1:], at[1:]
-                bands = np.asarray(
-                    [
-                        machine.backlash.true_at(axis, at[k, 0] / true[0], at[k, 1] / true[1])
-                        / 1000.0
-                        * true[axis]
-                        if signs[k] < 0
-                        else 0.0
-                        for k in range(len(starts))
-                    ],
-                    dtype=np.float64,
-                )
+                bands = _run_bands(machine, axis, signs, at)
                 if len(signs):
                     last_sign[axis] = int(signs[-1])
                 motor[axis] = int(
