@@ -622,14 +622,9 @@ def _nearest(
         sure = (near + half < rk) | (near - lower <= NEAREST_TOLERANCE_MM)
         d[i : i + len(chunk)] = near
         unsure[i : i + len(chunk)] = ~sure
-    if unsure.any():
-        tree = (points, boxes, offsets)
-        need = _reaching(d[unsure], d[~unsure], samples) if only_max else None
-        exact = _nearby_boxes(samples[unsure], d[unsure], a, b, tree, half, kernels, need)
-        if exact is None:
-            exact = _all_exact_where(samples[unsure], d[unsure], a, b, need)
-        d[unsure] = exact
-    return d
+    tree = (points, boxes, offsets)
+    nearby = partial(_nearby_boxes, a=a, b=b, tree=tree, half=half, kernels=kernels)
+    return _settle_unsure(samples, d, unsure, a, b, nearby, only_max=only_max)
 
 
 def _near_segments_numpy(
@@ -770,9 +765,30 @@ def _nearest_kd(
     ]
     d = np.concatenate([p[0] for p in parts]) if parts else np.zeros(0)
     unsure = np.concatenate([p[1] for p in parts]) if parts else np.zeros(0, dtype=bool)
+    nearby = partial(_nearby_exact, a=a, b=b, ends=tree, half=half)
+    return _settle_unsure(samples, d, unsure, a, b, nearby, only_max=only_max)
+
+
+def _settle_unsure(
+    samples: FloatArray,
+    d: FloatArray,
+    unsure: npt.NDArray[np.bool_],
+    a: FloatArray,
+    b: FloatArray,
+    nearby: Callable[..., FloatArray | None],
+    *,
+    only_max: bool,
+) -> FloatArray:
+    """The exact stage of both searches: GEOS's distance where the cheap tests were unsure.
+
+    ``nearby(samples, upper, need=...)`` measures the segments near each unsure sample
+    (:func:`_nearby_boxes` or :func:`_nearby_exact`, ``None`` over the pair limit, then
+    :func:`_all_exact_where`); with ``only_max`` only the samples that can be the largest
+    (:func:`_reaching`). ``d`` is updated in place and returned.
+    """
     if unsure.any():
         need = _reaching(d[unsure], d[~unsure], samples) if only_max else None
-        exact = _nearby_exact(samples[unsure], d[unsure], a, b, tree, half, need)
+        exact = nearby(samples[unsure], d[unsure], need=need)
         if exact is None:
             exact = _all_exact_where(samples[unsure], d[unsure], a, b, need)
         d[unsure] = exact
