@@ -16,6 +16,24 @@ from camtool.geometry import fitpool
 from camtool.geometry.fitpool import CurveKey, fit_key, fit_many
 
 
+def spy_pool(monkeypatch: pytest.MonkeyPatch) -> list[bool]:
+    """Record, for each pool :func:`fit_many` starts, whether its workers answered.
+
+    ``fitpool._in_pool`` falls back to the serial fits (``None``) on any worker error, so
+    a test comparing pooled and serial drawings alone would pass without a pool at all.
+    """
+    pooled: list[bool] = []
+    in_pool = fitpool._in_pool
+
+    def spy(*args: Any) -> Any:
+        out = in_pool(*args)
+        pooled.append(out is not None)
+        return out
+
+    monkeypatch.setattr(fitpool, "_in_pool", spy)
+    return pooled
+
+
 def _keys(n: int) -> list[CurveKey]:
     rng = np.random.default_rng(1717)
     out: list[CurveKey] = []
@@ -44,15 +62,7 @@ def test_parallel_fits_equal_serial_fits(monkeypatch: pytest.MonkeyPatch) -> Non
     """300 random Béziers and elliptical arcs: the workers' fits are the serial fits."""
     monkeypatch.setattr(fitpool, "MIN_CURVES", 1)
     monkeypatch.setattr(fitpool, "_CHUNK", 7)  # many chunks, gathered in order
-    pooled: list[bool] = []
-    in_pool = fitpool._in_pool
-
-    def spy(*args: Any) -> Any:
-        out = in_pool(*args)
-        pooled.append(out is not None)
-        return out
-
-    monkeypatch.setattr(fitpool, "_in_pool", spy)
+    pooled = spy_pool(monkeypatch)
     keys = _keys(300)
     serial = [fit_key(k, 0.01) for k in keys]
     assert repr(fit_many(keys, 0.01, jobs=2)) == repr(serial)

@@ -8,7 +8,6 @@ error the same message.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pytest
@@ -17,6 +16,7 @@ from camtool.geometry import fitpool
 from camtool.importers import svg as svg_module
 from camtool.importers.svg import read_svg
 from camtool.model.errors import InputError
+from tests.geometry.test_fitpool import spy_pool
 
 SVG = """<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100">
 {paths}
@@ -51,15 +51,7 @@ def test_read_svg_with_workers_equals_without(
     monkeypatch.setattr(svg_module, "MIN_CURVES", 1)
     monkeypatch.setattr(fitpool, "MIN_CURVES", 1)
     monkeypatch.setattr(fitpool, "_CHUNK", 5)
-    pooled: list[bool] = []
-    in_pool = fitpool._in_pool
-
-    def spy(*args: Any) -> Any:
-        out = in_pool(*args)
-        pooled.append(out is not None)
-        return out
-
-    monkeypatch.setattr(fitpool, "_in_pool", spy)
+    pooled = spy_pool(monkeypatch)
     assert repr(read_svg(path)) == repr(serial)
     assert pooled == [True]  # the fits came from the workers, not the serial fallback
 
