@@ -605,6 +605,8 @@ def _nearest(
     half = float(np.max(np.hypot(*(b - a).T))) / 2.0
     points = np.concatenate([a, b])
     boxes, offsets = kernels.build(points)
+    if not _far(samples, points, boxes, offsets, half, kernels):
+        return _nearest_kd(samples, a, b, ends=ends, only_max=only_max)
     ends = ends or _LazyTree(points)
     d = np.empty(len(samples), dtype=np.float64)
     unsure = np.zeros(len(samples), dtype=bool)
@@ -767,6 +769,36 @@ def _nearest_kd(
     unsure = np.concatenate([p[1] for p in parts]) if parts else np.zeros(0, dtype=bool)
     nearby = partial(_nearby_exact, a=a, b=b, ends=tree, half=half)
     return _settle_unsure(samples, d, unsure, a, b, nearby, only_max=only_max)
+
+
+FAR_PROBE = 1000
+"""Samples :func:`_far` looks at (evenly spread)."""
+FAR_RATIO = 8.0
+"""Median nearest-end distance, in half the longest segment, from which the box tree
+searches (:func:`_far`)."""
+
+
+def _far(
+    samples: FloatArray,
+    points: FloatArray,
+    boxes: Any,
+    offsets: Any,
+    half: float,
+    kernels: ModuleType,
+) -> bool:
+    """Whether the samples lie far from the segments for their length: the box tree's case.
+
+    The compiled box tree answers a sample a tool radius from a dense trace (a drawing
+    point against the tool-centre path) 2–3× faster than scipy's k-d tree, but one near
+    the trace (a path sample, a drawing cut on its line) several times slower: a LibreCAD
+    hatch cut on the line took 13.6 s in the box tree and 2.0 s in the k-d tree. The
+    median distance of :data:`FAR_PROBE` samples to their nearest end, against half the
+    longest segment (:data:`FAR_RATIO`), decides. Both give the same distances; only the
+    time depends on it.
+    """
+    probe = np.ascontiguousarray(samples[:: max(1, len(samples) // FAR_PROBE)])
+    r0_2 = kernels.knn(probe, points, boxes, offsets, 1)[0]
+    return bool(np.median(r0_2) > (FAR_RATIO * half) ** 2)
 
 
 def _settle_unsure(

@@ -20,9 +20,11 @@ nearkernels = pytest.importorskip("camtool.verify.nearkernels")
 
 
 @pytest.fixture(autouse=True)
-def _compiled() -> None:
-    """The compiled search in use from the first call (the default threshold is a load)."""
+def _compiled(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The compiled search in use from the first call (the default threshold is a load),
+    near samples included (:func:`metrics._far` would send those to the k-d tree)."""
     assert metrics.near_kernels() is nearkernels
+    monkeypatch.setattr(metrics, "_far", lambda *args: True)
 
 
 def _trace(rng: np.random.Generator, kind: int) -> np.ndarray:
@@ -281,3 +283,23 @@ def test_nearby_min_compiled_is_the_geos_grouping(
     monkeypatch.setattr(metrics, "_pair_kernels", lambda pairs: None)
     for chunk in (7, metrics.NEARBY_CHUNK_PAIRS):
         assert metrics._nearby_min(p, owner, seg, a, b, chunk).tobytes() == compiled.tobytes()
+
+
+def test_the_box_tree_searches_only_samples_far_from_the_segments(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A dense line of 4 µm segments: samples 1.5 mm off are far (375 half-lengths), on
+    it near; the distances are the same whichever search answers."""
+    monkeypatch.undo()  # the real _far
+    x = np.arange(0.0, 20.0, 0.004)
+    line = np.c_[x, np.zeros_like(x)]
+    points = np.concatenate([line[:-1], line[1:]])
+    boxes, offsets = nearkernels.build(points)
+    off = np.c_[np.arange(0.0, 20.0, 0.005), np.full(4000, 1.5)]
+    on = off * [1.0, 0.0] + [0.001, 0.0001]
+    assert metrics._far(off, points, boxes, offsets, 0.002, nearkernels)
+    assert not metrics._far(on, points, boxes, offsets, 0.002, nearkernels)
+    for samples in (off, on):
+        want = metrics.nearest_distances_kd(samples, line[:-1], line[1:])
+        got = metrics.nearest_distances(samples, line[:-1], line[1:])
+        assert got.tobytes() == want.tobytes()
