@@ -249,9 +249,12 @@ def _vanished(contour: Contour, options: PlanOptions) -> Finding:
 
     tol = options.tolerance / 4
     poly = Polygon(contour.points(tol)).buffer(0)
-    centre = poly.centroid
-    width = 2.0 * maximum_inscribed_circle(poly, tol).length  # twice the largest inradius
-    x, y = float(centre.x), float(centre.y)
+    if poly.is_empty:  # no area (a closed contour that folds back on itself): no width
+        (x, y), width = contour.start, 0.0
+    else:
+        centre = poly.centroid
+        width = 2.0 * maximum_inscribed_circle(poly, tol).length  # twice the largest inradius
+        x, y = float(centre.x), float(centre.y)
     d = options.tool_diameter
     return Finding(
         "offset-vanished",

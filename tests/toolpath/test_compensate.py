@@ -202,6 +202,21 @@ def test_a_slot_narrower_than_the_tool_vanishes_with_its_location() -> None:
     assert "(35.0000, 5.0000)" in finding.message and "3 mm tool" in finding.message
 
 
+def test_a_closed_contour_without_area_vanishes_without_a_crash() -> None:
+    """A line drawn out and back (LibreCAD's ed119.dxf has two) encloses no area.
+
+    Inside the part it is a hole no tool fits: an ``offset-vanished`` finding at its
+    start with width 0, not GEOS's "Empty input" from the width measure.
+    """
+    out_and_back = (Line((20.0, 5.0), (30.0, 5.0)), Line((30.0, 5.0), (20.0, 5.0)))
+    there_and_back = Contour(out_and_back, closed=True)
+    stage = _run([rect(0, 0, 50, 10), there_and_back], "outside", 1.0)
+    assert [c.group for c in stage.cuts] == [0]  # the part is still cut
+    (finding,) = [f for f in stage.findings if f.kind == "offset-vanished"]
+    assert finding.at == (20.0, 5.0) and finding.value == 0.0
+    assert "(20.0000, 5.0000)" in finding.message and "1 mm tool" in finding.message
+
+
 def test_when_everything_vanishes_planning_stops_with_the_reason() -> None:
     with pytest.raises(ToolpathError, match=r"nothing left to cut.*narrower than the 3 mm tool"):
         _run([stadium(30, 40, 5, 1.0)], "inside", 3.0)
