@@ -59,6 +59,11 @@ FULL_SEARCH_MAX_CUTS = 2000
 above it, the windowed O(n) search of :func:`_large_travel_order`."""
 
 _GAIN_MM = 1e-9
+_PER_CELL = 2.0
+"""Mean number of candidate or entry points per grid cell (:class:`_Cells`, :class:`_Grid`)."""
+
+IntArray = npt.NDArray[np.int64]
+FloatArray = npt.NDArray[np.float64]
 
 
 def precedence(cuts: Sequence[Cut], parents: Sequence[Sequence[int]]) -> list[tuple[int, ...]]:
@@ -248,6 +253,45 @@ def _improve(
 def _nearest_neighbour(
     cuts: Sequence[Cut], before: Sequence[Sequence[int]], origin: Point, flip_open: bool
 ) -> list[Step]:
+    """Greedy nearest neighbour over every allowed start of the cuts whose predecessors are cut.
+
+    Each step takes the active candidate start nearest to the tool (``np.hypot``), ties to
+    the lowest candidate (the lower cut, then vertex). The candidates are searched by
+    rings of grid cells around the tool (:class:`_Cells`), which answers exactly what a
+    scan of them all answers (:func:`_nearest_neighbour_scan`, kept for the tests) at a
+    fraction of the cost when the cuts have many vertices.
+    """
+    starts, finish, steps, first = _candidates(cuts, flip_open)
+    waiting = [len(b) for b in before]
+    after: list[list[int]] = [[] for _ in cuts]
+    for a, bs in enumerate(before):
+        for b in bs:
+            after[b].append(a)
+    active = np.zeros(len(steps), dtype=bool)
+    for r, w in enumerate(waiting):
+        if w == 0:
+            active[first[r] : first[r + 1]] = True
+    cells = _Cells(starts, active)
+    hx, hy = float(origin[0]), float(origin[1])
+    ends_at = finish.tolist()
+    out: list[Step] = []
+    for _ in range(len(cuts)):
+        p = cells.nearest(hx, hy)
+        i = int(steps[p][0])
+        out.append(steps[p])
+        hx, hy = ends_at[p]
+        active[first[i] : first[i + 1]] = False
+        for a in after[i]:
+            waiting[a] -= 1
+            if waiting[a] == 0:
+                active[first[a] : first[a + 1]] = True
+    return out
+
+
+def _nearest_neighbour_scan(
+    cuts: Sequence[Cut], before: Sequence[Sequence[int]], origin: Point, flip_open: bool
+) -> list[Step]:
+    """:func:`_nearest_neighbour` by a scan of every candidate at each step (the reference)."""
     starts, finish, steps, first = _candidates(cuts, flip_open)
     waiting = np.asarray([len(b) for b in before])
     after: list[list[int]] = [[] for _ in cuts]
@@ -272,6 +316,68 @@ def _nearest_neighbour(
             if waiting[a] == 0:
                 active[first[a] : first[a + 1]] = True
     return out
+
+
+class _Cells:
+    """Candidate points in square grid cells; the nearest active one as a full scan finds it.
+
+    ``points``: ``(P, 2)`` mm; ``active``: ``(P,)`` mask, owned and updated by the caller.
+    Distances are ``np.hypot`` of the same differences as the scan, so the answer (the
+    least distance, the lowest index among equals) is the scan's bit for bit. The rings
+    stop once the best distance is below the nearest a point outside them can be (less a
+    millionth of a cell, far above the rounding of the cell indices); past
+    :data:`_PER_CELL`-sized rings that cover the grid, a scan answers.
+    """
+
+    def __init__(self, points: FloatArray, active: npt.NDArray[np.bool_]) -> None:
+        self.points, self.active = points, active
+        self.xs, self.ys = points[:, 0], points[:, 1]
+        x0, y0 = points.min(axis=0)
+        x1, y1 = points.max(axis=0)
+        w, h = float(x1 - x0), float(y1 - y0)
+        count = max(1.0, len(points) / _PER_CELL)
+        size = max(math.sqrt(w * h / count), max(w, h) / count)
+        self.size = size if size > 0 else 1.0
+        self.x0, self.y0 = float(x0), float(y0)
+        ix = np.floor((points[:, 0] - x0) / self.size).astype(np.int64)
+        iy = np.floor((points[:, 1] - y0) / self.size).astype(np.int64)
+        order = np.lexsort((iy, ix))  # stable: each cell's indices ascending
+        keys = np.stack((ix[order], iy[order]), axis=1)
+        cut = np.flatnonzero(np.any(keys[1:] != keys[:-1], axis=1)) + 1
+        self.cells: dict[tuple[int, int], IntArray] = {
+            (int(k[0]), int(k[1])): part
+            for k, part in zip(keys[np.r_[0, cut]], np.split(order, cut), strict=True)
+        }
+
+    def nearest(self, hx: float, hy: float) -> int:
+        """Index of the active point nearest to ``(hx, hy)`` mm; ties to the lowest index."""
+        cx = math.floor((hx - self.x0) / self.size)
+        cy = math.floor((hy - self.y0) / self.size)
+        best_d, best_p = math.inf, -1
+        r = 0
+        while True:
+            if (2 * r + 1) ** 2 > 4 * len(self.cells) + 16:
+                return self._scan(hx, hy)
+            cells = (self.cells.get(cell) for cell in _ring(cx, cy, r))
+            found = [part for part in cells if part is not None]
+            if found:
+                idx = found[0] if len(found) == 1 else np.concatenate(found)
+                idx = idx[self.active[idx]]
+                if len(idx):
+                    d = np.hypot(self.xs[idx] - hx, self.ys[idx] - hy)
+                    m = float(d.min())
+                    p = int(idx[d == m].min())
+                    if m < best_d or (m == best_d and p < best_p):
+                        best_d, best_p = m, p
+            # every point not yet seen lies in ring r + 1 or further: at least r cells away
+            if best_p >= 0 and best_d < (r - 1e-6) * self.size:
+                return best_p
+            r += 1
+
+    def _scan(self, hx: float, hy: float) -> int:
+        d = np.hypot(self.xs - hx, self.ys - hy)
+        d[~self.active] = np.inf
+        return int(np.argmin(d))  # first minimum: lowest index
 
 
 def _two_opt(
@@ -375,11 +481,6 @@ _CHUNK = 32768
 """Positions evaluated together in a windowed 2-opt sweep (bounds memory to ~50 MB)."""
 MIN_SWEEP_GAIN = 1e-3
 """A sweep that shortens the rapids by less than this share ends the improvement."""
-_PER_CELL = 2.0
-"""Mean number of entry points per grid cell."""
-
-IntArray = npt.NDArray[np.int64]
-FloatArray = npt.NDArray[np.float64]
 
 
 @dataclass(frozen=True)

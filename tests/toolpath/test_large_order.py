@@ -118,3 +118,38 @@ def test_search_orders_refuse_more_cuts_than_their_limit(mode: str) -> None:
     options = PlanOptions(feed_mm_min=100.0, order=mode)
     with pytest.raises(UsageError, match=f"--order {mode} plans at most {MAX_SEARCH_CUTS} cuts"):
         order_cuts(cuts, Nesting(((),) * n), options, (0.0, 0.0))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_cell_nearest_neighbour_is_the_full_scan_bit_for_bit(seed: int) -> None:
+    # the full search's nearest neighbour by grid cells must choose exactly what the scan of
+    # every candidate chooses: same np.hypot distances, ties to the lower cut, then vertex
+    rng = random.Random(seed)
+    cuts = _mixed_cuts(300, seed=seed)
+    # exact ties: duplicated squares, and a polygon whose vertices all lie on one circle
+    cuts += [Cut(rect(5, 5, 6, 6), 300 + k) for k in range(3)]
+    angles = [k * math.pi / 4 for k in range(8)]
+    ring = [(50 + 3 * math.cos(a), 50 + 3 * math.sin(a)) for a in angles]
+    poly = Contour(tuple(Line(ring[k], ring[(k + 1) % 8]) for k in range(8)), True)
+    cuts.append(Cut(poly, 303))
+    before = _before(len(cuts))
+    for origin in ((0.0, 0.0), (50.0, 50.0), (-1e4, 3e3), (rng.uniform(0, 100), 1e-300)):
+        for flip in (True, False):
+            assert travel._nearest_neighbour(cuts, before, origin, flip) == (
+                travel._nearest_neighbour_scan(cuts, before, origin, flip)
+            )
+
+
+def test_cell_nearest_neighbour_on_one_point_and_on_a_line_of_points() -> None:
+    # degenerate grids: every candidate at one point (zero-size box), all on one line
+    same = [Cut(rect(1, 1, 1, 1), i) for i in range(3)]
+    row = [
+        Cut(Contour((Line((i, 0.0), (i + 0.5, 0.0)),), False), i, kind="open", may_rotate=False)
+        for i in range(40)
+    ]
+    for cuts in (same, row):
+        before: list[tuple[int, ...]] = [()] * len(cuts)
+        for origin in ((0.0, 0.0), (20.0, 7.0)):
+            assert travel._nearest_neighbour(cuts, before, origin, True) == (
+                travel._nearest_neighbour_scan(cuts, before, origin, True)
+            )
