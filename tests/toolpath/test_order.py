@@ -513,3 +513,48 @@ def test_mirror_order_cuts_holes_first(contours: list[Contour]) -> None:
     for g, contour in enumerate(contours):
         mine = [c.path.length for c in got.cuts if c.group == g]
         assert sum(mine) == pytest.approx(contour.length)
+
+
+def _nest_scene(seed: int) -> list[Contour]:
+    """Random squares, circles, touching and duplicate outlines, bow-ties and open lines, mm."""
+    rng = np.random.default_rng(seed)
+    out: list[Contour] = []
+    for _ in range(60):
+        x, y = (float(v) for v in rng.integers(0, 20, 2))
+        a = float(rng.choice([1.0, 2.0, 4.0, 8.0, 0.5]))
+        kind = int(rng.integers(0, 6))
+        if kind == 0:
+            out.append(rect(x, y, x + a, y + a, clockwise=bool(rng.integers(0, 2))))
+        elif kind == 1:
+            r = a / 2
+            cw = bool(rng.integers(0, 2))
+            out.append(Contour((Arc((x + r, y), (x + r, y), (x, y), cw),), True))
+        elif kind == 2:  # a bow-tie (self-crossing: buffer(0) repairs it)
+            out.append(polygon([(x, y), (x + a, y + a), (x + a, y), (x, y + a)]))
+        elif kind == 3:
+            out.append(Contour((Line((x, y), (x + a, y + a / 3)),), False))
+        elif kind == 4 and out:
+            out.append(out[int(rng.integers(0, len(out)))])  # a duplicate
+        else:  # a half-disc: an arc and its chord
+            arc = Arc((x + a, y), (x - a, y), (x, y), False)
+            out.append(Contour((arc, Line((x - a, y), (x + a, y))), True))
+    return out
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_bulk_nesting_is_the_one_by_one_nesting(seed: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    # the vectorised shapely path must give exactly the per-contour queries' relation
+    from camtool.toolpath import order
+
+    contours = _nest_scene(seed)
+    reference = order._nesting_one_by_one(contours)
+    monkeypatch.setattr(order, "_nesting_one_by_one", None)  # no fallback taken
+    got = nesting(contours)
+    assert got == reference
+    assert any(got.parents)  # the scenes do nest
+
+
+def test_nesting_without_closed_contours_or_contours() -> None:
+    line = Contour((Line((0, 0), (1, 1)),), False)
+    assert nesting([line, line]).parents == ((), ())
+    assert nesting([]).parents == ()
