@@ -75,13 +75,7 @@ def nesting(contours: Sequence[Contour]) -> Nesting:
 
     if not contours:
         return Nesting(())
-    outlines_pts = [c.points(_NEST_TOLERANCE_MM) for c in contours]
-    counts = np.fromiter((len(p) for p in outlines_pts), dtype=np.int64, count=len(contours))
-    coords = np.fromiter(
-        (v for pts in outlines_pts for xy in pts for v in xy),
-        dtype=np.float64,
-        count=2 * int(counts.sum()),
-    ).reshape(-1, 2)
+    coords, counts = _outline_coords(contours, _NEST_TOLERANCE_MM)
     owner = np.repeat(np.arange(len(contours)), counts)
     outlines = shapely.linestrings(coords, indices=owner)
     closed = [i for i, c in enumerate(contours) if c.closed]
@@ -98,19 +92,131 @@ def nesting(contours: Sequence[Contour]) -> Nesting:
     polygons = shapely.buffer(shapely.polygons(rings), 0)
     area = np.zeros(len(contours))
     area[closed] = shapely.area(polygons)
-    tree = shapely.STRtree(polygons)
-    which, around = tree.query(outlines, predicate="covered_by")
+    # Candidates by their boxes; a polygon covers its own outline and an identical
+    # duplicate's, so a parent must also be strictly larger: that test, which needs no
+    # geometry, goes first, and GEOS decides the rest (as the tree's predicate query did).
+    which, around = shapely.STRtree(polygons).query(outlines)
     parent = np.asarray(closed, dtype=np.int64)[around]
-    # A polygon covers its own outline and that of an identical duplicate: a parent must
-    # also be strictly larger.
     larger = area[parent] > np.where(in_closed[which], area[which], 0.0)
-    which, parent = which[larger], parent[larger]
+    which, around, parent = which[larger], around[larger], parent[larger]
+    covered = shapely.covered_by(outlines[which], polygons[around])
+    which, parent = which[covered], parent[covered]
     order = np.lexsort((parent, which))
-    which, parent = which[order].tolist(), parent[order].tolist()
     parents: list[list[int]] = [[] for _ in contours]
-    for i, j in zip(which, parent, strict=True):
+    for i, j in zip(which[order].tolist(), parent[order].tolist(), strict=True):
         parents[i].append(j)
     return Nesting(tuple(tuple(p) for p in parents))
+
+
+def _outline_coords(contours: Sequence[Contour], tolerance: float) -> tuple[Any, Any]:
+    """Every contour's :meth:`~camtool.model.shapes.Contour.points`, as arrays, bit for bit.
+
+    Returns ``(coords, counts)``: ``(N, 2)`` float64 mm, the contours' polylines one after
+    the other, and ``(len(contours),)`` int64 points per contour. The arcs' chords are
+    computed together: the angles ``a0 + sweep·(k/n)`` and the products and sums in numpy
+    (IEEE operations, the same bits as Python's), the radius, angles, cosines and sines
+    with Python's own ``math`` functions (numpy's ``hypot``, ``arctan2``, ``cos`` may differ
+    in the last bit) and the chord count by :func:`~camtool.model.shapes.chord_count`
+    itself (its errors included).
+
+    Raises:
+        GeometryError, UsageError: as :func:`~camtool.model.shapes.chord_count`.
+    """
+    import itertools
+    import math
+    import operator
+
+    import numpy as np
+
+    from camtool.model.shapes import _FULL_CIRCLE_EPS, TAU, Arc
+
+    segs = [s for c in contours for s in c.segments]
+    per_contour = np.fromiter((len(c.segments) for c in contours), np.int64, len(contours))
+    is_arc = np.fromiter((type(s) is Arc for s in segs), bool, len(segs))
+    arcs = [s for s in segs if type(s) is Arc]
+    adds = np.ones(len(segs), dtype=np.int64)  # points a segment adds after its start
+    if arcs:
+        flat = itertools.chain.from_iterable
+        points3 = map(operator.attrgetter("start", "end", "centre"), arcs)
+        ends6 = np.fromiter(flat(flat(points3)), np.float64, 6 * len(arcs)).reshape(-1, 6)
+        sx, sy, ex, ey, cx, cy = ends6.T
+        cw = np.fromiter((a.clockwise for a in arcs), bool, len(arcs))
+        dx0, dy0 = (sx - cx).tolist(), (sy - cy).tolist()
+        r = np.fromiter(map(math.hypot, dx0, dy0), np.float64, len(arcs))
+        a0 = np.fromiter(map(math.atan2, dy0, dx0), np.float64, len(arcs))
+        a1 = np.fromiter(
+            map(math.atan2, (ey - cy).tolist(), (ex - cx).tolist()), np.float64, len(arcs)
+        )
+        gap = np.fromiter(map(math.hypot, (ex - sx).tolist(), (ey - sy).tolist()), np.float64)
+        with np.errstate(all="ignore"):
+            full = gap <= _FULL_CIRCLE_EPS * np.where(r > 1.0, r, 1.0)  # max(1.0, r)
+            ccw = np.remainder(a1 - a0, TAU)  # Python's float % (floored, as fmod then sign)
+        ccw[ccw == 0.0] = TAU
+        sweep = np.where(cw, -(TAU - ccw), ccw)
+        sweep[full] = np.where(cw[full], -TAU, TAU)
+        n = _chord_counts(r, np.abs(sweep), tolerance)
+        adds[is_arc] = n
+    counts = np.add.reduceat(adds, np.r_[0, np.cumsum(per_contour)[:-1]]) + 1
+    coords = np.empty((int(counts.sum()), 2), dtype=np.float64)
+    # where each segment's added points begin: after its contour's start and the segments before
+    seg_contour = np.repeat(np.arange(len(contours)), per_contour)
+    first_point = np.r_[0, np.cumsum(counts)[:-1]]
+    seg_first = np.cumsum(adds) - adds + seg_contour + 1  # past each earlier contour's start
+    starts = itertools.chain.from_iterable(c.segments[0].start for c in contours)
+    coords[first_point] = np.fromiter(starts, np.float64, 2 * len(contours)).reshape(-1, 2)
+    ends = itertools.chain.from_iterable(s.end for s in segs)
+    coords[seg_first + adds - 1] = np.fromiter(ends, np.float64, 2 * len(segs)).reshape(-1, 2)
+    if arcs:
+        inner = n - 1
+        rep = np.repeat(np.arange(len(arcs)), inner)
+        k = np.arange(len(rep)) - np.repeat(np.cumsum(inner) - inner, inner) + 1
+        angle = a0[rep] + sweep[rep] * (k / n[rep])
+        cos = np.fromiter(map(math.cos, angle.tolist()), np.float64, len(angle))
+        sin = np.fromiter(map(math.sin, angle.tolist()), np.float64, len(angle))
+        at = np.repeat(seg_first[is_arc], inner) + k - 1
+        coords[at, 0] = cx[rep] + r[rep] * cos
+        coords[at, 1] = cy[rep] + r[rep] * sin
+    return coords, counts
+
+
+def _chord_counts(radius: Any, sweep: Any, tolerance: float) -> Any:
+    """:func:`~camtool.model.shapes.chord_count` of each ``(radius, sweep)``, bit for bit.
+
+    ``radius``, ``sweep``: ``(A,)`` float64 (mm, unsigned radians). The usual arcs (finite,
+    the tolerance under the radius and over a millionth of it, the count within
+    :data:`~camtool.model.shapes.MAX_CHORDS`) are counted together, with Python's
+    ``math.acos``; every other arc by ``chord_count`` itself, in order, so that its errors
+    are the same.
+    """
+    import itertools
+    import math
+
+    import numpy as np
+
+    from camtool.model.shapes import _SMALL_RATIO, MAX_CHORDS, chord_count
+
+    with np.errstate(all="ignore"):
+        ratio = tolerance / radius
+        usual = (
+            np.isfinite(radius)
+            & np.isfinite(sweep)
+            & (tolerance < radius)
+            & (ratio > _SMALL_RATIO)
+            & bool(tolerance > 0 and math.isfinite(tolerance))
+        )
+        half = np.fromiter(map(math.acos, (1.0 - ratio[usual]).tolist()), np.float64)
+        count = sweep[usual] / (2.0 * half)
+    usual[usual] = count <= MAX_CHORDS
+    count = count[count <= MAX_CHORDS]
+    n = np.empty(len(radius), dtype=np.int64)
+    n[usual] = np.maximum(1, np.ceil(count - 1e-9)).astype(np.int64)
+    odd = np.flatnonzero(~usual)
+    n[odd] = np.fromiter(
+        map(chord_count, radius[odd].tolist(), sweep[odd].tolist(), itertools.repeat(tolerance)),
+        np.int64,
+        len(odd),
+    )
+    return n
 
 
 def _nesting_one_by_one(contours: Sequence[Contour]) -> Nesting:

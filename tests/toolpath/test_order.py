@@ -16,7 +16,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from camtool.model.errors import ToolpathError
+from camtool.model.errors import GeometryError, ToolpathError, UsageError
 from camtool.model.program import ArcMove, Linear, Move, Program, Rapid
 from camtool.model.shapes import Arc, Contour, Line, Point
 from camtool.post.registry import load_target
@@ -558,3 +558,64 @@ def test_nesting_without_closed_contours_or_contours() -> None:
     line = Contour((Line((0, 0), (1, 1)),), False)
     assert nesting([line, line]).parents == ((), ())
     assert nesting([]).parents == ()
+
+
+def _random_arcs(seed: int) -> list[Contour]:
+    """Contours of random arcs (any size, sweep, direction; full circles, near-full, tiny)."""
+    rng = np.random.default_rng(seed)
+    out: list[Contour] = []
+    for _ in range(200):
+        cx, cy = (float(v) for v in rng.normal(0, 10.0 ** int(rng.integers(-2, 4)), 2))
+        r = float(10.0 ** rng.uniform(-4, 3))
+        a0 = float(rng.uniform(-4, 4))
+        kind = int(rng.integers(0, 5))
+        sweep = {0: 2 * math.pi, 1: float(rng.uniform(-6.28, 6.28)), 2: 1e-9}.get(kind, 0.5)
+        a1 = a0 + sweep
+        start = (cx + r * math.cos(a0), cy + r * math.sin(a0))
+        end = start if kind == 0 else (cx + r * math.cos(a1), cy + r * math.sin(a1))
+        if kind == 3:
+            end = (start[0] + r * 1e-13, start[1])  # within the full-circle tolerance
+        arc = Arc(start, end, (cx, cy), bool(rng.integers(0, 2)))
+        tail = Line(end, (end[0] + 1.0, end[1])) if kind == 4 else None
+        out.append(Contour((arc,) if tail is None else (arc, tail), False))
+    return out
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_outline_coords_are_the_contours_points(seed: int) -> None:
+    from camtool.toolpath.order import _outline_coords
+
+    contours = _random_arcs(seed) + _nest_scene(seed)
+    for tol in (1e-4, 0.01, 5.0):
+        coords, counts = _outline_coords(contours, tol)
+        expected = [c.points(tol) for c in contours]
+        assert counts.tolist() == [len(p) for p in expected]
+        assert coords.tolist() == [list(xy) for pts in expected for xy in pts]
+
+
+def test_chord_counts_are_chord_count_on_every_branch() -> None:
+    # tolerance over the radius, a tiny ratio (asin form), zero sweep, full turns, and the
+    # usual acos form: all as camtool.model.shapes.chord_count counts them
+    from camtool.model.shapes import chord_count
+    from camtool.toolpath.order import _chord_counts
+
+    rng = np.random.default_rng(7)
+    radius = np.concatenate([10.0 ** rng.uniform(-5, 4, 3000), [1e-4, 0.5, 1e-300, 3.0]])
+    sweep = np.concatenate([rng.uniform(0, 2 * math.pi, 3000), [0.0, 2 * math.pi, 1.0, 0.0]])
+    for tol in (1e-4, 1e-3, 0.1):
+        ok = [
+            i
+            for i in range(len(radius))
+            if radius[i] < 1e6 * tol  # the others need more than MAX_CHORDS chords
+        ]
+        got = _chord_counts(radius[ok], sweep[ok], tol).tolist()
+        assert got == [chord_count(float(radius[i]), float(sweep[i]), tol) for i in ok]
+
+
+def test_chord_counts_refuse_as_chord_count() -> None:
+    from camtool.toolpath.order import _chord_counts
+
+    with pytest.raises(UsageError, match="more than the limit"):
+        _chord_counts(np.array([1.0, 1e9]), np.array([1.0, 6.0]), 1e-6)
+    with pytest.raises(GeometryError, match="must be finite"):
+        _chord_counts(np.array([1.0, math.nan]), np.array([1.0, 1.0]), 1e-3)
