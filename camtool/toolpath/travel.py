@@ -172,20 +172,26 @@ def _candidates(
     first: list[int] = []
     for i, cut in enumerate(cuts):
         first.append(len(steps))
-        if cut.path.closed:
-            ks = range(len(cut.path.segments)) if cut.may_rotate else range(1)
-            variants = [(k, False) for k in ks]
-        else:
-            variants = [(0, False)] + ([(0, True)] if flip_open and cut.may_reverse else [])
-        for k, rev in variants:
-            s, e = ends(cut, k, rev)
-            starts.append(s)
-            finish.append(e)
-            steps.append((i, k, rev))
+        path = cut.path
+        if path.closed:  # every vertex (or the first) a start, where the cut also ends
+            vertices = [seg.start for seg in path.segments] if cut.may_rotate else [path.start]
+            starts += vertices
+            finish += vertices
+            steps += zip(itertools.repeat(i), range(len(vertices)), itertools.repeat(False))
+            continue
+        a, b = path.start, path.end
+        starts.append(a)
+        finish.append(b)
+        steps.append((i, 0, False))
+        if flip_open and cut.may_reverse:
+            starts.append(b)
+            finish.append(a)
+            steps.append((i, 0, True))
     first.append(len(steps))
+    flat = itertools.chain.from_iterable
     return (
-        np.asarray(starts, dtype=np.float64).reshape(-1, 2),
-        np.asarray(finish, dtype=np.float64).reshape(-1, 2),
+        np.fromiter(flat(starts), np.float64, 2 * len(starts)).reshape(-1, 2),
+        np.fromiter(flat(finish), np.float64, 2 * len(finish)).reshape(-1, 2),
         steps,
         first,
     )
@@ -273,13 +279,12 @@ def _nearest_neighbour(
             active[first[r] : first[r + 1]] = True
     cells = _Cells(starts, active)
     hx, hy = float(origin[0]), float(origin[1])
-    ends_at = finish.tolist()
     out: list[Step] = []
     for _ in range(len(cuts)):
         p = cells.nearest(hx, hy)
         i = int(steps[p][0])
         out.append(steps[p])
-        hx, hy = ends_at[p]
+        hx, hy = float(finish[p, 0]), float(finish[p, 1])
         active[first[i] : first[i + 1]] = False
         for a in after[i]:
             waiting[a] -= 1

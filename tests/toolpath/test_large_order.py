@@ -153,3 +153,24 @@ def test_cell_nearest_neighbour_on_one_point_and_on_a_line_of_points() -> None:
             assert travel._nearest_neighbour(cuts, before, origin, True) == (
                 travel._nearest_neighbour_scan(cuts, before, origin, True)
             )
+
+
+def test_candidates_are_every_allowed_variant_with_its_ends() -> None:
+    cuts = _mixed_cuts(200, seed=3)
+    cuts.append(Cut(rect(0, 0, 1, 1), 200, may_rotate=False))
+    for flip in (True, False):
+        starts, finish, steps, first = travel._candidates(cuts, flip)
+        expected = []
+        for i, cut in enumerate(cuts):
+            if cut.path.closed:
+                ks = range(len(cut.path.segments)) if cut.may_rotate else range(1)
+                expected += [(i, k, False) for k in ks]
+            else:
+                expected += [(i, 0, False)] + ([(i, 0, True)] if flip and cut.may_reverse else [])
+        assert steps == expected
+        assert first == [
+            next(p for p, s in enumerate(steps) if s[0] == i) for i in range(len(cuts))
+        ] + [len(steps)]
+        for p, (i, k, rev) in enumerate(steps):
+            s, e = travel.ends(cuts[i], k, rev)
+            assert (tuple(starts[p]), tuple(finish[p])) == (s, e)
