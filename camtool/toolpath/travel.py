@@ -246,9 +246,10 @@ def _improve(
 ) -> list[Step]:
     """2-opt and start re-choice sweeps on ``seq`` until they gain nothing (or MAX_SWEEPS)."""
     best_seq, best = seq, rapid_mm(cuts, seq, origin)
+    vertices: dict[int, FloatArray] = {}
     for _ in range(MAX_SWEEPS):
         seq = _two_opt(cuts, before, seq, origin, flip_open)
-        seq = rechoose_starts(cuts, seq, origin, flip_open)
+        seq = rechoose_starts(cuts, seq, origin, flip_open, vertices)
         total = rapid_mm(cuts, seq, origin)
         if total >= best - _GAIN_MM:
             break
@@ -451,20 +452,30 @@ def _latest_before(
 
 
 def rechoose_starts(
-    cuts: Sequence[Cut], seq: Sequence[Step], origin: Point, flip_open: bool
+    cuts: Sequence[Cut],
+    seq: Sequence[Step],
+    origin: Point,
+    flip_open: bool,
+    vertices: dict[int, FloatArray] | None = None,
 ) -> list[Step]:
     """Each cut's start re-chosen for its neighbours, first to last.
 
     The start vertex of closed cuts with ``may_rotate``, the direction of open
-    cuts with ``may_reverse`` when ``flip_open``.
+    cuts with ``may_reverse`` when ``flip_open``. ``vertices``: a cache of the closed
+    cuts' vertex arrays ``(n, 2)`` mm by cut index, filled here, kept by a caller that
+    sweeps again.
     """
+    vertices = {} if vertices is None else vertices
     out = list(seq)
     for p, (i, _, rev) in enumerate(out):
         cut = cuts[i]
         prev = ends(cuts[out[p - 1][0]], *out[p - 1][1:])[1] if p else origin
         nxt = ends(cuts[out[p + 1][0]], *out[p + 1][1:])[0] if p + 1 < len(out) else None
         if cut.path.closed and cut.may_rotate:
-            v = np.asarray([seg.start for seg in cut.path.segments], dtype=np.float64)
+            v = vertices.get(i)
+            if v is None:
+                v = np.asarray([seg.start for seg in cut.path.segments], dtype=np.float64)
+                vertices[i] = v
             cost = np.hypot(v[:, 0] - prev[0], v[:, 1] - prev[1])
             if nxt is not None:
                 cost = cost + np.hypot(v[:, 0] - nxt[0], v[:, 1] - nxt[1])
