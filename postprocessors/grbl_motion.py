@@ -69,9 +69,17 @@ def grbl_arc_segments(radius_mm: float, angular_travel_rad: float, arc_tolerance
 
     Raises:
         UsageError: If ``arc_tolerance_mm`` is not positive.
+        InputError: If ``2·radius_mm ≤ arc_tolerance_mm`` (GRBL's count is undefined).
     """
     if not arc_tolerance_mm > 0:
         raise UsageError(f"arc tolerance must be > 0 mm, got {arc_tolerance_mm!r}")
+    if not 2.0 * radius_mm - arc_tolerance_mm > 0:
+        raise InputError(
+            f"an arc of radius {radius_mm:.6g} mm is not over half of grbl's arc tolerance "
+            f"$12 = {arc_tolerance_mm:g} mm: mc_arc divides by √($12·(2r − $12)), which is 0 "
+            "or not a number, so what grbl does is undefined; write the arc as a G1 line "
+            "(camtool's grbl writer does) or lower $12"
+        )
     chord_half = math.sqrt(arc_tolerance_mm * (2.0 * radius_mm - arc_tolerance_mm))
     return math.floor(abs(0.5 * angular_travel_rad * radius_mm) / chord_half)
 

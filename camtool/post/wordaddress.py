@@ -244,6 +244,13 @@ class BlockWriter(WriterState[str]):
         self._quantum: float | None = None
         self._conformed_arcs: dict[tuple[Any, ...], list[tuple[Point, Point | None]]] = {}
         self._feed_text: tuple[float, str] | None = None
+        # GRBL's mc_arc counts an arc's chords as ⌊|θ·r/2| / √($12·(2r − $12))⌋: an arc of
+        # radius r ≤ $12/2 divides by zero or by the root of a negative number, and what the
+        # controller then does is undefined (the verifier refuses it). Such an arc lies
+        # within $12 of its chord, so it is written as a line (a millionth to spare).
+        motion = machine.motion
+        grbl_chords = motion.arc == "chords" and motion.chords == "grbl"
+        self._arc_floor_mm = motion.chord_tolerance_mm * (1 + 1e-6) if grbl_chords else 0.0
 
     # -- the program -------------------------------------------------------------
 
@@ -605,6 +612,10 @@ class BlockWriter(WriterState[str]):
             ti, i = printed["I"].get(ci) or self._print("I", ci)
             tj, j = printed["J"].get(cj) or self._print("J", cj)
             tiny = tiny or (i + ox, j + oy) == before
+            if self._arc_floor_mm:
+                tiny = tiny or 2.0 * math.hypot(i + ox - before[0], j + oy - before[1]) <= (
+                    self._arc_floor_mm
+                )
         if tiny:
             self.counts["tiny-arc"] += 1
             linear = Linear(end[0], end[1], move.feed_mm_min, contour=move.contour)

@@ -45,6 +45,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from camtool.model.errors import InputError
 from camtool.model.machine import Backlash, Machine
 from camtool.model.program import ArcMove, Move, Program
 from camtool.model.shapes import Point, distance
@@ -85,10 +86,19 @@ def simulate_steps(program: Program, machine: Machine, *, sources: Sources = ALL
     kind = _Controller if sources.interpolation else _IdealController
     sim = kind(machine, program.origin, sources)
     start = program.origin
-    for move in program.moves:
-        sim.block(start, move)
+    for k, move in enumerate(program.moves):
+        try:
+            sim.block(start, move)
+        except InputError as exc:
+            raise _at(program, k, exc) from exc
         start = (move.x, move.y)
     return sim.finish(len(program.moves))
+
+
+def _at(program: Program, index: int, exc: InputError) -> InputError:
+    """``exc`` (a block the controller cannot run) with the block's source line in front."""
+    line = program.line_of(index)
+    return InputError(f"{'block' if line is None else 'line'} {line or index + 1}: {exc}")
 
 
 def switched_machine(machine: Machine, sources: Sources) -> Machine:
@@ -544,8 +554,11 @@ def simulate_or_count(program: Program, machine: Machine, limit: int) -> StepTra
     sim = _Controller(machine, program.origin, ALL)
     start = program.origin
     rows = 0
-    for move in program.moves:
-        sim.block(start, move)
+    for k, move in enumerate(program.moves):
+        try:
+            sim.block(start, move)
+        except InputError as exc:
+            raise _at(program, k, exc) from exc
         start = (move.x, move.y)
         rows += sim.counts[-1]
         if rows > limit:
@@ -625,7 +638,10 @@ class ChunkedSimulation:
         first, row0, pending = 0, 0, 0
         moves = self.program.moves
         for b, move in enumerate(moves):
-            sim.block(start, move)
+            try:
+                sim.block(start, move)
+            except InputError as exc:
+                raise _at(self.program, b, exc) from exc
             start = (move.x, move.y)
             pending += sim.counts[-1]
             if pending < self.chunk_rows and b + 1 < len(moves):

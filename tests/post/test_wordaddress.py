@@ -642,3 +642,26 @@ def test_a_spindle_without_a_speed_writes_no_s0() -> None:
     assert lines[1] == "M3"
     back = post(RS274).parse("\n".join(lines) + "\n")
     assert back.commands[0] == (0, Spindle("cw", 0.0))
+
+
+def test_grbl_writes_an_arc_within_half_its_arc_tolerance_as_a_line() -> None:
+    # GRBL's mc_arc divides by √($12·(2r − $12)): undefined for r ≤ $12/2 = 0.001 mm at the
+    # default $12 = 0.002 mm. A 1-quantum radius (filters.svg, Inkscape's examples, had
+    # 2 567) is written as a G1; 2 quanta stays an arc, and both programs verify.
+    from camtool.verify.verifier import verify_code
+
+    target = load_target("grbl")
+    tiny = (Rapid(1.028, 0.728), ArcMove(1.027, 0.729, 1.027, 0.728, True, 300.0))
+    result = target.emit(Program(tiny))
+    lines = str(result.code).splitlines()
+    assert [ln for ln in lines if ln.startswith(("G2 ", "G3 "))] == []
+    assert any(ln.startswith("G1 X1.027 Y0.729") for ln in lines)
+    assert any("1 arc(s) too small" in w for w in result.warnings)
+    verify_code(str(result.code), target)
+    half = (Rapid(1.028, 0.728), ArcMove(1.026, 0.728, 1.027, 0.728, True, 300.0))
+    lines = str(target.emit(Program(half)).code).splitlines()
+    assert any(ln.startswith("G1 X1.026 Y0.728") for ln in lines)
+    small = (Rapid(1.030, 0.728), ArcMove(1.026, 0.728, 1.028, 0.728, True, 300.0))
+    result = target.emit(Program(small))
+    assert any(ln.startswith("G2 X1.026 Y0.728 I-0.002") for ln in str(result.code).splitlines())
+    verify_code(str(result.code), target)

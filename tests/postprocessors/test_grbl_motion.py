@@ -62,3 +62,16 @@ def test_grbl_junction_speed():
     v = grbl_junction_speed_mm_s([0.0, math.pi / 2, math.pi], acceleration_mm_s2=100)
     assert math.isinf(v[0]) and v[2] == 0.0
     assert float(v[1]) == pytest.approx(math.sqrt((1 + math.sqrt(2)) * 100 * 0.010))
+
+
+@pytest.mark.parametrize("radius", [0.001, 0.00099999999999989, 0.0004])
+def test_grbl_segment_count_is_refused_where_mc_arc_divides_by_nothing(radius: float) -> None:
+    # analytic: √(tol·(2r − tol)) is 0 at r = tol/2 and the root of a negative number below
+    # it; GRBL's uint16 cast of the quotient (inf or NaN) is undefined C: no prediction
+    with pytest.raises(InputError, match=r"not over half of grbl's arc tolerance \$12"):
+        grbl_arc_segments(radius, math.pi, 0.002)
+    # just over half: a finite count (analytic, the formula)
+    r = 0.0010001
+    assert grbl_arc_segments(r, math.pi, 0.002) == math.floor(
+        0.5 * math.pi * r / math.sqrt(0.002 * (2 * r - 0.002))
+    )
