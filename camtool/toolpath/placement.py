@@ -79,7 +79,7 @@ def _extent(program: Program) -> BBox | None:
         return bbox_union([(x, y, x, y) for x, y in ends]) if ends else None
     start = program.origin if first == 0 else (moves[first - 1].x, moves[first - 1].y)
     tail = moves[first:]
-    box = _extent_fast(start, tail)
+    box = _extent_fast(start, tail, zero_sides=True)
     return box if box is not None else _extent_slow(start, tail)
 
 
@@ -97,7 +97,7 @@ _QUAD_SIN = tuple(math.sin(k * math.pi / 2) for k in range(4))
 """``cos``/``sin`` of the quadrant angles, as :meth:`Arc.bbox` computes its extremes."""
 
 
-def _extent_fast(start: Point, moves: Sequence[Move]) -> BBox | None:
+def _extent_fast(start: Point, moves: Sequence[Move], *, zero_sides: bool = False) -> BBox | None:
     """:func:`_extent_slow`'s box, skipping the arcs that cannot widen it; ``None``: not sure.
 
     The box of the end points comes first. An arc whose four circle extremes (the very floats
@@ -105,7 +105,15 @@ def _extent_fast(start: Point, moves: Sequence[Move]) -> BBox | None:
     inside it adds no value that could be a minimum or a maximum, so its box is not needed;
     the others' boxes are computed as before. The union of a set of floats is the same in any
     order but for the sign of a zero and NaN (``min`` keeps the first of equals), so a box
-    with a zero or a non-finite side is left to the slow union (``None``).
+    with a non-finite side is left to the slow union (``None``), and so is one with a zero
+    side unless ``zero_sides``.
+
+    ``zero_sides`` (what :func:`toolpath_extent` uses: ``--origin lower-left`` puts the
+    lower-left corner at exactly 0): a zero side is kept when no value that could be it is
+    ``-0.0``. The slow union's values are the end points (all in the end-point box's lists),
+    the boxes of the arcs kept here (the same boxes) and extremes of the skipped arcs, which
+    lie strictly inside and so are no side. When none of the first two is ``-0.0``, every
+    zero among them is ``+0.0`` and both unions give ``+0.0`` in any order.
     """
     xs = [start[0], *(m.x for m in moves)]
     ys = [start[1], *(m.y for m in moves)]
@@ -135,8 +143,14 @@ def _extent_fast(start: Point, moves: Sequence[Move]) -> BBox | None:
                 boxes.append(segment_of((hx, hy), move).bbox())
         hx, hy = move.x, move.y
     box = bbox_union(boxes)
-    if not all(map(math.isfinite, box)) or 0.0 in box:
+    if not all(map(math.isfinite, box)):
         return None
+    if 0.0 in box:
+        if not zero_sides:
+            return None
+        values = (*xs, *ys, *(v for b in boxes[1:] for v in b))
+        if any(v == 0.0 and math.copysign(1.0, v) < 0.0 for v in values):
+            return None  # a -0.0 takes part: its place in the order decides
     return box
 
 
