@@ -88,6 +88,36 @@ def bbox_union(boxes: Iterator[BBox] | list[BBox]) -> BBox:
     )
 
 
+_new = object.__new__
+
+
+def make_line(start: Point, end: Point) -> Line:
+    """``Line(start, end)``, built without the frozen dataclass's checked ``__init__``.
+
+    The same object: an instance whose ``__dict__`` holds the fields in the same order
+    (what the dataclass ``__init__`` stores through ``object.__setattr__``), so equal, with
+    the same hash, ``repr`` and pickle. For loops that make segments by the hundred
+    thousand (transforms, reversals, pieces of a path); :class:`Line` has no
+    ``__post_init__`` to skip.
+    """
+    obj = _new(Line)
+    d = obj.__dict__
+    d["start"] = start
+    d["end"] = end
+    return obj
+
+
+def make_arc(start: Point, end: Point, centre: Point, clockwise: bool) -> Arc:
+    """``Arc(start, end, centre, clockwise)``, built as :func:`make_line` builds a line."""
+    obj = _new(Arc)
+    d = obj.__dict__
+    d["start"] = start
+    d["end"] = end
+    d["centre"] = centre
+    d["clockwise"] = clockwise
+    return obj
+
+
 @dataclass(frozen=True)
 class Line:
     """A straight segment from ``start`` to ``end`` (mm)."""
@@ -102,7 +132,7 @@ class Line:
 
     def reversed(self) -> Line:
         """The same segment traversed from end to start."""
-        return Line(self.end, self.start)
+        return make_line(self.end, self.start)
 
     def bbox(self) -> BBox:
         """Bounding box ``(xmin, ymin, xmax, ymax)``, mm."""
@@ -116,7 +146,7 @@ class Line:
 
     def transformed(self, scale: float, dx: float, dy: float) -> Line:
         """Uniformly scaled about the origin (``scale`` > 0), then translated."""
-        return Line(_tf(self.start, scale, dx, dy), _tf(self.end, scale, dx, dy))
+        return make_line(_tf(self.start, scale, dx, dy), _tf(self.end, scale, dx, dy))
 
 
 @dataclass(frozen=True)
@@ -180,7 +210,7 @@ class Arc:
 
     def reversed(self) -> Arc:
         """The same arc traversed from end to start (direction flips)."""
-        return Arc(self.end, self.start, self.centre, not self.clockwise)
+        return make_arc(self.end, self.start, self.centre, not self.clockwise)
 
     def split(self, parts: int) -> list[Arc]:
         """Split into ``parts`` arcs of equal sweep; the ends are kept exact."""
@@ -218,7 +248,7 @@ class Arc:
 
     def transformed(self, scale: float, dx: float, dy: float) -> Arc:
         """Uniformly scaled about the origin (``scale`` > 0), then translated."""
-        return Arc(
+        return make_arc(
             _tf(self.start, scale, dx, dy),
             _tf(self.end, scale, dx, dy),
             _tf(self.centre, scale, dx, dy),

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from camtool.model.errors import DialectError
-from camtool.model.program import ArcMove, Move, Program, Rapid, segment_of
+from camtool.model.program import ArcMove, Linear, Move, Program, Rapid, segment_of
 from camtool.model.shapes import BBox, Point, bbox_union
 from camtool.model.units import fmt_num
 
@@ -218,7 +218,49 @@ def _at_start(program: Program) -> int:
     return k
 
 
+def _plain_fields(cls: type) -> int | None:
+    """How many fields ``cls`` has when it is a plain frozen dataclass, else ``None``.
+
+    Plain: no ``__post_init__`` (nothing checked or derived at ``__init__``), no
+    ``__slots__``, its own generated ``__init__``. Such an object is its ``__dict__``: the
+    fields, in declaration order, and nothing else when it holds as many keys.
+    """
+    fields = getattr(cls, "__dataclass_fields__", None)
+    if not fields or hasattr(cls, "__post_init__") or "__slots__" in vars(cls):
+        return None
+    return len(fields) if "__init__" in vars(cls) else None
+
+
+_PLAIN_MOVES = {cls: n for cls in (Rapid, Linear, ArcMove) if (n := _plain_fields(cls))}
+"""Move classes :func:`_shifted` may copy by their ``__dict__``, with their field counts."""
+_new = object.__new__
+
+
 def _shifted(move: Move, dx: float, dy: float) -> Move:
+    """``move`` moved by ``(dx, dy)``: :func:`_shifted_slow`'s object, made faster.
+
+    A plain move whose ``__dict__`` holds just its fields is copied key by key, with
+    ``x``, ``y`` (and an arc's ``cx``, ``cy``) shifted: for a move its ``__init__`` made,
+    the same keys in the same order as ``dataclasses.replace`` stores, so equal, with the
+    same hash, ``repr`` and pickle. Anything else goes through :func:`_shifted_slow`.
+    """
+    cls = type(move)
+    d = move.__dict__
+    if _PLAIN_MOVES.get(cls) != len(d):
+        return _shifted_slow(move, dx, dy)
+    new = _new(cls)
+    nd = new.__dict__
+    nd.update(d)
+    nd["x"] = d["x"] + dx
+    nd["y"] = d["y"] + dy
+    if cls is ArcMove:
+        nd["cx"] = d["cx"] + dx
+        nd["cy"] = d["cy"] + dy
+    return new
+
+
+def _shifted_slow(move: Move, dx: float, dy: float) -> Move:
+    """``move`` moved by ``(dx, dy)`` through ``dataclasses.replace`` (the reference)."""
     if isinstance(move, Rapid):
         return dataclasses.replace(move, x=move.x + dx, y=move.y + dy)
     if isinstance(move, ArcMove):

@@ -47,15 +47,33 @@ _TRAVEL_PER_REVERSAL_MM = 1e6
 """Travel worth one unit-weight reversal in the combined key (reversals dominate)."""
 
 
-def segment_signs(seg: Segment) -> tuple[list[int], list[int]]:
-    """Successive directions (+1/-1) in which ``seg`` moves X and Y (see the module)."""
+def segment_signs(seg: Segment) -> tuple[Sequence[int], Sequence[int]]:
+    """Successive directions (+1/-1) in which ``seg`` moves X and Y (see the module).
+
+    An arc's are computed once and kept on it (in its ``__dict__``, as its cached
+    properties are: no field, so equality, hash and ``repr`` ignore them; they depend on
+    its fields only), shared tuples: callers read them, never change them.
+    """
     if isinstance(seg, Line):
         dx, dy = seg.end[0] - seg.start[0], seg.end[1] - seg.start[1]
         return ([_sign(dx)] if abs(dx) > MOVE_EPS_MM else []), (
             [_sign(dy)] if abs(dy) > MOVE_EPS_MM else []
         )
-    a0, sweep = seg.start_angle, seg.sweep
-    return _axis_signs(a0, sweep, 0.0, math.pi), _axis_signs(a0, sweep, _HALF_PI, _HALF_PI_PI)
+    kept = seg.__dict__.get("_axis_signs")
+    if kept is None:
+        a0, sweep = seg.start_angle, seg.sweep
+        pair = (
+            tuple(_axis_signs(a0, sweep, 0.0, math.pi)),
+            tuple(_axis_signs(a0, sweep, _HALF_PI, _HALF_PI_PI)),
+        )
+        kept = _SIGN_PAIRS.setdefault(pair, pair)  # a few dozen distinct pairs: one each
+        seg.__dict__["_axis_signs"] = kept
+    return kept
+
+
+_SIGN_PAIRS: dict[tuple[tuple[int, ...], tuple[int, ...]], tuple[tuple[int, ...], tuple[int, ...]]]
+_SIGN_PAIRS = {}
+"""Every distinct ``(x signs, y signs)`` of an arc, so that arcs share one tuple each."""
 
 
 _HALF_PI = math.pi / 2
@@ -183,6 +201,7 @@ def count_reversals_slow(cuts: Sequence[Cut], start: Point) -> tuple[int, int]:
     for cut in cuts:
         moves: list[Segment] = [Line(here, cut.path.start), *cut.path.segments]
         for seg in moves:
+            signs: tuple[Sequence[int], Sequence[int]]
             if isinstance(seg, Arc):
                 signs = (_arc_signs(seg, 0.0), _arc_signs(seg, math.pi / 2))
             else:

@@ -17,7 +17,15 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from camtool.model.shapes import Arc, Contour, Line, Point, Segment, cached_property
+from camtool.model.shapes import (
+    Arc,
+    Contour,
+    Point,
+    Segment,
+    cached_property,
+    make_arc,
+    make_line,
+)
 
 MIN_PIECE = 1e-9
 """Pieces shorter than this (mm) are dropped: a zero-length arc would read as a full circle."""
@@ -46,8 +54,8 @@ def _piece(seg: Segment, f0: float, f1: float) -> Segment:
     start = _point_at(seg, f0)
     end = _point_at(seg, f1)
     if isinstance(seg, Arc):
-        return Arc(start, end, seg.centre, seg.clockwise)
-    return Line(start, end)
+        return make_arc(start, end, seg.centre, seg.clockwise)
+    return make_line(start, end)
 
 
 def _point_at(seg: Segment, f: float) -> Point:

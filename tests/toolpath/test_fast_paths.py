@@ -84,7 +84,10 @@ def arcs(draw: st.DrawFn) -> Arc:
 @settings(max_examples=1500, deadline=None)
 @given(arcs())
 def test_arc_signs_equal_the_slow_form(arc: Arc) -> None:
-    assert segment_signs(arc) == (_arc_signs(arc, 0.0), _arc_signs(arc, math.pi / 2))
+    slow = (_arc_signs(arc, 0.0), _arc_signs(arc, math.pi / 2))
+    for _ in range(2):  # computed, then kept
+        xs, ys = segment_signs(arc)
+        assert (list(xs), list(ys)) == slow
 
 
 @settings(max_examples=300, deadline=None)
@@ -180,3 +183,35 @@ def test_cached_lengths_and_boxes_equal_fresh_ones() -> None:
     track = Track.of(contour)
     assert track.length == sum(s.length for s in segs)
     assert track.ends == (5.0, 5.0 + TAU, 10.0 + TAU)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    st.lists(
+        st.tuples(st.integers(0, 2), point, point, st.booleans(), st.one_of(st.none(), coord)),
+        min_size=1,
+        max_size=20,
+    ),
+    coord,
+    coord,
+)
+def test_shifted_moves_are_the_replaced_ones(items: list, dx: float, dy: float) -> None:
+    """placement._shifted copies plain moves by their __dict__: the object replace() makes."""
+    import pickle
+
+    from camtool.model.program import ArcMove, Linear, Rapid
+    from camtool.toolpath.placement import _shifted, _shifted_slow
+
+    for kind, (x, y), (cx, cy), cw, z in items:
+        move = (
+            Rapid(x, y, z, 3)
+            if kind == 0
+            else Linear(x, y, 120.0, z, contour=4)
+            if kind == 1
+            else ArcMove(x, y, cx, cy, cw, 90.0, z, 5)
+        )
+        fast, slow = _shifted(move, dx, dy), _shifted_slow(move, dx, dy)
+        assert type(fast) is type(slow)
+        assert list(vars(fast).items()) == list(vars(slow).items())
+        assert fast == slow and hash(fast) == hash(slow)
+        assert pickle.dumps(fast) == pickle.dumps(slow)
