@@ -335,6 +335,15 @@ def check_travel(
     return _zero_warnings(box, machine, chosen=chosen)
 
 
+def larger_than_travel(box: BBox, machine: Machine) -> bool:
+    """Whether a toolpath extent ``box`` is larger than the travel of ``machine`` (mm).
+
+    The test of :func:`too_large`; only then is :attr:`Placing.margin_mm` read.
+    """
+    tw, th = machine.travel_mm
+    return not (box[2] - box[0] <= tw + EPS_MM and box[3] - box[1] <= th + EPS_MM)
+
+
 def too_large(box: BBox, machine: Machine, placing: Placing | None) -> None:
     """Refuse a toolpath extent ``box`` larger than the travel of ``machine``.
 
@@ -342,10 +351,10 @@ def too_large(box: BBox, machine: Machine, placing: Placing | None) -> None:
         DialectError: naming both sizes, ``--fit W H`` that makes it fit (when the
             program was planned here) and a larger machine.
     """
+    if not larger_than_travel(box, machine):
+        return
     w, h = box[2] - box[0], box[3] - box[1]
     tw, th = machine.travel_mm
-    if w <= tw + EPS_MM and h <= th + EPS_MM:
-        return
     fit = _fit_remedy(machine, placing, w, h)
     raise DialectError(
         f"the toolpath is {_mm(w)} × {_mm(h)} mm, larger than the {_mm(tw)} × {_mm(th)} mm "
