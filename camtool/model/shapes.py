@@ -28,6 +28,12 @@ _FULL_CIRCLE_EPS = 1e-12
 
 _T = TypeVar("_T")
 
+_QUADRANTS = tuple(
+    (k * math.pi / 2, math.cos(k * math.pi / 2), math.sin(k * math.pi / 2)) for k in range(4)
+)
+"""``(angle, cos, sin)`` of the quadrant angles ``k·π/2``: the very floats :meth:`Arc.bbox`
+computed per call before (``math.cos(k * math.pi / 2)``), computed once."""
+
 
 class cached_property(Generic[_T]):
     """A property computed once per instance and kept in its ``__dict__`` (lock-free).
@@ -82,6 +88,36 @@ def bbox_union(boxes: Iterator[BBox] | list[BBox]) -> BBox:
     )
 
 
+_new = object.__new__
+
+
+def make_line(start: Point, end: Point) -> Line:
+    """``Line(start, end)``, built without the frozen dataclass's checked ``__init__``.
+
+    The same object: an instance whose ``__dict__`` holds the fields in the same order
+    (what the dataclass ``__init__`` stores through ``object.__setattr__``), so equal, with
+    the same hash, ``repr`` and pickle. For loops that make segments by the hundred
+    thousand (transforms, reversals, pieces of a path); :class:`Line` has no
+    ``__post_init__`` to skip.
+    """
+    obj = _new(Line)
+    d = obj.__dict__
+    d["start"] = start
+    d["end"] = end
+    return obj
+
+
+def make_arc(start: Point, end: Point, centre: Point, clockwise: bool) -> Arc:
+    """``Arc(start, end, centre, clockwise)``, built as :func:`make_line` builds a line."""
+    obj = _new(Arc)
+    d = obj.__dict__
+    d["start"] = start
+    d["end"] = end
+    d["centre"] = centre
+    d["clockwise"] = clockwise
+    return obj
+
+
 @dataclass(frozen=True)
 class Line:
     """A straight segment from ``start`` to ``end`` (mm)."""
@@ -89,14 +125,14 @@ class Line:
     start: Point
     end: Point
 
-    @property
+    @cached_property
     def length(self) -> float:
-        """Length in mm."""
+        """Length in mm (computed once)."""
         return distance(self.start, self.end)
 
     def reversed(self) -> Line:
         """The same segment traversed from end to start."""
-        return Line(self.end, self.start)
+        return make_line(self.end, self.start)
 
     def bbox(self) -> BBox:
         """Bounding box ``(xmin, ymin, xmax, ymax)``, mm."""
@@ -110,7 +146,7 @@ class Line:
 
     def transformed(self, scale: float, dx: float, dy: float) -> Line:
         """Uniformly scaled about the origin (``scale`` > 0), then translated."""
-        return Line(_tf(self.start, scale, dx, dy), _tf(self.end, scale, dx, dy))
+        return make_line(_tf(self.start, scale, dx, dy), _tf(self.end, scale, dx, dy))
 
 
 @dataclass(frozen=True)
@@ -128,14 +164,14 @@ class Arc:
     centre: Point
     clockwise: bool
 
-    @property
+    @cached_property
     def radius(self) -> float:
-        """Radius in mm, measured from the centre to the start point."""
+        """Radius in mm, measured from the centre to the start point (computed once)."""
         return distance(self.centre, self.start)
 
-    @property
+    @cached_property
     def start_angle(self) -> float:
-        """Angle of the start point seen from the centre, radians CCW from +X."""
+        """Angle of the start point seen from the centre, radians CCW from +X (computed once)."""
         return math.atan2(self.start[1] - self.centre[1], self.start[0] - self.centre[0])
 
     @property
@@ -161,9 +197,9 @@ class Arc:
             ccw = TAU
         return -(TAU - ccw) if self.clockwise else ccw
 
-    @property
+    @cached_property
     def length(self) -> float:
-        """Arc length in mm."""
+        """Arc length in mm (computed once)."""
         return abs(self.sweep) * self.radius
 
     def point_at(self, fraction: float) -> Point:
@@ -174,7 +210,7 @@ class Arc:
 
     def reversed(self) -> Arc:
         """The same arc traversed from end to start (direction flips)."""
-        return Arc(self.end, self.start, self.centre, not self.clockwise)
+        return make_arc(self.end, self.start, self.centre, not self.clockwise)
 
     def split(self, parts: int) -> list[Arc]:
         """Split into ``parts`` arcs of equal sweep; the ends are kept exact."""
@@ -188,13 +224,14 @@ class Arc:
         cx, cy = self.centre
         r = self.radius
         a0, sweep = self.start_angle, self.sweep
-        for k in range(4):
-            quad = k * math.pi / 2
+        span = abs(sweep)
+        ccw = sweep > 0
+        for quad, cos_q, sin_q in _QUADRANTS:
             # distance travelled along the sweep direction to reach angle `quad`
-            delta = (quad - a0) % TAU if sweep > 0 else (a0 - quad) % TAU
-            if delta <= abs(sweep):
-                xs.append(cx + r * math.cos(quad))
-                ys.append(cy + r * math.sin(quad))
+            delta = (quad - a0) % TAU if ccw else (a0 - quad) % TAU
+            if delta <= span:
+                xs.append(cx + r * cos_q)
+                ys.append(cy + r * sin_q)
         return (min(xs), min(ys), max(xs), max(ys))
 
     def points(self, tolerance: float) -> list[Point]:
@@ -211,7 +248,7 @@ class Arc:
 
     def transformed(self, scale: float, dx: float, dy: float) -> Arc:
         """Uniformly scaled about the origin (``scale`` > 0), then translated."""
-        return Arc(
+        return make_arc(
             _tf(self.start, scale, dx, dy),
             _tf(self.end, scale, dx, dy),
             _tf(self.centre, scale, dx, dy),
@@ -321,14 +358,18 @@ class Contour:
         """Last point, mm."""
         return self.segments[-1].end
 
-    @property
+    @cached_property
     def length(self) -> float:
-        """Total length, mm."""
+        """Total length, mm (computed once)."""
         return sum(s.length for s in self.segments)
 
     def bbox(self) -> BBox:
-        """Bounding box ``(xmin, ymin, xmax, ymax)``, mm."""
-        return bbox_union([s.bbox() for s in self.segments])
+        """Bounding box ``(xmin, ymin, xmax, ymax)``, mm (computed once, then kept)."""
+        box: BBox | None = self.__dict__.get("_bbox")
+        if box is None:
+            box = bbox_union([s.bbox() for s in self.segments])
+            self.__dict__["_bbox"] = box
+        return box
 
     def reversed(self) -> Contour:
         """The same contour traversed the other way."""

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from camtool.model.errors import DialectError
-from camtool.model.program import ArcMove, Move, Program, Rapid, segment_of
+from camtool.model.program import ArcMove, Linear, Move, Program, Rapid, segment_of
 from camtool.model.shapes import BBox, Point, bbox_union
 from camtool.model.units import fmt_num
 
@@ -79,7 +79,7 @@ def _extent(program: Program) -> BBox | None:
         return bbox_union([(x, y, x, y) for x, y in ends]) if ends else None
     start = program.origin if first == 0 else (moves[first - 1].x, moves[first - 1].y)
     tail = moves[first:]
-    box = _extent_fast(start, tail)
+    box = _extent_fast(start, tail, zero_sides=True)
     return box if box is not None else _extent_slow(start, tail)
 
 
@@ -97,7 +97,7 @@ _QUAD_SIN = tuple(math.sin(k * math.pi / 2) for k in range(4))
 """``cos``/``sin`` of the quadrant angles, as :meth:`Arc.bbox` computes its extremes."""
 
 
-def _extent_fast(start: Point, moves: Sequence[Move]) -> BBox | None:
+def _extent_fast(start: Point, moves: Sequence[Move], *, zero_sides: bool = False) -> BBox | None:
     """:func:`_extent_slow`'s box, skipping the arcs that cannot widen it; ``None``: not sure.
 
     The box of the end points comes first. An arc whose four circle extremes (the very floats
@@ -105,7 +105,15 @@ def _extent_fast(start: Point, moves: Sequence[Move]) -> BBox | None:
     inside it adds no value that could be a minimum or a maximum, so its box is not needed;
     the others' boxes are computed as before. The union of a set of floats is the same in any
     order but for the sign of a zero and NaN (``min`` keeps the first of equals), so a box
-    with a zero or a non-finite side is left to the slow union (``None``).
+    with a non-finite side is left to the slow union (``None``), and so is one with a zero
+    side unless ``zero_sides``.
+
+    ``zero_sides`` (what :func:`toolpath_extent` uses: ``--origin lower-left`` puts the
+    lower-left corner at exactly 0): a zero side is kept when no value that could be it is
+    ``-0.0``. The slow union's values are the end points (all in the end-point box's lists),
+    the boxes of the arcs kept here (the same boxes) and extremes of the skipped arcs, which
+    lie strictly inside and so are no side. When none of the first two is ``-0.0``, every
+    zero among them is ``+0.0`` and both unions give ``+0.0`` in any order.
     """
     xs = [start[0], *(m.x for m in moves)]
     ys = [start[1], *(m.y for m in moves)]
@@ -135,8 +143,14 @@ def _extent_fast(start: Point, moves: Sequence[Move]) -> BBox | None:
                 boxes.append(segment_of((hx, hy), move).bbox())
         hx, hy = move.x, move.y
     box = bbox_union(boxes)
-    if not all(map(math.isfinite, box)) or 0.0 in box:
+    if not all(map(math.isfinite, box)):
         return None
+    if 0.0 in box:
+        if not zero_sides:
+            return None
+        values = (*xs, *ys, *(v for b in boxes[1:] for v in b))
+        if any(v == 0.0 and math.copysign(1.0, v) < 0.0 for v in values):
+            return None  # a -0.0 takes part: its place in the order decides
     return box
 
 
@@ -204,7 +218,49 @@ def _at_start(program: Program) -> int:
     return k
 
 
+def _plain_fields(cls: type) -> int | None:
+    """How many fields ``cls`` has when it is a plain frozen dataclass, else ``None``.
+
+    Plain: no ``__post_init__`` (nothing checked or derived at ``__init__``), no
+    ``__slots__``, its own generated ``__init__``. Such an object is its ``__dict__``: the
+    fields, in declaration order, and nothing else when it holds as many keys.
+    """
+    fields = getattr(cls, "__dataclass_fields__", None)
+    if not fields or hasattr(cls, "__post_init__") or "__slots__" in vars(cls):
+        return None
+    return len(fields) if "__init__" in vars(cls) else None
+
+
+_PLAIN_MOVES = {cls: n for cls in (Rapid, Linear, ArcMove) if (n := _plain_fields(cls))}
+"""Move classes :func:`_shifted` may copy by their ``__dict__``, with their field counts."""
+_new = object.__new__
+
+
 def _shifted(move: Move, dx: float, dy: float) -> Move:
+    """``move`` moved by ``(dx, dy)``: :func:`_shifted_slow`'s object, made faster.
+
+    A plain move whose ``__dict__`` holds just its fields is copied key by key, with
+    ``x``, ``y`` (and an arc's ``cx``, ``cy``) shifted: for a move its ``__init__`` made,
+    the same keys in the same order as ``dataclasses.replace`` stores, so equal, with the
+    same hash, ``repr`` and pickle. Anything else goes through :func:`_shifted_slow`.
+    """
+    cls = type(move)
+    d = move.__dict__
+    if _PLAIN_MOVES.get(cls) != len(d):
+        return _shifted_slow(move, dx, dy)
+    new = _new(cls)
+    nd = new.__dict__
+    nd.update(d)
+    nd["x"] = d["x"] + dx
+    nd["y"] = d["y"] + dy
+    if cls is ArcMove:
+        nd["cx"] = d["cx"] + dx
+        nd["cy"] = d["cy"] + dy
+    return new
+
+
+def _shifted_slow(move: Move, dx: float, dy: float) -> Move:
+    """``move`` moved by ``(dx, dy)`` through ``dataclasses.replace`` (the reference)."""
     if isinstance(move, Rapid):
         return dataclasses.replace(move, x=move.x + dx, y=move.y + dy)
     if isinstance(move, ArcMove):
@@ -279,6 +335,15 @@ def check_travel(
     return _zero_warnings(box, machine, chosen=chosen)
 
 
+def larger_than_travel(box: BBox, machine: Machine) -> bool:
+    """Whether a toolpath extent ``box`` is larger than the travel of ``machine`` (mm).
+
+    The test of :func:`too_large`; only then is :attr:`Placing.margin_mm` read.
+    """
+    tw, th = machine.travel_mm
+    return not (box[2] - box[0] <= tw + EPS_MM and box[3] - box[1] <= th + EPS_MM)
+
+
 def too_large(box: BBox, machine: Machine, placing: Placing | None) -> None:
     """Refuse a toolpath extent ``box`` larger than the travel of ``machine``.
 
@@ -286,10 +351,10 @@ def too_large(box: BBox, machine: Machine, placing: Placing | None) -> None:
         DialectError: naming both sizes, ``--fit W H`` that makes it fit (when the
             program was planned here) and a larger machine.
     """
+    if not larger_than_travel(box, machine):
+        return
     w, h = box[2] - box[0], box[3] - box[1]
     tw, th = machine.travel_mm
-    if w <= tw + EPS_MM and h <= th + EPS_MM:
-        return
     fit = _fit_remedy(machine, placing, w, h)
     raise DialectError(
         f"the toolpath is {_mm(w)} × {_mm(h)} mm, larger than the {_mm(tw)} × {_mm(th)} mm "

@@ -39,6 +39,7 @@ from camtool.toolpath.order import Ordering, nesting, order_cuts
 from camtool.toolpath.placement import (
     Placing,
     check_travel,
+    larger_than_travel,
     placement_shift,
     shift_program,
     toolpath_extent,
@@ -267,17 +268,22 @@ def place_program(
     if dx or dy:
         placed = placed.transformed(1.0, dx, dy)
     if machine is not None:
-        said = check_travel(program, machine, _placing(program, placed, options))
+        said = check_travel(program, machine, _placing(program, placed, options, machine))
         if said:
             program = dataclasses.replace(program, warnings=(*program.warnings, *said))
     return program, placed, (dx, dy)
 
 
-def _placing(program: Program, placed: Drawing, options: PlanOptions) -> Placing:
-    """How ``options`` placed ``program``, and its toolpath's margin over the drawing."""
+def _placing(program: Program, placed: Drawing, options: PlanOptions, machine: Machine) -> Placing:
+    """How ``options`` placed ``program``, and its toolpath's margin over the drawing.
+
+    The margin is read only by the ``--fit`` remedy of a toolpath larger than the travel
+    (:func:`~camtool.toolpath.placement.too_large`), so it is measured only then (the
+    placed drawing's box walks every segment); otherwise it is left at ``(0, 0)``.
+    """
     margin = (0.0, 0.0)
     box = toolpath_extent(program)
-    if box is not None and placed.contours:
+    if box is not None and placed.contours and larger_than_travel(box, machine):
         d = placed.bbox()
         margin = ((box[2] - box[0]) - (d[2] - d[0]), (box[3] - box[1]) - (d[3] - d[1]))
     return Placing(options.placement, options.translate, margin)

@@ -47,14 +47,67 @@ _TRAVEL_PER_REVERSAL_MM = 1e6
 """Travel worth one unit-weight reversal in the combined key (reversals dominate)."""
 
 
-def segment_signs(seg: Segment) -> tuple[list[int], list[int]]:
-    """Successive directions (+1/-1) in which ``seg`` moves X and Y (see the module)."""
+def segment_signs(seg: Segment) -> tuple[Sequence[int], Sequence[int]]:
+    """Successive directions (+1/-1) in which ``seg`` moves X and Y (see the module).
+
+    An arc's are computed once and kept on it (in its ``__dict__``, as its cached
+    properties are: no field, so equality, hash and ``repr`` ignore them; they depend on
+    its fields only), shared tuples: callers read them, never change them.
+    """
     if isinstance(seg, Line):
         dx, dy = seg.end[0] - seg.start[0], seg.end[1] - seg.start[1]
         return ([_sign(dx)] if abs(dx) > MOVE_EPS_MM else []), (
             [_sign(dy)] if abs(dy) > MOVE_EPS_MM else []
         )
-    return _arc_signs(seg, 0.0), _arc_signs(seg, math.pi / 2)
+    kept = seg.__dict__.get("_axis_signs")
+    if kept is None:
+        a0, sweep = seg.start_angle, seg.sweep
+        pair = (
+            tuple(_axis_signs(a0, sweep, 0.0, math.pi)),
+            tuple(_axis_signs(a0, sweep, _HALF_PI, _HALF_PI_PI)),
+        )
+        kept = _SIGN_PAIRS.setdefault(pair, pair)  # a few dozen distinct pairs: one each
+        seg.__dict__["_axis_signs"] = kept
+    return kept
+
+
+_SIGN_PAIRS: dict[tuple[tuple[int, ...], tuple[int, ...]], tuple[tuple[int, ...], tuple[int, ...]]]
+_SIGN_PAIRS = {}
+"""Every distinct ``(x signs, y signs)`` of an arc, so that arcs share one tuple each."""
+
+
+_HALF_PI = math.pi / 2
+_HALF_PI_PI = _HALF_PI + math.pi  # the float _arc_signs computes as ``phase + math.pi``
+
+
+def _axis_signs(a0: float, sweep: float, phase: float, phase_pi: float) -> list[int]:
+    """:func:`_arc_signs` of an arc from ``a0`` over ``sweep`` (radians), inlined.
+
+    ``phase_pi`` is ``phase + math.pi``. The same floats in the same operations: the
+    two turning points, their order, each piece's midpoint and the sine there.
+    """
+    s = 1.0 if sweep > 0 else -1.0
+    total = abs(sweep)
+    hi_end = total - _ANGLE_EPS
+    d1 = (s * (phase - a0)) % TAU
+    d2 = (s * (phase_pi - a0)) % TAU
+    in1 = _ANGLE_EPS < d1 < hi_end
+    in2 = _ANGLE_EPS < d2 < hi_end
+    if in1 and in2:
+        if d2 < d1:
+            d1, d2 = d2, d1
+        return [
+            1 if -s * math.sin(a0 + s * (0.0 + d1) / 2 - phase) > 0 else -1,
+            1 if -s * math.sin(a0 + s * (d1 + d2) / 2 - phase) > 0 else -1,
+            1 if -s * math.sin(a0 + s * (d2 + total) / 2 - phase) > 0 else -1,
+        ]
+    if in1 or in2:
+        d = d1 if in1 else d2
+        return [
+            1 if -s * math.sin(a0 + s * (0.0 + d) / 2 - phase) > 0 else -1,
+            1 if -s * math.sin(a0 + s * (d + total) / 2 - phase) > 0 else -1,
+        ]
+    return [1 if -s * math.sin(a0 + s * (0.0 + total) / 2 - phase) > 0 else -1]
 
 
 def _sign(v: float) -> int:
@@ -112,14 +165,49 @@ def count_reversals(cuts: Sequence[Cut], start: Point) -> tuple[int, int]:
         ``(rx, ry)``: reversals of X and of Y. On a machine that compensates
         every reversal (pic-mmh, seed-000 §5.1) this is the compensation count.
     """
+    state_x = state_y = 0
+    count_x = count_y = 0
+    here = start
+    for cut in cuts:
+        path = cut.path
+        to = path.start
+        # the rapid here → to as a line (segment_signs of Line(here, to)), then the path
+        dx, dy = to[0] - here[0], to[1] - here[1]
+        rapid = (
+            ([_sign(dx)] if abs(dx) > MOVE_EPS_MM else []),
+            ([_sign(dy)] if abs(dy) > MOVE_EPS_MM else []),
+        )
+        for xs, ys in itertools.chain((rapid,), map(segment_signs, path.segments)):
+            for v in xs:
+                if state_x and v != state_x:
+                    count_x += 1
+                state_x = v
+            for v in ys:
+                if state_y and v != state_y:
+                    count_y += 1
+                state_y = v
+        here = path.end
+    return count_x, count_y
+
+
+def count_reversals_slow(cuts: Sequence[Cut], start: Point) -> tuple[int, int]:
+    """:func:`count_reversals` as first written (the reference for tests).
+
+    Every rapid is a :class:`Line`, every arc goes through :func:`_arc_signs`.
+    """
     state = [0, 0]
     count = [0, 0]
     here = start
     for cut in cuts:
         moves: list[Segment] = [Line(here, cut.path.start), *cut.path.segments]
         for seg in moves:
-            for axis, signs in enumerate(segment_signs(seg)):
-                for v in signs:
+            signs: tuple[Sequence[int], Sequence[int]]
+            if isinstance(seg, Arc):
+                signs = (_arc_signs(seg, 0.0), _arc_signs(seg, math.pi / 2))
+            else:
+                signs = segment_signs(seg)
+            for axis, axis_signs in enumerate(signs):
+                for v in axis_signs:
                     if state[axis] and v != state[axis]:
                         count[axis] += 1
                     state[axis] = v

@@ -17,7 +17,15 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from camtool.model.shapes import Arc, Contour, Line, Point, Segment
+from camtool.model.shapes import (
+    Arc,
+    Contour,
+    Point,
+    Segment,
+    cached_property,
+    make_arc,
+    make_line,
+)
 
 MIN_PIECE = 1e-9
 """Pieces shorter than this (mm) are dropped: a zero-length arc would read as a full circle."""
@@ -35,15 +43,19 @@ def sub_segment(seg: Segment, a: float, b: float) -> Segment:
         A :class:`Line` or an :class:`Arc` about the same centre and direction;
         an end at ``0`` or at ``length`` is the original end point, exactly.
     """
-    return _piece(seg, a / seg.length, b / seg.length)
+    length = seg.length
+    f0, f1 = a / length, b / length
+    if f0 <= 0.0 and f1 >= 1.0:
+        return seg  # both ends are the segment's own (as _piece would rebuild it: equal)
+    return _piece(seg, f0, f1)
 
 
 def _piece(seg: Segment, f0: float, f1: float) -> Segment:
     start = _point_at(seg, f0)
     end = _point_at(seg, f1)
     if isinstance(seg, Arc):
-        return Arc(start, end, seg.centre, seg.clockwise)
-    return Line(start, end)
+        return make_arc(start, end, seg.centre, seg.clockwise)
+    return make_line(start, end)
 
 
 def _point_at(seg: Segment, f: float) -> Point:
@@ -105,9 +117,12 @@ class Track:
         """The track of ``segments`` (zero-length ones dropped)."""
         return cls(tuple(s for s in segments if s.length > MIN_PIECE), closed)
 
-    @property
+    @cached_property
     def ends(self) -> tuple[float, ...]:
-        """Arc length at the end of each segment, mm: ``(N,)`` increasing, last = :attr:`length`."""
+        """Arc length at the end of each segment, mm: ``(N,)`` increasing, last = :attr:`length`.
+
+        Computed once per track (a track is immutable).
+        """
         out: list[float] = []
         total = 0.0
         for seg in self.segments:
@@ -115,9 +130,9 @@ class Track:
             out.append(total)
         return tuple(out)
 
-    @property
+    @cached_property
     def length(self) -> float:
-        """Total length, mm (0 for a track with no segment)."""
+        """Total length, mm (0 for a track with no segment; computed once)."""
         return sum(s.length for s in self.segments)
 
     @property
@@ -161,6 +176,40 @@ class Track:
         if not self.closed:
             s0, s1 = max(s0, 0.0), min(s1, total)
         ends = self.ends
+        segments = self.segments
+        n = len(segments)
+        out: list[tuple[Segment, float]] = []
+        lap = math.floor(s0 / total) if self.closed else 0
+        while lap * total < s1 - MIN_PIECE:
+            base = lap * total
+            # the segments ending at or before s0 give no piece (hi <= s0 <= lo): skip them.
+            # ``base + ends[i]`` grows with i, so all before the first i whose end (as the
+            # loop computes it) is past s0 are skipped; bisect finds it, the while settles it
+            i = min(bisect.bisect_left(ends, s0 - base), n - 1)
+            while i > 0 and base + ends[i - 1] > s0:
+                i -= 1
+            while i < n:
+                a = base + (ends[i - 1] if i else 0.0)
+                if a >= s1:
+                    break  # this and every later segment start at or after s1: no piece
+                b = base + ends[i]
+                lo, hi = max(a, s0), min(b, s1)
+                if hi - lo > MIN_PIECE:
+                    out.append((sub_segment(segments[i], lo - a, hi - a), hi))
+                i += 1
+            lap += 1
+            if not self.closed:
+                break
+        return out
+
+    def pieces_slow(self, s0: float, s1: float) -> list[tuple[Segment, float]]:
+        """:meth:`pieces` walking every segment of every lap (the reference for tests)."""
+        total = self.length
+        if total <= MIN_PIECE or s1 - s0 <= MIN_PIECE:
+            return []
+        if not self.closed:
+            s0, s1 = max(s0, 0.0), min(s1, total)
+        ends = self.ends
         out: list[tuple[Segment, float]] = []
         lap = math.floor(s0 / total) if self.closed else 0
         while lap * total < s1 - MIN_PIECE:
@@ -169,7 +218,7 @@ class Track:
                 a, b = base + (ends[i - 1] if i else 0.0), base + ends[i]
                 lo, hi = max(a, s0), min(b, s1)
                 if hi - lo > MIN_PIECE:
-                    out.append((sub_segment(seg, lo - a, hi - a), hi))
+                    out.append((_piece(seg, (lo - a) / seg.length, (hi - a) / seg.length), hi))
             lap += 1
             if not self.closed:
                 break

@@ -63,3 +63,24 @@ def test_cache_is_not_part_of_equality_hash_or_pickle() -> None:
     assert a == b and hash(a) == hash(b) and repr(a) == repr(b)
     again = pickle.loads(pickle.dumps(a))
     assert again == a and again.sweep == a.sweep
+
+
+@settings(max_examples=200, deadline=None)
+@given(point, point, point, st.booleans())
+def test_made_segments_are_the_dataclass_ones(s: tuple, e: tuple, c: tuple, cw: bool) -> None:
+    """make_line/make_arc give the object the checked __init__ gives (dict, eq, hash, pickle)."""
+    from camtool.model.shapes import Line, make_arc, make_line
+
+    for fast, slow in ((make_line(s, e), Line(s, e)), (make_arc(s, e, c, cw), Arc(s, e, c, cw))):
+        assert type(fast) is type(slow)
+        assert list(vars(fast).items()) == list(vars(slow).items())
+        assert fast == slow and hash(fast) == hash(slow) and repr(fast) == repr(slow)
+        assert pickle.dumps(fast) == pickle.dumps(slow)
+    arc = Arc(s, e, c, cw)
+    assert arc.reversed() == Arc(e, s, c, not cw)
+    assert arc.transformed(2.5, 1.0, -3.0) == Arc(
+        (s[0] * 2.5 + 1.0, s[1] * 2.5 - 3.0),
+        (e[0] * 2.5 + 1.0, e[1] * 2.5 - 3.0),
+        (c[0] * 2.5 + 1.0, c[1] * 2.5 - 3.0),
+        cw,
+    )

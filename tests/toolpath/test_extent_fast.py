@@ -64,3 +64,40 @@ def test_zero_or_non_finite_sides_go_to_the_slow_union() -> None:
     ) == placement._extent_slow(
         (3.0, 3.0), [Linear(4.0, 4.0, 1.0), ArcMove(6.0, 4.0, 5.0, 4.0, True, 1.0)]
     )
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_zero_sides_kept_only_when_they_are_the_slow_union(seed: int) -> None:
+    """Programs shifted so that a side is exactly 0 (``--origin lower-left``), some with -0.0."""
+    rng = np.random.default_rng(100 + seed)
+    kept = 0
+    for _ in range(300):
+        scale = 10.0 ** rng.uniform(-3, 3)
+        moves = _moves(rng, int(rng.integers(1, 40)), scale)
+        start = (float(rng.normal(0, scale)), float(rng.normal(0, scale)))
+        box = placement._extent_slow(start, moves)
+        dx, dy = -box[0], -box[1]  # as placement_shift does for lower-left
+        if rng.random() < 0.5:
+            dx = 0.0  # only Y on zero
+        shifted = [placement._shifted(m, dx, dy) for m in moves]
+        here = (start[0] + dx, start[1] + dy)
+        if rng.random() < 0.2:  # a -0.0 somewhere: the order decides, so it must decline
+            k = int(rng.integers(0, len(shifted)))
+            m = shifted[k]
+            shifted[k] = type(m)(**{**m.__dict__, "x": -0.0})
+        slow = placement._extent_slow(here, shifted)
+        fast = placement._extent_fast(here, shifted, zero_sides=True)
+        if fast is not None:
+            kept += 1
+            assert repr(fast) == repr(slow)
+        assert placement._extent_fast(here, shifted) is None or 0.0 not in slow
+    assert kept > 150
+
+
+def test_a_negative_zero_side_goes_to_the_slow_union() -> None:
+    moves: list[Move] = [Linear(0.0, 1.0, 100.0), Linear(-0.0, 2.0, 100.0)]
+    assert placement._extent_fast((1.0, 1.0), moves, zero_sides=True) is None
+    ok: list[Move] = [Linear(0.0, 1.0, 100.0), Linear(0.0, 2.0, 100.0)]
+    assert repr(placement._extent_fast((1.0, 1.0), ok, zero_sides=True)) == repr(
+        placement._extent_slow((1.0, 1.0), ok)
+    )

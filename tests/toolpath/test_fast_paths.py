@@ -1,0 +1,217 @@
+"""The planner's fast paths give exactly what their slow forms give (issue 17, fourth pass).
+
+Each fast path is compared with a slow form on many random inputs, for exact equality
+(every float's bits, not approximately): :meth:`Track.pieces` (which skips the segments
+before ``s0`` and stops after ``s1``) with :meth:`Track.pieces_slow` (every segment of every
+lap); :func:`segment_signs` (inlined turning points) with the module's
+:func:`~camtool.toolpath.reversals._arc_signs`; :meth:`Arc.bbox` (quadrant cosines
+computed once) with the per-call formula written out here; :func:`sub_segment` on a whole
+segment (the segment itself) with the piece rebuilt from its ends.
+"""
+
+from __future__ import annotations
+
+import math
+import struct
+
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from camtool.model.shapes import TAU, Arc, Contour, Line, Segment
+from camtool.toolpath.cuts import Cut
+from camtool.toolpath.reversals import (
+    _arc_signs,
+    count_reversals,
+    count_reversals_slow,
+    segment_signs,
+)
+from camtool.toolpath.split import Track, _piece, sub_segment
+
+coord = st.floats(-500.0, 500.0, allow_nan=False, allow_infinity=False)
+point = st.tuples(coord, coord)
+
+
+def _bits(x: object) -> object:
+    """Floats as their bit patterns (so -0.0 differs from 0.0), recursively."""
+    if isinstance(x, float):
+        return struct.pack("<d", x)
+    if isinstance(x, tuple | list):
+        return type(x)(_bits(v) for v in x)
+    if isinstance(x, Line | Arc):
+        return (type(x).__name__, _bits(x.start), _bits(x.end), _bits(getattr(x, "centre", None)),
+                getattr(x, "clockwise", None))  # fmt: skip
+    return x
+
+
+def _bbox_slow(arc: Arc) -> tuple[float, float, float, float]:
+    """:meth:`Arc.bbox` as it was written before the quadrant table (per-call cos/sin)."""
+    xs = [arc.start[0], arc.end[0]]
+    ys = [arc.start[1], arc.end[1]]
+    cx, cy = arc.centre
+    r = math.hypot(arc.start[0] - cx, arc.start[1] - cy)
+    a0 = math.atan2(arc.start[1] - cy, arc.start[0] - cx)
+    sweep = arc.sweep
+    for k in range(4):
+        quad = k * math.pi / 2
+        delta = (quad - a0) % TAU if sweep > 0 else (a0 - quad) % TAU
+        if delta <= abs(sweep):
+            xs.append(cx + r * math.cos(quad))
+            ys.append(cy + r * math.sin(quad))
+    return (min(xs), min(ys), max(xs), max(ys))
+
+
+@settings(max_examples=400, deadline=None)
+@given(point, point, point, st.booleans())
+def test_arc_bbox_is_the_per_call_formula(s: tuple, e: tuple, c: tuple, cw: bool) -> None:
+    arc = Arc(s, e, c, cw)
+    assert _bits(arc.bbox()) == _bits(_bbox_slow(Arc(s, e, c, cw)))
+
+
+@st.composite
+def arcs(draw: st.DrawFn) -> Arc:
+    """Arcs of any sweep, including ones starting or ending exactly on a quadrant."""
+    cx, cy = draw(coord), draw(coord)
+    r = draw(st.floats(1e-6, 300.0))
+    quads = [k * math.pi / 2 for k in range(-4, 5)]
+    a0 = draw(st.one_of(st.floats(-7.0, 7.0), st.sampled_from(quads)))
+    a1 = draw(st.one_of(st.floats(-7.0, 7.0), st.sampled_from(quads)))
+    start = (cx + r * math.cos(a0), cy + r * math.sin(a0))
+    end = start if draw(st.booleans()) and draw(st.booleans()) else (
+        cx + r * math.cos(a1), cy + r * math.sin(a1))  # fmt: skip
+    return Arc(start, end, (cx, cy), draw(st.booleans()))
+
+
+@settings(max_examples=1500, deadline=None)
+@given(arcs())
+def test_arc_signs_equal_the_slow_form(arc: Arc) -> None:
+    slow = (_arc_signs(arc, 0.0), _arc_signs(arc, math.pi / 2))
+    for _ in range(2):  # computed, then kept
+        xs, ys = segment_signs(arc)
+        assert (list(xs), list(ys)) == slow
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.one_of(arcs(), st.tuples(point, point)), min_size=1, max_size=30), point)
+def test_count_reversals_equals_the_slow_count(items: list, origin: tuple) -> None:
+    """Cuts of random arcs and lines (each its own open cut), from a random origin."""
+    cuts = []
+    for k, item in enumerate(items):
+        seg = item if isinstance(item, Arc) else Line(*item)
+        cuts.append(Cut(Contour((seg,), False), k, may_rotate=False))
+    assert count_reversals(cuts, origin) == count_reversals_slow(cuts, origin)
+
+
+@settings(max_examples=300, deadline=None)
+@given(arcs(), point, point)
+def test_arc_and_line_bbox_of_random_arcs(arc: Arc, p: tuple, q: tuple) -> None:
+    assert _bits(arc.bbox()) == _bits(_bbox_slow(arc))
+    assert Line(p, q).bbox() == (min(p[0], q[0]), min(p[1], q[1]), max(p[0], q[0]),
+                                 max(p[1], q[1]))  # fmt: skip
+
+
+@st.composite
+def tracks(draw: st.DrawFn) -> Track:
+    """Closed or open chains of lines and arcs (some very short, some long)."""
+    n = draw(st.integers(1, 12))
+    x, y = draw(coord), draw(coord)
+    segs: list[Segment] = []
+    for _ in range(n):
+        step = draw(st.sampled_from([1e-9, 3e-9, 1e-6, 0.01, 1.0, 37.5, 200.0]))
+        ang = draw(st.floats(-math.pi, math.pi))
+        nx, ny = x + step * math.cos(ang), y + step * math.sin(ang)
+        if draw(st.booleans()):
+            # an arc through (x, y) and (nx, ny): centre on the chord's bisector
+            off = draw(st.floats(-3.0, 3.0))
+            mx, my = (x + nx) / 2, (y + ny) / 2
+            c = (mx - off * (ny - y), my + off * (nx - x))
+            segs.append(Arc((x, y), (nx, ny), c, draw(st.booleans())))
+        else:
+            segs.append(Line((x, y), (nx, ny)))
+        x, y = nx, ny
+    closed = draw(st.booleans())
+    if closed and (x, y) != segs[0].start:
+        segs.append(Line((x, y), segs[0].start))
+    return Track.from_segments(segs, closed)
+
+
+@settings(max_examples=800, deadline=None)
+@given(tracks(), st.data())
+def test_pieces_equal_the_walk_over_every_segment(track: Track, data: st.DataObject) -> None:
+    total = track.length
+    if not track.segments:
+        assert track.pieces(0.0, 1.0) == track.pieces_slow(0.0, 1.0) == []
+        return
+    ends = [0.0, *track.ends]
+    # bounds at segment ends (exactly), just off them, inside, and a few laps on
+    anchor = st.one_of(
+        st.sampled_from(ends),
+        st.sampled_from(ends).map(lambda v: v + 1e-9),
+        st.sampled_from(ends).map(lambda v: math.nextafter(v, -math.inf)),
+        st.floats(-0.5 * total - 1.0, 3.5 * total + 1.0),
+    )
+    for _ in range(6):
+        lap = data.draw(st.integers(0, 3)) * total
+        s0 = data.draw(anchor) + lap
+        s1 = s0 + data.draw(st.one_of(st.floats(0.0, 3.0 * total), st.sampled_from([total])))
+        fast, slow = track.pieces(s0, s1), track.pieces_slow(s0, s1)
+        assert _bits(fast) == _bits(slow)
+        assert fast == slow
+
+
+@settings(max_examples=300, deadline=None)
+@given(tracks())
+def test_sub_segment_of_a_whole_segment_is_the_segment(track: Track) -> None:
+    for seg in track.segments:
+        whole = sub_segment(seg, 0.0, seg.length)
+        assert whole is seg
+        assert _bits(whole) == _bits(_piece(seg, 0.0, 1.0))
+        part = sub_segment(seg, 0.0, seg.length * 0.5)
+        assert _bits(part) == _bits(_piece(seg, 0.0, (seg.length * 0.5) / seg.length))
+
+
+def test_cached_lengths_and_boxes_equal_fresh_ones() -> None:
+    segs: list[Segment] = [
+        Line((0.0, 0.0), (3.0, 4.0)),
+        Arc((3.0, 4.0), (3.0, 4.0), (3.0, 3.0), False),
+        Line((3.0, 4.0), (0.0, 0.0)),
+    ]
+    contour = Contour(tuple(segs), True)
+    twin = Contour(tuple(segs), True)
+    assert contour.bbox() == contour.bbox() == (0.0, 0.0, 4.0, 4.0)  # circle r 1 about (3, 3)
+    assert contour.length == contour.length == 10.0 + TAU
+    assert contour == twin and hash(contour) == hash(twin)  # the cache is no field
+    track = Track.of(contour)
+    assert track.length == sum(s.length for s in segs)
+    assert track.ends == (5.0, 5.0 + TAU, 10.0 + TAU)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    st.lists(
+        st.tuples(st.integers(0, 2), point, point, st.booleans(), st.one_of(st.none(), coord)),
+        min_size=1,
+        max_size=20,
+    ),
+    coord,
+    coord,
+)
+def test_shifted_moves_are_the_replaced_ones(items: list, dx: float, dy: float) -> None:
+    """placement._shifted copies plain moves by their __dict__: the object replace() makes."""
+    import pickle
+
+    from camtool.model.program import ArcMove, Linear, Rapid
+    from camtool.toolpath.placement import _shifted, _shifted_slow
+
+    for kind, (x, y), (cx, cy), cw, z in items:
+        move = (
+            Rapid(x, y, z, 3)
+            if kind == 0
+            else Linear(x, y, 120.0, z, contour=4)
+            if kind == 1
+            else ArcMove(x, y, cx, cy, cw, 90.0, z, 5)
+        )
+        fast, slow = _shifted(move, dx, dy), _shifted_slow(move, dx, dy)
+        assert type(fast) is type(slow)
+        assert list(vars(fast).items()) == list(vars(slow).items())
+        assert fast == slow and hash(fast) == hash(slow)
+        assert pickle.dumps(fast) == pickle.dumps(slow)
