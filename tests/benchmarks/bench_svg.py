@@ -78,6 +78,14 @@ numba kernel is not used: on this AVX-512 machine numpy's ``arctan2`` differs fr
 (~1.5 s),
 nesting (shapely polygons and STRtree queries, twice), reversal counts for the summary
 line, and the writer.
+
+Fourth pass (``make bench``, quiet, 22 Nov 2026 14:10): camtool 17.5 s against vpype
+6.68 s, 2.6× (third pass 20.6 s against 4.88 s, 4.2×); output still the b3b77a5 hash;
+camtool's peak 261 MiB (201 before: segments now keep their length, radius and start
+angle). What changed is the planner (docs/performance.md, "Planning big real drawings"):
+``nesting`` 5.2 → 1.3–1.7 s of CPU per call on this file (outlines built in one pass, GEOS
+asked only about pairs the area test leaves), cached segment values, ``Track.pieces`` by
+bisection, arcs' reversal signs kept.
 """
 
 from __future__ import annotations
