@@ -324,6 +324,23 @@ def _nearest_neighbour_scan(
     return out
 
 
+def _cell_grid(points: FloatArray) -> tuple[float, float, float, IntArray, IntArray]:
+    """Square cells over ``points`` ``(P, 2)`` mm, :data:`_PER_CELL` points a cell on average.
+
+    Returns the grid's corner ``x0, y0`` and cell ``size`` (mm), and each point's cell
+    column and row ``(P,)``.
+    """
+    x0, y0 = points.min(axis=0)
+    x1, y1 = points.max(axis=0)
+    w, h = float(x1 - x0), float(y1 - y0)
+    count = max(1.0, len(points) / _PER_CELL)
+    size = max(math.sqrt(w * h / count), max(w, h) / count)
+    size = size if size > 0 else 1.0
+    ix = np.floor((points[:, 0] - x0) / size).astype(np.int64)
+    iy = np.floor((points[:, 1] - y0) / size).astype(np.int64)
+    return float(x0), float(y0), size, ix, iy
+
+
 class _Cells:
     """Candidate points in square grid cells; the nearest active one as a full scan finds it.
 
@@ -338,15 +355,7 @@ class _Cells:
     def __init__(self, points: FloatArray, active: npt.NDArray[np.bool_]) -> None:
         self.points, self.active = points, active
         self.xs, self.ys = points[:, 0], points[:, 1]
-        x0, y0 = points.min(axis=0)
-        x1, y1 = points.max(axis=0)
-        w, h = float(x1 - x0), float(y1 - y0)
-        count = max(1.0, len(points) / _PER_CELL)
-        size = max(math.sqrt(w * h / count), max(w, h) / count)
-        self.size = size if size > 0 else 1.0
-        self.x0, self.y0 = float(x0), float(y0)
-        ix = np.floor((points[:, 0] - x0) / self.size).astype(np.int64)
-        iy = np.floor((points[:, 1] - y0) / self.size).astype(np.int64)
+        self.x0, self.y0, self.size, ix, iy = _cell_grid(points)
         order = np.lexsort((iy, ix))  # stable: each cell's indices ascending
         keys = np.stack((ix[order], iy[order]), axis=1)
         cut = np.flatnonzero(np.any(keys[1:] != keys[:-1], axis=1)) + 1
@@ -585,15 +594,7 @@ class _Grid:
         self.points = points
         self.xs: list[float] = points[:, 0].tolist()
         self.ys: list[float] = points[:, 1].tolist()
-        x0, y0 = points.min(axis=0)
-        x1, y1 = points.max(axis=0)
-        w, h = float(x1 - x0), float(y1 - y0)
-        count = max(1.0, len(points) / _PER_CELL)
-        size = max(math.sqrt(w * h / count), max(w, h) / count)
-        self.size = size if size > 0 else 1.0
-        self.x0, self.y0 = float(x0), float(y0)
-        ix = np.floor((points[:, 0] - x0) / self.size).astype(np.int64)
-        iy = np.floor((points[:, 1] - y0) / self.size).astype(np.int64)
+        self.x0, self.y0, self.size, ix, iy = _cell_grid(points)
         self.cell_of: list[tuple[int, int]] = list(zip(ix.tolist(), iy.tolist(), strict=True))
         self.cells: dict[tuple[int, int], list[int]] = {}
         self.active = np.zeros(len(points), dtype=bool)
