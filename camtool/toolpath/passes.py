@@ -481,34 +481,8 @@ class _Writer:
             up = any(a < (u + v) / 2 < b for a, b in raised)
             zu, zv = z_at(u, up), z_at(v, up)
             self.vertical(zu)
-            pieces = track.pieces(u, v)
-            if zu == zv and math.isfinite(zu):
-                self._cut_level(pieces)
-                continue
-            for seg, s_end in pieces:
+            for seg, s_end in track.pieces(u, v):
                 self.cut(seg, zv if s_end >= v else zu + (zv - zu) * (s_end - u) / (v - u))
-
-    def _cut_level(self, pieces: Sequence[tuple[Segment, float]]) -> None:
-        """:meth:`cut` of each piece at the level :meth:`vertical` just went to (no Z).
-
-        What :meth:`run` does when a stretch starts and ends at one Z: each piece's Z is
-        ``zu + 0·…``, equal to ``zu``, within :data:`Z_EPS` of where :meth:`vertical` left
-        the tool, so :meth:`cut` drops it and writes a move without Z. The same moves,
-        without a call per piece.
-        """
-        if not pieces:
-            return
-        feed = self.options.feed
-        number = self.number
-        add = self.add
-        for seg, _ in pieces:
-            x, y = seg.end
-            if isinstance(seg, Arc):
-                cx, cy = seg.centre
-                add(ArcMove(x, y, cx, cy, seg.clockwise, feed, None, number))
-            else:
-                add(Linear(x, y, feed, None, contour=number))
-        self.x, self.y = pieces[-1][0].end
 
     def _tab_top(self) -> float | None:
         o = self.options
