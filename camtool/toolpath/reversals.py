@@ -50,64 +50,30 @@ _TRAVEL_PER_REVERSAL_MM = 1e6
 def segment_signs(seg: Segment) -> tuple[Sequence[int], Sequence[int]]:
     """Successive directions (+1/-1) in which ``seg`` moves X and Y (see the module).
 
-    An arc's are computed once and kept on it (in its ``__dict__``, as its cached
-    properties are: no field, so equality, hash and ``repr`` ignore them; they depend on
-    its fields only), shared tuples: callers read them, never change them.
+    An arc's are computed once (:func:`_arc_signs`) and kept on it (in its ``__dict__``,
+    as its cached properties are: no field, so equality, hash and ``repr`` ignore them;
+    they depend on its fields only), as shared tuples: callers read them, never change them.
     """
     if isinstance(seg, Line):
-        dx, dy = seg.end[0] - seg.start[0], seg.end[1] - seg.start[1]
-        return ([_sign(dx)] if abs(dx) > MOVE_EPS_MM else []), (
-            [_sign(dy)] if abs(dy) > MOVE_EPS_MM else []
-        )
+        return _line_signs(seg.end[0] - seg.start[0], seg.end[1] - seg.start[1])
     kept = seg.__dict__.get("_axis_signs")
     if kept is None:
-        a0, sweep = seg.start_angle, seg.sweep
-        pair = (
-            tuple(_axis_signs(a0, sweep, 0.0, math.pi)),
-            tuple(_axis_signs(a0, sweep, _HALF_PI, _HALF_PI_PI)),
-        )
+        pair = (tuple(_arc_signs(seg, 0.0)), tuple(_arc_signs(seg, math.pi / 2)))
         kept = _SIGN_PAIRS.setdefault(pair, pair)  # a few dozen distinct pairs: one each
         seg.__dict__["_axis_signs"] = kept
     return kept
 
 
+def _line_signs(dx: float, dy: float) -> tuple[list[int], list[int]]:
+    """X and Y directions of a straight move by ``(dx, dy)`` mm (none for a still axis)."""
+    return ([_sign(dx)] if abs(dx) > MOVE_EPS_MM else []), (
+        [_sign(dy)] if abs(dy) > MOVE_EPS_MM else []
+    )
+
+
 _SIGN_PAIRS: dict[tuple[tuple[int, ...], tuple[int, ...]], tuple[tuple[int, ...], tuple[int, ...]]]
 _SIGN_PAIRS = {}
 """Every distinct ``(x signs, y signs)`` of an arc, so that arcs share one tuple each."""
-
-
-_HALF_PI = math.pi / 2
-_HALF_PI_PI = _HALF_PI + math.pi  # the float _arc_signs computes as ``phase + math.pi``
-
-
-def _axis_signs(a0: float, sweep: float, phase: float, phase_pi: float) -> list[int]:
-    """:func:`_arc_signs` of an arc from ``a0`` over ``sweep`` (radians), inlined.
-
-    ``phase_pi`` is ``phase + math.pi``. The same floats in the same operations: the
-    two turning points, their order, each piece's midpoint and the sine there.
-    """
-    s = 1.0 if sweep > 0 else -1.0
-    total = abs(sweep)
-    hi_end = total - _ANGLE_EPS
-    d1 = (s * (phase - a0)) % TAU
-    d2 = (s * (phase_pi - a0)) % TAU
-    in1 = _ANGLE_EPS < d1 < hi_end
-    in2 = _ANGLE_EPS < d2 < hi_end
-    if in1 and in2:
-        if d2 < d1:
-            d1, d2 = d2, d1
-        return [
-            1 if -s * math.sin(a0 + s * (0.0 + d1) / 2 - phase) > 0 else -1,
-            1 if -s * math.sin(a0 + s * (d1 + d2) / 2 - phase) > 0 else -1,
-            1 if -s * math.sin(a0 + s * (d2 + total) / 2 - phase) > 0 else -1,
-        ]
-    if in1 or in2:
-        d = d1 if in1 else d2
-        return [
-            1 if -s * math.sin(a0 + s * (0.0 + d) / 2 - phase) > 0 else -1,
-            1 if -s * math.sin(a0 + s * (d + total) / 2 - phase) > 0 else -1,
-        ]
-    return [1 if -s * math.sin(a0 + s * (0.0 + total) / 2 - phase) > 0 else -1]
 
 
 def _sign(v: float) -> int:
@@ -172,11 +138,7 @@ def count_reversals(cuts: Sequence[Cut], start: Point) -> tuple[int, int]:
         path = cut.path
         to = path.start
         # the rapid here → to as a line (segment_signs of Line(here, to)), then the path
-        dx, dy = to[0] - here[0], to[1] - here[1]
-        rapid = (
-            ([_sign(dx)] if abs(dx) > MOVE_EPS_MM else []),
-            ([_sign(dy)] if abs(dy) > MOVE_EPS_MM else []),
-        )
+        rapid = _line_signs(to[0] - here[0], to[1] - here[1])
         for xs, ys in itertools.chain((rapid,), map(segment_signs, path.segments)):
             for v in xs:
                 if state_x and v != state_x:

@@ -3,7 +3,7 @@
 Each fast path is compared with a slow form on many random inputs, for exact equality
 (every float's bits, not approximately): :meth:`Track.pieces` (which skips the segments
 before ``s0`` and stops after ``s1``) with :meth:`Track.pieces_slow` (every segment of every
-lap); :func:`segment_signs` (inlined turning points) with the module's
+lap); :func:`segment_signs` (kept on the arc) with the module's
 :func:`~camtool.toolpath.reversals._arc_signs`; :meth:`Arc.bbox` (quadrant cosines
 computed once) with the per-call formula written out here; :func:`sub_segment` on a whole
 segment (the segment itself) with the piece rebuilt from its ends.
