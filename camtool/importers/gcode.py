@@ -75,6 +75,7 @@ from pathlib import Path
 from camtool.importers.gcode_codes import BlockWords, Notes, g_key
 from camtool.importers.gcode_lexer import Block, Word, cut_mid_word, lex_line
 from camtool.model.errors import InputError
+from camtool.model.plain import plain_fields
 from camtool.model.program import (
     ArcMove,
     Command,
@@ -107,27 +108,11 @@ _PLAIN_G = {0.0: "G0", 1.0: "G1", 2.0: "G2", 3.0: "G3"}
 """:data:`_PLAIN_MOTION` by the G word's value, for the values ``g_key`` gives those keys."""
 
 
-def _fields_are(cls: type, names: tuple[str, ...]) -> bool:
-    """True when ``cls`` is a plain frozen dataclass of the fields ``names``, in that order.
-
-    Then an object made by :func:`_new_move` is the one its ``__init__`` makes: the
-    same ``__dict__`` (the same keys in the same order), so equal, with the same hash
-    and repr. No ``__post_init__`` (nothing checked or derived) and no ``__slots__``.
-    """
-    fields = getattr(cls, "__dataclass_fields__", {})
-    return (
-        tuple(fields) == names
-        and not hasattr(cls, "__post_init__")
-        and "__slots__" not in vars(cls)
-        and "__init__" in vars(cls)
-    )
-
-
 _new_move = object.__new__
 _FAST_MOVES = (
-    _fields_are(Rapid, ("x", "y", "z", "contour"))
-    and _fields_are(Linear, ("x", "y", "feed_mm_min", "z", "contour"))
-    and _fields_are(ArcMove, ("x", "y", "cx", "cy", "clockwise", "feed_mm_min", "z", "contour"))
+    plain_fields(Rapid) == ("x", "y", "z", "contour")
+    and plain_fields(Linear) == ("x", "y", "feed_mm_min", "z", "contour")
+    and plain_fields(ArcMove) == ("x", "y", "cx", "cy", "clockwise", "feed_mm_min", "z", "contour")
 )
 """Whether the plain reader makes its moves without their (frozen, slow) ``__init__``."""
 

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from typing import Any, Generic, TypeAlias, TypeVar, overload
 
 from camtool.model.errors import GeometryError, UsageError
+from camtool.model.plain import plain_fields
 from camtool.model.units import fmt_num
 
 Point: TypeAlias = tuple[float, float]
@@ -97,9 +98,11 @@ def make_line(start: Point, end: Point) -> Line:
     The same object: an instance whose ``__dict__`` holds the fields in the same order
     (what the dataclass ``__init__`` stores through ``object.__setattr__``), so equal, with
     the same hash, ``repr`` and pickle. For loops that make segments by the hundred
-    thousand (transforms, reversals, pieces of a path); :class:`Line` has no
-    ``__post_init__`` to skip.
+    thousand (transforms, reversals, pieces of a path), when :class:`Line` is a plain
+    dataclass (:func:`~camtool.model.plain.plain_fields`; else the constructor).
     """
+    if not _PLAIN_SEGMENTS:
+        return Line(start, end)
     obj = _new(Line)
     d = obj.__dict__
     d["start"] = start
@@ -109,6 +112,8 @@ def make_line(start: Point, end: Point) -> Line:
 
 def make_arc(start: Point, end: Point, centre: Point, clockwise: bool) -> Arc:
     """``Arc(start, end, centre, clockwise)``, built as :func:`make_line` builds a line."""
+    if not _PLAIN_SEGMENTS:
+        return Arc(start, end, centre, clockwise)
     obj = _new(Arc)
     d = obj.__dict__
     d["start"] = start
@@ -328,6 +333,16 @@ def chord_count(radius: float, sweep: float, tolerance: float) -> int:
 
 def _tf(p: Point, scale: float, dx: float, dy: float) -> Point:
     return (p[0] * scale + dx, p[1] * scale + dy)
+
+
+_PLAIN_SEGMENTS = plain_fields(Line) == ("start", "end") and plain_fields(Arc) == (
+    "start",
+    "end",
+    "centre",
+    "clockwise",
+)
+"""Whether :func:`make_line` and :func:`make_arc` may skip the constructors
+(:func:`camtool.model.plain.plain_fields`)."""
 
 
 @dataclass(frozen=True)

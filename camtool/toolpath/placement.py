@@ -29,6 +29,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from camtool.model.errors import DialectError
+from camtool.model.plain import plain_fields
 from camtool.model.program import ArcMove, Linear, Move, Program, Rapid, segment_of
 from camtool.model.shapes import BBox, Point, bbox_union
 from camtool.model.units import fmt_num
@@ -218,20 +219,7 @@ def _at_start(program: Program) -> int:
     return k
 
 
-def _plain_fields(cls: type) -> int | None:
-    """How many fields ``cls`` has when it is a plain frozen dataclass, else ``None``.
-
-    Plain: no ``__post_init__`` (nothing checked or derived at ``__init__``), no
-    ``__slots__``, its own generated ``__init__``. Such an object is its ``__dict__``: the
-    fields, in declaration order, and nothing else when it holds as many keys.
-    """
-    fields = getattr(cls, "__dataclass_fields__", None)
-    if not fields or hasattr(cls, "__post_init__") or "__slots__" in vars(cls):
-        return None
-    return len(fields) if "__init__" in vars(cls) else None
-
-
-_PLAIN_MOVES = {cls: n for cls in (Rapid, Linear, ArcMove) if (n := _plain_fields(cls))}
+_PLAIN_MOVES = {cls: len(f) for cls in (Rapid, Linear, ArcMove) if (f := plain_fields(cls))}
 """Move classes :func:`_shifted` may copy by their ``__dict__``, with their field counts."""
 _new = object.__new__
 
