@@ -170,12 +170,11 @@ class Track:
             (same unrolled scale as ``s0``/``s1``) at the piece's end. Pieces
             shorter than :data:`MIN_PIECE` are left out.
         """
-        total = self.length
-        if total <= MIN_PIECE or s1 - s0 <= MIN_PIECE:
+        span = self._span(s0, s1)
+        if span is None:
             return []
-        if not self.closed:
-            s0, s1 = max(s0, 0.0), min(s1, total)
-        ends = self.ends
+        s0, s1 = span
+        total, ends = self.length, self.ends
         segments = self.segments
         n = len(segments)
         out: list[tuple[Segment, float]] = []
@@ -202,14 +201,22 @@ class Track:
                 break
         return out
 
-    def pieces_slow(self, s0: float, s1: float) -> list[tuple[Segment, float]]:
-        """:meth:`pieces` walking every segment of every lap (the reference for tests)."""
+    def _span(self, s0: float, s1: float) -> tuple[float, float] | None:
+        """``(s0, s1)`` clamped to an open track's length; ``None`` when no piece can come."""
         total = self.length
         if total <= MIN_PIECE or s1 - s0 <= MIN_PIECE:
-            return []
+            return None
         if not self.closed:
             s0, s1 = max(s0, 0.0), min(s1, total)
-        ends = self.ends
+        return s0, s1
+
+    def pieces_slow(self, s0: float, s1: float) -> list[tuple[Segment, float]]:
+        """:meth:`pieces` walking every segment of every lap (the reference for tests)."""
+        span = self._span(s0, s1)
+        if span is None:
+            return []
+        s0, s1 = span
+        total, ends = self.length, self.ends
         out: list[tuple[Segment, float]] = []
         lap = math.floor(s0 / total) if self.closed else 0
         while lap * total < s1 - MIN_PIECE:
