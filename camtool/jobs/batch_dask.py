@@ -25,7 +25,11 @@ from __future__ import annotations
 import contextlib
 import importlib.util
 import logging
+import queue
+import time
+from collections import deque
 from collections.abc import Callable, Iterator
+from concurrent.futures import CancelledError
 from typing import TYPE_CHECKING, Any
 
 from camtool.model.errors import CamtoolError, UsageError
@@ -162,43 +166,134 @@ def map_unordered(
     holds the whole batch's inputs. Each task may be retried (:data:`RETRIES`, and
     the scheduler's own re-runs of a task whose worker died).
 
+    It does not trust Dask to bring every result back: when a worker dies, a result
+    can be lost between the scheduler and the client and the client waits for ever
+    (dask/distributed#6074, #7331; seen here with Dask 2026.8). So each finished
+    task's result is fetched with a deadline (:data:`RESULT_TIMEOUT_S`), and when the
+    cluster sits idle (no worker running a task) for :data:`STALL_S` while tasks are
+    unfinished, those tasks are submitted again, each at most :data:`RESUBMITS` times
+    before its file is an error row. Nothing is written twice: a task's result is
+    taken once, from whichever of its runs returns first, and the others are
+    cancelled or ignored.
+
     Args:
         client: a ``dask.distributed.Client``.
         work: a module-level function (workers import it by name).
         count: how many tasks.
-        arguments: the arguments of task ``i`` (sent to the cluster; picklable).
+        arguments: the arguments of task ``i`` (sent to the cluster; picklable); called
+            again for a task submitted again.
 
     Yields:
         ``(i, result, None)`` as each task finishes, in finishing order, or
         ``(i, None, error)`` for a task that failed on the cluster (e.g.
-        ``KilledWorker``: its workers kept dying). Leaving the loop early cancels
-        the tasks not yet finished.
+        ``KilledWorker``: its workers kept dying; :class:`LostTask`: its result never
+        came back). Each ``i`` once. Leaving the loop early cancels the tasks not yet
+        finished.
     """
-    distributed = _distributed()
     threads = sum(client.nthreads().values())
     ahead = max(MIN_IN_FLIGHT, IN_FLIGHT_PER_THREAD * threads)
-    pending: dict[Any, int] = {}
-    done = distributed.as_completed(with_results=True, raise_errors=False)  # fetched as they end
-    submitted = 0
+    pending: dict[Any, int] = {}  # the live run of each unfinished task
+    again: deque[int] = deque()  # tasks to submit again, before new ones
+    submits = [0] * count
+    finished: queue.SimpleQueue[Any] = queue.SimpleQueue()  # filled by Dask's callback thread
+    following = 0
+    idle_since: float | None = None
 
-    def submit() -> None:
-        nonlocal submitted
-        future = client.submit(work, *arguments(submitted), retries=RETRIES, pure=False)
-        pending[future] = submitted
-        done.add(future)
-        submitted += 1
+    def fill() -> None:
+        nonlocal following
+        while len(pending) < ahead and (again or following < count):
+            if again:
+                index = again.popleft()
+            else:
+                index, following = following, following + 1
+            future = client.submit(work, *arguments(index), retries=RETRIES, pure=False)
+            submits[index] += 1
+            pending[future] = index
+            future.add_done_callback(finished.put)
+
+    def lost(future: Any, why: str) -> tuple[int, Any, BaseException | None] | None:
+        """Forget ``future``'s run; its task again, or its error once it was run too often."""
+        index = pending.pop(future)
+        future.cancel()
+        if submits[index] <= RESUBMITS:
+            again.append(index)
+            return None
+        return index, None, LostTask(f"{why}, {submits[index]} times; giving up on it")
 
     try:
-        while submitted < min(ahead, count):
-            submit()
-        for future, result in done:
-            index = pending.pop(future)
-            failed = isinstance(result, BaseException)  # failed or cancelled on the cluster
-            outcome = (index, None, result) if failed else (index, result, None)
+        fill()
+        while pending:
+            try:
+                future = finished.get(timeout=POLL_S)
+            except queue.Empty:
+                idle_since = _idle_since(client, idle_since)
+                if idle_since is not None and time.monotonic() - idle_since >= STALL_S:
+                    idle_since = None
+                    why = f"the cluster sat idle for {STALL_S:g} s with the task unfinished"
+                    for outcome in [lost(f, why) for f in list(pending)]:
+                        if outcome is not None:
+                            yield outcome
+                    fill()
+                continue
+            idle_since = None
+            if future not in pending:  # a run given up on (cancelled), or one already taken
+                future.release()
+                continue
+            fetched = _outcome(future)
+            if fetched is None:
+                outcome = lost(
+                    future, f"its result did not come back within {RESULT_TIMEOUT_S:g} s"
+                )
+            else:
+                outcome = (pending.pop(future), *fetched)
             future.release()
-            if submitted < count:
-                submit()
-            yield outcome
+            fill()
+            if outcome is not None:
+                yield outcome
     finally:
         if pending:
             client.cancel(list(pending))
+
+
+class LostTask(CamtoolError):
+    """A task of a batch on Dask whose result never came back, however often it was submitted."""
+
+
+STALL_S = 30.0
+"""How long the cluster may sit idle (no worker running a task) while tasks of the batch
+are unfinished before those tasks are submitted again, s. A cluster waiting for a worker
+to join or restart is idle too; that takes seconds, not this long."""
+RESULT_TIMEOUT_S = 120.0
+"""How long fetching a finished task's result may take before the task is submitted again, s."""
+RESUBMITS = 2
+"""Times a task is submitted again (after a stall or a lost result) before its file is an error."""
+POLL_S = 1.0
+"""How often the client looks at the cluster while no task finishes, s."""
+
+
+def _outcome(future: Any) -> tuple[Any, BaseException | None] | None:
+    """``(result, None)`` or ``(None, error)`` of a done future.
+
+    ``None`` when its result did not come back within :data:`RESULT_TIMEOUT_S`.
+    """
+    if future.status == "error":
+        return None, future.exception()
+    if future.cancelled():
+        return None, CancelledError(f"task {future.key} was cancelled on the cluster")
+    try:
+        return future.result(timeout=RESULT_TIMEOUT_S), None
+    except TimeoutError:
+        return None
+    except Exception as exc:  # the task failed after all (its result could not be fetched)
+        return None, exc
+
+
+def _idle_since(client: Any, since: float | None) -> float | None:
+    """When the cluster became idle (``since``, or now), or ``None`` while a worker runs a task."""
+    try:
+        running = any(client.processing().values())
+    except (OSError, TimeoutError):  # the scheduler does not answer: not known to be idle
+        return since
+    if running:
+        return None
+    return since if since is not None else time.monotonic()

@@ -28,6 +28,7 @@ from distributed import Client, LocalCluster, WorkerPlugin
 
 import camtool
 import camtool.jobs.batch
+import camtool.jobs.batch_dask
 from camtool.cli.main import main
 from camtool.jobs.batch import BatchResult, batch_report, run
 from camtool.jobs.pipeline import post_file
@@ -213,6 +214,69 @@ def test_a_killed_worker_loses_nothing_and_writes_nothing_twice(
     written = [out for row in result.rows for out in (row.code_path, row.report_path) if out]
     assert sorted(writes) == sorted(written) and set(writes.values()) == {1}
     assert [p for p in Path("dask").rglob(".*")] == []  # no partial file
+
+
+# -- a task that never comes back (dask/distributed#6074) ---------------------------------------
+
+
+def _stranding(client: Client, monkeypatch: pytest.MonkeyPatch, runs: int) -> list[str]:
+    """Make the first ``runs`` submissions of :data:`VICTIM` wait for ever; their log.
+
+    Each asks for a resource no worker has, so the scheduler never runs it and the
+    cluster goes idle with the task unfinished: what the client sees when a result is
+    lost as a worker dies. Returns the files of every submission, in order.
+    """
+    submitted: list[str] = []
+    submit = client.submit
+
+    def stranding(work: Any, *args: Any, **kwargs: Any) -> Any:
+        name = Path(args[0].file).name
+        submitted.append(name)
+        if name == VICTIM and submitted.count(VICTIM) <= runs:
+            kwargs["resources"] = {"nowhere": 1}
+        return submit(work, *args, **kwargs)
+
+    monkeypatch.setattr(client, "submit", stranding)
+    monkeypatch.setattr(camtool.jobs.batch_dask, "STALL_S", 2.0)
+    monkeypatch.setattr(camtool.jobs.batch_dask, "POLL_S", 0.2)
+    return submitted
+
+
+def test_a_task_stranded_on_an_idle_cluster_is_submitted_again(
+    drawings: Path, client: Client, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    rectangle_dxf(drawings / "parts" / VICTIM, 3, 2)
+    ref = run(["drawings"], targets="pic-mmh", output_dir="ref", jobs=1)
+    submitted = _stranding(client, monkeypatch, runs=1)
+    start = time.monotonic()
+    result = run(["drawings"], targets="pic-mmh", output_dir="dask", client=client)
+    assert time.monotonic() - start < 60  # before the fix: waits for ever
+    assert submitted.count(VICTIM) == 2  # stranded once, then run
+    assert comparable(result) == comparable(ref)  # every file, the victim too
+    assert tree(Path("dask")) == tree(Path("ref"))
+
+
+def test_a_task_that_never_comes_back_is_its_files_error(
+    drawings: Path, client: Client, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    rectangle_dxf(drawings / "parts" / VICTIM, 3, 2)
+    ref = run(["drawings"], targets="pic-mmh", output_dir="ref", jobs=1)
+    runs = 1 + camtool.jobs.batch_dask.RESUBMITS
+    submitted = _stranding(client, monkeypatch, runs=runs)
+    result = run(["drawings"], targets="pic-mmh", output_dir="dask", client=client)
+    assert submitted.count(VICTIM) == runs  # then given up on, not submitted for ever
+    rows = {Path(row.file).name: row for row in result.rows}
+    victim = rows.pop(VICTIM)
+    assert (victim.status, victim.exit_code) == ("error", 1)
+    assert victim.error.startswith("worker failed: LostTask: the cluster sat idle for 2 s")
+    assert f"{runs} times" in victim.error
+    others = {Path(row.file).name: row for row in ref.rows if Path(row.file).name != VICTIM}
+    assert {n: (r.status, r.error) for n, r in rows.items()} == {
+        n: (r.status, r.error) for n, r in others.items()
+    }
+    expected = {k: v for k, v in tree(Path("ref")).items() if Path(k).stem != Path(VICTIM).stem}
+    assert tree(Path("dask")) == expected  # the others written, the victim not
+    assert result.exit_code == 1
 
 
 # -- several targets --------------------------------------------------------------------------
