@@ -22,3 +22,25 @@ def plain_fields(cls: type) -> tuple[str, ...] | None:
     if not fields or hasattr(cls, "__post_init__") or "__slots__" in vars(cls):
         return None
     return tuple(fields) if "__init__" in vars(cls) else None
+
+
+def share_keys(cls: type, names: tuple[str, ...]) -> None:
+    """Make room for ``names`` in the ``__dict__`` of every later instance of ``cls``.
+
+    A memory measure with no effect on behaviour. CPython (3.11+) keeps the attributes of a
+    class's instances in *split* dicts: the keys once per class, the values per instance
+    in an array sized, when the instance is made, for the keys the class has learned so
+    far. Values kept later on an instance (:class:`~camtool.model.shapes.cached_property`,
+    an arc's axis signs) that do not fit turn its dict into an ordinary one, ~170 bytes
+    more per object. This makes a first instance holding ``names`` (the fields first, in
+    order, then what is kept later), so the class learns them all; the instance is
+    thrown away. Call it right after the class is defined, before any instance is made.
+
+    Args:
+        cls: a class whose instances have a ``__dict__``.
+        names: every attribute its instances may hold, fields first, in order.
+    """
+    first = object.__new__(cls)
+    values = first.__dict__
+    for name in names:
+        values[name] = None

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from typing import Any, Generic, TypeAlias, TypeVar, overload
 
 from camtool.model.errors import GeometryError, UsageError
-from camtool.model.plain import plain_fields
+from camtool.model.plain import plain_fields, share_keys
 from camtool.model.units import fmt_num
 
 Point: TypeAlias = tuple[float, float]
@@ -345,6 +345,16 @@ _PLAIN_SEGMENTS = plain_fields(Line) == ("start", "end") and plain_fields(Arc) =
 (:func:`camtool.model.plain.plain_fields`)."""
 
 
+def _kept(cls: type) -> tuple[str, ...]:
+    """The names of ``cls``'s fields, in order, then of its :class:`cached_property` values."""
+    cached = tuple(n for n, v in vars(cls).items() if isinstance(v, cached_property))
+    return (*cls.__dataclass_fields__, *cached)
+
+
+share_keys(Line, _kept(Line))
+share_keys(Arc, (*_kept(Arc), "_axis_signs"))  # toolpath.reversals keeps an arc's signs on it
+
+
 @dataclass(frozen=True)
 class Contour:
     """A chain of segments, each starting where the previous one ended.
@@ -411,6 +421,9 @@ class Contour:
         """Uniformly scaled about the origin (``scale`` > 0), then translated."""
         segs = tuple(s.transformed(scale, dx, dy) for s in self.segments)
         return Contour(segs, self.closed, self.layer, self.source)
+
+
+share_keys(Contour, (*_kept(Contour), "_bbox"))
 
 
 @dataclass(frozen=True)

@@ -6,13 +6,20 @@ arc's cached values and its hoisted :meth:`Arc.points` must give the same floats
 
 from __future__ import annotations
 
+import gc
 import math
 import pickle
+import sys
+import tracemalloc
+from collections.abc import Callable
+from typing import Any
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from camtool.model.shapes import TAU, Arc, chord_count, distance
+from camtool.model.shapes import TAU, Arc, Contour, chord_count, distance, make_arc, make_line
+from camtool.toolpath.reversals import segment_signs
 
 coord = st.floats(-500.0, 500.0, allow_nan=False, allow_infinity=False)
 point = st.tuples(coord, coord)
@@ -84,3 +91,53 @@ def test_made_segments_are_the_dataclass_ones(s: tuple, e: tuple, c: tuple, cw: 
         (c[0] * 2.5 + 1.0, c[1] * 2.5 - 3.0),
         cw,
     )
+
+
+# -- the kept values fit in the objects' shared-key dicts (camtool.model.plain.share_keys) ----
+
+split_dicts = pytest.mark.skipif(
+    sys.implementation.name != "cpython" or sys.version_info < (3, 11),
+    reason="CPython 3.11+'s key-sharing instance dicts",
+)
+
+
+def _kept_bytes(objects: list[Any], keep: Callable[[Any], object]) -> float:
+    """Bytes allocated per object while ``keep`` computes (and keeps) its values."""
+    gc.collect()
+    tracemalloc.start()
+    try:
+        before = tracemalloc.get_traced_memory()[0]
+        for obj in objects:
+            keep(obj)
+        return (tracemalloc.get_traced_memory()[0] - before) / len(objects)
+    finally:
+        tracemalloc.stop()
+
+
+@split_dicts
+def test_an_arcs_kept_values_cost_only_themselves() -> None:
+    # 4 floats (radius, start angle, sweep, length: 24 bytes each; the axis signs are
+    # shared tuples) and, for an arc made by the constructor (half of them), the dict
+    # object that first holds a kept value (64 bytes; make_arc made it already). An arc
+    # whose dict turns ordinary on its 6th key costs ~170 bytes more.
+    arcs = [
+        (make_arc if k % 2 else Arc)((1.0 + k, 0.0), (0.0, 1.0 + k), (0.0, 0.0), k % 3 == 0)
+        for k in range(20_000)
+    ]
+
+    def keep(arc: Arc) -> None:
+        if arc.end[0] == 0.0 and int(arc.end[1]) % 5 == 0:
+            arc.start_angle  # noqa: B018 - some first, as the planner may
+        arc.length  # noqa: B018
+        segment_signs(arc)
+
+    assert _kept_bytes(arcs, keep) <= 4 * 24 + 64 / 2 + 8
+
+
+@split_dicts
+def test_a_lines_and_a_contours_kept_values_cost_only_themselves() -> None:
+    lines = [make_line((0.0, 0.0), (1.0, float(k))) for k in range(20_000)]
+    assert _kept_bytes(lines, lambda line: line.length) <= 24 + 8
+    contours = [Contour((line, line.reversed()), True) for line in lines]
+    # the length (a float) and the box (a 4-tuple of floats: 72 + 16 + 4 × 24 at most)
+    assert _kept_bytes(contours, lambda c: (c.length, c.bbox())) <= 24 + 88 + 96 + 8
