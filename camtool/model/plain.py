@@ -40,7 +40,7 @@ def share_keys(cls: type, names: tuple[str, ...]) -> None:
         cls: a class whose instances have a ``__dict__``.
         names: every attribute its instances may hold, fields first, in order.
     """
-    first = object.__new__(cls)
+    first: object = object.__new__(cls)
     values = first.__dict__
     for name in names:
         values[name] = None

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any, Generic, TypeAlias, TypeVar, overload
 
 from camtool.model.errors import GeometryError, UsageError
@@ -348,7 +348,7 @@ _PLAIN_SEGMENTS = plain_fields(Line) == ("start", "end") and plain_fields(Arc) =
 def _kept(cls: type) -> tuple[str, ...]:
     """The names of ``cls``'s fields, in order, then of its :class:`cached_property` values."""
     cached = tuple(n for n, v in vars(cls).items() if isinstance(v, cached_property))
-    return (*cls.__dataclass_fields__, *cached)
+    return (*(f.name for f in fields(cls)), *cached)
 
 
 share_keys(Line, _kept(Line))
