@@ -37,6 +37,7 @@ segments are parsed by svgelements (``Move``, ``Line``, ``Close``, ``Arc``,
 
 from __future__ import annotations
 
+import gc
 import io
 import math
 from collections.abc import Iterable, Iterator
@@ -106,6 +107,7 @@ def read_svg(
     progress(Step("reading", name=path.name))
     prepared = prepare(path, options.layers, max_entities=options.max_entities)
     svg = _parse(path, prepared)
+    gc.collect(1)  # svgelements' parse leaves its XML tree in cycles: free it now (issue 17)
     warnings = list(prepared.warnings)
     contours: list[Contour] = []
     hidden = invisible = 0
