@@ -94,7 +94,11 @@ def preview(
     )
     chosen = _target(target, machine_file)
     drawing, program = preview_inputs(input_name, program_name, chosen, import_settings(options))
-    verification = _verify(program, drawing, chosen, tool_diameter) if verify_too else None
+    verification = (
+        _verify(program, drawing, chosen, tool_diameter, program_name or input_name)
+        if verify_too
+        else None
+    )
     shown = title or (f"{program_name} over {input_name}" if program_name else input_name)
     data = render_preview(
         ".svg" if out == "-" else out,
@@ -121,7 +125,11 @@ def _target(name: str | None, machine_file: Path | None) -> Target | None:
 
 
 def _verify(
-    program: Program | None, drawing: Drawing | None, target: Target | None, tool_diameter: float
+    program: Program | None,
+    drawing: Drawing | None,
+    target: Target | None,
+    tool_diameter: float,
+    source: str,
 ) -> Verification:
     if target is None or program is None:
         raise UsageError(
@@ -131,7 +139,12 @@ def _verify(
     from camtool.verify.verifier import verify_program
 
     v = verify_program(
-        program, target.machine, name=target.name, against=drawing, tool_diameter=tool_diameter
+        program,
+        target.machine,
+        name=target.name,
+        against=drawing,
+        tool_diameter=tool_diameter,
+        source=source,
     )
     warn(v.warnings)
     click.echo(

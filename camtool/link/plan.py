@@ -161,7 +161,7 @@ def prepare_send(
     program = _read_back(data, target, source)
     from camtool.verify.verifier import check_area
 
-    warnings = [*program.warnings, *spec.warnings, *check_area(program, target.machine)]
+    warnings = [*program.warnings, *spec.warnings, *check_area(program, target.machine, source)]
     _check_depth(program, max_depth_mm if max_depth_mm is not None else spec.max_depth_mm, source)
     verification, move_times = _times(program, target, verify, max_error_um)
     move_times = _with_z(program, target, move_times)

@@ -39,7 +39,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from camtool.model.errors import CamtoolError, InputError, UsageError
+from camtool.model.errors import CamtoolError, DialectError, InputError, UsageError
 from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Dwell, Home, Program, Rapid
 from camtool.model.progress import Progress, Step, no_progress
@@ -239,6 +239,8 @@ def verify_code(
     Raises:
         ParseError: the code is not valid in the target's dialect (names the line).
         InputError: the code holds no cutting move (nothing to verify).
+        DialectError: the program does not fit the machine; the message starts with
+            ``source`` (:func:`check_area`).
     """
     program = target.post.parse(code, source=source)
     if all(isinstance(move, Rapid) for move in program.moves):
@@ -256,6 +258,7 @@ def verify_code(
         findings=findings,
         planned=planned,
         budget=budget,
+        source=source,
     )
 
 
@@ -271,6 +274,7 @@ def verify_program(
     budget: bool = True,
     chunk_rows: int = CHUNK_ROWS,
     stream_above: int = STREAM_ROWS,
+    source: str = "",
 ) -> Verification:
     """Simulate ``program`` on ``machine`` and measure the machined error.
 
@@ -293,6 +297,8 @@ def verify_program(
         chunk_rows: rows simulated and measured at a time when the trace is streamed.
         stream_above: a trace of more rows than this is streamed (simulated and
             measured ``chunk_rows`` at a time, :func:`_simulate_big`) when it can be.
+        source: the file the program was read from, named in the messages of
+            :func:`check_area` (``""``: the line alone).
 
     A drawing whose box does not overlap the program's (less than
     :data:`MIN_OVERLAP`) is not compared: ``against`` is ``None``,
@@ -306,7 +312,7 @@ def verify_program(
     """
     if tool_diameter < 0:
         raise UsageError(f"tool diameter must be >= 0 mm, got {tool_diameter!r}")
-    placement = check_area(program, machine)
+    placement = check_area(program, machine, source)
     skipped = None if against is None else _no_overlap(program, against, tool_diameter / 2.0)
     compared_with = against if skipped is None else None
     trace, streamed = _simulate_big(program, machine, compared_with, chunk_rows, stream_above)
@@ -699,11 +705,17 @@ def _short(value: float) -> str:
     return "0" if text in ("-0", "") else text
 
 
-def check_area(program: Program, machine: Machine) -> tuple[str, ...]:
+def check_area(program: Program, machine: Machine, source: str = "") -> tuple[str, ...]:
     """The rule ``post`` applies (:func:`camtool.post.base.check_placement`), on read code.
 
     Work coordinates: the toolpath must fit the travel (warnings where work zero needs
     care); machine coordinates: every move inside the work area, named by its line.
+
+    Args:
+        program: the code as read.
+        machine: the machine it is checked against.
+        source: the file the code was read from; messages then start with it (and name
+            a move ``FILE:LINE``, as the readers name a line), else with the line alone.
 
     Raises:
         DialectError: the program cannot run on ``machine`` (with the remedy).
@@ -712,9 +724,17 @@ def check_area(program: Program, machine: Machine) -> tuple[str, ...]:
 
     for index, (start, move) in enumerate(program.steps()):
         line = program.line_of(index)
-        where = f"line {line}" if line is not None else f"move {index + 1}"
+        if line is None:
+            where = f"{source}: move {index + 1}" if source else f"move {index + 1}"
+        else:
+            where = f"{source}:{line}" if source else f"line {line}"
         check_work_area(start, move, machine, where, program)
-    return check_placement(program, machine)
+    try:
+        return check_placement(program, machine)
+    except DialectError as exc:
+        if not source:
+            raise
+        raise DialectError(f"{source}: {exc}") from None
 
 
 def block_times(trace: StepTrace, program: Program, machine: Machine) -> np.ndarray:

@@ -195,3 +195,31 @@ def test_summary_counts_the_contours_it_leaves_out(
         assert tail == []
     else:
         assert tail == [f"camtool:   ... {more} more contours in the report"]
+
+
+def test_a_program_too_large_for_the_machine_is_named_by_its_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The placement refusal starts with the file, as a reader's error does (``FILE:LINE:``)."""
+    far = tmp_path / "far.ngc"
+    far.write_text("G21 G90\nG0 X0 Y0\nG1 X5000 Y0 F100\nM2\n")  # GRBL's default travel: 200 mm
+    code, _, err = run(["verify", str(far), "-t", "grbl"], capsys)
+    assert code == 1
+    assert f"camtool: error: {far}: the toolpath is 5000 × 0 mm, larger than the 200" in err
+
+
+def test_a_move_outside_a_machine_coordinate_work_area_is_named_file_colon_line() -> None:
+    """On a machine-coordinate machine each move is checked and named ``FILE:LINE``."""
+    from camtool.model.errors import DialectError
+    from camtool.post.registry import load_target
+    from camtool.verify.verifier import check_area
+
+    machine = load_target("matlab-router").machine  # machine coordinates, 0…200 mm
+    assert machine.coordinates == "machine"
+    program = load_target("linuxcnc").post.parse(
+        "G21 G90\nG0 X10 Y10\nG1 X-5 Y10 F100\nG1 X10 Y10\nM2\n", source="cut.ngc"
+    )
+    with pytest.raises(DialectError, match=r"^cut\.ngc:3: reaches X -5\.0000…10\.0000, Y 10"):
+        check_area(program, machine, "cut.ngc")
+    with pytest.raises(DialectError, match=r"^line 3: reaches X -5\.0000…10"):
+        check_area(program, machine)
