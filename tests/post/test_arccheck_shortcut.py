@@ -185,6 +185,12 @@ def test_grid_digits_equal_decimal(quantum: float) -> None:
     values += [float(v) for v in rng.uniform(-2000, 2000, 3000)]
     values += [round(float(v), int(rng.integers(0, 7))) for v in rng.uniform(-600, 600, 3000)]
     values += [(int(k) + 0.5) * quantum for k in rng.integers(-(10**6), 10**6, 2000)]
+    # the floats next to decimal halves (2.675 is 2.67499999… in binary) and big indices,
+    # where Grid.index's float rounding must hand over to the digits
+    halves = [(int(k) + 0.5) * quantum for k in rng.integers(-(10**13), 10**13, 500)]
+    halves += [2.675, -2.675, 1.0005, 0.0015, 1e14 * quantum + 0.5 * quantum]
+    values += [math.nextafter(h, towards) for h in halves for towards in (-math.inf, math.inf)]
+    values += [*halves, math.inf, -math.inf, 2.0**50 * quantum, 2.0**52 * quantum]
     for v in values:
         assert _called(grid.index, v) == _called(grid._index_slow, v), v
     for k in [0, 1, -1, 10**12, -(10**19), 10**21, *map(int, rng.integers(-(10**9), 10**9, 3000))]:
