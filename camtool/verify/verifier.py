@@ -714,22 +714,20 @@ def check_area(program: Program, machine: Machine, source: str = "") -> tuple[st
     Args:
         program: the code as read.
         machine: the machine it is checked against.
-        source: the file the code was read from; messages then start with it (and name
-            a move ``FILE:LINE``, as the readers name a line), else with the line alone.
+        source: the file the code was read from; every refusal then starts with it
+            (``FILE: line 7: reaches …``, ``FILE: the toolpath is …``).
 
     Raises:
         DialectError: the program cannot run on ``machine`` (with the remedy).
     """
     from camtool.post.base import check_placement, check_work_area
 
-    for index, (start, move) in enumerate(program.steps()):
-        line = program.line_of(index)
-        if line is None:
-            where = f"{source}: move {index + 1}" if source else f"move {index + 1}"
-        else:
-            where = f"{source}:{line}" if source else f"line {line}"
-        check_work_area(start, move, machine, where, program)
     try:
+        if machine.coordinates != "work":  # in work coordinates any position runs
+            for index, (start, move) in enumerate(program.steps()):
+                line = program.line_of(index)
+                where = f"line {line}" if line is not None else f"move {index + 1}"
+                check_work_area(start, move, machine, where, program)
         return check_placement(program, machine)
     except DialectError as exc:
         if not source:

@@ -208,8 +208,8 @@ def test_a_program_too_large_for_the_machine_is_named_by_its_file(
     assert f"camtool: error: {far}: the toolpath is 5000 × 0 mm, larger than the 200" in err
 
 
-def test_a_move_outside_a_machine_coordinate_work_area_is_named_file_colon_line() -> None:
-    """On a machine-coordinate machine each move is checked and named ``FILE:LINE``."""
+def test_a_move_outside_a_machine_coordinate_work_area_is_named_by_file_and_line() -> None:
+    """On a machine-coordinate machine each move is checked, named by its file and line."""
     from camtool.model.errors import DialectError
     from camtool.post.registry import load_target
     from camtool.verify.verifier import check_area
@@ -219,7 +219,13 @@ def test_a_move_outside_a_machine_coordinate_work_area_is_named_file_colon_line(
     program = load_target("linuxcnc").post.parse(
         "G21 G90\nG0 X10 Y10\nG1 X-5 Y10 F100\nG1 X10 Y10\nM2\n", source="cut.ngc"
     )
-    with pytest.raises(DialectError, match=r"^cut\.ngc:3: reaches X -5\.0000…10\.0000, Y 10"):
+    with pytest.raises(DialectError, match=r"^cut\.ngc: line 3: reaches X -5\.0000…10\.0000, Y 10"):
         check_area(program, machine, "cut.ngc")
     with pytest.raises(DialectError, match=r"^line 3: reaches X -5\.0000…10"):
         check_area(program, machine)
+    # larger than the travel: refused before any move is looked at, named by the file too
+    big = load_target("linuxcnc").post.parse(
+        "G21 G90\nG0 X10 Y10\nG1 X250 Y10 F100\nM2\n", source="big.ngc"
+    )
+    with pytest.raises(DialectError, match=r"^big\.ngc: the toolpath is 240 × 0 mm, larger than"):
+        check_area(big, machine, "big.ngc")
