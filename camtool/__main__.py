@@ -10,11 +10,12 @@ GC_THRESHOLD = (200_000, 30, 30)
 
 A job builds hundreds of thousands of long-lived objects (segments, moves, blocks) and
 frees few, so with Python's defaults (700, 10, 10) the collector rescans that growing
-heap again and again: on the 213-icon SVG benchmark 2 941 young and 11 full collections,
-1.7 s of the job's CPU; with these 25 young ones and no full one, 0.45 s (issue 17). The
-values are mypy's (``mypy/build.py``), chosen for the same reason. Reference counting
-still frees every object not in a cycle at once; cycles wait for the next collection.
-Only the command-line process is tuned: a program that imports camtool keeps its own.
+heap again and again: on the 213-icon SVG benchmark 2 941 + 267 + 11 collections, 1.7 s
+of the main process; with these, 9 young ones and the SVG importer's one of its parse's
+garbage, 0.75 s (``gc.callbacks``; issue 17). The values are mypy's (``mypy/build.py``),
+chosen for the same reason. Reference counting still frees every object not in a cycle at
+once; cycles wait for the next collection. Only the command-line process is tuned: a
+program that imports camtool keeps its own.
 """
 
 

@@ -107,7 +107,6 @@ def read_svg(
     progress(Step("reading", name=path.name))
     prepared = prepare(path, options.layers, max_entities=options.max_entities)
     svg = _parse(path, prepared)
-    gc.collect(1)  # svgelements' parse leaves its XML tree in cycles: free it now (issue 17)
     warnings = list(prepared.warnings)
     contours: list[Contour] = []
     hidden = invisible = 0
@@ -143,13 +142,22 @@ def read_svg(
 
 
 def _parse(path: Path, prepared: Prepared) -> Any:
+    """The prepared file parsed by svgelements, and the XML tree it leaves behind freed.
+
+    svgelements leaves the elements it read in reference cycles (its table of ids points
+    back into the tree), which only the cyclic collector frees; the ``camtool`` command
+    runs it rarely (:data:`camtool.__main__.GC_THRESHOLD`), so the young generations are
+    collected here, where that garbage is made (issue 17).
+    """
     width, height = prepared.viewport
     try:
-        return se.SVG.parse(
+        svg = se.SVG.parse(
             io.BytesIO(prepared.data), reify=False, ppi=96.0, width=width, height=height
         )
     except (ValueError, TypeError, IndexError, KeyError, ZeroDivisionError) as exc:
         raise InputError(f"{path}: svgelements cannot read this SVG ({exc!r})") from exc
+    gc.collect(1)
+    return svg
 
 
 def _shapes(node: Any) -> Iterator[Any]:
