@@ -274,7 +274,8 @@ def fit_curve(
 
     Returns:
         Segments from ``point_at(t0)`` to ``point_at(t1)`` (exactly), each starting at the end
-        of the one before; empty when the whole curve is one point.
+        of the one before; empty when the curve ends where it starts and never leaves the
+        tolerance of that point (one point, or a loop smaller than the tolerance).
 
     Raises:
         UsageError: bad ``tolerance`` or parameter range.
