@@ -761,12 +761,11 @@ def _nearest_kd(
         return np.full(len(samples), np.inf)
     half = float(np.max(np.hypot(*(b - a).T))) / 2.0
     tree = (ends or _LazyTree(np.concatenate([a, b]))).tree
-    parts = [
-        _nearest_chunk(samples[i : i + NEAREST_CHUNK], a, b, tree, half)
-        for i in range(0, len(samples), NEAREST_CHUNK)
-    ]
-    d = np.concatenate([p[0] for p in parts]) if parts else np.zeros(0)
-    unsure = np.concatenate([p[1] for p in parts]) if parts else np.zeros(0, dtype=bool)
+    d = np.empty(len(samples), dtype=np.float64)
+    unsure = np.empty(len(samples), dtype=bool)
+    for i in range(0, len(samples), NEAREST_CHUNK):
+        part = slice(i, i + NEAREST_CHUNK)
+        d[part], unsure[part] = _nearest_chunk(samples[part], a, b, tree, half)
     nearby = partial(_nearby_exact, a=a, b=b, ends=tree, half=half)
     return _settle_unsure(samples, d, unsure, a, b, nearby, only_max=only_max)
 
@@ -848,12 +847,25 @@ def _all_exact(samples: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
 
     What :func:`nearest_distances` gave before :func:`_nearby_exact` (its fallback, and
     the reference the tests compare it with, bit for bit).
+
+    The samples are asked :data:`ALL_EXACT_CHUNK` at a time against one tree: GEOS
+    answers each point alone, so the distances are those of one query of them all,
+    while only a chunk's point geometries (~100 bytes each) exist at once (5.9 M unsure
+    samples of a 213-icon drawing took 1.3 GB in one query).
     """
     import shapely
 
     tree = shapely.STRtree(shapely.linestrings(np.stack([a, b], axis=1)))
-    _, exact = tree.query_nearest(shapely.points(samples), return_distance=True, all_matches=False)
-    return np.asarray(exact, dtype=np.float64)
+    out = np.empty(len(samples), dtype=np.float64)
+    for lo in range(0, len(samples), ALL_EXACT_CHUNK):
+        points = shapely.points(samples[lo : lo + ALL_EXACT_CHUNK])
+        _, exact = tree.query_nearest(points, return_distance=True, all_matches=False)
+        out[lo : lo + len(points)] = exact
+    return out
+
+
+ALL_EXACT_CHUNK = 1 << 16
+"""Samples :func:`_all_exact` asks GEOS's nearest query at once (memory, not the answer)."""
 
 
 NEARBY_MAX_PAIRS = 4_000_000
@@ -890,10 +902,9 @@ def _nearby_exact(
             sample's distance does not depend on ``need``.
     """
     reach = (upper + half) * (1.0 + 1e-9) + 1e-12  # a float margin: never leaves one out
-    near = ends.query_ball_point(samples, reach, return_length=True, workers=KD_WORKERS)
-    if int(np.sum(near)) > NEARBY_MAX_PAIRS:
+    counts = _counts_within(ends, samples, reach)
+    if counts is None:
         return None
-    counts = np.asarray(near, dtype=np.int64)
     if counts.min() == 0:
         return None  # cannot happen (the segment of ``upper`` is within reach): be safe
     if need is not None:
@@ -902,6 +913,31 @@ def _nearby_exact(
             out[need] = _nearby_pairs(samples[need], reach[need], counts[need], a, b, ends)
         return out
     return _nearby_pairs(samples, reach, counts, a, b, ends)
+
+
+def _counts_within(ends: Any, samples: FloatArray, reach: FloatArray) -> IntArray | None:
+    """How many ends lie within ``reach`` of each sample, or ``None`` over the pair limit.
+
+    Counted :data:`NEARBY_COUNT_CHUNK` samples at a time (scipy's count holds a list per
+    sample while it runs: ~400 MB for 5.9 M samples in one call), stopping as soon as the
+    running total passes :data:`NEARBY_MAX_PAIRS`: the answer of one count of them all.
+    """
+    parts: list[IntArray] = []
+    total = 0
+    for lo in range(0, len(samples), NEARBY_COUNT_CHUNK):
+        part = slice(lo, lo + NEARBY_COUNT_CHUNK)
+        near = ends.query_ball_point(
+            samples[part], reach[part], return_length=True, workers=KD_WORKERS
+        )
+        total += int(np.sum(near))
+        if total > NEARBY_MAX_PAIRS:
+            return None
+        parts.append(np.asarray(near, dtype=np.int64))
+    return np.concatenate(parts) if parts else np.zeros(0, dtype=np.int64)
+
+
+NEARBY_COUNT_CHUNK = 1 << 16
+"""Samples :func:`_counts_within` counts at once (memory, and an early end over the limit)."""
 
 
 def _nearby_pairs(
@@ -1192,10 +1228,15 @@ def _thin_every(head: FloatArray, n: int) -> int:
     ``head`` is the trace's first ``min(n, THIN_HEAD)`` points: their median spacing
     against :data:`ALONG_RESOLUTION_MM`, and at most :data:`ALONG_MAX_TRACE` points.
     """
-    steps = np.diff(head, axis=0)
-    step = float(np.median(np.hypot(steps[:, 0], steps[:, 1])))
+    step = _median_step(head)
     every = max(1, int(ALONG_RESOLUTION_MM / step) if step > 0 else 1)
     return max(every, -(-n // ALONG_MAX_TRACE))
+
+
+def _median_step(head: FloatArray) -> float:
+    """The median distance between consecutive points of ``head`` ``(n, 2)``, mm (0 if n < 2)."""
+    steps = np.diff(head, axis=0)
+    return float(np.median(np.hypot(steps[:, 0], steps[:, 1]))) if len(steps) else 0.0
 
 
 def _carriage_after(
@@ -1693,13 +1734,17 @@ class Against:
         return max([self.max_um, *(f.error_um for f in self.not_cut)])
 
 
+AGAINST_RESOLUTION_MM = 0.0005
+"""Spacing :func:`against_drawing` thins the cutting trace to by default, mm."""
+
+
 def against_drawing(
     points: FloatArray,
     drawing: Drawing,
     tool_radius_mm: float,
     *,
     spacing_mm: float = 0.005,
-    resolution_mm: float = 0.0005,
+    resolution_mm: float = AGAINST_RESOLUTION_MM,
     runs: IntArray | None = None,
     nominal: Sequence[FloatArray] = (),
     findings: Sequence[FindingLike] = (),
@@ -1732,17 +1777,177 @@ def against_drawing(
         overcut: measure the overcut (``False``: ``overcut_um`` is 0, for a caller that
             reads only the other figures, as the error budget does).
     """
-    samples, sizes = _sample_drawing(drawing, spacing_mm)
-    if len(points) < 2 or len(samples) == 0:
+    if len(points) < 2:
         return Against(0.0, 0.0, (0.0, 0.0), 0.0, 0)
-    head = np.diff(points[: min(len(points), 2000)], axis=0)
-    step = float(np.median(np.hypot(head[:, 0], head[:, 1]))) if len(head) else 0.0
-    every = max(1, int(resolution_mm / step)) if step > 0 else 1
-    keep = _thin_index(len(points), min(400_000, math.ceil(len(points) / every)), runs)
-    trace = points[keep]
-    joined = (
-        np.ones(len(keep) - 1, dtype=bool) if runs is None else runs[keep][1:] == runs[keep][:-1]
+    every = _cut_every(points[: min(len(points), CUT_HEAD_ROWS)], resolution_mm)
+    keep = _thin_index(len(points), _cut_limit(len(points), every), runs)
+    thin = ThinTrace(points[keep], None if runs is None else runs[keep], len(points))
+    return against_thinned(
+        thin,
+        drawing,
+        tool_radius_mm,
+        spacing_mm=spacing_mm,
+        nominal=nominal,
+        findings=findings,
+        overcut=overcut,
     )
+
+
+CUT_HEAD_ROWS = 2000
+"""Cutting rows whose median step sets the thinning of :func:`against_drawing`."""
+CUT_MAX_ROWS = 400_000
+"""Most every-k-th rows :func:`against_drawing` keeps of the cutting trace."""
+
+
+def _cut_every(head: FloatArray, resolution_mm: float) -> int:
+    """Every how many rows the trace is about ``resolution_mm`` long (``head``: its first rows)."""
+    step = _median_step(head)
+    return max(1, int(resolution_mm / step)) if step > 0 else 1
+
+
+def _cut_limit(n: int, every: int) -> int:
+    """The ``limit`` of :func:`_thin_index` for ``n`` cutting rows thinned ``every`` rows."""
+    return min(CUT_MAX_ROWS, math.ceil(n / every))
+
+
+@dataclass(frozen=True, eq=False)
+class ThinTrace:
+    """A cutting trace thinned as :func:`against_drawing` thins it.
+
+    Attributes:
+        points: ``(K, 2)`` the rows kept (every k-th, each run's first and last, the
+            last), mm, in trace order.
+        runs: ``(K,)`` the run (continuous cut between rapids) of each, or ``None``
+            (one run).
+        rows: the cutting rows of the whole trace (``N``; ``K <= N``).
+    """
+
+    points: FloatArray
+    runs: IntArray | None
+    rows: int
+
+
+class CuttingStream:
+    """The thinned cutting trace of :func:`against_drawing`, from a trace read chunk by chunk.
+
+    Feed every chunk of the whole trace in order with :meth:`add` (the chunk's rows, mm,
+    and the move of each row), then :meth:`finish`: the rows and run ids are those
+    :func:`against_drawing` keeps of the whole trace's cutting rows (what
+    :func:`camtool.verify.verifier._cutting_rows` gives), bit for bit, while no more
+    than a chunk and :data:`CUT_HEAD_ROWS` rows are held besides the kept ones. The
+    cutting rows are known in advance (``rows``: from the moves' row counts), so the
+    every-k-th is known as soon as the first :data:`CUT_HEAD_ROWS` of them are read;
+    the last row of each chunk waits for the next chunk to say whether a run ends there.
+
+    Args:
+        rapid: ``(B,)`` bool, which moves are rapids (their rows do not cut).
+        rows: the cutting rows of the whole trace.
+        resolution_mm: as for :func:`against_drawing`.
+    """
+
+    def __init__(self, rapid: npt.NDArray[np.bool_], rows: int, resolution_mm: float) -> None:
+        self.rapid = rapid
+        self.n = rows
+        self.resolution_mm = resolution_mm
+        self.k = 0  # the every-k-th, once the head is read
+        self.seen = 0  # cutting rows given to _take (the carried one included)
+        self.gaps = 0  # rows that do not cut, so far (the run id is their count)
+        self.head: list[tuple[FloatArray, IntArray]] = []
+        self.head_rows = 0
+        self.carry: tuple[FloatArray, IntArray, bool] | None = None
+        self.kept: list[tuple[FloatArray, IntArray]] = []
+
+    def add(self, points: FloatArray, blocks: IntArray) -> None:
+        """One chunk: its rows ``(R, 2)`` mm and the move of each row ``(R,)``."""
+        cutting = ~self.rapid[blocks] if len(blocks) else np.zeros(0, dtype=bool)
+        runs = (self.gaps + np.cumsum(~cutting))[cutting]
+        self.gaps += int(len(cutting) - np.count_nonzero(cutting))
+        cut = points[cutting]
+        if not len(cut):
+            return
+        if self.k:
+            self._take(cut, runs, final=False)
+            return
+        self.head.append((cut, runs))
+        self.head_rows += len(cut)
+        if self.head_rows >= min(self.n, CUT_HEAD_ROWS):
+            self._start()
+
+    def _start(self) -> None:
+        """The every-k-th from the head, then the head's rows taken."""
+        cut = np.concatenate([c for c, _ in self.head]) if self.head else np.zeros((0, 2))
+        runs = np.concatenate([r for _, r in self.head]) if self.head else np.zeros(0, np.int64)
+        self.head = []
+        every = _cut_every(cut[:CUT_HEAD_ROWS], self.resolution_mm)
+        self.k = max(1, math.ceil(self.n / _cut_limit(self.n, every))) if self.n else 1
+        if len(cut):
+            self._take(cut, runs, final=False)
+
+    def _take(self, cut: FloatArray, runs: IntArray, *, final: bool) -> None:
+        """Keep what :func:`_thin_index` keeps of these consecutive cutting rows.
+
+        Each row is kept when its index is a multiple of k, is the last, or starts or
+        ends a run; the last row given waits (``carry``) for the row after it, unless
+        ``final``.
+        """
+        first = self.seen
+        if self.carry is not None:
+            point, run, picked_before = self.carry
+            cut = np.concatenate([point, cut])
+            runs = np.concatenate([run, runs])
+            first -= 1
+        index = np.arange(first, first + len(cut))
+        picked = (index % self.k == 0) | (index == self.n - 1)
+        change = runs[1:] != runs[:-1]
+        picked[1:] |= change
+        picked[:-1] |= change
+        if self.carry is not None:
+            picked[0] |= picked_before
+        decided = len(cut) if final else len(cut) - 1
+        self.kept.append((cut[:decided][picked[:decided]], runs[:decided][picked[:decided]]))
+        self.carry = None if final else (cut[-1:], runs[-1:], bool(picked[-1]))
+        self.seen = first + len(cut)
+
+    def finish(self) -> ThinTrace:
+        """The thinned cutting trace (after the last chunk).
+
+        Raises:
+            RuntimeError: the chunks did not hold the ``rows`` cutting rows announced.
+        """
+        if not self.k:
+            self._start()
+        if self.carry is not None:
+            point, run, _ = self.carry
+            self.carry = None
+            self.seen -= 1
+            self._take(point, run, final=True)
+        if self.seen != self.n:
+            raise RuntimeError(f"{self.seen} cutting rows streamed, {self.n} announced")
+        points = np.concatenate([p for p, _ in self.kept]) if self.kept else np.zeros((0, 2))
+        runs = np.concatenate([r for _, r in self.kept]) if self.kept else np.zeros(0, np.int64)
+        return ThinTrace(points, runs, self.n)
+
+
+def against_thinned(
+    thin: ThinTrace,
+    drawing: Drawing,
+    tool_radius_mm: float,
+    *,
+    spacing_mm: float = 0.005,
+    nominal: Sequence[FloatArray] = (),
+    findings: Sequence[FindingLike] = (),
+    overcut: bool = True,
+) -> Against:
+    """:func:`against_drawing` of a trace already thinned (:class:`ThinTrace`).
+
+    The arguments are :func:`against_drawing`'s; ``thin`` is its thinned cutting trace
+    (of a whole trace, or of one streamed by :class:`CuttingStream`).
+    """
+    samples, sizes = _sample_drawing(drawing, spacing_mm)
+    if thin.rows < 2 or len(samples) == 0:
+        return Against(0.0, 0.0, (0.0, 0.0), 0.0, 0)
+    trace, runs = thin.points, thin.runs
+    joined = np.ones(len(trace) - 1, dtype=bool) if runs is None else runs[1:] == runs[:-1]
     if not joined.any():
         joined[:] = True  # single points only: their nearest distances still count
     off = nearest_distances(samples, trace[:-1][joined], trace[1:][joined]) - tool_radius_mm
@@ -1762,8 +1967,11 @@ def against_drawing(
                     value=finding.value,
                 )
             )
-    kept = off[main] if main.any() else np.zeros(1)
-    kept_at = samples[main] if main.any() else np.zeros((1, 2))
+    if main.all():  # no feature apart: the arrays themselves, not copies
+        kept, kept_at = off, samples
+    else:
+        kept = off[main] if main.any() else np.zeros(1)
+        kept_at = samples[main] if main.any() else np.zeros((1, 2))
     worst = int(np.argmax(np.abs(kept)))
     overcut_um = 0.0
     if overcut and tool_radius_mm > 0:
@@ -1965,10 +2173,24 @@ def _sample_drawing(drawing: Drawing, spacing_mm: float) -> tuple[FloatArray, li
 
 
 def _sample_drawing_now(drawing: Drawing, spacing_mm: float) -> tuple[FloatArray, list[int]]:
-    """:func:`_sample_drawing` without the kept copy."""
-    chunks = [_sample_contour(c.segments, spacing_mm) for c in drawing.contours]
-    sizes = [len(c) for c in chunks]
-    return (np.vstack(chunks) if chunks else np.zeros((0, 2))), sizes
+    """:func:`_sample_drawing` without the kept copy.
+
+    The points are written into one array sized in advance (what stacking the
+    contours' arrays gives, without holding them all twice: 9.6 M points of a
+    213-icon drawing are 154 MB).
+    """
+    sizes = [_contour_samples(c.segments, spacing_mm) for c in drawing.contours]
+    out = np.empty((sum(sizes), 2), dtype=np.float64)
+    at = 0
+    for contour, size in zip(drawing.contours, sizes, strict=True):
+        out[at : at + size] = _sample_contour(contour.segments, spacing_mm)
+        at += size
+    return out, sizes
+
+
+def _contour_samples(segments: tuple[Segment, ...], spacing_mm: float) -> int:
+    """How many points :func:`_sample_contour` gives for ``segments``."""
+    return sum(max(1, math.ceil(seg.length / spacing_mm)) for seg in segments) + 1
 
 
 def _sample_contour(segments: tuple[Segment, ...], spacing_mm: float) -> FloatArray:

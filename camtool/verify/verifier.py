@@ -50,13 +50,17 @@ from camtool.verify import budget as eb
 from camtool.verify.clock import block_times_s, timing_warnings
 from camtool.verify.interpolators import compiled
 from camtool.verify.metrics import (
+    AGAINST_RESOLUTION_MM,
     Against,
     AlongPath,
     ContourMeasure,
+    CuttingStream,
     Deviation,
     FindingLike,
+    ThinTrace,
     TraceStream,
     against_drawing,
+    against_thinned,
     along_path,
     deviation,
     measure_contours,
@@ -320,7 +324,16 @@ def verify_program(
     if skipped is not None:
         warnings.append(skipped)
     if streamed is not None:
-        dev, along, contours, compared = streamed
+        dev, along, contours, thin = streamed
+        compared = None
+        if thin is not None and compared_with is not None:
+            compared = against_thinned(
+                thin,
+                compared_with,
+                tool_diameter / 2.0,
+                nominal=_nominal_lines(program) if findings else (),
+                findings=findings,
+            )
     else:
         dev, along, contours, compared = _measure(
             program, trace, compared_with, tool_diameter, findings
@@ -353,19 +366,25 @@ def _simulate_big(
     against: Drawing | None,
     chunk_rows: int,
     stream_above: int,
-) -> tuple[StepTrace, tuple[Deviation, AlongPath, tuple[ContourMeasure, ...], None] | None]:
+) -> tuple[
+    StepTrace, tuple[Deviation, AlongPath, tuple[ContourMeasure, ...], ThinTrace | None] | None
+]:
     """The trace of ``program``, and its measures when they were taken as it streamed.
 
-    A trace of at most ``stream_above`` rows, one from a target's own simulator, or one
-    to be compared with a drawing (which needs the cutting rows whole) is simulated whole
-    (:func:`simulate`) and measured by :func:`_measure` (then ``None``). A longer one of
-    the step simulator is simulated again in chunks of ``chunk_rows`` rows
-    (:class:`camtool.verify.simulate.ChunkedSimulation`) and measured chunk by chunk
-    (:class:`camtool.verify.metrics.TraceStream`: the same figures, the deviation's rms
-    summed exactly); the trace returned (:class:`StreamedTrace`) then holds only the rows
-    kept for the picture. Without the compiled kernels it is simulated whole.
+    A trace of at most ``stream_above`` rows or one from a target's own simulator is
+    simulated whole (:func:`simulate`) and measured by :func:`_measure` (then ``None``).
+    A longer one of the step simulator is simulated again in chunks of ``chunk_rows``
+    rows (:class:`camtool.verify.simulate.ChunkedSimulation`) and measured chunk by
+    chunk (:class:`camtool.verify.metrics.TraceStream`: the same figures, the
+    deviation's rms summed exactly); the trace returned (:class:`StreamedTrace`) then
+    holds only the rows kept for the picture. With a drawing (``against``), the cutting
+    rows the comparison keeps are gathered as the chunks pass
+    (:class:`~camtool.verify.metrics.CuttingStream`, the last item; ``None`` without a
+    drawing): the comparison needs only those, so the trace is not held whole for it
+    (13 M rows of a 213-icon SVG job took 1.65 GB). Without the compiled kernels it is
+    simulated whole.
     """
-    if against is not None or library().simulator(machine.motion.line) is not None:
+    if library().simulator(machine.motion.line) is not None:
         return simulate(program, machine), None
     if _rows_at_least(program, machine) > stream_above:
         compiled()  # it will be streamed, which needs the kernels: count with them too
@@ -378,6 +397,7 @@ def _simulate_big(
     sim = ChunkedSimulation(program, machine, chunk_rows)
     summary = sim.trace_summary()
     stream = TraceStream(program, got, summary["start_mm"], kernels)
+    cutting = None if against is None else _cutting_stream(program, got)
     try:
         for chunk in sim.chunks():
             stream.add(
@@ -387,6 +407,8 @@ def _simulate_big(
                 chunk.rows,
                 chunk.compensation,
             )
+            if cutting is not None:
+                cutting.add(chunk.carriage_mm, chunk.block_of_row())
     except NotStreamable:
         return simulate(program, machine), None
     summary = sim.trace_summary()
@@ -404,7 +426,18 @@ def _simulate_big(
         total_rows=int(got[-1]),
         total_compensation_steps=m.compensation_steps,
     )
-    return trace, (m.deviation, m.along, m.contours, None)
+    thin = None if cutting is None else cutting.finish()
+    return trace, (m.deviation, m.along, m.contours, thin)
+
+
+def _cutting_stream(program: Program, block_start: np.ndarray) -> CuttingStream:
+    """A :class:`CuttingStream` for the trace of ``program`` whose moves start at ``block_start``.
+
+    The cutting rows are those of the moves that are not rapids (as :func:`_cutting_rows`).
+    """
+    rapid = np.asarray([isinstance(m, Rapid) for m in program.moves], dtype=bool)
+    rows = int(np.diff(block_start)[~rapid].sum()) if len(rapid) else 0
+    return CuttingStream(rapid, rows, AGAINST_RESOLUTION_MM)
 
 
 def _rows_at_least(program: Program, machine: Machine) -> int:

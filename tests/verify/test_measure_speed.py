@@ -257,3 +257,57 @@ def test_sample_batches_are_the_slices_of_the_whole_samples(size: int) -> None:
     assert np.concatenate([p for p, _ in pieces]).tobytes() == whole.tobytes()
     assert np.array_equal(np.concatenate([o for _, o in pieces]), owner)
     assert set(owner.tolist()) == {1, 2, 3, 4}
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_all_segments_query_in_chunks_is_one_query_of_them_all(
+    seed: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """GEOS's nearest query asked a few samples at a time = asked of all at once (shapely)."""
+    import shapely
+
+    rng = np.random.default_rng(seed)
+    pts = _polyline(rng, seed)
+    a, b = pts[:-1], pts[1:]
+    samples = rng.uniform(pts.min(axis=0) - 0.01, pts.max(axis=0) + 0.01, (500, 2))
+    tree = shapely.STRtree(shapely.linestrings(np.stack([a, b], axis=1)))
+    _, once = tree.query_nearest(shapely.points(samples), return_distance=True, all_matches=False)
+    monkeypatch.setattr(metrics, "ALL_EXACT_CHUNK", int(rng.integers(1, 60)))
+    assert metrics._all_exact(samples, a, b).tobytes() == np.asarray(once, np.float64).tobytes()
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_counts_within_reach_are_scipys_or_none_over_the_limit(
+    seed: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    rng = np.random.default_rng(seed)
+    pts = _polyline(rng, seed + 1)
+    ends = cKDTree(pts)
+    samples = pts[rng.integers(0, len(pts), 400)] + rng.normal(0.0, 0.01, (400, 2))
+    reach = rng.uniform(0.0, 0.05, 400)
+    once = ends.query_ball_point(samples, reach, return_length=True)
+    monkeypatch.setattr(metrics, "NEARBY_COUNT_CHUNK", int(rng.integers(1, 50)))
+    monkeypatch.setattr(metrics, "NEARBY_MAX_PAIRS", int(np.sum(once)))
+    got = metrics._counts_within(ends, samples, reach)
+    assert got is not None and np.array_equal(got, once)
+    monkeypatch.setattr(metrics, "NEARBY_MAX_PAIRS", int(np.sum(once)) - 1)
+    assert metrics._counts_within(ends, samples, reach) is None
+
+
+def test_a_drawing_sampled_into_one_array_is_its_contours_stacked() -> None:
+    """The drawing's points written in place = each contour's points stacked (the old form)."""
+    square = Contour(
+        (
+            Line((0.0, 0.0), (1.0, 0.0)),
+            Arc((1.0, 0.0), (1.5, 0.5), (1.0, 0.5), False),
+            Line((1.5, 0.5), (0.0, 0.0)),
+        ),
+        True,
+    )
+    circle = Contour((Arc((3.0, 0.0), (3.0, 0.0), (2.0, 0.0), True),), True)
+    dot = Contour((Line((5.0, 5.0), (5.0, 5.0)),), False)
+    drawing = Drawing((square, circle, dot))
+    got, sizes = metrics._sample_drawing_now(drawing, 0.013)
+    parts = [metrics._sample_contour(c.segments, 0.013) for c in drawing.contours]
+    assert sizes == [len(p) for p in parts]
+    assert got.tobytes() == np.vstack(parts).tobytes()

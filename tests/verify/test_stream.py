@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from camtool.model.program import ArcMove, Linear, Program, Rapid
+from camtool.model.shapes import Drawing
 from camtool.post.registry import load_target
 from camtool.verify.simulate import ChunkedSimulation, StreamedTrace, simulate_steps
 from camtool.verify.verifier import build_report, verify_program
@@ -230,3 +231,109 @@ def test_rows_at_least_never_overstates_the_trace(name: str, seed: int) -> None:
         alone = Program((move,), origin=start)
         assert _rows_at_least(alone, machine) <= rows
         start = (move.x, move.y)
+
+
+def _drawn(program: Program) -> Drawing:
+    """The drawing :func:`_program` cuts: its full circle and its square with an arc corner."""
+    from camtool.model.shapes import Arc, Contour, Line
+
+    circle = Contour((Arc((4.5, 3.0), (4.5, 3.0), (3.5, 3.0), False),), True)
+    square = Contour(
+        (
+            Line((1.0, 1.0), (2.0, 1.0)),
+            Arc((2.0, 1.0), (2.5, 1.5), (2.0, 1.5), False),
+            Line((2.5, 1.5), (2.5, 2.5)),
+            Line((2.5, 2.5), (1.0, 2.5)),
+            Line((1.0, 2.5), (1.0, 1.0)),
+        ),
+        True,
+    )
+    return Drawing((circle, square))
+
+
+@pytest.mark.parametrize("name", TARGETS)
+@pytest.mark.parametrize("seed", range(3))
+def test_a_streamed_verification_compares_the_drawing_as_the_whole_one(
+    name: str, seed: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """With a drawing, a streamed trace gives the whole trace's comparison, float for float.
+
+    Few thinned rows (``CUT_MAX_ROWS``) and a short head, so the every-k-th, the runs' ends
+    and the head all fall across chunk edges.
+    """
+    from camtool.verify import metrics
+
+    monkeypatch.setattr(metrics, "CUT_MAX_ROWS", 97)
+    monkeypatch.setattr(metrics, "CUT_HEAD_ROWS", 11)
+    target = load_target(name)
+    program = _program(seed)
+    drawing = _drawn(program)
+    whole = verify_program(
+        program, target.machine, name=name, budget=False, against=drawing, tool_diameter=0.2
+    )
+    assert not isinstance(whole.trace, StreamedTrace)
+    assert whole.against is not None and whole.against.samples > 0
+    for chunk in (1, 53, 4000):
+        v = verify_program(
+            program,
+            target.machine,
+            name=name,
+            budget=False,
+            against=drawing,
+            tool_diameter=0.2,
+            chunk_rows=chunk,
+            stream_above=10,
+        )
+        assert isinstance(v.trace, StreamedTrace)
+        assert v.against == whole.against
+        assert _strip_rms(build_report(v)) == _strip_rms(build_report(whole))
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_the_cutting_stream_keeps_the_rows_the_whole_trace_keeps(
+    seed: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """:class:`CuttingStream` over any split of the rows = the whole trace's thinning.
+
+    The reference is what :func:`against_drawing` does with the whole cutting trace
+    (``_cutting_rows``, then the every-k-th from its head and ``_thin_index``).
+    """
+    from camtool.verify import metrics
+
+    rng = np.random.default_rng(seed)
+    monkeypatch.setattr(metrics, "CUT_MAX_ROWS", int(rng.integers(1, 400)))
+    monkeypatch.setattr(metrics, "CUT_HEAD_ROWS", int(rng.integers(2, 60)))
+    counts = rng.integers(0, 300, int(rng.integers(1, 30)))  # rows of each move
+    counts[rng.random(len(counts)) < 0.2] = 0
+    rapid = rng.random(len(counts)) < 0.3
+    if seed % 7 == 0:
+        rapid[:] = True  # nothing cuts
+    blocks = np.repeat(np.arange(len(counts)), counts)
+    step = float(rng.choice([0.0001, 0.004, 0.0]))
+    points = np.cumsum(rng.choice([-step, 0.0, step], size=(len(blocks), 2)), axis=0)
+    resolution = float(rng.choice([0.0005, 0.01, 0.1]))
+    cutting = ~rapid[blocks]
+    runs = np.cumsum(~cutting)[cutting]
+    cut = points[cutting]
+    n = len(cut)
+    every = metrics._cut_every(cut[: min(n, metrics.CUT_HEAD_ROWS)], resolution)
+    keep = metrics._thin_index(n, metrics._cut_limit(n, every), runs) if n else np.zeros(0, int)
+    stream = metrics.CuttingStream(rapid, n, resolution)
+    edges = np.sort(rng.integers(0, len(blocks) + 1, int(rng.integers(0, 12))))
+    if seed % 3 == 1:
+        edges = np.arange(len(blocks) + 1)  # a row at a time: every row waits for the next
+    for lo, hi in zip(np.r_[0, edges], np.r_[edges, len(blocks)], strict=True):
+        stream.add(points[lo:hi], blocks[lo:hi])
+    thin = stream.finish()
+    assert thin.rows == n
+    assert np.array_equal(thin.points, cut[keep])
+    assert thin.runs is not None and np.array_equal(thin.runs, runs[keep])
+
+
+def test_the_cutting_stream_refuses_rows_it_was_not_told_of() -> None:
+    from camtool.verify.metrics import CuttingStream
+
+    stream = CuttingStream(np.zeros(1, dtype=bool), 5, 0.0005)
+    stream.add(np.zeros((3, 2)), np.zeros(3, dtype=np.int64))
+    with pytest.raises(RuntimeError, match="3 cutting rows streamed, 5 announced"):
+        stream.finish()
