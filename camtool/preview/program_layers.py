@@ -21,6 +21,7 @@ from camtool.preview.scene import (
     Rect,
     Style,
     Text,
+    kept_indices,
     place_labels,
     polyline,
 )
@@ -70,12 +71,17 @@ def cut_runs(program: Program) -> list[list[Segment]]:
 def program_layers(program: Program, u: float, *, edge_radius_mm: float = 0.0) -> list[Layer]:
     """Tool width, rapids, cuts, starts and order of ``program`` (empty layers left out).
 
+    Every run gets a start marker and its number up to :data:`MAX_LABELS` runs; past
+    that only the runs whose number is kept do (every k-th, :func:`kept_indices`), so a
+    job of thousands of contours is not buried under its markers.
+
     Args:
         program: the moves, mm.
         u: the picture's size unit, mm (1/100 of the view).
         edge_radius_mm: tool radius of an offset cut; > 0 draws the swept tool.
     """
     runs = cut_runs(program)
+    shown = kept_indices(len(runs))  # a start marker where a number is: on a big job, 1 in k
     rapids = tuple((seg,) for move, seg in program.segments() if isinstance(move, Rapid))
     layers = [
         Layer("tool-width", tool_width(runs, edge_radius_mm, u)),
@@ -90,8 +96,8 @@ def program_layers(program: Program, u: float, *, edge_radius_mm: float = 0.0) -
             (Path(tuple(tuple(r) for r in runs), Style(CUT_COLOUR, 0.35 * u)),) if runs else (),
         ),
         Layer("tabs", tab_shapes(tab_segments(program), u)),
-        Layer("starts", tuple(s for run in runs for s in _start_marker(run, u))),
-        Layer("order", tuple(place_labels([_number(i + 1, run, u) for i, run in enumerate(runs)]))),
+        Layer("starts", tuple(s for i in shown for s in _start_marker(runs[i], u))),
+        Layer("order", tuple(place_labels([_number(i + 1, runs[i], u) for i in shown]))),
     ]
     return [layer for layer in layers if layer.shapes]
 

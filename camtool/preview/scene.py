@@ -204,6 +204,17 @@ def text_box(t: Text) -> BBox:
     return (x, t.at[1] - 0.25 * t.size, x + w, t.at[1] + 0.8 * t.size)
 
 
+def kept_indices(n: int, limit: int = MAX_LABELS) -> list[int]:
+    """Which of ``n`` marks of one kind a picture shows: all up to ``limit``, else every k-th.
+
+    Past ``limit``, every k-th (``k = ⌈n / (limit − 1)⌉``) and the last, at most ``limit``.
+    """
+    if n <= limit:
+        return list(range(n))
+    k = math.ceil(n / max(limit - 1, 1))
+    return sorted({*range(0, n, k), n - 1})[:limit]
+
+
 def place_labels(
     labels: list[Text], *, limit: int = MAX_LABELS, taken: list[BBox] | None = None
 ) -> list[Text]:
@@ -214,11 +225,8 @@ def place_labels(
     about its own size, else it is hidden. ``taken`` holds boxes already used
     (by other labels); the placed labels' boxes are added to it.
     """
-    n = len(labels)
-    if n > limit:
-        k = math.ceil(n / max(limit - 1, 1))
-        keep = sorted({*range(0, n, k), n - 1})[:limit]
-        labels = [labels[i] for i in keep]
+    if len(labels) > limit:
+        labels = [labels[i] for i in kept_indices(len(labels), limit)]
     boxes = taken if taken is not None else []
     placed: list[Text] = []
     for label in labels:

@@ -84,6 +84,28 @@ def test_500_contours_show_at_most_max_labels_order_numbers() -> None:
     assert 0 < len(numbers) <= MAX_LABELS
 
 
+@pytest.mark.parametrize(("runs", "marked"), [(40, 40), (MAX_LABELS, MAX_LABELS), (500, 57)])
+def test_start_markers_go_where_the_numbers_are(runs: int, marked: int) -> None:
+    """Every run's start is marked up to MAX_LABELS runs; past it the numbered ones only.
+
+    (500 runs: every ⌈500/59⌉ = 9th, 56 of them, and the last; the 4 634 runs of a
+    213-icon SVG job buried its picture under markers.)
+    """
+    moves = []
+    for i in range(runs):
+        x, y = float(i % 25) * 2.0, float(i // 25) * 2.0
+        moves += [Rapid(x, y), Linear(x + 1.0, y, 100.0, contour=i + 1)]
+    svg = render_preview(".svg", program=Program(tuple(moves)))
+    dots = list(_groups(svg)["starts"].iter(f"{NS}circle"))
+    assert len(dots) == marked
+    numbers = {int(t.text or "0") for t in _groups(svg)["order"].iter(f"{NS}text")}
+    centres = {(float(d.get("cx", "nan")), -float(d.get("cy", "nan"))) for d in dots}
+    starts = {(float(i % 25) * 2.0, float(i // 25) * 2.0) for i in range(runs)}
+    assert centres <= starts
+    if runs > MAX_LABELS:  # the numbered runs are the marked ones (numbers are 1-based)
+        assert numbers <= {i + 1 for i in range(0, runs, 9)} | {runs}
+
+
 def test_png_circle_is_round() -> None:
     # A circle of radius 90 mm on a 200 mm page 2000 px wide: 900 px radius. Every inked
     # pixel must lie within half the line (1 px) and a pixel's diagonal of the true circle.
