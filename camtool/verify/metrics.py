@@ -1316,6 +1316,9 @@ STREAM_SAMPLES = 100_000
 """Path samples :class:`TraceStream` measures against a contour's trace at once: the
 distance of each is found alone (:func:`nearest_distances`), so the pieces give the same
 distances as one call, with about 30 MB less held on the bench program."""
+ZOOM_ROWS = 256
+"""Rows on each side of the worst deviation a streamed trace keeps for the picture's zoom
+(within the worst point's chunk): every k-th row alone leaves the zoom on it empty."""
 PICTURE_ROWS = 100_000
 """About how many rows of a streamed trace :class:`TraceStream` keeps for the picture
 (on the 10 mm wide 13 M-row benchmark program, a kept row about every 20 µm of path,
@@ -1476,7 +1479,7 @@ class TraceStream:
         # deviation
         self.dev_max = -1.0
         self.dev_where: tuple[Point, int, int] = ((0.0, 0.0), -1, -1)  # at, block, row
-        self.dev_row: tuple[Any, bool] = (np.zeros(2, np.int8), False)  # its steps, comp
+        self.dev_rows: tuple[IntArray, FloatArray, IntArray, Any, Any] | None = None  # near it
         self.dev_count = 0
         self.bins = np.zeros(kernels.EXACT_BINS, dtype=np.int64)
         self.pending = 0
@@ -1532,7 +1535,14 @@ class TraceStream:
             self.dev_max = float(dist[worst])
             at = (float(points[row, 0]), float(points[row, 1]))
             self.dev_where = (at, int(blocks[row]), r0 + row)
-            self.dev_row = (steps[row].copy(), bool(compensation[row]))
+            near = slice(max(0, row - ZOOM_ROWS), row + ZOOM_ROWS + 1)
+            self.dev_rows = (
+                np.arange(r0 + near.start, r0 + near.start + len(points[near]), dtype=np.int64),
+                points[near].copy(),
+                blocks[near].copy(),
+                steps[near].copy(),
+                compensation[near].copy(),
+            )
         self.dev_count += len(dist)
         self.pending = self.kernels.exact_sum_squares(dist, self.bins, self.pending)
 
@@ -1638,18 +1648,11 @@ class TraceStream:
             contour_end_um=tuple(e * 1000.0 for e in self.ends),
             samples=self.samples,
         )
-        at, block, row = self.dev_where
-        if row >= 0 and row % self.every_picture:  # the worst point, unless kept already
-            steps_row, comp_row = self.dev_row
-            self.picture.append(
-                (
-                    np.asarray([row], dtype=np.int64),
-                    np.asarray([at], dtype=np.float64),
-                    np.asarray([block], dtype=np.int64),
-                    steps_row.reshape(1, 2),
-                    np.asarray([comp_row]),
-                )
-            )
+        if self.dev_rows is not None:  # the worst point and the rows around it, unless kept
+            rows, *columns = self.dev_rows
+            new = rows % self.every_picture != 0
+            points, blocks, steps, comp = columns
+            self.picture.append((rows[new], points[new], blocks[new], steps[new], comp[new]))
         order = np.argsort(np.concatenate([p[0] for p in self.picture]), kind="stable")
 
         def joined(k: int) -> Any:

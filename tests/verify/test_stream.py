@@ -337,3 +337,33 @@ def test_the_cutting_stream_refuses_rows_it_was_not_told_of() -> None:
     stream.add(np.zeros((3, 2)), np.zeros(3, dtype=np.int64))
     with pytest.raises(RuntimeError, match="3 cutting rows streamed, 5 announced"):
         stream.finish()
+
+
+@pytest.mark.parametrize("name", TARGETS)
+def test_a_streamed_picture_keeps_the_rows_around_the_worst_point(
+    name: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The zoom on the worst point has a trace to show: the rows around it are kept.
+
+    Every k-th row alone (k = rows / PICTURE_ROWS) left the zoom of a 13 M-row job with
+    the worst point's marker and nothing else.
+    """
+    from camtool.verify import metrics
+
+    monkeypatch.setattr(metrics, "PICTURE_ROWS", 50)
+    monkeypatch.setattr(metrics, "ZOOM_ROWS", 30)
+    target = load_target(name)
+    program = _program(4)
+    whole = simulate_steps(program, target.machine)
+    v = verify_program(
+        program, target.machine, name=name, budget=False, chunk_rows=10**6, stream_above=10
+    )
+    assert isinstance(v.trace, StreamedTrace)
+    at = np.asarray(v.deviation.at_mm)
+    # the first row of the worst move at that point (a carriage may stay put for rows)
+    here = (whole.carriage_mm == at).all(axis=1) & (whole.block_of_row == v.deviation.block)
+    worst = int(np.flatnonzero(here)[0])
+    near = whole.carriage_mm[max(0, worst - 30) : worst + 31]
+    kept = {tuple(p) for p in v.trace.carriage_mm.tolist()}
+    assert {tuple(p) for p in near.tolist()} <= kept
+    assert len(v.trace.carriage_mm) < len(whole.carriage_mm)  # still thinned elsewhere
