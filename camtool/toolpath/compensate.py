@@ -102,6 +102,7 @@ def compensate(contours: Sequence[Contour], nest: Nesting, options: PlanOptions)
     findings: list[Finding] = []
     vanished: list[Finding] = []
     open_count = 0
+    made_by_occt = _offsets(contours, nest, options)
     for i, contour in enumerate(contours):
         if not contour.closed:
             open_count += 1
@@ -110,7 +111,7 @@ def compensate(contours: Sequence[Contour], nest: Nesting, options: PlanOptions)
         elif options.offset == "on":
             cuts.append(_on_line(contour, i, nest, options))
         else:
-            made, found = _compensated(contour, i, nest, options)
+            made, found = _compensated(contour, i, nest, options, made_by_occt.get(i))
             cuts.extend(made)
             findings.extend(found)
             vanished.extend(f for f in found if f.kind == "offset-vanished")
@@ -145,17 +146,59 @@ def _on_line(contour: Contour, index: int, nest: Nesting, options: PlanOptions) 
     )
 
 
-def _compensated(
+def _offsets(
+    contours: Sequence[Contour], nest: Nesting, options: PlanOptions
+) -> dict[int, list[Contour] | ToolpathError]:
+    """OpenCASCADE's offset of each closed contour to the tool's side, by contour index.
+
+    All made at once by :func:`~camtool.toolpath.offset.offset_all` (in a child process
+    that a crash of OpenCASCADE cannot take this one down with); a zero radius needs none.
+    """
+    from camtool.toolpath.offset import offset_all
+
+    if options.offset == "on" or options.radius == 0:
+        return {}
+    jobs = {
+        i: _offset_job(contour, i, nest, options)
+        for i, contour in enumerate(contours)
+        if contour.closed
+    }
+    return dict(zip(jobs, offset_all(list(jobs.values())), strict=True))
+
+
+def _offset_job(
     contour: Contour, index: int, nest: Nesting, options: PlanOptions
+) -> tuple[Contour, float]:
+    """The contour oriented for the tool's side and the offset that puts the tool there, mm."""
+    side = _side(index, nest, options)
+    r = options.radius
+    return _oriented(contour, side), -r if side.inside else r
+
+
+def _side(index: int, nest: Nesting, options: PlanOptions) -> _Side:
+    return _Side(
+        tool_inside(nest.depth(index), options.offset), options.direction != "conventional"
+    )
+
+
+def _compensated(
+    contour: Contour,
+    index: int,
+    nest: Nesting,
+    options: PlanOptions,
+    occt: list[Contour] | ToolpathError | None = None,
 ) -> tuple[list[Cut], list[Finding]]:
-    """The cuts of one closed contour offset to the tool's side, and what was found."""
+    """The cuts of one closed contour offset to the tool's side, and what was found.
+
+    ``occt``: OpenCASCADE's offset when it was made already (:func:`_offsets`).
+    """
     from camtool.toolpath.offset import offset_checked
 
     depth = nest.depth(index)
-    side = _Side(tool_inside(depth, options.offset), options.direction != "conventional")
-    drawn = _oriented(contour, side)
+    side = _side(index, nest, options)
+    drawn, amount = _offset_job(contour, index, nest, options)
     r = options.radius
-    result = offset_checked(drawn, -r if side.inside else r, options.tolerance)
+    result = offset_checked(drawn, amount, options.tolerance, occt=occt)
     findings: list[Finding] = []
     if not result.pieces:
         return [], [_vanished(contour, options)]

@@ -20,6 +20,11 @@ of travel as for the drawn contour.
 from __future__ import annotations
 
 import math
+import os
+import pickle
+import signal
+import sys
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -118,7 +123,15 @@ def offset_pieces(contour: Contour, amount: float) -> list[Contour]:
         ) from exc
     pieces: list[Contour] = []
     for wire in wires:
-        edges = [_from_edge(e, contour) for e in _wire_edges(wire)]
+        try:
+            edges = [_from_edge(e, contour) for e in _wire_edges(wire)]
+        except ToolpathError:
+            raise
+        except Exception as exc:  # OCCT's Standard_* errors measuring an edge it made
+            raise ToolpathError(
+                f"{_where(contour)}: offset by {amount:+.4g} mm gives an edge OpenCASCADE "
+                f"cannot measure ({type(exc).__name__})"
+            ) from exc
         joined = chain(
             [Contour((e,), False, contour.layer, contour.source) for e in edges], _JOIN_MM
         )
@@ -131,7 +144,122 @@ def offset_pieces(contour: Contour, amount: float) -> list[Contour]:
     return _oriented(pieces, contour)
 
 
-def offset_checked(contour: Contour, amount: float, tolerance: float) -> OffsetResult:
+def offset_all(jobs: Sequence[tuple[Contour, float]]) -> list[list[Contour] | ToolpathError]:
+    """:func:`offset_pieces` of every ``(contour, amount)``, OpenCASCADE run in a child process.
+
+    OCCT's 2D offset can crash the process (SIGSEGV in ``BRepOffsetAPI_MakeOffset``: Tango's
+    ``filequickprint.svg`` grown by 0.5 mm, a valid contour of 22 arcs and 2 lines), which
+    no ``except`` can catch. So on Linux the offsets are made in a forked child, one
+    after the other, each answer sent back as it is made; when the child dies, the job
+    it was making gets a :class:`ToolpathError` naming the signal (its caller falls back
+    to shapely's buffer, :func:`offset_checked`) and a new child takes the jobs after it.
+    The child is a fork of this process, so its answers are the ones :func:`offset_pieces`
+    gives here, bit for bit. OpenCASCADE is loaded here first, so that each child
+    inherits it instead of loading it again. Elsewhere the offsets are made in this process.
+
+    Returns:
+        Per job, in order, the pieces (as :func:`offset_pieces`) or the
+        :class:`ToolpathError` it raised.
+    """
+    if not jobs:
+        return []
+    if not _FORK:
+        return [_attempt(contour, amount) for contour, amount in jobs]
+    _load_occt()
+    out: list[list[Contour] | ToolpathError] = []
+    while len(out) < len(jobs):
+        got, died = _in_child(jobs[len(out) :])
+        out.extend(got)
+        if died is not None and len(out) < len(jobs):
+            contour, amount = jobs[len(out)]
+            out.append(
+                ToolpathError(
+                    f"{_where(contour)}: the process making the offset by {amount:+.4g} mm "
+                    f"crashed ({died})"
+                )
+            )
+    return out
+
+
+_FORK = sys.platform.startswith("linux") and hasattr(os, "fork")
+"""Whether :func:`offset_all` runs OpenCASCADE in a forked child (Linux)."""
+
+
+def _attempt(contour: Contour, amount: float) -> list[Contour] | ToolpathError:
+    try:
+        return offset_pieces(contour, amount)
+    except ToolpathError as exc:
+        return exc
+
+
+def _load_occt() -> None:
+    """Import the OCP modules the offsets use (once per process)."""
+    import OCP.BRepBuilderAPI
+    import OCP.BRepOffsetAPI
+    import OCP.BRepTools  # noqa: F401
+
+
+def _in_child(
+    jobs: Sequence[tuple[Contour, float]],
+) -> tuple[list[list[Contour] | ToolpathError], str | None]:
+    """The answers a forked child sends for ``jobs``, and how it died (``None``: it did not)."""
+    read_end, write_end = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # the child: answer each job, then leave without running the parent's code
+        code = 0
+        try:
+            _quiet_crash()
+            os.close(read_end)
+            with os.fdopen(write_end, "wb") as pipe:
+                for contour, amount in jobs:
+                    got = _attempt(contour, amount)
+                    record = ("error", str(got)) if isinstance(got, ToolpathError) else ("ok", got)
+                    pickle.dump(record, pipe, protocol=pickle.HIGHEST_PROTOCOL)
+                    pipe.flush()
+        except BaseException:
+            code = 70  # the parent sees which job got no answer
+        finally:
+            os._exit(code)
+    os.close(write_end)
+    answers: list[list[Contour] | ToolpathError] = []
+    with os.fdopen(read_end, "rb") as pipe:
+        while len(answers) < len(jobs):
+            try:
+                kind, value = pickle.load(pipe)
+            except Exception:  # the end of the pipe, or a record cut off by a crash
+                break
+            answers.append(ToolpathError(value) if kind == "error" else value)
+    _, status = os.waitpid(pid, 0)
+    if len(answers) == len(jobs):
+        return answers, None
+    if os.WIFSIGNALED(status):
+        number = os.WTERMSIG(status)
+        try:
+            name = signal.Signals(number).name
+        except ValueError:
+            name = "a signal"
+        return answers, f"{name}, signal {number}"
+    return answers, f"exit code {os.waitstatus_to_exitcode(status)}"
+
+
+def _quiet_crash() -> None:
+    """In the child: a crash leaves no core file and no Python fault report (the parent says it)."""
+    import contextlib
+    import faulthandler
+    import resource
+
+    faulthandler.disable()
+    with contextlib.suppress(ValueError, OSError):
+        resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
+
+
+def offset_checked(
+    contour: Contour,
+    amount: float,
+    tolerance: float,
+    *,
+    occt: list[Contour] | ToolpathError | None = None,
+) -> OffsetResult:
     """Offset with OpenCASCADE, checked against shapely; fall back to the buffer.
 
     OCCT's pieces are used when they close, hold only lines and arcs, change
@@ -145,6 +273,8 @@ def offset_checked(contour: Contour, amount: float, tolerance: float) -> OffsetR
         contour: a closed contour, mm.
         amount: offset distance, mm; positive grows the enclosed area.
         tolerance: chord and fitting tolerance, mm (> 0).
+        occt: OpenCASCADE's answer for this contour and amount when it was made
+            already (an item of :func:`offset_all`); ``None`` makes it here.
 
     Raises:
         ToolpathError: the contour is open.
@@ -155,7 +285,9 @@ def offset_checked(contour: Contour, amount: float, tolerance: float) -> OffsetR
         return OffsetResult((contour,))
     reference = _buffer(contour, amount, tolerance)
     try:
-        pieces = offset_pieces(contour, amount)
+        if isinstance(occt, ToolpathError):
+            raise occt
+        pieces = offset_pieces(contour, amount) if occt is None else occt
         reason = _disagreement(pieces, contour, amount, reference, tolerance)
     except ToolpathError as exc:  # OCCT failed or gave curves other than lines and arcs
         reason = str(exc).split(": ", 1)[-1]

@@ -1,0 +1,134 @@
+"""OpenCASCADE's offsets are made in a forked child that a crash cannot take the job down with.
+
+OCCT's 2D offset segfaulted on real drawings (Tango's ``filequickprint.svg`` and
+``mail-mark-junk.svg`` with ``--offset outside --tool-diameter 1``): the process died with
+SIGSEGV, no message. :func:`camtool.toolpath.offset.offset_all` makes the offsets in a
+child; a job whose child dies gets a ToolpathError (the planner falls back to shapely's
+buffer, with a warning) and the jobs after it are made by a new child. The answers of a
+child are those of the parent, bit for bit.
+"""
+
+from __future__ import annotations
+
+import os
+import pickle
+import signal
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from camtool.model.errors import ToolpathError
+from camtool.model.shapes import Contour
+from camtool.toolpath import offset as offset_module
+from camtool.toolpath.compensate import compensate
+from camtool.toolpath.offset import offset_all, offset_pieces
+from camtool.toolpath.options import PlanOptions
+from camtool.toolpath.order import nesting
+from tests.toolpath.contours import circle, dumbbell, l_shape, rect
+
+pytestmark = pytest.mark.skipif(not offset_module._FORK, reason="offsets in a child: Linux only")
+
+JOBS = [(circle(0, 0, 5), 1.0), (rect(0, 0, 10, 5), 0.5), (l_shape(), -1.0), (dumbbell(), -1.2)]
+
+
+def _same(a: list[Contour] | ToolpathError, b: list[Contour] | ToolpathError) -> bool:
+    """Bit for bit: the same pieces (every float) or the same error message."""
+    if isinstance(a, ToolpathError) or isinstance(b, ToolpathError):
+        return str(a) == str(b)
+    return pickle.dumps([p.segments for p in a]) == pickle.dumps([p.segments for p in b])
+
+
+def test_the_child_answers_what_this_process_answers() -> None:
+    here = [offset_pieces(c, a) for c, a in JOBS]
+    there = offset_all(JOBS)
+    assert len(there) == len(JOBS)
+    assert all(_same(x, y) for x, y in zip(here, there, strict=True))
+    assert os.getpid() == os.getpid()  # still this process, whatever the child did
+
+
+def _segfault_on(amount: float) -> Any:
+    real = offset_module._occt_offset
+
+    def occt(contour: Contour, asked: float) -> Any:
+        if asked == amount:
+            os.kill(os.getpid(), signal.SIGSEGV)  # what OCCT did to the whole job
+        return real(contour, asked)
+
+    return occt
+
+
+def test_a_crash_in_the_child_fails_its_job_only(monkeypatch: pytest.MonkeyPatch) -> None:
+    expected = [offset_pieces(c, a) for c, a in JOBS]
+    monkeypatch.setattr(offset_module, "_occt_offset", _segfault_on(0.5))
+    got = offset_all(JOBS)
+    assert len(got) == len(JOBS)
+    crashed = got[1]
+    assert isinstance(crashed, ToolpathError)
+    assert "crashed (SIGSEGV, signal 11)" in str(crashed) and "+0.5 mm" in str(crashed)
+    for k in (0, 2, 3):  # before it, and made by a new child after it
+        assert _same(got[k], expected[k])
+
+
+def test_an_error_in_the_child_comes_back_as_the_error(monkeypatch: pytest.MonkeyPatch) -> None:
+    def refuses(contour: Contour, amount: float) -> Any:
+        raise RuntimeError("StdFail_NotDone")
+
+    monkeypatch.setattr(offset_module, "_occt_offset", refuses)
+    (got,) = offset_all(JOBS[:1])
+    assert isinstance(got, ToolpathError)
+    with pytest.raises(ToolpathError) as here:
+        offset_pieces(*JOBS[0])
+    assert str(got) == str(here.value)
+
+
+def test_an_edge_occt_cannot_measure_is_a_toolpath_error(monkeypatch: pytest.MonkeyPatch) -> None:
+    """OCCT's Standard_ConstructionError measuring an edge escaped as an internal error."""
+
+    def unmeasurable(edge: Any, contour: Contour) -> Any:
+        raise ArithmeticError("Standard_ConstructionError")
+
+    monkeypatch.setattr(offset_module, "_from_edge", unmeasurable)
+    with pytest.raises(ToolpathError, match=r"cannot measure \(ArithmeticError\)"):
+        offset_pieces(*JOBS[0])
+
+
+def test_the_planner_falls_back_where_the_child_crashed(monkeypatch: pytest.MonkeyPatch) -> None:
+    contours = [rect(0, 0, 20, 20), circle(10, 10, 3)]  # a plate with a hole
+    options = PlanOptions(offset="outside", tool_diameter=2.0, feed_mm_min=100.0)
+    calm = compensate(contours, nesting(contours), options)
+    assert not any(f.kind == "offset-fallback" for f in calm.findings)
+    monkeypatch.setattr(offset_module, "_occt_offset", _segfault_on(-1.0))  # the hole's
+    stage = compensate(contours, nesting(contours), options)
+    (fallback,) = [f for f in stage.findings if f.kind == "offset-fallback"]
+    assert "crashed (SIGSEGV, signal 11)" in fallback.message
+    assert "used shapely's buffer" in fallback.message
+    plate = [c for c in stage.cuts if c.group == 0]
+    assert [c.path.segments for c in plate] == [c.path.segments for c in calm.cuts if c.group == 0]
+    assert any(c.group == 1 for c in stage.cuts)  # the hole is still cut
+
+
+CORPUS = Path(__file__).resolve().parents[2] / ".corpus"
+TANGO = CORPUS / "pkg" / "tango-icon-theme" / "usr" / "share" / "icons" / "Tango" / "scalable"
+
+
+@pytest.mark.parametrize("icon", ["actions/filequickprint.svg", "actions/mail-mark-junk.svg"])
+def test_tango_icons_that_crashed_opencascade_are_posted(icon: str, tmp_path: Path) -> None:
+    source = TANGO / icon
+    if not source.exists():
+        pytest.skip("the corpus is not fetched (tests/corpus/fetch_corpus.py)")
+    out = tmp_path / "icon.gcode"
+    done = subprocess.run(
+        [
+            *(sys.executable, "-m", "camtool", "post", str(source), "--target", "grbl"),
+            *("--tool-diameter", "1", "--offset", "outside", "-o", str(out)),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "crashed (SIGSEGV, signal 11)" in done.stderr
+    assert out.read_text().count("\n") > 100
