@@ -57,7 +57,7 @@ import dataclasses
 import math
 from collections.abc import Mapping
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from camtool.model.errors import DialectError, ParseError
 from camtool.model.machine import Machine
@@ -83,6 +83,9 @@ from camtool.post.base import (
 )
 from camtool.post.wordaddress_read import BlockReader, ControllerRefusal
 from camtool.post.wordaddress_spec import WordAddressSpec, load_spec
+
+if TYPE_CHECKING:
+    from camtool.post.arccheck import ArcPiece
 
 
 class WordAddressPost(PostProcessor):
@@ -571,12 +574,62 @@ class BlockWriter(WriterState[str]):
                 exact_start=piece.start,
             )
         except DialectError as exc:
-            if piece.radius > 10 * quantum:
+            if piece.radius <= 10 * quantum:
+                return [(piece.end, None)]
+            equalised = self._conform_equalised(piece, quantum)
+            if equalised is None:
                 raise DialectError(f"{self.where()}: {exc}") from exc
-            return [(piece.end, None)]
+            out = equalised
         if not out:
             self.counts["tiny-arc"] += 1  # rounds away to nothing within a quantum
         return [(p.end, p.centre) for p in out]
+
+    def _conform_equalised(self, piece: Arc, quantum: float) -> list[ArcPiece] | None:
+        """``piece`` conformed about the centre that puts both its ends at one radius, or None.
+
+        For an arc the arc check refused whose ends lie at different distances from its
+        centre (a joint snapped within ``--chain-tolerance`` keeps an arc's centre, so its
+        start can move off its circle: LinuxCNC's ``conv_slot_l.svg`` gave an arc 3.4 µm
+        apart in radius, which no split could write). The centre moves to the nearest
+        point of its ends' perpendicular bisector; the warning gives both radii and the
+        move. Only when the radii differ by no more than the controller's own absolute
+        tolerance (GRBL 0.005 mm, LinuxCNC 0.028 mm: :func:`~camtool.post.arccheck.
+        max_difference` at radius 0), numbers it would itself take as one arc; ``None``
+        otherwise, or when that does not help (the ends meet, the check still fails). Only
+        arcs refused before take this path: every other arc is written as before.
+        """
+        from camtool.post.arccheck import conform_arc, max_difference
+
+        (sx, sy), (ex, ey), (cx, cy) = piece.start, piece.end, piece.centre
+        dx, dy = ex - sx, ey - sy
+        chord = math.hypot(dx, dy)
+        r0, r1 = math.hypot(sx - cx, sy - cy), math.hypot(ex - cx, ey - cy)
+        if chord == 0.0 or r0 == r1 or abs(r1 - r0) > max_difference(self.spec.arc_check, 0.0):
+            return None  # beyond the controller's own absolute tolerance: refused as before
+        nx, ny = -dy / chord, dx / chord
+        mx, my = (sx + ex) / 2.0, (sy + ey) / 2.0
+        along = (cx - mx) * nx + (cy - my) * ny
+        centre = (mx + along * nx, my + along * ny)
+        try:
+            out = conform_arc(
+                self.written,
+                piece.end,
+                centre,
+                piece.clockwise,
+                rule=self.spec.arc_check,
+                quantum_mm=quantum,
+                exact_start=piece.start,
+            )
+        except DialectError:
+            return None
+        moved = math.dist(centre, piece.centre)
+        self.warn(
+            f"{self.where()}: the arc starts {r0:.4f} mm and ends {r1:.4f} mm from its centre "
+            f"({abs(r1 - r0) * 1000:.1f} µm apart), more than {self.spec.name}'s arc check "
+            f"takes; written about the centre {moved * 1000:.1f} µm away that puts both ends "
+            f"{math.dist(centre, piece.end):.4f} mm from it"
+        )
+        return out
 
     def _arc_block(
         self,

@@ -1,0 +1,91 @@
+"""An arc whose ends lie at slightly different radii is written about an equalised centre.
+
+A joint snapped within ``--chain-tolerance`` keeps an arc's centre (geometry.chain), so
+its start can leave its circle: LinuxCNC's ``qtplasmac/images/conv_slot_l.svg`` gave an
+arc starting 7.80178 mm and ending 7.80521 mm from its centre, which the arc check
+refused even split eleven times ("write more decimals"): the job could not be posted.
+Within the controller's own absolute tolerance the writer now moves the centre onto the
+perpendicular bisector of the ends and says so; larger differences are still refused.
+Expected values come from the geometry (GRBL's and LinuxCNC's radius rules, the
+bisector), not from camtool's output.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+import pytest
+
+from camtool.model.errors import DialectError
+from camtool.model.program import ArcMove, Program, Rapid
+from camtool.post.registry import load_target
+
+START = (41.18972952738987, 28.688510821938745)
+END = (32.69833426692413, 35.14707873195296)
+CENTRE = (33.49796123917177, 27.38293886750414)  # 7.80178 mm from START, 7.80521 from END
+
+
+def _program(centre: tuple[float, float]) -> Program:
+    return Program(
+        (
+            Rapid(*START),
+            ArcMove(*END, *centre, False, 300.0, contour=1),
+        ),
+        origin=(0.0, 0.0),
+    )
+
+
+def _arc_words(code: str) -> list[dict[str, float]]:
+    """The X, Y, I, J of each G2/G3 block (mm, I/J relative: both targets' default)."""
+    out = []
+    for line in code.splitlines():
+        if re.match(r"G[23]\b", line):
+            out.append({k: float(v) for k, v in re.findall(r"([XYIJ])(-?[\d.]+)", line)})
+    return out
+
+
+@pytest.mark.parametrize("name", ["grbl", "linuxcnc"])
+def test_the_slot_arc_is_written_within_the_controllers_radius_rule(name: str) -> None:
+    target = load_target(name)
+    result = target.emit(_program(CENTRE))
+    (warning,) = [w for w in result.warnings if "from its centre" in w]
+    assert "7.8018 mm" in warning and "7.8052 mm" in warning and "3.4 µm apart" in warning
+    x, y = round(START[0], 3), round(START[1], 3)
+    blocks = _arc_words(result.code)
+    assert blocks
+    for words in blocks:  # each block as the controller reads it, from where the last ended
+        cx, cy = x + words["I"], y + words["J"]
+        r0 = math.hypot(x - cx, y - cy)
+        x, y = words.get("X", x), words.get("Y", y)
+        r1 = math.hypot(x - cx, y - cy)
+        assert abs(r1 - r0) <= 0.005  # GRBL's absolute rule (LinuxCNC's is looser)
+        # the written centre lies near the bisector of the exact ends: at their mean radius
+        mean = (math.dist(START, CENTRE) + math.dist(END, CENTRE)) / 2.0
+        assert abs(math.dist((cx, cy), END) - mean) < 0.003
+    assert (x, y) == (round(END[0], 3), round(END[1], 3))
+
+
+def test_a_consistent_arc_takes_no_new_path() -> None:
+    """The same arc with its centre on the bisector: written without the warning."""
+    mx, my = (START[0] + END[0]) / 2, (START[1] + END[1]) / 2
+    dx, dy = END[0] - START[0], END[1] - START[1]
+    n = math.hypot(dx, dy)
+    nx, ny = -dy / n, dx / n
+    along = (CENTRE[0] - mx) * nx + (CENTRE[1] - my) * ny
+    result = load_target("grbl").emit(_program((mx + along * nx, my + along * ny)))
+    assert not [w for w in result.warnings if "from its centre" in w]
+
+
+def test_radii_further_apart_than_the_controller_takes_are_still_refused() -> None:
+    """Over 7.5 µm apart: beyond GRBL's absolute 5 µm, so the old refusal stands."""
+    # move the centre 8 µm along the chord, towards the start
+    ux, uy = (END[0] - START[0]), (END[1] - START[1])
+    n = math.hypot(ux, uy)
+    mx, my = (START[0] + END[0]) / 2, (START[1] + END[1]) / 2
+    nx, ny = -uy / n, ux / n
+    along = (CENTRE[0] - mx) * nx + (CENTRE[1] - my) * ny
+    centre = (mx + along * nx - 0.008 * ux / n, my + along * ny - 0.008 * uy / n)
+    assert abs(math.dist(START, centre) - math.dist(END, centre)) > 0.0075
+    with pytest.raises(DialectError, match="cannot be written for grbl"):
+        load_target("grbl").emit(_program(centre))
