@@ -35,6 +35,7 @@ reported when its mean width (2·area / perimeter) exceeds ``tolerance``.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -102,7 +103,7 @@ def compensate(contours: Sequence[Contour], nest: Nesting, options: PlanOptions)
     findings: list[Finding] = []
     vanished: list[Finding] = []
     open_count = 0
-    made_by_occt = _offsets(contours, nest, options)
+    jobs = _offset_jobs(contours, nest, options)
     for i, contour in enumerate(contours):
         if not contour.closed:
             open_count += 1
@@ -111,7 +112,7 @@ def compensate(contours: Sequence[Contour], nest: Nesting, options: PlanOptions)
         elif options.offset == "on":
             cuts.append(_on_line(contour, i, nest, options))
         else:
-            made, found = _compensated(contour, i, nest, options, made_by_occt.get(i))
+            made, found = _compensated(contour, i, nest, options, jobs[i])
             cuts.extend(made)
             findings.extend(found)
             vanished.extend(f for f in found if f.kind == "offset-vanished")
@@ -146,59 +147,60 @@ def _on_line(contour: Contour, index: int, nest: Nesting, options: PlanOptions) 
     )
 
 
-def _offsets(
-    contours: Sequence[Contour], nest: Nesting, options: PlanOptions
-) -> dict[int, list[Contour] | ToolpathError]:
-    """OpenCASCADE's offset of each closed contour to the tool's side, by contour index.
+@dataclass(frozen=True)
+class _OffsetJob:
+    """A closed contour's offset to the tool's side.
 
-    All made at once by :func:`~camtool.toolpath.offset.offset_all` (in a child process
-    that a crash of OpenCASCADE cannot take this one down with); a zero radius needs none.
+    The side, the contour oriented for it, the signed offset (mm) and OpenCASCADE's
+    answer (``None`` for a zero radius: nothing to ask).
+    """
+
+    side: _Side
+    drawn: Contour
+    amount: float
+    occt: list[Contour] | ToolpathError | None = None
+
+
+def _offset_jobs(
+    contours: Sequence[Contour], nest: Nesting, options: PlanOptions
+) -> dict[int, _OffsetJob]:
+    """The offset of each closed contour to the tool's side, by contour index.
+
+    OpenCASCADE's answers are all made at once by
+    :func:`~camtool.toolpath.offset.offset_all` (in a child process that a crash of
+    OpenCASCADE cannot take this one down with); a zero radius needs none, and
+    ``--offset on`` no job at all.
     """
     from camtool.toolpath.offset import offset_all
 
-    if options.offset == "on" or options.radius == 0:
+    if options.offset == "on":
         return {}
-    jobs = {
-        i: _offset_job(contour, i, nest, options)
-        for i, contour in enumerate(contours)
-        if contour.closed
-    }
-    return dict(zip(jobs, offset_all(list(jobs.values())), strict=True))
-
-
-def _offset_job(
-    contour: Contour, index: int, nest: Nesting, options: PlanOptions
-) -> tuple[Contour, float]:
-    """The contour oriented for the tool's side and the offset that puts the tool there, mm."""
-    side = _side(index, nest, options)
     r = options.radius
-    return _oriented(contour, side), -r if side.inside else r
-
-
-def _side(index: int, nest: Nesting, options: PlanOptions) -> _Side:
-    return _Side(
-        tool_inside(nest.depth(index), options.offset), options.direction != "conventional"
-    )
+    jobs: dict[int, _OffsetJob] = {}
+    for i, contour in enumerate(contours):
+        if contour.closed:
+            depth = nest.depth(i)
+            side = _Side(tool_inside(depth, options.offset), options.direction != "conventional")
+            jobs[i] = _OffsetJob(side, _oriented(contour, side), -r if side.inside else r)
+    if r == 0:
+        return jobs
+    answers = offset_all([(job.drawn, job.amount) for job in jobs.values()])
+    return {
+        i: dataclasses.replace(job, occt=occt)
+        for (i, job), occt in zip(jobs.items(), answers, strict=True)
+    }
 
 
 def _compensated(
-    contour: Contour,
-    index: int,
-    nest: Nesting,
-    options: PlanOptions,
-    occt: list[Contour] | ToolpathError | None = None,
+    contour: Contour, index: int, nest: Nesting, options: PlanOptions, job: _OffsetJob
 ) -> tuple[list[Cut], list[Finding]]:
-    """The cuts of one closed contour offset to the tool's side, and what was found.
-
-    ``occt``: OpenCASCADE's offset when it was made already (:func:`_offsets`).
-    """
+    """The cuts of one closed contour offset to the tool's side (``job``), and what was found."""
     from camtool.toolpath.offset import offset_checked
 
     depth = nest.depth(index)
-    side = _side(index, nest, options)
-    drawn, amount = _offset_job(contour, index, nest, options)
+    side, drawn = job.side, job.drawn
     r = options.radius
-    result = offset_checked(drawn, amount, options.tolerance, occt=occt)
+    result = offset_checked(drawn, job.amount, options.tolerance, occt=job.occt)
     findings: list[Finding] = []
     if not result.pieces:
         return [], [_vanished(contour, options)]
