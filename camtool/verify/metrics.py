@@ -1794,13 +1794,8 @@ def against_drawing(
         overcut: measure the overcut (``False``: ``overcut_um`` is 0, for a caller that
             reads only the other figures, as the error budget does).
     """
-    if len(points) < 2:
-        return Against(0.0, 0.0, (0.0, 0.0), 0.0, 0)
-    every = _cut_every(points[: min(len(points), CUT_HEAD_ROWS)], resolution_mm)
-    keep = _thin_index(len(points), _cut_limit(len(points), every), runs)
-    thin = ThinTrace(points[keep], None if runs is None else runs[keep], len(points))
     return against_thinned(
-        thin,
+        thin_cutting(points, runs, resolution_mm),
         drawing,
         tool_radius_mm,
         spacing_mm=spacing_mm,
@@ -1808,6 +1803,29 @@ def against_drawing(
         findings=findings,
         overcut=overcut,
     )
+
+
+def thin_cutting(
+    points: FloatArray, runs: IntArray | None, resolution_mm: float = AGAINST_RESOLUTION_MM
+) -> ThinTrace:
+    """The cutting trace thinned as :func:`against_drawing` compares it with the drawing.
+
+    Every k-th row (about ``resolution_mm`` apart, read from the first
+    :data:`CUT_HEAD_ROWS` rows; at most :data:`CUT_MAX_ROWS` of them), each run's first
+    and last row and the last row (:func:`_thin_index`). :class:`CuttingStream` gives
+    the same from a trace read chunk by chunk.
+
+    Args:
+        points: ``(N, 2)`` cutting rows, mm.
+        runs: ``(N,)`` the run (cut between rapids) of each row, or ``None`` (one run).
+        resolution_mm: the spacing aimed at, mm.
+    """
+    n = len(points)
+    if n < 2:
+        return ThinTrace(points, runs, n)
+    every = _cut_every(points[: min(n, CUT_HEAD_ROWS)], resolution_mm)
+    keep = _thin_index(n, _cut_limit(n, every), runs)
+    return ThinTrace(points[keep], None if runs is None else runs[keep], n)
 
 
 CUT_HEAD_ROWS = 2000
@@ -1883,7 +1901,7 @@ class CuttingStream:
         if not len(cut):
             return
         if self.k:
-            self._take(cut, runs, final=False)
+            self._take(cut, runs)
             return
         self.head.append((cut, runs))
         self.head_rows += len(cut)
@@ -1896,16 +1914,16 @@ class CuttingStream:
         runs = np.concatenate([r for _, r in self.head]) if self.head else np.zeros(0, np.int64)
         self.head = []
         every = _cut_every(cut[:CUT_HEAD_ROWS], self.resolution_mm)
-        self.k = max(1, math.ceil(self.n / _cut_limit(self.n, every))) if self.n else 1
+        self.k = _thin_step(self.n, _cut_limit(self.n, every)) if self.n else 1
         if len(cut):
-            self._take(cut, runs, final=False)
+            self._take(cut, runs)
 
-    def _take(self, cut: FloatArray, runs: IntArray, *, final: bool) -> None:
+    def _take(self, cut: FloatArray, runs: IntArray) -> None:
         """Keep what :func:`_thin_index` keeps of these consecutive cutting rows.
 
         Each row is kept when its index is a multiple of k, is the last, or starts or
-        ends a run; the last row given waits (``carry``) for the row after it, unless
-        ``final``.
+        ends a run (:func:`_picked`); the last row given waits (``carry``) for the row
+        after it, which says whether a run ends there.
         """
         first = self.seen
         if self.carry is not None:
@@ -1913,16 +1931,11 @@ class CuttingStream:
             cut = np.concatenate([point, cut])
             runs = np.concatenate([run, runs])
             first -= 1
-        index = np.arange(first, first + len(cut))
-        picked = (index % self.k == 0) | (index == self.n - 1)
-        change = runs[1:] != runs[:-1]
-        picked[1:] |= change
-        picked[:-1] |= change
+        picked = _picked(first, len(cut), self.k, self.n, runs)
         if self.carry is not None:
             picked[0] |= picked_before
-        decided = len(cut) if final else len(cut) - 1
-        self.kept.append((cut[:decided][picked[:decided]], runs[:decided][picked[:decided]]))
-        self.carry = None if final else (cut[-1:], runs[-1:], bool(picked[-1]))
+        self.kept.append((cut[:-1][picked[:-1]], runs[:-1][picked[:-1]]))
+        self.carry = (cut[-1:], runs[-1:], bool(picked[-1]))
         self.seen = first + len(cut)
 
     def finish(self) -> ThinTrace:
@@ -1933,11 +1946,10 @@ class CuttingStream:
         """
         if not self.k:
             self._start()
-        if self.carry is not None:
+        if self.carry is not None:  # the last cutting row (n − 1): always kept
             point, run, _ = self.carry
             self.carry = None
-            self.seen -= 1
-            self._take(point, run, final=True)
+            self.kept.append((point, run))
         if self.seen != self.n:
             raise RuntimeError(f"{self.seen} cutting rows streamed, {self.n} announced")
         points = np.concatenate([p for p, _ in self.kept]) if self.kept else np.zeros((0, 2))
@@ -2241,13 +2253,27 @@ def _thin_index(n: int, limit: int, runs: IntArray | None) -> IntArray:
 
     Sorted, each once (a mask: what ``np.unique`` of the picks gives, without sorting).
     """
-    k = max(1, math.ceil(n / limit))
-    picked = np.zeros(n, dtype=bool)
-    picked[::k] = True
-    if n > 0:
-        picked[n - 1] = True
-    if runs is not None and n > 1:
-        change = np.flatnonzero(runs[1:] != runs[:-1])
-        picked[change] = True
-        picked[change + 1] = True
-    return np.flatnonzero(picked).astype(np.int64)
+    return np.flatnonzero(_picked(0, n, _thin_step(n, limit), n, runs)).astype(np.int64)
+
+
+def _thin_step(n: int, limit: int) -> int:
+    """The k of :func:`_thin_index`: every k-th of ``n`` rows keeps at most ``limit``."""
+    return max(1, math.ceil(n / limit))
+
+
+def _picked(first: int, count: int, k: int, n: int, runs: IntArray | None) -> npt.NDArray[np.bool_]:
+    """Which of the rows ``first .. first + count − 1`` (of ``n``) :func:`_thin_index` keeps.
+
+    Every k-th row, the last one, and where ``runs`` (the run of each of these rows,
+    ``None``: one run) changes the rows on both sides. A caller that gives a part of the
+    rows (:class:`CuttingStream`) decides its last row with the part after it.
+    """
+    picked = np.zeros(count, dtype=bool)
+    picked[(-first) % k :: k] = True
+    if 0 <= n - 1 - first < count:
+        picked[n - 1 - first] = True
+    if runs is not None and count > 1:
+        change = runs[1:] != runs[:-1]
+        picked[1:] |= change
+        picked[:-1] |= change
+    return picked

@@ -59,11 +59,11 @@ from camtool.verify.metrics import (
     FindingLike,
     ThinTrace,
     TraceStream,
-    against_drawing,
     against_thinned,
     along_path,
     deviation,
     measure_contours,
+    thin_cutting,
 )
 from camtool.verify.motion import StepTrace, library
 from camtool.verify.simulate import (
@@ -326,14 +326,8 @@ def verify_program(
     if streamed is not None:
         dev, along, contours, thin = streamed
         compared = None
-        if thin is not None and compared_with is not None:
-            compared = against_thinned(
-                thin,
-                compared_with,
-                tool_diameter / 2.0,
-                nominal=_nominal_lines(program) if findings else (),
-                findings=findings,
-            )
+        if thin is not None and compared_with is not None:  # a thinned trace: a drawing
+            compared = _compare(program, thin, compared_with, tool_diameter, findings)
     else:
         dev, along, contours, compared = _measure(
             program, trace, compared_with, tool_diameter, findings
@@ -435,7 +429,7 @@ def _cutting_stream(program: Program, block_start: np.ndarray) -> CuttingStream:
 
     The cutting rows are those of the moves that are not rapids (as :func:`_cutting_rows`).
     """
-    rapid = np.asarray([isinstance(m, Rapid) for m in program.moves], dtype=bool)
+    rapid = _rapids(program)
     rows = int(np.diff(block_start)[~rapid].sum()) if len(rapid) else 0
     return CuttingStream(rapid, rows, AGAINST_RESOLUTION_MM)
 
@@ -476,30 +470,51 @@ def _measure(
     contours = tuple(measure_contours(points, trace.block_start, trace.start_mm, program))
     compared = None
     if against is not None:
-        cut, runs = _cutting_rows(program, trace)
-        compared = against_drawing(
-            cut,
-            against,
-            tool_diameter / 2.0,
-            runs=runs,
-            nominal=_nominal_lines(program) if findings else (),
-            findings=findings,
-            overcut=overcut,
-        )
+        thin = thin_cutting(*_cutting_rows(program, trace))
+        compared = _compare(program, thin, against, tool_diameter, findings, overcut=overcut)
     return dev, along, contours, compared
+
+
+def _compare(
+    program: Program,
+    thin: ThinTrace,
+    against: Drawing,
+    tool_diameter: float,
+    findings: Sequence[FindingLike],
+    *,
+    overcut: bool = True,
+) -> Against:
+    """The machined edge of ``program``'s thinned cutting trace against the drawing.
+
+    The one call of :func:`~camtool.verify.metrics.against_thinned` for a whole trace
+    (:func:`_measure`) and a streamed one (:func:`_simulate_big`).
+    """
+    return against_thinned(
+        thin,
+        against,
+        tool_diameter / 2.0,
+        nominal=_nominal_lines(program) if findings else (),
+        findings=findings,
+        overcut=overcut,
+    )
+
+
+def _rapids(program: Program) -> np.ndarray:
+    """``(B,)`` bool: which moves of ``program`` are rapids (their rows do not cut)."""
+    return np.asarray([isinstance(m, Rapid) for m in program.moves], dtype=bool)
 
 
 def _cutting_rows(program: Program, trace: StepTrace) -> tuple[np.ndarray, np.ndarray]:
     """The trace's cutting rows ``(N, 2)`` mm and the id of each one's run between rapids."""
     points, blocks = trace.carriage_mm, trace.block_of_row
-    rapid = np.asarray([isinstance(m, Rapid) for m in program.moves], dtype=bool)
+    rapid = _rapids(program)
     cutting = ~rapid[blocks] if len(blocks) else np.zeros(0, dtype=bool)
     runs = np.cumsum(~cutting)[cutting]  # a new id after every rapid row
     return points[cutting], runs
 
 
 def _same_against(v: Verification, program: Program, trace: StepTrace) -> bool:
-    """Whether :func:`against_drawing` of ``trace`` would get exactly ``v``'s inputs.
+    """Whether the drawing comparison of ``trace`` (:func:`_compare`) gets exactly ``v``'s inputs.
 
     The same cutting rows, the same runs and (with findings) the same programmed path:
     then its figures are ``v.against``'s, bit for bit, and need not be measured again
