@@ -1998,9 +1998,10 @@ def against_thinned(
             )
     if main.all():  # no feature apart: the arrays themselves, not copies
         kept, kept_at = off, samples
+    elif main.any():
+        kept, kept_at = off[main], samples[main]
     else:
-        kept = off[main] if main.any() else np.zeros(1)
-        kept_at = samples[main] if main.any() else np.zeros((1, 2))
+        kept, kept_at = np.zeros(1), np.zeros((1, 2))
     worst = int(np.argmax(np.abs(kept)))
     overcut_um = 0.0
     if overcut and tool_radius_mm > 0:
@@ -2219,13 +2220,18 @@ def _sample_drawing_now(drawing: Drawing, spacing_mm: float) -> tuple[FloatArray
 
 def _contour_samples(segments: tuple[Segment, ...], spacing_mm: float) -> int:
     """How many points :func:`_sample_contour` gives for ``segments``."""
-    return sum(max(1, math.ceil(seg.length / spacing_mm)) for seg in segments) + 1
+    return sum(_segment_samples(seg, spacing_mm) for seg in segments) + 1
+
+
+def _segment_samples(seg: Segment, spacing_mm: float) -> int:
+    """Points :func:`_sample_contour` takes along ``seg`` (its end is the next one's start)."""
+    return max(1, math.ceil(seg.length / spacing_mm))
 
 
 def _sample_contour(segments: tuple[Segment, ...], spacing_mm: float) -> FloatArray:
     pts: list[Point] = []
     for seg in segments:
-        n = max(1, math.ceil(seg.length / spacing_mm))
+        n = _segment_samples(seg, spacing_mm)
         if isinstance(seg, Line):
             (x0, y0), (x1, y1) = seg.start, seg.end
             pts.extend((x0 + (x1 - x0) * k / n, y0 + (y1 - y0) * k / n) for k in range(n))
