@@ -14,12 +14,16 @@ from __future__ import annotations
 
 import math
 import re
+import subprocess
+import sys
+from pathlib import Path
 
 import pytest
 
 from camtool.model.errors import DialectError
 from camtool.model.program import ArcMove, Program, Rapid
 from camtool.post.registry import load_target
+from tests.corpus.conftest import CORPUS, FETCH_HINT, load_manifest
 
 START = (41.18972952738987, 28.688510821938745)
 END = (32.69833426692413, 35.14707873195296)
@@ -89,3 +93,27 @@ def test_radii_further_apart_than_the_controller_takes_are_still_refused() -> No
     assert abs(math.dist(START, centre) - math.dist(END, centre)) > 0.0075
     with pytest.raises(DialectError, match="cannot be written for grbl"):
         load_target("grbl").emit(_program(centre))
+
+
+@pytest.mark.parametrize("name", ["grbl", "linuxcnc"])
+def test_the_real_slot_drawing_posts_and_reads_back(name: str, tmp_path: Path) -> None:
+    """LinuxCNC's own qtplasmac drawing, as a user posts it, then verified as code."""
+    source = CORPUS / "pkg/linuxcnc/usr/share/qtvcp/images/qtplasmac/images/conv_slot_l.svg"
+    if load_manifest() is None or not source.exists():
+        pytest.skip(FETCH_HINT)
+    out = tmp_path / "slot.ngc"
+    posted = subprocess.run(
+        [sys.executable, "-m", "camtool", "post", str(source), "-t", name, "-o", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert posted.returncode == 0, posted.stderr[-2000:]
+    assert "(3.4 µm apart)" in posted.stderr
+    verified = subprocess.run(
+        [sys.executable, "-m", "camtool", "verify", str(out), "-t", name, "--no-budget"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert verified.returncode == 0, verified.stderr[-2000:]  # the controller's arc rule

@@ -27,6 +27,7 @@ from camtool.toolpath.compensate import compensate
 from camtool.toolpath.offset import offset_all, offset_pieces
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.order import nesting
+from tests.corpus.conftest import CORPUS, FETCH_HINT, load_manifest
 from tests.toolpath.contours import circle, dumbbell, l_shape, rect
 
 pytestmark = pytest.mark.skipif(not offset_module._FORK, reason="offsets in a child: Linux only")
@@ -41,12 +42,25 @@ def _same(a: list[Contour] | ToolpathError, b: list[Contour] | ToolpathError) ->
     return pickle.dumps([p.segments for p in a]) == pickle.dumps([p.segments for p in b])
 
 
-def test_the_child_answers_what_this_process_answers() -> None:
+def test_the_child_answers_what_this_process_answers(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
     here = [offset_pieces(c, a) for c, a in JOBS]
+    real = offset_module._occt_offset
+    made_by = tmp_path / "pids"
+
+    def occt(contour: Contour, amount: float) -> Any:  # notes which process made it
+        with made_by.open("a") as note:
+            note.write(f"{os.getpid()}\n")
+        return real(contour, amount)
+
+    monkeypatch.setattr(offset_module, "_occt_offset", occt)
     there = offset_all(JOBS)
     assert len(there) == len(JOBS)
     assert all(_same(x, y) for x, y in zip(here, there, strict=True))
-    assert os.getpid() == os.getpid()  # still this process, whatever the child did
+    pids = made_by.read_text().split()
+    assert len(pids) == len(JOBS) and len(set(pids)) == 1  # one child made them all
+    assert pids[0] != str(os.getpid())  # and it was not this process
 
 
 def _segfault_on(amount: float) -> Any:
@@ -110,15 +124,14 @@ def test_the_planner_falls_back_where_the_child_crashed(monkeypatch: pytest.Monk
     assert any(c.group == 1 for c in stage.cuts)  # the hole is still cut
 
 
-CORPUS = Path(__file__).resolve().parents[2] / ".corpus"
 TANGO = CORPUS / "pkg" / "tango-icon-theme" / "usr" / "share" / "icons" / "Tango" / "scalable"
 
 
 @pytest.mark.parametrize("icon", ["actions/filequickprint.svg", "actions/mail-mark-junk.svg"])
 def test_tango_icons_that_crashed_opencascade_are_posted(icon: str, tmp_path: Path) -> None:
     source = TANGO / icon
-    if not source.exists():
-        pytest.skip("the corpus is not fetched (tests/corpus/fetch_corpus.py)")
+    if load_manifest() is None or not source.exists():
+        pytest.skip(FETCH_HINT)
     out = tmp_path / "icon.gcode"
     done = subprocess.run(
         [
