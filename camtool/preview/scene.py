@@ -225,8 +225,7 @@ def place_labels(
     about its own size, else it is hidden. ``taken`` holds boxes already used
     (by other labels); the placed labels' boxes are added to it.
     """
-    if len(labels) > limit:
-        labels = [labels[i] for i in kept_indices(len(labels), limit)]
+    labels = [labels[i] for i in kept_indices(len(labels), limit)]
     boxes = taken if taken is not None else []
     placed: list[Text] = []
     for label in labels:
