@@ -13,8 +13,8 @@ the same place as without workers.
 Workers are started by ``fork`` (Linux; nothing to re-import, ~10 ms each) and only for at
 least :data:`MIN_CURVES` keys, so small files never pay for a pool; where ``fork`` is not
 available, or the pool cannot start or breaks, or this process is itself a worker (``camtool
-batch``, Dask: the cores are busy with other files already), every fit runs here, one after
-the other.
+batch``, Dask: :func:`camtool.model.cores.in_worker`), every fit runs here, one after the
+other.
 Forking is safe at this point: the importers run before anything starts threads of its own
 (camtool starts none; numba, whose threading layer must not be forked, is not imported on the
 import path; OpenBLAS's idle threads are re-made by its own ``pthread_atfork`` handler).
@@ -23,7 +23,6 @@ import path; OpenBLAS's idle threads are re-made by its own ``pthread_atfork`` h
 from __future__ import annotations
 
 import multiprocessing
-import os
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from typing import Any, TypeAlias
@@ -37,9 +36,10 @@ from camtool.geometry.curves import (
     quadratic_bezier,
     quadratic_bezier_points,
 )
+from camtool.model.cores import default_jobs, in_worker
 from camtool.model.shapes import Arc, Line, Segment
 
-__all__ = ["MIN_CURVES", "CurveKey", "default_jobs", "fit_key", "fit_many"]
+__all__ = ["MIN_CURVES", "CurveKey", "fit_key", "fit_many"]
 
 CurveKey: TypeAlias = tuple[str, tuple[Any, ...]]
 """A curve by kind and exact arguments: ``("cubic", (p0, p1, p2, p3))``, ``("quadratic",
@@ -79,14 +79,6 @@ def fit_key(key: CurveKey, tolerance: float) -> list[Segment]:
     return fit_curve(point_at, tangent_at, 0.0, 1.0, tolerance, points_at=points_at)
 
 
-def default_jobs() -> int:
-    """The CPUs this process may run on (``os.sched_getaffinity``; else ``os.cpu_count()``)."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:  # pragma: no cover - not on Linux
-        return max(1, os.cpu_count() or 1)
-
-
 def fit_many(
     keys: Sequence[CurveKey],
     tolerance: float,
@@ -99,8 +91,8 @@ def fit_many(
     Args:
         keys: the curves.
         tolerance: mm (> 0), as for :func:`fit_key`.
-        jobs: worker processes; ``None``: :func:`default_jobs`. With 1, or fewer than
-            :data:`MIN_CURVES` keys, every fit runs in this process.
+        jobs: worker processes; ``None``: :func:`~camtool.model.cores.default_jobs`. With
+            1, or fewer than :data:`MIN_CURVES` keys, every fit runs in this process.
         done: called in this process with the number of keys fitted so far, as they
             come in (after each fit here, after each worker's chunk of keys with a pool);
             for a progress report, it does not change the fits.
@@ -110,7 +102,7 @@ def fit_many(
     """
     workers = default_jobs() if jobs is None else max(1, jobs)
     workers = min(workers, -(-len(keys) // _CHUNK))
-    if workers > 1 and len(keys) >= MIN_CURVES and not _in_worker():
+    if workers > 1 and len(keys) >= MIN_CURVES and not in_worker():
         packed = _in_pool(keys, tolerance, workers, done)
         if packed is not None:
             return [None if p is None else _unpack(p) for p in packed]
@@ -120,16 +112,6 @@ def fit_many(
         if done is not None:
             done(len(fits))
     return fits
-
-
-def _in_worker() -> bool:
-    """Whether this process is itself a worker (``camtool batch``'s pool, a Dask worker).
-
-    A batch already keeps the cores busy with one file per worker, and a daemonic process
-    (Dask's) may not start children: there the fits run in the worker, one after the other.
-    """
-    current = multiprocessing.current_process()
-    return bool(current.daemon) or multiprocessing.parent_process() is not None
 
 
 def _in_pool(

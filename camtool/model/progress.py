@@ -8,7 +8,8 @@ stderr lines, and only for a job still running after a couple of seconds
 
 A callback must be cheap and must not raise: it may be called once per shape or per
 chunk of curve fits (thousands of times on a big drawing); it is called in the calling
-process only (never from a worker of :mod:`camtool.geometry.fitpool`).
+process only (never from a worker of :mod:`camtool.geometry.fitpool` or
+:func:`camtool.model.cores.fork_map`).
 """
 
 from __future__ import annotations
@@ -23,7 +24,8 @@ reading the file (``total``: its drawn shapes, once counted), fitting arcs to it
 (``total``: distinct curves), making the contours of the shapes (``total``: shapes),
 planning the toolpath (``total``: contours), writing the code (``total``: moves of the
 program), verifying it (``total``: blocks of code) and its error budget (``total``: the
-error sources re-simulated one at a time; ``name``: the one being re-simulated)."""
+error sources re-simulated, in forked workers when there are cores for them; ``name``: the
+next source, in order, whose figures are not in yet)."""
 
 
 @dataclass(frozen=True)

@@ -131,4 +131,4 @@ def test_a_worker_process_fits_serially_and_the_same(monkeypatch: pytest.MonkeyP
     got = queue.get(timeout=120)
     child.join(timeout=60)
     assert got == repr([fit_key(k, 0.01) for k in keys])
-    assert not fitpool._in_worker()
+    assert not fitpool.in_worker()

@@ -288,3 +288,37 @@ def test_measure_budget_tells_nothing_when_the_budget_is_off() -> None:
     v = verify_program(_circle10(), load_target("flashcut").machine, name="fc", budget=False)
     assert v.measure_budget(told.append).skipped is not None
     assert told == []
+
+
+def test_the_budget_made_in_workers_is_the_one_made_here(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    """The sources re-simulated in forked workers, one per core, give the same budget.
+
+    The reference is the budget made in this process, one source after the other (one
+    job); the workers' pids show the five sources were re-simulated elsewhere.
+    """
+    import os
+
+    from camtool.model import cores
+    from camtool.verify import verifier
+
+    if not cores.FORK:
+        pytest.skip("forked workers: Linux only")
+    machine = load_target("flashcut").machine
+    monkeypatch.setattr(cores, "default_jobs", lambda: 1)
+    here = verify_program(_circle10(), machine, name="flashcut").error_budget
+    pids = tmp_path / "pids"
+    measure = verifier._without
+
+    def noted(v: verifier.Verification, name: str) -> object:
+        with pids.open("a") as note:
+            note.write(f"{os.getpid()}\n")
+        return measure(v, name)
+
+    monkeypatch.setattr(verifier, "_without", noted)
+    monkeypatch.setattr(cores, "default_jobs", lambda: 2)
+    there = verify_program(_circle10(), machine, name="flashcut").error_budget
+    assert there == here and len(here.without) == 5
+    made_by = pids.read_text().split()
+    assert len(made_by) == 5 and str(os.getpid()) not in made_by

@@ -1,0 +1,149 @@
+"""Independent pieces of one job on the machine's cores: forked workers, answers in order.
+
+:func:`fork_map` runs a function over a few items in worker processes started by ``fork``
+(Linux), so the function may be a closure over this process's state (a verification, its
+trace, loaded kernels): nothing is pickled on the way in, and each answer comes back
+pickled, every bit kept. The workers are copies of this process, so an answer made there is
+the answer made here. An item whose worker raised, died or could not send its answer back is
+run here afterwards, in order, so an error is raised as it would be without workers.
+
+Where ``fork`` is missing, with one core, or in a process that is itself a worker
+(``camtool batch``'s pool, a Dask worker: the cores are busy with other files already), every
+item runs here, one after the other. Forking is safe where camtool calls it: camtool starts
+no thread that outlives a call (scipy's query threads and the verifier's thread pool are
+joined before they return), numba's threading layer is never started (no kernel is
+``parallel``), and OpenBLAS re-makes its idle threads in its own ``pthread_atfork`` handler.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import signal
+import sys
+from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from typing import Any, TypeVar
+
+__all__ = ["FORK", "default_jobs", "fork_map", "in_worker"]
+
+T = TypeVar("T")
+R = TypeVar("R")
+
+FORK = sys.platform.startswith("linux") and hasattr(os, "fork")
+"""Whether workers can be forked here (Linux)."""
+
+
+def default_jobs() -> int:
+    """The CPUs this process may run on (``os.sched_getaffinity``; else ``os.cpu_count()``)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # pragma: no cover - not on Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def in_worker() -> bool:
+    """Whether this process is itself a worker (``camtool batch``'s pool, a Dask worker).
+
+    A batch already keeps the cores busy with one file per worker, and a daemonic process
+    (Dask's) may not start children: there the work runs in the worker, one item after the
+    other.
+    """
+    current = multiprocessing.current_process()
+    return bool(current.daemon) or multiprocessing.parent_process() is not None
+
+
+def fork_map(
+    fn: Callable[[T], R],
+    items: Sequence[T],
+    *,
+    jobs: int | None = None,
+    done: Callable[[int], None] | None = None,
+) -> list[R]:
+    """``[fn(item) for item in items]``, the items shared out among forked workers.
+
+    Args:
+        fn: any callable, a closure included (it is inherited by the workers, not pickled);
+            its answers must pickle. It must not depend on side effects of other items:
+            each runs in its own process, whose changes to its state are not seen here.
+        items: the work, a few coarse pieces (each worker takes the next item as it ends
+            one, so the longest item bounds the wall time).
+        jobs: worker processes at most; ``None``: :func:`default_jobs`. With 1, one item,
+            no ``fork`` or in a worker process, every item runs here.
+        done: called here with the number of items answered so far, as each answer comes
+            in (for a progress report; it changes no answer).
+
+    Returns:
+        ``fn``'s answers, in the order of ``items``.
+
+    Raises:
+        Whatever ``fn`` raises for the first item it fails on, raised here: an item whose
+        worker raised, died or sent no answer is run again in this process, in order.
+    """
+    workers = min(default_jobs() if jobs is None else max(1, jobs), len(items))
+    answers: dict[int, R] = {}
+    if workers > 1 and FORK and not in_worker():
+        answers = _in_pool(fn, items, workers, done)
+    out: list[R] = []
+    for i, item in enumerate(items):
+        if i not in answers:
+            answers[i] = fn(item)
+            if done is not None:
+                done(len(answers))
+        out.append(answers[i])
+    return out
+
+
+def _in_pool(
+    fn: Callable[[T], R],
+    items: Sequence[T],
+    workers: int,
+    done: Callable[[int], None] | None,
+) -> dict[int, R]:
+    """The answers ``workers`` forked processes give, by item index (failed items left out)."""
+    answers: dict[int, R] = {}
+    try:
+        context = multiprocessing.get_context("fork")
+        pool = ProcessPoolExecutor(
+            workers, mp_context=context, initializer=_start_worker, initargs=(fn, items)
+        )
+    except (OSError, ValueError):  # pragma: no cover - cannot fork here
+        return answers
+    try:
+        futures = {pool.submit(_run_item, i): i for i in range(len(items))}
+        for future in as_completed(futures):
+            try:
+                ok, value = future.result()
+            except Exception:  # the worker died or its answer did not come back whole
+                continue
+            if ok:
+                answers[futures[future]] = value
+                if done is not None:
+                    done(len(answers))
+    except (OSError, RuntimeError):  # cannot fork, or the pool broke: the rest run here
+        pass
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+    return answers
+
+
+_WORK: list[tuple[Callable[[Any], Any], Sequence[Any]]] = []
+"""In a worker process only: the ``(fn, items)`` it was forked with (set by its initializer)."""
+
+
+def _start_worker(fn: Callable[[Any], Any], items: Sequence[Any]) -> None:
+    """A worker's initializer: keep its work; Ctrl-C is the parent's to handle."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _WORK.append((fn, items))
+
+
+def _run_item(index: int) -> tuple[bool, Any]:
+    """In a worker: ``(True, fn(items[index]))``, or ``(False, None)`` when ``fn`` raised.
+
+    The parent runs a failed item again itself, so the error is raised there, in order.
+    """
+    fn, items = _WORK[-1]
+    try:
+        return True, fn(items[index])
+    except Exception:  # answered in the parent, which raises it where it belongs
+        return False, None

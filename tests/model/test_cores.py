@@ -1,0 +1,108 @@
+"""fork_map: a job's independent pieces in forked workers, answers in order, errors as without.
+
+The expected values are the plain ``[fn(x) for x in items]`` run in the test's own process;
+that the work was done elsewhere is shown by the pids that did it.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import signal
+from pathlib import Path
+
+import pytest
+
+from camtool.model import cores
+from camtool.model.cores import fork_map
+from camtool.model.errors import InputError
+
+pytestmark = pytest.mark.skipif(not cores.FORK, reason="forked workers: Linux only")
+
+
+def test_answers_come_back_in_order_from_other_processes(tmp_path: Path) -> None:
+    """A closure over this process's state (not picklable) runs in the workers, in order."""
+    state = {"scale": 3}  # only a fork sees it: nothing is pickled on the way in
+    seen = tmp_path / "pids"
+
+    def work(x: int) -> tuple[int, float]:
+        with seen.open("a") as note:
+            note.write(f"{os.getpid()}\n")
+        return x * state["scale"], x / 7.0
+
+    items = list(range(9))
+    told: list[int] = []
+    got = fork_map(work, items, jobs=2, done=told.append)
+    assert got == [(x * 3, x / 7.0) for x in items]  # every float bit kept
+    pids = set(seen.read_text().split())
+    assert str(os.getpid()) not in pids and 1 <= len(pids) <= 2
+    assert told == list(range(1, 10))
+
+
+def test_one_job_or_one_item_runs_here(tmp_path: Path) -> None:
+    pids: list[int] = []
+
+    def work(x: int) -> int:
+        pids.append(os.getpid())  # seen here only when it runs here
+        return x + 1
+
+    assert fork_map(work, [1, 2, 3], jobs=1) == [2, 3, 4]
+    assert fork_map(work, [5]) == [6]
+    assert pids == [os.getpid()] * 4
+
+
+def test_the_first_error_is_raised_here_as_without_workers() -> None:
+    """Items 2 and 4 fail in their workers; item 2's error is raised here, like a plain loop."""
+    ran_here: list[int] = []
+
+    def work(x: int) -> int:
+        if x in (2, 4):
+            if os.getpid() == parent:
+                ran_here.append(x)
+            raise InputError(f"item {x} is bad")
+        return x
+
+    parent = os.getpid()
+    with pytest.raises(InputError, match="item 2 is bad"):
+        fork_map(work, list(range(6)), jobs=2)
+    assert ran_here == [2]  # run again here, in order, and it stopped there
+
+
+def test_a_worker_that_dies_has_its_item_made_here() -> None:
+    """SIGKILL in a worker (a crash): that item is made in this process, the answers whole."""
+    parent = os.getpid()
+
+    def work(x: int) -> int:
+        if x == 3 and os.getpid() != parent:
+            os.kill(os.getpid(), signal.SIGKILL)
+        return x * x
+
+    assert fork_map(work, list(range(8)), jobs=2) == [x * x for x in range(8)]
+
+
+def test_an_answer_that_cannot_pickle_is_made_here() -> None:
+    parent = os.getpid()
+
+    def work(x: int) -> object:
+        if os.getpid() != parent:
+            return lambda: x  # a lambda does not pickle
+        return ("here", x)
+
+    assert fork_map(work, [1, 2], jobs=2) == [("here", 1), ("here", 2)]
+
+
+def _in_a_child(queue: multiprocessing.Queue) -> None:  # type: ignore[type-arg]
+    queue.put((cores.in_worker(), fork_map(lambda x: (x, os.getpid()), [1, 2], jobs=2)))
+
+
+def test_a_worker_process_runs_its_items_itself() -> None:
+    """In a process that is itself a worker (a batch's pool), no workers of its own."""
+    context = multiprocessing.get_context("fork")
+    queue = context.Queue()
+    child = context.Process(target=_in_a_child, args=(queue,))
+    child.start()
+    worker, got = queue.get(timeout=60)
+    child.join(timeout=60)
+    assert worker is True
+    assert [x for x, _ in got] == [1, 2] and got[0][1] == got[1][1] == child.pid
+    assert not cores.in_worker()
