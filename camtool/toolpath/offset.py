@@ -23,12 +23,12 @@ import math
 import os
 import pickle
 import signal
-import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from camtool.geometry.chain import chain
+from camtool.model.cores import FORK, in_worker
 from camtool.model.errors import ToolpathError
 from camtool.model.shapes import Arc, Contour, Line, Point, Segment, distance
 
@@ -154,8 +154,14 @@ def offset_all(jobs: Sequence[tuple[Contour, float]]) -> list[list[Contour] | To
     it was making gets a :class:`ToolpathError` naming the signal (its caller falls back
     to shapely's buffer, :func:`offset_checked`) and a new child takes the jobs after it.
     The child is a fork of this process, so its answers are the ones :func:`offset_pieces`
-    gives here, bit for bit. OpenCASCADE is loaded here first, so that each child
-    inherits it instead of loading it again. Elsewhere the offsets are made in this process.
+    gives here, bit for bit. Elsewhere the offsets are made in this process.
+
+    OpenCASCADE (about 230 MB and 0.5 s to load) is loaded by the child, so the process of
+    a single job (``camtool post``) never holds it: the largest process of ``post
+    --preview`` of a profiled part is then ~290 MB where it was ~600 MB. A process that
+    offsets again (``camtool batch --jobs 1``: one job after another) or a worker of a
+    pool loads it here first, from its second call or at once, so that each child
+    inherits it instead of loading it again (:data:`_OFFSET_CALLS`).
 
     Returns:
         Per job, in order, the pieces (as :func:`offset_pieces`) or the
@@ -163,9 +169,11 @@ def offset_all(jobs: Sequence[tuple[Contour, float]]) -> list[list[Contour] | To
     """
     if not jobs:
         return []
-    if not _FORK:
+    if not FORK:
         return [_attempt(contour, amount) for contour, amount in jobs]
-    _load_occt()
+    _OFFSET_CALLS[0] += 1
+    if _OFFSET_CALLS[0] > 1 or in_worker():
+        _load_occt()
     out: list[list[Contour] | ToolpathError] = []
     while len(out) < len(jobs):
         got, died = _in_child(jobs[len(out) :])
@@ -181,8 +189,10 @@ def offset_all(jobs: Sequence[tuple[Contour, float]]) -> list[list[Contour] | To
     return out
 
 
-_FORK = sys.platform.startswith("linux") and hasattr(os, "fork")
-"""Whether :func:`offset_all` runs OpenCASCADE in a forked child (Linux)."""
+_OFFSET_CALLS = [0]
+"""Calls of :func:`offset_all` in this process so far: from the second on (or in a worker
+process, :func:`~camtool.model.cores.in_worker`), OpenCASCADE is loaded here before the
+child is forked. A count, not a setting: only the time and memory depend on it."""
 
 
 def _attempt(contour: Contour, amount: float) -> list[Contour] | ToolpathError:

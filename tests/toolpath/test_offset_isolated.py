@@ -30,7 +30,7 @@ from camtool.toolpath.order import nesting
 from tests.corpus.conftest import CORPUS, FETCH_HINT, load_manifest
 from tests.toolpath.contours import circle, dumbbell, l_shape, rect
 
-pytestmark = pytest.mark.skipif(not offset_module._FORK, reason="offsets in a child: Linux only")
+pytestmark = pytest.mark.skipif(not offset_module.FORK, reason="offsets in a child: Linux only")
 
 JOBS = [(circle(0, 0, 5), 1.0), (rect(0, 0, 10, 5), 0.5), (l_shape(), -1.0), (dumbbell(), -1.2)]
 
@@ -145,3 +145,31 @@ def test_tango_icons_that_crashed_opencascade_are_posted(icon: str, tmp_path: Pa
     assert done.returncode == 0, done.stderr[-2000:]
     assert "crashed (SIGSEGV, signal 11)" in done.stderr
     assert out.read_text().count("\n") > 100
+
+
+ONE_JOB = """
+import sys
+from camtool.toolpath.offset import offset_all
+from tests.toolpath.contours import circle, rect
+jobs = [(circle(0, 0, 5), 1.0), (rect(0, 0, 10, 5), 0.5)]
+first = offset_all(jobs)
+held = "OCP" in sys.modules
+second = offset_all(jobs)
+same = [[p.segments for p in a] for a in first] == [[p.segments for p in a] for a in second]
+print(held, "OCP" in sys.modules, same)
+"""
+
+
+def test_one_job_leaves_opencascade_to_its_child() -> None:
+    """The process of one job never loads OCP (~230 MB); one that offsets again loads it once.
+
+    A fresh interpreter, since this one may hold OCP from other tests: after the first
+    ``offset_all`` OCP is not in ``sys.modules``, after the second it is (so the children
+    of a ``batch --jobs 1`` inherit it), and both give the same pieces.
+    """
+    root = Path(__file__).resolve().parents[2]
+    done = subprocess.run(
+        [sys.executable, "-c", ONE_JOB], capture_output=True, text=True, cwd=root, timeout=300
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.split() == ["False", "True", "True"]
