@@ -270,6 +270,8 @@ class _Controller:
     def finish(self, blocks: int) -> StepTrace:
         rows = np.concatenate(self.parts) if self.parts else np.zeros((0, 2), STEP_DTYPE)
         comp = np.concatenate(self.comp_parts) if self.comp_parts else np.zeros(0, np.bool_)
+        self.parts.clear()  # not held twice while the carriage is computed
+        self.comp_parts.clear()
         counts = np.asarray(self.counts, dtype=np.int64)
         block_start = np.concatenate(([0], np.cumsum(counts))).astype(np.int64)
         block_of_row = _block_of_row(blocks, block_start)
@@ -415,11 +417,14 @@ def _carriage_numpy(
     """:func:`_carriage` with numpy (any row dtype); holds the motor positions whole."""
     true = machine.real_steps_per_mm
     kind = np.float64 if rows.dtype.kind == "f" else np.int64
-    motor = np.cumsum(rows, axis=0, dtype=kind) + np.asarray(origin, dtype=kind)
+    motor = np.cumsum(rows, axis=0, dtype=kind)
+    motor += np.asarray(origin, dtype=kind)
     signs = np.sign(rows).astype(np.int8)
     out = np.empty((len(rows), 2), dtype=np.float64)
     for axis in (0, 1):
-        out[:, axis] = _play(signs[:, axis], motor, axis, origin[axis], machine) / true[axis]
+        np.divide(
+            _play(signs[:, axis], motor, axis, origin[axis], machine), true[axis], out=out[:, axis]
+        )
     return out
 
 
@@ -509,7 +514,9 @@ def _play(
             values = np.minimum(current, segment + band(lo))
         out[lo:hi] = values
         current = float(values[-1])
-    return out - c0 + start
+    out -= c0  # in place: the same floats as ``out - c0 + start``
+    out += start
+    return out
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
