@@ -164,9 +164,12 @@ def post_path(
     """
     plan = plan if plan is not None else PlanOptions()
     if not is_program_file(path):
-        drawing = read_drawing(path, import_options, progress=progress)
-        drawing = _note_units(drawing, path, import_options)
-        return post_drawing(drawing, target, plan, output, progress=progress)
+        from camtool.toolpath.compensate import offsets_ahead
+
+        with offsets_ahead(plan):  # OpenCASCADE loads in the offsets' child meanwhile
+            drawing = read_drawing(path, import_options, progress=progress)
+            drawing = _note_units(drawing, path, import_options)
+            return post_drawing(drawing, target, plan, output, progress=progress)
     refuse_planning(path, drawing_only(plan.given()))
     from camtool.importers.gcode import read_gcode
 

@@ -37,18 +37,19 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
 from camtool.model.errors import ToolpathError
 from camtool.model.shapes import Arc, Contour, Line, Point, Segment
 from camtool.toolpath.cuts import Cut, Finding, Stage, where
-from camtool.toolpath.offset import quad_segs
+from camtool.toolpath.offset import quad_segs, start_ahead, stop_ahead
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.order import Nesting
 
-__all__ = ["compensate", "tight_corners", "tool_inside"]
+__all__ = ["compensate", "offsets_ahead", "tight_corners", "tool_inside"]
 
 CORNER_TURN_DEG = 1.0
 """A joint turning more than this toward the tool is a corner the tool cannot follow."""
@@ -159,6 +160,24 @@ class _OffsetJob:
     drawn: Contour
     amount: float
     occt: list[Contour] | ToolpathError | None = None
+
+
+@contextmanager
+def offsets_ahead(options: PlanOptions) -> Iterator[None]:
+    """Within it, the child that will make the offsets loads OpenCASCADE meanwhile.
+
+    For a caller about to read a drawing and plan it with ``options``: when
+    :func:`compensate` will offset (``--offset`` other than ``on``, a tool radius above
+    0), :func:`camtool.toolpath.offset.start_ahead` starts the offsets' child now, so
+    that it loads OpenCASCADE (~0.5 s) on another core while this process reads and
+    plans; leaving stops it if no offsets used it. The plan is the same either way.
+    """
+    if options.offset != "on" and options.radius > 0:
+        start_ahead()
+    try:
+        yield
+    finally:
+        stop_ahead()
 
 
 def _offset_jobs(

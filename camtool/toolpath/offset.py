@@ -19,6 +19,7 @@ of travel as for the drawn contour.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import pickle
@@ -153,15 +154,18 @@ def offset_all(jobs: Sequence[tuple[Contour, float]]) -> list[list[Contour] | To
     after the other, each answer sent back as it is made; when the child dies, the job
     it was making gets a :class:`ToolpathError` naming the signal (its caller falls back
     to shapely's buffer, :func:`offset_checked`) and a new child takes the jobs after it.
-    The child is a fork of this process, so its answers are the ones :func:`offset_pieces`
-    gives here, bit for bit. Elsewhere the offsets are made in this process.
+    The child gets each contour pickled (every float kept) and runs this module's own
+    :func:`offset_pieces`, so its answers are the ones made here, bit for bit. Elsewhere
+    the offsets are made in this process.
 
     OpenCASCADE (about 230 MB and 0.5 s to load) is loaded by the child, so the process of
     a single job (``camtool post``) never holds it: the largest process of ``post
-    --preview`` of a profiled part is then ~290 MB where it was ~600 MB. A process that
-    offsets again (``camtool batch --jobs 1``: one job after another) or a worker of a
-    pool loads it here first, from its second call or at once, so that each child
-    inherits it instead of loading it again (:data:`_OFFSET_CALLS`).
+    --preview`` of a profiled part is then ~290 MB where it was ~600 MB. The child can be
+    started ahead (:func:`start_ahead`), so that it loads OpenCASCADE while this process
+    reads and plans. A process that offsets again (``camtool batch --jobs 1``: one job
+    after another) or a worker of a pool loads it here first, from its second call or at
+    once, so that each child inherits it instead of loading it again
+    (:data:`_OFFSET_CALLS`).
 
     Returns:
         Per job, in order, the pieces (as :func:`offset_pieces`) or the
@@ -176,7 +180,11 @@ def offset_all(jobs: Sequence[tuple[Contour, float]]) -> list[list[Contour] | To
         _load_occt()
     out: list[list[Contour] | ToolpathError] = []
     while len(out) < len(jobs):
-        got, died = _in_child(jobs[len(out) :])
+        child = _AHEAD.pop() if _AHEAD else _Child()
+        try:
+            got, died = child.make(jobs[len(out) :])
+        finally:
+            child.close()
         out.extend(got)
         if died is not None and len(out) < len(jobs):
             contour, amount = jobs[len(out)]
@@ -189,10 +197,31 @@ def offset_all(jobs: Sequence[tuple[Contour, float]]) -> list[list[Contour] | To
     return out
 
 
+def start_ahead() -> None:
+    """Start the child that will make this process's first offsets now (Linux).
+
+    It loads OpenCASCADE while this process goes on reading and planning (on another
+    core: ~0.5 s off a profiled part's ``post``), then waits for :func:`offset_all`'s
+    jobs. Nothing is started where :func:`offset_all` would not use it: without ``fork``,
+    in a worker process, after this process's first offsets, or when one is waiting
+    already. :func:`stop_ahead` stops it if no offsets came.
+    """
+    if FORK and not _AHEAD and _OFFSET_CALLS[0] == 0 and not in_worker():
+        _AHEAD.append(_Child())
+
+
+def stop_ahead() -> None:
+    """Stop the child :func:`start_ahead` started, if :func:`offset_all` did not use it."""
+    while _AHEAD:
+        _AHEAD.pop().close(kill=True)  # no need to wait for OpenCASCADE to load
+
+
 _OFFSET_CALLS = [0]
 """Calls of :func:`offset_all` in this process so far: from the second on (or in a worker
 process, :func:`~camtool.model.cores.in_worker`), OpenCASCADE is loaded here before the
 child is forked. A count, not a setting: only the time and memory depend on it."""
+_AHEAD: list[_Child] = []
+"""The child :func:`start_ahead` started, until :func:`offset_all` takes it (at most one)."""
 
 
 def _attempt(contour: Contour, amount: float) -> list[Contour] | ToolpathError:
@@ -209,52 +238,101 @@ def _load_occt() -> None:
     import OCP.BRepTools  # noqa: F401
 
 
-def _in_child(
-    jobs: Sequence[tuple[Contour, float]],
-) -> tuple[list[list[Contour] | ToolpathError], str | None]:
-    """The answers a forked child sends for ``jobs``, and how it died (``None``: it did not)."""
-    read_end, write_end = os.pipe()
-    pid = os.fork()
-    if pid == 0:  # the child: answer each job, then leave without running the parent's code
-        code = 0
-        try:
-            _quiet_crash()
-            os.close(read_end)
-            with os.fdopen(write_end, "wb") as pipe:
-                for contour, amount in jobs:
-                    got = _attempt(contour, amount)
-                    record = ("error", str(got)) if isinstance(got, ToolpathError) else ("ok", got)
-                    pickle.dump(record, pipe, protocol=pickle.HIGHEST_PROTOCOL)
-                    pipe.flush()
-        except BaseException:
-            code = 70  # the parent sees which job got no answer
-        finally:
-            os._exit(code)
-    os.close(write_end)
-    answers: list[list[Contour] | ToolpathError] = []
-    with os.fdopen(read_end, "rb") as pipe:
-        while len(answers) < len(jobs):
+class _Child:
+    """A forked child that loads OpenCASCADE and makes the offsets sent to it.
+
+    It reads a pickled list of jobs, answers each as it is made (a pickled ``("ok",
+    pieces)`` or ``("error", message)``) and waits for the next list; it leaves when its
+    jobs pipe closes (:meth:`close`, or this process ending), without running any of
+    this process's code.
+    """
+
+    def __init__(self) -> None:
+        jobs_read, jobs_write = os.pipe()
+        answers_read, answers_write = os.pipe()
+        pid = os.fork()
+        if pid == 0:  # the child
+            code = 0
             try:
-                kind, value = pickle.load(pipe)
-            except Exception:  # the end of the pipe, or a record cut off by a crash
-                break
-            answers.append(ToolpathError(value) if kind == "error" else value)
-    _, status = os.waitpid(pid, 0)
-    if len(answers) == len(jobs):
-        return answers, None
-    if os.WIFSIGNALED(status):
-        number = os.WTERMSIG(status)
+                _quiet_crash()
+                os.close(jobs_write)
+                os.close(answers_read)
+                _load_occt()
+                with os.fdopen(jobs_read, "rb") as inbox, os.fdopen(answers_write, "wb") as out:
+                    _serve(inbox, out)
+            except BaseException:
+                code = 70  # the parent sees which job got no answer
+            finally:
+                os._exit(code)
+        os.close(jobs_read)
+        os.close(answers_write)
+        self.pid: int | None = pid
+        self.jobs = os.fdopen(jobs_write, "wb")
+        self.answers = os.fdopen(answers_read, "rb")
+
+    def make(
+        self, jobs: Sequence[tuple[Contour, float]]
+    ) -> tuple[list[list[Contour] | ToolpathError], str | None]:
+        """The answers the child sends for ``jobs``, and how it died (``None``: it did not)."""
+        got: list[list[Contour] | ToolpathError] = []
         try:
-            name = signal.Signals(number).name
-        except ValueError:
-            name = "a signal"
-        return answers, f"{name}, signal {number}"
-    return answers, f"exit code {os.waitstatus_to_exitcode(status)}"
+            pickle.dump(list(jobs), self.jobs, protocol=pickle.HIGHEST_PROTOCOL)
+            self.jobs.flush()
+        except OSError:  # it died before it read them
+            return got, self._death()
+        while len(got) < len(jobs):
+            try:
+                kind, value = pickle.load(self.answers)
+            except Exception:  # the end of the pipe, or a record cut off by a crash
+                return got, self._death()
+            got.append(ToolpathError(value) if kind == "error" else value)
+        return got, None
+
+    def close(self, *, kill: bool = False) -> None:
+        """Close its pipes (it leaves; ``kill``: at once) and wait for it (idempotent)."""
+        for pipe in (self.jobs, self.answers):
+            with contextlib.suppress(OSError):
+                pipe.close()
+        if self.pid is not None:
+            if kill:
+                with contextlib.suppress(OSError):
+                    os.kill(self.pid, signal.SIGKILL)
+            os.waitpid(self.pid, 0)
+            self.pid = None
+
+    def _death(self) -> str:
+        """How the child ended (after it stopped answering): a signal or an exit code."""
+        assert self.pid is not None
+        with contextlib.suppress(OSError):
+            self.jobs.close()  # a child still waiting for jobs leaves
+        _, status = os.waitpid(self.pid, 0)
+        self.pid = None
+        if os.WIFSIGNALED(status):
+            number = os.WTERMSIG(status)
+            try:
+                name = signal.Signals(number).name
+            except ValueError:
+                name = "a signal"
+            return f"{name}, signal {number}"
+        return f"exit code {os.waitstatus_to_exitcode(status)}"
+
+
+def _serve(inbox: Any, out: Any) -> None:
+    """In the child: answer each list of jobs read from ``inbox`` until it closes."""
+    while True:
+        try:
+            jobs = pickle.load(inbox)
+        except EOFError:
+            return
+        for contour, amount in jobs:
+            got = _attempt(contour, amount)
+            record = ("error", str(got)) if isinstance(got, ToolpathError) else ("ok", got)
+            pickle.dump(record, out, protocol=pickle.HIGHEST_PROTOCOL)
+            out.flush()
 
 
 def _quiet_crash() -> None:
     """In the child: a crash leaves no core file and no Python fault report (the parent says it)."""
-    import contextlib
     import faulthandler
     import resource
 

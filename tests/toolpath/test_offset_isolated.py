@@ -74,10 +74,18 @@ def _segfault_on(amount: float) -> Any:
     return occt
 
 
-def test_a_crash_in_the_child_fails_its_job_only(monkeypatch: pytest.MonkeyPatch) -> None:
+@pytest.mark.parametrize("ahead", [False, True], ids=["forked-then", "started-ahead"])
+def test_a_crash_in_the_child_fails_its_job_only(
+    monkeypatch: pytest.MonkeyPatch, ahead: bool
+) -> None:
     expected = [offset_pieces(c, a) for c, a in JOBS]
     monkeypatch.setattr(offset_module, "_occt_offset", _segfault_on(0.5))
+    if ahead:
+        monkeypatch.setattr(offset_module, "_OFFSET_CALLS", [0])
+        offset_module.start_ahead()
+        assert len(offset_module._AHEAD) == 1
     got = offset_all(JOBS)
+    assert offset_module._AHEAD == []
     assert len(got) == len(JOBS)
     crashed = got[1]
     assert isinstance(crashed, ToolpathError)
@@ -173,3 +181,55 @@ def test_one_job_leaves_opencascade_to_its_child() -> None:
     )
     assert done.returncode == 0, done.stderr[-2000:]
     assert done.stdout.split() == ["False", "True", "True"]
+
+
+def test_a_child_started_ahead_makes_the_offsets(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    """start_ahead's child (OpenCASCADE loaded while the job reads and plans) makes them all.
+
+    The same pieces as this process makes, bit for bit, made by that very child; it is
+    used once and gone afterwards.
+    """
+    here = [offset_pieces(c, a) for c, a in JOBS]
+    real = offset_module._occt_offset
+    made_by = tmp_path / "pids"
+
+    def occt(contour: Contour, amount: float) -> Any:
+        with made_by.open("a") as note:
+            note.write(f"{os.getpid()}\n")
+        return real(contour, amount)
+
+    monkeypatch.setattr(offset_module, "_occt_offset", occt)
+    monkeypatch.setattr(offset_module, "_OFFSET_CALLS", [0])  # this process's first offsets
+    offset_module.start_ahead()
+    (ahead,) = offset_module._AHEAD
+    pid = ahead.pid
+    there = offset_all(JOBS)
+    assert all(_same(x, y) for x, y in zip(here, there, strict=True))
+    assert pid is not None and made_by.read_text().split() == [str(pid)] * len(JOBS)
+    assert offset_module._AHEAD == [] and ahead.pid is None  # used, then waited for
+    offset_module.start_ahead()  # not again: this process has made its offsets
+    assert offset_module._AHEAD == []
+
+
+def test_a_child_started_ahead_and_not_used_is_stopped(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A drawing with nothing to offset: stop_ahead ends the child, no process is left."""
+    monkeypatch.setattr(offset_module, "_OFFSET_CALLS", [0])
+    contours = [rect(0, 0, 20, 20)]
+    with_tool = PlanOptions(offset="outside", tool_diameter=2.0, feed_mm_min=100.0)
+    from camtool.toolpath.compensate import offsets_ahead
+
+    with offsets_ahead(PlanOptions(offset="on", feed_mm_min=100.0)):
+        assert offset_module._AHEAD == []  # --offset on: no offsets to make
+    with offsets_ahead(with_tool):
+        (ahead,) = offset_module._AHEAD
+        pid = ahead.pid
+        assert pid is not None
+    assert offset_module._AHEAD == []
+    with pytest.raises(ChildProcessError):
+        os.waitpid(pid, os.WNOHANG)  # already waited for: no such child
+    with offsets_ahead(with_tool):
+        stage = compensate(contours, nesting(contours), with_tool)
+    assert offset_module._AHEAD == []
+    assert not any(f.kind == "offset-fallback" for f in stage.findings)
