@@ -10,7 +10,17 @@ runs it, ``camtool batch in -t grbl -o OUT --force --jobs J`` in a subprocess, o
 2). Both output trees must be byte-identical, and identical to the pre-work code's: the
 SHA-256 of the sorted (path, bytes) pairs is compared with :data:`EXPECTED_SHA256`, taken
 from the outputs of commit b3b77a5 (before issue 17), so a mismatch means some output
-changed. Without the corpus the row says how to get it.
+changed. The pre-work code refused 13 of these files that camtool now writes
+(:data:`WRITTEN_SINCE`); the comparison leaves them out and the row counts them. Without
+the corpus the row says how to get it.
+
+The 13: LibreCAD parts whose chained arcs start and end at radii a few µm apart, which
+b3b77a5 refused ("an arc of radius 11.7463 mm cannot be written for grbl ... write more
+decimals") and 6e92f55 writes about the equalised centre, with a warning; ``camtool
+verify`` of three of them gives 5.6–6.2 µm deviation. Until 23 Nov 2026 the row said
+"DIFFER from the pre-work outputs" for this reason, and the sixth pass's note blamed the
+environment: b3b77a5 run on the same corpus gives :data:`EXPECTED_SHA256` over 982 files,
+this tree the same 982 files byte for byte plus the 13.
 """
 
 from __future__ import annotations
@@ -34,7 +44,17 @@ CORPUS = Path(os.environ.get("CAMTOOL_CORPUS_DIR", ROOT / ".corpus"))
 LIBRARY = CORPUS / "pkg/librecad-data/usr/share/librecad/library"
 GOAL_S = 60.0
 EXPECTED_SHA256 = "579708340135187f52798a0d80aaf555068b01e5e3453462c2b13824472271c0"
-"""SHA-256 of the 1 000-file output tree of commit b3b77a5 (see :func:`tree_hash`)."""
+"""SHA-256 of the output tree of commit b3b77a5 for the first 1 000 files (see
+:func:`tree_hash`): 982 programs, the other 18 files refused."""
+WRITTEN_SINCE = frozenset(
+    {
+        "algoritm/alg16.gcode",
+        "elektro/dev/dev4.gcode",
+        "elektro/dev/dev5.gcode",
+        *(f"kinetics/kin{k}.gcode" for k in (1, 2, 3, 4, 8, 45, 49, 51, 86, 101)),
+    }
+)
+"""Outputs b3b77a5 did not write (it refused their arcs; 6e92f55 writes them)."""
 
 
 def inputs(n: int, folder: Path) -> list[Path]:
@@ -49,10 +69,14 @@ def inputs(n: int, folder: Path) -> list[Path]:
     return found
 
 
-def tree_hash(folder: Path) -> str:
-    """SHA-256 over every file below ``folder``: its relative path, then its bytes, sorted."""
+def tree_hash(folder: Path, leave_out: frozenset[str] = frozenset()) -> str:
+    """SHA-256 over every file below ``folder``: its relative path, then its bytes, sorted.
+
+    ``leave_out``: relative paths not hashed (:data:`WRITTEN_SINCE`).
+    """
     digest = hashlib.sha256()
-    for path in sorted(p for p in folder.rglob("*") if p.is_file()):
+    files = (p for p in folder.rglob("*") if p.is_file())
+    for path in sorted(p for p in files if str(p.relative_to(folder)) not in leave_out):
         digest.update(str(path.relative_to(folder)).encode() + b"\0")
         digest.update(path.read_bytes() + b"\0")
     return digest.hexdigest()
@@ -97,13 +121,15 @@ def main() -> int:
     two_s, two_code = batch(work / "in", work / "out2", 2)
     h1, h2 = tree_hash(work / "out1"), tree_hash(work / "out2")
     same = h1 == h2 and one_code == two_code
-    expected = h2 == EXPECTED_SHA256
+    new = sorted(p for p in WRITTEN_SINCE if (work / "out2" / p).is_file()) if n == 1000 else []
+    expected = tree_hash(work / "out2", frozenset(new)) == EXPECTED_SHA256
     print(f"outputs: --jobs 1 {h1[:16]}, --jobs 2 {h2[:16]}; pre-work {EXPECTED_SHA256[:16]}")
     speedup = one_s / two_s
+    also = f" ({len(new)} more written that it refused)" if new else ""
     note = (
         f"--jobs 1 {one_s:.1f} s, speed-up {speedup:.2f}× on 2 cores; exit {two_code}; "
         f"outputs {'identical' if same else 'DIFFER'} across --jobs, "
-        f"{'identical to' if expected else 'DIFFER from'} the pre-work outputs"
+        f"{'identical to' if expected else 'DIFFER from'} the pre-work outputs{also}"
     )
     row(
         job,
