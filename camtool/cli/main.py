@@ -184,7 +184,7 @@ def post(
         )
     if verify_too or report or preview or max_error_um is not None:
         progress(Step("verifying", 0, job.result.blocks, chosen.name))
-        verified = verify_job(job, budget=not no_budget)
+        verified = verify_job(job, budget=not no_budget, budget_now=progress)
         _measure_budget(verified, progress)
         _finish_verification(
             verified,
@@ -262,6 +262,7 @@ def verify(
         against=drawing,
         tool_diameter=tool_diameter,
         budget=not no_budget,
+        budget_now=progress,
     )
     _measure_budget(v, progress)
     _finish_verification(

@@ -481,13 +481,16 @@ def _work_zero(plan: PlanOptions) -> str:
     return f"work zero X0 Y0: {where}{moved}"
 
 
-def verify_job(job: PostJob, *, budget: bool = True) -> Verification:
+def verify_job(
+    job: PostJob, *, budget: bool = True, budget_now: Progress | None = None
+) -> Verification:
     """Verify what ``job`` emitted: read its code back and simulate it against its drawing.
 
     The plan's findings go along, so features the planner reported it cannot cut
     with this tool are measured apart (:func:`camtool.verify.verifier.verify_program`),
     and so does the unrounded plan, so that the error budget knows what rounding
-    the emitted numbers costs (``budget=False``: no error budget).
+    the emitted numbers costs (``budget=False``: no error budget; ``budget_now``: it
+    is computed now, told to that progress callback, as ``verify_program`` says).
 
     Raises:
         CamtoolError: the target cannot read its own code back, or its machine
@@ -504,6 +507,7 @@ def verify_job(job: PostJob, *, budget: bool = True) -> Verification:
         findings=job.plan.placed_findings() if job.plan is not None else (),
         planned=job.program,
         budget=budget,
+        budget_now=budget_now,
     )
 
 

@@ -23,9 +23,9 @@ import signal
 import sys
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from typing import Any, TypeVar
+from typing import Any, Generic, TypeVar
 
-__all__ = ["FORK", "default_jobs", "fork_map", "in_worker"]
+__all__ = ["FORK", "ForkedWork", "default_jobs", "fork_map", "in_worker"]
 
 T = TypeVar("T")
 R = TypeVar("R")
@@ -80,51 +80,82 @@ def fork_map(
         Whatever ``fn`` raises for the first item it fails on, raised here: an item whose
         worker raised, died or sent no answer is run again in this process, in order.
     """
-    workers = min(default_jobs() if jobs is None else max(1, jobs), len(items))
-    answers: dict[int, R] = {}
-    if workers > 1 and FORK and not in_worker():
-        answers = _in_pool(fn, items, workers, done)
-    out: list[R] = []
-    for i, item in enumerate(items):
-        if i not in answers:
-            answers[i] = fn(item)
-            if done is not None:
-                done(len(answers))
-        out.append(answers[i])
-    return out
+    with ForkedWork(fn, items, jobs=jobs) as work:
+        return work.answers(done)
 
 
-def _in_pool(
-    fn: Callable[[T], R],
-    items: Sequence[T],
-    workers: int,
-    done: Callable[[int], None] | None,
-) -> dict[int, R]:
-    """The answers ``workers`` forked processes give, by item index (failed items left out)."""
-    answers: dict[int, R] = {}
-    try:
-        context = multiprocessing.get_context("fork")
-        pool = ProcessPoolExecutor(
-            workers, mp_context=context, initializer=_start_worker, initargs=(fn, items)
-        )
-    except (OSError, ValueError):  # pragma: no cover - cannot fork here
-        return answers
-    try:
-        futures = {pool.submit(_run_item, i): i for i in range(len(items))}
-        for future in as_completed(futures):
-            try:
-                ok, value = future.result()
-            except Exception:  # the worker died or its answer did not come back whole
-                continue
-            if ok:
-                answers[futures[future]] = value
+class ForkedWork(Generic[T, R]):
+    """:func:`fork_map` started now and gathered later: this process works meanwhile.
+
+    The workers are forked when it is made, so they see this process's state as it is
+    then; :meth:`answers` gathers what they made (and makes here what they could not).
+    Use it as a context manager: leaving it stops the workers (the items not yet started
+    are dropped, those running are waited for), so an error raised here meanwhile
+    leaves no process behind.
+    """
+
+    def __init__(self, fn: Callable[[T], R], items: Sequence[T], *, jobs: int | None = None):
+        self.fn, self.items = fn, items
+        self._got: dict[int, R] = {}
+        self._pool: ProcessPoolExecutor | None = None
+        self._futures: dict[Any, int] = {}
+        workers = min(default_jobs() if jobs is None else max(1, jobs), len(items))
+        if workers > 1 and FORK and not in_worker():
+            self._start(workers)
+
+    def __enter__(self) -> ForkedWork[T, R]:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Stop the workers (idempotent)."""
+        if self._pool is not None:
+            self._pool.shutdown(wait=True, cancel_futures=True)
+            self._pool = None
+
+    def answers(self, done: Callable[[int], None] | None = None) -> list[R]:
+        """``fn``'s answers in the order of the items (see :func:`fork_map`).
+
+        Raises:
+            Whatever ``fn`` raises for the first item it fails on, raised here.
+        """
+        try:
+            for future in as_completed(self._futures):
+                try:
+                    ok, value = future.result()
+                except Exception:  # the worker died or its answer did not come back whole
+                    continue
+                if ok:
+                    self._got[self._futures[future]] = value
+                    if done is not None:
+                        done(len(self._got))
+        finally:
+            self.close()
+        out: list[R] = []
+        for i, item in enumerate(self.items):
+            if i not in self._got:
+                self._got[i] = self.fn(item)
                 if done is not None:
-                    done(len(answers))
-    except (OSError, RuntimeError):  # cannot fork, or the pool broke: the rest run here
-        pass
-    finally:
-        pool.shutdown(wait=True, cancel_futures=True)
-    return answers
+                    done(len(self._got))
+            out.append(self._got[i])
+        return out
+
+    def _start(self, workers: int) -> None:
+        """Fork the workers and hand them every item (nothing if they cannot start)."""
+        try:
+            context = multiprocessing.get_context("fork")
+            self._pool = ProcessPoolExecutor(
+                workers,
+                mp_context=context,
+                initializer=_start_worker,
+                initargs=(self.fn, self.items),
+            )
+            self._futures = {self._pool.submit(_run_item, i): i for i in range(len(self.items))}
+        except (OSError, ValueError, RuntimeError):  # cannot fork: every item runs here
+            self._futures = {}
+            self.close()
 
 
 _WORK: list[tuple[Callable[[Any], Any], Sequence[Any]]] = []

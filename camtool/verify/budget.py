@@ -59,9 +59,12 @@ def figures(
         out[f"contour {c.number} size error y"] = c.size_error_um[1]
         if c.circle is not None:
             out[f"contour {c.number} diameter error"] = (c.circle[1] - c.circle[0]) * 1000.0
-    if against is not None:
-        out["distance to the drawing"] = against.max_um
-    return out
+    return out | against_figures(against)
+
+
+def against_figures(against: Against | None) -> Figures:
+    """The figures of a drawing comparison: those :func:`figures` adds for it."""
+    return {} if against is None else {"distance to the drawing": against.max_um}
 
 
 @dataclass(frozen=True)

@@ -604,7 +604,8 @@ def _nearest(
     a = np.ascontiguousarray(a, dtype=np.float64)
     b = np.ascontiguousarray(b, dtype=np.float64)
     half = float(np.max(np.hypot(*(b - a).T))) / 2.0
-    points = np.concatenate([a, b])
+    # the caller's ends are these very points (its k-d tree's): not made twice
+    points = np.concatenate([a, b]) if ends is None else _float_rows(ends.points)
     boxes, offsets = kernels.build(points)
     if not _far(samples, points, boxes, offsets, half, kernels):
         return _nearest_kd(samples, a, b, ends=ends, only_max=only_max)
@@ -701,6 +702,11 @@ def _tied(
 
 TIED_CHUNK = 2_000
 """Samples :func:`_tied` measures at once."""
+
+
+def _float_rows(points: FloatArray) -> FloatArray:
+    """``points`` as a C-contiguous float64 array (itself when it is one already)."""
+    return np.ascontiguousarray(points, dtype=np.float64)
 
 
 class _LazyTree:
@@ -1755,12 +1761,36 @@ AGAINST_RESOLUTION_MM = 0.0005
 """Spacing :func:`against_drawing` thins the cutting trace to by default, mm."""
 
 
+AGAINST_SPACING_MM = 0.005
+"""Spacing of the drawing's points :func:`against_drawing` measures by default, mm."""
+PREPARE_KERNELS_FROM = 20_000
+"""Drawing points (100 mm of edge at :data:`AGAINST_SPACING_MM`) from which
+:func:`prepare_comparison` loads the compiled nearest search: the comparisons of such a
+drawing (and the shortfall of its toolpath) measure more than :data:`NEAR_KERNELS_FROM`
+samples; the preview benchmark's part has 112 688, ``make demo``'s plate 48 577, its logo
+6 911 (which keeps the k-d tree)."""
+
+
+def prepare_comparison(drawing: Drawing) -> None:
+    """Ahead of comparing traces with ``drawing`` here and in forked workers: make them once.
+
+    The drawing's points are sampled now (and kept, as every comparison keeps its last
+    drawing's) and, for a drawing of at least :data:`PREPARE_KERNELS_FROM` points, the
+    compiled nearest search is loaded (:func:`near_kernels`), so that workers forked next
+    inherit both instead of each making them again (its loading alone is ~0.5 s). Only the
+    time depends on it: the figures are the same.
+    """
+    samples, _ = _sample_drawing(drawing, AGAINST_SPACING_MM)
+    if len(samples) >= PREPARE_KERNELS_FROM:
+        near_kernels()
+
+
 def against_drawing(
     points: FloatArray,
     drawing: Drawing,
     tool_radius_mm: float,
     *,
-    spacing_mm: float = 0.005,
+    spacing_mm: float = AGAINST_SPACING_MM,
     resolution_mm: float = AGAINST_RESOLUTION_MM,
     runs: IntArray | None = None,
     nominal: Sequence[FloatArray] = (),
@@ -1962,7 +1992,7 @@ def against_thinned(
     drawing: Drawing,
     tool_radius_mm: float,
     *,
-    spacing_mm: float = 0.005,
+    spacing_mm: float = AGAINST_SPACING_MM,
     nominal: Sequence[FloatArray] = (),
     findings: Sequence[FindingLike] = (),
     overcut: bool = True,

@@ -275,9 +275,15 @@ class _Controller:
         counts = np.asarray(self.counts, dtype=np.int64)
         block_start = np.concatenate(([0], np.cumsum(counts))).astype(np.int64)
         block_of_row = _block_of_row(blocks, block_start)
-        carriage = _carriage(rows, self.origin_steps, self.machine)
+        if rows.dtype == STEP_DTYPE:
+            carriage = _carriage(rows, self.origin_steps, self.machine)
+        else:  # the ideal controller's fractional steps: let go of them once summed
+            motor = _motor(rows, self.origin_steps)
+            rows = np.sign(rows).astype(STEP_DTYPE)  # each sample's direction
+            carriage = _carriage_of(rows, motor, self.origin_steps, self.machine)
+            del motor
         return StepTrace(
-            rows=read_only(rows if rows.dtype == STEP_DTYPE else np.sign(rows).astype(STEP_DTYPE)),
+            rows=read_only(rows),
             compensation=read_only(comp),
             block_of_row=read_only(block_of_row),
             block_start=read_only(block_start),
@@ -415,12 +421,26 @@ def _carriage_numpy(
     rows: npt.NDArray[Any], origin: tuple[int, int], machine: Machine
 ) -> FloatArray:
     """:func:`_carriage` with numpy (any row dtype); holds the motor positions whole."""
-    true = machine.real_steps_per_mm
+    return _carriage_of(np.sign(rows).astype(np.int8), _motor(rows, origin), origin, machine)
+
+
+def _motor(rows: npt.NDArray[Any], origin: tuple[int, int]) -> npt.NDArray[Any]:
+    """``(N, 2)`` motor position after each row, steps (float64 for fractional rows)."""
     kind = np.float64 if rows.dtype.kind == "f" else np.int64
     motor = np.cumsum(rows, axis=0, dtype=kind)
     motor += np.asarray(origin, dtype=kind)
-    signs = np.sign(rows).astype(np.int8)
-    out = np.empty((len(rows), 2), dtype=np.float64)
+    return motor
+
+
+def _carriage_of(
+    signs: npt.NDArray[np.int8],
+    motor: npt.NDArray[Any],
+    origin: tuple[int, int],
+    machine: Machine,
+) -> FloatArray:
+    """:func:`_carriage_numpy` from the rows' signs ``(N, 2)`` and :func:`_motor`'s positions."""
+    true = machine.real_steps_per_mm
+    out = np.empty((len(signs), 2), dtype=np.float64)
     for axis in (0, 1):
         np.divide(
             _play(signs[:, axis], motor, axis, origin[axis], machine), true[axis], out=out[:, axis]

@@ -33,13 +33,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from contextlib import nullcontext, suppress
 from dataclasses import dataclass, field
 from functools import cached_property, partial
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from camtool.model.cores import fork_map
+from camtool.model.cores import ForkedWork
 from camtool.model.errors import CamtoolError, DialectError, InputError, UsageError
 from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Dwell, Home, Program, Rapid
@@ -64,6 +65,7 @@ from camtool.verify.metrics import (
     along_path,
     deviation,
     measure_contours,
+    prepare_comparison,
     thin_cutting,
 )
 from camtool.verify.motion import StepTrace, library
@@ -239,11 +241,12 @@ def verify_code(
     findings: Sequence[FindingLike] = (),
     planned: Program | None = None,
     budget: bool = True,
+    budget_now: Progress | None = None,
 ) -> Verification:
     """Read ``code`` with ``target``'s reader and verify it on ``target``'s machine.
 
-    ``findings`` are the plan's, ``planned`` the unrounded plan and ``budget``
-    the error budget switch (see :func:`verify_program`).
+    ``findings`` are the plan's, ``planned`` the unrounded plan, ``budget`` the error
+    budget switch and ``budget_now`` when it is computed (see :func:`verify_program`).
 
     Raises:
         ParseError: the code is not valid in the target's dialect (names the line).
@@ -268,6 +271,7 @@ def verify_code(
         planned=planned,
         budget=budget,
         source=source,
+        budget_now=budget_now,
     )
 
 
@@ -284,6 +288,7 @@ def verify_program(
     chunk_rows: int = CHUNK_ROWS,
     stream_above: int = STREAM_ROWS,
     source: str = "",
+    budget_now: Progress | None = None,
 ) -> Verification:
     """Simulate ``program`` on ``machine`` and measure the machined error.
 
@@ -308,6 +313,15 @@ def verify_program(
             measured ``chunk_rows`` at a time, :func:`_simulate_big`) when it can be.
         source: the file the program was read from, named in the messages of
             :func:`check_area` (``""``: the line alone).
+        budget_now: compute the error budget now, told to this progress callback as
+            :meth:`Verification.measure_budget` tells it: its sources are re-simulated
+            in forked workers while this process compares the trace with the drawing
+            (the same budget; ``post --preview`` of issue 17's benchmark part takes
+            6.1 s where the two one after the other took 6.7 s). A budget that fails
+            is left to be computed, and to fail, when it is asked for. ``None``: when
+            it is asked for. The kernels the measures need are loaded first
+            (:func:`~camtool.verify.metrics.prepare_comparison`), so each worker
+            inherits them instead of loading them again.
 
     A drawing whose box does not overlap the program's (less than
     :data:`MIN_OVERLAP`) is not compared: ``against`` is ``None``,
@@ -328,35 +342,45 @@ def verify_program(
     warnings = _warnings(program, trace)
     if skipped is not None:
         warnings.append(skipped)
+    now = budget_now if streamed is None else None  # streamed: a budget waits to be asked for
     if streamed is not None:
         dev, along, contours, thin = streamed
-        compared = None
-        if thin is not None and compared_with is not None:  # a thinned trace: a drawing
-            compared = _compare(program, thin, compared_with, tool_diameter, findings)
     else:
-        dev, along, contours, compared = _measure(
-            program, trace, compared_with, tool_diameter, findings
+        if now is not None and budget and compared_with is not None:
+            prepare_comparison(compared_with)  # loaded once here, not once per worker
+        dev, along, contours, thin = _trace_measures(
+            program, trace, cutting=compared_with is not None
         )
-    times = block_times(trace, program, machine)
-    warnings.extend(timing_warnings(trace, program, machine))
-    return Verification(
-        target=name or machine.name,
-        program=program,
-        machine=machine,
-        trace=trace,
-        deviation=dev,
-        contours=contours,
-        against=compared,
-        block_time_s=times,
-        warnings=tuple(dict.fromkeys((*warnings, *placement))),
-        against_skipped=skipped,
-        along=along,
-        planned=planned,
-        budget=budget,
-        drawing=compared_with,
-        tool_diameter=tool_diameter,
-        findings=tuple(findings),
-    )
+    inputs = _Inputs(program, machine, trace, planned, compared_with, tool_diameter, findings)
+    # the budget's workers are forked once this process has loaded what the measures need
+    with nullcontext() if now is None else _BudgetRun(inputs, budget, now) as run:
+        compared = None
+        if thin is not None and compared_with is not None:  # the drawing, meanwhile
+            compared = _compare(program, thin, compared_with, tool_diameter, findings)
+        times = block_times(trace, program, machine)
+        warnings.extend(timing_warnings(trace, program, machine))
+        v = Verification(
+            target=name or machine.name,
+            program=program,
+            machine=machine,
+            trace=trace,
+            deviation=dev,
+            contours=contours,
+            against=compared,
+            block_time_s=times,
+            warnings=tuple(dict.fromkeys((*warnings, *placement))),
+            against_skipped=skipped,
+            along=along,
+            planned=planned,
+            budget=budget,
+            drawing=compared_with,
+            tool_diameter=tool_diameter,
+            findings=tuple(findings),
+        )
+        if run is not None:
+            with suppress(CamtoolError):  # then asked for, it is computed (and fails) again
+                v.__dict__["error_budget"] = run.gather(v)  # cached_property's own slot
+    return v
 
 
 def _simulate_big(
@@ -434,9 +458,9 @@ def _cutting_stream(program: Program, block_start: np.ndarray) -> CuttingStream:
 
     The cutting rows are those of the moves that are not rapids (as :func:`_cutting_rows`).
     """
-    rapid = _rapids(program)
-    rows = int(np.diff(block_start)[~rapid].sum()) if len(rapid) else 0
-    return CuttingStream(rapid, rows, AGAINST_RESOLUTION_MM)
+    return CuttingStream(
+        _rapids(program), _cutting_count(program, block_start), AGAINST_RESOLUTION_MM
+    )
 
 
 def _rows_at_least(program: Program, machine: Machine) -> int:
@@ -469,15 +493,27 @@ def _measure(
     ``overcut=False`` leaves the drawing's overcut out (0): the error budget, which
     re-measures once per source, has no figure of it.
     """
+    dev, along, contours, thin = _trace_measures(program, trace, cutting=against is not None)
+    compared = None
+    if against is not None and thin is not None:
+        compared = _compare(program, thin, against, tool_diameter, findings, overcut=overcut)
+    return dev, along, contours, compared
+
+
+def _trace_measures(
+    program: Program, trace: StepTrace, *, cutting: bool
+) -> tuple[Deviation, AlongPath, tuple[ContourMeasure, ...], ThinTrace | None]:
+    """The measures of ``trace`` itself, and its thinned cutting rows when ``cutting``.
+
+    The drawing comparison (:func:`_compare`) needs only the thinned rows, so a caller
+    that is done with the trace can let it go before comparing.
+    """
     points, blocks = trace.carriage_mm, trace.block_of_row
     dev = deviation(points, blocks, program)
     along = along_path(points, trace.block_start, trace.start_mm, program)
     contours = tuple(measure_contours(points, trace.block_start, trace.start_mm, program))
-    compared = None
-    if against is not None:
-        thin = thin_cutting(*_cutting_rows(program, trace))
-        compared = _compare(program, thin, against, tool_diameter, findings, overcut=overcut)
-    return dev, along, contours, compared
+    thin = thin_cutting(*_cutting_rows(program, trace)) if cutting else None
+    return dev, along, contours, thin
 
 
 def _compare(
@@ -509,6 +545,15 @@ def _rapids(program: Program) -> np.ndarray:
     return np.asarray([isinstance(m, Rapid) for m in program.moves], dtype=bool)
 
 
+def _cutting_count(program: Program, block_start: np.ndarray) -> int:
+    """Rows of the moves of ``program`` that are not rapids (their rows start at ``block_start``).
+
+    For a whole trace, the length of :func:`_cutting_rows`' answer.
+    """
+    rapid = _rapids(program)
+    return int(np.diff(block_start)[~rapid].sum()) if len(rapid) else 0
+
+
 def _cutting_rows(program: Program, trace: StepTrace) -> tuple[np.ndarray, np.ndarray]:
     """The trace's cutting rows ``(N, 2)`` mm and the id of each one's run between rapids."""
     points, blocks = trace.carriage_mm, trace.block_of_row
@@ -518,15 +563,17 @@ def _cutting_rows(program: Program, trace: StepTrace) -> tuple[np.ndarray, np.nd
     return points[cutting], runs
 
 
-def _same_against(v: Verification, program: Program, trace: StepTrace) -> bool:
+def _same_against(v: _Inputs, program: Program, trace: StepTrace) -> bool:
     """Whether the drawing comparison of ``trace`` (:func:`_compare`) gets exactly ``v``'s inputs.
 
     The same cutting rows, the same runs and (with findings) the same programmed path:
-    then its figures are ``v.against``'s, bit for bit, and need not be measured again
-    (the ``rounding`` source of a machine whose steps absorb the emitted rounding).
+    then its figures are the verification's own (``against``, measured whenever there
+    is a drawing), bit for bit, and need not be measured again (the ``rounding`` source
+    of a machine whose steps absorb the emitted rounding).
     """
-    if v.against is None or v.drawing is None:
-        return False
+    count = _cutting_count(program, trace.block_start)
+    if v.drawing is None or count != _cutting_count(v.program, v.trace.block_start):
+        return False  # told without copying the rows (1.8 M with the interpolation off)
     cut, runs = _cutting_rows(program, trace)
     cut_v, runs_v = _cutting_rows(v.program, v.trace)
     if not (np.array_equal(cut, cut_v) and np.array_equal(runs, runs_v)):
@@ -541,66 +588,142 @@ def _same_against(v: Verification, program: Program, trace: StepTrace) -> bool:
 
 def _budget(v: Verification, progress: Progress = no_progress) -> eb.ErrorBudget:
     """The error budget of ``v`` (see :attr:`Verification.error_budget`), told to ``progress``."""
-    total = eb.figures(v.deviation, v.along, v.contours, v.against)
-    notes = []
-    if len(v.contours) > eb.MAX_CONTOURS:
-        notes.append(
-            f"only the first {eb.MAX_CONTOURS} of {len(v.contours)} contours are in the budget"
+    inputs = _Inputs(
+        v.program, v.machine, v.trace, v.planned, v.drawing, v.tool_diameter, v.findings
+    )
+    with _BudgetRun(inputs, v.budget, progress) as run:
+        return run.gather(v)
+
+
+@dataclass(frozen=True)
+class _Inputs:
+    """What a verification measured: its program, machine and trace, and what it was told."""
+
+    program: Program
+    machine: Machine
+    trace: StepTrace
+    planned: Program | None
+    drawing: Drawing | None
+    tool_diameter: float
+    findings: Sequence[FindingLike]
+
+
+class _BudgetRun:
+    """The error budget's re-simulations, started in forked workers when it is made.
+
+    The workers (:class:`~camtool.model.cores.ForkedWork`, one per core) need only the
+    verification's inputs and trace, so they can start before all its measures are
+    taken (:func:`verify_program` starts them before the drawing comparison);
+    :meth:`gather` joins their figures with the verification's own. A context manager:
+    leaving it stops the workers.
+    """
+
+    def __init__(self, inputs: _Inputs, budget: bool, progress: Progress) -> None:
+        self.progress = progress
+        self.skipped: str | None = None
+        rows = inputs.trace.row_count
+        if not budget:
+            self.skipped = "switched off (--no-budget)"
+        elif rows > eb.MAX_ROWS:
+            self.skipped = (
+                f"the trace has {rows} rows (over {eb.MAX_ROWS}): re-simulating it once per "
+                "source would take too long; verify a part of the program to see it"
+            )
+        self.statuses = source_statuses(inputs.program, inputs.machine, planned=inputs.planned)
+        self.modelled = (
+            [] if self.skipped else [s.name for s in self.statuses if s.status == "modelled"]
         )
-    if not v.budget:
-        return eb.ErrorBudget(total, skipped="switched off (--no-budget)")
-    if v.trace.row_count > eb.MAX_ROWS:
-        return eb.ErrorBudget(
-            total,
-            skipped=f"the trace has {v.trace.row_count} rows (over {eb.MAX_ROWS}): re-simulating "
-            "it once per source would take too long; verify a part of the program to see it",
-        )
-    statuses = source_statuses(v.program, v.machine, planned=v.planned)
-    modelled = [s.name for s in statuses if s.status == "modelled"]
+        self._answered(0)
+        self.work = ForkedWork(partial(_without, inputs), self.modelled)
 
-    def answered(count: int) -> None:
-        if count < len(modelled):
-            progress(Step("budget", count, len(modelled), SOURCES[modelled[count]]))
+    def __enter__(self) -> _BudgetRun:
+        return self
 
-    answered(0)
-    measured = fork_map(partial(_without, v), modelled, done=answered)
-    notes.extend(note for _, note in measured if note is not None)
-    without = {name: values for name, (values, _) in zip(modelled, measured, strict=True)}
-    return eb.compute(total, statuses, without.__getitem__, notes=notes)
+    def __exit__(self, *exc: object) -> None:
+        self.work.close()
+
+    def _answered(self, count: int) -> None:
+        if count < len(self.modelled):
+            name = self.modelled[count]
+            self.progress(Step("budget", count, len(self.modelled), SOURCES[name]))
+
+    def gather(self, v: Verification) -> eb.ErrorBudget:
+        """The budget of ``v``, whose inputs and trace this run was made from.
+
+        Raises:
+            CamtoolError: a re-simulation fails (the full model did not).
+        """
+        total = eb.figures(v.deviation, v.along, v.contours, v.against)
+        if self.skipped is not None:
+            return eb.ErrorBudget(total, skipped=self.skipped)
+        notes = []
+        if len(v.contours) > eb.MAX_CONTOURS:
+            notes.append(
+                f"only the first {eb.MAX_CONTOURS} of {len(v.contours)} contours are in the budget"
+            )
+        without: dict[str, eb.Figures] = {}
+        for name, got in zip(self.modelled, self.work.answers(self._answered), strict=True):
+            values = got.values | (eb.against_figures(v.against) if got.same else {})
+            if got.blocks is not None and got.blocks != [c.blocks for c in v.contours]:
+                # the plan's moves are not the code's: only the whole-program figures compare
+                values = {k: x for k, x in values.items() if not k.startswith("contour ")}
+            if got.note is not None:
+                notes.append(got.note)
+            without[name] = values
+        return eb.compute(total, self.statuses, without.__getitem__, notes=notes)
 
 
-def _without(v: Verification, name: str) -> tuple[eb.Figures, str | None]:
-    """The figures of ``v`` re-simulated with the error source ``name`` off, and a note.
+@dataclass(frozen=True)
+class _Without:
+    """A verification re-simulated with one error source off (:func:`_without`).
+
+    Attributes:
+        values: its figures (:func:`camtool.verify.budget.figures`), the distance to the
+            drawing left out when ``same``.
+        same: its drawing comparison gets exactly the verification's inputs, so its
+            figure is the verification's own (:func:`_same_against`).
+        blocks: ``rounding`` only: the plan's contours' ``(first, last)`` moves.
+        note: why the source could not be compared (then ``values`` is empty).
+    """
+
+    values: eb.Figures
+    same: bool = False
+    blocks: list[tuple[int, int]] | None = None
+    note: str | None = None
+
+
+def _without(inputs: _Inputs, name: str) -> _Without:
+    """The verification of ``inputs`` re-simulated with the error source ``name`` off.
 
     ``rounding`` simulates the unrounded plan instead; when the plan does not simulate
     (not what this machine reads), no figure and a note that says why. The drawing is
-    measured again only when the cutting trace differs from ``v``'s (:func:`_same_against`).
+    measured again only when the cutting trace differs (:func:`_same_against`).
 
     Raises:
         CamtoolError: the re-simulation fails (the full model did not).
     """
-    program = v.program
+    program = inputs.program
     if name == "rounding":
-        assert v.planned is not None
+        assert inputs.planned is not None
         try:
-            program, trace = v.planned, simulate(v.planned, v.machine)
+            program, trace = inputs.planned, simulate(inputs.planned, inputs.machine)
         except CamtoolError as exc:  # the plan is not what this machine reads: say so
-            return {}, f"rounding not compared: the unrounded plan does not simulate ({exc})"
+            return _Without(
+                {}, note=f"rounding not compared: the unrounded plan does not simulate ({exc})"
+            )
     else:
-        trace = simulate(program, v.machine, sources=ALL.without(name))
-    same = _same_against(v, program, trace)  # then the drawing is not measured again
-    drawing = None if same else v.drawing
-    dev, along, contours, against = _measure(
-        program, trace, drawing, v.tool_diameter, v.findings, overcut=False
-    )
-    if same:
-        against = v.against
-    values = eb.figures(dev, along, contours, against)
-    if name == "rounding" and [c.blocks for c in contours] != [
-        c.blocks for c in v.contours
-    ]:  # the plan's moves are not the code's: only the whole-program figures compare
-        values = {k: x for k, x in values.items() if not k.startswith("contour ")}
-    return values, None
+        trace = simulate(program, inputs.machine, sources=ALL.without(name))
+    same = _same_against(inputs, program, trace)  # then the drawing is not measured again
+    drawing = None if same else inputs.drawing
+    dev, along, contours, thin = _trace_measures(program, trace, cutting=drawing is not None)
+    del trace  # ~50 MB of a 1.8 M-row trace, freed before the drawing's distances
+    against = None
+    if drawing is not None and thin is not None:
+        against = _compare(
+            program, thin, drawing, inputs.tool_diameter, inputs.findings, overcut=False
+        )
+    blocks = [c.blocks for c in contours] if name == "rounding" else None
+    return _Without(eb.figures(dev, along, contours, against), same, blocks)
 
 
 def source_statuses(

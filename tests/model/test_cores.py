@@ -106,3 +106,38 @@ def test_a_worker_process_runs_its_items_itself() -> None:
     assert worker is True
     assert [x for x, _ in got] == [1, 2] and got[0][1] == got[1][1] == child.pid
     assert not cores.in_worker()
+
+
+def test_forked_work_runs_while_this_process_works(tmp_path: Path) -> None:
+    """ForkedWork forks at once; its workers see the state of then, not what changes after."""
+    from camtool.model.cores import ForkedWork
+
+    state = {"offset": 10}
+    started = tmp_path / "started"
+
+    def work(x: int) -> int:
+        with started.open("a") as note:
+            note.write(f"{x}\n")
+        return x + state["offset"]
+
+    with ForkedWork(work, [1, 2, 3], jobs=2) as pending:
+        state["offset"] = 1000  # this process goes on; the workers were forked before
+        got = pending.answers()
+    assert got == [11, 12, 13]
+    assert sorted(started.read_text().split()) == ["1", "2", "3"]
+
+
+def test_leaving_forked_work_on_an_error_leaves_no_worker() -> None:
+    """An error raised here while the workers run: the with-block stops them, none is left."""
+    from camtool.model.cores import ForkedWork
+
+    pids: list[int] = []
+    pending = ForkedWork(lambda x: x, list(range(4)), jobs=2)
+    with pytest.raises(RuntimeError, match="this process failed"), pending:
+        assert pending._pool is not None
+        pids.extend(pending._pool._processes)  # type: ignore[attr-defined]
+        raise RuntimeError("this process failed")
+    assert pending._pool is None
+    for pid in pids:
+        with pytest.raises(ChildProcessError):
+            os.waitpid(pid, os.WNOHANG)  # reaped: not a child any more

@@ -322,3 +322,38 @@ def test_the_budget_made_in_workers_is_the_one_made_here(
     assert there == here and len(here.without) == 5
     made_by = pids.read_text().split()
     assert len(made_by) == 5 and str(os.getpid()) not in made_by
+
+
+def test_a_budget_asked_for_now_is_the_budget_asked_for_later() -> None:
+    """``budget_now``: made while the program is measured, told as measure_budget tells it."""
+    from camtool.model.progress import Step
+
+    machine = load_target("flashcut").machine
+    later = verify_program(_circle10(), machine, name="flashcut")
+    told_later: list[Step] = []
+    expected = later.measure_budget(told_later.append)
+    told: list[Step] = []
+    now = verify_program(_circle10(), machine, name="flashcut", budget_now=told.append)
+    assert "error_budget" in now.__dict__  # made before verify_program returned
+    assert now.error_budget == expected
+    assert [(s.stage, s.done, s.total, s.name) for s in told] == [
+        (s.stage, s.done, s.total, s.name) for s in told_later
+    ]
+    off = verify_program(_circle10(), machine, budget=False, budget_now=told.append)
+    assert off.error_budget.skipped == "switched off (--no-budget)" and len(told) == 5
+
+
+def test_a_budget_that_fails_now_fails_when_asked_for(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A re-simulation that fails does not stop the verification; asking for the budget does."""
+    from camtool.model.errors import InputError
+    from camtool.verify import verifier
+
+    def fails(inputs: object, name: str) -> object:
+        raise InputError(f"{name} cannot be simulated")
+
+    monkeypatch.setattr(verifier, "_without", fails)
+    machine = load_target("flashcut").machine
+    v = verify_program(_circle10(), machine, name="flashcut", budget_now=lambda step: None)
+    assert v.deviation.max_um > 0 and "error_budget" not in v.__dict__
+    with pytest.raises(InputError, match="interpolation cannot be simulated"):
+        v.error_budget  # noqa: B018 - asked for: it fails as it always did

@@ -16,7 +16,8 @@ from scipy.spatial import cKDTree
 from camtool.model.program import ArcMove, Linear, Program, Rapid
 from camtool.model.shapes import Arc, Contour, Drawing, Line
 from camtool.post.registry import load_target
-from camtool.verify import metrics
+from camtool.verify import metrics, verifier
+from camtool.verify.sources import ALL
 from camtool.verify.verifier import _cutting_rows, simulate, verify_program
 
 
@@ -311,3 +312,20 @@ def test_a_drawing_sampled_into_one_array_is_its_contours_stacked() -> None:
     parts = [metrics._sample_contour(c.segments, 0.013) for c in drawing.contours]
     assert sizes == [len(p) for p in parts]
     assert got.tobytes() == np.vstack(parts).tobytes()
+
+
+def test_the_cutting_count_is_the_count_of_cutting_rows() -> None:
+    """_same_against tells traces apart by their count before it copies any row."""
+    from camtool.verify.verifier import _cutting_count, _same_against
+
+    target = load_target("grbl")
+    program, drawing = _plate()
+    trace = simulate(program, target.machine)
+    assert _cutting_count(program, trace.block_start) == len(_cutting_rows(program, trace)[0])
+    assert 0 < _cutting_count(program, trace.block_start) < trace.row_count  # rapids left out
+    v = verify_program(program, target.machine, against=drawing, tool_diameter=0.5)
+    ideal = simulate(program, target.machine, sources=ALL.without("interpolation"))
+    assert _cutting_count(program, ideal.block_start) != _cutting_count(program, trace.block_start)
+    inputs = verifier._Inputs(program, target.machine, v.trace, None, drawing, 0.5, ())
+    assert not _same_against(inputs, program, ideal)
+    assert _same_against(inputs, program, trace)
