@@ -148,3 +148,30 @@ def test_a_lead_in_shortened_to_fit_is_named() -> None:
     assert lead.value is not None and lead.value < 2.0
     assert "--lead-in 2" in lead.message
     assert lead.message in plan.program.warnings
+
+
+def test_many_near_gaps_are_reported_nearest_first_and_counted(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """30 lines, each 0.05 + k·0.001 mm short of the next (29 gaps): 10 reported, nearest
+    first, the rest counted; only the 10 reported are written out (100 000 loose lines
+    made 240 000 messages)."""
+    from camtool.toolpath import gaps
+
+    lines, x = [], 0.0
+    for k in range(30):
+        lines.append(Contour((Line((x, 0.0), (x + 1.0, 0.0)),), False))
+        x += 1.0 + 0.05 + k * 0.001
+    written: list[float] = []
+    finding = gaps._finding
+
+    def counted(contours: Any, a: Any, b: Any, gap: float, options: Any) -> Any:
+        written.append(gap)
+        return finding(contours, a, b, gap, options)
+
+    monkeypatch.setattr(gaps, "_finding", counted)
+    found = gaps.open_gaps(lines, PlanOptions(feed_mm_min=100.0))
+    assert len(found) == gaps.MAX_REPORTED + 1 == len(written) + 1
+    assert [f.value for f in found[:-1]] == pytest.approx([0.05 + k * 0.001 for k in range(10)])
+    assert found[-1].message.startswith("19 more open end(s) lie near another (gaps up to 0.0780")
+    assert found[-1].value == pytest.approx(0.078)  # 29 gaps between 30 lines
