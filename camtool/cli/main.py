@@ -425,11 +425,30 @@ def main(argv: list[str] | None = None) -> int:
         click.echo(f"camtool: error: {exc}", err=True)
         return exc.exit_code
     except Exception as exc:  # a bug: still a message, never a traceback
+        if _interrupted(exc):
+            click.echo("camtool: aborted", err=True)
+            return 130
         click.echo(
             f"camtool: internal error: {type(exc).__name__}: {exc} (please report it)", err=True
         )
         return 1
     return code if isinstance(code, int) else 0  # a command's ctx.exit(n) returns n here
+
+
+def _interrupted(exc: BaseException) -> bool:
+    """Whether ``exc`` comes of Ctrl-C (a KeyboardInterrupt in its chain of causes).
+
+    A compiled kernel (numba) interrupted mid-call raises ``SystemError: ... returned a
+    result with an exception set`` from the KeyboardInterrupt.
+    """
+    seen: set[int] = set()
+    cause: BaseException | None = exc
+    while cause is not None and id(cause) not in seen:
+        if isinstance(cause, KeyboardInterrupt):
+            return True
+        seen.add(id(cause))
+        cause = cause.__cause__ or cause.__context__
+    return False
 
 
 if __name__ == "__main__":

@@ -404,3 +404,28 @@ def test_post_through_a_symlink_replaces_its_target(
     assert code == 0, err
     assert Path("prog.pic").is_symlink() and os.readlink("prog.pic") == "sub/prog.pic"
     assert Path("sub/prog.pic").read_bytes() == Path("part.pic").read_bytes()
+
+
+@pytest.mark.parametrize("raised", ["plain", "from a compiled kernel"])
+def test_ctrl_c_is_aborted_not_an_internal_error(
+    raised: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Ctrl-C while numba's kernel runs came out as 'internal error: SystemError ... returned a
+    result with an exception set'; it is the user stopping the job: 'aborted', exit 130."""
+    import camtool.jobs.pipeline as pipeline
+
+    def interrupted(*args: object, **kwargs: object) -> None:
+        if raised == "plain":
+            raise KeyboardInterrupt
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt as exc:  # what CPython raises for a C call that left it set
+            raise SystemError("CPUDispatcher(<function near_segments>) returned a result "
+                              "with an exception set") from exc  # fmt: skip
+
+    monkeypatch.setattr(pipeline, "verify_job", interrupted)
+    src = rectangle_dxf(tmp_path / "r.dxf")
+    code = main(["post", str(src), "-t", "grbl", "-o", str(tmp_path / "r.gcode"), "--verify"])
+    err = capsys.readouterr().err
+    assert code == 130
+    assert "camtool: aborted" in err and "internal error" not in err
