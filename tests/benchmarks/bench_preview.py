@@ -66,6 +66,15 @@ report and PNG identical. The verification's distance searches are cheaper (docs
 "Speed and memory"); planning alone is 2.9 s and 293 MB on this part (OpenCascade), so the
 goal is still out of reach without moving the offsets out of the process and skipping or
 approximating the error budget.
+
+Seventh pass (23 Nov 2026, quiet, ``make bench``): part 6.27 s, 284 MB; plate 5.72 s, 259 MB
+(sixth pass 8.95 s, 596 MB and 7.44 s, 498 MB; G-code, reports and pictures identical).
+The job's own process no longer loads OpenCASCADE (its offsets' child does, started as the
+job begins), and the error budget's sources are re-simulated in forked workers, one per
+core, while the job compares its trace with the drawing (docs/performance.md). The memory
+goal is met (MB here are MiB: ``ru_maxrss`` / 1024; 284 MiB is 298 × 10⁶ bytes); the time
+is not: reading and planning take ~1 s, the verification with its budget ~4.5 s on two
+cores, the picture ~0.6 s.
 """
 
 from __future__ import annotations
