@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Any
 
 from camtool.geometry.chain import joint_distance
 from camtool.model.shapes import Contour, Point
@@ -58,33 +59,84 @@ def open_gaps(contours: Sequence[Contour], options: PlanOptions) -> list[Finding
     xy = np.array([p for _, p in ends], dtype=np.float64)
     points = shapely.points(xy)
     tree = shapely.STRtree(points)
-    pairs = tree.query(points, predicate="dwithin", distance=near)
-    best: dict[tuple[int, int], float] = {}
-    for a, b in zip(*pairs, strict=True):
-        if a >= b:
-            continue
-        gap = math.dist(xy[a], xy[b])
-        if gap > joint:
-            best[(int(a), int(b))] = gap
-    found: list[tuple[float, int, int]] = []
-    for (a, b), gap in sorted(best.items(), key=lambda item: item[1]):
-        if ends[a][0] == ends[b][0] and gap >= GAP_SHARE * contours[ends[a][0]].length:
-            continue  # a "C": drawn open on purpose (close_gaps leaves it too)
-        found.append((gap, a, b))
-    # only the reported ones are written out (100 000 loose lines: 240 000 near pairs)
-    out = [_finding(contours, ends[a], ends[b], gap, options) for gap, a, b in found[:MAX_REPORTED]]
-    if len(found) > MAX_REPORTED:
-        largest = max(g for g, _, _ in found)
+    a, b = tree.query(points, predicate="dwithin", distance=near)
+    a, b = a[a < b], b[a < b]  # each pair once, in the order the tree gives them
+    exact = _Exact(xy, a, b)
+    keep = exact.above(np.arange(len(a)), joint)
+    owner = np.array([index for index, _ in ends])
+    for k in np.flatnonzero(keep & (owner[a] == owner[b])):  # a contour's own two ends
+        share = GAP_SHARE * contours[owner[a[k]]].length
+        keep[k] = not exact.above(np.array([k]), share, inclusive=True)[0]  # a "C": drawn
+        # open on purpose (close_gaps leaves it too)
+    kept = np.flatnonzero(keep)  # the near gaps, in the order the tree gives them
+    out = [
+        _finding(contours, ends[a[k]], ends[b[k]], exact.gap(k), options)
+        for k in exact.smallest(kept, MAX_REPORTED)
+    ]
+    if len(kept) > MAX_REPORTED:
+        largest = exact.largest(kept)
         out.append(
             Finding(
                 "open-gap",
-                f"{len(found) - MAX_REPORTED} more open end(s) lie near another (gaps up to "
+                f"{len(kept) - MAX_REPORTED} more open end(s) lie near another (gaps up to "
                 f"{fmt_num(largest, 4)} mm); --chain-tolerance {_option_value(largest)} joins "
                 "them all",
                 value=largest,
             )
         )
     return out
+
+
+class _Exact:
+    """The gaps of pairs of ends ``xy[a[k]]``, ``xy[b[k]]``: what ``math.dist`` gives, in bulk.
+
+    numpy's ``hypot`` and ``math.dist`` may differ in the last bit, so numpy decides only
+    what a relative margin of :data:`_MARGIN` (far above an ulp) leaves certain; every
+    comparison within it, and every value written out or ordered, is ``math.dist``'s.
+    """
+
+    def __init__(self, xy: Any, a: Any, b: Any) -> None:
+        import numpy as np
+
+        self.xy, self.a, self.b = xy, a, b
+        d = xy[b] - xy[a]
+        self.rough = np.hypot(d[:, 0], d[:, 1])
+
+    def gap(self, k: int) -> float:
+        return math.dist(self.xy[self.a[k]], self.xy[self.b[k]])
+
+    def above(self, ks: Any, limit: float, *, inclusive: bool = False) -> Any:
+        """``(len(ks),) bool``: gap ``> limit`` (``>=`` with ``inclusive``) for pairs ``ks``."""
+        import numpy as np
+
+        rough = self.rough[ks]
+        out = rough > limit
+        near = np.flatnonzero(np.abs(rough - limit) <= _MARGIN * max(limit, 1e-300))
+        for i in near:
+            gap = self.gap(int(ks[i]))
+            out[i] = gap >= limit if inclusive else gap > limit
+        return out
+
+    def smallest(self, ks: Any, count: int) -> list[int]:
+        """The ``count`` pairs of ``ks`` with the least gaps, least first, ties in ``ks`` order."""
+        import numpy as np
+
+        if len(ks) == 0:
+            return []
+        rough = self.rough[ks]
+        bound = np.partition(rough, min(count, len(ks)) - 1)[min(count, len(ks)) - 1]
+        maybe = ks[rough <= bound * (1.0 + _MARGIN)]  # the exact least are among these
+        return sorted((int(k) for k in maybe), key=lambda k: (self.gap(k), k))[:count]
+
+    def largest(self, ks: Any) -> float:
+        """The largest gap of the pairs ``ks`` (at least one)."""
+        rough = self.rough[ks]
+        maybe = ks[rough >= rough.max() * (1.0 - _MARGIN)]
+        return max(self.gap(int(k)) for k in maybe)
+
+
+_MARGIN = 1e-9
+"""Relative band around a limit within which the exact gap decides (an ulp is ~2e-16)."""
 
 
 def _finding(

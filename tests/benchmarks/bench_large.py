@@ -31,9 +31,9 @@ At 10⁵ disjoint lines (profiled) the importer takes about 27 %, planning 52 % 
 
 23 Nov 2026 (quiet, wall time of the CLI): 10⁵ disjoint lines took 45.3 s and 1.72 GB, of
 which the open-gap check made a message for each of its 240 000 near pairs of ends and
-reported ten; it now writes out only those: 24.8 s and 0.93 GB, the same G-code and
-findings. What is left of that check is its Python loop over the pairs (``math.dist``
-each, ~5 s).
+reported ten; it now writes out only those (24.8 s, 0.93 GB), and measures the pairs in
+bulk, ``math.dist`` only where it decides a comparison or a reported value: 15.9 s and
+0.38 GB (4·10⁴ lines 9.9 → 6.1 s), the same G-code and findings.
 """
 
 from __future__ import annotations
