@@ -547,12 +547,23 @@ def _run_here(
     jobs = min(options.jobs or os.cpu_count() or 1, len(tasks))
     if jobs > 1:
         return _run_pool(tasks, options, jobs, progress)
+    if len(tasks) > 1:
+        _offsets_here(options)
     rows = []
     for done, task in enumerate(tasks, start=1):
         rows.append(post_one(task, options))
         if progress is not None:
             progress(done, len(tasks), rows[-1])
     return tuple(rows)
+
+
+def _offsets_here(options: BatchOptions) -> None:
+    """Load OpenCASCADE here once when every file will be offset in this process, one by one."""
+    from camtool.toolpath.compensate import makes_offsets
+    from camtool.toolpath.offset import load_here
+
+    if makes_offsets(options.plan):
+        load_here()
 
 
 def _run_dask(

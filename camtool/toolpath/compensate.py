@@ -49,7 +49,7 @@ from camtool.toolpath.offset import quad_segs, start_ahead, stop_ahead
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.order import Nesting
 
-__all__ = ["compensate", "offsets_ahead", "tight_corners", "tool_inside"]
+__all__ = ["compensate", "makes_offsets", "offsets_ahead", "tight_corners", "tool_inside"]
 
 CORNER_TURN_DEG = 1.0
 """A joint turning more than this toward the tool is a corner the tool cannot follow."""
@@ -162,6 +162,14 @@ class _OffsetJob:
     occt: list[Contour] | ToolpathError | None = None
 
 
+def makes_offsets(options: PlanOptions) -> bool:
+    """Whether :func:`compensate` offsets closed contours with ``options`` (OpenCASCADE).
+
+    ``--offset`` other than ``on`` and a tool radius above 0 (:func:`_offset_jobs`).
+    """
+    return options.offset != "on" and options.radius > 0
+
+
 @contextmanager
 def offsets_ahead(options: PlanOptions) -> Iterator[None]:
     """Within it, the child that will make the offsets loads OpenCASCADE meanwhile.
@@ -172,7 +180,7 @@ def offsets_ahead(options: PlanOptions) -> Iterator[None]:
     that it loads OpenCASCADE (~0.5 s) on another core while this process reads and
     plans; leaving stops it if no offsets used it. The plan is the same either way.
     """
-    if options.offset != "on" and options.radius > 0:
+    if makes_offsets(options):
         start_ahead()
     try:
         yield

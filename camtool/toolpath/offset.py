@@ -24,6 +24,7 @@ import math
 import os
 import pickle
 import signal
+import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -203,11 +204,27 @@ def start_ahead() -> None:
     It loads OpenCASCADE while this process goes on reading and planning (on another
     core: ~0.5 s off a profiled part's ``post``), then waits for :func:`offset_all`'s
     jobs. Nothing is started where :func:`offset_all` would not use it: without ``fork``,
-    in a worker process, after this process's first offsets, or when one is waiting
-    already. :func:`stop_ahead` stops it if no offsets came.
+    in a worker process, after this process's first offsets, when one is waiting already,
+    or when this process holds OpenCASCADE itself (:func:`load_here`). :func:`stop_ahead`
+    stops it if no offsets came.
     """
-    if FORK and not _AHEAD and _OFFSET_CALLS[0] == 0 and not in_worker():
+    if FORK and not _AHEAD and _OFFSET_CALLS[0] == 0 and not in_worker() and not _occt_here():
         _AHEAD.append(_Child())
+
+
+def load_here() -> None:
+    """Load OpenCASCADE into this process now, for one that makes offsets job after job.
+
+    ``camtool batch --jobs 1`` posts its files one after the other in its own process:
+    each job's child then inherits OpenCASCADE (loaded once, not once a job), and no child
+    is started ahead (:func:`start_ahead`), whose load a small job would only wait for.
+    """
+    _load_occt()
+
+
+def _occt_here() -> bool:
+    """Whether this process has loaded OpenCASCADE (:func:`_load_occt`)."""
+    return "OCP.BRepOffsetAPI" in sys.modules
 
 
 def stop_ahead() -> None:
