@@ -147,21 +147,22 @@ class ErrorBudget:
 def compute(
     total: Figures,
     statuses: Sequence[SourceStatus],
-    measure_without: Callable[[str], Figures],
+    without: Mapping[str, Figures],
     *,
     notes: Sequence[str] = (),
 ) -> ErrorBudget:
-    """The budget: ``measure_without(source)`` for every modelled source.
+    """The budget: ``without[source]``, the figures re-measured with that source off.
 
     A figure that the re-simulation does not have (the program read differently)
-    is left out of that source's column.
+    is left out of that source's column; the columns follow the modelled sources
+    of ``statuses``, in order.
     """
-    without: dict[str, Figures] = {}
-    for status in statuses:
-        if status.status == "modelled":
-            values = measure_without(status.name)
-            without[status.name] = {k: v for k, v in values.items() if k in total}
-    return ErrorBudget(total, without, tuple(statuses), None, tuple(notes))
+    columns = {
+        s.name: {k: v for k, v in without[s.name].items() if k in total}
+        for s in statuses
+        if s.status == "modelled"
+    }
+    return ErrorBudget(total, columns, tuple(statuses), None, tuple(notes))
 
 
 def to_json(b: ErrorBudget, digits: Callable[[float], float]) -> dict[str, Any]:

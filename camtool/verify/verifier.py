@@ -148,7 +148,7 @@ class Verification:
         """The error budget by source (:mod:`camtool.verify.budget`), computed on first use.
 
         Re-simulates the program once per modelled source, the sources shared out among
-        forked workers (:func:`camtool.model.cores.fork_map`: the same figures as one
+        forked workers (:class:`camtool.model.cores.ForkedWork`: the same figures as one
         after the other); skipped (with the reason) when :attr:`budget` is off or the
         trace is over :data:`camtool.verify.budget.MAX_ROWS` rows.
 
@@ -164,7 +164,7 @@ class Verification:
         and as each source's figures come in (``done`` the sources finished, ``total`` the
         modelled ones, ``name`` the next in order), so a long verification can say what
         it is doing; the budget is the same. The sources are re-simulated in forked
-        workers, one per core (:func:`camtool.model.cores.fork_map`): the part of
+        workers, one per core (:class:`camtool.model.cores.ForkedWork`): the part of
         issue 17's preview bench takes 2.6 s for its three where it took 3.8 s.
 
         Raises:
@@ -670,7 +670,7 @@ class _BudgetRun:
             if got.note is not None:
                 notes.append(got.note)
             without[name] = values
-        return eb.compute(total, self.statuses, without.__getitem__, notes=notes)
+        return eb.compute(total, self.statuses, without, notes=notes)
 
 
 @dataclass(frozen=True)
