@@ -604,8 +604,7 @@ def _nearest(
     a = np.ascontiguousarray(a, dtype=np.float64)
     b = np.ascontiguousarray(b, dtype=np.float64)
     half = float(np.max(np.hypot(*(b - a).T))) / 2.0
-    # the caller's ends are these very points (its k-d tree's): not made twice
-    points = np.concatenate([a, b]) if ends is None else _float_rows(ends.points)
+    points = np.concatenate([a, b])
     boxes, offsets = kernels.build(points)
     if not _far(samples, points, boxes, offsets, half, kernels):
         return _nearest_kd(samples, a, b, ends=ends, only_max=only_max)
@@ -702,11 +701,6 @@ def _tied(
 
 TIED_CHUNK = 2_000
 """Samples :func:`_tied` measures at once."""
-
-
-def _float_rows(points: FloatArray) -> FloatArray:
-    """``points`` as a C-contiguous float64 array (itself when it is one already)."""
-    return np.ascontiguousarray(points, dtype=np.float64)
 
 
 class _LazyTree:
