@@ -258,10 +258,9 @@ def _load_occt() -> None:
 class _Child:
     """A forked child that loads OpenCASCADE and makes the offsets sent to it.
 
-    It reads a pickled list of jobs, answers each as it is made (a pickled ``("ok",
-    pieces)`` or ``("error", message)``) and waits for the next list; it leaves when its
-    jobs pipe closes (:meth:`close`, or this process ending), without running any of
-    this process's code.
+    It reads one pickled list of jobs (:meth:`make`), answers each as it is made (a pickled
+    ``("ok", pieces)`` or ``("error", message)``) and leaves, without running any of this
+    process's code; one started ahead and never used is killed (:meth:`close`).
     """
 
     def __init__(self) -> None:
@@ -335,17 +334,16 @@ class _Child:
 
 
 def _serve(inbox: Any, out: Any) -> None:
-    """In the child: answer each list of jobs read from ``inbox`` until it closes."""
-    while True:
-        try:
-            jobs = pickle.load(inbox)
-        except EOFError:
-            return
-        for contour, amount in jobs:
-            got = _attempt(contour, amount)
-            record = ("error", str(got)) if isinstance(got, ToolpathError) else ("ok", got)
-            pickle.dump(record, out, protocol=pickle.HIGHEST_PROTOCOL)
-            out.flush()
+    """In the child: answer the list of jobs read from ``inbox`` (none if it closes first)."""
+    try:
+        jobs = pickle.load(inbox)
+    except EOFError:  # this process ended before it sent any
+        return
+    for contour, amount in jobs:
+        got = _attempt(contour, amount)
+        record = ("error", str(got)) if isinstance(got, ToolpathError) else ("ok", got)
+        pickle.dump(record, out, protocol=pickle.HIGHEST_PROTOCOL)
+        out.flush()
 
 
 def _quiet_crash() -> None:
