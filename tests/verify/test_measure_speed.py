@@ -252,11 +252,16 @@ def test_sample_batches_are_the_slices_of_the_whole_samples(size: int) -> None:
     )
     program = Program(moves, origin=(0.0, 0.0))
     starts = [program.origin] + [(m.x, m.y) for m in program.moves]
-    whole, owner = metrics._sample_moves(program, starts, 1, 4, 0.01)
+    whole, owner, along = metrics._sample_moves(program, starts, 1, 4, 0.01)
     pieces = list(metrics._sample_batches(program, starts, 1, 4, 0.01, size))
-    assert [len(p) for p, _ in pieces[:-1]] == [size] * (len(pieces) - 1)
-    assert np.concatenate([p for p, _ in pieces]).tobytes() == whole.tobytes()
-    assert np.array_equal(np.concatenate([o for _, o in pieces]), owner)
+    assert [len(p) for p, _, _ in pieces[:-1]] == [size] * (len(pieces) - 1)
+    assert np.concatenate([p for p, _, _ in pieces]).tobytes() == whole.tobytes()
+    assert np.array_equal(np.concatenate([o for _, o, _ in pieces]), owner)
+    assert np.concatenate([t for _, _, t in pieces]).tobytes() == along.tobytes()
+    # each move's fractions run from 0 at its start to 1 at its end
+    for move in (1, 2, 3, 4):
+        t = along[owner == move]
+        assert t[0] == 0.0 and t[-1] == 1.0 and np.all(np.diff(t) > 0)
     assert set(owner.tolist()) == {1, 2, 3, 4}
 
 
