@@ -1275,8 +1275,8 @@ class _Places:
 
     Attributes:
         trace: the trace.
-        points: ``(K, 2)`` its points that moved (each unlike the one before): the same
-            polyline without its segments of no length.
+        index: ``(K,)`` its points that moved (each unlike the one before; int32 below
+            2**31 points): the same polyline without its segments of no length.
         keys: ``(K,)`` their places, non-decreasing.
     """
 
@@ -1285,20 +1285,23 @@ class _Places:
     ) -> None:
         self.trace = trace
         first, last = spans
-        keys = np.empty(len(trace), dtype=np.float64)
-        for lo in range(0, len(trace), SHORTFALL_CHUNK):
-            index = np.arange(lo, min(lo + SHORTFALL_CHUNK, len(trace)), dtype=np.int64)
+        # a row that did not move the carriage adds a segment of no length: the points
+        # that moved make the same polyline, and the window then spans real segments
+        moved = np.ones(len(trace), dtype=bool)
+        for lo in range(1, len(trace), SHORTFALL_CHUNK):
+            part = slice(lo, lo + SHORTFALL_CHUNK)
+            here, before = trace[part], trace[lo - 1 : lo - 1 + len(trace[part])]
+            moved[part] = (here[:, 0] != before[:, 0]) | (here[:, 1] != before[:, 1])
+        self.index = np.flatnonzero(moved).astype(np.int32 if len(trace) < 2**31 else np.int64)
+        del moved
+        keys = np.empty(len(self.index), dtype=np.float64)
+        for lo in range(0, len(keys), SHORTFALL_CHUNK):
+            index = self.index[lo : lo + SHORTFALL_CHUNK].astype(np.int64)
             move = np.minimum(np.searchsorted(last, index), len(last) - 1)
             rows = np.maximum(last[move] - first[move], 1)
             by_row = (index - first[move]) / rows
             keys[lo : lo + len(index)] = move + _foot_fraction(trace[index], move, nominal, by_row)
-        keys = np.maximum.accumulate(keys) if len(keys) else keys
-        # a row that did not move the carriage adds a segment of no length: the points
-        # that moved make the same polyline, and the window then spans real segments
-        moved = np.ones(len(trace), dtype=bool)
-        moved[1:] = np.any(trace[1:] != trace[:-1], axis=1)
-        self.points = trace if moved.all() else trace[moved]
-        self.keys = keys if moved.all() else keys[moved]
+        self.keys = np.maximum.accumulate(keys, out=keys) if len(keys) else keys
 
 
 def _foot_fraction(
@@ -1374,7 +1377,7 @@ class _Bounded:
         if len(samples) == 0 or len(trace) < 2:  # one point: nothing to bound with
             self.reach = np.full(len(samples), math.inf)
         else:
-            scale = max(float(np.max(np.abs(samples))), float(np.max(np.abs(trace))))
+            scale = max(_largest_magnitude(samples), _largest_magnitude(trace))
             self.slack = 1e-12 + 64.0 * float(np.spacing(scale))
             if reach is None:
                 upper = _window_bounds(samples, move + t, places)
@@ -1426,6 +1429,11 @@ class _Bounded:
         return far, int(index[k])
 
 
+def _largest_magnitude(values: FloatArray) -> float:
+    """``max(|values|)`` without an array of the magnitudes (a trace's would be ~6 MB)."""
+    return max(abs(float(np.max(values))), abs(float(np.min(values))))
+
+
 def _least_distance(p: FloatArray, trace: FloatArray) -> float:
     """Distance of the point ``p`` ``(2,)`` to the polyline ``trace`` ``(M >= 2, 2)``, mm."""
     least = math.inf
@@ -1456,8 +1464,8 @@ def _window_bounds(samples: FloatArray, place: FloatArray, places: _Places) -> F
     whose places (:class:`_Places`) enclose the sample's. Each is a distance to one
     segment of the trace, so no less than the distance to them all.
     """
-    trace = places.points
-    m = len(trace) - 1
+    trace, moved = places.trace, places.index
+    m = len(moved) - 1
     if m == 0:  # the carriage never moved: the one point
         return np.hypot(samples[:, 0] - trace[0, 0], samples[:, 1] - trace[0, 1])
     out = np.empty(len(samples), dtype=np.float64)
@@ -1468,8 +1476,9 @@ def _window_bounds(samples: FloatArray, place: FloatArray, places: _Places) -> F
         best = np.full(len(px), np.inf)
         for off in range(-SHORTFALL_WINDOW, SHORTFALL_WINDOW + 1):
             k = np.clip(centre + off, 0, m - 1)
-            ax, ay = trace[k, 0], trace[k, 1]
-            d = _segment_formula(px - ax, py - ay, trace[k + 1, 0] - ax, trace[k + 1, 1] - ay)
+            i, j = moved[k], moved[k + 1]
+            ax, ay = trace[i, 0], trace[i, 1]
+            d = _segment_formula(px - ax, py - ay, trace[j, 0] - ax, trace[j, 1] - ay)
             np.minimum(best, d, out=best)
         out[part] = best
     return out
