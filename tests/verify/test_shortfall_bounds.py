@@ -17,37 +17,12 @@ import math
 import numpy as np
 import pytest
 
-from camtool.model.program import ArcMove, Linear, Program, Rapid
+from camtool.model.program import Linear, Program, Rapid
 from camtool.post.registry import load_target
 from camtool.verify import metrics
 from camtool.verify.simulate import simulate_steps
-
-TARGETS = ("pic-mmh", "flashcut", "valcnc", "i8751", "grbl")
-"""Targets of the step simulator: backlash that holds the carriage at a move's start
-(pic-mmh), compensation rows, chords (grbl)."""
-
-
-def _program(seed: int) -> Program:
-    """Zig-zags (reversals), a full circle, an arc-cornered square, zero-length moves."""
-    rng = np.random.default_rng(seed)
-    moves: list[Linear | ArcMove | Rapid] = [Rapid(1.0, 1.0, contour=1)]
-    for _ in range(int(rng.integers(3, 9))):
-        x = round(float(rng.uniform(0.5, 6.0)), 3)
-        y = round(float(rng.uniform(0.5, 6.0)), 3)
-        moves.append(Linear(x, y, 300.0, contour=1))
-    moves.append(Linear(x, y, 300.0, contour=1))  # no XY length
-    moves.append(Rapid(4.5, 3.0, contour=2))
-    moves.append(ArcMove(4.5, 3.0, 3.5, 3.0, bool(seed % 2), 300.0, contour=2))
-    moves.append(Rapid(1.0, 1.0, contour=3))
-    moves += [
-        Linear(2.0, 1.0, 300.0, contour=3),
-        ArcMove(2.5, 1.5, 2.0, 1.5, False, 300.0, contour=3),
-        Linear(2.5, 2.5, 300.0, contour=3),
-        Linear(1.0, 2.5, 300.0, contour=3),
-        Linear(1.0, 1.0, 300.0, contour=3),
-    ]
-    moves.append(Rapid(0.5, 0.5))
-    return Program(tuple(moves), origin=(0.0, 0.0))
+from tests.verify.programs import TARGETS
+from tests.verify.programs import mixed_program as _program
 
 
 def _shortfall_reference(
