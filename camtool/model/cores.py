@@ -10,22 +10,25 @@ run here afterwards, in order, so an error is raised as it would be without work
 Where ``fork`` is missing, with one core, or in a process that is itself a worker
 (``camtool batch``'s pool, a Dask worker: the cores are busy with other files already), every
 item runs here, one after the other. Forking is safe where camtool calls it: camtool starts
-no thread that outlives a call (scipy's query threads and the verifier's thread pool are
-joined before they return), numba's threading layer is never started (no kernel is
-``parallel``), and OpenBLAS re-makes its idle threads in its own ``pthread_atfork`` handler.
+no thread that outlives a call (scipy's query threads, the verifier's thread pool and
+:func:`ahead`'s thread are joined before they return), numba's threading layer is never
+started (no kernel is ``parallel``), and OpenBLAS re-makes its idle threads in its own
+``pthread_atfork`` handler.
 """
 
 from __future__ import annotations
 
 import multiprocessing
 import os
+import queue
 import signal
 import sys
-from collections.abc import Callable, Sequence
+import threading
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import Any, Generic, TypeVar
 
-__all__ = ["FORK", "ForkedWork", "default_jobs", "fork_map", "in_worker"]
+__all__ = ["FORK", "ForkedWork", "ahead", "default_jobs", "fork_map", "in_worker"]
 
 T = TypeVar("T")
 R = TypeVar("R")
@@ -51,6 +54,60 @@ def in_worker() -> bool:
     """
     current = multiprocessing.current_process()
     return bool(current.daemon) or multiprocessing.parent_process() is not None
+
+
+def ahead(items: Iterable[T]) -> Iterator[T]:
+    """``items`` in order, the next one made in a thread while the caller works on this one.
+
+    For a producer and a consumer that both spend their time where Python lets go of the
+    GIL (numba's ``nogil`` kernels, numpy on large arrays), the two run on two cores. One
+    item is made ahead, never more, so at most two are held beyond the caller's (memory).
+    An exception raised while making an item is raised here, at that item's place, after
+    the items before it. Leaving the loop early (``break``, an error, Ctrl-C) stops the
+    thread once it has made its current item, and it is joined before this returns: no
+    thread outlives the loop (forking stays safe). With one core, or in a worker process
+    (:func:`in_worker`), the items are made here, one after the other.
+    """
+    if default_jobs() < 2 or in_worker():
+        yield from items
+        return
+    made: queue.Queue[tuple[bool, Any]] = queue.Queue(maxsize=1)
+    stop = threading.Event()
+
+    def hand(done: bool, value: Any) -> bool:
+        while not stop.is_set():
+            try:
+                made.put((done, value), timeout=0.05)
+                return True
+            except queue.Full:
+                continue
+        return False
+
+    def make() -> None:
+        try:
+            for item in items:
+                if not hand(False, item):
+                    return
+            hand(True, None)
+        except BaseException as exc:  # raised in the caller's thread, at its place
+            hand(True, exc)
+
+    thread = threading.Thread(target=make, name="camtool-ahead", daemon=True)
+    thread.start()
+    try:
+        while True:
+            done, value = made.get()
+            if done:
+                if value is not None:
+                    raise value
+                return
+            yield value
+    finally:
+        stop.set()
+        thread.join()
+        close = getattr(items, "close", None)
+        if close is not None:  # a generator left early: its own clean-up, here
+            close()
 
 
 def fork_map(

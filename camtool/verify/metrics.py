@@ -1729,7 +1729,9 @@ class _Contour:
         """The thinned trace (what :func:`_thinned` gives of the whole run)."""
         if self.every == 0:
             self._head_read()
-        return np.vstack(self.kept) if self.kept else np.zeros((0, 2))
+        if len(self.kept) > 1:  # joined once: the pieces are let go (6 MB for 400 000 rows)
+            self.kept = [np.vstack(self.kept)]
+        return self.kept[0] if self.kept else np.zeros((0, 2))
 
     def extent(self) -> tuple[float, float]:
         """:func:`_extent` of the run."""

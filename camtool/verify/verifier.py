@@ -40,7 +40,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from camtool.model.cores import ForkedWork
+from camtool.model.cores import ForkedWork, ahead
 from camtool.model.errors import CamtoolError, DialectError, InputError, UsageError
 from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Dwell, Home, Program, Rapid
@@ -422,7 +422,7 @@ def _simulate_big(
     stream = TraceStream(program, got, summary["start_mm"], kernels)
     cutting = None if against is None else _cutting_stream(program, got)
     try:
-        for chunk in sim.chunks():
+        for chunk in ahead(sim.chunks()):  # the next chunk simulated while this one is measured
             stream.add(
                 chunk.first_block,
                 chunk.block_start,

@@ -9,6 +9,8 @@ from __future__ import annotations
 import multiprocessing
 import os
 import signal
+import threading
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -141,3 +143,78 @@ def test_leaving_forked_work_on_an_error_leaves_no_worker() -> None:
     for pid in pids:
         with pytest.raises(ChildProcessError):
             os.waitpid(pid, os.WNOHANG)  # reaped: not a child any more
+
+
+def _threads_named(name: str) -> list[threading.Thread]:
+    return [t for t in threading.enumerate() if t.name == name]
+
+
+def test_ahead_gives_the_items_in_order_each_made_in_its_thread(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.setattr(cores, "default_jobs", lambda: 2)
+    makers: list[str] = []
+
+    def made() -> Iterator[int]:
+        for k in range(50):
+            makers.append(threading.current_thread().name)
+            yield k
+
+    assert list(cores.ahead(made())) == list(range(50))
+    assert set(makers) == {"camtool-ahead"}
+    assert not _threads_named("camtool-ahead")  # joined
+
+
+def test_ahead_raises_an_error_at_its_place(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(cores, "default_jobs", lambda: 2)
+
+    def made() -> Iterator[int]:
+        yield 1
+        yield 2
+        raise InputError("line 3: no")
+
+    got: list[int] = []
+    with pytest.raises(InputError, match="line 3: no"):
+        for item in cores.ahead(made()):
+            got.append(item)
+    assert got == [1, 2]
+    assert not _threads_named("camtool-ahead")
+
+
+def test_leaving_ahead_early_stops_and_closes_the_maker(monkeypatch: pytest.MonkeyPatch) -> None:
+    """At most one item is made past the one the caller stopped at; the generator is closed."""
+    monkeypatch.setattr(cores, "default_jobs", lambda: 2)
+    started: list[int] = []
+    closed: list[bool] = []
+
+    def made() -> Iterator[int]:
+        try:
+            for k in range(1000):
+                started.append(k)
+                yield k
+        finally:
+            closed.append(True)
+
+    for item in cores.ahead(made()):
+        if item == 3:
+            break
+    assert not _threads_named("camtool-ahead")
+    assert closed == [True]
+    assert max(started) <= 5  # 3 taken, one in the queue, one being handed
+
+
+def test_ahead_makes_the_items_here_in_a_worker_or_on_one_core(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    for jobs, worker in ((1, False), (2, True)):
+        monkeypatch.setattr(cores, "default_jobs", lambda jobs=jobs: jobs)
+        monkeypatch.setattr(cores, "in_worker", lambda worker=worker: worker)
+        makers: list[str] = []
+
+        def made(makers: list[str] = makers) -> Iterator[int]:
+            for k in range(3):
+                makers.append(threading.current_thread().name)
+                yield k
+
+        assert list(cores.ahead(made())) == [0, 1, 2]
+        assert set(makers) == {threading.current_thread().name}
