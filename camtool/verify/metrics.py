@@ -1266,33 +1266,43 @@ class _Places:
     (:func:`_fractions`). Where the backlash holds the carriage at a move's start, or
     the rows crowd, the place still finds the rows beside a sample.
 
+    The trace is given as its segments ``a[i] → b[i]`` (``b[i] == a[i + 1]``; one
+    segment of no length for a trace of one point): the streamed verify holds them as
+    views of the k-d tree's array of segment ends, not the trace beside it (6 MB).
+
     Args:
-        trace: ``(M, 2)`` the contour's thinned trace (:func:`_thinned`), mm.
-        spans: ``(J,)`` each move's first and ``(J,)`` last index in ``trace``
+        a: ``(S, 2)`` segment starts, mm (the trace less its last point).
+        b: ``(S, 2)`` segment ends, mm (the trace less its first point).
+        spans: ``(J,)`` each move's first and ``(J,)`` last index in the trace
             (:func:`_move_spans`).
         nominal: the contour's moves' nominal geometry (:func:`nominal_arrays` of the
             program, rows ``first..last``).
 
     Attributes:
-        trace: the trace.
-        index: ``(K,)`` its points that moved (each unlike the one before; int32 below
-            2**31 points): the same polyline without its segments of no length.
+        a, b: the segments.
+        index: ``(K,)`` the trace points that moved (each unlike the one before; int32
+            below 2**31 points): the same polyline without its segments of no length.
         keys: ``(K,)`` their places, non-decreasing.
     """
 
     def __init__(
-        self, trace: FloatArray, spans: tuple[IntArray, IntArray], nominal: dict[str, FloatArray]
+        self,
+        a: FloatArray,
+        b: FloatArray,
+        spans: tuple[IntArray, IntArray],
+        nominal: dict[str, FloatArray],
     ) -> None:
-        self.trace = trace
+        self.a, self.b = a, b
         first, last = spans
         # a row that did not move the carriage adds a segment of no length: the points
         # that moved make the same polyline, and the window then spans real segments
-        moved = np.ones(len(trace), dtype=bool)
-        for lo in range(1, len(trace), SHORTFALL_CHUNK):
+        points = len(a) + 1 if len(a) > 1 or np.any(a != b) else 1
+        moved = np.ones(points, dtype=bool)
+        for lo in range(0, points - 1, SHORTFALL_CHUNK):
             part = slice(lo, lo + SHORTFALL_CHUNK)
-            here, before = trace[part], trace[lo - 1 : lo - 1 + len(trace[part])]
-            moved[part] = (here[:, 0] != before[:, 0]) | (here[:, 1] != before[:, 1])
-        self.index = np.flatnonzero(moved).astype(np.int32 if len(trace) < 2**31 else np.int64)
+            sa, sb = a[part], b[part]
+            moved[lo + 1 : lo + 1 + len(sa)] = (sa[:, 0] != sb[:, 0]) | (sa[:, 1] != sb[:, 1])
+        self.index = np.flatnonzero(moved).astype(np.int32 if points < 2**31 else np.int64)
         del moved
         keys = np.empty(len(self.index), dtype=np.float64)
         for lo in range(0, len(keys), SHORTFALL_CHUNK):
@@ -1300,8 +1310,16 @@ class _Places:
             move = np.minimum(np.searchsorted(last, index), len(last) - 1)
             rows = np.maximum(last[move] - first[move], 1)
             by_row = (index - first[move]) / rows
-            keys[lo : lo + len(index)] = move + _foot_fraction(trace[index], move, nominal, by_row)
+            keys[lo : lo + len(index)] = move + _foot_fraction(
+                self.point(index), move, nominal, by_row
+            )
         self.keys = np.maximum.accumulate(keys, out=keys) if len(keys) else keys
+
+    def point(self, index: IntArray) -> FloatArray:
+        """The trace points ``index`` ``(N, 2)``: ``a[i]``, or ``b[i - 1]`` for the last."""
+        out = self.b[np.maximum(index - 1, 0)]
+        out[index == 0] = self.a[0]
+        return out
 
 
 def _foot_fraction(
@@ -1357,9 +1375,11 @@ class _Bounded:
         samples: ``(N, 2)`` path samples, mm (:func:`_sample_moves`).
         move: ``(N,)`` each one's move, counted from the contour's first (0).
         t: ``(N,)`` how far along its move each lies, 0 to 1 (:func:`_fractions`).
-        places: the contour's thinned trace and its places.
+        places: the contour's thinned trace (its segments) and its places.
         ends: the k-d tree of the trace's segment ends (:func:`_trace_ends`), shared
             by the batches of one trace; built when needed otherwise.
+        reach: the bounds an earlier one of the same samples and trace made
+            (:attr:`reach`), instead of making them again.
     """
 
     def __init__(
@@ -1371,13 +1391,13 @@ class _Bounded:
         ends: _LazyTree | None = None,
         reach: FloatArray | None = None,
     ) -> None:
-        trace = places.trace
-        self.samples, self.places, self.trace, self.ends = samples, places, trace, ends
+        self.samples, self.places, self.ends = samples, places, ends
+        a, b = places.a, places.b
         self.slack = 0.0
-        if len(samples) == 0 or len(trace) < 2:  # one point: nothing to bound with
-            self.reach = np.full(len(samples), math.inf)
+        if len(samples) == 0:
+            self.reach = np.zeros(0)
         else:
-            scale = max(_largest_magnitude(samples), _largest_magnitude(trace))
+            scale = max(_largest_magnitude(samples), _largest_magnitude(a), _largest_magnitude(b))
             self.slack = 1e-12 + 64.0 * float(np.spacing(scale))
             if reach is None:
                 upper = _window_bounds(samples, move + t, places)
@@ -1400,10 +1420,12 @@ class _Bounded:
 
         ``run``: the point before the contour, then its rows; ``keep``: each move's last
         row in ``run``; ``nominal``: the contour's moves' (:class:`_Places`); ``reach``:
-        the bounds an earlier one of the same samples and run made (:attr:`reach`).
+        as for the class.
         """
         spans = _move_spans(len(run), _run_every(run), keep)
-        return cls(samples, move, t, _Places(_thinned(run, keep), spans, nominal), reach=reach)
+        trace = _thinned(run, keep)
+        a, b = (trace, trace) if len(trace) == 1 else (trace[:-1], trace[1:])
+        return cls(samples, move, t, _Places(a, b, spans, nominal), reach=reach)
 
     def farthest(self, floor: float = 0.0) -> tuple[float, int] | None:
         """:func:`_farthest_from_trace` of the samples, or ``None`` when none can reach ``floor``.
@@ -1417,15 +1439,14 @@ class _Bounded:
         top = int(np.argmax(self.reach))
         if self.reach[top] < floor:
             return None
-        if len(self.trace) < 2:
-            return _farthest_from_trace(self.samples, self.trace, self.ends)
+        a, b = self.places.a, self.places.b
         # the top sample's true distance: what it is measured is no less, nor the largest
-        least = _least_distance(self.samples[top], self.trace)
+        least = _least_distance(self.samples[top], a, b)
         known = max(floor, least * (1.0 - 1e-9) - self.slack)
         keep = self.reach >= known
         keep[top] = True
         index = np.flatnonzero(keep)
-        far, k = _farthest_from_trace(self.samples[index], self.trace, self.ends)
+        far, k = farthest_nearest(self.samples[index], a, b, ends=self.ends)
         return far, int(index[k])
 
 
@@ -1434,13 +1455,14 @@ def _largest_magnitude(values: FloatArray) -> float:
     return max(abs(float(np.max(values))), abs(float(np.min(values))))
 
 
-def _least_distance(p: FloatArray, trace: FloatArray) -> float:
-    """Distance of the point ``p`` ``(2,)`` to the polyline ``trace`` ``(M >= 2, 2)``, mm."""
+def _least_distance(p: FloatArray, a: FloatArray, b: FloatArray) -> float:
+    """Distance of the point ``p`` ``(2,)`` to the segments ``a → b`` ``(S, 2)``, mm."""
     least = math.inf
-    for lo in range(0, len(trace) - 1, SHORTFALL_CHUNK):
-        a, b = trace[lo : lo + SHORTFALL_CHUNK], trace[lo + 1 : lo + SHORTFALL_CHUNK + 1]
-        a = a[: len(b)]
-        d = _segment_formula(p[0] - a[:, 0], p[1] - a[:, 1], b[:, 0] - a[:, 0], b[:, 1] - a[:, 1])
+    for lo in range(0, len(a), SHORTFALL_CHUNK):
+        sa, sb = a[lo : lo + SHORTFALL_CHUNK], b[lo : lo + SHORTFALL_CHUNK]
+        d = _segment_formula(
+            p[0] - sa[:, 0], p[1] - sa[:, 1], sb[:, 0] - sa[:, 0], sb[:, 1] - sa[:, 1]
+        )
         least = min(least, float(np.min(d)))
     return least
 
@@ -1464,10 +1486,10 @@ def _window_bounds(samples: FloatArray, place: FloatArray, places: _Places) -> F
     whose places (:class:`_Places`) enclose the sample's. Each is a distance to one
     segment of the trace, so no less than the distance to them all.
     """
-    trace, moved = places.trace, places.index
+    a, b, moved = places.a, places.b, places.index
     m = len(moved) - 1
     if m == 0:  # the carriage never moved: the one point
-        return np.hypot(samples[:, 0] - trace[0, 0], samples[:, 1] - trace[0, 1])
+        return np.hypot(samples[:, 0] - a[0, 0], samples[:, 1] - a[0, 1])
     out = np.empty(len(samples), dtype=np.float64)
     for lo in range(0, len(samples), SHORTFALL_CHUNK):
         part = slice(lo, lo + SHORTFALL_CHUNK)
@@ -1476,9 +1498,9 @@ def _window_bounds(samples: FloatArray, place: FloatArray, places: _Places) -> F
         best = np.full(len(px), np.inf)
         for off in range(-SHORTFALL_WINDOW, SHORTFALL_WINDOW + 1):
             k = np.clip(centre + off, 0, m - 1)
-            i, j = moved[k], moved[k + 1]
-            ax, ay = trace[i, 0], trace[i, 1]
-            d = _segment_formula(px - ax, py - ay, trace[j, 0] - ax, trace[j, 1] - ay)
+            i, j = moved[k], moved[k + 1] - 1  # from point i (a[i]) to point j + 1 (b[j])
+            ax, ay = a[i, 0], a[i, 1]
+            d = _segment_formula(px - ax, py - ay, b[j, 0] - ax, b[j, 1] - ay)
             np.minimum(best, d, out=best)
         out[part] = best
     return out
@@ -1938,8 +1960,12 @@ class TraceStream:
         )
         trace = c.trace()
         ends = _trace_ends(trace)  # one k-d tree for every batch (when one is used)
+        segments = len(ends.points) // 2  # a and b: views of the tree's ends, not the trace
+        a, b = ends.points[:segments], ends.points[segments:]
+        del trace
+        c.kept = []  # the trace is let go: ~6 MB of a 400 000-point contour
         nominal = {k: v[c.first : c.last + 1] for k, v in self.nominal.items()}
-        places = _Places(trace, _move_spans(c.n, c.every, c.keep), nominal)
+        places = _Places(a, b, _move_spans(c.n, c.every, c.keep), nominal)
         batches = _sample_batches(program, starts, c.first, c.last, self.spacing, STREAM_SAMPLES)
         for samples, owner, t in batches:  # each sample's distance is its own
             self.samples += len(samples)
