@@ -202,6 +202,18 @@ def dda_line(dx: int, dy: int) -> StepArray:
     return dda_line_numpy(dx, dy)
 
 
+def dda_line_rows(dx: int, dy: int) -> int:
+    """How many rows :func:`dda_line` ``(dx, dy)`` gives, without making them.
+
+    ``floor(HIPO) + 1`` (0 for no move; HIPO as in :func:`dda_line`). Each axis pulses
+    ``|d|`` times (its counter stops at its projection, and ``k(N) = P`` at the last
+    row), every pulse the way of ``d``: a line reverses an axis at most once, at its
+    first pulse. ``tests/verify/test_count_rows.py`` checks both against the rows.
+    """
+    s = dx * dx + dy * dy
+    return math.isqrt(s) + 1 if s else 0
+
+
 def dda_line_numpy(dx: int, dy: int) -> StepArray:
     """:func:`dda_line` by the numpy closed form (no numba); same rows.
 

@@ -40,6 +40,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -49,7 +50,7 @@ from camtool.model.errors import InputError
 from camtool.model.machine import Backlash, Machine
 from camtool.model.program import ArcMove, Move, Program
 from camtool.model.shapes import Point, distance
-from camtool.verify.interpolators import compiled, sagitta_chord_points
+from camtool.verify.interpolators import compiled, dda_line, dda_line_rows, sagitta_chord_points
 from camtool.verify.motion import StepTrace, library
 from camtool.verify.quantize import Rounding, steps_from_mm
 from camtool.verify.sources import ALL, Sources
@@ -179,6 +180,32 @@ class _Controller:
         self.counts.append(len(rows))
         self.block_comp.append(int(comp.sum()))
         self.logical.append(end)
+        self.pos = end
+
+    def count_line(self, move: Move, rows_of: Callable[[int, int], int]) -> None:
+        """:meth:`block` of a line or rapid, its rows counted by ``rows_of``, not made.
+
+        ``rows_of``: the closed-form row count of this controller's line interpolator
+        (:data:`LINE_ROWS`), one whose every pulse on an axis goes the way of that
+        axis's move. Only the rows' count and the state the next block needs are kept:
+        the position, Z, each axis's direction and its reversals and compensations.
+        """
+        end = (self.to_steps(move.x, 0), self.to_steps(move.y, 1))
+        if move.z is not None:
+            self.z_pos = self.to_steps(move.z, 2)
+        dx, dy = end[0] - self.pos[0], end[1] - self.pos[1]
+        rows = rows_of(dx, dy)
+        for axis, d in ((0, dx), (1, dy)):
+            if d == 0:
+                continue
+            sign = 1 if d > 0 else -1
+            if self.direction[axis] not in (0, sign):  # reversed at its first pulse
+                self.reversals[axis] += 1
+                if self.comp_steps[axis] != 0:
+                    self.compensations += 1
+                    rows += int(self.comp_steps[axis])
+            self.direction[axis] = sign
+        self.counts.append(rows)
         self.pos = end
 
     def _arc(
@@ -593,6 +620,42 @@ def simulate_or_count(program: Program, machine: Machine, limit: int) -> StepTra
             sim.comp_parts.clear()
     if rows <= limit:
         return sim.finish(len(program.moves))
+    return np.concatenate(([0], np.cumsum(np.asarray(sim.counts, dtype=np.int64))))
+
+
+LINE_ROWS: dict[Callable[[int, int], StepArray], Callable[[int, int], int]] = {
+    dda_line: dda_line_rows,
+}
+"""Line interpolators whose rows :func:`count_rows` counts in closed form, and the count."""
+
+
+def count_rows(program: Program, machine: Machine) -> IntArray:
+    """The ``(B + 1,) int64`` row offsets of the moves of ``program``'s step trace.
+
+    What :func:`simulate_or_count` returns for a trace over its limit, without making the
+    rows of a line or rapid whose interpolator counts them in closed form
+    (:data:`LINE_ROWS`: the A.3 DDA's ``floor(HIPO) + 1``, and a compensation's rows at a
+    reversal); other moves (arcs, other interpolators, a line whose piece models
+    dynamics) are simulated, their rows dropped. :class:`ChunkedSimulation` makes the
+    same offsets again from the rows themselves, and the verifier compares the two.
+
+    Raises:
+        InputError: as :func:`simulate_or_count` (naming the block).
+    """
+    sim = _Controller(machine, program.origin, ALL)
+    rows_of = None if sim.inexact else LINE_ROWS.get(sim.line)
+    start = program.origin
+    for k, move in enumerate(program.moves):
+        try:
+            if rows_of is not None and not isinstance(move, ArcMove):
+                sim.count_line(move, rows_of)
+            else:
+                sim.block(start, move)
+                sim.parts.clear()
+                sim.comp_parts.clear()
+        except InputError as exc:
+            raise _at(program, k, exc) from exc
+        start = (move.x, move.y)
     return np.concatenate(([0], np.cumsum(np.asarray(sim.counts, dtype=np.int64))))
 
 

@@ -73,6 +73,7 @@ from camtool.verify.simulate import (
     ChunkedSimulation,
     NotStreamable,
     StreamedTrace,
+    count_rows,
     simulate_or_count,
     simulate_steps,
 )
@@ -409,36 +410,73 @@ def _simulate_big(
     """
     if library().simulator(machine.motion.line) is not None:
         return simulate(program, machine), None
-    if _rows_at_least(program, machine) > stream_above:
-        compiled()  # it will be streamed, which needs the kernels: count with them too
-    got = simulate_or_count(program, machine, stream_above)
+    counted = _rows_at_least(program, machine) > stream_above
+    if counted:  # it will be streamed: its rows are counted, and with the kernels
+        compiled()
+        got: StepTrace | np.ndarray = count_rows(program, machine)
+    else:
+        got = simulate_or_count(program, machine, stream_above)
     if isinstance(got, StepTrace):
         return got, None
     kernels = compiled()
     if kernels is None:
         return simulate(program, machine), None
-    sim = ChunkedSimulation(program, machine, chunk_rows)
-    summary = sim.trace_summary()
-    stream = TraceStream(program, got, summary["start_mm"], kernels)
-    cutting = None if against is None else _cutting_stream(program, got)
     try:
-        for chunk in ahead(sim.chunks()):  # the next chunk simulated while this one is measured
-            stream.add(
-                chunk.first_block,
-                chunk.block_start,
-                chunk.carriage_mm,
-                chunk.rows,
-                chunk.compensation,
-            )
-            if cutting is not None:
-                cutting.add(chunk.carriage_mm, chunk.block_of_row())
+        streamed = _stream(program, machine, against, chunk_rows, got, kernels)
+        if streamed is None and counted:  # the count was not the rows': count them again
+            got = simulate_or_count(program, machine, stream_above)
+            assert not isinstance(got, StepTrace)  # it has more rows than the limit
+            streamed = _stream(program, machine, against, chunk_rows, got, kernels)
     except NotStreamable:
         return simulate(program, machine), None
-    summary = sim.trace_summary()
-    if not np.array_equal(summary["block_start"], got):
+    if streamed is None:
         raise RuntimeError(
             "the chunked simulation did not repeat the first one"
         )  # pragma: no cover
+    return streamed
+
+
+def _stream(
+    program: Program,
+    machine: Machine,
+    against: Drawing | None,
+    chunk_rows: int,
+    block_start: np.ndarray,
+    kernels: Any,
+) -> (
+    tuple[StepTrace, tuple[Deviation, AlongPath, tuple[ContourMeasure, ...], ThinTrace | None]]
+    | None
+):
+    """:func:`_simulate_big`'s streamed trace and measures, its moves at ``block_start``.
+
+    ``None`` when the chunked simulation's rows do not start where ``block_start`` says
+    (the measures, which were told those offsets, are then not the trace's).
+
+    Raises:
+        NotStreamable: the rows are not whole steps.
+    """
+    sim = ChunkedSimulation(program, machine, chunk_rows)
+    summary = sim.trace_summary()
+    stream = TraceStream(program, block_start, summary["start_mm"], kernels)
+    cutting = None if against is None else _cutting_stream(program, block_start)
+    for chunk in ahead(sim.chunks()):  # the next chunk simulated while this one is measured
+        if not np.array_equal(
+            chunk.block_start,
+            block_start[chunk.first_block : chunk.first_block + len(chunk.block_start)],
+        ):
+            return None
+        stream.add(
+            chunk.first_block,
+            chunk.block_start,
+            chunk.carriage_mm,
+            chunk.rows,
+            chunk.compensation,
+        )
+        if cutting is not None:
+            cutting.add(chunk.carriage_mm, chunk.block_of_row())
+    summary = sim.trace_summary()
+    if not np.array_equal(summary["block_start"], block_start):
+        return None
     m = stream.finish()
     trace = StreamedTrace(
         rows=read_only(m.picture_steps),
@@ -446,7 +484,7 @@ def _simulate_big(
         block_of_row=read_only(m.picture_blocks),
         carriage_mm=read_only(m.picture_mm),
         **summary,
-        total_rows=int(got[-1]),
+        total_rows=int(block_start[-1]),
         total_compensation_steps=m.compensation_steps,
     )
     thin = None if cutting is None else cutting.finish()

@@ -1,0 +1,111 @@
+"""A streamed trace's rows are counted without being made where a closed form says how many.
+
+Issue 17: the streamed verify needs every move's row offsets before it measures, and
+counted them by simulating the whole program once more (0.6 s of a 66 M-step program).
+:func:`camtool.verify.simulate.count_rows` counts a line of the A.3 DDA as
+``floor(HIPO) + 1`` rows plus a compensation at a reversal. The judges: the rows the
+interpolator makes, and the offsets the full simulation gives.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from camtool.model.program import Linear, Program, Rapid
+from camtool.post.registry import load_target
+from camtool.verify import simulate as sim
+from camtool.verify import verifier
+from camtool.verify.interpolators import dda_line, dda_line_numpy, dda_line_rows
+from camtool.verify.verifier import build_report, verify_program
+from tests.verify.programs import TARGETS, mixed_program
+
+pytest.importorskip("camtool.verify.kernels")
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_dda_line_has_the_rows_its_count_says_each_pulse_its_axis_way(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    pairs = [(0, 0), (1, 0), (0, -1), (3, 4), (-3, 4), (7, 7), (1, 1000)]
+    pairs += [tuple(int(v) for v in rng.integers(-5000, 5000, 2)) for _ in range(200)]
+    pairs += [tuple(int(v) for v in rng.integers(-(10**6), 10**6, 2)) for _ in range(5)]
+    for dx, dy in pairs:
+        for line in (dda_line, dda_line_numpy):
+            rows = line(dx, dy)
+            assert len(rows) == dda_line_rows(dx, dy), (dx, dy)
+            for axis, d in ((0, dx), (1, dy)):
+                column = rows[:, axis].astype(np.int64)
+                assert int(np.abs(column).sum()) == abs(d)
+                assert set(np.sign(column[column != 0]).tolist()) <= {int(math.copysign(1, d))}
+
+
+def _zigzag(seed: int) -> Program:
+    """Lines and rapids that reverse both axes, stand still, and move Z (pic-mmh's area)."""
+    rng = np.random.default_rng(seed)
+    moves: list[Linear | Rapid] = [Rapid(1.0, 1.0, z=1.0)]
+    for k in range(40):
+        x = round(float(rng.uniform(0.5, 9.5)), 3)
+        y = round(float(rng.uniform(0.5, 6.5)), 3)
+        if k % 7 == 3:
+            moves.append(Rapid(x, y, z=1.0))
+        elif k % 11 == 5:
+            moves.append(Linear(moves[-1].x, moves[-1].y, 300.0, z=-0.5))  # Z only
+        else:
+            moves.append(Linear(x, y, 300.0, z=-0.5 if k % 2 else None))
+    return Program(tuple(moves), origin=(0.0, 0.0))
+
+
+@pytest.mark.parametrize("name", TARGETS)
+@pytest.mark.parametrize("seed", range(3))
+def test_counted_offsets_are_the_simulated_ones(name: str, seed: int) -> None:
+    """pic-mmh's lines counted in closed form, arcs and other machines simulated: the same."""
+    machine = load_target(name).machine
+    for program in (mixed_program(seed), _zigzag(seed)):
+        want = sim.simulate_or_count(program, machine, 0)
+        assert not isinstance(want, sim.StepTrace)
+        assert np.array_equal(sim.count_rows(program, machine), want)
+
+
+def test_pic_mmh_lines_are_counted_without_their_rows(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The closed form is what counts pic-mmh's lines: its interpolator is never asked."""
+    machine = load_target("pic-mmh").machine
+    program = _zigzag(5)
+    want = sim.simulate_or_count(program, machine, 0)
+    monkeypatch.setitem(sim.LINE_ROWS, dda_line, dda_line_rows)
+    made: list[int] = []
+    real = sim._Controller.block
+
+    def spy(self: sim._Controller, *args: object) -> None:
+        made.append(1)
+        real(self, *args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(sim._Controller, "block", spy)
+    assert np.array_equal(sim.count_rows(program, machine), want)
+    assert made == []
+
+
+def test_a_wrong_count_is_found_and_counted_again(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Were a closed form wrong, the streamed report is still the whole trace's."""
+    machine = load_target("pic-mmh").machine
+    program = _zigzag(2)
+    whole = build_report(verify_program(program, machine, name="pic-mmh", budget=False))
+    monkeypatch.setitem(sim.LINE_ROWS, dda_line, lambda dx, dy: dda_line_rows(dx, dy) + 1)
+    recounted: list[int] = []
+    real = verifier.simulate_or_count
+
+    def spy(*args: object) -> object:
+        recounted.append(1)
+        return real(*args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(verifier, "simulate_or_count", spy)
+    v = verify_program(
+        program, machine, name="pic-mmh", budget=False, chunk_rows=500, stream_above=10
+    )
+    assert isinstance(v.trace, sim.StreamedTrace)
+    assert recounted == [1]
+    got = build_report(v)
+    for report in (got, whole):
+        report["deviation_um"].pop("rms")  # summed exactly when streamed (test_stream.py)
+    assert got == whole
