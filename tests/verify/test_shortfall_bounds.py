@@ -61,7 +61,12 @@ def _shortfall(along: metrics.AlongPath) -> tuple[float, tuple[float, float], in
 
 @pytest.mark.parametrize("name", TARGETS)
 @pytest.mark.parametrize("seed", range(3))
-def test_the_shortfall_is_the_one_of_every_sample(name: str, seed: int) -> None:
+@pytest.mark.parametrize("bound_from", [0, metrics.SHORTFALL_BOUND_FROM])
+def test_the_shortfall_is_the_one_of_every_sample(
+    name: str, seed: int, bound_from: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Every contour bounded (0), and small ones measured at once (the default)."""
+    monkeypatch.setattr(metrics, "SHORTFALL_BOUND_FROM", bound_from)
     machine = load_target(name).machine
     program = _program(seed)
     trace = simulate_steps(program, machine)
@@ -103,8 +108,9 @@ def test_equal_shortfalls_name_the_first_contour(
     The bounds measure the likeliest contour first; a later one with an equal figure
     must not displace an earlier one (the loop kept the first strictly larger).
     ``later_first``: each later pass's bounds are made a little looser (still bounds),
-    so the passes are measured last first.
+    so the passes are measured last first. Every contour is bounded here, however small.
     """
+    monkeypatch.setattr(metrics, "SHORTFALL_BOUND_FROM", 0)
     if later_first:
         sample, real = metrics._sample_moves, metrics._Bounded.of_run
         passing = [0]
@@ -225,3 +231,22 @@ def test_a_floor_leaves_out_only_samples_that_cannot_reach_it(seed: int) -> None
             assert got == want
         else:
             assert got is None or got[0] < floor
+
+
+@pytest.mark.parametrize("bound_from", [0, 10**9])
+def test_a_streamed_shortfall_is_the_whole_ones(
+    bound_from: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Streamed (batches bounded against the worst so far, or all measured): the same."""
+    from camtool.verify.verifier import verify_program
+
+    monkeypatch.setattr(metrics, "SHORTFALL_BOUND_FROM", bound_from)
+    machine = load_target("pic-mmh").machine
+    for seed in range(3):
+        program = _program(seed)
+        trace = simulate_steps(program, machine)
+        want = _shortfall_reference(trace.carriage_mm, trace.block_start, trace.start_mm, program)
+        v = verify_program(
+            program, machine, name="pic-mmh", budget=False, chunk_rows=300, stream_above=10
+        )
+        assert _shortfall(v.along) == want
