@@ -407,6 +407,12 @@ def _simulate_big(
     drawing): the comparison needs only those, so the trace is not held whole for it
     (13 M rows of a 213-icon SVG job took 1.65 GB). Without the compiled kernels it is
     simulated whole.
+
+    The measures need every move's row offsets first: a trace sure to be streamed has
+    them counted (:func:`~camtool.verify.simulate.count_rows`, a DDA line in closed
+    form), others from a simulation that drops its rows. The chunks, made one ahead in a
+    thread (:func:`~camtool.model.cores.ahead`), say where each move's rows start; should
+    they not agree with the count, the offsets are simulated and the trace streamed again.
     """
     if library().simulator(machine.motion.line) is not None:
         return simulate(program, machine), None
@@ -425,7 +431,8 @@ def _simulate_big(
         streamed = _stream(program, machine, against, chunk_rows, got, kernels)
         if streamed is None and counted:  # the count was not the rows': count them again
             got = simulate_or_count(program, machine, stream_above)
-            assert not isinstance(got, StepTrace)  # it has more rows than the limit
+            if isinstance(got, StepTrace):  # not over the limit after all: the whole trace
+                return got, None
             streamed = _stream(program, machine, against, chunk_rows, got, kernels)
     except NotStreamable:
         return simulate(program, machine), None
