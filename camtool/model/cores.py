@@ -1,6 +1,6 @@
 """Independent pieces of one job on the machine's cores: forked workers, answers in order.
 
-:func:`fork_map` runs a function over a few items in worker processes started by ``fork``
+:class:`ForkedWork` runs a function over a few items in worker processes started by ``fork``
 (Linux), so the function may be a closure over this process's state (a verification, its
 trace, loaded kernels): nothing is pickled on the way in, and each answer comes back
 pickled, every bit kept. The workers are copies of this process, so an answer made there is
@@ -28,7 +28,7 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import Any, Generic, TypeVar
 
-__all__ = ["FORK", "ForkedWork", "ahead", "default_jobs", "fork_map", "in_worker"]
+__all__ = ["FORK", "ForkedWork", "ahead", "default_jobs", "in_worker"]
 
 T = TypeVar("T")
 R = TypeVar("R")
@@ -110,14 +110,14 @@ def ahead(items: Iterable[T]) -> Iterator[T]:
             close()
 
 
-def fork_map(
-    fn: Callable[[T], R],
-    items: Sequence[T],
-    *,
-    jobs: int | None = None,
-    done: Callable[[int], None] | None = None,
-) -> list[R]:
-    """``[fn(item) for item in items]``, the items shared out among forked workers.
+class ForkedWork(Generic[T, R]):
+    """``[fn(item) for item in items]``, started now in forked workers, gathered later.
+
+    The workers are forked when it is made, so they see this process's state as it is
+    then, and this process works meanwhile; :meth:`answers` gathers what they made (and
+    makes here what they could not). Use it as a context manager: leaving it stops the
+    workers (the items not yet started are dropped, those running are waited for), so an
+    error raised here meanwhile leaves no process behind.
 
     Args:
         fn: any callable, a closure included (it is inherited by the workers, not pickled);
@@ -126,29 +126,7 @@ def fork_map(
         items: the work, a few coarse pieces (each worker takes the next item as it ends
             one, so the longest item bounds the wall time).
         jobs: worker processes at most; ``None``: :func:`default_jobs`. With 1, one item,
-            no ``fork`` or in a worker process, every item runs here.
-        done: called here with the number of items answered so far, as each answer comes
-            in (for a progress report; it changes no answer).
-
-    Returns:
-        ``fn``'s answers, in the order of ``items``.
-
-    Raises:
-        Whatever ``fn`` raises for the first item it fails on, raised here: an item whose
-        worker raised, died or sent no answer is run again in this process, in order.
-    """
-    with ForkedWork(fn, items, jobs=jobs) as work:
-        return work.answers(done)
-
-
-class ForkedWork(Generic[T, R]):
-    """:func:`fork_map` started now and gathered later: this process works meanwhile.
-
-    The workers are forked when it is made, so they see this process's state as it is
-    then; :meth:`answers` gathers what they made (and makes here what they could not).
-    Use it as a context manager: leaving it stops the workers (the items not yet started
-    are dropped, those running are waited for), so an error raised here meanwhile
-    leaves no process behind.
+            no ``fork`` or in a worker process, every item runs here (in :meth:`answers`).
     """
 
     def __init__(self, fn: Callable[[T], R], items: Sequence[T], *, jobs: int | None = None):
@@ -173,10 +151,15 @@ class ForkedWork(Generic[T, R]):
             self._pool = None
 
     def answers(self, done: Callable[[int], None] | None = None) -> list[R]:
-        """``fn``'s answers in the order of the items (see :func:`fork_map`).
+        """``fn``'s answers, in the order of the items; the workers are stopped after.
+
+        ``done``: called here with the number of items answered so far, as each answer
+        comes in (for a progress report; it changes no answer).
 
         Raises:
-            Whatever ``fn`` raises for the first item it fails on, raised here.
+            Whatever ``fn`` raises for the first item it fails on, raised here: an item
+            whose worker raised, died or sent no answer is run again in this process, in
+            order.
         """
         try:
             for future in as_completed(self._futures):

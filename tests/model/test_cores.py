@@ -1,4 +1,4 @@
-"""fork_map: a job's independent pieces in forked workers, answers in order, errors as without.
+"""ForkedWork: a job's independent pieces in forked workers, answers in order, errors as without.
 
 The expected values are the plain ``[fn(x) for x in items]`` run in the test's own process;
 that the work was done elsewhere is shown by the pids that did it.
@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 
 from camtool.model import cores
-from camtool.model.cores import fork_map
+from camtool.model.cores import ForkedWork
 from camtool.model.errors import InputError
 
 pytestmark = pytest.mark.skipif(not cores.FORK, reason="forked workers: Linux only")
@@ -34,7 +34,7 @@ def test_answers_come_back_in_order_from_other_processes(tmp_path: Path) -> None
 
     items = list(range(9))
     told: list[int] = []
-    got = fork_map(work, items, jobs=2, done=told.append)
+    got = ForkedWork(work, items, jobs=2).answers(told.append)
     assert got == [(x * 3, x / 7.0) for x in items]  # every float bit kept
     pids = set(seen.read_text().split())
     assert str(os.getpid()) not in pids and 1 <= len(pids) <= 2
@@ -48,8 +48,8 @@ def test_one_job_or_one_item_runs_here(tmp_path: Path) -> None:
         pids.append(os.getpid())  # seen here only when it runs here
         return x + 1
 
-    assert fork_map(work, [1, 2, 3], jobs=1) == [2, 3, 4]
-    assert fork_map(work, [5]) == [6]
+    assert ForkedWork(work, [1, 2, 3], jobs=1).answers() == [2, 3, 4]
+    assert ForkedWork(work, [5]).answers() == [6]
     assert pids == [os.getpid()] * 4
 
 
@@ -66,7 +66,7 @@ def test_the_first_error_is_raised_here_as_without_workers() -> None:
 
     parent = os.getpid()
     with pytest.raises(InputError, match="item 2 is bad"):
-        fork_map(work, list(range(6)), jobs=2)
+        ForkedWork(work, list(range(6)), jobs=2).answers()
     assert ran_here == [2]  # run again here, in order, and it stopped there
 
 
@@ -79,7 +79,7 @@ def test_a_worker_that_dies_has_its_item_made_here() -> None:
             os.kill(os.getpid(), signal.SIGKILL)
         return x * x
 
-    assert fork_map(work, list(range(8)), jobs=2) == [x * x for x in range(8)]
+    assert ForkedWork(work, list(range(8)), jobs=2).answers() == [x * x for x in range(8)]
 
 
 def test_an_answer_that_cannot_pickle_is_made_here() -> None:
@@ -90,11 +90,11 @@ def test_an_answer_that_cannot_pickle_is_made_here() -> None:
             return lambda: x  # a lambda does not pickle
         return ("here", x)
 
-    assert fork_map(work, [1, 2], jobs=2) == [("here", 1), ("here", 2)]
+    assert ForkedWork(work, [1, 2], jobs=2).answers() == [("here", 1), ("here", 2)]
 
 
 def _in_a_child(queue: multiprocessing.Queue) -> None:  # type: ignore[type-arg]
-    queue.put((cores.in_worker(), fork_map(lambda x: (x, os.getpid()), [1, 2], jobs=2)))
+    queue.put((cores.in_worker(), ForkedWork(lambda x: (x, os.getpid()), [1, 2], jobs=2).answers()))
 
 
 def test_a_worker_process_runs_its_items_itself() -> None:
