@@ -185,36 +185,62 @@ def staircase_quadrant(
 
 
 @numba.njit(cache=True, nogil=True)
-def _count_runs(rows: Any, axis: int) -> int:
-    """Runs of equal non-zero step sign in column ``axis`` of ``rows``."""
-    count = 0
-    last = 0
+def _count_runs(rows: Any) -> tuple[int, int]:
+    """Runs of equal non-zero step sign in each column of ``rows`` (one pass, both axes)."""
+    count_x = 0
+    count_y = 0
+    last_x = 0
+    last_y = 0
     for i in range(rows.shape[0]):
-        s = rows[i, axis]
-        if s != 0 and s != last:
-            count += 1
-            last = s
-    return count
+        sx = rows[i, 0]
+        sy = rows[i, 1]
+        if sx != 0 and sx != last_x:
+            count_x += 1
+            last_x = sx
+        if sy != 0 and sy != last_y:
+            count_y += 1
+            last_y = sy
+    return count_x, count_y
 
 
 @numba.njit(cache=True, nogil=True)
-def _fill_runs(rows: Any, axis: int, ox: int, oy: int, starts: Any, signs: Any, at: Any) -> None:
-    """Fill the run starts, signs and motor positions of column ``axis`` (see play_runs)."""
-    k = 0
-    last = 0
+def _fill_runs(
+    rows: Any,
+    ox: int,
+    oy: int,
+    starts_x: Any,
+    signs_x: Any,
+    at_x: Any,
+    starts_y: Any,
+    signs_y: Any,
+    at_y: Any,
+) -> None:
+    """Fill the run starts, signs and motor positions of both columns (see play_runs)."""
+    kx = 0
+    ky = 0
+    last_x = 0
+    last_y = 0
     mx = ox
     my = oy
     for i in range(rows.shape[0]):
-        mx += rows[i, 0]
-        my += rows[i, 1]
-        s = rows[i, axis]
-        if s != 0 and s != last:
-            starts[k] = i
-            signs[k] = s
-            at[k, 0] = mx
-            at[k, 1] = my
-            k += 1
-            last = s
+        sx = rows[i, 0]
+        sy = rows[i, 1]
+        mx += sx
+        my += sy
+        if sx != 0 and sx != last_x:
+            starts_x[kx] = i
+            signs_x[kx] = sx
+            at_x[kx, 0] = mx
+            at_x[kx, 1] = my
+            kx += 1
+            last_x = sx
+        if sy != 0 and sy != last_y:
+            starts_y[ky] = i
+            signs_y[ky] = sy
+            at_y[ky, 0] = mx
+            at_y[ky, 1] = my
+            ky += 1
+            last_y = sy
 
 
 def play_runs(rows: Any, ox: int, oy: int) -> tuple[Any, ...]:
@@ -224,34 +250,40 @@ def play_runs(rows: Any, ox: int, oy: int) -> tuple[Any, ...]:
     axis's previous non-zero step (or is its first). Returns, per axis, the run start
     rows ``(R,) int64``, their signs ``(R,) int8`` (+1/-1) and the motor positions
     ``(R, 2) int64`` after each start row (steps, absolute from ``(ox, oy)``): what the
-    band of the run is looked up with.
+    band of the run is looked up with. Two passes over the rows, both axes in each: one
+    counts the runs, one fills them.
     """
+    counts = _count_runs(rows)
     out: list[Any] = []
     for axis in (0, 1):
-        count = _count_runs(rows, axis)
-        starts = np.empty(count, dtype=np.int64)
-        signs = np.empty(count, dtype=np.int8)
-        at = np.empty((count, 2), dtype=np.int64)
-        _fill_runs(rows, axis, ox, oy, starts, signs, at)
-        out += [starts, signs, at]
+        count = counts[axis]
+        out += [
+            np.empty(count, dtype=np.int64),
+            np.empty(count, dtype=np.int8),
+            np.empty((count, 2), dtype=np.int64),
+        ]
+    _fill_runs(rows, ox, oy, *out)
     return tuple(out)
 
 
 @numba.njit(cache=True, nogil=True)
-def _count_reversals(rows: Any, axis: int, direction: int) -> int:
+def _scan_column(rows: Any, axis: int, direction: int) -> tuple[int, int, int]:
+    """Reversals, direction after and pulses of column ``axis`` (one pass; see reversals)."""
     count = 0
+    pulses = 0
     previous = direction
     for i in range(rows.shape[0]):
         s = rows[i, axis]
         if s != 0:
+            pulses += abs(int(s))
             if previous != 0 and s != previous:
                 count += 1
             previous = s
-    return count
+    return count, previous, pulses
 
 
 @numba.njit(cache=True, nogil=True)
-def _fill_reversals(rows: Any, axis: int, direction: int, at: Any, signs: Any) -> int:
+def _fill_reversals(rows: Any, axis: int, direction: int, at: Any, signs: Any) -> None:
     k = 0
     previous = direction
     for i in range(rows.shape[0]):
@@ -262,23 +294,25 @@ def _fill_reversals(rows: Any, axis: int, direction: int, at: Any, signs: Any) -
                 signs[k] = s
                 k += 1
             previous = s
-    return previous
 
 
-def reversals(rows: Any, axis: int, direction: int) -> tuple[Any, Any, int]:
+def reversals(rows: Any, axis: int, direction: int) -> tuple[Any, Any, int, int]:
     """Reversals of column ``axis`` of step rows, given the axis's direction before them.
 
     A reversal is a non-zero step whose sign differs from the previous non-zero one
     (``direction`` before the first row; 0: none yet, so no reversal). Returns the rows
-    ``(K,) int64`` and signs ``(K,) int8`` of the reversals and the direction after the
-    rows (``direction`` when the column has no step), as ``simulate._Controller._compensate``
-    finds them with numpy.
+    ``(K,) int64`` and signs ``(K,) int8`` of the reversals, the direction after the
+    rows (``direction`` when the column has no step) and the column's pulses (the sum
+    of ``|step|``), as ``simulate._Controller._compensate`` and ``block`` find them
+    with numpy. One pass over the column; a second, to fill the reversals, only when
+    there are any (a line has at most one, at its first pulse).
     """
-    count = _count_reversals(rows, axis, direction)
+    count, last, pulses = _scan_column(rows, axis, direction)
     at = np.empty(count, dtype=np.int64)
     signs = np.empty(count, dtype=np.int8)
-    last = _fill_reversals(rows, axis, direction, at, signs)
-    return at, signs, int(last)
+    if count:
+        _fill_reversals(rows, axis, direction, at, signs)
+    return at, signs, int(last), int(pulses)
 
 
 @numba.njit(cache=True, nogil=True)
@@ -354,21 +388,29 @@ def play_axis_from(
 EXACT_BINS = 2048 + 64
 """Bins of :func:`exact_sum_squares`: one per binary exponent of a double, and room for
 the carries above the largest."""
+EXACT_CARRY = 512
+"""Additions after which :func:`exact_sum_squares` carries its bins: a carried bin is
+below ``2^32 + 2^31``, and 512 mantissas below ``2^53`` keep it below ``2^63``."""
 
 
 @numba.njit(cache=True, nogil=True)
-def exact_sum_squares(values: Any, bins: Any, pending: int) -> int:
+def exact_sum_squares(values: Any, bins: Any) -> None:
     """Add ``values[i]²`` (each square rounded to float64, as numpy's ``d * d``) exactly.
 
     A finite double ``x >= 0`` is ``m · 2^(e − 1074)`` with an integer ``m < 2^53`` and
     ``e = max(exponent field − 1, 0)``; ``m`` is added to ``bins[e]`` (int64). After at
-    most 1024 additions a bin is below ``2^63``; then every bin's bits from 32 up are
-    carried into the bin 32 exponents higher (the same value), so the bins hold the
-    exact sum at all times: :func:`exact_sum` turns them into the correctly rounded
-    float. ``pending`` counts the additions since the last carry (returned updated). A
-    square that is not finite (inf, nan) sets ``bins[-1]`` to 1.
+    most :data:`EXACT_CARRY` additions, and at the end of each call, every bin's bits
+    from 32 up are carried into the bin 32 exponents higher (the same value), so the
+    bins hold the exact sum at all times and stay below ``2^63``: :func:`exact_sum`
+    turns them into the correctly rounded float. Only the bins from the lowest this
+    call added to up to the highest any carry reached are carried: the others were
+    carried before and have not changed since. A square that is not finite (inf, nan)
+    sets ``bins[-1]`` to 1.
     """
     mask = (1 << 52) - 1
+    pending = 0
+    low = bins.shape[0]
+    high = -1
     for k in range(values.shape[0]):
         x = values[k] * values[k]
         bits = np.float64(x).view(np.int64)
@@ -381,22 +423,38 @@ def exact_sum_squares(values: Any, bins: Any, pending: int) -> int:
             mantissa |= 1 << 52
             exponent -= 1
         bins[exponent] += mantissa
+        if exponent < low:
+            low = int(exponent)
+        if exponent > high:
+            high = int(exponent)
         pending += 1
-        if pending == 1024:
-            _carry(bins)
+        if pending == EXACT_CARRY:
+            high = _carry(bins, low, high)
             pending = 0
-    return pending
+    if pending:
+        _carry(bins, low, high)
 
 
 @numba.njit(cache=True, nogil=True)
-def _carry(bins: Any) -> None:
-    """Move each bin's bits from 32 up into the bin 32 exponents higher (exact)."""
-    low = (1 << 32) - 1
-    for e in range(bins.shape[0] - 33):
-        high = bins[e] >> 32
-        if high:
-            bins[e] &= low
-            bins[e + 32] += high
+def _carry(bins: Any, low: int, high: int) -> int:
+    """Carry bins ``low`` up (bits from 32 up into the bin 32 exponents higher, exact).
+
+    Every bin from ``low`` to ``high`` and every bin a carry reaches is carried in turn
+    (a bin below ``bins.shape[0] - 33`` only: the top ones hold the carries). Returns
+    the highest bin reached.
+    """
+    keep = (1 << 32) - 1
+    last = bins.shape[0] - 34
+    e = low
+    while e <= high and e <= last:
+        carried = bins[e] >> 32
+        if carried:
+            bins[e] &= keep
+            bins[e + 32] += carried
+            if e + 32 > high:
+                high = e + 32
+        e += 1
+    return high
 
 
 def exact_sum(bins: Any) -> float:
@@ -407,6 +465,38 @@ def exact_sum(bins: Any) -> float:
         return float("nan")
     total = sum(int(v) << e for e, v in enumerate(bins[:-1].tolist()) if v)
     return float(Fraction(total, 1 << 1074))
+
+
+@numba.njit(cache=True, nogil=True)
+def extent(points: Any) -> tuple[float, float, float, float]:
+    """``(x max, x min, y max, y min)`` of ``(N, 2)`` points, ``N >= 1``: numpy's ``max``/``min``.
+
+    One pass over both columns. Exact (a comparison rounds nothing); a NaN in a column
+    makes both of its figures NaN, as numpy's reductions give.
+    """
+    x_top = x_low = points[0, 0]
+    y_top = y_low = points[0, 1]
+    x_nan = y_nan = False
+    for i in range(points.shape[0]):
+        x = points[i, 0]
+        y = points[i, 1]
+        if x > x_top:
+            x_top = x
+        elif x < x_low:
+            x_low = x
+        elif x != x:
+            x_nan = True
+        if y > y_top:
+            y_top = y
+        elif y < y_low:
+            y_low = y
+        elif y != y:
+            y_nan = True
+    if x_nan:
+        x_top = x_low = math.nan
+    if y_nan:
+        y_top = y_low = math.nan
+    return x_top, x_low, y_top, y_low
 
 
 @numba.njit(cache=True, nogil=True)

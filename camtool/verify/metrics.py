@@ -1842,7 +1842,6 @@ class TraceStream:
         self.dev_rows: tuple[IntArray, FloatArray, IntArray, Any, Any] | None = None  # near it
         self.dev_count = 0
         self.bins = np.zeros(kernels.EXACT_BINS, dtype=np.int64)
-        self.pending = 0
         # along the path
         total = sum(
             segment_of(self.starts[i], program.moves[i]).length
@@ -1904,7 +1903,7 @@ class TraceStream:
                 compensation[near].copy(),
             )
         self.dev_count += len(dist)
-        self.pending = self.kernels.exact_sum_squares(dist, self.bins, self.pending)
+        self.kernels.exact_sum_squares(dist, self.bins)
 
     def _picture(
         self, r0: int, points: FloatArray, blocks: IntArray, steps: Any, compensation: Any
@@ -1945,10 +1944,9 @@ class TraceStream:
             g0, g1 = max(c.lo, r0), min(c.hi, r0 + len(points))
             if g1 > g0:
                 part = points[g0 - r0 : g1 - r0]
-                for axis in (0, 1):
-                    column = part[:, axis]
-                    c.top[axis] = max(float(column.max()), c.top[axis])
-                    c.low[axis] = min(float(column.min()), c.low[axis])
+                x_top, x_low, y_top, y_low = self.kernels.extent(part)  # one pass
+                c.top[0], c.low[0] = max(x_top, c.top[0]), min(x_low, c.low[0])
+                c.top[1], c.low[1] = max(y_top, c.top[1]), min(y_low, c.low[1])
                 c.add(g0 - c.lo + 1, part)
             for b in range(max(c.first, first), min(c.last, stop - 1) + 1):
                 here = self._point(int(bs[b + 1]) - 1, r0, points)

@@ -171,10 +171,13 @@ class _Controller:
         else:
             dx, dy = end[0] - self.pos[0], end[1] - self.pos[1]
             rows, line_starts, dominant = self.line(dx, dy), [0], max(abs(dx), abs(dy))
-        pulses = [int(np.abs(rows[:, k]).sum(dtype=np.int64)) for k in (0, 1)]  # by column: fast
+        made = rows
+        rows, comp, pulses = self._compensate(rows, line_starts)
+        if pulses is None:  # not counted as the reversals were found
+            x, y = (int(np.abs(made[:, k]).sum(dtype=np.int64)) for k in (0, 1))
+            pulses = (x, y)
         self.steps.append((int(pulses[0]), int(pulses[1]), z_steps))
         self.dominant.append(dominant)
-        rows, comp = self._compensate(rows, line_starts)
         self.parts.append(rows)
         self.comp_parts.append(comp)
         self.counts.append(len(rows))
@@ -243,13 +246,19 @@ class _Controller:
 
     def _compensate(
         self, rows: npt.NDArray[Any], line_starts: list[int]
-    ) -> tuple[npt.NDArray[Any], npt.NDArray[np.bool_]]:
-        """Insert compensation rows at this block's reversals; update the direction state."""
+    ) -> tuple[npt.NDArray[Any], npt.NDArray[np.bool_], tuple[int, int] | None]:
+        """Insert compensation rows at this block's reversals; update the direction state.
+
+        Returns the rows with the compensation rows, which rows those are, and each
+        axis's pulses in ``rows`` (as given) when the compiled scan counted them as it
+        found the reversals (``None`` on the numpy path).
+        """
         inserts: list[tuple[int, int, int]] = []  # (row, axis, sign)
         jit = compiled(len(rows)) if rows.dtype == STEP_DTYPE else None
+        pulses = [0, 0]
         for axis in (0, 1):
             if jit is not None:
-                at_rows, at_signs, self.direction[axis] = jit.reversals(
+                at_rows, at_signs, self.direction[axis], pulses[axis] = jit.reversals(
                     rows, axis, self.direction[axis]
                 )
             else:
@@ -262,8 +271,9 @@ class _Controller:
                     row = line_starts[int(np.searchsorted(line_starts, row, side="right")) - 1]
                 inserts.append((row, axis, int(sign)))
         flags = np.zeros(len(rows), dtype=np.bool_)
+        counted = None if jit is None else (pulses[0], pulses[1])
         if not inserts:
-            return rows, flags
+            return rows, flags, counted
         self.compensations += len(inserts)
         inserts.sort()
         pieces, flag_pieces, last = [], [], 0
@@ -276,7 +286,7 @@ class _Controller:
             last = row
         pieces.append(rows[last:])
         flag_pieces.append(flags[last:])
-        return np.concatenate(pieces), np.concatenate(flag_pieces)
+        return np.concatenate(pieces), np.concatenate(flag_pieces), counted
 
     def _reversals(
         self, column: npt.NDArray[Any], axis: int
@@ -371,7 +381,7 @@ class _IdealController(_Controller):
             rows, line_starts = self._ideal_line(self.pos, end), [0]
         self.steps.append((0, 0, 0))
         self.dominant.append(0)
-        rows, comp = self._compensate(rows, line_starts)
+        rows, comp, _ = self._compensate(rows, line_starts)
         self.parts.append(rows)
         self.comp_parts.append(comp)
         self.counts.append(len(rows))

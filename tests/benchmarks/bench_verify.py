@@ -199,7 +199,8 @@ dda_line(3, 2)
 k.play_runs(np.zeros((2, 2), np.int8), 0, 0)
 k.play_axis_from(np.zeros((2, 2), np.int8), 0, np.zeros(0, np.int64), np.zeros(0, np.int8),
                  np.zeros(0), np.zeros(5), 0, 0.0, 1.0, np.zeros((2, 2)))
-k.exact_sum_squares(np.zeros(2), np.zeros(k.EXACT_BINS, np.int64), 0)
+k.exact_sum_squares(np.zeros(2), np.zeros(k.EXACT_BINS, np.int64))
+k.extent(np.zeros((2, 2)))
 k.to_line(np.zeros((2, 2)), 0.0, 0.0, 1.0, 0.0, np.zeros(2))
 print(time.perf_counter() - t0)
 """

@@ -207,6 +207,47 @@ def test_carriage_compiled_equals_numpy(profile: str) -> None:
     assert np.array_equal(fast, simulate._carriage_numpy(still, (4, 9), machine))
 
 
+@pytest.mark.parametrize("seed", range(6))
+def test_reversals_and_pulses_equal_numpy(seed: int) -> None:
+    """One compiled scan gives the numpy reversals, the direction after and the pulses."""
+    jit = itp.compiled()
+    rng = np.random.default_rng(seed)
+    rows = _random_rows(rng, int(rng.integers(0, 20_000)))
+    for axis in (0, 1):
+        for direction in (-1, 0, 1):
+            column = rows[:, axis].astype(np.int64)
+            nz = np.flatnonzero(column)
+            signs = np.sign(column[nz])
+            before = np.concatenate(([direction], signs[:-1]))
+            at = np.flatnonzero((signs != before) & (before != 0))
+            rows_at, signs_at, last, pulses = jit.reversals(rows, axis, direction)
+            assert np.array_equal(rows_at, nz[at]) and np.array_equal(signs_at, signs[at])
+            assert signs_at.dtype == np.int8 and rows_at.dtype == np.int64
+            assert last == (int(signs[-1]) if len(nz) else direction)
+            assert pulses == int(np.abs(column).sum())
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_play_runs_equal_a_python_scan(seed: int) -> None:
+    """Both axes' runs from one pass each: the first row, sign and motor of every run."""
+    jit = itp.compiled()
+    rng = np.random.default_rng(seed)
+    rows = _random_rows(rng, int(rng.integers(0, 5000)))
+    ox, oy = int(rng.integers(-100, 100)), int(rng.integers(-100, 100))
+    got = jit.play_runs(rows, ox, oy)
+    motor = np.cumsum(rows.astype(np.int64), axis=0) + np.asarray([ox, oy])
+    for axis in (0, 1):
+        starts, signs, last = [], [], 0
+        for i, s in enumerate(rows[:, axis].tolist()):
+            if s != 0 and s != last:
+                starts.append(i)
+                signs.append(s)
+                last = s
+        assert np.array_equal(got[3 * axis], np.asarray(starts, dtype=np.int64))
+        assert np.array_equal(got[3 * axis + 1], np.asarray(signs, dtype=np.int8))
+        assert np.array_equal(got[3 * axis + 2], motor[starts].reshape(-1, 2))
+
+
 def test_deviation_by_blocks_equals_the_gathered_form() -> None:
     """Block-wise deviation (scalars for long lines, chunks) == the one-pass gathered form."""
     from camtool.model.program import ArcMove, Linear, Program, Rapid

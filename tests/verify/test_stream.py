@@ -122,17 +122,92 @@ def test_exact_sum_squares_is_the_exact_sum(seed: int) -> None:
         values[-1] = 5e-324  # a subnormal (its square is 0)
         values[0] = 1e-160  # a subnormal square
     bins = np.zeros(kernels.EXACT_BINS, dtype=np.int64)
-    pending = 0
-    for i in range(0, n, 997):  # in pieces, past the carry at 1024
-        pending = kernels.exact_sum_squares(values[i : i + 997], bins, pending)
+    for i in range(0, n, 997):  # in pieces, past the carry at 512
+        kernels.exact_sum_squares(values[i : i + 997], bins)
     exact = sum((Fraction(float(x) * float(x)) for x in values), Fraction(0))
     assert kernels.exact_sum(bins) == float(exact)
 
 
+def _all_ones_square() -> float:
+    """A double whose square (rounded) is within 4 ulps below 2: its mantissa's top 50 bits set.
+
+    The largest double whose square is below 2. Such an addend, ``m > 2^53 − 2^21``,
+    is what could overflow a bin carried only every 1024 additions (see below).
+    """
+    x = math.sqrt(2.0)
+    while x * x >= 2.0:
+        x = math.nextafter(x, 0.0)
+    mantissa = int((x * x).hex()[4:17], 16) | (1 << 52)
+    assert mantissa > (1 << 53) - (1 << 21)
+    return x
+
+
+@pytest.mark.parametrize("count", [511, 512, 513, 2048, 5000])
+def test_exact_sum_squares_of_the_largest_mantissas_does_not_overflow(count: int) -> None:
+    """Thousands of equal squares of all-ones mantissa in one bin (a constant offset).
+
+    Carried every 1024 additions, the bin held ``1024·m`` (below 2^63), kept its low 32
+    bits after the carry, and 1024 more such mantissas ``m`` took it past 2^63: it
+    wrapped. Carried every 512 additions it cannot (analysis: a carried bin is below
+    2^32 + 2^31, plus 512 mantissas below 2^53).
+    """
+    x = _all_ones_square()
+    values = np.full(count, x)
+    bins = np.zeros(kernels.EXACT_BINS, dtype=np.int64)
+    kernels.exact_sum_squares(values[: count // 3], bins)  # in two calls, too
+    kernels.exact_sum_squares(values[count // 3 :], bins)
+    assert kernels.exact_sum(bins) == float(Fraction(x * x) * count)
+
+
+def test_exact_sum_squares_carries_what_earlier_calls_left() -> None:
+    """Small pieces at far exponents, then many at one: every bin stays exact."""
+    bins = np.zeros(kernels.EXACT_BINS, dtype=np.int64)
+    x = _all_ones_square()
+    pieces = [np.full(300, 1e-150), np.full(300, x), np.full(300, 3e100), np.full(3000, x)]
+    for values in pieces:
+        kernels.exact_sum_squares(values, bins)
+    total = sum((Fraction(float(v) * float(v)) for p in pieces for v in p), Fraction(0))
+    assert kernels.exact_sum(bins) == float(total)
+
+
+def test_carry_leaves_every_bin_it_reaches_below_two_to_the_32() -> None:
+    """A carry into a bin outside the range added to carries that bin too, up the chain."""
+    bins = np.zeros(kernels.EXACT_BINS, dtype=np.int64)
+    bins[900] = 1 << 62
+    bins[932] = (1 << 62) - (1 << 30)  # becomes 2^62 with the carry from bin 900
+    bins[964] = 5
+    before = sum(int(v) << e for e, v in enumerate(bins.tolist()))
+    assert kernels._carry(bins, 900, 900) == 964
+    assert sum(int(v) << e for e, v in enumerate(bins.tolist())) == before
+    assert int(bins.max()) < 1 << 32 and bins[964] == 5 + (1 << 30)
+
+
 def test_exact_sum_squares_flags_a_non_finite_square() -> None:
     bins = np.zeros(kernels.EXACT_BINS, dtype=np.int64)
-    kernels.exact_sum_squares(np.asarray([1.0, 1e200]), bins, 0)
+    kernels.exact_sum_squares(np.asarray([1.0, 1e200]), bins)
     assert math.isnan(kernels.exact_sum(bins))
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_extent_is_numpys_max_and_min(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 3000))
+    points = (rng.random((n, 2)) - 0.5) * 10.0 ** rng.uniform(-3, 3)
+    if seed % 3 == 1:
+        points[rng.integers(0, n), int(rng.integers(0, 2))] = np.nan
+    if seed % 4 == 2:
+        points[:, 1] = 7.25  # a column of one value
+    got = kernels.extent(points)
+    want = (points[:, 0].max(), points[:, 0].min(), points[:, 1].max(), points[:, 1].min())
+    for g, w in zip(got, want, strict=True):
+        same_sign = math.copysign(1, g) == math.copysign(1, w)
+        assert (math.isnan(g) and math.isnan(w)) or (g == w and same_sign)
+
+
+def test_extent_of_a_nan_first_point() -> None:
+    points = np.asarray([[np.nan, 1.0], [2.0, -3.0], [-4.0, 5.0]])
+    x_top, x_low, y_top, y_low = kernels.extent(points)
+    assert math.isnan(x_top) and math.isnan(x_low) and (y_top, y_low) == (5.0, -3.0)
 
 
 @pytest.mark.parametrize("seed", range(12))
