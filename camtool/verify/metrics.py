@@ -1861,31 +1861,47 @@ class TraceStream:
         points: FloatArray,
         steps: npt.NDArray[np.int8],
         compensation: npt.NDArray[np.bool_],
+        measured: tuple[IntArray, FloatArray, list[tuple[int, int]]] | None = None,
     ) -> None:
-        """Measure one chunk: moves ``first ..`` with global row offsets ``block_start``."""
+        """Measure one chunk: moves ``first ..`` with global row offsets ``block_start``.
+
+        ``measured``: :meth:`distances` of this chunk, when another thread took them.
+        """
         r0 = int(block_start[0])
-        count = len(block_start) - 1
-        blocks = np.repeat(np.arange(first, first + count, dtype=np.int64), np.diff(block_start))
-        self._deviation(first, r0, block_start - r0, points, blocks, steps, compensation)
+        blocks, dist, pieces = measured or self.distances(first, block_start, points)
+        self._deviation(r0, points, blocks, steps, compensation, dist, pieces)
         self._picture(r0, points, blocks, steps, compensation)
         comp = steps[compensation]
         for axis in (0, 1):
             self.comp_steps[axis] += int(np.abs(comp[:, axis]).sum())
-        self._contours(first, first + count, r0, points)
+        self._contours(first, first + len(block_start) - 1, r0, points)
         if len(points):
             self.prev = points[-1].copy()
 
+    def distances(
+        self, first: int, block_start: IntArray, points: FloatArray
+    ) -> tuple[IntArray, FloatArray, list[tuple[int, int]]]:
+        """A chunk's move of each row and its rows' distances to their moves (:func:`_distances`).
+
+        It reads only the chunk and the program's nominal moves, so another thread may
+        take it while this one measures the chunk before (:func:`_stream`'s producer).
+        """
+        r0 = int(block_start[0])
+        count = len(block_start) - 1
+        blocks = np.repeat(np.arange(first, first + count, dtype=np.int64), np.diff(block_start))
+        bounds = block_start - r0
+        return blocks, *_distances(points, blocks, self.nominal, bounds, first, self.kernels)
+
     def _deviation(
         self,
-        first: int,
         r0: int,
-        bounds: IntArray,
         points: FloatArray,
         blocks: IntArray,
         steps: Any,
         compensation: Any,
+        dist: FloatArray,
+        pieces: list[tuple[int, int]],
     ) -> None:
-        dist, pieces = _distances(points, blocks, self.nominal, bounds, first, self.kernels)
         if not len(dist):
             return
         worst = int(np.argmax(dist))
@@ -1982,6 +1998,11 @@ class TraceStream:
         a, b = ends.points[:segments], ends.points[segments:]
         del trace
         c.kept = []  # the trace is let go: ~6 MB of a 400 000-point contour
+        self._shortfall(c, ends, a, b)
+
+    def _shortfall(self, c: _Contour, ends: _LazyTree, a: FloatArray, b: FloatArray) -> None:
+        """The largest shortfall of contour ``c`` from its thinned trace ``a → b`` (``ends``)."""
+        program, starts = self.program, self.starts
         places: _Places | None = None  # made for the first batch that is bounded
         batches = _sample_batches(program, starts, c.first, c.last, self.spacing, STREAM_SAMPLES)
         for samples, owner, t in batches:  # each sample's distance is its own

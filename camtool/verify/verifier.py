@@ -32,7 +32,8 @@ digits and at least 3 decimals) so the same input gives the same bytes.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+import time
+from collections.abc import Iterator, Sequence
 from contextlib import nullcontext, suppress
 from dataclasses import dataclass, field
 from functools import cached_property, partial
@@ -73,6 +74,7 @@ from camtool.verify.simulate import (
     ChunkedSimulation,
     NotStreamable,
     StreamedTrace,
+    TraceChunk,
     count_rows,
     simulate_or_count,
     simulate_steps,
@@ -466,21 +468,44 @@ def _stream(
     summary = sim.trace_summary()
     stream = TraceStream(program, block_start, summary["start_mm"], kernels)
     cutting = None if against is None else _cutting_stream(program, block_start)
-    for chunk in ahead(sim.chunks()):  # the next chunk simulated while this one is measured
+    share = _Share()
+
+    def made() -> Iterator[tuple[TraceChunk, Any]]:  # in the thread ahead
+        clock = time.perf_counter()
+        for chunk in sim.chunks():
+            rows = max(1, len(chunk.rows))
+            now = time.perf_counter()
+            share.made(now - clock, rows)
+            pre = None
+            if share.take():
+                pre = stream.distances(chunk.first_block, chunk.block_start, chunk.carriage_mm)
+                share.measured_distances(time.perf_counter() - now, rows)
+            yield chunk, pre
+            clock = time.perf_counter()
+
+    for chunk, pre in ahead(made()):  # the next chunk simulated while this one is measured
+        start = time.perf_counter()
+        rows = max(1, len(chunk.rows))
         if not np.array_equal(
             chunk.block_start,
             block_start[chunk.first_block : chunk.first_block + len(chunk.block_start)],
         ):
             return None
+        if pre is None:
+            pre = stream.distances(chunk.first_block, chunk.block_start, chunk.carriage_mm)
+            share.measured_distances(time.perf_counter() - start, rows)
+        measuring = time.perf_counter()
         stream.add(
             chunk.first_block,
             chunk.block_start,
             chunk.carriage_mm,
             chunk.rows,
             chunk.compensation,
+            pre,
         )
         if cutting is not None:
             cutting.add(chunk.carriage_mm, chunk.block_of_row())
+        share.measured(time.perf_counter() - measuring, rows)
     summary = sim.trace_summary()
     if not np.array_equal(summary["block_start"], block_start):
         return None
@@ -496,6 +521,56 @@ def _stream(
     )
     thin = None if cutting is None else cutting.finish()
     return trace, (m.deviation, m.along, m.contours, thin)
+
+
+class _Share:
+    """Which chunks' deviation distances the thread ahead takes (:func:`_stream`).
+
+    The simulating thread (:func:`~camtool.model.cores.ahead`) and the measuring one run
+    on two cores; the slower sets the pace. On a program of long lines measuring is the
+    slower (the distances alone, ``to_line``, take about as long as simulating), so the
+    thread ahead also takes the distances (:meth:`TraceStream.distances`) of a share
+    ``f`` of the chunks, chosen so that both take as long a row: with ``m`` its time a
+    row, ``c`` the measuring thread's without the distances and ``d`` the distances',
+    ``m + f·d = c + (1 − f)·d``, ``f = (c + d − m) / 2d`` in [0, 1]. The times are
+    means over the last chunks (each written by one thread; a float's assignment is
+    whole under the GIL). Only the wall time depends on it: the distances are the same
+    whichever thread takes them.
+    """
+
+    MEAN = 0.25
+    """Weight of the newest chunk in the means."""
+
+    def __init__(self) -> None:
+        self.make = self.measure = self.dist = 0.0  # seconds a row
+        self.credit = 0.0
+
+    def _mean(self, old: float, seconds: float, rows: int) -> float:
+        rate = seconds / rows
+        return rate if old == 0.0 else old + self.MEAN * (rate - old)
+
+    def made(self, seconds: float, rows: int) -> None:
+        """The thread ahead took ``seconds`` to simulate a chunk of ``rows`` rows."""
+        self.make = self._mean(self.make, seconds, rows)
+
+    def measured(self, seconds: float, rows: int) -> None:
+        """The measuring thread took ``seconds`` for a chunk, its distances left out."""
+        self.measure = self._mean(self.measure, seconds, rows)
+
+    def measured_distances(self, seconds: float, rows: int) -> None:
+        """One thread took ``seconds`` for a chunk's distances."""
+        self.dist = self._mean(self.dist, seconds, rows)
+
+    def take(self) -> bool:
+        """Whether the thread ahead takes this chunk's distances."""
+        if self.dist == 0.0 or self.measure == 0.0:
+            return False  # nothing measured yet
+        share = (self.measure + self.dist - self.make) / (2.0 * self.dist)
+        self.credit += min(max(share, 0.0), 1.0)
+        if self.credit < 1.0:
+            return False
+        self.credit -= 1.0
+        return True
 
 
 def _cutting_stream(program: Program, block_start: np.ndarray) -> CuttingStream:

@@ -18,6 +18,7 @@ import pytest
 from camtool.model.program import Program
 from camtool.model.shapes import Drawing
 from camtool.post.registry import load_target
+from camtool.verify import verifier
 from camtool.verify.simulate import ChunkedSimulation, StreamedTrace, simulate_steps
 from camtool.verify.verifier import build_report, verify_program
 from tests.verify.programs import TARGETS
@@ -86,6 +87,57 @@ def test_streamed_verification_reports_the_whole_figures(name: str, seed: int) -
         rows = np.flatnonzero(np.isin(whole.trace.carriage_mm[:, 0], v.trace.carriage_mm[:, 0]))
         assert len(rows) >= len(v.trace.carriage_mm) > 0
         assert tuple(dev.at_mm) in {tuple(p) for p in v.trace.carriage_mm.tolist()}
+
+
+@pytest.mark.parametrize("take", [True, False, "alternate"])
+def test_distances_taken_by_the_thread_ahead_give_the_same_report(
+    monkeypatch: pytest.MonkeyPatch, take: bool | str
+) -> None:
+    """Whichever thread takes a chunk's distances (all, none, every other), the same report."""
+    target = load_target("pic-mmh")
+    program = _program(1)
+    reference = verify_program(
+        program, target.machine, name="pic-mmh", budget=False, chunk_rows=53, stream_above=10
+    )
+    calls = iter(range(10**6))
+    taken: list[bool] = []
+
+    def decide(self: verifier._Share) -> bool:
+        got = next(calls) % 2 == 0 if take == "alternate" else bool(take)
+        taken.append(got)
+        return got
+
+    monkeypatch.setattr(verifier._Share, "take", decide)
+    v = verify_program(
+        program, target.machine, name="pic-mmh", budget=False, chunk_rows=53, stream_above=10
+    )
+    assert len(taken) > 3 and (any(taken) if take else not any(taken))
+    assert build_report(v) == build_report(reference)
+    assert (v.deviation, v.along, v.contours) == (
+        reference.deviation,
+        reference.along,
+        reference.contours,
+    )
+
+
+def test_the_share_balances_the_two_threads_time_a_row() -> None:
+    """f = (c + d − m) / 2d of the chunks, in [0, 1]; none before anything is measured."""
+    share = verifier._Share()
+    assert not share.take()
+    share.made(10e-6, 1000)  # m = 10 ns a row
+    share.measured(7e-6, 1000)  # c = 7 ns
+    share.measured_distances(11e-6, 1000)  # d = 11 ns: f = 8 / 22
+    taken = sum(share.take() for _ in range(2200))
+    assert abs(taken - 800) <= 1  # the credit is summed in floats
+    share.made(40e-6, 1000)  # simulating slower than both: the mean moves, none taken
+    for _ in range(40):
+        share.made(40e-6, 1000)
+    assert not any(share.take() for _ in range(100))
+    fast = verifier._Share()
+    fast.made(1e-9, 1000)
+    fast.measured(50e-6, 1000)
+    fast.measured_distances(1e-6, 1000)  # f > 1: every chunk
+    assert all(fast.take() for _ in range(100))
 
 
 def test_a_streamed_rms_is_the_exact_mean() -> None:
