@@ -215,14 +215,22 @@ def _fill_runs(
     signs_y: Any,
     at_y: Any,
 ) -> None:
-    """Fill the run starts, signs and motor positions of both columns (see play_runs)."""
+    """Fill the run starts, signs and motor positions of both columns (see play_runs).
+
+    The arrays are as long as :func:`_count_runs` counted; the pass stops once they are
+    full (a line's runs start at its first pulses).
+    """
     kx = 0
     ky = 0
     last_x = 0
     last_y = 0
     mx = ox
     my = oy
+    need_x = starts_x.shape[0]
+    need_y = starts_y.shape[0]
     for i in range(rows.shape[0]):
+        if kx == need_x and ky == need_y:
+            break  # every run counted is filled: the rows after start none
         sx = rows[i, 0]
         sy = rows[i, 1]
         mx += sx
@@ -284,9 +292,12 @@ def _scan_column(rows: Any, axis: int, direction: int) -> tuple[int, int, int]:
 
 @numba.njit(cache=True, nogil=True)
 def _fill_reversals(rows: Any, axis: int, direction: int, at: Any, signs: Any) -> None:
+    """Fill the rows and signs of the reversals :func:`_scan_column` counted (then stop)."""
     k = 0
     previous = direction
     for i in range(rows.shape[0]):
+        if k == at.shape[0]:
+            break
         s = rows[i, axis]
         if s != 0:
             if previous != 0 and s != previous:
@@ -472,7 +483,9 @@ def extent(points: Any) -> tuple[float, float, float, float]:
     """``(x max, x min, y max, y min)`` of ``(N, 2)`` points, ``N >= 1``: numpy's ``max``/``min``.
 
     One pass over both columns. Exact (a comparison rounds nothing); a NaN in a column
-    makes both of its figures NaN, as numpy's reductions give.
+    makes both of its figures NaN, as numpy's reductions give. (``0.0`` and ``-0.0``
+    compare equal, so either may be given where both are the extreme, as with numpy; a
+    carriage, made from whole steps, is never ``-0.0``.)
     """
     x_top = x_low = points[0, 0]
     y_top = y_low = points[0, 1]
@@ -480,18 +493,12 @@ def extent(points: Any) -> tuple[float, float, float, float]:
     for i in range(points.shape[0]):
         x = points[i, 0]
         y = points[i, 1]
-        if x > x_top:
-            x_top = x
-        elif x < x_low:
-            x_low = x
-        elif x != x:
-            x_nan = True
-        if y > y_top:
-            y_top = y
-        elif y < y_low:
-            y_low = y
-        elif y != y:
-            y_nan = True
+        x_top = max(x_top, x)
+        x_low = min(x_low, x)
+        y_top = max(y_top, y)
+        y_low = min(y_low, y)
+        x_nan |= x != x
+        y_nan |= y != y
     if x_nan:
         x_top = x_low = math.nan
     if y_nan:
