@@ -306,6 +306,12 @@ def test_a_contour_thinned_on_the_fly_keeps_the_points_thinned_keeps(
     for lo, hi in zip(np.r_[0, cuts], np.r_[cuts, rows], strict=True):
         if hi > lo:
             contour.add(int(lo) + 1, points[lo:hi])
+    # the segment ends, made from the pieces, before the pieces are joined
+    ends = contour.ends()
+    if len(expected) == 1:
+        assert np.array_equal(ends, np.concatenate([expected, expected]))
+    else:
+        assert np.array_equal(ends, np.concatenate([expected[:-1], expected[1:]]))
     assert np.array_equal(contour.trace(), expected)
 
 
