@@ -1417,7 +1417,6 @@ class _Bounded:
         reach: FloatArray | None = None,
     ) -> None:
         self.samples, self.places, self.ends = samples, places, ends
-        a, b = places.a, places.b
         self.slack = 0.0
         if len(samples) == 0:
             self.reach = np.zeros(0)
