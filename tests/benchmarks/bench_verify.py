@@ -65,6 +65,13 @@ runs of this script: 13.2 M steps 1.24 / 1.29 s, 0.018× C, 239 MB; 66.2 M steps
 2.38 s, **0.050× / 0.048×** C (584 M steps/s), 242 MB; start-up 0.72 s, then 23–25 ns a
 step. The goal is reached on the 66.2 M-step program in one run of two: at it, not over
 it. Reports byte-identical (docs/verify.md "Speed and memory", docs/performance.md).
+
+Ninth pass (23 Nov 2026, quiet): the thread ahead takes a share of the deviation's
+distances so that both threads take as long a row, the kernels make fewer passes over
+the rows, the exact sum of squares carries every 512 additions (1 024 could wrap a bin).
+Two runs: 66.2 M steps **2.08 / 2.09 s, 0.055× / 0.053×** C (584 / 594 M steps/s), 243 /
+244 MB; 13.2 M steps 1.24 / 1.22 s, 0.018×. The goal is met on the 66.2 M-step program,
+with about 8 % to spare; not on the 13.2 M one (start-up 0.8 s). Reports byte-identical.
 """
 
 from __future__ import annotations
