@@ -204,6 +204,20 @@ def _count_runs(rows: Any) -> tuple[int, int]:
 
 
 @numba.njit(cache=True, nogil=True)
+def _fill_run(
+    i: int, s: int, last: int, k: int, starts: Any, signs: Any, at: Any, mx: int, my: int
+) -> tuple[int, int]:
+    """Row ``i``'s step ``s`` on one axis: a new run there is filled. Returns ``(k, last)``."""
+    if s != 0 and s != last:
+        starts[k] = i
+        signs[k] = s
+        at[k, 0] = mx
+        at[k, 1] = my
+        return k + 1, s
+    return k, last
+
+
+@numba.njit(cache=True, nogil=True)
 def _fill_runs(
     rows: Any,
     ox: int,
@@ -235,20 +249,8 @@ def _fill_runs(
         sy = rows[i, 1]
         mx += sx
         my += sy
-        if sx != 0 and sx != last_x:
-            starts_x[kx] = i
-            signs_x[kx] = sx
-            at_x[kx, 0] = mx
-            at_x[kx, 1] = my
-            kx += 1
-            last_x = sx
-        if sy != 0 and sy != last_y:
-            starts_y[ky] = i
-            signs_y[ky] = sy
-            at_y[ky, 0] = mx
-            at_y[ky, 1] = my
-            ky += 1
-            last_y = sy
+        kx, last_x = _fill_run(i, sx, last_x, kx, starts_x, signs_x, at_x, mx, my)
+        ky, last_y = _fill_run(i, sy, last_y, ky, starts_y, signs_y, at_y, mx, my)
 
 
 def play_runs(rows: Any, ox: int, oy: int) -> tuple[Any, ...]:
