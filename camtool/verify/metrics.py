@@ -1767,8 +1767,10 @@ class _Contour:
         extra = self.keep[a:b]
         if j0 <= self.n - 1 < j1:
             extra = np.append(extra, self.n - 1)
-        if len(extra):
-            wanted = np.union1d(wanted, extra)
+        if len(extra):  # np.union1d's sorted distinct values, without its hash table
+            merged = np.concatenate([wanted, extra])
+            merged.sort()
+            wanted = merged[np.concatenate(([True], merged[1:] != merged[:-1]))]
         self.kept.append(points[wanted - j0])
 
     def trace(self) -> FloatArray:
