@@ -185,6 +185,10 @@ class _Controller:
         self.logical.append(end)
         self.pos = end
 
+    def block_start(self) -> IntArray:
+        """``(B + 1,) int64`` row offsets of the moves simulated or counted so far."""
+        return np.concatenate(([0], np.cumsum(np.asarray(self.counts, dtype=np.int64))))
+
     def count_line(self, move: Move, rows_of: Callable[[int, int], int]) -> None:
         """:meth:`block` of a line or rapid, its rows counted by ``rows_of``, not made.
 
@@ -309,8 +313,7 @@ class _Controller:
         comp = np.concatenate(self.comp_parts) if self.comp_parts else np.zeros(0, np.bool_)
         self.parts.clear()  # not held twice while the carriage is computed
         self.comp_parts.clear()
-        counts = np.asarray(self.counts, dtype=np.int64)
-        block_start = np.concatenate(([0], np.cumsum(counts))).astype(np.int64)
+        block_start = self.block_start()
         block_of_row = _block_of_row(blocks, block_start)
         if rows.dtype == STEP_DTYPE:
             carriage = _carriage(rows, self.origin_steps, self.machine)
@@ -630,7 +633,7 @@ def simulate_or_count(program: Program, machine: Machine, limit: int) -> StepTra
             sim.comp_parts.clear()
     if rows <= limit:
         return sim.finish(len(program.moves))
-    return np.concatenate(([0], np.cumsum(np.asarray(sim.counts, dtype=np.int64))))
+    return sim.block_start()
 
 
 LINE_ROWS: dict[Callable[[int, int], StepArray], Callable[[int, int], int]] = {
@@ -666,7 +669,7 @@ def count_rows(program: Program, machine: Machine) -> IntArray:
         except InputError as exc:
             raise _at(program, k, exc) from exc
         start = (move.x, move.y)
-    return np.concatenate(([0], np.cumsum(np.asarray(sim.counts, dtype=np.int64))))
+    return sim.block_start()
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -792,9 +795,8 @@ class ChunkedSimulation:
     def trace_summary(self) -> dict[str, Any]:
         """The per-move arrays and counts of the whole trace (after :meth:`chunks`)."""
         sim = self.sim
-        counts = np.asarray(sim.counts, dtype=np.int64)
         return {
-            "block_start": read_only(np.concatenate(([0], np.cumsum(counts))).astype(np.int64)),
+            "block_start": read_only(sim.block_start()),
             "start_mm": _start_mm(sim.origin_steps, self.machine),
             "logical_end": read_only(np.asarray(sim.logical, dtype=np.int64).reshape(-1, 2)),
             "block_steps": read_only(np.asarray(sim.steps, dtype=np.int64).reshape(-1, 3)),
