@@ -1248,18 +1248,16 @@ def _farthest_from_trace(
     """Largest distance of a path sample to the polyline ``trace`` and the first sample at it.
 
     Distances in mm, to the one point when ``trace`` has one (:func:`farthest_nearest`);
-    ``ends``: :func:`_trace_ends`, shared by the batches of one trace.
+    ``ends``: the k-d tree of the segment ends, shared by the batches of one trace.
     """
-    if len(trace) == 1:
-        return farthest_nearest(samples, trace, trace, ends=ends)
-    return farthest_nearest(samples, trace[:-1], trace[1:], ends=ends)
+    return farthest_nearest(samples, *_segments(trace), ends=ends)
 
 
-def _trace_ends(trace: FloatArray) -> _LazyTree:
-    """The k-d tree of the segment ends of the polyline ``trace`` (built on first use)."""
+def _segments(trace: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """The segments ``a → b`` of the polyline ``trace`` (views): one of no length for one point."""
     if len(trace) == 1:
-        return _LazyTree(np.concatenate([trace, trace]))
-    return _LazyTree(np.concatenate([trace[:-1], trace[1:]]))
+        return trace, trace
+    return trace[:-1], trace[1:]
 
 
 SHORTFALL_BOUND_FROM = 2048
@@ -1401,7 +1399,7 @@ class _Bounded:
         move: ``(N,)`` each one's move, counted from the contour's first (0).
         t: ``(N,)`` how far along its move each lies, 0 to 1 (:func:`_fractions`).
         places: the contour's thinned trace (its segments) and its places.
-        ends: the k-d tree of the trace's segment ends (:func:`_trace_ends`), shared
+        ends: the k-d tree of the trace's segment ends (:meth:`_Contour.ends`), shared
             by the batches of one trace; built when needed otherwise.
         reach: the bounds an earlier one of the same samples and trace made
             (:attr:`reach`), instead of making them again.
@@ -1447,8 +1445,7 @@ class _Bounded:
         as for the class.
         """
         spans = _move_spans(len(run), _run_every(run), keep)
-        trace = _thinned(run, keep)
-        a, b = (trace, trace) if len(trace) == 1 else (trace[:-1], trace[1:])
+        a, b = _segments(_thinned(run, keep))
         return cls(samples, move, t, _Places(a, b, spans, nominal), reach=reach)
 
     def farthest(self, floor: float = 0.0) -> tuple[float, int] | None:
@@ -1777,22 +1774,19 @@ class _Contour:
         """The thinned trace (what :func:`_thinned` gives of the whole run)."""
         if self.every == 0:
             self._head_read()
-        if len(self.kept) > 1:  # joined once: the pieces are let go (6 MB for 400 000 rows)
-            self.kept = [np.vstack(self.kept)]
-        return self.kept[0] if self.kept else np.zeros((0, 2))
+        return np.vstack(self.kept) if self.kept else np.zeros((0, 2))
 
     def ends(self) -> FloatArray:
-        """:func:`_trace_ends`'s points of :meth:`trace`, made from the kept pieces.
+        """The segment ends of :meth:`trace`, ``concatenate(_segments(trace))``, from the pieces.
 
-        ``concatenate([trace[:-1], trace[1:]])`` (the trace twice for one point), without
-        the joined trace beside it (6 MB of a 400 000-point contour).
+        The starts ``a``, then the ends ``b`` (:func:`_segments`), made from the kept
+        pieces without the joined trace beside them (6 MB of a 400 000-point contour).
         """
         if self.every == 0:
             self._head_read()
         n = sum(len(p) for p in self.kept)
         if n <= 1:
-            trace = self.trace()
-            return np.concatenate([trace, trace])
+            return np.concatenate(_segments(self.trace()))
         out = np.empty((2 * (n - 1), 2), dtype=np.float64)
         at = n - 2  # the trace from n - 2: its points 1.. are the segment ends b
         for piece in self.kept:

@@ -504,7 +504,7 @@ def _stream(
             pre,
         )
         if cutting is not None:
-            cutting.add(chunk.carriage_mm, chunk.block_of_row())
+            cutting.add(chunk.carriage_mm, pre[0])  # the rows' moves, made with the distances
         share.measured(time.perf_counter() - measuring, rows)
     summary = sim.trace_summary()
     if not np.array_equal(summary["block_start"], block_start):
