@@ -21,14 +21,24 @@ from __future__ import annotations
 import multiprocessing
 import os
 import queue
+import select
 import signal
 import sys
 import threading
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from contextlib import contextmanager, suppress
 from typing import Any, Generic, TypeVar
 
-__all__ = ["FORK", "ForkedWork", "ahead", "default_jobs", "in_worker"]
+__all__ = [
+    "FORK",
+    "ForkedWork",
+    "ahead",
+    "default_jobs",
+    "in_worker",
+    "meanwhile",
+    "wait_readable",
+]
 
 T = TypeVar("T")
 R = TypeVar("R")
@@ -54,6 +64,45 @@ def in_worker() -> bool:
     """
     current = multiprocessing.current_process()
     return bool(current.daemon) or multiprocessing.parent_process() is not None
+
+
+_MEANWHILE: list[Callable[[], object]] = []
+"""The tasks :func:`meanwhile` gave that no wait has run yet, in order."""
+
+
+@contextmanager
+def meanwhile(tasks: Sequence[Callable[[], object]]) -> Iterator[None]:
+    """Within it, this process runs ``tasks`` while it waits for another (:func:`wait_readable`).
+
+    For work the job will need later and that depends on nothing the other process
+    makes, such as loading the modules and compiled kernels a verification uses:
+    ``post --preview`` of a part with offsets waits ~0.4 s for the offsets' child to load
+    OpenCASCADE (:func:`camtool.toolpath.offset.offset_all`), and loads numba's kernels
+    there instead of afterwards (issue 17). Each task runs at most once; those no wait
+    ran are dropped on leaving. A task only saves time: what it does must be what the
+    job would do anyway, with the same results.
+    """
+    _MEANWHILE.extend(tasks)
+    try:
+        yield
+    finally:
+        for task in tasks:
+            with suppress(ValueError):  # already run
+                _MEANWHILE.remove(task)
+
+
+def wait_readable(fd: int) -> None:
+    """Run the tasks :func:`meanwhile` gave, one at a time, until ``fd`` can be read.
+
+    A task is not interrupted: the wait may end up to one task later than the other
+    process's answer. A task that raises is dropped (it only saved time; the job does
+    the same work, and meets the same error, when it needs it); ``KeyboardInterrupt``
+    and ``SystemExit`` are not caught.
+    """
+    while _MEANWHILE and not select.select([fd], [], [], 0)[0]:
+        task = _MEANWHILE.pop(0)
+        with suppress(Exception):
+            task()
 
 
 def ahead(items: Iterable[T]) -> Iterator[T]:

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from camtool.geometry.chain import chain
-from camtool.model.cores import FORK, in_worker
+from camtool.model.cores import FORK, in_worker, wait_readable
 from camtool.model.errors import ToolpathError
 from camtool.model.shapes import Arc, Contour, Line, Point, Segment, distance
 
@@ -296,6 +296,7 @@ class _Child:
             self.jobs.flush()
         except OSError:  # it died before it read them
             return got, self._death()
+        wait_readable(self.answers.fileno())  # what the job needs next is loaded meanwhile
         while len(got) < len(jobs):
             try:
                 kind, value = pickle.load(self.answers)
