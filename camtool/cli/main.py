@@ -157,6 +157,7 @@ def post(
     if drawing != "-" and is_program_file(drawing):
         refuse_planning(drawing, drawing_only(options))  # before checking them
     plan = plan_settings(options)
+    verifying = bool(verify_too or report or preview or max_error_um is not None)
     progress = StageReporter()
     try:
         if drawing == "-":
@@ -164,7 +165,13 @@ def post(
             job = post_drawing(drawn, chosen, plan, output_options, progress=progress)
         else:
             job = post_path(
-                drawing, chosen, plan, output_options, import_options=settings, progress=progress
+                drawing,
+                chosen,
+                plan,
+                output_options,
+                import_options=settings,
+                progress=progress,
+                verifying=verifying,
             )
     finally:
         progress.close()
@@ -182,7 +189,7 @@ def post(
         click.echo(
             f"camtool: wrote {job.result.blocks} blocks for {chosen.name} to {output}", err=True
         )
-    if verify_too or report or preview or max_error_um is not None:
+    if verifying:
         progress(Step("verifying", 0, job.result.blocks, chosen.name))
         verified = verify_job(job, budget=not no_budget, budget_now=progress)
         _measure_budget(verified, progress)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -139,6 +140,7 @@ def post_path(
     *,
     import_options: ImportOptions | None = None,
     progress: Progress = no_progress,
+    verifying: bool = False,
 ) -> PostJob:
     """Post the file at ``path``: a drawing is planned, a G-code program re-posted.
 
@@ -156,6 +158,11 @@ def post_path(
             :func:`camtool.importers.read_drawing`), ``planning`` and ``writing``
             (:func:`post_drawing`); a program: ``reading`` and ``writing``. It changes
             nothing in the job.
+        verifying: the caller verifies the job against its drawing next (``post
+            --verify``, ``--preview``): while this process waits for the offsets' child
+            to load OpenCASCADE, it loads what that comparison will
+            (:func:`camtool.verify.metrics.comparison_preloads`). Only the time depends
+            on it.
 
     Raises:
         UsageError: a planning option (offset, tool diameter, scale, depth, order...)
@@ -164,12 +171,14 @@ def post_path(
     """
     plan = plan if plan is not None else PlanOptions()
     if not is_program_file(path):
+        from camtool.model.cores import meanwhile
         from camtool.toolpath.compensate import offsets_ahead
 
         with offsets_ahead(plan):  # OpenCASCADE loads in the offsets' child meanwhile
             drawing = read_drawing(path, import_options, progress=progress)
             drawing = _note_units(drawing, path, import_options)
-            return post_drawing(drawing, target, plan, output, progress=progress)
+            with meanwhile(_preloads(drawing) if verifying else []):
+                return post_drawing(drawing, target, plan, output, progress=progress)
     refuse_planning(path, drawing_only(plan.given()))
     from camtool.importers.gcode import read_gcode
 
@@ -182,6 +191,13 @@ def post_path(
         source=str(path),
         progress=progress,
     )
+
+
+def _preloads(drawing: Drawing) -> list[Callable[[], object]]:
+    """What verifying a job planned from ``drawing`` will load, to load while waiting."""
+    from camtool.verify.metrics import comparison_preloads
+
+    return comparison_preloads(drawing)
 
 
 def post_bytes(

@@ -2195,6 +2195,30 @@ def prepare_comparison(drawing: Drawing) -> None:
         near_kernels()
 
 
+def comparison_preloads(drawing: Drawing) -> list[Callable[[], object]]:
+    """What :func:`prepare_comparison` will load for ``drawing``, as tasks for a wait.
+
+    For a job that will compare a trace with ``drawing`` but first waits for another
+    process (:func:`camtool.model.cores.meanwhile`: ``post --preview`` waits ~0.4 s for
+    the offsets' child to load OpenCASCADE): the compiled nearest search
+    (:func:`near_kernels`, numba's import ~0.15 s), then numba's first call, which loads
+    its compiler's registries (~0.2 s), two tasks so that a short wait ends sooner;
+    only when ``drawing`` has at least :data:`PREPARE_KERNELS_FROM` points at
+    :data:`AGAINST_SPACING_MM` (counted, not sampled). Only the time depends on it. The
+    drawing compared may be scaled from this one (``--fit``), so the count is an
+    estimate; a wrong one costs time and memory, not figures.
+    """
+    count = sum(_contour_samples(c.segments, AGAINST_SPACING_MM) for c in drawing.contours)
+    return [near_kernels, _first_call] if count >= PREPARE_KERNELS_FROM else []
+
+
+def _first_call() -> None:
+    """Make :func:`near_kernels`' first call, on one point: numba loads its registries then."""
+    kernels = near_kernels()
+    if kernels is not None:
+        kernels.build(np.zeros((1, 2)))
+
+
 def against_drawing(
     points: FloatArray,
     drawing: Drawing,
