@@ -114,11 +114,18 @@ def point_distances(
         i.e. the radial error inside the sweep, else to the nearer end point).
     """
     out = np.empty(len(points), dtype=np.float64)
-    is_arc = nominal["kind"][blocks] == 1
-    for mask, measure in ((~is_arc, _to_lines), (is_arc, _to_arcs)):
-        if mask.any():
-            out[mask] = measure(points[mask], blocks[mask], nominal)
+    for lo in range(0, len(points), POINT_CHUNK):  # each point alone: the same floats
+        part = slice(lo, lo + POINT_CHUNK)
+        is_arc = nominal["kind"][blocks[part]] == 1
+        for mask, measure in ((~is_arc, _to_lines), (is_arc, _to_arcs)):
+            if mask.any():
+                out[part][mask] = measure(points[part][mask], blocks[part][mask], nominal)
     return out
+
+
+POINT_CHUNK = 1 << 16
+"""Points :func:`point_distances` measures at once: its ~10 temporaries of ``N`` floats held
+18 MB at the peak of the benchmark part's picture (369 000 cutting rows), now ~5 MB."""
 
 
 def _to_lines(points: FloatArray, blocks: IntArray, nominal: dict[str, FloatArray]) -> FloatArray:
@@ -605,9 +612,9 @@ def _nearest(
     b = np.ascontiguousarray(b, dtype=np.float64)
     half = float(np.max(np.hypot(*(b - a).T))) / 2.0
     points = np.concatenate([a, b])
-    boxes, offsets = kernels.build(points)
+    tree = _ends_tree(points, len(samples), kernels)
     few = len(samples) <= BOX_TREE_UP_TO
-    if not few and not _far(samples, points, boxes, offsets, half, kernels):
+    if not few and not _far(samples, tree, half, kernels):
         return _nearest_kd(samples, a, b, ends=ends, only_max=only_max)
     ends = ends or _LazyTree(points)
     d = np.empty(len(samples), dtype=np.float64)
@@ -615,7 +622,7 @@ def _nearest(
     k = NEAREST_ENDS
     for i in range(0, len(samples), NEAREST_CHUNK):
         chunk = samples[i : i + NEAREST_CHUNK]
-        near, r0_2, rk_2, ask = kernels.near_segments(chunk, points, boxes, offsets, a, b, k)
+        near, r0_2, rk_2, ask = kernels.near_segments(chunk, *tree, a, b, k)
         r0, rk = np.sqrt(r0_2), np.sqrt(rk_2)  # what the k-d tree gives: the same sqrt
         if ask.any():  # ends tie at the k-th distance and the k-d tree's choice matters
             rows = np.flatnonzero(ask)
@@ -626,18 +633,34 @@ def _nearest(
         sure = (near + half < rk) | (near - lower <= NEAREST_TOLERANCE_MM)
         d[i : i + len(chunk)] = near
         unsure[i : i + len(chunk)] = ~sure
-    tree = (points, boxes, offsets)
     nearby = partial(_nearby_boxes, a=a, b=b, tree=tree, half=half, kernels=kernels)
     return _settle_unsure(samples, d, unsure, a, b, nearby, only_max=only_max)
+
+
+MERGE_ENDS_PER_SAMPLE = 16
+"""Ends per sample up to which :func:`_ends_tree` merges the ends at one point into a place."""
+
+
+def _ends_tree(points: FloatArray, samples: int, kernels: ModuleType) -> tuple[Any, ...]:
+    """The search tree of the segment ends ``points`` (``concatenate([a, b])``) for ``samples``.
+
+    :func:`camtool.verify.nearkernels.tree`, its places along the segments. The ends at
+    one point are one place for at least one sample per :data:`MERGE_ENDS_PER_SAMPLE`
+    ends: the 737 736 ends of issue 17's benchmark part are 115 838 places (two segments
+    meet at each, and the part is cut in three passes), and the drawing's search takes
+    about a fifth of the time; a few samples against a long trace (the shortfall's
+    unsure ones) search every end instead of paying for the merge. The answers are the
+    same.
+    """
+    merge = len(points) <= MERGE_ENDS_PER_SAMPLE * samples
+    return tuple(kernels.tree(points, segments=True, merge=merge))
 
 
 def _near_segments_numpy(
     chunk: FloatArray,
     a: FloatArray,
     b: FloatArray,
-    points: FloatArray,
-    boxes: Any,
-    offsets: Any,
+    tree: tuple[Any, ...],
     kernels: ModuleType,
 ) -> tuple[FloatArray, FloatArray, FloatArray, npt.NDArray[np.bool_]]:
     """:func:`camtool.verify.nearkernels.near_segments` with numpy's segment distances.
@@ -646,13 +669,13 @@ def _near_segments_numpy(
     as the tests' reference: the same ``near``, ``r0_2``, ``rk_2`` and ``ask``.
     """
     k = NEAREST_ENDS
-    r0_2, rk_2, index, state = kernels.knn(chunk, points, boxes, offsets, k)
+    r0_2, rk_2, index, state = kernels.knn(chunk, *tree, k)
     seg = index % len(a)
     near = _to_segments(chunk, a[seg], b[seg]).min(axis=1)
     ask = np.zeros(len(chunk), dtype=bool)
     tied = state != 0
     if tied.any():
-        near[tied], asks = _tied(chunk[tied], rk_2[tied], a, b, points, boxes, offsets, kernels)
+        near[tied], asks = _tied(chunk[tied], rk_2[tied], a, b, tree, kernels)
         ask[np.flatnonzero(tied)[asks]] = True
     return near, r0_2, rk_2, ask
 
@@ -662,9 +685,7 @@ def _tied(
     kth2: FloatArray,
     a: FloatArray,
     b: FloatArray,
-    points: FloatArray,
-    boxes: Any,
-    offsets: Any,
+    tree: tuple[Any, ...],
     kernels: ModuleType,
 ) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
     """The k-d tree's ``d`` where ends tie at the k-th distance, when its choice cannot matter.
@@ -681,7 +702,7 @@ def _tied(
     settled = np.empty(len(samples), dtype=bool)
     for i in range(0, len(samples), TIED_CHUNK):  # ~1.5 kB per sample at once
         part = slice(i, i + TIED_CHUNK)
-        found, d2, count = kernels.within(samples[part], points, boxes, offsets, kth2[part])
+        found, d2, count = kernels.within(samples[part], *tree, kth2[part])
         cap = found.shape[1]
         width = max(1, min(cap, int(count.max())))  # the columns any sample fills
         found, d2 = found[:, :width], d2[:, :width]
@@ -784,14 +805,7 @@ FAR_RATIO = 8.0
 searches (:func:`_far`)."""
 
 
-def _far(
-    samples: FloatArray,
-    points: FloatArray,
-    boxes: Any,
-    offsets: Any,
-    half: float,
-    kernels: ModuleType,
-) -> bool:
+def _far(samples: FloatArray, tree: tuple[Any, ...], half: float, kernels: ModuleType) -> bool:
     """Whether the samples lie far from the segments for their length: the box tree's case.
 
     The compiled box tree answers a sample a tool radius from a dense trace (a drawing
@@ -803,7 +817,7 @@ def _far(
     time depends on it.
     """
     probe = np.ascontiguousarray(samples[:: max(1, len(samples) // FAR_PROBE)])
-    r0_2 = kernels.knn(probe, points, boxes, offsets, 1)[0]
+    r0_2 = kernels.knn(probe, *tree, 1)[0]
     return bool(np.median(r0_2) > (FAR_RATIO * half) ** 2)
 
 
@@ -988,7 +1002,7 @@ def _nearby_boxes(
     upper: FloatArray,
     a: FloatArray,
     b: FloatArray,
-    tree: tuple[FloatArray, Any, Any],
+    tree: tuple[Any, ...],
     half: float,
     kernels: ModuleType,
     need: npt.NDArray[np.bool_] | None = None,
@@ -1003,16 +1017,13 @@ def _nearby_boxes(
         upper: ``(U,)`` distance of each to some segment ``a → b``, mm.
         a: ``(M, 2)`` segment starts, mm.
         b: ``(M, 2)`` segment ends, mm.
-        tree: ``(points, boxes, offsets)``: the ends and their box tree.
+        tree: the ends' search tree (:func:`camtool.verify.nearkernels.tree`).
         half: half the longest segment, mm.
         kernels: :mod:`camtool.verify.nearkernels`.
         need: as for :func:`_nearby_exact` (the limit counts every sample's pairs).
     """
     reach = ((upper + half) * (1.0 + 1e-9) + 1e-12) * (1.0 + 1e-12)
-    points, boxes, offsets = tree
-    owner, seg = kernels.pairs_within(
-        np.ascontiguousarray(samples), points, boxes, offsets, reach, NEARBY_MAX_PAIRS
-    )
+    owner, seg = kernels.pairs_within(np.ascontiguousarray(samples), *tree, reach, NEARBY_MAX_PAIRS)
     if len(owner) == 0 or len(np.unique(owner)) < len(samples):
         return None  # over the limit (or, which cannot happen, a sample without one)
     if need is None:

@@ -8,6 +8,14 @@ consecutive points under a tree of :data:`FAN`-fold nodes, each with the *tight*
 bounding box of its points; a query visits only the boxes nearer than its current
 k-th end.
 
+The tree holds *places*, not ends (:func:`tree`): the ends of a trace's segments repeat
+(the end of one segment starts the next; a part cut in three passes of the same path
+repeats each end three times more), so each distinct point is kept once with the list of
+the ends at it, and a search visits one leaf where it visited six. On issue 17's
+benchmark part the 737 736 ends of the cutting trace are 115 838 places, and the
+drawing's search takes a fifth of the time. Every end at a place is counted as it was,
+so the answers are unchanged.
+
 The answers are the k-d tree's, bit for bit (the tests compare them): the squared
 distance of two points is scipy's (``(x − u)² + (y − v)²`` summed from 0, then its
 square root), and the set of the ``k`` nearest ends is the same wherever it is one
@@ -34,6 +42,84 @@ FAN = 8
 """Children per node above the leaves."""
 CAP = 64
 """Most ends a query keeps at its k-th distance (ties included); more: the k-d tree answers."""
+
+
+def tree(
+    points: Any, *, segments: bool = False, merge: bool = True
+) -> tuple[Any, Any, Any, Any, Any]:
+    """The search tree of the ends ``points`` ``(P, 2)``: ``(places, boxes, offsets, start, ends)``.
+
+    ``places`` ``(U, 2)`` are the distinct points among ``points`` (the same float64
+    bits), numbered in the order of their first end; ``ends[start[u]:start[u + 1]]`` are
+    the ends at place ``u``, in that order; ``boxes`` and ``offsets`` are :func:`build`'s
+    of ``places``. The searches give the ends, as a tree of every end would. With
+    ``segments``, ``points`` is ``concatenate([a, b])`` of ``P / 2`` segments and the order
+    is along them (``a[0]``, ``b[0]``, ``a[1]``…), so that consecutive places lie together
+    and the leaves' boxes stay small. ``merge=False`` keeps every end its own place.
+    """
+    points = np.ascontiguousarray(points, dtype=np.float64)
+    n = len(points)
+    if not merge or n == 0:
+        start = np.arange(n + 1, dtype=np.int64)
+        ends = np.arange(n, dtype=np.int64)
+        return (points, *build(points), start, ends)
+    if n >= 2**31:  # _merge numbers ends in int32
+        return tree(points, merge=False)
+    half = n // 2 if segments else 0
+    start, ends = _merge(points.view(np.uint64), half)
+    places = np.ascontiguousarray(points[ends[start[:-1]]])
+    return (places, *build(places), start, ends)
+
+
+@numba.njit(cache=True, nogil=True)
+def _merge(bits: Any, half: int) -> tuple[Any, Any]:  # pragma: no cover - compiled
+    """:func:`tree`'s places of the ends whose coordinates' bits are ``bits`` ``(P, 2)``.
+
+    The ends are taken in order (``half > 0``: ``j // 2 + (j % 2) · half``, along the
+    segments), each looked up by its bits in an open-addressing table of twice as many
+    slots; a place is numbered when its first end comes. Returns ``start`` ``(U + 1,)``
+    and ``ends`` ``(P,)``, the ends grouped by place, each group in the order taken.
+    """
+    n = len(bits)
+    size = 1
+    while size < 2 * n:
+        size *= 2
+    mask = np.uint64(size - 1)
+    table = np.full(size, -1, dtype=np.int32)  # int32: less memory (P < 2**31)
+    place_of = np.empty(n, dtype=np.int32)
+    first = np.empty(n, dtype=np.int32)
+    count = np.zeros(n + 1, dtype=np.int64)
+    places = 0
+    for j in range(n):
+        e = j // 2 + (j % 2) * half if half > 0 else j
+        x = bits[e, 0]
+        y = bits[e, 1]
+        h = x * np.uint64(0x9E3779B97F4A7C15) ^ y * np.uint64(0xC2B2AE3D27D4EB4F)
+        h ^= h >> np.uint64(31)
+        slot = h & mask
+        while True:
+            p = table[slot]
+            if p < 0:
+                table[slot] = places
+                first[places] = e
+                place_of[e] = places
+                places += 1
+                break
+            f = first[p]
+            if bits[f, 0] == x and bits[f, 1] == y:
+                place_of[e] = p
+                break
+            slot = (slot + np.uint64(1)) & mask
+        count[place_of[e] + 1] += 1
+    start = np.cumsum(count[: places + 1])
+    at = start[:places].copy()
+    ends = np.empty(n, dtype=np.int64)
+    for j in range(n):
+        e = j // 2 + (j % 2) * half if half > 0 else j
+        p = place_of[e]
+        ends[at[p]] = e
+        at[p] += 1
+    return start, ends
 
 
 def build(points: Any) -> tuple[Any, Any]:
@@ -143,6 +229,8 @@ def _knn_one(
     points: Any,
     boxes: Any,
     offsets: Any,
+    start: Any,
+    ends: Any,
     k: int,
     last: int,
     best: Any,
@@ -152,11 +240,12 @@ def _knn_one(
 ) -> tuple[int, int, bool]:  # pragma: no cover - compiled
     """:func:`knn`'s search for one query ``(qx, qy)``.
 
-    Fills ``best[:k]`` (the k smallest squared distances, ascending) and
-    ``found[:count]``/``found2[:count]``: ends kept within the bound at the time, which
-    holds every end within the k-th distance unless ``spill`` (more than :data:`CAP`).
-    ``last`` is the previous query's nearest end (a warm start); ``work`` the scratch
-    stacks. Returns ``(nearest end or -1, count, spill)``.
+    Fills ``best[:k]`` (the k smallest squared distances of the ends, ascending: a place
+    counts once per end at it) and ``found[:count]``/``found2[:count]``: ends kept within
+    the bound at the time, which holds every end within the k-th distance unless
+    ``spill`` (more than :data:`CAP`). ``last`` is the previous query's nearest place (a
+    warm start); ``work`` the scratch stacks. Returns ``(nearest place or -1, count,
+    spill)``.
     """
     stack_level, stack_node, child, child2 = work
     npts = len(points)
@@ -166,10 +255,11 @@ def _knn_one(
     for j in range(k):
         best[j] = np.inf
     leaf = last // LEAF
-    for i in range(max(0, (leaf - 1) * LEAF), min(npts, (leaf + 2) * LEAF)):
-        d2 = _point2(points, i, qx, qy)
-        if d2 < best[k - 1]:
-            _insert(best, k, d2)
+    for u in range(max(0, (leaf - 1) * LEAF), min(npts, (leaf + 2) * LEAF)):
+        d2 = _point2(points, u, qx, qy)
+        for _ in range(start[u], start[u + 1]):
+            if d2 < best[k - 1]:
+                _insert(best, k, d2)
     warm = best[k - 1]  # >= the k-th smallest of all: prunes nothing it needs
     for j in range(k):
         best[j] = np.inf
@@ -189,28 +279,29 @@ def _knn_one(
         if level == 0:
             lo = node * LEAF
             hi = min(npts, lo + LEAF)
-            for i in range(lo, hi):
-                d2 = _point2(points, i, qx, qy)
-                if d2 < best[k - 1]:
-                    if d2 < best[0]:
-                        nearest = i
-                    _insert(best, k, d2)
-                bound = min(best[k - 1], warm)
-                if d2 <= bound:
-                    if count == CAP:  # drop what the bound has passed
-                        kept = 0
-                        for j in range(count):
-                            if found2[j] <= bound:
-                                found[kept] = found[j]
-                                found2[kept] = found2[j]
-                                kept += 1
-                        count = kept
-                    if count < CAP:
-                        found[count] = i
-                        found2[count] = d2
-                        count += 1
-                    else:
-                        spill = True
+            for u in range(lo, hi):
+                d2 = _point2(points, u, qx, qy)
+                for e in range(start[u], start[u + 1]):  # each end at the place
+                    if d2 < best[k - 1]:
+                        if d2 < best[0]:
+                            nearest = u
+                        _insert(best, k, d2)
+                    bound = min(best[k - 1], warm)
+                    if d2 <= bound:
+                        if count == CAP:  # drop what the bound has passed
+                            kept = 0
+                            for j in range(count):
+                                if found2[j] <= bound:
+                                    found[kept] = found[j]
+                                    found2[kept] = found2[j]
+                                    kept += 1
+                            count = kept
+                        if count < CAP:
+                            found[count] = ends[e]
+                            found2[count] = d2
+                            count += 1
+                        else:
+                            spill = True
             continue
         below = offsets[level - 1]
         count_below = offsets[level] - below
@@ -238,16 +329,18 @@ def _knn_one(
 
 @numba.njit(cache=True, nogil=True)
 def knn(
-    samples: Any, points: Any, boxes: Any, offsets: Any, k: int
+    samples: Any, points: Any, boxes: Any, offsets: Any, start: Any, ends: Any, k: int
 ) -> tuple[Any, Any, Any, Any]:  # pragma: no cover - compiled
-    """The ``k`` nearest of ``points`` to each sample, as scipy's k-d tree finds them.
+    """The ``k`` nearest ends to each sample, as scipy's k-d tree of the ends finds them.
 
     Args:
         samples: ``(N, 2)`` query points.
-        points: ``(P, 2)`` the ends.
-        boxes: :func:`build`'s boxes of ``points``.
-        offsets: :func:`build`'s level offsets.
-        k: neighbours, ``1 <= k <= P``.
+        points: ``(U, 2)`` the places of the ends (:func:`tree`).
+        boxes: their boxes (:func:`tree`).
+        offsets: the boxes' level offsets (:func:`tree`).
+        start: ``(U + 1,)`` where each place's ends start in ``ends`` (:func:`tree`).
+        ends: ``(P,)`` the ends at the places, place after place (:func:`tree`).
+        k: neighbours, ``1 <= k <=`` the number of ends.
 
     Returns:
         ``r0`` ``(N,)`` the nearest end's squared distance and ``rk`` ``(N,)`` the k-th's
@@ -267,8 +360,9 @@ def knn(
     work = _scratch()
     last = 0
     for q in range(n):
+        qx, qy = samples[q, 0], samples[q, 1]
         nearest, count, spill = _knn_one(
-            samples[q, 0], samples[q, 1], points, boxes, offsets, k, last, best, found, found2, work
+            qx, qy, points, boxes, offsets, start, ends, k, last, best, found, found2, work
         )
         kth = best[k - 1]
         if nearest >= 0:
@@ -288,9 +382,11 @@ def knn(
 
 @numba.njit(cache=True, nogil=True)
 def within(
-    samples: Any, points: Any, boxes: Any, offsets: Any, bound2: Any
+    samples: Any, points: Any, boxes: Any, offsets: Any, start: Any, ends: Any, bound2: Any
 ) -> tuple[Any, Any, Any]:  # pragma: no cover - compiled
     """Every end within ``bound2[i]`` (squared distance, inclusive) of each sample.
+
+    ``points``, ``boxes``, ``offsets``, ``start``, ``ends``: :func:`tree` of the ends.
 
     Returns:
         ``found`` ``(N, CAP)`` ends, ``d2`` ``(N, CAP)`` their squared distances (as
@@ -305,21 +401,32 @@ def within(
     for q in range(n):
         row, row2 = found[q], found2[q]
         qx, qy = samples[q, 0], samples[q, 1]
-        count[q] = _ends_within(qx, qy, points, boxes, offsets, bound2[q], row, row2, work)
+        count[q] = _ends_within(
+            qx, qy, points, boxes, offsets, start, ends, bound2[q], row, row2, work
+        )
     return found, found2, count
 
 
 @numba.njit(cache=True, nogil=True)
 def pairs_within(
-    samples: Any, points: Any, boxes: Any, offsets: Any, reach: Any, limit: int
+    samples: Any,
+    points: Any,
+    boxes: Any,
+    offsets: Any,
+    start: Any,
+    ends: Any,
+    reach: Any,
+    limit: int,
 ) -> tuple[Any, Any]:  # pragma: no cover - compiled
     """Every ``(sample, end)`` pair closer than ``reach[sample]`` (or at it), sample-major.
 
     Args:
         samples: ``(N, 2)`` query points.
-        points: ``(P, 2)`` the ends.
-        boxes: :func:`build`'s boxes of ``points``.
-        offsets: :func:`build`'s level offsets.
+        points: ``(U, 2)`` the places of the ends (:func:`tree`).
+        boxes: their boxes (:func:`tree`).
+        offsets: the boxes' level offsets (:func:`tree`).
+        start: ``(U + 1,)`` where each place's ends start in ``ends`` (:func:`tree`).
+        ends: ``(P,)`` the ends at the places, place after place (:func:`tree`).
         reach: ``(N,)`` distances.
         limit: most pairs; beyond it none are given.
 
@@ -356,13 +463,14 @@ def pairs_within(
                 if _box2(boxes, offsets[level] + node, qx, qy) > bound:
                     continue
                 if level == 0:
-                    for i in range(node * LEAF, min(npts, node * LEAF + LEAF)):
-                        if _point2(points, i, qx, qy) <= bound:
-                            if fill == 1:
-                                owner[at] = q
-                                end[at] = i
-                                at += 1
-                            c += 1
+                    for u in range(node * LEAF, min(npts, node * LEAF + LEAF)):
+                        if _point2(points, u, qx, qy) <= bound:
+                            for e in range(start[u], start[u + 1]):
+                                if fill == 1:
+                                    owner[at] = q
+                                    end[at] = ends[e]
+                                    at += 1
+                                c += 1
                     continue
                 below = offsets[level - 1]
                 count_below = offsets[level] - below
@@ -403,12 +511,21 @@ def _segment(px: float, py: float, a: Any, b: Any, s: int) -> float:  # pragma: 
 
 @numba.njit(cache=True, nogil=True)
 def near_segments(
-    samples: Any, points: Any, boxes: Any, offsets: Any, a: Any, b: Any, k: int
+    samples: Any,
+    points: Any,
+    boxes: Any,
+    offsets: Any,
+    start: Any,
+    ends: Any,
+    a: Any,
+    b: Any,
+    k: int,
 ) -> tuple[Any, Any, Any, Any]:  # pragma: no cover - compiled
     """The k-d tree path's distance to the segments of the ``k`` nearest ends, in one pass.
 
-    For each sample, :func:`knn`'s ``k`` nearest ends (``points`` is ``concatenate([a,
-    b])``: end ``i`` belongs to segment ``i % len(a)``) and the least distance to their
+    For each sample, :func:`knn`'s ``k`` nearest ends (``points``, ``boxes``,
+    ``offsets``, ``start``, ``ends``: :func:`tree` of ``concatenate([a, b])``, so end
+    ``i`` belongs to segment ``i % len(a)``) and the least distance to their
     segments (:func:`_segment`). Where ends tie at the k-th distance the k-d tree keeps
     some of them; as :func:`camtool.verify.metrics._tied` does, every end within the
     k-th distance is looked at (the search's own list, or :func:`_ends_within` when it
@@ -434,7 +551,7 @@ def near_segments(
         qx = samples[q, 0]
         qy = samples[q, 1]
         nearest, count, spill = _knn_one(
-            qx, qy, points, boxes, offsets, k, last, best, found, found2, work
+            qx, qy, points, boxes, offsets, start, ends, k, last, best, found, found2, work
         )
         kth2 = best[k - 1]
         if nearest >= 0:
@@ -442,7 +559,9 @@ def near_segments(
         r0_2[q] = best[0]
         rk_2[q] = kth2
         if spill:  # the list overflowed: every end within the k-th distance, searched again
-            count = _ends_within(qx, qy, points, boxes, offsets, kth2, found, found2, work)
+            count = _ends_within(
+                qx, qy, points, boxes, offsets, start, ends, kth2, found, found2, work
+            )
             if count > CAP:  # _tied() sees only CAP of them: it asks the k-d tree
                 ask[q] = True
                 continue
@@ -482,6 +601,8 @@ def _ends_within(
     points: Any,
     boxes: Any,
     offsets: Any,
+    start: Any,
+    ends: Any,
     bound2: float,
     found: Any,
     found2: Any,
@@ -505,13 +626,14 @@ def _ends_within(
         if _box2(boxes, offsets[level] + node, qx, qy) > bound2:
             continue
         if level == 0:
-            for i in range(node * LEAF, min(npts, node * LEAF + LEAF)):
-                d2 = _point2(points, i, qx, qy)
+            for u in range(node * LEAF, min(npts, node * LEAF + LEAF)):
+                d2 = _point2(points, u, qx, qy)
                 if d2 <= bound2:
-                    if c < CAP:
-                        found[c] = i
-                        found2[c] = d2
-                    c += 1
+                    for e in range(start[u], start[u + 1]):
+                        if c < CAP:
+                            found[c] = ends[e]
+                            found2[c] = d2
+                        c += 1
             continue
         below = offsets[level - 1]
         count_below = offsets[level] - below

@@ -71,16 +71,18 @@ def test_nearest_distances_equal_the_kd_tree_path_bit_for_bit(seed: int) -> None
         assert np.array_equal(got.view(np.int64), want.view(np.int64))
 
 
+@pytest.mark.parametrize("merge", [True, False])
 @pytest.mark.parametrize("seed", range(4))
-def test_knn_finds_the_kd_trees_ends_where_they_are_one_set(seed: int) -> None:
+def test_knn_finds_the_kd_trees_ends_where_they_are_one_set(seed: int, merge: bool) -> None:
+    """Every end counts, whether the ends at one point are one place of the tree or not."""
     rng = np.random.default_rng(100 + seed)
     for kind in range(12):
         pts = _trace(rng, kind)
         points = np.concatenate([pts[:-1], pts[1:]])
         samples = _samples(rng, pts, 2000, reach=0.5)
-        boxes, offsets = nearkernels.build(points)
+        tree = nearkernels.tree(points, merge=merge)
         for k in (1, 4, 7):
-            r0, rk, index, state = nearkernels.knn(samples, points, boxes, offsets, k)
+            r0, rk, index, state = nearkernels.knn(samples, *tree, k)
             r, want = cKDTree(points).query(samples, k=k)
             r = np.asarray(r).reshape(len(samples), k)
             want = np.asarray(want).reshape(len(samples), k)
@@ -89,10 +91,39 @@ def test_knn_finds_the_kd_trees_ends_where_they_are_one_set(seed: int) -> None:
             one = state == 0
             assert np.array_equal(np.sort(index[one], axis=1), np.sort(want[one], axis=1))
             # where not one set, every end the k-d tree chose is within the k-th distance
-            found, _, count = nearkernels.within(samples[~one], points, boxes, offsets, rk[~one])
+            found, _, count = nearkernels.within(samples[~one], *tree, rk[~one])
             for row, chosen in enumerate(want[~one]):
                 if count[row] <= found.shape[1]:
                     assert set(chosen.tolist()) <= set(found[row, : count[row]].tolist())
+
+
+@pytest.mark.parametrize("segments", [True, False])
+def test_the_tree_holds_each_end_once_at_its_place(segments: bool) -> None:
+    """Three passes of a stepped path: one place per distinct point, every end at its own.
+
+    The places are numbered in the order of their first end (along the segments with
+    ``segments``: ``a[0]``, ``b[0]``, ``a[1]``…), and 0.0 and -0.0 stay apart (bits).
+    """
+    rng = np.random.default_rng(5)
+    path = np.cumsum(rng.integers(-1, 2, size=(3000, 2)) * 0.004, axis=0)
+    pts = np.concatenate([path] * 3)
+    pts[7] = [0.0, -0.0]
+    pts[8] = [0.0, 0.0]
+    a, b = pts[:-1], pts[1:]
+    points = np.concatenate([a, b])
+    places, _, _, start, ends = nearkernels.tree(points, segments=segments)
+    m = len(a)
+    taken = np.ravel(np.c_[np.arange(m), m + np.arange(m)]) if segments else np.arange(2 * m)
+    bits = points.view(np.uint64)
+    assert np.array_equal(np.sort(ends), np.arange(2 * m))  # every end, once
+    assert len(places) == len(np.unique(bits, axis=0))  # one place per distinct point
+    rank = np.empty(2 * m, dtype=np.int64)
+    rank[taken] = np.arange(2 * m)
+    for u in range(len(places)):
+        at = ends[start[u] : start[u + 1]]
+        assert (bits[at] == places[u].view(np.uint64)).all()
+        assert (np.diff(rank[at]) > 0).all()  # in the order taken
+    assert (np.diff(rank[ends[start[:-1]]]) > 0).all()  # places by their first end
 
 
 def test_knn_on_a_line_of_repeated_ends_far_away() -> None:
@@ -132,9 +163,7 @@ def test_nearby_boxes_is_the_kd_tree_nearby_query_bit_for_bit(seed: int) -> None
         half = float(np.max(np.hypot(*(b - a).T))) / 2.0
         ends = cKDTree(np.concatenate([a, b]))
         upper, _ = metrics._nearest_chunk(samples, a, b, ends, half)
-        points = np.concatenate([a, b])
-        boxes, offsets = nearkernels.build(points)
-        tree = (points, boxes, offsets)
+        tree = nearkernels.tree(np.concatenate([a, b]))
         fast = metrics._nearby_boxes(samples, upper, a, b, tree, half, nearkernels)
         assert fast is not None
         assert np.array_equal(fast, metrics._nearby_exact(samples, upper, a, b, ends, half))
@@ -143,12 +172,10 @@ def test_nearby_boxes_is_the_kd_tree_nearby_query_bit_for_bit(seed: int) -> None
 def test_nearby_boxes_gives_way_over_the_pair_limit(monkeypatch: pytest.MonkeyPatch) -> None:
     pts = _trace(np.random.default_rng(3), 1)
     a, b = pts[:-1], pts[1:]
-    points = np.concatenate([a, b])
-    boxes, offsets = nearkernels.build(points)
+    tree = nearkernels.tree(np.concatenate([a, b]))
     samples = pts[:50] + 0.001
     upper = np.full(50, 0.01)
     monkeypatch.setattr(metrics, "NEARBY_MAX_PAIRS", 10)
-    tree = (points, boxes, offsets)
     assert metrics._nearby_boxes(samples, upper, a, b, tree, 0.002, nearkernels) is None
 
 
@@ -216,10 +243,11 @@ def test_near_segments_is_the_numpy_form_bit_for_bit(seed: int) -> None:
         pts = _trace(rng, kind)
         a, b = np.ascontiguousarray(pts[:-1]), np.ascontiguousarray(pts[1:])
         points = np.concatenate([a, b])
-        boxes, offsets = nearkernels.build(points)
         samples = _samples(rng, pts, 2000, reach=float(rng.choice([0.0015, 0.1, 1.5])))
-        want = metrics._near_segments_numpy(samples, a, b, points, boxes, offsets, nearkernels)
-        got = nearkernels.near_segments(samples, points, boxes, offsets, a, b, 4)
+        every = nearkernels.tree(points, merge=False)  # the reference: each end its own place
+        want = metrics._near_segments_numpy(samples, a, b, every, nearkernels)
+        places = nearkernels.tree(points, segments=True)  # as nearest_distances builds it
+        got = nearkernels.near_segments(samples, *places, a, b, 4)
         assert np.array_equal(got[3], want[3])  # the same samples ask the k-d tree
         for g, w in zip(got[1:3], want[1:3], strict=True):
             assert np.array_equal(g, w)
@@ -293,12 +321,11 @@ def test_the_box_tree_searches_only_samples_far_from_the_segments(
     monkeypatch.undo()  # the real _far
     x = np.arange(0.0, 20.0, 0.004)
     line = np.c_[x, np.zeros_like(x)]
-    points = np.concatenate([line[:-1], line[1:]])
-    boxes, offsets = nearkernels.build(points)
+    tree = nearkernels.tree(np.concatenate([line[:-1], line[1:]]))
     off = np.c_[np.arange(0.0, 20.0, 0.005), np.full(4000, 1.5)]
     on = off * [1.0, 0.0] + [0.001, 0.0001]
-    assert metrics._far(off, points, boxes, offsets, 0.002, nearkernels)
-    assert not metrics._far(on, points, boxes, offsets, 0.002, nearkernels)
+    assert metrics._far(off, tree, 0.002, nearkernels)
+    assert not metrics._far(on, tree, 0.002, nearkernels)
     for samples in (off, on):
         want = metrics.nearest_distances_kd(samples, line[:-1], line[1:])
         got = metrics.nearest_distances(samples, line[:-1], line[1:])
