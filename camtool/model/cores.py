@@ -38,6 +38,7 @@ __all__ = [
     "in_worker",
     "meanwhile",
     "wait_readable",
+    "wait_until",
 ]
 
 T = TypeVar("T")
@@ -78,9 +79,10 @@ def meanwhile(tasks: Sequence[Callable[[], object]]) -> Iterator[None]:
     makes, such as loading the modules and compiled kernels a verification uses:
     ``post --preview`` of a part with offsets waits ~0.4 s for the offsets' child to load
     OpenCASCADE (:func:`camtool.toolpath.offset.offset_all`), and loads numba's kernels
-    there instead of afterwards (issue 17). Each task runs at most once; those no wait
-    ran are dropped on leaving. A task only saves time: what it does must be what the
-    job would do anyway, with the same results.
+    there instead of afterwards; it waits for the error budget's workers
+    (:meth:`ForkedWork.answers`) and loads matplotlib for the picture (issue 17). Each
+    task runs at most once; those no wait ran are dropped on leaving. A task only saves
+    time: what it does must be what the job would do anyway, with the same results.
     """
     _MEANWHILE.extend(tasks)
     try:
@@ -92,14 +94,19 @@ def meanwhile(tasks: Sequence[Callable[[], object]]) -> Iterator[None]:
 
 
 def wait_readable(fd: int) -> None:
-    """Run the tasks :func:`meanwhile` gave, one at a time, until ``fd`` can be read.
+    """Run the tasks :func:`meanwhile` gave, one at a time, until ``fd`` can be read."""
+    wait_until(lambda: bool(select.select([fd], [], [], 0)[0]))
+
+
+def wait_until(ready: Callable[[], bool]) -> None:
+    """Run the tasks :func:`meanwhile` gave, one at a time, until ``ready()``.
 
     A task is not interrupted: the wait may end up to one task later than the other
     process's answer. A task that raises is dropped (it only saved time; the job does
     the same work, and meets the same error, when it needs it); ``KeyboardInterrupt``
     and ``SystemExit`` are not caught.
     """
-    while _MEANWHILE and not select.select([fd], [], [], 0)[0]:
+    while _MEANWHILE and not ready():
         task = _MEANWHILE.pop(0)
         with suppress(Exception):
             task()
@@ -210,7 +217,8 @@ class ForkedWork(Generic[T, R]):
             whose worker raised, died or sent no answer is run again in this process, in
             order.
         """
-        try:
+        try:  # what this process needs next is loaded while the workers work
+            wait_until(lambda: all(future.done() for future in self._futures))
             for future in as_completed(self._futures):
                 try:
                     ok, value = future.result()

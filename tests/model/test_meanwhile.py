@@ -92,3 +92,22 @@ def test_an_interrupt_in_a_task_is_not_swallowed(pipe: tuple[int, int]) -> None:
 
     with cores.meanwhile([interrupt]), pytest.raises(KeyboardInterrupt):
         cores.wait_readable(read)
+
+
+@pytest.mark.skipif(not cores.FORK, reason="forked workers: Linux only")
+def test_waiting_for_forked_work_runs_the_tasks(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``ForkedWork.answers`` waits for its workers by running the tasks; answers unchanged."""
+    import time
+
+    monkeypatch.setattr(cores, "default_jobs", lambda: 2)
+    done: list[str] = []
+
+    def slow(x: int) -> int:
+        time.sleep(0.3)
+        return x * x
+
+    with cores.meanwhile([_recorder(done, "a"), _recorder(done, "b")]):
+        work = cores.ForkedWork(slow, [1, 2, 3])
+        assert done == []  # nothing runs until this process waits
+        assert work.answers() == [1, 4, 9]
+    assert done == ["a", "b"]

@@ -46,3 +46,35 @@ def test_a_job_posted_while_preloading_is_the_same_job() -> None:
     assert loading.result.code == plain.result.code
     assert loading.program == plain.program
     assert cores._MEANWHILE == []  # the tasks no wait ran are gone with the job
+
+
+@pytest.mark.parametrize(
+    ("preview", "tasks"), [(None, 0), ("out.svg", 0), ("out.png", 1), ("OUT.PNG", 1)]
+)
+def test_only_a_png_preview_loads_matplotlib_while_waiting(preview: str | None, tasks: int) -> None:
+    from camtool.cli.main import _loading_the_picture
+
+    with _loading_the_picture(preview):
+        assert len(cores._MEANWHILE) == tasks
+    assert cores._MEANWHILE == []
+
+
+def test_point_distances_in_chunks_are_the_whole_answer_bit_for_bit(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Each point's distance is its own, so measuring a few at a time changes no float."""
+    import numpy as np
+
+    from camtool.jobs.pipeline import post_drawing
+
+    target = load_target("grbl")
+    plan = PlanOptions(offset="outside", tool_diameter=3.0)
+    job = post_drawing(read_drawing(SAMPLES / "plate.dxf"), target, plan)
+    rng = np.random.default_rng(8)
+    blocks = rng.integers(0, len(job.program.moves), size=5000)
+    points = rng.uniform(-5.0, 105.0, size=(5000, 2))
+    nominal = metrics.nominal_arrays(job.program)
+    assert (nominal["kind"][blocks] == 1).any() and (nominal["kind"][blocks] == 0).any()
+    whole = metrics.point_distances(points, blocks, nominal)
+    monkeypatch.setattr(metrics, "POINT_CHUNK", 7)
+    assert metrics.point_distances(points, blocks, nominal).tobytes() == whole.tobytes()
