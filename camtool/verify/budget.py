@@ -64,7 +64,12 @@ def figures(
 
 def against_figures(against: Against | None) -> Figures:
     """The figures of a drawing comparison: those :func:`figures` adds for it."""
-    return {} if against is None else {"distance to the drawing": against.max_um}
+    return {} if against is None else distance_figures(against.max_um)
+
+
+def distance_figures(max_um: float) -> Figures:
+    """:func:`against_figures` of a comparison whose largest distance is ``max_um``."""
+    return {"distance to the drawing": max_um}
 
 
 @dataclass(frozen=True)

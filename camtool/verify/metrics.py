@@ -637,6 +637,90 @@ def _nearest(
     return _settle_unsure(samples, d, unsure, a, b, nearby, only_max=only_max)
 
 
+def farthest_off(samples: FloatArray, a: FloatArray, b: FloatArray, offset: float) -> float:
+    """``max(|nearest_distances(samples, a, b) - offset|)``: the same float.
+
+    For a caller that needs only the largest offset distance (the error budget's
+    distance to the drawing: ``offset`` is the tool radius). The compiled search of
+    :func:`_nearest` settles most samples; the others are made exact as it makes them
+    only where they can reach the largest value, given bounds on their distance: at
+    most the segment distance found (a sample its tests leave unsure) or the k-th end's
+    distance (a sample where the k-d tree's choice among tied ends matters: every
+    segment it can keep has an end that near), at least ``sqrt(r0² − L²/4)`` (``r0``
+    the nearest end, ``L`` the longest segment), each widened by a billionth, 1e-12 mm
+    and 64 ulps of the largest coordinate for the rounding of two formulas. So the k-d
+    tree of every end is built only when a tied sample can be the largest: on issue
+    17's benchmark part none can, which spares a budget worker that tree (~0.3 s).
+
+    The exact stage gets what :func:`_settle_unsure` gets in :func:`_nearest` (the same
+    unsure samples, so the same choice between its two ways of measuring): that needs
+    every tied sample left out to be sure whatever the k-d tree keeps (its upper bound
+    passes the vertex test); else, without the compiled search, or where it would not
+    search (:func:`_far`), every distance is measured (:func:`nearest_distances`).
+
+    Args:
+        samples: ``(N, 2)`` query points, mm, ``N >= 1``.
+        a: ``(M, 2)`` segment starts, mm.
+        b: ``(M, 2)`` segment ends, mm.
+        offset: subtracted from each distance, mm.
+    """
+    kernels = near_kernels(len(samples))
+    if kernels is None or len(a) == 0 or 2 * len(a) <= NEAREST_ENDS:
+        return _largest_off(nearest_distances(samples, a, b), offset)
+    samples = np.ascontiguousarray(samples, dtype=np.float64)
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    b = np.ascontiguousarray(b, dtype=np.float64)
+    half = float(np.max(np.hypot(*(b - a).T))) / 2.0
+    points = np.concatenate([a, b])
+    tree = _ends_tree(points, len(samples), kernels)
+    if len(samples) > BOX_TREE_UP_TO and not _far(samples, tree, half, kernels):
+        return _largest_off(nearest_distances(samples, a, b), offset)
+    n = len(samples)
+    d, lower, kth = np.empty(n), np.empty(n), np.empty(n)
+    ask = np.zeros(n, dtype=bool)
+    for i in range(0, n, NEAREST_CHUNK):
+        part = slice(i, i + NEAREST_CHUNK)
+        chunk = samples[part]
+        near, r0_2, rk_2, ask[part] = kernels.near_segments(chunk, *tree, a, b, NEAREST_ENDS)
+        d[part], kth[part] = near, np.sqrt(rk_2)
+        lower[part] = np.sqrt(np.maximum(np.sqrt(r0_2) ** 2 - half * half, 0.0))
+    sure = ~ask & ((d + half < kth) | (d - lower <= NEAREST_TOLERANCE_MM))
+    best = _largest_off(d[sure], offset)
+    slack = 1e-12 + 64.0 * float(np.spacing(np.max(np.abs(samples))))
+    low = lower * (1.0 - 1e-9) - slack
+    high = kth * (1.0 + 1e-9) + slack
+    asked = ask & _can_reach(high, low, offset, best)
+    if (ask & ~asked).any() and not np.all((high - lower <= NEAREST_TOLERANCE_MM)[ask & ~asked]):
+        return _largest_off(nearest_distances(samples, a, b), offset)  # see above
+    if asked.any():  # the k-d tree's choice, as _nearest takes it
+        rows = np.flatnonzero(asked)
+        ends = _LazyTree(points).tree.query(samples[rows], k=NEAREST_ENDS, workers=KD_WORKERS)[1]
+        seg = np.asarray(ends).reshape(-1, NEAREST_ENDS) % len(a)
+        d[rows] = _to_segments(samples[rows], a[seg], b[seg]).min(axis=1)
+        sure[rows] = (d[rows] + half < kth[rows]) | (d[rows] - lower[rows] <= NEAREST_TOLERANCE_MM)
+        best = max(best, _largest_off(d[rows[sure[rows]]], offset))
+    unsure = ~sure & (asked | ~ask)
+    if unsure.any():  # _settle_unsure's exact stage, only where a distance can be the largest
+        need = _can_reach(d[unsure] * (1.0 + 1e-9) + slack, low[unsure], offset, best)
+        exact = _nearby_boxes(samples[unsure], d[unsure], a, b, tree, half, kernels, need)
+        if exact is None:
+            exact = _all_exact_where(samples[unsure], d[unsure], a, b, need)
+        best = max(best, _largest_off(exact[need], offset))
+    return best
+
+
+def _can_reach(
+    upper: FloatArray, lower: FloatArray, offset: float, best: float
+) -> npt.NDArray[np.bool_]:
+    """Where a distance within ``[lower, upper]`` may be ``offset`` ± at least ``best``."""
+    return np.asarray((upper - offset >= best) | (offset - lower >= best))
+
+
+def _largest_off(distances: FloatArray, offset: float) -> float:
+    """``max(|distances - offset|)`` (``-inf`` for none)."""
+    return float(np.max(np.abs(distances - offset))) if len(distances) else -math.inf
+
+
 MERGE_ENDS_PER_SAMPLE = 16
 """Ends per sample up to which :func:`_ends_tree` merges the ends at one point into a place."""
 
@@ -2457,20 +2541,17 @@ def against_thinned(
     off = nearest_distances(samples, trace[:-1][joined], trace[1:][joined]) - tool_radius_mm
     features: list[NotCut] = []
     main = np.ones(len(samples), dtype=bool)
-    if nominal and any(f.kind in NOT_CUT_KINDS and f.at is not None for f in findings):
-        nominal_off = _distance_to(samples, nominal) - tool_radius_mm
-        groups = not_cut_groups(samples, _contour_ids(sizes), nominal_off, findings, tool_radius_mm)
-        for finding, index, at in groups:
-            main[index] = False
-            features.append(
-                NotCut(
-                    kind=finding.kind,
-                    at=at,
-                    error_um=float(np.max(np.abs(off[index]))) * 1000.0,
-                    samples=len(index),
-                    value=finding.value,
-                )
+    for finding, index, at in _not_cut(samples, sizes, tool_radius_mm, nominal, findings):
+        main[index] = False
+        features.append(
+            NotCut(
+                kind=finding.kind,
+                at=at,
+                error_um=float(np.max(np.abs(off[index]))) * 1000.0,
+                samples=len(index),
+                value=finding.value,
             )
+        )
     if main.all():  # no feature apart: the arrays themselves, not copies
         kept, kept_at = off, samples
     elif main.any():
@@ -2490,6 +2571,51 @@ def against_thinned(
         samples=len(samples),
         not_cut=tuple(features),
     )
+
+
+def against_worst(
+    thin: ThinTrace,
+    drawing: Drawing,
+    tool_radius_mm: float,
+    *,
+    spacing_mm: float = AGAINST_SPACING_MM,
+    nominal: Sequence[FloatArray] = (),
+    findings: Sequence[FindingLike] = (),
+) -> float:
+    """``against_thinned(...).max_um`` alone, the same float, for the error budget.
+
+    The distance to the drawing of the samples cut as drawn is measured exactly only
+    where it can be the largest (:func:`farthest_off`); the arguments are
+    :func:`against_thinned`'s.
+    """
+    samples, sizes = _sample_drawing(drawing, spacing_mm)
+    if thin.rows < 2 or len(samples) == 0:
+        return 0.0
+    trace, runs = thin.points, thin.runs
+    joined = np.ones(len(trace) - 1, dtype=bool) if runs is None else runs[1:] == runs[:-1]
+    if not joined.any():
+        joined[:] = True  # single points only: their nearest distances still count
+    main = np.ones(len(samples), dtype=bool)
+    for _, index, _ in _not_cut(samples, sizes, tool_radius_mm, nominal, findings):
+        main[index] = False
+    if not main.any():
+        return 0.0
+    kept = samples if main.all() else samples[main]
+    return farthest_off(kept, trace[:-1][joined], trace[1:][joined], tool_radius_mm) * 1000.0
+
+
+def _not_cut(
+    samples: FloatArray,
+    sizes: list[int],
+    tool_radius_mm: float,
+    nominal: Sequence[FloatArray],
+    findings: Sequence[FindingLike],
+) -> list[tuple[FindingLike, IntArray, Point]]:
+    """:func:`not_cut_groups` of the drawing's ``samples`` when there is anything to group."""
+    if not nominal or not any(f.kind in NOT_CUT_KINDS and f.at is not None for f in findings):
+        return []
+    nominal_off = _distance_to(samples, nominal) - tool_radius_mm
+    return not_cut_groups(samples, _contour_ids(sizes), nominal_off, findings, tool_radius_mm)
 
 
 OVERCUT_PRUNE_FROM = 20_000

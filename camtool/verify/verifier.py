@@ -63,6 +63,7 @@ from camtool.verify.metrics import (
     ThinTrace,
     TraceStream,
     against_thinned,
+    against_worst,
     along_path,
     deviation,
     measure_contours,
@@ -841,13 +842,19 @@ def _without(inputs: _Inputs, name: str) -> _Without:
     drawing = None if same else inputs.drawing
     dev, along, contours, thin = _trace_measures(program, trace, cutting=drawing is not None)
     del trace  # ~50 MB of a 1.8 M-row trace, freed before the drawing's distances
-    against = None
-    if drawing is not None and thin is not None:
-        against = _compare(
-            program, thin, drawing, inputs.tool_diameter, inputs.findings, overcut=False
+    values = eb.figures(dev, along, contours, None)
+    if drawing is not None and thin is not None:  # only its largest distance is a figure
+        values |= eb.distance_figures(
+            against_worst(
+                thin,
+                drawing,
+                inputs.tool_diameter / 2.0,
+                nominal=_nominal_lines(program) if inputs.findings else (),
+                findings=inputs.findings,
+            )
         )
     blocks = [c.blocks for c in contours] if name == "rounding" else None
-    return _Without(eb.figures(dev, along, contours, against), same, blocks)
+    return _Without(values, same, blocks)
 
 
 def source_statuses(

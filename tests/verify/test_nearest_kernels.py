@@ -330,3 +330,63 @@ def test_the_box_tree_searches_only_samples_far_from_the_segments(
         want = metrics.nearest_distances_kd(samples, line[:-1], line[1:])
         got = metrics.nearest_distances(samples, line[:-1], line[1:])
         assert got.tobytes() == want.tobytes()
+
+
+@pytest.mark.parametrize("every", [False, True])
+@pytest.mark.parametrize("seed", range(4))
+def test_farthest_off_is_the_largest_offset_distance_bit_for_bit(
+    seed: int, every: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``farthest_off`` against ``max(|nearest_distances − offset|)`` on traces built to tie.
+
+    Offsets of 0 (a path on its line), a few steps, and a tool radius (a drawing point
+    1.5 mm from the tool centre); the k-d tree of every end is built only where a tied
+    sample can be the largest, and some cases need none at all. ``every``: every
+    sample is taken as able to reach the largest, so the k-d tree's choice and the exact
+    stage are made for all of them, as :func:`metrics.nearest_distances` makes them.
+    """
+    if every:
+        monkeypatch.setattr(metrics, "_can_reach", lambda upper, *args: np.ones(len(upper), bool))
+    built = [0]
+    tree = metrics._LazyTree.tree
+
+    def counted(self: metrics._LazyTree) -> object:
+        built[0] += self._tree is None
+        return tree.fget(self)  # type: ignore[attr-defined]
+
+    monkeypatch.setattr(metrics._LazyTree, "tree", property(counted))
+    rng = np.random.default_rng(600 + seed)
+    spared = used = 0
+    for kind in range(12):
+        pts = _trace(rng, kind)
+        a, b = pts[:-1], pts[1:]
+        reach = float(rng.choice([0.0015, 0.1, 1.5]))
+        samples = _samples(rng, pts, 2000, reach=reach)
+        for offset in (0.0, 0.003, reach):
+            want = float(np.max(np.abs(metrics.nearest_distances(samples, a, b) - offset)))
+            before = built[0]
+            with monkeypatch.context() as m:
+                if every:  # not by measuring every distance, its fallback
+                    m.setattr(metrics, "nearest_distances", None)
+                got = metrics.farthest_off(samples, a, b, offset)
+            assert got == want
+            spared += built[0] == before
+            used += built[0] != before
+    assert used > 0 if every else spared > 0  # the tied samples' own branch ran, or not
+
+
+def test_farthest_off_measures_all_when_a_tie_left_out_may_be_unsure(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """With no tolerance every tied sample may end unsure: then every distance is measured."""
+    monkeypatch.setattr(metrics, "NEAREST_TOLERANCE_MM", 0.0)
+    rng = np.random.default_rng(7)
+    pts = _trace(rng, 1)
+    a, b = pts[:-1], pts[1:]
+    samples = _samples(rng, pts, 2000, reach=1.5)
+    whole: list[int] = []
+    plain = metrics.nearest_distances
+    monkeypatch.setattr(metrics, "nearest_distances", lambda *args: whole.append(1) or plain(*args))
+    want = float(np.max(np.abs(plain(samples, a, b) - 1.5)))
+    assert metrics.farthest_off(samples, a, b, 1.5) == want
+    assert whole  # the tied samples left out could not be shown sure: all were measured

@@ -78,3 +78,29 @@ def test_point_distances_in_chunks_are_the_whole_answer_bit_for_bit(
     whole = metrics.point_distances(points, blocks, nominal)
     monkeypatch.setattr(metrics, "POINT_CHUNK", 7)
     assert metrics.point_distances(points, blocks, nominal).tobytes() == whole.tobytes()
+
+
+@pytest.mark.parametrize(("offset", "tool"), [("outside", 0.5), ("outside", 3.0), ("on", 0.0)])
+def test_the_budget_s_distance_is_the_comparison_s_bit_for_bit(offset: str, tool: float) -> None:
+    """``against_worst`` (the budget's figure) is ``against_thinned(...).max_um``.
+
+    On ``make demo``'s plate: cut outside, its tight corners (and with 3 mm a narrow
+    slot) are not cut as drawn, so those samples are measured apart in both; cut on
+    the line, every sample counts.
+    """
+    from camtool.jobs.pipeline import post_drawing, verify_job
+    from camtool.verify import verifier
+
+    target = load_target("grbl")
+    plan = PlanOptions(offset=offset, tool_diameter=tool, depth=1.0)
+    job = post_drawing(read_drawing(SAMPLES / "plate.dxf"), target, plan)
+    v = verify_job(job, budget=False)
+    assert v.drawing is not None and v.against is not None
+    thin = metrics.thin_cutting(*verifier._cutting_rows(v.program, v.trace))
+    nominal = verifier._nominal_lines(v.program) if v.findings else ()
+    args = (thin, v.drawing, tool / 2.0)
+    full = metrics.against_thinned(*args, nominal=nominal, findings=v.findings)
+    assert full.max_um == v.against.max_um
+    worst = metrics.against_worst(*args, nominal=nominal, findings=v.findings)
+    assert worst == full.max_um
+    assert bool(full.not_cut) == (offset == "outside")
