@@ -615,6 +615,7 @@ def _nearest(
     tree = _ends_tree(points, len(samples), kernels)
     few = len(samples) <= BOX_TREE_UP_TO
     if not few and not _far(samples, tree, half, kernels):
+        del tree, points  # not held while the k-d tree path measures
         return _nearest_kd(samples, a, b, ends=ends, only_max=only_max)
     ends = ends or _LazyTree(points)
     d = np.empty(len(samples), dtype=np.float64)
@@ -653,10 +654,11 @@ def farthest_off(samples: FloatArray, a: FloatArray, b: FloatArray, offset: floa
     17's benchmark part none can, which spares a budget worker that tree (~0.3 s).
 
     The exact stage gets what :func:`_settle_unsure` gets in :func:`_nearest` (the same
-    unsure samples, so the same choice between its two ways of measuring): that needs
-    every tied sample left out to be sure whatever the k-d tree keeps (its upper bound
-    passes the vertex test); else, without the compiled search, or where it would not
-    search (:func:`_far`), every distance is measured (:func:`nearest_distances`).
+    unsure samples, so the same choice between its two ways of measuring), so a tied
+    sample is left out only when it is sure whatever the k-d tree keeps (its upper bound
+    passes the vertex test); one that may end unsure is asked the k-d tree as
+    :func:`_nearest` asks it. Without the compiled search, or where it would not search
+    (:func:`_far`), every distance is measured (:func:`nearest_distances`).
 
     Args:
         samples: ``(N, 2)`` query points, mm, ``N >= 1``.
@@ -674,6 +676,7 @@ def farthest_off(samples: FloatArray, a: FloatArray, b: FloatArray, offset: floa
     points = np.concatenate([a, b])
     tree = _ends_tree(points, len(samples), kernels)
     if len(samples) > BOX_TREE_UP_TO and not _far(samples, tree, half, kernels):
+        del tree, points  # not held while every distance is measured
         return _largest_off(nearest_distances(samples, a, b), offset)
     n = len(samples)
     d, lower, kth = np.empty(n), np.empty(n), np.empty(n)
@@ -689,9 +692,8 @@ def farthest_off(samples: FloatArray, a: FloatArray, b: FloatArray, offset: floa
     slack = 1e-12 + 64.0 * float(np.spacing(np.max(np.abs(samples))))
     low = lower * (1.0 - 1e-9) - slack
     high = kth * (1.0 + 1e-9) + slack
-    asked = ask & _can_reach(high, low, offset, best)
-    if (ask & ~asked).any() and not np.all((high - lower <= NEAREST_TOLERANCE_MM)[ask & ~asked]):
-        return _largest_off(nearest_distances(samples, a, b), offset)  # see above
+    surely = high - lower <= NEAREST_TOLERANCE_MM  # sure whatever the k-d tree keeps
+    asked = ask & (~surely | _can_reach(high, low, offset, best))
     if asked.any():  # the k-d tree's choice, as _nearest takes it
         rows = np.flatnonzero(asked)
         ends = _LazyTree(points).tree.query(samples[rows], k=NEAREST_ENDS, workers=KD_WORKERS)[1]

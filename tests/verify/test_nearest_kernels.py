@@ -375,18 +375,32 @@ def test_farthest_off_is_the_largest_offset_distance_bit_for_bit(
     assert used > 0 if every else spared > 0  # the tied samples' own branch ran, or not
 
 
-def test_farthest_off_measures_all_when_a_tie_left_out_may_be_unsure(
+def test_farthest_off_asks_the_tree_for_every_tie_that_may_end_unsure(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    """With no tolerance every tied sample may end unsure: then every distance is measured."""
+    """With no tolerance a tied sample may end unsure whatever its bounds: all are asked.
+
+    The exact stage then gets the unsure samples the full search gets, and the figure is
+    the same.
+    """
     monkeypatch.setattr(metrics, "NEAREST_TOLERANCE_MM", 0.0)
     rng = np.random.default_rng(7)
     pts = _trace(rng, 1)
     a, b = pts[:-1], pts[1:]
     samples = _samples(rng, pts, 2000, reach=1.5)
-    whole: list[int] = []
-    plain = metrics.nearest_distances
-    monkeypatch.setattr(metrics, "nearest_distances", lambda *args: whole.append(1) or plain(*args))
-    want = float(np.max(np.abs(plain(samples, a, b) - 1.5)))
+    want = float(np.max(np.abs(metrics.nearest_distances(samples, a, b) - 1.5)))
+    asked: list[int] = []
+
+    class Counted:  # the k-d tree, counting the samples it is asked about
+        def __init__(self, points: np.ndarray) -> None:
+            self.kd = cKDTree(points)
+
+        def query(self, x: np.ndarray, *args: object, **kwargs: object) -> object:
+            asked.append(len(x))
+            return self.kd.query(x, *args, **kwargs)
+
+    monkeypatch.setattr(metrics._LazyTree, "tree", property(lambda self: Counted(self.points)))
     assert metrics.farthest_off(samples, a, b, 1.5) == want
-    assert whole  # the tied samples left out could not be shown sure: all were measured
+    tree = nearkernels.tree(np.concatenate([a, b]), segments=True)
+    ask = nearkernels.near_segments(samples, *tree, a, b, 4)[3]
+    assert ask.any() and sum(asked) == int(ask.sum())
