@@ -2536,11 +2536,8 @@ def against_thinned(
     samples, sizes = _sample_drawing(drawing, spacing_mm)
     if thin.rows < 2 or len(samples) == 0:
         return Against(0.0, 0.0, (0.0, 0.0), 0.0, 0)
-    trace, runs = thin.points, thin.runs
-    joined = np.ones(len(trace) - 1, dtype=bool) if runs is None else runs[1:] == runs[:-1]
-    if not joined.any():
-        joined[:] = True  # single points only: their nearest distances still count
-    off = nearest_distances(samples, trace[:-1][joined], trace[1:][joined]) - tool_radius_mm
+    trace = thin.points
+    off = nearest_distances(samples, *_chords(thin)) - tool_radius_mm
     features: list[NotCut] = []
     main = np.ones(len(samples), dtype=bool)
     for finding, index, at in _not_cut(samples, sizes, tool_radius_mm, nominal, findings):
@@ -2593,17 +2590,26 @@ def against_worst(
     samples, sizes = _sample_drawing(drawing, spacing_mm)
     if thin.rows < 2 or len(samples) == 0:
         return 0.0
-    trace, runs = thin.points, thin.runs
-    joined = np.ones(len(trace) - 1, dtype=bool) if runs is None else runs[1:] == runs[:-1]
-    if not joined.any():
-        joined[:] = True  # single points only: their nearest distances still count
     main = np.ones(len(samples), dtype=bool)
     for _, index, _ in _not_cut(samples, sizes, tool_radius_mm, nominal, findings):
         main[index] = False
     if not main.any():
         return 0.0
     kept = samples if main.all() else samples[main]
-    return farthest_off(kept, trace[:-1][joined], trace[1:][joined], tool_radius_mm) * 1000.0
+    return farthest_off(kept, *_chords(thin), tool_radius_mm) * 1000.0
+
+
+def _chords(thin: ThinTrace) -> tuple[FloatArray, FloatArray]:
+    """The machined edge's segments: ``(a, b)`` joining consecutive rows of a run of ``thin``.
+
+    A trace of single points (no two rows in one run) gives each point as a segment
+    from the point to the next, so that their nearest distances still count.
+    """
+    trace, runs = thin.points, thin.runs
+    joined = np.ones(len(trace) - 1, dtype=bool) if runs is None else runs[1:] == runs[:-1]
+    if not joined.any():
+        joined[:] = True
+    return trace[:-1][joined], trace[1:][joined]
 
 
 def _not_cut(
