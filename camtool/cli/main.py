@@ -151,6 +151,7 @@ def post(
         target=target,
         machine_file=machine_file,
     )
+    _check_preview(preview)
     chosen = load_target_checked(target, machine_file=machine_file)
     output_options = output_settings(options)
     chosen.post.check_format(output_options.fmt)
@@ -260,6 +261,7 @@ def verify(
         target=target,
         machine_file=machine_file,
     )
+    _check_preview(preview)
     chosen = load_target_checked(target, machine_file=machine_file)
     text = read_code(code, binary=chosen.post.binary)
     drawing = read_input(against) if against is not None else None
@@ -284,6 +286,18 @@ def verify(
         edge_radius_mm=tool_diameter / 2.0,
         strict=strict,
     )
+
+
+def _check_preview(preview: str | None) -> None:
+    """Refuse a ``--preview`` file that is neither ``.png`` nor ``.svg``, before any work.
+
+    Raises:
+        UsageError: the ending names no preview format (nothing is written).
+    """
+    if preview is not None:
+        from camtool.preview import preview_format
+
+        preview_format(preview)
 
 
 def _loading_the_picture(preview: str | None) -> AbstractContextManager[None]:

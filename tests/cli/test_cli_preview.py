@@ -165,3 +165,19 @@ def test_same_bytes_in_another_process(
     )
     assert proc.returncode == 0, proc.stderr
     assert (work / "here.svg").read_bytes() == (work / "there.svg").read_bytes()
+
+
+@pytest.mark.parametrize("command", ["post", "verify"])
+def test_a_bad_preview_ending_is_refused_before_anything_is_written(
+    command: str, work: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--preview x.jpg`` fails first: no program, report or picture is written."""
+    out, report = work / "new.gcode", work / "new.json"
+    if command == "post":
+        args = ["post", str(work / "logo.dxf"), "-t", "grbl", "-o", str(out)]
+    else:
+        args = ["verify", str(work / "logo.pic"), "-t", "pic-mmh"]
+    code, _, err = run([*args, "--report", str(report), "--preview", str(work / "x.jpg")], capsys)
+    assert code == 2
+    assert "a preview is .png or .svg, not '.jpg'" in err
+    assert not out.exists() and not report.exists() and not (work / "x.jpg").exists()
