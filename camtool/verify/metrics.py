@@ -604,38 +604,99 @@ def _nearest(
     With ``only_max`` an unsure sample that cannot reach the largest settled distance
     keeps its upper bound (:func:`_reaching`): the array's max and argmax are exact.
     """
+    search = _box_search(samples, a, b)
+    if search is None:
+        return _nearest_kd(samples, a, b, ends=ends, only_max=only_max)
+    ends = ends or _LazyTree(search.points)
+    d = np.empty(len(samples), dtype=np.float64)
+    unsure = np.zeros(len(samples), dtype=bool)
+    for i in range(0, len(samples), NEAREST_CHUNK):
+        part = slice(i, i + NEAREST_CHUNK)
+        near, rk, lower, ask = search.measure(part)
+        if ask.any():  # ends tie at the k-th distance and the k-d tree's choice matters
+            rows = np.flatnonzero(ask) + i
+            near[rows - i] = search.chosen(ends, rows)
+        d[part] = near
+        unsure[part] = ~search.settled(near, rk, lower)
+    return _settle_unsure(
+        search.samples, d, unsure, search.a, search.b, search.nearby, only_max=only_max
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class _BoxSearch:
+    """The compiled nearest search of some samples among segments ``a → b`` (:func:`_box_search`).
+
+    Attributes:
+        samples: ``(N, 2)`` the query points, C-contiguous float64, mm.
+        a: ``(M, 2)`` segment starts, likewise.
+        b: ``(M, 2)`` segment ends, likewise.
+        half: half the longest segment, mm.
+        points: ``concatenate([a, b])``, the ends (as the k-d tree of ties holds them).
+        tree: their search tree (:func:`_ends_tree`).
+        kernels: :mod:`camtool.verify.nearkernels`.
+    """
+
+    samples: FloatArray
+    a: FloatArray
+    b: FloatArray
+    half: float
+    points: FloatArray
+    tree: tuple[Any, ...]
+    kernels: ModuleType
+
+    def measure(self, part: slice) -> tuple[FloatArray, FloatArray, FloatArray, Any]:
+        """``near``, ``rk``, ``lower`` and ``ask`` of the samples ``part``.
+
+        :func:`camtool.verify.nearkernels.near_segments`' distance to the segments of the
+        nearest ends (unset where ``ask``: the k-d tree's choice among tied ends matters),
+        the k-th end's distance and the vertex bound ``sqrt(r0² − half²)``, with the
+        square roots the k-d tree takes.
+        """
+        near, r0_2, rk_2, ask = self.kernels.near_segments(
+            self.samples[part], *self.tree, self.a, self.b, NEAREST_ENDS
+        )
+        lower = np.sqrt(np.maximum(np.sqrt(r0_2) ** 2 - self.half * self.half, 0.0))
+        return near, np.sqrt(rk_2), lower, ask
+
+    def chosen(self, ends: _LazyTree, rows: IntArray) -> FloatArray:
+        """The distance of samples ``rows`` to the segments of the ends the k-d tree keeps."""
+        x = self.samples[rows]
+        found = ends.tree.query(x, k=NEAREST_ENDS, workers=KD_WORKERS)[1]
+        seg = np.asarray(found).reshape(-1, NEAREST_ENDS) % len(self.a)
+        return _to_segments(x, self.a[seg], self.b[seg]).min(axis=1)
+
+    def settled(self, near: FloatArray, rk: FloatArray, lower: FloatArray) -> Any:
+        """Where ``near`` is the distance (:func:`nearest_distances`' two tests)."""
+        return (near + self.half < rk) | (near - lower <= NEAREST_TOLERANCE_MM)
+
+    def nearby(self, samples: FloatArray, upper: FloatArray, need: Any = None) -> FloatArray | None:
+        """:func:`_nearby_boxes` among these segments."""
+        return _nearby_boxes(
+            samples, upper, self.a, self.b, self.tree, self.half, self.kernels, need
+        )
+
+
+def _box_search(samples: FloatArray, a: FloatArray, b: FloatArray) -> _BoxSearch | None:
+    """The compiled search of ``samples`` among ``a → b``, or ``None`` for the k-d tree path.
+
+    ``None`` without the compiled search (:func:`near_kernels`: numba missing, or too few
+    samples in this process so far), for fewer than :data:`NEAREST_ENDS` ends, and for
+    many samples near the segments (:func:`_far`), which the k-d tree answers faster.
+    Both paths give the same distances.
+    """
     kernels = near_kernels(len(samples))
     if kernels is None or len(a) == 0 or 2 * len(a) <= NEAREST_ENDS:
-        return _nearest_kd(samples, a, b, ends=ends, only_max=only_max)
+        return None
     samples = np.ascontiguousarray(samples, dtype=np.float64)
     a = np.ascontiguousarray(a, dtype=np.float64)
     b = np.ascontiguousarray(b, dtype=np.float64)
     half = float(np.max(np.hypot(*(b - a).T))) / 2.0
     points = np.concatenate([a, b])
     tree = _ends_tree(points, len(samples), kernels)
-    few = len(samples) <= BOX_TREE_UP_TO
-    if not few and not _far(samples, tree, half, kernels):
-        del tree, points  # not held while the k-d tree path measures
-        return _nearest_kd(samples, a, b, ends=ends, only_max=only_max)
-    ends = ends or _LazyTree(points)
-    d = np.empty(len(samples), dtype=np.float64)
-    unsure = np.zeros(len(samples), dtype=bool)
-    k = NEAREST_ENDS
-    for i in range(0, len(samples), NEAREST_CHUNK):
-        chunk = samples[i : i + NEAREST_CHUNK]
-        near, r0_2, rk_2, ask = kernels.near_segments(chunk, *tree, a, b, k)
-        r0, rk = np.sqrt(r0_2), np.sqrt(rk_2)  # what the k-d tree gives: the same sqrt
-        if ask.any():  # ends tie at the k-th distance and the k-d tree's choice matters
-            rows = np.flatnonzero(ask)
-            found = ends.tree.query(chunk[rows], k=k, workers=KD_WORKERS)[1]
-            s = np.asarray(found).reshape(-1, k) % len(a)
-            near[rows] = _to_segments(chunk[rows], a[s], b[s]).min(axis=1)
-        lower = np.sqrt(np.maximum(r0**2 - half * half, 0.0))
-        sure = (near + half < rk) | (near - lower <= NEAREST_TOLERANCE_MM)
-        d[i : i + len(chunk)] = near
-        unsure[i : i + len(chunk)] = ~sure
-    nearby = partial(_nearby_boxes, a=a, b=b, tree=tree, half=half, kernels=kernels)
-    return _settle_unsure(samples, d, unsure, a, b, nearby, only_max=only_max)
+    if len(samples) > BOX_TREE_UP_TO and not _far(samples, tree, half, kernels):
+        return None
+    return _BoxSearch(samples, a, b, half, points, tree, kernels)
 
 
 def farthest_off(samples: FloatArray, a: FloatArray, b: FloatArray, offset: float) -> float:
@@ -657,8 +718,8 @@ def farthest_off(samples: FloatArray, a: FloatArray, b: FloatArray, offset: floa
     unsure samples, so the same choice between its two ways of measuring), so a tied
     sample is left out only when it is sure whatever the k-d tree keeps (its upper bound
     passes the vertex test); one that may end unsure is asked the k-d tree as
-    :func:`_nearest` asks it. Without the compiled search, or where it would not search
-    (:func:`_far`), every distance is measured (:func:`nearest_distances`).
+    :func:`_nearest` asks it. Where :func:`_nearest` takes the k-d tree path
+    (:func:`_box_search` gives none), every distance is measured on it.
 
     Args:
         samples: ``(N, 2)`` query points, mm, ``N >= 1``.
@@ -666,47 +727,34 @@ def farthest_off(samples: FloatArray, a: FloatArray, b: FloatArray, offset: floa
         b: ``(M, 2)`` segment ends, mm.
         offset: subtracted from each distance, mm.
     """
-    kernels = near_kernels(len(samples))
-    if kernels is None or len(a) == 0 or 2 * len(a) <= NEAREST_ENDS:
-        return _largest_off(nearest_distances(samples, a, b), offset)
-    samples = np.ascontiguousarray(samples, dtype=np.float64)
-    a = np.ascontiguousarray(a, dtype=np.float64)
-    b = np.ascontiguousarray(b, dtype=np.float64)
-    half = float(np.max(np.hypot(*(b - a).T))) / 2.0
-    points = np.concatenate([a, b])
-    tree = _ends_tree(points, len(samples), kernels)
-    if len(samples) > BOX_TREE_UP_TO and not _far(samples, tree, half, kernels):
-        del tree, points  # not held while every distance is measured
-        return _largest_off(nearest_distances(samples, a, b), offset)
+    search = _box_search(samples, a, b)
+    if search is None:
+        return _largest_off(_nearest_kd(samples, a, b, ends=None, only_max=False), offset)
     n = len(samples)
     d, lower, kth = np.empty(n), np.empty(n), np.empty(n)
     ask = np.zeros(n, dtype=bool)
     for i in range(0, n, NEAREST_CHUNK):
         part = slice(i, i + NEAREST_CHUNK)
-        chunk = samples[part]
-        near, r0_2, rk_2, ask[part] = kernels.near_segments(chunk, *tree, a, b, NEAREST_ENDS)
-        d[part], kth[part] = near, np.sqrt(rk_2)
-        lower[part] = np.sqrt(np.maximum(np.sqrt(r0_2) ** 2 - half * half, 0.0))
-    sure = ~ask & ((d + half < kth) | (d - lower <= NEAREST_TOLERANCE_MM))
+        d[part], kth[part], lower[part], ask[part] = search.measure(part)
+    sure = ~ask & search.settled(d, kth, lower)
     best = _largest_off(d[sure], offset)
-    slack = 1e-12 + 64.0 * float(np.spacing(np.max(np.abs(samples))))
+    slack = 1e-12 + 64.0 * float(np.spacing(np.max(np.abs(search.samples))))
     low = lower * (1.0 - 1e-9) - slack
     high = kth * (1.0 + 1e-9) + slack
     surely = high - lower <= NEAREST_TOLERANCE_MM  # sure whatever the k-d tree keeps
     asked = ask & (~surely | _can_reach(high, low, offset, best))
     if asked.any():  # the k-d tree's choice, as _nearest takes it
         rows = np.flatnonzero(asked)
-        ends = _LazyTree(points).tree.query(samples[rows], k=NEAREST_ENDS, workers=KD_WORKERS)[1]
-        seg = np.asarray(ends).reshape(-1, NEAREST_ENDS) % len(a)
-        d[rows] = _to_segments(samples[rows], a[seg], b[seg]).min(axis=1)
-        sure[rows] = (d[rows] + half < kth[rows]) | (d[rows] - lower[rows] <= NEAREST_TOLERANCE_MM)
+        d[rows] = search.chosen(_LazyTree(search.points), rows)
+        sure[rows] = search.settled(d[rows], kth[rows], lower[rows])
         best = max(best, _largest_off(d[rows[sure[rows]]], offset))
     unsure = ~sure & (asked | ~ask)
     if unsure.any():  # _settle_unsure's exact stage, only where a distance can be the largest
         need = _can_reach(d[unsure] * (1.0 + 1e-9) + slack, low[unsure], offset, best)
-        exact = _nearby_boxes(samples[unsure], d[unsure], a, b, tree, half, kernels, need)
+        x = search.samples[unsure]
+        exact = search.nearby(x, d[unsure], need)
         if exact is None:
-            exact = _all_exact_where(samples[unsure], d[unsure], a, b, need)
+            exact = _all_exact_where(x, d[unsure], search.a, search.b, need)
         best = max(best, _largest_off(exact[need], offset))
     return best
 

@@ -327,8 +327,9 @@ def verify_program(
             loaded first (:func:`~camtool.verify.metrics.prepare_comparison`), so each
             worker inherits them instead of loading them again; the workers are then
             forked at once, before this process's own measures (their core is idle
-            otherwise: 3.9 → 3.5 s on that part, with the kernels loaded while the
-            plan waited for OpenCASCADE, :func:`camtool.model.cores.meanwhile`).
+            otherwise; with the kernels loaded while the plan waited for
+            OpenCASCADE, :func:`camtool.model.cores.meanwhile`, ~0.3 s of that part's
+            preview).
 
     A drawing whose box does not overlap the program's (less than
     :data:`MIN_OVERLAP`) is not compared: ``against`` is ``None``,
@@ -604,27 +605,6 @@ def _rows_at_least(program: Program, machine: Machine) -> int:
     return total
 
 
-def _measure(
-    program: Program,
-    trace: StepTrace,
-    against: Drawing | None,
-    tool_diameter: float,
-    findings: Sequence[FindingLike],
-    *,
-    overcut: bool = True,
-) -> tuple[Deviation, AlongPath, tuple[ContourMeasure, ...], Against | None]:
-    """Every measure of one trace: deviation, along the path, contours, the drawing.
-
-    ``overcut=False`` leaves the drawing's overcut out (0): the error budget, which
-    re-measures once per source, has no figure of it.
-    """
-    dev, along, contours, thin = _trace_measures(program, trace, cutting=against is not None)
-    compared = None
-    if against is not None and thin is not None:
-        compared = _compare(program, thin, against, tool_diameter, findings, overcut=overcut)
-    return dev, along, contours, compared
-
-
 def _trace_measures(
     program: Program, trace: StepTrace, *, cutting: bool
 ) -> tuple[Deviation, AlongPath, tuple[ContourMeasure, ...], ThinTrace | None]:
@@ -647,13 +627,12 @@ def _compare(
     against: Drawing,
     tool_diameter: float,
     findings: Sequence[FindingLike],
-    *,
-    overcut: bool = True,
 ) -> Against:
     """The machined edge of ``program``'s thinned cutting trace against the drawing.
 
-    The one call of :func:`~camtool.verify.metrics.against_thinned` for a whole trace
-    (:func:`_measure`) and a streamed one (:func:`_simulate_big`).
+    The one call of :func:`~camtool.verify.metrics.against_thinned` of a verification,
+    for a whole trace and a streamed one (:func:`verify_program`); the error budget's
+    sources need only its largest distance (:func:`_without`).
     """
     return against_thinned(
         thin,
@@ -661,7 +640,6 @@ def _compare(
         tool_diameter / 2.0,
         nominal=_nominal_lines(program) if findings else (),
         findings=findings,
-        overcut=overcut,
     )
 
 

@@ -32,10 +32,24 @@ def test_the_preloads_follow_the_drawing_s_sample_count(name: str) -> None:
         assert tasks == []
 
 
-def test_the_first_call_loads_the_kernels() -> None:
-    pytest.importorskip("numba")
+def test_the_first_call_makes_one_call_of_the_kernels(monkeypatch: pytest.MonkeyPatch) -> None:
+    """It calls the search's tree builder once, on one point (numba loads its registries
+    at a process's first call); without numba it does nothing."""
+    import numpy as np
+
+    calls: list[np.ndarray] = []
+
+    class Kernels:
+        @staticmethod
+        def build(points: np.ndarray) -> None:
+            calls.append(points)
+
+    monkeypatch.setattr(metrics, "near_kernels", lambda *args: Kernels)
     metrics._first_call()
-    assert metrics.near_kernels(0) is not None
+    assert len(calls) == 1 and calls[0].shape == (1, 2) and calls[0].dtype == np.float64
+    monkeypatch.setattr(metrics, "near_kernels", lambda *args: None)
+    metrics._first_call()
+    assert len(calls) == 1
 
 
 def test_a_job_posted_while_preloading_is_the_same_job() -> None:
