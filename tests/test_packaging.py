@@ -18,3 +18,11 @@ def test_every_package_is_listed_in_pyproject() -> None:
     assert config["package-dir"] == {"camtool_postprocessors": "postprocessors"}
     assert (ROOT / "postprocessors" / "__init__.py").is_file()
     assert listed == on_disk
+
+
+def test_the_builtin_targets_are_the_entry_point_camtool_registers() -> None:
+    """The registry loads its built-ins from the object camtool's entry point names."""
+    from camtool.post.registry import BUILTIN_ENTRY_POINT, ENTRY_POINT_GROUP
+
+    config = tomllib.loads((ROOT / "pyproject.toml").read_text("utf-8"))["project"]
+    assert list(config["entry-points"][ENTRY_POINT_GROUP].values()) == [BUILTIN_ENTRY_POINT]

@@ -19,7 +19,9 @@ provider (:class:`TomlTargets`: a package of ``<name>.toml`` files, each with an
 optional sibling module ``<stem>.py``) or a single
 :class:`~camtool.post.base.Target` (or a callable returning one). camtool's own
 targets are the provider of its ``camtool_postprocessors`` package (the
-``postprocessors/`` folder); they win over plugins of the same name. A plugin
+``postprocessors/`` folder); they win over plugins of the same name, so they are
+loaded from the object their entry point names (:data:`BUILTIN_ENTRY_POINT`) without
+scanning the installed distributions, which only a plugin's name needs. A plugin
 that fails to load is listed by :func:`list_targets` as broken with the reason,
 and choosing it is a clear error; it never crashes the CLI.
 """
@@ -34,10 +36,13 @@ import itertools
 import tomllib
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, replace
-from importlib import metadata, resources
+from importlib import resources
 from pathlib import Path
 from types import MappingProxyType, ModuleType
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from importlib import metadata
 
 from camtool.model.errors import InputError, UsageError
 from camtool.model.machine import Machine, load_toml, machine_from_table, merge_tables
@@ -51,6 +56,14 @@ WORD_ADDRESS = "word-address"
 
 _DISTRIBUTION = "camtool"
 """Entry points of this distribution are the built-in targets."""
+
+BUILTIN_ENTRY_POINT = "camtool_postprocessors:TARGETS"
+"""The object camtool's own entry point names: its built-in targets (pyproject
+``[project.entry-points."camtool.postprocessors"]``; tests/test_packaging.py holds the two
+equal). The built-in targets are loaded from it directly: finding them through
+:mod:`importlib.metadata` cost every command ~0.03 s of imports and a scan of the
+installed distributions (issue 17), and a plugin can never shadow a built-in anyway.
+Plugins are still found by their entry points, when a name is not built in."""
 
 _TOP_KEYS = {
     "name",
@@ -221,7 +234,13 @@ class TargetEntry:
 
 
 def _entry_points() -> tuple[list[metadata.EntryPoint], list[metadata.EntryPoint]]:
-    """Entry points of :data:`ENTRY_POINT_GROUP`: (camtool's own, third-party), by name."""
+    """Entry points of :data:`ENTRY_POINT_GROUP`: (camtool's own, third-party), by name.
+
+    :mod:`importlib.metadata` is imported here, when plugins are asked for (see
+    :data:`BUILTIN_ENTRY_POINT`).
+    """
+    from importlib import metadata
+
     found = sorted(metadata.entry_points(group=ENTRY_POINT_GROUP), key=lambda ep: ep.name)
     own = [ep for ep in found if ep.dist is not None and ep.dist.name == _DISTRIBUTION]
     return own, [ep for ep in found if ep not in own]
@@ -229,19 +248,26 @@ def _entry_points() -> tuple[list[metadata.EntryPoint], list[metadata.EntryPoint
 
 @functools.cache
 def _builtin_providers() -> tuple[TomlTargets, ...]:
-    """The providers camtool itself registers (its ``camtool_postprocessors`` package).
+    """The providers camtool itself registers: :data:`BUILTIN_ENTRY_POINT`'s, loaded directly.
 
     Raises:
-        InputError: camtool is installed without its entry points (reinstall it).
+        InputError: the ``camtool_postprocessors`` package is missing or gives no
+            provider (camtool is installed incompletely: reinstall it).
     """
-    own, _ = _entry_points()
-    providers = tuple(p for ep in own if isinstance(p := ep.load(), TomlTargets))
-    if not providers:
+    module, _, name = BUILTIN_ENTRY_POINT.partition(":")
+    try:
+        provider = getattr(importlib.import_module(module), name)
+    except (ImportError, AttributeError) as exc:
         raise InputError(
-            f"camtool's built-in targets are not registered (no {ENTRY_POINT_GROUP!r} entry "
-            "point of the camtool distribution); reinstall camtool (pip install -e .)"
+            f"camtool's built-in targets cannot be loaded ({BUILTIN_ENTRY_POINT}: {exc}); "
+            "reinstall camtool (pip install -e .)"
+        ) from exc
+    if not isinstance(provider, TomlTargets):
+        raise InputError(
+            f"camtool's built-in targets cannot be loaded ({BUILTIN_ENTRY_POINT} is a "
+            f"{type(provider).__name__}); reinstall camtool (pip install -e .)"
         )
-    return providers
+    return (provider,)
 
 
 def _builtin(name: str) -> TomlTargets | None:
