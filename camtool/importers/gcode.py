@@ -98,11 +98,13 @@ _ARC_TOL_IN = (0.0005, 0.05)
 """The same in inches (G20)."""
 
 _PLAIN_NUMBER = r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)"
-_PLAIN_LINE = re.compile(r"[ \t]*(?:[GXYZIJRFNgxyzijrfn]" + _PLAIN_NUMBER + r"[ \t]*)+")
-"""A plain line (:meth:`_Reader.plain`): words of these letters with ASCII numbers, blanks
-between words only; anything else (comments, other letters or characters, a blank inside a
-word, a non-ASCII digit) goes to the lexer."""
-_PLAIN_WORD = re.compile(r"([GXYZIJRFN])(" + _PLAIN_NUMBER + ")")
+_PLAIN_WORDS = re.compile(r"[ \t]*([GXYZIJRFN](?=[+-]?\.?[0-9])|)(" + _PLAIN_NUMBER + r"|[^ \t].*)")
+"""The words of a plain line (:meth:`_Reader.plain`), found in the line in upper case: a
+(letter, number text) pair per word of these letters with an ASCII number, blanks between
+words only. Anything else (a comment, another letter or character, a blank inside a word)
+gives a pair whose letter is empty (the rest of the line its text): the line is not plain
+and goes to the lexer. A line with a non-ASCII character goes there unsearched. One search
+per line: the line no longer has to match a pattern of the whole line first (issue 17)."""
 _PLAIN_MOTION = {0: "G0", 10: "G1", 20: "G2", 30: "G3"}
 _PLAIN_G = {0.0: "G0", 1.0: "G1", 2.0: "G2", 3.0: "G3"}
 """:data:`_PLAIN_MOTION` by the G word's value, for the values ``g_key`` gives those keys."""
@@ -234,8 +236,7 @@ def _parse(text: str, source: str, *, plain: bool) -> Program:
     reader = _Reader(source)
     opened = False  # a '%' line before the first block: the next '%' ends the program
     ended = False
-    plain_line = _PLAIN_LINE.fullmatch
-    plain_words = _PLAIN_WORD.findall
+    plain_words = _PLAIN_WORDS.findall
     last = len(lines)
     for number, raw in enumerate(lines, start=1):
         if number == last and (cut := cut_mid_word(raw)) is not None:
@@ -244,7 +245,7 @@ def _parse(text: str, source: str, *, plain: bool) -> Program:
                 "end of line after it): the last line is incomplete, the file looks "
                 "truncated; copy or export the program again"
             )
-        if plain and plain_line(raw) and reader.plain(plain_words(raw.upper()), number):
+        if plain and raw.isascii() and reader.plain(plain_words(raw.upper()), number):
             continue
         block = lex_line(raw, number, source)
         if block is None:
@@ -319,18 +320,23 @@ class _Reader:
     def plain(self, words: list[tuple[str, str]], line: int) -> bool:
         """Execute a plain line as :meth:`run` would, if it is one; False leaves all as it was.
 
-        ``words`` are the (upper-case letter, number text) pairs of a line that
-        :data:`_PLAIN_LINE` matches: G, X, Y, Z, I, J, R, F and N words. Such a line is
-        read here without making its :class:`Word` objects when it can end in
-        nothing but what :meth:`run` does without a warning or an error: each letter
-        once, numbers in range, a G word that is G0 to G3, absolute distances (G90),
-        a known position, a feed > 0 for a cut, and for an arc a centre within the
-        radius tolerance. Every other line (False, nothing changed) goes through the
-        lexer and :meth:`run`, which give its warning or error. The arithmetic is
-        :meth:`run`'s, operation for operation, so the moves are the same floats.
+        ``words`` are what :data:`_PLAIN_WORDS` finds in the line: (upper-case letter,
+        number text) pairs of G, X, Y, Z, I, J, R, F and N words, and pairs with an empty
+        letter where the line holds anything else. Such a line is read here without
+        making its :class:`Word` objects when it can end in nothing but what :meth:`run`
+        does without a warning or an error: only those words, each letter once, numbers
+        in range, a G word that is G0 to G3, absolute distances (G90), a known position,
+        a feed > 0 for a cut, and for an arc a centre within the radius tolerance. Every
+        other line (False, nothing changed) goes through the lexer and :meth:`run`, which
+        give its warning or error. The arithmetic is :meth:`run`'s, operation for
+        operation, so the moves are the same floats.
         """
+        if not words:
+            return False  # a blank line
         args: dict[str, float] = {}
         for letter, text in words:
+            if not letter:
+                return False  # not only plain words
             value = float(text)
             if not abs(value) < LARGEST_VALUE:
                 return False
