@@ -73,7 +73,7 @@ from camtool.model.program import (
     Spindle,
     ToolChange,
 )
-from camtool.model.shapes import Arc, Point
+from camtool.model.shapes import _FULL_CIRCLE_EPS, Arc, Point, make_arc
 from camtool.post.base import (
     PostProcessor,
     PostResult,
@@ -254,6 +254,10 @@ class BlockWriter(WriterState[str]):
         motion = machine.motion
         grbl_chords = motion.arc == "chords" and motion.chords == "grbl"
         self._arc_floor_mm = motion.chord_tolerance_mm * (1 + 1e-6) if grbl_chords else 0.0
+        self._one_part = spec.max_arc_deg >= 360.0  # an arc but a full circle is one block
+        _, _, self._cw, self._ccw = spec.motion_codes
+        self._modal_g = "G" in spec.modal
+        self._absolute_centre = spec.arc_centre == "absolute"
 
     # -- the program -------------------------------------------------------------
 
@@ -481,35 +485,51 @@ class BlockWriter(WriterState[str]):
     # -- arcs --------------------------------------------------------------------
 
     def _arc(self, start: Point, move: ArcMove) -> None:
-        arc = Arc(start, (move.x, move.y), (move.cx, move.cy), move.clockwise)
+        end, centre, clockwise = (move.x, move.y), (move.cx, move.cy), move.clockwise
         printed = self._printed
-        tx = printed["X"].get(move.x) or self._print("X", move.x)
-        ty = printed["Y"].get(move.y) or self._print("Y", move.y)
-        if (tx[1], ty[1]) == self.written and abs(arc.sweep) > math.pi:
-            # within the resolution of a full circle: the controller reads one
-            arc = Arc(start, start, arc.centre, arc.clockwise)
-        full_circle = arc.is_full_circle
-        parts = self._parts(arc, full_circle)
+        tx = printed["X"].get(end[0]) or self._print("X", end[0])
+        ty = printed["Y"].get(end[1]) or self._print("Y", end[1])
+        # Arc(start, end, centre).is_full_circle; the arc itself is made only where needed
+        radius = math.hypot(start[0] - centre[0], start[1] - centre[1])
+        full_circle = math.hypot(end[0] - start[0], end[1] - start[1]) <= (
+            _FULL_CIRCLE_EPS * max(1.0, radius)
+        )
+        arc: Arc | None = None
+        if (tx[1], ty[1]) == self.written:
+            arc = make_arc(start, end, centre, clockwise)
+            if abs(arc.sweep) > math.pi:
+                # within the resolution of a full circle: the controller reads one
+                arc = make_arc(start, start, centre, clockwise)
+                full_circle = arc.is_full_circle
+        if self._one_part and not full_circle:
+            parts = 1
+        else:
+            arc = arc or make_arc(start, end, centre, clockwise)
+            parts = self._parts(arc, full_circle)
         blocks: list[tuple[Point, Point | None, bool]] = []
         if parts == 1:
-            conformed = self._conformed(arc)
+            if arc is None:
+                conformed = self._conformed_at(start, end, centre, clockwise)
+            else:
+                conformed = self._conformed(arc)
             full = full_circle and len(conformed) == 1
             if len(conformed) == 1 and move.z is None:  # the usual arc: one block, no helix
-                end, centre = conformed[0]
-                xy = (tx, ty) if end == (move.x, move.y) else None  # its end is printed
-                self._arc_block(move, (end, centre), None, full=full, xy=xy)
+                block_end, block_centre = conformed[0]
+                xy = (tx, ty) if block_end == end else None  # its end is printed
+                self._arc_block(move, block_end, block_centre, None, full, xy)
                 return
-            blocks += [(end, centre, full) for end, centre in conformed]
+            blocks += [(e, c, full) for e, c in conformed]
         else:
+            assert arc is not None  # made for _parts
             for piece in arc.split(parts):
                 conformed = self._conformed(piece)
                 full = piece.is_full_circle and len(conformed) == 1
-                blocks += [(end, centre, full) for end, centre in conformed]
-        for k, (end, centre, full) in enumerate(blocks, start=1):
+                blocks += [(e, c, full) for e, c in conformed]
+        for k, (block_end, block_centre, full) in enumerate(blocks, start=1):
             z = move.z  # a helix climbs evenly over the blocks it is written in
             if move.z is not None and self.z is not None:
                 z = self.z + (move.z - self.z) * k / len(blocks)
-            self._arc_block(move, (end, centre), z, full=full)
+            self._arc_block(move, block_end, block_centre, z, full)
 
     def _parts(self, arc: Arc, full_circle: bool) -> int:
         """How many equal arcs ``arc`` is written as (``max_arc_deg``, ``full_circle``).
@@ -536,9 +556,15 @@ class BlockWriter(WriterState[str]):
         A centre of ``None`` asks for a straight line: the arc is a few quanta
         across and no printable centre passes the controller's check.
         """
+        return self._conformed_at(piece.start, piece.end, piece.centre, piece.clockwise, piece)
+
+    def _conformed_at(
+        self, start: Point, end: Point, centre: Point, clockwise: bool, piece: Arc | None = None
+    ) -> list[tuple[Point, Point | None]]:
+        """:meth:`_conformed` of the arc from ``start`` to ``end`` (``piece``, made if ``None``)."""
         if self.spec.arc_check == "none":
-            return [(piece.end, piece.centre)]
-        key = (self.written, piece.end, piece.centre, piece.clockwise, piece.start)
+            return [(end, centre)]
+        key = (self.written, end, centre, clockwise, start)
         # The same arc from the same written start (a program that cuts a contour again at
         # another depth) gives the same blocks: conform_arc is a function of its arguments.
         # Zeros are left out: -0.0 equals 0.0 as a key, but not as an angle (atan2).
@@ -548,8 +574,8 @@ class BlockWriter(WriterState[str]):
             if not known:
                 self.counts["tiny-arc"] += 1
             return known
-        zero = 0.0 in key[0] or 0.0 in key[1] or 0.0 in key[2] or 0.0 in key[4]
-        out = self._conform(piece)
+        zero = 0.0 in key[0] or 0.0 in end or 0.0 in centre or 0.0 in start
+        out = self._conform(piece or make_arc(start, end, centre, clockwise))
         if not zero:
             if len(kept) >= _CONFORMED_KEPT:
                 kept.clear()
@@ -634,9 +660,9 @@ class BlockWriter(WriterState[str]):
     def _arc_block(
         self,
         move: ArcMove,
-        end_centre: tuple[Point, Point | None],
+        end: Point,
+        centre: Point | None,
         z: float | None,
-        *,
         full: bool,
         xy: tuple[tuple[str, float], tuple[str, float]] | None = None,
     ) -> None:
@@ -648,15 +674,12 @@ class BlockWriter(WriterState[str]):
         is too small to write. ``xy``: what :meth:`_print` gives the end's X and Y,
         when the caller has it.
         """
-        end, centre = end_centre
-        spec = self.spec
-        _, _, cw, ccw = spec.motion_codes
         if xy is None:
             xy = self._print("X", end[0]), self._print("Y", end[1])
         (tx, px), (ty, py) = xy
         written = (px, py)
         before = self.written
-        ox, oy = (0.0, 0.0) if spec.arc_centre == "absolute" else before
+        ox, oy = (0.0, 0.0) if self._absolute_centre else before
         ti = tj = ""
         tiny = centre is None or (written == before and not full)
         if centre is not None:
@@ -674,9 +697,9 @@ class BlockWriter(WriterState[str]):
             linear = Linear(end[0], end[1], move.feed_mm_min, contour=move.contour)
             self._line(linear, end, z)
             return
-        code = cw if move.clockwise else ccw
+        code = self._cw if move.clockwise else self._ccw
         last = self.last
-        words = [] if "G" in spec.modal and last.get("G") == code else [code]  # _code
+        words = [] if self._modal_g and last.get("G") == code else [code]  # _code
         last["G"] = code
         words += ["X" + tx, "Y" + ty]  # _word(..., force=True)
         last["X"], last["Y"] = tx, ty
@@ -684,7 +707,11 @@ class BlockWriter(WriterState[str]):
             self._word("Z", self.text("Z", z), words)
         words += ["I" + ti, "J" + tj]
         self.written = written
-        self._feed(move, words)
+        same = self._feed_text
+        if same is not None and same[0] == move.feed_mm_min:
+            self._word("F", same[1], words)  # _feed: the feed before
+        else:
+            self._feed(move, words)
         self.block(words)
 
     # -- commands ----------------------------------------------------------------
