@@ -577,7 +577,7 @@ class BlockWriter(WriterState[str]):
                 self.counts["tiny-arc"] += 1
             return known
         zero = 0.0 in key[0] or 0.0 in end or 0.0 in centre or 0.0 in start
-        out = self._conform(piece or make_arc(start, end, centre, clockwise))
+        out = self._conform(piece if piece is not None else make_arc(start, end, centre, clockwise))
         if not zero:
             if len(kept) >= _CONFORMED_KEPT:
                 kept.clear()
@@ -712,11 +712,7 @@ class BlockWriter(WriterState[str]):
             self._word("Z", self.text("Z", z), words)
         words += ["I" + ti, "J" + tj]
         self.written = written
-        same = self._feed_text
-        if same is not None and same[0] == move.feed_mm_min:
-            self._word("F", same[1], words)  # _feed: the feed before
-        else:
-            self._feed(move, words)
+        self._feed(move, words)
         self.block(words)
 
     # -- commands ----------------------------------------------------------------
