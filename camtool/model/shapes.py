@@ -25,7 +25,9 @@ BBox: TypeAlias = tuple[float, float, float, float]
 """``(xmin, ymin, xmax, ymax)`` in mm."""
 
 TAU = 2.0 * math.pi
-_FULL_CIRCLE_EPS = 1e-12
+FULL_CIRCLE_EPS = 1e-12
+"""An arc is a full circle when its ends are within this times ``max(1, radius)`` mm
+(:attr:`Arc.is_full_circle`; the word-address writer and the ordering test it inline)."""
 
 _T = TypeVar("_T")
 
@@ -187,7 +189,7 @@ class Arc:
     @property
     def is_full_circle(self) -> bool:
         """True when start and end coincide (sweep 2π)."""
-        return distance(self.start, self.end) <= _FULL_CIRCLE_EPS * max(1.0, self.radius)
+        return distance(self.start, self.end) <= FULL_CIRCLE_EPS * max(1.0, self.radius)
 
     @cached_property
     def sweep(self) -> float:

@@ -73,7 +73,7 @@ from camtool.model.program import (
     Spindle,
     ToolChange,
 )
-from camtool.model.shapes import _FULL_CIRCLE_EPS, Arc, Point, make_arc
+from camtool.model.shapes import FULL_CIRCLE_EPS, Arc, Point, make_arc
 from camtool.post.base import (
     PostProcessor,
     PostResult,
@@ -494,7 +494,7 @@ class BlockWriter(WriterState[str]):
         # Arc(start, end, centre).is_full_circle; the arc itself is made only where needed
         radius = math.hypot(start[0] - centre[0], start[1] - centre[1])
         full_circle = math.hypot(end[0] - start[0], end[1] - start[1]) <= (
-            _FULL_CIRCLE_EPS * max(1.0, radius)
+            FULL_CIRCLE_EPS * max(1.0, radius)
         )
         arc: Arc | None = None
         if (tx[1], ty[1]) == self.written:

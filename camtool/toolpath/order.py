@@ -128,7 +128,7 @@ def _outline_coords(contours: Sequence[Contour], tolerance: float) -> tuple[Any,
 
     import numpy as np
 
-    from camtool.model.shapes import _FULL_CIRCLE_EPS, TAU, Arc
+    from camtool.model.shapes import FULL_CIRCLE_EPS, TAU, Arc
 
     segs = [s for c in contours for s in c.segments]
     per_contour = np.fromiter((len(c.segments) for c in contours), np.int64, len(contours))
@@ -149,7 +149,7 @@ def _outline_coords(contours: Sequence[Contour], tolerance: float) -> tuple[Any,
         )
         gap = np.fromiter(map(math.hypot, (ex - sx).tolist(), (ey - sy).tolist()), np.float64)
         with np.errstate(all="ignore"):
-            full = gap <= _FULL_CIRCLE_EPS * np.where(r > 1.0, r, 1.0)  # max(1.0, r)
+            full = gap <= FULL_CIRCLE_EPS * np.where(r > 1.0, r, 1.0)  # max(1.0, r)
             ccw = np.remainder(a1 - a0, TAU)  # Python's float % (floored, as fmod then sign)
         ccw[ccw == 0.0] = TAU
         sweep = np.where(cw, -(TAU - ccw), ccw)
