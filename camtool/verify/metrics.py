@@ -2586,19 +2586,18 @@ def against_thinned(
         return Against(0.0, 0.0, (0.0, 0.0), 0.0, 0)
     trace = thin.points
     off = nearest_distances(samples, *_chords(thin)) - tool_radius_mm
-    features: list[NotCut] = []
-    main = np.ones(len(samples), dtype=bool)
-    for finding, index, at in _not_cut(samples, sizes, tool_radius_mm, nominal, findings):
-        main[index] = False
-        features.append(
-            NotCut(
-                kind=finding.kind,
-                at=at,
-                error_um=float(np.max(np.abs(off[index]))) * 1000.0,
-                samples=len(index),
-                value=finding.value,
-            )
+    apart = _not_cut(samples, sizes, tool_radius_mm, nominal, findings)
+    main = _cut_as_drawn(len(samples), apart)
+    features = [
+        NotCut(
+            kind=finding.kind,
+            at=at,
+            error_um=float(np.max(np.abs(off[index]))) * 1000.0,
+            samples=len(index),
+            value=finding.value,
         )
+        for finding, index, at in apart
+    ]
     if main.all():  # no feature apart: the arrays themselves, not copies
         kept, kept_at = off, samples
     elif main.any():
@@ -2638,9 +2637,7 @@ def against_worst(
     samples, sizes = _sample_drawing(drawing, spacing_mm)
     if thin.rows < 2 or len(samples) == 0:
         return 0.0
-    main = np.ones(len(samples), dtype=bool)
-    for _, index, _ in _not_cut(samples, sizes, tool_radius_mm, nominal, findings):
-        main[index] = False
+    main = _cut_as_drawn(len(samples), _not_cut(samples, sizes, tool_radius_mm, nominal, findings))
     if not main.any():
         return 0.0
     kept = samples if main.all() else samples[main]
@@ -2672,6 +2669,20 @@ def _not_cut(
         return []
     nominal_off = _distance_to(samples, nominal) - tool_radius_mm
     return not_cut_groups(samples, _contour_ids(sizes), nominal_off, findings, tool_radius_mm)
+
+
+def _cut_as_drawn(
+    count: int, apart: list[tuple[FindingLike, IntArray, Point]]
+) -> npt.NDArray[np.bool_]:
+    """Which of ``count`` drawing samples are cut as drawn: in none of ``apart``'s groups.
+
+    ``apart`` is :func:`_not_cut`'s: the samples a finding (an uncut feature) accounts for,
+    which the comparison reports apart instead of in its largest distance and rms.
+    """
+    main = np.ones(count, dtype=bool)
+    for _, index, _ in apart:
+        main[index] = False
+    return main
 
 
 OVERCUT_PRUNE_FROM = 20_000
