@@ -2,10 +2,10 @@
 
 OCCT's 2D offset segfaulted on real drawings (Tango's ``filequickprint.svg`` and
 ``mail-mark-junk.svg`` with ``--offset outside --tool-diameter 1``): the process died with
-SIGSEGV, no message. :func:`camtool.toolpath.offset.offset_all` makes the offsets in a
-child; a job whose child dies gets a ToolpathError (the planner falls back to shapely's
-buffer, with a warning) and the jobs after it are made by a new child. The answers of a
-child are those of the parent, bit for bit.
+SIGSEGV, no message. :func:`camtool.toolpath.offset.offset_all` makes the offsets in
+workers forked by a child; a job whose worker dies gets a ToolpathError (the planner falls
+back to shapely's buffer, with a warning) and the jobs after it are made by a new worker
+of the same child. The answers are those of the parent, bit for bit.
 """
 
 from __future__ import annotations
@@ -46,21 +46,29 @@ def test_the_child_answers_what_this_process_answers(
     monkeypatch: pytest.MonkeyPatch, tmp_path: Path
 ) -> None:
     here = [offset_pieces(c, a) for c, a in JOBS]
-    real = offset_module._occt_offset
     made_by = tmp_path / "pids"
 
-    def occt(contour: Contour, amount: float) -> Any:  # notes which process made it
-        with made_by.open("a") as note:
-            note.write(f"{os.getpid()}\n")
-        return real(contour, amount)
-
-    monkeypatch.setattr(offset_module, "_occt_offset", occt)
+    monkeypatch.setattr(offset_module, "_occt_offset", _noting(made_by))
+    monkeypatch.setattr(offset_module, "_workers", lambda jobs: 1)
     there = offset_all(JOBS)
     assert len(there) == len(JOBS)
     assert all(_same(x, y) for x, y in zip(here, there, strict=True))
     pids = made_by.read_text().split()
-    assert len(pids) == len(JOBS) and len(set(pids)) == 1  # one child made them all
-    assert pids[0] != str(os.getpid())  # and it was not this process
+    assert len(pids) == len(JOBS) and len(set(pids)) == 1  # one worker made them all
+    maker, its_parent = pids[0].split(":")
+    assert str(os.getpid()) not in (maker, its_parent)  # a child's, not this process
+
+
+def _noting(made_by: Path) -> Any:
+    """OCCT's offset, noting ``pid:parent pid`` of the process that makes each."""
+    real = offset_module._occt_offset
+
+    def occt(contour: Contour, amount: float) -> Any:
+        with made_by.open("a") as note:
+            note.write(f"{os.getpid()}:{os.getppid()}\n")
+        return real(contour, amount)
+
+    return occt
 
 
 def _segfault_on(amount: float) -> Any:
@@ -93,6 +101,70 @@ def test_a_crash_in_the_child_fails_its_job_only(
     assert "crashed (SIGSEGV, signal 11)" in str(crashed) and "+0.5 mm" in str(crashed)
     for k in (0, 2, 3):  # before it, and made by a new child after it
         assert _same(got[k], expected[k])
+
+
+MANY = [(circle(0, 0, 1 + k), 0.25 + k / 64) for k in range(24)]
+CRASHING = {0.25 + k / 64 for k in range(24) if k % 3 != 1}  # 16 of 24, the first and last
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_many_crashes_are_answered_by_one_child(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, workers: int
+) -> None:
+    """Each crash costs a new worker of the same child, not a new child (issue 17).
+
+    Inkscape's ``filters.svg`` fitted to 299 × 199 mm and grown by 1 mm crashed OCCT on 438
+    of 1 752 contours; each crash forked a new child of the job's 1.3 GB process, which
+    loaded OpenCASCADE again and was sent every job left: over 25 minutes. Here two jobs in
+    three crash, with one worker or two at once: every crash is its job's error, every
+    other job is this process's answer, in order, and only one child was started.
+    """
+    expected = [offset_pieces(c, a) for c, a in MANY]
+    real = offset_module._occt_offset
+
+    def occt(contour: Contour, asked: float) -> Any:
+        if asked in CRASHING:
+            os.kill(os.getpid(), signal.SIGSEGV)
+        return real(contour, asked)
+
+    started = []
+
+    class Counted(offset_module._Child):
+        def __init__(self) -> None:
+            super().__init__()
+            started.append(self.pid)
+
+    monkeypatch.setattr(offset_module, "_occt_offset", occt)
+    monkeypatch.setattr(offset_module, "_Child", Counted)
+    monkeypatch.setattr(offset_module, "_workers", lambda jobs: workers)
+    got = offset_all(MANY)
+    assert len(started) == 1
+    assert len(got) == len(MANY)
+    for (_, amount), answer, here in zip(MANY, got, expected, strict=True):
+        if amount in CRASHING:
+            assert isinstance(answer, ToolpathError)
+            assert f"offset by {amount:+.4g} mm crashed (SIGSEGV, signal 11)" in str(answer)
+        else:
+            assert _same(answer, here)
+
+
+def test_a_large_job_is_made_by_two_workers_at_once(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    """Jobs of PARALLEL_SEGMENTS or more on two cores: two workers, the same answers in order."""
+    expected = [offset_pieces(c, a) for c, a in MANY]
+    made_by = tmp_path / "pids"
+    monkeypatch.setattr(offset_module, "_occt_offset", _noting(made_by))
+    monkeypatch.setattr(offset_module, "default_jobs", lambda: 2)
+    monkeypatch.setattr(offset_module, "in_worker", lambda: False)
+    segments = sum(len(c.segments) for c, _ in MANY)
+    monkeypatch.setattr(offset_module, "PARALLEL_SEGMENTS", segments)
+    assert offset_module._workers(MANY) == 2
+    assert offset_module._workers(MANY[1:]) == 1  # one contour fewer: too few segments
+    got = offset_all(MANY)
+    assert all(_same(x, y) for x, y in zip(got, expected, strict=True))
+    makers = {line.split(":")[0] for line in made_by.read_text().split()}
+    assert len(makers) == 2 and str(os.getpid()) not in makers
 
 
 def test_an_error_in_the_child_comes_back_as_the_error(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -189,19 +261,13 @@ def test_a_child_started_ahead_makes_the_offsets(
 ) -> None:
     """start_ahead's child (OpenCASCADE loaded while the job reads and plans) makes them all.
 
-    The same pieces as this process makes, bit for bit, made by that very child; it is
-    used once and gone afterwards.
+    The same pieces as this process makes, bit for bit, made by one worker that very child
+    forked; it is used once and gone afterwards.
     """
     here = [offset_pieces(c, a) for c, a in JOBS]
-    real = offset_module._occt_offset
     made_by = tmp_path / "pids"
-
-    def occt(contour: Contour, amount: float) -> Any:
-        with made_by.open("a") as note:
-            note.write(f"{os.getpid()}\n")
-        return real(contour, amount)
-
-    monkeypatch.setattr(offset_module, "_occt_offset", occt)
+    monkeypatch.setattr(offset_module, "_occt_offset", _noting(made_by))
+    monkeypatch.setattr(offset_module, "_workers", lambda jobs: 1)
     monkeypatch.setattr(offset_module, "_OFFSET_CALLS", [0])
     monkeypatch.setattr(offset_module, "_occt_here", lambda: False)  # a fresh job
     offset_module.start_ahead()
@@ -209,7 +275,9 @@ def test_a_child_started_ahead_makes_the_offsets(
     pid = ahead.pid
     there = offset_all(JOBS)
     assert all(_same(x, y) for x, y in zip(here, there, strict=True))
-    assert pid is not None and made_by.read_text().split() == [str(pid)] * len(JOBS)
+    makers = made_by.read_text().split()
+    assert len(makers) == len(JOBS) and len(set(makers)) == 1  # one worker of that child
+    assert pid is not None and makers[0].split(":")[1] == str(pid)
     assert offset_module._AHEAD == [] and ahead.pid is None  # used, then waited for
     offset_module.start_ahead()  # not again: this process has made its offsets
     assert offset_module._AHEAD == []
