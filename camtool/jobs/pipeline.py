@@ -404,7 +404,8 @@ def post_drawing(
             ``depth``, ``order``...); ``None``: the defaults.
         output: the output format and spindle (``None``: the defaults; the spindle
             speed then is the target's ``spindle_rpm``, which may be none).
-        progress: told the ``planning`` stage (``total``: the drawing's contours) and
+        progress: told the ``planning`` stage (``total``: the drawing's contours), the
+            ``offsetting`` stage within it (:func:`~camtool.toolpath.plan.plan_drawing`) and
             the ``writing`` stage (``total``: the program's moves; ``name``: the target).
 
     Raises:
@@ -415,7 +416,9 @@ def post_drawing(
     from camtool.toolpath.plan import plan_drawing  # not needed by a re-post: numpy
 
     progress(Step("planning", 0, len(drawing.contours)))
-    planned = plan_drawing(drawing, plan, target.machine, helix=target.post.helix)
+    planned = plan_drawing(
+        drawing, plan, target.machine, helix=target.post.helix, progress=progress
+    )
     program = dataclasses.replace(
         planned.program,
         notes=job_notes(drawing.source, target, plan),

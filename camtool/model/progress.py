@@ -18,11 +18,21 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TypeAlias
 
-STAGES = ("reading", "fitting", "contours", "planning", "writing", "verifying", "budget")
+STAGES = (
+    "reading",
+    "fitting",
+    "contours",
+    "planning",
+    "offsetting",
+    "writing",
+    "verifying",
+    "budget",
+)
 """The stages of ``camtool post``, in the order a job meets them (a job may skip some):
 reading the file (``total``: its drawn shapes, once counted), fitting arcs to its curves
 (``total``: distinct curves), making the contours of the shapes (``total``: shapes),
-planning the toolpath (``total``: contours), writing the code (``total``: moves of the
+planning the toolpath (``total``: contours), within it offsetting the closed contours for
+the tool with OpenCASCADE (``total``: contours offset), writing the code (``total``: moves of the
 program), verifying it (``total``: blocks of code) and its error budget (``total``: the
 error sources re-simulated, in forked workers when there are cores for them; ``name``: the
 next source, in order, whose figures are not in yet)."""

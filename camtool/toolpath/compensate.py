@@ -43,6 +43,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from camtool.model.errors import ToolpathError
+from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import Arc, Contour, Line, Point, Segment
 from camtool.toolpath.cuts import Cut, Finding, Stage, where
 from camtool.toolpath.offset import quad_segs, start_ahead, stop_ahead
@@ -74,7 +75,13 @@ def tool_inside(depth: int, offset: str) -> bool:
     return hole != (offset == "inside")
 
 
-def compensate(contours: Sequence[Contour], nest: Nesting, options: PlanOptions) -> Stage:
+def compensate(
+    contours: Sequence[Contour],
+    nest: Nesting,
+    options: PlanOptions,
+    *,
+    progress: Progress = no_progress,
+) -> Stage:
     """Turn contours into cuts: compensated for the tool (``outside``/``inside``) or on the line.
 
     Cuts come in contour order; ``group`` is the contour's index. Compensated
@@ -89,6 +96,8 @@ def compensate(contours: Sequence[Contour], nest: Nesting, options: PlanOptions)
         nest: their nesting (:func:`~camtool.toolpath.order.nesting`).
         options: ``offset`` (on/outside/inside), ``radius``, ``direction``,
             ``tolerance``.
+        progress: told the ``offsetting`` stage (``done`` of ``total`` closed contours)
+            as OpenCASCADE's offsets come in.
 
     Returns:
         The cuts and the findings (``open-on-line``, ``offset-fallback``,
@@ -104,7 +113,7 @@ def compensate(contours: Sequence[Contour], nest: Nesting, options: PlanOptions)
     findings: list[Finding] = []
     vanished: list[Finding] = []
     open_count = 0
-    jobs = _offset_jobs(contours, nest, options)
+    jobs = _offset_jobs(contours, nest, options, progress)
     for i, contour in enumerate(contours):
         if not contour.closed:
             open_count += 1
@@ -189,7 +198,7 @@ def offsets_ahead(options: PlanOptions) -> Iterator[None]:
 
 
 def _offset_jobs(
-    contours: Sequence[Contour], nest: Nesting, options: PlanOptions
+    contours: Sequence[Contour], nest: Nesting, options: PlanOptions, progress: Progress
 ) -> dict[int, _OffsetJob]:
     """The offset of each closed contour to the tool's side, by contour index.
 
@@ -211,7 +220,12 @@ def _offset_jobs(
             jobs[i] = _OffsetJob(side, _oriented(contour, side), -r if side.inside else r)
     if r == 0:
         return jobs
-    answers = offset_all([(job.drawn, job.amount) for job in jobs.values()])
+    total = len(jobs)
+    progress(Step("offsetting", 0, total))
+    answers = offset_all(
+        [(job.drawn, job.amount) for job in jobs.values()],
+        done=lambda n: progress(Step("offsetting", n, total)),
+    )
     return {
         i: dataclasses.replace(job, occt=occt)
         for (i, job), occt in zip(jobs.items(), answers, strict=True)

@@ -26,7 +26,7 @@ import pickle
 import select
 import signal
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -147,7 +147,9 @@ def offset_pieces(contour: Contour, amount: float) -> list[Contour]:
     return _oriented(pieces, contour)
 
 
-def offset_all(jobs: Sequence[tuple[Contour, float]]) -> list[list[Contour] | ToolpathError]:
+def offset_all(
+    jobs: Sequence[tuple[Contour, float]], *, done: Callable[[int], None] | None = None
+) -> list[list[Contour] | ToolpathError]:
     """:func:`offset_pieces` of every ``(contour, amount)``, OpenCASCADE run in a child process.
 
     OCCT's 2D offset can crash the process (SIGSEGV in ``BRepOffsetAPI_MakeOffset``: Tango's
@@ -169,6 +171,11 @@ def offset_all(jobs: Sequence[tuple[Contour, float]]) -> list[list[Contour] | To
     once, so that each child inherits it instead of loading it again
     (:data:`_OFFSET_CALLS`).
 
+    Args:
+        jobs: ``(contour, amount)`` as :func:`offset_pieces` takes them.
+        done: called in this process with the number of jobs answered so far, as the
+            answers come in (for a progress report; it does not change them).
+
     Returns:
         Per job, in order, the pieces (as :func:`offset_pieces`) or the
         :class:`ToolpathError` it raised.
@@ -185,13 +192,20 @@ def offset_all(jobs: Sequence[tuple[Contour, float]]) -> list[list[Contour] | To
     while len(out) < len(jobs):
         child = _AHEAD.pop() if _AHEAD else _Child()
         try:
-            got, died = child.make(jobs[len(out) :], workers)
+            got, died = child.make(jobs[len(out) :], workers, _after(len(out), done))
         finally:
             child.close()
         out.extend(got)
         if died is not None and len(out) < len(jobs):
             out.append(_crashed(*jobs[len(out)], died))
     return out
+
+
+def _after(before: int, done: Callable[[int], None] | None) -> Callable[[int], None] | None:
+    """``done`` told ``before + n`` for a child's ``n`` answers (``None`` stays ``None``)."""
+    if done is None:
+        return None
+    return lambda n: done(before + n)
 
 
 PARALLEL_SEGMENTS = 2000
@@ -315,11 +329,15 @@ class _Child:
         self.answers = os.fdopen(answers_read, "rb")
 
     def make(
-        self, jobs: Sequence[tuple[Contour, float]], workers: int = 1
+        self,
+        jobs: Sequence[tuple[Contour, float]],
+        workers: int = 1,
+        done: Callable[[int], None] | None = None,
     ) -> tuple[list[list[Contour] | ToolpathError], str | None]:
         """The answers the child sends for ``jobs``, and how it died (``None``: it did not).
 
-        ``workers``: how many of its workers make the jobs at once (:func:`_serve`).
+        ``workers``: how many of its workers make the jobs at once (:func:`_serve`);
+        ``done``: told the number of answers so far, after each.
         """
         got: list[list[Contour] | ToolpathError] = []
         try:
@@ -337,6 +355,8 @@ class _Child:
                 got.append(_crashed(*jobs[len(got)], value))
             else:
                 got.append(ToolpathError(value) if kind == "error" else value)
+            if done is not None:
+                done(len(got))
         return got, None
 
     def close(self, *, kill: bool = False) -> None:
@@ -393,7 +413,10 @@ def _serve(inbox: Any, out: Any) -> None:
     try:
         while sent < len(jobs):
             while len(busy) < workers and given < len(jobs):
-                worker = _Worker(jobs, closing)
+                # the new worker closes the others' pipes: a worker holding another's
+                # pipe of indices open would keep that one from seeing its end
+                others = [fd for w in busy.values() for fd in (w.given, w.answers)]
+                worker = _Worker(jobs, (*closing, *others))
                 busy[worker.answers] = worker
                 worker.give(given)
                 given += 1
@@ -429,6 +452,7 @@ class _Worker:
     """
 
     def __init__(self, jobs: Sequence[tuple[Contour, float]], closing: Sequence[int]) -> None:
+        """Fork it; ``closing``: the fds it must not hold (the child's own, other workers')."""
         given_read, given_write = os.pipe()
         answers_read, answers_write = os.pipe()
         pid = os.fork()

@@ -30,6 +30,7 @@ from camtool.geometry.arcfit import FitStats, fit_polyline, fit_stats
 from camtool.geometry.chain import chain, joint_distance
 from camtool.model.errors import InputError
 from camtool.model.program import Move, Program, Rapid
+from camtool.model.progress import Progress, no_progress
 from camtool.model.shapes import Contour, Drawing, Line, Point, Segment
 from camtool.toolpath.chain import close_gaps
 from camtool.toolpath.cuts import Finding, Stage
@@ -146,6 +147,7 @@ def plan_drawing(
     machine: Machine | None = None,
     *,
     helix: bool = True,
+    progress: Progress = no_progress,
 ) -> Plan:
     """Turn a drawing into a program and say what planning found.
 
@@ -163,6 +165,8 @@ def plan_drawing(
             and a machine without Z refuses the depth options.
         helix: the target writes arcs that move Z; ``False`` ramps down arcs as
             chords within the tolerance.
+        progress: told the ``offsetting`` stage (``total``: the closed contours offset
+            for the tool) as the offsets come in, when there are any.
 
     Raises:
         UsageError: invalid options, no feed (``options.feed_mm_min`` is ``None``:
@@ -185,7 +189,7 @@ def plan_drawing(
     if options.fit_arcs:
         contours, stats = fit_dense(contours, options.tolerance)
     nest = nesting(contours)
-    stage = _stage(contours, nest, options)
+    stage = _stage(contours, nest, options, progress)
     findings.extend(stage.findings)
     backlash = (0.0, 0.0) if machine is None else _backlash_weights(machine)
     ordering = order_cuts(stage.cuts, nest, options, backlash)
@@ -207,14 +211,16 @@ def plan_drawing(
     return Plan(program, report, placed)
 
 
-def _stage(contours: Sequence[Contour], nest: Any, options: PlanOptions) -> Stage:
+def _stage(
+    contours: Sequence[Contour], nest: Any, options: PlanOptions, progress: Progress
+) -> Stage:
     if options.offset == "pocket":
         from camtool.toolpath.pocket import pocket
 
         return pocket(contours, nest, options)
     from camtool.toolpath.compensate import compensate
 
-    return compensate(contours, nest, options)
+    return compensate(contours, nest, options, progress=progress)
 
 
 def _backlash_weights(machine: Machine) -> tuple[float, float]:

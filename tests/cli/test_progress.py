@@ -101,6 +101,7 @@ def test_a_closed_stderr_silences_progress_without_failing() -> None:
         (Step("reading", 3, 12, "a.svg"), "reading a.svg: 12 shapes"),
         (Step("fitting", 0, 400), "fitting arcs to 400 curves"),
         (Step("writing", 0, 7, "valcnc"), "writing 7 moves for valcnc"),
+        (Step("offsetting", 2, 9), "offsetting 9 contours for the tool"),
     ],
 )
 def test_stage_text_says_how_big_the_work_is(step: Step, text: str) -> None:
@@ -178,3 +179,45 @@ def test_a_long_verification_tells_its_error_budget(
     assert [ln for ln in err.splitlines() if ln not in stages] == quiet_err.splitlines()
     assert stages[-2].startswith("camtool: verifying ")
     assert stages[-1] == "camtool: error budget: re-simulating once per error source (3)…"
+
+
+def test_a_long_job_with_offsets_tells_its_offsetting_stage(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``--offset outside``: an ``offsetting`` line after ``planning``, one per closed contour.
+
+    OpenCASCADE's offsets of Inkscape's ``filters.svg`` (1 752 contours) ran for minutes
+    after "planning" with nothing said. Into a file the stage gets one line; on a terminal
+    its count is redrawn up to all contours offset.
+    """
+    path = _svg(tmp_path, 4)
+    args = [str(path), "-t", "grbl", "--offset", "outside", "--tool-diameter", "1"]
+    monkeypatch.setattr(progress_module, "AFTER_S", 1e9)
+    code, quiet_out, quiet_err = _post(args, capsys)
+    assert code == 0
+    monkeypatch.setattr(progress_module, "AFTER_S", 0.0)
+    code, out, err = _post(args, capsys)
+    assert code == 0 and out == quiet_out
+    stages = [ln for ln in err.splitlines() if ln.endswith("…")]
+    assert [ln for ln in err.splitlines() if ln not in stages] == quiet_err.splitlines()
+    planning = next(i for i, ln in enumerate(stages) if ln.startswith("camtool: planning "))
+    drawn = int(stages[planning].split()[2])
+    offsetting = stages[planning + 1].split()
+    assert offsetting[:2] == ["camtool:", "offsetting"]
+    assert offsetting[3:] == ["contours", "for", "the", "tool…"]
+    assert 0 < int(offsetting[2]) <= drawn  # the closed ones
+    assert stages[planning + 2].startswith("camtool: writing ")
+
+
+def test_the_offsetting_stage_counts_every_answer() -> None:
+    """compensate tells ``offsetting`` 0, 1, …, n of n, in order, n the closed contours."""
+    from camtool.toolpath.compensate import compensate
+    from camtool.toolpath.options import PlanOptions
+    from camtool.toolpath.order import nesting
+    from tests.toolpath.contours import circle, rect
+
+    contours = [rect(0, 0, 40, 30), circle(10, 10, 3), circle(25, 10, 4), circle(30, 20, 2)]
+    steps: list[Step] = []
+    options = PlanOptions(offset="outside", tool_diameter=1.0, feed_mm_min=100.0)
+    compensate(contours, nesting(contours), options, progress=steps.append)
+    assert steps == [Step("offsetting", n, 4) for n in range(5)]

@@ -167,6 +167,51 @@ def test_a_large_job_is_made_by_two_workers_at_once(
     assert len(makers) == 2 and str(os.getpid()) not in makers
 
 
+TWO_WORKERS = """
+import time
+from camtool.toolpath import offset
+from tests.toolpath.contours import circle, rect
+jobs = [(circle(0, 0, 5), 1.0), (rect(0, 0, 10, 5), 0.5)]
+here = [offset.offset_pieces(c, a) for c, a in jobs]
+real = offset._occt_offset
+def occt(contour, asked):
+    if asked == 0.5:
+        time.sleep(0.5)  # the second job is slow: the first worker is ended first
+    return real(contour, asked)
+offset._occt_offset = occt
+offset._workers = lambda jobs: 2
+got = offset.offset_all(jobs)
+print([[p.segments for p in a] for a in got] == [[p.segments for p in a] for a in here])
+"""
+
+
+def test_two_workers_end_whichever_finishes_first() -> None:
+    """The first worker done is ended while the second still works: no deadlock.
+
+    The second worker was forked holding the first one's pipe of job indices: ending the
+    first left its pipe open there, and the child waited for it for ever (LinuxCNC's
+    ``Chip_Linuxcnc.svg`` with ``--offset outside`` hung one run in two). In a fresh
+    interpreter of its own session, killed whole if it hangs.
+    """
+    root = Path(__file__).resolve().parents[2]
+    run = subprocess.Popen(
+        [sys.executable, "-c", TWO_WORKERS],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=root,
+        start_new_session=True,
+    )
+    try:
+        out, err = run.communicate(timeout=120)
+    except subprocess.TimeoutExpired:
+        os.killpg(run.pid, signal.SIGKILL)  # it, its child and the workers
+        run.communicate()
+        pytest.fail("offset_all with two workers hung")
+    assert run.returncode == 0, err[-2000:]
+    assert out.split() == ["True"]
+
+
 def test_an_error_in_the_child_comes_back_as_the_error(monkeypatch: pytest.MonkeyPatch) -> None:
     def refuses(contour: Contour, amount: float) -> Any:
         raise RuntimeError("StdFail_NotDone")
