@@ -308,20 +308,14 @@ class _Child:
     def __init__(self) -> None:
         jobs_read, jobs_write = os.pipe()
         answers_read, answers_write = os.pipe()
-        pid = os.fork()
-        if pid == 0:  # the child
-            code = 0
-            try:
-                _quiet_crash()
-                os.close(jobs_write)
-                os.close(answers_read)
-                _load_occt()
-                with os.fdopen(jobs_read, "rb") as inbox, os.fdopen(answers_write, "wb") as out:
-                    _serve(inbox, out)
-            except BaseException:
-                code = 70  # the parent sees which job got no answer
-            finally:
-                os._exit(code)
+
+        def child() -> None:
+            _quiet_crash()
+            _load_occt()
+            with os.fdopen(jobs_read, "rb") as inbox, os.fdopen(answers_write, "wb") as out:
+                _serve(inbox, out)
+
+        pid = _fork(child, closing=(jobs_write, answers_read))
         os.close(jobs_read)
         os.close(answers_write)
         self.pid: int | None = pid
@@ -379,6 +373,27 @@ class _Child:
         _, status = os.waitpid(self.pid, 0)
         self.pid = None
         return _how_ended(status)
+
+
+def _fork(run: Callable[[], None], *, closing: Sequence[int]) -> int:
+    """Fork a process that closes ``closing`` (fds it must not hold), runs ``run`` and leaves.
+
+    It leaves with ``os._exit``: 0 after ``run``, 70 when ``run`` raised (whoever reads
+    its answers sees which it did not give), never through this process's own code.
+    Returns its pid, in this process.
+    """
+    pid = os.fork()
+    if pid == 0:
+        code = 0
+        try:
+            for fd in closing:
+                os.close(fd)
+            run()
+        except BaseException:
+            code = 70
+        finally:
+            os._exit(code)
+    return pid
 
 
 def _how_ended(status: int) -> str:
@@ -455,17 +470,10 @@ class _Worker:
         """Fork it; ``closing``: the fds it must not hold (the child's own, other workers')."""
         given_read, given_write = os.pipe()
         answers_read, answers_write = os.pipe()
-        pid = os.fork()
-        if pid == 0:  # the worker
-            code = 0
-            try:
-                for fd in (*closing, given_write, answers_read):
-                    os.close(fd)  # the job's process sees the end when the child ends
-                _work(jobs, given_read, answers_write)
-            except BaseException:
-                code = 70  # the child answers its job "died"
-            finally:
-                os._exit(code)
+        pid = _fork(
+            lambda: _work(jobs, given_read, answers_write),
+            closing=(*closing, given_write, answers_read),
+        )
         os.close(given_read)
         os.close(answers_write)
         self.pid: int | None = pid

@@ -114,6 +114,25 @@ def _post(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str
     return code, out, err
 
 
+def _stage_lines(
+    args: list[str], capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> list[str]:
+    """``post args`` quiet, then with threshold 0: the stage lines of the second run.
+
+    Both succeed and write the same code, and the second's other stderr lines are the
+    first's: progress adds lines and changes nothing else.
+    """
+    monkeypatch.setattr(progress_module, "AFTER_S", 1e9)  # quiet, however loaded the machine
+    code, quiet_out, quiet_err = _post(args, capsys)
+    assert code == 0
+    monkeypatch.setattr(progress_module, "AFTER_S", 0.0)
+    code, out, err = _post(args, capsys)
+    assert code == 0 and out == quiet_out
+    stages = [ln for ln in err.splitlines() if ln.endswith("…")]
+    assert [ln for ln in err.splitlines() if ln not in stages] == quiet_err.splitlines()
+    return stages
+
+
 def test_a_short_job_prints_nothing_new(
     capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -167,16 +186,7 @@ def test_a_long_verification_tells_its_error_budget(
     grbl's profile models interpolation, chords and (post --verify) rounding for a
     drawing with arcs: three sources. The summary is what it is without progress.
     """
-    path = _svg(tmp_path, 3)
-    args = [str(path), "-t", "grbl", "--verify"]
-    monkeypatch.setattr(progress_module, "AFTER_S", 1e9)  # quiet, however loaded the machine
-    code, quiet_out, quiet_err = _post(args, capsys)
-    assert code == 0
-    monkeypatch.setattr(progress_module, "AFTER_S", 0.0)
-    code, out, err = _post(args, capsys)
-    assert code == 0 and out == quiet_out
-    stages = [ln for ln in err.splitlines() if ln.endswith("…")]
-    assert [ln for ln in err.splitlines() if ln not in stages] == quiet_err.splitlines()
+    stages = _stage_lines([str(_svg(tmp_path, 3)), "-t", "grbl", "--verify"], capsys, monkeypatch)
     assert stages[-2].startswith("camtool: verifying ")
     assert stages[-1] == "camtool: error budget: re-simulating once per error source (3)…"
 
@@ -190,16 +200,8 @@ def test_a_long_job_with_offsets_tells_its_offsetting_stage(
     after "planning" with nothing said. Into a file the stage gets one line; on a terminal
     its count is redrawn up to all contours offset.
     """
-    path = _svg(tmp_path, 4)
-    args = [str(path), "-t", "grbl", "--offset", "outside", "--tool-diameter", "1"]
-    monkeypatch.setattr(progress_module, "AFTER_S", 1e9)
-    code, quiet_out, quiet_err = _post(args, capsys)
-    assert code == 0
-    monkeypatch.setattr(progress_module, "AFTER_S", 0.0)
-    code, out, err = _post(args, capsys)
-    assert code == 0 and out == quiet_out
-    stages = [ln for ln in err.splitlines() if ln.endswith("…")]
-    assert [ln for ln in err.splitlines() if ln not in stages] == quiet_err.splitlines()
+    args = [str(_svg(tmp_path, 4)), "-t", "grbl", "--offset", "outside", "--tool-diameter", "1"]
+    stages = _stage_lines(args, capsys, monkeypatch)
     planning = next(i for i, ln in enumerate(stages) if ln.startswith("camtool: planning "))
     drawn = int(stages[planning].split()[2])
     offsetting = stages[planning + 1].split()

@@ -47,7 +47,6 @@ def test_the_child_answers_what_this_process_answers(
 ) -> None:
     here = [offset_pieces(c, a) for c, a in JOBS]
     made_by = tmp_path / "pids"
-
     monkeypatch.setattr(offset_module, "_occt_offset", _noting(made_by))
     monkeypatch.setattr(offset_module, "_workers", lambda jobs: 1)
     there = offset_all(JOBS)
