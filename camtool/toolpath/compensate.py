@@ -46,7 +46,7 @@ from camtool.model.errors import ToolpathError
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import Arc, Contour, Line, Point, Segment
 from camtool.toolpath.cuts import Cut, Finding, Stage, where
-from camtool.toolpath.offset import quad_segs, start_ahead, stop_ahead
+from camtool.toolpath.offset import Answer, quad_segs, start_ahead, stop_ahead
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.order import Nesting
 
@@ -162,13 +162,14 @@ class _OffsetJob:
     """A closed contour's offset to the tool's side.
 
     The side, the contour oriented for it, the signed offset (mm) and OpenCASCADE's
-    answer (``None`` for a zero radius: nothing to ask).
+    answer, mostly already checked (an item of :func:`~camtool.toolpath.offset.offset_all`;
+    ``None`` for a zero radius: nothing to ask).
     """
 
     side: _Side
     drawn: Contour
     amount: float
-    occt: list[Contour] | ToolpathError | None = None
+    occt: Answer | None = None
 
 
 def makes_offsets(options: PlanOptions) -> bool:
@@ -203,9 +204,10 @@ def _offset_jobs(
     """The offset of each closed contour to the tool's side, by contour index.
 
     OpenCASCADE's answers are all made at once by
-    :func:`~camtool.toolpath.offset.offset_all` (in a child process that a crash of
-    OpenCASCADE cannot take this one down with); a zero radius needs none, and
-    ``--offset on`` no job at all.
+    :func:`~camtool.toolpath.offset.offset_all` (in workers of a child process that a crash
+    of OpenCASCADE cannot take this one down with), and checked there against shapely's
+    buffer with the plan's tolerance; a zero radius needs none, and ``--offset on`` no
+    job at all.
     """
     from camtool.toolpath.offset import offset_all
 
@@ -224,6 +226,7 @@ def _offset_jobs(
     progress(Step("offsetting", 0, total))
     answers = offset_all(
         [(job.drawn, job.amount) for job in jobs.values()],
+        tolerance=options.tolerance,
         done=lambda n: progress(Step("offsetting", n, total)),
     )
     return {
@@ -236,12 +239,15 @@ def _compensated(
     contour: Contour, index: int, nest: Nesting, options: PlanOptions, job: _OffsetJob
 ) -> tuple[list[Cut], list[Finding]]:
     """The cuts of one closed contour offset to the tool's side (``job``), and what was found."""
-    from camtool.toolpath.offset import offset_checked
+    from camtool.toolpath.offset import OffsetResult, offset_checked
 
     depth = nest.depth(index)
     side, drawn = job.side, job.drawn
     r = options.radius
-    result = offset_checked(drawn, job.amount, options.tolerance, occt=job.occt)
+    if isinstance(job.occt, OffsetResult):  # checked by the offsets' worker
+        result = job.occt
+    else:
+        result = offset_checked(drawn, job.amount, options.tolerance, occt=job.occt)
     findings: list[Finding] = []
     if not result.pieces:
         return [], [_vanished(contour, options)]

@@ -28,7 +28,7 @@ import signal
 import sys
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeAlias
 
 from camtool.geometry.chain import chain
 from camtool.model.cores import FORK, default_jobs, in_worker, wait_readable
@@ -147,9 +147,17 @@ def offset_pieces(contour: Contour, amount: float) -> list[Contour]:
     return _oriented(pieces, contour)
 
 
+Answer: TypeAlias = "list[Contour] | ToolpathError | OffsetResult"
+"""An item of :func:`offset_all`: OpenCASCADE's pieces or its error, or with a tolerance
+the checked offset (:func:`offset_checked`)."""
+
+
 def offset_all(
-    jobs: Sequence[tuple[Contour, float]], *, done: Callable[[int], None] | None = None
-) -> list[list[Contour] | ToolpathError]:
+    jobs: Sequence[tuple[Contour, float]],
+    *,
+    tolerance: float | None = None,
+    done: Callable[[int], None] | None = None,
+) -> list[Answer]:
     """:func:`offset_pieces` of every ``(contour, amount)``, OpenCASCADE run in a child process.
 
     OCCT's 2D offset can crash the process (SIGSEGV in ``BRepOffsetAPI_MakeOffset``: Tango's
@@ -173,12 +181,20 @@ def offset_all(
 
     Args:
         jobs: ``(contour, amount)`` as :func:`offset_pieces` takes them.
+        tolerance: when given, mm: each worker also checks its offset against shapely's
+            buffer and makes the fallback where it fails, as :func:`offset_checked` with
+            this tolerance would here, and answers that :class:`OffsetResult` (the checks
+            then run on the workers' cores too: Inkscape's ``filters.svg``, ~35 s of this
+            process's time). Where the check raised, or the worker died, the answer is
+            OpenCASCADE's own (pieces or error), for :func:`offset_checked` here to make
+            the result (and raise the same error) from.
         done: called in this process with the number of jobs answered so far, as the
             answers come in (for a progress report; it does not change them).
 
     Returns:
         Per job, in order, the pieces (as :func:`offset_pieces`) or the
-        :class:`ToolpathError` it raised.
+        :class:`ToolpathError` it raised; with ``tolerance``, mostly the checked
+        :class:`OffsetResult`.
     """
     if not jobs:
         return []
@@ -188,11 +204,11 @@ def offset_all(
     if _OFFSET_CALLS[0] > 1 or in_worker():
         _load_occt()
     workers = _workers(jobs)
-    out: list[list[Contour] | ToolpathError] = []
+    out: list[Answer] = []
     while len(out) < len(jobs):
         child = _AHEAD.pop() if _AHEAD else _Child()
         try:
-            got, died = child.make(jobs[len(out) :], workers, _after(len(out), done))
+            got, died = child.make(jobs[len(out) :], workers, tolerance, _after(len(out), done))
         finally:
             child.close()
         out.extend(got)
@@ -283,6 +299,21 @@ def _attempt(contour: Contour, amount: float) -> list[Contour] | ToolpathError:
         return exc
 
 
+def _answer(contour: Contour, amount: float, tolerance: float | None) -> Answer:
+    """In a worker: OpenCASCADE's answer, checked with ``tolerance`` unless ``None``.
+
+    OpenCASCADE's own answer where the check raised, so that the job's process checks
+    it again and raises the error there, at its place.
+    """
+    occt = _attempt(contour, amount)
+    if tolerance is None:
+        return occt
+    try:
+        return offset_checked(contour, amount, tolerance, occt=occt)
+    except Exception:
+        return occt
+
+
 def _load_occt() -> None:
     """Import the OCP modules the offsets use (once per process)."""
     import OCP.BRepBuilderAPI
@@ -326,16 +357,19 @@ class _Child:
         self,
         jobs: Sequence[tuple[Contour, float]],
         workers: int = 1,
+        tolerance: float | None = None,
         done: Callable[[int], None] | None = None,
-    ) -> tuple[list[list[Contour] | ToolpathError], str | None]:
+    ) -> tuple[list[Answer], str | None]:
         """The answers the child sends for ``jobs``, and how it died (``None``: it did not).
 
         ``workers``: how many of its workers make the jobs at once (:func:`_serve`);
-        ``done``: told the number of answers so far, after each.
+        ``tolerance``: as for :func:`offset_all`; ``done``: told the number of answers so
+        far, after each.
         """
-        got: list[list[Contour] | ToolpathError] = []
+        got: list[Answer] = []
         try:
-            pickle.dump((workers, list(jobs)), self.jobs, protocol=pickle.HIGHEST_PROTOCOL)
+            task = (workers, tolerance, list(jobs))
+            pickle.dump(task, self.jobs, protocol=pickle.HIGHEST_PROTOCOL)
             self.jobs.flush()
         except OSError:  # it died before it read them
             return got, self._death()
@@ -411,16 +445,18 @@ def _how_ended(status: int) -> str:
 def _serve(inbox: Any, out: Any) -> None:
     """In the child: answer the jobs read from ``inbox`` (none if it closes first), in order.
 
-    The jobs come as ``(workers, jobs)``. That many :class:`_Worker` make them, one job
+    The jobs come as ``(workers, tolerance, jobs)``. That many :class:`_Worker` make them, one job
     at a time each, the next job going to the first worker free. Each answer is sent on
     ``out`` as soon as every job before it is answered; a job whose worker died is
     answered ``("died", how)`` and a new worker takes the place of the dead one. The
     answers are those of :func:`_attempt` in this process, whichever worker made them.
     """
     try:
-        workers, jobs = pickle.load(inbox)
+        workers, tolerance, jobs = pickle.load(inbox)
     except EOFError:  # this process ended before it sent any
         return
+    if tolerance is not None:
+        import shapely  # noqa: F401  (once here, not once a worker: the checks use it)
     closing = (inbox.fileno(), out.fileno())
     done: dict[int, bytes] = {}  # answers made but not sent yet, by job
     sent = given = 0
@@ -431,7 +467,7 @@ def _serve(inbox: Any, out: Any) -> None:
                 # the new worker closes the others' pipes: a worker holding another's
                 # pipe of indices open would keep that one from seeing its end
                 others = [fd for w in busy.values() for fd in (w.given, w.answers)]
-                worker = _Worker(jobs, (*closing, *others))
+                worker = _Worker(jobs, tolerance, (*closing, *others))
                 busy[worker.answers] = worker
                 worker.give(given)
                 given += 1
@@ -466,12 +502,17 @@ class _Worker:
     indices closes (:meth:`close`). A crash of OpenCASCADE ends it, and only it.
     """
 
-    def __init__(self, jobs: Sequence[tuple[Contour, float]], closing: Sequence[int]) -> None:
+    def __init__(
+        self,
+        jobs: Sequence[tuple[Contour, float]],
+        tolerance: float | None,
+        closing: Sequence[int],
+    ) -> None:
         """Fork it; ``closing``: the fds it must not hold (the child's own, other workers')."""
         given_read, given_write = os.pipe()
         answers_read, answers_write = os.pipe()
         pid = _fork(
-            lambda: _work(jobs, given_read, answers_write),
+            lambda: _work(jobs, tolerance, given_read, answers_write),
             closing=(*closing, given_write, answers_read),
         )
         os.close(given_read)
@@ -509,10 +550,12 @@ class _Worker:
         return _how_ended(status)
 
 
-def _work(jobs: Sequence[tuple[Contour, float]], given: int, answers: int) -> None:
+def _work(
+    jobs: Sequence[tuple[Contour, float]], tolerance: float | None, given: int, answers: int
+) -> None:
     """In a worker: make each job whose index comes on ``given``, answer it on ``answers``."""
     while (head := _read_exactly(given, 8)) is not None:
-        got = _attempt(*jobs[int.from_bytes(head, "little")])
+        got = _answer(*jobs[int.from_bytes(head, "little")], tolerance)
         record = ("error", str(got)) if isinstance(got, ToolpathError) else ("ok", got)
         data = pickle.dumps(record, protocol=pickle.HIGHEST_PROTOCOL)
         view = memoryview(len(data).to_bytes(8, "little") + data)

@@ -211,6 +211,50 @@ def test_two_workers_end_whichever_finishes_first() -> None:
     assert out.split() == ["True"]
 
 
+def _same_result(a: Any, b: Any) -> bool:
+    """Two OffsetResults bit for bit: the same pieces (every float), the same fallback."""
+    return pickle.dumps((a.pieces, a.fallback)) == pickle.dumps((b.pieces, b.fallback))
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_with_a_tolerance_the_workers_answer_the_checked_offset(
+    monkeypatch: pytest.MonkeyPatch, workers: int
+) -> None:
+    """offset_all(…, tolerance) answers offset_checked's result, fallbacks included.
+
+    The l-shape's offset is refused (OpenCASCADE's error), so its worker falls back to the
+    fitted buffer there; every result equals this process's offset_checked bit for bit.
+    """
+    real = offset_module._occt_offset
+
+    def refuses_the_l(contour: Contour, amount: float) -> Any:
+        if amount == -1.0:
+            raise RuntimeError("StdFail_NotDone")
+        return real(contour, amount)
+
+    monkeypatch.setattr(offset_module, "_occt_offset", refuses_the_l)
+    monkeypatch.setattr(offset_module, "_workers", lambda jobs: workers)
+    here = [offset_module.offset_checked(c, a, 0.01) for c, a in JOBS]
+    assert here[2].fallback is not None and here[0].fallback is None
+    got = offset_all(JOBS, tolerance=0.01)
+    assert all(isinstance(g, offset_module.OffsetResult) for g in got)
+    assert all(_same_result(g, h) for g, h in zip(got, here, strict=True))
+
+
+def test_a_check_that_raises_in_the_worker_is_made_again_here(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Where offset_checked raised in the worker, the answer is OpenCASCADE's own pieces,
+    so that the job's process checks them itself and meets the error at its place."""
+
+    def broken(*args: Any) -> Any:
+        raise ArithmeticError("a check that fails")
+
+    monkeypatch.setattr(offset_module, "_disagreement", broken)
+    (got,) = offset_all(JOBS[:1], tolerance=0.01)
+    assert isinstance(got, list) and _same(got, offset_pieces(*JOBS[0]))
+
+
 def test_an_error_in_the_child_comes_back_as_the_error(monkeypatch: pytest.MonkeyPatch) -> None:
     def refuses(contour: Contour, amount: float) -> Any:
         raise RuntimeError("StdFail_NotDone")
