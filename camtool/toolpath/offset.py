@@ -445,11 +445,11 @@ def _how_ended(status: int) -> str:
 def _serve(inbox: Any, out: Any) -> None:
     """In the child: answer the jobs read from ``inbox`` (none if it closes first), in order.
 
-    The jobs come as ``(workers, tolerance, jobs)``. That many :class:`_Worker` make them, one job
-    at a time each, the next job going to the first worker free. Each answer is sent on
-    ``out`` as soon as every job before it is answered; a job whose worker died is
+    The jobs come as ``(workers, tolerance, jobs)``. That many :class:`_Worker` make them,
+    one job at a time each, the next job going to the first worker free. Each answer is
+    sent on ``out`` as soon as every job before it is answered; a job whose worker died is
     answered ``("died", how)`` and a new worker takes the place of the dead one. The
-    answers are those of :func:`_attempt` in this process, whichever worker made them.
+    answers are those of :func:`_answer` in this process, whichever worker made them.
     """
     try:
         workers, tolerance, jobs = pickle.load(inbox)
@@ -497,7 +497,7 @@ def _serve(inbox: Any, out: Any) -> None:
 class _Worker:
     """In the child: a process forked from it that makes the jobs it is given, one at a time.
 
-    It is given a job's index (:meth:`give`), makes it with :func:`_attempt` and sends back
+    It is given a job's index (:meth:`give`), makes it with :func:`_answer` and sends back
     the pickled answer (:meth:`answer`), framed by its length; it leaves when its pipe of
     indices closes (:meth:`close`). A crash of OpenCASCADE ends it, and only it.
     """
