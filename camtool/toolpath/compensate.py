@@ -46,7 +46,15 @@ from camtool.model.errors import ToolpathError
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import Arc, Contour, Line, Point, Segment
 from camtool.toolpath.cuts import Cut, Finding, Stage, where
-from camtool.toolpath.offset import Answer, quad_segs, start_ahead, stop_ahead
+from camtool.toolpath.offset import (
+    Answer,
+    OffsetResult,
+    offset_all,
+    offset_checked,
+    quad_segs,
+    start_ahead,
+    stop_ahead,
+)
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.order import Nesting
 
@@ -161,15 +169,15 @@ def _on_line(contour: Contour, index: int, nest: Nesting, options: PlanOptions) 
 class _OffsetJob:
     """A closed contour's offset to the tool's side.
 
-    The side, the contour oriented for it, the signed offset (mm) and OpenCASCADE's
-    answer, mostly already checked (an item of :func:`~camtool.toolpath.offset.offset_all`;
+    The side, the contour oriented for it, the signed offset (mm) and the offsets' answer
+    for it, mostly already checked (an item of :func:`~camtool.toolpath.offset.offset_all`;
     ``None`` for a zero radius: nothing to ask).
     """
 
     side: _Side
     drawn: Contour
     amount: float
-    occt: Answer | None = None
+    answer: Answer | None = None
 
 
 def makes_offsets(options: PlanOptions) -> bool:
@@ -209,8 +217,6 @@ def _offset_jobs(
     buffer with the plan's tolerance; a zero radius needs none, and ``--offset on`` no
     job at all.
     """
-    from camtool.toolpath.offset import offset_all
-
     if options.offset == "on":
         return {}
     r = options.radius
@@ -230,8 +236,8 @@ def _offset_jobs(
         done=lambda n: progress(Step("offsetting", n, total)),
     )
     return {
-        i: dataclasses.replace(job, occt=occt)
-        for (i, job), occt in zip(jobs.items(), answers, strict=True)
+        i: dataclasses.replace(job, answer=answer)
+        for (i, job), answer in zip(jobs.items(), answers, strict=True)
     }
 
 
@@ -239,15 +245,13 @@ def _compensated(
     contour: Contour, index: int, nest: Nesting, options: PlanOptions, job: _OffsetJob
 ) -> tuple[list[Cut], list[Finding]]:
     """The cuts of one closed contour offset to the tool's side (``job``), and what was found."""
-    from camtool.toolpath.offset import OffsetResult, offset_checked
-
     depth = nest.depth(index)
     side, drawn = job.side, job.drawn
     r = options.radius
-    if isinstance(job.occt, OffsetResult):  # checked by the offsets' worker
-        result = job.occt
-    else:
-        result = offset_checked(drawn, job.amount, options.tolerance, occt=job.occt)
+    if isinstance(job.answer, OffsetResult):  # checked by the offsets' worker
+        result = job.answer
+    else:  # OpenCASCADE's own answer (its worker died, or the check raised there)
+        result = offset_checked(drawn, job.amount, options.tolerance, occt=job.answer)
     findings: list[Finding] = []
     if not result.pieces:
         return [], [_vanished(contour, options)]

@@ -324,8 +324,8 @@ def _load_occt() -> None:
 class _Child:
     """A forked child that loads OpenCASCADE and has the offsets sent to it made.
 
-    It reads one pickled ``(workers, jobs)`` (:meth:`make`), and :func:`_serve` answers each
-    job in order as it is made (a pickled ``("ok", pieces)``, ``("error", message)`` or
+    It reads one pickled ``(workers, tolerance, jobs)`` (:meth:`make`), and :func:`_serve`
+    answers each job in order as it is made (a pickled ``("ok", pieces)``, ``("error", message)`` or
     ``("died", how)``) and leaves, without running any of this process's code; one started
     ahead and never used is killed (:meth:`close`). The offsets themselves are made by
     workers it forks (:class:`_Worker`): a crash of OpenCASCADE takes down a worker, whose
