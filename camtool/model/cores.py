@@ -35,10 +35,15 @@ __all__ = [
     "ForkedWork",
     "ahead",
     "default_jobs",
+    "fork_process",
+    "how_ended",
     "in_worker",
     "meanwhile",
+    "read_exactly",
+    "read_record",
     "wait_readable",
     "wait_until",
+    "write_record",
 ]
 
 T = TypeVar("T")
@@ -275,3 +280,68 @@ def _run_item(index: int) -> tuple[bool, Any]:
         return True, fn(items[index])
     except Exception:  # answered in the parent, which raises it where it belongs
         return False, None
+
+
+def fork_process(run: Callable[[], None], *, closing: Sequence[int]) -> int:
+    """Fork a process that closes ``closing`` (fds it must not hold), runs ``run`` and leaves.
+
+    It leaves with ``os._exit``: 0 after ``run``, 70 when ``run`` raised (whoever reads
+    its answers sees which it did not give), never through this process's own code.
+    Returns its pid, in this process. For the helpers a job starts ahead of the work they
+    will do (:mod:`camtool.toolpath.offset`'s child, :mod:`camtool.preview.ahead`).
+    """
+    pid = os.fork()
+    if pid == 0:
+        code = 0
+        try:
+            for fd in closing:
+                os.close(fd)
+            run()
+        except BaseException:
+            code = 70
+        finally:
+            os._exit(code)
+    return pid
+
+
+def how_ended(status: int) -> str:
+    """How a process ended, from its ``waitpid`` status: ``"SIGSEGV, signal 11"``, an exit code."""
+    if os.WIFSIGNALED(status):
+        number = os.WTERMSIG(status)
+        try:
+            name = signal.Signals(number).name
+        except ValueError:
+            name = "a signal"
+        return f"{name}, signal {number}"
+    return f"exit code {os.waitstatus_to_exitcode(status)}"
+
+
+def read_exactly(fd: int, size: int) -> bytes | None:
+    """``size`` bytes from ``fd``; ``None`` when it ends first (its writer left or died)."""
+    parts = []
+    while size:
+        part = os.read(fd, min(size, 1 << 20))
+        if not part:
+            return None
+        parts.append(part)
+        size -= len(part)
+    return b"".join(parts)
+
+
+def write_record(fd: int, data: bytes) -> None:
+    """Write ``data`` to ``fd`` framed by its length (8 bytes, little-endian), whole.
+
+    Raises:
+        OSError: the reader has gone (``BrokenPipeError``).
+    """
+    view = memoryview(len(data).to_bytes(8, "little") + data)
+    while view:
+        view = view[os.write(fd, view) :]
+
+
+def read_record(fd: int) -> bytes | None:
+    """The next record :func:`write_record` wrote to ``fd``; ``None`` when it ends first."""
+    head = read_exactly(fd, 8)
+    if head is None:
+        return None
+    return read_exactly(fd, int.from_bytes(head, "little"))

@@ -31,7 +31,17 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeAlias
 
 from camtool.geometry.chain import chain
-from camtool.model.cores import FORK, default_jobs, in_worker, wait_readable
+from camtool.model.cores import (
+    FORK,
+    default_jobs,
+    fork_process,
+    how_ended,
+    in_worker,
+    read_exactly,
+    read_record,
+    wait_readable,
+    write_record,
+)
 from camtool.model.errors import ToolpathError
 from camtool.model.shapes import Arc, Contour, Line, Point, Segment, distance
 
@@ -346,7 +356,7 @@ class _Child:
             with os.fdopen(jobs_read, "rb") as inbox, os.fdopen(answers_write, "wb") as out:
                 _serve(inbox, out)
 
-        pid = _fork(child, closing=(jobs_write, answers_read))
+        pid = fork_process(child, closing=(jobs_write, answers_read))
         os.close(jobs_read)
         os.close(answers_write)
         self.pid: int | None = pid
@@ -406,40 +416,7 @@ class _Child:
             self.jobs.close()  # a child still waiting for jobs leaves
         _, status = os.waitpid(self.pid, 0)
         self.pid = None
-        return _how_ended(status)
-
-
-def _fork(run: Callable[[], None], *, closing: Sequence[int]) -> int:
-    """Fork a process that closes ``closing`` (fds it must not hold), runs ``run`` and leaves.
-
-    It leaves with ``os._exit``: 0 after ``run``, 70 when ``run`` raised (whoever reads
-    its answers sees which it did not give), never through this process's own code.
-    Returns its pid, in this process.
-    """
-    pid = os.fork()
-    if pid == 0:
-        code = 0
-        try:
-            for fd in closing:
-                os.close(fd)
-            run()
-        except BaseException:
-            code = 70
-        finally:
-            os._exit(code)
-    return pid
-
-
-def _how_ended(status: int) -> str:
-    """How a process ended, from its ``waitpid`` status: ``"SIGSEGV, signal 11"``, an exit code."""
-    if os.WIFSIGNALED(status):
-        number = os.WTERMSIG(status)
-        try:
-            name = signal.Signals(number).name
-        except ValueError:
-            name = "a signal"
-        return f"{name}, signal {number}"
-    return f"exit code {os.waitstatus_to_exitcode(status)}"
+        return how_ended(status)
 
 
 def _serve(inbox: Any, out: Any) -> None:
@@ -511,7 +488,7 @@ class _Worker:
         """Fork it; ``closing``: the fds it must not hold (the child's own, other workers')."""
         given_read, given_write = os.pipe()
         answers_read, answers_write = os.pipe()
-        pid = _fork(
+        pid = fork_process(
             lambda: _work(jobs, tolerance, given_read, answers_write),
             closing=(*closing, given_write, answers_read),
         )
@@ -530,13 +507,13 @@ class _Worker:
 
     def answer(self) -> bytes | None:
         """The pickled answer to its job (waits for it); ``None`` when it died first."""
-        head = _read_exactly(self.answers, 8)
-        if head is None:
-            return None
-        return _read_exactly(self.answers, int.from_bytes(head, "little"))
+        return read_record(self.answers)
 
     def close(self, *, kill: bool = False) -> str:
-        """End it (``kill``: at once) and wait for it; how it ended (:func:`_how_ended`)."""
+        """End it (``kill``: at once) and wait for it; how it ended.
+
+        As :func:`camtool.model.cores.how_ended` says it.
+        """
         for fd in (self.given, self.answers):
             with contextlib.suppress(OSError):
                 os.close(fd)
@@ -547,32 +524,17 @@ class _Worker:
                 os.kill(self.pid, signal.SIGKILL)
         _, status = os.waitpid(self.pid, 0)
         self.pid = None
-        return _how_ended(status)
+        return how_ended(status)
 
 
 def _work(
     jobs: Sequence[tuple[Contour, float]], tolerance: float | None, given: int, answers: int
 ) -> None:
     """In a worker: make each job whose index comes on ``given``, answer it on ``answers``."""
-    while (head := _read_exactly(given, 8)) is not None:
+    while (head := read_exactly(given, 8)) is not None:
         got = _answer(*jobs[int.from_bytes(head, "little")], tolerance)
         record = ("error", str(got)) if isinstance(got, ToolpathError) else ("ok", got)
-        data = pickle.dumps(record, protocol=pickle.HIGHEST_PROTOCOL)
-        view = memoryview(len(data).to_bytes(8, "little") + data)
-        while view:
-            view = view[os.write(answers, view) :]
-
-
-def _read_exactly(fd: int, size: int) -> bytes | None:
-    """``size`` bytes from ``fd``; ``None`` when it ends first (its writer left or died)."""
-    parts = []
-    while size:
-        part = os.read(fd, min(size, 1 << 20))
-        if not part:
-            return None
-        parts.append(part)
-        size -= len(part)
-    return b"".join(parts)
+        write_record(answers, pickle.dumps(record, protocol=pickle.HIGHEST_PROTOCOL))
 
 
 def _quiet_crash() -> None:
