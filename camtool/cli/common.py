@@ -9,7 +9,8 @@ from __future__ import annotations
 import math
 import os
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -120,6 +121,33 @@ def _silence_stdout() -> None:
     null = os.open(os.devnull, os.O_WRONLY)
     os.dup2(null, fd)
     os.close(null)
+
+
+@contextmanager
+def picture_ahead(preview: str | None) -> Iterator[None]:
+    """Within it, a PNG preview is drawn by a child started now (:mod:`camtool.preview.ahead`).
+
+    For a command that ends by drawing ``preview`` (a file name; ``-`` is an SVG on
+    stdout): the child loads matplotlib when told
+    (:func:`~camtool.preview.ahead.load_ahead`, where this process leaves a core idle) and
+    draws the scene :func:`~camtool.preview.render_preview` sends it, ~0.3 s of imports
+    off the end of issue 17's benchmark part. An SVG, or no preview, starts nothing;
+    leaving ends the child if it was not used. Only the time depends on it: the PNG is
+    the same bytes. A command enters it with ``click.get_current_context().with_resource``,
+    so it is left however the command ends.
+    """
+    from camtool.preview import preview_format
+
+    if preview is None or preview == "-" or preview_format(preview) != ".png":
+        yield
+        return
+    from camtool.preview.ahead import start_ahead, stop_ahead
+
+    start_ahead()
+    try:
+        yield
+    finally:
+        stop_ahead()
 
 
 MACHINE = click.option(

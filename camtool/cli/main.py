@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import json
 import sys
-from contextlib import AbstractContextManager, nullcontext
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -24,6 +23,7 @@ from camtool.cli.common import (
     import_settings,
     number_range,
     output_settings,
+    picture_ahead,
     plan_settings,
     post_options,
     warn,
@@ -143,6 +143,7 @@ def post(
         verify_job,
     )
     from camtool.model.progress import Step
+    from camtool.preview.ahead import load_ahead
     from camtool.toolpath.options import drawing_only
 
     check_paths(
@@ -160,6 +161,7 @@ def post(
         refuse_planning(drawing, drawing_only(options))  # before checking them
     plan = plan_settings(options)
     verifying = bool(verify_too or report or preview or max_error_um is not None)
+    click.get_current_context().with_resource(picture_ahead(preview))
     progress = StageReporter()
     try:
         if drawing == "-":
@@ -193,8 +195,8 @@ def post(
         )
     if verifying:
         progress(Step("verifying", 0, job.result.blocks, chosen.name))
-        with _loading_the_picture(preview):
-            verified = verify_job(job, budget=not no_budget, budget_now=progress)
+        load_ahead()  # matplotlib, on the core the verification's start leaves idle
+        verified = verify_job(job, budget=not no_budget, budget_now=progress)
         _measure_budget(verified, progress)
         _finish_verification(
             verified,
@@ -253,6 +255,7 @@ def verify(
     from camtool.jobs.inputs import read_code, read_input
     from camtool.jobs.output import check_paths
     from camtool.jobs.pipeline import load_target_checked
+    from camtool.preview.ahead import load_ahead
     from camtool.verify.verifier import verify_code
 
     check_paths(
@@ -266,16 +269,17 @@ def verify(
     text = read_code(code, binary=chosen.post.binary)
     drawing = read_input(against) if against is not None else None
     progress = StageReporter()
-    with _loading_the_picture(preview):
-        v = verify_code(
-            text,
-            chosen,
-            source=code,
-            against=drawing,
-            tool_diameter=tool_diameter,
-            budget=not no_budget,
-            budget_now=progress,
-        )
+    click.get_current_context().with_resource(picture_ahead(preview))
+    load_ahead()  # matplotlib, on the core the verification's start leaves idle
+    v = verify_code(
+        text,
+        chosen,
+        source=code,
+        against=drawing,
+        tool_diameter=tool_diameter,
+        budget=not no_budget,
+        budget_now=progress,
+    )
     _measure_budget(v, progress)
     _finish_verification(
         v,
@@ -298,24 +302,6 @@ def _check_preview(preview: str | None) -> None:
         from camtool.preview import preview_format
 
         preview_format(preview)
-
-
-def _loading_the_picture(preview: str | None) -> AbstractContextManager[None]:
-    """Within it, a wait for the error budget's workers loads matplotlib for a PNG preview.
-
-    The verification's own measures end before the budget's workers on issue 17's
-    benchmark part; this process then waits for them, and the picture's ~0.3 s of
-    imports fit in that wait (:func:`camtool.model.cores.meanwhile`). Only the time
-    depends on it.
-    """
-    from camtool.model.cores import meanwhile
-    from camtool.preview import preview_format
-
-    if preview is None or preview_format(preview) != ".png":
-        return nullcontext()
-    from camtool.preview.raster import preload
-
-    return meanwhile([preload])
 
 
 def _measure_budget(v: Verification, progress: StageReporter) -> None:

@@ -13,7 +13,8 @@ a 20 µm error is invisible at full scale.
 The picture is laid out once (:mod:`camtool.preview.layout`) and written
 either as direct SVG (:mod:`camtool.preview.svg`: exact arcs, 1 unit = 1 mm,
 same input → same bytes) or as PNG through matplotlib's Agg backend
-(:mod:`camtool.preview.raster`, no display needed). In the SVG every layer is a
+(:mod:`camtool.preview.raster`, no display needed; a command may have a child started
+ahead draw it, :mod:`camtool.preview.ahead`, the same bytes). In the SVG every layer is a
 group with a stable id: ``drawing``, ``work-area``, ``tool-width``, ``trace``,
 ``rapids``, ``cuts``, ``starts``, ``order``, ``worst`` in the ``main`` panel;
 ``title``, ``scale-bar``, ``legend``, ``colour-scale``, ``inset-labels`` on
@@ -128,6 +129,11 @@ def render_preview(
         from camtool.preview.svg import scene_svg
 
         return scene_svg(scene).encode("utf-8")
+    from camtool.preview.ahead import draw_ahead
+
+    drawn = draw_ahead(scene)  # by the child a command started ahead, if there is one
+    if drawn is not None:
+        return drawn
     from camtool.preview.raster import scene_png
 
     return scene_png(scene)

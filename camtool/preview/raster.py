@@ -31,7 +31,7 @@ _ANCHOR = {"start": "left", "middle": "center", "end": "right"}
 
 
 def preload() -> None:
-    """Import what :func:`scene_png` needs (~0.3 s), for a job with time to spare before it."""
+    """Import what :func:`scene_png` needs (~0.3 s): :mod:`camtool.preview.ahead`'s child, when told."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: F401
     from matplotlib.figure import Figure  # noqa: F401
 

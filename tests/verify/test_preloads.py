@@ -62,17 +62,6 @@ def test_a_job_posted_while_preloading_is_the_same_job() -> None:
     assert cores._MEANWHILE == []  # the tasks no wait ran are gone with the job
 
 
-@pytest.mark.parametrize(
-    ("preview", "tasks"), [(None, 0), ("out.svg", 0), ("out.png", 1), ("OUT.PNG", 1)]
-)
-def test_only_a_png_preview_loads_matplotlib_while_waiting(preview: str | None, tasks: int) -> None:
-    from camtool.cli.main import _loading_the_picture
-
-    with _loading_the_picture(preview):
-        assert len(cores._MEANWHILE) == tasks
-    assert cores._MEANWHILE == []
-
-
 def test_point_distances_in_chunks_are_the_whole_answer_bit_for_bit(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:

@@ -1,0 +1,155 @@
+"""A child that will draw this job's PNG, started ahead so matplotlib loads on an idle core.
+
+``post --preview part.png`` and ``verify --preview part.png`` end by drawing the picture
+with matplotlib (:func:`camtool.preview.raster.scene_png`). Importing matplotlib takes
+~0.3 s of one core, and on issue 17's benchmark part it came last, after the verification,
+while the other core had nothing left to do. So the command forks a child at its start
+(:func:`start_ahead`, while the process is still small: a fork, not a second Python), tells
+it when to load matplotlib (:func:`load_ahead`: when the verification starts, while this
+process simulates the program on one core and the other is free), and at the end sends it
+the composed scene (:func:`draw_ahead`): it draws the PNG and sends the bytes back.
+
+The picture is the same bytes either way: the child runs this process's own code on the
+scene, pickled exactly. Where the child cannot be started (no ``fork``, a worker process),
+sends nothing back (it died, or a pipe broke) or was never started, the caller draws the
+picture itself (:func:`draw_ahead` returns ``None``). The child ignores Ctrl-C, which is
+this process's to handle; :func:`stop_ahead` (the command's ``finally``) ends it. Processes
+forked later (the offsets' child, the error budget's workers) do not keep its pipes open
+(:func:`os.register_at_fork`), so it sees this process's end as the end of its pipe.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import pickle
+import signal
+from typing import TYPE_CHECKING
+
+from camtool.model.cores import FORK, fork_process, in_worker, read_record, write_record
+
+if TYPE_CHECKING:
+    from camtool.preview.scene import Scene
+
+__all__ = ["draw_ahead", "load_ahead", "start_ahead", "stop_ahead"]
+
+_LOAD = b"L"
+"""The byte that tells the child to load matplotlib (then a scene may follow)."""
+
+
+class _Drawer:
+    """The forked child (:func:`_serve`) and this process's ends of its two pipes."""
+
+    def __init__(self) -> None:
+        inbox_read, inbox_write = os.pipe()
+        out_read, out_write = os.pipe()
+        self.pid: int | None = fork_process(
+            lambda: _serve(inbox_read, out_write), closing=(inbox_write, out_read)
+        )
+        os.close(inbox_read)
+        os.close(out_write)
+        self.inbox: int | None = inbox_write
+        self.out: int | None = out_read
+        self.loading = False
+
+    def fds(self) -> tuple[int, ...]:
+        """This process's ends of the pipes, while open."""
+        return tuple(fd for fd in (self.inbox, self.out) if fd is not None)
+
+    def load(self) -> None:
+        """Have it load matplotlib now (once; a dead child is found by :meth:`draw`)."""
+        if not self.loading and self.inbox is not None:
+            self.loading = True
+            with contextlib.suppress(OSError):
+                os.write(self.inbox, _LOAD)
+
+    def draw(self, scene: Scene) -> bytes | None:
+        """The PNG bytes it draws for ``scene``; ``None`` when it could not send them."""
+        self.load()
+        assert self.inbox is not None and self.out is not None
+        try:
+            write_record(self.inbox, pickle.dumps(scene, protocol=pickle.HIGHEST_PROTOCOL))
+            return read_record(self.out)
+        except OSError:  # it died before it read the scene
+            return None
+        finally:
+            self.close()
+
+    def close(self) -> None:
+        """Close the pipes, end it (if it has not) and wait for it (idempotent)."""
+        for fd in self.fds():
+            with contextlib.suppress(OSError):
+                os.close(fd)
+        self.inbox = self.out = None
+        if self.pid is not None:
+            with contextlib.suppress(OSError):
+                os.kill(self.pid, signal.SIGKILL)
+            with contextlib.suppress(ChildProcessError):
+                os.waitpid(self.pid, 0)
+            self.pid = None
+
+
+def _serve(inbox: int, out: int) -> None:
+    """In the child: wait for the word to load matplotlib, load it, draw the scene sent.
+
+    It leaves, without drawing, when ``inbox`` ends first (the job ended or failed).
+    """
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C and ends it
+    if os.read(inbox, 1) != _LOAD:
+        return
+    from camtool.preview.raster import preload, scene_png
+
+    preload()
+    data = read_record(inbox)
+    if data is not None:
+        write_record(out, scene_png(pickle.loads(data)))
+
+
+_AHEAD: list[_Drawer] = []
+"""The child :func:`start_ahead` started, until :func:`draw_ahead` uses it (at most one)."""
+
+
+def start_ahead() -> None:
+    """Start the child that will draw this process's next PNG (Linux; once at a time).
+
+    Nothing is started without ``fork`` or in a worker process (a batch's or Dask's, whose
+    cores are busy with other files): the picture is then drawn here, as before.
+    """
+    if FORK and not _AHEAD and not in_worker():
+        _AHEAD.append(_Drawer())
+
+
+def load_ahead() -> None:
+    """Tell the child to load matplotlib now: call it where this process leaves a core idle."""
+    for drawer in _AHEAD:
+        drawer.load()
+
+
+def draw_ahead(scene: Scene) -> bytes | None:
+    """The PNG bytes of ``scene`` drawn by the child, which then leaves.
+
+    ``None`` when there is no child, or it sent nothing back: the caller draws it itself
+    (:func:`camtool.preview.raster.scene_png`), the same bytes.
+    """
+    if not _AHEAD:
+        return None
+    return _AHEAD.pop().draw(scene)
+
+
+def stop_ahead() -> None:
+    """End the child if it was not used (idempotent; a command's ``finally``)."""
+    while _AHEAD:
+        _AHEAD.pop().close()
+
+
+def _close_in_forked_child() -> None:
+    """In a process forked after the child: close this process's ends of its pipes."""
+    for drawer in _AHEAD:
+        for fd in drawer.fds():
+            with contextlib.suppress(OSError):
+                os.close(fd)
+    _AHEAD.clear()
+
+
+if FORK:
+    os.register_at_fork(after_in_child=_close_in_forked_child)
