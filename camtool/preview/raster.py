@@ -31,7 +31,7 @@ _ANCHOR = {"start": "left", "middle": "center", "end": "right"}
 
 
 def preload() -> None:
-    """Import what :func:`scene_png` needs (~0.3 s): :mod:`camtool.preview.ahead`'s child, when told."""
+    """Import what :func:`scene_png` needs (~0.3 s), in :mod:`camtool.preview.ahead`'s child."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: F401
     from matplotlib.figure import Figure  # noqa: F401
 

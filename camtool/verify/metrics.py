@@ -2331,13 +2331,14 @@ def prepare_comparison(drawing: Drawing) -> None:
 
     The drawing's points are sampled now (and kept, as every comparison keeps its last
     drawing's) and, for a drawing of at least :data:`PREPARE_KERNELS_FROM` points, the
-    compiled nearest search is loaded (:func:`near_kernels`), so that workers forked next
+    compiled nearest search is loaded (:func:`near_kernels`) with the machine code of the
+    kernels a comparison calls (:func:`_load_kernels`), so that workers forked next
     inherit both instead of each making them again (its loading alone is ~0.5 s). Only the
     time depends on it: the figures are the same.
     """
     samples, _ = _sample_drawing(drawing, AGAINST_SPACING_MM)
     if len(samples) >= PREPARE_KERNELS_FROM:
-        near_kernels()
+        _load_kernels()
 
 
 def comparison_preloads(drawing: Drawing) -> list[Callable[[], object]]:
@@ -2347,14 +2348,15 @@ def comparison_preloads(drawing: Drawing) -> list[Callable[[], object]]:
     process (:func:`camtool.model.cores.meanwhile`: ``post --preview`` waits ~0.4 s for
     the offsets' child to load OpenCASCADE): the compiled nearest search
     (:func:`near_kernels`, numba's import ~0.15 s), then numba's first call, which loads
-    its compiler's registries (~0.2 s), two tasks so that a short wait ends sooner;
+    its compiler's registries (~0.2 s), then the machine code of the kernels a comparison
+    calls (:func:`_load_kernels`, ~0.08 s), three tasks so that a short wait ends sooner;
     only when ``drawing`` has at least :data:`PREPARE_KERNELS_FROM` points at
     :data:`AGAINST_SPACING_MM` (counted, not sampled). Only the time depends on it. The
     drawing compared may be scaled from this one (``--fit``), so the count is an
     estimate; a wrong one costs time and memory, not figures.
     """
     count = sum(_contour_samples(c.segments, AGAINST_SPACING_MM) for c in drawing.contours)
-    return [near_kernels, _first_call] if count >= PREPARE_KERNELS_FROM else []
+    return [near_kernels, _first_call, _load_kernels] if count >= PREPARE_KERNELS_FROM else []
 
 
 def _first_call() -> None:
@@ -2362,6 +2364,13 @@ def _first_call() -> None:
     kernels = near_kernels()
     if kernels is not None:
         kernels.build(np.zeros((1, 2)))
+
+
+def _load_kernels() -> None:
+    """:func:`near_kernels` with the kernels a comparison calls loaded (``load_cached``)."""
+    kernels = near_kernels()
+    if kernels is not None:
+        kernels.load_cached()
 
 
 def against_drawing(

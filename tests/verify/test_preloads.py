@@ -7,6 +7,10 @@ they run (``post_path(verifying=True)``) must be the job posted without them.
 
 from __future__ import annotations
 
+import json
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -27,7 +31,7 @@ def test_the_preloads_follow_the_drawing_s_sample_count(name: str) -> None:
     samples, _ = metrics._sample_drawing_now(drawing, metrics.AGAINST_SPACING_MM)
     tasks = metrics.comparison_preloads(drawing)
     if len(samples) >= metrics.PREPARE_KERNELS_FROM:  # prepare_comparison loads the kernels
-        assert tasks == [metrics.near_kernels, metrics._first_call]
+        assert tasks == [metrics.near_kernels, metrics._first_call, metrics._load_kernels]
     else:  # the logo (6 911 samples) keeps the k-d tree: nothing to load ahead
         assert tasks == []
 
@@ -107,3 +111,55 @@ def test_the_budget_s_distance_is_the_comparison_s_bit_for_bit(offset: str, tool
     worst = metrics.against_worst(*args, nominal=nominal, findings=v.findings)
     assert worst == full.max_um
     assert bool(full.not_cut) == (offset == "outside")
+
+
+LOADED = r"""
+import json, os, sys
+from pathlib import Path
+os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})  # one core: the budget runs here
+from numba.core.registry import CPUDispatcher
+from camtool.jobs.pipeline import post_path, verify_job
+from camtool.post.registry import load_target
+from camtool.toolpath.options import PlanOptions
+from camtool.verify import metrics
+
+kernels = metrics.near_kernels()
+
+def loaded():
+    return sorted(
+        f"{name} {sig}" for name, kernel in vars(kernels).items()
+        if isinstance(kernel, CPUDispatcher) for sig in kernel.signatures
+    )
+
+before = loaded()
+if sys.argv[1] == "warm":
+    kernels.load_cached()
+warm = loaded()
+plan = PlanOptions(offset="outside", tool_diameter=3.0, depth=3.0, step_down=1.0)
+job = post_path(Path(sys.argv[2]), load_target("grbl"), plan)
+v = verify_job(job)
+v.error_budget  # its sources re-simulated and measured in this process
+print(json.dumps({"before": before, "warm": warm, "used": loaded()}))
+"""
+
+
+@pytest.mark.skipif(not hasattr(os, "sched_setaffinity"), reason="Linux")
+def test_the_kernels_loaded_ahead_are_those_a_verification_calls() -> None:
+    """``load_cached`` loads exactly the kernels and types that verifying a part against its
+    drawing calls, its error budget included: none for nothing, and none left for a forked
+    worker to load again. Judged by numba's own record of each kernel's signatures."""
+    pytest.importorskip("numba")
+    plate = str(SAMPLES / "plate.dxf")
+    runs = {}
+    for mode in ("cold", "warm"):
+        out = subprocess.run(
+            [sys.executable, "-c", LOADED, mode, plate],
+            capture_output=True,
+            text=True,
+            check=True,
+        )
+        runs[mode] = json.loads(out.stdout.splitlines()[-1])
+    cold, warm = runs["cold"], runs["warm"]
+    assert cold["before"] == cold["warm"] == []  # a fresh process: nothing loaded yet
+    assert set(warm["warm"]) == set(cold["used"])  # ahead: what the verification calls
+    assert warm["used"] == warm["warm"]  # and the verification loads nothing more
