@@ -39,6 +39,7 @@ __all__ = [
     "how_ended",
     "in_worker",
     "meanwhile",
+    "quiet_crashes",
     "read_exactly",
     "read_record",
     "wait_readable",
@@ -302,6 +303,20 @@ def fork_process(run: Callable[[], None], *, closing: Sequence[int]) -> int:
         finally:
             os._exit(code)
     return pid
+
+
+def quiet_crashes() -> None:
+    """In a helper process: a crash leaves no core file and no Python fault report.
+
+    The process that started it says what happened (a helper that dies is answered for,
+    or its work is done again, by the job's own process).
+    """
+    import faulthandler
+    import resource
+
+    faulthandler.disable()
+    with suppress(ValueError, OSError):
+        resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
 
 
 def how_ended(status: int) -> str:

@@ -26,7 +26,14 @@ import pickle
 import signal
 from typing import TYPE_CHECKING
 
-from camtool.model.cores import FORK, fork_process, in_worker, read_record, write_record
+from camtool.model.cores import (
+    FORK,
+    fork_process,
+    in_worker,
+    quiet_crashes,
+    read_record,
+    write_record,
+)
 
 if TYPE_CHECKING:
     from camtool.preview.scene import Scene
@@ -70,7 +77,7 @@ class _Drawer:
         try:
             write_record(self.inbox, pickle.dumps(scene, protocol=pickle.HIGHEST_PROTOCOL))
             return read_record(self.out)
-        except OSError:  # it died before it read the scene
+        except Exception:  # it died before it read the scene, or the scene did not pickle
             return None
         finally:
             self.close()
@@ -95,6 +102,7 @@ def _serve(inbox: int, out: int) -> None:
     It leaves, without drawing, when ``inbox`` ends first (the job ended or failed).
     """
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C and ends it
+    quiet_crashes()
     if os.read(inbox, 1) != _LOAD:
         return
     from camtool.preview.raster import preload, scene_png

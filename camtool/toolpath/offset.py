@@ -37,6 +37,7 @@ from camtool.model.cores import (
     fork_process,
     how_ended,
     in_worker,
+    quiet_crashes,
     read_exactly,
     read_record,
     wait_readable,
@@ -351,7 +352,7 @@ class _Child:
         answers_read, answers_write = os.pipe()
 
         def child() -> None:
-            _quiet_crash()
+            quiet_crashes()
             _load_occt()
             with os.fdopen(jobs_read, "rb") as inbox, os.fdopen(answers_write, "wb") as out:
                 _serve(inbox, out)
@@ -535,16 +536,6 @@ def _work(
         got = _answer(*jobs[int.from_bytes(head, "little")], tolerance)
         record = ("error", str(got)) if isinstance(got, ToolpathError) else ("ok", got)
         write_record(answers, pickle.dumps(record, protocol=pickle.HIGHEST_PROTOCOL))
-
-
-def _quiet_crash() -> None:
-    """In the child: a crash leaves no core file and no Python fault report (the parent says it)."""
-    import faulthandler
-    import resource
-
-    faulthandler.disable()
-    with contextlib.suppress(ValueError, OSError):
-        resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
 
 
 def offset_checked(

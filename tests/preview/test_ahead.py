@@ -11,6 +11,7 @@ import os
 import signal
 import sys
 from pathlib import Path
+from typing import cast
 
 import pytest
 
@@ -102,6 +103,16 @@ def test_a_child_killed_while_loading_sends_nothing() -> None:
     os.kill(drawer.pid, signal.SIGKILL)
     assert ahead.draw_ahead(_scene()) is None  # the end of its pipe, not a hang
     assert ahead._AHEAD == []
+
+
+def test_a_scene_that_does_not_pickle_is_drawn_here() -> None:
+    """Not a camtool scene (they pickle): whatever goes wrong on the way, nothing raises."""
+    ahead.start_ahead()
+    (drawer,) = ahead._AHEAD
+    pid = drawer.pid
+    assert pid is not None
+    assert ahead.draw_ahead(cast(Scene, lambda: None)) is None
+    assert ahead._AHEAD == [] and _gone(pid)
 
 
 def test_a_child_never_told_to_load_leaves_on_its_own_when_its_pipe_ends() -> None:
