@@ -124,28 +124,27 @@ def _silence_stdout() -> None:
 
 
 @contextmanager
-def picture_ahead(preview: str | None) -> Iterator[None]:
+def picture_ahead(preview: str | None) -> Iterator[Callable[[], None]]:
     """Within it, a PNG preview is drawn by a child started now (:mod:`camtool.preview.ahead`).
 
     For a command that ends by drawing ``preview`` (a file name; ``-`` is an SVG on
-    stdout): the child loads matplotlib when told
-    (:func:`~camtool.preview.ahead.load_ahead`, where this process leaves a core idle) and
-    draws the scene :func:`~camtool.preview.render_preview` sends it, ~0.3 s of imports
-    off the end of issue 17's benchmark part. An SVG, or no preview, starts nothing;
-    leaving ends the child if it was not used. Only the time depends on it: the PNG is
-    the same bytes. A command enters it with ``click.get_current_context().with_resource``,
-    so it is left however the command ends.
+    stdout). It gives the call that tells the child to import matplotlib
+    (:func:`~camtool.preview.ahead.load_ahead`): the command makes it where it leaves a
+    core idle. The child then draws the scene :func:`~camtool.preview.render_preview`
+    sends it: ~0.3 s of imports off the end of issue 17's benchmark part. An SVG, or no
+    preview, starts nothing and imports nothing (a re-post loads no numpy); leaving ends
+    the child if it was not used. Only the time depends on it: the PNG is the same bytes.
+    A command enters it with ``click.get_current_context().with_resource``, so it is left
+    however the command ends.
     """
-    from camtool.preview import preview_format
-
-    if preview is None or preview == "-" or preview_format(preview) != ".png":
-        yield
+    if preview is None or preview == "-" or not preview.lower().endswith(".png"):
+        yield lambda: None
         return
-    from camtool.preview.ahead import start_ahead, stop_ahead
+    from camtool.preview.ahead import load_ahead, start_ahead, stop_ahead
 
     start_ahead()
     try:
-        yield
+        yield load_ahead
     finally:
         stop_ahead()
 

@@ -143,7 +143,6 @@ def post(
         verify_job,
     )
     from camtool.model.progress import Step
-    from camtool.preview.ahead import load_ahead
     from camtool.toolpath.options import drawing_only
 
     check_paths(
@@ -161,7 +160,7 @@ def post(
         refuse_planning(drawing, drawing_only(options))  # before checking them
     plan = plan_settings(options)
     verifying = bool(verify_too or report or preview or max_error_um is not None)
-    click.get_current_context().with_resource(picture_ahead(preview))
+    load_picture = click.get_current_context().with_resource(picture_ahead(preview))
     progress = StageReporter()
     try:
         if drawing == "-":
@@ -195,7 +194,7 @@ def post(
         )
     if verifying:
         progress(Step("verifying", 0, job.result.blocks, chosen.name))
-        load_ahead()  # matplotlib, on the core the verification's start leaves idle
+        load_picture()  # matplotlib, on the core the verification's start leaves idle
         verified = verify_job(job, budget=not no_budget, budget_now=progress)
         _measure_budget(verified, progress)
         _finish_verification(
@@ -255,7 +254,6 @@ def verify(
     from camtool.jobs.inputs import read_code, read_input
     from camtool.jobs.output import check_paths
     from camtool.jobs.pipeline import load_target_checked
-    from camtool.preview.ahead import load_ahead
     from camtool.verify.verifier import verify_code
 
     check_paths(
@@ -269,8 +267,8 @@ def verify(
     text = read_code(code, binary=chosen.post.binary)
     drawing = read_input(against) if against is not None else None
     progress = StageReporter()
-    click.get_current_context().with_resource(picture_ahead(preview))
-    load_ahead()  # matplotlib, on the core the verification's start leaves idle
+    load_picture = click.get_current_context().with_resource(picture_ahead(preview))
+    load_picture()  # matplotlib, on the core the verification's start leaves idle
     v = verify_code(
         text,
         chosen,

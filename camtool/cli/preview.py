@@ -84,7 +84,6 @@ def preview(
     from camtool.jobs.inputs import default_preview_path, preview_inputs
     from camtool.jobs.output import check_paths
     from camtool.preview import preview_format, render_preview
-    from camtool.preview.ahead import load_ahead
 
     out = output or default_preview_path(input_name)
     preview_format(".svg" if out == "-" else out)
@@ -94,8 +93,8 @@ def preview(
         target=target,
         machine_file=machine_file,
     )
-    click.get_current_context().with_resource(picture_ahead(out))
-    load_ahead()  # matplotlib loads while this process reads the inputs
+    load_picture = click.get_current_context().with_resource(picture_ahead(out))
+    load_picture()  # matplotlib loads while this process reads the inputs
     chosen = _target(target, machine_file)
     drawing, program = preview_inputs(input_name, program_name, chosen, import_settings(options))
     verification = (

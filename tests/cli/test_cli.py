@@ -178,6 +178,24 @@ def test_version_does_not_load_opencascade() -> None:
     assert proc.stdout.strip().endswith("False False")
 
 
+def test_a_re_post_without_a_picture_loads_no_numpy(tmp_path: Path) -> None:
+    """A re-post of straight moves needs neither numpy nor the preview (issue 17's start-up):
+    the picture's child and its imports come only with a PNG ``--preview``."""
+    program = tmp_path / "lines.ngc"
+    program.write_text("G21 G90\nG0 X0 Y0\nG1 X10 Y0 F100\nG1 X10 Y10\nM2\n")
+    code = (
+        "import sys; from camtool.cli.main import cli\n"
+        "try:\n"
+        f"    cli.main(['post', {str(program)!r}, '-t', 'linuxcnc', '-o', "
+        f"{str(tmp_path / 'out.ngc')!r}], standalone_mode=False)\n"
+        "finally:\n"
+        "    print('numpy' in sys.modules, 'camtool.preview' in sys.modules)"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert proc.stdout.strip() == "False False"
+    assert "G1 X10.000 Y10.000" in (tmp_path / "out.ngc").read_text()
+
+
 BIG_MACHINE = """
 [machine]
 name = "MMH on a big table"

@@ -167,8 +167,10 @@ def test_processes_forked_later_do_not_hold_its_pipes() -> None:
     [(None, False), ("out.svg", False), ("-", False), ("out.png", True), ("OUT.PNG", True)],
 )
 def test_only_a_png_preview_starts_a_child(preview: str | None, started: bool) -> None:
-    with picture_ahead(preview):
+    with picture_ahead(preview) as load:
         assert (len(ahead._AHEAD) == 1) == started
+        assert (load is ahead.load_ahead) == started  # else a call that does nothing
+        load()
         pid = ahead._AHEAD[0].pid if started else None
     assert ahead._AHEAD == []
     if pid is not None:
