@@ -82,6 +82,12 @@ as ``bench_repost.py`` and ``bench_verify.py`` already ran: an installed camtool
 from bytecode, and this machine's ``PYTHONDONTWRITEBYTECODE`` had every run compile
 each camtool module from source (ninth pass: the part took 4.67 s in one such run, 4.0–4.1 s
 from cached bytecode).
+
+Thirteenth pass (23 Nov 2026, ``make bench`` at 15:33, quiet): part 2.67 s, 290 MiB; plate
+2.63 s, 248 MiB (twelfth pass 3.01 s and 2.83 s). The PNG is drawn by a child forked as
+the command starts, which imports matplotlib on the core the verification's start leaves
+idle (``camtool.preview.ahead``), and the budget's workers inherit the comparison's
+compiled kernels; the G-code and the PNG are the same bytes. 290 MiB is ~304 × 10⁶ bytes.
 """
 
 from __future__ import annotations
