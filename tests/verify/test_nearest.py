@@ -34,3 +34,49 @@ def test_points_and_no_segments() -> None:
     p = np.array([[0.0, 0.0], [3.0, 4.0]])
     assert nearest_distances(p, p[:1], p[:1]) == pytest.approx([0.0, 5.0])
     assert np.isinf(nearest_distances(p, np.zeros((0, 2)), np.zeros((0, 2)))).all()
+
+
+@pytest.mark.parametrize("runs", [None, "three", "all-apart"])
+def test_the_chords_and_their_ends_are_numpy_s_own_selection_and_concatenation(
+    runs: str | None,
+) -> None:
+    """The machined edge's segments (``_chords``) are the boolean selection of consecutive
+    rows of a run, and the ends the searches hold are ``np.concatenate([a, b])``: made in
+    one array, handed over without a second copy (the comparison's memory peak)."""
+    from camtool.verify.metrics import ThinTrace, _chords, _end_points
+
+    rng = np.random.default_rng(3)
+    points = rng.uniform(-5.0, 5.0, (101, 2))
+    run_ids = {
+        None: None,
+        "three": np.repeat([0, 1, 2], [40, 30, 31]),
+        "all-apart": np.arange(101),
+    }[runs]
+    thin = ThinTrace(points, run_ids, 101)
+    a, b = _chords(thin)
+    joined = np.ones(100, dtype=bool) if run_ids is None else run_ids[1:] == run_ids[:-1]
+    if not joined.any():  # single points: each point to the next
+        joined[:] = True
+    assert a.dtype == b.dtype == np.float64
+    assert np.array_equal(a, points[:-1][joined]) and np.array_equal(b, points[1:][joined])
+    ends = _end_points(a, b)
+    assert np.array_equal(ends, np.concatenate([a, b]))
+    assert ends is a.base is b.base  # no copy of the ends
+
+
+def test_the_ends_are_shared_only_when_a_and_b_are_the_halves_of_one_array() -> None:
+    from camtool.verify.metrics import _end_points
+
+    trace = np.arange(24.0).reshape(12, 2).copy()  # an array of its own, not a view
+    cases = [
+        ((trace[:-1], trace[1:]), False),  # overlapping views of one polyline
+        ((trace[:6], trace[6:]), True),  # its two halves: concatenated, they are the array
+        ((trace[::2], trace[1::2]), False),  # strided views
+        ((trace[6:], trace[:6]), False),  # the halves the other way round
+        ((trace[:5].copy(), trace[5:10].copy()), False),  # separate arrays
+    ]
+    for (a, b), shared in cases:
+        ends = _end_points(a, b)
+        assert np.array_equal(ends, np.concatenate([a, b]))
+        assert (ends is trace) == shared
+        assert shared or not np.shares_memory(ends, trace)
