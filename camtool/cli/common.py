@@ -137,7 +137,12 @@ def picture_ahead(preview: str | None) -> Iterator[Callable[[], None]]:
     A command enters it with ``click.get_current_context().with_resource``, so it is left
     however the command ends.
     """
-    if preview is None or preview == "-" or not preview.lower().endswith(".png"):
+    if preview is None or preview == "-":
+        yield lambda: None
+        return
+    from camtool.preview import preview_format
+
+    if preview_format(preview) != ".png":
         yield lambda: None
         return
     from camtool.preview.ahead import load_ahead, start_ahead, stop_ahead

@@ -35,6 +35,7 @@ __all__ = [
     "ForkedWork",
     "ahead",
     "default_jobs",
+    "end_process",
     "fork_process",
     "how_ended",
     "in_worker",
@@ -303,6 +304,20 @@ def fork_process(run: Callable[[], None], *, closing: Sequence[int]) -> int:
         finally:
             os._exit(code)
     return pid
+
+
+def end_process(pid: int, *, kill: bool = False) -> int:
+    """Wait for the child ``pid`` (``kill``: SIGKILL it first); its ``waitpid`` status.
+
+    For the helpers :func:`fork_process` started (:func:`how_ended` reads the status).
+
+    Raises:
+        ChildProcessError: ``pid`` is no child of this process (already waited for).
+    """
+    if kill:
+        with suppress(OSError):  # it has ended already
+            os.kill(pid, signal.SIGKILL)
+    return os.waitpid(pid, 0)[1]
 
 
 def quiet_crashes() -> None:

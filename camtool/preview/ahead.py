@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING
 
 from camtool.model.cores import (
     FORK,
+    end_process,
     fork_process,
     in_worker,
     quiet_crashes,
@@ -91,10 +92,8 @@ class _Drawer:
                 os.close(fd)
         self.inbox = self.out = None
         if self.pid is not None:
-            with contextlib.suppress(OSError):
-                os.kill(self.pid, signal.SIGKILL)
-            with contextlib.suppress(ChildProcessError):
-                os.waitpid(self.pid, 0)
+            with contextlib.suppress(ChildProcessError):  # a test waited for it already
+                end_process(self.pid, kill=True)
             self.pid = None
 
 
@@ -117,6 +116,8 @@ def _serve(inbox: int, out: int) -> None:
 
 _AHEAD: list[_Drawer] = []
 """The child :func:`start_ahead` started, until :func:`draw_ahead` uses it (at most one)."""
+_HOOKED: list[bool] = []
+"""Whether :func:`_close_in_forked_child` is registered to run in every later fork."""
 
 
 def start_ahead() -> None:
@@ -126,6 +127,9 @@ def start_ahead() -> None:
     cores are busy with other files): the picture is then drawn here, as before.
     """
     if FORK and not _AHEAD and not in_worker():
+        if not _HOOKED:  # once, and only in a process that starts a child
+            os.register_at_fork(after_in_child=_close_in_forked_child)
+            _HOOKED.append(True)
         _AHEAD.append(_Drawer())
 
 
@@ -159,7 +163,3 @@ def _close_in_forked_child() -> None:
             with contextlib.suppress(OSError):
                 os.close(fd)
     _AHEAD.clear()
-
-
-if FORK:
-    os.register_at_fork(after_in_child=_close_in_forked_child)

@@ -24,7 +24,6 @@ import math
 import os
 import pickle
 import select
-import signal
 import sys
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -34,6 +33,7 @@ from camtool.geometry.chain import chain
 from camtool.model.cores import (
     FORK,
     default_jobs,
+    end_process,
     fork_process,
     how_ended,
     in_worker,
@@ -404,10 +404,7 @@ class _Child:
             with contextlib.suppress(OSError):
                 pipe.close()
         if self.pid is not None:
-            if kill:
-                with contextlib.suppress(OSError):
-                    os.kill(self.pid, signal.SIGKILL)
-            os.waitpid(self.pid, 0)
+            end_process(self.pid, kill=kill)
             self.pid = None
 
     def _death(self) -> str:
@@ -415,7 +412,7 @@ class _Child:
         assert self.pid is not None
         with contextlib.suppress(OSError):
             self.jobs.close()  # a child still waiting for jobs leaves
-        _, status = os.waitpid(self.pid, 0)
+        status = end_process(self.pid)
         self.pid = None
         return how_ended(status)
 
@@ -520,10 +517,7 @@ class _Worker:
                 os.close(fd)
         if self.pid is None:
             return "exit code 0"
-        if kill:
-            with contextlib.suppress(OSError):
-                os.kill(self.pid, signal.SIGKILL)
-        _, status = os.waitpid(self.pid, 0)
+        status = end_process(self.pid, kill=kill)
         self.pid = None
         return how_ended(status)
 
