@@ -15,6 +15,7 @@ import pickle
 import signal
 import subprocess
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -45,14 +46,12 @@ def _same(a: list[Contour] | ToolpathError, b: list[Contour] | ToolpathError) ->
 def test_the_child_answers_what_this_process_answers(
     monkeypatch: pytest.MonkeyPatch, tmp_path: Path
 ) -> None:
-    here = [offset_pieces(c, a) for c, a in JOBS]
-    made_by = tmp_path / "pids"
-    monkeypatch.setattr(offset_module, "_occt_offset", _noting(made_by))
+    here, made_by = _made_elsewhere(monkeypatch, tmp_path, JOBS)
     monkeypatch.setattr(offset_module, "_workers", lambda jobs: 1)
     there = offset_all(JOBS)
     assert len(there) == len(JOBS)
     assert all(_same(x, y) for x, y in zip(here, there, strict=True))
-    pids = made_by.read_text().split()
+    pids = made_by()
     assert len(pids) == len(JOBS) and len(set(pids)) == 1  # one worker made them all
     maker, its_parent = pids[0].split(":")
     assert str(os.getpid()) not in (maker, its_parent)  # a child's, not this process
@@ -68,6 +67,18 @@ def _noting(made_by: Path) -> Any:
         return real(contour, amount)
 
     return occt
+
+
+def _made_elsewhere(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, jobs: list[tuple[Contour, float]]
+) -> tuple[list[list[Contour] | ToolpathError], Callable[[], list[str]]]:
+    """``jobs``' offsets made here first (the expected answers), then OpenCASCADE's offset
+    patched to note ``pid:parent pid`` of each process making one; gives the answers and
+    the reader of those notes."""
+    here = [offset_pieces(c, a) for c, a in jobs]
+    made_by = tmp_path / "pids"
+    monkeypatch.setattr(offset_module, "_occt_offset", _noting(made_by))
+    return here, lambda: made_by.read_text().split()
 
 
 def _segfault_on(amount: float) -> Any:
@@ -151,9 +162,7 @@ def test_a_large_job_is_made_by_two_workers_at_once(
     monkeypatch: pytest.MonkeyPatch, tmp_path: Path
 ) -> None:
     """Jobs of PARALLEL_SEGMENTS or more on two cores: two workers, the same answers in order."""
-    expected = [offset_pieces(c, a) for c, a in MANY]
-    made_by = tmp_path / "pids"
-    monkeypatch.setattr(offset_module, "_occt_offset", _noting(made_by))
+    expected, made_by = _made_elsewhere(monkeypatch, tmp_path, MANY)
     monkeypatch.setattr(offset_module, "default_jobs", lambda: 2)
     monkeypatch.setattr(offset_module, "in_worker", lambda: False)
     segments = sum(len(c.segments) for c, _ in MANY)
@@ -162,7 +171,7 @@ def test_a_large_job_is_made_by_two_workers_at_once(
     assert offset_module._workers(MANY[1:]) == 1  # one contour fewer: too few segments
     got = offset_all(MANY)
     assert all(_same(x, y) for x, y in zip(got, expected, strict=True))
-    makers = {line.split(":")[0] for line in made_by.read_text().split()}
+    makers = {line.split(":")[0] for line in made_by()}
     assert len(makers) == 2 and str(os.getpid()) not in makers
 
 
@@ -352,9 +361,7 @@ def test_a_child_started_ahead_makes_the_offsets(
     The same pieces as this process makes, bit for bit, made by one worker that very child
     forked; it is used once and gone afterwards.
     """
-    here = [offset_pieces(c, a) for c, a in JOBS]
-    made_by = tmp_path / "pids"
-    monkeypatch.setattr(offset_module, "_occt_offset", _noting(made_by))
+    here, made_by = _made_elsewhere(monkeypatch, tmp_path, JOBS)
     monkeypatch.setattr(offset_module, "_workers", lambda jobs: 1)
     monkeypatch.setattr(offset_module, "_OFFSET_CALLS", [0])
     monkeypatch.setattr(offset_module, "_occt_here", lambda: False)  # a fresh job
@@ -363,7 +370,7 @@ def test_a_child_started_ahead_makes_the_offsets(
     pid = ahead.pid
     there = offset_all(JOBS)
     assert all(_same(x, y) for x, y in zip(here, there, strict=True))
-    makers = made_by.read_text().split()
+    makers = made_by()
     assert len(makers) == len(JOBS) and len(set(makers)) == 1  # one worker of that child
     assert pid is not None and makers[0].split(":")[1] == str(pid)
     assert offset_module._AHEAD == [] and ahead.pid is None  # used, then waited for
@@ -396,6 +403,7 @@ def test_a_child_started_ahead_and_not_used_is_stopped(monkeypatch: pytest.Monke
 
 BATCH_ONE_BY_ONE = """
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from camtool.cli.main import main
 from camtool.toolpath import offset
