@@ -109,12 +109,21 @@ def check_paths(
 ) -> None:
     """:func:`check_outputs` with the target and machine files as inputs too.
 
-    Called first thing by every command that writes (:func:`definition_inputs`).
+    Called first thing by every command that writes (:func:`definition_inputs`). An
+    output whose directory does not exist is refused too, before any work: found only
+    when it is written, the run's other files would be written and this one not.
 
     Raises:
-        UsageError: an output would overwrite an input, or two outputs are one file.
+        UsageError: an output would overwrite an input, two outputs are one file, or an
+            output's directory does not exist.
     """
+    outputs = list(outputs)
     check_outputs([*inputs, *definition_inputs(target, machine_file)], outputs)
+    for label, path in _named(outputs):
+        folder = os.path.dirname(path)
+        if path != "-" and folder and not os.path.isdir(folder):
+            what = "is not a directory" if os.path.exists(folder) else "does not exist"
+            raise UsageError(f"{label} {path}: {folder} {what}; create it or choose another path")
 
 
 def write_file(path: str | Path, data: str | bytes) -> None:

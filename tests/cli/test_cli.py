@@ -447,3 +447,29 @@ def test_ctrl_c_is_aborted_not_an_internal_error(
     err = capsys.readouterr().err
     assert code == 130
     assert "camtool: aborted" in err and "internal error" not in err
+
+
+@pytest.mark.parametrize("command", ["post", "verify"])
+def test_an_output_in_a_missing_directory_is_refused_before_any_work(
+    part: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], command: str
+) -> None:
+    """Found only when written, the preview's missing directory failed the run after the
+    program had been written and verified; now nothing is written and the exit is 2."""
+    code, _, err = run(["post", "part.dxf", "-t", "grbl", "-o", "part.gcode"], capsys)
+    assert code == 0
+    program = Path("part.gcode").read_bytes()
+    out = tmp_path / "new.gcode"
+    missing = tmp_path / "no" / "such" / "dir" / "p.png"
+    args = {
+        "post": ["post", "part.dxf", "-t", "grbl", "-o", str(out), "--preview", str(missing)],
+        "verify": ["verify", "part.gcode", "-t", "grbl", "--preview", str(missing)],
+    }[command]
+    code, _, err = run(args, capsys)
+    assert code == 2
+    assert f"--preview {missing}: {missing.parent} does not exist" in err
+    assert not out.exists() and not missing.parent.exists()
+    assert Path("part.gcode").read_bytes() == program
+    a_file = tmp_path / "a-file"
+    a_file.write_text("x")
+    code, _, err = run(["post", "part.dxf", "-t", "grbl", "-o", str(a_file / "p.gcode")], capsys)
+    assert code == 2 and f"{a_file} is not a directory" in err
