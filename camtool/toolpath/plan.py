@@ -31,7 +31,7 @@ from camtool.geometry.chain import chain, joint_distance
 from camtool.model.errors import InputError
 from camtool.model.program import Move, Program, Rapid
 from camtool.model.progress import Progress, no_progress
-from camtool.model.shapes import Contour, Drawing, Line, Point, Segment
+from camtool.model.shapes import Contour, Drawing, Line, Point, Segment, fit_factor
 from camtool.toolpath.chain import close_gaps
 from camtool.toolpath.cuts import Finding, Stage
 from camtool.toolpath.gaps import open_gaps
@@ -233,9 +233,8 @@ def place(drawing: Drawing, options: PlanOptions) -> Drawing:
     """The drawing scaled as ``options.scale`` or ``options.fit_mm`` ask (mm)."""
     if options.fit_mm is None:
         return drawing if options.scale == 1.0 else drawing.transformed(options.scale)
-    x0, y0, x1, y1 = drawing.bbox()
-    w, h = options.fit_mm
-    k = min(w / (x1 - x0) if x1 > x0 else math.inf, h / (y1 - y0) if y1 > y0 else math.inf)
+    x0, y0, _, _ = box = drawing.bbox()
+    k = fit_factor(box, options.fit_mm)
     if math.isinf(k):
         return drawing
     return drawing.transformed(k, x0 * (1 - k), y0 * (1 - k))
