@@ -140,6 +140,7 @@ def post(
         post_drawing,
         post_path,
         refuse_planning,
+        sized,
         verify_job,
     )
     from camtool.model.progress import Step
@@ -164,7 +165,7 @@ def post(
     progress = StageReporter()
     try:
         if drawing == "-":
-            drawn = read_input(drawing, settings)
+            drawn = read_input(drawing, sized(settings, plan))
             job = post_drawing(drawn, chosen, plan, output_options, progress=progress)
         else:
             job = post_path(

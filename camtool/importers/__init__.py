@@ -9,12 +9,13 @@ never loads ezdxf or svgelements. The options and limits every importer takes ar
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from camtool.importers.options import ImportOptions
 from camtool.model.errors import InputError
 from camtool.model.progress import Progress, Step, no_progress
-from camtool.model.shapes import Drawing
+from camtool.model.shapes import Drawing, fit_factor
 
 POINT_SUFFIXES = (".csv", ".txt", ".xy", ".m")
 """File endings of unitless point lists, the only inputs ``--units`` applies to."""
@@ -28,6 +29,15 @@ def read_drawing(
 ) -> Drawing:
     """Read the drawing at ``path``, choosing the importer by the file name ending.
 
+    Curves (Béziers, ellipses, splines) are fitted within ``options.tolerance`` at the
+    size planning will give the drawing (``options.scale`` or ``options.fit_mm``:
+    :meth:`~camtool.importers.options.ImportOptions.curve_tolerance`). For ``--fit`` the
+    factor depends on the extent of the drawing read: the SVG importer fits for the
+    extent of its segments' ends (within the drawing's, so never coarser), the others
+    for the drawing as drawn; then the factor of the drawing read is checked, and where
+    its curves would be further than ``tolerance`` from the arcs once scaled (a drawing
+    scaled up), the file is read again with the finer tolerance that factor asks.
+
     Args:
         path: the drawing file.
         options: importer options; ``None`` takes the defaults.
@@ -37,25 +47,53 @@ def read_drawing(
 
     Raises:
         InputError: the file is missing, unreadable, of an unknown kind, or holds
-            no usable entity.
+            no usable entity; or (``--fit``) a drawing so small against the tolerance
+            that no fit holds it once scaled.
     """
     path = Path(path)
     options = options or ImportOptions()
+    if options.fit_mm is None:
+        return _read(path, options, progress)[0]
+    drawing, used = _read(path, options, progress)
+    for margin in _REFIT_MARGINS:
+        k = fit_factor(drawing.bbox(), options.fit_mm)
+        k = 1.0 if math.isinf(k) else k
+        if used * k <= options.tolerance:
+            return drawing
+        used = options.tolerance / k * (1.0 - margin)
+        drawing, _ = _read(path, options.at_tolerance(used), progress)
+    raise InputError(
+        f"{path}: its curves cannot be fitted within --tolerance {options.tolerance:g} mm at "
+        "the --fit size (the drawing is hardly larger than the tolerance); raise --tolerance"
+    )
+
+
+_REFIT_MARGINS = (1e-6, 1e-3, 0.1, 0.5)
+"""Each new fit of a drawing read again for ``--fit`` asks this much finer than the factor
+of the drawing before it (a finer fit moves the extent, so the factor, by a few tolerances)."""
+
+
+def _read(path: Path, options: ImportOptions, progress: Progress) -> tuple[Drawing, float]:
+    """The drawing at ``path`` and the tolerance its curves were fitted within (mm, as drawn).
+
+    0.0 for a drawing without fitted curves (a point list).
+    """
     suffix = path.suffix.lower()
     if suffix == ".dxf":
         from camtool.importers.dxf import read_dxf
 
         progress(Step("reading", name=path.name))
-        return read_dxf(path, options)
+        used = options.curve_tolerance()
+        return read_dxf(path, options.at_tolerance(used)), used
     if suffix == ".svg":
-        from camtool.importers.svg import read_svg
+        from camtool.importers.svg import svg_drawing
 
-        return read_svg(path, options, progress=progress)
+        return svg_drawing(path, options, progress=progress)
     if suffix in POINT_SUFFIXES:
         from camtool.importers.points import read_points
 
         progress(Step("reading", name=path.name))
-        return read_points(path, options)
+        return read_points(path, options), 0.0
     if suffix == "" and str(path) == "-":
         raise InputError("'-' (stdin) must be read with read_drawing_bytes")
     kind = f"{suffix!r} files" if suffix else "a file without a name ending"

@@ -10,9 +10,11 @@ points) and every caller that builds options (jobs, cli) imports them from here.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, replace
 
 from camtool.model.errors import InputError, UsageError
+from camtool.model.shapes import BBox, fit_factor
 from camtool.model.units import LARGEST_VALUE
 
 MAX_ENTITIES = 5_000_000
@@ -75,6 +77,14 @@ class ImportOptions:
         max_entities: most entities a drawing may expand to (DXF block references and
             MINSERT grids, SVG ``<use>`` clones, counted before anything is expanded);
             a drawing over it is refused with an :class:`InputError` naming this limit.
+        scale: the uniform scale planning will apply to the drawing (``--scale``; 1:
+            none). ``tolerance`` holds once scaled: curves are fitted within
+            ``tolerance / scale`` at the drawing's size (:meth:`curve_tolerance`).
+        fit_mm: the box planning will scale the drawing into (``--fit W H``;
+            :func:`~camtool.model.shapes.fit_factor`), or ``None``. Likewise, curves are
+            fitted within ``tolerance`` divided by that factor, and
+            :func:`camtool.importers.read_drawing` checks the factor of the drawing it
+            read (and fits again, finer, if it must).
 
     Raises:
         UsageError: ``max_entities`` is not a positive whole number.
@@ -85,6 +95,28 @@ class ImportOptions:
     units: str | None = None
     hatch_boundaries: bool = False
     max_entities: int = MAX_ENTITIES
+    scale: float = 1.0
+    fit_mm: tuple[float, float] | None = None
+
+    def curve_tolerance(self, box: BBox | None = None) -> float:
+        """The fitting tolerance at the drawing's size (mm) that is ``tolerance`` once placed.
+
+        A fit within ``t`` of a curve is within ``k·t`` of it once the drawing is scaled
+        by ``k``, so the curves of a drawing planning scales by ``k`` are fitted within
+        ``tolerance / k``: a drawing scaled up (``--fit`` of a small icon) is fitted
+        finer, one scaled down coarser, and the G-code holds ``--tolerance`` either way.
+        ``k`` is ``scale``, or with ``fit_mm`` the factor for ``box`` (the drawing's
+        extent, or a box within it: a smaller box gives a larger factor, so a finer fit);
+        1 without a box, or for a box with neither width nor height (not scaled).
+        """
+        if self.fit_mm is None:
+            return self.tolerance / self.scale
+        k = 1.0 if box is None else fit_factor(box, self.fit_mm)
+        return self.tolerance / (1.0 if math.isinf(k) else k)
+
+    def at_tolerance(self, tolerance: float) -> ImportOptions:
+        """These options with curves fitted within ``tolerance`` (mm at the drawing's size)."""
+        return replace(self, tolerance=tolerance, scale=1.0, fit_mm=None)
 
     def __post_init__(self) -> None:
         if isinstance(self.max_entities, bool) or not (

@@ -63,7 +63,17 @@ from camtool.importers.svgdoc import (
 )
 from camtool.model.errors import GeometryError, InputError
 from camtool.model.progress import Progress, Step, no_progress
-from camtool.model.shapes import TAU, Arc, Contour, Drawing, Line, Point, Segment, distance
+from camtool.model.shapes import (
+    TAU,
+    Arc,
+    BBox,
+    Contour,
+    Drawing,
+    Line,
+    Point,
+    Segment,
+    distance,
+)
 
 DEFAULT_LAYER = "0"
 """Contour.layer of shapes outside any Inkscape layer (the DXF default layer's name)."""
@@ -74,7 +84,14 @@ _SHAPES = (se.Path, se.Rect, se.Circle, se.Ellipse, se.SimpleLine, se.Polyline, 
 def read_svg(
     path: str | Path, options: ImportOptions | None = None, *, progress: Progress = no_progress
 ) -> Drawing:
-    """Read an SVG file into a drawing in mm, Y up.
+    """Read an SVG file into a drawing in mm, Y up (:func:`svg_drawing`'s drawing)."""
+    return svg_drawing(path, options, progress=progress)[0]
+
+
+def svg_drawing(
+    path: str | Path, options: ImportOptions | None = None, *, progress: Progress = no_progress
+) -> tuple[Drawing, float]:
+    """Read an SVG file into a drawing in mm, Y up, and the tolerance its curves were fitted within.
 
     The page's bottom-left corner is the origin. ``width``/``height`` in mm, cm, in, pt,
     pc or px (1/96 in) with a ``viewBox`` set the scale; without an absolute size user units
@@ -83,8 +100,10 @@ def read_svg(
     Args:
         path: the SVG file.
         options: ``layers`` (Inkscape layer labels or ids; hidden layers named here are read)
-            and ``tolerance`` (mm, for Béziers and ellipses) are used; ``units`` does not
-            apply (SVG files carry their own units).
+            and ``tolerance`` (mm, for Béziers and ellipses, once the drawing is scaled as
+            ``scale`` or ``fit_mm`` say: for ``fit_mm``, the factor of the extent of the
+            drawn segments' ends, :func:`_ends_box`) are used; ``units`` does not apply
+            (SVG files carry their own units).
         progress: told the stages (:class:`~camtool.model.progress.Step`): ``reading``
             (the file's name; ``total``: drawn shapes once counted, ``done`` as their
             segments are read), ``fitting`` (only when the curves are fitted ahead, see
@@ -93,7 +112,9 @@ def read_svg(
 
     Returns:
         One contour per drawn subpath, and the warnings a user should see (assumed units,
-        skipped elements by kind and count, hidden layers).
+        skipped elements by kind and count, hidden layers); and the tolerance the curves
+        were fitted within, mm at the drawing's size
+        (:meth:`~camtool.importers.options.ImportOptions.curve_tolerance`).
 
     Raises:
         UsageError: ``options.tolerance`` is not a positive number.
@@ -122,7 +143,9 @@ def read_svg(
         else:
             drawn.append((shape, _segments(shape)))
         progress(Step("reading", i, len(shapes), path.name))
-    fitter = _prefitted(drawn, prepared.matrix, options.tolerance, progress)
+    box = _ends_box(drawn, prepared.matrix) if options.fit_mm is not None else None
+    tolerance = options.curve_tolerance(box)
+    fitter = _prefitted(drawn, prepared.matrix, tolerance, progress)
     progress(Step("contours", 0, len(drawn)))
     for i, (shape, segments) in enumerate(drawn, start=1):
         contours.extend(_contours(path, shape, segments, prepared.matrix, fitter))
@@ -138,7 +161,37 @@ def read_svg(
             f"{path}: nothing to cut{where}; camtool reads path, rect, circle, ellipse, "
             "line, polyline and polygon elements that are drawn"
         )
-    return Drawing(tuple(contours), str(path), tuple(warnings))
+    return Drawing(tuple(contours), str(path), tuple(warnings)), tolerance
+
+
+def _ends_box(drawn: list[tuple[Any, list[Any] | None]], page: Affine) -> BBox | None:
+    """The extent (mm) of the ends of the drawn shapes' segments, before any curve is fitted.
+
+    Every end of a segment that is drawn is a point of the drawing (a fit ends where its
+    curve does), so the box lies within the drawing's and ``--fit``'s factor for it is
+    at least the drawing's: curves fitted for it are fitted at least as finely as the
+    drawing's own factor asks. ``None`` when there is no finite end (the shapes whose
+    segments svgelements could not give, and ``Move`` points, are left out).
+    """
+    xs: list[float] = []
+    ys: list[float] = []
+    for shape, segments in drawn:
+        if not segments:
+            continue
+        m = compose(page, affine_of(shape.transform))
+        for seg in segments:
+            if isinstance(seg, se.Move):
+                continue
+            for point in (seg.start, seg.end):
+                if point is None:
+                    continue
+                x, y = apply(m, float(point.x), float(point.y))
+                if math.isfinite(x) and math.isfinite(y):
+                    xs.append(x)
+                    ys.append(y)
+    if not xs:
+        return None
+    return (min(xs), min(ys), max(xs), max(ys))
 
 
 def _parse(path: Path, prepared: Prepared) -> Any:

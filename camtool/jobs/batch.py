@@ -196,14 +196,15 @@ class BatchOptions:
 
     def import_options(self) -> ImportOptions:
         """The importer options of every drawing."""
-        limit = {} if self.max_entities is None else {"max_entities": self.max_entities}
-        return ImportOptions(
+        options = ImportOptions(
             layers=self.layers,
             tolerance=self.plan.tolerance,
             units=self.units,
             hatch_boundaries=self.hatch_boundaries,
-            **limit,
         )
+        if self.max_entities is None:
+            return options
+        return dataclasses.replace(options, max_entities=self.max_entities)
 
 
 def _targets(target: str | Sequence[str]) -> str | tuple[str, ...]:

@@ -175,7 +175,7 @@ def post_path(
         from camtool.toolpath.compensate import offsets_ahead
 
         with offsets_ahead(plan):  # OpenCASCADE loads in the offsets' child meanwhile
-            drawing = read_drawing(path, import_options, progress=progress)
+            drawing = read_drawing(path, sized(import_options, plan), progress=progress)
             drawing = _note_units(drawing, path, import_options)
             with meanwhile(_preloads(drawing) if verifying else []):
                 return post_drawing(drawing, target, plan, output, progress=progress)
@@ -230,7 +230,8 @@ def post_bytes(
     plan = plan if plan is not None else PlanOptions()
     if not is_program_file(name):
         suffix = Path(name).suffix
-        drawing = read_drawing_bytes(data, name=name, suffix=suffix, options=import_options)
+        options = sized(import_options, plan)
+        drawing = read_drawing_bytes(data, name=name, suffix=suffix, options=options)
         return post_drawing(_note_units(drawing, name, import_options), target, plan, output)
     refuse_planning(name, drawing_only(plan.given()))
     from camtool.importers.gcode import read_gcode_bytes
@@ -242,6 +243,17 @@ def post_bytes(
         feed_mm_min=plan.feed_mm_min,
         source=name,
     )
+
+
+def sized(options: ImportOptions | None, plan: PlanOptions) -> ImportOptions:
+    """``options`` (``None``: the defaults) for a drawing planned with ``plan``.
+
+    With the scale planning gives the drawing (``plan.scale``, ``plan.fit_mm``), so that
+    its curves are fitted within the tolerance at that size, in the program
+    (:meth:`~camtool.importers.options.ImportOptions.curve_tolerance`).
+    """
+    base = options if options is not None else ImportOptions()
+    return dataclasses.replace(base, scale=plan.scale, fit_mm=plan.fit_mm)
 
 
 def refuse_planning(path: str | Path, given: list[str]) -> None:

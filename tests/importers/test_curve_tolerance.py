@@ -1,0 +1,210 @@
+"""--tolerance holds at the size planning gives the drawing (--scale, --fit), not as drawn.
+
+Curves are fitted within ``--tolerance`` mm. Before this was fixed they were fitted at the
+drawing's own size and the drawing was scaled afterwards, so a Bézier scaled up 19 times
+by ``--fit`` came out 18 µm from its curve at the default 1 µm (a scaled-down drawing was
+fitted 17 times finer than asked: Inkscape's filters.svg made 768 000 blocks and took
+101 s). Expected curves come from svgpathtools (SVG) and ezdxf (DXF), both independent of
+the importers, mapped by the placement's own definition (scale about the origin for
+``--scale``; for ``--fit`` about the drawing's lower-left corner, here the exact corner of
+a frame drawn with straight lines at 0..100).
+"""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+from typing import Any
+
+import ezdxf
+import pytest
+
+import camtool.importers.svg as svg_importer
+from camtool.cli.main import main
+from camtool.importers import read_drawing
+from camtool.importers.options import ImportOptions
+from camtool.jobs.pipeline import post_bytes, post_path
+from camtool.model.program import ArcMove, Linear, Program
+from camtool.model.shapes import Arc, Contour, Drawing, Line, Segment, make_arc
+from camtool.post.registry import load_target
+from camtool.toolpath.options import PlanOptions
+from camtool.toolpath.plan import place
+from tests.importers.svgutil import page, svg, true_curve
+from tests.importers.svgutil import two_sided_error as svg_error
+from tests.shapes import two_sided_error, write_dxf
+
+TOL = 0.001  # mm, the default --tolerance
+FRAME = '<path id="frame" d="M 0 0 H 100 V 100 H 0 Z" fill="none" stroke="black"/>'
+BEZ_D = "M 0 50 C 20 0, 80 100, 100 50"
+BEZ = f'<path id="bez" d="{BEZ_D}" fill="none" stroke="black"/>'
+
+
+def _placed(path: Path, options: ImportOptions) -> Drawing:
+    """The drawing read with ``options`` and placed as planning places it."""
+    drawing = read_drawing(path, options)
+    return place(drawing, PlanOptions(scale=options.scale, fit_mm=options.fit_mm))
+
+
+def _factor(options: ImportOptions) -> float:
+    """The scale of the 100 × 100 mm frame's drawing: --scale, or --fit's W / 100."""
+    return options.scale if options.fit_mm is None else min(options.fit_mm) / 100.0
+
+
+def _named(drawing: Drawing, name: str) -> list[Contour]:
+    return [c for c in drawing.contours if name in c.source]
+
+
+def test_curve_tolerance_is_the_tolerance_divided_by_the_placement_scale() -> None:
+    assert ImportOptions().curve_tolerance() == 0.001
+    assert ImportOptions(scale=4.0).curve_tolerance() == 0.001 / 4.0
+    assert ImportOptions(scale=0.5).curve_tolerance() == 0.001 / 0.5
+    fit = ImportOptions(fit_mm=(100.0, 50.0))
+    assert fit.curve_tolerance((0.0, 0.0, 10.0, 10.0)) == 0.001 / 5.0  # min(100/10, 50/10)
+    assert fit.curve_tolerance((2.0, 3.0, 202.0, 13.0)) == 0.001 / 0.5  # min(100/200, 50/10)
+    assert fit.curve_tolerance(None) == 0.001  # no extent: as drawn
+    assert fit.curve_tolerance((5.0, 5.0, 5.0, 5.0)) == 0.001  # a point: --fit leaves it
+    exact = fit.at_tolerance(0.0002)
+    assert (exact.tolerance, exact.scale, exact.fit_mm) == (0.0002, 1.0, None)
+    assert exact.curve_tolerance() == 0.0002
+
+
+@pytest.mark.parametrize(
+    "options",
+    [
+        ImportOptions(fit_mm=(400.0, 400.0)),
+        ImportOptions(scale=4.0),
+        ImportOptions(fit_mm=(10.0, 10.0)),
+        ImportOptions(scale=0.1),
+        ImportOptions(),
+    ],
+    ids=["fit-up", "scale-up", "fit-down", "scale-down", "as-drawn"],
+)
+def test_svg_bezier_holds_the_tolerance_once_placed(tmp_path: Path, options: ImportOptions) -> None:
+    k = _factor(options)
+    placed = _placed(svg(tmp_path, FRAME + BEZ), options)
+    curve = true_curve(BEZ_D, lambda xy: k * page(xy), n=40001)
+    there, back = svg_error(_named(placed, "bez"), curve)
+    assert there <= TOL, f"the curve is {there * 1000:.3f} µm from its arcs"
+    assert back <= TOL, f"the arcs are {back * 1000:.3f} µm from the curve"
+
+
+def test_a_drawing_scaled_down_is_fitted_with_fewer_arcs(tmp_path: Path) -> None:
+    path = svg(tmp_path, FRAME + BEZ)
+    (as_drawn,) = _named(read_drawing(path), "bez")
+    (down,) = _named(read_drawing(path, ImportOptions(fit_mm=(10.0, 10.0))), "bez")
+    assert len(down.segments) < len(as_drawn.segments)
+
+
+def test_an_svg_whose_ends_overstate_its_extent_is_fitted_again(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A zero-length path far away is not drawn, but its ends widen the box the first fit is
+    # made for (a smaller --fit factor, a coarser fit): the drawing read is 100 mm across,
+    # so read_drawing fits it again for its own factor.
+    far = '<path id="dot" d="M 500 500 L 500 500" fill="none" stroke="black"/>'
+    path = svg(tmp_path, FRAME + BEZ + far)
+    used: list[float] = []
+    made = svg_importer.svg_drawing
+
+    def noting(*args: Any, **kwargs: Any) -> tuple[Drawing, float]:
+        drawing, tolerance = made(*args, **kwargs)
+        used.append(tolerance)
+        return drawing, tolerance
+
+    monkeypatch.setattr(svg_importer, "svg_drawing", noting)
+    options = ImportOptions(fit_mm=(400.0, 400.0))
+    placed = _placed(path, options)
+    assert [c.source for c in placed.contours] == ["path#frame", "path#bez"]
+    assert used[0] == pytest.approx(TOL / (400.0 / 500.0))  # the box of the ends, 500 mm
+    assert len(used) == 2 and used[1] <= TOL / 4.0
+    curve = true_curve(BEZ_D, lambda xy: 4.0 * page(xy), n=40001)
+    there, back = svg_error(_named(placed, "bez"), curve)
+    assert max(there, back) <= TOL
+
+
+def _spline_dxf(path: Path) -> Path:
+    def build(msp: Any) -> None:
+        msp.add_lwpolyline([(0, 0), (100, 0), (100, 100), (0, 100)], close=True)
+        msp.add_open_spline([(5, 20, 0), (30, 90, 0), (60, 5, 0), (95, 70, 0)], degree=3)
+
+    return write_dxf(path, build)
+
+
+@pytest.mark.parametrize(
+    "options",
+    [ImportOptions(fit_mm=(400.0, 400.0)), ImportOptions(scale=4.0)],
+    ids=["fit-up", "scale-up"],
+)
+def test_dxf_spline_holds_the_tolerance_once_placed(tmp_path: Path, options: ImportOptions) -> None:
+    path = _spline_dxf(tmp_path / "s.dxf")
+    k = _factor(options)
+    (spline,) = [e for e in ezdxf.readfile(path).modelspace() if e.dxftype() == "SPLINE"]
+    bs = spline.construction_tool()
+    knots = bs.knots()
+
+    def point_at(t: float) -> tuple[float, float]:
+        p = bs.point(t)
+        return (k * p[0], k * p[1])
+
+    (contour,) = _named(_placed(path, options), "SPLINE")
+    lo, hi = float(knots[bs.degree]), float(knots[bs.count])
+    forward, backward = two_sided_error(point_at, lo, hi, contour.segments, TOL)
+    assert forward <= TOL and backward <= TOL
+
+
+def test_a_dxf_scaled_down_is_read_as_drawn(tmp_path: Path) -> None:
+    # A DXF is fitted for its size as drawn and fitted again only when --fit scales it up
+    # (its extent is known once read): scaled down, its curves are the ones read without.
+    path = _spline_dxf(tmp_path / "s.dxf")
+    down = read_drawing(path, ImportOptions(fit_mm=(10.0, 10.0)))
+    assert down == read_drawing(path)
+
+
+def _cut_segments(program: Program) -> list[Contour]:
+    """The cutting moves of the program's contours that hold an arc, as contours (mm)."""
+    by_contour: dict[int, list[Segment]] = {}
+    here = program.origin
+    for move in program.moves:
+        end = (move.x, move.y)
+        if isinstance(move, ArcMove):
+            seg: Segment = make_arc(here, end, (move.cx, move.cy), move.clockwise)
+            by_contour.setdefault(move.contour, []).append(seg)
+        elif isinstance(move, Linear) and end != here:
+            by_contour.setdefault(move.contour, []).append(Line(here, end))
+        here = end
+    return [
+        Contour(tuple(segs), False)
+        for segs in by_contour.values()
+        if any(isinstance(s, Arc) for s in segs)
+    ]
+
+
+def test_every_way_in_fits_curves_for_the_planned_size(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # post_path (the CLI, batch --jobs) and post_bytes (a Dask worker) take the planned
+    # --fit to the importer; the CLI's file and stdin paths write post_path's code.
+    path = svg(tmp_path, FRAME + BEZ)
+    target = load_target("linuxcnc")
+    plan = PlanOptions(fit_mm=(190.0, 190.0))  # within the 300 × 200 mm travel
+    curve = true_curve(BEZ_D, lambda xy: 1.9 * page(xy), n=40001)
+    by_path = post_path(path, target, plan)
+    by_bytes = post_bytes(path.read_bytes(), path.name, target, plan)
+    for job in (by_path, by_bytes):
+        (cut,) = _cut_segments(job.program)
+        assert max(svg_error([cut], curve)) <= TOL
+    assert by_bytes.result.code == by_path.result.code
+    fit = ["-t", "linuxcnc", "--fit", "190", "190"]
+    assert main(["post", str(path), *fit, "-o", str(tmp_path / "f.ngc")]) == 0
+    assert (tmp_path / "f.ngc").read_text() == by_path.result.code
+    # standard input is read as DXF: a spline scaled up 1.9 times, fitted again finer
+    dxf = _spline_dxf(tmp_path / "s.dxf")
+    monkeypatch.setattr("sys.stdin", io.TextIOWrapper(io.BytesIO(dxf.read_bytes())))
+    assert main(["post", "-", *fit, "-o", str(tmp_path / "s.ngc")]) == 0
+    as_file = post_path(dxf, target, plan).result.code
+    assert _blocks((tmp_path / "s.ngc").read_text()) == _blocks(as_file)
+
+
+def _blocks(code: str) -> list[str]:
+    """The program's blocks without its comments (which name the input)."""
+    return [line for line in code.splitlines() if not line.startswith("(")]
