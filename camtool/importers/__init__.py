@@ -33,10 +33,11 @@ def read_drawing(
     size planning will give the drawing (``options.scale`` or ``options.fit_mm``:
     :meth:`~camtool.importers.options.ImportOptions.curve_tolerance`). For ``--fit`` the
     factor depends on the extent of the drawing read: the SVG importer fits for the
-    extent of its segments' ends (within the drawing's, so never coarser), the others
-    for the drawing as drawn; then the factor of the drawing read is checked, and where
-    its curves would be further than ``tolerance`` from the arcs once scaled (a drawing
-    scaled up), the file is read again with the finer tolerance that factor asks.
+    extent of its segments' ends (as a rule within the drawing's, so not coarser), the
+    others for the drawing as drawn; then the factor of the drawing read is checked, and
+    where its curves would be further than ``tolerance`` from the arcs once scaled (a DXF
+    scaled up, an SVG with a path of zero length far off), the file is read again with
+    the finer tolerance that factor asks.
 
     Args:
         path: the drawing file.

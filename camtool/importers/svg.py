@@ -167,11 +167,13 @@ def svg_drawing(
 def _ends_box(drawn: list[tuple[Any, list[Any] | None]], page: Affine) -> BBox | None:
     """The extent (mm) of the ends of the drawn shapes' segments, before any curve is fitted.
 
-    Every end of a segment that is drawn is a point of the drawing (a fit ends where its
-    curve does), so the box lies within the drawing's and ``--fit``'s factor for it is
-    at least the drawing's: curves fitted for it are fitted at least as finely as the
-    drawing's own factor asks. ``None`` when there is no finite end (the shapes whose
-    segments svgelements could not give, and ``Move`` points, are left out).
+    The end of a segment that is drawn is a point of the drawing (a fit ends where its
+    curve does), so the box lies within the drawing's and ``--fit``'s factor for it is at
+    least the drawing's: curves fitted for it are fitted at least as finely as the
+    drawing's own factor asks. A subpath dropped whole (one of zero length) can widen it;
+    :func:`camtool.importers.read_drawing` then finds the drawing's factor larger and
+    fits again. ``None`` when there is no finite end (the shapes whose segments
+    svgelements could not give, and ``Move`` points, are left out).
     """
     xs: list[float] = []
     ys: list[float] = []
