@@ -40,7 +40,7 @@ from __future__ import annotations
 import gc
 import io
 import math
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import Any, TypeAlias
 
@@ -89,7 +89,11 @@ def read_svg(
 
 
 def svg_drawing(
-    path: str | Path, options: ImportOptions | None = None, *, progress: Progress = no_progress
+    path: str | Path,
+    options: ImportOptions | None = None,
+    *,
+    progress: Progress = no_progress,
+    check: Callable[[BBox], None] | None = None,
 ) -> tuple[Drawing, float]:
     """Read an SVG file into a drawing in mm, Y up, and the tolerance its curves were fitted within.
 
@@ -104,6 +108,10 @@ def svg_drawing(
             ``scale`` or ``fit_mm`` say: for ``fit_mm``, the factor of the extent of the
             drawn segments' ends, :func:`_ends_box`) are used; ``units`` does not apply
             (SVG files carry their own units).
+        check: called with the extent of the drawn segments' ends (:func:`_ends_box`, mm,
+            a box within the drawing's) before any curve is fitted; what it raises stops
+            the reading (``camtool post`` refuses there a drawing too large for the
+            machine, :func:`camtool.jobs.pipeline.post_path`).
         progress: told the stages (:class:`~camtool.model.progress.Step`): ``reading``
             (the file's name; ``total``: drawn shapes once counted, ``done`` as their
             segments are read), ``fitting`` (only when the curves are fitted ahead, see
@@ -143,7 +151,11 @@ def svg_drawing(
         else:
             drawn.append((shape, _segments(shape)))
         progress(Step("reading", i, len(shapes), path.name))
-    box = _ends_box(drawn, prepared.matrix) if options.fit_mm is not None else None
+    box = None
+    if options.fit_mm is not None or check is not None:
+        box = _ends_box(drawn, prepared.matrix)
+    if check is not None and box is not None:
+        check(box)
     tolerance = options.curve_tolerance(box)
     fitter = _prefitted(drawn, prepared.matrix, tolerance, progress)
     progress(Step("contours", 0, len(drawn)))
@@ -164,16 +176,22 @@ def svg_drawing(
     return Drawing(tuple(contours), str(path), tuple(warnings)), tolerance
 
 
+_DISTINCT_MM = 1e-6
+"""Ends at least this far apart (mm) make a segment :func:`_ends_box` counts: well above
+:data:`ZERO_LENGTH_MM`, under which :func:`convert` drops a segment."""
+
+
 def _ends_box(drawn: list[tuple[Any, list[Any] | None]], page: Affine) -> BBox | None:
     """The extent (mm) of the ends of the drawn shapes' segments, before any curve is fitted.
 
-    The end of a segment that is drawn is a point of the drawing (a fit ends where its
-    curve does), so the box lies within the drawing's and ``--fit``'s factor for it is at
-    least the drawing's: curves fitted for it are fitted at least as finely as the
-    drawing's own factor asks. A subpath dropped whole (one of zero length) can widen it;
-    :func:`camtool.importers.read_drawing` then finds the drawing's factor larger and
-    fits again. ``None`` when there is no finite end (the shapes whose segments
-    svgelements could not give, and ``Move`` points, are left out).
+    Only the ends of segments whose ends are more than :data:`_DISTINCT_MM` apart are
+    taken: such a segment is drawn (:func:`convert` drops only segments of zero length,
+    and a fit ends where its curve does), so each end taken is a point of the drawing,
+    and the box lies within the drawing's. So ``--fit``'s factor for it is at least the
+    drawing's (curves fitted for it are fitted at least as finely as the drawing's own
+    factor asks), and a drawing whose box is larger than a machine's travel is larger
+    than it. ``None`` when there is no such end (``Move`` points, and the shapes whose
+    segments svgelements could not give, are left out).
     """
     xs: list[float] = []
     ys: list[float] = []
@@ -182,15 +200,14 @@ def _ends_box(drawn: list[tuple[Any, list[Any] | None]], page: Affine) -> BBox |
             continue
         m = compose(page, affine_of(shape.transform))
         for seg in segments:
-            if isinstance(seg, se.Move):
+            if isinstance(seg, se.Move) or seg.start is None or seg.end is None:
                 continue
-            for point in (seg.start, seg.end):
-                if point is None:
-                    continue
-                x, y = apply(m, float(point.x), float(point.y))
-                if math.isfinite(x) and math.isfinite(y):
-                    xs.append(x)
-                    ys.append(y)
+            x0, y0 = apply(m, float(seg.start.x), float(seg.start.y))
+            x1, y1 = apply(m, float(seg.end.x), float(seg.end.y))
+            finite = math.isfinite(x0 + y0 + x1 + y1)  # refused with its message later
+            if finite and math.hypot(x1 - x0, y1 - y0) > _DISTINCT_MM:
+                xs += (x0, x1)
+                ys += (y0, y1)
     if not xs:
         return None
     return (min(xs), min(ys), max(xs), max(ys))

@@ -95,12 +95,11 @@ def test_a_drawing_scaled_down_is_fitted_with_fewer_arcs(tmp_path: Path) -> None
     assert len(down.segments) < len(as_drawn.segments)
 
 
-def test_an_svg_whose_ends_overstate_its_extent_is_fitted_again(
+def test_a_path_of_zero_length_does_not_widen_the_fit(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    # A zero-length path far away is not drawn, but its ends widen the box the first fit is
-    # made for (a smaller --fit factor, a coarser fit): the drawing read is 100 mm across,
-    # so read_drawing fits it again for its own factor.
+    # A zero-length path far away is not drawn: its ends do not count in the box the fit
+    # is made for, so the drawing is read once, fitted for its own factor (4).
     far = '<path id="dot" d="M 500 500 L 500 500" fill="none" stroke="black"/>'
     path = svg(tmp_path, FRAME + BEZ + far)
     used: list[float] = []
@@ -112,14 +111,28 @@ def test_an_svg_whose_ends_overstate_its_extent_is_fitted_again(
         return drawing, tolerance
 
     monkeypatch.setattr(svg_importer, "svg_drawing", noting)
-    options = ImportOptions(fit_mm=(400.0, 400.0))
-    placed = _placed(path, options)
+    placed = _placed(path, ImportOptions(fit_mm=(400.0, 400.0)))
     assert [c.source for c in placed.contours] == ["path#frame", "path#bez"]
-    assert used[0] == pytest.approx(TOL / (400.0 / 500.0))  # the box of the ends, 500 mm
-    assert len(used) == 2 and used[1] <= TOL / 4.0
-    curve = true_curve(BEZ_D, lambda xy: 4.0 * page(xy), n=40001)
-    there, back = svg_error(_named(placed, "bez"), curve)
-    assert max(there, back) <= TOL
+    assert used == [TOL / 4.0]
+
+
+def test_a_dxf_scaled_up_is_read_again_finer(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A DXF is read for its size as drawn; its factor (4) known, it is read again, fitted
+    # within TOL / 4 (a millionth finer, for the extent the finer fit moves).
+    import camtool.importers.dxf as dxf_importer
+
+    asked: list[float] = []
+    read_dxf = dxf_importer.read_dxf
+
+    def noting(path: Path, options: ImportOptions) -> Drawing:
+        asked.append(options.tolerance)
+        return read_dxf(path, options)
+
+    monkeypatch.setattr(dxf_importer, "read_dxf", noting)
+    read_drawing(_spline_dxf(tmp_path / "s.dxf"), ImportOptions(fit_mm=(400.0, 400.0)))
+    assert asked == [TOL, pytest.approx(TOL / 4.0 * (1 - 1e-6), rel=1e-12)]
 
 
 def _spline_dxf(path: Path) -> Path:
@@ -138,7 +151,8 @@ def _spline_dxf(path: Path) -> Path:
 def test_dxf_spline_holds_the_tolerance_once_placed(tmp_path: Path, options: ImportOptions) -> None:
     path = _spline_dxf(tmp_path / "s.dxf")
     k = _factor(options)
-    (spline,) = [e for e in ezdxf.readfile(path).modelspace() if e.dxftype() == "SPLINE"]
+    splines: list[Any] = [e for e in ezdxf.readfile(path).modelspace() if e.dxftype() == "SPLINE"]
+    (spline,) = splines
     bs = spline.construction_tool()
     knots = bs.knots()
 
@@ -201,7 +215,7 @@ def test_every_way_in_fits_curves_for_the_planned_size(
     dxf = _spline_dxf(tmp_path / "s.dxf")
     monkeypatch.setattr("sys.stdin", io.TextIOWrapper(io.BytesIO(dxf.read_bytes())))
     assert main(["post", "-", *fit, "-o", str(tmp_path / "s.ngc")]) == 0
-    as_file = post_path(dxf, target, plan).result.code
+    as_file = str(post_path(dxf, target, plan).result.code)
     assert _blocks((tmp_path / "s.ngc").read_text()) == _blocks(as_file)
 
 
