@@ -10,12 +10,14 @@ never loads ezdxf or svgelements. The options and limits every importer takes ar
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from pathlib import Path
+from typing import NoReturn
 
 from camtool.importers.options import ImportOptions
 from camtool.model.errors import InputError
 from camtool.model.progress import Progress, Step, no_progress
-from camtool.model.shapes import Drawing, fit_factor
+from camtool.model.shapes import BBox, Drawing, fit_factor
 
 POINT_SUFFIXES = (".csv", ".txt", ".xy", ".m")
 """File endings of unitless point lists, the only inputs ``--units`` applies to."""
@@ -25,7 +27,11 @@ DRAWING_SUFFIXES = (".dxf", ".svg", *POINT_SUFFIXES)
 
 
 def read_drawing(
-    path: str | Path, options: ImportOptions | None = None, *, progress: Progress = no_progress
+    path: str | Path,
+    options: ImportOptions | None = None,
+    *,
+    progress: Progress = no_progress,
+    check: Callable[[BBox], None] | None = None,
 ) -> Drawing:
     """Read the drawing at ``path``, choosing the importer by the file name ending.
 
@@ -45,17 +51,23 @@ def read_drawing(
         progress: told the ``reading`` stage (:class:`~camtool.model.progress.Step`),
             and by the SVG importer its shapes and curve fits as it goes
             (:func:`camtool.importers.svg.read_svg`).
+        check: called with a box (mm, as drawn) within the drawing's extent as soon as
+            there is one: by the SVG importer before it fits curves (the extent of its
+            segments' ends), else with the extent of the drawing read. What it raises
+            stops the reading; ``camtool post`` refuses there a drawing too large for the
+            machine (:func:`camtool.jobs.pipeline.post_path`).
 
     Raises:
         InputError: the file is missing, unreadable, of an unknown kind, or holds
             no usable entity; or (``--fit``) a drawing so small against the tolerance
             that no fit holds it once scaled.
+        Whatever ``check`` raises.
     """
     path = Path(path)
     options = options or ImportOptions()
+    drawing, used = _read(path, options, progress, check)
     if options.fit_mm is None:
-        return _read(path, options, progress)[0]
-    drawing, used = _read(path, options, progress)
+        return drawing
     for margin in _REFIT_MARGINS:
         k = fit_factor(drawing.bbox(), options.fit_mm)
         k = 1.0 if math.isinf(k) else k
@@ -74,27 +86,42 @@ _REFIT_MARGINS = (1e-6, 1e-3, 0.1, 0.5)
 of the drawing before it (a finer fit moves the extent, so the factor, by a few tolerances)."""
 
 
-def _read(path: Path, options: ImportOptions, progress: Progress) -> tuple[Drawing, float]:
+def _read(
+    path: Path,
+    options: ImportOptions,
+    progress: Progress,
+    check: Callable[[BBox], None] | None = None,
+) -> tuple[Drawing, float]:
     """The drawing at ``path`` and the tolerance its curves were fitted within (mm, as drawn).
 
-    0.0 for a drawing without fitted curves (a point list).
+    0.0 for a drawing without fitted curves (a point list). ``check``: see
+    :func:`read_drawing`.
     """
     suffix = path.suffix.lower()
+    if suffix == ".svg":
+        from camtool.importers.svg import svg_drawing
+
+        return svg_drawing(path, options, progress=progress, check=check)
     if suffix == ".dxf":
         from camtool.importers.dxf import read_dxf
 
         progress(Step("reading", name=path.name))
         used = options.curve_tolerance()
-        return read_dxf(path, options.at_tolerance(used)), used
-    if suffix == ".svg":
-        from camtool.importers.svg import svg_drawing
-
-        return svg_drawing(path, options, progress=progress)
-    if suffix in POINT_SUFFIXES:
+        drawing = read_dxf(path, options.at_tolerance(used))
+    elif suffix in POINT_SUFFIXES:
         from camtool.importers.points import read_points
 
         progress(Step("reading", name=path.name))
-        return read_points(path, options), 0.0
+        drawing, used = read_points(path, options), 0.0
+    else:
+        _unknown(path, suffix)
+    if check is not None:
+        check(drawing.bbox())
+    return drawing, used
+
+
+def _unknown(path: Path, suffix: str) -> NoReturn:
+    """Refuse a file of a kind no importer reads (InputError)."""
     if suffix == "" and str(path) == "-":
         raise InputError("'-' (stdin) must be read with read_drawing_bytes")
     kind = f"{suffix!r} files" if suffix else "a file without a name ending"
@@ -109,11 +136,13 @@ def read_drawing_bytes(
     name: str = "<stdin>",
     suffix: str = ".dxf",
     options: ImportOptions | None = None,
+    check: Callable[[BBox], None] | None = None,
 ) -> Drawing:
     """Read a drawing given as bytes (e.g. piped on stdin), of the kind ``suffix`` names.
 
     The bytes go through a temporary file so that each importer detects the
-    encoding as it does for files; messages name ``name``.
+    encoding as it does for files; messages name ``name``. ``check``: as for
+    :func:`read_drawing`.
 
     Raises:
         InputError: as :func:`read_drawing`.
@@ -125,7 +154,7 @@ def read_drawing_bytes(
         path = Path(tmp) / f"stdin{suffix}"
         path.write_bytes(data)
         try:
-            drawing = read_drawing(path, options)
+            drawing = read_drawing(path, options, check=check)
         except InputError as exc:
             raise InputError(str(exc).replace(str(path), name)) from exc
     warnings = tuple(w.replace(str(path), name) for w in drawing.warnings)

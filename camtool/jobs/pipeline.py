@@ -14,7 +14,7 @@ from camtool.jobs.inputs import is_program_file
 from camtool.model.errors import InputError, UsageError
 from camtool.model.program import Move, Program
 from camtool.model.progress import Progress, Step, no_progress
-from camtool.model.shapes import Drawing
+from camtool.model.shapes import BBox, Drawing
 from camtool.post.base import PostResult, Target
 from camtool.post.registry import load_target
 from camtool.toolpath.options import PlanOptions, drawing_only
@@ -175,7 +175,12 @@ def post_path(
         from camtool.toolpath.compensate import offsets_ahead
 
         with offsets_ahead(plan):  # OpenCASCADE loads in the offsets' child meanwhile
-            drawing = read_drawing(path, sized(import_options, plan), progress=progress)
+            drawing = read_drawing(
+                path,
+                sized(import_options, plan),
+                progress=progress,
+                check=travel_check(plan, target),
+            )
             drawing = _note_units(drawing, path, import_options)
             with meanwhile(_preloads(drawing) if verifying else []):
                 return post_drawing(drawing, target, plan, output, progress=progress)
@@ -230,8 +235,8 @@ def post_bytes(
     plan = plan if plan is not None else PlanOptions()
     if not is_program_file(name):
         suffix = Path(name).suffix
-        options = sized(import_options, plan)
-        drawing = read_drawing_bytes(data, name=name, suffix=suffix, options=options)
+        options, check = sized(import_options, plan), travel_check(plan, target)
+        drawing = read_drawing_bytes(data, name=name, suffix=suffix, options=options, check=check)
         return post_drawing(_note_units(drawing, name, import_options), target, plan, output)
     refuse_planning(name, drawing_only(plan.given()))
     from camtool.importers.gcode import read_gcode_bytes
@@ -254,6 +259,35 @@ def sized(options: ImportOptions | None, plan: PlanOptions) -> ImportOptions:
     """
     base = options if options is not None else ImportOptions()
     return dataclasses.replace(base, scale=plan.scale, fit_mm=plan.fit_mm)
+
+
+def travel_check(plan: PlanOptions, target: Target) -> Callable[[BBox], None] | None:
+    """The check of a drawing's size against the travel before planning, or ``None``.
+
+    Only where the toolpath passes within the chaining and fitting tolerances of every
+    point of the drawing: ``--offset on`` (each contour cut on its line) or ``outside``
+    (open contours on their line; a closed one's cut outside it, or, for a hole, inside
+    a contour whose cut is outside), without ``--fit`` (which scales the drawing into a
+    box). Then :func:`~camtool.toolpath.placement.too_large_drawing` refuses a drawing
+    larger than the travel as soon as the importer knows its extent, before its curves
+    are fitted; inside offsets and pockets, whose cuts can vanish, are checked after
+    planning only, as every program is.
+    """
+    if plan.fit_mm is not None or plan.offset not in ("on", "outside"):
+        return None
+    from camtool.geometry.chain import joint_distance
+    from camtool.toolpath.placement import Placing, too_large_drawing
+
+    machine = target.machine
+    slack = joint_distance(plan.chain_tolerance) + plan.tolerance
+    tool = plan.radius if plan.offset == "outside" else 0.0
+    margin = 2.0 * (tool + plan.lead_in_mm)
+    placing = Placing(plan.placement, plan.translate, (margin, margin))
+
+    def check(box: BBox) -> None:
+        too_large_drawing(box, machine, placing, scale=plan.scale, slack_mm=slack)
+
+    return check
 
 
 def refuse_planning(path: str | Path, given: list[str]) -> None:

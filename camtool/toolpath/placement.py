@@ -351,6 +351,45 @@ def too_large(box: BBox, machine: Machine, placing: Placing | None) -> None:
     )
 
 
+def too_large_drawing(
+    box: BBox, machine: Machine, placing: Placing, *, scale: float = 1.0, slack_mm: float = 0.0
+) -> None:
+    """Refuse, before planning, a drawing whose toolpath would be larger than the travel.
+
+    For a caller that knows the toolpath will pass within ``slack_mm`` of every point of
+    the drawing as planning scales it (every contour cut on its line or enclosed by a cut
+    outside it; ``slack_mm`` covers the chaining and arc-fitting tolerances): then a
+    drawing more than ``2 · slack_mm`` larger than the travel on an axis gives a toolpath
+    :func:`too_large` refuses after planning, and it is refused here instead, before
+    the curves are fitted and the contours planned (Inkscape's ``filters.svg`` without
+    ``--fit``: 65 s to the same refusal).
+
+    Args:
+        box: a box within the drawing's extent, mm as drawn (before ``scale``).
+        machine: the machine profile.
+        placing: how the program will be placed, for the ``--fit`` remedy (its margin:
+            what the toolpath adds to the drawing, tool and lead arcs).
+        scale: the scale planning applies (``--scale``).
+        slack_mm: how far inside the drawing's points the toolpath may pass, mm.
+
+    Raises:
+        DialectError: naming the drawing's size (at least), the travel, ``--fit W H``
+            that makes it fit and a larger machine.
+    """
+    w, h = (box[2] - box[0]) * scale, (box[3] - box[1]) * scale
+    inner = (0.0, 0.0, max(w - 2.0 * slack_mm, 0.0), max(h - 2.0 * slack_mm, 0.0))
+    if not larger_than_travel(inner, machine):
+        return
+    tw, th = machine.travel_mm
+    fit = _fit_remedy(machine, placing, w, h)
+    scaled = f" at --scale {_num(scale)}" if scale != 1.0 else ""
+    raise DialectError(
+        f"the drawing is at least {_mm(w)} × {_mm(h)} mm{scaled}, so its toolpath is larger "
+        f"than the {_mm(tw)} × {_mm(th)} mm travel of {machine.name} (refused before "
+        f"planning); {fit}use a larger machine (--machine FILE.toml with its work_area_mm)"
+    )
+
+
 def outside_text(machine: Machine) -> str:
     """``outside the work area X a…b, Y c…d mm of NAME, which …`` for messages."""
     x0, y0, x1, y1 = machine.work_area_mm

@@ -163,7 +163,10 @@ def test_a_toolpath_larger_than_the_travel_names_both_sizes_and_a_fit_that_works
     argv = [str(plate(tmp_path / "p.dxf")), "-t", target, *OUTSIDE, "--machine", str(machine)]
     code, err = post([*argv, "-o", str(tmp_path / "refused")], capsys)
     assert code == 1
-    assert f"the toolpath is 103 × 63 mm, larger than the {size} mm travel of" in err
+    # --offset outside: the toolpath reaches the whole drawing, so it is refused once read
+    # (the toolpath's own size, 103 × 63 mm, is known only after planning)
+    assert f"the drawing is at least 100 × 60 mm, so its toolpath is larger than the {size}" in err
+    assert "(refused before planning)" in err
     assert "use a larger machine (--machine FILE.toml" in err
     (remedy,) = remedies(err)
     assert remedy[0] == "--fit"

@@ -1,0 +1,126 @@
+"""A drawing larger than the machine's travel is refused before its curves are fitted.
+
+Inkscape's filters.svg (3 275 mm wide) posted for GRBL (200 × 200 mm) without --fit took
+65 s and 1.29 GB to be refused after planning. With --offset on or outside the toolpath
+passes within the chaining and fitting tolerances of every point of the drawing, so the
+drawing's extent settles it at once. These tests hold: the refusal comes before any fit
+or planning; it is exact at the edge (a drawing that fits, within the tolerances, is
+planned and its program judged by the usual check); points that are not drawn (a path of
+zero length) do not count; inside offsets and pockets, whose cuts may vanish, are left to
+the check after planning.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+import camtool.importers.svg as svg_importer
+import camtool.toolpath.plan as plan_module
+from camtool.cli.main import main
+from camtool.jobs.pipeline import post_bytes, post_path
+from camtool.model.errors import DialectError
+from camtool.post.registry import load_target
+from camtool.toolpath.options import PlanOptions
+from tests.importers.svgutil import svg
+from tests.shapes import write_dxf
+
+GRBL_TRAVEL = 200.0  # mm, GRBL's default $130/$131 in the built-in profile
+BEZ = '<path d="M 0 50 C 20 0, 80 100, {w} 50" fill="none" stroke="black"/>'
+
+
+def _wide(tmp_path: Path, width_mm: float, extra: str = "") -> Path:
+    """An SVG whose one Bézier spans ``width_mm`` (1 user unit = 1 mm)."""
+    root = f'width="{width_mm + 10}mm" height="100mm" viewBox="0 0 {width_mm + 10} 100"'
+    return svg(tmp_path, BEZ.format(w=width_mm) + extra, root=root, name=f"w{width_mm}.svg")
+
+
+def _never(*_: Any, **__: Any) -> Any:
+    raise AssertionError("called after the drawing was found too large")
+
+
+def test_the_travel_is_grbls() -> None:
+    assert load_target("grbl").machine.travel_mm == (GRBL_TRAVEL, GRBL_TRAVEL)
+
+
+@pytest.mark.parametrize("offset", ["on", "outside"])
+def test_a_drawing_wider_than_the_travel_is_refused_before_any_fit(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, offset: str
+) -> None:
+    path = _wide(tmp_path, 1000.0)
+    monkeypatch.setattr(svg_importer, "_prefitted", _never)
+    monkeypatch.setattr(plan_module, "plan_drawing", _never)
+    plan = PlanOptions(offset=offset, tool_diameter=2.0)
+    with pytest.raises(DialectError, match=r"at least 1000 × \d+(\.\d+)? mm") as err:
+        post_path(path, load_target("grbl"), plan)
+    assert "refused before planning" in str(err.value)
+    assert "--fit" in str(err.value) and "travel of GRBL" in str(err.value)
+    with pytest.raises(DialectError, match="refused before planning"):
+        post_bytes(path.read_bytes(), path.name, load_target("grbl"), plan)
+
+
+def test_the_cli_refuses_it_with_exit_code_1_and_writes_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "out.gcode"
+    assert main(["post", str(_wide(tmp_path, 1000.0)), "-t", "grbl", "-o", str(out)]) == 1
+    assert "refused before planning" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_scale_counts(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    path = _wide(tmp_path, 150.0)  # fits as drawn, 300 mm at --scale 2 does not
+    monkeypatch.setattr(plan_module, "plan_drawing", _never)
+    with pytest.raises(DialectError, match=r"at least 300 × .* at --scale 2"):
+        post_path(path, load_target("grbl"), PlanOptions(scale=2.0))
+
+
+def test_a_drawing_that_fits_within_the_tolerances_is_planned(tmp_path: Path) -> None:
+    # 200.005 mm: over the travel by less than the chaining tolerance (0.01 mm) each side;
+    # the check before planning leaves it to planning, which judges the toolpath itself.
+    job = post_path(_wide(tmp_path, 199.99), load_target("grbl"), PlanOptions())
+    assert job.program.moves
+    with pytest.raises(DialectError, match=r"^the toolpath is 200\.005 × "):
+        post_path(_wide(tmp_path, 200.005), load_target("grbl"), PlanOptions())
+
+
+def test_points_that_are_not_drawn_do_not_count(tmp_path: Path) -> None:
+    far = '<path d="M 900 90 L 900 90" fill="none" stroke="black"/>'  # zero length
+    job = post_path(_wide(tmp_path, 100.0, far), load_target("grbl"), PlanOptions())
+    xs = [m.x for m in job.program.moves]
+    assert max(xs) - min(xs) == pytest.approx(100.0, abs=1e-6)
+
+
+@pytest.mark.parametrize("offset", ["inside", "pocket"])
+def test_inside_offsets_and_pockets_are_judged_after_planning(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, offset: str
+) -> None:
+    path = svg(
+        tmp_path,
+        '<rect x="0" y="0" width="1000" height="50" fill="none" stroke="black"/>',
+        root='width="1010mm" height="100mm" viewBox="0 0 1010 100"',
+    )
+    planned: list[bool] = []
+    plan_drawing = plan_module.plan_drawing
+
+    def noting(*args: Any, **kwargs: Any) -> Any:
+        planned.append(True)
+        return plan_drawing(*args, **kwargs)
+
+    monkeypatch.setattr(plan_module, "plan_drawing", noting)
+    with pytest.raises(DialectError, match=r"^the toolpath is 99\d(\.\d+)? × "):
+        post_path(path, load_target("grbl"), PlanOptions(offset=offset, tool_diameter=3.0))
+    assert planned == [True]
+
+
+def test_a_dxf_is_checked_once_read(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    def build(msp: Any) -> None:
+        msp.add_line((0, 0), (640, 0))
+        msp.add_open_spline([(0, 10, 0), (200, 90, 0), (400, -40, 0), (640, 30, 0)], degree=3)
+
+    path = write_dxf(tmp_path / "long.dxf", build)
+    monkeypatch.setattr(plan_module, "plan_drawing", _never)
+    with pytest.raises(DialectError, match=r"at least 640 × .*refused before planning"):
+        post_path(path, load_target("grbl"), PlanOptions())
