@@ -145,14 +145,18 @@ def post_path(
     """Post the file at ``path``: a drawing is planned, a G-code program re-posted.
 
     A program (by its ending, :func:`camtool.jobs.inputs.is_program_file`) is already a toolpath:
-    only ``plan.feed_mm_min`` and ``output`` apply (:func:`post_program`).
+    only ``plan.feed_mm_min`` and ``output`` apply (:func:`post_program`). A drawing's
+    curves are fitted for the size ``plan`` gives it (:func:`sized`), and a drawing
+    whose toolpath cannot fit the machine's travel is refused as soon as it is read
+    (:func:`travel_check`).
 
     Args:
         path: a drawing (DXF, SVG, points) or an existing G-code program.
         target: the target to write for.
         plan: the planning options (``None``: the defaults, the target's feed).
         output: how the program is written (``None``: the defaults).
-        import_options: how the drawing is read (layers, units…).
+        import_options: how the drawing is read (layers, units…; its ``scale`` and
+            ``fit_mm`` are ``plan``'s).
         progress: told the stages (:class:`~camtool.model.progress.Step`) as the job goes:
             ``reading`` (and for an SVG ``fitting`` and ``contours``,
             :func:`camtool.importers.read_drawing`), ``planning`` and ``writing``
