@@ -141,6 +141,7 @@ def post(
         post_path,
         refuse_planning,
         sized,
+        travel_check,
         verify_job,
     )
     from camtool.model.progress import Step
@@ -165,7 +166,7 @@ def post(
     progress = StageReporter()
     try:
         if drawing == "-":
-            drawn = read_input(drawing, sized(settings, plan))
+            drawn = read_input(drawing, sized(settings, plan), travel_check(plan, chosen))
             job = post_drawing(drawn, chosen, plan, output_options, progress=progress)
         else:
             job = post_path(

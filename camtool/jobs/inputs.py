@@ -43,9 +43,11 @@ from camtool.importers import DRAWING_SUFFIXES, read_drawing, read_drawing_bytes
 from camtool.model.errors import InputError, UsageError
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
     from camtool.importers.options import ImportOptions
     from camtool.model.program import Program
-    from camtool.model.shapes import Drawing
+    from camtool.model.shapes import BBox, Drawing
     from camtool.post.base import Target
 
 _MAGIC = re.compile(r"[*?[]")
@@ -59,15 +61,22 @@ def is_program_file(name: str | Path) -> bool:
     return Path(name).suffix.lower() in PROGRAM_SUFFIXES
 
 
-def read_input(name: str, settings: ImportOptions | None = None) -> Drawing:
+def read_input(
+    name: str,
+    settings: ImportOptions | None = None,
+    check: Callable[[BBox], None] | None = None,
+) -> Drawing:
     """The drawing at ``name`` (``-``: stdin), read by its ending.
+
+    ``check``: as for :func:`camtool.importers.read_drawing`.
 
     Raises:
         InputError: the drawing cannot be read (see :mod:`camtool.importers`).
+        Whatever ``check`` raises.
     """
     if name == "-":
-        return read_drawing_bytes(sys.stdin.buffer.read(), options=settings)
-    return read_drawing(name, settings)
+        return read_drawing_bytes(sys.stdin.buffer.read(), options=settings, check=check)
+    return read_drawing(name, settings, check=check)
 
 
 def read_code(name: str, *, binary: bool = False) -> str | bytes:

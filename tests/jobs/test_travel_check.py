@@ -12,6 +12,7 @@ the check after planning.
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 from typing import Any
 
@@ -124,3 +125,18 @@ def test_a_dxf_is_checked_once_read(tmp_path: Path, monkeypatch: pytest.MonkeyPa
     monkeypatch.setattr(plan_module, "plan_drawing", _never)
     with pytest.raises(DialectError, match=r"at least 640 × .*refused before planning"):
         post_path(path, load_target("grbl"), PlanOptions())
+
+
+def test_standard_input_is_checked_too(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    def build(msp: Any) -> None:
+        msp.add_lwpolyline([(0, 0), (640, 0), (640, 30), (0, 30)], close=True)
+
+    data = write_dxf(tmp_path / "long.dxf", build).read_bytes()
+    monkeypatch.setattr(plan_module, "plan_drawing", _never)
+    monkeypatch.setattr("sys.stdin", io.TextIOWrapper(io.BytesIO(data)))
+    out = tmp_path / "out.gcode"
+    assert main(["post", "-", "-t", "grbl", "-o", str(out)]) == 1
+    assert "the drawing is at least 640 × 30 mm" in capsys.readouterr().err
+    assert not out.exists()
