@@ -204,8 +204,10 @@ def _ends_box(drawn: list[tuple[Any, list[Any] | None]], page: Affine) -> BBox |
                 continue
             x0, y0 = apply(m, float(seg.start.x), float(seg.start.y))
             x1, y1 = apply(m, float(seg.end.x), float(seg.end.y))
-            finite = math.isfinite(x0 + y0 + x1 + y1)  # refused with its message later
-            if finite and math.hypot(x1 - x0, y1 - y0) > _DISTINCT_MM:
+            # a number past MAX_COORDINATE_MM (or not finite) is refused later, with its
+            # own message: it is no extent to judge
+            sane = max(abs(x0), abs(y0), abs(x1), abs(y1)) <= MAX_COORDINATE_MM
+            if sane and math.hypot(x1 - x0, y1 - y0) > _DISTINCT_MM:
                 xs += (x0, x1)
                 ys += (y0, y1)
     if not xs:

@@ -140,3 +140,15 @@ def test_standard_input_is_checked_too(
     assert main(["post", "-", "-t", "grbl", "-o", str(out)]) == 1
     assert "the drawing is at least 640 × 30 mm" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_a_number_past_the_coordinate_limit_is_refused_as_such(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # 1e300 is no extent to judge: the importer's own refusal (exit 3) names the path
+    huge = '<path d="M 0 0 L 1e300 10" fill="none" stroke="black"/>'
+    path = svg(tmp_path, '<path d="M 0 0 L 10 10" stroke="black"/>' + huge)
+    assert main(["post", str(path), "-t", "grbl", "-o", str(tmp_path / "h.gcode")]) == 3
+    err = capsys.readouterr().err
+    assert "path[2]" in err and "far too large" in err
+    assert "travel" not in err
