@@ -45,6 +45,7 @@ __all__ = [
     "read_record",
     "wait_readable",
     "wait_until",
+    "write_all",
     "write_record",
 ]
 
@@ -358,15 +359,27 @@ def read_exactly(fd: int, size: int) -> bytes | None:
     return b"".join(parts)
 
 
+def write_all(fd: int, data: bytes) -> None:
+    """Write every byte of ``data`` to ``fd``, ``os.write`` after ``os.write``.
+
+    A write to a pipe may take only part of its bytes; the next one then reports a reader
+    that has gone.
+
+    Raises:
+        OSError: the write failed (``BrokenPipeError``: the reader has gone).
+    """
+    view = memoryview(data)
+    while view:
+        view = view[os.write(fd, view) :]
+
+
 def write_record(fd: int, data: bytes) -> None:
     """Write ``data`` to ``fd`` framed by its length (8 bytes, little-endian), whole.
 
     Raises:
         OSError: the reader has gone (``BrokenPipeError``).
     """
-    view = memoryview(len(data).to_bytes(8, "little") + data)
-    while view:
-        view = view[os.write(fd, view) :]
+    write_all(fd, len(data).to_bytes(8, "little") + data)
 
 
 def read_record(fd: int) -> bytes | None:
