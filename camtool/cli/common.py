@@ -288,7 +288,7 @@ _POST_OPTIONS = (
     ),
     click.option(
         "--tool-diameter",
-        type=NUMBER,
+        type=number_range(min=0),
         default=0.0,
         metavar="MM",
         help="Tool diameter in mm (needed by every --offset but 'on').",

@@ -225,7 +225,7 @@ def post(
 )
 @click.option(
     "--tool-diameter",
-    type=NUMBER,
+    type=number_range(min=0),
     default=0.0,
     show_default=True,
     metavar="MM",

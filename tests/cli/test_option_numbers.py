@@ -97,3 +97,19 @@ def test_help_shows_no_empty_range(capsys) -> None:
     out = capsys.readouterr().out
     assert "None]" not in out and "x<=None" not in out
     assert "x>=0" in out  # a bounded option still shows its range
+
+
+@pytest.mark.parametrize("command", ["post", "verify"])
+def test_a_negative_tool_diameter_is_refused_naming_the_option_before_any_reading(
+    command: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # verify used to read the code first and then say "tool diameter must be >= 0 mm"
+    # without the option (a code with an O-word was refused for that instead)
+    code = tmp_path / "p.ngc"
+    code.write_text("O100 sub\nG1 X1 F100\nM2\n")  # an O-word: refused if it were read
+    source = str(SAMPLES / "plate.dxf") if command == "post" else str(code)
+    out = ["-o", str(tmp_path / "p.gcode")] if command == "post" else []
+    assert main([command, source, "-t", "grbl", "--tool-diameter", "-1", *out]) == 2
+    err = capsys.readouterr().err
+    assert "--tool-diameter" in err and "-1" in err
+    assert "O100" not in err and "O-word" not in err
