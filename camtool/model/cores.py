@@ -37,6 +37,7 @@ __all__ = [
     "default_jobs",
     "end_process",
     "fork_process",
+    "fork_with_pipes",
     "how_ended",
     "in_worker",
     "meanwhile",
@@ -305,6 +306,35 @@ def fork_process(run: Callable[[], None], *, closing: Sequence[int]) -> int:
         finally:
             os._exit(code)
     return pid
+
+
+def fork_with_pipes(
+    run: Callable[[int, int], None], *, closing: Sequence[int] = ()
+) -> tuple[int, int, int]:
+    """Fork a helper joined to this process by two pipes: ``(pid, to_child, from_child)``.
+
+    The child runs ``run(inbox, outbox)`` on its ends of the pipes, with this process's
+    ends and ``closing`` closed in it, and leaves as :func:`fork_process` says; this
+    process keeps ``to_child`` and ``from_child``. The one way the offsets' child, its
+    workers and the picture's child are started.
+
+    Raises:
+        OSError: no pipe or no fork (a process limit, no memory). Nothing is left open:
+            the caller does the work itself, as where ``fork`` is missing.
+    """
+    made: list[int] = []
+    try:
+        made += os.pipe()
+        made += os.pipe()
+        inbox, to_child, from_child, outbox = made
+        pid = fork_process(lambda: run(inbox, outbox), closing=(*closing, to_child, from_child))
+    except OSError:
+        for fd in made:
+            os.close(fd)
+        raise
+    os.close(inbox)
+    os.close(outbox)
+    return pid, to_child, from_child
 
 
 def end_process(pid: int, *, kill: bool = False) -> int:

@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING
 from camtool.model.cores import (
     FORK,
     end_process,
-    fork_process,
+    fork_with_pipes,
     in_worker,
     quiet_crashes,
     read_record,
@@ -51,15 +51,15 @@ class _Drawer:
     """The forked child (:func:`_serve`) and this process's ends of its two pipes."""
 
     def __init__(self) -> None:
-        inbox_read, inbox_write = os.pipe()
-        out_read, out_write = os.pipe()
-        self.pid: int | None = fork_process(
-            lambda: _serve(inbox_read, out_write), closing=(inbox_write, out_read)
-        )
-        os.close(inbox_read)
-        os.close(out_write)
-        self.inbox: int | None = inbox_write
-        self.out: int | None = out_read
+        """Fork it.
+
+        Raises:
+            OSError: it cannot be forked now (:func:`~camtool.model.cores.fork_with_pipes`).
+        """
+        pid, inbox, out = fork_with_pipes(_serve)
+        self.pid: int | None = pid
+        self.inbox: int | None = inbox
+        self.out: int | None = out
         self.loading = False
 
     def fds(self) -> tuple[int, ...]:
@@ -123,14 +123,16 @@ _HOOKED: list[bool] = []
 def start_ahead() -> None:
     """Start the child that will draw this process's next PNG (Linux; once at a time).
 
-    Nothing is started without ``fork`` or in a worker process (a batch's or Dask's, whose
-    cores are busy with other files): the picture is then drawn here, as before.
+    Nothing is started without ``fork``, in a worker process (a batch's or Dask's, whose
+    cores are busy with other files) or when the fork fails (a process limit, no memory):
+    the picture is then drawn here, as before.
     """
     if FORK and not _AHEAD and not in_worker():
         if not _HOOKED:  # once, and only in a process that starts a child
             os.register_at_fork(after_in_child=_close_in_forked_child)
             _HOOKED.append(True)
-        _AHEAD.append(_Drawer())
+        with contextlib.suppress(OSError):  # no fork now: the picture is drawn here
+            _AHEAD.append(_Drawer())
 
 
 def load_ahead() -> None:

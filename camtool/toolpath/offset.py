@@ -34,7 +34,7 @@ from camtool.model.cores import (
     FORK,
     default_jobs,
     end_process,
-    fork_process,
+    fork_with_pipes,
     how_ended,
     in_worker,
     quiet_crashes,
@@ -217,7 +217,11 @@ def offset_all(
     workers = _workers(jobs)
     out: list[Answer] = []
     while len(out) < len(jobs):
-        child = _AHEAD.pop() if _AHEAD else _Child()
+        try:
+            child = _AHEAD.pop() if _AHEAD else _Child()
+        except OSError:  # no fork now (a process limit, memory): made here, as without fork
+            out.extend(_attempt(contour, amount) for contour, amount in jobs[len(out) :])
+            break
         try:
             got, died = child.make(jobs[len(out) :], workers, tolerance, _after(len(out), done))
         finally:
@@ -271,7 +275,8 @@ def start_ahead() -> None:
     stops it if no offsets came.
     """
     if FORK and not _AHEAD and _OFFSET_CALLS[0] == 0 and not in_worker() and not _occt_here():
-        _AHEAD.append(_Child())
+        with contextlib.suppress(OSError):  # no fork now: offset_all makes its own, or not
+            _AHEAD.append(_Child())
 
 
 def load_here() -> None:
@@ -348,21 +353,22 @@ class _Child:
     """
 
     def __init__(self) -> None:
-        jobs_read, jobs_write = os.pipe()
-        answers_read, answers_write = os.pipe()
+        """Fork it.
 
-        def child() -> None:
+        Raises:
+            OSError: it cannot be forked now (:func:`~camtool.model.cores.fork_with_pipes`).
+        """
+
+        def child(jobs: int, answers: int) -> None:
             quiet_crashes()
             _load_occt()
-            with os.fdopen(jobs_read, "rb") as inbox, os.fdopen(answers_write, "wb") as out:
+            with os.fdopen(jobs, "rb") as inbox, os.fdopen(answers, "wb") as out:
                 _serve(inbox, out)
 
-        pid = fork_process(child, closing=(jobs_write, answers_read))
-        os.close(jobs_read)
-        os.close(answers_write)
+        pid, jobs, answers = fork_with_pipes(child)
         self.pid: int | None = pid
-        self.jobs = os.fdopen(jobs_write, "wb")
-        self.answers = os.fdopen(answers_read, "rb")
+        self.jobs = os.fdopen(jobs, "wb")
+        self.answers = os.fdopen(answers, "rb")
 
     def make(
         self,
@@ -484,17 +490,12 @@ class _Worker:
         closing: Sequence[int],
     ) -> None:
         """Fork it; ``closing``: the fds it must not hold (the child's own, other workers')."""
-        given_read, given_write = os.pipe()
-        answers_read, answers_write = os.pipe()
-        pid = fork_process(
-            lambda: _work(jobs, tolerance, given_read, answers_write),
-            closing=(*closing, given_write, answers_read),
+        pid, given, answers = fork_with_pipes(
+            lambda inbox, out: _work(jobs, tolerance, inbox, out), closing=closing
         )
-        os.close(given_read)
-        os.close(answers_write)
         self.pid: int | None = pid
-        self.given = given_write
-        self.answers = answers_read
+        self.given = given
+        self.answers = answers
         self.job = -1
 
     def give(self, job: int) -> None:

@@ -218,3 +218,55 @@ def test_ahead_makes_the_items_here_in_a_worker_or_on_one_core(
 
         assert list(cores.ahead(made())) == [0, 1, 2]
         assert set(makers) == {threading.current_thread().name}
+
+
+def _no_fork() -> int:
+    raise BlockingIOError(11, "Resource temporarily unavailable")
+
+
+def test_a_failed_fork_leaves_no_pipe_open(monkeypatch: pytest.MonkeyPatch) -> None:
+    from camtool.model.cores import fork_with_pipes
+
+    before = sorted(os.listdir("/proc/self/fd"))
+    monkeypatch.setattr(os, "fork", _no_fork)
+    with pytest.raises(BlockingIOError):
+        fork_with_pipes(lambda inbox, out: None)
+    assert sorted(os.listdir("/proc/self/fd")) == before
+
+
+def test_fork_with_pipes_joins_the_child(monkeypatch: pytest.MonkeyPatch) -> None:
+    from camtool.model.cores import end_process, fork_with_pipes, read_record, write_record
+
+    def echo(inbox: int, out: int) -> None:
+        data = read_record(inbox)
+        assert data is not None
+        write_record(out, data[::-1])
+
+    pid, to_child, from_child = fork_with_pipes(echo)
+    write_record(to_child, b"G1 X1")
+    assert read_record(from_child) == b"1X 1G"
+    os.close(to_child)
+    os.close(from_child)
+    assert end_process(pid) == 0
+
+
+def test_post_with_offsets_and_a_png_when_no_process_can_be_forked(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Under a process limit or out of memory, the offsets' child, its workers, the
+    # picture's child and the budget's workers cannot start: the job is done here, the
+    # same program and picture (it was "internal error: BlockingIOError" before).
+    from camtool.cli.main import main
+
+    plate = Path(__file__).resolve().parents[2] / "samples" / "plate.dxf"
+    args = ["post", str(plate), "-t", "grbl", "--offset", "outside", "--tool-diameter", "3"]
+    args += ["--origin", "lower-left"]
+
+    def run(name: str) -> tuple[bytes, bytes]:
+        out, png = tmp_path / f"{name}.gcode", tmp_path / f"{name}.png"
+        assert main([*args, "-o", str(out), "--preview", str(png)]) == 0, capsys.readouterr()
+        return out.read_bytes(), png.read_bytes()
+
+    forked = run("forked")
+    monkeypatch.setattr(os, "fork", _no_fork)
+    assert run("here") == forked
