@@ -48,8 +48,9 @@ def check_curve_size(extent: float, tolerance: float) -> None:
     if not extent <= MAX_CURVE_RATIO * tolerance:
         raise ValueError(
             f"a curve {extent:g} across, more than {MAX_CURVE_RATIO:g} times the fitting "
-            f"tolerance {tolerance:g}, would need too many arcs; scale the drawing or "
-            "raise --tolerance"
+            f"tolerance {tolerance:g} (--tolerance at the drawing's own size: --scale and "
+            "--fit divide it by their factor), would need too many arcs; scale the drawing "
+            "less or raise --tolerance"
         )
 
 

@@ -24,6 +24,7 @@ from camtool.cli.main import main
 from camtool.importers import read_drawing
 from camtool.importers.options import ImportOptions
 from camtool.jobs.pipeline import post_bytes, post_path
+from camtool.model.errors import InputError
 from camtool.model.program import ArcMove, Linear, Program
 from camtool.model.shapes import Arc, Contour, Drawing, Line, Segment, make_arc
 from camtool.post.registry import load_target
@@ -222,3 +223,14 @@ def test_every_way_in_fits_curves_for_the_planned_size(
 def _blocks(code: str) -> list[str]:
     """The program's blocks without its comments (which name the input)."""
     return [line for line in code.splitlines() if not line.startswith("(")]
+
+
+def test_a_scale_too_large_for_the_tolerance_says_the_tolerance_was_divided(
+    tmp_path: Path,
+) -> None:
+    # 100 mm × 10⁶: a fit within 1 µm would need a tolerance of 10⁻⁹ mm as drawn, the
+    # curve 10¹¹ times it; the message says why the tolerance it names is not --tolerance
+    path = svg(tmp_path, FRAME + BEZ)
+    with pytest.raises(InputError, match=r"--scale and --fit divide it") as err:
+        read_drawing(path, ImportOptions(scale=1e6))
+    assert "path#bez" in str(err.value) and "1e-09" in str(err.value)
