@@ -74,6 +74,7 @@ from camtool.model.program import (
     ToolChange,
 )
 from camtool.model.shapes import FULL_CIRCLE_EPS, Arc, Point, make_arc
+from camtool.post import conformahead
 from camtool.post.base import (
     PostProcessor,
     PostResult,
@@ -200,6 +201,20 @@ _SAME_MM = 1e-9
 _PRINTED_KEPT = 1 << 16
 """Coordinates per letter whose text a writer keeps (:meth:`BlockWriter._print`)."""
 _MOVES = (Rapid, Linear, ArcMove)
+
+
+class _Conformed(dict[tuple[Any, ...], list[tuple[Point, Point | None]]]):
+    """A writer's memory of the arcs it has conformed, by key (``BlockWriter._conformed_at``).
+
+    ``ahead``: the helper conforming the program's arcs meanwhile
+    (:mod:`camtool.post.conformahead`), or ``None``.
+    """
+
+    def __init__(self, ahead: conformahead.ConformAhead | None = None) -> None:
+        super().__init__()
+        self.ahead = ahead
+
+
 """The kinds of move (a tuple: ``isinstance`` takes it faster than ``Rapid | Linear | ...``)."""
 _CONFORMED_KEPT = 20_000
 """Arcs whose blocks a writer keeps (:meth:`BlockWriter._conformed`); then it starts anew."""
@@ -247,7 +262,7 @@ class BlockWriter(WriterState[str]):
             letter: {} for letter in spec.words
         }
         self._quantum: float | None = None
-        self._conformed_arcs: dict[tuple[Any, ...], list[tuple[Point, Point | None]]] = {}
+        self._conformed_arcs = _Conformed()
         self._feed_text: tuple[float, str] | None = None
         # GRBL's mc_arc counts an arc's chords as ⌊|θ·r/2| / √($12·(2r − $12))⌋: an arc of
         # radius r ≤ $12/2 divides by zero or by the root of a negative number, and what the
@@ -284,11 +299,21 @@ class BlockWriter(WriterState[str]):
                 self.blocks.append(comment)
         for codes in self.spec.preamble:
             self.block(list(codes))
-        for item in program.items():
-            if isinstance(item, _MOVES):
-                self.move(item)
-            else:
-                self.command(item)
+        # the arcs' blocks, conformed ahead in a helper when there are many (issue 17); held
+        # by the memory of conformed arcs, not as a 30th attribute of the writer: that one
+        # made every block of issue 17's re-post ~8 % slower (CPython 3.11 stops sharing
+        # the keys of instances with that many attributes)
+        ahead = conformahead.start(self, program)
+        self._conformed_arcs = _Conformed(ahead)
+        try:
+            for item in program.items():
+                if isinstance(item, _MOVES):
+                    self.move(item)
+                else:
+                    self.command(item)
+        finally:
+            if ahead is not None:
+                ahead.close()
         for codes in self.spec.postamble:
             self.block(list(codes))
         if self.spec.end:
@@ -577,7 +602,15 @@ class BlockWriter(WriterState[str]):
                 self.counts["tiny-arc"] += 1
             return known
         zero = 0.0 in key[0] or 0.0 in end or 0.0 in centre or 0.0 in start
-        out = self._conform(piece if piece is not None else make_arc(start, end, centre, clockwise))
+        ahead = None if zero or kept.ahead is None else kept.ahead.take(key)
+        if ahead is not None:  # what _conform gives: the helper ran conform_arc on the same key
+            out = ahead
+            if not out:
+                self.counts["tiny-arc"] += 1
+        else:
+            out = self._conform(
+                piece if piece is not None else make_arc(start, end, centre, clockwise)
+            )
         if not zero:
             if len(kept) >= _CONFORMED_KEPT:
                 kept.clear()

@@ -1,0 +1,252 @@
+"""A program's arcs conformed ahead, in a forked helper, while the writer works (issue 17).
+
+The arc check of GRBL and LinuxCNC (:func:`camtool.post.arccheck.conform_arc`, about
+25 µs an arc) is a function of its arguments alone: the start the controller holds (as
+printed), the exact end, the exact centre, the direction and the exact start (the rule and
+the quantum are the writer's, the same for every arc). On a program of many arcs it is
+about half the writer's time: issue 17's 213-icon SVG has 60 310 distinct arcs, 1.7 s of
+the writer's 3.5 s, while the second core waits.
+
+:class:`ConformAhead` forks a helper as the writer starts (:func:`start`). The helper
+predicts each arc's arguments from the program: the start the controller holds is where
+the move before the arc ends, as printed (:meth:`~camtool.post.wordaddress.BlockWriter.
+_print`). It then conforms the arcs from the last towards the first, and sends what it
+found in records of :data:`BATCH` arcs, until it reaches the arcs the writer has passed
+(the writer tells how far it is in memory they share). Meanwhile the writer works from
+the first arc. For each arc, the writer looks up its own arguments
+(:meth:`ConformAhead.take`). It takes the helper's blocks only when these arguments equal
+the helper's prediction exactly (the dictionary key), so they are the blocks the writer
+would have made itself. Any other arc is conformed by the writer, as before:
+
+- an arc whose prediction missed (an arc before it ended elsewhere than printed);
+- an arc the helper has not reached yet;
+- an arc whose check failed in the helper (the writer repeats it and words the error
+  where it belongs).
+
+The output is the same bytes whether or not the helper runs, answers, or dies. Keys with
+a zero are left out, as the writer's own memory of conformed arcs leaves them out:
+``-0.0`` equals ``0.0`` as a key, but not as an angle.
+
+Measured on that SVG (`make bench`'s, `post --target grbl`): the writer 3.5 → 2.4 s, the
+whole command 10.7 → 10.1 s, the same G-code; the helper answered 33 000 of the arcs.
+
+No helper (the writer conforms every arc) under :data:`MIN_ARCS` arcs, without an arc
+check, on one core, in a worker process (``camtool batch``'s: its cores are busy with
+other files), or when no process can be forked.
+"""
+
+from __future__ import annotations
+
+import math
+import mmap
+import os
+import struct
+from collections.abc import Iterator
+from contextlib import suppress
+from typing import TYPE_CHECKING
+
+from camtool.model.errors import CamtoolError
+from camtool.model.program import ArcMove, Linear, Program, Rapid
+from camtool.model.shapes import Point
+
+if TYPE_CHECKING:
+    from camtool.post.wordaddress import BlockWriter
+
+Key = tuple[Point, Point, Point, bool, Point]
+"""An arc's arguments: ``(written start, end, centre, clockwise, exact start)``, mm."""
+Blocks = list[tuple[Point, Point | None]]
+"""The writer's blocks of one arc: ``(end, absolute centre)`` each."""
+
+MIN_ARCS = 2000
+"""Arcs of distinct centres (told apart by their x) from which a helper is forked (~50 ms
+of conforming: below that, the fork and the helper's prediction cost about what they
+save). Issue 17's re-post repeats 1 653 arcs 17 times: the writer reuses their blocks, and
+no helper runs."""
+BATCH = 256
+"""Arcs a record holds (~25 kB: under a pipe's buffer, so a record is read at once)."""
+POLL_EVERY = 32
+"""Lookups between two looks at the helper's pipe (a look costs a system call)."""
+AT = struct.Struct("<q")
+"""The shared count of arcs the writer has looked up (:class:`ConformAhead`)."""
+SAME_MM = 1e-9
+"""A move of this much XY or less with a Z is written as a Z-only block (no X, Y words):
+the position the controller holds does not change (``BlockWriter._straight``)."""
+
+
+class ConformAhead:
+    """The helper's answers, as :func:`start` forked it; :meth:`close` it after writing.
+
+    Args:
+        pid: the helper's process id.
+        fd: the read end of the pipe its records come through.
+        shared: memory shared with the helper, where :meth:`take` tells it how many arcs
+            the writer has looked up (:data:`AT`): the helper stops at the arcs the
+            writer has passed.
+    """
+
+    def __init__(self, pid: int, fd: int, shared: mmap.mmap) -> None:
+        self.pid = pid
+        self.fd: int | None = fd
+        self.shared = shared
+        self.got: dict[Key, Blocks] = {}
+        self.looks = 0
+        self.taken = 0
+
+    def take(self, key: Key) -> Blocks | None:
+        """The blocks the helper found for the arc ``key``, or ``None`` (not found yet, or not)."""
+        self.looks += 1
+        if self.looks % POLL_EVERY == 0:
+            AT.pack_into(self.shared, 0, self.looks)
+            self._read()
+        found = self.got.pop(key, None)
+        if found is not None:
+            self.taken += 1
+        return found
+
+    def _read(self) -> None:
+        """Take every record the helper has written so far, without waiting for more."""
+        import pickle
+        import select
+
+        from camtool.model.cores import read_record
+
+        fd = self.fd
+        while fd is not None and select.select([fd], [], [], 0.0)[0]:
+            record = read_record(fd)
+            if record is None:  # the helper has finished (or died): nothing more comes
+                self._close_pipe()
+                return
+            self.got.update(pickle.loads(record))
+
+    def _close_pipe(self) -> None:
+        if self.fd is not None:
+            os.close(self.fd)
+            self.fd = None
+
+    def close(self) -> None:
+        """End the helper (it may still be working: its answers are no longer needed)."""
+        from camtool.model.cores import end_process
+
+        self._close_pipe()
+        with suppress(ChildProcessError):
+            end_process(self.pid, kill=True)
+        self.got.clear()
+        self.shared.close()
+
+
+def start(writer: BlockWriter, program: Program) -> ConformAhead | None:
+    """Fork the helper that conforms ``program``'s arcs for ``writer``; ``None`` when not.
+
+    Call it once ``writer`` holds the program's origin as written (``writer.written``),
+    before its first block: the helper is a copy of it. Not under :data:`MIN_ARCS` arcs,
+    without an arc check, on one core, in a worker process, or when no process can be
+    forked (``None``: the writer conforms every arc itself).
+    """
+    if writer.spec.arc_check == "none" or len(program.moves) < MIN_ARCS:
+        return None
+    # Distinct arcs, told apart by their centre's x (a few ms; an estimate from below): a
+    # program that cuts its contours again (at other depths, or copies) has the writer
+    # reuse their blocks (BlockWriter._conformed_at), not conform them again.
+    if len({m.cx for m in program.moves if isinstance(m, ArcMove)}) < MIN_ARCS:
+        return None
+    from camtool.model.cores import (  # only here: ~9 ms that a re-post does not need
+        default_jobs,
+        fork_with_pipes,
+        in_worker,
+        quiet_crashes,
+        write_record,
+    )
+
+    if default_jobs() < 2 or in_worker():
+        return None
+
+    import pickle
+
+    shared = mmap.mmap(-1, AT.size)  # anonymous and shared with the helper
+    AT.pack_into(shared, 0, 0)
+
+    def serve(inbox: int, outbox: int) -> None:
+        quiet_crashes()
+        os.close(inbox)
+        keys = list(dict.fromkeys(predicted_keys(writer, program)))  # each arc once, first
+        k = len(keys) - 1  # from the last arc back, until the writer has passed them
+        while k >= 0 and k >= AT.unpack_from(shared)[0]:
+            found = []
+            for key in keys[k : max(k - BATCH, -1) : -1]:
+                blocks = _conformed(writer, key)
+                if blocks is not None:
+                    found.append((key, blocks))
+            write_record(outbox, pickle.dumps(found, protocol=pickle.HIGHEST_PROTOCOL))
+            k -= BATCH
+
+    try:
+        pid, to_child, from_child = fork_with_pipes(serve)
+    except OSError:
+        shared.close()
+        return None
+    os.close(to_child)
+    return ConformAhead(pid, from_child, shared)
+
+
+def predicted_keys(writer: BlockWriter, program: Program) -> Iterator[Key]:
+    """The arguments ``writer`` will conform each arc of ``program`` with, as predicted.
+
+    The start the controller holds before an arc is where the last move that wrote X and
+    Y ended, as printed; the exact start is where the move before ended. An arc whose end
+    prints as that start (a full circle, or an arc that rounds away) is left out: the
+    writer conforms it otherwise. So is a key with a zero (the module's docstring), and
+    an arc after a number that cannot be printed (the writer raises there).
+    """
+    here = program.origin
+    written = writer.written
+    last_xy: Point | None = None  # where the last move writing X and Y ended, not printed yet
+    for move in program.moves:
+        end = (move.x, move.y)
+        if isinstance(move, ArcMove):
+            try:
+                if last_xy is not None:
+                    written = _printed(writer, last_xy)
+                    last_xy = None
+                printed_end = _printed(writer, end)
+            except CamtoolError:
+                return
+            if printed_end != written:
+                key = (written, end, (move.cx, move.cy), move.clockwise, here)
+                if not any(0.0 in point for point in (written, end, key[2], here)):
+                    yield key
+            written = printed_end
+        elif not (
+            isinstance(move, (Rapid, Linear))
+            and move.z is not None
+            and math.dist(here, end) <= SAME_MM
+        ):
+            last_xy = end
+        here = end
+
+
+def _printed(writer: BlockWriter, point: Point) -> Point:
+    """``point`` as the controller reads it back after ``writer`` prints it."""
+    return (writer._print("X", point[0])[1], writer._print("Y", point[1])[1])
+
+
+def _conformed(writer: BlockWriter, key: Key) -> Blocks | None:
+    """The writer's blocks for the arc ``key`` (``BlockWriter._conform``), or ``None``.
+
+    ``None`` when the check raises: the writer repeats the arc and says why.
+    """
+    from camtool.post.arccheck import conform_arc
+
+    written, end, centre, clockwise, exact_start = key
+    try:
+        pieces = conform_arc(
+            written,
+            end,
+            centre,
+            clockwise,
+            rule=writer.spec.arc_check,
+            quantum_mm=writer.spec.quantum_mm(),
+            exact_start=exact_start,
+        )
+    except Exception:  # repeated by the writer, which words it
+        return None
+    return [(p.end, p.centre) for p in pieces]
