@@ -68,6 +68,8 @@ POLL_EVERY = 32
 """Lookups between two looks at the helper's pipe (a look costs a system call)."""
 AT = struct.Struct("<q")
 """The shared count of arcs the writer has looked up (:class:`ConformAhead`)."""
+NEAR = 2 * BATCH
+"""Lookups ahead of a record's first arc from which the writer reads it."""
 SAME_MM = 1e-9
 """A move of this much XY or less with a Z is written as a Z-only block (no X, Y words):
 the position the controller holds does not change (``BlockWriter._straight``)."""
@@ -89,15 +91,19 @@ class ConformAhead:
         self.fd: int | None = fd
         self.shared = shared
         self.got: dict[Key, Blocks] = {}
+        # records as they came, (first arc, bytes), the latest arcs first: each is read
+        # once the writer nears its arcs (~100 bytes an arc where ~800 read)
+        self.raw: list[tuple[int, bytes]] = []
         self.looks = 0
         self.taken = 0
 
     def take(self, key: Key) -> Blocks | None:
         """The blocks the helper found for the arc ``key``, or ``None`` (not found yet, or not)."""
         self.looks += 1
-        if self.looks % POLL_EVERY == 0:
+        if self.looks % POLL_EVERY == 1:  # the first lookup too
             AT.pack_into(self.shared, 0, self.looks)
             self._read()
+            self._open_near()
         found = self.got.pop(key, None)
         if found is not None:
             self.taken += 1
@@ -105,7 +111,6 @@ class ConformAhead:
 
     def _read(self) -> None:
         """Take every record the helper has written so far, without waiting for more."""
-        import pickle
         import select
 
         from camtool.model.cores import read_record
@@ -116,7 +121,20 @@ class ConformAhead:
             if record is None:  # the helper has finished (or died): nothing more comes
                 self._close_pipe()
                 return
-            self.got.update(pickle.loads(record))
+            self.raw.append((AT.unpack_from(record)[0], record))
+
+    def _open_near(self) -> None:
+        """Read the records of the arcs the writer is near into :attr:`got`.
+
+        The writer's lookups number at least its arcs (it also looks up the arcs the
+        helper leaves out), so a record of the arcs from ``first`` is read once the
+        lookups reach ``first`` less :data:`NEAR`: never after the writer needs it.
+        """
+        import pickle
+
+        raw, near = self.raw, self.looks + NEAR
+        while raw and raw[-1][0] <= near:  # the earliest arcs came last
+            self.got.update(pickle.loads(memoryview(raw.pop()[1])[AT.size :]))
 
     def _close_pipe(self) -> None:
         if self.fd is not None:
@@ -131,6 +149,7 @@ class ConformAhead:
         with suppress(ChildProcessError):
             end_process(self.pid, kill=True)
         self.got.clear()
+        self.raw.clear()
         self.shared.close()
 
 
@@ -176,7 +195,9 @@ def start(writer: BlockWriter, program: Program) -> ConformAhead | None:
                 blocks = _conformed(writer, key)
                 if blocks is not None:
                     found.append((key, blocks))
-            write_record(outbox, pickle.dumps(found, protocol=pickle.HIGHEST_PROTOCOL))
+            first = max(k - BATCH + 1, 0)
+            data = pickle.dumps(found, protocol=pickle.HIGHEST_PROTOCOL)
+            write_record(outbox, AT.pack(first) + data)
             k -= BATCH
 
     try:
