@@ -187,12 +187,13 @@ def start(writer: BlockWriter, program: Program) -> ConformAhead | None:
     def serve(inbox: int, outbox: int) -> None:
         quiet_crashes()
         os.close(inbox)
-        keys = list(dict.fromkeys(predicted_keys(writer, program)))  # each arc once, first
-        k = len(keys) - 1  # from the last arc back, until the writer has passed them
+        calls = list(dict.fromkeys(arc_calls(program)))  # each arc once, first
+        k = len(calls) - 1  # from the last arc back, until the writer has passed them
         while k >= 0 and k >= AT.unpack_from(shared)[0]:
             found = []
-            for key in keys[k : max(k - BATCH, -1) : -1]:
-                blocks = _conformed(writer, key)
+            for call in calls[k : max(k - BATCH, -1) : -1]:
+                key = key_of(writer, call)
+                blocks = None if key is None else _conformed(writer, key)
                 if blocks is not None:
                     found.append((key, blocks))
             first = max(k - BATCH + 1, 0)
@@ -212,37 +213,70 @@ def start(writer: BlockWriter, program: Program) -> ConformAhead | None:
 def predicted_keys(writer: BlockWriter, program: Program) -> Iterator[Key]:
     """The arguments ``writer`` will conform each arc of ``program`` with, as predicted.
 
-    The start the controller holds before an arc is where the last move that wrote X and
-    Y ended, as printed; the exact start is where the move before ended. An arc whose end
-    prints as that start (a full circle, or an arc that rounds away) is left out: the
-    writer conforms it otherwise. So is a key with a zero (the module's docstring), and
-    an arc after a number that cannot be printed (the writer raises there).
+    In the program's order, each arc once (:func:`arc_calls`, :func:`key_of`).
     """
+    for call in dict.fromkeys(arc_calls(program)):
+        key = key_of(writer, call)
+        if key is not None:
+            yield key
+
+
+Call = tuple["Point | None", Point, Point, bool, Point]
+"""An arc as :func:`arc_calls` gives it: ``(before, end, centre, clockwise, exact start)``."""
+
+
+def arc_calls(program: Program) -> list[Call]:
+    """Each arc of ``program`` with where the last move writing X and Y before it ended.
+
+    ``before`` is that end, not yet printed (``None``: no such move, the controller holds
+    the program's origin as written); the exact start is where the move before ended.
+    A move that changes only Z writes no X or Y (``BlockWriter._straight``); an arc does.
+    Nothing is printed here, so the helper predicts the arcs in any order, the last first,
+    with no pass over the program before its first answer (printing every end first took
+    0.5 s of issue 17's SVG). An arc with a zero in it is left out (the module's
+    docstring).
+    """
+    calls: list[Call] = []
     here = program.origin
-    written = writer.written
-    last_xy: Point | None = None  # where the last move writing X and Y ended, not printed yet
+    before: Point | None = None
     for move in program.moves:
         end = (move.x, move.y)
         if isinstance(move, ArcMove):
-            try:
-                if last_xy is not None:
-                    written = _printed(writer, last_xy)
-                    last_xy = None
-                printed_end = _printed(writer, end)
-            except CamtoolError:
-                return
-            if printed_end != written:
-                key = (written, end, (move.cx, move.cy), move.clockwise, here)
-                if not any(0.0 in point for point in (written, end, key[2], here)):
-                    yield key
-            written = printed_end
+            centre = (move.cx, move.cy)
+            if not any(0.0 in p for p in (end, centre, here)) and (
+                before is None or 0.0 not in before
+            ):
+                calls.append((before, end, centre, move.clockwise, here))
+            before = end
         elif not (
             isinstance(move, (Rapid, Linear))
             and move.z is not None
             and math.dist(here, end) <= SAME_MM
         ):
-            last_xy = end
+            before = end
         here = end
+    return calls
+
+
+def key_of(writer: BlockWriter, call: Call) -> Key | None:
+    """The arguments ``writer`` will conform the arc ``call`` with, or ``None``.
+
+    The start the controller holds is ``before`` as printed (``writer.written`` as the
+    writer starts, for ``None``). ``None`` for an arc whose end prints as that start (a
+    full circle, or an arc that rounds away: the writer conforms it otherwise), one with
+    a zero in its key, and one after a number that cannot be printed (the writer raises
+    there).
+    """
+    before, end, centre, clockwise, here = call
+    try:
+        written = writer.written if before is None else _printed(writer, before)
+        if _printed(writer, end) == written:
+            return None
+    except CamtoolError:
+        return None
+    if 0.0 in written:
+        return None
+    return (written, end, centre, clockwise, here)
 
 
 def _printed(writer: BlockWriter, point: Point) -> Point:

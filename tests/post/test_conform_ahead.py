@@ -183,13 +183,13 @@ def test_answers_to_other_arguments_are_not_taken(monkeypatch: pytest.MonkeyPatc
     post = post_of("grbl")
     program = arc_program(random.Random(5), ARCS, messy=False)
     expected = alone(post, program, monkeypatch)
-    predict = conformahead.predicted_keys
+    key_of = conformahead.key_of
 
-    def off(writer: BlockWriter, program: Program) -> Any:
-        for (wx, wy), *rest in predict(writer, program):
-            yield ((wx + 0.001, wy), *rest)
+    def off(writer: BlockWriter, call: Any) -> Any:
+        key = key_of(writer, call)
+        return None if key is None else ((key[0][0] + 0.001, key[0][1]), *key[1:])
 
-    monkeypatch.setattr(conformahead, "predicted_keys", off)
+    monkeypatch.setattr(conformahead, "key_of", off)
     started = Started(drain=True)
     monkeypatch.setattr(conformahead, "start", started)
     assert written(post, program) == expected
