@@ -93,6 +93,14 @@ raises the collector's thresholds (its collections 1.7 → 0.75 s of the main pr
 the SVG importer frees svgelements' cyclic XML tree after the parse, the arc check's
 ``Grid.index`` rounds in floats where that is provably the repr's rounding, and segments
 keep their cached values in shared-key dicts (docs/performance.md, "Fifth pass").
+
+Fifteenth pass (``make bench``, quiet, 23 Nov 2026 19:57): camtool 9.52 s against vpype
+4.09 s, **2.33×** (10.98 s, 2.66× in the fourteenth pass's run); output still the b3b77a5
+hash; peak 240 MiB. What changed: the GRBL arc check of the 60 310 distinct arcs runs on the
+second core while the writer works (``camtool.post.conformahead``: a forked helper from the
+last arc back, the writer from the first, an answer taken only for exactly the writer's
+own inputs), writing 3.5 → 2.2 s. What is left (wall, quiet): start-up and svgelements'
+parse ~1.4 s, the fit 3.7 s on both cores, planning 2.2 s and writing 2.2 s on one.
 """
 
 from __future__ import annotations
