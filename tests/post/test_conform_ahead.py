@@ -118,6 +118,18 @@ class Started:
         return ahead
 
 
+def same_with_helper(
+    post: WordAddressPost, program: Program, monkeypatch: pytest.MonkeyPatch, *, drain: bool
+) -> conformahead.ConformAhead:
+    """Assert that the writer writes the same with its helper as alone; the helper it had."""
+    expected = alone(post, program, monkeypatch)
+    started = Started(drain)
+    monkeypatch.setattr(conformahead, "start", started)
+    assert written(post, program) == expected
+    assert started.ahead is not None
+    return started.ahead
+
+
 @pytest.mark.parametrize("target", ["grbl", "linuxcnc"])
 def test_predicted_keys_are_the_keys_the_writer_conforms(
     target: str, monkeypatch: pytest.MonkeyPatch
@@ -146,13 +158,9 @@ def test_predicted_keys_are_the_keys_the_writer_conforms(
 def test_every_answer_taken_writes_the_same(target: str, monkeypatch: pytest.MonkeyPatch) -> None:
     post = post_of(target)
     program = arc_program(random.Random(2), ARCS, messy=True)
-    expected = alone(post, program, monkeypatch)
-    started = Started(drain=True)
-    monkeypatch.setattr(conformahead, "start", started)
-    assert written(post, program) == expected
-    assert started.ahead is not None
-    assert started.ahead.taken > 0.8 * ARCS  # the messy arcs are left to the writer
-    assert started.ahead.fd is None  # closed
+    ahead = same_with_helper(post, program, monkeypatch, drain=True)
+    assert ahead.taken > 0.8 * ARCS  # the messy arcs are left to the writer
+    assert ahead.fd is None  # closed
 
 
 def test_the_helper_and_the_writer_meet_and_write_the_same(
@@ -160,29 +168,20 @@ def test_the_helper_and_the_writer_meet_and_write_the_same(
 ) -> None:
     post = post_of("grbl")
     program = arc_program(random.Random(3), ARCS, messy=True)
-    expected = alone(post, program, monkeypatch)
-    started = Started(drain=False)
-    monkeypatch.setattr(conformahead, "start", started)
-    assert written(post, program) == expected
-    assert started.ahead is not None
+    same_with_helper(post, program, monkeypatch, drain=False)
 
 
 def test_a_helper_that_dies_changes_nothing(monkeypatch: pytest.MonkeyPatch) -> None:
     post = post_of("grbl")
     program = arc_program(random.Random(4), ARCS, messy=True)
-    expected = alone(post, program, monkeypatch)
     monkeypatch.setattr(conformahead, "_conformed", lambda writer, key: os._exit(3))
-    started = Started(drain=True)
-    monkeypatch.setattr(conformahead, "start", started)
-    assert written(post, program) == expected
-    assert started.ahead is not None and started.ahead.taken == 0
+    assert same_with_helper(post, program, monkeypatch, drain=True).taken == 0
 
 
 def test_answers_to_other_arguments_are_not_taken(monkeypatch: pytest.MonkeyPatch) -> None:
     """Predictions one quantum off: every answer is for another arc, and none is taken."""
     post = post_of("grbl")
     program = arc_program(random.Random(5), ARCS, messy=False)
-    expected = alone(post, program, monkeypatch)
     key_of = conformahead.key_of
 
     def off(writer: BlockWriter, call: Any) -> Any:
@@ -190,12 +189,9 @@ def test_answers_to_other_arguments_are_not_taken(monkeypatch: pytest.MonkeyPatc
         return None if key is None else ((key[0][0] + 0.001, key[0][1]), *key[1:])
 
     monkeypatch.setattr(conformahead, "key_of", off)
-    started = Started(drain=True)
-    monkeypatch.setattr(conformahead, "start", started)
-    assert written(post, program) == expected
-    assert started.ahead is not None
-    assert started.ahead.taken == 0
-    assert not started.ahead.got  # closed: what it sent is let go
+    ahead = same_with_helper(post, program, monkeypatch, drain=True)
+    assert ahead.taken == 0
+    assert not ahead.got and not ahead.raw  # closed: what it sent is let go
 
 
 def test_no_helper_for_repeated_arcs_or_without_an_arc_check(
