@@ -548,10 +548,23 @@ class BlockWriter(WriterState[str]):
             blocks += [(e, c, full) for e, c in conformed]
         else:
             assert arc is not None  # made for _parts
-            for piece in arc.split(parts):
-                conformed = self._conformed(piece)
-                full = piece.is_full_circle and len(conformed) == 1
-                blocks += [(e, c, full) for e, c in conformed]
+            # each piece is checked from where the controller stands when it starts: the
+            # end of the piece before, as written (the blocks are written after; the
+            # check from the arc's own start refused the second piece with a ValueError)
+            written = self.written
+            try:
+                for piece in arc.split(parts):
+                    conformed = self._conformed(piece)
+                    full = piece.is_full_circle and len(conformed) == 1
+                    blocks += [(e, c, full) for e, c in conformed]
+                    if conformed:
+                        (_, px), (_, py) = (
+                            self._print("X", conformed[-1][0][0]),
+                            self._print("Y", conformed[-1][0][1]),
+                        )
+                        self.written = (px, py)
+            finally:
+                self.written = written  # _arc_block moves it, block by block
         for k, (block_end, block_centre, full) in enumerate(blocks, start=1):
             z = move.z  # a helix climbs evenly over the blocks it is written in
             if move.z is not None and self.z is not None:
