@@ -201,6 +201,9 @@ _SAME_MM = 1e-9
 _PRINTED_KEPT = 1 << 16
 """Coordinates per letter whose text a writer keeps (:meth:`BlockWriter._print`)."""
 _MOVES = (Rapid, Linear, ArcMove)
+"""The kinds of move (a tuple: ``isinstance`` takes it faster than ``Rapid | Linear | ...``)."""
+_CONFORMED_KEPT = 20_000
+"""Arcs whose blocks a writer keeps (:meth:`BlockWriter._conformed`); then it starts anew."""
 
 
 class _Conformed(dict[tuple[Any, ...], list[tuple[Point, Point | None]]]):
@@ -213,11 +216,6 @@ class _Conformed(dict[tuple[Any, ...], list[tuple[Point, Point | None]]]):
     def __init__(self, ahead: conformahead.ConformAhead | None = None) -> None:
         super().__init__()
         self.ahead = ahead
-
-
-"""The kinds of move (a tuple: ``isinstance`` takes it faster than ``Rapid | Linear | ...``)."""
-_CONFORMED_KEPT = 20_000
-"""Arcs whose blocks a writer keeps (:meth:`BlockWriter._conformed`); then it starts anew."""
 
 
 class BlockWriter(WriterState[str]):
