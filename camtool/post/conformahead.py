@@ -126,9 +126,13 @@ class ConformAhead:
     def _open_near(self) -> None:
         """Read the records of the arcs the writer is near into :attr:`got`.
 
-        The writer's lookups number at least its arcs (it also looks up the arcs the
-        helper leaves out), so a record of the arcs from ``first`` is read once the
-        lookups reach ``first`` less :data:`NEAR`: never after the writer needs it.
+        A record of the arcs from ``first`` (their place in :func:`arc_calls`) is read
+        once the lookups reach ``first`` less :data:`NEAR`. The writer looks up the arcs
+        the helper leaves out too (full circles, arcs that round away), so its count
+        runs ahead of its place, and a record is read before the writer needs it. Only
+        arcs that start where X or Y is written as exactly 0 are counted by the helper
+        and not looked up: after more than :data:`NEAR` of them a record can be read
+        late, and the writer then checks its arcs itself (the same blocks, more time).
         """
         import pickle
 
