@@ -9,13 +9,14 @@ the writer's 3.5 s, while the second core waits.
 
 :class:`ConformAhead` forks a helper as the writer starts (:func:`start`). The helper
 predicts each arc's arguments from the program: the start the controller holds is where
-the move before the arc ends, as printed (:meth:`~camtool.post.wordaddress.BlockWriter.
-_print`). It then conforms the arcs from the last towards the first, and sends what it
-found in records of :data:`BATCH` arcs, until it reaches the arcs the writer has passed
-(the writer tells how far it is in memory they share). Meanwhile the writer works from
-the first arc. For each arc, the writer looks up its own arguments
-(:meth:`ConformAhead.take`). It takes the helper's blocks only when these arguments equal
-the helper's prediction exactly (the dictionary key), so they are the blocks the writer
+the last move that wrote X and Y ended, as printed
+(:meth:`~camtool.post.wordaddress.BlockWriter.written_xy`). It then conforms the arcs
+from the last towards the first, and sends what it found in records of :data:`BATCH`
+arcs, until it reaches the arcs the writer has passed (the writer tells how far it is in
+memory they share). Meanwhile the writer works from the first arc. For each arc, the
+writer looks up its own arguments (:meth:`ConformAhead.take`). It takes the helper's
+blocks only when these arguments equal the helper's prediction exactly (the dictionary
+key), so they are the blocks the writer
 would have made itself. Any other arc is conformed by the writer, as before:
 
 - an arc whose prediction missed (an arc before it ended elsewhere than printed);
@@ -37,11 +38,9 @@ other files), or when no process can be forked.
 
 from __future__ import annotations
 
-import math
 import mmap
 import os
 import struct
-from collections.abc import Iterator
 from contextlib import suppress
 from typing import TYPE_CHECKING
 
@@ -70,9 +69,6 @@ AT = struct.Struct("<q")
 """The shared count of arcs the writer has looked up (:class:`ConformAhead`)."""
 NEAR = 2 * BATCH
 """Lookups ahead of a record's first arc from which the writer reads it."""
-SAME_MM = 1e-9
-"""A move of this much XY or less with a Z is written as a Z-only block (no X, Y words):
-the position the controller holds does not change (``BlockWriter._straight``)."""
 
 
 class ConformAhead:
@@ -191,7 +187,7 @@ def start(writer: BlockWriter, program: Program) -> ConformAhead | None:
     def serve(inbox: int, outbox: int) -> None:
         quiet_crashes()
         os.close(inbox)
-        calls = list(dict.fromkeys(arc_calls(program)))  # each arc once, first
+        calls = arc_calls(writer, program)
         k = len(calls) - 1  # from the last arc back, until the writer has passed them
         while k >= 0 and k >= AT.unpack_from(shared)[0]:
             found = []
@@ -214,27 +210,17 @@ def start(writer: BlockWriter, program: Program) -> ConformAhead | None:
     return ConformAhead(pid, from_child, shared)
 
 
-def predicted_keys(writer: BlockWriter, program: Program) -> Iterator[Key]:
-    """The arguments ``writer`` will conform each arc of ``program`` with, as predicted.
-
-    In the program's order, each arc once (:func:`arc_calls`, :func:`key_of`).
-    """
-    for call in dict.fromkeys(arc_calls(program)):
-        key = key_of(writer, call)
-        if key is not None:
-            yield key
-
-
 Call = tuple["Point | None", Point, Point, bool, Point]
 """An arc as :func:`arc_calls` gives it: ``(before, end, centre, clockwise, exact start)``."""
 
 
-def arc_calls(program: Program) -> list[Call]:
-    """Each arc of ``program`` with where the last move writing X and Y before it ended.
+def arc_calls(writer: BlockWriter, program: Program) -> list[Call]:
+    """Each arc of ``program`` once, in order: ``(before, end, centre, clockwise, start)``.
 
-    ``before`` is that end, not yet printed (``None``: no such move, the controller holds
-    the program's origin as written); the exact start is where the move before ended.
-    A move that changes only Z writes no X or Y (``BlockWriter._straight``); an arc does.
+    ``before`` is where the last move writing X and Y before the arc ended, not yet
+    printed (``None``: no such move, the controller holds the program's origin as
+    written); ``start`` is the exact start, where the move before ended. A move that
+    changes only Z writes no X or Y (``writer.z_only``); an arc does.
     Nothing is printed here, so the helper predicts the arcs in any order, the last first,
     with no pass over the program before its first answer (printing every end first took
     0.5 s of issue 17's SVG). An arc with a zero in it is left out (the module's
@@ -252,14 +238,10 @@ def arc_calls(program: Program) -> list[Call]:
             ):
                 calls.append((before, end, centre, move.clockwise, here))
             before = end
-        elif not (
-            isinstance(move, (Rapid, Linear))
-            and move.z is not None
-            and math.dist(here, end) <= SAME_MM
-        ):
+        elif not (isinstance(move, (Rapid, Linear)) and writer.z_only(here, move)):
             before = end
         here = end
-    return calls
+    return list(dict.fromkeys(calls))  # an arc cut again: the writer reuses its blocks
 
 
 def key_of(writer: BlockWriter, call: Call) -> Key | None:
@@ -273,8 +255,8 @@ def key_of(writer: BlockWriter, call: Call) -> Key | None:
     """
     before, end, centre, clockwise, here = call
     try:
-        written = writer.written if before is None else _printed(writer, before)
-        if _printed(writer, end) == written:
+        written = writer.written if before is None else writer.written_xy(before)
+        if writer.written_xy(end) == written:
             return None
     except CamtoolError:
         return None
@@ -283,29 +265,13 @@ def key_of(writer: BlockWriter, call: Call) -> Key | None:
     return (written, end, centre, clockwise, here)
 
 
-def _printed(writer: BlockWriter, point: Point) -> Point:
-    """``point`` as the controller reads it back after ``writer`` prints it."""
-    return (writer._print("X", point[0])[1], writer._print("Y", point[1])[1])
-
-
 def _conformed(writer: BlockWriter, key: Key) -> Blocks | None:
-    """The writer's blocks for the arc ``key`` (``BlockWriter._conform``), or ``None``.
+    """The writer's blocks for the arc ``key`` (``BlockWriter.checked``), or ``None``.
 
     ``None`` when the check raises: the writer repeats the arc and says why.
     """
-    from camtool.post.arccheck import conform_arc
-
-    written, end, centre, clockwise, exact_start = key
     try:
-        pieces = conform_arc(
-            written,
-            end,
-            centre,
-            clockwise,
-            rule=writer.spec.arc_check,
-            quantum_mm=writer.spec.quantum_mm(),
-            exact_start=exact_start,
-        )
+        pieces = writer.checked(*key)
     except Exception:  # repeated by the writer, which words it
         return None
     return [(p.end, p.centre) for p in pieces]

@@ -388,6 +388,23 @@ class BlockWriter(WriterState[str]):
             kept[value] = known
         return known
 
+    @staticmethod
+    def z_only(start: Point, move: Rapid | Linear) -> bool:
+        """Whether ``move`` from ``start`` is written as a Z-only block (no X or Y word).
+
+        A move that changes Z and not XY (by :data:`_SAME_MM` at most): the module
+        docstring.
+        """
+        return move.z is not None and math.dist(start, (move.x, move.y)) <= _SAME_MM
+
+    def written_xy(self, point: Point) -> Point:
+        """Where the controller stands after a block that writes X and Y of ``point``, mm.
+
+        Raises:
+            DialectError: a number that does not fit its word (:meth:`text`).
+        """
+        return (self._print("X", point[0])[1], self._print("Y", point[1])[1])
+
     def _round(self, letter: str, value: float) -> float:
         """``value`` as the controller reads it back after writing."""
         number = self.spec.words[letter].number
@@ -453,7 +470,7 @@ class BlockWriter(WriterState[str]):
             )
 
     def _straight(self, start: Point, move: Rapid | Linear) -> None:
-        if move.z is not None and math.dist(start, (move.x, move.y)) <= _SAME_MM:
+        if self.z_only(start, move):
             self._line(move, None, move.z)  # a Z-only move: no X or Y word (module docstring)
             return
         if move.z is None or self.spec.z_moves == "with-xy":
@@ -556,11 +573,7 @@ class BlockWriter(WriterState[str]):
                     full = piece.is_full_circle and len(conformed) == 1
                     blocks += [(e, c, full) for e, c in conformed]
                     if conformed:
-                        (_, px), (_, py) = (
-                            self._print("X", conformed[-1][0][0]),
-                            self._print("Y", conformed[-1][0][1]),
-                        )
-                        self.written = (px, py)
+                        self.written = self.written_xy(conformed[-1][0])
             finally:
                 self.written = written  # _arc_block moves it, block by block
         for k, (block_end, block_centre, full) in enumerate(blocks, start=1):
@@ -628,24 +641,46 @@ class BlockWriter(WriterState[str]):
             kept[key] = out
         return out
 
-    def _conform(self, piece: Arc) -> list[tuple[Point, Point | None]]:
-        """:meth:`_conformed` without its memory of the arcs already conformed."""
+    def checked(
+        self, written: Point, end: Point, centre: Point, clockwise: bool, exact_start: Point
+    ) -> list[ArcPiece]:
+        """The blocks of an arc that pass the controller's check (``conform_arc``).
+
+        Args:
+            written: the start the controller holds, as written, mm.
+            end: the exact end, mm.
+            centre: the exact absolute centre, mm.
+            clockwise: G2 when True.
+            exact_start: the exact start, mm.
+
+        A function of its arguments (the rule and the quantum are the dialect's): the
+        writer keeps its answers by them (:meth:`_conformed_at`), and
+        :mod:`camtool.post.conformahead`'s helper calls it ahead of the writer.
+
+        Raises:
+            DialectError: :func:`~camtool.post.arccheck.conform_arc`'s, without the block.
+        """
         from camtool.post.arccheck import conform_arc
 
         quantum = self._quantum
         if quantum is None:
             quantum = self._quantum = self.spec.quantum_mm()  # the same for every arc
+        return conform_arc(
+            written,
+            end,
+            centre,
+            clockwise,
+            rule=self.spec.arc_check,
+            quantum_mm=quantum,
+            exact_start=exact_start,
+        )
+
+    def _conform(self, piece: Arc) -> list[tuple[Point, Point | None]]:
+        """:meth:`_conformed` without its memory of the arcs already conformed."""
         try:
-            out = conform_arc(
-                self.written,
-                piece.end,
-                piece.centre,
-                piece.clockwise,
-                rule=self.spec.arc_check,
-                quantum_mm=quantum,
-                exact_start=piece.start,
-            )
+            out = self.checked(self.written, piece.end, piece.centre, piece.clockwise, piece.start)
         except DialectError as exc:
+            quantum = self.spec.quantum_mm()
             if piece.radius <= 10 * quantum:
                 return [(piece.end, None)]
             equalised = self._conform_equalised(piece, quantum)
@@ -670,7 +705,7 @@ class BlockWriter(WriterState[str]):
         otherwise, or when that does not help (the ends meet, the check still fails). Only
         arcs refused before take this path: every other arc is written as before.
         """
-        from camtool.post.arccheck import conform_arc, max_difference
+        from camtool.post.arccheck import max_difference
 
         (sx, sy), (ex, ey), (cx, cy) = piece.start, piece.end, piece.centre
         dx, dy = ex - sx, ey - sy
@@ -683,15 +718,7 @@ class BlockWriter(WriterState[str]):
         along = (cx - mx) * nx + (cy - my) * ny
         centre = (mx + along * nx, my + along * ny)
         try:
-            out = conform_arc(
-                self.written,
-                piece.end,
-                centre,
-                piece.clockwise,
-                rule=self.spec.arc_check,
-                quantum_mm=quantum,
-                exact_start=piece.start,
-            )
+            out = self.checked(self.written, piece.end, centre, piece.clockwise, piece.start)
         except DialectError:
             return None
         moved = math.dist(centre, piece.centre)
