@@ -16,8 +16,8 @@ arcs, until it reaches the arcs the writer has passed (the writer tells how far 
 memory they share). Meanwhile the writer works from the first arc. For each arc, the
 writer looks up its own arguments (:meth:`ConformAhead.take`). It takes the helper's
 blocks only when these arguments equal the helper's prediction exactly (the dictionary
-key), so they are the blocks the writer
-would have made itself. Any other arc is conformed by the writer, as before:
+key), so they are the blocks the writer would have made itself. Any other arc is
+conformed by the writer, as before:
 
 - an arc whose prediction missed (an arc before it ended elsewhere than printed);
 - an arc the helper has not reached yet;
