@@ -13,7 +13,8 @@ move does not change Z (2D machines never set it). ``contour`` is the 1-based
 number of the toolpath contour a move belongs to (0 for none), used by
 messages such as "contour 3, block 12".
 
-Non-motion instructions (spindle, dwell, tool change, return to machine zero)
+Non-motion instructions (spindle, dwell, tool change, program stop, return to
+machine zero)
 are :data:`Command` values held beside the moves in :attr:`Program.commands`,
 each with the index of the move it comes before; motion consumers (planner,
 simulator, metrics) never see them.
@@ -93,9 +94,69 @@ class Dwell:
 
 @dataclass(frozen=True)
 class ToolChange:
-    """Change to tool (magazine position) ``tool`` (M06 T)."""
+    """Change to tool (magazine position) ``tool`` (M06 T).
+
+    ``description`` says what the operator loads (``"drill 3 mm"``): a dialect that
+    changes tools by hand (a program stop) shows it in its comment; ``""``: nothing
+    known but the number.
+    """
 
     tool: int
+    description: str = ""
+
+
+@dataclass(frozen=True)
+class Stop:
+    """Program stop (M0), or optional stop (M1) when ``optional``.
+
+    The machine halts until the operator resumes. ``message`` says why (``"change to
+    T2: drill 3 mm"``); ``""``: no reason given. A stop is never dropped: a dialect
+    that cannot write one refuses the program.
+    """
+
+    optional: bool = False
+    message: str = ""
+
+
+DrillKind: TypeAlias = Literal["drill", "peck", "chip-break"]
+"""A canned drilling cycle: ``drill`` feeds to the bottom in one go (G81, G82 with a
+dwell), ``peck`` retracts to the R plane after each peck (G83), ``chip-break`` backs off a
+little after each peck (G73)."""
+
+
+@dataclass(frozen=True)
+class DrillCycle:
+    """A canned drilling cycle at one hole, standing for the ``moves`` moves that follow it.
+
+    The moves are the cycle's expansion (:func:`camtool.model.drilling.expand`, LinuxCNC's
+    rules), so every motion consumer (verifier, preview, time) sees a drilled hole as plain
+    rapids and feeds; a dialect with canned cycles may write the cycle instead of those
+    moves (``G81``/``G82``/``G83``/``G73``), one without them writes the moves.
+
+    Attributes:
+        kind: see :data:`DrillKind`.
+        x, y: the hole's centre, mm.
+        bottom_z: the hole's bottom, mm (below the top: negative).
+        r_z: the R plane, mm: rapids end there, feeds start there.
+        feed_mm_min: the feed into the material, mm/min.
+        peck_mm: depth of each peck (Q), mm (> 0); ``None`` for ``drill``.
+        dwell_s: wait at the bottom, s (G82 ``P``); 0: none.
+        retract: where the tool goes after the hole: ``"initial"`` (G98: back to the
+            height it started from, or the R plane if that is higher) or ``"r-plane"``
+            (G99).
+        moves: how many of the program's moves after this command the cycle stands for.
+    """
+
+    kind: DrillKind
+    x: float
+    y: float
+    bottom_z: float
+    r_z: float
+    feed_mm_min: float
+    peck_mm: float | None = None
+    dwell_s: float = 0.0
+    retract: Literal["initial", "r-plane"] = "initial"
+    moves: int = 0
 
 
 @dataclass(frozen=True)
@@ -109,7 +170,7 @@ class Home:
     axes: str = "XY"
 
 
-Command: TypeAlias = Spindle | Dwell | ToolChange | Home
+Command: TypeAlias = Spindle | Dwell | ToolChange | Stop | DrillCycle | Home
 """A non-motion instruction (see :attr:`Program.commands`)."""
 
 
