@@ -46,6 +46,7 @@ from camtool.model.machine import Machine
 from camtool.model.program import (
     ArcMove,
     Command,
+    DrillCycle,
     Dwell,
     Home,
     Linear,
@@ -53,6 +54,7 @@ from camtool.model.program import (
     Program,
     Rapid,
     Spindle,
+    Stop,
     ToolChange,
 )
 from camtool.model.shapes import Arc, distance
@@ -525,6 +527,10 @@ class PicMmhPost(PostProcessor):
                     "seed-000 Tabla 22, L3455–L3464)"
                 )
             w.blocks.append(f"M06{WORDS['T'].format(command.tool)};")
+        elif isinstance(command, DrillCycle):
+            pass  # the moves that follow are the cycle: written as they are
+        elif isinstance(command, Stop):
+            raise DialectError(f"{where}: pic-mmh has no program stop (M0/M1)")
         else:
             blocks = _home(command, where)
             w.blocks.extend(blocks)
