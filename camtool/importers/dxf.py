@@ -17,6 +17,7 @@ saying what was repaired. Model space only: paper space is ignored.
 
 from __future__ import annotations
 
+import dataclasses
 import gc
 import logging
 import math
@@ -34,9 +35,10 @@ from camtool.importers.dxf_entities import (
     layer_of,
     line_inside,
 )
+from camtool.importers.dxf_style import CONTINUOUS, Style, StyleResolver
 from camtool.importers.options import MAX_COORDINATE_MM, ImportOptions, too_many_entities
 from camtool.model.errors import InputError, UsageError
-from camtool.model.shapes import Contour, Drawing, Line, Point
+from camtool.model.shapes import Contour, Drawing, Line, Mark, Point
 from camtool.model.units import INCH
 
 # Exact mm per unit for the $INSUNITS codes a shop meets (ezdxf's own factors
@@ -171,6 +173,7 @@ def _import(path: Path, options: ImportOptions) -> DxfImport:
     graph = _check_size(path, msp, options.max_entities)
     limit = MAX_COORDINATE_MM / max(scale, 1.0)
     reader = _Reader(options.tolerance / scale, options.hatch_boundaries, keep, limit, graph)
+    reader.styles = StyleResolver(doc)
     try:
         for entity in msp:
             reader.read(entity)
@@ -179,7 +182,7 @@ def _import(path: Path, options: ImportOptions) -> DxfImport:
     for (kind, reason), count in sorted(reader.skipped.items()):
         plural = "entity" if count == 1 else "entities"
         warnings.append(f"{path}: skipped {count} {kind} {plural} ({reason})")
-    if not reader.contours:
+    if not reader.contours and not reader.marks:
         on = f" on layers {', '.join(options.layers)}" if options.layers else ""
         raise InputError(
             f"{path}: no usable entity in model space{on}; camtool cuts LINE, ARC, CIRCLE, "
@@ -187,11 +190,12 @@ def _import(path: Path, options: ImportOptions) -> DxfImport:
             + "".join(f"\n  {w}" for w in warnings)
         )
     contours = tuple(c.transformed(scale, 0.0, 0.0) if scale != 1.0 else c for c in reader.contours)
+    marks = tuple(m.transformed(scale, 0.0, 0.0) if scale != 1.0 else m for m in reader.marks)
     notes = tuple(
         DxfNote(n.source, n.layer, n.reason, _scaled(n.location, scale)) for n in reader.notes
     )
     return DxfImport(
-        drawing=Drawing(contours, str(path), tuple(warnings)),
+        drawing=Drawing(contours, str(path), tuple(warnings), marks),
         units=units,
         mm_per_unit=scale,
         entity_counts=_rows(reader.counts),
@@ -247,6 +251,8 @@ class _Reader:
         self.limit = limit  # largest number accepted, drawing units
         self.cyclic = graph.cyclic
         self.contours: list[Contour] = []
+        self.marks: list[Mark] = []
+        self.styles: StyleResolver | None = None
         self.skipped: Counter[tuple[str, str]] = Counter()
         self.notes: list[DxfNote] = []
         self.counts: Counter[tuple[str, str]] = Counter()
@@ -266,6 +272,7 @@ class _Reader:
         if kind != "INSERT":
             self._item(Item(entity, f"{kind} #{dxf.handle}", layer))
             return
+        block = self._style(entity, layer)
         for placed in expand_insert(entity, layer, self.limit, self.cyclic):
             if isinstance(placed, Skip):
                 self.block_counts[(placed.kind, placed.layer)] += 1
@@ -275,7 +282,7 @@ class _Reader:
                     )
             else:
                 self.block_counts[(placed.entity.dxftype(), placed.layer)] += 1
-                self._item(placed)
+                self._item(placed, block)
 
     def _line(self, entity: Any, layer: str) -> None:
         """A model-space LINE, read as ``_item`` would read it, without its machinery.
@@ -294,9 +301,24 @@ class _Reader:
         if math.hypot(end[0] - start[0], end[1] - start[1]) <= ZERO_LENGTH:
             self._skip("LINE", "zero length", label, layer, start)
             return
-        self.contours.append(Contour((Line(start, end),), False, layer, label))
+        colour, linetype = self._style(entity, layer)
+        self.contours.append(Contour((Line(start, end),), False, layer, label, colour, linetype))
 
-    def _item(self, item: Any) -> None:
+    def _style(self, entity: Any, layer: str, block: Style = CONTINUOUS) -> Style:
+        """How ``entity`` is drawn (:class:`~camtool.importers.dxf_style.StyleResolver`)."""
+        if self.styles is None:
+            return CONTINUOUS
+        return self.styles.style(entity, layer, block)
+
+    def _mark(self, item: Any, block: Style) -> None:
+        """A POINT: a mark a drill operation may select (nothing to cut otherwise)."""
+        check_numbers(item.entity, item.label, item.layer, self.limit)
+        at = self._where(item)
+        if at is not None:
+            colour = self._style(item.entity, item.layer, block)[0]
+            self.marks.append(Mark(at, item.layer, item.label, colour))
+
+    def _item(self, item: Any, block: Style = CONTINUOUS) -> None:
         from camtool.importers.dxf_entities import (
             CONVERTED,
             Unsupported,
@@ -308,6 +330,8 @@ class _Reader:
         if not self.keep(item.layer):
             return
         kind = _kind(item.entity)
+        if kind == "POINT":
+            self._mark(item, block)
         if kind not in CONVERTED or (kind == "HATCH" and not self.hatch):
             reason = _SKIP_REASONS.get(kind, "not a 2D contour camtool cuts")
             self._skip(kind, reason, item.label, item.layer, self._where(item))
@@ -326,6 +350,11 @@ class _Reader:
             self._skip(kind, exc.reason, item.label, item.layer, self._where(item), detail)
             return
         check_centres(contours, item.layer, self.limit)
+        style = self._style(item.entity, item.layer, block)
+        if style != CONTINUOUS:
+            contours = [
+                dataclasses.replace(c, colour=style[0], linetype=style[1]) for c in contours
+            ]
         self.contours.extend(contours)
 
     @staticmethod

@@ -376,13 +376,19 @@ class Contour:
 
     ``closed`` contours end where they start. ``layer`` is the drawing layer the
     contour came from; ``source`` names where it came from for messages (e.g.
-    ``"LWPOLYLINE #2A"``).
+    ``"LWPOLYLINE #2A"``). ``colour`` (``"#rrggbb"``, lower case; ``""``: not known) and
+    ``linetype`` (the DXF linetype name in upper case, e.g. ``"CENTER"``, or ``"DASHED"``
+    for a dashed SVG stroke; ``""``: continuous or not known) are how the entity is drawn,
+    resolved through its layer and block; a job selects by them, and centre and hidden
+    lines are construction (:mod:`camtool.model.construction`).
     """
 
     segments: tuple[Segment, ...]
     closed: bool
     layer: str = "0"
     source: str = ""
+    colour: str = ""
+    linetype: str = ""
 
     def __post_init__(self) -> None:
         if not self.segments:
@@ -414,7 +420,7 @@ class Contour:
     def reversed(self) -> Contour:
         """The same contour traversed the other way."""
         segs = tuple(s.reversed() for s in reversed(self.segments))
-        return Contour(segs, self.closed, self.layer, self.source)
+        return Contour(segs, self.closed, self.layer, self.source, self.colour, self.linetype)
 
     def points(self, tolerance: float) -> list[Point]:
         """Polyline through the contour within ``tolerance`` mm (arcs as chords)."""
@@ -435,10 +441,28 @@ class Contour:
     def transformed(self, scale: float, dx: float, dy: float) -> Contour:
         """Uniformly scaled about the origin (``scale`` > 0), then translated."""
         segs = tuple(s.transformed(scale, dx, dy) for s in self.segments)
-        return Contour(segs, self.closed, self.layer, self.source)
+        return Contour(segs, self.closed, self.layer, self.source, self.colour, self.linetype)
 
 
 share_keys(Contour, (*_kept(Contour), "_bbox"))
+
+
+@dataclass(frozen=True)
+class Mark:
+    """A point of the drawing (a DXF POINT): nothing to cut, a place to drill.
+
+    ``at`` in mm; ``layer``, ``source``, ``colour`` as a :class:`Contour`'s.
+    """
+
+    at: Point
+    layer: str = "0"
+    source: str = ""
+    colour: str = ""
+
+    def transformed(self, scale: float, dx: float, dy: float) -> Mark:
+        """Uniformly scaled about the origin (``scale`` > 0), then translated."""
+        x, y = self.at
+        return Mark((x * scale + dx, y * scale + dy), self.layer, self.source, self.colour)
 
 
 @dataclass(frozen=True)
@@ -446,12 +470,15 @@ class Drawing:
     """What an importer read: contours in mm, Y up, plus what it had to say.
 
     ``warnings`` are messages for the user (skipped entity types, assumed
-    units); the CLI prints them on stderr. ``source`` is the file name.
+    units); the CLI prints them on stderr. ``source`` is the file name. ``marks``
+    are the drawing's points (DXF POINT entities): only a drill operation that
+    selects them uses them.
     """
 
     contours: tuple[Contour, ...]
     source: str = ""
     warnings: tuple[str, ...] = field(default=())
+    marks: tuple[Mark, ...] = field(default=())
 
     def bbox(self) -> BBox:
         """Bounding box of every contour, mm.
@@ -464,4 +491,5 @@ class Drawing:
     def transformed(self, scale: float, dx: float = 0.0, dy: float = 0.0) -> Drawing:
         """Uniformly scaled about the origin (``scale`` > 0), then translated."""
         contours = tuple(c.transformed(scale, dx, dy) for c in self.contours)
-        return Drawing(contours, self.source, self.warnings)
+        marks = tuple(m.transformed(scale, dx, dy) for m in self.marks)
+        return Drawing(contours, self.source, self.warnings, marks)

@@ -12,11 +12,11 @@ of travel, so with ``outside`` an outer boundary's path runs clockwise and a hol
 counter-clockwise; conventional milling runs the other way. ``--offset on`` keeps the drawn
 direction unless ``--direction`` is given, which orients as for ``outside``.
 
-What the stage reports (:class:`~camtool.toolpath.cuts.Finding`): open contours cut on the line
-when a side was asked, offsets that needed the fallback, contours offset away entirely (with
-their location and width), inside corners tighter than the tool radius (the part keeps a fillet
-of radius ``r`` there), and places where the tool's swept area cuts into material (neighbouring
-offsets colliding).
+What the stage reports (:class:`~camtool.toolpath.cuts.Finding`): open contours left uncut
+when a side was asked (they have none), offsets that needed the fallback, contours offset
+away entirely (with their location and width), inside corners tighter than the tool radius
+(the part keeps a fillet of radius ``r`` there), and places where the tool's swept area cuts
+into material (neighbouring offsets colliding).
 
 Gouge check (:func:`gouges`): does the tool's swept area cut into the material that must
 stay? Each compensated path sweeps a band of the tool radius on both sides
@@ -45,7 +45,7 @@ from typing import Any
 from camtool.model.errors import ToolpathError
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import Arc, Contour, Line, Point, Segment
-from camtool.toolpath.cuts import Cut, Finding, Stage, where
+from camtool.toolpath.cuts import Cut, Finding, Stage, open_left_out, where
 from camtool.toolpath.offset import (
     Answer,
     OffsetResult,
@@ -96,8 +96,10 @@ def compensate(
     profiles have ``may_reverse=False``, ``may_rotate=True``, ``material_side``
     ``"right"`` for climb (``"left"`` conventional) and ``outside_profile`` for
     outer boundaries cut ``outside``. A contour whose offset splits gives one
-    cut per piece. Open contours give ``kind="open"`` cuts on the line, in their
-    drawn direction (``may_reverse`` only with ``options.reverse_open``).
+    cut per piece. With ``offset="on"`` open contours give ``kind="open"`` cuts on the
+    line, in their drawn direction (``may_reverse`` only with ``options.reverse_open``);
+    under ``outside``/``inside`` they have no side and are not cut
+    (:func:`~camtool.toolpath.cuts.open_left_out` says which).
 
     Args:
         contours: chained, closed-where-possible contours, mm.
@@ -108,25 +110,26 @@ def compensate(
             as OpenCASCADE's offsets come in.
 
     Returns:
-        The cuts and the findings (``open-on-line``, ``offset-fallback``,
+        The cuts and the findings (``open-left-out``, ``offset-fallback``,
         ``offset-vanished``, ``tight-corner``, ``gouge``).
 
     Raises:
         ToolpathError: every closed contour is offset away and nothing is left
-            to cut (the message lists them); ``offset`` is ``pocket``.
+            to cut (the message lists them), or every contour is open under
+            ``outside``/``inside``; ``offset`` is ``pocket``.
     """
     if options.offset not in ("on", "outside", "inside"):
         raise ToolpathError(f"--offset {options.offset} is planned by the pocket stage")
     cuts: list[Cut] = []
     findings: list[Finding] = []
     vanished: list[Finding] = []
-    open_count = 0
     jobs = _offset_jobs(contours, nest, options, progress)
     for i, contour in enumerate(contours):
         if not contour.closed:
-            open_count += 1
-            # drawn direction unless --reverse-open: a drawn arc is a G02 or G03 as drawn
-            cuts.append(Cut(contour, i, "open", may_reverse=options.reverse_open, may_rotate=False))
+            if options.offset == "on":
+                # drawn direction unless --reverse-open: a drawn arc is a G02 or G03 as drawn
+                cut = Cut(contour, i, "open", may_reverse=options.reverse_open, may_rotate=False)
+                cuts.append(cut)
         elif options.offset == "on":
             cuts.append(_on_line(contour, i, nest, options))
         else:
@@ -136,15 +139,10 @@ def compensate(
             vanished.extend(f for f in found if f.kind == "offset-vanished")
     if not cuts and vanished:
         raise ToolpathError("nothing left to cut: " + "; ".join(f.message for f in vanished))
-    if open_count and options.offset != "on":
-        findings.append(
-            Finding(
-                "open-on-line",
-                f"{open_count} open contour(s) cut on the line: --offset {options.offset} needs "
-                "closed contours",
-                value=float(open_count),
-            )
-        )
+    if options.offset != "on":
+        if not cuts:
+            raise ToolpathError(_all_open(contours, options.offset))
+        findings[:0] = open_left_out(contours, f"--offset {options.offset}")
     if options.offset != "on":
         findings.extend(gouges(contours, nest, cuts, options))
     return Stage(tuple(cuts), tuple(findings))
@@ -466,4 +464,14 @@ def _finding(contour: Contour, part: Any, options: PlanOptions) -> Finding:
         "tool; use a smaller tool or move them apart",
         (x, y),
         area,
+    )
+
+
+def _all_open(contours: Sequence[Contour], side: str) -> str:
+    """Why nothing is cut when every contour is open under ``--offset side``."""
+    layers = sorted({c.layer for c in contours}, key=str.casefold)
+    return (
+        f"nothing to cut: all {len(contours)} contour(s) (layers {', '.join(layers)}) are open, "
+        f"and --offset {side} needs closed contours; cut them on their lines with --offset on "
+        "(or an engrave operation), or close them in the drawing (--close-gap closes small gaps)"
     )

@@ -14,6 +14,7 @@ with a clockwise (M03) spindle, ``"left"`` for conventional milling.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 from camtool.model.shapes import Contour, Point
@@ -82,7 +83,7 @@ FINDING_KINDS = (
     "tight-corner",
     "uncut",
     "gouge",
-    "open-on-line",
+    "open-left-out",
     "open-gap",
     "lead-in",
     "option",
@@ -130,3 +131,41 @@ def where(contour: Contour) -> str:
 
     src = f"{contour.source} " if contour.source else ""
     return f"contour {src}at {fmt_point(contour.start)} mm"
+
+
+MAX_LISTED = 10
+"""Most contours one kind of finding names one by one; the rest are counted in one line."""
+
+
+def open_left_out(contours: Sequence[Contour], side: str) -> list[Finding]:
+    """An ``open-left-out`` finding per open contour of ``contours`` (the first :data:`MAX_LISTED`).
+
+    An open contour has no inside or outside: under ``side`` (``outside``, ``inside`` or
+    ``pocket``) it is not cut at all (cutting it on its line would cut through the part:
+    the diameter lines of a disc, a construction line across it). Each finding names the
+    contour, its layer and where it runs; past :data:`MAX_LISTED`, one more counts the rest.
+    """
+    from camtool.model.units import fmt_point
+
+    opened = [c for c in contours if not c.closed]
+    out = [
+        Finding(
+            "open-left-out",
+            f"not cut: open {where(c)} to {fmt_point(c.end)} mm on layer {c.layer!r}: "
+            f"{side} needs a closed contour (an engrave operation or --offset on cuts it on "
+            "its line)",
+            c.start,
+            c.length,
+        )
+        for c in opened[:MAX_LISTED]
+    ]
+    if len(opened) > MAX_LISTED:
+        rest = len(opened) - MAX_LISTED
+        out.append(
+            Finding(
+                "open-left-out",
+                f"not cut: {rest} more open contour(s) (`camtool inspect` lists them)",
+                value=float(rest),
+            )
+        )
+    return out

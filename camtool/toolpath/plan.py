@@ -59,6 +59,7 @@ __all__ = [
     "place_program",
     "plan",
     "plan_drawing",
+    "plan_unplaced",
 ]
 
 MIN_FIT_RUN = 6
@@ -175,6 +176,29 @@ def plan_drawing(
         ToolpathError: a stage cannot plan the drawing (names the contour).
         DialectError: the toolpath does not fit the machine (:func:`place_program`).
     """
+    unplaced = plan_unplaced(drawing, options, machine, helix=helix, progress=progress)
+    program, placed, shift = place_program(unplaced.program, unplaced.placed, options, machine)
+    report = dataclasses.replace(unplaced.report, work_shift=shift)
+    return Plan(program, report, placed)
+
+
+def plan_unplaced(
+    drawing: Drawing,
+    options: PlanOptions,
+    machine: Machine | None = None,
+    *,
+    helix: bool = True,
+    progress: Progress = no_progress,
+) -> Plan:
+    """:func:`plan_drawing` without its placement stage: the program in drawing coordinates.
+
+    The drawing is scaled (``--scale``/``--fit``) and planned as :func:`plan_drawing`
+    plans it; ``options.placement``, ``translate`` and the travel check are not applied
+    (:func:`place_program` does that, once for a whole job of several operations).
+
+    Raises:
+        As :func:`plan_drawing`, except the travel check.
+    """
     from camtool.toolpath.passes import emit
 
     _ = options.feed  # no feed (the target's not filled in): refused before any work
@@ -204,10 +228,8 @@ def plan_drawing(
             "(or --scale it)"
         )
     warnings = tuple(dict.fromkeys((*drawing.warnings, *(f.message for f in findings))))
-    program, placed, shift = place_program(
-        Program(tuple(moves), options.origin, warnings), placed, options, machine
-    )
-    report = PlanReport(len(contours), len(stage.cuts), tuple(findings), ordering, stats, shift)
+    program = Program(tuple(moves), options.origin, warnings)
+    report = PlanReport(len(contours), len(stage.cuts), tuple(findings), ordering, stats)
     return Plan(program, report, placed)
 
 

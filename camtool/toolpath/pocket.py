@@ -65,7 +65,7 @@ from camtool.geometry.arcfit import fit_polyline
 from camtool.model.errors import InputError, ToolpathError, UsageError
 from camtool.model.shapes import TAU, Arc, Contour, Line, Point, Segment, distance
 from camtool.model.units import fmt_num
-from camtool.toolpath.cuts import Cut, Finding, Stage, where
+from camtool.toolpath.cuts import Cut, Finding, Stage, open_left_out, where
 from camtool.toolpath.offset import offset_contour
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.order import Nesting
@@ -120,7 +120,7 @@ class _Path:
 
 
 def pocket(contours: Sequence[Contour], nest: Nesting, options: PlanOptions) -> Stage:
-    """Clear the inside of every pocket region; cut open contours on the line.
+    """Clear the inside of every pocket region; open contours are not cut (said in findings).
 
     Args:
         contours: chained contours, mm.
@@ -130,10 +130,10 @@ def pocket(contours: Sequence[Contour], nest: Nesting, options: PlanOptions) -> 
 
     Returns:
         Cuts of kind ``"pocket"`` (group = the pocket boundary's index; in each
-        group the order given is the cutting order) and ``"open"``, and findings:
-        ``open-on-line``, ``uncut`` (regions narrower than the tool, with
-        location and area mm²), ``tight-corner`` (corners left with the tool
-        radius) and ``offset-fallback``.
+        group the order given is the cutting order), and findings:
+        ``open-left-out`` (:func:`~camtool.toolpath.cuts.open_left_out`), ``uncut``
+        (regions narrower than the tool, with location and area mm²), ``tight-corner``
+        (corners left with the tool radius) and ``offset-fallback``.
 
     Raises:
         ToolpathError: no region can be pocketed at all (no closed contours, or
@@ -147,19 +147,7 @@ def pocket(contours: Sequence[Contour], nest: Nesting, options: PlanOptions) -> 
         findings.extend(found)
     if not cuts:
         raise ToolpathError(_nothing_message(contours, options))
-    opened = [i for i, c in enumerate(contours) if not c.closed]
-    for i in opened:
-        cuts.append(Cut(contours[i], i, kind="open", may_rotate=False))
-    if opened:
-        first = contours[opened[0]]
-        findings.append(
-            Finding(
-                "open-on-line",
-                f"{len(opened)} open contour(s) cut on the line: --offset pocket needs closed "
-                f"contours (first: {where(first)})",
-                first.start,
-            )
-        )
+    findings[:0] = open_left_out(contours, "--offset pocket")
     return Stage(tuple(cuts), tuple(findings))
 
 

@@ -161,16 +161,35 @@ def test_on_keeps_the_drawn_direction_unless_one_is_asked() -> None:
     assert all(not c.may_reverse and c.material_side == "right" for c in climb)
 
 
-def test_open_contours_are_cut_on_the_line_and_counted() -> None:
-    line = Contour((Line((30, 0), (40, 0)),), False)
+def test_open_contours_are_cut_on_the_line_only_with_offset_on() -> None:
+    line = Contour((Line((30, 0), (40, 0)),), False, "CUT", "LINE #2A")
     stage = _run([rect(0, 0, 10, 10), line], "outside")
-    cut = stage.cuts[1]
+    # an open contour has no outside: cut on its line it would cut through the part
+    assert [c.kind for c in stage.cuts] == ["profile"]
+    (finding,) = [f for f in stage.findings if f.kind == "open-left-out"]
+    assert finding.message.startswith("not cut: open contour LINE #2A at (30.0000, 0.0000) mm")
+    assert "layer 'CUT'" in finding.message and "--offset outside" in finding.message
+    assert finding.at == (30, 0) and finding.value == 10
+    on = _run([rect(0, 0, 10, 10), line], "on", 0.0)
+    cut = on.cuts[1]
     # drawn direction by default: an open path is never reversed by the ordering
     assert (cut.kind, cut.path, cut.may_rotate, cut.may_reverse) == ("open", line, False, False)
-    assert _run([rect(0, 0, 10, 10), line], "outside", reverse_open=True).cuts[1].may_reverse
-    (finding,) = [f for f in stage.findings if f.kind == "open-on-line"]
-    assert finding.message.startswith("1 open contour(s) cut on the line: --offset outside")
-    assert "open-on-line" not in _kinds(_run([line], "on", 0.0))
+    assert _run([line], "on", 0.0, reverse_open=True).cuts[0].may_reverse
+    assert "open-left-out" not in _kinds(on)
+
+
+def test_only_open_contours_under_a_side_is_nothing_to_cut() -> None:
+    line = Contour((Line((30, 0), (40, 0)),), False, "CUT")
+    with pytest.raises(ToolpathError, match=r"all 1 contour\(s\) \(layers CUT\) are open"):
+        _run([line], "inside")
+
+
+def test_many_open_contours_are_named_ten_then_counted() -> None:
+    lines = [Contour((Line((30, k), (40, k)),), False) for k in range(13)]
+    stage = _run([rect(0, 0, 10, 10), *lines], "outside")
+    found = [f for f in stage.findings if f.kind == "open-left-out"]
+    assert len(found) == 11
+    assert found[-1].message.startswith("not cut: 3 more open contour(s)")
 
 
 # --- split and vanished offsets --------------------------------------------------------------

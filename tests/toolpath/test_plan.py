@@ -113,10 +113,15 @@ def test_plan_one_rapid_per_contour(tmp_path: Path) -> None:
     assert program.cut_length() == pytest.approx(30.0)
 
 
-def test_open_contours_with_a_side_warn(tmp_path: Path) -> None:
-    drawing = Drawing((Contour((Line((0, 0), (1, 0)),), False),))
-    program = plan(drawing, PlanOptions(offset="outside", tool_diameter=1.0, feed_mm_min=1.0))
-    assert any("open contour" in w for w in program.warnings)
+def test_open_contours_with_a_side_are_left_out_with_a_warning(tmp_path: Path) -> None:
+    options = PlanOptions(offset="outside", tool_diameter=1.0, feed_mm_min=1.0)
+    drawing = Drawing((rect(0, 0, 10, 10), Contour((Line((0, 0), (1, 0)),), False)))
+    program = plan(drawing, options)
+    assert any(w.startswith("not cut: open contour") for w in program.warnings)
+    # the line from (0, 0) to (1, 0) lies on the square's edge: only the offset square is cut
+    assert min(m.y for m in program.moves) == pytest.approx(-0.5)
+    with pytest.raises(ToolpathError, match="are open"):
+        plan(Drawing(drawing.contours[1:]), options)
 
 
 @pytest.mark.parametrize(

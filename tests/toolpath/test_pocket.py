@@ -272,13 +272,13 @@ def test_island_inside_an_island_is_a_new_pocket() -> None:
     assert inner.difference(_shape(contours[2])).area < TOL * 40
 
 
-def test_open_contours_are_cut_on_the_line() -> None:
+def test_open_contours_are_not_cut_by_a_pocket() -> None:
     line = Contour((Line((50, 0), (60, 0)),), False)
     stage = _plan([rect(0, 0, 20, 10), line])
-    opened = [c for c in stage.cuts if c.kind == "open"]
-    assert [(c.path, c.group, c.may_rotate) for c in opened] == [(line, 1, False)]
-    (finding,) = [f for f in stage.findings if f.kind == "open-on-line"]
-    assert finding.message.startswith("1 open contour(s) cut on the line")
+    assert not [c for c in stage.cuts if c.kind == "open"]
+    (finding,) = [f for f in stage.findings if f.kind == "open-left-out"]
+    assert finding.message.startswith("not cut: open contour at (50.0000, 0.0000) mm")
+    assert "--offset pocket needs a closed contour" in finding.message
 
 
 @settings(max_examples=15, deadline=None)

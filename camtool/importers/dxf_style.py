@@ -1,0 +1,120 @@
+"""How a DXF entity is drawn: its colour and linetype, resolved through layer and block.
+
+A job selects contours by colour, and centre, hidden and dashed lines are construction
+that camtool leaves uncut (:mod:`camtool.model.construction`), so each contour carries the
+colour and linetype it is drawn with. The DXF rules (DXF reference, "Common Group Codes
+for Entities"): colour 256 (BYLAYER) and linetype ``BYLAYER`` take the layer's; colour 0
+and ``BYBLOCK`` take the INSERT's that places the entity; a true colour (group 420)
+overrides the ACI colour. ACI numbers become RGB by :func:`ezdxf.colors.aci2rgb`.
+
+A linetype is *continuous* when its pattern has no gaps
+(:meth:`ezdxf.entities.Linetype.simplified_line_pattern` is empty: LibreCAD's hatch
+patterns name their solid lines ``K5LT...``); a name the file's table lacks is judged by
+name (:func:`camtool.model.construction.dashed_name`).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from camtool.model.construction import dashed_name
+
+Style = tuple[str, str]
+"""``(colour, linetype)``: ``"#rrggbb"`` (``""``: unknown) and the upper-case linetype
+name when it is not continuous (``""``: continuous)."""
+
+CONTINUOUS: Style = ("", "")
+"""No colour known, continuous."""
+
+
+class StyleResolver:
+    """Resolves entities' styles in one document; layers and linetypes looked up once."""
+
+    def __init__(self, doc: Any) -> None:
+        self.doc = doc
+        self._layers: dict[str, Style] = {}
+        self._dashed: dict[str, bool] = {}
+
+    def style(self, entity: Any, layer: str, block: Style = CONTINUOUS) -> Style:
+        """The colour and linetype ``entity`` on effective ``layer`` is drawn with.
+
+        Args:
+            entity: an ezdxf graphic entity.
+            layer: its effective layer (a block entity on layer ``0`` takes the INSERT's).
+            block: the style of the INSERT that places it (for BYBLOCK).
+        """
+        dxf = entity.dxf
+        if not dxf.is_supported("color"):
+            return self.layer_style(layer)
+        by_layer = self.layer_style(layer)
+        colour = self._colour(dxf, by_layer[0], block[0])
+        linetype = str(dxf.get("linetype", "BYLAYER") or "BYLAYER").upper()
+        if linetype == "BYLAYER":
+            dashed = by_layer[1]
+        elif linetype == "BYBLOCK":
+            dashed = block[1]
+        else:
+            dashed = linetype if self._is_dashed(linetype) else ""
+        return colour, dashed
+
+    def layer_style(self, layer: str) -> Style:
+        """The colour and linetype of ``layer`` (white and continuous when it is missing)."""
+        found = self._layers.get(layer)
+        if found is None:
+            found = self._layers[layer] = self._read_layer(layer)
+        return found
+
+    def _read_layer(self, name: str) -> Style:
+        from ezdxf.colors import aci2rgb
+
+        table = self.doc.layers
+        record = table.get(name) if table.has_entry(name) else None
+        if record is None:
+            return "#ffffff", ""
+        dxf = record.dxf
+        true = dxf.get("true_color")
+        aci = abs(int(dxf.get("color", 7) or 7))
+        colour = _hex_int(true) if true is not None else _hex(aci2rgb(aci if aci < 256 else 7))
+        linetype = str(dxf.get("linetype", "CONTINUOUS") or "CONTINUOUS").upper()
+        return colour, (linetype if self._is_dashed(linetype) else "")
+
+    def _colour(self, dxf: Any, layer_colour: str, block_colour: str) -> str:
+        from ezdxf.colors import aci2rgb
+
+        true = dxf.get("true_color")
+        if true is not None:
+            return _hex_int(true)
+        aci = int(dxf.get("color", 256))
+        if aci == 256:
+            return layer_colour
+        if aci == 0:
+            return block_colour or "#ffffff"
+        return _hex(aci2rgb(aci)) if 0 < aci < 256 else layer_colour
+
+    def _is_dashed(self, name: str) -> bool:
+        found = self._dashed.get(name)
+        if found is None:
+            found = self._dashed[name] = self._judge(name)
+        return found
+
+    def _judge(self, name: str) -> bool:
+        if name in ("CONTINUOUS", "BYLAYER", "BYBLOCK", ""):
+            return False
+        table = self.doc.linetypes
+        if table.has_entry(name):
+            try:
+                return bool(table.get(name).simplified_line_pattern())
+            except (ValueError, TypeError, AttributeError, IndexError):
+                pass  # a damaged pattern: judged by its name
+        return dashed_name(name)
+
+
+def _hex(rgb: Any) -> str:
+    r, g, b = (max(0, min(255, int(v))) for v in rgb)
+    return f"#{r:02x}{g:02x}{b:02x}"
+
+
+def _hex_int(value: Any) -> str:
+    """A DXF true colour (group 420: 0x00RRGGBB) as ``#rrggbb``."""
+    v = int(value) & 0xFFFFFF
+    return f"#{v:06x}"

@@ -1,0 +1,38 @@
+"""What a drawing holds that is not the part: centre lines, hidden lines, construction layers.
+
+A machinist draws a part's edges continuous; centre lines (linetype CENTER), hidden edges
+(HIDDEN, DASHED), phantom and dotted lines are drawing conventions (ISO 128-20, ASME
+Y14.2), and layers named for construction or dimensions hold geometry that helps the
+drawing, not the part. camtool never cuts them unless an operation selects them by name
+(:mod:`camtool.jobs.selection`); they are left out with one line each on stderr and listed
+by ``camtool inspect``.
+"""
+
+from __future__ import annotations
+
+import re
+
+DASHED_FAMILIES = ("CENTER", "DASH", "HIDDEN", "PHANTOM", "DOT", "DIVIDE", "BORDER", "ACAD_ISO")
+"""Linetype name stems that are not continuous (AutoCAD's ``acad.lin`` and ``acadiso.lin``
+families, with their ``2`` and ``X2`` variants; LibreCAD's ``DashLine``, ``CenterLine``...)."""
+
+_CONSTRUCTION_LAYER = re.compile(
+    r"(?:^|[^a-z])(?:constr[a-z]*|hilf[a-z]*|helpers?|aux[a-z]*|guides?|ref|references?|"
+    r"dims?|dimensions?|bema(?:ss|ß)ung[a-z]*|cotas?|annot[a-z]*|notes?|text|title|"
+    r"cent(?:er|re)(?:[ _-]?lines?)?|axis|axes|hidden|defpoints)(?:[^a-z]|$)",
+    re.IGNORECASE,
+)
+"""Layer names that say construction, dimensions, annotation or centre lines (AutoCAD's
+``Defpoints`` too), in English and a few shop languages; a word of the name, so
+``OUTLINE`` or ``POCKET`` never match."""
+
+
+def dashed_name(linetype: str) -> bool:
+    """Whether the linetype ``linetype`` (any case) is by its name not continuous."""
+    name = linetype.upper()
+    return any(stem in name for stem in DASHED_FAMILIES)
+
+
+def construction_layer(layer: str) -> bool:
+    """Whether the layer name ``layer`` says it holds construction, not the part."""
+    return bool(_CONSTRUCTION_LAYER.search(layer))
