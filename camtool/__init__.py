@@ -51,10 +51,17 @@ _HOMES: dict[str, str] = {
     "Target": "camtool.post.base",
     "load_target": "camtool.post.registry",
     "list_targets": "camtool.post.registry",
+    # jobs: operations and tools, run as one program
+    "Job": "camtool.jobs.job",
+    "Tool": "camtool.jobs.job",
+    "Operation": "camtool.jobs.job",
+    "Selection": "camtool.jobs.job",
+    "load_job": "camtool.jobs.job",
+    "run_job": "camtool.jobs.run",
     # post
-    "OutputOptions": "camtool.jobs.pipeline",
-    "PostJob": "camtool.jobs.pipeline",
-    "plan_options": "camtool.jobs.pipeline",
+    "OutputOptions": "camtool.jobs.run",
+    "PostJob": "camtool.jobs.run",
+    "plan_options": "camtool.jobs.run",
     "post_drawing": "camtool.jobs.pipeline",
     "post_path": "camtool.jobs.pipeline",
     "post_file": "camtool.jobs.pipeline",
@@ -101,14 +108,20 @@ if TYPE_CHECKING:  # the names as type checkers see them (``X as X``: exported, 
     from camtool.importers import read_drawing as read_drawing
     from camtool.importers.options import ImportOptions as ImportOptions
     from camtool.jobs import batch as batch
-    from camtool.jobs.pipeline import OutputOptions as OutputOptions
-    from camtool.jobs.pipeline import PostJob as PostJob
-    from camtool.jobs.pipeline import plan_options as plan_options
+    from camtool.jobs.job import Job as Job
+    from camtool.jobs.job import Operation as Operation
+    from camtool.jobs.job import Selection as Selection
+    from camtool.jobs.job import Tool as Tool
+    from camtool.jobs.job import load_job as load_job
     from camtool.jobs.pipeline import post_drawing as post_drawing
     from camtool.jobs.pipeline import post_file as post_file
     from camtool.jobs.pipeline import post_path as post_path
     from camtool.jobs.pipeline import post_program as post_program
     from camtool.jobs.pipeline import verify_job as verify_job
+    from camtool.jobs.run import OutputOptions as OutputOptions
+    from camtool.jobs.run import PostJob as PostJob
+    from camtool.jobs.run import plan_options as plan_options
+    from camtool.jobs.run import run_job as run_job
     from camtool.model.errors import CamtoolError as CamtoolError
     from camtool.model.errors import DialectError as DialectError
     from camtool.model.errors import InputError as InputError

@@ -351,7 +351,8 @@ def _layout(name: str, options: BatchOptions, several: bool) -> tuple[str, str]:
         UsageError: as :func:`plan_batch`; a target whose name cannot be a folder
             (with several targets).
     """
-    from camtool.jobs.pipeline import load_target_checked, plan_options
+    from camtool.jobs.pipeline import load_target_checked
+    from camtool.jobs.run import plan_options
 
     target = load_target_checked(name, machine_file=options.machine_file)
     fmt = target.post.check_format(options.output.fmt)

@@ -4,74 +4,25 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from camtool.importers import POINT_SUFFIXES, read_drawing, read_drawing_bytes
 from camtool.importers.options import ImportOptions
+from camtool.jobs.header import job_notes
 from camtool.jobs.inputs import is_program_file
+from camtool.jobs.run import OutputOptions, PostJob, run_job
 from camtool.model.errors import InputError, UsageError
 from camtool.model.program import Move, Program
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import BBox, Drawing
-from camtool.post.base import PostResult, Target
+from camtool.post.base import Target
 from camtool.post.registry import load_target
 from camtool.toolpath.options import PlanOptions, drawing_only
 
 if TYPE_CHECKING:
     from camtool.toolpath.plan import PlanReport
     from camtool.verify.verifier import Verification
-
-
-@dataclass(frozen=True)
-class PostJob:
-    """Everything one ``post`` produced.
-
-    Attributes:
-        drawing: what was imported (``None`` when the input was already a program).
-        program: the planned, machine-neutral program.
-        target: the target it was written for.
-        result: the emitted code and its warnings.
-        placed: the drawing as placed on the machine (after ``scale``/``fit_mm``),
-            in the program's coordinates.
-        edge_radius_mm: how far the cut edge lies from the tool path: half the tool
-            diameter for ``outside``/``inside``/``pocket``, 0 for paths on the line.
-        plan: what planning did and found (``None`` for a re-posted program).
-    """
-
-    drawing: Drawing | None
-    program: Program
-    target: Target
-    result: PostResult
-    placed: Drawing | None
-    edge_radius_mm: float = 0.0
-    plan: PlanReport | None = None
-
-    @property
-    def warnings(self) -> tuple[str, ...]:
-        """Warnings of every stage, in pipeline order, without repeats."""
-        return tuple(dict.fromkeys(self.program.warnings + self.result.warnings))
-
-
-@dataclass(frozen=True, kw_only=True)
-class OutputOptions:
-    """How the planned program is written: the options that are not planning options.
-
-    They apply to a re-posted program too (:func:`post_program`).
-
-    Attributes:
-        fmt: the dialect's output format (``None``: its first, see ``camtool targets``).
-        spindle_rpm: spindle speed, rev/min; ``None`` takes the target's
-            ``spindle_rpm`` for a planned drawing (which may be none), 0 programs no
-            spindle; a re-posted program gets spindle commands only when > 0 and it
-            has none of its own.
-        spindle_dwell_s: wait this long after the spindle starts, s (``--spindle-dwell``).
-    """
-
-    fmt: str | None = None
-    spindle_rpm: float | None = None
-    spindle_dwell_s: float = 0.0
 
 
 def load_target_checked(name: str, *, machine_file: Path | str | None = None) -> Target:
@@ -187,7 +138,8 @@ def post_path(
             )
             drawing = _note_units(drawing, path, import_options)
             with meanwhile(_preloads(drawing) if verifying else []):
-                return post_drawing(drawing, target, plan, output, progress=progress)
+                layers = import_options.layers if import_options is not None else None
+                return post_drawing(drawing, target, plan, output, progress=progress, layers=layers)
     refuse_planning(path, drawing_only(plan.given()))
     from camtool.importers.gcode import read_gcode
 
@@ -241,7 +193,9 @@ def post_bytes(
         suffix = Path(name).suffix
         options, check = sized(import_options, plan), travel_check(plan, target)
         drawing = read_drawing_bytes(data, name=name, suffix=suffix, options=options, check=check)
-        return post_drawing(_note_units(drawing, name, import_options), target, plan, output)
+        layers = import_options.layers if import_options is not None else None
+        drawing = _note_units(drawing, name, import_options)
+        return post_drawing(drawing, target, plan, output, layers=layers)
     refuse_planning(name, drawing_only(plan.given()))
     from camtool.importers.gcode import read_gcode_bytes
 
@@ -405,37 +359,6 @@ def _flatten(program: Program, target: str) -> Program:
     )
 
 
-def plan_options(target: Target, plan: PlanOptions | None = None) -> PlanOptions:
-    """``plan`` for ``target``: its default feed filled in, checked against what it can do.
-
-    Args:
-        target: the target the plan is for.
-        plan: the planning options (``None``: the defaults); ``feed_mm_min`` ``None``
-            takes the target's default feed.
-
-    Raises:
-        UsageError: options the target cannot carry out: depth options for a machine
-            without Z, lead-in arcs on a target that writes arcs as chords, a ramp on
-            a target that moves Z in its own block (the options themselves are
-            checked when the :class:`PlanOptions` is made).
-    """
-    plan = plan if plan is not None else PlanOptions()
-    if plan.feed_mm_min is None:
-        plan = dataclasses.replace(plan, feed_mm_min=target.default_feed_mm_min)
-    plan.check_machine(target.machine, target.name)
-    if plan.lead_in_mm > 0 and not target.post.arcs:
-        raise UsageError(
-            f"--lead-in: {target.name} writes arcs as chords; lead-in arcs are for targets "
-            "with arcs (leave --lead-in out)"
-        )
-    if plan.ramp_angle_deg is not None and not target.post.z_with_xy:
-        raise UsageError(
-            f"--ramp: {target.name} moves Z in a block of its own, so it cannot descend "
-            "along the path; leave --ramp out (the tool plunges straight down)"
-        )
-    return plan
-
-
 def post_drawing(
     drawing: Drawing,
     target: Target,
@@ -443,8 +366,12 @@ def post_drawing(
     output: OutputOptions | None = None,
     *,
     progress: Progress = no_progress,
+    layers: tuple[str, ...] | None = None,
 ) -> PostJob:
-    """Plan a drawing and post it for a target.
+    """Plan a drawing and post it for a target: the one-operation job of ``plan``.
+
+    ``plan`` is :meth:`~camtool.jobs.job.Job.single`'s shorthand, run by
+    :func:`camtool.jobs.run.run_job` as every job is.
 
     Args:
         drawing: the imported drawing, mm.
@@ -457,97 +384,17 @@ def post_drawing(
         progress: told the ``planning`` stage (``total``: the drawing's contours), the
             ``offsetting`` stage within it (:func:`~camtool.toolpath.plan.plan_drawing`) and
             the ``writing`` stage (``total``: the program's moves; ``name``: the target).
+        layers: the layers ``--layers`` named (``None``: all): their construction
+            geometry (centre lines...) is cut too, as asked by name.
 
     Raises:
         CamtoolError: from any stage, with its exit code.
     """
-    output = output if output is not None else OutputOptions()
-    plan = plan_options(target, plan)
-    from camtool.toolpath.plan import plan_drawing  # not needed by a re-post: numpy
+    from camtool.jobs.job import Job
 
-    progress(Step("planning", 0, len(drawing.contours)))
-    planned = plan_drawing(
-        drawing, plan, target.machine, helix=target.post.helix, progress=progress
-    )
-    program = dataclasses.replace(
-        planned.program,
-        notes=job_notes(drawing.source, target, plan),
-        tolerance_mm=plan.tolerance,
-        warnings=(*planned.program.warnings, *_surface_warning(plan, target)),
-    )
-    program = _with_spindle(
-        program,
-        target.spindle_rpm if output.spindle_rpm is None else output.spindle_rpm,
-        output.spindle_dwell_s,
-    )
-    edge = plan.radius if plan.offset != "on" else 0.0
-    progress(Step("writing", 0, len(program.moves), target.name))
-    result = target.emit(program, fmt=output.fmt)
-    return PostJob(drawing, program, target, result, planned.placed, edge, planned.report)
-
-
-NO_DEPTH_WARNING = (
-    "no --depth: cutting at Z 0, the top of the stock — a pen, a drag knife or an engraving "
-    "at the surface; give --depth MM to cut into it"
-)
-"""What a plan without ``--depth`` for a machine with Z says (rapids stay at safe Z)."""
-
-
-def _surface_warning(plan: PlanOptions, target: Target) -> tuple[str, ...]:
-    """:data:`NO_DEPTH_WARNING` when ``target`` has Z and ``plan`` no depth."""
-    return (NO_DEPTH_WARNING,) if plan.depth is None and target.machine.has_z else ()
-
-
-def job_notes(source: str, target: Target, plan: PlanOptions | None = None) -> tuple[str, ...]:
-    """The job, in a few lines for the top of the program (comments where the dialect has them).
-
-    Input file name (without its folder), target, camtool version, and for a
-    planned drawing the tool, offset, depth and heights, mm. Nothing varies
-    between two runs of the same job (no date, no absolute path).
-
-    Args:
-        source: the input's file name (``""`` or ``"-"``: standard input).
-        target: the target the program is for.
-        plan: the planning options (``None``: a re-posted program).
-    """
-    from camtool.model.version import __version__
-
-    name = Path(source).name if source and source != "-" else "stdin"
-    notes = [f"camtool {__version__}: {name} for {target.name}"]
-    if plan is None:
-        return (*notes, "re-posted program: moves as the input gives them")
-    tool = f"tool diameter {plan.tool_diameter:g} mm, offset {plan.offset}"
-    if plan.offset == "on":
-        tool = "offset on: the tool centre follows the drawing"
-        if plan.tool_diameter > 0:
-            tool += f" (tool diameter {plan.tool_diameter:g} mm)"
-    elif plan.offset == "pocket":
-        tool += f" ({plan.pocket}, stepover {plan.stepover:g})"
-    notes.append(tool)
-    notes.append(_work_zero(plan))
-    if not target.machine.has_z:
-        notes.append("no Z axis: set the depth by hand")
-        return tuple(notes)
-    if plan.depth is None:
-        depth = "depth none: cuts at Z 0, the top of the stock"
-    else:
-        step = "" if plan.step_down is None else f" in passes of {plan.step_down:g} mm"
-        depth = f"depth {plan.depth:g} mm{step}"
-    notes.append(depth)
-    notes.append(f"safe Z {plan.safe_z:g} mm, clearance Z {plan.clearance:g} mm above the top")
-    return tuple(notes)
-
-
-def _work_zero(plan: PlanOptions) -> str:
-    """Where X0 Y0 of the program lies, for the job notes (``--origin``, ``--translate``)."""
-    where = {
-        "drawing": "the drawing's origin",
-        "lower-left": "the toolpath's lower-left corner",
-        "center": "the toolpath's centre",
-    }[plan.placement]
-    dx, dy = plan.translate
-    moved = f", moved by X{dx:g} Y{dy:g} mm" if (dx, dy) != (0.0, 0.0) else ""
-    return f"work zero X0 Y0: {where}{moved}"
+    plan = plan if plan is not None else PlanOptions()
+    job = Job.single(plan, layers)
+    return run_job(drawing, target, job, output, progress=progress)
 
 
 def verify_job(

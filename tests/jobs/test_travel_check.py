@@ -52,7 +52,7 @@ def test_a_drawing_wider_than_the_travel_is_refused_before_any_fit(
 ) -> None:
     path = _wide(tmp_path, 1000.0)
     monkeypatch.setattr(svg_importer, "_prefitted", _never)
-    monkeypatch.setattr(plan_module, "plan_drawing", _never)
+    monkeypatch.setattr(plan_module, "plan_unplaced", _never)
     plan = PlanOptions(offset=offset, tool_diameter=2.0)
     with pytest.raises(DialectError, match=r"at least 1000 × \d+(\.\d+)? mm") as err:
         post_path(path, load_target("grbl"), plan)
@@ -73,7 +73,7 @@ def test_the_cli_refuses_it_with_exit_code_1_and_writes_nothing(
 
 def test_scale_counts(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     path = _wide(tmp_path, 150.0)  # fits as drawn, 300 mm at --scale 2 does not
-    monkeypatch.setattr(plan_module, "plan_drawing", _never)
+    monkeypatch.setattr(plan_module, "plan_unplaced", _never)
     with pytest.raises(DialectError, match=r"at least 300 × .* at --scale 2"):
         post_path(path, load_target("grbl"), PlanOptions(scale=2.0))
 
@@ -104,13 +104,13 @@ def test_inside_offsets_and_pockets_are_judged_after_planning(
         root='width="1010mm" height="100mm" viewBox="0 0 1010 100"',
     )
     planned: list[bool] = []
-    plan_drawing = plan_module.plan_drawing
+    plan_unplaced = plan_module.plan_unplaced
 
     def noting(*args: Any, **kwargs: Any) -> Any:
         planned.append(True)
-        return plan_drawing(*args, **kwargs)
+        return plan_unplaced(*args, **kwargs)
 
-    monkeypatch.setattr(plan_module, "plan_drawing", noting)
+    monkeypatch.setattr(plan_module, "plan_unplaced", noting)
     with pytest.raises(DialectError, match=r"^the toolpath is 99\d(\.\d+)? × "):
         post_path(path, load_target("grbl"), PlanOptions(offset=offset, tool_diameter=3.0))
     assert planned == [True]
@@ -122,7 +122,7 @@ def test_a_dxf_is_checked_once_read(tmp_path: Path, monkeypatch: pytest.MonkeyPa
         msp.add_open_spline([(0, 10, 0), (200, 90, 0), (400, -40, 0), (640, 30, 0)], degree=3)
 
     path = write_dxf(tmp_path / "long.dxf", build)
-    monkeypatch.setattr(plan_module, "plan_drawing", _never)
+    monkeypatch.setattr(plan_module, "plan_unplaced", _never)
     with pytest.raises(DialectError, match=r"at least 640 × .*refused before planning"):
         post_path(path, load_target("grbl"), PlanOptions())
 
@@ -134,7 +134,7 @@ def test_standard_input_is_checked_too(
         msp.add_lwpolyline([(0, 0), (640, 0), (640, 30), (0, 30)], close=True)
 
     data = write_dxf(tmp_path / "long.dxf", build).read_bytes()
-    monkeypatch.setattr(plan_module, "plan_drawing", _never)
+    monkeypatch.setattr(plan_module, "plan_unplaced", _never)
     monkeypatch.setattr("sys.stdin", io.TextIOWrapper(io.BytesIO(data)))
     out = tmp_path / "out.gcode"
     assert main(["post", "-", "-t", "grbl", "-o", str(out)]) == 1

@@ -21,7 +21,7 @@ import pytest
 
 from camtool.cli.main import main
 from camtool.importers.gcode import read_gcode
-from camtool.jobs.pipeline import NO_DEPTH_WARNING
+from camtool.jobs.header import NO_DEPTH_WARNING
 from camtool.model.program import Program, Rapid, Spindle
 from camtool.post.registry import load_target
 

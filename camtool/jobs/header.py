@@ -1,0 +1,152 @@
+"""The program header: the job in a few comment lines, and the warnings every job shares.
+
+What a machinist reads before running the program: the input, target and camtool
+version, where work zero is, the heights, and for a job file its tools and each
+operation in order with its tool, depths and time. Nothing in it varies between two runs
+of the same job (no date, no absolute path), so programs stay byte-for-byte reproducible.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from camtool.jobs.job import Job
+    from camtool.jobs.run import OperationRun
+    from camtool.post.base import Target
+    from camtool.toolpath.options import PlanOptions
+
+
+NO_DEPTH_WARNING = (
+    "no --depth: cutting at Z 0, the top of the stock — a pen, a drag knife or an engraving "
+    "at the surface; give --depth MM to cut into it"
+)
+"""What a plan without ``--depth`` for a machine with Z says (rapids stay at safe Z)."""
+
+
+def surface_warnings(runs: Sequence[OperationRun], target: Target) -> tuple[str, ...]:
+    """:data:`NO_DEPTH_WARNING` when ``target`` has Z and an operation no depth."""
+    if not target.machine.has_z:
+        return ()
+    bare = [r for r in runs if r.operation.plan.depth is None]
+    if not bare:
+        return ()
+    if len(runs) == 1:
+        return (NO_DEPTH_WARNING,)
+    return (f"{', '.join(r.label for r in bare)}: {NO_DEPTH_WARNING}",)
+
+
+def job_notes(
+    source: str,
+    target: Target,
+    plan: PlanOptions | None = None,
+    job: Job | None = None,
+    runs: Sequence[OperationRun] = (),
+) -> tuple[str, ...]:
+    """The job, in a few lines for the top of the program (comments where the dialect has them).
+
+    Input file name (without its folder), target, camtool version, and for a
+    planned drawing the tool, offset, depth and heights, mm; for a job file its tools
+    and each operation in order with its tool, depths and time. Nothing varies
+    between two runs of the same job (no date, no absolute path).
+
+    Args:
+        source: the input's file name (``""`` or ``"-"``: standard input).
+        target: the target the program is for.
+        plan: the planning options of ``post``'s one operation (``None``: a re-posted
+            program, or a job file's: ``job`` and ``runs``).
+        job: a job file's job.
+        runs: what each of its operations made, in order.
+    """
+    from camtool.model.version import __version__
+
+    name = Path(source).name if source and source != "-" else "stdin"
+    notes = [f"camtool {__version__}: {name} for {target.name}"]
+    if job is not None and plan is None:
+        return (*notes, *_job_lines(job, runs, target))
+    if plan is None:
+        return (*notes, "re-posted program: moves as the input gives them")
+    tool = f"tool diameter {plan.tool_diameter:g} mm, offset {plan.offset}"
+    if plan.offset == "on":
+        tool = "offset on: the tool centre follows the drawing"
+        if plan.tool_diameter > 0:
+            tool += f" (tool diameter {plan.tool_diameter:g} mm)"
+    elif plan.offset == "pocket":
+        tool += f" ({plan.pocket}, stepover {plan.stepover:g})"
+    notes.append(tool)
+    notes.append(_work_zero(plan))
+    if not target.machine.has_z:
+        notes.append("no Z axis: set the depth by hand")
+        return tuple(notes)
+    if plan.depth is None:
+        depth = "depth none: cuts at Z 0, the top of the stock"
+    else:
+        step = "" if plan.step_down is None else f" in passes of {plan.step_down:g} mm"
+        depth = f"depth {plan.depth:g} mm{step}"
+    notes.append(depth)
+    notes.append(f"safe Z {plan.safe_z:g} mm, clearance Z {plan.clearance:g} mm above the top")
+    return tuple(notes)
+
+
+def _job_lines(job: Job, runs: Sequence[OperationRun], target: Target) -> list[str]:
+    """The header lines of a job file's program: setup, tools, operations in order."""
+    setup = job.setup.plan
+    lines = [f"job {job.source}: {len(runs)} operation(s), {len(job.tools)} tool(s)"]
+    lines.append(_work_zero(setup))
+    if target.machine.has_z:
+        safe = sorted({r.operation.plan.safe_z for r in runs})
+        lines.append(
+            f"safe Z {', '.join(f'{z:g}' for z in safe)} mm, clearance Z {setup.clearance:g} "
+            "mm above the top"
+        )
+    used = dict.fromkeys(r.tool.id for r in runs)
+    lines.append("tools: " + "; ".join(f"T{t} {job.tool(t).describe()}" for t in used))
+    for run in runs:
+        lines.append(_operation_line(run, target))
+    total = sum(r.time_s for r in runs)
+    lines.append(f"time at the programmed feeds: {_minutes(total)} (verify simulates it)")
+    return lines
+
+
+def _operation_line(run: OperationRun, target: Target) -> str:
+    """``"2. pocket 'floor' T1: depth 2 mm in passes of 1 mm, layer POCKET; 3.1 min"``."""
+    op = run.operation
+    name = f" {op.name!r}" if op.name else ""
+    plan = op.plan
+    parts = [f"{run.number}. {op.kind}{name} T{run.tool.id}"]
+    what = op.select.describe()
+    if op.type == "drill":
+        depth = f"{run.holes} hole(s) to depth {plan.depth:g} mm"
+        if plan.step_down is not None and plan.depth is not None and plan.step_down < plan.depth:
+            depth += f", pecks of {plan.step_down:g} mm ({op.peck})"
+    elif not target.machine.has_z:
+        depth = "no Z"
+    elif plan.depth is None:
+        depth = "at Z 0"
+    else:
+        depth = f"depth {plan.depth:g} mm"
+        if plan.step_down is not None and plan.step_down < plan.depth:
+            depth += f" in passes of {plan.step_down:g} mm"
+        if plan.tabs:
+            depth += f", {plan.tabs} tab(s)"
+    return f"{parts[0]}: {depth}; {what}; {_minutes(run.time_s)}"
+
+
+def _minutes(seconds: float) -> str:
+    if seconds < 60:
+        return f"{seconds:.0f} s"
+    return f"{seconds / 60:.1f} min"
+
+
+def _work_zero(plan: PlanOptions) -> str:
+    """Where X0 Y0 of the program lies, for the job notes (``--origin``, ``--translate``)."""
+    where = {
+        "drawing": "the drawing's origin",
+        "lower-left": "the toolpath's lower-left corner",
+        "center": "the toolpath's centre",
+    }[plan.placement]
+    dx, dy = plan.translate
+    moved = f", moved by X{dx:g} Y{dy:g} mm" if (dx, dy) != (0.0, 0.0) else ""
+    return f"work zero X0 Y0: {where}{moved}"

@@ -1,0 +1,619 @@
+"""Run a job: every operation planned in turn, joined into one program for one target.
+
+:func:`run_job` is the one path from a drawing to code: ``post``, ``batch`` and the API
+(:func:`camtool.jobs.pipeline.post_drawing`, whose options are the one-operation
+shorthand :meth:`~camtool.jobs.job.Job.single`) all come through it. In turn, for each
+operation of :meth:`~camtool.jobs.job.Job.sequenced`:
+
+1. its selection of the drawing (:mod:`camtool.jobs.selection`), after the drawing is
+   scaled once for all (``scale``/``fit``), construction geometry left out;
+2. its moves: a drill operation's holes as canned cycles
+   (:class:`~camtool.model.program.DrillCycle`, expanded by LinuxCNC's rules), every other
+   one planned from where the last one ended (:func:`camtool.toolpath.plan.plan_unplaced`);
+   each ends at clearance height;
+3. a tool change before it when its tool is not the one loaded: spindle off,
+   :class:`~camtool.model.program.ToolChange` with what to load, spindle on again.
+
+The joined program is then placed once (work zero, ``translate``, the travel check:
+:func:`camtool.toolpath.plan.place_program`), so every operation lies where the others do.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from camtool.jobs.job import Job, Operation, Tool
+from camtool.jobs.selection import (
+    circle_of,
+    construction_notes,
+    nothing_selected,
+    select,
+)
+from camtool.model.drilling import expand
+from camtool.model.errors import InputError, UsageError
+from camtool.model.program import (
+    Command,
+    DrillCycle,
+    Dwell,
+    Move,
+    Program,
+    Rapid,
+    Spindle,
+    ToolChange,
+)
+from camtool.model.progress import Progress, Step, no_progress
+from camtool.model.shapes import Contour, Drawing, Point
+from camtool.toolpath.options import PlanOptions
+
+if TYPE_CHECKING:
+    from camtool.post.base import PostResult, Target
+    from camtool.toolpath.plan import PlanReport
+
+
+@dataclass(frozen=True)
+class PostJob:
+    """Everything one ``post`` produced.
+
+    Attributes:
+        drawing: what was imported (``None`` when the input was already a program).
+        program: the planned, machine-neutral program.
+        target: the target it was written for.
+        result: the emitted code and its warnings.
+        placed: the drawing as placed on the machine (after ``scale``/``fit_mm``),
+            in the program's coordinates.
+        edge_radius_mm: how far the cut edge lies from the tool path: half the tool
+            diameter for ``outside``/``inside``/``pocket``, 0 for paths on the line.
+        plan: what planning did and found (``None`` for a re-posted program).
+    """
+
+    drawing: Drawing | None
+    program: Program
+    target: Target
+    result: PostResult
+    placed: Drawing | None
+    edge_radius_mm: float = 0.0
+    plan: PlanReport | None = None
+    operations: tuple[OperationRun, ...] = ()
+
+    @property
+    def warnings(self) -> tuple[str, ...]:
+        """Warnings of every stage, in pipeline order, without repeats."""
+        return tuple(dict.fromkeys(self.program.warnings + self.result.warnings))
+
+
+@dataclass(frozen=True, kw_only=True)
+class OutputOptions:
+    """How the planned program is written: the options that are not planning options.
+
+    They apply to a re-posted program too (:func:`post_program`).
+
+    Attributes:
+        fmt: the dialect's output format (``None``: its first, see ``camtool targets``).
+        spindle_rpm: spindle speed, rev/min; ``None`` takes the target's
+            ``spindle_rpm`` for a planned drawing (which may be none), 0 programs no
+            spindle; a re-posted program gets spindle commands only when > 0 and it
+            has none of its own.
+        spindle_dwell_s: wait this long after the spindle starts, s (``--spindle-dwell``).
+    """
+
+    fmt: str | None = None
+    spindle_rpm: float | None = None
+    spindle_dwell_s: float = 0.0
+
+
+def plan_options(target: Target, plan: PlanOptions | None = None) -> PlanOptions:
+    """``plan`` for ``target``: its default feed filled in, checked against what it can do.
+
+    Args:
+        target: the target the plan is for.
+        plan: the planning options (``None``: the defaults); ``feed_mm_min`` ``None``
+            takes the target's default feed.
+
+    Raises:
+        UsageError: options the target cannot carry out: depth options for a machine
+            without Z, lead-in arcs on a target that writes arcs as chords, a ramp on
+            a target that moves Z in its own block (the options themselves are
+            checked when the :class:`PlanOptions` is made).
+    """
+    plan = plan if plan is not None else PlanOptions()
+    if plan.feed_mm_min is None:
+        plan = dataclasses.replace(plan, feed_mm_min=target.default_feed_mm_min)
+    plan.check_machine(target.machine, target.name)
+    if plan.lead_in_mm > 0 and not target.post.arcs:
+        raise UsageError(
+            f"--lead-in: {target.name} writes arcs as chords; lead-in arcs are for targets "
+            "with arcs (leave --lead-in out)"
+        )
+    if plan.ramp_angle_deg is not None and not target.post.z_with_xy:
+        raise UsageError(
+            f"--ramp: {target.name} moves Z in a block of its own, so it cannot descend "
+            "along the path; leave --ramp out (the tool plunges straight down)"
+        )
+    return plan
+
+
+@dataclass(frozen=True)
+class OperationRun:
+    """What one operation of a job made.
+
+    Attributes:
+        number: its place in the run, 1-based.
+        operation: the operation.
+        tool: its tool.
+        moves: ``(first, end)``: its moves are ``program.moves[first:end]``.
+        contours: ``(first, last)`` contour numbers of its cuts in the program (``(0, -1)``
+            when it has none).
+        placed: what it cuts, in the program's work coordinates.
+        edge_radius_mm: how far the cut edge lies from the tool path (half the tool for
+            a compensated profile or pocket, 0 on the line and for drilling).
+        report: what planning found (``None`` for drilling).
+        holes: the holes a drill operation drills.
+        time_s: its moves' time at their programmed feeds (rapids at the machine's rate
+            where its profile gives one), s.
+    """
+
+    number: int
+    operation: Operation
+    tool: Tool
+    moves: tuple[int, int]
+    contours: tuple[int, int]
+    placed: Drawing
+    edge_radius_mm: float
+    report: PlanReport | None
+    holes: int = 0
+    time_s: float = 0.0
+
+    @property
+    def label(self) -> str:
+        """``"operation 2 (pocket 'floor')"``: how messages name it."""
+        name = f" {self.operation.name!r}" if self.operation.name else ""
+        return f"operation {self.number} ({self.operation.kind}{name})"
+
+
+@dataclass(frozen=True)
+class _Planned:
+    moves: list[Move]
+    commands: list[tuple[int, Command]]
+    warnings: list[str]
+    report: PlanReport | None
+    placed: Drawing
+    holes: int = 0
+
+
+def run_job(
+    drawing: Drawing,
+    target: Target,
+    job: Job,
+    output: OutputOptions | None = None,
+    *,
+    progress: Progress = no_progress,
+) -> PostJob:
+    """Plan every operation of ``job`` on ``drawing`` and write the program for ``target``.
+
+    Args:
+        drawing: the imported drawing, mm.
+        target: the target.
+        job: the job (:func:`~camtool.jobs.job.load_job`, or :meth:`Job.single` of
+            ``post``'s options).
+        output: the output format and spindle (``None``: the defaults).
+        progress: told the ``planning`` stage (and ``offsetting`` within it) and the
+            ``writing`` stage.
+
+    Returns:
+        The job's :class:`~camtool.jobs.pipeline.PostJob`, with one
+        :class:`OperationRun` per operation in ``operations``.
+
+    Raises:
+        InputError: an operation selects nothing, a drill operation selects what is not
+            a hole or a hole of another size than its drill, or an operation leaves nothing
+            to cut (names the operation).
+        UsageError: options the target cannot carry out (depth for a machine without Z...).
+        CamtoolError: from any stage, with its exit code.
+    """
+    from camtool.jobs.header import job_notes, surface_warnings
+    from camtool.toolpath.plan import place, place_program
+
+    output = output if output is not None else OutputOptions()
+    setup = plan_options(target, job.setup.plan)
+    scaled = place(drawing, setup)
+    progress(Step("planning", 0, len(drawing.contours)))
+    moves: list[Move] = []
+    commands: list[tuple[int, Command]] = []
+    warnings: list[str] = list(drawing.warnings)
+    runs: list[OperationRun] = []
+    construction: list[Contour] = []
+    here: tuple[float, float, float | None] = (*setup.origin, None)
+    loaded: int | None = None
+    sequence = job.sequenced()
+    for number, op in enumerate(sequence, start=1):
+        tool = job.tool(op.tool)
+        where = _where(job, op, number)
+        chosen = select(scaled, op.select)
+        construction.extend(c for c in chosen.construction if c not in construction)
+        if not chosen.drawing.contours and not chosen.drawing.marks:
+            if job.shorthand and chosen.construction:
+                raise InputError(
+                    f"{drawing.source or 'the drawing'}: nothing to cut: every contour is "
+                    "construction (" + "; ".join(construction_notes(chosen.construction)) + ")"
+                )
+            raise InputError(f"{job.source or 'the job'}: {nothing_selected(scaled, op, where)}")
+        last = number == len(sequence)
+        options = _operation_options(target, op, setup, here, last)
+        if not job.shorthand and tool.id != loaded:
+            commands.extend(_tool_change(len(moves), tool, loaded, output, target))
+            loaded = tool.id
+        first = len(moves)
+        planned = _plan_operation(chosen.drawing, op, tool, options, target, here, where, progress)
+        offset = _last_contour(moves)
+        _join(moves, commands, planned, offset)
+        warnings.extend(planned.warnings)
+        here = _position(moves, here)
+        runs.append(
+            OperationRun(
+                number=number,
+                operation=op,
+                tool=tool,
+                moves=(first, len(moves)),
+                contours=(offset + 1, _last_contour(moves)),
+                placed=planned.placed,
+                edge_radius_mm=options.radius if options.offset != "on" else 0.0,
+                report=planned.report,
+                holes=planned.holes,
+                time_s=feed_time_s(moves[first:], target, start=_start(moves, first, setup)),
+            )
+        )
+    warnings[len(drawing.warnings) : len(drawing.warnings)] = construction_notes(construction)
+    warnings.extend(_overlaps(runs, job))
+    placed_all = Drawing(
+        tuple(c for r in runs for c in r.placed.contours),
+        drawing.source,
+        (),
+        tuple(m for r in runs for m in r.placed.marks),
+    )
+    program = Program(tuple(moves), setup.origin, tuple(dict.fromkeys(warnings)))
+    program, placed_all, shift = place_program(program, placed_all, setup, target.machine)
+    runs = [_shifted(r, shift) for r in runs]
+    program = dataclasses.replace(
+        program,
+        commands=tuple(commands),
+        notes=job_notes(drawing.source, target, setup if job.shorthand else None, job, runs),
+        tolerance_mm=setup.tolerance,
+        warnings=(*program.warnings, *surface_warnings(runs, target)),
+    )
+    if job.shorthand:
+        program = _spindle_around(program, output, target)
+    elif any(isinstance(c, Spindle) for _, c in commands):
+        program = dataclasses.replace(
+            program, commands=(*program.commands, (len(program.moves), Spindle("off")))
+        )
+    progress(Step("writing", 0, len(program.moves), target.name))
+    result = target.emit(program, fmt=output.fmt)
+    only = runs[0]
+    report = only.report if len(runs) == 1 else None
+    if report is not None:
+        report = dataclasses.replace(report, work_shift=shift)
+    return PostJob(
+        drawing,
+        program,
+        target,
+        result,
+        placed_all,
+        only.edge_radius_mm if len(runs) == 1 else 0.0,
+        report,
+        operations=tuple(runs),
+    )
+
+
+def _where(job: Job, op: Operation, number: int) -> str:
+    """How messages name an operation (the shorthand is the command's options)."""
+    if job.shorthand:
+        return "the options"
+    name = f" ({op.name!r})" if op.name else ""
+    return f"operation {number}{name}"
+
+
+def _operation_options(
+    target: Target,
+    op: Operation,
+    setup: PlanOptions,
+    here: tuple[float, float, float | None],
+    last: bool,
+) -> PlanOptions:
+    """``op``'s planning options for planning it alone, from where the tool is."""
+    shared = {
+        "scale": 1.0,
+        "fit_mm": None,
+        "placement": "drawing",
+        "translate": (0.0, 0.0),
+        "end_position": setup.end_position if last else None,
+        "origin": (here[0], here[1]),
+        "clearance_z": setup.clearance_z,
+        "chain_tolerance": setup.chain_tolerance,
+        "close_gap": setup.close_gap,
+        "tolerance": setup.tolerance,
+    }
+    plan = dataclasses.replace(op.plan, **shared)  # type: ignore[arg-type]
+    return plan_options(target, plan)
+
+
+def _plan_operation(
+    drawing: Drawing,
+    op: Operation,
+    tool: Tool,
+    options: PlanOptions,
+    target: Target,
+    here: tuple[float, float, float | None],
+    where: str,
+    progress: Progress,
+) -> _Planned:
+    """The moves of one operation, in drawing coordinates (scaled, not yet placed)."""
+    if op.type == "drill":
+        return _drill(drawing, op, tool, options, here, where)
+    from camtool.toolpath.plan import plan_unplaced
+
+    if not drawing.contours:
+        raise InputError(f"{where} selects only points, which only a drill operation drills")
+    try:
+        planned = plan_unplaced(
+            drawing, options, target.machine, helix=target.post.helix, progress=progress
+        )
+    except InputError as exc:
+        if where == "the options":
+            raise
+        raise InputError(f"{where}: {exc}") from None
+    program = planned.program
+    return _Planned(list(program.moves), [], list(program.warnings), planned.report, planned.placed)
+
+
+def _drill(
+    drawing: Drawing,
+    op: Operation,
+    tool: Tool,
+    options: PlanOptions,
+    here: tuple[float, float, float | None],
+    where: str,
+) -> _Planned:
+    """A drill operation: a canned cycle at each hole, nearest first."""
+    holes = _holes(drawing, op, tool, where)
+    assert options.depth is not None  # a drill operation's depth is required when loaded
+    clearance = options.clearance
+    moves: list[Move] = []
+    commands: list[tuple[int, Command]] = []
+    x, y, _ = here
+    moves.append(Rapid(x, y, clearance))  # the rise (left out when the tool is up there)
+    z = clearance
+    peck = options.step_down if options.step_down is not None else None
+    kind = (
+        "drill"
+        if peck is None or peck >= options.depth
+        else ("peck" if op.peck == "retract" else "chip-break")
+    )
+    for n, (hx, hy) in enumerate(_nearest_first(holes, (x, y)), start=1):
+        cycle = DrillCycle(
+            kind,  # type: ignore[arg-type]
+            hx,
+            hy,
+            -options.depth,
+            options.safe_z,
+            options.plunge_feed if options.plunge_feed_mm_min is not None else options.feed,
+            peck_mm=None if kind == "drill" else peck,
+            dwell_s=op.dwell_s if kind == "drill" else 0.0,
+            retract="initial",
+        )
+        items = expand(cycle, (x, y, z))
+        count = sum(1 for item in items if not isinstance(item, Dwell))
+        commands.append((len(moves), dataclasses.replace(cycle, moves=count)))
+        for item in items:
+            if isinstance(item, Dwell):
+                commands.append((len(moves), item))
+            else:
+                moves.append(dataclasses.replace(item, contour=n))
+        x, y = hx, hy
+        z = clearance
+    placed = Drawing(drawing.contours, drawing.source, (), drawing.marks)
+    return _Planned(moves, commands, [], None, placed, holes=len(holes))
+
+
+def _holes(drawing: Drawing, op: Operation, tool: Tool, where: str) -> list[Point]:
+    """The centres of the holes a drill operation drills, each checked against its drill."""
+    out: list[Point] = []
+    for contour in drawing.contours:
+        circle = circle_of(contour)
+        name = f"{contour.source or 'contour'} on layer {contour.layer!r}"
+        if circle is None:
+            raise InputError(
+                f"{where} drills {name} at ({contour.start[0]:.4f}, {contour.start[1]:.4f}) "
+                "mm, which is not a circle: a drill operation drills circles and points; cut "
+                "it with a profile or pocket operation (or narrow the selection)"
+            )
+        (cx, cy), d = circle
+        if abs(d - tool.diameter) > op.hole_tolerance_mm + 1e-9:
+            size = "larger" if d > tool.diameter else "smaller"
+            raise InputError(
+                f"{where}: hole {name} at ({cx:.4f}, {cy:.4f}) mm is {d:.4g} mm across, "
+                f"{size} than the {tool.diameter:g} mm drill (hole_tolerance "
+                f"{op.hole_tolerance_mm:g} mm): "
+                + (
+                    'cut it with a profile operation (side = "inside") instead'
+                    if d > tool.diameter
+                    else "drill it with a smaller drill"
+                )
+            )
+        out.append((cx, cy))
+    out.extend(m.at for m in drawing.marks)
+    return list(dict.fromkeys(out))
+
+
+def _nearest_first(points: Sequence[Point], start: Point) -> list[Point]:
+    """``points`` in nearest-neighbour order from ``start`` (ties: the earlier point)."""
+    left = list(points)
+    out: list[Point] = []
+    here = start
+    while left:
+        k = min(range(len(left)), key=lambda i: (math.dist(here, left[i]), i))
+        here = left.pop(k)
+        out.append(here)
+    return out
+
+
+def _tool_change(
+    index: int, tool: Tool, loaded: int | None, output: OutputOptions, target: Target
+) -> list[tuple[int, Command]]:
+    """Spindle off (when a tool turns), the change, the spindle on for the new tool."""
+    rpm = _rpm(tool, output, target)
+    out: list[tuple[int, Command]] = []
+    if loaded is not None and rpm:
+        out.append((index, Spindle("off")))
+    out.append((index, ToolChange(tool.id, tool.describe())))
+    if rpm:
+        out.append((index, Spindle("cw", rpm)))
+        if output.spindle_dwell_s > 0:
+            out.append((index, Dwell(output.spindle_dwell_s)))
+    return out
+
+
+def _rpm(tool: Tool, output: OutputOptions, target: Target) -> float:
+    if tool.rpm is not None:
+        return tool.rpm
+    if output.spindle_rpm is not None:
+        return output.spindle_rpm
+    return target.spindle_rpm or 0.0
+
+
+def _spindle_around(program: Program, output: OutputOptions, target: Target) -> Program:
+    """The shorthand's spindle: on before the first move, off after the last."""
+    rpm = target.spindle_rpm if output.spindle_rpm is None else output.spindle_rpm
+    if not rpm or any(isinstance(c, Spindle) for _, c in program.commands):
+        return program
+    return program.with_spindle(rpm, dwell_s=output.spindle_dwell_s)
+
+
+def _last_contour(moves: Sequence[Move]) -> int:
+    return max((m.contour for m in moves), default=0)
+
+
+def _join(
+    moves: list[Move], commands: list[tuple[int, Command]], planned: _Planned, offset: int
+) -> None:
+    """Append an operation's moves (contours renumbered after ``offset``) and commands.
+
+    The operation's first move is its rise to clearance where the tool stands. When the
+    last operation left the tool there at that height and no command (a tool change)
+    comes between, it moves nothing and is left out.
+    """
+    new = planned.moves
+    skip = 0
+    if moves and new and not any(i == len(moves) for i, _ in commands):
+        first, last = new[0], moves[-1]
+        still = (first.x, first.y) == (last.x, last.y) and first.z == _z_of(moves)
+        if isinstance(first, Rapid) and still and not any(i == 0 for i, _ in planned.commands):
+            skip = 1
+    base = len(moves) - skip
+    for move in new[skip:]:
+        moves.append(
+            dataclasses.replace(move, contour=move.contour + offset) if move.contour else move
+        )
+    commands.extend((i + base, c) for i, c in planned.commands)
+
+
+def _z_of(moves: Sequence[Move]) -> float | None:
+    for move in reversed(moves):
+        if move.z is not None:
+            return move.z
+    return None
+
+
+def _position(
+    moves: Sequence[Move], here: tuple[float, float, float | None]
+) -> tuple[float, float, float | None]:
+    if not moves:
+        return here
+    z = _z_of(moves)
+    return (moves[-1].x, moves[-1].y, z if z is not None else here[2])
+
+
+def _start(moves: Sequence[Move], first: int, setup: PlanOptions) -> tuple[float, float, float]:
+    """Where the tool stands before ``moves[first]`` (Z 0 when no Z was written yet)."""
+    if first == 0:
+        return (*setup.origin, 0.0)
+    z = _z_of(moves[:first])
+    return (moves[first - 1].x, moves[first - 1].y, 0.0 if z is None else z)
+
+
+def feed_time_s(
+    moves: Sequence[Move], target: Target, *, start: tuple[float, float, float]
+) -> float:
+    """The time of ``moves`` at their programmed feeds, s (Z moves counted).
+
+    Rapids count at the profile's ``max_rate_mm_min`` (``[machine.timing]``) where it has
+    one, else not at all; acceleration is not counted. A header estimate: ``verify``
+    simulates the controller's own timing.
+    """
+    rate = target.machine.timing.get("max_rate_mm_min")
+    x, y, z = start
+    total = 0.0
+    from camtool.model.program import ArcMove, segment_of
+
+    for move in moves:
+        nz = z if move.z is None else move.z
+        xy = (
+            segment_of((x, y), move).length
+            if isinstance(move, ArcMove)
+            else math.dist((x, y), (move.x, move.y))
+        )
+        length = math.hypot(xy, nz - z)
+        if isinstance(move, Rapid):
+            if rate:
+                total += length / float(rate) * 60.0
+        elif move.feed_mm_min > 0:
+            total += length / move.feed_mm_min * 60.0
+        x, y, z = move.x, move.y, nz
+    return total
+
+
+def _shifted(run: OperationRun, shift: Point) -> OperationRun:
+    dx, dy = shift
+    if dx == 0.0 and dy == 0.0:
+        return run
+    report = run.report
+    if report is not None:
+        report = dataclasses.replace(report, work_shift=shift)
+    return dataclasses.replace(run, placed=run.placed.transformed(1.0, dx, dy), report=report)
+
+
+def _overlaps(runs: Sequence[OperationRun], job: Job) -> list[str]:
+    """A warning for two operations of one kind that cut the same contour."""
+    if job.shorthand:
+        return []
+    out: list[str] = []
+    seen: dict[tuple[str, str], OperationRun] = {}
+    for run in runs:
+        for contour in run.placed.contours:
+            key = (run.operation.kind, contour.source)
+            other = seen.get(key)
+            if other is not None and other.number != run.number and contour.source:
+                out.append(
+                    f"{run.label} cuts {contour.source} on layer {contour.layer!r} again, as "
+                    f"{other.label} does: is one selection too wide?"
+                )
+                break
+            seen[key] = run
+    return out
+
+
+def refuse_operation_options(given: list[str]) -> None:
+    """Refuse per-operation options given on the command line with ``--job``.
+
+    Raises:
+        UsageError: ``given`` (their flags) is not empty.
+    """
+    if given:
+        raise UsageError(
+            f"{', '.join(given)} apply to one operation: with --job, put them in the job "
+            "file's [[operations]] (the command line may give --origin, --translate, "
+            "--scale/--fit, --clearance-z, --end-position, --tolerance and --feed)"
+        )

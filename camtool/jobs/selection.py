@@ -1,0 +1,157 @@
+"""What an operation cuts: its selection of the drawing, without what is not the part.
+
+A :class:`~camtool.jobs.job.Selection` keeps the contours (and points) whose layer,
+colour, closedness, circle diameter and linetype it names. Construction geometry — a
+non-continuous linetype (centre, hidden, dashed lines) or a construction, dimension or
+centre-line layer (:mod:`camtool.model.construction`) — is kept only when the selection
+names its layer or its linetype: a selection of "everything" never cuts it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from camtool.jobs.job import Operation, Selection
+from camtool.model.construction import construction_layer
+from camtool.model.shapes import Arc, Contour, Drawing, Mark, Point
+
+
+@dataclass(frozen=True)
+class Selected:
+    """An operation's share of the drawing.
+
+    Attributes:
+        drawing: the contours and marks it cuts (the drawing's source and warnings kept).
+        construction: the construction contours its selection held but leaves uncut.
+    """
+
+    drawing: Drawing
+    construction: tuple[Contour, ...] = ()
+
+
+def circle_of(contour: Contour) -> tuple[Point, float] | None:
+    """The centre and diameter (mm) of a contour that is a whole circle, else ``None``.
+
+    A circle is a closed contour of arcs about one centre with one radius (a DXF CIRCLE
+    is one arc from a point back to itself; a polyline of two bulges is two), to 1e-9 of
+    the radius.
+    """
+    segs = contour.segments
+    if not contour.closed or not all(isinstance(s, Arc) for s in segs):
+        return None
+    first = segs[0]
+    assert isinstance(first, Arc)
+    r = math.dist(first.start, first.centre)
+    if r <= 0:
+        return None
+    for s in segs:
+        assert isinstance(s, Arc)
+        if math.dist(s.centre, first.centre) > 1e-9 * r or abs(s.radius - r) > 1e-9 * r:
+            return None
+        if s.clockwise != first.clockwise:
+            return None
+    return first.centre, 2.0 * r
+
+
+def construction_reason(contour: Contour, selection: Selection) -> str | None:
+    """Why ``contour`` is construction that ``selection`` does not name, or ``None``."""
+    named_layer = selection.layers is not None and contour.layer.casefold() in {
+        n.casefold() for n in selection.layers
+    }
+    if contour.linetype:
+        named = selection.linetypes is not None and contour.linetype in selection.linetypes
+        if not (named or named_layer):
+            return f"linetype {contour.linetype}"
+    if construction_layer(contour.layer) and not named_layer:
+        return f"construction layer {contour.layer!r}"
+    return None
+
+
+def matches(contour: Contour, selection: Selection) -> bool:
+    """Whether ``contour`` meets every condition of ``selection`` (construction aside)."""
+    if selection.layers is not None and contour.layer.casefold() not in {
+        n.casefold() for n in selection.layers
+    }:
+        return False
+    if selection.colours is not None and contour.colour not in selection.colours:
+        return False
+    if selection.closed is not None and contour.closed != selection.closed:
+        return False
+    if selection.linetypes is not None and contour.linetype not in selection.linetypes:
+        return False
+    if selection.diameter_mm is not None:
+        circle = circle_of(contour)
+        lo, hi = selection.diameter_mm
+        slack = 1e-6 * max(hi, 1.0)
+        if circle is None or not lo - slack <= circle[1] <= hi + slack:
+            return False
+    return True
+
+
+def mark_matches(mark: Mark, selection: Selection) -> bool:
+    """Whether the point ``mark`` is selected (``points`` on, layer and colour matching)."""
+    if not selection.points:
+        return False
+    if selection.layers is not None and mark.layer.casefold() not in {
+        n.casefold() for n in selection.layers
+    }:
+        return False
+    return selection.colours is None or mark.colour in selection.colours
+
+
+def select(drawing: Drawing, selection: Selection) -> Selected:
+    """The contours and marks of ``drawing`` that ``selection`` cuts (see the module)."""
+    kept: list[Contour] = []
+    construction: list[Contour] = []
+    for contour in drawing.contours:
+        if not matches(contour, selection):
+            continue
+        if construction_reason(contour, selection) is None:
+            kept.append(contour)
+        else:
+            construction.append(contour)
+    marks = tuple(m for m in drawing.marks if mark_matches(m, selection))
+    chosen = Drawing(tuple(kept), drawing.source, drawing.warnings, marks)
+    return Selected(chosen, tuple(construction))
+
+
+def nothing_selected(drawing: Drawing, op: Operation, where: str) -> str:
+    """Why an operation selects nothing, naming what the drawing does have."""
+    s = op.select
+    layers = sorted({c.layer for c in drawing.contours} | {m.layer for m in drawing.marks})
+    if s.layers is not None:
+        present = {name.casefold() for name in layers}
+        missing = [n for n in s.layers if n.casefold() not in present]
+        if missing:
+            return (
+                f"{where} selects layer {', '.join(repr(n) for n in missing)}; the drawing has "
+                f"{', '.join(layers)}"
+            )
+    colours = sorted({c.colour for c in drawing.contours if c.colour})
+    return (
+        f"{where} selects nothing ({s.describe()}): the drawing has layers "
+        f"{', '.join(layers)}" + (f" and colours {', '.join(colours)}" if colours else "")
+    )
+
+
+def construction_notes(contours: Sequence[Contour]) -> list[str]:
+    """One line per kind of construction left uncut, with counts and a first place."""
+    groups: Counter[tuple[str, str]] = Counter()
+    first: dict[tuple[str, str], Contour] = {}
+    for c in contours:
+        key = (c.layer, c.linetype)
+        groups[key] += 1
+        first.setdefault(key, c)
+    out = []
+    for (layer, linetype), count in sorted(groups.items()):
+        c = first[(layer, linetype)]
+        what = f"linetype {linetype}" if linetype else "a construction layer"
+        where = f"{c.source} at ({c.start[0]:.4f}, {c.start[1]:.4f}) mm"
+        out.append(
+            f"not cut: {count} contour(s) on layer {layer!r} ({what}: construction, not the "
+            f"part; first {where}); an operation that names the layer cuts them"
+        )
+    return out
