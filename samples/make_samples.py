@@ -15,7 +15,10 @@ the thesis cut. It uses every entity kind the first importer reads:
 tool can reach), four ø4 mm holes, a 12 × 4 mm slot with round ends and a 2 × 2 mm
 square hole narrower than a 3 mm tool. ``pocket.dxf`` is a 30 × 20 mm pocket with 3 mm
 corner radii around two islands, a ø6 mm boss and a 5 × 5 mm block, for
-``--offset pocket``.
+``--offset pocket``. ``part.dxf`` is the job sample (``part.toml``, docs/jobs.md): an
+80 × 60 mm plate on layer OUTLINE, four ø3.2 mm holes on HOLES, a 30 × 20 mm pocket on
+POCKET, a line to engrave on ENGRAVE and centre lines (linetype CENTER) on CENTER, two of
+them across the whole part.
 """
 
 from __future__ import annotations
@@ -100,7 +103,57 @@ def make_pocket(path: Path) -> None:
     doc.saveas(path)
 
 
-SAMPLES = {"logo.dxf": make_logo, "plate.dxf": make_plate, "pocket.dxf": make_pocket}
+def make_part(path: Path) -> None:
+    """Write the job sample (a plate made by several operations) to ``path`` (units: mm)."""
+    doc = ezdxf.new("R2010", setup=True)  # setup: the CENTER linetype
+    doc.header["$INSUNITS"] = 4
+    for name, colour, linetype in (
+        ("OUTLINE", 7, "Continuous"),
+        ("HOLES", 1, "Continuous"),
+        ("POCKET", 3, "Continuous"),
+        ("ENGRAVE", 5, "Continuous"),
+        ("CENTER", 4, "CENTER"),
+    ):
+        doc.layers.add(name, color=colour, linetype=linetype)
+    msp = doc.modelspace()
+    r, b = 4.0, math.tan(math.pi / 8)  # corner radius; bulge of a 90° CCW arc
+    msp.add_lwpolyline(
+        [
+            (r, 0, 0.0), (80 - r, 0, b), (80, r, 0.0), (80, 60 - r, b),
+            (80 - r, 60, 0.0), (r, 60, b), (0, 60 - r, 0.0), (0, r, b),
+        ],
+        format="xyb",
+        close=True,
+        dxfattribs={"layer": "OUTLINE"},
+    )  # fmt: skip
+    holes = ((8, 8), (72, 8), (72, 52), (8, 52))
+    for x, y in holes:
+        msp.add_circle((x, y), 1.6, dxfattribs={"layer": "HOLES"})
+    p = 3.0
+    msp.add_lwpolyline(
+        [
+            (25 + p, 20, 0.0), (55 - p, 20, b), (55, 20 + p, 0.0), (55, 40 - p, b),
+            (55 - p, 40, 0.0), (25 + p, 40, b), (25, 40 - p, 0.0), (25, 20 + p, b),
+        ],
+        format="xyb",
+        close=True,
+        dxfattribs={"layer": "POCKET"},
+    )  # fmt: skip
+    msp.add_lwpolyline([(30, 10), (50, 10)], dxfattribs={"layer": "ENGRAVE"})
+    for x, y in holes:  # a cross of centre lines through each hole
+        msp.add_line((x - 4, y), (x + 4, y), dxfattribs={"layer": "CENTER"})
+        msp.add_line((x, y - 4), (x, y + 4), dxfattribs={"layer": "CENTER"})
+    msp.add_line((-5, 30), (85, 30), dxfattribs={"layer": "CENTER"})  # across the part
+    msp.add_line((40, -5), (40, 65), dxfattribs={"layer": "CENTER"})
+    doc.saveas(path)
+
+
+SAMPLES = {
+    "logo.dxf": make_logo,
+    "plate.dxf": make_plate,
+    "pocket.dxf": make_pocket,
+    "part.dxf": make_part,
+}
 """Each bundled drawing and the function that writes it."""
 
 

@@ -38,8 +38,10 @@ if TYPE_CHECKING:
     from collections.abc import Callable
 
     from camtool.cli.progress import StageReporter
+    from camtool.jobs.job import Job
     from camtool.model.shapes import Drawing
     from camtool.post.registry import TargetEntry
+    from camtool.toolpath.options import PlanOptions
     from camtool.toolpath.plan import PlanReport
     from camtool.verify.verifier import Verification
 
@@ -104,6 +106,15 @@ def cli() -> None:
     metavar="FILE",
     help="Where to write the program; '-' (default) is stdout.",
 )
+@click.option(
+    "--job",
+    "job_file",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    metavar="JOB.toml",
+    help="The operations and tools that make the part (docs/jobs.md; `camtool job init` "
+    "writes a first one). Without it the options below are one operation.",
+)
 @post_options
 @MACHINE
 @import_options
@@ -113,6 +124,7 @@ def post(
     drawing: str,
     target: str,
     output: str,
+    job_file: Path | None,
     machine_file: Path | None,
     verify_too: bool,
     report: str | None,
@@ -148,7 +160,7 @@ def post(
     from camtool.toolpath.options import drawing_only
 
     check_paths(
-        [("the input", drawing)],
+        [("the input", drawing), ("the --job file", job_file)],
         [("-o", output), ("--report", report), ("--preview", preview)],
         target=target,
         machine_file=machine_file,
@@ -159,15 +171,27 @@ def post(
     chosen.post.check_format(output_options.fmt)
     settings = import_settings(options)
     if drawing != "-" and is_program_file(drawing):
-        refuse_planning(drawing, drawing_only(options))  # before checking them
+        given = drawing_only(options) + (["--job"] if job_file is not None else [])
+        refuse_planning(drawing, given)  # before checking them
     plan = plan_settings(options)
+    job_spec = None if job_file is None else read_job(job_file, plan)
     verifying = bool(verify_too or report or preview or max_error_um is not None)
     load_picture = click.get_current_context().with_resource(picture_ahead(preview))
     progress = StageReporter()
     try:
         if drawing == "-":
-            drawn = read_input(drawing, sized(settings, plan), travel_check(plan, chosen))
-            job = post_drawing(drawn, chosen, plan, output_options, progress=progress)
+            shared = plan if job_spec is None else job_spec.setup.plan
+            check = travel_check(plan, chosen) if job_spec is None else None
+            drawn = read_input(drawing, sized(settings, shared), check)
+            job = post_drawing(
+                drawn,
+                chosen,
+                plan,
+                output_options,
+                progress=progress,
+                layers=settings.layers,
+                job=job_spec,
+            )
         else:
             job = post_path(
                 drawing,
@@ -177,6 +201,7 @@ def post(
                 import_options=settings,
                 progress=progress,
                 verifying=verifying,
+                job=job_spec,
             )
     finally:
         progress.close()
@@ -290,6 +315,20 @@ def verify(
         edge_radius_mm=tool_diameter / 2.0,
         strict=strict,
     )
+
+
+def read_job(path: Path, plan: PlanOptions) -> Job:
+    """The job file at ``path``, with the shared options given on the command line.
+
+    Raises:
+        UsageError: a per-operation option (``--depth``, ``--offset``...) was given too.
+        InputError: the job file is invalid (:func:`camtool.jobs.job.load_job`).
+    """
+    from camtool.jobs.job import load_job, operation_flags, shared_overrides
+    from camtool.jobs.run import refuse_operation_options
+
+    refuse_operation_options(operation_flags(plan))
+    return load_job(path, overrides=shared_overrides(plan))
 
 
 def _check_preview(preview: str | None) -> None:

@@ -91,9 +91,12 @@ def job_notes(
 
 
 def _job_lines(job: Job, runs: Sequence[OperationRun], target: Target) -> list[str]:
-    """The header lines of a job file's program: setup, tools, operations in order."""
+    """The header lines of a job file's program: setup, tools, operations in order.
+
+    Each line stays short (GRBL's line buffer holds 79 characters, comment included).
+    """
     setup = job.setup.plan
-    lines = [f"job {job.source}: {len(runs)} operation(s), {len(job.tools)} tool(s)"]
+    lines = [f"job {job.source}: {_count(len(runs), 'operation')}"]
     lines.append(_work_zero(setup))
     if target.machine.has_z:
         safe = sorted({r.operation.plan.safe_z for r in runs})
@@ -102,36 +105,38 @@ def _job_lines(job: Job, runs: Sequence[OperationRun], target: Target) -> list[s
             "mm above the top"
         )
     used = dict.fromkeys(r.tool.id for r in runs)
-    lines.append("tools: " + "; ".join(f"T{t} {job.tool(t).describe()}" for t in used))
-    for run in runs:
-        lines.append(_operation_line(run, target))
+    lines.extend(f"T{t}: {job.tool(t).describe()}" for t in used)
+    lines.extend(_operation_line(run, target) for run in runs)
     total = sum(r.time_s for r in runs)
-    lines.append(f"time at the programmed feeds: {_minutes(total)} (verify simulates it)")
+    lines.append(f"about {_minutes(total)} at the programmed feeds")
     return lines
 
 
 def _operation_line(run: OperationRun, target: Target) -> str:
-    """``"2. pocket 'floor' T1: depth 2 mm in passes of 1 mm, layer POCKET; 3.1 min"``."""
+    """``"3. pocket 'floor' T1: 2 deep, passes of 1; 2.3 min"``."""
     op = run.operation
     name = f" {op.name!r}" if op.name else ""
     plan = op.plan
-    parts = [f"{run.number}. {op.kind}{name} T{run.tool.id}"]
-    what = op.select.describe()
+    head = f"{run.number}. {op.kind}{name} T{run.tool.id}"
     if op.type == "drill":
-        depth = f"{run.holes} hole(s) to depth {plan.depth:g} mm"
+        what = f"{_count(run.holes, 'hole')}, {plan.depth:g} deep"
         if plan.step_down is not None and plan.depth is not None and plan.step_down < plan.depth:
-            depth += f", pecks of {plan.step_down:g} mm ({op.peck})"
+            what += f", pecks of {plan.step_down:g}"
     elif not target.machine.has_z:
-        depth = "no Z"
+        what = "no Z"
     elif plan.depth is None:
-        depth = "at Z 0"
+        what = "at Z 0"
     else:
-        depth = f"depth {plan.depth:g} mm"
+        what = f"{plan.depth:g} deep"
         if plan.step_down is not None and plan.step_down < plan.depth:
-            depth += f" in passes of {plan.step_down:g} mm"
+            what += f", passes of {plan.step_down:g}"
         if plan.tabs:
-            depth += f", {plan.tabs} tab(s)"
-    return f"{parts[0]}: {depth}; {what}; {_minutes(run.time_s)}"
+            what += f", {_count(plan.tabs, 'tab')}"
+    return f"{head}: {what}; {_minutes(run.time_s)}"
+
+
+def _count(n: int, noun: str) -> str:
+    return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
 
 
 def _minutes(seconds: float) -> str:

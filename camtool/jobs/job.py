@@ -756,7 +756,7 @@ def operation_flags(plan: PlanOptions) -> list[str]:
     With ``--job`` these belong in the job file's operations: ``post`` refuses them.
     """
     fields = PlanOptions.__dataclass_fields__
-    shared = {*SETUP_FIELDS, "origin", "feed_mm_min"}
+    shared = {*SETUP_FIELDS, "origin"}
     return [
         flag(f.name)
         for f in dataclasses.fields(PlanOptions)

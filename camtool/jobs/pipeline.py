@@ -21,6 +21,7 @@ from camtool.post.registry import load_target
 from camtool.toolpath.options import PlanOptions, drawing_only
 
 if TYPE_CHECKING:
+    from camtool.jobs.job import Job
     from camtool.toolpath.plan import PlanReport
     from camtool.verify.verifier import Verification
 
@@ -92,6 +93,7 @@ def post_path(
     import_options: ImportOptions | None = None,
     progress: Progress = no_progress,
     verifying: bool = False,
+    job: Job | None = None,
 ) -> PostJob:
     """Post the file at ``path``: a drawing is planned, a G-code program re-posted.
 
@@ -118,6 +120,8 @@ def post_path(
             to load OpenCASCADE, it loads what that comparison will
             (:func:`camtool.verify.metrics.comparison_preloads`). Only the time depends
             on it.
+        job: the operations and tools to run (``post --job``); ``None``: ``plan`` is
+            the one operation.
 
     Raises:
         UsageError: a planning option (offset, tool diameter, scale, depth, order...)
@@ -129,18 +133,21 @@ def post_path(
         from camtool.model.cores import meanwhile
         from camtool.toolpath.compensate import offsets_ahead
 
-        with offsets_ahead(plan):  # OpenCASCADE loads in the offsets' child meanwhile
+        shared = plan if job is None else job.setup.plan
+        with offsets_ahead(plan if job is None else _offsetting(job)):
             drawing = read_drawing(
                 path,
-                sized(import_options, plan),
+                sized(import_options, shared),
                 progress=progress,
-                check=travel_check(plan, target),
+                check=travel_check(plan, target) if job is None else None,
             )
             drawing = _note_units(drawing, path, import_options)
             with meanwhile(_preloads(drawing) if verifying else []):
                 layers = import_options.layers if import_options is not None else None
-                return post_drawing(drawing, target, plan, output, progress=progress, layers=layers)
-    refuse_planning(path, drawing_only(plan.given()))
+                return post_drawing(
+                    drawing, target, plan, output, progress=progress, layers=layers, job=job
+                )
+    refuse_planning(path, drawing_only(plan.given()) + (["--job"] if job is not None else []))
     from camtool.importers.gcode import read_gcode
 
     progress(Step("reading", name=Path(path).name))
@@ -152,6 +159,14 @@ def post_path(
         source=str(path),
         progress=progress,
     )
+
+
+def _offsetting(job: Job) -> PlanOptions:
+    """An operation of ``job`` that offsets for its tool (to start OpenCASCADE early), if any."""
+    for op in job.operations:
+        if op.plan.offset != "on":
+            return op.plan
+    return job.operations[0].plan
 
 
 def _preloads(drawing: Drawing) -> list[Callable[[], object]]:
@@ -367,6 +382,7 @@ def post_drawing(
     *,
     progress: Progress = no_progress,
     layers: tuple[str, ...] | None = None,
+    job: Job | None = None,
 ) -> PostJob:
     """Plan a drawing and post it for a target: the one-operation job of ``plan``.
 
@@ -386,14 +402,15 @@ def post_drawing(
             the ``writing`` stage (``total``: the program's moves; ``name``: the target).
         layers: the layers ``--layers`` named (``None``: all): their construction
             geometry (centre lines...) is cut too, as asked by name.
+        job: a job of operations and tools to run instead of ``plan``'s one operation.
 
     Raises:
         CamtoolError: from any stage, with its exit code.
     """
     from camtool.jobs.job import Job
 
-    plan = plan if plan is not None else PlanOptions()
-    job = Job.single(plan, layers)
+    if job is None:
+        job = Job.single(plan if plan is not None else PlanOptions(), layers)
     return run_job(drawing, target, job, output, progress=progress)
 
 

@@ -266,7 +266,10 @@ def run_job(
                 time_s=feed_time_s(moves[first:], target, start=_start(moves, first, setup)),
             )
         )
-    warnings[len(drawing.warnings) : len(drawing.warnings)] = construction_notes(construction)
+    notes = construction_notes(construction)
+    if not job.shorthand:
+        notes.extend(_unselected(scaled, runs))
+    warnings[len(drawing.warnings) : len(drawing.warnings)] = notes
     warnings.extend(_overlaps(runs, job))
     placed_all = Drawing(
         tuple(c for r in runs for c in r.placed.contours),
@@ -585,6 +588,20 @@ def _shifted(run: OperationRun, shift: Point) -> OperationRun:
     return dataclasses.replace(run, placed=run.placed.transformed(1.0, dx, dy), report=report)
 
 
+def _unselected(drawing: Drawing, runs: Sequence[OperationRun]) -> list[str]:
+    """One line per layer none of whose contours an operation cuts."""
+    cut = {c.layer for r in runs for c in r.placed.contours}
+    cut |= {m.layer for r in runs for m in r.placed.marks}
+    left: dict[str, int] = {}
+    for contour in drawing.contours:
+        if contour.layer not in cut:
+            left[contour.layer] = left.get(contour.layer, 0) + 1
+    return [
+        f"not cut: layer {layer!r} ({count} contour(s)): no operation selects it"
+        for layer, count in sorted(left.items())
+    ]
+
+
 def _overlaps(runs: Sequence[OperationRun], job: Job) -> list[str]:
     """A warning for two operations of one kind that cut the same contour."""
     if job.shorthand:
@@ -613,7 +630,8 @@ def refuse_operation_options(given: list[str]) -> None:
     """
     if given:
         raise UsageError(
-            f"{', '.join(given)} apply to one operation: with --job, put them in the job "
-            "file's [[operations]] (the command line may give --origin, --translate, "
-            "--scale/--fit, --clearance-z, --end-position, --tolerance and --feed)"
+            f"{', '.join(given)}: with --job, each operation has its own; put them in the job "
+            "file's [[operations]] or [[tools]] (with --job the command line may give "
+            "--origin, --translate, --scale or --fit, --clearance-z, --end-position, "
+            "--tolerance, --chain-tolerance and --close-gap)"
         )
