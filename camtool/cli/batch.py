@@ -15,12 +15,14 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from camtool.cli.common import (
+    JOB,
     MACHINE,
     import_options,
     number_range,
     output_settings,
     plan_settings,
     post_options,
+    read_job,
     write_output,
 )
 from camtool.model.errors import CamtoolError, InputError, UsageError, VerifyLimitError
@@ -96,6 +98,7 @@ def _post_options(command: Callable[..., None]) -> Callable[..., None]:
 )
 @click.option("--report", default=None, metavar="BATCH.json", help="Batch report ('-': stdout).")
 @click.option("--force", is_flag=True, help="Overwrite existing outputs.")
+@JOB
 @_post_options
 def batch(inputs: tuple[str, ...], layers: str | None, verify_too: bool, **options: Any) -> None:
     """Post every drawing of INPUTS (files, directories, quoted globs with **) for a target.
@@ -117,10 +120,12 @@ def batch(inputs: tuple[str, ...], layers: str | None, verify_too: bool, **optio
 
     names = tuple(n.strip() for n in layers.split(",") if n.strip()) if layers else None
     planning, output = plan_settings(options), output_settings(options)
-    plan = plan_batch(
-        inputs,
-        BatchOptions(layers=names, verify=verify_too, plan=planning, output=output, **options),
+    job_file = options.pop("job_file")
+    job = None if job_file is None else read_job(job_file, planning)
+    settings = BatchOptions(
+        layers=names, verify=verify_too, plan=planning, output=output, job=job, **options
     )
+    plan = plan_batch(inputs, settings)
     result = _run(plan)
     click.echo(summary_table(result), err=True, nl=False)
     if options["report"] == "-":  # a report file is written by run_batch, in its claim

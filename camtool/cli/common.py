@@ -29,6 +29,7 @@ from camtool.toolpath.options import (
 
 if TYPE_CHECKING:
     from camtool.importers.options import ImportOptions
+    from camtool.jobs.job import Job
     from camtool.jobs.pipeline import OutputOptions
 
 
@@ -175,6 +176,32 @@ def picture_ahead(preview: str | None) -> Iterator[Callable[[], None]]:
         yield load_ahead
     finally:
         stop_ahead()
+
+
+JOB = click.option(
+    "--job",
+    "job_file",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    metavar="JOB.toml",
+    help="The operations and tools that make the part (docs/jobs.md; `camtool job init` "
+    "writes a first one). Without it the planning options are one operation.",
+)
+"""``--job``: a job file, the same for ``post`` and ``batch``."""
+
+
+def read_job(path: Path, plan: PlanOptions) -> Job:
+    """The job file at ``path``, with the shared options given on the command line.
+
+    Raises:
+        UsageError: a per-operation option (``--depth``, ``--offset``...) was given too.
+        InputError: the job file is invalid (:func:`camtool.jobs.job.load_job`).
+    """
+    from camtool.jobs.job import load_job, operation_flags, shared_overrides
+    from camtool.jobs.run import refuse_operation_options
+
+    refuse_operation_options(operation_flags(plan))
+    return load_job(path, overrides=shared_overrides(plan))
 
 
 MACHINE = click.option(

@@ -16,6 +16,7 @@ import click
 from camtool.cli.batch import batch
 from camtool.cli.calibrate import calibrate
 from camtool.cli.common import (
+    JOB,
     MACHINE,
     NUMBER,
     chain_tolerance_option,
@@ -26,9 +27,11 @@ from camtool.cli.common import (
     picture_ahead,
     plan_settings,
     post_options,
+    read_job,
     warn,
     write_output,
 )
+from camtool.cli.job import job
 from camtool.cli.preview import preview
 from camtool.cli.send import send, simulate_device
 from camtool.model.errors import CamtoolError, UsageError, VerifyLimitError
@@ -38,10 +41,8 @@ if TYPE_CHECKING:
     from collections.abc import Callable
 
     from camtool.cli.progress import StageReporter
-    from camtool.jobs.job import Job
     from camtool.model.shapes import Drawing
     from camtool.post.registry import TargetEntry
-    from camtool.toolpath.options import PlanOptions
     from camtool.toolpath.plan import PlanReport
     from camtool.verify.verifier import Verification
 
@@ -106,15 +107,7 @@ def cli() -> None:
     metavar="FILE",
     help="Where to write the program; '-' (default) is stdout.",
 )
-@click.option(
-    "--job",
-    "job_file",
-    type=click.Path(dir_okay=False, path_type=Path),
-    default=None,
-    metavar="JOB.toml",
-    help="The operations and tools that make the part (docs/jobs.md; `camtool job init` "
-    "writes a first one). Without it the options below are one operation.",
-)
+@JOB
 @post_options
 @MACHINE
 @import_options
@@ -317,20 +310,6 @@ def verify(
     )
 
 
-def read_job(path: Path, plan: PlanOptions) -> Job:
-    """The job file at ``path``, with the shared options given on the command line.
-
-    Raises:
-        UsageError: a per-operation option (``--depth``, ``--offset``...) was given too.
-        InputError: the job file is invalid (:func:`camtool.jobs.job.load_job`).
-    """
-    from camtool.jobs.job import load_job, operation_flags, shared_overrides
-    from camtool.jobs.run import refuse_operation_options
-
-    refuse_operation_options(operation_flags(plan))
-    return load_job(path, overrides=shared_overrides(plan))
-
-
 def _check_preview(preview: str | None) -> None:
     """Refuse a ``--preview`` file that is neither ``.png`` nor ``.svg``, before any work.
 
@@ -473,6 +452,7 @@ cli.add_command(preview)
 cli.add_command(batch)
 cli.add_command(calibrate)
 cli.add_command(send)
+cli.add_command(job)
 cli.add_command(simulate_device)
 
 

@@ -87,6 +87,7 @@ from camtool.toolpath.options import PLAN_FIELDS, PlanOptions
 if TYPE_CHECKING:
     from concurrent.futures import Future
 
+    from camtool.jobs.job import Job
     from camtool.jobs.pipeline import PostJob
     from camtool.post.base import Target
     from camtool.verify.verifier import Verification
@@ -118,6 +119,8 @@ class BatchOptions:
             ``depth``, ``order``...).
         output: the output format and spindle (``fmt``, ``spindle_rpm``,
             ``spindle_dwell_s``).
+        job: the operations and tools of every drawing (``batch --job``); ``None``:
+            ``plan`` is the one operation.
         layers: layers to keep (``None``: all).
         units: unit of unitless inputs (point lists).
         hatch_boundaries: use DXF HATCH boundaries as contours.
@@ -150,6 +153,7 @@ class BatchOptions:
     machine_file: Path | None = None
     plan: PlanOptions = field(default_factory=PlanOptions)
     output: OutputOptions = field(default_factory=OutputOptions)
+    job: Job | None = None
     layers: tuple[str, ...] | None = None
     units: str | None = None
     hatch_boundaries: bool = False
@@ -768,6 +772,7 @@ def post_data(
             options.plan,
             options.output,
             import_options=options.import_options(),
+            job=options.job,
         )
         row, files = _outputs(task, options, job)
         return row, files, __version__
@@ -843,6 +848,7 @@ def _post_job(file: str, options: BatchOptions) -> PostJob:
         options.output,
         machine_file=options.machine_file,
         import_options=options.import_options(),
+        job=options.job,
     )
 
 

@@ -65,6 +65,7 @@ def post_file(
     machine_file: Path | None = None,
     import_options: ImportOptions | None = None,
     progress: Progress = no_progress,
+    job: Job | None = None,
 ) -> PostJob:
     """Load the target called ``target_name`` and post the file at ``path`` (see :func:`post_path`).
 
@@ -76,12 +77,15 @@ def post_file(
         machine_file: TOML file laid over the target's machine profile.
         import_options: how the drawing is read (layers, units…).
         progress: told the stages as the job goes (see :func:`post_path`).
+        job: the operations and tools to run (``None``: ``plan`` is the one operation).
 
     Raises:
         CamtoolError: from any stage, with its exit code.
     """
     target = load_target_checked(target_name, machine_file=machine_file)
-    return post_path(path, target, plan, output, import_options=import_options, progress=progress)
+    return post_path(
+        path, target, plan, output, import_options=import_options, progress=progress, job=job
+    )
 
 
 def post_path(
@@ -184,6 +188,7 @@ def post_bytes(
     output: OutputOptions | None = None,
     *,
     import_options: ImportOptions | None = None,
+    job: Job | None = None,
 ) -> PostJob:
     """Post a file given as its bytes, as :func:`post_path` posts the file ``name``.
 
@@ -198,6 +203,7 @@ def post_bytes(
         plan: the planning options (``None``: the defaults, the target's feed).
         output: how the program is written (``None``: the defaults).
         import_options: how the drawing is read (layers, units…).
+        job: the operations and tools to run (``None``: ``plan`` is the one operation).
 
     Raises:
         UsageError: a planning option given for a program (see :func:`post_path`).
@@ -206,12 +212,14 @@ def post_bytes(
     plan = plan if plan is not None else PlanOptions()
     if not is_program_file(name):
         suffix = Path(name).suffix
-        options, check = sized(import_options, plan), travel_check(plan, target)
+        shared = plan if job is None else job.setup.plan
+        options = sized(import_options, shared)
+        check = travel_check(plan, target) if job is None else None
         drawing = read_drawing_bytes(data, name=name, suffix=suffix, options=options, check=check)
         layers = import_options.layers if import_options is not None else None
         drawing = _note_units(drawing, name, import_options)
-        return post_drawing(drawing, target, plan, output, layers=layers)
-    refuse_planning(name, drawing_only(plan.given()))
+        return post_drawing(drawing, target, plan, output, layers=layers, job=job)
+    refuse_planning(name, drawing_only(plan.given()) + (["--job"] if job is not None else []))
     from camtool.importers.gcode import read_gcode_bytes
 
     return post_program(

@@ -277,12 +277,13 @@ def run_job(
         (),
         tuple(m for r in runs for m in r.placed.marks),
     )
-    program = Program(tuple(moves), setup.origin, tuple(dict.fromkeys(warnings)))
+    program = Program(
+        tuple(moves), setup.origin, tuple(dict.fromkeys(warnings)), commands=tuple(commands)
+    )
     program, placed_all, shift = place_program(program, placed_all, setup, target.machine)
     runs = [_shifted(r, shift) for r in runs]
     program = dataclasses.replace(
         program,
-        commands=tuple(commands),
         notes=job_notes(drawing.source, target, setup if job.shorthand else None, job, runs),
         tolerance_mm=setup.tolerance,
         warnings=(*program.warnings, *surface_warnings(runs, target)),

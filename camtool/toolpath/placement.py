@@ -30,7 +30,15 @@ from typing import TYPE_CHECKING
 
 from camtool.model.errors import DialectError
 from camtool.model.plain import plain_fields
-from camtool.model.program import ArcMove, Linear, Move, Program, Rapid, segment_of
+from camtool.model.program import (
+    ArcMove,
+    DrillCycle,
+    Linear,
+    Move,
+    Program,
+    Rapid,
+    segment_of,
+)
 from camtool.model.shapes import BBox, Point, bbox_union
 from camtool.model.units import fmt_num
 
@@ -186,14 +194,19 @@ def shift_program(program: Program, dx: float, dy: float) -> Program:
     travel): moving them would drag the tool sideways from wherever it stands. When
     the path itself began at the start position (a cut from there), one rapid to its
     new start is put before it, at the height the tool is at. Commands keep their
-    place (those before the first shifted move stay before that rapid).
+    place (those before the first shifted move stay before that rapid); a drilling
+    cycle's hole moves with its moves.
     """
     if dx == 0.0 and dy == 0.0:
         return program
     k = _at_start(program)
     moves: list[Move] = list(program.moves[:k])
     moves += [_shifted(m, dx, dy) for m in program.moves[k:]]
-    commands, lines = program.commands, program.lines
+    lines = program.lines
+    commands = tuple(
+        (i, dataclasses.replace(c, x=c.x + dx, y=c.y + dy) if isinstance(c, DrillCycle) else c)
+        for i, c in program.commands
+    )
     if k < len(program.moves) and not isinstance(program.moves[k], Rapid):
         x, y = program.origin
         moves.insert(k, Rapid(x + dx, y + dy, contour=program.moves[k].contour))

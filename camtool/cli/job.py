@@ -1,0 +1,64 @@
+"""``camtool job``: job files (the operations and tools that make a part)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import click
+
+from camtool.cli.common import import_options, import_settings, number_range, write_output
+
+
+@click.group()
+def job() -> None:
+    """Job files: the operations and tools that make a part (docs/jobs.md)."""
+
+
+@job.command("init")
+@click.argument("drawing", metavar="DRAWING")
+@click.option(
+    "-o",
+    "--output",
+    default="-",
+    metavar="JOB.toml",
+    help="Where to write the job; '-' (default) is stdout.",
+)
+@click.option(
+    "--thickness",
+    type=number_range(min=0, min_open=True, max=1000),
+    default=3.0,
+    show_default=True,
+    metavar="MM",
+    help="The stock's thickness: profiles cut through it, pockets half way.",
+)
+@click.option(
+    "--tool-diameter",
+    type=number_range(min=0, min_open=True, max=100),
+    default=3.0,
+    show_default=True,
+    metavar="MM",
+    help="The end mill's diameter.",
+)
+@import_options
+def init(drawing: str, output: str, thickness: float, tool_diameter: float, **options: Any) -> None:
+    """Write a first job for DRAWING: one operation per layer, each guess commented.
+
+    Small circles are drilled, closed contours profiled (outside for the outermost, inside
+    for a layer of holes), a layer named for a pocket pocketed; open contours and
+    construction (centre lines, construction and dimension layers) are left out.
+    """
+    from camtool.jobs.init import initial_job
+    from camtool.jobs.inputs import read_input
+    from camtool.jobs.output import check_paths
+
+    check_paths([("the input", drawing)], [("-o", output)])
+    drawn = read_input(drawing, import_settings(options))
+    text = initial_job(drawn, thickness_mm=thickness, tool_diameter=tool_diameter)
+    write_output(text, output)
+    if output != "-":
+        count = sum(line.startswith("[[operations]]") for line in text.splitlines())
+        click.echo(
+            f"camtool: wrote a job of {count} operation(s) to {output}; read it, then: "
+            f"camtool post {drawing} -t TARGET --job {output}",
+            err=True,
+        )

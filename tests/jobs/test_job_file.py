@@ -1,0 +1,159 @@
+"""Job files: what load_job takes, and the clear error for each thing it refuses."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from camtool.jobs.job import Job, load_job
+from camtool.model.errors import InputError
+
+ROOT = Path(__file__).resolve().parents[2]
+
+GOOD = """
+[job]
+origin = "lower-left"
+clearance_z = 8
+[[tools]]
+id = 1
+type = "end-mill"
+diameter = 3.0
+feed = 500
+[[tools]]
+id = 2
+type = "drill"
+diameter = 2.5
+[[operations]]
+type = "profile"
+tool = 1
+layers = ["OUTLINE"]
+side = "outside"
+depth = 6.0
+step_down = 2.0
+tabs = 3
+[[operations]]
+name = "holes"
+type = "drill"
+tool = 2
+layers = "HOLES"
+depth = 6.5
+step_down = 2
+peck = "chip-break"
+"""
+
+
+def _job(tmp_path: Path, text: str) -> Job:
+    path = tmp_path / "job.toml"
+    path.write_text(text)
+    return load_job(path)
+
+
+def test_a_job_file_becomes_tools_operations_and_setup(tmp_path: Path) -> None:
+    job = _job(tmp_path, GOOD)
+    assert [t.id for t in job.tools] == [1, 2]
+    assert job.tool(2).describe() == "drill 2.5 mm"
+    profile, drill = job.operations
+    assert (profile.kind, profile.plan.offset, profile.plan.tool_diameter) == (
+        "profile outside",
+        "outside",
+        3.0,
+    )
+    assert (profile.plan.depth, profile.plan.step_down, profile.plan.tabs) == (6.0, 2.0, 3)
+    assert profile.plan.feed_mm_min == 500  # the tool's feed
+    assert profile.plan.placement == "lower-left" and profile.plan.clearance == 8
+    assert drill.select.layers == ("HOLES",) and drill.select.points
+    assert (drill.peck, drill.plan.step_down, drill.plan.offset) == ("chip-break", 2.0, "on")
+    assert job.source == "job.toml" and not job.shorthand
+
+
+def test_the_bundled_sample_job_loads() -> None:
+    job = load_job(ROOT / "samples" / "part.toml")
+    assert [op.kind for op in job.operations] == [
+        "drill",
+        "engrave",
+        "pocket",
+        "profile outside",
+    ]
+
+
+def test_auto_sequence_drills_first_and_cuts_the_outline_last(tmp_path: Path) -> None:
+    text = GOOD.replace('origin = "lower-left"', 'origin = "lower-left"\nsequence = "auto"')
+    text += '[[operations]]\ntype = "pocket"\ntool = 1\ndepth = 1\n'
+    text += '[[operations]]\ntype = "profile"\nside = "inside"\ntool = 1\ndepth = 2\n'
+    kinds = [op.kind for op in _job(tmp_path, text).sequenced()]
+    assert kinds == ["drill", "pocket", "profile inside", "profile outside"]
+    # in the file's order unless asked
+    assert [op.kind for op in _job(tmp_path, GOOD).sequenced()] == ["profile outside", "drill"]
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (("depth = 6.0", "dept = 6.0"), r"unknown key 'dept'; did you mean 'depth'\?"),
+        (('side = "outside"', 'side = "outsid"'), r"did you mean 'outside'\?"),
+        (("tool = 2", "tool = 7"), r"uses tool 7, which \[\[tools\]\] does not define"),
+        (("diameter = 3.0", "diameter = -3.0"), r"tool 1 diameter = -3 mm"),
+        (("depth = 6.0", 'depth = "6"'), r"depth = '6'; give a number"),
+        (("tabs = 3", "tabs = 3.5"), r"tabs = 3.5; give a whole number"),
+        (("step_down = 2.0", "step_down = -2.0"), r"step_down must be > 0 mm"),
+        (("[job]", "[jobs]"), r"unknown key 'jobs'; did you mean 'job'\?"),
+        (("id = 2", "id = 1"), r"two tools with id 1"),
+        (('peck = "chip-break"', 'peck = "chip"'), r"peck = 'chip'"),
+        (("depth = 6.5", "depth = 6.5\ntabs = 2"), r"tabs does not apply to drilling"),
+        (("clearance_z = 8", "clearance_z = 1"), r"clearance_z 1 mm is below safe_z 2 mm"),
+    ],
+)
+def test_what_a_job_file_may_not_say_is_refused_naming_it(
+    tmp_path: Path, change: tuple[str, str], message: str
+) -> None:
+    old, new = change
+    assert old in GOOD
+    with pytest.raises(InputError, match=message) as caught:
+        _job(tmp_path, GOOD.replace(old, new, 1))
+    assert str(caught.value).startswith(f"{tmp_path / 'job.toml'}: ")
+
+
+@pytest.mark.parametrize(
+    ("data", "message"),
+    [
+        (b"[[tools]]\nid = 1\n", r"diameter is missing"),
+        (b"[job]\n", r"no \[\[tools\]\]"),
+        (b"[[tools]]\nid=1\ndiameter=3\n", r"no \[\[operations\]\]"),
+        (b"[[tools]\n", r"not valid TOML"),
+        (b"\xff\xfe[job]", r"not UTF-8 text"),
+        (b"a = " + b"[" * 5000 + b"]" * 5000 + b"\n", r"nests arrays or tables"),
+    ],
+)
+def test_broken_job_files_are_refused(tmp_path: Path, data: bytes, message: str) -> None:
+    path = tmp_path / "job.toml"
+    path.write_bytes(data)
+    with pytest.raises(InputError, match=message):
+        load_job(path)
+
+
+def test_a_job_file_that_is_not_a_regular_file_is_refused_without_blocking(
+    tmp_path: Path,
+) -> None:
+    import os
+
+    fifo = tmp_path / "job.toml"
+    os.mkfifo(fifo)
+    with pytest.raises(InputError, match="not a regular file"):
+        load_job(fifo)
+    with pytest.raises(InputError, match="cannot read the job file"):
+        load_job(tmp_path / "missing.toml")
+
+
+def test_a_bom_is_read_as_utf8_text(tmp_path: Path) -> None:
+    path = tmp_path / "job.toml"
+    path.write_bytes(b"\xef\xbb\xbf" + GOOD.encode())
+    assert len(load_job(path).operations) == 2
+
+
+def test_command_line_shared_options_replace_the_files(tmp_path: Path) -> None:
+    path = tmp_path / "job.toml"
+    path.write_text(GOOD)
+    job = load_job(path, overrides={"placement": "center", "translate": (1.0, 2.0)})
+    assert job.setup.plan.placement == "center" and job.setup.plan.translate == (1.0, 2.0)
+    assert all(op.plan.placement == "center" for op in job.operations)

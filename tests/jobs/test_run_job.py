@@ -1,0 +1,225 @@
+"""Running a job: the bundled test plate as drill, engrave, pocket and outline, one program.
+
+Expected values come from the drawing (samples/make_samples.py: an 80 × 60 mm plate,
+four ø3.2 mm holes at 8 mm from the corners, a 30 × 20 mm pocket, centre lines) and the
+job (samples/part.toml: a 3.2 mm drill, a 3 mm end mill, work zero at the toolpath's
+lower-left corner, i.e. the outline offset by the 1.5 mm tool radius: a shift of +1.5 mm).
+"""
+
+from __future__ import annotations
+
+from itertools import pairwise
+from pathlib import Path
+
+import pytest
+
+from camtool.importers import read_drawing
+from camtool.jobs.job import load_job
+from camtool.jobs.run import run_job
+from camtool.model.errors import InputError
+from camtool.model.program import DrillCycle, Linear, Rapid, Spindle, ToolChange
+from camtool.post.registry import load_target
+
+ROOT = Path(__file__).resolve().parents[2]
+SHIFT = 1.5  # lower-left work zero: the outline's offset path starts at -1.5 mm
+HOLES = {(8.0 + SHIFT, 8.0 + SHIFT), (72 + SHIFT, 8 + SHIFT), (72 + SHIFT, 52 + SHIFT),
+         (8 + SHIFT, 52 + SHIFT)}  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def part() -> object:
+    drawing = read_drawing(ROOT / "samples" / "part.dxf")
+    return run_job(drawing, load_target("linuxcnc"), load_job(ROOT / "samples" / "part.toml"))
+
+
+def _xy(x: float, y: float) -> tuple[float, float]:
+    return (round(x, 6), round(y, 6))
+
+
+def _moves(job: object, number: int) -> list[object]:
+    run = job.operations[number - 1]  # type: ignore[attr-defined]
+    first, end = run.moves
+    return list(job.program.moves[first:end])  # type: ignore[attr-defined]
+
+
+def test_operations_run_in_the_files_order_with_their_tools(part: object) -> None:
+    runs = part.operations  # type: ignore[attr-defined]
+    assert [(r.operation.kind, r.tool.id) for r in runs] == [
+        ("drill", 2),
+        ("engrave", 1),
+        ("pocket", 1),
+        ("profile outside", 1),
+    ]
+    assert runs[0].holes == 4
+
+
+def test_holes_are_drilled_at_their_centres_to_depth(part: object) -> None:
+    moves = _moves(part, 1)
+    feeds = [m for m in moves if isinstance(m, Linear)]
+    assert {_xy(m.x, m.y) for m in feeds} == HOLES  # no feed anywhere but at a centre
+    assert min(m.z for m in feeds) == -6.5
+    bottoms = [m for m in feeds if m.z == -6.5]
+    assert len(bottoms) == 4
+    # pecks of 2 mm from the R plane (safe Z 2): 0, -2, -4, -6, -6.5 at each hole
+    assert sorted({m.z for m in feeds}) == [-6.5, -6.0, -4.0, -2.0, 0.0]
+    cycles = [c for _, c in part.program.commands if isinstance(c, DrillCycle)]  # type: ignore[attr-defined]
+    assert len(cycles) == 4 and {_xy(c.x, c.y) for c in cycles} == HOLES
+    assert all(c.kind == "peck" and c.peck_mm == 2.0 and c.r_z == 2.0 for c in cycles)
+
+
+def test_every_xy_rapid_of_the_job_is_above_the_top(part: object) -> None:
+    z = None
+    here = None
+    for move in part.program.moves:  # type: ignore[attr-defined]
+        if isinstance(move, Rapid) and here is not None and (move.x, move.y) != here:
+            assert z is not None and z >= 2.0, f"an XY rapid at Z {z}"
+        z = move.z if move.z is not None else z
+        here = (move.x, move.y)
+
+
+def test_the_pocket_goes_to_its_depth_and_stays_inside_it(part: object) -> None:
+    cuts = [m for m in _moves(part, 3) if isinstance(m, Linear)]
+    assert min(m.z for m in cuts if m.z is not None) == -2.0
+    # the tool centre stays 1.5 mm inside the 30 x 20 pocket at (25, 20)-(55, 40)
+    xs = [m.x for m in cuts]
+    ys = [m.y for m in cuts]
+    assert min(xs) >= 25 + 1.5 + SHIFT - 1e-9 and max(xs) <= 55 - 1.5 + SHIFT + 1e-9
+    assert min(ys) >= 20 + 1.5 + SHIFT - 1e-9 and max(ys) <= 40 - 1.5 + SHIFT + 1e-9
+
+
+def test_the_outline_comes_last_with_tabs_at_full_depth(part: object) -> None:
+    moves = _moves(part, 4)
+    zs = [m.z for m in moves if m.z is not None]
+    assert min(zs) == -6.5
+    assert -5.5 in zs  # the tab top: depth 6.5 - tab height 1
+    xs = [m.x for m in moves if not isinstance(m, Rapid)]
+    # the outline (0..80) offset outside by the 1.5 mm radius, moved by the shift
+    assert min(xs) == pytest.approx(0.0) and max(xs) == pytest.approx(83.0)
+
+
+def test_no_centre_line_is_cut(part: object) -> None:
+    # the centre lines across the part run at Y 30 and X 40 (+ shift), from outside it
+    for move in part.program.moves:  # type: ignore[attr-defined]
+        if isinstance(move, Linear) and move.z is None:
+            assert not (round(move.y, 6) == 30 + SHIFT and move.x > 80), move
+    assert any("layer 'CENTER'" in w for w in part.warnings)  # type: ignore[attr-defined]
+
+
+def test_a_tool_change_comes_between_drilling_and_milling(part: object) -> None:
+    program = part.program  # type: ignore[attr-defined]
+    changes = [(i, c) for i, c in program.commands if isinstance(c, ToolChange)]
+    assert [c.tool for _, c in changes] == [2, 1]
+    assert changes[0][0] == 0
+    engrave_first = part.operations[1].moves[0]  # type: ignore[attr-defined]
+    assert changes[1][0] == engrave_first
+    # the drill is up at clearance when it is changed, and the spindle is off meanwhile
+    z_before = [m.z for m in program.moves[:engrave_first] if m.z is not None][-1]
+    assert z_before == 10.0
+    around = [c for i, c in program.commands if i == engrave_first]
+    assert around[:2] == [Spindle("off"), ToolChange(1, "end-mill 3 mm")]
+    assert around[2] == Spindle("cw", 10000.0)
+
+
+def test_the_header_lists_the_tools_and_the_operations_in_order(part: object) -> None:
+    notes = part.program.notes  # type: ignore[attr-defined]
+    assert "T2: drill 3.2 mm" in notes and "T1: end-mill 3 mm" in notes
+    ops = [n for n in notes if n[:2] in ("1.", "2.", "3.", "4.")]
+    assert [n.split(":")[0] for n in ops] == [
+        "1. drill 'holes' T2",
+        "2. engrave 'mark' T1",
+        "3. pocket 'pocket' T1",
+        "4. profile outside 'outline' T1",
+    ]
+    assert "4 holes, 6.5 deep, pecks of 2" in ops[0]
+
+
+def test_a_selection_that_matches_nothing_names_the_drawings_layers(tmp_path: Path) -> None:
+    text = (ROOT / "samples" / "part.toml").read_text().replace('["POCKET"]', '["POKET"]')
+    path = tmp_path / "job.toml"
+    path.write_text(text)
+    drawing = read_drawing(ROOT / "samples" / "part.dxf")
+    with pytest.raises(InputError) as caught:
+        run_job(drawing, load_target("grbl"), load_job(path))
+    assert str(caught.value) == (
+        "job.toml: operation 3 ('pocket') selects layer 'POKET'; the drawing has CENTER, "
+        "ENGRAVE, HOLES, OUTLINE, POCKET"
+    )
+
+
+@pytest.mark.parametrize(
+    ("drill", "message"),
+    [
+        (4.0, r"hole CIRCLE #\w+ on layer 'HOLES' at \(8\.0000, 8\.0000\) mm is 3\.2 mm across, "
+         r"smaller than the 4 mm drill"),
+        (3.0, r"is 3\.2 mm across, larger than the 3 mm drill .*profile operation"),
+    ],
+)  # fmt: skip
+def test_a_drill_of_another_size_than_its_holes_is_refused(
+    tmp_path: Path, drill: float, message: str
+) -> None:
+    text = (ROOT / "samples" / "part.toml").read_text().replace("3.2", f"{drill:g}")
+    path = tmp_path / "job.toml"
+    path.write_text(text)
+    drawing = read_drawing(ROOT / "samples" / "part.dxf")
+    with pytest.raises(InputError, match=message):
+        run_job(drawing, load_target("grbl"), load_job(path))
+
+
+def test_a_drill_operation_refuses_what_is_not_a_hole(tmp_path: Path) -> None:
+    text = (ROOT / "samples" / "part.toml").read_text().replace('["HOLES"]', '["OUTLINE"]', 1)
+    path = tmp_path / "job.toml"
+    path.write_text(text)
+    drawing = read_drawing(ROOT / "samples" / "part.dxf")
+    with pytest.raises(InputError, match=r"which is not a circle"):
+        run_job(drawing, load_target("grbl"), load_job(path))
+
+
+def test_a_point_is_drilled_where_it_is(tmp_path: Path) -> None:
+    from tests.shapes import write_dxf
+
+    def build(msp: object) -> None:
+        msp.add_point((12.5, 7.25), dxfattribs={"layer": "DRILL"})  # type: ignore[attr-defined]
+        msp.add_lwpolyline(  # type: ignore[attr-defined]
+            [(0, 0), (30, 0), (30, 20), (0, 20)], close=True, dxfattribs={"layer": "EDGE"}
+        )
+
+    dxf = write_dxf(tmp_path / "points.dxf", build)
+    job = tmp_path / "job.toml"
+    job.write_text(
+        '[[tools]]\nid = 5\ntype = "drill"\ndiameter = 1\n'
+        '[[operations]]\ntype = "drill"\ntool = 5\nlayers = ["DRILL"]\ndepth = 2\n'
+    )
+    done = run_job(read_drawing(dxf), load_target("grbl"), load_job(job))
+    feeds = [m for m in done.program.moves if isinstance(m, Linear)]
+    assert [(m.x, m.y, m.z) for m in feeds] == [(12.5, 7.25, -2.0)]  # work zero: the drawing's
+
+
+def test_the_one_operation_shorthand_runs_the_same_path(tmp_path: Path) -> None:
+    from camtool.jobs.pipeline import post_drawing
+    from camtool.toolpath.options import PlanOptions
+
+    drawing = read_drawing(ROOT / "samples" / "plate.dxf")
+    plan = PlanOptions(offset="outside", tool_diameter=3.0, depth=3.0)
+    done = post_drawing(drawing, load_target("grbl"), plan)
+    assert len(done.operations) == 1 and done.plan is not None
+    assert not any(isinstance(c, ToolChange) for _, c in done.program.commands)
+    assert done.program.notes[1] == "tool diameter 3 mm, offset outside"
+
+
+def test_operations_that_cut_the_same_contour_twice_are_warned_about(tmp_path: Path) -> None:
+    text = (ROOT / "samples" / "part.toml").read_text()
+    text += '[[operations]]\ntype = "profile"\ntool = 1\nlayers = ["OUTLINE"]\ndepth = 1\n'
+    path = tmp_path / "job.toml"
+    path.write_text(text)
+    drawing = read_drawing(ROOT / "samples" / "part.dxf")
+    done = run_job(drawing, load_target("grbl"), load_job(path))
+    assert any("operation 5 (profile outside) cuts LWPOLYLINE" in w for w in done.warnings)
+
+
+def test_between_two_holes_the_drill_rises_to_clearance(part: object) -> None:
+    moves = _moves(part, 1)
+    z = None
+    for a, b in pairwise(moves):
+        z = a.z if a.z is not None else z
+        if isinstance(b, Rapid) and (b.x, b.y) != (a.x, a.y):
+            assert z == 10.0
