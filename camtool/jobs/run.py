@@ -268,7 +268,7 @@ def run_job(
         )
     notes = construction_notes(construction)
     if not job.shorthand:
-        notes.extend(_unselected(scaled, runs))
+        notes.extend(_unselected(scaled, runs, construction))
     warnings[len(drawing.warnings) : len(drawing.warnings)] = notes
     warnings.extend(_overlaps(runs, job))
     placed_all = Drawing(
@@ -589,18 +589,26 @@ def _shifted(run: OperationRun, shift: Point) -> OperationRun:
     return dataclasses.replace(run, placed=run.placed.transformed(1.0, dx, dy), report=report)
 
 
-def _unselected(drawing: Drawing, runs: Sequence[OperationRun]) -> list[str]:
-    """One line per layer none of whose contours an operation cuts."""
-    cut = {c.layer for r in runs for c in r.placed.contours}
-    cut |= {m.layer for r in runs for m in r.placed.marks}
-    left: dict[str, int] = {}
+def _unselected(
+    drawing: Drawing, runs: Sequence[OperationRun], construction: Sequence[Contour]
+) -> list[str]:
+    """One line per layer of the contours no operation selects (construction said apart)."""
+    taken = {id(c) for r in runs for c in r.placed.contours}
+    taken |= {id(c) for c in construction}
+    left: dict[str, list[Contour]] = {}
     for contour in drawing.contours:
-        if contour.layer not in cut:
-            left[contour.layer] = left.get(contour.layer, 0) + 1
-    return [
-        f"not cut: layer {layer!r} ({count} contour(s)): no operation selects it"
-        for layer, count in sorted(left.items())
-    ]
+        if id(contour) not in taken:
+            left.setdefault(contour.layer, []).append(contour)
+    out = []
+    for layer, contours in sorted(left.items()):
+        opened = sum(not c.closed for c in contours)
+        first = contours[0]
+        out.append(
+            f"not cut: {len(contours)} contour(s) on layer {layer!r} ({opened} open; first "
+            f"{first.source or 'contour'} at ({first.start[0]:.4f}, {first.start[1]:.4f}) mm): "
+            "no operation selects them"
+        )
+    return out
 
 
 def _overlaps(runs: Sequence[OperationRun], job: Job) -> list[str]:

@@ -1,0 +1,95 @@
+"""``camtool job init``: the first job's guesses, on the sample plate and on real drawings."""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from camtool.importers import read_drawing
+from camtool.jobs.init import initial_job
+from camtool.jobs.job import job_from_dict
+from camtool.jobs.run import run_job
+from camtool.model.errors import InputError
+from camtool.model.program import Linear
+from camtool.post.registry import load_target
+from tests.corpus.conftest import CORPUS
+from tests.shapes import write_dxf
+
+ROOT = Path(__file__).resolve().parents[2]
+KIN42 = CORPUS / "pkg/librecad-data/usr/share/librecad/library/kinetics/kin42.dxf"
+
+
+def _ops(text: str) -> list[dict[str, object]]:
+    return list(tomllib.loads(text)["operations"])
+
+
+def test_the_sample_plate_gets_drill_pocket_and_outline_in_that_order() -> None:
+    text = initial_job(read_drawing(ROOT / "samples" / "part.dxf"), thickness_mm=6.0)
+    ops = _ops(text)
+    assert [(op["type"], op.get("side")) for op in ops] == [
+        ("drill", None),
+        ("pocket", None),
+        ("profile", "outside"),
+    ]
+    drill, pocket, outline = ops
+    assert drill["layers"] == ["HOLES"] and drill["diameter"] == 3.2 and drill["depth"] == 6.5
+    assert outline["layers"] == ["OUTLINE"] and outline["tabs"] == 3
+    tools = {t["id"]: t for t in tomllib.loads(text)["tools"]}
+    assert tools[drill["tool"]]["type"] == "drill" and tools[drill["tool"]]["diameter"] == 3.2
+    assert tools[outline["tool"]]["type"] == "end-mill"
+    # every guess says why; the open line and the centre lines are left out, said so
+    assert "# 4 circle(s) of ø3.2 mm on layer 'HOLES'" in text
+    assert "# [[operations]]\n# type = \"engrave\"" in text
+    assert "layer 'CENTER': linetype CENTER: 10 contour(s)" in text
+
+
+def test_a_layer_of_holes_only_is_cut_on_their_inside(tmp_path: Path) -> None:
+    def build(msp: object) -> None:
+        msp.add_lwpolyline(  # type: ignore[attr-defined]
+            [(0, 0), (100, 0), (100, 50), (0, 50)], close=True, dxfattribs={"layer": "EDGE"}
+        )
+        msp.add_circle((30, 25), 10, dxfattribs={"layer": "CUTOUTS"})  # type: ignore[attr-defined]
+        msp.add_circle((70, 25), 2, dxfattribs={"layer": "CUTOUTS"})  # type: ignore[attr-defined]
+
+    text = initial_job(read_drawing(write_dxf(tmp_path / "p.dxf", build)))
+    kinds = [(op["type"], op.get("side"), tuple(op["layers"])) for op in _ops(text)]  # type: ignore[arg-type]
+    assert kinds == [
+        ("drill", None, ("CUTOUTS",)),  # the ø4 mm circle
+        ("profile", "inside", ("CUTOUTS",)),  # the ø20 mm hole, too large to drill
+        ("profile", "outside", ("EDGE",)),
+    ]
+
+
+def test_a_drawing_of_lines_only_is_engraved(tmp_path: Path) -> None:
+    def build(msp: object) -> None:
+        msp.add_line((0, 0), (10, 0))  # type: ignore[attr-defined]
+        msp.add_line((10, 0), (10, 5))  # type: ignore[attr-defined]
+
+    text = initial_job(read_drawing(write_dxf(tmp_path / "sign.dxf", build)))
+    assert [op["type"] for op in _ops(text)] == ["engrave"]
+
+
+def test_a_drawing_of_construction_only_has_nothing_to_cut(tmp_path: Path) -> None:
+    def build(msp: object) -> None:
+        msp.add_line((0, 0), (10, 0), dxfattribs={"layer": "DIMENSIONS"})  # type: ignore[attr-defined]
+
+    with pytest.raises(InputError, match="nothing to cut: every contour is construction"):
+        initial_job(read_drawing(write_dxf(tmp_path / "dims.dxf", build)))
+
+
+@pytest.mark.skipif(not KIN42.exists(), reason="the LibreCAD corpus is not fetched")
+def test_kin42_job_cuts_the_disc_and_not_its_diameter_lines() -> None:
+    drawing = read_drawing(KIN42)
+    text = initial_job(drawing)
+    job = job_from_dict(tomllib.loads(text), source="kin42.toml")
+    done = run_job(drawing, load_target("grbl"), job)
+    # the two diameter lines of the ø22 mm disc run along X and Y through its centre; cut,
+    # the tool would run the whole 22 mm across the part on one of those lines
+    cuts = [m for m in done.program.moves if isinstance(m, Linear) and m.z is None]
+    starts = [done.program.moves[i - 1] for i, m in enumerate(done.program.moves) if m in cuts]
+    for start, move in zip(starts, cuts, strict=True):
+        across = abs(move.x - start.x) >= 22 - 1e-6 or abs(move.y - start.y) >= 22 - 1e-6
+        assert not across, (start, move)
+    assert "LINE" in "\n".join(done.warnings)
