@@ -1,0 +1,129 @@
+"""``camtool post --job``, ``batch --job`` and ``job init`` as a user runs them."""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from camtool.cli.main import main
+from tests.corpus.conftest import CORPUS
+from tests.corpus.test_rs274 import MANIFEST, rs274_problem
+
+ROOT = Path(__file__).resolve().parents[2]
+PART = str(ROOT / "samples" / "part.dxf")
+JOB = str(ROOT / "samples" / "part.toml")
+
+
+@pytest.fixture
+def run(capsys: pytest.CaptureFixture[str]) -> object:
+    def call(*args: str) -> tuple[int, str, str]:
+        code = main(list(args))
+        out, err = capsys.readouterr()
+        return code, out, err
+
+    return call
+
+
+def test_post_job_writes_one_program_for_the_whole_part(run: Any, tmp_path: Path) -> None:
+    out = tmp_path / "part.ngc"
+    code, _, err = run("post", PART, "-t", "linuxcnc", "--job", JOB, "-o", str(out))
+    assert code == 0, err
+    text = out.read_text()
+    assert "(job part.toml: 4 operations)" in text
+    assert "not cut: 10 contour(s) on layer 'CENTER'" in err
+
+
+@pytest.mark.parametrize(
+    ("extra", "code", "message"),
+    [
+        (["--depth", "3"], 2, "--depth: with --job, each operation has its own"),
+        (["--offset", "outside", "--tool-diameter", "3"], 2, "--offset, --tool-diameter"),
+        (["--feed", "100"], 2, "--feed: with --job"),
+    ],
+)
+def test_per_operation_options_with_a_job_are_refused(
+    run: Any, tmp_path: Path, extra: list[str], code: int, message: str
+) -> None:
+    out = tmp_path / "part.gcode"
+    got, _, err = run("post", PART, "-t", "grbl", "--job", JOB, "-o", str(out), *extra)
+    assert got == code and message in err
+    assert not out.exists()
+
+
+def test_a_bad_job_file_is_exit_3_and_writes_nothing(run: Any, tmp_path: Path) -> None:
+    job = tmp_path / "job.toml"
+    job.write_text(Path(JOB).read_text().replace("step_down = 2.0", "stepdown = 2.0", 1))
+    out = tmp_path / "part.gcode"
+    code, _, err = run("post", PART, "-t", "grbl", "--job", str(job), "-o", str(out))
+    assert code == 3
+    assert "unknown key 'stepdown'; did you mean 'step_down'?" in err
+    assert not out.exists()
+
+
+def test_a_job_for_a_program_is_refused(run: Any, tmp_path: Path) -> None:
+    program = tmp_path / "p.ngc"
+    program.write_text("G21 G90\nG0 X0 Y0\nG1 X1 F100\nM2\n")
+    code, _, err = run("post", str(program), "-t", "grbl", "--job", JOB)
+    assert code == 2 and "--job only apply to drawings" in err
+
+
+def test_the_job_file_is_an_input_never_overwritten(run: Any, tmp_path: Path) -> None:
+    job = tmp_path / "job.toml"
+    job.write_text(Path(JOB).read_text())
+    code, _, err = run("post", PART, "-t", "grbl", "--job", str(job), "-o", str(job))
+    assert code == 2 and "would overwrite the --job file" in err
+    assert job.read_text() == Path(JOB).read_text()
+
+
+def test_job_init_then_post(run: Any, tmp_path: Path) -> None:
+    job = tmp_path / "first.toml"
+    code, _, err = run("job", "init", PART, "-o", str(job), "--thickness", "6")
+    assert code == 0 and "wrote a job of 3 operation(s)" in err
+    out = tmp_path / "part.gcode"
+    code, _, err = run("post", PART, "-t", "grbl", "--job", str(job), "-o", str(out))
+    assert code == 0, err
+
+
+def test_batch_job_posts_each_drawing_with_the_job(run: Any, tmp_path: Path) -> None:
+    code, _, err = run(
+        "batch", PART, "-t", "grbl", "-o", str(tmp_path / "out"), "--job", JOB, "--jobs", "1"
+    )
+    assert code == 0, err
+    assert "(job part.toml: 4 operations)" in (tmp_path / "out" / "part.gcode").read_text()
+
+
+TOOL_TABLE = "T1 P1 D3.0 Z0 ;end mill\nT2 P2 D3.2 Z0 ;drill\n"
+
+
+@pytest.mark.skipif(MANIFEST is None or rs274_problem() is not None, reason="no rs274")
+def test_linuxcnc_accepts_the_job_program(run: Any, tmp_path: Path) -> None:
+    out = tmp_path / "part.ngc"
+    code, _, err = run("post", PART, "-t", "linuxcnc", "--job", JOB, "-o", str(out))
+    assert code == 0, err
+    table = tmp_path / "tool.tbl"
+    table.write_text(TOOL_TABLE)
+    assert MANIFEST is not None
+    entry = MANIFEST["rs274"]
+    env = dict(
+        os.environ,
+        LD_LIBRARY_PATH=os.pathsep.join(str(CORPUS / d) for d in entry["ld_library_path"]),
+    )
+    done = subprocess.run(
+        [str(CORPUS / entry["exe"]), "-t", str(table), "-g", str(out)],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr
+    # LinuxCNC changes to T2 first, then T1, and feeds each drill hole down to Z-6.5
+    changes = re.findall(r"CHANGE_TOOL\((\d+)\)", done.stdout)
+    assert changes == ["2", "1"]
+    bottoms = re.findall(r"STRAIGHT_FEED\(([-\d.]+), ([-\d.]+), -6\.5000", done.stdout)
+    assert len(bottoms) >= 4

@@ -1,0 +1,101 @@
+"""How a DXF entity is drawn: colour and linetype resolved as the DXF reference says.
+
+Expected colours are ezdxf's own ACI table (:func:`ezdxf.colors.aci2rgb`, the AutoCAD
+palette): 1 red, 3 green, 5 blue; BYLAYER takes the layer's, BYBLOCK the INSERT's, a true
+colour (group 420) wins over the ACI number.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import ezdxf
+import pytest
+
+from camtool.importers import read_drawing
+from camtool.jobs.pipeline import post_drawing
+from camtool.model.program import Linear
+from camtool.post.registry import load_target
+from camtool.toolpath.options import PlanOptions
+
+
+def _doc() -> Any:
+    doc = ezdxf.new("R2010", setup=True)
+    doc.header["$INSUNITS"] = 4
+    doc.layers.add("RED", color=1)
+    doc.layers.add("AXES", color=3, linetype="CENTER")
+    return doc
+
+
+def test_colours_and_linetypes_resolve_through_layer_and_block(tmp_path: Path) -> None:
+    doc = _doc()
+    msp = doc.modelspace()
+    msp.add_line((0, 0), (1, 0), dxfattribs={"layer": "RED"})  # BYLAYER: red
+    msp.add_line((0, 1), (1, 1), dxfattribs={"layer": "RED", "color": 5})  # blue
+    line = msp.add_line((0, 2), (1, 2), dxfattribs={"layer": "RED"})
+    line.rgb = (10, 20, 30)  # a true colour wins
+    msp.add_line((0, 3), (1, 3), dxfattribs={"layer": "AXES"})  # CENTER by layer
+    msp.add_line((0, 4), (1, 4), dxfattribs={"layer": "RED", "linetype": "DASHED"})
+    block = doc.blocks.new("B")
+    block.add_line((0, 0), (1, 0), dxfattribs={"color": 0, "linetype": "BYBLOCK"})
+    msp.add_blockref("B", (0, 5), dxfattribs={"layer": "RED", "color": 3, "linetype": "HIDDEN"})
+    path = tmp_path / "styles.dxf"
+    doc.saveas(path)
+    got = {round(c.start[1]): (c.colour, c.linetype) for c in read_drawing(path).contours}
+    assert got == {
+        0: ("#ff0000", ""),
+        1: ("#0000ff", ""),
+        2: ("#0a141e", ""),
+        3: ("#00ff00", "CENTER"),
+        4: ("#ff0000", "DASHED"),
+        5: ("#00ff00", "HIDDEN"),
+    }
+
+
+def test_a_linetype_whose_pattern_is_solid_is_continuous(tmp_path: Path) -> None:
+    doc = _doc()
+    doc.linetypes.add("K5LT_SOLID", pattern=[0.0], description="solid")
+    doc.modelspace().add_line((0, 0), (1, 0), dxfattribs={"linetype": "K5LT_SOLID"})
+    path = tmp_path / "solid.dxf"
+    doc.saveas(path)
+    (contour,) = read_drawing(path).contours
+    assert contour.linetype == ""
+
+
+def _crossed_square(tmp_path: Path) -> Path:
+    doc = _doc()
+    msp = doc.modelspace()
+    msp.add_lwpolyline([(0, 0), (20, 0), (20, 20), (0, 20)], close=True)
+    msp.add_line((-5, 10), (25, 10), dxfattribs={"layer": "AXES"})  # a centre line across
+    path = tmp_path / "crossed.dxf"
+    doc.saveas(path)
+    return path
+
+
+def test_a_centre_line_is_never_cut_by_default(tmp_path: Path) -> None:
+    drawing = read_drawing(_crossed_square(tmp_path))
+    job = post_drawing(drawing, load_target("grbl"), PlanOptions(depth=1.0))
+    cuts = [m for m in job.program.moves if isinstance(m, Linear) and m.z is None]
+    assert cuts and all(m.y in (0, 20) or m.x in (0, 20) for m in cuts)
+    (note,) = [w for w in job.warnings if "layer 'AXES'" in w]
+    assert note.startswith("not cut: 1 contour(s) on layer 'AXES' (linetype CENTER")
+
+
+def test_a_centre_line_named_by_its_layer_is_cut(tmp_path: Path) -> None:
+    drawing = read_drawing(_crossed_square(tmp_path))
+    job = post_drawing(drawing, load_target("grbl"), PlanOptions(depth=1.0), layers=("axes",))
+    assert any(isinstance(m, Linear) and (m.x, m.y) == (25, 10) for m in job.program.moves)
+
+
+@pytest.mark.parametrize("layer", ["DIMENSIONS", "Construction", "Hilfslinien"])
+def test_a_construction_layer_is_left_out(tmp_path: Path, layer: str) -> None:
+    doc = _doc()
+    msp = doc.modelspace()
+    msp.add_lwpolyline([(0, 0), (20, 0), (20, 20), (0, 20)], close=True)
+    msp.add_lwpolyline([(30, 0), (40, 0), (40, 10)], dxfattribs={"layer": layer})
+    path = tmp_path / "c.dxf"
+    doc.saveas(path)
+    job = post_drawing(read_drawing(path), load_target("grbl"), PlanOptions(depth=1.0))
+    assert max(m.x for m in job.program.moves) == 20
+    assert any(f"on layer {layer!r} (a construction layer" in w for w in job.warnings)
