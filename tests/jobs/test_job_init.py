@@ -33,7 +33,7 @@ def test_the_sample_plate_gets_drill_pocket_and_outline_in_that_order() -> None:
         ("pocket", None),
         ("profile", "outside"),
     ]
-    drill, pocket, outline = ops
+    drill, _pocket, outline = ops
     assert drill["layers"] == ["HOLES"] and drill["diameter"] == 3.2 and drill["depth"] == 6.5
     assert outline["layers"] == ["OUTLINE"] and outline["tabs"] == 3
     tools = {t["id"]: t for t in tomllib.loads(text)["tools"]}
@@ -41,7 +41,7 @@ def test_the_sample_plate_gets_drill_pocket_and_outline_in_that_order() -> None:
     assert tools[outline["tool"]]["type"] == "end-mill"
     # every guess says why; the open line and the centre lines are left out, said so
     assert "# 4 circle(s) of ø3.2 mm on layer 'HOLES'" in text
-    assert "# [[operations]]\n# type = \"engrave\"" in text
+    assert '# [[operations]]\n# type = "engrave"' in text
     assert "layer 'CENTER': linetype CENTER: 10 contour(s)" in text
 
 
