@@ -64,6 +64,7 @@ _KIND_TITLES = {
     "overlap": "overlapping segments",
     "zero-length": "zero-length segments or entities",
     "tiny-segment": "tiny segments",
+    "construction": "not cut unless an operation names them (construction, not the part)",
     "skipped": "entities not read",
     "repaired": "repairs made to read a damaged file (ezdxf recover mode)",
 }
@@ -78,6 +79,23 @@ class LayerContours:
     open: int
     lines: int
     arcs: int
+
+
+@dataclass(frozen=True)
+class StyleCount:
+    """Contours drawn one way: on one layer, in one colour and linetype (before chaining).
+
+    A job selects by these (docs/jobs.md). ``circles`` are whole circles (drillable),
+    ``points`` the DXF POINTs of the layer and colour.
+    """
+
+    layer: str
+    colour: str
+    linetype: str
+    closed: int
+    open: int
+    circles: int
+    points: int = 0
 
 
 @dataclass(frozen=True)
@@ -98,6 +116,7 @@ class InspectReport:
         findings: the checks' findings, by kind.
         chain_tolerance: ends closer than this are joined into one contour
             (``--chain-tolerance``), mm; None: the ends were joined within ``tolerance``.
+        styles: the contours by layer, colour and linetype, before chaining.
     """
 
     source: str
@@ -110,6 +129,7 @@ class InspectReport:
     warnings: tuple[str, ...] = field(default=())
     findings: tuple[Finding, ...] = field(default=())
     chain_tolerance: float | None = None
+    styles: tuple[StyleCount, ...] = field(default=())
 
     @property
     def joined_within(self) -> float:
@@ -128,7 +148,9 @@ class InspectReport:
         ``size_mm`` ``[w, h]``, ``entities`` and ``block_entities`` (lists of
         ``{type, layer, count}``), ``contours`` ``{total, closed, open, by_layer: [{layer,
         closed, open, lines, arcs}]}``, ``warnings`` (strings), ``findings`` (list of
-        ``{kind, message, location: [x, y] | null, sources}``) and ``finding_counts``.
+        ``{kind, message, location: [x, y] | null, sources}``), ``finding_counts`` and
+        ``styles`` (list of ``{layer, colour, linetype, closed, open, circles, points}``:
+        what a job's operations select by).
         """
         x0, y0, x1, y1 = self.bbox
 
@@ -150,6 +172,7 @@ class InspectReport:
                 "open": sum(lay.open for lay in self.layers),
                 "by_layer": [vars(lay).copy() for lay in self.layers],
             },
+            "styles": [vars(st).copy() for st in self.styles],
             "warnings": list(self.warnings),
             "findings": [f.to_json() for f in self.findings],
             "finding_counts": self.counts(),
@@ -174,6 +197,9 @@ class InspectReport:
             lines += ["", "entities placed by blocks (INSERT):", *_table(self.block_entities)]
         lines += ["", "contours by layer (after chaining):"]
         lines += _layer_table(self.layers)
+        if self.styles:
+            lines += ["", "layers, colours and linetypes (what a job selects by):"]
+            lines += _style_table(self.styles)
         if self.warnings:
             lines += ["", "warnings:", *(f"  {w}" for w in self.warnings)]
         lines += ["", *self._findings_text()]
@@ -241,6 +267,7 @@ def inspect_drawing(
     chained, findings = check_drawing(
         drawing, options.tolerance, tiny_mm=tiny_mm, chain_tolerance=chain_tolerance
     )
+    notes += _construction(drawing)
     order = list(_KIND_TITLES)
     every = sorted(
         [*findings, *notes], key=lambda f: order.index(f.kind) if f.kind in order else 99
@@ -256,7 +283,63 @@ def inspect_drawing(
         warnings=drawing.warnings,
         findings=tuple(every),
         chain_tolerance=chain_tolerance,
+        styles=_styles(drawing),
     )
+
+
+def _styles(drawing: Drawing) -> tuple[StyleCount, ...]:
+    """The drawing's contours (and points) counted by layer, colour and linetype."""
+    from camtool.model.shapes import circle_of
+
+    counts: dict[tuple[str, str, str], list[int]] = {}
+    for c in drawing.contours:
+        row = counts.setdefault((c.layer, c.colour, c.linetype), [0, 0, 0, 0])
+        row[0 if c.closed else 1] += 1
+        row[2] += circle_of(c) is not None
+    for m in drawing.marks:
+        counts.setdefault((m.layer, m.colour, ""), [0, 0, 0, 0])[3] += 1
+    return tuple(
+        StyleCount(layer, colour, linetype, *row)
+        for (layer, colour, linetype), row in sorted(
+            counts.items(), key=lambda item: (item[0][0].casefold(), item[0][1], item[0][2])
+        )
+    )
+
+
+def _style_table(styles: tuple[StyleCount, ...]) -> list[str]:
+    wl = max(len("layer"), *(len(st.layer) for st in styles))
+    wt = max(len("linetype"), *(len(st.linetype or "continuous") for st in styles))
+    out = [f"  {'layer':<{wl}}  colour   {'linetype':<{wt}}  closed   open  circles  points"]
+    out += [
+        f"  {st.layer:<{wl}}  {st.colour or '-':<7}  {st.linetype or 'continuous':<{wt}}  "
+        f"{st.closed:>6} {st.open:>6} {st.circles:>8} {st.points:>7}"
+        for st in styles
+    ]
+    return out
+
+
+def _construction(drawing: Drawing) -> list[Finding]:
+    """A ``construction`` finding per layer and linetype that ``post`` leaves uncut."""
+    from camtool.model.construction import construction_layer
+
+    groups: dict[tuple[str, str], list[Contour]] = {}
+    for c in drawing.contours:
+        if c.linetype or construction_layer(c.layer):
+            groups.setdefault((c.layer, c.linetype), []).append(c)
+    out = []
+    for (layer, linetype), contours in sorted(groups.items()):
+        what = f"linetype {linetype}" if linetype else "a construction layer"
+        first = contours[0]
+        out.append(
+            Finding(
+                "construction",
+                f"{len(contours)} contour(s) on layer {layer!r} ({what}), first at "
+                f"({first.start[0]:.4f}, {first.start[1]:.4f})",
+                first.start,
+                tuple(c.source for c in contours[:5] if c.source),
+            )
+        )
+    return out
 
 
 def _note_finding(note: DxfNote) -> Finding:

@@ -9,14 +9,13 @@ names its layer or its linetype: a selection of "everything" never cuts it.
 
 from __future__ import annotations
 
-import math
 from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 from camtool.jobs.job import Operation, Selection
 from camtool.model.construction import construction_layer
-from camtool.model.shapes import Arc, Contour, Drawing, Mark, Point
+from camtool.model.shapes import Contour, Drawing, Mark, circle_of
 
 
 @dataclass(frozen=True)
@@ -30,30 +29,6 @@ class Selected:
 
     drawing: Drawing
     construction: tuple[Contour, ...] = ()
-
-
-def circle_of(contour: Contour) -> tuple[Point, float] | None:
-    """The centre and diameter (mm) of a contour that is a whole circle, else ``None``.
-
-    A circle is a closed contour of arcs about one centre with one radius (a DXF CIRCLE
-    is one arc from a point back to itself; a polyline of two bulges is two), to 1e-9 of
-    the radius.
-    """
-    segs = contour.segments
-    if not contour.closed or not all(isinstance(s, Arc) for s in segs):
-        return None
-    first = segs[0]
-    assert isinstance(first, Arc)
-    r = math.dist(first.start, first.centre)
-    if r <= 0:
-        return None
-    for s in segs:
-        assert isinstance(s, Arc)
-        if math.dist(s.centre, first.centre) > 1e-9 * r or abs(s.radius - r) > 1e-9 * r:
-            return None
-        if s.clockwise != first.clockwise:
-            return None
-    return first.centre, 2.0 * r
 
 
 def construction_reason(contour: Contour, selection: Selection) -> str | None:

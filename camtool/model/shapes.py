@@ -447,6 +447,30 @@ class Contour:
 share_keys(Contour, (*_kept(Contour), "_bbox"))
 
 
+def circle_of(contour: Contour) -> tuple[Point, float] | None:
+    """The centre and diameter (mm) of a contour that is a whole circle, else ``None``.
+
+    A circle is a closed contour of arcs about one centre with one radius (a DXF CIRCLE
+    is one arc from a point back to itself; a polyline of two bulges is two), to 1e-9 of
+    the radius.
+    """
+    segs = contour.segments
+    if not contour.closed or not all(isinstance(s, Arc) for s in segs):
+        return None
+    first = segs[0]
+    assert isinstance(first, Arc)
+    r = math.dist(first.start, first.centre)
+    if r <= 0:
+        return None
+    for s in segs:
+        assert isinstance(s, Arc)
+        if math.dist(s.centre, first.centre) > 1e-9 * r or abs(s.radius - r) > 1e-9 * r:
+            return None
+        if s.clockwise != first.clockwise:
+            return None
+    return first.centre, 2.0 * r
+
+
 @dataclass(frozen=True)
 class Mark:
     """A point of the drawing (a DXF POINT): nothing to cut, a place to drill.

@@ -99,3 +99,25 @@ def test_a_construction_layer_is_left_out(tmp_path: Path, layer: str) -> None:
     job = post_drawing(read_drawing(path), load_target("grbl"), PlanOptions(depth=1.0))
     assert max(m.x for m in job.program.moves) == 20
     assert any(f"on layer {layer!r} (a construction layer" in w for w in job.warnings)
+
+
+def test_inspect_lists_layers_colours_linetypes_and_construction() -> None:
+    from camtool.importers.lint import StyleCount, inspect_drawing
+
+    root = Path(__file__).resolve().parents[2]
+    report = inspect_drawing(root / "samples" / "part.dxf")
+    # samples/make_samples.py: layers HOLES red (ACI 1), CENTER cyan (ACI 4) with the
+    # CENTER linetype, four circles, ten centre lines
+    assert StyleCount("HOLES", "#ff0000", "", 4, 0, 4) in report.styles
+    assert StyleCount("CENTER", "#00ffff", "CENTER", 0, 10, 0) in report.styles
+    (construction,) = [f for f in report.findings if f.kind == "construction"]
+    assert construction.message.startswith("10 contour(s) on layer 'CENTER' (linetype CENTER)")
+    assert report.to_json()["styles"][0] == {  # type: ignore[index]
+        "layer": "CENTER",
+        "colour": "#00ffff",
+        "linetype": "CENTER",
+        "closed": 0,
+        "open": 10,
+        "circles": 0,
+        "points": 0,
+    }
