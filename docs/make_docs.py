@@ -66,6 +66,7 @@ def generated() -> dict[Path, str]:
     page = ROOT / "docs" / "verify.md"
     text = page.read_text(encoding="utf-8")
     files[page] = _VERIFY.sub(lambda m: m[1] + f"```\n{lines}```\n" + m[2], text)
+    files.update(job_files())
     from make_gallery import gallery_files
 
     files.update(gallery_files())
@@ -73,6 +74,28 @@ def generated() -> dict[Path, str]:
 
     files.update(toolpath_files())
     return files
+
+
+_JOB = re.compile(r"(<!-- job:begin -->\n).*?(<!-- job:end -->)", re.S)
+
+
+def job_files() -> dict[Path, str]:
+    """docs/jobs.md's sample program (its head) and the picture of the sample job."""
+    from camtool.importers import read_drawing
+    from camtool.jobs.job import load_job
+    from camtool.jobs.run import run_job
+
+    drawing = read_drawing(ROOT / "samples" / "part.dxf")
+    job = run_job(drawing, load_target("grbl"), load_job(ROOT / "samples" / "part.toml"))
+    title = "samples/part.dxf + samples/part.toml → grbl"
+    svg = render_preview(".svg", program=job.program, target=job.target, title=title)
+    page = ROOT / "docs" / "jobs.md"
+    text = page.read_text(encoding="utf-8")
+    head = "".join(str(job.result.code).splitlines(keepends=True)[:40]) + "…\n"
+    return {
+        ROOT / "docs" / "jobs-part.svg": svg.decode("utf-8"),
+        page: _JOB.sub(lambda m: m[1] + f"```\n{head}```\n" + m[2], text),
+    }
 
 
 def targets_table() -> str:

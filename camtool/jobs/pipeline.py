@@ -22,8 +22,9 @@ from camtool.toolpath.options import PlanOptions, drawing_only
 
 if TYPE_CHECKING:
     from camtool.jobs.job import Job
+    from camtool.jobs.run import OperationRun
     from camtool.toolpath.plan import PlanReport
-    from camtool.verify.verifier import Verification
+    from camtool.verify.verifier import Part, Verification
 
 
 def load_target_checked(name: str, *, machine_file: Path | str | None = None) -> Target:
@@ -433,23 +434,62 @@ def verify_job(
     the emitted numbers costs (``budget=False``: no error budget; ``budget_now``: it
     is computed now, told to that progress callback, as ``verify_program`` says).
 
+    A job of several operations is verified whole (deviation, contours, time), and each
+    operation again alone against the drawing it cuts, with its own tool
+    (:attr:`~camtool.verify.verifier.Verification.parts`, :func:`verify_operation`).
+
     Raises:
         CamtoolError: the target cannot read its own code back, or its machine
             profile is invalid for the verifier.
     """
     from camtool.verify.verifier import verify_code
 
-    return verify_code(
+    several = len(job.operations) > 1
+    whole = verify_code(
         job.result.code,
         job.target,
         source=f"<{job.target.name} code>",
-        against=job.placed,
+        against=None if several else job.placed,
         tool_diameter=2.0 * job.edge_radius_mm,
         findings=job.plan.placed_findings() if job.plan is not None else (),
         planned=job.program,
         budget=budget,
         budget_now=budget_now,
     )
+    if not several:
+        return whole
+    parts = tuple(verify_operation(job, run) for run in job.operations)
+    return dataclasses.replace(whole, parts=parts)
+
+
+def verify_operation(job: PostJob, run: OperationRun) -> Part:
+    """One operation of ``job`` written alone, read back, simulated and compared with its drawing.
+
+    The operation's moves and commands, from where the job left the tool, are written
+    for the job's target as they are in the job's program; the machined edge is its
+    tool's (a drill's hole is the drill's diameter about its centre).
+    """
+    from camtool.verify.verifier import Part, verify_code
+
+    first, end = run.moves
+    program = job.program
+    here = (
+        program.origin if first == 0 else (program.moves[first - 1].x, program.moves[first - 1].y)
+    )
+    commands = tuple((i - first, c) for i, c in program.commands if first <= i < end)
+    alone = Program(program.moves[first:end], here, commands=commands)
+    code = job.target.emit(alone).code
+    v = verify_code(
+        code,
+        job.target,
+        source=f"<{job.target.name} code of {run.label}>",
+        against=run.placed,
+        tool_diameter=2.0 * run.edge_radius_mm,
+        findings=run.report.placed_findings() if run.report is not None else (),
+        planned=alone,
+        budget=False,
+    )
+    return Part(f"{run.label} T{run.tool.id}", run.moves, v)
 
 
 def report_json(v: Verification, plan: PlanReport | None = None) -> str:

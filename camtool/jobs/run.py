@@ -149,7 +149,7 @@ class OperationRun:
             when it has none).
         placed: what it cuts, in the program's work coordinates.
         edge_radius_mm: how far the cut edge lies from the tool path (half the tool for
-            a compensated profile or pocket, 0 on the line and for drilling).
+            a compensated profile, a pocket and a drill; 0 on the line).
         report: what planning found (``None`` for drilling).
         holes: the holes a drill operation drills.
         time_s: its moves' time at their programmed feeds (rapids at the machine's rate
@@ -260,7 +260,7 @@ def run_job(
                 moves=(first, len(moves)),
                 contours=(offset + 1, _last_contour(moves)),
                 placed=planned.placed,
-                edge_radius_mm=options.radius if options.offset != "on" else 0.0,
+                edge_radius_mm=_edge(op, tool, options),
                 report=planned.report,
                 holes=planned.holes,
                 time_s=feed_time_s(moves[first:], target, start=_start(moves, first, setup)),
@@ -310,6 +310,13 @@ def run_job(
         report,
         operations=tuple(runs),
     )
+
+
+def _edge(op: Operation, tool: Tool, options: PlanOptions) -> float:
+    """How far the cut edge lies from the tool path, mm (a drill's: its radius)."""
+    if op.type == "drill":
+        return tool.diameter / 2.0
+    return options.radius if options.offset != "on" else 0.0
 
 
 def _where(job: Job, op: Operation, number: int) -> str:

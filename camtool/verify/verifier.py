@@ -104,6 +104,22 @@ MIN_OVERLAP = 0.1
 
 
 @dataclass(frozen=True, eq=False)
+class Part:
+    """A part of a program verified alone: a job's operation, against its own drawing.
+
+    Attributes:
+        label: how the report names it (``"operation 2 (pocket 'floor') T1"``).
+        moves: ``(first, end)``: the program's moves it holds.
+        verification: the part written, read back and simulated alone, and compared
+            with the drawing it cuts with its own tool.
+    """
+
+    label: str
+    moves: tuple[int, int]
+    verification: Verification
+
+
+@dataclass(frozen=True, eq=False)
 class Verification:
     """Everything one verification produced.
 
@@ -128,6 +144,8 @@ class Verification:
         drawing: the drawing given to compare with (the budget measures it again).
         tool_diameter: the tool diameter the drawing was compared with, mm.
         findings: the plan's findings the drawing was compared with.
+        parts: the program's parts verified each alone (a job's operations, each with
+            its tool against its own drawing); their errors count in the limits.
     """
 
     target: str
@@ -146,6 +164,7 @@ class Verification:
     drawing: Drawing | None = None
     tool_diameter: float = 0.0
     findings: Sequence[FindingLike] = ()
+    parts: tuple[Part, ...] = ()
 
     @cached_property
     def error_budget(self) -> eb.ErrorBudget:
@@ -203,7 +222,7 @@ class Verification:
             worst = max(worst, self.along.shortfall_um)
         if self.against is not None:
             worst = max(worst, self.against.max_um, self.against.overcut_um)
-        return worst
+        return max([worst, *(p.verification.max_error_um for p in self.parts)])
 
     @property
     def strict_error_um(self) -> float:
@@ -211,7 +230,7 @@ class Verification:
         worst = self.max_error_um
         if self.against is not None:
             worst = max(worst, self.against.strict_max_um)
-        return worst
+        return max([worst, *(p.verification.strict_error_um for p in self.parts)])
 
     def over_limit(self, limit_um: float, *, strict: bool = False) -> str | None:
         """Why this verification fails ``--max-error-um limit_um``, or ``None`` when it passes.
@@ -220,10 +239,12 @@ class Verification:
         planner reported it cannot cut with this tool). A drawing that was given but
         not compared (it does not overlap the program) fails: it cannot pass unjudged.
         """
-        if self.against_skipped is not None:
+        skipped = [p.label for p in self.parts if p.verification.against_skipped is not None]
+        if self.against_skipped is not None or skipped:
+            where = f" of {', '.join(skipped)}" if skipped else ""
             return (
-                f"--max-error-um {limit_um:g} cannot be judged: the drawing was not compared "
-                "(it does not overlap the program; see the warning above)"
+                f"--max-error-um {limit_um:g} cannot be judged: the drawing{where} was not "
+                "compared (it does not overlap the program; see the warning above)"
             )
         error = self.strict_error_um if strict else self.max_error_um
         if error <= limit_um:
@@ -1093,6 +1114,7 @@ def summary_lines(v: Verification) -> list[str]:
         )
         if a.not_cut:
             lines.append("  " + not_cut_text(a))
+    lines.extend(part_lines(v))
     lines.append(f"  estimated time {time_text(v.time_s)}")
     lines.extend(f"  {line}" for line in eb.text_lines(v.error_budget))
     return lines
@@ -1167,6 +1189,38 @@ def _mm(value: float) -> float:
     return round(float(value), 6) + 0.0
 
 
+def _part(p: Part) -> dict[str, Any]:
+    """One ``operations`` entry of the report: a part verified alone."""
+    v = p.verification
+    against = None
+    if v.against is not None:
+        against = {"max_um": _um(v.against.max_um), "overcut_um": _um(v.against.overcut_um)}
+    return {
+        "operation": p.label,
+        "moves": [p.moves[0] + 1, p.moves[1]],
+        "deviation_um": {"max": _um(v.deviation.max_um), "rms": _um(v.deviation.rms_um)},
+        "against": against,
+        "against_skipped": v.against_skipped,
+        "tool_diameter_mm": _mm(v.tool_diameter),
+        "max_error_um": _um(v.max_error_um),
+        "time_s": seconds_6(v.time_s),
+    }
+
+
+def part_lines(v: Verification) -> list[str]:
+    """A line per part of ``v`` for the summary: deviation, the drawing, time."""
+    lines = []
+    for p in v.parts:
+        pv = p.verification
+        text = f"  {p.label}: deviation max {fmt_num(pv.deviation.max_um, 2)} µm"
+        if pv.against is not None:
+            text += f", against its drawing max {fmt_num(pv.against.max_um, 2)} µm"
+        elif pv.against_skipped is not None:
+            text += ", not compared with its drawing"
+        lines.append(text + f", {fmt_num(pv.time_s, 1)} s")
+    return lines
+
+
 def build_report(v: Verification) -> dict[str, Any]:
     """The report of a verification (see the module docstring for the keys)."""
     t = v.trace
@@ -1206,6 +1260,7 @@ def build_report(v: Verification) -> dict[str, Any]:
         "time_s": seconds_6(v.time_s),
         "warnings": list(v.warnings),
         "error_budget": eb.to_json(v.error_budget, _um),
+        "operations": [_part(p) for p in v.parts],
     }
     if v.against is not None:
         a = v.against
