@@ -43,7 +43,7 @@ def test_the_report_has_a_section_per_operation(verified: object) -> None:
     ops = report["operations"]
     assert [op["operation"] for op in ops][-1] == "operation 4 (profile outside 'outline') T1"
     assert all(op["against"] is not None and op["time_s"] > 0 for op in ops)
-    assert report["max_error_um"] == max(op["max_error_um"] for op in ops + [report])
+    assert report["max_error_um"] == max(op["max_error_um"] for op in [*ops, report])
 
 
 def test_the_limit_judges_every_operation(verified: object) -> None:
