@@ -181,6 +181,7 @@ class PlanOptions:
     origin: Point = (0.0, 0.0)
 
     def __post_init__(self) -> None:
+        _check_types(self)
         self._check_numbers()
         self._check_choices()
         self._check_tool()
@@ -411,6 +412,92 @@ MIN_TOLERANCE_MM = 1e-6
 
 MAX_PASSES = 10_000
 """Most depth passes a plan may have (``--depth`` / ``--step-down``)."""
+
+
+_KINDS: dict[str, str] = {
+    "offset": "choice",
+    "tool_diameter": "number",
+    "direction": "choice?",
+    "stepover": "number",
+    "pocket": "choice",
+    "pocket_angle_deg": "number",
+    "depth": "number?",
+    "step_down": "number?",
+    "safe_z": "number",
+    "plunge_feed_mm_min": "number?",
+    "ramp_angle_deg": "number?",
+    "tabs": "int",
+    "tab_width": "number",
+    "tab_height": "number",
+    "order": "choice",
+    "lead_in_mm": "number",
+    "close_gap": "number",
+    "fit_arcs": "bool",
+    "feed_mm_min": "number?",
+    "tolerance": "number",
+    "scale": "number",
+    "fit_mm": "pair?",
+    "placement": "choice",
+    "translate": "pair",
+    "chain_tolerance": "number",
+    "clearance_z": "number?",
+    "end_position": "pair?",
+    "reverse_open": "bool",
+    "origin": "pair",
+}
+"""The kind of value each :class:`PlanOptions` field takes (``?``: or ``None``)."""
+
+_KIND_NAMES = {
+    "number": "a number",
+    "int": "a whole number",
+    "bool": "True or False",
+    "pair": "two numbers (x, y)",
+    "choice": "a name",
+}
+
+
+def _check_types(options: PlanOptions) -> None:
+    """Refuse a value of the wrong kind, naming the field and what it takes.
+
+    Raises:
+        UsageError: e.g. ``PlanOptions(origin="center")``: the start position is two
+            numbers (the work zero is ``placement``, ``--origin`` on the command line).
+    """
+    for name, kind in _KINDS.items():
+        value = getattr(options, name)
+        base = kind.rstrip("?")
+        if value is None and kind.endswith("?"):
+            continue
+        if _of_kind(value, base):
+            if isinstance(value, list):  # a pair given as a list: kept as the tuple it is
+                object.__setattr__(options, name, tuple(value))
+            continue
+        hint = ""
+        if name == "origin" and isinstance(value, str):
+            hint = (
+                f"; origin is where the tool stands before the program; for the work zero "
+                f"({', '.join(PLACEMENTS)}: --origin on the command line) give "
+                f"placement={value!r}"
+            )
+        raise UsageError(
+            f"PlanOptions {name} = {value!r}: give {_KIND_NAMES[base]} ({flag(name)}){hint}"
+        )
+
+
+def _of_kind(value: object, kind: str) -> bool:
+    if kind == "bool":
+        return isinstance(value, bool)
+    if kind == "choice":
+        return isinstance(value, str)
+    if kind == "int":
+        return isinstance(value, int) and not isinstance(value, bool)
+    if kind == "number":
+        return isinstance(value, int | float) and not isinstance(value, bool)
+    return (
+        isinstance(value, tuple | list)
+        and len(value) == 2
+        and all(_of_kind(v, "number") for v in value)
+    )
 
 
 def _numbers(options: PlanOptions) -> list[tuple[str, float]]:

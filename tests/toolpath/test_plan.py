@@ -175,3 +175,21 @@ def test_plan_without_a_feed_is_refused_before_any_work(tmp_path: Path) -> None:
     drawing = read_dxf(rectangle_dxf(tmp_path / "r.dxf"))
     with pytest.raises(UsageError, match="no cutting feed: give --feed"):
         plan(drawing, PlanOptions())
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"origin": "center"}, r"origin = 'center': give two numbers .* placement='center'"),
+        ({"depth": "3"}, r"depth = '3': give a number \(--depth\)"),
+        ({"tabs": 2.5}, r"tabs = 2.5: give a whole number"),
+        ({"fit_mm": (10.0,)}, r"fit_mm = \(10.0,\): give two numbers"),
+        ({"reverse_open": "yes"}, r"reverse_open = 'yes': give True or False"),
+    ],
+)
+def test_plan_options_of_the_wrong_kind_are_refused_when_made(
+    kwargs: dict[str, Any], message: str
+) -> None:
+    with pytest.raises(UsageError, match=message):
+        PlanOptions(**kwargs)
+    assert PlanOptions(translate=[1.0, 2.0]).translate == (1.0, 2.0)  # type: ignore[arg-type]
