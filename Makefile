@@ -20,8 +20,11 @@ demo: $(STAMP)
 	$(BIN)/camtool post samples/plate.dxf --target grbl --offset outside --tool-diameter 3 \
 		--origin lower-left \
 		--depth 3 --step-down 1 --tabs 3 --lead-in 2 -o out/plate.gcode --preview out/plate.png
+	$(BIN)/camtool post samples/part.dxf --target linuxcnc --job samples/part.toml \
+		-o out/part.ngc --report out/part-verify.json --preview out/part.png
 	@echo "demo: out/logo.pic (pic-mmh program), out/logo-verify.json and .png (predicted error)"
 	@echo "demo: out/plate.gcode (GRBL: outside profile, 3 passes, tabs, lead-ins), out/plate.png"
+	@echo "demo: out/part.ngc (LinuxCNC job: drill, engrave, pocket, outline; samples/part.toml)"
 
 lint: $(STAMP)
 	$(BIN)/ruff check camtool postprocessors tests samples docs
