@@ -1,0 +1,63 @@
+"""Every LibreCAD part of the corpus as a job: ``job init``'s job posts on grbl and linuxcnc.
+
+A new user's first run on a real drawing: ``camtool job init PART.dxf``, then ``camtool post
+PART.dxf --job`` that job. It must post on GRBL and LinuxCNC with no edit, and LinuxCNC's own
+interpreter (``rs274``) must accept the linuxcnc program (with a tool table holding every
+tool the job names). The drawings are LibreCAD's parts library (``make corpus``).
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from camtool.importers import read_drawing
+from camtool.jobs.init import initial_job
+from camtool.jobs.job import job_from_dict
+from camtool.jobs.run import run_job
+from camtool.post.registry import load_target
+from tests.corpus.conftest import CORPUS, case_id, corpus_files, load_manifest, skip_reason
+from tests.corpus.test_rs274 import rs274_problem
+
+MANIFEST = load_manifest()
+FILES = [f for f in corpus_files(MANIFEST) if "librecad" in f and f.endswith(".dxf")]
+
+
+def _rs274(program: Path, table: Path) -> subprocess.CompletedProcess[str]:
+    assert MANIFEST is not None
+    entry = MANIFEST["rs274"]
+    env = dict(
+        os.environ,
+        LD_LIBRARY_PATH=os.pathsep.join(str(CORPUS / d) for d in entry["ld_library_path"]),
+    )
+    return subprocess.run(
+        [str(CORPUS / entry["exe"]), "-t", str(table), "-g", str(program)],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+        check=False,
+    )
+
+
+@pytest.mark.parametrize("rel", FILES or ["<none>"], ids=case_id)
+def test_job_init_then_post_on_grbl_and_linuxcnc(rel: str, tmp_path: Path) -> None:
+    if MANIFEST is None or not FILES:
+        pytest.skip(skip_reason())
+    drawing = read_drawing(CORPUS / rel)
+    data = tomllib.loads(initial_job(drawing))
+    job = job_from_dict(data, source="init.toml")
+    run_job(drawing, load_target("grbl"), job)
+    done = run_job(drawing, load_target("linuxcnc"), job)
+    if rs274_problem() is not None:
+        return
+    program = tmp_path / "job.ngc"
+    program.write_text(str(done.result.code))
+    table = tmp_path / "tool.tbl"
+    table.write_text("".join(f"T{t.id} P{t.id} D{t.diameter:g} Z0 ;{t.type}\n" for t in job.tools))
+    judged = _rs274(program, table)
+    assert judged.returncode == 0, judged.stderr[-500:]
