@@ -271,6 +271,7 @@ def run_job(
         notes.extend(_unselected(scaled, runs, construction))
     warnings[len(drawing.warnings) : len(drawing.warnings)] = notes
     warnings.extend(_overlaps(runs, job))
+    warnings.extend(_holes_cut_outside(runs, job))
     placed_all = Drawing(
         tuple(c for r in runs for c in r.placed.contours),
         drawing.source,
@@ -635,6 +636,36 @@ def _overlaps(runs: Sequence[OperationRun], job: Job) -> list[str]:
                 )
                 break
             seen[key] = run
+    return out
+
+
+def _holes_cut_outside(runs: Sequence[OperationRun], job: Job) -> list[str]:
+    """A warning for a contour cut on its outside that lies inside another operation's.
+
+    Within one operation a hole is cut on its inside (its nesting says it is a hole); a
+    hole selected alone by an ``outside`` profile is cut outside itself, into the part.
+    """
+    if job.shorthand:
+        return []
+    from camtool.toolpath.order import nesting
+
+    closed = [(r, c) for r in runs for c in r.placed.contours if c.closed]
+    if len(closed) < 2:
+        return []
+    nest = nesting([c for _, c in closed])
+    out: list[str] = []
+    for i, (run, contour) in enumerate(closed):
+        if run.operation.kind != "profile outside":
+            continue
+        around = [closed[j] for j in nest.parents[i] if closed[j][0] is not run]
+        if around and not any(closed[j][0] is run for j in nest.parents[i]):
+            other, outer = around[0]
+            out.append(
+                f"{run.label} cuts {contour.source or 'a contour'} on layer "
+                f"{contour.layer!r} on its outside, but it lies inside "
+                f"{outer.source or 'a contour'} of {other.label}: a hole cut outside itself "
+                'cuts into the part; give that operation side = "inside"'
+            )
     return out
 
 

@@ -223,3 +223,30 @@ def test_between_two_holes_the_drill_rises_to_clearance(part: object) -> None:
         z = a.z if a.z is not None else z
         if isinstance(b, Rapid) and (b.x, b.y) != (a.x, a.y):
             assert z == 10.0
+
+
+def test_a_hole_selected_alone_for_an_outside_profile_is_warned_about(tmp_path: Path) -> None:
+    from tests.shapes import write_dxf
+
+    def build(msp: object) -> None:
+        msp.add_lwpolyline(  # type: ignore[attr-defined]
+            [(0, 0), (60, 0), (60, 40), (0, 40)], close=True, dxfattribs={"layer": "EDGE"}
+        )
+        msp.add_circle((30, 20), 8, dxfattribs={"layer": "CUTOUT"})  # type: ignore[attr-defined]
+
+    dxf = write_dxf(tmp_path / "plate.dxf", build)
+    job = tmp_path / "job.toml"
+    job.write_text(
+        "[[tools]]\nid = 1\ndiameter = 3\n"
+        '[[operations]]\ntype = "profile"\ntool = 1\nlayers = ["CUTOUT"]\nside = "outside"\n'
+        "depth = 2\n"
+        '[[operations]]\ntype = "profile"\ntool = 1\nlayers = ["EDGE"]\ndepth = 2\n'
+    )
+    done = run_job(read_drawing(dxf), load_target("grbl"), load_job(job))
+    (warning,) = [w for w in done.warnings if "cuts into the part" in w]
+    assert warning.startswith("operation 1 (profile outside) cuts CIRCLE")
+    assert 'give that operation side = "inside"' in warning
+    fixed = job.read_text().replace('side = "outside"', 'side = "inside"')
+    job.write_text(fixed)
+    done = run_job(read_drawing(dxf), load_target("grbl"), load_job(job))
+    assert not [w for w in done.warnings if "cuts into the part" in w]
