@@ -2,11 +2,18 @@
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 import click
 
-from camtool.cli.common import import_options, import_settings, number_range, write_output
+from camtool.cli.common import (
+    MACHINE,
+    import_options,
+    import_settings,
+    number_range,
+    write_output,
+)
 
 
 @click.group()
@@ -39,8 +46,25 @@ def job() -> None:
     metavar="MM",
     help="The end mill's diameter.",
 )
+@click.option(
+    "--target",
+    "-t",
+    default=None,
+    metavar="NAME",
+    help="The machine the job is for: a drawing larger than its travel is scaled to fit "
+    "(said in the job).",
+)
+@MACHINE
 @import_options
-def init(drawing: str, output: str, thickness: float, tool_diameter: float, **options: Any) -> None:
+def init(
+    drawing: str,
+    output: str,
+    thickness: float,
+    tool_diameter: float,
+    target: str | None,
+    machine_file: Path | None,
+    **options: Any,
+) -> None:
     """Write a first job for DRAWING: one operation per layer, each guess commented.
 
     Small circles are drilled, closed contours profiled (outside for the outermost, inside
@@ -51,9 +75,16 @@ def init(drawing: str, output: str, thickness: float, tool_diameter: float, **op
     from camtool.jobs.inputs import read_input
     from camtool.jobs.output import check_paths
 
-    check_paths([("the input", drawing)], [("-o", output)])
+    check_paths(
+        [("the input", drawing)], [("-o", output)], target=target, machine_file=machine_file
+    )
+    travel = None
+    if target is not None:
+        from camtool.jobs.pipeline import load_target_checked
+
+        travel = load_target_checked(target, machine_file=machine_file).machine.travel_mm
     drawn = read_input(drawing, import_settings(options))
-    text = initial_job(drawn, thickness_mm=thickness, tool_diameter=tool_diameter)
+    text = initial_job(drawn, thickness_mm=thickness, tool_diameter=tool_diameter, travel_mm=travel)
     write_output(text, output)
     if output != "-":
         count = sum(line.startswith("[[operations]]") for line in text.splitlines())

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 from camtool.jobs.job import Selection
 from camtool.jobs.selection import circle_of, construction_reason
 from camtool.model.errors import InputError
-from camtool.model.shapes import Contour, Drawing
+from camtool.model.shapes import Contour, Drawing, fit_factor
 
 DRILL_MAX_MM = 6.5
 """Largest circle drilled (ø6.5 mm: an M6 clearance hole); larger ones are profiled."""
@@ -59,6 +59,7 @@ def initial_job(
     thickness_mm: float = 3.0,
     tool_diameter: float = 3.0,
     source: str = "",
+    travel_mm: tuple[float, float] | None = None,
 ) -> str:
     """A job file (TOML text, comments included) for ``drawing``.
 
@@ -68,13 +69,21 @@ def initial_job(
             :data:`BREAKTHROUGH_MM`), pockets go half way.
         tool_diameter: the end mill's diameter, mm.
         source: the drawing's name for the header comment.
+        travel_mm: the target machine's travel ``(x, y)``; a drawing (with the tool
+            around it) larger than it gets a ``fit`` that scales it down, said in a
+            comment (``None``: no machine in view).
     """
+    fit = _fit(drawing, tool_diameter, travel_mm)
+    k = 1.0
+    if fit:  # sizes as cut (drills, tabs), selections in the drawing's own mm
+        k = fit_factor(drawing.bbox(), _fit_box(tool_diameter, travel_mm))
+        drawing = drawing.transformed(k)
     groups = _groups(drawing)
     outer = _outermost(drawing.contours)
     ops: list[_Op] = []
     left: Counter[str] = Counter()
     for group in groups:
-        ops.extend(_ops_of(group, outer, thickness_mm, tool_diameter, left))
+        ops.extend(_ops_of(group, outer, thickness_mm, tool_diameter, left, k))
     if all(op.kind == "engrave" for op in ops):
         # lines only, no part outline: a drawing to engrave (a sign, a symbol)
         ops = [dataclasses.replace(op, commented=False, lines=_engraved(op)) for op in ops]
@@ -85,7 +94,32 @@ def initial_job(
             f"({'; '.join(f'{w}: {n}' for w, n in sorted(left.items()))}); name its layer in "
             "an operation of a job written by hand to cut it"
         )
-    return _render(ops, left, thickness_mm, tool_diameter, source or drawing.source)
+    return _render(ops, left, thickness_mm, tool_diameter, source or drawing.source, fit)
+
+
+def _fit(drawing: Drawing, tool: float, travel: tuple[float, float] | None) -> tuple[str, ...]:
+    """``fit = [w, h]`` lines when the drawing is larger than the machine's travel."""
+    if travel is None or not drawing.contours:
+        return ()
+    x0, y0, x1, y1 = drawing.bbox()
+    w, h = travel
+    fw, fh = _fit_box(tool, travel)
+    if x1 - x0 <= fw and y1 - y0 <= fh:
+        return ()
+    return (
+        f"fit = [{fw:g}, {fh:g}]"
+        + _why(
+            f"the drawing is {x1 - x0:.4g} × {y1 - y0:.4g} mm, larger than the "
+            f"{w:g} × {h:g} mm travel: SCALED DOWN to fit; remove this line on a larger machine"
+        ),
+    )
+
+
+def _fit_box(tool: float, travel: tuple[float, float] | None) -> tuple[float, float]:
+    """The box a drawing must fit for its outside profile to fit ``travel`` (mm)."""
+    assert travel is not None
+    margin = 2.0 * tool  # the tool's width on both sides of an outside profile
+    return max(travel[0] - margin, 1.0), max(travel[1] - margin, 1.0)
 
 
 def _engraved(op: _Op) -> tuple[str, ...]:
@@ -121,8 +155,9 @@ def _outermost(contours: Sequence[Contour]) -> set[int]:
 
 
 def _ops_of(
-    group: _Group, outer: set[int], thickness: float, tool: float, left: Counter[str]
+    group: _Group, outer: set[int], thickness: float, tool: float, left: Counter[str], k: float
 ) -> list[_Op]:
+    """The operations of one layer (or colour); ``k``: the scale the job fits it by."""
     select = f"{group.by} = [{_quote(group.key)}]"
     what = f"layer {group.key!r}" if group.by == "layers" else f"colour {group.key}"
     kept: list[Contour] = []
@@ -135,35 +170,52 @@ def _ops_of(
     if not kept:
         return []
     out: list[_Op] = []
-    circles: dict[float, int] = {}
+    circles: dict[float, list[float]] = {}  # by the diameter to 1 µm: every diameter
     profiled: list[Contour] = []
     opened: list[Contour] = []
     for contour in kept:
         circle = circle_of(contour)
         if circle is not None and circle[1] <= DRILL_MAX_MM:
-            d = round(circle[1], 3)
-            circles[d] = circles.get(d, 0) + 1
+            circles.setdefault(round(circle[1], 3), []).append(circle[1])
         elif contour.closed:
             profiled.append(contour)
         else:
             opened.append(contour)
-    for d, count in sorted(circles.items()):
-        out.append(_drill_op(select, what, d, count, thickness))
+    for d, exact in sorted(circles.items()):
+        span = (_drawn(min(exact), k), _drawn(max(exact), k))
+        out.append(_drill_op(select, what, d, span, thickness, len(exact)))
     if profiled:
-        out.append(_profile_op(select, what, profiled, outer, thickness, tool, group.key))
+        op = _profile_op(select, what, profiled, outer, thickness, tool, group.key)
+        if circles:
+            lo = _drawn(min(min(v) for v in circles.values()), k)
+            hi = _drawn(max(max(v) for v in circles.values()), k)
+            lo, hi = round(lo, 6), round(hi, 6)
+            skip = f"except_diameter = [{lo!r}, {hi!r}]" + _why("not the drilled holes")
+            op = dataclasses.replace(op, lines=(*op.lines[:4], skip, *op.lines[4:]))
+        out.append(op)
     if opened:
         out.append(_engrave_op(select, what, len(opened)))
     return out
 
 
-def _drill_op(select: str, what: str, d: float, count: int, thickness: float) -> _Op:
+def _drawn(d: float, k: float) -> float:
+    """A diameter as cut (scaled by ``k``) back in the drawing's mm, as selections give it."""
+    return d if k == 1.0 else round(d / k, 9)
+
+
+def _drill_op(
+    select: str, what: str, d: float, span: tuple[float, float], thickness: float, count: int
+) -> _Op:
+    """A drill per hole size: the circles whose diameter rounds to ``d`` (to 1 µm)."""
     depth = thickness + BREAKTHROUGH_MM
+    lo, hi = round(span[0], 6), round(span[1], 6)  # selections match to 1e-6 of the value
+    size = f"diameter = {lo!r}" if lo == hi else f"diameter = [{lo!r}, {hi!r}]"
     lines = (
         f"name = {_quote(f'holes {d:g}')}",
         'type = "drill"' + _why(f"{count} circle(s) of ø{d:g} mm on {what}: small, drilled"),
         f"tool = {{drill {d:g}}}",
         select,
-        f"diameter = {d:g}" + _why("only the circles of this size"),
+        size + _why("only the circles of this size"),
         f"depth = {depth:g}" + _why(f"through the {thickness:g} mm stock"),
         f"step_down = {max(d, 1.0):g}" + _why("peck about a diameter deep (G83)"),
     )
@@ -213,11 +265,36 @@ def _profile_op(
         f"step_down = {min(step, depth):g}" + _why("passes of at most the tool's diameter"),
     ]
     if has_outer:
-        lines.append("tabs = 3" + _why("hold the part to the stock on the last pass"))
-        lines.append(
-            f"tab_height = {min(1.0, depth / 2):g}" + _why("mm of material left in each tab")
-        )
+        shortest = min(c.length for c in contours if id(c) in outer)
+        tabs = _tabs_that_fit(shortest, tool)
+        if tabs:
+            lines.append(f"tabs = {tabs}" + _why("hold the part to the stock on the last pass"))
+            lines.append(
+                f"tab_height = {min(1.0, depth / 2):g}" + _why("mm of material left in each tab")
+            )
+        else:
+            lines.append(
+                _why(
+                    f"no tabs: a {shortest:.3g} mm outline has no room for them; hold the "
+                    "part another way"
+                ).lstrip()
+            )
     return _Op(f"profile {side}", tool, tuple(lines))
+
+
+TAB_WIDTH_MM = 2.0
+"""The tab width a job leaves as ``post``'s ``--tab-width`` default."""
+
+
+def _tabs_that_fit(length: float, tool: float) -> int:
+    """Up to 3 tabs, as many as fit a path of ``length`` mm (with room between them).
+
+    Each tab needs its width plus the tool's diameter of path
+    (:func:`camtool.toolpath.passes.tab_spans`), within the middle 90 % of the path; a
+    tab's own length again between two keeps them apart.
+    """
+    need = 2.0 * (TAB_WIDTH_MM + tool)
+    return max(0, min(3, int(0.9 * length // need)))
 
 
 def _engrave_op(select: str, what: str, count: int) -> _Op:
@@ -248,7 +325,14 @@ def _marks(drawing: Drawing, thickness: float) -> list[_Op]:
 _ORDER = {"drill": 0, "engrave": 1, "pocket": 2, "profile inside": 3, "profile outside": 4}
 
 
-def _render(ops: list[_Op], left: Counter[str], thickness: float, tool: float, source: str) -> str:
+def _render(
+    ops: list[_Op],
+    left: Counter[str],
+    thickness: float,
+    tool: float,
+    source: str,
+    fit: tuple[str, ...] = (),
+) -> str:
     tools: dict[tuple[str, float], int] = {}
     ordered = sorted(ops, key=lambda op: (_ORDER[op.kind], op.tool))
     for op in ordered:
@@ -267,6 +351,7 @@ def _render(ops: list[_Op], left: Counter[str], thickness: float, tool: float, s
         "safe_z = 2.0" + _why("mm above the top: rapids within an operation"),
         'sequence = "auto"'
         + _why("drill, engrave, pocket, inside, outside profiles last, by tool"),
+        *fit,
         "",
     ]
     for (kind, d), number in tools.items():

@@ -102,6 +102,8 @@ class Selection:
         colours: colours as ``#rrggbb``; ``None``: any.
         closed: only closed (``True``) or only open (``False``) contours; ``None``: both.
         diameter_mm: ``(min, max)``: only circles whose diameter lies in it, mm.
+        except_diameter_mm: ``(min, max)``: not the circles whose diameter lies in it (the
+            holes a drill operation drills), mm.
         linetypes: linetype names (upper case): only these; naming one selects it even
             when it is construction (CENTER, DASHED...). ``None``: any continuous one.
         points: the drawing's points (DXF POINTs) too (drill operations).
@@ -111,6 +113,7 @@ class Selection:
     colours: tuple[str, ...] | None = None
     closed: bool | None = None
     diameter_mm: tuple[float, float] | None = None
+    except_diameter_mm: tuple[float, float] | None = None
     linetypes: tuple[str, ...] | None = None
     points: bool = False
 
@@ -126,6 +129,9 @@ class Selection:
         if self.diameter_mm is not None:
             lo, hi = self.diameter_mm
             parts.append(f"circles of {lo:g}" + (f"–{hi:g}" if hi != lo else "") + " mm")
+        if self.except_diameter_mm is not None:
+            lo, hi = self.except_diameter_mm
+            parts.append(f"not circles of {lo:g}" + (f"–{hi:g}" if hi != lo else "") + " mm")
         if self.linetypes is not None:
             parts.append("linetype " + ", ".join(self.linetypes))
         return "; ".join(parts) or "the whole drawing"
@@ -324,6 +330,7 @@ _OP_KEYS = (
     "colours",
     "closed",
     "diameter",
+    "except_diameter",
     "linetypes",
     "points",
     "side",
@@ -539,6 +546,7 @@ def _selection(row: Mapping[str, Any], kind: str, source: str, where: str) -> Se
         colours=None if colours is None else tuple(_colour(c, source, where) for c in colours),
         closed=closed,
         diameter_mm=_diameters(row.get("diameter"), source, where),
+        except_diameter_mm=_diameters(row.get("except_diameter"), source, where),
         linetypes=None
         if linetypes is None
         else tuple(n.upper() for n in _names(linetypes, source, f"{where} linetypes")),

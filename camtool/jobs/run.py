@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING
 
 from camtool.jobs.job import Job, Operation, Tool
 from camtool.jobs.selection import (
-    circle_of,
+    Selected,
     construction_notes,
     nothing_selected,
     select,
@@ -46,7 +46,7 @@ from camtool.model.program import (
     ToolChange,
 )
 from camtool.model.progress import Progress, Step, no_progress
-from camtool.model.shapes import Contour, Drawing, Point
+from camtool.model.shapes import Contour, Drawing, Point, circle_of
 from camtool.toolpath.options import PlanOptions
 
 if TYPE_CHECKING:
@@ -232,7 +232,7 @@ def run_job(
     for number, op in enumerate(sequence, start=1):
         tool = job.tool(op.tool)
         where = _where(job, op, number)
-        chosen = select(scaled, op.select)
+        chosen = _as_scaled(select(drawing, op.select), drawing, scaled)
         construction.extend(c for c in chosen.construction if c not in construction)
         if not chosen.drawing.contours and not chosen.drawing.marks:
             if job.shorthand and chosen.construction:
@@ -318,6 +318,27 @@ def _edge(op: Operation, tool: Tool, options: PlanOptions) -> float:
     if op.type == "drill":
         return tool.diameter / 2.0
     return options.radius if options.offset != "on" else 0.0
+
+
+def _as_scaled(chosen: Selected, drawing: Drawing, scaled: Drawing) -> Selected:
+    """A selection made on ``drawing`` (its own mm: a ``diameter`` as drawn), as ``scaled``.
+
+    ``scaled`` is ``drawing`` after ``scale``/``fit``: the same contours, in order.
+    """
+    if scaled is drawing:
+        return chosen
+    contours = {id(a): b for a, b in zip(drawing.contours, scaled.contours, strict=True)}
+    marks = {id(a): b for a, b in zip(drawing.marks, scaled.marks, strict=True)}
+    picked = chosen.drawing
+    return Selected(
+        Drawing(
+            tuple(contours[id(c)] for c in picked.contours),
+            picked.source,
+            picked.warnings,
+            tuple(marks[id(m)] for m in picked.marks),
+        ),
+        tuple(contours[id(c)] for c in chosen.construction),
+    )
 
 
 def _where(job: Job, op: Operation, number: int) -> str:

@@ -59,11 +59,20 @@ def matches(contour: Contour, selection: Selection) -> bool:
         return False
     if selection.diameter_mm is not None:
         circle = circle_of(contour)
-        lo, hi = selection.diameter_mm
-        slack = 1e-6 * max(hi, 1.0)
-        if circle is None or not lo - slack <= circle[1] <= hi + slack:
+        if circle is None or not _within(circle[1], selection.diameter_mm):
+            return False
+    if selection.except_diameter_mm is not None:
+        circle = circle_of(contour)
+        if circle is not None and _within(circle[1], selection.except_diameter_mm):
             return False
     return True
+
+
+def _within(d: float, span: tuple[float, float]) -> bool:
+    """Whether the diameter ``d`` lies in ``span`` (mm, to 1e-6 of it: printed values)."""
+    lo, hi = span
+    slack = 1e-6 * max(hi, 1.0)
+    return lo - slack <= d <= hi + slack
 
 
 def mark_matches(mark: Mark, selection: Selection) -> bool:

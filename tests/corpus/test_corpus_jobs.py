@@ -49,9 +49,10 @@ def test_job_init_then_post_on_grbl_and_linuxcnc(rel: str, tmp_path: Path) -> No
     if MANIFEST is None or not FILES:
         pytest.skip(skip_reason())
     drawing = read_drawing(CORPUS / rel)
-    data = tomllib.loads(initial_job(drawing))
+    grbl = load_target("grbl")
+    data = tomllib.loads(initial_job(drawing, travel_mm=grbl.machine.travel_mm))
     job = job_from_dict(data, source="init.toml")
-    run_job(drawing, load_target("grbl"), job)
+    run_job(drawing, grbl, job)
     done = run_job(drawing, load_target("linuxcnc"), job)
     if rs274_problem() is not None:
         return

@@ -93,3 +93,23 @@ def test_kin42_job_cuts_the_disc_and_not_its_diameter_lines() -> None:
         across = abs(move.x - start.x) >= 22 - 1e-6 or abs(move.y - start.y) >= 22 - 1e-6
         assert not across, (start, move)
     assert "LINE" in "\n".join(done.warnings)
+
+
+def test_a_drawing_larger_than_the_machine_is_fitted_and_said_so(tmp_path: Path) -> None:
+    def build(msp: object) -> None:
+        msp.add_lwpolyline(  # type: ignore[attr-defined]
+            [(0, 0), (388, 0), (388, 100), (0, 100)], close=True, dxfattribs={"layer": "EDGE"}
+        )
+        msp.add_circle((20, 20), 3, dxfattribs={"layer": "EDGE"})  # type: ignore[attr-defined]
+
+    drawing = read_drawing(write_dxf(tmp_path / "long.dxf", build))
+    text = initial_job(drawing, travel_mm=(200.0, 200.0))
+    # 200 mm of travel less the 3 mm tool on both sides: 194 mm, the 388 mm part halved
+    assert "fit = [194, 194]  # the drawing is 388 × 100 mm" in text
+    data = tomllib.loads(text)
+    drill = data["operations"][0]
+    assert drill["diameter"] == 6.0  # as drawn: a selection is in the drawing's own mm
+    tool = {t["id"]: t for t in data["tools"]}[drill["tool"]]
+    assert tool["diameter"] == 3.0  # as cut: the ø6 circle at half size
+    done = run_job(drawing, load_target("grbl"), job_from_dict(data, source="j.toml"))
+    assert done.operations[0].holes == 1
