@@ -2,17 +2,14 @@
 
 from __future__ import annotations
 
-import os
 import re
-import subprocess
 from pathlib import Path
 from typing import Any
 
 import pytest
 
 from camtool.cli.main import main
-from tests.corpus.conftest import CORPUS
-from tests.corpus.test_rs274 import MANIFEST, rs274_problem
+from tests.corpus.test_rs274 import MANIFEST, rs274, rs274_problem
 
 ROOT = Path(__file__).resolve().parents[2]
 PART = str(ROOT / "samples" / "part.dxf")
@@ -107,20 +104,7 @@ def test_linuxcnc_accepts_the_job_program(run: Any, tmp_path: Path) -> None:
     assert code == 0, err
     table = tmp_path / "tool.tbl"
     table.write_text(TOOL_TABLE)
-    assert MANIFEST is not None
-    entry = MANIFEST["rs274"]
-    env = dict(
-        os.environ,
-        LD_LIBRARY_PATH=os.pathsep.join(str(CORPUS / d) for d in entry["ld_library_path"]),
-    )
-    done = subprocess.run(
-        [str(CORPUS / entry["exe"]), "-t", str(table), "-g", str(out)],
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=120,
-        check=False,
-    )
+    done = rs274(out, table)
     assert done.returncode == 0, done.stderr
     # LinuxCNC changes to T2 first, then T1, and feeds each drill hole down to Z-6.5
     changes = re.findall(r"CHANGE_TOOL\((\d+)\)", done.stdout)

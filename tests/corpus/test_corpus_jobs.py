@@ -8,8 +8,6 @@ tool the job names). The drawings are LibreCAD's parts library (``make corpus``)
 
 from __future__ import annotations
 
-import os
-import subprocess
 import tomllib
 from pathlib import Path
 
@@ -21,27 +19,10 @@ from camtool.jobs.job import job_from_dict
 from camtool.jobs.run import run_job
 from camtool.post.registry import load_target
 from tests.corpus.conftest import CORPUS, case_id, corpus_files, load_manifest, skip_reason
-from tests.corpus.test_rs274 import rs274_problem
+from tests.corpus.test_rs274 import rs274, rs274_problem
 
 MANIFEST = load_manifest()
 FILES = [f for f in corpus_files(MANIFEST) if "librecad" in f and f.endswith(".dxf")]
-
-
-def _rs274(program: Path, table: Path) -> subprocess.CompletedProcess[str]:
-    assert MANIFEST is not None
-    entry = MANIFEST["rs274"]
-    env = dict(
-        os.environ,
-        LD_LIBRARY_PATH=os.pathsep.join(str(CORPUS / d) for d in entry["ld_library_path"]),
-    )
-    return subprocess.run(
-        [str(CORPUS / entry["exe"]), "-t", str(table), "-g", str(program)],
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=120,
-        check=False,
-    )
 
 
 @pytest.mark.parametrize("rel", FILES or ["<none>"], ids=case_id)
@@ -60,5 +41,5 @@ def test_job_init_then_post_on_grbl_and_linuxcnc(rel: str, tmp_path: Path) -> No
     program.write_text(str(done.result.code))
     table = tmp_path / "tool.tbl"
     table.write_text("".join(f"T{t.id} P{t.id} D{t.diameter:g} Z0 ;{t.type}\n" for t in job.tools))
-    judged = _rs274(program, table)
+    judged = rs274(program, table)
     assert judged.returncode == 0, judged.stderr[-500:]

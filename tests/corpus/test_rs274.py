@@ -46,15 +46,16 @@ CANON = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED)\(([^)]*)\)")
 ROUND_MM = 0.0005 + 1e-9  # the linuxcnc dialect writes 3 decimals
 
 
-def rs274(program: Path) -> subprocess.CompletedProcess[str]:
-    """Run rs274 in batch mode on PROGRAM (mm tool table from the manifest)."""
+def rs274(program: Path, tool_table: Path | None = None) -> subprocess.CompletedProcess[str]:
+    """Run rs274 in batch mode on PROGRAM (``tool_table``: the manifest's, with one tool)."""
     assert MANIFEST is not None
     entry = MANIFEST["rs274"]
     env = dict(
         os.environ,
         LD_LIBRARY_PATH=os.pathsep.join(str(CORPUS / d) for d in entry["ld_library_path"]),
     )
-    cmd = [str(CORPUS / entry["exe"]), "-t", str(CORPUS / entry["tool_table"]), "-g"]
+    table = tool_table if tool_table is not None else CORPUS / entry["tool_table"]
+    cmd = [str(CORPUS / entry["exe"]), "-t", str(table), "-g"]
     return subprocess.run(
         [*cmd, str(program)], capture_output=True, text=True, env=env, timeout=120, check=False
     )
