@@ -30,8 +30,10 @@ Rules (RS-274/NGC as LinuxCNC documents them, unless said otherwise):
 - Contours: 1-based; a rapid after cutting moves starts the next contour.
 - ``Program.origin`` is (0, 0): the program's own zero. ``Program.lines`` holds
   the 1-based file line of each move.
-- S, M3/M4/M5, T with M6, G4 P (seconds) and G28 are kept as
-  :attr:`Program.commands` (:class:`CommandReader`, below).
+- S, M3/M4/M5, T with M6, G4 P (seconds), M0/M1 and G28 are kept as
+  :attr:`Program.commands` (:class:`CommandReader`, below): a program stop is never
+  dropped, and a ``T`` followed by a stop with no ``M6`` (a manual tool change, as
+  EAGLE's drill programs write ``T02`` then ``M00``) is a stop whose message names it.
 - G28/G30: an intermediate point, if given, becomes a rapid; G28 is then kept
   as a ``Home`` command on the axes it names (all when none), G30 is not kept;
   camtool does not know the stored position (warning), so the axes it moves
@@ -87,6 +89,7 @@ from camtool.model.program import (
     Rapid,
     Spindle,
     SpindleDirection,
+    Stop,
     ToolChange,
 )
 from camtool.model.shapes import Point
@@ -315,6 +318,8 @@ class _Reader:
         used = self._motion(words)
         self._check_unused(words, used)
         stop = words.m.get("stop")
+        if stop is not None and stop.name in ("M0", "M1"):  # last in the order of execution
+            self.commands.stop(len(self.moves), stop.name == "M1")
         return stop is not None and stop.name in ("M2", "M30")
 
     def plain(self, words: list[tuple[str, str]], line: int) -> bool:
@@ -905,6 +910,18 @@ class CommandReader:
         """Warn about a selected tool that no M6 used (call after the last block)."""
         if not self.tool_used:
             self._unused_tool()
+
+    def stop(self, index: int, optional: bool) -> None:
+        """M0 (``optional``: M1) before move ``index``: a :class:`Stop`, never dropped.
+
+        A tool selected (``T``) with no ``M6`` since is changed by hand at this stop (a
+        drill program's ``T02`` then ``M00``): the stop's message names it.
+        """
+        message = ""
+        if not self.tool_used and self.tool is not None:
+            message = f"change to T{self.tool}"
+            self.tool_used = True
+        self.add(index, Stop(optional, message))
 
     def _select(self, value: float, text: str, line: int, where: str) -> None:
         if value < 0 or value != int(value):

@@ -162,14 +162,16 @@ M_CODES = MappingProxyType(
     _m(
         ("M2 M30", "stop", "read", ""),
         ("M3 M4 M5", "spindle", "read", ""),
-        ("M0 M1", "stop", "warn", "{code} program pause dropped: the program carries no stops"),
+        ("M0 M1", "stop", "read", ""),
         ("M6", "tool", "read", ""),
         ("M7 M8 M9", "coolant", "warn", "coolant {code} ignored"),
     )
 )
 """M codes by number, read-only."""
 
-READ_CODES = "G0 G1 G2 G3 G4 G17 G20 G21 G28 G30 G80 G90 G91 G90.1 G91.1 G94 M2 M3 M4 M5 M6 M30"
+READ_CODES = (
+    "G0 G1 G2 G3 G4 G17 G20 G21 G28 G30 G80 G90 G91 G90.1 G91.1 G94 M0 M1 M2 M3 M4 M5 M6 M30"
+)
 """What camtool reads, for messages about unknown codes."""
 
 WORD_LETTERS = frozenset("GMNXYZIJKRFSTPHQ")

@@ -18,7 +18,15 @@ from typing import Any, ClassVar, Generic, TypeVar, get_args
 
 from camtool.model.errors import DialectError, InputError, UsageError
 from camtool.model.machine import Machine
-from camtool.model.program import Command, Move, Program, segment_of
+from camtool.model.program import (
+    Command,
+    DrillCycle,
+    Move,
+    Program,
+    Stop,
+    ToolChange,
+    segment_of,
+)
 from camtool.model.shapes import Point, bbox_union
 from camtool.model.units import fmt_num
 from camtool.toolpath.placement import (
@@ -183,7 +191,28 @@ class WriterState(Generic[B]):
         ]
 
     def drop(self, command: Command) -> None:
-        """Count ``command`` as not written (under its class name, e.g. ``"Dwell"``)."""
+        """Count ``command`` as not written (under its class name, e.g. ``"Dwell"``).
+
+        A drilling cycle is written as the moves that follow it: nothing is lost. A tool
+        change or a program stop is never dropped (a wrong tool or an unattended change
+        ruins the part): the program is refused.
+
+        Raises:
+            DialectError: ``command`` is a tool change or a stop.
+        """
+        if isinstance(command, DrillCycle):
+            return
+        if isinstance(command, ToolChange | Stop):
+            what = (
+                f"a tool change to T{command.tool}"
+                if isinstance(command, ToolChange)
+                else "a program stop" + (f" ({command.message})" if command.message else "")
+            )
+            raise DialectError(
+                f"{self.where()}: this dialect cannot write {what}, and camtool never drops "
+                "one; post one program per tool (a job does so for such a target), or a "
+                "target that changes tools or stops"
+            )
         self.counts[type(command).__name__] += 1
 
     def dropped(self) -> list[tuple[str, int]]:
@@ -238,6 +267,16 @@ class PostProcessor(ABC):
     def z_with_xy(self) -> bool:
         """True when one block may move X, Y and Z together (a ramp or a helix)."""
         return False
+
+    @property
+    def tool_changes(self) -> str:
+        """How the dialect changes tools: ``"code"``, ``"stop"`` or ``"none"``.
+
+        ``code``: a tool change code (LinuxCNC's ``T2 M6``); ``stop``: by hand, a program
+        stop with a comment naming the tool (GRBL 1.1); ``none``: it cannot, and a job of
+        several tools is written as one program per tool (:func:`camtool.jobs.run.per_tool`).
+        """
+        return "none"
 
     @property
     def helix(self) -> bool:

@@ -71,6 +71,7 @@ from camtool.model.program import (
     Program,
     Rapid,
     Spindle,
+    Stop,
     ToolChange,
 )
 from camtool.model.shapes import FULL_CIRCLE_EPS, Arc, Point, make_arc
@@ -112,6 +113,13 @@ class WordAddressPost(PostProcessor):
     def helix(self) -> bool:
         """True when the spec lets an arc carry a Z word (``helix = true``)."""
         return self.spec.helix
+
+    @property
+    def tool_changes(self) -> str:
+        """``code`` with a ``tool_change`` code, ``stop`` with a stop and comments."""
+        if self.spec.tool_change:
+            return "code"
+        return "stop" if self.spec.stop and self.spec.comment else "none"
 
     def emit(self, program: Program, machine: Machine, *, fmt: str | None = None) -> PostResult:
         """Write ``program`` for ``machine`` (rules: the module docstring).
@@ -241,6 +249,7 @@ class BlockWriter(WriterState[str]):
         super().__init__()
         self.spec, self.machine = spec, machine
         self.z: float | None = None
+        self.spindle: Spindle | None = None  # turning, as last written
         self.written: Point = (0.0, 0.0)
         self.last: dict[str, str] = {}
         self.grid_error_mm = 0.0
@@ -789,7 +798,14 @@ class BlockWriter(WriterState[str]):
     # -- commands ----------------------------------------------------------------
 
     def command(self, command: Command) -> None:
-        """Write a spindle, dwell or tool-change command, or count it as dropped."""
+        """Write a spindle, dwell, tool change or stop, or count it as dropped.
+
+        A tool change or a stop is never dropped: a dialect that cannot write it
+        refuses the program (a job of several tools is split per tool before).
+
+        Raises:
+            DialectError: a tool change or stop the dialect cannot write.
+        """
         spec = self.spec
         if isinstance(command, Spindle):
             code = {"cw": spec.spindle_cw, "ccw": spec.spindle_ccw, "off": spec.spindle_off}[
@@ -798,6 +814,7 @@ class BlockWriter(WriterState[str]):
             if code is None:
                 self.drop(command)
                 return
+            self.spindle = None if command.direction == "off" else command
             words = [code]
             if command.direction != "off" and spec.has("S") and command.rpm > 0:
                 words.append("S" + self.text("S", command.rpm))  # rpm 0: speed not given
@@ -810,12 +827,54 @@ class BlockWriter(WriterState[str]):
                 return
             self.block([spec.dwell, "P" + self.text("P", command.seconds)])
         elif isinstance(command, ToolChange):
-            if spec.tool_change is None:
-                self.drop(command)
-                return
-            self.block([spec.tool_change, "T" + self.text("T", float(command.tool))])
+            self._tool_change(command)
+        elif isinstance(command, Stop):
+            self._stop(command.optional, command.message)
         elif isinstance(command, Home):
             self.drop(command)
+
+    def _tool_change(self, change: ToolChange) -> None:
+        """``T2 M6`` (and ``G43 H2``), or by hand: spindle off, a comment, a stop."""
+        spec = self.spec
+        text = self.text("T", float(change.tool)) if spec.has("T") else str(change.tool)
+        if spec.tool_change is not None:
+            self.block(["T" + text, spec.tool_change])
+            if spec.tool_length_offset is not None:
+                self.block([spec.tool_length_offset, "H" + self.text("H", float(change.tool))])
+            self.z = None  # the new tool's length: the next Z is written again
+            self.last.pop("Z", None)
+            return
+        what = f"change to T{change.tool}" + (
+            f": {change.description}" if change.description else ""
+        )
+        if spec.stop is None or spec.comment is None:
+            raise DialectError(
+                f"{self.where()}: {spec.name} cannot change tools ({what}): it has no tool "
+                "change code and no program stop with a comment, and camtool never drops a tool "
+                "change: post one program per tool (a job does so for such a target)"
+            )
+        turning = self.spindle
+        if turning is not None and spec.spindle_off is not None:
+            self.block([spec.spindle_off])
+        self._stop(False, what)
+        if turning is not None:
+            self.command(turning)  # the spindle as it was, for the new tool
+
+    def _stop(self, optional: bool, message: str) -> None:
+        """A program stop (``M0``; ``M1`` when ``optional``), after a comment saying why."""
+        spec = self.spec
+        code = (spec.optional_stop or spec.stop) if optional else spec.stop
+        if code is None:
+            kind = "optional stop (M1)" if optional else "program stop (M0)"
+            reason = f" ({message})" if message else ""
+            raise DialectError(
+                f"{self.where()}: {spec.name} has no {kind}{reason}; a stop is never dropped: "
+                "post the program for a target that stops, or take the stop out of it"
+            )
+        comment = spec.comment_line(message) if message else None
+        if comment is not None:
+            self.blocks.append(comment)
+        self.block([code])
 
     def _summary(self) -> list[str]:
         """One warning per kind of thing dropped or converted."""

@@ -52,6 +52,7 @@ from camtool.model.program import (
     Rapid,
     Spindle,
     SpindleDirection,
+    Stop,
     ToolChange,
 )
 from camtool.model.shapes import Point
@@ -109,6 +110,7 @@ class BlockReader:
         self.static = spec.static_codes()
         self.codes = set(self.motions) | set(self.spindle) | set(spec.end) | self.static
         self.codes |= {c for c in (spec.dwell, spec.tool_change) if c}
+        self.codes |= {c for c in (spec.tool_length_offset, spec.stop, spec.optional_stop) if c}
 
     def fail(self, text: str) -> ParseError:
         """A ParseError naming the source and line."""
@@ -194,6 +196,12 @@ class BlockReader:
         elif key is not None and key == spec.tool_change:
             self._only(codes, values, key, "a tool change", needs="T")
             s.commands.append((len(s.moves), ToolChange(round(values["T"]))))
+        elif key is not None and key == spec.tool_length_offset:
+            self._only(codes, values, key, "a tool length offset", needs="H")
+        elif key is not None and key in (spec.stop, spec.optional_stop):
+            self._only(codes, values, key, "a program stop")
+            optional = key == spec.optional_stop and key != spec.stop
+            s.commands.append((len(s.moves), Stop(optional)))
         elif codes and all(c in static for c in codes):
             if values:
                 raise self.fail(f"{', '.join(values)} in a setup block ({' '.join(codes)})")

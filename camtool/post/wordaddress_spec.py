@@ -27,9 +27,9 @@ from typing import Any
 from camtool.model.errors import InputError
 from camtool.post.numfmt import SIGN_POLICIES, NumberFormat
 
-WORD_LETTERS = "XYZIJFSPT"
+WORD_LETTERS = "XYZIJFSPTH"
 """Value words a dialect may have: axes X Y Z (mm), arc centre I J (mm), feed F
-(mm/min), spindle speed S (rev/min), dwell P (s), tool number T."""
+(mm/min), spindle speed S (rev/min), dwell P (s), tool number T, tool length offset H."""
 
 MOTIONS = ("rapid", "linear", "cw", "ccw")
 """Keys of ``motion_codes``: G0, G1, G2 (clockwise) and G3 (counter-clockwise)."""
@@ -110,7 +110,14 @@ class WordAddressSpec:
         spindle_ccw: code that starts it counter-clockwise.
         spindle_off: code that stops it.
         dwell: dwell code, followed by the P word (seconds).
-        tool_change: tool change code, followed by the T word.
+        tool_change: tool change code; the block is ``T<n> <code>`` (LinuxCNC ``T2 M6``).
+        tool_length_offset: code that applies the new tool's length offset after a
+            change, followed by the H word (LinuxCNC ``G43 H2``); ``None``: none.
+        stop: program stop code (``M0``): the machine waits for the operator. A
+            dialect with a stop and comments but no ``tool_change`` changes tools by
+            hand: a comment naming the tool, then the stop (GRBL 1.1).
+        optional_stop: optional stop code (``M1``); ``None``: an optional stop is
+            written as a stop.
         end: program-end codes; the writer ends with the first, the reader
             accepts any of them.
         comment: how the dialect writes a comment line (:data:`COMMENTS`):
@@ -145,6 +152,9 @@ class WordAddressSpec:
     spindle_off: str | None = None
     dwell: str | None = None
     tool_change: str | None = None
+    tool_length_offset: str | None = None
+    stop: str | None = None
+    optional_stop: str | None = None
     end: tuple[str, ...] = ()
     comment: str | None = None
     header: tuple[str, ...] = ()
@@ -366,7 +376,8 @@ def _codes(t: _Table) -> dict[str, Any]:
         if not code.startswith("G"):
             raise motion.error(m, f"a motion code is a G code, got {_show(code)}")
     out: dict[str, Any] = {"motion_codes": spelled}
-    for key in ("spindle_cw", "spindle_ccw", "spindle_off", "dwell", "tool_change"):
+    keys = ("spindle_cw", "spindle_ccw", "spindle_off", "dwell", "tool_change")
+    for key in (*keys, "tool_length_offset", "stop", "optional_stop"):
         value = t.get(key)
         out[key] = None if value is None else _code(t, key, value)
     out["end"] = tuple(_code(t, "end", v) for v in t.strings("end"))
@@ -461,9 +472,16 @@ def _check(spec: WordAddressSpec, t: _Table) -> None:
         raise t.error("dwell", "a dwell code needs a P word (seconds) in words")
     if spec.tool_change and not spec.has("T"):
         raise t.error("tool_change", "a tool change code needs a T word in words")
+    if spec.tool_length_offset and not (spec.tool_change and spec.has("H")):
+        raise t.error(
+            "tool_length_offset", "a tool length offset needs tool_change and an H word in words"
+        )
+    if spec.optional_stop and not spec.stop:
+        raise t.error("optional_stop", "an optional stop needs a stop code (stop)")
     roles = [*spec.motion_codes, *spec.end]
     roles += [c for c in (spec.spindle_cw, spec.spindle_ccw, spec.spindle_off) if c]
-    roles += [c for c in (spec.dwell, spec.tool_change) if c]
+    roles += [c for c in (spec.dwell, spec.tool_change, spec.tool_length_offset) if c]
+    roles += [c for c in (spec.stop, spec.optional_stop) if c]
     if len(set(roles)) != len(roles):
         twice = sorted({c for c in roles if roles.count(c) > 1})
         raise t.error("", f"code(s) {', '.join(twice)} given two meanings")

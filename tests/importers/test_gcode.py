@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from camtool.importers.gcode import parse_gcode, read_gcode
 from camtool.model.errors import InputError
-from camtool.model.program import ArcMove, Linear, Move, Program, Rapid
+from camtool.model.program import ArcMove, Linear, Move, Program, Rapid, Spindle, Stop
 from camtool.model.shapes import Arc
 from camtool.post.registry import load_target
 
@@ -99,7 +99,7 @@ def test_flashcut_n_words_comments_and_m_codes_are_tolerated() -> None:
     )
     assert [type(m) for m in program.moves] == [Rapid, Linear, Linear]
     assert program.moves[-1] == Linear(2.0, 2.0, 3.0, contour=1)
-    assert any(w.startswith("t.ngc:5: M0 program pause dropped") for w in program.warnings)
+    assert program.commands[1:3] == ((2, Stop()), (2, Spindle("ccw", 0.0)))  # M00: kept
 
 
 def test_flashcut_missing_axis_word_keeps_its_value() -> None:
@@ -306,8 +306,6 @@ def test_g80_alone_is_a_no_op() -> None:
         ("G64 P0.01 Q0.01", "G64 path blending (with its P/Q tolerances, if any) ignored"),
         ("G98", "G98 canned-cycle return mode ignored"),
         ("G97 S1000", "G97 spindle speed mode ignored"),
-        ("M0", "M0 program pause dropped"),
-        ("M1", "M1 program pause dropped"),
         ("M7", "coolant M7 ignored"),
         ("M8", "coolant M8 ignored"),
         ("M9", "coolant M9 ignored"),

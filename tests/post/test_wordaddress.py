@@ -230,7 +230,7 @@ def test_rs274_program_with_every_command() -> None:
         "G21 G90 G17",
         "M3 S12000",
         "G0 Z5.000",  # Z only: the program adds no X0 Y0
-        "M6 T3",
+        "T3 M6",  # LinuxCNC's documentation writes T1 M6 ("M6 Tool Change")
         "G0 X10.000 Y0.000",
         "G4 P0.5",
         "G1 Z-1.000 F120",

@@ -19,9 +19,19 @@ from hypothesis import strategies as st
 from camtool import __version__
 from camtool.importers.gcode import parse_gcode
 from camtool.jobs.pipeline import post_file, verify_job
-from camtool.model.errors import ParseError
+from camtool.model.errors import DialectError, ParseError
 from camtool.model.machine import Machine
-from camtool.model.program import ArcMove, Dwell, Linear, Move, Program, Rapid, ToolChange
+from camtool.model.program import (
+    ArcMove,
+    Dwell,
+    Linear,
+    Move,
+    Program,
+    Rapid,
+    Spindle,
+    Stop,
+    ToolChange,
+)
 from camtool.post.arccheck import arc_error
 from camtool.post.registry import load_target
 from camtool.post.wordaddress import WordAddressPost, word_address_dialect
@@ -101,17 +111,37 @@ def test_dwell_tool_change_and_helix() -> None:
         Linear(10, 10, 200.0, z=0.0),
         ArcMove(10, 10, 15, 10, True, 200.0, z=-1.0),
     )
-    program = Program(moves, commands=((0, ToolChange(2)), (1, Dwell(0.5))))
+    program = Program(moves, commands=((0, ToolChange(2, "drill 3 mm")), (1, Dwell(0.5))))
     linuxcnc = code_of("linuxcnc", program).splitlines()
-    assert linuxcnc[1:6] == [
-        "M6 T2",
+    assert linuxcnc[1:7] == [
+        "T2 M6",  # LinuxCNC "M6 Tool Change": T1 M6, then G43 H1 for its length offset
+        "G43 H2",
         "G0 X10.000 Y10.000 Z5.000",
         "G4 P0.5",
         "G1 Z0.000 F200",
         "G2 X10.000 Y10.000 Z-1.000 I5.000 J0.000",  # a full-circle helix, one block
     ]
-    result = load_target("grbl").emit(program)
-    assert "M6" not in str(result.code) and any("no tool change" in w for w in result.warnings)
+    # GRBL 1.1 has no M6 (gcode.c: error:20): the operator changes the tool at a stop
+    grbl = code_of("grbl", program).splitlines()
+    assert grbl[1:3] == ["(change to T2: drill 3 mm)", "M0"]
+    assert "M6" not in "\n".join(grbl)
+
+
+def test_grbl_stops_the_spindle_for_a_tool_change_and_starts_it_again() -> None:
+    moves = (Rapid(0, 0, z=5.0), Linear(0, 0, 100.0, z=-1.0), Rapid(0, 0, z=5.0))
+    commands = ((0, Spindle("cw", 1000.0)), (2, ToolChange(3)), (3, Spindle("off")))
+    grbl = code_of("grbl", Program(moves, commands=commands)).splitlines()
+    i = grbl.index("M0")
+    assert grbl[i - 2 : i + 2] == ["M5", "(change to T3)", "M0", "M3 S1000"]
+
+
+@pytest.mark.parametrize("target", ["valcnc", "flashcut", "i8751", "matlab-router"])
+def test_a_tool_change_or_stop_a_dialect_cannot_write_is_refused(target: str) -> None:
+    moves = (Linear(1, 0, 60.0), Linear(2, 0, 60.0))
+    for command in (ToolChange(2), Stop(message="change to T2")):
+        program = Program(moves, commands=((1, command),))
+        with pytest.raises(DialectError, match="never drop"):
+            load_target(target).emit(program)
 
 
 @pytest.mark.parametrize("target", TARGETS)

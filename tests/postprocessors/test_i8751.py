@@ -26,7 +26,6 @@ from camtool.model.program import (
     Program,
     Rapid,
     Spindle,
-    ToolChange,
 )
 from camtool.post.registry import load_target
 from camtool.toolpath.options import PlanOptions
@@ -286,7 +285,6 @@ def test_dwells_become_waits_and_commands_are_dropped_with_warnings() -> None:
         commands=(
             (0, Spindle("cw", 1000)),
             (0, Dwell(300)),  # before the first move: 255 + 45 s in two motionless records
-            (1, ToolChange(2)),
             (1, Dwell(1.6)),  # rounded to 2 s, in T2 of move 1
             (1, Dwell(0.2)),  # rounded to 0 s: dropped
             (2, Home("XY")),
@@ -303,7 +301,7 @@ def test_dwells_become_waits_and_commands_are_dropped_with_warnings() -> None:
         "45 54"  # end of packet, end of data
     )
     text = "\n".join(result.warnings)
-    assert "2 spindle command(s)" in text and "1 tool change(s)" in text
+    assert "2 spindle command(s)" in text
     assert "1 home command(s)" in text
     assert "2 dwell(s) rounded to whole seconds" in text and "1 dwell(s) of 0 s" in text
     back = post.parse(result.code)
