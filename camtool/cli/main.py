@@ -41,6 +41,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable
 
     from camtool.cli.progress import StageReporter
+    from camtool.jobs.run import PostJob
     from camtool.model.shapes import Drawing
     from camtool.post.registry import TargetEntry
     from camtool.toolpath.plan import PlanReport
@@ -207,8 +208,11 @@ def post(
             f"{chosen.name} writes binary code: give -o FILE{chosen.post.suffix} or "
             "pipe stdout (or choose a text --format)"
         )
-    write_output(job.result.code, output)
-    if output != "-":
+    if job.pieces:
+        _write_pieces(job, output, [("the input", drawing), ("the --job file", job_file)])
+    else:
+        write_output(job.result.code, output)
+    if output != "-" and not job.pieces:
         click.echo(
             f"camtool: wrote {job.result.blocks} blocks for {chosen.name} to {output}", err=True
         )
@@ -307,6 +311,35 @@ def verify(
         drawing=drawing,
         edge_radius_mm=tool_diameter / 2.0,
         strict=strict,
+    )
+
+
+def _write_pieces(job: PostJob, output: str, inputs: list[tuple[str, Any]]) -> None:
+    """Write a job split per tool: ``-o part.nc`` → ``part.T1.nc``, ``part.T2.nc``...
+
+    Raises:
+        UsageError: the output is stdout (several programs need file names), or a
+            piece's file would overwrite an input.
+    """
+    from camtool.jobs.output import check_outputs
+
+    name = job.target.name
+    if output == "-":
+        raise UsageError(
+            f"{name} cannot change tools, so this job of {len(job.pieces)} tools is "
+            f"{len(job.pieces)} programs, one per tool: give -o FILE{job.target.post.suffix} "
+            "(they are written as FILE.T<n>" + job.target.post.suffix + ")"
+        )
+    paths = [piece.path(output) for piece in job.pieces]
+    check_outputs(inputs, [("-o", p) for p in paths])
+    for piece, path in zip(job.pieces, paths, strict=True):
+        write_output(piece.result.code, path)
+    order = ", then ".join(
+        f"{p} (T{piece.change.tool})" for piece, p in zip(job.pieces, paths, strict=True)
+    )
+    click.echo(
+        f"camtool: {name} cannot change tools: wrote one program per tool, run {order}",
+        err=True,
     )
 
 

@@ -237,6 +237,9 @@ class BatchTask:
         preview_path: where its preview goes (``None``: no preview).
         target: the target it is posted for when the batch has several (``None``:
             the batch's only target).
+        tools: for a job on a target that cannot change tools, the T numbers of its
+            programs, one per tool (``code_path`` then names none of them: each is
+            ``<name>.T<n><ending>``); empty: one program at ``code_path``.
     """
 
     file: str
@@ -244,11 +247,14 @@ class BatchTask:
     report_path: str | None = None
     preview_path: str | None = None
     target: str | None = None
+    tools: tuple[int, ...] = ()
 
     @property
     def outputs(self) -> tuple[str, ...]:
         """Every path this task writes."""
-        paths = (self.code_path, self.report_path, self.preview_path)
+        base = Path(self.code_path)
+        codes = [str(base.with_name(f"{base.stem}.T{t}{base.suffix}")) for t in self.tools]
+        paths = (*(codes or [self.code_path]), self.report_path, self.preview_path)
         return tuple(p for p in paths if p is not None)
 
 
@@ -340,16 +346,19 @@ def plan_batch(inputs: Sequence[str], options: BatchOptions) -> BatchPlan:
         raise UsageError(f"{options.output_dir}: exists and is not a directory (-o OUTDIR)")
     items = expand_inputs(inputs, exclude=options.output_dir)
     tasks = tuple(
-        _task(item, options, suffix, (name, folder) if several else None)
-        for name, (folder, suffix) in layouts.items()
+        _task(item, options, suffix, (name, folder) if several else None, tools)
+        for name, (folder, suffix, tools) in layouts.items()
         for item in items
     )
     _check_outputs(items, tasks, options)
     return BatchPlan(options, tasks)
 
 
-def _layout(name: str, options: BatchOptions, several: bool) -> tuple[str, str]:
-    """The target ``name`` checked with the options: its folder (its own name) and ending.
+def _layout(name: str, options: BatchOptions, several: bool) -> tuple[str, str, tuple[int, ...]]:
+    """The target ``name`` checked with the options: its folder, ending and per-tool programs.
+
+    The last is the T numbers of a job's programs on a target that cannot change tools
+    (one program per tool), empty otherwise.
 
     Raises:
         UsageError: as :func:`plan_batch`; a target whose name cannot be a folder
@@ -366,11 +375,19 @@ def _layout(name: str, options: BatchOptions, several: bool) -> tuple[str, str]:
             f"target {name}: its name {target.name!r} cannot name a folder of -o; "
             "give it a plain name (name = ... in its .toml)"
         )
-    return target.name, target.post.formats[fmt]
+    tools: tuple[int, ...] = ()
+    if options.job is not None and target.post.tool_changes == "none":
+        used = tuple(dict.fromkeys(op.tool for op in options.job.sequenced()))
+        tools = used if len(used) > 1 else ()
+    return target.name, target.post.formats[fmt], tools
 
 
 def _task(
-    item: BatchInput, options: BatchOptions, suffix: str, of: tuple[str, str] | None
+    item: BatchInput,
+    options: BatchOptions,
+    suffix: str,
+    of: tuple[str, str] | None,
+    tools: tuple[int, ...] = (),
 ) -> BatchTask:
     """One file's task: for the batch's only target (``of`` None), or for one of several.
 
@@ -383,6 +400,7 @@ def _task(
         report_path=str(base.with_suffix(".json")) if options.verifying else None,
         preview_path=str(base.with_suffix(f".{options.preview}")) if options.preview else None,
         target=of[0] if of else None,
+        tools=tools,
     )
 
 
@@ -800,6 +818,8 @@ def _outputs(
 ) -> tuple[BatchRow, tuple[tuple[str, str | bytes], ...]]:
     """The row of a posted file and its outputs ``(path, data)``, verified and drawn as asked."""
     files: list[tuple[str, str | bytes]] = [(task.code_path, job.result.code)]
+    if job.pieces:  # a target that cannot change tools: one program per tool
+        files = [(piece.path(task.code_path), piece.result.code) for piece in job.pieces]
     warnings = job.warnings
     error_um: float | None = None
     time_s = job.program.cutting_time_s()

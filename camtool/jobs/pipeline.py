@@ -11,9 +11,9 @@ from camtool.importers import POINT_SUFFIXES, read_drawing, read_drawing_bytes
 from camtool.importers.options import ImportOptions
 from camtool.jobs.header import job_notes
 from camtool.jobs.inputs import is_program_file
-from camtool.jobs.run import OutputOptions, PostJob, run_job
+from camtool.jobs.run import OutputOptions, PostJob, per_tool, run_job
 from camtool.model.errors import InputError, UsageError
-from camtool.model.program import Move, Program
+from camtool.model.program import Move, Program, ToolChange
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import BBox, Drawing
 from camtool.post.base import Target
@@ -318,6 +318,9 @@ def post_program(
     ``output.spindle_dwell_s`` seconds after it starts. ``source`` (the input's file
     name) goes into the job notes (:func:`job_notes`) unless the program has notes.
     Nothing is added to the program's motion: no move to X0 Y0, no clearance move.
+    A program that starts with a tool change and changes tools again is written one
+    program per tool for a target that cannot change tools (``pieces``); a tool change
+    or stop the target cannot write otherwise is refused, never dropped.
     ``progress`` is told the ``writing`` stage (``total``: the program's moves).
 
     Raises:
@@ -338,6 +341,11 @@ def post_program(
         program = dataclasses.replace(program, notes=job_notes(source, target))
     program = _with_spindle(program, output.spindle_rpm, output.spindle_dwell_s)
     progress(Step("writing", 0, len(program.moves), target.name))
+    starts_with_change = any(i == 0 and isinstance(c, ToolChange) for i, c in program.commands)
+    changes = sum(isinstance(c, ToolChange) for _, c in program.commands)
+    if target.post.tool_changes == "none" and changes > 1 and starts_with_change:
+        pieces = per_tool(program, target, output.fmt)  # one program per tool
+        return PostJob(None, program, target, pieces[0].result, None, 0.0, pieces=pieces)
     return PostJob(None, program, target, target.emit(program, fmt=output.fmt), None, 0.0)
 
 
@@ -445,8 +453,11 @@ def verify_job(
     from camtool.verify.verifier import verify_code
 
     several = len(job.operations) > 1
+    code = job.result.code
+    if job.pieces:  # one program per tool: their moves, one after the other
+        code = job.target.emit(_without_changes(job.program)).code
     whole = verify_code(
-        job.result.code,
+        code,
         job.target,
         source=f"<{job.target.name} code>",
         against=None if several else job.placed,
@@ -460,6 +471,12 @@ def verify_job(
         return whole
     parts = tuple(verify_operation(job, run) for run in job.operations)
     return dataclasses.replace(whole, parts=parts)
+
+
+def _without_changes(program: Program) -> Program:
+    """``program`` without its tool changes (the moves of a job written per tool)."""
+    commands = tuple((i, c) for i, c in program.commands if not isinstance(c, ToolChange))
+    return dataclasses.replace(program, commands=commands)
 
 
 def verify_operation(job: PostJob, run: OperationRun) -> Part:
@@ -476,7 +493,11 @@ def verify_operation(job: PostJob, run: OperationRun) -> Part:
     here = (
         program.origin if first == 0 else (program.moves[first - 1].x, program.moves[first - 1].y)
     )
-    commands = tuple((i - first, c) for i, c in program.commands if first <= i < end)
+    commands = tuple(
+        (i - first, c)
+        for i, c in program.commands
+        if first <= i < end and not isinstance(c, ToolChange)
+    )
     alone = Program(program.moves[first:end], here, commands=commands)
     code = job.target.emit(alone).code
     v = verify_code(

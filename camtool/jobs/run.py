@@ -24,6 +24,7 @@ import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from camtool.jobs.job import Job, Operation, Tool
@@ -67,7 +68,14 @@ class PostJob:
             in the program's coordinates.
         edge_radius_mm: how far the cut edge lies from the tool path: half the tool
             diameter for ``outside``/``inside``/``pocket``, 0 for paths on the line.
-        plan: what planning did and found (``None`` for a re-posted program).
+        plan: what planning did and found (``None`` for a re-posted program, and for a
+            job of several operations: each has its own, in ``operations``).
+        operations: what each operation of the job made, in the order they ran (one for
+            ``post``'s options; none for a re-posted program).
+        pieces: for a target that cannot change tools (:attr:`PostProcessor.tool_changes
+            <camtool.post.base.PostProcessor.tool_changes>` ``"none"``), the job as one
+            program per tool, in the order they run; ``result`` is then the first's.
+            Empty otherwise: ``result`` is the whole program.
     """
 
     drawing: Drawing | None
@@ -78,11 +86,35 @@ class PostJob:
     edge_radius_mm: float = 0.0
     plan: PlanReport | None = None
     operations: tuple[OperationRun, ...] = ()
+    pieces: tuple[ToolProgram, ...] = ()
 
     @property
     def warnings(self) -> tuple[str, ...]:
         """Warnings of every stage, in pipeline order, without repeats."""
-        return tuple(dict.fromkeys(self.program.warnings + self.result.warnings))
+        written = [w for p in self.pieces for w in p.result.warnings] or self.result.warnings
+        return tuple(dict.fromkeys((*self.program.warnings, *written)))
+
+
+@dataclass(frozen=True)
+class ToolProgram:
+    """One program of a job written per tool (a machine that cannot change tools).
+
+    Attributes:
+        number: its place in the run, 1-based.
+        change: the tool change it starts with (the tool it cuts with, and what it is).
+        program: its moves and commands (its header says which program of how many).
+        result: its code.
+    """
+
+    number: int
+    change: ToolChange
+    program: Program
+    result: PostResult
+
+    def path(self, output: str | Path) -> str:
+        """Where it is written for ``-o output``: ``part.nc`` → ``part.T2.nc``."""
+        out = Path(output)
+        return str(out.with_name(f"{out.stem}.T{self.change.tool}{out.suffix}"))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -296,7 +328,12 @@ def run_job(
             program, commands=(*program.commands, (len(program.moves), Spindle("off")))
         )
     progress(Step("writing", 0, len(program.moves), target.name))
-    result = target.emit(program, fmt=output.fmt)
+    pieces: tuple[ToolProgram, ...] = ()
+    if target.post.tool_changes == "none" and len({r.tool.id for r in runs}) > 1:
+        pieces = per_tool(program, target, output.fmt)
+        result = pieces[0].result
+    else:
+        result = target.emit(program, fmt=output.fmt)
     only = runs[0]
     report = only.report if len(runs) == 1 else None
     if report is not None:
@@ -310,7 +347,52 @@ def run_job(
         only.edge_radius_mm if len(runs) == 1 else 0.0,
         report,
         operations=tuple(runs),
+        pieces=pieces,
     )
+
+
+def per_tool(program: Program, target: Target, fmt: str | None) -> tuple[ToolProgram, ...]:
+    """``program`` cut at its tool changes into one program per tool, each written.
+
+    Each piece holds the moves from its tool change to the next and the commands among
+    them in program order (the spindle stop before a change ends the piece before it;
+    the change itself is the piece's start); its header is the job's, then which program
+    of how many it is and what to load.
+
+    Raises:
+        DialectError: a piece the target cannot write.
+    """
+    changes = [(i, c) for i, c in program.commands if isinstance(c, ToolChange)]
+    bounds = [i for i, _ in changes] + [len(program.moves)]
+    commands: list[list[tuple[int, Command]]] = [[] for _ in changes]
+    piece = 0
+    for i, command in program.commands:
+        if isinstance(command, ToolChange):
+            piece = next(k for k, (_, c) in enumerate(changes) if c is command)
+            continue
+        commands[piece].append((i - bounds[piece], command))
+    out: list[ToolProgram] = []
+    here = program.origin
+    for k, (first, change) in enumerate(changes):
+        moves = program.moves[first : bounds[k + 1]]
+        what = f" {change.description}" if change.description else ""
+        after = "" if k == 0 else f", after the T{changes[k - 1][1].tool} program"
+        notes = (
+            *program.notes,
+            f"program {k + 1} of {len(changes)}: load T{change.tool}{what}{after}",
+        )
+        alone = Program(
+            moves,
+            here,
+            program.warnings,
+            commands=tuple(commands[k]),
+            notes=notes,
+            tolerance_mm=program.tolerance_mm,
+        )
+        out.append(ToolProgram(k + 1, change, alone, target.emit(alone, fmt=fmt)))
+        if moves:
+            here = (moves[-1].x, moves[-1].y)
+    return tuple(out)
 
 
 def _edge(op: Operation, tool: Tool, options: PlanOptions) -> float:

@@ -1,0 +1,94 @@
+"""Tool changes and stops reach the machine in its own way, or the program is refused.
+
+Expected behaviour from the controllers' documents: LinuxCNC changes tools with ``T2 M6``
+and applies the length offset with ``G43 H2`` ("M6 Tool Change", "G43"); GRBL 1.1 has no
+M6 (gcode.c answers error:20) and pauses at ``M0``; the thesis machines without a changer
+or a stop get one program per tool.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from camtool.cli.main import main
+from camtool.importers import read_drawing
+from camtool.importers.gcode import read_gcode
+from camtool.jobs.job import load_job
+from camtool.jobs.pipeline import post_program
+from camtool.jobs.run import run_job
+from camtool.model.errors import DialectError
+from camtool.model.program import Linear, Stop
+from camtool.post.registry import load_target
+
+ROOT = Path(__file__).resolve().parents[2]
+EAGLE = ROOT / "tests" / "data" / "eagle-drill.nc"
+PART = ROOT / "samples" / "part.dxf"
+JOB = ROOT / "samples" / "part.toml"
+
+
+def test_a_drill_programs_manual_tool_changes_are_read_as_stops() -> None:
+    program = read_gcode(EAGLE)
+    stops = [(i, c) for i, c in program.commands if isinstance(c, Stop)]
+    # T01 / M00 before the first hole, T02 / M00 before the third
+    assert [c.message for _, c in stops] == ["change to T1", "change to T2"]
+    assert stops[1][0] == 7  # before the eighth move, the rapid to the third hole
+    assert (program.moves[7].x, program.moves[7].y) == (30.0, 15.0)
+
+
+@pytest.mark.parametrize("target", ["grbl", "linuxcnc"])
+def test_re_posted_stops_are_kept_before_the_holes_they_precede(target: str) -> None:
+    code = str(post_program(read_gcode(EAGLE), load_target(target)).result.code)
+    lines = code.splitlines()
+    stops = [i for i, line in enumerate(lines) if line == "M0"]
+    assert len(stops) == 2
+    assert lines[stops[0] - 1] == "(change to T1)" and lines[stops[1] - 1] == "(change to T2)"
+    # the 0.9 mm holes come after the second stop, never before it
+    assert lines.index("G0 X30.000 Y15.000") > stops[1]
+
+
+@pytest.mark.parametrize("target", ["valcnc", "flashcut", "i8751"])
+def test_a_target_without_a_stop_refuses_a_program_with_stops(target: str) -> None:
+    with pytest.raises(DialectError, match="never drop"):
+        post_program(read_gcode(EAGLE), load_target(target))
+
+
+def test_a_job_for_a_machine_without_a_changer_is_one_program_per_tool() -> None:
+    done = run_job(read_drawing(PART), load_target("valcnc"), load_job(JOB))
+    assert [p.change.tool for p in done.pieces] == [2, 1]
+    assert done.pieces[0].path("out/part.ngc") == "out/part.T2.ngc"
+    assert done.pieces[1].program.notes[-1] == (
+        "program 2 of 2: load T1 end-mill 3 mm, after the T2 program"
+    )
+    # together the pieces are the job's moves, in order
+    moves = [m for p in done.pieces for m in p.program.moves]
+    assert moves == list(done.program.moves)
+    # the second program starts where the first left the tool, and first rises to clearance
+    first = done.pieces[1].program.moves[0]
+    assert first.z == 10.0 and (first.x, first.y) == done.pieces[1].program.origin
+    cuts = [m for m in done.pieces[0].program.moves if isinstance(m, Linear)]
+    assert min(m.z for m in cuts if m.z is not None) == -6.5  # drilling only
+
+
+def test_post_writes_each_tools_program_and_refuses_stdout(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "part.ngc"
+    assert main(["post", str(PART), "-t", "valcnc", "--job", str(JOB), "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["part.T1.ngc", "part.T2.ngc"]
+    assert "run " + str(tmp_path / "part.T2.ngc") + " (T2), then" in err
+    assert main(["post", str(PART), "-t", "valcnc", "--job", str(JOB)]) == 2
+    assert "give -o FILE.ngc" in capsys.readouterr().err
+
+
+def test_batch_names_each_tools_program_and_refuses_to_overwrite_them(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    args = ["batch", str(PART), "-t", "valcnc", "-o", str(tmp_path), "--job", str(JOB)]
+    assert main([*args, "--jobs", "1"]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["part.T1.ngc", "part.T2.ngc"]
+    capsys.readouterr()
+    assert main([*args, "--jobs", "1"]) == 2
+    assert "part.T1.ngc" in capsys.readouterr().err
