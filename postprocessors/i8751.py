@@ -73,6 +73,7 @@ from camtool.post.base import (
     WriterState,
     check_placement,
     check_work_area,
+    check_written_z,
     from_options,
 )
 from camtool.post.numfmt import NumberFormat
@@ -257,7 +258,11 @@ class _Writer(WriterState[Record]):
         records, then X/Y), so it never travels at the cutting depth it leaves.
         """
         target = [self.steps(x, 0), self.steps(y, 1)]
-        target.append(self.pos[2] if z is None else self.steps(z, 2))
+        if z is None:
+            target.append(self.pos[2])
+        else:
+            target.append(self.steps(z, 2))
+            check_written_z(z, target[2] / self.spm[2], self.where())
         dx, dy, dz = (t - p for t, p in zip(target, self.pos, strict=True))
         xy = split_xy(dx, dy)
         zs = split_count(dz)
@@ -364,6 +369,11 @@ class I8751Post(PostProcessor):
         bound = copy.copy(self)
         bound.machine = machine
         return bound
+
+    def written_z(self, z: float, machine: Machine) -> float | None:
+        """``z`` as whole motor steps of Z (half away from zero), in mm."""
+        spm = machine.steps_per_mm[2]
+        return _round_steps(z, spm) / spm
 
     # -- writing ---------------------------------------------------------------
 

@@ -607,8 +607,12 @@ def _plan(values: Mapping[str, object], source: str, where: str) -> PlanOptions:
     try:
         return PlanOptions(**values)  # type: ignore[arg-type]
     except UsageError as exc:
-        message = _FLAG.sub(lambda m: _key_of(m.group(1)), str(exc))
-        raise InputError(f"{source}: {where}: {message}") from None
+        raise InputError(f"{source}: {where}: {as_keys(str(exc))}") from None
+
+
+def as_keys(message: str) -> str:
+    """``message`` with ``post``'s flags named as job file keys (``step_down``)."""
+    return _FLAG.sub(lambda m: _key_of(m.group(1)), message)
 
 
 def _key_of(flag_name: str) -> str:

@@ -27,7 +27,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from camtool.jobs.job import Job, Operation, Tool
+from camtool.jobs.heights import check_heights
+from camtool.jobs.job import Job, Operation, Tool, as_keys
 from camtool.jobs.selection import (
     Selected,
     construction_notes,
@@ -165,6 +166,7 @@ def plan_options(target: Target, plan: PlanOptions | None = None) -> PlanOptions
             f"--ramp: {target.name} moves Z in a block of its own, so it cannot descend "
             "along the path; leave --ramp out (the tool plunges straight down)"
         )
+    check_heights(target, plan)
     return plan
 
 
@@ -274,7 +276,12 @@ def run_job(
                 )
             raise InputError(f"{job.source or 'the job'}: {nothing_selected(scaled, op, where)}")
         last = number == len(sequence)
-        options = _operation_options(target, op, setup, here, last)
+        try:
+            options = _operation_options(target, op, setup, here, last)
+        except UsageError as exc:
+            if job.shorthand:
+                raise
+            raise InputError(f"{job.source or 'the job'}: {where}: {as_keys(str(exc))}") from None
         if not job.shorthand and tool.id != loaded:
             commands.extend(_tool_change(len(moves), tool, loaded, output, target))
             loaded = tool.id

@@ -71,6 +71,31 @@ def check_work_area(
         )
 
 
+def check_written_z(requested: float, written: float, where: str) -> None:
+    """Refuse a height above the stock that the dialect's rounding writes at its top.
+
+    A move the program puts above the top (Z > 0: a rapid, a retract) written at or
+    below Z0 would travel at the surface. A depth rounded to Z0 is refused earlier,
+    by the option that asked for it (:func:`camtool.jobs.heights.check_heights`); a
+    re-posted program's own depths are written as the dialect rounds them.
+
+    Args:
+        requested: the Z the program asks for, mm.
+        written: the Z the code says, read back, mm.
+        where: the block, for the message.
+
+    Raises:
+        DialectError: ``requested`` above 1 µm written at or below 0.
+    """
+    if requested < 1e-6 or written > 0:
+        return
+    raise DialectError(
+        f"{where}: Z{requested:g} mm above the stock is written as Z{written:g}, at its "
+        "top: moves there would run at the surface; raise the height to the dialect's "
+        "resolution or more"
+    )
+
+
 def check_placement(program: Program, machine: Machine) -> tuple[str, ...]:
     """The work-coordinate rule for a program about to be written (or verified).
 
@@ -267,6 +292,16 @@ class PostProcessor(ABC):
     def z_with_xy(self) -> bool:
         """True when one block may move X, Y and Z together (a ramp or a helix)."""
         return False
+
+    def written_z(self, z: float, machine: Machine) -> float | None:
+        """The Z (mm) the code says for a requested ``z``, as the controller reads it back.
+
+        Rounding to the dialect's resolution (decimals, a step grid, motor steps) can
+        turn a shallow depth into the top of the stock or a low safe height into the
+        surface: :func:`camtool.jobs.run.check_heights` refuses such options by it.
+        ``None``: the dialect writes no Z.
+        """
+        return None
 
     @property
     def tool_changes(self) -> str:

@@ -82,6 +82,7 @@ from camtool.post.base import (
     WriterState,
     check_placement,
     check_work_area,
+    check_written_z,
 )
 from camtool.post.wordaddress_read import BlockReader, ControllerRefusal
 from camtool.post.wordaddress_spec import WordAddressSpec, load_spec
@@ -113,6 +114,13 @@ class WordAddressPost(PostProcessor):
     def helix(self) -> bool:
         """True when the spec lets an arc carry a Z word (``helix = true``)."""
         return self.spec.helix
+
+    def written_z(self, z: float, machine: Machine) -> float | None:
+        """``z`` as the Z word prints it, read back (``None``: no Z word)."""
+        word = self.spec.word("Z")
+        if word is None:
+            return None
+        return word.number.parse(word.number.format(z))
 
     @property
     def tool_changes(self) -> str:
@@ -353,6 +361,12 @@ class BlockWriter(WriterState[str]):
 
     # -- numbers -----------------------------------------------------------------
 
+    def _z_text(self, z: float) -> str:
+        """``z`` in the Z word's format, checked not to cross the top of the stock."""
+        text = self.text("Z", z)
+        check_written_z(z, self.spec.words["Z"].number.parse(text), self.where())
+        return text
+
     def text(self, letter: str, value: float) -> str:
         """``value`` written in word ``letter``'s format (without the letter).
 
@@ -506,7 +520,7 @@ class BlockWriter(WriterState[str]):
             self._word("Y", ty, words, force=force)
             self.written = (px, py)
         if z is not None:
-            self._word("Z", self.text("Z", z), words, force=xy is None)
+            self._word("Z", self._z_text(z), words, force=xy is None)
         if isinstance(move, Linear):
             self._feed(move, words)
         self.block(words)
@@ -789,7 +803,7 @@ class BlockWriter(WriterState[str]):
         words += ["X" + tx, "Y" + ty]  # _word(..., force=True)
         last["X"], last["Y"] = tx, ty
         if z is not None:
-            self._word("Z", self.text("Z", z), words)
+            self._word("Z", self._z_text(z), words)
         words += ["I" + ti, "J" + tj]
         self.written = written
         self._feed(move, words)

@@ -423,7 +423,8 @@ def _programs(draw: st.DrawFn) -> tuple[Program, list[tuple[int, int, int]]]:
         if z == here[2]:
             z = None
         xmm, ymm = (x + draw(_sub)) / SPM, (y + draw(_sub)) / SPM
-        zmm = None if z is None else (z + draw(_sub)) / SPM
+        # a height above the stock that rounds to its top (Z0) is refused, not written
+        zmm = None if z is None else (z + (draw(_sub) if z else 0.0)) / SPM
         kind = draw(st.sampled_from(["rapid", "line"]))
         moves.append(Rapid(xmm, ymm, zmm) if kind == "rapid" else Linear(xmm, ymm, 60.0, zmm))
         if kind == "rapid" and z is not None and z > here[2] and (x, y) != tuple(here[:2]):
