@@ -220,6 +220,10 @@ _MOVES = (Rapid, Linear, ArcMove)
 """The kinds of move (a tuple: ``isinstance`` takes it faster than ``Rapid | Linear | ...``)."""
 _CONFORMED_KEPT = 20_000
 """Arcs whose blocks a writer keeps (:meth:`BlockWriter._conformed`); then it starts anew."""
+ARC_CHORD_TOLERANCE_MM = 0.002
+"""Chord deviation, mm, of an arc no printable centre can write (GRBL's default ``$12``)."""
+_CHORD: Point = (math.nan, math.nan)
+"""The centre of a conformed block that is a chord of such an arc (by identity)."""
 
 
 class _Conformed(dict[tuple[Any, ...], list[tuple[Point, Point | None]]]):
@@ -702,13 +706,16 @@ class BlockWriter(WriterState[str]):
         """:meth:`_conformed` without its memory of the arcs already conformed."""
         try:
             out = self.checked(self.written, piece.end, piece.centre, piece.clockwise, piece.start)
-        except DialectError as exc:
+        except DialectError:
             quantum = self.spec.quantum_mm()
             if piece.radius <= 10 * quantum:
                 return [(piece.end, None)]
             equalised = self._conform_equalised(piece, quantum)
             if equalised is None:
-                raise DialectError(f"{self.where()}: {exc}") from exc
+                # no printable centre passes the controller's check: chords, as the
+                # controller itself would cut the arc (GRBL's $12 arc tolerance)
+                tolerance = max(2.0 * quantum, ARC_CHORD_TOLERANCE_MM)
+                return [(point, _CHORD) for point in piece.points(tolerance)[1:]]
             out = equalised
         if not out:
             self.counts["tiny-arc"] += 1  # rounds away to nothing within a quantum
@@ -725,8 +732,8 @@ class BlockWriter(WriterState[str]):
         move. Only when the radii differ by no more than the controller's own absolute
         tolerance (GRBL 0.005 mm, LinuxCNC 0.028 mm: :func:`~camtool.post.arccheck.
         max_difference` at radius 0), numbers it would itself take as one arc; ``None``
-        otherwise, or when that does not help (the ends meet, the check still fails). Only
-        arcs refused before take this path: every other arc is written as before.
+        otherwise, or when that does not help (the ends meet, the check still fails): the
+        arc is then written as chords. Only arcs the check refused take this path.
         """
         from camtool.post.arccheck import max_difference
 
@@ -735,7 +742,7 @@ class BlockWriter(WriterState[str]):
         chord = math.hypot(dx, dy)
         r0, r1 = math.hypot(sx - cx, sy - cy), math.hypot(ex - cx, ey - cy)
         if chord == 0.0 or r0 == r1 or abs(r1 - r0) > max_difference(self.spec.arc_check, 0.0):
-            return None  # beyond the controller's own absolute tolerance: refused as before
+            return None  # beyond the controller's own absolute tolerance: written as chords
         nx, ny = -dy / chord, dx / chord
         mx, my = (sx + ex) / 2.0, (sy + ey) / 2.0
         along = (cx - mx) * nx + (cy - my) * ny
@@ -781,6 +788,10 @@ class BlockWriter(WriterState[str]):
         before = self.written
         ox, oy = (0.0, 0.0) if self._absolute_centre else before
         ti = tj = ""
+        if centre is _CHORD:
+            self.counts["arc-chords"] += 1
+            self._line(Linear(*end, move.feed_mm_min, contour=move.contour), end, z)
+            return
         tiny = centre is None or (written == before and not full)
         if centre is not None:
             ci, cj = centre[0] - ox, centre[1] - oy
@@ -908,6 +919,9 @@ class BlockWriter(WriterState[str]):
             "z-split": f"{d['z-split']} move(s) changing XY and Z together written as a Z block "
             f"and an XY block (Z first when rising, last when plunging): {name} puts Z moves in "
             "blocks of their own",
+            "arc-chords": f"arcs that no printable centre lets {name}'s arc check accept at "
+            f"{self.spec.quantum_mm():g} mm written as {d['arc-chords']} straight chord(s) "
+            f"within {max(2.0 * self.spec.quantum_mm(), ARC_CHORD_TOLERANCE_MM):g} mm of them",
             "tiny-arc": f"{d['tiny-arc']} arc(s) too small for the "
             f"{self.spec.quantum_mm():g} mm the dialect writes were written as straight lines "
             "(or left out when both ends print the same)",

@@ -5,13 +5,15 @@ its start can leave its circle: LinuxCNC's ``qtplasmac/images/conv_slot_l.svg`` 
 arc starting 7.80178 mm and ending 7.80521 mm from its centre, which the arc check
 refused even split eleven times ("write more decimals"): the job could not be posted.
 Within the controller's own absolute tolerance the writer now moves the centre onto the
-perpendicular bisector of the ends and says so; larger differences are still refused.
+perpendicular bisector of the ends and says so; larger differences are written as chords
+within GRBL's own arc tolerance (``$12``, 0.002 mm), as the controller would cut them.
 Expected values come from the geometry (GRBL's and LinuxCNC's radius rules, the
 bisector), not from camtool's output.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 import subprocess
@@ -20,7 +22,6 @@ from pathlib import Path
 
 import pytest
 
-from camtool.model.errors import DialectError
 from camtool.model.program import ArcMove, Program, Rapid
 from camtool.post.registry import load_target
 from tests.corpus.conftest import CORPUS, FETCH_HINT, load_manifest
@@ -81,8 +82,8 @@ def test_a_consistent_arc_takes_no_new_path() -> None:
     assert not [w for w in result.warnings if "from its centre" in w]
 
 
-def test_radii_further_apart_than_the_controller_takes_are_still_refused() -> None:
-    """Over 7.5 µm apart: beyond GRBL's absolute 5 µm, so the old refusal stands."""
+def test_radii_further_apart_than_the_controller_takes_are_written_as_chords() -> None:
+    """Over 7.5 µm apart: beyond GRBL's absolute 5 µm: no arc block can pass, chords do."""
     # move the centre 8 µm along the chord, towards the start
     ux, uy = (END[0] - START[0]), (END[1] - START[1])
     n = math.hypot(ux, uy)
@@ -91,8 +92,21 @@ def test_radii_further_apart_than_the_controller_takes_are_still_refused() -> No
     along = (CENTRE[0] - mx) * nx + (CENTRE[1] - my) * ny
     centre = (mx + along * nx - 0.008 * ux / n, my + along * ny - 0.008 * uy / n)
     assert abs(math.dist(START, centre) - math.dist(END, centre)) > 0.0075
-    with pytest.raises(DialectError, match="cannot be written for grbl"):
-        load_target("grbl").emit(_program(centre))
+    result = load_target("grbl").emit(_program(centre))
+    assert not _arc_words(result.code)
+    points = [
+        (float(x), float(y))
+        for x, y in re.findall(r"^G1 X(-?[\d.]+) Y(-?[\d.]+)", result.code, re.MULTILINE)
+    ]
+    assert points[-1] == (round(END[0], 3), round(END[1], 3))
+    r0, r1 = math.dist(START, centre), math.dist(END, centre)
+    # each chord end on the arc, to 3 decimals; each chord within 2 µm of the arc
+    for p in points:
+        assert min(r0, r1) - 0.0008 <= math.dist(p, centre) <= max(r0, r1) + 0.0008
+    for a, b in itertools.pairwise(points):
+        middle = ((a[0] + b[0]) / 2, (a[1] + b[1]) / 2)
+        assert math.dist(middle, centre) >= min(r0, r1) - 0.002 - 0.0008
+    assert any("written as" in w and "chord(s) within 0.002 mm" in w for w in result.warnings)
 
 
 @pytest.mark.parametrize("name", ["grbl", "linuxcnc"])
