@@ -231,6 +231,7 @@ def post(
             plan=job.plan,
             strict=strict,
             said=job.warnings,
+            job=job,
         )
 
 
@@ -380,11 +381,13 @@ def _finish_verification(
     plan: PlanReport | None = None,
     strict: bool = False,
     said: tuple[str, ...] = (),
+    job: PostJob | None = None,
 ) -> None:
     """Summary to stderr, then the report and preview files, then the limit check.
 
     The report gets a ``plan`` key (what planning found) when the code was planned here;
-    warnings in ``said`` (already printed by ``post``) are not printed again.
+    warnings in ``said`` (already printed by ``post``) are not printed again; ``job``: the
+    post that made ``v``, whose operations the preview colours.
     The limit judges what was cut as drawn; ``strict`` adds the features the planner
     reported it cannot cut with this tool. A drawing that was given but not compared
     (it does not overlap the program) fails the limit: it cannot pass unjudged.
@@ -400,8 +403,15 @@ def _finish_verification(
     if preview is not None:
         from camtool.preview import render_preview
 
+        runs = job.operations if job is not None and len(job.operations) > 1 else ()
         picture = render_preview(
-            preview, verification=v, drawing=drawing, edge_radius_mm=edge_radius_mm
+            preview,
+            verification=v,
+            drawing=drawing,
+            edge_radius_mm=edge_radius_mm,
+            # a job's operations in colours: drawn from its plan, where they are numbered
+            program=job.program if job is not None and runs else None,
+            sections=[(r.label, *r.moves) for r in runs] or None,
         )
         write_output(picture, preview)
     problem = None if max_error_um is None else v.over_limit(max_error_um, strict=strict)

@@ -892,6 +892,7 @@ def preview_bytes(job: PostJob, v: Verification | None, path: str, title: str) -
         target=job.target,
         edge_radius_mm=job.edge_radius_mm,
         title=title,
+        sections=[(run.label, *run.moves) for run in job.operations] or None,
     )
 
 

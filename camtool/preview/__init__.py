@@ -24,6 +24,7 @@ Layers with nothing to draw are left out.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -77,6 +78,7 @@ def render_preview(
     title: str | None = None,
     work_area: BBox | None = None,
     width_px: int = WIDTH_PX,
+    sections: Sequence[tuple[str, int, int]] | None = None,
 ) -> bytes:
     """Draw a preview and return the file's bytes (the caller writes them, atomically).
 
@@ -91,6 +93,9 @@ def render_preview(
         title: a first title line (e.g. the input's name); the facts follow.
         work_area: ``(xmin, ymin, xmax, ymax)`` mm, instead of the target's.
         width_px: picture width in pixels (the height keeps the page's aspect).
+        sections: ``(label, first move, end move)`` parts of ``program`` cut in colours
+            of their own (a job's operations); ``None``: one per tool where the
+            program changes tools. Tool changes are marked either way.
 
     Returns:
         SVG text encoded as UTF-8, or PNG bytes. Same input, same SVG bytes.
@@ -123,6 +128,7 @@ def render_preview(
         edge_radius_mm=edge_radius_mm,
         title=title,
         width_px=width_px,
+        sections=_sections(program, sections),
     )
     scene = compose(content)
     if suffix == ".svg":
@@ -137,6 +143,18 @@ def render_preview(
     from camtool.preview.raster import scene_png
 
     return scene_png(scene)
+
+
+def _sections(
+    program: Program | None, sections: Sequence[tuple[str, int, int]] | None
+) -> tuple[tuple[str, int, int], ...]:
+    """The sections drawn in colours: given, or the program's tools; none for one."""
+    from camtool.preview.program_layers import sections_of
+
+    if program is None:
+        return ()
+    chosen = tuple(sections) if sections is not None else sections_of(program)
+    return chosen if len(chosen) > 1 else ()
 
 
 def program_svg(program: Program, *, work_area: BBox | None = None, title: str = "") -> str:

@@ -70,6 +70,7 @@ class Content:
     edge_radius_mm: float
     title: str | None
     width_px: int
+    sections: tuple[pl.Section, ...] = ()
 
 
 def part_box(c: Content) -> BBox:
@@ -150,7 +151,9 @@ def _main_layers(c: Content, u: float, frame: BBox) -> list[Layer]:
         layers.append(pl.drawing_layer(c.drawing, u))
     program = []
     if c.program is not None:
-        program = pl.program_layers(c.program, u, edge_radius_mm=c.edge_radius_mm)
+        program = pl.program_layers(
+            c.program, u, edge_radius_mm=c.edge_radius_mm, sections=c.sections
+        )
     layers.extend(layer for layer in program if layer.id == "tool-width")
     v = c.verification
     if v is not None:
@@ -296,6 +299,10 @@ def _entries(c: Content, u: float) -> list[tuple[Glyph, str]]:
         style = Style(fill=pl.TOOL_COLOUR, opacity=pl.TOOL_OPACITY)
         return (Rect((x, y - 1.2 * u, x + 4.5 * u, y + 1.2 * u), style),)
 
+    def change(x: float, y: float) -> tuple[Shape, ...]:
+        box = (x + 1.0 * u, y - 1.2 * u, x + 3.4 * u, y + 1.2 * u)
+        return (Rect(box, Style(pl.CHANGE_COLOUR, 0.4 * u)),)
+
     def marker(x: float, y: float) -> tuple[Shape, ...]:
         return tl.not_cut_marker((x + 2.2 * u, y), u)
 
@@ -310,7 +317,10 @@ def _entries(c: Content, u: float) -> list[tuple[Glyph, str]]:
 
     out: list[tuple[Glyph, str]] = []
     p = c.program
-    if p is not None and any(not isinstance(m, Rapid) for m in p.moves):
+    if c.sections:
+        for number, (label, _, _) in enumerate(c.sections):
+            out.append((stroke(Style(pl.section_colour(number), 0.5 * u)), label))
+    elif p is not None and any(not isinstance(m, Rapid) for m in p.moves):
         out.append((stroke(Style(pl.CUT_COLOUR, 0.5 * u)), "cut"))
     if p is not None and any(isinstance(m, Rapid) for m in p.moves):
         out.append((stroke(Style(pl.RAPID_COLOUR, 0.4 * u, dash=(1.2 * u, 0.9 * u))), "rapid"))
@@ -325,6 +335,8 @@ def _entries(c: Content, u: float) -> list[tuple[Glyph, str]]:
             "work area" if view_box(c)[1] else f"work area {size_text(c.work_area)}, partly shown"
         )
         out.append((stroke(Style(pl.AREA_COLOUR, 0.4 * u, dash=(1.5 * u, u))), label))
+    if p is not None and pl.change_marks(p, u):
+        out.append((change, "tool change"))
     if p is not None and pl.tab_segments(p):
         out.append((stroke(Style(pl.TAB_COLOUR, 1.0 * u)), "tab"))
     if c.verification is not None:

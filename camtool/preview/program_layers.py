@@ -2,16 +2,21 @@
 
 Colours of the thesis GUI (seed-000 S000-24): cutting moves blue, rapids dashed
 yellow. Each contour's start is a red dot with an arrow along the direction of
-travel and its number in cutting order. Sizes are given in ``u``, 1/100 of the
-main view's larger side, so the picture reads the same for a 5 mm logo and a
-300 mm plate.
+travel and its number in cutting order (one number per contour, however many
+depth passes and tab crossings cut it). A job's operations (or a program's tool
+changes) each get a colour of :data:`SECTION_COLOURS`, and each tool change a
+black square where it happens. Sizes are given in ``u``, 1/100 of the main
+view's larger side, so the picture reads the same for a 5 mm logo and a 300 mm
+plate.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from dataclasses import dataclass
 
-from camtool.model.program import Program, Rapid
+from camtool.model.program import Program, Rapid, ToolChange
 from camtool.model.shapes import Arc, BBox, Drawing, Line, Point, Segment
 from camtool.preview.scene import (
     Circle,
@@ -45,43 +50,111 @@ ZERO_COLOUR = "#000000"
 """The work zero's cross."""
 Z_EPS = 1e-6
 """Z difference, mm, below which two heights are the same."""
+SECTION_COLOURS = ("#1f4fd1", "#d62728", "#9467bd", "#e07b00", "#17becf", "#8c564b", "#e377c2")
+"""Cutting moves of a job's operations in turn (the first is :data:`CUT_COLOUR`)."""
+CHANGE_COLOUR = "#000000"
+"""Tool change marks."""
+
+Section = tuple[str, int, int]
+"""A part of a program drawn in its own colour: ``(label, first move, end move)``."""
 
 
-def cut_runs(program: Program) -> list[list[Segment]]:
-    """The cutting moves as runs, in cutting order: a run ends at a rapid or a new contour.
+@dataclass(frozen=True)
+class Run:
+    """Cutting moves in a row: ``segments``, from ``program.moves[first]``, of ``contour``."""
 
-    Returns:
-        One list of segments per run (the numbers on the picture are 1-based
-        positions in this list).
+    first: int
+    contour: int
+    segments: list[Segment]
+
+
+def runs_of(program: Program, breaks: Sequence[int] = ()) -> list[Run]:
+    """The cutting moves as runs, in cutting order.
+
+    A run ends at a rapid, a new contour or a move index in ``breaks`` (where a
+    section of the picture starts).
     """
-    runs: list[list[Segment]] = []
+    runs: list[Run] = []
     contour, open_run = None, False
-    for move, seg in program.segments():
+    cuts = set(breaks)
+    for index, (move, seg) in enumerate(program.segments()):
         if isinstance(move, Rapid):
             open_run = False
             continue
-        if not open_run or (move.contour and move.contour != contour):
-            runs.append([])
+        if not open_run or (move.contour and move.contour != contour) or index in cuts:
+            runs.append(Run(index, move.contour, []))
             open_run = True
         contour = move.contour
-        runs[-1].append(seg)
+        runs[-1].segments.append(seg)
     return runs
 
 
-def program_layers(program: Program, u: float, *, edge_radius_mm: float = 0.0) -> list[Layer]:
-    """Tool width, rapids, cuts, starts and order of ``program`` (empty layers left out).
+def cut_runs(program: Program) -> list[list[Segment]]:
+    """The segments of each run of :func:`runs_of`."""
+    return [run.segments for run in runs_of(program)]
 
-    Every run gets a start marker and its number up to :data:`MAX_LABELS` runs; past
-    that only the runs whose number is kept do (every k-th, :func:`kept_indices`), so a
-    job of thousands of contours is not buried under its markers.
+
+def numbered(runs: Sequence[Run]) -> list[int]:
+    """Indices of the runs that carry an order number: the first run of each contour.
+
+    The depth passes, tab crossings and pocket levels of a contour are one number;
+    moves of no contour (a re-read program without comments) number each run.
+    """
+    seen: set[int] = set()
+    out = []
+    for i, run in enumerate(runs):
+        if run.contour and run.contour in seen:
+            continue
+        seen.add(run.contour)
+        out.append(i)
+    return out
+
+
+def sections_of(program: Program) -> tuple[Section, ...]:
+    """The program cut at its tool changes: one section per tool (none without changes)."""
+    changes = [(i, c) for i, c in program.commands if isinstance(c, ToolChange)]
+    if not changes:
+        return ()
+    ends = [i for i, _ in changes[1:]] + [len(program.moves)]
+    sections = [
+        (" ".join(f"T{c.tool} {c.description}".split()), i, end)
+        for (i, c), end in zip(changes, ends, strict=True)
+    ]
+    if changes[0][0] > 0:
+        sections.insert(0, ("before the first tool change", 0, changes[0][0]))
+    return tuple(s for s in sections if s[2] > s[1])
+
+
+def section_colour(number: int) -> str:
+    """The colour of section ``number`` (0-based), repeating after :data:`SECTION_COLOURS`."""
+    return SECTION_COLOURS[number % len(SECTION_COLOURS)]
+
+
+def program_layers(
+    program: Program,
+    u: float,
+    *,
+    edge_radius_mm: float = 0.0,
+    sections: Sequence[Section] = (),
+) -> list[Layer]:
+    """Tool width, rapids, cuts, starts, order and tool changes of ``program``.
+
+    Every contour gets a start marker and its number up to :data:`MAX_LABELS`
+    contours; past that only those whose number is kept do (every k-th,
+    :func:`kept_indices`), so a job of thousands of contours is not buried under
+    its markers. Empty layers are left out.
 
     Args:
         program: the moves, mm.
         u: the picture's size unit, mm (1/100 of the view).
         edge_radius_mm: tool radius of an offset cut; > 0 draws the swept tool.
+        sections: parts of the program cut in their own colour (a job's operations);
+            empty: every cut in :data:`CUT_COLOUR`.
     """
-    runs = cut_runs(program)
-    shown = kept_indices(len(runs))  # a start marker where a number is: on a big job, 1 in k
+    all_runs = runs_of(program, [first for _, first, _ in sections])
+    runs = [run.segments for run in all_runs]
+    first = numbered(all_runs)
+    shown = [first[i] for i in kept_indices(len(first))]
     rapids = tuple((seg,) for move, seg in program.segments() if isinstance(move, Rapid))
     layers = [
         Layer("tool-width", tool_width(runs, edge_radius_mm, u)),
@@ -91,15 +164,44 @@ def program_layers(program: Program, u: float, *, edge_radius_mm: float = 0.0) -
             if rapids
             else (),
         ),
-        Layer(
-            "cuts",
-            (Path(tuple(tuple(r) for r in runs), Style(CUT_COLOUR, 0.35 * u)),) if runs else (),
-        ),
+        Layer("cuts", _cut_paths(all_runs, sections, u)),
         Layer("tabs", tab_shapes(tab_segments(program), u)),
         Layer("starts", tuple(s for i in shown for s in _start_marker(runs[i], u))),
-        Layer("order", tuple(place_labels([_number(i + 1, runs[i], u) for i in shown]))),
+        Layer(
+            "order",
+            tuple(place_labels([_number(first.index(i) + 1, runs[i], u) for i in shown])),
+        ),
+        Layer("tool-changes", change_marks(program, u)),
     ]
     return [layer for layer in layers if layer.shapes]
+
+
+def _cut_paths(runs: list[Run], sections: Sequence[Section], u: float) -> tuple[Path, ...]:
+    """The cuts, one path per section in its colour (one blue path without sections)."""
+    if not sections:
+        chains = tuple(tuple(r.segments) for r in runs)
+        return (Path(chains, Style(CUT_COLOUR, 0.35 * u)),) if chains else ()
+    paths = []
+    for number, (_, start, end) in enumerate(sections):
+        chains = tuple(tuple(r.segments) for r in runs if start <= r.first < end)
+        if chains:
+            paths.append(Path(chains, Style(section_colour(number), 0.35 * u)))
+    return tuple(paths)
+
+
+def change_marks(program: Program, u: float) -> tuple[Rect | Text, ...]:
+    """A black square and ``T2`` where each tool change happens (none at the start)."""
+    where = {}
+    ends = [seg.end for _, seg in program.segments()]
+    for index, command in program.commands:
+        if isinstance(command, ToolChange) and 0 < index <= len(ends):
+            where[ends[index - 1]] = f"T{command.tool}"
+    shapes: list[Rect | Text] = []
+    size = 1.4 * u
+    for (x, y), label in where.items():
+        shapes.append(Rect((x - size, y - size, x + size, y + size), Style(CHANGE_COLOUR, 0.4 * u)))
+        shapes.append(Text((x + 2.2 * u, y + 1.6 * u), label, 3.0 * u, CHANGE_COLOUR, bold=True))
+    return tuple(shapes)
 
 
 def tab_segments(program: Program) -> list[Segment]:
