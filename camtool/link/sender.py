@@ -600,6 +600,10 @@ class _Driver:
                 self._send(k)
             else:
                 self._read(now)
+        if s.failure:  # the last answer was an error: the loop ended with nothing in flight
+            self._fail()
+        if s.done != len(self.plan.blocks):  # pragma: no cover - a job ends only when all are done
+            raise LinkError(f"{self.spec.target}: the job ended {self._where()}")
 
     def _send(self, k: int) -> None:
         s = self.stream

@@ -154,3 +154,21 @@ def test_valcnc_through_simulate_device(tmp_path: Path, capsys: Any) -> None:
     assert code == 0, f"send: {err}\nsimulator: {sim_err}"
     assert "one limit switch per axis" in err
     assert f"received 10 blocks ({len(VALCNC)} bytes), ran 10" in sim_err, sim_err
+
+
+@pytest.mark.parametrize("refused", [41, 42])
+def test_a_refused_block_is_exit_1_even_the_last(
+    refused: int, tmp_path: Path, simulate: Any, capsys: Any
+) -> None:
+    # the logo posted for grbl has 42 lines, the last `M2`; GRBL answers a line it refuses
+    # with error:N (interface.md), so the job fails whichever line that is
+    logo = tmp_path / "logo.gcode"
+    assert main(["post", "samples/logo.dxf", "-t", "grbl", "-o", str(logo)]) == 0
+    lines = logo.read_text().splitlines()
+    assert len(lines) == 42 and lines[-1] == "M2"
+    capsys.readouterr()
+    sim = simulate("grbl", fail_at_block=refused, error="20")
+    code, _, err = run(["send", str(logo), "-t", "grbl", "--port", sim.path], capsys)
+    assert code == 1, err
+    assert f"refused block {refused} (line {refused}: {lines[refused - 1]!r})" in err
+    assert "sent 42 blocks" not in err

@@ -138,3 +138,14 @@ def test_a_controller_in_alarm_gets_nothing(simulate: Any) -> None:
     with pytest.raises(LinkError, match="alarm state"):
         run(sim.path, PROGRAM)
     assert len(sim.device.received) == before
+
+
+def test_an_error_on_the_last_block_fails_the_job(simulate: Any) -> None:
+    # GRBL answers every line `ok` or `error:N` (interface.md); the job is done only when the
+    # last line's answer has come: an `error:20` there is a failed job, not "sent N blocks"
+    last = PROGRAM.count("\n")
+    sim = simulate("grbl", fail_at_block=last, error="20")
+    with pytest.raises(LinkError) as info:
+        run(sim.path, PROGRAM)
+    assert f"refused block {last} (line {last}: 'M2')" in str(info.value)
+    assert "error:20 (Unsupported command" in str(info.value)
