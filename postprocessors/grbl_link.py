@@ -42,11 +42,19 @@ refused and the line to resume at (the one after the last line sent).
 from __future__ import annotations
 
 import re
-from collections.abc import Sequence
+from collections import deque
+from collections.abc import Callable, Sequence
+from dataclasses import replace
+from typing import TYPE_CHECKING
 
 from camtool.link.device import ANSWER_END, LineDevice
-from camtool.link.spec import LinkHooks, LinkSpec, WireBlock
+from camtool.link.spec import LinkHooks, LinkSpec, Status, WireBlock
 from camtool.model.errors import ParseError, UsageError
+from camtool.model.program import ArcMove
+
+if TYPE_CHECKING:
+    from camtool.model.program import Program
+    from camtool.post.base import Target
 
 ERRORS: dict[int, tuple[str, str]] = {
     1: (
@@ -302,6 +310,123 @@ def status_state(line: str) -> str | None:
     return match.group(1) if match else None
 
 
+_BF = re.compile(r"\|Bf:(\d+),(\d+)")
+
+
+def status(line: str) -> Status | None:
+    """A status report read: its state and, when reported, the ``Bf:`` free counts.
+
+    ``Bf:15,128`` is 15 free planner blocks and 128 free bytes of the RX ring
+    buffer (report.c: ``plan_get_block_buffer_available``,
+    ``serial_get_rx_buffer_available``, which says 128 for an empty buffer);
+    GRBL 1.1 sends it when bit 1 (value 2) of ``$10`` is set (interface.md,
+    "Buffer State").
+    """
+    state = status_state(line)
+    if state is None:
+        return None
+    match = _BF.search(line)
+    if match is None:
+        return Status(state)
+    return Status(state, int(match.group(1)), int(match.group(2)))
+
+
+BUFFER_STATE = 2
+"""``$10`` bit that adds ``Bf:`` to status reports (GRBL 1.1 settings.md, interface.md)."""
+
+
+def setup(ask: Callable[[str], list[str]]) -> list[str]:
+    """Turn on ``Bf:`` in status reports for the job; return the line that puts ``$10`` back.
+
+    ``Bf:`` (planner blocks free) is what tells which lines GRBL has run: its
+    ``ok`` means only that a line was queued. ``$$`` lists the settings; when
+    ``$10`` lacks bit 1 it is set for the job (``$10=`` old value ``| 2``) and
+    the old value is written back at the end. A controller whose ``$$`` has no
+    ``$10`` is left as it is (then only sync lines and ``Idle`` say what ran).
+    """
+    mask = None
+    for line in ask("$$"):
+        if line.startswith("$10="):
+            try:
+                mask = int(float(line[4:].split()[0]))
+            except (ValueError, IndexError):
+                return []
+    if mask is None or mask & BUFFER_STATE:
+        return []
+    ask(f"$10={mask | BUFFER_STATE}")
+    return [f"$10={mask}"]
+
+
+_SYNC_FLOW = ("M0", "M2", "M30")
+"""Program flow: gcode.c runs protocol_buffer_synchronize() before a pause or an end."""
+
+
+def expect(blocks: list[WireBlock], program: Program, target: Target) -> list[WireBlock]:
+    """Each block with the fewest planner blocks it queues and whether GRBL syncs on it.
+
+    ``queued``: one per move of the line that makes at least one step on some
+    axis (planner.c drops a move of no steps); an arc at least one (mc_arc
+    cuts it into more; one is the lower bound). The first move counts none (where
+    the machine stands before it is not known). ``sync``: GRBL answers the line
+    only after the planner has emptied (gcode.c, protocol_buffer_synchronize):
+    ``G4`` (mc_dwell), ``M0``/``M2``/``M30`` (program flow), and a spindle or
+    coolant change (spindle_sync, coolant_sync, also an ``S`` change while the
+    spindle runs) once the program itself has set that state (before that,
+    GRBL's state is not known).
+    """
+    spm = target.machine.steps_per_mm
+    queued: dict[int, int] = {}
+    z: float | None = None
+    for index, (move, segment) in enumerate(program.segments()):
+        line = program.line_of(index)
+        if line is None:
+            return blocks
+        dx, dy = abs(segment.end[0] - segment.start[0]), abs(segment.end[1] - segment.start[1])
+        dz = abs(move.z - z) if move.z is not None and z is not None else 0.0
+        z = move.z if move.z is not None else z
+        steps = max(dx * spm[0], dy * spm[1], dz * spm[2])
+        if isinstance(move, ArcMove):
+            steps = max(steps, segment.length * min(spm[0], spm[1]))
+        if index and steps >= 1.0:
+            queued[line] = queued.get(line, 0) + 1
+    modal = _SyncState()
+    return [
+        replace(block, queued=queued.get(block.line, 0), sync=modal.syncs(block.text))
+        for block in blocks
+    ]
+
+
+class _SyncState:
+    """Spindle and coolant as the program sets them (``None``: not known yet)."""
+
+    def __init__(self) -> None:
+        self.spindle: str | None = None
+        self.speed: str | None = None
+        self.coolant: frozenset[str] | None = None
+
+    def syncs(self, text: str) -> bool:
+        found = words(text)
+        codes = [f"{letter}{number}" for letter, number in found if letter in "GM"]
+        speed = next((number for letter, number in found if letter == "S"), None)
+        sync = "G4" in codes or any(code in _SYNC_FLOW for code in codes)
+        spindle = next((code for code in codes if code in _SPINDLE), None)
+        if spindle is not None:
+            sync = sync or (self.spindle is not None and spindle != self.spindle)
+            self.spindle = spindle
+        elif speed is not None and self.spindle in ("M3", "M4") and self.speed is not None:
+            sync = sync or float(speed) != float(self.speed)
+        if speed is not None:
+            self.speed = speed
+        coolant = [code for code in codes if code in _COOLANT]
+        if coolant:
+            new = frozenset() if "M9" in coolant else (self.coolant or frozenset()) | set(coolant)
+            sync = sync or (self.coolant is not None and new != self.coolant)
+            self.coolant = new
+        if any(code in ("M2", "M30") for code in codes):
+            self.spindle, self.coolant = "M5", frozenset()
+        return sync
+
+
 # -- resume -------------------------------------------------------------------------------
 
 _WORD = re.compile(r"([A-Z])([-+]?(?:\d+\.?\d*|\.\d+))")
@@ -421,24 +546,45 @@ def resume_blocks(before: Sequence[WireBlock], first: WireBlock, spec: LinkSpec)
 # -- the simulator --------------------------------------------------------------------------
 
 
+PLANNER_BLOCKS = 15
+"""Planner blocks GRBL 1.1h holds: BLOCK_BUFFER_SIZE 16 less one (planner.h; ``$I`` says
+``[OPT:V,15,128]``)."""
+_SYNCS = ("G4", *_SYNC_FLOW, *_SPINDLE, *_COOLANT)
+
+
 class GrblDevice(LineDevice):
-    """A simulated GRBL 1.1h: banner, RX buffer, ``ok``/``error:N``, status, hold, reset, alarms.
+    """A simulated GRBL 1.1h: banner, RX buffer, planner, ``ok``/``error:N``, status, hold, reset.
 
     Real-time bytes (``?`` ``!`` ``~`` Ctrl-X) are picked out of the stream the
     moment they arrive and never enter the RX buffer (interface.md). Other bytes
     go into a buffer of :data:`RX_BUFFER_BYTES`; :attr:`max_rx` is the most it
     ever held and :attr:`overflowed` is set if a host sent more (a real GRBL
-    would lose bytes). :meth:`step` takes one line out of it and answers
-    ``ok`` (``error:N`` for ``fail_at_block``; ``ALARM:N`` and the alarm state
-    for ``alarm_at_block``; ``error:9`` for any line while in alarm). The
-    position in status reports is where the lines that ran leave the tool,
-    read back with camtool's reader of the target.
+    would lose bytes). Each :meth:`step` parses the lines that fit the planner
+    (:data:`PLANNER_BLOCKS`; one block per line with axis words) and answers
+    them ``ok`` at once, as GRBL does (``ok`` means queued); a line GRBL syncs
+    on (``G4``, M codes) waits until the planner is empty. Then it runs the
+    oldest planner block (unless held): :attr:`executed` holds the lines run
+    to their end. ``error:N`` for ``fail_at_block``; ``ALARM:N`` and the alarm
+    state for ``alarm_at_block``; ``error:9`` for any line while in alarm.
+    Status reports say ``Run`` while the planner holds blocks, and carry
+    ``Bf:`` when ``$10`` has bit 1 (``$$`` and ``$10=`` are answered). A feed
+    hold stops running (``Hold:0``), ``~`` resumes; a reset empties the buffers,
+    and raises ``ALARM:3`` only if it came while moving. The position in status
+    reports is where the lines that ran leave the tool, read back with
+    camtool's reader of the target.
+
+    Faults a test can ask for: ``merge_at_block`` loses that line's line end
+    (GRBL takes it and the next as one line: one ``ok`` fewer);
+    ``mute_at_block`` answers no line from that one on (status reports go on);
+    ``deaf_at_block`` answers nothing at all from then on; ``ack_word`` answers
+    lines with another word (``"OK"``); ``run_forever`` reports ``Run`` forever.
 
     Args:
         spec: the grbl link.
         alarm_at_block: 1-based block that raises ``ALARM:<alarm>``.
         alarm: the alarm code (default 1, hard limit).
-        **options: as :class:`camtool.link.device.Device`.
+        status_mask: ``$10`` (GRBL's default 1: no ``Bf:``).
+        **options: as :class:`camtool.link.device.Device`, and the faults above.
     """
 
     def __init__(
@@ -447,16 +593,33 @@ class GrblDevice(LineDevice):
         *,
         alarm_at_block: int | None = None,
         alarm: int = 1,
+        status_mask: int = 1,
+        merge_at_block: int | None = None,
+        mute_at_block: int | None = None,
+        deaf_at_block: int | None = None,
+        ack_word: str = "ok",
+        run_forever: bool = False,
         **options: object,
     ) -> None:
         super().__init__(spec, **options)
         self.alarm_at_block = alarm_at_block
         self.alarm = alarm
+        self.status_mask = status_mask
+        self.merge_at_block = merge_at_block
+        self.mute_at_block = mute_at_block
+        self.deaf_at_block = deaf_at_block
+        self.ack_word = ack_word
+        self.run_forever = run_forever
         self.state = "Idle"
         self.held = False
         self.max_rx = 0
         self.overflowed = False
         self.wco_sent = False
+        self.planner: deque[bytes] = deque()
+        self.line_ends = 0
+        self.deaf = False
+        self.holds = 0
+        self.resets = 0
 
     def connect(self) -> bytes:
         """GRBL prints its banner when the port opens (an Arduino resets on DTR)."""
@@ -477,21 +640,28 @@ class GrblDevice(LineDevice):
             if char == b"?":
                 out += self.status_report()
             elif char == b"!":
-                self.held = self.held or bool(self.rx)
+                self.held = self.held or self.state != "Alarm"
+                self.holds += 1
             elif char == b"~":
                 self.held = False
             elif char == b"\x18":
                 out += self._reset()
             else:
+                if char == b"\n":
+                    self.line_ends += 1
+                    if self.line_ends == self.merge_at_block:
+                        continue  # lost on the wire
                 self.rx += char
                 self.max_rx = max(self.max_rx, len(self.rx))
                 self.overflowed = self.overflowed or len(self.rx) > RX_BUFFER_BYTES
-        return out
+        return b"" if self.deaf else out
 
     def _reset(self) -> bytes:
-        moving = self.spec.block_end in self.rx
+        moving = bool(self.planner) and not self.held
         self.rx.clear()
+        self.planner.clear()
         self.held = False
+        self.resets += 1
         out = b""
         if moving:
             self.state = "Alarm"
@@ -499,43 +669,105 @@ class GrblDevice(LineDevice):
         return out + self._banner()
 
     def pending(self) -> bool:
-        """A whole line waits, and no feed hold."""
-        return not self.held and super().pending()
+        """A line to parse, or a planner block to run."""
+        return self._parsable() or (bool(self.planner) and not self.held)
+
+    def _parsable(self) -> bool:
+        cut = self.rx.find(self.spec.block_end)
+        if not self.startup_seen or cut < 0:
+            return False
+        if len(self.planner) >= PLANNER_BLOCKS:
+            return False
+        codes = {f"{a}{n}" for a, n in words(self.rx[:cut].decode("latin-1")) if a in "GM"}
+        return not (codes & set(_SYNCS) and self.planner)
 
     def step(self) -> bytes:
-        """Run one line: ``ok``, ``error:N`` or ``ALARM:N``."""
-        block = self.take_block()
-        if block is None:
-            return b""
+        """Parse the lines that fit (``ok`` at once), then run one planner block."""
+        out = b""
+        while self._parsable():
+            block = self.take_block()
+            assert block is not None
+            out += self._parse(block)
+        if self.planner and not self.held:
+            self.executed.append(self.planner.popleft())
+        return b"" if self.deaf else out
+
+    def _parse(self, block: bytes) -> bytes:
         text = block.strip()
         if text == b"$X":
             self.state = "Idle"
-            return b"[MSG:Caution: Unlocked]" + ANSWER_END + b"ok" + ANSWER_END
+            return b"[MSG:Caution: Unlocked]" + ANSWER_END + self._ack()
+        if text.startswith(b"$"):
+            return self._setting(text.decode("latin-1"))
         if self.state == "Alarm":
             return b"error:9" + ANSWER_END
-        if len(self.blocks) + 1 == self.alarm_at_block:
+        number = len(self.blocks) + 1
+        if number == self.deaf_at_block:
+            self.deaf = True
+        if number == self.alarm_at_block:
             self.received += block
             self.blocks.append(block)
             self.state = "Alarm"
             self.rx.clear()
+            self.planner.clear()
             return f"ALARM:{self.alarm}".encode() + ANSWER_END
-        return self.run_block(block)
+        answer = self.run_block(block)
+        if self.executed and self.executed[-1] is block:  # accepted: queue it, not yet run
+            self.executed.pop()
+            if any(a in "XYZ" for a, _ in words(block.decode("latin-1"))):
+                self.planner.append(block)
+            else:
+                self.executed.append(block)
+        muted = self.mute_at_block is not None and number >= self.mute_at_block
+        return b"" if muted else answer
+
+    def run_block(self, block: bytes) -> bytes:
+        """Record ``block`` and answer it (``ack_word`` for an accepted line)."""
+        answer = super().run_block(block)
+        if answer == self.spec.ack.encode() + ANSWER_END:
+            return self._ack()
+        return answer
+
+    def _ack(self) -> bytes:
+        return self.ack_word.encode() + ANSWER_END
+
+    def _setting(self, text: str) -> bytes:
+        """``$$`` lists ``$10`` and ``$12``; ``$10=N`` sets the status mask; other ``$``: ``ok``."""
+        if text == "$$":
+            listed = f"$10={self.status_mask}\r\n$12=0.002\r\n".encode()
+            return listed + self._ack()
+        if text.startswith("$10="):
+            self.status_mask = int(text[4:])
+        return self._ack()
 
     def status_report(self) -> bytes:
-        """``<State|MPos:x,y,z|FS:0,0>`` (``|WCO:0.000,0.000,0.000`` in the first)."""
+        """``<State|MPos:x,y,z|Bf:p,r|FS:0,0>`` (``|WCO:0.000,0.000,0.000`` in the first)."""
         state = "Alarm" if self.state == "Alarm" else ("Hold:0" if self.held else "Idle")
-        if state == "Idle" and self.pending():
+        if state == "Idle" and (self.planner or self._parsable() or self.run_forever):
             state = "Run"
         try:
             x, y, z = self.position() if self.executed and self.target else (0.0, 0.0, 0.0)
         except (ParseError, ValueError):
             x = y = z = 0.0
-        report = f"<{state}|MPos:{x:.3f},{y:.3f},{z:.3f}|FS:0,0"
+        report = f"<{state}|MPos:{x:.3f},{y:.3f},{z:.3f}"
+        if self.status_mask & BUFFER_STATE:
+            report += (
+                f"|Bf:{PLANNER_BLOCKS - len(self.planner)},{RX_BUFFER_BYTES + 1 - len(self.rx)}"
+            )
+        report += "|FS:0,0"
         if not self.wco_sent:
             report += "|WCO:0.000,0.000,0.000"
             self.wco_sent = True
         return (report + ">").encode() + ANSWER_END
 
 
-LINK = LinkHooks(decode=decode, resume=resume_blocks, device=GrblDevice, status_state=status_state)
+LINK = LinkHooks(
+    decode=decode,
+    resume=resume_blocks,
+    device=GrblDevice,
+    status_state=status_state,
+    status=status,
+    setup=setup,
+    expect=expect,
+)
 """GRBL's link hooks (``camtool send -t grbl``, ``camtool simulate-device -t grbl``)."""

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 
 from camtool.link.spec import LinkHooks, LinkSpec, WireBlock, frame_lines, link_hooks, link_spec
 from camtool.model.errors import DialectError, InputError, UsageError, VerifyLimitError
-from camtool.model.program import Dwell, Program
+from camtool.model.program import ArcMove, Dwell, Program
 from camtool.model.units import fmt_num
 
 if TYPE_CHECKING:
@@ -77,6 +77,29 @@ class SendPlan:
         """Estimated time of the blocks after the first ``done`` of :attr:`blocks`, s."""
         rest = self.blocks[done:]
         return sum(self.block_time_s[done:]) + sum(self.wire_time_s(b) for b in rest)
+
+    def start_of(self, line: int) -> tuple[tuple[float, float, float] | None, bool]:
+        """Where the tool stands before source ``line`` runs, and whether that line holds an arc.
+
+        The position (X, Y, Z in mm, the program's coordinates) is where the
+        last move of an earlier line ends (``None``: no move before it, or the
+        program was not read with line numbers); Z is the last Z set before it
+        (0 when none was).
+        """
+        program = self.program
+        end: tuple[float, float, float] | None = None
+        z = 0.0
+        arc = False
+        for index, move in enumerate(program.moves):
+            at = program.line_of(index)
+            if at is None:
+                return None, False
+            if at >= line:
+                arc = at == line and isinstance(move, ArcMove)
+                break
+            z = z if move.z is None else move.z
+            end = (move.x, move.y, z)
+        return end, arc
 
     def describe(self) -> list[str]:
         """The protocol plan, one line per item: what ``--dry-run`` prints on stdout."""

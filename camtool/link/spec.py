@@ -101,6 +101,13 @@ class WireBlock:
             say (a dwell); the next block waits them.
         note: how messages show the block when its bytes are not text (a
             binary packet); ``""``: the bytes.
+        queued: fewest entries the block puts in the controller's motion
+            queue once accepted (GRBL: planner blocks, one per move that makes
+            a step; an arc at least one); a lower bound, so that counting the
+            queue back from the newest block never calls a block run too early.
+        sync: the controller answers the block only after every block before
+            it has run (GRBL: ``G4``, ``M3``/``M4``/``M5``, coolant, ``M0``,
+            ``M2``: protocol_buffer_synchronize); its answer says they ran.
     """
 
     index: int
@@ -111,6 +118,8 @@ class WireBlock:
     events: int = 0
     busy_s: float = 0.0
     note: str = ""
+    queued: int = 0
+    sync: bool = False
 
     @property
     def text(self) -> str:
@@ -162,6 +171,23 @@ class LinkSpec:
 
 
 @dataclass(frozen=True)
+class Status:
+    """What a controller's status report says (GRBL ``<Run|MPos:…|Bf:14,120|…>``).
+
+    Attributes:
+        state: the state word (``"Idle"``, ``"Run"``, ``"Hold:0"``, ``"Alarm"``).
+        queue_free: free entries of the motion queue (GRBL ``Bf:`` first
+            number, planner blocks); ``None``: not reported.
+        rx_free: free bytes of the receive buffer (``Bf:`` second number);
+            ``None``: not reported.
+    """
+
+    state: str
+    queue_free: int | None = None
+    rx_free: int | None = None
+
+
+@dataclass(frozen=True)
 class LinkHooks:
     """The Python a target's protocol needs beyond its ``[link]`` table (``LINK``).
 
@@ -188,10 +214,21 @@ class LinkHooks:
         feedback: ``answer -> bool``: True for a feedback event (counted
             against :attr:`WireBlock.events`, never an answer).
         expect: ``(blocks, program, target) -> blocks``: the blocks with what
-            the controller will report for each (``events``, ``busy_s``), from
-            the program as the target's reader read it back. Raises
-            :class:`~camtool.model.errors.DialectError` for a block whose end
-            the sender could not tell.
+            the controller will report for each (``events``, ``busy_s``,
+            ``queued``, ``sync``), from the program as the target's reader read
+            it back. Raises :class:`~camtool.model.errors.DialectError` for a
+            block whose end the sender could not tell.
+        status: ``line -> Status or None``: reads a status report with its
+            queue counts (GRBL ``Bf:``); takes precedence over ``status_state``.
+        setup: ``ask -> lines``: settings the job needs, asked of the controller
+            before the first block with ``ask(line) -> answers`` (it raises
+            :class:`LinkError` for an error answer); returns the lines that put
+            the controller's settings back at the end (GRBL: ``$10`` with its
+            buffer-state bit, so status reports carry ``Bf:``).
+        check: ``(blocks, source) -> None``: refuse what the controller would
+            refuse, before the first byte: raises
+            :class:`~camtool.model.errors.DialectError` naming the line (GRBL:
+            words and codes its gcode.c does not take).
     """
 
     frame: Callable[[bytes, LinkSpec, str], list[WireBlock]] | None = None
@@ -202,6 +239,9 @@ class LinkHooks:
     split: Callable[[bytearray], list[str]] | None = None
     feedback: Callable[[str], bool] | None = None
     expect: Callable[[list[WireBlock], Any, Any], list[WireBlock]] | None = None
+    status: Callable[[str], Status | None] | None = None
+    setup: Callable[[Callable[[str], list[str]]], list[str]] | None = None
+    check: Callable[[Sequence[WireBlock], str], None] | None = None
 
 
 NO_HOOKS = LinkHooks()
