@@ -172,3 +172,38 @@ def test_a_refused_block_is_exit_1_even_the_last(
     assert code == 1, err
     assert f"refused block {refused} (line {refused}: {lines[refused - 1]!r})" in err
     assert "sent 42 blocks" not in err
+
+
+SIMULATE = [sys.executable, "-m", "camtool", "simulate-device"]
+
+
+def test_sigterm_stops_the_job_as_the_operator_would(job: Path) -> None:
+    # SIGTERM (a service manager, `kill`) is the operator's stop: feed hold, reset, and the
+    # line to resume at, exit 1 — never a silent end
+    sim = subprocess.Popen(
+        [*SIMULATE, "-t", "grbl", "--pty", "--block-delay-ms", "200"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=_sigint_default,
+    )
+    try:
+        assert sim.stdout is not None
+        path = sim.stdout.readline().strip()
+        send = subprocess.Popen(
+            [sys.executable, "-m", "camtool", "send", str(job), "-t", "grbl", "--port", path],
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        assert send.stderr is not None
+        started = send.stderr.readline()  # "camtool: sending N blocks ...": the job runs
+        assert "sending" in started, started
+        send.send_signal(signal.SIGTERM)
+        _, err = send.communicate(timeout=120)
+    finally:
+        sim.send_signal(2)
+        sim.communicate(timeout=60)
+    assert send.returncode == 1, err
+    assert "stopped by the operator" in err
+    assert "feed hold, then a reset (spindle and coolant off" in err
+    assert "--from-line" in err and "Traceback" not in err
