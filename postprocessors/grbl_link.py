@@ -49,7 +49,7 @@ from typing import TYPE_CHECKING
 
 from camtool.link.device import ANSWER_END, LineDevice
 from camtool.link.spec import LinkHooks, LinkSpec, Status, WireBlock
-from camtool.model.errors import ParseError, UsageError
+from camtool.model.errors import InputError, ParseError, UsageError
 from camtool.model.program import ArcMove
 
 if TYPE_CHECKING:
@@ -427,6 +427,156 @@ class _SyncState:
         return sync
 
 
+# -- what GRBL 1.1h refuses (gnea/grbl grbl/gcode.c gc_execute_line step 1, protocol.c) ----
+
+G_CODES = frozenset(
+    (
+        *("0", "1", "2", "3", "4", "10", "17", "18", "19", "20", "21", "28", "28.1", "30"),
+        *("30.1", "38.2", "38.3", "38.4", "38.5", "40", "43.1", "49", "53", "54", "55", "56"),
+        *("57", "58", "59", "61", "80", "90", "91", "91.1", "92", "92.1", "93", "94"),
+    )
+)
+"""G codes gcode.c takes (its ``switch (int_value)`` for ``'G'``; G38.x needs probing, G43.1
+dynamic tool length); any other is ``error:20``, a fraction where none is taken ``error:23``
+(``error:20`` for the codes whose fraction gcode.c reads itself: G28 G30 G38 G43 G61 G90 G91
+G92)."""
+_FRACTIONS_READ = frozenset(("28", "30", "38", "43", "61", "90", "91", "92"))
+M_CODES = frozenset(("0", "1", "2", "30", "3", "4", "5", "8", "9"))
+"""M codes of the default build: no ``M6`` (no tool change), no ``M7`` (``ENABLE_M7`` is off
+in config.h), no ``M56`` (``ENABLE_PARKING_OVERRIDE_CONTROL`` off): ``error:20``."""
+LETTERS = frozenset("FIJKLNPRSTXYZ")
+"""Value words gcode.c takes; any other letter (A B C D E H O Q U V W) is ``error:20``."""
+NOT_NEGATIVE = frozenset("FNPST")
+"""Words whose value may not be negative: ``error:4``."""
+MAX_TOOL_NUMBER = 255
+"""``T`` above it is ``error:38`` (config.h MAX_TOOL_NUMBER)."""
+LINE_CHARACTERS = 79
+"""Characters a line keeps after spaces and comments go: LINE_BUFFER_SIZE 80 less one
+(protocol.c); one more is ``error:11``."""
+_G_GROUPS = (
+    ("4", "10", "28", "30", "53", "92", "28.1", "30.1", "92.1"),
+    ("0", "1", "2", "3", "38.2", "38.3", "38.4", "38.5", "80"),
+    ("17", "18", "19"),
+    ("90", "91"),
+    ("91.1",),
+    ("93", "94"),
+    ("20", "21"),
+    ("40",),
+    ("43.1", "49"),
+    ("54", "55", "56", "57", "58", "59"),
+    ("61",),
+)
+"""Modal groups (gcode.h): two G codes of one group in a line are ``error:21``."""
+_M_GROUPS = (("0", "1", "2", "30"), ("3", "4", "5"), ("7", "8", "9"))
+_AXIS_COMMANDS = (
+    *("0", "1", "2", "3", "10", "28", "30", "92"),
+    *("38.2", "38.3", "38.4", "38.5", "43.1", "49"),
+)
+"""Codes that use the axis words (gcode.c ``axis_command``): a second one is ``error:24``,
+found before the modal group's ``error:21``."""
+_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)")
+
+
+def kept_characters(text: str) -> str:
+    """A line as protocol.c keeps it: no spaces, ``/``, ``(…)`` or ``;…``; letters upper-cased."""
+    out = []
+    comment = False
+    for char in text:
+        if comment:
+            comment = char != ")"
+        elif char <= " " or char == "/":
+            continue
+        elif char == "(":
+            comment = True
+        elif char == ";":
+            break
+        else:
+            out.append(char.upper() if "a" <= char <= "z" else char)
+    return "".join(out)
+
+
+def refusal(text: str) -> int | None:
+    """The ``error:N`` GRBL 1.1h answers ``text`` with on parsing it, or ``None``.
+
+    Checks what gcode.c checks word by word, before any modal state counts:
+    the letter (1), the number (2), G and M codes (20, 23), two codes that use
+    the axis words (24), the value letters (20), repeated words (25), negative
+    F N P S T (4), ``T`` over 255 (38), two codes of one modal group (21), and
+    the line length (11, protocol.c). What depends on the modal state (a feed
+    not yet set, error:22) is left to GRBL.
+    ``$`` lines (GRBL's own commands) are not checked.
+    """
+    line = kept_characters(text)
+    if not line or line.startswith("$"):
+        return None
+    if len(line) > LINE_CHARACTERS:
+        return 11
+    seen: set[str] = set()
+    groups: set[tuple[str, ...]] = set()
+    at = 0
+    while at < len(line):
+        letter = line[at]
+        if not "A" <= letter <= "Z":
+            return 1
+        number = _NUMBER.match(line, at + 1)
+        if number is None:
+            return 2
+        at = number.end()
+        value = float(number.group())
+        error = _word(letter, value, seen, groups)
+        if error is not None:
+            return error
+    return None
+
+
+def _word(letter: str, value: float, seen: set[str], groups: set[tuple[str, ...]]) -> int | None:
+    if letter in "GM":
+        whole = int(value)
+        mantissa = round(100 * (value - whole))
+        code = str(whole) if not mantissa else f"{whole}.{mantissa:02d}".rstrip("0")
+        known = G_CODES if letter == "G" else M_CODES
+        if code not in known:
+            fraction = mantissa and str(whole) in known and str(whole) not in _FRACTIONS_READ
+            return 23 if fraction else 20
+        if letter == "G" and code in _AXIS_COMMANDS:
+            if _AXIS_COMMANDS in groups:
+                return 24
+            groups.add(_AXIS_COMMANDS)
+        for group in _G_GROUPS if letter == "G" else _M_GROUPS:
+            if code in group:
+                if group in groups:
+                    return 21
+                groups.add(group)
+        return None
+    if letter not in LETTERS:
+        return 20
+    if letter in seen:
+        return 25
+    seen.add(letter)
+    if letter in NOT_NEGATIVE and value < 0:
+        return 4
+    if letter == "T" and value > MAX_TOOL_NUMBER:
+        return 38
+    return None
+
+
+def check(blocks: Sequence[WireBlock], source: str) -> None:
+    """Refuse, before the first byte, a line GRBL 1.1h would answer with ``error:N``.
+
+    Raises:
+        InputError: naming the file, the line, the text and GRBL's own words.
+    """
+    for block in blocks:
+        error = refusal(block.text)
+        if error is not None:
+            where = f"line {block.line}" if block.index else "a restore line"
+            raise InputError(
+                f"{source}, {where}: {block.text!r}: GRBL 1.1 would refuse it with "
+                f"{decode(f'error:{error}')}; nothing was sent: change the line (or post "
+                "the drawing again for grbl)"
+            )
+
+
 # -- resume -------------------------------------------------------------------------------
 
 _WORD = re.compile(r"([A-Z])([-+]?(?:\d+\.?\d*|\.\d+))")
@@ -769,5 +919,6 @@ LINK = LinkHooks(
     status=status,
     setup=setup,
     expect=expect,
+    check=check,
 )
 """GRBL's link hooks (``camtool send -t grbl``, ``camtool simulate-device -t grbl``)."""

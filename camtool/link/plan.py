@@ -173,6 +173,8 @@ def prepare_send(
             or a block whose end the sender could not tell (the ``expect`` hook).
         UsageError: ``from_line`` is outside the program or inside a block,
             or ``max_error_um`` without ``verify``.
+        InputError: a line the controller would refuse (the link's ``check``
+            hook: GRBL's own word and code rules), naming it.
         VerifyLimitError: the predicted error exceeds ``max_error_um``.
     """
     spec, hooks = link_spec(target), link_hooks(target)
@@ -199,6 +201,8 @@ def prepare_send(
     if first and hooks.resume is not None:
         restore = hooks.resume(blocks[:first], blocks[first], spec)
         sent[:0], sent_times[:0] = restore, [0.0] * len(restore)
+    if hooks.check is not None:
+        hooks.check(sent, source)
     return SendPlan(
         target=target.name,
         spec=spec,

@@ -40,16 +40,16 @@ def test_dry_run_prints_the_plan_on_stdout(job: Path, capsys: Any) -> None:
     assert err == ""
 
 
-def test_what_the_reader_could_not_honour_is_said_before_sending(
-    tmp_path: Path, capsys: Any
-) -> None:
-    # a CamBam-style header (LinuxCNC's craftsmancnc.ngc): G64 blending means nothing to the
-    # verifier's model of GRBL, and the machinist must hear it before the job starts
+def test_what_grbl_would_refuse_is_refused_before_sending(tmp_path: Path, capsys: Any) -> None:
+    # a CamBam-style header (LinuxCNC's craftsmancnc.ngc): GRBL 1.1h has no G64 (gcode.c takes
+    # G61 only) and answers this very line `error:20` (checked on GRBL 1.1h built with
+    # grbl-sim): refused before the first byte, naming the line, exit 3
     path = tmp_path / "cambam.ngc"
     path.write_text("G21 G90 G64 P0.25 G40\nG0 Z5\nG0 X1 Y1\nG1 Z-0.5 F100\nG1 X2\nG0 Z5\nM2\n")
     code, _, err = run(["send", str(path), "-t", "grbl", "--dry-run"], capsys)
-    assert code == 0
-    assert ":1: G64 path blending" in err
+    assert code == 3
+    assert "cambam.ngc, line 1: 'G21 G90 G64 P0.25 G40': GRBL 1.1 would refuse it" in err
+    assert "error:20 (Unsupported command" in err
 
 
 def test_dry_run_from_line_shows_the_restore(job: Path, capsys: Any) -> None:

@@ -14,7 +14,7 @@ import pytest
 
 from camtool.link.plan import prepare_send
 from camtool.link.sender import StopAtPause, open_port, send_plan
-from camtool.model.errors import LinkError
+from camtool.model.errors import InputError, LinkError
 from camtool.post.registry import load_target
 from tests.link.controls import PauseAt
 
@@ -245,3 +245,52 @@ def test_a_lost_port_names_the_last_line_grbl_reported_run(simulate: Any) -> Non
     assert ran_in_order(sim.device, resume - 1)
     # and it is well before the line after the last one answered (the old, too late, advice)
     assert resume < 60
+
+
+# What GRBL 1.1h itself answers each line with: gnea/grbl v1.1h built for the host with
+# grbl/grbl-sim and fed one line at a time over a pseudo-terminal (a reset and $X between lines).
+GRBL_ANSWERS = {
+    "M7": "error:20",  # no M7 in the default build (config.h ENABLE_M7 off)
+    "M6 T1": "error:20",  # no M6 at all
+    "G4 P-1": "error:4",
+    "G90.1": "error:20",
+    "G1.5 X1": "error:23",
+    "G0 G1 X1": "error:24",
+    "X1 X2": "error:25",
+    "T256": "error:38",
+    "A5": "error:20",
+    "%": "error:1",
+    "M3 M5": "error:21",
+    "G61.1": "error:20",
+    "G28.2": "error:20",
+    "S-5": "error:4",
+    "G1 X1 F-1": "error:4",
+    "N-1 G0 X0": "error:4",
+    "G21 " + "X1.23456" * 11: "error:11",
+    "G1 X1 F100": "ok",
+    "M8": "ok",
+    "G91.1": "ok",
+    "M1": "ok",
+    "G38.2 Z-1 F10": "ok",  # taken by the parser (the probe then fails: an alarm, not an error)
+}
+
+
+@pytest.mark.parametrize(("line", "answer"), GRBL_ANSWERS.items())
+def test_the_pre_check_refuses_what_grbl_refuses(line: str, answer: str) -> None:
+    from camtool_postprocessors.grbl_link import refusal
+
+    code = refusal(line)
+    assert (f"error:{code}" if code is not None else "ok") == answer
+
+
+@pytest.mark.parametrize("line", ["M7", "M6 T1", "G4 P-1"])
+def test_a_line_grbl_refuses_is_refused_before_the_first_byte(line: str, simulate: Any) -> None:
+    code = PROGRAM.replace("M5\n", f"{line}\nM5\n")
+    number = code.splitlines().index(line) + 1
+    # (the reader itself already refuses a negative dwell, naming the line the same way)
+    with pytest.raises(InputError, match=rf"job.gcode(, line |:){number}: "):
+        prepare_send(code, load_target("grbl"), source="job.gcode")
+    sim = simulate("grbl")
+    with pytest.raises(InputError):
+        run(sim.path, code)
+    assert not sim.device.received  # nothing was sent
