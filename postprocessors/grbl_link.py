@@ -42,13 +42,14 @@ refused and the line to resume at (the one after the last line sent).
 from __future__ import annotations
 
 import re
+from array import array
 from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from camtool.link.device import ANSWER_END, LineDevice
-from camtool.link.spec import LinkHooks, LinkSpec, Status, WireBlock
+from camtool.link.spec import LineBlocks, LinkHooks, LinkSpec, Status, WireBlock
 from camtool.model.errors import InputError, ParseError, UsageError
 from camtool.model.program import ArcMove
 
@@ -361,7 +362,7 @@ _SYNC_FLOW = ("M0", "M2", "M30")
 """Program flow: gcode.c runs protocol_buffer_synchronize() before a pause or an end."""
 
 
-def expect(blocks: list[WireBlock], program: Program, target: Target) -> list[WireBlock]:
+def expect(blocks: Sequence[WireBlock], program: Program, target: Target) -> Sequence[WireBlock]:
     """Each block with the fewest planner blocks it queues and whether GRBL syncs on it.
 
     ``queued``: one per move of the line that makes at least one step on some
@@ -375,7 +376,8 @@ def expect(blocks: list[WireBlock], program: Program, target: Target) -> list[Wi
     GRBL's state is not known).
     """
     spm = target.machine.steps_per_mm
-    queued: dict[int, int] = {}
+    last_line = max((b.last_line for b in blocks[-1:]), default=0)
+    queued = array("H", [0]) * (last_line + 1)  # by source line
     z: float | None = None
     for index, (move, segment) in enumerate(program.segments()):
         line = program.line_of(index)
@@ -387,12 +389,14 @@ def expect(blocks: list[WireBlock], program: Program, target: Target) -> list[Wi
         steps = max(dx * spm[0], dy * spm[1], dz * spm[2])
         if isinstance(move, ArcMove):
             steps = max(steps, segment.length * min(spm[0], spm[1]))
-        if index and steps >= 1.0:
-            queued[line] = queued.get(line, 0) + 1
+        if index and steps >= 1.0 and 0 < line <= last_line:
+            queued[line] = min(queued[line] + 1, 65535)
     modal = _SyncState()
+    if isinstance(blocks, LineBlocks):  # block k is line k + 1
+        syncs = bytes(modal.syncs(b.text) for b in blocks)
+        return blocks.with_facts(queued[1:], syncs)
     return [
-        replace(block, queued=queued.get(block.line, 0), sync=modal.syncs(block.text))
-        for block in blocks
+        replace(block, queued=queued[block.line], sync=modal.syncs(block.text)) for block in blocks
     ]
 
 

@@ -105,7 +105,8 @@ def send(
         for line in summary_lines(plan.verification):
             click.echo(f"camtool: {line}", err=True)
     if dry_run:
-        click.echo("\n".join(plan.describe()))
+        for line in plan.describe_lines():
+            click.echo(line)
         return
     if port is None:
         raise UsageError("--port is required to send (or give --dry-run)")

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import contextlib
 import time
+from array import array
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -153,7 +154,7 @@ class Stream:
         self.status_answered = 0
         self.queue_size = 0
         self.synced = 0
-        self.cum = [0.0]
+        self.cum = array("d", [0.0])
         for seconds in plan.block_time_s:
             self.cum.append(self.cum[-1] + seconds)
 

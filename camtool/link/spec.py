@@ -66,9 +66,10 @@ report for each block (its feedback events, a dwell it is busy for).
 from __future__ import annotations
 
 import math
+from array import array
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, overload
 
 from camtool.model.errors import InputError, LinkError, UsageError
 
@@ -125,6 +126,95 @@ class WireBlock:
     def text(self) -> str:
         """The block as text for messages, without its terminator (or its note)."""
         return self.note or self.data.decode("latin-1").rstrip("\r\n")
+
+
+class LineBlocks(Sequence[WireBlock]):
+    """The blocks of a program framed one per line, made on demand from the file's bytes.
+
+    What :func:`frame_lines` returns: a long program (hundreds of thousands of
+    lines) is held as its bytes and one offset per line (``array``), not as one
+    :class:`WireBlock` object per line. Block ``k`` (0-based) is line ``k + 1``.
+    :meth:`with_facts` adds the ``queued`` and ``sync`` of every block the same
+    way (an ``expect`` hook's result).
+
+    Args:
+        data: the program's bytes.
+        starts: ``(n + 1,)`` offsets into ``data``: block ``k`` is
+            ``data[starts[k]:starts[k + 1]]``.
+        queued: ``(n,)`` per block, or ``None`` (all 0).
+        sync: ``(n,)`` 0/1 per block, or ``None`` (all False).
+    """
+
+    def __init__(
+        self,
+        data: bytes,
+        starts: array[int],
+        queued: array[int] | None = None,
+        sync: bytes | None = None,
+    ) -> None:
+        self.data = data
+        self.starts = starts
+        self.queued = queued
+        self.sync = sync
+
+    def __len__(self) -> int:
+        return len(self.starts) - 1
+
+    @overload
+    def __getitem__(self, k: int) -> WireBlock: ...
+
+    @overload
+    def __getitem__(self, k: slice) -> Sequence[WireBlock]: ...
+
+    def __getitem__(self, k: int | slice) -> WireBlock | Sequence[WireBlock]:
+        if isinstance(k, slice):
+            return [self[i] for i in range(*k.indices(len(self)))]
+        if k < 0:
+            k += len(self)
+        if not 0 <= k < len(self):
+            raise IndexError(k)
+        line = k + 1
+        return WireBlock(
+            line,
+            line,
+            line,
+            self.data[self.starts[k] : self.starts[k + 1]],
+            queued=self.queued[k] if self.queued is not None else 0,
+            sync=bool(self.sync[k]) if self.sync is not None else False,
+        )
+
+    def with_facts(self, queued: array[int], sync: bytes) -> LineBlocks:
+        """The same blocks with each one's ``queued`` and ``sync``."""
+        return LineBlocks(self.data, self.starts, queued, sync)
+
+
+class Joined(Sequence[WireBlock]):
+    """Some blocks before the blocks of another sequence from ``first`` on (a resume)."""
+
+    def __init__(self, head: Sequence[WireBlock], rest: Sequence[WireBlock], first: int) -> None:
+        self.head = list(head)
+        self.rest = rest
+        self.first = first
+
+    def __len__(self) -> int:
+        return len(self.head) + len(self.rest) - self.first
+
+    @overload
+    def __getitem__(self, k: int) -> WireBlock: ...
+
+    @overload
+    def __getitem__(self, k: slice) -> Sequence[WireBlock]: ...
+
+    def __getitem__(self, k: int | slice) -> WireBlock | Sequence[WireBlock]:
+        if isinstance(k, slice):
+            return [self[i] for i in range(*k.indices(len(self)))]
+        if k < 0:
+            k += len(self)
+        if not 0 <= k < len(self):
+            raise IndexError(k)
+        if k < len(self.head):
+            return self.head[k]
+        return self.rest[self.first + k - len(self.head)]
 
 
 @dataclass(frozen=True)
@@ -231,14 +321,14 @@ class LinkHooks:
             words and codes its gcode.c does not take).
     """
 
-    frame: Callable[[bytes, LinkSpec, str], list[WireBlock]] | None = None
+    frame: Callable[[bytes, LinkSpec, str], Sequence[WireBlock]] | None = None
     decode: Callable[[str], str] | None = None
     resume: Callable[[Sequence[WireBlock], WireBlock, LinkSpec], list[WireBlock]] | None = None
     device: Callable[..., Any] | None = None
     status_state: Callable[[str], str | None] | None = None
     split: Callable[[bytearray], list[str]] | None = None
     feedback: Callable[[str], bool] | None = None
-    expect: Callable[[list[WireBlock], Any, Any], list[WireBlock]] | None = None
+    expect: Callable[[Sequence[WireBlock], Any, Any], Sequence[WireBlock]] | None = None
     status: Callable[[str], Status | None] | None = None
     setup: Callable[[Callable[[str], list[str]]], list[str]] | None = None
     check: Callable[[Sequence[WireBlock], str], None] | None = None
@@ -340,27 +430,29 @@ def link_hooks(target: Target) -> LinkHooks:
     return hooks
 
 
-def frame_lines(code: bytes, spec: LinkSpec, source: str) -> list[WireBlock]:
+def frame_lines(code: bytes, spec: LinkSpec, source: str) -> LineBlocks:
     """One block per line: the bytes up to and including each ``block_end``.
 
     A last line without the terminator is a block too (it is sent as written:
     the file's bytes, no more). Empty lines are blocks (GRBL answers them ``ok``).
+    The blocks are made on demand (:class:`LineBlocks`).
 
     Raises:
         InputError: a block longer than ``max_block_bytes``, naming the line.
     """
     end = spec.block_end
-    blocks: list[WireBlock] = []
+    starts = array("q", [0])
+    limit = spec.max_block_bytes or spec.rx_buffer_bytes
     start = 0
     while start < len(code):
         cut = code.find(end, start)
         stop = len(code) if cut < 0 else cut + len(end)
-        line = len(blocks) + 1
-        blocks.append(WireBlock(line, line, line, code[start:stop]))
+        if limit and stop - start > limit:
+            line = len(starts)
+            check_block_size(WireBlock(line, line, line, code[start:stop]), spec, source)
+        starts.append(stop)
         start = stop
-    for block in blocks:
-        check_block_size(block, spec, source)
-    return blocks
+    return LineBlocks(code, starts)
 
 
 def check_block_size(block: WireBlock, spec: LinkSpec, source: str) -> None:
