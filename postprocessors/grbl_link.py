@@ -9,8 +9,16 @@ what needs Python (:data:`LINK`):
 - :func:`decode`: ``error:N`` and ``ALARM:N`` in GRBL's own words, from its
   documented tables (gnea/grbl ``doc/csv/error_codes_en_US.csv`` and
   ``doc/csv/alarm_codes_en_US.csv``, v1.1h);
-- :func:`status_state`: the state word of a ``<Idle|MPos:…|FS:…>`` report
-  (gnea/grbl ``doc/markdown/interface.md``, "Real-time Status Reports");
+- :func:`status_state` and :func:`status`: the state word of a
+  ``<Idle|MPos:…|Bf:15,128|FS:…>`` report and its ``Bf:`` free planner blocks
+  and RX bytes (gnea/grbl ``doc/markdown/interface.md``, "Real-time Status
+  Reports"); :func:`setup` turns ``Bf:`` on for the job (``$10`` bit 1) and
+  gives the line that puts ``$10`` back;
+- :func:`expect`: each line's fewest planner blocks and whether GRBL answers
+  it only once the planner is empty, so the sender can name the last line
+  surely run (GRBL's ``ok`` means queued, not run);
+- :func:`check` and :func:`refusal`: what GRBL 1.1h's parser refuses
+  (gnea/grbl ``grbl/gcode.c``, ``protocol.c``), refused before sending;
 - :func:`resume_blocks`: the modal state to restore before ``--from-line``;
 - :class:`GrblDevice`: a simulated GRBL that speaks all of it.
 
@@ -34,9 +42,11 @@ homing enabled it is in alarm until homed; re-establish the work zero before
 resuming (docs/send.md).
 
 Errors in flight. With character counting, lines already in GRBL's buffer
-when it answers ``error:N`` still run (interface.md, "RESERVATION"); the
-sender stops sending, waits for their answers, and names the line GRBL
-refused and the line to resume at (the one after the last line sent).
+when it answers ``error:N`` would still run (interface.md, "RESERVATION"); the
+sender stops the machine (feed hold ``!``, then once ``Hold:0`` a reset
+Ctrl-X, which turns the spindle and coolant off and keeps the position) and
+names the refused line as the line to resume at, or an earlier one that had
+not run to its end.
 """
 
 from __future__ import annotations
