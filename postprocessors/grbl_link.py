@@ -51,17 +51,19 @@ not run to its end.
 
 from __future__ import annotations
 
+import math
 import re
 from array import array
 from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from camtool.link.device import ANSWER_END, LineDevice
 from camtool.link.spec import LineBlocks, LinkHooks, LinkSpec, Status, WireBlock
-from camtool.model.errors import InputError, ParseError, UsageError
+from camtool.model.errors import CamtoolError, InputError, ParseError, UsageError
 from camtool.model.program import ArcMove
+from camtool.model.shapes import Arc
 
 if TYPE_CHECKING:
     from camtool.model.program import Program
@@ -368,6 +370,25 @@ def setup(ask: Callable[[str], list[str]]) -> list[str]:
     return [f"$10={mask}"]
 
 
+ARC_TOLERANCE_MARGIN = 4.0
+"""An arc's planner blocks are counted as if ``$12`` were this many times the profile's
+chord tolerance (GRBL's default 0.002 mm): fewer segments, so the count stays a lower
+bound on a controller whose ``$12`` was raised up to that much."""
+
+
+def arc_blocks(radius: float, sweep: float, tolerance: float) -> int:
+    """Planner blocks GRBL's mc_arc makes of an arc: its segments, at least one.
+
+    motion_control.c: ``segments = floor(|½·θ·r| / √(tol·(2r − tol)))`` with
+    ``tol`` the ``$12`` arc tolerance, mm; θ in radians, r in mm.
+    """
+    if radius <= tolerance / 2:
+        return 1
+    return max(
+        1, math.floor(abs(0.5 * sweep * radius) / math.sqrt(tolerance * (2 * radius - tolerance)))
+    )
+
+
 _SYNC_FLOW = ("M0", "M2", "M30")
 """Program flow: gcode.c runs protocol_buffer_synchronize() before a pause or an end."""
 
@@ -376,8 +397,9 @@ def expect(blocks: Sequence[WireBlock], program: Program, target: Target) -> Seq
     """Each block with the fewest planner blocks it queues and whether GRBL syncs on it.
 
     ``queued``: one per move of the line that makes at least one step on some
-    axis (planner.c drops a move of no steps); an arc at least one (mc_arc
-    cuts it into more; one is the lower bound). The first move counts none (where
+    axis (planner.c drops a move of no steps); an arc the segments mc_arc cuts
+    it into (:func:`arc_blocks`, ``$12`` taken as :data:`ARC_TOLERANCE_MARGIN`
+    times the profile's chord tolerance: a lower bound). The first move counts none (where
     the machine stands before it is not known). ``sync``: GRBL answers the line
     only after the planner has emptied (gcode.c, protocol_buffer_synchronize):
     ``G4`` (mc_dwell), ``M0``/``M2``/``M30`` (program flow), and a spindle or
@@ -386,6 +408,7 @@ def expect(blocks: Sequence[WireBlock], program: Program, target: Target) -> Seq
     GRBL's state is not known).
     """
     spm = target.machine.steps_per_mm
+    tolerance = ARC_TOLERANCE_MARGIN * target.machine.motion.chord_tolerance_mm
     last_line = max((b.last_line for b in blocks[-1:]), default=0)
     queued = array("H", [0]) * (last_line + 1)  # by source line
     z: float | None = None
@@ -397,10 +420,12 @@ def expect(blocks: Sequence[WireBlock], program: Program, target: Target) -> Seq
         dz = abs(move.z - z) if move.z is not None and z is not None else 0.0
         z = move.z if move.z is not None else z
         steps = max(dx * spm[0], dy * spm[1], dz * spm[2])
-        if isinstance(move, ArcMove):
+        count = 1
+        if isinstance(move, ArcMove) and isinstance(segment, Arc):
             steps = max(steps, segment.length * min(spm[0], spm[1]))
+            count = arc_blocks(segment.radius, abs(segment.sweep), tolerance)
         if index and steps >= 1.0 and 0 < line <= last_line:
-            queued[line] = min(queued[line] + 1, 65535)
+            queued[line] = min(queued[line] + count, 65535)
     modal = _SyncState()
     if isinstance(blocks, LineBlocks):  # block k is line k + 1
         syncs = bytes(modal.syncs(b.text) for b in blocks)
@@ -710,6 +735,8 @@ def resume_blocks(before: Sequence[WireBlock], first: WireBlock, spec: LinkSpec)
 # -- the simulator --------------------------------------------------------------------------
 
 
+DEVICE_ARC_TOLERANCE = 0.002
+"""The simulated GRBL's ``$12`` (defaults.h DEFAULT_ARC_TOLERANCE), mm."""
 PLANNER_BLOCKS = 15
 """Planner blocks GRBL 1.1h holds: BLOCK_BUFFER_SIZE 16 less one (planner.h; ``$I`` says
 ``[OPT:V,15,128]``)."""
@@ -779,7 +806,10 @@ class GrblDevice(LineDevice):
         self.max_rx = 0
         self.overflowed = False
         self.wco_sent = False
-        self.planner: deque[bytes] = deque()
+        self.planner: deque[list[Any]] = deque()  # [line, its blocks queued now]
+        self.queued = 0
+        self.waiting: tuple[list[Any], int, bytes] | None = None
+        self.accepted: list[bytes] = []
         self.line_ends = 0
         self.deaf = False
         self.holds = 0
@@ -821,9 +851,8 @@ class GrblDevice(LineDevice):
         return b"" if self.deaf else out
 
     def _reset(self) -> bytes:
-        moving = bool(self.planner) and not self.held
-        self.rx.clear()
-        self.planner.clear()
+        moving = self.queued > 0 and not self.held
+        self._flush()
         self.held = False
         self.resets += 1
         out = b""
@@ -834,27 +863,47 @@ class GrblDevice(LineDevice):
 
     def pending(self) -> bool:
         """A line to parse, or a planner block to run."""
-        return self._parsable() or (bool(self.planner) and not self.held)
+        return self._parsable() or (self.queued > 0 and not self.held)
 
     def _parsable(self) -> bool:
         cut = self.rx.find(self.spec.block_end)
-        if not self.startup_seen or cut < 0:
+        if not self.startup_seen or cut < 0 or self.waiting is not None:
             return False
-        if len(self.planner) >= PLANNER_BLOCKS:
+        if self.queued >= PLANNER_BLOCKS:
             return False
         codes = {f"{a}{n}" for a, n in words(self.rx[:cut].decode("latin-1")) if a in "GM"}
         return not (codes & set(_SYNCS) and self.planner)
 
     def step(self) -> bytes:
-        """Parse the lines that fit (``ok`` at once), then run one planner block."""
+        """Parse the lines that fit (``ok`` once queued), then run one planner block."""
         out = b""
         while self._parsable():
             block = self.take_block()
             assert block is not None
             out += self._parse(block)
-        if self.planner and not self.held:
-            self.executed.append(self.planner.popleft())
+        if self.queued and not self.held:
+            entry = self.planner[0]
+            entry[1] -= 1
+            self.queued -= 1
+            if not entry[1] and (self.waiting is None or self.waiting[0] is not entry):
+                self.planner.popleft()
+                self.executed.append(entry[0])
+            out += self._queue_waiting()
         return b"" if self.deaf else out
+
+    def _queue_waiting(self) -> bytes:
+        """Queue more of the line whose blocks did not all fit; its answer once all are in."""
+        if self.waiting is None:
+            return b""
+        entry, left, answer = self.waiting
+        more = min(left, PLANNER_BLOCKS - self.queued)
+        entry[1] += more
+        self.queued += more
+        if more < left:
+            self.waiting = (entry, left - more, answer)
+            return b""
+        self.waiting = None
+        return answer
 
     def _parse(self, block: bytes) -> bytes:
         text = block.strip()
@@ -872,18 +921,49 @@ class GrblDevice(LineDevice):
             self.received += block
             self.blocks.append(block)
             self.state = "Alarm"
-            self.rx.clear()
-            self.planner.clear()
+            self._flush()
             return f"ALARM:{self.alarm}".encode() + ANSWER_END
         answer = self.run_block(block)
-        if self.executed and self.executed[-1] is block:  # accepted: queue it, not yet run
-            self.executed.pop()
-            if any(a in "XYZ" for a, _ in words(block.decode("latin-1"))):
-                self.planner.append(block)
-            else:
-                self.executed.append(block)
         muted = self.mute_at_block is not None and number >= self.mute_at_block
-        return b"" if muted else answer
+        answer = b"" if muted else answer
+        if not (self.executed and self.executed[-1] is block):
+            return answer
+        self.executed.pop()  # accepted: queued, not yet run
+        self.accepted.append(block)
+        count = self._blocks_of(block)
+        if not count:
+            self.executed.append(block)
+            return answer
+        entry = [block, 0]
+        self.planner.append(entry)
+        self.waiting = (entry, count, answer)
+        return self._queue_waiting()
+
+    def _blocks_of(self, block: bytes) -> int:
+        """Planner blocks of an accepted line: one per move, an arc its mc_arc segments."""
+        if self.target is None or not any(a in "XYZ" for a, _ in words(block.decode("latin-1"))):
+            return 0
+        code = b"".join(self.accepted).decode("latin-1")
+        try:
+            program = self.target.parse(code)
+        except CamtoolError:  # not readable alone (rapids only, say): one block
+            return 1
+        line = len(self.accepted)
+        count = 0
+        for index, (move, segment) in enumerate(program.segments()):
+            if program.line_of(index) != line:
+                continue
+            if isinstance(move, ArcMove) and isinstance(segment, Arc):
+                count += arc_blocks(segment.radius, abs(segment.sweep), DEVICE_ARC_TOLERANCE)
+            else:
+                count += 1
+        return count
+
+    def _flush(self) -> None:
+        self.rx.clear()
+        self.planner.clear()
+        self.queued = 0
+        self.waiting = None
 
     def run_block(self, block: bytes) -> bytes:
         """Record ``block`` and answer it (``ack_word`` for an accepted line)."""
@@ -907,7 +987,7 @@ class GrblDevice(LineDevice):
     def status_report(self) -> bytes:
         """``<State|MPos:x,y,z|Bf:p,r|FS:0,0>`` (``|WCO:0.000,0.000,0.000`` in the first)."""
         state = "Alarm" if self.state == "Alarm" else ("Hold:0" if self.held else "Idle")
-        if state == "Idle" and (self.planner or self._parsable() or self.run_forever):
+        if state == "Idle" and (self.queued or self._parsable() or self.run_forever):
             state = "Run"
         try:
             x, y, z = self.position() if self.executed and self.target else (0.0, 0.0, 0.0)
@@ -915,9 +995,8 @@ class GrblDevice(LineDevice):
             x = y = z = 0.0
         report = f"<{state}|MPos:{x:.3f},{y:.3f},{z:.3f}"
         if self.status_mask & BUFFER_STATE:
-            report += (
-                f"|Bf:{PLANNER_BLOCKS - len(self.planner)},{RX_BUFFER_BYTES + 1 - len(self.rx)}"
-            )
+            free = (PLANNER_BLOCKS - self.queued, RX_BUFFER_BYTES + 1 - len(self.rx))
+            report += f"|Bf:{free[0]},{free[1]}"
         report += "|FS:0,0"
         if not self.wco_sent:
             report += "|WCO:0.000,0.000,0.000"

@@ -71,6 +71,11 @@ def ran_in_order(device: Any, upto: int) -> bool:
     return b"".join(device.executed).startswith("".join(lines).encode())
 
 
+def lines_run(device: Any) -> int:
+    """How many of PROGRAM's first lines the simulated GRBL ran: where its tool stands."""
+    return sum(1 for k in range(1, PROGRAM.count("\n") + 1) if ran_in_order(device, k))
+
+
 def test_an_error_stops_the_machine_and_names_the_line(simulate: Any) -> None:
     sim = simulate("grbl", fail_at_block=19, error="22", block_delay_s=0.002)
     with pytest.raises(LinkError) as info:
@@ -101,7 +106,13 @@ def test_from_line_after_an_error_ends_where_an_uninterrupted_run_ends(simulate:
     with pytest.raises(LinkError) as info:
         run(sim.path, PROGRAM)
     resume = resume_line(str(info.value))
-    assert ran_in_order(sim.device, resume - 1)
+    assert ran_in_order(sim.device, resume - 1)  # never too late
+    # camtool's line is never late, but may be early (its count of GRBL's planner is a lower
+    # bound): the operator resumes where the tool stands, at the first line not run, which
+    # is camtool's line or a later one
+    ran = lines_run(sim.device)
+    assert resume <= ran + 1
+    resume = ran + 1
     first = len(sim.device.blocks)
     run(sim.path, PROGRAM, from_line=resume)
     assert sim.device.connections == 2
@@ -136,10 +147,12 @@ def test_stop_at_a_pause_halts_and_names_the_line_to_resume_at(simulate: Any) ->
     assert "feed hold, then a reset (spindle and coolant off, position kept)" in message
     resume = resume_line(message)
     assert ran_in_order(sim.device, resume - 1)
+    ran = lines_run(sim.device)
+    assert resume <= ran + 1  # never late; where the tool stands decides (see above)
     # whole blocks only: what arrived is the file's first lines
     received = len(sim.device.blocks)
     assert bytes(sim.device.received) == "".join(PROGRAM.splitlines(True)[:received]).encode()
-    run(sim.path, PROGRAM, from_line=resume)
+    run(sim.path, PROGRAM, from_line=ran + 1)
     assert sim.device.position() == pytest.approx(END)
 
 
@@ -294,3 +307,20 @@ def test_a_line_grbl_refuses_is_refused_before_the_first_byte(line: str, simulat
     with pytest.raises(InputError):
         run(sim.path, code)
     assert not sim.device.received  # nothing was sent
+
+
+def test_an_arc_counts_grbls_segments_as_a_lower_bound() -> None:
+    import math
+
+    from camtool_postprocessors.grbl_link import arc_blocks
+
+    # motion_control.c mc_arc: floor(|0.5 θ r| / sqrt(tol (2r - tol))); a half circle of radius
+    # 5 mm at $12 = 0.002 mm: 7.854 / 0.14141 = 55.5 -> 55 planner blocks
+    assert arc_blocks(5.0, math.pi, 0.002) == 55
+    plan = prepare_send(PROGRAM, load_target("grbl"))
+    arc = next(b for b in plan.blocks if b.text.startswith("G2 "))
+    # counted at 4 x the profile's $12 (a controller's $12 may be raised): fewer, never more
+    assert arc.queued == arc_blocks(5.0, math.pi, 0.008) == 27
+    # G4 waits for an empty planner (mc_dwell), M5 too once the program started the spindle
+    syncs = [b.text for b in plan.blocks if b.sync]
+    assert syncs == ["G4 P1.5", "M5", "M2"]
