@@ -508,7 +508,7 @@ def step_events(program: Program, machine: Machine) -> dict[int, bytes]:
     return {line: bytes(data) for line, data in out.items()}
 
 
-def expect(blocks: list[WireBlock], program: Program, target: Target) -> list[WireBlock]:
+def expect(blocks: Sequence[WireBlock], program: Program, target: Target) -> list[WireBlock]:
     """Each block with its feedback count (motor steps) and a dwell's seconds.
 
     Raises:

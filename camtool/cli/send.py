@@ -75,9 +75,11 @@ def send(
     """Stream PROGRAM (a posted file) to the machine over the target's own link.
 
     The program is read back with the target's reader and checked first (work
-    area, plunge depth, with --verify the predicted error). Ctrl-C pauses after
-    the current block; a controller error, an alarm or a lost port stop the job
-    and name the --from-line that resumes it (exit 1).
+    area, plunge depth, with --verify the predicted error). Ctrl-C pauses (GRBL:
+    a feed hold; other links after the current block); SIGTERM, or 'stop' at the
+    pause, stops (GRBL: feed hold, then reset). A controller error, an alarm, a
+    lost port or a controller that stops answering end the job naming the lines
+    that surely ran and the --from-line that resumes it (exit 1).
     """
     from camtool.jobs.inputs import read_code
     from camtool.jobs.output import check_paths
@@ -103,7 +105,8 @@ def send(
         for line in summary_lines(plan.verification):
             click.echo(f"camtool: {line}", err=True)
     if dry_run:
-        click.echo("\n".join(plan.describe()))
+        for line in plan.describe_lines():
+            click.echo(line)
         return
     if port is None:
         raise UsageError("--port is required to send (or give --dry-run)")
@@ -166,22 +169,33 @@ def _log_file(path: str | None) -> Iterator[IO[str] | None]:
 
 @contextlib.contextmanager
 def _pause_on_ctrl_c(control: _Operator) -> Iterator[None]:
-    """Ctrl-C asks for a pause after the current block instead of killing the job."""
+    """Ctrl-C asks for a pause (a feed hold where the link has one); SIGTERM for a stop.
 
-    def handler(signum: int, frame: Any) -> None:
+    Neither kills the job: a stop is the link's own (GRBL: feed hold, then reset) and
+    ends with the line to resume at, as a stop at the pause prompt does.
+    """
+
+    def pause(signum: int, frame: Any) -> None:
         if not control.pause_requested:
-            click.echo("\ncamtool: pausing after the current block…", err=True)
+            click.echo("\ncamtool: pausing…", err=True)
         control.pause_requested = True
 
+    def stop(signum: int, frame: Any) -> None:
+        if not control.stop_requested:
+            click.echo("\ncamtool: stopping (SIGTERM)…", err=True)
+        control.stop_requested = True
+
     try:
-        previous = signal.signal(signal.SIGINT, handler)
+        previous = {sig: signal.signal(sig, h) for sig, h in ((signal.SIGINT, pause),)}
+        previous[signal.SIGTERM] = signal.signal(signal.SIGTERM, stop)
     except ValueError:  # not the main thread (a test runner): no handler
         yield
         return
     try:
         yield
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
 
 
 class _Operator:
@@ -190,6 +204,7 @@ class _Operator:
     def __init__(self, *, interactive: bool) -> None:
         self.interactive = interactive
         self.pause_requested = False
+        self.stop_requested = False
 
     def paused(self, progress: Progress) -> str:
         if not self.interactive:

@@ -14,16 +14,27 @@ time its bytes take on the wire.
 from __future__ import annotations
 
 import bisect
-from collections.abc import Callable
+from array import array
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from functools import cached_property
+from typing import TYPE_CHECKING, Any
 
-from camtool.link.spec import LinkHooks, LinkSpec, WireBlock, frame_lines, link_hooks, link_spec
+from camtool.link.spec import (
+    Joined,
+    LinkHooks,
+    LinkSpec,
+    WireBlock,
+    frame_lines,
+    link_hooks,
+    link_spec,
+)
 from camtool.model.errors import DialectError, InputError, UsageError, VerifyLimitError
-from camtool.model.program import Dwell, Program
+from camtool.model.program import ArcMove, Dwell, Program
 from camtool.model.units import fmt_num
 
 if TYPE_CHECKING:
+    from camtool.model.machine import Machine
     from camtool.post.base import Target
     from camtool.verify.verifier import Verification
 
@@ -51,15 +62,23 @@ class SendPlan:
     spec: LinkSpec
     hooks: LinkHooks
     source: str
-    blocks: tuple[WireBlock, ...]
-    block_time_s: tuple[float, ...]
+    blocks: Sequence[WireBlock]
+    block_time_s: Sequence[float]
     total_blocks: int
     skipped: int
     program: Program
     warnings: tuple[str, ...] = ()
     verification: Verification | None = None
 
-    @property
+    @cached_property
+    def _elapsed(self) -> array[float]:
+        """``(n + 1,)``: estimated time of the first ``k`` blocks, wire time included, s."""
+        out = array("d", [0.0])
+        for block, seconds in zip(self.blocks, self.block_time_s, strict=True):
+            out.append(out[-1] + seconds + self.wire_time_s(block))
+        return out
+
+    @cached_property
     def total_bytes(self) -> int:
         """Bytes to send (real-time and start-up bytes not counted)."""
         return sum(len(b.data) for b in self.blocks)
@@ -71,15 +90,42 @@ class SendPlan:
     @property
     def estimated_time_s(self) -> float:
         """Motion time of the blocks to send plus their wire time, s."""
-        return sum(self.block_time_s) + sum(self.wire_time_s(b) for b in self.blocks)
+        return self._elapsed[-1]
 
     def time_left_s(self, done: int) -> float:
         """Estimated time of the blocks after the first ``done`` of :attr:`blocks`, s."""
-        rest = self.blocks[done:]
-        return sum(self.block_time_s[done:]) + sum(self.wire_time_s(b) for b in rest)
+        elapsed = self._elapsed
+        return elapsed[-1] - elapsed[min(max(done, 0), len(elapsed) - 1)]
+
+    def start_of(self, line: int) -> tuple[tuple[float, float, float] | None, bool]:
+        """Where the tool stands before source ``line`` runs, and whether that line holds an arc.
+
+        The position (X, Y, Z in mm, the program's coordinates) is where the
+        last move of an earlier line ends (``None``: no move before it, or the
+        program was not read with line numbers); Z is the last Z set before it
+        (0 when none was).
+        """
+        program = self.program
+        end: tuple[float, float, float] | None = None
+        z = 0.0
+        arc = False
+        for index, move in enumerate(program.moves):
+            at = program.line_of(index)
+            if at is None:
+                return None, False
+            if at >= line:
+                arc = at == line and isinstance(move, ArcMove)
+                break
+            z = z if move.z is None else move.z
+            end = (move.x, move.y, z)
+        return end, arc
 
     def describe(self) -> list[str]:
         """The protocol plan, one line per item: what ``--dry-run`` prints on stdout."""
+        return list(self.describe_lines())
+
+    def describe_lines(self) -> Iterator[str]:
+        """:meth:`describe`, one line at a time (a long program is never held as text)."""
         spec = self.spec
         flow = {
             "char-count": f"character counting ({spec.rx_buffer_bytes}-byte receive buffer)",
@@ -102,14 +148,14 @@ class SendPlan:
             f"from line {first}" + (f" ({self.skipped} skipped)" if self.skipped else ""),
             f"estimated time: {duration(self.estimated_time_s)}",
         ]
+        yield from out
         for block, seconds in zip(self.blocks, self.block_time_s, strict=True):
             where = f"block {block.index} line {block.line}" if block.index else "restore"
             extra = f", {block.events} feedback events" if block.events else ""
             extra += f", answer {block.ack!r}" if block.ack else ""
             text = block.text.replace("\r", " ")
             text = text if len(text) <= 60 else text[:57] + "..."
-            out.append(f"{where}: {len(block.data)} bytes, {fmt_num(seconds, 3)} s{extra}: {text}")
-        return out
+            yield f"{where}: {len(block.data)} bytes, {fmt_num(seconds, 3)} s{extra}: {text}"
 
 
 def duration(seconds: float) -> str:
@@ -150,6 +196,8 @@ def prepare_send(
             or a block whose end the sender could not tell (the ``expect`` hook).
         UsageError: ``from_line`` is outside the program or inside a block,
             or ``max_error_um`` without ``verify``.
+        InputError: a line the controller would refuse (the link's ``check``
+            hook: GRBL's own word and code rules), naming it.
         VerifyLimitError: the predicted error exceeds ``max_error_um``.
     """
     spec, hooks = link_spec(target), link_hooks(target)
@@ -171,18 +219,21 @@ def prepare_send(
         blocks = hooks.expect(blocks, program, target)
     times = _block_times(blocks, program, move_times)
     first = _first_block(blocks, from_line, source)
-    sent = list(blocks[first:])
-    sent_times = list(times[first:])
+    restore: list[WireBlock] = []
     if first and hooks.resume is not None:
         restore = hooks.resume(blocks[:first], blocks[first], spec)
-        sent[:0], sent_times[:0] = restore, [0.0] * len(restore)
+    sent: Sequence[WireBlock] = Joined(restore, blocks, first) if first or restore else blocks
+    sent_times = array("d", [0.0] * len(restore))
+    sent_times.extend(times[first:])
+    if hooks.check is not None:
+        hooks.check(sent, source)
     return SendPlan(
         target=target.name,
         spec=spec,
         hooks=hooks,
         source=source,
-        blocks=tuple(sent),
-        block_time_s=tuple(sent_times),
+        blocks=sent,
+        block_time_s=sent_times,
         total_blocks=len(blocks),
         skipped=first,
         program=program,
@@ -218,7 +269,7 @@ def _check_depth(program: Program, max_depth_mm: float | None, source: str) -> N
 
 def _times(
     program: Program, target: Target, verify: bool, max_error_um: float | None
-) -> tuple[Verification | None, list[float]]:
+) -> tuple[Verification | None, Sequence[float]]:
     """The verifier's result (with ``verify``) and each move's estimated time, s."""
     from camtool.verify.verifier import block_times, simulate, verify_program
 
@@ -231,11 +282,59 @@ def _times(
             if over:
                 raise VerifyLimitError(f"not sent: {over}")
         return v, [float(t) for t in v.block_time_s]
-    trace = simulate(program, target.machine)
-    return None, [float(t) for t in block_times(trace, program, target.machine)]
+    return None, _chunk_times(program, target.machine, simulate, block_times)
 
 
-def _with_z(program: Program, target: Target, move_times: list[float]) -> list[float]:
+CHUNK_MOVES = 2000
+"""Most moves timed at once (see :data:`CHUNK_ROWS`)."""
+CHUNK_ROWS = 200_000
+"""About how many step rows a chunk may make: the step simulation behind the timing model
+holds every row of the moves it is given (a 1 MB program of 2 mm moves made 15 M rows,
+600 MB), so a long program is timed in chunks and only the seconds are kept."""
+
+
+def _chunk_times(
+    program: Program,
+    machine: Machine,
+    simulate: Callable[[Program, Machine], Any],
+    block_times: Callable[[Any, Program, Machine], Any],
+) -> array[float]:
+    """Each move's time, s, by the timing model (through the verifier), in chunks of moves.
+
+    A chunk ends after :data:`CHUNK_MOVES` moves or about :data:`CHUNK_ROWS`
+    steps along the longest axis; it starts where the move before it ends, so
+    each move is timed from the point it starts at. A backlash take-up at a
+    chunk's first move may be timed differently than in one run (the play is not
+    carried over): an estimate for pacing and bounds, not the verifier's figure.
+    """
+    moves = program.moves
+    out = array("d")
+    first = 0
+    for last in _chunk_ends(program, machine):
+        origin = program.origin if not first else (moves[first - 1].x, moves[first - 1].y)
+        chunk = Program(
+            moves=moves[first:last], origin=origin, lines=tuple(program.lines[first:last])
+        )
+        out.extend(float(t) for t in block_times(simulate(chunk, machine), chunk, machine))
+        first = last
+    return out
+
+
+def _chunk_ends(program: Program, machine: Machine) -> Iterator[int]:
+    """Where each chunk of :func:`_chunk_times` ends (exclusive move indices)."""
+    spm = max(machine.steps_per_mm[0], machine.steps_per_mm[1])
+    rows, count = 0.0, 0
+    for index, (_, segment) in enumerate(program.segments()):
+        rows += segment.length * spm + 1
+        count += 1
+        if rows >= CHUNK_ROWS or count >= CHUNK_MOVES:
+            yield index + 1
+            rows, count = 0.0, 0
+    if count:
+        yield len(program.moves)
+
+
+def _with_z(program: Program, target: Target, move_times: Sequence[float]) -> Sequence[float]:
     """Each move's time with its Z travel added at the machine's step rate, s.
 
     The verifier simulates XY; a timed link must not send the next block while
@@ -246,7 +345,7 @@ def _with_z(program: Program, target: Target, move_times: list[float]) -> list[f
     machine = target.machine
     if not machine.max_step_rate_hz > 0:
         return move_times
-    out, z = [], 0.0
+    out, z = array("d"), 0.0
     for move, seconds in zip(program.moves, move_times, strict=False):
         dz = 0.0 if move.z is None else abs(move.z - z)
         z = z if move.z is None else move.z
@@ -254,12 +353,14 @@ def _with_z(program: Program, target: Target, move_times: list[float]) -> list[f
     return out
 
 
-def _block_times(blocks: list[WireBlock], program: Program, move_times: list[float]) -> list[float]:
+def _block_times(
+    blocks: Sequence[WireBlock], program: Program, move_times: Sequence[float]
+) -> array[float]:
     """Each block's time: the moves (and dwells) whose source line it holds, s."""
-    times = [0.0] * len(blocks)
+    times = array("d", [0.0]) * len(blocks)
     if not blocks:
         return times
-    starts = [b.line for b in blocks]
+    starts = array("q", (b.line for b in blocks))
 
     def block_of(move: int) -> int:
         line = program.line_of(move)
@@ -276,7 +377,7 @@ def _block_times(blocks: list[WireBlock], program: Program, move_times: list[flo
 
 
 def _dwell_block(
-    index: int, program: Program, blocks: list[WireBlock], block_of: Callable[[int], int]
+    index: int, program: Program, blocks: Sequence[WireBlock], block_of: Callable[[int], int]
 ) -> int:
     """The block that holds a dwell run before ``moves[index]`` (after the last: ``len``).
 
@@ -292,7 +393,7 @@ def _dwell_block(
     return min(following, len(blocks) - 1)
 
 
-def _first_block(blocks: list[WireBlock], from_line: int | None, source: str) -> int:
+def _first_block(blocks: Sequence[WireBlock], from_line: int | None, source: str) -> int:
     """Index of the block that starts at ``from_line`` (0 without one)."""
     if from_line is None:
         return 0

@@ -3,11 +3,16 @@
 :class:`Stream` is the protocol state, with no I/O: which block may go now
 (character counting against the receive buffer, one block per answer, or one
 block per estimated block time), what an answer from the controller means, and
-what was done. :func:`send_plan` drives it over a pyserial port: start-up
-(banner, start-up bytes, the controller's state), the blocks, answers, status
-polls, pause after the current block (never inside one), resume, stop, the
-operator's turn between blocks where the machine needs it, and the end of the
-job. Every byte both ways goes to the :class:`ByteLog` when one is given.
+what was done, and which blocks surely ran (:meth:`Stream.surely_run`: an answer
+that says "queued", as GRBL's ``ok`` does, is not "run"; the controller's status
+reports of its queue are). :func:`send_plan` drives it over a pyserial port:
+start-up (banner, start-up bytes, the controller's state, settings the job
+needs), the blocks, answers, status polls, pause (the link's feed hold where it
+has one, else after the current block: never inside one), resume, stop (feed
+hold, then reset, where the link has them), the operator's turn between blocks
+where the machine needs it, and the end of the job. Every wait is bounded by
+the timing model's estimate of what the controller had to do first. Every byte
+both ways goes to the :class:`ByteLog` when one is given.
 
 Ports come from :func:`open_port` (``serial.serial_for_url``): a device
 (``/dev/ttyUSB0``, ``COM3``, a pseudo-terminal ``/dev/pts/N``) or a pyserial URL
@@ -22,12 +27,13 @@ from __future__ import annotations
 
 import contextlib
 import time
+from array import array
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import IO, TYPE_CHECKING, Any, Protocol
 
-from camtool.link.spec import WireBlock
+from camtool.link.spec import Status, WireBlock
 from camtool.model.errors import LinkError
 
 if TYPE_CHECKING:
@@ -62,7 +68,8 @@ class Control(Protocol):
     """How the operator steers a job (the CLI's prompt; tests script it)."""
 
     pause_requested: bool
-    """Set (from a signal handler, say) to pause after the current block."""
+    """Set (from a signal handler, say) to pause: with a feed hold where the link has
+    one (GRBL ``!``), else after the current block."""
 
     def paused(self, progress: Progress) -> str:
         """The job is paused between blocks: return ``"resume"`` or ``"stop"``."""
@@ -78,6 +85,7 @@ class StopAtPause:
 
     def __init__(self) -> None:
         self.pause_requested = False
+        self.stop_requested = False
 
     def paused(self, progress: Progress) -> str:
         """Always ``"stop"``."""
@@ -128,16 +136,27 @@ class Stream:
         self.in_flight: deque[int] = deque()
         self.buffered = 0
         self.done = 0
+        self.answered = 0
         self.last_done: WireBlock | None = None
         self.ready_at = 0.0
         self.time_scale = time_scale
         self.failure: str | None = None
         self.failed_block: WireBlock | None = None
+        self.failed_at: int | None = None
+        self.refused: set[int] = set()
+        self.attempted: int | None = None
         self.max_buffered = 0
         self.feedback = plan.hooks.feedback
         self.head_acked = False
         self.events_left = 0
         self.events = 0
+        self.status: Status | None = None
+        self.status_answered = 0
+        self.queue_size = 0
+        self.synced = 0
+        self.cum = array("d", [0.0])
+        for seconds in plan.block_time_s:
+            self.cum.append(self.cum[-1] + seconds)
 
     def block(self, k: int) -> WireBlock:
         """Block ``k`` of the plan."""
@@ -157,18 +176,30 @@ class Stream:
             return None
         return k
 
+    def sending(self, k: int) -> None:
+        """Block ``k`` is being written (should the port fail now, it may have gone)."""
+        self.attempted = k
+
     def sent(self, k: int, now: float) -> None:
         """Block ``k`` went on the wire at ``now``."""
         self.queue.popleft()
+        self.attempted = None
         block = self.block(k)
         if self.spec.flow == "timed":
             wait = self.plan.block_time_s[k] * (1.0 + self.spec.pace_margin)
             self.ready_at = now + self.time_scale * (wait + self.plan.wire_time_s(block))
+            self.answered += 1
             self._done(k)
             return
         self.in_flight.append(k)
         self.buffered += len(block.data)
         self.max_buffered = max(self.max_buffered, self.buffered)
+
+    @property
+    def sent_count(self) -> int:
+        """Blocks written whole, and the one being written when the port failed."""
+        written = len(self.plan.blocks) - len(self.queue)
+        return written + (1 if self.attempted is not None else 0)
 
     def _done(self, k: int) -> None:
         self.done += 1
@@ -215,12 +246,16 @@ class Stream:
 
     def _acked(self, now: float, failed: str | None = None) -> str:
         k = self.in_flight[0]
+        self.answered = k + 1
         if failed is not None:
             self.in_flight.popleft()
             self.buffered -= len(self.block(k).data)
+            self.refused.add(k)
             if self.failure is None:
-                self.failure, self.failed_block = failed, self.block(k)
+                self.failure, self.failed_block, self.failed_at = failed, self.block(k), k
             return "error"
+        if self.block(k).sync:
+            self.synced = k + 1
         if self.block(k).events:
             self.head_acked, self.events_left = True, self.block(k).events
             return "answer"
@@ -260,6 +295,53 @@ class Stream:
         if wait:
             self.ready_at = max(self.ready_at, now + wait)
 
+    def report(self, status: Status) -> None:
+        """A status report arrived: what it says holds for the blocks answered before it.
+
+        Answers and reports come in the order the controller wrote them, so every
+        block answered so far was in its queue (or run) when it wrote the report.
+        """
+        self.status, self.status_answered = status, self.answered
+        if status.queue_free is not None:
+            self.queue_size = max(self.queue_size, status.queue_free)
+
+    def surely_run(self) -> int:
+        """How many leading blocks are surely run to their end (or refused), by what is known.
+
+        ``"ack"`` flow: a block's answer says it ran (an echo and all its
+        feedback, an 'F'). ``"timed"``: the last block sent may still be
+        running. ``"char-count"``: an answer says only that the block was queued
+        (GRBL's ``ok``); the blocks up to a ``sync`` block's answer ran, and the
+        last status report's free queue entries (GRBL ``Bf:``) say how many
+        queue entries the newest answered blocks still held: counted back from
+        the newest with each block's ``queued`` (a lower bound, so the count
+        never reaches too early a block), plus one entry while the controller
+        moves (GRBL's stepper segment buffer still runs the block it last took
+        out of the planner; standing, ``Idle`` or ``Hold:0``, it has run it).
+        """
+        flow = self.spec.flow
+        if flow == "ack":
+            return self.answered - (1 if self.head_acked else 0)
+        if flow == "timed":
+            return max(0, self.done - 1)
+        known = self.synced
+        status = self.status
+        if status is None or status.queue_free is None or not self.queue_size:
+            return known
+        standing = status.state in ("Idle", "Hold:0")
+        held = self.queue_size - status.queue_free + (0 if standing else 1)
+        k = self.status_answered
+        while k > known and held > 0:
+            if k - 1 not in self.refused:
+                held -= self.block(k - 1).queued
+            k -= 1
+        return max(k, known)
+
+    def time_s(self, first: int, last: int) -> float:
+        """Estimated time of blocks ``first`` to ``last - 1``, s."""
+        last = max(first, min(last, len(self.plan.blocks)))
+        return self.cum[last] - self.cum[first]
+
     def idle(self, now: float) -> bool:
         """True when nothing is in flight (timed: the last block's time is over)."""
         return not self.in_flight and now >= self.ready_at
@@ -284,6 +366,11 @@ class Stream:
         """The ``--from-line`` that continues after the last block done (``None``: all done)."""
         rest = [self.block(k) for k in (*self.in_flight, *self.queue)]
         return next((b.line for b in rest if b.index), None)
+
+    def first_line_from(self, k: int) -> int | None:
+        """Source line of the first program block from block ``k`` on (``None``: none)."""
+        blocks = self.plan.blocks
+        return next((blocks[j].line for j in range(k, len(blocks)) if blocks[j].index), None)
 
 
 def _port_errors() -> tuple[type[BaseException], ...]:
@@ -336,6 +423,7 @@ class _Wire:
         self.buffer = bytearray()
         self.last_rx = time.monotonic()
         self.split = split or split_lines
+        self.unread: list[str] = []
 
     def write(self, data: bytes, where: str) -> None:
         try:
@@ -377,8 +465,15 @@ class _Wire:
             return None
         return True
 
+    def put_back(self, answers: list[str]) -> None:
+        """Answers read but not taken: the next :meth:`lines` returns them first."""
+        self.unread[:0] = answers
+
     def lines(self, timeout: float, where: str) -> list[str]:
         """Whole answers received within ``timeout`` s (lines, line ends stripped, by default)."""
+        if self.unread:
+            out, self.unread = self.unread, []
+            return out
         try:
             self.port.timeout = timeout
             data = self.port.read(max(1, self.port.in_waiting))
@@ -433,6 +528,14 @@ def send_plan(
 ) -> SendResult:
     """Send ``plan`` over an open ``port`` (see the module docstring).
 
+    Every wait has a bound that follows from the program: an answer may take
+    :data:`WAIT_FACTOR` times the estimated time of the blocks the controller
+    may still have to run before it, plus the link's ``response_timeout_s``; a
+    controller that reports ``Idle`` with blocks unanswered (a lost line end:
+    two lines taken as one, one answer fewer) is stopped after
+    :data:`IDLE_GRACE_S` plus the head block's own time. A job succeeds only
+    when every block was answered as accepted.
+
     Args:
         port: an open pyserial port (:func:`open_port`) or anything with its
             ``write``, ``flush``, ``read``, ``in_waiting`` and ``timeout``.
@@ -452,12 +555,23 @@ def send_plan(
 
     Raises:
         LinkError: no banner or answer in time, the controller in alarm, an
-            error or alarm during the job, the port gone, or the operator
-            stopped; the message says where and which ``--from-line`` resumes.
+            error or alarm during the job, the port gone, a controller that
+            stopped answering or went idle with blocks unanswered, or the
+            operator stopped; the message says which lines surely ran, which
+            may have run in part, and which ``--from-line`` resumes.
     """
     driver = _Driver(port, plan, port_name, control or StopAtPause(), progress, log, time_scale)
     driver.reopen = reopen
     return driver.run()
+
+
+WAIT_FACTOR = 3.0
+"""An answer may take this many times the timing model's estimate (plus the link's
+``response_timeout_s``) before the controller counts as lost: the estimate is a model,
+the controller's planner may be slower (overrides, acceleration), never this much."""
+IDLE_GRACE_S = 0.5
+"""Reports of ``Idle`` (every :data:`STATUS_PERIOD_S`) with blocks unanswered for this
+long, beyond the head block's own time, mean the controller will not answer them."""
 
 
 class _Driver:
@@ -480,6 +594,13 @@ class _Driver:
         self.last_status = 0.0
         self.turns = 0
         self.reopen: Callable[[], Any] | None = None
+        self.answer_since = time.monotonic()
+        self.idle_since: float | None = None
+        self.put_back: list[str] = []
+        self.unknown: list[str] = []
+        hooks = plan.hooks
+        self.can_halt = bool(self.spec.hold and self.spec.reset and self.spec.status)
+        self.can_halt = self.can_halt and (hooks.status or hooks.status_state) is not None
 
     def run(self) -> SendResult:
         start = time.monotonic()
@@ -489,6 +610,10 @@ class _Driver:
             self._finish()
         except _PortGone as exc:
             raise LinkError(f"{exc}; {self._lost_hint()}") from exc
+        except LinkError:
+            self._restore_settings()
+            raise
+        self._restore_settings()
         return SendResult(
             len(self.plan.blocks),
             self.plan.total_bytes,
@@ -509,15 +634,63 @@ class _Driver:
                 f"within {spec.banner_timeout_s:g} s): is it the {spec.target} controller, "
                 f"powered, at {spec.baud} baud?"
             )
-        if spec.status and self.plan.hooks.status_state is not None:
+        if spec.status and self._reads_status():
             state = self._query_state("before the job")
             if state.startswith("Alarm"):
                 raise LinkError(
                     f"{spec.target} is in alarm state ({state}): nothing was sent; clear it "
                     "at the machine (home it or unlock it) and send again"
                 )
+        if self.plan.hooks.setup is not None:
+            self.put_back = self.plan.hooks.setup(self._ask)
+            if spec.status and self._reads_status():
+                self._query_state("before the job")
         if spec.startup:
             self.wire.write(spec.startup, "at start-up")
+        self.answer_since = time.monotonic()
+
+    def _reads_status(self) -> bool:
+        hooks = self.plan.hooks
+        return hooks.status is not None or hooks.status_state is not None
+
+    def _ask(self, line: str) -> list[str]:
+        """Send one command line outside the program; its answers up to the ack.
+
+        Raises:
+            LinkError: an error answer, or none within ``response_timeout_s``.
+        """
+        spec = self.spec
+        where = f"asking {line!r}"
+        self.wire.write(line.encode("latin-1") + spec.block_end, where)
+        out: list[str] = []
+        deadline = time.monotonic() + spec.response_timeout_s
+        while time.monotonic() < deadline:
+            got = self.wire.lines(POLL_S, where)
+            for n, answer in enumerate(got):
+                if answer == spec.ack:
+                    self.wire.put_back(got[n + 1 :])
+                    return out
+                if spec.error and answer.startswith(spec.error):
+                    decode = self.plan.hooks.decode
+                    words = decode(answer) if decode else answer
+                    raise LinkError(f"{spec.target} refused {line!r}: {words}; nothing was sent")
+                if self._status_of(answer) is None:
+                    out.append(answer)
+        said = f" (it said only {', '.join(repr(a) for a in out[-5:])})" if out else ""
+        raise LinkError(
+            f"{spec.target}: no {spec.ack!r} to {line!r} within {spec.response_timeout_s:g} s"
+            f"{said}; nothing was sent"
+        )
+
+    def _restore_settings(self) -> None:
+        """Put back the settings :attr:`LinkHooks.setup` changed (best effort)."""
+        lines, self.put_back = self.put_back, []
+        for line in lines:
+            try:
+                self._ask(line)
+            except LinkError as exc:
+                self.messages.append(f"could not put back {line!r}: {exc}")
+                return
 
     def _modem_handshake(self) -> None:
         """DTR out, DSR back (seed-003 §3.2); skipped, with a note, on a port without them."""
@@ -547,30 +720,41 @@ class _Driver:
                 self.wire.write(wake, "at start-up")
             deadline = time.monotonic() + spec.banner_timeout_s
             while time.monotonic() < deadline:
-                for line in self.wire.lines(POLL_S, "at start-up"):
-                    if line.startswith(spec.banner) or (wake and self._state_of(line)):
+                got = self.wire.lines(POLL_S, "at start-up")
+                for n, line in enumerate(got):
+                    if line.startswith(spec.banner) or (wake and self._status_of(line)):
+                        self.wire.put_back(got[n + 1 :])
                         return True
                     self.messages.append(line)
             if not spec.wake:
                 break
         return False
 
-    def _state_of(self, line: str) -> str | None:
-        state = self.plan.hooks.status_state
-        return state(line) if state is not None else None
+    def _status_of(self, line: str) -> Status | None:
+        hooks = self.plan.hooks
+        if hooks.status is not None:
+            return hooks.status(line)
+        if hooks.status_state is not None:
+            state = hooks.status_state(line)
+            return Status(state) if state is not None else None
+        return None
 
     def _query_state(self, where: str) -> str:
         self.wire.write(self.spec.status, where)
+        self.last_status = time.monotonic()
         deadline = time.monotonic() + self.spec.response_timeout_s
         while time.monotonic() < deadline:
-            for line in self.wire.lines(POLL_S, where):
-                state = self._state_of(line)
-                if state is not None:
-                    return state
-                self._push(line)
+            got = self.wire.lines(POLL_S, where)
+            for n, line in enumerate(got):
+                status = self._status_of(line)
+                if status is not None:
+                    self.stream.report(status)
+                    self.wire.put_back(got[n + 1 :])
+                    return status.state
+                self._take(line)
         raise LinkError(
             f"{self.spec.target}: no status report on {self.wire.name!r} within "
-            f"{self.spec.response_timeout_s:g} s {where}"
+            f"{self.spec.response_timeout_s:g} s {where}; {self._unsure()}"
         )
 
     # -- the blocks -------------------------------------------------------------------
@@ -588,7 +772,12 @@ class _Driver:
             now = time.monotonic()
             if s.failure:
                 self._fail()
+            if getattr(control, "stop_requested", False):
+                self._operator_stop()
             pausing = pausing or control.pause_requested
+            if pausing and self.can_halt:
+                pausing = self._hold_pause()
+                continue
             if pausing or self._operator_turn():
                 if s.idle(now):
                     pausing = self._pause(pausing)
@@ -600,10 +789,17 @@ class _Driver:
                 self._send(k)
             else:
                 self._read(now)
+        if s.failure:  # the last answer was an error: the loop ended with nothing in flight
+            self._fail()
+        if s.done != len(self.plan.blocks):  # pragma: no cover - a job ends only when all are done
+            raise LinkError(f"{self.spec.target}: the job ended {self._where()}")
 
     def _send(self, k: int) -> None:
         s = self.stream
         block = s.block(k)
+        if not s.in_flight:
+            self.answer_since = time.monotonic()
+        s.sending(k)
         self.wire.write(block.data, f"while sending block {block.index} (line {block.line})")
         s.sent(k, time.monotonic())
         if self.spec.flow == "timed":
@@ -622,8 +818,9 @@ class _Driver:
         if pausing:
             control.pause_requested = False
             if control.paused(s.progress()) == "resume":
+                self.answer_since = time.monotonic()
                 return False
-            self._stop("stopped by the operator")
+            self._operator_stop()
         following = s.block(s.queue[0])
         assert s.last_done is not None
         if not control.between_blocks(self.spec.operator_between_blocks, s.last_done, following):
@@ -635,14 +832,73 @@ class _Driver:
             self.wire.port = self.reopen()
             if self.spec.startup:
                 self.wire.write(self.spec.startup, "at start-up")
+        self.answer_since = time.monotonic()
         return False
+
+    def _hold_pause(self) -> bool:
+        """Pause with the link's feed hold (GRBL ``!``); resume with its resume byte (``~``)."""
+        s, control = self.stream, self.control
+        control.pause_requested = False
+        self.wire.write(self.spec.hold, "pausing (feed hold)")
+        state = self._wait_held("pausing")
+        if not state.startswith(("Hold", "Idle")):
+            self._halt_and_raise(f"the feed hold was not confirmed (state {state})")
+        if control.paused(s.progress()) != "resume":
+            self._operator_stop()
+        self.wire.write(self.spec.resume, "resuming (cycle start)")
+        self.answer_since = time.monotonic()
+        self.idle_since = None
+        return False
+
+    def _wait_held(self, where: str) -> str:
+        """After a feed hold: poll until the controller says it stands (``Hold:0``, ``Idle``).
+
+        Answers that come meanwhile are taken (lines the controller still
+        queues). Bounded by ``response_timeout_s`` (a deceleration takes far
+        less); returns the last state seen.
+        """
+        state = ""
+        deadline = time.monotonic() + self.spec.response_timeout_s
+        while time.monotonic() < deadline:
+            self.wire.write(self.spec.status, where)
+            until = time.monotonic() + STATUS_PERIOD_S
+            while time.monotonic() < until:
+                got = self.wire.lines(POLL_S, where)
+                for n, line in enumerate(got):
+                    status = self._status_of(line)
+                    if status is None:
+                        self._take(line)
+                        continue
+                    self.stream.report(status)
+                    state = status.state
+                    if state in ("Hold:0", "Idle") or state.startswith("Alarm"):
+                        self.wire.put_back(got[n + 1 :])
+                        return state
+        return state
+
+    def _take(self, line: str) -> None:
+        """An answer read outside the stream's own turn: counted as the stream counts it."""
+        kind = self.stream.answer(line)
+        if kind == "ack":
+            self.answer_since = time.monotonic()
+            self.report(self.stream.progress())
+        elif kind == "push":
+            self._push(line)
 
     def _read(self, now: float) -> None:
         s = self.stream
         wait = POLL_S if s.in_flight or not s.queue else max(0.0, min(POLL_S, s.ready_at - now))
         lines = self.wire.lines(wait, f"while sending ({self._where()})")
         for line in lines:
+            status = self._status_of(line)
+            if status is not None:
+                s.report(status)
+                self._watch_idle(status)
+                continue
             kind = s.answer(line)
+            if kind in ("ack", "answer", "event", "error"):
+                self.answer_since = time.monotonic()
+                self.idle_since = None
             if kind == "ack":
                 self.report(s.progress())
             elif kind == "push":
@@ -651,18 +907,41 @@ class _Driver:
             self._keep_alive()
 
     def _push(self, line: str) -> None:
-        if self._state_of(line) is None:
+        if self._status_of(line) is None:
             self.messages.append(line)
+            self.unknown.append(line)
+
+    def _watch_idle(self, status: Status) -> None:
+        """A controller that says Idle while blocks wait for their answer will not answer them."""
+        s = self.stream
+        rx_empty = status.rx_free is None or status.rx_free >= self.spec.rx_buffer_bytes
+        queue_empty = status.queue_free is None or status.queue_free >= s.queue_size
+        if status.state != "Idle" or not s.in_flight or not (rx_empty and queue_empty):
+            self.idle_since = None
+            return
+        now = time.monotonic()
+        if self.idle_since is None:
+            self.idle_since = now
+            return
+        head = s.in_flight[0]
+        allowed = IDLE_GRACE_S + WAIT_FACTOR * s.time_s(head, head + 1)
+        if now - self.idle_since > allowed:
+            lines = self._lines_of(list(s.in_flight))
+            self._halt_and_raise(
+                f"{self.spec.target} is idle and has not answered {lines}: it took "
+                "them as fewer lines than were sent (a line end lost on the wire) or "
+                "never received them"
+            )
 
     def _keep_alive(self) -> None:
-        """Poll the status while waiting; a silent controller is lost after the timeout."""
+        """Poll the status while waiting; every wait for an answer has a bound."""
         now = time.monotonic()
+        s = self.stream
         if self.spec.status and now - self.last_status >= STATUS_PERIOD_S:
             self.wire.write(self.spec.status, f"while sending ({self._where()})")
             self.last_status = now
         if now - self.wire.last_rx > self.spec.response_timeout_s + self._in_flight_time():
             stopped = self._abort()
-            s = self.stream
             block = s.block(s.in_flight[0])
             unsure = (
                 f"block {block.index} (line {block.line}) was sent and not confirmed: it may "
@@ -672,6 +951,34 @@ class _Driver:
                 f"{self.spec.target} stopped answering on {self.wire.name!r} "
                 f"({self._where()}){stopped}; {unsure}{self._resume_hint()}"
             )
+        allowed = self._answer_bound()
+        if now - self.answer_since > allowed:
+            lines = self._lines_of(list(s.in_flight))
+            words = ""
+            if self.unknown:
+                shown = ", ".join(repr(w) for w in dict.fromkeys(self.unknown[-5:]))
+                words = f" (what it said instead: {shown})"
+            self._halt_and_raise(
+                f"{self.spec.target} has not answered {lines} in {now - self.answer_since:.0f} s, "
+                f"{WAIT_FACTOR:g} times the estimated time of what it had to run first plus "
+                f"{self.spec.response_timeout_s:g} s{words}"
+            )
+
+    def _answer_bound(self) -> float:
+        """Longest wait for the head block's answer: the blocks it may wait on, ×, + timeout."""
+        s = self.stream
+        head = s.in_flight[0]
+        first = min(s.surely_run(), head)
+        return WAIT_FACTOR * s.time_s(first, head + 1) + self.spec.response_timeout_s
+
+    def _lines_of(self, ks: list[int]) -> str:
+        blocks = [self.stream.block(k) for k in ks if self.stream.block(k).index]
+        if not blocks:
+            return "the restore blocks"
+        first, last = blocks[0], blocks[-1]
+        if first is last:
+            return f"block {first.index} (line {first.line}: {first.text!r})"
+        return f"blocks {first.index}–{last.index} (lines {first.line}–{last.last_line})"
 
     def _abort(self) -> str:
         """Send the link's ``abort`` bytes (the controller may be moving): what became of them.
@@ -696,6 +1003,89 @@ class _Driver:
             return f"; {text!r} could not be sent: stop the machine by hand"
         return f"; {text!r} sent but not echoed: stop the machine by hand"
 
+    def _halt(self) -> str:
+        """Stop the machine the link's way: feed hold, wait for it to stand, then reset.
+
+        GRBL: ``!`` decelerates to a stop keeping the position (``Hold:0``); a
+        reset (Ctrl-X) then empties its buffers and turns the spindle and the
+        coolant off (mc_reset), with no alarm since nothing moves (checked on
+        GRBL 1.1h: ``Idle`` after the banner, machine position kept). A
+        controller that does not confirm the hold within ``response_timeout_s``
+        is reset all the same (it then raises ``ALARM:3``: position lost).
+        Links without a hold: their ``abort`` bytes. Returns a clause for the
+        error message.
+        """
+        if not self.can_halt:
+            return self._abort()
+        spec, s = self.spec, self.stream
+        try:
+            self.wire.write(spec.hold, "stopping (feed hold)")
+            state = self._wait_held("stopping")
+            self.wire.write(spec.reset, "stopping (reset)")
+            deadline = time.monotonic() + spec.response_timeout_s
+            banner = False
+            while not banner and time.monotonic() < deadline:
+                for line in self.wire.lines(POLL_S, "stopping (reset)"):
+                    banner = banner or (bool(spec.banner) and line.startswith(spec.banner))
+                    if not banner:
+                        self._take(line)
+        except LinkError:
+            return "; the stop (feed hold, reset) could not be sent: stop the machine by hand"
+        s.in_flight.clear()
+        s.buffered = 0
+        held = state in ("Hold:0", "Idle")
+        how = "stopped it" if held else f"did not confirm the hold (state {state!r}): reset it"
+        return (
+            f"; camtool {how} with a feed hold, then a reset (spindle and coolant off"
+            + (", position kept" if held else ", position may be lost: home it")
+            + ")"
+        )
+
+    def _halt_and_raise(self, why: str) -> None:
+        stopped = self._halt()
+        raise LinkError(f"{why}{stopped}; {self._unsure()}")
+
+    def _unsure(self) -> str:
+        """What surely ran, what may have run in part, and where to resume."""
+        s = self.stream
+        run = s.surely_run()
+        if s.failed_at is not None:
+            run = min(run, s.failed_at)
+        sent = s.sent_count
+        first = s.first_line_from(run)
+        if first is None:
+            return "every block had run"
+        done = [s.block(k) for k in range(run) if s.block(k).index]
+        known = f"lines up to {done[-1].last_line} surely ran; " if done else ""
+        maybe = [s.block(k) for k in range(run, sent) if s.block(k).index]
+        maybe = [b for b in maybe if s.failed_at is None or b.index != s.block(s.failed_at).index]
+        partly = ""
+        if maybe:
+            span = (
+                f"line {maybe[0].line}"
+                if len(maybe) == 1
+                else f"lines {maybe[0].line}–{maybe[-1].last_line}"
+            )
+            partly = f"{span} had been taken by the controller and may have run, whole or in part; "
+        return f"{known}{partly}{self._resume_advice(first, bool(maybe))}"
+
+    def _resume_advice(self, line: int, partly: bool) -> str:
+        fix = "fix the cause, then " if self.stream.failed_at is not None else ""
+        if not partly:
+            return f"{fix}resume with --from-line {line}"
+        where, arc = self.plan.start_of(line)
+        if not arc:
+            return (
+                f"{fix}resume with --from-line {line} (a straight move re-run from where the "
+                "tool stands ends where it should)"
+            )
+        stand = f" (X{where[0]:g} Y{where[1]:g} Z{where[2]:g})" if where is not None else ""
+        return (
+            f"{fix}line {line} is an arc: if it began, bring the tool back to where it starts"
+            f"{stand} first (an arc re-run from part way has the wrong centre), then resume "
+            f"with --from-line {line}"
+        )
+
     def _in_flight_time(self) -> float:
         s = self.stream
         if self.spec.status:
@@ -714,9 +1104,12 @@ class _Driver:
     def _fail(self) -> None:
         s = self.stream
         failed, message = s.failed_block, s.failure or ""
-        stopped = self._abort()
-        if failed is not None:  # an alarm empties the controller's buffer: nothing to wait for
-            self._drain()
+        if self.can_halt:
+            stopped = self._halt()
+        else:
+            stopped = self._abort()
+            if failed is not None:  # an alarm empties the controller's buffer: nothing to wait for
+                self._drain()
         decode = self.plan.hooks.decode
         words = decode(message) if decode else message
         if failed is not None:
@@ -726,6 +1119,8 @@ class _Driver:
             head = f"{self.spec.target} refused {what}: {words}"
         else:
             head = f"{self.spec.target}: {words} ({self._where()})"
+        if self.can_halt or self.spec.flow == "char-count":
+            raise LinkError(f"{head}{stopped}; {self._unsure()}")
         raise LinkError(f"{head}{stopped}; the job stopped {self._where()}; {self._resume_hint()}")
 
     def _resume_hint(self) -> str:
@@ -737,11 +1132,13 @@ class _Driver:
     def _lost_hint(self) -> str:
         """Where a job stood when the port went: what is known to have run, what may have."""
         s = self.stream
-        sent = [b for b in self.plan.blocks[: len(self.plan.blocks) - len(s.queue)] if b.index]
+        sent = [s.block(k) for k in range(s.sent_count) if s.block(k).index]
         if not sent:
             return "no block of the program had been sent"
         last = sent[-1]
-        if self.spec.flow == "timed" or s.in_flight:
+        if self.spec.flow == "char-count":
+            return self._unsure()
+        if self.spec.flow == "timed" or s.in_flight or s.attempted is not None:
             confirmed = s.last_done if self.spec.flow != "timed" else None
             known = (
                 f"blocks up to line {confirmed.line} were confirmed; "
@@ -757,6 +1154,17 @@ class _Driver:
         line = s.resume_line()
         return f"resume with --from-line {line}" if line else "every block had been sent"
 
+    def _operator_stop(self) -> None:
+        """The operator stopped the job (Ctrl-C, SIGTERM, 'stop' at a pause)."""
+        if self.can_halt:
+            stopped = self._halt()
+            raise LinkError(f"stopped by the operator {self._where()}{stopped}; {self._unsure()}")
+        self._drain()
+        self._wait_idle()
+        line = self.stream.resume_line()
+        rest = f"resume with --from-line {line}" if line else "every block had been sent"
+        raise LinkError(f"stopped by the operator {self._where()}; {rest}")
+
     def _stop(self, why: str) -> None:
         self._drain()
         self._wait_idle()
@@ -768,13 +1176,28 @@ class _Driver:
         self._wait_idle()
 
     def _wait_idle(self) -> None:
-        """With status reports: wait until the controller says its motion is over."""
-        if not (self.spec.status and self.plan.hooks.status_state is not None):
+        """With status reports: wait until the controller says its motion is over.
+
+        Bounded by :data:`WAIT_FACTOR` times the estimated time of the blocks not
+        surely run, plus ``response_timeout_s``: a controller still in ``Run``
+        after that is stopped (:meth:`_halt`).
+        """
+        if not (self.spec.status and self._reads_status()):
             return
+        s = self.stream
+        start = time.monotonic()
+        allowed = WAIT_FACTOR * s.time_s(s.surely_run(), len(self.plan.blocks))
+        allowed += self.spec.response_timeout_s
         while True:
             state = self._query_state("at the end of the job")
             if state == "Idle":
                 return
             if state.startswith("Alarm"):
                 raise LinkError(f"{self.spec.target} went into alarm ({state}) {self._where()}")
+            if time.monotonic() - start > allowed:
+                self._halt_and_raise(
+                    f"{self.spec.target} still reports {state!r} {time.monotonic() - start:.0f} s "
+                    f"after its last answer, {WAIT_FACTOR:g} times the estimated time of what "
+                    f"it had left plus {self.spec.response_timeout_s:g} s"
+                )
             time.sleep(STATUS_PERIOD_S)

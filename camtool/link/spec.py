@@ -66,9 +66,10 @@ report for each block (its feedback events, a dwell it is busy for).
 from __future__ import annotations
 
 import math
+from array import array
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, overload
 
 from camtool.model.errors import InputError, LinkError, UsageError
 
@@ -101,6 +102,13 @@ class WireBlock:
             say (a dwell); the next block waits them.
         note: how messages show the block when its bytes are not text (a
             binary packet); ``""``: the bytes.
+        queued: fewest entries the block puts in the controller's motion
+            queue once accepted (GRBL: planner blocks, one per move that makes
+            a step; an arc at least one); a lower bound, so that counting the
+            queue back from the newest block never calls a block run too early.
+        sync: the controller answers the block only after every block before
+            it has run (GRBL: ``G4``, ``M3``/``M4``/``M5``, coolant, ``M0``,
+            ``M2``: protocol_buffer_synchronize); its answer says they ran.
     """
 
     index: int
@@ -111,11 +119,102 @@ class WireBlock:
     events: int = 0
     busy_s: float = 0.0
     note: str = ""
+    queued: int = 0
+    sync: bool = False
 
     @property
     def text(self) -> str:
         """The block as text for messages, without its terminator (or its note)."""
         return self.note or self.data.decode("latin-1").rstrip("\r\n")
+
+
+class LineBlocks(Sequence[WireBlock]):
+    """The blocks of a program framed one per line, made on demand from the file's bytes.
+
+    What :func:`frame_lines` returns: a long program (hundreds of thousands of
+    lines) is held as its bytes and one offset per line (``array``), not as one
+    :class:`WireBlock` object per line. Block ``k`` (0-based) is line ``k + 1``.
+    :meth:`with_facts` adds the ``queued`` and ``sync`` of every block the same
+    way (an ``expect`` hook's result).
+
+    Args:
+        data: the program's bytes.
+        starts: ``(n + 1,)`` offsets into ``data``: block ``k`` is
+            ``data[starts[k]:starts[k + 1]]``.
+        queued: ``(n,)`` per block, or ``None`` (all 0).
+        sync: ``(n,)`` 0/1 per block, or ``None`` (all False).
+    """
+
+    def __init__(
+        self,
+        data: bytes,
+        starts: array[int],
+        queued: array[int] | None = None,
+        sync: bytes | None = None,
+    ) -> None:
+        self.data = data
+        self.starts = starts
+        self.queued = queued
+        self.sync = sync
+
+    def __len__(self) -> int:
+        return len(self.starts) - 1
+
+    @overload
+    def __getitem__(self, k: int) -> WireBlock: ...
+
+    @overload
+    def __getitem__(self, k: slice) -> Sequence[WireBlock]: ...
+
+    def __getitem__(self, k: int | slice) -> WireBlock | Sequence[WireBlock]:
+        if isinstance(k, slice):
+            return [self[i] for i in range(*k.indices(len(self)))]
+        if k < 0:
+            k += len(self)
+        if not 0 <= k < len(self):
+            raise IndexError(k)
+        line = k + 1
+        return WireBlock(
+            line,
+            line,
+            line,
+            self.data[self.starts[k] : self.starts[k + 1]],
+            queued=self.queued[k] if self.queued is not None else 0,
+            sync=bool(self.sync[k]) if self.sync is not None else False,
+        )
+
+    def with_facts(self, queued: array[int], sync: bytes) -> LineBlocks:
+        """The same blocks with each one's ``queued`` and ``sync``."""
+        return LineBlocks(self.data, self.starts, queued, sync)
+
+
+class Joined(Sequence[WireBlock]):
+    """Some blocks before the blocks of another sequence from ``first`` on (a resume)."""
+
+    def __init__(self, head: Sequence[WireBlock], rest: Sequence[WireBlock], first: int) -> None:
+        self.head = list(head)
+        self.rest = rest
+        self.first = first
+
+    def __len__(self) -> int:
+        return len(self.head) + len(self.rest) - self.first
+
+    @overload
+    def __getitem__(self, k: int) -> WireBlock: ...
+
+    @overload
+    def __getitem__(self, k: slice) -> Sequence[WireBlock]: ...
+
+    def __getitem__(self, k: int | slice) -> WireBlock | Sequence[WireBlock]:
+        if isinstance(k, slice):
+            return [self[i] for i in range(*k.indices(len(self)))]
+        if k < 0:
+            k += len(self)
+        if not 0 <= k < len(self):
+            raise IndexError(k)
+        if k < len(self.head):
+            return self.head[k]
+        return self.rest[self.first + k - len(self.head)]
 
 
 @dataclass(frozen=True)
@@ -162,6 +261,23 @@ class LinkSpec:
 
 
 @dataclass(frozen=True)
+class Status:
+    """What a controller's status report says (GRBL ``<Run|MPos:…|Bf:14,120|…>``).
+
+    Attributes:
+        state: the state word (``"Idle"``, ``"Run"``, ``"Hold:0"``, ``"Alarm"``).
+        queue_free: free entries of the motion queue (GRBL ``Bf:`` first
+            number, planner blocks); ``None``: not reported.
+        rx_free: free bytes of the receive buffer (``Bf:`` second number);
+            ``None``: not reported.
+    """
+
+    state: str
+    queue_free: int | None = None
+    rx_free: int | None = None
+
+
+@dataclass(frozen=True)
 class LinkHooks:
     """The Python a target's protocol needs beyond its ``[link]`` table (``LINK``).
 
@@ -188,20 +304,34 @@ class LinkHooks:
         feedback: ``answer -> bool``: True for a feedback event (counted
             against :attr:`WireBlock.events`, never an answer).
         expect: ``(blocks, program, target) -> blocks``: the blocks with what
-            the controller will report for each (``events``, ``busy_s``), from
-            the program as the target's reader read it back. Raises
-            :class:`~camtool.model.errors.DialectError` for a block whose end
-            the sender could not tell.
+            the controller will report for each (``events``, ``busy_s``,
+            ``queued``, ``sync``), from the program as the target's reader read
+            it back. Raises :class:`~camtool.model.errors.DialectError` for a
+            block whose end the sender could not tell.
+        status: ``line -> Status or None``: reads a status report with its
+            queue counts (GRBL ``Bf:``); takes precedence over ``status_state``.
+        setup: ``ask -> lines``: settings the job needs, asked of the controller
+            before the first block with ``ask(line) -> answers`` (it raises
+            :class:`LinkError` for an error answer); returns the lines that put
+            the controller's settings back at the end (GRBL: ``$10`` with its
+            buffer-state bit, so status reports carry ``Bf:``).
+        check: ``(blocks, source) -> None``: refuse what the controller would
+            refuse, before the first byte: raises
+            :class:`~camtool.model.errors.DialectError` naming the line (GRBL:
+            words and codes its gcode.c does not take).
     """
 
-    frame: Callable[[bytes, LinkSpec, str], list[WireBlock]] | None = None
+    frame: Callable[[bytes, LinkSpec, str], Sequence[WireBlock]] | None = None
     decode: Callable[[str], str] | None = None
     resume: Callable[[Sequence[WireBlock], WireBlock, LinkSpec], list[WireBlock]] | None = None
     device: Callable[..., Any] | None = None
     status_state: Callable[[str], str | None] | None = None
     split: Callable[[bytearray], list[str]] | None = None
     feedback: Callable[[str], bool] | None = None
-    expect: Callable[[list[WireBlock], Any, Any], list[WireBlock]] | None = None
+    expect: Callable[[Sequence[WireBlock], Any, Any], Sequence[WireBlock]] | None = None
+    status: Callable[[str], Status | None] | None = None
+    setup: Callable[[Callable[[str], list[str]]], list[str]] | None = None
+    check: Callable[[Sequence[WireBlock], str], None] | None = None
 
 
 NO_HOOKS = LinkHooks()
@@ -300,27 +430,29 @@ def link_hooks(target: Target) -> LinkHooks:
     return hooks
 
 
-def frame_lines(code: bytes, spec: LinkSpec, source: str) -> list[WireBlock]:
+def frame_lines(code: bytes, spec: LinkSpec, source: str) -> LineBlocks:
     """One block per line: the bytes up to and including each ``block_end``.
 
     A last line without the terminator is a block too (it is sent as written:
     the file's bytes, no more). Empty lines are blocks (GRBL answers them ``ok``).
+    The blocks are made on demand (:class:`LineBlocks`).
 
     Raises:
         InputError: a block longer than ``max_block_bytes``, naming the line.
     """
     end = spec.block_end
-    blocks: list[WireBlock] = []
+    starts = array("q", [0])
+    limit = spec.max_block_bytes or spec.rx_buffer_bytes
     start = 0
     while start < len(code):
         cut = code.find(end, start)
         stop = len(code) if cut < 0 else cut + len(end)
-        line = len(blocks) + 1
-        blocks.append(WireBlock(line, line, line, code[start:stop]))
+        if limit and stop - start > limit:
+            line = len(starts)
+            check_block_size(WireBlock(line, line, line, code[start:stop]), spec, source)
+        starts.append(stop)
         start = stop
-    for block in blocks:
-        check_block_size(block, spec, source)
-    return blocks
+    return LineBlocks(code, starts)
 
 
 def check_block_size(block: WireBlock, spec: LinkSpec, source: str) -> None:

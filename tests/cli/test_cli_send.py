@@ -40,16 +40,16 @@ def test_dry_run_prints_the_plan_on_stdout(job: Path, capsys: Any) -> None:
     assert err == ""
 
 
-def test_what_the_reader_could_not_honour_is_said_before_sending(
-    tmp_path: Path, capsys: Any
-) -> None:
-    # a CamBam-style header (LinuxCNC's craftsmancnc.ngc): G64 blending means nothing to the
-    # verifier's model of GRBL, and the machinist must hear it before the job starts
+def test_what_grbl_would_refuse_is_refused_before_sending(tmp_path: Path, capsys: Any) -> None:
+    # a CamBam-style header (LinuxCNC's craftsmancnc.ngc): GRBL 1.1h has no G64 (gcode.c takes
+    # G61 only) and answers this very line `error:20` (checked on GRBL 1.1h built with
+    # grbl-sim): refused before the first byte, naming the line, exit 3
     path = tmp_path / "cambam.ngc"
     path.write_text("G21 G90 G64 P0.25 G40\nG0 Z5\nG0 X1 Y1\nG1 Z-0.5 F100\nG1 X2\nG0 Z5\nM2\n")
     code, _, err = run(["send", str(path), "-t", "grbl", "--dry-run"], capsys)
-    assert code == 0
-    assert ":1: G64 path blending" in err
+    assert code == 3
+    assert "cambam.ngc, line 1: 'G21 G90 G64 P0.25 G40': GRBL 1.1 would refuse it" in err
+    assert "error:20 (Unsupported command" in err
 
 
 def test_dry_run_from_line_shows_the_restore(job: Path, capsys: Any) -> None:
@@ -154,3 +154,56 @@ def test_valcnc_through_simulate_device(tmp_path: Path, capsys: Any) -> None:
     assert code == 0, f"send: {err}\nsimulator: {sim_err}"
     assert "one limit switch per axis" in err
     assert f"received 10 blocks ({len(VALCNC)} bytes), ran 10" in sim_err, sim_err
+
+
+@pytest.mark.parametrize("refused", [41, 42])
+def test_a_refused_block_is_exit_1_even_the_last(
+    refused: int, tmp_path: Path, simulate: Any, capsys: Any
+) -> None:
+    # the logo posted for grbl has 42 lines, the last `M2`; GRBL answers a line it refuses
+    # with error:N (interface.md), so the job fails whichever line that is
+    logo = tmp_path / "logo.gcode"
+    assert main(["post", "samples/logo.dxf", "-t", "grbl", "-o", str(logo)]) == 0
+    lines = logo.read_text().splitlines()
+    assert len(lines) == 42 and lines[-1] == "M2"
+    capsys.readouterr()
+    sim = simulate("grbl", fail_at_block=refused, error="20")
+    code, _, err = run(["send", str(logo), "-t", "grbl", "--port", sim.path], capsys)
+    assert code == 1, err
+    assert f"refused block {refused} (line {refused}: {lines[refused - 1]!r})" in err
+    assert "sent 42 blocks" not in err
+
+
+SIMULATE = [sys.executable, "-m", "camtool", "simulate-device"]
+
+
+def test_sigterm_stops_the_job_as_the_operator_would(job: Path) -> None:
+    # SIGTERM (a service manager, `kill`) is the operator's stop: feed hold, reset, and the
+    # line to resume at, exit 1 — never a silent end
+    sim = subprocess.Popen(
+        [*SIMULATE, "-t", "grbl", "--pty", "--block-delay-ms", "200"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=_sigint_default,
+    )
+    try:
+        assert sim.stdout is not None
+        path = sim.stdout.readline().strip()
+        send = subprocess.Popen(
+            [sys.executable, "-m", "camtool", "send", str(job), "-t", "grbl", "--port", path],
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        assert send.stderr is not None
+        started = send.stderr.readline()  # "camtool: sending N blocks ...": the job runs
+        assert "sending" in started, started
+        send.send_signal(signal.SIGTERM)
+        _, err = send.communicate(timeout=120)
+    finally:
+        sim.send_signal(2)
+        sim.communicate(timeout=60)
+    assert send.returncode == 1, err
+    assert "stopped by the operator" in err
+    assert "feed hold, then a reset (spindle and coolant off" in err
+    assert "--from-line" in err and "Traceback" not in err
