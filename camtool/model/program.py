@@ -23,6 +23,7 @@ simulator, metrics) never see them.
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Literal, TypeAlias
@@ -277,17 +278,33 @@ class Program:
         ]
         return bbox_union(boxes)
 
+    def path_lengths(self) -> list[float]:
+        """The length of each move's path, Z included, mm (``len(moves)`` values).
+
+        ``√(xy² + Δz²)``, where ``xy`` is the XY path (an arc's arc length): the distance a
+        controller's planner times a move by (GRBL's ``planner.c`` takes the
+        Euclidean length of the axis deltas; a helix's length by its arc). A Z-only move is
+        its Z travel. The program starts at Z 0, as it starts at :attr:`origin` in XY.
+        """
+        out = []
+        z = 0.0
+        for move, seg in self.segments():
+            dz = 0.0 if move.z is None else move.z - z
+            out.append(math.hypot(seg.length, dz))
+            z = move.z if move.z is not None else z
+        return out
+
     def cut_length(self) -> float:
         """Length of the cutting moves (not rapids), mm."""
         return sum(seg.length for move, seg in self.segments() if not isinstance(move, Rapid))
 
     def cutting_time_s(self) -> float:
-        """Time of the cutting moves at their programmed feeds, s (rapids excluded)."""
+        """Time of the cutting moves at their programmed feeds, Z included, s (no rapids)."""
         total = 0.0
-        for move, seg in self.segments():
+        for move, length in zip(self.moves, self.path_lengths(), strict=True):
             if isinstance(move, Rapid) or move.feed_mm_min <= 0:
                 continue
-            total += seg.length / move.feed_mm_min * 60.0
+            total += length / move.feed_mm_min * 60.0
         return total
 
 

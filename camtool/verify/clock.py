@@ -28,7 +28,7 @@ def block_kinematics(trace: StepTrace, program: Program) -> BlockKinematics:
         dominant_steps=trace.block_dominant,
         is_rapid=[isinstance(m, Rapid) for m in moves],
         feed_mm_min=[0.0 if isinstance(m, Rapid) else m.feed_mm_min for m in moves],
-        length_mm=[segment.length for _, segment in program.segments()],
+        length_mm=program.path_lengths(),
         iterations=rows - trace.block_compensation,
         steps=steps,
         compensation_steps=trace.block_compensation,
@@ -97,7 +97,7 @@ def _at_feed(program: Program, machine: Machine) -> npt.NDArray[np.float64]:
         )
     rapid = max(feeds, default=1.0)
     out = [
-        segment.length / ((rapid if isinstance(move, Rapid) else move.feed_mm_min) / 60.0)
-        for move, segment in program.segments()
+        length / ((rapid if isinstance(move, Rapid) else move.feed_mm_min) / 60.0)
+        for move, length in zip(program.moves, program.path_lengths(), strict=True)
     ]
     return np.asarray(out, dtype=np.float64)

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import pytest
 
 from camtool.model.errors import InputError
-from camtool.model.program import Linear, Program, Rapid
-from camtool.post.registry import load_machine
+from camtool.model.program import ArcMove, Linear, Program, Rapid
+from camtool.post.registry import load_machine, load_target
 from camtool.verify.verifier import verify_program
 
 
@@ -31,3 +32,22 @@ def test_a_cut_without_a_feed_is_named_not_divided_by() -> None:
     program = Program((Linear(5.0, 1.0, 0.0),))
     with pytest.raises(InputError, match=r"no \[machine.timing\] table.*without a feed"):
         verify_program(program, no_timing())
+
+
+def test_z_moves_are_timed_by_their_length() -> None:
+    """A 25 mm Z feed at F100 on GRBL: the trapezoid of its own length, never 0 s.
+
+    Rest to rest at v = 100/60 mm/s and GRBL's default a = 10 mm/s² ($122): the ramps
+    take v/a and cover v²/a, so t = L/v + v/a = 15 s + 1/6 s (analysis, not camtool).
+    """
+    from camtool.verify.verifier import verify_code
+
+    v = verify_code("G21 G90 G94\nG1 Z-25 F100\nM2\n", load_target("grbl"), source="z.ngc")
+    assert v.time_s == pytest.approx(25 / (100 / 60) + (100 / 60) / 10.0, rel=1e-6)
+
+
+def test_a_helix_is_as_long_as_its_arc_and_its_drop() -> None:
+    quarter = ArcMove(0.0, 10.0, 0.0, 0.0, False, 60.0, z=-3.0)
+    program = Program((Rapid(10.0, 0.0, 0.0), quarter))
+    arc = math.pi / 2 * 10.0
+    assert program.path_lengths() == pytest.approx([10.0, math.hypot(arc, 3.0)])
