@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import click
 
-from camtool.cli.common import MACHINE, warn, write_output
+from camtool.cli.common import MACHINE, publishes, warn, write_output
 from camtool.model.errors import InputError, UsageError
 
 TARGET = click.option(
@@ -32,9 +33,22 @@ def calibrate() -> None:
     metavar="FILE",
     help="Where the measurement sheet goes: FILE.md and FILE.csv (default: next to -o).",
 )
+@click.option(
+    "--force",
+    is_flag=True,
+    help="Replace an existing sheet beside -o (without --sheet) instead of refusing.",
+)
 @MACHINE
-def coupon(target: str, output: str, sheet: str | None, machine_file: Path | None) -> None:
-    """Write a calibration coupon for a target and its measurement sheet (.md and .csv)."""
+@publishes
+def coupon(
+    target: str, output: str, sheet: str | None, force: bool, machine_file: Path | None
+) -> None:
+    """Write a calibration coupon for a target and its measurement sheet (.md and .csv).
+
+    Without --sheet the sheet goes beside -o (part.gcode: part.md and part.csv); an
+    existing file of that name is refused without --force, since the command line
+    never named it.
+    """
     from camtool.calibrate import make_coupon
     from camtool.jobs.output import check_paths
     from camtool.jobs.pipeline import load_target_checked
@@ -49,6 +63,12 @@ def coupon(target: str, output: str, sheet: str | None, machine_file: Path | Non
         target=target,
         machine_file=machine_file,
     )
+    taken = [name for name in (md, csv) if os.path.lexists(name)]
+    if sheet is None and taken and not force:
+        raise UsageError(
+            f"{' and '.join(taken)} already exist beside -o {output}: the sheet would replace "
+            "them; give --sheet FILE for another name, or --force to replace them"
+        )
     files = make_coupon(
         load_target_checked(target, machine_file=machine_file),
         code_name=Path(output).name if output != "-" else "the coupon program",
@@ -70,6 +90,7 @@ def coupon(target: str, output: str, sheet: str | None, machine_file: Path | Non
 @click.argument("measured", metavar="MEASURED.csv")
 @click.option("-o", "--output", required=True, metavar="M.toml", help="The --machine overlay.")
 @MACHINE
+@publishes
 def fit(target: str, measured: str, output: str, machine_file: Path | None) -> None:
     """Fit the target's profile to a filled-in sheet; write a --machine overlay."""
     from camtool.calibrate import fit_sheet

@@ -6,17 +6,19 @@ every command; the helpers keep stdout for data and stderr for messages.
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from contextvars import ContextVar
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ParamSpec, TypeVar
 
 import click
 
-from camtool.model.errors import CamtoolError
+from camtool.model.errors import CamtoolError, VerifyLimitError
 from camtool.toolpath.options import (
     DEFAULT_CHAIN_TOLERANCE,
     DIRECTIONS,
@@ -30,6 +32,7 @@ from camtool.toolpath.options import (
 if TYPE_CHECKING:
     from camtool.importers.options import ImportOptions
     from camtool.jobs.job import Job
+    from camtool.jobs.output import Staged
     from camtool.jobs.pipeline import OutputOptions
 
 
@@ -80,8 +83,54 @@ def warn(messages: tuple[str, ...] | list[str]) -> None:
         click.echo(f"camtool: warning: {message}", err=True)
 
 
+P = ParamSpec("P")
+R = TypeVar("R")
+_STAGED: ContextVar[tuple[Staged, list[str | bytes]] | None] = ContextVar("staged", default=None)
+
+
+def publishes(command: Callable[P, R]) -> Callable[P, R]:
+    """Run ``command`` with its outputs published together, at its end, or not at all.
+
+    Inside, :func:`write_output` stages each file (:class:`camtool.jobs.output.Staged`)
+    and keeps what goes to stdout; when the command returns, every file is renamed
+    into place and stdout written. When it raises (a report that cannot be written,
+    a verification over its limit is not an error of writing: the limit check runs
+    after), the temporaries are removed and nothing of the run is published.
+    """
+
+    @functools.wraps(command)
+    def run(*args: P.args, **kwargs: P.kwargs) -> R:
+        from camtool.jobs.output import Staged
+
+        staged: tuple[Staged, list[str | bytes]] = (Staged(), [])
+        token = _STAGED.set(staged)
+        try:
+            result = command(*args, **kwargs)
+        except BaseException as exc:
+            if isinstance(exc, VerifyLimitError):
+                _publish(*staged)  # the files are right; the limit decides the exit code
+            else:
+                staged[0].discard()
+            raise
+        finally:
+            _STAGED.reset(token)
+        _publish(*staged)
+        return result
+
+    return run
+
+
+def _publish(files: Staged, stdout: list[str | bytes]) -> None:
+    files.publish()
+    for data in stdout:
+        _write_stdout(data)
+
+
 def write_output(data: str | bytes, out: str) -> None:
     """``data`` to the file ``out`` (:func:`camtool.jobs.output.write_file`), or stdout for ``-``.
+
+    Inside a command run by :func:`publishes`, the file is staged and published with
+    the command's other outputs when it ends.
 
     Raises:
         CamtoolError: the file cannot be written, naming it and why (``x.pic: cannot
@@ -91,6 +140,13 @@ def write_output(data: str | bytes, out: str) -> None:
     """
     from camtool.jobs.output import write_file
 
+    staged = _STAGED.get()
+    if staged is not None:
+        if out == "-":
+            staged[1].append(data)
+        else:
+            staged[0].stage(out, data)
+        return
     if out == "-":
         _write_stdout(data)
         return

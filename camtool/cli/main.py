@@ -27,6 +27,7 @@ from camtool.cli.common import (
     picture_ahead,
     plan_settings,
     post_options,
+    publishes,
     read_job,
     warn,
     write_output,
@@ -114,6 +115,7 @@ def cli() -> None:
 @import_options
 @click.option("--verify", "verify_too", is_flag=True, help="Verify the emitted code (see verify).")
 @_verify_outputs
+@publishes
 def post(
     drawing: str,
     target: str,
@@ -256,6 +258,7 @@ def post(
 )
 @MACHINE
 @_verify_outputs
+@publishes
 def verify(
     code: str,
     target: str,

@@ -21,6 +21,7 @@ from camtool.cli.common import (
     import_settings,
     number_range,
     picture_ahead,
+    publishes,
     warn,
     write_output,
 )
@@ -62,6 +63,7 @@ if TYPE_CHECKING:
 )
 @click.option("--title", default=None, metavar="TEXT", help="First title line [default: INPUT].")
 @import_options
+@publishes
 def preview(
     input_name: str,
     output: str | None,

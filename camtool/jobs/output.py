@@ -53,7 +53,9 @@ def check_outputs(
 
     Two paths are the same file when their :func:`os.path.realpath` (symlinks and
     ``..`` resolved) are equal, or, when both exist, when they share device and inode
-    (:func:`os.path.samefile`: hard links too). Two ``"-"`` outputs both name stdout.
+    (:func:`os.path.samefile`: hard links too). An input ``"-"`` is the file standard
+    input reads, when that is a regular file (``< part.dxf``: by device and inode). Two
+    ``"-"`` outputs both name stdout.
     Nothing is read or written; run it before anything else.
 
     Args:
@@ -70,6 +72,9 @@ def check_outputs(
     for label, path in _named(inputs):
         if path != "-":
             known_inputs.add(path, (label, path))
+        elif (inode := _stdin_file()) is not None:
+            # `camtool post - -o part.dxf < part.dxf`: stdin is that very file
+            known_inputs.by_inode.setdefault(inode, (label, "- (standard input)"))
     known_outputs = _Index()
     stdout: str | None = None
     for label, path in _named(outputs):
@@ -144,6 +149,86 @@ def write_file(path: str | Path, data: str | bytes) -> None:
         raise CamtoolError(f"{path}: cannot write ({reason(exc)})") from exc
 
 
+class Staged:
+    """The files of one run, written to temporaries first and published together.
+
+    :meth:`stage` writes a regular file's data to its temporary beside it (as
+    :func:`write_atomic` does, without the rename); a device or FIFO is only
+    remembered. :meth:`publish` renames every temporary into place, then writes the
+    devices; :meth:`discard` removes the temporaries. A run that fails on its third
+    file (a full disk, a read-only folder) has replaced none of the first two.
+    """
+
+    def __init__(self) -> None:
+        self._renames: list[tuple[Path, Path]] = []
+        self._through: list[tuple[str | Path, bytes]] = []
+
+    def stage(self, path: str | Path, data: str | bytes) -> None:
+        """Write ``data`` for ``path`` to its temporary (or keep it, for a device).
+
+        Raises:
+            CamtoolError: the temporary cannot be written, naming ``path`` and why.
+        """
+        payload = data.encode("utf-8") if isinstance(data, str) else data
+        try:
+            st: os.stat_result | None = os.stat(path)
+        except FileNotFoundError:
+            st = None
+        except OSError as exc:
+            raise CamtoolError(f"{path}: cannot write ({reason(exc)})") from exc
+        if st is not None and stat.S_ISDIR(st.st_mode):
+            raise CamtoolError(f"{path}: cannot write (is a directory)")
+        if st is not None and not stat.S_ISREG(st.st_mode):
+            self._through.append((path, payload))
+            return
+        target = Path(os.path.realpath(path))
+        tmp = temp_path(target)
+        try:
+            remove_stale_temps(target.parent)
+            fd = _create(tmp)
+            try:
+                if st is not None:
+                    os.fchmod(fd, stat.S_IMODE(st.st_mode))
+                view = memoryview(payload)
+                while view:
+                    view = view[os.write(fd, view) :]
+                os.fsync(fd)
+            finally:
+                os.close(fd)
+        except OSError as exc:
+            tmp.unlink(missing_ok=True)
+            raise CamtoolError(f"{path}: cannot write ({reason(exc)})") from exc
+        self._renames.append((tmp, target))
+
+    def publish(self) -> None:
+        """Write the devices, then rename every staged file into place.
+
+        Raises:
+            CamtoolError: a device write (then no file is published) or a rename failed,
+                naming the file.
+        """
+        for path, payload in self._through:
+            try:
+                _write_through(path, payload)
+            except OSError as exc:
+                self.discard()
+                raise CamtoolError(f"{path}: cannot write ({reason(exc)})") from exc
+        renames, self._renames = self._renames, []
+        for tmp, target in renames:
+            try:
+                os.replace(tmp, target)
+            except OSError as exc:
+                for left, _ in renames:
+                    left.unlink(missing_ok=True)
+                raise CamtoolError(f"{target}: cannot write ({reason(exc)})") from exc
+
+    def discard(self) -> None:
+        """Remove every staged temporary: nothing of the run is published."""
+        for tmp, _ in self._renames:
+            tmp.unlink(missing_ok=True)
+        self._renames, self._through = [], []
+
+
 class _Index:
     """Named paths by real path and by (device, inode): a clash is found in O(1)."""
 
@@ -173,6 +258,15 @@ def _named(items: Iterable[Named]) -> Iterator[tuple[str, str]]:
 
 _Key = tuple[str, tuple[int, int] | None]
 """A path's identity: its real path, and its (device, inode) when it exists."""
+
+
+def _stdin_file() -> tuple[int, int] | None:
+    """``(device, inode)`` of the regular file standard input reads, or ``None``."""
+    try:
+        st = os.fstat(0)
+    except OSError:
+        return None
+    return (st.st_dev, st.st_ino) if stat.S_ISREG(st.st_mode) else None
 
 
 def _identity(path: str | Path) -> _Key:
