@@ -41,6 +41,7 @@ from typing import TYPE_CHECKING
 
 from camtool.importers import DRAWING_SUFFIXES, read_drawing, read_drawing_bytes
 from camtool.model.errors import InputError, UsageError
+from camtool.model.tomlfile import read_toml_file
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -299,54 +300,5 @@ def _below(path: Path, directory: Path) -> bool:
 
 
 def read_small_toml(path: str | Path, *, what: str, limit_bytes: int) -> dict[str, object]:
-    """A small TOML file (a job file) read safely: a regular file, its size bounded.
-
-    Args:
-        path: the file.
-        what: what the file is, for messages (``"job file"``).
-        limit_bytes: the largest file read.
-
-    Raises:
-        InputError: not a regular file (a FIFO or a device is not opened for reading), too
-            large, not UTF-8 text, or not TOML (the message gives tomllib's line and
-            column); nested more deeply than any job needs.
-    """
-    import stat
-    import tomllib
-
-    name = str(path)
-    try:
-        fd = os.open(name, os.O_RDONLY | os.O_NONBLOCK)
-    except OSError as exc:
-        raise InputError(f"{name}: cannot read the {what} ({exc.strerror or exc})") from None
-    try:
-        info = os.fstat(fd)
-        if not stat.S_ISREG(info.st_mode):
-            raise InputError(f"{name}: the {what} is not a regular file")
-        if info.st_size > limit_bytes:
-            raise InputError(
-                f"{name}: the {what} is {info.st_size} bytes, more than {limit_bytes}; "
-                f"is it a {what}?"
-            )
-        with os.fdopen(os.dup(fd), "rb") as stream:
-            data = stream.read(limit_bytes + 1)
-    finally:
-        os.close(fd)
-    if len(data) > limit_bytes:
-        raise InputError(f"{name}: the {what} is larger than {limit_bytes} bytes")
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise InputError(
-            f"{name}: the {what} is not UTF-8 text (byte {exc.start}); save it as UTF-8"
-        ) from None
-    if text.startswith("\ufeff"):
-        text = text[1:]
-    if re.search(r"[\[{]{64}", text.replace(" ", "")):
-        raise InputError(f"{name}: the {what} nests arrays or tables more than 64 deep")
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{name}: the {what} is not valid TOML ({exc})") from None
-    except RecursionError:
-        raise InputError(f"{name}: the {what} nests arrays or tables too deeply") from None
+    """A small TOML file read safely (:func:`camtool.model.tomlfile.read_toml_file`)."""
+    return read_toml_file(path, what=what, limit_bytes=limit_bytes)

@@ -24,7 +24,6 @@ Profile layout (every key optional except ``name``, ``steps_per_mm`` and
 from __future__ import annotations
 
 import math
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -33,6 +32,7 @@ from typing import Any
 
 from camtool.model.errors import InputError
 from camtool.model.shapes import BBox
+from camtool.model.tomlfile import SMALL_TOML_BYTES, read_toml_file
 
 ROUNDINGS = ("half_even", "half_up", "floor", "trunc")
 """mm → steps rounding rules (:func:`camtool.verify.quantize.steps_from_mm`)."""
@@ -203,6 +203,23 @@ class Machine:
         )
 
 
+RANGES: dict[str, tuple[float, float, str]] = {
+    "steps_per_mm": (1e-3, 1e6, "steps/mm"),
+    "true_steps_per_mm": (1e-3, 1e6, "steps/mm"),
+    "max_step_rate_hz": (1e-3, 1e7, "Hz"),
+    "work_area_mm": (0.0, 1e6, "mm"),
+    "chord_tolerance_mm": (1e-5, 10.0, "mm"),
+    "chord_segments": (1, 10_000, "chords per arc"),
+    "chord_angle_deg": (1e-2, 180.0, "degrees"),
+    "true_um": (0.0, 1e5, "µm"),
+    "compensation_um": (0.0, 1e5, "µm"),
+}
+"""The physical range of each number of a ``[machine]`` table (its magnitude; 0 means
+"none" where a key allows it): a hostile or mistyped value (``steps_per_mm = 1e300``,
+``chord_tolerance_mm = 1e-300``, ``chord_segments = 1e15``) is refused naming the key,
+the range and the unit, before it can hang a simulation or fill memory."""
+
+
 def machine_from_table(table: Mapping[str, Any], *, where: str) -> Machine:
     """Build a :class:`Machine` from a TOML ``[machine]`` table.
 
@@ -225,7 +242,7 @@ def machine_from_table(table: Mapping[str, Any], *, where: str) -> Machine:
         work_area_mm=(x0, y0, x1, y1),
         coordinates=r.choice("coordinates", COORDINATES, "work"),
         has_z=r.flag("has_z", True),
-        max_step_rate_hz=r.number("max_step_rate_hz", 0.0),
+        max_step_rate_hz=r.number("max_step_rate_hz", 0.0, nonnegative=True),
         source=r.text("source"),
         true_steps_per_mm=true_steps if "true_steps_per_mm" in table else None,
         profile=r.text("profile"),
@@ -245,7 +262,7 @@ def _motion(r: _Reader) -> Motion:
         arc=r.name("arc", d.arc),
         chords=r.name("chords", d.chords),
         chord_tolerance_mm=r.number("chord_tolerance_mm", d.chord_tolerance_mm, positive=True),
-        chord_segments=int(r.number("chord_segments", d.chord_segments, positive=True)),
+        chord_segments=r.whole("chord_segments", d.chord_segments),
         chord_angle_deg=r.number("chord_angle_deg", d.chord_angle_deg, positive=True),
         rounding=r.choice("rounding", dict.fromkeys(ROUNDINGS, ""), d.rounding),
     )
@@ -340,6 +357,16 @@ class _Reader:
             return float(default)  # type: ignore[arg-type]
         return self._check(key, value, positive, nonnegative)
 
+    def whole(self, key: str, default: int) -> int:
+        """A whole number in :data:`RANGES` (``chord_segments``)."""
+        value = self._get(key, False)
+        if value is None:
+            return default
+        number = self._check(key, value, True, False)
+        if number != int(number):
+            raise self._fail(key, "a whole number", value)
+        return int(number)
+
     def _check(self, key: str, value: Any, positive: bool, nonnegative: bool) -> float:
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise self._fail(key, "a number", value)
@@ -347,6 +374,12 @@ class _Reader:
         if not math.isfinite(number) or (positive and number <= 0) or (nonnegative and number < 0):
             want = "a positive number" if positive else "a number >= 0" if nonnegative else "finite"
             raise self._fail(key, want, value)
+        span = RANGES.get(key)
+        if span is not None and number != 0 and not span[0] <= abs(number) <= span[1]:
+            low, high, unit = span
+            raise self._fail(
+                key, f"between {low:g} and {high:g} {unit} (a physical machine)", value
+            )
         return number
 
     def floats(
@@ -425,16 +458,11 @@ def merge_tables(base: Mapping[str, Any], override: Mapping[str, Any]) -> dict[s
     return merged
 
 
-def load_toml(path: Path) -> dict[str, Any]:
-    """Read a TOML file.
+def load_toml(path: Path, what: str = "TOML file") -> dict[str, Any]:
+    """Read a machine or target TOML file (:func:`camtool.model.tomlfile.read_toml_file`).
 
     Raises:
-        InputError: the file is missing or not valid TOML.
+        InputError: the file is missing, not a regular file, over
+            :data:`~camtool.model.tomlfile.SMALL_TOML_BYTES`, not UTF-8 or not valid TOML.
     """
-    try:
-        with path.open("rb") as fh:
-            return tomllib.load(fh)
-    except OSError as exc:
-        raise InputError(f"{path}: cannot read ({exc.strerror or exc})") from exc
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{path}: not valid TOML ({exc})") from exc
+    return read_toml_file(path, what=what, limit_bytes=SMALL_TOML_BYTES)

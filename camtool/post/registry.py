@@ -364,7 +364,10 @@ def load_target(name: str, *, machine_file: Path | str | None = None) -> Target:
     if name.endswith(".toml"):
         path = Path(name)
         return _target_from_table(
-            load_toml(path), where=str(path), machine_file=machine_file, origin=str(path)
+            load_toml(path, "target file"),
+            where=str(path),
+            machine_file=machine_file,
+            origin=str(path),
         )
     provider = _builtin(name)
     if provider is not None:
@@ -479,9 +482,20 @@ def _number(table: Mapping[str, Any], key: str, where: str, default: Any) -> Any
     value = table.get(key, default)
     if value is default:
         return value
-    if isinstance(value, bool) or not isinstance(value, int | float) or value <= 0:
-        raise InputError(f"{where}: {key} must be a positive number, not {value!r}")
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, int | float)
+        or not 0 < value <= _LIMITS.get(key, 1e6)
+    ):
+        raise InputError(
+            f"{where}: {key} must be a positive number up to {_LIMITS.get(key, 1e6):g}, "
+            f"not {value!r}"
+        )
     return float(value)
+
+
+_LIMITS = {"spindle_rpm": 1e6, "default_feed_mm_min": 1e6}
+"""Largest value of a target file's top-level numbers (rev/min, mm/min); nan is refused."""
 
 
 def machine_names() -> list[str]:
@@ -501,7 +515,7 @@ def machine_table(name: str) -> tuple[dict[str, Any], str]:
         InputError: no such profile or file, or not valid TOML.
     """
     if name.endswith(".toml") or Path(name).is_file():
-        table = load_toml(Path(name))
+        table = load_toml(Path(name), "machine file")
         where = name
     else:
         for provider in _builtin_providers():

@@ -249,26 +249,37 @@ class _Table:
             raise self.error(key, f"expected a string, got {_show(value)}")
         if choices and value not in choices:
             raise self.error(key, f"expected one of {_show(list(choices))}, got {_show(value)}")
+        self._ascii(key, value)
         return value
 
-    def integer(self, key: str, default: int | None, *, low: int = 0) -> int | None:
+    def _ascii(self, key: str, value: str) -> None:
+        """Machine code is ASCII: a controller reads bytes, not an encoding."""
+        if not value.isascii() or any(c < " " and c not in "\t\r\n" for c in value):
+            raise self.error(
+                key, f"expected printable ASCII (what a controller reads), got {_show(value)}"
+            )
+
+    def integer(self, key: str, default: int | None, *, low: int = 0, high: int = 15) -> int | None:
         value = self.get(key)
         if value is None:
             return default
         if isinstance(value, bool) or not isinstance(value, int):
             raise self.error(key, f"expected an integer, got {_show(value)}")
-        if value < low:
-            raise self.error(key, f"expected an integer >= {low}, got {value}")
+        if not low <= value <= high:
+            raise self.error(key, f"expected an integer from {low} to {high}, got {value}")
         return value
 
-    def number(self, key: str, default: float | None) -> float | None:
+    def number(
+        self, key: str, default: float | None, *, low: float = 1e-6, high: float = 1e6
+    ) -> float | None:
+        """A positive number from ``low`` to ``high`` (a grid in mm, a scale)."""
         value = self.get(key)
         if value is None:
             return default
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise self.error(key, f"expected a number, got {_show(value)}")
-        if not math.isfinite(value) or value <= 0:
-            raise self.error(key, f"expected a positive number, got {_show(value)}")
+        if not math.isfinite(value) or not low <= value <= high:
+            raise self.error(key, f"expected a number from {low:g} to {high:g}, got {_show(value)}")
         return float(value)
 
     def flag(self, key: str, default: bool) -> bool:
@@ -285,6 +296,8 @@ class _Table:
             return []
         if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
             raise self.error(key, f"expected a list of strings, got {_show(value)}")
+        for v in value:
+            self._ascii(key, v)
         return list(value)
 
     def table(self, key: str) -> _Table:
@@ -329,7 +342,7 @@ def load_spec(options: Mapping[str, Any], where: str) -> WordAddressSpec:
         full_circle=t.string("full_circle", "one-block", choices=FULL_CIRCLES),
         z_moves=t.string("z_moves", z_default, choices=Z_MOVES),
         helix=t.flag("helix", False),
-        max_block_bytes=t.integer("max_block_bytes", None, low=8),
+        max_block_bytes=t.integer("max_block_bytes", None, low=8, high=1 << 20),
         comments=t.flag("comments", False),
         rs274=t.flag("rs274", False),
         modal=_modal(t, words),
@@ -352,7 +365,7 @@ def _pattern(t: _Table, key: str, default: str, pattern: re.Pattern[str], want: 
 
 
 def _max_arc(t: _Table) -> float:
-    value = t.number("max_arc_deg", 360.0)
+    value = t.number("max_arc_deg", 360.0, low=1.0, high=360.0)
     assert value is not None
     if not 1.0 <= value <= 360.0:
         raise t.error("max_arc_deg", f"expected a number from 1 to 360, got {_show(value)}")
@@ -432,8 +445,8 @@ def _words(t: _Table) -> dict[str, WordSpec]:
 
 
 def _number_format(t: _Table) -> NumberFormat:
-    decimals = t.integer("decimals", 3)
-    min_decimals = t.integer("min_decimals", None)
+    decimals = t.integer("decimals", 3, high=9)
+    min_decimals = t.integer("min_decimals", None, high=9)
     assert decimals is not None
     if min_decimals is not None and min_decimals > decimals:
         raise t.error("min_decimals", f"expected at most decimals ({decimals}), got {min_decimals}")

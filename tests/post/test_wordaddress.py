@@ -143,7 +143,10 @@ def emit(
             {"words": {"XY": {"sign": "plus"}}},
             'words.XY.sign: expected one of \\["negative", "always"\\]',
         ),
-        ({"words": {"XY": {"scale": -1}}}, "words.XY.scale: expected a positive number, got -1"),
+        (
+            {"words": {"XY": {"scale": -1}}},
+            "words.XY.scale: expected a number from 1e-06 to 1e\\+06, got -1",
+        ),
     ],
 )
 def test_spec_errors_name_file_and_key(options: dict[str, Any], message: str) -> None:

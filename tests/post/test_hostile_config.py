@@ -1,0 +1,114 @@
+"""Hostile machine and target files: a clear error naming the file and key, nothing written.
+
+Each case ended in a traceback, a hang, a MemoryError or a program written from a value
+no machine has (``steps_per_mm = 1e300``). The ranges are physical (docs/dialects.md):
+no stepper makes a million steps per mm, no controller writes 30 decimals.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from camtool.cli.main import main
+
+ROOT = Path(__file__).resolve().parents[2]
+LOGO = str(ROOT / "samples" / "logo.dxf")
+GRBL = (ROOT / "postprocessors" / "grbl.toml").read_text()
+
+MACHINE_OVERLAYS = {
+    "steps_per_mm = [1e300, 1e300, 1e300]": "steps_per_mm",
+    "steps_per_mm = [0, 250, 250]": "steps_per_mm",
+    "max_step_rate_hz = -5": "max_step_rate_hz",
+    "max_step_rate_hz = nan": "max_step_rate_hz",
+    "[machine.motion]\nchord_segments = 0.5": "chord_segments",
+    "[machine.motion]\nchord_segments = 1000000000000000": "chord_segments",
+    "[machine.motion]\nchord_tolerance_mm = 1e-12": "chord_tolerance_mm",
+    "[machine.motion]\nchord_tolerance_mm = 1e-300": "chord_tolerance_mm",
+    "[machine.backlash]\ntrue_um = [1e300, 0, 0]": "true_um",
+    "work_area_mm = [0, 0, 1e300, 100]": "work_area_mm",
+}
+
+TARGET_EDITS = {
+    ("decimals = 3 ", "decimals = 30 #"): "decimals",
+    ("decimals = 3 ", "decimals = 9223372036854775807 #"): "decimals",
+    ("decimals = 3 ", "decimals = 3\ngrid_mm = 1e-300 #"): "grid_mm",
+    ('end = ["M2", "M30"]', 'end = ["M2\u00e9"]'): "end",
+    ('modal = ["F"]', 'modal = ["\uff26"]'): "modal",
+}
+
+
+@pytest.fixture
+def run(capsys: pytest.CaptureFixture[str]) -> Any:
+    def call(*args: str) -> tuple[int, str]:
+        code = main(list(args))
+        return code, capsys.readouterr().err
+
+    return call
+
+
+def _refused(run: Any, tmp_path: Path, *args: str) -> str:
+    out = tmp_path / "out.gcode"
+    code, err = run("post", LOGO, *args, "-o", str(out))
+    assert code == 3, err
+    assert "Traceback" not in err and "internal error" not in err
+    assert not out.exists()
+    return err
+
+
+@pytest.mark.parametrize("overlay", sorted(MACHINE_OVERLAYS))
+def test_a_machine_value_out_of_its_physical_range_is_refused(
+    run: Any, tmp_path: Path, overlay: str
+) -> None:
+    machine = tmp_path / "m.toml"
+    machine.write_text("[machine]\n" + overlay + "\n")
+    err = _refused(run, tmp_path, "-t", "grbl", "--machine", str(machine))
+    assert MACHINE_OVERLAYS[overlay] in err and "m.toml" in err
+
+
+@pytest.mark.parametrize("edit", sorted(TARGET_EDITS))
+def test_a_target_value_a_controller_cannot_take_is_refused(
+    run: Any, tmp_path: Path, edit: tuple[str, str]
+) -> None:
+    old, new = edit
+    assert old in GRBL
+    target = tmp_path / "mine.toml"
+    target.write_text(GRBL.replace(old, new, 1), encoding="utf-8")
+    err = _refused(run, tmp_path, "-t", str(target))
+    assert TARGET_EDITS[edit] in err and "mine.toml" in err
+
+
+@pytest.mark.parametrize("what", ["fifo", "device", "bad-utf8", "deep-arrays", "deep-tables"])
+def test_a_file_that_is_no_toml_file_is_refused_without_reading_forever(
+    run: Any, tmp_path: Path, what: str
+) -> None:
+    machine = tmp_path / "m.toml"
+    if what == "fifo":
+        os.mkfifo(machine)  # opening it for reading would wait for a writer
+    elif what == "device":
+        machine = Path("/dev/zero")  # reading it would fill memory
+        if not machine.exists():
+            pytest.skip("no /dev/zero")
+    elif what == "bad-utf8":
+        machine.write_bytes(b"[machine]\nname = '\xff\xfe'\n")
+    elif what == "deep-arrays":
+        machine.write_text("[machine]\nx = " + "[" * 10_000 + "]" * 10_000 + "\n")
+    else:
+        machine.write_text("[machine]\nx = " + "{a=" * 5_000 + "1" + "}" * 5_000 + "\n")
+    if what == "device":
+        code, err = run("post", LOGO, "-t", "grbl", "--machine", str(machine), "-o", "-")
+        assert code == 3 and "Traceback" not in err
+        return
+    _refused(run, tmp_path, "-t", "grbl", "--machine", str(machine))
+
+
+def test_a_byte_order_mark_is_read_as_utf8(run: Any, tmp_path: Path) -> None:
+    target = tmp_path / "bom.toml"
+    target.write_bytes(b"\xef\xbb\xbf" + GRBL.encode("utf-8"))
+    out = tmp_path / "out.gcode"
+    code, err = run("post", LOGO, "-t", str(target), "-o", str(out))
+    assert code == 0, err
+    assert out.exists()
