@@ -294,6 +294,8 @@ def verify(
     chosen = load_target_checked(target, machine_file=machine_file)
     text = read_code(code, binary=chosen.post.binary)
     drawing = read_input(against) if against is not None else None
+    if drawing is not None and isinstance(text, str):
+        drawing, tool_diameter = _as_posted(text, drawing, tool_diameter)
     progress = StageReporter()
     load_picture = click.get_current_context().with_resource(picture_ahead(preview))
     load_picture()  # matplotlib, on the core the verification's start leaves idle
@@ -316,6 +318,37 @@ def verify(
         edge_radius_mm=tool_diameter / 2.0,
         strict=strict,
     )
+
+
+def _as_posted(code: str, drawing: Drawing, tool_diameter: float) -> tuple[Drawing, float]:
+    """The --against drawing placed, and the tool, as camtool's header in ``code`` records.
+
+    A program camtool posted with ``--fit``/``--scale``/``--origin``/``--translate`` says
+    where the drawing went (``placement: scale K, shift X Y mm``); without it the
+    drawing would be compared where it was drawn, and the registration mistake reported
+    as machining error. A ``--tool-diameter`` of 0 takes the header's tool.
+    """
+    from camtool.jobs.header import read_placement, read_tool_diameter
+
+    placement = read_placement(code)
+    if placement is not None:
+        k, dx, dy = placement
+        drawing = drawing.transformed(k, dx, dy)
+        click.echo(
+            f"camtool: --against: the drawing placed as the program's header says "
+            f"(scale {k:g}, shift X{dx:g} Y{dy:g} mm)",
+            err=True,
+        )
+    if tool_diameter == 0:
+        recorded = read_tool_diameter(code)
+        if recorded is not None:
+            click.echo(
+                f"camtool: --against: tool diameter {recorded:g} mm, as the program's header "
+                "says (give --tool-diameter to change it)",
+                err=True,
+            )
+            return drawing, recorded
+    return drawing, tool_diameter
 
 
 def _write_pieces(job: PostJob, output: str, inputs: list[tuple[str, Any]]) -> None:

@@ -8,6 +8,8 @@ of the same job (no date, no absolute path), so programs stay byte-for-byte repr
 
 from __future__ import annotations
 
+import math
+import re
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -44,6 +46,7 @@ def job_notes(
     plan: PlanOptions | None = None,
     job: Job | None = None,
     runs: Sequence[OperationRun] = (),
+    placement: tuple[float, float, float] = (1.0, 0.0, 0.0),
 ) -> tuple[str, ...]:
     """The job, in a few lines for the top of the program (comments where the dialect has them).
 
@@ -59,11 +62,17 @@ def job_notes(
             program, or a job file's: ``job`` and ``runs``).
         job: a job file's job.
         runs: what each of its operations made, in order.
+        placement: ``(k, dx, dy)``: a drawing point ``p`` is the program's ``k·p + (dx,
+            dy)`` mm (``--scale``/``--fit``, ``--origin``, ``--translate``); written as
+            ``placement: scale K, shift XdX YdY mm`` unless it is the identity, so that
+            ``verify --against`` can place the drawing again (:func:`read_placement`).
     """
     from camtool.model.version import __version__
 
     name = Path(source).name if source and source != "-" else "stdin"
     notes = [f"camtool {__version__}: {name} for {target.name}"]
+    setup = plan if plan is not None else job.setup.plan if job is not None else None
+    notes.extend(_placement_lines(placement, setup))
     if job is not None and plan is None:
         return (*notes, *_job_lines(job, runs, target))
     if plan is None:
@@ -143,6 +152,66 @@ def _minutes(seconds: float) -> str:
     if seconds < 60:
         return f"{seconds:.0f} s"
     return f"{seconds / 60:.1f} min"
+
+
+PLACEMENT = re.compile(
+    r"placement: scale (?P<k>[-+0-9.eE]+), shift X(?P<dx>[-+0-9.eE]+) Y(?P<dy>[-+0-9.eE]+) mm"
+)
+"""The header line :func:`job_notes` writes for a drawing scaled or moved (any comment style)."""
+_CAMTOOL = re.compile(r"camtool \S+: .* for \S+")
+
+
+def _placement_lines(placement: tuple[float, float, float], plan: PlanOptions | None) -> list[str]:
+    k, dx, dy = placement
+    if (k, dx, dy) == (1.0, 0.0, 0.0):
+        return []
+    lines = [f"placement: scale {k:.12g}, shift X{dx:.12g} Y{dy:.12g} mm"]
+    if plan is not None and plan.fit_mm is not None and k != 1.0:
+        w, h = plan.fit_mm
+        lines.append(f"--fit {w:g} x {h:g} mm: the drawing at {100 * k:.4g} % of its size")
+    elif k != 1.0:
+        lines.append(f"--scale {k:g}: the drawing at {100 * k:.4g} % of its size")
+    return lines
+
+
+def read_placement(code: str) -> tuple[float, float, float] | None:
+    """The placement a camtool header in ``code`` records, or ``None``.
+
+    Only the first 60 lines are read, and only after camtool's own first line
+    (``camtool VERSION: NAME for TARGET``): another tool's comment is never taken.
+    """
+    head = code.splitlines()[:60]
+    if not any(_CAMTOOL.search(line) for line in head):
+        return None
+    for line in head:
+        found = PLACEMENT.search(line)
+        if found is not None:
+            try:
+                k, dx, dy = (float(found[g]) for g in ("k", "dx", "dy"))
+            except ValueError:
+                return None
+            if k > 0 and all(math.isfinite(v) for v in (k, dx, dy)):
+                return (k, dx, dy)
+    return None
+
+
+def read_tool_diameter(code: str) -> float | None:
+    """The tool diameter (mm) of an offset cut a camtool header in ``code`` records, or None."""
+    head = code.splitlines()[:60]
+    if not any(_CAMTOOL.search(line) for line in head):
+        return None
+    for line in head:
+        found = _TOOL.search(line)
+        if found is not None:
+            try:
+                value = float(found[1])
+            except ValueError:
+                return None
+            return value if math.isfinite(value) and value > 0 else None
+    return None
+
+
+_TOOL = re.compile(r"tool diameter ([0-9.eE+-]+) mm, offset (?:outside|inside|pocket)")
 
 
 def _work_zero(plan: PlanOptions) -> str:

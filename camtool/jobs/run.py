@@ -324,7 +324,14 @@ def run_job(
     runs = [_shifted(r, shift) for r in runs]
     program = dataclasses.replace(
         program,
-        notes=job_notes(drawing.source, target, setup if job.shorthand else None, job, runs),
+        notes=job_notes(
+            drawing.source,
+            target,
+            setup if job.shorthand else None,
+            job,
+            runs,
+            placement=_placement(drawing, setup, shift),
+        ),
         tolerance_mm=setup.tolerance,
         warnings=(*program.warnings, *surface_warnings(runs, target)),
     )
@@ -695,6 +702,14 @@ def feed_time_s(
             total += length / move.feed_mm_min * 60.0
         x, y, z = move.x, move.y, nz
     return total
+
+
+def _placement(drawing: Drawing, setup: PlanOptions, shift: Point) -> tuple[float, float, float]:
+    """``(k, dx, dy)``: the program's point of a drawing point ``p`` is ``k·p + (dx, dy)``."""
+    from camtool.toolpath.plan import scaling
+
+    k, dx, dy = scaling(drawing, setup) if drawing.contours or drawing.marks else (1.0, 0.0, 0.0)
+    return (k, dx + shift[0], dy + shift[1])
 
 
 def _shifted(run: OperationRun, shift: Point) -> OperationRun:

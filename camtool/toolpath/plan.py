@@ -253,13 +253,24 @@ def _backlash_weights(machine: Machine) -> tuple[float, float]:
 
 def place(drawing: Drawing, options: PlanOptions) -> Drawing:
     """The drawing scaled as ``options.scale`` or ``options.fit_mm`` ask (mm)."""
+    k, dx, dy = scaling(drawing, options)
+    if (k, dx, dy) == (1.0, 0.0, 0.0):
+        return drawing
+    return drawing.transformed(k, dx, dy)
+
+
+def scaling(drawing: Drawing, options: PlanOptions) -> tuple[float, float, float]:
+    """``(k, dx, dy)``: :func:`place` maps a drawing point ``p`` to ``k·p + (dx, dy)``, mm.
+
+    ``--scale`` scales about the drawing's origin; ``--fit`` about its lower-left corner.
+    """
     if options.fit_mm is None:
-        return drawing if options.scale == 1.0 else drawing.transformed(options.scale)
+        return (options.scale, 0.0, 0.0)
     x0, y0, _, _ = box = drawing.bbox()
     k = fit_factor(box, options.fit_mm)
     if math.isinf(k):
-        return drawing
-    return drawing.transformed(k, x0 * (1 - k), y0 * (1 - k))
+        return (1.0, 0.0, 0.0)
+    return (k, x0 * (1 - k), y0 * (1 - k))
 
 
 def place_program(

@@ -1,0 +1,62 @@
+"""The header records how the drawing was placed; ``verify --against`` places it again.
+
+Expected values from analysis: samples/plate.dxf is 40 × 30 mm from (0, 0), so
+``--fit 50 50`` scales it by min(50/40, 50/30) = 1.25 about its lower-left corner, and
+``--origin center`` then puts the toolpath's centre (the drawing's centre, grown by the
+1.5 mm tool radius on every side) at X0 Y0: a shift of −(1.25 · 20, 1.25 · 15).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from camtool.cli.main import main
+from camtool.jobs.header import read_placement, read_tool_diameter
+
+ROOT = Path(__file__).resolve().parents[2]
+PLATE = str(ROOT / "samples" / "plate.dxf")
+OPTIONS = ["--offset", "outside", "--tool-diameter", "3", "--depth", "1"]
+
+
+@pytest.fixture
+def run(capsys: pytest.CaptureFixture[str]) -> Any:
+    def call(*args: str) -> tuple[int, str]:
+        code = main(list(args))
+        return code, capsys.readouterr().err
+
+    return call
+
+
+def test_the_header_says_how_the_drawing_was_scaled_and_moved(run: Any, tmp_path: Path) -> None:
+    out = tmp_path / "plate.ngc"
+    placing = ["--fit", "50", "50", "--origin", "center"]
+    code, err = run("post", PLATE, "-t", "grbl", *OPTIONS, *placing, "-o", str(out))
+    assert code == 0, err
+    text = out.read_text()
+    assert "(--fit 50 x 50 mm: the drawing at 125 % of its size)" in text
+    k, dx, dy = read_placement(text) or (0.0, 0.0, 0.0)
+    assert k == pytest.approx(1.25)
+    assert (dx, dy) == pytest.approx((-25.0, -18.75))
+    assert read_tool_diameter(text) == 3.0
+
+
+def test_verify_against_places_the_drawing_as_posted(run: Any, tmp_path: Path) -> None:
+    out, report = tmp_path / "plate.ngc", tmp_path / "report.json"
+    placing = ["--fit", "50", "50", "--origin", "center"]
+    code, err = run("post", PLATE, "-t", "grbl", *OPTIONS, *placing, "-o", str(out))
+    assert code == 0, err
+    code, err = run("verify", str(out), "-t", "grbl", "--against", PLATE, "--report", str(report))
+    assert code == 0, err
+    assert "placed as the program's header says (scale 1.25" in err
+    against = json.loads(report.read_text())["against"]
+    # before: compared where it was drawn, 1500 µm of "overcut"; now the tool's own few µm
+    assert against["overcut_um"] < 20.0
+
+
+def test_a_comment_of_another_tool_is_not_read() -> None:
+    foreign = "(placement: scale 2, shift X5 Y5 mm)\nG0 X1 Y1\n"
+    assert read_placement(foreign) is None
