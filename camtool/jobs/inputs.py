@@ -81,10 +81,14 @@ def read_input(
 
 
 def read_code(name: str, *, binary: bool = False) -> str | bytes:
-    """A code file (``-``: stdin): bytes for a binary dialect, else ASCII text.
+    """A code file (``-``: stdin): bytes for a binary dialect, else text.
+
+    Text is read as the G-code importer reads it (UTF-8, a byte-order mark dropped): a
+    comment may hold any character (``(Linéal)``); the dialect's reader refuses one
+    outside a comment, naming the line.
 
     Raises:
-        InputError: missing, unreadable, or (text) not ASCII, naming the file.
+        InputError: missing, unreadable, or (text) not UTF-8, naming the file.
     """
     if binary:
         try:
@@ -96,11 +100,11 @@ def read_code(name: str, *, binary: bool = False) -> str | bytes:
     if name == "-":
         return sys.stdin.read()
     try:
-        return Path(name).read_text(encoding="ascii", errors="strict")
+        return Path(name).read_text(encoding="utf-8-sig", errors="strict")
     except FileNotFoundError as exc:
         raise InputError(f"{name}: no such file") from exc
     except UnicodeDecodeError as exc:
-        raise InputError(f"{name}: not a text program (byte {exc.start} is not ASCII)") from exc
+        raise InputError(f"{name}: not a text program (byte {exc.start} is not UTF-8)") from exc
     except OSError as exc:
         raise InputError(f"{name}: cannot read ({exc.strerror or exc})") from exc
 

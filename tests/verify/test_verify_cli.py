@@ -229,3 +229,19 @@ def test_a_move_outside_a_machine_coordinate_work_area_is_named_by_file_and_line
     )
     with pytest.raises(DialectError, match=r"^big\.ngc: the toolpath is 240 × 0 mm, larger than"):
         check_area(big, machine, "big.ngc")
+
+
+def test_verify_reads_a_comment_in_utf8_as_post_does(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Universal G-code Sender's test_files/ruler.gcode has UTF-8 in a comment."""
+    program = tmp_path / "ruler.gcode"
+    program.write_text(
+        "G21 G90\n(Lin\u00e9al \u2013 \u00c5\u00c4\u00d6)\nG0 X1 Y1\nG1 X5 Y1 F300\nM2\n"
+    )
+    code, _, err = run(["verify", str(program), "-t", "grbl"], capsys)
+    assert code == 0, err
+    program.write_bytes(b"G21 G90\n(\xff)\nG0 X1 Y1\nM2\n")
+    code, _, err = run(["verify", str(program), "-t", "grbl"], capsys)
+    assert code == 3
+    assert "ruler.gcode: not a text program (byte 9 is not UTF-8)" in err
