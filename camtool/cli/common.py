@@ -292,7 +292,9 @@ def import_options(command: Callable[..., None]) -> Callable[..., None]:
         "--units",
         type=click.Choice(list(LENGTH_UNITS)),
         default=None,
-        help="Unit of unitless inputs (point lists; default mm, Matlab xy files 0.1mm).",
+        help="Unit of a drawing that declares none: point lists (default mm, Matlab xy "
+        "files 0.1mm), a DXF without $INSUNITS, an SVG without width/height (default px). "
+        "Refused for a drawing that declares another unit.",
     )(command)
     return click.option(
         "--layers",

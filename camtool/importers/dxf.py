@@ -39,7 +39,7 @@ from camtool.importers.dxf_style import CONTINUOUS, Style, StyleResolver
 from camtool.importers.options import MAX_COORDINATE_MM, ImportOptions, too_many_entities
 from camtool.model.errors import InputError, UsageError
 from camtool.model.shapes import Contour, Drawing, Line, Mark, Point
-from camtool.model.units import INCH
+from camtool.model.units import INCH, LENGTH_UNITS
 
 # Exact mm per unit for the $INSUNITS codes a shop meets (ezdxf's own factors
 # carry rounding noise, e.g. 25.400000000101603 for inches).
@@ -165,7 +165,7 @@ def _import(path: Path, options: ImportOptions) -> DxfImport:
     doc, damage, repairs = _open(path)
     recovered = damage is not None
     warnings = [] if damage is None else [_damaged(path, damage, repairs)]
-    units, scale = _units(path, _insunits(path, doc, recovered), warnings)
+    units, scale = _units(path, _insunits(path, doc, recovered), warnings, options.units)
     msp = doc.modelspace()
     if len(msp) == 0:
         _refuse_empty(path, doc, damage)
@@ -507,16 +507,31 @@ class _captured_log:
         self.logger.propagate = self.propagate
 
 
-def _units(path: Path, code: int, warnings: list[str]) -> tuple[str, float]:
+def _units(path: Path, code: int, warnings: list[str], given: str | None) -> tuple[str, float]:
+    """The drawing unit and its size in mm: the file's ``$INSUNITS``, else ``--units``.
+
+    Raises:
+        InputError: an ``$INSUNITS`` camtool does not know.
+        UsageError: ``--units`` for a drawing that declares another unit.
+    """
     if code == 0:
+        if given is not None:
+            return given, LENGTH_UNITS[given]
         warnings.append(
-            f"{path}: drawing has no units ($INSUNITS = 0 or not in the file); assuming mm"
+            f"{path}: drawing has no units ($INSUNITS = 0 or not in the file); assuming mm "
+            "(give --units in, cm ... if it was drawn in another unit)"
         )
         return "mm (assumed)", 1.0
     if code not in _INSUNITS_MM:
         known = ", ".join(f"{c} ({n})" for c, (n, _) in sorted(_INSUNITS_MM.items()))
         raise InputError(f"{path}: unsupported $INSUNITS {code}; camtool knows {known}")
-    return _INSUNITS_MM[code]
+    declared = _INSUNITS_MM[code]
+    if given is not None and not math.isclose(LENGTH_UNITS[given], declared[1]):
+        raise UsageError(
+            f"--units {given}: {path} declares its unit, {declared[0]} ($INSUNITS = {code}); "
+            "--units is for a drawing without units: leave it out, or use --scale to resize"
+        )
+    return declared
 
 
 def _refuse_empty(path: Path, doc: Any, damage: str | None) -> None:

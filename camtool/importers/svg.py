@@ -107,8 +107,8 @@ def svg_drawing(
         options: ``layers`` (Inkscape layer labels or ids; hidden layers named here are read)
             and ``tolerance`` (mm, for Béziers and ellipses, once the drawing is scaled as
             ``scale`` or ``fit_mm`` say: for ``fit_mm``, the factor of the extent of the
-            drawn segments' ends, :func:`_ends_box`) are used; ``units`` does not apply
-            (SVG files carry their own units).
+            drawn segments' ends, :func:`_ends_box`) are used; ``units`` is the user
+            unit of a document without an absolute size (refused for one with it).
         check: called with the extent of the drawn segments' ends (:func:`_ends_box`, mm,
             a box within the drawing's) before any curve is fitted; what it raises stops
             the reading (``camtool post`` refuses there a drawing too large for the
@@ -135,7 +135,7 @@ def svg_drawing(
     options = options or ImportOptions()
     check_tolerance(options.tolerance)
     progress(Step("reading", name=path.name))
-    prepared = prepare(path, options.layers, max_entities=options.max_entities)
+    prepared = prepare(path, options.layers, max_entities=options.max_entities, units=options.units)
     svg = _parse(path, prepared)
     warnings = list(prepared.warnings)
     contours: list[Contour] = []

@@ -40,7 +40,7 @@ from typing import TypeAlias
 
 from camtool.importers import svgcheck
 from camtool.importers.options import MAX_ENTITIES, too_many_entities
-from camtool.model.errors import InputError
+from camtool.model.errors import InputError, UsageError
 from camtool.model.shapes import Point
 from camtool.model.units import LENGTH_UNITS, PX
 
@@ -413,7 +413,11 @@ class Prepared:
 
 
 def prepare(
-    path: Path, layers: tuple[str, ...] | None, *, max_entities: int = MAX_ENTITIES
+    path: Path,
+    layers: tuple[str, ...] | None,
+    *,
+    max_entities: int = MAX_ENTITIES,
+    units: str | None = None,
 ) -> Prepared:
     """Read, check and prepare the SVG file at ``path`` (see the module docstring).
 
@@ -422,6 +426,7 @@ def prepare(
         layers: Inkscape layer names (labels or ids) to keep; ``None`` keeps everything.
         max_entities: most elements the document may expand to, ``<use>`` clones
             included (:func:`check_size`).
+        units: ``--units``: the user unit of a document without an absolute size.
 
     Raises:
         InputError: the file is missing, is not well-formed XML, is not an SVG document,
@@ -433,7 +438,7 @@ def prepare(
     """
     root = _parse(path)
     warnings: list[str] = []
-    matrix, viewport = page_matrix(root, str(path), warnings)
+    matrix, viewport = page_matrix(root, str(path), warnings, units)
     parents = {child: parent for parent in root.iter() for child in parent}
     _label_and_check(root, str(path))
     check_use_cycles(root, str(path))
@@ -481,17 +486,19 @@ def _parse(path: Path) -> ET.Element:
 
 
 def page_matrix(
-    root: ET.Element, name: str, warnings: list[str]
+    root: ET.Element, name: str, warnings: list[str], units: str | None = None
 ) -> tuple[Affine, tuple[float, float]]:
     """Map from user units to mm, Y up, and the viewport size in user units.
 
     Removes ``width``, ``height``, ``viewBox``, ``preserveAspectRatio``, ``x`` and ``y`` from
     ``root``. Without an absolute ``width`` and ``height`` (missing, or in %) the user unit
-    is the px (1/96 in), with a warning; with a viewBox, one missing side is taken from the
-    viewBox's aspect ratio. Without a page height the Y flip is about the user-unit origin.
+    is ``units`` (``--units``), else the px (1/96 in) with a warning; with a viewBox, one
+    missing side is taken from the viewBox's aspect ratio. Without a page height the Y
+    flip is about the user-unit origin.
 
     Raises:
         InputError: a malformed size or viewBox, or a size in a unit with no physical length.
+        UsageError: ``units`` for a document whose size is given in absolute units.
     """
     width, width_text = _page_length(root, "width", name)
     height, height_text = _page_length(root, "height", name)
@@ -500,18 +507,28 @@ def page_matrix(
         height = width * box[3] / box[2]
     elif box is not None and height is not None and width is None:
         width = height * box[2] / box[3]
+    unit = PX
     if width is None and height is None:
         relative = [t for t in (width_text, height_text) if t]
         what = f"relative size {' x '.join(relative)}" if relative else "no width/height"
-        warnings.append(f"{name}: {what}; user units taken as px (1/96 in)")
+        if units is None:
+            warnings.append(f"{name}: {what}; user units taken as px (1/96 in)")
+        else:
+            unit = LENGTH_UNITS[units]
+    elif units is not None:
+        given = " x ".join(str(root.get(a)) for a in ("width", "height") if root.get(a))
+        raise UsageError(
+            f"--units {units}: {name} gives its size ({given}), so its units are known; "
+            "--units is for a drawing without them: leave it out, or use --scale to resize"
+        )
     if box is None:
-        sx = sy = PX
+        sx = sy = unit
         tx = ty = 0.0
         viewport = (width / PX, height / PX) if width and height else (1000.0, 1000.0)
     elif width is None or height is None:
-        sx = sy = PX
-        tx, ty = -box[0] * PX, -box[1] * PX
-        height = box[3] * PX
+        sx = sy = unit
+        tx, ty = -box[0] * unit, -box[1] * unit
+        height = box[3] * unit
         viewport = (box[2], box[3])
     else:
         sx, sy, tx, ty = _fit_viewbox(width, height, box, root.get("preserveAspectRatio"), name)

@@ -7,7 +7,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from camtool.importers import POINT_SUFFIXES, read_drawing, read_drawing_bytes
+from camtool.importers import read_drawing, read_drawing_bytes
 from camtool.importers.options import ImportOptions
 from camtool.jobs.header import job_notes
 from camtool.jobs.inputs import is_program_file
@@ -146,7 +146,6 @@ def post_path(
                 progress=progress,
                 check=travel_check(plan, target) if job is None else None,
             )
-            drawing = _note_units(drawing, path, import_options)
             with meanwhile(_preloads(drawing) if verifying else []):
                 layers = import_options.layers if import_options is not None else None
                 return post_drawing(
@@ -218,7 +217,6 @@ def post_bytes(
         check = travel_check(plan, target) if job is None else None
         drawing = read_drawing_bytes(data, name=name, suffix=suffix, options=options, check=check)
         layers = import_options.layers if import_options is not None else None
-        drawing = _note_units(drawing, name, import_options)
         return post_drawing(drawing, target, plan, output, layers=layers, job=job)
     refuse_planning(name, drawing_only(plan.given()) + (["--job"] if job is not None else []))
     from camtool.importers.gcode import read_gcode_bytes
@@ -283,17 +281,6 @@ def refuse_planning(path: str | Path, given: list[str]) -> None:
             f"{path} is already a toolpath (G-code): {', '.join(given)} only apply to "
             "drawings; plan it in the program that wrote it"
         )
-
-
-def _note_units(drawing: Drawing, path: str | Path, options: ImportOptions | None) -> Drawing:
-    """``drawing`` with a warning when ``--units`` was given for a file that carries its own."""
-    if options is None or options.units is None or Path(path).suffix.lower() in POINT_SUFFIXES:
-        return drawing
-    note = (
-        f"--units {options.units} has no effect on {Path(path).name}: DXF and SVG files carry "
-        "their own units (--units is for point lists)"
-    )
-    return dataclasses.replace(drawing, warnings=(*drawing.warnings, note))
 
 
 def post_program(

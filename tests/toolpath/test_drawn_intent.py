@@ -126,14 +126,15 @@ def test_options_without_effect_are_named(options: dict[str, Any], names: list[s
     assert bool(notes) == bool(names)
 
 
-def test_units_on_a_dxf_is_named_as_without_effect(
+def test_units_on_a_dxf_that_declares_its_own_is_refused(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    path = _golden_arc_from(tmp_path / "arc.dxf", 180.0)
+    path = _golden_arc_from(tmp_path / "arc.dxf", 180.0)  # $INSUNITS = 4, mm
     code = main(["post", str(path), "-t", "pic-mmh", "--units", "in", "-o", str(tmp_path / "a")])
     err = capsys.readouterr().err
-    assert code == 0
-    assert "--units in has no effect on arc.dxf" in err
+    assert code == 2
+    assert "--units in: " in err and "declares its unit, mm ($INSUNITS = 4)" in err
+    assert not (tmp_path / "a").exists()
 
 
 def test_a_lead_in_shortened_to_fit_is_named() -> None:
