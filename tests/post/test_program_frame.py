@@ -118,8 +118,11 @@ def test_header_names_the_job_and_two_runs_are_byte_identical(
     _, second, _ = _run(target, args, tmp_path, capsys)
     assert first == second
     lines = first.decode().splitlines()
-    assert lines[:7] == [
+    k = SCALE[target]
+    assert lines[:9] == [
         f"(camtool {__version__}: logo.dxf for {target})",
+        f"(placement: scale {k:g}, shift X0 Y0 mm)",  # --scale, about the drawing's origin
+        f"(--scale {k:g}: the drawing at {100 * k:g} % of its size)",
         "(tool diameter 3 mm, offset outside)",
         "(work zero X0 Y0: the drawing's origin)",
         "(depth 2 mm in passes of 1 mm)",
