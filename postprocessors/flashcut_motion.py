@@ -1,10 +1,10 @@
-"""Motion model of the seed-001 LMM VB6 application (``flashcut``) for the verifier.
+"""Motion model of the Yanez-07 LMM VB6 application (``flashcut``) for the verifier.
 
 Three pieces the generic library does not have:
 
 - the ``timer`` line (:func:`timer_line`): ``funcionXYH`` has no coordinated
   interpolator: each axis is stepped from a 1 ms timer (``timeGetTime``) and fires
-  when ``now − last > period`` (seed-001 §4.2, §4.7, R11). With a 1 ms timer an
+  when ``now − last > period`` (Yanez-07 §4.2, §4.7, R11). With a 1 ms timer an
   axis of period T ms fires every ``floor(T) + 1`` ms (:func:`timer_period_ms`).
   The dominant axis (more steps) has the configured half-period P and is
   count-limited; the other axis is scheduled at ``P·N_dom/N_other`` ms and is
@@ -16,9 +16,9 @@ Three pieces the generic library does not have:
   source (:mod:`camtool.verify.sources`): switched off, the axes fire at their
   exact periods (:func:`exact_timer_line`) and every axis makes its count.
 - the ``flashcut`` chord rule (:func:`flashcut_arc_points`): ``chord_segments``
-  equal chords per arc (seed-001 §4.4).
+  equal chords per arc (Yanez-07 §4.4).
 - the ``flashcut`` timing model (:class:`FlashcutTiming`): per dominant step
-  ``k·(P + δ)`` (seed-001 §2.6, §4.7, R15, R21).
+  ``k·(P + δ)`` (Yanez-07 §2.6, §4.7, R15, R21).
 """
 
 from __future__ import annotations
@@ -57,7 +57,7 @@ from camtool.verify.timing import (
 # ------------------------------------------------------------------ timing model
 
 FLASHCUT_MIN_HALF_PERIOD_MS = 3.0
-"""Smallest "Período medio de la señal", ms: the maximum speed (seed-001 §2.6, R21)."""
+"""Smallest "Período medio de la señal", ms: the maximum speed (Yanez-07 §2.6, R21)."""
 
 
 def flashcut_block_time_s(
@@ -70,9 +70,9 @@ def flashcut_block_time_s(
     timer_overshoot_ms: float = 1.0,
     rapid_half_period_ms: float = FLASHCUT_MIN_HALF_PERIOD_MS,
 ) -> FloatArray:
-    """Seconds per block of the seed-001 VB6 application: (N_dom + N_comp)·k·(P + δ).
+    """Seconds per block of the Yanez-07 VB6 application: (N_dom + N_comp)·k·(P + δ).
 
-    seed-001 §4.7 and R15 (fitted to Tables 4.1/4.2): each dominant-axis step
+    Yanez-07 §4.7 and R15 (fitted to Tables 4.1/4.2): each dominant-axis step
     costs ``k·(P + δ)`` ms with k = 2 and δ = 1 ms (for whole-ms P, δ is the
     ``floor(P) + 1`` firing rule of :func:`timer_period_ms`), P the configured
     half-period; backlash compensation steps (``backlashXY``, same stepping
@@ -115,7 +115,7 @@ def flashcut_block_time_s(
 
 @dataclass(frozen=True, kw_only=True)
 class FlashcutTiming:
-    """Parameters of the seed-001 ``flashcut`` time model (:func:`flashcut_block_time_s`).
+    """Parameters of the Yanez-07 ``flashcut`` time model (:func:`flashcut_block_time_s`).
 
     Attributes:
         half_period_ms: P, the "Período medio de la señal", ms (default 3, L1404).
@@ -148,7 +148,7 @@ class FlashcutTiming:
     def block_time_s(self, blocks: BlockKinematics) -> FloatArray:
         """Seconds per block, ``(B,) float64`` read-only.
 
-        Z moves are blocks of their own in seed-001 (``funcionZH``, §4.3), so
+        Z moves are blocks of their own in Yanez-07 (``funcionZH``, §4.3), so
         the counted steps are ``max(dominant_steps, |z steps|)``.
         """
         return flashcut_block_time_s(
@@ -170,7 +170,7 @@ def timer_period_ms(period_ms: float, timer_ms: int = 1) -> int:
 
     Args:
         period_ms: Scheduled period, ms, ``> 0``.
-        timer_ms: Timer resolution, ms (seed-001 §2.6: ``timeBeginPeriod 1``).
+        timer_ms: Timer resolution, ms (Yanez-07 §2.6: ``timeBeginPeriod 1``).
 
     Returns:
         The smallest multiple of ``timer_ms`` strictly greater than ``period_ms``.
@@ -186,11 +186,11 @@ def timer_period_ms(period_ms: float, timer_ms: int = 1) -> int:
 def flashcut_line_steps(
     n_dominant: int, n_other: int, half_period_ms: int, *, timer_ms: int = 1
 ) -> int:
-    """Steps the non-dominant axis really makes in one seed-001 ``funcionXYH`` line.
+    """Steps the non-dominant axis really makes in one Yanez-07 ``funcionXYH`` line.
 
     The move lasts ``n_dominant·(P + 1)`` ms (dominant period ``P + 1``); the other
     axis fires every ``floor(P·n_dominant/n_other) + 1`` ms until then.
-    seed-001 §4.7 Table 3.8: a 10 × 5 mm line (5263 × 2632 steps) gives 2763,
+    Yanez-07 §4.7 Table 3.8: a 10 × 5 mm line (5263 × 2632 steps) gives 2763,
     2719 and 2697 Y steps at P = 20, 30 and 40 ms.
 
     Args:
@@ -215,7 +215,7 @@ def flashcut_line_steps(
 
 
 def timer_line(dx: int, dy: int, half_period_ms: float, *, timer_ms: int = 1) -> StepArray:
-    """Motor steps of one seed-001 line move of ``(dx, dy)`` programmed steps.
+    """Motor steps of one Yanez-07 line move of ``(dx, dy)`` programmed steps.
 
     One row per timer event at which at least one axis fires (both fire in the
     same row when their events coincide). Events of the dominant axis fall at
@@ -287,7 +287,7 @@ def exact_timer_line(dx: int, dy: int) -> StepArray:
 def flashcut_arc_points(
     start: Point, end: Point, centre: Point, clockwise: bool, *, segments: int
 ) -> npt.NDArray[np.float64]:
-    """Arc points of the seed-001 VB6 application (seed-001 §4.4, reconstructed routine).
+    """Arc points of the Yanez-07 VB6 application (Yanez-07 §4.4, reconstructed routine).
 
     Start angle from ``angulo(I, J, "inicio")`` = atan2(−J, −I), end angle from
     the end offset; the sweep is normalised to [−2π, 0) for G02 and (0, 2π] for
@@ -341,7 +341,7 @@ def _timer(machine: Machine, *, sources: Sources = ALL) -> LineInterpolator:
     model = timing_model_from_table(machine.timing, where=where, machine=machine)
     if not isinstance(model, FlashcutTiming):
         raise UsageError(
-            f"{where}: line = 'timer' steps by the seed-001 half period; "
+            f"{where}: line = 'timer' steps by the Yanez-07 half period; "
             "it needs model = 'flashcut'"
         )
     period = model.half_period_ms

@@ -1,7 +1,7 @@
 """The ``i8751`` dialect: binary packets for the 8751 serial stepper interface.
 
-Source: seed-003 §3.7 (the byte protocol, :mod:`camtool_postprocessors.i8751_packets`),
-§4.1–4.4 (motion) and requirements R1–R7 (reference/seed-003.md). The PC
+Source: Intf8751 §3.7 (the byte protocol, :mod:`camtool_postprocessors.i8751_packets`),
+§4.1–4.4 (motion) and requirements R1–R7 (reference/Intf8751.md). The PC
 sends relative step counts per motor; the interface runs X and Y by "corte
 recto" (both motors together, then the longer one alone), waits T1 seconds,
 runs Z, waits T2 seconds, and goes on with the next move.
@@ -95,11 +95,11 @@ from camtool_postprocessors.i8751_packets import (
 #
 # The reader sums the steps from X = Y = Z = 0 and divides by the machine's
 # steps/mm; a record that moves X/Y and Z gives two moves (X/Y, then Z), as the
-# interface runs them (seed-003 §4.3, R11); waits T1/T2 give dwells. A move that
+# interface runs them (Intf8751 §4.3, R11); waits T1/T2 give dwells. A move that
 # ends with the tool above Z = 0 is a rapid, any other a cut at the cruise feed.
 
 CRUISE_HZ = 104.0
-"""Cruise step rate of the firmware ramp, X = 11H (seed-003 §4.4), used when the
+"""Cruise step rate of the firmware ramp, X = 11H (Intf8751 §4.4), used when the
 machine profile gives no ``max_step_rate_hz``."""
 
 
@@ -182,7 +182,7 @@ def program_from_records(
 _DROPPED = {
     Spindle: "spindle command(s): the interface drives only the three axis motors",
     ToolChange: "tool change(s): the interface has no tool changer",
-    Home: "home command(s): homing is only proposed in the thesis (seed-003 §6)",
+    Home: "home command(s): homing is only proposed in the thesis (Intf8751 §6)",
 }
 
 
@@ -201,7 +201,7 @@ def split_xy(dx: int, dy: int) -> list[tuple[int, int]]:
     """An X/Y move of ``(dx, dy)`` steps as pieces of at most 65 535 steps per axis.
 
     The longest axis advances 65 535 steps per piece (the last takes the rest,
-    seed-003 R3); the other axis goes to the nearest step of the segment.
+    Intf8751 R3); the other axis goes to the nearest step of the segment.
     Returns ``[]`` for no move.
     """
     n = max(abs(dx), abs(dy))
@@ -253,7 +253,7 @@ class _Writer(WriterState[Record]):
     def goto(self, x: float, y: float, z: float | None, *, rapid: bool = False) -> None:
         """Records from the current position to ``(x, y[, z])``: X/Y pieces, then Z.
 
-        A record runs X/Y before Z (seed-003 §3.7), so a move that also changes Z
+        A record runs X/Y before Z (Intf8751 §3.7), so a move that also changes Z
         runs its X/Y at the old height. A *rapid* that rises goes up first (Z-only
         records, then X/Y), so it never travels at the cutting depth it leaves.
         """
@@ -284,7 +284,7 @@ class _Writer(WriterState[Record]):
     def append(self, record: Record) -> None:
         """Add ``record``; a Z-only one joins a record that moved only X/Y (R4).
 
-        The thesis's move is "X/Y, wait T1, Z, wait T2" (seed-003 §3.7): a dwell
+        The thesis's move is "X/Y, wait T1, Z, wait T2" (Intf8751 §3.7): a dwell
         between the two (held in the earlier record's T2) becomes T1.
         """
         last = self.blocks[-1] if self.blocks else None
@@ -325,7 +325,7 @@ class _Writer(WriterState[Record]):
 
 
 class I8751Post(PostProcessor):
-    """Writer and reader of the i8751 binary protocol (seed-003 §3.7).
+    """Writer and reader of the i8751 binary protocol (Intf8751 §3.7).
 
     Args:
         lift_mm: raise Z by this much around each run of rapids of a program
@@ -462,7 +462,7 @@ class I8751Post(PostProcessor):
             feeds = ", ".join(f"{f:g}" for f in sorted(w.feeds)[:4])
             out.append(
                 f"feeds are not expressible: the 8751 runs every move at its delay-loop ramp "
-                f"(8 Hz start, {cruise_feed(machine):.1f} mm/min cruise, seed-003 §4.4); "
+                f"(8 Hz start, {cruise_feed(machine):.1f} mm/min cruise, Intf8751 §4.4); "
                 f"feed(s) {feeds} mm/min ignored"
             )
         if c["rapids"]:
@@ -480,7 +480,7 @@ class I8751Post(PostProcessor):
         if w.arcs:
             out.append(
                 f"{w.arcs} arc(s) written as {w.chords} chords (the 8751 has no arcs, "
-                f"seed-003 §4.1): largest chord error {w.chord_error_mm:.4f} mm "
+                f"Intf8751 §4.1): largest chord error {w.chord_error_mm:.4f} mm "
                 f"(chord_tolerance_mm {machine.motion.chord_tolerance_mm:g})"
             )
         out += _count_warnings(c)
@@ -489,7 +489,7 @@ class I8751Post(PostProcessor):
     def _header(self, w: _Writer, machine: Machine) -> list[str]:
         n = len(packets(w.blocks))
         return [
-            f"i8751 session (seed-003, section 3.7): access key {ACCESS_KEY:02X}H, packets of <= 5 "
+            f"i8751 session (Intf8751, section 3.7): access key {ACCESS_KEY:02X}H, packets of <= 5 "
             "moves ended by 45H, end of data 54H",
             "move = M1 D PH PL | M2 D PH PL | 00 T1 | M3 D PH PL | 00 T2; D 03H +, 04H -, "
             "05H no move (no PH PL); steps = PH*256+PL; T1, T2 in s",
@@ -544,19 +544,19 @@ def _count_warnings(c: Counter[str]) -> list[str]:
     if c["xyz"]:
         out.append(
             f"{c['xyz']} move(s) change X/Y and Z together: the 8751 runs X/Y first, then Z "
-            "(seed-003 §4.3, R11; a rising rapid goes up first); they read back as two moves"
+            "(Intf8751 §4.3, R11; a rising rapid goes up first); they read back as two moves"
         )
     if c["split"]:
         out.append(
             f"{c['split']} move(s) over {MAX_STEPS} steps on an axis split into several "
-            "records (seed-003 R3)"
+            "records (Intf8751 R3)"
         )
     if c["tiny"]:
         out.append(f"{c['tiny']} move(s) shorter than half a step written as nothing")
     if c["dwell_rounded"]:
         out.append(
             f"{c['dwell_rounded']} dwell(s) rounded to whole seconds (the 8751 waits in 1 s "
-            "units, seed-003 §3.7)"
+            "units, Intf8751 §3.7)"
         )
     if c["dwell_dropped"]:
         out.append(f"{c['dwell_dropped']} dwell(s) of 0 s (after rounding) dropped")

@@ -1,8 +1,8 @@
 r"""The i8751 host link: packets, 'F' after each, 'A' at the end, and a simulated interface.
 
-Source: seed-003 §3.2 (the RS-232C power-on handshake, thesis lines 1436–1468),
+Source: Intf8751 §3.2 (the RS-232C power-on handshake, thesis lines 1436–1468),
 §3.7 (the protocol, Table III.2, lines 4077–4093 and 4343–4466) and
-requirements R5, R6, R8, R19, R21 (reference/seed-003.md). The link itself is
+requirements R5, R6, R8, R19, R21 (reference/Intf8751.md). The link itself is
 declared in ``i8751.toml``'s ``[link]`` table; this module adds what needs
 Python (:data:`LINK`). A session, as camtool's i8751 post writes it
 (:mod:`camtool_postprocessors.i8751_packets`), goes on the wire like this:

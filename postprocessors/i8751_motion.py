@@ -1,9 +1,9 @@
-"""Motion model of the seed-003 8751 stepper interface (``i8751``): a delay-loop speed ramp.
+"""Motion model of the Intf8751 8751 stepper interface (``i8751``): a delay-loop speed ramp.
 
 Its line is the generic "corte recto" (:func:`camtool.verify.interpolators.corte_recto_line`,
 ``corte-recto``); what is the 8751's own is its time model, ``i8751`` (:class:`I8751Timing`).
 
-seed-003 §4.4 (R12): each step is followed by a software delay loop whose
+Intf8751 §4.4 (R12): each step is followed by a software delay loop whose
 length is set by the register X (RAM 28H)::
 
     t(X) = (6156·X + 10272) / 12 MHz  s        (thesis formula, 12 MHz crystal)
@@ -20,7 +20,7 @@ deceleration delays X = 17, 22, …, 237 (2.97 s); a mirrored reading
 (22, …, 242) would add 0.116 s per ramped move.
 
 The firmware's integer step of 5 ends the ramp at X = 11H, ≈104 Hz, while the
-design text asks for 70 Hz (14.28 ms) with 2.46 ms per step (seed-003 §4.4
+design text asks for 70 Hz (14.28 ms) with 2.46 ms per step (Intf8751 §4.4
 "inconsistency found"). ``cruise="firmware"`` reproduces the firmware,
 ``cruise="design"`` the 8 → 70 Hz intent: the same formula with X falling
 linearly (non-integer) from F2H to the X of 70 Hz (X ≈ 26.18) in 45 steps.
@@ -51,15 +51,15 @@ from camtool.verify.timing import (
 )
 
 I8751_CLOCK_HZ = 12e6
-"""Crystal of the 8751 board, Hz (seed-003 §4.4, T = 1/12 MHz)."""
+"""Crystal of the 8751 board, Hz (Intf8751 §4.4, T = 1/12 MHz)."""
 I8751_X_MIN_SPEED = 0xF2
-"""Delay register value of the minimum speed, 8 Hz (seed-003 §4.4)."""
+"""Delay register value of the minimum speed, 8 Hz (Intf8751 §4.4)."""
 I8751_X_CRUISE_FIRMWARE = 0x11
 """Delay register at the end of the firmware ramp: F2H − 45·5 = 11H (≈104 Hz)."""
 I8751_RAMP_STEPS = 45
-"""Steps of the acceleration and of the deceleration ramp (seed-003 §4.4)."""
+"""Steps of the acceleration and of the deceleration ramp (Intf8751 §4.4)."""
 I8751_DESIGN_CRUISE_HZ = 70.0
-"""Cruise step rate the design text aims at, Hz (seed-003 §4.4)."""
+"""Cruise step rate the design text aims at, Hz (Intf8751 §4.4)."""
 
 Cruise = Literal["firmware", "design"]
 CRUISES: tuple[str, ...] = ("firmware", "design")
@@ -69,7 +69,7 @@ CRUISES: tuple[str, ...] = ("firmware", "design")
 def i8751_delay_s(x: npt.ArrayLike) -> FloatArray:
     """Delay of one step for delay register ``x``: (6156·X + 10272)/12e6 s.
 
-    seed-003 §4.4 (R12): t(F2H) = 125.0 ms, t(EDH) = 122.4 ms, t(11H) = 9.58 ms.
+    Intf8751 §4.4 (R12): t(F2H) = 125.0 ms, t(EDH) = 122.4 ms, t(11H) = 9.58 ms.
 
     Args:
         x: Delay register value(s), any shape (non-integer values model the
@@ -105,7 +105,7 @@ def _ramp_x(cruise: Cruise) -> tuple[FloatArray, FloatArray, float]:
 def i8751_step_delays_s(n_steps: int, *, cruise: Cruise = "firmware") -> FloatArray:
     """Delay after each step of one 8751 motor routine of ``n_steps`` steps, s.
 
-    seed-003 §4.4 (R12): fewer than 90 steps all at X = F2H; otherwise 45
+    Intf8751 §4.4 (R12): fewer than 90 steps all at X = F2H; otherwise 45
     acceleration steps (X = F2H − 5k), ``n − 90`` cruise steps and 45
     deceleration steps (X = 11H + 5k), k = 0…44, with the firmware cruise.
     For plots of speed against step number.
@@ -133,7 +133,7 @@ def i8751_move_time_s(n_steps: npt.ArrayLike, *, cruise: Cruise = "firmware") ->
     """Duration of 8751 motor routines of ``n_steps`` steps each, s (closed form).
 
     Equals ``i8751_step_delays_s(n).sum()`` for each ``n``: ``n·t(F2H)`` below
-    90 steps, else the ramp sums plus ``(n − 90)·t(cruise)`` (seed-003 §4.4).
+    90 steps, else the ramp sums plus ``(n − 90)·t(cruise)`` (Intf8751 §4.4).
 
     Args:
         n_steps: ``(B,)`` step counts, ``>= 0``.
@@ -164,7 +164,7 @@ def i8751_block_time_s(
 ) -> FloatArray:
     """Time of each 8751 move: X/Y routine, wait T1, Z routine, wait T2, s.
 
-    seed-003 §4.3–4.4 and R11–R12: the X/Y "corte recto" move runs one ramped
+    Intf8751 §4.3–4.4 and R11–R12: the X/Y "corte recto" move runs one ramped
     routine of ``max(|n1|, |n2|)`` steps; Z (motor 3) runs its own routine
     after X/Y; T1 and T2 are the packet's whole-second waits (0–255 s in the
     dialect), here scalars or per-block arrays, default 0. Feed is ignored (the
@@ -196,7 +196,7 @@ def i8751_block_time_s(
 
 @dataclass(frozen=True, kw_only=True)
 class I8751Timing:
-    """Parameters of the seed-003 ``i8751`` time model (see :func:`i8751_block_time_s`).
+    """Parameters of the Intf8751 ``i8751`` time model (see :func:`i8751_block_time_s`).
 
     Attributes:
         cruise: ``"firmware"`` (ramp to 11H, ≈104 Hz) or ``"design"`` (to 70 Hz).

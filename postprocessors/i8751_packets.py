@@ -1,6 +1,6 @@
 """The byte stream of the 8751 serial stepper interface: records, packets, dump.
 
-Source: seed-003 §3.7 (reference/seed-003.md, thesis lines 4077–4165,
+Source: Intf8751 §3.7 (reference/Intf8751.md, thesis lines 4077–4165,
 4343–4415) and requirements R2–R6. The PC sends, in raw binary (``CHR$``)::
 
     session = 13H , { packet } , 54H           (access key ... end of data)
@@ -36,7 +36,7 @@ from camtool.model.errors import ParseError
 from camtool.post.numfmt import NumberFormat
 
 ACCESS_KEY = 0x13
-"""First byte of a session (seed-003 §3.7, 4399–4415)."""
+"""First byte of a session (Intf8751 §3.7, 4399–4415)."""
 END_PACKET = 0x45
 """End of a packet; the interface answers 'F' when it has run it (4343–4370)."""
 END_DATA = 0x54
@@ -90,7 +90,7 @@ class Record:
 def encode_block(motor: int, steps: int) -> bytes:
     """The bytes of one motor's block: ``m D PH PL``, or ``m 05H`` for no move.
 
-    seed-003 R2: +1000 on motor 1 → ``01 03 03 E8``; 0 on motor 2 → ``02 05``.
+    Intf8751 R2: +1000 on motor 1 → ``01 03 03 E8``; 0 on motor 2 → ``02 05``.
 
     Raises:
         ValueError: ``|steps|`` over :data:`MAX_STEPS` or a motor not 1–3.
@@ -122,7 +122,7 @@ def packets(records: Sequence[Record]) -> list[Sequence[Record]]:
 
 
 def encode_stream(records: Sequence[Record]) -> bytes:
-    """The whole session: 13H, each packet's moves then 45H, and 54H (seed-003 R5, R6)."""
+    """The whole session: 13H, each packet's moves then 45H, and 54H (Intf8751 R5, R6)."""
     out = bytearray((ACCESS_KEY,))
     for packet in packets(records):
         for record in packet:
@@ -270,7 +270,7 @@ def _block(cur: _Cursor, motor: int) -> int:
         raise cur.fail(
             at,
             f"expected motor {motor} ({motor:02X}H), got {got:02X}H "
-            "(a move is M1 M2 00H T1 M3 00H T2, seed-003 §3.7)",
+            "(a move is M1 M2 00H T1 M3 00H T2, Intf8751 §3.7)",
         )
     at = cur.at
     direction = cur.take(f"the direction of motor {motor}")
@@ -321,7 +321,7 @@ def _packet(cur: _Cursor, number: int, records: list[Record]) -> None:
             raise cur.fail(
                 at,
                 f"packet {number} holds more than {MOVES_PER_PACKET} moves: 45H must follow "
-                "the 5th (seed-003 §3.7)",
+                "the 5th (Intf8751 §3.7)",
             )
         records.append(_move(cur))
         moves += 1

@@ -1,7 +1,7 @@
-"""The ``matlab-router`` dialect: the seed-002 wood router's Matlab GUI arrays.
+"""The ``matlab-router`` dialect: the Angel-11 wood router's Matlab GUI arrays.
 
-Source: seed-002 §3 (the GUI, verbatim code in Appendix A.1), §2.7 (the USB
-stream), §2.8 (the master's job), §8 R1–R7 (reference/seed-002.md).
+Source: Angel-11 §3 (the GUI, verbatim code in Appendix A.1), §2.7 (the USB
+stream), §2.8 (the master's job), §8 R1–R7 (reference/Angel-11.md).
 
 The GUI turns clicked vertices into three integer arrays per figure
 (:mod:`camtool_postprocessors.matlab_router_arrays`): ``xy`` (``2 × N`` absolute vertices, 0.1 mm),
@@ -28,7 +28,7 @@ The GUI turns clicked vertices into three integer arrays per figure
 Jobs. The router has no travel inside a job (R6): a stroke (the cutting moves
 between two rapids) is one job, which the master runs as home (Z, X, Y) → first
 point (X then Y at speed 500) → tool down → segments, stopping at every vertex →
-tool off; then it idles (seed-002 §2.8; multi-stroke figures in §6, L3938–L3966).
+tool off; then it idles (Angel-11 §2.8; multi-stroke figures in §6, L3938–L3966).
 A rapid is therefore a job boundary, never written. A stroke of more than
 ``max_segments`` (128: the master's ``X_ROUTE[128]``, L4625) segments is split
 into jobs that continue from the same vertex: the thesis machine can do that (it
@@ -81,7 +81,7 @@ if TYPE_CHECKING:  # numpy is imported where it is used: `camtool targets` loads
 # Reader of the ``matlab-router`` dialect: the GUI's ``.m`` script and its USB wire stream.
 #
 # Both formats are written by :class:`camtool_postprocessors.matlab_router.MatlabRouterPost`
-# (seed-002 §3, §2.7, R2–R4) and read back here, strictly, into a
+# (Angel-11 §3, §2.7, R2–R4) and read back here, strictly, into a
 # :class:`~camtool.model.program.Program` of absolute mm, Y up: each job becomes a
 # :class:`~camtool.model.program.Rapid` to its first point (the master homes and goes
 # there, §2.8 st=0/st=1) followed by one :class:`~camtool.model.program.Linear` per
@@ -105,15 +105,15 @@ if TYPE_CHECKING:  # numpy is imported where it is used: `camtool targets` loads
 # job's rapid and of ``lx(i)`` for segment ``i``.
 
 COUNTS_PER_MM = 25_600
-"""Encoder counts per mm on X and Y: 1024 × 75 / 3 mm (seed-002 §2.2, R8)."""
+"""Encoder counts per mm on X and Y: 1024 × 75 / 3 mm (Angel-11 §2.2, R8)."""
 TS_S = 0.005
-"""Servo sample period of the slaves' speed loops, s (seed-002 §2.6)."""
+"""Servo sample period of the slaves' speed loops, s (Angel-11 §2.6)."""
 INT16_MAX = 32_767
 """Largest value the master's ``signed int16`` arrays hold (L4625–L4643)."""
 WIRE_MAX_CHARS = 6
 """Characters per wire value: ``get_string_usb(s, 7)`` keeps 6 and a NUL (L5009–L5021)."""
 UNITS_PER_MM = 10
-"""GUI units (0.1 mm) per mm (seed-002 §3, L3202–L3204)."""
+"""GUI units (0.1 mm) per mm (Angel-11 §3, L3202–L3204)."""
 ARRAYS = ("xy", "lxy", "velxy")
 """The variables of a job, in the order the script holds them."""
 
@@ -127,7 +127,7 @@ _ASSIGN = re.compile(r"([A-Za-z_]\w*)[ \t]*=[ \t]*")
 def major_axis_feed_mm_min(speed: int) -> float:
     """Feed of the major axis at ``speed`` counts per 5 ms, mm/min (R7: 480 → 3.75 mm/s).
 
-    ``speed · 200 / 25 600`` mm/s (seed-002 §2.3, R7), so 480 gives 225 mm/min.
+    ``speed · 200 / 25 600`` mm/s (Angel-11 §2.3, R7), so 480 gives 225 mm/min.
     """
     return speed / COUNTS_PER_MM / TS_S * 60.0
 
@@ -234,7 +234,7 @@ class _Reader:
             raise self.fail(
                 line,
                 f"job {job}: n = {n} segments; a job holds 1 to {self.max_segments} "
-                "(the master's arrays X_ROUTE[128]..., seed-002 §2.7 L4625)",
+                "(the master's arrays X_ROUTE[128]..., Angel-11 §2.7 L4625)",
             )
         if xy[0, 0] < 0 or xy[0, 1] < 0:
             raise self.fail(
@@ -252,7 +252,7 @@ class _Reader:
                 speed_line(axis, col),
                 f"job {job}, segment {col + 1}: {'XY'[axis]} moves {arrays.lxy[axis, col]} "
                 "(0.1 mm) at speed 0: the slave never reaches its count and the job hangs "
-                "(seed-002 §4.2)",
+                "(Angel-11 §4.2)",
             )
         return arrays
 
@@ -385,7 +385,7 @@ class _Reader:
                 raise self.fail(
                     k + 1,
                     f"job {job}: n = {n}; a job holds 1 to {self.max_segments} segments "
-                    "(the master's arrays, seed-002 §2.7 L4625)",
+                    "(the master's arrays, Angel-11 §2.7 L4625)",
                 )
             if len(records) < k + 3 + 4 * n:
                 raise self.fail(
@@ -467,17 +467,17 @@ def _skip_blank(code: str, pos: int) -> int:
 # The warnings of the ``matlab-router`` writer: one per kind of conversion.
 #
 # Gathered in a :class:`RouterWriter` (below) while :class:`MatlabRouterPost`
-# writes, then worded here (seed-002 §2.8, §3, §4.2 for the reasons given).
+# writes, then worded here (Angel-11 §2.8, §3, §4.2 for the reasons given).
 
 FIRST_POINT_SPEED = 500
 """Speed of the move from home to a job's first point, counts per 5 ms (L4796)."""
 
 COMMAND_REASONS = {
     "Spindle": "the Z slave switches the Dremel on at the first segment and off at the end "
-    "of every job by itself (seed-002 §2.8, L6556–L6560)",
+    "of every job by itself (Angel-11 §2.8, L6556–L6560)",
     "Dwell": "the GUI has no pause; the master stops at every vertex anyway",
     "ToolChange": "the router has one tool, changed by hand",
-    "Home": "every job homes Z, X and Y before it starts (seed-002 §2.8 st=0)",
+    "Home": "every job homes Z, X and Y before it starts (Angel-11 §2.8 st=0)",
 }
 """Why each kind of :data:`~camtool.model.program.Command` is not written."""
 
@@ -493,13 +493,13 @@ def notes_warnings(notes: RouterWriter, speed: int, tolerance: float) -> list[st
         w.append(
             f"feeds ignored ({feeds} mm/min): the router runs the longer axis of every segment "
             f"at {speed} counts per 5 ms = {major_axis_feed_mm_min(speed):g} mm/min and scales "
-            "the other (seed-002 §3, R7)"
+            "the other (Angel-11 §3, R7)"
         )
     if notes.arcs:
         w.append(
             f"{notes.arcs} arc(s) written as {notes.chords} chords within {tolerance:g} mm "
             f"(largest sagitta {notes.chord_error_mm:.4f} mm), then rounded to 0.1 mm: the router "
-            "has straight segments only (seed-002 §4.1)"
+            "has straight segments only (Angel-11 §4.1)"
         )
     if notes.counts["merged"]:
         w.append(
@@ -510,7 +510,7 @@ def notes_warnings(notes: RouterWriter, speed: int, tolerance: float) -> list[st
         x, y = notes.trailing_rapid
         w.append(
             f"the final rapid to ({x:g}, {y:g}) mm is not written: after a job the master "
-            "idles with the tool where the job ended (seed-002 §2.8 st=3)"
+            "idles with the tool where the job ended (Angel-11 §2.8 st=3)"
         )
     return w
 
@@ -535,7 +535,7 @@ def jobs_warnings(jobs: list[RouterJob], max_segments: int) -> list[str]:
         w.append(
             f"{len(jobs)} jobs: the router has no travel inside a job; each job homes Z, X, Y, "
             f"goes to its first point X then Y at speed {FIRST_POINT_SPEED} and lowers the tool, "
-            "and the master idles after it (seed-002 §2.8, §6 L3938–L3966): send the jobs "
+            "and the master idles after it (Angel-11 §2.8, §6 L3938–L3966): send the jobs "
             "one at a time, resetting the master in between"
         )
     ones = [
@@ -547,7 +547,7 @@ def jobs_warnings(jobs: list[RouterJob], max_segments: int) -> list[str]:
         w.append(
             f"{len(ones)} segment(s) move an axis by 0.1 mm (first: {ones[0]}): the thesis "
             "slave's chunk counter underflows on a distance of 1 (factor - 1 = 65535, "
-            "seed-002 §4.2) and that axis runs away; check the slave firmware or snap the "
+            "Angel-11 §4.2) and that axis runs away; check the slave firmware or snap the "
             "drawing to 0.2 mm"
         )
     return w
@@ -627,7 +627,7 @@ class _Stroke:
 
 
 class MatlabRouterPost(PostProcessor):
-    """Writer and reader of the seed-002 router's Matlab GUI arrays (seed-002 §3, R1–R7).
+    """Writer and reader of the Angel-11 router's Matlab GUI arrays (Angel-11 §3, R1–R7).
 
     Args:
         speed: major-axis speed of every segment, encoder counts per 5 ms (R7;
@@ -815,7 +815,7 @@ class MatlabRouterPost(PostProcessor):
     def _script(self, jobs: list[RouterJob]) -> str:
         """The thesis display format, one ``xy``/``lxy``/``velxy`` triple per job."""
         lines = [
-            "% camtool matlab-router: the seed-002 Matlab GUI arrays (thesis display format)",
+            "% camtool matlab-router: the Angel-11 Matlab GUI arrays (thesis display format)",
             f"% xy, lxy in 0.1 mm; velxy in encoder counts per 5 ms, major axis {self.speed}",
             f"% {len(jobs)} job(s); each job homes, goes to its first point and lowers the tool",
         ]
@@ -904,7 +904,7 @@ def _check_move(
     if move.z is not None:
         raise DialectError(
             f"{where}: matlab-router has no Z (the Matlab GUI is 2D; the Z slave only lowers "
-            "the tool by a fixed 100 units at each job's start, seed-002 §2.8 L6544); "
+            "the tool by a fixed 100 units at each job's start, Angel-11 §2.8 L6544); "
             "set the depth by hand"
         )
     check_work_area(notes.here, move, machine, where, program)
@@ -924,7 +924,7 @@ def _chords(here: Point, move: ArcMove, tolerance: float, notes: RouterWriter) -
 
 
 def _check_speeds(job: RouterJob) -> None:
-    """A moving axis whose speed rounds to 0 hangs the job (seed-002 §3, §4.2)."""
+    """A moving axis whose speed rounds to 0 hangs the job (Angel-11 §3, §4.2)."""
     import numpy as np
 
     a = job.arrays
@@ -935,7 +935,7 @@ def _check_speeds(job: RouterJob) -> None:
             f"{job.where(col)}: {'XY'[axis]} moves {a.lxy[axis, col] / 10:g} mm while the other "
             f"axis moves {a.lxy[1 - axis, col] / 10:g} mm: its speed {a.speed}·"
             f"{a.lxy[axis, col]}/{a.lxy[1 - axis, col]} rounds to 0 and the slave never reaches "
-            "its count, so the job would hang (seed-002 §3, §4.2); straighten the segment or "
+            "its count, so the job would hang (Angel-11 §3, §4.2); straighten the segment or "
             "split it"
         )
 

@@ -1,6 +1,6 @@
-"""The point-list arrays of the seed-002 wood router's Matlab GUI.
+"""The point-list arrays of the Angel-11 wood router's Matlab GUI.
 
-The GUI (seed-002 §3, verbatim code in Appendix A.1, thesis L4400–L4515) turns
+The GUI (Angel-11 §3, verbatim code in Appendix A.1, thesis L4400–L4515) turns
 the clicked vertices into three integer arrays that the master PIC replays one
 segment at a time:
 
@@ -33,7 +33,7 @@ if TYPE_CHECKING:  # numpy is imported where it is used: `camtool targets` loads
     IntArray: TypeAlias = npt.NDArray[np.int64]
 
 DEFAULT_SPEED = 480
-"""Major-axis speed of a segment, encoder counts per 5 ms (seed-002 §2.3, R7, L4458)."""
+"""Major-axis speed of a segment, encoder counts per 5 ms (Angel-11 §2.3, R7, L4458)."""
 
 
 @overload
@@ -45,7 +45,7 @@ def matlab_round(x: npt.NDArray[np.floating] | npt.NDArray[np.integer]) -> IntAr
 
 
 def matlab_round(x: float | npt.NDArray[np.floating] | npt.NDArray[np.integer]) -> int | IntArray:
-    """Round half away from zero, as Matlab's ``round`` (seed-002 §3, R1).
+    """Round half away from zero, as Matlab's ``round`` (Angel-11 §3, R1).
 
     ``matlab_round(2.5) == 3`` and ``matlab_round(-2.5) == -3`` (Python's
     ``round`` and ``numpy.round`` give 2 and -2). Exact for every double: the
@@ -99,7 +99,7 @@ def points_01mm(xy_mm: npt.ArrayLike) -> IntArray:
 
 @dataclass(frozen=True)
 class RouterArrays:
-    """The arrays the Matlab GUI sends for one stroke (seed-002 §3, R2).
+    """The arrays the Matlab GUI sends for one stroke (Angel-11 §3, R2).
 
     Attributes:
         xy: ``(2, N) int64``, read-only: absolute vertices, 0.1 mm; row 0 is x.
@@ -155,7 +155,7 @@ def _vertices(xy_01mm: npt.ArrayLike) -> IntArray:
 def router_arrays(xy_01mm: npt.ArrayLike, *, speed: int = DEFAULT_SPEED) -> RouterArrays:
     """Build ``xy``, ``lxy`` and ``velxy`` exactly as the GUI's ``axes5_CreateFcn`` does.
 
-    seed-002 §3 (verbatim Matlab, L4444–L4515) and R2. For the 11-point star of
+    Angel-11 §3 (verbatim Matlab, L4444–L4515) and R2. For the 11-point star of
     L3196 this gives the ``lxy`` and ``velxy`` printed at L3212–L3228.
 
     Args:

@@ -1,6 +1,6 @@
 """The matlab-router's USB link: a job is one wire block, and the master that takes it.
 
-Source: seed-002 §2.7 (reference/seed-002.md): the Matlab GUI's
+Source: Angel-11 §2.7 (reference/Angel-11.md): the Matlab GUI's
 ``pushbutton2_Callback`` opens the USB-CDC port (``fopen(s)``, L4288), writes
 one job as ASCII decimal numbers each followed by CR (``fprintf(s,'%d',v);
 fprintf(s,'%c',13)``, L4292–L4360): ``n, x1, y1, lx(1..n), ly(1..n),

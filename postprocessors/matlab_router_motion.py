@@ -1,6 +1,6 @@
-"""Motion model of the seed-002 DC-servo router (``matlab-router``): its ``servo`` simulator.
+"""Motion model of the Angel-11 DC-servo router (``matlab-router``): its ``servo`` simulator.
 
-The router has no coordinated interpolator (seed-002 §4): each stroke is a job
+The router has no coordinated interpolator (Angel-11 §4): each stroke is a job
 of straight segments between vertices in whole 0.1 mm, every axis at its own
 pre-scaled speed, moves floored to 0.2 mm chunks, a stop at every vertex
 (:func:`camtool.verify.servo.simulate_job`). Here a program is cut into strokes
@@ -92,19 +92,19 @@ def router_backlash_mm(machine: Machine) -> tuple[float, float]:
     if any(lash.compensation_um[:2]):
         raise InputError(
             f"{where} compensation_um = {list(lash.compensation_um)}: the matlab-router "
-            "firmware compensates no backlash (seed-002 R15); set compensation_um to 0 in "
+            "firmware compensates no backlash (Angel-11 R15); set compensation_um to 0 in "
             "the --machine file (true_um alone is simulated as a dead band)"
         )
     if lash.regions:
         raise InputError(
             f"{where} regions: the matlab-router model has one dead band per axis "
-            "(seed-002 R15), not regions; give true_um = [x, y, 0] instead in the --machine file"
+            "(Angel-11 R15), not regions; give true_um = [x, y, 0] instead in the --machine file"
         )
     return (lash.true_um[0] / 1000.0, lash.true_um[1] / 1000.0)
 
 
 def simulate_servo(program: Program, machine: Machine, *, sources: Sources = ALL) -> StepTrace:
-    """Simulate ``program`` stroke by stroke on the seed-002 router model.
+    """Simulate ``program`` stroke by stroke on the Angel-11 router model.
 
     Args:
         program: moves in mm (rapids separate strokes).

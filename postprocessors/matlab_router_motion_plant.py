@@ -1,18 +1,18 @@
-"""Speed-loop pieces of the seed-002 DC-servo router: plant, IP controllers, gain design.
+"""Speed-loop pieces of the Angel-11 DC-servo router: plant, IP controllers, gain design.
 
 Units: speeds are encoder counts (×4 quadrature, 1024 per motor revolution) per
-5 ms sample, "counts/Ts" (seed-002 §2.3: the thesis's "pulsos/s" are really
+5 ms sample, "counts/Ts" (Angel-11 §2.3: the thesis's "pulsos/s" are really
 counts per Ts); the command ``u`` is the PWM command in percent, −100…+100.
 
-- Plant (seed-002 §5.1, R9): first order, ``ω[k+1] = pole·ω[k] + gain·u[k]``.
+- Plant (Angel-11 §5.1, R9): first order, ``ω[k+1] = pole·ω[k] + gain·u[k]``.
   The thesis model is G_p(z) = 0.6986/(z − 0.9283) (eq. 4.34), identified from a
   u = 70 step (A = 9.715, τ = 0.067 s). ``ω[k+1]`` is the count advance during
   sample ``k → k+1``, which is what the firmware measures (``posAc − posAnt``).
-- Firmware IP law (seed-002 §4.5 (C), Appendix A.3.1 L5534–L5584, R10): integer
+- Firmware IP law (Angel-11 §4.5 (C), Appendix A.3.1 L5534–L5584, R10): integer
   arithmetic with ``kid = 28``, ``kpd = 159`` (Table 4.1's Y gains × 1000).
 - Idealised IP law (eq. 4.27) with the per-axis gains of Table 4.1.
 - Gain design (eqs. 4.39, 4.40, 4.44, 4.29, 4.30; R11) and its inverse, the
-  per-axis plants back-solved from Table 4.1 (seed-002 §5.2 (D)).
+  per-axis plants back-solved from Table 4.1 (Angel-11 §5.2 (D)).
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ import numpy.typing as npt
 from camtool.model.errors import UsageError
 
 TS_S = 0.005
-"""Servo sample period, s (seed-002 §2.6: ``#define Ts 0.005``, Timer5 preload 53036)."""
+"""Servo sample period, s (Angel-11 §2.6: ``#define Ts 0.005``, Timer5 preload 53036)."""
 
 Law = Literal["firmware", "ideal"]
 LAWS: tuple[str, ...] = ("firmware", "ideal")
@@ -39,7 +39,7 @@ FIRMWARE_GAINS = (28, 159)
 
 @dataclass(frozen=True)
 class Plant:
-    """First-order discrete speed plant ``ω[k+1] = pole·ω[k] + gain·u[k]`` (seed-002 §5.1, R9).
+    """First-order discrete speed plant ``ω[k+1] = pole·ω[k] + gain·u[k]`` (Angel-11 §5.1, R9).
 
     Attributes:
         pole: Discrete pole, ``0 <= pole < 1`` (0.9283 in eq. 4.34).
@@ -59,7 +59,7 @@ class Plant:
     def from_analog(cls, a: float, tau_s: float, *, ts_s: float = TS_S) -> Plant:
         """Zero-order-hold discretisation of ``A/(τs + 1)``.
 
-        ``pole = exp(−Ts/τ)``, ``gain = A·(1 − pole)`` (seed-002 §5.1 (D): the
+        ``pole = exp(−Ts/τ)``, ``gain = A·(1 − pole)`` (Angel-11 §5.1 (D): the
         thesis numerator 0.6986 has the ZOH form, not Tustin's).
 
         Args:
@@ -86,12 +86,12 @@ class Plant:
 
 
 THESIS_PLANT = Plant(pole=0.9283, gain=0.6986)
-"""G_p(z) = 0.6986/(z − 0.9283), seed-002 eq. 4.34 (all three axes in the thesis)."""
+"""G_p(z) = 0.6986/(z − 0.9283), Angel-11 eq. 4.34 (all three axes in the thesis)."""
 
 
 @dataclass(frozen=True)
 class IPGains:
-    """Gains of the IP speed controller (seed-002 §4.5, §5.2, Table 4.1).
+    """Gains of the IP speed controller (Angel-11 §4.5, §5.2, Table 4.1).
 
     Attributes:
         ki: Analog integral gain K_i, % per (counts/Ts)·s.
@@ -113,13 +113,13 @@ TABLE_4_1: tuple[IPGains, IPGains, IPGains] = (
     IPGains(ki=5.6304, kp=0.1732, kid=0.028152, kpd=0.159124, wn=22.63),
     IPGains(ki=3.2509, kp=0.10074, kid=0.0162, kpd=0.09264, wn=22.63),
 )
-"""Table 4.1 of seed-002 (L2872–L2880), verbatim, in axis order X, Y, Z."""
+"""Table 4.1 of Angel-11 (L2872–L2880), verbatim, in axis order X, Y, Z."""
 
 
 def digital_gains(ki: float, kp: float, sample_s: float = TS_S) -> tuple[float, float]:
     """Digital IP gains from analog ones: ``(K_id, K_pd) = (K_i·T, K_p − K_i·T/2)``.
 
-    seed-002 eqs. 4.29–4.30 (R11); Table 4.1's digital columns follow from its
+    Angel-11 eqs. 4.29–4.30 (R11); Table 4.1's digital columns follow from its
     analog ones this way.
     """
     kid = ki * sample_s
@@ -129,7 +129,7 @@ def digital_gains(ki: float, kp: float, sample_s: float = TS_S) -> tuple[float, 
 def design_ip(
     a: float, tau_s: float, settling_s: float, xi: float, sample_s: float = TS_S
 ) -> IPGains:
-    """Design IP speed-loop gains for the plant ``A/(τs + 1)`` (seed-002 §5.2, R11).
+    """Design IP speed-loop gains for the plant ``A/(τs + 1)`` (Angel-11 §5.2, R11).
 
     ``ω_n = 4/(ξ·t_s)`` (2 % settling, eq. 4.44), ``K_i = ω_n²·τ/A`` (4.39),
     ``K_p = (2ξω_nτ − 1)/A`` (4.40), then the digital gains of
@@ -166,7 +166,7 @@ def plant_from_gains(
     """Back-solve the plant ``(A, τ)`` a pair of analog IP gains was designed for.
 
     Inverts eqs. 4.39–4.40: ``A = 1/(2ξω_n·K_i/ω_n² − K_p)``, ``τ = K_i·A/ω_n²``.
-    seed-002 §5.2 (D): Table 4.1 gives X ≈ (8.90, 0.0610 s), Y ≈ (5.60, 0.0615 s),
+    Angel-11 §5.2 (D): Table 4.1 gives X ≈ (8.90, 0.0610 s), Y ≈ (5.60, 0.0615 s),
     Z ≈ (9.77, 0.0620 s).
 
     Args:
@@ -190,14 +190,14 @@ def plant_from_gains(
 
 
 def per_axis_plants(ts_s: float = TS_S) -> tuple[Plant, Plant, Plant]:
-    """The X, Y, Z plants back-solved from Table 4.1 (seed-002 §5.2 (D), R9), ZOH at ``ts_s``."""
+    """The X, Y, Z plants back-solved from Table 4.1 (Angel-11 §5.2 (D), R9), ZOH at ``ts_s``."""
     models = (plant_from_gains(g.ki, g.kp) for g in TABLE_4_1)
     x, y, z = (Plant.from_analog(a, tau, ts_s=ts_s) for a, tau in models)
     return x, y, z
 
 
 class FirmwareIP:
-    """The slaves' ``CONTROL_IP_VELOCIDAD`` in exact integer arithmetic (seed-002 §4.5 (C), R10).
+    """The slaves' ``CONTROL_IP_VELOCIDAD`` in exact integer arithmetic (Angel-11 §4.5 (C), R10).
 
     Per 5 ms tick, with ``velAc`` the measured speed magnitude (counts/Ts)::
 
@@ -238,7 +238,7 @@ class FirmwareIP:
 
 
 class IdealIP:
-    """Eq. 4.27, ``u(k) = u(k−1) − K_pd·[ω(k) − ω(k−1)] + K_id·[ω_ref(k) − ω(k)]`` (seed-002 §4.5).
+    """Eq. 4.27, ``u(k) = u(k−1) − K_pd·[ω(k) − ω(k−1)] + K_id·[ω_ref(k) − ω(k)]`` (Angel-11 §4.5).
 
     Floats, signed speeds, ``u`` clamped to ±100 % (the PWM range; clamping the
     carried ``u`` is the anti-windup of the incremental form). ``Ref == 0``
@@ -266,7 +266,7 @@ class IdealIP:
 
 
 def open_loop_step(plant: Plant, u_pct: float, n: int) -> npt.NDArray[np.float64]:
-    """Speed response to a constant command from rest (seed-002 §5.1 identification).
+    """Speed response to a constant command from rest (Angel-11 §5.1 identification).
 
     Args:
         plant: The plant.
@@ -291,7 +291,7 @@ def closed_loop_step(
     gains: IPGains | None = None,
     firmware_gains: tuple[int, int] = FIRMWARE_GAINS,
 ) -> npt.NDArray[np.float64]:
-    """Speed response of the IP loop to a constant reference from rest (seed-002 §5.3, Fig 4.12).
+    """Speed response of the IP loop to a constant reference from rest (Angel-11 §5.3, Fig 4.12).
 
     The controller sees the integer count advance per sample, as the firmware's
     ``velAc``; ``ideal`` sees the exact plant speed.

@@ -1,6 +1,6 @@
-"""The seed-002 DC-servo wood router's firmware moves, simulated, and their error measures.
+"""The Angel-11 DC-servo wood router's firmware moves, simulated, and their error measures.
 
-The router has no coordinated interpolator (seed-002 §4.1). For each segment the
+The router has no coordinated interpolator (Angel-11 §4.1). For each segment the
 master PIC sends every axis slave an absolute distance (0.1 mm) and a signed
 speed (counts per 5 ms) from the GUI's arrays (:mod:`camtool_postprocessors.matlab_router_arrays`),
 starts X then Y (one I²C frame apart, R13) and waits until both report done:
@@ -26,7 +26,7 @@ the count the firmware waits for, as if friction (a self-locking 3 mm lead
 screw behind a 1:75 gearbox) held it; ``stop="coast"`` lets the linear thesis
 plant coast on, and the trace shows the resulting overrun at every vertex.
 
-Error measures of a trace (seed-002 R14, R15), all in mm:
+Error measures of a trace (Angel-11 R14, R15), all in mm:
 
 - :func:`closure_mm`: where a job ends relative to its first point (R14c), with
   an optional per-axis backlash (R15) applied to the executed positions;
@@ -35,7 +35,7 @@ Error measures of a trace (seed-002 R14, R15), all in mm:
   the straight line joining where it started and where it stopped (R14b);
 - :func:`tracking_deviation_mm`: the same against the line the two speeds aim
   along, while both axes are moving: the servo-mismatch part of R14b, as in
-  seed-002 §5.2 "(D) Rough simulation".
+  Angel-11 §5.2 "(D) Rough simulation".
 
 The simulation works in integer encoder counts (25 600 per mm on X and Y, R8) and
 returns mm; Y up, positive speed = towards larger coordinates.
@@ -82,7 +82,7 @@ DECELS: tuple[str, ...] = ("capped", "listing")
 """``capped``: Ref = min(|speed|, Tabla[q]); ``listing``: Ref = Tabla[q] at any speed (L5703)."""
 
 QEI_COUNTS = 1024
-"""Counter states per motor revolution: 256 slots × 4 (seed-002 §2.2)."""
+"""Counter states per motor revolution: 256 slots × 4 (Angel-11 §2.2)."""
 UNITS_PER_MM = round(1 / TENTH_MM)
 """GUI units (0.1 mm) per mm."""
 MAX_TICKS = 200_000
@@ -96,7 +96,7 @@ def _check_choice(name: str, value: str, valid: tuple[str, ...]) -> None:
 
 @dataclass(frozen=True, kw_only=True)
 class RouterMachine:
-    """The seed-002 router: R8 constants, the speed loops and the model switches.
+    """The Angel-11 router: R8 constants, the speed loops and the model switches.
 
     Attributes:
         counts_per_mm: Encoder counts per mm on X and Y: 1024 × 75 / 3 mm (R8).
@@ -210,7 +210,7 @@ def chunked_increments(arrays: RouterArrays, machine: RouterMachine) -> npt.NDAr
 def chunk_closure_mm(xy_01mm: npt.ArrayLike, machine: RouterMachine | None = None) -> np.ndarray:
     """End of a job minus its first point by the chunk rule alone, mm: ``(2,) float64``.
 
-    seed-002 §4.2 (D)1 and R14: the star of §3 gives (+0.4, −0.2) mm under the
+    Angel-11 §4.2 (D)1 and R14: the star of §3 gives (+0.4, −0.2) mm under the
     floor(d/2) rule (the GUI commands (+0.2, 0) mm).
     """
     m = machine or RouterMachine()
@@ -388,7 +388,7 @@ def _segment_plans(
 
 
 def simulate_job(xy_01mm: npt.ArrayLike, machine: RouterMachine | None = None) -> ServoTrace:
-    """Simulate one stroke (one job, R6) of the seed-002 router, sample by sample.
+    """Simulate one stroke (one job, R6) of the Angel-11 router, sample by sample.
 
     Segment ``i``: a handshake (both axes idle), then X and Y (``start_skew_s``
     later) each run ``MOVIMIENTO_X`` with their own speed loop; the next
@@ -495,7 +495,7 @@ def apply_backlash(positions_mm: npt.ArrayLike, backlash_mm: tuple[float, float]
     The table follows the motor side only while the motor pushes it; after a
     reversal the motor travels the dead band before the table moves again. The
     band starts taken up in the + direction (the approach to the first point
-    is +X then +Y, seed-002 §2.8 st=1), so the table equals the motor position
+    is +X then +Y, Angel-11 §2.8 st=1), so the table equals the motor position
     while an axis moves +, and lags by the band (is ``+band`` from it) while it
     moves −.
 
@@ -584,8 +584,8 @@ def tracking_deviation_mm(trace: ServoTrace) -> FloatArray:
     samples), so the measure isolates the speed loops' mismatch (and the start skew) from
     the axes finishing apart. Includes the lurch of an axis that starts with
     the integrator wound up by the previous segment (``INTE`` is never reset,
-    seed-002 §4.5).
-    seed-002 §5.2 (D): ≈ 0.03 mm on star segment 1 with the back-solved per-axis
+    Angel-11 §4.5).
+    Angel-11 §5.2 (D): ≈ 0.03 mm on star segment 1 with the back-solved per-axis
     plants, ≈ 0.0003 mm with identical plants.
 
     Returns:

@@ -1,6 +1,6 @@
 """The ``pic-mmh`` dialect: the PIC18F8720 controller of the GMM micro machine tool.
 
-Source: seed-000 §3 (reference/seed-000.md), requirements S000-01…08. Example
+Source: UNAM-GMM §3 (reference/UNAM-GMM.md), requirements S000-01…08. Example
 block, verbatim from the thesis (L1731)::
 
     G02X02969.00Y03400.00I03012.00J03040.00F08;
@@ -19,7 +19,7 @@ block, verbatim from the thesis (L1731)::
   ``G04P##;``, ``M06T##;`` and ``G28X0Y0;`` / ``G28Z0;`` (S000-06, Tablas 21–22);
 - no Z words (S000-08): a program that moves Z is refused;
 - a full circle is written as two half arcs (the firmware takes the start from
-  its current position; a zero-length G02 is ambiguous, seed-000 §3.7 item 7);
+  its current position; a zero-length G02 is ambiguous, UNAM-GMM §3.7 item 7);
 - an arc whose absolute centre does not fit the I/J field (±99999.99 µm: a
   large radius, e.g. a nearly straight DXF bulge) is written as G01 chords
   within the program's ``tolerance_mm`` (``--tolerance``; else the machine's
@@ -72,7 +72,7 @@ from camtool.post.numfmt import NumberFormat, format_int
 # -- the feed table ---------------------------------------------------------------------
 # The F word of the pic-mmh dialect: two-digit feed codes and the feed each one means.
 #
-# Source: seed-000 §4.1 and §4.9, S000-05. The firmware reads F with its
+# Source: UNAM-GMM §4.1 and §4.9, S000-05. The firmware reads F with its
 # "obtención de 2 dígitos" routine into the variable ``Avance`` (L1839–L1845) and
 # *computes* the interpolator period from it, it does not look it up in a table:
 # ``FCIAALGORITMO = (PPR * AVANCE) / 60``, ``PDOALGORITMO = 1000000 / FCIAALGORITMO``
@@ -83,10 +83,10 @@ from camtool.post.numfmt import NumberFormat, format_int
 # instead is described by an explicit ``feed_codes`` table.
 
 DEFAULT_FEED_UNIT_MM_MIN = 0.1
-"""mm/min per unit of F under the default, linear table (seed-000 §4.9, S000-05)."""
+"""mm/min per unit of F under the default, linear table (UNAM-GMM §4.9, S000-05)."""
 
 MAX_CODE = 99
-"""F has two digits (seed-000 Tabla 21, L3297–L3358); F00 would divide by zero
+"""F has two digits (UNAM-GMM Tabla 21, L3297–L3358); F00 would divide by zero
 in the firmware's period ``1000000 / FCIAALGORITMO`` (L3664), so codes are 1–99."""
 
 
@@ -215,7 +215,7 @@ class Word:
     """One word of the fixed-width pic-mmh grammar: a letter and a zero-padded number.
 
     Both the writer (:meth:`format`, :meth:`coordinate`) and the reader
-    (:meth:`pattern`) are derived from it (seed-000 §3, S000-02…05).
+    (:meth:`pattern`) are derived from it (UNAM-GMM §3, S000-02…05).
 
     Attributes:
         letter: the address letter.
@@ -286,13 +286,13 @@ _ARGS = re.compile(
 )
 
 MAX_DWELL_S = WORDS["P"].largest
-"""Longest dwell of one ``G04P##;`` block, s (2 digits, seed-000 L3359–L3366)."""
+"""Longest dwell of one ``G04P##;`` block, s (2 digits, UNAM-GMM L3359–L3366)."""
 MAX_RPM = WORDS["S"].largest
-"""Highest spindle speed of ``M03S####;``, rev/min (4 digits, seed-000 L3418–L3436)."""
+"""Highest spindle speed of ``M03S####;``, rev/min (4 digits, UNAM-GMM L3418–L3436)."""
 MAX_TOOL = WORDS["T"].largest
-"""Highest magazine position of ``M06T##;`` (2 digits, seed-000 L3455–L3464)."""
+"""Highest magazine position of ``M06T##;`` (2 digits, UNAM-GMM L3455–L3464)."""
 BUFFER_CHARS = 35
-"""The firmware's receive vector ``CadenaControl`` (seed-000 L1739–L1744, S000-07)."""
+"""The firmware's receive vector ``CadenaControl`` (UNAM-GMM L1739–L1744, S000-07)."""
 
 
 class _Writer(WriterState[str]):
@@ -309,7 +309,7 @@ class _Writer(WriterState[str]):
 
 
 class PicMmhPost(PostProcessor):
-    """Writer and reader of the pic-mmh dialect (seed-000 §3).
+    """Writer and reader of the pic-mmh dialect (UNAM-GMM §3).
 
     Args:
         sign: ``"negative"`` (default, as the thesis example L1731: ``-`` only)
@@ -402,7 +402,7 @@ class PicMmhPost(PostProcessor):
         where = w.where(move.contour)
         if move.z is not None:
             raise DialectError(
-                f"{where}: pic-mmh has no Z word (seed-000 S000-08); "
+                f"{where}: pic-mmh has no Z word (UNAM-GMM S000-08); "
                 "set the depth by hand or use a target with a Z axis"
             )
         if homed and not isinstance(move, Rapid):
@@ -492,7 +492,7 @@ class PicMmhPost(PostProcessor):
             in_contours = f" ({contours})" if contours else ""
             w.warnings.append(
                 f"F{code:02d} = {feed:g} mm/min needs {machine.step_rate_hz(feed):.1f} steps/s "
-                f"but the serial link limits the machine to {cap:g} Hz (seed-000 S000-05, "
+                f"but the serial link limits the machine to {cap:g} Hz (UNAM-GMM S000-05, "
                 f"L3195–L3199): {blocks}{in_contours} will run at about "
                 f"{capped_feed:.3g} mm/min"
             )
@@ -506,7 +506,7 @@ class PicMmhPost(PostProcessor):
         if long:
             w.warnings.append(
                 f"{len(long)} block(s) longer than {limit} characters (the firmware's receive "
-                f"buffer holds {BUFFER_CHARS}, seed-000 L1739–L1744, S000-07): "
+                f"buffer holds {BUFFER_CHARS}, UNAM-GMM L1739–L1744, S000-07): "
                 f"{_listing('block', [n for n, _ in long])}; the longest has "
                 f"{max(c for _, c in long)}"
             )
@@ -524,7 +524,7 @@ class PicMmhPost(PostProcessor):
             if not 0 <= command.tool <= MAX_TOOL:
                 raise DialectError(
                     f"{where}: tool {command.tool} does not fit M06T## (0–{MAX_TOOL}, "
-                    "seed-000 Tabla 22, L3455–L3464)"
+                    "UNAM-GMM Tabla 22, L3455–L3464)"
                 )
             w.blocks.append(f"M06{WORDS['T'].format(command.tool)};")
         elif isinstance(command, DrillCycle):
@@ -540,7 +540,7 @@ class PicMmhPost(PostProcessor):
     # -- reading ---------------------------------------------------------------
 
     def parse(self, code: str | bytes, *, source: str = "<code>") -> Program:
-        """Read pic-mmh blocks back into moves and commands (the grammar of seed-000 §3.6).
+        """Read pic-mmh blocks back into moves and commands (the grammar of UNAM-GMM §3.6).
 
         ``G54;``, ``G90;`` and ``M30;`` carry nothing; ``M03S####;`` /
         ``M04S####;`` / ``M05;``, ``G04P##;``, ``M06T##;``, ``G28X0Y0;`` and
@@ -648,7 +648,7 @@ def _spindle(command: Spindle, where: str, w: _Writer) -> str | None:
     if not 1 <= whole <= MAX_RPM:
         raise DialectError(
             f"{where}: spindle speed {rpm:g} rev/min does not fit M03S####/M04S#### "
-            f"(1–{MAX_RPM} rev/min, 4 digits, seed-000 Tabla 22, L3418–L3436)"
+            f"(1–{MAX_RPM} rev/min, 4 digits, UNAM-GMM Tabla 22, L3418–L3436)"
         )
     if whole != rpm:
         w.note("rpm", f"spindle speed {rpm:g} rev/min rounded to S{whole:04d} (whole rev/min)")
@@ -666,7 +666,7 @@ def _dwell(command: Dwell, where: str, w: _Writer) -> list[str]:
         w.note(
             "dwell-round",
             f"{where}: dwell {seconds:g} s rounded up to {whole} s "
-            "(G04P## takes whole seconds, seed-000 L3359–L3366)",
+            "(G04P## takes whole seconds, UNAM-GMM L3359–L3366)",
         )
     pieces = [MAX_DWELL_S] * (whole // MAX_DWELL_S)
     if whole % MAX_DWELL_S or not pieces:
@@ -675,13 +675,13 @@ def _dwell(command: Dwell, where: str, w: _Writer) -> list[str]:
         w.note(
             "dwell-split",
             f"{where}: dwell {whole} s written as {len(pieces)} G04 blocks of at most "
-            f"{MAX_DWELL_S} s (P has 2 digits, seed-000 L3359–L3366)",
+            f"{MAX_DWELL_S} s (P has 2 digits, UNAM-GMM L3359–L3366)",
         )
     return [f"G04{WORDS['P'].format(p)};" for p in pieces]
 
 
 def _home(command: Home, where: str) -> list[str]:
-    """``G28X0Y0;`` / ``G28Z0;``; XYZ homes Z first (seed-000 §7: Z, then X, then Y)."""
+    """``G28X0Y0;`` / ``G28Z0;``; XYZ homes Z first (UNAM-GMM §7: Z, then X, then Y)."""
     axes = set(command.axes.upper())
     if axes == {"X", "Y"} and len(command.axes) == 2:
         return ["G28X0Y0;"]
@@ -691,7 +691,7 @@ def _home(command: Home, where: str) -> list[str]:
         return ["G28Z0;", "G28X0Y0;"]
     raise DialectError(
         f"{where}: cannot return to machine zero on {command.axes!r}: pic-mmh homes X and Y "
-        "together (G28X0Y0;) or Z (G28Z0;) (seed-000 Tabla 21, L3375–L3386)"
+        "together (G28X0Y0;) or Z (G28Z0;) (UNAM-GMM Tabla 21, L3375–L3386)"
     )
 
 

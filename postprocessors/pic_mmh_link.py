@@ -1,6 +1,6 @@
 """Mode strings of the pic-mmh host link: jog, steps, frequency, backlash, home, stop.
 
-Source: seed-000 §3.2 (Tabla 23, annex A.2, L3474–L3505) and §3.1 (how the
+Source: UNAM-GMM §3.2 (Tabla 23, annex A.2, L3474–L3505) and §3.1 (how the
 firmware decodes a string, Fig. 37, L1739–L1770); requirement S000-10. Each
 string is sent on its own over RS-232 and ends with ``;``:
 
@@ -34,7 +34,7 @@ the ``B`` number is µm (204 and 178 µm, the final compensations, fit 3 digits;
 in steps they would not, §3.2 notes); which way "+" turns an axis is not
 documented (§4.6).
 
-The host link (``camtool send -t pic-mmh``; seed-000 §2.4, S000-11, thesis
+The host link (``camtool send -t pic-mmh``; UNAM-GMM §2.4, S000-11, thesis
 L1592–L1596, L1739–L1807; the ``[link]`` table of ``pic-mmh.toml``) and its
 simulator are at the end of this module (:data:`LINK`):
 
@@ -67,7 +67,7 @@ simulator are at the end of this module (:data:`LINK`):
 - the receive buffer ``CadenaControl`` has 35 elements (L1739–L1744), but
   the thesis's own G02 string is 43 characters and its circles (Tabla 15)
   were cut with such strings, so the firmware must parse fields on the fly
-  (seed-000 §2.4 flag). camtool follows that evidence: it sends strings
+  (UNAM-GMM §2.4 flag). camtool follows that evidence: it sends strings
   longer than 35 characters (every G02/G03 is), and the echo check stops the
   job, naming the block, if a controller truncates one. The simulator takes
   them by default (``on_the_fly=True``); ``on_the_fly=False`` models a strict
@@ -98,7 +98,7 @@ if TYPE_CHECKING:
     from camtool.post.base import Target
 
 Axis: TypeAlias = Literal["X", "Y", "Z"]
-"""An axis letter of the mode strings (seed-000 §3.6 ``axis``)."""
+"""An axis letter of the mode strings (UNAM-GMM §3.6 ``axis``)."""
 Sign: TypeAlias = Literal["+", "-"]
 """A direction character: ``-`` counter-clockwise, ``+`` clockwise (L1765–L1768)."""
 
@@ -113,19 +113,19 @@ MAX_BACKLASH_UM = 999
 
 def _check_axis(axis: str) -> None:
     if axis not in AXES:
-        raise DialectError(f"axis {axis!r} is not one of X, Y, Z (seed-000 §3.2)")
+        raise DialectError(f"axis {axis!r} is not one of X, Y, Z (UNAM-GMM §3.2)")
 
 
 def _check_sign(sign: str) -> None:
     if sign not in ("+", "-"):
-        raise DialectError(f"direction {sign!r} is not '+' or '-' (seed-000 §3.2)")
+        raise DialectError(f"direction {sign!r} is not '+' or '-' (UNAM-GMM §3.2)")
 
 
 def _check_count(what: str, value: int, most: int, unit: str) -> None:
     if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= most:
         digits = len(str(most))
         raise DialectError(
-            f"{what} {value!r} does not fit {digits} digits (0–{most} {unit}, seed-000 Tabla 23)"
+            f"{what} {value!r} does not fit {digits} digits (0–{most} {unit}, UNAM-GMM Tabla 23)"
         )
 
 
@@ -196,7 +196,7 @@ class Steps:
 class Frequency:
     """``F<axis><sign>###;``: run one axis at ``hz`` steps/s (0–999; ``FX+250;``).
 
-    The unit is presumed Hz (seed-000 §3.2 notes); the serial link limits the
+    The unit is presumed Hz (UNAM-GMM §3.2 notes); the serial link limits the
     machine to 166 Hz (L3198), so higher rates run slower.
     """
 
@@ -295,7 +295,7 @@ class _Cursor:
     def fail(self, what: str) -> ParseError:
         return ParseError(
             f"{self.source}: {what} at character {self.pos + 1} of {self.text!r}; "
-            "the controller would not run it (seed-000 §3.1)"
+            "the controller would not run it (UNAM-GMM §3.1)"
         )
 
     def axis(self) -> Axis:
@@ -335,7 +335,7 @@ def _shown(text: str) -> str:
 
 
 def parse_mode(text: str, *, source: str = "<mode string>") -> ModeString:
-    """Read one mode string as the controller's firmware does (seed-000 §3.1, S000-10).
+    """Read one mode string as the controller's firmware does (UNAM-GMM §3.1, S000-10).
 
     Args:
         text: one string, ``;`` included, nothing after it (no line end).
@@ -374,7 +374,7 @@ def parse_mode(text: str, *, source: str = "<mode string>") -> ModeString:
     hint = " (a G/M line: read it with PicMmhPost.parse)" if mode in ("G", "M") else ""
     raise ParseError(
         f"{source}: {text!r} is not a mode string{hint}; the first character selects "
-        "the mode: J & P F B H A W V Q (seed-000 Tabla 23)"
+        "the mode: J & P F B H A W V Q (UNAM-GMM Tabla 23)"
     )
 
 
@@ -397,7 +397,7 @@ def _multi(cursor: _Cursor) -> JogAxes:
 def backlash_command(axis: str, um: float) -> str:
     """``B<axis>###;`` for a compensation of ``um`` µm, rounded half up to whole µm.
 
-    Example: ``backlash_command("X", 204.0)`` → ``"BX204;"`` (seed-000 §5.2, the
+    Example: ``backlash_command("X", 204.0)`` → ``"BX204;"`` (UNAM-GMM §5.2, the
     final X compensation); ``192.5`` (the first pass) → ``"BX193;"``.
 
     Raises:
@@ -413,7 +413,7 @@ def backlash_command(axis: str, um: float) -> str:
 def backlash_commands(machine: Machine) -> tuple[str, ...]:
     """The ``B`` strings setting ``machine``'s compensation, one per axis that has one.
 
-    For the ``mmh-gmm`` profile: ``("BX204;", "BY178;")`` (seed-000 §5.2, L2486–L2490).
+    For the ``mmh-gmm`` profile: ``("BX204;", "BY178;")`` (UNAM-GMM §5.2, L2486–L2490).
 
     Raises:
         DialectError: a compensation does not fit 0–999 µm.
@@ -459,7 +459,7 @@ def frame(code: bytes, spec: LinkSpec, source: str) -> list[WireBlock]:
         if not data.endswith(end) or data.count(end) != 1:
             raise InputError(
                 f"{source}, line {number}: {data.decode('latin-1')!r} is not one string ending "
-                f"with {end.decode('latin-1')!r} (seed-000 §2.4): one block per line"
+                f"with {end.decode('latin-1')!r} (UNAM-GMM §2.4): one block per line"
             )
         blocks.append(WireBlock(len(blocks) + 1, number, number, data))
     return blocks

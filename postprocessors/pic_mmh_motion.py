@@ -1,10 +1,10 @@
-"""Motion model of the seed-000 GMM PIC controller (``pic-mmh``) for the verifier.
+"""Motion model of the UNAM-GMM GMM PIC controller (``pic-mmh``) for the verifier.
 
 Its line (linear DDA, annex A.3) and arc (direct search method, annex A.6)
 interpolators are generic algorithms (:mod:`camtool.verify.interpolators`,
 ``dda`` and ``dsm``); what is the PIC's own is its time model: block time is a
 count of interpolator iterations (and backlash compensation steps) times the
-period of a step rate ``f = d·F/60`` capped by the serial link (seed-000 §4.9,
+period of a step rate ``f = d·F/60`` capped by the serial link (UNAM-GMM §4.9,
 §5.1, S000-17), no acceleration ramp. The ``pic-mmh`` timing model takes ``d``
 (steps/mm) and the cap from the machine profile when its ``[machine.timing]``
 table does not state them, so that ``--machine`` changes reach the time model.
@@ -35,9 +35,9 @@ from camtool.verify.timing import (
 )
 
 PIC_MMH_STEPS_PER_MM = 1e6 / 140.0
-"""Steps per mm of the GMM MMH-1: 140 nm/step (seed-000 S000-12)."""
+"""Steps per mm of the GMM MMH-1: 140 nm/step (UNAM-GMM S000-12)."""
 PIC_MMH_MAX_STEP_RATE_HZ = 166.0
-"""Serial-link-limited step rate of the PIC controller, Hz (seed-000 §2.4, L3198)."""
+"""Serial-link-limited step rate of the PIC controller, Hz (UNAM-GMM §2.4, L3198)."""
 
 
 def _feed_moves_have_feed(feed: FloatArray, rapid: npt.NDArray[np.bool_], work: FloatArray) -> None:
@@ -59,9 +59,9 @@ def pic_mmh_step_rate_hz(
     steps_per_mm: float = PIC_MMH_STEPS_PER_MM,
     max_step_rate_hz: float = PIC_MMH_MAX_STEP_RATE_HZ,
 ) -> FloatArray:
-    """Interpolator iteration frequency of the seed-000 PIC controller, Hz.
+    """Interpolator iteration frequency of the UNAM-GMM PIC controller, Hz.
 
-    seed-000 §4.9 (Eq. 3.1 reconstructed, S000-17): ``f = d·F/60`` with ``d``
+    UNAM-GMM §4.9 (Eq. 3.1 reconstructed, S000-17): ``f = d·F/60`` with ``d``
     the steps/mm the controller assumes and ``F`` in mm/min, capped at the
     serial-limited 166 Hz; rapids (G00, G28) run at the cap. F08 (0.8 mm/min
     under the 0.1 mm/min feed unit) at 140 nm/step gives 95.2 Hz.
@@ -95,11 +95,11 @@ def pic_mmh_block_time_s(
     steps_per_mm: float = PIC_MMH_STEPS_PER_MM,
     max_step_rate_hz: float = PIC_MMH_MAX_STEP_RATE_HZ,
 ) -> FloatArray:
-    """Seconds per block of the seed-000 PIC controller: (iterations + compensation)/f.
+    """Seconds per block of the UNAM-GMM PIC controller: (iterations + compensation)/f.
 
     One interpolator iteration (DDA or DSM, with or without a pulse) per period
     of :func:`pic_mmh_step_rate_hz`; backlash compensation steps run at the
-    block's rate before its move (seed-000 §5.1: "at the current step rate",
+    block's rate before its move (UNAM-GMM §5.1: "at the current step rate",
     the natural reading). One X take-up of 204 µm (1457 steps) at 166 Hz takes
     8.8 s (§5.1). G04 dwells are not blocks here; the simulator adds them.
 
@@ -131,7 +131,7 @@ def pic_mmh_block_time_s(
 
 @dataclass(frozen=True, kw_only=True)
 class PicMmhTiming:
-    """Parameters of the seed-000 ``pic-mmh`` time model (:func:`pic_mmh_block_time_s`).
+    """Parameters of the UNAM-GMM ``pic-mmh`` time model (:func:`pic_mmh_block_time_s`).
 
     Attributes:
         steps_per_mm: Steps/mm the controller assumes in Eq. 3.1.
@@ -152,7 +152,7 @@ class PicMmhTiming:
     def capped_blocks(self, blocks: BlockKinematics) -> list[tuple[int, str]]:
         """Feed moves whose step rate ``d·F/60`` is over the cap (F14 and up at 140 nm/step).
 
-        seed-000 §2.4 (L3198): the serial link limits the PIC to 166 Hz, so such
+        UNAM-GMM §2.4 (L3198): the serial link limits the PIC to 166 Hz, so such
         a move runs (and is timed) at the cap, slower than programmed.
         """
         rate = self.steps_per_mm * blocks.feed_mm_min / 60.0
@@ -163,7 +163,7 @@ class PicMmhTiming:
                 int(i),
                 f"feed {blocks.feed_mm_min[i]:g} mm/min asks {rate[i]:.1f} Hz, over the "
                 f"{self.max_step_rate_hz:g} Hz step-rate cap of the pic-mmh controller (serial "
-                f"link, seed-000 §2.4): it runs and is timed at {slowest:.4g} mm/min",
+                f"link, UNAM-GMM §2.4): it runs and is timed at {slowest:.4g} mm/min",
             )
             for i in np.flatnonzero(over)
         ]
@@ -184,7 +184,7 @@ def _timing(table: Mapping[str, Any], machine: Machine | None, where: str) -> Pi
     """The ``pic-mmh`` model from its table, completed from the profile.
 
     The profile's steps/mm (the larger of X and Y) and step-rate cap go in where
-    the table does not say (seed-000 Eq. 3.1).
+    the table does not say (UNAM-GMM Eq. 3.1).
 
     Raises:
         InputError: an unknown key or a bad value, naming ``where``.

@@ -1,11 +1,11 @@
-"""Motion model of the seed-004 ValCNC controller (``valcnc``) for the verifier.
+"""Motion model of the Munoz-22 ValCNC controller (``valcnc``) for the verifier.
 
 Its line interpolator is the generic accumulator DDA
 (:func:`camtool.verify.interpolators.accumulator_dda_line`, ``accumulator-dda``);
 what is ValCNC's own is its arc routine, chords of a fixed angle β (the
-``valcnc`` chord rule, seed-004 §4.2, S004-R12), and its time model: a fixed
+``valcnc`` chord rule, Munoz-22 §4.2, S004-R12), and its time model: a fixed
 delay per DDA iteration, no acceleration, F not parsed (the ``valcnc`` timing
-model, seed-004 §2.8, §4.1, §4.3, S004-R13).
+model, Munoz-22 §2.8, §4.1, §4.3, S004-R13).
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ from camtool.verify.timing import (
 )
 
 VALCNC_STEP_DELAY_US = 166.667
-"""The ValCNC firmware's "reposo motor" delay after each step pulse, µs (seed-004 L1336)."""
+"""The ValCNC firmware's "reposo motor" delay after each step pulse, µs (Munoz-22 L1336)."""
 
 
 def serial_time_s(
@@ -42,7 +42,7 @@ def serial_time_s(
 ) -> FloatArray:
     """Time to send ``n_bytes`` over an asynchronous serial link, s.
 
-    8N1 framing is 10 bits per byte: 9600 baud → 1.04 ms per byte (seed-004
+    8N1 framing is 10 bits per byte: 9600 baud → 1.04 ms per byte (Munoz-22
     S004-R13).
 
     Args:
@@ -67,9 +67,9 @@ def valcnc_block_time_s(
     block_bytes: npt.ArrayLike | None = None,
     serial_baud: float = 0.0,
 ) -> FloatArray:
-    """Seconds per block of the seed-004 ValCNC firmware: iterations × 166.667 µs.
+    """Seconds per block of the Munoz-22 ValCNC firmware: iterations × 166.667 µs.
 
-    seed-004 §4.1, §4.3 (S004-R13): one fixed delay per accumulator-DDA
+    Munoz-22 §4.1, §4.3 (S004-R13): one fixed delay per accumulator-DDA
     iteration (one iteration per master-axis step), no acceleration, F not
     parsed. 10 mm at 25 steps/mm = 250 steps = 41.7 ms, and so does a
     10 × 10 mm diagonal. Optionally adds the time to send each block over the
@@ -99,10 +99,10 @@ def valcnc_block_time_s(
 
 @dataclass(frozen=True, kw_only=True)
 class ValcncTiming:
-    """Parameters of the seed-004 ``valcnc`` time model (:func:`valcnc_block_time_s`).
+    """Parameters of the Munoz-22 ``valcnc`` time model (:func:`valcnc_block_time_s`).
 
     Attributes:
-        step_delay_us: Delay per DDA iteration, µs (166.667, seed-004 L1336).
+        step_delay_us: Delay per DDA iteration, µs (166.667, Munoz-22 L1336).
         serial_baud: Serial speed for adding each block's send time, baud
             (9600 in the thesis); 0 leaves it out, the only value accepted for
             now: the verifier does not yet count the bytes of each block, so a
@@ -142,7 +142,7 @@ class ValcncTiming:
 def valcnc_arc_points(
     start: Point, end: Point, centre: Point, clockwise: bool, *, beta_rad: float
 ) -> npt.NDArray[np.float64]:
-    """Chord points of the ValCNC arc routine (seed-004 §4.2, S004-R12).
+    """Chord points of the ValCNC arc routine (Munoz-22 §4.2, S004-R12).
 
     α = 2·asin(min(1, C/2R)) from the chord C and R = √(i² + j²); a sweep over π
     in the commanded sense uses 2π − α (the thesis' reflex test is lost with

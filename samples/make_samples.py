@@ -1,7 +1,7 @@
 """Regenerate the bundled sample drawings (run: ``python samples/make_samples.py``).
 
 ``logo.dxf`` is camtool's own logo, 5.0 × 4.5 mm, placed inside the 10 × 7 mm
-work area of the pic-mmh machine (seed-000 §2.1), the size of the 5 mm logos
+work area of the pic-mmh machine (UNAM-GMM §2.1), the size of the 5 mm logos
 the thesis cut. It uses every entity kind the first importer reads:
 
 - a shield outline: a closed LWPOLYLINE whose top edge is a bulged arc;

@@ -12,7 +12,7 @@ import numpy as np
 
 from camtool.model.shapes import Line, Point, Segment
 
-# seed-000 L1731: G02X02969.00Y03400.00I03012.00J03040.00F08;
+# UNAM-GMM L1731: G02X02969.00Y03400.00I03012.00J03040.00F08;
 GOLDEN_CENTRE = (3.012, 3.040)
 GOLDEN_END = (2.969, 3.400)
 
@@ -136,7 +136,7 @@ def _distance_to_curve(
     return min(dist(a), dist(b), dist(0.5 * (a + b)))
 
 
-# seed-002 §3, L3196–L3200: the Matlab GUI's 11-point star, as the thesis prints ``xy``:
+# Angel-11 §3, L3196–L3200: the Matlab GUI's 11-point star, as the thesis prints ``xy``:
 # row 1 x, row 2 y, in 0.1 mm.
 STAR_XY_01MM = (
     (151, 400, 630, 575, 815, 501, 400, 294, 6, 220, 153),
@@ -147,10 +147,10 @@ STAR_LXY = [
     [249, 230, 55, 240, 314, 101, 106, 288, 214, 67],
     [179, 179, 345, 208, 3, 357, 354, 20, 237, 342],
 ]
-"""The star's ``lxy`` as the thesis prints it (seed-002 §3, L3212–L3228), 0.1 mm."""
+"""The star's ``lxy`` as the thesis prints it (Angel-11 §3, L3212–L3228), 0.1 mm."""
 
 STAR_VELXY = [
     [480, 480, -77, 480, -480, -136, -144, -480, 433, -94],
     [345, -374, 480, 416, 5, 480, -480, 33, -480, -480],
 ]
-"""The star's ``velxy`` as the thesis prints it (seed-002 §3, L3212–L3228), counts per 5 ms."""
+"""The star's ``velxy`` as the thesis prints it (Angel-11 §3, L3212–L3228), counts per 5 ms."""

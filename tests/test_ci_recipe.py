@@ -1,7 +1,7 @@
 """docs/ci.md's script runs as written: a drawings repository posted, verified and drawn.
 
 The sample is samples/logo.dxf for pic-mmh; its predicted error is the X over-compensation of
-seed-000 §5.2 (204 µm compensated, 190 µm true backlash in region H1, Tabla 13): 14 µm, at most
+UNAM-GMM §5.2 (204 µm compensated, 190 µm true backlash in region H1, Tabla 13): 14 µm, at most
 combined with 2 µm of Y under-compensation (180/178 µm in V2), so a 50 µm limit passes. A
 2 × 1 mm rectangle, whose reversals leave tens of µm (the same compensation), fails a 1 µm
 limit with exit code 4 (a small part keeps the test fast).

@@ -1,6 +1,6 @@
 """Calibration: a coupon that measures what a machine profile models, and a least-squares fit.
 
-:mod:`camtool.calibrate.coupon` lays out the test features (seed-000 §5: the U pattern per axis
+:mod:`camtool.calibrate.coupon` lays out the test features (UNAM-GMM §5: the U pattern per axis
 and backlash region, 2.5 mm squares, ø6/4/2 circles; a long move per axis for steps/mm) and
 turns them into a program for a target; :mod:`camtool.calibrate.predict` measures each feature
 on the verifier's simulation exactly as the sheet tells a machinist to;

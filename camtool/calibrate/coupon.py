@@ -1,23 +1,23 @@
 """The calibration coupon: test features that measure what a machine profile models.
 
-Every feature is the seed-000 §5 procedure or a direct extension of it (seed-000 §5.2, Tablas
-13-15; seed-001 §5 and §6.1; seed-004 §5.1):
+Every feature is the UNAM-GMM §5 procedure or a direct extension of it (UNAM-GMM §5.2, Tablas
+13-15; Yanez-07 §5 and §6.1; Munoz-22 §5.1):
 
-- **U pattern** per axis (and per backlash region where the profile has regions, seed-000
+- **U pattern** per axis (and per backlash region where the profile has regions, UNAM-GMM
   Tabla 13): a line along the axis, a short step across, the line back. The first line is cut
   after an approach that takes up the play, so its length measures the scale; the second is
   cut after a reversal, so the difference measures the backlash left after compensation.
-- **Squares** (seed-000 Tabla 14, 2.5 mm): cut counter-clockwise from the lower-left corner;
+- **Squares** (UNAM-GMM Tabla 14, 2.5 mm): cut counter-clockwise from the lower-left corner;
   the top edge is cut after the X reversal and the left edge after the Y reversal, so their
   lengths carry each axis's scale and backlash residual.
-- **Circles** of three sizes, concentric, cut clockwise from the top (seed-000 Tabla 15,
+- **Circles** of three sizes, concentric, cut clockwise from the top (UNAM-GMM Tabla 15,
   ø6/4/2 mm): the mean of eight diameters, every 22.5°.
-- **Long moves** per axis (seed-004 Tables 14-16, ten moves of 8 mm): ten equal segments in
+- **Long moves** per axis (Munoz-22 Tables 14-16, ten moves of 8 mm): ten equal segments in
   the + direction, each end marked; the distance of each mark from the start measures steps/mm.
 
 Every feature starts with an **approach**: a short cut towards its first point in the direction
 of its first stroke on both axes, longer than the profile's backlash, so the play is taken up
-before the first stroke (seed-001 §5: "approach the start point moving in the same direction as
+before the first stroke (Yanez-07 §5: "approach the start point moving in the same direction as
 the first line"). Features are laid out in the work area (:func:`build_coupon`) and scaled with
 the travel; the coupon program is posted through the target like any program.
 """
@@ -39,10 +39,10 @@ if TYPE_CHECKING:
     from camtool.post.base import Target
 
 DIAMETER_ANGLES_DEG: tuple[float, ...] = tuple(22.5 * k for k in range(8))
-"""Directions of the eight diameters of a circle (seed-000 Tabla 15 measured ø1-ø8; the angles
+"""Directions of the eight diameters of a circle (UNAM-GMM Tabla 15 measured ø1-ø8; the angles
 are only in the lost Fig. 54, so every 22.5° is our choice)."""
 SEGMENTS = 10
-"""Segments of a long move (seed-004 §5.1: "10 tramos de 8mm")."""
+"""Segments of a long move (Munoz-22 §5.1: "10 tramos de 8mm")."""
 SAFE_Z_MM = 2.0
 """Height of the rapids between features on a machine with Z, mm above the work."""
 MIN_STEPS = 40
@@ -51,7 +51,7 @@ measurable; a smaller travel is refused."""
 MAX_CIRCLE_STEPS = 2_000_000
 """Most motor steps around the largest circle (the simulation's size)."""
 SCALES: tuple[float, ...] = (10, 8, 6, 5, 4, 3, 2.5, 2, 1.5, 1.2, 1, 0.8, 0.6, 0.5, 0.4, 0.3)
-"""Coupon scales tried, largest first (1 = the seed-000 sizes: U 2.5/1.2 mm, squares 2.5 mm,
+"""Coupon scales tried, largest first (1 = the UNAM-GMM sizes: U 2.5/1.2 mm, squares 2.5 mm,
 circles ø6/4/2 mm)."""
 
 
@@ -145,7 +145,7 @@ class Coupon:
 
     Attributes:
         target: the target's name.
-        scale: size of the features against seed-000's (1: U 2.5/1.2 mm, squares 2.5 mm,
+        scale: size of the features against UNAM-GMM's (1: U 2.5/1.2 mm, squares 2.5 mm,
             circles ø6/4/2 mm); ``0`` for a coupon of hand-made features.
         features: the features, in cutting order.
         program: the coupon program (every feature with rapids between), mm.
@@ -168,10 +168,10 @@ class Coupon:
 def u_pattern(
     fid: str, axis: int, start: Point, length: float, gap: float, approach: float, feed: float
 ) -> Feature:
-    """The seed-000 §5.2 U pattern along ``axis`` (0 = X, 1 = Y) from ``start``.
+    """The UNAM-GMM §5.2 U pattern along ``axis`` (0 = X, 1 = Y) from ``start``.
 
     Out along +axis by ``length``, across by ``gap`` (+ the other axis), back by ``length``.
-    Measures: ``out`` and ``back`` lengths (seed-000 Tabla 13: their difference is the backlash).
+    Measures: ``out`` and ``back`` lengths (UNAM-GMM Tabla 13: their difference is the backlash).
     """
     other = 1 - axis
     x0, y0 = start
@@ -220,7 +220,7 @@ def u_pattern(
 def rectangle(
     fid: str, corner: Point, size: tuple[float, float], approach: float, feed: float
 ) -> Feature:
-    """A rectangle cut counter-clockwise from its lower-left ``corner`` (seed-000 Tabla 14).
+    """A rectangle cut counter-clockwise from its lower-left ``corner`` (UNAM-GMM Tabla 14).
 
     Measures: ``dx``, the top edge (cut in -X after the X reversal), and ``dy``, the left
     edge (cut in -Y after the Y reversal), each end to end.
@@ -265,10 +265,10 @@ def rectangle(
 
 
 def circle(fid: str, centre: Point, diameter: float, approach: float, feed: float) -> Feature:
-    """A full circle cut clockwise from its top (seed-000 Tabla 15).
+    """A full circle cut clockwise from its top (UNAM-GMM Tabla 15).
 
-    Measures: ``h`` and ``v``, the horizontal and vertical diameters (seed-001 §6.2), and
-    ``mean``, the mean of eight diameters every 22.5° (:data:`DIAMETER_ANGLES_DEG`, seed-000
+    Measures: ``h`` and ``v``, the horizontal and vertical diameters (Yanez-07 §6.2), and
+    ``mean``, the mean of eight diameters every 22.5° (:data:`DIAMETER_ANGLES_DEG`, UNAM-GMM
     Tabla 15).
     """
     cx, cy = centre
@@ -322,7 +322,7 @@ def long_move(
     """A long move along +``axis`` (0 = X, 1 = Y) in :data:`SEGMENTS` equal segments.
 
     Measures ``p1`` … ``p10``: travel from the start to the end of each segment, measured on the
-    carriage (seed-004 Tables 14-16: a vernier after each move of 8 mm).
+    carriage (Munoz-22 Tables 14-16: a vernier after each move of 8 mm).
     """
     name = AXES[axis].upper()
     direction = (1.0, 0.0) if axis == 0 else (0.0, 1.0)
@@ -336,7 +336,7 @@ def long_move(
             Measure(
                 f"{fid}.p{i}",
                 f"travel along {name} from the start to the end of segment {i} (the carriage "
-                "against a vernier or dial indicator, as seed-004 measured it)",
+                "against a vernier or dial indicator, as Munoz-22 measured it)",
                 end,
                 segment * i,
                 "position",
@@ -355,7 +355,7 @@ def long_move(
 
 
 def long_move_z(fid: str, at: Point, segment: float, approach: float, feed: float) -> Feature:
-    """A long move along +Z (up from the work) in :data:`SEGMENTS` segments (seed-004 Table 14).
+    """A long move along +Z (up from the work) in :data:`SEGMENTS` segments (Munoz-22 Table 14).
 
     Measures ``p1`` … ``p10`` with a height gauge or the vernier's depth rod: the height of
     each stop above the first.
@@ -467,7 +467,7 @@ def approach_mm(machine: Machine) -> float:
 def build_coupon(target: Target) -> Coupon:
     """The default coupon of ``target``, laid out in its work area at the largest scale that fits.
 
-    Scale 1 is seed-000's sizes; a machine with a larger travel gets a larger coupon (up to
+    Scale 1 is UNAM-GMM's sizes; a machine with a larger travel gets a larger coupon (up to
     10×, and no circle of more than :data:`MAX_CIRCLE_STEPS` steps), a smaller one a smaller
     coupon. Features: a long move along X and along Y (and Z on a machine with Z), a U pattern
     per axis and per backlash region of the profile (one per axis when it has none), three

@@ -9,9 +9,9 @@ differences of the simulation.
 Parameters (what a profile models that a coupon can determine):
 
 - ``true_steps_per_mm`` X, Y (and Z on a machine with Z): the steps the mechanics really make
-  per mm (seed-001 R14: 1.9 µm assumed, 1.88 µm real; seed-004 §5.3: 80.86 mm for 80);
+  per mm (Yanez-07 R14: 1.9 µm assumed, 1.88 µm real; Munoz-22 §5.3: 80.86 mm for 80);
 - the true backlash per axis, ``backlash.true_um`` X, Y, and per region where the profile has
-  regions (``backlash.regions[i].true_um``, seed-000 Tabla 13).
+  regions (``backlash.regions[i].true_um``, UNAM-GMM Tabla 13).
 
 The compensation is the controller's setting, not a property of the mechanics: it is not fitted
 but taken from each measurement row (the setting the feature was cut with).

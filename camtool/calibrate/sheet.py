@@ -14,7 +14,7 @@ Two forms of the same rows: ``coupon.md`` (Markdown, to print and read at the co
 ``compensation_x_um``, ``compensation_y_um``
     the controller's backlash compensation when the feature was cut, µm (the profile's
     values are filled in; write 0 if compensation was off, as for a U pattern cut the
-    seed-001 §5 way).
+    Yanez-07 §5 way).
 
 Only ``id`` and ``measured_mm`` are required; columns may come in any order.
 """
@@ -92,7 +92,7 @@ def sheet_markdown(
     ]
     if coupon.scale:
         lines += [
-            f"Scale {coupon.scale:g} of seed-000's coupon (U 2.5/1.2 mm, squares 2.5 mm, "
+            f"Scale {coupon.scale:g} of UNAM-GMM's coupon (U 2.5/1.2 mm, squares 2.5 mm, "
             "circles ø6/4/2 mm), to fit the travel.",
             "",
         ]

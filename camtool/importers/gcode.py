@@ -2,8 +2,8 @@
 
 Reads G0/G1/G2/G3 (I/J centre and R-form arcs, G90.1/G91.1), G17, G20/G21,
 G90/G91, F, S, T, M3/M4/M5/M6, G4, G28, M2/M30, N-words, comments, ``%`` lines, modal motion
-and modal words — including the FlashCut programs of seed-001 §3 (R1–R5) and
-the Inkscape Gcodetools ``.ngc`` files of seed-004 §3.3 (S004-R07). Lines are
+and modal words — including the FlashCut programs of Yanez-07 §3 (R1–R5) and
+the Inkscape Gcodetools ``.ngc`` files of Munoz-22 §3.3 (S004-R07). Lines are
 split into words by :mod:`camtool.importers.gcode_lexer`; the codes and what is
 done with each are in :mod:`camtool.importers.gcode_codes`. User docs:
 ``docs/importers/gcode.md``.
@@ -12,12 +12,12 @@ Rules (RS-274/NGC as LinuxCNC documents them, unless said otherwise):
 
 - mm inside: G20 numbers (X Y Z I J R F) are × 25.4; a G20/G21 applies to every
   number of its own block. No G20/G21 before the first move: mm, with a warning
-  (seed-001 §3.3: FlashCut programs carry none and are in mm).
+  (Yanez-07 §3.3: FlashCut programs carry none and are in mm).
 - F is modal, in units per minute, converted to mm/min when read (so a later
   unit change keeps the physical feed); G0 may carry F and keeps it modal.
-- A missing axis word keeps its value (lenient, standard RS-274); seed-001 R4's
+- A missing axis word keeps its value (lenient, standard RS-274); Yanez-07 R4's
   "X and Y both required" strictness of the FlashCut app is not replicated.
-- Arcs: I/J are incremental from the start (G91.1, the default, seed-001 R2) or
+- Arcs: I/J are incremental from the start (G91.1, the default, Yanez-07 R2) or
   absolute (G90.1, both required). The arc is refused when the radii to start and
   end differ by more than 0.5 mm (0.05 in), or by more than 0.005 mm (0.0005 in)
   and 0.1 % of the radius (LinuxCNC, "G2 G3 Arcs"); within that the programmed
@@ -50,7 +50,7 @@ Non-motion words, kept as :data:`camtool.model.program.Command` values (:class:`
 Spindle (``S``, ``M3``/``M4``/``M5``), dwell (``G4 P``), tool change (``T``,
 ``M6``) and return to machine zero (``G28``) become :attr:`Program.commands`,
 each before the move that follows it, so that a target whose dialect has them
-(e.g. pic-mmh ``M03S####;``, ``G04P##;``, ``M06T##;``, ``G28X0Y0;``, seed-000
+(e.g. pic-mmh ``M03S####;``, ``G04P##;``, ``M06T##;``, ``G28X0Y0;``, UNAM-GMM
 Tablas 21–22) writes them again. Within a block they run in the RS-274/NGC
 order of execution (LinuxCNC "Order of Execution"): ``S``, ``T``, ``M6``,
 ``M3``/``M4``/``M5``, ``G4``, then ``G28`` and the motion.

@@ -1,7 +1,7 @@
 """RS-274 lexer: one text line of G-code into a :class:`Block` of words.
 
 What a line may hold (RS-274/NGC as LinuxCNC documents it, and the FlashCut
-and Gcodetools programs of seed-001 §3 and seed-004 §3.3):
+and Gcodetools programs of Yanez-07 §3 and Munoz-22 §3.3):
 
 - words: a letter and a number, case-insensitive, spaces anywhere outside
   comments (``G01X1.Y2`` = ``g1 x 1 y 2``); numbers like ``.5``, ``-0.``, ``+1``

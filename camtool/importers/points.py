@@ -17,7 +17,7 @@ since it also takes ``1_000``, ``inf`` and ``infinity``. ``NaN`` is a stroke bre
 coordinate. A value whose magnitude in mm reaches :data:`~camtool.model.units.LARGEST_VALUE` is
 refused. Errors name the file, the line and the column of the bad field.
 
-Matlab files (``.m``): ``xy = [ x1 x2 ...; y1 y2 ... ]`` as the Matlab GUI of seed-002 §3 shows
+Matlab files (``.m``): ``xy = [ x1 x2 ...; y1 y2 ... ]`` as the Matlab GUI of Angel-11 §3 shows
 it (row 1 x, row 2 y, in 0.1 mm unless ``--units`` says otherwise), over as many lines as it
 likes; ``lxy`` and ``velxy`` (the GUI's derived arrays) are ignored; several ``xy``
 assignments are several strokes; ``%`` starts a comment. Anything else is an error.
@@ -40,7 +40,7 @@ MATLAB_SUFFIX = ".m"
 DEFAULT_UNITS = "mm"
 """Unit of text point lists when ``--units`` is not given."""
 MATLAB_UNITS = "0.1mm"
-"""Unit of Matlab ``xy`` matrices when ``--units`` is not given (seed-002 §3: "resolución ...
+"""Unit of Matlab ``xy`` matrices when ``--units`` is not given (Angel-11 §3: "resolución ...
 de una decima de milímetro")."""
 LAYER = "0"
 """Contour.layer of every stroke (point lists have no layers)."""
@@ -289,7 +289,7 @@ _MATRIX = re.compile(r"\[([^\]\[]*)\]\s*[;,]?")
 
 
 def _matlab_strokes(text: str, path: Path, scale: float) -> list[_Stroke]:
-    """Strokes from every ``xy = [ ... ]`` assignment of a Matlab script (seed-002 §3)."""
+    """Strokes from every ``xy = [ ... ]`` assignment of a Matlab script (Angel-11 §3)."""
     code = re.sub(r"%[^\n]*", "", text)  # comments; the file holds no strings
     strokes: list[_Stroke] = []
     pos = 0
@@ -310,7 +310,7 @@ def _matlab_strokes(text: str, path: Path, scale: float) -> list[_Stroke]:
             snippet = code[pos:].split("\n", 1)[0].strip()[:40]
             raise InputError(
                 f"{path}: line {line}: expected 'xy = [ x ...; y ... ]', got {snippet!r}; "
-                "camtool reads the xy matrix of the thesis GUI (seed-002 §3)"
+                "camtool reads the xy matrix of the thesis GUI (Angel-11 §3)"
             )
         pos = matrix.end()
         if assign.group(1) == "xy":

@@ -296,9 +296,9 @@ def post_program(
 
     No planning: the program is already a toolpath. ``feed_mm_min``, when given,
     replaces the feed of every cutting move (the program's own feeds are kept
-    otherwise). For a target without a Z axis (depth set by hand, seed-000
+    otherwise). For a target without a Z axis (depth set by hand, UNAM-GMM
     S000-08) Z is dropped with a warning: Z-only moves go, XY moves keep their
-    kind, as the thesis users edited VisiCAM output by hand (seed-000 §3.8).
+    kind, as the thesis users edited VisiCAM output by hand (UNAM-GMM §3.8).
     ``output.fmt`` is the dialect's output format (default: its first);
     ``output.spindle_rpm`` > 0 starts the spindle before the first move and stops it
     after the last (when the program has no spindle commands of its own), waiting

@@ -1,7 +1,7 @@
 """Before anything is sent: read the program back, check it, frame it, time it.
 
 :func:`prepare_send` is what ``camtool send`` (and ``--dry-run``) does before it
-opens a port, as seed-004 S004-R20 asks of a sender: the code is read back with
+opens a port, as Munoz-22 S004-R20 asks of a sender: the code is read back with
 the target's own reader; every move must lie in the machine's travel or work
 area (:func:`camtool.verify.verifier.check_area`); no Z may go deeper than the
 link's ``max_depth_mm``; with ``verify`` the verifier predicts the machined
@@ -262,7 +262,7 @@ def _check_depth(program: Program, max_depth_mm: float | None, source: str) -> N
             where = f"line {line}" if line is not None else f"move {index + 1}"
             raise DialectError(
                 f"{source}, {where}: Z {move.z:g} mm is deeper than the "
-                f"{max_depth_mm:g} mm this link allows (seed-004 S004-R20); "
+                f"{max_depth_mm:g} mm this link allows (Munoz-22 S004-R20); "
                 "give --max-depth MM if the machine and tool can take it"
             )
 
@@ -340,7 +340,7 @@ def _with_z(program: Program, target: Target, move_times: Sequence[float]) -> Se
     The verifier simulates XY; a timed link must not send the next block while
     Z still moves. Adding Z at ``max_step_rate_hz`` (when the profile has one)
     is the conservative reading: it assumes Z moves after XY, not with it (for
-    ValCNC the thesis does not say, seed-004 open question 5). Z starts at 0.
+    ValCNC the thesis does not say, Munoz-22 open question 5). Z starts at 0.
     """
     machine = target.machine
     if not machine.max_step_rate_hz > 0:

@@ -693,7 +693,7 @@ class _Driver:
                 return
 
     def _modem_handshake(self) -> None:
-        """DTR out, DSR back (seed-003 §3.2); skipped, with a note, on a port without them."""
+        """DTR out, DSR back (Intf8751 §3.2); skipped, with a note, on a port without them."""
         spec, wire = self.spec, self.wire
         answered = wire.modem_handshake(spec.response_timeout_s)
         if answered is None:

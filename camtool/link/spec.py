@@ -42,7 +42,7 @@ Every target declares how code reaches its machine next to its dialect, in a
 ``warnings``               what to tell the operator before every job
 ``handshake``              ``"dtr-dsr"``: raise DTR (and RTS) and wait
                            ``response_timeout_s`` for DSR before anything is sent
-                           (seed-003's power-on handshake); a port without modem
+                           (Intf8751's power-on handshake); a port without modem
                            lines (a pseudo-terminal, a URL) skips it, with a note
 ``ignore``                 answers the sender only logs (per-byte confirmations)
 ``abort``                  bytes that stop the controller at once, sent when a job

@@ -66,7 +66,7 @@ class Motion:
         chord_segments: chords per arc (``flashcut``; the thesis does not say).
         chord_angle_deg: chord angle β, degrees (``valcnc``; not given).
         rounding: mm → steps rounding of the controller, one of :data:`ROUNDINGS`.
-            Positions are converted absolutely (no drift), seed-001 §4.5.
+            Positions are converted absolutely (no drift), Yanez-07 §4.5.
     """
 
     line: str = "dda"
@@ -80,7 +80,7 @@ class Motion:
 
 @dataclass(frozen=True, kw_only=True)
 class BacklashRegion:
-    """True backlash of one axis inside a rectangle of the work area (seed-000 Tabla 13).
+    """True backlash of one axis inside a rectangle of the work area (UNAM-GMM Tabla 13).
 
     Attributes:
         axis: ``"x"`` or ``"y"``.
@@ -101,7 +101,7 @@ class BacklashRegion:
 
 @dataclass(frozen=True, kw_only=True)
 class Backlash:
-    """Mechanical backlash and the controller's compensation (seed-000 §5, seed-001 §5).
+    """Mechanical backlash and the controller's compensation (UNAM-GMM §5, Yanez-07 §5).
 
     A reversal of an axis takes up the true backlash before the carriage moves;
     the controller adds ``compensation_um`` (as whole steps, rounded) in the new
@@ -147,7 +147,7 @@ class Machine:
         max_step_rate_hz: highest step frequency the controller sustains, Hz
             (0 = no limit known).
         source: where the numbers come from (a thesis section).
-        true_steps_per_mm: steps per mm the mechanics really make (seed-001 R14:
+        true_steps_per_mm: steps per mm the mechanics really make (Yanez-07 R14:
             1.9 µm assumed, 1.88 µm real); ``None`` means the nominal values.
         motion: interpolators and arc handling.
         backlash: true backlash and compensation.
@@ -182,7 +182,7 @@ class Machine:
     def step_rate_hz(self, feed_mm_min: float) -> float:
         """Step frequency of the fastest axis moving alone at ``feed_mm_min``, Hz.
 
-        seed-000 Eq. 3.1: f = d · F / 60 with d in steps/mm and F in mm/min.
+        UNAM-GMM Eq. 3.1: f = d · F / 60 with d in steps/mm and F in mm/min.
         """
         return max(self.steps_per_mm[:2]) * feed_mm_min / 60.0
 

@@ -291,7 +291,7 @@ def chord_count(radius: float, sweep: float, tolerance: float) -> int:
     fitter's statistics (:func:`camtool.geometry.arcfit.chord_equivalent`) and the
     verifier's ``sagitta`` chord model (machines with ``chords = "sagitta"``) all count
     chords here. The sagitta of a chord spanning angle θ is ``r·(1 − cos(θ/2))``
-    (seed-004 §4.2, "chord error per segment"), so the widest chord spans
+    (Munoz-22 §4.2, "chord error per segment"), so the widest chord spans
     ``2·acos(1 − t/r)`` and the count is ``⌈sweep / that⌉`` (less 1e-9, so that an exact
     quotient is not rounded up).
 

@@ -13,7 +13,7 @@ MM: Final = 1.0
 UM: Final = 0.001
 """One micrometre in mm."""
 TENTH_MM: Final = 0.1
-"""0.1 mm in mm (the unit of seed-002 point lists and of the pic-mmh feed word)."""
+"""0.1 mm in mm (the unit of Angel-11 point lists and of the pic-mmh feed word)."""
 INCH: Final = 25.4
 PX: Final = 25.4 / 96.0
 """One CSS pixel (1/96 in) in mm."""

@@ -22,7 +22,7 @@ from functools import lru_cache
 from camtool.model.errors import DialectError
 
 SIGN_POLICIES = ("negative", "always")
-"""``negative``: ``-`` only before negatives (seed-000 L1731); ``always``: ``+`` too."""
+"""``negative``: ``-`` only before negatives (UNAM-GMM L1731); ``always``: ``+`` too."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -38,11 +38,11 @@ class NumberFormat:
         sign: one of :data:`SIGN_POLICIES`.
         min_decimals: ``None`` writes all ``decimals`` digits; a number trims
             trailing zeros down to that many decimals (FlashCut's ``X1.0`` and
-            ``X2.969`` with ``decimals=3, min_decimals=1``, seed-001 R7; with 0
+            ``X2.969`` with ``decimals=3, min_decimals=1``, Yanez-07 R7; with 0
             a whole number is written without a point).
         pad: ``False`` makes ``int_digits`` a limit only (no zero padding).
         grid_mm: round the value to a multiple of this many mm before scaling
-            (a machine's step grid, seed-004 S004-R10); ``None``: no grid.
+            (a machine's step grid, Munoz-22 S004-R10); ``None``: no grid.
     """
 
     scale: float = 1.0

@@ -3,7 +3,7 @@
 A target file with ``dialect = "word-address"`` describes its G-code in its
 ``[dialect_options]`` table (every key: docs/dialects.md); no Python is needed.
 The built-in ``flashcut``, ``valcnc``, ``grbl`` and ``linuxcnc`` targets are
-such files (postprocessors/*.toml), for example ValCNC (seed-004 §3.4)::
+such files (postprocessors/*.toml), for example ValCNC (Munoz-22 §3.4)::
 
     [dialect_options]
     separator = ""                       # the firmware strips spaces (S004-R02)

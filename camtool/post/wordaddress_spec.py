@@ -88,7 +88,7 @@ class WordAddressSpec:
         max_arc_deg: arcs sweeping more than this are split into equal pieces.
         full_circle: ``"one-block"`` or ``"split"`` (into
             ``max(2, ceil(360 / max_arc_deg))`` equal arcs).
-        z_moves: ``"own-block"`` (Z alone in its block, seed-001 R7),
+        z_moves: ``"own-block"`` (Z alone in its block, Yanez-07 R7),
             ``"with-xy"`` or ``"none"`` (no Z word).
         helix: whether an arc may carry a Z word (``with-xy`` only).
         max_block_bytes: longest block in bytes with its block end and line

@@ -1,6 +1,6 @@
 """Previews a person can read: a program, a drawing, or a verification, as SVG or PNG.
 
-:func:`render_preview` draws what a machinist checks before cutting (seed-000
+:func:`render_preview` draws what a machinist checks before cutting (UNAM-GMM
 S000-24 colours): cutting moves in blue and rapids in dashed yellow, each
 contour's start with an arrow along its direction and its number in cutting
 order, the tool width where the cut was offset, the target's work area, a scale

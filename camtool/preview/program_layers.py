@@ -1,6 +1,6 @@
 """Layers of a program and its drawing: cuts, rapids, tool width, starts, order, work area.
 
-Colours of the thesis GUI (seed-000 S000-24): cutting moves blue, rapids dashed
+Colours of the thesis GUI (UNAM-GMM S000-24): cutting moves blue, rapids dashed
 yellow. Each contour's start is a red dot with an arrow along the direction of
 travel and its number in cutting order (one number per contour, however many
 depth passes and tab crossings cut it). A job's operations (or a program's tool

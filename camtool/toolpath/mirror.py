@@ -1,4 +1,4 @@
-"""Mirror ordering for symmetric parts (seed-000 S000-20, §5.3, L2816–L2841).
+"""Mirror ordering for symmetric parts (UNAM-GMM S000-20, §5.3, L2816–L2841).
 
 The thesis cut the 1.2 mm puma's right half from a shared start point Ie to Fe,
 returned to Ie and cut the left half from there: the two halves then move as

@@ -11,8 +11,8 @@ group's pocket cuts (:func:`camtool.toolpath.travel.precedence`).
 - ``travel``: short rapids, nearest neighbour then 2-opt
   (:mod:`camtool.toolpath.travel`);
 - ``reversals``: few axis direction reversals weighted by the machine's
-  backlash, seed-000 §5.3 (:mod:`camtool.toolpath.reversals`);
-- ``mirror``: symmetric parts cut half by half from a shared point, seed-000
+  backlash, UNAM-GMM §5.3 (:mod:`camtool.toolpath.reversals`);
+- ``mirror``: symmetric parts cut half by half from a shared point, UNAM-GMM
   S000-20 (:mod:`camtool.toolpath.mirror`).
 
 and reports the reversal counts and rapid travel of the drawn order, the travel
@@ -242,7 +242,7 @@ square of the count; the parts they are for have tens of cuts). ``travel`` has n
 SMALL_PART_MM = 1.0
 """Parts smaller than this (bounding box of the cuts) fail after about 16 compensations."""
 MAX_REVERSALS_SMALL = 16
-"""Reversals above which a small part is warned about (seed-000 S000-19, L3205–L3211)."""
+"""Reversals above which a small part is warned about (UNAM-GMM S000-19, L3205–L3211)."""
 
 ORDER_KEYS = ("drawn", "travel", "planned")
 """Keys of :attr:`Ordering.reversals` and :attr:`Ordering.travel_mm`."""
@@ -317,7 +317,7 @@ def order_cuts(
     Returns:
         The order, with the reversal counts and rapids of the drawn, travel and
         planned orders, and a finding when a part under 1 mm still needs more
-        than 16 reversals outside mirror order (seed-000 S000-19).
+        than 16 reversals outside mirror order (UNAM-GMM S000-19).
 
     Raises:
         ToolpathError: ``mirror`` on a drawing symmetric about neither axis.
@@ -386,7 +386,7 @@ def _rapids(cuts: Sequence[Cut], origin: Point) -> float:
 
 
 def _small_part(cuts: Sequence[Cut], counts: tuple[int, int], mode: str) -> list[Finding]:
-    """seed-000 S000-19 (L3205–L3211): a part under 1 mm fails after about 16 compensations."""
+    """UNAM-GMM S000-19 (L3205–L3211): a part under 1 mm fails after about 16 compensations."""
     if not cuts or mode == "mirror" or sum(counts) <= MAX_REVERSALS_SMALL:
         return []
     x0, y0, x1, y1 = cuts[0].path.bbox()
@@ -404,7 +404,7 @@ def _small_part(cuts: Sequence[Cut], counts: tuple[int, int], mode: str) -> list
             "ordering",
             f"order {mode}: {sum(counts)} axis reversals (X {counts[0]}, Y {counts[1]}) on a "
             f"part of {size:.3f} mm: parts under {SMALL_PART_MM:g} mm fail after about "
-            f"{MAX_REVERSALS_SMALL} backlash compensations (seed-000 §5.3); try {better}",
+            f"{MAX_REVERSALS_SMALL} backlash compensations (UNAM-GMM §5.3); try {better}",
             None,
             float(sum(counts)),
         )

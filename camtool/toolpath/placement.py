@@ -6,7 +6,7 @@ on the machine (``G54`` and touch-off on GRBL/LinuxCNC, ``Q;``/``G54;`` on the G
 the tool stands). Such a controller runs negative numbers as a matter of course, so the
 only hard limit is the program's **size**: its extent must fit the travel of the
 machine. A controller in **machine coordinates** (``coordinates = "machine"``: the
-seed-002 router counts from its home switches) can only reach positions inside its
+Angel-11 router counts from its home switches) can only reach positions inside its
 ``work_area_mm``.
 
 Placement (``--origin`` and ``--translate``) moves the finished program so that the work

@@ -3,7 +3,7 @@
 Offset modes (the ``--offset`` option):
 
 - ``on``: the tool centre follows the drawing (the pic-mmh machine scribes with
-  a point, seed-000 §6; S000-09);
+  a point, UNAM-GMM §6; S000-09);
 - ``outside``: cut outside the material. Material is the even-odd region of the
   closed contours: an outer boundary (even nesting depth) grows by the tool
   radius, a hole (odd depth) shrinks by it (:mod:`~camtool.toolpath.compensate`);

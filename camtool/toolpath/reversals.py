@@ -1,6 +1,6 @@
 """Axis direction reversals of a cutting sequence, and an order that needs few of them.
 
-The model (seed-000 §5.1, L1707–L1709: the controller compensates backlash
+The model (UNAM-GMM §5.1, L1707–L1709: the controller compensates backlash
 "whenever any axis changes direction", on rapids as well as cuts):
 
 - each axis (X, Y) has a current direction, +1 or -1, unknown before the first
@@ -129,7 +129,7 @@ def count_reversals(cuts: Sequence[Cut], start: Point) -> tuple[int, int]:
 
     Returns:
         ``(rx, ry)``: reversals of X and of Y. On a machine that compensates
-        every reversal (pic-mmh, seed-000 §5.1) this is the compensation count.
+        every reversal (pic-mmh, UNAM-GMM §5.1) this is the compensation count.
     """
     state_x = state_y = 0
     count_x = count_y = 0

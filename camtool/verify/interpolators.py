@@ -9,14 +9,14 @@ interpolator iteration, rows in ``{-1, 0, +1}²``. Positive ``dx``/``dy`` give
 
 Line interpolators (``line = ...``):
 
-- ``dda``: :func:`dda_line` — seed-000 §4.2, annex A.3, vectorised with a
+- ``dda``: :func:`dda_line` — UNAM-GMM §4.2, annex A.3, vectorised with a
   closed form; :func:`dda_line_reference` is the literal register loop.
-- ``accumulator-dda``: :func:`accumulator_dda_line` — seed-004 §4.1, Table 8.
-- ``corte-recto``: :func:`corte_recto_line` — seed-003 §4.1–4.2.
+- ``accumulator-dda``: :func:`accumulator_dda_line` — Munoz-22 §4.1, Table 8.
+- ``corte-recto``: :func:`corte_recto_line` — Intf8751 §4.1–4.2.
 - ``bresenham``: :func:`bresenham_line` — Bresenham over a block's step events
   with AMASS (as GRBL 1.1's ``stepper.c`` runs it).
 
-Arc interpolators on the step lattice (``arc = ...``), seed-000 §4.3–4.7:
+Arc interpolators on the step lattice (``arc = ...``), UNAM-GMM §4.3–4.7:
 ``dsm`` (:func:`dsm_arc`), ``staircase`` (:func:`staircase_arc`),
 ``circular-dda`` (:func:`circular_dda_arc`); conventions below.
 
@@ -27,16 +27,16 @@ shares (:func:`arc_offsets`, :func:`freeze_points`, :func:`chord_sagitta`,
 
 mm → steps rounding is :func:`~camtool.verify.quantize.steps_from_mm`.
 
-Arc interpolators: Three algorithms of seed-000, all quadrant by quadrant on magnitudes:
+Arc interpolators: Three algorithms of UNAM-GMM, all quadrant by quadrant on magnitudes:
 
-- :func:`dsm_arc` — Direct Search Method, annex A.6 (the one seed-000 selects);
+- :func:`dsm_arc` — Direct Search Method, annex A.6 (the one UNAM-GMM selects);
   :func:`dsm_arc_reference` is a literal, unoptimised transcription.
 - :func:`staircase_arc` — "escalones", annex A.5 (one axis per iteration).
 - :func:`circular_dda_arc` — circular DDA, annex A.4.
 
 Common conventions (all coordinates absolute, integer steps; Y up):
 
-- ``clockwise=True`` is G02, ``False`` G03 (seed-000 §4.6).
+- ``clockwise=True`` is G02, ``False`` G03 (UNAM-GMM §4.6).
 - Radius: R² = (x0 − cx)² + (y0 − cy)² from the start point, so D₀ = 0 at the
   start (the thesis' "rutina de cálculos" that derives it is not shown). The
   circular DDA needs an integer RADIO register: R rounded to the nearest step.
@@ -124,15 +124,15 @@ def _sign(v: int) -> int:
     return (v > 0) - (v < 0)
 
 
-# --------------------------------------------------------------------------- DDA, seed-000
+# --------------------------------------------------------------------------- DDA, UNAM-GMM
 
 
 def dda_iterations(dx: int, dy: int) -> int:
-    """Number of iterations of the seed-000 A.3 line DDA: ``floor(HIPO) + 1``.
+    """Number of iterations of the UNAM-GMM A.3 line DDA: ``floor(HIPO) + 1``.
 
     Every axis with a non-zero projection P overflows for the last time in the
     first iteration n with ``n·P > P·HIPO``, i.e. ``n = floor(HIPO) + 1``; a
-    zero move has no iterations. Source: seed-000 §4.2 (Eq. 3.3, code A.3).
+    zero move has no iterations. Source: UNAM-GMM §4.2 (Eq. 3.3, code A.3).
 
     Args:
         dx: X move, steps (sign ignored).
@@ -169,7 +169,7 @@ def _dda_counts(p: int, s: int, n: npt.NDArray[np.int64]) -> npt.NDArray[np.int6
 
 
 def dda_line(dx: int, dy: int) -> StepArray:
-    """Linear DDA of the GMM PIC controller, vectorised (seed-000 §4.2, annex A.3).
+    """Linear DDA of the GMM PIC controller, vectorised (UNAM-GMM §4.2, annex A.3).
 
     Projection registers ``PX = |dx|``, ``PY = |dy|``; each iteration adds them
     to accumulators QX, QY (starting at 0, no half preload); an accumulator that
@@ -186,7 +186,7 @@ def dda_line(dx: int, dy: int) -> StepArray:
 
     Returns:
         Step array ``(floor(HIPO) + 1, 2) int8``; ``(0, 2)`` for a zero move.
-        Golden: (3, 4) → ``- XY Y XY - XY`` (seed-000 §4.2).
+        Golden: (3, 4) → ``- XY Y XY - XY`` (UNAM-GMM §4.2).
 
     Raises:
         UsageError: If ``dx`` or ``dy`` is not an integer.
@@ -319,7 +319,7 @@ _COMPILED: dict[str, ModuleType | None] = {}
 
 
 def dda_line_reference(dx: int, dy: int) -> StepArray:
-    """Literal register loop of the seed-000 A.3 DDA; same result as :func:`dda_line`.
+    """Literal register loop of the UNAM-GMM A.3 DDA; same result as :func:`dda_line`.
 
     Plain Python, one pass per iteration, kept as the executable reading of
     annex A.3 and as the speed baseline of the benchmark. The register
@@ -355,7 +355,7 @@ def dda_line_reference(dx: int, dy: int) -> StepArray:
     return freeze(rows)
 
 
-# ----------------------------------------------------------- accumulator DDA, seed-004
+# ----------------------------------------------------------- accumulator DDA, Munoz-22
 
 
 def _major_minor(dx: int, dy: int) -> tuple[int, int, bool]:
@@ -365,7 +365,7 @@ def _major_minor(dx: int, dy: int) -> tuple[int, int, bool]:
 
 
 def accumulator_dda_table(dx: int, dy: int) -> npt.NDArray[np.int64]:
-    """Iteration table of the ValCNC accumulator DDA, as Table 8 of seed-004 §4.1.
+    """Iteration table of the ValCNC accumulator DDA, as Table 8 of Munoz-22 §4.1.
 
     K counts the major-axis steps; CUENTA accumulates the minor move each
     iteration and, when ``CUENTA >= major``, the minor axis steps and CUENTA
@@ -397,12 +397,12 @@ def accumulator_dda_table(dx: int, dy: int) -> npt.NDArray[np.int64]:
 
 
 def accumulator_dda_line(dx: int, dy: int) -> StepArray:
-    """Line of the ValCNC PIC18F4550 firmware (seed-004 §4.1, Table 8), vectorised.
+    """Line of the ValCNC PIC18F4550 firmware (Munoz-22 §4.1, Table 8), vectorised.
 
     One iteration per major-axis step (the major axis steps every iteration; X is
     major on a tie); the accumulator starts at 0 and the comparison is ``>=``, so
     the minor axis lags and the staircase lies on one side of the ideal line.
-    Each iteration costs one 166.667 µs delay (seed-004 §4.3).
+    Each iteration costs one 166.667 µs delay (Munoz-22 §4.3).
 
     Args:
         dx: X move, steps, signed.
@@ -423,7 +423,7 @@ def accumulator_dda_line(dx: int, dy: int) -> StepArray:
 
 
 def accumulator_dda_reference(dx: int, dy: int) -> StepArray:
-    """Plain loop of the seed-004 §4.1 accumulator DDA; same result as the vectorised one.
+    """Plain loop of the Munoz-22 §4.1 accumulator DDA; same result as the vectorised one.
 
     Args:
         dx: X move, steps, signed.
@@ -539,7 +539,7 @@ def polyline_steps(
 ) -> StepArray:
     """Execute a polyline of step-lattice points with a line interpolator.
 
-    How chord arcs (seed-001 §4.4, seed-004 §4.2, the ``chords`` arc) reach the motors: each
+    How chord arcs (Yanez-07 §4.4, Munoz-22 §4.2, the ``chords`` arc) reach the motors: each
     pair of consecutive points is one line move.
 
     Args:
@@ -559,11 +559,11 @@ def polyline_steps(
     return concatenate([line(int(a), int(b)) for a, b in moves])
 
 
-# --------------------------------------------------------------- corte recto, seed-003
+# --------------------------------------------------------------- corte recto, Intf8751
 
 
 def corte_recto_line(dx: int, dy: int) -> StepArray:
-    """Line by "corte recto" of the 8751 interface (seed-003 §4.1–4.2, RESTA/RUT2/GIRA1).
+    """Line by "corte recto" of the 8751 interface (Intf8751 §4.1–4.2, RESTA/RUT2/GIRA1).
 
     Both motors step together ``min(|dx|, |dy|)`` times, then the motor with
     more steps continues alone for the difference. The tool goes
@@ -612,8 +612,8 @@ def corte_recto_max_deviation(dx: int, dy: int) -> float:
     """Largest distance of the corte-recto path from the ideal segment, in steps.
 
     ``e = b·(a − b)/√(a² + b²)`` with ``a ≥ b`` the step magnitudes, reached at
-    the corner ``(b, b)`` (seed-003 §4.2, derived there); 0 for axis-parallel and
-    45° moves. Golden: (100, 50) → 22.36 steps (seed-003 §9 R10).
+    the corner ``(b, b)`` (Intf8751 §4.2, derived there); 0 for axis-parallel and
+    45° moves. Golden: (100, 50) → 22.36 steps (Intf8751 §9 R10).
 
     Args:
         dx: X move, steps, signed.
@@ -629,7 +629,7 @@ def corte_recto_max_deviation(dx: int, dy: int) -> float:
     return 0.0 if a == 0 else b * (a - b) / math.hypot(a, b)
 
 
-# ----------------------------------------------------------------- arcs, seed-000
+# ----------------------------------------------------------------- arcs, UNAM-GMM
 
 # Move codes of the inner loops, in magnitudes: X step, Y step, both, none.
 _X, _Y, _XY, _NONE = 0, 1, 2, 3
@@ -639,7 +639,7 @@ Quadrant = tuple[int, int]
 
 
 def _depart(u: int, v: int, cw: bool) -> Quadrant:
-    """Quadrant the motion enters from offset ``(u, v)`` (seed-000 §4.6 order)."""
+    """Quadrant the motion enters from offset ``(u, v)`` (UNAM-GMM §4.6 order)."""
     if u and v:
         return (_sign(u), _sign(v))
     if u == 0:  # on the Y axis: CW goes towards +x above the centre
@@ -818,13 +818,13 @@ def _search_arc(args: tuple[int, ...], clockwise: bool, run: _Runner) -> StepArr
 
 
 def dsm_arc(x0: int, y0: int, x1: int, y1: int, cx: int, cy: int, clockwise: bool) -> StepArray:
-    """Arc by the Direct Search Method of the GMM PIC (seed-000 §4.5, annex A.6).
+    """Arc by the Direct Search Method of the GMM PIC (UNAM-GMM §4.5, annex A.6).
 
     Each iteration takes, among the moves "growing axis", "shrinking axis" and
     both, the one with the least |D| (D = x² + y² − R², Eqs. 3.4–3.14), ties to
     single-axis moves exactly as the annex code. Conventions (R from the start,
     quadrants, end rule, closing steps): see the module docstring.
-    Golden (seed-000 §4.7, Tabla 7): full circle R = 30 → 168 iterations, radial
+    Golden (UNAM-GMM §4.7, Tabla 7): full circle R = 30 → 168 iterations, radial
     error ≤ ½ step.
 
     Args:
@@ -849,11 +849,11 @@ def dsm_arc(x0: int, y0: int, x1: int, y1: int, cx: int, cy: int, clockwise: boo
 def staircase_arc(
     x0: int, y0: int, x1: int, y1: int, cx: int, cy: int, clockwise: bool
 ) -> StepArray:
-    """Arc by the incremental "escalones" method (seed-000 §4.4, annex A.5).
+    """Arc by the incremental "escalones" method (UNAM-GMM §4.4, annex A.5).
 
     One axis per iteration: inside or on the circle (D ≤ 0, as the annex puts
     D = 0) the magnitude that grows in this quadrant steps, outside the one that
-    shrinks. Conventions: see the module docstring. Golden (seed-000 §4.7,
+    shrinks. Conventions: see the module docstring. Golden (UNAM-GMM §4.7,
     Tabla 7): full circle R = 30 → 240 iterations (8R).
 
     Args:
@@ -922,14 +922,14 @@ def _round_radius(r2: int) -> int:
 def circular_dda_arc(
     x0: int, y0: int, x1: int, y1: int, cx: int, cy: int, clockwise: bool
 ) -> StepArray:
-    """Arc by the circular DDA of the GMM PIC (seed-000 §4.3, annex A.4).
+    """Arc by the circular DDA of the GMM PIC (UNAM-GMM §4.3, annex A.4).
 
     The overflow threshold is the radius (RADIO, R rounded to a whole step); the
     projections are stored crosswise and updated as the tool moves; each axis
     counter stops at the steps left to the quadrant's axis point ((R, 0) or
     (0, R) in magnitudes) or, in the last quadrant, to the end point. Iterations
     without a pulse are rows ``(0, 0)``. Conventions: see the module docstring.
-    Golden (seed-000 §4.7, Tabla 7): full circle R = 30 → 188 iterations.
+    Golden (UNAM-GMM §4.7, Tabla 7): full circle R = 30 → 188 iterations.
 
     Args:
         x0: Start x, steps (absolute).
@@ -1066,7 +1066,7 @@ def chord_sagitta(radius_mm: float, angle_rad: float) -> float:
         angle_rad: Angle subtended by the chord, rad (sign ignored).
 
     Returns:
-        Sagitta, mm (seed-004 §4.2 "chord error per segment").
+        Sagitta, mm (Munoz-22 §4.2 "chord error per segment").
     """
     return radius_mm * (1.0 - math.cos(abs(angle_rad) / 2.0))
 

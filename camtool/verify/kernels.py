@@ -2,7 +2,7 @@
 
 The loops here are the same arithmetic as the pure-Python/numpy code of
 :mod:`camtool.verify.interpolators`, compiled with numba (``@njit(cache=True)``)
-so that a step costs a few nanoseconds: the linear DDA closed form (seed-000
+so that a step costs a few nanoseconds: the linear DDA closed form (UNAM-GMM
 annex A.3, :func:`camtool.verify.interpolators.dda_line`) and the quadrant
 loops of the direct search method (A.6) and the staircase (A.5). They work on
 int64 and are only called where no value can overflow (the callers check

@@ -5,7 +5,7 @@ position after each simulated iteration, ``(N, 2) float64``, with the index of
 the program move each point belongs to. The nominal path of a move is its own
 segment (line or arc) of the program read back from the code, so the
 deviation of a point is its distance to the segment its block was cutting
-(the contour error a machinist measures, seed-000 §6 and seed-001 R16).
+(the contour error a machinist measures, UNAM-GMM §6 and Yanez-07 R16).
 """
 
 from __future__ import annotations
@@ -63,7 +63,7 @@ class ContourMeasure:
         size_error_um: machined minus nominal ``(width, height)``, µm.
         circle: for a full circle, ``(nominal_diameter_mm, fitted_diameter_mm,
             horizontal_mm, vertical_mm)`` (least-squares fit, Kåsa 1976; extents
-            as seed-001 R16 measures them), else ``None``.
+            as Yanez-07 R16 measures them), else ``None``.
     """
 
     number: int

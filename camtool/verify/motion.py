@@ -88,7 +88,7 @@ class StepTrace:
             compensation: ``(x, y, z)``.
         block_dominant: ``(B,) int64``, steps of the dominant axis of each executed line
             (summed over the chords of a chord arc; iterations for a native arc), what
-            per-step time models count (seed-001 R15).
+            per-step time models count (Yanez-07 R15).
         block_compensation: ``(B,) int64``, compensation steps inserted in each move.
         reversals: reversals of the commanded X and Y directions.
         compensations: compensation events (axis reversals the controller

@@ -23,9 +23,9 @@ def steps_from_mm(value_mm: float, step_mm: float, rounding: Rounding = "half_ev
     The quotient is formed in decimal from the shortest repr of both floats, so
     10/0.0019 and 0.0057/0.0019 (= 3 exactly) are not spoiled by binary
     rounding. ``half_even`` is the banker's rounding of VB6 ``CLng``/``CInt``,
-    which the seed-001 application (VB6) would use; ``half_up`` rounds halves
+    which the Yanez-07 application (VB6) would use; ``half_up`` rounds halves
     away from zero; ``floor`` (towards −∞) and ``trunc`` (towards 0) cut.
-    seed-001 §4.5 (R8): 10 mm → 5263 and 5 mm → 2632 steps at 1.9 µm/step, which
+    Yanez-07 §4.5 (R8): 10 mm → 5263 and 5 mm → 2632 steps at 1.9 µm/step, which
     both nearest-rounding rules give and truncation (2631) does not.
 
     Args:

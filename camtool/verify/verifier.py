@@ -7,7 +7,7 @@ program on a machine profile (:func:`simulate`: the step simulator of
 the profile's line name, :mod:`camtool.verify.motion`) and measures the result
 (:mod:`camtool.verify.metrics`); :func:`report_dict` is the JSON report.
 
-The verify report: a JSON-ready dict with the keys of ../shared/DESIGN.md.
+The verify report: a JSON-ready dict with the keys listed in docs/verify.md.
 Stable keys other tools read: ``target``, ``blocks``, ``steps`` {x, y, z},
 ``iterations``, ``reversals`` {x, y}, ``compensations``, ``deviation_um``
 {max, rms}, ``closure_um`` (one value per closed contour, the gap's length),
@@ -95,7 +95,7 @@ CHUNK_ROWS = 1 << 16
 with their temporaries about 130 bytes a row, ~9 MB next to Python, numpy, scipy,
 shapely and the loaded numba kernels (~160 MB)."""
 SMALL_PART_MM = 1.0
-"""Parts under this size suffer most from compensations (seed-000 §5.3, S000-19)."""
+"""Parts under this size suffer most from compensations (UNAM-GMM §5.3, S000-19)."""
 MAX_COMPENSATIONS_SMALL = 16
 """Compensations above which a small part is warned about (the puma: 15-16; the logo: 45)."""
 MIN_OVERLAP = 0.1
@@ -1072,7 +1072,7 @@ def _warnings(program: Program, trace: StepTrace) -> list[str]:
         out.append(
             f"{trace.compensations} backlash compensations on a part of {size:.3f} mm: parts "
             f"under {SMALL_PART_MM:g} mm fail after about {MAX_COMPENSATIONS_SMALL} "
-            "(seed-000 §5.3); try --order mirror or fewer reversals"
+            "(UNAM-GMM §5.3); try --order mirror or fewer reversals"
         )
     return out
 
@@ -1170,7 +1170,7 @@ def _signed(value: float, decimals: int = 1) -> str:
 
 
 def report_dict(v: Verification, plan: PlanReport | None = None) -> dict[str, Any]:
-    """The verify report (keys of ../shared/DESIGN.md, plus details), JSON-ready.
+    """The verify report (the keys of docs/verify.md, plus details), JSON-ready.
 
     ``plan``, what planning found when the code was planned in the same run, goes
     under the ``plan`` key (:meth:`camtool.toolpath.plan.PlanReport.to_json`).

@@ -3,13 +3,13 @@
 Run as ``python tests/benchmarks/bench_interpolators.py`` (or through ``run_all.py``).
 Two jobs, each measured on camtool and on its C peer in the same run, on the same inputs:
 
-- linear DDA (seed-000 §4.2, annex A.3): random lines of up to 200 000 steps, 10 M
+- linear DDA (UNAM-GMM §4.2, annex A.3): random lines of up to 200 000 steps, 10 M
   iterations in all; camtool's :func:`camtool.verify.interpolators.dda_line`;
-- DSM (seed-000 §4.5, annex A.6): a full circle of radius 2 000 000 steps (11.3 M
+- DSM (UNAM-GMM §4.5, annex A.6): a full circle of radius 2 000 000 steps (11.3 M
   iterations); camtool's :func:`camtool.verify.interpolators.dsm_arc`.
 
 The C peers (``tests/benchmarks/c/dda.c``, ``dsm.c``) are the thesis loops straight from
-the pseudocode of reference/seed-000.md §4.2 and §4.5, compiled at run time with
+the pseudocode of reference/UNAM-GMM.md §4.2 and §4.5, compiled at run time with
 ``cc -O2`` into a temporary directory; they write the same rows (two int8 per iteration)
 into a buffer, time their own loop (best of 3) and print the iteration and pulse counts
 and a checksum of the rows, which this script compares with camtool's rows: equal
@@ -240,7 +240,7 @@ def main() -> None:
     cc = compiler()
     with tempfile.TemporaryDirectory(prefix="camtool-bench-c-") as tmp:
         job(
-            "linear DDA (seed-000 A.3), 10 M iterations, in-process",
+            "linear DDA (UNAM-GMM A.3), 10 M iterations, in-process",
             itp.dda_line,
             itp.dda_line_reference,
             lines(TOTAL, 200_000, seed=1),
@@ -252,7 +252,7 @@ def main() -> None:
             extra,
         )
         job(
-            f"DSM arc (seed-000 A.6), full circle R = {DSM_RADIUS:,} steps, in-process",
+            f"DSM arc (UNAM-GMM A.6), full circle R = {DSM_RADIUS:,} steps, in-process",
             itp.dsm_arc,
             itp.dsm_arc_reference,
             circles(TOTAL, DSM_RADIUS, 5.64, seed=4),

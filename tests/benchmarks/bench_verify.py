@@ -5,10 +5,10 @@ the CLI as a user runs it: ``camtool verify BIG.pic -t pic-mmh --report R.json``
 subprocess (``sys.executable -m camtool``, PYTHONPATH the tree's root), timed wall-clock,
 its peak memory taken from ``RUSAGE_CHILDREN`` of a small runner process spawned for that
 one measurement. BIG.pic is written deterministically to a temporary directory: a
-pic-mmh program (seed-000's fixed-width µm dialect) of :data:`LINES` long lines zig-zagging
+pic-mmh program (UNAM-GMM's fixed-width µm dialect) of :data:`LINES` long lines zig-zagging
 across the 10 × 7 mm work area, 13.2 M motor steps (x 12 860 771, y 361 911) and 13.2 M
 trace rows, over the 3 M rows above which the error budget is skipped (as it is for a
-user's big program). pic-mmh because its controller's line is the seed-000 A.3 DDA, the
+user's big program). pic-mmh because its controller's line is the UNAM-GMM A.3 DDA, the
 loop the C peer runs: the C peer is ``tests/benchmarks/c/dda.c`` (``cc -O2``, compiled at
 run time) on the same lines in steps, and the ratio is camtool's whole-verify steps/s over
 the C DDA loop's steps/s. The demo logo (``samples/logo.dxf`` posted to pic-mmh, as
@@ -100,7 +100,7 @@ BIG_LINES = int(os.environ.get("CAMTOOL_BENCH_BIG_LINES", "1000"))
 REPEATS = 2
 """Runs of each CLI job (the best wall time is kept; memory is the largest)."""
 SPM = 1e6 / 140.0
-"""pic-mmh steps/mm (140 nm/step, seed-000 S000-12)."""
+"""pic-mmh steps/mm (140 nm/step, UNAM-GMM S000-12)."""
 
 RUNNER = """
 import resource, subprocess, sys, time
@@ -115,7 +115,7 @@ def big_program(lines: int) -> tuple[str, list[tuple[int, int]]]:
     """The big pic-mmh program and its line moves in steps (for the C peer).
 
     Zig-zag lines from x = 0.5 mm to 9.5 mm and back, each 0.137 mm higher (modulo 6 mm),
-    F08 (0.8 mm/min, seed-000's own example feed).
+    F08 (0.8 mm/min, UNAM-GMM's own example feed).
     """
     out = ["G54;", "G90;", "G00X00500.00Y00500.00;"]
     moves: list[tuple[int, int]] = []

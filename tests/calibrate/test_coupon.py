@@ -72,7 +72,7 @@ def test_a_perfect_machine_predicts_the_nominal_values() -> None:
 
 
 def test_u_pattern_shows_an_uncompensated_backlash() -> None:
-    # analytic: the back line is shorter than the out line by the true backlash (seed-001 §5)
+    # analytic: the back line is shorter than the out line by the true backlash (Yanez-07 §5)
     target = load_target("grbl")
     machine = machine_from_table(
         merge_tables(target.machine.table, {"backlash": {"true_um": [120.0, 80.0, 0.0]}}),

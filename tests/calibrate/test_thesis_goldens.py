@@ -1,6 +1,6 @@
 """The fit fed the theses' own measurements recovers the theses' own conclusions.
 
-Every measured number below is copied from ../shared/reference/seed-NNN.md (table and line
+Every measured number below is copied from docs/references.md (table and line
 cited); every expected value is the thesis's conclusion or arithmetic on its numbers, never
 camtool's output. The scatter each prediction is held to is the thesis's own, stated where it
 is used.
@@ -28,7 +28,7 @@ from camtool.model.machine import Machine, machine_from_table, merge_tables
 from camtool.post.base import Target
 from camtool.post.registry import load_target
 
-STEPS_000 = 1 / 0.00014  # 140 nm/step, seed-000 §2.1
+STEPS_000 = 1 / 0.00014  # 140 nm/step, UNAM-GMM §2.1
 
 
 def _with(machine: Machine, overlay: dict) -> Machine:
@@ -46,9 +46,9 @@ def _by_id(result: FitResult) -> dict[str, tuple[float, float, float]]:
     }
 
 
-# --- seed-000 ------------------------------------------------------------------------------------
+# --- UNAM-GMM ------------------------------------------------------------------------------------
 
-# Tabla 13 (seed-000 §5.2, L2387-L2423): (region row, experimental length mm, backlash µm).
+# Tabla 13 (UNAM-GMM §5.2, L2387-L2423): (region row, experimental length mm, backlash µm).
 # The U pattern's first line is cut after the approach: its length is the "experimental" one;
 # the second loses the backlash: experimental − backlash (the thesis's own definition: "la
 # diferencia de las longitudes de las dos rectas"). Cut without compensation (the compensation
@@ -127,7 +127,7 @@ def test_tabla_14_contradicts_tabla_13(pic: Target) -> None:
     assert max(r[2] for r in TABLA_13_X) < 192.5 + 11.5  # the new 204 µm exceeds 201
 
 
-# Tabla 15 (seed-000 §6.3, L2528-L2594): mean diameters and sample σ of 8 diameters, cut
+# Tabla 15 (UNAM-GMM §6.3, L2528-L2594): mean diameters and sample σ of 8 diameters, cut
 # clockwise with 204/178 µm compensation.
 TABLA_15 = [(6.0, 5.958, 0.035), (4.0, 3.982, 0.022), (2.0, 1.991, 0.020)]
 
@@ -152,7 +152,7 @@ def tabla_15(pic: Target, circles: tuple[tuple[ReadBack, ...], list[Observation]
 def test_tabla_15_circles_fit_one_screw_lead(tabla_15: FitResult) -> None:
     by_id = _by_id(tabla_15)
     # before: the nominal 140 nm step predicts ~6/4/2 mm: the measured circles are 42/18/9 µm
-    # smaller (seed-000 §6.3 [derived]: mean diameter errors −42, −18, −9 µm)
+    # smaller (UNAM-GMM §6.3 [derived]: mean diameter errors −42, −18, −9 µm)
     for (d, _, sigma), expected_um in zip(TABLA_15, (42, 18, 9), strict=True):
         measured, before, after = by_id[f"C{d:g}.mean"]
         assert (before - measured) * 1000 == pytest.approx(expected_um, abs=1.5)
@@ -171,7 +171,7 @@ def test_the_issue_lead_of_7168_steps_per_mm_brings_o4_and_o2_within_5_um(
     pic: Target, circles: tuple[tuple[ReadBack, ...], list[Observation]]
 ) -> None:
     read, observations = circles
-    # a 0.5 mm screw: 28 steps × 128 / 0.5 mm = 7168 steps/mm (seed-000 §2.1 [derived])
+    # a 0.5 mm screw: 28 steps × 128 / 0.5 mm = 7168 steps/mm (UNAM-GMM §2.1 [derived])
     machine = _with(pic.machine, {"true_steps_per_mm": [7168.0, 7168.0, STEPS_000]})
     machine = _with(machine, {"backlash": {"compensation_um": [204.0, 178.0, 0.0]}})
     predicted = predict(read, machine)
@@ -182,7 +182,7 @@ def test_the_issue_lead_of_7168_steps_per_mm_brings_o4_and_o2_within_5_um(
     assert 15 < gaps[0] < 25  # ø6 stays ~21 µm off: 7168 is not the least-squares lead
 
 
-# --- seed-001 ------------------------------------------------------------------------------------
+# --- Yanez-07 ------------------------------------------------------------------------------------
 
 
 @pytest.fixture(scope="module")
@@ -192,12 +192,12 @@ def flashcut() -> Target:
 
 @pytest.fixture(scope="module")
 def rectangle_10x5(flashcut: Target) -> tuple[FitResult, Machine, tuple[ReadBack, ...]]:
-    """seed-001 §6.1 (L1568-L1570): the 10 × 5 rectangle measured 9.897 × 4.906 mm."""
+    """Yanez-07 §6.1 (L1568-L1570): the 10 × 5 rectangle measured 9.897 × 4.906 mm."""
     feed = flashcut.default_feed_mm_min
     rect = rectangle("R", (3.0, 3.0), (10.0, 5.0), 1.0, feed)
     ring = circle("C10", (10.0, 22.0), 10.0, 1.0, feed)
     read = _read(flashcut, [rect, ring])
-    # start from the application's own constant, 1.9 µm (seed-001 §4.5), as a user would
+    # start from the application's own constant, 1.9 µm (Yanez-07 §4.5), as a user would
     nominal = _with(flashcut.machine, {"true_steps_per_mm": list(flashcut.machine.steps_per_mm)})
     observations = [Observation(rect.measures[0], 9.897), Observation(rect.measures[1], 4.906)]
     result = fit(read[:1], nominal, observations, target="flashcut")
@@ -211,7 +211,7 @@ def test_seed_001_rectangle_finds_the_1_88_um_step(
     step_x = 1000 / result.value("true_steps_per_mm[0]")
     step_y = 1000 / result.value("true_steps_per_mm[1]")
     # R14: 5263 steps × 1.88 µm = 9.894 mm ≈ 9.897 measured; the thesis's own implied steps of
-    # this part are 1.880 and 1.864 µm (seed-001 §6.1 [INFERENCE]), both below the 1.9 assumed
+    # this part are 1.880 and 1.864 µm (Yanez-07 §6.1 [INFERENCE]), both below the 1.9 assumed
     assert step_x == pytest.approx(1.880, abs=0.002)
     assert step_y == pytest.approx(1.864, abs=0.002)
     # two measurements, two parameters: no residual variance, so no σ; backlash not separable
@@ -223,7 +223,7 @@ def test_seed_001_circle_stays_unexplained(
     flashcut: Target, rectangle_10x5: tuple[FitResult, Machine, tuple[ReadBack, ...]]
 ) -> None:
     """The ø10 circle came out 9.004 × 9.123 mm at P = 20 ms (L1612); nothing the coupon fits
-    explains a 0.9 mm undersize (the thesis does not either, seed-001 §6.2)."""
+    explains a 0.9 mm undersize (the thesis does not either, Yanez-07 §6.2)."""
     result, nominal, read = rectangle_10x5
     fitted = _with(nominal, dict(result.overlay))
     for machine in (flashcut.machine, fitted):
@@ -232,9 +232,9 @@ def test_seed_001_circle_stays_unexplained(
         assert predicted["C10.v"] - 9.123 > 0.6
 
 
-# --- seed-004 ------------------------------------------------------------------------------------
+# --- Munoz-22 ------------------------------------------------------------------------------------
 
-# Tables 14-16 (seed-004 §5.2, L1647-L1682): position after each of ten 8 mm moves, mm.
+# Tables 14-16 (Munoz-22 §5.2, L1647-L1682): position after each of ten 8 mm moves, mm.
 TABLE_16_X = [8.08, 16.19, 24.23, 32.29, 40.35, 48.41, 56.53, 64.61, 72.70, 80.76]
 TABLE_15_Y = [8.09, 16.19, 24.23, 32.28, 40.36, 48.48, 56.60, 64.71, 72.75, 80.86]
 TABLE_14_Z = [8.05, 16.09, 24.21, 32.20, 40.29, 48.44, 56.52, 64.57, 72.61, 80.60]
@@ -267,7 +267,7 @@ def test_seed_004_finds_the_scale_of_each_axis(valcnc: FitResult) -> None:
         assert 8.0 * scale[axis] == pytest.approx(end / 10, abs=PLUS_MINUS[axis])
     assert scale[1] == pytest.approx(80.86 / 80, abs=0.0005)
     # every position predicted within the thesis's ± per revolution; Z's own data depart up to
-    # 0.072 mm from any straight line (seed-004 §5.3 [derived]), more than its stated ± 0.06
+    # 0.072 mm from any straight line (Munoz-22 §5.3 [derived]), more than its stated ± 0.06
     scatter = {**PLUS_MINUS, 2: 0.072}
     for r in valcnc.residuals:
         assert abs(r.residual_um) / 1000 <= scatter[r.observation.measure.axis]
@@ -275,7 +275,7 @@ def test_seed_004_finds_the_scale_of_each_axis(valcnc: FitResult) -> None:
 
 
 def test_seed_004_never_measured_backlash(valcnc: FitResult) -> None:
-    # only + moves (seed-004 §5.3: "Not tested: backlash"): nothing depends on it
+    # only + moves (Munoz-22 §5.3: "Not tested: backlash"): nothing depends on it
     reasons = dict((p.key, why) for p, why in valcnc.undetermined)
     assert "none depends on it" in reasons["backlash.true_um[0]"]
 

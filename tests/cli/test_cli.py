@@ -234,7 +234,7 @@ DATA = Path(__file__).parents[1] / "data"
 
 
 def test_post_existing_gcode_reposts_it(capsys: pytest.CaptureFixture[str]) -> None:
-    """seed-001 §3.3: the FlashCut examples, re-posted for pic-mmh (I/J become absolute)."""
+    """Yanez-07 §3.3: the FlashCut examples, re-posted for pic-mmh (I/J become absolute)."""
     code, out, err = run(["post", str(DATA / "flashcut-seed001.nc"), "-t", "pic-mmh"], capsys)
     assert code == 0
     assert "G02X03000.00Y03000.00I02000.00J02000.00F30;" in out.splitlines()

@@ -1,4 +1,4 @@
-"""G-code import: RS-274 as CAM programs write it, FlashCut (seed-001 §3), Gcodetools (seed-004)."""
+"""G-code import: RS-274 as CAM programs write it, FlashCut (Yanez-07 §3), Gcodetools (Munoz-22)."""
 
 from __future__ import annotations
 
@@ -39,11 +39,11 @@ def refused(text: str) -> str:
     return str(info.value)
 
 
-# -- seed-001 (FlashCut, Yáñez Soto 2007) --------------------------------------------------
+# -- Yanez-07 (FlashCut, Yáñez Soto 2007) --------------------------------------------------
 
 
 def test_seed001_r2_g02_golden_arc() -> None:
-    # seed-001 §10 R2 / §3.3 (L1004-1005): centre (2,2), r = √2, CW sweep −180°,
+    # Yanez-07 §10 R2 / §3.3 (L1004-1005): centre (2,2), r = √2, CW sweep −180°,
     # passing through (2−√2, 2).
     program = parse("G01 X1.0 Y1.0 F3.0\nG02 X3.0 Y3.0 I1.0 J1.0\n")
     line, arc_move = program.moves
@@ -57,7 +57,7 @@ def test_seed001_r2_g02_golden_arc() -> None:
 
 
 def test_seed001_r2_g03_golden_arc() -> None:
-    # seed-001 §10 R2 / §3.3 (L1020-1021): centre (1,2), CCW +180°, through (1+√2, 2).
+    # Yanez-07 §10 R2 / §3.3 (L1020-1021): centre (1,2), CCW +180°, through (1+√2, 2).
     program = parse("G01 X2.0 Y1.0 F8.0\nG03 X0.0 Y3.0 I-1.0 J1.0\n")
     assert program.moves[1] == ArcMove(0.0, 3.0, 1.0, 2.0, False, 8.0, contour=1)
     (arc,) = arcs(program)
@@ -67,7 +67,7 @@ def test_seed001_r2_g03_golden_arc() -> None:
 
 
 def test_flashcut_file_with_the_four_literal_examples() -> None:
-    # tests/data/flashcut-seed001.nc: seed-001 §3.3's four lines in one file (CR LF ends);
+    # tests/data/flashcut-seed001.nc: Yanez-07 §3.3's four lines in one file (CR LF ends);
     # no units anywhere (mm implied, §3.3) → a warning naming line 1; no M2/M30 either (the
     # thesis shows four lines, not a whole program) → a warning naming the last block.
     program = read_gcode(DATA / "flashcut-seed001.nc")
@@ -84,7 +84,7 @@ def test_flashcut_file_with_the_four_literal_examples() -> None:
 
 
 def test_flashcut_n_words_comments_and_m_codes_are_tolerated() -> None:
-    # seed-001 R1 (M00/M02/M03/M04/M05/M30) and R5 (N-words, comments): the program loads.
+    # Yanez-07 R1 (M00/M02/M03/M04/M05/M30) and R5 (N-words, comments): the program loads.
     program = parse(
         "%\n"
         "N1 (LMM logo) M03\n"
@@ -103,26 +103,26 @@ def test_flashcut_n_words_comments_and_m_codes_are_tolerated() -> None:
 
 
 def test_flashcut_missing_axis_word_keeps_its_value() -> None:
-    # seed-001 R4: the app refused `G01 X2.0` without Y; camtool reads leniently (RS-274).
+    # Yanez-07 R4: the app refused `G01 X2.0` without Y; camtool reads leniently (RS-274).
     program = parse("G21 G01 X1.0 Y1.0 F3.0\nG01 X2.0\nG00 Y5.0\n")
     assert program.moves[1] == Linear(2.0, 1.0, 3.0, contour=1)
     assert program.moves[2] == Rapid(2.0, 5.0, contour=2)
 
 
 def test_g20_g21_have_their_modern_meaning() -> None:
-    # seed-001 R6: G20/G21 are inch/mm, not the textbook's interpolation codes.
+    # Yanez-07 R6: G20/G21 are inch/mm, not the textbook's interpolation codes.
     program = parse("G20 G1 X1 Y2 F10\nG21 G1 X1 Y2\n")
     assert program.moves[0] == Linear(25.4, 50.8, 254.0, contour=1)
     assert program.moves[1] == Linear(1.0, 2.0, 254.0, contour=1)  # feed stays physical
 
 
-# -- seed-004 (Gcodetools .ngc, S004-R07) -------------------------------------------------
+# -- Munoz-22 (Gcodetools .ngc, S004-R07) -------------------------------------------------
 
 
 def test_gcodetools_ngc_file() -> None:
     # tests/data/gcodetools-circle.ngc, written as Gcodetools 0.7 writes (header/footer
     # comments, G21, G00 Z5 retracts, G01 Z-1 F100 (Penetrate), G02 X Y Z I J F400, M2).
-    # seed-004 §3.3: cut depth Z = −1 mm.
+    # Munoz-22 §3.3: cut depth Z = −1 mm.
     program = read_gcode(DATA / "gcodetools-circle.ngc", source_name="logo.ngc")
     assert program.moves == (
         Rapid(0.0, 0.0, 5.0, contour=1),
@@ -197,7 +197,7 @@ def test_full_circle_without_axis_words() -> None:
 
 
 def test_g0_with_f_keeps_f_modal() -> None:
-    # seed-001 R3: G00 ignores F for its own speed, but F stays set.
+    # Yanez-07 R3: G00 ignores F for its own speed, but F stays set.
     program = parse("G21 G0 X1 Y0 F50\nG1 X2\n")
     assert program.moves == (Rapid(1.0, 0.0, contour=1), Linear(2.0, 0.0, 50.0, contour=1))
 
@@ -398,7 +398,7 @@ def test_read_gcode_errors_and_encodings(tmp_path: Path) -> None:
         read_gcode(bad, source_name="<stdin>")
 
 
-# -- properties (seed-004 S004-R03: G91 and R-form read to the same points) ---------------
+# -- properties (Munoz-22 S004-R03: G91 and R-form read to the same points) ---------------
 
 coords = st.integers(-50_000, 50_000).map(lambda n: n / 1000)
 
@@ -457,7 +457,7 @@ def _same(a: Move, b: Move) -> bool:
 
 
 def test_round_trip_through_pic_mmh() -> None:
-    # Z-free, inside the pic-mmh 10 × 7 mm work area (seed-000 L2359-L2360), feeds on the
+    # Z-free, inside the pic-mmh 10 × 7 mm work area (UNAM-GMM L2359-L2360), feeds on the
     # F01-F99 grid of 0.1 mm/min (S000-05).
     program = parse(
         "G21 G90 G17\n"

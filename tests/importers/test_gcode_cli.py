@@ -63,7 +63,7 @@ def test_verify_refuses_a_nested_comment_naming_the_line(
 def test_valcnc_reader_still_refuses_comments(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    # The ValCNC firmware reads no comments (seed-004 S004-R04): the reader must not skip them.
+    # The ValCNC firmware reads no comments (Munoz-22 S004-R04): the reader must not skip them.
     path = write(tmp_path, "v.ngc", "G00X0Y0\nG01X1Y1(cut)\n")
     code, _, err = run(["verify", path, "-t", "valcnc"], capsys)
     assert code == 3

@@ -66,7 +66,7 @@ def test_s_changes_a_turning_spindle_only() -> None:
 
 
 def test_bare_m3_has_no_speed_and_no_warning() -> None:
-    # Gcodetools writes `M3` without S (tests/data/gcodetools-circle.ngc, seed-004 §3.3).
+    # Gcodetools writes `M3` without S (tests/data/gcodetools-circle.ngc, Munoz-22 §3.3).
     program = read_gcode(DATA / "gcodetools-circle.ngc")
     assert program.commands == ((0, Spindle("cw", 0.0)), (7, Spindle("off")))
     assert program.warnings == ()
@@ -114,7 +114,7 @@ def test_bad_command_words_are_refused_naming_the_line(block: str, message: str)
 
 
 def test_reposted_to_pic_mmh_with_its_commands() -> None:
-    # A typical program re-posted to pic-mmh (seed-000 §3.8: the thesis users edited CAM
+    # A typical program re-posted to pic-mmh (UNAM-GMM §3.8: the thesis users edited CAM
     # output by hand): Z moves are dropped (S000-08) and the commands are written in the
     # syntax of Tablas 21-22 at their new places.
     program = parse(

@@ -1,4 +1,4 @@
-"""Point-list importer: CSV/TXT/XY rows and the thesis GUI's Matlab xy matrices (seed-002 §3)."""
+"""Point-list importer: CSV/TXT/XY rows and the thesis GUI's Matlab xy matrices (Angel-11 §3)."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ from camtool.model.shapes import Contour, Line
 ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT / "tests" / "data"
 
-# seed-002 §3, "Worked example (verbatim, L3183-L3228)": the star's xy matrix in 0.1 mm
+# Angel-11 §3, "Worked example (verbatim, L3183-L3228)": the star's xy matrix in 0.1 mm
 STAR_X = (151, 400, 630, 575, 815, 501, 400, 294, 6, 220, 153)
 STAR_Y = (86, 265, 86, 431, 639, 642, 999, 645, 665, 428, 86)
 STAR_MM = [(15.1, 8.6), (40.0, 26.5), (63.0, 8.6), (57.5, 43.1), (81.5, 63.9), (50.1, 64.2),
@@ -38,20 +38,20 @@ def write(tmp_path: Path, name: str, text: str) -> Path:
 
 
 def test_star_csv_sample_has_the_eleven_thesis_points() -> None:
-    # seed-002 §3: "esta figura consta de 11 puntos (10 líneas)"; xy/10 in mm
+    # Angel-11 §3: "esta figura consta de 11 puntos (10 líneas)"; xy/10 in mm
     drawing = read_points(ROOT / "samples" / "star.csv")
     assert len(drawing.contours) == 1
     star = drawing.contours[0]
     assert vertices(star) == STAR_MM
     assert [(x / 10, y / 10) for x, y in zip(STAR_X, STAR_Y, strict=True)] == STAR_MM
     assert len(star.segments) == 10
-    # seed-002 §3: "it starts at (151,86) and ends at (153,86)" - not closed
+    # Angel-11 §3: "it starts at (151,86) and ends at (153,86)" - not closed
     assert not star.closed
     assert drawing.warnings == ()
 
 
 def test_star_matlab_text_equals_the_csv() -> None:
-    # tests/data/star.m is the thesis's printed xy/lxy/velxy block, verbatim (seed-002 §3)
+    # tests/data/star.m is the thesis's printed xy/lxy/velxy block, verbatim (Angel-11 §3)
     from_m = read_points(DATA / "star.m")
     from_csv = read_points(ROOT / "samples" / "star.csv")
     assert [c.segments for c in from_m.contours] == [c.segments for c in from_csv.contours]

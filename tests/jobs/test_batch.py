@@ -1,6 +1,6 @@
 """camtool batch: input expansion, outputs, one bad file among good ones, exit codes, report.
 
-Drawings are small pic-mmh parts inside its 10 × 7 mm work area (seed-000 §2.1): a 2 × 1 mm
+Drawings are small pic-mmh parts inside its 10 × 7 mm work area (UNAM-GMM §2.1): a 2 × 1 mm
 rectangle at (1, 1) and an L of two axis-parallel lines as a G-code program.
 """
 
@@ -38,9 +38,9 @@ from tests.shapes import rectangle_dxf
 
 ROOT = Path(__file__).parents[2]
 SAMPLES = ROOT / "samples"
-# An L along the axes at the pic-mmh feed F08 = 0.8 mm/min (seed-000 L1731).
+# An L along the axes at the pic-mmh feed F08 = 0.8 mm/min (UNAM-GMM L1731).
 L_PROGRAM = "G21 G90\nG0 X1 Y1\nG1 X2 Y1 F0.8\nG1 X2 Y2\nM30\n"
-HALF_STEP_UM = 0.07  # ½ BLU of the 140 nm step (seed-000 §2.1; DDA lines, §4.2, §4.7)
+HALF_STEP_UM = 0.07  # ½ BLU of the 140 nm step (UNAM-GMM §2.1; DDA lines, §4.2, §4.7)
 
 
 @pytest.fixture
@@ -251,7 +251,7 @@ def test_progress_is_called_once_per_file(tree: Path) -> None:
     [
         (None, [], 0, "3 file(s): 3 ok"),
         ("corrupt", [], 3, "not a readable DXF"),
-        ("corrupt+big", [], 1, "larger than the 10 × 7 mm travel"),  # seed-000 §2.1
+        ("corrupt+big", [], 1, "larger than the 10 × 7 mm travel"),  # UNAM-GMM §2.1
         (None, ["--target", "nope"], 2, "unknown target 'nope'"),
         (None, ["--jobs", "0"], 2, "Invalid value for '--jobs'"),
         (None, ["--preview", "gif"], 2, "Invalid value for '--preview'"),
@@ -294,7 +294,7 @@ def test_over_the_limit_exits_4_and_keeps_the_outputs(
 ) -> None:
     # The L program's axis-parallel lines stay within half a step of the path; the drawn
     # rectangles reverse both axes, and the pic-mmh backlash compensation (204/178 µm,
-    # seed-000 §5.2) leaves them tens of µm off: a 1 µm limit passes the L, stops the rest.
+    # UNAM-GMM §5.2) leaves them tens of µm off: a 1 µm limit passes the L, stops the rest.
     code, _, err = run(
         ["drawings", "-t", "pic-mmh", "-o", "out", "-j", "1", "--max-error-um", "1"], capsys
     )

@@ -5,7 +5,7 @@ module. The reference for every output is the same batch run with ``jobs=1`` in 
 process: a batch on Dask must give the same files, byte for byte, and the same report
 but for where it ran (``scheduler``) and where it wrote (``output_dir``, ``outputs``).
 The drawings are the bundled samples, small pic-mmh parts inside its 10 × 7 mm work
-area (seed-000 §2.1), a G-code program, a corrupt file, and a slice of the
+area (UNAM-GMM §2.1), a G-code program, a corrupt file, and a slice of the
 real-drawing corpus when it is fetched (docs/corpus.md).
 """
 
@@ -38,7 +38,7 @@ from tests.shapes import rectangle_dxf
 
 ROOT = Path(__file__).parents[2]
 SAMPLES = ROOT / "samples"
-# An L along the axes at the pic-mmh feed F08 = 0.8 mm/min (seed-000 L1731).
+# An L along the axes at the pic-mmh feed F08 = 0.8 mm/min (UNAM-GMM L1731).
 L_PROGRAM = "G21 G90\nG0 X1 Y1\nG1 X2 Y1 F0.8\nG1 X2 Y2\nM30\n"
 VICTIM = "victim.dxf"
 """The drawing whose first run kills its worker (:class:`KillOnce`)."""
@@ -116,7 +116,7 @@ def test_samples_on_dask_equal_jobs_one(drawings: Path, client: Client) -> None:
     assert rows[str(drawings / "parts" / "l.ngc")].status == "ok"  # a program, re-posted
     bad = rows[str(drawings / "parts" / "bad.dxf")]
     assert (bad.status, bad.exit_code) == ("error", 3) and "not a readable DXF" in bad.error
-    # samples/plate.dxf is 40 × 30 mm: larger than the 10 × 7 mm travel (seed-000 §2.1)
+    # samples/plate.dxf is 40 × 30 mm: larger than the 10 × 7 mm travel (UNAM-GMM §2.1)
     assert "larger than the 10 × 7 mm travel" in rows[str(drawings / "plate.dxf")].error
     assert result.exit_code == 1
     assert [p for p in Path("dask").rglob(".*")] == []  # no temp file, no lock left

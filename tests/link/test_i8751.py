@@ -1,6 +1,6 @@
 """The i8751 link over a pseudo-terminal pair: packets, 'F' and 'A', stalls, resume, DTR/DSR.
 
-Expected values come from seed-003 §3.7 (reference/seed-003.md: access key
+Expected values come from Intf8751 §3.7 (reference/Intf8751.md: access key
 13H, packets of at most 5 moves ending 45H, 'F' after each, 54H answered 'A')
 and from the programs themselves (the summed step counts), never from
 camtool's output.

@@ -1,6 +1,6 @@
 """The pic-mmh link over a pseudo-terminal pair: echo, per-step feedback, abort on a new string.
 
-Expected values come from seed-000 (reference/seed-000.md §2.4, S000-11: every
+Expected values come from UNAM-GMM (reference/UNAM-GMM.md §2.4, S000-11: every
 ``;``-ended string echoed, one feedback event per motor step, a new string
 aborts the motion, a 35-element receive buffer), from the thesis's own G02
 string (43 characters, L1731) and from the program itself (where its last
@@ -22,7 +22,7 @@ from camtool.model.errors import DialectError, LinkError
 from camtool.post.registry import load_target
 from tests.link.controls import PauseAt
 
-THESIS_G02 = "G02X02969.00Y03400.00I03012.00J03040.00F08;"  # seed-000 L1731, 43 characters
+THESIS_G02 = "G02X02969.00Y03400.00I03012.00J03040.00F08;"  # UNAM-GMM L1731, 43 characters
 PROGRAM = (
     "G54;\n"
     "G90;\n"

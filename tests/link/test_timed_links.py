@@ -1,7 +1,7 @@
 """ValCNC and matlab-router over a pseudo-terminal pair: the links with no answer.
 
-ValCNC (seed-004 S004-R17): ``C\\n`` on open, then one block at a time; the bytes
-after ``C\\n`` equal the posted file. matlab-router (seed-002 §2.7): CR-ended
+ValCNC (Munoz-22 S004-R17): ``C\\n`` on open, then one block at a time; the bytes
+after ``C\\n`` equal the posted file. matlab-router (Angel-11 §2.7): CR-ended
 numbers, one job per connection. Waits are scaled to 0 (``time_scale``): these
 links pace themselves by the timing model, which the verifier tests cover.
 """
@@ -20,7 +20,7 @@ from camtool.link.spec import WireBlock
 from camtool.model.errors import InputError, LinkError
 from camtool.post.registry import load_target
 
-# A 20 x 10 mm rectangle and an arc in the ValCNC dialect (seed-004 Table 7: G00-G03 X Y Z I J,
+# A 20 x 10 mm rectangle and an arc in the ValCNC dialect (Munoz-22 Table 7: G00-G03 X Y Z I J,
 # no spaces); the tool ends at X5 Y5 Z5.
 VALCNC = (
     "G00Z5\nG00X5Y5\nG01Z-1\nG01X25Y5Z-1\nG01X25Y15Z-1\nG01X5Y15Z-1\nG01X5Y5Z-1\n"
@@ -128,7 +128,7 @@ def test_router_jobs_arrive_byte_for_byte_one_per_connection(
 ) -> None:
     plan = prepare_send(router_wire, load_target("matlab-router"))
     assert len(plan.blocks) == 2
-    # each job is n, x1, y1 and 4n values, every one ended by CR (seed-002 §2.7)
+    # each job is n, x1, y1 and 4n values, every one ended by CR (Angel-11 §2.7)
     for block in plan.blocks:
         n = int(block.data.split(b"\r")[0])
         assert block.data.count(b"\r") == 3 + 4 * n

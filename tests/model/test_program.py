@@ -55,7 +55,7 @@ def test_with_moves_drops_commands_that_no_longer_fit() -> None:
 
 
 def test_flattening_for_a_2d_target_moves_commands_with_their_moves() -> None:
-    """pic-mmh has no Z (seed-000 S000-08): Z-only moves go, commands stay in place."""
+    """pic-mmh has no Z (UNAM-GMM S000-08): Z-only moves go, commands stay in place."""
     moves = (
         Rapid(1.0, 1.0, z=2.0),
         Linear(1.0, 1.0, 50.0, z=-0.1),  # Z-only: dropped

@@ -115,7 +115,7 @@ def test_the_plugin_through_the_cli(
     # the plugin's timing: one second per block, whatever the block does
     assert report["time_s"] == 9.0
 
-    # the same code with the generic DDA (seed-000 A.3: floor(hypot) + 1 iterations a move):
+    # the same code with the generic DDA (UNAM-GMM A.3: floor(hypot) + 1 iterations a move):
     # 101 per side, 15 for the diagonal rapid (10, 10) steps
     Path("dda.toml").write_text('[machine.motion]\nline = "dda"\n', encoding="utf-8")
     args = ["verify", "square.xyt", "-t", "xy-then", "--machine", "dda.toml"]

@@ -15,7 +15,7 @@ UM52 = NumberFormat(scale=1000.0, decimals=2, int_digits=5)
 @pytest.mark.parametrize(
     ("value_mm", "fmt", "text"),
     [
-        (2.969, UM52, "02969.00"),  # seed-000 L1731
+        (2.969, UM52, "02969.00"),  # UNAM-GMM L1731
         (3.4, UM52, "03400.00"),
         (-0.15, UM52, "-00150.00"),  # S000-03 example X-00150.00
         (0.0, UM52, "00000.00"),

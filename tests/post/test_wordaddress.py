@@ -172,8 +172,8 @@ def test_a_bad_target_file_names_itself_and_the_key(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("word", "value", "text"),
     [
-        ({"decimals": 3, "min_decimals": 1}, 1.0, "1.0"),  # FlashCut X1.0 (seed-001 L1004, R7)
-        ({"decimals": 3, "min_decimals": 1}, -1.0, "-1.0"),  # I-1.0 (seed-001 L1021)
+        ({"decimals": 3, "min_decimals": 1}, 1.0, "1.0"),  # FlashCut X1.0 (Yanez-07 L1004, R7)
+        ({"decimals": 3, "min_decimals": 1}, -1.0, "-1.0"),  # I-1.0 (Yanez-07 L1021)
         ({"decimals": 3, "min_decimals": 1}, 2.969, "2.969"),
         ({"decimals": 3, "min_decimals": 1}, 1.25, "1.25"),
         ({"decimals": 3, "min_decimals": 1}, -0.0004, "0.0"),  # never -0
@@ -194,7 +194,7 @@ def test_word_format_table(word: dict[str, Any], value: float, text: str) -> Non
 
 
 def test_the_pic_mmh_block_can_be_declared_in_toml() -> None:
-    # seed-000 L1731, verbatim: fixed-width µm, absolute centre, F in 0.1 mm/min, ';'.
+    # UNAM-GMM L1731, verbatim: fixed-width µm, absolute centre, F in 0.1 mm/min, ';'.
     um = {"scale": 1000.0, "decimals": 2, "int_digits": 5, "zero_pad": True}
     options = {
         "separator": "",
@@ -287,7 +287,7 @@ def test_modal_axes_and_motion_omit_unchanged_words() -> None:
 
 
 def test_z_own_block_splits_rising_first_and_plunging_last() -> None:
-    # seed-001 R7: Z moves in their own blocks.
+    # Yanez-07 R7: Z moves in their own blocks.
     options = {"words": {"XYZ": {"decimals": 1}}, "z_moves": "own-block", "modal": []}
     moves = (Rapid(0, 0, z=5.0), Rapid(2, 0, z=1.0), Rapid(4, 0, z=6.0), Linear(4, 0, 9.0, z=3.0))
     lines, warnings = emit(options, moves)
@@ -425,7 +425,7 @@ FLASHLIKE: dict[str, Any] = {
         ("G01 X1e3 Y1.0", "'X1e3' is not a word"),
         ("G01  X1.0 Y1.0", "separated by one space"),
         ("G01X1.0 Y1.0", "separated by one space"),
-        ("G01 X1.0", "missing Y word"),  # both X and Y (seed-001 R4)
+        ("G01 X1.0", "missing Y word"),  # both X and Y (Yanez-07 R4)
         ("G1 X1.0 Y1.0", "unknown code 'G1'"),
         ("G17", "unknown code 'G17'"),
         ("G01 X1.0 Y1.0 Q1.0", "unknown word Q1.0"),

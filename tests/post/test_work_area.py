@@ -14,7 +14,7 @@ BASE = {"name": "bench", "steps_per_mm": [100, 100, 100], "work_area_mm": [0, 0,
 
 
 def test_every_thesis_controller_with_a_work_zero_is_work_and_the_router_machine() -> None:
-    # seed-002: every job homes and starts from its first point's offset from home (R1, R6).
+    # Angel-11: every job homes and starts from its first point's offset from home (R1, R6).
     kinds = {name: load_machine(name).coordinates for name in machine_names()}
     assert kinds.pop("router-2011") == "machine"
     assert set(kinds.values()) == {"work"}

@@ -1,4 +1,4 @@
-"""The flashcut target (a TOML word-address dialect) against seed-001 §3, R1–R8, R11, R14."""
+"""The flashcut target (a TOML word-address dialect) against Yanez-07 §3, R1–R8, R11, R14."""
 
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ GOLDEN = ROOT / "tests" / "golden" / "flashcut"
 TARGET = load_target("flashcut")
 POST = TARGET.post
 
-# seed-001 §3.7 inferred grammar, for the blocks camtool writes (R1, R7): every number with a
+# Yanez-07 §3.7 inferred grammar, for the blocks camtool writes (R1, R7): every number with a
 # point and at least one decimal, words separated by one space.
 NUM = r"-?\d{1,4}\.\d{1,3}"
 GRAMMAR = re.compile(
@@ -36,7 +36,7 @@ def emit(moves: tuple[Move, ...], **program: object) -> list[str]:
 
 
 def test_r1_r2_thesis_examples_are_written_verbatim() -> None:
-    # seed-001 §3.3, L1004-1005 and L1020-1021: the four literal lines (tests/data holds them).
+    # Yanez-07 §3.3, L1004-1005 and L1020-1021: the four literal lines (tests/data holds them).
     moves = (
         Linear(1, 1, 3.0),
         ArcMove(3, 3, 2, 2, True, 3.0),  # starts (1,1), centre (2,2), ends (3,3)
@@ -53,7 +53,7 @@ def test_r2_thesis_examples_read_to_their_glossed_arcs() -> None:
     assert a == Linear(1, 1, 3.0, contour=1) and c == Linear(2, 1, 8.0, contour=1)
     assert b == ArcMove(3, 3, 2, 2, True, 3.0, contour=1)  # "con centro en (2,2)", same F (R3)
     assert d == ArcMove(0, 3, 1, 2, False, 8.0, contour=1)  # "con centro en (1,2)"
-    # Both are semicircles of radius √2 (seed-001 §3.3): the G02 (225° → 45° clockwise)
+    # Both are semicircles of radius √2 (Yanez-07 §3.3): the G02 (225° → 45° clockwise)
     # passes (2 − √2, 2) and (2, 2 + √2) a quarter and three quarters of the way; the G03
     # (−45° → 135°) passes (1 + √2, 2) and, half way, (2, 3).
     first = Arc((1, 1), (b.x, b.y), (b.cx, b.cy), b.clockwise)

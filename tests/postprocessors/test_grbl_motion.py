@@ -2,7 +2,7 @@
 (camtool_postprocessors.grbl_motion).
 
 Every expected value names its source: a section/requirement of
-../shared/reference/seed-00N.md, or "analytic" for a property of the model's formula.
+docs/references.md, or "analytic" for a property of the model's formula.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The i8751 dialect against seed-003 §3.7 (protocol) and R1–R7, R10 (reference/seed-003.md)."""
+"""The i8751 dialect against Intf8751 §3.7 (protocol) and R1–R7, R10 (reference/Intf8751.md)."""
 
 from __future__ import annotations
 
@@ -54,7 +54,7 @@ WIDE = {"work_area_mm": (-1000.0, -1000.0, 1000.0, 1000.0)}
 
 
 def test_block_encoding_r2() -> None:
-    # seed-003 R2 (lines 4108–4134): +1000 → 01 03 03 E8; Y 0 → 02 05; − is 04H.
+    # Intf8751 R2 (lines 4108–4134): +1000 → 01 03 03 E8; Y 0 → 02 05; − is 04H.
     assert encode_block(1, 1000) == bytes.fromhex("01 03 03 E8")
     assert encode_block(2, 0) == bytes.fromhex("02 05")
     assert encode_block(3, -100) == bytes.fromhex("03 04 00 64")
@@ -64,7 +64,7 @@ def test_block_encoding_r2() -> None:
 
 
 def test_thesis_worked_example_byte_for_byte() -> None:
-    # seed-003 §3.7 "Worked example": X +1000, Y −250, wait 2 s, Z −100, wait 0; then Y +300:
+    # Intf8751 §3.7 "Worked example": X +1000, Y −250, wait 2 s, Z −100, wait 0; then Y +300:
     # 13 | 01 03 03 E8 02 04 00 FA 00 02 03 04 00 64 00 00 | 01 05 02 03 01 2C 00 00 03 05
     # 00 00 | 45 | 54. At 100 steps/mm: X 10 mm, Y −2.5 mm, Z −1 mm, then Y +3 mm.
     post, machine = _target(**WIDE)
@@ -92,7 +92,7 @@ def test_thesis_worked_example_byte_for_byte() -> None:
 
 
 # The golden program: a 10 mm square from (5, 5) and a diagonal of (10, 5) mm = (1000, 500)
-# steps, the corte-recto case (100, 50) of seed-003 R10 scaled by 10; a 2 s dwell before the
+# steps, the corte-recto case (100, 50) of Intf8751 R10 scaled by 10; a 2 s dwell before the
 # diagonal. Bytes worked out by hand from §3.7 (block format 4106–4134, order M1 M2 T1 M3 T2
 # 4129–4165, 45H after ≤ 5 moves, 54H at the end) with lift_mm = 1 (100 steps):
 GOLDEN_MOVES = (
@@ -178,7 +178,7 @@ def test_golden_reads_back() -> None:
 
 
 def test_packets_hold_five_moves() -> None:
-    # seed-003 §3.7: 15 blocks / 60 data per packet = 5 moves; 45H closes each packet.
+    # Intf8751 §3.7: 15 blocks / 60 data per packet = 5 moves; 45H closes each packet.
     # 11 one-axis moves of 12 bytes each: 45H at 1 + 60, 1 + 60 + 1 + 60, then 1 more move.
     post, machine = _target()
     moves = tuple(Linear(0.01 * (k + 1), 0, 60) for k in range(11))
@@ -206,7 +206,7 @@ def test_absolute_rounding_does_not_accumulate() -> None:
 
 
 def test_split_over_65535_steps_r3() -> None:
-    # seed-003 R3: 70 000 steps become two moves, 65 535 + 4 465.
+    # Intf8751 R3: 70 000 steps become two moves, 65 535 + 4 465.
     assert split_xy(70000, 0) == [(65535, 0), (4465, 0)]
     assert split_count(-70000) == [-65535, -4465]
     # A diagonal keeps to its segment: Y at the nearest step of 65 535 · 35 000/70 000.
@@ -505,7 +505,7 @@ def test_round_trip_logo_sample() -> None:
 
 
 def test_verify_corte_recto_golden_r10() -> None:
-    # seed-003 R10: (100, 50) steps visits (50, 50) and deviates b(a − b)/√(a² + b²) =
+    # Intf8751 R10: (100, 50) steps visits (50, 50) and deviates b(a − b)/√(a² + b²) =
     # 22.36 steps from the ideal segment; at 0.01 mm per step: 223.6 µm at (0.5, 0.5) mm.
     target = load_target("i8751")
     code = target.emit(Program((Linear(1.0, 0.5, 62.4),))).code

@@ -1,7 +1,7 @@
-"""Tests of the seed-003 i8751 ramp timing model (camtool_postprocessors.i8751_motion).
+"""Tests of the Intf8751 i8751 ramp timing model (camtool_postprocessors.i8751_motion).
 
 Every expected value names its source: a section/requirement of
-../shared/reference/seed-00N.md, or "analytic" for a property of the model's formula.
+docs/references.md, or "analytic" for a property of the model's formula.
 """
 
 from __future__ import annotations
@@ -40,12 +40,12 @@ def test_model_calls_its_function():
     ("x", "ms", "digits"), [(0xF2, 125.0, 1), (0xED, 122.4, 1), (0x11, 9.58, 2)]
 )
 def test_i8751_delay_formula(x, ms, digits):
-    # seed-003 R12: t(F2H) = 125.0 ms, t(EDH) = 122.4 ms, t(11H) = 9.58 ms
+    # Intf8751 R12: t(F2H) = 125.0 ms, t(EDH) = 122.4 ms, t(11H) = 9.58 ms
     assert round(float(i8751_delay_s(x)) * 1000, digits) == ms
 
 
 def test_i8751_firmware_ramp():
-    # seed-003 §4.4: 45 acceleration steps, X −= 5 from F2H (2.565 ms less per step),
+    # Intf8751 §4.4: 45 acceleration steps, X −= 5 from F2H (2.565 ms less per step),
     # ≈ 3.09 s in all; cruise at X = 11H ≈ 104 Hz; then 45 deceleration steps
     d = i8751_step_delays_s(100)
     assert_seconds(d, 100)
@@ -60,14 +60,14 @@ def test_i8751_firmware_ramp():
 
 
 def test_i8751_short_moves_run_at_minimum_speed():
-    # seed-003 §4.4: fewer than 90 steps run entirely at F2H (8 Hz)
+    # Intf8751 §4.4: fewer than 90 steps run entirely at F2H (8 Hz)
     assert i8751_step_delays_s(89) == pytest.approx(np.full(89, 0.125002))
     assert float(i8751_step_delays_s(90).max()) == pytest.approx(0.125002)
     assert len(i8751_step_delays_s(0)) == 0
 
 
 def test_i8751_design_cruise_is_70_hz():
-    # seed-003 §4.4 design intent: 8 Hz → 70 Hz (14.28 ms), 2.46 ms less per step
+    # Intf8751 §4.4 design intent: 8 Hz → 70 Hz (14.28 ms), 2.46 ms less per step
     assert 1 / float(i8751_delay_s(i8751_cruise_x("design"))) == pytest.approx(70.0)
     d = i8751_step_delays_s(200, cruise="design")
     assert round(float(d[100]) * 1000, 2) == 14.29
@@ -83,7 +83,7 @@ def test_i8751_closed_form_equals_step_sum(n, cruise):
 
 
 def test_i8751_block_sequence_xy_wait_z_wait():
-    # seed-003 R11: X/Y, then T1 s, then Z, then T2 s; Z is its own ramped routine
+    # Intf8751 R11: X/Y, then T1 s, then Z, then T2 s; Z is its own ramped routine
     xy, z = 120, 30
     t = i8751_block_time_s([xy, 0], [z, -z], wait_t1_s=2, wait_t2_s=[0, 1])
     assert_seconds(t, 2)

@@ -1,6 +1,6 @@
-"""The matlab-router dialect against seed-002 §3 (the GUI), §2.7 (the wire), §2.8 (jobs), R1–R7.
+"""The matlab-router dialect against Angel-11 §3 (the GUI), §2.7 (the wire), §2.8 (jobs), R1–R7.
 
-Golden numbers: reference/seed-002.md §3, the star worked example (thesis L3183–L3235).
+Golden numbers: reference/Angel-11.md §3, the star worked example (thesis L3183–L3235).
 Other expectations are analytic (chord sagitta, the GUI's rounding rule, int16 limits).
 """
 
@@ -31,7 +31,7 @@ TARGET = load_target("matlab-router")
 MACHINE = TARGET.machine
 FEED = 225.0  # R7: 480 counts / 5 ms at 25 600 counts/mm = 3.75 mm/s on the major axis
 
-# seed-002 §3, thesis text lines as printed: the velxy block and the first rows of xy, lxy.
+# Angel-11 §3, thesis text lines as printed: the velxy block and the first rows of xy, lxy.
 THESIS_LINES = [
     "[   151   400   630   575   815   501   400   294     6   220   153; ",  # L3198
     "[   249   230    55   240   314   101   106   288   214    67; ",  # L3214
@@ -61,7 +61,7 @@ def _star_moves(contour: int = 0) -> tuple[Move, ...]:
 
 
 def test_star_csv_is_the_thesis_star_in_mm() -> None:
-    # seed-002 §3, L3196–L3200: xy of the star in 0.1 mm; samples/star.csv holds it in mm.
+    # Angel-11 §3, L3196–L3200: xy of the star in 0.1 mm; samples/star.csv holds it in mm.
     drawing = read_points(SAMPLES / "star.csv")
     (contour,) = drawing.contours
     points = contour.points(1e-3)

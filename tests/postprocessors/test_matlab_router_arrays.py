@@ -1,6 +1,6 @@
-"""Tests of the seed-002 Matlab GUI arrays (camtool_postprocessors.matlab_router_arrays).
+"""Tests of the Angel-11 Matlab GUI arrays (camtool_postprocessors.matlab_router_arrays).
 
-Golden numbers: reference/seed-002.md §3 (the star worked example, thesis L3183–L3235)
+Golden numbers: reference/Angel-11.md §3 (the star worked example, thesis L3183–L3235)
 and §8 R1–R2, R7. Other expectations are analytic (the algorithm's definition).
 """
 
@@ -20,11 +20,11 @@ from camtool_postprocessors.matlab_router_arrays import (
 )
 from tests.shapes import STAR_LXY, STAR_VELXY, STAR_XY_01MM
 
-STAR_XY = np.array(STAR_XY_01MM)  # seed-002 §3, L3196–L3200
+STAR_XY = np.array(STAR_XY_01MM)  # Angel-11 §3, L3196–L3200
 
 
 def test_star_reproduces_the_thesis_arrays_exactly() -> None:
-    # seed-002 §3 (L3212–L3228) and R2 golden test.
+    # Angel-11 §3 (L3212–L3228) and R2 golden test.
     arrays = router_arrays(STAR_XY.T)
     assert arrays.lxy.tolist() == STAR_LXY
     assert arrays.velxy.tolist() == STAR_VELXY
@@ -32,7 +32,7 @@ def test_star_reproduces_the_thesis_arrays_exactly() -> None:
 
 
 def test_star_header_values() -> None:
-    # seed-002 §3, L3233–L3235: "n=10 y el primer punto ... x=151 e y=86"; default speed 480 (R7).
+    # Angel-11 §3, L3233–L3235: "n=10 y el primer punto ... x=151 e y=86"; default speed 480 (R7).
     arrays = router_arrays(STAR_XY.T)
     assert arrays.n == 10
     assert arrays.first_point == (151, 86)
@@ -52,7 +52,7 @@ def test_arrays_are_read_only_int64() -> None:
      (0.49999999999999994, 0), (-0.2, 0), (76.52, 77), (-77.5, -78)],
 )  # fmt: skip
 def test_matlab_round_is_half_away_from_zero(value: float, expected: int) -> None:
-    # seed-002 §3: Matlab round rounds halves away from zero (Python's round(2.5) == 2).
+    # Angel-11 §3: Matlab round rounds halves away from zero (Python's round(2.5) == 2).
     assert matlab_round(value) == expected
     assert isinstance(matlab_round(value), int)
 
@@ -76,14 +76,14 @@ def test_points_01mm_rounds_like_the_gui() -> None:
 
 
 def test_equal_deltas_keep_both_axes_at_full_speed() -> None:
-    # seed-002 §3 observations: |lx| = |ly| leaves both speeds at ±480.
+    # Angel-11 §3 observations: |lx| = |ly| leaves both speeds at ±480.
     arrays = router_arrays([(0, 0), (100, -100), (100, -100)])
     assert arrays.velxy.tolist() == [[480, 480], [-480, 480]]
     assert arrays.lxy.tolist() == [[100, 0], [100, 0]]
 
 
 def test_zero_minor_delta_gives_zero_speed() -> None:
-    # seed-002 §3 observations: factor = Inf, so the minor speed is 480/Inf = 0.
+    # Angel-11 §3 observations: factor = Inf, so the minor speed is 480/Inf = 0.
     arrays = router_arrays([(0, 0), (0, -50), (70, -50)])
     assert arrays.velxy.tolist() == [[0, 480], [-480, 0]]
 

@@ -41,7 +41,7 @@ def test_count_reversals_ignores_a_wobble_under_the_dead_band() -> None:
 
 
 def test_backlash_overlay_is_applied_as_a_dead_band() -> None:
-    """seed-002 R15: the band starts taken up in +; after the square's − legs the table
+    """Angel-11 R15: the band starts taken up in +; after the square's − legs the table
     lags by the band, so the closure is (+100, +50) µm for bands of 100 and 50 µm."""
     base = load_target("matlab-router").machine
     machine = dataclasses.replace(base, backlash=Backlash(true_um=(100.0, 50.0, 0.0)))

@@ -1,6 +1,6 @@
-"""Tests of the seed-002 DC-servo router model (camtool_postprocessors.matlab_router_motion*).
+"""Tests of the Angel-11 DC-servo router model (camtool_postprocessors.matlab_router_motion*).
 
-Every expected value names its source: a section/table of reference/seed-002.md, or
+Every expected value names its source: a section/table of reference/Angel-11.md, or
 "analytic" when it follows from the model's own equations.
 """
 
@@ -41,8 +41,8 @@ from camtool_postprocessors.matlab_router_motion_servo import (
 )
 from tests.shapes import STAR_XY_01MM
 
-STAR = np.array(STAR_XY_01MM).T  # seed-002 §3, L3196–L3200, (N, 2) in 0.1 mm
-CPM = 25_600  # counts per mm on X/Y (seed-002 §2.2, R8)
+STAR = np.array(STAR_XY_01MM).T  # Angel-11 §3, L3196–L3200, (N, 2) in 0.1 mm
+CPM = 25_600  # counts per mm on X/Y (Angel-11 §2.2, R8)
 
 
 def settling(w: np.ndarray, ref: float, band: float = 0.02) -> tuple[float, float]:
@@ -55,7 +55,7 @@ def settling(w: np.ndarray, ref: float, band: float = 0.02) -> tuple[float, floa
 
 
 def test_r8_counts_follow_from_the_mechanics() -> None:
-    # seed-002 §2.2: 1024 counts/rev × 75 (gear) / 3 mm (lead) = 25 600 counts/mm; a
+    # Angel-11 §2.2: 1024 counts/rev × 75 (gear) / 3 mm (lead) = 25 600 counts/mm; a
     # 0.2 mm chunk is the firmware's RefP = 5120 (L5601); one GUI unit (0.1 mm) is 2560.
     m = RouterMachine()
     assert m.counts_per_mm == 1024 * 75 // 3
@@ -92,14 +92,14 @@ def test_unknown_choice_lists_the_valid_ones() -> None:
 
 
 def test_design_ip_natural_frequency() -> None:
-    # seed-002 §5.2 and R11: xi = 0.707, ts = 0.25 s -> wn = 22.63 rad/s.
+    # Angel-11 §5.2 and R11: xi = 0.707, ts = 0.25 s -> wn = 22.63 rad/s.
     g = design_ip(9.715, 0.067, 0.25, 0.707, 0.005)
     assert g.wn == pytest.approx(22.63, abs=0.005)
 
 
 @pytest.mark.parametrize("row", TABLE_4_1, ids=["X", "Y", "Z"])
 def test_table_4_1_analog_gains_give_its_digital_columns(row) -> None:  # type: ignore[no-untyped-def]
-    # seed-002 Table 4.1 and R11: Kid = Ki·T, Kpd = Kp − Kid/2 reproduce the printed columns.
+    # Angel-11 Table 4.1 and R11: Kid = Ki·T, Kpd = Kp − Kid/2 reproduce the printed columns.
     kid, kpd = digital_gains(row.ki, row.kp, 0.005)
     assert abs(kid - row.kid) <= 1e-4
     assert abs(kpd - row.kpd) <= 1e-4
@@ -111,7 +111,7 @@ def test_table_4_1_analog_gains_give_its_digital_columns(row) -> None:  # type: 
     ids=["X", "Y", "Z"],
 )
 def test_back_solved_plants(row, a: float, tau: float) -> None:  # type: ignore[no-untyped-def]
-    # seed-002 §5.2 (D) table of back-solved per-axis plants (printed to 3 significant digits).
+    # Angel-11 §5.2 (D) table of back-solved per-axis plants (printed to 3 significant digits).
     got_a, got_tau = plant_from_gains(row.ki, row.kp)
     assert got_a == pytest.approx(a, abs=0.005)
     assert got_tau == pytest.approx(tau, abs=0.0001)
@@ -137,12 +137,12 @@ def test_design_ip_rejects_non_positive() -> None:
 
 
 def test_thesis_pole_is_the_zoh_pole_of_alpha_14_88() -> None:
-    # seed-002 §5.1: G_p(s) = 145/(s + 14.88) and G_p(z) = 0.6986/(z − 0.9283) at Ts = 5 ms.
+    # Angel-11 §5.1: G_p(s) = 145/(s + 14.88) and G_p(z) = 0.6986/(z − 0.9283) at Ts = 5 ms.
     assert Plant.from_analog(9.715, 1 / 14.88).pole == pytest.approx(THESIS_PLANT.pole, abs=1e-4)
 
 
 def test_open_loop_u70_step() -> None:
-    # seed-002 §5.1 and R9: u = 70 reaches 680 counts/Ts (±1 %) with 63.2 % at ≈ 67 ms (τ).
+    # Angel-11 §5.1 and R9: u = 70 reaches 680 counts/Ts (±1 %) with 63.2 % at ≈ 67 ms (τ).
     w = open_loop_step(THESIS_PLANT, 70, 200)
     assert w[-1] == pytest.approx(680, rel=0.01)
     t63 = float(np.interp(0.632 * w[-1], w, np.arange(len(w)))) * 0.005
@@ -156,7 +156,7 @@ def test_open_loop_u70_step() -> None:
     ids=["thesis-plant+designed-gains", "X-plant+Table-4.1-X"],
 )
 def test_ideal_closed_loop_to_682(plant: Plant, gains) -> None:  # type: ignore[no-untyped-def]
-    # R10 / seed-002 §5.2–5.3: designed for ts = 250 ms (2 %) and < 5 % overshoot (xi = 0.707).
+    # R10 / Angel-11 §5.2–5.3: designed for ts = 250 ms (2 %) and < 5 % overshoot (xi = 0.707).
     # 4/(xi·wn) is the envelope estimate; the sampled 2 % band is left at 260 ms, so ±30 ms.
     w = closed_loop_step(plant, 682, 400, law="ideal", gains=gains)
     overshoot, ts = settling(w, 682)
@@ -166,7 +166,7 @@ def test_ideal_closed_loop_to_682(plant: Plant, gains) -> None:  # type: ignore[
 
 @pytest.mark.parametrize(("axis", "t98_ms"), [(0, 105), (1, 135)], ids=["X", "Y"])
 def test_firmware_law_on_back_solved_plants(axis: int, t98_ms: float) -> None:
-    # seed-002 §5.2 (D) rough simulation: firmware law (28/159), ref 480, time to 98 %
+    # Angel-11 §5.2 (D) rough simulation: firmware law (28/159), ref 480, time to 98 %
     # speed X ≈ 105 ms, Y ≈ 135 ms (one 5 ms sample of tolerance each way, plus one).
     w = closed_loop_step(per_axis_plants()[axis], 480, 400)
     t98 = (np.argmax(w >= 0.98 * 480)) * 5
@@ -175,7 +175,7 @@ def test_firmware_law_on_back_solved_plants(axis: int, t98_ms: float) -> None:
 
 
 def test_firmware_law_integer_arithmetic() -> None:
-    # seed-002 §4.5 (C), L5538–L5582, by hand: tick 1 from rest, Ref = -480:
+    # Angel-11 §4.5 (C), L5538–L5582, by hand: tick 1 from rest, Ref = -480:
     # INTE = 480·28 = 13440, u = (0 + 13440 − 0)/1000 = 13 -> -13 (sign of Ref).
     ctrl = FirmwareIP()
     assert ctrl.step(-480, 0, 0.0) == -13
@@ -200,7 +200,7 @@ def test_ideal_law_needs_gains() -> None:
 
 
 def test_star_closure_by_chunk_arithmetic() -> None:
-    # seed-002 §4.2 (D)1 and R14 test: floor(d/2) chunks give (+0.4, −0.2) mm.
+    # Angel-11 §4.2 (D)1 and R14 test: floor(d/2) chunks give (+0.4, −0.2) mm.
     assert chunk_closure_mm(STAR).tolist() == pytest.approx([0.4, -0.2], abs=1e-12)
 
 
@@ -278,7 +278,7 @@ def test_closure_is_the_chunk_rule_for_both_laws(controller: str) -> None:
 
 
 def test_segment_1_tracking_deviation_per_axis_vs_identical_plants() -> None:
-    # seed-002 §5.2 (D) rough simulation, star segment 1 (X 480, Y 345), no start skew:
+    # Angel-11 §5.2 (D) rough simulation, star segment 1 (X 480, Y 345), no start skew:
     # ≈ 0.03 mm with the back-solved per-axis plants, ≈ 0.0003 mm with identical plants.
     # This model: 0.0318 mm and 0.00026 mm.
     x, y, z = per_axis_plants()
@@ -321,7 +321,7 @@ def test_segment_deviation_of_a_known_path() -> None:
 
 
 def test_carried_integrator_makes_a_slow_axis_lurch() -> None:
-    # seed-002 §4.5 (C): INTE is never reset. Star segment 3 (X at −77) after segment 2
+    # Angel-11 §4.5 (C): INTE is never reset. Star segment 3 (X at −77) after segment 2
     # (X at +480) starts with X's integrator wound up: u = 100 % for a few samples, and the
     # path is offset ≈ 0.14 mm; the same segment as the first of a job is off < 0.001 mm.
     m = RouterMachine(start_skew_s=0.0)
@@ -344,11 +344,11 @@ def test_coast_overrun_is_the_plant_geometric_series() -> None:
     coast = w_done * p * (1 - p ** (nxt - done)) / (1 - p)
     assert x[nxt] - x[done] == pytest.approx(coast, rel=1e-9)
     assert x[done] - x[0] >= 50 * 5120  # the count was reached
-    assert coast / CPM > 0.15  # seed-002 §4.2 (D)5: coasting is not compensated
+    assert coast / CPM > 0.15  # Angel-11 §4.2 (D)5: coasting is not compensated
 
 
 def test_qei_bookkeeping_loses_the_start_angle_on_reversal() -> None:
-    # seed-002 §4.2 (D)3–4 with the listing's loops (L5625–L5711), analytic:
+    # Angel-11 §4.2 (D)3–4 with the listing's loops (L5625–L5711), analytic:
     # Posi = conv + 1023·k exits a `<= 5120` chunk at counter advance S = 5126 and the
     # final `< 5120` loop at S = 5125. +X 1.0 mm from angle 0: 5126 + 3·5120 + (5125 − 6)
     # = 25605 counts, ending at angle 5. −X 1.0 mm: Posi starts at 1023 − 5 = 1018, so it
@@ -359,7 +359,7 @@ def test_qei_bookkeeping_loses_the_start_angle_on_reversal() -> None:
 
 
 def test_listing_decel_speeds_up_a_slow_axis() -> None:
-    # seed-002 L5703: Ref = Tabla[q] whatever the segment speed; star segment 3 moves X at
+    # Angel-11 L5703: Ref = Tabla[q] whatever the segment speed; star segment 3 moves X at
     # -77 counts/Ts, and the table (up to 480) drives it faster over its last 1000 counts.
     def last_x_speeds(decel: str) -> np.ndarray:
         tr = simulate_job(STAR[:4], RouterMachine(decel=decel))  # type: ignore[arg-type]
@@ -371,7 +371,7 @@ def test_listing_decel_speeds_up_a_slow_axis() -> None:
 
 
 def test_underflow_and_zero_speed_are_warned() -> None:
-    # seed-002 §4.2 (D)2: d = 1 underflows factor − 1 (runaway); a minor speed that rounds
+    # Angel-11 §4.2 (D)2: d = 1 underflows factor − 1 (runaway); a minor speed that rounds
     # to 0 (480·2/2000 = 0.48) leaves Ref = 0 and the move never ends.
     tr = simulate_job([(0, 0), (1, 100), (2001, 102)])
     assert len(tr.warnings) == 2
@@ -414,7 +414,7 @@ def test_negative_backlash_is_rejected(star_trace) -> None:  # type: ignore[no-u
 def test_each_strokes_measures_start_where_the_positioning_left_the_carriage() -> None:
     """Two squares 30 mm apart: the second's closure and size are its own, not the gap.
 
-    The router moves to each job's first point X then Y (seed-002 R13); that point,
+    The router moves to each job's first point X then Y (Angel-11 R13); that point,
     not the end of the stroke before, is where the second contour starts.
     """
     from camtool.model.program import Linear, Program, Rapid

@@ -1,4 +1,4 @@
-"""The pic-mmh dialect against seed-000 §3 (S000-01…08, Tablas 21-22)."""
+"""The pic-mmh dialect against UNAM-GMM §3 (S000-01…08, Tablas 21-22)."""
 
 from __future__ import annotations
 
@@ -36,7 +36,7 @@ from tests.shapes import golden_arc_dxf
 SAMPLES = Path(__file__).parents[2] / "samples"
 GOLDEN = Path(__file__).parents[1] / "golden" / "pic-mmh"
 
-# seed-000 §3.6, the inferred grammar, for the blocks a toolpath uses.
+# UNAM-GMM §3.6, the inferred grammar, for the blocks a toolpath uses.
 COORD = r"[+-]?\d{5}\.\d{2}"
 GRAMMAR = re.compile(
     rf"^(G00X{COORD}Y{COORD}"
@@ -47,7 +47,7 @@ GRAMMAR = re.compile(
 
 
 def test_golden_block_seed000_l1731(tmp_path: Path) -> None:
-    # seed-000 L1731 / S000-04: CW arc centred (3.012, 3.040) mm ending (2.969, 3.400) mm, F08.
+    # UNAM-GMM L1731 / S000-04: CW arc centred (3.012, 3.040) mm ending (2.969, 3.400) mm, F08.
     job = post_file(golden_arc_dxf(tmp_path / "arc.dxf"), "pic-mmh", PlanOptions(feed_mm_min=0.8))
     lines = str(job.result.code).splitlines()
     assert "G02X02969.00Y03400.00I03012.00J03040.00F08;" in lines
@@ -188,7 +188,7 @@ SQUARE = (Rapid(1, 1, contour=1), Linear(2, 1, 0.8, contour=1), Linear(2, 2, 0.8
 
 
 def test_every_command_in_the_thesis_syntax() -> None:
-    # seed-000 Tabla 22 (L3418-L3471) `M03S____;` `M04S____;` `M05;` `M06T__;`, Tabla 21
+    # UNAM-GMM Tabla 22 (L3418-L3471) `M03S____;` `M04S____;` `M05;` `M06T__;`, Tabla 21
     # (L3359-L3386) `G04P__;` and `G28X0Y0;     ó     G28Z0;`, each before the move it precedes.
     commands: tuple[tuple[int, Command], ...] = (
         (0, ToolChange(3)),
@@ -235,7 +235,7 @@ def test_commands_read_back_at_their_index() -> None:
 
 
 def test_home_xyz_is_z_first_then_xy() -> None:
-    # seed-000 §7 (L1698-L1705): "primero se desplaza el eje Z, enseguida el eje X, y por
+    # UNAM-GMM §7 (L1698-L1705): "primero se desplaza el eje Z, enseguida el eje X, y por
     # último el eje Y"; the dialect homes X and Y together (Tabla 21, L3375-L3386).
     lines = str(_post(Program(SQUARE, commands=((0, Home("XYZ")),))).code).splitlines()
     assert lines[2:4] == ["G28Z0;", "G28X0Y0;"]
@@ -277,7 +277,7 @@ def test_a_cut_right_after_g28_xy_is_refused_a_rapid_first_is_fine() -> None:
 def test_dwell_is_whole_seconds_two_digits(
     seconds: float, blocks: list[str], warnings: list[str]
 ) -> None:
-    # seed-000 Tabla 21 (L3359-L3366): `G04P__;`, P "en segundos y de 2 dígitos".
+    # UNAM-GMM Tabla 21 (L3359-L3366): `G04P__;`, P "en segundos y de 2 dígitos".
     result = _post(Program(SQUARE, commands=((1, Dwell(seconds)),)))
     lines = str(result.code).splitlines()
     assert lines[3 : 3 + len(blocks)] == blocks
@@ -420,7 +420,7 @@ def test_round_trip_random_programs_with_commands(
 
 
 def test_default_feed_table_is_the_firmware_formula() -> None:
-    # seed-000 §4.9: F in units of 0.1 mm/min, F01-F99; F08 = 0.8 mm/min (L1731).
+    # UNAM-GMM §4.9: F in units of 0.1 mm/min, F01-F99; F08 = 0.8 mm/min (L1731).
     table = FeedTable.linear()
     assert table.lowest == (1, pytest.approx(0.1)) and table.highest == (99, pytest.approx(9.9))
     assert table.feed_of(8) == pytest.approx(0.8)
@@ -518,7 +518,7 @@ def test_step_rate_warning_names_blocks_contours_and_the_effective_feed() -> Non
 
 
 def test_line_length_warning_is_off_by_default_and_counts_the_semicolon() -> None:
-    # S000-07 / seed-000 §2.4: the receive vector holds 35 characters (L1740) but the
+    # S000-07 / UNAM-GMM §2.4: the receive vector holds 35 characters (L1740) but the
     # thesis's own G02 block (L1731) has 43, so the check is an opt-in warning.
     arc = (Rapid(3.012 - 0.36256, 3.040), ArcMove(2.969, 3.4, 3.012, 3.040, True, 0.8))
     assert _post(Program(arc)).warnings == ()
@@ -537,7 +537,7 @@ def test_logo_with_commands_verifies_and_dwell_counts_in_the_time() -> None:
     # The verifier reads the code back with this reader; the dwell read from `G04P05;`
     # adds its 5 s to the predicted time (verifier.Verification.dwell_s). The DSM/DDA
     # interpolators at 140 nm/step keep the path within a few steps of the ideal
-    # (seed-000 Tabla 7: ≤ 1 BLU = 0.14 µm per interpolator; backlash residuals aside).
+    # (UNAM-GMM Tabla 7: ≤ 1 BLU = 0.14 µm per interpolator; backlash residuals aside).
     target = load_target("pic-mmh")
     job = post_file(SAMPLES / "logo.dxf", "pic-mmh")
     program = job.program
@@ -581,7 +581,7 @@ def test_large_radius_arc_becomes_chords_with_a_warning(tolerance: float) -> Non
 
 
 def test_arc_with_a_centre_in_the_field_stays_an_arc() -> None:
-    # The thesis block (seed-000 L1731): centre (3.012, 3.040) mm fits; no chords, no warning.
+    # The thesis block (UNAM-GMM L1731): centre (3.012, 3.040) mm fits; no chords, no warning.
     r = math.dist((2.969, 3.400), (3.012, 3.040))
     program = Program((Rapid(3.012 - r, 3.04), ArcMove(2.969, 3.4, 3.012, 3.04, True, 0.8)))
     target = load_target("pic-mmh")

@@ -1,4 +1,4 @@
-"""Mode strings of the pic-mmh host link against seed-000 §3.1-§3.2 (Tabla 23, S000-10)."""
+"""Mode strings of the pic-mmh host link against UNAM-GMM §3.1-§3.2 (Tabla 23, S000-10)."""
 
 from __future__ import annotations
 
@@ -61,7 +61,7 @@ def test_thesis_strings_parse_and_build_verbatim(text: str, mode: ModeString, wh
     ],
 )
 def test_parser_reads_as_the_firmware(text: str, mode: ModeString) -> None:
-    # seed-000 §3.1 (Fig. 37, L1747-L1770): first character selects the mode, "obtén
+    # UNAM-GMM §3.1 (Fig. 37, L1747-L1770): first character selects the mode, "obtén
     # sentido de giro" tests only for '-', then "esperar fin de línea".
     assert parse_mode(text) == mode
 
@@ -125,7 +125,7 @@ def test_builder_refuses_out_of_range_values(build: object, message: str) -> Non
 
 
 def test_backlash_command_from_the_thesis_compensations() -> None:
-    # seed-000 §5.2: final compensation X 204 µm, Y 178 µm (L2486-L2490); the first pass
+    # UNAM-GMM §5.2: final compensation X 204 µm, Y 178 µm (L2486-L2490); the first pass
     # used 192.5 / 168.5 µm, which a 3-digit field can only carry rounded (half up).
     assert backlash_command("X", 200) == "BX200;"  # L3492
     assert backlash_command("x", 204.0) == "BX204;"

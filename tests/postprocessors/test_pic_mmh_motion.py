@@ -1,7 +1,7 @@
-"""Tests of the seed-000 pic-mmh timing model (camtool_postprocessors.pic_mmh_motion).
+"""Tests of the UNAM-GMM pic-mmh timing model (camtool_postprocessors.pic_mmh_motion).
 
 Every expected value names its source: a section/requirement of
-../shared/reference/seed-00N.md, or "analytic" for a property of the model's formula.
+docs/references.md, or "analytic" for a property of the model's formula.
 """
 
 from __future__ import annotations
@@ -35,11 +35,11 @@ def test_model_calls_its_function():
     assert np.array_equal(t, direct(b))
 
 
-MMH_STEP_MM = 140e-6  # seed-000 S000-12: 140 nm/step
+MMH_STEP_MM = 140e-6  # UNAM-GMM S000-12: 140 nm/step
 
 
 def test_pic_mmh_f08_is_95_hz():
-    # seed-000 §4.9: F08 = 0.8 mm/min at 140 nm/step → f = 7142.857·0.8/60 = 95.2 Hz
+    # UNAM-GMM §4.9: F08 = 0.8 mm/min at 140 nm/step → f = 7142.857·0.8/60 = 95.2 Hz
     rate = pic_mmh_step_rate_hz([0.8], FALSE)
     assert_seconds(rate, 1)
     assert round(float(rate[0]), 1) == 95.2
@@ -47,14 +47,14 @@ def test_pic_mmh_f08_is_95_hz():
 
 @pytest.mark.parametrize(("feed_word", "capped"), [(13, False), (14, True), (99, True)])
 def test_pic_mmh_cap_at_166_hz(feed_word, capped):
-    # seed-000 S000-05: with F in 0.1 mm/min units only F <= 13 stays under 166 Hz
+    # UNAM-GMM S000-05: with F in 0.1 mm/min units only F <= 13 stays under 166 Hz
     rate = float(pic_mmh_step_rate_hz([feed_word * 0.1], FALSE)[0])
     assert (rate == 166.0) is capped
     assert rate <= 166.0
 
 
 def test_pic_mmh_x_backlash_take_up_is_8_8_s():
-    # seed-000 §5.1 / S000-17: X 204 µm ≈ 1457 steps, one take-up at 166 Hz ≈ 8.8 s;
+    # UNAM-GMM §5.1 / S000-17: X 204 µm ≈ 1457 steps, one take-up at 166 Hz ≈ 8.8 s;
     # a rapid runs at the cap, and so does a feed move whose F exceeds it
     take_up = steps_from_mm(0.204, MMH_STEP_MM)
     assert take_up == 1457
@@ -64,7 +64,7 @@ def test_pic_mmh_x_backlash_take_up_is_8_8_s():
 
 
 def test_pic_mmh_compensation_runs_at_the_block_rate():
-    # seed-000 §5.1 ("at the current step rate"): at F08 (95.2 Hz) the same take-up
+    # UNAM-GMM §5.1 ("at the current step rate"): at F08 (95.2 Hz) the same take-up
     # lasts 1457/95.238 s, and DDA iterations of (3, 4) (6 of them, §4.2) add 6 periods
     it = dda_iterations(3, 4)
     t = pic_mmh_block_time_s([it], [1457], [0.8], FALSE)

@@ -1,4 +1,4 @@
-"""The valcnc target (a TOML word-address dialect) against seed-004 §3.4, S004-R01…R10."""
+"""The valcnc target (a TOML word-address dialect) against Munoz-22 §3.4, S004-R01…R10."""
 
 from __future__ import annotations
 
@@ -24,12 +24,12 @@ GOLDEN = ROOT / "tests" / "golden" / "valcnc"
 TARGET = load_target("valcnc")
 POST = TARGET.post
 
-# S004-R01, verbatim from seed-004 §8.
+# S004-R01, verbatim from Munoz-22 §8.
 R01 = re.compile(
     r"^G0[0-3](X-?\d+(\.\d+)?)?(Y-?\d+(\.\d+)?)?(Z-?\d+(\.\d+)?)?(I-?\d+(\.\d+)?)?(J-?\d+(\.\d+)?)?$"
 )
 STEP = 0.04
-"""mm per step: 200 steps/rev, full step, 8 mm lead (seed-004 §2.8, S004-R08)."""
+"""mm per step: 200 steps/rev, full step, 8 mm lead (Munoz-22 §2.8, S004-R08)."""
 
 
 def emit(moves: tuple[Move, ...], **program: object) -> tuple[list[str], tuple[str, ...]]:
@@ -82,7 +82,7 @@ def test_r04_feeds_spindle_and_program_end_are_dropped_and_reported() -> None:
 
 def test_r04_r07_a_gcodetools_program_is_cleaned() -> None:
     # tests/data/gcodetools-circle.ngc: comments, G21, M3/M5, F100.0 and F400.000000,
-    # Z retract and "Z-1" penetration (seed-004 §3.3).
+    # Z retract and "Z-1" penetration (Munoz-22 §3.3).
     program = read_gcode(ROOT / "tests" / "data" / "gcodetools-circle.ngc")
     job = post_program(program, TARGET)
     lines = str(job.result.code).splitlines()

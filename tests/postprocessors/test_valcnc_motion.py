@@ -1,8 +1,8 @@
-"""Tests of the seed-004 valcnc motion model: timing and β chords
+"""Tests of the Munoz-22 valcnc motion model: timing and β chords
 (camtool_postprocessors.valcnc_motion).
 
 Every expected value names its source: a section/requirement of
-../shared/reference/seed-00N.md, or "analytic" for a property of the model's formula.
+docs/references.md, or "analytic" for a property of the model's formula.
 """
 
 from __future__ import annotations
@@ -40,7 +40,7 @@ def test_model_calls_its_function():
 
 
 def test_valcnc_ten_mm_is_41_7_ms():
-    # seed-004 S004-R13: 10 mm at 25 steps/mm = 250 steps = 41.7 ms, and the 10×10
+    # Munoz-22 S004-R13: 10 mm at 25 steps/mm = 250 steps = 41.7 ms, and the 10×10
     # diagonal (250 accumulator-DDA iterations) takes the same time
     n = steps_from_mm(10.0, 0.04)
     iterations = [len(accumulator_dda_line(n, 0)), len(accumulator_dda_line(n, n))]
@@ -50,7 +50,7 @@ def test_valcnc_ten_mm_is_41_7_ms():
 
 
 def test_valcnc_serial_time_at_9600_baud():
-    # seed-004 S004-R13: ≈ 1.04 ms per byte at 9600 baud; a 27-byte block ≈ 28 ms
+    # Munoz-22 S004-R13: ≈ 1.04 ms per byte at 9600 baud; a 27-byte block ≈ 28 ms
     assert float(serial_time_s([1], baud=9600)[0]) == pytest.approx(1.04e-3, abs=5e-6)
     t = valcnc_block_time_s([25], block_bytes=[27], serial_baud=9600)
     assert float(t[0]) == pytest.approx(27 * 10 / 9600 + 25 * 166.667e-6)
@@ -61,21 +61,21 @@ def test_valcnc_serial_time_at_9600_baud():
 
 
 def test_valcnc_arc_points():
-    # seed-004 §4.2: θ0 = atan2(−j, −i); α = 2·asin(C/2R); G02 subtracts β, G03 adds it
+    # Munoz-22 §4.2: θ0 = atan2(−j, −i); α = 2·asin(C/2R); G02 subtracts β, G03 adds it
     beta = math.radians(10)
     pts = valcnc_arc_points((10.0, 0.0), (0.0, 10.0), (0.0, 0.0), False, beta_rad=beta)
     assert len(pts) == 9  # 90° in 10° chords: 8 interior points + the end
     assert pts[0] == pytest.approx((10 * math.cos(beta), 10 * math.sin(beta)))
     assert tuple(pts[-1]) == (0.0, 10.0)
-    # seed-004 §4.2 Consideración 2: the same end point clockwise is a reflex 270° sweep
+    # Munoz-22 §4.2 Consideración 2: the same end point clockwise is a reflex 270° sweep
     assert len(valcnc_arc_points((10.0, 0.0), (0.0, 10.0), (0.0, 0.0), True, beta_rad=beta)) == 27
-    # seed-004 §4.2 pitfall: start == end gives C = 0, α = 0, nothing moves
+    # Munoz-22 §4.2 pitfall: start == end gives C = 0, α = 0, nothing moves
     full = valcnc_arc_points((10.0, 0.0), (10.0, 0.0), (0.0, 0.0), True, beta_rad=beta)
     assert full.tolist() == [[10.0, 0.0]]
 
 
 def test_valcnc_quarter_arc_through_the_line_dda():
-    # seed-004 §8 S004-R12: quarter arc R = 10 mm, β for sagitta ≤ 0.02 mm, chords run
+    # Munoz-22 §8 S004-R12: quarter arc R = 10 mm, β for sagitta ≤ 0.02 mm, chords run
     # by the line DDA at 0.04 mm/step stay within 0.02 + 0.04 mm of the true circle
     n = chord_count(10.0, math.pi / 2, 0.02)
     beta = (math.pi / 2) / n

@@ -131,7 +131,7 @@ def test_title_gives_size_and_time_at_programmed_feeds() -> None:
 
 
 def test_title_time_by_the_pic_mmh_timing_model() -> None:
-    # seed-000 S000-17: f = d·F/60 = 7142.857 · 0.8 / 60 = 95.24 Hz, one DDA iteration per
+    # UNAM-GMM S000-17: f = d·F/60 = 7142.857 · 0.8 / 60 = 95.24 Hz, one DDA iteration per
     # step: a 1 mm X line (7143 steps) at F08 takes 7143 / 95.24 = 75.0 s.
     one_mm = Program((Linear(1.0, 0.0, 0.8, contour=1),))
     svg = render_preview(".svg", program=one_mm, target=load_target("pic-mmh"))

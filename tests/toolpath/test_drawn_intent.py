@@ -18,7 +18,7 @@ from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.plan import plan_drawing
 from tests.shapes import GOLDEN_CENTRE, GOLDEN_END, write_dxf
 
-GOLDEN_BLOCK = "G02X02969.00Y03400.00I03012.00J03040.00F08;"  # seed-000 L1731
+GOLDEN_BLOCK = "G02X02969.00Y03400.00I03012.00J03040.00F08;"  # UNAM-GMM L1731
 
 
 def _golden_arc_from(path: Path, start_deg: float) -> Path:

@@ -1,7 +1,7 @@
 """Cutting order: precedence, travel, backlash-aware reversals and mirror ordering.
 
 Expected values are derived in each test from the reversal model of
-camtool.toolpath.reversals (seed-000 §5.1, L1707–L1709: the controller compensates
+camtool.toolpath.reversals (UNAM-GMM §5.1, L1707–L1709: the controller compensates
 "whenever any axis changes direction") and checked against the pic-mmh simulator.
 """
 
@@ -164,7 +164,7 @@ def test_grid_of_holes_reversals_beat_travel_and_drawn(backlash: tuple[float, fl
 
 
 def test_model_matches_the_pic_mmh_compensations_on_lines() -> None:
-    """The mmh-gmm profile compensates every reversal (seed-000 §5.1): the simulated
+    """The mmh-gmm profile compensates every reversal (UNAM-GMM §5.1): the simulated
     reversals and compensation count equal the model's for the planned grid order."""
     cuts, nest = cuts_of(plate_with_grid(3))
     for mode in ("travel", "reversals"):
@@ -319,7 +319,7 @@ def test_reversals_flip_open_cuts_with_reverse_open(reverse_open: bool) -> None:
 
 
 def test_small_part_with_many_reversals_is_warned() -> None:
-    """seed-000 S000-19 (L3205–L3211): under 1 mm, more than 16 compensations fail."""
+    """UNAM-GMM S000-19 (L3205–L3211): under 1 mm, more than 16 compensations fail."""
     holes = [
         rect(0.1 + 0.2 * i, 0.1 + 0.2 * j, 0.2 + 0.2 * i, 0.2 + 0.2 * j)
         for i in range(4)
@@ -429,7 +429,7 @@ def test_mirror_of_an_asymmetric_drawing_names_the_cut() -> None:
 
 
 def test_mirror_order_makes_mirrored_features_equal_under_residual_backlash(tmp_path: Path) -> None:
-    """seed-000 S000-20 (L2816–L2841): h/j asymmetry 59 → 3 µm on the thesis's puma.
+    """UNAM-GMM S000-20 (L2816–L2841): h/j asymmetry 59 → 3 µm on the thesis's puma.
 
     This is not the puma, so only the reduction is expected. The machine keeps 100 µm of X
     backlash uncompensated (true 204, compensation 104 µm, uniform). The carriage then sits

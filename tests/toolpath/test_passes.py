@@ -1,7 +1,7 @@
 """Emitting moves: splitting, 2D moves, depth passes, safe Z, ramps, tabs and lead arcs.
 
 Expectations are analytic (lengths, slopes, tangents, areas); the one thesis number
-is seed-004's cut depth of −1 mm (reference/seed-004.md, §"Gcodetools" step 14, L446).
+is Munoz-22's cut depth of −1 mm (reference/Munoz-22.md, §"Gcodetools" step 14, L446).
 """
 
 from __future__ import annotations
@@ -162,7 +162,7 @@ def test_pass_depths() -> None:
     # 0.3 / 0.1 = 2.9999999999999996 in floats: still 3 passes, the last exactly −0.3
     assert pass_depths(0.3, 0.1) == pytest.approx((-0.1, -0.2, -0.3))
     assert len(pass_depths(0.3, 0.1)) == 3 and pass_depths(0.3, 0.1)[-1] == -0.3
-    # seed-004 (Gcodetools step 14, L446): one pass at the thesis's cut depth Z = −1 mm
+    # Munoz-22 (Gcodetools step 14, L446): one pass at the thesis's cut depth Z = −1 mm
     assert pass_depths(1.0, None) == (-1.0,)
 
 

@@ -125,11 +125,11 @@ def replaced(argv: list[str], remedy: list[str]) -> list[str]:
 def test_machine_coordinates_refuse_with_remedies_that_work(
     placing: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    # The seed-002 router counts from its home: X 0…200, Y 0…200 mm.
+    # The Angel-11 router counts from its home: X 0…200, Y 0…200 mm.
     argv = [str(plate(tmp_path / "p.dxf")), "-t", "matlab-router", *OUTSIDE, *placing]
     code, err = post([*argv, "-o", str(tmp_path / "refused.m")], capsys)
     assert code == 1
-    assert "outside the work area X 0…200, Y 0…200 mm of Router (seed-002, 2011)" in err
+    assert "outside the work area X 0…200, Y 0…200 mm of Router (Angel-11, 2011)" in err
     assert "machine coordinates" in err
     suggested = remedies(err)
     assert len(suggested) == 2, err

@@ -52,7 +52,7 @@ def test_lead_in_refused_on_a_chord_only_target() -> None:
 
 
 def test_ramp_refused_where_z_has_its_own_block() -> None:
-    # flashcut writes "G01 Z…" alone (seed-001 R7): it cannot descend along the path.
+    # flashcut writes "G01 Z…" alone (Yanez-07 R7): it cannot descend along the path.
     with pytest.raises(UsageError, match="--ramp: flashcut moves Z in a block of its own"):
         post_drawing(_plate(), load_target("flashcut"), PlanOptions(depth=0.2, ramp_angle_deg=5.0))
 
@@ -85,7 +85,7 @@ def test_dense_polyline_becomes_arcs_and_the_saving_is_reported() -> None:
 
 
 def test_sharp_polygons_are_not_fitted() -> None:
-    # The seed-002 star (§3, L3196–L3200) keeps its ten straight edges: ten lines are a run
+    # The Angel-11 star (§3, L3196–L3200) keeps its ten straight edges: ten lines are a run
     # long enough to be tried, but every vertex turns far more than the corner angle, and
     # its lxy arrays (L3212–L3228) are golden values of the matlab-router tests.
     xs, ys = STAR_XY_01MM

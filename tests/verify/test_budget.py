@@ -35,7 +35,7 @@ def _circle10() -> Program:
 
 
 def test_budget_scale_share_of_a_circle_is_d_times_k_minus_1() -> None:
-    """seed-001 R14: the app assumes 1.9 µm/step, the machine makes 1.88 µm.
+    """Yanez-07 R14: the app assumes 1.9 µm/step, the machine makes 1.88 µm.
 
     Without backlash the carriage with the scale on is the carriage with it off
     times k = nominal/true steps/mm (same motor rows), and a least-squares circle
@@ -123,7 +123,7 @@ def test_ideal_controller_follows_lines_and_native_arcs_exactly() -> None:
     assert math.dist(end, (2.0001, 2.2)) < 1e-9  # no rounding of the end to whole steps
 
 
-# seed-000 §5.2: the U pattern (two 2.5 mm lines along X joined by a 1 mm line); on the
+# UNAM-GMM §5.2: the U pattern (two 2.5 mm lines along X joined by a 1 mm line); on the
 # return leg an uncompensated X backlash of 190 µm (Tabla 13, figure A) is taken up by the
 # motor while the carriage stands, so the leg ends 190 µm short of X = 1.
 U_CODE = (
@@ -197,7 +197,7 @@ def test_no_budget_skips_the_resimulation(
 
 
 def test_pic_mmh_warns_about_the_166_hz_cap_by_line() -> None:
-    """seed-000 §2.4/§4.9: f = d·F/60 at d = 1e6/140 steps/mm; F13 = 1.3 mm/min asks
+    """UNAM-GMM §2.4/§4.9: f = d·F/60 at d = 1e6/140 steps/mm; F13 = 1.3 mm/min asks
     154.8 Hz (under 166 Hz), F14 = 1.4 mm/min asks 166.7 Hz (capped)."""
     target = load_target("pic-mmh")
     code = (
@@ -208,7 +208,7 @@ def test_pic_mmh_warns_about_the_166_hz_cap_by_line() -> None:
     capped = [w for w in v.warnings if "step-rate cap" in w]
     assert len(capped) == 2  # one per feed: F14 on line 5, F20 on line 6
     assert capped[0].startswith("line 5: feed 1.4 mm/min asks 166.7 Hz")
-    assert "166 Hz" in capped[0] and "seed-000" in capped[0]
+    assert "166 Hz" in capped[0] and "UNAM-GMM" in capped[0]
     assert capped[1].startswith("line 6: feed 2 mm/min asks 238.1 Hz")
     assert not any("line 4" in w for w in capped)
 
@@ -224,7 +224,7 @@ def test_trapezoid_warns_when_a_feed_is_over_the_maximum_rate() -> None:
 
 
 def test_time_s_keeps_six_significant_digits() -> None:
-    """seed-004: ValCNC takes 166.667 µs per DDA iteration, so 7 steps take 1.167 ms."""
+    """Munoz-22: ValCNC takes 166.667 µs per DDA iteration, so 7 steps take 1.167 ms."""
     assert seconds_6(7 * 166.667e-6) == pytest.approx(7 * 166.667e-6, rel=1e-5)
     assert seconds_6(0.0007352941) == 0.000735294  # 6 significant digits
     assert seconds_6(172.5123456) == 172.512  # 6 significant digits, 3 decimals
@@ -240,7 +240,7 @@ def test_time_s_keeps_six_significant_digits() -> None:
 
 
 def test_every_contour_has_its_end_error() -> None:
-    """Two U patterns (seed-000 §5.2), each ending 190 µm short on its return leg."""
+    """Two U patterns (UNAM-GMM §5.2), each ending 190 µm short on its return leg."""
     target = load_target("pic-mmh")
     lash = Backlash(true_um=(190.0, 0.0, 0.0), compensation_um=(0.0, 0.0, 0.0))
     machine = dataclasses.replace(target.machine, backlash=lash)
@@ -264,7 +264,7 @@ def test_measure_budget_tells_each_source_it_re_simulates() -> None:
 
     The flashcut profile as shipped models five sources for the circle: interpolation,
     chords (an arc cut in chords), the steps/mm scale (1.9 assumed, 1.88 µm real),
-    backlash (654 µm true, seed-001) and dynamics (the timer); the rounding is unknown
+    backlash (654 µm true, Yanez-07) and dynamics (the timer); the rounding is unknown
     from code alone. So five steps, ``done`` 0 to 4 of 5.
     """
     from camtool.model.progress import Step

@@ -1,6 +1,6 @@
 """Tests of the verifier's interpolators against the thesis notes and analytic facts.
 
-Every expected value names its source: a table/section of ../shared/reference/seed-00N.md,
+Every expected value names its source: a table/section of docs/references.md,
 or "analytic" for a property that follows from the geometry or the algorithm's definition.
 """
 
@@ -45,7 +45,7 @@ small = st.integers(min_value=-300, max_value=300)
 
 
 def pattern(steps: np.ndarray) -> str:
-    """seed-000 §4.2 notation: X, Y, XY per iteration, '-' without a pulse."""
+    """UNAM-GMM §4.2 notation: X, Y, XY per iteration, '-' without a pulse."""
     return " ".join(("X" if a else "") + ("Y" if b else "") or "-" for a, b in steps)
 
 
@@ -66,16 +66,16 @@ def radial_error(steps: np.ndarray, start: tuple[int, int], centre: tuple[int, i
     return float(np.max(np.abs(np.hypot(pos[:, 0], pos[:, 1]) - r)))
 
 
-# ------------------------------------------------------------------ linear DDA, seed-000
+# ------------------------------------------------------------------ linear DDA, UNAM-GMM
 
 
 @pytest.mark.parametrize(
     ("dx", "dy", "expected"),
     [
-        (3, 4, "- XY Y XY - XY"),  # seed-000 §4.2 test vectors table
-        (5, 0, "- X X X X X"),  # seed-000 §4.2 test vectors table
-        (10, 3, "- X X XY X X XY X X X XY"),  # seed-000 §4.2 / §9 S000-13
-        (7, 7, "- XY XY - XY XY - XY XY XY"),  # seed-000 §4.2 test vectors table
+        (3, 4, "- XY Y XY - XY"),  # UNAM-GMM §4.2 test vectors table
+        (5, 0, "- X X X X X"),  # UNAM-GMM §4.2 test vectors table
+        (10, 3, "- X X XY X X XY X X X XY"),  # UNAM-GMM §4.2 / §9 S000-13
+        (7, 7, "- XY XY - XY XY - XY XY XY"),  # UNAM-GMM §4.2 test vectors table
     ],
 )
 @pytest.mark.parametrize("line", [dda_line, dda_line_reference])
@@ -86,7 +86,7 @@ def test_dda_golden_patterns(line, dx, dy, expected):
 
 
 def test_dda_golden_iteration_counts():
-    # seed-000 §4.2 table: (3,4) → 6, (5,0) → 6, (10,3) → 11, (7,7) → 10 iterations
+    # UNAM-GMM §4.2 table: (3,4) → 6, (5,0) → 6, (10,3) → 11, (7,7) → 10 iterations
     assert [len(dda_line(*d)) for d in [(3, 4), (5, 0), (10, 3), (7, 7)]] == [6, 6, 11, 10]
 
 
@@ -116,7 +116,7 @@ def test_dda_vectorised_equals_reference_large_and_ties(dx, dy):
 
 @given(small, small)
 def test_dda_iterations_is_floor_hipo_plus_one(dx, dy):
-    # analytic (seed-000 §4.2 notes: "about L iterations per segment")
+    # analytic (UNAM-GMM §4.2 notes: "about L iterations per segment")
     expected = 0 if dx == dy == 0 else math.isqrt(dx * dx + dy * dy) + 1
     assert dda_iterations(dx, dy) == expected == len(dda_line(dx, dy))
 
@@ -140,11 +140,11 @@ def test_lines_end_exactly_at_the_target(line, dx, dy):
     assert tuple(int(v) for v in steps.astype(np.int64).sum(axis=0)) == (dx, dy)
 
 
-# ------------------------------------------------------------ accumulator DDA, seed-004
+# ------------------------------------------------------------ accumulator DDA, Munoz-22
 
 
 def test_accumulator_dda_reproduces_table_8():
-    # seed-004 §4.1 Table 8 (L1241–L1250): 7 steps in X, 3 in Y; columns
+    # Munoz-22 §4.1 Table 8 (L1241–L1250): 7 steps in X, 3 in Y; columns
     # iteration, X travelled, Y travelled, CUENTA
     expected = [
         [1, 1, 0, 3],
@@ -166,7 +166,7 @@ def test_accumulator_dda_vectorised_equals_reference(dx, dy):
 
 
 def test_accumulator_dda_timing_example():
-    # seed-004 §8 S004-R13: a 10 mm single-axis move = 250 steps (25 steps/mm) = 41.7 ms
+    # Munoz-22 §8 S004-R13: a 10 mm single-axis move = 250 steps (25 steps/mm) = 41.7 ms
     # at 166.667 µs per iteration; a 10×10 mm diagonal also takes 41.7 ms
     n = steps_from_mm(10.0, 0.04)
     assert n == 250
@@ -175,7 +175,7 @@ def test_accumulator_dda_timing_example():
 
 
 def test_accumulator_dda_minor_axis_lags():
-    # seed-004 §4.1 [derived]: the accumulator starts at 0, so the minor axis never
+    # Munoz-22 §4.1 [derived]: the accumulator starts at 0, so the minor axis never
     # leads the ideal line: minor travelled = floor(n·minor/major)
     table = accumulator_dda_table(-13, 5)
     n = table[:, 0]
@@ -208,23 +208,23 @@ def test_bresenham_visits_the_nearest_lattice_point(dx, dy):
     assert len(steps) == big  # one iteration per major-axis step
 
 
-# ------------------------------------------------------------------- corte recto, seed-003
+# ------------------------------------------------------------------- corte recto, Intf8751
 
 
 def test_corte_recto_golden():
-    # seed-003 §9 R10: (100, 50) visits (50, 50); max deviation 22.36 steps;
+    # Intf8751 §9 R10: (100, 50) visits (50, 50); max deviation 22.36 steps;
     # (100, 100) and (100, 0) have zero deviation
     assert (50, 50) in path(corte_recto_line(100, 50), (0, 0))
     assert corte_recto_max_deviation(100, 50) == pytest.approx(22.36, abs=0.005)
     assert corte_recto_max_deviation(100, 100) == 0.0
     assert corte_recto_max_deviation(100, 0) == 0.0
-    # seed-003 §4.2: "(100, 50) gives 22.4 steps"
+    # Intf8751 §4.2: "(100, 50) gives 22.4 steps"
     assert round(corte_recto_max_deviation(100, 50), 1) == 22.4
 
 
 @given(small, small)
 def test_corte_recto_deviation_is_the_worst_visited_point(dx, dy):
-    # analytic: the formula of seed-003 §4.2 equals the largest distance of the
+    # analytic: the formula of Intf8751 §4.2 equals the largest distance of the
     # visited lattice points from the ideal segment
     steps = corte_recto_line(dx, dy)
     assert np.array_equal(steps, corte_recto_reference(dx, dy))
@@ -242,13 +242,13 @@ def test_corte_recto_deviation_is_the_worst_visited_point(dx, dy):
 
 
 def test_steps_from_mm_seed001_golden():
-    # seed-001 §4.5 / §10 R8: 10 mm → 5263 and 5 mm → 2632 steps at 1.9 µm/step
+    # Yanez-07 §4.5 / §10 R8: 10 mm → 5263 and 5 mm → 2632 steps at 1.9 µm/step
     for rounding in ("half_even", "half_up"):
         assert steps_from_mm(10.0, 0.0019, rounding) == 5263
         assert steps_from_mm(5.0, 0.0019, rounding) == 2632
-    # seed-001 §4.5: truncation would give 2631 (the thesis' values rule it out)
+    # Yanez-07 §4.5: truncation would give 2631 (the thesis' values rule it out)
     assert steps_from_mm(5.0, 0.0019, "trunc") == 2631
-    # seed-001 §4.5: 345.27 µm → 182 steps at 1.9 µm
+    # Yanez-07 §4.5: 345.27 µm → 182 steps at 1.9 µm
     assert steps_from_mm(0.34527, 0.0019) == 182
 
 
@@ -261,7 +261,7 @@ def test_steps_from_mm_rules():
     assert steps_from_mm(-0.00095, 0.0019, "half_up") == -1  # halves away from zero
     assert steps_from_mm(-0.001, 0.0019, "floor") == -1
     assert steps_from_mm(-0.001, 0.0019, "trunc") == 0
-    assert steps_from_mm(8.0, 0.04) == 200  # seed-004 §8 S004-R08: 8 mm → 200 steps
+    assert steps_from_mm(8.0, 0.04) == 200  # Munoz-22 §8 S004-R08: 8 mm → 200 steps
 
 
 @pytest.mark.parametrize(
@@ -273,16 +273,16 @@ def test_steps_from_mm_rejects_bad_arguments(value, step, rounding):
         steps_from_mm(value, step, rounding)
 
 
-# ------------------------------------------------------------------- arcs, seed-000
+# ------------------------------------------------------------------- arcs, UNAM-GMM
 
 
 @pytest.mark.parametrize(
     ("arc", "radius", "iterations"),
     [
-        (staircase_arc, 30, 240),  # seed-000 §4.7 Tabla 7
-        (circular_dda_arc, 30, 188),  # seed-000 §4.7 Tabla 7
-        (dsm_arc, 30, 168),  # seed-000 §4.7 Tabla 7, §9 S000-14
-        (staircase_arc, 5, 40),  # seed-000 §4.7 further reference values
+        (staircase_arc, 30, 240),  # UNAM-GMM §4.7 Tabla 7
+        (circular_dda_arc, 30, 188),  # UNAM-GMM §4.7 Tabla 7
+        (dsm_arc, 30, 168),  # UNAM-GMM §4.7 Tabla 7, §9 S000-14
+        (staircase_arc, 5, 40),  # UNAM-GMM §4.7 further reference values
         (circular_dda_arc, 5, 36),
         (dsm_arc, 5, 28),
         (staircase_arc, 10, 80),
@@ -302,13 +302,13 @@ def test_full_circle_iteration_counts(arc, radius, iterations):
 @pytest.mark.parametrize(
     ("arc", "radius", "max_error"),
     [
-        (staircase_arc, 5, 0.88),  # seed-000 §4.7 further reference values (stair/DDA/DSM)
+        (staircase_arc, 5, 0.88),  # UNAM-GMM §4.7 further reference values (stair/DDA/DSM)
         (circular_dda_arc, 5, 0.83),
         (dsm_arc, 5, 0.39),
         (staircase_arc, 10, 0.95),
         (circular_dda_arc, 10, 0.82),
         (dsm_arc, 10, 0.44),
-        (staircase_arc, 30, 0.98),  # seed-000 §4.7 measured at R = 30
+        (staircase_arc, 30, 0.98),  # UNAM-GMM §4.7 measured at R = 30
         (circular_dda_arc, 30, 0.89),
         (dsm_arc, 30, 0.45),
         (staircase_arc, 100, 1.00),
@@ -324,13 +324,13 @@ def test_full_circle_radial_errors(arc, radius, max_error):
 
 
 def test_tabla7_error_bounds_at_r30():
-    # seed-000 §4.7 Tabla 7: max theoretical radial error 140 nm = 1 BLU (staircase,
+    # UNAM-GMM §4.7 Tabla 7: max theoretical radial error 140 nm = 1 BLU (staircase,
     # DDA) and 70 nm = ½ BLU (DSM); §9 S000-14 "≤ 0.5 BLU"
     for arc, bound in [(staircase_arc, 1.0), (circular_dda_arc, 1.0), (dsm_arc, 0.5)]:
         assert radial_error(arc(0, 30, 0, 30, 0, 0, True), (0, 30), (0, 0)) <= bound
 
 
-# seed-000 §4.7 "Per-quadrant paths for R = 5, from (0,5) to (5,0), magnitudes"
+# UNAM-GMM §4.7 "Per-quadrant paths for R = 5, from (0,5) to (5,0), magnitudes"
 R5_STAIRCASE = [(0, 5), (1, 5), (1, 4), (2, 4), (3, 4), (4, 4), (4, 3), (5, 3), (5, 2), (5, 1)]
 R5_STAIRCASE += [(5, 0)]
 R5_DSM = [(0, 5), (1, 5), (2, 5), (3, 4), (4, 3), (5, 2), (5, 1), (5, 0)]
@@ -358,7 +358,7 @@ def test_r5_quadrant_paths(arc, expected):
 
 
 def test_dsm_ties_follow_the_annex():
-    # seed-000 §4.5: D1 = D2 tie goes to X, ties with the diagonal go to a single axis.
+    # UNAM-GMM §4.5: D1 = D2 tie goes to X, ties with the diagonal go to a single axis.
     # At (0, 5) on R = 5, G02: D1 = |0 + 1| = 1, D2 = |0 − 9| = 9, D3 = |−8| = 8 → X.
     # At (4, 3): D1 = |0 + 9| = 9, D2 = |0 − 5| = 5, D3 = |4| = 4 → diagonal to (5, 2).
     visited = path(dsm_arc(0, 5, 5, 0, 0, 0, True), (0, 5))
@@ -404,7 +404,7 @@ def on_circle_arcs(draw):
 @given(on_circle_arcs())
 @settings(max_examples=300)
 def test_dsm_on_circle_end_and_half_step_bound(args):
-    # seed-000 §4.7 Tabla 7 (70 nm = ½ BLU) and §9 S000-14: radial error ≤ 0.5 step;
+    # UNAM-GMM §4.7 Tabla 7 (70 nm = ½ BLU) and §9 S000-14: radial error ≤ 0.5 step;
     # analytic: ends exactly at the end point; equal to the literal transcription
     steps = dsm_arc(*args)
     assert_step_array(steps)
@@ -416,7 +416,7 @@ def test_dsm_on_circle_end_and_half_step_bound(args):
 @given(on_circle_arcs())
 @settings(max_examples=300)
 def test_staircase_on_circle_end_and_one_step_bound(args):
-    # seed-000 §4.7 Tabla 7: 140 nm = 1 BLU; §4.4: one axis per iteration
+    # UNAM-GMM §4.7 Tabla 7: 140 nm = 1 BLU; §4.4: one axis per iteration
     steps = staircase_arc(*args)
     assert_step_array(steps)
     assert path(steps, args[:2])[-1] == args[2:4]
@@ -470,7 +470,7 @@ def test_chord_count():
 def test_polyline_steps_joins_lines():
     pts = np.array([[0, 0], [3, 4], [13, 7]])
     steps = polyline_steps(pts)
-    assert len(steps) == 6 + 11  # seed-000 §4.2: (3,4) → 6 and (10,3) → 11 iterations
+    assert len(steps) == 6 + 11  # UNAM-GMM §4.2: (3,4) → 6 and (10,3) → 11 iterations
     assert tuple(positions(steps)[-1]) == (13, 7)
     with pytest.raises(UsageError):
         polyline_steps(np.array([[0.0, 0.0], [1.0, 1.0]]))

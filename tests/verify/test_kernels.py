@@ -1,7 +1,7 @@
 """The compiled (numba) interpolator paths give exactly the rows of the plain ones.
 
 Expected values are never camtool's compiled output: every case compares the compiled path
-with the literal register loops of seed-000 annex A.3 / A.6 (``*_reference``) or with the
+with the literal register loops of UNAM-GMM annex A.3 / A.6 (``*_reference``) or with the
 numpy / pure-Python path the compiled one replaces, on thousands of random cases and the
 edge cases (zero-length, one axis, 45°, integer HIPO, negative, large).
 """
@@ -74,7 +74,7 @@ EDGE_LINES = [
 
 @pytest.mark.parametrize(("dx", "dy"), EDGE_LINES)
 def test_dda_edges_equal_the_a3_register_loop(dx: int, dy: int) -> None:
-    """Analytic (seed-000 A.3): the compiled DDA is the register loop, row for row."""
+    """Analytic (UNAM-GMM A.3): the compiled DDA is the register loop, row for row."""
     fast = itp.dda_line(dx, dy)
     assert not fast.flags.writeable
     assert _same(fast, itp.dda_line_numpy(dx, dy))
@@ -138,13 +138,13 @@ def _arc_cases(count: int, seed: int) -> Iterator[tuple[int, int, int, int, int,
 
 
 def test_dsm_thousands_of_random_arcs_equal_the_a6_transcription() -> None:
-    """Analytic (seed-000 A.6): compiled DSM == the literal transcription on 3000 arcs."""
+    """Analytic (UNAM-GMM A.6): compiled DSM == the literal transcription on 3000 arcs."""
     for case in _arc_cases(3000, seed=6):
         assert _same(itp.dsm_arc(*case), itp.dsm_arc_reference(*case)), case
 
 
 def test_staircase_and_dsm_random_arcs_equal_the_python_loops() -> None:
-    """Analytic (seed-000 A.5/A.6): compiled quadrant loops == the Python ones."""
+    """Analytic (UNAM-GMM A.5/A.6): compiled quadrant loops == the Python ones."""
     for case in _arc_cases(2000, seed=5):
         for fn in (itp.staircase_arc, itp.dsm_arc):
             assert _same(fn(*case), _plain(fn, *case)), (fn.__name__, case)
@@ -153,7 +153,7 @@ def test_staircase_and_dsm_random_arcs_equal_the_python_loops() -> None:
 @pytest.mark.parametrize("radius", [1, 2, 30, 1000, 200_000])
 @pytest.mark.parametrize("clockwise", [True, False])
 def test_full_circles_edges(radius: int, clockwise: bool) -> None:
-    """seed-000 §4.7 Tabla 7 circles and large ones: compiled == plain, start on each axis."""
+    """UNAM-GMM §4.7 Tabla 7 circles and large ones: compiled == plain, start on each axis."""
     for x0, y0 in ((radius, 0), (0, radius), (-radius, 0), (0, -radius)):
         case = (x0 + 7, y0 - 3, x0 + 7, y0 - 3, 7, -3, clockwise)
         for fn in (itp.staircase_arc, itp.dsm_arc):

@@ -1,6 +1,6 @@
 """The step simulation of emitted programs: the thesis figures, end to end.
 
-Expected values come from ../shared/reference/ (the section is named in each test);
+Expected values come from docs/references.md (the thesis and section is named in each test);
 machine profiles are the built-in ones in postprocessors/*.toml ([machine] tables).
 """
 
@@ -51,11 +51,11 @@ GMM = profile("mmh-gmm")
 STEP_GMM = 1.0 / GMM.steps_per_mm[0]  # 140 nm
 
 
-# --------------------------------------------------------------- seed-000 interpolators
+# --------------------------------------------------------------- UNAM-GMM interpolators
 
 
 def test_dda_line_3_4_takes_six_iterations_through_the_simulator() -> None:
-    """seed-000 §4.2 (S000-13): (3, 4) steps -> 6 iterations '- XY Y XY - XY'."""
+    """UNAM-GMM §4.2 (S000-13): (3, 4) steps -> 6 iterations '- XY Y XY - XY'."""
     program = Program((Linear(3 * STEP_GMM, 4 * STEP_GMM, 0.8),))
     trace = simulate_steps(program, profile("mmh-gmm", backlash={"compensation_um": [0, 0, 0]}))
     names = {(0, 0): "-", (1, 1): "XY", (0, 1): "Y", (1, 0): "X"}
@@ -63,14 +63,14 @@ def test_dda_line_3_4_takes_six_iterations_through_the_simulator() -> None:
 
 
 def test_dda_line_10_3_takes_eleven_iterations() -> None:
-    """seed-000 §4.2 (S000-13): (10, 3) steps -> 11 iterations."""
+    """UNAM-GMM §4.2 (S000-13): (10, 3) steps -> 11 iterations."""
     trace = simulate_steps(Program((Linear(10 * STEP_GMM, 3 * STEP_GMM, 0.8),)), GMM)
     assert len(trace.rows) == 11
 
 
 @pytest.mark.parametrize("emitted", [False, True])
 def test_full_circle_r30_takes_168_dsm_iterations(emitted: bool) -> None:
-    """seed-000 §4.7 Tabla 7 (S000-14): a full circle of R = 30 steps, DSM: 168 iterations,
+    """UNAM-GMM §4.7 Tabla 7 (S000-14): a full circle of R = 30 steps, DSM: 168 iterations,
     radial error <= 1/2 step; also after pic-mmh writes it as two half arcs and reads it back."""
     r = 30 * STEP_GMM
     program = Program((Rapid(5.0, 3.5), ArcMove(5.0, 3.5, 5.0 - r, 3.5, True, 0.8)))
@@ -93,14 +93,14 @@ def test_full_circle_r30_takes_168_dsm_iterations(emitted: bool) -> None:
     assert np.max(np.abs(radial)) <= 0.5
 
 
-# ----------------------------------------------------------------- backlash, seed-000 §5
+# ----------------------------------------------------------------- backlash, UNAM-GMM §5
 
 
 @pytest.mark.parametrize(("y_mm", "expected_um"), [(1.0, 190.0), (3.5, 201.0), (6.0, 187.0)])
 def test_u_pattern_recovers_the_true_x_backlash_of_each_region(
     y_mm: float, expected_um: float
 ) -> None:
-    """seed-000 §5.2 Tabla 13: two 2.5 mm X lines joined by a step; without compensation
+    """UNAM-GMM §5.2 Tabla 13: two 2.5 mm X lines joined by a step; without compensation
     their length difference is the true backlash of the region (H1/H2/H3: 190/201/187 µm)."""
     machine = profile("mmh-gmm", backlash={"compensation_um": [0, 0, 0]})
     program = Program(
@@ -120,7 +120,7 @@ def test_u_pattern_recovers_the_true_x_backlash_of_each_region(
 def test_u_pattern_recovers_the_true_y_backlash_of_each_region(
     x_mm: float, expected_um: float
 ) -> None:
-    """seed-000 §5.2 Tabla 13: 1.2 mm Y lines in V1/V2/V3 -> 152/180/173 µm."""
+    """UNAM-GMM §5.2 Tabla 13: 1.2 mm Y lines in V1/V2/V3 -> 152/180/173 µm."""
     machine = profile("mmh-gmm", backlash={"compensation_um": [0, 0, 0]})
     program = Program(
         (
@@ -149,7 +149,7 @@ def square(x0: float, y0: float, side: float, feed: float = 0.8) -> Program:
 
 
 def test_square_with_the_first_compensation_is_off_by_the_residual() -> None:
-    """seed-000 §5.2 Tabla 14: true 204/178 µm, compensation 192.5/168.5 µm: the 2.5 mm
+    """UNAM-GMM §5.2 Tabla 14: true 204/178 µm, compensation 192.5/168.5 µm: the 2.5 mm
     square comes out 11.5/9.5 µm off (its closure gap), and the X distance between its
     two Y edges is 2.5 - 0.0115 = 2.4885 mm (Cuadrado_X measured Dx = 2.489 mm)."""
     machine = profile(
@@ -168,7 +168,7 @@ def test_square_with_the_first_compensation_is_off_by_the_residual() -> None:
 
 
 def test_exact_compensation_closes_the_square() -> None:
-    """Compensation equal to the true backlash (seed-000 §5.2, final 204/178 µm): no gap."""
+    """Compensation equal to the true backlash (UNAM-GMM §5.2, final 204/178 µm): no gap."""
     machine = profile(
         "mmh-gmm",
         backlash={"true_um": [204, 178, 0], "compensation_um": [204, 178, 0], "regions": []},
@@ -179,7 +179,7 @@ def test_exact_compensation_closes_the_square() -> None:
 
 
 def test_many_compensations_on_a_sub_millimetre_part_are_warned() -> None:
-    """seed-000 §5.3, S000-19: parts under 1 mm fail after about 16 compensations."""
+    """UNAM-GMM §5.3, S000-19: parts under 1 mm fail after about 16 compensations."""
     moves: list[Linear | Rapid] = [Rapid(1.0, 1.0)]
     for i in range(20):  # a zigzag: every stroke reverses X
         x = 1.5 if i % 2 == 0 else 1.0
@@ -189,28 +189,28 @@ def test_many_compensations_on_a_sub_millimetre_part_are_warned() -> None:
     assert any("compensations on a part of" in w for w in v.warnings)
 
 
-# ---------------------------------------------------------------- seed-001, the LMM MMH
+# ---------------------------------------------------------------- Yanez-07, the LMM MMH
 
 
 LMM = profile("mmh-lmm")
 
 
 def test_lines_are_rounded_at_the_applications_1_9_um() -> None:
-    """seed-001 §4.5, R8: 10 mm -> 5263 steps, 5 mm -> 2632 steps."""
+    """Yanez-07 §4.5, R8: 10 mm -> 5263 steps, 5 mm -> 2632 steps."""
     machine = profile("mmh-lmm", motion={"line": "bresenham"})
     trace = simulate_steps(Program((Linear(10.0, 5.0, 10.0),)), machine)
     assert tuple(trace.block_steps[0, :2]) == (5263, 2632)
 
 
 def test_a_10_mm_line_measures_5263_real_steps_of_1_88_um() -> None:
-    """seed-001 R14: 10 mm commanded -> 5263 x 1.88 µm = 9.894 mm (measured 9.897, L1568)."""
+    """Yanez-07 R14: 10 mm commanded -> 5263 x 1.88 µm = 9.894 mm (measured 9.897, L1568)."""
     trace = simulate_steps(Program((Linear(10.0, 0.0, 10.0),)), LMM)
     assert line_length(trace, 0) == pytest.approx(5263 * 0.00188, abs=1e-9)
 
 
 @pytest.mark.parametrize(("period_ms", "y_steps"), [(20, 2763), (30, 2719), (40, 2697)])
 def test_timer_stepping_overshoots_the_minor_axis(period_ms: int, y_steps: int) -> None:
-    """seed-001 §4.7 Table 3.8 (R11): a 10 x 5 mm line makes 5263 X and 2763 / 2719 / 2697
+    """Yanez-07 §4.7 Table 3.8 (R11): a 10 x 5 mm line makes 5263 X and 2763 / 2719 / 2697
     Y motor steps at P = 20 / 30 / 40 ms (programmed: 2632)."""
     machine = profile("mmh-lmm", timing={"model": "flashcut", "half_period_ms": period_ms})
     trace = simulate_steps(Program((Linear(10.0, 5.0, 10.0),)), machine)
@@ -218,7 +218,7 @@ def test_timer_stepping_overshoots_the_minor_axis(period_ms: int, y_steps: int) 
 
 
 def test_uncompensated_rectangle_fails_to_close_by_the_backlash() -> None:
-    """seed-001 §5, R13: a 10 x 5 mm rectangle without compensation leaves a gap equal to the
+    """Yanez-07 §5, R13: a 10 x 5 mm rectangle without compensation leaves a gap equal to the
     true backlash, 0.654 / 0.302 mm (the thesis measured 0.675 / 0.321)."""
     machine = profile("mmh-lmm", backlash={"compensation_um": [0, 0, 0]})
     program = Program(
@@ -234,7 +234,7 @@ def test_uncompensated_rectangle_fails_to_close_by_the_backlash() -> None:
 
 
 def test_timer_model_time_of_the_10_mm_square() -> None:
-    """seed-001 §4.7, R15: the 10 x 10 mm square at P = 3 ms took 2:53 = 173 s (within 5 %)."""
+    """Yanez-07 §4.7, R15: the 10 x 10 mm square at P = 3 ms took 2:53 = 173 s (within 5 %)."""
     machine = profile("mmh-lmm", timing={"model": "flashcut", "half_period_ms": 3})
     program = Program(square(1.0, 1.0, 10.0, feed=10.0).moves[1:], origin=(1.0, 1.0))
     v = verify_program(program, machine)
@@ -242,11 +242,11 @@ def test_timer_model_time_of_the_10_mm_square() -> None:
     assert v.time_s == pytest.approx(173.0, rel=0.05)
 
 
-# ------------------------------------------------------------- seed-003, seed-004, GRBL
+# ------------------------------------------------------------- Intf8751, Munoz-22, GRBL
 
 
 def test_corte_recto_deviation_of_a_100_by_50_move() -> None:
-    """seed-003 §4.2 (R10): (100, 50) steps goes through (50, 50); max deviation
+    """Intf8751 §4.2 (R10): (100, 50) steps goes through (50, 50); max deviation
     b(a-b)/sqrt(a^2+b^2) = 22.36 steps."""
     machine = Machine(
         name="8751 test",
@@ -260,7 +260,7 @@ def test_corte_recto_deviation_of_a_100_by_50_move() -> None:
 
 
 def test_valcnc_line_time() -> None:
-    """seed-004 §4.3: 166.667 µs per step; 10 mm at 25 steps/mm -> 250 steps -> 41.7 ms."""
+    """Munoz-22 §4.3: 166.667 µs per step; 10 mm at 25 steps/mm -> 250 steps -> 41.7 ms."""
     v = verify_program(Program((Linear(10.0, 0.0, 100.0),)), profile("valcnc"))
     assert tuple(v.trace.block_steps[0]) == (250, 0, 0)
     assert v.time_s == pytest.approx(0.0417, abs=5e-5)
@@ -299,13 +299,13 @@ def test_fit_circle_recovers_centre_and_radius() -> None:
     assert fit_circle(pts) == pytest.approx((3.0, -1.0, 2.0))
 
 
-# ------------------------------------------------------------ seed-002, the servo router
+# ------------------------------------------------------------ Angel-11, the servo router
 
-STAR_01MM = list(zip(*STAR_XY_01MM, strict=True))  # seed-002 §3: (x, y) per point, 0.1 mm
+STAR_01MM = list(zip(*STAR_XY_01MM, strict=True))  # Angel-11 §3: (x, y) per point, 0.1 mm
 
 
 def test_star_on_the_router_closes_off_by_the_chunk_flooring() -> None:
-    """seed-002 §8 R14: with the floor(d/2) chunk rule the star ends (+0.4, -0.2) mm from its
+    """Angel-11 §8 R14: with the floor(d/2) chunk rule the star ends (+0.4, -0.2) mm from its
     first point (it was drawn ending at (+0.2, 0)); its cruise time is ~79 s (R14e) plus ten
     150 ms handshakes and the speed loops' lag."""
     moves = [Rapid(STAR_01MM[0][0] / 10, STAR_01MM[0][1] / 10)]
@@ -348,7 +348,7 @@ def test_every_built_in_profile_verifies_a_square_and_a_circle(name: str) -> Non
 
 
 def test_valcnc_does_not_move_on_a_full_circle_in_one_block() -> None:
-    """seed-004 §4.2: alpha = 2 asin(C / 2R) is 0 when start == end, so nothing moves (the
+    """Munoz-22 §4.2: alpha = 2 asin(C / 2R) is 0 when start == end, so nothing moves (the
     valcnc dialect must split full circles, S004-R05); the verifier shows it."""
     program = Program((Rapid(5.0, 4.0), ArcMove(5.0, 4.0, 4.0, 4.0, True, 100.0)))
     v = verify_program(program, profile("valcnc"))

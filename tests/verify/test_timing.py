@@ -3,7 +3,7 @@
 Each target's own timing model is tested in tests/postprocessors/test_<name>_motion.py.
 
 Every expected value names its source: a section/requirement of
-../shared/reference/seed-00N.md, or "analytic" for a property of the model's formula.
+docs/references.md, or "analytic" for a property of the model's formula.
 """
 
 from __future__ import annotations

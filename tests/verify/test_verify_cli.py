@@ -24,7 +24,7 @@ DESIGN_KEYS = {
     "size_error_um",
     "time_s",
     "warnings",
-}  # ../shared/DESIGN.md, "Verify report"
+}  # docs/verify.md, "the keys are stable"
 
 
 def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
@@ -55,7 +55,7 @@ def test_verify_writes_a_report_with_the_design_keys(
     motion = [ln for ln in logo_pic.read_text().splitlines() if ln.startswith("G0")]
     assert data["blocks"] == len(motion) and data["target"] == "pic-mmh"
     # the worst error is the X over-compensation in region H1: 204 - 190 = 14 µm
-    # (seed-000 §5.2: final compensation 204 µm; Tabla 13: H1 true backlash 190 µm),
+    # (UNAM-GMM §5.2: final compensation 204 µm; Tabla 13: H1 true backlash 190 µm),
     # at most combined with the Y under-compensation in V2 (180 - 178 = 2 µm) still held
     # from the last Y reversal, plus 0.2 µm of step quantisation (140 nm steps)
     assert 204 - 190 - 0.2 <= data["deviation_um"]["max"] <= math.hypot(14, 2) + 0.2

@@ -1,4 +1,4 @@
-/* Linear DDA of the GMM PIC controller, seed-000 §4.2, annex A.3 (reference/seed-000.md
+/* Linear DDA of the GMM PIC controller, UNAM-GMM §4.2, annex A.3 (reference/UNAM-GMM.md
  * §4.2, "Pseudo-code [derived from A.3]"), as a C peer of camtool's dda_line:
  *
  *   PX=|dx|; PY=|dy|; HIPO=sqrt(PX²+PY²); QX=QY=0; CX=CY=0

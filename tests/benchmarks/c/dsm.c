@@ -1,5 +1,5 @@
-/* Direct Search Method of the GMM PIC controller, seed-000 §4.5, annex A.6
- * (reference/seed-000.md §4.5, "Code (verbatim, A.6)"), as a C peer of camtool's dsm_arc.
+/* Direct Search Method of the GMM PIC controller, UNAM-GMM §4.5, annex A.6
+ * (reference/UNAM-GMM.md §4.5, "Code (verbatim, A.6)"), as a C peer of camtool's dsm_arc.
  *
  * The inner loop is the annex's: D1 = |D + DeltaX|, D2 = |D + DeltaY|,
  * D3 = |D + DeltaX + DeltaY|; if D1 > D2 the diagonal wins only when D2 > D3 (else Y),

@@ -1,4 +1,4 @@
-% camtool matlab-router: the seed-002 Matlab GUI arrays (thesis display format)
+% camtool matlab-router: the Angel-11 Matlab GUI arrays (thesis display format)
 % xy, lxy in 0.1 mm; velxy in encoder counts per 5 ms, major axis 480
 % 1 job(s); each job homes, goes to its first point and lowers the tool
 
