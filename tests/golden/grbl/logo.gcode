@@ -1,4 +1,6 @@
 (camtool 0.1.0: logo.dxf for grbl)
+(placement: scale 20, shift X0 Y0 mm)
+(--scale 20: the drawing at 2000 % of its size)
 (offset on: the tool centre follows the drawing)
 (work zero X0 Y0: the drawing's origin)
 (depth none: cuts at Z 0, the top of the stock)
