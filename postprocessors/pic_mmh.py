@@ -51,6 +51,7 @@ from camtool.model.program import (
     Home,
     Linear,
     Move,
+    PlaneArc,
     Program,
     Rapid,
     Spindle,
@@ -527,8 +528,8 @@ class PicMmhPost(PostProcessor):
                     "UNAM-GMM Tabla 22, L3455–L3464)"
                 )
             w.blocks.append(f"M06{WORDS['T'].format(command.tool)};")
-        elif isinstance(command, DrillCycle):
-            pass  # the moves that follow are the cycle: written as they are
+        elif isinstance(command, DrillCycle | PlaneArc):
+            pass  # the moves that follow are the cycle, or the arc's chords: written as they are
         elif isinstance(command, Stop):
             raise DialectError(f"{where}: pic-mmh has no program stop (M0/M1)")
         else:

@@ -1,6 +1,6 @@
 """G-code importer: RS-274 programs as CAM programs write them, read into a Program.
 
-Reads G0/G1/G2/G3 (I/J centre and R-form arcs, G90.1/G91.1), G17, G20/G21,
+Reads G0/G1/G2/G3 (I/J centre and R-form arcs, G90.1/G91.1), G17/G18/G19, G20/G21,
 G90/G91, F, S, T, M3/M4/M5/M6, G4, G28, M2/M30, N-words, comments, ``%`` lines, modal motion
 and modal words — including the FlashCut programs of Yanez-07 §3 (R1–R5) and
 the Inkscape Gcodetools ``.ngc`` files of Munoz-22 §3.3 (S004-R07). Lines are
@@ -24,6 +24,14 @@ Rules (RS-274/NGC as LinuxCNC documents them, unless said otherwise):
   centre and end are kept. R-form: R > 0 the short way (≤ 180°), R < 0 the long
   way; a full circle in R-form is refused. A centre-form arc without X/Y is a
   full circle.
+- Planes: G17 (XY, I and J), G18 (ZX, I and K) and G19 (YZ, J and K), modal. An
+  arc in ZX or YZ is read as a :class:`~camtool.model.program.PlaneArc` command
+  standing for its chords within :data:`PLANE_CHORD_MM` (straight cuts, one per
+  chord, each with its Z), so that everything that follows the path sees them; a
+  dialect with planes writes the arc again. G2 is clockwise seen from +Y (ZX, with
+  Z the first axis and X the second) or from +X (YZ), as LinuxCNC's ``rs274``
+  takes it; the third axis (Y in ZX, X in YZ) moves with the angle (a helix). Such
+  an arc needs a known Z.
 - Z: a move carries ``z`` when its Z word changes Z (an arc with such a Z is a
   helix). Z starts unknown: the first Z word is always carried, an incremental Z
   before any absolute Z is refused.
@@ -73,6 +81,7 @@ import dataclasses
 import math
 import re
 from pathlib import Path
+from typing import cast
 
 from camtool.importers.gcode_codes import BlockWords, Notes, g_key
 from camtool.importers.gcode_lexer import Block, Word, cut_mid_word, lex_line
@@ -85,6 +94,8 @@ from camtool.model.program import (
     Home,
     Linear,
     Move,
+    Plane,
+    PlaneArc,
     Program,
     Rapid,
     Spindle,
@@ -99,6 +110,13 @@ _ARC_TOL_MM = (0.005, 0.5)
 """LinuxCNC arc end tolerance in mm: (with 0.1 % of the radius, absolute ceiling)."""
 _ARC_TOL_IN = (0.0005, 0.05)
 """The same in inches (G20)."""
+PLANE_CHORD_MM = 0.001
+"""Chord error, mm, of the straight cuts a G18/G19 arc is read as (the default
+``--tolerance``; LinuxCNC's and below GRBL's own $12 = 0.002 mm)."""
+_PLANES = {"G17": "xy", "G18": "zx", "G19": "yz"}
+_CENTRE_LETTERS = {"xy": ("I", "J"), "zx": ("K", "I"), "yz": ("J", "K")}
+"""The offset words of an arc's centre in each plane, in the plane's (first, second) order."""
+_PLANE_NAMES = {"xy": "XY plane (G17)", "zx": "ZX plane (G18)", "yz": "YZ plane (G19)"}
 
 _PLAIN_NUMBER = r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)"
 _PLAIN_WORDS = re.compile(r"[ \t]*([GXYZIJRFN](?=[+-]?\.?[0-9])|)(" + _PLAIN_NUMBER + r"|[^ \t].*)")
@@ -288,6 +306,7 @@ class _Reader:
         self.z: float | None = None
         self.positioned = False  # no X or Y word yet: the machine's XY is the program's guess
         self.motion: str | None = None
+        self.plane = "xy"
         self.absolute = True
         self.arc_absolute = False
         self.inch = False
@@ -367,6 +386,8 @@ class _Reader:
             if motion is None or not self.absolute or self.x is None or self.y is None:
                 return False  # without motion run() refuses the words; the rest is not plain
             if motion == "G2" or motion == "G3":
+                if self.plane != "xy":
+                    return False  # run() reads arcs in the other planes
                 if not self._plain_arc(args, motion, feed, scale, line, (self.x, self.y)):
                     return False
             elif not self._plain_move(args, motion, feed, scale, line, (self.x, self.y)):
@@ -565,6 +586,8 @@ class _Reader:
                     "offset (the part zero); split the program at the change"
                 )
             self.coord = coord
+        if (plane := w.g_name("plane")) is not None:
+            self.plane = _PLANES[plane]
         if (distance := w.g_name("distance")) is not None:
             self.absolute = distance == "G90"
         if (arc_distance := w.g_name("arc_distance")) is not None:
@@ -580,10 +603,12 @@ class _Reader:
             word = w.args.get(letter)
             if word is None or letter in used:
                 continue
-            if letter == "K":
+            if letter in "IJK" and self.motion in ("G2", "G3") and used:
+                first, second = sorted(_CENTRE_LETTERS[self.plane])
                 raise InputError(
-                    f"{self.where()}: {word}: camtool reads arcs in the XY plane (G17) only, "
-                    "which take I and J"
+                    f"{self.where()}: {word}: an arc in the {_PLANE_NAMES[self.plane]} takes "
+                    f"its centre from {first} and {second}; select the plane of {word.letter} "
+                    "(G17 XY: I J, G18 ZX: I K, G19 YZ: J K) or remove it"
                 )
             hint = {
                 "X": "axis words need G0, G1, G2 or G3 (or modal motion) before them",
@@ -592,7 +617,7 @@ class _Reader:
                 "P": "P belongs to G4 (dwell), G2/G3 (turns) or G64 (tolerance)",
                 "H": "H belongs to G43",
                 "Q": "Q belongs to G64 here (canned cycles are not read)",
-            }.get(letter, "I, J and R belong to G2/G3 arcs")
+            }.get(letter, "I, J, K and R belong to G2/G3 arcs")
             raise InputError(f"{self.where()}: {word} has no code to use it; {hint}")
 
     # -- motion ------------------------------------------------------------------
@@ -614,7 +639,8 @@ class _Reader:
             self._home(home, w.args)
             return used | axes
         if self.motion in ("G2", "G3"):
-            arc_words = {letter for letter in "XYZIJRP" if letter in w.args}
+            letters = "XYZRP" + "".join(_CENTRE_LETTERS[self.plane])
+            arc_words = {letter for letter in letters if letter in w.args}
             if arc_words - {"P"}:
                 self._arc(w.args)
                 return used | arc_words
@@ -746,30 +772,78 @@ class _Reader:
                 f"{self.where()}: {name} {turns}: multi-turn arcs are not supported; "
                 "write each turn as its own G2/G3"
             )
+        if self.plane != "xy":
+            self._plane_arc(args, name, feed, (tx, ty, tz))
+            return
         clockwise = name == "G2"
-        if "R" in args:
-            if "I" in args or "J" in args:
-                raise InputError(f"{self.where()}: {name} with both R and I/J; keep one form")
-            cx, cy = self._centre_r(args["R"], start, (tx, ty), clockwise, name)
-        else:
-            cx, cy = self._centre_ij(args, start, (tx, ty), name)
+        cx, cy = self._centre(args, start, (tx, ty), clockwise, name)
         arc = ArcMove(tx, ty, cx, cy, clockwise, feed, self._z_out(args, tz))
         self._push(arc, tx, ty, tz)
+
+    def _centre(
+        self, args: dict[str, Word], start: Point, end: Point, clockwise: bool, name: str
+    ) -> Point:
+        """The absolute centre of an arc from ``start`` to ``end`` in the current plane."""
+        letters = _CENTRE_LETTERS[self.plane]
+        if "R" in args:
+            if any(letter in args for letter in letters):
+                raise InputError(
+                    f"{self.where()}: {name} with both R and {'/'.join(sorted(letters))}; "
+                    "keep one form"
+                )
+            return self._centre_r(args["R"], start, end, clockwise, name)
+        return self._centre_ij(args, start, end, name, letters)
+
+    def _plane_arc(
+        self, args: dict[str, Word], name: str, feed: float, end: tuple[float, float, float | None]
+    ) -> None:
+        """An arc in the ZX or YZ plane: a :class:`PlaneArc` command and its chords."""
+        if self.z is None or end[2] is None:
+            raise InputError(
+                f"{self.where()}: {name} in the {_PLANE_NAMES[self.plane]} starts or ends at "
+                f"an unknown Z{f' after {self.home}' if self.home else ''}; give an absolute "
+                "Z (G90) first"
+            )
+        assert self.x is not None and self.y is not None  # _start_xy checked them
+        start3 = (self.x, self.y, self.z)
+        end3 = (end[0], end[1], end[2])
+        plane = cast(Plane, self.plane)
+        probe = PlaneArc(plane, start3, end3, (0.0, 0.0), name == "G2")
+        a, b = probe.in_plane(start3), probe.in_plane(end3)
+        centre = self._centre(args, a, b, probe.clockwise, name)
+        points = dataclasses.replace(probe, centre=centre).points(PLANE_CHORD_MM)
+        arc = dataclasses.replace(probe, centre=centre, moves=len(points) - 1)
+        self.commands.add(len(self.moves), arc)
+        for x, y, z in points[1:]:
+            self._push(Linear(x, y, feed, z), x, y, z)
 
     def _tolerance(self) -> tuple[float, float]:
         small, large = _ARC_TOL_IN if self.inch else _ARC_TOL_MM
         return small * self.scale, large * self.scale
 
-    def _centre_ij(self, args: dict[str, Word], start: Point, end: Point, name: str) -> Point:
-        i, j = args.get("I"), args.get("J")
+    def _centre_ij(
+        self,
+        args: dict[str, Word],
+        start: Point,
+        end: Point,
+        name: str,
+        letters: tuple[str, str] = ("I", "J"),
+    ) -> Point:
+        """The centre from the offset words ``letters`` (the plane's first and second axis)."""
+        i, j = args.get(letters[0]), args.get(letters[1])
+        both = " and ".join(sorted(letters))
         if i is None and j is None:
-            raise InputError(f"{self.where()}: {name} without a centre; give I and J (or R) words")
+            stray = " ".join(str(args[c]) for c in "IJK" if c in args)
+            plane = f" in the {_PLANE_NAMES[self.plane]}" + (f", not {stray}" if stray else "")
+            raise InputError(
+                f"{self.where()}: {name} without a centre{plane}; give {both} (or R) words"
+            )
         di = i.value * self.scale if i is not None else 0.0
         dj = j.value * self.scale if j is not None else 0.0
         if self.arc_absolute:
             if i is None or j is None:
                 raise InputError(
-                    f"{self.where()}: {name} in G90.1 (absolute centre) needs both I and J"
+                    f"{self.where()}: {name} in G90.1 (absolute centre) needs both {both}"
                 )
             centre = (di, dj)
         else:
@@ -788,8 +862,8 @@ class _Reader:
             raise InputError(
                 f"{self.where()}: {name} end point is {off:.4g} mm off its circle (radius "
                 f"{r_start:.4f} mm at the start, {r_end:.4f} mm at the end; the limit is "
-                f"{small:g} mm and 0.1 % of the radius); I/J are read as {mode}: check them "
-                "or export with more decimals"
+                f"{small:g} mm and 0.1 % of the radius); the centre words are read as {mode}: "
+                "check them or export with more decimals"
             )
 
     def _centre_r(

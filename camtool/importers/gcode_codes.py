@@ -7,7 +7,7 @@ Three actions (docs/importers/gcode.md lists them for users):
 - ``warn``: harmless for the XY(Z) path, converted or dropped with one warning per
   code (count and first line) — program pauses, coolant, work offset assumed 0…;
 - ``error``: would change the path in a way camtool cannot represent (cutter
-  compensation, canned cycles, other planes…); refused naming the line.
+  compensation, canned cycles, the tilted planes G17.1–G19.1…); refused naming the line.
 
 A code in neither table is refused as unknown, listing what camtool reads. Modal
 groups follow the RS-274/NGC tables as LinuxCNC documents them; two codes of one
@@ -64,14 +64,14 @@ _CANNED = (
     "ask your CAM to write the cycle as plain G0/G1 moves"
 )
 _PLANE = (
-    "{code} selects another arc plane; camtool reads arcs in the XY plane (G17) only; "
-    "write the program in the XY plane"
+    "{code} selects a plane in the UVW axes, which camtool does not have; camtool reads "
+    "arcs in the XY, ZX and YZ planes (G17, G18, G19)"
 )
 
 G_CODES = MappingProxyType(
     _g(
         ("G0 G1 G2 G3 G80", "motion", "read", ""),
-        ("G17", "plane", "read", ""),
+        ("G17 G18 G19", "plane", "read", ""),
         ("G90 G91", "distance", "read", ""),
         ("G90.1 G91.1", "arc_distance", "read", ""),
         ("G94", "feed_mode", "read", ""),
@@ -102,7 +102,7 @@ G_CODES = MappingProxyType(
         ),
         ("G98 G99", "retract", "warn", "{code} canned-cycle return mode ignored (no cycles)"),
         ("G97", "spindle_mode", "warn", "G97 spindle speed mode ignored"),
-        ("G18 G19 G17.1 G18.1 G19.1", "plane", "error", _PLANE),
+        ("G17.1 G18.1 G19.1", "plane", "error", _PLANE),
         (
             "G41 G42 G41.1 G42.1",
             "cutter",
@@ -170,7 +170,8 @@ M_CODES = MappingProxyType(
 """M codes by number, read-only."""
 
 READ_CODES = (
-    "G0 G1 G2 G3 G4 G17 G20 G21 G28 G30 G80 G90 G91 G90.1 G91.1 G94 M0 M1 M2 M3 M4 M5 M6 M30"
+    "G0 G1 G2 G3 G4 G17 G18 G19 G20 G21 G28 G30 G80 G90 G91 G90.1 G91.1 G94 "
+    "M0 M1 M2 M3 M4 M5 M6 M30"
 )
 """What camtool reads, for messages about unknown codes."""
 

@@ -16,7 +16,7 @@ from camtool.model.errors import InputError, UsageError
 from camtool.model.program import Move, Program, ToolChange
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import BBox, Drawing
-from camtool.post.base import Target
+from camtool.post.base import Target, plane_chords
 from camtool.post.registry import load_target
 from camtool.toolpath.options import PlanOptions, drawing_only
 
@@ -160,6 +160,7 @@ def post_path(
         target,
         output,
         feed_mm_min=plan.feed_mm_min,
+        tolerance_mm=plan.tolerance,
         source=str(path),
         progress=progress,
     )
@@ -226,6 +227,7 @@ def post_bytes(
         target,
         output,
         feed_mm_min=plan.feed_mm_min,
+        tolerance_mm=plan.tolerance,
         source=name,
     )
 
@@ -289,6 +291,7 @@ def post_program(
     output: OutputOptions | None = None,
     *,
     feed_mm_min: float | None = None,
+    tolerance_mm: float | None = None,
     source: str = "",
     progress: Progress = no_progress,
 ) -> PostJob:
@@ -296,8 +299,11 @@ def post_program(
 
     No planning: the program is already a toolpath. ``feed_mm_min``, when given,
     replaces the feed of every cutting move (the program's own feeds are kept
-    otherwise). For a target without a Z axis (depth set by hand, UNAM-GMM
-    S000-08) Z is dropped with a warning: Z-only moves go, XY moves keep their
+    otherwise). Arcs in the ZX and YZ planes (G18/G19) stay arcs for a target that
+    writes them; for any other they become chords within ``tolerance_mm``
+    (``--tolerance``; ``None``: the machine's chord tolerance), with a warning
+    (:func:`camtool.post.base.plane_chords`). For a target without a Z axis (depth set
+    by hand, UNAM-GMM S000-08) Z is dropped with a warning: Z-only moves go, XY moves keep their
     kind, as the thesis users edited VisiCAM output by hand (UNAM-GMM §3.8).
     ``output.fmt`` is the dialect's output format (default: its first);
     ``output.spindle_rpm`` > 0 starts the spindle before the first move and stops it
@@ -322,6 +328,9 @@ def post_program(
             for m in program.moves
         )
         program = dataclasses.replace(program, moves=moves)
+    program, chorded = plane_chords(program, target, tolerance_mm)
+    if chorded:
+        program = dataclasses.replace(program, warnings=(*program.warnings, chorded))
     if not target.machine.has_z:
         program = _flatten(program, target.name)
     if not program.notes:

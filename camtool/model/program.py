@@ -18,17 +18,23 @@ machine zero)
 are :data:`Command` values held beside the moves in :attr:`Program.commands`,
 each with the index of the move it comes before; motion consumers (planner,
 simulator, metrics) never see them.
+
+An arc in another plane (G18 ZX, G19 YZ, read from another CAM's program) is a
+:class:`PlaneArc` command standing for the straight chords that follow it, as a
+:class:`DrillCycle` stands for its moves: every motion consumer sees the chords, a
+dialect with planes writes the arc instead.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import Literal, TypeAlias
 
-from camtool.model.shapes import Arc, BBox, Line, Point, Segment, bbox_union
+from camtool.model.shapes import Arc, BBox, Line, Point, Segment, bbox_union, chord_count
 
 
 @dataclass(frozen=True)
@@ -171,7 +177,94 @@ class Home:
     axes: str = "XY"
 
 
-Command: TypeAlias = Spindle | Dwell | ToolChange | Stop | DrillCycle | Home
+Plane: TypeAlias = Literal["zx", "yz"]
+"""An arc plane other than XY: ``"zx"`` (G18) or ``"yz"`` (G19)."""
+
+PLANE_AXES: Mapping[str, tuple[int, int, int]] = MappingProxyType(
+    {"zx": (2, 0, 1), "yz": (1, 2, 0)}
+)
+"""For each :data:`Plane`, the indices into ``(x, y, z)`` of its first axis, its second axis
+and its linear (helix) axis: ZX is (Z, X) with Y linear, YZ is (Y, Z) with X linear
+(RS-274/NGC, LinuxCNC "G17 - G19.1": the first axis × the second is +Y, resp. +X)."""
+
+Point3: TypeAlias = tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class PlaneArc:
+    """An arc in the ZX (G18) or YZ (G19) plane, standing for the ``moves`` chords after it.
+
+    The chords are plain :class:`Linear` moves (each with its ``z``), so every motion
+    consumer — verifier, preview, time — sees the arc as straight lines within the
+    tolerance they were made with (:meth:`points`); a dialect that selects planes
+    (``G18``/``G19``) may write the arc instead of them, one without writes the
+    chords.
+
+    Coordinates in the plane are ``(first, second)`` as :data:`PLANE_AXES` orders
+    them: ZX is (Z, X), YZ is (Y, Z). ``clockwise`` (G2) is clockwise in that frame,
+    i.e. seen from +Y for ZX and from +X for YZ, looking towards the origin — the
+    RS-274/NGC convention, so G2/G3 keep their sense whatever the plane. A helix
+    moves the linear axis (Y for ZX, X for YZ) evenly with the angle.
+
+    Attributes:
+        plane: :data:`Plane`.
+        start: ``(x, y, z)`` where the arc starts, mm.
+        end: ``(x, y, z)`` where it ends, mm (its first and second axes on the
+            circle through ``start``; equal to ``start`` in the plane: a full circle).
+        centre: the absolute centre, ``(first, second)`` in the plane, mm.
+        clockwise: G2 when True, G3 otherwise.
+        moves: how many of the program's moves after this command are its chords.
+    """
+
+    plane: Plane
+    start: Point3
+    end: Point3
+    centre: Point
+    clockwise: bool
+    moves: int = 0
+
+    def in_plane(self, p: Point3) -> Point:
+        """``p``'s ``(first, second)`` coordinates in the arc's plane, mm."""
+        a, b, _ = PLANE_AXES[self.plane]
+        return (p[a], p[b])
+
+    def arc(self) -> Arc:
+        """The arc in the plane's ``(first, second)`` frame (``clockwise`` there as here)."""
+        return Arc(self.in_plane(self.start), self.in_plane(self.end), self.centre, self.clockwise)
+
+    def length(self) -> float:
+        """The path's length, mm (a helix's along its turns)."""
+        _, _, lin = PLANE_AXES[self.plane]
+        return math.hypot(self.arc().length, self.end[lin] - self.start[lin])
+
+    def points(self, tolerance_mm: float, max_chord_mm: float | None = None) -> list[Point3]:
+        """Points of equal chords within ``tolerance_mm`` of the arc, ``start`` and ``end`` exact.
+
+        The chords are those of :meth:`Arc.points` in the plane (the one sagitta rule,
+        :func:`~camtool.model.shapes.chord_count`); the linear axis moves with the angle,
+        so a helix's chords lie as close to it as their projections to the circle.
+        ``max_chord_mm``: no chord longer than that either (for a dialect that moves Z in
+        blocks of its own, whose staircase then stays that close to the arc).
+
+        Raises:
+            UsageError: ``tolerance_mm`` is not > 0, or the arc would need too many chords.
+        """
+        a, b, lin = PLANE_AXES[self.plane]
+        arc = self.arc()
+        n = chord_count(arc.radius, abs(arc.sweep), tolerance_mm)
+        if max_chord_mm is not None:
+            n = max(n, math.ceil(self.length() / max_chord_mm))
+        out: list[Point3] = [self.start]
+        for k in range(1, n):
+            p = [0.0, 0.0, 0.0]
+            p[a], p[b] = arc.point_at(k / n)
+            p[lin] = self.start[lin] + (self.end[lin] - self.start[lin]) * k / n
+            out.append((p[0], p[1], p[2]))
+        out.append(self.end)
+        return out
+
+
+Command: TypeAlias = Spindle | Dwell | ToolChange | Stop | DrillCycle | Home | PlaneArc
 """A non-motion instruction (see :attr:`Program.commands`)."""
 
 
@@ -249,6 +342,21 @@ class Program:
         commands = (*start, *self.commands, (end, Spindle("off")))
         return dataclasses.replace(self, commands=commands)
 
+    def has_chords_of(self, index: int, arc: PlaneArc) -> bool:
+        """Whether the ``arc.moves`` moves from ``index`` are still ``arc``'s chords.
+
+        They are when they are all straight cuts, the last ends at ``arc.end`` (its ``z``
+        given) and no other command runs between them; a dialect writes the arc instead
+        of them only then.
+        """
+        moves = self.moves[index : index + arc.moves]
+        if not moves or len(moves) != arc.moves or not all(isinstance(m, Linear) for m in moves):
+            return False
+        last = moves[-1]
+        if (last.x, last.y, last.z) != arc.end:
+            return False
+        return not any(index < i < index + arc.moves for i, _ in self.commands)
+
     def line_of(self, index: int) -> int | None:
         """Source line of move ``index``, or None when the program was not read from code."""
         return self.lines[index] if 0 <= index < len(self.lines) else None
@@ -313,3 +421,78 @@ def segment_of(start: Point, move: Move) -> Segment:
     if isinstance(move, ArcMove):
         return Arc(start, (move.x, move.y), (move.cx, move.cy), move.clockwise)
     return Line(start, (move.x, move.y))
+
+
+@dataclass(frozen=True)
+class Chorded:
+    """What :func:`plane_arcs_as_chords` did: arcs replaced, chords written, largest error.
+
+    Attributes:
+        arcs: plane arcs replaced by chords.
+        chords: chords written for them.
+        error_mm: the largest chord error (sagitta) of those chords, mm (0 without any);
+            with ``max_chord_mm``, the longest chord (what a Z-apart staircase may stray).
+    """
+
+    arcs: int = 0
+    chords: int = 0
+    error_mm: float = 0.0
+
+
+def plane_arcs_as_chords(
+    program: Program, tolerance_mm: float, max_chord_mm: float | None = None
+) -> tuple[Program, Chorded]:
+    """``program`` with each :class:`PlaneArc` replaced by its chords within ``tolerance_mm``.
+
+    For a dialect without G18/G19: the arc's moves become the chords of
+    :meth:`PlaneArc.points` (``max_chord_mm`` long at most; each a :class:`Linear` with
+    its ``z``, the feed and contour of the arc's first move, the source line of its first
+    move), the command goes. A plane arc whose moves are no longer its chords (not all
+    straight cuts, not ending at its end, or a command among them:
+    :meth:`Program.has_chords_of`) loses its command and keeps its moves, which every
+    consumer already sees. ``program`` itself is returned when it has no plane arc.
+
+    Raises:
+        UsageError: ``tolerance_mm`` is not > 0, or an arc would need too many chords.
+    """
+    if not any(isinstance(c, PlaneArc) for _, c in program.commands):
+        return program, Chorded()
+    moves: list[Move] = []
+    lines: list[int] = []
+    commands: list[tuple[int, Command]] = []
+    arcs = chords = 0
+    error = 0.0
+    taken = 0  # moves of the input copied or replaced so far
+    for index, command in program.commands:
+        if index > taken:
+            moves.extend(program.moves[taken:index])
+            lines.extend(program.lines[taken:index])
+            taken = index
+        if not isinstance(command, PlaneArc):
+            commands.append((len(moves), command))
+            continue
+        if index < taken or not program.has_chords_of(index, command):
+            continue  # not (or no longer) its chords: the moves stay, the command goes
+        first = program.moves[index]
+        assert isinstance(first, Linear)
+        points = command.points(tolerance_mm, max_chord_mm)
+        line = program.line_of(index)
+        for x, y, z in points[1:]:
+            moves.append(Linear(x, y, first.feed_mm_min, z, first.contour))
+            if line is not None:
+                lines.append(line)
+        taken = index + command.moves
+        arc = command.arc()
+        n = len(points) - 1
+        arcs, chords = arcs + 1, chords + n
+        sagitta = arc.radius * (1.0 - math.cos(abs(arc.sweep) / n / 2.0))
+        error = max(error, sagitta if max_chord_mm is None else command.length() / n)
+    moves.extend(program.moves[taken:])
+    lines.extend(program.lines[taken:])
+    out = dataclasses.replace(
+        program,
+        moves=tuple(moves),
+        lines=tuple(lines) if program.lines else (),
+        commands=tuple(commands),
+    )
+    return out, Chorded(arcs, chords, error)

@@ -9,6 +9,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from abc import ABC, abstractmethod
 from collections import Counter
 from collections.abc import Callable, Iterable, Mapping
@@ -22,9 +23,11 @@ from camtool.model.program import (
     Command,
     DrillCycle,
     Move,
+    PlaneArc,
     Program,
     Stop,
     ToolChange,
+    plane_arcs_as_chords,
     segment_of,
 )
 from camtool.model.shapes import Point, bbox_union
@@ -218,14 +221,15 @@ class WriterState(Generic[B]):
     def drop(self, command: Command) -> None:
         """Count ``command`` as not written (under its class name, e.g. ``"Dwell"``).
 
-        A drilling cycle is written as the moves that follow it: nothing is lost. A tool
+        A drilling cycle or an arc in another plane is written as the moves that follow
+        it (the cycle's moves, the arc's chords): nothing is lost. A tool
         change or a program stop is never dropped (a wrong tool or an unattended change
         ruins the part): the program is refused.
 
         Raises:
             DialectError: ``command`` is a tool change or a stop.
         """
-        if isinstance(command, DrillCycle):
+        if isinstance(command, DrillCycle | PlaneArc):
             return
         if isinstance(command, ToolChange | Stop):
             what = (
@@ -319,6 +323,15 @@ class PostProcessor(ABC):
         return False
 
     @property
+    def planes(self) -> bool:
+        """True when the dialect writes arcs in the ZX and YZ planes (G18, G19).
+
+        A dialect without them never sees a :class:`~camtool.model.program.PlaneArc`:
+        :meth:`Target.emit` writes such arcs as chords first (:func:`plane_chords`).
+        """
+        return False
+
+    @property
     def suffix(self) -> str:
         """File name ending of the default format."""
         return next(iter(self.formats.values()))
@@ -381,6 +394,45 @@ def from_options(
         raise InputError(f"{where}: invalid dialect_options ({exc})") from exc
 
 
+def plane_chords(
+    program: Program, target: Target, tolerance_mm: float | None = None
+) -> tuple[Program, str]:
+    """``program`` with its ZX/YZ arcs as chords when ``target`` cannot write them, and why.
+
+    A target writes them when its dialect has planes (:attr:`PostProcessor.planes`) and
+    its machine a Z axis; otherwise each :class:`~camtool.model.program.PlaneArc`
+    becomes equal chords within ``tolerance_mm`` (``None``: the program's
+    ``tolerance_mm``, else the machine's ``motion.chord_tolerance_mm``), ends exact
+    (:func:`~camtool.model.program.plane_arcs_as_chords`); for a dialect that moves Z
+    in blocks of its own (:attr:`PostProcessor.z_with_xy` False) no chord is longer
+    than the tolerance, so its Z-then-XY staircase stays within it too. The warning (``""``: nothing
+    done) says how many arcs, chords and the largest chord error.
+
+    Raises:
+        UsageError: the tolerance is not > 0, or an arc would need too many chords.
+    """
+    if target.post.planes and target.machine.has_z:
+        return program, ""
+    if tolerance_mm is None:
+        tolerance_mm = program.tolerance_mm
+    if tolerance_mm is None:
+        tolerance_mm = target.machine.motion.chord_tolerance_mm
+    apart = not target.post.z_with_xy  # a chord's Z and XY in two blocks: a staircase
+    out, done = plane_arcs_as_chords(program, tolerance_mm, tolerance_mm if apart else None)
+    if not done.arcs:
+        return out, ""
+    how = (
+        f"no longer than {tolerance_mm:g} mm, each as a Z block and an XY block (the "
+        f"staircase strays at most {done.error_mm * 1000:.2f} µm)"
+        if apart
+        else f"within {tolerance_mm:g} mm (largest chord error {done.error_mm * 1000:.2f} µm)"
+    )
+    return out, (
+        f"{target.name} has no arcs in the ZX and YZ planes (G18/G19): {done.arcs} such "
+        f"arc(s) written as {done.chords} straight chords {how}"
+    )
+
+
 @dataclass(frozen=True)
 class Target:
     """One machine: its dialect (write and read back), its machine profile, its motion model.
@@ -429,8 +481,16 @@ class Target:
             object.__setattr__(self, "post", self.post.for_machine(self.machine))
 
     def emit(self, program: Program, *, fmt: str | None = None) -> PostResult:
-        """Write ``program`` in this target's dialect for its machine (format ``fmt``)."""
-        return self.post.emit(program, self.machine, fmt=fmt)
+        """Write ``program`` in this target's dialect for its machine (format ``fmt``).
+
+        Arcs in the ZX and YZ planes are written as chords (:func:`plane_chords`) unless
+        the dialect writes them (:attr:`PostProcessor.planes`) and the machine has Z.
+        """
+        program, warning = plane_chords(program, self)
+        result = self.post.emit(program, self.machine, fmt=fmt)
+        if warning:
+            result = dataclasses.replace(result, warnings=(*result.warnings, warning))
+        return result
 
     def parse(self, code: str | bytes, *, source: str = "<code>") -> Program:
         """Read code of this target back into a program (see :meth:`PostProcessor.parse`)."""

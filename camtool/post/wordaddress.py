@@ -36,6 +36,10 @@ Writing rules (docs/dialects.md explains them for users):
 - an arc too small for the written resolution (its written end is its written
   start, or its centre rounds onto its start) becomes a straight line, with a
   warning;
+- with ``planes`` an arc in the ZX or YZ plane (a :class:`~camtool.model.program.PlaneArc`)
+  is written as ``G18``/``G19`` with its arc block(s), then ``G17``; when its printed
+  numbers fail the controller's arc check, or it is too small to print, its chords are
+  written instead, with a warning;
 - a move that changes Z and not XY (where the tool is, or the program's origin for
   the first move) is a Z-only block (``G0 Z5``): no X or Y word, so the first
   block of a program never moves XY from wherever the machine stands, and a
@@ -68,6 +72,7 @@ from camtool.model.program import (
     Home,
     Linear,
     Move,
+    PlaneArc,
     Program,
     Rapid,
     Spindle,
@@ -85,7 +90,7 @@ from camtool.post.base import (
     check_written_z,
 )
 from camtool.post.wordaddress_read import BlockReader, ControllerRefusal
-from camtool.post.wordaddress_spec import WordAddressSpec, load_spec
+from camtool.post.wordaddress_spec import PLANE_CODES, WordAddressSpec, load_spec
 
 if TYPE_CHECKING:
     from camtool.post.arccheck import ArcPiece
@@ -114,6 +119,11 @@ class WordAddressPost(PostProcessor):
     def helix(self) -> bool:
         """True when the spec lets an arc carry a Z word (``helix = true``)."""
         return self.spec.helix
+
+    @property
+    def planes(self) -> bool:
+        """True when the spec writes arcs in the ZX and YZ planes (``planes = true``)."""
+        return self.spec.planes
 
     def written_z(self, z: float, machine: Machine) -> float | None:
         """``z`` as the Z word prints it, read back (``None``: no Z word)."""
@@ -184,6 +194,19 @@ class WordAddressPost(PostProcessor):
             return
         from camtool.post.arccheck import arc_error
 
+        for index, command in program.commands:
+            if isinstance(command, PlaneArc):
+                reason = arc_error(
+                    command.in_plane(command.start),
+                    command.in_plane(command.end),
+                    command.centre,
+                    rule=self.spec.arc_check,
+                )
+                if reason is not None:
+                    raise ControllerRefusal(
+                        f"{source}:{program.line_of(index)}: {self.spec.arc_check} refuses this "
+                        f"arc: {reason}"
+                    )
         for index, (start, move) in enumerate(program.steps()):
             if not isinstance(move, ArcMove):
                 continue
@@ -324,10 +347,16 @@ class BlockWriter(WriterState[str]):
         # the keys of instances with that many attributes)
         ahead = conformahead.start(self, program)
         self._conformed_arcs = _Conformed(ahead)
+        index = 0  # of the next move
+        written = 0  # moves written up to here (a plane arc writes its chords' moves)
         try:
             for item in program.items():
                 if isinstance(item, _MOVES):
-                    self.move(item)
+                    index += 1
+                    if index > written:
+                        self.move(item)
+                elif isinstance(item, PlaneArc):
+                    written = self.plane_arc(item, index)
                 else:
                     self.command(item)
         finally:
@@ -820,6 +849,120 @@ class BlockWriter(WriterState[str]):
         self._feed(move, words)
         self.block(words)
 
+    # -- arcs in the ZX and YZ planes -----------------------------------------------
+
+    def plane_arc(self, arc: PlaneArc, index: int) -> int:
+        """Write ``arc`` as ``G18``/``G19`` arc block(s) then ``G17``, if it can be.
+
+        ``index`` is the arc's first move in the program. It is written as an arc when
+        the dialect has ``planes``, the machine a Z axis, the ``arc.moves`` moves from
+        ``index`` are still its chords (:meth:`~camtool.model.program.Program.has_chords_of`)
+        and it starts where the controller is; its printed numbers must pass the
+        controller's arc check (``arc_check``, in the plane) and print an arc (not a
+        point, not a centre on the start). Otherwise nothing is written here, and the
+        chords are written as the moves they are (with a warning when only the printed
+        numbers stood in the way).
+
+        Returns:
+            The number of the program's moves written once this returns: ``index +
+            arc.moves`` when the arc was written, else ``index``.
+
+        Raises:
+            DialectError: a number over its field, a block over ``max_block_bytes`` or a
+                chord outside the work area.
+        """
+        spec = self.spec
+        if not (spec.planes and self.machine.has_z and self._starts_here(arc, index)):
+            return index
+        chords = self.program.moves[index : index + arc.moves]
+        blocks = self._plane_blocks(arc)
+        if blocks is None:
+            self.counts["plane-chords"] += 1
+            return index
+        first = chords[0]
+        assert isinstance(first, Linear)  # has_chords_of checked
+        if first.contour:
+            self.contour = first.contour
+        here = self.here
+        for chord in chords:
+            self._check_area(here, chord)
+            here = (chord.x, chord.y)
+        for k, words in enumerate(blocks):
+            if k == 0:
+                words.insert(0, PLANE_CODES[arc.plane])
+            self._feed(first, words)
+            self.block(words)
+        self.block([PLANE_CODES["xy"]])
+        self.here, self.z = (arc.end[0], arc.end[1]), arc.end[2]
+        return index + arc.moves
+
+    def _starts_here(self, arc: PlaneArc, index: int) -> bool:
+        """Whether ``arc``'s chords follow ``index`` and it starts where the controller is."""
+        if self.z is None or not self.program.has_chords_of(index, arc):
+            return False
+        sx, sy, sz = arc.start
+        same_z = self.text("Z", sz) == self.text("Z", self.z)
+        return math.dist(self.here, (sx, sy)) <= _SAME_MM and same_z
+
+    def _plane_blocks(self, arc: PlaneArc) -> list[list[str]] | None:
+        """The words of each block of ``arc`` (no plane code, no F), or ``None``: chords.
+
+        Split as XY arcs are (``max_arc_deg``, ``full_circle``); each block's offsets
+        are from its printed start, as the controller takes them. ``None`` when a
+        block's printed numbers fail the arc check or print no arc.
+        """
+        from camtool.model.program import PLANE_AXES
+
+        axes = PLANE_AXES[arc.plane]
+        letters = ["XYZ"[i] for i in axes]  # first, second, linear
+        offsets = ["IJK"[i] for i in axes[:2]]
+        whole = arc.arc()
+        full = whole.is_full_circle
+        pieces = whole.split(self._parts(whole, full))
+        position = [self.written[0], self.written[1], self._round("Z", self.z or 0.0)]
+        lin0, lin1 = arc.start[axes[2]], arc.end[axes[2]]
+        out: list[list[str]] = []
+        for k, piece in enumerate(pieces, start=1):
+            start = (position[axes[0]], position[axes[1]])
+            texts: dict[str, str] = {}
+            linear = lin1 if k == len(pieces) else lin0 + (lin1 - lin0) * k / len(pieces)
+            values = (piece.end[0], piece.end[1], linear)
+            printed = []
+            for letter, value in zip(letters, values, strict=True):
+                text = self._z_text(value) if letter == "Z" else self.text(letter, value)
+                printed.append(self._parses[letter](text))
+                if letter != letters[2] or printed[-1] != position[axes[2]]:
+                    texts[letter] = text  # the linear axis only when it moves
+            centre = []
+            for letter, c, s0 in zip(offsets, piece.centre, start, strict=True):
+                origin = 0.0 if self._absolute_centre else s0
+                texts[letter] = self.text(letter, c - origin)
+                centre.append(self._parses[letter](texts[letter]) + origin)
+            end = (printed[0], printed[1])
+            if not self._printable(start, end, (centre[0], centre[1]), full and len(pieces) == 1):
+                return None
+            for i, value in zip(axes, printed, strict=True):
+                position[i] = value
+            code = self._cw if arc.clockwise else self._ccw
+            out.append([code] + [c + texts[c] for c in "XYZIJK" if c in texts])
+        self.written = (position[0], position[1])
+        self.last["X"], self.last["Y"] = "", ""  # modal X/Y: written again after the arc
+        self.last.pop("Z", None)
+        self.last["G"] = ""
+        return out
+
+    def _printable(self, start: Point, end: Point, centre: Point, full: bool) -> bool:
+        """Whether a plane arc block's printed numbers make an arc the controller accepts."""
+        if centre == start or (end == start and not full):
+            return False
+        if self._arc_floor_mm and 2.0 * math.dist(centre, start) <= self._arc_floor_mm:
+            return False
+        if self.spec.arc_check == "none":
+            return True
+        from camtool.post.arccheck import arc_error
+
+        return arc_error(start, end, centre, rule=self.spec.arc_check) is None
+
     # -- commands ----------------------------------------------------------------
 
     def command(self, command: Command) -> None:
@@ -922,6 +1065,9 @@ class BlockWriter(WriterState[str]):
             "arc-chords": f"arcs that no printable centre lets {name}'s arc check accept at "
             f"{self.spec.quantum_mm():g} mm written as {d['arc-chords']} straight chord(s) "
             f"within {max(2.0 * self.spec.quantum_mm(), ARC_CHORD_TOLERANCE_MM):g} mm of them",
+            "plane-chords": f"{d['plane-chords']} arc(s) in the ZX or YZ plane whose printed "
+            f"numbers {name}'s arc check refuses, or too small to print, written as their "
+            "chords (a G-code file's within 0.001 mm, as read)",
             "tiny-arc": f"{d['tiny-arc']} arc(s) too small for the "
             f"{self.spec.quantum_mm():g} mm the dialect writes were written as straight lines "
             "(or left out when both ends print the same)",

@@ -27,9 +27,13 @@ from typing import Any
 from camtool.model.errors import InputError
 from camtool.post.numfmt import SIGN_POLICIES, NumberFormat
 
-WORD_LETTERS = "XYZIJFSPTH"
-"""Value words a dialect may have: axes X Y Z (mm), arc centre I J (mm), feed F
-(mm/min), spindle speed S (rev/min), dwell P (s), tool number T, tool length offset H."""
+WORD_LETTERS = "XYZIJKFSPTH"
+"""Value words a dialect may have: axes X Y Z (mm), arc centre I J K (mm; K only with
+``planes``), feed F (mm/min), spindle speed S (rev/min), dwell P (s), tool number T, tool
+length offset H."""
+
+PLANE_CODES = MappingProxyType({"xy": "G17", "zx": "G18", "yz": "G19"})
+"""The RS-274 plane codes a dialect with ``planes`` writes."""
 
 MOTIONS = ("rapid", "linear", "cw", "ccw")
 """Keys of ``motion_codes``: G0, G1, G2 (clockwise) and G3 (counter-clockwise)."""
@@ -91,6 +95,11 @@ class WordAddressSpec:
         z_moves: ``"own-block"`` (Z alone in its block, Yanez-07 R7),
             ``"with-xy"`` or ``"none"`` (no Z word).
         helix: whether an arc may carry a Z word (``with-xy`` only).
+        planes: whether the controller selects the arc plane, as RS-274 does (GRBL,
+            LinuxCNC): G17 XY with I J, G18 ZX with I K, G19 YZ with J K. A program's
+            arcs in the ZX and YZ planes (:class:`~camtool.model.program.PlaneArc`)
+            are then written as arcs, else as chords. Needs I, J, K and Z words,
+            ``helix`` and ``rs274`` (the RS-274 reader reads them back).
         max_block_bytes: longest block in bytes with its block end and line
             end; ``None``: no limit.
         comments: whether the controller skips comments, as RS-274/NGC
@@ -142,6 +151,7 @@ class WordAddressSpec:
     full_circle: str = "one-block"
     z_moves: str = "with-xy"
     helix: bool = False
+    planes: bool = False
     max_block_bytes: int | None = None
     comments: bool = False
     rs274: bool = False
@@ -342,6 +352,7 @@ def load_spec(options: Mapping[str, Any], where: str) -> WordAddressSpec:
         full_circle=t.string("full_circle", "one-block", choices=FULL_CIRCLES),
         z_moves=t.string("z_moves", z_default, choices=Z_MOVES),
         helix=t.flag("helix", False),
+        planes=t.flag("planes", False),
         max_block_bytes=t.integer("max_block_bytes", None, low=8, high=1 << 20),
         comments=t.flag("comments", False),
         rs274=t.flag("rs274", False),
@@ -481,6 +492,17 @@ def _check(spec: WordAddressSpec, t: _Table) -> None:
         raise t.error("z_moves", f"expected {want}, got {_show(spec.z_moves)}")
     if spec.helix and spec.z_moves != "with-xy":
         raise t.error("helix", 'a helix needs z_moves = "with-xy"')
+    if spec.planes and not all(spec.has(c) for c in "ZIJK"):
+        missing = ", ".join(c for c in "ZIJK" if not spec.has(c))
+        raise t.error(
+            "planes", f"arcs in the ZX and YZ planes need Z, I, J and K words; {missing} missing"
+        )
+    if spec.planes and not (spec.helix and spec.rs274):
+        raise t.error("planes", "arcs in other planes need helix = true and rs274 = true")
+    if spec.has("K") and not spec.planes:
+        raise t.error(
+            "words", "a K word is written only in the ZX and YZ planes: set planes = true"
+        )
     if spec.dwell and not spec.has("P"):
         raise t.error("dwell", "a dwell code needs a P word (seconds) in words")
     if spec.tool_change and not spec.has("T"):
