@@ -66,6 +66,7 @@ from typing import TYPE_CHECKING, Any
 from camtool.model.errors import DialectError, ParseError
 from camtool.model.machine import Machine
 from camtool.model.program import (
+    PLANE_AXES,
     ArcMove,
     Command,
     Dwell,
@@ -911,15 +912,14 @@ class BlockWriter(WriterState[str]):
         are from its printed start, as the controller takes them. ``None`` when a
         block's printed numbers fail the arc check or print no arc.
         """
-        from camtool.model.program import PLANE_AXES
-
         axes = PLANE_AXES[arc.plane]
         letters = ["XYZ"[i] for i in axes]  # first, second, linear
         offsets = ["IJK"[i] for i in axes[:2]]
         whole = arc.arc()
         full = whole.is_full_circle
         pieces = whole.split(self._parts(whole, full))
-        position = [self.written[0], self.written[1], self._round("Z", self.z or 0.0)]
+        assert self.z is not None  # _starts_here checked
+        position = [self.written[0], self.written[1], self._round("Z", self.z)]
         lin0, lin1 = arc.start[axes[2]], arc.end[axes[2]]
         out: list[list[str]] = []
         for k, piece in enumerate(pieces, start=1):

@@ -164,3 +164,18 @@ def test_the_plain_reader_does_not_read_a_modal_plane_arc_as_an_xy_arc() -> None
     assert not any(isinstance(m, ArcMove) for m in program.moves)
     assert [type(c) for _, c in program.commands] == [PlaneArc]
     assert program.moves[-1] == Linear(1.0, 0.0, 100.0, 0.0, contour=1)
+
+
+@needs_rs274
+def test_inch_absolute_centres_and_incremental_moves_in_the_planes(tmp_path: Path) -> None:
+    path = tmp_path / "inch.ngc"
+    path.write_text(
+        "G20 G90 G17\nG0 X0.1 Y0.2 Z0.3\nG18 G2 X0.3 Z0.1 I0.2 K0 F10\n"
+        "G90.1\nG3 X0.1 Z0.3 I0.1 K0.1\nG91.1\nG91\nG19 G2 Y0.2 Z-0.2 J0.2 K0\nG90\nG17\nM2\n"
+    )
+    theirs = rs274_arcs(path)  # in inches, as the program is
+    ours = camtool_arcs(read_gcode(path))  # in mm
+    assert [p for p, _ in ours] == [p for p, _ in theirs] == ["zx", "zx", "yz"]
+    for (_, a), (_, b) in zip(theirs, ours, strict=True):
+        inch = tuple(v * 25.4 if k != 4 else v for k, v in enumerate(a))
+        assert b == pytest.approx(inch, abs=1e-9)
