@@ -417,7 +417,8 @@ def plane_chords(
         tolerance_mm = program.tolerance_mm
     if tolerance_mm is None:
         tolerance_mm = target.machine.motion.chord_tolerance_mm
-    apart = not target.post.z_with_xy  # a chord's Z and XY in two blocks: a staircase
+    # a chord's Z and XY in two blocks: a staircase (a machine without Z drops Z anyway)
+    apart = target.machine.has_z and not target.post.z_with_xy
     out, done = plane_arcs_as_chords(program, tolerance_mm, tolerance_mm if apart else None)
     if not done.arcs:
         return out, ""

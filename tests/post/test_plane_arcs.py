@@ -192,6 +192,18 @@ def test_a_target_without_z_gets_the_chords_flattened_not_an_xy_arc() -> None:
     assert any("pic-mmh has no arcs in the ZX and YZ planes" in w for w in job.program.warnings)
 
 
+def test_a_target_without_z_gets_equal_chords_not_a_z_staircase() -> None:
+    # No Z is written, so no Z-then-XY staircase: the quarter circle of radius 0.4 needs
+    # n = ceil(θ / (2 acos(1 - tol / r))) equal chords for a sagitta within tol.
+    program = parse_gcode(program_with(LEAD_IN_ZX[0]), source="t.ngc")
+    program = dataclasses.replace(program, tolerance_mm=0.001)
+    job = post_program(program, load_target("pic-mmh"), feed_mm_min=5.0)
+    radius, tol = LEAD_IN_ZX[3], 0.001
+    chords = math.ceil((math.pi / 2) / (2 * math.acos(1 - tol / radius)))
+    said = [w for w in job.program.warnings if "ZX and YZ planes" in w]
+    assert said and f"written as {chords} straight chords within" in said[0]
+
+
 def test_a_dialect_with_planes_needs_k_a_helix_and_the_rs274_reader() -> None:
     ok = {"words": {"XYZIJK": {}}, "helix": True, "rs274": True, "planes": True}
     assert load_spec(ok, "m.toml").planes
