@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 
 from camtool.cli.common import MACHINE, publishes, warn, write_output
-from camtool.model.errors import InputError, UsageError
+from camtool.model.errors import UsageError
 
 TARGET = click.option(
     "--target",
@@ -95,18 +95,14 @@ def fit(target: str, measured: str, output: str, machine_file: Path | None) -> N
     """Fit the target's profile to a filled-in sheet; write a --machine overlay."""
     from camtool.calibrate import fit_sheet
     from camtool.calibrate.fit import overlay_toml, summary_lines
+    from camtool.calibrate.sheet import read_sheet
     from camtool.jobs.output import check_paths
     from camtool.jobs.pipeline import load_target_checked
 
     check_paths(
         [("the sheet", measured)], [("-o", output)], target=target, machine_file=machine_file
     )
-    try:
-        text = Path(measured).read_text("utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(
-            f"{measured}: cannot read ({getattr(exc, 'strerror', None) or exc})"
-        ) from exc
+    text = read_sheet(measured)
     chosen = load_target_checked(target, machine_file=machine_file)
     result = fit_sheet(chosen, text, source=measured)
     for line in summary_lines(result):

@@ -70,7 +70,7 @@ def _sheet(rows: list[str]) -> str:
     ("rows", "message"),
     [
         (["LX.p1,abc,"], r"m\.csv: line 2, column 'measured_mm': 'abc' is not a number"),
-        (["LX.p1,nan,"], r"line 2, column 'measured_mm': 'nan' must be a finite number"),
+        (["LX.p1,nan,"], r"line 2, column 'measured_mm': 'nan' is not a number"),
         (["LX.p1,-1,"], r"line 2, column 'measured_mm'"),
         (["ZZ.p1,1,"], r"line 2, column 'id': unknown measure 'ZZ.p1'"),
         (["LX.p1,15,", "LX.p1,15,"], r"line 3, column 'id': 'LX.p1' repeats line 2"),
