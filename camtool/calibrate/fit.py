@@ -554,7 +554,7 @@ def _check_backlash_sign(
         if p.unit != "µm" or theta[k] > 1e-9:
             continue
         estimate = float(theta[k] + delta[k])
-        axis = 0 if p.label.startswith("backlash X") else 1
+        axis = _backlash_axis(p, machine)
         floor = max(3 * (sigmas[k] or 0.0), 1000.0 / machine.real_steps_per_mm[axis], 2.0)
         if estimate >= -floor:
             continue
@@ -571,6 +571,14 @@ def _check_backlash_sign(
             "mistyped rows (out/back), and that the compensation columns hold what each "
             "feature was cut with"
         )
+
+
+def _backlash_axis(p: Parameter, machine: Machine) -> int:
+    """The axis (0 = X, 1 = Y) of a backlash parameter, from its key."""
+    index = int(p.key.split("[")[1].split("]")[0])
+    if p.key.startswith("backlash.regions"):
+        return AXES.index(machine.backlash.regions[index].axis)
+    return index
 
 
 def _settings(
