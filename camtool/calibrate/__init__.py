@@ -14,6 +14,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from camtool.model.errors import InputError, UsageError
+
 if TYPE_CHECKING:
     from camtool.calibrate.coupon import Coupon
     from camtool.calibrate.fit import FitResult
@@ -65,18 +67,54 @@ def make_coupon(
     )
 
 
-def fit_sheet(target: Target, text: str, *, source: str) -> FitResult:
+HOLD = {"steps": "steps/mm", "backlash": "µm"}
+"""What ``--hold`` keeps at the profile's values: the steps/mm or the backlash parameters."""
+
+
+def fit_sheet(
+    target: Target,
+    text: str,
+    *,
+    source: str,
+    hold: tuple[str, ...] = (),
+    max_correction: float = 0.2,
+) -> FitResult:
     """Fit ``target``'s profile to a filled-in sheet of its default coupon.
 
+    Args:
+        target: the target (its profile is the start).
+        text: the sheet CSV.
+        source: the sheet's name, for messages.
+        hold: kinds of parameters held at the profile's values (keys of :data:`HOLD`).
+        max_correction: the largest accepted steps/mm correction, a fraction (0.2: ±20 %).
+
     Raises:
+        UsageError: an unknown ``hold`` kind, or ``max_correction`` not in (0, 10].
         InputError: the sheet is not valid (names ``source``, line and column), holds no
-            measured value, or is of another coupon.
+            measured value, is of another coupon, or its values cannot be trusted
+            (:func:`camtool.calibrate.fit.fit`; prefixed with ``source``).
     """
     from camtool.calibrate.coupon import build_coupon
     from camtool.calibrate.fit import fit
     from camtool.calibrate.predict import read_back
     from camtool.calibrate.sheet import read_measurements
 
+    unknown = sorted(set(hold) - set(HOLD))
+    if unknown:
+        raise UsageError(f"--hold {unknown[0]!r}: hold one of {', '.join(HOLD)}")
+    if not 0 < max_correction <= 10:
+        raise UsageError(f"--max-correction {max_correction * 100:g}: give a % in (0, 1000]")
+    units = {HOLD[h] for h in hold}
     coupon = build_coupon(target)
     observations = read_measurements(text, coupon, source=source)
-    return fit(read_back(coupon, target), target.machine, observations, target=target.name)
+    try:
+        return fit(
+            read_back(coupon, target),
+            target.machine,
+            observations,
+            target=target.name,
+            only=(lambda p: p.unit not in units) if units else None,
+            max_correction=max_correction,
+        )
+    except InputError as exc:
+        raise InputError(f"{source}: {exc}") from None

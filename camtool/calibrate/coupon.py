@@ -50,7 +50,10 @@ MIN_STEPS = 40
 measurable; a smaller travel is refused."""
 MAX_CIRCLE_STEPS = 2_000_000
 """Most motor steps around the largest circle (the simulation's size)."""
-SCALES: tuple[float, ...] = (10, 8, 6, 5, 4, 3, 2.5, 2, 1.5, 1.2, 1, 0.8, 0.6, 0.5, 0.4, 0.3)
+SCALES: tuple[float, ...] = (
+    *(10, 8, 6, 5, 4, 3, 2.5, 2, 1.5, 1.2, 1),
+    *(0.8, 0.6, 0.5, 0.4, 0.3, 0.25, 0.2, 0.15, 0.12, 0.1),
+)
 """Coupon scales tried, largest first (1 = the UNAM-GMM sizes: U 2.5/1.2 mm, squares 2.5 mm,
 circles ø6/4/2 mm)."""
 
@@ -450,18 +453,18 @@ def coupon_from_features(
     return Coupon(target.name, scale, tuple(features), program)
 
 
-def approach_mm(machine: Machine) -> float:
-    """Length of every feature's approach, mm: longer than any backlash the profile knows.
+def approach_mm(machine: Machine, scale: float) -> float:
+    """Length of every feature's approach at ``scale``, mm: longer than any backlash known.
 
     1.5 × the largest true or compensated backlash of X and Y (regions included), at least
-    2 % of the shorter travel and 20 motor steps.
+    0.2 mm per unit of scale and 20 motor steps. It does not depend on the travel, so that
+    a larger travel never needs more room for the same coupon.
     """
     b = machine.backlash
     largest = max(
         [*b.true_um[:2], *b.compensation_um[:2], *(r.true_um for r in b.regions)], default=0.0
     )
-    travel = min(machine.travel_mm)
-    return max(1.5 * largest / 1000.0, 0.02 * travel, 20.0 / min(machine.steps_per_mm[:2]))
+    return max(1.5 * largest / 1000.0, 0.2 * scale, 20.0 / min(machine.steps_per_mm[:2]))
 
 
 def build_coupon(target: Target) -> Coupon:
@@ -469,9 +472,14 @@ def build_coupon(target: Target) -> Coupon:
 
     Scale 1 is UNAM-GMM's sizes; a machine with a larger travel gets a larger coupon (up to
     10×, and no circle of more than :data:`MAX_CIRCLE_STEPS` steps), a smaller one a smaller
-    coupon. Features: a long move along X and along Y (and Z on a machine with Z), a U pattern
-    per axis and per backlash region of the profile (one per axis when it has none), three
-    squares and three concentric circles.
+    coupon, down to :data:`MIN_STEPS` steps across the smallest circle. Features: a long move
+    along X (at the top of the work area) and along Y (at its right), each as long as the
+    travel allows (and Z on a machine with Z), a U pattern per axis and per backlash region of
+    the profile (one per axis when it has none), three squares and three concentric circles.
+
+    The scale never decreases when the travel grows: whether scale ``s`` fits is decided in
+    boxes whose size depends only on ``s`` and the profile (:data:`ASPECTS`), at the lower
+    left of the work area, so what fits in a travel fits in every larger one.
 
     Raises:
         UsageError: the travel is too small for a measurable coupon (names the size needed).
@@ -480,43 +488,85 @@ def build_coupon(target: Target) -> Coupon:
     spm = min(machine.steps_per_mm[:2])
     largest = min(10.0, MAX_CIRCLE_STEPS / (math.pi * 6.0 * spm))
     smallest = MIN_STEPS / (2.0 * spm)
-    for scale in SCALES:
-        if scale > largest or scale < smallest:
-            continue
+    scales = [s for s in SCALES if smallest <= s <= largest]
+    for scale in scales:
         features = _layout(target, scale)
         if features is not None:
             return coupon_from_features(target, features, scale=scale)
     w, h = machine.travel_mm
+    least = scales[-1] if scales else max(smallest, SCALES[-1])
+    need = _travel_needed(target, least)
+    regions = " with a U pattern in each backlash region" if machine.backlash.regions else ""
     raise UsageError(
         f"the travel of {target.name} ({w:g} x {h:g} mm) is too small for a calibration coupon "
-        f"(the smallest, at scale {max(smallest, SCALES[-1]):g}, needs about "
-        f"{10 * max(smallest, SCALES[-1]) + 2:g} x {7 * max(smallest, SCALES[-1]) + 2:g} mm); "
-        "give the real work_area_mm with --machine"
+        f"(the smallest, at scale {least:g}{regions}, needs {need}); give the real "
+        "work_area_mm with --machine"
     )
 
 
+def _travel_needed(target: Target, scale: float) -> str:
+    """The smallest square travel from the work area's corner that holds the coupon at ``scale``."""
+    x0, y0, x1, y1 = target.machine.work_area_mm
+    side = max(x1 - x0, y1 - y0)
+    for _ in range(80):
+        side *= 1.1
+        machine = replace(target.machine, work_area_mm=(x0, y0, x0 + side, y0 + side))
+        if _layout(replace(target, machine=machine), scale) is not None:
+            return f"about {side:.3g} x {side:.3g} mm"
+    return "a larger travel"
+
+
+ASPECTS: tuple[float, ...] = (1.0, 1.5, 1 / 1.5, 1.75, 1 / 1.75, 2.5, 1 / 2.5)
+"""Width/height of the boxes the scaled features are packed in, tried in this order."""
+GROWTH = 1.08
+"""Each box tried is this much larger than the one before (from the features' total area)."""
+
+
 def _layout(target: Target, scale: float) -> list[Feature] | None:
-    """The default features placed in the work area at ``scale``, or ``None`` if they do not fit."""
+    """The default features placed in the work area at ``scale``, or ``None`` if they do not fit.
+
+    The long moves run along the top and the right of the work area (as long as it allows);
+    the other features are packed at its lower left in the smallest box of one of
+    :data:`ASPECTS` (sizes growing by :data:`GROWTH`) where they fit; that box depends on the
+    scale and the profile only, never on the travel.
+    """
     machine = target.machine
     feed = target.default_feed_mm_min
-    a = approach_mm(machine)
+    a = approach_mm(machine, scale)
     x0, y0, x1, y1 = machine.work_area_mm
-    margin = a + 0.02 * min(machine.travel_mm)
-    packer = _Packer((x0 + margin, y0 + margin, x1 - margin, y1 - margin), gap=a)
-    out: list[Feature] = []
-    w, h = packer.width, packer.height
-    seg_x = _nice_floor((w - a) / SEGMENTS)
-    if seg_x <= 0:
+    m = a  # beyond the approach, which the footprints include
+    ix0, iy0, ix1, iy1 = x0 + m, y0 + m, x1 - m, y1 - m
+    seg_x = _nice_floor((ix1 - ix0 - a) / SEGMENTS)
+    seg_y = _nice_floor((iy1 - iy0 - 3 * a) / SEGMENTS)
+    if seg_x <= 0 or seg_y <= 0:
         return None
-    for make in (
-        lambda: long_move("LX", 0, (0.0, 0.0), seg_x, a, feed),
-        lambda: long_move("LY", 1, (0.0, 0.0), _nice_floor((h - 3 * a) / SEGMENTS), a, feed),
-    ):
-        feature = make()
-        placed = packer.place(feature)
-        if placed is None:
-            return None
-        out.append(placed)
+    lx = long_move("LX", 0, (0.0, 0.0), seg_x, a, feed)
+    ly = long_move("LY", 1, (0.0, 0.0), seg_y, a, feed)
+    lx = _at(lx, (ix0, iy1 - _size(lx)[1]))
+    ly = _at(ly, (ix1 - _size(ly)[0], iy0))
+    cw, ch = ix1 - ix0 - _size(ly)[0] - a, iy1 - iy0 - _size(lx)[1] - a
+    if cw <= 0 or ch <= 0:
+        return None
+    items = _scaled_features(target, scale, a, feed)
+    area = sum(_size(f)[0] * _size(f)[1] for group in items for f in group[0])
+    for aspect in ASPECTS:
+        side = math.sqrt(max(area, 1e-12))
+        fit_side = min(cw / math.sqrt(aspect), ch * math.sqrt(aspect))
+        while side <= fit_side * (1 + 1e-12):
+            w, h = side * math.sqrt(aspect), side / math.sqrt(aspect)
+            placed = _pack(items, (ix0, iy0, ix0 + w, iy0 + h), a)
+            if placed is not None:
+                return [lx, ly, *placed]
+            side *= GROWTH
+    return None
+
+
+def _scaled_features(
+    target: Target, scale: float, a: float, feed: float
+) -> list[tuple[list[Feature], BBox | None]]:
+    """The features other than the long moves, in packing order, each group with its region."""
+    machine = target.machine
+    out: list[tuple[list[Feature], BBox | None]] = []
     regions = machine.backlash.regions
     for axis, length in ((0, 2.5 * scale), (1, 1.2 * scale)):
         gap = 0.3 * scale
@@ -529,27 +579,39 @@ def _layout(target: Target, scale: float) -> list[Feature] | None:
             if region is not None:
                 bounds = (region.x_mm[0], region.y_mm[0], region.x_mm[1], region.y_mm[1])
                 feature = replace(feature, region=_region_text(region.x_mm, region.y_mm))
-            placed = packer.place(feature, within=bounds)
-            if placed is None:
-                return None
-            out.append(placed)
+            out.append(([feature], bounds))
     for i in range(1, 4):
-        placed = packer.place(rectangle(f"SQ{i}", (0.0, 0.0), (2.5 * scale,) * 2, a, feed))
+        out.append(([rectangle(f"SQ{i}", (0.0, 0.0), (2.5 * scale,) * 2, a, feed)], None))
+    out.append(([circle(f"C{d:g}", (0.0, 0.0), d * scale, a, feed) for d in (6, 4, 2)], None))
+    if machine.has_z:
+        seg_z = _nice_floor(min(20.0, 4.0 * scale) / SEGMENTS)
+        out.append(([long_move_z("LZ", (0.0, 0.0), seg_z, a, feed)], None))
+    return out
+
+
+def _pack(
+    items: Sequence[tuple[list[Feature], BBox | None]], box: BBox, gap: float
+) -> list[Feature] | None:
+    """``items`` packed bottom-left in ``box`` (``None``: they do not all fit)."""
+    packer = _Packer(box, gap=gap)
+    out: list[Feature] = []
+    for group, within in items:
+        placed = packer.place_group(group, within=within)
         if placed is None:
             return None
-        out.append(placed)
-    rings = [circle(f"C{d:g}", (0.0, 0.0), d * scale, a, feed) for d in (6, 4, 2)]
-    shift = packer.place_group(rings)
-    if shift is None:
-        return None
-    out.extend(shift)
-    if machine.has_z:
-        seg_z = _nice_floor(min(20.0, 0.1 * min(machine.travel_mm)) / SEGMENTS)
-        spot = packer.place(long_move_z("LZ", (0.0, 0.0), seg_z, a, feed))
-        if spot is None:
-            return None
-        out.append(spot)
+        out.extend(placed)
     return out
+
+
+def _size(feature: Feature) -> tuple[float, float]:
+    x0, y0, x1, y1 = feature.bbox()
+    return (x1 - x0, y1 - y0)
+
+
+def _at(feature: Feature, corner: Point) -> Feature:
+    """``feature`` moved so that its footprint's lower-left corner is ``corner``."""
+    x0, y0, _, _ = feature.bbox()
+    return feature.moved(corner[0] - x0, corner[1] - y0)
 
 
 def _region_text(x_mm: tuple[float, float], y_mm: tuple[float, float]) -> str:

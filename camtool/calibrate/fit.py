@@ -16,11 +16,27 @@ Parameters (what a profile models that a coupon can determine):
 The compensation is the controller's setting, not a property of the mechanics: it is not fitted
 but taken from each measurement row (the setting the feature was cut with).
 
-A parameter on which no measurement depends, or whose effect the others already explain (its
-scaled Jacobian column is near-dependent: a small pivot of the QR factorisation), is "not
-determined by these measurements" and left out of the fit and the overlay. Uncertainties are
-1 σ from the covariance s²·(JᵀJ)⁻¹, with s² = Σr²/(m − n) the residual variance (none when
-m = n).
+What the sheet cannot determine is never reported as fitted:
+
+- a parameter on which no filled-in row depends keeps the profile's value and is said to (the
+  others do not depend on it either, so nothing is biased); so does one the caller holds
+  (``hold``, ``--hold``);
+- a parameter the filled-in rows depend on but cannot tell from the others (its scaled
+  Jacobian column is near-dependent on theirs: a small pivot of the QR factorisation) is
+  refused (:class:`~camtool.model.errors.InputError`), naming the coupon rows that would tell
+  them apart: holding it at the profile's value would move its error into the others (a Y
+  backlash frozen at 0 makes Y's steps/mm absorb it). X's and Y's steps/mm that only circles
+  measure are the exception: they are fitted as one lead, said so;
+- a parameter fitted with a 1-σ uncertainty over :data:`LOOSE_SIGMA` of its size stays in the
+  fit (the others' σ include it) but is reported as not determined and left out of the overlay.
+
+The data are checked against physics: a row far from its nominal value (µm or inches typed in
+the mm column) is refused before the fit; a backlash the rows put below 0 (a line after a
+reversal longer than the compensation explains) is refused with the numbers; a steps/mm
+correction beyond ``max_correction`` (default ±20 %) is refused naming the likely cause.
+Uncertainties are 1 σ from the covariance s²·(JᵀJ)⁻¹, with s² = Σr²/(m − n) the residual
+variance (none when m = n). The parameters are classified at the profile and again at the
+fitted values (a sensitivity that is 0 at the start is not trusted to stay 0).
 """
 
 from __future__ import annotations
@@ -47,6 +63,13 @@ LOOSE_SIGMA = 0.25
 determined and the fit is run again without it (a backlash of 125 ± 75 µm tells nothing)."""
 SENSITIVITY_MM = 1e-7
 """A parameter whose unit change moves no measurement by more than this (mm) is not measured."""
+MAX_CORRECTION = 0.2
+"""The largest steps/mm correction a fit accepts by default (fitted / profile − 1, ±20 %): a
+mis-set steps/mm of a real machine is a few %; more is a wrong unit, scale or driver setting."""
+ROW_RATIO = 3.0
+"""A measured value more than this many times its nominal value (or less than its inverse)
+is a unit or typing mistake, refused before the fit."""
+UNMEASURED = "not measured by this sheet (no filled-in row depends on it)"
 
 
 @dataclass(frozen=True)
@@ -123,6 +146,9 @@ class FitResult:
         dof: measurements − fitted parameters.
         overlay: the ``[machine]`` overlay table (fitted keys only).
         iterations: Levenberg–Marquardt iterations run.
+        settings: the controller's steps/mm settings to make, one per fitted axis
+            (``"$100=252.000"`` where the profile names them, else the profile's
+            ``steps_per_mm`` key with the new values).
     """
 
     target: str
@@ -132,6 +158,7 @@ class FitResult:
     dof: int
     overlay: Mapping[str, Any] = field(repr=False)
     iterations: int = 0
+    settings: tuple[str, ...] = ()
 
     @property
     def rms_before_um(self) -> float:
@@ -303,61 +330,92 @@ def fit(
     *,
     target: str = "",
     only: Callable[[Parameter], bool] | None = None,
+    max_correction: float = MAX_CORRECTION,
 ) -> FitResult:
     """Fit ``machine``'s parameters to ``observations`` of the read-back coupon ``read``.
 
     Args:
         read: the coupon's features as the target reads them
-            (:func:`~camtool.calibrate.predict.read_back`).
+            (:func:`~camtool.calibrate.predict.read_back`); every feature of the coupon,
+            so that a refusal can name the rows that would determine a parameter.
         machine: the profile to start from (its ``table`` is what the overlay goes over).
         observations: the measurements.
         target: the target's name, for the result.
-        only: fit only the parameters this accepts (the others keep the profile's values).
+        only: fit only the parameters this accepts (the others are held at the profile's
+            values, said so in the result).
+        max_correction: the largest accepted ``|fitted / profile − 1|`` of a steps/mm.
 
     Raises:
-        InputError: no observation, or the profile cannot be simulated.
+        InputError: no observation; a row that looks like another unit; parameters the
+            rows depend on but cannot tell apart (names the rows that would); a backlash
+            the rows put below 0; a steps/mm correction over ``max_correction``; or the
+            profile cannot be simulated.
     """
     if not observations:
         raise InputError("no measured value to fit: fill in the 'measured_mm' column of the sheet")
-    candidates = [p for p in parameters(machine) if only is None or only(p)]
+    _check_rows(observations)
+    everything = parameters(machine)
+    candidates = [p for p in everything if only is None or only(p)]
+    undetermined: list[tuple[Parameter, str]] = [
+        (p, "held at the profile's value (not fitted: --hold)")
+        for p in everything
+        if p not in candidates
+    ]
     model = _Model(read, machine, observations, candidates)
     start = np.array([p.start for p in candidates])
     y = np.array([o.value_mm for o in observations])
     before = model(start)
-    undetermined: list[tuple[Parameter, str]] = []
+    first = len(undetermined)
     jac = _jacobian(model, start, before, candidates, undetermined)
-    keep = _determined(jac, candidates, undetermined)
+    keep, confounded = _determined(jac, candidates, undetermined)
     if only is None or only(joint_xy(machine)):
-        keep, jac = _joint_if_needed(model, jac, candidates, keep, undetermined, machine)
-        start = np.array([p.start for p in candidates])
-    while True:
-        params = [candidates[k] for k in keep]
-        theta, pred, iterations, sigmas = _solve(model, start, keep, y, jac, params, before)
-        loose = _loosest(params, theta, sigmas)
-        if loose is None:
-            break
-        k = keep.pop(loose)
-        undetermined.append(
-            (
-                candidates[k],
-                "not determined by these measurements (it came out "
-                f"{_value_text(candidates[k], theta[loose])} ± "
-                f"{_value_text(candidates[k], sigmas[loose] or 0.0)}: they hardly constrain it)",
-            )
+        keep, jac, confounded = _joint_if_needed(
+            model, jac, candidates, keep, confounded, undetermined, machine
         )
+        start = np.array([p.start for p in candidates])
+    _refuse_confounded(confounded, candidates, jac, read, machine, observations)
+    theta, pred, iterations, sigmas, jac_k = _solve(model, start, keep, y, jac)
+    # a parameter no row depended on at the profile may matter at the fitted values
+    full = start.copy()
+    full[keep] = theta
+    woken = _woken(model, full, pred, candidates, undetermined[first:])
+    if woken:
+        undetermined[first:] = [(p, why) for p, why in undetermined[first:] if p not in woken]
+        jac = _jacobian(model, full, pred, candidates)
+        keep, confounded = _determined(jac, candidates, undetermined)
+        _refuse_confounded(confounded, candidates, jac, read, machine, observations)
+        theta, pred, iterations, sigmas, jac_k = _solve(model, full, keep, y, jac)
+    params = [candidates[k] for k in keep]
+    _check_backlash_sign(params, theta, y - pred, jac_k, observations, machine)
+    _check_correction(params, theta, max_correction)
     dof = len(y) - len(params)
-    fitted = tuple(Fitted(p, float(v), s) for p, v, s in zip(params, theta, sigmas, strict=True))
+    fitted = []
+    for p, v, sd in zip(params, theta, sigmas, strict=True):
+        if _loose(p, float(v), sd):
+            undetermined.append(
+                (
+                    p,
+                    "not determined by these measurements (it came out "
+                    f"{_value_text(p, float(v))} ± {_value_text(p, sd or 0.0)}: they hardly "
+                    "constrain it; the others were fitted with it free)",
+                )
+            )
+        else:
+            fitted.append(Fitted(p, float(v), sd))
     residuals = tuple(
         Residual(o, float(b), float(a)) for o, b, a in zip(observations, before, pred, strict=True)
     )
+    kept = [f.parameter for f in fitted]
+    overlay = overlay_table(machine, kept, [f.value for f in fitted])
     return FitResult(
         target or machine.name,
-        fitted,
+        tuple(fitted),
         tuple(undetermined),
         residuals,
         dof,
-        overlay_table(machine, params, [float(v) for v in theta]),
+        overlay,
         iterations,
+        _settings(machine, kept, overlay),
     )
 
 
@@ -367,30 +425,242 @@ def _solve(
     keep: list[int],
     y: np.ndarray,
     jac: np.ndarray,
-    params: list[Parameter],
-    before: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray, int, list[float | None]]:
-    """Levenberg–Marquardt over the parameters ``keep``: values, prediction, iterations, σ."""
+) -> tuple[np.ndarray, np.ndarray, int, list[float | None], np.ndarray]:
+    """Levenberg–Marquardt over the parameters ``keep``: values, prediction, iterations, σ, J."""
     full = start.copy()
+    params = [model.params[k] for k in keep]
 
     def run(values: np.ndarray) -> np.ndarray:
         full[keep] = values
         return model(full)
 
     if not params:
-        return start[keep], before, 0, []
+        return start[keep], model(start), 0, [], np.zeros((len(y), 0))
     theta, pred, iterations, jac_k = _levenberg_marquardt(run, start[keep], y, jac[:, keep], params)
-    return theta, pred, iterations, _sigmas(jac_k, y - pred, len(y) - len(params))
+    return theta, pred, iterations, _sigmas(jac_k, y - pred, len(y) - len(params)), jac_k
 
 
-def _loosest(params: list[Parameter], theta: np.ndarray, sigmas: list[float | None]) -> int | None:
-    """The parameter whose σ is largest against its size, if over :data:`LOOSE_SIGMA`, else None."""
-    worst, index = LOOSE_SIGMA, None
-    for k, (p, v, s) in enumerate(zip(params, theta, sigmas, strict=True)):
-        size = max(abs(p.start), abs(float(v)), 10 * p.unit_change)
-        if s is not None and s / size > worst:
-            worst, index = s / size, k
+def _loose(p: Parameter, value: float, sigma: float | None) -> bool:
+    """Whether ``sigma`` exceeds :data:`LOOSE_SIGMA` of the parameter's size."""
+    size = max(abs(p.start), abs(value), 10 * p.unit_change)
+    return sigma is not None and sigma / size > LOOSE_SIGMA
+
+
+def _woken(
+    model: _Model,
+    theta: np.ndarray,
+    at: np.ndarray,
+    candidates: Sequence[Parameter],
+    undetermined: Sequence[tuple[Parameter, str]],
+) -> list[Parameter]:
+    """The unmeasured candidates on which a row depends at ``theta`` (the fitted values)."""
+    out = []
+    for p, why in undetermined:
+        if why != UNMEASURED or p not in candidates:
+            continue
+        k = candidates.index(p)
+        step = theta.copy()
+        step[k] += p.unit_change
+        try:
+            moved = np.max(np.abs(model(step) - at), initial=0.0)
+        except CamtoolError:
+            continue
+        if moved >= SENSITIVITY_MM:
+            out.append(p)
+    return out
+
+
+def _check_rows(observations: Sequence[Observation]) -> None:
+    """Refuse a row whose value is far from its nominal: another unit, or a typing mistake."""
+    for o in observations:
+        ratio = o.value_mm / o.measure.nominal_mm if o.measure.nominal_mm > 0 else 1.0
+        if 1 / ROW_RATIO <= ratio <= ROW_RATIO:
+            continue
+        where = f"line {o.line}, " if o.line else ""
+        raise InputError(
+            f"{where}{o.measure.id}: measured {fmt_num(o.value_mm, 4)} for a nominal of "
+            f"{fmt_num(o.measure.nominal_mm, 4)} mm ({_factor_text(ratio)} it): "
+            f"{_unit_cause(ratio)}; the measured_mm column is in millimetres"
+        )
+
+
+def _factor_text(ratio: float) -> str:
+    return f"{ratio:.4g} times" if ratio >= 1 else f"1/{1 / ratio:.4g} of"
+
+
+def _unit_cause(ratio: float) -> str:
+    """The likely mistake behind values ``ratio`` times what a right sheet would hold."""
+    for factor, cause in (
+        (1000.0, "the values look like µm"),
+        (1 / 25.4, "the values look like inches"),
+        (0.001, "the values look like metres"),
+        (10.0, "the values look like 0.1 mm units"),
+        (0.1, "the values look like cm"),
+        (25.4, "the values look like mm measured on an inch nominal"),
+    ):
+        if abs(ratio / factor - 1) < 0.05:
+            return cause
+    power = round(math.log2(ratio)) if ratio > 0 else 0
+    if power and abs(ratio / 2.0**power - 1) < 0.05:
+        n = 2 ** abs(power)
+        typed = "doubled" if power > 0 else "halved, a radius for a diameter"
+        return (
+            f"the values look {n}× too {'large' if power > 0 else 'small'} ({typed}), or a "
+            f"driver's microstepping is set {n}× off (fix that first)"
+        )
+    return "a typing mistake or another unit"
+
+
+def _check_correction(params: Sequence[Parameter], theta: np.ndarray, limit: float) -> None:
+    """Refuse a steps/mm correction beyond ``limit``, naming the likely cause."""
+    for p, v in zip(params, (float(t) for t in theta), strict=True):
+        if p.unit != "steps/mm" or abs(v / p.start - 1) <= limit:
+            continue
+        ratio = p.start / v  # how much longer the machine moves than it should
+        raise InputError(
+            f"{p.label} came out {_value_text(p, v)} steps/mm against the profile's "
+            f"{_value_text(p, p.start)}: a correction of {(v / p.start - 1) * 100:+.1f} %, "
+            f"beyond the ±{limit * 100:g} % a mis-set steps/mm explains; the machine moves "
+            f"{_factor_text(ratio)} the nominal distances: {_unit_cause(ratio)}; if the machine "
+            "really is that far off (a wrong lead, pulley or steps_per_mm in the profile), "
+            "correct the profile's steps_per_mm first, or give --max-correction "
+            f"{math.ceil(abs(v / p.start - 1) * 100 + 1)}"
+        )
+
+
+def _check_backlash_sign(
+    params: Sequence[Parameter],
+    theta: np.ndarray,
+    residual: np.ndarray,
+    jac: np.ndarray,
+    observations: Sequence[Observation],
+    machine: Machine,
+) -> None:
+    """Refuse a backlash held at 0 that the rows put clearly below 0.
+
+    The fit keeps a backlash >= 0; at that bound the unconstrained linearised estimate
+    (J at the fitted values) says how far below 0 the rows want it: more than 3 σ and more
+    than a motor step (or 2 µm) means the rows contradict the model (swapped or mistyped
+    rows, or a wrong compensation column), and the other parameters would absorb it.
+    """
+    if jac.size == 0:
+        return
+    scaled = jac * np.array([p.unit_change for p in params])
+    delta_scaled, *_ = np.linalg.lstsq(scaled, residual, rcond=None)
+    delta = delta_scaled * np.array([p.unit_change for p in params])
+    dof = len(residual) - len(params)
+    sigmas = _sigmas(jac, residual - jac @ delta, dof)
+    for k, p in enumerate(params):
+        if p.unit != "µm" or theta[k] > 1e-9:
+            continue
+        estimate = float(theta[k] + delta[k])
+        axis = _backlash_axis(p, machine)
+        floor = max(3 * (sigmas[k] or 0.0), 1000.0 / machine.real_steps_per_mm[axis], 2.0)
+        if estimate >= -floor:
+            continue
+        rows = [o for o, d in zip(observations, jac[:, k], strict=True) if abs(d) > 1e-9]
+        shown = ", ".join(
+            f"{o.measure.id} {fmt_num(o.value_mm, 4)} mm" + (f" (line {o.line})" if o.line else "")
+            for o in rows[:6]
+        )
+        sigma = f" ± {_value_text(p, sigmas[k] or 0.0)}" if sigmas[k] is not None else ""
+        raise InputError(
+            f"{p.label} comes out negative, {_value_text(p, estimate)}{sigma} µm: a backlash is "
+            f">= 0, so these rows contradict the model ({shown}): a line cut after a reversal "
+            "is longer than the compensation on the sheet can make it; check for swapped or "
+            "mistyped rows (out/back), and that the compensation columns hold what each "
+            "feature was cut with"
+        )
+
+
+def _backlash_axis(p: Parameter, machine: Machine) -> int:
+    """The axis (0 = X, 1 = Y) of a backlash parameter, from its key."""
+    index = int(p.key.split("[")[1].split("]")[0])
+    if p.key.startswith("backlash.regions"):
+        return AXES.index(machine.backlash.regions[index].axis)
     return index
+
+
+def _settings(
+    machine: Machine, fitted: Sequence[Parameter], overlay: Mapping[str, Any]
+) -> tuple[str, ...]:
+    """The controller settings that make the machine move true distances (fitted axes only)."""
+    keys = {p.key for p in fitted}
+    axes = [a for a in range(3) if f"true_steps_per_mm[{a}]" in keys]
+    if JOINT_XY in keys:
+        axes = sorted({0, 1, *axes})
+    if not axes:
+        return ()
+    true = overlay["true_steps_per_mm"]
+    if machine.steps_per_mm_settings:
+        return tuple(
+            machine.steps_per_mm_settings[a].replace("{}", fmt_num(true[a], 3)) for a in axes
+        )
+    new = [true[a] if a in axes else machine.steps_per_mm[a] for a in range(3)]
+    return (f"steps_per_mm = {_array(new)}",)
+
+
+def _refuse_confounded(
+    confounded: Sequence[tuple[int, list[int]]],
+    candidates: Sequence[Parameter],
+    jac: np.ndarray,
+    read: Sequence[ReadBack],
+    machine: Machine,
+    observations: Sequence[Observation],
+) -> None:
+    """Refuse parameters the rows depend on but cannot tell apart, naming the missing rows."""
+    if not confounded:
+        return
+    k, partners = confounded[0]
+    group = [k, *partners]
+    labels = " and ".join(candidates[i].label for i in group)
+    rows = sorted(
+        {o.measure.id for i in group for o, d in zip(observations, jac[:, i], strict=True) if d}
+    )
+    missing = _rows_that_depend(read, machine, observations, [candidates[i] for i in group])
+    measure = f"fill in {_ids_text(missing)} too" if missing else "add a feature that does"
+    raise InputError(
+        f"the sheet cannot tell {labels} apart: the filled-in rows that depend on them "
+        f"({_ids_text(rows)}) change the same way with each, so fitting one would move the "
+        f"other's error into it. To fit them, {measure}; or hold the profile's values "
+        f"(--hold {'backlash' if candidates[k].unit == 'µm' else 'steps'}, said so in the "
+        "overlay); or leave those rows empty"
+    )
+
+
+def _rows_that_depend(
+    read: Sequence[ReadBack],
+    machine: Machine,
+    observations: Sequence[Observation],
+    params: Sequence[Parameter],
+) -> list[str]:
+    """The coupon's rows not filled in on which any of ``params`` acts (at the profile)."""
+    taken = {o.measure.id for o in observations}
+    others = [Observation(m, m.nominal_mm) for r in read for m in r.feature.measures]
+    others = [o for o in others if o.measure.id not in taken]
+    if not others:
+        return []
+    model = _Model(read, machine, others, params)
+    start = np.array([p.start for p in params])
+    at = model(start)
+    jac = _jacobian(model, start, at, params, [])
+    moved = np.max(np.abs(jac * np.array([p.unit_change for p in params])), axis=1)
+    return [o.measure.id for o, d in zip(others, moved, strict=True) if d >= SENSITIVITY_MM]
+
+
+def _ids_text(ids: Sequence[str]) -> str:
+    """Row ids grouped by feature: ``LY.p1…p10, UY.out, UY.back``."""
+    groups: dict[str, list[str]] = {}
+    for i in ids:
+        feature, _, measure = i.partition(".")
+        groups.setdefault(feature, []).append(measure)
+    parts = []
+    for feature, names in groups.items():
+        if len(names) > 3:
+            parts.append(f"{feature}.{names[0]}…{names[-1]}")
+        else:
+            parts += [f"{feature}.{n}" for n in names]
+    return ", ".join(parts)
 
 
 def _jacobian(
@@ -422,12 +692,14 @@ def _joint_if_needed(
     jac: np.ndarray,
     candidates: list[Parameter],
     keep: list[int],
+    confounded: list[tuple[int, list[int]]],
     undetermined: list[tuple[Parameter, str]],
     machine: Machine,
-) -> tuple[list[int], np.ndarray]:
+) -> tuple[list[int], np.ndarray, list[tuple[int, list[int]]]]:
     """Keep X's and Y's steps/mm, or fit them as one (:data:`JOINT_XY`) if only that is determined.
 
-    Appends the joint parameter to ``candidates`` (and a column to the model) when it is used.
+    Appends the joint parameter to ``candidates`` (and a column to the model) when it is used;
+    then neither is confounded any more.
     """
     xy = [
         k
@@ -435,67 +707,70 @@ def _joint_if_needed(
         if p.key in ("true_steps_per_mm[0]", "true_steps_per_mm[1]")
     ]
     kept = [k for k in xy if k in keep]
-    unmeasured = {p.key for p, why in undetermined if "none depends" in why}
-    if len(kept) == 2 or len(xy) < 2 or any(candidates[k].key in unmeasured for k in xy):
-        return keep, jac
+    if len(kept) == 2 or len(xy) < 2 or not any(k in xy for k, _ in confounded):
+        return keep, jac, confounded
     joint = joint_xy(machine)
     ratio = candidates[xy[1]].start / candidates[xy[0]].start
     column = jac[:, xy[0]] + jac[:, xy[1]] * ratio
     others = [k for k in keep if k not in xy]
+    rest = [(k, partners) for k, partners in confounded if k not in xy]
     candidates.append(joint)
     model.params.append(joint)
     trial_jac = np.hstack([jac, column[:, None]])
-    sub_undetermined: list[tuple[Parameter, str]] = []
     order = [*others, len(candidates) - 1]
-    ok = _determined(trial_jac[:, order], [candidates[k] for k in order], sub_undetermined)
-    if len(ok) != len(order):
+    ok, sub_confounded = _determined(
+        trial_jac[:, order], [candidates[k] for k in order], [], report=False
+    )
+    if len(ok) != len(order) or sub_confounded:
         model.params.pop()
         candidates.pop()
-        return keep, jac
-    undetermined[:] = [
-        (p, why)
-        for p, why in undetermined
-        if p.key not in ("true_steps_per_mm[0]", "true_steps_per_mm[1]")
-    ]
+        return keep, jac, confounded
     for k in xy:
         undetermined.append(
             (
                 candidates[k],
                 "not determined alone by these measurements (only with the other "
-                "axis: fitted as one lead, see 'X and Y')",
+                "axis: fitted as one lead, see 'X and Y', Y keeping its ratio to X)",
             )
         )
-    return sorted([*others, len(candidates) - 1]), trial_jac
+    return sorted(order), trial_jac, rest
 
 
 def _determined(
-    jac: np.ndarray, params: Sequence[Parameter], undetermined: list[tuple[Parameter, str]]
-) -> list[int]:
-    """Indices of the parameters the measurements determine; the others go to ``undetermined``."""
+    jac: np.ndarray,
+    params: Sequence[Parameter],
+    undetermined: list[tuple[Parameter, str]],
+    *,
+    report: bool = True,
+) -> tuple[list[int], list[tuple[int, list[int]]]]:
+    """The parameters the measurements determine, and those they cannot tell apart.
+
+    Returns the indices kept, and for each confounded parameter its index with the kept
+    indices whose columns share its rows. An unmeasured parameter goes to
+    ``undetermined`` (:data:`UNMEASURED`; when ``report``).
+    """
     refused = {p.key for p, _ in undetermined}
     scaled = jac * np.array([p.unit_change for p in params])
     keep: list[int] = []
+    confounded: list[tuple[int, list[int]]] = []
     for k, p in enumerate(params):
         if p.key in refused:
             continue
         if np.max(np.abs(scaled[:, k]), initial=0.0) < SENSITIVITY_MM:
-            undetermined.append((p, "not determined by these measurements (none depends on it)"))
+            if report:
+                undetermined.append((p, UNMEASURED))
             continue
         trial = [*keep, k]
         cols = scaled[:, trial] / np.linalg.norm(scaled[:, trial], axis=0)
         r = np.linalg.qr(cols, mode="r")
         pivots = np.abs(np.diag(r))
         if len(trial) > len(jac) or pivots.min() < PIVOT_RATIO * pivots.max():
-            undetermined.append(
-                (
-                    p,
-                    "not determined by these measurements (the other parameters explain the "
-                    "same measurements; measure a feature that tells them apart)",
-                )
-            )
+            rows = np.abs(scaled[:, k]) >= SENSITIVITY_MM
+            partners = [j for j in keep if np.any(np.abs(scaled[rows, j]) >= SENSITIVITY_MM)]
+            confounded.append((k, partners))
             continue
         keep.append(k)
-    return keep
+    return keep, confounded
 
 
 def _levenberg_marquardt(
@@ -507,7 +782,8 @@ def _levenberg_marquardt(
 ) -> tuple[np.ndarray, np.ndarray, int, np.ndarray]:
     """Minimise Σ (y − run(θ))²; returns θ, the prediction, the iterations and the Jacobian."""
     unit = np.array([p.unit_change for p in params])
-    lower = np.array([0.0 if p.unit == "µm" else 1e-3 * p.start for p in params])
+    lower = np.array([0.0 if p.unit == "µm" else p.start / 10 for p in params])
+    upper = np.array([1e5 if p.unit == "µm" else p.start * 10 for p in params])
     pred = run(theta)
     cost = float(np.sum((y - pred) ** 2))
     lam = 1e-3
@@ -518,8 +794,8 @@ def _levenberg_marquardt(
         g = a.T @ (y - pred)
         h = a.T @ a
         while True:
-            step = np.linalg.solve(h + lam * np.diag(np.diag(h)), g)
-            trial = np.maximum(theta + step * unit, lower)  # backlash >= 0, steps/mm > 0
+            step = np.linalg.lstsq(h + lam * np.diag(np.diag(h)), g, rcond=None)[0]
+            trial = np.clip(theta + step * unit, lower, upper)  # backlash >= 0, in RANGES
             trial_pred = run(trial)
             trial_cost = float(np.sum((y - trial_pred) ** 2))
             if trial_cost <= cost or lam > 1e8:
@@ -587,6 +863,7 @@ def summary_lines(result: FitResult) -> list[str]:
         )
     for p, why in result.undetermined:
         lines.append(f"  {p.label}: {why}; left at {_value_text(p, p.start)} {p.unit}")
+    lines += [f"  {line}" for line in setting_lines(result)]
     lines.append(
         f"  residuals (measured - predicted), µm: rms {fmt_num(result.rms_before_um, 1)} before, "
         f"{fmt_num(result.rms_after_um, 1)} after"
@@ -599,6 +876,22 @@ def summary_lines(result: FitResult) -> list[str]:
             f"residual {fmt_num(r.residual_um, 1)} µm"
         )
     return lines
+
+
+def setting_lines(result: FitResult) -> list[str]:
+    """What to change so that the machine cuts true sizes (empty when no steps/mm was fitted)."""
+    if not result.settings:
+        return []
+    where = (
+        "the controller's setting"
+        if not result.settings[0].startswith("steps_per_mm =")
+        else "the profile's (the firmware's) value"
+    )
+    return [
+        f"to cut true sizes, change {where}: {'  '.join(result.settings)}",
+        "(the overlay describes the machine as it is set now: after the change, drop its "
+        "true_steps_per_mm and cut the coupon again to check)",
+    ]
 
 
 def overlay_toml(result: FitResult, *, source: str) -> str:
@@ -619,7 +912,8 @@ def overlay_toml(result: FitResult, *, source: str) -> str:
             f"{f.parameter.unit}"
         )
     for p, why in result.undetermined:
-        head.append(f"# not fitted: {p.label}: {why}")
+        head.append(f"# not fitted: {p.label}: {why}; the profile's {_value_text(p, p.start)}")
+    head += [f"# {line}" for line in setting_lines(result)]
     body = ["[machine]"]
     o = result.overlay
     if "true_steps_per_mm" in o:

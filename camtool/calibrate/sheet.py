@@ -24,12 +24,21 @@ from __future__ import annotations
 import csv
 import io
 import math
+import re
+from pathlib import Path
 
 from camtool.calibrate.coupon import Coupon, Measure
 from camtool.calibrate.fit import Observation
 from camtool.model.errors import InputError
 from camtool.model.machine import Machine
+from camtool.model.tomlfile import read_small_text
 from camtool.model.units import LARGEST_VALUE, fmt_num
+
+SHEET_BYTES = 1 << 20
+"""The largest sheet read, bytes (a coupon's filled-in sheet is under 20 KB)."""
+NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?", re.ASCII)
+"""A plain ASCII decimal (``12``, ``12.5``, ``.5``, ``1.2e-3``): what a sheet's number may be.
+Python's ``float`` also takes ``1_5``, full-width and Arabic-Indic digits, ``inf`` and ``nan``."""
 
 COLUMNS = (
     "id",
@@ -114,6 +123,16 @@ def sheet_markdown(
     return "\n".join(lines)
 
 
+def read_sheet(path: str | Path) -> str:
+    """The text of a filled-in sheet file: a regular file of at most :data:`SHEET_BYTES`, UTF-8.
+
+    Raises:
+        InputError: missing or unreadable, not a regular file (a FIFO or a device is
+            refused before it is opened for reading), too large or not UTF-8.
+    """
+    return read_small_text(path, what="measurement sheet", limit_bytes=SHEET_BYTES)
+
+
 def read_measurements(text: str, coupon: Coupon, *, source: str) -> list[Observation]:
     """The filled-in rows of a sheet CSV as observations of ``coupon``'s measures.
 
@@ -191,13 +210,12 @@ def _number(
     text = cells.get(column, "")
     if not text:
         return None
-    try:
-        value = float(text)
-    except ValueError:
+    if NUMBER.fullmatch(text) is None:
         raise InputError(
-            f"{source}: line {line}, column '{column}': {text!r} is not a number (mm or µm as the "
-            "column's name says; a decimal point, not a comma)"
-        ) from None
+            f"{source}: line {line}, column '{column}': {text!r} is not a number (plain ASCII "
+            "digits with a decimal point, e.g. 12.345; mm or µm as the column's name says)"
+        )
+    value = float(text)
     if (
         not math.isfinite(value)
         or abs(value) >= LARGEST_VALUE

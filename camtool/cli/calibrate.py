@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 
 from camtool.cli.common import MACHINE, publishes, warn, write_output
-from camtool.model.errors import InputError, UsageError
+from camtool.model.errors import UsageError
 
 TARGET = click.option(
     "--target",
@@ -89,26 +89,49 @@ def coupon(
 @TARGET
 @click.argument("measured", metavar="MEASURED.csv")
 @click.option("-o", "--output", required=True, metavar="M.toml", help="The --machine overlay.")
+@click.option(
+    "--hold",
+    multiple=True,
+    type=click.Choice(["steps", "backlash"]),
+    help="Keep the profile's steps/mm or backlash instead of fitting it (repeatable).",
+)
+@click.option(
+    "--max-correction",
+    type=click.FloatRange(min=0, min_open=True, max=1000),
+    default=20.0,
+    show_default=True,
+    metavar="PCT",
+    help="Refuse a steps/mm correction larger than this, %.",
+)
 @MACHINE
 @publishes
-def fit(target: str, measured: str, output: str, machine_file: Path | None) -> None:
-    """Fit the target's profile to a filled-in sheet; write a --machine overlay."""
+def fit(
+    target: str,
+    measured: str,
+    output: str,
+    hold: tuple[str, ...],
+    max_correction: float,
+    machine_file: Path | None,
+) -> None:
+    """Fit the target's profile to a filled-in sheet; write a --machine overlay.
+
+    What the sheet cannot determine is refused, naming the rows to measure, unless
+    --hold keeps the profile's value; the steps/mm settings to change are printed.
+    """
     from camtool.calibrate import fit_sheet
     from camtool.calibrate.fit import overlay_toml, summary_lines
+    from camtool.calibrate.sheet import read_sheet
     from camtool.jobs.output import check_paths
     from camtool.jobs.pipeline import load_target_checked
 
     check_paths(
         [("the sheet", measured)], [("-o", output)], target=target, machine_file=machine_file
     )
-    try:
-        text = Path(measured).read_text("utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(
-            f"{measured}: cannot read ({getattr(exc, 'strerror', None) or exc})"
-        ) from exc
+    text = read_sheet(measured)
     chosen = load_target_checked(target, machine_file=machine_file)
-    result = fit_sheet(chosen, text, source=measured)
+    result = fit_sheet(
+        chosen, text, source=measured, hold=hold, max_correction=max_correction / 100
+    )
     for line in summary_lines(result):
         click.echo(line, err=True)
     write_output(overlay_toml(result, source=Path(measured).name), output)

@@ -14,6 +14,7 @@ Profile layout (every key optional except ``name``, ``steps_per_mm`` and
     true_steps_per_mm = [x, y, z]       # what the mechanics do (default: nominal)
     work_area_mm = [xmin, ymin, xmax, ymax], coordinates = "work" | "machine",
     has_z, max_step_rate_hz, source
+    steps_per_mm_settings = ["$100={}", ...]  # how the operator sets steps/mm, per axis
     [machine.motion]    line, arc, chords (names the verifier looks up),
                         chord_tolerance_mm, chord_segments, chord_angle_deg, rounding
     [machine.backlash]  true_um = [x, y, z], compensation_um = [x, y, z]
@@ -154,6 +155,10 @@ class Machine:
         timing: the ``[machine.timing]`` table as written: ``model`` (a timing model
             name) and its parameters; the verifier looks it up and checks it
             (:func:`camtool.verify.motion.timing_model_from_table`).
+        steps_per_mm_settings: how the operator sets the controller's steps/mm per
+            axis ``(x, y, z)``: a template with ``{}`` where the value goes (GRBL:
+            ``"$100={}"``); empty when the profile's ``steps_per_mm`` is the setting
+            (compiled into the firmware). Printed by ``camtool calibrate fit``.
         table: the ``[machine]`` table it was built from (empty when built in
             code), so that ``--machine`` can be laid over any profile.
     """
@@ -170,6 +175,7 @@ class Machine:
     motion: Motion = field(default_factory=Motion)
     backlash: Backlash = field(default_factory=Backlash)
     timing: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
+    steps_per_mm_settings: tuple[str, ...] = ()
     table: Mapping[str, Any] = field(
         default_factory=lambda: MappingProxyType({}), compare=False, repr=False
     )
@@ -249,6 +255,7 @@ def machine_from_table(table: Mapping[str, Any], *, where: str) -> Machine:
         motion=_motion(r.table("motion")),
         backlash=_backlash(r.table("backlash")),
         timing=r.raw_table("timing"),
+        steps_per_mm_settings=r.templates("steps_per_mm_settings", 3),
         table=MappingProxyType(dict(table)),
     )
     r.done()
@@ -318,6 +325,25 @@ class _Reader:
         if not isinstance(value, str):
             raise self._fail(key, "a string", value)
         return value
+
+    def templates(self, key: str, count: int) -> tuple[str, ...]:
+        """``count`` short printable-ASCII templates, each with one ``{}``, or ``()``."""
+        value = self._get(key, False)
+        if value is None:
+            return ()
+        want = f'a list of {count} strings, each with one {{}} for the value ("$100={{}}")'
+        if not isinstance(value, list) or len(value) != count:
+            raise self._fail(key, want, value)
+        for item in value:
+            if (
+                not isinstance(item, str)
+                or len(item) > 80
+                or not (item.isascii() and item.isprintable())
+                or item.count("{}") != 1
+                or item.replace("{}", "").count("{") + item.replace("{}", "").count("}")
+            ):
+                raise self._fail(key, want, value)
+        return tuple(value)
 
     def name(self, key: str, default: str) -> str:
         """A non-empty name (checked where it is used, e.g. an interpolator's)."""

@@ -1,6 +1,7 @@
-"""Small TOML files (job, machine and target files) read safely.
+"""Small TOML files (job, machine and target files) and other small text files read safely.
 
-One reader for every TOML file a user hands camtool: only a regular file (a FIFO or
+One reader for every small file a user hands camtool (:func:`read_small_text`; the TOML
+files through :func:`read_toml_file`, measurement sheets too): only a regular file (a FIFO or
 a device such as ``/dev/zero`` is refused before it is read, so nothing blocks or
 fills memory), at most a given size, UTF-8 (a byte-order mark is dropped), nested no
 deeper than such a file needs (tomllib recurses per level).
@@ -21,18 +22,20 @@ SMALL_TOML_BYTES = 1 << 20
 """The largest machine or target file read, bytes (the built-in ones are under 20 KB)."""
 
 
-def read_toml_file(path: str | Path, *, what: str, limit_bytes: int) -> dict[str, Any]:
-    """A small TOML file read safely: a regular file, its size bounded.
+def read_small_text(path: str | Path, *, what: str, limit_bytes: int) -> str:
+    """A small text file read safely: a regular file, its size bounded, UTF-8.
+
+    A FIFO or a device is refused before it is read (opened without blocking, checked
+    with ``fstat``); a byte-order mark is dropped.
 
     Args:
         path: the file.
-        what: what the file is, for messages (``"job file"``).
+        what: what the file is, for messages (``"job file"``, ``"measurement sheet"``).
         limit_bytes: the largest file read.
 
     Raises:
-        InputError: not a regular file (a FIFO or a device is not opened for reading), too
-            large, not UTF-8 text, or not TOML (the message gives tomllib's line and
-            column); nested more deeply than any such file needs.
+        InputError: missing or unreadable, not a regular file, larger than
+            ``limit_bytes``, or not UTF-8 text; each message names the file.
     """
     name = str(path)
     try:
@@ -50,6 +53,8 @@ def read_toml_file(path: str | Path, *, what: str, limit_bytes: int) -> dict[str
             )
         with os.fdopen(os.dup(fd), "rb") as stream:
             data = stream.read(limit_bytes + 1)
+    except OSError as exc:
+        raise InputError(f"{name}: cannot read the {what} ({exc.strerror or exc})") from None
     finally:
         os.close(fd)
     if len(data) > limit_bytes:
@@ -60,8 +65,24 @@ def read_toml_file(path: str | Path, *, what: str, limit_bytes: int) -> dict[str
         raise InputError(
             f"{name}: the {what} is not UTF-8 text (byte {exc.start}); save it as UTF-8"
         ) from None
-    if text.startswith("\ufeff"):
-        text = text[1:]
+    return text[1:] if text.startswith("\ufeff") else text
+
+
+def read_toml_file(path: str | Path, *, what: str, limit_bytes: int) -> dict[str, Any]:
+    """A small TOML file read safely (:func:`read_small_text`), nesting bounded.
+
+    Args:
+        path: the file.
+        what: what the file is, for messages (``"job file"``).
+        limit_bytes: the largest file read.
+
+    Raises:
+        InputError: not a regular file (a FIFO or a device is not opened for reading), too
+            large, not UTF-8 text, or not TOML (the message gives tomllib's line and
+            column); nested more deeply than any such file needs.
+    """
+    name = str(path)
+    text = read_small_text(path, what=what, limit_bytes=limit_bytes)
     if re.search(r"[\[{]{64}", text.replace(" ", "")):
         raise InputError(f"{name}: the {what} nests arrays or tables more than 64 deep")
     try:

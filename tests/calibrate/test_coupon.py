@@ -127,3 +127,43 @@ def test_the_spindle_runs_for_the_whole_coupon(name: str, rpm: float) -> None:
     spindle = [(i, c) for i, c in program.commands if isinstance(c, Spindle)]
     assert spindle[0][0] == 0 and spindle[0][1].rpm == rpm and spindle[0][1].direction == "cw"
     assert spindle[-1] == (len(program.moves), Spindle("off"))
+
+
+def _scale(target, width: float, height: float) -> float:
+    """The coupon's scale in a ``width`` x ``height`` mm work area (0: refused as too small)."""
+    from dataclasses import replace
+
+    machine = machine_from_table(
+        merge_tables(target.machine.table, {"work_area_mm": [0.0, 0.0, width, height]}), where="t"
+    )
+    try:
+        return build_coupon(replace(target, machine=machine)).scale
+    except UsageError:
+        return 0.0
+
+
+@pytest.mark.parametrize("name", TARGETS)
+def test_a_100_by_70_mm_travel_gets_a_coupon(name: str) -> None:
+    """A common small router; pic-mmh's regions (sized for its 10 x 7 mm) stay inside it."""
+    assert _scale(load_target(name), 100.0, 70.0) >= 1.0
+
+
+SIDES = (3.0, 5.0, 7.0, 10.0, 14.0, 20.0, 30.0, 45.0, 70.0, 100.0, 150.0, 220.0, 330.0)
+
+
+@pytest.mark.parametrize("name", ["grbl", "pic-mmh", "valcnc", "matlab-router"])
+def test_the_scale_never_decreases_when_the_travel_grows(name: str) -> None:
+    """Property: over a grid of travels, a wider or taller work area never gets a smaller
+    coupon (the scale is monotonic non-decreasing in each side), and a travel ten times
+    another's gets a larger coupon until the largest (10×)."""
+    target = load_target(name)
+    grid = {(w, h): _scale(target, w, h) for w in SIDES for h in SIDES}
+    for (w, h), s in grid.items():
+        i, j = SIDES.index(w), SIDES.index(h)
+        if i + 1 < len(SIDES):
+            assert s <= grid[(SIDES[i + 1], h)], (w, h)
+        if j + 1 < len(SIDES):
+            assert s <= grid[(w, SIDES[j + 1])], (w, h)
+    squares = [grid[(side, side)] for side in SIDES]
+    for small, large in zip(squares, squares[6:], strict=False):
+        assert large > small or large == 10 or small == 0

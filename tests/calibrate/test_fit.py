@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from camtool.calibrate.coupon import build_coupon
-from camtool.calibrate.fit import Observation, fit, overlay_toml
+from camtool.calibrate.fit import UNMEASURED, Observation, fit, overlay_toml
 from camtool.calibrate.predict import predict, read_back
 from camtool.calibrate.sheet import read_measurements, sheet_csv
 from camtool.model.errors import InputError
@@ -57,7 +57,7 @@ def test_nothing_depends_on_an_unmeasured_parameter() -> None:
     lx = [m for m in coupon.measures if m.id.startswith("LX.")]
     result = fit(read, target.machine, [Observation(m, m.nominal_mm * 1.01) for m in lx])
     undetermined = dict((p.key, why) for p, why in result.undetermined)
-    assert "none depends on it" in undetermined["true_steps_per_mm[1]"]
+    assert undetermined["true_steps_per_mm[1]"] == UNMEASURED
     assert "backlash.true_um[0]" in undetermined  # a one-way move never reverses
     assert result.value("true_steps_per_mm[0]") == pytest.approx(250.0 / 1.01, rel=1e-4)
 
@@ -70,7 +70,7 @@ def _sheet(rows: list[str]) -> str:
     ("rows", "message"),
     [
         (["LX.p1,abc,"], r"m\.csv: line 2, column 'measured_mm': 'abc' is not a number"),
-        (["LX.p1,nan,"], r"line 2, column 'measured_mm': 'nan' must be a finite number"),
+        (["LX.p1,nan,"], r"line 2, column 'measured_mm': 'nan' is not a number"),
         (["LX.p1,-1,"], r"line 2, column 'measured_mm'"),
         (["ZZ.p1,1,"], r"line 2, column 'id': unknown measure 'ZZ.p1'"),
         (["LX.p1,15,", "LX.p1,15,"], r"line 3, column 'id': 'LX.p1' repeats line 2"),
