@@ -318,6 +318,10 @@ class PostProcessor(ABC):
         """True when an arc may move Z (a helical arc)."""
         return False
 
+    def resolution_mm(self) -> float | None:
+        """The smallest XY step the code can write, mm; ``None``: the dialect does not say."""
+        return None
+
     @property
     def suffix(self) -> str:
         """File name ending of the default format."""

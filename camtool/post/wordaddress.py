@@ -115,6 +115,10 @@ class WordAddressPost(PostProcessor):
         """True when the spec lets an arc carry a Z word (``helix = true``)."""
         return self.spec.helix
 
+    def resolution_mm(self) -> float | None:
+        """The coarsest resolution of the X, Y, I and J words, mm (``spec.quantum_mm()``)."""
+        return self.spec.quantum_mm()
+
     def written_z(self, z: float, machine: Machine) -> float | None:
         """``z`` as the Z word prints it, read back (``None``: no Z word)."""
         word = self.spec.word("Z")

@@ -34,6 +34,7 @@ from camtool.model.shapes import BBox, Drawing
 from camtool.preview.program_layers import AREA_COLOUR, CUT_COLOUR, RAPID_COLOUR
 
 if TYPE_CHECKING:
+    from camtool.model.machine import Machine
     from camtool.post.base import Target
     from camtool.verify.verifier import Verification
 
@@ -129,6 +130,7 @@ def render_preview(
         title=title,
         width_px=width_px,
         sections=_sections(program, sections),
+        resolution_mm=_resolution_mm(machine, target),
     )
     scene = compose(content)
     if suffix == ".svg":
@@ -143,6 +145,16 @@ def render_preview(
     from camtool.preview.raster import scene_png
 
     return scene_png(scene)
+
+
+def _resolution_mm(machine: Machine | None, target: Target | None) -> float | None:
+    """The machine's XY resolution, mm: its motor step or its code's quantum, the coarser."""
+    if machine is None:
+        return None
+    steps = [1.0 / s for s in machine.steps_per_mm[:2] if s > 0]
+    quantum = target.post.resolution_mm() if target is not None else None
+    candidates = [*steps, *([quantum] if quantum else [])]
+    return max(candidates) if candidates else None
 
 
 def _sections(
