@@ -246,8 +246,9 @@ def place_labels(
 
     Past ``limit`` every k-th label is kept (the first and the last always). Each
     kept label goes where it was asked, else moved up, down, left, right or
-    diagonally by its own size (then twice up or down), else it is hidden. ``inside`` (a panel's frame, ``None``: no
-    bound): a label that would cross its edge is moved in first, so no label is clipped.
+    diagonally by its own size (then twice up or down), else it is hidden.
+    ``inside`` (a panel's frame, ``None``: no bound): a label that would cross its
+    edge is moved in first, so no label is clipped.
     ``taken`` holds boxes already used (by other labels); the placed labels' boxes are
     added to it.
     """
