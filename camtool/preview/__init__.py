@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING
 
 from camtool.model.errors import UsageError
 from camtool.model.program import Program
+from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import BBox, Drawing
 from camtool.preview.program_layers import AREA_COLOUR, CUT_COLOUR, RAPID_COLOUR
 
@@ -80,6 +81,7 @@ def render_preview(
     work_area: BBox | None = None,
     width_px: int = WIDTH_PX,
     sections: Sequence[tuple[str, int, int]] | None = None,
+    progress: Progress = no_progress,
 ) -> bytes:
     """Draw a preview and return the file's bytes (the caller writes them, atomically).
 
@@ -97,6 +99,7 @@ def render_preview(
         sections: ``(label, first move, end move)`` parts of ``program`` cut in colours
             of their own (a job's operations); ``None``: one per tool where the
             program changes tools. Tool changes are marked either way.
+        progress: told the ``drawing`` stage (``total``: the program's moves).
 
     Returns:
         SVG text encoded as UTF-8, or PNG bytes. Same input, same SVG bytes.
@@ -119,6 +122,7 @@ def render_preview(
         work_area = machine.work_area_mm
     if (program is None or not program.moves) and (drawing is None or not drawing.contours):
         raise UsageError("nothing to preview: the program has no moves and there is no drawing")
+    progress(Step("drawing", 0, len(program.moves) if program is not None else 0))
     content = Content(
         program=program,
         drawing=drawing,

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 import tracemalloc
 import xml.etree.ElementTree as ET
+from pathlib import Path
 
 import pytest
 
@@ -262,3 +263,26 @@ def test_order_numbers_are_inside_the_picture_and_apart() -> None:
     for i, a in enumerate(boxes):
         for b in boxes[i + 1 :]:
             assert not a.overlaps(b), (a, b)
+
+
+def test_a_long_preview_tells_its_stages_on_stderr(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Threshold 0 (every job "long"): reading and drawing on stderr; quiet otherwise."""
+    from camtool.cli import progress as progress_module
+    from camtool.cli.main import main
+
+    code = tmp_path / "part.ngc"
+    code.write_text("G21 G90\nG0 X0 Y0\nG1 X10 Y0 F600\nG1 X10 Y10\nM2\n")
+    args = ["preview", str(code), "-o", str(tmp_path / "p.svg")]
+
+    def run() -> str:
+        assert main(args) == 0
+        return capsys.readouterr().err
+
+    quiet = run()
+    monkeypatch.setattr(progress_module, "AFTER_S", 0.0)
+    told = run()
+    stages = [ln for ln in told.splitlines() if ln.endswith("…")]
+    assert stages == ["camtool: reading part.ngc…", "camtool: drawing 3 moves…"]
+    assert [ln for ln in told.splitlines() if ln not in stages] == quiet.splitlines()
