@@ -83,8 +83,10 @@ def preview(
     on the target and the picture adds the tool-centre trace coloured by its
     deviation in µm, the worst point and a zoom inset on it.
     """
+    from camtool.cli.progress import StageReporter
     from camtool.jobs.inputs import default_preview_path, preview_inputs
     from camtool.jobs.output import check_paths
+    from camtool.model.progress import Step
     from camtool.preview import preview_format, render_preview
 
     out = output or default_preview_path(input_name)
@@ -98,6 +100,8 @@ def preview(
     load_picture = click.get_current_context().with_resource(picture_ahead(out))
     load_picture()  # matplotlib loads while this process reads the inputs
     chosen = _target(target, machine_file)
+    progress = StageReporter()
+    progress(Step("reading", name=Path(program_name or input_name).name))
     drawing, program = preview_inputs(input_name, program_name, chosen, import_settings(options))
     verification = (
         _verify(program, drawing, chosen, tool_diameter, program_name or input_name)
@@ -113,7 +117,9 @@ def preview(
         target=chosen,
         edge_radius_mm=tool_diameter / 2.0,
         title=shown,
+        progress=progress,
     )
+    progress.close()
     write_output(data, out)
     if out != "-":
         click.echo(f"camtool: wrote preview {out}", err=True)

@@ -46,6 +46,7 @@ _TEXTS = {
     "writing": "writing {total} moves for {name}",
     "verifying": "verifying {total} blocks on {name}",
     "budget": "error budget: re-simulating once per error source ({total})",
+    "drawing": "drawing {total} moves",
 }
 """What each stage after ``reading`` says (``total`` and ``name`` of its :class:`Step`)."""
 

@@ -80,6 +80,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import re
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import cast
 
@@ -199,10 +200,10 @@ def read_gcode(path: str | Path, *, source_name: str | None = None) -> Program:
     path = Path(path)
     source = source_name or str(path)
     try:
-        data = path.read_bytes()
+        text = _decoded(path.read_bytes())  # the bytes go as soon as they are text
     except OSError as exc:
         raise InputError(f"{source}: cannot read the file ({exc.strerror or exc})") from exc
-    return read_gcode_bytes(data, source=source)
+    return parse_gcode(text, source=source)
 
 
 def read_gcode_bytes(data: bytes, *, source: str) -> Program:
@@ -215,11 +216,32 @@ def read_gcode_bytes(data: bytes, *, source: str) -> Program:
     Raises:
         InputError: as :func:`parse_gcode`.
     """
+    return parse_gcode(_decoded(data), source=source)
+
+
+def _decoded(data: bytes) -> str:
+    """``data`` as text: UTF-8 (a byte-order mark dropped), else Latin-1."""
     try:
-        text = data.decode("utf-8-sig")
+        return data.decode("utf-8-sig")
     except UnicodeDecodeError:
-        text = data.decode("latin-1")
-    return parse_gcode(text, source=source)
+        return data.decode("latin-1")
+
+
+_LINE_END = re.compile(r"\r\n|\r|\n")
+
+
+def _lines(text: str) -> Iterator[tuple[str, bool]]:
+    """The lines of ``text`` one at a time, each with whether it is the last.
+
+    Lines end with LF, CR LF or CR (a CR LF is one end); the last line is what follows
+    the last line end, maybe empty: the lines splitting at each end would give, without
+    a list of them all (a 50 MB program is 2.6 million lines).
+    """
+    start = 0
+    for end in _LINE_END.finditer(text):
+        yield text[start : end.start()], False
+        start = end.end()
+    yield text[start:], True
 
 
 def parse_gcode(text: str, *, source: str) -> Program:
@@ -253,14 +275,14 @@ def parse_gcode_slow(text: str, *, source: str) -> Program:
 
 def _parse(text: str, source: str, *, plain: bool) -> Program:
     """:func:`parse_gcode`; ``plain``: take the plain-line path where it applies."""
-    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+    lines = _lines(text)
+    rest = (raw for raw, _ in lines)  # the lines after the program's end
     reader = _Reader(source)
     opened = False  # a '%' line before the first block: the next '%' ends the program
     ended = False
     plain_words = _PLAIN_WORDS.findall
-    last = len(lines)
-    for number, raw in enumerate(lines, start=1):
-        if number == last and (cut := cut_mid_word(raw)) is not None:
+    for number, (raw, last) in enumerate(lines, start=1):
+        if last and (cut := cut_mid_word(raw)) is not None:
             raise InputError(
                 f"{source}:{number}: the file ends in the middle of a word ({cut!r}, with no "
                 "end of line after it): the last line is incomplete, the file looks "
@@ -272,13 +294,13 @@ def _parse(text: str, source: str, *, plain: bool) -> Program:
         if block is None:
             if raw.lstrip().startswith("%"):
                 if opened:
-                    reader.after_end(lines[number:], number)
+                    reader.after_end(rest, number)
                     ended = True
                     break
                 opened = not reader.line
             continue
         if reader.run(block):
-            reader.after_end(lines[number:], number)
+            reader.after_end(rest, number)
             ended = True
             break
     if not ended and reader.line:
@@ -528,7 +550,7 @@ class _Reader:
         self.lines.append(line)
         self.x, self.y, self.z = tx, ty, tz
 
-    def after_end(self, rest: list[str], end_line: int) -> None:
+    def after_end(self, rest: Iterable[str], end_line: int) -> None:
         """Warn about lines with words after M2/M30 on ``end_line``."""
         count, first = 0, 0
         for number, raw in enumerate(rest, start=end_line + 1):

@@ -27,6 +27,7 @@ STAGES = (
     "writing",
     "verifying",
     "budget",
+    "drawing",
 )
 """The stages of ``camtool post``, in the order a job meets them (a job may skip some):
 reading the file (``total``: its drawn shapes, once counted), fitting arcs to its curves
@@ -35,7 +36,8 @@ planning the toolpath (``total``: contours), within it offsetting the closed con
 the tool with OpenCASCADE (``total``: contours offset), writing the code (``total``: moves of the
 program), verifying it (``total``: blocks of code) and its error budget (``total``: the
 error sources re-simulated, in forked workers when there are cores for them; ``name``: the
-next source, in order, whose figures are not in yet)."""
+next source, in order, whose figures are not in yet); ``camtool preview`` reads, then
+draws the picture (``total``: the program's moves)."""
 
 
 @dataclass(frozen=True)

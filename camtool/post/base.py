@@ -322,6 +322,10 @@ class PostProcessor(ABC):
         """True when an arc may move Z (a helical arc)."""
         return False
 
+    def resolution_mm(self) -> float | None:
+        """The smallest XY step the code can write, mm; ``None``: the dialect does not say."""
+        return None
+
     @property
     def planes(self) -> bool:
         """True when the dialect writes arcs in the ZX and YZ planes (G18, G19).

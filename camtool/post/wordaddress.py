@@ -126,6 +126,10 @@ class WordAddressPost(PostProcessor):
         """True when the spec writes arcs in the ZX and YZ planes (``planes = true``)."""
         return self.spec.planes
 
+    def resolution_mm(self) -> float | None:
+        """The coarsest resolution of the X, Y, I and J words, mm (``spec.quantum_mm()``)."""
+        return self.spec.quantum_mm()
+
     def written_z(self, z: float, machine: Machine) -> float | None:
         """``z`` as the Z word prints it, read back (``None``: no Z word)."""
         word = self.spec.word("Z")
@@ -153,7 +157,7 @@ class WordAddressPost(PostProcessor):
         self.check_format(fmt)
         writer = BlockWriter(self.spec, machine)
         code = writer.write(program)
-        return PostResult(code, len(writer.blocks), tuple(writer.warnings), "code")
+        return PostResult(code, writer.count, tuple(writer.warnings), "code")
 
     def parse(self, code: str | bytes, *, source: str = "<code>") -> Program:
         """Read code of this dialect (rules: :mod:`camtool.post.wordaddress_read`).
@@ -242,6 +246,8 @@ _PRINTED_KEPT = 1 << 16
 """Coordinates per letter whose text a writer keeps (:meth:`BlockWriter._print`)."""
 _MOVES = (Rapid, Linear, ArcMove)
 """The kinds of move (a tuple: ``isinstance`` takes it faster than ``Rapid | Linear | ...``)."""
+_JOINED_BLOCKS = 4096
+"""Blocks a writer holds apart before it joins them into text (:meth:`BlockWriter.block`)."""
 _CONFORMED_KEPT = 20_000
 """Arcs whose blocks a writer keeps (:meth:`BlockWriter._conformed`); then it starts anew."""
 ARC_CHORD_TOLERANCE_MM = 0.002
@@ -318,6 +324,24 @@ class BlockWriter(WriterState[str]):
         _, _, self._cw, self._ccw = spec.motion_codes
         self._modal_g = "G" in spec.modal
         self._absolute_centre = spec.arc_centre == "absolute"
+        self._done: list[str] = []  # blocks written out of :attr:`blocks`, as text
+        self._done_blocks = 0
+
+    @property
+    def count(self) -> int:
+        """Blocks written so far (header and comment lines included)."""
+        return self._done_blocks + len(self.blocks)
+
+    def where(self, contour: int | None = None, block: int | None = None) -> str:
+        """:meth:`WriterState.where`, counting the blocks already joined into text."""
+        return super().where(contour, self.count + 1 if block is None else block)
+
+    def _join_blocks(self) -> None:
+        """Move :attr:`blocks` into one text, so a long program is not a string a block."""
+        end = self.spec.line_end
+        self._done.append(end.join(self.blocks) + end)
+        self._done_blocks += len(self.blocks)
+        self.blocks.clear()
 
     # -- the program -------------------------------------------------------------
 
@@ -369,8 +393,9 @@ class BlockWriter(WriterState[str]):
             self.block([self.spec.end[0]])
         self.blocks.extend(self.spec.footer)
         self.warnings.extend(self._summary())
-        end = self.spec.line_end
-        return end.join(self.blocks) + end if self.blocks else ""
+        if self.blocks:
+            self._join_blocks()
+        return "".join(self._done)
 
     def block(self, words: list[str]) -> None:
         """Append one block made of ``words``.
@@ -384,6 +409,8 @@ class BlockWriter(WriterState[str]):
         # the size of ASCII text is its length
         if text.isascii() and (limit is None or len(text) + len(spec.line_end) <= limit):
             self.blocks.append(text)
+            if len(self.blocks) >= _JOINED_BLOCKS:
+                self._join_blocks()
             return
         size = len((text + spec.line_end).encode("ascii"))
         if limit is not None and size > limit:

@@ -30,10 +30,12 @@ from typing import TYPE_CHECKING
 
 from camtool.model.errors import UsageError
 from camtool.model.program import Program
+from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import BBox, Drawing
 from camtool.preview.program_layers import AREA_COLOUR, CUT_COLOUR, RAPID_COLOUR
 
 if TYPE_CHECKING:
+    from camtool.model.machine import Machine
     from camtool.post.base import Target
     from camtool.verify.verifier import Verification
 
@@ -79,6 +81,7 @@ def render_preview(
     work_area: BBox | None = None,
     width_px: int = WIDTH_PX,
     sections: Sequence[tuple[str, int, int]] | None = None,
+    progress: Progress = no_progress,
 ) -> bytes:
     """Draw a preview and return the file's bytes (the caller writes them, atomically).
 
@@ -96,6 +99,7 @@ def render_preview(
         sections: ``(label, first move, end move)`` parts of ``program`` cut in colours
             of their own (a job's operations); ``None``: one per tool where the
             program changes tools. Tool changes are marked either way.
+        progress: told the ``drawing`` stage (``total``: the program's moves).
 
     Returns:
         SVG text encoded as UTF-8, or PNG bytes. Same input, same SVG bytes.
@@ -118,6 +122,7 @@ def render_preview(
         work_area = machine.work_area_mm
     if (program is None or not program.moves) and (drawing is None or not drawing.contours):
         raise UsageError("nothing to preview: the program has no moves and there is no drawing")
+    progress(Step("drawing", 0, len(program.moves) if program is not None else 0))
     content = Content(
         program=program,
         drawing=drawing,
@@ -129,6 +134,7 @@ def render_preview(
         title=title,
         width_px=width_px,
         sections=_sections(program, sections),
+        resolution_mm=_resolution_mm(machine, target),
     )
     scene = compose(content)
     if suffix == ".svg":
@@ -143,6 +149,16 @@ def render_preview(
     from camtool.preview.raster import scene_png
 
     return scene_png(scene)
+
+
+def _resolution_mm(machine: Machine | None, target: Target | None) -> float | None:
+    """The machine's XY resolution, mm: its motor step or its code's quantum, the coarser."""
+    if machine is None:
+        return None
+    steps = [1.0 / s for s in machine.steps_per_mm[:2] if s > 0]
+    quantum = target.post.resolution_mm() if target is not None else None
+    candidates = [*steps, *([quantum] if quantum else [])]
+    return max(candidates) if candidates else None
 
 
 def _sections(

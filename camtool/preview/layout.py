@@ -13,15 +13,17 @@ is the best estimate available, and the title says which it is:
 - a verification's own time (the machine's timing model over the simulated
   steps, :mod:`camtool.verify.clock`);
 - for a program with a target: the same model, run on a step simulation of the
-  program (no measurement);
+  program (no measurement), up to :data:`TIMED_MOVES` moves;
 - otherwise the cutting moves at their programmed feeds
   (:meth:`camtool.model.program.Program.cutting_time_s`; rapids not counted).
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import cached_property
 from typing import TYPE_CHECKING, TypeAlias
 
 from camtool.model.program import Program, Rapid
@@ -53,6 +55,9 @@ if TYPE_CHECKING:
     from camtool.verify.motion import StepTrace
     from camtool.verify.verifier import Verification
 
+TIMED_MOVES = 20_000
+"""Most moves a preview times by a step simulation; a bigger program at programmed feeds
+(simulating it is ``camtool verify``'s work: minutes and memory, not a picture's)."""
 AREA_IN_VIEW = 4.0
 """Largest work-area / part extent ratio at which the whole work area is in view."""
 
@@ -71,24 +76,52 @@ class Content:
     title: str | None
     width_px: int
     sections: tuple[pl.Section, ...] = ()
+    resolution_mm: float | None = None
+    """The machine's resolution (its step or the code's quantum, the coarser), mm: the
+    program's extent in the title is rounded to it; ``None``: to 0.001 mm."""
+
+    @cached_property
+    def cut_box(self) -> BBox | None:
+        """The program's cutting moves' box, mm (``None``: no program or no cut)."""
+        return None if self.program is None else program_box(self.program, cutting_only=True)
+
+    @cached_property
+    def moves_box(self) -> BBox | None:
+        """The box of all the program's moves, mm (``None``: no program or no move)."""
+        return None if self.program is None else program_box(self.program)
+
+
+def program_box(program: Program, *, cutting_only: bool = False) -> BBox | None:
+    """:meth:`Program.bbox` in one pass and constant memory; ``None`` when it has no move.
+
+    A picture asks for it several times: :class:`Content` keeps each.
+    """
+    x0 = y0 = math.inf
+    x1 = y1 = -math.inf
+    for move, seg in program.segments():
+        if cutting_only and isinstance(move, Rapid):
+            continue
+        b = seg.bbox()
+        x0, y0, x1, y1 = min(x0, b[0]), min(y0, b[1]), max(x1, b[2]), max(y1, b[3])
+    return None if x0 > x1 else (x0, y0, x1, y1)
 
 
 def part_box(c: Content) -> BBox:
     """What the title gives the size of: the cutting moves, else the drawing, else all moves."""
-    if c.program is not None and any(not isinstance(m, Rapid) for m in c.program.moves):
-        return c.program.bbox(cutting_only=True)
+    if c.cut_box is not None:
+        return c.cut_box
     if c.drawing is not None and c.drawing.contours:
         return c.drawing.bbox()
-    if c.program is not None and c.program.moves:
-        return c.program.bbox()
+    if c.moves_box is not None:
+        return c.moves_box
     raise ValueError("nothing to draw: no moves and no contours")
 
 
 def view_box(c: Content) -> tuple[BBox, bool]:
     """The main view (mm) and whether the whole work area is in it."""
     boxes = [part_box(c)]
-    if c.program is not None and c.program.moves:
-        boxes.append(c.program.bbox())
+    if c.moves_box is not None:
+        boxes.append(c.moves_box)
     if c.drawing is not None and c.drawing.contours:
         boxes.append(c.drawing.bbox())
     view = bbox_union(boxes)
@@ -127,7 +160,9 @@ def compose(c: Content) -> Scene:
         scale_bar,
         legend,
     ]
-    panels = [Panel("main", frame, frame, tuple(_main_layers(c, u, frame)), border=None)]
+    pixel_mm = (page[2] - page[0]) / c.width_px
+    main = tuple(_main_layers(c, u, frame, pixel_mm))
+    panels = [Panel("main", frame, frame, main, border=None)]
     if worst and v is not None:
         inset, labels = _column(v, frame, u)
         furniture.extend(labels)
@@ -143,7 +178,7 @@ def _at_least(box: BBox, size: float) -> BBox:
     return (x0 - dx, y0 - dy, x1 + dx, y1 + dy)
 
 
-def _main_layers(c: Content, u: float, frame: BBox) -> list[Layer]:
+def _main_layers(c: Content, u: float, frame: BBox, pixel_mm: float) -> list[Layer]:
     layers: list[Layer] = []
     if c.work_area is not None:
         layers.append(pl.work_area_layer(c.work_area, u))
@@ -152,7 +187,12 @@ def _main_layers(c: Content, u: float, frame: BBox) -> list[Layer]:
     program = []
     if c.program is not None:
         program = pl.program_layers(
-            c.program, u, edge_radius_mm=c.edge_radius_mm, sections=c.sections
+            c.program,
+            u,
+            edge_radius_mm=c.edge_radius_mm,
+            sections=c.sections,
+            pixel_mm=pixel_mm,
+            frame=frame,
         )
     layers.extend(layer for layer in program if layer.id == "tool-width")
     v = c.verification
@@ -180,13 +220,14 @@ def extent_text(c: Content) -> str:
     has_drawing = c.drawing is not None and bool(c.drawing.contours)
     if c.drawing is not None and has_drawing:
         parts.append(f"part {size_text(c.drawing.bbox())}")
-    cutting = c.program is not None and any(not isinstance(m, Rapid) for m in c.program.moves)
-    if c.program is not None and cutting:
-        box = c.program.bbox(cutting_only=True)
+    step = c.resolution_mm
+    if c.cut_box is not None:
+        box = c.cut_box
         small = _is_small(box)
-        x0, y0, x1, y1 = (length(v, um=small).replace("-", "−") for v in box)
+        x0, y0, x1, y1 = (length(v, um=small, step_mm=step).replace("-", "−") for v in box)
         span = f"X {x0}…{x1} Y {y0}…{y1} {'µm' if small else 'mm'}"
-        parts.append(f"toolpath {span}" if has_drawing else f"toolpath {size_text(box)}, {span}")
+        size = size_text(box, step_mm=step)
+        parts.append(f"toolpath {span}" if has_drawing else f"toolpath {size}, {span}")
     return ", ".join(parts) or size_text(part_box(c))
 
 
@@ -445,8 +486,12 @@ def estimated_time(
         return verification.time_s, time_basis(verification.machine, verification.trace)
     if program is None or not any(not isinstance(m, Rapid) for m in program.moves):
         return None
-    if machine is not None:
+    if machine is not None and len(program.moves) <= TIMED_MOVES:
         return machine_time(program, machine)
+    if machine is not None:
+        return program.cutting_time_s(), (
+            f"at programmed feeds, cuts only ({len(program.moves)} moves: not simulated)"
+        )
     return program.cutting_time_s(), "at programmed feeds, cuts only"
 
 
@@ -470,11 +515,32 @@ def zoom_text(zoom: float) -> str:
     return f"{zoom:.0f}" if zoom >= 10 else f"{zoom:.2g}"
 
 
-def length(mm: float, *, um: bool = False) -> str:
-    """A length for titles: mm to at most 3 decimals (``"4.5"``); ``um``: in µm to 0.01 µm."""
-    text = f"{mm * 1000.0:.2f}" if um else f"{mm:.3f}"
-    text = text.rstrip("0").rstrip(".")
-    return "0" if text in ("-0", "") else text
+def length(mm: float, *, um: bool = False, step_mm: float | None = None) -> str:
+    """A length for titles: mm to at most 3 decimals (``"4.5"``); ``um``: in µm to 0.01 µm.
+
+    ``step_mm``: the machine's resolution. The length is then written as the shortest
+    decimal within half a step of it (at most :data:`MOST_DECIMALS` in mm): the machine
+    cannot tell the two apart, so ``34.999`` and ``-0.001`` on a 0.004 mm machine are
+    ``"35"`` and ``"0"``, and ``12.345`` stays ``"12.345"``. Never ``"-0"``.
+    """
+    value = mm * 1000.0 if um else mm
+    if step_mm is None:
+        text = f"{value:.{2 if um else 3}f}"
+    else:
+        half = step_mm * (1000.0 if um else 1.0) / 2.0
+        most = MOST_DECIMALS - 3 if um else MOST_DECIMALS
+        text = f"{value:.{most}f}"
+        for places in range(-6, most + 1):  # tens of µm first for a part in µm
+            if abs(round(value, places) - value) <= half:
+                text = f"{value:.{places}f}" if places >= 0 else f"{round(value, places):.0f}"
+                break
+    if "." in text:
+        text = text.rstrip("0").rstrip(".")
+    return "0" if text.strip("-0.") == "" else text
+
+
+MOST_DECIMALS = 5
+"""Most decimals of a title's mm (0.01 µm)."""
 
 
 SMALL_MM = 1.0
@@ -485,8 +551,12 @@ def _is_small(box: BBox) -> bool:
     return max(box[2] - box[0], box[3] - box[1]) < SMALL_MM
 
 
-def size_text(box: BBox) -> str:
-    """``"5 × 4.5 mm"``: width × height of ``box``; ``"980 × 120 µm"`` for a part under 1 mm."""
+def size_text(box: BBox, *, step_mm: float | None = None) -> str:
+    """``"5 × 4.5 mm"``: width × height of ``box``; ``"980 × 120 µm"`` for a part under 1 mm.
+
+    ``step_mm``: round to the machine's resolution (:func:`length`).
+    """
     small = _is_small(box)
-    w, h = length(box[2] - box[0], um=small), length(box[3] - box[1], um=small)
+    w = length(box[2] - box[0], um=small, step_mm=step_mm)
+    h = length(box[3] - box[1], um=small, step_mm=step_mm)
     return f"{w} × {h} {'µm' if small else 'mm'}"

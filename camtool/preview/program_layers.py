@@ -24,12 +24,16 @@ from camtool.preview.scene import (
     Path,
     Polylines,
     Rect,
+    Segments,
     Style,
     Text,
     kept_indices,
+    moved_inside,
     place_labels,
     polyline,
+    text_box,
 )
+from camtool.preview.thin import CELL_PX, DETAIL_MOVES, Strokes
 
 CUT_COLOUR = "#1f4fd1"
 """Cutting moves (blue, S000-24)."""
@@ -136,6 +140,8 @@ def program_layers(
     *,
     edge_radius_mm: float = 0.0,
     sections: Sequence[Section] = (),
+    pixel_mm: float | None = None,
+    frame: BBox | None = None,
 ) -> list[Layer]:
     """Tool width, rapids, cuts, starts, order and tool changes of ``program``.
 
@@ -150,7 +156,16 @@ def program_layers(
         edge_radius_mm: tool radius of an offset cut; > 0 draws the swept tool.
         sections: parts of the program cut in their own colour (a job's operations);
             empty: every cut in :data:`CUT_COLOUR`.
+        pixel_mm: the picture's pixel, mm; a program of more than
+            :data:`~camtool.preview.thin.DETAIL_MOVES` moves is then drawn at that
+            resolution (:mod:`camtool.preview.thin`: tool width, rapids, cuts and tabs as
+            :class:`~camtool.preview.scene.Segments`). ``None``: always move by move.
+        frame: the main panel's frame, mm: order numbers are kept inside it, clear of
+            each other, of the tool numbers and of the work zero's label
+            (:func:`order_labels`). ``None``: not bounded.
     """
+    if pixel_mm is not None and len(program.moves) > DETAIL_MOVES:
+        return _dense_layers(program, u, pixel_mm, edge_radius_mm, sections, frame)
     all_runs = runs_of(program, [first for _, first, _ in sections])
     runs = [run.segments for run in all_runs]
     first = numbered(all_runs)
@@ -167,13 +182,30 @@ def program_layers(
         Layer("cuts", _cut_paths(all_runs, sections, u)),
         Layer("tabs", tab_shapes(tab_segments(program), u)),
         Layer("starts", tuple(s for i in shown for s in _start_marker(runs[i], u))),
-        Layer(
-            "order",
-            tuple(place_labels([_number(first.index(i) + 1, runs[i], u) for i in shown])),
-        ),
+        Layer("order", order_labels(program, runs, first, shown, u, frame)),
         Layer("tool-changes", change_marks(program, u)),
     ]
     return [layer for layer in layers if layer.shapes]
+
+
+def order_labels(
+    program: Program,
+    runs: list[list[Segment]],
+    first: list[int],
+    shown: list[int],
+    u: float,
+    frame: BBox | None,
+) -> tuple[Text, ...]:
+    """The order numbers of the ``shown`` runs (:func:`~camtool.preview.scene.place_labels`).
+
+    Inside ``frame`` (when given) and clear of each other, of the tool numbers
+    (:func:`change_marks`) and of the work zero's label (:func:`zero_label`).
+    """
+    taken = [text_box(t) for t in change_marks(program, u) if isinstance(t, Text)]
+    if frame is not None and (zero := zero_label(frame, u)) is not None:
+        taken.append(text_box(zero))
+    numbers = [_number(first.index(i) + 1, runs[i], u) for i in shown]
+    return tuple(place_labels(numbers, taken=taken, inside=frame))
 
 
 def _cut_paths(runs: list[Run], sections: Sequence[Section], u: float) -> tuple[Path, ...]:
@@ -192,10 +224,11 @@ def _cut_paths(runs: list[Run], sections: Sequence[Section], u: float) -> tuple[
 def change_marks(program: Program, u: float) -> tuple[Rect | Text, ...]:
     """A black square and ``T2`` where each tool change happens (none at the start)."""
     where = {}
-    ends = [seg.end for _, seg in program.segments()]
+    moves = program.moves
     for index, command in program.commands:
-        if isinstance(command, ToolChange) and 0 < index <= len(ends):
-            where[ends[index - 1]] = f"T{command.tool}"
+        if isinstance(command, ToolChange) and 0 < index <= len(moves):
+            end = moves[index - 1]
+            where[(end.x, end.y)] = f"T{command.tool}"
     shapes: list[Rect | Text] = []
     size = 1.4 * u
     for (x, y), label in where.items():
@@ -214,32 +247,42 @@ def tab_segments(program: Program) -> list[Segment]:
     rise onto the tab top, cross it, go down). A first, shallower pass of a multi-pass
     run is not a tab: nothing before it was deeper. Programs without Z have none.
     """
-    rows: list[list[tuple[Segment, float, float]]] = []
+    out: list[Segment] = []
+    run: list[tuple[Segment, float, float]] = []  # one run at a time: memory of a run
     z_here: float | None = None
-    fresh = True
     for move, seg in program.segments():
         z0 = z_here
         z_here = move.z if move.z is not None else z_here
         if isinstance(move, Rapid):
-            fresh = True
+            out.extend(_tabs_of(run))
+            run = []
             continue
         if z0 is None or z_here is None:
             continue
-        if fresh:
-            rows.append([])
-            fresh = False
-        rows[-1].append((seg, z0, z_here))
+        run.append((seg, z0, z_here))
+    out.extend(_tabs_of(run))
+    return out
+
+
+def _tabs_of(run: list[tuple[Segment, float, float]]) -> list[Segment]:
+    """The tab crossings of one run of ``(segment, z before, z after)`` (:func:`tab_segments`).
+
+    Linear in the run: the lowest Z before each move and after it are running minima.
+    """
     out: list[Segment] = []
-    for run in rows:
-        ends = [z1 for _, _, z1 in run]
-        starts = [z0 for _, z0, _ in run]
-        for i, (seg, z0, z1) in enumerate(run):
-            if abs(z1 - z0) > Z_EPS or (seg.start == seg.end and not isinstance(seg, Arc)):
-                continue
-            before = min([starts[0], *ends[:i]])
-            after = min(ends[i + 1 :], default=math.inf)
-            if before < z1 - Z_EPS and after < z1 - Z_EPS:
-                out.append(seg)
+    if not run:
+        return out
+    after = [math.inf] * len(run)  # after[i]: the lowest end of the moves after move i
+    for i in range(len(run) - 1, 0, -1):
+        after[i - 1] = min(after[i], run[i][2])
+    before = run[0][1]  # the lowest of the run's start and the ends before move i
+    for i, (seg, z0, z1) in enumerate(run):
+        if i:
+            before = min(before, run[i - 1][2])
+        if abs(z1 - z0) > Z_EPS or (seg.start == seg.end and not isinstance(seg, Arc)):
+            continue
+        if before < z1 - Z_EPS and after[i] < z1 - Z_EPS:
+            out.append(seg)
     return out
 
 
@@ -259,8 +302,16 @@ def zero_layer(view: BBox, u: float) -> Layer:
         ((Line((-a, 0.0), (a, 0.0)),), (Line((0.0, -a), (0.0, a)),)),
         Style(ZERO_COLOUR, 0.3 * u),
     )
+    label = zero_label(view, u)
+    return Layer("zero", (cross, label) if label is not None else (cross,))
+
+
+def zero_label(view: BBox, u: float) -> Text | None:
+    """The ``0, 0`` label of the work zero's cross, inside ``view``; None when 0, 0 is not."""
+    if not (view[0] <= 0.0 <= view[2] and view[1] <= 0.0 <= view[3]):
+        return None
     label = Text((0.6 * u, -2.6 * u), "0, 0", 2.2 * u, ZERO_COLOUR, halo=True)
-    return Layer("zero", (cross, label))
+    return moved_inside(label, view) or label
 
 
 def drawing_layer(drawing: Drawing, u: float) -> Layer:
@@ -346,3 +397,71 @@ def start_tangent(run: list[Segment]) -> Point:
         if length > 0:
             return tx / length, ty / length
     return 1.0, 0.0
+
+
+def _dense_layers(
+    program: Program,
+    u: float,
+    pixel_mm: float,
+    edge_radius_mm: float,
+    sections: Sequence[Section],
+    frame: BBox | None,
+) -> list[Layer]:
+    """:func:`program_layers` of a big program, drawn at the picture's resolution.
+
+    One pass over the moves, keeping points in :class:`~camtool.preview.thin.Strokes`
+    and of each run only its first moves (for its start marker): the memory is the
+    points', not an object per move. Tool width, rapids, cuts and tabs are
+    :class:`~camtool.preview.scene.Segments` thinned to cells of
+    :data:`~camtool.preview.thin.CELL_PX` pixel; starts and order numbers as
+    :func:`program_layers` draws them.
+    """
+    from bisect import bisect_right
+
+    cell = CELL_PX * pixel_mm
+    firsts = [first for _, first, _ in sections]
+    cuts = [Strokes(cell) for _ in range(max(len(sections), 1))]
+    rapids = Strokes(cell)
+    runs: list[Run] = []
+    contour, open_run = None, False
+    for index, (move, seg) in enumerate(program.segments()):
+        if isinstance(move, Rapid):
+            open_run = False
+            rapids.start(seg.start)
+            rapids.extend([seg.end])
+            continue
+        if not open_run or (move.contour and move.contour != contour) or index in firsts:
+            runs.append(Run(index, move.contour, []))
+            cuts[max(bisect_right(firsts, index) - 1, 0)].start(seg.start)
+            open_run = True
+        contour = move.contour
+        if len(runs[-1].segments) < 4:  # enough for its start tangent
+            runs[-1].segments.append(seg)
+        cuts[max(bisect_right(firsts, index) - 1, 0)].extend(seg.points(cell)[1:])
+    first = numbered(runs)
+    shown = [first[i] for i in kept_indices(len(first))]
+    segments = [run.segments for run in runs]
+    colours = [section_colour(k) for k in range(len(sections))] or [CUT_COLOUR]
+    cut_strokes = [(c.thinned(), colour) for c, colour in zip(cuts, colours, strict=True)]
+    tabs = Strokes(cell)
+    for seg in tab_segments(program):
+        tabs.start(seg.start)
+        tabs.extend(seg.points(cell)[1:])
+    width: tuple[Segments, ...] = ()
+    if edge_radius_mm > 0:  # the swept band: the cuts stroked as wide as the tool
+        band = Style(TOOL_COLOUR, 2.0 * edge_radius_mm, opacity=TOOL_OPACITY)
+        width = tuple(Segments(xy, band) for xy, _ in cut_strokes if len(xy))
+    rapid_style = Style(RAPID_COLOUR, 0.25 * u, dash=(1.2 * u, 0.9 * u))
+    layers = [
+        Layer("tool-width", width),
+        Layer("rapids", (Segments(rapids.thinned(), rapid_style),) if rapids else ()),
+        Layer(
+            "cuts",
+            tuple(Segments(xy, Style(c, 0.35 * u)) for xy, c in cut_strokes if len(xy)),
+        ),
+        Layer("tabs", (Segments(tabs.thinned(), Style(TAB_COLOUR, 1.0 * u)),) if tabs else ()),
+        Layer("starts", tuple(s for i in shown for s in _start_marker(segments[i], u))),
+        Layer("order", order_labels(program, segments, first, shown, u, frame)),
+        Layer("tool-changes", change_marks(program, u)),
+    ]
+    return [layer for layer in layers if layer.shapes]

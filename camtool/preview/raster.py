@@ -19,10 +19,22 @@ import io
 from typing import TYPE_CHECKING, Any
 
 from camtool.model.shapes import Point, Segment
-from camtool.preview.scene import Circle, Panel, Path, Polylines, Rect, Scene, Shape, Style, Text
+from camtool.preview.scene import (
+    Circle,
+    Panel,
+    Path,
+    Polylines,
+    Rect,
+    Scene,
+    Segments,
+    Shape,
+    Style,
+    Text,
+)
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 DPI = 100
 ARC_TOLERANCE_PX = 0.1
@@ -38,6 +50,13 @@ def preload() -> None:
 
 def scene_png(scene: Scene) -> bytes:
     """The PNG bytes of ``scene``."""
+    buffer = io.BytesIO()
+    scene_figure(scene).savefig(buffer, format="png", dpi=DPI, metadata={"Software": None})
+    return buffer.getvalue()
+
+
+def scene_figure(scene: Scene) -> Figure:
+    """``scene`` as a matplotlib figure on an Agg canvas (what :func:`scene_png` saves)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -59,9 +78,7 @@ def scene_png(scene: Scene) -> bytes:
         if panel.border is not None:
             border = Style(panel.border.stroke, panel.border.width / panel.scale)
             ax.add_artist(_rect(panel.window, border, points_per_mm * panel.scale, 1000))
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=DPI, metadata={"Software": None})
-    return buffer.getvalue()
+    return fig
 
 
 def _draw(ax: Axes, panel: Panel, pt: float) -> None:
@@ -108,6 +125,10 @@ def _shape(ax: Axes, shape: Shape, pt: float, z: int, *, clip: bool) -> None:
             )
         path = MplPath(np.asarray(verts), codes)
         ax.add_artist(patches.PathPatch(path, **_patch(shape.style, pt, z)))
+    elif isinstance(shape, Segments):
+        strokes: Any = shape.xy  # (M, 2, 2): what LineCollection takes, one array
+        collection = LineCollection(strokes, **_line(shape.style, pt), zorder=z)
+        ax.add_collection(collection, autolim=False)
     else:
         if isinstance(shape, Path):
             # arcs as chords within a tenth of a pixel (pt points per unit, DPI/72 px per point)

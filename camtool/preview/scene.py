@@ -63,6 +63,21 @@ class Polylines:
     closed: bool = False
 
 
+@dataclass(frozen=True, eq=False)
+class Segments:
+    """Separate straight strokes, drawn as one shape.
+
+    ``xy`` is ``(M, 2, 2) float64`` (mm, read-only): stroke ``k`` goes from ``xy[k, 0]``
+    to ``xy[k, 1]`` (a stroke from a point to itself is a dot).
+
+    What :mod:`camtool.preview.thin` draws a big program with: one shape, one
+    matplotlib collection, one SVG path, however many strokes.
+    """
+
+    xy: npt.NDArray[np.float64]
+    style: Style
+
+
 @dataclass(frozen=True)
 class Circle:
     """A circle of ``radius`` around ``centre``."""
@@ -97,7 +112,7 @@ class Text:
     halo: bool = False
 
 
-Shape: TypeAlias = Path | Polylines | Circle | Rect | Text
+Shape: TypeAlias = Path | Polylines | Segments | Circle | Rect | Text
 
 
 @dataclass(frozen=True)
@@ -198,10 +213,15 @@ MAX_LABELS = 60
 
 
 def text_box(t: Text) -> BBox:
-    """Approximate ink box of ``t`` (window units), from :func:`text_width`."""
-    w = text_width(t.text, t.size, bold=t.bold)
+    """The box ``t`` takes (window units), from :func:`text_width`, on the generous side.
+
+    A little wider and taller than the letters (DejaVu Sans Bold's digits are 0.70 em
+    wide, its line 1.16 em from descent to ascent), so that labels kept apart by these
+    boxes stay apart as matplotlib lays them out.
+    """
+    w = text_width(t.text, t.size, bold=t.bold) * 1.04 + 0.12 * t.size
     x = t.at[0] - {"start": 0.0, "middle": w / 2, "end": w}.get(t.anchor, 0.0)
-    return (x, t.at[1] - 0.25 * t.size, x + w, t.at[1] + 0.8 * t.size)
+    return (x, t.at[1] - 0.3 * t.size, x + w, t.at[1] + 0.9 * t.size)
 
 
 def kept_indices(n: int, limit: int = MAX_LABELS) -> list[int]:
@@ -216,21 +236,31 @@ def kept_indices(n: int, limit: int = MAX_LABELS) -> list[int]:
 
 
 def place_labels(
-    labels: list[Text], *, limit: int = MAX_LABELS, taken: list[BBox] | None = None
+    labels: list[Text],
+    *,
+    limit: int = MAX_LABELS,
+    taken: list[BBox] | None = None,
+    inside: BBox | None = None,
 ) -> list[Text]:
-    """Labels that do not pile up: at most ``limit``, none overlapping another.
+    """Labels that do not pile up: at most ``limit``, none overlapping another, all in ``inside``.
 
     Past ``limit`` every k-th label is kept (the first and the last always). Each
-    kept label goes where it was asked, else moved up, down, left or right by
-    about its own size, else it is hidden. ``taken`` holds boxes already used
-    (by other labels); the placed labels' boxes are added to it.
+    kept label goes where it was asked, else moved up, down, left, right or
+    diagonally by its own size (then twice up or down), else it is hidden.
+    ``inside`` (a panel's frame, ``None``: no bound): a label that would cross its
+    edge is moved in first, so no label is clipped.
+    ``taken`` holds boxes already used (by other labels); the placed labels' boxes are
+    added to it.
     """
     labels = [labels[i] for i in kept_indices(len(labels), limit)]
     boxes = taken if taken is not None else []
     placed: list[Text] = []
     for label in labels:
-        s, w = label.size, text_width(label.text, label.size, bold=label.bold)
-        for dx, dy in ((0.0, 0.0), (0.0, 1.1 * s), (0.0, -1.1 * s), (-w - 0.3 * s, 0.0)):
+        s = label.size
+        box = text_box(label)
+        w, h = box[2] - box[0], box[3] - box[1]
+        for dx, dy in _NEAR_PLACES:
+            dx, dy = dx * w, dy * h
             moved = Text(
                 (label.at[0] + dx, label.at[1] + dy),
                 label.text,
@@ -240,12 +270,46 @@ def place_labels(
                 label.bold,
                 label.halo,
             )
+            if inside is not None:
+                kept = moved_inside(moved, inside)
+                if kept is None:
+                    continue
+                moved = kept
             box = text_box(moved)
             if not any(_overlap(box, other) for other in boxes):
                 boxes.append(box)
                 placed.append(moved)
                 break
     return placed
+
+
+_NEAR_PLACES = (
+    (0.0, 0.0),
+    (0.0, 1.0),
+    (0.0, -1.0),
+    (-1.0, 0.0),
+    (1.0, 0.0),
+    (-1.0, 1.0),
+    (1.0, 1.0),
+    (-1.0, -1.0),
+    (1.0, -1.0),
+    (0.0, 2.0),
+    (0.0, -2.0),
+)
+"""Where :func:`place_labels` tries a label, in label widths and heights from where asked."""
+
+
+def moved_inside(label: Text, inside: BBox) -> Text | None:
+    """``label`` shifted by the least that puts its box in ``inside``; None if it cannot fit."""
+    x0, y0, x1, y1 = text_box(label)
+    if x1 - x0 > inside[2] - inside[0] or y1 - y0 > inside[3] - inside[1]:
+        return None
+    dx = max(inside[0] - x0, 0.0) + min(inside[2] - x1, 0.0)
+    dy = max(inside[1] - y0, 0.0) + min(inside[3] - y1, 0.0)
+    if dx == 0.0 and dy == 0.0:
+        return label
+    at = (label.at[0] + dx, label.at[1] + dy)
+    return Text(at, label.text, label.size, label.colour, label.anchor, label.bold, label.halo)
 
 
 def _overlap(a: BBox, b: BBox) -> bool:

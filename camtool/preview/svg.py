@@ -25,6 +25,7 @@ from camtool.preview.scene import (
     Polylines,
     Rect,
     Scene,
+    Segments,
     Shape,
     Style,
     Text,
@@ -121,6 +122,12 @@ def _shape(shape: Shape, n: _Numbers) -> str:
         d = "".join(_points(line, n, shape.closed) for line in shape.lines)
         rule = ' fill-rule="evenodd"' if shape.closed else ""
         return f'<path d="{d}"{_style(shape.style, n)}{rule}/>'
+    if isinstance(shape, Segments):
+        d = "".join(
+            f"M{n(float(x0))} {n.y(float(y0))}L{n(float(x1))} {n.y(float(y1))}"
+            for (x0, y0), (x1, y1) in shape.xy.tolist()
+        )
+        return f'<path d="{d}"{_style(shape.style, n)}/>'
     if isinstance(shape, Circle):
         cx, cy = shape.centre
         return (

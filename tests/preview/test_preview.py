@@ -245,8 +245,9 @@ def test_a_part_under_1_mm_is_labelled_in_um() -> None:
     v = verify_program(program, target.machine, name="pic-mmh")
     svg = render_preview(".svg", verification=v)
     title = " ".join(_texts(svg, "title"))
-    assert "0.98 × 0 µm" in title and "0.001 mm" not in title
-    assert "X 1000…1000.98 Y 1000…1000 µm" in title
+    # 0.98 µm is written as the shortest decimal within half a step (0.07 µm) of it: 1 µm
+    assert "1 × 0 µm" in title and "0.001 mm" not in title
+    assert "X 1000…1001 Y 1000…1000 µm" in title
     assert " µm" in " ".join(_texts(svg, "scale-bar"))
     # an inset window wider than the main view (an error larger than the part) zooms out
     assert (zoom_text(0.06), zoom_text(0.5), zoom_text(9.6), zoom_text(48.2)) == (
