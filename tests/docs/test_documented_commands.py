@@ -8,8 +8,9 @@ The rules a page follows (docs/index.md, "Reading these pages") and this test re
   and each ``camtool: error: ...`` line after one must be what the command prints, with a
   non-zero exit. Any other ``camtool <word>`` line in such a block is an error of the page:
   tag a synopsis ``text`` (never run), a command ``sh``.
-- A ``python`` block runs (unless its first line is a ``# needs ...`` comment); a block tagged with a file name after its language
-  (`` ```toml my-router.toml ``) is written to that file before the page's commands run.
+- A ``python`` block runs (unless its first line is a ``# needs ...`` comment); a block
+  tagged with a file name after its language (`` ```toml my-router.toml ``) is written to
+  that file before the page's commands run.
 - A command exits 0 unless its comment says ``exit N`` (``exit code N``).
 - Skipped, and only these: a line with a placeholder in angle brackets
   (``<your-drawing.dxf>``), and a line whose comment starts ``# needs`` (a machine on a
@@ -137,7 +138,9 @@ def steps(page: Path) -> list[Step]:
             result.append(Step("python", block.line, "\n".join(block.lines)))
             continue
         if block.info:
-            result.append(Step("file", block.line, "\n".join(block.lines) + "\n", path=block.info[0]))
+            result.append(
+                Step("file", block.line, "\n".join(block.lines) + "\n", path=block.info[0])
+            )
             continue
         if block.lang in SHELL_LANGS:
             commands = _shell_lines(block, "")
@@ -205,8 +208,8 @@ class Page:
     def _python(self, step: Step) -> None:
         code = compile(step.text, f"{self.page.name}:{step.line}", "exec")
         try:
-            exec(code, {"__name__": "__docs__"})  # noqa: S102 (the page's own example)
-        except Exception:  # noqa: BLE001 (reported as the page's failure)
+            exec(code, {"__name__": "__docs__"})
+        except Exception:
             self.fail(step, traceback.format_exc(limit=-3))
         finally:
             self.capsys.readouterr()
@@ -240,7 +243,10 @@ class Page:
                 self.fail(step, f"the page shows {line!r}; camtool printed {tail}")
 
     def _bash(self, command: str) -> tuple[int, str]:
-        env = {**os.environ, "PATH": f"{self.workdir / '.venv' / 'bin'}{os.pathsep}{os.environ['PATH']}"}
+        env = {
+            **os.environ,
+            "PATH": f"{self.workdir / '.venv' / 'bin'}{os.pathsep}{os.environ['PATH']}",
+        }
         proc = subprocess.run(
             ["bash", "-c", command],
             cwd=self.workdir,
