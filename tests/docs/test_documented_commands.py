@@ -20,8 +20,10 @@ The rules a page follows (docs/index.md, "Reading these pages") and this test re
 
 Each page runs in its own temporary directory holding a copy of ``samples/`` and an empty
 ``docs/gallery/``, so a page may use the files its earlier commands wrote. Commands run in
-this process through :func:`camtool.cli.main.main` (as tests/cli does); a command that needs
-the shell (a glob, a pipe, a variable) runs under ``bash`` with ``camtool`` on ``PATH``.
+this process through :func:`camtool.cli.main.main` (as tests/cli does; a batch without
+``--jobs`` in this process too, as ``--jobs 1``: its pool is tested in tests/jobs); a command
+that needs the shell (a glob, a pipe, a variable) or a Dask cluster runs under ``bash`` with
+``camtool`` on ``PATH``.
 """
 
 from __future__ import annotations
@@ -223,7 +225,7 @@ class Page:
             self._simulator(step, argv)
             return
         unquoted = re.sub(r"'[^']*'|\"[^\"]*\"", "", command.split(" #")[0])
-        if SHELL_ONLY.search(unquoted):
+        if SHELL_ONLY.search(unquoted) or "--scheduler" in argv:  # Dask: its own process
             code, err = self._bash(command)
         else:
             try:
@@ -292,6 +294,7 @@ def test_page_runs_as_written(
     page: Path, tmp_path: Path, capsys: Any, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(os, "cpu_count", lambda: 1)  # batch without --jobs: in this process
     run = Page(page, tmp_path, capsys)
     try:
         found = steps(page)
