@@ -151,7 +151,12 @@ def test_an_unknown_keyword_names_the_valid_ones(
         (lambda: PlanOptions(depth=math.nan), "--depth must be a finite number, got nan"),
         (lambda: PlanOptions(feed_mm_min=-1.0), "--feed must be > 0 mm/min"),
         (lambda: PlanOptions(placement="centre"), "unknown --origin 'centre'; choose one of"),
-        (lambda: PlanOptions(origin="center"), "origin"),  # type: ignore[arg-type]
+        (
+            lambda: PlanOptions(origin="center"),  # type: ignore[arg-type]
+            "for the work zero (drawing, lower-left, center: --origin on the command line) "
+            "give placement='center'",
+        ),
+        (lambda: PlanOptions(depth="3"), "PlanOptions depth = '3': give a number (--depth)"),  # type: ignore[arg-type]
         (
             lambda: PlanOptions(offset="outside", tool_diameter=1.0, lead_in=-1.0),
             "--lead-in must be ≥ 0 mm",
