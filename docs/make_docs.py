@@ -137,7 +137,7 @@ def _options(words: dict[str, str]) -> dict[str, object]:
     for key, value in words.items():
         if key == "fit":
             w, h = value.lower().split("x")
-            out["fit_mm"] = (float(w), float(h))
+            out["fit"] = (float(w), float(h))
         elif key == "offset":
             out[key] = value
         elif key in ("scale", "tool_diameter"):

@@ -34,7 +34,7 @@ EXAMPLES: dict[str, tuple[str, str, dict[str, Any]]] = {
             "depth": 3.0,
             "step_down": 1.0,
             "tabs": 3,
-            "lead_in_mm": 2.0,
+            "lead_in": 2.0,
             "placement": "lower-left",
         },
     ),

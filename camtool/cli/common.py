@@ -441,7 +441,7 @@ _POST_OPTIONS = (
     ),
     click.option(
         "--ramp",
-        "ramp_angle_deg",
+        "ramp_deg",
         type=NUMBER,
         default=None,
         metavar="DEG",
@@ -483,7 +483,7 @@ _POST_OPTIONS = (
     ),
     click.option(
         "--lead-in",
-        "lead_in_mm",
+        "lead_in",
         type=NUMBER,
         default=0.0,
         show_default=True,
@@ -531,7 +531,7 @@ _POST_OPTIONS = (
     ),
     click.option(
         "--fit",
-        "fit_mm",
+        "fit",
         type=(NUMBER, NUMBER),
         default=None,
         metavar="W H",

@@ -36,7 +36,7 @@ def read_drawing(
     """Read the drawing at ``path``, choosing the importer by the file name ending.
 
     Curves (Béziers, ellipses, splines) are fitted within ``options.tolerance`` at the
-    size planning will give the drawing (``options.scale`` or ``options.fit_mm``:
+    size planning will give the drawing (``options.scale`` or ``options.fit``:
     :meth:`~camtool.importers.options.ImportOptions.curve_tolerance`). For ``--fit`` the
     factor depends on the extent of the drawing read: the SVG importer fits for the
     extent of its segments' ends (as a rule within the drawing's, so not coarser), the
@@ -66,10 +66,10 @@ def read_drawing(
     path = Path(path)
     options = options or ImportOptions()
     drawing, used = _read(path, options, progress, check)
-    if options.fit_mm is None:
+    if options.fit is None:
         return drawing
     for margin in _REFIT_MARGINS:
-        k = fit_factor(drawing.bbox(), options.fit_mm)
+        k = fit_factor(drawing.bbox(), options.fit)
         k = 1.0 if math.isinf(k) else k
         if used * k <= options.tolerance:
             return drawing

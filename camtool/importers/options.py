@@ -14,6 +14,7 @@ import math
 from dataclasses import dataclass, replace
 
 from camtool.model.errors import InputError, UsageError
+from camtool.model.keywords import checked_keywords
 from camtool.model.shapes import BBox, fit_factor
 from camtool.model.units import LARGEST_VALUE
 
@@ -63,6 +64,7 @@ def too_many_entities(name: str, limit: int) -> InputError:
     )
 
 
+@checked_keywords({"fit_mm": "fit"})
 @dataclass(frozen=True, kw_only=True)
 class ImportOptions:
     """What the user asked of an importer (the CLI's ``--layers``, ``--units`` ...).
@@ -81,7 +83,7 @@ class ImportOptions:
         scale: the uniform scale planning will apply to the drawing (``--scale``; 1:
             none). ``tolerance`` holds once scaled: curves are fitted within
             ``tolerance / scale`` at the drawing's size (:meth:`curve_tolerance`).
-        fit_mm: the box planning will scale the drawing into (``--fit W H``;
+        fit: the box planning will scale the drawing into (``--fit W H``;
             :func:`~camtool.model.shapes.fit_factor`), or ``None``. Likewise, curves are
             fitted within ``tolerance`` divided by that factor, and
             :func:`camtool.importers.read_drawing` checks the factor of the drawing it
@@ -97,7 +99,7 @@ class ImportOptions:
     hatch_boundaries: bool = False
     max_entities: int = MAX_ENTITIES
     scale: float = 1.0
-    fit_mm: tuple[float, float] | None = None
+    fit: tuple[float, float] | None = None
 
     def curve_tolerance(self, box: BBox | None = None) -> float:
         """The fitting tolerance at the drawing's size (mm) that is ``tolerance`` once placed.
@@ -106,18 +108,18 @@ class ImportOptions:
         by ``k``, so the curves of a drawing planning scales by ``k`` are fitted within
         ``tolerance / k``: a drawing scaled up (``--fit`` of a small icon) is fitted
         finer, one scaled down coarser, and the G-code holds ``--tolerance`` either way.
-        ``k`` is ``scale``, or with ``fit_mm`` the factor for ``box`` (the drawing's
+        ``k`` is ``scale``, or with ``fit`` the factor for ``box`` (the drawing's
         extent, or a box within it: a smaller box gives a larger factor, so a finer fit);
         1 without a box, or for a box with neither width nor height (not scaled).
         """
-        if self.fit_mm is None:
+        if self.fit is None:
             return self.tolerance / self.scale
-        k = 1.0 if box is None else fit_factor(box, self.fit_mm)
+        k = 1.0 if box is None else fit_factor(box, self.fit)
         return self.tolerance / (1.0 if math.isinf(k) else k)
 
     def at_tolerance(self, tolerance: float) -> ImportOptions:
         """These options with curves fitted within ``tolerance`` (mm at the drawing's size)."""
-        return replace(self, tolerance=tolerance, scale=1.0, fit_mm=None)
+        return replace(self, tolerance=tolerance, scale=1.0, fit=None)
 
     def __post_init__(self) -> None:
         if isinstance(self.max_entities, bool) or not (

@@ -106,7 +106,7 @@ def svg_drawing(
         path: the SVG file.
         options: ``layers`` (Inkscape layer labels or ids; hidden layers named here are read)
             and ``tolerance`` (mm, for Béziers and ellipses, once the drawing is scaled as
-            ``scale`` or ``fit_mm`` say: for ``fit_mm``, the factor of the extent of the
+            ``scale`` or ``fit`` say: for ``fit``, the factor of the extent of the
             drawn segments' ends, :func:`_ends_box`) are used; ``units`` is the user
             unit of a document without an absolute size (refused for one with it).
         check: called with the extent of the drawn segments' ends (:func:`_ends_box`, mm,
@@ -153,7 +153,7 @@ def svg_drawing(
             drawn.append((shape, _segments(shape)))
         progress(Step("reading", i, len(shapes), path.name))
     box = None
-    if options.fit_mm is not None or check is not None:
+    if options.fit is not None or check is not None:
         box = _ends_box(drawn, prepared.matrix)
     if check is not None and box is not None:
         check(box)

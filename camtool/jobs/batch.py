@@ -47,7 +47,7 @@ The report (``camtool batch --report batch.json``), keys other tools may read:
 - ``options``: every option that shapes the outputs (``target`` — a list of
   names with several targets —, ``output_dir``,
   ``machine_file``, ``offset``, ``tool_diameter``, ``feed_mm_min``, ``tolerance``,
-  ``scale``, ``fit_mm``, ``fmt``, ``spindle_rpm``, ``layers``, ``units``,
+  ``scale``, ``fit``, ``fmt``, ``spindle_rpm``, ``layers``, ``units``,
   ``hatch_boundaries``, ``verify`` (true also when implied by ``preview`` or
   ``max_error_um``), ``preview``, ``max_error_um``) and ``scheduler`` (``null``:
   this machine's processes; else the ``--scheduler`` given or the address of the

@@ -166,8 +166,8 @@ def _placement_lines(placement: tuple[float, float, float], plan: PlanOptions | 
     if (k, dx, dy) == (1.0, 0.0, 0.0):
         return []
     lines = [f"placement: scale {k:.12g}, shift X{dx:.12g} Y{dy:.12g} mm"]
-    if plan is not None and plan.fit_mm is not None and k != 1.0:
-        w, h = plan.fit_mm
+    if plan is not None and plan.fit is not None and k != 1.0:
+        w, h = plan.fit
         lines.append(f"--fit {w:g} x {h:g} mm: the drawing at {100 * k:.4g} % of its size")
     elif k != 1.0:
         lines.append(f"--scale {k:g}: the drawing at {100 * k:.4g} % of its size")

@@ -39,6 +39,7 @@ from pathlib import Path
 from typing import Any
 
 from camtool.model.errors import InputError, UsageError
+from camtool.model.keywords import checked_keywords
 from camtool.toolpath.options import PLACEMENTS, PlanOptions, flag
 
 TOOL_TYPES = ("end-mill", "drill", "v-bit", "engraver")
@@ -65,6 +66,7 @@ MAX_JOB_BYTES = 1_000_000
 """Largest job file read (a job of a thousand operations is a few hundred kB)."""
 
 
+@checked_keywords()
 @dataclass(frozen=True, kw_only=True)
 class Tool:
     """A tool of the job's tool table.
@@ -87,11 +89,27 @@ class Tool:
     feed_mm_min: float | None = None
     plunge_feed_mm_min: float | None = None
 
+    def __post_init__(self) -> None:
+        if isinstance(self.id, bool) or not isinstance(self.id, int):
+            raise UsageError(f"Tool.id must be a whole number, got {self.id!r}")
+        if not 0 <= self.id <= MAX_TOOL_NUMBER:
+            raise UsageError(f"Tool.id must be 0…{MAX_TOOL_NUMBER}, got {self.id!r}")
+        if self.type not in TOOL_TYPES:
+            raise UsageError(
+                f"unknown Tool.type {self.type!r}; choose one of {', '.join(TOOL_TYPES)}"
+            )
+        _check_number("Tool.diameter", self.diameter, "mm", low=0.0, high=1000.0)
+        for name in ("rpm", "feed_mm_min", "plunge_feed_mm_min"):
+            value = getattr(self, name)
+            if value is not None:
+                _check_number(f"Tool.{name}", value, "", low=0.0, high=1e6, above=True)
+
     def describe(self) -> str:
         """``"drill 3 mm"`` (or the tool's name): what the operator is asked to load."""
         return self.name or f"{self.type} {self.diameter:g} mm"
 
 
+@checked_keywords({"diameter_mm": "diameter", "except_diameter_mm": "except_diameter"})
 @dataclass(frozen=True, kw_only=True)
 class Selection:
     """Which of the drawing an operation cuts: every condition given must hold.
@@ -101,8 +119,8 @@ class Selection:
             selects its construction geometry too (centre lines, a construction layer).
         colours: colours as ``#rrggbb``; ``None``: any.
         closed: only closed (``True``) or only open (``False``) contours; ``None``: both.
-        diameter_mm: ``(min, max)``: only circles whose diameter lies in it, mm.
-        except_diameter_mm: ``(min, max)``: not the circles whose diameter lies in it (the
+        diameter: ``(min, max)``: only circles whose diameter lies in it, mm.
+        except_diameter: ``(min, max)``: not the circles whose diameter lies in it (the
             holes a drill operation drills), mm.
         linetypes: linetype names (upper case): only these; naming one selects it even
             when it is construction (CENTER, DASHED...). ``None``: any continuous one.
@@ -112,10 +130,24 @@ class Selection:
     layers: tuple[str, ...] | None = None
     colours: tuple[str, ...] | None = None
     closed: bool | None = None
-    diameter_mm: tuple[float, float] | None = None
-    except_diameter_mm: tuple[float, float] | None = None
+    diameter: tuple[float, float] | None = None
+    except_diameter: tuple[float, float] | None = None
     linetypes: tuple[str, ...] | None = None
     points: bool = False
+
+    def __post_init__(self) -> None:
+        for name in ("diameter", "except_diameter"):
+            span = getattr(self, name)
+            if span is None:
+                continue
+            if not isinstance(span, tuple) or len(span) != 2:
+                raise UsageError(f"Selection.{name} must be (min, max) in mm, got {span!r}")
+            for value in span:
+                _check_number(f"Selection.{name}", value, "mm", low=0.0, high=1000.0)
+            if span[0] > span[1]:
+                raise UsageError(
+                    f"Selection.{name} must be (min, max) with min ≤ max, got {span!r}"
+                )
 
     def describe(self) -> str:
         """The selection in a few words for messages and the program header."""
@@ -126,17 +158,18 @@ class Selection:
             parts.append("colour " + ", ".join(self.colours))
         if self.closed is not None:
             parts.append("closed contours" if self.closed else "open contours")
-        if self.diameter_mm is not None:
-            lo, hi = self.diameter_mm
+        if self.diameter is not None:
+            lo, hi = self.diameter
             parts.append(f"circles of {lo:g}" + (f"–{hi:g}" if hi != lo else "") + " mm")
-        if self.except_diameter_mm is not None:
-            lo, hi = self.except_diameter_mm
+        if self.except_diameter is not None:
+            lo, hi = self.except_diameter
             parts.append(f"not circles of {lo:g}" + (f"–{hi:g}" if hi != lo else "") + " mm")
         if self.linetypes is not None:
             parts.append("linetype " + ", ".join(self.linetypes))
         return "; ".join(parts) or "the whole drawing"
 
 
+@checked_keywords({"hole_tolerance_mm": "hole_tolerance"})
 @dataclass(frozen=True, kw_only=True)
 class Operation:
     """One operation: what to cut (its selection), with which tool, and how.
@@ -152,7 +185,7 @@ class Operation:
         side: for a profile, one of :data:`SIDES`; else ``""``.
         peck: for a drill with a ``step_down``, one of :data:`PECKS`.
         dwell_s: for a drill, the wait at the bottom, s (G82).
-        hole_tolerance_mm: for a drill, how far a circle's diameter may differ from the
+        hole_tolerance: for a drill, how far a circle's diameter may differ from the
             drill's, mm.
     """
 
@@ -164,7 +197,21 @@ class Operation:
     side: str = ""
     peck: str = "retract"
     dwell_s: float = 0.0
-    hole_tolerance_mm: float = 0.05
+    hole_tolerance: float = 0.05
+
+    def __post_init__(self) -> None:
+        if self.type not in OPERATION_TYPES:
+            raise UsageError(
+                f"unknown Operation.type {self.type!r}; choose one of {', '.join(OPERATION_TYPES)}"
+            )
+        if self.type == "profile" and self.side not in SIDES:
+            raise UsageError(f"Operation.side of a profile must be one of {', '.join(SIDES)}")
+        if self.peck not in PECKS:
+            raise UsageError(
+                f"unknown Operation.peck {self.peck!r}; choose one of {', '.join(PECKS)}"
+            )
+        _check_number("Operation.dwell_s", self.dwell_s, "s", low=0.0, high=3600.0)
+        _check_number("Operation.hole_tolerance", self.hole_tolerance, "mm", low=0.0, high=1000.0)
 
     @property
     def kind(self) -> str:
@@ -172,12 +219,13 @@ class Operation:
         return f"profile {self.side}" if self.type == "profile" else self.type
 
 
+@checked_keywords()
 @dataclass(frozen=True, kw_only=True)
 class Setup:
     """What every operation of a job shares: where work zero is, the size, the heights.
 
     Attributes:
-        plan: the shared planning options (``scale``/``fit_mm``, ``placement`` and
+        plan: the shared planning options (``scale``/``fit``, ``placement`` and
             ``translate``, ``clearance_z``, ``end_position``, ``chain_tolerance``,
             ``close_gap``, ``tolerance``, the default ``safe_z``).
         sequence: one of :data:`SEQUENCES`.
@@ -189,7 +237,7 @@ class Setup:
 
 SETUP_FIELDS = (
     "scale",
-    "fit_mm",
+    "fit",
     "placement",
     "translate",
     "clearance_z",
@@ -203,6 +251,7 @@ SETUP_FIELDS = (
 """The :class:`PlanOptions` fields a job shares (the rest belong to each operation)."""
 
 
+@checked_keywords()
 @dataclass(frozen=True, kw_only=True)
 class Job:
     """Tools, operations and the setup they share (see the module docstring).
@@ -268,6 +317,18 @@ class Job:
         return tuple(op for _, op in sorted(enumerate(self.operations), key=key))
 
 
+def _check_number(
+    name: str, value: object, unit: str, *, low: float, high: float, above: bool = False
+) -> None:
+    """``value`` a finite number in ``[low, high]`` (``(low, high]`` when ``above``)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise UsageError(f"{name} must be a number, got {value!r}")
+    unit = f" {unit}" if unit else ""
+    if not math.isfinite(value) or value < low or (above and value == low) or value > high:
+        side = ">" if above else "≥"
+        raise UsageError(f"{name} must be {side} {low:g} and ≤ {high:g}{unit}, got {value!r}")
+
+
 _STAGE = {
     "drill": 0,
     "engrave": 1,
@@ -285,7 +346,7 @@ _JOB_KEYS: dict[str, str] = {
     "origin": "placement",
     "translate": "translate",
     "scale": "scale",
-    "fit": "fit_mm",
+    "fit": "fit",
     "clearance_z": "clearance_z",
     "end_position": "end_position",
     "chain_tolerance": "chain_tolerance",
@@ -306,11 +367,11 @@ _OP_PLAN_KEYS: dict[str, str] = {
     "safe_z": "safe_z",
     "feed": "feed_mm_min",
     "plunge_feed": "plunge_feed_mm_min",
-    "ramp": "ramp_angle_deg",
+    "ramp": "ramp_deg",
     "tabs": "tabs",
     "tab_width": "tab_width",
     "tab_height": "tab_height",
-    "lead_in": "lead_in_mm",
+    "lead_in": "lead_in",
     "direction": "direction",
     "stepover": "stepover",
     "pocket": "pocket",
@@ -489,7 +550,7 @@ def _operation(
         side=side,
         peck=_choice(row.get("peck", "retract"), PECKS, source, f"{where} peck"),
         dwell_s=_number(row.get("dwell", 0.0), source, f"{where} dwell", low=0.0, high=3600.0),
-        hole_tolerance_mm=_number(
+        hole_tolerance=_number(
             row.get("hole_tolerance", 0.05), source, f"{where} hole_tolerance", low=0.0, high=100.0
         ),
     )
@@ -545,8 +606,8 @@ def _selection(row: Mapping[str, Any], kind: str, source: str, where: str) -> Se
         layers=None if layers is None else _names(layers, source, f"{where} layers"),
         colours=None if colours is None else tuple(_colour(c, source, where) for c in colours),
         closed=closed,
-        diameter_mm=_diameters(row.get("diameter"), source, where),
-        except_diameter_mm=_diameters(row.get("except_diameter"), source, where),
+        diameter=_diameters(row.get("diameter"), source, where),
+        except_diameter=_diameters(row.get("except_diameter"), source, where),
         linetypes=None
         if linetypes is None
         else tuple(n.upper() for n in _names(linetypes, source, f"{where} linetypes")),
@@ -625,7 +686,7 @@ def _key_of(flag_name: str) -> str:
 def _value(value: Any, fieldname: str, source: str, where: str) -> object:
     """A TOML value for the :class:`PlanOptions` field ``fieldname``, its type checked."""
     default = PlanOptions.__dataclass_fields__[fieldname].default
-    if fieldname in ("translate", "end_position", "fit_mm"):
+    if fieldname in ("translate", "end_position", "fit"):
         if not (isinstance(value, list) and len(value) == 2):
             raise InputError(f"{source}: {where} = {value!r}; give two numbers, [x, y] in mm")
         return (_number(value[0], source, where), _number(value[1], source, where))

@@ -114,7 +114,7 @@ def post_path(
         plan: the planning options (``None``: the defaults, the target's feed).
         output: how the program is written (``None``: the defaults).
         import_options: how the drawing is read (layers, units…; its ``scale`` and
-            ``fit_mm`` are ``plan``'s).
+            ``fit`` are ``plan``'s).
         progress: told the stages (:class:`~camtool.model.progress.Step`) as the job goes:
             ``reading`` (and for an SVG ``fitting`` and ``contours``,
             :func:`camtool.importers.read_drawing`), ``planning`` and ``writing``
@@ -235,12 +235,12 @@ def post_bytes(
 def sized(options: ImportOptions | None, plan: PlanOptions) -> ImportOptions:
     """``options`` (``None``: the defaults) for a drawing planned with ``plan``.
 
-    With the scale planning gives the drawing (``plan.scale``, ``plan.fit_mm``), so that
+    With the scale planning gives the drawing (``plan.scale``, ``plan.fit``), so that
     its curves are fitted within the tolerance at that size, in the program
     (:meth:`~camtool.importers.options.ImportOptions.curve_tolerance`).
     """
     base = options if options is not None else ImportOptions()
-    return dataclasses.replace(base, scale=plan.scale, fit_mm=plan.fit_mm)
+    return dataclasses.replace(base, scale=plan.scale, fit=plan.fit)
 
 
 def travel_check(plan: PlanOptions, target: Target) -> Callable[[BBox], None] | None:
@@ -255,7 +255,7 @@ def travel_check(plan: PlanOptions, target: Target) -> Callable[[BBox], None] | 
     are fitted; inside offsets and pockets, whose cuts can vanish, are checked after
     planning only, as every program is.
     """
-    if plan.fit_mm is not None or plan.offset not in ("on", "outside"):
+    if plan.fit is not None or plan.offset not in ("on", "outside"):
         return None
     from camtool.geometry.chain import joint_distance
     from camtool.toolpath.placement import Placing, too_large_drawing
@@ -263,7 +263,7 @@ def travel_check(plan: PlanOptions, target: Target) -> Callable[[BBox], None] | 
     machine = target.machine
     slack = joint_distance(plan.chain_tolerance) + plan.tolerance
     tool = plan.radius if plan.offset == "outside" else 0.0
-    margin = 2.0 * (tool + plan.lead_in_mm)
+    margin = 2.0 * (tool + plan.lead_in)
     placing = Placing(plan.placement, plan.translate, (margin, margin))
 
     def check(box: BBox) -> None:
@@ -406,7 +406,7 @@ def post_drawing(
         drawing: the imported drawing, mm.
         target: the target (see :func:`camtool.post.registry.load_target`).
         plan: the planning options (``offset``, ``tool_diameter``, ``feed_mm_min`` —
-            ``None`` takes the target's —, ``tolerance``, ``scale``, ``fit_mm``,
+            ``None`` takes the target's —, ``tolerance``, ``scale``, ``fit``,
             ``depth``, ``order``...); ``None``: the defaults.
         output: the output format and spindle (``None``: the defaults; the spindle
             speed then is the target's ``spindle_rpm``, which may be none).

@@ -65,7 +65,7 @@ class PostJob:
         program: the planned, machine-neutral program.
         target: the target it was written for.
         result: the emitted code and its warnings.
-        placed: the drawing as placed on the machine (after ``scale``/``fit_mm``),
+        placed: the drawing as placed on the machine (after ``scale``/``fit``),
             in the program's coordinates.
         edge_radius_mm: how far the cut edge lies from the tool path: half the tool
             diameter for ``outside``/``inside``/``pocket``, 0 for paths on the line.
@@ -156,12 +156,12 @@ def plan_options(target: Target, plan: PlanOptions | None = None) -> PlanOptions
     if plan.feed_mm_min is None:
         plan = dataclasses.replace(plan, feed_mm_min=target.default_feed_mm_min)
     plan.check_machine(target.machine, target.name)
-    if plan.lead_in_mm > 0 and not target.post.arcs:
+    if plan.lead_in > 0 and not target.post.arcs:
         raise UsageError(
             f"--lead-in: {target.name} writes arcs as chords; lead-in arcs are for targets "
             "with arcs (leave --lead-in out)"
         )
-    if plan.ramp_angle_deg is not None and not target.post.z_with_xy:
+    if plan.ramp_deg is not None and not target.post.z_with_xy:
         raise UsageError(
             f"--ramp: {target.name} moves Z in a block of its own, so it cannot descend "
             "along the path; leave --ramp out (the tool plunges straight down)"
@@ -455,7 +455,7 @@ def _operation_options(
     """``op``'s planning options for planning it alone, from where the tool is."""
     shared = {
         "scale": 1.0,
-        "fit_mm": None,
+        "fit": None,
         "placement": "drawing",
         "translate": (0.0, 0.0),
         "end_position": setup.end_position if last else None,
@@ -560,12 +560,12 @@ def _holes(drawing: Drawing, op: Operation, tool: Tool, where: str) -> list[Poin
                 "it with a profile or pocket operation (or narrow the selection)"
             )
         (cx, cy), d = circle
-        if abs(d - tool.diameter) > op.hole_tolerance_mm + 1e-9:
+        if abs(d - tool.diameter) > op.hole_tolerance + 1e-9:
             size = "larger" if d > tool.diameter else "smaller"
             raise InputError(
                 f"{where}: hole {name} at ({cx:.4f}, {cy:.4f}) mm is {d:.4g} mm across, "
                 f"{size} than the {tool.diameter:g} mm drill (hole_tolerance "
-                f"{op.hole_tolerance_mm:g} mm): "
+                f"{op.hole_tolerance:g} mm): "
                 + (
                     'cut it with a profile operation (side = "inside") instead'
                     if d > tool.diameter

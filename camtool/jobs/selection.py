@@ -57,13 +57,13 @@ def matches(contour: Contour, selection: Selection) -> bool:
         return False
     if selection.linetypes is not None and contour.linetype not in selection.linetypes:
         return False
-    if selection.diameter_mm is not None:
+    if selection.diameter is not None:
         circle = circle_of(contour)
-        if circle is None or not _within(circle[1], selection.diameter_mm):
+        if circle is None or not _within(circle[1], selection.diameter):
             return False
-    if selection.except_diameter_mm is not None:
+    if selection.except_diameter is not None:
         circle = circle_of(contour)
-        if circle is not None and _within(circle[1], selection.except_diameter_mm):
+        if circle is not None and _within(circle[1], selection.except_diameter):
             return False
     return True
 

@@ -74,7 +74,7 @@ def distance(a: Point, b: Point) -> float:
     return math.hypot(b[0] - a[0], b[1] - a[1])
 
 
-def fit_factor(box: BBox, fit_mm: tuple[float, float]) -> float:
+def fit_factor(box: BBox, fit: tuple[float, float]) -> float:
     """The uniform scale ``--fit W H`` applies to a drawing of extent ``box`` (mm).
 
     The largest factor that keeps the scaled box within ``W`` × ``H`` mm; ``math.inf``
@@ -83,7 +83,7 @@ def fit_factor(box: BBox, fit_mm: tuple[float, float]) -> float:
     tolerance (:meth:`camtool.importers.options.ImportOptions.curve_tolerance`).
     """
     x0, y0, x1, y1 = box
-    w, h = fit_mm
+    w, h = fit
     return min(w / (x1 - x0) if x1 > x0 else math.inf, h / (y1 - y0) if y1 > y0 else math.inf)
 
 

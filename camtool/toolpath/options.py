@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from camtool.model.errors import UsageError
+from camtool.model.keywords import checked_keywords
 from camtool.model.shapes import Point
 
 if TYPE_CHECKING:
@@ -50,17 +51,19 @@ DEFAULT_CLEARANCE_Z = 5.0
 this and ``--safe-z``."""
 
 _FLAG_NAMES = {
-    "fit_mm": "--fit",
     "plunge_feed_mm_min": "--plunge-feed",
-    "ramp_angle_deg": "--ramp",
+    "ramp_deg": "--ramp",
     "pocket_angle_deg": "--pocket-angle",
-    "lead_in_mm": "--lead-in",
     "fit_arcs": "--no-fit-arcs",
     "feed_mm_min": "--feed",
     "placement": "--origin",
     "reverse_open": "--reverse-open",
     "origin": "the start position (PlanOptions.origin)",  # API only: --origin is placement
 }
+
+
+RENAMED = {"lead_in_mm": "lead_in", "fit_mm": "fit", "ramp_angle_deg": "ramp_deg"}
+"""Old :class:`PlanOptions` keywords → their names (deprecated aliases for one release)."""
 
 
 def flag(field_name: str) -> str:
@@ -86,6 +89,7 @@ def drawing_only(values: Mapping[str, object]) -> list[str]:
     ]
 
 
+@checked_keywords(RENAMED)
 @dataclass(frozen=True, kw_only=True)
 class PlanOptions:
     """How to turn a drawing into a toolpath.
@@ -107,7 +111,7 @@ class PlanOptions:
             closed with a warning; 0 closes nothing.
         origin: tool position before the program, mm.
         scale: uniform scale applied to the drawing about its origin (> 0).
-        fit_mm: ``(width, height)``: scale the drawing uniformly, about the
+        fit: ``(width, height)``: scale the drawing uniformly, about the
             lower-left corner of its bounding box, to the largest size that fits
             this box. Excludes ``scale``.
         direction: ``climb`` or ``conventional`` for closed contours with a
@@ -123,13 +127,13 @@ class PlanOptions:
         safe_z: height of every rapid when a depth is given, mm (> 0).
         plunge_feed_mm_min: feed of Z moves into the material (and, on a Z machine
             without ``depth``, down to Z 0), mm/min; ``None``: half of ``feed_mm_min``.
-        ramp_angle_deg: enter each pass along the path descending at this angle
+        ramp_deg: enter each pass along the path descending at this angle
             from the horizontal, degrees in (0, 90); ``None`` plunges straight.
         tabs: number of holding tabs on each outside profile (0 = none).
         tab_width: tab length along the part edge, mm.
         tab_height: tab height above the final depth, mm (< ``depth``).
         order: cutting order, one of :data:`ORDERS`.
-        lead_in_mm: radius of tangent lead-in/lead-out arcs on closed profiles,
+        lead_in: radius of tangent lead-in/lead-out arcs on closed profiles,
             mm (0 = none).
         fit_arcs: fit arcs to dense polylines within ``tolerance``.
         placement: where the work zero lies, one of :data:`PLACEMENTS` (``--origin``):
@@ -137,7 +141,7 @@ class PlanOptions:
             the program so that the lower-left corner / the centre of the toolpath's
             extent (tool radius, lead-ins and tabs included) is X0 Y0.
         translate: ``(dx, dy)`` mm added to every position after ``placement``.
-            Order: ``scale``/``fit_mm`` on the drawing, then planning, then
+            Order: ``scale``/``fit`` on the drawing, then planning, then
             ``placement``, then ``translate``.
         chain_tolerance: entity ends closer than this (mm) are joined into one
             contour (:data:`DEFAULT_CHAIN_TOLERANCE`).
@@ -160,18 +164,18 @@ class PlanOptions:
     step_down: float | None = None
     safe_z: float = 2.0
     plunge_feed_mm_min: float | None = None
-    ramp_angle_deg: float | None = None
+    ramp_deg: float | None = None
     tabs: int = 0
     tab_width: float = 2.0
     tab_height: float = 0.5
     order: str = "travel"
-    lead_in_mm: float = 0.0
+    lead_in: float = 0.0
     close_gap: float = 0.02
     fit_arcs: bool = True
     feed_mm_min: float | None = None
     tolerance: float = 0.001
     scale: float = 1.0
-    fit_mm: tuple[float, float] | None = None
+    fit: tuple[float, float] | None = None
     placement: str = "drawing"
     translate: tuple[float, float] = (0.0, 0.0)
     chain_tolerance: float = DEFAULT_CHAIN_TOLERANCE
@@ -267,11 +271,11 @@ class PlanOptions:
 
     def _check_tool(self) -> None:
         if self.tool_diameter < 0:
-            raise UsageError(f"tool diameter must be ≥ 0 mm, got {self.tool_diameter!r}")
+            raise UsageError(f"--tool-diameter must be ≥ 0 mm, got {self.tool_diameter!r}")
         if self.offset != "on" and self.tool_diameter <= 0:
             raise UsageError(f"--offset {self.offset} needs --tool-diameter MM (> 0)")
         if self.feed_mm_min is not None and self.feed_mm_min <= 0:
-            raise UsageError(f"feed must be > 0 mm/min, got {self.feed_mm_min!r}")
+            raise UsageError(f"--feed must be > 0 mm/min, got {self.feed_mm_min!r}")
         if self.tolerance < MIN_TOLERANCE_MM:
             raise UsageError(
                 f"--tolerance must be at least {MIN_TOLERANCE_MM:g} mm (1 nm, below every "
@@ -283,9 +287,9 @@ class PlanOptions:
             raise UsageError(
                 f"--stepover is a fraction of the tool diameter in (0, 1], got {self.stepover!r}"
             )
-        if self.lead_in_mm < 0:
-            raise UsageError(f"--lead-in must be ≥ 0 mm, got {self.lead_in_mm!r}")
-        if self.lead_in_mm > 0 and self.offset in ("on", "pocket"):
+        if self.lead_in < 0:
+            raise UsageError(f"--lead-in must be ≥ 0 mm, got {self.lead_in!r}")
+        if self.lead_in > 0 and self.offset in ("on", "pocket"):
             raise UsageError(
                 "--lead-in needs a side to approach from: use --offset outside or inside"
             )
@@ -294,12 +298,12 @@ class PlanOptions:
         if self.chain_tolerance < 0:
             raise UsageError(f"--chain-tolerance must be ≥ 0 mm, got {self.chain_tolerance!r}")
         if self.scale <= 0:
-            raise UsageError(f"scale must be > 0, got {self.scale!r}")
-        if self.fit_mm is not None:
+            raise UsageError(f"--scale must be > 0, got {self.scale!r}")
+        if self.fit is not None:
             if self.scale != 1.0:
                 raise UsageError("give either --scale or --fit, not both")
-            if min(self.fit_mm) <= 0:
-                raise UsageError(f"--fit needs a width and height > 0 mm, got {self.fit_mm!r}")
+            if min(self.fit) <= 0:
+                raise UsageError(f"--fit needs a width and height > 0 mm, got {self.fit!r}")
 
     def _check_depth(self) -> None:
         if self.safe_z <= 0:
@@ -315,7 +319,7 @@ class PlanOptions:
                 flag
                 for flag, value in (
                     ("--step-down", self.step_down),
-                    ("--ramp", self.ramp_angle_deg),
+                    ("--ramp", self.ramp_deg),
                 )
                 if value is not None
             ]
@@ -330,10 +334,9 @@ class PlanOptions:
             raise UsageError(f"--step-down must be > 0 mm, got {self.step_down!r}")
         if self.plunge_feed_mm_min is not None and self.plunge_feed_mm_min <= 0:
             raise UsageError(f"--plunge-feed must be > 0 mm/min, got {self.plunge_feed_mm_min!r}")
-        if self.ramp_angle_deg is not None and not 0 < self.ramp_angle_deg < 90:
+        if self.ramp_deg is not None and not 0 < self.ramp_deg < 90:
             raise UsageError(
-                f"--ramp is an angle in (0, 90) degrees from the horizontal, got "
-                f"{self.ramp_angle_deg!r}"
+                f"--ramp is an angle in (0, 90) degrees from the horizontal, got {self.ramp_deg!r}"
             )
 
     def _check_tabs(self) -> None:
@@ -425,18 +428,18 @@ _KINDS: dict[str, str] = {
     "step_down": "number?",
     "safe_z": "number",
     "plunge_feed_mm_min": "number?",
-    "ramp_angle_deg": "number?",
+    "ramp_deg": "number?",
     "tabs": "int",
     "tab_width": "number",
     "tab_height": "number",
     "order": "choice",
-    "lead_in_mm": "number",
+    "lead_in": "number",
     "close_gap": "number",
     "fit_arcs": "bool",
     "feed_mm_min": "number?",
     "tolerance": "number",
     "scale": "number",
-    "fit_mm": "pair?",
+    "fit": "pair?",
     "placement": "choice",
     "translate": "pair",
     "chain_tolerance": "number",

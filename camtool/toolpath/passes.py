@@ -43,7 +43,7 @@ move is written.
 - consecutive ``pocket`` cuts of the same group are cut level by level (every
   ring or path at pass 1, then every one at pass 2...), retracting between cuts.
 
-**Ramp** (``ramp_angle_deg``): instead of a vertical plunge the tool descends
+**Ramp** (``ramp_deg``): instead of a vertical plunge the tool descends
 along the path over ``L = Δz / tan(angle)``; arcs descend as helical arc moves
 (or, with ``helix=False``, chords within ``tolerance`` over which Z falls evenly
 per arc length: a chord is steeper than the angle by the factor arc/chord, at
@@ -59,7 +59,7 @@ below the tab top ``z_tab = −depth + tab_height`` the tool rises to ``z_tab`` 
 each tab start (at the cutting feed), crosses the tab at ``z_tab`` and goes down
 at its end (at the plunge feed); a ramp crossing a tab stays at or above ``z_tab``.
 
-**Lead arcs** (``lead_in_mm``, closed profiles with a material side,
+**Lead arcs** (``lead_in``, closed profiles with a material side,
 :mod:`~camtool.toolpath.leads`): the tool travels to the lead-in's start (off the
 part), goes down there (or ramps along the lead-in), cuts the lead-in, the loop
 and the lead-out at the pass depth, and rises; each pass is entered the same way.
@@ -140,8 +140,8 @@ def emit(
             on its moves.
         options: feeds (``feed_mm_min``, ``plunge_feed``), ``depth``,
             ``step_down``, ``safe_z``, ``clearance``, ``end_position``,
-            ``ramp_angle_deg``, ``tabs``/``tab_width``/``tab_height``/
-            ``tool_diameter``, ``lead_in_mm``, ``tolerance``, ``origin`` (where
+            ``ramp_deg``, ``tabs``/``tab_width``/``tab_height``/
+            ``tool_diameter``, ``lead_in``, ``tolerance``, ``origin`` (where
             the tool is before the first move).
         helix: the target can write helical arcs (an arc move with Z). ``False``:
             the descending part of an arc in a ramp becomes chords within
@@ -245,7 +245,7 @@ def check_ramp(cuts: Sequence[Cut], options: PlanOptions, levels: Sequence[float
             than :data:`MAX_RAMP_LAPS` laps, naming ``--ramp``, the ramp length per
             pass and what to do.
     """
-    angle = options.ramp_angle_deg
+    angle = options.ramp_deg
     if angle is None or not cuts:
         return
     dz = max(a - b for a, b in pairwise((0.0, *levels)))
@@ -306,12 +306,12 @@ class _Writer:
         self._lift_at: int | None = None
         self.findings: list[Finding] = []
         self._positioned = False
-        ramp = options.ramp_angle_deg
+        ramp = options.ramp_deg
         self.slope = None if ramp is None else math.tan(math.radians(ramp))
 
     def leads(self, cut: Cut) -> tuple[Arc, Arc] | None:
         """The lead arcs of ``cut`` (:func:`leads_for`), saying when they had to shrink."""
-        asked = self.options.lead_in_mm
+        asked = self.options.lead_in
         leads = leads_for(cut, asked)
         if asked <= 0 or cut.kind != "profile" or cut.material_side is None:
             return leads

@@ -252,7 +252,7 @@ def _backlash_weights(machine: Machine) -> tuple[float, float]:
 
 
 def place(drawing: Drawing, options: PlanOptions) -> Drawing:
-    """The drawing scaled as ``options.scale`` or ``options.fit_mm`` ask (mm)."""
+    """The drawing scaled as ``options.scale`` or ``options.fit`` ask (mm)."""
     k, dx, dy = scaling(drawing, options)
     if (k, dx, dy) == (1.0, 0.0, 0.0):
         return drawing
@@ -264,10 +264,10 @@ def scaling(drawing: Drawing, options: PlanOptions) -> tuple[float, float, float
 
     ``--scale`` scales about the drawing's origin; ``--fit`` about its lower-left corner.
     """
-    if options.fit_mm is None:
+    if options.fit is None:
         return (options.scale, 0.0, 0.0)
     x0, y0, _, _ = box = drawing.bbox()
-    k = fit_factor(box, options.fit_mm)
+    k = fit_factor(box, options.fit)
     if math.isinf(k):
         return (1.0, 0.0, 0.0)
     return (k, x0 * (1 - k), y0 * (1 - k))

@@ -47,23 +47,23 @@ def test_non_finite_option_is_a_usage_error_naming_it(
     ("field", "value"),
     [
         ("tab_height", math.nan),
-        ("lead_in_mm", math.nan),
+        ("lead_in", math.nan),
         ("close_gap", math.nan),
         ("safe_z", math.inf),
         ("tolerance", math.nan),
         ("stepover", math.nan),
-        ("ramp_angle_deg", math.nan),
+        ("ramp_deg", math.nan),
     ],
 )
 def test_plan_options_refuse_non_finite(field: str, value: float) -> None:
-    extra = {"depth": 3.0} if field == "ramp_angle_deg" else {}
+    extra = {"depth": 3.0} if field == "ramp_deg" else {}
     with pytest.raises(UsageError, match="finite"):
         PlanOptions(feed_mm_min=100.0, **extra, **{field: value})
 
 
 def test_fit_with_infinite_box_is_refused() -> None:
     with pytest.raises(UsageError, match="--fit"):
-        PlanOptions(feed_mm_min=100.0, fit_mm=(math.inf, math.inf))
+        PlanOptions(feed_mm_min=100.0, fit=(math.inf, math.inf))
 
 
 def test_pass_count_is_bounded() -> None:

@@ -171,5 +171,5 @@ def _options(extra: list[str]) -> PlanOptions:
     if not extra:
         return PlanOptions()
     if extra[0] == "--fit" and len(extra) == 3:
-        return PlanOptions(fit_mm=(float(extra[1]), float(extra[2])))
+        return PlanOptions(fit=(float(extra[1]), float(extra[2])))
     pytest.skip(f"comparison with flags {extra} is not mapped to planning options")

@@ -43,12 +43,12 @@ BEZ = f'<path id="bez" d="{BEZ_D}" fill="none" stroke="black"/>'
 def _placed(path: Path, options: ImportOptions) -> Drawing:
     """The drawing read with ``options`` and placed as planning places it."""
     drawing = read_drawing(path, options)
-    return place(drawing, PlanOptions(scale=options.scale, fit_mm=options.fit_mm))
+    return place(drawing, PlanOptions(scale=options.scale, fit=options.fit))
 
 
 def _factor(options: ImportOptions) -> float:
     """The scale of the 100 × 100 mm frame's drawing: --scale, or --fit's W / 100."""
-    return options.scale if options.fit_mm is None else min(options.fit_mm) / 100.0
+    return options.scale if options.fit is None else min(options.fit) / 100.0
 
 
 def _named(drawing: Drawing, name: str) -> list[Contour]:
@@ -59,22 +59,22 @@ def test_curve_tolerance_is_the_tolerance_divided_by_the_placement_scale() -> No
     assert ImportOptions().curve_tolerance() == 0.001
     assert ImportOptions(scale=4.0).curve_tolerance() == 0.001 / 4.0
     assert ImportOptions(scale=0.5).curve_tolerance() == 0.001 / 0.5
-    fit = ImportOptions(fit_mm=(100.0, 50.0))
+    fit = ImportOptions(fit=(100.0, 50.0))
     assert fit.curve_tolerance((0.0, 0.0, 10.0, 10.0)) == 0.001 / 5.0  # min(100/10, 50/10)
     assert fit.curve_tolerance((2.0, 3.0, 202.0, 13.0)) == 0.001 / 0.5  # min(100/200, 50/10)
     assert fit.curve_tolerance(None) == 0.001  # no extent: as drawn
     assert fit.curve_tolerance((5.0, 5.0, 5.0, 5.0)) == 0.001  # a point: --fit leaves it
     exact = fit.at_tolerance(0.0002)
-    assert (exact.tolerance, exact.scale, exact.fit_mm) == (0.0002, 1.0, None)
+    assert (exact.tolerance, exact.scale, exact.fit) == (0.0002, 1.0, None)
     assert exact.curve_tolerance() == 0.0002
 
 
 @pytest.mark.parametrize(
     "options",
     [
-        ImportOptions(fit_mm=(400.0, 400.0)),
+        ImportOptions(fit=(400.0, 400.0)),
         ImportOptions(scale=4.0),
-        ImportOptions(fit_mm=(10.0, 10.0)),
+        ImportOptions(fit=(10.0, 10.0)),
         ImportOptions(scale=0.1),
         ImportOptions(),
     ],
@@ -92,7 +92,7 @@ def test_svg_bezier_holds_the_tolerance_once_placed(tmp_path: Path, options: Imp
 def test_a_drawing_scaled_down_is_fitted_with_fewer_arcs(tmp_path: Path) -> None:
     path = svg(tmp_path, FRAME + BEZ)
     (as_drawn,) = _named(read_drawing(path), "bez")
-    (down,) = _named(read_drawing(path, ImportOptions(fit_mm=(10.0, 10.0))), "bez")
+    (down,) = _named(read_drawing(path, ImportOptions(fit=(10.0, 10.0))), "bez")
     assert len(down.segments) < len(as_drawn.segments)
 
 
@@ -112,7 +112,7 @@ def test_a_path_of_zero_length_does_not_widen_the_fit(
         return drawing, tolerance
 
     monkeypatch.setattr(svg_importer, "svg_drawing", noting)
-    placed = _placed(path, ImportOptions(fit_mm=(400.0, 400.0)))
+    placed = _placed(path, ImportOptions(fit=(400.0, 400.0)))
     assert [c.source for c in placed.contours] == ["path#frame", "path#bez"]
     assert used == [TOL / 4.0]
 
@@ -132,7 +132,7 @@ def test_a_dxf_scaled_up_is_read_again_finer(
         return read_dxf(path, options)
 
     monkeypatch.setattr(dxf_importer, "read_dxf", noting)
-    read_drawing(_spline_dxf(tmp_path / "s.dxf"), ImportOptions(fit_mm=(400.0, 400.0)))
+    read_drawing(_spline_dxf(tmp_path / "s.dxf"), ImportOptions(fit=(400.0, 400.0)))
     assert asked == [TOL, pytest.approx(TOL / 4.0 * (1 - 1e-6), rel=1e-12)]
 
 
@@ -146,7 +146,7 @@ def _spline_dxf(path: Path) -> Path:
 
 @pytest.mark.parametrize(
     "options",
-    [ImportOptions(fit_mm=(400.0, 400.0)), ImportOptions(scale=4.0)],
+    [ImportOptions(fit=(400.0, 400.0)), ImportOptions(scale=4.0)],
     ids=["fit-up", "scale-up"],
 )
 def test_dxf_spline_holds_the_tolerance_once_placed(tmp_path: Path, options: ImportOptions) -> None:
@@ -171,7 +171,7 @@ def test_a_dxf_scaled_down_is_read_as_drawn(tmp_path: Path) -> None:
     # A DXF is fitted for its size as drawn and fitted again only when --fit scales it up
     # (its extent is known once read): scaled down, its curves are the ones read without.
     path = _spline_dxf(tmp_path / "s.dxf")
-    down = read_drawing(path, ImportOptions(fit_mm=(10.0, 10.0)))
+    down = read_drawing(path, ImportOptions(fit=(10.0, 10.0)))
     assert down == read_drawing(path)
 
 
@@ -201,7 +201,7 @@ def test_every_way_in_fits_curves_for_the_planned_size(
     # --fit to the importer; the CLI's file and stdin paths write post_path's code.
     path = svg(tmp_path, FRAME + BEZ)
     target = load_target("linuxcnc")
-    plan = PlanOptions(fit_mm=(190.0, 190.0))  # within the 300 × 200 mm travel
+    plan = PlanOptions(fit=(190.0, 190.0))  # within the 300 × 200 mm travel
     curve = true_curve(BEZ_D, lambda xy: 1.9 * page(xy), n=40001)
     by_path = post_path(path, target, plan)
     by_bytes = post_bytes(path.read_bytes(), path.name, target, plan)

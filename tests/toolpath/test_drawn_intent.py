@@ -143,7 +143,7 @@ def test_a_lead_in_shortened_to_fit_is_named() -> None:
     # a ø4 mm hole cut inside with a 3 mm tool: the tool centre runs on a 0.5 mm radius
     # circle, far too small for 2 mm lead arcs on the waste side (the hole's middle)
     hole = Contour((Arc((2.0, 0.0), (2.0, 0.0), (0.0, 0.0), False),), True)
-    options = PlanOptions(feed_mm_min=100.0, offset="inside", tool_diameter=3.0, lead_in_mm=2.0)
+    options = PlanOptions(feed_mm_min=100.0, offset="inside", tool_diameter=3.0, lead_in=2.0)
     plan = plan_drawing(Drawing((hole,)), options)
     (lead,) = [f for f in plan.report.findings if f.kind == "lead-in"]
     assert lead.value is not None and lead.value < 2.0

@@ -263,7 +263,7 @@ def test_lead_moves_2d_and_with_depth() -> None:
     path = _rounded_rect()
     cut = Cut(path, 0, outside_profile=True, material_side="right")
     lead_in, lead_out = lead_arcs(cut, 1.0)
-    moves = emit_moves([cut], _options(offset="outside", tool_diameter=1.0, lead_in_mm=1.0))
+    moves = emit_moves([cut], _options(offset="outside", tool_diameter=1.0, lead_in=1.0))
     assert moves[0] == Rapid(*lead_in.start, contour=1)
     assert moves[1] == ArcMove(*lead_in.end, *lead_in.centre, lead_in.clockwise, FEED, contour=1)
     assert moves[-1] == ArcMove(
@@ -272,7 +272,7 @@ def test_lead_moves_2d_and_with_depth() -> None:
     assert len(moves) == len(path.segments) + 3
     deep = emit_moves(
         [cut],
-        _options(offset="outside", tool_diameter=1.0, lead_in_mm=1.0, depth=1.0, step_down=0.5),
+        _options(offset="outside", tool_diameter=1.0, lead_in=1.0, depth=1.0, step_down=0.5),
     )
     plunges = [m for m in deep if isinstance(m, Linear) and m.z is not None]
     assert [m.z for m in plunges] == [-0.5, -1.0]
@@ -392,10 +392,10 @@ def test_safe_z_rules_hold_for_any_mix(
         tool_diameter=1.0,
         depth=depth,
         step_down=None if ratio is None else depth * ratio,
-        ramp_angle_deg=ramp,
+        ramp_deg=ramp,
         tabs=tabs,
         tab_height=depth / 2,
-        lead_in_mm=lead,
+        lead_in=lead,
     )
     ss = _check_safe(emit_moves(cuts, o), o.safe_z)
     assert min(s.z1 for s in ss if s.z1 is not None) == -depth
@@ -413,7 +413,7 @@ def _ramp_strokes(ss: Sequence[Stroke]) -> list[Stroke]:
 def test_ramp_round_a_circle_is_a_helix(helix: bool) -> None:
     # r = 1 circle (2π ≈ 6.28 mm) and a 0.8 mm pass at 5°: L = 0.8/tan 5° ≈ 9.14 mm > 2π.
     circle = _circle(0, 0, 1.0)
-    o = _options(depth=1.6, step_down=0.8, ramp_angle_deg=5.0, tolerance=0.001)
+    o = _options(depth=1.6, step_down=0.8, ramp_deg=5.0, tolerance=0.001)
     ss = _check_safe(emit_moves([Cut(circle, 0)], o, helix=helix), o.safe_z)
     ramps = _ramp_strokes(ss)
     slope = math.tan(math.radians(5.0))
@@ -439,7 +439,7 @@ def test_ramp_round_a_circle_is_a_helix(helix: bool) -> None:
 
 def test_ramp_on_a_long_loop_then_full_loop() -> None:
     path = _rounded_rect()
-    o = _options(depth=1.0, ramp_angle_deg=10.0)  # L = 1/tan 10° ≈ 5.67 mm < 31.6 mm
+    o = _options(depth=1.0, ramp_deg=10.0)  # L = 1/tan 10° ≈ 5.67 mm < 31.6 mm
     ss = _check_safe(emit_moves([Cut(path, 0)], o), o.safe_z)
     down = [s for s in ss if s.xy_length == 0 and not isinstance(s.move, Rapid)]
     assert [s.z1 for s in down] == [0.0]  # only down to the top: the rest is the ramp
@@ -455,7 +455,7 @@ def test_ramp_on_a_long_loop_then_full_loop() -> None:
 def test_ramp_zigzags_on_a_short_open_path() -> None:
     # 2 mm path, 1 mm deep at 20°: L = 1/tan 20° ≈ 2.75 mm → forward 2 mm, back 0.75 mm.
     line = Contour((Line((0.0, 0.0), (2.0, 0.0)),), False)
-    o = _options(depth=1.0, ramp_angle_deg=20.0)
+    o = _options(depth=1.0, ramp_deg=20.0)
     ss = _check_safe(emit_moves([Cut(line, 0, "open", may_rotate=False)], o), o.safe_z)
     slope = math.tan(math.radians(20.0))
     ramps = _ramp_strokes(ss)
@@ -490,7 +490,7 @@ def test_tabs_raise_the_tool_on_deep_passes(ramp: float | None) -> None:
         tabs=3,
         tab_width=2.0,
         tab_height=0.5,
-        ramp_angle_deg=ramp,
+        ramp_deg=ramp,
     )
     cut = Cut(path, 0, outside_profile=True, material_side="right")
     ss = _check_safe(emit_moves([cut], o), o.safe_z)
@@ -608,7 +608,7 @@ def test_a_hostile_ramp_is_refused_before_any_move() -> None:
     # (--step-down 0.001 of 2 mm) → 3.3e8 moves.
     from camtool.model.errors import UsageError
 
-    o = _options(depth=2.0, step_down=1.0, ramp_angle_deg=0.0001)
+    o = _options(depth=2.0, step_down=1.0, ramp_deg=0.0001)
     with pytest.raises(UsageError, match=r"--ramp 0\.0001° needs 573 m of ramp per pass"):
         emit_moves([Cut(_rounded_rect(), 0)] * 40, o)
 

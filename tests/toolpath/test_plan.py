@@ -136,7 +136,7 @@ def test_plan_options_validated(kwargs: dict[str, Any]) -> None:
 
 def test_fit_scales_uniformly_about_the_lower_left_corner(tmp_path: Path) -> None:
     drawing = read_dxf(rectangle_dxf(tmp_path / "r.dxf", 10, 5))  # (1,1)–(11,6)
-    program = plan(drawing, PlanOptions(feed_mm_min=1.0, fit_mm=(4.0, 4.0)))
+    program = plan(drawing, PlanOptions(feed_mm_min=1.0, fit=(4.0, 4.0)))
     assert program.bbox(cutting_only=True) == pytest.approx(
         (1.0, 1.0, 5.0, 3.0)
     )  # limited by the width
@@ -150,7 +150,7 @@ def test_scale_about_the_origin(tmp_path: Path) -> None:
 
 def test_scale_and_fit_exclude_each_other() -> None:
     with pytest.raises(UsageError, match="either --scale or --fit"):
-        PlanOptions(feed_mm_min=1.0, scale=2.0, fit_mm=(1.0, 1.0))
+        PlanOptions(feed_mm_min=1.0, scale=2.0, fit=(1.0, 1.0))
 
 
 def test_a_single_arc_whose_ends_meet_is_closed() -> None:
@@ -183,7 +183,7 @@ def test_plan_without_a_feed_is_refused_before_any_work(tmp_path: Path) -> None:
         ({"origin": "center"}, r"origin = 'center': give two numbers .* placement='center'"),
         ({"depth": "3"}, r"depth = '3': give a number \(--depth\)"),
         ({"tabs": 2.5}, r"tabs = 2.5: give a whole number"),
-        ({"fit_mm": (10.0,)}, r"fit_mm = \(10.0,\): give two numbers"),
+        ({"fit": (10.0,)}, r"fit = \(10.0,\): give two numbers"),
         ({"reverse_open": "yes"}, r"reverse_open = 'yes': give True or False"),
     ],
 )

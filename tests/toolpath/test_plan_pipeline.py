@@ -47,14 +47,14 @@ def test_lead_in_refused_on_a_chord_only_target() -> None:
         post_drawing(
             _plate(),
             load_target("i8751"),
-            PlanOptions(offset="outside", tool_diameter=1.0, lead_in_mm=1.0),
+            PlanOptions(offset="outside", tool_diameter=1.0, lead_in=1.0),
         )
 
 
 def test_ramp_refused_where_z_has_its_own_block() -> None:
     # flashcut writes "G01 Z…" alone (Yanez-07 R7): it cannot descend along the path.
     with pytest.raises(UsageError, match="--ramp: flashcut moves Z in a block of its own"):
-        post_drawing(_plate(), load_target("flashcut"), PlanOptions(depth=0.2, ramp_angle_deg=5.0))
+        post_drawing(_plate(), load_target("flashcut"), PlanOptions(depth=0.2, ramp_deg=5.0))
 
 
 def test_gcode_input_refuses_planning_options(tmp_path: Path) -> None:
