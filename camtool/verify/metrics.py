@@ -10,6 +10,7 @@ deviation of a point is its distance to the segment its block was cutting
 
 from __future__ import annotations
 
+import hashlib
 import itertools
 import math
 import os
@@ -2480,6 +2481,44 @@ class ThinTrace:
     rows: int
 
 
+class CutDigest:
+    """A digest of a trace's cutting rows and their run ids, fed chunk by chunk.
+
+    Two traces whose cutting rows (mm, as float64 bytes) and runs between rapids are the
+    same have the same :meth:`digest` however they were cut into chunks, so the drawing
+    comparison of one (it reads nothing else of the trace) is the other's: the error
+    budget tells so without holding either trace whole. A different digest says only
+    that they may differ (a ``-0.0`` is not a ``0.0`` here).
+
+    Args:
+        rapid: ``(B,)`` bool, which moves are rapids (their rows do not cut).
+    """
+
+    def __init__(self, rapid: npt.NDArray[np.bool_]) -> None:
+        self.rapid = rapid
+        self.gaps = 0  # rows that do not cut, so far (the run id is their count)
+        self._rows = hashlib.sha256()
+        self._runs = hashlib.sha256()
+
+    def add(self, points: FloatArray, blocks: IntArray) -> tuple[FloatArray, IntArray]:
+        """One chunk: its rows ``(R, 2)`` mm and the move of each; returns its cutting rows.
+
+        The cutting rows ``(C, 2)`` and their run ids ``(C,) int64`` (the count of rows
+        that do not cut before each, from the first chunk on).
+        """
+        cutting = ~self.rapid[blocks] if len(blocks) else np.zeros(0, dtype=bool)
+        runs = (self.gaps + np.cumsum(~cutting, dtype=np.int64))[cutting]
+        self.gaps += int(len(cutting) - np.count_nonzero(cutting))
+        cut = points[cutting]
+        self._rows.update(np.ascontiguousarray(cut, dtype="<f8").tobytes())
+        self._runs.update(np.ascontiguousarray(runs, dtype="<i8").tobytes())
+        return cut, runs
+
+    def digest(self) -> bytes:
+        """The digest of every chunk added so far."""
+        return self._rows.digest() + self._runs.digest()
+
+
 class CuttingStream:
     """The thinned cutting trace of :func:`against_drawing`, from a trace read chunk by chunk.
 
@@ -2504,18 +2543,16 @@ class CuttingStream:
         self.resolution_mm = resolution_mm
         self.k = 0  # the every-k-th, once the head is read
         self.seen = 0  # cutting rows given to _take (the carried one included)
-        self.gaps = 0  # rows that do not cut, so far (the run id is their count)
         self.head: list[tuple[FloatArray, IntArray]] = []
         self.head_rows = 0
         self.carry: tuple[FloatArray, IntArray, bool] | None = None
         self.kept: list[tuple[FloatArray, IntArray]] = []
+        self.digest = CutDigest(rapid)
+        """The digest of the cutting rows seen (:class:`CutDigest`)."""
 
     def add(self, points: FloatArray, blocks: IntArray) -> None:
         """One chunk: its rows ``(R, 2)`` mm and the move of each row ``(R,)``."""
-        cutting = ~self.rapid[blocks] if len(blocks) else np.zeros(0, dtype=bool)
-        runs = (self.gaps + np.cumsum(~cutting))[cutting]
-        self.gaps += int(len(cutting) - np.count_nonzero(cutting))
-        cut = points[cutting]
+        cut, runs = self.digest.add(points, blocks)
         if not len(cut):
             return
         if self.k:
