@@ -40,6 +40,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
+from array import array
 from collections.abc import Callable
 from typing import Any
 
@@ -130,11 +131,12 @@ class _Controller:
         self.comp_steps = self.compensation_steps()
         self.parts: list[npt.NDArray[Any]] = []
         self.comp_parts: list[npt.NDArray[np.bool_]] = []
-        self.counts: list[int] = []
-        self.logical: list[tuple[int, int]] = []
-        self.steps: list[tuple[int, int, int]] = []
-        self.dominant: list[int] = []
-        self.block_comp: list[int] = []
+        # per move, 8 bytes a value (a list of tuples took ~390 bytes a move)
+        self.counts = array("q")  # rows
+        self.logical = array("q")  # x, y: the logical end, steps
+        self.steps = array("q")  # x, y, z pulses
+        self.dominant = array("q")
+        self.block_comp = array("q")  # compensation rows
         self.reversals = [0, 0]
         self.compensations = 0
         lib = library()
@@ -176,18 +178,18 @@ class _Controller:
         if pulses is None:  # not counted as the reversals were found
             x, y = (int(np.abs(made[:, k]).sum(dtype=np.int64)) for k in (0, 1))
             pulses = (x, y)
-        self.steps.append((int(pulses[0]), int(pulses[1]), z_steps))
+        self.steps.extend((int(pulses[0]), int(pulses[1]), z_steps))
         self.dominant.append(dominant)
         self.parts.append(rows)
         self.comp_parts.append(comp)
         self.counts.append(len(rows))
         self.block_comp.append(int(comp.sum()))
-        self.logical.append(end)
+        self.logical.extend(end)
         self.pos = end
 
     def block_start(self) -> IntArray:
         """``(B + 1,) int64`` row offsets of the moves simulated or counted so far."""
-        return np.concatenate(([0], np.cumsum(np.asarray(self.counts, dtype=np.int64))))
+        return np.concatenate(([0], np.cumsum(np.array(self.counts, dtype=np.int64))))
 
     def count_line(self, move: Move, rows_of: Callable[[int, int], int]) -> None:
         """:meth:`block` of a line or rapid, its rows counted by ``rows_of``, not made.
@@ -329,10 +331,10 @@ class _Controller:
             block_start=read_only(block_start),
             carriage_mm=read_only(carriage),
             start_mm=_start_mm(self.origin_steps, self.machine),
-            logical_end=read_only(np.asarray(self.logical, dtype=np.int64).reshape(-1, 2)),
-            block_steps=read_only(np.asarray(self.steps, dtype=np.int64).reshape(-1, 3)),
-            block_dominant=read_only(np.asarray(self.dominant, dtype=np.int64)),
-            block_compensation=read_only(np.asarray(self.block_comp, dtype=np.int64)),
+            logical_end=read_only(np.array(self.logical, dtype=np.int64).reshape(-1, 2)),
+            block_steps=read_only(np.array(self.steps, dtype=np.int64).reshape(-1, 3)),
+            block_dominant=read_only(np.array(self.dominant, dtype=np.int64)),
+            block_compensation=read_only(np.array(self.block_comp, dtype=np.int64)),
             reversals=(self.reversals[0], self.reversals[1]),
             compensations=self.compensations,
         )
@@ -382,14 +384,14 @@ class _IdealController(_Controller):
             rows = np.concatenate(parts) if parts else np.zeros((0, 2))
         else:
             rows, line_starts = self._ideal_line(self.pos, end), [0]
-        self.steps.append((0, 0, 0))
+        self.steps.extend((0, 0, 0))
         self.dominant.append(0)
         rows, comp, _ = self._compensate(rows, line_starts)
         self.parts.append(rows)
         self.comp_parts.append(comp)
         self.counts.append(len(rows))
         self.block_comp.append(int(comp.sum()))
-        self.logical.append((round(end[0]), round(end[1])))
+        self.logical.extend((round(end[0]), round(end[1])))
         self.pos = end  # type: ignore[assignment]
 
     def _ideal_line(self, a: tuple[float, float], b: tuple[float, float]) -> FloatArray:
@@ -772,7 +774,7 @@ class ChunkedSimulation:
             if rows.dtype != kind:
                 raise NotStreamable(f"rows of dtype {rows.dtype}")
             comp = np.concatenate(sim.comp_parts) if sim.comp_parts else np.zeros(0, np.bool_)
-            counts = np.asarray(sim.counts[first:], dtype=np.int64)
+            counts = np.array(sim.counts[first:], dtype=np.int64)
             sim.parts.clear()
             sim.comp_parts.clear()
             rows, out = play.chunk(rows)
@@ -792,10 +794,10 @@ class ChunkedSimulation:
         return {
             "block_start": read_only(sim.block_start()),
             "start_mm": _start_mm(sim.origin_steps, self.machine),
-            "logical_end": read_only(np.asarray(sim.logical, dtype=np.int64).reshape(-1, 2)),
-            "block_steps": read_only(np.asarray(sim.steps, dtype=np.int64).reshape(-1, 3)),
-            "block_dominant": read_only(np.asarray(sim.dominant, dtype=np.int64)),
-            "block_compensation": read_only(np.asarray(sim.block_comp, dtype=np.int64)),
+            "logical_end": read_only(np.array(sim.logical, dtype=np.int64).reshape(-1, 2)),
+            "block_steps": read_only(np.array(sim.steps, dtype=np.int64).reshape(-1, 3)),
+            "block_dominant": read_only(np.array(sim.dominant, dtype=np.int64)),
+            "block_compensation": read_only(np.array(sim.block_comp, dtype=np.int64)),
             "reversals": (sim.reversals[0], sim.reversals[1]),
             "compensations": sim.compensations,
         }

@@ -88,7 +88,7 @@ if TYPE_CHECKING:
     from camtool.post.base import Target
     from camtool.toolpath.plan import PlanReport
 
-STREAM_ROWS = eb.MAX_ROWS
+STREAM_ROWS = 1 << 20
 """Rows above which a trace is streamed (:func:`_simulate_big`); the error budget, which
 re-simulates whole traces, is skipped above the same count."""
 CHUNK_ROWS = 1 << 16
@@ -849,13 +849,14 @@ class _Without:
     note: str | None = None
 
 
-def _without(inputs: _Inputs, name: str, chunk_rows: int = CHUNK_ROWS) -> _Without:
+def _without(inputs: _Inputs, name: str) -> _Without:
     """The verification of ``inputs`` re-simulated with the error source ``name`` off.
 
     ``rounding`` simulates the unrounded plan instead; when the plan does not simulate
     (not what this machine reads), no figure and a note that says why. The drawing is
     measured again only when the cutting trace differs (:func:`_same_against`). A trace
-    of more than ``chunk_rows`` rows is streamed (:func:`_resimulate`).
+    of more than :data:`CHUNK_ROWS` rows is streamed, that many rows at a time
+    (:func:`_resimulate`).
 
     Raises:
         CamtoolError: the re-simulation fails (the full model did not).
@@ -866,6 +867,7 @@ def _without(inputs: _Inputs, name: str, chunk_rows: int = CHUNK_ROWS) -> _Witho
         program = inputs.planned
     else:
         sources = ALL.without(name)
+    chunk_rows = CHUNK_ROWS
     stream = inputs.trace.row_count > chunk_rows
     try:
         dev, along, contours, thin, digest = _resimulate(
@@ -914,9 +916,7 @@ def _resimulate(
     kernels = compiled() if chunk_rows else None
     if kernels is not None and library().simulator(machine.motion.line) is None:
         for closed_form in (True, False):  # a count the chunks do not repeat: simulated
-            block_start = count_rows(
-                program, machine, sources=sources, closed_form=closed_form
-            )
+            block_start = count_rows(program, machine, sources=sources, closed_form=closed_form)
             try:
                 got = _stream(
                     program, machine, drawing, chunk_rows, block_start, kernels, sources=sources
