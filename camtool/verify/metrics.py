@@ -2009,9 +2009,20 @@ class TraceStream:
         block_start: ``(B + 1,) int64`` row offsets of every move in the whole trace.
         start_mm: the carriage before the first row.
         kernels: the compiled kernels (:mod:`camtool.verify.kernels`).
+        rms: measure the deviation's rms; ``False`` (the error budget, whose figures do
+            not include it): ``deviation.rms_um`` is NaN.
     """
 
-    def __init__(self, program: Program, block_start: IntArray, start_mm: Point, kernels: Any):
+    def __init__(
+        self,
+        program: Program,
+        block_start: IntArray,
+        start_mm: Point,
+        kernels: Any,
+        *,
+        rms: bool = True,
+    ):
+        self.rms = rms
         self.program = program
         self.block_start = block_start
         self.kernels = kernels
@@ -2118,7 +2129,8 @@ class TraceStream:
                 compensation[near].copy(),
             )
         self.dev_count += len(dist)
-        self.kernels.exact_sum_squares(dist, self.bins)
+        if self.rms:
+            self.kernels.exact_sum_squares(dist, self.bins)
 
     def _picture(
         self, r0: int, points: FloatArray, blocks: IntArray, steps: Any, compensation: Any
@@ -2224,7 +2236,7 @@ class TraceStream:
         if self.dev_count == 0:
             dev = Deviation(0.0, 0.0, (0.0, 0.0), -1, 0)
         else:
-            mean = self.kernels.exact_sum(self.bins) / self.dev_count
+            mean = self.kernels.exact_sum(self.bins) / self.dev_count if self.rms else math.nan
             at, block, _ = self.dev_where
             dev = Deviation(
                 self.dev_max * 1000.0, math.sqrt(mean) * 1000.0, at, block, self.dev_count

@@ -394,6 +394,25 @@ class _IdealController(_Controller):
         self.logical.extend((round(end[0]), round(end[1])))
         self.pos = end  # type: ignore[assignment]
 
+    def _reversals(
+        self, column: npt.NDArray[Any], axis: int
+    ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
+        """:meth:`_Controller._reversals`, at once for a column of one value (a line's rows).
+
+        Every row of a straight line moves the axis the same way: a reversal, if any, is
+        at its first row (the same rows and signs as the row-by-row scan).
+        """
+        if not len(column) or column.min() != column.max():
+            return super()._reversals(column, axis)
+        none = np.zeros(0, dtype=np.int64)
+        if column[0] == 0:
+            return none, none
+        sign = 1 if column[0] > 0 else -1
+        before, self.direction[axis] = self.direction[axis], sign
+        if before in (0, sign):
+            return none, none
+        return np.zeros(1, dtype=np.int64), np.full(1, sign, dtype=np.int64)
+
     def _ideal_line(self, a: tuple[float, float], b: tuple[float, float]) -> FloatArray:
         dx, dy = b[0] - a[0], b[1] - a[1]
         counted = (

@@ -89,8 +89,9 @@ if TYPE_CHECKING:
     from camtool.toolpath.plan import PlanReport
 
 STREAM_ROWS = 1 << 20
-"""Rows above which a trace is streamed (:func:`_simulate_big`); the error budget, which
-re-simulates whole traces, is skipped above the same count."""
+"""Rows above which a trace is streamed (:func:`_simulate_big`): a whole trace's arrays
+and measures take ~100 bytes a row; the error budget's re-simulations are streamed
+above :data:`CHUNK_ROWS` rows (:func:`_without`)."""
 CHUNK_ROWS = 1 << 16
 """Rows a streamed trace is simulated and measured at a time (a move is never split):
 with their temporaries about 130 bytes a row, ~9 MB next to Python, numpy, scipy,
@@ -491,19 +492,21 @@ def _stream(
     kernels: Any,
     *,
     sources: Sources = ALL,
+    rms: bool = True,
 ) -> tuple[StepTrace, _Streamed] | None:
     """:func:`_simulate_big`'s streamed trace and measures, its moves at ``block_start``.
 
     ``None`` when the chunked simulation's rows do not start where ``block_start`` says
     (the measures, which were told those offsets, are then not the trace's).
-    ``sources``: the error sources simulated (the error budget's re-simulations).
+    ``sources``: the error sources simulated (the error budget's re-simulations);
+    ``rms=False``: the deviation's rms is not measured (NaN; the budget has no use for it).
 
     Raises:
         NotStreamable: the rows are not whole steps.
     """
     sim = ChunkedSimulation(program, machine, chunk_rows, sources=sources)
     summary = sim.trace_summary()
-    stream = TraceStream(program, block_start, summary["start_mm"], kernels)
+    stream = TraceStream(program, block_start, summary["start_mm"], kernels, rms=rms)
     cutting = None if against is None else _cutting_stream(program, block_start)
     share = _Share()
 
@@ -905,8 +908,8 @@ def _resimulate(
     """The measures of ``program`` simulated with ``sources`` (the error budget's).
 
     With ``chunk_rows`` and the compiled kernels, the step simulator's trace is streamed
-    (:func:`_stream`: the same figures as the whole trace's, bit for bit, but the rms,
-    which the budget does not use), its rows counted first
+    (:func:`_stream`: the same figures as the whole trace's, bit for bit; the rms, which
+    the budget does not use, is not measured), its rows counted first
     (:func:`~camtool.verify.simulate.count_rows`); else simulated whole and measured by
     :func:`_trace_measures`. With a drawing, the thinned cutting rows and their digest.
 
@@ -919,7 +922,14 @@ def _resimulate(
             block_start = count_rows(program, machine, sources=sources, closed_form=closed_form)
             try:
                 got = _stream(
-                    program, machine, drawing, chunk_rows, block_start, kernels, sources=sources
+                    program,
+                    machine,
+                    drawing,
+                    chunk_rows,
+                    block_start,
+                    kernels,
+                    sources=sources,
+                    rms=False,
                 )
             except NotStreamable:
                 break

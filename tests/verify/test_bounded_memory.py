@@ -198,3 +198,22 @@ def test_a_streamed_verification_keeps_a_few_numbers_per_move() -> None:
     """
     per_move = _kept_per_move(_zigzags(40), load_target("grbl").machine)
     assert per_move < 350, per_move
+
+
+@pytest.mark.parametrize("value", [0.25, -0.25, 0.0, -0.0])
+@pytest.mark.parametrize("direction", [-1, 0, 1])
+def test_an_ideal_line_s_reversals_are_the_row_scan_s(value: float, direction: int) -> None:
+    """A column of one value (an ideal line's rows): the same reversals as the scan of rows."""
+    from camtool.verify import simulate as sim
+
+    machine = load_target("pic-mmh").machine
+    column = np.full(1000, value)
+    fast = sim._IdealController(machine, (0.0, 0.0))
+    scan = sim._IdealController(machine, (0.0, 0.0))
+    fast.direction = [direction, direction]
+    scan.direction = [direction, direction]
+    got = fast._reversals(column, 0)
+    expected = sim._Controller._reversals(scan, column, 0)
+    assert [a.tolist() for a in got] == [a.tolist() for a in expected]
+    assert [a.dtype for a in got] == [a.dtype for a in expected]
+    assert fast.direction == scan.direction
