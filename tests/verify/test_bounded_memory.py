@@ -217,3 +217,59 @@ def test_an_ideal_line_s_reversals_are_the_row_scan_s(value: float, direction: i
     assert [a.tolist() for a in got] == [a.tolist() for a in expected]
     assert [a.dtype for a in got] == [a.dtype for a in expected]
     assert fast.direction == scan.direction
+
+
+@pytest.mark.parametrize("target", ["grbl", "pic-mmh"])
+def test_a_streamed_budget_against_a_drawing_is_the_whole_one(
+    target: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Trace and sources streamed, compared with a drawing and with the plan: the same budget.
+
+    The distance to the drawing of a source whose cutting rows are the verification's
+    own (the plan's rounding, absorbed by the steps) is told by their digest.
+    """
+    from camtool.model.shapes import Arc, Contour, Drawing, Line
+
+    machine = load_target(target).machine
+    c = [(1.0, 1.0), (5.0, 1.0), (5.0, 4.0), (1.0, 4.0)]
+    outline = Contour(tuple(Line(c[i], c[(i + 1) % 4]) for i in range(4)), True)
+    hole = Contour((Arc((4.0, 2.5), (4.0, 2.5), (3.0, 2.5), False),), True)
+    drawing = Drawing((hole, outline))
+    moves = (
+        Rapid(3.75, 2.5, contour=1),
+        ArcMove(3.75, 2.5, 3.0, 2.5, False, 300.0, contour=1),
+        Rapid(0.75, 0.75, contour=2),
+        Linear(5.25, 0.75, 300.0, contour=2),
+        Linear(5.25, 4.25, 300.0, contour=2),
+        Linear(0.75, 4.25, 300.0, contour=2),
+        Linear(0.75, 0.75, 300.0, contour=2),
+    )
+    program = Program(moves, origin=(0.0, 0.0))
+    planned = Program(
+        tuple(
+            m if isinstance(m, Rapid | ArcMove) else Linear(m.x + 1e-7, m.y, 300.0, contour=2)
+            for m in moves
+        ),
+        origin=(0.0, 0.0),
+    )
+    monkeypatch.setattr(cores, "default_jobs", lambda: 1)
+
+    def budget(**kw: Any) -> Any:
+        v = verifier.verify_program(
+            program,
+            machine,
+            name=target,
+            against=drawing,
+            tool_diameter=0.5,
+            planned=planned,
+            **kw,
+        )
+        return v, v.error_budget
+
+    whole, expected = budget()
+    assert whole.cut_digest is None  # a whole trace: its digest made when needed
+    assert "distance to the drawing" in expected.total and "rounding" in expected.without
+    monkeypatch.setattr(verifier, "CHUNK_ROWS", 97)
+    v, got = budget(chunk_rows=97, stream_above=10)
+    assert v.cut_digest is not None and v.trace.row_count > 97
+    assert got == expected
