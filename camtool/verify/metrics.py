@@ -488,9 +488,13 @@ def fit_circle(points: FloatArray) -> tuple[float, float, float]:
     """
     x, y = points[:, 0], points[:, 1]
     mx, my = float(x.mean()), float(y.mean())
-    u, v = x - mx, y - my
-    a = np.column_stack([u, v, np.ones_like(u)])
-    b = u * u + v * v
+    a = np.empty((len(points), 3), dtype=np.float64)  # (u, v, 1), u and v written in place
+    u, v = a[:, 0], a[:, 1]
+    np.subtract(x, mx, out=u)
+    np.subtract(y, my, out=v)
+    a[:, 2] = 1.0
+    b = u * u
+    b += v * v  # u² + v², as one expression adds them
     (p, q, s), *_ = np.linalg.lstsq(a, b, rcond=None)
     cx, cy = p / 2.0, q / 2.0
     return (mx + cx, my + cy, math.sqrt(s + cx * cx + cy * cy))
@@ -1905,12 +1909,12 @@ class _Contour:
         self.pending: list[tuple[int, FloatArray]] = []
         self.pending_count = 0
         self.kept: list[FloatArray] = []
-        self.circle: list[FloatArray] | None = None
+        self.circle: FloatArray | None = None  # a circle's whole run, for the fit
 
     def add(self, j0: int, points: FloatArray) -> None:
         """The run's points ``j0, j0 + 1, ...`` (run index 0 is the point before)."""
         if self.circle is not None:
-            self.circle.append(points.copy())
+            self.circle[j0 : j0 + len(points)] = points
         if self.every == 0:
             self.pending.append((j0, points))
             self.pending_count += len(points)
@@ -2163,7 +2167,7 @@ class TraceStream:
                     is not None
                     and math.dist(self.starts[a], self.starts[b + 1]) <= 1e-6
                 ):
-                    c.circle = []
+                    c.circle = np.empty((c.n, 2), dtype=np.float64)  # filled as it comes
                 for axis in (0, 1):
                     c.top[axis] = c.low[axis] = float(c.before[axis])
                 c.add(0, c.before.reshape(1, 2))
@@ -2190,7 +2194,7 @@ class TraceStream:
         program, starts = self.program, self.starts
         self.ends.append(math.dist(c.last_point, starts[c.last + 1]))
         circle = c.circle
-        run_of = (lambda: np.vstack(circle)) if circle is not None else (lambda: np.zeros((0, 2)))
+        run_of = (lambda: circle) if circle is not None else (lambda: np.zeros((0, 2)))
         self.contours.append(
             _contour_measure(
                 program,
