@@ -10,6 +10,7 @@ deviation of a point is its distance to the segment its block was cutting
 
 from __future__ import annotations
 
+import hashlib
 import itertools
 import math
 import os
@@ -73,6 +74,35 @@ class ContourMeasure:
     size_um: tuple[float, float]
     size_error_um: tuple[float, float]
     circle: tuple[float, float, float, float] | None
+
+
+class _Starts(Sequence[Point]):
+    """Where each move of a program starts, from one ``(B + 1, 2) float64`` array, mm.
+
+    ``starts[i]`` is the point before move ``i`` (``starts[0]`` the program's origin,
+    ``starts[B]`` the last move's end), as a tuple of floats: the moves' own values
+    (a float64 holds a float exactly). 16 bytes a move, where a list of tuples took
+    about 110.
+    """
+
+    def __init__(self, xy: FloatArray) -> None:
+        self.xy = xy
+
+    def __len__(self) -> int:
+        return len(self.xy)
+
+    def __getitem__(self, index: int) -> Point:  # type: ignore[override]
+        return (float(self.xy[index, 0]), float(self.xy[index, 1]))
+
+
+def move_starts(program: Program) -> Sequence[Point]:
+    """The start of each move of ``program`` and the last one's end (see :class:`_Starts`)."""
+    moves = program.moves
+    xy = np.empty((len(moves) + 1, 2), dtype=np.float64)
+    xy[0] = program.origin
+    xy[1:, 0] = np.fromiter((m.x for m in moves), dtype=np.float64, count=len(moves))
+    xy[1:, 1] = np.fromiter((m.y for m in moves), dtype=np.float64, count=len(moves))
+    return _Starts(xy)
 
 
 def nominal_arrays(program: Program) -> dict[str, FloatArray]:
@@ -340,7 +370,7 @@ def measure_contours(
         program: the program the trace executed.
     """
     measures = []
-    starts = [program.origin] + [(m.x, m.y) for m in program.moves]
+    starts = move_starts(program)
     for number, (first, last) in enumerate(contour_runs(program), start=1):
         lo, hi = int(block_start[first]), int(block_start[last + 1])
         before = points[lo - 1] if lo > 0 else np.asarray(start_mm, dtype=np.float64)
@@ -357,7 +387,7 @@ def measure_contours(
 
 def _contour_measure(
     program: Program,
-    starts: list[Point],
+    starts: Sequence[Point],
     number: int,
     blocks: tuple[int, int],
     before: FloatArray,
@@ -458,9 +488,13 @@ def fit_circle(points: FloatArray) -> tuple[float, float, float]:
     """
     x, y = points[:, 0], points[:, 1]
     mx, my = float(x.mean()), float(y.mean())
-    u, v = x - mx, y - my
-    a = np.column_stack([u, v, np.ones_like(u)])
-    b = u * u + v * v
+    a = np.empty((len(points), 3), dtype=np.float64)  # (u, v, 1), u and v written in place
+    u, v = a[:, 0], a[:, 1]
+    np.subtract(x, mx, out=u)
+    np.subtract(y, my, out=v)
+    a[:, 2] = 1.0
+    b = u * u
+    b += v * v  # u² + v², as one expression adds them
     (p, q, s), *_ = np.linalg.lstsq(a, b, rcond=None)
     cx, cy = p / 2.0, q / 2.0
     return (mx + cx, my + cy, math.sqrt(s + cx * cx + cy * cy))
@@ -1311,7 +1345,7 @@ def along_path(
     equal ones named), bit for bit; a part's 400 000 samples took 0.85 s that way and
     take about 0.15 s (issue 17).
     """
-    starts = [program.origin] + [(m.x, m.y) for m in program.moves]
+    starts = move_starts(program)
     runs = contour_runs(program)
     total = sum(
         segment_of(starts[i], program.moves[i]).length for a, b in runs for i in range(a, b + 1)
@@ -1751,7 +1785,7 @@ def _carriage_after(
 
 
 def _sample_moves(
-    program: Program, starts: list[Point], first: int, last: int, spacing: float
+    program: Program, starts: Sequence[Point], first: int, last: int, spacing: float
 ) -> tuple[FloatArray, IntArray, FloatArray]:
     """Points along moves ``first..last`` at most ``spacing`` apart, ends included.
 
@@ -1772,7 +1806,7 @@ def _fractions(count: int) -> FloatArray:
     return np.arange(count, dtype=np.float64) / max(1, count - 1)
 
 
-def _sample_move(program: Program, starts: list[Point], b: int, spacing: float) -> FloatArray:
+def _sample_move(program: Program, starts: Sequence[Point], b: int, spacing: float) -> FloatArray:
     """``(n + 1, 2)`` points along move ``b`` at most ``spacing`` apart, its ends included."""
     seg = segment_of(starts[b], program.moves[b])
     n = max(1, math.ceil(seg.length / spacing))
@@ -1788,7 +1822,7 @@ def _sample_move(program: Program, starts: list[Point], b: int, spacing: float) 
 
 
 def _sample_batches(
-    program: Program, starts: list[Point], first: int, last: int, spacing: float, size: int
+    program: Program, starts: Sequence[Point], first: int, last: int, spacing: float, size: int
 ) -> Iterator[tuple[FloatArray, IntArray, FloatArray]]:
     """:func:`_sample_moves` in consecutive pieces of ``size`` points (the last shorter).
 
@@ -1875,12 +1909,12 @@ class _Contour:
         self.pending: list[tuple[int, FloatArray]] = []
         self.pending_count = 0
         self.kept: list[FloatArray] = []
-        self.circle: list[FloatArray] | None = None
+        self.circle: FloatArray | None = None  # a circle's whole run, for the fit
 
     def add(self, j0: int, points: FloatArray) -> None:
         """The run's points ``j0, j0 + 1, ...`` (run index 0 is the point before)."""
         if self.circle is not None:
-            self.circle.append(points.copy())
+            self.circle[j0 : j0 + len(points)] = points
         if self.every == 0:
             self.pending.append((j0, points))
             self.pending_count += len(points)
@@ -1979,16 +2013,27 @@ class TraceStream:
         block_start: ``(B + 1,) int64`` row offsets of every move in the whole trace.
         start_mm: the carriage before the first row.
         kernels: the compiled kernels (:mod:`camtool.verify.kernels`).
+        rms: measure the deviation's rms; ``False`` (the error budget, whose figures do
+            not include it): ``deviation.rms_um`` is NaN.
     """
 
-    def __init__(self, program: Program, block_start: IntArray, start_mm: Point, kernels: Any):
+    def __init__(
+        self,
+        program: Program,
+        block_start: IntArray,
+        start_mm: Point,
+        kernels: Any,
+        *,
+        rms: bool = True,
+    ):
+        self.rms = rms
         self.program = program
         self.block_start = block_start
         self.kernels = kernels
         self.nominal = nominal_arrays(program)
         self.start = np.asarray(start_mm, dtype=np.float64).reshape(1, 2)
         self.prev: FloatArray = self.start[0]
-        self.starts = [program.origin] + [(m.x, m.y) for m in program.moves]
+        self.starts = move_starts(program)
         self.runs = contour_runs(program)
         self.next_run = 0
         self.open: _Contour | None = None
@@ -2088,7 +2133,8 @@ class TraceStream:
                 compensation[near].copy(),
             )
         self.dev_count += len(dist)
-        self.kernels.exact_sum_squares(dist, self.bins)
+        if self.rms:
+            self.kernels.exact_sum_squares(dist, self.bins)
 
     def _picture(
         self, r0: int, points: FloatArray, blocks: IntArray, steps: Any, compensation: Any
@@ -2121,7 +2167,7 @@ class TraceStream:
                     is not None
                     and math.dist(self.starts[a], self.starts[b + 1]) <= 1e-6
                 ):
-                    c.circle = []
+                    c.circle = np.empty((c.n, 2), dtype=np.float64)  # filled as it comes
                 for axis in (0, 1):
                     c.top[axis] = c.low[axis] = float(c.before[axis])
                 c.add(0, c.before.reshape(1, 2))
@@ -2148,7 +2194,7 @@ class TraceStream:
         program, starts = self.program, self.starts
         self.ends.append(math.dist(c.last_point, starts[c.last + 1]))
         circle = c.circle
-        run_of = (lambda: np.vstack(circle)) if circle is not None else (lambda: np.zeros((0, 2)))
+        run_of = (lambda: circle) if circle is not None else (lambda: np.zeros((0, 2)))
         self.contours.append(
             _contour_measure(
                 program,
@@ -2194,7 +2240,7 @@ class TraceStream:
         if self.dev_count == 0:
             dev = Deviation(0.0, 0.0, (0.0, 0.0), -1, 0)
         else:
-            mean = self.kernels.exact_sum(self.bins) / self.dev_count
+            mean = self.kernels.exact_sum(self.bins) / self.dev_count if self.rms else math.nan
             at, block, _ = self.dev_where
             dev = Deviation(
                 self.dev_max * 1000.0, math.sqrt(mean) * 1000.0, at, block, self.dev_count
@@ -2480,6 +2526,44 @@ class ThinTrace:
     rows: int
 
 
+class CutDigest:
+    """A digest of a trace's cutting rows and their run ids, fed chunk by chunk.
+
+    Two traces whose cutting rows (mm, as float64 bytes) and runs between rapids are the
+    same have the same :meth:`digest` however they were cut into chunks, so the drawing
+    comparison of one (it reads nothing else of the trace) is the other's: the error
+    budget tells so without holding either trace whole. A different digest says only
+    that they may differ (a ``-0.0`` is not a ``0.0`` here).
+
+    Args:
+        rapid: ``(B,)`` bool, which moves are rapids (their rows do not cut).
+    """
+
+    def __init__(self, rapid: npt.NDArray[np.bool_]) -> None:
+        self.rapid = rapid
+        self.gaps = 0  # rows that do not cut, so far (the run id is their count)
+        self._rows = hashlib.sha256()
+        self._runs = hashlib.sha256()
+
+    def add(self, points: FloatArray, blocks: IntArray) -> tuple[FloatArray, IntArray]:
+        """One chunk: its rows ``(R, 2)`` mm and the move of each; returns its cutting rows.
+
+        The cutting rows ``(C, 2)`` and their run ids ``(C,) int64`` (the count of rows
+        that do not cut before each, from the first chunk on).
+        """
+        cutting = ~self.rapid[blocks] if len(blocks) else np.zeros(0, dtype=bool)
+        runs = (self.gaps + np.cumsum(~cutting, dtype=np.int64))[cutting]
+        self.gaps += int(len(cutting) - np.count_nonzero(cutting))
+        cut = points[cutting]
+        self._rows.update(np.ascontiguousarray(cut, dtype="<f8").tobytes())
+        self._runs.update(np.ascontiguousarray(runs, dtype="<i8").tobytes())
+        return cut, runs
+
+    def digest(self) -> bytes:
+        """The digest of every chunk added so far."""
+        return self._rows.digest() + self._runs.digest()
+
+
 class CuttingStream:
     """The thinned cutting trace of :func:`against_drawing`, from a trace read chunk by chunk.
 
@@ -2504,18 +2588,16 @@ class CuttingStream:
         self.resolution_mm = resolution_mm
         self.k = 0  # the every-k-th, once the head is read
         self.seen = 0  # cutting rows given to _take (the carried one included)
-        self.gaps = 0  # rows that do not cut, so far (the run id is their count)
         self.head: list[tuple[FloatArray, IntArray]] = []
         self.head_rows = 0
         self.carry: tuple[FloatArray, IntArray, bool] | None = None
         self.kept: list[tuple[FloatArray, IntArray]] = []
+        self.digest = CutDigest(rapid)
+        """The digest of the cutting rows seen (:class:`CutDigest`)."""
 
     def add(self, points: FloatArray, blocks: IntArray) -> None:
         """One chunk: its rows ``(R, 2)`` mm and the move of each row ``(R,)``."""
-        cutting = ~self.rapid[blocks] if len(blocks) else np.zeros(0, dtype=bool)
-        runs = (self.gaps + np.cumsum(~cutting))[cutting]
-        self.gaps += int(len(cutting) - np.count_nonzero(cutting))
-        cut = points[cutting]
+        cut, runs = self.digest.add(points, blocks)
         if not len(cut):
             return
         if self.k:

@@ -40,6 +40,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
+from array import array
 from collections.abc import Callable
 from typing import Any
 
@@ -130,11 +131,12 @@ class _Controller:
         self.comp_steps = self.compensation_steps()
         self.parts: list[npt.NDArray[Any]] = []
         self.comp_parts: list[npt.NDArray[np.bool_]] = []
-        self.counts: list[int] = []
-        self.logical: list[tuple[int, int]] = []
-        self.steps: list[tuple[int, int, int]] = []
-        self.dominant: list[int] = []
-        self.block_comp: list[int] = []
+        # per move, 8 bytes a value (a list of tuples took ~390 bytes a move)
+        self.counts = array("q")  # rows
+        self.logical = array("q")  # x, y: the logical end, steps
+        self.steps = array("q")  # x, y, z pulses
+        self.dominant = array("q")
+        self.block_comp = array("q")  # compensation rows
         self.reversals = [0, 0]
         self.compensations = 0
         lib = library()
@@ -176,18 +178,18 @@ class _Controller:
         if pulses is None:  # not counted as the reversals were found
             x, y = (int(np.abs(made[:, k]).sum(dtype=np.int64)) for k in (0, 1))
             pulses = (x, y)
-        self.steps.append((int(pulses[0]), int(pulses[1]), z_steps))
+        self.steps.extend((int(pulses[0]), int(pulses[1]), z_steps))
         self.dominant.append(dominant)
         self.parts.append(rows)
         self.comp_parts.append(comp)
         self.counts.append(len(rows))
         self.block_comp.append(int(comp.sum()))
-        self.logical.append(end)
+        self.logical.extend(end)
         self.pos = end
 
     def block_start(self) -> IntArray:
         """``(B + 1,) int64`` row offsets of the moves simulated or counted so far."""
-        return np.concatenate(([0], np.cumsum(np.asarray(self.counts, dtype=np.int64))))
+        return np.concatenate(([0], np.cumsum(np.array(self.counts, dtype=np.int64))))
 
     def count_line(self, move: Move, rows_of: Callable[[int, int], int]) -> None:
         """:meth:`block` of a line or rapid, its rows counted by ``rows_of``, not made.
@@ -329,10 +331,10 @@ class _Controller:
             block_start=read_only(block_start),
             carriage_mm=read_only(carriage),
             start_mm=_start_mm(self.origin_steps, self.machine),
-            logical_end=read_only(np.asarray(self.logical, dtype=np.int64).reshape(-1, 2)),
-            block_steps=read_only(np.asarray(self.steps, dtype=np.int64).reshape(-1, 3)),
-            block_dominant=read_only(np.asarray(self.dominant, dtype=np.int64)),
-            block_compensation=read_only(np.asarray(self.block_comp, dtype=np.int64)),
+            logical_end=read_only(np.array(self.logical, dtype=np.int64).reshape(-1, 2)),
+            block_steps=read_only(np.array(self.steps, dtype=np.int64).reshape(-1, 3)),
+            block_dominant=read_only(np.array(self.dominant, dtype=np.int64)),
+            block_compensation=read_only(np.array(self.block_comp, dtype=np.int64)),
             reversals=(self.reversals[0], self.reversals[1]),
             compensations=self.compensations,
         )
@@ -382,15 +384,34 @@ class _IdealController(_Controller):
             rows = np.concatenate(parts) if parts else np.zeros((0, 2))
         else:
             rows, line_starts = self._ideal_line(self.pos, end), [0]
-        self.steps.append((0, 0, 0))
+        self.steps.extend((0, 0, 0))
         self.dominant.append(0)
         rows, comp, _ = self._compensate(rows, line_starts)
         self.parts.append(rows)
         self.comp_parts.append(comp)
         self.counts.append(len(rows))
         self.block_comp.append(int(comp.sum()))
-        self.logical.append((round(end[0]), round(end[1])))
+        self.logical.extend((round(end[0]), round(end[1])))
         self.pos = end  # type: ignore[assignment]
+
+    def _reversals(
+        self, column: npt.NDArray[Any], axis: int
+    ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
+        """:meth:`_Controller._reversals`, at once for a column of one value (a line's rows).
+
+        Every row of a straight line moves the axis the same way: a reversal, if any, is
+        at its first row (the same rows and signs as the row-by-row scan).
+        """
+        if not len(column) or column.min() != column.max():
+            return super()._reversals(column, axis)
+        none = np.zeros(0, dtype=np.int64)
+        if column[0] == 0:
+            return none, none
+        sign = 1 if column[0] > 0 else -1
+        before, self.direction[axis] = self.direction[axis], sign
+        if before in (0, sign):
+            return none, none
+        return np.zeros(1, dtype=np.int64), np.full(1, sign, dtype=np.int64)
 
     def _ideal_line(self, a: tuple[float, float], b: tuple[float, float]) -> FloatArray:
         dx, dy = b[0] - a[0], b[1] - a[1]
@@ -642,21 +663,29 @@ LINE_ROWS: dict[Callable[[int, int], StepArray], Callable[[int, int], int]] = {
 """Line interpolators whose rows :func:`count_rows` counts in closed form, and the count."""
 
 
-def count_rows(program: Program, machine: Machine) -> IntArray:
+def count_rows(
+    program: Program, machine: Machine, *, sources: Sources = ALL, closed_form: bool = True
+) -> IntArray:
     """The ``(B + 1,) int64`` row offsets of the moves of ``program``'s step trace.
 
     What :func:`simulate_or_count` returns for a trace over its limit, without making the
     rows of a line or rapid whose interpolator counts them in closed form
     (:data:`LINE_ROWS`: the A.3 DDA's ``floor(HIPO) + 1``, and a compensation's rows at a
     reversal); other moves (arcs, other interpolators, a line whose piece models
-    dynamics) are simulated, their rows dropped. :class:`ChunkedSimulation` makes the
-    same offsets again from the rows themselves, and the verifier compares the two.
+    dynamics, every move of the ideal controller) are simulated, their rows dropped.
+    ``sources``: the trace of :func:`simulate_steps` with these sources;
+    ``closed_form=False`` simulates every move.
+    :class:`ChunkedSimulation` makes the same offsets again from the rows themselves,
+    and the verifier compares the two.
 
     Raises:
         InputError: as :func:`simulate_or_count` (naming the block).
     """
-    sim = _Controller(machine, program.origin, ALL)
-    rows_of = None if sim.inexact else LINE_ROWS.get(sim.line)
+    machine = switched_machine(machine, sources)
+    kind = _Controller if sources.interpolation else _IdealController
+    sim = kind(machine, program.origin, sources)
+    exact = closed_form and sources.interpolation and not sim.inexact
+    rows_of = LINE_ROWS.get(sim.line) if exact else None
     start = program.origin
     for k, move in enumerate(program.moves):
         try:
@@ -711,32 +740,42 @@ class NotStreamable(Exception):
 
 
 class ChunkedSimulation:
-    """The step simulator (all sources) run in chunks of whole moves, carriage included.
+    """The step simulator run in chunks of whole moves, carriage included.
 
     :meth:`chunks` yields :class:`TraceChunk` s of at least ``chunk_rows`` rows (a move
     is never split: a longer move is one chunk), each with the carriage the whole
-    simulation would give (the backlash play is carried from chunk to chunk,
-    :func:`camtool.verify.kernels.play_axis_from`); afterwards :meth:`trace_summary` is
-    the trace's per-move arrays. Needs the compiled kernels (``numba``).
+    simulation (:func:`simulate_steps` with the same ``sources``) would give: the
+    backlash play is carried from chunk to chunk
+    (:func:`camtool.verify.kernels.play_axis_from` for whole steps; for the ideal
+    controller's fractional steps, ``interpolation`` off, the motor's running sum and
+    the play by :class:`_FloatPlay`, whose chunk's ``rows`` are each sample's direction
+    as the whole trace's are). Afterwards :meth:`trace_summary` is the trace's per-move
+    arrays. Needs the compiled kernels (``numba``).
     """
 
-    def __init__(self, program: Program, machine: Machine, chunk_rows: int) -> None:
+    def __init__(
+        self, program: Program, machine: Machine, chunk_rows: int, *, sources: Sources = ALL
+    ) -> None:
         self.program = program
-        self.machine = machine
+        self.machine = switched_machine(machine, sources)
         self.chunk_rows = max(1, int(chunk_rows))
-        self.sim = _Controller(machine, program.origin, ALL)
+        kind = _Controller if sources.interpolation else _IdealController
+        self.sim = kind(self.machine, program.origin, sources)
         self.jit: Any = compiled()
         if self.jit is None:
             raise RuntimeError("the chunked simulation needs numba")  # callers check first
 
     def chunks(self) -> Any:
-        """Yield the :class:`TraceChunk` s in order (an iterator)."""
-        sim, machine = self.sim, self.machine
-        true = machine.real_steps_per_mm
-        origin = sim.origin_steps
-        motor = [int(origin[0]), int(origin[1])]
-        last_sign = [0, 0]
-        state = [np.zeros(5, dtype=np.float64), np.zeros(5, dtype=np.float64)]
+        """Yield the :class:`TraceChunk` s in order (an iterator).
+
+        Raises:
+            InputError: a block the controller cannot run (naming its line).
+            NotStreamable: a move's rows are neither whole steps nor the ideal
+                controller's fractional ones.
+        """
+        sim = self.sim
+        ideal = isinstance(sim, _IdealController)
+        play = _FloatPlay(sim.origin_steps, self.machine) if ideal else _StepPlay(self)
         start = self.program.origin
         first, row0, pending = 0, 0, 0
         moves = self.program.moves
@@ -749,39 +788,15 @@ class ChunkedSimulation:
             pending += sim.counts[-1]
             if pending < self.chunk_rows and b + 1 < len(moves):
                 continue
-            rows = np.concatenate(sim.parts) if sim.parts else np.zeros((0, 2), STEP_DTYPE)
-            if rows.dtype != STEP_DTYPE:
+            kind = np.float64 if ideal else STEP_DTYPE
+            rows = np.concatenate(sim.parts) if sim.parts else np.zeros((0, 2), kind)
+            if rows.dtype != kind:
                 raise NotStreamable(f"rows of dtype {rows.dtype}")
             comp = np.concatenate(sim.comp_parts) if sim.comp_parts else np.zeros(0, np.bool_)
-            counts = np.asarray(sim.counts[first:], dtype=np.int64)
+            counts = np.array(sim.counts[first:], dtype=np.int64)
             sim.parts.clear()
             sim.comp_parts.clear()
-            out = np.empty((len(rows), 2), dtype=np.float64)
-            if len(rows):
-                runs = self.jit.play_runs(rows, motor[0], motor[1])
-            for axis in (0, 1):
-                if not len(rows):
-                    break
-                starts, signs, at = runs[3 * axis : 3 * axis + 3]
-                if len(starts) and int(signs[0]) == last_sign[axis]:  # the run goes on
-                    starts, signs, at = starts[1:], signs[1:], at[1:]
-                bands = _run_bands(machine, axis, signs, at)
-                if len(signs):
-                    last_sign[axis] = int(signs[-1])
-                motor[axis] = int(
-                    self.jit.play_axis_from(
-                        rows,
-                        axis,
-                        starts,
-                        signs,
-                        bands,
-                        state[axis],
-                        motor[axis],
-                        float(origin[axis]),
-                        float(true[axis]),
-                        out,
-                    )
-                )
+            rows, out = play.chunk(rows)
             block_start = np.concatenate(([row0], row0 + np.cumsum(counts))).astype(np.int64)
             yield TraceChunk(
                 first_block=first,
@@ -798,10 +813,141 @@ class ChunkedSimulation:
         return {
             "block_start": read_only(sim.block_start()),
             "start_mm": _start_mm(sim.origin_steps, self.machine),
-            "logical_end": read_only(np.asarray(sim.logical, dtype=np.int64).reshape(-1, 2)),
-            "block_steps": read_only(np.asarray(sim.steps, dtype=np.int64).reshape(-1, 3)),
-            "block_dominant": read_only(np.asarray(sim.dominant, dtype=np.int64)),
-            "block_compensation": read_only(np.asarray(sim.block_comp, dtype=np.int64)),
+            "logical_end": read_only(np.array(sim.logical, dtype=np.int64).reshape(-1, 2)),
+            "block_steps": read_only(np.array(sim.steps, dtype=np.int64).reshape(-1, 3)),
+            "block_dominant": read_only(np.array(sim.dominant, dtype=np.int64)),
+            "block_compensation": read_only(np.array(sim.block_comp, dtype=np.int64)),
             "reversals": (sim.reversals[0], sim.reversals[1]),
             "compensations": sim.compensations,
         }
+
+
+class _StepPlay:
+    """The carriage of whole-step rows chunk after chunk (:class:`ChunkedSimulation`).
+
+    The compiled play operator (:func:`camtool.verify.kernels.play_axis_from`) resumed
+    from the chunk before: the motor position, each axis's last run sign and its state.
+    """
+
+    def __init__(self, simulation: ChunkedSimulation) -> None:
+        self.jit = simulation.jit
+        self.machine = simulation.machine
+        self.origin = simulation.sim.origin_steps
+        self.motor = [int(self.origin[0]), int(self.origin[1])]
+        self.last_sign = [0, 0]
+        self.state = [np.zeros(5, dtype=np.float64), np.zeros(5, dtype=np.float64)]
+
+    def chunk(self, rows: StepArray) -> tuple[StepArray, FloatArray]:
+        """``rows`` and the carriage after each, ``(n, 2) float64`` mm."""
+        machine, motor, origin = self.machine, self.motor, self.origin
+        true = machine.real_steps_per_mm
+        out = np.empty((len(rows), 2), dtype=np.float64)
+        if not len(rows):
+            return rows, out
+        runs = self.jit.play_runs(rows, motor[0], motor[1])
+        for axis in (0, 1):
+            starts, signs, at = runs[3 * axis : 3 * axis + 3]
+            if len(starts) and int(signs[0]) == self.last_sign[axis]:  # the run goes on
+                starts, signs, at = starts[1:], signs[1:], at[1:]
+            bands = _run_bands(machine, axis, signs, at)
+            if len(signs):
+                self.last_sign[axis] = int(signs[-1])
+            motor[axis] = int(
+                self.jit.play_axis_from(
+                    rows,
+                    axis,
+                    starts,
+                    signs,
+                    bands,
+                    self.state[axis],
+                    motor[axis],
+                    float(origin[axis]),
+                    float(true[axis]),
+                    out,
+                )
+            )
+        return rows, out
+
+
+class _FloatPlay:
+    """The carriage of the ideal controller's fractional rows chunk after chunk.
+
+    The same float operations, in the same order, as the whole trace's
+    (:func:`_motor` then :func:`_carriage_of`, :func:`_play`): the motor is the running
+    sum of the rows (``np.cumsum`` adds in order, so the sum is resumed from the chunk
+    before's last, bit for bit) plus the origin; a run of one sign starts where a row's
+    sign differs from the axis's last non-zero one, its band looked up at its first
+    row; in an up run the carriage is ``max(c, M)``, in a down run ``min(c, M + band)``,
+    ``c`` the carriage at the end of the run before; then ``(v − c0) + start``,
+    divided by the true steps/mm. The rows returned are each row's direction (int8).
+    """
+
+    def __init__(self, origin: tuple[float, float], machine: Machine) -> None:
+        self.machine = machine
+        self.origin = origin
+        self.total = np.zeros((1, 2), dtype=np.float64)  # the rows' running sum so far
+        self.sign = [0, 0]  # each axis's last non-zero direction (0: none yet)
+        self.c0 = [0.0, 0.0]  # the carriage before the first run (once one started)
+        self.current = [0.0, 0.0]  # the carriage at the end of the run before this one
+        self.value = [0.0, 0.0]  # the carriage after the last row
+        self.band = [0.0, 0.0]  # the band of the run going on, steps
+
+    def chunk(self, rows: FloatArray) -> tuple[StepArray, FloatArray]:
+        """Each row's direction ``(n, 2) int8`` and the carriage after it, ``(n, 2)`` mm."""
+        n = len(rows)
+        if not n:
+            return np.zeros((0, 2), dtype=STEP_DTYPE), np.empty((0, 2), dtype=np.float64)
+        total = np.cumsum(np.concatenate((self.total, rows)), axis=0)[1:]
+        self.total = total[-1:].copy()
+        motor = total  # the motor: the running sum plus the origin, as _motor adds it
+        motor += np.asarray(self.origin, dtype=np.float64)
+        signs = np.sign(rows).astype(STEP_DTYPE)
+        true = self.machine.real_steps_per_mm
+        out = np.empty((n, 2), dtype=np.float64)
+        for axis in (0, 1):
+            values = self._play(signs[:, axis], motor, axis)
+            np.divide(values, true[axis], out=out[:, axis])
+        return signs, out
+
+    def _band(self, motor: FloatArray, row: int, axis: int) -> float:
+        """The true backlash at the motor's position after ``row``, steps (as :func:`_play`)."""
+        true = self.machine.real_steps_per_mm
+        x_mm, y_mm = motor[row, 0] / true[0], motor[row, 1] / true[1]
+        return self.machine.backlash.true_at(axis, x_mm, y_mm) / 1000.0 * true[axis]
+
+    def _play(self, steps: npt.NDArray[np.int8], motor: FloatArray, axis: int) -> FloatArray:
+        """One axis's carriage in motor steps, ``(v − c0) + start`` (:func:`_play`'s values)."""
+        column = motor[:, axis]
+        nz = np.flatnonzero(steps)
+        signs = steps[nz]
+        run_first = np.flatnonzero(signs != np.concatenate(([self.sign[axis]], signs[:-1])))
+        bounds = np.append(nz[run_first], len(steps))
+        out = np.empty(len(steps), dtype=np.float64)
+        started = 0 if self.sign[axis] else int(bounds[0])  # rows from which a run has started
+        if started:  # no run yet: c0 − c0
+            out[:started] = 0.0
+        else:  # the run going on from the chunk before
+            self._run(column, 0, int(bounds[0]), axis, out)
+        for r in range(len(run_first)):
+            lo, hi = int(bounds[r]), int(bounds[r + 1])
+            sign = int(signs[run_first[r]])
+            band = self._band(motor, lo, axis) if sign < 0 else 0.0
+            if self.sign[axis] == 0:  # the first run: the carriage's start contact
+                start = float(self.origin[axis])
+                self.value[axis] = self.c0[axis] = start if sign > 0 else start + band
+            self.current[axis], self.band[axis], self.sign[axis] = self.value[axis], band, sign
+            self._run(column, lo, hi, axis, out)
+        if self.sign[axis]:
+            out[started:] -= self.c0[axis]
+        out += float(self.origin[axis])
+        return out
+
+    def _run(self, column: FloatArray, lo: int, hi: int, axis: int, out: FloatArray) -> None:
+        """Rows ``lo:hi`` of the run going on: ``max(c, M)`` up, ``min(c, M + band)`` down."""
+        if hi <= lo:
+            return
+        if self.sign[axis] > 0:
+            np.maximum(self.current[axis], column[lo:hi], out=out[lo:hi])
+        else:
+            np.minimum(self.current[axis], column[lo:hi] + self.band[axis], out=out[lo:hi])
+        self.value[axis] = float(out[hi - 1])

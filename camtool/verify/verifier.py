@@ -57,6 +57,7 @@ from camtool.verify.metrics import (
     Against,
     AlongPath,
     ContourMeasure,
+    CutDigest,
     CuttingStream,
     Deviation,
     FindingLike,
@@ -87,9 +88,10 @@ if TYPE_CHECKING:
     from camtool.post.base import Target
     from camtool.toolpath.plan import PlanReport
 
-STREAM_ROWS = eb.MAX_ROWS
-"""Rows above which a trace is streamed (:func:`_simulate_big`); the error budget, which
-re-simulates whole traces, is skipped above the same count."""
+STREAM_ROWS = 1 << 20
+"""Rows above which a trace is streamed (:func:`_simulate_big`): a whole trace's arrays
+and measures take ~100 bytes a row; the error budget's re-simulations are streamed
+above :data:`CHUNK_ROWS` rows (:func:`_without`)."""
 CHUNK_ROWS = 1 << 16
 """Rows a streamed trace is simulated and measured at a time (a move is never split):
 with their temporaries about 130 bytes a row, ~9 MB next to Python, numpy, scipy,
@@ -146,6 +148,9 @@ class Verification:
         findings: the plan's findings the drawing was compared with.
         parts: the program's parts verified each alone (a job's operations, each with
             its tool against its own drawing); their errors count in the limits.
+        cut_digest: the :class:`~camtool.verify.metrics.CutDigest` of the trace's cutting
+            rows when a streamed trace was compared with a drawing (the error budget tells
+            by it which re-simulations cut the same rows), else ``None``.
     """
 
     target: str
@@ -165,6 +170,7 @@ class Verification:
     tool_diameter: float = 0.0
     findings: Sequence[FindingLike] = ()
     parts: tuple[Part, ...] = ()
+    cut_digest: bytes | None = None
 
     @cached_property
     def error_budget(self) -> eb.ErrorBudget:
@@ -378,8 +384,9 @@ def verify_program(
     # the budget's workers are forked once this process has loaded what the measures need,
     # and before it takes its own measures
     with nullcontext() if now is None else _BudgetRun(inputs, budget, now) as run:
+        digest = None
         if streamed is not None:
-            dev, along, contours, thin = streamed
+            dev, along, contours, thin, digest = streamed
         else:
             dev, along, contours, thin = _trace_measures(
                 program, trace, cutting=compared_with is not None
@@ -406,11 +413,16 @@ def verify_program(
             drawing=compared_with,
             tool_diameter=tool_diameter,
             findings=tuple(findings),
+            cut_digest=digest,
         )
         if run is not None:
             with suppress(CamtoolError):  # then asked for, it is computed (and fails) again
                 v.__dict__["error_budget"] = run.gather(v)  # cached_property's own slot
     return v
+
+
+_Streamed = tuple[Deviation, AlongPath, tuple[ContourMeasure, ...], ThinTrace | None, bytes | None]
+"""A streamed trace's measures, thinned cutting rows and their digest (:func:`_stream`)."""
 
 
 def _simulate_big(
@@ -419,9 +431,7 @@ def _simulate_big(
     against: Drawing | None,
     chunk_rows: int,
     stream_above: int,
-) -> tuple[
-    StepTrace, tuple[Deviation, AlongPath, tuple[ContourMeasure, ...], ThinTrace | None] | None
-]:
+) -> tuple[StepTrace, _Streamed | None]:
     """The trace of ``program``, and its measures when they were taken as it streamed.
 
     A trace of at most ``stream_above`` rows or one from a target's own simulator is
@@ -434,8 +444,9 @@ def _simulate_big(
     rows the comparison keeps are gathered as the chunks pass
     (:class:`~camtool.verify.metrics.CuttingStream`, the last item; ``None`` without a
     drawing): the comparison needs only those, so the trace is not held whole for it
-    (13 M rows of a 213-icon SVG job took 1.65 GB). Without the compiled kernels it is
-    simulated whole.
+    (13 M rows of a 213-icon SVG job took 1.65 GB), and their digest
+    (:class:`~camtool.verify.metrics.CutDigest`, the last item). Without the compiled
+    kernels it is simulated whole.
 
     The measures need every move's row offsets first: a trace sure to be streamed has
     them counted (:func:`~camtool.verify.simulate.count_rows`, a DDA line in closed
@@ -479,21 +490,23 @@ def _stream(
     chunk_rows: int,
     block_start: np.ndarray,
     kernels: Any,
-) -> (
-    tuple[StepTrace, tuple[Deviation, AlongPath, tuple[ContourMeasure, ...], ThinTrace | None]]
-    | None
-):
+    *,
+    sources: Sources = ALL,
+    rms: bool = True,
+) -> tuple[StepTrace, _Streamed] | None:
     """:func:`_simulate_big`'s streamed trace and measures, its moves at ``block_start``.
 
     ``None`` when the chunked simulation's rows do not start where ``block_start`` says
     (the measures, which were told those offsets, are then not the trace's).
+    ``sources``: the error sources simulated (the error budget's re-simulations);
+    ``rms=False``: the deviation's rms is not measured (NaN; the budget has no use for it).
 
     Raises:
         NotStreamable: the rows are not whole steps.
     """
-    sim = ChunkedSimulation(program, machine, chunk_rows)
+    sim = ChunkedSimulation(program, machine, chunk_rows, sources=sources)
     summary = sim.trace_summary()
-    stream = TraceStream(program, block_start, summary["start_mm"], kernels)
+    stream = TraceStream(program, block_start, summary["start_mm"], kernels, rms=rms)
     cutting = None if against is None else _cutting_stream(program, block_start)
     share = _Share()
 
@@ -546,8 +559,9 @@ def _stream(
         total_rows=int(block_start[-1]),
         total_compensation_steps=m.compensation_steps,
     )
-    thin = None if cutting is None else cutting.finish()
-    return trace, (m.deviation, m.along, m.contours, thin)
+    if cutting is None:
+        return trace, (m.deviation, m.along, m.contours, None, None)
+    return trace, (m.deviation, m.along, m.contours, cutting.finish(), cutting.digest.digest())
 
 
 class _Share:
@@ -687,20 +701,16 @@ def _cutting_rows(program: Program, trace: StepTrace) -> tuple[np.ndarray, np.nd
     return points[cutting], runs
 
 
-def _same_against(v: _Inputs, program: Program, trace: StepTrace) -> bool:
-    """Whether the drawing comparison of ``trace`` (:func:`_compare`) gets exactly ``v``'s inputs.
+def _same_against(v: _Inputs, program: Program, digest: bytes | None) -> bool:
+    """Whether the drawing comparison of a re-simulation gets exactly ``v``'s inputs.
 
-    The same cutting rows, the same runs and (with findings) the same programmed path:
-    then its figures are the verification's own (``against``, measured whenever there
-    is a drawing), bit for bit, and need not be measured again (the ``rounding`` source
-    of a machine whose steps absorb the emitted rounding).
+    The same cutting rows and runs (the same :class:`~camtool.verify.metrics.CutDigest`,
+    ``digest`` the re-simulation's) and (with findings) the same programmed path: then
+    its figures are the verification's own (``against``, measured whenever there is a
+    drawing), bit for bit, and need not be measured again (the ``rounding`` source of
+    a machine whose steps absorb the emitted rounding).
     """
-    count = _cutting_count(program, trace.block_start)
-    if v.drawing is None or count != _cutting_count(v.program, v.trace.block_start):
-        return False  # told without copying the rows (1.8 M with the interpolation off)
-    cut, runs = _cutting_rows(program, trace)
-    cut_v, runs_v = _cutting_rows(v.program, v.trace)
-    if not (np.array_equal(cut, cut_v) and np.array_equal(runs, runs_v)):
+    if v.drawing is None or digest is None or digest != v.digest:
         return False
     if not v.findings or program is v.program:
         return True
@@ -710,10 +720,26 @@ def _same_against(v: _Inputs, program: Program, trace: StepTrace) -> bool:
     )
 
 
+def _trace_digest(program: Program, trace: StepTrace) -> bytes:
+    """The :class:`~camtool.verify.metrics.CutDigest` of a whole trace, read a chunk at a time."""
+    digest = CutDigest(_rapids(program))
+    points, blocks = trace.carriage_mm, trace.block_of_row
+    for lo in range(0, len(points), CHUNK_ROWS):
+        digest.add(points[lo : lo + CHUNK_ROWS], blocks[lo : lo + CHUNK_ROWS])
+    return digest.digest()
+
+
 def _budget(v: Verification, progress: Progress = no_progress) -> eb.ErrorBudget:
     """The error budget of ``v`` (see :attr:`Verification.error_budget`), told to ``progress``."""
     inputs = _Inputs(
-        v.program, v.machine, v.trace, v.planned, v.drawing, v.tool_diameter, v.findings
+        v.program,
+        v.machine,
+        v.trace,
+        v.planned,
+        v.drawing,
+        v.tool_diameter,
+        v.findings,
+        v.cut_digest,
     )
     with _BudgetRun(inputs, v.budget, progress) as run:
         return run.gather(v)
@@ -730,6 +756,16 @@ class _Inputs:
     drawing: Drawing | None
     tool_diameter: float
     findings: Sequence[FindingLike]
+    cut_digest: bytes | None = None
+
+    @cached_property
+    def digest(self) -> bytes | None:
+        """The :class:`~camtool.verify.metrics.CutDigest` of the trace (``None``: no drawing)."""
+        if self.drawing is None:
+            return None
+        if self.cut_digest is not None:
+            return self.cut_digest
+        return _trace_digest(self.program, self.trace)
 
 
 class _BudgetRun:
@@ -821,32 +857,38 @@ def _without(inputs: _Inputs, name: str) -> _Without:
 
     ``rounding`` simulates the unrounded plan instead; when the plan does not simulate
     (not what this machine reads), no figure and a note that says why. The drawing is
-    measured again only when the cutting trace differs (:func:`_same_against`).
+    measured again only when the cutting trace differs (:func:`_same_against`). A trace
+    of more than :data:`CHUNK_ROWS` rows is streamed, that many rows at a time
+    (:func:`_resimulate`).
 
     Raises:
         CamtoolError: the re-simulation fails (the full model did not).
     """
-    program = inputs.program
+    program, sources = inputs.program, ALL
     if name == "rounding":
         assert inputs.planned is not None
-        try:
-            program, trace = inputs.planned, simulate(inputs.planned, inputs.machine)
-        except CamtoolError as exc:  # the plan is not what this machine reads: say so
-            return _Without(
-                {}, note=f"rounding not compared: the unrounded plan does not simulate ({exc})"
-            )
+        program = inputs.planned
     else:
-        trace = simulate(program, inputs.machine, sources=ALL.without(name))
-    same = _same_against(inputs, program, trace)  # then the drawing is not measured again
-    drawing = None if same else inputs.drawing
-    dev, along, contours, thin = _trace_measures(program, trace, cutting=drawing is not None)
-    del trace  # ~50 MB of a 1.8 M-row trace, freed before the drawing's distances
+        sources = ALL.without(name)
+    chunk_rows = CHUNK_ROWS
+    stream = inputs.trace.row_count > chunk_rows
+    try:
+        dev, along, contours, thin, digest = _resimulate(
+            program, inputs.machine, sources, inputs.drawing, chunk_rows if stream else 0
+        )
+    except CamtoolError as exc:  # the plan is not what this machine reads: say so
+        if name != "rounding":
+            raise
+        return _Without(
+            {}, note=f"rounding not compared: the unrounded plan does not simulate ({exc})"
+        )
+    same = _same_against(inputs, program, digest)  # then the drawing is not measured again
     values = eb.figures(dev, along, contours, None)
-    if drawing is not None and thin is not None:  # only its largest distance is a figure
-        values |= eb.distance_figures(
+    if inputs.drawing is not None and thin is not None and not same:
+        values |= eb.distance_figures(  # only its largest distance is a figure
             against_worst(
                 thin,
-                drawing,
+                inputs.drawing,
                 inputs.tool_diameter / 2.0,
                 nominal=_nominal_lines(program) if inputs.findings else (),
                 findings=inputs.findings,
@@ -854,6 +896,49 @@ def _without(inputs: _Inputs, name: str) -> _Without:
         )
     blocks = [c.blocks for c in contours] if name == "rounding" else None
     return _Without(values, same, blocks)
+
+
+def _resimulate(
+    program: Program,
+    machine: Machine,
+    sources: Sources,
+    drawing: Drawing | None,
+    chunk_rows: int,
+) -> _Streamed:
+    """The measures of ``program`` simulated with ``sources`` (the error budget's).
+
+    With ``chunk_rows`` and the compiled kernels, the step simulator's trace is streamed
+    (:func:`_stream`: the same figures as the whole trace's, bit for bit; the rms, which
+    the budget does not use, is not measured), its rows counted first
+    (:func:`~camtool.verify.simulate.count_rows`); else simulated whole and measured by
+    :func:`_trace_measures`. With a drawing, the thinned cutting rows and their digest.
+
+    Raises:
+        CamtoolError: the simulation fails.
+    """
+    kernels = compiled() if chunk_rows else None
+    if kernels is not None and library().simulator(machine.motion.line) is None:
+        for closed_form in (True, False):  # a count the chunks do not repeat: simulated
+            block_start = count_rows(program, machine, sources=sources, closed_form=closed_form)
+            try:
+                got = _stream(
+                    program,
+                    machine,
+                    drawing,
+                    chunk_rows,
+                    block_start,
+                    kernels,
+                    sources=sources,
+                    rms=False,
+                )
+            except NotStreamable:
+                break
+            if got is not None:
+                return got[1]
+    trace = simulate(program, machine, sources=sources)
+    dev, along, contours, thin = _trace_measures(program, trace, cutting=drawing is not None)
+    digest = None if drawing is None else _trace_digest(program, trace)
+    return dev, along, contours, thin, digest
 
 
 def source_statuses(

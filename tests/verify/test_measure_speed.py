@@ -320,8 +320,8 @@ def test_a_drawing_sampled_into_one_array_is_its_contours_stacked() -> None:
 
 
 def test_the_cutting_count_is_the_count_of_cutting_rows() -> None:
-    """_same_against tells traces apart by their count before it copies any row."""
-    from camtool.verify.verifier import _cutting_count, _same_against
+    """_same_against tells traces apart by the digest of their cutting rows, copying none."""
+    from camtool.verify.verifier import _cutting_count, _same_against, _trace_digest
 
     target = load_target("grbl")
     program, drawing = _plate()
@@ -332,5 +332,6 @@ def test_the_cutting_count_is_the_count_of_cutting_rows() -> None:
     ideal = simulate(program, target.machine, sources=ALL.without("interpolation"))
     assert _cutting_count(program, ideal.block_start) != _cutting_count(program, trace.block_start)
     inputs = verifier._Inputs(program, target.machine, v.trace, None, drawing, 0.5, ())
-    assert not _same_against(inputs, program, ideal)
-    assert _same_against(inputs, program, trace)
+    assert not _same_against(inputs, program, _trace_digest(program, ideal))
+    assert _same_against(inputs, program, _trace_digest(program, trace))
+    assert not _same_against(inputs, program, None)
