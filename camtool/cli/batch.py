@@ -109,13 +109,17 @@ def batch(inputs: tuple[str, ...], layers: str | None, verify_too: bool, **optio
     verified, .png/.svg with --preview; OUTDIR/<target>/a/b.<ending> with several
     targets) and are never overwritten without --force. Exit code: 0 all ok, else the
     smallest per-file code (1 error, 2 usage, 3 unreadable input, 4 over --max-error-um).
+    Ctrl-C or SIGTERM stops it at once, keeping the files finished, with a summary of what
+    was and was not written (exit code 130, 143 for SIGTERM).
     """
     from camtool.jobs.batch import (
+        BatchInterrupted,
         BatchOptions,
         batch_report,
         failure_line,
         plan_batch,
         summary_table,
+        unwritten_lines,
     )
 
     names = tuple(n.strip() for n in layers.split(",") if n.strip()) if layers else None
@@ -126,7 +130,13 @@ def batch(inputs: tuple[str, ...], layers: str | None, verify_too: bool, **optio
         layers=names, verify=verify_too, plan=planning, output=output, job=job, **options
     )
     plan = plan_batch(inputs, settings)
-    result = _run(plan)
+    try:
+        result = _run(plan)
+    except BatchInterrupted as stop:
+        click.echo("", err=True)  # off the line ^C was echoed on
+        table = summary_table(stop.result) if stop.result.rows else ""
+        click.echo(table + unwritten_lines(stop), err=True, nl=False)
+        raise
     click.echo(summary_table(result), err=True, nl=False)
     if options["report"] == "-":  # a report file is written by run_batch, in its claim
         text = json.dumps(batch_report(result), indent=2, ensure_ascii=False)

@@ -15,11 +15,19 @@ that fails (any exception) becomes an ``error`` row; it never stops the others,
 and it leaves no output behind: each file's outputs are computed in memory and
 written (atomically) only when all of them are ready.
 
-Pool workers die with the batch process, even when it is killed with ``kill -9``.
-Dask workers get the input's bytes (a remote worker does not share this disk)
-and return the outputs' bytes and the row; only this process writes, so a
-worker lost mid-file (Dask runs its task again elsewhere) never leaves a
-partial file, and each output is written once.
+Workers never write: a pool worker returns the row and the outputs' bytes, and
+only this process writes them, so a worker killed mid-file leaves nothing half
+written. Pool workers die with the batch process, even when it is killed with
+``kill -9``. Dask workers get the input's bytes (a remote worker does not share
+this disk) and return the outputs' bytes and the row, so a worker lost mid-file
+(Dask runs its task again elsewhere) never leaves a partial file, and each
+output is written once.
+
+Ctrl-C (SIGINT) or SIGTERM stops a batch run in the main thread at once
+(:class:`BatchInterrupted`): the files finished are kept, whole (a file's outputs
+are written with the signal held back until the last one is in place), the pool's
+workers are killed (Dask's tasks cancelled), the output folder's claim is
+released, and the exception says which files were and were not written.
 
 Outputs keep the path below the input's root: ``drawings/a/b.dxf`` gives
 ``OUT/a/b.pic`` (the target's ending), ``OUT/a/b.json`` (the verify report,
@@ -72,7 +80,9 @@ import contextlib
 import dataclasses
 import json
 import os
-from collections.abc import Callable, Sequence
+import signal
+import threading
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -98,6 +108,8 @@ STATUSES = ("ok", "error", "over-limit")
 """Values of :attr:`BatchRow.status`."""
 SHOWN_EXISTING = 5
 """Existing outputs named in the refusal to overwrite (the rest are counted)."""
+SHOWN_UNWRITTEN = 10
+"""Files not posted named in an interrupted batch's summary (the rest are counted)."""
 
 Progress = Callable[[int, int, "BatchRow"], None]
 """``progress(done, total, row)``: called in the calling process as each file finishes."""
@@ -314,6 +326,95 @@ class BatchResult:
         return batch_exit_code(self.rows)
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised as Ctrl-C is, so that a batch stops the same way (:class:`Interrupts`)."""
+
+
+class BatchInterrupted(CamtoolError):
+    """A batch stopped by Ctrl-C (SIGINT) or SIGTERM before every file was posted.
+
+    Exit code 128 + the signal's number: 130 for SIGINT, 143 for SIGTERM (as a shell
+    reports a process the signal ended).
+
+    Attributes:
+        result: the files finished before the signal, in input order: their outputs are
+            written whole (``ok``, ``over-limit``) or not at all (``error``).
+        unwritten: the files not finished, in input order: none of their outputs is
+            written (an output of a previous run, with ``force``, is left as it was).
+        signal_name: ``"SIGINT"`` or ``"SIGTERM"``.
+    """
+
+    def __init__(self, result: BatchResult, unwritten: tuple[BatchTask, ...], signum: int) -> None:
+        self.result = result
+        self.unwritten = unwritten
+        self.signal_name = signal.Signals(signum).name
+        self.exit_code = 128 + signum
+        rows = result.rows
+        written = sum(r.status != "error" for r in rows)
+        reported = result.options.report is not None
+        super().__init__(
+            f"stopped by {self.signal_name} after {len(rows)} of {len(rows) + len(unwritten)} "
+            f"file(s): {written} written, {len(rows) - written} failed, {len(unwritten)} not "
+            "posted (nothing of them written)"
+            + ("; the batch report is not written" if reported else "")
+        )
+
+
+class Interrupts:
+    """Ctrl-C (SIGINT) and SIGTERM while a batch runs: the first one stops it, cleanly.
+
+    Inside the block (in the main thread) the first of these signals raises
+    ``KeyboardInterrupt`` (:class:`Terminated` for SIGTERM) — at once, or, inside
+    :meth:`held`, at its end, so that a file being written is written whole and
+    recorded. Signals that follow are ignored: the batch is already stopping
+    (killing its workers, releasing its output folder), and a second Ctrl-C must not
+    cut that short. Only a signal whose handler is Python's default is taken over
+    (SIGINT raising ``KeyboardInterrupt``, SIGTERM ending the process): one ignored
+    (``nohup``) or handled by the caller is left alone. The handlers are restored at
+    the end; outside the main thread nothing changes.
+    """
+
+    def __init__(self) -> None:
+        self.signum: int | None = None
+        self._holding = False
+        self._previous: dict[int, Any] = {}
+
+    def __enter__(self) -> Interrupts:
+        if threading.current_thread() is threading.main_thread():
+            defaults = {signal.SIGINT: signal.default_int_handler, signal.SIGTERM: signal.SIG_DFL}
+            for signum, default in defaults.items():
+                if signal.getsignal(signum) == default:
+                    self._previous[signum] = signal.signal(signum, self._handle)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        for signum, handler in self._previous.items():
+            signal.signal(signum, handler)
+        self._previous = {}
+
+    def _handle(self, signum: int, frame: object) -> None:
+        if self.signum is not None:  # stopping already
+            return
+        self.signum = signum
+        if not self._holding:
+            raise self.exception()
+
+    def exception(self) -> KeyboardInterrupt:
+        """The exception the signal received stands for."""
+        return Terminated() if self.signum == signal.SIGTERM else KeyboardInterrupt()
+
+    @contextlib.contextmanager
+    def held(self) -> Iterator[None]:
+        """A signal arriving inside the block is raised at its end (no later)."""
+        self._holding = True
+        try:
+            yield
+        finally:
+            self._holding = False
+        if self.signum is not None:
+            raise self.exception()
+
+
 def batch_exit_code(rows: Sequence[BatchRow]) -> int:
     """0 when every row is ok, else the smallest non-zero per-file exit code.
 
@@ -518,6 +619,12 @@ def run_batch(
         progress: called in this process as each file finishes, in finishing order.
         client: a ``dask.distributed.Client`` to post on (``None``: see above).
 
+    Ctrl-C (SIGINT) and SIGTERM, in the main thread, stop the batch at once
+    (:class:`Interrupts`): the pool's workers are killed (a file being posted is lost,
+    never half written), Dask's tasks cancelled (a ``local:N`` cluster closed), the
+    claim released, and :class:`BatchInterrupted` raised with the files finished and
+    those not written. No batch report is written then.
+
     Returns:
         The rows in the plan's (sorted input) order.
 
@@ -526,12 +633,32 @@ def run_batch(
             written, or the Dask scheduler cannot be reached or has no worker.
         UsageError: outputs appeared since the plan was checked (without ``force``);
             a ``client`` with ``jobs`` or ``scheduler``.
+        BatchInterrupted: Ctrl-C or SIGTERM (or a ``KeyboardInterrupt`` raised by the
+            caller's own handler) stopped it.
     """
+    options = plan.options if client is None else _with_client(plan.options, client)
+    rows: dict[int, BatchRow] = {}
+    with Interrupts() as interrupts:
+        try:
+            return _run_claimed(plan.tasks, options, client, progress, rows, interrupts)
+        except KeyboardInterrupt as exc:
+            done = tuple(rows[i] for i in sorted(rows))
+            left = tuple(t for i, t in enumerate(plan.tasks) if i not in rows)
+            signum = signal.SIGTERM if isinstance(exc, Terminated) else signal.SIGINT
+            raise BatchInterrupted(BatchResult(options, done), left, signum) from None
+
+
+def _run_claimed(
+    tasks: Sequence[BatchTask],
+    options: BatchOptions,
+    client: Any,
+    progress: Progress | None,
+    rows: dict[int, BatchRow],
+    interrupts: Interrupts,
+) -> BatchResult:
+    """:func:`run_batch` once the signals are taken: ``rows`` fills up as files finish."""
     from camtool.jobs.output import lock_directory
 
-    tasks, options = plan.tasks, plan.options
-    if client is not None:
-        options = _with_client(options, client)
     with contextlib.ExitStack() as stack:
         if client is None and options.scheduler is not None:
             from camtool.jobs.batch_dask import connect
@@ -543,10 +670,10 @@ def run_batch(
                 _refuse_existing(tasks, options)
             _remove_stale_temps(tasks)
             if client is not None:
-                rows = _run_dask(tasks, options, client, progress)
+                _run_dask(tasks, options, client, progress, rows, interrupts)
             else:
-                rows = _run_here(tasks, options, progress)
-            result = BatchResult(options, rows)
+                _run_here(tasks, options, progress, rows, interrupts)
+            result = BatchResult(options, tuple(rows[i] for i in range(len(tasks))))
             if options.report is not None and options.report != "-":
                 _write_report(result, options.report)
     return result
@@ -565,20 +692,25 @@ def _with_client(options: BatchOptions, client: Any) -> BatchOptions:
 
 
 def _run_here(
-    tasks: Sequence[BatchTask], options: BatchOptions, progress: Progress | None
-) -> tuple[BatchRow, ...]:
-    """The rows of ``tasks`` posted on this machine: a process pool, or this process for 1."""
+    tasks: Sequence[BatchTask],
+    options: BatchOptions,
+    progress: Progress | None,
+    rows: dict[int, BatchRow],
+    interrupts: Interrupts,
+) -> None:
+    """Post ``tasks`` on this machine, into ``rows``: a process pool, or this process for 1."""
     jobs = min(options.jobs or os.cpu_count() or 1, len(tasks))
     if jobs > 1:
-        return _run_pool(tasks, options, jobs, progress)
+        _run_pool(tasks, options, jobs, progress, rows, interrupts)
+        return
     if len(tasks) > 1:
         _offsets_here(options)
-    rows = []
     for done, task in enumerate(tasks, start=1):
-        rows.append(post_one(task, options))
+        row, files = _posted(task, options)
+        with interrupts.held():
+            rows[done - 1] = _publish(task, row, files)
         if progress is not None:
-            progress(done, len(tasks), rows[-1])
-    return tuple(rows)
+            progress(done, len(tasks), rows[done - 1])
 
 
 def _offsets_here(options: BatchOptions) -> None:
@@ -591,9 +723,14 @@ def _offsets_here(options: BatchOptions) -> None:
 
 
 def _run_dask(
-    tasks: Sequence[BatchTask], options: BatchOptions, client: Any, progress: Progress | None
-) -> tuple[BatchRow, ...]:
-    """The rows of ``tasks`` posted on ``client``'s cluster; the files written here.
+    tasks: Sequence[BatchTask],
+    options: BatchOptions,
+    client: Any,
+    progress: Progress | None,
+    rows: dict[int, BatchRow],
+    interrupts: Interrupts,
+) -> None:
+    """Post ``tasks`` on ``client``'s cluster, into ``rows``; the files written here.
 
     Each task travels with the input's bytes (read here, as it is submitted) and the
     target loaded here (so a target or ``--machine`` file need not exist on the
@@ -610,14 +747,13 @@ def _run_dask(
         task = tasks[i]
         return task, options, loaded[task.target or options.targets[0]], _read(task.file)
 
-    rows: dict[int, BatchRow] = {}
     for done, (i, value, error) in enumerate(
         map_unordered(client, post_data, len(tasks), arguments), start=1
     ):
-        rows[i] = _written(tasks[i], value, error)
+        with interrupts.held():
+            rows[i] = _written(tasks[i], value, error)
         if progress is not None:
             progress(done, len(tasks), rows[i])
-    return tuple(rows[i] for i in range(len(tasks)))
 
 
 def _read(file: str) -> bytes | CamtoolError:
@@ -632,7 +768,9 @@ def _read(file: str) -> bytes | CamtoolError:
         return InputError(f"{file}: cannot read ({reason(exc)})")
 
 
-Written = tuple["BatchRow", tuple[tuple[str, "str | bytes"], ...], str]
+Files = tuple[tuple[str, "str | bytes"], ...]
+"""A file's outputs, ``(path, text or bytes)``, in the order they are written."""
+Written = tuple["BatchRow", Files, str]
 """What a Dask worker returns (:func:`post_data`): the row, the outputs, its camtool version."""
 
 
@@ -648,6 +786,11 @@ def _written(task: BatchTask, value: Written | None, error: BaseException | None
             f"the Dask worker runs camtool {version}, this camtool is {__version__}; "
             "install the same camtool on every worker",
         )
+    return _publish(task, row, files)
+
+
+def _publish(task: BatchTask, row: BatchRow, files: Files) -> BatchRow:
+    """Write a posted file's outputs (each atomically); its row, or why they cannot be written."""
     try:
         for path, data in files:
             _write(path, data)
@@ -674,32 +817,58 @@ def _write_report(result: BatchResult, path: str) -> None:
 
 
 def _run_pool(
-    tasks: Sequence[BatchTask], options: BatchOptions, jobs: int, progress: Progress | None
-) -> tuple[BatchRow, ...]:
-    """Run ``tasks`` in a pool of ``jobs`` processes; rows in task order.
+    tasks: Sequence[BatchTask],
+    options: BatchOptions,
+    jobs: int,
+    progress: Progress | None,
+    rows: dict[int, BatchRow],
+    interrupts: Interrupts,
+) -> None:
+    """Post ``tasks`` in a pool of ``jobs`` processes, into ``rows``; the files written here.
 
-    The workers die with this process (:func:`_worker_init`), so killing a batch
-    (even with ``kill -9``) leaves no worker writing or holding its pipes.
+    The workers post (:func:`_posted`) and this process writes (:func:`_publish`), so
+    a worker killed mid-file leaves nothing behind. They die with this process
+    (:func:`_worker_init`), so killing a batch (even with ``kill -9``) leaves no
+    worker running or holding its pipes; and when the loop ends early (Ctrl-C, a
+    failing progress callback) they are killed at once (:func:`_kill_pool`) rather
+    than left to finish the files they hold.
     """
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
-    rows: dict[int, BatchRow] = {}
-    with ProcessPoolExecutor(
-        max_workers=jobs, initializer=_worker_init, initargs=(os.getpid(),)
-    ) as pool:
-        futures = {pool.submit(post_one, task, options): i for i, task in enumerate(tasks)}
-        try:
-            for done, future in enumerate(as_completed(futures), start=1):
-                index = futures[future]
+    pool = ProcessPoolExecutor(max_workers=jobs, initializer=_worker_init, initargs=(os.getpid(),))
+    try:
+        futures = {pool.submit(_posted, task, options): i for i, task in enumerate(tasks)}
+        for done, future in enumerate(as_completed(futures), start=1):
+            index = futures[future]
+            with interrupts.held():
                 rows[index] = _collect(future, tasks[index])
-                if progress is not None:
-                    progress(done, len(tasks), rows[index])
-        except BaseException:  # Ctrl-C or a failing callback: stop the pool, then re-raise
-            pool.shutdown(wait=False, cancel_futures=True)
-            raise
-    return tuple(rows[i] for i in range(len(tasks)))
+            if progress is not None:
+                progress(done, len(tasks), rows[index])
+    except BaseException:
+        _kill_pool(pool)
+        raise
+    pool.shutdown()
 
 
+def _kill_pool(pool: Any) -> None:
+    """Kill ``pool``'s workers now (SIGKILL), reap them, and drop the work not started.
+
+    The pool's processes are its private ``_processes`` (CPython's since 3.2; the
+    public ``kill_workers`` comes only with Python 3.14). With its workers gone the
+    pool's own thread sees them die and ends, so nothing waits for a file in flight.
+    """
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    for process in processes:
+        with contextlib.suppress(OSError, ValueError):
+            process.kill()
+    for process in processes:
+        with contextlib.suppress(OSError, ValueError, AssertionError):
+            process.join(KILL_WAIT_S)
+    pool.shutdown(wait=False, cancel_futures=True)
+
+
+KILL_WAIT_S = 5.0
+"""Longest wait for a killed worker to be reaped, s (SIGKILL ends it at once)."""
 PARENT_POLL_S = 0.5
 """How often a worker checks that the batch that started it is still alive, s."""
 
@@ -713,18 +882,19 @@ def _worker_init(parent_pid: int) -> None:
     has been re-parented. A parent already gone ends the worker at once.
 
     The worker's k-d tree queries run on one thread (``KD_WORKERS``): the pool already
-    runs one worker per job, and the distances do not depend on it.
+    runs one worker per job, and the distances do not depend on it. It ignores SIGINT:
+    Ctrl-C at a terminal reaches the whole process group, and the batch alone decides
+    what stops (it kills its workers, :func:`_kill_pool`).
     """
     import sys
-    import threading
 
     from camtool.verify import metrics
 
     metrics.KD_WORKERS = 1
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
     if sys.platform.startswith("linux"):
         import ctypes
-        import signal
 
         pr_set_pdeathsig = 1  # <linux/prctl.h>
         ctypes.CDLL(None, use_errno=True).prctl(pr_set_pdeathsig, signal.SIGKILL, 0, 0, 0)
@@ -741,30 +911,36 @@ def _worker_init(parent_pid: int) -> None:
     threading.Thread(target=watch, name="camtool-parent-watch", daemon=True).start()
 
 
-def _collect(future: Future[BatchRow], task: BatchTask) -> BatchRow:
-    """The row a worker returned, or an error row when the worker itself failed."""
+def _collect(future: Future[tuple[BatchRow, Files]], task: BatchTask) -> BatchRow:
+    """The row of a worker's file once its outputs are written here, or why they are not."""
     try:
-        return future.result()
+        row, files = future.result()
     except Exception as exc:  # e.g. a worker killed (BrokenProcessPool): that file's error
         return _error_row(task, 1, f"worker failed: {type(exc).__name__}: {exc}")
+    return _publish(task, row, files)
 
 
 def post_one(task: BatchTask, options: BatchOptions) -> BatchRow:
-    """Post (and verify, and draw) one file and write its outputs: the pool's worker.
+    """Post (and verify, and draw) one file and write its outputs.
 
     Never raises for the file's own problems: a :class:`CamtoolError` becomes an
     ``error`` row with its exit code, any other exception an ``error`` row with
     exit code 1 ("internal error").
     """
+    return _publish(task, *_posted(task, options))
+
+
+def _posted(task: BatchTask, options: BatchOptions) -> tuple[BatchRow, Files]:
+    """One file posted (and verified, and drawn), its outputs in memory: the pool's worker.
+
+    Touches no output; errors become rows as in :func:`post_one` (with no outputs).
+    """
     try:
-        row, files = _outputs(task, options, _post_job(task.file, _for(task, options)))
-        for path, data in files:
-            _write(path, data)
-        return row
+        return _outputs(task, options, _post_job(task.file, _for(task, options)))
     except CamtoolError as exc:
-        return _error_row(task, exc.exit_code, str(exc))
+        return _error_row(task, exc.exit_code, str(exc)), ()
     except Exception as exc:  # a bug on one file must not stop the batch
-        return _error_row(task, 1, f"internal error: {type(exc).__name__}: {exc}")
+        return _error_row(task, 1, f"internal error: {type(exc).__name__}: {exc}"), ()
 
 
 def post_data(
@@ -813,9 +989,7 @@ def _error_row(task: BatchTask, code: int, message: str) -> BatchRow:
     )
 
 
-def _outputs(
-    task: BatchTask, options: BatchOptions, job: PostJob
-) -> tuple[BatchRow, tuple[tuple[str, str | bytes], ...]]:
+def _outputs(task: BatchTask, options: BatchOptions, job: PostJob) -> tuple[BatchRow, Files]:
     """The row of a posted file and its outputs ``(path, data)``, verified and drawn as asked."""
     files: list[tuple[str, str | bytes]] = [(task.code_path, job.result.code)]
     if job.pieces:  # a target that cannot change tools: one program per tool
@@ -1055,6 +1229,24 @@ def message(row: BatchRow) -> str:
     """The first line of ``row``'s error, without a leading ``<file>: `` (shown beside it)."""
     first = row.error.splitlines()[0] if row.error else ""
     return first.removeprefix(f"{row.file}: ")
+
+
+def unwritten_lines(stop: BatchInterrupted) -> str:
+    """The files an interrupted batch did not post (the first :data:`SHOWN_UNWRITTEN` named).
+
+    ``not posted (stopped by SIGINT): 3 file(s)`` then one indented line per file
+    (``for <target>`` in a batch of several targets) and ``... and N more``; each line
+    ends with a newline. Empty when every file was posted.
+    """
+    if not stop.unwritten:
+        return ""
+    lines = [f"not posted (stopped by {stop.signal_name}): {len(stop.unwritten)} file(s)"]
+    for task in stop.unwritten[:SHOWN_UNWRITTEN]:
+        lines.append(f"  {task.file}" + (f" for {task.target}" if task.target else ""))
+    more = len(stop.unwritten) - SHOWN_UNWRITTEN
+    if more > 0:
+        lines.append(f"  ... and {more} more")
+    return "\n".join(lines) + "\n"
 
 
 def failure_line(result: BatchResult) -> str:

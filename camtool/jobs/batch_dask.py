@@ -25,7 +25,9 @@ from __future__ import annotations
 import contextlib
 import importlib.util
 import logging
+import os
 import queue
+import signal
 import time
 from collections import deque
 from collections.abc import Callable, Iterator
@@ -111,6 +113,10 @@ def connect(scheduler: str, *, most_workers: int | None = None) -> Iterator[Clie
     connects to a running scheduler and waits up to :data:`WORKER_WAIT_S` for a
     first worker.
 
+    A ``KeyboardInterrupt`` (Ctrl-C, or SIGTERM in a batch) inside the block kills
+    the local cluster's worker processes before it closes: closing it with its workers
+    busy waits seconds for their tasks, and what they post is not wanted any more.
+
     Raises:
         UsageError: ``scheduler`` is malformed, or Dask is not installed.
         CamtoolError: the scheduler does not answer, or no worker joins it.
@@ -132,7 +138,11 @@ def connect(scheduler: str, *, most_workers: int | None = None) -> Iterator[Clie
             ) as cluster,
             distributed.Client(cluster) as client,
         ):
-            yield client
+            try:
+                yield client
+            except KeyboardInterrupt:  # Ctrl-C or SIGTERM: stop now, not when the tasks end
+                _kill_workers(cluster)
+                raise
         return
     try:
         client = distributed.Client(scheduler, timeout=CONNECT_TIMEOUT_S)
@@ -150,6 +160,15 @@ def connect(scheduler: str, *, most_workers: int | None = None) -> Iterator[Clie
                 f"{WORKER_WAIT_S:g} s; start one with `dask worker {scheduler}`"
             ) from exc
         yield client
+
+
+def _kill_workers(cluster: Any) -> None:
+    """SIGKILL the worker processes of a local cluster's nannies (those still running)."""
+    for nanny in list(cluster.workers.values()):
+        pid = getattr(getattr(nanny, "process", None), "pid", None)
+        if pid is not None:
+            with contextlib.suppress(OSError):
+                os.kill(pid, signal.SIGKILL)
 
 
 def map_unordered(

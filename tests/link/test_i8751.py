@@ -31,6 +31,12 @@ SESSION = encode_stream(RECORDS)
 END = (12.0, 1.2, 0.0)
 
 
+SILENT_S = 5.0
+"""The response timeout of a test that waits it out, s: the simulator's thread must answer the
+packets before the silent one within it, and a loaded machine deschedules it for a good part of
+a second (0.3 s, the bound before, failed then)."""
+
+
 def plan_for(code: bytes, **options: Any) -> Any:
     plan = prepare_send(code, load_target("i8751"), source="job.bin", **options)
     return plan
@@ -129,7 +135,7 @@ def test_stop_at_a_pause_sends_whole_packets_and_from_line_finishes(simulate: An
 def test_a_packet_never_answered_stops_naming_it_and_from_line_continues(simulate: Any) -> None:
     sim = simulate("i8751", fail_at_block=2)
     with pytest.raises(LinkError) as info:
-        run(sim.path, timeout_s=0.3)
+        run(sim.path, timeout_s=SILENT_S)
     message = str(info.value)
     assert "block 2 (line 6) was sent and not confirmed" in message
     assert "--from-line 6" in message
@@ -148,8 +154,8 @@ def test_from_line_inside_a_packet_is_refused() -> None:
 
 def test_a_port_that_disappears_is_a_link_error(simulate: Any) -> None:
     sim = simulate("i8751", drop_at_block=2)
-    with pytest.raises(LinkError, match="disappeared"):
-        run(sim.path, timeout_s=1.0)
+    with pytest.raises(LinkError, match="disappeared"):  # noticed at once: the bound never runs out
+        run(sim.path, timeout_s=60.0)
 
 
 class InProcessPort:

@@ -8,6 +8,7 @@ links pace themselves by the timing model, which the verifier tests cover.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -26,6 +27,8 @@ VALCNC = (
     "G00Z5\nG00X5Y5\nG01Z-1\nG01X25Y5Z-1\nG01X25Y15Z-1\nG01X5Y15Z-1\nG01X5Y5Z-1\n"
     "G02X15Y5I5J0\nG03X5Y5I-5J0\nG00Z5\n"
 )
+PACED_S = 1e6
+"""A block time far longer than any test (11 days), s: the host waits on, whatever the load."""
 
 
 def send(path: str, name: str, code: str | bytes, **options: Any) -> Any:
@@ -91,8 +94,18 @@ def test_valcnc_pause_and_resume_never_split_a_block(simulate: Any) -> None:
 
 def test_valcnc_lost_port_then_from_line_ends_where_a_whole_run_ends(simulate: Any) -> None:
     sim = simulate("valcnc", drop_at_block=6)
-    with pytest.raises(LinkError, match="disappeared") as info:
-        send(sim.path, "valcnc", VALCNC, time_scale=1)  # paced: the port goes mid-job
+    # the port goes as block 6 arrives, while the host waits out block 6's time: that time
+    # is made far longer than the test (the others none), so the host notices the drop
+    # before it may write block 7 however slowly this machine runs the simulator's thread
+    # (paced by the real times, a loaded machine let the host write blocks 7-9 first)
+    plan = prepare_send(VALCNC, load_target("valcnc"))
+    times = [PACED_S if block.line == 6 else 0.0 for block in plan.blocks]
+    port = open_port(sim.path, plan.spec.baud)
+    try:
+        with pytest.raises(LinkError, match="disappeared") as info:
+            send_plan(port, replace(plan, block_time_s=times), port_name=sim.path)
+    finally:
+        port.close()
     assert "the last block sent was line 6" in str(info.value)
     assert "--from-line 6 if line 6 did not run" in str(info.value)
     # the simulator dropped the port as block 6 arrived: it did not run; resume there
