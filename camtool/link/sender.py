@@ -1145,11 +1145,20 @@ class _Driver:
                 if confirmed is not None and confirmed.index
                 else ""
             )
+            paced = (
+                "this link confirms nothing: camtool sent each block after the one before "
+                f"had its estimated time plus {self.spec.pace_margin:.0%}, so the lines "
+                f"before line {last.line} ran only if the machine kept that pace (a slower "
+                "machine may not have run them yet); "
+                if self.spec.flow == "timed"
+                else ""
+            )
             return (
                 f"{known}the last block sent was line {last.line} and camtool cannot know "
-                f"whether the blocks after the last confirmed one ran: look where the tool "
-                f"stands, then resume with --from-line {last.line} if line {last.line} did "
-                "not run, or with the line after it if it did"
+                f"whether the blocks after the last confirmed one ran; {paced}look where the "
+                f"tool stands, then resume with --from-line {last.line} if line {last.line} "
+                "did not run, or with the line after it if it did (an earlier line if the "
+                "tool stands before it)"
             )
         line = s.resume_line()
         return f"resume with --from-line {line}" if line else "every block had been sent"

@@ -108,6 +108,8 @@ def test_valcnc_lost_port_then_from_line_ends_where_a_whole_run_ends(simulate: A
         port.close()
     assert "the last block sent was line 6" in str(info.value)
     assert "--from-line 6 if line 6 did not run" in str(info.value)
+    # no answer on this link: the earlier lines ran only if the machine kept the paced time
+    assert "the lines before line 6 ran only if the machine kept that pace" in str(info.value)
     # the simulator dropped the port as block 6 arrived: it did not run; resume there
     resumed = simulate("valcnc")
     send(resumed.path, "valcnc", VALCNC, from_line=6)
