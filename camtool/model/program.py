@@ -37,7 +37,7 @@ from typing import Literal, TypeAlias
 from camtool.model.shapes import Arc, BBox, Line, Point, Segment, bbox_union, chord_count
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Rapid:
     """Rapid positioning to ``(x, y[, z])``, mm."""
 
@@ -47,7 +47,7 @@ class Rapid:
     contour: int = 0
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Linear:
     """Straight cut to ``(x, y[, z])`` at ``feed_mm_min`` (mm/min)."""
 
@@ -58,7 +58,7 @@ class Linear:
     contour: int = 0
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class ArcMove:
     """Circular cut to ``(x, y)`` around the absolute centre ``(cx, cy)``, mm.
 
