@@ -84,9 +84,7 @@ def open_gaps(contours: Sequence[Contour], options: PlanOptions) -> list[Finding
             ]
             least = sorted(least)[:MAX_REPORTED]
         offset += len(a)
-    out = [
-        _finding(contours, ends[ia], ends[ib], gap, options) for gap, _, ia, ib in least
-    ]
+    out = [_finding(contours, ends[ia], ends[ib], gap, options) for gap, _, ia, ib in least]
     if kept > MAX_REPORTED:
         out.append(
             Finding(

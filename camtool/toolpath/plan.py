@@ -313,10 +313,8 @@ def place_program(
     return program, placed, (dx, dy)
 
 
-def _placing(
-    box: BBox | None, placed: Drawing, options: PlanOptions, machine: Machine
-) -> Placing:
-    """How ``options`` placed a program of toolpath extent ``box``, and its margin over the drawing.
+def _placing(box: BBox | None, placed: Drawing, options: PlanOptions, machine: Machine) -> Placing:
+    """How ``options`` placed a program of toolpath extent ``box``; its margin over the drawing.
 
     The margin is read only by the ``--fit`` remedy of a toolpath larger than the travel
     (:func:`~camtool.toolpath.placement.too_large`), so it is measured only then (the

@@ -24,9 +24,7 @@ def _live_linears() -> int:
 def test_no_move_of_a_posted_program_outlives_it() -> None:
     from camtool.jobs.pipeline import post_drawing
 
-    lines = [
-        Contour((Line((0.5 * k, 0.0), (0.5 * k, 10.0 + k % 7)),), False) for k in range(300)
-    ]
+    lines = [Contour((Line((0.5 * k, 0.0), (0.5 * k, 10.0 + k % 7)),), False) for k in range(300)]
     drawing = Drawing(tuple(lines), "lines")
     target = load_target("grbl")
     before = _live_linears()
