@@ -87,7 +87,7 @@ from typing import cast
 from camtool.importers.gcode_codes import BlockWords, Notes, g_key
 from camtool.importers.gcode_lexer import Block, Word, cut_mid_word, lex_line
 from camtool.model.errors import InputError
-from camtool.model.plain import plain_fields
+from camtool.model.plain import slot_setters
 from camtool.model.program import (
     ArcMove,
     Command,
@@ -133,12 +133,24 @@ _PLAIN_G = {0.0: "G0", 1.0: "G1", 2.0: "G2", 3.0: "G3"}
 
 
 _new_move = object.__new__
+_RAPID_SET = slot_setters(Rapid)
+_LINEAR_SET = slot_setters(Linear)
+_ARC_SET = slot_setters(ArcMove)
 _FAST_MOVES = (
-    plain_fields(Rapid) == ("x", "y", "z", "contour")
-    and plain_fields(Linear) == ("x", "y", "feed_mm_min", "z", "contour")
-    and plain_fields(ArcMove) == ("x", "y", "cx", "cy", "clockwise", "feed_mm_min", "z", "contour")
+    _RAPID_SET is not None
+    and _LINEAR_SET is not None
+    and _ARC_SET is not None
+    and tuple(Rapid.__dataclass_fields__) == ("x", "y", "z", "contour")
+    and tuple(Linear.__dataclass_fields__) == ("x", "y", "feed_mm_min", "z", "contour")
+    and tuple(ArcMove.__dataclass_fields__)
+    == ("x", "y", "cx", "cy", "clockwise", "feed_mm_min", "z", "contour")
 )
 """Whether the plain reader makes its moves without their (frozen, slow) ``__init__``."""
+if _FAST_MOVES:
+    assert _RAPID_SET is not None and _LINEAR_SET is not None and _ARC_SET is not None
+    _RX, _RY, _RZ, _RC = _RAPID_SET
+    _LX, _LY, _LF, _LZ, _LC = _LINEAR_SET
+    _AX, _AY, _ACX, _ACY, _ACW, _AF, _AZ, _AC = _ARC_SET
 
 
 def _rapid(x: float, y: float, z: float | None, contour: int) -> Rapid:
@@ -146,8 +158,10 @@ def _rapid(x: float, y: float, z: float | None, contour: int) -> Rapid:
     if not _FAST_MOVES:
         return Rapid(x, y, z, contour)
     move = _new_move(Rapid)
-    d = move.__dict__
-    d["x"], d["y"], d["z"], d["contour"] = x, y, z, contour
+    _RX(move, x)
+    _RY(move, y)
+    _RZ(move, z)
+    _RC(move, contour)
     return move
 
 
@@ -156,8 +170,11 @@ def _linear(x: float, y: float, feed: float, z: float | None, contour: int) -> L
     if not _FAST_MOVES:
         return Linear(x, y, feed, z, contour)
     move = _new_move(Linear)
-    d = move.__dict__
-    d["x"], d["y"], d["feed_mm_min"], d["z"], d["contour"] = x, y, feed, z, contour
+    _LX(move, x)
+    _LY(move, y)
+    _LF(move, feed)
+    _LZ(move, z)
+    _LC(move, contour)
     return move
 
 
@@ -175,9 +192,14 @@ def _arc_move(
     if not _FAST_MOVES:
         return ArcMove(x, y, cx, cy, clockwise, feed, z, contour)
     move = _new_move(ArcMove)
-    d = move.__dict__
-    d["x"], d["y"], d["cx"], d["cy"] = x, y, cx, cy
-    d["clockwise"], d["feed_mm_min"], d["z"], d["contour"] = clockwise, feed, z, contour
+    _AX(move, x)
+    _AY(move, y)
+    _ACX(move, cx)
+    _ACY(move, cy)
+    _ACW(move, clockwise)
+    _AF(move, feed)
+    _AZ(move, z)
+    _AC(move, contour)
     return move
 
 

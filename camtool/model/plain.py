@@ -1,5 +1,9 @@
 """Plain frozen dataclasses: objects that may be built without their ``__init__``.
 
+Two kinds: dataclasses whose fields live in a ``__dict__`` (:func:`plain_fields`) and
+slotted ones (``slots=True``: no ``__dict__``, ~100 bytes less an object;
+:func:`slot_setters`).
+
 The planner and the G-code reader build moves and segments by the hundred thousand; a
 frozen dataclass's ``__init__`` stores each field through ``object.__setattr__``, which
 costs more than the rest of the work. For a *plain* one (the test below) an object whose
@@ -9,6 +13,9 @@ here once, at import, and fall back to the constructor otherwise.
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
 
 
 def plain_fields(cls: type) -> tuple[str, ...] | None:
@@ -44,3 +51,21 @@ def share_keys(cls: type, names: tuple[str, ...]) -> None:
     values = first.__dict__
     for name in names:
         values[name] = None
+
+
+def slot_setters(cls: type) -> tuple[Callable[[Any, Any], None], ...] | None:
+    """The setters of a slotted dataclass's fields, in order, when it is plain; else ``None``.
+
+    Plain here: a dataclass with ``__slots__`` (``slots=True``) holding exactly its fields,
+    its own generated ``__init__`` and no ``__post_init__``. ``object.__new__(cls)`` then each
+    setter called with the instance and a field's value, in order, makes the object its
+    ``__init__`` makes (equal, same hash, ``repr`` and pickle) without the frozen
+    ``__setattr__`` detour, which costs more than the rest of the work per move.
+    """
+    fields = getattr(cls, "__dataclass_fields__", None)
+    slots = vars(cls).get("__slots__")
+    if not fields or hasattr(cls, "__post_init__") or "__init__" not in vars(cls):
+        return None
+    if slots is None or tuple(slots) != tuple(fields):
+        return None
+    return tuple(vars(cls)[name].__set__ for name in fields)

@@ -34,10 +34,10 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Literal, TypeAlias
 
-from camtool.model.shapes import Arc, BBox, Line, Point, Segment, bbox_union, chord_count
+from camtool.model.shapes import Arc, BBox, Line, Point, Segment, chord_count
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Rapid:
     """Rapid positioning to ``(x, y[, z])``, mm."""
 
@@ -47,7 +47,7 @@ class Rapid:
     contour: int = 0
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Linear:
     """Straight cut to ``(x, y[, z])`` at ``feed_mm_min`` (mm/min)."""
 
@@ -58,7 +58,7 @@ class Linear:
     contour: int = 0
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class ArcMove:
     """Circular cut to ``(x, y)`` around the absolute centre ``(cx, cy)``, mm.
 
@@ -376,15 +376,31 @@ class Program:
     def bbox(self, *, cutting_only: bool = False) -> BBox:
         """Bounding box of the XY path (arcs by their extremes), mm.
 
+        One pass over the moves (no list of their boxes): a program may hold millions.
+
         Raises:
             ValueError: the program has no moves.
         """
-        boxes = [
-            seg.bbox()
-            for move, seg in self.segments()
-            if not (cutting_only and isinstance(move, Rapid))
-        ]
-        return bbox_union(boxes)
+        box: list[float] | None = None
+        for move, seg in self.segments():
+            if cutting_only and isinstance(move, Rapid):
+                continue
+            b = seg.bbox()
+            if box is None:
+                box = list(b)
+                continue
+            # strict comparisons keep the first of equal values, as min() and max() do
+            if b[0] < box[0]:
+                box[0] = b[0]
+            if b[1] < box[1]:
+                box[1] = b[1]
+            if b[2] > box[2]:
+                box[2] = b[2]
+            if b[3] > box[3]:
+                box[3] = b[3]
+        if box is None:
+            raise ValueError("bbox of nothing")
+        return (box[0], box[1], box[2], box[3])
 
     def path_lengths(self) -> list[float]:
         """The length of each move's path, Z included, mm (``len(moves)`` values).
@@ -407,12 +423,18 @@ class Program:
         return sum(seg.length for move, seg in self.segments() if not isinstance(move, Rapid))
 
     def cutting_time_s(self) -> float:
-        """Time of the cutting moves at their programmed feeds, Z included, s (no rapids)."""
+        """Time of the cutting moves at their programmed feeds, Z included, s (no rapids).
+
+        Each move's length as :meth:`path_lengths` gives it, in one pass (no list of them).
+        """
         total = 0.0
-        for move, length in zip(self.moves, self.path_lengths(), strict=True):
+        z = 0.0
+        for move, seg in self.segments():
+            dz = 0.0 if move.z is None else move.z - z
+            z = move.z if move.z is not None else z
             if isinstance(move, Rapid) or move.feed_mm_min <= 0:
                 continue
-            total += length / move.feed_mm_min * 60.0
+            total += math.hypot(seg.length, dz) / move.feed_mm_min * 60.0
         return total
 
 

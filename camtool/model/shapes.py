@@ -11,6 +11,7 @@ Conventions:
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field, fields
@@ -222,6 +223,16 @@ class Arc:
         """Arc length in mm (computed once)."""
         return abs(self.sweep) * self.radius
 
+    @cached_property
+    def axis_signs(self) -> tuple[tuple[int, ...], tuple[int, ...]]:
+        """Successive directions (+1/-1) in which the arc moves X, and Y (computed once).
+
+        X turns at the circle's left and right extremes, Y at its top and bottom; the
+        first direction is the tangent's at the start (just after it at an extreme).
+        Equal pairs are one shared tuple (:func:`_shared_signs`): read them, never change them.
+        """
+        return _shared_signs((arc_axis_signs(self, 0.0), arc_axis_signs(self, math.pi / 2)))
+
     def point_at(self, fraction: float) -> Point:
         """The point a ``fraction`` (0…1) of the way along the arc."""
         a = self.start_angle + self.sweep * fraction
@@ -360,6 +371,45 @@ _PLAIN_SEGMENTS = plain_fields(Line) == ("start", "end") and plain_fields(Arc) =
 (:func:`camtool.model.plain.plain_fields`)."""
 
 
+_SIGN_EPS = 1e-9
+"""Turning points closer than this (rad) to an arc's ends do not count."""
+
+
+def arc_axis_signs(arc: Arc, phase: float) -> tuple[int, ...]:
+    """Directions (+1/-1) of one axis along ``arc``: X for ``phase`` 0, Y for π/2.
+
+    The coordinate is ``c + r·cos(θ - phase)``; it turns where ``θ = phase + kπ``.
+    """
+    a0, sweep = arc.start_angle, arc.sweep
+    s = 1.0 if sweep > 0 else -1.0
+    total = abs(sweep)
+    turns = sorted(
+        d
+        for q in (phase, phase + math.pi)
+        for d in ((s * (q - a0)) % TAU,)
+        if _SIGN_EPS < d < total - _SIGN_EPS
+    )
+    bounds = [0.0, *turns, total]
+    out = []
+    for k in range(len(bounds) - 1):
+        theta = a0 + s * (bounds[k] + bounds[k + 1]) / 2
+        v = -s * math.sin(theta - phase)  # d/dt of cos(θ - phase) with dθ/dt = s
+        out.append(1 if v > 0 else -1)
+    return tuple(out)
+
+
+@functools.lru_cache(maxsize=256)
+def _shared_signs(
+    pair: tuple[tuple[int, ...], tuple[int, ...]],
+) -> tuple[tuple[int, ...], tuple[int, ...]]:
+    """``pair`` itself, the first time an equal pair is seen: arcs share one each.
+
+    An arc's X and Y each turn at most three times, so there are a few dozen distinct
+    pairs; the cache holds small tuples of ints, never a segment.
+    """
+    return pair
+
+
 def _kept(cls: type) -> tuple[str, ...]:
     """The names of ``cls``'s fields, in order, then of its :class:`cached_property` values."""
     cached = tuple(n for n, v in vars(cls).items() if isinstance(v, cached_property))
@@ -367,7 +417,7 @@ def _kept(cls: type) -> tuple[str, ...]:
 
 
 share_keys(Line, _kept(Line))
-share_keys(Arc, (*_kept(Arc), "_axis_signs"))  # toolpath.reversals keeps an arc's signs on it
+share_keys(Arc, _kept(Arc))
 
 
 @dataclass(frozen=True)

@@ -57,28 +57,39 @@ def open_gaps(contours: Sequence[Contour], options: PlanOptions) -> list[Finding
     joint = joint_distance(options.chain_tolerance)
     near = max(0.1, NEAR_GAP_FACTOR * joint)
     xy = np.array([p for _, p in ends], dtype=np.float64)
+    owner = np.array([index for index, _ in ends])
     points = shapely.points(xy)
     tree = shapely.STRtree(points)
-    a, b = tree.query(points, predicate="dwithin", distance=near)
-    a, b = a[a < b], b[a < b]  # each pair once, in the order the tree gives them
-    exact = _Exact(xy, a, b)
-    keep = exact.above(np.arange(len(a)), joint)
-    owner = np.array([index for index, _ in ends])
-    for k in np.flatnonzero(keep & (owner[a] == owner[b])):  # a contour's own two ends
-        share = GAP_SHARE * contours[owner[a[k]]].length
-        keep[k] = not exact.above(np.array([k]), share, inclusive=True)[0]  # a "C": drawn
-        # open on purpose (close_gaps leaves it too)
-    kept = np.flatnonzero(keep)  # the near gaps, in the order the tree gives them
-    out = [
-        _finding(contours, ends[a[k]], ends[b[k]], exact.gap(k), options)
-        for k in exact.smallest(kept, MAX_REPORTED)
-    ]
-    if len(kept) > MAX_REPORTED:
-        largest = exact.largest(kept)
+    least: list[tuple[float, int, int, int]] = []  # (gap, pair number, a, b)
+    kept, largest, offset = 0, 0.0, 0
+    for lo in range(0, len(points), _QUERY_CHUNK):
+        # the pairs of a run of ends at a time: all of them at once are ~100 bytes a pair,
+        # and a dense drawing has tens of near ends per end
+        a, b = tree.query(points[lo : lo + _QUERY_CHUNK], predicate="dwithin", distance=near)
+        a = a + lo
+        a, b = a[a < b], b[a < b]  # each pair once, in the order the tree gives them
+        exact = _Exact(xy, a, b)
+        keep = exact.above(np.arange(len(a)), joint)
+        for k in np.flatnonzero(keep & (owner[a] == owner[b])):  # a contour's own two ends
+            share = GAP_SHARE * contours[owner[a[k]]].length
+            keep[k] = not exact.above(np.array([k]), share, inclusive=True)[0]  # a "C": drawn
+            # open on purpose (close_gaps leaves it too)
+        near_gaps = np.flatnonzero(keep)  # the near gaps, in the order the tree gives them
+        if len(near_gaps):
+            kept += len(near_gaps)
+            largest = max(largest, exact.largest(near_gaps))
+            least += [
+                (exact.gap(k), offset + k, int(a[k]), int(b[k]))
+                for k in exact.smallest(near_gaps, MAX_REPORTED)
+            ]
+            least = sorted(least)[:MAX_REPORTED]
+        offset += len(a)
+    out = [_finding(contours, ends[ia], ends[ib], gap, options) for gap, _, ia, ib in least]
+    if kept > MAX_REPORTED:
         out.append(
             Finding(
                 "open-gap",
-                f"{len(kept) - MAX_REPORTED} more open end(s) lie near another (gaps up to "
+                f"{kept - MAX_REPORTED} more open end(s) lie near another (gaps up to "
                 f"{fmt_num(largest, 4)} mm); --chain-tolerance {_option_value(largest)} joins "
                 "them all",
                 value=largest,
@@ -135,6 +146,8 @@ class _Exact:
         return max(self.gap(int(k)) for k in maybe)
 
 
+_QUERY_CHUNK = 8192
+"""Ends whose near pairs :func:`open_gaps` looks for at a time (bounds its arrays)."""
 _MARGIN = 1e-9
 """Relative band around a limit within which the exact gap decides (an ulp is ~2e-16)."""
 

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from camtool.model.errors import DialectError
-from camtool.model.plain import plain_fields
+from camtool.model.plain import slot_setters
 from camtool.model.program import (
     ArcMove,
     DrillCycle,
@@ -59,24 +59,10 @@ def toolpath_extent(program: Program) -> BBox | None:
     Arcs count by their extremes. A program without cuts: the ends of its rapids
     but those that stay at the start position.
 
-    The last result is kept: planning, placement and the writer's checks ask it of one
-    program (or of copies sharing its moves and origin) several times; a hit needs the
-    very same ``moves`` and ``origin`` objects, so the box is the one computed for them.
-
     Returns:
         ``(xmin, ymin, xmax, ymax)``, mm; ``None`` for a program with nothing to place.
     """
-    moves, origin = program.moves, program.origin
-    last = _LAST_EXTENT[0]
-    if last is not None and last[0] is moves and last[1] is origin:
-        return last[2]
-    box = _extent(program)
-    _LAST_EXTENT[0] = (moves, origin, box)
-    return box
-
-
-_LAST_EXTENT: list[tuple[tuple[Move, ...], Point, BBox | None] | None] = [None]
-"""``(moves, origin, box)`` of the last :func:`toolpath_extent` (one slot, read atomically)."""
+    return _extent(program)
 
 
 def _extent(program: Program) -> BBox | None:
@@ -232,31 +218,34 @@ def _at_start(program: Program) -> int:
     return k
 
 
-_PLAIN_MOVES = {cls: len(f) for cls in (Rapid, Linear, ArcMove) if (f := plain_fields(cls))}
-"""Move classes :func:`_shifted` may copy by their ``__dict__``, with their field counts."""
+_SLOTTED = {
+    cls: tuple(zip(cls.__dataclass_fields__, setters, strict=True))
+    for cls in (Rapid, Linear, ArcMove)
+    if (setters := slot_setters(cls))
+}
+"""Move classes :func:`_shifted` may build field by field: each field's name and setter."""
 _new = object.__new__
 
 
 def _shifted(move: Move, dx: float, dy: float) -> Move:
     """``move`` moved by ``(dx, dy)``: :func:`_shifted_slow`'s object, made faster.
 
-    A plain move whose ``__dict__`` holds just its fields is copied key by key, with
-    ``x``, ``y`` (and an arc's ``cx``, ``cy``) shifted: for a move its ``__init__`` made,
-    the same keys in the same order as ``dataclasses.replace`` stores, so equal, with the
-    same hash, ``repr`` and pickle. Anything else goes through :func:`_shifted_slow`.
+    A plain slotted move (:func:`~camtool.model.plain.slot_setters`) is copied field by
+    field, with ``x``, ``y`` (and an arc's ``cx``, ``cy``) shifted: the fields
+    ``dataclasses.replace`` gives, so equal, with the same hash, ``repr`` and pickle.
+    Anything else goes through :func:`_shifted_slow`.
     """
-    cls = type(move)
-    d = move.__dict__
-    if _PLAIN_MOVES.get(cls) != len(d):
+    spec = _SLOTTED.get(type(move))
+    if spec is None:
         return _shifted_slow(move, dx, dy)
-    new = _new(cls)
-    nd = new.__dict__
-    nd.update(d)
-    nd["x"] = d["x"] + dx
-    nd["y"] = d["y"] + dy
-    if cls is ArcMove:
-        nd["cx"] = d["cx"] + dx
-        nd["cy"] = d["cy"] + dy
+    new = _new(type(move))
+    for name, put in spec:
+        value = getattr(move, name)
+        if name == "x" or name == "cx":
+            value += dx
+        elif name == "y" or name == "cy":
+            value += dy
+        put(new, value)
     return new
 
 
@@ -319,7 +308,17 @@ def check_travel(
             coordinates) reaches outside the work area; the message gives both sizes
             and a remedy.
     """
-    box = toolpath_extent(program)
+    return check_extent(toolpath_extent(program), machine, placing)
+
+
+def check_extent(box: BBox | None, machine: Machine, placing: Placing | None) -> tuple[str, ...]:
+    """:func:`check_travel` of a program whose :func:`toolpath_extent` is ``box``.
+
+    For a caller that has the box already (one walk of the moves, not one per check).
+
+    Raises:
+        DialectError: as :func:`check_travel`.
+    """
     if box is None:
         return ()
     too_large(box, machine, placing)

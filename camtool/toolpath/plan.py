@@ -31,7 +31,7 @@ from camtool.geometry.chain import chain, joint_distance
 from camtool.model.errors import InputError
 from camtool.model.program import Move, Program, Rapid
 from camtool.model.progress import Progress, no_progress
-from camtool.model.shapes import Contour, Drawing, Line, Point, Segment, fit_factor
+from camtool.model.shapes import BBox, Contour, Drawing, Line, Point, Segment, fit_factor
 from camtool.toolpath.chain import close_gaps
 from camtool.toolpath.cuts import Finding, Stage
 from camtool.toolpath.gaps import open_gaps
@@ -39,7 +39,7 @@ from camtool.toolpath.options import OFFSET_MODES, PlanOptions
 from camtool.toolpath.order import Ordering, nesting, order_cuts
 from camtool.toolpath.placement import (
     Placing,
-    check_travel,
+    check_extent,
     larger_than_travel,
     placement_shift,
     shift_program,
@@ -306,21 +306,21 @@ def place_program(
     if dx or dy:
         placed = placed.transformed(1.0, dx, dy)
     if machine is not None:
-        said = check_travel(program, machine, _placing(program, placed, options, machine))
+        box = toolpath_extent(program)
+        said = check_extent(box, machine, _placing(box, placed, options, machine))
         if said:
             program = dataclasses.replace(program, warnings=(*program.warnings, *said))
     return program, placed, (dx, dy)
 
 
-def _placing(program: Program, placed: Drawing, options: PlanOptions, machine: Machine) -> Placing:
-    """How ``options`` placed ``program``, and its toolpath's margin over the drawing.
+def _placing(box: BBox | None, placed: Drawing, options: PlanOptions, machine: Machine) -> Placing:
+    """How ``options`` placed a program of toolpath extent ``box``; its margin over the drawing.
 
     The margin is read only by the ``--fit`` remedy of a toolpath larger than the travel
     (:func:`~camtool.toolpath.placement.too_large`), so it is measured only then (the
     placed drawing's box walks every segment); otherwise it is left at ``(0, 0)``.
     """
     margin = (0.0, 0.0)
-    box = toolpath_extent(program)
     if box is not None and placed.contours and larger_than_travel(box, machine):
         d = placed.bbox()
         margin = ((box[2] - box[0]) - (d[2] - d[0]), (box[3] - box[1]) - (d[3] - d[1]))

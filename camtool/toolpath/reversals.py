@@ -31,14 +31,13 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from camtool.model.shapes import TAU, Arc, Line, Point, Segment
+from camtool.model.shapes import Arc, Line, Point, Segment, arc_axis_signs
 from camtool.toolpath.cuts import Cut
 from camtool.toolpath.travel import Step, ends, oriented, rapid_mm, travel_order
 
 MOVE_EPS_MM = 1e-9
 """A line moving an axis by less than this does not move it."""
 
-_ANGLE_EPS = 1e-9
 IMPROVE_MAX_CUTS = 40
 """Neighbour swaps (each re-running the variant choice) only up to this many cuts."""
 IMPROVE_PASSES = 4
@@ -50,18 +49,12 @@ _TRAVEL_PER_REVERSAL_MM = 1e6
 def segment_signs(seg: Segment) -> tuple[Sequence[int], Sequence[int]]:
     """Successive directions (+1/-1) in which ``seg`` moves X and Y (see the module).
 
-    An arc's are computed once (:func:`_arc_signs`) and kept on it (in its ``__dict__``,
-    as its cached properties are: no field, so equality, hash and ``repr`` ignore them;
-    they depend on its fields only), as shared tuples: callers read them, never change them.
+    An arc's are its :attr:`~camtool.model.shapes.Arc.axis_signs` (computed once, shared
+    tuples): callers read them, never change them.
     """
     if isinstance(seg, Line):
         return _line_signs(seg.end[0] - seg.start[0], seg.end[1] - seg.start[1])
-    kept = seg.__dict__.get("_axis_signs")
-    if kept is None:
-        pair = (tuple(_arc_signs(seg, 0.0)), tuple(_arc_signs(seg, math.pi / 2)))
-        kept = _SIGN_PAIRS.setdefault(pair, pair)  # a few dozen distinct pairs: one each
-        seg.__dict__["_axis_signs"] = kept
-    return kept
+    return seg.axis_signs
 
 
 def _line_signs(dx: float, dy: float) -> tuple[list[int], list[int]]:
@@ -71,36 +64,13 @@ def _line_signs(dx: float, dy: float) -> tuple[list[int], list[int]]:
     )
 
 
-_SIGN_PAIRS: dict[tuple[tuple[int, ...], tuple[int, ...]], tuple[tuple[int, ...], tuple[int, ...]]]
-_SIGN_PAIRS = {}
-"""Every distinct ``(x signs, y signs)`` of an arc, so that arcs share one tuple each."""
-
-
 def _sign(v: float) -> int:
     return 1 if v > 0 else -1
 
 
 def _arc_signs(arc: Arc, phase: float) -> list[int]:
-    """Directions of one axis along ``arc``: X for ``phase`` 0, Y for π/2.
-
-    The coordinate is ``c + r·cos(θ - phase)``; it turns where ``θ = phase + kπ``.
-    """
-    a0, sweep = arc.start_angle, arc.sweep
-    s = 1.0 if sweep > 0 else -1.0
-    total = abs(sweep)
-    turns = sorted(
-        d
-        for q in (phase, phase + math.pi)
-        for d in ((s * (q - a0)) % TAU,)
-        if _ANGLE_EPS < d < total - _ANGLE_EPS
-    )
-    bounds = [0.0, *turns, total]
-    out: list[int] = []
-    for lo, hi in itertools.pairwise(bounds):
-        theta = a0 + s * (lo + hi) / 2
-        v = -s * math.sin(theta - phase)  # d/dt of cos(θ - phase) with dθ/dt = s
-        out.append(_sign(v))
-    return out
+    """Directions of one axis along ``arc``: X for ``phase`` 0, Y for π/2 (computed afresh)."""
+    return list(arc_axis_signs(arc, phase))
 
 
 def _path_signs(segments: Sequence[Segment]) -> tuple[list[tuple[int, int]], list[tuple[int, int]]]:

@@ -502,8 +502,8 @@ def rechoose_starts(
 
 TWO_OPT_WINDOW = 32
 """Longest run (in cuts) a windowed 2-opt move may reverse."""
-_CHUNK = 32768
-"""Positions evaluated together in a windowed 2-opt sweep (bounds memory to ~50 MB)."""
+_CHUNK = 4096
+"""Positions evaluated together in a windowed 2-opt sweep (its arrays: ~13 MB at a time)."""
 MIN_SWEEP_GAIN = 1e-3
 """A sweep that shortens the rapids by less than this share ends the improvement."""
 

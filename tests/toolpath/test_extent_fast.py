@@ -6,6 +6,7 @@ give the same four floats (compared by ``repr``: the sign of a zero too) or leav
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -84,7 +85,7 @@ def test_zero_sides_kept_only_when_they_are_the_slow_union(seed: int) -> None:
         if rng.random() < 0.2:  # a -0.0 somewhere: the order decides, so it must decline
             k = int(rng.integers(0, len(shifted)))
             m = shifted[k]
-            shifted[k] = type(m)(**{**m.__dict__, "x": -0.0})
+            shifted[k] = dataclasses.replace(m, x=-0.0)
         slow = placement._extent_slow(here, shifted)
         fast = placement._extent_fast(here, shifted, zero_sides=True)
         if fast is not None:
