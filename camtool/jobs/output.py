@@ -169,7 +169,6 @@ class Staged:
         Raises:
             CamtoolError: the temporary cannot be written, naming ``path`` and why.
         """
-        payload = data.encode("utf-8") if isinstance(data, str) else data
         try:
             st: os.stat_result | None = os.stat(path)
         except FileNotFoundError:
@@ -179,7 +178,7 @@ class Staged:
         if st is not None and stat.S_ISDIR(st.st_mode):
             raise CamtoolError(f"{path}: cannot write (is a directory)")
         if st is not None and not stat.S_ISREG(st.st_mode):
-            self._through.append((path, payload))
+            self._through.append((path, data.encode("utf-8") if isinstance(data, str) else data))
             return
         target = Path(os.path.realpath(path))
         tmp = temp_path(target)
@@ -189,9 +188,7 @@ class Staged:
             try:
                 if st is not None:
                     os.fchmod(fd, stat.S_IMODE(st.st_mode))
-                view = memoryview(payload)
-                while view:
-                    view = view[os.write(fd, view) :]
+                _write_all(fd, data)
                 os.fsync(fd)
             finally:
                 os.close(fd)
@@ -299,7 +296,6 @@ def write_atomic(path: str | Path, data: str | bytes) -> None:
             or the write fails (``ENOSPC`` on a full disk or ``/dev/full``); a
             temporary file is removed again.
     """
-    payload = data.encode("utf-8") if isinstance(data, str) else data
     try:
         st: os.stat_result | None = os.stat(path)
     except FileNotFoundError:
@@ -307,10 +303,10 @@ def write_atomic(path: str | Path, data: str | bytes) -> None:
     if st is not None and stat.S_ISDIR(st.st_mode):
         raise IsADirectoryError(errno.EISDIR, "is a directory", str(path))
     if st is not None and not stat.S_ISREG(st.st_mode):
-        _write_through(path, payload)
+        _write_through(path, data.encode("utf-8") if isinstance(data, str) else data)
         return
     mode = stat.S_IMODE(st.st_mode) if st is not None else None
-    _replace(Path(os.path.realpath(path)), payload, mode)
+    _replace(Path(os.path.realpath(path)), data, mode)
 
 
 def _write_through(path: str | Path, payload: bytes) -> None:
@@ -324,17 +320,37 @@ def _write_through(path: str | Path, payload: bytes) -> None:
         os.close(fd)
 
 
-def _replace(target: Path, payload: bytes, mode: int | None) -> None:
-    """Write ``payload`` to a temporary file beside ``target`` and rename it over it."""
+def _write_all(fd: int, data: str | bytes) -> None:
+    """All of ``data`` to ``fd``; text encoded as UTF-8 a slice at a time.
+
+    A slice of :data:`ENCODE_CHARS` characters is encoded, written and dropped, so a
+    program's text is never held a second time as one whole ``bytes`` (the encoding of
+    the slices joined is the encoding of the whole: UTF-8 encodes each character alone).
+    """
+    if isinstance(data, bytes):
+        view = memoryview(data)
+        while view:
+            view = view[os.write(fd, view) :]
+        return
+    for start in range(0, len(data), ENCODE_CHARS):
+        view = memoryview(data[start : start + ENCODE_CHARS].encode("utf-8"))
+        while view:
+            view = view[os.write(fd, view) :]
+
+
+ENCODE_CHARS = 1 << 20
+"""Characters of text encoded at a time when a file is written (:func:`_write_all`)."""
+
+
+def _replace(target: Path, data: str | bytes, mode: int | None) -> None:
+    """Write ``data`` to a temporary file beside ``target`` and rename it over it."""
     tmp = temp_path(target)
     fd = _create(tmp)
     try:
         try:
             if mode is not None:
                 os.fchmod(fd, mode)
-            view = memoryview(payload)
-            while view:
-                view = view[os.write(fd, view) :]
+            _write_all(fd, data)
             os.fsync(fd)
         finally:
             os.close(fd)

@@ -237,3 +237,37 @@ def test_the_lock_of_a_killed_run_is_taken_over(tmp_path: Path) -> None:
     assert proc.returncode == -9 and (folder / LOCK_NAME).exists()
     with lock_directory(folder):
         assert (folder / LOCK_NAME).read_text() == f"{os.getpid()}\n"
+
+
+def test_text_is_written_in_slices_byte_for_byte(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import camtool.jobs.output as output
+
+    # slices of 7 characters cut through the two- and three-byte UTF-8 characters
+    monkeypatch.setattr(output, "ENCODE_CHARS", 7)
+    text = "(é)\nG1 X1.000 (ø…)\n" * 50
+    for name, write in (("atomic.ngc", write_atomic), ("staged.ngc", None)):
+        path = tmp_path / name
+        if write is not None:
+            write(path, text)
+        else:
+            staged = output.Staged()
+            staged.stage(path, text)
+            staged.publish()
+        assert path.read_bytes() == text.encode("utf-8")
+
+
+def test_writing_a_long_program_holds_no_second_whole_copy(tmp_path: Path) -> None:
+    import tracemalloc
+
+    text = "G1 X1.000 Y2.000\n" * 500_000  # 8.5 MB
+    tracemalloc.start()
+    try:
+        write_atomic(tmp_path / "big.ngc", text)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    # one slice and its bytes at a time (~2 MiB), not the whole text encoded again
+    assert peak < len(text) // 2, peak
+    assert (tmp_path / "big.ngc").stat().st_size == len(text)
