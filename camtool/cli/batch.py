@@ -112,15 +112,8 @@ def batch(inputs: tuple[str, ...], layers: str | None, verify_too: bool, **optio
     Ctrl-C or SIGTERM stops it at once, keeping the files finished, with a summary of what
     was and was not written (exit code 130, 143 for SIGTERM).
     """
-    from camtool.jobs.batch import (
-        BatchInterrupted,
-        BatchOptions,
-        batch_report,
-        failure_line,
-        plan_batch,
-        summary_table,
-        unwritten_lines,
-    )
+    from camtool.jobs.batch import BatchInterrupted, BatchOptions, plan_batch
+    from camtool.jobs.batch_report import batch_report, failure_line, summary_table, unwritten_lines
 
     names = tuple(n.strip() for n in layers.split(",") if n.strip()) if layers else None
     planning, output = plan_settings(options), output_settings(options)
@@ -147,7 +140,8 @@ def batch(inputs: tuple[str, ...], layers: str | None, verify_too: bool, **optio
 
 def _run(plan: BatchPlan) -> BatchResult:
     """Run the batch with progress on stderr: a bar on a terminal, else a line per file."""
-    from camtool.jobs.batch import progress_line, run_batch
+    from camtool.jobs.batch import run_batch
+    from camtool.jobs.batch_report import progress_line
 
     if not sys.stderr.isatty():
         return run_batch(

@@ -45,33 +45,9 @@ but the predicted error is over ``max_error_um``). So 4 means "everything
 posted; only the accuracy limit failed", 3 "some inputs are bad and nothing
 worse happened".
 
-What a batch tells (:func:`batch_report`, :func:`summary_table`, :func:`progress_line`,
-:func:`failure_line`) are pure functions returning data or text; this module never
-prints (progress goes through a callback) and the CLI decides where they go.
-
-The report (``camtool batch --report batch.json``), keys other tools may read:
-
-- ``camtool``: the version; ``exit_code``: the batch's (:func:`batch_exit_code`);
-- ``options``: every option that shapes the outputs (``target`` — a list of
-  names with several targets —, ``output_dir``,
-  ``machine_file``, ``offset``, ``tool_diameter``, ``feed_mm_min``, ``tolerance``,
-  ``scale``, ``fit``, ``fmt``, ``spindle_rpm``, ``layers``, ``units``,
-  ``hatch_boundaries``, ``verify`` (true also when implied by ``preview`` or
-  ``max_error_um``), ``preview``, ``max_error_um``) and ``scheduler`` (``null``:
-  this machine's processes; else the ``--scheduler`` given or the address of the
-  client passed in) — not ``jobs``, ``force`` or ``report``, so ``--jobs 1`` and
-  ``--jobs 8`` give the same report;
-- ``files``: one object per file, in input order (with several targets, target
-  by target, and each names its ``target`` after ``file``): ``file``, ``status``
-  (``ok``, ``error``, ``over-limit``), ``exit_code``, ``blocks``, ``max_error_um``,
-  ``time_s``, ``verified``, ``outputs`` {``code``, ``report``, ``preview``} (paths
-  written, ``null`` when not), ``warnings`` (list), ``error`` ("" when ok);
-- ``totals``: ``files``, ``ok``, ``error``, ``over_limit``, ``blocks``, ``time_s``
-  (sums over the files that posted), ``max_error_um`` (the worst verified file,
-  ``null`` when none was verified).
-
-Numbers are rounded (µm to 4 decimals, s to 3) and nothing depends on the clock
-or the order files finished in, so the same batch gives the same bytes.
+What a batch tells — its JSON report, summary table and progress lines — is
+:mod:`camtool.jobs.batch_report`; this module never prints (progress goes through a
+callback).
 """
 
 from __future__ import annotations
@@ -81,18 +57,20 @@ import dataclasses
 import json
 import os
 import signal
-import threading
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from camtool.importers.options import ImportOptions
+from camtool.jobs.batch_report import batch_report
+from camtool.jobs.batch_report import summary_table as summary_table  # camtool.batch API
+from camtool.jobs.batch_stop import Interrupts, Terminated, kill_pool, worker_init
 from camtool.jobs.inputs import BatchInput, expand_inputs
 from camtool.jobs.pipeline import OutputOptions
 from camtool.model.errors import CamtoolError, InputError, UsageError
 from camtool.model.version import __version__
-from camtool.toolpath.options import PLAN_FIELDS, PlanOptions
+from camtool.toolpath.options import PlanOptions
 
 if TYPE_CHECKING:
     from concurrent.futures import Future
@@ -108,8 +86,6 @@ STATUSES = ("ok", "error", "over-limit")
 """Values of :attr:`BatchRow.status`."""
 SHOWN_EXISTING = 5
 """Existing outputs named in the refusal to overwrite (the rest are counted)."""
-SHOWN_UNWRITTEN = 10
-"""Files not posted named in an interrupted batch's summary (the rest are counted)."""
 
 Progress = Callable[[int, int, "BatchRow"], None]
 """``progress(done, total, row)``: called in the calling process as each file finishes."""
@@ -326,10 +302,6 @@ class BatchResult:
         return batch_exit_code(self.rows)
 
 
-class Terminated(KeyboardInterrupt):
-    """SIGTERM, raised as Ctrl-C is, so that a batch stops the same way (:class:`Interrupts`)."""
-
-
 class BatchInterrupted(CamtoolError):
     """A batch stopped by Ctrl-C (SIGINT) or SIGTERM before every file was posted.
 
@@ -358,61 +330,6 @@ class BatchInterrupted(CamtoolError):
             "posted (nothing of them written)"
             + ("; the batch report is not written" if reported else "")
         )
-
-
-class Interrupts:
-    """Ctrl-C (SIGINT) and SIGTERM while a batch runs: the first one stops it, cleanly.
-
-    Inside the block (in the main thread) the first of these signals raises
-    ``KeyboardInterrupt`` (:class:`Terminated` for SIGTERM) — at once, or, inside
-    :meth:`held`, at its end, so that a file being written is written whole and
-    recorded. Signals that follow are ignored: the batch is already stopping
-    (killing its workers, releasing its output folder), and a second Ctrl-C must not
-    cut that short. Only a signal whose handler is Python's default is taken over
-    (SIGINT raising ``KeyboardInterrupt``, SIGTERM ending the process): one ignored
-    (``nohup``) or handled by the caller is left alone. The handlers are restored at
-    the end; outside the main thread nothing changes.
-    """
-
-    def __init__(self) -> None:
-        self.signum: int | None = None
-        self._holding = False
-        self._previous: dict[int, Any] = {}
-
-    def __enter__(self) -> Interrupts:
-        if threading.current_thread() is threading.main_thread():
-            defaults = {signal.SIGINT: signal.default_int_handler, signal.SIGTERM: signal.SIG_DFL}
-            for signum, default in defaults.items():
-                if signal.getsignal(signum) == default:
-                    self._previous[signum] = signal.signal(signum, self._handle)
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        for signum, handler in self._previous.items():
-            signal.signal(signum, handler)
-        self._previous = {}
-
-    def _handle(self, signum: int, frame: object) -> None:
-        if self.signum is not None:  # stopping already
-            return
-        self.signum = signum
-        if not self._holding:
-            raise self.exception()
-
-    def exception(self) -> KeyboardInterrupt:
-        """The exception the signal received stands for."""
-        return Terminated() if self.signum == signal.SIGTERM else KeyboardInterrupt()
-
-    @contextlib.contextmanager
-    def held(self) -> Iterator[None]:
-        """A signal arriving inside the block is raised at its end (no later)."""
-        self._holding = True
-        try:
-            yield
-        finally:
-            self._holding = False
-        if self.signum is not None:
-            raise self.exception()
 
 
 def batch_exit_code(rows: Sequence[BatchRow]) -> int:
@@ -828,14 +745,14 @@ def _run_pool(
 
     The workers post (:func:`_posted`) and this process writes (:func:`_publish`), so
     a worker killed mid-file leaves nothing behind. They die with this process
-    (:func:`_worker_init`), so killing a batch (even with ``kill -9``) leaves no
+    (:func:`worker_init`), so killing a batch (even with ``kill -9``) leaves no
     worker running or holding its pipes; and when the loop ends early (Ctrl-C, a
     failing progress callback) they are killed at once (:func:`_kill_pool`) rather
     than left to finish the files they hold.
     """
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
-    pool = ProcessPoolExecutor(max_workers=jobs, initializer=_worker_init, initargs=(os.getpid(),))
+    pool = ProcessPoolExecutor(max_workers=jobs, initializer=worker_init, initargs=(os.getpid(),))
     try:
         futures = {pool.submit(_posted, task, options): i for i, task in enumerate(tasks)}
         for done, future in enumerate(as_completed(futures), start=1):
@@ -845,70 +762,9 @@ def _run_pool(
             if progress is not None:
                 progress(done, len(tasks), rows[index])
     except BaseException:
-        _kill_pool(pool)
+        kill_pool(pool)
         raise
     pool.shutdown()
-
-
-def _kill_pool(pool: Any) -> None:
-    """Kill ``pool``'s workers now (SIGKILL), reap them, and drop the work not started.
-
-    The pool's processes are its private ``_processes`` (CPython's since 3.2; the
-    public ``kill_workers`` comes only with Python 3.14). With its workers gone the
-    pool's own thread sees them die and ends, so nothing waits for a file in flight.
-    """
-    processes = list((getattr(pool, "_processes", None) or {}).values())
-    for process in processes:
-        with contextlib.suppress(OSError, ValueError):
-            process.kill()
-    for process in processes:
-        with contextlib.suppress(OSError, ValueError, AssertionError):
-            process.join(KILL_WAIT_S)
-    pool.shutdown(wait=False, cancel_futures=True)
-
-
-KILL_WAIT_S = 5.0
-"""Longest wait for a killed worker to be reaped, s (SIGKILL ends it at once)."""
-PARENT_POLL_S = 0.5
-"""How often a worker checks that the batch that started it is still alive, s."""
-
-
-def _worker_init(parent_pid: int) -> None:
-    """Make a pool worker die with the batch process ``parent_pid``.
-
-    On Linux the kernel sends the worker SIGKILL when its parent dies
-    (``prctl(PR_SET_PDEATHSIG)``, prctl(2)); everywhere a daemon thread also polls
-    the parent pid every :data:`PARENT_POLL_S` and exits the worker when the worker
-    has been re-parented. A parent already gone ends the worker at once.
-
-    The worker's k-d tree queries run on one thread (``KD_WORKERS``): the pool already
-    runs one worker per job, and the distances do not depend on it. It ignores SIGINT:
-    Ctrl-C at a terminal reaches the whole process group, and the batch alone decides
-    what stops (it kills its workers, :func:`_kill_pool`).
-    """
-    import sys
-
-    from camtool.verify import metrics
-
-    metrics.KD_WORKERS = 1
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-
-    if sys.platform.startswith("linux"):
-        import ctypes
-
-        pr_set_pdeathsig = 1  # <linux/prctl.h>
-        ctypes.CDLL(None, use_errno=True).prctl(pr_set_pdeathsig, signal.SIGKILL, 0, 0, 0)
-    if os.getppid() != parent_pid:
-        os._exit(1)
-
-    def watch() -> None:
-        import time
-
-        while os.getppid() == parent_pid:
-            time.sleep(PARENT_POLL_S)
-        os._exit(1)
-
-    threading.Thread(target=watch, name="camtool-parent-watch", daemon=True).start()
 
 
 def _collect(future: Future[tuple[BatchRow, Files]], task: BatchTask) -> BatchRow:
@@ -1079,197 +935,3 @@ def _write(path: str, data: str | bytes) -> None:
         write_atomic(path, data)
     except OSError as exc:
         raise CamtoolError(f"{path}: cannot write ({reason(exc)})") from exc
-
-
-# What a batch tells: the JSON report, the summary table and the progress lines.
-
-FILE_COLUMN_MAX = 48
-"""Widest file column of the summary table; longer names keep their end."""
-_NOT_OPTIONS = ("jobs", "force", "report")
-_NOT_PLAN_OPTIONS = ("origin",)
-"""Planning fields that are no option of ``batch`` (the tool's position before the program)."""
-
-
-def batch_report(result: BatchResult) -> dict[str, Any]:
-    """The batch report (keys in the module docstring), JSON-ready."""
-    return {
-        "camtool": __version__,
-        "options": _options(result.options),
-        "files": [row_dict(row) for row in result.rows],
-        "totals": totals(result.rows),
-        "exit_code": result.exit_code,
-    }
-
-
-def _options(options: BatchOptions) -> dict[str, Any]:
-    out: dict[str, Any] = {}
-    for f in dataclasses.fields(options):
-        if f.name in _NOT_OPTIONS:
-            continue
-        value = getattr(options, f.name)
-        if f.name == "plan":
-            out["feed_mm_min"] = value.feed_mm_min
-            out["tolerance"] = value.tolerance
-            out["plan"] = {
-                k: _json(getattr(value, k))
-                for k in type(value).__dataclass_fields__
-                if k in PLAN_FIELDS and k not in _NOT_PLAN_OPTIONS
-            }
-        elif f.name == "output":
-            out.update(dataclasses.asdict(value))
-        else:
-            out[f.name] = _json(value)
-    out["verify"] = options.verifying  # also when implied by preview or max_error_um
-    return out
-
-
-def _json(value: Any) -> Any:
-    """An option's value as JSON: paths POSIX, tuples lists."""
-    if isinstance(value, Path):
-        return value.as_posix()
-    if isinstance(value, tuple):
-        return list(value)
-    return value
-
-
-def row_dict(row: BatchRow) -> dict[str, Any]:
-    """One file of the report (its ``target`` only in a batch of several targets)."""
-    named = {"target": row.target} if row.target is not None else {}
-    return {
-        "file": row.file,
-        **named,
-        "status": row.status,
-        "exit_code": row.exit_code,
-        "blocks": row.blocks,
-        "max_error_um": None if row.max_error_um is None else round(row.max_error_um, 4),
-        "time_s": None if row.time_s is None else round(row.time_s, 3),
-        "verified": row.verified,
-        "outputs": {"code": row.code_path, "report": row.report_path, "preview": row.preview_path},
-        "warnings": list(row.warnings),
-        "error": row.error,
-    }
-
-
-def totals(rows: tuple[BatchRow, ...]) -> dict[str, Any]:
-    """Counts by status and sums over the files that posted (see the module docstring)."""
-    errors = [r.max_error_um for r in rows if r.max_error_um is not None]
-    return {
-        "files": len(rows),
-        "ok": sum(r.status == "ok" for r in rows),
-        "error": sum(r.status == "error" for r in rows),
-        "over_limit": sum(r.status == "over-limit" for r in rows),
-        "blocks": sum(r.blocks or 0 for r in rows),
-        "time_s": round(sum(r.time_s or 0.0 for r in rows), 3),
-        "max_error_um": round(max(errors), 4) if errors else None,
-    }
-
-
-def summary_table(result: BatchResult) -> str:
-    """The end-of-batch table: one line per file and a totals line (plain text).
-
-    Columns: file, target (only in a batch of several targets), status, blocks,
-    predicted max error (µm, ``-`` when not verified), time (s; verified time, else
-    at programmed feeds), and a note (the error, or the number of warnings). Each
-    line ends with a newline.
-    """
-    width = min(max([len("file")] + [len(r.file) for r in result.rows]), FILE_COLUMN_MAX)
-    named = [r.target for r in result.rows if r.target is not None]
-    tw = max([len("target"), *map(len, named)]) if named else 0
-
-    def target(text: str | None) -> str:
-        return f"{text or '':<{tw}}  " if tw else ""
-
-    lines = [
-        f"{'file':<{width}}  {target('target')}{'status':<10}  {'blocks':>6}  {'max µm':>9}  "
-        f"{'time s':>9}  note"
-    ]
-    for row in result.rows:
-        note = message(row) if row.error else _warning_count(row)
-        lines.append(
-            f"{_shorten(row.file, width):<{width}}  {target(row.target)}{row.status:<10}  "
-            f"{_int(row.blocks):>6}  {_fixed(row.max_error_um, 2):>9}  "
-            f"{_fixed(row.time_s, 1):>9}  {note}".rstrip()
-        )
-    lines.append(totals_line(result))
-    return "\n".join(lines) + "\n"
-
-
-def totals_line(result: BatchResult) -> str:
-    """``3 files: 1 ok, 1 over the limit, 1 error; 50 blocks; max 14.07 µm; 6804.2 s``."""
-    t = totals(result.rows)
-    text = (
-        f"{t['files']} file(s): {t['ok']} ok, {t['over_limit']} over the limit, "
-        f"{t['error']} error(s); {t['blocks']} blocks"
-    )
-    if t["max_error_um"] is not None:
-        text += f"; max {t['max_error_um']:.2f} µm"
-    return f"{text}; {sum(r.time_s or 0.0 for r in result.rows):.1f} s"
-
-
-def progress_line(done: int, total: int, row: BatchRow) -> str:
-    """One finished file, for a log: ``[3/12] ok  a.dxf → out/a.pic  41 blocks  12.3 µm  2.1 s``.
-
-    An error shows its message instead of the outputs; an over-limit file shows
-    both. In a batch of several targets the file is followed by ``for <target>``.
-    """
-    head = f"[{done}/{total}] {row.status}  {row.file}"
-    if row.target is not None:
-        head += f" for {row.target}"
-    if row.code_path is None:
-        return f"{head}: {message(row) or 'failed'}"
-    text = f"{head} → {row.code_path}  {row.blocks} blocks"
-    if row.max_error_um is not None:
-        text += f"  {row.max_error_um:.1f} µm"
-    if row.time_s is not None:
-        text += f"  {row.time_s:.1f} s"
-    return f"{text}: {row.error}" if row.error else text
-
-
-def message(row: BatchRow) -> str:
-    """The first line of ``row``'s error, without a leading ``<file>: `` (shown beside it)."""
-    first = row.error.splitlines()[0] if row.error else ""
-    return first.removeprefix(f"{row.file}: ")
-
-
-def unwritten_lines(stop: BatchInterrupted) -> str:
-    """The files an interrupted batch did not post (the first :data:`SHOWN_UNWRITTEN` named).
-
-    ``not posted (stopped by SIGINT): 3 file(s)`` then one indented line per file
-    (``for <target>`` in a batch of several targets) and ``... and N more``; each line
-    ends with a newline. Empty when every file was posted.
-    """
-    if not stop.unwritten:
-        return ""
-    lines = [f"not posted (stopped by {stop.signal_name}): {len(stop.unwritten)} file(s)"]
-    for task in stop.unwritten[:SHOWN_UNWRITTEN]:
-        lines.append(f"  {task.file}" + (f" for {task.target}" if task.target else ""))
-    more = len(stop.unwritten) - SHOWN_UNWRITTEN
-    if more > 0:
-        lines.append(f"  ... and {more} more")
-    return "\n".join(lines) + "\n"
-
-
-def failure_line(result: BatchResult) -> str:
-    """Why a batch failed, for its last line: ``1 of 3 file(s) failed, 1 over the limit``."""
-    t = totals(result.rows)
-    parts = [f"{t['error']} of {t['files']} file(s) failed"] if t["error"] else []
-    if t["over_limit"]:
-        parts.append(f"{t['over_limit']} of {t['files']} over the limit")
-    return ", ".join(parts) + " (see the table above)"
-
-
-def _warning_count(row: BatchRow) -> str:
-    n = len(row.warnings)
-    return "" if n == 0 else f"{n} warning{'s' if n > 1 else ''}"
-
-
-def _shorten(text: str, width: int) -> str:
-    return text if len(text) <= width else "…" + text[-(width - 1) :]
-
-
-def _int(value: int | None) -> str:
-    return "-" if value is None else str(value)
-
-
-def _fixed(value: float | None, decimals: int) -> str:
-    return "-" if value is None else f"{value:.{decimals}f}"

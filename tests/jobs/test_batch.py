@@ -24,13 +24,11 @@ from camtool.jobs.batch import (
     BatchOptions,
     BatchRow,
     batch_exit_code,
-    batch_report,
     plan_batch,
     post_one,
-    progress_line,
     run_batch,
-    summary_table,
 )
+from camtool.jobs.batch_report import batch_report, progress_line, summary_table
 from camtool.jobs.inputs import expand_inputs
 from camtool.jobs.pipeline import post_file
 from camtool.model.errors import InputError, UsageError

@@ -27,12 +27,11 @@ from camtool.jobs.batch import (
     BatchInterrupted,
     BatchOptions,
     BatchRow,
-    Interrupts,
-    Terminated,
     plan_batch,
     run_batch,
-    unwritten_lines,
 )
+from camtool.jobs.batch_report import unwritten_lines
+from camtool.jobs.batch_stop import Interrupts, Terminated
 from camtool.jobs.output import LOCK_NAME
 from tests.jobs.test_batch import alive, children
 
