@@ -10,7 +10,7 @@ the writer's 3.5 s, while the second core waits.
 :class:`ConformAhead` forks a helper as the writer starts (:func:`start`). The helper
 predicts each arc's arguments from the program: the start the controller holds is where
 the last move that wrote X and Y ended, as printed
-(:meth:`~camtool.post.wordaddress.BlockWriter.written_xy`). It then conforms the arcs
+(:meth:`~camtool.post.wordaddress_write.BlockWriter.written_xy`). It then conforms the arcs
 from the last towards the first, and sends what it found in records of :data:`BATCH`
 arcs, until it reaches the arcs the writer has passed (the writer tells how far it is in
 memory they share). Meanwhile the writer works from the first arc. For each arc, the
@@ -49,7 +49,7 @@ from camtool.model.program import ArcMove, Linear, Program, Rapid
 from camtool.model.shapes import Point
 
 if TYPE_CHECKING:
-    from camtool.post.wordaddress import BlockWriter
+    from camtool.post.wordaddress_write import BlockWriter
 
 Key = tuple[Point, Point, Point, bool, Point]
 """An arc's arguments: ``(written start, end, centre, clockwise, exact start)``, mm."""

@@ -56,7 +56,8 @@ fitter's distance functions work x and y in separate arrays (half the fit's CPU,
 floats), the toolpath extent skips arcs that cannot widen it, the arc check keeps the grid
 values it printed. ``plainly_passes`` answers 61 151 of this file's 61 463 arcs (312 go to
 the search); the whole arc check costs 2.6–3.0 s of CPU here, about as much as the rest of
-the writer's arc handling (``wordaddress._arc``: splitting, formatting; not this pass's).
+the writer's arc handling (``wordaddress_write.BlockWriter._arc``: splitting, formatting;
+not this pass's).
 CPU seconds in one process per stage, first pass → second pass, two runs each one after
 the other, under heavy load (8–9 jobs on 2 cores; wall times meaningless):
 

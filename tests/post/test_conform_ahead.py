@@ -25,9 +25,10 @@ import pytest
 from camtool.model import cores
 from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Linear, Move, Program, Rapid
-from camtool.post import conformahead, wordaddress
+from camtool.post import conformahead, wordaddress_write
 from camtool.post.registry import load_target
-from camtool.post.wordaddress import BlockWriter, WordAddressPost, word_address_dialect
+from camtool.post.wordaddress import WordAddressPost, word_address_dialect
+from camtool.post.wordaddress_write import BlockWriter
 
 BIG = Machine(name="test bench", steps_per_mm=(1000.0,) * 3, work_area_mm=(-900, -900, 900, 900))
 ARCS = conformahead.MIN_ARCS + 500
@@ -155,12 +156,12 @@ def test_predicted_keys_are_the_keys_the_writer_conforms(
     program = arc_program(random.Random(1), ARCS, messy=False)
     looked: list[tuple[Any, ...]] = []
 
-    class Recording(wordaddress._Conformed):
+    class Recording(wordaddress_write._Conformed):
         def __setitem__(self, key: Any, value: Any) -> None:
             looked.append(key)
             super().__setitem__(key, value)
 
-    monkeypatch.setattr(wordaddress, "_Conformed", Recording)
+    monkeypatch.setattr(wordaddress_write, "_Conformed", Recording)
     alone(post, program, monkeypatch)
     writer = BlockWriter(post.spec, BIG)
     origin = program.origin

@@ -1,6 +1,6 @@
 """The word-address writer's shortcuts write what its full path writes (issue 17).
 
-:class:`~camtool.post.wordaddress.BlockWriter` formats a word without a step grid with
+:class:`~camtool.post.wordaddress_write.BlockWriter` formats a word without a step grid with
 its number format directly (:meth:`text`), writes the feed of the block before again
 without checking it anew (:meth:`_feed`), keeps the text and value read back of each
 coordinate it printed (:meth:`_print`) and keeps the blocks of each arc it conformed to
@@ -24,7 +24,8 @@ from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Linear, Move, Program, Rapid
 from camtool.model.shapes import Arc, Point
 from camtool.post.registry import load_target
-from camtool.post.wordaddress import BlockWriter, WordAddressPost, word_address_dialect
+from camtool.post.wordaddress import WordAddressPost, word_address_dialect
+from camtool.post.wordaddress_write import BlockWriter
 
 BIG = Machine(name="test bench", steps_per_mm=(1000.0,) * 3, work_area_mm=(-900, -900, 900, 900))
 

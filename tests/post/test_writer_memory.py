@@ -39,7 +39,8 @@ def test_writing_holds_the_code_not_a_string_per_block() -> None:
 
 def test_block_numbers_in_messages_count_the_blocks_joined_already() -> None:
     """After thousands of blocks, the block a message names is still the file's line."""
-    from camtool.post.wordaddress import BlockWriter, WordAddressPost
+    from camtool.post.wordaddress import WordAddressPost
+    from camtool.post.wordaddress_write import BlockWriter
 
     target = load_target("grbl")
     post = target.post

@@ -1,0 +1,941 @@
+"""The word-address writer: one :class:`BlockWriter` writes a program for every such dialect.
+
+Its dialect is :class:`camtool.post.wordaddress.WordAddressPost`; the grammar it writes is
+:class:`~camtool.post.wordaddress_spec.WordAddressSpec`.
+
+Writing rules (docs/dialects.md explains them for users):
+
+- coordinates are absolute; I/J are written from the start point *as written*
+  (the rounded position the controller holds), so the centre the controller
+  computes is the exact centre to within one written step;
+- arcs sweeping more than ``max_arc_deg`` are split into equal arcs, full
+  circles too when ``full_circle = "split"``; with ``arc_check`` each arc goes
+  through :func:`camtool.post.arccheck.conform_arc` so that the rounded numbers
+  pass the controller's own check;
+- an arc too small for the written resolution (its written end is its written
+  start, or its centre rounds onto its start) becomes a straight line, with a
+  warning;
+- with ``planes`` an arc in the ZX or YZ plane (a :class:`~camtool.model.program.PlaneArc`)
+  is written as ``G18``/``G19`` with its arc block(s), then ``G17``; when its printed
+  numbers fail the controller's arc check, or it is too small to print, its chords are
+  written instead, with a warning;
+- a move that changes Z and not XY (where the tool is, or the program's origin for
+  the first move) is a Z-only block (``G0 Z5``): no X or Y word, so the first
+  block of a program never moves XY from wherever the machine stands, and a
+  re-posted program gets no X/Y it did not have;
+- with ``z_moves = "own-block"`` a move that changes XY and Z is written as two
+  blocks (Z first when rising, last when plunging), with a warning;
+- what the dialect lacks (F, S, spindle, dwell, tool change, return home) is
+  dropped with one warning per kind saying how many; a Z move without a Z word,
+  a helix without ``helix``, a point outside the work area, a number over its
+  field or a block over ``max_block_bytes`` is a DialectError naming the
+  contour and block.
+
+Numbers are formatted by :mod:`camtool.post.numfmt` only.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import TYPE_CHECKING, Any
+
+from camtool.model.errors import DialectError
+from camtool.model.machine import Machine
+from camtool.model.program import (
+    PLANE_AXES,
+    ArcMove,
+    Command,
+    Dwell,
+    Home,
+    Linear,
+    Move,
+    PlaneArc,
+    Program,
+    Rapid,
+    Spindle,
+    Stop,
+    ToolChange,
+)
+from camtool.model.shapes import FULL_CIRCLE_EPS, Arc, Point, make_arc
+from camtool.post import conformahead
+from camtool.post.base import (
+    WriterState,
+    check_placement,
+    check_work_area,
+    check_written_z,
+)
+from camtool.post.wordaddress_spec import PLANE_CODES, WordAddressSpec
+
+if TYPE_CHECKING:
+    from camtool.post.arccheck import ArcPiece
+
+
+_SAME_MM = 1e-9
+"""Exact XY closer than this is the same point (a Z-only move)."""
+_PRINTED_KEPT = 1 << 16
+"""Coordinates per letter whose text a writer keeps (:meth:`BlockWriter._print`)."""
+_MOVES = (Rapid, Linear, ArcMove)
+"""The kinds of move (a tuple: ``isinstance`` takes it faster than ``Rapid | Linear | ...``)."""
+_JOINED_BLOCKS = 4096
+"""Blocks a writer holds apart before it joins them into text (:meth:`BlockWriter.block`)."""
+_CONFORMED_KEPT = 20_000
+"""Arcs whose blocks a writer keeps (:meth:`BlockWriter._conformed`); then it starts anew."""
+ARC_CHORD_TOLERANCE_MM = 0.002
+"""Chord deviation, mm, of an arc no printable centre can write (GRBL's default ``$12``)."""
+_CHORD: Point = (math.nan, math.nan)
+"""The centre of a conformed block that is a chord of such an arc (by identity)."""
+
+
+class _Conformed(dict[tuple[Any, ...], list[tuple[Point, Point | None]]]):
+    """A writer's memory of the arcs it has conformed, by key (``BlockWriter._conformed_at``).
+
+    ``ahead``: the helper conforming the program's arcs meanwhile
+    (:mod:`camtool.post.conformahead`), or ``None``.
+    """
+
+    def __init__(self, ahead: conformahead.ConformAhead | None = None) -> None:
+        super().__init__()
+        self.ahead = ahead
+
+
+class BlockWriter(WriterState[str]):
+    """Writes one program; holds the controller's state as the written code sets it.
+
+    The lines written are :attr:`blocks` (header and comment lines included:
+    block numbers in messages are line numbers); what the dialect lacks is
+    counted in :attr:`counts` by kind (``"feed"``, ``"spindle"``, ``"z-split"``,
+    ``"tiny-arc"``...) and worded once at the end.
+
+    Args:
+        spec: the dialect.
+        machine: the machine the program is for (work area, Z axis).
+
+    Attributes:
+        z: the Z the controller is at, mm (``None``: not set yet).
+        written: the XY the controller holds, as written (rounded), mm.
+        last: the last text of each word letter (modal words).
+        grid_error_mm: largest change of a coordinate rounded to a step grid, mm.
+    """
+
+    def __init__(self, spec: WordAddressSpec, machine: Machine) -> None:
+        super().__init__()
+        self.spec, self.machine = spec, machine
+        self.z: float | None = None
+        self.spindle: Spindle | None = None  # turning, as last written
+        self.written: Point = (0.0, 0.0)
+        self.last: dict[str, str] = {}
+        self.grid_error_mm = 0.0
+        self.program = Program(())
+        # The formats of the words without a step grid (their text is the number's alone,
+        # :meth:`text`) and the readers of every word, looked up once.
+        self._formats = {
+            letter: word.number.format
+            for letter, word in spec.words.items()
+            if word.number.grid_mm is None
+        }
+        self._parses = {letter: word.number.parse for letter, word in spec.words.items()}
+        # The text and the value read back of each coordinate already written, by letter
+        # and value (:meth:`_print`): the writer prints an arc's end twice (to see whether
+        # it prints as its start, then in its block) and every end is read back.
+        self._printed: dict[str, dict[float, tuple[str, float]]] = {
+            letter: {} for letter in spec.words
+        }
+        self._quantum: float | None = None
+        self._conformed_arcs = _Conformed()
+        self._feed_text: tuple[float, str] | None = None
+        # GRBL's mc_arc counts an arc's chords as ⌊|θ·r/2| / √($12·(2r − $12))⌋: an arc of
+        # radius r ≤ $12/2 divides by zero or by the root of a negative number, and what the
+        # controller then does is undefined (the verifier refuses it). Such an arc lies
+        # within $12 of its chord, so it is written as a line (a millionth to spare).
+        motion = machine.motion
+        grbl_chords = motion.arc == "chords" and motion.chords == "grbl"
+        self._arc_floor_mm = motion.chord_tolerance_mm * (1 + 1e-6) if grbl_chords else 0.0
+        self._one_part = spec.max_arc_deg >= 360.0  # an arc but a full circle is one block
+        _, _, self._cw, self._ccw = spec.motion_codes
+        self._modal_g = "G" in spec.modal
+        self._absolute_centre = spec.arc_centre == "absolute"
+        self._done: list[str] = []  # blocks written out of :attr:`blocks`, as text
+        self._done_blocks = 0
+
+    @property
+    def count(self) -> int:
+        """Blocks written so far (header and comment lines included)."""
+        return self._done_blocks + len(self.blocks)
+
+    def where(self, contour: int | None = None, block: int | None = None) -> str:
+        """:meth:`WriterState.where`, counting the blocks already joined into text."""
+        return super().where(contour, self.count + 1 if block is None else block)
+
+    def _join_blocks(self) -> None:
+        """Move :attr:`blocks` into one text, so a long program is not a string a block."""
+        end = self.spec.line_end
+        self._done.append(end.join(self.blocks) + end)
+        self._done_blocks += len(self.blocks)
+        self.blocks.clear()
+
+    # -- the program -------------------------------------------------------------
+
+    def write(self, program: Program) -> str:
+        """The whole program as text.
+
+        In order: the ``header`` lines, the program's notes as comments (when the
+        dialect has comments), the preamble, the moves and commands, the
+        postamble, the end code and the ``footer`` lines.
+
+        Raises:
+            DialectError: see the module docstring; the message names the block.
+        """
+        self.here = program.origin
+        self.program = program
+        self.warnings.extend(check_placement(program, self.machine))
+        self.written = (self._round("X", program.origin[0]), self._round("Y", program.origin[1]))
+        self.blocks.extend(self.spec.header)
+        for note in program.notes:
+            comment = self.spec.comment_line(note)
+            if comment is not None:
+                self.blocks.append(comment)
+        for codes in self.spec.preamble:
+            self.block(list(codes))
+        # the arcs' blocks, conformed ahead in a helper when there are many (issue 17); held
+        # by the memory of conformed arcs, not as a 30th attribute of the writer: that one
+        # made every block of issue 17's re-post ~8 % slower (CPython 3.11 stops sharing
+        # the keys of instances with that many attributes)
+        ahead = conformahead.start(self, program)
+        self._conformed_arcs = _Conformed(ahead)
+        index = 0  # of the next move
+        written = 0  # moves written up to here (a plane arc writes its chords' moves)
+        try:
+            for item in program.items():
+                if isinstance(item, _MOVES):
+                    index += 1
+                    if index > written:
+                        self.move(item)
+                elif isinstance(item, PlaneArc):
+                    written = self.plane_arc(item, index)
+                else:
+                    self.command(item)
+        finally:
+            if ahead is not None:
+                ahead.close()
+        for codes in self.spec.postamble:
+            self.block(list(codes))
+        if self.spec.end:
+            self.block([self.spec.end[0]])
+        self.blocks.extend(self.spec.footer)
+        self.warnings.extend(self._summary())
+        if self.blocks:
+            self._join_blocks()
+        return "".join(self._done)
+
+    def block(self, words: list[str]) -> None:
+        """Append one block made of ``words``.
+
+        Raises:
+            DialectError: the block is longer than ``max_block_bytes``.
+        """
+        spec = self.spec
+        text = spec.separator.join(words) + spec.block_end
+        limit = spec.max_block_bytes
+        # the size of ASCII text is its length
+        if text.isascii() and (limit is None or len(text) + len(spec.line_end) <= limit):
+            self.blocks.append(text)
+            if len(self.blocks) >= _JOINED_BLOCKS:
+                self._join_blocks()
+            return
+        size = len((text + spec.line_end).encode("ascii"))
+        if limit is not None and size > limit:
+            raise DialectError(
+                f"{self.where()}: {text!r} is {size} bytes with its line end; "
+                f"{self.spec.name} takes at most {limit} (max_block_bytes)"
+            )
+        self.blocks.append(text)
+
+    # -- numbers -----------------------------------------------------------------
+
+    def _z_text(self, z: float) -> str:
+        """``z`` in the Z word's format, checked not to cross the top of the stock."""
+        text = self.text("Z", z)
+        check_written_z(z, self.spec.words["Z"].number.parse(text), self.where())
+        return text
+
+    def text(self, letter: str, value: float) -> str:
+        """``value`` written in word ``letter``'s format (without the letter).
+
+        Raises:
+            DialectError: the number does not fit the word's integer digits.
+        """
+        plain = self._formats.get(letter)
+        if plain is not None:
+            try:
+                return plain(value)  # no grid: the text alone (an error is worded below)
+            except DialectError:
+                pass
+        number = self.spec.words[letter].number
+        try:
+            text = number.format(value)
+        except DialectError as exc:
+            raise DialectError(
+                f"{self.where()}: {letter} = {exc} (value {value:g}); "
+                f"{self.spec.name} writes at most {number.int_digits} integer digits"
+            ) from exc
+        if number.grid_mm is not None:
+            self.grid_error_mm = max(self.grid_error_mm, abs(number.parse(text) - value))
+        return text
+
+    def _print(self, letter: str, value: float) -> tuple[str, float]:
+        """``value``'s text in word ``letter`` and the value the controller reads from it, mm.
+
+        The same as ``(text, parse(text))`` with :meth:`text` (which is a function of
+        ``letter`` and ``value``, its step-grid error a running maximum): kept by value
+        (up to :data:`_PRINTED_KEPT` per letter; ``0.0`` and ``-0.0`` print the same).
+
+        Raises:
+            DialectError: see :meth:`text` (errors are not kept).
+        """
+        kept = self._printed[letter]
+        known = kept.get(value)
+        if known is None:
+            text = self.text(letter, value)
+            known = (text, self._parses[letter](text))
+            if len(kept) >= _PRINTED_KEPT:
+                kept.clear()
+            kept[value] = known
+        return known
+
+    @staticmethod
+    def z_only(start: Point, move: Rapid | Linear) -> bool:
+        """Whether ``move`` from ``start`` is written as a Z-only block (no X or Y word).
+
+        A move that changes Z and not XY (by :data:`_SAME_MM` at most): the module
+        docstring.
+        """
+        return move.z is not None and math.dist(start, (move.x, move.y)) <= _SAME_MM
+
+    def written_xy(self, point: Point) -> Point:
+        """Where the controller stands after a block that writes X and Y of ``point``, mm.
+
+        Raises:
+            DialectError: a number that does not fit its word (:meth:`text`).
+        """
+        return (self._print("X", point[0])[1], self._print("Y", point[1])[1])
+
+    def _round(self, letter: str, value: float) -> float:
+        """``value`` as the controller reads it back after writing."""
+        number = self.spec.words[letter].number
+        return number.parse(number.format(value))
+
+    def _word(self, letter: str, text: str, words: list[str], *, force: bool = False) -> None:
+        """Add ``letter`` + ``text`` unless modal and unchanged; remember it."""
+        if force or letter not in self.spec.modal or self.last.get(letter) != text:
+            words.append(letter + text)
+        self.last[letter] = text
+
+    def _code(self, code: str, words: list[str]) -> None:
+        if "G" not in self.spec.modal or self.last.get("G") != code:
+            words.append(code)
+        self.last["G"] = code
+
+    # -- moves -------------------------------------------------------------------
+
+    def move(self, move: Move) -> None:
+        """Write one move (one or more blocks).
+
+        Raises:
+            DialectError: see the module docstring.
+        """
+        if move.contour:
+            self.contour = move.contour
+        start = self.here
+        if self.machine.coordinates != "work":
+            self._check_area(start, move)
+        if move.z is not None:
+            if self._same_z(move.z):
+                move = dataclasses.replace(move, z=None)  # Z does not change as written
+            else:
+                self._check_z(move)
+        if isinstance(move, ArcMove):
+            self._arc(start, move)
+        else:
+            self._straight(start, move)
+        self.here = (move.x, move.y)
+        if move.z is not None:
+            self.z = move.z
+
+    def _same_z(self, z: float) -> bool:
+        """True when ``z`` prints as the Z the controller is at."""
+        if self.z is None or not self.spec.has("Z"):
+            return False
+        return self.text("Z", z) == self.text("Z", self.z)
+
+    def _check_area(self, start: Point, move: Move) -> None:
+        if self.machine.coordinates != "work":  # in work coordinates any position runs
+            check_work_area(start, move, self.machine, self.where(), self.program)
+
+    def _check_z(self, move: Move) -> None:
+        if not self.spec.has("Z") or not self.machine.has_z:
+            raise DialectError(
+                f"{self.where()}: {self.spec.name} has no Z axis (z = {move.z:g} mm); "
+                "set the depth by hand or use a target with a Z axis"
+            )
+        if isinstance(move, ArcMove) and not self.spec.helix:
+            raise DialectError(
+                f"{self.where()}: an arc that moves Z (a helix) cannot be written in "
+                f"{self.spec.name}; cut the arc at one depth and move Z in its own move"
+            )
+
+    def _straight(self, start: Point, move: Rapid | Linear) -> None:
+        if self.z_only(start, move):
+            self._line(move, None, move.z)  # a Z-only move: no X or Y word (module docstring)
+            return
+        if move.z is None or self.spec.z_moves == "with-xy":
+            self._line(move, (move.x, move.y), move.z)
+            return
+        self.counts["z-split"] += 1
+        if self.z is not None and move.z < self.z:
+            self._line(move, (move.x, move.y), None)
+            self._line(move, None, move.z)
+        else:
+            self._line(move, None, move.z)
+            self._line(move, (move.x, move.y), None)
+
+    def _line(self, move: Rapid | Linear, xy: Point | None, z: float | None) -> None:
+        """A G0/G1 block to ``xy`` (``None``: a Z-only block) and/or ``z``."""
+        rapid, linear, _, _ = self.spec.motion_codes
+        words: list[str] = []
+        self._code(rapid if isinstance(move, Rapid) else linear, words)
+        if xy is not None:
+            (tx, px), (ty, py) = self._print("X", xy[0]), self._print("Y", xy[1])
+            unchanged = self.last.get("X") == tx and self.last.get("Y") == ty
+            force = unchanged and z is None
+            self._word("X", tx, words, force=force)
+            self._word("Y", ty, words, force=force)
+            self.written = (px, py)
+        if z is not None:
+            self._word("Z", self._z_text(z), words, force=xy is None)
+        if isinstance(move, Linear):
+            self._feed(move, words)
+        self.block(words)
+
+    def _feed(self, move: Linear | ArcMove, words: list[str]) -> None:
+        same = self._feed_text
+        if same is not None and same[0] == move.feed_mm_min:
+            self._word("F", same[1], words)  # the feed before: checked and warned about
+            return
+        spec = self.spec.word("F")
+        if spec is None:
+            self.counts["feed"] += 1
+            return
+        text = self.text("F", move.feed_mm_min)
+        written = spec.number.parse(text)
+        if written <= 0:
+            raise DialectError(
+                f"{self.where()}: feed {move.feed_mm_min:g} mm/min rounds to F{text}; "
+                f"the smallest feed {self.spec.name} writes is {spec.number.resolution_mm():g}"
+            )
+        if abs(written - move.feed_mm_min) > 1e-9 * max(1.0, move.feed_mm_min):
+            msg = f"feed {move.feed_mm_min:g} mm/min written as F{text} ({written:g} mm/min)"
+            self.warn(msg)
+        self._feed_text = (move.feed_mm_min, text)
+        self._word("F", text, words)
+
+    # -- arcs --------------------------------------------------------------------
+
+    def _arc(self, start: Point, move: ArcMove) -> None:
+        end, centre, clockwise = (move.x, move.y), (move.cx, move.cy), move.clockwise
+        printed = self._printed
+        tx = printed["X"].get(end[0]) or self._print("X", end[0])
+        ty = printed["Y"].get(end[1]) or self._print("Y", end[1])
+        # Arc(start, end, centre).is_full_circle; the arc itself is made only where needed
+        radius = math.hypot(start[0] - centre[0], start[1] - centre[1])
+        full_circle = math.hypot(end[0] - start[0], end[1] - start[1]) <= (
+            FULL_CIRCLE_EPS * max(1.0, radius)
+        )
+        arc: Arc | None = None
+        if (tx[1], ty[1]) == self.written:
+            arc = make_arc(start, end, centre, clockwise)
+            if abs(arc.sweep) > math.pi:
+                # within the resolution of a full circle: the controller reads one
+                arc = make_arc(start, start, centre, clockwise)
+                full_circle = arc.is_full_circle
+        if self._one_part and not full_circle:
+            parts = 1
+        else:
+            arc = arc or make_arc(start, end, centre, clockwise)
+            parts = self._parts(arc, full_circle)
+        blocks: list[tuple[Point, Point | None, bool]] = []
+        if parts == 1:
+            if arc is None:
+                conformed = self._conformed_at(start, end, centre, clockwise)
+            else:
+                conformed = self._conformed(arc)
+            full = full_circle and len(conformed) == 1
+            if len(conformed) == 1 and move.z is None:  # the usual arc: one block, no helix
+                block_end, block_centre = conformed[0]
+                xy = (tx, ty) if block_end == end else None  # its end is printed
+                self._arc_block(move, block_end, block_centre, None, full, xy)
+                return
+            blocks += [(e, c, full) for e, c in conformed]
+        else:
+            assert arc is not None  # made for _parts
+            # each piece is checked from where the controller stands when it starts: the
+            # end of the piece before, as written (the blocks are written after; the
+            # check from the arc's own start refused the second piece with a ValueError)
+            written = self.written
+            try:
+                for piece in arc.split(parts):
+                    conformed = self._conformed(piece)
+                    full = piece.is_full_circle and len(conformed) == 1
+                    blocks += [(e, c, full) for e, c in conformed]
+                    if conformed:
+                        self.written = self.written_xy(conformed[-1][0])
+            finally:
+                self.written = written  # _arc_block moves it, block by block
+        for k, (block_end, block_centre, full) in enumerate(blocks, start=1):
+            z = move.z  # a helix climbs evenly over the blocks it is written in
+            if move.z is not None and self.z is not None:
+                z = self.z + (move.z - self.z) * k / len(blocks)
+            self._arc_block(move, block_end, block_centre, z, full)
+
+    def _parts(self, arc: Arc, full_circle: bool) -> int:
+        """How many equal arcs ``arc`` is written as (``max_arc_deg``, ``full_circle``).
+
+        ``full_circle`` is ``arc.is_full_circle``.
+        """
+        limit = self.spec.max_arc_deg
+        if limit >= 360.0:
+            if not full_circle:
+                return 1  # a sweep is at most 360° (the formula below gives 1 too)
+            parts = 1
+        else:
+            sweep = math.degrees(abs(arc.sweep))
+            parts = max(1, math.ceil(sweep / limit - 1e-9))
+        if full_circle and self.spec.full_circle == "split":
+            parts = max(2, parts)
+        elif full_circle:
+            parts = 1
+        return parts
+
+    def _conformed(self, piece: Arc) -> list[tuple[Point, Point | None]]:
+        """End and absolute centre of each block of ``piece`` (after the arc check).
+
+        A centre of ``None`` asks for a straight line: the arc is a few quanta
+        across and no printable centre passes the controller's check.
+        """
+        return self._conformed_at(piece.start, piece.end, piece.centre, piece.clockwise, piece)
+
+    def _conformed_at(
+        self, start: Point, end: Point, centre: Point, clockwise: bool, piece: Arc | None = None
+    ) -> list[tuple[Point, Point | None]]:
+        """:meth:`_conformed` of the arc from ``start`` to ``end`` (``piece``, made if ``None``)."""
+        if self.spec.arc_check == "none":
+            return [(end, centre)]
+        key = (self.written, end, centre, clockwise, start)
+        # The same arc from the same written start (a program that cuts a contour again at
+        # another depth) gives the same blocks: conform_arc is a function of its arguments.
+        # Zeros are left out: -0.0 equals 0.0 as a key, but not as an angle (atan2).
+        kept = self._conformed_arcs
+        known = kept.get(key)
+        if known is not None:
+            if not known:
+                self.counts["tiny-arc"] += 1
+            return known
+        zero = 0.0 in key[0] or 0.0 in end or 0.0 in centre or 0.0 in start
+        ahead = None if zero or kept.ahead is None else kept.ahead.take(key)
+        if ahead is not None:  # what _conform gives: the helper ran conform_arc on the same key
+            out = ahead
+            if not out:
+                self.counts["tiny-arc"] += 1
+        else:
+            out = self._conform(
+                piece if piece is not None else make_arc(start, end, centre, clockwise)
+            )
+        if not zero:
+            if len(kept) >= _CONFORMED_KEPT:
+                kept.clear()
+            kept[key] = out
+        return out
+
+    def checked(
+        self, written: Point, end: Point, centre: Point, clockwise: bool, exact_start: Point
+    ) -> list[ArcPiece]:
+        """The blocks of an arc that pass the controller's check (``conform_arc``).
+
+        Args:
+            written: the start the controller holds, as written, mm.
+            end: the exact end, mm.
+            centre: the exact absolute centre, mm.
+            clockwise: G2 when True.
+            exact_start: the exact start, mm.
+
+        A function of its arguments (the rule and the quantum are the dialect's): the
+        writer keeps its answers by them (:meth:`_conformed_at`), and
+        :mod:`camtool.post.conformahead`'s helper calls it ahead of the writer.
+
+        Raises:
+            DialectError: :func:`~camtool.post.arccheck.conform_arc`'s, without the block.
+        """
+        from camtool.post.arccheck import conform_arc
+
+        quantum = self._quantum
+        if quantum is None:
+            quantum = self._quantum = self.spec.quantum_mm()  # the same for every arc
+        return conform_arc(
+            written,
+            end,
+            centre,
+            clockwise,
+            rule=self.spec.arc_check,
+            quantum_mm=quantum,
+            exact_start=exact_start,
+        )
+
+    def _conform(self, piece: Arc) -> list[tuple[Point, Point | None]]:
+        """:meth:`_conformed` without its memory of the arcs already conformed."""
+        try:
+            out = self.checked(self.written, piece.end, piece.centre, piece.clockwise, piece.start)
+        except DialectError:
+            quantum = self.spec.quantum_mm()
+            if piece.radius <= 10 * quantum:
+                return [(piece.end, None)]
+            equalised = self._conform_equalised(piece, quantum)
+            if equalised is None:
+                # no printable centre passes the controller's check: chords, as the
+                # controller itself would cut the arc (GRBL's $12 arc tolerance)
+                tolerance = max(2.0 * quantum, ARC_CHORD_TOLERANCE_MM)
+                return [(point, _CHORD) for point in piece.points(tolerance)[1:]]
+            out = equalised
+        if not out:
+            self.counts["tiny-arc"] += 1  # rounds away to nothing within a quantum
+        return [(p.end, p.centre) for p in out]
+
+    def _conform_equalised(self, piece: Arc, quantum: float) -> list[ArcPiece] | None:
+        """``piece`` conformed about the centre that puts both its ends at one radius, or None.
+
+        For an arc the arc check refused whose ends lie at different distances from its
+        centre (a joint snapped within ``--chain-tolerance`` keeps an arc's centre, so its
+        start can move off its circle: LinuxCNC's ``conv_slot_l.svg`` gave an arc 3.4 µm
+        apart in radius, which no split could write). The centre moves to the nearest
+        point of its ends' perpendicular bisector; the warning gives both radii and the
+        move. Only when the radii differ by no more than the controller's own absolute
+        tolerance (GRBL 0.005 mm, LinuxCNC 0.028 mm: :func:`~camtool.post.arccheck.
+        max_difference` at radius 0), numbers it would itself take as one arc; ``None``
+        otherwise, or when that does not help (the ends meet, the check still fails): the
+        arc is then written as chords. Only arcs the check refused take this path.
+        """
+        from camtool.post.arccheck import max_difference
+
+        (sx, sy), (ex, ey), (cx, cy) = piece.start, piece.end, piece.centre
+        dx, dy = ex - sx, ey - sy
+        chord = math.hypot(dx, dy)
+        r0, r1 = math.hypot(sx - cx, sy - cy), math.hypot(ex - cx, ey - cy)
+        if chord == 0.0 or r0 == r1 or abs(r1 - r0) > max_difference(self.spec.arc_check, 0.0):
+            return None  # beyond the controller's own absolute tolerance: written as chords
+        nx, ny = -dy / chord, dx / chord
+        mx, my = (sx + ex) / 2.0, (sy + ey) / 2.0
+        along = (cx - mx) * nx + (cy - my) * ny
+        centre = (mx + along * nx, my + along * ny)
+        try:
+            out = self.checked(self.written, piece.end, centre, piece.clockwise, piece.start)
+        except DialectError:
+            return None
+        moved = math.dist(centre, piece.centre)
+        self.warn(
+            f"{self.where()}: the arc starts {r0:.4f} mm and ends {r1:.4f} mm from its centre "
+            f"({abs(r1 - r0) * 1000:.1f} µm apart), more than {self.spec.name}'s arc check "
+            f"takes; written about the centre {moved * 1000:.1f} µm away that puts both ends "
+            f"{math.dist(centre, piece.end):.4f} mm from it"
+        )
+        return out
+
+    def _arc_block(
+        self,
+        move: ArcMove,
+        end: Point,
+        centre: Point | None,
+        z: float | None,
+        full: bool,
+        xy: tuple[tuple[str, float], tuple[str, float]] | None = None,
+    ) -> None:
+        """One G2/G3 block, or a G1 block when the arc vanishes at this resolution.
+
+        ``full`` says the arc is meant as a full circle (its written end is its
+        written start); any other arc whose written end is its written start, or
+        whose written centre is its start (or no centre, see :meth:`_conformed`),
+        is too small to write. ``xy``: what :meth:`_print` gives the end's X and Y,
+        when the caller has it.
+        """
+        printed = self._printed
+        if xy is None:
+            xy = (
+                printed["X"].get(end[0]) or self._print("X", end[0]),
+                printed["Y"].get(end[1]) or self._print("Y", end[1]),
+            )
+        (tx, px), (ty, py) = xy
+        written = (px, py)
+        before = self.written
+        ox, oy = (0.0, 0.0) if self._absolute_centre else before
+        ti = tj = ""
+        if centre is _CHORD:
+            self.counts["arc-chords"] += 1
+            self._line(Linear(*end, move.feed_mm_min, contour=move.contour), end, z)
+            return
+        tiny = centre is None or (written == before and not full)
+        if centre is not None:
+            ci, cj = centre[0] - ox, centre[1] - oy
+            ti, i = printed["I"].get(ci) or self._print("I", ci)
+            tj, j = printed["J"].get(cj) or self._print("J", cj)
+            tiny = tiny or (i + ox, j + oy) == before
+            if self._arc_floor_mm:
+                tiny = tiny or 2.0 * math.hypot(i + ox - before[0], j + oy - before[1]) <= (
+                    self._arc_floor_mm
+                )
+        if tiny:
+            self.counts["tiny-arc"] += 1
+            linear = Linear(end[0], end[1], move.feed_mm_min, contour=move.contour)
+            self._line(linear, end, z)
+            return
+        code = self._cw if move.clockwise else self._ccw
+        last = self.last
+        words = [] if self._modal_g and last.get("G") == code else [code]  # _code
+        last["G"] = code
+        words += ["X" + tx, "Y" + ty]  # _word(..., force=True)
+        last["X"], last["Y"] = tx, ty
+        if z is not None:
+            self._word("Z", self._z_text(z), words)
+        words += ["I" + ti, "J" + tj]
+        self.written = written
+        self._feed(move, words)
+        self.block(words)
+
+    # -- arcs in the ZX and YZ planes -----------------------------------------------
+
+    def plane_arc(self, arc: PlaneArc, index: int) -> int:
+        """Write ``arc`` as ``G18``/``G19`` arc block(s) then ``G17``, if it can be.
+
+        ``index`` is the arc's first move in the program. It is written as an arc when
+        the dialect has ``planes``, the machine a Z axis, the ``arc.moves`` moves from
+        ``index`` are still its chords (:meth:`~camtool.model.program.Program.has_chords_of`)
+        and it starts where the controller is; its printed numbers must pass the
+        controller's arc check (``arc_check``, in the plane) and print an arc (not a
+        point, not a centre on the start). Otherwise nothing is written here, and the
+        chords are written as the moves they are (with a warning when only the printed
+        numbers stood in the way).
+
+        Returns:
+            The number of the program's moves written once this returns: ``index +
+            arc.moves`` when the arc was written, else ``index``.
+
+        Raises:
+            DialectError: a number over its field, a block over ``max_block_bytes`` or a
+                chord outside the work area.
+        """
+        spec = self.spec
+        if not (spec.planes and self.machine.has_z and self._starts_here(arc, index)):
+            return index
+        chords = self.program.moves[index : index + arc.moves]
+        blocks = self._plane_blocks(arc)
+        if blocks is None:
+            self.counts["plane-chords"] += 1
+            return index
+        first = chords[0]
+        assert isinstance(first, Linear)  # has_chords_of checked
+        if first.contour:
+            self.contour = first.contour
+        here = self.here
+        for chord in chords:
+            self._check_area(here, chord)
+            here = (chord.x, chord.y)
+        for k, words in enumerate(blocks):
+            if k == 0:
+                words.insert(0, PLANE_CODES[arc.plane])
+            self._feed(first, words)
+            self.block(words)
+        self.block([PLANE_CODES["xy"]])
+        self.here, self.z = (arc.end[0], arc.end[1]), arc.end[2]
+        return index + arc.moves
+
+    def _starts_here(self, arc: PlaneArc, index: int) -> bool:
+        """Whether ``arc``'s chords follow ``index`` and it starts where the controller is."""
+        if self.z is None or not self.program.has_chords_of(index, arc):
+            return False
+        sx, sy, sz = arc.start
+        same_z = self.text("Z", sz) == self.text("Z", self.z)
+        return math.dist(self.here, (sx, sy)) <= _SAME_MM and same_z
+
+    def _plane_blocks(self, arc: PlaneArc) -> list[list[str]] | None:
+        """The words of each block of ``arc`` (no plane code, no F), or ``None``: chords.
+
+        Split as XY arcs are (``max_arc_deg``, ``full_circle``); each block's offsets
+        are from its printed start, as the controller takes them. ``None`` when a
+        block's printed numbers fail the arc check or print no arc.
+        """
+        axes = PLANE_AXES[arc.plane]
+        letters = ["XYZ"[i] for i in axes]  # first, second, linear
+        offsets = ["IJK"[i] for i in axes[:2]]
+        whole = arc.arc()
+        full = whole.is_full_circle
+        pieces = whole.split(self._parts(whole, full))
+        assert self.z is not None  # _starts_here checked
+        position = [self.written[0], self.written[1], self._round("Z", self.z)]
+        lin0, lin1 = arc.start[axes[2]], arc.end[axes[2]]
+        out: list[list[str]] = []
+        for k, piece in enumerate(pieces, start=1):
+            start = (position[axes[0]], position[axes[1]])
+            texts: dict[str, str] = {}
+            linear = lin1 if k == len(pieces) else lin0 + (lin1 - lin0) * k / len(pieces)
+            values = (piece.end[0], piece.end[1], linear)
+            printed = []
+            for letter, value in zip(letters, values, strict=True):
+                text = self._z_text(value) if letter == "Z" else self.text(letter, value)
+                printed.append(self._parses[letter](text))
+                if letter != letters[2] or printed[-1] != position[axes[2]]:
+                    texts[letter] = text  # the linear axis only when it moves
+            centre = []
+            for letter, c, s0 in zip(offsets, piece.centre, start, strict=True):
+                origin = 0.0 if self._absolute_centre else s0
+                texts[letter] = self.text(letter, c - origin)
+                centre.append(self._parses[letter](texts[letter]) + origin)
+            end = (printed[0], printed[1])
+            if not self._printable(start, end, (centre[0], centre[1]), full and len(pieces) == 1):
+                return None
+            for i, value in zip(axes, printed, strict=True):
+                position[i] = value
+            code = self._cw if arc.clockwise else self._ccw
+            out.append([code] + [c + texts[c] for c in "XYZIJK" if c in texts])
+        self.written = (position[0], position[1])
+        self.last["X"], self.last["Y"] = "", ""  # modal X/Y: written again after the arc
+        self.last.pop("Z", None)
+        self.last["G"] = ""
+        return out
+
+    def _printable(self, start: Point, end: Point, centre: Point, full: bool) -> bool:
+        """Whether a plane arc block's printed numbers make an arc the controller accepts."""
+        if centre == start or (end == start and not full):
+            return False
+        if self._arc_floor_mm and 2.0 * math.dist(centre, start) <= self._arc_floor_mm:
+            return False
+        if self.spec.arc_check == "none":
+            return True
+        from camtool.post.arccheck import arc_error
+
+        return arc_error(start, end, centre, rule=self.spec.arc_check) is None
+
+    # -- commands ----------------------------------------------------------------
+
+    def command(self, command: Command) -> None:
+        """Write a spindle, dwell, tool change or stop, or count it as dropped.
+
+        A tool change or a stop is never dropped: a dialect that cannot write it
+        refuses the program (a job of several tools is split per tool before).
+
+        Raises:
+            DialectError: a tool change or stop the dialect cannot write.
+        """
+        spec = self.spec
+        if isinstance(command, Spindle):
+            code = {"cw": spec.spindle_cw, "ccw": spec.spindle_ccw, "off": spec.spindle_off}[
+                command.direction
+            ]
+            if code is None:
+                self.drop(command)
+                return
+            self.spindle = None if command.direction == "off" else command
+            words = [code]
+            if command.direction != "off" and spec.has("S") and command.rpm > 0:
+                words.append("S" + self.text("S", command.rpm))  # rpm 0: speed not given
+            elif command.direction != "off" and command.rpm > 0:
+                self.counts["speed"] += 1
+            self.block(words)
+        elif isinstance(command, Dwell):
+            if spec.dwell is None:
+                self.drop(command)
+                return
+            self.block([spec.dwell, "P" + self.text("P", command.seconds)])
+        elif isinstance(command, ToolChange):
+            self._tool_change(command)
+        elif isinstance(command, Stop):
+            self._stop(command.optional, command.message)
+        elif isinstance(command, Home):
+            self.drop(command)
+
+    def _tool_change(self, change: ToolChange) -> None:
+        """``T2 M6`` (and ``G43 H2``), or by hand: spindle off, a comment, a stop."""
+        spec = self.spec
+        text = self.text("T", float(change.tool)) if spec.has("T") else str(change.tool)
+        if spec.tool_change is not None:
+            self.block(["T" + text, spec.tool_change])
+            if spec.tool_length_offset is not None:
+                self.block([spec.tool_length_offset, "H" + self.text("H", float(change.tool))])
+            self.z = None  # the new tool's length: the next Z is written again
+            self.last.pop("Z", None)
+            return
+        what = f"change to T{change.tool}" + (
+            f": {change.description}" if change.description else ""
+        )
+        if spec.stop is None or spec.comment is None:
+            raise DialectError(
+                f"{self.where()}: {spec.name} cannot change tools ({what}): it has no tool "
+                "change code and no program stop with a comment, and camtool never drops a tool "
+                "change: post one program per tool (a job does so for such a target)"
+            )
+        turning = self.spindle
+        if turning is not None and spec.spindle_off is not None:
+            self.block([spec.spindle_off])
+        self._stop(False, what)
+        if turning is not None:
+            self.command(turning)  # the spindle as it was, for the new tool
+
+    def _stop(self, optional: bool, message: str) -> None:
+        """A program stop (``M0``; ``M1`` when ``optional``), after a comment saying why."""
+        spec = self.spec
+        code = (spec.optional_stop or spec.stop) if optional else spec.stop
+        if code is None:
+            kind = "optional stop (M1)" if optional else "program stop (M0)"
+            reason = f" ({message})" if message else ""
+            raise DialectError(
+                f"{self.where()}: {spec.name} has no {kind}{reason}; a stop is never dropped: "
+                "post the program for a target that stops, or take the stop out of it"
+            )
+        comment = spec.comment_line(message) if message else None
+        if comment is not None:
+            self.blocks.append(comment)
+        self.block([code])
+
+    def _summary(self) -> list[str]:
+        """One warning per kind of thing dropped or converted."""
+        name, d = self.spec.name, self.counts
+        texts = {
+            "feed": f"{name} has no F word: the feed of {d['feed']} cutting block(s) is not "
+            "written; the machine moves at its own speed",
+            "Spindle": f"{name} has no spindle command: {d['Spindle']} spindle command(s) "
+            "dropped; switch the spindle (or tool) on and off by hand",
+            "speed": f"{name}'s {self.spec.spindle_cw or self.spec.spindle_ccw} takes no S "
+            f"word: {d['speed']} spindle speed(s) not written; set the speed on the machine",
+            "Dwell": f"{name} has no dwell: {d['Dwell']} pause(s) dropped",
+            "ToolChange": f"{name} has no tool change: {d['ToolChange']} tool change(s) "
+            "dropped; change tools by hand",
+            "Home": f"{name} has no return to machine zero: {d['Home']} G28-style return(s) "
+            "dropped",
+            "z-split": f"{d['z-split']} move(s) changing XY and Z together written as a Z block "
+            f"and an XY block (Z first when rising, last when plunging): {name} puts Z moves in "
+            "blocks of their own",
+            "arc-chords": f"arcs that no printable centre lets {name}'s arc check accept at "
+            f"{self.spec.quantum_mm():g} mm written as {d['arc-chords']} straight chord(s) "
+            f"within {max(2.0 * self.spec.quantum_mm(), ARC_CHORD_TOLERANCE_MM):g} mm of them",
+            "plane-chords": f"{d['plane-chords']} arc(s) in the ZX or YZ plane whose printed "
+            f"numbers {name}'s arc check refuses, or too small to print, written as their "
+            "chords (a G-code file's within 0.001 mm, as read)",
+            "tiny-arc": f"{d['tiny-arc']} arc(s) too small for the "
+            f"{self.spec.quantum_mm():g} mm the dialect writes were written as straight lines "
+            "(or left out when both ends print the same)",
+        }
+        out = [texts[kind] for kind in texts if d[kind]]
+        if self.grid_error_mm > 0:
+            grids = {w.number.grid_mm for w in self.spec.words.values() if w.number.grid_mm}
+            grid = ", ".join(f"{g:g}" for g in sorted(grids))
+            out.append(
+                f"coordinates rounded to the {grid} mm step grid of {name}: largest change "
+                f"{self.grid_error_mm:.4f} mm"
+            )
+        return out
