@@ -56,7 +56,7 @@ _HOMES: dict[str, str] = {
     "Tool": "camtool.jobs.job",
     "Operation": "camtool.jobs.job",
     "Selection": "camtool.jobs.job",
-    "load_job": "camtool.jobs.job",
+    "load_job": "camtool.jobs.jobfile",
     "run_job": "camtool.jobs.run",
     # post
     "OutputOptions": "camtool.jobs.run",
@@ -112,7 +112,7 @@ if TYPE_CHECKING:  # the names as type checkers see them (``X as X``: exported, 
     from camtool.jobs.job import Operation as Operation
     from camtool.jobs.job import Selection as Selection
     from camtool.jobs.job import Tool as Tool
-    from camtool.jobs.job import load_job as load_job
+    from camtool.jobs.jobfile import load_job as load_job
     from camtool.jobs.pipeline import post_drawing as post_drawing
     from camtool.jobs.pipeline import post_file as post_file
     from camtool.jobs.pipeline import post_path as post_path

@@ -82,7 +82,7 @@ _JOB = re.compile(r"(<!-- job:begin -->\n).*?(<!-- job:end -->)", re.S)
 def job_files() -> dict[Path, str]:
     """docs/jobs.md's sample program (its head) and the picture of the sample job."""
     from camtool.importers import read_drawing
-    from camtool.jobs.job import load_job
+    from camtool.jobs.jobfile import load_job
     from camtool.jobs.run import run_job
 
     drawing = read_drawing(ROOT / "samples" / "part.dxf")

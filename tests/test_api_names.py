@@ -18,7 +18,8 @@ import pytest
 
 import camtool
 from camtool.importers.options import ImportOptions
-from camtool.jobs.job import _JOB_KEYS, _OP_PLAN_KEYS, Operation, Selection, Tool
+from camtool.jobs.job import Operation, Selection, Tool
+from camtool.jobs.jobfile import _JOB_KEYS, _OP_PLAN_KEYS
 from camtool.model.errors import UsageError
 from camtool.toolpath.options import RENAMED, PlanOptions, flag
 

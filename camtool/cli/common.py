@@ -251,9 +251,9 @@ def read_job(path: Path, plan: PlanOptions) -> Job:
 
     Raises:
         UsageError: a per-operation option (``--depth``, ``--offset``...) was given too.
-        InputError: the job file is invalid (:func:`camtool.jobs.job.load_job`).
+        InputError: the job file is invalid (:func:`camtool.jobs.jobfile.load_job`).
     """
-    from camtool.jobs.job import load_job, operation_flags, shared_overrides
+    from camtool.jobs.jobfile import load_job, operation_flags, shared_overrides
     from camtool.jobs.run import refuse_operation_options
 
     refuse_operation_options(operation_flags(plan))

@@ -28,7 +28,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from camtool.jobs.heights import check_heights
-from camtool.jobs.job import Job, Operation, Tool, as_keys
+from camtool.jobs.job import Job, Operation, Tool
+from camtool.jobs.jobfile import as_keys
 from camtool.jobs.selection import (
     Selected,
     construction_notes,
@@ -231,7 +232,7 @@ def run_job(
     Args:
         drawing: the imported drawing, mm.
         target: the target.
-        job: the job (:func:`~camtool.jobs.job.load_job`, or :meth:`Job.single` of
+        job: the job (:func:`~camtool.jobs.jobfile.load_job`, or :meth:`Job.single` of
             ``post``'s options).
         output: the output format and spindle (``None``: the defaults).
         progress: told the ``planning`` stage (and ``offsetting`` within it) and the

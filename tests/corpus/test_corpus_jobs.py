@@ -15,7 +15,7 @@ import pytest
 
 from camtool.importers import read_drawing
 from camtool.jobs.init import initial_job
-from camtool.jobs.job import job_from_dict
+from camtool.jobs.jobfile import job_from_dict
 from camtool.jobs.run import run_job
 from camtool.post.registry import load_target
 from tests.corpus.conftest import CORPUS, case_id, corpus_files, load_manifest, skip_reason

@@ -6,7 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from camtool.jobs.job import Job, load_job
+from camtool.jobs.job import Job
+from camtool.jobs.jobfile import load_job
 from camtool.model.errors import InputError
 
 ROOT = Path(__file__).resolve().parents[2]

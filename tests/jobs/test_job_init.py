@@ -9,7 +9,7 @@ import pytest
 
 from camtool.importers import read_drawing
 from camtool.jobs.init import initial_job
-from camtool.jobs.job import job_from_dict
+from camtool.jobs.jobfile import job_from_dict
 from camtool.jobs.run import run_job
 from camtool.model.errors import InputError
 from camtool.model.program import Linear

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from camtool.importers import read_drawing
-from camtool.jobs.job import load_job
+from camtool.jobs.jobfile import load_job
 from camtool.jobs.run import run_job
 from camtool.model.errors import InputError
 from camtool.model.program import DrillCycle, Linear, Rapid, Spindle, ToolChange

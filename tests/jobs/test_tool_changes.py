@@ -15,7 +15,7 @@ import pytest
 from camtool.cli.main import main
 from camtool.importers import read_drawing
 from camtool.importers.gcode import read_gcode
-from camtool.jobs.job import load_job
+from camtool.jobs.jobfile import load_job
 from camtool.jobs.pipeline import post_program
 from camtool.jobs.run import run_job
 from camtool.model.errors import DialectError

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from camtool.importers import read_drawing
-from camtool.jobs.job import load_job
+from camtool.jobs.jobfile import load_job
 from camtool.jobs.pipeline import report_json, verify_job
 from camtool.jobs.run import run_job
 from camtool.post.registry import load_target
