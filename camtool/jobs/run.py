@@ -27,6 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from camtool.jobs.drill import drill_moves
 from camtool.jobs.heights import check_heights
 from camtool.jobs.job import Job, Operation, Tool
 from camtool.jobs.jobfile import as_keys
@@ -36,11 +37,9 @@ from camtool.jobs.selection import (
     nothing_selected,
     select,
 )
-from camtool.model.drilling import expand
 from camtool.model.errors import InputError, UsageError
 from camtool.model.program import (
     Command,
-    DrillCycle,
     Dwell,
     Move,
     Program,
@@ -49,7 +48,7 @@ from camtool.model.program import (
     ToolChange,
 )
 from camtool.model.progress import Progress, Step, no_progress
-from camtool.model.shapes import Contour, Drawing, Point, circle_of
+from camtool.model.shapes import Contour, Drawing, Point
 from camtool.toolpath.options import PlanOptions
 
 if TYPE_CHECKING:
@@ -507,87 +506,10 @@ def _drill(
     here: tuple[float, float, float | None],
     where: str,
 ) -> _Planned:
-    """A drill operation: a canned cycle at each hole, nearest first."""
-    holes = _holes(drawing, op, tool, where)
-    assert options.depth is not None  # a drill operation's depth is required when loaded
-    clearance = options.clearance
-    moves: list[Move] = []
-    commands: list[tuple[int, Command]] = []
-    x, y, _ = here
-    moves.append(Rapid(x, y, clearance))  # the rise (left out when the tool is up there)
-    z = clearance
-    peck = options.step_down if options.step_down is not None else None
-    kind = (
-        "drill"
-        if peck is None or peck >= options.depth
-        else ("peck" if op.peck == "retract" else "chip-break")
-    )
-    for n, (hx, hy) in enumerate(_nearest_first(holes, (x, y)), start=1):
-        cycle = DrillCycle(
-            kind,  # type: ignore[arg-type]
-            hx,
-            hy,
-            -options.depth,
-            options.safe_z,
-            options.plunge_feed if options.plunge_feed_mm_min is not None else options.feed,
-            peck_mm=None if kind == "drill" else peck,
-            dwell_s=op.dwell_s if kind == "drill" else 0.0,
-            retract="initial",
-        )
-        items = expand(cycle, (x, y, z))
-        count = sum(1 for item in items if not isinstance(item, Dwell))
-        commands.append((len(moves), dataclasses.replace(cycle, moves=count)))
-        for item in items:
-            if isinstance(item, Dwell):
-                commands.append((len(moves), item))
-            else:
-                moves.append(dataclasses.replace(item, contour=n))
-        x, y = hx, hy
-        z = clearance
+    """A drill operation (:func:`camtool.jobs.drill.drill_moves`) as a planned operation."""
+    moves, commands, holes = drill_moves(drawing, op, tool, options, here, where)
     placed = Drawing(drawing.contours, drawing.source, (), drawing.marks)
-    return _Planned(moves, commands, [], None, placed, holes=len(holes))
-
-
-def _holes(drawing: Drawing, op: Operation, tool: Tool, where: str) -> list[Point]:
-    """The centres of the holes a drill operation drills, each checked against its drill."""
-    out: list[Point] = []
-    for contour in drawing.contours:
-        circle = circle_of(contour)
-        name = f"{contour.source or 'contour'} on layer {contour.layer!r}"
-        if circle is None:
-            raise InputError(
-                f"{where} drills {name} at ({contour.start[0]:.4f}, {contour.start[1]:.4f}) "
-                "mm, which is not a circle: a drill operation drills circles and points; cut "
-                "it with a profile or pocket operation (or narrow the selection)"
-            )
-        (cx, cy), d = circle
-        if abs(d - tool.diameter) > op.hole_tolerance + 1e-9:
-            size = "larger" if d > tool.diameter else "smaller"
-            raise InputError(
-                f"{where}: hole {name} at ({cx:.4f}, {cy:.4f}) mm is {d:.4g} mm across, "
-                f"{size} than the {tool.diameter:g} mm drill (hole_tolerance "
-                f"{op.hole_tolerance:g} mm): "
-                + (
-                    'cut it with a profile operation (side = "inside") instead'
-                    if d > tool.diameter
-                    else "drill it with a smaller drill"
-                )
-            )
-        out.append((cx, cy))
-    out.extend(m.at for m in drawing.marks)
-    return list(dict.fromkeys(out))
-
-
-def _nearest_first(points: Sequence[Point], start: Point) -> list[Point]:
-    """``points`` in nearest-neighbour order from ``start`` (ties: the earlier point)."""
-    left = list(points)
-    out: list[Point] = []
-    here = start
-    while left:
-        k = min(range(len(left)), key=lambda i: (math.dist(here, left[i]), i))
-        here = left.pop(k)
-        out.append(here)
-    return out
+    return _Planned(moves, commands, [], None, placed, holes=holes)
 
 
 def _tool_change(
