@@ -27,6 +27,7 @@ import numpy.typing as npt
 from camtool.model.program import ArcMove, Program, Rapid, segment_of
 from camtool.model.shapes import Arc, BBox, Drawing, Line, Point, Segment, bbox_union
 from camtool.model.units import fmt_num
+from camtool.verify.circlefit import CircleFit
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -376,10 +377,10 @@ def measure_contours(
         before = points[lo - 1] if lo > 0 else np.asarray(start_mm, dtype=np.float64)
         size = _extent(before, points, lo, hi)  # np.ptp of the run, without copying it
         last_point = points[hi - 1] if hi > lo else before
-        run_of = partial(_run_of, before, points, lo, hi)
+        radius_of = partial(_fitted_radius, before, points[lo:hi])
         measures.append(
             _contour_measure(
-                program, starts, number, (first, last), before, last_point, size, run_of
+                program, starts, number, (first, last), before, last_point, size, radius_of
             )
         )
     return measures
@@ -393,13 +394,15 @@ def _contour_measure(
     before: FloatArray,
     last_point: FloatArray,
     size: tuple[float, float],
-    run_of: Callable[[], FloatArray],
+    radius_of: Callable[[Point], float | None],
 ) -> ContourMeasure:
     """One contour's :class:`ContourMeasure` from its trace's extent and ends.
 
     ``before`` is the carriage before the contour's first row, ``last_point`` after its
     last (``before`` without rows), ``size`` the trace's extent (:func:`_extent`) and
-    ``run_of()`` its whole trace (read only for a circle).
+    ``radius_of(centre)`` the radius of the circle fitted to its whole trace about the
+    nominal ``centre`` (:class:`~camtool.verify.circlefit.CircleFit`; asked only for a
+    circle; ``None``: fewer than three points).
     """
     first, last = blocks
     segments = [segment_of(starts[i], program.moves[i]) for i in range(first, last + 1)]
@@ -424,12 +427,12 @@ def _contour_measure(
             (size[0] - nominal_size[0]) * 1000.0,
             (size[1] - nominal_size[1]) * 1000.0,
         ),
-        circle=_circle(segments, run_of, size) if closed else None,
+        circle=_circle(segments, radius_of, size) if closed else None,
     )
 
 
-def _circle_candidate(segments: list[Segment]) -> float | None:
-    """The radius of a contour made of arcs of one circle (see :func:`_circle`), else None."""
+def _circle_candidate(segments: list[Segment]) -> tuple[float, Point] | None:
+    """Radius and centre of a contour made of arcs of one circle (:func:`_circle`), else None."""
     cuts = [s for s in segments if not (isinstance(s, Line) and s.length <= 1e-9)]
     if not cuts or not all(isinstance(s, Arc) for s in cuts):
         return None
@@ -439,12 +442,16 @@ def _circle_candidate(segments: list[Segment]) -> float | None:
     turns = abs(sum(a.sweep for a in arcs)) / math.tau
     if not same or turns < 0.5 or abs(turns - round(turns)) > 1e-6:
         return None
-    return r0
+    return r0, c0
 
 
-def _run_of(before: FloatArray, points: FloatArray, lo: int, hi: int) -> FloatArray:
-    """A contour's trace: ``before`` then ``points[lo:hi]``, ``(hi − lo + 1, 2)`` mm."""
-    return np.vstack([before, points[lo:hi]])
+def _fitted_radius(before: FloatArray, rows: FloatArray, centre: Point) -> float | None:
+    """The radius of the circle fitted to ``before`` then ``rows`` (a contour's trace), mm."""
+    fit = CircleFit(centre)
+    fit.add(np.asarray(before, dtype=np.float64).reshape(1, 2))
+    fit.add(rows)
+    got = fit.result()
+    return None if got is None else got[2]
 
 
 def _extent(before: FloatArray, points: FloatArray, lo: int, hi: int) -> tuple[float, float]:
@@ -461,43 +468,26 @@ def _extent(before: FloatArray, points: FloatArray, lo: int, hi: int) -> tuple[f
 
 
 def _circle(
-    segments: list[Segment], run_of: Callable[[], FloatArray], size: tuple[float, float]
+    segments: list[Segment],
+    radius_of: Callable[[Point], float | None],
+    size: tuple[float, float],
 ) -> tuple[float, float, float, float] | None:
     """Nominal and fitted diameter of a contour made of arcs of one circle, else None.
 
-    ``run_of()`` gives the contour's trace (the point before it first), built only for a
-    contour of arcs.
+    ``radius_of(centre)`` gives the radius fitted to the contour's trace (the point
+    before it first) about the nominal centre, asked only for a contour of arcs.
 
     Z-only moves (a plunge, a rise onto a tab: no XY length) do not count, and a circle
     cut in several depth passes (sweeps adding up to a whole number of turns) is one.
     """
-    r0 = _circle_candidate(segments)
-    if r0 is None:
+    candidate = _circle_candidate(segments)
+    if candidate is None:
         return None
-    run = run_of()
-    if len(run) < 3:
+    r0, centre = candidate
+    radius = radius_of(centre)
+    if radius is None:
         return None
-    return (2.0 * r0, 2.0 * fit_circle(run)[2], size[0], size[1])
-
-
-def fit_circle(points: FloatArray) -> tuple[float, float, float]:
-    """Least-squares circle through points (Kåsa 1976): ``(cx, cy, r)``, mm.
-
-    Args:
-        points: ``(N, 2)`` float64, N >= 3, not collinear.
-    """
-    x, y = points[:, 0], points[:, 1]
-    mx, my = float(x.mean()), float(y.mean())
-    a = np.empty((len(points), 3), dtype=np.float64)  # (u, v, 1), u and v written in place
-    u, v = a[:, 0], a[:, 1]
-    np.subtract(x, mx, out=u)
-    np.subtract(y, my, out=v)
-    a[:, 2] = 1.0
-    b = u * u
-    b += v * v  # u² + v², as one expression adds them
-    (p, q, s), *_ = np.linalg.lstsq(a, b, rcond=None)
-    cx, cy = p / 2.0, q / 2.0
-    return (mx + cx, my + cy, math.sqrt(s + cx * cx + cy * cy))
+    return (2.0 * r0, 2.0 * radius, size[0], size[1])
 
 
 @dataclass(frozen=True)
@@ -1909,12 +1899,12 @@ class _Contour:
         self.pending: list[tuple[int, FloatArray]] = []
         self.pending_count = 0
         self.kept: list[FloatArray] = []
-        self.circle: FloatArray | None = None  # a circle's whole run, for the fit
+        self.circle: CircleFit | None = None  # a circle's fit, fed its run as it comes
 
     def add(self, j0: int, points: FloatArray) -> None:
-        """The run's points ``j0, j0 + 1, ...`` (run index 0 is the point before)."""
+        """The run's points ``j0, j0 + 1, ...`` (run index 0 is the point before), in order."""
         if self.circle is not None:
-            self.circle[j0 : j0 + len(points)] = points
+            self.circle.add(points)
         if self.every == 0:
             self.pending.append((j0, points))
             self.pending_count += len(points)
@@ -2000,8 +1990,9 @@ class TraceStream:
     every-k-th, read from the contour's first :data:`THIN_HEAD` points and its known
     length, the moves' last rows and its last point) and measured as
     :func:`along_path` measures it (:class:`_Bounded`, the samples that cannot pass the
-    largest shortfall so far left out). A contour that is a circle keeps its whole trace for
-    the fit. The one exception is the deviation's rms: numpy's pairwise mean of the
+    largest shortfall so far left out). A contour that is a circle feeds its rows to its
+    fit as they come (:class:`~camtool.verify.circlefit.CircleFit`). The one exception
+    is the deviation's rms: numpy's pairwise mean of the
     whole array cannot be reproduced chunk by chunk, so it is the square root of the
     exact sum of the squares (an integer sum of their mantissas by exponent,
     :func:`camtool.verify.kernels.exact_sum_squares`; the squares are numpy's ``d * d``),
@@ -2160,14 +2151,11 @@ class TraceStream:
                 self.next_run += 1
                 c = _Contour(self.next_run, a, b, bs)
                 c.before = self._point(c.lo - 1, r0, points).copy()
-                if (
-                    _circle_candidate(
-                        [segment_of(self.starts[i], self.program.moves[i]) for i in range(a, b + 1)]
-                    )
-                    is not None
-                    and math.dist(self.starts[a], self.starts[b + 1]) <= 1e-6
-                ):
-                    c.circle = np.empty((c.n, 2), dtype=np.float64)  # filled as it comes
+                candidate = _circle_candidate(
+                    [segment_of(self.starts[i], self.program.moves[i]) for i in range(a, b + 1)]
+                )
+                if candidate is not None and math.dist(self.starts[a], self.starts[b + 1]) <= 1e-6:
+                    c.circle = CircleFit(candidate[1])  # fed as the rows come
                 for axis in (0, 1):
                     c.top[axis] = c.low[axis] = float(c.before[axis])
                 c.add(0, c.before.reshape(1, 2))
@@ -2193,8 +2181,7 @@ class TraceStream:
     def _close(self, c: _Contour) -> None:
         program, starts = self.program, self.starts
         self.ends.append(math.dist(c.last_point, starts[c.last + 1]))
-        circle = c.circle
-        run_of = (lambda: circle) if circle is not None else (lambda: np.zeros((0, 2)))
+        fitted = None if c.circle is None else c.circle.result()
         self.contours.append(
             _contour_measure(
                 program,
@@ -2204,7 +2191,7 @@ class TraceStream:
                 c.before,
                 c.last_point,
                 c.extent(),
-                run_of,
+                lambda centre: None if fitted is None else fitted[2],
             )
         )
         ends = _LazyTree(c.ends())  # one k-d tree for every batch (when one is used)
