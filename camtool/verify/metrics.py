@@ -628,7 +628,7 @@ def _nearest(
     With ``only_max`` an unsure sample that cannot reach the largest settled distance
     keeps its upper bound (:func:`_reaching`): the array's max and argmax are exact.
     """
-    search = _box_search(samples, a, b)
+    search = _box_search(samples, a, b, ends)
     if search is None:
         return _nearest_kd(samples, a, b, ends=ends, only_max=only_max)
     ends = ends or _LazyTree(search.points)
@@ -701,26 +701,34 @@ class _BoxSearch:
         )
 
 
-def _box_search(samples: FloatArray, a: FloatArray, b: FloatArray) -> _BoxSearch | None:
+def _box_search(
+    samples: FloatArray, a: FloatArray, b: FloatArray, ends: _LazyTree | None = None
+) -> _BoxSearch | None:
     """The compiled search of ``samples`` among ``a → b``, or ``None`` for the k-d tree path.
 
     ``None`` without the compiled search (:func:`near_kernels`: numba missing, or too few
     samples in this process so far), for fewer than :data:`NEAREST_ENDS` ends, and for
     many samples near the segments (:func:`_far`), which the k-d tree answers faster.
-    Both paths give the same distances.
+    Both paths give the same distances. ``ends``: the segments' ends
+    (``concatenate([a, b])``, C-contiguous float64) with the search trees already built
+    for other samples; built here otherwise.
     """
     kernels = near_kernels(len(samples))
     if kernels is None or len(a) == 0 or 2 * len(a) <= NEAREST_ENDS:
         return None
     samples = np.ascontiguousarray(samples, dtype=np.float64)
-    a = np.ascontiguousarray(a, dtype=np.float64)
-    b = np.ascontiguousarray(b, dtype=np.float64)
-    half = float(np.max(np.hypot(*(b - a).T))) / 2.0
-    points = _end_points(a, b)
-    tree = _ends_tree(points, len(samples), kernels)
-    if len(samples) > BOX_TREE_UP_TO and not _far(samples, tree, half, kernels):
+    if ends is None:
+        a = np.ascontiguousarray(a, dtype=np.float64)
+        b = np.ascontiguousarray(b, dtype=np.float64)
+        ends = _LazyTree(_end_points(a, b))
+    else:
+        a, b = _halves(np.ascontiguousarray(ends.points, dtype=np.float64))
+    half = ends.half()
+    many = len(samples) > BOX_TREE_UP_TO
+    if many and not _far(samples, ends.boxes(len(samples), kernels, any_built=True), half, kernels):
         return None
-    return _BoxSearch(samples, a, b, half, points, tree, kernels)
+    tree = ends.boxes(len(samples), kernels)
+    return _BoxSearch(samples, a, b, half, ends.points, tree, kernels)
 
 
 def farthest_off(samples: FloatArray, a: FloatArray, b: FloatArray, offset: float) -> float:
@@ -884,11 +892,19 @@ TIED_CHUNK = 2_000
 
 
 class _LazyTree:
-    """scipy's k-d tree of some points, built when first asked for."""
+    """The search structures of some points, each built when first asked for.
+
+    scipy's k-d tree (:attr:`tree`) and, for segment ends ``concatenate([a, b])``
+    (:func:`_end_points`), the compiled search's trees (:meth:`boxes`) and half the
+    longest segment (:meth:`half`): the batches of samples measured against one trace
+    share them instead of building them once a batch.
+    """
 
     def __init__(self, points: FloatArray) -> None:
         self.points = points
         self._tree: Any = None
+        self._boxes: dict[bool, tuple[Any, ...]] = {}
+        self._half: float | None = None
 
     @property
     def tree(self) -> Any:
@@ -897,6 +913,34 @@ class _LazyTree:
 
             self._tree = cKDTree(self.points)
         return self._tree
+
+    def half(self) -> float:
+        """Half the longest of the segments ``a[i] → b[i]`` whose ends these points are, mm."""
+        if self._half is None:
+            a, b = _halves(self.points)
+            self._half = float(np.max(np.hypot(*(b - a).T))) / 2.0
+        return self._half
+
+    def boxes(
+        self, samples: int, kernels: ModuleType, *, any_built: bool = False
+    ) -> tuple[Any, ...]:
+        """:func:`_ends_tree` of these segment ends for ``samples`` samples.
+
+        ``any_built``: a tree built already for another number of samples will do (the
+        same answers, :func:`_ends_tree`).
+        """
+        merge = len(self.points) <= MERGE_ENDS_PER_SAMPLE * samples
+        if any_built and self._boxes:
+            return next(iter(self._boxes.values()))
+        if merge not in self._boxes:
+            self._boxes[merge] = _ends_tree(self.points, samples, kernels)
+        return self._boxes[merge]
+
+
+def _halves(points: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """``(a, b)`` of segment ends ``concatenate([a, b])`` (views)."""
+    n = len(points) // 2
+    return points[:n], points[n:]
 
 
 NEAR_KERNELS_FROM = 500_000
@@ -940,7 +984,7 @@ def _nearest_kd(
     """:func:`nearest_distances_kd` (``ends``, ``only_max``: as for :func:`_nearest`)."""
     if len(a) == 0:
         return np.full(len(samples), np.inf)
-    half = float(np.max(np.hypot(*(b - a).T))) / 2.0
+    half = float(np.max(np.hypot(*(b - a).T))) / 2.0 if ends is None else ends.half()
     tree = (ends or _LazyTree(_end_points(a, b))).tree
     d = np.empty(len(samples), dtype=np.float64)
     unsure = np.empty(len(samples), dtype=bool)
@@ -1440,6 +1484,9 @@ on it."""
 SHORTFALL_WINDOW = 4
 """Trace segments on each side of a path sample's place along the trace that
 :class:`_Bounded` measures it against (its bound; only the time depends on it)."""
+SHORTFALL_ROUND = 1024
+"""Samples of largest bound :meth:`_Bounded.farthest` measures first (only the time
+depends on it: the likeliest samples measured first leave most others out)."""
 SHORTFALL_CHUNK = 1 << 15
 """Path samples or trace points :class:`_Bounded` works on at once (memory)."""
 
@@ -1623,38 +1670,40 @@ class _Bounded:
         ``floor``: a shortfall already found, mm. A sample whose shortfall cannot reach
         it is not measured; ``None`` says that none can (their largest is below it).
         The answer may still be below ``floor`` (then the largest of those that may not).
+
+        The samples are measured in two rounds: the :data:`SHORTFALL_ROUND` of largest
+        bound, then the others whose bound reaches the largest shortfall of the first.
+        Each sample's distance is its own (:func:`nearest_distances`) and each round
+        gives its largest and the first sample at it, so the larger of the two and the
+        first sample at it are those of measuring them all at once.
         """
         if len(self.samples) == 0:
             return None
-        top = int(np.argmax(self.reach))
-        if self.reach[top] < floor:
+        order = np.argsort(-self.reach, kind="stable")  # the likeliest first
+        reach = self.reach[order]
+        if reach[0] < floor:
             return None
         a, b = self.places.a, self.places.b
-        # the top sample's true distance: what it is measured is no less, nor the largest
-        least = _least_distance(self.samples[top], a, b)
-        known = max(floor, least * (1.0 - 1e-9) - self.slack)
-        keep = self.reach >= known
-        keep[top] = True
-        index = np.flatnonzero(keep)
-        far, k = farthest_nearest(self.samples[index], a, b, ends=self.ends)
-        return far, int(index[k])
+        ends = self.ends if self.ends is not None else _LazyTree(_end_points(a, b))
+        best: tuple[float, int] | None = None
+        known, at, size = floor, 0, SHORTFALL_ROUND
+        while at < len(order):
+            stop = min(len(order), at + size)  # of those whose bound reaches the largest known
+            stop = min(stop, at + int(np.searchsorted(-reach[at:stop], -known, "right")))
+            if stop <= at:
+                break
+            index = np.sort(order[at:stop])  # in sample order: the first of equal ones
+            far, k = farthest_nearest(self.samples[index], a, b, ends=ends)
+            if best is None or far > best[0] or (far == best[0] and index[k] < best[1]):
+                best = (far, int(index[k]))
+            known = max(known, far)
+            at, size = stop, len(order)
+        return best
 
 
 def _largest_magnitude(values: FloatArray) -> float:
     """``max(|values|)`` without an array of the magnitudes (a trace's would be ~6 MB)."""
     return max(abs(float(np.max(values))), abs(float(np.min(values))))
-
-
-def _least_distance(p: FloatArray, a: FloatArray, b: FloatArray) -> float:
-    """Distance of the point ``p`` ``(2,)`` to the segments ``a → b`` ``(S, 2)``, mm."""
-    least = math.inf
-    for lo in range(0, len(a), SHORTFALL_CHUNK):
-        sa, sb = a[lo : lo + SHORTFALL_CHUNK], b[lo : lo + SHORTFALL_CHUNK]
-        d = _segment_formula(
-            p[0] - sa[:, 0], p[1] - sa[:, 1], sb[:, 0] - sa[:, 0], sb[:, 1] - sa[:, 1]
-        )
-        least = min(least, float(np.min(d)))
-    return least
 
 
 def _segment_formula(
@@ -2018,6 +2067,7 @@ class TraceStream:
         rms: bool = True,
     ):
         self.rms = rms
+        near_kernels()  # numba is loaded already: the compiled nearest search costs its cache
         self.program = program
         self.block_start = block_start
         self.kernels = kernels
