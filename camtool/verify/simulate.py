@@ -372,9 +372,7 @@ class _IdealController(_Controller):
             rows = self._ideal_arc(start_mm, move)
             line_starts: list[int] = []
         elif isinstance(move, ArcMove):
-            points = self._chord_points(start_mm, move)
-            lattice = [self.pos] + [(x * self.spm[0], y * self.spm[1]) for x, y in points]
-            lattice[-1] = end
+            lattice = self._lattice(start_mm, move, end)
             parts, line_starts, offset = [], [], 0
             for a, b in itertools.pairwise(lattice):
                 part = self._ideal_line(a, b)
@@ -413,6 +411,44 @@ class _IdealController(_Controller):
             return none, none
         return np.zeros(1, dtype=np.int64), np.full(1, sign, dtype=np.int64)
 
+    def _lattice(
+        self, start_mm: Point, move: ArcMove, end: tuple[float, float]
+    ) -> list[tuple[float, float]]:
+        """A chord arc's corners in fractional steps, from here to ``end``."""
+        points = self._chord_points(start_mm, move)
+        lattice = [self.pos] + [(x * self.spm[0], y * self.spm[1]) for x, y in points]
+        lattice[-1] = end
+        return lattice
+
+    def count_block(self, start_mm: Point, move: Move) -> None:
+        """:meth:`block` without its rows: their count, and the position the next one needs.
+
+        For a controller that inserts no compensation rows (no compensation steps) and
+        whose lines reach their counts (not :attr:`inexact`): then a block's rows are
+        those of its ideal line, arc or chords, whose counts :meth:`_line_rows` and
+        :meth:`_arc_rows` give as :meth:`_ideal_line` and :meth:`_ideal_arc` make them.
+        """
+        assert not any(self.comp_steps) and not self.inexact
+        end = (self.to_steps(move.x, 0), self.to_steps(move.y, 1))
+        if isinstance(move, ArcMove) and self.arc is not None:
+            rows = self._arc_rows(start_mm, move)[0]
+        elif isinstance(move, ArcMove):
+            lattice = self._lattice(start_mm, move, end)
+            rows = sum(
+                self._line_rows(b[0] - a[0], b[1] - a[1]) for a, b in itertools.pairwise(lattice)
+            )
+        else:
+            rows = self._line_rows(end[0] - self.pos[0], end[1] - self.pos[1])
+        self.counts.append(rows)
+        self.pos = end  # type: ignore[assignment]
+
+    @staticmethod
+    def _line_rows(dx: float, dy: float) -> int:
+        """Rows of an ideal line of ``(dx, dy)`` fractional steps (0 for none)."""
+        if dx == 0 and dy == 0:
+            return 0
+        return max(1, math.ceil(IDEAL_SAMPLES_PER_STEP * max(abs(dx), abs(dy))))
+
     def _ideal_line(self, a: tuple[float, float], b: tuple[float, float]) -> FloatArray:
         dx, dy = b[0] - a[0], b[1] - a[1]
         counted = (
@@ -423,12 +459,19 @@ class _IdealController(_Controller):
             net = np.asarray(counted, dtype=np.int64).sum(axis=0)
             dx *= float(net[0]) / programmed[0] if programmed[0] else 1.0
             dy *= float(net[1]) / programmed[1] if programmed[1] else 1.0
-        n = max(1, math.ceil(IDEAL_SAMPLES_PER_STEP * max(abs(dx), abs(dy))))
-        if dx == 0 and dy == 0:
+        n = self._line_rows(dx, dy)
+        if n == 0:
             return np.zeros((0, 2), dtype=np.float64)
         return np.tile(np.asarray([[dx / n, dy / n]], dtype=np.float64), (n, 1))
 
-    def _ideal_arc(self, start_mm: Point, move: ArcMove) -> FloatArray:
+    def _arc_rows(
+        self, start_mm: Point, move: ArcMove
+    ) -> tuple[int, tuple[float, float, float, float, float, float]]:
+        """Rows of the ideal arc from here to ``move``'s end, and its circle in steps.
+
+        ``(n, (cx, cy, r0, r1, a0, sweep))``: centre, start and end radius, start angle
+        and signed sweep; ``n`` is 0 for an arc shorter than 1e-9 steps (not a full one).
+        """
         sx, sy = self.spm[0], self.spm[1]
         cx, cy = move.cx * sx, move.cy * sy
         x0, y0 = self.pos
@@ -438,9 +481,17 @@ class _IdealController(_Controller):
         turn = -math.tau if move.clockwise else math.tau
         sweep = (a1 - a0) % turn or turn
         full = distance(start_mm, (move.x, move.y)) <= 1e-9
+        circle = (cx, cy, r0, r1, a0, sweep)
         if not full and math.hypot(x1 - x0, y1 - y0) < 1e-9:
+            return 0, circle
+        return max(1, math.ceil(IDEAL_SAMPLES_PER_STEP * abs(sweep) * max(r0, r1))), circle
+
+    def _ideal_arc(self, start_mm: Point, move: ArcMove) -> FloatArray:
+        n, (cx, cy, r0, r1, a0, sweep) = self._arc_rows(start_mm, move)
+        if n == 0:
             return np.zeros((0, 2), dtype=np.float64)
-        n = max(1, math.ceil(IDEAL_SAMPLES_PER_STEP * abs(sweep) * max(r0, r1)))
+        x0, y0 = self.pos
+        x1, y1 = move.x * self.spm[0], move.y * self.spm[1]
         t = np.arange(1, n + 1, dtype=np.float64) / n
         radius = r0 + (r1 - r0) * t
         points = np.column_stack(
@@ -671,8 +722,10 @@ def count_rows(
     What :func:`simulate_or_count` returns for a trace over its limit, without making the
     rows of a line or rapid whose interpolator counts them in closed form
     (:data:`LINE_ROWS`: the A.3 DDA's ``floor(HIPO) + 1``, and a compensation's rows at a
-    reversal); other moves (arcs, other interpolators, a line whose piece models
-    dynamics, every move of the ideal controller) are simulated, their rows dropped.
+    reversal), and every move of the ideal controller that inserts no compensation rows
+    (:meth:`_IdealController.count_block`); other moves (arcs, other interpolators, a
+    line whose piece models dynamics, the ideal controller's moves with compensation)
+    are simulated, their rows dropped.
     ``sources``: the trace of :func:`simulate_steps` with these sources;
     ``closed_form=False`` simulates every move.
     :class:`ChunkedSimulation` makes the same offsets again from the rows themselves,
@@ -686,10 +739,15 @@ def count_rows(
     sim = kind(machine, program.origin, sources)
     exact = closed_form and sources.interpolation and not sim.inexact
     rows_of = LINE_ROWS.get(sim.line) if exact else None
+    ideal = sim if isinstance(sim, _IdealController) else None
+    if not closed_form or any(sim.comp_steps) or sim.inexact:
+        ideal = None
     start = program.origin
     for k, move in enumerate(program.moves):
         try:
-            if rows_of is not None and not isinstance(move, ArcMove):
+            if ideal is not None:
+                ideal.count_block(start, move)
+            elif rows_of is not None and not isinstance(move, ArcMove):
                 sim.count_line(move, rows_of)
             else:
                 sim.block(start, move)
