@@ -2424,6 +2424,28 @@ def prepare_comparison(drawing: Drawing) -> None:
         _load_kernels()
 
 
+def prepare_stream() -> None:
+    """Ahead of streaming a trace here and in a forked helper: load what both call once.
+
+    numba's compiler registries (its first call, ~0.2 s), the kernels the measures of
+    every chunk call on its read-only carriage (``to_line``, ``extent``) and the
+    compiled nearest search of the shortfall (:func:`near_kernels`, ``load_cached``),
+    so that a helper forked next inherits them instead of loading them again, while this
+    process would load them at its first chunk anyway. Only the time depends on it.
+    """
+    from camtool.verify.interpolators import compiled
+
+    kernels = compiled()
+    near = near_kernels()
+    if kernels is None or near is None:
+        return
+    near.load_cached()
+    points = np.zeros((2, 2))
+    points.flags.writeable = False  # as a chunk's carriage comes
+    kernels.to_line(points, 0.0, 0.0, 1.0, 0.0, np.zeros(2))
+    kernels.extent(points)
+
+
 def comparison_preloads(drawing: Drawing) -> list[Callable[[], object]]:
     """What :func:`prepare_comparison` will load for ``drawing``, as tasks for a wait.
 

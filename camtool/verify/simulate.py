@@ -833,7 +833,9 @@ class ChunkedSimulation:
         """
         sim = self.sim
         ideal = isinstance(sim, _IdealController)
-        play = _FloatPlay(sim.origin_steps, self.machine) if ideal else _StepPlay(self)
+        play: _StepPlay | _FloatPlay | _FloatPlayCompiled = _StepPlay(self)
+        if ideal:
+            play = _FloatPlayCompiled(sim.origin_steps, self.machine, self.jit)
         start = self.program.origin
         first, row0, pending = 0, 0, 0
         moves = self.program.moves
@@ -925,6 +927,49 @@ class _StepPlay:
                 )
             )
         return rows, out
+
+
+class _FloatPlayCompiled:
+    """:class:`_FloatPlay` by the compiled loops: the same floats, three passes, no temporaries.
+
+    :func:`camtool.verify.kernels.ideal_motor` sums the rows into the motor and takes
+    their directions; :func:`camtool.verify.kernels.runs` finds where each axis's runs
+    start, whose bands :func:`_run_bands` looks up at the motor there, as
+    :meth:`_FloatPlay._band` does; :func:`camtool.verify.kernels.ideal_play_axis` is the
+    play operator, its state carried from chunk to chunk.
+    """
+
+    def __init__(self, origin: tuple[float, float], machine: Machine, jit: Any) -> None:
+        self.machine = machine
+        self.origin = np.asarray(origin, dtype=np.float64)
+        self.jit = jit
+        self.total = np.zeros(2, dtype=np.float64)  # the rows' running sum so far
+        self.state = [np.zeros(5, dtype=np.float64), np.zeros(5, dtype=np.float64)]
+
+    def chunk(self, rows: FloatArray) -> tuple[StepArray, FloatArray]:
+        """Each row's direction ``(n, 2) int8`` and the carriage after it, ``(n, 2)`` mm."""
+        n = len(rows)
+        signs = np.empty((n, 2), dtype=STEP_DTYPE)
+        out = np.empty((n, 2), dtype=np.float64)
+        if not n:
+            return signs, out
+        motor = np.empty((n, 2), dtype=np.float64)
+        rows = np.ascontiguousarray(rows, dtype=np.float64)
+        self.jit.ideal_motor(rows, self.total, self.origin, motor, signs)
+        true = self.machine.real_steps_per_mm
+        found = []
+        for axis in (0, 1):  # every band looked up before the motor is overwritten
+            starts, run_signs = self.jit.runs(signs, axis, int(self.state[axis][4]))
+            found.append(
+                (starts, run_signs, _run_bands(self.machine, axis, run_signs, motor[starts]))
+            )
+        for axis in (0, 1):
+            starts, run_signs, bands = found[axis]
+            origin, spm = float(self.origin[axis]), float(true[axis])
+            self.jit.ideal_play_axis(
+                motor, axis, starts, run_signs, bands, self.state[axis], origin, spm, out
+            )
+        return signs, out
 
 
 class _FloatPlay:
