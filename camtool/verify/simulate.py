@@ -494,11 +494,13 @@ class _IdealController(_Controller):
         x1, y1 = move.x * self.spm[0], move.y * self.spm[1]
         t = np.arange(1, n + 1, dtype=np.float64) / n
         radius = r0 + (r1 - r0) * t
-        points = np.column_stack(
-            (cx + radius * np.cos(a0 + sweep * t), cy + radius * np.sin(a0 + sweep * t))
-        )
+        angle = a0 + sweep * t
+        points = np.empty((n + 1, 2), dtype=np.float64)  # the start, then the samples
+        points[0] = (x0, y0)
+        points[1:, 0] = cx + radius * np.cos(angle)
+        points[1:, 1] = cy + radius * np.sin(angle)
         points[-1] = (x1, y1)
-        return np.diff(np.vstack([[x0, y0], points]), axis=0)
+        return points[1:] - points[:-1]
 
 
 def _block_of_row(blocks: int, block_start: IntArray) -> IntArray:
