@@ -421,26 +421,51 @@ class _IdealController(_Controller):
         return lattice
 
     def count_block(self, start_mm: Point, move: Move) -> None:
-        """:meth:`block` without its rows: their count, and the position the next one needs.
+        """:meth:`block` without its rows: their count, and the state the next one needs.
 
-        For a controller that inserts no compensation rows (no compensation steps) and
-        whose lines reach their counts (not :attr:`inexact`): then a block's rows are
-        those of its ideal line, arc or chords, whose counts :meth:`_line_rows` and
-        :meth:`_arc_rows` give as :meth:`_ideal_line` and :meth:`_ideal_arc` make them.
+        For a controller whose lines reach their counts (not :attr:`inexact`): a line's
+        or chord's rows are its ideal line's (:meth:`_line_rows`, as :meth:`_ideal_line`
+        makes them) and one compensation row for each axis it reverses (its rows all go
+        one way: the reversal is at its first row); a native arc's are its ideal arc's
+        (:meth:`_arc_rows`) when no compensation can be inserted, else the arc is made
+        (its reversals lie inside it) and its rows dropped. The position, each axis's
+        direction and its reversals are kept as :meth:`block` keeps them.
         """
-        assert not any(self.comp_steps) and not self.inexact
+        assert not self.inexact
         end = (self.to_steps(move.x, 0), self.to_steps(move.y, 1))
         if isinstance(move, ArcMove) and self.arc is not None:
+            if any(self.comp_steps):
+                self.block(start_mm, move)
+                self.parts.clear()
+                self.comp_parts.clear()
+                return
             rows = self._arc_rows(start_mm, move)[0]
         elif isinstance(move, ArcMove):
             lattice = self._lattice(start_mm, move, end)
             rows = sum(
-                self._line_rows(b[0] - a[0], b[1] - a[1]) for a, b in itertools.pairwise(lattice)
+                self._count_line(b[0] - a[0], b[1] - a[1]) for a, b in itertools.pairwise(lattice)
             )
         else:
-            rows = self._line_rows(end[0] - self.pos[0], end[1] - self.pos[1])
+            rows = self._count_line(end[0] - self.pos[0], end[1] - self.pos[1])
         self.counts.append(rows)
         self.pos = end  # type: ignore[assignment]
+
+    def _count_line(self, dx: float, dy: float) -> int:
+        """Rows of the ideal line of ``(dx, dy)`` with its compensations; the directions kept."""
+        rows = self._line_rows(dx, dy)
+        if rows == 0:
+            return 0
+        for axis, d in ((0, dx), (1, dy)):
+            step = d / rows  # the line's rows: one value (see _ideal_line)
+            if step == 0:
+                continue
+            sign = 1 if step > 0 else -1
+            if self.direction[axis] not in (0, sign):
+                self.reversals[axis] += 1
+                if self.comp_steps[axis]:
+                    rows += 1  # one row of the exact compensation (comp_rows)
+            self.direction[axis] = sign
+        return rows
 
     @staticmethod
     def _line_rows(dx: float, dy: float) -> int:
@@ -724,10 +749,10 @@ def count_rows(
     What :func:`simulate_or_count` returns for a trace over its limit, without making the
     rows of a line or rapid whose interpolator counts them in closed form
     (:data:`LINE_ROWS`: the A.3 DDA's ``floor(HIPO) + 1``, and a compensation's rows at a
-    reversal), and every move of the ideal controller that inserts no compensation rows
-    (:meth:`_IdealController.count_block`); other moves (arcs, other interpolators, a
-    line whose piece models dynamics, the ideal controller's moves with compensation)
-    are simulated, their rows dropped.
+    reversal), and the ideal controller's lines, chords and, where it inserts no
+    compensation, native arcs (:meth:`_IdealController.count_block`); other moves (arcs,
+    other interpolators, a line whose piece models dynamics, the ideal controller's arcs
+    with compensation) are simulated, their rows dropped.
     ``sources``: the trace of :func:`simulate_steps` with these sources;
     ``closed_form=False`` simulates every move.
     :class:`ChunkedSimulation` makes the same offsets again from the rows themselves,
@@ -742,7 +767,7 @@ def count_rows(
     exact = closed_form and sources.interpolation and not sim.inexact
     rows_of = LINE_ROWS.get(sim.line) if exact else None
     ideal = sim if isinstance(sim, _IdealController) else None
-    if not closed_form or any(sim.comp_steps) or sim.inexact:
+    if not closed_form or sim.inexact:
         ideal = None
     start = program.origin
     for k, move in enumerate(program.moves):
