@@ -14,6 +14,16 @@ run time) on the same lines in steps, and the ratio is camtool's whole-verify st
 the C DDA loop's steps/s. The demo logo (``samples/logo.dxf`` posted to pic-mmh, as
 ``make demo``) is verified too (time only).
 
+Three rows first (:func:`budget_rows`): ``camtool verify`` with the error budget against
+``--no-budget`` on 40 of these lines (2.58 M steps, under the budget's 3 M rows) without
+backlash (``--machine`` overlay: one source, the interpolation) and with the profile's (two
+sources), and on one contour of 40 half circles (:func:`arcs_program`, 2.45 M rows, no
+backlash). The goal: with the budget, at most 1.5 times the wall and CPU time of
+``--no-budget`` and at most 250 MB. Second pass (24 Nov 2026, quiet; docs/performance.md):
+1.25 s, 1.69 s CPU, 234 MB against 0.57 s, 0.80 s CPU (2.2×); 1.60 s, 2.06 s CPU, 226 MB
+against 0.56 s, 0.79 s CPU (2.8×); 2.26 s, 3.39 s CPU, 235 MB against 0.90 s, 1.23 s CPU
+(2.8×). The memory goal is met, the time goal is not.
+
 Set ``CAMTOOL_BENCH_BASE=/path/to/old/tree`` to run the same two jobs on another tree
 (e.g. the code before issue 17) in the same run: its times and memory are printed, and
 the reports must be byte-identical (the row notes it).
