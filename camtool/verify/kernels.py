@@ -527,3 +527,126 @@ def to_line(points: Any, x0: float, y0: float, x1: float, y1: float, out: Any) -
         elif t > 1.0:
             t = 1.0
         out[i] = math.hypot(px - t * dx, py - t * dy)
+
+
+@numba.njit(cache=True, nogil=True)
+def ideal_motor(rows: Any, total: Any, origin: Any, motor: Any, signs: Any) -> None:
+    """The ideal controller's motor after each fractional row, and each row's direction.
+
+    ``motor[i] = (total + rows[0] + … + rows[i]) + origin`` per axis: the running sum in
+    row order (numpy's ``cumsum``, resumed from ``total``), then the origin added, as
+    ``simulate._FloatPlay`` and ``simulate._motor`` take them; ``total`` becomes the
+    running sum after the last row. ``signs[i]`` is ``sign(rows[i])`` (int8; 0 for a
+    zero of either sign).
+    """
+    tx = total[0]
+    ty = total[1]
+    ox = origin[0]
+    oy = origin[1]
+    for i in range(rows.shape[0]):
+        rx = rows[i, 0]
+        ry = rows[i, 1]
+        tx += rx
+        ty += ry
+        motor[i, 0] = tx + ox
+        motor[i, 1] = ty + oy
+        signs[i, 0] = 1 if rx > 0 else (-1 if rx < 0 else 0)
+        signs[i, 1] = 1 if ry > 0 else (-1 if ry < 0 else 0)
+    total[0] = tx
+    total[1] = ty
+
+
+@numba.njit(cache=True, nogil=True)
+def _scan_runs(signs: Any, axis: int, sign0: int, starts: Any, run_signs: Any) -> int:
+    """Count (and, given room, fill) the runs of column ``axis`` (see :func:`runs`)."""
+    count = 0
+    previous = sign0
+    room = starts.shape[0]
+    for i in range(signs.shape[0]):
+        s = signs[i, axis]
+        if s != 0 and s != previous:
+            if count < room:
+                starts[count] = i
+                run_signs[count] = s
+            count += 1
+        if s != 0:
+            previous = s
+    return count
+
+
+def runs(signs: Any, axis: int, sign0: int) -> tuple[Any, Any]:
+    """The runs that start in column ``axis`` of direction rows ``signs`` ``(N, 2) int8``.
+
+    A run starts at a non-zero direction that differs from the previous non-zero one
+    (``sign0`` before the first row; 0: none yet, so the first non-zero starts one).
+    Returns their rows ``(R,) int64`` and directions ``(R,) int8``.
+    """
+    none = np.empty(0, dtype=np.int64)
+    count = _scan_runs(signs, axis, sign0, none, np.empty(0, dtype=np.int8))
+    starts = np.empty(count, dtype=np.int64)
+    run_signs = np.empty(count, dtype=np.int8)
+    if count:
+        _scan_runs(signs, axis, sign0, starts, run_signs)
+    return starts, run_signs
+
+
+@numba.njit(cache=True, nogil=True)
+def ideal_play_axis(
+    motor: Any,
+    axis: int,
+    starts: Any,
+    signs: Any,
+    bands: Any,
+    state: Any,
+    origin: float,
+    true_spm: float,
+    out: Any,
+) -> None:
+    """One axis of ``simulate._FloatPlay.chunk``, the play operator on fractional steps.
+
+    The same float operations, in the same order, as the numpy form: before the first
+    run the carriage is ``origin``; a run starting here takes ``current`` from the value
+    at the end of the run before (the first run sets ``c0``: ``origin`` going up,
+    ``origin + band`` going down); in an up run the carriage is ``max(current, M)``, in a
+    down run ``min(current, M + band)`` (numpy's ``maximum``/``minimum``: the motor's
+    where equal, as for ``0.0`` and ``-0.0``), ``M`` the motor; then
+    ``((v − c0) + origin) / true_spm`` into ``out``.
+    ``starts``/``signs``/``bands``: the runs that start in this chunk (:func:`runs`), the
+    band in steps (unused going up). ``state`` is ``float64[5]``, carried from chunk to
+    chunk: ``c0``, ``current``, ``value`` (after the last row), ``band``, ``sign`` (0: no
+    run yet).
+    """
+    c0 = state[0]
+    current = state[1]
+    value = state[2]
+    band = state[3]
+    sign = int(state[4])
+    r = 0
+    count = starts.shape[0]
+    for i in range(motor.shape[0]):
+        if r < count and i == starts[r]:
+            s = int(signs[r])
+            b = bands[r] if s < 0 else 0.0
+            if sign == 0:
+                value = origin if s > 0 else origin + b
+                c0 = value
+            current = value
+            band = b
+            sign = s
+            r += 1
+        if sign == 0:
+            out[i, axis] = (0.0 + origin) / true_spm
+            continue
+        m = motor[i, axis]
+        if sign > 0:
+            v = current if current > m else m
+        else:
+            mb = m + band
+            v = current if current < mb else mb
+        value = v
+        out[i, axis] = ((v - c0) + origin) / true_spm
+    state[0] = c0
+    state[1] = current
+    state[2] = value
+    state[3] = band
+    state[4] = float(sign)

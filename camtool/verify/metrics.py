@@ -27,6 +27,7 @@ import numpy.typing as npt
 from camtool.model.program import ArcMove, Program, Rapid, segment_of
 from camtool.model.shapes import Arc, BBox, Drawing, Line, Point, Segment, bbox_union
 from camtool.model.units import fmt_num
+from camtool.verify.circlefit import CircleFit
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -376,10 +377,10 @@ def measure_contours(
         before = points[lo - 1] if lo > 0 else np.asarray(start_mm, dtype=np.float64)
         size = _extent(before, points, lo, hi)  # np.ptp of the run, without copying it
         last_point = points[hi - 1] if hi > lo else before
-        run_of = partial(_run_of, before, points, lo, hi)
+        radius_of = partial(_fitted_radius, before, points[lo:hi])
         measures.append(
             _contour_measure(
-                program, starts, number, (first, last), before, last_point, size, run_of
+                program, starts, number, (first, last), before, last_point, size, radius_of
             )
         )
     return measures
@@ -393,13 +394,15 @@ def _contour_measure(
     before: FloatArray,
     last_point: FloatArray,
     size: tuple[float, float],
-    run_of: Callable[[], FloatArray],
+    radius_of: Callable[[Point], float | None],
 ) -> ContourMeasure:
     """One contour's :class:`ContourMeasure` from its trace's extent and ends.
 
     ``before`` is the carriage before the contour's first row, ``last_point`` after its
     last (``before`` without rows), ``size`` the trace's extent (:func:`_extent`) and
-    ``run_of()`` its whole trace (read only for a circle).
+    ``radius_of(centre)`` the radius of the circle fitted to its whole trace about the
+    nominal ``centre`` (:class:`~camtool.verify.circlefit.CircleFit`; asked only for a
+    circle; ``None``: fewer than three points).
     """
     first, last = blocks
     segments = [segment_of(starts[i], program.moves[i]) for i in range(first, last + 1)]
@@ -424,12 +427,12 @@ def _contour_measure(
             (size[0] - nominal_size[0]) * 1000.0,
             (size[1] - nominal_size[1]) * 1000.0,
         ),
-        circle=_circle(segments, run_of, size) if closed else None,
+        circle=_circle(segments, radius_of, size) if closed else None,
     )
 
 
-def _circle_candidate(segments: list[Segment]) -> float | None:
-    """The radius of a contour made of arcs of one circle (see :func:`_circle`), else None."""
+def _circle_candidate(segments: list[Segment]) -> tuple[float, Point] | None:
+    """Radius and centre of a contour made of arcs of one circle (:func:`_circle`), else None."""
     cuts = [s for s in segments if not (isinstance(s, Line) and s.length <= 1e-9)]
     if not cuts or not all(isinstance(s, Arc) for s in cuts):
         return None
@@ -439,12 +442,16 @@ def _circle_candidate(segments: list[Segment]) -> float | None:
     turns = abs(sum(a.sweep for a in arcs)) / math.tau
     if not same or turns < 0.5 or abs(turns - round(turns)) > 1e-6:
         return None
-    return r0
+    return r0, c0
 
 
-def _run_of(before: FloatArray, points: FloatArray, lo: int, hi: int) -> FloatArray:
-    """A contour's trace: ``before`` then ``points[lo:hi]``, ``(hi − lo + 1, 2)`` mm."""
-    return np.vstack([before, points[lo:hi]])
+def _fitted_radius(before: FloatArray, rows: FloatArray, centre: Point) -> float | None:
+    """The radius of the circle fitted to ``before`` then ``rows`` (a contour's trace), mm."""
+    fit = CircleFit(centre)
+    fit.add(np.asarray(before, dtype=np.float64).reshape(1, 2))
+    fit.add(rows)
+    got = fit.result()
+    return None if got is None else got[2]
 
 
 def _extent(before: FloatArray, points: FloatArray, lo: int, hi: int) -> tuple[float, float]:
@@ -461,43 +468,26 @@ def _extent(before: FloatArray, points: FloatArray, lo: int, hi: int) -> tuple[f
 
 
 def _circle(
-    segments: list[Segment], run_of: Callable[[], FloatArray], size: tuple[float, float]
+    segments: list[Segment],
+    radius_of: Callable[[Point], float | None],
+    size: tuple[float, float],
 ) -> tuple[float, float, float, float] | None:
     """Nominal and fitted diameter of a contour made of arcs of one circle, else None.
 
-    ``run_of()`` gives the contour's trace (the point before it first), built only for a
-    contour of arcs.
+    ``radius_of(centre)`` gives the radius fitted to the contour's trace (the point
+    before it first) about the nominal centre, asked only for a contour of arcs.
 
     Z-only moves (a plunge, a rise onto a tab: no XY length) do not count, and a circle
     cut in several depth passes (sweeps adding up to a whole number of turns) is one.
     """
-    r0 = _circle_candidate(segments)
-    if r0 is None:
+    candidate = _circle_candidate(segments)
+    if candidate is None:
         return None
-    run = run_of()
-    if len(run) < 3:
+    r0, centre = candidate
+    radius = radius_of(centre)
+    if radius is None:
         return None
-    return (2.0 * r0, 2.0 * fit_circle(run)[2], size[0], size[1])
-
-
-def fit_circle(points: FloatArray) -> tuple[float, float, float]:
-    """Least-squares circle through points (Kåsa 1976): ``(cx, cy, r)``, mm.
-
-    Args:
-        points: ``(N, 2)`` float64, N >= 3, not collinear.
-    """
-    x, y = points[:, 0], points[:, 1]
-    mx, my = float(x.mean()), float(y.mean())
-    a = np.empty((len(points), 3), dtype=np.float64)  # (u, v, 1), u and v written in place
-    u, v = a[:, 0], a[:, 1]
-    np.subtract(x, mx, out=u)
-    np.subtract(y, my, out=v)
-    a[:, 2] = 1.0
-    b = u * u
-    b += v * v  # u² + v², as one expression adds them
-    (p, q, s), *_ = np.linalg.lstsq(a, b, rcond=None)
-    cx, cy = p / 2.0, q / 2.0
-    return (mx + cx, my + cy, math.sqrt(s + cx * cx + cy * cy))
+    return (2.0 * r0, 2.0 * radius, size[0], size[1])
 
 
 @dataclass(frozen=True)
@@ -638,7 +628,7 @@ def _nearest(
     With ``only_max`` an unsure sample that cannot reach the largest settled distance
     keeps its upper bound (:func:`_reaching`): the array's max and argmax are exact.
     """
-    search = _box_search(samples, a, b)
+    search = _box_search(samples, a, b, ends)
     if search is None:
         return _nearest_kd(samples, a, b, ends=ends, only_max=only_max)
     ends = ends or _LazyTree(search.points)
@@ -711,26 +701,34 @@ class _BoxSearch:
         )
 
 
-def _box_search(samples: FloatArray, a: FloatArray, b: FloatArray) -> _BoxSearch | None:
+def _box_search(
+    samples: FloatArray, a: FloatArray, b: FloatArray, ends: _LazyTree | None = None
+) -> _BoxSearch | None:
     """The compiled search of ``samples`` among ``a → b``, or ``None`` for the k-d tree path.
 
     ``None`` without the compiled search (:func:`near_kernels`: numba missing, or too few
     samples in this process so far), for fewer than :data:`NEAREST_ENDS` ends, and for
     many samples near the segments (:func:`_far`), which the k-d tree answers faster.
-    Both paths give the same distances.
+    Both paths give the same distances. ``ends``: the segments' ends
+    (``concatenate([a, b])``, C-contiguous float64) with the search trees already built
+    for other samples; built here otherwise.
     """
     kernels = near_kernels(len(samples))
     if kernels is None or len(a) == 0 or 2 * len(a) <= NEAREST_ENDS:
         return None
     samples = np.ascontiguousarray(samples, dtype=np.float64)
-    a = np.ascontiguousarray(a, dtype=np.float64)
-    b = np.ascontiguousarray(b, dtype=np.float64)
-    half = float(np.max(np.hypot(*(b - a).T))) / 2.0
-    points = _end_points(a, b)
-    tree = _ends_tree(points, len(samples), kernels)
-    if len(samples) > BOX_TREE_UP_TO and not _far(samples, tree, half, kernels):
+    if ends is None:
+        a = np.ascontiguousarray(a, dtype=np.float64)
+        b = np.ascontiguousarray(b, dtype=np.float64)
+        ends = _LazyTree(_end_points(a, b))
+    else:
+        a, b = _halves(np.ascontiguousarray(ends.points, dtype=np.float64))
+    half = ends.half()
+    many = len(samples) > BOX_TREE_UP_TO
+    if many and not _far(samples, ends.boxes(len(samples), kernels, any_built=True), half, kernels):
         return None
-    return _BoxSearch(samples, a, b, half, points, tree, kernels)
+    tree = ends.boxes(len(samples), kernels)
+    return _BoxSearch(samples, a, b, half, ends.points, tree, kernels)
 
 
 def farthest_off(samples: FloatArray, a: FloatArray, b: FloatArray, offset: float) -> float:
@@ -894,11 +892,19 @@ TIED_CHUNK = 2_000
 
 
 class _LazyTree:
-    """scipy's k-d tree of some points, built when first asked for."""
+    """The search structures of some points, each built when first asked for.
+
+    scipy's k-d tree (:attr:`tree`) and, for segment ends ``concatenate([a, b])``
+    (:func:`_end_points`), the compiled search's trees (:meth:`boxes`) and half the
+    longest segment (:meth:`half`): the batches of samples measured against one trace
+    share them instead of building them once a batch.
+    """
 
     def __init__(self, points: FloatArray) -> None:
         self.points = points
         self._tree: Any = None
+        self._boxes: dict[bool, tuple[Any, ...]] = {}
+        self._half: float | None = None
 
     @property
     def tree(self) -> Any:
@@ -907,6 +913,34 @@ class _LazyTree:
 
             self._tree = cKDTree(self.points)
         return self._tree
+
+    def half(self) -> float:
+        """Half the longest of the segments ``a[i] → b[i]`` whose ends these points are, mm."""
+        if self._half is None:
+            a, b = _halves(self.points)
+            self._half = float(np.max(np.hypot(*(b - a).T))) / 2.0
+        return self._half
+
+    def boxes(
+        self, samples: int, kernels: ModuleType, *, any_built: bool = False
+    ) -> tuple[Any, ...]:
+        """:func:`_ends_tree` of these segment ends for ``samples`` samples.
+
+        ``any_built``: a tree built already for another number of samples will do (the
+        same answers, :func:`_ends_tree`).
+        """
+        merge = len(self.points) <= MERGE_ENDS_PER_SAMPLE * samples
+        if any_built and self._boxes:
+            return next(iter(self._boxes.values()))
+        if merge not in self._boxes:
+            self._boxes[merge] = _ends_tree(self.points, samples, kernels)
+        return self._boxes[merge]
+
+
+def _halves(points: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """``(a, b)`` of segment ends ``concatenate([a, b])`` (views)."""
+    n = len(points) // 2
+    return points[:n], points[n:]
 
 
 NEAR_KERNELS_FROM = 500_000
@@ -950,7 +984,7 @@ def _nearest_kd(
     """:func:`nearest_distances_kd` (``ends``, ``only_max``: as for :func:`_nearest`)."""
     if len(a) == 0:
         return np.full(len(samples), np.inf)
-    half = float(np.max(np.hypot(*(b - a).T))) / 2.0
+    half = float(np.max(np.hypot(*(b - a).T))) / 2.0 if ends is None else ends.half()
     tree = (ends or _LazyTree(_end_points(a, b))).tree
     d = np.empty(len(samples), dtype=np.float64)
     unsure = np.empty(len(samples), dtype=bool)
@@ -1450,6 +1484,9 @@ on it."""
 SHORTFALL_WINDOW = 4
 """Trace segments on each side of a path sample's place along the trace that
 :class:`_Bounded` measures it against (its bound; only the time depends on it)."""
+SHORTFALL_ROUND = 1024
+"""Samples of largest bound :meth:`_Bounded.farthest` measures first (only the time
+depends on it: the likeliest samples measured first leave most others out)."""
 SHORTFALL_CHUNK = 1 << 15
 """Path samples or trace points :class:`_Bounded` works on at once (memory)."""
 
@@ -1633,38 +1670,40 @@ class _Bounded:
         ``floor``: a shortfall already found, mm. A sample whose shortfall cannot reach
         it is not measured; ``None`` says that none can (their largest is below it).
         The answer may still be below ``floor`` (then the largest of those that may not).
+
+        The samples are measured in two rounds: the :data:`SHORTFALL_ROUND` of largest
+        bound, then the others whose bound reaches the largest shortfall of the first.
+        Each sample's distance is its own (:func:`nearest_distances`) and each round
+        gives its largest and the first sample at it, so the larger of the two and the
+        first sample at it are those of measuring them all at once.
         """
         if len(self.samples) == 0:
             return None
-        top = int(np.argmax(self.reach))
-        if self.reach[top] < floor:
+        order = np.argsort(-self.reach, kind="stable")  # the likeliest first
+        reach = self.reach[order]
+        if reach[0] < floor:
             return None
         a, b = self.places.a, self.places.b
-        # the top sample's true distance: what it is measured is no less, nor the largest
-        least = _least_distance(self.samples[top], a, b)
-        known = max(floor, least * (1.0 - 1e-9) - self.slack)
-        keep = self.reach >= known
-        keep[top] = True
-        index = np.flatnonzero(keep)
-        far, k = farthest_nearest(self.samples[index], a, b, ends=self.ends)
-        return far, int(index[k])
+        ends = self.ends if self.ends is not None else _LazyTree(_end_points(a, b))
+        best: tuple[float, int] | None = None
+        known, at, size = floor, 0, SHORTFALL_ROUND
+        while at < len(order):
+            stop = min(len(order), at + size)  # of those whose bound reaches the largest known
+            stop = min(stop, at + int(np.searchsorted(-reach[at:stop], -known, "right")))
+            if stop <= at:
+                break
+            index = np.sort(order[at:stop])  # in sample order: the first of equal ones
+            far, k = farthest_nearest(self.samples[index], a, b, ends=ends)
+            if best is None or far > best[0] or (far == best[0] and index[k] < best[1]):
+                best = (far, int(index[k]))
+            known = max(known, far)
+            at, size = stop, len(order)
+        return best
 
 
 def _largest_magnitude(values: FloatArray) -> float:
     """``max(|values|)`` without an array of the magnitudes (a trace's would be ~6 MB)."""
     return max(abs(float(np.max(values))), abs(float(np.min(values))))
-
-
-def _least_distance(p: FloatArray, a: FloatArray, b: FloatArray) -> float:
-    """Distance of the point ``p`` ``(2,)`` to the segments ``a → b`` ``(S, 2)``, mm."""
-    least = math.inf
-    for lo in range(0, len(a), SHORTFALL_CHUNK):
-        sa, sb = a[lo : lo + SHORTFALL_CHUNK], b[lo : lo + SHORTFALL_CHUNK]
-        d = _segment_formula(
-            p[0] - sa[:, 0], p[1] - sa[:, 1], sb[:, 0] - sa[:, 0], sb[:, 1] - sa[:, 1]
-        )
-        least = min(least, float(np.min(d)))
-    return least
 
 
 def _segment_formula(
@@ -1909,12 +1948,12 @@ class _Contour:
         self.pending: list[tuple[int, FloatArray]] = []
         self.pending_count = 0
         self.kept: list[FloatArray] = []
-        self.circle: FloatArray | None = None  # a circle's whole run, for the fit
+        self.circle: CircleFit | None = None  # a circle's fit, fed its run as it comes
 
     def add(self, j0: int, points: FloatArray) -> None:
-        """The run's points ``j0, j0 + 1, ...`` (run index 0 is the point before)."""
+        """The run's points ``j0, j0 + 1, ...`` (run index 0 is the point before), in order."""
         if self.circle is not None:
-            self.circle[j0 : j0 + len(points)] = points
+            self.circle.add(points)
         if self.every == 0:
             self.pending.append((j0, points))
             self.pending_count += len(points)
@@ -2000,8 +2039,9 @@ class TraceStream:
     every-k-th, read from the contour's first :data:`THIN_HEAD` points and its known
     length, the moves' last rows and its last point) and measured as
     :func:`along_path` measures it (:class:`_Bounded`, the samples that cannot pass the
-    largest shortfall so far left out). A contour that is a circle keeps its whole trace for
-    the fit. The one exception is the deviation's rms: numpy's pairwise mean of the
+    largest shortfall so far left out). A contour that is a circle feeds its rows to its
+    fit as they come (:class:`~camtool.verify.circlefit.CircleFit`). The one exception
+    is the deviation's rms: numpy's pairwise mean of the
     whole array cannot be reproduced chunk by chunk, so it is the square root of the
     exact sum of the squares (an integer sum of their mantissas by exponent,
     :func:`camtool.verify.kernels.exact_sum_squares`; the squares are numpy's ``d * d``),
@@ -2027,6 +2067,7 @@ class TraceStream:
         rms: bool = True,
     ):
         self.rms = rms
+        near_kernels()  # numba is loaded already: the compiled nearest search costs its cache
         self.program = program
         self.block_start = block_start
         self.kernels = kernels
@@ -2160,14 +2201,11 @@ class TraceStream:
                 self.next_run += 1
                 c = _Contour(self.next_run, a, b, bs)
                 c.before = self._point(c.lo - 1, r0, points).copy()
-                if (
-                    _circle_candidate(
-                        [segment_of(self.starts[i], self.program.moves[i]) for i in range(a, b + 1)]
-                    )
-                    is not None
-                    and math.dist(self.starts[a], self.starts[b + 1]) <= 1e-6
-                ):
-                    c.circle = np.empty((c.n, 2), dtype=np.float64)  # filled as it comes
+                candidate = _circle_candidate(
+                    [segment_of(self.starts[i], self.program.moves[i]) for i in range(a, b + 1)]
+                )
+                if candidate is not None and math.dist(self.starts[a], self.starts[b + 1]) <= 1e-6:
+                    c.circle = CircleFit(candidate[1])  # fed as the rows come
                 for axis in (0, 1):
                     c.top[axis] = c.low[axis] = float(c.before[axis])
                 c.add(0, c.before.reshape(1, 2))
@@ -2193,8 +2231,7 @@ class TraceStream:
     def _close(self, c: _Contour) -> None:
         program, starts = self.program, self.starts
         self.ends.append(math.dist(c.last_point, starts[c.last + 1]))
-        circle = c.circle
-        run_of = (lambda: circle) if circle is not None else (lambda: np.zeros((0, 2)))
+        fitted = None if c.circle is None else c.circle.result()
         self.contours.append(
             _contour_measure(
                 program,
@@ -2204,7 +2241,7 @@ class TraceStream:
                 c.before,
                 c.last_point,
                 c.extent(),
-                run_of,
+                lambda centre: None if fitted is None else fitted[2],
             )
         )
         ends = _LazyTree(c.ends())  # one k-d tree for every batch (when one is used)
@@ -2385,6 +2422,28 @@ def prepare_comparison(drawing: Drawing) -> None:
     samples, _ = _sample_drawing(drawing, AGAINST_SPACING_MM)
     if len(samples) >= PREPARE_KERNELS_FROM:
         _load_kernels()
+
+
+def prepare_stream() -> None:
+    """Ahead of streaming a trace here and in a forked helper: load what both call once.
+
+    numba's compiler registries (its first call, ~0.2 s), the kernels the measures of
+    every chunk call on its read-only carriage (``to_line``, ``extent``) and the
+    compiled nearest search of the shortfall (:func:`near_kernels`, ``load_cached``),
+    so that a helper forked next inherits them instead of loading them again, while this
+    process would load them at its first chunk anyway. Only the time depends on it.
+    """
+    from camtool.verify.interpolators import compiled
+
+    kernels = compiled()
+    near = near_kernels()
+    if kernels is None or near is None:
+        return
+    near.load_cached()
+    points = np.zeros((2, 2))
+    points.flags.writeable = False  # as a chunk's carriage comes
+    kernels.to_line(points, 0.0, 0.0, 1.0, 0.0, np.zeros(2))
+    kernels.extent(points)
 
 
 def comparison_preloads(drawing: Drawing) -> list[Callable[[], object]]:

@@ -372,9 +372,7 @@ class _IdealController(_Controller):
             rows = self._ideal_arc(start_mm, move)
             line_starts: list[int] = []
         elif isinstance(move, ArcMove):
-            points = self._chord_points(start_mm, move)
-            lattice = [self.pos] + [(x * self.spm[0], y * self.spm[1]) for x, y in points]
-            lattice[-1] = end
+            lattice = self._lattice(start_mm, move, end)
             parts, line_starts, offset = [], [], 0
             for a, b in itertools.pairwise(lattice):
                 part = self._ideal_line(a, b)
@@ -413,6 +411,69 @@ class _IdealController(_Controller):
             return none, none
         return np.zeros(1, dtype=np.int64), np.full(1, sign, dtype=np.int64)
 
+    def _lattice(
+        self, start_mm: Point, move: ArcMove, end: tuple[float, float]
+    ) -> list[tuple[float, float]]:
+        """A chord arc's corners in fractional steps, from here to ``end``."""
+        points = self._chord_points(start_mm, move)
+        lattice = [self.pos] + [(x * self.spm[0], y * self.spm[1]) for x, y in points]
+        lattice[-1] = end
+        return lattice
+
+    def count_block(self, start_mm: Point, move: Move) -> None:
+        """:meth:`block` without its rows: their count, and the state the next one needs.
+
+        For a controller whose lines reach their counts (not :attr:`inexact`): a line's
+        or chord's rows are its ideal line's (:meth:`_line_rows`, as :meth:`_ideal_line`
+        makes them) and one compensation row for each axis it reverses (its rows all go
+        one way: the reversal is at its first row); a native arc's are its ideal arc's
+        (:meth:`_arc_rows`) when no compensation can be inserted, else the arc is made
+        (its reversals lie inside it) and its rows dropped. The position, each axis's
+        direction and its reversals are kept as :meth:`block` keeps them.
+        """
+        assert not self.inexact
+        end = (self.to_steps(move.x, 0), self.to_steps(move.y, 1))
+        if isinstance(move, ArcMove) and self.arc is not None:
+            if any(self.comp_steps):
+                self.block(start_mm, move)
+                self.parts.clear()
+                self.comp_parts.clear()
+                return
+            rows = self._arc_rows(start_mm, move)[0]
+        elif isinstance(move, ArcMove):
+            lattice = self._lattice(start_mm, move, end)
+            rows = sum(
+                self._count_line(b[0] - a[0], b[1] - a[1]) for a, b in itertools.pairwise(lattice)
+            )
+        else:
+            rows = self._count_line(end[0] - self.pos[0], end[1] - self.pos[1])
+        self.counts.append(rows)
+        self.pos = end  # type: ignore[assignment]
+
+    def _count_line(self, dx: float, dy: float) -> int:
+        """Rows of the ideal line of ``(dx, dy)`` with its compensations; the directions kept."""
+        rows = self._line_rows(dx, dy)
+        if rows == 0:
+            return 0
+        for axis, d in ((0, dx), (1, dy)):
+            step = d / rows  # the line's rows: one value (see _ideal_line)
+            if step == 0:
+                continue
+            sign = 1 if step > 0 else -1
+            if self.direction[axis] not in (0, sign):
+                self.reversals[axis] += 1
+                if self.comp_steps[axis]:
+                    rows += 1  # one row of the exact compensation (comp_rows)
+            self.direction[axis] = sign
+        return rows
+
+    @staticmethod
+    def _line_rows(dx: float, dy: float) -> int:
+        """Rows of an ideal line of ``(dx, dy)`` fractional steps (0 for none)."""
+        if dx == 0 and dy == 0:
+            return 0
+        return max(1, math.ceil(IDEAL_SAMPLES_PER_STEP * max(abs(dx), abs(dy))))
+
     def _ideal_line(self, a: tuple[float, float], b: tuple[float, float]) -> FloatArray:
         dx, dy = b[0] - a[0], b[1] - a[1]
         counted = (
@@ -423,12 +484,19 @@ class _IdealController(_Controller):
             net = np.asarray(counted, dtype=np.int64).sum(axis=0)
             dx *= float(net[0]) / programmed[0] if programmed[0] else 1.0
             dy *= float(net[1]) / programmed[1] if programmed[1] else 1.0
-        n = max(1, math.ceil(IDEAL_SAMPLES_PER_STEP * max(abs(dx), abs(dy))))
-        if dx == 0 and dy == 0:
+        n = self._line_rows(dx, dy)
+        if n == 0:
             return np.zeros((0, 2), dtype=np.float64)
         return np.tile(np.asarray([[dx / n, dy / n]], dtype=np.float64), (n, 1))
 
-    def _ideal_arc(self, start_mm: Point, move: ArcMove) -> FloatArray:
+    def _arc_rows(
+        self, start_mm: Point, move: ArcMove
+    ) -> tuple[int, tuple[float, float, float, float, float, float]]:
+        """Rows of the ideal arc from here to ``move``'s end, and its circle in steps.
+
+        ``(n, (cx, cy, r0, r1, a0, sweep))``: centre, start and end radius, start angle
+        and signed sweep; ``n`` is 0 for an arc shorter than 1e-9 steps (not a full one).
+        """
         sx, sy = self.spm[0], self.spm[1]
         cx, cy = move.cx * sx, move.cy * sy
         x0, y0 = self.pos
@@ -438,16 +506,26 @@ class _IdealController(_Controller):
         turn = -math.tau if move.clockwise else math.tau
         sweep = (a1 - a0) % turn or turn
         full = distance(start_mm, (move.x, move.y)) <= 1e-9
+        circle = (cx, cy, r0, r1, a0, sweep)
         if not full and math.hypot(x1 - x0, y1 - y0) < 1e-9:
+            return 0, circle
+        return max(1, math.ceil(IDEAL_SAMPLES_PER_STEP * abs(sweep) * max(r0, r1))), circle
+
+    def _ideal_arc(self, start_mm: Point, move: ArcMove) -> FloatArray:
+        n, (cx, cy, r0, r1, a0, sweep) = self._arc_rows(start_mm, move)
+        if n == 0:
             return np.zeros((0, 2), dtype=np.float64)
-        n = max(1, math.ceil(IDEAL_SAMPLES_PER_STEP * abs(sweep) * max(r0, r1)))
+        x0, y0 = self.pos
+        x1, y1 = move.x * self.spm[0], move.y * self.spm[1]
         t = np.arange(1, n + 1, dtype=np.float64) / n
         radius = r0 + (r1 - r0) * t
-        points = np.column_stack(
-            (cx + radius * np.cos(a0 + sweep * t), cy + radius * np.sin(a0 + sweep * t))
-        )
+        angle = a0 + sweep * t
+        points = np.empty((n + 1, 2), dtype=np.float64)  # the start, then the samples
+        points[0] = (x0, y0)
+        points[1:, 0] = cx + radius * np.cos(angle)
+        points[1:, 1] = cy + radius * np.sin(angle)
         points[-1] = (x1, y1)
-        return np.diff(np.vstack([[x0, y0], points]), axis=0)
+        return points[1:] - points[:-1]
 
 
 def _block_of_row(blocks: int, block_start: IntArray) -> IntArray:
@@ -671,8 +749,10 @@ def count_rows(
     What :func:`simulate_or_count` returns for a trace over its limit, without making the
     rows of a line or rapid whose interpolator counts them in closed form
     (:data:`LINE_ROWS`: the A.3 DDA's ``floor(HIPO) + 1``, and a compensation's rows at a
-    reversal); other moves (arcs, other interpolators, a line whose piece models
-    dynamics, every move of the ideal controller) are simulated, their rows dropped.
+    reversal), and the ideal controller's lines, chords and, where it inserts no
+    compensation, native arcs (:meth:`_IdealController.count_block`); other moves (arcs,
+    other interpolators, a line whose piece models dynamics, the ideal controller's arcs
+    with compensation) are simulated, their rows dropped.
     ``sources``: the trace of :func:`simulate_steps` with these sources;
     ``closed_form=False`` simulates every move.
     :class:`ChunkedSimulation` makes the same offsets again from the rows themselves,
@@ -686,10 +766,15 @@ def count_rows(
     sim = kind(machine, program.origin, sources)
     exact = closed_form and sources.interpolation and not sim.inexact
     rows_of = LINE_ROWS.get(sim.line) if exact else None
+    ideal = sim if isinstance(sim, _IdealController) else None
+    if not closed_form or sim.inexact:
+        ideal = None
     start = program.origin
     for k, move in enumerate(program.moves):
         try:
-            if rows_of is not None and not isinstance(move, ArcMove):
+            if ideal is not None:
+                ideal.count_block(start, move)
+            elif rows_of is not None and not isinstance(move, ArcMove):
                 sim.count_line(move, rows_of)
             else:
                 sim.block(start, move)
@@ -775,7 +860,9 @@ class ChunkedSimulation:
         """
         sim = self.sim
         ideal = isinstance(sim, _IdealController)
-        play = _FloatPlay(sim.origin_steps, self.machine) if ideal else _StepPlay(self)
+        play: _StepPlay | _FloatPlay | _FloatPlayCompiled = _StepPlay(self)
+        if ideal:
+            play = _FloatPlayCompiled(sim.origin_steps, self.machine, self.jit)
         start = self.program.origin
         first, row0, pending = 0, 0, 0
         moves = self.program.moves
@@ -867,6 +954,49 @@ class _StepPlay:
                 )
             )
         return rows, out
+
+
+class _FloatPlayCompiled:
+    """:class:`_FloatPlay` by the compiled loops: the same floats, three passes, no temporaries.
+
+    :func:`camtool.verify.kernels.ideal_motor` sums the rows into the motor and takes
+    their directions; :func:`camtool.verify.kernels.runs` finds where each axis's runs
+    start, whose bands :func:`_run_bands` looks up at the motor there, as
+    :meth:`_FloatPlay._band` does; :func:`camtool.verify.kernels.ideal_play_axis` is the
+    play operator, its state carried from chunk to chunk.
+    """
+
+    def __init__(self, origin: tuple[float, float], machine: Machine, jit: Any) -> None:
+        self.machine = machine
+        self.origin = np.asarray(origin, dtype=np.float64)
+        self.jit = jit
+        self.total = np.zeros(2, dtype=np.float64)  # the rows' running sum so far
+        self.state = [np.zeros(5, dtype=np.float64), np.zeros(5, dtype=np.float64)]
+
+    def chunk(self, rows: FloatArray) -> tuple[StepArray, FloatArray]:
+        """Each row's direction ``(n, 2) int8`` and the carriage after it, ``(n, 2)`` mm."""
+        n = len(rows)
+        signs = np.empty((n, 2), dtype=STEP_DTYPE)
+        out = np.empty((n, 2), dtype=np.float64)
+        if not n:
+            return signs, out
+        motor = np.empty((n, 2), dtype=np.float64)
+        rows = np.ascontiguousarray(rows, dtype=np.float64)
+        self.jit.ideal_motor(rows, self.total, self.origin, motor, signs)
+        true = self.machine.real_steps_per_mm
+        found = []
+        for axis in (0, 1):  # every band looked up before the motor is overwritten
+            starts, run_signs = self.jit.runs(signs, axis, int(self.state[axis][4]))
+            found.append(
+                (starts, run_signs, _run_bands(self.machine, axis, run_signs, motor[starts]))
+            )
+        for axis in (0, 1):
+            starts, run_signs, bands = found[axis]
+            origin, spm = float(self.origin[axis]), float(true[axis])
+            self.jit.ideal_play_axis(
+                motor, axis, starts, run_signs, bands, self.state[axis], origin, spm, out
+            )
+        return signs, out
 
 
 class _FloatPlay:

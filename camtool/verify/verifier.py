@@ -32,16 +32,31 @@ digits and at least 3 decimals) so the same input gives the same bytes.
 from __future__ import annotations
 
 import math
+import os
+import pickle
+import signal
 import time
-from collections.abc import Iterator, Sequence
-from contextlib import nullcontext, suppress
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import ExitStack, suppress
 from dataclasses import dataclass, field
 from functools import cached_property, partial
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 import numpy as np
 
-from camtool.model.cores import ForkedWork, ahead
+from camtool.model.cores import (
+    FORK,
+    ForkedWork,
+    ahead,
+    default_jobs,
+    end_process,
+    fork_with_pipes,
+    in_worker,
+    quiet_crashes,
+    read_record,
+    wait_readable,
+    write_record,
+)
 from camtool.model.errors import CamtoolError, DialectError, InputError, UsageError
 from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Dwell, Home, Program, Rapid
@@ -69,6 +84,7 @@ from camtool.verify.metrics import (
     deviation,
     measure_contours,
     prepare_comparison,
+    prepare_stream,
     thin_cutting,
 )
 from camtool.verify.motion import StepTrace, library
@@ -87,6 +103,9 @@ from camtool.verify.steparray import read_only
 if TYPE_CHECKING:
     from camtool.post.base import Target
     from camtool.toolpath.plan import PlanReport
+
+T = TypeVar("T")
+R = TypeVar("R")
 
 STREAM_ROWS = 1 << 20
 """Rows above which a trace is streamed (:func:`_simulate_big`): a whole trace's arrays
@@ -373,17 +392,29 @@ def verify_program(
     placement = check_area(program, machine, source)
     skipped = None if against is None else _no_overlap(program, against, tool_diameter / 2.0)
     compared_with = against if skipped is None else None
-    trace, streamed = _simulate_big(program, machine, compared_with, chunk_rows, stream_above)
-    warnings = _warnings(program, trace)
-    if skipped is not None:
-        warnings.append(skipped)
-    now = budget_now if streamed is None else None  # streamed: a budget waits to be asked for
-    if now is not None and budget and compared_with is not None:
-        prepare_comparison(compared_with)  # loaded once here, not once per worker
-    inputs = _Inputs(program, machine, trace, planned, compared_with, tool_diameter, findings)
-    # the budget's workers are forked once this process has loaded what the measures need,
-    # and before it takes its own measures
-    with nullcontext() if now is None else _BudgetRun(inputs, budget, now) as run:
+    with ExitStack() as stack:  # leaving it stops the budget's workers, if any
+        early = None
+        if budget_now is not None and budget and compared_with is None:
+            early = _EarlyBudget(program, machine, planned, tool_diameter, findings, budget_now)
+            stack.callback(early.close)
+        trace, streamed = _simulate_big(
+            program,
+            machine,
+            compared_with,
+            chunk_rows,
+            stream_above,
+            streaming=None if early is None else early.start,
+        )
+        warnings = _warnings(program, trace)
+        if skipped is not None:
+            warnings.append(skipped)
+        run = None if early is None else early.run_for(trace.row_count)
+        now = budget_now if streamed is None and run is None else None  # else when asked for
+        if now is not None and budget and compared_with is not None:
+            prepare_comparison(compared_with)  # loaded once here, not once per worker
+        inputs = _Inputs(program, machine, trace, planned, compared_with, tool_diameter, findings)
+        if now is not None:  # the budget's workers are forked once this process has loaded
+            run = stack.enter_context(_BudgetRun(inputs, budget, now))  # what it needs
         digest = None
         if streamed is not None:
             dev, along, contours, thin, digest = streamed
@@ -425,12 +456,81 @@ _Streamed = tuple[Deviation, AlongPath, tuple[ContourMeasure, ...], ThinTrace | 
 """A streamed trace's measures, thinned cutting rows and their digest (:func:`_stream`)."""
 
 
+class _EarlyBudget:
+    """A verification's error budget of one source, started before its trace.
+
+    Without a drawing, the budget's re-simulations need only the program, the machine and
+    the trace's row count: a streamed trace (:func:`_simulate_big`) is told to
+    :meth:`start` the one source as soon as its rows are counted, and it runs in a helper
+    of its own (:class:`_BudgetRun`, ``alongside``) while this process simulates and
+    measures the trace: the two peaks of memory are in two processes, not one after the
+    other in one. The kernels both call are loaded first, so the helper inherits them
+    (:func:`~camtool.verify.metrics.prepare_stream`). Two sources or more are
+    re-simulated side by side once the trace is measured, as before: started with it,
+    three processes shared two cores and took longer.
+    """
+
+    def __init__(
+        self,
+        program: Program,
+        machine: Machine,
+        planned: Program | None,
+        tool_diameter: float,
+        findings: Sequence[FindingLike],
+        progress: Progress,
+    ) -> None:
+        self.program, self.machine, self.planned = program, machine, planned
+        self.tool_diameter, self.findings, self.progress = tool_diameter, findings, progress
+        self.run: _BudgetRun | None = None
+        statuses = source_statuses(program, machine, planned=planned)
+        self.one = sum(s.status == "modelled" for s in statuses) == 1
+
+    def start(self, rows: int) -> None:
+        """Start the budget of a trace of ``rows`` rows (again, if another count came first).
+
+        Not for two sources or more, nor for a trace whose budget is skipped (over
+        :data:`camtool.verify.budget.MAX_ROWS` rows).
+        """
+        if not self.one or rows > eb.MAX_ROWS:
+            self.close()
+            return
+        if self.run is not None and self.run.rows == rows:
+            return
+        self.close()
+        prepare_stream()  # the helper inherits the kernels this process calls too
+        inputs = _Inputs(
+            self.program,
+            self.machine,
+            None,
+            self.planned,
+            None,
+            self.tool_diameter,
+            self.findings,
+            rows=rows,
+        )
+        self.run = _BudgetRun(inputs, True, self.progress, alongside=True)
+
+    def run_for(self, rows: int) -> _BudgetRun | None:
+        """The run started for a trace of ``rows`` rows (``None``, closed: none, or another)."""
+        if self.run is not None and self.run.rows != rows:
+            self.close()
+        return self.run
+
+    def close(self) -> None:
+        """Stop what was started (idempotent)."""
+        if self.run is not None:
+            self.run.work.close()
+            self.run = None
+
+
 def _simulate_big(
     program: Program,
     machine: Machine,
     against: Drawing | None,
     chunk_rows: int,
     stream_above: int,
+    *,
+    streaming: Callable[[int], None] | None = None,
 ) -> tuple[StepTrace, _Streamed | None]:
     """The trace of ``program``, and its measures when they were taken as it streamed.
 
@@ -453,6 +553,8 @@ def _simulate_big(
     form), others from a simulation that drops its rows. The chunks, made one ahead in a
     thread (:func:`~camtool.model.cores.ahead`), say where each move's rows start; should
     they not agree with the count, the offsets are simulated and the trace streamed again.
+    ``streaming`` is told the rows of a trace about to be streamed, before it is (each
+    time it is).
     """
     if library().simulator(machine.motion.line) is not None:
         return simulate(program, machine), None
@@ -468,11 +570,15 @@ def _simulate_big(
     if kernels is None:
         return simulate(program, machine), None
     try:
+        if streaming is not None:
+            streaming(int(got[-1]))
         streamed = _stream(program, machine, against, chunk_rows, got, kernels)
         if streamed is None and counted:  # the count was not the rows': count them again
             got = simulate_or_count(program, machine, stream_above)
             if isinstance(got, StepTrace):  # not over the limit after all: the whole trace
                 return got, None
+            if streaming is not None:
+                streaming(int(got[-1]))
             streamed = _stream(program, machine, against, chunk_rows, got, kernels)
     except NotStreamable:
         return simulate(program, machine), None
@@ -747,16 +853,28 @@ def _budget(v: Verification, progress: Progress = no_progress) -> eb.ErrorBudget
 
 @dataclass(frozen=True)
 class _Inputs:
-    """What a verification measured: its program, machine and trace, and what it was told."""
+    """What a verification measures: its program, machine and trace, and what it was told.
+
+    ``trace`` is ``None`` for a budget started before a streamed trace is simulated
+    (without a drawing, it needs only the trace's ``rows``).
+    """
 
     program: Program
     machine: Machine
-    trace: StepTrace
+    trace: StepTrace | None
     planned: Program | None
     drawing: Drawing | None
     tool_diameter: float
     findings: Sequence[FindingLike]
     cut_digest: bytes | None = None
+    rows: int = -1
+
+    @property
+    def row_count(self) -> int:
+        """Rows of the verification's trace."""
+        if self.trace is not None:
+            return self.trace.row_count
+        return self.rows
 
     @cached_property
     def digest(self) -> bytes | None:
@@ -765,6 +883,7 @@ class _Inputs:
             return None
         if self.cut_digest is not None:
             return self.cut_digest
+        assert self.trace is not None  # a budget started before its trace has no drawing
         return _trace_digest(self.program, self.trace)
 
 
@@ -773,15 +892,21 @@ class _BudgetRun:
 
     The workers (:class:`~camtool.model.cores.ForkedWork`, one per core) need only the
     verification's inputs and trace, so they can start before all its measures are
-    taken (:func:`verify_program` starts them before the drawing comparison);
+    taken (:func:`verify_program` starts them before the drawing comparison, and before
+    a streamed trace without a drawing: they need only its row count);
     :meth:`gather` joins their figures with the verification's own. A context manager:
-    leaving it stops the workers.
+    leaving it stops the workers. ``alongside``: this process has work of its own
+    meanwhile (a streamed trace to simulate and measure), so even one source is
+    re-simulated in a process of its own (:class:`_ForkedOne`).
     """
 
-    def __init__(self, inputs: _Inputs, budget: bool, progress: Progress) -> None:
+    def __init__(
+        self, inputs: _Inputs, budget: bool, progress: Progress, *, alongside: bool = False
+    ) -> None:
         self.progress = progress
         self.skipped: str | None = None
-        rows = inputs.trace.row_count
+        rows = inputs.row_count
+        self.rows = rows
         if not budget:
             self.skipped = "switched off (--no-budget)"
         elif rows > eb.MAX_ROWS:
@@ -794,7 +919,12 @@ class _BudgetRun:
             [] if self.skipped else [s.name for s in self.statuses if s.status == "modelled"]
         )
         self._answered(0)
-        self.work = ForkedWork(partial(_without, inputs), self.modelled)
+        work = partial(_without, inputs)
+        self.work: ForkedWork[str, _Without] | _ForkedOne[str, _Without]
+        if alongside and len(self.modelled) == 1:
+            self.work = _ForkedOne(work, self.modelled[0])
+        else:
+            self.work = ForkedWork(work, self.modelled)
 
     def __enter__(self) -> _BudgetRun:
         return self
@@ -831,6 +961,72 @@ class _BudgetRun:
                 notes.append(got.note)
             without[name] = values
         return eb.compute(total, self.statuses, without, notes=notes)
+
+
+class _ForkedOne(Generic[T, R]):
+    """``[fn(item)]``, started now in one forked helper, gathered later (as ForkedWork).
+
+    :class:`~camtool.model.cores.ForkedWork` runs a lone item in this process, when its
+    answers are asked for; a process with work of its own meanwhile (a streamed trace)
+    gives it a helper of its own (:func:`~camtool.model.cores.fork_with_pipes`), a copy of
+    this process as it is now. Its answer comes back pickled, every bit kept; a helper that
+    raised, died or could not start has the item run here, so an error is raised as it
+    would be without it. Where ForkedWork would not fork (no ``fork``, one core, in a
+    worker process) the item runs here. Leaving it (:meth:`close`) ends the helper.
+    """
+
+    def __init__(self, fn: Callable[[T], R], item: T) -> None:
+        self.fn, self.item = fn, item
+        self.pid: int | None = None
+        self.fd: int | None = None
+        if not FORK or default_jobs() < 2 or in_worker():
+            return
+
+        def run(inbox: int, outbox: int) -> None:
+            quiet_crashes()
+            signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
+            os.close(inbox)
+            write_record(outbox, pickle.dumps(fn(item), protocol=pickle.HIGHEST_PROTOCOL))
+
+        with suppress(OSError):  # no process now: the item runs here
+            self.pid, to_child, self.fd = fork_with_pipes(run)
+            os.close(to_child)
+
+    def __enter__(self) -> _ForkedOne[T, R]:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def answers(self, done: Callable[[int], None] | None = None) -> list[R]:
+        """``[fn(item)]``, from the helper or made here; the helper is ended after.
+
+        ``done``: called with 1 once the answer is in (for a progress report).
+
+        Raises:
+            Whatever ``fn`` raises (run here when the helper did not answer).
+        """
+        record = None
+        if self.fd is not None:
+            try:
+                wait_readable(self.fd)
+                record = read_record(self.fd)
+            finally:
+                self.close()
+        answer: R = pickle.loads(record) if record is not None else self.fn(self.item)
+        if done is not None:
+            done(1)
+        return [answer]
+
+    def close(self) -> None:
+        """End the helper (idempotent)."""
+        if self.fd is not None:
+            os.close(self.fd)
+            self.fd = None
+        if self.pid is not None:
+            with suppress(ChildProcessError):
+                end_process(self.pid, kill=True)
+            self.pid = None
 
 
 @dataclass(frozen=True)
@@ -871,7 +1067,7 @@ def _without(inputs: _Inputs, name: str) -> _Without:
     else:
         sources = ALL.without(name)
     chunk_rows = CHUNK_ROWS
-    stream = inputs.trace.row_count > chunk_rows
+    stream = inputs.row_count > chunk_rows
     try:
         dev, along, contours, thin, digest = _resimulate(
             program, inputs.machine, sources, inputs.drawing, chunk_rows if stream else 0

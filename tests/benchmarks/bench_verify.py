@@ -14,6 +14,16 @@ run time) on the same lines in steps, and the ratio is camtool's whole-verify st
 the C DDA loop's steps/s. The demo logo (``samples/logo.dxf`` posted to pic-mmh, as
 ``make demo``) is verified too (time only).
 
+Three rows first (:func:`budget_rows`): ``camtool verify`` with the error budget against
+``--no-budget`` on 40 of these lines (2.58 M steps, under the budget's 3 M rows) without
+backlash (``--machine`` overlay: one source, the interpolation) and with the profile's (two
+sources), and on one contour of 40 half circles (:func:`arcs_program`, 2.45 M rows, no
+backlash). The goal: with the budget, at most 1.5 times the wall and CPU time of
+``--no-budget`` and at most 250 MB. Second pass (24 Nov 2026, quiet; docs/performance.md):
+1.25 s, 1.69 s CPU, 234 MB against 0.57 s, 0.80 s CPU (2.2×); 1.60 s, 2.06 s CPU, 226 MB
+against 0.56 s, 0.79 s CPU (2.8×); 2.26 s, 3.39 s CPU, 235 MB against 0.90 s, 1.23 s CPU
+(2.8×). The memory goal is met, the time goal is not.
+
 Set ``CAMTOOL_BENCH_BASE=/path/to/old/tree`` to run the same two jobs on another tree
 (e.g. the code before issue 17) in the same run: its times and memory are printed, and
 the reports must be byte-identical (the row notes it).
@@ -107,7 +117,8 @@ import resource, subprocess, sys, time
 start = time.perf_counter()
 rc = subprocess.run(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode
 wall = time.perf_counter() - start
-print(wall, rc, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)
+use = resource.getrusage(resource.RUSAGE_CHILDREN)
+print(wall, rc, use.ru_maxrss, use.ru_utime + use.ru_stime)
 """
 
 
@@ -127,6 +138,87 @@ def big_program(lines: int) -> tuple[str, list[tuple[int, int]]]:
         moves.append((_steps(x) - _steps(x0), _steps(y) - _steps(y0)))
         x0, y0 = x, y
     return "\n".join(out) + "\n", moves
+
+
+def arcs_program(half_circles: int, radius_um: float = 3000.0) -> str:
+    """One contour of ``half_circles`` clockwise half circles round (5, 3.5) mm, F08.
+
+    A circle cut again and again (a hole in many passes): UNAM-GMM's direct-search arcs,
+    2.45 M rows for 40 half circles of 3 mm, its diameter fitted over every row.
+    """
+    cx, cy = 5000.0, 3500.0
+    out = ["G54;", "G90;", f"G00X{cx - radius_um:08.2f}Y{cy:08.2f};"]
+    for k in range(half_circles):
+        x = cx + radius_um if k % 2 == 0 else cx - radius_um
+        out.append(f"G02X{x:08.2f}Y{cy:08.2f}I{cx:08.2f}J{cy:08.2f}F08;")
+    return "\n".join(out) + "\n"
+
+
+NO_BACKLASH = """[machine.backlash]
+true_um = [0.0, 0.0, 0.0]
+compensation_um = [0.0, 0.0, 0.0]
+regions = []
+"""
+"""A ``--machine`` overlay without backlash: the budget's one source is the interpolation."""
+BUDGET_LINES = 40
+"""Lines of the budget rows' program (40: 2.58 M steps, under the budget's 3 M rows)."""
+
+
+def budget_rows(tmp: Path, base: str | None) -> None:
+    """The error budget on against ``--no-budget``: wall and CPU ratio and peak, three programs.
+
+    40 of the big program's lines without backlash (one source, the interpolation), the
+    same with the profile's backlash (two sources), and 40 half circles without backlash.
+    With ``base``, the same jobs on that tree: its figures in the note, reports compared.
+    """
+    (tmp / "lines.pic").write_text(big_program(BUDGET_LINES)[0])
+    (tmp / "arcs.pic").write_text(arcs_program(40))
+    (tmp / "no-backlash.toml").write_text(NO_BACKLASH)
+    jobs = [
+        ("40 DDA lines, no backlash (1 source)", "lines.pic", True),
+        ("40 DDA lines, the profile's backlash (2 sources)", "lines.pic", False),
+        ("40 half circles, no backlash (1 source)", "arcs.pic", True),
+    ]
+    trees = {"after": ROOT} | ({"before": Path(base)} if base else {})
+    for job, name, bare in jobs:
+        args = ["verify", str(tmp / name), "-t", "pic-mmh"]
+        if bare:
+            args += ["--machine", str(tmp / "no-backlash.toml")]
+        got = {}
+        for label, tree in trees.items():
+            report = tmp / f"budget-{label}-{name}.json"
+            warm(tree, [*args, "--no-budget"])
+            on = measure_cpu(tree, [*args, "--report", str(report)])
+            off = measure_cpu(tree, [*args, "--no-budget"])
+            got[label] = (on, off, report)
+        (wall, rc, rss, cpu), (off_wall, _rc, off_rss, off_cpu), report = got["after"]
+        ratio = max(wall / off_wall, cpu / off_cpu)
+        note = (
+            f"exit {rc}; budget on {wall:.2f} s, {cpu:.2f} s CPU, {rss:.0f} MB; --no-budget "
+            f"{off_wall:.2f} s, {off_cpu:.2f} s CPU, {off_rss:.0f} MB; "
+            f"wall {wall / off_wall:.2f}x, CPU {cpu / off_cpu:.2f}x"
+        )
+        met = rc == 0 and ratio <= 1.5 and rss <= 250.0
+        if base:
+            (bwall, _brc, brss, bcpu), (bo_wall, _b, bo_rss, bo_cpu), breport = got["before"]
+            same = breport.read_bytes() == report.read_bytes()
+            met = met and same
+            note += (
+                f"; before ({base}): on {bwall:.2f} s, {bcpu:.2f} s CPU, {brss:.0f} MB, off "
+                f"{bo_wall:.2f} s, {bo_cpu:.2f} s CPU, {bo_rss:.0f} MB; reports "
+                + ("identical" if same else "DIFFER")
+            )
+        row(
+            f"camtool verify with the error budget, {job} (CLI)",
+            f"{wall:.2f} s, {cpu:.2f} s CPU, {rss:.0f} MB",
+            "the same with --no-budget",
+            f"{off_wall:.2f} s, {off_cpu:.2f} s CPU",
+            ratio,
+            "time",
+            "≤ 1.5× (wall and CPU), ≤ 250 MB",
+            met,
+            note,
+        )
 
 
 def _steps(um: int) -> int:
@@ -165,8 +257,16 @@ def warm(tree: Path, args: list[str]) -> None:
 
 def measure(tree: Path, args: list[str], repeats: int = REPEATS) -> tuple[float, int, float]:
     """Best wall time (s), exit code and largest peak RSS (MB) of ``camtool ARGS`` in ``tree``."""
+    wall, rc, rss, _cpu = measure_cpu(tree, args, repeats)
+    return wall, rc, rss
+
+
+def measure_cpu(
+    tree: Path, args: list[str], repeats: int = REPEATS
+) -> tuple[float, int, float, float]:
+    """:func:`measure` and the best CPU time (user + sys, s, helpers included)."""
     env = camtool_env(tree)
-    best, rss, rc = float("inf"), 0.0, 0
+    best, rss, rc, cpu = float("inf"), 0.0, 0, float("inf")
     for _ in range(repeats):
         out = subprocess.run(
             [sys.executable, "-c", RUNNER, sys.executable, "-m", "camtool", *args],
@@ -176,9 +276,10 @@ def measure(tree: Path, args: list[str], repeats: int = REPEATS) -> tuple[float,
             cwd=tree,
             check=True,
         )
-        wall, code, kib = out.stdout.split()
+        wall, code, kib, used = out.stdout.split()
         best, rc, rss = min(best, float(wall)), int(code), max(rss, int(kib) / 1024.0)
-    return best, rc, rss
+        cpu = min(cpu, float(used))
+    return best, rc, rss, cpu
 
 
 def c_dda_rate(moves: list[tuple[int, int]], tmp: Path) -> tuple[float, str] | None:
@@ -299,6 +400,7 @@ def main() -> None:
         (tmp / "warm.pic").write_text(big_program(60)[0])  # streamed: every module it needs
         warm(ROOT, ["verify", str(tmp / "warm.pic"), "-t", "pic-mmh"])
         start = startup_s(ROOT)
+        budget_rows(tmp, base)
         verify_row(tmp, LINES, base, start)
         if BIG_LINES:  # not on the tree before issue 17: it would hold ~10 GB
             verify_row(tmp, BIG_LINES, None, start)

@@ -17,7 +17,7 @@ import math
 import numpy as np
 import pytest
 
-from camtool.model.program import Linear, Program, Rapid
+from camtool.model.program import ArcMove, Linear, Program, Rapid
 from camtool.post.registry import load_target
 from camtool.verify import metrics
 from camtool.verify.simulate import simulate_steps
@@ -250,3 +250,96 @@ def test_a_streamed_shortfall_is_the_whole_ones(
             program, machine, name="pic-mmh", budget=False, chunk_rows=300, stream_above=10
         )
         assert _shortfall(v.along) == want
+
+
+def _circle_turns(turns: int, radius: float = 0.5) -> Program:
+    """One contour going round a circle ``turns`` times in half circles (a hole in passes)."""
+    cx, cy = 3.0, 3.0
+    moves: list[Linear | Rapid | ArcMove] = [Rapid(cx - radius, cy, contour=1)]
+    for k in range(2 * turns):
+        x = cx + radius if k % 2 == 0 else cx - radius
+        moves.append(ArcMove(x, cy, cx, cy, True, 300.0, contour=1))
+    return Program(tuple(moves), origin=(0.0, 0.0))
+
+
+@pytest.mark.parametrize("streamed", [False, True])
+def test_the_likeliest_samples_measured_first_leave_most_out(
+    streamed: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A staircase round a circle: few samples measured, the shortfall of every sample.
+
+    The direct-search arcs' rows bound most path samples near the largest shortfall.
+    The top sample's own distance left half of them to measure; the 1024 of largest
+    bound measured first leave out all but a few of the rest.
+    """
+    from camtool.verify.verifier import verify_program
+
+    machine = load_target("pic-mmh").machine
+    program = _circle_turns(3)
+    trace = simulate_steps(program, machine)
+    want = _shortfall_reference(trace.carriage_mm, trace.block_start, trace.start_mm, program)
+    measured = [0]
+    real = metrics.farthest_nearest
+
+    def spy(samples: np.ndarray, a: np.ndarray, b: np.ndarray, **kw: object) -> tuple[float, int]:
+        measured[0] += len(samples)
+        return real(samples, a, b, **kw)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(metrics, "farthest_nearest", spy)
+    if streamed:
+        v = verify_program(
+            program, machine, name="pic-mmh", budget=False, chunk_rows=300, stream_above=10
+        )
+        along = v.along
+        assert along is not None
+    else:
+        along = metrics.along_path(trace.carriage_mm, trace.block_start, trace.start_mm, program)
+    assert _shortfall(along) == want
+    assert measured[0] < 0.2 * along.samples, (measured[0], along.samples)  # 51 % before
+
+
+def test_a_streamed_contour_builds_its_search_trees_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The batches and rounds of a streamed contour share its ends' search trees.
+
+    A few samples to measure: the compiled box tree, built once for the contour (its
+    form for few samples), and no scipy k-d tree (its build took most of the
+    shortfall's time, for ~100 samples measured). The same shortfall.
+    """
+    from camtool.verify.verifier import verify_program
+
+    builds: list[tuple[int, bool]] = []
+    kd: list[int] = []
+    real_tree = metrics._ends_tree
+
+    def ends_tree(points: np.ndarray, samples: int, kernels: object) -> tuple[object, ...]:
+        got = real_tree(points, samples, kernels)  # type: ignore[arg-type]
+        builds.append((len(points), len(got[0]) < len(points)))
+        return got
+
+    real_kd = metrics._LazyTree.tree.fget
+    assert real_kd is not None
+
+    def kd_tree(self: metrics._LazyTree) -> object:
+        if self._tree is None:
+            kd.append(len(self.points))
+        return real_kd(self)
+
+    monkeypatch.setattr(metrics, "_ends_tree", ends_tree)
+    monkeypatch.setattr(metrics._LazyTree, "tree", property(kd_tree))
+    monkeypatch.setattr(metrics, "STREAM_SAMPLES", 3000)  # several batches per contour
+    machine = load_target("pic-mmh").machine
+    moves = [Rapid(0.5, 0.5, contour=1)]
+    for k in range(8):  # long lines along X, back and forth, 0.137 mm apart
+        moves.append(Linear(6.0 if k % 2 == 0 else 0.5, 0.5 + 0.137 * (k + 1), 300.0, contour=1))
+    program = Program(tuple(moves), origin=(0.0, 0.0))
+    trace = simulate_steps(program, machine)
+    want = _shortfall_reference(trace.carriage_mm, trace.block_start, trace.start_mm, program)
+    builds.clear()
+    kd.clear()
+    v = verify_program(
+        program, machine, name="pic-mmh", budget=False, chunk_rows=4096, stream_above=10
+    )
+    assert v.along is not None and _shortfall(v.along) == want
+    assert want[3] > 5 * 3000  # path samples: several batches
+    assert kd == []
+    assert len(builds) == len(set(builds)) >= 1  # each form once for the contour
