@@ -30,3 +30,17 @@ def _progress_quiet(monkeypatch: pytest.MonkeyPatch) -> None:
     from camtool.cli import progress
 
     monkeypatch.setattr(progress, "AFTER_S", 1e9)
+
+
+@pytest.fixture(params=["accel", "plain"])
+def accel(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> bool:
+    """Run the test twice: with the accelerated versions, then with ``CAMTOOL_ACCEL=0``.
+
+    For the tests of a piece that :mod:`camtool.accel` speeds up: both ways must give the
+    same answer. The value says which way this run is (True: accelerated).
+    """
+    from camtool.accel import SWITCH
+
+    on = request.param == "accel"
+    monkeypatch.setenv(SWITCH, "1" if on else "0")
+    return on

@@ -157,15 +157,15 @@ def _write_stdout(data: str | bytes) -> None:
     """``data`` to stdout, every byte; a failed write or flush is a :class:`CamtoolError`.
 
     Written to the file descriptor with ``os.write`` until all is taken
-    (:func:`camtool.model.cores.write_all`), text encoded as stdout encodes it. Python's
+    (:func:`camtool.accel.cores.write_all`), text encoded as stdout encodes it. Python's
     buffered stream can report a large write as done when a pipe's reader left during it:
     on the development VM, ``write(2)`` took 64 KiB of a 5.3 MB program, the process got
     the SIGPIPE Python ignores, and ``sys.stdout.write`` returned without an error, so
     ``camtool post -o - | sender`` said nothing (exit 0) of a program cut short. A stdout
     without a file descriptor (a test's capture) is written by click, as before.
     """
+    from camtool.accel.cores import write_all
     from camtool.jobs.output import reason
-    from camtool.model.cores import write_all
 
     try:
         fd: int | None = sys.stdout.fileno()

@@ -13,7 +13,7 @@ the same place as without workers.
 Workers are started by ``fork`` (Linux; nothing to re-import, ~10 ms each) and only for at
 least :data:`MIN_CURVES` keys, so small files never pay for a pool; where ``fork`` is not
 available, or the pool cannot start or breaks, or this process is itself a worker (``camtool
-batch``, Dask: :func:`camtool.model.cores.in_worker`), every fit runs here, one after the
+batch``, Dask: :func:`camtool.accel.cores.in_worker`), every fit runs here, one after the
 other.
 Forking is safe at this point: the importers run before anything starts threads of its own
 (camtool starts none; numba, whose threading layer must not be forked, is not imported on the
@@ -27,6 +27,7 @@ from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from typing import Any, TypeAlias
 
+from camtool.accel.cores import default_jobs, in_worker
 from camtool.geometry.arcfit import fit_curve
 from camtool.geometry.curves import (
     cubic_bezier,
@@ -36,7 +37,6 @@ from camtool.geometry.curves import (
     quadratic_bezier,
     quadratic_bezier_points,
 )
-from camtool.model.cores import default_jobs, in_worker
 from camtool.model.shapes import Arc, Line, Segment
 
 __all__ = ["MIN_CURVES", "CurveKey", "fit_key", "fit_many"]
@@ -91,7 +91,7 @@ def fit_many(
     Args:
         keys: the curves.
         tolerance: mm (> 0), as for :func:`fit_key`.
-        jobs: worker processes; ``None``: :func:`~camtool.model.cores.default_jobs`. With
+        jobs: worker processes; ``None``: :func:`~camtool.accel.cores.default_jobs`. With
             1, or fewer than :data:`MIN_CURVES` keys, every fit runs in this process.
         done: called in this process with the number of keys fitted so far, as they
             come in (after each fit here, after each worker's chunk of keys with a pool);

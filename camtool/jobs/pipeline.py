@@ -135,7 +135,7 @@ def post_path(
     """
     plan = plan if plan is not None else PlanOptions()
     if not is_program_file(path):
-        from camtool.model.cores import meanwhile
+        from camtool.accel.cores import meanwhile
         from camtool.toolpath.compensate import offsets_ahead
 
         shared = plan if job is None else job.setup.plan

@@ -9,7 +9,7 @@ stderr lines, and only for a job still running after a couple of seconds
 A callback must be cheap and must not raise: it may be called once per shape or per
 chunk of curve fits (thousands of times on a big drawing); it is called in the calling
 process only (never from a worker of :mod:`camtool.geometry.fitpool` or
-:class:`camtool.model.cores.ForkedWork`).
+:class:`camtool.accel.cores.ForkedWork`).
 """
 
 from __future__ import annotations

@@ -109,7 +109,7 @@ class ConformAhead:
         """Take every record the helper has written so far, without waiting for more."""
         import select
 
-        from camtool.model.cores import read_record
+        from camtool.accel.cores import read_record
 
         fd = self.fd
         while fd is not None and select.select([fd], [], [], 0.0)[0]:
@@ -143,7 +143,7 @@ class ConformAhead:
 
     def close(self) -> None:
         """End the helper (it may still be working: its answers are no longer needed)."""
-        from camtool.model.cores import end_process
+        from camtool.accel.cores import end_process
 
         self._close_pipe()
         with suppress(ChildProcessError):
@@ -168,7 +168,7 @@ def start(writer: BlockWriter, program: Program) -> ConformAhead | None:
     # reuse their blocks (BlockWriter._conformed_at), not conform them again.
     if len({m.cx for m in program.moves if isinstance(m, ArcMove)}) < MIN_ARCS:
         return None
-    from camtool.model.cores import (  # only here: ~9 ms that a re-post does not need
+    from camtool.accel.cores import (  # only here: ~9 ms that a re-post does not need
         default_jobs,
         fork_with_pipes,
         in_worker,

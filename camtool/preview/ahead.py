@@ -28,7 +28,7 @@ import pickle
 import signal
 from typing import TYPE_CHECKING
 
-from camtool.model.cores import (
+from camtool.accel.cores import (
     FORK,
     end_process,
     fork_with_pipes,
@@ -54,7 +54,7 @@ class _Drawer:
         """Fork it.
 
         Raises:
-            OSError: it cannot be forked now (:func:`~camtool.model.cores.fork_with_pipes`).
+            OSError: it cannot be forked now (:func:`~camtool.accel.cores.fork_with_pipes`).
         """
         pid, inbox, out = fork_with_pipes(_serve)
         self.pid: int | None = pid

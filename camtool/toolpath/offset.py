@@ -29,8 +29,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeAlias
 
-from camtool.geometry.chain import chain
-from camtool.model.cores import (
+from camtool.accel.cores import (
     FORK,
     default_jobs,
     end_process,
@@ -43,6 +42,7 @@ from camtool.model.cores import (
     wait_readable,
     write_record,
 )
+from camtool.geometry.chain import chain
 from camtool.model.errors import ToolpathError
 from camtool.model.shapes import Arc, Contour, Line, Point, Segment, distance
 
@@ -302,7 +302,7 @@ def stop_ahead() -> None:
 
 _OFFSET_CALLS = [0]
 """Calls of :func:`offset_all` in this process so far: from the second on (or in a worker
-process, :func:`~camtool.model.cores.in_worker`), OpenCASCADE is loaded here before the
+process, :func:`~camtool.accel.cores.in_worker`), OpenCASCADE is loaded here before the
 child is forked. A count, not a setting: only the time and memory depend on it."""
 _AHEAD: list[_Child] = []
 """The child :func:`start_ahead` started, until :func:`offset_all` takes it (at most one)."""
@@ -356,7 +356,7 @@ class _Child:
         """Fork it.
 
         Raises:
-            OSError: it cannot be forked now (:func:`~camtool.model.cores.fork_with_pipes`).
+            OSError: it cannot be forked now (:func:`~camtool.accel.cores.fork_with_pipes`).
         """
 
         def child(jobs: int, answers: int) -> None:
@@ -511,7 +511,7 @@ class _Worker:
     def close(self, *, kill: bool = False) -> str:
         """End it (``kill``: at once) and wait for it; how it ended.
 
-        As :func:`camtool.model.cores.how_ended` says it.
+        As :func:`camtool.accel.cores.how_ended` says it.
         """
         for fd in (self.given, self.answers):
             with contextlib.suppress(OSError):

@@ -2450,7 +2450,7 @@ def comparison_preloads(drawing: Drawing) -> list[Callable[[], object]]:
     """What :func:`prepare_comparison` will load for ``drawing``, as tasks for a wait.
 
     For a job that will compare a trace with ``drawing`` but first waits for another
-    process (:func:`camtool.model.cores.meanwhile`: ``post --preview`` waits ~0.4 s for
+    process (:func:`camtool.accel.cores.meanwhile`: ``post --preview`` waits ~0.4 s for
     the offsets' child to load OpenCASCADE): the compiled nearest search
     (:func:`near_kernels`, numba's import ~0.15 s), then numba's first call, which loads
     its compiler's registries (~0.2 s), then the machine code of the kernels a comparison

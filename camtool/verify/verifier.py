@@ -44,7 +44,7 @@ from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 import numpy as np
 
-from camtool.model.cores import (
+from camtool.accel.cores import (
     FORK,
     ForkedWork,
     ahead,
@@ -196,7 +196,7 @@ class Verification:
         """The error budget by source (:mod:`camtool.verify.budget`), computed on first use.
 
         Re-simulates the program once per modelled source, the sources shared out among
-        forked workers (:class:`camtool.model.cores.ForkedWork`: the same figures as one
+        forked workers (:class:`camtool.accel.cores.ForkedWork`: the same figures as one
         after the other); skipped (with the reason) when :attr:`budget` is off or the
         trace is over :data:`camtool.verify.budget.MAX_ROWS` rows.
 
@@ -212,7 +212,7 @@ class Verification:
         and as each source's figures come in (``done`` the sources finished, ``total`` the
         modelled ones, ``name`` the next in order), so a long verification can say what
         it is doing; the budget is the same. The sources are re-simulated in forked
-        workers, one per core (:class:`camtool.model.cores.ForkedWork`): the part of
+        workers, one per core (:class:`camtool.accel.cores.ForkedWork`): the part of
         issue 17's preview bench takes 2.6 s for its three where it took 3.8 s.
 
         Raises:
@@ -374,7 +374,7 @@ def verify_program(
             worker inherits them instead of loading them again; the workers are then
             forked at once, before this process's own measures (their core is idle
             otherwise; with the kernels loaded while the plan waited for
-            OpenCASCADE, :func:`camtool.model.cores.meanwhile`, ~0.3 s of that part's
+            OpenCASCADE, :func:`camtool.accel.cores.meanwhile`, ~0.3 s of that part's
             preview).
 
     A drawing whose box does not overlap the program's (less than
@@ -551,7 +551,7 @@ def _simulate_big(
     The measures need every move's row offsets first: a trace sure to be streamed has
     them counted (:func:`~camtool.verify.simulate.count_rows`, a DDA line in closed
     form), others from a simulation that drops its rows. The chunks, made one ahead in a
-    thread (:func:`~camtool.model.cores.ahead`), say where each move's rows start; should
+    thread (:func:`~camtool.accel.cores.ahead`), say where each move's rows start; should
     they not agree with the count, the offsets are simulated and the trace streamed again.
     ``streaming`` is told the rows of a trace about to be streamed, before it is (each
     time it is).
@@ -673,7 +673,7 @@ def _stream(
 class _Share:
     """Which chunks' deviation distances the thread ahead takes (:func:`_stream`).
 
-    The simulating thread (:func:`~camtool.model.cores.ahead`) and the measuring one run
+    The simulating thread (:func:`~camtool.accel.cores.ahead`) and the measuring one run
     on two cores; the slower sets the pace. On a program of long lines measuring is the
     slower (the distances alone, ``to_line``, take about as long as simulating), so the
     thread ahead also takes the distances (:meth:`TraceStream.distances`) of a share
@@ -890,7 +890,7 @@ class _Inputs:
 class _BudgetRun:
     """The error budget's re-simulations, started in forked workers when it is made.
 
-    The workers (:class:`~camtool.model.cores.ForkedWork`, one per core) need only the
+    The workers (:class:`~camtool.accel.cores.ForkedWork`, one per core) need only the
     verification's inputs and trace, so they can start before all its measures are
     taken (:func:`verify_program` starts them before the drawing comparison, and before
     a streamed trace without a drawing: they need only its row count);
@@ -966,9 +966,9 @@ class _BudgetRun:
 class _ForkedOne(Generic[T, R]):
     """``[fn(item)]``, started now in one forked helper, gathered later (as ForkedWork).
 
-    :class:`~camtool.model.cores.ForkedWork` runs a lone item in this process, when its
+    :class:`~camtool.accel.cores.ForkedWork` runs a lone item in this process, when its
     answers are asked for; a process with work of its own meanwhile (a streamed trace)
-    gives it a helper of its own (:func:`~camtool.model.cores.fork_with_pipes`), a copy of
+    gives it a helper of its own (:func:`~camtool.accel.cores.fork_with_pipes`), a copy of
     this process as it is now. Its answer comes back pickled, every bit kept; a helper that
     raised, died or could not start has the item run here, so an error is raised as it
     would be without it. Where ForkedWork would not fork (no ``fork``, one core, in a

@@ -22,7 +22,7 @@ from typing import Any
 
 import pytest
 
-from camtool.model import cores
+from camtool.accel import cores
 from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Linear, Move, Program, Rapid
 from camtool.post import conformahead, wordaddress_write

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from camtool.model import cores
+from camtool.accel import cores
 from camtool.model.program import ArcMove, Linear, Program, Rapid
 from camtool.post.registry import load_target
 from camtool.verify import verifier

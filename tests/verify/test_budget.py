@@ -300,7 +300,7 @@ def test_the_budget_made_in_workers_is_the_one_made_here(
     """
     import os
 
-    from camtool.model import cores
+    from camtool.accel import cores
     from camtool.verify import verifier
 
     if not cores.FORK:

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from camtool.model import cores
+from camtool.accel import cores
 from camtool.model.machine import Backlash, BacklashRegion, Machine
 from camtool.model.program import Linear, Program, Rapid
 from camtool.model.progress import Step

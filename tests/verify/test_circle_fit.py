@@ -15,7 +15,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from camtool.model import cores
+from camtool.accel import cores
 from camtool.model.machine import Backlash, Machine
 from camtool.model.program import ArcMove, Program, Rapid
 from camtool.post.registry import load_target

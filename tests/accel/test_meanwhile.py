@@ -11,7 +11,7 @@ from collections.abc import Callable, Iterator
 
 import pytest
 
-from camtool.model import cores
+from camtool.accel import cores
 
 
 @pytest.fixture

@@ -1,5 +1,10 @@
 """Independent pieces of one job on the machine's cores: forked workers, answers in order.
 
+Behind the switch (:func:`camtool.accel.enabled`): switched off, :class:`ForkedWork` and
+:func:`ahead` run every item here, in order, and :func:`meanwhile` runs nothing. The fork
+primitives at the end (:func:`fork_with_pipes` and the records) also serve the offsets'
+child, which isolates OpenCASCADE's crashes whether or not the switch is on.
+
 :class:`ForkedWork` runs a function over a few items in worker processes started by ``fork``
 (Linux), so the function may be a closure over this process's state (a verification, its
 trace, loaded kernels): nothing is pickled on the way in, and each answer comes back
@@ -28,7 +33,10 @@ import threading
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from contextlib import contextmanager, suppress
+from contextvars import ContextVar
 from typing import Any, Generic, TypeVar
+
+from camtool.accel import enabled
 
 __all__ = [
     "FORK",
@@ -76,8 +84,10 @@ def in_worker() -> bool:
     return bool(current.daemon) or multiprocessing.parent_process() is not None
 
 
-_MEANWHILE: list[Callable[[], object]] = []
-"""The tasks :func:`meanwhile` gave that no wait has run yet, in order."""
+_MEANWHILE: ContextVar[list[Callable[[], object]] | None] = ContextVar(
+    "camtool_meanwhile", default=None
+)
+"""The tasks :func:`meanwhile` gave that no wait has run yet, in order (this context's)."""
 
 
 @contextmanager
@@ -93,13 +103,22 @@ def meanwhile(tasks: Sequence[Callable[[], object]]) -> Iterator[None]:
     task runs at most once; those no wait ran are dropped on leaving. A task only saves
     time: what it does must be what the job would do anyway, with the same results.
     """
-    _MEANWHILE.extend(tasks)
+    pending = _MEANWHILE.get()
+    if pending is None:
+        pending = []
+        token = _MEANWHILE.set(pending)
+    else:
+        token = None
+    if enabled():
+        pending.extend(tasks)
     try:
         yield
     finally:
         for task in tasks:
             with suppress(ValueError):  # already run
-                _MEANWHILE.remove(task)
+                pending.remove(task)
+        if token is not None:
+            _MEANWHILE.reset(token)
 
 
 def wait_readable(fd: int) -> None:
@@ -115,8 +134,9 @@ def wait_until(ready: Callable[[], bool]) -> None:
     the same work, and meets the same error, when it needs it); ``KeyboardInterrupt``
     and ``SystemExit`` are not caught.
     """
-    while _MEANWHILE and not ready():
-        task = _MEANWHILE.pop(0)
+    pending = _MEANWHILE.get()
+    while pending and not ready():
+        task = pending.pop(0)
         with suppress(Exception):
             task()
 
@@ -133,7 +153,7 @@ def ahead(items: Iterable[T]) -> Iterator[T]:
     thread outlives the loop (forking stays safe). With one core, or in a worker process
     (:func:`in_worker`), the items are made here, one after the other.
     """
-    if default_jobs() < 2 or in_worker():
+    if default_jobs() < 2 or in_worker() or not enabled():
         yield from items
         return
     made: queue.Queue[tuple[bool, Any]] = queue.Queue(maxsize=1)
@@ -200,7 +220,7 @@ class ForkedWork(Generic[T, R]):
         self._pool: ProcessPoolExecutor | None = None
         self._futures: dict[Any, int] = {}
         workers = min(default_jobs() if jobs is None else max(1, jobs), len(items))
-        if workers > 1 and FORK and not in_worker():
+        if workers > 1 and FORK and not in_worker() and enabled():
             self._start(workers)
 
     def __enter__(self) -> ForkedWork[T, R]:

@@ -15,8 +15,8 @@ from pathlib import Path
 
 import pytest
 
-from camtool.model import cores
-from camtool.model.cores import ForkedWork
+from camtool.accel import cores
+from camtool.accel.cores import ForkedWork
 from camtool.model.errors import InputError
 
 pytestmark = pytest.mark.skipif(not cores.FORK, reason="forked workers: Linux only")
@@ -112,7 +112,7 @@ def test_a_worker_process_runs_its_items_itself() -> None:
 
 def test_forked_work_runs_while_this_process_works(tmp_path: Path) -> None:
     """ForkedWork forks at once; its workers see the state of then, not what changes after."""
-    from camtool.model.cores import ForkedWork
+    from camtool.accel.cores import ForkedWork
 
     state = {"offset": 10}
     started = tmp_path / "started"
@@ -131,7 +131,7 @@ def test_forked_work_runs_while_this_process_works(tmp_path: Path) -> None:
 
 def test_leaving_forked_work_on_an_error_leaves_no_worker() -> None:
     """An error raised here while the workers run: the with-block stops them, none is left."""
-    from camtool.model.cores import ForkedWork
+    from camtool.accel.cores import ForkedWork
 
     pids: list[int] = []
     pending = ForkedWork(lambda x: x, list(range(4)), jobs=2)
@@ -225,7 +225,7 @@ def _no_fork() -> int:
 
 
 def test_a_failed_fork_leaves_no_pipe_open(monkeypatch: pytest.MonkeyPatch) -> None:
-    from camtool.model.cores import fork_with_pipes
+    from camtool.accel.cores import fork_with_pipes
 
     before = sorted(os.listdir("/proc/self/fd"))
     monkeypatch.setattr(os, "fork", _no_fork)
@@ -235,7 +235,7 @@ def test_a_failed_fork_leaves_no_pipe_open(monkeypatch: pytest.MonkeyPatch) -> N
 
 
 def test_fork_with_pipes_joins_the_child(monkeypatch: pytest.MonkeyPatch) -> None:
-    from camtool.model.cores import end_process, fork_with_pipes, read_record, write_record
+    from camtool.accel.cores import end_process, fork_with_pipes, read_record, write_record
 
     def echo(inbox: int, out: int) -> None:
         data = read_record(inbox)
@@ -270,3 +270,26 @@ def test_post_with_offsets_and_a_png_when_no_process_can_be_forked(
     forked = run("forked")
     monkeypatch.setattr(os, "fork", _no_fork)
     assert run("here") == forked
+
+
+def test_switched_off_every_item_runs_here_in_order(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``CAMTOOL_ACCEL=0``: no worker is forked and no thread made; the same answers."""
+    from camtool.accel import SWITCH
+
+    monkeypatch.setenv(SWITCH, "0")
+    monkeypatch.setattr(cores, "default_jobs", lambda: 2)
+    here = os.getpid()
+    assert ForkedWork(lambda x: (x, os.getpid()), [1, 2, 3], jobs=2).answers() == [
+        (1, here),
+        (2, here),
+        (3, here),
+    ]
+    makers: list[str] = []
+
+    def made() -> Iterator[int]:
+        for i in range(3):
+            makers.append(threading.current_thread().name)
+            yield i
+
+    assert list(cores.ahead(made())) == [0, 1, 2]
+    assert set(makers) == {threading.current_thread().name}
