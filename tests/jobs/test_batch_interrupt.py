@@ -18,6 +18,7 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -58,6 +59,29 @@ def drawings(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     return root
 
 
+@pytest.fixture(autouse=True)
+def _signals_as_at_a_terminal() -> Iterator[None]:
+    """Ctrl-C and SIGTERM have Python's default handlers here, however the suite was started.
+
+    A suite started in the background by a non-interactive shell inherits SIGINT ignored,
+    and a batch leaves an ignored signal alone (as after ``nohup``): these tests are of a
+    batch run from a terminal.
+    """
+    previous = {
+        signal.SIGINT: signal.signal(signal.SIGINT, signal.default_int_handler),
+        signal.SIGTERM: signal.signal(signal.SIGTERM, signal.SIG_DFL),
+    }
+    yield
+    for signum, handler in previous.items():
+        signal.signal(signum, handler)
+
+
+def _as_at_a_terminal() -> None:
+    """In a child before ``exec``: SIGINT and SIGTERM at their defaults (see above)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
 def _env() -> dict[str, str]:
     paths = [str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])]
     return {**os.environ, "PYTHONPATH": os.pathsep.join(paths)}
@@ -84,6 +108,7 @@ def _signal_batch(where: list[str], signum: int, out: Path) -> tuple[int, str, l
         stderr=subprocess.PIPE,
         text=True,
         env=_env(),
+        preexec_fn=_as_at_a_terminal,
     )
     workers: list[int] = []
     try:
@@ -151,6 +176,7 @@ def test_ctrl_c_at_a_terminal_reaches_the_workers_too_and_still_stops_cleanly(
         text=True,
         env=_env(),
         start_new_session=True,
+        preexec_fn=_as_at_a_terminal,
     )
     workers: list[int] = []
     try:
