@@ -423,7 +423,7 @@ class I8751Post(PostProcessor):
         before = len(w.blocks)
         points = [(move.x, move.y)]
         if isinstance(move, ArcMove):
-            points = self._chords(w, start, move, machine.motion.chord_tolerance_mm)
+            points = self._chords(w, start, move, _tolerance(program, machine))
         for k, (x, y) in enumerate(points, start=1):
             w.goto(x, y, move.z if k == len(points) else None, rapid=isinstance(move, Rapid))
         if len(w.blocks) == before:
@@ -481,7 +481,7 @@ class I8751Post(PostProcessor):
             out.append(
                 f"{w.arcs} arc(s) written as {w.chords} chords (the 8751 has no arcs, "
                 f"Intf8751 §4.1): largest chord error {w.chord_error_mm:.4f} mm "
-                f"(chord_tolerance_mm {machine.motion.chord_tolerance_mm:g})"
+                f"(within {_tolerance(program, machine):g} mm)"
             )
         out += _count_warnings(c)
         return tuple(out)
@@ -578,3 +578,12 @@ def post_processor(options: Mapping[str, Any], where: str) -> PostProcessor:
         InputError: an unknown option or a bad value, naming ``where``.
     """
     return from_options(I8751Post, options, where)
+
+
+def _tolerance(program: Program, machine: Machine) -> float:
+    """Chord sagitta, mm: ``--tolerance`` when coarser than the machine's ``chord_tolerance_mm``.
+
+    The machine's sagitta is the finest its steps hold; finer chords only add moves
+    shorter than half a step, written as nothing.
+    """
+    return max(machine.motion.chord_tolerance_mm, program.tolerance_mm or 0.0)

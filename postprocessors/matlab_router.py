@@ -724,18 +724,24 @@ class MatlabRouterPost(PostProcessor):
                 "more (rapids alone are not written)"
             )
         warnings = [*check_placement(program, machine), *notes.warnings]
-        warnings += notes_warnings(notes, self.speed, self._tolerance(machine))
+        warnings += notes_warnings(notes, self.speed, self._tolerance(program, machine))
         return jobs, warnings + jobs_warnings(jobs, self.max_segments)
 
-    def _tolerance(self, machine: Machine) -> float:
-        return self.chord_tolerance_mm or machine.motion.chord_tolerance_mm
+    def _tolerance(self, program: Program, machine: Machine) -> float:
+        """Chord sagitta, mm: ``--tolerance`` when coarser than the dialect's or machine's.
+
+        The dialect's (else the machine's) sagitta is the finest a 0.1 mm grid can hold:
+        finer chords would only add 0.1 mm segments (Angel-11 §4.2).
+        """
+        finest = self.chord_tolerance_mm or machine.motion.chord_tolerance_mm
+        return max(finest, program.tolerance_mm or 0.0)
 
     def _strokes(self, program: Program, machine: Machine, notes: RouterWriter) -> list[_Stroke]:
         """Runs of cutting moves (mm, arcs as chords); rapids only end them."""
         strokes: list[_Stroke] = []
         current: _Stroke | None = None
         feed = major_axis_feed_mm_min(self.speed)
-        tolerance = self._tolerance(machine)
+        tolerance = self._tolerance(program, machine)
         index = -1
         for item in program.items():
             if not isinstance(item, Rapid | Linear | ArcMove):

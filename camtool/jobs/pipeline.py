@@ -328,6 +328,8 @@ def post_program(
             for m in program.moves
         )
         program = dataclasses.replace(program, moves=moves)
+    if tolerance_mm is not None:
+        program = dataclasses.replace(program, tolerance_mm=tolerance_mm)
     program, chorded = plane_chords(program, target, tolerance_mm)
     if chorded:
         program = dataclasses.replace(program, warnings=(*program.warnings, chorded))
