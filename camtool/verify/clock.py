@@ -14,7 +14,7 @@ import numpy.typing as npt
 
 from camtool.model.errors import InputError
 from camtool.model.machine import Machine
-from camtool.model.program import Program, Rapid
+from camtool.model.program import PlaneArc, Program, Rapid
 from camtool.verify.motion import StepTrace, timing_model_from_table
 from camtool.verify.timing import BlockKinematics
 
@@ -52,7 +52,50 @@ def block_times_s(trace: StepTrace, program: Program, machine: Machine) -> npt.N
         return _at_feed(program, machine)
     where = f"machine {machine.name!r} [machine.timing]"
     model = timing_model_from_table(machine.timing, where=where, machine=machine)
-    return np.asarray(model.block_time_s(block_kinematics(trace, program)), dtype=np.float64)
+    blocks = block_kinematics(trace, program)
+    times = np.array(model.block_time_s(blocks), dtype=np.float64)
+    spans = _plane_arc_spans(program)
+    if spans:
+        arcs = np.asarray(model.block_time_s(_joined(blocks, spans)), dtype=np.float64)
+        lengths = blocks.length_mm
+        for (start, stop), seconds in zip(spans, arcs, strict=True):
+            share = lengths[start:stop] / max(float(lengths[start:stop].sum()), 1e-300)
+            times[start:stop] = seconds * share
+    return times
+
+
+def _plane_arc_spans(program: Program) -> list[tuple[int, int]]:
+    """``[start, stop)`` move ranges that are the chords of a G18/G19 arc the code holds.
+
+    The controller runs such an arc as one block (GRBL's ``mc_arc`` and LinuxCNC's
+    planner blend its segments as they do an XY arc's), so it is timed as one.
+    """
+    return [
+        (index, index + command.moves)
+        for index, command in program.commands
+        if isinstance(command, PlaneArc)
+        and command.moves > 1
+        and program.has_chords_of(index, command)
+    ]
+
+
+def _joined(blocks: BlockKinematics, spans: list[tuple[int, int]]) -> BlockKinematics:
+    """One block per span of ``blocks``: counts and lengths summed, the first block's feed."""
+
+    def total(values: npt.NDArray[np.generic]) -> npt.NDArray[np.generic]:
+        return np.array([values[a:b].sum(axis=0) for a, b in spans])
+
+    first = np.array([a for a, _ in spans], dtype=np.int64)
+    return BlockKinematics.build(
+        dominant_steps=total(blocks.dominant_steps),
+        is_rapid=blocks.is_rapid[first],
+        feed_mm_min=blocks.feed_mm_min[first],
+        length_mm=total(blocks.length_mm),
+        iterations=total(blocks.iterations),
+        steps=total(blocks.steps).reshape(len(spans), 3),
+        compensation_steps=total(blocks.compensation_steps),
+        block_bytes=total(blocks.block_bytes),
+    )
 
 
 def timing_warnings(trace: StepTrace, program: Program, machine: Machine) -> list[str]:
@@ -82,8 +125,10 @@ def timing_warnings(trace: StepTrace, program: Program, machine: Machine) -> lis
         word, numbers = "line", [str(n) for n in lines]
         if any(n is None for n in lines):
             word, numbers = "move", [str(b + 1) for b in blocks]
-        shown = ", ".join(numbers[:8]) + (f" and {len(blocks) - 8} more" if len(blocks) > 8 else "")
-        out.append(f"{word}{'s' if len(blocks) > 1 else ''} {shown}: {reason}")
+        numbers = list(dict.fromkeys(numbers))  # the chords of one arc share its line
+        more = len(numbers) - 8
+        shown = ", ".join(numbers[:8]) + (f" and {more} more" if more > 0 else "")
+        out.append(f"{word}{'s' if len(numbers) > 1 else ''} {shown}: {reason}")
     return out
 
 
