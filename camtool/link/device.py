@@ -238,6 +238,9 @@ class PtyServer:
         self.path = os.ttyname(slave)
         os.close(slave)
         self.error: BaseException | None = None
+        self.written = 0
+        """Bytes written to the host so far."""
+        self._quiet = threading.Event()
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name="camtool-device", daemon=True)
 
@@ -258,6 +261,19 @@ class PtyServer:
         if self._thread.is_alive():
             self._thread.join(5)
         self._close()
+
+    def quiet(self) -> bool:
+        """True when the device has taken every byte the host wrote and has nothing left to run.
+
+        What it answered may still be on its way to the host (see :attr:`written`).
+        """
+        if not self._quiet.is_set() or self.master < 0:
+            return False
+        try:
+            ready, _, _ = select.select([self.master], [], [], 0)
+        except (OSError, ValueError):
+            return False
+        return not ready
 
     def wait_closed(self, timeout: float) -> bool:
         """Wait until the device has dropped the port (or ``timeout`` s); True if it has."""
@@ -302,9 +318,13 @@ class PtyServer:
         connected = False
         next_block = 0.0
         while not self._stop.is_set() and not self.device.dropped:
-            ready, _, _ = select.select([self.master], [], [], 0.005)
+            wait = 0.005
+            if self.device.pending():  # the next block is due then, not at the next poll
+                wait = min(wait, max(0.0, next_block - time.monotonic()))
+            ready, _, _ = select.select([self.master], [], [], wait)
             data = b""
             if ready:
+                self._quiet.clear()
                 try:
                     data = os.read(self.master, 4096)
                 except OSError as exc:  # EIO: no host holds the port open
@@ -315,16 +335,20 @@ class PtyServer:
                     continue
             if not connected:
                 connected = True
+                self._quiet.clear()
                 time.sleep(self.settle_s)
                 self._write(self.device.connect())
             if data:
                 self._write(self.device.feed(data))
             now = time.monotonic()
             if self.device.pending() and now >= next_block:
+                self._quiet.clear()
                 self._write(self.device.step())
                 next_block = now + self.block_delay_s
+            if not self.device.pending():
+                self._quiet.set()
 
     def _write(self, data: bytes) -> None:
         if data and not self.device.dropped:
             with contextlib.suppress(OSError):  # no host holds the port: the answer is lost
-                os.write(self.master, data)
+                self.written += os.write(self.master, data)

@@ -45,6 +45,45 @@ STATUS_PERIOD_S = 0.2
 """Status queries while waiting, at most 5 per second (GRBL interface.md)."""
 
 
+class Clock(Protocol):
+    """The driver's time and its waits: :class:`WallClock`, or a test's simulated time.
+
+    Every deadline of :func:`send_plan` is read from :meth:`monotonic`, and every wait
+    goes through :meth:`sleep` or :meth:`read`, so a test can run a controller that
+    stops answering through its bounds without waiting them out.
+    """
+
+    def monotonic(self) -> float:
+        """Seconds from any fixed start, never going back."""
+        ...
+
+    def sleep(self, seconds: float) -> None:
+        """Let ``seconds`` pass."""
+        ...
+
+    def read(self, port: Any, seconds: float) -> bytes:
+        """The bytes ``port`` has, waiting up to ``seconds`` for the first (``b""``: none)."""
+        ...
+
+
+class WallClock:
+    """The real clock: :func:`time.monotonic`, :func:`time.sleep`, the port's own timeout."""
+
+    def monotonic(self) -> float:
+        """:func:`time.monotonic`."""
+        return time.monotonic()
+
+    def sleep(self, seconds: float) -> None:
+        """:func:`time.sleep`."""
+        time.sleep(seconds)
+
+    def read(self, port: Any, seconds: float) -> bytes:
+        """One read of ``port`` with ``seconds`` as its timeout."""
+        port.timeout = seconds
+        data: bytes = port.read(max(1, port.in_waiting))
+        return data
+
+
 @dataclass(frozen=True)
 class Progress:
     """Where a job is, for a progress bar.
@@ -416,12 +455,14 @@ class _Wire:
         name: str,
         log: ByteLog | None,
         split: Callable[[bytearray], list[str]] | None = None,
+        clock: Clock | None = None,
     ) -> None:
         self.port = port
         self.name = name
         self.log = log
+        self.clock = clock or WallClock()
         self.buffer = bytearray()
-        self.last_rx = time.monotonic()
+        self.last_rx = self.clock.monotonic()
         self.split = split or split_lines
         self.unread: list[str] = []
 
@@ -450,11 +491,11 @@ class _Wire:
         try:
             self.port.dtr = True
             self.port.rts = True
-            deadline = time.monotonic() + timeout
+            deadline = self.clock.monotonic() + timeout
             while not self.port.dsr:
-                if time.monotonic() >= deadline:
+                if self.clock.monotonic() >= deadline:
                     return False
-                time.sleep(POLL_S)
+                self.clock.sleep(POLL_S)
         except OSError as exc:
             if exc.errno in (errno.ENOTTY, errno.EINVAL):
                 return None
@@ -475,12 +516,11 @@ class _Wire:
             out, self.unread = self.unread, []
             return out
         try:
-            self.port.timeout = timeout
-            data = self.port.read(max(1, self.port.in_waiting))
+            data = self.clock.read(self.port, timeout)
         except _port_errors() as exc:
             raise _PortGone(f"port {self.name!r} disappeared {where}: {exc}") from exc
         if data:
-            self.last_rx = time.monotonic()
+            self.last_rx = self.clock.monotonic()
             if self.log:
                 self.log.record("<", data)
             self.buffer += data
@@ -525,6 +565,7 @@ def send_plan(
     log: ByteLog | None = None,
     time_scale: float = 1.0,
     reopen: Callable[[], Any] | None = None,
+    clock: Clock | None = None,
 ) -> SendResult:
     """Send ``plan`` over an open ``port`` (see the module docstring).
 
@@ -549,6 +590,7 @@ def send_plan(
         reopen: opens the port again after the operator's turn between blocks
             (``operator_between_blocks``: the device was reset, as the
             matlab-router master is after every job); ``None``: keep the port.
+        clock: time and waits (default: :class:`WallClock`).
 
     Returns:
         What was sent.
@@ -560,7 +602,9 @@ def send_plan(
             operator stopped; the message says which lines surely ran, which
             may have run in part, and which ``--from-line`` resumes.
     """
-    driver = _Driver(port, plan, port_name, control or StopAtPause(), progress, log, time_scale)
+    driver = _Driver(
+        port, plan, port_name, control or StopAtPause(), progress, log, time_scale, clock
+    )
     driver.reopen = reopen
     return driver.run()
 
@@ -584,9 +628,11 @@ class _Driver:
         progress: Callable[[Progress], None] | None,
         log: ByteLog | None,
         time_scale: float,
+        clock: Clock | None = None,
     ) -> None:
         self.plan, self.spec, self.control = plan, plan.spec, control
-        self.wire = _Wire(port, name or "port", log, plan.hooks.split)
+        self.clock = clock or WallClock()
+        self.wire = _Wire(port, name or "port", log, plan.hooks.split, self.clock)
         self.log = log
         self.stream = Stream(plan, time_scale=time_scale)
         self.report = progress or (lambda p: None)
@@ -594,7 +640,7 @@ class _Driver:
         self.last_status = 0.0
         self.turns = 0
         self.reopen: Callable[[], Any] | None = None
-        self.answer_since = time.monotonic()
+        self.answer_since = self.clock.monotonic()
         self.idle_since: float | None = None
         self.put_back: list[str] = []
         self.unknown: list[str] = []
@@ -603,7 +649,7 @@ class _Driver:
         self.can_halt = self.can_halt and (hooks.status or hooks.status_state) is not None
 
     def run(self) -> SendResult:
-        start = time.monotonic()
+        start = self.clock.monotonic()
         try:
             self._start_up()
             self._stream()
@@ -617,7 +663,7 @@ class _Driver:
         return SendResult(
             len(self.plan.blocks),
             self.plan.total_bytes,
-            time.monotonic() - start,
+            self.clock.monotonic() - start,
             self.stream.max_buffered,
             tuple(self.messages),
         )
@@ -647,7 +693,7 @@ class _Driver:
                 self._query_state("before the job")
         if spec.startup:
             self.wire.write(spec.startup, "at start-up")
-        self.answer_since = time.monotonic()
+        self.answer_since = self.clock.monotonic()
 
     def _reads_status(self) -> bool:
         hooks = self.plan.hooks
@@ -663,8 +709,8 @@ class _Driver:
         where = f"asking {line!r}"
         self.wire.write(line.encode("latin-1") + spec.block_end, where)
         out: list[str] = []
-        deadline = time.monotonic() + spec.response_timeout_s
-        while time.monotonic() < deadline:
+        deadline = self.clock.monotonic() + spec.response_timeout_s
+        while self.clock.monotonic() < deadline:
             got = self.wire.lines(POLL_S, where)
             for n, answer in enumerate(got):
                 if answer == spec.ack:
@@ -718,8 +764,8 @@ class _Driver:
         for wake in (b"", spec.wake):
             if wake:
                 self.wire.write(wake, "at start-up")
-            deadline = time.monotonic() + spec.banner_timeout_s
-            while time.monotonic() < deadline:
+            deadline = self.clock.monotonic() + spec.banner_timeout_s
+            while self.clock.monotonic() < deadline:
                 got = self.wire.lines(POLL_S, "at start-up")
                 for n, line in enumerate(got):
                     if line.startswith(spec.banner) or (wake and self._status_of(line)):
@@ -741,9 +787,9 @@ class _Driver:
 
     def _query_state(self, where: str) -> str:
         self.wire.write(self.spec.status, where)
-        self.last_status = time.monotonic()
-        deadline = time.monotonic() + self.spec.response_timeout_s
-        while time.monotonic() < deadline:
+        self.last_status = self.clock.monotonic()
+        deadline = self.clock.monotonic() + self.spec.response_timeout_s
+        while self.clock.monotonic() < deadline:
             got = self.wire.lines(POLL_S, where)
             for n, line in enumerate(got):
                 status = self._status_of(line)
@@ -768,8 +814,8 @@ class _Driver:
     def _stream(self) -> None:
         s, control = self.stream, self.control
         pausing = False
-        while not s.finished or not s.idle(time.monotonic()):
-            now = time.monotonic()
+        while not s.finished or not s.idle(self.clock.monotonic()):
+            now = self.clock.monotonic()
             if s.failure:
                 self._fail()
             if getattr(control, "stop_requested", False):
@@ -798,10 +844,10 @@ class _Driver:
         s = self.stream
         block = s.block(k)
         if not s.in_flight:
-            self.answer_since = time.monotonic()
+            self.answer_since = self.clock.monotonic()
         s.sending(k)
         self.wire.write(block.data, f"while sending block {block.index} (line {block.line})")
-        s.sent(k, time.monotonic())
+        s.sent(k, self.clock.monotonic())
         if self.spec.flow == "timed":
             self.report(s.progress())
 
@@ -818,7 +864,7 @@ class _Driver:
         if pausing:
             control.pause_requested = False
             if control.paused(s.progress()) == "resume":
-                self.answer_since = time.monotonic()
+                self.answer_since = self.clock.monotonic()
                 return False
             self._operator_stop()
         following = s.block(s.queue[0])
@@ -832,7 +878,7 @@ class _Driver:
             self.wire.port = self.reopen()
             if self.spec.startup:
                 self.wire.write(self.spec.startup, "at start-up")
-        self.answer_since = time.monotonic()
+        self.answer_since = self.clock.monotonic()
         return False
 
     def _hold_pause(self) -> bool:
@@ -846,7 +892,7 @@ class _Driver:
         if control.paused(s.progress()) != "resume":
             self._operator_stop()
         self.wire.write(self.spec.resume, "resuming (cycle start)")
-        self.answer_since = time.monotonic()
+        self.answer_since = self.clock.monotonic()
         self.idle_since = None
         return False
 
@@ -858,11 +904,11 @@ class _Driver:
         less); returns the last state seen.
         """
         state = ""
-        deadline = time.monotonic() + self.spec.response_timeout_s
-        while time.monotonic() < deadline:
+        deadline = self.clock.monotonic() + self.spec.response_timeout_s
+        while self.clock.monotonic() < deadline:
             self.wire.write(self.spec.status, where)
-            until = time.monotonic() + STATUS_PERIOD_S
-            while time.monotonic() < until:
+            until = self.clock.monotonic() + STATUS_PERIOD_S
+            while self.clock.monotonic() < until:
                 got = self.wire.lines(POLL_S, where)
                 for n, line in enumerate(got):
                     status = self._status_of(line)
@@ -878,9 +924,9 @@ class _Driver:
 
     def _take(self, line: str) -> None:
         """An answer read outside the stream's own turn: counted as the stream counts it."""
-        kind = self.stream.answer(line)
+        kind = self.stream.answer(line, self.clock.monotonic())
         if kind == "ack":
-            self.answer_since = time.monotonic()
+            self.answer_since = self.clock.monotonic()
             self.report(self.stream.progress())
         elif kind == "push":
             self._push(line)
@@ -895,9 +941,9 @@ class _Driver:
                 s.report(status)
                 self._watch_idle(status)
                 continue
-            kind = s.answer(line)
+            kind = s.answer(line, self.clock.monotonic())
             if kind in ("ack", "answer", "event", "error"):
-                self.answer_since = time.monotonic()
+                self.answer_since = self.clock.monotonic()
                 self.idle_since = None
             if kind == "ack":
                 self.report(s.progress())
@@ -919,7 +965,7 @@ class _Driver:
         if status.state != "Idle" or not s.in_flight or not (rx_empty and queue_empty):
             self.idle_since = None
             return
-        now = time.monotonic()
+        now = self.clock.monotonic()
         if self.idle_since is None:
             self.idle_since = now
             return
@@ -935,7 +981,7 @@ class _Driver:
 
     def _keep_alive(self) -> None:
         """Poll the status while waiting; every wait for an answer has a bound."""
-        now = time.monotonic()
+        now = self.clock.monotonic()
         s = self.stream
         if self.spec.status and now - self.last_status >= STATUS_PERIOD_S:
             self.wire.write(self.spec.status, f"while sending ({self._where()})")
@@ -995,8 +1041,8 @@ class _Driver:
             self.wire.write(spec.abort, "stopping the controller")
             if not spec.echo:
                 return f"; {text!r} sent to stop the controller"
-            deadline = time.monotonic() + spec.response_timeout_s
-            while time.monotonic() < deadline:
+            deadline = self.clock.monotonic() + spec.response_timeout_s
+            while self.clock.monotonic() < deadline:
                 if text in self.wire.lines(POLL_S, "stopping the controller"):
                     return f"; {text!r} sent and echoed: the controller stopped"
         except LinkError:
@@ -1022,9 +1068,9 @@ class _Driver:
             self.wire.write(spec.hold, "stopping (feed hold)")
             state = self._wait_held("stopping")
             self.wire.write(spec.reset, "stopping (reset)")
-            deadline = time.monotonic() + spec.response_timeout_s
+            deadline = self.clock.monotonic() + spec.response_timeout_s
             banner = False
-            while not banner and time.monotonic() < deadline:
+            while not banner and self.clock.monotonic() < deadline:
                 for line in self.wire.lines(POLL_S, "stopping (reset)"):
                     banner = banner or (bool(spec.banner) and line.startswith(spec.banner))
                     if not banner:
@@ -1095,10 +1141,10 @@ class _Driver:
     def _drain(self) -> None:
         """Wait for the answers of the blocks still in flight (they run on the controller)."""
         s = self.stream
-        deadline = time.monotonic() + self.spec.response_timeout_s
-        while s.in_flight and time.monotonic() < deadline:
+        deadline = self.clock.monotonic() + self.spec.response_timeout_s
+        while s.in_flight and self.clock.monotonic() < deadline:
             for line in self.wire.lines(POLL_S, "while finishing the blocks in flight"):
-                if s.answer(line) == "push":
+                if s.answer(line, self.clock.monotonic()) == "push":
                     self._push(line)
 
     def _fail(self) -> None:
@@ -1194,7 +1240,7 @@ class _Driver:
         if not (self.spec.status and self._reads_status()):
             return
         s = self.stream
-        start = time.monotonic()
+        start = self.clock.monotonic()
         allowed = WAIT_FACTOR * s.time_s(s.surely_run(), len(self.plan.blocks))
         allowed += self.spec.response_timeout_s
         while True:
@@ -1203,10 +1249,11 @@ class _Driver:
                 return
             if state.startswith("Alarm"):
                 raise LinkError(f"{self.spec.target} went into alarm ({state}) {self._where()}")
-            if time.monotonic() - start > allowed:
+            waited = self.clock.monotonic() - start
+            if waited > allowed:
                 self._halt_and_raise(
-                    f"{self.spec.target} still reports {state!r} {time.monotonic() - start:.0f} s "
+                    f"{self.spec.target} still reports {state!r} {waited:.0f} s "
                     f"after its last answer, {WAIT_FACTOR:g} times the estimated time of what "
                     f"it had left plus {self.spec.response_timeout_s:g} s"
                 )
-            time.sleep(STATUS_PERIOD_S)
+            self.clock.sleep(STATUS_PERIOD_S)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import time
 from collections.abc import Iterator
 from typing import Any
 
@@ -11,6 +12,48 @@ from camtool.link.device import Device, PtyServer, make_device
 from camtool.post.registry import load_target
 
 
+class DeviceClock:
+    """Simulated time for :func:`camtool.link.sender.send_plan` against a :class:`PtyServer`.
+
+    Time passes only while the host waits and the device has nothing to say: a read that
+    finds no byte advances the clock by its whole timeout once the device is quiet (every
+    byte the host wrote taken, nothing left to run) and every byte it wrote has been read.
+    So a controller that stops answering reaches the sender's bounds at once, and a slow
+    machine (a loaded test run) never reaches them early. A read that stays unsettled for
+    :attr:`GRACE_S` of real time (bytes the host dropped on opening the port) advances too.
+    """
+
+    GRACE_S = 2.0
+    REAL_POLL_S = 0.001
+
+    def __init__(self, server: PtyServer) -> None:
+        self.server = server
+        self.now = 0.0
+        self.read_bytes = 0
+
+    def monotonic(self) -> float:
+        return self.now
+
+    def sleep(self, seconds: float) -> None:
+        give_up = time.monotonic() + self.GRACE_S
+        while not self.server.quiet() and time.monotonic() < give_up:
+            time.sleep(self.REAL_POLL_S)
+        self.now += seconds
+
+    def read(self, port: Any, seconds: float) -> bytes:
+        give_up = time.monotonic() + self.GRACE_S
+        while True:
+            port.timeout = self.REAL_POLL_S
+            data: bytes = port.read(max(1, port.in_waiting))
+            if data:
+                self.read_bytes += len(data)
+                return data
+            settled = self.server.quiet() and self.server.written <= self.read_bytes
+            if settled or time.monotonic() > give_up:
+                self.now += seconds
+                return b""
+
+
 class Simulated:
     """A device on a pty, and the port path to open."""
 
@@ -18,6 +61,10 @@ class Simulated:
         self.device = device
         self.server = server
         self.path = server.path
+
+    def clock(self) -> DeviceClock:
+        """Simulated time for a send to this device (see :class:`DeviceClock`)."""
+        return DeviceClock(self.server)
 
 
 @pytest.fixture

@@ -198,11 +198,12 @@ def quick(plan: Any) -> Any:
     return replace(plan, spec=replace(plan.spec, response_timeout_s=2.0))
 
 
-def run_quick(path: str, code: str) -> Any:
+def run_quick(sim: Any, code: str) -> Any:
+    """Send ``code`` to ``sim`` in simulated time: the bounds are reached without waiting."""
     plan = quick(prepare_send(code, load_target("grbl"), source="job.gcode"))
-    port = open_port(path, plan.spec.baud)
+    port = open_port(sim.path, plan.spec.baud)
     try:
-        return send_plan(port, plan, port_name=path)
+        return send_plan(port, plan, port_name=sim.path, clock=sim.clock())
     finally:
         port.close()
 
@@ -212,7 +213,7 @@ def test_a_lost_line_end_is_an_error_not_a_hang(simulate: Any) -> None:
     # reports Idle with an empty planner and RX buffer (Bf:15,128): nothing more will come
     sim = simulate("grbl", merge_at_block=50)
     with pytest.raises(LinkError, match="is idle and has not answered block 96") as info:
-        run_quick(sim.path, PROGRAM)
+        run_quick(sim, PROGRAM)
     assert "line end lost" in str(info.value)
 
 
@@ -229,7 +230,7 @@ def test_a_controller_that_stops_answering_is_named_within_a_bound(
 ) -> None:
     sim = simulate("grbl", **fault)
     with pytest.raises(LinkError) as info:
-        run_quick(sim.path, PROGRAM)
+        run_quick(sim, PROGRAM)
     assert said in str(info.value)
     assert "--from-line" in str(info.value) or "nothing was sent" in str(info.value)
 
@@ -240,7 +241,7 @@ def test_a_controller_that_runs_forever_is_stopped(simulate: Any) -> None:
     sim = simulate("grbl", run_forever=True)
     code = "G21 G90\nG1 X1 F600\nG1 X2\n"
     with pytest.raises(LinkError, match="still reports 'Run'") as info:
-        run_quick(sim.path, code)
+        run_quick(sim, code)
     assert "feed hold, then a reset" in str(info.value)
     assert sim.device.resets == 1
 
