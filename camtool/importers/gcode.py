@@ -80,6 +80,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import re
+from array import array
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import cast
@@ -343,7 +344,7 @@ class _Reader:
         self.notes = Notes(source)
         self.commands = CommandReader(self.notes)
         self.moves: list[Move] = []
-        self.lines: list[int] = []
+        self.lines = array("q")
         self.line = 0
         self.x: float | None = 0.0
         self.y: float | None = 0.0
@@ -605,7 +606,7 @@ class _Reader:
             tuple(self.moves),
             (0.0, 0.0),
             self.notes.warnings(),
-            lines=tuple(self.lines),
+            lines=self.lines,
             commands=tuple(self.commands.commands),
         )
 

@@ -565,10 +565,12 @@ def _join(
         if isinstance(first, Rapid) and still and not any(i == 0 for i, _ in planned.commands):
             skip = 1
     base = len(moves) - skip
-    for move in new[skip:]:
-        moves.append(
-            dataclasses.replace(move, contour=move.contour + offset) if move.contour else move
-        )
+    rest: Sequence[Move] = new[skip:]
+    if offset:  # contours numbered after the operations before (the first: no copy)
+        rest = [
+            dataclasses.replace(m, contour=m.contour + offset) if m.contour else m for m in rest
+        ]
+    moves.extend(rest)
     commands.extend((i + base, c) for i, c in planned.commands)
 
 

@@ -29,10 +29,11 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Iterator, Mapping
+from array import array
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Literal, TypeAlias
+from typing import Literal, TypeAlias, overload
 
 from camtool.model.shapes import Arc, BBox, Line, Point, Segment, chord_count
 
@@ -268,6 +269,55 @@ Command: TypeAlias = Spindle | Dwell | ToolChange | Stop | DrillCycle | Home | P
 """A non-motion instruction (see :attr:`Program.commands`)."""
 
 
+class SourceLines(Sequence[int]):
+    """An immutable sequence of line numbers held as 64-bit integers, 8 bytes each.
+
+    A program read from a file of a million lines keeps one number per move; as a
+    tuple each would be an integer object (36 bytes). Compares equal to any sequence
+    of the same numbers (a tuple too), hashes as the tuple does, slices to its own kind.
+    """
+
+    __slots__ = ("_numbers",)
+
+    def __init__(self, numbers: Iterable[int] = ()) -> None:
+        self._numbers = numbers if isinstance(numbers, array) else array("q", numbers)
+
+    def __len__(self) -> int:
+        return len(self._numbers)
+
+    @overload
+    def __getitem__(self, index: int) -> int: ...
+
+    @overload
+    def __getitem__(self, index: slice) -> SourceLines: ...
+
+    def __getitem__(self, index: int | slice) -> int | SourceLines:
+        if isinstance(index, slice):
+            return SourceLines(self._numbers[index])
+        return self._numbers[index]
+
+    def __iter__(self) -> Iterator[int]:
+        return iter(self._numbers)
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, SourceLines):
+            return self._numbers == other._numbers
+        if isinstance(other, Sequence) and not isinstance(other, str | bytes):
+            return len(other) == len(self._numbers) and all(
+                a == b for a, b in zip(self._numbers, other, strict=True)
+            )
+        return NotImplemented
+
+    def __hash__(self) -> int:
+        return hash(tuple(self._numbers))
+
+    def __repr__(self) -> str:
+        return f"SourceLines({list(self._numbers)!r})"
+
+    def __reduce__(self) -> tuple[type[SourceLines], tuple[array[int]]]:
+        return (SourceLines, (self._numbers,))
+
+
 @dataclass(frozen=True)
 class Program:
     """An immutable list of moves, absolute mm, Y up.
@@ -275,7 +325,8 @@ class Program:
     ``origin`` is where the machine stands before the first move (the part zero
     unless said otherwise). ``warnings`` carry what the planner or reader had to
     tell the user. ``lines`` gives, for a program read from code, the 1-based
-    source line of each move (empty otherwise), so reports can point at a block.
+    source line of each move (empty otherwise), so reports can point at a block;
+    it is kept as :class:`SourceLines` (8 bytes a move), whatever sequence is given.
     ``commands`` holds ``(index, command)`` pairs in program order: ``command``
     runs before ``moves[index]`` (``index == len(moves)``: after the last move).
 
@@ -291,12 +342,14 @@ class Program:
     moves: tuple[Move, ...]
     origin: Point = (0.0, 0.0)
     warnings: tuple[str, ...] = field(default=())
-    lines: tuple[int, ...] = field(default=())
+    lines: Sequence[int] = field(default=())
     commands: tuple[tuple[int, Command], ...] = field(default=())
     notes: tuple[str, ...] = field(default=())
     tolerance_mm: float | None = None
 
     def __post_init__(self) -> None:
+        if not isinstance(self.lines, SourceLines):
+            object.__setattr__(self, "lines", SourceLines(self.lines))
         indices = [i for i, _ in self.commands]
         if indices != sorted(indices) or any(not 0 <= i <= len(self.moves) for i in indices):
             raise ValueError(f"command indices must be sorted within 0..{len(self.moves)}")

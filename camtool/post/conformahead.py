@@ -31,9 +31,10 @@ a zero are left out, as the writer's own memory of conformed arcs leaves them ou
 Measured on that SVG (`make bench`'s, `post --target grbl`): the writer 3.5 → 2.4 s, the
 whole command 10.7 → 10.1 s, the same G-code; the helper answered 33 000 of the arcs.
 
-No helper (the writer conforms every arc) under :data:`MIN_ARCS` arcs, without an arc
-check, on one core, in a worker process (``camtool batch``'s: its cores are busy with
-other files), or when no process can be forked.
+No helper (the writer conforms every arc) under :data:`MIN_ARCS` arcs or over
+:data:`MAX_MOVES` moves, with ``CAMTOOL_ACCEL=0``, without an arc check, on one core,
+in a worker process (``camtool batch``'s: its cores are busy with other files), or
+when no process can be forked.
 """
 
 from __future__ import annotations
@@ -61,6 +62,10 @@ MIN_ARCS = 2000
 of conforming: below that, the fork and the helper's prediction cost about what they
 save). Issue 17's re-post repeats 1 653 arcs 17 times: the writer reuses their blocks, and
 no helper runs."""
+MAX_MOVES = 250_000
+"""Moves above which no helper is forked: it walks the whole program, and the reference
+counts it touches copy the program's memory into it (a 1.5 M-move program: 526 MB in the
+helper beside the writer's 450 MB)."""
 BATCH = 256
 """Arcs a record holds (~25 kB: under a pipe's buffer, so a record is read at once)."""
 POLL_EVERY = 32
@@ -161,7 +166,11 @@ def start(writer: BlockWriter, program: Program) -> ConformAhead | None:
     without an arc check, on one core, in a worker process, or when no process can be
     forked (``None``: the writer conforms every arc itself).
     """
-    if writer.spec.arc_check == "none" or len(program.moves) < MIN_ARCS:
+    from camtool import accel
+
+    if writer.spec.arc_check == "none" or not MIN_ARCS <= len(program.moves) <= MAX_MOVES:
+        return None
+    if not accel.enabled():
         return None
     # Distinct arcs, told apart by their centre's x (a few ms; an estimate from below): a
     # program that cuts its contours again (at other depths, or copies) has the writer

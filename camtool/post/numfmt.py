@@ -207,7 +207,7 @@ class NumberFormat:
         return value
 
 
-_CACHED = 1 << 16
+_CACHED = 1 << 13
 """Most texts a :class:`NumberFormat` keeps (written or read), each way."""
 _PLAIN = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)")
 """A decimal without exponent, as the writers print them."""

@@ -250,3 +250,19 @@ def test_a_hole_selected_alone_for_an_outside_profile_is_warned_about(tmp_path: 
     job.write_text(fixed)
     done = run_job(read_drawing(dxf), load_target("grbl"), load_job(job))
     assert not [w for w in done.warnings if "cuts into the part" in w]
+
+
+def test_the_first_operation_s_moves_are_taken_not_copied() -> None:
+    # a job of one operation over 200 000 LINEs holds a million moves: a renumbered copy of
+    # each (for an offset of 0) doubled them; later operations are renumbered
+    from camtool.jobs import run
+    from camtool.model.program import Linear, Move, Rapid
+
+    new: list[Move] = [Rapid(0.0, 0.0, 5.0, 1), Linear(1.0, 0.0, 100.0, -1.0, 1)]
+    planned = run._Planned(list(new), [], [], None, None)  # type: ignore[arg-type]
+    moves: list[Move] = []
+    run._join(moves, [], planned, 0)
+    assert all(a is b for a, b in zip(moves, new, strict=True))
+    later: list[Move] = []
+    run._join(later, [], planned, 3)
+    assert [m.contour for m in later] == [4, 4]

@@ -74,3 +74,23 @@ def test_bbox_and_cutting_time_walk_the_moves_once_without_lists() -> None:
         finally:
             tracemalloc.stop()
         assert peak < 60_000 * 8, f"{measure.__name__}: {peak} bytes"  # a list's pointers alone
+
+
+def test_source_lines_cost_8_bytes_a_move_and_behave_as_a_tuple() -> None:
+    # a program read from a file keeps the source line of every move: a tuple would hold
+    # an int object each (28 bytes + an 8-byte pointer)
+    n = 200_000
+    numbers = list(range(1_000_000, 1_000_000 + n))
+    tracemalloc.start()
+    try:
+        before = tracemalloc.get_traced_memory()[0]
+        program = Program((), lines=numbers[:0]), Program(MOVES[:1], lines=(7,))
+        lines = Program(tuple(MOVES[:1]) * n, lines=numbers).lines
+        held = tracemalloc.get_traced_memory()[0] - before
+    finally:
+        tracemalloc.stop()
+    assert held < 9 * n + 8 * n + 100_000  # the lines (8 a move) and the moves' tuple (8)
+    assert lines == tuple(numbers) and tuple(numbers) == lines and lines != numbers[:-1]
+    assert lines[5] == numbers[5] and lines[2:4] == (numbers[2], numbers[3])
+    assert hash(program[1].lines) == hash((7,)) and not program[0].lines
+    assert pickle.loads(pickle.dumps(program[1])) == program[1]

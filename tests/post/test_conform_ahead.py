@@ -250,3 +250,17 @@ def test_no_helper_when_no_process_can_be_forked(monkeypatch: pytest.MonkeyPatch
     monkeypatch.setattr(os, "fork", no_fork)
     assert conformahead.start(BlockWriter(post.spec, BIG), program) is None
     assert written(post, program) == expected
+
+
+def test_no_helper_for_a_program_too_big_to_copy_or_when_switched_off(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # the helper walks every move, and the reference counts it touches copy the program's
+    # pages into it: above MAX_MOVES the writer conforms its arcs alone (bounded memory)
+    grbl = post_of("grbl")
+    many = arc_program(random.Random(9), ARCS, messy=False)
+    monkeypatch.setattr(conformahead, "MAX_MOVES", len(many.moves) - 1)
+    assert conformahead.start(BlockWriter(grbl.spec, BIG), many) is None
+    monkeypatch.setattr(conformahead, "MAX_MOVES", len(many.moves))
+    monkeypatch.setenv("CAMTOOL_ACCEL", "0")
+    assert conformahead.start(BlockWriter(grbl.spec, BIG), many) is None
