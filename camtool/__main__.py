@@ -17,7 +17,7 @@ A job builds hundreds of thousands of long-lived objects (segments, moves, block
 frees few, so with Python's defaults (700, 10, 10) the collector rescans that growing
 heap again and again: on the 213-icon SVG benchmark 2 941 + 267 + 11 collections, 1.7 s
 of the main process; with these, 9 young ones and the SVG importer's one of its parse's
-garbage, 0.75 s (``gc.callbacks``; issue 17). The values are mypy's (``mypy/build.py``),
+garbage, 0.75 s (``gc.callbacks``). The values are mypy's (``mypy/build.py``),
 chosen for the same reason. Reference counting still frees every object not in a cycle at
 once; cycles wait for the next collection. Only the command-line process is tuned: a
 program that imports camtool keeps its own.
@@ -37,7 +37,7 @@ def leave(code: int) -> NoReturn:
 
     After a big job that teardown is long for nothing: 0.15 s after ``camtool verify`` of
     the 66 M-step benchmark program (numba's compiled code, numpy's and scipy's modules,
-    the last arrays), ~6 % of the command (issue 17). What an exit must do is still done:
+    the last arrays), ~6 % of the command. What an exit must do is still done:
     the exit functions run (``atexit``: multiprocessing's children, tempfile's
     finalizers, a coverage run's data), then stdout and stderr are flushed; camtool
     writes its files in ``with`` blocks and flushes its stdout itself

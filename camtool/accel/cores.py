@@ -99,7 +99,7 @@ def meanwhile(tasks: Sequence[Callable[[], object]]) -> Iterator[None]:
     ``post --preview`` of a part with offsets waits ~0.4 s for the offsets' child to load
     OpenCASCADE (:func:`camtool.toolpath.offset.offset_all`), and loads numba's kernels
     there instead of afterwards; it waits for the error budget's workers
-    (:meth:`ForkedWork.answers`) and loads matplotlib for the picture (issue 17). Each
+    (:meth:`ForkedWork.answers`) and loads matplotlib for the picture. Each
     task runs at most once; those no wait ran are dropped on leaving. A task only saves
     time: what it does must be what the job would do anyway, with the same results.
     """

@@ -211,7 +211,7 @@ def picture_ahead(preview: str | None) -> Iterator[Callable[[], None]]:
     stdout). It gives the call that tells the child to import matplotlib
     (:func:`~camtool.preview.ahead.load_ahead`): the command makes it where it leaves a
     core idle. The child then draws the scene :func:`~camtool.preview.render_preview`
-    sends it: ~0.3 s of imports off the end of issue 17's benchmark part. An SVG, or no
+    sends it: ~0.3 s of imports off the end of the benchmark part. An SVG, or no
     preview, starts nothing and imports nothing (a re-post loads no numpy); leaving ends
     the child if it was not used. Only the time depends on it: the PNG is the same bytes.
     A command enters it with ``click.get_current_context().with_resource``, so it is left

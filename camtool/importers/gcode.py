@@ -127,7 +127,7 @@ _PLAIN_WORDS = re.compile(r"[ \t]*([GXYZIJRFN](?=[+-]?\.?[0-9])|)(" + _PLAIN_NUM
 words only. Anything else (a comment, another letter or character, a blank inside a word)
 gives a pair whose letter is empty (the rest of the line its text): the line is not plain
 and goes to the lexer. A line with a non-ASCII character goes there unsearched. One search
-per line: the line no longer has to match a pattern of the whole line first (issue 17)."""
+per line: the line no longer has to match a pattern of the whole line first."""
 _PLAIN_MOTION = {0: "G0", 10: "G1", 20: "G2", 30: "G3"}
 _PLAIN_G = {0.0: "G0", 1.0: "G1", 2.0: "G2", 3.0: "G3"}
 """:data:`_PLAIN_MOTION` by the G word's value, for the values ``g_key`` gives those keys."""
@@ -289,7 +289,7 @@ def parse_gcode(text: str, *, source: str) -> Program:
 def parse_gcode_slow(text: str, *, source: str) -> Program:
     """:func:`parse_gcode` with every line lexed into words and run block by block.
 
-    The way every line was read before issue 17; :func:`parse_gcode` reads plain
+    The reference way of reading a line; :func:`parse_gcode` reads plain
     lines (:meth:`_Reader.plain`) without making words, to the same program with
     the same warnings and errors (tests/importers/test_gcode_plain.py compares the two).
     """

@@ -111,7 +111,7 @@ def _strip_comments(raw: str, where: str) -> tuple[str, int | None]:
 
 
 def _strip_comments_slow(raw: str, where: str) -> tuple[str, int | None]:
-    """:func:`_strip_comments` character by character (every line before issue 17)."""
+    """:func:`_strip_comments` character by character (the reference version)."""
     kept: list[str] = []
     star_at: int | None = None
     i = 0
@@ -179,7 +179,7 @@ def _words(code: str, where: str) -> list[Word]:
 
 
 def _words_slow(code: str, where: str) -> list[Word]:
-    """:func:`_words` one character at a time (every line before issue 17)."""
+    """:func:`_words` one character at a time (the reference version)."""
     words: list[Word] = []
     i = 0
     while i < len(code):

@@ -222,7 +222,7 @@ def _parse(path: Path, prepared: Prepared) -> Any:
     svgelements leaves the elements it read in reference cycles (its table of ids points
     back into the tree), which only the cyclic collector frees; the ``camtool`` command
     runs it rarely (:data:`camtool.__main__.GC_THRESHOLD`), so the young generations are
-    collected here, where that garbage is made (issue 17).
+    collected here, where that garbage is made.
     """
     width, height = prepared.viewport
     try:

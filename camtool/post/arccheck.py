@@ -67,7 +67,7 @@ own; a part that cannot be halved into solvable halves tries the centres along
 its chord's bisector, further from the exact centre, last), the shortcut in
 front of the search (:func:`plainly_passes`: the rounded centre tested with a
 bound, no numpy, in a few µs; the search runs only when the bound is not sure,
-and the blocks are the same: issue 17, the search was ~0.7 ms per arc), and
+and the blocks are the same: the search was ~0.7 ms per arc), and
 :func:`conform_arc` itself.
 """
 

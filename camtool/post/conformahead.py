@@ -1,11 +1,11 @@
-"""A program's arcs conformed ahead, in a forked helper, while the writer works (issue 17).
+"""A program's arcs conformed ahead, in a forked helper, while the writer works.
 
 The arc check of GRBL and LinuxCNC (:func:`camtool.post.arccheck.conform_arc`, about
 25 µs an arc) is a function of its arguments alone: the start the controller holds (as
 printed), the exact end, the exact centre, the direction and the exact start (the rule and
 the quantum are the writer's, the same for every arc). On a program of many arcs it is
-about half the writer's time: issue 17's 213-icon SVG has 60 310 distinct arcs, 1.7 s of
-the writer's 3.5 s, while the second core waits.
+about half the writer's time: the SVG benchmark's 213-icon drawing has 60 310 distinct
+arcs, 1.7 s of the writer's 3.5 s, while the second core waits.
 
 :class:`ConformAhead` forks a helper as the writer starts (:func:`start`). The helper
 predicts each arc's arguments from the program: the start the controller holds is where
@@ -60,7 +60,7 @@ Blocks = list[tuple[Point, Point | None]]
 MIN_ARCS = 2000
 """Arcs of distinct centres (told apart by their x) from which a helper is forked (~50 ms
 of conforming: below that, the fork and the helper's prediction cost about what they
-save). Issue 17's re-post repeats 1 653 arcs 17 times: the writer reuses their blocks, and
+save). The re-post benchmark repeats 1 653 arcs 17 times: the writer reuses their blocks, and
 no helper runs."""
 MAX_MOVES = 250_000
 """Moves above which no helper is forked: it walks the whole program, and the reference
@@ -232,7 +232,7 @@ def arc_calls(writer: BlockWriter, program: Program) -> list[Call]:
     changes only Z writes no X or Y (``writer.z_only``); an arc does.
     Nothing is printed here, so the helper predicts the arcs in any order, the last first,
     with no pass over the program before its first answer (printing every end first took
-    0.5 s of issue 17's SVG). An arc with a zero in it is left out (the module's
+    0.5 s of the SVG benchmark). An arc with a zero in it is left out (the module's
     docstring).
     """
     calls: list[Call] = []

@@ -150,7 +150,7 @@ class NumberFormat:
         return ("+" + text) if self.sign == "always" else text
 
     def _format_slow(self, value_mm: float) -> str:
-        """:meth:`format` through ``Decimal`` always (as before issue 17; for tests)."""
+        """:meth:`format` through ``Decimal`` always (the reference path; for tests)."""
         q = self.quantize(value_mm)
         magnitude = abs(q)
         text = f"{magnitude:.{self.decimals}f}"
@@ -192,7 +192,7 @@ class NumberFormat:
         return value
 
     def _parse_slow(self, text: str) -> float:
-        """:meth:`parse` through ``Decimal`` always (as before issue 17; for tests)."""
+        """:meth:`parse` through ``Decimal`` always (the reference path; for tests)."""
         try:
             number = Decimal(text)
         except InvalidOperation:

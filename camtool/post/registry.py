@@ -62,7 +62,7 @@ BUILTIN_ENTRY_POINT = "camtool_postprocessors:TARGETS"
 ``[project.entry-points."camtool.postprocessors"]``; tests/test_packaging.py holds the two
 equal). The built-in targets are loaded from it directly: finding them through
 :mod:`importlib.metadata` cost every command ~0.03 s of imports and a scan of the
-installed distributions (issue 17), and a plugin can never shadow a built-in anyway.
+installed distributions, and a plugin can never shadow a built-in anyway.
 Plugins are still found by their entry points, when a name is not built in."""
 
 _TOP_KEYS = {

@@ -197,9 +197,9 @@ class BlockWriter(WriterState[str]):
                 self.blocks.append(comment)
         for codes in self.spec.preamble:
             self.block(list(codes))
-        # the arcs' blocks, conformed ahead in a helper when there are many (issue 17); held
+        # the arcs' blocks, conformed ahead in a helper when there are many; held
         # by the memory of conformed arcs, not as a 30th attribute of the writer: that one
-        # made every block of issue 17's re-post ~8 % slower (CPython 3.11 stops sharing
+        # made every block of the re-post benchmark ~8 % slower (CPython 3.11 stops sharing
         # the keys of instances with that many attributes)
         ahead = conformahead.start(self, program)
         self._conformed_arcs = _Conformed(ahead)

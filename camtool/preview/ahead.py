@@ -2,7 +2,7 @@
 
 ``post --preview part.png``, ``verify --preview part.png`` and ``preview … -o part.png`` end
 by drawing the picture with matplotlib (:func:`camtool.preview.raster.scene_png`). Importing
-matplotlib takes ~0.3 s of one core, and on issue 17's benchmark part it came last, after
+matplotlib takes ~0.3 s of one core, and on the benchmark part it came last, after
 the verification, while the other core had nothing left to do. So the command forks a child
 at its start (:func:`start_ahead`, while the process is still small: a fork, not a second
 Python), tells it when to load matplotlib (:func:`load_ahead`: when the verification

@@ -4,7 +4,7 @@ A *variant* of a cut is ``(k, rev)``: start at vertex ``k`` (the start of
 ``path.segments[k]``; always 0 for an open path) and traverse the path backwards
 when ``rev``. A *sequence* is a list of ``(cut index, k, rev)`` in cutting order.
 
-Precedence (issue 4, "inside before outside"): cut ``a`` comes after cut ``b`` when
+Precedence ("inside before outside"): cut ``a`` comes after cut ``b`` when
 ``a``'s group contains ``b``'s group (``cuts[a].group in parents[cuts[b].group]``),
 and pocket cuts of one group keep the relative order the pocket stage gave them.
 

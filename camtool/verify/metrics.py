@@ -812,7 +812,7 @@ def _ends_tree(points: FloatArray, samples: int, kernels: ModuleType) -> tuple[A
 
     :func:`camtool.verify.nearkernels.tree`, its places along the segments. The ends at
     one point are one place for at least one sample per :data:`MERGE_ENDS_PER_SAMPLE`
-    ends: the 737 736 ends of issue 17's benchmark part are 115 838 places (two segments
+    ends: the 737 736 ends of the benchmark part are 115 838 places (two segments
     meet at each, and the part is cut in three passes), and the drawing's search takes
     about a fifth of the time; a few samples against a long trace (the shortfall's
     unsure ones) search every end instead of paying for the merge. The answers are the
@@ -1377,7 +1377,7 @@ def along_path(
     one's samples only where their bound reaches the largest found so far. The
     figures are those of measuring every sample, contours in order (the first of
     equal ones named), bit for bit; a part's 400 000 samples took 0.85 s that way and
-    take about 0.15 s (issue 17).
+    take about 0.15 s.
     """
     starts = move_starts(program)
     runs = contour_runs(program)
@@ -2816,7 +2816,7 @@ def _end_points(a: FloatArray, b: FloatArray) -> FloatArray:
 
     Where ``a`` and ``b`` are already the two halves of one array of float64 (as
     :func:`_chords` makes them), that array itself: the same values, without a second copy
-    of every end at the comparison's peak of memory (~11 MiB on issue 17's benchmark part).
+    of every end at the comparison's peak of memory (~11 MiB on the benchmark part).
     """
     base = a.base
     if (
@@ -2866,7 +2866,7 @@ OVERCUT_PRUNE_FROM = 20_000
 """Trace points from which :func:`_least_nearest` measures only those that can be nearest."""
 OVERCUT_ANCHOR = 4
 """Every how many trace points :func:`_least_nearest` measures first, to bound the others:
-on issue 17's benchmark part (369 000 thinned trace points 1.5 mm from 112 000 drawing
+on the benchmark part (369 000 thinned trace points 1.5 mm from 112 000 drawing
 chords) 92 000 anchors and 105 000 points left took 0.30 s where all took 0.55 s (every
 8th: 0.41 s). Only the time depends on it."""
 

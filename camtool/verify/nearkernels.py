@@ -11,7 +11,7 @@ k-th end.
 The tree holds *places*, not ends (:func:`tree`): the ends of a trace's segments repeat
 (the end of one segment starts the next; a part cut in three passes of the same path
 repeats each end three times more), so each distinct point is kept once with the list of
-the ends at it, and a search visits one leaf where it visited six. On issue 17's
+the ends at it, and a search visits one leaf where it visited six. On the
 benchmark part the 737 736 ends of the cutting trace are 115 838 places, and the
 drawing's search takes a fifth of the time. Every end at a place is counted as it was,
 so the answers are unchanged.
@@ -707,7 +707,7 @@ def load_cached() -> None:
     numba loads a kernel's machine code from its cache (or compiles it) at the kernel's
     first call in a process, ~10–15 ms for each of these. A verification that forks the
     error budget's workers (:func:`camtool.verify.metrics.prepare_comparison`) calls this
-    first, so the workers inherit them instead of each loading them again (issue 17's
+    first, so the workers inherit them instead of each loading them again (the
     benchmark part: ~0.08 s of each worker's CPU, while every core is busy). The samples
     of a drawing come read-only (they are kept between comparisons), hence the second
     type of :func:`near_segments`. A signature no comparison uses would be loaded for

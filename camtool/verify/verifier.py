@@ -213,7 +213,7 @@ class Verification:
         modelled ones, ``name`` the next in order), so a long verification can say what
         it is doing; the budget is the same. The sources are re-simulated in forked
         workers, one per core (:class:`camtool.accel.cores.ForkedWork`): the part of
-        issue 17's preview bench takes 2.6 s for its three where it took 3.8 s.
+        the preview benchmark takes 2.6 s for its three where it took 3.8 s.
 
         Raises:
             CamtoolError: as :attr:`error_budget`.
@@ -366,7 +366,7 @@ def verify_program(
         budget_now: compute the error budget now, told to this progress callback as
             :meth:`Verification.measure_budget` tells it: its sources are re-simulated
             in forked workers while this process measures the trace and compares it
-            with the drawing (the same budget; ``post --preview`` of issue 17's
+            with the drawing (the same budget; ``post --preview`` of the
             benchmark part took 6.1 s where the two one after the other took 6.7 s).
             A budget that fails is left to be computed, and to fail, when it is asked
             for. ``None``: when it is asked for. The kernels the measures need are
