@@ -40,6 +40,7 @@ import dataclasses
 import math
 from typing import TYPE_CHECKING, Any
 
+from camtool.accel import conformahead
 from camtool.model.errors import DialectError
 from camtool.model.machine import Machine
 from camtool.model.program import (
@@ -58,7 +59,6 @@ from camtool.model.program import (
     ToolChange,
 )
 from camtool.model.shapes import FULL_CIRCLE_EPS, Arc, Point, make_arc
-from camtool.post import conformahead
 from camtool.post.base import (
     WriterState,
     check_placement,
@@ -91,7 +91,7 @@ class _Conformed(dict[tuple[Any, ...], list[tuple[Point, Point | None]]]):
     """A writer's memory of the arcs it has conformed, by key (``BlockWriter._conformed_at``).
 
     ``ahead``: the helper conforming the program's arcs meanwhile
-    (:mod:`camtool.post.conformahead`), or ``None``.
+    (:mod:`camtool.accel.conformahead`), or ``None``.
     """
 
     def __init__(self, ahead: conformahead.ConformAhead | None = None) -> None:
@@ -570,7 +570,7 @@ class BlockWriter(WriterState[str]):
 
         A function of its arguments (the rule and the quantum are the dialect's): the
         writer keeps its answers by them (:meth:`_conformed_at`), and
-        :mod:`camtool.post.conformahead`'s helper calls it ahead of the writer.
+        :mod:`camtool.accel.conformahead`'s helper calls it ahead of the writer.
 
         Raises:
             DialectError: :func:`~camtool.post.arccheck.conform_arc`'s, without the block.

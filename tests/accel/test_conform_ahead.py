@@ -1,6 +1,6 @@
 """Arcs conformed ahead in a forked helper: the writer writes what it writes alone (issue 17).
 
-:mod:`camtool.post.conformahead` forks a helper that predicts the arguments of each arc's
+:mod:`camtool.accel.conformahead` forks a helper that predicts the arguments of each arc's
 arc check (:func:`~camtool.post.arccheck.conform_arc`) and conforms the arcs from the last
 back, while the writer works from the first; the writer takes an answer only for an arc
 whose arguments are the key the helper predicted. These tests hold:
@@ -22,10 +22,10 @@ from typing import Any
 
 import pytest
 
-from camtool.accel import cores
+from camtool.accel import conformahead, cores
 from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Linear, Move, Program, Rapid
-from camtool.post import conformahead, wordaddress_write
+from camtool.post import wordaddress_write
 from camtool.post.registry import load_target
 from camtool.post.wordaddress import WordAddressPost, word_address_dialect
 from camtool.post.wordaddress_write import BlockWriter

@@ -45,6 +45,7 @@ import struct
 from contextlib import suppress
 from typing import TYPE_CHECKING
 
+from camtool.accel import enabled
 from camtool.model.errors import CamtoolError
 from camtool.model.program import ArcMove, Linear, Program, Rapid
 from camtool.model.shapes import Point
@@ -166,11 +167,9 @@ def start(writer: BlockWriter, program: Program) -> ConformAhead | None:
     without an arc check, on one core, in a worker process, or when no process can be
     forked (``None``: the writer conforms every arc itself).
     """
-    from camtool import accel
-
     if writer.spec.arc_check == "none" or not MIN_ARCS <= len(program.moves) <= MAX_MOVES:
         return None
-    if not accel.enabled():
+    if not enabled():
         return None
     # Distinct arcs, told apart by their centre's x (a few ms; an estimate from below): a
     # program that cuts its contours again (at other depths, or copies) has the writer
