@@ -10,11 +10,11 @@ done in a worker process is the very fit done here: the segments come back as th
 ``None``: the caller fits it again itself, in its own order, and so raises the same error at
 the same place as without workers.
 
-Workers are started by ``fork`` (Linux; nothing to re-import, ~10 ms each) and only for at
-least :data:`MIN_CURVES` keys, so small files never pay for a pool; where ``fork`` is not
-available, or the pool cannot start or breaks, or this process is itself a worker (``camtool
-batch``, Dask: :func:`camtool.accel.cores.in_worker`), every fit runs here, one after the
-other.
+Workers are started by ``fork`` (:func:`camtool.accel.pool.map_forked`) and only for at
+least :data:`MIN_CURVES` keys, so small files never pay for a pool; with
+``CAMTOOL_ACCEL=0``, where ``fork`` is not available, or the pool cannot start or breaks,
+or this process is itself a worker (``camtool batch``, Dask), every fit runs here, one
+after the other.
 Forking is safe at this point: the importers run before anything starts threads of its own
 (camtool starts none; numba, whose threading layer must not be forked, is not imported on the
 import path; OpenBLAS's idle threads are re-made by its own ``pthread_atfork`` handler).
@@ -22,12 +22,11 @@ import path; OpenBLAS's idle threads are re-made by its own ``pthread_atfork`` h
 
 from __future__ import annotations
 
-import multiprocessing
 from collections.abc import Callable, Iterable, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from typing import Any, TypeAlias
 
-from camtool.accel.cores import default_jobs, in_worker
+from camtool.accel.cores import default_jobs
+from camtool.accel.pool import map_forked
 from camtool.geometry.arcfit import fit_curve
 from camtool.geometry.curves import (
     cubic_bezier,
@@ -102,7 +101,7 @@ def fit_many(
     """
     workers = default_jobs() if jobs is None else max(1, jobs)
     workers = min(workers, -(-len(keys) // _CHUNK))
-    if workers > 1 and len(keys) >= MIN_CURVES and not in_worker():
+    if workers > 1 and len(keys) >= MIN_CURVES:
         packed = _in_pool(keys, tolerance, workers, done)
         if packed is not None:
             return [None if p is None else _unpack(p) for p in packed]
@@ -120,25 +119,20 @@ def _in_pool(
     workers: int,
     done: Callable[[int], None] | None = None,
 ) -> list[_Packed | None] | None:
-    """The packed fits from ``workers`` forked processes; ``None`` if no pool can run them.
+    """The packed fits from ``workers`` forked processes; ``None`` if no pool runs them.
 
     ``done`` is called here with the count of fits received, after each chunk.
     """
-    try:
-        context = multiprocessing.get_context("fork")
-    except ValueError:  # pragma: no cover - no fork on this platform
-        return None
     chunks = [(list(keys[i : i + _CHUNK]), tolerance) for i in range(0, len(keys), _CHUNK)]
-    try:
-        with ProcessPoolExecutor(workers, mp_context=context) as pool:
-            packed: list[_Packed | None] = []
-            for chunk in pool.map(_fit_chunk, chunks):
-                packed.extend(chunk)
-                if done is not None:
-                    done(len(packed))
-            return packed
-    except (OSError, RuntimeError, EOFError, AssertionError):  # cannot fork, a worker died
-        return None
+    received = [0]
+
+    def chunk_done(chunk: list[_Packed | None]) -> None:
+        received[0] += len(chunk)
+        if done is not None:
+            done(received[0])
+
+    results = map_forked(_fit_chunk, chunks, workers, chunk_done)
+    return None if results is None else [p for chunk in results for p in chunk]
 
 
 def _fit_chunk(task: tuple[list[CurveKey], float]) -> list[_Packed | None]:

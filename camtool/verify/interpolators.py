@@ -80,6 +80,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from camtool import accel
 from camtool.model.errors import InputError, UsageError
 from camtool.model.program import ArcMove
 from camtool.model.shapes import chord_count, distance
@@ -285,13 +286,14 @@ rows, simulated about 4 times with the error budget) never pays it."""
 
 
 def compiled(work: int = COMPILE_FROM) -> ModuleType | None:
-    """The numba kernels (:mod:`camtool.verify.kernels`), once the work warrants them.
+    """The numba kernels (:mod:`camtool.accel.kernels`), once the work warrants them.
 
     ``work`` is the rows the caller is about to produce; the kernels are loaded when
     the rows asked for so far in this process reach :data:`COMPILE_FROM` (the default
     asks for them at once) and then used by every later call. ``None`` before that,
-    when numba is not installed, or on a big-endian machine (the packed rows assume
-    little-endian); the numpy / Python paths then give the same rows.
+    with ``CAMTOOL_ACCEL=0``, when numba is not installed, or on a big-endian machine
+    (the packed rows assume little-endian); the numpy / Python paths then give the same
+    rows.
 
     Args:
         work: Rows the caller is about to compute, ``>= 0``.
@@ -299,6 +301,8 @@ def compiled(work: int = COMPILE_FROM) -> ModuleType | None:
     Returns:
         The kernels module, or ``None`` (use the plain path).
     """
+    if not accel.enabled():
+        return None
     if "kernels" in _COMPILED:
         return _COMPILED["kernels"]
     _WORK[0] += work
@@ -307,7 +311,7 @@ def compiled(work: int = COMPILE_FROM) -> ModuleType | None:
     kernels: ModuleType | None = None
     if sys.byteorder == "little":
         try:
-            from camtool.verify import kernels
+            from camtool.accel import kernels
         except ImportError:
             kernels = None
     _COMPILED["kernels"] = kernels

@@ -13,7 +13,6 @@ from __future__ import annotations
 import hashlib
 import itertools
 import math
-import os
 import sys
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
@@ -24,6 +23,8 @@ from typing import Any, Protocol
 import numpy as np
 import numpy.typing as npt
 
+from camtool import accel
+from camtool.accel.pool import each_threaded
 from camtool.model.program import ArcMove, Program, Rapid, segment_of
 from camtool.model.shapes import Arc, BBox, Drawing, Line, Point, Segment, bbox_union
 from camtool.model.units import fmt_num
@@ -244,8 +245,8 @@ def _distances(
     ``bounds`` ``(b + 1,)`` are the row offsets (in ``points``) of the moves
     ``first .. first + b - 1``; every row of ``points`` belongs to one of them. Rows are
     measured a block (or a run of short blocks) at a time (see :func:`deviation`); with
-    ``kernels`` (:mod:`camtool.verify.kernels`) a long line by the compiled
-    :func:`camtool.verify.kernels.to_line` (the same floats as :func:`_to_line`).
+    ``kernels`` (:mod:`camtool.accel.kernels`) a long line by the compiled
+    :func:`camtool.accel.kernels.to_line` (the same floats as :func:`_to_line`).
 
     Returns:
         The distances of the cutting rows in row order, and the measured pieces
@@ -562,7 +563,7 @@ def nearest_distances(
     that). Samples neither test settles get shapely's exact nearest query.
 
     With numba (:func:`near_kernels`), the nearest ends come from
-    :func:`camtool.verify.nearkernels.knn`, the k-d tree's answer bit for bit
+    :func:`camtool.accel.nearkernels.knn`, the k-d tree's answer bit for bit
     (where it cannot say so, from the k-d tree itself); the plain form is
     :func:`nearest_distances_kd`, kept for comparison.
 
@@ -658,7 +659,7 @@ class _BoxSearch:
         half: half the longest segment, mm.
         points: ``concatenate([a, b])``, the ends (as the k-d tree of ties holds them).
         tree: their search tree (:func:`_ends_tree`).
-        kernels: :mod:`camtool.verify.nearkernels`.
+        kernels: :mod:`camtool.accel.nearkernels`.
     """
 
     samples: FloatArray
@@ -672,7 +673,7 @@ class _BoxSearch:
     def measure(self, part: slice) -> tuple[FloatArray, FloatArray, FloatArray, Any]:
         """``near``, ``rk``, ``lower`` and ``ask`` of the samples ``part``.
 
-        :func:`camtool.verify.nearkernels.near_segments`' distance to the segments of the
+        :func:`camtool.accel.nearkernels.near_segments`' distance to the segments of the
         nearest ends (unset where ``ask``: the k-d tree's choice among tied ends matters),
         the k-th end's distance and the vertex bound ``sqrt(r0² − half²)``, with the
         square roots the k-d tree takes.
@@ -810,7 +811,7 @@ MERGE_ENDS_PER_SAMPLE = 16
 def _ends_tree(points: FloatArray, samples: int, kernels: ModuleType) -> tuple[Any, ...]:
     """The search tree of the segment ends ``points`` (``concatenate([a, b])``) for ``samples``.
 
-    :func:`camtool.verify.nearkernels.tree`, its places along the segments. The ends at
+    :func:`camtool.accel.nearkernels.tree`, its places along the segments. The ends at
     one point are one place for at least one sample per :data:`MERGE_ENDS_PER_SAMPLE`
     ends: the 737 736 ends of the benchmark part are 115 838 places (two segments
     meet at each, and the part is cut in three passes), and the drawing's search takes
@@ -829,7 +830,7 @@ def _near_segments_numpy(
     tree: tuple[Any, ...],
     kernels: ModuleType,
 ) -> tuple[FloatArray, FloatArray, FloatArray, npt.NDArray[np.bool_]]:
-    """:func:`camtool.verify.nearkernels.near_segments` with numpy's segment distances.
+    """:func:`camtool.accel.nearkernels.near_segments` with numpy's segment distances.
 
     The form it replaced (its :func:`_tied` and :func:`_to_segments` in numpy), kept
     as the tests' reference: the same ``near``, ``r0_2``, ``rk_2`` and ``ask``.
@@ -953,12 +954,14 @@ _NEAR_WORK = [0]
 
 
 def near_kernels(work: int = NEAR_KERNELS_FROM) -> ModuleType | None:
-    """:mod:`camtool.verify.nearkernels` once the samples asked for reach the threshold.
+    """:mod:`camtool.accel.nearkernels` once the samples asked for reach the threshold.
 
     ``work``: the samples the caller is about to measure, added to those before
-    (:data:`NEAR_KERNELS_FROM`; the default loads at once). ``None`` before that and
-    without numba; :func:`nearest_distances_kd` then answers, the same.
+    (:data:`NEAR_KERNELS_FROM`; the default loads at once). ``None`` before that, with
+    ``CAMTOOL_ACCEL=0`` and without numba; :func:`nearest_distances_kd` then answers, the same.
     """
+    if not accel.enabled():
+        return None
     if "kernels" in _NEAR_KERNELS:
         return _NEAR_KERNELS["kernels"]
     _NEAR_WORK[0] += work
@@ -966,7 +969,7 @@ def near_kernels(work: int = NEAR_KERNELS_FROM) -> ModuleType | None:
         return None
     kernels: ModuleType | None
     try:
-        from camtool.verify import nearkernels as kernels
+        from camtool.accel import nearkernels as kernels
     except ImportError:
         kernels = None
     _NEAR_KERNELS["kernels"] = kernels
@@ -1087,16 +1090,7 @@ def _all_exact(samples: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
         _, exact = tree.query_nearest(points, return_distance=True, all_matches=False)
         out[lo : lo + len(points)] = exact
 
-    starts = range(0, len(samples), ALL_EXACT_CHUNK)
-    threads = min(len(starts), os.cpu_count() or 1)
-    if threads <= 1:
-        for lo in starts:
-            nearest(lo)
-        return out
-    from concurrent.futures import ThreadPoolExecutor
-
-    with ThreadPoolExecutor(max_workers=threads) as pool:
-        list(pool.map(nearest, starts))  # each fills its own rows; errors are raised here
+    each_threaded(nearest, range(0, len(samples), ALL_EXACT_CHUNK))  # each fills its rows
     return out
 
 
@@ -1219,9 +1213,9 @@ def _nearby_boxes(
         upper: ``(U,)`` distance of each to some segment ``a → b``, mm.
         a: ``(M, 2)`` segment starts, mm.
         b: ``(M, 2)`` segment ends, mm.
-        tree: the ends' search tree (:func:`camtool.verify.nearkernels.tree`).
+        tree: the ends' search tree (:func:`camtool.accel.nearkernels.tree`).
         half: half the longest segment, mm.
-        kernels: :mod:`camtool.verify.nearkernels`.
+        kernels: :mod:`camtool.accel.nearkernels`.
         need: as for :func:`_nearby_exact` (the limit counts every sample's pairs).
     """
     reach = ((upper + half) * (1.0 + 1e-9) + 1e-12) * (1.0 + 1e-12)
@@ -1257,7 +1251,7 @@ def _nearby_min(
     bounds the memory GEOS's points and lines take; each pair's distance and each
     sample's minimum are the same whatever the grouping. With numba
     (:func:`_pair_kernels`) the same GEOS distances are taken compiled, in one pass
-    (:func:`camtool.verify.nearkernels.least_of_pairs`).
+    (:func:`camtool.accel.nearkernels.least_of_pairs`).
     """
     kernels = _pair_kernels(len(owner))
     if kernels is not None:  # the same GEOS floats, compiled: no line objects
@@ -1291,15 +1285,15 @@ loaded yet (loading it costs about 0.5 s once; GEOS through shapely ~1 µs a pai
 
 
 def _pair_kernels(pairs: int) -> ModuleType | None:
-    """:mod:`camtool.verify.nearkernels` for :func:`_nearby_min`, or ``None`` (GEOS).
+    """:mod:`camtool.accel.nearkernels` for :func:`_nearby_min`, or ``None`` (GEOS).
 
     Loaded when numba already is (its cached kernel loads in milliseconds) or for at
     least :data:`PAIR_KERNELS_FROM` pairs; ``None`` without numba.
     """
-    if "numba" not in sys.modules and pairs < PAIR_KERNELS_FROM:
+    if not accel.enabled() or ("numba" not in sys.modules and pairs < PAIR_KERNELS_FROM):
         return None
     try:
-        from camtool.verify import nearkernels
+        from camtool.accel import nearkernels
     except ImportError:
         return None
     return nearkernels
@@ -2044,7 +2038,7 @@ class TraceStream:
     is the deviation's rms: numpy's pairwise mean of the
     whole array cannot be reproduced chunk by chunk, so it is the square root of the
     exact sum of the squares (an integer sum of their mantissas by exponent,
-    :func:`camtool.verify.kernels.exact_sum_squares`; the squares are numpy's ``d * d``),
+    :func:`camtool.accel.kernels.exact_sum_squares`; the squares are numpy's ``d * d``),
     correctly rounded, divided by the count: at least as accurate, and it may differ
     from the whole-array figure in the last bits.
 
@@ -2052,7 +2046,7 @@ class TraceStream:
         program: the program the trace executed.
         block_start: ``(B + 1,) int64`` row offsets of every move in the whole trace.
         start_mm: the carriage before the first row.
-        kernels: the compiled kernels (:mod:`camtool.verify.kernels`).
+        kernels: the compiled kernels (:mod:`camtool.accel.kernels`).
         rms: measure the deviation's rms; ``False`` (the error budget, whose figures do
             not include it): ``deviation.rms_um`` is NaN.
     """

@@ -299,7 +299,7 @@ class _Controller:
     ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
         """Rows and signs of the reversals of one axis's column; updates its direction.
 
-        (numpy; :func:`camtool.verify.kernels.reversals` is the compiled twin.)
+        (numpy; :func:`camtool.accel.kernels.reversals` is the compiled twin.)
         """
         nz = np.flatnonzero(column)
         if nz.size == 0:
@@ -593,7 +593,7 @@ def _carriage_compiled(
     """:func:`_carriage_numpy` by the compiled loops, for whole steps: the same floats.
 
     Two passes over the rows, no motor array: the runs of each axis (their first row,
-    sign and the motor position there, :func:`camtool.verify.kernels.play_runs`), the
+    sign and the motor position there, :func:`camtool.accel.kernels.play_runs`), the
     band of each run looked up as :func:`_play` does, then the play operator.
     """
     true = machine.real_steps_per_mm
@@ -614,7 +614,7 @@ def _run_bands(
     """The backlash band of each run of ``axis``, motor steps (0 for an up run).
 
     ``signs`` and ``at`` are the runs' directions and the motor position ``(x, y)`` in
-    steps where each starts (:func:`camtool.verify.kernels.play_runs`); the band is the
+    steps where each starts (:func:`camtool.accel.kernels.play_runs`); the band is the
     profile's true backlash there (``Backlash.true_at``, regions included), as
     :func:`_play` takes it.
     """
@@ -831,7 +831,7 @@ class ChunkedSimulation:
     is never split: a longer move is one chunk), each with the carriage the whole
     simulation (:func:`simulate_steps` with the same ``sources``) would give: the
     backlash play is carried from chunk to chunk
-    (:func:`camtool.verify.kernels.play_axis_from` for whole steps; for the ideal
+    (:func:`camtool.accel.kernels.play_axis_from` for whole steps; for the ideal
     controller's fractional steps, ``interpolation`` off, the motor's running sum and
     the play by :class:`_FloatPlay`, whose chunk's ``rows`` are each sample's direction
     as the whole trace's are). Afterwards :meth:`trace_summary` is the trace's per-move
@@ -912,7 +912,7 @@ class ChunkedSimulation:
 class _StepPlay:
     """The carriage of whole-step rows chunk after chunk (:class:`ChunkedSimulation`).
 
-    The compiled play operator (:func:`camtool.verify.kernels.play_axis_from`) resumed
+    The compiled play operator (:func:`camtool.accel.kernels.play_axis_from`) resumed
     from the chunk before: the motor position, each axis's last run sign and its state.
     """
 
@@ -959,10 +959,10 @@ class _StepPlay:
 class _FloatPlayCompiled:
     """:class:`_FloatPlay` by the compiled loops: the same floats, three passes, no temporaries.
 
-    :func:`camtool.verify.kernels.ideal_motor` sums the rows into the motor and takes
-    their directions; :func:`camtool.verify.kernels.runs` finds where each axis's runs
+    :func:`camtool.accel.kernels.ideal_motor` sums the rows into the motor and takes
+    their directions; :func:`camtool.accel.kernels.runs` finds where each axis's runs
     start, whose bands :func:`_run_bands` looks up at the motor there, as
-    :meth:`_FloatPlay._band` does; :func:`camtool.verify.kernels.ideal_play_axis` is the
+    :meth:`_FloatPlay._band` does; :func:`camtool.accel.kernels.ideal_play_axis` is the
     play operator, its state carried from chunk to chunk.
     """
 

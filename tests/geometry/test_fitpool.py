@@ -12,6 +12,8 @@ from typing import Any
 import numpy as np
 import pytest
 
+from camtool.accel import pool
+from camtool.accel.cores import in_worker
 from camtool.geometry import fitpool
 from camtool.geometry.fitpool import CurveKey, fit_key, fit_many
 
@@ -107,11 +109,11 @@ def test_few_curves_start_no_pool(monkeypatch: pytest.MonkeyPatch) -> None:
 
 
 def _fits_in_a_child(keys: list[CurveKey], queue: object) -> None:
-    def no_pool(*args: object) -> None:
+    def no_pool(*args: object, **kwargs: object) -> None:
         raise AssertionError("a pool in a worker process")
 
     fitpool.MIN_CURVES = 1
-    fitpool._in_pool = no_pool  # type: ignore[assignment]
+    pool.ProcessPoolExecutor = no_pool  # type: ignore[assignment,misc]
     try:
         queue.put(repr(fit_many(keys, 0.01, jobs=2)))  # type: ignore[attr-defined]
     except AssertionError as exc:
@@ -131,4 +133,16 @@ def test_a_worker_process_fits_serially_and_the_same(monkeypatch: pytest.MonkeyP
     got = queue.get(timeout=120)
     child.join(timeout=60)
     assert got == repr([fit_key(k, 0.01) for k in keys])
-    assert not fitpool.in_worker()
+    assert not in_worker()
+
+
+def test_switched_off_fits_serially_and_the_same(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``CAMTOOL_ACCEL=0``: no pool is started; the fits are the same."""
+
+    def no_pool(*args: object, **kwargs: object) -> None:
+        raise AssertionError("a pool with the accel layer switched off")
+
+    monkeypatch.setenv("CAMTOOL_ACCEL", "0")
+    monkeypatch.setattr(pool, "ProcessPoolExecutor", no_pool)
+    keys = _keys(fitpool.MIN_CURVES)
+    assert repr(fit_many(keys, 0.01, jobs=2)) == repr([fit_key(k, 0.01) for k in keys])

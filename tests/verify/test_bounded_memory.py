@@ -26,7 +26,7 @@ from camtool.verify.simulate import ChunkedSimulation, TraceChunk, count_rows, s
 from camtool.verify.sources import ALL, SOURCES, Sources
 from tests.verify.programs import TARGETS, mixed_program
 
-kernels = pytest.importorskip("camtool.verify.kernels")
+kernels = pytest.importorskip("camtool.accel.kernels")
 
 SIMULATED = [name for name in SOURCES if name != "rounding"]
 

@@ -25,7 +25,7 @@ from camtool.post.registry import load_target
 from camtool.verify import simulate, verifier
 from camtool.verify.simulate import ChunkedSimulation, TraceChunk
 
-kernels = pytest.importorskip("camtool.verify.kernels")
+kernels = pytest.importorskip("camtool.accel.kernels")
 pytestmark = pytest.mark.skipif(not cores.FORK, reason="needs fork (Linux)")
 
 

@@ -24,7 +24,7 @@ from camtool.verify.circlefit import CircleFit, fit_circle
 from camtool.verify.simulate import count_rows
 from camtool.verify.sources import ALL
 
-pytest.importorskip("camtool.verify.kernels")
+pytest.importorskip("camtool.accel.kernels")
 
 
 def _exact_fit(points: np.ndarray) -> tuple[float, float, float]:

@@ -90,7 +90,7 @@ def test_pic_mmh_lines_are_counted_without_their_rows(monkeypatch: pytest.Monkey
 
 def test_a_wrong_count_is_found_and_counted_again(monkeypatch: pytest.MonkeyPatch) -> None:
     """Were a closed form wrong, the streamed report is still the whole trace's."""
-    pytest.importorskip("camtool.verify.kernels")  # a trace streams only with them
+    pytest.importorskip("camtool.accel.kernels")  # a trace streams only with them
     machine = load_target("pic-mmh").machine
     program = _zigzag(2)
     whole = build_report(verify_program(program, machine, name="pic-mmh", budget=False))

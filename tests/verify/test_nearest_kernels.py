@@ -1,7 +1,7 @@
 """The compiled nearest-end search gives what the k-d tree path gives, bit for bit (issue 17).
 
 :func:`camtool.verify.metrics.nearest_distances` (numba box tree,
-:mod:`camtool.verify.nearkernels`) against :func:`~camtool.verify.metrics.nearest_distances_kd`
+:mod:`camtool.accel.nearkernels`) against :func:`~camtool.verify.metrics.nearest_distances_kd`
 (scipy's k-d tree, the code it replaces) on many random inputs built to tie: traces on a
 step grid, samples on the same grid, traces cut in several identical passes (every end
 repeated), samples far from the trace (a drawing point a tool radius away). Equality is
@@ -16,7 +16,7 @@ from scipy.spatial import cKDTree
 
 from camtool.verify import metrics
 
-nearkernels = pytest.importorskip("camtool.verify.nearkernels")
+nearkernels = pytest.importorskip("camtool.accel.nearkernels")
 
 
 @pytest.fixture(autouse=True)

@@ -24,7 +24,7 @@ from camtool.verify.verifier import build_report, verify_program
 from tests.verify.programs import TARGETS
 from tests.verify.programs import mixed_program as _program
 
-kernels = pytest.importorskip("camtool.verify.kernels")
+kernels = pytest.importorskip("camtool.accel.kernels")
 
 
 @pytest.mark.parametrize("name", TARGETS)
