@@ -3,15 +3,7 @@
 The public API (docs/api.md): read a drawing, plan it, post it for a target,
 verify the code by simulating it on the target's machine::
 
-    import camtool
-
-    drawing = camtool.read_drawing("samples/plate.dxf")
-    job = camtool.post_drawing(drawing, camtool.load_target("grbl"))
-    v = camtool.verify_job(job)
-
-Every name in :data:`__all__` is imported from its module on first use (PEP 562
-module ``__getattr__``), so ``import camtool`` (and ``camtool --version``) loads
-none of the stages: no OCCT, no matplotlib, no numpy.
+Design notes: docs/internals.md, ``camtool/__init__.py``.
 """
 
 from __future__ import annotations

@@ -2,23 +2,7 @@
 
 Three pieces the generic library does not have:
 
-- the ``timer`` line (:func:`timer_line`): ``funcionXYH`` has no coordinated
-  interpolator: each axis is stepped from a 1 ms timer (``timeGetTime``) and fires
-  when ``now − last > period`` (Yanez-07 §4.2, §4.7, R11). With a 1 ms timer an
-  axis of period T ms fires every ``floor(T) + 1`` ms (:func:`timer_period_ms`).
-  The dominant axis (more steps) has the configured half-period P and is
-  count-limited; the other axis is scheduled at ``P·N_dom/N_other`` ms and is
-  **not** count-limited: it keeps stepping until the dominant axis is done, which
-  over-steps it (Table 3.8: 5263 × 2632 programmed → 2763 / 2719 / 2697 Y steps at
-  P = 20 / 30 / 40 ms). The step array is what the motors do; the application's
-  own position counter still believes the programmed counts. The line takes P
-  from the profile's ``flashcut`` timing table. It models the ``dynamics`` error
-  source (:mod:`camtool.verify.sources`): switched off, the axes fire at their
-  exact periods (:func:`exact_timer_line`) and every axis makes its count.
-- the ``flashcut`` chord rule (:func:`flashcut_arc_points`): ``chord_segments``
-  equal chords per arc (Yanez-07 §4.4).
-- the ``flashcut`` timing model (:class:`FlashcutTiming`): per dominant step
-  ``k·(P + δ)`` (Yanez-07 §2.6, §4.7, R15, R21).
+Design notes: docs/internals.md, ``postprocessors/flashcut_motion.py``.
 """
 
 from __future__ import annotations

@@ -1,52 +1,6 @@
 r"""GRBL 1.1's serial link: messages decoded, status reports read, resume, and a simulator.
 
-The protocol itself (115200 baud, ``\\n``-ended lines, character counting against
-the 127 bytes GRBL's 128-byte RX ring buffer holds, ``ok``/``error:N``,
-``ALARM:N``, the ``Grbl 1.1h ['$' for help]`` banner, real-time ``?`` ``!`` ``~``
-and Ctrl-X) is declared in ``grbl.toml``'s ``[link]`` table; this module adds
-what needs Python (:data:`LINK`):
-
-- :func:`decode`: ``error:N`` and ``ALARM:N`` in GRBL's own words, from its
-  documented tables (gnea/grbl ``doc/csv/error_codes_en_US.csv`` and
-  ``doc/csv/alarm_codes_en_US.csv``, v1.1h);
-- :func:`status_state` and :func:`status`: the state word of a
-  ``<Idle|MPos:…|Bf:15,128|FS:…>`` report and its ``Bf:`` free planner blocks
-  and RX bytes (gnea/grbl ``doc/markdown/interface.md``, "Real-time Status
-  Reports"); :func:`setup` turns ``Bf:`` on for the job (``$10`` bit 1) and
-  gives the line that puts ``$10`` back;
-- :func:`expect`: each line's fewest planner blocks and whether GRBL answers
-  it only once the planner is empty, so the sender can name the last line
-  surely run (GRBL's ``ok`` means queued, not run);
-- :func:`check` and :func:`refusal`: what GRBL 1.1h's parser refuses
-  (gnea/grbl ``grbl/gcode.c``, ``protocol.c``), refused before sending;
-- :func:`resume_blocks`: the modal state to restore before ``--from-line``;
-- :class:`GrblDevice`: a simulated GRBL that speaks all of it.
-
-Resuming (``--from-line K``). GRBL forgets nothing between lines, so before line
-K the sender repeats, in one line, the last word lines 1…K−1 set in each modal
-group the program used: units (G20/G21), distance (G90/G91), arc distance
-(G91.1), feed mode (G93/G94), plane (G17–G19), work coordinate system
-(G54–G59) and tool length offset cancel (G49); then the last feed ``F``; the
-spindle (``M3``/``M4`` with the last ``S``, or ``M5``) and the spin-up dwell
-the program had after starting it (``G4 P…``); the coolant (``M7``/``M8``/
-``M9``). A group the program never set is left as the controller has it. When
-line K has axis words but no motion word, the modal ``G0``/``G1`` is sent
-alone before it (GRBL accepts a motion word without axes: no motion). Not
-restored: a ``G92`` offset, ``G43.1`` dynamic tool length offsets, and the
-position: the machine must stand where line K−1 ended, which is where
-``camtool send`` leaves it when it stops and names line K. A line K that
-continues a modal ``G2``/``G3`` without its own motion word is refused (resume
-at the line that holds it). On an Arduino, opening the port resets GRBL
-(DTR): the machine position is then zero where the carriage stands, and with
-homing enabled it is in alarm until homed; re-establish the work zero before
-resuming (docs/send.md).
-
-Errors in flight. With character counting, lines already in GRBL's buffer
-when it answers ``error:N`` would still run (interface.md, "RESERVATION"); the
-sender stops the machine (feed hold ``!``, then once ``Hold:0`` a reset
-Ctrl-X, which turns the spindle and coolant off and keeps the position) and
-names the refused line as the line to resume at, or an earlier one that had
-not run to its end.
+Design notes: docs/internals.md, ``postprocessors/grbl_link.py``.
 """
 
 from __future__ import annotations

@@ -4,21 +4,7 @@ GRBL's stepper runs the generic Bresenham with AMASS
 (:func:`camtool.verify.interpolators.bresenham_line`, ``bresenham``). What is
 GRBL's own:
 
-- the ``grbl`` chord rule (:func:`grbl_arc_points`): ``mc_arc`` of
-  ``motion_control.c``, segments within ``$12`` arc tolerance
-  (``chord_tolerance_mm``), third-order small-angle rotation with an exact
-  correction every 12 segments;
-- the ``grbl`` timing model: the generic rest-to-rest trapezoid
-  (:class:`camtool.verify.timing.TrapezoidTiming`, GRBL's ``defaults.h`` for
-  ``$110``/``$120``), an upper bound of the real time: GRBL's planner
-  (``planner.c``) looks ahead over its block buffer and only slows down at
-  junctions to the *junction deviation* speed ``v_j = √(a·δ·s/(1 − s))`` with
-  ``s = sin(θ/2)``, θ the angle between the reversed incoming and the outgoing
-  direction (θ = π − turn angle, so ``s = cos(turn/2)``), δ = ``$11`` (0.010 mm by
-  default), capped by both blocks' nominal speeds: a straight continuation has
-  no slow-down, a 90° corner ``v_j = √(2.414·a·δ)``, a reversal stops. See
-  :func:`grbl_junction_speed_mm_s`; with those entry/exit speeds
-  :func:`camtool.verify.timing.trapezoid_time_s` gives the blended time.
+Design notes: docs/internals.md, ``postprocessors/grbl_motion.py``.
 """
 
 from __future__ import annotations

@@ -1,44 +1,6 @@
 """The ``i8751`` dialect: binary packets for the 8751 serial stepper interface.
 
-Source: Intf8751 §3.7 (the byte protocol, :mod:`camtool_postprocessors.i8751_packets`),
-§4.1–4.4 (motion) and requirements R1–R7 (reference/Intf8751.md). The PC
-sends relative step counts per motor; the interface runs X and Y by "corte
-recto" (both motors together, then the longer one alone), waits T1 seconds,
-runs Z, waits T2 seconds, and goes on with the next move.
-
-How a :class:`~camtool.model.program.Program` is written:
-
-- every end point is rounded to whole steps ABSOLUTELY (half away from zero,
-  with the machine's steps/mm), and the record carries the difference from the
-  previous rounded point, so rounding never accumulates (R1);
-- a move of more than 65 535 steps on an axis is split into records of at most
-  65 535 steps on its longest axis, the others at the nearest step of the
-  segment (R3: 70 000 → 65 535 + 4 465);
-- X/Y then Z in one record (R4, R11): a move that changes X/Y and Z together
-  runs X/Y first, then Z, with a warning, except a rapid that rises: it goes up
-  first, so no rapid travels at the depth it leaves; a Z-only move right after an
-  X/Y-only move joins its record (a dwell between them becomes T1), as in the
-  thesis's worked example;
-- arcs: the interface has none (§4.1) → equal chords within the machine's
-  ``chord_tolerance_mm``, with a warning giving the chord count and error;
-- feeds: the thesis has no feed code; every move runs the same delay-loop ramp
-  (8 Hz start, ≈104 Hz cruise, §4.4), so feeds are not expressible and a
-  warning says so;
-- rapids: the interface has no rapid and no pen-up; with ``lift_mm`` > 0 and a
-  program without Z, Z is raised by ``lift_mm`` before each run of rapids and
-  lowered after it (03H on motor 3 taken as +Z, up), else rapids are ordinary
-  moves and a warning says the tool cuts along them;
-- dwells: whole seconds in T2 of the move before (T1 is written 0), extra
-  records with no motion for more than 255 s or a dwell before the first move;
-- spindle, tool change and home commands are not in the protocol: dropped with
-  one warning per kind.
-
-The reader gives absolute mm from the summed steps, counted from where the
-machine stood (X = Y = Z = 0). A record that moves X/Y and Z is read as two
-moves (X/Y, then Z), as the machine runs it; ``Program.lines`` holds the
-1-based move number (record) in the stream, as the dump notes count them. A
-move that ends with the tool above Z = 0 (the part surface) is read as a rapid,
-any other as a cut at the machine's cruise feed (for reports only).
+Design notes: docs/internals.md, ``postprocessors/i8751.py``.
 """
 
 from __future__ import annotations

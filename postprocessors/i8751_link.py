@@ -1,50 +1,6 @@
 r"""The i8751 host link: packets, 'F' after each, 'A' at the end, and a simulated interface.
 
-Source: Intf8751 §3.2 (the RS-232C power-on handshake, thesis lines 1436–1468),
-§3.7 (the protocol, Table III.2, lines 4077–4093 and 4343–4466) and
-requirements R5, R6, R8, R19, R21 (reference/Intf8751.md). The link itself is
-declared in ``i8751.toml``'s ``[link]`` table; this module adds what needs
-Python (:data:`LINK`). A session, as camtool's i8751 post writes it
-(:mod:`camtool_postprocessors.i8751_packets`), goes on the wire like this:
-
-======================  ==========================  ====================================
-host (PC)               interface (8751)            camtool
-======================  ==========================  ====================================
-DTR                     DSR                         ``handshake = "dtr-dsr"``
-13H (access key)        —                           ``startup``: sent at every session
-packet 1, ending 45H    'M' per stored byte; 'F'    one wire block per packet, answer 'F'
-                        (46H) once it has run it
-…                       …                           the next packet only after 'F' (R19)
-54H (end of data)       'A' (41H), and it stops     the last block, answer 'A'
-======================  ==========================  ====================================
-
-The bytes sent are exactly the file ``camtool post -t i8751 -f bin`` writes (a
-dump, ``-f dump``, is sent as the bytes it lists). The interface only answers
-(R19): the host starts, and waits for 'F' after each packet before the next
-(half-duplex, thesis 3757–3767), so one packet at a time is in the
-interface's RAM tables (R5: at most 5 moves, 15 blocks) and a program of any
-length streams (R21).
-
-Decisions where the thesis is silent (docs/send.md):
-
-- The DTR/DSR handshake uses the port's modem lines (pyserial ``dtr``/``dsr``);
-  a pseudo-terminal or a URL has none, so there it is skipped with a note and
-  the first 'F' is the interface's sign of life. No DSR within
-  ``response_timeout_s`` on a real port stops before any byte is sent.
-- The access key is sent once per session, first (as the thesis's worked
-  example); the interface's reply to it («LISTO»/«OTRO» on the PC's screen)
-  has no documented byte, so the host does not wait for one.
-- The 'M' (4DH, "dato memorizado") the interface sends for each stored byte
-  is logged and otherwise ignored (``ignore``); the letter it shows for a
-  motor number is illegible in the thesis (Table III.2) and not modelled.
-- The protocol has no error answer: an interface that does not run a packet
-  stays silent, and the host stops when no 'F' has come within the packet's
-  estimated time (the verifier's timing model) + ``response_timeout_s``,
-  naming the packet as sent but not confirmed.
-- ``--from-line N``: N counts moves (records), as the reader's line numbers
-  and the dump's notes do; it must be the first move of a packet (1, 6, 11,
-  …). The resumed session starts again with the access key; the end of data
-  counts as move (last + 1).
+Design notes: docs/internals.md, ``postprocessors/i8751_link.py``.
 """
 
 from __future__ import annotations

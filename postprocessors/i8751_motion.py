@@ -3,32 +3,7 @@
 Its line is the generic "corte recto" (:func:`camtool.verify.interpolators.corte_recto_line`,
 ``corte-recto``); what is the 8751's own is its time model, ``i8751`` (:class:`I8751Timing`).
 
-Intf8751 §4.4 (R12): each step is followed by a software delay loop whose
-length is set by the register X (RAM 28H)::
-
-    t(X) = (6156·X + 10272) / 12 MHz  s        (thesis formula, 12 MHz crystal)
-
-so t(F2H) = 125.0 ms (8 Hz, the minimum speed), t(EDH) = 122.4 ms and
-t(11H) = 9.58 ms. A motor routine of fewer than 90 steps runs every step at
-X = F2H. From 90 steps on it ramps: 45 acceleration steps in which X starts at
-F2H and drops by 5 after each step, cruise at the X the ramp reached (11H,
-≈104 Hz), and 45 deceleration steps in which X "inicia con un valor de 11H …
-se le suman 5H cada vez hasta llegar a F2H" (X starts at 11H and grows by 5
-after each step). Both ramps are read the same way (delay, then change X), so
-acceleration delays use X = 242, 237, …, 22 (3.09 s, the thesis figure) and
-deceleration delays X = 17, 22, …, 237 (2.97 s); a mirrored reading
-(22, …, 242) would add 0.116 s per ramped move.
-
-The firmware's integer step of 5 ends the ramp at X = 11H, ≈104 Hz, while the
-design text asks for 70 Hz (14.28 ms) with 2.46 ms per step (Intf8751 §4.4
-"inconsistency found"). ``cruise="firmware"`` reproduces the firmware,
-``cruise="design"`` the 8 → 70 Hz intent: the same formula with X falling
-linearly (non-integer) from F2H to the X of 70 Hz (X ≈ 26.18) in 45 steps.
-
-Not stated in the thesis, assumed here: the ramp runs once over the whole
-"corte recto" move of ``max(n1, n2)`` steps (RUT2 then GIRA1 share the
-MENOS/MAS loops), and Z (motor 3) runs its own ramped routine after X/Y. The
-2½-D sequencing per move (R11) is X/Y, wait T1 s, Z, wait T2 s.
+Design notes: docs/internals.md, ``postprocessors/i8751_motion.py``.
 """
 
 from __future__ import annotations

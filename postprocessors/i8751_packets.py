@@ -3,27 +3,7 @@
 Source: Intf8751 §3.7 (reference/Intf8751.md, thesis lines 4077–4165,
 4343–4415) and requirements R2–R6. The PC sends, in raw binary (``CHR$``)::
 
-    session = 13H , { packet } , 54H           (access key ... end of data)
-    packet  = move , { move } , 45H            (1 to 5 moves, then end of packet)
-    move    = block(1) , block(2) , 00H T1 , block(3) , 00H T2
-    block(m)= m , ( D , PH , PL | 05H )        (motor 1 = X, 2 = Y, 3 = Z)
-
-``D`` is 03H (forward, "horario", +) or 04H (backward, "antihorario", −) and
-the step count is ``PH·256 + PL`` (high byte first, 0–65 535); a motor that
-does not move sends ``m 05H``. ``T1`` (before motor 3 moves) and ``T2`` (after
-it) are whole seconds, 0–255. The thesis does not say whether 13H is sent again
-before every packet; camtool sends it once, first, as the worked example of
-§3.7 does. The interface's replies ('F' after each packet, 'A' after 54H) are
-not part of the stream.
-
-The dump is the same bytes as text, one line per byte group (the key, one
-move, an end marker): the offset in hex, the bytes in hex, and after ``;`` a
-note the reader ignores; lines that start with ``;`` are comments::
-
-    0000  13                                                   ; access key
-    0001  01 03 03 E8  02 04 00 FA  00 02  03 04 00 64  00 00  ; move 1: ...
-    0011  45                                                   ; end of packet 1
-    0012  54                                                   ; end of data
+Design notes: docs/internals.md, ``postprocessors/i8751_packets.py``.
 """
 
 from __future__ import annotations

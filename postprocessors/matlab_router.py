@@ -3,43 +3,7 @@
 Source: Angel-11 §3 (the GUI, verbatim code in Appendix A.1), §2.7 (the USB
 stream), §2.8 (the master's job), §8 R1–R7 (reference/Angel-11.md).
 
-The GUI turns clicked vertices into three integer arrays per figure
-(:mod:`camtool_postprocessors.matlab_router_arrays`): ``xy`` (``2 × N`` absolute vertices, 0.1 mm),
-``lxy`` (``2 × n`` absolute increments, 0.1 mm, ``n = N − 1``) and ``velxy``
-(``2 × n`` signed speeds, encoder counts per 5 ms: the major axis at ±``speed``,
-480 by default, the other scaled so both end together). Two formats:
-
-- ``script`` (``.m``): the arrays in the thesis's display format (L3196–L3228),
-  one ``xy``/``lxy``/``velxy`` triple per job, ``%`` comments naming the job,
-  stroke and contour. Each matrix is ``name = `` on one line, then
-  ``[`` + the x row (values right-aligned in 6 columns) + ``; `` and `` `` + the y
-  row + `` ] ``. This is the thesis's ``velxy`` block character for character
-  and the first row of every block; the thesis's second rows of ``xy`` and
-  ``lxy`` sit one column further left (typed by hand), which camtool does not
-  copy. camtool's points importer reads these files back as strokes.
-- ``wire`` (``.txt``): the bytes the GUI sent the master over the USB-CDC port
-  (``pushbutton2_Callback``, L4292–L4360): per job ``n``, ``x1``, ``y1``, then
-  ``lx(1..n)``, ``ly(1..n)``, ``velx(1..n)``, ``vely(1..n)``, each as Matlab
-  ``fprintf(s,'%d',v)`` followed by CR (char 13): ``3 + 4n`` values, no other
-  byte. The GUI's pauses (10 ms after the header values, 1 ms after the
-  others) are not bytes and are not written. ``first_pointy_as_char`` reproduces
-  the GUI's ``fprintf(s,'%c',first_pointy)`` bug (L4306): ``y1`` as one character.
-
-Jobs. The router has no travel inside a job (R6): a stroke (the cutting moves
-between two rapids) is one job, which the master runs as home (Z, X, Y) → first
-point (X then Y at speed 500) → tool down → segments, stopping at every vertex →
-tool off; then it idles (Angel-11 §2.8; multi-stroke figures in §6, L3938–L3966).
-A rapid is therefore a job boundary, never written. A stroke of more than
-``max_segments`` (128: the master's ``X_ROUTE[128]``, L4625) segments is split
-into jobs that continue from the same vertex: the thesis machine can do that (it
-is how it cut multi-stroke lettering), at the price of a tool lift, re-homing and
-a re-plunge at the joint; camtool warns.
-
-Rounding (R1): vertices are ``round(x_mm · 10)`` with Matlab's ``round`` (half
-away from zero), as the GUI's ``round(xy*100)`` in cm. A vertex that rounds onto
-the previous one is dropped (reported). Arcs become equal chords within
-``chord_tolerance_mm`` (default: the machine's ``motion.chord_tolerance_mm``),
-reported with the chord count and the largest sagitta measured.
+Design notes: docs/internals.md, ``postprocessors/matlab_router.py``.
 """
 
 from __future__ import annotations

@@ -4,19 +4,7 @@ The GUI (Angel-11 §3, verbatim code in Appendix A.1, thesis L4400–L4515) turn
 the clicked vertices into three integer arrays that the master PIC replays one
 segment at a time:
 
-- ``xy``: ``2 × N`` absolute vertices in 0.1 mm (row 0 = x, row 1 = y);
-- ``lxy``: ``2 × n`` **absolute values** of the per-segment increments, 0.1 mm,
-  ``n = N − 1``;
-- ``velxy``: ``2 × n`` **signed** speeds in encoder counts per 5 ms sample: the
-  axis with the larger increment runs at ``±speed``, the other at
-  ``±round(speed / (|major| / |minor|))`` (Matlab ``round``: half away from
-  zero), ``0`` when its increment is 0, and both at ``±speed`` when the two
-  increments are equal. The sign is the direction of the increment.
-
-The speed quotient is formed exactly as Matlab does (``factor = |major|/|minor|``
-then ``speed/factor``, IEEE double), so the rounding of ties matches the GUI bit
-for bit. This module only builds the arrays; printing them is the dialect
-writer's job.
+Design notes: docs/internals.md, ``postprocessors/matlab_router_arrays.py``.
 """
 
 from __future__ import annotations

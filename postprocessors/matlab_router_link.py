@@ -1,26 +1,6 @@
 """The matlab-router's USB link: a job is one wire block, and the master that takes it.
 
-Source: Angel-11 §2.7 (reference/Angel-11.md): the Matlab GUI's
-``pushbutton2_Callback`` opens the USB-CDC port (``fopen(s)``, L4288), writes
-one job as ASCII decimal numbers each followed by CR (``fprintf(s,'%d',v);
-fprintf(s,'%c',13)``, L4292–L4360): ``n, x1, y1, lx(1..n), ly(1..n),
-velx(1..n), vely(1..n)``, and closes the port (``fclose(s)``, L4366). The master
-reads exactly those ``3 + 4n`` values (``get_int16_usb``, L4662–L4716), then
-homes, runs the stroke and idles (``st = 3``, L4923): it takes one job per
-reset. There is no answer on the USB link.
-
-So ``send`` frames the wire file (``camtool post -t matlab-router --format
-wire``) into one block per job (:func:`frame_jobs`), sends a job, waits its
-estimated time, and then needs the operator (``operator_between_blocks``):
-reset the master; the port is opened again for the next job, as the GUI did.
-Without an operator the job stops after the first job and names the
-``--from-line`` of the next. The GUI's pauses between values (10 ms, 1 ms)
-are not reproduced: USB-CDC is flow-controlled by USB itself and the master's
-``get_string_usb`` waits for each character. ``--from-line`` must be the first
-record of a job (every job homes first, so any job boundary is a safe resume).
-
-:class:`RouterDevice` is the master's receiving side: it takes ``3 + 4n``
-CR-ended values as one job.
+Design notes: docs/internals.md, ``postprocessors/matlab_router_link.py``.
 """
 
 from __future__ import annotations

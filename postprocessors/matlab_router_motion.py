@@ -1,27 +1,6 @@
 """Motion model of the Angel-11 DC-servo router (``matlab-router``): its ``servo`` simulator.
 
-The router has no coordinated interpolator (Angel-11 §4): each stroke is a job
-of straight segments between vertices in whole 0.1 mm, every axis at its own
-pre-scaled speed, moves floored to 0.2 mm chunks, a stop at every vertex
-(:func:`camtool.verify.servo.simulate_job`). Here a program is cut into strokes
-at its rapids; arcs (which the router's dialect never writes) become chords
-within ``[motion] chord_tolerance_mm``. The result has the shape of a
-:class:`~camtool.verify.motion.StepTrace` so that the same measures apply: one
-"row" per 5 ms servo sample (no motor steps: ``rows`` are zeros, ``iterations``
-counts samples), positions from the simulated encoders.
-
-The move from home to each stroke's first point (homing, the X-then-Y dog-leg at
-speed 500) is not simulated: a stroke starts at rest on its first vertex, and
-its rapid is timed as that dog-leg (R13).
-
-``reversals`` are counted from the simulated positions (:func:`count_reversals`).
-A backlash in the profile (``[machine.backlash] true_um``, e.g. from a
-``--machine`` overlay) is applied to the positions as the per-axis dead band of
-R15 (:func:`~camtool_postprocessors.matlab_router_motion_servo.apply_backlash`);
-what the router cannot do is refused, never ignored: the firmware compensates
-nothing (``compensation_um`` must be 0) and the dead band is one per axis (no
-``regions``). The simulator honours the ``backlash`` error source of the budget
-(:mod:`camtool.verify.sources`).
+Design notes: docs/internals.md, ``postprocessors/matlab_router_motion.py``.
 """
 
 from __future__ import annotations

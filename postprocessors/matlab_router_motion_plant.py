@@ -4,15 +4,7 @@ Units: speeds are encoder counts (×4 quadrature, 1024 per motor revolution) per
 5 ms sample, "counts/Ts" (Angel-11 §2.3: the thesis's "pulsos/s" are really
 counts per Ts); the command ``u`` is the PWM command in percent, −100…+100.
 
-- Plant (Angel-11 §5.1, R9): first order, ``ω[k+1] = pole·ω[k] + gain·u[k]``.
-  The thesis model is G_p(z) = 0.6986/(z − 0.9283) (eq. 4.34), identified from a
-  u = 70 step (A = 9.715, τ = 0.067 s). ``ω[k+1]`` is the count advance during
-  sample ``k → k+1``, which is what the firmware measures (``posAc − posAnt``).
-- Firmware IP law (Angel-11 §4.5 (C), Appendix A.3.1 L5534–L5584, R10): integer
-  arithmetic with ``kid = 28``, ``kpd = 159`` (Table 4.1's Y gains × 1000).
-- Idealised IP law (eq. 4.27) with the per-axis gains of Table 4.1.
-- Gain design (eqs. 4.39, 4.40, 4.44, 4.29, 4.30; R11) and its inverse, the
-  per-axis plants back-solved from Table 4.1 (Angel-11 §5.2 (D)).
+Design notes: docs/internals.md, ``postprocessors/matlab_router_motion_plant.py``.
 """
 
 from __future__ import annotations

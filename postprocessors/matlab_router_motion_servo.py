@@ -1,44 +1,6 @@
 """The Angel-11 DC-servo wood router's firmware moves, simulated, and their error measures.
 
-The router has no coordinated interpolator (Angel-11 §4.1). For each segment the
-master PIC sends every axis slave an absolute distance (0.1 mm) and a signed
-speed (counts per 5 ms) from the GUI's arrays (:mod:`camtool_postprocessors.matlab_router_arrays`),
-starts X then Y (one I²C frame apart, R13) and waits until both report done:
-a stop at every vertex (§2.8). Each slave runs ``MOVIMIENTO_X`` (Appendix A.3.1,
-L5589–L5729; §4.2, R12) on top of its 5 ms IP speed loop (§4.5, R10):
-
-- ``factor = d/2`` chunks of 5 120 counts (0.2 mm): ``factor − 1`` chunks at
-  ``Ref = speed``, then the last chunk at ``speed`` until 1 000 counts remain,
-  then ``Ref = Tabla[remaining]`` down to the count, then motor off. An odd
-  distance therefore loses 0.1 mm and the losses add up over a job (§4.2 (D)1);
-  ``d = 1`` makes ``factor − 1`` underflow to 65 535 (a runaway, §4.2 (D)2).
-- ``Tabla2.c`` is not in the thesis; it is modelled as the braking law of
-  §4.3, ``Tabla[q] = floor(√(2βq))`` (eq. 4.14), with β = 115.2 counts/Ts² by
-  default: ``Tabla[1000] = 480``, the cruise speed, so the reference enters
-  the table without a jump and never asks for more than the segment speed.
-
-Caveat, found while building this model: with the thesis plant (τ = 67 ms) and
-a law that can only cut the drive (u is clamped to [0, 100] % in the direction
-of motion), an axis cruising at 480 counts/Ts coasts about ``480·p/(1−p)`` ≈ 6 200
-counts (0.24 mm) after the drive is cut, so no table acting on the last 1 000
-counts can stop it at its count. ``stop="count"`` (default) stops the axis at
-the count the firmware waits for, as if friction (a self-locking 3 mm lead
-screw behind a 1:75 gearbox) held it; ``stop="coast"`` lets the linear thesis
-plant coast on, and the trace shows the resulting overrun at every vertex.
-
-Error measures of a trace (Angel-11 R14, R15), all in mm:
-
-- :func:`closure_mm`: where a job ends relative to its first point (R14c), with
-  an optional per-axis backlash (R15) applied to the executed positions;
-- :func:`backlash_effect_mm`: what that backlash alone adds to the closure;
-- :func:`segment_deviation_mm`: largest distance of each segment's path from
-  the straight line joining where it started and where it stopped (R14b);
-- :func:`tracking_deviation_mm`: the same against the line the two speeds aim
-  along, while both axes are moving: the servo-mismatch part of R14b, as in
-  Angel-11 §5.2 "(D) Rough simulation".
-
-The simulation works in integer encoder counts (25 600 per mm on X and Y, R8) and
-returns mm; Y up, positive speed = towards larger coordinates.
+Design notes: docs/internals.md, ``postprocessors/matlab_router_motion_servo.py``.
 """
 
 from __future__ import annotations

@@ -3,31 +3,7 @@
 Source: UNAM-GMM §3 (reference/UNAM-GMM.md), requirements S000-01…08. Example
 block, verbatim from the thesis (L1731)::
 
-    G02X02969.00Y03400.00I03012.00J03040.00F08;
-
-- one block per line, no spaces, no N-words, no comments, every block ends
-  with ``;`` (S000-01);
-- coordinates in µm, absolute from the G54 part zero: axis letter, ``-`` only
-  for negatives (or ``+`` too with ``sign = "always"``), 5 zero-padded integer
-  digits, ``.``, 2 decimals (S000-02, S000-03);
-- ``I``/``J`` are the ABSOLUTE arc centre, same format (S000-04);
-- ``F`` is two zero-padded digits; by default in units of 0.1 mm/min (``F08``
-  = 0.8 mm/min), or an explicit code table (S000-05,
-  :mod:`camtool_postprocessors.pic_mmh`);
-- programs open with ``G54;`` ``G90;`` and close with ``M30;``; the commands of
-  :attr:`Program.commands` are ``M03S####;`` / ``M04S####;`` / ``M05;``,
-  ``G04P##;``, ``M06T##;`` and ``G28X0Y0;`` / ``G28Z0;`` (S000-06, Tablas 21–22);
-- no Z words (S000-08): a program that moves Z is refused;
-- a full circle is written as two half arcs (the firmware takes the start from
-  its current position; a zero-length G02 is ambiguous, UNAM-GMM §3.7 item 7);
-- an arc whose absolute centre does not fit the I/J field (±99999.99 µm: a
-  large radius, e.g. a nearly straight DXF bulge) is written as G01 chords
-  within the program's ``tolerance_mm`` (``--tolerance``; else the machine's
-  ``chord_tolerance_mm``), with one warning giving how many arcs and chords. An
-  end point that does not fit X/Y is still an error.
-
-The mode strings of the host link (``JX+;``, ``BX200;`` …) are in
-:mod:`camtool_postprocessors.pic_mmh_link`.
+Design notes: docs/internals.md, ``postprocessors/pic_mmh.py``.
 """
 
 from __future__ import annotations

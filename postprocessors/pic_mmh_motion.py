@@ -1,13 +1,6 @@
 """Motion model of the UNAM-GMM GMM PIC controller (``pic-mmh``) for the verifier.
 
-Its line (linear DDA, annex A.3) and arc (direct search method, annex A.6)
-interpolators are generic algorithms (:mod:`camtool.verify.interpolators`,
-``dda`` and ``dsm``); what is the PIC's own is its time model: block time is a
-count of interpolator iterations (and backlash compensation steps) times the
-period of a step rate ``f = d·F/60`` capped by the serial link (UNAM-GMM §4.9,
-§5.1, S000-17), no acceleration ramp. The ``pic-mmh`` timing model takes ``d``
-(steps/mm) and the cap from the machine profile when its ``[machine.timing]``
-table does not state them, so that ``--machine`` changes reach the time model.
+Design notes: docs/internals.md, ``postprocessors/pic_mmh_motion.py``.
 """
 
 from __future__ import annotations

@@ -1,40 +1,6 @@
 """A program's arcs conformed ahead, in a forked helper, while the writer works.
 
-The arc check of GRBL and LinuxCNC (:func:`camtool.post.arccheck.conform_arc`, about
-25 µs an arc) is a function of its arguments alone: the start the controller holds (as
-printed), the exact end, the exact centre, the direction and the exact start (the rule and
-the quantum are the writer's, the same for every arc). On a program of many arcs it is
-about half the writer's time: the SVG benchmark's 213-icon drawing has 60 310 distinct
-arcs, 1.7 s of the writer's 3.5 s, while the second core waits.
-
-:class:`ConformAhead` forks a helper as the writer starts (:func:`start`). The helper
-predicts each arc's arguments from the program: the start the controller holds is where
-the last move that wrote X and Y ended, as printed
-(:meth:`~camtool.post.wordaddress_write.BlockWriter.written_xy`). It then conforms the arcs
-from the last towards the first, and sends what it found in records of :data:`BATCH`
-arcs, until it reaches the arcs the writer has passed (the writer tells how far it is in
-memory they share). Meanwhile the writer works from the first arc. For each arc, the
-writer looks up its own arguments (:meth:`ConformAhead.take`). It takes the helper's
-blocks only when these arguments equal the helper's prediction exactly (the dictionary
-key), so they are the blocks the writer would have made itself. Any other arc is
-conformed by the writer, as before:
-
-- an arc whose prediction missed (an arc before it ended elsewhere than printed);
-- an arc the helper has not reached yet;
-- an arc whose check failed in the helper (the writer repeats it and words the error
-  where it belongs).
-
-The output is the same bytes whether or not the helper runs, answers, or dies. Keys with
-a zero are left out, as the writer's own memory of conformed arcs leaves them out:
-``-0.0`` equals ``0.0`` as a key, but not as an angle.
-
-Measured on that SVG (`make bench`'s, `post --target grbl`): the writer 3.5 → 2.4 s, the
-whole command 10.7 → 10.1 s, the same G-code; the helper answered 33 000 of the arcs.
-
-No helper (the writer conforms every arc) under :data:`MIN_ARCS` arcs or over
-:data:`MAX_MOVES` moves, with ``CAMTOOL_ACCEL=0``, without an arc check, on one core,
-in a worker process (``camtool batch``'s: its cores are busy with other files), or
-when no process can be forked.
+Design notes: docs/internals.md, ``camtool/accel/conformahead.py``.
 """
 
 from __future__ import annotations

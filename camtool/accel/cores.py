@@ -5,20 +5,7 @@ Behind the switch (:func:`camtool.accel.enabled`): switched off, :class:`ForkedW
 primitives at the end (:func:`fork_with_pipes` and the records) also serve the offsets'
 child, which isolates OpenCASCADE's crashes whether or not the switch is on.
 
-:class:`ForkedWork` runs a function over a few items in worker processes started by ``fork``
-(Linux), so the function may be a closure over this process's state (a verification, its
-trace, loaded kernels): nothing is pickled on the way in, and each answer comes back
-pickled, every bit kept. The workers are copies of this process, so an answer made there is
-the answer made here. An item whose worker raised, died or could not send its answer back is
-run here afterwards, in order, so an error is raised as it would be without workers.
-
-Where ``fork`` is missing, with one core, or in a process that is itself a worker
-(``camtool batch``'s pool, a Dask worker: the cores are busy with other files already), every
-item runs here, one after the other. Forking is safe where camtool calls it: camtool starts
-no thread that outlives a call (scipy's query threads, the verifier's thread pool and
-:func:`ahead`'s thread are joined before they return), numba's threading layer is never
-started (no kernel is ``parallel``), and OpenBLAS re-makes its idle threads in its own
-``pthread_atfork`` handler.
+Design notes: docs/internals.md, ``camtool/accel/cores.py``.
 """
 
 from __future__ import annotations

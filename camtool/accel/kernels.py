@@ -1,17 +1,6 @@
 """Compiled inner loops of the verifier's interpolators (numba).
 
-The loops here are the same arithmetic as the pure-Python/numpy code of
-:mod:`camtool.verify.interpolators`, compiled with numba (``@njit(cache=True)``)
-so that a step costs a few nanoseconds: the linear DDA closed form (UNAM-GMM
-annex A.3, :func:`camtool.verify.interpolators.dda_line`) and the quadrant
-loops of the direct search method (A.6) and the staircase (A.5). They work on
-int64 and are only called where no value can overflow (the callers check
-:data:`SAFE_MAGNITUDE` and :data:`SAFE_SQUARE`); anything else stays on the
-exact Python path.
-
-This module imports numba, so it is imported lazily
-(:func:`camtool.verify.interpolators.compiled`), never at ``camtool --help`` time;
-without numba the callers run the numpy / Python code, which gives the same rows.
+Design notes: docs/internals.md, ``camtool/accel/kernels.py``.
 """
 
 from __future__ import annotations

@@ -1,31 +1,6 @@
 """Compiled nearest-end searches of :func:`camtool.verify.metrics.nearest_distances` (numba).
 
-scipy's k-d tree answers a query point 1.5 mm from a dense trace (a drawing point
-against the tool-centre path) slowly: its cells are cut by split planes only, so
-every cell of the strip between the point and the trace is visited. Here the ends
-are kept in the order they come (along the trace), in leaves of :data:`LEAF`
-consecutive points under a tree of :data:`FAN`-fold nodes, each with the *tight*
-bounding box of its points; a query visits only the boxes nearer than its current
-k-th end.
-
-The tree holds *places*, not ends (:func:`tree`): the ends of a trace's segments repeat
-(the end of one segment starts the next; a part cut in three passes of the same path
-repeats each end three times more), so each distinct point is kept once with the list of
-the ends at it, and a search visits one leaf where it visited six. On the
-benchmark part the 737 736 ends of the cutting trace are 115 838 places, and the
-drawing's search takes a fifth of the time. Every end at a place is counted as it was,
-so the answers are unchanged.
-
-The answers are the k-d tree's, bit for bit (the tests compare them): the squared
-distance of two points is scipy's (``(x − u)² + (y − v)²`` summed from 0, then its
-square root), and the set of the ``k`` nearest ends is the same wherever it is one
-set. Where several ends lie exactly at the k-th distance the k-d tree keeps some
-of them (which ones depends on its tree); :func:`knn` then says whether every such
-choice gives the same segments (coordinates, not indices: a trace cut in several
-passes repeats them) and else asks the caller to use the k-d tree.
-
-This module imports numba, so it is imported lazily
-(:func:`camtool.verify.metrics.near_kernels`), never at ``camtool --help`` time.
+Design notes: docs/internals.md, ``camtool/accel/nearkernels.py``.
 """
 
 from __future__ import annotations

@@ -1,12 +1,6 @@
 """Calibration: a coupon that measures what a machine profile models, and a least-squares fit.
 
-:mod:`camtool.calibrate.coupon` lays out the test features (UNAM-GMM §5: the U pattern per axis
-and backlash region, 2.5 mm squares, ø6/4/2 circles; a long move per axis for steps/mm) and
-turns them into a program for a target; :mod:`camtool.calibrate.predict` measures each feature
-on the verifier's simulation exactly as the sheet tells a machinist to;
-:mod:`camtool.calibrate.sheet` writes the measurement sheet and reads it back filled in;
-:mod:`camtool.calibrate.fit` fits the profile's parameters to the measurements and writes a
-``--machine`` overlay.
+Design notes: docs/internals.md, ``camtool/calibrate/__init__.py``.
 """
 
 from __future__ import annotations

@@ -3,23 +3,7 @@
 Every feature is the UNAM-GMM §5 procedure or a direct extension of it (UNAM-GMM §5.2, Tablas
 13-15; Yanez-07 §5 and §6.1; Munoz-22 §5.1):
 
-- **U pattern** per axis (and per backlash region where the profile has regions, UNAM-GMM
-  Tabla 13): a line along the axis, a short step across, the line back. The first line is cut
-  after an approach that takes up the play, so its length measures the scale; the second is
-  cut after a reversal, so the difference measures the backlash left after compensation.
-- **Squares** (UNAM-GMM Tabla 14, 2.5 mm): cut counter-clockwise from the lower-left corner;
-  the top edge is cut after the X reversal and the left edge after the Y reversal, so their
-  lengths carry each axis's scale and backlash residual.
-- **Circles** of three sizes, concentric, cut clockwise from the top (UNAM-GMM Tabla 15,
-  ø6/4/2 mm): the mean of eight diameters, every 22.5°.
-- **Long moves** per axis (Munoz-22 Tables 14-16, ten moves of 8 mm): ten equal segments in
-  the + direction, each end marked; the distance of each mark from the start measures steps/mm.
-
-Every feature starts with an **approach**: a short cut towards its first point in the direction
-of its first stroke on both axes, longer than the profile's backlash, so the play is taken up
-before the first stroke (Yanez-07 §5: "approach the start point moving in the same direction as
-the first line"). Features are laid out in the work area (:func:`build_coupon`) and scaled with
-the travel; the coupon program is posted through the target like any program.
+Design notes: docs/internals.md, ``camtool/calibrate/coupon.py``.
 """
 
 from __future__ import annotations

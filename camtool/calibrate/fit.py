@@ -1,42 +1,6 @@
 """Fit a machine profile to measured coupon features by least squares.
 
-The model is the verifier itself: for a candidate parameter vector θ the coupon's features are
-simulated on the target's profile with θ laid over it (:func:`camtool.model.machine.merge_tables`)
-and measured as the sheet says (:func:`camtool.calibrate.predict.predict`). The fit minimises
-Σ (measured − predicted(θ))² with Levenberg–Marquardt (Marquardt 1963), the Jacobian by forward
-differences of the simulation.
-
-Parameters (what a profile models that a coupon can determine):
-
-- ``true_steps_per_mm`` X, Y (and Z on a machine with Z): the steps the mechanics really make
-  per mm (Yanez-07 R14: 1.9 µm assumed, 1.88 µm real; Munoz-22 §5.3: 80.86 mm for 80);
-- the true backlash per axis, ``backlash.true_um`` X, Y, and per region where the profile has
-  regions (``backlash.regions[i].true_um``, UNAM-GMM Tabla 13).
-
-The compensation is the controller's setting, not a property of the mechanics: it is not fitted
-but taken from each measurement row (the setting the feature was cut with).
-
-What the sheet cannot determine is never reported as fitted:
-
-- a parameter on which no filled-in row depends keeps the profile's value and is said to (the
-  others do not depend on it either, so nothing is biased); so does one the caller holds
-  (``hold``, ``--hold``);
-- a parameter the filled-in rows depend on but cannot tell from the others (its scaled
-  Jacobian column is near-dependent on theirs: a small pivot of the QR factorisation) is
-  refused (:class:`~camtool.model.errors.InputError`), naming the coupon rows that would tell
-  them apart: holding it at the profile's value would move its error into the others (a Y
-  backlash frozen at 0 makes Y's steps/mm absorb it). X's and Y's steps/mm that only circles
-  measure are the exception: they are fitted as one lead, said so;
-- a parameter fitted with a 1-σ uncertainty over :data:`LOOSE_SIGMA` of its size stays in the
-  fit (the others' σ include it) but is reported as not determined and left out of the overlay.
-
-The data are checked against physics: a row far from its nominal value (µm or inches typed in
-the mm column) is refused before the fit; a backlash the rows put below 0 (a line after a
-reversal longer than the compensation explains) is refused with the numbers; a steps/mm
-correction beyond ``max_correction`` (default ±20 %) is refused naming the likely cause.
-Uncertainties are 1 σ from the covariance s²·(JᵀJ)⁻¹, with s² = Σr²/(m − n) the residual
-variance (none when m = n). The parameters are classified at the profile and again at the
-fitted values (a sensitivity that is 0 at the start is not trusted to stay 0).
+Design notes: docs/internals.md, ``camtool/calibrate/fit.py``.
 """
 
 from __future__ import annotations

@@ -1,18 +1,6 @@
 """The verifier's prediction of every coupon measure, measured as the sheet says.
 
-Each feature is posted through the target on its own (the same absolute numbers as in the
-coupon, so the same rounding), read back with the target's reader and simulated with
-:func:`camtool.verify.verifier.simulate` on the candidate machine. Every feature starts with an
-approach that takes up the play (:mod:`camtool.calibrate.coupon`), so simulating it alone
-gives what it gives inside the coupon. The carriage trace is then measured the way the sheet
-tells a machinist to (:class:`camtool.calibrate.coupon.Measure`):
-
-- ``length``: the extent along the axis of the marks of the stroke (the carriage's travel
-  while that stroke runs, from where the previous one left it);
-- ``diameter``: the mean over the measure's directions of the width of the circle's mark
-  across each (a two-point diameter);
-- ``position``: the carriage's travel along the axis from the start of the first stroke to the
-  end of the last (Z: the signed Z steps over the true Z steps/mm: the trace holds XY only).
+Design notes: docs/internals.md, ``camtool/calibrate/predict.py``.
 """
 
 from __future__ import annotations

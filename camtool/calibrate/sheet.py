@@ -3,20 +3,7 @@
 Two forms of the same rows: ``coupon.md`` (Markdown, to print and read at the comparator) and
 ``coupon.csv`` (the template to fill in and give to ``camtool calibrate fit``). CSV columns:
 
-``id``
-    the measure (``UX-2.back``: feature ``UX-2``, measure ``back``); the row key.
-``what``, ``x_mm``, ``y_mm``
-    what to measure and where (work coordinates, the middle of the mark), for people.
-``nominal_mm``
-    the value of a perfect machine; checked against the coupon when read back.
-``measured_mm``
-    the value measured, mm; leave it empty for a measure not taken.
-``compensation_x_um``, ``compensation_y_um``
-    the controller's backlash compensation when the feature was cut, µm (the profile's
-    values are filled in; write 0 if compensation was off, as for a U pattern cut the
-    Yanez-07 §5 way).
-
-Only ``id`` and ``measured_mm`` are required; columns may come in any order.
+Design notes: docs/internals.md, ``camtool/calibrate/sheet.py``.
 """
 
 from __future__ import annotations

@@ -1,25 +1,6 @@
 """Progress of a long ``camtool post`` on stderr: quiet for short jobs, a line per stage after.
 
-The library tells where a job is through a callback (:mod:`camtool.model.progress`);
-:class:`StageReporter` is that callback for the CLI. It stays silent until the job has run
-:data:`AFTER_S` seconds, so a job that finishes sooner prints exactly what it printed
-before. After that it prints one line per stage, naming how big the work is, as the job
-enters it (or, for the stage it is in when the time is up, at once)::
-
-    camtool: reading eastern-motive-P4G.svg: 5712 shapes…
-    camtool: fitting arcs to 30576 curves…
-    camtool: making contours of 5712 shapes…
-    camtool: planning 5712 contours…
-    camtool: offsetting 1752 contours for the tool…   (with --offset outside/inside)
-    camtool: writing 232119 moves for grbl…
-    camtool: verifying 232128 blocks on grbl…          (with --verify, --preview, --report)
-    camtool: error budget: re-simulating once per error source (3)…
-
-On a terminal the line of the current stage is also redrawn in place (a carriage return)
-with the count and percentage done, at most :data:`REDRAW_S` apart; the line is finished
-before anything else goes to stderr. Into a file or a pipe (CI logs, ``2> log``) only the
-stage lines are written, never a redrawn line. stdout is never touched (it may carry the
-program, ``-o -``).
+Design notes: docs/internals.md, ``camtool/cli/progress.py``.
 """
 
 from __future__ import annotations

@@ -1,20 +1,6 @@
 """Arc fitting: smooth curves and dense polylines become arcs and lines within a tolerance.
 
-The one fitter the project shares. Importers fit SVG Béziers, DXF splines and ellipses with
-:func:`fit_curve` (biarcs); the planner turns dense polylines (buffers, point lists) into
-G02/G03-ready arcs with :func:`fit_polyline` (least-squares circles); :class:`FitStats` says
-how many segments a fit saved. Both fitters check their output with the same exact distance
-functions (:func:`distances`, :func:`dist_line`, :func:`dist_arc`, ...), kept here with them.
-
-Conventions: mm, Y up, arcs exact (``clockwise=True`` is G02); arrays of points are ``(N, 2)``
-float64. A tolerance is a distance in mm checked both ways: every input point lies within it
-of the output and every output point lies within it of the input. Consecutive output segments
-share end points bit for bit.
-
-Sources: biarcs with equal tangent lengths (d1 = d2) after K. M. Bolton, "Biarc curves",
-Computer-Aided Design 7(2), 1975, and R. Juckett, "Biarc interpolation", 2010; circle fit
-after I. Kåsa, "A circle fitting procedure and its error analysis", IEEE Trans. Instrum.
-Meas. 25(1), 1976, constrained here to pass through the run's two end points.
+Design notes: docs/internals.md, ``camtool/geometry/arcfit.py``.
 """
 
 from __future__ import annotations

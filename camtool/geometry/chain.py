@@ -1,16 +1,6 @@
 """Chaining: segments and contours whose ends meet within a tolerance, joined exactly.
 
-The importers give one contour per entity; a drawing made of separate LINE and
-ARC entities becomes closed contours here (:func:`chain`, used by the planner and by
-``camtool inspect``). A joint within ``tolerance`` is snapped: the later segment starts
-exactly where the earlier one ends, so the emitted code has no gaps. A contour whose
-ends meet within ``tolerance`` is closed. :func:`snap` does the same for the pieces of
-one fitted curve; :func:`with_start` and :func:`with_end` move one end of a segment.
-Closing larger gaps (reported) is the planner's :func:`camtool.toolpath.chain.close_gaps`.
-:func:`joint_distance` turns a ``--chain-tolerance`` into the ``tolerance`` to chain at,
-one rule for the planner and ``camtool inspect``.
-
-Conventions: mm, Y up; an arc moved to a new end keeps its centre and direction.
+Design notes: docs/internals.md, ``camtool/geometry/chain.py``.
 """
 
 from __future__ import annotations

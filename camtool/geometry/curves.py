@@ -1,18 +1,6 @@
 """Smooth curves as lines and arcs: Béziers and ellipses evaluated, fitted piece by piece.
 
-The importers read curves (SVG Béziers and elliptical arcs, DXF ELLIPSE and SPLINE) and hand
-their parametric form to this module: :func:`cubic_bezier`, :func:`quadratic_bezier`,
-:func:`ellipse` and :func:`ellipse_arc` give ``(point_at, tangent_at)`` pairs, and
-:func:`fit_pieces` fits a curve between its possible corners with the shared biarc fitter
-(:func:`camtool.geometry.arcfit.fit_curve`), so the output lies within the tolerance of the
-curve and the curve within the tolerance of the output. :func:`semi_axes_gap` tells an ellipse
-that is really a circle (then the importer writes one exact arc), :func:`corner_knots` where a
-B-spline may have a corner, :func:`merge_arcs` joins neighbouring arcs of one circle.
-
-Conventions: any length unit (the importers work in drawing units or mm; the tolerance must
-be in the same unit), Y up, arcs exact (``clockwise=True`` is G02). An ellipse is
-``c + a·cos t + b·sin t`` with ``a``, ``b`` conjugate semi-diameters (DXF reference, ELLIPSE;
-SVG 1.1 implementation notes F.6).
+Design notes: docs/internals.md, ``camtool/geometry/curves.py``.
 """
 
 from __future__ import annotations

@@ -1,23 +1,6 @@
 """Many curve fits at once: the same biarc fits, on the machine's cores, results in order.
 
-An importer that meets thousands of Béziers (a big SVG) names each curve by a
-:data:`CurveKey` — its kind and the exact floats that define it — and asks :func:`fit_many`
-for the fits of all of them. Each fit is :func:`fit_key`, a pure function of its key and the
-tolerance (:func:`camtool.geometry.arcfit.fit_curve` on the curve the key rebuilds), so a fit
-done in a worker process is the very fit done here: the segments come back as their floats
-(pickle keeps every bit) and are rebuilt as the same :class:`~camtool.model.shapes.Line` and
-:class:`~camtool.model.shapes.Arc` objects. A key whose fit raised in a worker is answered
-``None``: the caller fits it again itself, in its own order, and so raises the same error at
-the same place as without workers.
-
-Workers are started by ``fork`` (:func:`camtool.accel.pool.map_forked`) and only for at
-least :data:`MIN_CURVES` keys, so small files never pay for a pool; with
-``CAMTOOL_ACCEL=0``, where ``fork`` is not available, or the pool cannot start or breaks,
-or this process is itself a worker (``camtool batch``, Dask), every fit runs here, one
-after the other.
-Forking is safe at this point: the importers run before anything starts threads of its own
-(camtool starts none; numba, whose threading layer must not be forked, is not imported on the
-import path; OpenBLAS's idle threads are re-made by its own ``pthread_atfork`` handler).
+Design notes: docs/internals.md, ``camtool/geometry/fitpool.py``.
 """
 
 from __future__ import annotations

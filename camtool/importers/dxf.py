@@ -1,18 +1,6 @@
 """DXF importer (ezdxf): model space as contours in mm, arcs kept exact, curves fitted.
 
-Read: LINE, ARC, CIRCLE, LWPOLYLINE and 2D POLYLINE exactly (bulges become arcs; bulge > 0
-is counter-clockwise); ELLIPSE and SPLINE as biarcs within the tolerance
-(:mod:`camtool.importers.dxf_entities`); INSERT/MINSERT expanded with their full transform,
-nested blocks included (:mod:`camtool.importers.dxf_blocks`); HATCH boundary paths when
-asked (``hatch_boundaries``). Entities with an extrusion of (0, 0, −1) are mirrored into
-the WCS, which flips their arcs' direction. Each entity becomes one contour; chaining
-entities whose ends meet is the planner's job (:mod:`camtool.geometry.chain`).
-
-``$INSUNITS`` is converted to mm exactly; a unitless drawing is taken as mm with a
-warning. Everything else (text, dimensions, images, points, 3D entities, HATCH without
-the option) is skipped with one warning per type and reason, giving the count. A file
-ezdxf cannot read is tried again with :func:`ezdxf.recover.readfile`, with a warning
-saying what was repaired. Model space only: paper space is ignored.
+Design notes: docs/internals.md, ``camtool/importers/dxf.py``.
 """
 
 from __future__ import annotations

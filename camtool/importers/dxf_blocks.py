@@ -1,18 +1,6 @@
 """INSERT and MINSERT: block content transformed into the WCS, nested blocks included.
 
-Each entity of a block is copied and transformed once, by the product of the matrices of
-the block references that lead to it (:meth:`ezdxf.entities.Insert.matrix44`: insertion
-point, scale including negative (mirror) scales, rotation, OCS extrusion and the block's
-base point). ezdxf's own ``transform`` is exact for lines, uniformly scaled arcs,
-polylines, ellipses, splines and hatches; under a non-uniform scale an ARC or CIRCLE
-becomes an ELLIPSE (:meth:`ezdxf.entities.Ellipse.from_arc`, as ezdxf's
-``Insert.virtual_entities`` does) and a polyline with bulges is exploded into lines and
-such ellipses. A mirror (negative scale) turns the extrusion to (0, 0, −1), which the
-converter reads as clockwise. MINSERT grids are expanded row by column, the grid rotated
-with the insert and not scaled (DXF reference, INSERT group codes 70/71/44/45).
-
-An entity on layer ``0`` inside a block takes the layer of the INSERT that places it
-(DXF rule), through every level of nesting.
+Design notes: docs/internals.md, ``camtool/importers/dxf_blocks.py``.
 """
 
 from __future__ import annotations

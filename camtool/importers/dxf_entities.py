@@ -5,27 +5,7 @@ counter-clockwise in the entity's OCS). HATCH boundary paths become closed conto
 Entities with an extrusion of (0, 0, −1) are mirrored into the WCS, which flips their arcs'
 direction; entities tilted out of the XY plane are refused.
 
-ELLIPSE and SPLINE have no exact arc form. Both live in the WCS. Their true curve is
-evaluated with ezdxf's construction tools (:class:`ezdxf.math.ConstructionEllipse`,
-:class:`ezdxf.math.BSpline`) and fitted by the shared fitter
-(:func:`camtool.geometry.curves.fit_pieces`, built on
-:func:`camtool.geometry.arcfit.fit_curve`), so the output lies within the tolerance of the
-curve and the curve within the tolerance of the output. A circular ellipse (both axes equal)
-is returned as exact arcs, without fitting.
-
-A HATCH is an OCS entity: its boundary paths are 2D, in the plane of its extrusion at its
-elevation. A polyline path (vertices with bulges) becomes a virtual LWPOLYLINE; an edge
-path's LINE, ARC, ELLIPSE and SPLINE edges become virtual entities of those types (arc
-and ellipse angles are stored counter-clockwise by ezdxf whatever the edge's direction).
-Each is converted like a drawn entity and the pieces of a path are joined, in order, into
-closed contours (:func:`join_pieces`).
-
-Everything here is in drawing units (the caller scales to mm afterwards), so the
-tolerance passed in must already be in drawing units.
-
-Sources: AutoCAD DXF Reference (entities section; OCS and the arbitrary axis algorithm;
-HATCH boundary path data); the mapping of hatch edges to entities follows ezdxf's
-``explode.virtual_boundary_path_entities``.
+Design notes: docs/internals.md, ``camtool/importers/dxf_entities.py``.
 """
 
 from __future__ import annotations

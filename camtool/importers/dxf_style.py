@@ -1,16 +1,6 @@
 """How a DXF entity is drawn: its colour and linetype, resolved through layer and block.
 
-A job selects contours by colour, and centre, hidden and dashed lines are construction
-that camtool leaves uncut (:mod:`camtool.model.construction`), so each contour carries the
-colour and linetype it is drawn with. The DXF rules (DXF reference, "Common Group Codes
-for Entities"): colour 256 (BYLAYER) and linetype ``BYLAYER`` take the layer's; colour 0
-and ``BYBLOCK`` take the INSERT's that places the entity; a true colour (group 420)
-overrides the ACI colour. ACI numbers become RGB by :func:`ezdxf.colors.aci2rgb`.
-
-A linetype is *continuous* when its pattern has no gaps
-(:meth:`ezdxf.entities.Linetype.simplified_line_pattern` is empty: LibreCAD's hatch
-patterns name their solid lines ``K5LT...``); a name the file's table lacks is judged by
-name (:func:`camtool.model.construction.dashed_name`).
+Design notes: docs/internals.md, ``camtool/importers/dxf_style.py``.
 """
 
 from __future__ import annotations

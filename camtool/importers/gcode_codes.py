@@ -2,16 +2,7 @@
 
 Three actions (docs/importers/gcode.md lists them for users):
 
-- ``read``: part of the program camtool reads (motion, units, distance modes…,
-  and spindle, dwell, tool change and G28, kept as program commands);
-- ``warn``: harmless for the XY(Z) path, converted or dropped with one warning per
-  code (count and first line) — program pauses, coolant, work offset assumed 0…;
-- ``error``: would change the path in a way camtool cannot represent (cutter
-  compensation, canned cycles, the tilted planes G17.1–G19.1…); refused naming the line.
-
-A code in neither table is refused as unknown, listing what camtool reads. Modal
-groups follow the RS-274/NGC tables as LinuxCNC documents them; two codes of one
-group in one block are an error.
+Design notes: docs/internals.md, ``camtool/importers/gcode_codes.py``.
 """
 
 from __future__ import annotations

@@ -3,24 +3,7 @@
 What a line may hold (RS-274/NGC as LinuxCNC documents it, and the FlashCut
 and Gcodetools programs of Yanez-07 §3 and Munoz-22 §3.3):
 
-- words: a letter and a number, case-insensitive, spaces anywhere outside
-  comments (``G01X1.Y2`` = ``g1 x 1 y 2``); numbers like ``.5``, ``-0.``, ``+1``
-  (plain decimals: no exponent, as in RS-274/NGC), of magnitude below
-  :data:`~camtool.model.units.LARGEST_VALUE`;
-- comments in parentheses (not nested; ``(MSG, ...)``, ``(PRINT, ...)`` and
-  ``(DEBUG, ...)`` are comments too) and from ``;`` to the end of the line, a
-  ``;`` inside parentheses being part of that comment (LinuxCNC
-  ``Interp::close_and_downcase``);
-- ``%`` tape-marker lines, blank lines;
-- a leading ``/`` (block delete; the line is read as if the switch were off);
-- a RepRap checksum ``*NN`` at the end: the XOR of every byte before ``*``,
-  which is verified.
-
-Refused with an :class:`~camtool.model.errors.InputError` naming the line: O-words
-(subroutines and flow control), ``#`` parameters, ``[ ]`` expressions, a
-letter without a number, any other character, unclosed or nested comments,
-a wrong checksum, an absurd number (``1`` followed by 400 zeros), and a last
-line cut in the middle of a word (:func:`cut_mid_word`).
+Design notes: docs/internals.md, ``camtool/importers/gcode_lexer.py``.
 """
 
 from __future__ import annotations

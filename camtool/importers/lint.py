@@ -1,39 +1,6 @@
 """``camtool inspect``: what a drawing holds and what to fix before cutting it.
 
-:func:`inspect_drawing` reads a drawing like ``camtool post`` does (same importer, same
-options), chains it as the planner does (ends within ``--chain-tolerance`` are joined, by
-the planner's rule :func:`camtool.geometry.chain.joint_distance`) and reports: entity
-counts by type and layer (DXF), contour counts by layer, the bounding box, the units, the
-importer's warnings and the findings of :func:`check_drawing` (open contours, gaps just
-above the chaining tolerance, duplicates and overlaps, zero-length and tiny segments,
-dropped entities),
-each with its location, and for a damaged DXF what ezdxf's recover mode repaired (the
-importer's warning only counts the repairs). :class:`InspectReport` gives a text for
-people and a JSON object for scripts (``--json``).
-
-The drawing checks (:func:`check_drawing`, the geometry half of ``camtool inspect``) are
-what a machinist wants before cutting.
-
-Each check works on any :class:`~camtool.model.shapes.Drawing` (mm, Y up) and returns
-:class:`Finding` records with a location, so the report can say where to look:
-
-- ``open-contour``: a contour still open after chaining at the chaining tolerance;
-- ``gap``: two open ends farther apart than the chaining tolerance (so not joined) but
-  within :data:`GAP_FACTOR` times it: almost certainly meant to meet;
-- ``duplicate``: two segments that are the same within the tolerance, either direction
-  (cut twice);
-- ``overlap``: collinear lines, or arcs on one circle, that share more than the
-  tolerance of length without being duplicates;
-- ``zero-length`` and ``tiny-segment``: segments of no length, or shorter than the tiny
-  limit (many tiny moves slow a controller down and can stall a step generator).
-
-The tolerance is the importer's (``--tolerance``, 0.001 mm by default). The chaining
-tolerance is ``--chain-tolerance`` (0.01 mm by default, as for ``camtool post``); the
-library functions chain at the tolerance when no chaining tolerance is given. Chaining is
-:func:`camtool.geometry.chain.chain` at
-:func:`~camtool.geometry.chain.joint_distance` of the chaining tolerance, the planner's
-own, so an open contour here is an open contour there (the planner may still close it
-with ``--close-gap``, with a warning).
+Design notes: docs/internals.md, ``camtool/importers/lint.py``.
 """
 
 from __future__ import annotations

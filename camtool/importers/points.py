@@ -1,26 +1,6 @@
 """Point-list importer: X,Y(,Z) text files and the thesis GUI's Matlab ``xy`` matrices.
 
-Each stroke becomes one contour of straight lines through its points (no fitting here: turning
-dense strokes into arcs is a planning step, :func:`~camtool.geometry.arcfit.fit_polyline`). A
-stroke whose last point equals its first is closed. Points in a row that repeat the previous
-point are dropped. The drawing is 2D: a Z column is read, kept out of the drawing, and a
-warning says so when it is not constant.
-
-Text files (``.csv``, ``.txt``, ``.xy``): one point per line, ``X,Y`` or ``X,Y,Z``, separated
-by a comma, semicolon, tab or spaces; a blank line or a row of ``NaN`` ends a stroke; one
-header line (no numbers) may come first; lines starting with ``#`` are comments. Units: the
-``--units`` option, default mm.
-
-Numbers are plain decimals (:data:`NUMBER`: optional sign, digits, optional fraction, optional
-exponent), as CSV writers and Matlab print them: Python's ``float`` is not used to decide,
-since it also takes ``1_000``, ``inf`` and ``infinity``. ``NaN`` is a stroke break, never a
-coordinate. A value whose magnitude in mm reaches :data:`~camtool.model.units.LARGEST_VALUE` is
-refused. Errors name the file, the line and the column of the bad field.
-
-Matlab files (``.m``): ``xy = [ x1 x2 ...; y1 y2 ... ]`` as the Matlab GUI of Angel-11 §3 shows
-it (row 1 x, row 2 y, in 0.1 mm unless ``--units`` says otherwise), over as many lines as it
-likes; ``lxy`` and ``velxy`` (the GUI's derived arrays) are ignored; several ``xy``
-assignments are several strokes; ``%`` starts a comment. Anything else is an error.
+Design notes: docs/internals.md, ``camtool/importers/points.py``.
 """
 
 from __future__ import annotations

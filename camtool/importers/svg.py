@@ -1,38 +1,6 @@
 """SVG importer: paths and basic shapes become contours in mm, Y up, arcs exact.
 
-Built on svgelements (https://github.com/meerk40t/svgelements), which resolves CSS (``style``
-attributes and ``<style>`` sheets), ``<use>``, nested transforms and every path command
-(M L H V C S Q T A Z, absolute and relative, with ``S``/``T`` control-point reflection) into
-segments. Before it, :mod:`camtool.importers.svgdoc` reads the page size and viewBox
-exactly, checks syntax, selects Inkscape layers and counts what is skipped; after it,
-:func:`convert` maps each segment to mm: circular arcs (after the full transform) become
-exact :class:`~camtool.model.shapes.Arc` objects, Béziers and elliptical arcs are
-biarc-fitted within the tolerance (:mod:`camtool.geometry.curves`).
-
-Each shape's segments are mapped with the full affine map from its own (local) coordinates
-to mm with Y up. Every curve is mapped exactly before it is judged: a Bézier's control points
-map to the control points of the image curve, and an elliptical arc ``c + a·cos t + b·sin t``
-maps to ``C + A·cos t + B·sin t`` with ``A``, ``B`` the images of its conjugate
-semi-diameters ``a``, ``b``. The image is a circle when ``A`` and ``B`` are perpendicular and
-of equal length, i.e. when the two singular values of ``[A B]`` agree; a circle under a
-non-uniform scale or a skew is an ellipse and is fitted.
-
-Rules (docs/importers/svg.md for the user's view):
-
-- ``<path>``, ``<rect>`` (rounded corners too), ``<circle>``, ``<ellipse>``, ``<line>``,
-  ``<polyline>`` and ``<polygon>`` are read, whether filled, stroked or both; each subpath
-  is one contour (each M starts one; Z closes it; so does ending on the start point).
-- Not drawn, so not cut: ``display:none`` (also on a layer: a warning says so),
-  ``visibility:hidden``/``collapse``, and shapes with neither fill nor stroke (a warning
-  counts them).
-- Contour.layer is the innermost Inkscape layer's name (``"0"`` outside any layer);
-  Contour.source names the element: ``path#id`` or ``path[3]`` (the third ``<path>``), with
-  ``use#u1 > path#p`` for a clone and `` subpath 2`` when an element has several.
-
-Sources: SVG 1.1 §8.3 (path data) and implementation notes F.6 (elliptical arcs);
-segments are parsed by svgelements (``Move``, ``Line``, ``Close``, ``Arc``,
-``QuadraticBezier``, ``CubicBezier``); curves are fitted by
-:func:`camtool.geometry.arcfit.fit_curve`.
+Design notes: docs/internals.md, ``camtool/importers/svg.py``.
 """
 
 from __future__ import annotations

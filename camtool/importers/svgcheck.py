@@ -1,13 +1,6 @@
 """Strict checks of SVG attribute syntax: path data, transforms, lengths, point lists.
 
-svgelements, which the SVG importer builds on, reads malformed path data up to the first error
-and silently drops the rest, and fails with a bare ``IndexError`` on a malformed transform.
-These checks run first so that a malformed drawing is an error naming the element and the
-place, never a silently different part. Each function returns ``None`` or raises
-``ValueError`` with a lowercase message the importer prefixes with file and element.
-
-Sources: SVG 1.1 §8.3.9 (path data grammar), §7.6.1 (transform list), §4.2 (lengths),
-§9.7.1 (points).
+Design notes: docs/internals.md, ``camtool/importers/svgcheck.py``.
 """
 
 from __future__ import annotations

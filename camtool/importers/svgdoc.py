@@ -4,29 +4,7 @@ The SVG importer reads geometry with svgelements (CSS, ``<use>``, transforms); t
 prepares the document for it with the standard library's XML parser and decides what
 svgelements is not asked to decide:
 
-- the page: ``width``/``height`` (mm, cm, in, pt, pc, px; px = 1/96 in) and ``viewBox``
-  with ``preserveAspectRatio`` give one affine map from user units to mm with Y up (the page's
-  bottom-left corner is the origin). These root attributes are then removed, so svgelements
-  works in user units; its own unit factors are rounded (0.0393701 in/mm).
-- Inkscape layers (``<g inkscape:groupmode="layer">``) are named by ``inkscape:label``, else
-  ``id``. With a selection, unselected drawn content is moved into a ``<defs>`` (the *hold*:
-  not drawn, still usable by ``<use>``) and the selected layers (and their parents) are
-  shown even if hidden.
-- svgelements draws the children of elements it does not know (``<mask>``, ``<symbol>``,
-  ``<marker>``, ``<flowRoot>``) as if they were a group, and a ``<symbol>`` placed by
-  ``<use>`` without its viewBox; these go into the hold too.
-- what is skipped, counted per kind: ``<defs>`` with content, ``<clipPath>``, ``<mask>``,
-  ``<text>`` (and Inkscape's ``<flowRoot>``), ``<image>``, ``<use>`` of a ``<symbol>`` with
-  a ``viewBox``.
-- syntax: path data, transforms, lengths and point lists are checked strictly
-  (:mod:`camtool.importers.svgcheck`); every element gets a source label (``path#id`` or
-  ``path[3]``, the third ``<path>`` in document order) and its layer as private attributes.
-
-Maps are :data:`Affine` tuples (SVG's ``matrix()``), composed with :func:`compose`.
-
-Sources: SVG 1.1 §7.2 and §7.8 (viewport, viewBox, preserveAspectRatio), §4.2 (lengths),
-§7.4 (``matrix()``), §5.3 (defs), §5.5 (symbol), §14 (clipping and masking); Inkscape's SVG
-extensions (``inkscape:groupmode``, ``inkscape:label``).
+Design notes: docs/internals.md, ``camtool/importers/svgdoc.py``.
 """
 
 from __future__ import annotations

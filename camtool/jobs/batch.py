@@ -1,53 +1,6 @@
 """Many inputs, one or more targets: post every file in a process pool or on Dask; summarise.
 
-:func:`plan_batch` expands the inputs (:func:`camtool.jobs.inputs.expand_inputs`), loads the
-targets and checks everything that can be checked before any work starts: the
-options, that every input matches something, that every output stays inside the
-output folder, that no two files write the same output, that no output is one of
-the inputs (:func:`camtool.jobs.output.check_outputs`), and that no output exists
-already unless ``force``. :func:`run_batch` claims the output folder for the run
-(a second batch into it is refused), then posts each file — in a
-``concurrent.futures.ProcessPoolExecutor`` of ``jobs`` workers, in this process
-for ``jobs=1``, or on a Dask cluster (``scheduler``, or a
-``dask.distributed.Client`` passed in: :mod:`camtool.jobs.batch_dask`) — and
-returns one :class:`BatchRow` per file (and target), in input order. A file
-that fails (any exception) becomes an ``error`` row; it never stops the others,
-and it leaves no output behind: each file's outputs are computed in memory and
-written (atomically) only when all of them are ready.
-
-Workers never write: a pool worker returns the row and the outputs' bytes, and
-only this process writes them, so a worker killed mid-file leaves nothing half
-written. Pool workers die with the batch process, even when it is killed with
-``kill -9``. Dask workers get the input's bytes (a remote worker does not share
-this disk) and return the outputs' bytes and the row, so a worker lost mid-file
-(Dask runs its task again elsewhere) never leaves a partial file, and each
-output is written once.
-
-Ctrl-C (SIGINT) or SIGTERM stops a batch run in the main thread at once
-(:class:`BatchInterrupted`): the files finished are kept, whole (a file's outputs
-are written with the signal held back until the last one is in place), the pool's
-workers are killed (Dask's tasks cancelled), the output folder's claim is
-released, and the exception says which files were and were not written.
-
-Outputs keep the path below the input's root: ``drawings/a/b.dxf`` gives
-``OUT/a/b.pic`` (the target's ending), ``OUT/a/b.json`` (the verify report,
-when verified) and ``OUT/a/b.png`` or ``.svg`` (the preview). With several
-targets each writes below a folder named after it: ``OUT/pic-mmh/a/b.pic``,
-``OUT/grbl/a/b.gcode``.
-
-:func:`run` plans and runs a batch in one call (``camtool.batch.run``).
-
-The batch's exit code (:func:`batch_exit_code`) is 0 when every file is ok,
-otherwise the *smallest* non-zero per-file code: 1 (an error: the target cannot
-express a drawing, a write failed, a bug), then 2 (an option a file cannot
-take), then 3 (an unreadable or invalid input), then 4 (posted and verified,
-but the predicted error is over ``max_error_um``). So 4 means "everything
-posted; only the accuracy limit failed", 3 "some inputs are bad and nothing
-worse happened".
-
-What a batch tells — its JSON report, summary table and progress lines — is
-:mod:`camtool.jobs.batch_report`; this module never prints (progress goes through a
-callback).
+Design notes: docs/internals.md, ``camtool/jobs/batch.py``.
 """
 
 from __future__ import annotations

@@ -1,23 +1,6 @@
 """A batch on a Dask cluster: reach the scheduler (or start one here), run the files on it.
 
-Dask distributed (``pip install 'camtool[cluster]'``) runs a batch's files on the
-workers of a cluster — on other hosts (``dask scheduler`` on one, ``dask worker
-tcp://HOST:8786`` on each, see docs/batch.md "On a cluster") or on this machine
-(``local:N``: a ``LocalCluster`` of N worker processes, one thread each: posting is
-CPU-bound Python). This module knows Dask and nothing of posting:
-:func:`camtool.jobs.batch.run_batch` gives it the work function and its arguments.
-
-What it relies on from Dask (https://distributed.dask.org):
-
-- a task whose worker dies is run again on another worker by the scheduler, up
-  to its ``distributed.scheduler.allowed-failures`` (3 by default) worker deaths;
-  then its future raises ``KilledWorker``. A task that raises is also retried
-  :data:`RETRIES` times (``Client.submit(retries=...)``);
-- a future's result reaches the client once, however often its task ran.
-
-Dask is imported only here and only when a batch runs on it, so camtool works
-without it; ``--scheduler`` without it is refused before any work starts
-(:func:`require_dask`).
+Design notes: docs/internals.md, ``camtool/jobs/batch_dask.py``.
 """
 
 from __future__ import annotations

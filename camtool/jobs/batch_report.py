@@ -3,30 +3,7 @@
 Pure functions of a :class:`~camtool.jobs.batch.BatchResult` (or a row) returning data or
 text; the CLI decides where they go.
 
-The report (``camtool batch --report batch.json``), keys other tools may read:
-
-- ``camtool``: the version; ``exit_code``: the batch's
-  (:func:`~camtool.jobs.batch.batch_exit_code`);
-- ``options``: every option that shapes the outputs (``target`` — a list of
-  names with several targets —, ``output_dir``,
-  ``machine_file``, ``offset``, ``tool_diameter``, ``feed_mm_min``, ``tolerance``,
-  ``scale``, ``fit``, ``fmt``, ``spindle_rpm``, ``layers``, ``units``,
-  ``hatch_boundaries``, ``verify`` (true also when implied by ``preview`` or
-  ``max_error_um``), ``preview``, ``max_error_um``) and ``scheduler`` (``null``:
-  this machine's processes; else the ``--scheduler`` given or the address of the
-  client passed in) — not ``jobs``, ``force`` or ``report``, so ``--jobs 1`` and
-  ``--jobs 8`` give the same report;
-- ``files``: one object per file, in input order (with several targets, target
-  by target, and each names its ``target`` after ``file``): ``file``, ``status``
-  (``ok``, ``error``, ``over-limit``), ``exit_code``, ``blocks``, ``max_error_um``,
-  ``time_s``, ``verified``, ``outputs`` {``code``, ``report``, ``preview``} (paths
-  written, ``null`` when not), ``warnings`` (list), ``error`` ("" when ok);
-- ``totals``: ``files``, ``ok``, ``error``, ``over_limit``, ``blocks``, ``time_s``
-  (sums over the files that posted), ``max_error_um`` (the worst verified file,
-  ``null`` when none was verified).
-
-Numbers are rounded (µm to 4 decimals, s to 3) and nothing depends on the clock
-or the order files finished in, so the same batch gives the same bytes.
+Design notes: docs/internals.md, ``camtool/jobs/batch_report.py``.
 """
 
 from __future__ import annotations

@@ -1,12 +1,6 @@
 """Heights as the dialect writes them: refuse an option its rounding turns into another move.
 
-A dialect writes Z to its resolution (three decimals on GRBL, a 0.04 mm grid on
-the VALCNC, whole motor steps on the i8751), so a requested height can be written
-as a different one. Where that changes what the machine does — a depth written
-as the top of the stock (a cut at Z 0), a safe height written as the top (rapids
-at the surface), two depth passes written at one level, a tab written at the
-final depth (no tab) — the option is refused before anything is planned, naming
-the option, the dialect's Z resolution and the nearest value that works.
+Design notes: docs/internals.md, ``camtool/jobs/heights.py``.
 """
 
 from __future__ import annotations

@@ -3,18 +3,7 @@
 One operation per layer (per colour when the drawing has one layer drawn in several
 colours), each with a comment saying why:
 
-- circles no larger than :data:`DRILL_MAX_MM` → a drill operation, a drill per diameter;
-- closed contours → a profile: ``outside`` for a layer holding an outermost contour (its
-  holes, on the same layer, are cut on their inside by the same operation), ``inside``
-  for a layer of holes only; a layer whose name says pocket → a pocket;
-- open contours → left out, with a commented engrave operation to uncomment;
-- construction (centre lines, construction and dimension layers,
-  :mod:`camtool.model.construction`) → left out, said in a comment.
-
-Operations come in the order :meth:`camtool.jobs.job.Job.sequenced` gives ``auto``: drill,
-engrave, pocket, inside profiles, outside profiles last, grouped by tool. The depth is the
-stock's thickness (``--thickness``) plus a little, in passes of at most the tool's
-diameter; every guess is a line the user can change.
+Design notes: docs/internals.md, ``camtool/jobs/init.py``.
 """
 
 from __future__ import annotations

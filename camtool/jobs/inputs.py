@@ -5,27 +5,7 @@ A name is read by its ending (:func:`read_input`, :func:`read_code`,
 G-code program (:data:`PROGRAM_SUFFIXES`), which is already a toolpath and is
 re-posted, not planned; ``-`` is standard input.
 
-A batch's inputs (:func:`expand_inputs`) are files, directories and shell-style
-globs, expanded. An input is, in this order:
-
-- an existing directory: every file below it (recursively) whose ending camtool
-  reads (:data:`READABLE_SUFFIXES`: drawings and G-code programs); hidden files
-  and directories (``.git``, ``.venv`` ...) and the batch's own output directory
-  are skipped, so re-running a batch never posts its previous outputs;
-- an existing file: taken as it is, whatever its ending (a wrong ending is that
-  file's error when it is posted);
-- a glob (``*``, ``?``, ``[...]``; ``**`` matches any number of directories):
-  matching files with a readable ending, and matching directories expanded as
-  above. Quote globs on the command line so camtool, not the shell, expands
-  them (the shell's ``**`` is not recursive in POSIX sh).
-
-Every found file keeps its path relative to its input's root — the directory,
-the glob's leading part without wildcards, or the file's own directory — so
-``drawings/a/b.dxf`` found through ``drawings`` is ``a/b.dxf`` in the output
-directory. A glob whose ``..`` climbs above its leading part (``a/*/../../x/*.dxf``)
-names its files below the deepest folder that holds them all, never with ``..``.
-The result is sorted by path and free of repeats (the same file found twice keeps
-its first relative path).
+Design notes: docs/internals.md, ``camtool/jobs/inputs.py``.
 """
 
 from __future__ import annotations

@@ -1,15 +1,6 @@
 """A job: the tools and the operations that make a part, as one typed value.
 
-A machinist's part is several operations, each with its own tool: drill the holes, clear a
-pocket, cut the inside profiles, then the outline with tabs (FreeCAD's job of operations
-with a tool controller each, CAMotics' per-layer templates). A :class:`Job` holds them:
-its :class:`Tool` table, its :class:`Operation` list (each a :class:`Selection` of the
-drawing, a tool and its planning options) and the settings every operation shares
-(:class:`Setup`: work zero, scale, clearance). ``camtool post --job JOB.toml`` reads one
-(:func:`~camtool.jobs.jobfile.load_job`); ``post``'s options are the one-operation
-shorthand (:meth:`Job.single`); :func:`camtool.jobs.run.run_job` runs either.
-
-Its file format, a TOML job file, is read by :mod:`camtool.jobs.jobfile`.
+Design notes: docs/internals.md, ``camtool/jobs/job.py``.
 """
 
 from __future__ import annotations

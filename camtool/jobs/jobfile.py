@@ -2,22 +2,7 @@
 
 The file format is TOML (docs/jobs.md)::
 
-    [job]                 # settings of every operation (optional)
-    origin = "lower-left"
-    [[tools]]
-    id = 1                # the T number
-    type = "end-mill"     # end-mill | drill | v-bit | engraver
-    diameter = 3.0        # mm
-    [[operations]]
-    type = "profile"      # drill | pocket | profile | engrave
-    tool = 1
-    layers = ["OUTLINE"]
-    side = "outside"
-    depth = 6.0
-    step_down = 2.0
-    tabs = 3
-Every value is checked where it is read; a bad one is an :class:`InputError` naming the
-file, the table and the key.
+Design notes: docs/internals.md, ``camtool/jobs/jobfile.py``.
 """
 
 from __future__ import annotations

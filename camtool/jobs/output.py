@@ -2,21 +2,7 @@
 
 Every command goes through this module for what it writes (see docs/cli.md, "Safety"):
 
-- :func:`check_outputs` refuses, before anything is read or written, an output that is
-  one of the run's inputs or another of its outputs (after symlinks and ``..``, and by
-  inode for files that exist: a hard link is the same file);
-- :func:`write_atomic` writes a regular file through a temporary file renamed into
-  place, follows a symlink and replaces its *target*, and writes straight through to
-  anything that is not a regular file (a device such as ``/dev/null``, a FIFO), which
-  it never replaces;
-- temporary files are named ``.NAME.camtool-PID.tmp``, so one left by a killed run
-  says what it is, and :func:`remove_stale_temps` removes those whose process is gone;
-- :func:`lock_directory` claims an output folder for one run (``flock`` on
-  ``.camtool.lock`` in it, removed at the end), so two batches never write into one
-  folder at once.
-
-Paths are POSIX paths; the lock and the liveness test of a temporary file's process
-assume one host (a folder shared over NFS by two hosts is not protected).
+Design notes: docs/internals.md, ``camtool/jobs/output.py``.
 """
 
 from __future__ import annotations

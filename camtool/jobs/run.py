@@ -5,17 +5,7 @@
 shorthand :meth:`~camtool.jobs.job.Job.single`) all come through it. In turn, for each
 operation of :meth:`~camtool.jobs.job.Job.sequenced`:
 
-1. its selection of the drawing (:mod:`camtool.jobs.selection`), after the drawing is
-   scaled once for all (``scale``/``fit``), construction geometry left out;
-2. its moves: a drill operation's holes as canned cycles
-   (:class:`~camtool.model.program.DrillCycle`, expanded by LinuxCNC's rules), every other
-   one planned from where the last one ended (:func:`camtool.toolpath.plan.plan_unplaced`);
-   each ends at clearance height;
-3. a tool change before it when its tool is not the one loaded: spindle off,
-   :class:`~camtool.model.program.ToolChange` with what to load, spindle on again.
-
-The joined program is then placed once (work zero, ``translate``, the travel check:
-:func:`camtool.toolpath.plan.place_program`), so every operation lies where the others do.
+Design notes: docs/internals.md, ``camtool/jobs/run.py``.
 """
 
 from __future__ import annotations

@@ -1,27 +1,6 @@
 """Device simulators: a controller at the other end of the link, with no hardware.
 
-A :class:`Device` is a sans-IO model of one controller: :meth:`Device.feed` takes
-the bytes the host wrote (answering real-time bytes at once), :meth:`Device.step`
-runs one received block (its answer, if the protocol has one), and
-:meth:`Device.connect` is what the controller prints when a host opens the port.
-It keeps every program byte it received (:attr:`Device.received`: start-up and
-real-time bytes excluded, so a test can compare it with the posted file) and the
-blocks it ran (:attr:`Device.executed`), which :meth:`Device.program` reads back
-with camtool's own reader of the target, for its final position or the verifier.
-
-It can be told to fail: ``fail_at_block`` answers that block with ``error``
-(the controller's own code), ``drop_at_block`` makes the port disappear when that
-block arrives (the server closes its end).
-
-Two ways to run one: :class:`PtyServer` serves it on a pseudo-terminal pair in a
-thread (the host opens :attr:`PtyServer.path` with pyserial as it would a USB
-adapter; ``camtool simulate-device --pty``), or in-process by calling
-:meth:`~Device.feed` and :meth:`~Device.step` directly.
-
-Extension point: a target whose protocol is more than "blocks, maybe answered"
-subclasses :class:`LineDevice` in its ``<stem>_link.py`` and names the class in
-its ``LINK = LinkHooks(device=...)`` (GRBL: receive buffer, status reports,
-feed hold, soft reset, alarms).
+Design notes: docs/internals.md, ``camtool/link/device.py``.
 """
 
 from __future__ import annotations

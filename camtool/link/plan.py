@@ -1,14 +1,6 @@
 """Before anything is sent: read the program back, check it, frame it, time it.
 
-:func:`prepare_send` is what ``camtool send`` (and ``--dry-run``) does before it
-opens a port, as Munoz-22 S004-R20 asks of a sender: the code is read back with
-the target's own reader; every move must lie in the machine's travel or work
-area (:func:`camtool.verify.verifier.check_area`); no Z may go deeper than the
-link's ``max_depth_mm``; with ``verify`` the verifier predicts the machined
-error and ``max_error_um`` is a hard limit. The code is framed into wire blocks
-with their source lines, and each block gets its estimated time from the
-verifier's timing model (:func:`camtool.verify.verifier.block_times`) plus the
-time its bytes take on the wire.
+Design notes: docs/internals.md, ``camtool/link/plan.py``.
 """
 
 from __future__ import annotations

@@ -1,26 +1,6 @@
 """The host side of a link: a sans-IO stream of blocks and the driver over a serial port.
 
-:class:`Stream` is the protocol state, with no I/O: which block may go now
-(character counting against the receive buffer, one block per answer, or one
-block per estimated block time), what an answer from the controller means, and
-what was done, and which blocks surely ran (:meth:`Stream.surely_run`: an answer
-that says "queued", as GRBL's ``ok`` does, is not "run"; the controller's status
-reports of its queue are). :func:`send_plan` drives it over a pyserial port:
-start-up (banner, start-up bytes, the controller's state, settings the job
-needs), the blocks, answers, status polls, pause (the link's feed hold where it
-has one, else after the current block: never inside one), resume, stop (feed
-hold, then reset, where the link has them), the operator's turn between blocks
-where the machine needs it, and the end of the job. Every wait is bounded by
-the timing model's estimate of what the controller had to do first. Every byte
-both ways goes to the :class:`ByteLog` when one is given.
-
-Ports come from :func:`open_port` (``serial.serial_for_url``): a device
-(``/dev/ttyUSB0``, ``COM3``, a pseudo-terminal ``/dev/pts/N``) or a pyserial URL
-(``socket://host:port``, ``rfc2217://``, ``loop://``).
-
-Errors: every way a job ends early is a :class:`~camtool.model.errors.LinkError`
-whose message names the block, its source line, the controller's own words and
-the ``--from-line`` to resume with.
+Design notes: docs/internals.md, ``camtool/link/sender.py``.
 """
 
 from __future__ import annotations

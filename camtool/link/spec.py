@@ -1,66 +1,6 @@
 r"""A target's link: the ``[link]`` table of its TOML, its ``LINK`` hooks, and wire blocks.
 
-Every target declares how code reaches its machine next to its dialect, in a
-``[link]`` table of ``postprocessors/<name>.toml`` (read here, once, by
-:func:`link_spec`), plus Python only where the protocol needs it: a module
-``<stem>_link.py`` exposing ``LINK = LinkHooks(...)``, found lazily as
-``<stem>_motion.py``'s ``MOTION`` is (:attr:`camtool.post.base.Target.link`).
-
-``[link]`` keys (docs/send.md has the table per target):
-
-=========================  =========================================================
-``protocol``               ``"stream"`` (camtool sends it) or ``"none"`` (no host link:
-                           ``how`` says how programs reach the machine)
-``how``                    for ``"none"``: the message ``send`` refuses with
-``source``                 where the protocol comes from (thesis section, a document)
-``baud``                   bits per second (8N1, no handshake)
-``block_end``              the byte string that ends a block (``"\\n"``, ``"\\r"``)
-``flow``                   ``"char-count"``: as many blocks as fit ``rx_buffer_bytes``,
-                           each answered by ``ack``/``error`` (GRBL); ``"ack"``: one
-                           block per answer; ``"timed"``: no answer, wait the block's
-                           estimated time (the verifier's timing model) before the next
-``rx_buffer_bytes``        ``"char-count"``: bytes the controller's receive buffer holds
-``ack`` ``error``          the answer that accepts a block; the prefix of one that
-                           rejects it (``"ok"``, ``"error:"``)
-``echo``                   the controller answers a block with the block itself
-                           (its confirmation); a different echo stops the job
-``alarm``                  prefix of a push message that stops the job (``"ALARM:"``)
-``banner``                 prefix of the line the controller prints when it starts;
-                           ``send`` waits ``banner_timeout_s`` for it, then sends
-                           ``wake`` once and waits again
-``startup``                bytes sent once the port is open (ValCNC: ``"C\\n"``)
-``status`` ``hold``        real-time bytes: status query, feed hold, cycle resume,
-``resume`` ``reset``       soft reset (GRBL ``?`` ``!`` ``~`` ``\\x18``); never counted
-                           as part of the program
-``response_timeout_s``     silence after which a controller that should answer is lost
-``pace_margin``            ``"timed"``: the wait is the block time × (1 + margin) + the
-                           time its bytes take on the wire
-``max_block_bytes``        longest block the controller takes, terminator included
-``max_depth_mm``           deepest Z below 0 the sender lets through (S004-R20)
-``operator_between_blocks``  a prompt: the operator must act after every block (the
-                           matlab-router master runs one job per reset)
-``warnings``               what to tell the operator before every job
-``handshake``              ``"dtr-dsr"``: raise DTR (and RTS) and wait
-                           ``response_timeout_s`` for DSR before anything is sent
-                           (Intf8751's power-on handshake); a port without modem
-                           lines (a pseudo-terminal, a URL) skips it, with a note
-``ignore``                 answers the sender only logs (per-byte confirmations)
-``abort``                  bytes that stop the controller at once, sent when a job
-                           fails while the controller may be moving (pic-mmh ``A;``)
-``settle_s``               after a block's last feedback event, the quiet time before
-                           the next block; an event in it stops the job
-=========================  =========================================================
-
-Hooks (:class:`LinkHooks`), each optional: ``frame`` splits code into wire blocks
-when "one line, one block" is wrong (a matlab-router job is ``3 + 4n`` records);
-``decode`` words a controller's message (GRBL ``error:22``); ``resume`` gives
-the blocks that restore the controller's modal state before ``--from-line``;
-``device`` builds the target's simulator (:mod:`camtool.link.device`);
-``status_state`` reads a status report; ``split`` cuts the controller's bytes
-into answers when they are not lines (single bytes, ``;``-ended echoes);
-``feedback`` tells a feedback event (one motor step) from an answer;
-``expect`` fills in, from the program read back, what the controller will
-report for each block (its feedback events, a dwell it is busy for).
+Design notes: docs/internals.md, ``camtool/link/spec.py``.
 """
 
 from __future__ import annotations

@@ -5,16 +5,7 @@ CAM's cycles) and every dialect without canned cycles (which writes the moves), 
 hole is the same rapids and feeds wherever it comes from. The rules are LinuxCNC's
 (G-code reference, "G81", "G83", "G73"; ``rs274`` gives the same canonical moves):
 
-- first, if the tool is below the R plane, a Z-only rapid up to it; then an XY rapid to
-  the hole at the current height; then a Z-only rapid down to the R plane if above it;
-- ``drill``: a feed to the bottom (and a dwell there for G82);
-- ``peck`` (G83): pecks of ``peck_mm`` measured from the R plane; after each peck but
-  the last, a rapid up to the R plane and a rapid back down to :data:`RAPID_DELTA_MM`
-  above the depth reached;
-- ``chip-break`` (G73): the same pecks, backing off :data:`RAPID_DELTA_MM` after each
-  instead of leaving the hole;
-- last, a rapid up to the retract height: the height the tool started from when that is
-  above the R plane and the cycle retracts to it (G98), else the R plane (G99).
+Design notes: docs/internals.md, ``camtool/model/drilling.py``.
 """
 
 from __future__ import annotations

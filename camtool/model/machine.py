@@ -5,21 +5,7 @@ key by key, with ``--machine FILE.toml`` (see :func:`merge_tables`). Lengths in
 mm unless the name says otherwise. The verifier (:mod:`camtool.verify`) reads
 everything below; the post-processors read the work area, Z and step rate.
 
-Profile layout (every key optional except ``name``, ``steps_per_mm`` and
-``work_area_mm``; unknown keys and wrong types are errors naming the key)::
-
-    [machine]
-    profile                             # the profile's short name ("mmh-gmm")
-    name, steps_per_mm = [x, y, z]      # what the controller assumes (nominal)
-    true_steps_per_mm = [x, y, z]       # what the mechanics do (default: nominal)
-    work_area_mm = [xmin, ymin, xmax, ymax], coordinates = "work" | "machine",
-    has_z, max_step_rate_hz, source
-    steps_per_mm_settings = ["$100={}", ...]  # how the operator sets steps/mm, per axis
-    [machine.motion]    line, arc, chords (names the verifier looks up),
-                        chord_tolerance_mm, chord_segments, chord_angle_deg, rounding
-    [machine.backlash]  true_um = [x, y, z], compensation_um = [x, y, z]
-    [[machine.backlash.regions]]  axis, x_mm = [lo, hi], y_mm = [lo, hi], true_um
-    [machine.timing]    model and the model's own parameters (checked by the verifier)
+Design notes: docs/internals.md, ``camtool/model/machine.py``.
 """
 
 from __future__ import annotations

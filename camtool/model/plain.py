@@ -4,12 +4,7 @@ Two kinds: dataclasses whose fields live in a ``__dict__`` (:func:`plain_fields`
 slotted ones (``slots=True``: no ``__dict__``, ~100 bytes less an object;
 :func:`slot_setters`).
 
-The planner and the G-code reader build moves and segments by the hundred thousand; a
-frozen dataclass's ``__init__`` stores each field through ``object.__setattr__``, which
-costs more than the rest of the work. For a *plain* one (the test below) an object whose
-``__dict__`` is filled with the fields, in declaration order, is the object ``__init__``
-makes: equal, with the same hash, ``repr`` and pickle. The fast builders check a class
-here once, at import, and fall back to the constructor otherwise.
+Design notes: docs/internals.md, ``camtool/model/plain.py``.
 """
 
 from __future__ import annotations

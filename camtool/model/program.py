@@ -2,27 +2,7 @@
 
 A program is an immutable sequence of moves in absolute mm, Y up:
 
-- :class:`Rapid` — positioning at the machine's rapid rate (G00);
-- :class:`Linear` — a straight cut at ``feed_mm_min`` (G01);
-- :class:`ArcMove` — a circular cut (G02 when ``clockwise``, G03 otherwise)
-  around the ABSOLUTE centre ``(cx, cy)``.
-
-Every move carries its end point; the start of a move is the end of the one
-before it (or :attr:`Program.origin` for the first). ``z`` is ``None`` when the
-move does not change Z (2D machines never set it). ``contour`` is the 1-based
-number of the toolpath contour a move belongs to (0 for none), used by
-messages such as "contour 3, block 12".
-
-Non-motion instructions (spindle, dwell, tool change, program stop, return to
-machine zero)
-are :data:`Command` values held beside the moves in :attr:`Program.commands`,
-each with the index of the move it comes before; motion consumers (planner,
-simulator, metrics) never see them.
-
-An arc in another plane (G18 ZX, G19 YZ, read from another CAM's program) is a
-:class:`PlaneArc` command standing for the straight chords that follow it, as a
-:class:`DrillCycle` stands for its moves: every motion consumer sees the chords, a
-dialect with planes writes the arc instead.
+Design notes: docs/internals.md, ``camtool/model/program.py``.
 """
 
 from __future__ import annotations

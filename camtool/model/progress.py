@@ -1,15 +1,6 @@
 """Where a long job is: the stages a post goes through, told to a callback as it works.
 
-Library code never prints (STYLE.md): an importer or the pipeline calls a
-:data:`Progress` callback with a :class:`Step` at each stage and, in a long loop, as it
-counts through the work; the caller decides what to do with it. The CLI turns steps into
-stderr lines, and only for a job still running after a couple of seconds
-(:mod:`camtool.cli.progress`), so short jobs say exactly what they said before.
-
-A callback must be cheap and must not raise: it may be called once per shape or per
-chunk of curve fits (thousands of times on a big drawing); it is called in the calling
-process only (never from a worker of :mod:`camtool.geometry.fitpool` or
-:class:`camtool.accel.cores.ForkedWork`).
+Design notes: docs/internals.md, ``camtool/model/progress.py``.
 """
 
 from __future__ import annotations

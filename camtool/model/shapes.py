@@ -1,12 +1,6 @@
 """Drawing geometry: Line, Arc, Contour, Drawing. Immutable, mm, Y up, arcs exact.
 
-Conventions:
-- Points are ``(x, y)`` tuples of floats in mm, Y up (the drawing's up is +Y).
-- An :class:`Arc` is exact: start point, end point, centre and direction.
-  ``clockwise=True`` is G02 (clockwise seen from +Z), ``False`` is G03.
-  An arc whose start equals its end is a full circle.
-- Angles are radians, counter-clockwise from +X.
-- Signed areas are positive for counter-clockwise closed contours.
+Design notes: docs/internals.md, ``camtool/model/shapes.py``.
 """
 
 from __future__ import annotations

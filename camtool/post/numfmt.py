@@ -1,14 +1,6 @@
 """All number formatting of every dialect, in one place.
 
-A :class:`NumberFormat` says how one word's value is written: scale from mm,
-decimals, zero padding of the integer part, sign policy. Rounding is half away
-from zero on the decimal value (``Decimal`` of the float's shortest repr), so
-``2.969 mm`` at 1000 units/mm is exactly ``2969.00``. ``-0`` never appears: a
-value that rounds to zero is written without a sign.
-
-Every value is checked: NaN and infinity are a :class:`DialectError` naming the
-value, and a finite value of any size is written exactly (the decimal context
-is as wide as the number), so no float reaches the code unchecked.
+Design notes: docs/internals.md, ``camtool/post/numfmt.py``.
 """
 
 from __future__ import annotations

@@ -1,29 +1,6 @@
 """Targets by name: providers of target files, target files, and plugins.
 
-A target file (``postprocessors/<name>.toml`` or any ``--target path.toml``)
-holds ``name``, ``description``, ``source``, ``dialect``, ``default_feed_mm_min``,
-optional ``spindle_rpm``, a ``[dialect_options]`` table for that dialect and
-``machine``: a ``[machine]`` table (:mod:`camtool.model.machine`) or the name of
-a machine profile (the ``profile`` key of a built-in target's ``[machine]``
-table, e.g. ``"mmh-gmm"``). Every field is documented in docs/targets/index.md
-and docs/dialects.md.
-
-Dialects: ``word-address`` is the framework's own family
-(:mod:`camtool.post.wordaddress`, described wholly in TOML); any other dialect
-name is provided by the module of the target whose TOML declares it, through
-its ``post_processor(options, where)`` factory (:class:`TomlTargets`).
-
-Every target, built-in or third-party, registers under the entry-point group
-:data:`ENTRY_POINT_GROUP`. The object an entry point names is either a
-provider (:class:`TomlTargets`: a package of ``<name>.toml`` files, each with an
-optional sibling module ``<stem>.py``) or a single
-:class:`~camtool.post.base.Target` (or a callable returning one). camtool's own
-targets are the provider of its ``camtool_postprocessors`` package (the
-``postprocessors/`` folder); they win over plugins of the same name, so they are
-loaded from the object their entry point names (:data:`BUILTIN_ENTRY_POINT`) without
-scanning the installed distributions, which only a plugin's name needs. A plugin
-that fails to load is listed by :func:`list_targets` as broken with the reason,
-and choosing it is a clear error; it never crashes the CLI.
+Design notes: docs/internals.md, ``camtool/post/registry.py``.
 """
 
 from __future__ import annotations

@@ -5,24 +5,7 @@ A target file with ``dialect = "word-address"`` describes its G-code in its
 The built-in ``flashcut``, ``valcnc``, ``grbl`` and ``linuxcnc`` targets are
 such files (postprocessors/*.toml), for example ValCNC (Munoz-22 §3.4)::
 
-    [dialect_options]
-    separator = ""                       # the firmware strips spaces (S004-R02)
-    max_block_bytes = 127                # under 128 bytes with its line end
-    max_arc_deg = 180.0                  # split reflex arcs (S004-R05)
-    full_circle = "split"
-    modal = []
-    motion_codes = { rapid = "G00", linear = "G01", cw = "G02", ccw = "G03" }
-    [dialect_options.words.XYZIJ]
-    decimals = 2
-    min_decimals = 0
-    grid_mm = 0.04                       # the 25 steps/mm grid (S004-R10)
-
-This module is the dialect (:class:`WordAddressPost`, built by
-:func:`word_address_dialect`); its writer is :mod:`camtool.post.wordaddress_write`
-(:class:`~camtool.post.wordaddress_write.BlockWriter`, the writing rules), its reader
-:mod:`camtool.post.wordaddress_read`, and the grammar both directions share
-:mod:`camtool.post.wordaddress_spec` (:class:`WordAddressSpec` and its strict loader:
-errors name the file and the key path).
+Design notes: docs/internals.md, ``camtool/post/wordaddress.py``.
 """
 
 from __future__ import annotations

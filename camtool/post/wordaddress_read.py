@@ -5,34 +5,7 @@ Whole-line comments in the dialect's own ``comment`` syntax (the job notes the
 writer puts at the top) and the ``%`` tape marks of ``header``/``footer`` are
 skipped.
 
-- with ``comments`` (GRBL, LinuxCNC) comments are removed first, as those
-  controllers do: ``( ... )`` (not nested, closed on its line) and ``;`` to
-  the end of the line, a ``;`` inside parentheses being part of that comment
-  (LinuxCNC ``Interp::close_and_downcase``, GRBL ``protocol.c``); the blanks
-  on either side of a removed comment go with it, and a line left empty is
-  skipped. Without ``comments`` a ``(`` or ``;`` is an error, as the machine
-  would refuse it;
-
-- words are split by the dialect's separator (``""``: no whitespace at all;
-  ``" "``: exactly one space between words) and each block ends with
-  ``block_end``; a block longer than ``max_block_bytes`` is refused;
-- a value word must be written exactly as the writer writes it (its number
-  format, re-formatted, gives the same text: no ``-0``, no missing decimals,
-  no padding where there is none); a code (G/M word) must be one of the
-  dialect's codes spelled as the dialect spells it; each letter once per block;
-- modal per RS-274: letters in ``modal`` keep their value when absent (the
-  motion code ``G`` included); the others are required in every block that
-  uses them; F (the feed) is always remembered;
-- a block is one instruction: a motion (motion code, axis words, I/J for arcs,
-  F), a spindle code (with S when the dialect has S), a dwell (with P), a tool
-  change (with T), the preamble/postamble codes, or an end code (nothing may
-  follow it);
-- arcs: I/J incremental from the start or absolute as the spec says; with
-  ``arc_check`` the controller's own arc check is applied and an arc it would
-  refuse is a ParseError.
-
-``Program.lines`` holds the 1-based source line of each move; a rapid after
-cutting moves starts the next contour (1-based).
+Design notes: docs/internals.md, ``camtool/post/wordaddress_read.py``.
 """
 
 from __future__ import annotations

@@ -1,16 +1,6 @@
 """The word-address dialect specification and its strict TOML loader.
 
-A :class:`WordAddressSpec` is everything a plain word-address dialect needs:
-how each word's number is written (:class:`WordSpec`, formatted by
-:mod:`camtool.post.numfmt`), how blocks are put together, which codes exist,
-and how arcs, Z moves and commands are expressed. It is read from the
-``[dialect_options]`` table of a target file (``dialect = "word-address"``);
-every key is documented in docs/dialects.md.
-
-The loader is strict: an unknown key, a wrong type or an impossible
-combination is an :class:`~camtool.model.errors.InputError` naming the file and the
-full key path, e.g. ``valcnc.toml: dialect_options.words.X.decimals: expected
-an integer, got "3"``.
+Design notes: docs/internals.md, ``camtool/post/wordaddress_spec.py``.
 """
 
 from __future__ import annotations

@@ -3,35 +3,7 @@
 Its dialect is :class:`camtool.post.wordaddress.WordAddressPost`; the grammar it writes is
 :class:`~camtool.post.wordaddress_spec.WordAddressSpec`.
 
-Writing rules (docs/dialects.md explains them for users):
-
-- coordinates are absolute; I/J are written from the start point *as written*
-  (the rounded position the controller holds), so the centre the controller
-  computes is the exact centre to within one written step;
-- arcs sweeping more than ``max_arc_deg`` are split into equal arcs, full
-  circles too when ``full_circle = "split"``; with ``arc_check`` each arc goes
-  through :func:`camtool.post.arccheck.conform_arc` so that the rounded numbers
-  pass the controller's own check;
-- an arc too small for the written resolution (its written end is its written
-  start, or its centre rounds onto its start) becomes a straight line, with a
-  warning;
-- with ``planes`` an arc in the ZX or YZ plane (a :class:`~camtool.model.program.PlaneArc`)
-  is written as ``G18``/``G19`` with its arc block(s), then ``G17``; when its printed
-  numbers fail the controller's arc check, or it is too small to print, its chords are
-  written instead, with a warning;
-- a move that changes Z and not XY (where the tool is, or the program's origin for
-  the first move) is a Z-only block (``G0 Z5``): no X or Y word, so the first
-  block of a program never moves XY from wherever the machine stands, and a
-  re-posted program gets no X/Y it did not have;
-- with ``z_moves = "own-block"`` a move that changes XY and Z is written as two
-  blocks (Z first when rising, last when plunging), with a warning;
-- what the dialect lacks (F, S, spindle, dwell, tool change, return home) is
-  dropped with one warning per kind saying how many; a Z move without a Z word,
-  a helix without ``helix``, a point outside the work area, a number over its
-  field or a block over ``max_block_bytes`` is a DialectError naming the
-  contour and block.
-
-Numbers are formatted by :mod:`camtool.post.numfmt` only.
+Design notes: docs/internals.md, ``camtool/post/wordaddress_write.py``.
 """
 
 from __future__ import annotations

@@ -1,25 +1,6 @@
 """Previews a person can read: a program, a drawing, or a verification, as SVG or PNG.
 
-:func:`render_preview` draws what a machinist checks before cutting (UNAM-GMM
-S000-24 colours): cutting moves in blue and rapids in dashed yellow, each
-contour's start with an arrow along its direction and its number in cutting
-order, the tool width where the cut was offset, the target's work area, a scale
-bar in mm and a title with the target, the part size and the estimated time.
-For a verification it adds the simulated tool centre coloured by its deviation
-from the programmed path (µm, with a colour scale), the worst point marked and
-annotated with its µm and code line, and an inset zoomed on it: on a 5 mm part
-a 20 µm error is invisible at full scale.
-
-The picture is laid out once (:mod:`camtool.preview.layout`) and written
-either as direct SVG (:mod:`camtool.preview.svg`: exact arcs, 1 unit = 1 mm,
-same input → same bytes) or as PNG through matplotlib's Agg backend
-(:mod:`camtool.preview.raster`, no display needed; a command may have a child started
-ahead draw it, :mod:`camtool.preview.ahead`, the same bytes). In the SVG every layer is a
-group with a stable id: ``drawing``, ``work-area``, ``tool-width``, ``trace``,
-``rapids``, ``cuts``, ``starts``, ``order``, ``worst`` in the ``main`` panel;
-``title``, ``scale-bar``, ``legend``, ``colour-scale``, ``inset-labels`` on
-the page; ``inset`` (with ``inset-trace``, ``inset-cuts``, ``inset-worst``).
-Layers with nothing to draw are left out.
+Design notes: docs/internals.md, ``camtool/preview/__init__.py``.
 """
 
 from __future__ import annotations

@@ -1,23 +1,6 @@
 """A child that will draw this job's PNG, started ahead so matplotlib loads on an idle core.
 
-``post --preview part.png``, ``verify --preview part.png`` and ``preview … -o part.png`` end
-by drawing the picture with matplotlib (:func:`camtool.preview.raster.scene_png`). Importing
-matplotlib takes ~0.3 s of one core, and on the benchmark part it came last, after
-the verification, while the other core had nothing left to do. So the command forks a child
-at its start (:func:`start_ahead`, while the process is still small: a fork, not a second
-Python), tells it when to load matplotlib (:func:`load_ahead`: when the verification
-starts, while this process simulates the program on one core and the other is free;
-``preview`` at once, while it reads its inputs), and at the end sends it the composed scene
-(:func:`draw_ahead`): it draws the PNG and sends the bytes back.
-
-The picture is the same bytes either way: the child runs this process's own code on the
-scene, pickled exactly. Where the child cannot be started (no ``fork``, a worker process),
-sends nothing back (it died, or a pipe broke) or was never started, the caller draws the
-picture itself (:func:`draw_ahead` returns ``None``). The child ignores Ctrl-C, which is
-this process's to handle; :func:`stop_ahead` ends it when the command ends, however it
-ends (:func:`camtool.cli.common.picture_ahead`). Processes
-forked later (the offsets' child, the error budget's workers) do not keep its pipes open
-(:func:`os.register_at_fork`), so it sees this process's end as the end of its pipe.
+Design notes: docs/internals.md, ``camtool/preview/ahead.py``.
 """
 
 from __future__ import annotations

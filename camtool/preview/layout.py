@@ -1,21 +1,6 @@
 """Page layout of a preview: title band, main panel, right column (inset, colour scale), legend.
 
-Sizes are in ``u`` = 1/100 of the main view's larger side (mm), so every part
-gets the same proportions. The main view holds the program (rapids included)
-and the drawing, and the machine's work area when it is at most
-:data:`AREA_IN_VIEW` times the part's extent (a 5 mm logo on a 10 × 7 mm
-micro machine shows it whole; on a 300 mm router only the edges near the part
-show, and the title gives its size).
-
-The facts the title states: the part size and the estimated machining time. The time
-is the best estimate available, and the title says which it is:
-
-- a verification's own time (the machine's timing model over the simulated
-  steps, :mod:`camtool.verify.clock`);
-- for a program with a target: the same model, run on a step simulation of the
-  program (no measurement), up to :data:`TIMED_MOVES` moves;
-- otherwise the cutting moves at their programmed feeds
-  (:meth:`camtool.model.program.Program.cutting_time_s`; rapids not counted).
+Design notes: docs/internals.md, ``camtool/preview/layout.py``.
 """
 
 from __future__ import annotations

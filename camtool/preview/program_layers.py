@@ -1,13 +1,6 @@
 """Layers of a program and its drawing: cuts, rapids, tool width, starts, order, work area.
 
-Colours of the thesis GUI (UNAM-GMM S000-24): cutting moves blue, rapids dashed
-yellow. Each contour's start is a red dot with an arrow along the direction of
-travel and its number in cutting order (one number per contour, however many
-depth passes and tab crossings cut it). A job's operations (or a program's tool
-changes) each get a colour of :data:`SECTION_COLOURS`, and each tool change a
-black square where it happens. Sizes are given in ``u``, 1/100 of the main
-view's larger side, so the picture reads the same for a 5 mm logo and a 300 mm
-plate.
+Design notes: docs/internals.md, ``camtool/preview/program_layers.py``.
 """
 
 from __future__ import annotations

@@ -1,16 +1,6 @@
 """Write a preview scene as PNG with matplotlib's Agg backend (headless, no display).
 
-Each panel becomes an axes placed at its frame, with the panel's window as
-its limits, so the picture matches the SVG writer's. The shapes are added as plain
-artists (``add_artist``, ``add_collection(autolim=False)``): the limits are set, so
-updating the data limits for every patch (Bézier extrema of each circle and path,
-~0.06 s of the benchmark part's picture) would change nothing drawn; the PNG bytes
-are the same. Line widths and font
-sizes, given in window units, are converted to points. The figure is built
-without pyplot (no global figure registry); the PNG carries no software or
-date metadata, so one machine always writes the same bytes for one scene
-(text is rasterised by FreeType, whose version may shift pixels between
-machines).
+Design notes: docs/internals.md, ``camtool/preview/raster.py``.
 """
 
 from __future__ import annotations

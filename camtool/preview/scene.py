@@ -1,14 +1,6 @@
 """What a preview draws, independent of the file format: panels of layers of shapes.
 
-Every coordinate is in mm with +Y up: the page itself is laid out in the
-drawing's own millimetres around the part (the main panel shows the part at
-1:1 in those units), so a shape's numbers are the part's coordinates. A
-:class:`Panel` maps a *window* of the world onto a *frame* of the page; the
-main panel and the page furniture use the identity (frame == window), the
-zoom inset a small window around the worst point. Widths and sizes of shapes
-are in the units of their panel's window. The two writers,
-:mod:`camtool.preview.svg` (direct SVG, exact arcs) and
-:mod:`camtool.preview.raster` (matplotlib Agg, PNG), draw the same scene.
+Design notes: docs/internals.md, ``camtool/preview/scene.py``.
 """
 
 from __future__ import annotations

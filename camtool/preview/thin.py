@@ -1,14 +1,6 @@
 """Strokes at the picture's resolution: how a program too big to draw move by move is drawn.
 
-A picture ``W`` pixels wide cannot show two strokes closer than a pixel apart, nor a
-thousand passes over the same line as anything but one line. A program of more than
-:data:`DETAIL_MOVES` moves is therefore drawn through :class:`Strokes`: each polyline (a
-run of cuts, a rapid; arcs as chords within a cell) is snapped to a grid of cells of
-:data:`CELL_PX` pixel, vertices that fall in the cell before them are dropped, and each
-stroke from one cell to another is kept once, however many moves run along it
-(:meth:`Strokes.thinned`). What is drawn is then bounded by the picture's cells, not by
-the program's blocks, and no vertex moves by more than ``√2 / 2`` of a cell (a third of a
-pixel). Smaller programs keep their exact lines and arcs.
+Design notes: docs/internals.md, ``camtool/preview/thin.py``.
 """
 
 from __future__ import annotations

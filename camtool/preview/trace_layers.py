@@ -1,12 +1,6 @@
 """Layers of a verification: the simulated trace coloured by deviation, the worst point, the inset.
 
-The trace is the carriage (tool-centre) path of the simulation, split into
-pieces inside each run of cutting moves (a rapid never shows as a cut) and
-coloured by the distance of each piece from its block's programmed segment,
-µm, on a scale from 0 to the largest deviation (:mod:`camtool.verify.metrics`).
-To keep files small the trace is thinned to about one point per ``tolerance``
-mm of travel, each kept piece taking the largest deviation of the points it
-stands for, so the worst colour is never thinned away.
+Design notes: docs/internals.md, ``camtool/preview/trace_layers.py``.
 """
 
 from __future__ import annotations

@@ -1,36 +1,6 @@
 """Tool compensation: closed contours offset to the tool's side, oriented for climb or conventional.
 
-Material is the even-odd region of the closed contours (:class:`~camtool.toolpath.order.Nesting`):
-an outer boundary (even depth) has material inside, a hole (odd depth) outside. With
-``--offset outside`` the tool runs on the side without material: outer boundaries grow by the
-tool radius ``r`` and holes shrink; ``--offset inside`` is the opposite. The offsets keep arcs
-exact (:mod:`~camtool.toolpath.offset`: OpenCASCADE, checked against shapely, with a fitted
-buffer as fallback).
-
-Direction (a clockwise M03 spindle): climb milling keeps the material that stays on the RIGHT
-of travel, so with ``outside`` an outer boundary's path runs clockwise and a hole's
-counter-clockwise; conventional milling runs the other way. ``--offset on`` keeps the drawn
-direction unless ``--direction`` is given, which orients as for ``outside``.
-
-What the stage reports (:class:`~camtool.toolpath.cuts.Finding`): open contours left uncut
-when a side was asked (they have none), offsets that needed the fallback, contours offset
-away entirely (with their location and width), inside corners tighter than the tool radius
-(the part keeps a fillet of radius ``r`` there), and places where the tool's swept area cuts
-into material (neighbouring offsets colliding).
-
-Gouge check (:func:`gouges`): does the tool's swept area cut into the material that must
-stay? Each compensated path sweeps a band of the tool radius on both sides
-(``LineString(path).buffer(r)``). A correct offset only touches the material;
-where offsets of neighbouring contours collide (two parts closer than the tool,
-a wall between two holes thinner than the tool with ``--offset inside``) the band
-overlaps the material. Material is the even-odd region of the closed contours for
-``outside`` and its complement for ``inside`` (:func:`material`).
-
-Cost: the material is split into one polygon per contour (an outer boundary minus
-its holes), indexed by an STRtree; each path is intersected only with the
-polygons its band reaches. Polylines use chords within ``tolerance/4``, so a
-correct offset overlaps by slivers narrower than ``tolerance/2``; an overlap is
-reported when its mean width (2·area / perimeter) exceeds ``tolerance``.
+Design notes: docs/internals.md, ``camtool/toolpath/compensate.py``.
 """
 
 from __future__ import annotations

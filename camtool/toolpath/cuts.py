@@ -1,15 +1,6 @@
 """The planner's intermediate forms: cuts before ordering, and what planning found.
 
-Planning runs in stages (see :mod:`camtool.toolpath.plan`): chain and close the
-drawing's contours, compensate them for the tool (:mod:`~camtool.toolpath.compensate`)
-or clear pockets (:mod:`~camtool.toolpath.pocket`), giving :class:`Cut` objects; order
-the cuts (:mod:`~camtool.toolpath.order`); then emit moves with depth passes, tabs and
-lead-ins (:mod:`~camtool.toolpath.passes`). Each stage returns its findings as
-:class:`Finding` objects that the plan report collects (never printed by the library).
-
-Conventions: mm, Y up. A path's *material side* is the side of the direction of
-travel on which the material that must stay lies: ``"right"`` for climb milling
-with a clockwise (M03) spindle, ``"left"`` for conventional milling.
+Design notes: docs/internals.md, ``camtool/toolpath/cuts.py``.
 """
 
 from __future__ import annotations

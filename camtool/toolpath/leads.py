@@ -1,18 +1,6 @@
 """Tangent lead-in and lead-out arcs for closed profiles (``--lead-in MM``).
 
-The tool reaches a closed profile along a quarter circle that ends at the path's
-start tangent to its first segment, and leaves it along the mirror-image quarter
-circle that starts at the path's end tangent to its last segment. Both lie on the
-side of the path away from the material (the waste), so the tool never dwells or
-plunges against the finished wall. Where a quarter circle of the asked radius would
-cross the path into the material (a hole smaller than the lead, a start in a concave
-corner), the radius is halved until the arcs stay on the waste side, at most
-:data:`MAX_HALVINGS` times; a profile where none fits gets no lead arcs.
-
-Conventions: mm, Y up; a cut's ``material_side`` is the side of the travel
-direction on which the material stays (:mod:`camtool.toolpath.cuts`). Material on
-the right means the waste is on the left: the tool turns left, counter-clockwise,
-along both arcs (clockwise for material on the left).
+Design notes: docs/internals.md, ``camtool/toolpath/leads.py``.
 """
 
 from __future__ import annotations

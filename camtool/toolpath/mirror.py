@@ -1,22 +1,6 @@
 """Mirror ordering for symmetric parts (UNAM-GMM S000-20, §5.3, L2816–L2841).
 
-The thesis cut the 1.2 mm puma's right half from a shared start point Ie to Fe,
-returned to Ie and cut the left half from there: the two halves then move as
-mirror images (X directions opposite, Y the same), so an under-compensated
-backlash displaces mirrored features symmetrically and the h/j asymmetry fell
-from 59 µm to 3 µm.
-
-Here the axis is the vertical line ``x = c`` through the centre of the cuts'
-bounding box, or else the horizontal ``y = c``. The drawing is symmetric when
-every cut has a mirror image cut (itself for a cut crossing the axis) within the
-tolerance: the largest distance of exact samples of one (vertices, arc and line
-interior points) from the exact path of the other, both ways. Cuts crossing the
-axis are split there (arcs exactly) into right and left pieces; Ie is the highest
-crossing of the outermost closed cut crossing the axis. Each crossing cut is cut
-as its right pieces, each from its crossing nearest Ie, then the left pieces from
-the same crossings; the other cuts come in pairs: the right one (from its vertex
-nearest Ie), then its partner from the mirror of that start, turning the other way.
-A horizontal axis is handled by swapping X and Y (a reflection) before and after.
+Design notes: docs/internals.md, ``camtool/toolpath/mirror.py``.
 """
 
 from __future__ import annotations

@@ -1,20 +1,6 @@
 """Arc-preserving 2D offsets of closed contours (OpenCASCADE), with a fallback.
 
-The only module that touches OpenCASCADE; its OCP bindings are
-imported lazily so that ``camtool --version`` and ``camtool targets`` never load
-them. Straight edges stay lines, arcs stay arcs and convex corners become arcs of
-the offset radius (``Kind.ARC``, OCCT's ``GeomAbs_Arc`` join), so the toolpath
-keeps exact G02/G03 moves.
-
-:func:`offset_checked` checks OCCT's answer against shapely's buffer of the same
-polygon (closed pieces, the area grows or shrinks as asked, Hausdorff distance)
-and, where OCCT fails, uses the buffer fitted with arcs (:func:`buffer_pieces`).
-
-Conventions: mm, Y up; ``amount > 0`` grows the enclosed area, ``< 0`` shrinks it,
-whatever the contour's orientation. The pieces of an offset keep the contour's
-orientation (clockwise stays clockwise); a hole of the offset region (a grown
-"C" whose mouth closes) runs the other way, so the region lies on the same side
-of travel as for the drawn contour.
+Design notes: docs/internals.md, ``camtool/toolpath/offset.py``.
 """
 
 from __future__ import annotations

@@ -1,22 +1,6 @@
 """Cutting order: nesting of contours, and the order, starts and directions of the cuts.
 
-Nesting is found with shapely on the contours' polylines (arcs as chords within
-a fine tolerance): a contour lies inside a closed contour when the closed
-contour's polygon contains it. Every order cuts a contour's inner contours
-before it (inside before outside) and keeps the pocket stage's order of one
-group's pocket cuts (:func:`camtool.toolpath.travel.precedence`).
-
-:func:`order_cuts` offers three orders (``--order``):
-
-- ``travel``: short rapids, nearest neighbour then 2-opt
-  (:mod:`camtool.toolpath.travel`);
-- ``reversals``: few axis direction reversals weighted by the machine's
-  backlash, UNAM-GMM §5.3 (:mod:`camtool.toolpath.reversals`);
-- ``mirror``: symmetric parts cut half by half from a shared point, UNAM-GMM
-  S000-20 (:mod:`camtool.toolpath.mirror`).
-
-and reports the reversal counts and rapid travel of the drawn order, the travel
-order and the planned one.
+Design notes: docs/internals.md, ``camtool/toolpath/order.py``.
 """
 
 from __future__ import annotations

@@ -4,75 +4,7 @@ The last planning stage (see :mod:`camtool.toolpath.plan`). Cuts arrive in their
 final cutting order, each already rotated and reversed as it will be cut; this
 module turns them into :mod:`camtool.model.program` moves.
 
-**2D** (a machine without Z, no ``depth``): per cut a rapid to its start (kept
-even when the tool is already there, so every contour begins with a positioning
-block, as the goldens expect), then one cutting move per segment; no Z anywhere.
-
-**Z machine** (``depth``, or ``z_axis`` without a depth: one pass at Z 0, the top
-of the stock, for a pen, a drag knife or an engraving at the surface): passes
-from the top (Z = 0) down (:func:`pass_depths`). No move ever changes XY and Z
-together except a cut that descends along the path (a ramp):
-
-- **start**: a Z-only rapid up to the clearance height
-  (:attr:`~camtool.toolpath.options.PlanOptions.clearance`) where the tool stands
-  (``origin``), then XY at clearance to the first cut, a Z-only rapid down to
-  ``safe_z``, and a Z-only :class:`~camtool.model.program.Linear` at the plunge feed
-  into the material. The machine's XY position before the program is not known,
-  so nothing rapids in XY before Z is at clearance.
-- **between cuts of one part**: Z-only rapid up to ``safe_z``, XY rapid at
-  ``safe_z``, plunge; **between parts**: up to clearance instead, XY at
-  clearance, rapid down to ``safe_z``, plunge. A *part* is an outermost closed
-  cut path and every cut nested inside it (its holes, pockets and engravings,
-  :func:`parts`); a cut inside no closed path is a part of its own.
-- **end**: a Z-only rapid up to clearance, then, with ``end_position``, an XY
-  rapid there at clearance. (The pipeline stops the spindle after the last move.)
-
-Every rapid that moves XY is at ``safe_z`` or above. Feeds: cutting moves at
-``feed_mm_min``, downward Z moves at ``plunge_feed``, the rise onto a tab at
-``feed_mm_min``.
-
-**Move limit**: a plan of more than :data:`MAX_MOVES` moves is refused with a
-:class:`~camtool.model.errors.UsageError` (a hostile ``--ramp 0.0001`` would otherwise
-write kilometres of helix); a ramp is checked against the path length before any
-move is written.
-
-- closed cut: all passes in a row without retracting;
-- open cut: if it ``may_reverse``, the next pass cuts back the other way from
-  where the last one ended (no retract, no air travel); otherwise retract,
-  rapid back to its start and go down again;
-- consecutive ``pocket`` cuts of the same group are cut level by level (every
-  ring or path at pass 1, then every one at pass 2...), retracting between cuts.
-
-**Ramp** (``ramp_deg``): instead of a vertical plunge the tool descends
-along the path over ``L = Δz / tan(angle)``; arcs descend as helical arc moves
-(or, with ``helix=False``, chords within ``tolerance`` over which Z falls evenly
-per arc length: a chord is steeper than the angle by the factor arc/chord, at
-most about ``1 + tolerance/(3·radius)``). On a closed path the ramp
-runs on round the loop (a helix when the loop is shorter than ``L``), then a whole
-loop is cut at the new depth, so the pass ends where the ramp ended and the next
-pass ramps on from there. On an open path (and on a lead-in arc) it zigzags back
-and forth from the start until the depth is reached, goes back to the start at
-that depth and cuts the whole path.
-
-**Tabs** on closed outside profiles (see *Tab placement* below): on passes
-below the tab top ``z_tab = −depth + tab_height`` the tool rises to ``z_tab`` at
-each tab start (at the cutting feed), crosses the tab at ``z_tab`` and goes down
-at its end (at the plunge feed); a ramp crossing a tab stays at or above ``z_tab``.
-
-**Lead arcs** (``lead_in``, closed profiles with a material side,
-:mod:`~camtool.toolpath.leads`): the tool travels to the lead-in's start (off the
-part), goes down there (or ramps along the lead-in), cuts the lead-in, the loop
-and the lead-out at the pass depth, and rises; each pass is entered the same way.
-
-Tab placement (:func:`tab_spans`, ``--tabs N --tab-width MM --tab-height MM``): a tab is
-material left standing between the part and the stock so the part does not come loose on
-the last pass. Along the tool-centre path the tool must stay up over the tab's width
-*plus its own diameter*: the tool's edge, not its centre, defines the tab, so a stretch
-of path ``tab_width + tool_diameter`` long leaves a tab ``tab_width`` wide at the part
-(for a straight edge).
-
-Tabs are spaced evenly by arc length over the middle 90 % of the path: the first
-and last 5 % hold the entry (plunge or ramp start) and are left free.
+Design notes: docs/internals.md, ``camtool/toolpath/passes.py``.
 """
 
 from __future__ import annotations

@@ -1,23 +1,6 @@
 """Work coordinates and placement: where a program's X0 Y0 lies and whether it fits a machine.
 
-A program is written in **work coordinates**: X0 Y0 is the work zero the operator sets
-on the machine (``G54`` and touch-off on GRBL/LinuxCNC, ``Q;``/``G54;`` on the GMM PIC,
-"Cero de programa" on the LMM, the start position on controllers that count from where
-the tool stands). Such a controller runs negative numbers as a matter of course, so the
-only hard limit is the program's **size**: its extent must fit the travel of the
-machine. A controller in **machine coordinates** (``coordinates = "machine"``: the
-Angel-11 router counts from its home switches) can only reach positions inside its
-``work_area_mm``.
-
-Placement (``--origin`` and ``--translate``) moves the finished program so that the work
-zero lies where the user wants it (:func:`placement_shift`, :func:`shift_program`). The
-order is: ``--scale``/``--fit`` on the drawing, then planning, then ``--origin``, then
-``--translate``. :func:`check_travel` applies the rule above and says how to fix a
-program that does not fit, with options that work as written (``--origin lower-left``,
-``--translate DX DY`` with the numbers, ``--fit W H`` with the toolpath's margin taken
-off the travel).
-
-Sign convention: a shift ``(dx, dy)`` is added to every position (mm).
+Design notes: docs/internals.md, ``camtool/toolpath/placement.py``.
 """
 
 from __future__ import annotations

@@ -2,19 +2,7 @@
 
 Offset modes (the ``--offset`` option):
 
-- ``on``: the tool centre follows the drawing (the pic-mmh machine scribes with
-  a point, UNAM-GMM §6; S000-09);
-- ``outside``: cut outside the material. Material is the even-odd region of the
-  closed contours: an outer boundary (even nesting depth) grows by the tool
-  radius, a hole (odd depth) shrinks by it (:mod:`~camtool.toolpath.compensate`);
-- ``inside``: the opposite side: outer boundaries shrink, holes grow;
-- ``pocket``: clear the inside of each outer boundary down to its islands
-  (:mod:`~camtool.toolpath.pocket`).
-
-Open contours cannot be compensated to a side; they are cut on the line with a
-warning when a side was asked for. The stages report what they found (closed gaps,
-offsets that vanished, corners the tool cannot reach, uncut pocket area, reversals
-before and after ordering) in :class:`PlanReport`.
+Design notes: docs/internals.md, ``camtool/toolpath/plan.py``.
 """
 
 from __future__ import annotations

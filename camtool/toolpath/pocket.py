@@ -5,46 +5,7 @@ even nesting depth bounds a pocket, the closed contours directly inside it (dept
 are its islands, and a contour inside an island (depth + 2) starts a new pocket. Each
 region is a shapely polygon with holes (arcs as chords within ``tolerance / 4``).
 
-Two styles (``--pocket``):
-
-- ``concentric``: rings at distances ``r, r + s, r + 2s, ...`` inside the region
-  (``r`` tool radius, ``s = stepover × diameter``), outermost (the wall pass) first
-  and innermost last. The wall ring is the exact OpenCASCADE offset when each boundary
-  offsets on its own (:func:`~camtool.toolpath.offset.offset_contour`); the other rings
-  are shapely buffers fitted with arcs and lines
-  (:func:`~camtool.geometry.arcfit.fit_polyline`). Where a ring splits around islands
-  the rings form a tree, cut depth first so each sub-pocket is finished before the next.
-- ``zigzag``: the wall ring, then parallel lines at spacing ``s`` and the angle
-  ``--pocket-angle`` (see *Zigzag lines* below).
-
-Consecutive paths are linked by a straight feed move when the tool, moving along it,
-stays inside the region (it cuts only material that is removed anyway); elsewhere a new
-:class:`~camtool.toolpath.cuts.Cut` starts and the passes stage retracts. Direction:
-climb keeps the wall on the right of travel (rings along an outer wall run
-counter-clockwise, rings around an island clockwise); conventional is the opposite.
-What the tool cannot reach is reported by :mod:`~camtool.toolpath.pocket_uncut`.
-
-Error budget of a fitted ring against the true offset: region chords ``tolerance / 4``,
-buffer chords ``tolerance / 4``, arc fit ``tolerance / 2`` and the joining of arcs on one
-circle ``tolerance / 4`` (see *Rings* below); in the worst case
-``1.25·tolerance``, usually well within ``tolerance``.
-
-Rings as exact arcs and lines (:func:`fit_ring`): a ring is a closed sequence of segments
-(start == end). A shapely buffer ring is fitted with arcs and lines
-(:func:`~camtool.geometry.arcfit.fit_polyline` within ``tolerance / 2``), then neighbours
-that lie on one circle are merged, so a circular ring comes out as one full circle rather
-than two half arcs and a left-over chord. :func:`start_near` rotates a ring to start at
-its point nearest the tool, splitting a segment there.
-
-Zigzag lines (:func:`zigzag_lines`, :func:`order_lines`): after the wall ring, the area
-the tool centre may reach (the region shrunk by the tool radius and a small margin) is
-crossed by lines at the step-over spacing and the ``--pocket-angle``. Lines that an
-island interrupts become separate pieces; the pieces are ordered greedily, each starting
-at its end nearest the tool (which gives the back-and-forth of a zigzag row after row,
-and finishes one side of an island before the other).
-
-Conventions: mm, Y up; ``Arc.clockwise`` is G02; angles in degrees counter-clockwise
-from +X.
+Design notes: docs/internals.md, ``camtool/toolpath/pocket.py``.
 """
 
 from __future__ import annotations

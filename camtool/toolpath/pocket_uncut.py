@@ -1,22 +1,6 @@
 """What a pocket's tool paths leave uncut, and which of it the user must hear about.
 
-The swept area of the cuts is the union of their polylines buffered by the tool
-radius (shapely); ``uncut = region − swept``. Every round tool leaves a fillet of its
-radius in each sharp corner of the pocket: those pieces are counted in one
-``tight-corner`` finding. Every other piece larger than ``(0.01·d)²`` mm² (``d`` the
-tool diameter) is reported with its location and area (``uncut``, up to five, then a
-count): a part of the pocket narrower than the tool when the tool cannot reach it at all
-(it lies outside the opening ``(region ⊖ r) ⊕ r``), otherwise material left between
-passes (a step-over too large for the shape).
-
-A piece is a corner fillet when it lies within the corner zones of the region's
-convex vertices: a vertex where the boundary turns by ``T`` (summed over the boundary
-within one tool radius, so the chords of a small rounded corner count as one corner)
-has the zone of radius ``1.1·r·tan(T/2)`` around it, the reach of the fillet a tool of
-radius ``r`` leaves in a corner of that angle. Turns of 150° or more (slot ends, spikes)
-are not corners: what stays there is narrower than the tool.
-
-Conventions: mm, mm², Y up.
+Design notes: docs/internals.md, ``camtool/toolpath/pocket_uncut.py``.
 """
 
 from __future__ import annotations

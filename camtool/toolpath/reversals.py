@@ -3,22 +3,7 @@
 The model (UNAM-GMM §5.1, L1707–L1709: the controller compensates backlash
 "whenever any axis changes direction", on rapids as well as cuts):
 
-- each axis (X, Y) has a current direction, +1 or -1, unknown before the first
-  motion; the first motion of an axis sets it without counting;
-- a line moving an axis (by more than :data:`MOVE_EPS_MM`) against the axis's
-  current direction counts one reversal of that axis; an axis a line does not
-  move keeps its direction;
-- an arc moves X with the sign of ``dx/dt`` of its tangent, which changes at the
-  circle's left and right extreme points, and Y with the sign of ``dy/dt``, which
-  changes at the top and bottom: X reverses at each left/right extreme the arc
-  passes through, Y at each top/bottom; the arc's first direction on each axis is
-  the tangent's at its start (just after it when the start is an extreme point);
-- the rapid from the tool position to each cut's start is a line.
-
-:func:`count_reversals` counts them for cuts as given; :func:`reversal_order`
-chooses an order, start vertices and directions that minimise the weighted count
-``bx·rx + by·ry`` (``bx``, ``by`` the machine's per-axis backlash, µm; ``rx + ry``
-when both are 0), rapid travel breaking ties.
+Design notes: docs/internals.md, ``camtool/toolpath/reversals.py``.
 """
 
 from __future__ import annotations

@@ -5,9 +5,7 @@ the same (exact) centre, so a piece of an arc is still an exact arc. Split point
 that fall on a segment's end take that end's coordinates unchanged, so pieces meet
 exactly where the original segments met.
 
-Conventions: mm, Y up; arc length ``s`` is measured from a path's start along its
-travel direction. On a closed :class:`Track` ``s`` may exceed the path length: it
-goes round again (``s`` is taken modulo the length).
+Design notes: docs/internals.md, ``camtool/toolpath/split.py``.
 """
 
 from __future__ import annotations

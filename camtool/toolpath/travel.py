@@ -4,35 +4,7 @@ A *variant* of a cut is ``(k, rev)``: start at vertex ``k`` (the start of
 ``path.segments[k]``; always 0 for an open path) and traverse the path backwards
 when ``rev``. A *sequence* is a list of ``(cut index, k, rev)`` in cutting order.
 
-Precedence ("inside before outside"): cut ``a`` comes after cut ``b`` when
-``a``'s group contains ``b``'s group (``cuts[a].group in parents[cuts[b].group]``),
-and pocket cuts of one group keep the relative order the pocket stage gave them.
-
-:func:`travel_order` minimises the rapid travel (origin → first start, then each
-end → next start, mm): greedy nearest neighbour over (cut, start vertex,
-direction) among the cuts whose predecessors are cut, then 2-opt sweeps that
-reverse a run of the sequence only where no precedence pair lies inside the run,
-alternating with a re-choice of each cut's start vertex (or direction) for its
-neighbours. The drawn order is improved the same way as a second seed and the shorter
-result wins, so the travel order is never longer than the drawing's own. Deterministic:
-ties go to the lower cut index, then vertex.
-
-Above :data:`FULL_SEARCH_MAX_CUTS` cuts, where the full search (an O(n) scan per
-nearest-neighbour step and O(n²) 2-opt sweeps) would take hours on 10⁵–10⁶ cuts,
-the same steps run in O(n) or O(n·w) each, on arrays of entry indices (one entry per
-cut, in cutting order; :class:`Entries`):
-
-- nearest neighbour over the allowed entries (:func:`_candidates`) of the cuts whose
-  predecessors are cut, found in a uniform grid of the entry points by rings of cells
-  around the tool (:func:`grid_nearest_neighbour`; exact: ties go to the lower entry,
-  i.e. the lower cut, then vertex, as in the full search);
-- 2-opt sweeps that reverse runs of at most :data:`TWO_OPT_WINDOW` cuts (no
-  precedence pair inside a run), every improving run found at once and the
-  non-overlapping ones applied left to right (:func:`windowed_two_opt`);
-- start re-choice (vertex of a closed cut, direction of an open one) for the
-  neighbours, even then odd positions (:func:`rechoose_entries`); sweeps stop when one
-  gains less than :data:`MIN_SWEEP_GAIN` of the rapids (:func:`windowed_improve`);
-- the drawn order is compared (not improved): the result is never longer than it.
+Design notes: docs/internals.md, ``camtool/toolpath/travel.py``.
 """
 
 from __future__ import annotations

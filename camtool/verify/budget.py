@@ -1,21 +1,6 @@
 """The error budget: each figure of a verification, and what it is with one source off.
 
-A verification's figures (max deviation, the along-path shortfall, each
-contour's closure, size error and circle diameter error, the distance to the
-drawing) come from one simulation with every error source on
-(:mod:`camtool.verify.sources`). The budget re-simulates the same program with
-one source switched off at a time and measures the same figures again. For each
-figure it gives the *total* (everything on), the figure *with only this source
-off*, and the *difference* (total − without): what that source does in the
-full model. Sources do not add: a scale error scales what the others did, a
-timer's overshoot depends on the chords it runs, so the differences do not sum
-to the total, and the budget says so. The *dominant* source of a figure is the
-one with the largest difference.
-
-A source the machine does not model is *absent* (not 0); the rounding of the
-emitted numbers is *unknown* when only the code is at hand (``verify``), and
-modelled when the unrounded plan is (``post --verify``: the plan simulated
-instead of the code read back).
+Design notes: docs/internals.md, ``camtool/verify/budget.py``.
 """
 
 from __future__ import annotations

@@ -3,38 +3,7 @@
 Every simulator produces a :class:`StepTrace` (the step simulator of
 :mod:`camtool.verify.simulate`, or a target's own), which the measures read.
 
-A machine profile names its motion model in ``[machine.motion]`` (``line``,
-``arc``, ``chords``) and ``[machine.timing]`` (``model``). Each name is looked
-up first in the generic library (:data:`GENERIC`: the algorithms of
-:mod:`camtool.verify.interpolators` and :mod:`camtool.verify.timing`, named by
-algorithm), then in the ``MOTION`` of every installed target
-(:func:`camtool.post.registry.motion_hooks`), so any profile may use a piece any
-target brings. A target adds pieces with a :class:`MotionHooks`; the verifier
-itself names no machine.
-
-Piece types (all pure; lengths mm, steps integer motor steps, Y up):
-
-- :data:`LineFactory`: ``machine -> (dx, dy) -> StepArray``. The factory gets the
-  profile so that a line that needs parameters (a timer period) can read them;
-  :func:`fixed_line` wraps a plain interpolator.
-- :data:`ArcInterpolator`: ``(x0, y0, x1, y1, cx, cy, clockwise) -> StepArray``,
-  absolute steps, ``clockwise`` is G02.
-- :data:`ChordRule`: ``(start_mm, arc move, motion parameters) -> (N, 2)`` chord
-  end points in mm (the start not included, the last normally the arc's end);
-  used when a profile says ``arc = "chords"``.
-- :data:`TimingFactory`: ``(timing table, machine or None, where) -> TimingModel``;
-  the machine lets a model take defaults from the profile (steps/mm, step-rate
-  cap) that the table does not state; :func:`timing_class` wraps a plain
-  parameter dataclass.
-- :data:`Simulator`: ``(program, machine) -> StepTrace``, a whole simulator that
-  replaces the step simulator for a ``line`` name (a servo loop, say).
-
-A piece that models an error source of :mod:`camtool.verify.sources` (a timer's
-overshoot is ``dynamics``) names it in ``MotionHooks.honours``; the library then
-calls it with ``sources=`` (a line factory ``(machine, sources=...)``, a
-simulator ``(program, machine, sources=...)``) so that the error budget can
-switch the source off. A piece that honours nothing is called as above, and its
-sources are absent from the budget.
+Design notes: docs/internals.md, ``camtool/verify/motion.py``.
 """
 
 from __future__ import annotations

@@ -3,36 +3,7 @@
 The program is what the target's reader got back from the emitted code, so
 rounding and field widths are already in it. For each block the controller:
 
-1. converts the end point (and arc centre) to integer steps with its nominal
-   steps/mm and rounding, absolutely (no drift, Yanez-07 §4.5);
-2. runs its line or arc interpolator from its logical position
-   (looked up by name, :mod:`camtool.verify.motion`): one row per iteration;
-3. on a reversal of an axis adds the backlash compensation steps in the new
-   direction, not counted in its logical position (UNAM-GMM §5.1, Yanez-07 §5):
-   before the move for a line (and before each chord of a chord arc), where the
-   reversal happens for a native arc (UNAM-GMM: "for arcs it also runs during
-   interpolation"); X's compensation before Y's when both reverse at once.
-
-The mechanics then move the carriage: a reversal takes up the true backlash
-before the carriage follows (a play operator per axis, the band width taken
-from the region the carriage is in at the reversal, UNAM-GMM Tabla 13), and a
-motor step moves it by the *true* step length. The machine starts at the
-program origin with every axis's backlash taken up in the direction of its
-first move (Yanez-07 §5: "approach the start point moving in the same direction
-as the first line"), so only reversals inside the program cost accuracy.
-
-Z moves are counted in steps and time but not traced (the trace is the XY
-tool-centre path); Z backlash is not modelled.
-
-Error sources can be switched off (:class:`camtool.verify.sources.Sources`, for
-the error budget): ``scale`` off makes the true steps/mm the nominal ones,
-``backlash`` off removes the play and the compensation, ``chords`` off cuts
-arcs of an ``arc = "chords"`` profile into chords of 1/10 step sagitta, and
-``interpolation`` off runs the *ideal* controller (:class:`_IdealController`):
-positions in fractional steps (no rounding to steps), lines straight and arcs
-exact, sampled at :data:`IDEAL_SAMPLES_PER_STEP` points per step so that the
-play still bites where it does; a line interpolator that does not reach its
-count (a timer's overshoot) keeps its net displacement per axis.
+Design notes: docs/internals.md, ``camtool/verify/simulate.py``.
 """
 
 from __future__ import annotations

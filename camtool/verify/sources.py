@@ -1,15 +1,6 @@
 """The error sources a simulation can switch off, one at a time, for the error budget.
 
-A :class:`Sources` is a small set of switches passed down to a simulation
-(:func:`camtool.verify.verifier.simulate`): every source is on in the full model
-(:data:`ALL`); the error budget (:mod:`camtool.verify.budget`) re-simulates with
-one source off at a time. The step simulator (:mod:`camtool.verify.simulate`)
-honours ``interpolation``, ``chords``, ``scale`` and ``backlash`` itself; a
-target's motion pieces honour what they model (``dynamics``: a timer's
-overshoot, a servo's lag) and say so in ``MotionHooks.honours``; ``rounding``
-(the emitted numbers against the unrounded plan) is a matter of which program is
-simulated, decided by the verifier. A source that a machine does not model is
-*absent* from its budget, not 0.
+Design notes: docs/internals.md, ``camtool/verify/sources.py``.
 """
 
 from __future__ import annotations

@@ -1,13 +1,6 @@
 """Step arrays: the common output of every step interpolator.
 
-A *step array* is a read-only ``(N, 2) int8`` numpy array with one row per
-interpolator **iteration**. Row ``i`` holds the signed step increments
-``(dx, dy)``, each in ``{-1, 0, +1}``, issued in iteration ``i``; a row
-``(0, 0)`` is an iteration without a pulse (the "-" iterations of the DDA in
-UNAM-GMM §4.2 count as iterations). The iteration count is ``len(steps)`` and
-the positions are the cumulative sum of the rows, in steps, relative to the
-start point. Sign convention: ``+1`` moves the axis towards larger machine
-coordinates (mm inside camtool, Y up).
+Design notes: docs/internals.md, ``camtool/verify/steparray.py``.
 """
 
 from __future__ import annotations

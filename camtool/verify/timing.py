@@ -1,36 +1,6 @@
 """Generic machining-time library: per-block kinematics and the rest-to-rest trapezoid.
 
-The verifier simulates emitted code block by block; a *timing model* turns what it
-knows per block (:class:`BlockKinematics`: iterations, dominant steps,
-compensation steps, length, feed, rapid flag) into ``(B,)`` float64 seconds,
-read-only. Every model is a frozen parameter dataclass with
-``block_time_s(blocks)`` (:class:`TimingModel`), built from a profile's
-``[machine.timing]`` table by :func:`timing_from_table`; which class a ``model``
-name means is resolved by :mod:`camtool.verify.motion` (this library's
-``trapezoid``, or a target's ``MOTION.timing``). The helpers here validate and
-freeze arrays for every model, generic or a target's.
-
-The rest-to-rest trapezoid (:func:`trapezoid_time_s`, :class:`TrapezoidTiming`):
-each block runs at its programmed feed ``F`` (capped at the machine's maximum
-rate; rapids at the maximum rate) with constant acceleration ``a`` up to and
-down from that speed. For a block of length ``L`` entered at ``v0`` and left at
-``v1`` with nominal speed ``v`` (all mm/s)::
-
-    d_acc = (v² − v0²)/(2a),   d_dec = (v² − v1²)/(2a)
-    trapezoid (d_acc + d_dec ≤ L):  t = (v − v0)/a + (v − v1)/a + (L − d_acc − d_dec)/v
-    triangle  (otherwise):          v_p = √((2aL + v0² + v1²)/2),  t = (v_p − v0)/a + (v_p − v1)/a
-
-The block-time model is **conservative**: every block starts and ends at rest
-(``v0 = v1 = 0``, so ``t = L/v + v/a`` or ``t = 2√(L/a)``). That is exact for a
-controller in exact-stop mode (RS-274 G61.1) but longer than the real time of a
-planner that blends blocks (junction look-ahead slows down only at corners; a
-target that models its planner passes entry/exit speeds to
-:func:`trapezoid_time_s`).
-
-Per-axis limits: a controller limits a block's acceleration and maximum rate by
-every moving axis (``min_i a_i/|u_i|`` over the unit vector ``u``); pass such a
-per-block value as a ``(B,)`` array if axes differ. The defaults are the generic
-``defaults.h`` of GRBL 1.1: ``$110`` = 500 mm/min and ``$120`` = 10 mm/s².
+Design notes: docs/internals.md, ``camtool/verify/timing.py``.
 """
 
 from __future__ import annotations

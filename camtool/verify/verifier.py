@@ -1,32 +1,6 @@
 """The verifier: emitted code → program → simulated machine → measured error → report.
 
-:func:`verify_code` reads code with the target's own reader (so rounding and
-field widths are part of the prediction), :func:`verify_program` simulates a
-program on a machine profile (:func:`simulate`: the step simulator of
-:mod:`camtool.verify.simulate`, or the simulator a target's ``MOTION`` brings for
-the profile's line name, :mod:`camtool.verify.motion`) and measures the result
-(:mod:`camtool.verify.metrics`); :func:`report_dict` is the JSON report.
-
-The verify report: a JSON-ready dict with the keys listed in docs/verify.md.
-Stable keys other tools read: ``target``, ``blocks``, ``steps`` {x, y, z},
-``iterations``, ``reversals`` {x, y}, ``compensations``, ``deviation_um``
-{max, rms}, ``closure_um`` (one value per closed contour, the gap's length),
-``size_error_um`` (one ``[dx, dy]`` per contour, bounding box), ``time_s``,
-``warnings``. Added here: ``machine``, ``compensation_steps``, the location of
-the worst deviation, ``contours`` (every measure per contour, circles with
-their fitted diameter), ``against`` (the drawing comparison, over what was
-cut as drawn), ``not_cut_as_drawn`` (the features the planner reported it
-cannot cut with this tool, each ``{kind, label, at: {x_mm, y_mm}, error_um,
-samples, value}``), ``strict_error_um`` (the largest error with them),
-``against_skipped`` (why a drawing given was not compared, else null),
-``shortfall_um`` {max, at, samples} (the part of the programmed path the tool
-never reached, :class:`camtool.verify.metrics.AlongPath`), ``block_end_um`` {max,
-at} (the carriage against every cutting move's programmed end; each contour's in
-``contours[].end_error_um``), ``max_error_um`` (what ``--max-error-um`` checks:
-deviation, shortfall and the drawing) and ``error_budget`` (every figure with
-everything on and with each source off in turn, :mod:`camtool.verify.budget`).
-Numbers are rounded (µm to 4 decimals, mm to 6, ``time_s`` to 6 significant
-digits and at least 3 decimals) so the same input gives the same bytes.
+Design notes: docs/internals.md, ``camtool/verify/verifier.py``.
 """
 
 from __future__ import annotations
