@@ -22,6 +22,12 @@ from camtool.model.errors import InputError
 pytestmark = pytest.mark.skipif(not cores.FORK, reason="forked workers: Linux only")
 
 
+@pytest.fixture(autouse=True)
+def switched_on(monkeypatch: pytest.MonkeyPatch) -> None:
+    """These are the accel layer's own tests: on, whatever the suite runs (one test: off)."""
+    monkeypatch.setenv("CAMTOOL_ACCEL", "1")
+
+
 def test_answers_come_back_in_order_from_other_processes(tmp_path: Path) -> None:
     """A closure over this process's state (not picklable) runs in the workers, in order."""
     state = {"scale": 3}  # only a fork sees it: nothing is pickled on the way in
