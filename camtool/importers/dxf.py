@@ -6,16 +6,14 @@ Design notes: docs/internals.md, ``camtool/importers/dxf.py``.
 from __future__ import annotations
 
 import dataclasses
-import gc
 import logging
 import math
 from collections import Counter
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from camtool.accel.collector import paused
 from camtool.importers.dxf_entities import (
     ZERO_LENGTH,
     BadEntity,
@@ -145,7 +143,7 @@ def import_dxf(path: str | Path, options: ImportOptions | None = None) -> DxfImp
     options = options or ImportOptions()
     if not options.tolerance > 0:
         raise UsageError(f"the tolerance must be > 0 mm, got {options.tolerance!r}")
-    with _gc_paused():
+    with paused():
         return _import(path, options)
 
 
@@ -209,24 +207,6 @@ def _check_size(path: Path, msp: Any, max_entities: int) -> Any:
     if expanded_count(inserts, len(msp) - len(inserts), graph, max_entities) > max_entities:
         raise too_many_entities(str(path), max_entities)
     return graph
-
-
-@contextmanager
-def _gc_paused() -> Iterator[None]:
-    """Pause Python's cyclic garbage collector while a drawing is read.
-
-    Reading allocates a few objects per entity (ezdxf's and camtool's) and frees almost
-    none, which makes the collector rescan the whole growing heap again and again:
-    for 10⁵ LINEs it took 1.1 of 4.5 s of CPU. Reference counting still frees
-    everything acyclic; the collector is re-enabled (if it was) on the way out.
-    """
-    enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if enabled:
-            gc.enable()
 
 
 class _Reader:

@@ -5,7 +5,6 @@ Design notes: docs/internals.md, ``camtool/importers/svg.py``.
 
 from __future__ import annotations
 
-import gc
 import io
 import math
 import re
@@ -15,6 +14,7 @@ from typing import Any, TypeAlias
 
 import svgelements as se
 
+from camtool.accel.collector import collect_young
 from camtool.geometry.arcfit import check_tolerance
 from camtool.geometry.chain import with_end
 from camtool.geometry.curves import merge_arcs, semi_axes_gap
@@ -189,8 +189,8 @@ def _parse(path: Path, prepared: Prepared) -> Any:
 
     svgelements leaves the elements it read in reference cycles (its table of ids points
     back into the tree), which only the cyclic collector frees; the ``camtool`` command
-    runs it rarely (:data:`camtool.__main__.GC_THRESHOLD`), so the young generations are
-    collected here, where that garbage is made.
+    runs it rarely (:data:`camtool.accel.collector.THRESHOLD`), so the young generations
+    are collected here, where that garbage is made.
     """
     width, height = prepared.viewport
     try:
@@ -199,7 +199,7 @@ def _parse(path: Path, prepared: Prepared) -> Any:
         )
     except (ValueError, TypeError, IndexError, KeyError, ZeroDivisionError) as exc:
         raise InputError(f"{path}: svgelements cannot read this SVG ({exc!r})") from exc
-    gc.collect(1)
+    collect_young()
     return svg
 
 

@@ -2,7 +2,7 @@
 
 svgelements' parse leaves the XML elements it read in reference cycles (its id table holds
 ``(element, children)`` tuples that point back), so reference counting never frees them;
-with the CLI's raised collector thresholds (:data:`camtool.__main__.GC_THRESHOLD`) they would
+with the CLI's raised collector thresholds (:data:`camtool.accel.collector.THRESHOLD`) they would
 wait for a rare full collection. The importer collects the young generations right after
 the parse (issue 17).
 """
@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 
 import camtool.__main__ as entry
+from camtool.accel import collector
 from camtool.importers.svg import read_svg
 
 DATA = Path(__file__).resolve().parents[1] / "data"
@@ -66,7 +67,7 @@ def test_reading_an_svg_leaves_no_xml_tree_behind() -> None:
 def test_the_console_script_raises_the_collector_thresholds(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    """``run()`` sets :data:`~camtool.__main__.GC_THRESHOLD` before the CLI runs, then exits."""
+    """``run()`` sets the accel layer's thresholds before the CLI runs (when switched on)."""
     seen: list[tuple[int, int, int]] = []
 
     def fake_main() -> int:
@@ -75,12 +76,26 @@ def test_the_console_script_raises_the_collector_thresholds(
 
     monkeypatch.setattr("camtool.cli.main.main", fake_main)
     monkeypatch.setattr(entry, "leave", sys.exit)  # not os._exit: this is pytest's process
+    monkeypatch.setenv("CAMTOOL_ACCEL", "1")
     old = gc.get_threshold()
     try:
         with pytest.raises(SystemExit) as exited:
             entry.run()
     finally:
         gc.set_threshold(*old)
-    assert seen == [entry.GC_THRESHOLD]
+    assert seen == [collector.THRESHOLD]
     assert exited.value.code == 3
-    assert entry.GC_THRESHOLD[0] > old[0]
+    assert collector.THRESHOLD[0] > old[0]
+
+
+def test_switched_off_the_collector_keeps_python_s_thresholds(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    seen: list[tuple[int, int, int]] = []
+    monkeypatch.setattr("camtool.cli.main.main", lambda: seen.append(gc.get_threshold()) or 0)
+    monkeypatch.setattr(entry, "leave", sys.exit)
+    monkeypatch.setenv("CAMTOOL_ACCEL", "0")
+    old = gc.get_threshold()
+    with pytest.raises(SystemExit):
+        entry.run()
+    assert seen == [old]
