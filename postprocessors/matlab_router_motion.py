@@ -12,8 +12,8 @@ from camtool.model.errors import InputError
 from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Move, Program
 from camtool.model.shapes import distance
+from camtool.verify.contour_measures import contour_runs
 from camtool.verify.interpolators import sagitta_chord_points
-from camtool.verify.metrics import contour_runs
 from camtool.verify.motion import MotionHooks, StepTrace
 from camtool.verify.sources import ALL, Sources
 from camtool.verify.steparray import STEP_DTYPE, read_only

@@ -32,6 +32,16 @@ def _progress_quiet(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(progress, "AFTER_S", 1e9)
 
 
+@pytest.fixture
+def accel_on(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The accelerated versions on, whatever the suite runs (``CAMTOOL_ACCEL=0`` in CI's
+    second run): for the tests of what only they do (a forked helper, a compiled kernel,
+    a streamed trace's bounded memory)."""
+    from camtool.accel import SWITCH
+
+    monkeypatch.setenv(SWITCH, "1")
+
+
 @pytest.fixture(params=["accel", "plain"])
 def accel(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> bool:
     """Run the test twice: with the accelerated versions, then with ``CAMTOOL_ACCEL=0``.

@@ -499,7 +499,7 @@ def extent(points: Any) -> tuple[float, float, float, float]:
 
 @numba.njit(cache=True, nogil=True)
 def to_line(points: Any, x0: float, y0: float, x1: float, y1: float, out: Any) -> None:
-    """``metrics._to_line`` into ``out``: each point's distance to the segment, mm.
+    """``deviations._to_line`` into ``out``: each point's distance to the segment, mm.
 
     The same float operations per point, in the same order (``t`` clipped to [0, 1],
     0 for a segment of no length; ``math.hypot`` is the C library's, as numpy's).

@@ -1,4 +1,4 @@
-"""Compiled nearest-end searches of :func:`camtool.verify.metrics.nearest_distances` (numba).
+"""Compiled nearest-end searches of :func:`camtool.verify.nearest_search.nearest_distances` (numba).
 
 Design notes: docs/internals.md, ``camtool/accel/nearkernels.py``.
 """
@@ -466,7 +466,7 @@ def pairs_within(
 def _segment(px: float, py: float, a: Any, b: Any, s: int) -> float:  # pragma: no cover - compiled
     """Distance of ``(px, py)`` to segment ``a[s] → b[s]``, the floats of numpy's form.
 
-    :func:`camtool.verify.metrics._to_segments` step for step: ``t`` the projection
+    :func:`camtool.verify.nearest_exact._to_segments` step for step: ``t`` the projection
     clipped to ``[0, 1]`` (0 for a point segment), then the length of ``ap − t·ab``;
     each product and sum as numpy takes them (two-term sums, no fused multiply-add).
     """
@@ -502,7 +502,7 @@ def near_segments(
     ``offsets``, ``start``, ``ends``: :func:`tree` of ``concatenate([a, b])``, so end
     ``i`` belongs to segment ``i % len(a)``) and the least distance to their
     segments (:func:`_segment`). Where ends tie at the k-th distance the k-d tree keeps
-    some of them; as :func:`camtool.verify.metrics._tied` does, every end within the
+    some of them; as :func:`camtool.verify.nearest_search._tied` does, every end within the
     k-th distance is looked at (the search's own list, or :func:`_ends_within` when it
     overflowed), and when any choice the k-d tree could make gives the same least
     distance it is that one; else ``ask`` (the caller asks the k-d tree).
@@ -681,7 +681,7 @@ def load_cached() -> None:
 
     numba loads a kernel's machine code from its cache (or compiles it) at the kernel's
     first call in a process, ~10–15 ms for each of these. A verification that forks the
-    error budget's workers (:func:`camtool.verify.metrics.prepare_comparison`) calls this
+    error budget's workers (:func:`camtool.verify.drawing_compare.prepare_comparison`) calls this
     first, so the workers inherit them instead of each loading them again (the
     benchmark part: ~0.08 s of each worker's CPU, while every core is busy). The samples
     of a drawing come read-only (they are kept between comparisons), hence the second

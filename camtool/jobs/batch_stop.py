@@ -112,9 +112,9 @@ def worker_init(parent_pid: int) -> None:
     """
     import sys
 
-    from camtool.verify import metrics
+    from camtool.verify import nearest_exact
 
-    metrics.KD_WORKERS = 1
+    nearest_exact.KD_WORKERS = 1
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
     if sys.platform.startswith("linux"):

@@ -123,7 +123,7 @@ def post_path(
         verifying: the caller verifies the job against its drawing next (``post
             --verify``, ``--preview``): while this process waits for the offsets' child
             to load OpenCASCADE, it loads what that comparison will
-            (:func:`camtool.verify.metrics.comparison_preloads`). Only the time depends
+            (:func:`camtool.verify.drawing_compare.comparison_preloads`). Only the time depends
             on it.
         job: the operations and tools to run (``post --job``); ``None``: ``plan`` is
             the one operation.
@@ -176,7 +176,7 @@ def _offsetting(job: Job) -> PlanOptions:
 
 def _preloads(drawing: Drawing) -> list[Callable[[], object]]:
     """What verifying a job planned from ``drawing`` will load, to load while waiting."""
-    from camtool.verify.metrics import comparison_preloads
+    from camtool.verify.drawing_compare import comparison_preloads
 
     return comparison_preloads(drawing)
 

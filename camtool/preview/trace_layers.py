@@ -29,7 +29,7 @@ from camtool.preview.scene import (
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
-    from camtool.verify.metrics import NotCut
+    from camtool.verify.drawing_compare import NotCut
     from camtool.verify.verifier import Verification
 
 BINS = 16
@@ -51,7 +51,7 @@ def cutting_trace(v: Verification) -> tuple[FloatArray, IntArray, FloatArray]:
         cutting moves share it) and ``dev_um (N,) float64``, distance of each
         point from its block's programmed segment, µm.
     """
-    from camtool.verify.metrics import nominal_arrays, point_distances
+    from camtool.verify.deviations import nominal_arrays, point_distances
 
     program, trace = v.program, v.trace
     if len(trace.block_of_row) == 0 or not program.moves:

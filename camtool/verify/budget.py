@@ -11,7 +11,10 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from camtool.model.units import fmt_num
-from camtool.verify.metrics import Against, AlongPath, ContourMeasure, Deviation
+from camtool.verify.contour_measures import ContourMeasure
+from camtool.verify.deviations import Deviation
+from camtool.verify.drawing_compare import Against
+from camtool.verify.path_shortfall import AlongPath
 from camtool.verify.sources import SOURCES
 
 MAX_CONTOURS = 20

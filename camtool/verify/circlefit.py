@@ -2,7 +2,7 @@
 
 A circle cut in many turns (a hole in many depth passes) has a trace of millions of
 points; the fit reads them block by block and keeps a 4 × 4 triangle, so a streamed
-verification (:class:`camtool.verify.metrics.TraceStream`) never holds the contour's
+verification (:class:`camtool.verify.trace_measures.TraceStream`) never holds the contour's
 trace. The blocks start at fixed offsets of the points (multiples of :data:`FIT_BLOCK`),
 so the same points give the same floats however they are handed in.
 """

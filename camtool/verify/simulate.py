@@ -762,7 +762,7 @@ class StreamedTrace(StepTrace):
     """The trace of a streamed verification: per-move arrays whole, rows only thinned.
 
     ``rows``, ``compensation``, ``block_of_row`` and ``carriage_mm`` hold only the rows
-    kept for the picture (:class:`camtool.verify.metrics.StreamedMeasures`: every k-th
+    kept for the picture (:class:`camtool.verify.trace_measures.StreamedMeasures`: every k-th
     and the worst point), in trace order; ``block_start`` and the other per-move arrays
     are the whole trace's. The whole trace's counts are :attr:`row_count`,
     :attr:`iterations` and :attr:`compensation_steps`.

@@ -40,28 +40,26 @@ from camtool.model.units import fmt_num
 from camtool.model.version import __version__
 from camtool.verify import budget as eb
 from camtool.verify.clock import block_times_s, timing_warnings
-from camtool.verify.interpolators import compiled
-from camtool.verify.metrics import (
+from camtool.verify.contour_measures import ContourMeasure, measure_contours
+from camtool.verify.cutting_thin import (
     AGAINST_RESOLUTION_MM,
-    Against,
-    AlongPath,
-    ContourMeasure,
     CutDigest,
     CuttingStream,
-    Deviation,
-    FindingLike,
     ThinTrace,
-    TraceStream,
-    against_thinned,
-    against_worst,
-    along_path,
-    deviation,
-    measure_contours,
-    prepare_comparison,
-    prepare_stream,
     thin_cutting,
 )
+from camtool.verify.deviations import Deviation, deviation
+from camtool.verify.drawing_compare import (
+    Against,
+    FindingLike,
+    against_thinned,
+    against_worst,
+    prepare_comparison,
+    prepare_stream,
+)
+from camtool.verify.interpolators import compiled
 from camtool.verify.motion import StepTrace, library
+from camtool.verify.path_shortfall import AlongPath, along_path
 from camtool.verify.simulate import (
     ChunkedSimulation,
     NotStreamable,
@@ -73,6 +71,7 @@ from camtool.verify.simulate import (
 )
 from camtool.verify.sources import ALL, SOURCES, Sources
 from camtool.verify.steparray import read_only
+from camtool.verify.trace_measures import TraceStream
 
 if TYPE_CHECKING:
     from camtool.post.base import Target
@@ -141,7 +140,7 @@ class Verification:
         findings: the plan's findings the drawing was compared with.
         parts: the program's parts verified each alone (a job's operations, each with
             its tool against its own drawing); their errors count in the limits.
-        cut_digest: the :class:`~camtool.verify.metrics.CutDigest` of the trace's cutting
+        cut_digest: the :class:`~camtool.verify.cutting_thin.CutDigest` of the trace's cutting
             rows when a streamed trace was compared with a drawing (the error budget tells
             by it which re-simulations cut the same rows), else ``None``.
     """
@@ -326,7 +325,7 @@ def verify_program(
         findings: what planning found (:class:`camtool.toolpath.cuts.Finding`):
             features it reported as impossible with this tool (a tight corner, a
             region narrower than the tool) are measured apart from the rest of
-            the drawing (:func:`camtool.verify.metrics.not_cut_groups`).
+            the drawing (:func:`camtool.verify.drawing_compare.not_cut_groups`).
         planned: the unrounded plan ``program`` was emitted from, in the same
             coordinates (the error budget's ``rounding`` source); ``None`` when
             only the code is known.
@@ -344,7 +343,7 @@ def verify_program(
             benchmark part took 6.1 s where the two one after the other took 6.7 s).
             A budget that fails is left to be computed, and to fail, when it is asked
             for. ``None``: when it is asked for. The kernels the measures need are
-            loaded first (:func:`~camtool.verify.metrics.prepare_comparison`), so each
+            loaded first (:func:`~camtool.verify.drawing_compare.prepare_comparison`), so each
             worker inherits them instead of loading them again; the workers are then
             forked at once, before this process's own measures (their core is idle
             otherwise; with the kernels loaded while the plan waited for
@@ -439,7 +438,7 @@ class _EarlyBudget:
     of its own (:class:`_BudgetRun`, ``alongside``) while this process simulates and
     measures the trace: the two peaks of memory are in two processes, not one after the
     other in one. The kernels both call are loaded first, so the helper inherits them
-    (:func:`~camtool.verify.metrics.prepare_stream`). Two sources or more are
+    (:func:`~camtool.verify.drawing_compare.prepare_stream`). Two sources or more are
     re-simulated side by side once the trace is measured, as before: started with it,
     three processes shared two cores and took longer.
     """
@@ -512,14 +511,14 @@ def _simulate_big(
     simulated whole (:func:`simulate`) and measured by :func:`_measure` (then ``None``).
     A longer one of the step simulator is simulated again in chunks of ``chunk_rows``
     rows (:class:`camtool.verify.simulate.ChunkedSimulation`) and measured chunk by
-    chunk (:class:`camtool.verify.metrics.TraceStream`: the same figures, the
+    chunk (:class:`camtool.verify.trace_measures.TraceStream`: the same figures, the
     deviation's rms summed exactly); the trace returned (:class:`StreamedTrace`) then
     holds only the rows kept for the picture. With a drawing (``against``), the cutting
     rows the comparison keeps are gathered as the chunks pass
-    (:class:`~camtool.verify.metrics.CuttingStream`, the last item; ``None`` without a
+    (:class:`~camtool.verify.cutting_thin.CuttingStream`, the last item; ``None`` without a
     drawing): the comparison needs only those, so the trace is not held whole for it
     (13 M rows of a 213-icon SVG job took 1.65 GB), and their digest
-    (:class:`~camtool.verify.metrics.CutDigest`, the last item). Without the compiled
+    (:class:`~camtool.verify.cutting_thin.CutDigest`, the last item). Without the compiled
     kernels it is simulated whole.
 
     The measures need every move's row offsets first: a trace sure to be streamed has
@@ -745,7 +744,7 @@ def _compare(
 ) -> Against:
     """The machined edge of ``program``'s thinned cutting trace against the drawing.
 
-    The one call of :func:`~camtool.verify.metrics.against_thinned` of a verification,
+    The one call of :func:`~camtool.verify.drawing_compare.against_thinned` of a verification,
     for a whole trace and a streamed one (:func:`verify_program`); the error budget's
     sources need only its largest distance (:func:`_without`).
     """
@@ -784,7 +783,7 @@ def _cutting_rows(program: Program, trace: StepTrace) -> tuple[np.ndarray, np.nd
 def _same_against(v: _Inputs, program: Program, digest: bytes | None) -> bool:
     """Whether the drawing comparison of a re-simulation gets exactly ``v``'s inputs.
 
-    The same cutting rows and runs (the same :class:`~camtool.verify.metrics.CutDigest`,
+    The same cutting rows and runs (the same :class:`~camtool.verify.cutting_thin.CutDigest`,
     ``digest`` the re-simulation's) and (with findings) the same programmed path: then
     its figures are the verification's own (``against``, measured whenever there is a
     drawing), bit for bit, and need not be measured again (the ``rounding`` source of
@@ -801,7 +800,7 @@ def _same_against(v: _Inputs, program: Program, digest: bytes | None) -> bool:
 
 
 def _trace_digest(program: Program, trace: StepTrace) -> bytes:
-    """The :class:`~camtool.verify.metrics.CutDigest` of a whole trace, read a chunk at a time."""
+    """The :class:`~camtool.verify.cutting_thin.CutDigest` of a whole trace, a chunk at a time."""
     digest = CutDigest(_rapids(program))
     points, blocks = trace.carriage_mm, trace.block_of_row
     for lo in range(0, len(points), CHUNK_ROWS):
@@ -852,7 +851,7 @@ class _Inputs:
 
     @cached_property
     def digest(self) -> bytes | None:
-        """The :class:`~camtool.verify.metrics.CutDigest` of the trace (``None``: no drawing)."""
+        """The trace's :class:`~camtool.verify.cutting_thin.CutDigest` (``None``: no drawing)."""
         if self.drawing is None:
             return None
         if self.cut_digest is not None:

@@ -52,7 +52,7 @@ steps/s, < 250 MB) are not met. The trace is now streamed (simulated and measure
 chunks of whole moves, never held whole: docs/verify.md "Speed and memory"), which took
 the memory from 846 to ~259 MB; what is left is the start-up (~1.5 s quiet, itself over the
 0.46 s the goal allows at 13.2 M steps) and the path-to-trace distances of the shortfall
-(``metrics.nearest_distances``, 2.4–3.5 s of CPU on 400 000 path samples against a
+(``nearest_search.nearest_distances``, 2.4–3.5 s of CPU on 400 000 path samples against a
 390 000-point thinned trace, and ~75 MB while it runs; on the 66 M-step program most of
 its 28 s, since the thinned trace's segments are as long as the samples' spacing and far
 more samples miss the cheap vertex bound). Python, numpy, scipy, shapely and the loaded

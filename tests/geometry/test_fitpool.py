@@ -17,6 +17,9 @@ from camtool.accel.cores import in_worker
 from camtool.geometry import fitpool
 from camtool.geometry.fitpool import CurveKey, fit_key, fit_many
 
+# what this file checks is done by the accelerated versions only (docs/architecture.md)
+pytestmark = pytest.mark.usefixtures("accel_on")
+
 
 def spy_pool(monkeypatch: pytest.MonkeyPatch) -> list[bool]:
     """Record, for each pool :func:`fit_many` starts, whether its workers answered.

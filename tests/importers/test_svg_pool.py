@@ -18,6 +18,9 @@ from camtool.importers.svg import read_svg
 from camtool.model.errors import InputError
 from tests.geometry.test_fitpool import spy_pool
 
+# what this file checks is done by the accelerated versions only (docs/architecture.md)
+pytestmark = pytest.mark.usefixtures("accel_on")
+
 SVG = """<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100">
 {paths}
 </svg>"""

@@ -19,6 +19,9 @@ from camtool.importers.svg import read_svg
 from camtool.model.progress import Step
 from tests.importers.test_svg_pool import _svg
 
+# what this file checks is done by the accelerated versions only (docs/architecture.md)
+pytestmark = pytest.mark.usefixtures("accel_on")
+
 PATHS = 60
 CURVES = PATHS * 5 + 1
 """Distinct curves of ``_svg(tmp_path, 60)``: each path has five (c, q, a with radii 3 and

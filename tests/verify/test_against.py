@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from camtool.model.shapes import Contour, Drawing, Line
-from camtool.verify.metrics import against_drawing
+from camtool.verify.drawing_compare import against_drawing
 
 
 def _line(y: float) -> np.ndarray:

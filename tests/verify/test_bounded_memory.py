@@ -21,10 +21,13 @@ from camtool.accel import cores
 from camtool.model.program import ArcMove, Linear, Program, Rapid
 from camtool.post.registry import load_target
 from camtool.verify import verifier
-from camtool.verify.metrics import TraceStream
 from camtool.verify.simulate import ChunkedSimulation, TraceChunk, count_rows, simulate_steps
 from camtool.verify.sources import ALL, SOURCES, Sources
+from camtool.verify.trace_measures import TraceStream
 from tests.verify.programs import TARGETS, mixed_program
+
+# what this file checks is done by the accelerated versions only (docs/architecture.md)
+pytestmark = pytest.mark.usefixtures("accel_on")
 
 kernels = pytest.importorskip("camtool.accel.kernels")
 

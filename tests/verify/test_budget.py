@@ -25,6 +25,9 @@ from camtool.verify.verifier import (
     verify_program,
 )
 
+# what this file checks is done by the accelerated versions only (docs/architecture.md)
+pytestmark = pytest.mark.usefixtures("accel_on")
+
 D_MM = 10.0
 DIAMETER = "contour 1 diameter error"
 

@@ -26,7 +26,10 @@ from camtool.verify import simulate, verifier
 from camtool.verify.simulate import ChunkedSimulation, TraceChunk
 
 kernels = pytest.importorskip("camtool.accel.kernels")
-pytestmark = pytest.mark.skipif(not cores.FORK, reason="needs fork (Linux)")
+pytestmark = [
+    pytest.mark.skipif(not cores.FORK, reason="needs fork (Linux)"),
+    pytest.mark.usefixtures("accel_on"),  # the accelerated versions only
+]
 
 
 def _lines(count: int = 8) -> Program:
@@ -169,7 +172,7 @@ def test_the_compiled_ideal_play_is_the_numpy_one(seed: int) -> None:
 
 
 def test_an_error_in_the_stream_leaves_no_helper_behind(monkeypatch: pytest.MonkeyPatch) -> None:
-    from camtool.verify.metrics import TraceStream
+    from camtool.verify.trace_measures import TraceStream
 
     events = _spy(monkeypatch)
 

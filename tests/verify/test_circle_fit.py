@@ -24,6 +24,9 @@ from camtool.verify.circlefit import CircleFit, fit_circle
 from camtool.verify.simulate import count_rows
 from camtool.verify.sources import ALL
 
+# what this file checks is done by the accelerated versions only (docs/architecture.md)
+pytestmark = pytest.mark.usefixtures("accel_on")
+
 pytest.importorskip("camtool.accel.kernels")
 
 

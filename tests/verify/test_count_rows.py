@@ -26,6 +26,9 @@ from camtool.verify.sources import ALL
 from camtool.verify.verifier import build_report, verify_program
 from tests.verify.programs import TARGETS, mixed_program
 
+# what this file checks is done by the accelerated versions only (docs/architecture.md)
+pytestmark = pytest.mark.usefixtures("accel_on")
+
 
 @pytest.mark.parametrize("seed", range(4))
 def test_a_dda_line_has_the_rows_its_count_says_each_pulse_its_axis_way(seed: int) -> None:

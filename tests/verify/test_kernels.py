@@ -251,7 +251,7 @@ def test_play_runs_equal_a_python_scan(seed: int) -> None:
 def test_deviation_by_blocks_equals_the_gathered_form() -> None:
     """Block-wise deviation (scalars for long lines, chunks) == the one-pass gathered form."""
     from camtool.model.program import ArcMove, Linear, Program, Rapid
-    from camtool.verify import metrics
+    from camtool.verify import deviations
 
     rng = np.random.default_rng(8)
     moves = [Rapid(1.0, 1.0), Linear(5.0, 1.0, 100.0), ArcMove(5.0, 3.0, 5.0, 2.0, False, 100.0)]
@@ -263,15 +263,15 @@ def test_deviation_by_blocks_equals_the_gathered_form() -> None:
     blocks = np.repeat(np.arange(len(moves), dtype=np.int64), sizes)
     points = rng.uniform(0.0, 6.0, (len(blocks), 2))
     for chunk in (1 << 18, 1000):
-        saved = metrics.DEVIATION_CHUNK
-        metrics.DEVIATION_CHUNK = chunk
+        saved = deviations.DEVIATION_CHUNK
+        deviations.DEVIATION_CHUNK = chunk
         try:
-            fast = metrics.deviation(points, blocks, program)
+            fast = deviations.deviation(points, blocks, program)
         finally:
-            metrics.DEVIATION_CHUNK = saved
-        assert fast == metrics.deviation_gathered(points, blocks, program)
+            deviations.DEVIATION_CHUNK = saved
+        assert fast == deviations.deviation_gathered(points, blocks, program)
     shuffled = blocks[::-1].copy()  # not in block order: the gathered form runs
-    assert metrics.deviation(points, shuffled, program) == metrics.deviation_gathered(
+    assert deviations.deviation(points, shuffled, program) == deviations.deviation_gathered(
         points, shuffled, program
     )
 

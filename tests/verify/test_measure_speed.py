@@ -16,7 +16,14 @@ from scipy.spatial import cKDTree
 from camtool.model.program import ArcMove, Linear, Program, Rapid
 from camtool.model.shapes import Arc, Contour, Drawing, Line
 from camtool.post.registry import load_target
-from camtool.verify import metrics, verifier
+from camtool.verify import (
+    cutting_thin,
+    drawing_compare,
+    nearest_exact,
+    nearest_search,
+    path_shortfall,
+    verifier,
+)
 from camtool.verify.sources import ALL
 from camtool.verify.verifier import _cutting_rows, simulate, verify_program
 
@@ -46,10 +53,10 @@ def test_nearby_exact_is_the_all_segments_query_bit_for_bit(seed: int) -> None:
         samples[:100] = on + rng.choice([0.0, step / 2, step], size=(100, 2))
         half = step / 2.0
         ends = cKDTree(np.concatenate([a, b]))
-        upper, _ = metrics._nearest_chunk(samples, a, b, ends, half)
-        fast = metrics._nearby_exact(samples, upper, a, b, ends, half)
+        upper, _ = nearest_exact._nearest_chunk(samples, a, b, ends, half)
+        fast = nearest_exact._nearby_exact(samples, upper, a, b, ends, half)
         assert fast is not None
-        assert np.array_equal(fast, metrics._all_exact(samples, a, b))
+        assert np.array_equal(fast, nearest_exact._all_exact(samples, a, b))
 
 
 def test_nearby_exact_gives_way_when_too_many_segments_are_near(
@@ -59,17 +66,17 @@ def test_nearby_exact_gives_way_when_too_many_segments_are_near(
     a, b = pts[:-1], pts[1:]
     ends = cKDTree(np.concatenate([a, b]))
     samples = pts[:50] + 0.001
-    upper, _ = metrics._nearest_chunk(samples, a, b, ends, 0.002)
-    monkeypatch.setattr(metrics, "NEARBY_MAX_PAIRS", 10)
-    assert metrics._nearby_exact(samples, upper, a, b, ends, 0.002) is None
-    monkeypatch.setattr(metrics, "NEARBY_MAX_PAIRS", 10**9)
-    got = metrics.nearest_distances(samples, a, b)
-    monkeypatch.setattr(metrics, "NEARBY_MAX_PAIRS", 0)  # every unsure sample: all segments
-    assert np.array_equal(got, metrics.nearest_distances(samples, a, b))
+    upper, _ = nearest_exact._nearest_chunk(samples, a, b, ends, 0.002)
+    monkeypatch.setattr(nearest_exact, "NEARBY_MAX_PAIRS", 10)
+    assert nearest_exact._nearby_exact(samples, upper, a, b, ends, 0.002) is None
+    monkeypatch.setattr(nearest_exact, "NEARBY_MAX_PAIRS", 10**9)
+    got = nearest_search.nearest_distances(samples, a, b)
+    monkeypatch.setattr(nearest_exact, "NEARBY_MAX_PAIRS", 0)  # every unsure sample: all segments
+    assert np.array_equal(got, nearest_search.nearest_distances(samples, a, b))
 
 
 def _thin_index_reference(n: int, limit: int, runs: np.ndarray | None) -> np.ndarray:
-    """The code :func:`metrics._thin_index` replaced (sorted unique of the picks)."""
+    """The code :func:`cutting_thin._thin_index` replaced (sorted unique of the picks)."""
     k = max(1, -(-n // limit))
     picked = [np.arange(0, n, k), np.array([n - 1])]
     if runs is not None and n > 1:
@@ -84,7 +91,7 @@ def test_thin_index_is_the_sorted_unique_picks() -> None:
         n = int(rng.integers(1, 3000))
         limit = int(rng.integers(1, 4000))
         runs = None if rng.random() < 0.3 else np.cumsum(rng.random(n) < 0.01)
-        got = metrics._thin_index(n, limit, runs)
+        got = cutting_thin._thin_index(n, limit, runs)
         want = _thin_index_reference(n, limit, runs)
         assert got.dtype == want.dtype
         assert np.array_equal(got, want)
@@ -93,12 +100,12 @@ def test_thin_index_is_the_sorted_unique_picks() -> None:
 def test_drawing_samples_are_kept_for_the_same_drawing_only() -> None:
     one = Drawing((Contour((Line((0.0, 0.0), (1.0, 0.0)),), False),))
     two = Drawing((Contour((Line((0.0, 0.0), (2.0, 0.0)),), False),))
-    first, sizes = metrics._sample_drawing(one, 0.005)
-    again, _ = metrics._sample_drawing(one, 0.005)
+    first, sizes = drawing_compare._sample_drawing(one, 0.005)
+    again, _ = drawing_compare._sample_drawing(one, 0.005)
     assert again is first and not first.flags.writeable
-    other, other_sizes = metrics._sample_drawing(two, 0.005)
+    other, other_sizes = drawing_compare._sample_drawing(two, 0.005)
     assert len(other) == 401 and other_sizes == [401] and sizes == [201]
-    assert np.array_equal(metrics._sample_drawing(one, 0.005)[0], first)
+    assert np.array_equal(drawing_compare._sample_drawing(one, 0.005)[0], first)
 
 
 def _plate() -> tuple[Program, Drawing]:
@@ -135,7 +142,7 @@ def test_budget_reuses_the_drawing_figure_only_when_the_trace_is_the_same() -> N
     trace = simulate(planned, target.machine)
     assert np.array_equal(_cutting_rows(planned, trace)[0], _cutting_rows(program, v.trace)[0])
     cut, runs = _cutting_rows(planned, trace)
-    again = metrics.against_drawing(cut, drawing, 0.25, runs=runs)
+    again = drawing_compare.against_drawing(cut, drawing, 0.25, runs=runs)
     assert v.against is not None
     assert v.error_budget.without["rounding"]["distance to the drawing"] == again.max_um
     assert again.max_um == v.against.max_um
@@ -144,16 +151,16 @@ def test_budget_reuses_the_drawing_figure_only_when_the_trace_is_the_same() -> N
 def test_distance_to_the_path_is_kept_only_for_inputs_that_cannot_change() -> None:
     samples = np.random.default_rng(5).uniform(0.0, 2.0, (200, 2))
     lines = (np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 2.0]]), np.array([[0.5, 1.0]]))
-    want = metrics._distance_to_now(samples, lines)
-    open_answer = metrics._distance_to(samples, lines)  # writeable: measured, not kept
+    want = drawing_compare._distance_to_now(samples, lines)
+    open_answer = drawing_compare._distance_to(samples, lines)  # writeable: measured, not kept
     assert np.array_equal(open_answer, want) and open_answer.flags.writeable
     samples.flags.writeable = False
     for line in lines:
         line.flags.writeable = False
-    first = metrics._distance_to(samples, lines)
-    assert metrics._distance_to(samples, lines) is first and np.array_equal(first, want)
+    first = drawing_compare._distance_to(samples, lines)
+    assert drawing_compare._distance_to(samples, lines) is first and np.array_equal(first, want)
     copied = tuple(line.copy() for line in lines)  # other objects: measured again
-    assert metrics._distance_to(samples, copied) is not first
+    assert drawing_compare._distance_to(samples, copied) is not first
 
 
 def test_nominal_lines_are_kept_for_the_code_and_the_plan() -> None:
@@ -170,8 +177,8 @@ def test_nominal_lines_are_kept_for_the_code_and_the_plan() -> None:
 
 
 def _farthest_reference(samples: np.ndarray, a: np.ndarray, b: np.ndarray) -> tuple[float, int]:
-    """What the shortfall took before :func:`metrics.farthest_nearest`: every distance."""
-    d = metrics.nearest_distances(samples, a, b)
+    """What the shortfall took before :func:`nearest_search.farthest_nearest`: every distance."""
+    d = nearest_search.nearest_distances(samples, a, b)
     k = int(np.argmax(d))
     return float(d[k]), k
 
@@ -189,10 +196,10 @@ def test_farthest_nearest_is_the_max_of_every_distance(
     query over all segments when the pairs are over the limit).
     """
     if compiled:
-        if metrics.near_kernels() is None:
+        if nearest_search.near_kernels() is None:
             pytest.skip("numba is not installed")
     else:
-        monkeypatch.setattr(metrics, "near_kernels", lambda work=0: None)
+        monkeypatch.setattr(nearest_search, "near_kernels", lambda work=0: None)
     rng = np.random.default_rng(100 + seed)
     for kind in range(12):
         pts = _polyline(rng, kind)
@@ -205,19 +212,19 @@ def test_farthest_nearest_is_the_max_of_every_distance(
         if kind % 3 == 0:  # the farthest sample repeated: the first one must be named
             far = int(rng.integers(0, 200))
             samples = np.insert(samples, [far // 2, far], samples[far] + 5 * step, axis=0)
-        for limit in (metrics.NEARBY_MAX_PAIRS, 0):
-            monkeypatch.setattr(metrics, "NEARBY_MAX_PAIRS", limit)
+        for limit in (nearest_exact.NEARBY_MAX_PAIRS, 0):
+            monkeypatch.setattr(nearest_exact, "NEARBY_MAX_PAIRS", limit)
             want = _farthest_reference(samples, a, b)
-            got = metrics.farthest_nearest(samples, a, b)
+            got = nearest_search.farthest_nearest(samples, a, b)
             assert got[1] == want[1]
             assert np.float64(got[0]).tobytes() == np.float64(want[0]).tobytes()
-            ends = metrics._LazyTree(np.concatenate([a, b]))  # a tree shared by batches
-            assert metrics.farthest_nearest(samples, a, b, ends=ends) == got
+            ends = nearest_search._LazyTree(np.concatenate([a, b]))  # a tree shared by batches
+            assert nearest_search.farthest_nearest(samples, a, b, ends=ends) == got
 
 
 def test_farthest_nearest_measures_few_unsure_samples(monkeypatch: pytest.MonkeyPatch) -> None:
     """Unsure samples far below the largest settled distance are not measured exactly."""
-    monkeypatch.setattr(metrics, "near_kernels", lambda work=0: None)
+    monkeypatch.setattr(nearest_search, "near_kernels", lambda work=0: None)
     x = np.arange(0.0, 4.0, 0.004)
     pts = np.c_[x, np.zeros_like(x)]  # a straight trace of 4 µm steps
     a, b = pts[:-1], pts[1:]
@@ -226,17 +233,17 @@ def test_farthest_nearest_measures_few_unsure_samples(monkeypatch: pytest.Monkey
     above = pts[:300] + np.array([0.0, 0.01])
     samples = np.concatenate([above, [[0.002, 0.5]]])
     measured: list[int] = []
-    real = metrics._nearby_pairs
+    real = nearest_exact._nearby_pairs
 
     def spy(s: np.ndarray, *args: object) -> np.ndarray:
         measured.append(len(s))
         return real(s, *args)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(metrics, "_nearby_pairs", spy)
+    monkeypatch.setattr(nearest_exact, "_nearby_pairs", spy)
     want = _farthest_reference(samples, a, b)
     every = sum(measured)
     measured.clear()
-    assert metrics.farthest_nearest(samples, a, b) == want == (0.5, 300)
+    assert nearest_search.farthest_nearest(samples, a, b) == want == (0.5, 300)
     assert every == 299 and sum(measured) == 0
 
 
@@ -252,8 +259,8 @@ def test_sample_batches_are_the_slices_of_the_whole_samples(size: int) -> None:
     )
     program = Program(moves, origin=(0.0, 0.0))
     starts = [program.origin] + [(m.x, m.y) for m in program.moves]
-    whole, owner, along = metrics._sample_moves(program, starts, 1, 4, 0.01)
-    pieces = list(metrics._sample_batches(program, starts, 1, 4, 0.01, size))
+    whole, owner, along = path_shortfall._sample_moves(program, starts, 1, 4, 0.01)
+    pieces = list(path_shortfall._sample_batches(program, starts, 1, 4, 0.01, size))
     assert [len(p) for p, _, _ in pieces[:-1]] == [size] * (len(pieces) - 1)
     assert np.concatenate([p for p, _, _ in pieces]).tobytes() == whole.tobytes()
     assert np.array_equal(np.concatenate([o for _, o, _ in pieces]), owner)
@@ -278,8 +285,10 @@ def test_the_all_segments_query_in_chunks_is_one_query_of_them_all(
     samples = rng.uniform(pts.min(axis=0) - 0.01, pts.max(axis=0) + 0.01, (500, 2))
     tree = shapely.STRtree(shapely.linestrings(np.stack([a, b], axis=1)))
     _, once = tree.query_nearest(shapely.points(samples), return_distance=True, all_matches=False)
-    monkeypatch.setattr(metrics, "ALL_EXACT_CHUNK", int(rng.integers(1, 60)))
-    assert metrics._all_exact(samples, a, b).tobytes() == np.asarray(once, np.float64).tobytes()
+    monkeypatch.setattr(nearest_exact, "ALL_EXACT_CHUNK", int(rng.integers(1, 60)))
+    assert (
+        nearest_exact._all_exact(samples, a, b).tobytes() == np.asarray(once, np.float64).tobytes()
+    )
 
 
 @pytest.mark.parametrize("seed", range(4))
@@ -292,12 +301,12 @@ def test_the_counts_within_reach_are_scipys_or_none_over_the_limit(
     samples = pts[rng.integers(0, len(pts), 400)] + rng.normal(0.0, 0.01, (400, 2))
     reach = rng.uniform(0.0, 0.05, 400)
     once = ends.query_ball_point(samples, reach, return_length=True)
-    monkeypatch.setattr(metrics, "NEARBY_COUNT_CHUNK", int(rng.integers(1, 50)))
-    monkeypatch.setattr(metrics, "NEARBY_MAX_PAIRS", int(np.sum(once)))
-    got = metrics._counts_within(ends, samples, reach)
+    monkeypatch.setattr(nearest_exact, "NEARBY_COUNT_CHUNK", int(rng.integers(1, 50)))
+    monkeypatch.setattr(nearest_exact, "NEARBY_MAX_PAIRS", int(np.sum(once)))
+    got = nearest_exact._counts_within(ends, samples, reach)
     assert got is not None and np.array_equal(got, once)
-    monkeypatch.setattr(metrics, "NEARBY_MAX_PAIRS", int(np.sum(once)) - 1)
-    assert metrics._counts_within(ends, samples, reach) is None
+    monkeypatch.setattr(nearest_exact, "NEARBY_MAX_PAIRS", int(np.sum(once)) - 1)
+    assert nearest_exact._counts_within(ends, samples, reach) is None
 
 
 def test_a_drawing_sampled_into_one_array_is_its_contours_stacked() -> None:
@@ -313,8 +322,8 @@ def test_a_drawing_sampled_into_one_array_is_its_contours_stacked() -> None:
     circle = Contour((Arc((3.0, 0.0), (3.0, 0.0), (2.0, 0.0), True),), True)
     dot = Contour((Line((5.0, 5.0), (5.0, 5.0)),), False)
     drawing = Drawing((square, circle, dot))
-    got, sizes = metrics._sample_drawing_now(drawing, 0.013)
-    parts = [metrics._sample_contour(c.segments, 0.013) for c in drawing.contours]
+    got, sizes = drawing_compare._sample_drawing_now(drawing, 0.013)
+    parts = [drawing_compare._sample_contour(c.segments, 0.013) for c in drawing.contours]
     assert sizes == [len(p) for p in parts]
     assert got.tobytes() == np.vstack(parts).tobytes()
 

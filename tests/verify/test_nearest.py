@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 import shapely
 
-from camtool.verify.metrics import NEAREST_TOLERANCE_MM, nearest_distances
+from camtool.verify.nearest_exact import NEAREST_TOLERANCE_MM
+from camtool.verify.nearest_search import nearest_distances
 
 
 def _shapely(samples: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -43,7 +44,9 @@ def test_the_chords_and_their_ends_are_numpy_s_own_selection_and_concatenation(
     """The machined edge's segments (``_chords``) are the boolean selection of consecutive
     rows of a run, and the ends the searches hold are ``np.concatenate([a, b])``: made in
     one array, handed over without a second copy (the comparison's memory peak)."""
-    from camtool.verify.metrics import ThinTrace, _chords, _end_points
+    from camtool.verify.cutting_thin import ThinTrace
+    from camtool.verify.drawing_compare import _chords
+    from camtool.verify.nearest_search import _end_points
 
     rng = np.random.default_rng(3)
     points = rng.uniform(-5.0, 5.0, (101, 2))
@@ -65,7 +68,7 @@ def test_the_chords_and_their_ends_are_numpy_s_own_selection_and_concatenation(
 
 
 def test_the_ends_are_shared_only_when_a_and_b_are_the_halves_of_one_array() -> None:
-    from camtool.verify.metrics import _end_points
+    from camtool.verify.nearest_search import _end_points
 
     trace = np.arange(24.0).reshape(12, 2).copy()  # an array of its own, not a view
     cases = [

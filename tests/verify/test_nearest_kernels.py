@@ -1,7 +1,8 @@
 """The compiled nearest-end search gives what the k-d tree path gives, bit for bit (issue 17).
 
-:func:`camtool.verify.metrics.nearest_distances` (numba box tree,
-:mod:`camtool.accel.nearkernels`) against :func:`~camtool.verify.metrics.nearest_distances_kd`
+:func:`camtool.verify.nearest_search.nearest_distances` (numba box tree,
+:mod:`camtool.accel.nearkernels`) against
+:func:`~camtool.verify.nearest_search.nearest_distances_kd`
 (scipy's k-d tree, the code it replaces) on many random inputs built to tie: traces on a
 step grid, samples on the same grid, traces cut in several identical passes (every end
 repeated), samples far from the trace (a drawing point a tool radius away). Equality is
@@ -14,17 +15,20 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from camtool.verify import metrics
+from camtool.verify import nearest_exact, nearest_search
+
+# what this file checks is done by the accelerated versions only (docs/architecture.md)
+pytestmark = pytest.mark.usefixtures("accel_on")
 
 nearkernels = pytest.importorskip("camtool.accel.nearkernels")
 
 
 @pytest.fixture(autouse=True)
-def _compiled(monkeypatch: pytest.MonkeyPatch) -> None:
+def _compiled(accel_on: None, monkeypatch: pytest.MonkeyPatch) -> None:
     """The compiled search in use from the first call (the default threshold is a load),
-    near samples included (:func:`metrics._far` would send those to the k-d tree)."""
-    assert metrics.near_kernels() is nearkernels
-    monkeypatch.setattr(metrics, "_far", lambda *args: True)
+    near samples included (:func:`nearest_search._far` would send those to the k-d tree)."""
+    assert nearest_search.near_kernels() is nearkernels
+    monkeypatch.setattr(nearest_search, "_far", lambda *args: True)
 
 
 def _trace(rng: np.random.Generator, kind: int) -> np.ndarray:
@@ -66,8 +70,8 @@ def test_nearest_distances_equal_the_kd_tree_path_bit_for_bit(seed: int) -> None
         pts = _trace(rng, kind)
         a, b = pts[:-1], pts[1:]
         samples = _samples(rng, pts, 2000, reach=float(rng.choice([0.0015, 0.1, 1.5])))
-        got = metrics.nearest_distances(samples, a, b)
-        want = metrics.nearest_distances_kd(samples, a, b)
+        got = nearest_search.nearest_distances(samples, a, b)
+        want = nearest_search.nearest_distances_kd(samples, a, b)
         assert np.array_equal(got.view(np.int64), want.view(np.int64))
 
 
@@ -132,8 +136,8 @@ def test_knn_on_a_line_of_repeated_ends_far_away() -> None:
     line = np.c_[x, np.zeros_like(x)]
     pts = np.concatenate([line] * 3)
     samples = np.c_[np.arange(0.0, 20.0, 0.005), np.full(4000, 1.5)]
-    got = metrics.nearest_distances(samples, pts[:-1], pts[1:])
-    want = metrics.nearest_distances_kd(samples, pts[:-1], pts[1:])
+    got = nearest_search.nearest_distances(samples, pts[:-1], pts[1:])
+    want = nearest_search.nearest_distances_kd(samples, pts[:-1], pts[1:])
     assert np.array_equal(got, want)
     assert np.allclose(got, 1.5, atol=1e-12)  # the line is 1.5 mm away everywhere
 
@@ -142,17 +146,17 @@ def test_small_inputs_take_the_kd_tree_path() -> None:
     a = np.array([[0.0, 0.0]])
     b = np.array([[1.0, 0.0]])
     samples = np.array([[0.5, 1.0], [2.0, 0.0]])
-    assert np.array_equal(metrics.nearest_distances(samples, a, b), [1.0, 1.0])
+    assert np.array_equal(nearest_search.nearest_distances(samples, a, b), [1.0, 1.0])
     assert np.array_equal(
-        metrics.nearest_distances(samples, np.zeros((0, 2)), np.zeros((0, 2))), [np.inf] * 2
+        nearest_search.nearest_distances(samples, np.zeros((0, 2)), np.zeros((0, 2))), [np.inf] * 2
     )
 
 
 @pytest.mark.parametrize("seed", range(3))
 def test_nearby_boxes_is_the_kd_tree_nearby_query_bit_for_bit(seed: int) -> None:
-    """The same GEOS minimum as :func:`~camtool.verify.metrics._nearby_exact`.
+    """The same GEOS minimum as :func:`~camtool.verify.nearest_exact._nearby_exact`.
 
-    (Not always :func:`~camtool.verify.metrics._all_exact`'s: with a segment 2.3 mm long
+    (Not always :func:`~camtool.verify.nearest_exact._all_exact`'s: with a segment 2.3 mm long
     joining two passes, GEOS's tree query and its plain distance were seen 1 ulp apart.)
     """
     rng = np.random.default_rng(200 + seed)
@@ -162,11 +166,11 @@ def test_nearby_boxes_is_the_kd_tree_nearby_query_bit_for_bit(seed: int) -> None
         samples = _samples(rng, pts, 400, reach=float(rng.choice([0.0015, 1.5])))
         half = float(np.max(np.hypot(*(b - a).T))) / 2.0
         ends = cKDTree(np.concatenate([a, b]))
-        upper, _ = metrics._nearest_chunk(samples, a, b, ends, half)
+        upper, _ = nearest_exact._nearest_chunk(samples, a, b, ends, half)
         tree = nearkernels.tree(np.concatenate([a, b]))
-        fast = metrics._nearby_boxes(samples, upper, a, b, tree, half, nearkernels)
+        fast = nearest_exact._nearby_boxes(samples, upper, a, b, tree, half, nearkernels)
         assert fast is not None
-        assert np.array_equal(fast, metrics._nearby_exact(samples, upper, a, b, ends, half))
+        assert np.array_equal(fast, nearest_exact._nearby_exact(samples, upper, a, b, ends, half))
 
 
 def test_nearby_boxes_gives_way_over_the_pair_limit(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -175,8 +179,8 @@ def test_nearby_boxes_gives_way_over_the_pair_limit(monkeypatch: pytest.MonkeyPa
     tree = nearkernels.tree(np.concatenate([a, b]))
     samples = pts[:50] + 0.001
     upper = np.full(50, 0.01)
-    monkeypatch.setattr(metrics, "NEARBY_MAX_PAIRS", 10)
-    assert metrics._nearby_boxes(samples, upper, a, b, tree, 0.002, nearkernels) is None
+    monkeypatch.setattr(nearest_exact, "NEARBY_MAX_PAIRS", 10)
+    assert nearest_exact._nearby_boxes(samples, upper, a, b, tree, 0.002, nearkernels) is None
 
 
 @pytest.mark.parametrize("chunk", [1, 2, 5, 37, 1000])
@@ -184,7 +188,7 @@ def test_nearby_min_in_groups_is_the_whole_pairs_answer_bit_for_bit(chunk: int) 
     """Measuring the pairs a few samples at a time changes no distance and no minimum.
 
     The reference is the one-group answer, computed here independently of
-    :func:`metrics._nearby_min`: GEOS's distance of every pair, the least per sample.
+    :func:`nearest_exact._nearby_min`: GEOS's distance of every pair, the least per sample.
     """
     import shapely
 
@@ -198,7 +202,7 @@ def test_nearby_min_in_groups_is_the_whole_pairs_answer_bit_for_bit(chunk: int) 
     lines = shapely.linestrings(np.stack([a, b], axis=1))
     pair_d = shapely.distance(shapely.points(samples)[owner], lines[seg % len(a)])
     expected = np.array([pair_d[owner == i].min() for i in range(len(samples))])
-    got = metrics._nearby_min(samples, owner, seg, a, b, chunk=chunk)
+    got = nearest_exact._nearby_min(samples, owner, seg, a, b, chunk=chunk)
     assert got.tobytes() == expected.tobytes()
 
 
@@ -208,31 +212,31 @@ def test_nearby_exact_in_groups_is_geos_over_all_segments(
 ) -> None:
     """The k-d tree's nearby pairs, asked a few samples at a time, give GEOS's exact minimum.
 
-    The reference is :func:`metrics._all_exact` (GEOS's nearest query over every segment)
+    The reference is :func:`nearest_exact._all_exact` (GEOS's nearest query over every segment)
     on a staircase trace of 1 µm steps with a far-off pass, where the upper bounds are the
     distances to the first segment (loose, so many pairs per sample).
     """
-    monkeypatch.setattr(metrics, "NEARBY_CHUNK_PAIRS", chunk)
+    monkeypatch.setattr(nearest_exact, "NEARBY_CHUNK_PAIRS", chunk)
     rng = np.random.default_rng(chunk)
     steps = rng.integers(0, 2, (400, 2)) * 0.001
     trace = np.cumsum(steps, axis=0)
     a, b = trace[:-1], trace[1:]
     samples = trace[rng.integers(0, len(trace), 40)] + rng.normal(0.0, 0.002, (40, 2))
-    upper = metrics._to_segments(
+    upper = nearest_exact._to_segments(
         samples, a[:1][None, :, :].repeat(40, 0), b[:1][None, :, :].repeat(40, 0)
     )[:, 0]
     half = float(np.max(np.hypot(*(b - a).T))) / 2.0
-    got = metrics._nearby_exact(samples, upper, a, b, cKDTree(np.concatenate([a, b])), half)
+    got = nearest_exact._nearby_exact(samples, upper, a, b, cKDTree(np.concatenate([a, b])), half)
     assert got is not None
-    assert got.tobytes() == metrics._all_exact(samples, a, b).tobytes()
+    assert got.tobytes() == nearest_exact._all_exact(samples, a, b).tobytes()
 
 
 @pytest.mark.parametrize("seed", range(4))
 def test_near_segments_is_the_numpy_form_bit_for_bit(seed: int) -> None:
     """The one-pass kernel gives the numpy form's distances, tie verdicts and asks.
 
-    The numpy form (:func:`metrics._near_segments_numpy`: :func:`metrics._to_segments`
-    and :func:`metrics._tied`) is the code the kernel replaced; on traces built to tie
+    The numpy form (:func:`nearest_search._near_segments_numpy`: :func:`nearest_exact._to_segments`
+    and :func:`nearest_search._tied`) is the code the kernel replaced; on traces built to tie
     (step grids, repeated passes, samples on the grid and a tool radius away) every
     distance the kernel settles has the same float64 bits, and it asks the k-d tree
     for exactly the same samples.
@@ -245,7 +249,7 @@ def test_near_segments_is_the_numpy_form_bit_for_bit(seed: int) -> None:
         points = np.concatenate([a, b])
         samples = _samples(rng, pts, 2000, reach=float(rng.choice([0.0015, 0.1, 1.5])))
         every = nearkernels.tree(points, merge=False)  # the reference: each end its own place
-        want = metrics._near_segments_numpy(samples, a, b, every, nearkernels)
+        want = nearest_search._near_segments_numpy(samples, a, b, every, nearkernels)
         places = nearkernels.tree(points, segments=True)  # as nearest_distances builds it
         got = nearkernels.near_segments(samples, *places, a, b, 4)
         assert np.array_equal(got[3], want[3])  # the same samples ask the k-d tree
@@ -266,7 +270,7 @@ def test_segment_distance_is_numpys_on_awkward_segments() -> None:
     t = rng.choice([-1.0, 0.0, 0.5, 1.0, 2.0, 0.3], size=(n, 1))
     off = rng.choice([0.0, 1e-15, 1e-3], size=(n, 1)) * rng.normal(size=(n, 2))
     p = a + t * (b - a) + off
-    want = metrics._to_segments(p, a[:, None, :], b[:, None, :])[:, 0]
+    want = nearest_exact._to_segments(p, a[:, None, :], b[:, None, :])[:, 0]
     got = np.array([nearkernels._segment(p[i, 0], p[i, 1], a, b, i) for i in range(n)])
     assert got.tobytes() == want.tobytes()
 
@@ -306,11 +310,11 @@ def test_nearby_min_compiled_is_the_geos_grouping(
     counts = rng.integers(1, 30, size=len(p))
     owner = np.repeat(np.arange(len(p)), counts)
     seg = rng.integers(0, 2 * len(a), size=len(owner))  # ends of a or b: seg % len(a)
-    assert metrics._pair_kernels(1) is nearkernels  # numba is loaded: the compiled form
-    compiled = metrics._nearby_min(p, owner, seg, a, b)
-    monkeypatch.setattr(metrics, "_pair_kernels", lambda pairs: None)
-    for chunk in (7, metrics.NEARBY_CHUNK_PAIRS):
-        assert metrics._nearby_min(p, owner, seg, a, b, chunk).tobytes() == compiled.tobytes()
+    assert nearest_exact._pair_kernels(1) is nearkernels  # numba is loaded: the compiled form
+    compiled = nearest_exact._nearby_min(p, owner, seg, a, b)
+    monkeypatch.setattr(nearest_exact, "_pair_kernels", lambda pairs: None)
+    for chunk in (7, nearest_exact.NEARBY_CHUNK_PAIRS):
+        assert nearest_exact._nearby_min(p, owner, seg, a, b, chunk).tobytes() == compiled.tobytes()
 
 
 def test_the_box_tree_searches_only_samples_far_from_the_segments(
@@ -324,11 +328,11 @@ def test_the_box_tree_searches_only_samples_far_from_the_segments(
     tree = nearkernels.tree(np.concatenate([line[:-1], line[1:]]))
     off = np.c_[np.arange(0.0, 20.0, 0.005), np.full(4000, 1.5)]
     on = off * [1.0, 0.0] + [0.001, 0.0001]
-    assert metrics._far(off, tree, 0.002, nearkernels)
-    assert not metrics._far(on, tree, 0.002, nearkernels)
+    assert nearest_search._far(off, tree, 0.002, nearkernels)
+    assert not nearest_search._far(on, tree, 0.002, nearkernels)
     for samples in (off, on):
-        want = metrics.nearest_distances_kd(samples, line[:-1], line[1:])
-        got = metrics.nearest_distances(samples, line[:-1], line[1:])
+        want = nearest_search.nearest_distances_kd(samples, line[:-1], line[1:])
+        got = nearest_search.nearest_distances(samples, line[:-1], line[1:])
         assert got.tobytes() == want.tobytes()
 
 
@@ -343,18 +347,20 @@ def test_farthest_off_is_the_largest_offset_distance_bit_for_bit(
     1.5 mm from the tool centre); the k-d tree of every end is built only where a tied
     sample can be the largest, and some cases need none at all. ``every``: every
     sample is taken as able to reach the largest, so the k-d tree's choice and the exact
-    stage are made for all of them, as :func:`metrics.nearest_distances` makes them.
+    stage are made for all of them, as :func:`nearest_search.nearest_distances` makes them.
     """
     if every:
-        monkeypatch.setattr(metrics, "_can_reach", lambda upper, *args: np.ones(len(upper), bool))
+        monkeypatch.setattr(
+            nearest_search, "_can_reach", lambda upper, *args: np.ones(len(upper), bool)
+        )
     built = [0]
-    tree = metrics._LazyTree.tree
+    tree = nearest_search._LazyTree.tree
 
-    def counted(self: metrics._LazyTree) -> object:
+    def counted(self: nearest_search._LazyTree) -> object:
         built[0] += self._tree is None
         return tree.fget(self)  # type: ignore[attr-defined]
 
-    monkeypatch.setattr(metrics._LazyTree, "tree", property(counted))
+    monkeypatch.setattr(nearest_search._LazyTree, "tree", property(counted))
     rng = np.random.default_rng(600 + seed)
     spared = used = 0
     for kind in range(12):
@@ -363,12 +369,12 @@ def test_farthest_off_is_the_largest_offset_distance_bit_for_bit(
         reach = float(rng.choice([0.0015, 0.1, 1.5]))
         samples = _samples(rng, pts, 2000, reach=reach)
         for offset in (0.0, 0.003, reach):
-            want = float(np.max(np.abs(metrics.nearest_distances(samples, a, b) - offset)))
+            want = float(np.max(np.abs(nearest_search.nearest_distances(samples, a, b) - offset)))
             before = built[0]
             with monkeypatch.context() as m:
                 if every:  # not by measuring every distance, its fallback
-                    m.setattr(metrics, "nearest_distances", None)
-                got = metrics.farthest_off(samples, a, b, offset)
+                    m.setattr(nearest_search, "nearest_distances", None)
+                got = nearest_search.farthest_off(samples, a, b, offset)
             assert got == want
             spared += built[0] == before
             used += built[0] != before
@@ -383,12 +389,12 @@ def test_farthest_off_asks_the_tree_for_every_tie_that_may_end_unsure(
     The exact stage then gets the unsure samples the full search gets, and the figure is
     the same.
     """
-    monkeypatch.setattr(metrics, "NEAREST_TOLERANCE_MM", 0.0)
+    monkeypatch.setattr(nearest_exact, "NEAREST_TOLERANCE_MM", 0.0)
     rng = np.random.default_rng(7)
     pts = _trace(rng, 1)
     a, b = pts[:-1], pts[1:]
     samples = _samples(rng, pts, 2000, reach=1.5)
-    want = float(np.max(np.abs(metrics.nearest_distances(samples, a, b) - 1.5)))
+    want = float(np.max(np.abs(nearest_search.nearest_distances(samples, a, b) - 1.5)))
     asked: list[int] = []
 
     class Counted:  # the k-d tree, counting the samples it is asked about
@@ -399,8 +405,10 @@ def test_farthest_off_asks_the_tree_for_every_tie_that_may_end_unsure(
             asked.append(len(x))
             return self.kd.query(x, *args, **kwargs)
 
-    monkeypatch.setattr(metrics._LazyTree, "tree", property(lambda self: Counted(self.points)))
-    assert metrics.farthest_off(samples, a, b, 1.5) == want
+    monkeypatch.setattr(
+        nearest_search._LazyTree, "tree", property(lambda self: Counted(self.points))
+    )
+    assert nearest_search.farthest_off(samples, a, b, 1.5) == want
     tree = nearkernels.tree(np.concatenate([a, b]), segments=True)
     ask = nearkernels.near_segments(samples, *tree, a, b, 4)[3]
     assert ask.any() and sum(asked) == int(ask.sum())

@@ -1,6 +1,6 @@
 """The overcut's least distance, measured only where it can be least, is the full minimum.
 
-``metrics._least_nearest`` measures every ``OVERCUT_ANCHOR``-th trace point first and
+``drawing_compare._least_nearest`` measures every ``OVERCUT_ANCHOR``-th trace point first and
 then only the points whose bound from the anchors beside them (the triangle inequality,
 less the search's tolerance) can reach the least anchor's distance. The judge is the
 plain form it replaced: ``np.min`` of :func:`nearest_distances` of every point, bit for
@@ -16,12 +16,12 @@ import math
 import numpy as np
 import pytest
 
-from camtool.verify import metrics
+from camtool.verify import drawing_compare, nearest_search
 
 
 def _plain(points: np.ndarray, samples: np.ndarray, sizes: list[int]) -> float:
-    same = metrics._same_contour(sizes)
-    d = metrics.nearest_distances(points, samples[:-1][same], samples[1:][same])
+    same = drawing_compare._same_contour(sizes)
+    d = nearest_search.nearest_distances(points, samples[:-1][same], samples[1:][same])
     return float(np.min(d)) if len(d) else math.inf
 
 
@@ -49,8 +49,8 @@ def test_least_nearest_is_the_minimum_of_every_point(seed: int) -> None:
     rng = np.random.default_rng(seed)
     samples, sizes = _drawing(rng)
     points = _trace(rng, int(rng.integers(20_000, 60_000)), gouges=int(rng.integers(0, 4)))
-    assert len(points) >= metrics.OVERCUT_PRUNE_FROM
-    assert metrics._least_nearest(points, samples, sizes) == _plain(points, samples, sizes)
+    assert len(points) >= drawing_compare.OVERCUT_PRUNE_FROM
+    assert drawing_compare._least_nearest(points, samples, sizes) == _plain(points, samples, sizes)
 
 
 @pytest.mark.parametrize("offset", [1, 2, 3])
@@ -58,13 +58,13 @@ def test_a_single_deep_point_between_anchors_is_found(
     offset: int, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """One point far nearer than its anchors: only the anchors' gap lets it through."""
-    monkeypatch.setattr(metrics, "OVERCUT_PRUNE_FROM", 0)
+    monkeypatch.setattr(drawing_compare, "OVERCUT_PRUNE_FROM", 0)
     rng = np.random.default_rng(offset)
     samples, sizes = _drawing(rng)
     points = _trace(rng, 4001, gouges=0)
     k = 4 * 500 + offset  # not an anchor
     points[k] = points[k] + (np.array([20.0, 20.0]) - points[k]) * 0.2  # 1.3 mm nearer
-    got = metrics._least_nearest(points, samples, sizes)
+    got = drawing_compare._least_nearest(points, samples, sizes)
     assert got == _plain(points, samples, sizes)
     assert got < 0.3
 
@@ -73,20 +73,20 @@ def test_few_points_or_no_chords(monkeypatch: pytest.MonkeyPatch) -> None:
     rng = np.random.default_rng(9)
     samples, sizes = _drawing(rng)
     points = _trace(rng, 500, gouges=1)  # under OVERCUT_PRUNE_FROM: measured at once
-    assert metrics._least_nearest(points, samples, sizes) == _plain(points, samples, sizes)
-    monkeypatch.setattr(metrics, "OVERCUT_PRUNE_FROM", 0)
+    assert drawing_compare._least_nearest(points, samples, sizes) == _plain(points, samples, sizes)
+    monkeypatch.setattr(drawing_compare, "OVERCUT_PRUNE_FROM", 0)
     single = np.asarray([[1.0, 2.0], [3.0, 4.0]])
-    assert metrics._least_nearest(points, single, [1, 1]) == math.inf  # two lone points
-    assert metrics._least_nearest(points[:0], samples, sizes) == math.inf
+    assert drawing_compare._least_nearest(points, single, [1, 1]) == math.inf  # two lone points
+    assert drawing_compare._least_nearest(points[:0], samples, sizes) == math.inf
 
 
 def test_every_point_an_anchor_or_a_candidate(monkeypatch: pytest.MonkeyPatch) -> None:
     """Anchors every point, or every 1 000th: the same minimum."""
-    monkeypatch.setattr(metrics, "OVERCUT_PRUNE_FROM", 0)
+    monkeypatch.setattr(drawing_compare, "OVERCUT_PRUNE_FROM", 0)
     rng = np.random.default_rng(4)
     samples, sizes = _drawing(rng)
     points = _trace(rng, 9000, gouges=3)
     want = _plain(points, samples, sizes)
     for every in (1, 2, 1000, 20_000):
-        monkeypatch.setattr(metrics, "OVERCUT_ANCHOR", every)
-        assert metrics._least_nearest(points, samples, sizes) == want
+        monkeypatch.setattr(drawing_compare, "OVERCUT_ANCHOR", every)
+        assert drawing_compare._least_nearest(points, samples, sizes) == want

@@ -20,7 +20,10 @@ from camtool.importers import read_drawing
 from camtool.jobs.pipeline import post_path
 from camtool.post.registry import load_target
 from camtool.toolpath.options import PlanOptions
-from camtool.verify import metrics
+from camtool.verify import cutting_thin, deviations, drawing_compare, nearest_search
+
+# what this file checks is done by the accelerated versions only (docs/architecture.md)
+pytestmark = pytest.mark.usefixtures("accel_on")
 
 SAMPLES = Path(__file__).resolve().parents[2] / "samples"
 
@@ -28,10 +31,14 @@ SAMPLES = Path(__file__).resolve().parents[2] / "samples"
 @pytest.mark.parametrize("name", ["logo.dxf", "plate.dxf", "pocket.dxf"])
 def test_the_preloads_follow_the_drawing_s_sample_count(name: str) -> None:
     drawing = read_drawing(SAMPLES / name)
-    samples, _ = metrics._sample_drawing_now(drawing, metrics.AGAINST_SPACING_MM)
-    tasks = metrics.comparison_preloads(drawing)
-    if len(samples) >= metrics.PREPARE_KERNELS_FROM:  # prepare_comparison loads the kernels
-        assert tasks == [metrics.near_kernels, metrics._first_call, metrics._load_kernels]
+    samples, _ = drawing_compare._sample_drawing_now(drawing, drawing_compare.AGAINST_SPACING_MM)
+    tasks = drawing_compare.comparison_preloads(drawing)
+    if len(samples) >= drawing_compare.PREPARE_KERNELS_FROM:  # prepare_comparison loads the kernels
+        assert tasks == [
+            nearest_search.near_kernels,
+            drawing_compare._first_call,
+            drawing_compare._load_kernels,
+        ]
     else:  # the logo (6 911 samples) keeps the k-d tree: nothing to load ahead
         assert tasks == []
 
@@ -48,11 +55,11 @@ def test_the_first_call_makes_one_call_of_the_kernels(monkeypatch: pytest.Monkey
         def build(points: np.ndarray) -> None:
             calls.append(points)
 
-    monkeypatch.setattr(metrics, "near_kernels", lambda *args: Kernels)
-    metrics._first_call()
+    monkeypatch.setattr(nearest_search, "near_kernels", lambda *args: Kernels)
+    drawing_compare._first_call()
     assert len(calls) == 1 and calls[0].shape == (1, 2) and calls[0].dtype == np.float64
-    monkeypatch.setattr(metrics, "near_kernels", lambda *args: None)
-    metrics._first_call()
+    monkeypatch.setattr(nearest_search, "near_kernels", lambda *args: None)
+    drawing_compare._first_call()
     assert len(calls) == 1
 
 
@@ -80,11 +87,11 @@ def test_point_distances_in_chunks_are_the_whole_answer_bit_for_bit(
     rng = np.random.default_rng(8)
     blocks = rng.integers(0, len(job.program.moves), size=5000)
     points = rng.uniform(-5.0, 105.0, size=(5000, 2))
-    nominal = metrics.nominal_arrays(job.program)
+    nominal = deviations.nominal_arrays(job.program)
     assert (nominal["kind"][blocks] == 1).any() and (nominal["kind"][blocks] == 0).any()
-    whole = metrics.point_distances(points, blocks, nominal)
-    monkeypatch.setattr(metrics, "POINT_CHUNK", 7)
-    assert metrics.point_distances(points, blocks, nominal).tobytes() == whole.tobytes()
+    whole = deviations.point_distances(points, blocks, nominal)
+    monkeypatch.setattr(deviations, "POINT_CHUNK", 7)
+    assert deviations.point_distances(points, blocks, nominal).tobytes() == whole.tobytes()
 
 
 @pytest.mark.parametrize(("offset", "tool"), [("outside", 0.5), ("outside", 3.0), ("on", 0.0)])
@@ -103,12 +110,12 @@ def test_the_budget_s_distance_is_the_comparison_s_bit_for_bit(offset: str, tool
     job = post_drawing(read_drawing(SAMPLES / "plate.dxf"), target, plan)
     v = verify_job(job, budget=False)
     assert v.drawing is not None and v.against is not None
-    thin = metrics.thin_cutting(*verifier._cutting_rows(v.program, v.trace))
+    thin = cutting_thin.thin_cutting(*verifier._cutting_rows(v.program, v.trace))
     nominal = verifier._nominal_lines(v.program) if v.findings else ()
     args = (thin, v.drawing, tool / 2.0)
-    full = metrics.against_thinned(*args, nominal=nominal, findings=v.findings)
+    full = drawing_compare.against_thinned(*args, nominal=nominal, findings=v.findings)
     assert full.max_um == v.against.max_um
-    worst = metrics.against_worst(*args, nominal=nominal, findings=v.findings)
+    worst = drawing_compare.against_worst(*args, nominal=nominal, findings=v.findings)
     assert worst == full.max_um
     assert bool(full.not_cut) == (offset == "outside")
 
@@ -121,9 +128,9 @@ from numba.core.registry import CPUDispatcher
 from camtool.jobs.pipeline import post_path, verify_job
 from camtool.post.registry import load_target
 from camtool.toolpath.options import PlanOptions
-from camtool.verify import metrics
+from camtool.verify import cutting_thin, deviations, drawing_compare, nearest_search
 
-kernels = metrics.near_kernels()
+kernels = nearest_search.near_kernels()
 
 def loaded():
     return sorted(

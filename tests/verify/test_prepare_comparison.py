@@ -11,7 +11,7 @@ from typing import Any
 import pytest
 
 from camtool.model.shapes import Contour, Drawing, Line
-from camtool.verify import metrics
+from camtool.verify import drawing_compare, nearest_search
 
 
 def _square(side: float) -> Drawing:
@@ -26,12 +26,12 @@ def test_a_drawing_is_sampled_and_the_kernels_loaded_when_it_is_large(
 ) -> None:
     """A 10 mm square: 8 001 points at 5 µm, under 20 000: the k-d tree stays; 110 mm: 88 001."""
     asked: list[Any] = []
-    monkeypatch.setattr(metrics, "near_kernels", lambda *a: asked.append(a))
+    monkeypatch.setattr(nearest_search, "near_kernels", lambda *a: asked.append(a))
     drawing = _square(side)
-    metrics.prepare_comparison(drawing)
-    ((seen, spacing, samples, sizes),) = metrics._SAMPLED
-    assert seen is drawing and spacing == metrics.AGAINST_SPACING_MM
+    drawing_compare.prepare_comparison(drawing)
+    ((seen, spacing, samples, sizes),) = drawing_compare._SAMPLED
+    assert seen is drawing and spacing == drawing_compare.AGAINST_SPACING_MM
     assert len(samples) == round(4 * side / 0.005) + 1 == sum(sizes)
     assert asked == ([()] if loads else [])
-    again, _ = metrics._sample_drawing(drawing, metrics.AGAINST_SPACING_MM)
+    again, _ = drawing_compare._sample_drawing(drawing, drawing_compare.AGAINST_SPACING_MM)
     assert again is samples  # what the comparison then takes: the same points, not resampled

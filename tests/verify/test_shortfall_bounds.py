@@ -1,11 +1,11 @@
 """The shortfall measures only the path samples that can be the largest (issue 17).
 
-:class:`camtool.verify.metrics._Bounded` bounds every path sample's distance to the
+:class:`camtool.verify.path_shortfall._Bounded` bounds every path sample's distance to the
 contour's thinned trace by a few segments at its place along the trace, and hands only
 the samples whose bound can reach the largest shortfall to
-:func:`camtool.verify.metrics._farthest_from_trace`. The figures must be the ones that
+:func:`camtool.verify.path_shortfall._farthest_from_trace`. The figures must be the ones that
 measuring every sample gives, bit for bit: the reference here is the loop
-:func:`camtool.verify.metrics.along_path` ran before (every sample of every contour,
+:func:`camtool.verify.path_shortfall.along_path` ran before (every sample of every contour,
 contours in order, the first strictly larger one kept), kept as the independent judge.
 """
 
@@ -17,12 +17,21 @@ import math
 import numpy as np
 import pytest
 
-from camtool.model.program import ArcMove, Linear, Program, Rapid
+from camtool.model.program import ArcMove, Linear, Program, Rapid, segment_of
 from camtool.post.registry import load_target
-from camtool.verify import metrics
+from camtool.verify import (
+    contour_measures,
+    deviations,
+    nearest_exact,
+    nearest_search,
+    path_shortfall,
+)
 from camtool.verify.simulate import simulate_steps
 from tests.verify.programs import TARGETS
 from tests.verify.programs import mixed_program as _program
+
+# what this file checks is done by the accelerated versions only (docs/architecture.md)
+pytestmark = pytest.mark.usefixtures("accel_on")
 
 
 def _shortfall_reference(
@@ -30,13 +39,11 @@ def _shortfall_reference(
 ) -> tuple[float, tuple[float, float], int, int]:
     """The shortfall as along_path measured it before the bounds: every sample, in order."""
     starts = [program.origin] + [(m.x, m.y) for m in program.moves]
-    runs = metrics.contour_runs(program)
+    runs = contour_measures.contour_runs(program)
     total = sum(
-        metrics.segment_of(starts[i], program.moves[i]).length
-        for a, b in runs
-        for i in range(a, b + 1)
+        segment_of(starts[i], program.moves[i]).length for a, b in runs for i in range(a, b + 1)
     )
-    spacing = max(metrics.ALONG_SPACING_MM, total / metrics.ALONG_MAX_SAMPLES)
+    spacing = max(path_shortfall.ALONG_SPACING_MM, total / path_shortfall.ALONG_MAX_SAMPLES)
     start = np.asarray(start_mm, dtype=np.float64).reshape(1, 2)
     worst: tuple[float, tuple[float, float], int] = (0.0, (0.0, 0.0), -1)
     count = 0
@@ -44,35 +51,37 @@ def _shortfall_reference(
         lo, hi = int(block_start[first]), int(block_start[last + 1])
         before = points[lo - 1 : lo] if lo > 0 else start
         run = np.vstack([before, points[lo:hi]])
-        samples, owner, _ = metrics._sample_moves(program, starts, first, last, spacing)
+        samples, owner, _ = path_shortfall._sample_moves(program, starts, first, last, spacing)
         count += len(samples)
         if len(samples) == 0:
             continue
         move_ends = block_start[first + 1 : last + 2] - lo
-        far, k = metrics._farthest_from_trace(samples, metrics._thinned(run, move_ends))
+        far, k = path_shortfall._farthest_from_trace(
+            samples, path_shortfall._thinned(run, move_ends)
+        )
         if far * 1000.0 > worst[0]:
             worst = (far * 1000.0, (float(samples[k, 0]), float(samples[k, 1])), int(owner[k]))
     return worst[0], worst[1], worst[2], count
 
 
-def _shortfall(along: metrics.AlongPath) -> tuple[float, tuple[float, float], int, int]:
+def _shortfall(along: path_shortfall.AlongPath) -> tuple[float, tuple[float, float], int, int]:
     return along.shortfall_um, along.shortfall_at_mm, along.shortfall_block, along.samples
 
 
 @pytest.mark.parametrize("name", TARGETS)
 @pytest.mark.parametrize("seed", range(3))
-@pytest.mark.parametrize("bound_from", [0, metrics.SHORTFALL_BOUND_FROM])
+@pytest.mark.parametrize("bound_from", [0, path_shortfall.SHORTFALL_BOUND_FROM])
 def test_the_shortfall_is_the_one_of_every_sample(
     name: str, seed: int, bound_from: int, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Every contour bounded (0), and small ones measured at once (the default)."""
-    monkeypatch.setattr(metrics, "SHORTFALL_BOUND_FROM", bound_from)
+    monkeypatch.setattr(path_shortfall, "SHORTFALL_BOUND_FROM", bound_from)
     machine = load_target(name).machine
     program = _program(seed)
     trace = simulate_steps(program, machine)
     args = (trace.carriage_mm, trace.block_start, trace.start_mm, program)
     want = _shortfall_reference(*args)
-    got = _shortfall(metrics.along_path(*args))
+    got = _shortfall(path_shortfall.along_path(*args))
     assert got == want
     assert np.float64(got[0]).tobytes() == np.float64(want[0]).tobytes()
 
@@ -110,23 +119,23 @@ def test_equal_shortfalls_name_the_first_contour(
     ``later_first``: each later pass's bounds are made a little looser (still bounds),
     so the passes are measured last first. Every contour is bounded here, however small.
     """
-    monkeypatch.setattr(metrics, "SHORTFALL_BOUND_FROM", 0)
+    monkeypatch.setattr(path_shortfall, "SHORTFALL_BOUND_FROM", 0)
     if later_first:
-        sample, real = metrics._sample_moves, metrics._Bounded.of_run
+        sample, real = path_shortfall._sample_moves, path_shortfall._Bounded.of_run
         passing = [0]
 
         def samples_of(program: Program, starts: list, first: int, *rest: object) -> tuple:
             passing[0] = (first - 1) // 5  # the pass: its moves are 5k + 1 … 5k + 4
             return sample(program, starts, first, *rest)  # type: ignore[arg-type]
 
-        def looser(*args: object, **kwargs: object) -> metrics._Bounded:
+        def looser(*args: object, **kwargs: object) -> path_shortfall._Bounded:
             bounded = real(*args, **kwargs)  # type: ignore[arg-type]
             bounded.reach = bounded.reach + 1e-6 * passing[0]  # looser: still a bound
             bounded.reach_max = float(np.max(bounded.reach))
             return bounded
 
-        monkeypatch.setattr(metrics, "_sample_moves", samples_of)
-        monkeypatch.setattr(metrics._Bounded, "of_run", looser)
+        monkeypatch.setattr(path_shortfall, "_sample_moves", samples_of)
+        monkeypatch.setattr(path_shortfall._Bounded, "of_run", looser)
     moves: list[Linear | Rapid] = []
     rows = []
     for _ in range(3):
@@ -139,7 +148,7 @@ def test_equal_shortfalls_name_the_first_contour(
     args = (points, block_start, (0.0, 0.0), program)
     want = _shortfall_reference(*args)
     assert want[0] > 0 and want[2] in (1, 2, 3, 4)  # on the first pass
-    assert _shortfall(metrics.along_path(*args)) == want
+    assert _shortfall(path_shortfall.along_path(*args)) == want
 
 
 def _contour_case(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -160,17 +169,17 @@ def test_move_spans_name_each_moves_last_row_in_the_thinned_trace(
     seed: int, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     rng = np.random.default_rng(seed)
-    monkeypatch.setattr(metrics, "ALONG_MAX_TRACE", int(rng.integers(30, 2000)))
+    monkeypatch.setattr(path_shortfall, "ALONG_MAX_TRACE", int(rng.integers(30, 2000)))
     run, keep, _ = _contour_case(rng)
-    every = metrics._run_every(run)
+    every = path_shortfall._run_every(run)
     kept = np.zeros(len(run), dtype=bool)  # what _thinned keeps, from its docstring
     kept[::every] = True
     kept[-1] = True
     kept[keep] = True
-    first, last = metrics._move_spans(len(run), every, keep)
+    first, last = path_shortfall._move_spans(len(run), every, keep)
     assert np.array_equal(last, np.searchsorted(np.flatnonzero(kept), keep))
     assert np.array_equal(first, np.r_[0, last[:-1]])
-    thinned = metrics._thinned(run, keep)
+    thinned = path_shortfall._thinned(run, keep)
     assert np.array_equal(thinned[last], run[keep])
 
 
@@ -182,29 +191,32 @@ def test_a_bound_is_never_below_the_distance_to_the_whole_trace(name: str) -> No
     trace = simulate_steps(program, machine)
     points, block_start = trace.carriage_mm, trace.block_start
     starts = [program.origin] + [(m.x, m.y) for m in program.moves]
-    nominal = metrics.nominal_arrays(program)
-    for first, last in metrics.contour_runs(program):
+    nominal = deviations.nominal_arrays(program)
+    for first, last in contour_measures.contour_runs(program):
         lo, hi = int(block_start[first]), int(block_start[last + 1])
         run = np.vstack([points[lo - 1 : lo], points[lo:hi]])
-        samples, owner, t = metrics._sample_moves(program, starts, first, last, 0.001)
+        samples, owner, t = path_shortfall._sample_moves(program, starts, first, last, 0.001)
         keep = block_start[first + 1 : last + 2] - lo
         part = {k: v[first : last + 1] for k, v in nominal.items()}
-        bounded = metrics._Bounded.of_run(samples, owner - first, t, run, keep, part)
-        thinned = metrics._thinned(run, keep)
+        bounded = path_shortfall._Bounded.of_run(samples, owner - first, t, run, keep, part)
+        thinned = path_shortfall._thinned(run, keep)
         if len(thinned) < 2:  # one point: the distance to it
             point = np.hypot(*(samples - thinned[0]).T)
-            assert np.all(bounded.reach >= point + metrics.NEAREST_TOLERANCE_MM)
+            assert np.all(bounded.reach >= point + nearest_exact.NEAREST_TOLERANCE_MM)
             continue
         a, b = thinned[:-1], thinned[1:]
         every = np.array(
-            [metrics._to_segments(s[None, :], a[None, :], b[None, :]).min() for s in samples[::7]]
+            [
+                nearest_exact._to_segments(s[None, :], a[None, :], b[None, :]).min()
+                for s in samples[::7]
+            ]
         )
-        upper = metrics._window_bounds(samples, owner - first + t, bounded.places)
+        upper = path_shortfall._window_bounds(samples, owner - first + t, bounded.places)
         assert np.all(upper[::7] >= every * (1 - 1e-12))
-        assert np.all(bounded.reach[::7] >= every + metrics.NEAREST_TOLERANCE_MM)
+        assert np.all(bounded.reach[::7] >= every + nearest_exact.NEAREST_TOLERANCE_MM)
         # tight where the trace follows the path (the point of them); i8751's lines
         # stray up to 0.5 mm from it, so its nearest rows may lie elsewhere (still right)
-        excess = np.median(upper - metrics.nearest_distances(samples, a, b))
+        excess = np.median(upper - nearest_search.nearest_distances(samples, a, b))
         assert name == "i8751" or excess < 1e-4
 
 
@@ -216,15 +228,15 @@ def test_a_floor_leaves_out_only_samples_that_cannot_reach_it(seed: int) -> None
     trace = simulate_steps(program, machine)
     points, block_start = trace.carriage_mm, trace.block_start
     starts = [program.origin] + [(m.x, m.y) for m in program.moves]
-    nominal = metrics.nominal_arrays(program)
-    first, last = metrics.contour_runs(program)[0]
+    nominal = deviations.nominal_arrays(program)
+    first, last = contour_measures.contour_runs(program)[0]
     lo, hi = int(block_start[first]), int(block_start[last + 1])
     run = np.vstack([points[lo - 1 : lo] if lo else np.zeros((1, 2)), points[lo:hi]])
-    samples, owner, t = metrics._sample_moves(program, starts, first, last, 0.001)
+    samples, owner, t = path_shortfall._sample_moves(program, starts, first, last, 0.001)
     keep = block_start[first + 1 : last + 2] - lo
     part = {k: v[first : last + 1] for k, v in nominal.items()}
-    want = metrics._farthest_from_trace(samples, metrics._thinned(run, keep))
-    bounded = metrics._Bounded.of_run(samples, owner - first, t, run, keep, part)
+    want = path_shortfall._farthest_from_trace(samples, path_shortfall._thinned(run, keep))
+    bounded = path_shortfall._Bounded.of_run(samples, owner - first, t, run, keep, part)
     for floor in (0.0, want[0] / 2, want[0], math.nextafter(want[0], 1.0), 2 * want[0] + 1e-3):
         got = bounded.farthest(floor)
         if floor <= want[0]:
@@ -240,7 +252,7 @@ def test_a_streamed_shortfall_is_the_whole_ones(
     """Streamed (batches bounded against the worst so far, or all measured): the same."""
     from camtool.verify.verifier import verify_program
 
-    monkeypatch.setattr(metrics, "SHORTFALL_BOUND_FROM", bound_from)
+    monkeypatch.setattr(path_shortfall, "SHORTFALL_BOUND_FROM", bound_from)
     machine = load_target("pic-mmh").machine
     for seed in range(3):
         program = _program(seed)
@@ -279,13 +291,13 @@ def test_the_likeliest_samples_measured_first_leave_most_out(
     trace = simulate_steps(program, machine)
     want = _shortfall_reference(trace.carriage_mm, trace.block_start, trace.start_mm, program)
     measured = [0]
-    real = metrics.farthest_nearest
+    real = nearest_search.farthest_nearest
 
     def spy(samples: np.ndarray, a: np.ndarray, b: np.ndarray, **kw: object) -> tuple[float, int]:
         measured[0] += len(samples)
         return real(samples, a, b, **kw)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(metrics, "farthest_nearest", spy)
+    monkeypatch.setattr(nearest_search, "farthest_nearest", spy)
     if streamed:
         v = verify_program(
             program, machine, name="pic-mmh", budget=False, chunk_rows=300, stream_above=10
@@ -293,7 +305,9 @@ def test_the_likeliest_samples_measured_first_leave_most_out(
         along = v.along
         assert along is not None
     else:
-        along = metrics.along_path(trace.carriage_mm, trace.block_start, trace.start_mm, program)
+        along = path_shortfall.along_path(
+            trace.carriage_mm, trace.block_start, trace.start_mm, program
+        )
     assert _shortfall(along) == want
     assert measured[0] < 0.2 * along.samples, (measured[0], along.samples)  # 51 % before
 
@@ -309,24 +323,24 @@ def test_a_streamed_contour_builds_its_search_trees_once(monkeypatch: pytest.Mon
 
     builds: list[tuple[int, bool]] = []
     kd: list[int] = []
-    real_tree = metrics._ends_tree
+    real_tree = nearest_search._ends_tree
 
     def ends_tree(points: np.ndarray, samples: int, kernels: object) -> tuple[object, ...]:
         got = real_tree(points, samples, kernels)  # type: ignore[arg-type]
         builds.append((len(points), len(got[0]) < len(points)))
         return got
 
-    real_kd = metrics._LazyTree.tree.fget
+    real_kd = nearest_search._LazyTree.tree.fget
     assert real_kd is not None
 
-    def kd_tree(self: metrics._LazyTree) -> object:
+    def kd_tree(self: nearest_search._LazyTree) -> object:
         if self._tree is None:
             kd.append(len(self.points))
         return real_kd(self)
 
-    monkeypatch.setattr(metrics, "_ends_tree", ends_tree)
-    monkeypatch.setattr(metrics._LazyTree, "tree", property(kd_tree))
-    monkeypatch.setattr(metrics, "STREAM_SAMPLES", 3000)  # several batches per contour
+    monkeypatch.setattr(nearest_search, "_ends_tree", ends_tree)
+    monkeypatch.setattr(nearest_search._LazyTree, "tree", property(kd_tree))
+    monkeypatch.setattr(path_shortfall, "STREAM_SAMPLES", 3000)  # several batches per contour
     machine = load_target("pic-mmh").machine
     moves = [Rapid(0.5, 0.5, contour=1)]
     for k in range(8):  # long lines along X, back and forth, 0.137 mm apart

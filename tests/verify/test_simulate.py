@@ -16,7 +16,7 @@ from camtool.model.machine import Machine, machine_from_table, merge_tables
 from camtool.model.program import ArcMove, Linear, Program, Rapid
 from camtool.post.registry import machine_table
 from camtool.verify.circlefit import fit_circle
-from camtool.verify.metrics import nominal_arrays, point_distances
+from camtool.verify.deviations import nominal_arrays, point_distances
 from camtool.verify.motion import StepTrace
 from camtool.verify.simulate import simulate_steps
 from camtool.verify.verifier import verify_program

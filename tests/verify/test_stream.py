@@ -18,11 +18,14 @@ import pytest
 from camtool.model.program import Program
 from camtool.model.shapes import Drawing
 from camtool.post.registry import load_target
-from camtool.verify import verifier
+from camtool.verify import cutting_thin, path_shortfall, trace_measures, verifier
 from camtool.verify.simulate import ChunkedSimulation, StreamedTrace, simulate_steps
 from camtool.verify.verifier import build_report, verify_program
 from tests.verify.programs import TARGETS
 from tests.verify.programs import mixed_program as _program
+
+# what this file checks is done by the accelerated versions only (docs/architecture.md)
+pytestmark = pytest.mark.usefixtures("accel_on")
 
 kernels = pytest.importorskip("camtool.accel.kernels")
 
@@ -148,7 +151,7 @@ def test_a_streamed_rms_is_the_exact_mean() -> None:
         program, target.machine, name="pic-mmh", budget=False, chunk_rows=100, stream_above=10
     )
     whole = simulate_steps(program, target.machine)
-    from camtool.verify.metrics import nominal_arrays, point_distances
+    from camtool.verify.deviations import nominal_arrays, point_distances
 
     nominal = nominal_arrays(program)
     cutting = nominal["kind"][whole.block_of_row] != 2
@@ -264,7 +267,7 @@ def test_extent_of_a_nan_first_point() -> None:
 
 @pytest.mark.parametrize("seed", range(12))
 def test_compiled_to_line_is_the_numpy_distance_bit_for_bit(seed: int) -> None:
-    from camtool.verify.metrics import _to_line
+    from camtool.verify.deviations import _to_line
 
     rng = np.random.default_rng(seed)
     scale = 10.0 ** rng.uniform(-4, 3)
@@ -287,10 +290,10 @@ def test_a_contour_thinned_on_the_fly_keeps_the_points_thinned_keeps(
     seed: int, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """A streamed contour keeps the points :func:`_thinned` keeps of the whole run."""
-    from camtool.verify import metrics
+    from camtool.verify import path_shortfall
 
     rng = np.random.default_rng(seed)
-    monkeypatch.setattr(metrics, "ALONG_MAX_TRACE", int(rng.integers(50, 3000)))
+    monkeypatch.setattr(path_shortfall, "ALONG_MAX_TRACE", int(rng.integers(50, 3000)))
     counts = rng.integers(0, 900, int(rng.integers(1, 12)))  # rows of each move
     counts[rng.random(len(counts)) < 0.2] = 0  # moves without rows
     rows = int(counts.sum())
@@ -299,8 +302,8 @@ def test_a_contour_thinned_on_the_fly_keeps_the_points_thinned_keeps(
     points = np.cumsum(rng.choice([-step, 0.0, step], size=(rows, 2)), axis=0)
     before = rng.random(2)
     run = np.vstack([before, points])
-    expected = metrics._thinned(run, block_start[1:])
-    contour = metrics._Contour(1, 0, len(counts) - 1, block_start)
+    expected = path_shortfall._thinned(run, block_start[1:])
+    contour = trace_measures._Contour(1, 0, len(counts) - 1, block_start)
     contour.add(0, before.reshape(1, 2))
     cuts = np.sort(rng.integers(0, rows + 1, int(rng.integers(0, 6))))
     for lo, hi in zip(np.r_[0, cuts], np.r_[cuts, rows], strict=True):
@@ -366,10 +369,9 @@ def test_a_streamed_verification_compares_the_drawing_as_the_whole_one(
     Few thinned rows (``CUT_MAX_ROWS``) and a short head, so the every-k-th, the runs' ends
     and the head all fall across chunk edges.
     """
-    from camtool.verify import metrics
 
-    monkeypatch.setattr(metrics, "CUT_MAX_ROWS", 97)
-    monkeypatch.setattr(metrics, "CUT_HEAD_ROWS", 11)
+    monkeypatch.setattr(cutting_thin, "CUT_MAX_ROWS", 97)
+    monkeypatch.setattr(cutting_thin, "CUT_HEAD_ROWS", 11)
     target = load_target(name)
     program = _program(seed)
     drawing = _drawn(program)
@@ -403,11 +405,11 @@ def test_the_cutting_stream_keeps_the_rows_the_whole_trace_keeps(
     The reference is what :func:`against_drawing` does with the whole cutting trace
     (``_cutting_rows``, then the every-k-th from its head and ``_thin_index``).
     """
-    from camtool.verify import metrics
+    from camtool.verify import cutting_thin
 
     rng = np.random.default_rng(seed)
-    monkeypatch.setattr(metrics, "CUT_MAX_ROWS", int(rng.integers(1, 400)))
-    monkeypatch.setattr(metrics, "CUT_HEAD_ROWS", int(rng.integers(2, 60)))
+    monkeypatch.setattr(cutting_thin, "CUT_MAX_ROWS", int(rng.integers(1, 400)))
+    monkeypatch.setattr(cutting_thin, "CUT_HEAD_ROWS", int(rng.integers(2, 60)))
     counts = rng.integers(0, 300, int(rng.integers(1, 30)))  # rows of each move
     counts[rng.random(len(counts)) < 0.2] = 0
     rapid = rng.random(len(counts)) < 0.3
@@ -421,9 +423,13 @@ def test_the_cutting_stream_keeps_the_rows_the_whole_trace_keeps(
     runs = np.cumsum(~cutting)[cutting]
     cut = points[cutting]
     n = len(cut)
-    every = metrics._cut_every(cut[: min(n, metrics.CUT_HEAD_ROWS)], resolution)
-    keep = metrics._thin_index(n, metrics._cut_limit(n, every), runs) if n else np.zeros(0, int)
-    stream = metrics.CuttingStream(rapid, n, resolution)
+    every = cutting_thin._cut_every(cut[: min(n, cutting_thin.CUT_HEAD_ROWS)], resolution)
+    keep = (
+        cutting_thin._thin_index(n, cutting_thin._cut_limit(n, every), runs)
+        if n
+        else np.zeros(0, int)
+    )
+    stream = cutting_thin.CuttingStream(rapid, n, resolution)
     edges = np.sort(rng.integers(0, len(blocks) + 1, int(rng.integers(0, 12))))
     if seed % 3 == 1:
         edges = np.arange(len(blocks) + 1)  # a row at a time: every row waits for the next
@@ -436,7 +442,7 @@ def test_the_cutting_stream_keeps_the_rows_the_whole_trace_keeps(
 
 
 def test_the_cutting_stream_refuses_rows_it_was_not_told_of() -> None:
-    from camtool.verify.metrics import CuttingStream
+    from camtool.verify.cutting_thin import CuttingStream
 
     stream = CuttingStream(np.zeros(1, dtype=bool), 5, 0.0005)
     stream.add(np.zeros((3, 2)), np.zeros(3, dtype=np.int64))
@@ -453,10 +459,9 @@ def test_a_streamed_picture_keeps_the_rows_around_the_worst_point(
     Every k-th row alone (k = rows / PICTURE_ROWS) left the zoom of a 13 M-row job with
     the worst point's marker and nothing else.
     """
-    from camtool.verify import metrics
 
-    monkeypatch.setattr(metrics, "PICTURE_ROWS", 50)
-    monkeypatch.setattr(metrics, "ZOOM_ROWS", 30)
+    monkeypatch.setattr(path_shortfall, "PICTURE_ROWS", 50)
+    monkeypatch.setattr(path_shortfall, "ZOOM_ROWS", 30)
     target = load_target(name)
     program = _program(4)
     whole = simulate_steps(program, target.machine)

@@ -1,0 +1,375 @@
+"""The exact stage of the nearest-segment search: GEOS distances to the segments near each sample.
+
+All inputs in mm, results in µm. Design notes: docs/internals.md, "The measures of a trace".
+"""
+
+from __future__ import annotations
+
+import itertools
+import sys
+from collections.abc import Callable
+from types import ModuleType
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from camtool import accel
+from camtool.accel.pool import each_threaded
+
+FloatArray = npt.NDArray[np.float64]
+IntArray = npt.NDArray[np.int64]
+
+
+NEAREST_TOLERANCE_MM = 1e-5
+"""Largest error :func:`nearest_distances` accepts from its vertex bound, mm (0.01 µm)."""
+
+
+NEAREST_ENDS = 4
+"""Segment ends :func:`nearest_distances` looks at around each sample."""
+
+
+KD_WORKERS = -1
+"""Threads of the k-d tree queries (scipy's ``workers``; -1: one per core). Each query is
+answered alone, so the distances do not depend on it; only the wall time does."""
+
+
+def _to_segments(p: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
+    """``(N, K)`` distances of points ``p`` ``(N, 2)`` to segments ``a → b`` ``(N, K, 2)``."""
+    ab = b - a
+    ap = p[:, None, :] - a
+    length2 = np.einsum("nkj,nkj->nk", ab, ab)
+    t = np.divide(
+        np.einsum("nkj,nkj->nk", ap, ab), length2, out=np.zeros_like(length2), where=length2 > 0
+    )
+    t = np.clip(t, 0.0, 1.0)
+    off = ap - t[..., None] * ab
+    return np.sqrt(np.einsum("nkj,nkj->nk", off, off))
+
+
+def _reaching(upper: FloatArray, settled: FloatArray, samples: FloatArray) -> npt.NDArray[np.bool_]:
+    """Which unsure samples (distance at most ``upper``) may reach the largest ``settled``.
+
+    A sample's exact distance is at most ``upper`` (the segments of its nearest ends)
+    up to the rounding of two formulas for one distance: a few ulps of the distance,
+    and near a segment a few ulps of the coordinates. The margin (a billionth, plus
+    1e-12 mm and 64 ulps of the largest coordinate of ``samples``) covers both, so a
+    sample left out is strictly below the largest settled distance, which is at most
+    the largest of all.
+    """
+    if len(settled) == 0:
+        return np.ones(len(upper), dtype=bool)
+    top = float(np.max(settled))
+    slack = 1e-12 + 64.0 * float(np.spacing(np.max(np.abs(samples))))
+    return np.asarray(upper * (1.0 + 1e-9) + slack >= top)
+
+
+def _settle_unsure(
+    samples: FloatArray,
+    d: FloatArray,
+    unsure: npt.NDArray[np.bool_],
+    a: FloatArray,
+    b: FloatArray,
+    nearby: Callable[..., FloatArray | None],
+    *,
+    only_max: bool,
+) -> FloatArray:
+    """The exact stage of both searches: GEOS's distance where the cheap tests were unsure.
+
+    ``nearby(samples, upper, need=...)`` measures the segments near each unsure sample
+    (:func:`_nearby_boxes` or :func:`_nearby_exact`, ``None`` over the pair limit, then
+    :func:`_all_exact_where`); with ``only_max`` only the samples that can be the largest
+    (:func:`_reaching`). ``d`` is updated in place and returned.
+    """
+    if unsure.any():
+        need = _reaching(d[unsure], d[~unsure], samples) if only_max else None
+        exact = nearby(samples[unsure], d[unsure], need=need)
+        if exact is None:
+            exact = _all_exact_where(samples[unsure], d[unsure], a, b, need)
+        d[unsure] = exact
+    return d
+
+
+def _all_exact_where(
+    samples: FloatArray,
+    upper: FloatArray,
+    a: FloatArray,
+    b: FloatArray,
+    need: npt.NDArray[np.bool_] | None,
+) -> FloatArray:
+    """:func:`_all_exact` of the samples ``need`` names (all when ``None``); ``upper`` elsewhere."""
+    if need is None:
+        return _all_exact(samples, a, b)
+    out = upper.copy()
+    if need.any():
+        out[need] = _all_exact(samples[need], a, b)  # GEOS answers each sample alone
+    return out
+
+
+def _all_exact(samples: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
+    """The GEOS distance (shapely) from each sample to the nearest of all segments, mm.
+
+    What :func:`nearest_distances` gave before :func:`_nearby_exact` (its fallback, and
+    the reference the tests compare it with, bit for bit).
+
+    The samples are asked :data:`ALL_EXACT_CHUNK` at a time against one tree, a chunk
+    per core at once (shapely releases the GIL while GEOS works): GEOS answers each
+    point alone, so the distances are those of one query of them all, while only a few
+    chunks' point geometries (~100 bytes each) exist at once (5.9 M unsure samples of a
+    213-icon drawing took 1.3 GB in one query).
+    """
+    import shapely
+
+    tree = shapely.STRtree(shapely.linestrings(np.stack([a, b], axis=1)))
+    out = np.empty(len(samples), dtype=np.float64)
+
+    def nearest(lo: int) -> None:
+        points = shapely.points(samples[lo : lo + ALL_EXACT_CHUNK])
+        _, exact = tree.query_nearest(points, return_distance=True, all_matches=False)
+        out[lo : lo + len(points)] = exact
+
+    each_threaded(nearest, range(0, len(samples), ALL_EXACT_CHUNK))  # each fills its rows
+    return out
+
+
+ALL_EXACT_CHUNK = 1 << 16
+"""Samples :func:`_all_exact` asks GEOS's nearest query at once (memory, not the answer)."""
+
+
+NEARBY_MAX_PAIRS = 4_000_000
+"""Most (sample, segment) pairs :func:`_nearby_exact` measures; beyond it :func:`_all_exact`."""
+
+
+def _nearby_exact(
+    samples: FloatArray,
+    upper: FloatArray,
+    a: FloatArray,
+    b: FloatArray,
+    ends: Any,
+    half: float,
+    need: npt.NDArray[np.bool_] | None = None,
+) -> FloatArray | None:
+    """:func:`_all_exact` over only the segments that can be the nearest, or ``None``.
+
+    A segment lies within ``L/2 <= half`` of one of its ends, so one whose ends are both
+    farther than ``upper + half`` from a sample lies farther than ``upper``, the distance
+    to a segment already found: it cannot be the nearest. The same GEOS distance is
+    taken over the rest, so the minimum is the one :func:`_all_exact` finds, without
+    building a tree of every segment for a few samples. ``None`` when the segments near
+    the samples are too many (over :data:`NEARBY_MAX_PAIRS` pairs).
+
+    Args:
+        samples: ``(U, 2)`` query points, mm.
+        upper: ``(U,)`` distance of each to some segment ``a → b``, mm.
+        a: ``(M, 2)`` segment starts, mm.
+        b: ``(M, 2)`` segment ends, mm.
+        ends: the k-d tree of ``concatenate([a, b])``.
+        half: half the longest segment, mm.
+        need: ``(U,)`` the samples to measure (``None``: all); the others keep ``upper``.
+            The limit counts the pairs of all samples, so which of the two ways gives a
+            sample's distance does not depend on ``need``.
+    """
+    reach = (upper + half) * (1.0 + 1e-9) + 1e-12  # a float margin: never leaves one out
+    counts = _counts_within(ends, samples, reach)
+    if counts is None:
+        return None
+    if counts.min() == 0:
+        return None  # cannot happen (the segment of ``upper`` is within reach): be safe
+    if need is not None:
+        out = upper.copy()
+        if need.any():
+            out[need] = _nearby_pairs(samples[need], reach[need], counts[need], a, b, ends)
+        return out
+    return _nearby_pairs(samples, reach, counts, a, b, ends)
+
+
+def _counts_within(ends: Any, samples: FloatArray, reach: FloatArray) -> IntArray | None:
+    """How many ends lie within ``reach`` of each sample, or ``None`` over the pair limit.
+
+    Counted :data:`NEARBY_COUNT_CHUNK` samples at a time (scipy's count holds a list per
+    sample while it runs: ~400 MB for 5.9 M samples in one call), stopping as soon as the
+    running total passes :data:`NEARBY_MAX_PAIRS`: the answer of one count of them all.
+    """
+    parts: list[IntArray] = []
+    total = 0
+    for lo in range(0, len(samples), NEARBY_COUNT_CHUNK):
+        part = slice(lo, lo + NEARBY_COUNT_CHUNK)
+        near = ends.query_ball_point(
+            samples[part], reach[part], return_length=True, workers=KD_WORKERS
+        )
+        total += int(np.sum(near))
+        if total > NEARBY_MAX_PAIRS:
+            return None
+        parts.append(np.asarray(near, dtype=np.int64))
+    return np.concatenate(parts) if parts else np.zeros(0, dtype=np.int64)
+
+
+NEARBY_COUNT_CHUNK = 1 << 16
+"""Samples :func:`_counts_within` counts at once (memory, and an early end over the limit)."""
+
+
+def _nearby_pairs(
+    samples: FloatArray,
+    reach: FloatArray,
+    counts: IntArray,
+    a: FloatArray,
+    b: FloatArray,
+    ends: Any,
+) -> FloatArray:
+    """:func:`_nearby_exact`'s GEOS minimum over the ends within ``reach`` (``counts`` of them)."""
+    out = np.empty(len(samples), dtype=np.float64)
+    ends_before = np.concatenate([[0], np.cumsum(counts)])
+    lo = 0
+    while lo < len(samples):  # a few samples at a time: their lists of ends are Python ints
+        hi = int(np.searchsorted(ends_before, ends_before[lo] + NEARBY_CHUNK_PAIRS, "right")) - 1
+        hi = min(max(hi, lo + 1), len(samples))
+        found = ends.query_ball_point(samples[lo:hi], reach[lo:hi], workers=KD_WORKERS)
+        owner = np.repeat(np.arange(hi - lo), counts[lo:hi])
+        seg = np.fromiter(itertools.chain.from_iterable(found), dtype=np.int64, count=len(owner))
+        out[lo:hi] = _nearby_min(samples[lo:hi], owner, seg, a, b)
+        lo = hi
+    return out
+
+
+def _nearby_boxes(
+    samples: FloatArray,
+    upper: FloatArray,
+    a: FloatArray,
+    b: FloatArray,
+    tree: tuple[Any, ...],
+    half: float,
+    kernels: ModuleType,
+    need: npt.NDArray[np.bool_] | None = None,
+) -> FloatArray | None:
+    """:func:`_nearby_exact` with the ends within reach from the box tree (numba).
+
+    The same GEOS distances over the segments with an end within reach (a margin wider:
+    any set holding those gives the same minimum), so the same answer.
+
+    Args:
+        samples: ``(U, 2)`` query points, mm.
+        upper: ``(U,)`` distance of each to some segment ``a → b``, mm.
+        a: ``(M, 2)`` segment starts, mm.
+        b: ``(M, 2)`` segment ends, mm.
+        tree: the ends' search tree (:func:`camtool.accel.nearkernels.tree`).
+        half: half the longest segment, mm.
+        kernels: :mod:`camtool.accel.nearkernels`.
+        need: as for :func:`_nearby_exact` (the limit counts every sample's pairs).
+    """
+    reach = ((upper + half) * (1.0 + 1e-9) + 1e-12) * (1.0 + 1e-12)
+    owner, seg = kernels.pairs_within(np.ascontiguousarray(samples), *tree, reach, NEARBY_MAX_PAIRS)
+    if len(owner) == 0 or len(np.unique(owner)) < len(samples):
+        return None  # over the limit (or, which cannot happen, a sample without one)
+    if need is None:
+        return _nearby_min(samples, owner, seg, a, b)
+    out = upper.copy()
+    if need.any():
+        keep = need[owner]
+        renumber = np.cumsum(need) - 1  # a needed sample's place among the needed
+        out[need] = _nearby_min(samples[need], renumber[owner[keep]], seg[keep], a, b)
+    return out
+
+
+NEARBY_CHUNK_PAIRS = 50_000
+"""Most ``(sample, segment)`` pairs :func:`_nearby_min` hands GEOS at once (memory)."""
+
+
+def _nearby_min(
+    samples: FloatArray,
+    owner: IntArray,
+    seg: IntArray,
+    a: FloatArray,
+    b: FloatArray,
+    chunk: int = NEARBY_CHUNK_PAIRS,
+) -> FloatArray:
+    """The least GEOS distance of each sample over its ``(owner, end)`` pairs (sample-major).
+
+    ``owner`` is ascending and names every sample at least once. The pairs are measured
+    a few samples at a time (about ``chunk`` pairs, a sample's pairs never split), which
+    bounds the memory GEOS's points and lines take; each pair's distance and each
+    sample's minimum are the same whatever the grouping. With numba
+    (:func:`_pair_kernels`) the same GEOS distances are taken compiled, in one pass
+    (:func:`camtool.accel.nearkernels.least_of_pairs`).
+    """
+    kernels = _pair_kernels(len(owner))
+    if kernels is not None:  # the same GEOS floats, compiled: no line objects
+        return np.asarray(
+            kernels.least_of_pairs(
+                np.ascontiguousarray(samples, dtype=np.float64),
+                np.ascontiguousarray(owner, dtype=np.int64),
+                np.ascontiguousarray(seg % len(a), dtype=np.int64),
+                np.ascontiguousarray(a, dtype=np.float64),
+                np.ascontiguousarray(b, dtype=np.float64),
+            ),
+            dtype=np.float64,
+        )
+    out = np.empty(len(samples), dtype=np.float64)
+    pos, count = 0, len(owner)
+    while pos < count:
+        end = min(pos + max(1, chunk), count)
+        if end < count:  # back to the first pair of the sample ``end`` falls in
+            end = int(np.searchsorted(owner, owner[end], side="left"))
+            if end <= pos:  # one sample has more pairs than ``chunk``: take them all
+                end = int(np.searchsorted(owner, owner[pos], side="right"))
+        first, last = int(owner[pos]), int(owner[end - 1])
+        out[first : last + 1] = _nearby_group(samples, owner[pos:end], seg[pos:end], a, b)
+        pos = end
+    return out
+
+
+PAIR_KERNELS_FROM = 200_000
+"""Pairs from which :func:`_nearby_min` loads the compiled GEOS distance when numba is not
+loaded yet (loading it costs about 0.5 s once; GEOS through shapely ~1 µs a pair)."""
+
+
+def _pair_kernels(pairs: int) -> ModuleType | None:
+    """:mod:`camtool.accel.nearkernels` for :func:`_nearby_min`, or ``None`` (GEOS).
+
+    Loaded when numba already is (its cached kernel loads in milliseconds) or for at
+    least :data:`PAIR_KERNELS_FROM` pairs; ``None`` without numba.
+    """
+    if not accel.enabled() or ("numba" not in sys.modules and pairs < PAIR_KERNELS_FROM):
+        return None
+    try:
+        from camtool.accel import nearkernels
+    except ImportError:
+        return None
+    return nearkernels
+
+
+def _nearby_group(
+    samples: FloatArray, owner: IntArray, seg: IntArray, a: FloatArray, b: FloatArray
+) -> FloatArray:
+    """:func:`_nearby_min` of consecutive samples ``owner[0]..owner[-1]`` (each with a pair)."""
+    import shapely
+
+    seg = seg % len(a)
+    pair = np.unique(owner * len(a) + seg)  # each (sample, segment) once, sample-major
+    owner, seg = pair // len(a), pair % len(a)
+    used, local = np.unique(seg, return_inverse=True)
+    lines = shapely.linestrings(np.stack([a[used], b[used]], axis=1))
+    first_sample = int(owner[0])
+    points = shapely.points(samples[first_sample : int(owner[-1]) + 1])
+    dist = shapely.distance(points[owner - first_sample], lines[local])
+    first = np.flatnonzero(np.r_[True, owner[1:] != owner[:-1]])
+    return np.asarray(np.minimum.reduceat(dist, first), dtype=np.float64)
+
+
+def _nearest_chunk(
+    samples: FloatArray, a: FloatArray, b: FloatArray, ends: Any, half: float
+) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
+    """:func:`nearest_distances` of a few samples from the k-d tree of segment ``ends``.
+
+    Returns:
+        The distances and which of them the tests could not settle.
+    """
+    k = min(NEAREST_ENDS, 2 * len(a))
+    r, index = ends.query(samples, k=k, workers=KD_WORKERS)
+    r = np.asarray(r, dtype=np.float64).reshape(len(samples), k)
+    seg = np.asarray(index).reshape(len(samples), k) % len(a)
+    d = _to_segments(samples, a[seg], b[seg]).min(axis=1)
+    lower = np.sqrt(np.maximum(r[:, 0] ** 2 - half * half, 0.0))
+    # exact where every segment that could be nearer had an end among the k found
+    # (its nearer end lies within d + L/2), or where the vertex bound is tight enough
+    sure = (d + half < r[:, -1]) | (k == 2 * len(a)) | (d - lower <= NEAREST_TOLERANCE_MM)
+    return d, ~sure

@@ -1,0 +1,518 @@
+"""The nearest-segment search: distances from sample points to the nearest of many segments.
+
+All inputs in mm, results in µm. Design notes: docs/internals.md, "The measures of a trace".
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import partial
+from types import ModuleType
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from camtool import accel
+from camtool.verify import nearest_exact
+
+FloatArray = npt.NDArray[np.float64]
+IntArray = npt.NDArray[np.int64]
+
+
+NEAREST_CHUNK = 20_000
+"""Samples :func:`nearest_distances` measures at once (memory ~ 1 kB each)."""
+
+
+def nearest_distances(
+    samples: FloatArray, a: FloatArray, b: FloatArray, *, ends: _LazyTree | None = None
+) -> FloatArray:
+    """Distance of each sample to the nearest segment ``a[i] → b[i]``, mm.
+
+    Exact to :data:`NEAREST_TOLERANCE_MM`. The segments owning the
+    :data:`NEAREST_ENDS` nearest segment ends (a scipy k-d tree) give a distance
+    ``d``; it is the true one when the k-th end lies farther than ``d + L/2``
+    (``L`` the longest segment: a nearer segment has an end within that), or
+    when the nearest end ``r`` bounds it tightly, ``sqrt(r² − L²/4) ≤ d``
+    (a segment whose ends are both ``r`` or more away comes no nearer than
+    that). Samples neither test settles get shapely's exact nearest query.
+
+    With numba (:func:`near_kernels`), the nearest ends come from
+    :func:`camtool.accel.nearkernels.knn`, the k-d tree's answer bit for bit
+    (where it cannot say so, from the k-d tree itself); the plain form is
+    :func:`nearest_distances_kd`, kept for comparison.
+
+    Args:
+        samples: ``(N, 2)`` query points, mm.
+        a: ``(M, 2)`` segment starts, mm.
+        b: ``(M, 2)`` segment ends, mm (``a[i] == b[i]``: a point).
+        ends: the k-d tree of ``concatenate([a, b])`` when the caller measures several
+            batches against the same segments (built here otherwise; the same answers).
+
+    Returns:
+        ``(N,)`` float64 distances, mm (``inf`` without segments).
+    """
+    return _nearest(samples, a, b, ends=ends, only_max=False)
+
+
+def farthest_nearest(
+    samples: FloatArray, a: FloatArray, b: FloatArray, *, ends: _LazyTree | None = None
+) -> tuple[float, int]:
+    """``max`` and first ``argmax`` of :func:`nearest_distances`, the same two numbers.
+
+    Only the largest distance is wanted (the shortfall of a path from its trace), so a
+    sample the cheap tests leave unsure is measured exactly only when it could reach
+    the largest one settled (its distance to the segments of its nearest ends is an
+    upper bound); the others cannot be the largest, nor tie with it.
+
+    Args:
+        samples: ``(N, 2)`` query points, mm, ``N >= 1``.
+        a: ``(M, 2)`` segment starts, mm.
+        b: ``(M, 2)`` segment ends, mm.
+        ends: as for :func:`nearest_distances`.
+
+    Returns:
+        ``(distance mm, index)`` of the first sample farthest from the segments.
+    """
+    d = _nearest(samples, a, b, ends=ends, only_max=True)
+    k = int(np.argmax(d))
+    return float(d[k]), k
+
+
+def _nearest(
+    samples: FloatArray, a: FloatArray, b: FloatArray, *, ends: _LazyTree | None, only_max: bool
+) -> FloatArray:
+    """:func:`nearest_distances`; with ``only_max``, exact only where it can be the largest.
+
+    With ``only_max`` an unsure sample that cannot reach the largest settled distance
+    keeps its upper bound (:func:`_reaching`): the array's max and argmax are exact.
+    """
+    search = _box_search(samples, a, b, ends)
+    if search is None:
+        return _nearest_kd(samples, a, b, ends=ends, only_max=only_max)
+    ends = ends or _LazyTree(search.points)
+    d = np.empty(len(samples), dtype=np.float64)
+    unsure = np.zeros(len(samples), dtype=bool)
+    for i in range(0, len(samples), NEAREST_CHUNK):
+        part = slice(i, i + NEAREST_CHUNK)
+        near, rk, lower, ask = search.measure(part)
+        if ask.any():  # ends tie at the k-th distance and the k-d tree's choice matters
+            rows = np.flatnonzero(ask) + i
+            near[rows - i] = search.chosen(ends, rows)
+        d[part] = near
+        unsure[part] = ~search.settled(near, rk, lower)
+    return nearest_exact._settle_unsure(
+        search.samples, d, unsure, search.a, search.b, search.nearby, only_max=only_max
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class _BoxSearch:
+    """The compiled nearest search of some samples among segments ``a → b`` (:func:`_box_search`).
+
+    Attributes:
+        samples: ``(N, 2)`` the query points, C-contiguous float64, mm.
+        a: ``(M, 2)`` segment starts, likewise.
+        b: ``(M, 2)`` segment ends, likewise.
+        half: half the longest segment, mm.
+        points: ``concatenate([a, b])``, the ends (as the k-d tree of ties holds them).
+        tree: their search tree (:func:`_ends_tree`).
+        kernels: :mod:`camtool.accel.nearkernels`.
+    """
+
+    samples: FloatArray
+    a: FloatArray
+    b: FloatArray
+    half: float
+    points: FloatArray
+    tree: tuple[Any, ...]
+    kernels: ModuleType
+
+    def measure(self, part: slice) -> tuple[FloatArray, FloatArray, FloatArray, Any]:
+        """``near``, ``rk``, ``lower`` and ``ask`` of the samples ``part``.
+
+        :func:`camtool.accel.nearkernels.near_segments`' distance to the segments of the
+        nearest ends (unset where ``ask``: the k-d tree's choice among tied ends matters),
+        the k-th end's distance and the vertex bound ``sqrt(r0² − half²)``, with the
+        square roots the k-d tree takes.
+        """
+        near, r0_2, rk_2, ask = self.kernels.near_segments(
+            self.samples[part], *self.tree, self.a, self.b, nearest_exact.NEAREST_ENDS
+        )
+        lower = np.sqrt(np.maximum(np.sqrt(r0_2) ** 2 - self.half * self.half, 0.0))
+        return near, np.sqrt(rk_2), lower, ask
+
+    def chosen(self, ends: _LazyTree, rows: IntArray) -> FloatArray:
+        """The distance of samples ``rows`` to the segments of the ends the k-d tree keeps."""
+        x = self.samples[rows]
+        found = ends.tree.query(x, k=nearest_exact.NEAREST_ENDS, workers=nearest_exact.KD_WORKERS)[
+            1
+        ]
+        seg = np.asarray(found).reshape(-1, nearest_exact.NEAREST_ENDS) % len(self.a)
+        return nearest_exact._to_segments(x, self.a[seg], self.b[seg]).min(axis=1)
+
+    def settled(self, near: FloatArray, rk: FloatArray, lower: FloatArray) -> Any:
+        """Where ``near`` is the distance (:func:`nearest_distances`' two tests)."""
+        return (near + self.half < rk) | (near - lower <= nearest_exact.NEAREST_TOLERANCE_MM)
+
+    def nearby(self, samples: FloatArray, upper: FloatArray, need: Any = None) -> FloatArray | None:
+        """:func:`_nearby_boxes` among these segments."""
+        return nearest_exact._nearby_boxes(
+            samples, upper, self.a, self.b, self.tree, self.half, self.kernels, need
+        )
+
+
+def _box_search(
+    samples: FloatArray, a: FloatArray, b: FloatArray, ends: _LazyTree | None = None
+) -> _BoxSearch | None:
+    """The compiled search of ``samples`` among ``a → b``, or ``None`` for the k-d tree path.
+
+    ``None`` without the compiled search (:func:`near_kernels`: numba missing, or too few
+    samples in this process so far), for fewer than :data:`NEAREST_ENDS` ends, and for
+    many samples near the segments (:func:`_far`), which the k-d tree answers faster.
+    Both paths give the same distances. ``ends``: the segments' ends
+    (``concatenate([a, b])``, C-contiguous float64) with the search trees already built
+    for other samples; built here otherwise.
+    """
+    kernels = near_kernels(len(samples))
+    if kernels is None or len(a) == 0 or 2 * len(a) <= nearest_exact.NEAREST_ENDS:
+        return None
+    samples = np.ascontiguousarray(samples, dtype=np.float64)
+    if ends is None:
+        a = np.ascontiguousarray(a, dtype=np.float64)
+        b = np.ascontiguousarray(b, dtype=np.float64)
+        ends = _LazyTree(_end_points(a, b))
+    else:
+        a, b = _halves(np.ascontiguousarray(ends.points, dtype=np.float64))
+    half = ends.half()
+    many = len(samples) > BOX_TREE_UP_TO
+    if many and not _far(samples, ends.boxes(len(samples), kernels, any_built=True), half, kernels):
+        return None
+    tree = ends.boxes(len(samples), kernels)
+    return _BoxSearch(samples, a, b, half, ends.points, tree, kernels)
+
+
+def farthest_off(samples: FloatArray, a: FloatArray, b: FloatArray, offset: float) -> float:
+    """``max(|nearest_distances(samples, a, b) - offset|)``: the same float.
+
+    For a caller that needs only the largest offset distance (the error budget's
+    distance to the drawing: ``offset`` is the tool radius). The compiled search of
+    :func:`_nearest` settles most samples; the others are made exact as it makes them
+    only where they can reach the largest value, given bounds on their distance: at
+    most the segment distance found (a sample its tests leave unsure) or the k-th end's
+    distance (a sample where the k-d tree's choice among tied ends matters: every
+    segment it can keep has an end that near), at least ``sqrt(r0² − L²/4)`` (``r0``
+    the nearest end, ``L`` the longest segment), each widened by a billionth, 1e-12 mm
+    and 64 ulps of the largest coordinate for the rounding of two formulas. So the k-d
+    tree of every end is built only when a tied sample can be the largest: on issue
+    17's benchmark part none can, which spares a budget worker that tree (~0.3 s).
+
+    The exact stage gets what :func:`_settle_unsure` gets in :func:`_nearest` (the same
+    unsure samples, so the same choice between its two ways of measuring), so a tied
+    sample is left out only when it is sure whatever the k-d tree keeps (its upper bound
+    passes the vertex test); one that may end unsure is asked the k-d tree as
+    :func:`_nearest` asks it. Where :func:`_nearest` takes the k-d tree path
+    (:func:`_box_search` gives none), every distance is measured on it.
+
+    Args:
+        samples: ``(N, 2)`` query points, mm, ``N >= 1``.
+        a: ``(M, 2)`` segment starts, mm.
+        b: ``(M, 2)`` segment ends, mm.
+        offset: subtracted from each distance, mm.
+    """
+    search = _box_search(samples, a, b)
+    if search is None:
+        return _largest_off(_nearest_kd(samples, a, b, ends=None, only_max=False), offset)
+    n = len(samples)
+    d, lower, kth = np.empty(n), np.empty(n), np.empty(n)
+    ask = np.zeros(n, dtype=bool)
+    for i in range(0, n, NEAREST_CHUNK):
+        part = slice(i, i + NEAREST_CHUNK)
+        d[part], kth[part], lower[part], ask[part] = search.measure(part)
+    sure = ~ask & search.settled(d, kth, lower)
+    best = _largest_off(d[sure], offset)
+    slack = 1e-12 + 64.0 * float(np.spacing(np.max(np.abs(search.samples))))
+    low = lower * (1.0 - 1e-9) - slack
+    high = kth * (1.0 + 1e-9) + slack
+    surely = high - lower <= nearest_exact.NEAREST_TOLERANCE_MM  # sure whatever the k-d tree keeps
+    asked = ask & (~surely | _can_reach(high, low, offset, best))
+    if asked.any():  # the k-d tree's choice, as _nearest takes it
+        rows = np.flatnonzero(asked)
+        d[rows] = search.chosen(_LazyTree(search.points), rows)
+        sure[rows] = search.settled(d[rows], kth[rows], lower[rows])
+        best = max(best, _largest_off(d[rows[sure[rows]]], offset))
+    unsure = ~sure & (asked | ~ask)
+    if unsure.any():  # _settle_unsure's exact stage, only where a distance can be the largest
+        need = _can_reach(d[unsure] * (1.0 + 1e-9) + slack, low[unsure], offset, best)
+        x = search.samples[unsure]
+        exact = search.nearby(x, d[unsure], need)
+        if exact is None:
+            exact = nearest_exact._all_exact_where(x, d[unsure], search.a, search.b, need)
+        best = max(best, _largest_off(exact[need], offset))
+    return best
+
+
+def _can_reach(
+    upper: FloatArray, lower: FloatArray, offset: float, best: float
+) -> npt.NDArray[np.bool_]:
+    """Where a distance within ``[lower, upper]`` may be ``offset`` ± at least ``best``."""
+    return np.asarray((upper - offset >= best) | (offset - lower >= best))
+
+
+def _largest_off(distances: FloatArray, offset: float) -> float:
+    """``max(|distances - offset|)`` (``-inf`` for none)."""
+    return float(np.max(np.abs(distances - offset))) if len(distances) else -math.inf
+
+
+MERGE_ENDS_PER_SAMPLE = 16
+"""Ends per sample up to which :func:`_ends_tree` merges the ends at one point into a place."""
+
+
+def _ends_tree(points: FloatArray, samples: int, kernels: ModuleType) -> tuple[Any, ...]:
+    """The search tree of the segment ends ``points`` (``concatenate([a, b])``) for ``samples``.
+
+    :func:`camtool.accel.nearkernels.tree`, its places along the segments. The ends at
+    one point are one place for at least one sample per :data:`MERGE_ENDS_PER_SAMPLE`
+    ends: the 737 736 ends of the benchmark part are 115 838 places (two segments
+    meet at each, and the part is cut in three passes), and the drawing's search takes
+    about a fifth of the time; a few samples against a long trace (the shortfall's
+    unsure ones) search every end instead of paying for the merge. The answers are the
+    same.
+    """
+    merge = len(points) <= MERGE_ENDS_PER_SAMPLE * samples
+    return tuple(kernels.tree(points, segments=True, merge=merge))
+
+
+def _near_segments_numpy(
+    chunk: FloatArray,
+    a: FloatArray,
+    b: FloatArray,
+    tree: tuple[Any, ...],
+    kernels: ModuleType,
+) -> tuple[FloatArray, FloatArray, FloatArray, npt.NDArray[np.bool_]]:
+    """:func:`camtool.accel.nearkernels.near_segments` with numpy's segment distances.
+
+    The form it replaced (its :func:`_tied` and :func:`_to_segments` in numpy), kept
+    as the tests' reference: the same ``near``, ``r0_2``, ``rk_2`` and ``ask``.
+    """
+    k = nearest_exact.NEAREST_ENDS
+    r0_2, rk_2, index, state = kernels.knn(chunk, *tree, k)
+    seg = index % len(a)
+    near = nearest_exact._to_segments(chunk, a[seg], b[seg]).min(axis=1)
+    ask = np.zeros(len(chunk), dtype=bool)
+    tied = state != 0
+    if tied.any():
+        near[tied], asks = _tied(chunk[tied], rk_2[tied], a, b, tree, kernels)
+        ask[np.flatnonzero(tied)[asks]] = True
+    return near, r0_2, rk_2, ask
+
+
+def _tied(
+    samples: FloatArray,
+    kth2: FloatArray,
+    a: FloatArray,
+    b: FloatArray,
+    tree: tuple[Any, ...],
+    kernels: ModuleType,
+) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
+    """The k-d tree's ``d`` where ends tie at the k-th distance, when its choice cannot matter.
+
+    The k-d tree keeps every end nearer than the k-th distance (``S``) and some of those
+    exactly at it (``T``); ``d`` is the least segment distance over what it keeps. With
+    ``V`` the least over ``S`` and ``T``: when ``S`` reaches ``V``, or so many ends of
+    ``T`` reach it that any choice keeps one, ``d`` is ``V`` whatever it chose.
+
+    Returns:
+        ``d`` ``(U,)`` and ``(U,)`` True where the choice matters (``d`` is then unset).
+    """
+    least = np.empty(len(samples), dtype=np.float64)
+    settled = np.empty(len(samples), dtype=bool)
+    for i in range(0, len(samples), TIED_CHUNK):  # ~1.5 kB per sample at once
+        part = slice(i, i + TIED_CHUNK)
+        found, d2, count = kernels.within(samples[part], *tree, kth2[part])
+        cap = found.shape[1]
+        width = max(1, min(cap, int(count.max())))  # the columns any sample fills
+        found, d2 = found[:, :width], d2[:, :width]
+        valid = np.arange(width)[None, :] < count[:, None]
+        seg = found % len(a)
+        values = nearest_exact._to_segments(samples[part], a[seg], b[seg])
+        values[~valid] = np.inf
+        nearer = valid & (d2 < kth2[part, None])
+        at = valid & (d2 == kth2[part, None])
+        low = values.min(axis=1)
+        low_nearer = np.where(nearer, values, np.inf).min(axis=1)
+        pick = nearest_exact.NEAREST_ENDS - nearer.sum(axis=1)
+        reaching = (at & (values == low[:, None])).sum(axis=1)
+        least[part] = low
+        settled[part] = (count <= cap) & ((low_nearer == low) | (at.sum(axis=1) - reaching < pick))
+    return least, ~settled
+
+
+TIED_CHUNK = 2_000
+"""Samples :func:`_tied` measures at once."""
+
+
+class _LazyTree:
+    """The search structures of some points, each built when first asked for.
+
+    scipy's k-d tree (:attr:`tree`) and, for segment ends ``concatenate([a, b])``
+    (:func:`_end_points`), the compiled search's trees (:meth:`boxes`) and half the
+    longest segment (:meth:`half`): the batches of samples measured against one trace
+    share them instead of building them once a batch.
+    """
+
+    def __init__(self, points: FloatArray) -> None:
+        self.points = points
+        self._tree: Any = None
+        self._boxes: dict[bool, tuple[Any, ...]] = {}
+        self._half: float | None = None
+
+    @property
+    def tree(self) -> Any:
+        if self._tree is None:
+            from scipy.spatial import cKDTree
+
+            self._tree = cKDTree(self.points)
+        return self._tree
+
+    def half(self) -> float:
+        """Half the longest of the segments ``a[i] → b[i]`` whose ends these points are, mm."""
+        if self._half is None:
+            a, b = _halves(self.points)
+            self._half = float(np.max(np.hypot(*(b - a).T))) / 2.0
+        return self._half
+
+    def boxes(
+        self, samples: int, kernels: ModuleType, *, any_built: bool = False
+    ) -> tuple[Any, ...]:
+        """:func:`_ends_tree` of these segment ends for ``samples`` samples.
+
+        ``any_built``: a tree built already for another number of samples will do (the
+        same answers, :func:`_ends_tree`).
+        """
+        merge = len(self.points) <= MERGE_ENDS_PER_SAMPLE * samples
+        if any_built and self._boxes:
+            return next(iter(self._boxes.values()))
+        if merge not in self._boxes:
+            self._boxes[merge] = _ends_tree(self.points, samples, kernels)
+        return self._boxes[merge]
+
+
+def _halves(points: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """``(a, b)`` of segment ends ``concatenate([a, b])`` (views)."""
+    n = len(points) // 2
+    return points[:n], points[n:]
+
+
+NEAR_KERNELS_FROM = 500_000
+"""Samples :func:`nearest_distances` has measured in this process (this call's included)
+from which it loads the numba search: loading numba and its cache costs about 0.5 s and
+100 MB once, the search saves about 1–3 µs a sample (most far from the trace, a drawing
+point against the tool-centre path), so a small part (the logo) keeps the k-d tree."""
+
+
+_NEAR_KERNELS: dict[str, ModuleType | None] = {}
+
+
+_NEAR_WORK = [0]
+
+
+def near_kernels(work: int = NEAR_KERNELS_FROM) -> ModuleType | None:
+    """:mod:`camtool.accel.nearkernels` once the samples asked for reach the threshold.
+
+    ``work``: the samples the caller is about to measure, added to those before
+    (:data:`NEAR_KERNELS_FROM`; the default loads at once). ``None`` before that, with
+    ``CAMTOOL_ACCEL=0`` and without numba; :func:`nearest_distances_kd` then answers, the same.
+    """
+    if not accel.enabled():
+        return None
+    if "kernels" in _NEAR_KERNELS:
+        return _NEAR_KERNELS["kernels"]
+    _NEAR_WORK[0] += work
+    if _NEAR_WORK[0] < NEAR_KERNELS_FROM:
+        return None
+    kernels: ModuleType | None
+    try:
+        from camtool.accel import nearkernels as kernels
+    except ImportError:
+        kernels = None
+    _NEAR_KERNELS["kernels"] = kernels
+    return kernels
+
+
+def nearest_distances_kd(samples: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
+    """:func:`nearest_distances` with the nearest ends from scipy's k-d tree (the plain form)."""
+    return _nearest_kd(samples, a, b, ends=None, only_max=False)
+
+
+def _nearest_kd(
+    samples: FloatArray, a: FloatArray, b: FloatArray, *, ends: _LazyTree | None, only_max: bool
+) -> FloatArray:
+    """:func:`nearest_distances_kd` (``ends``, ``only_max``: as for :func:`_nearest`)."""
+    if len(a) == 0:
+        return np.full(len(samples), np.inf)
+    half = float(np.max(np.hypot(*(b - a).T))) / 2.0 if ends is None else ends.half()
+    tree = (ends or _LazyTree(_end_points(a, b))).tree
+    d = np.empty(len(samples), dtype=np.float64)
+    unsure = np.empty(len(samples), dtype=bool)
+    for i in range(0, len(samples), NEAREST_CHUNK):
+        part = slice(i, i + NEAREST_CHUNK)
+        d[part], unsure[part] = nearest_exact._nearest_chunk(samples[part], a, b, tree, half)
+    nearby = partial(nearest_exact._nearby_exact, a=a, b=b, ends=tree, half=half)
+    return nearest_exact._settle_unsure(samples, d, unsure, a, b, nearby, only_max=only_max)
+
+
+BOX_TREE_UP_TO = 20_000
+"""Samples up to which :func:`_nearest` asks the box tree it has built whether or not they
+lie far from the segments (:func:`_far`): the shortfall's few unsure samples
+(:class:`_Bounded`) search it in milliseconds, where a k-d tree would be built for them
+(and scipy loaded, ~0.3 s). Both give the same distances; only the time depends on it."""
+
+
+FAR_PROBE = 1000
+"""Samples :func:`_far` looks at (evenly spread)."""
+
+
+FAR_RATIO = 8.0
+"""Median nearest-end distance, in half the longest segment, from which the box tree
+searches (:func:`_far`)."""
+
+
+def _far(samples: FloatArray, tree: tuple[Any, ...], half: float, kernels: ModuleType) -> bool:
+    """Whether the samples lie far from the segments for their length: the box tree's case.
+
+    The compiled box tree answers a sample a tool radius from a dense trace (a drawing
+    point against the tool-centre path) 2–3× faster than scipy's k-d tree, but one near
+    the trace (a path sample, a drawing cut on its line) several times slower: a LibreCAD
+    hatch cut on the line took 13.6 s in the box tree and 2.0 s in the k-d tree. The
+    median distance of :data:`FAR_PROBE` samples to their nearest end, against half the
+    longest segment (:data:`FAR_RATIO`), decides. Both give the same distances; only the
+    time depends on it.
+    """
+    probe = np.ascontiguousarray(samples[:: max(1, len(samples) // FAR_PROBE)])
+    r0_2 = kernels.knn(probe, *tree, 1)[0]
+    return bool(np.median(r0_2) > (FAR_RATIO * half) ** 2)
+
+
+def _end_points(a: FloatArray, b: FloatArray) -> FloatArray:
+    """``concatenate([a, b])``: the segments' ends, as the searches' trees hold them.
+
+    Where ``a`` and ``b`` are already the two halves of one array of float64 (as
+    :func:`_chords` makes them), that array itself: the same values, without a second copy
+    of every end at the comparison's peak of memory (~11 MiB on the benchmark part).
+    """
+    base = a.base
+    if (
+        isinstance(base, np.ndarray)
+        and base is b.base
+        and base.dtype == np.float64
+        and base.flags.c_contiguous
+        and base.shape == (len(a) + len(b), 2)
+        and a.flags.c_contiguous
+        and b.flags.c_contiguous
+        and a.ctypes.data == base.ctypes.data
+        and b.ctypes.data == base.ctypes.data + a.nbytes
+    ):
+        return base
+    return np.concatenate([a, b])
