@@ -13,6 +13,7 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import cast
 
+from camtool import accel
 from camtool.importers.gcode_codes import BlockWords, Notes, g_key
 from camtool.importers.gcode_lexer import Block, Word, cut_mid_word, lex_line
 from camtool.model.errors import InputError
@@ -210,8 +211,11 @@ def parse_gcode(text: str, *, source: str) -> Program:
             whose end is off its circle beyond tolerance, a number out of range,
             a last line cut in the middle of a word, no move at all, or no
             cutting move.
+
+    Plain lines take the fast path (:meth:`_Reader.plain`, no word objects) unless
+    ``CAMTOOL_ACCEL=0``; :func:`parse_gcode_slow` is the reference, with the same result.
     """
-    return _parse(text, source, plain=True)
+    return _parse(text, source, plain=accel.enabled())
 
 
 def parse_gcode_slow(text: str, *, source: str) -> Program:

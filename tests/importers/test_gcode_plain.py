@@ -21,6 +21,9 @@ import pytest
 from camtool.importers.gcode import parse_gcode, parse_gcode_slow
 from camtool.model.errors import CamtoolError
 
+# the fast path against the reference: the accelerated versions on
+pytestmark = pytest.mark.usefixtures("accel_on")
+
 CORPUS = Path(__file__).resolve().parents[2] / ".corpus" / "pkg" / "linuxcnc"
 
 LINES = [
@@ -197,3 +200,24 @@ def test_plain_moves_are_made_as_their_init_makes_them() -> None:
             assert [getattr(fast, n) for n in names] == [getattr(made, n) for n in names]
             assert fast == made and hash(fast) == hash(made)
             assert pickle.loads(pickle.dumps(fast)) == made
+
+
+def test_switched_off_every_line_is_read_the_reference_way(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from camtool.importers import gcode
+
+    taken: list[int] = []
+    plain = gcode._Reader.plain
+
+    def spy(self: object, *args: object) -> bool:
+        taken.append(1)
+        return plain(self, *args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(gcode._Reader, "plain", spy)
+    program = "G21 G90\nG0 X0 Y0\nG1 X1 Y1 F100\nG2 X2 Y0 I0.5 J-0.5\nM2\n"
+    fast = repr(parse_gcode(program, source="p.ngc"))
+    assert taken
+    monkeypatch.setenv("CAMTOOL_ACCEL", "0")
+    taken.clear()
+    assert repr(parse_gcode(program, source="p.ngc")) == fast and not taken
