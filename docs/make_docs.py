@@ -30,7 +30,7 @@ from camtool.jobs.pipeline import OutputOptions, PostJob, post_file, verify_job
 from camtool.post.registry import load_target, target_names
 from camtool.preview import render_preview
 from camtool.toolpath.options import PlanOptions
-from camtool.verify.verifier import summary_lines
+from camtool.verify.report import summary_lines
 
 ROOT = Path(__file__).resolve().parents[1]
 MAX_LINES = 60

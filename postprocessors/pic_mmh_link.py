@@ -417,11 +417,11 @@ def split_answers(buffer: bytearray) -> list[str]:
 def step_events(program: Program, machine: Machine) -> dict[int, bytes]:
     """The feedback bytes each source line's moves send, by camtool's interpolator.
 
-    The verifier's step simulation (:func:`camtool.verify.verifier.simulate`:
+    The verifier's step simulation (:func:`camtool.verify.trace_sources.simulate`:
     the DDA and DSM of annexes A.3/A.6, backlash compensation included) gives
     each move's step rows; every non-zero entry is one motor step, one byte.
     """
-    from camtool.verify.verifier import simulate
+    from camtool.verify.trace_sources import simulate
 
     if not program.moves:
         return {}

@@ -19,7 +19,7 @@ from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Move, Program
 from camtool.model.shapes import Point, distance
 from camtool.verify.motion import StepTrace
-from camtool.verify.verifier import simulate
+from camtool.verify.trace_sources import simulate
 
 if TYPE_CHECKING:
     from camtool.post.base import Target

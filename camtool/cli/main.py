@@ -429,7 +429,7 @@ def _finish_verification(
     (it does not overlap the program) fails the limit: it cannot pass unjudged.
     """
     from camtool.jobs.pipeline import report_json
-    from camtool.verify.verifier import summary_lines
+    from camtool.verify.report import summary_lines
 
     warn([w for w in v.warnings if w not in said])
     for line in summary_lines(v):

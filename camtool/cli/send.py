@@ -100,7 +100,7 @@ def send(
     )
     warn(list(plan.warnings))
     if plan.verification is not None:
-        from camtool.verify.verifier import summary_lines
+        from camtool.verify.report import summary_lines
 
         for line in summary_lines(plan.verification):
             click.echo(f"camtool: {line}", err=True)

@@ -515,10 +515,10 @@ def report_json(v: Verification, plan: PlanReport | None = None) -> str:
     """The verify report of ``v`` as indented JSON text with a final newline.
 
     ``plan`` (what planning found, when the code was planned here) adds a ``plan``
-    key (:func:`camtool.verify.verifier.report_dict`).
+    key (:func:`camtool.verify.report.report_dict`).
     """
     import json
 
-    from camtool.verify.verifier import report_dict
+    from camtool.verify.report import report_dict
 
     return json.dumps(report_dict(v, plan), indent=2) + "\n"

@@ -199,7 +199,7 @@ def prepare_send(
     if max_error_um is not None and not verify:
         raise UsageError("--max-error-um needs --verify")
     program = _read_back(data, target, source)
-    from camtool.verify.verifier import check_area
+    from camtool.verify.report import check_area
 
     warnings = [*program.warnings, *spec.warnings, *check_area(program, target.machine, source)]
     _check_depth(program, max_depth_mm if max_depth_mm is not None else spec.max_depth_mm, source)
@@ -263,7 +263,9 @@ def _times(
     program: Program, target: Target, verify: bool, max_error_um: float | None
 ) -> tuple[Verification | None, Sequence[float]]:
     """The verifier's result (with ``verify``) and each move's estimated time, s."""
-    from camtool.verify.verifier import block_times, simulate, verify_program
+    from camtool.verify.report import block_times
+    from camtool.verify.trace_sources import simulate
+    from camtool.verify.verifier import verify_program
 
     if not program.moves:
         return None, []

@@ -33,7 +33,7 @@ from camtool.preview.scene import (
     ramp_colour,
     text_width,
 )
-from camtool.verify.verifier import error_text
+from camtool.verify.report import error_text
 
 if TYPE_CHECKING:
     from camtool.model.machine import Machine
@@ -457,7 +457,8 @@ def machine_time(program: Program, machine: Machine) -> tuple[float, str]:
     Raises:
         CamtoolError: the machine profile is invalid for the simulator.
     """
-    from camtool.verify.verifier import block_times, simulate
+    from camtool.verify.report import block_times
+    from camtool.verify.trace_sources import simulate
 
     trace = simulate(program, machine)
     return float(block_times(trace, program, machine).sum()), time_basis(machine, trace)

@@ -534,7 +534,7 @@ def _distance_to(samples: FloatArray, lines: Sequence[FloatArray]) -> FloatArray
 
     The same ``samples`` and ``lines`` objects as the last call, when they cannot change
     (read-only arrays, ``lines`` a tuple: see :func:`_sample_drawing` and
-    :func:`camtool.verify.verifier._nominal_lines`), give the last answer again.
+    :func:`camtool.verify.trace_sources._nominal_lines`), give the last answer again.
     """
     frozen = (
         not samples.flags.writeable

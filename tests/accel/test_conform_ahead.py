@@ -35,9 +35,8 @@ ARCS = conformahead.MIN_ARCS + 500
 
 
 @pytest.fixture(autouse=True)
-def two_cores(monkeypatch: pytest.MonkeyPatch) -> None:
+def two_cores(accel_on: None, monkeypatch: pytest.MonkeyPatch) -> None:
     """A helper may run wherever the tests run (one core, a worker process, CAMTOOL_ACCEL=0)."""
-    monkeypatch.setenv("CAMTOOL_ACCEL", "1")
     monkeypatch.setattr(cores, "default_jobs", lambda: 2)
     monkeypatch.setattr(cores, "in_worker", lambda: False)
 

@@ -19,13 +19,11 @@ from camtool.accel import cores
 from camtool.accel.cores import ForkedWork
 from camtool.model.errors import InputError
 
-pytestmark = pytest.mark.skipif(not cores.FORK, reason="forked workers: Linux only")
-
-
-@pytest.fixture(autouse=True)
-def switched_on(monkeypatch: pytest.MonkeyPatch) -> None:
-    """These are the accel layer's own tests: on, whatever the suite runs (one test: off)."""
-    monkeypatch.setenv("CAMTOOL_ACCEL", "1")
+pytestmark = [
+    pytest.mark.skipif(not cores.FORK, reason="forked workers: Linux only"),
+    # the accel layer's own tests: on, whatever the suite runs (one test switches it off)
+    pytest.mark.usefixtures("accel_on"),
+]
 
 
 def test_answers_come_back_in_order_from_other_processes(tmp_path: Path) -> None:

@@ -13,11 +13,8 @@ import pytest
 
 from camtool.accel import cores
 
-
-@pytest.fixture(autouse=True)
-def switched_on(monkeypatch: pytest.MonkeyPatch) -> None:
-    """The work done while waiting is the accel layer's: on here, whatever the suite runs."""
-    monkeypatch.setenv("CAMTOOL_ACCEL", "1")
+# the accel layer's own tests: on, whatever the suite runs (one test switches it off)
+pytestmark = pytest.mark.usefixtures("accel_on")
 
 
 @pytest.fixture

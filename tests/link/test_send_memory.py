@@ -33,9 +33,9 @@ def test_a_long_program_is_timed_in_chunks_with_the_same_result(monkeypatch: Any
     code = zigzag(1200, 2.0)
     whole = prepare_send(code, load_target("grbl"))
     sizes: list[int] = []
-    from camtool.verify import verifier
+    from camtool.verify import trace_sources
 
-    real = verifier.simulate
+    real = trace_sources.simulate
 
     def counting(program: Any, machine: Any, **kw: Any) -> Any:
         sizes.append(len(program.moves))
@@ -43,7 +43,7 @@ def test_a_long_program_is_timed_in_chunks_with_the_same_result(monkeypatch: Any
 
     monkeypatch.setattr(plan_module, "CHUNK_MOVES", 100)
     monkeypatch.setattr(plan_module, "CHUNK_ROWS", 10**9)
-    monkeypatch.setattr(verifier, "simulate", counting)
+    monkeypatch.setattr(trace_sources, "simulate", counting)
     chunked = prepare_send(code, load_target("grbl"))
     assert sizes and max(sizes) <= 100
     # GRBL's time model times each move alone (rest to rest): chunks change nothing

@@ -122,7 +122,7 @@ def test_grbl_depth_passes_and_tabs_verify(tmp_path: Path) -> None:
     assert -1.0 in cutting_z  # the tab top: −1.5 + 0.5
     # rapids at safe Z (2 mm) or at the 5 mm clearance (start, end, between parts)
     assert {m.z for m in moves if isinstance(m, Rapid) and m.z is not None} == {2.0, 5.0}
-    from camtool.verify.verifier import report_dict
+    from camtool.verify.report import report_dict
 
     report = report_dict(verify_job(job))
     # Z travel: 2 mm down to the top and 1.5 mm on into the part, and back, at least.

@@ -20,7 +20,7 @@ import pytest
 from camtool.accel import cores
 from camtool.model.program import ArcMove, Linear, Program, Rapid
 from camtool.post.registry import load_target
-from camtool.verify import verifier
+from camtool.verify import trace_sources, verifier
 from camtool.verify.simulate import ChunkedSimulation, TraceChunk, count_rows, simulate_steps
 from camtool.verify.sources import ALL, SOURCES, Sources
 from camtool.verify.trace_measures import TraceStream
@@ -100,13 +100,13 @@ def _spy_chunks(monkeypatch: pytest.MonkeyPatch) -> list[tuple[int, int, Sources
 def _spy_whole(monkeypatch: pytest.MonkeyPatch) -> list[Sources]:
     """Record the sources of every whole simulation the verifier asks for."""
     calls: list[Sources] = []
-    real: Callable[..., Any] = verifier.simulate
+    real: Callable[..., Any] = trace_sources.simulate
 
     def simulate(program: Program, machine: Any, *, sources: Sources = ALL) -> Any:
         calls.append(sources)
         return real(program, machine, sources=sources)
 
-    monkeypatch.setattr(verifier, "simulate", simulate)
+    monkeypatch.setattr(trace_sources, "simulate", simulate)
     return calls
 
 

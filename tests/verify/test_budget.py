@@ -15,15 +15,10 @@ from camtool.model.machine import Backlash
 from camtool.model.program import ArcMove, Linear, Program, Rapid
 from camtool.post.registry import load_target
 from camtool.verify.budget import NOTE
+from camtool.verify.report import report_dict, seconds_6, summary_lines
 from camtool.verify.sources import ALL, SOURCES
-from camtool.verify.verifier import (
-    report_dict,
-    seconds_6,
-    simulate,
-    summary_lines,
-    verify_code,
-    verify_program,
-)
+from camtool.verify.trace_sources import simulate
+from camtool.verify.verifier import verify_code, verify_program
 
 # what this file checks is done by the accelerated versions only (docs/architecture.md)
 pytestmark = pytest.mark.usefixtures("accel_on")

@@ -22,8 +22,9 @@ from camtool.post.registry import load_target
 from camtool.verify import simulate as sim
 from camtool.verify import verifier
 from camtool.verify.interpolators import dda_line, dda_line_numpy, dda_line_rows
+from camtool.verify.report import build_report
 from camtool.verify.sources import ALL
-from camtool.verify.verifier import build_report, verify_program
+from camtool.verify.verifier import verify_program
 from tests.verify.programs import TARGETS, mixed_program
 
 # what this file checks is done by the accelerated versions only (docs/architecture.md)

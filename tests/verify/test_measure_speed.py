@@ -25,7 +25,8 @@ from camtool.verify import (
     verifier,
 )
 from camtool.verify.sources import ALL
-from camtool.verify.verifier import _cutting_rows, simulate, verify_program
+from camtool.verify.trace_sources import simulate
+from camtool.verify.verifier import _cutting_rows, verify_program
 
 
 def _polyline(rng: np.random.Generator, kind: int) -> np.ndarray:
@@ -164,7 +165,7 @@ def test_distance_to_the_path_is_kept_only_for_inputs_that_cannot_change() -> No
 
 
 def test_nominal_lines_are_kept_for_the_code_and_the_plan() -> None:
-    from camtool.verify.verifier import _nominal_lines, _nominal_lines_now
+    from camtool.verify.trace_sources import _nominal_lines, _nominal_lines_now
 
     code, _ = _plate()
     plan = dataclasses.replace(code, moves=code.moves[:-1])

@@ -26,7 +26,7 @@ from camtool.model.shapes import Contour, Drawing, Line, Point
 from camtool.post.registry import load_target
 from camtool.toolpath.options import PlanOptions
 from camtool.verify.drawing_compare import NotCut
-from camtool.verify.verifier import not_cut_text, summary_lines
+from camtool.verify.report import not_cut_text, summary_lines
 
 R = 1.5
 CORNER_UM = R * (math.sqrt(2.0) - 1.0) * 1000.0  # 621.32 µm

@@ -103,7 +103,7 @@ def test_the_budget_s_distance_is_the_comparison_s_bit_for_bit(offset: str, tool
     the line, every sample counts.
     """
     from camtool.jobs.pipeline import post_drawing, verify_job
-    from camtool.verify import verifier
+    from camtool.verify import trace_sources, verifier
 
     target = load_target("grbl")
     plan = PlanOptions(offset=offset, tool_diameter=tool, depth=1.0)
@@ -111,7 +111,7 @@ def test_the_budget_s_distance_is_the_comparison_s_bit_for_bit(offset: str, tool
     v = verify_job(job, budget=False)
     assert v.drawing is not None and v.against is not None
     thin = cutting_thin.thin_cutting(*verifier._cutting_rows(v.program, v.trace))
-    nominal = verifier._nominal_lines(v.program) if v.findings else ()
+    nominal = trace_sources._nominal_lines(v.program) if v.findings else ()
     args = (thin, v.drawing, tool / 2.0)
     full = drawing_compare.against_thinned(*args, nominal=nominal, findings=v.findings)
     assert full.max_um == v.against.max_um

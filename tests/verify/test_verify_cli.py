@@ -212,7 +212,7 @@ def test_a_move_outside_a_machine_coordinate_work_area_is_named_by_file_and_line
     """On a machine-coordinate machine each move is checked, named by its file and line."""
     from camtool.model.errors import DialectError
     from camtool.post.registry import load_target
-    from camtool.verify.verifier import check_area
+    from camtool.verify.report import check_area
 
     machine = load_target("matlab-router").machine  # machine coordinates, 0…200 mm
     assert machine.coordinates == "machine"

@@ -1,0 +1,137 @@
+"""A trace with some error sources switched off, and what each source does on a machine."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from camtool.model.errors import UsageError
+from camtool.model.machine import Machine
+from camtool.model.program import ArcMove, Program, Rapid
+from camtool.verify import budget as eb
+from camtool.verify.motion import StepTrace, library
+from camtool.verify.simulate import (
+    simulate_steps,
+)
+from camtool.verify.sources import ALL, Sources
+
+
+def source_statuses(
+    program: Program, machine: Machine, *, planned: Program | None = None
+) -> list[eb.SourceStatus]:
+    """Which error sources ``machine`` models for ``program`` (the budget's columns).
+
+    The step simulator models interpolation always, chords when the profile cuts
+    arcs into chords and the program has arcs, the scale when the true steps/mm
+    differ from the nominal ones, backlash when the profile has some (true or
+    compensated); ``dynamics`` when the machine's line piece models it. A target's
+    whole simulator models what it honours (``MotionHooks.honours``). Rounding
+    is known only with the unrounded plan.
+    """
+    lib = library()
+    line = machine.motion.line
+    whole = lib.simulator(line) is not None
+    honoured = set(lib.honours(line))
+    arcs = any(isinstance(m, ArcMove) for m in program.moves)
+    true = machine.real_steps_per_mm[:2]
+    lash = machine.backlash
+    present = {
+        "interpolation": (True, ""),
+        "chords": (
+            arcs and machine.motion.arc == "chords",
+            "no arcs in the program" if not arcs else "the controller runs arcs natively",
+        ),
+        "scale": (true != machine.steps_per_mm[:2], "the profile has no true steps/mm"),
+        "backlash": (
+            any(lash.true_um[:2]) or any(lash.compensation_um[:2]) or bool(lash.regions),
+            "the profile has no backlash",
+        ),
+        "dynamics": (
+            "dynamics" in honoured,
+            f"the {line!r} motion models no timer overshoot or servo lag",
+        ),
+    }
+    out = []
+    for name, (there, why) in present.items():
+        if whole and name not in honoured:
+            out.append(eb.SourceStatus(name, "absent", f"not modelled by the {line!r} simulator"))
+        elif there:
+            out.append(eb.SourceStatus(name, "modelled"))
+        else:
+            out.append(eb.SourceStatus(name, "absent", why))
+    if planned is None:
+        out.append(eb.SourceStatus("rounding", "unknown", "not known from the code alone"))
+    else:
+        out.append(eb.SourceStatus("rounding", "modelled"))
+    return out
+
+
+def simulate(program: Program, machine: Machine, *, sources: Sources = ALL) -> StepTrace:
+    """Simulate ``program`` on ``machine``: the simulator its ``line`` name selects.
+
+    A ``line`` name that a target's ``MOTION.simulators`` holds runs that simulator
+    (:meth:`camtool.verify.motion.Library.simulator`); any other runs the step
+    simulator (:func:`camtool.verify.simulate.simulate_steps`) with the named
+    interpolators.
+
+    Args:
+        program: moves in mm.
+        machine: the machine profile.
+        sources: the error sources modelled (:mod:`camtool.verify.sources`); a
+            target's simulator gets them when it honours some
+            (``MotionHooks.honours``), else only the full model can run on it.
+
+    Raises:
+        InputError: an unknown interpolator or chord rule name.
+        UsageError: the profile lacks a parameter its line model needs, or
+            ``sources`` switch off a source the machine's simulator does not model.
+    """
+    lib = library()
+    run = lib.simulator(machine.motion.line)
+    if run is not None:
+        if sources == ALL:
+            return run(program, machine)
+        honoured = lib.honours(machine.motion.line)
+        if not set(sources.off) <= set(honoured):
+            raise UsageError(
+                f"the {machine.motion.line!r} simulator cannot switch off "
+                f"{', '.join(sorted(set(sources.off) - set(honoured)))}"
+            )
+        return run(program, machine, sources=sources)  # type: ignore[call-arg]
+    return simulate_steps(program, machine, sources=sources)
+
+
+_NOMINAL: list[tuple[Program, tuple[np.ndarray, ...]]] = []
+"""The last two programs' :func:`_nominal_lines` (kept, so their ``id`` is not reused)."""
+
+
+def _nominal_lines(program: Program) -> tuple[np.ndarray, ...]:
+    """The programmed cutting path as polylines ``(M, 2)`` mm, one per run between rapids.
+
+    The last two programs' lines are kept (read-only, the same tuple for the same
+    program: the error budget compares the drawing once per source with the same program).
+    """
+    for seen, lines in _NOMINAL:
+        if seen is program:
+            return lines
+    lines = _nominal_lines_now(program)
+    for line in lines:
+        line.flags.writeable = False
+    _NOMINAL[:] = [*_NOMINAL[-1:], (program, lines)]  # the code's and the plan's
+    return lines
+
+
+def _nominal_lines_now(program: Program) -> tuple[np.ndarray, ...]:
+    """:func:`_nominal_lines` without the kept copy."""
+    lines: list[list[tuple[float, float]]] = []
+    fresh = True
+    for move, seg in program.segments():
+        if isinstance(move, Rapid):
+            fresh = True
+            continue
+        pts = seg.points(0.0002)
+        if fresh:
+            lines.append(list(pts))
+            fresh = False
+        else:
+            lines[-1].extend(pts[1:])
+    return tuple(np.asarray(p, dtype=np.float64) for p in lines)
