@@ -12,7 +12,7 @@ from camtool.model.errors import InputError, UsageError
 
 if TYPE_CHECKING:
     from camtool.calibrate.coupon import Coupon
-    from camtool.calibrate.fit import FitResult
+    from camtool.calibrate.fitdata import FitResult
     from camtool.post.base import Target
 
 

@@ -15,7 +15,7 @@ import re
 from pathlib import Path
 
 from camtool.calibrate.coupon import Coupon, Measure
-from camtool.calibrate.fit import Observation
+from camtool.calibrate.fitdata import Observation
 from camtool.model.errors import InputError
 from camtool.model.machine import Machine
 from camtool.model.tomlfile import read_small_text

@@ -30,7 +30,7 @@ from camtool.model.errors import CamtoolError, InputError, UsageError, VerifyLim
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from camtool.jobs.batch import BatchPlan, BatchResult, BatchRow
+    from camtool.jobs.batch_plan import BatchPlan, BatchResult, BatchRow
 
 _PREVIEW_FORMATS = ("png", "svg")  # camtool.jobs.batch.PREVIEW_FORMATS, validated there too
 _ERRORS: dict[int, type[CamtoolError]] = {2: UsageError, 3: InputError, 4: VerifyLimitError}
@@ -112,7 +112,8 @@ def batch(inputs: tuple[str, ...], layers: str | None, verify_too: bool, **optio
     Ctrl-C or SIGTERM stops it at once, keeping the files finished, with a summary of what
     was and was not written (exit code 130, 143 for SIGTERM).
     """
-    from camtool.jobs.batch import BatchInterrupted, BatchOptions, plan_batch
+    from camtool.jobs.batch import BatchOptions, plan_batch
+    from camtool.jobs.batch_plan import BatchInterrupted
     from camtool.jobs.batch_report import batch_report, failure_line, summary_table, unwritten_lines
 
     names = tuple(n.strip() for n in layers.split(",") if n.strip()) if layers else None

@@ -1,6 +1,6 @@
 """What a batch tells: its JSON report, the summary table and the progress lines.
 
-Pure functions of a :class:`~camtool.jobs.batch.BatchResult` (or a row) returning data or
+Pure functions of a :class:`~camtool.jobs.batch_plan.BatchResult` (or a row) returning data or
 text; the CLI decides where they go.
 
 Design notes: docs/internals.md, ``camtool/jobs/batch_report.py``.
@@ -16,7 +16,8 @@ from camtool.model.version import __version__
 from camtool.toolpath.options import PLAN_FIELDS
 
 if TYPE_CHECKING:
-    from camtool.jobs.batch import BatchInterrupted, BatchOptions, BatchResult, BatchRow
+    from camtool.jobs.batch import BatchOptions
+    from camtool.jobs.batch_plan import BatchInterrupted, BatchResult, BatchRow
 
 SHOWN_UNWRITTEN = 10
 """Files not posted named in an interrupted batch's summary (the rest are counted)."""

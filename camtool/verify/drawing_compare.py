@@ -137,7 +137,7 @@ def prepare_stream() -> None:
     so that a helper forked next inherits them instead of loading them again, while this
     process would load them at its first chunk anyway. Only the time depends on it.
     """
-    from camtool.verify.interpolators import compiled
+    from camtool.verify.dda import compiled
 
     kernels = compiled()
     near = nearest_search.near_kernels()

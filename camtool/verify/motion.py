@@ -20,12 +20,12 @@ from camtool.model.errors import InputError
 from camtool.model.machine import Machine, Motion
 from camtool.model.program import ArcMove, Program
 from camtool.model.shapes import Point
+from camtool.verify.dda import dda_line
 from camtool.verify.interpolators import (
     accumulator_dda_line,
     bresenham_line,
     circular_dda_arc,
     corte_recto_line,
-    dda_line,
     dsm_arc,
     sagitta_chord_points,
     staircase_arc,

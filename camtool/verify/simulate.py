@@ -22,7 +22,8 @@ from camtool.model.errors import InputError
 from camtool.model.machine import Backlash, Machine
 from camtool.model.program import ArcMove, Move, Program
 from camtool.model.shapes import Point, distance
-from camtool.verify.interpolators import compiled, dda_line, dda_line_rows, sagitta_chord_points
+from camtool.verify.dda import compiled, dda_line, dda_line_rows
+from camtool.verify.interpolators import sagitta_chord_points
 from camtool.verify.motion import StepTrace, library
 from camtool.verify.quantize import Rounding, steps_from_mm
 from camtool.verify.sources import ALL, Sources

@@ -47,6 +47,7 @@ from camtool.verify.cutting_thin import (
     ThinTrace,
     thin_cutting,
 )
+from camtool.verify.dda import compiled
 from camtool.verify.deviations import Deviation, deviation
 from camtool.verify.drawing_compare import (
     Against,
@@ -56,7 +57,6 @@ from camtool.verify.drawing_compare import (
     prepare_comparison,
     prepare_stream,
 )
-from camtool.verify.interpolators import compiled
 from camtool.verify.motion import StepTrace, library
 from camtool.verify.path_shortfall import AlongPath, along_path
 from camtool.verify.simulate import (

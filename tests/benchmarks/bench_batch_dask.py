@@ -37,8 +37,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
-from camtool.jobs.batch import BatchResult, run
+from camtool.jobs.batch import run
 from camtool.jobs.batch_dask import connect
+from camtool.jobs.batch_plan import BatchResult
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from table import row

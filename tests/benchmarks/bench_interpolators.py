@@ -4,7 +4,7 @@ Run as ``python tests/benchmarks/bench_interpolators.py`` (or through ``run_all.
 Two jobs, each measured on camtool and on its C peer in the same run, on the same inputs:
 
 - linear DDA (UNAM-GMM §4.2, annex A.3): random lines of up to 200 000 steps, 10 M
-  iterations in all; camtool's :func:`camtool.verify.interpolators.dda_line`;
+  iterations in all; camtool's :func:`camtool.verify.dda.dda_line`;
 - DSM (UNAM-GMM §4.5, annex A.6): a full circle of radius 2 000 000 steps (11.3 M
   iterations); camtool's :func:`camtool.verify.interpolators.dsm_arc`.
 

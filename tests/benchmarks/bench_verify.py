@@ -301,7 +301,7 @@ import time
 t0 = time.perf_counter()
 import numpy as np
 import camtool.cli.main, camtool.verify.verifier, scipy.spatial, shapely
-from camtool.verify.interpolators import compiled, dda_line
+from camtool.verify.dda import compiled, dda_line
 k = compiled()
 dda_line(3, 2)
 k.play_runs(np.zeros((2, 2), np.int8), 0, 0)

@@ -5,7 +5,8 @@ from __future__ import annotations
 import pytest
 
 from camtool.calibrate.coupon import build_coupon
-from camtool.calibrate.fit import UNMEASURED, Observation, fit, overlay_toml
+from camtool.calibrate.fit import UNMEASURED, fit, overlay_toml
+from camtool.calibrate.fitdata import Observation
 from camtool.calibrate.predict import predict, read_back
 from camtool.calibrate.sheet import read_measurements, sheet_csv
 from camtool.model.errors import InputError

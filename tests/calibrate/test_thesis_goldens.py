@@ -22,7 +22,8 @@ from camtool.calibrate.coupon import (
     rectangle,
     u_pattern,
 )
-from camtool.calibrate.fit import JOINT_XY, UNMEASURED, FitResult, Observation, fit
+from camtool.calibrate.fit import UNMEASURED, fit
+from camtool.calibrate.fitdata import JOINT_XY, FitResult, Observation
 from camtool.calibrate.predict import ReadBack, predict, read_back
 from camtool.model.errors import InputError
 from camtool.model.machine import Machine, machine_from_table, merge_tables

@@ -20,14 +20,8 @@ from pathlib import Path
 import pytest
 
 from camtool.cli.main import main
-from camtool.jobs.batch import (
-    BatchOptions,
-    BatchRow,
-    batch_exit_code,
-    plan_batch,
-    post_one,
-    run_batch,
-)
+from camtool.jobs.batch import BatchOptions, plan_batch, post_one, run_batch
+from camtool.jobs.batch_plan import BatchRow, batch_exit_code
 from camtool.jobs.batch_report import batch_report, progress_line, summary_table
 from camtool.jobs.inputs import expand_inputs
 from camtool.jobs.pipeline import post_file
@@ -384,7 +378,7 @@ def test_non_tty_progress_lines(tree: Path, capsys: pytest.CaptureFixture[str]) 
 
 
 def test_summary_table_columns() -> None:
-    from camtool.jobs.batch import BatchResult
+    from camtool.jobs.batch_plan import BatchResult
 
     rows = (
         BatchRow(

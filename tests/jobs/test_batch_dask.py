@@ -30,7 +30,8 @@ import camtool
 import camtool.jobs.batch
 import camtool.jobs.batch_dask
 from camtool.cli.main import main
-from camtool.jobs.batch import BatchResult, run
+from camtool.jobs.batch import run
+from camtool.jobs.batch_plan import BatchResult
 from camtool.jobs.batch_report import batch_report
 from camtool.jobs.pipeline import post_file
 from camtool.model.errors import UsageError

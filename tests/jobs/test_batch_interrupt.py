@@ -24,13 +24,8 @@ from typing import Any
 
 import pytest
 
-from camtool.jobs.batch import (
-    BatchInterrupted,
-    BatchOptions,
-    BatchRow,
-    plan_batch,
-    run_batch,
-)
+from camtool.jobs.batch import BatchOptions, plan_batch, run_batch
+from camtool.jobs.batch_plan import BatchInterrupted, BatchRow
 from camtool.jobs.batch_report import unwritten_lines
 from camtool.jobs.batch_stop import Interrupts, Terminated
 from camtool.jobs.output import LOCK_NAME

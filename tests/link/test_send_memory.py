@@ -56,7 +56,7 @@ def test_a_long_program_is_timed_in_chunks_with_the_same_result(monkeypatch: Any
 PEAK = """
 import resource, sys
 from camtool.cli.main import main
-from camtool.verify.interpolators import COMPILE_FROM, compiled
+from camtool.verify.dda import COMPILE_FROM, compiled
 compiled(COMPILE_FROM)  # the compiled kernels (a constant ~100 MB) in both runs alike
 main(["send", sys.argv[1], "-t", "grbl", "--dry-run"])
 print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss // 1024, file=sys.stderr)

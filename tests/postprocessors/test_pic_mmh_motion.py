@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from camtool.model.errors import UsageError
-from camtool.verify.interpolators import dda_iterations
+from camtool.verify.dda import dda_iterations
 from camtool.verify.quantize import steps_from_mm
 from camtool_postprocessors.pic_mmh_motion import (
     PicMmhTiming,

@@ -13,11 +13,7 @@ import numpy as np
 import pytest
 
 from camtool.model.shapes import chord_count
-from camtool.verify.interpolators import (
-    accumulator_dda_line,
-    chord_sagitta,
-    polyline_steps,
-)
+from camtool.verify.interpolators import accumulator_dda_line, chord_sagitta, polyline_steps
 from camtool.verify.quantize import steps_from_mm
 from camtool.verify.steparray import positions
 from camtool_postprocessors.valcnc_motion import (

@@ -21,7 +21,7 @@ from camtool.model.program import Linear, Program, Rapid
 from camtool.post.registry import load_target
 from camtool.verify import simulate as sim
 from camtool.verify import verifier
-from camtool.verify.interpolators import dda_line, dda_line_numpy, dda_line_rows
+from camtool.verify.dda import dda_line, dda_line_numpy, dda_line_rows
 from camtool.verify.report import build_report
 from camtool.verify.sources import ALL
 from camtool.verify.verifier import verify_program

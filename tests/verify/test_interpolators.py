@@ -15,10 +15,10 @@ from hypothesis import strategies as st
 
 from camtool.model.errors import InputError, UsageError
 from camtool.model.shapes import chord_count
+from camtool.verify.dda import accumulator_dda_table, dda_iterations, dda_line, dda_line_reference
 from camtool.verify.interpolators import (
     accumulator_dda_line,
     accumulator_dda_reference,
-    accumulator_dda_table,
     bresenham_line,
     bresenham_reference,
     chord_sagitta,
@@ -26,9 +26,6 @@ from camtool.verify.interpolators import (
     corte_recto_line,
     corte_recto_max_deviation,
     corte_recto_reference,
-    dda_iterations,
-    dda_line,
-    dda_line_reference,
     dsm_arc,
     dsm_arc_reference,
     polyline_steps,
