@@ -58,6 +58,7 @@ sys.path.insert(0, str(HERE))
 
 from table import row  # noqa: E402
 
+from camtool.verify import dda  # noqa: E402
 from camtool.verify import interpolators as itp  # noqa: E402
 
 TOTAL = 10_000_000
@@ -159,9 +160,9 @@ def first_call_s() -> float:
     """Wall time of the first DDA + DSM call in a fresh process (numba import + cache)."""
     code = (
         "import time; t = time.perf_counter()\n"
-        "from camtool.verify import interpolators as i\n"
-        "getattr(i, 'compiled', lambda: None)()\n"  # load the kernels now (a big job would)
-        "i.dda_line(3, 4); i.dda_line(3, 5); i.dsm_arc(0, 30, 0, 30, 0, 0, True)\n"
+        "from camtool.verify import dda, interpolators as i\n"
+        "dda.compiled()\n"  # load the kernels now (a big job would)
+        "dda.dda_line(3, 4); dda.dda_line(3, 5); i.dsm_arc(0, 30, 0, 30, 0, 0, True)\n"
         "print(time.perf_counter() - t)\n"
     )
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
@@ -241,8 +242,8 @@ def main() -> None:
     with tempfile.TemporaryDirectory(prefix="camtool-bench-c-") as tmp:
         job(
             "linear DDA (UNAM-GMM A.3), 10 M iterations, in-process",
-            itp.dda_line,
-            itp.dda_line_reference,
+            dda.dda_line,
+            dda.dda_line_reference,
             lines(TOTAL, 200_000, seed=1),
             lines(REFERENCE_TOTAL, 20_000, seed=2),
             "dda.c",

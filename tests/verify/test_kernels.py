@@ -16,26 +16,27 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from camtool.verify import dda
 from camtool.verify import interpolators as itp
 
-pytestmark = pytest.mark.skipif(itp.compiled() is None, reason="numba not installed")
+pytestmark = pytest.mark.skipif(dda.compiled() is None, reason="numba not installed")
 
 
 @pytest.fixture
 def plain(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
     """Run the interpolators without the compiled kernels inside the ``with``-less test."""
-    monkeypatch.setitem(itp._COMPILED, "kernels", None)
+    monkeypatch.setitem(dda._COMPILED, "kernels", None)
     yield
 
 
 def _plain(fn, *args):  # type: ignore[no-untyped-def]
     """``fn(*args)`` with the compiled kernels switched off."""
-    saved = itp._COMPILED.get("kernels")
-    itp._COMPILED["kernels"] = None
+    saved = dda._COMPILED.get("kernels")
+    dda._COMPILED["kernels"] = None
     try:
         return fn(*args)
     finally:
-        itp._COMPILED["kernels"] = saved
+        dda._COMPILED["kernels"] = saved
 
 
 def _same(a: np.ndarray, b: np.ndarray) -> bool:
@@ -75,11 +76,11 @@ EDGE_LINES = [
 @pytest.mark.parametrize(("dx", "dy"), EDGE_LINES)
 def test_dda_edges_equal_the_a3_register_loop(dx: int, dy: int) -> None:
     """Analytic (UNAM-GMM A.3): the compiled DDA is the register loop, row for row."""
-    fast = itp.dda_line(dx, dy)
+    fast = dda.dda_line(dx, dy)
     assert not fast.flags.writeable
-    assert _same(fast, itp.dda_line_numpy(dx, dy))
+    assert _same(fast, dda.dda_line_numpy(dx, dy))
     if abs(dx) + abs(dy) <= 300_000:  # the literal loop is slow on the largest ones
-        assert _same(fast, itp.dda_line_reference(dx, dy))
+        assert _same(fast, dda.dda_line_reference(dx, dy))
 
 
 def test_dda_thousands_of_random_lines() -> None:
@@ -90,10 +91,10 @@ def test_dda_thousands_of_random_lines() -> None:
         dx, dy = rng.randint(-m, m), rng.randint(-m, m)
         if rng.random() < 0.1:
             dx, dy = (dx, 0) if rng.random() < 0.5 else (0, dy)
-        fast = itp.dda_line(dx, dy)
-        assert _same(fast, itp.dda_line_numpy(dx, dy)), (dx, dy)
+        fast = dda.dda_line(dx, dy)
+        assert _same(fast, dda.dda_line_numpy(dx, dy)), (dx, dy)
         if m <= 1000:
-            assert _same(fast, itp.dda_line_reference(dx, dy)), (dx, dy)
+            assert _same(fast, dda.dda_line_reference(dx, dy)), (dx, dy)
 
 
 def test_dda_pythagorean_lines_take_the_integer_loop() -> None:
@@ -102,20 +103,20 @@ def test_dda_pythagorean_lines_take_the_integer_loop() -> None:
         for k in (1, 2, 7, 50, 1001):
             for sx, sy in ((1, 1), (-1, 1), (1, -1), (-1, -1)):
                 dx, dy = sx * a * k, sy * b * k
-                fast = itp.dda_line(dx, dy)
-                assert _same(fast, itp.dda_line_reference(dx, dy)), (dx, dy)
+                fast = dda.dda_line(dx, dy)
+                assert _same(fast, dda.dda_line_reference(dx, dy)), (dx, dy)
 
 
 @settings(max_examples=300, deadline=None)
 @given(st.integers(-5000, 5000), st.integers(-5000, 5000))
 def test_dda_property(dx: int, dy: int) -> None:
     """Analytic: any line, compiled == the literal A.3 loop."""
-    assert _same(itp.dda_line(dx, dy), itp.dda_line_reference(dx, dy))
+    assert _same(dda.dda_line(dx, dy), dda.dda_line_reference(dx, dy))
 
 
 def test_dda_numpy_integers_accepted() -> None:
     """numpy integers are integers (as for the plain path)."""
-    assert _same(itp.dda_line(np.int64(30), np.int32(-40)), itp.dda_line_reference(30, -40))
+    assert _same(dda.dda_line(np.int64(30), np.int32(-40)), dda.dda_line_reference(30, -40))
 
 
 def _arc_cases(count: int, seed: int) -> Iterator[tuple[int, int, int, int, int, int, bool]]:
@@ -172,8 +173,8 @@ def test_huge_coordinates_stay_on_the_exact_python_path() -> None:
 
 def test_plain_fixture_switches_the_kernels_off(plain: None) -> None:
     """The comparison really runs two paths: with the fixture no kernel is loaded."""
-    assert itp.compiled() is None
-    assert _same(itp.dda_line(3, 4), itp.dda_line_reference(3, 4))
+    assert dda.compiled() is None
+    assert _same(dda.dda_line(3, 4), dda.dda_line_reference(3, 4))
 
 
 def _random_rows(rng: np.random.Generator, n: int) -> np.ndarray:
@@ -195,7 +196,7 @@ def test_carriage_compiled_equals_numpy(profile: str) -> None:
     from camtool.verify import simulate
 
     machine = load_machine(profile)
-    jit = itp.compiled()
+    jit = dda.compiled()
     rng = np.random.default_rng(3)
     for n, origin in ((1, (0, 0)), (7, (5, -3)), (50_000, (3000, 20_000)), (200_000, (0, 0))):
         rows = _random_rows(rng, n)
@@ -210,7 +211,7 @@ def test_carriage_compiled_equals_numpy(profile: str) -> None:
 @pytest.mark.parametrize("seed", range(6))
 def test_reversals_and_pulses_equal_numpy(seed: int) -> None:
     """One compiled scan gives the numpy reversals, the direction after and the pulses."""
-    jit = itp.compiled()
+    jit = dda.compiled()
     rng = np.random.default_rng(seed)
     rows = _random_rows(rng, int(rng.integers(0, 20_000)))
     for axis in (0, 1):
@@ -230,7 +231,7 @@ def test_reversals_and_pulses_equal_numpy(seed: int) -> None:
 @pytest.mark.parametrize("seed", range(6))
 def test_play_runs_equal_a_python_scan(seed: int) -> None:
     """Both axes' runs from one pass each: the first row, sign and motor of every run."""
-    jit = itp.compiled()
+    jit = dda.compiled()
     rng = np.random.default_rng(seed)
     rows = _random_rows(rng, int(rng.integers(0, 5000)))
     ox, oy = int(rng.integers(-100, 100)), int(rng.integers(-100, 100))
