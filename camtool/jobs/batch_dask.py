@@ -108,7 +108,9 @@ def connect(scheduler: str, *, most_workers: int | None = None) -> Iterator[Clie
     distributed = _distributed()
     if scheduler.startswith(LOCAL):
         dashboard = ":8787" if importlib.util.find_spec("bokeh") is not None else ":0"
+        stopping = contextlib.ExitStack()  # held until the cluster has closed
         with (
+            stopping,
             distributed.LocalCluster(
                 n_workers=min(int(scheduler.removeprefix(LOCAL)), max(1, most_workers or 1 << 30)),
                 threads_per_worker=1,
@@ -124,6 +126,9 @@ def connect(scheduler: str, *, most_workers: int | None = None) -> Iterator[Clie
             try:
                 yield client
             except KeyboardInterrupt:  # Ctrl-C or SIGTERM: stop now, not when the tasks end
+                # the client's own comms then fail as the workers go, and distributed logs
+                # each with its traceback: not the user's business while the batch stops
+                stopping.enter_context(_quiet("distributed"))
                 _kill_workers(cluster)
                 raise
         return
@@ -143,6 +148,18 @@ def connect(scheduler: str, *, most_workers: int | None = None) -> Iterator[Clie
                 f"{WORKER_WAIT_S:g} s; start one with `dask worker {scheduler}`"
             ) from exc
         yield client
+
+
+@contextlib.contextmanager
+def _quiet(name: str) -> Iterator[None]:
+    """Logger ``name`` (and its children) says nothing inside; its level is restored after."""
+    logger = logging.getLogger(name)
+    level = logger.level
+    logger.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        logger.setLevel(level)
 
 
 def _kill_workers(cluster: Any) -> None:
