@@ -36,8 +36,9 @@ def chain(contours: Sequence[Contour], tolerance: float) -> list[Contour]:
 
     Closed contours pass through unchanged. Open contours are extended forwards
     then backwards, reversing a neighbour where its far end is the one that
-    meets; the first contour of a chain keeps its drawn direction. Layers and
-    sources of the joined pieces are kept from the first piece.
+    meets; the first contour of a chain keeps its drawn direction. Layer, source,
+    colour and linetype of a chain are its first piece's; an open contour that joins
+    nothing is returned as it was (the same object).
 
     Args:
         contours: contours as read, mm.
@@ -76,7 +77,14 @@ def chain(contours: Sequence[Contour], tolerance: float) -> list[Contour]:
         closed = meets and (len(segs) > 1 or isinstance(segs[0], Arc))
         if closed:
             segs[-1] = with_end(segs[-1], segs[0].start)
-        result.append(Contour(tuple(segs), closed, contour.layer, contour.source))
+        elif len(segs) == len(contour.segments):  # nothing joined: the contour as it was
+            result.append(contour)
+            continue
+        result.append(
+            Contour(
+                tuple(segs), closed, contour.layer, contour.source, contour.colour, contour.linetype
+            )
+        )
     return result
 
 

@@ -284,6 +284,12 @@ class Arc:
 Segment: TypeAlias = Line | Arc
 
 
+def _segment_length(segment: Segment) -> float:
+    """``segment.length`` (the same float), not kept on the segment."""
+    kept = segment.__dict__.get("length")
+    return float(kept) if kept is not None else type(segment).length.func(segment)
+
+
 MAX_CHORDS = 1_000_000
 """Most chords one arc may become (a 1 m radius within 1 nm needs about 70 000)."""
 _SMALL_RATIO = 1e-6  # below this tolerance/radius, acos(1 − x) loses digits: use the asin form
@@ -452,6 +458,17 @@ class Contour:
     def length(self) -> float:
         """Total length, mm (computed once)."""
         return sum(s.length for s in self.segments)
+
+    def length_unkept(self) -> float:
+        """:attr:`length` (the same float), neither kept nor keeping its segments' lengths.
+
+        For a one-off look at many contours: a kept length is a ``__dict__`` on each
+        contour and segment, ~90 bytes each.
+        """
+        kept = self.__dict__.get("length")
+        if kept is not None:
+            return float(kept)
+        return sum(_segment_length(s) for s in self.segments)
 
     def bbox(self) -> BBox:
         """Bounding box ``(xmin, ymin, xmax, ymax)``, mm (computed once, then kept)."""

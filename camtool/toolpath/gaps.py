@@ -71,7 +71,7 @@ def open_gaps(contours: Sequence[Contour], options: PlanOptions) -> list[Finding
         exact = _Exact(xy, a, b)
         keep = exact.above(np.arange(len(a)), joint)
         for k in np.flatnonzero(keep & (owner[a] == owner[b])):  # a contour's own two ends
-            share = GAP_SHARE * contours[owner[a[k]]].length
+            share = GAP_SHARE * contours[owner[a[k]]].length_unkept()
             keep[k] = not exact.above(np.array([k]), share, inclusive=True)[0]  # a "C": drawn
             # open on purpose (close_gaps leaves it too)
         near_gaps = np.flatnonzero(keep)  # the near gaps, in the order the tree gives them
@@ -146,7 +146,7 @@ class _Exact:
         return max(self.gap(int(k)) for k in maybe)
 
 
-_QUERY_CHUNK = 8192
+_QUERY_CHUNK = 1024
 """Ends whose near pairs :func:`open_gaps` looks for at a time (bounds its arrays)."""
 _MARGIN = 1e-9
 """Relative band around a limit within which the exact gap decides (an ulp is ~2e-16)."""
