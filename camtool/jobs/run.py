@@ -295,6 +295,7 @@ def run_job(
                 time_s=feed_time_s(moves[first:], target, start=_start(moves, first, setup)),
             )
         )
+        del planned  # its moves are in ``moves``: not kept past the placement's shifted copy
     notes = construction_notes(construction)
     if not job.shorthand:
         notes.extend(_unselected(scaled, runs, construction))
@@ -310,8 +311,9 @@ def run_job(
     program = Program(
         tuple(moves), setup.origin, tuple(dict.fromkeys(warnings)), commands=tuple(commands)
     )
+    moves.clear()  # the program holds them, and placing it may shift every one
     program, placed_all, shift = place_program(program, placed_all, setup, target.machine)
-    runs = [_shifted(r, shift) for r in runs]
+    runs = _shifted(runs, placed_all, shift)
     program = dataclasses.replace(
         program,
         notes=job_notes(
@@ -627,14 +629,29 @@ def _placement(drawing: Drawing, setup: PlanOptions, shift: Point) -> tuple[floa
     return (k, dx + shift[0], dy + shift[1])
 
 
-def _shifted(run: OperationRun, shift: Point) -> OperationRun:
-    dx, dy = shift
-    if dx == 0.0 and dy == 0.0:
-        return run
-    report = run.report
-    if report is not None:
-        report = dataclasses.replace(report, work_shift=shift)
-    return dataclasses.replace(run, placed=run.placed.transformed(1.0, dx, dy), report=report)
+def _shifted(runs: list[OperationRun], placed: Drawing, shift: Point) -> list[OperationRun]:
+    """``runs`` placed by ``shift`` (mm), their contours and marks taken from ``placed``.
+
+    ``placed`` is the runs' drawings joined in order and shifted (:func:`place_program`):
+    each run's part of it is that run's drawing shifted, so it is not shifted again.
+    """
+    if shift == (0.0, 0.0):
+        return runs
+    out, contours, marks = [], 0, 0
+    for run in runs:
+        own = run.placed
+        moved = Drawing(
+            placed.contours[contours : contours + len(own.contours)],
+            own.source,
+            own.warnings,
+            placed.marks[marks : marks + len(own.marks)],
+        )
+        contours, marks = contours + len(own.contours), marks + len(own.marks)
+        report = run.report
+        if report is not None:
+            report = dataclasses.replace(report, work_shift=shift)
+        out.append(dataclasses.replace(run, placed=moved, report=report))
+    return out
 
 
 def _unselected(

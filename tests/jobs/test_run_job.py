@@ -266,3 +266,18 @@ def test_the_first_operation_s_moves_are_taken_not_copied() -> None:
     later: list[Move] = []
     run._join(later, [], planned, 3)
     assert [m.contour for m in later] == [4, 4]
+
+
+def test_each_operation_s_placed_drawing_is_its_share_of_the_job_s(part: object) -> None:
+    """Shifted once: an operation's placed contours are the job's (no second copy), in order,
+    and each is its contour of the drawing moved by the work-zero shift of +1.5 mm."""
+    drawing = read_drawing(ROOT / "samples" / "part.dxf")
+    runs = part.operations  # type: ignore[attr-defined]
+    joined = [c for r in runs for c in r.placed.contours]
+    placed = part.placed.contours  # type: ignore[attr-defined]
+    assert len(joined) == len(placed)
+    assert all(a is b for a, b in zip(joined, placed, strict=True))
+    by_source = {c.source: c for c in drawing.contours}
+    for contour in joined:
+        drawn = by_source[contour.source]
+        assert _xy(*contour.start) == _xy(drawn.start[0] + SHIFT, drawn.start[1] + SHIFT)
