@@ -4,7 +4,7 @@ svgelements' parse leaves the XML elements it read in reference cycles (its id t
 ``(element, children)`` tuples that point back), so reference counting never frees them;
 with the CLI's raised collector thresholds (:data:`camtool.accel.collector.THRESHOLD`) they would
 wait for a rare full collection. The importer collects the young generations right after
-the parse (issue 17).
+the parse.
 """
 
 from __future__ import annotations
@@ -57,8 +57,9 @@ def test_svgelements_really_leaves_cycles() -> None:
     assert _xml_elements() == 0
 
 
-@pytest.mark.usefixtures("paused_gc")
+@pytest.mark.usefixtures("paused_gc", "accel_on")
 def test_reading_an_svg_leaves_no_xml_tree_behind() -> None:
+    """With the accel layer's collector thresholds the importer collects the tree itself."""
     drawing = read_svg(DATA / "inkscape-source.svg")
     assert drawing.contours
     assert _xml_elements() == 0
