@@ -74,7 +74,8 @@ def read_drawing(
         if used * k <= options.tolerance:
             return drawing
         used = options.tolerance / k * (1.0 - margin)
-        drawing, _ = _read(path, options.at_tolerance(used), progress)
+        del drawing  # not held while the finer one is read
+        drawing = _read(path, options.at_tolerance(used), progress)[0]  # noqa: F841 (read above)
     raise InputError(
         f"{path}: its curves cannot be fitted within --tolerance {options.tolerance:g} mm at "
         "the --fit size (the drawing is hardly larger than the tolerance); raise --tolerance"
@@ -94,7 +95,7 @@ def _read(
 ) -> tuple[Drawing, float]:
     """The drawing at ``path`` and the tolerance its curves were fitted within (mm, as drawn).
 
-    0.0 for a drawing without fitted curves (a point list). ``check``: see
+    0.0 for a drawing without fitted curves (a point list, a DXF of LINEs only). ``check``: see
     :func:`read_drawing`.
     """
     suffix = path.suffix.lower()
@@ -103,11 +104,14 @@ def _read(
 
         return svg_drawing(path, options, progress=progress, check=check)
     if suffix == ".dxf":
-        from camtool.importers.dxf import read_dxf
+        from camtool.importers.dxf import import_dxf
 
         progress(Step("reading", name=path.name))
         used = options.curve_tolerance()
-        drawing = read_dxf(path, options.at_tolerance(used))
+        imported = import_dxf(path, options.at_tolerance(used))
+        drawing = imported.drawing
+        if not imported.converted:  # only LINEs: the same drawing at any tolerance
+            used = 0.0
     elif suffix in POINT_SUFFIXES:
         from camtool.importers.points import read_points
 

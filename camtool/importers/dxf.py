@@ -97,6 +97,9 @@ class DxfImport:
         recovered: the file was damaged and read by ezdxf's recover mode.
         repairs: what recover mode repaired or could not (ezdxf's auditor and log), one
             message each; the user warning only gives their count.
+        converted: an entity other than a plain LINE was read, whose contours may
+            depend on the tolerance (a fitted curve, a joined boundary); ``False``: the
+            drawing is the same at any tolerance.
     """
 
     drawing: Drawing
@@ -107,6 +110,7 @@ class DxfImport:
     notes: tuple[DxfNote, ...] = field(default=())
     recovered: bool = False
     repairs: tuple[str, ...] = field(default=())
+    converted: bool = True
 
 
 def read_dxf(path: str | Path, options: ImportOptions | None = None) -> Drawing:
@@ -189,6 +193,7 @@ def _import(path: Path, options: ImportOptions) -> DxfImport:
         notes=notes,
         recovered=recovered,
         repairs=tuple(repairs),
+        converted=reader.converted,
     )
 
 
@@ -225,6 +230,7 @@ class _Reader:
         self.notes: list[DxfNote] = []
         self.counts: Counter[tuple[str, str]] = Counter()
         self.block_counts: Counter[tuple[str, str]] = Counter()
+        self.converted = False  # an entity went through the converters (and the tolerance)
 
     def read(self, entity: Any) -> None:
         from camtool.importers.dxf_blocks import Skip, expand_insert
@@ -307,6 +313,7 @@ class _Reader:
         check_numbers(item.entity, item.label, item.layer, self.limit)
         for part in item.parts:
             check_numbers(part, item.label, item.layer, self.limit)
+        self.converted = True
         try:
             contours = convert(item, self.tolerance, self.limit)
         except BadEntity as exc:  # the converters do not know the entity's name

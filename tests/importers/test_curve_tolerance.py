@@ -122,18 +122,42 @@ def test_a_dxf_scaled_up_is_read_again_finer(
 ) -> None:
     # A DXF is read for its size as drawn; its factor (4) known, it is read again, fitted
     # within TOL / 4 (a millionth finer, for the extent the finer fit moves).
+    asked = _asked(monkeypatch)
+    read_drawing(_spline_dxf(tmp_path / "s.dxf"), ImportOptions(fit=(400.0, 400.0)))
+    assert asked == [TOL, pytest.approx(TOL / 4.0 * (1 - 1e-6), rel=1e-12)]
+
+
+def test_a_dxf_of_lines_only_is_read_once_for_fit(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A LINE does not depend on the tolerance: the drawing read as drawn is the drawing at
+    # any size (a 200 000-LINE drawing was read twice, both copies alive at once).
+    def build(msp: Any) -> None:
+        msp.add_line((0, 0), (100, 0))
+        msp.add_line((100, 0), (100, 100))
+
+    asked = _asked(monkeypatch)
+    drawing = read_drawing(write_dxf(tmp_path / "l.dxf", build), ImportOptions(fit=(400.0, 400.0)))
+    assert asked == [TOL]
+    assert [c.segments[0] for c in drawing.contours] == [
+        Line((0.0, 0.0), (100.0, 0.0)),
+        Line((100.0, 0.0), (100.0, 100.0)),
+    ]
+
+
+def _asked(monkeypatch: pytest.MonkeyPatch) -> list[float]:
+    """The tolerance of each DXF read from now on (the importer's own entry, patched)."""
     import camtool.importers.dxf as dxf_importer
 
     asked: list[float] = []
-    read_dxf = dxf_importer.read_dxf
+    import_dxf = dxf_importer.import_dxf
 
-    def noting(path: Path, options: ImportOptions) -> Drawing:
+    def noting(path: Path, options: ImportOptions) -> Any:
         asked.append(options.tolerance)
-        return read_dxf(path, options)
+        return import_dxf(path, options)
 
-    monkeypatch.setattr(dxf_importer, "read_dxf", noting)
-    read_drawing(_spline_dxf(tmp_path / "s.dxf"), ImportOptions(fit=(400.0, 400.0)))
-    assert asked == [TOL, pytest.approx(TOL / 4.0 * (1 - 1e-6), rel=1e-12)]
+    monkeypatch.setattr(dxf_importer, "import_dxf", noting)
+    return asked
 
 
 def _spline_dxf(path: Path) -> Path:
