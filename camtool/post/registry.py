@@ -440,11 +440,13 @@ def _target_from_table(
     link_table = table.get("link", {})
     if not isinstance(link_table, Mapping):
         raise InputError(f"{where}: [link] must be a table")
+    built = machine_from_table(machine, where=where_machine)
+    _check_z_word(post, built, where, where_machine)
     return Target(
         name=str(table.get("name", Path(where).stem)),
         description=str(table.get("description", "")),
         post=post,
-        machine=machine_from_table(machine, where=where_machine),
+        machine=built,
         default_feed_mm_min=_number(table, "default_feed_mm_min", where, 100.0),
         source=str(table.get("source", "")),
         spindle_rpm=_number(table, "spindle_rpm", where, None),
@@ -452,6 +454,27 @@ def _target_from_table(
         motion_hook=motion,
         link_table=MappingProxyType(dict(link_table)),
         link_hook=link,
+    )
+
+
+def _check_z_word(post: PostProcessor, machine: Machine, where: str, where_machine: str) -> None:
+    """Refuse a machine with a Z axis whose dialect writes no Z word.
+
+    Every depth, safe height and plunge of such a target would be refused block by block
+    as the program is written (or, re-posting, dropped): the file is what to change.
+
+    Raises:
+        InputError: naming both files' keys to change.
+    """
+    if not machine.has_z or not isinstance(post, PostProcessor):
+        return
+    if post.for_machine(machine).written_z(1.0, machine) is not None:
+        return
+    machine_at = "" if where_machine == where else f" ({where_machine})"
+    raise InputError(
+        f"{where}: the machine has a Z axis (has_z = true{machine_at}) but the dialect "
+        "writes no Z word: give the dialect a Z word (z_moves and a Z in [dialect_options."
+        "words]) or set has_z = false for a machine whose depth is set by hand"
     )
 
 

@@ -171,3 +171,24 @@ def test_unknown_format_is_a_usage_error() -> None:
     target = load_target("pic-mmh")
     with pytest.raises(UsageError, match="unknown format 'wire'; this target writes: code"):
         target.emit(Program((Linear(1.0, 1.0, 0.8),)), fmt="wire")
+
+
+def test_a_target_whose_machine_has_z_and_its_dialect_no_z_word_is_refused_at_load(
+    tmp_path: Path,
+) -> None:
+    """Not block by block when the program is written: the file names what to change."""
+    valcnc = (Path(__file__).resolve().parents[2] / "postprocessors" / "valcnc.toml").read_text()
+    text = valcnc.replace('name = "valcnc"', 'name = "noz"').replace("words.XYZIJ", "words.XYIJ")
+    text = text.replace('z_moves = "with-xy"', 'z_moves = "none"')
+    (tmp_path / "noz.toml").write_text(text)
+    with pytest.raises(InputError, match=r"noz\.toml: the machine has a Z axis .*has_z = false"):
+        load_target(str(tmp_path / "noz.toml"))
+    (tmp_path / "noz.toml").write_text(text.replace("has_z = true", "has_z = false"))
+    assert not load_target(str(tmp_path / "noz.toml")).machine.has_z
+
+
+def test_a_z_axis_given_to_a_machine_without_z_word_is_refused(tmp_path: Path) -> None:
+    """A --machine overlay that gives pic-mmh (no Z word) a Z axis."""
+    (tmp_path / "z.toml").write_text("has_z = true\n")
+    with pytest.raises(InputError, match=r"has_z = true .*z\.toml"):
+        load_target("pic-mmh", machine_file=tmp_path / "z.toml")

@@ -536,7 +536,13 @@ name = "my-router"
 description = "my router: inch G-code with ';' block ends"
 dialect = "word-address"
 default_feed_mm_min = 254.0
-machine = "grbl"
+
+[machine]  # no Z word: a 2D machine (a Z axis is refused at load)
+profile = "my-router"
+name = "my router"
+steps_per_mm = [80.0, 80.0, 80.0]
+work_area_mm = [0.0, 0.0, 600.0, 400.0]
+has_z = false
 
 [dialect_options]
 suffix = ".tap"
