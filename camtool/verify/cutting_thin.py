@@ -125,7 +125,7 @@ class CuttingStream:
     Feed every chunk of the whole trace in order with :meth:`add` (the chunk's rows, mm,
     and the move of each row), then :meth:`finish`: the rows and run ids are those
     :func:`against_drawing` keeps of the whole trace's cutting rows (what
-    :func:`camtool.verify.verifier._cutting_rows` gives), bit for bit, while no more
+    :func:`camtool.verify.streamed.cutting_rows` gives), bit for bit, while no more
     than a chunk and :data:`CUT_HEAD_ROWS` rows are held besides the kept ones. The
     cutting rows are known in advance (``rows``: from the moves' row counts), so the
     every-k-th is known as soon as the first :data:`CUT_HEAD_ROWS` of them are read;

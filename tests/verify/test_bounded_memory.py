@@ -20,7 +20,7 @@ import pytest
 from camtool.accel import cores
 from camtool.model.program import ArcMove, Linear, Program, Rapid
 from camtool.post.registry import load_target
-from camtool.verify import trace_sources, verifier
+from camtool.verify import budget_run, trace_sources, verifier
 from camtool.verify.simulate import ChunkedSimulation, TraceChunk, count_rows, simulate_steps
 from camtool.verify.sources import ALL, SOURCES, Sources
 from camtool.verify.trace_measures import TraceStream
@@ -121,7 +121,7 @@ def test_the_budget_re_simulates_in_chunks_never_whole(
     expected = verifier.verify_program(program, machine, name=name).error_budget  # whole
     assert expected.without  # some sources are modelled
     chunk_rows = 256
-    monkeypatch.setattr(verifier, "CHUNK_ROWS", chunk_rows)
+    monkeypatch.setattr(budget_run, "CHUNK_ROWS", chunk_rows)
     seen = _spy_chunks(monkeypatch)
     whole = _spy_whole(monkeypatch)
     v = verifier.verify_program(program, machine, name=name)
@@ -154,7 +154,7 @@ def test_the_budget_peak_does_not_grow_with_the_program(monkeypatch: pytest.Monk
     """
     machine = load_target("grbl").machine
     monkeypatch.setattr(cores, "default_jobs", lambda: 1)
-    monkeypatch.setattr(verifier, "CHUNK_ROWS", 1024)
+    monkeypatch.setattr(budget_run, "CHUNK_ROWS", 1024)
     small = _budget_peak(_squares(10, side=4.0), machine)
     big = _budget_peak(_squares(40, side=4.0), machine)
     assert big < 2 * small, (small, big)
@@ -272,7 +272,7 @@ def test_a_streamed_budget_against_a_drawing_is_the_whole_one(
     whole, expected = budget()
     assert whole.cut_digest is None  # a whole trace: its digest made when needed
     assert "distance to the drawing" in expected.total and "rounding" in expected.without
-    monkeypatch.setattr(verifier, "CHUNK_ROWS", 97)
+    monkeypatch.setattr(budget_run, "CHUNK_ROWS", 97)
     v, got = budget(chunk_rows=97, stream_above=10)
     assert v.cut_digest is not None and v.trace.row_count > 97
     assert got == expected

@@ -299,7 +299,7 @@ def test_the_budget_made_in_workers_is_the_one_made_here(
     import os
 
     from camtool.accel import cores
-    from camtool.verify import verifier
+    from camtool.verify import budget_run, verifier
 
     if not cores.FORK:
         pytest.skip("forked workers: Linux only")
@@ -307,14 +307,14 @@ def test_the_budget_made_in_workers_is_the_one_made_here(
     monkeypatch.setattr(cores, "default_jobs", lambda: 1)
     here = verify_program(_circle10(), machine, name="flashcut").error_budget
     pids = tmp_path / "pids"
-    measure = verifier._without
+    measure = budget_run.without_source
 
     def noted(v: verifier.Verification, name: str) -> object:
         with pids.open("a") as note:
             note.write(f"{os.getpid()}\n")
         return measure(v, name)
 
-    monkeypatch.setattr(verifier, "_without", noted)
+    monkeypatch.setattr(budget_run, "without_source", noted)
     monkeypatch.setattr(cores, "default_jobs", lambda: 2)
     there = verify_program(_circle10(), machine, name="flashcut").error_budget
     assert there == here and len(here.without) == 5
@@ -344,12 +344,12 @@ def test_a_budget_asked_for_now_is_the_budget_asked_for_later() -> None:
 def test_a_budget_that_fails_now_fails_when_asked_for(monkeypatch: pytest.MonkeyPatch) -> None:
     """A re-simulation that fails does not stop the verification; asking for the budget does."""
     from camtool.model.errors import InputError
-    from camtool.verify import verifier
+    from camtool.verify import budget_run
 
     def fails(inputs: object, name: str) -> object:
         raise InputError(f"{name} cannot be simulated")
 
-    monkeypatch.setattr(verifier, "_without", fails)
+    monkeypatch.setattr(budget_run, "without_source", fails)
     machine = load_target("flashcut").machine
     v = verify_program(_circle10(), machine, name="flashcut", budget_now=lambda step: None)
     assert v.deviation.max_um > 0 and "error_budget" not in v.__dict__

@@ -22,7 +22,7 @@ from camtool.model.machine import Backlash, BacklashRegion, Machine
 from camtool.model.program import Linear, Program, Rapid
 from camtool.model.progress import Step
 from camtool.post.registry import load_target
-from camtool.verify import simulate, verifier
+from camtool.verify import budget_run, simulate, verifier
 from camtool.verify.simulate import ChunkedSimulation, TraceChunk
 
 kernels = pytest.importorskip("camtool.accel.kernels")
@@ -54,7 +54,7 @@ def _verify(machine: Machine, **kw: Any) -> verifier.Verification:
 def _spy(monkeypatch: pytest.MonkeyPatch) -> list[str]:
     """Record, in this process, each helper forked and each chunk streamed."""
     events: list[str] = []
-    fork = verifier.fork_with_pipes
+    fork = budget_run.fork_with_pipes
 
     def forked(*args: Any, **kw: Any) -> Any:
         events.append("fork")
@@ -69,9 +69,9 @@ def _spy(monkeypatch: pytest.MonkeyPatch) -> list[str]:
             events.append("chunk")
             yield chunk
 
-    monkeypatch.setattr(verifier, "fork_with_pipes", forked)
+    monkeypatch.setattr(budget_run, "fork_with_pipes", forked)
     monkeypatch.setattr(ChunkedSimulation, "chunks", chunks)
-    monkeypatch.setattr(verifier, "default_jobs", lambda: 2)  # a helper even on one core
+    monkeypatch.setattr(budget_run, "default_jobs", lambda: 2)  # a helper even on one core
     return events
 
 
@@ -101,14 +101,14 @@ def test_a_helper_that_dies_has_its_source_re_simulated_here(
     expected = _verify(machine).error_budget
     events = _spy(monkeypatch)
     here = os.getpid()
-    real = verifier._without
+    real = budget_run.without_source
 
     def dies(inputs: Any, name: str) -> Any:
         if os.getpid() != here:
             os._exit(3)  # the helper, before it answers
         return real(inputs, name)
 
-    monkeypatch.setattr(verifier, "_without", dies)
+    monkeypatch.setattr(budget_run, "without_source", dies)
     v = _verify(machine, budget_now=lambda step: None)
     assert events[0] == "fork"
     assert v.error_budget == expected

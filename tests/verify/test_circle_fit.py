@@ -19,7 +19,7 @@ from camtool.accel import cores
 from camtool.model.machine import Backlash, Machine
 from camtool.model.program import ArcMove, Program, Rapid
 from camtool.post.registry import load_target
-from camtool.verify import circlefit, verifier
+from camtool.verify import budget_run, circlefit, verifier
 from camtool.verify.circlefit import CircleFit, fit_circle
 from camtool.verify.simulate import count_rows
 from camtool.verify.sources import ALL
@@ -149,7 +149,7 @@ def test_a_streamed_circle_of_many_turns_holds_no_trace(monkeypatch: pytest.Monk
     """
     machine = dataclasses.replace(load_target("pic-mmh").machine, backlash=Backlash())
     monkeypatch.setattr(cores, "default_jobs", lambda: 1)  # one source, here
-    monkeypatch.setattr(verifier, "CHUNK_ROWS", 4096)
+    monkeypatch.setattr(budget_run, "CHUNK_ROWS", 4096)
     small, small_rows = _budget_peak(8, machine)
     big, big_rows = _budget_peak(32, machine)
     assert big_rows > 3 * small_rows

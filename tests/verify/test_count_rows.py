@@ -20,7 +20,7 @@ from camtool.model.machine import Backlash, Machine
 from camtool.model.program import Linear, Program, Rapid
 from camtool.post.registry import load_target
 from camtool.verify import simulate as sim
-from camtool.verify import verifier
+from camtool.verify import streamed
 from camtool.verify.dda import dda_line, dda_line_numpy, dda_line_rows
 from camtool.verify.report import build_report
 from camtool.verify.sources import ALL
@@ -100,13 +100,13 @@ def test_a_wrong_count_is_found_and_counted_again(monkeypatch: pytest.MonkeyPatc
     whole = build_report(verify_program(program, machine, name="pic-mmh", budget=False))
     monkeypatch.setitem(sim.LINE_ROWS, dda_line, lambda dx, dy: dda_line_rows(dx, dy) + 1)
     recounted: list[int] = []
-    real = verifier.simulate_or_count
+    real = streamed.simulate_or_count
 
     def spy(*args: object) -> object:
         recounted.append(1)
         return real(*args)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(verifier, "simulate_or_count", spy)
+    monkeypatch.setattr(streamed, "simulate_or_count", spy)
     v = verify_program(
         program, machine, name="pic-mmh", budget=False, chunk_rows=500, stream_above=10
     )

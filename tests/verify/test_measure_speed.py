@@ -22,11 +22,11 @@ from camtool.verify import (
     nearest_exact,
     nearest_search,
     path_shortfall,
-    verifier,
 )
 from camtool.verify.sources import ALL
+from camtool.verify.streamed import cutting_rows
 from camtool.verify.trace_sources import simulate
-from camtool.verify.verifier import _cutting_rows, verify_program
+from camtool.verify.verifier import verify_program
 
 
 def _polyline(rng: np.random.Generator, kind: int) -> np.ndarray:
@@ -141,8 +141,8 @@ def test_budget_reuses_the_drawing_figure_only_when_the_trace_is_the_same() -> N
     v = verify_program(program, target.machine, against=drawing, tool_diameter=0.5,
                        planned=planned)  # fmt: skip
     trace = simulate(planned, target.machine)
-    assert np.array_equal(_cutting_rows(planned, trace)[0], _cutting_rows(program, v.trace)[0])
-    cut, runs = _cutting_rows(planned, trace)
+    assert np.array_equal(cutting_rows(planned, trace)[0], cutting_rows(program, v.trace)[0])
+    cut, runs = cutting_rows(planned, trace)
     again = drawing_compare.against_drawing(cut, drawing, 0.25, runs=runs)
     assert v.against is not None
     assert v.error_budget.without["rounding"]["distance to the drawing"] == again.max_um
@@ -330,18 +330,19 @@ def test_a_drawing_sampled_into_one_array_is_its_contours_stacked() -> None:
 
 
 def test_the_cutting_count_is_the_count_of_cutting_rows() -> None:
-    """_same_against tells traces apart by the digest of their cutting rows, copying none."""
-    from camtool.verify.verifier import _cutting_count, _same_against, _trace_digest
+    """same_against tells traces apart by the digest of their cutting rows, copying none."""
+    from camtool.verify.budget_run import BudgetInputs, same_against, trace_digest
+    from camtool.verify.streamed import cutting_count
 
     target = load_target("grbl")
     program, drawing = _plate()
     trace = simulate(program, target.machine)
-    assert _cutting_count(program, trace.block_start) == len(_cutting_rows(program, trace)[0])
-    assert 0 < _cutting_count(program, trace.block_start) < trace.row_count  # rapids left out
+    assert cutting_count(program, trace.block_start) == len(cutting_rows(program, trace)[0])
+    assert 0 < cutting_count(program, trace.block_start) < trace.row_count  # rapids left out
     v = verify_program(program, target.machine, against=drawing, tool_diameter=0.5)
     ideal = simulate(program, target.machine, sources=ALL.without("interpolation"))
-    assert _cutting_count(program, ideal.block_start) != _cutting_count(program, trace.block_start)
-    inputs = verifier._Inputs(program, target.machine, v.trace, None, drawing, 0.5, ())
-    assert not _same_against(inputs, program, _trace_digest(program, ideal))
-    assert _same_against(inputs, program, _trace_digest(program, trace))
-    assert not _same_against(inputs, program, None)
+    assert cutting_count(program, ideal.block_start) != cutting_count(program, trace.block_start)
+    inputs = BudgetInputs(program, target.machine, v.trace, None, drawing, 0.5, ())
+    assert not same_against(inputs, program, trace_digest(program, ideal))
+    assert same_against(inputs, program, trace_digest(program, trace))
+    assert not same_against(inputs, program, None)

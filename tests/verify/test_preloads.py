@@ -103,14 +103,14 @@ def test_the_budget_s_distance_is_the_comparison_s_bit_for_bit(offset: str, tool
     the line, every sample counts.
     """
     from camtool.jobs.pipeline import post_drawing, verify_job
-    from camtool.verify import trace_sources, verifier
+    from camtool.verify import streamed, trace_sources
 
     target = load_target("grbl")
     plan = PlanOptions(offset=offset, tool_diameter=tool, depth=1.0)
     job = post_drawing(read_drawing(SAMPLES / "plate.dxf"), target, plan)
     v = verify_job(job, budget=False)
     assert v.drawing is not None and v.against is not None
-    thin = cutting_thin.thin_cutting(*verifier._cutting_rows(v.program, v.trace))
+    thin = cutting_thin.thin_cutting(*streamed.cutting_rows(v.program, v.trace))
     nominal = trace_sources._nominal_lines(v.program) if v.findings else ()
     args = (thin, v.drawing, tool / 2.0)
     full = drawing_compare.against_thinned(*args, nominal=nominal, findings=v.findings)

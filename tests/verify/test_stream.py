@@ -1,10 +1,10 @@
 """A streamed verification (the trace simulated and measured in chunks) equals the whole one.
 
-Issue 17: a big program's trace is never held whole (:func:`camtool.verify.verifier.
-_simulate_big`). Run with a tiny chunk size and a tiny streaming threshold, the same
-programs must give the same report as the whole-array path, figure for figure; the one
-allowed exception is the deviation's rms, summed exactly instead of by numpy's pairwise
-mean (its value may differ in the last bits; the report rounds it to 0.1 nm).
+A big program's trace is never held whole (:func:`camtool.verify.streamed.simulate_big`).
+Run with a tiny chunk size and a tiny streaming threshold, the same programs must give
+the same report as the whole-array path, figure for figure; the one allowed exception is
+the deviation's rms, summed exactly instead of by numpy's pairwise mean (its value may
+differ in the last bits; the report rounds it to 0.1 nm).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import pytest
 from camtool.model.program import Program
 from camtool.model.shapes import Drawing
 from camtool.post.registry import load_target
-from camtool.verify import cutting_thin, path_shortfall, trace_measures, verifier
+from camtool.verify import cutting_thin, path_shortfall, streamed, trace_measures
 from camtool.verify.report import build_report
 from camtool.verify.simulate import ChunkedSimulation, StreamedTrace, simulate_steps
 from camtool.verify.verifier import verify_program
@@ -106,12 +106,12 @@ def test_distances_taken_by_the_thread_ahead_give_the_same_report(
     calls = iter(range(10**6))
     taken: list[bool] = []
 
-    def decide(self: verifier._Share) -> bool:
+    def decide(self: streamed.Share) -> bool:
         got = next(calls) % 2 == 0 if take == "alternate" else bool(take)
         taken.append(got)
         return got
 
-    monkeypatch.setattr(verifier._Share, "take", decide)
+    monkeypatch.setattr(streamed.Share, "take", decide)
     v = verify_program(
         program, target.machine, name="pic-mmh", budget=False, chunk_rows=53, stream_above=10
     )
@@ -126,7 +126,7 @@ def test_distances_taken_by_the_thread_ahead_give_the_same_report(
 
 def test_the_share_balances_the_two_threads_time_a_row() -> None:
     """f = (c + d − m) / 2d of the chunks, in [0, 1]; none before anything is measured."""
-    share = verifier._Share()
+    share = streamed.Share()
     assert not share.take()
     share.made(10e-6, 1000)  # m = 10 ns a row
     share.measured(7e-6, 1000)  # c = 7 ns
@@ -137,7 +137,7 @@ def test_the_share_balances_the_two_threads_time_a_row() -> None:
     for _ in range(40):
         share.made(40e-6, 1000)
     assert not any(share.take() for _ in range(100))
-    fast = verifier._Share()
+    fast = streamed.Share()
     fast.made(1e-9, 1000)
     fast.measured(50e-6, 1000)
     fast.measured_distances(1e-6, 1000)  # f > 1: every chunk
@@ -327,18 +327,18 @@ def test_rows_at_least_never_overstates_the_trace(name: str, seed: int) -> None:
     (A row steps each motor at most once, so a move takes at least its larger axis's
     steps in rows; the rounding of the ends takes one off.)
     """
-    from camtool.verify.verifier import _rows_at_least
+    from camtool.verify.streamed import rows_at_least
 
     machine = load_target(name).machine
     program = _program(seed)
     trace = simulate_steps(program, machine)
-    bound = _rows_at_least(program, machine)
+    bound = rows_at_least(program, machine)
     assert 0 < bound <= trace.row_count
     per_move = np.diff(trace.block_start)
     start = program.origin
     for move, rows in zip(program.moves, per_move, strict=True):  # move by move too
         alone = Program((move,), origin=start)
-        assert _rows_at_least(alone, machine) <= rows
+        assert rows_at_least(alone, machine) <= rows
         start = (move.x, move.y)
 
 
@@ -404,7 +404,7 @@ def test_the_cutting_stream_keeps_the_rows_the_whole_trace_keeps(
     """:class:`CuttingStream` over any split of the rows = the whole trace's thinning.
 
     The reference is what :func:`against_drawing` does with the whole cutting trace
-    (``_cutting_rows``, then the every-k-th from its head and ``_thin_index``).
+    (``cutting_rows``, then the every-k-th from its head and ``_thin_index``).
     """
     from camtool.verify import cutting_thin
 
