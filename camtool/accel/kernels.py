@@ -243,7 +243,7 @@ def _fill_runs(
 
 
 def play_runs(rows: Any, ox: int, oy: int) -> tuple[Any, ...]:
-    """Runs of equal step sign per axis, for the backlash play (``simulate._play``).
+    """Runs of equal step sign per axis, for the backlash play (``simulate.backlash_play``).
 
     A run starts at a row whose non-zero step on that axis differs in sign from the
     axis's previous non-zero step (or is its first). Returns, per axis, the run start
@@ -305,7 +305,7 @@ def reversals(rows: Any, axis: int, direction: int) -> tuple[Any, Any, int, int]
     (``direction`` before the first row; 0: none yet, so no reversal). Returns the rows
     ``(K,) int64`` and signs ``(K,) int8`` of the reversals, the direction after the
     rows (``direction`` when the column has no step) and the column's pulses (the sum
-    of ``|step|``), as ``simulate._Controller._compensate`` and ``block`` find them
+    of ``|step|``), as ``simulate.StepController._compensate`` and ``block`` find them
     with numpy. One pass over the column; a second, to fill the reversals, only when
     there are any (a line has at most one, at its first pulse).
     """
@@ -339,7 +339,7 @@ def play_axis_from(
     true_spm`` into ``out``. ``bands[r]`` is the band of run ``r`` in steps (unused for
     up runs). The whole trace is one chunk from a zero ``state``
     (``simulate._carriage_compiled``); a streamed one resumes each chunk from the last
-    (``simulate.ChunkedSimulation``), and the chunks' rows joined give the same values.
+    (``chunked.ChunkedSimulation``), and the chunks' rows joined give the same values.
 
     ``state`` is ``float64[5]``: ``c0`` (the carriage before the first run, set at the
     first run: ``start`` going up, ``start + band`` going down), ``current``, ``value``,
@@ -524,7 +524,7 @@ def ideal_motor(rows: Any, total: Any, origin: Any, motor: Any, signs: Any) -> N
 
     ``motor[i] = (total + rows[0] + … + rows[i]) + origin`` per axis: the running sum in
     row order (numpy's ``cumsum``, resumed from ``total``), then the origin added, as
-    ``simulate._FloatPlay`` and ``simulate._motor`` take them; ``total`` becomes the
+    ``chunked._FloatPlay`` and ``simulate.motor_positions`` take them; ``total`` becomes the
     running sum after the last row. ``signs[i]`` is ``sign(rows[i])`` (int8; 0 for a
     zero of either sign).
     """
@@ -591,7 +591,7 @@ def ideal_play_axis(
     true_spm: float,
     out: Any,
 ) -> None:
-    """One axis of ``simulate._FloatPlay.chunk``, the play operator on fractional steps.
+    """One axis of ``chunked._FloatPlay.chunk``, the play operator on fractional steps.
 
     The same float operations, in the same order, as the numpy form: before the first
     run the carriage is ``origin``; a run starting here takes ``current`` from the value

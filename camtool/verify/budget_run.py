@@ -36,6 +36,10 @@ from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import Drawing
 from camtool.verify import budget as eb
 from camtool.verify import trace_sources
+from camtool.verify.chunked import (
+    NotStreamable,
+    count_rows,
+)
 from camtool.verify.cutting_thin import (
     CutDigest,
 )
@@ -46,10 +50,6 @@ from camtool.verify.drawing_compare import (
     prepare_stream,
 )
 from camtool.verify.motion import StepTrace, library
-from camtool.verify.simulate import (
-    NotStreamable,
-    count_rows,
-)
 from camtool.verify.sources import ALL, SOURCES, Sources
 from camtool.verify.streamed import (
     CHUNK_ROWS,

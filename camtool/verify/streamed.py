@@ -19,6 +19,14 @@ from camtool.model.machine import Machine
 from camtool.model.program import Program, Rapid
 from camtool.model.shapes import Drawing
 from camtool.verify import trace_sources
+from camtool.verify.chunked import (
+    ChunkedSimulation,
+    NotStreamable,
+    StreamedTrace,
+    TraceChunk,
+    count_rows,
+    simulate_or_count,
+)
 from camtool.verify.contour_measures import ContourMeasure, measure_contours
 from camtool.verify.cutting_thin import (
     AGAINST_RESOLUTION_MM,
@@ -35,14 +43,6 @@ from camtool.verify.drawing_compare import (
 )
 from camtool.verify.motion import StepTrace, library
 from camtool.verify.path_shortfall import AlongPath, along_path
-from camtool.verify.simulate import (
-    ChunkedSimulation,
-    NotStreamable,
-    StreamedTrace,
-    TraceChunk,
-    count_rows,
-    simulate_or_count,
-)
 from camtool.verify.sources import ALL, Sources
 from camtool.verify.steparray import read_only
 from camtool.verify.trace_measures import TraceStream
@@ -78,7 +78,7 @@ def simulate_big(
     A trace of at most ``stream_above`` rows or one from a target's own simulator is
     simulated whole (:func:`simulate`) and measured by :func:`_measure` (then ``None``).
     A longer one of the step simulator is simulated again in chunks of ``chunk_rows``
-    rows (:class:`camtool.verify.simulate.ChunkedSimulation`) and measured chunk by
+    rows (:class:`camtool.verify.chunked.ChunkedSimulation`) and measured chunk by
     chunk (:class:`camtool.verify.trace_measures.TraceStream`: the same figures, the
     deviation's rms summed exactly); the trace returned (:class:`StreamedTrace`) then
     holds only the rows kept for the picture. With a drawing (``against``), the cutting

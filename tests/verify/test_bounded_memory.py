@@ -21,7 +21,8 @@ from camtool.accel import cores
 from camtool.model.program import ArcMove, Linear, Program, Rapid
 from camtool.post.registry import load_target
 from camtool.verify import budget_run, trace_sources, verifier
-from camtool.verify.simulate import ChunkedSimulation, TraceChunk, count_rows, simulate_steps
+from camtool.verify.chunked import ChunkedSimulation, TraceChunk, count_rows
+from camtool.verify.simulate import simulate_steps
 from camtool.verify.sources import ALL, SOURCES, Sources
 from camtool.verify.trace_measures import TraceStream
 from tests.verify.programs import TARGETS, mixed_program
@@ -211,12 +212,12 @@ def test_an_ideal_line_s_reversals_are_the_row_scan_s(value: float, direction: i
 
     machine = load_target("pic-mmh").machine
     column = np.full(1000, value)
-    fast = sim._IdealController(machine, (0.0, 0.0))
-    scan = sim._IdealController(machine, (0.0, 0.0))
+    fast = sim.IdealController(machine, (0.0, 0.0))
+    scan = sim.IdealController(machine, (0.0, 0.0))
     fast.direction = [direction, direction]
     scan.direction = [direction, direction]
     got = fast._reversals(column, 0)
-    expected = sim._Controller._reversals(scan, column, 0)
+    expected = sim.StepController._reversals(scan, column, 0)
     assert [a.tolist() for a in got] == [a.tolist() for a in expected]
     assert [a.dtype for a in got] == [a.dtype for a in expected]
     assert fast.direction == scan.direction

@@ -22,8 +22,8 @@ from camtool.model.machine import Backlash, BacklashRegion, Machine
 from camtool.model.program import Linear, Program, Rapid
 from camtool.model.progress import Step
 from camtool.post.registry import load_target
-from camtool.verify import budget_run, simulate, verifier
-from camtool.verify.simulate import ChunkedSimulation, TraceChunk
+from camtool.verify import budget_run, chunked, verifier
+from camtool.verify.chunked import ChunkedSimulation, TraceChunk
 
 kernels = pytest.importorskip("camtool.accel.kernels")
 pytestmark = [
@@ -85,7 +85,7 @@ def test_one_source_is_forked_before_the_stream_and_gives_the_same_budget(
     events = _spy(monkeypatch)
     told: list[Step] = []
     v = _verify(machine, budget_now=told.append)
-    assert isinstance(v.trace, simulate.StreamedTrace)
+    assert isinstance(v.trace, chunked.StreamedTrace)
     assert "error_budget" in v.__dict__  # computed with the verification
     assert events[0] == "fork" and events.count("fork") == 1
     assert events.count("chunk") > 1  # this process streamed its own trace meanwhile
@@ -133,8 +133,8 @@ def _play_both(
     rows: np.ndarray, cuts: list[int], machine: Machine, origin: tuple[float, float]
 ) -> tuple[list[np.ndarray], list[np.ndarray]]:
     """The chunks' directions and carriage by the numpy play and by the compiled one."""
-    numpy_play = simulate._FloatPlay(origin, machine)
-    compiled = simulate._FloatPlayCompiled(origin, machine, kernels)
+    numpy_play = chunked._FloatPlay(origin, machine)
+    compiled = chunked._FloatPlayCompiled(origin, machine, kernels)
     got: tuple[list[np.ndarray], list[np.ndarray]] = ([], [])
     for piece in np.split(rows, cuts):
         for out, play in zip(got, (numpy_play, compiled), strict=True):

@@ -20,8 +20,8 @@ from camtool.model.machine import Backlash, Machine
 from camtool.model.program import ArcMove, Program, Rapid
 from camtool.post.registry import load_target
 from camtool.verify import budget_run, circlefit, verifier
+from camtool.verify.chunked import count_rows
 from camtool.verify.circlefit import CircleFit, fit_circle
-from camtool.verify.simulate import count_rows
 from camtool.verify.sources import ALL
 
 # what this file checks is done by the accelerated versions only (docs/architecture.md)

@@ -2,7 +2,7 @@
 
 Issue 17: the streamed verify needs every move's row offsets before it measures, and
 counted them by simulating the whole program once more (0.6 s of a 66 M-step program).
-:func:`camtool.verify.simulate.count_rows` counts a line of the A.3 DDA as
+:func:`camtool.verify.chunked.count_rows` counts a line of the A.3 DDA as
 ``floor(HIPO) + 1`` rows plus a compensation at a reversal. The judges: the rows the
 interpolator makes, and the offsets the full simulation gives.
 """
@@ -19,8 +19,8 @@ import pytest
 from camtool.model.machine import Backlash, Machine
 from camtool.model.program import Linear, Program, Rapid
 from camtool.post.registry import load_target
+from camtool.verify import chunked, streamed
 from camtool.verify import simulate as sim
-from camtool.verify import streamed
 from camtool.verify.dda import dda_line, dda_line_numpy, dda_line_rows
 from camtool.verify.report import build_report
 from camtool.verify.sources import ALL
@@ -69,26 +69,26 @@ def test_counted_offsets_are_the_simulated_ones(name: str, seed: int) -> None:
     """pic-mmh's lines counted in closed form, arcs and other machines simulated: the same."""
     machine = load_target(name).machine
     for program in (mixed_program(seed), _zigzag(seed)):
-        want = sim.simulate_or_count(program, machine, 0)
+        want = chunked.simulate_or_count(program, machine, 0)
         assert not isinstance(want, sim.StepTrace)
-        assert np.array_equal(sim.count_rows(program, machine), want)
+        assert np.array_equal(chunked.count_rows(program, machine), want)
 
 
 def test_pic_mmh_lines_are_counted_without_their_rows(monkeypatch: pytest.MonkeyPatch) -> None:
     """The closed form is what counts pic-mmh's lines: its interpolator is never asked."""
     machine = load_target("pic-mmh").machine
     program = _zigzag(5)
-    want = sim.simulate_or_count(program, machine, 0)
-    monkeypatch.setitem(sim.LINE_ROWS, dda_line, dda_line_rows)
+    want = chunked.simulate_or_count(program, machine, 0)
+    monkeypatch.setitem(chunked.LINE_ROWS, dda_line, dda_line_rows)
     made: list[int] = []
-    real = sim._Controller.block
+    real = sim.StepController.block
 
-    def spy(self: sim._Controller, *args: object) -> None:
+    def spy(self: sim.StepController, *args: object) -> None:
         made.append(1)
         real(self, *args)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(sim._Controller, "block", spy)
-    assert np.array_equal(sim.count_rows(program, machine), want)
+    monkeypatch.setattr(sim.StepController, "block", spy)
+    assert np.array_equal(chunked.count_rows(program, machine), want)
     assert made == []
 
 
@@ -98,7 +98,7 @@ def test_a_wrong_count_is_found_and_counted_again(monkeypatch: pytest.MonkeyPatc
     machine = load_target("pic-mmh").machine
     program = _zigzag(2)
     whole = build_report(verify_program(program, machine, name="pic-mmh", budget=False))
-    monkeypatch.setitem(sim.LINE_ROWS, dda_line, lambda dx, dy: dda_line_rows(dx, dy) + 1)
+    monkeypatch.setitem(chunked.LINE_ROWS, dda_line, lambda dx, dy: dda_line_rows(dx, dy) + 1)
     recounted: list[int] = []
     real = streamed.simulate_or_count
 
@@ -110,7 +110,7 @@ def test_a_wrong_count_is_found_and_counted_again(monkeypatch: pytest.MonkeyPatc
     v = verify_program(
         program, machine, name="pic-mmh", budget=False, chunk_rows=500, stream_above=10
     )
-    assert isinstance(v.trace, sim.StreamedTrace)
+    assert isinstance(v.trace, chunked.StreamedTrace)
     assert recounted == [1]
     got = build_report(v)
     for report in (got, whole):
@@ -135,8 +135,8 @@ def test_the_ideal_controller_s_rows_are_counted_as_it_makes_them(name: str, see
     for machine in (_no_compensation(name), load_target(name).machine):
         for program in (mixed_program(seed), _zigzag(seed)):
             want = sim.simulate_steps(program, machine, sources=sources).block_start
-            assert np.array_equal(sim.count_rows(program, machine, sources=sources), want)
-            counted = sim.count_rows(program, machine, sources=sources, closed_form=False)
+            assert np.array_equal(chunked.count_rows(program, machine, sources=sources), want)
+            counted = chunked.count_rows(program, machine, sources=sources, closed_form=False)
             assert np.array_equal(counted, want)
 
 
@@ -156,14 +156,14 @@ def test_the_ideal_controller_counts_without_making_rows(
     want = sim.simulate_steps(program, machine, sources=sources).block_start
     made: list[str] = []
     for method in ("_ideal_line", "_ideal_arc"):
-        real = getattr(sim._IdealController, method)
+        real = getattr(sim.IdealController, method)
 
         def spy(
-            self: sim._IdealController, *args: object, _real: Any = real, _m: str = method
+            self: sim.IdealController, *args: object, _real: Any = real, _m: str = method
         ) -> Any:
             made.append(_m)
             return _real(self, *args)
 
-        monkeypatch.setattr(sim._IdealController, method, spy)
-    assert np.array_equal(sim.count_rows(program, machine, sources=sources), want)
+        monkeypatch.setattr(sim.IdealController, method, spy)
+    assert np.array_equal(chunked.count_rows(program, machine, sources=sources), want)
     assert made == []

@@ -19,8 +19,9 @@ from camtool.model.program import Program
 from camtool.model.shapes import Drawing
 from camtool.post.registry import load_target
 from camtool.verify import cutting_thin, path_shortfall, streamed, trace_measures
+from camtool.verify.chunked import ChunkedSimulation, StreamedTrace
 from camtool.verify.report import build_report
-from camtool.verify.simulate import ChunkedSimulation, StreamedTrace, simulate_steps
+from camtool.verify.simulate import simulate_steps
 from camtool.verify.verifier import verify_program
 from tests.verify.programs import TARGETS
 from tests.verify.programs import mixed_program as _program
