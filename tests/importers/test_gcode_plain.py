@@ -175,7 +175,7 @@ def test_corpus_programs_read_the_same() -> None:
 
 def test_plain_moves_are_made_as_their_init_makes_them() -> None:
     """The plain reader's moves, made without ``__init__``, equal the dataclass's own."""
-    from camtool.importers import gcode
+    from camtool.importers import gcode_plain as gcode
     from camtool.model.program import ArcMove, Linear, Rapid
 
     assert gcode._FAST_MOVES  # the model's moves are plain slotted frozen dataclasses
