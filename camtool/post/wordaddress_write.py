@@ -40,7 +40,7 @@ from camtool.post.base import (
 from camtool.post.wordaddress_spec import PLANE_CODES, WordAddressSpec
 
 if TYPE_CHECKING:
-    from camtool.post.arccheck import ArcPiece
+    from camtool.post.arcconform import ArcPiece
 
 
 _SAME_MM = 1e-9
@@ -545,9 +545,9 @@ class BlockWriter(WriterState[str]):
         :mod:`camtool.accel.conformahead`'s helper calls it ahead of the writer.
 
         Raises:
-            DialectError: :func:`~camtool.post.arccheck.conform_arc`'s, without the block.
+            DialectError: :func:`~camtool.post.arcconform.conform_arc`'s, without the block.
         """
-        from camtool.post.arccheck import conform_arc
+        from camtool.post.arcconform import conform_arc
 
         quantum = self._quantum
         if quantum is None:

@@ -1,7 +1,7 @@
 """Arcs conformed ahead in a forked helper: the writer writes what it writes alone (issue 17).
 
 :mod:`camtool.accel.conformahead` forks a helper that predicts the arguments of each arc's
-arc check (:func:`~camtool.post.arccheck.conform_arc`) and conforms the arcs from the last
+arc check (:func:`~camtool.post.arcconform.conform_arc`) and conforms the arcs from the last
 back, while the writer works from the first; the writer takes an answer only for an arc
 whose arguments are the key the helper predicted. These tests hold:
 

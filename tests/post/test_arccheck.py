@@ -20,15 +20,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from camtool.model.errors import DialectError, UsageError
-from camtool.post.arccheck import (
-    DEVIATION_QUANTA,
-    GRBL_TOLERANCE_MM,
-    LINUXCNC_TOLERANCE_MM,
-    MARGIN_MM,
-    ArcPiece,
-    arc_error,
-    conform_arc,
-)
+from camtool.post.arccheck import GRBL_TOLERANCE_MM, LINUXCNC_TOLERANCE_MM, MARGIN_MM, arc_error
+from camtool.post.arcconform import DEVIATION_QUANTA, ArcPiece, conform_arc
 from camtool.post.numfmt import NumberFormat
 
 Point = tuple[float, float]

@@ -5,12 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from camtool.post import arccheck
-from camtool.post.arccheck import Grid
+from camtool.post import arcconform
+from camtool.post.arcconform import Grid
 
 
 def test_value_memo_gives_the_fresh_float(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(arccheck, "_MEMO_SIZE", 50)  # overflow: the memo starts again
+    monkeypatch.setattr(arcconform, "_MEMO_SIZE", 50)  # overflow: the memo starts again
     rng = np.random.default_rng(17)
     for quantum in (0.001, 0.01, 0.0001, 0.005):
         grid = Grid.of(quantum)

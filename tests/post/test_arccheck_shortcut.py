@@ -23,9 +23,9 @@ import os
 import numpy as np
 import pytest
 
-import camtool.post.arccheck as arccheck
+import camtool.post.arcconform as arcconform
 from camtool.model.errors import CamtoolError
-from camtool.post.arccheck import ArcPiece, conform_arc
+from camtool.post.arcconform import ArcPiece, conform_arc
 from camtool.post.numfmt import NumberFormat
 
 Point = tuple[float, float]
@@ -40,7 +40,7 @@ def _printed(p: Point, quantum: float) -> Point:
     if math.isclose(10.0**-decimals, quantum):
         fmt = NumberFormat(decimals=decimals)
         return (float(fmt.quantize(p[0])), float(fmt.quantize(p[1])))
-    grid = arccheck.Grid.of(quantum)
+    grid = arcconform.Grid.of(quantum)
     return grid.point(grid.indices(p))
 
 
@@ -95,14 +95,14 @@ def test_shortcut_equals_the_search_on_random_arcs(
     rule: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     seen = {True: 0, False: 0}
-    plain = arccheck.plainly_passes
+    plain = arcconform.plainly_passes
 
     def counted(*args: object) -> bool:
         ok = plain(*args)  # type: ignore[arg-type]
         seen[ok] += 1
         return ok
 
-    monkeypatch.setattr(arccheck, "plainly_passes", counted)
+    monkeypatch.setattr(arcconform, "plainly_passes", counted)
     rng = np.random.default_rng(17 if rule == "grbl" else 1717)
     for k in range(N_WHOLE):
         args = _arc(rng)
@@ -126,14 +126,14 @@ def test_shortcut_equals_the_search_along_a_spiral(
     # each through the previous end (its centre on the chord's bisector), written from
     # the previous printed end as the writer chains them
     answered = []
-    plain = arccheck.plainly_passes
+    plain = arcconform.plainly_passes
 
     def counted(*args: object) -> bool:
         ok = plain(*args)  # type: ignore[arg-type]
         answered.append(ok)
         return ok
 
-    monkeypatch.setattr(arccheck, "plainly_passes", counted)
+    monkeypatch.setattr(arcconform, "plainly_passes", counted)
     q = 0.001
     exact = (50.8, 0.0)
     here = _printed(exact, q)
@@ -159,16 +159,16 @@ def test_whenever_the_shortcut_says_yes_the_search_passes_the_rounded_centre(rul
     answered = 0
     for k in range(N):
         start, exact_start, end, centre, clockwise, q = _arc(rng)
-        grid = arccheck.Grid.of(q)
-        ref = arccheck._reference(start, end, centre, clockwise, exact_start)
+        grid = arcconform.Grid.of(q)
+        ref = arcconform._reference(start, end, centre, clockwise, exact_start)
         if rng.integers(0, 3) == 0:  # a part of a split arc, between printed points
             lo, hi = sorted(rng.uniform(0, 1, size=2))
             ref = ref.part(float(lo), float(hi))
             start, end = ref.at(0.0), ref.at(1.0)
         s, e = grid.indices(start), grid.indices(end)
-        solver = arccheck.Solver(grid, rule, clockwise, centre)
+        solver = arcconform.Solver(grid, rule, clockwise, centre)
         c = grid.indices(centre)
-        if not arccheck.plainly_passes(solver, s, e, c, ref):
+        if not arcconform.plainly_passes(solver, s, e, c, ref):
             continue
         answered += 1
         _, ok = solver._passes(s, e, np.array([c], dtype=np.int64), ref)
@@ -179,7 +179,7 @@ def test_whenever_the_shortcut_says_yes_the_search_passes_the_rounded_centre(rul
 
 @pytest.mark.parametrize("quantum", [0.001, 0.01, 0.1, 1.0, 0.0254, 1e-6, 2e-7])
 def test_grid_digits_equal_decimal(quantum: float) -> None:
-    grid = arccheck.Grid.of(quantum)
+    grid = arcconform.Grid.of(quantum)
     rng = np.random.default_rng(7)
     values = [0.0, -0.0, 0.0005, -0.0005, 1e-5, 1e16, -1e22, 2.0005, 1234.5675]
     values += [float(v) for v in rng.uniform(-2000, 2000, 3000)]

@@ -6,7 +6,7 @@ without checking it anew (:meth:`_feed`), keeps the text and value read back of 
 coordinate it printed (:meth:`_print`) and keeps the blocks of each arc it conformed to
 the controller's check for the same arc again (:meth:`_conformed`). :class:`Reference`
 turns them all off: every word goes through the full formatting, every feed through its
-checks and every arc through :func:`~camtool.post.arccheck.conform_arc`, as before. On
+checks and every arc through :func:`~camtool.post.arcconform.conform_arc`, as before. On
 random programs of rapids, lines and arcs (tiny, huge, full circles, reflex arcs,
 helices, feeds that round, numbers over their field) written for every built-in
 word-address target and a few dialects of other widths, the code, the warnings and the
