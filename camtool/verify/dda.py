@@ -4,13 +4,12 @@ from __future__ import annotations
 
 import math
 import operator
-import sys
 from types import ModuleType
 
 import numpy as np
 import numpy.typing as npt
 
-from camtool import accel
+from camtool.accel.loader import KernelsOnDemand
 from camtool.model.errors import UsageError
 from camtool.verify.steparray import StepArray, empty_steps, freeze
 
@@ -219,27 +218,11 @@ def compiled(work: int = COMPILE_FROM) -> ModuleType | None:
     Returns:
         The kernels module, or ``None`` (use the plain path).
     """
-    if not accel.enabled():
-        return None
-    if "kernels" in _COMPILED:
-        return _COMPILED["kernels"]
-    _WORK[0] += work
-    if _WORK[0] < COMPILE_FROM:
-        return None
-    kernels: ModuleType | None = None
-    if sys.byteorder == "little":
-        try:
-            from camtool.accel import kernels
-        except ImportError:
-            kernels = None
-    _COMPILED["kernels"] = kernels
-    return kernels
+    return KERNELS.get(work)
 
 
-_WORK = [0]
-
-
-_COMPILED: dict[str, ModuleType | None] = {}
+KERNELS = KernelsOnDemand("camtool.accel.kernels", COMPILE_FROM, little_endian=True)
+"""The step kernels of this process, loaded from :data:`COMPILE_FROM` rows on."""
 
 
 def dda_line_reference(dx: int, dy: int) -> StepArray:

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from camtool import accel
+from camtool.accel.loader import KernelsOnDemand
 from camtool.verify import nearest_exact
 
 FloatArray = npt.NDArray[np.float64]
@@ -412,10 +412,8 @@ from which it loads the numba search: loading numba and its cache costs about 0.
 point against the tool-centre path), so a small part (the logo) keeps the k-d tree."""
 
 
-_NEAR_KERNELS: dict[str, ModuleType | None] = {}
-
-
-_NEAR_WORK = [0]
+NEAR_KERNELS = KernelsOnDemand("camtool.accel.nearkernels", NEAR_KERNELS_FROM)
+"""The nearest-search kernels of this process, loaded from :data:`NEAR_KERNELS_FROM` samples on."""
 
 
 def near_kernels(work: int = NEAR_KERNELS_FROM) -> ModuleType | None:
@@ -425,20 +423,7 @@ def near_kernels(work: int = NEAR_KERNELS_FROM) -> ModuleType | None:
     (:data:`NEAR_KERNELS_FROM`; the default loads at once). ``None`` before that, with
     ``CAMTOOL_ACCEL=0`` and without numba; :func:`nearest_distances_kd` then answers, the same.
     """
-    if not accel.enabled():
-        return None
-    if "kernels" in _NEAR_KERNELS:
-        return _NEAR_KERNELS["kernels"]
-    _NEAR_WORK[0] += work
-    if _NEAR_WORK[0] < NEAR_KERNELS_FROM:
-        return None
-    kernels: ModuleType | None
-    try:
-        from camtool.accel import nearkernels as kernels
-    except ImportError:
-        kernels = None
-    _NEAR_KERNELS["kernels"] = kernels
-    return kernels
+    return NEAR_KERNELS.get(work)
 
 
 def nearest_distances_kd(samples: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:

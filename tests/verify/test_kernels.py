@@ -25,18 +25,14 @@ pytestmark = pytest.mark.skipif(dda.compiled() is None, reason="numba not instal
 @pytest.fixture
 def plain(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
     """Run the interpolators without the compiled kernels inside the ``with``-less test."""
-    monkeypatch.setitem(dda._COMPILED, "kernels", None)
-    yield
+    with dda.KERNELS.off():
+        yield
 
 
 def _plain(fn, *args):  # type: ignore[no-untyped-def]
     """``fn(*args)`` with the compiled kernels switched off."""
-    saved = dda._COMPILED.get("kernels")
-    dda._COMPILED["kernels"] = None
-    try:
+    with dda.KERNELS.off():
         return fn(*args)
-    finally:
-        dda._COMPILED["kernels"] = saved
 
 
 def _same(a: np.ndarray, b: np.ndarray) -> bool:
