@@ -175,7 +175,7 @@ def offset_all(
     reads and plans. A process that offsets again (``camtool batch --jobs 1``: one job
     after another) or a worker of a pool loads it here first, from its second call or at
     once, so that each child inherits it instead of loading it again
-    (:data:`_OFFSET_CALLS`).
+    (:data:`CHILDREN`).
 
     Args:
         jobs: ``(contour, amount)`` as :func:`offset_pieces` takes them.
@@ -198,14 +198,14 @@ def offset_all(
         return []
     if not FORK:
         return [_attempt(contour, amount) for contour, amount in jobs]
-    _OFFSET_CALLS[0] += 1
-    if _OFFSET_CALLS[0] > 1 or in_worker():
+    CHILDREN.calls += 1
+    if CHILDREN.calls > 1 or in_worker():
         _load_occt()
     workers = _workers(jobs)
     out: list[Answer] = []
     while len(out) < len(jobs):
         try:
-            child = _AHEAD.pop() if _AHEAD else _Child()
+            child = CHILDREN.take()
         except OSError:  # no fork now (a process limit, memory): made here, as without fork
             out.extend(_attempt(contour, amount) for contour, amount in jobs[len(out) :])
             break
@@ -261,9 +261,10 @@ def start_ahead() -> None:
     or when this process holds OpenCASCADE itself (:func:`load_here`). :func:`stop_ahead`
     stops it if no offsets came.
     """
-    if FORK and not _AHEAD and _OFFSET_CALLS[0] == 0 and not in_worker() and not _occt_here():
+    fresh = CHILDREN.ahead is None and CHILDREN.calls == 0
+    if FORK and fresh and not in_worker() and not _occt_here():
         with contextlib.suppress(OSError):  # no fork now: offset_all makes its own, or not
-            _AHEAD.append(_Child())
+            CHILDREN.ahead = _Child()
 
 
 def load_here() -> None:
@@ -283,16 +284,38 @@ def _occt_here() -> bool:
 
 def stop_ahead() -> None:
     """Stop the child :func:`start_ahead` started, if :func:`offset_all` did not use it."""
-    while _AHEAD:
-        _AHEAD.pop().close(kill=True)  # no need to wait for OpenCASCADE to load
+    ahead, CHILDREN.ahead = CHILDREN.ahead, None
+    if ahead is not None:
+        ahead.close(kill=True)  # no need to wait for OpenCASCADE to load
 
 
-_OFFSET_CALLS = [0]
-"""Calls of :func:`offset_all` in this process so far: from the second on (or in a worker
-process, :func:`~camtool.accel.cores.in_worker`), OpenCASCADE is loaded here before the
-child is forked. A count, not a setting: only the time and memory depend on it."""
-_AHEAD: list[_Child] = []
-"""The child :func:`start_ahead` started, until :func:`offset_all` takes it (at most one)."""
+class _Children:
+    """This process's OpenCASCADE children: the offset runs so far, and one started ahead.
+
+    Attributes:
+        calls: calls of :func:`offset_all` in this process so far: from the second on
+            (or in a worker process, :func:`~camtool.accel.cores.in_worker`),
+            OpenCASCADE is loaded here before the child is forked. A count, not a
+            setting: only the time and memory depend on it.
+        ahead: the child :func:`start_ahead` started, until :func:`offset_all` takes it.
+    """
+
+    def __init__(self) -> None:
+        self.calls = 0
+        self.ahead: _Child | None = None
+
+    def take(self) -> _Child:
+        """The child started ahead, else a new one.
+
+        Raises:
+            OSError: no fork now (a process limit, memory).
+        """
+        child, self.ahead = self.ahead, None
+        return child if child is not None else _Child()
+
+
+CHILDREN = _Children()
+"""The OpenCASCADE children of this process (one process, one set)."""
 
 
 def _attempt(contour: Contour, amount: float) -> list[Contour] | ToolpathError:

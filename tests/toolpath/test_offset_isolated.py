@@ -99,12 +99,12 @@ def test_a_crash_in_the_child_fails_its_job_only(
     expected = [offset_pieces(c, a) for c, a in JOBS]
     monkeypatch.setattr(offset_module, "_occt_offset", _segfault_on(0.5))
     if ahead:
-        monkeypatch.setattr(offset_module, "_OFFSET_CALLS", [0])
+        monkeypatch.setattr(offset_module, "CHILDREN", offset_module._Children())
         monkeypatch.setattr(offset_module, "_occt_here", lambda: False)  # a fresh job
         offset_module.start_ahead()
-        assert len(offset_module._AHEAD) == 1
+        assert offset_module.CHILDREN.ahead is not None
     got = offset_all(JOBS)
-    assert offset_module._AHEAD == []
+    assert offset_module.CHILDREN.ahead is None
     assert len(got) == len(JOBS)
     crashed = got[1]
     assert isinstance(crashed, ToolpathError)
@@ -363,41 +363,43 @@ def test_a_child_started_ahead_makes_the_offsets(
     """
     here, made_by = _made_elsewhere(monkeypatch, tmp_path, JOBS)
     monkeypatch.setattr(offset_module, "_workers", lambda jobs: 1)
-    monkeypatch.setattr(offset_module, "_OFFSET_CALLS", [0])
+    monkeypatch.setattr(offset_module, "CHILDREN", offset_module._Children())
     monkeypatch.setattr(offset_module, "_occt_here", lambda: False)  # a fresh job
     offset_module.start_ahead()
-    (ahead,) = offset_module._AHEAD
+    ahead = offset_module.CHILDREN.ahead
+    assert ahead is not None
     pid = ahead.pid
     there = offset_all(JOBS)
     assert all(_same(x, y) for x, y in zip(here, there, strict=True))
     makers = made_by()
     assert len(makers) == len(JOBS) and len(set(makers)) == 1  # one worker of that child
     assert pid is not None and makers[0].split(":")[1] == str(pid)
-    assert offset_module._AHEAD == [] and ahead.pid is None  # used, then waited for
+    assert offset_module.CHILDREN.ahead is None and ahead.pid is None  # used, then waited for
     offset_module.start_ahead()  # not again: this process has made its offsets
-    assert offset_module._AHEAD == []
+    assert offset_module.CHILDREN.ahead is None
 
 
 def test_a_child_started_ahead_and_not_used_is_stopped(monkeypatch: pytest.MonkeyPatch) -> None:
     """A drawing with nothing to offset: stop_ahead ends the child, no process is left."""
-    monkeypatch.setattr(offset_module, "_OFFSET_CALLS", [0])
+    monkeypatch.setattr(offset_module, "CHILDREN", offset_module._Children())
     monkeypatch.setattr(offset_module, "_occt_here", lambda: False)  # a fresh job
     contours = [rect(0, 0, 20, 20)]
     with_tool = PlanOptions(offset="outside", tool_diameter=2.0, feed_mm_min=100.0)
     from camtool.toolpath.compensate import offsets_ahead
 
     with offsets_ahead(PlanOptions(offset="on", feed_mm_min=100.0)):
-        assert offset_module._AHEAD == []  # --offset on: no offsets to make
+        assert offset_module.CHILDREN.ahead is None  # --offset on: no offsets to make
     with offsets_ahead(with_tool):
-        (ahead,) = offset_module._AHEAD
+        ahead = offset_module.CHILDREN.ahead
+        assert ahead is not None
         pid = ahead.pid
         assert pid is not None
-    assert offset_module._AHEAD == []
+    assert offset_module.CHILDREN.ahead is None
     with pytest.raises(ChildProcessError):
         os.waitpid(pid, os.WNOHANG)  # already waited for: no such child
     with offsets_ahead(with_tool):
         stage = compensate(contours, nesting(contours), with_tool)
-    assert offset_module._AHEAD == []
+    assert offset_module.CHILDREN.ahead is None
     assert not any(f.kind == "offset-fallback" for f in stage.findings)
 
 
@@ -410,17 +412,22 @@ from camtool.toolpath import offset
 from tests.shapes import rectangle_dxf
 
 started = []
-class Noted(list):
-    def append(self, child):
-        started.append(child.pid)
-        super().append(child)
-offset._AHEAD = Noted()
+class Noted(offset._Children):
+    @property
+    def ahead(self):
+        return self._ahead
+    @ahead.setter
+    def ahead(self, child):
+        if child is not None:
+            started.append(child.pid)
+        self._ahead = child
+offset.CHILDREN = Noted()
 src = Path(sys.argv[1])
 for k in range(3):
     rectangle_dxf(src / f"r{k}.dxf", 10.0 + k, 5.0)
 args = ["batch", str(src), "-t", "grbl", "-o", str(src / "out"), "--jobs", "1"]
 code = main([*args, "--offset", "outside", "--tool-diameter", "1"])
-print(code, len(started), offset._OFFSET_CALLS[0], "OCP.BRepOffsetAPI" in sys.modules)
+print(code, len(started), offset.CHILDREN.calls, "OCP.BRepOffsetAPI" in sys.modules)
 """
 
 
