@@ -13,6 +13,7 @@ from typing import Protocol
 import numpy as np
 import numpy.typing as npt
 
+from camtool.accel.memo import LastAnswers
 from camtool.model.shapes import Drawing, Line, Point, Segment
 from camtool.model.units import fmt_num
 from camtool.verify import cutting_thin, nearest_exact, nearest_search, path_shortfall
@@ -524,9 +525,9 @@ def _named_contour(
     return int(contour_of[np.argmin(np.hypot(*(samples - at).T))])
 
 
-_DISTANCE_TO: list[tuple[FloatArray, Sequence[FloatArray], FloatArray]] = []
-"""The last :func:`_distance_to` answer, with the very arrays it was for (kept, so their
-``id`` is not reused): the error budget asks it again for the same samples and path."""
+_DISTANCE_TO: LastAnswers[FloatArray] = LastAnswers()
+"""The last :func:`_distance_to` answer, with the very arrays it was for: the error budget
+asks it again for the same samples and path."""
 
 
 def _distance_to(samples: FloatArray, lines: Sequence[FloatArray]) -> FloatArray:
@@ -543,12 +544,11 @@ def _distance_to(samples: FloatArray, lines: Sequence[FloatArray]) -> FloatArray
     )
     if not frozen:
         return _distance_to_now(samples, lines)
-    for seen_samples, seen_lines, answer in _DISTANCE_TO:
-        if seen_samples is samples and seen_lines is lines:
-            return answer
-    answer = _distance_to_now(samples, lines)
-    answer.flags.writeable = False
-    _DISTANCE_TO[:] = [(samples, lines, answer)]
+    answer = _DISTANCE_TO.get(samples, lines)
+    if answer is None:
+        answer = _distance_to_now(samples, lines)
+        answer.flags.writeable = False
+        _DISTANCE_TO.keep(answer, samples, lines)
     return answer
 
 
@@ -575,9 +575,9 @@ def _contour_ids(sizes: list[int]) -> IntArray:
     return np.repeat(np.arange(len(sizes), dtype=np.int64), sizes)
 
 
-_SAMPLED: list[tuple[Drawing, float, FloatArray, list[int]]] = []
+_SAMPLED: LastAnswers[tuple[FloatArray, tuple[int, ...]]] = LastAnswers()
 """The last drawing :func:`_sample_drawing` sampled (the error budget compares the same
-drawing once per source): the drawing itself is kept, so its ``id`` is not reused."""
+drawing once per source)."""
 
 
 def _sample_drawing(drawing: Drawing, spacing_mm: float) -> tuple[FloatArray, list[int]]:
@@ -586,12 +586,12 @@ def _sample_drawing(drawing: Drawing, spacing_mm: float) -> tuple[FloatArray, li
     Contour after contour; the counts feed :func:`_contour_ids` and :func:`_same_contour`.
     The last drawing's points are kept (read-only) and given again for the same drawing.
     """
-    for seen, spacing, samples, sizes in _SAMPLED:
-        if seen is drawing and spacing == spacing_mm:
-            return samples, list(sizes)
+    kept = _SAMPLED.get(drawing, spacing_mm)
+    if kept is not None:
+        return kept[0], list(kept[1])
     samples, sizes = _sample_drawing_now(drawing, spacing_mm)
     samples.flags.writeable = False
-    _SAMPLED[:] = [(drawing, spacing_mm, samples, list(sizes))]
+    _SAMPLED.keep((samples, tuple(sizes)), drawing, spacing_mm)
     return samples, sizes
 
 

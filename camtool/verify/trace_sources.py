@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from camtool.accel.memo import LastAnswers
 from camtool.model.errors import UsageError
 from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Program, Rapid
@@ -100,8 +101,8 @@ def simulate(program: Program, machine: Machine, *, sources: Sources = ALL) -> S
     return simulate_steps(program, machine, sources=sources)
 
 
-_NOMINAL: list[tuple[Program, tuple[np.ndarray, ...]]] = []
-"""The last two programs' :func:`_nominal_lines` (kept, so their ``id`` is not reused)."""
+_NOMINAL: LastAnswers[tuple[np.ndarray, ...]] = LastAnswers(2)
+"""The last two programs' :func:`_nominal_lines` (the code's and the plan's)."""
 
 
 def _nominal_lines(program: Program) -> tuple[np.ndarray, ...]:
@@ -110,13 +111,12 @@ def _nominal_lines(program: Program) -> tuple[np.ndarray, ...]:
     The last two programs' lines are kept (read-only, the same tuple for the same
     program: the error budget compares the drawing once per source with the same program).
     """
-    for seen, lines in _NOMINAL:
-        if seen is program:
-            return lines
-    lines = _nominal_lines_now(program)
-    for line in lines:
-        line.flags.writeable = False
-    _NOMINAL[:] = [*_NOMINAL[-1:], (program, lines)]  # the code's and the plan's
+    lines = _NOMINAL.get(program)
+    if lines is None:
+        lines = _nominal_lines_now(program)
+        for line in lines:
+            line.flags.writeable = False
+        _NOMINAL.keep(lines, program)
     return lines
 
 

@@ -98,6 +98,7 @@ def test_thin_index_is_the_sorted_unique_picks() -> None:
         assert np.array_equal(got, want)
 
 
+@pytest.mark.usefixtures("accel_on")  # a kept answer is the accel layer's
 def test_drawing_samples_are_kept_for_the_same_drawing_only() -> None:
     one = Drawing((Contour((Line((0.0, 0.0), (1.0, 0.0)),), False),))
     two = Drawing((Contour((Line((0.0, 0.0), (2.0, 0.0)),), False),))
@@ -149,6 +150,7 @@ def test_budget_reuses_the_drawing_figure_only_when_the_trace_is_the_same() -> N
     assert again.max_um == v.against.max_um
 
 
+@pytest.mark.usefixtures("accel_on")  # a kept answer is the accel layer's
 def test_distance_to_the_path_is_kept_only_for_inputs_that_cannot_change() -> None:
     samples = np.random.default_rng(5).uniform(0.0, 2.0, (200, 2))
     lines = (np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 2.0]]), np.array([[0.5, 1.0]]))
@@ -164,6 +166,7 @@ def test_distance_to_the_path_is_kept_only_for_inputs_that_cannot_change() -> No
     assert drawing_compare._distance_to(samples, copied) is not first
 
 
+@pytest.mark.usefixtures("accel_on")  # a kept answer is the accel layer's
 def test_nominal_lines_are_kept_for_the_code_and_the_plan() -> None:
     from camtool.verify.trace_sources import _nominal_lines, _nominal_lines_now
 
