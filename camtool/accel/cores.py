@@ -299,7 +299,7 @@ def fork_process(run: Callable[[], None], *, closing: Sequence[int]) -> int:
     It leaves with ``os._exit``: 0 after ``run``, 70 when ``run`` raised (whoever reads
     its answers sees which it did not give), never through this process's own code.
     Returns its pid, in this process. For the helpers a job starts ahead of the work they
-    will do (:mod:`camtool.toolpath.offset`'s child, :mod:`camtool.preview.ahead`).
+    will do (:mod:`camtool.toolpath.offset`'s child, :mod:`camtool.accel.ahead`).
     """
     pid = os.fork()
     if pid == 0:

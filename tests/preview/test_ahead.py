@@ -1,4 +1,4 @@
-"""The child that draws a command's PNG, started ahead (issue 17, ``camtool.preview.ahead``).
+"""The child that draws a command's PNG, started ahead (``camtool.preview.ahead``).
 
 The picture it sends back must be the bytes this process draws for the same scene
 (``scene_png`` here is the independent judge), and whatever becomes of the child (never
@@ -68,14 +68,15 @@ def _no_child_left() -> object:
 def test_the_child_draws_the_bytes_drawn_here_and_leaves() -> None:
     scene = _scene()
     ahead.start_ahead()
-    (drawer,) = ahead._AHEAD
+    drawer = ahead.DRAWER.helper
+    assert drawer is not None
     pid = drawer.pid
     assert pid is not None
     ahead.load_ahead()
     drawn = ahead.draw_ahead(scene)
     assert drawn is not None and drawn[:8] == b"\x89PNG\r\n\x1a\n"
     assert drawn == scene_png(scene)
-    assert ahead._AHEAD == [] and _gone(pid)
+    assert ahead.DRAWER.helper is None and _gone(pid)
     assert ahead.draw_ahead(scene) is None  # used once: the next picture is drawn here
 
 
@@ -87,37 +88,41 @@ def test_render_preview_uses_the_child_and_a_dead_one_changes_nothing() -> None:
 
     plain = picture()  # no child: drawn here
     ahead.start_ahead()
-    assert picture() == plain and ahead._AHEAD == []  # drawn by the child
+    assert picture() == plain and ahead.DRAWER.helper is None  # drawn by the child
     ahead.start_ahead()
-    (drawer,) = ahead._AHEAD
+    drawer = ahead.DRAWER.helper
+    assert drawer is not None
     assert drawer.pid is not None
     os.kill(drawer.pid, signal.SIGKILL)  # dead before it is used: drawn here again
-    assert picture() == plain and ahead._AHEAD == []
+    assert picture() == plain and ahead.DRAWER.helper is None
 
 
 def test_a_child_killed_while_loading_sends_nothing() -> None:
     ahead.start_ahead()
-    (drawer,) = ahead._AHEAD
+    drawer = ahead.DRAWER.helper
+    assert drawer is not None
     assert drawer.pid is not None
     ahead.load_ahead()
     os.kill(drawer.pid, signal.SIGKILL)
     assert ahead.draw_ahead(_scene()) is None  # the end of its pipe, not a hang
-    assert ahead._AHEAD == []
+    assert ahead.DRAWER.helper is None
 
 
 def test_a_scene_that_does_not_pickle_is_drawn_here() -> None:
     """Not a camtool scene (they pickle): whatever goes wrong on the way, nothing raises."""
     ahead.start_ahead()
-    (drawer,) = ahead._AHEAD
+    drawer = ahead.DRAWER.helper
+    assert drawer is not None
     pid = drawer.pid
     assert pid is not None
     assert ahead.draw_ahead(cast(Scene, lambda: None)) is None
-    assert ahead._AHEAD == [] and _gone(pid)
+    assert ahead.DRAWER.helper is None and _gone(pid)
 
 
 def test_a_child_never_told_to_load_leaves_on_its_own_when_its_pipe_ends() -> None:
     ahead.start_ahead()
-    (drawer,) = ahead._AHEAD
+    drawer = ahead.DRAWER.helper
+    assert drawer is not None
     pid = drawer.pid
     assert pid is not None and drawer.inbox is not None
     os.close(drawer.inbox)
@@ -130,20 +135,22 @@ def test_a_child_never_told_to_load_leaves_on_its_own_when_its_pipe_ends() -> No
 def test_an_unused_child_is_ended_by_stop_ahead() -> None:
     ahead.start_ahead()
     ahead.start_ahead()  # at most one at a time
-    assert len(ahead._AHEAD) == 1
-    pid = ahead._AHEAD[0].pid
+    drawer = ahead.DRAWER.helper
+    assert drawer is not None
+    pid = drawer.pid
     assert pid is not None
     ahead.load_ahead()
     ahead.stop_ahead()
     ahead.stop_ahead()  # idempotent
-    assert ahead._AHEAD == [] and _gone(pid)
+    assert ahead.DRAWER.helper is None and _gone(pid)
 
 
 def test_processes_forked_later_do_not_hold_its_pipes() -> None:
     """A later fork (an offsets' child, a budget worker) closes this process's ends of the
     child's pipes, so the child sees this process's end as the end of its pipe."""
     ahead.start_ahead()
-    (drawer,) = ahead._AHEAD
+    drawer = ahead.DRAWER.helper
+    assert drawer is not None
     fds = drawer.fds()
     assert len(fds) == 2
     pid = os.fork()
@@ -155,7 +162,7 @@ def test_processes_forked_later_do_not_hold_its_pipes() -> None:
                 still += 1
             except OSError:
                 pass
-        os._exit(10 + still + (1 if ahead._AHEAD else 0) * 5)
+        os._exit(10 + still + (1 if ahead.DRAWER.helper else 0) * 5)
     _, status = os.waitpid(pid, 0)
     assert os.WEXITSTATUS(status) == 10  # none open there, and no child of its own
     for fd in fds:
@@ -168,11 +175,11 @@ def test_processes_forked_later_do_not_hold_its_pipes() -> None:
 )
 def test_only_a_png_preview_starts_a_child(preview: str | None, started: bool) -> None:
     with picture_ahead(preview) as load:
-        assert (len(ahead._AHEAD) == 1) == started
+        assert (ahead.DRAWER.helper is not None) == started
         assert (load is ahead.load_ahead) == started  # else a call that does nothing
         load()
-        pid = ahead._AHEAD[0].pid if started else None
-    assert ahead._AHEAD == []
+        pid = ahead.DRAWER.helper.pid if ahead.DRAWER.helper is not None else None
+    assert ahead.DRAWER.helper is None
     if pid is not None:
         assert _gone(pid)
 
@@ -197,7 +204,7 @@ def test_the_cli_png_is_the_png_drawn_in_process(tmp_path: Path) -> None:
         ],
     )
     assert result.exit_code == 0, result.output
-    assert ahead._AHEAD == []
+    assert ahead.DRAWER.helper is None
     job = post_path(sample, load_target("grbl"), PlanOptions(offset="outside", tool_diameter=3.0))
     v = verify_job(job)
     here = render_preview(
