@@ -207,7 +207,7 @@ _PLAIN_DIGITS = 24
 """Longest such text :meth:`NumberFormat.parse` reads with ``float`` (mm)."""
 
 
-@lru_cache(maxsize=1 << 16)
+@lru_cache(maxsize=1 << 13)
 def half_up(value: float, decimals: int) -> tuple[str, bool] | None:
     """``|value|`` to ``decimals`` places, halves away from zero, and its sign (or ``None``).
 

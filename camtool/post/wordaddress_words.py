@@ -18,7 +18,7 @@ from camtool.post.wordaddress_spec import WordAddressSpec
 
 SAME_MM = 1e-9
 """Exact XY closer than this is the same point (a Z-only move)."""
-_PRINTED_KEPT = 1 << 16
+_PRINTED_KEPT = 1 << 13
 """Coordinates per letter whose text a writer keeps (:meth:`WordWriter._print`)."""
 _JOINED_BLOCKS = 4096
 """Blocks a writer holds apart before it joins them into text (:meth:`WordWriter.block`)."""

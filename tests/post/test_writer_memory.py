@@ -8,6 +8,7 @@ a block of 20) and join them at the end.
 
 from __future__ import annotations
 
+import gc
 import tracemalloc
 
 from camtool.model.program import Linear, Program, Rapid
@@ -50,3 +51,27 @@ def test_block_numbers_in_messages_count_the_blocks_joined_already() -> None:
     lines = code.count("\n")
     assert writer.count == lines > 10_000
     assert writer.where(contour=0) == f"block {lines + 1}"
+
+
+def test_the_number_texts_kept_for_many_distinct_coordinates_stay_few() -> None:
+    """100 000 distinct X values: the texts the writer and the number formats keep between
+    calls (caches by value) stay a few MB. Measured 4.2 MB kept and a 6.2 MB peak beside a
+    1.8 MB code; 21.7 MB and 27.5 MB when a format's rounding kept 65 536 texts and the
+    writer 65 536 per letter (~330 and ~190 bytes each)."""
+    target = load_target("grbl")
+    target.emit(_square_passes(1000))  # caches and imports first
+    moves: list[Rapid | Linear] = [Rapid(0.0, 0.0, 5.0, contour=1)]
+    moves += [Linear(1.0 + k * 0.001, float(k % 2), 600.0, contour=1) for k in range(100_000)]
+    program = Program(tuple(moves))
+    gc.collect()
+    tracemalloc.start()
+    try:
+        result = target.emit(program)
+        peak = tracemalloc.get_traced_memory()[1]
+        gc.collect()
+        kept = tracemalloc.get_traced_memory()[0]
+    finally:
+        tracemalloc.stop()
+    assert isinstance(result.code, str) and len(result.code) < 2_000_000
+    assert kept < 10_000_000, kept  # the code and the bounded caches
+    assert peak < 12_000_000, peak
