@@ -10,6 +10,7 @@ import functools
 import importlib
 import importlib.util
 import itertools
+import sys
 import tomllib
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, replace
@@ -210,17 +211,29 @@ class TargetEntry:
     error: str = ""
 
 
-def _entry_points() -> tuple[list[metadata.EntryPoint], list[metadata.EntryPoint]]:
+def _entry_points() -> tuple[tuple[metadata.EntryPoint, ...], tuple[metadata.EntryPoint, ...]]:
     """Entry points of :data:`ENTRY_POINT_GROUP`: (camtool's own, third-party), by name.
 
     :mod:`importlib.metadata` is imported here, when plugins are asked for (see
-    :data:`BUILTIN_ENTRY_POINT`).
+    :data:`BUILTIN_ENTRY_POINT`). Its scan of the installed distributions (~5 ms) is made
+    once for each ``sys.path``: the verifier asks for the targets' motion models at every
+    simulation, and a dry run of a 1 MB program simulated in 708 pieces spent 11 of its
+    33 s of CPU scanning. A distribution installed on a path already scanned is seen by a
+    new process.
     """
     from importlib import metadata
 
-    found = sorted(metadata.entry_points(group=ENTRY_POINT_GROUP), key=lambda ep: ep.name)
-    own = [ep for ep in found if ep.dist is not None and ep.dist.name == _DISTRIBUTION]
-    return own, [ep for ep in found if ep not in own]
+    return _entry_points_on(tuple(sys.path), metadata.entry_points)
+
+
+@functools.lru_cache(maxsize=4)
+def _entry_points_on(
+    path: tuple[str, ...], scan: Callable[..., metadata.EntryPoints]
+) -> tuple[tuple[metadata.EntryPoint, ...], tuple[metadata.EntryPoint, ...]]:
+    """:func:`_entry_points` as ``scan`` finds them on the search path ``path`` (the key)."""
+    found = sorted(scan(group=ENTRY_POINT_GROUP), key=lambda ep: ep.name)
+    own = tuple(ep for ep in found if ep.dist is not None and ep.dist.name == _DISTRIBUTION)
+    return own, tuple(ep for ep in found if ep not in own)
 
 
 @functools.cache
