@@ -220,6 +220,8 @@ class PtyServer:
         self.written = 0
         """Bytes written to the host so far."""
         self._quiet = threading.Event()
+        self._alone = threading.Event()  # no host holds the port, as the server last saw
+        self._alone.set()
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name="camtool-device", daemon=True)
 
@@ -254,6 +256,15 @@ class PtyServer:
             return False
         return not ready
 
+    def wait_host_gone(self, timeout: float) -> bool:
+        """Wait until the server has seen the host close the port (or ``timeout`` s).
+
+        A host that closes the port and opens it again before the server's next poll would
+        be taken for the same host: its device would not start a new session. A test that
+        sends twice waits for this between the two. True if the server has seen it.
+        """
+        return self._alone.wait(timeout)
+
     def wait_closed(self, timeout: float) -> bool:
         """Wait until the device has dropped the port (or ``timeout`` s); True if it has."""
         self._thread.join(timeout)
@@ -273,6 +284,7 @@ class PtyServer:
         finally:
             if self.device.dropped:
                 self._close()
+            self._alone.set()  # no longer serving: no host is held
 
     def _serve(self) -> None:
         self._loop()
@@ -310,10 +322,12 @@ class PtyServer:
                     if exc.errno != errno.EIO:
                         raise
                     connected = False
+                    self._alone.set()
                     time.sleep(0.005)
                     continue
             if not connected:
                 connected = True
+                self._alone.clear()
                 self._quiet.clear()
                 time.sleep(self.settle_s)
                 self._write(self.device.connect())

@@ -42,17 +42,23 @@ def plan_for(code: bytes, **options: Any) -> Any:
     return plan
 
 
-def run(path: str, code: bytes = SESSION, timeout_s: float | None = None, **options: Any) -> Any:
+def run(sim: Any, code: bytes = SESSION, timeout_s: float | None = None, **options: Any) -> Any:
+    """Send ``code`` to the simulated device ``sim``; return once it has seen the port closed.
+
+    The wait makes the next send a new session for the device, however soon it opens the
+    port again (the server would not see a close and an open between two of its polls).
+    """
     plan = plan_for(code, from_line=options.pop("from_line", None))
     if timeout_s is not None:
         plan = dataclasses.replace(
             plan, spec=dataclasses.replace(plan.spec, response_timeout_s=timeout_s)
         )
-    port = open_port(path, plan.spec.baud)
+    port = open_port(sim.path, plan.spec.baud)
     try:
-        return send_plan(port, plan, port_name=path, time_scale=0.0, **options)
+        return send_plan(port, plan, port_name=sim.path, time_scale=0.0, **options)
     finally:
         port.close()
+        assert sim.server.wait_host_gone(60.0), "the device never saw the port closed"
 
 
 def test_the_session_is_three_packets_and_the_end_of_data() -> None:
@@ -72,7 +78,7 @@ def test_the_session_is_three_packets_and_the_end_of_data() -> None:
 
 def test_the_interface_receives_the_file_byte_for_byte(simulate: Any) -> None:
     sim = simulate("i8751")
-    result = run(sim.path)
+    result = run(sim)
     assert bytes(sim.device.received) == SESSION
     assert sim.device.ended and not sim.device.overrun and not sim.device.garbled
     assert len(sim.device.executed) == 3
@@ -88,7 +94,7 @@ def test_a_posted_file_arrives_byte_for_byte(simulate: Any, tmp_path: Path) -> N
     out = tmp_path / "plate.bin"
     assert main(["post", "samples/plate.dxf", "-t", "i8751", "-o", str(out)]) == 0
     sim = simulate("i8751")
-    run(sim.path, out.read_bytes())
+    run(sim, out.read_bytes())
     assert bytes(sim.device.received) == out.read_bytes()
     assert not sim.device.overrun
 
@@ -101,14 +107,14 @@ def test_a_dump_is_sent_as_the_bytes_it_lists(simulate: Any, tmp_path: Path) -> 
     dumped = ["post", "samples/plate.dxf", "-t", "i8751", "--format", "dump", "-o", str(dump)]
     assert main(dumped) == 0
     sim = simulate("i8751")
-    run(sim.path, dump.read_bytes())
+    run(sim, dump.read_bytes())
     assert bytes(sim.device.received) == binary.read_bytes()
 
 
 def test_pause_comes_between_packets_then_resumes(simulate: Any) -> None:
     sim = simulate("i8751", block_delay_s=0.002)
     control = PauseAt(1, "resume")
-    run(sim.path, control=control, progress=control.progress)
+    run(sim, control=control, progress=control.progress)
     (pause,) = control.pauses
     assert pause.in_flight == 0 and pause.done == 1 and pause.line == 1
     assert bytes(sim.device.received) == SESSION
@@ -119,14 +125,14 @@ def test_stop_at_a_pause_sends_whole_packets_and_from_line_finishes(simulate: An
     sim = simulate("i8751", block_delay_s=0.002)
     control = PauseAt(2, "stop")
     with pytest.raises(LinkError, match="stopped by the operator after block 2") as info:
-        run(sim.path, control=control, progress=control.progress)
+        run(sim, control=control, progress=control.progress)
     # packets 1 and 2 whole: the key, then each packet's 4 moves without Z (14 bytes: 4 + 4
     # + 2 + 2 (m 05H) + 2), one with Z (16 bytes) and its 45H
     first = SESSION[: 1 + 2 * (4 * 14 + 16 + 1)]
     assert first[-1] == 0x45
     assert bytes(sim.device.received) == first
     assert "--from-line 11" in str(info.value)
-    run(sim.path, from_line=11)
+    run(sim, from_line=11)
     # the second session starts with the key again and holds packet 3 and the end
     assert bytes(sim.device.received) == first + b"\x13" + SESSION[len(first) :]
     assert sim.device.position() == pytest.approx(END)
@@ -135,12 +141,12 @@ def test_stop_at_a_pause_sends_whole_packets_and_from_line_finishes(simulate: An
 def test_a_packet_never_answered_stops_naming_it_and_from_line_continues(simulate: Any) -> None:
     sim = simulate("i8751", fail_at_block=2)
     with pytest.raises(LinkError) as info:
-        run(sim.path, timeout_s=SILENT_S)
+        run(sim, timeout_s=SILENT_S)
     message = str(info.value)
     assert "block 2 (line 6) was sent and not confirmed" in message
     assert "--from-line 6" in message
     assert len(sim.device.blocks) == 2  # nothing after the packet that was not answered
-    run(sim.path, from_line=6)
+    run(sim, from_line=6)
     assert sim.device.connections == 2
     assert sim.device.position() == pytest.approx(END)
 
@@ -155,7 +161,7 @@ def test_from_line_inside_a_packet_is_refused() -> None:
 def test_a_port_that_disappears_is_a_link_error(simulate: Any) -> None:
     sim = simulate("i8751", drop_at_block=2)
     with pytest.raises(LinkError, match="disappeared"):  # noticed at once: the bound never runs out
-        run(sim.path, timeout_s=60.0)
+        run(sim, timeout_s=60.0)
 
 
 class InProcessPort:
