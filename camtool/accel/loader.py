@@ -1,10 +1,10 @@
 """Compiled kernels loaded on demand: once a process has asked for enough work to pay for them.
 
-Loading numba and its cached kernels costs about half a second and 100 MB, once a process;
-a small job is faster on the plain numpy paths. A :class:`KernelsOnDemand` counts the work
-its callers announce and imports its kernel module when the count reaches its threshold;
-from then on every caller gets the module. Nothing but the speed depends on it: every
-kernel gives what the plain path gives.
+Loading numba and its cached kernels costs start-up time and memory once a process, so a
+small job is faster on the plain numpy paths (figures: docs/performance.md). A
+:class:`KernelsOnDemand` counts the work its callers announce and imports its kernel
+module when the count reaches its threshold; from then on every caller gets the module.
+Nothing but the speed depends on it: every kernel gives what the plain path gives.
 """
 
 from __future__ import annotations

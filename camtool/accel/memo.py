@@ -43,10 +43,6 @@ class LastAnswers(Generic[V]):
             self._kept = [*self._kept[max(0, len(self._kept) + 1 - self.size) :], (args, answer)]
         return answer
 
-    def forget(self) -> None:
-        """Keep nothing (for tests)."""
-        self._kept = []
-
 
 def _same(a: object, b: object) -> bool:
     """The same object, or equal numbers (a spacing in mm)."""

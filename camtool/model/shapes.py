@@ -462,8 +462,8 @@ class Contour:
     def length_unkept(self) -> float:
         """:attr:`length` (the same float), neither kept nor keeping its segments' lengths.
 
-        For a one-off look at many contours: a kept length is a ``__dict__`` on each
-        contour and segment, ~90 bytes each.
+        For a one-off look at many contours, which would otherwise each keep a length in
+        their ``__dict__``, and their segments too.
         """
         kept = self.__dict__.get("length")
         if kept is not None:

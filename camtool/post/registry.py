@@ -215,10 +215,9 @@ def _entry_points() -> tuple[tuple[metadata.EntryPoint, ...], tuple[metadata.Ent
     """Entry points of :data:`ENTRY_POINT_GROUP`: (camtool's own, third-party), by name.
 
     :mod:`importlib.metadata` is imported here, when plugins are asked for (see
-    :data:`BUILTIN_ENTRY_POINT`). Its scan of the installed distributions (~5 ms) is made
-    once for each ``sys.path``: the verifier asks for the targets' motion models at every
-    simulation, and a dry run of a 1 MB program simulated in 708 pieces spent 11 of its
-    33 s of CPU scanning. A distribution installed on a path already scanned is seen by a
+    :data:`BUILTIN_ENTRY_POINT`). The installed distributions are scanned once for each
+    ``sys.path`` (and discovery function): the verifier asks for the targets' motion models
+    at every simulation. A distribution installed on a path already scanned is seen by a
     new process.
     """
     from importlib import metadata
