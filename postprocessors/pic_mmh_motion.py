@@ -18,6 +18,8 @@ from camtool.verify.motion import MotionHooks
 from camtool.verify.timing import (
     BlockKinematics,
     FloatArray,
+    IntArray,
+    blocks_by_value,
     counts,
     flags,
     floats,
@@ -142,7 +144,7 @@ class PicMmhTiming:
         positive("steps_per_mm", self.steps_per_mm)
         positive("max_step_rate_hz", self.max_step_rate_hz)
 
-    def capped_blocks(self, blocks: BlockKinematics) -> list[tuple[int, str]]:
+    def capped_blocks(self, blocks: BlockKinematics) -> list[tuple[IntArray, str]]:
         """Feed moves whose step rate ``d·F/60`` is over the cap (F14 and up at 140 nm/step).
 
         UNAM-GMM §2.4 (L3198): the serial link limits the PIC to 166 Hz, so such
@@ -153,12 +155,12 @@ class PicMmhTiming:
         slowest = self.max_step_rate_hz * 60.0 / self.steps_per_mm
         return [
             (
-                int(i),
-                f"feed {blocks.feed_mm_min[i]:g} mm/min asks {rate[i]:.1f} Hz, over the "
+                group,
+                f"feed {feed:g} mm/min asks {rate[group[0]]:.1f} Hz, over the "
                 f"{self.max_step_rate_hz:g} Hz step-rate cap of the pic-mmh controller (serial "
                 f"link, UNAM-GMM §2.4): it runs and is timed at {slowest:.4g} mm/min",
             )
-            for i in np.flatnonzero(over)
+            for group, feed in blocks_by_value(over, blocks.feed_mm_min)
         ]
 
     def block_time_s(self, blocks: BlockKinematics) -> FloatArray:

@@ -279,6 +279,10 @@ class SourceLines(Sequence[int]):
     def __iter__(self) -> Iterator[int]:
         return iter(self._numbers)
 
+    def view(self) -> memoryview:
+        """The numbers as a read-only buffer of int64 (``numpy.frombuffer`` reads it, no copy)."""
+        return memoryview(self._numbers).toreadonly()
+
     def __eq__(self, other: object) -> bool:
         if isinstance(other, SourceLines):
             return self._numbers == other._numbers
@@ -435,15 +439,16 @@ class Program:
             raise ValueError("bbox of nothing")
         return (box[0], box[1], box[2], box[3])
 
-    def path_lengths(self) -> list[float]:
+    def path_lengths(self) -> array[float]:
         """The length of each move's path, Z included, mm (``len(moves)`` values).
 
         ``√(xy² + Δz²)``, where ``xy`` is the XY path (an arc's arc length): the distance a
         controller's planner times a move by (GRBL's ``planner.c`` takes the
         Euclidean length of the axis deltas; a helix's length by its arc). A Z-only move is
         its Z travel. The program starts at Z 0, as it starts at :attr:`origin` in XY.
+        Returned as an ``array('d')`` (8 bytes a move; ``numpy.asarray`` reads it whole).
         """
-        out = []
+        out = array("d")
         z = 0.0
         for move, seg in self.segments():
             dz = 0.0 if move.z is None else move.z - z

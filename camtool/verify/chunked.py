@@ -19,6 +19,7 @@ from camtool.model.errors import InputError
 from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Program
 from camtool.verify.dda import compiled, dda_line, dda_line_rows
+from camtool.verify.interpolators import bresenham_line, bresenham_line_rows
 from camtool.verify.motion import StepTrace
 from camtool.verify.simulate import (
     IdealController,
@@ -94,6 +95,7 @@ def simulate_or_count(program: Program, machine: Machine, limit: int) -> StepTra
 
 LINE_ROWS: dict[Callable[[int, int], StepArray], Callable[[int, int], int]] = {
     dda_line: dda_line_rows,
+    bresenham_line: bresenham_line_rows,
 }
 """Line interpolators whose rows :func:`count_rows` counts in closed form, and the count."""
 
@@ -105,11 +107,12 @@ def count_rows(
 
     What :func:`simulate_or_count` returns for a trace over its limit, without making the
     rows of a line or rapid whose interpolator counts them in closed form
-    (:data:`LINE_ROWS`: the A.3 DDA's ``floor(HIPO) + 1``, and a compensation's rows at a
-    reversal), and the ideal controller's lines, chords and, where it inserts no
-    compensation, native arcs (:meth:`IdealController.count_block`); other moves (arcs,
-    other interpolators, a line whose piece models dynamics, the ideal controller's arcs
-    with compensation) are simulated, their rows dropped.
+    (:data:`LINE_ROWS`: the A.3 DDA's ``floor(HIPO) + 1``, GRBL's Bresenham's
+    ``max(|dx|, |dy|)``, and a compensation's rows at a reversal), the chords of an arc
+    such a controller cuts as chords, and the ideal controller's lines, chords and,
+    where it inserts no compensation, native arcs (:meth:`IdealController.count_block`);
+    other moves (native arcs, other interpolators, a line whose piece models dynamics, the
+    ideal controller's arcs with compensation) are simulated, their rows dropped.
     ``sources``: the trace of :func:`simulate_steps` with these sources;
     ``closed_form=False`` simulates every move.
     :class:`ChunkedSimulation` makes the same offsets again from the rows themselves,
@@ -133,6 +136,8 @@ def count_rows(
                 ideal.count_block(start, move)
             elif rows_of is not None and not isinstance(move, ArcMove):
                 sim.count_line(move, rows_of)
+            elif rows_of is not None and sim.arc is None and isinstance(move, ArcMove):
+                sim.count_chords(start, move, rows_of)
             else:
                 sim.block(start, move)
                 sim.parts.clear()

@@ -14,7 +14,7 @@ import numpy.typing as npt
 
 from camtool.model.errors import InputError
 from camtool.model.machine import Machine
-from camtool.model.program import PlaneArc, Program, Rapid
+from camtool.model.program import PlaneArc, Program, Rapid, SourceLines
 from camtool.verify.motion import StepTrace, timing_model_from_table
 from camtool.verify.timing import BlockKinematics
 
@@ -26,8 +26,10 @@ def block_kinematics(trace: StepTrace, program: Program) -> BlockKinematics:
     rows = np.diff(trace.block_start) if len(trace.block_start) else np.zeros(0, np.int64)
     return BlockKinematics.build(
         dominant_steps=trace.block_dominant,
-        is_rapid=[isinstance(m, Rapid) for m in moves],
-        feed_mm_min=[0.0 if isinstance(m, Rapid) else m.feed_mm_min for m in moves],
+        is_rapid=np.fromiter((isinstance(m, Rapid) for m in moves), np.bool_, len(moves)),
+        feed_mm_min=np.fromiter(
+            (0.0 if isinstance(m, Rapid) else m.feed_mm_min for m in moves), np.float64, len(moves)
+        ),
         length_mm=program.path_lengths(),
         iterations=rows - trace.block_compensation,
         steps=steps,
@@ -116,18 +118,20 @@ def timing_warnings(trace: StepTrace, program: Program, machine: Machine) -> lis
     capped = getattr(model, "capped_blocks", None)
     if capped is None:
         return []
-    by_reason: dict[str, list[int]] = {}
-    for block, reason in capped(block_kinematics(trace, program)):
-        by_reason.setdefault(reason, []).append(block)
+    known = len(program.lines)
+    source = program.lines if isinstance(program.lines, SourceLines) else SourceLines(program.lines)
+    lines = np.frombuffer(source.view(), dtype=np.int64)
     out = []
-    for reason, blocks in by_reason.items():
-        lines = [program.line_of(b) for b in blocks]
-        word, numbers = "line", [str(n) for n in lines]
-        if any(n is None for n in lines):
-            word, numbers = "move", [str(b + 1) for b in blocks]
-        numbers = list(dict.fromkeys(numbers))  # the chords of one arc share its line
+    for blocks, reason in capped(block_kinematics(trace, program)):
+        word, numbers = "line", lines[blocks] if int(blocks[-1]) < known else None
+        if numbers is None:
+            word, numbers = "move", blocks + 1
+        # the chords of one arc share its line: each number once, in the order first met
+        numbers = numbers[np.sort(np.unique(numbers, return_index=True)[1])]
         more = len(numbers) - 8
-        shown = ", ".join(numbers[:8]) + (f" and {more} more" if more > 0 else "")
+        shown = ", ".join(str(int(n)) for n in numbers[:8]) + (
+            f" and {more} more" if more > 0 else ""
+        )
         out.append(f"{word}{'s' if len(numbers) > 1 else ''} {shown}: {reason}")
     return out
 

@@ -6,6 +6,7 @@ All inputs in mm, results in µm. Design notes: docs/internals.md, "The measures
 from __future__ import annotations
 
 import math
+from array import array
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -74,7 +75,7 @@ def nominal_arrays(program: Program) -> dict[str, FloatArray]:
     Keys: ``kind, x0, y0, x1, y1, cx, cy, r, a0, sweep``; ``a0`` is the start
     angle and ``sweep`` the signed sweep of arcs (radians, CCW positive).
     """
-    rows = []
+    flat = array("d")  # ten floats a move, no list of tuples beside them (80 bytes a move)
     start = program.origin
     for move in program.moves:
         end = (move.x, move.y)
@@ -82,12 +83,12 @@ def nominal_arrays(program: Program) -> dict[str, FloatArray]:
             arc = segment_of(start, move)
             assert isinstance(arc, Arc)
             a0 = math.atan2(start[1] - move.cy, start[0] - move.cx)
-            rows.append((1, *start, *end, move.cx, move.cy, arc.radius, a0, arc.sweep))
+            flat.extend((1, *start, *end, move.cx, move.cy, arc.radius, a0, arc.sweep))
         else:
             kind = 2 if isinstance(move, Rapid) else 0
-            rows.append((kind, *start, *end, 0.0, 0.0, 0.0, 0.0, 0.0))
+            flat.extend((kind, *start, *end, 0.0, 0.0, 0.0, 0.0, 0.0))
         start = end
-    table = np.asarray(rows, dtype=np.float64).reshape(-1, 10)
+    table = np.frombuffer(flat, dtype=np.float64).reshape(-1, 10)
     names = ("kind", "x0", "y0", "x1", "y1", "cx", "cy", "r", "a0", "sweep")
     return {name: table[:, i] for i, name in enumerate(names)}
 

@@ -132,6 +132,16 @@ def bresenham_line(dx: int, dy: int, *, amass: bool = True) -> StepArray:
     return dda._rows(dda._sign(dx), dda._sign(dy), kx, ky)
 
 
+def bresenham_line_rows(dx: int, dy: int) -> int:
+    """How many rows :func:`bresenham_line` ``(dx, dy)`` gives, without making them.
+
+    One row per step event, ``max(|dx|, |dy|)``, every pulse the way of ``d``; with
+    AMASS (GRBL's default build) each axis pulses ``|d|`` times.
+    ``tests/verify/test_count_rows.py`` checks both against the rows.
+    """
+    return max(abs(dx), abs(dy))
+
+
 def bresenham_reference(dx: int, dy: int, *, amass: bool = True) -> StepArray:
     """Plain counter loop of :func:`bresenham_line` (GRBL ``stepper.c`` logic).
 

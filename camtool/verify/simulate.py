@@ -176,7 +176,33 @@ class StepController:
         end = (self.to_steps(move.x, 0), self.to_steps(move.y, 1))
         if move.z is not None:
             self.z_pos = self.to_steps(move.z, 2)
-        dx, dy = end[0] - self.pos[0], end[1] - self.pos[1]
+        self.counts.append(self._count_piece(end[0] - self.pos[0], end[1] - self.pos[1], rows_of))
+        self.pos = end
+
+    def count_chords(
+        self, start_mm: Point, move: ArcMove, rows_of: Callable[[int, int], int]
+    ) -> None:
+        """:meth:`count_line` of an arc this controller cuts as chords (``arc = "chords"``).
+
+        Each chord is a line of the line interpolator between lattice points, as
+        :meth:`block` runs it, counted by ``rows_of``.
+        """
+        end = (self.to_steps(move.x, 0), self.to_steps(move.y, 1))
+        if move.z is not None:
+            self.z_pos = self.to_steps(move.z, 2)
+        lattice = self._chord_lattice(start_mm, move, end)
+        rows = 0
+        for (x0, y0), (x1, y1) in itertools.pairwise(lattice):
+            rows += self._count_piece(x1 - x0, y1 - y0, rows_of)
+        self.counts.append(rows)
+        self.pos = end
+
+    def _count_piece(self, dx: int, dy: int, rows_of: Callable[[int, int], int]) -> int:
+        """Rows of one line piece ``(dx, dy)`` steps with the compensation rows it needs.
+
+        Updates each axis's direction, reversals and compensations (a piece reverses an
+        axis at most once, at its first pulse on it).
+        """
         rows = rows_of(dx, dy)
         for axis, d in ((0, dx), (1, dy)):
             if d == 0:
@@ -188,8 +214,7 @@ class StepController:
                     self.compensations += 1
                     rows += int(self.comp_steps[axis])
             self.direction[axis] = sign
-        self.counts.append(rows)
-        self.pos = end
+        return rows
 
     def _arc(
         self, start_mm: Point, move: ArcMove, end: tuple[int, int]
@@ -201,12 +226,8 @@ class StepController:
                 return self.line(0, 0), [0], 0
             rows = self.arc(*self.pos, *end, *centre, move.clockwise)
             return rows, [], len(rows)
-        points = self._chord_points(start_mm, move)
-        lattice: list[tuple[int, int]] = [self.pos]
-        lattice += [(self.to_steps(x, 0), self.to_steps(y, 1)) for x, y in points]
-        lattice[-1] = end
         parts, starts, offset, dominant = [], [], 0, 0
-        for (x0, y0), (x1, y1) in itertools.pairwise(lattice):
+        for (x0, y0), (x1, y1) in itertools.pairwise(self._chord_lattice(start_mm, move, end)):
             rows = self.line(x1 - x0, y1 - y0)
             parts.append(rows)
             starts.append(offset)
@@ -214,6 +235,16 @@ class StepController:
             dominant += max(abs(x1 - x0), abs(y1 - y0))
         joined = np.concatenate(parts) if parts else np.zeros((0, 2), STEP_DTYPE)
         return joined, starts, dominant
+
+    def _chord_lattice(
+        self, start_mm: Point, move: ArcMove, end: tuple[int, int]
+    ) -> list[tuple[int, int]]:
+        """The chords' ends of an arc in whole steps, from the position to ``end``."""
+        points = self._chord_points(start_mm, move)
+        lattice: list[tuple[int, int]] = [self.pos]
+        lattice += [(self.to_steps(x, 0), self.to_steps(y, 1)) for x, y in points]
+        lattice[-1] = end
+        return lattice
 
     def _chord_points(self, start_mm: Point, move: ArcMove) -> FloatArray:
         assert self.chord_rule is not None  # arc = "chords"

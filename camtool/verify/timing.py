@@ -175,7 +175,9 @@ class BlockKinematics:
         b = same_length(**values)
         values["steps"] = _axis_steps(self.steps, b)
         for name, arr in values.items():
-            object.__setattr__(self, name, frozen(arr.copy()))
+            given = getattr(self, name)
+            fresh = arr is not given and arr.base is None and arr.flags.owndata  # a new array
+            object.__setattr__(self, name, frozen(arr if fresh else arr.copy()))
 
     @classmethod
     def build(
@@ -363,18 +365,35 @@ class TrapezoidTiming:
             max_rate_mm_min=self.max_rate_mm_min,
         )
 
-    def capped_blocks(self, blocks: BlockKinematics) -> list[tuple[int, str]]:
+    def capped_blocks(self, blocks: BlockKinematics) -> list[tuple[IntArray, str]]:
         """Feed moves whose feed is over the maximum rate, timed at the rate instead."""
         over = ~blocks.is_rapid & (blocks.feed_mm_min > self.max_rate_mm_min)
         return [
             (
-                int(i),
-                f"feed {blocks.feed_mm_min[i]:g} mm/min is over the maximum rate "
+                group,
+                f"feed {feed:g} mm/min is over the maximum rate "
                 f"{self.max_rate_mm_min:g} mm/min of the {self.model} timing model "
                 "([machine.timing] max_rate_mm_min): timed at the maximum rate",
             )
-            for i in np.flatnonzero(over)
+            for group, feed in blocks_by_value(over, blocks.feed_mm_min)
         ]
+
+
+def blocks_by_value(chosen: BoolArray, values: FloatArray) -> list[tuple[IntArray, float]]:
+    """The ``chosen`` blocks grouped by their value: ``(indices, value)`` per distinct value.
+
+    Each group's indices ``(n,) int64`` rise; the groups come in the order of their first
+    block. A program of half a million capped moves makes a few groups, not a message each.
+    """
+    index = np.flatnonzero(chosen)
+    if not len(index):
+        return []
+    group_of = np.unique(values[index], return_inverse=True)[1]
+    order = np.argsort(group_of, kind="stable")
+    bounds = np.flatnonzero(np.diff(group_of[order])) + 1
+    groups = np.split(index[order], bounds)
+    groups.sort(key=lambda g: int(g[0]))
+    return [(g, float(values[g[0]])) for g in groups]
 
 
 class TimingModel(Protocol):
@@ -391,10 +410,11 @@ class TimingModel(Protocol):
         ...
 
 
-CappedBlocks = Callable[[BlockKinematics], list[tuple[int, str]]]
+CappedBlocks = Callable[[BlockKinematics], list[tuple[IntArray, str]]]
 """Optional method ``capped_blocks(blocks)`` of a timing model: every block the model
 times slower than programmed because of a limit it applies (a step-rate cap, a
-maximum rate), as ``(block index, what was capped)``; the verifier warns about
+maximum rate), as ``(block indices (n,) int64 rising, what was capped)``, one pair
+per reason (:func:`blocks_by_value`); the verifier warns about
 each (:func:`camtool.verify.clock.timing_warnings`), so no cap is silent."""
 
 

@@ -10,6 +10,7 @@ contours (tracemalloc's peak, with a wide margin), never a wall clock.
 
 from __future__ import annotations
 
+import json
 import tracemalloc
 from collections.abc import Callable, Iterator
 from typing import Any
@@ -277,3 +278,63 @@ def test_a_streamed_budget_against_a_drawing_is_the_whole_one(
     v, got = budget(chunk_rows=97, stream_above=10)
     assert v.cut_digest is not None and v.trace.row_count > 97
     assert got == expected
+
+
+def _peak_per_move(program: Program, measure: Callable[[], object]) -> float:
+    """tracemalloc's peak while ``measure()`` runs, bytes a move of ``program``."""
+    measure()  # its imports and first calls
+    tracemalloc.start()
+    try:
+        measure()
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    return peak / len(program.moves)
+
+
+def test_the_nominal_moves_are_built_without_a_row_object_a_move() -> None:
+    """Ten floats a move (80 bytes) and no tuple of them beside: a 12 MB program's
+    616 000 moves peaked 93 MB over the table (a list of tuples, ~230 bytes a move)."""
+    from camtool.verify.deviations import nominal_arrays
+
+    program = _zigzags(40)
+    assert _peak_per_move(program, lambda: nominal_arrays(program)) < 130
+
+
+def test_capped_feeds_are_named_by_reason_not_a_message_a_move() -> None:
+    """Every move of a program fed over GRBL's maximum rate (F600 > $110 = 500) is capped;
+    the warning names the lines once per feed. A message and a tuple per capped move, the
+    feeds and flags as lists and each per-block array copied twice peaked ~355 bytes a move
+    (a 12 MB program's verify 650 → 760 MB); ~130 now, all in arrays of numbers."""
+    from camtool.verify.clock import timing_warnings
+
+    machine = load_target("grbl").machine
+    base = _zigzags(40)
+    moves = tuple(m if isinstance(m, Rapid) else Linear(m.x, m.y, 600.0) for m in base.moves)
+    program = Program(moves, origin=base.origin, lines=range(10, 10 + len(moves)))
+    trace = simulate_steps(program, machine)
+    warnings = timing_warnings(trace, program, machine)
+    assert len(warnings) == 1 and "feed 600 mm/min is over the maximum rate 500" in warnings[0]
+    assert warnings[0].startswith("lines 11, 12, 13, 14, 15, 16, 17, 18 and ")
+    assert _peak_per_move(program, lambda: timing_warnings(trace, program, machine)) < 200
+
+
+def test_the_report_text_is_joined_without_a_piece_object_each() -> None:
+    """The JSON report of many contours: ``json.dumps(indent=2)`` keeps each of its pieces
+    (a key, a number, a comma: tens of bytes of object each) until it joins them; joined
+    8 192 at a time the peak is the report's dict and text (8.9x the text before, 5.9x
+    now; a 12 MB program's report of 61 600 contours took its verify 516 -> 681 MB)."""
+    from camtool.jobs.pipeline import report_json
+
+    v = verifier.verify_program(
+        _zigzags(300, 4), load_target("grbl").machine, name="grbl", budget=False
+    )
+    text = report_json(v)
+    assert text == json.dumps(json.loads(text), indent=2, ensure_ascii=True) + "\n"
+    tracemalloc.start()
+    try:
+        report_json(v)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 7.4 * len(text), peak / len(text)
