@@ -16,7 +16,7 @@ from camtool.model.units import LARGEST_VALUE
 
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)")
 _WORD = re.compile(r"([A-NP-Z])(" + _NUMBER.pattern + ")")
-"""A word as :func:`_words_slow` reads it: a letter (not O) and its number."""
+"""A word as :func:`_words_by_char` reads it: a letter (not O) and its number."""
 _COMMENT_CHARS = re.compile(r"[;()*]")
 _CHECKSUM = re.compile(r"\*(\d+)$")
 _CUT = re.compile(r"[A-Za-z]\s*[+-]?\s*(?:\d[\d\s]*)?\.$|[A-Za-z]\s*[+-]?$")
@@ -86,15 +86,15 @@ def _strip_comments(raw: str, where: str) -> tuple[str, int | None]:
     """The line without comments, and the index in ``raw`` of a ``*`` outside them.
 
     A line without ``;``, ``(``, ``)`` or ``*`` (most lines) is returned as it is,
-    which is what the character loop of :func:`_strip_comments_slow` gives it.
+    which is what the character loop of :func:`_strip_comments_by_char` gives it.
     """
     if _COMMENT_CHARS.search(raw) is None:
         return raw, None
-    return _strip_comments_slow(raw, where)
+    return _strip_comments_by_char(raw, where)
 
 
-def _strip_comments_slow(raw: str, where: str) -> tuple[str, int | None]:
-    """:func:`_strip_comments` character by character (the reference version)."""
+def _strip_comments_by_char(raw: str, where: str) -> tuple[str, int | None]:
+    """:func:`_strip_comments` of any line, character by character (naming what is wrong)."""
     kept: list[str] = []
     star_at: int | None = None
     i = 0
@@ -143,9 +143,9 @@ def _words(code: str, where: str) -> list[Word]:
     """Words of a comment-free, upper-case line without blanks.
 
     One regular-expression pass (:data:`_WORD`, the letter and then
-    :data:`_NUMBER` exactly as :func:`_words_slow` matches them at each letter)
+    :data:`_NUMBER` exactly as :func:`_words_by_char` matches them at each letter)
     when the words follow each other to the end of the line and every number is
-    in range; any other line goes to :func:`_words_slow`, which finds its error.
+    in range; any other line goes to :func:`_words_by_char`, which finds its error.
     """
     words: list[Word] = []
     pos = 0
@@ -153,16 +153,16 @@ def _words(code: str, where: str) -> list[Word]:
         text = m[2]
         value = float(text)
         if m.start() != pos or not abs(value) < LARGEST_VALUE:
-            return _words_slow(code, where)
+            return _words_by_char(code, where)
         words.append(Word(m[1], value, text))
         pos = m.end()
     if pos != len(code):
-        return _words_slow(code, where)
+        return _words_by_char(code, where)
     return words
 
 
-def _words_slow(code: str, where: str) -> list[Word]:
-    """:func:`_words` one character at a time (the reference version)."""
+def _words_by_char(code: str, where: str) -> list[Word]:
+    """:func:`_words` of any line, one character at a time (naming what is wrong)."""
     words: list[Word] = []
     i = 0
     while i < len(code):

@@ -95,8 +95,8 @@ class NumberFormat:
 
         In mm (``scale`` 1, no ``grid_mm``) the digits are rounded on the
         float's shortest repr directly (:func:`half_up`), which is what
-        :meth:`quantize` does with ``Decimal``, without it; :meth:`_format_slow`
-        is the ``Decimal`` path, kept for the tests that compare the two.
+        :meth:`quantize` does with ``Decimal``, without it (tests/post/test_numfmt.py
+        holds the two equal).
 
         A program writes the same numbers again and again: the texts are kept by
         value (up to :data:`_CACHED` of them; ``0.0`` and ``-0.0`` share one, both
@@ -141,25 +141,6 @@ class NumberFormat:
             return "-" + text
         return ("+" + text) if self.sign == "always" else text
 
-    def _format_slow(self, value_mm: float) -> str:
-        """:meth:`format` through ``Decimal`` always (the reference path; for tests)."""
-        q = self.quantize(value_mm)
-        magnitude = abs(q)
-        text = f"{magnitude:.{self.decimals}f}"
-        if self.min_decimals is not None and self.decimals > self.min_decimals:
-            whole, frac = text.split(".")
-            frac = frac.rstrip("0").ljust(self.min_decimals, "0")
-            text = f"{whole}.{frac}" if frac else whole
-        int_part = text.split(".")[0]
-        if self.int_digits is not None:
-            if len(int_part) > self.int_digits:
-                raise DialectError(f"{_short(q)} does not fit {self.int_digits} integer digits")
-            if self.pad:
-                text = text.rjust(len(text) - len(int_part) + self.int_digits, "0")
-        if q < 0:
-            return "-" + text
-        return ("+" + text) if self.sign == "always" else text
-
     def parse(self, text: str) -> float:
         """Read a value written in this format back to mm (signs optional).
 
@@ -177,14 +158,14 @@ class NumberFormat:
             if self.scale == 1.0 and len(text) <= _PLAIN_DIGITS and _PLAIN.fullmatch(text):
                 value = float(text)
             else:
-                value = self._parse_slow(text)
+                value = self._parse_decimal(text)
             if len(values) >= _CACHED:
                 values.clear()
             values[text] = value
         return value
 
-    def _parse_slow(self, text: str) -> float:
-        """:meth:`parse` through ``Decimal`` always (the reference path; for tests)."""
+    def _parse_decimal(self, text: str) -> float:
+        """:meth:`parse` of any text, through ``Decimal`` (exponents, long digits, a scale)."""
         try:
             number = Decimal(text)
         except InvalidOperation:

@@ -57,11 +57,11 @@ def _extent(program: Program) -> BBox | None:
         return bbox_union([(x, y, x, y) for x, y in ends]) if ends else None
     start = program.origin if first == 0 else (moves[first - 1].x, moves[first - 1].y)
     tail = moves[first:]
-    box = _extent_fast(start, tail, zero_sides=True)
-    return box if box is not None else _extent_slow(start, tail)
+    box = _extent_of_ends(start, tail, zero_sides=True)
+    return box if box is not None else _union_of_boxes(start, tail)
 
 
-def _extent_slow(start: Point, moves: Sequence[Move]) -> BBox:
+def _union_of_boxes(start: Point, moves: Sequence[Move]) -> BBox:
     """The union of every move's :meth:`~camtool.model.shapes.Arc.bbox` (or Line's), in order."""
     boxes = []
     for move in moves:
@@ -75,20 +75,22 @@ _QUAD_SIN = tuple(math.sin(k * math.pi / 2) for k in range(4))
 """``cos``/``sin`` of the quadrant angles, as :meth:`Arc.bbox` computes its extremes."""
 
 
-def _extent_fast(start: Point, moves: Sequence[Move], *, zero_sides: bool = False) -> BBox | None:
-    """:func:`_extent_slow`'s box, skipping the arcs that cannot widen it; ``None``: not sure.
+def _extent_of_ends(
+    start: Point, moves: Sequence[Move], *, zero_sides: bool = False
+) -> BBox | None:
+    """:func:`_union_of_boxes`'s box, skipping the arcs that cannot widen it; ``None``: not sure.
 
     The box of the end points comes first. An arc whose four circle extremes (the very floats
     :meth:`Arc.bbox` would add: ``c + r·cos(kπ/2)``, ``c + r·sin(kπ/2)``) all lie strictly
     inside it adds no value that could be a minimum or a maximum, so its box is not needed;
     the others' boxes are computed as before. The union of a set of floats is the same in any
     order but for the sign of a zero and NaN (``min`` keeps the first of equals), so a box
-    with a non-finite side is left to the slow union (``None``), and so is one with a zero
+    with a non-finite side is left to the union (``None``), and so is one with a zero
     side unless ``zero_sides``.
 
     ``zero_sides`` (what :func:`toolpath_extent` uses: ``--origin lower-left`` puts the
     lower-left corner at exactly 0): a zero side is kept when no value that could be it is
-    ``-0.0``. The slow union's values are the end points (all in the end-point box's lists),
+    ``-0.0``. The union's values are the end points (all in the end-point box's lists),
     the boxes of the arcs kept here (the same boxes) and extremes of the skipped arcs, which
     lie strictly inside and so are no side. When none of the first two is ``-0.0``, every
     zero among them is ``+0.0`` and both unions give ``+0.0`` in any order.
@@ -211,16 +213,16 @@ _new = object.__new__
 
 
 def _shifted(move: Move, dx: float, dy: float) -> Move:
-    """``move`` moved by ``(dx, dy)``: :func:`_shifted_slow`'s object, made faster.
+    """``move`` moved by ``(dx, dy)``: :func:`_shifted_replaced`'s object, field by field.
 
     A plain slotted move (:func:`~camtool.model.plain.slot_setters`) is copied field by
     field, with ``x``, ``y`` (and an arc's ``cx``, ``cy``) shifted: the fields
     ``dataclasses.replace`` gives, so equal, with the same hash, ``repr`` and pickle.
-    Anything else goes through :func:`_shifted_slow`.
+    Anything else goes through :func:`_shifted_replaced`.
     """
     spec = _SLOTTED.get(type(move))
     if spec is None:
-        return _shifted_slow(move, dx, dy)
+        return _shifted_replaced(move, dx, dy)
     new = _new(type(move))
     for name, put in spec:
         value = getattr(move, name)
@@ -232,8 +234,8 @@ def _shifted(move: Move, dx: float, dy: float) -> Move:
     return new
 
 
-def _shifted_slow(move: Move, dx: float, dy: float) -> Move:
-    """``move`` moved by ``(dx, dy)`` through ``dataclasses.replace`` (the reference)."""
+def _shifted_replaced(move: Move, dx: float, dy: float) -> Move:
+    """``move`` moved by ``(dx, dy)`` through ``dataclasses.replace`` (any move)."""
     if isinstance(move, Rapid):
         return dataclasses.replace(move, x=move.x + dx, y=move.y + dy)
     if isinstance(move, ArcMove):

@@ -9,14 +9,13 @@ Design notes: docs/internals.md, ``camtool/toolpath/reversals.py``.
 from __future__ import annotations
 
 import itertools
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
-from camtool.model.shapes import Arc, Line, Point, Segment, arc_axis_signs
+from camtool.model.shapes import Line, Point, Segment
 from camtool.toolpath.cuts import Cut
 from camtool.toolpath.travel import Step, ends, oriented, rapid_mm, travel_order
 
@@ -51,11 +50,6 @@ def _line_signs(dx: float, dy: float) -> tuple[list[int], list[int]]:
 
 def _sign(v: float) -> int:
     return 1 if v > 0 else -1
-
-
-def _arc_signs(arc: Arc, phase: float) -> list[int]:
-    """Directions of one axis along ``arc``: X for ``phase`` 0, Y for π/2 (computed afresh)."""
-    return list(arc_axis_signs(arc, phase))
 
 
 def _path_signs(segments: Sequence[Segment]) -> tuple[list[tuple[int, int]], list[tuple[int, int]]]:
@@ -105,31 +99,6 @@ def count_reversals(cuts: Sequence[Cut], start: Point) -> tuple[int, int]:
                 state_y = v
         here = path.end
     return count_x, count_y
-
-
-def count_reversals_slow(cuts: Sequence[Cut], start: Point) -> tuple[int, int]:
-    """:func:`count_reversals` as first written (the reference for tests).
-
-    Every rapid is a :class:`Line`, every arc goes through :func:`_arc_signs`.
-    """
-    state = [0, 0]
-    count = [0, 0]
-    here = start
-    for cut in cuts:
-        moves: list[Segment] = [Line(here, cut.path.start), *cut.path.segments]
-        for seg in moves:
-            signs: tuple[Sequence[int], Sequence[int]]
-            if isinstance(seg, Arc):
-                signs = (_arc_signs(seg, 0.0), _arc_signs(seg, math.pi / 2))
-            else:
-                signs = segment_signs(seg)
-            for axis, axis_signs in enumerate(signs):
-                for v in axis_signs:
-                    if state[axis] and v != state[axis]:
-                        count[axis] += 1
-                    state[axis] = v
-        here = cut.path.end
-    return count[0], count[1]
 
 
 @dataclass(frozen=True)

@@ -208,27 +208,6 @@ class Track:
             s0, s1 = max(s0, 0.0), min(s1, total)
         return s0, s1
 
-    def pieces_slow(self, s0: float, s1: float) -> list[tuple[Segment, float]]:
-        """:meth:`pieces` walking every segment of every lap (the reference for tests)."""
-        span = self._span(s0, s1)
-        if span is None:
-            return []
-        s0, s1 = span
-        total, ends = self.length, self.ends
-        out: list[tuple[Segment, float]] = []
-        lap = math.floor(s0 / total) if self.closed else 0
-        while lap * total < s1 - MIN_PIECE:
-            base = lap * total
-            for i, seg in enumerate(self.segments):
-                a, b = base + (ends[i - 1] if i else 0.0), base + ends[i]
-                lo, hi = max(a, s0), min(b, s1)
-                if hi - lo > MIN_PIECE:
-                    out.append((_piece(seg, (lo - a) / seg.length, (hi - a) / seg.length), hi))
-            lap += 1
-            if not self.closed:
-                break
-        return out
-
     def _local(self, s: float, total: float) -> float:
         if self.closed:
             return s % total if total > 0 else 0.0

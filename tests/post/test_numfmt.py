@@ -1,13 +1,21 @@
-"""Table tests of the one number-formatting module (STYLE 8)."""
+"""Table tests of the one number-formatting module (STYLE 8), and its shortcuts against
+``Decimal``: the texts it keeps, ``half_up`` on the float's repr and ``float`` for a plain
+decimal give what ``Decimal`` gives, on random values of every kind and every format
+option (the texts, or the refusals, identical)."""
 
 from __future__ import annotations
 
+import contextlib
 import math
+from decimal import ROUND_HALF_UP, Decimal, InvalidOperation, localcontext
 
+import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from camtool.model.errors import DialectError
-from camtool.post.numfmt import NumberFormat, format_int
+from camtool.post.numfmt import NumberFormat, format_int, half_up
 
 UM52 = NumberFormat(scale=1000.0, decimals=2, int_digits=5)
 
@@ -104,3 +112,179 @@ def test_format_refuses_a_scale_that_would_divide_by_zero(
 def test_parse_refuses_what_is_not_a_finite_number(text: str, message: str) -> None:
     with pytest.raises(DialectError, match=message):
         NumberFormat().parse(text)
+
+
+# ---------------------------------------------------------------- against Decimal
+# The judge of the shortcuts (``half_up`` on the float's repr, ``float`` for a plain
+# decimal, the kept texts): the writer and reader written out with ``Decimal`` here.
+
+
+def decimal_format(fmt: NumberFormat, value_mm: float) -> str:
+    """What :meth:`NumberFormat.format` must write: its ``Decimal`` quantization, laid out."""
+    q = fmt.quantize(value_mm)
+    text = f"{abs(q):.{fmt.decimals}f}"
+    if fmt.min_decimals is not None and fmt.decimals > fmt.min_decimals:
+        whole, frac = text.split(".")
+        frac = frac.rstrip("0").ljust(fmt.min_decimals, "0")
+        text = f"{whole}.{frac}" if frac else whole
+    int_part = text.split(".")[0]
+    if fmt.int_digits is not None:
+        if len(int_part) > fmt.int_digits:
+            raise DialectError(f"does not fit {fmt.int_digits} integer digits")
+        if fmt.pad:
+            text = text.rjust(len(text) - len(int_part) + fmt.int_digits, "0")
+    if q < 0:
+        return "-" + text
+    return ("+" + text) if fmt.sign == "always" else text
+
+
+def decimal_parse(fmt: NumberFormat, text: str) -> float:
+    """What :meth:`NumberFormat.parse` must read: the decimal over the scale, correctly rounded."""
+    try:
+        number = Decimal(text)
+    except InvalidOperation:
+        raise DialectError("not a number") from None
+    if not number.is_finite():
+        raise DialectError("not a finite number")
+    with localcontext() as ctx:
+        ctx.prec = max(28, len(number.as_tuple().digits) + 8)
+        value = float(number / Decimal(repr(float(fmt.scale))))
+    if not math.isfinite(value):
+        raise DialectError("too large")
+    return value
+
+
+ALL_FORMATS = [
+    NumberFormat(decimals=d, min_decimals=m, int_digits=i, pad=p, sign=sg)
+    for d in (0, 1, 3, 4, 6)
+    for m in (None, 0, min(1, d))
+    if m is None or m <= d
+    for i, p in ((None, True), (4, True), (4, False))
+    for sg in ("negative", "always")
+]
+
+
+def _values(rng: np.random.Generator, n: int) -> list[float]:
+    out = [0.0, -0.0, 0.5, -0.5, 0.0005, -0.0005, 2.0005, 1e-5, -1e-7, 1e15, 1e16, -1e22]
+    out += [math.nan, math.inf, -math.inf, 5e-324, 1.7976931348623157e308]
+    for _ in range(n):
+        kind = rng.integers(0, 6)
+        if kind == 0:
+            v = float(rng.uniform(-1000, 1000))
+        elif kind == 1:  # an exact half at some number of decimals
+            d = int(rng.integers(0, 8))
+            v = (int(rng.integers(-(10**6), 10**6)) + 0.5) / 10**d
+        elif kind == 2:  # a few digits, as G-code is written
+            v = round(float(rng.uniform(-500, 500)), int(rng.integers(0, 7)))
+        elif kind == 3:
+            v = float(10 ** rng.uniform(-9, 18)) * float(rng.choice([-1, 1]))
+        elif kind == 4:  # repr with a digit 4 or 5 just past the 3rd decimal
+            tail = rng.choice([4, 5, 49, 50, 51])
+            v = float(f"{rng.integers(-9999, 9999)}.{rng.integers(0, 1000):03d}{tail}")
+        else:
+            v = float(rng.normal(0, 50)) * 10 ** -int(rng.integers(0, 5))
+        out.append(v)
+    return out
+
+
+def _outcome(call: object, arg: object) -> str:
+    """The value's repr, or that it was refused (the messages are the library's own)."""
+    try:
+        return repr(call(arg))  # type: ignore[operator]
+    except DialectError:
+        return "DialectError"
+
+
+@pytest.mark.parametrize("k", range(0, len(ALL_FORMATS), 1))
+def test_format_fast_equals_decimal(k: int) -> None:
+    fmt = ALL_FORMATS[k]
+    rng = np.random.default_rng(k)
+    for v in _values(rng, 1500):
+        assert _outcome(fmt.format, v) == _outcome(lambda x: decimal_format(fmt, x), v), (fmt, v)
+
+
+def test_parse_fast_equals_decimal() -> None:
+    rng = np.random.default_rng(99)
+    fmt = NumberFormat(decimals=3)
+    texts = [
+        "0",
+        "-0",
+        "-0.000",
+        "+1.5",
+        ".5",
+        "5.",
+        "-.5",
+        "1e3",
+        "1_0",
+        " 1",
+        "",
+        "-",
+        ".",
+        "0x10",
+        "nan",
+        "inf",
+        "1" * 30,
+        "9" * 24,
+        "0." + "1" * 22,
+        "00012.34000",
+    ]
+    for v in _values(rng, 5000):
+        for f in ALL_FORMATS[::7]:
+            with contextlib.suppress(DialectError):
+                texts.append(f.format(v))
+        texts.append(repr(v))
+    for t in texts:
+        assert _outcome(fmt.parse, t) == _outcome(lambda x: decimal_parse(fmt, x), t), t
+
+
+def test_half_up_equals_decimal() -> None:
+    """``half_up``'s shortcut (a repr that rounds down keeps its digits) is Decimal's rounding."""
+    rng = np.random.default_rng(1717)
+    for v in _values(rng, 4000):
+        for d in range(8):
+            got = half_up.__wrapped__(v, d)
+            if got is None:
+                assert "e" in repr(v) or not math.isfinite(v)
+                continue
+            q = Decimal(repr(v)).quantize(Decimal(1).scaleb(-d), rounding=ROUND_HALF_UP)
+            assert got == (f"{abs(q):.{d}f}", q < 0), (v, d)
+
+
+MEMO_FORMATS = [
+    NumberFormat(),
+    NumberFormat(scale=1000.0, decimals=0, int_digits=6),
+    NumberFormat(decimals=3, min_decimals=1, sign="always"),
+    NumberFormat(scale=10.0, decimals=2, grid_mm=0.0125),
+]
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.floats(-1e5, 1e5, allow_nan=False), st.sampled_from(range(len(MEMO_FORMATS))))
+def test_memo_equals_uncached(value: float, which: int) -> None:
+    fmt = MEMO_FORMATS[which]
+    try:
+        slow = decimal_format(fmt, value)
+    except DialectError:
+        with pytest.raises(DialectError):
+            fmt.format(value)
+        return
+    for _ in range(2):  # computed, then remembered
+        assert fmt.format(value) == slow
+        assert fmt.parse(slow) == decimal_parse(fmt, slow)
+
+
+def test_signed_zero_and_errors_are_not_remembered_wrongly() -> None:
+    fmt = NumberFormat()
+    assert fmt.format(-0.0) == decimal_format(fmt, -0.0) == fmt.format(0.0) == "0.000"
+    for bad in (math.nan, math.inf):
+        for _ in range(2):
+            with pytest.raises(DialectError):
+                fmt.format(bad)
+    with pytest.raises(DialectError):
+        fmt.parse("x1")
+
+
+def test_memo_is_not_part_of_equality() -> None:
+    a, b = NumberFormat(), NumberFormat()
+    a.format(1.5)
+    assert a == b and hash(a) == hash(b) and repr(a) == repr(b)

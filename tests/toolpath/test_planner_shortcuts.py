@@ -1,12 +1,12 @@
-"""The planner's fast paths give exactly what their slow forms give (issue 17, fourth pass).
+"""The planner's shortcuts give exactly what the plain forms written out here give.
 
-Each fast path is compared with a slow form on many random inputs, for exact equality
-(every float's bits, not approximately): :meth:`Track.pieces` (which skips the segments
-before ``s0`` and stops after ``s1``) with :meth:`Track.pieces_slow` (every segment of every
-lap); :func:`segment_signs` (kept on the arc) with the module's
-:func:`~camtool.toolpath.reversals._arc_signs`; :meth:`Arc.bbox` (quadrant cosines
-computed once) with the per-call formula written out here; :func:`sub_segment` on a whole
-segment (the segment itself) with the piece rebuilt from its ends.
+Each is compared on many random inputs, for exact equality (every float's bits, not
+approximately): :meth:`Track.pieces` (which skips the segments before ``s0`` and stops
+after ``s1``) with a walk over every segment of every lap; :func:`segment_signs` (kept
+on the arc) and :func:`count_reversals` (rapids and arcs by their kept signs) with the
+signs computed afresh; :meth:`Arc.bbox` (quadrant cosines computed once) with the
+per-call formula; :func:`sub_segment` on a whole segment (the segment itself) with the
+piece rebuilt from its ends; a shifted move with ``dataclasses.replace``'s.
 """
 
 from __future__ import annotations
@@ -17,15 +17,59 @@ import struct
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from camtool.model.shapes import TAU, Arc, Contour, Line, Segment
+from camtool.model.shapes import TAU, Arc, Contour, Line, Segment, arc_axis_signs
 from camtool.toolpath.cuts import Cut
-from camtool.toolpath.reversals import (
-    _arc_signs,
-    count_reversals,
-    count_reversals_slow,
-    segment_signs,
-)
-from camtool.toolpath.split import Track, _piece, sub_segment
+from camtool.toolpath.reversals import count_reversals, segment_signs
+from camtool.toolpath.split import MIN_PIECE, Track, _piece, sub_segment
+
+
+def _arc_signs(arc: Arc, phase: float) -> list[int]:
+    """Directions of one axis along ``arc``: X for ``phase`` 0, Y for π/2 (computed afresh)."""
+    return list(arc_axis_signs(arc, phase))
+
+
+def count_reversals_afresh(cuts: list[Cut], start: tuple[float, float]) -> tuple[int, int]:
+    """:func:`count_reversals` with every rapid a :class:`Line` and every arc's signs afresh."""
+    state = [0, 0]
+    count = [0, 0]
+    here = start
+    for cut in cuts:
+        for seg in [Line(here, cut.path.start), *cut.path.segments]:
+            if isinstance(seg, Arc):
+                signs = (_arc_signs(seg, 0.0), _arc_signs(seg, math.pi / 2))
+            else:
+                xs, ys = segment_signs(seg)
+                signs = (list(xs), list(ys))
+            for axis, axis_signs in enumerate(signs):
+                for v in axis_signs:
+                    if state[axis] and v != state[axis]:
+                        count[axis] += 1
+                    state[axis] = v
+        here = cut.path.end
+    return count[0], count[1]
+
+
+def pieces_of_every_segment(track: Track, s0: float, s1: float) -> list[tuple[Segment, float]]:
+    """:meth:`Track.pieces` walking every segment of every lap."""
+    span = track._span(s0, s1)
+    if span is None:
+        return []
+    s0, s1 = span
+    total, ends = track.length, track.ends
+    out: list[tuple[Segment, float]] = []
+    lap = math.floor(s0 / total) if track.closed else 0
+    while lap * total < s1 - MIN_PIECE:
+        base = lap * total
+        for i, seg in enumerate(track.segments):
+            a, b = base + (ends[i - 1] if i else 0.0), base + ends[i]
+            lo, hi = max(a, s0), min(b, s1)
+            if hi - lo > MIN_PIECE:
+                out.append((_piece(seg, (lo - a) / seg.length, (hi - a) / seg.length), hi))
+        lap += 1
+        if not track.closed:
+            break
+    return out
+
 
 coord = st.floats(-500.0, 500.0, allow_nan=False, allow_infinity=False)
 point = st.tuples(coord, coord)
@@ -83,7 +127,7 @@ def arcs(draw: st.DrawFn) -> Arc:
 
 @settings(max_examples=1500, deadline=None)
 @given(arcs())
-def test_arc_signs_equal_the_slow_form(arc: Arc) -> None:
+def test_arc_signs_equal_the_signs_afresh(arc: Arc) -> None:
     slow = (_arc_signs(arc, 0.0), _arc_signs(arc, math.pi / 2))
     for _ in range(2):  # computed, then kept
         xs, ys = segment_signs(arc)
@@ -92,13 +136,13 @@ def test_arc_signs_equal_the_slow_form(arc: Arc) -> None:
 
 @settings(max_examples=300, deadline=None)
 @given(st.lists(st.one_of(arcs(), st.tuples(point, point)), min_size=1, max_size=30), point)
-def test_count_reversals_equals_the_slow_count(items: list, origin: tuple) -> None:
+def test_count_reversals_equals_the_count_afresh(items: list, origin: tuple) -> None:
     """Cuts of random arcs and lines (each its own open cut), from a random origin."""
     cuts = []
     for k, item in enumerate(items):
         seg = item if isinstance(item, Arc) else Line(*item)
         cuts.append(Cut(Contour((seg,), False), k, may_rotate=False))
-    assert count_reversals(cuts, origin) == count_reversals_slow(cuts, origin)
+    assert count_reversals(cuts, origin) == count_reversals_afresh(cuts, origin)
 
 
 @settings(max_examples=300, deadline=None)
@@ -139,7 +183,7 @@ def tracks(draw: st.DrawFn) -> Track:
 def test_pieces_equal_the_walk_over_every_segment(track: Track, data: st.DataObject) -> None:
     total = track.length
     if not track.segments:
-        assert track.pieces(0.0, 1.0) == track.pieces_slow(0.0, 1.0) == []
+        assert track.pieces(0.0, 1.0) == pieces_of_every_segment(track, 0.0, 1.0) == []
         return
     ends = [0.0, *track.ends]
     # bounds at segment ends (exactly), just off them, inside, and a few laps on
@@ -153,7 +197,7 @@ def test_pieces_equal_the_walk_over_every_segment(track: Track, data: st.DataObj
         lap = data.draw(st.integers(0, 3)) * total
         s0 = data.draw(anchor) + lap
         s1 = s0 + data.draw(st.one_of(st.floats(0.0, 3.0 * total), st.sampled_from([total])))
-        fast, slow = track.pieces(s0, s1), track.pieces_slow(s0, s1)
+        fast, slow = track.pieces(s0, s1), pieces_of_every_segment(track, s0, s1)
         assert _bits(fast) == _bits(slow)
         assert fast == slow
 
@@ -200,7 +244,7 @@ def test_shifted_moves_are_the_replaced_ones(items: list, dx: float, dy: float) 
     import pickle
 
     from camtool.model.program import ArcMove, Linear, Rapid
-    from camtool.toolpath.placement import _shifted, _shifted_slow
+    from camtool.toolpath.placement import _shifted, _shifted_replaced
 
     for kind, (x, y), (cx, cy), cw, z in items:
         move = (
@@ -210,7 +254,7 @@ def test_shifted_moves_are_the_replaced_ones(items: list, dx: float, dy: float) 
             if kind == 1
             else ArcMove(x, y, cx, cy, cw, 90.0, z, 5)
         )
-        fast, slow = _shifted(move, dx, dy), _shifted_slow(move, dx, dy)
+        fast, slow = _shifted(move, dx, dy), _shifted_replaced(move, dx, dy)
         assert type(fast) is type(slow)
         assert repr(fast) == repr(slow)  # every field, -0.0 included
         assert fast == slow and hash(fast) == hash(slow)

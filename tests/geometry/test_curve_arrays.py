@@ -1,9 +1,9 @@
-"""The fast paths of the SVG curve fit give the slow paths' results bit for bit (issue 17).
+"""The curve fit's array evaluation gives the point-by-point results bit for bit.
 
-Fast == slow on many random inputs: the array evaluators of
-:mod:`camtool.geometry.curves` against the scalar ``point_at`` they mirror, ``fit_curve``
-with ``points_at`` against ``fit_curve`` without it (the kept slow path, point by point),
-and the early exit of the piece error against the full two-sided error. Exact equality
+On many random inputs: the array evaluators of :mod:`camtool.geometry.curves` against the
+scalar ``point_at`` they mirror, ``fit_curve`` with ``points_at`` against ``fit_curve``
+without it (a curve that has only ``point_at``, as a plugin's may), and the early exit of
+the piece error against the full two-sided error. Exact equality
 (``==`` on floats and segments), never a tolerance: the emitted G-code must not change.
 """
 

@@ -1,6 +1,6 @@
 """The toolpath extent without the boxes of arcs that cannot widen it (issue 17).
 
-Reference: the union of every move's box, as before (``_extent_slow``); the fast one must
+Reference: the union of every move's box, as before (``_union_of_boxes``); the fast one must
 give the same four floats (compared by ``repr``: the sign of a zero too) or leave it to it.
 """
 
@@ -39,36 +39,36 @@ def _moves(rng: np.random.Generator, n: int, scale: float) -> list[Move]:
 
 
 @pytest.mark.parametrize("seed", range(6))
-def test_fast_extent_is_the_union_of_every_box(seed: int) -> None:
+def test_the_extent_of_ends_is_the_union_of_every_box(seed: int) -> None:
     rng = np.random.default_rng(seed)
     checked = 0
     for _ in range(300):
         scale = 10.0 ** rng.uniform(-3, 3)
         moves = _moves(rng, int(rng.integers(1, 40)), scale)
         start = (float(rng.normal(0, scale)), float(rng.normal(0, scale)))
-        slow = placement._extent_slow(start, moves)
-        fast = placement._extent_fast(start, moves)
+        union = placement._union_of_boxes(start, moves)
+        fast = placement._extent_of_ends(start, moves)
         if fast is not None:
             checked += 1
-            assert repr(fast) == repr(slow)
+            assert repr(fast) == repr(union)
     assert checked > 250
 
 
-def test_zero_or_non_finite_sides_go_to_the_slow_union() -> None:
+def test_zero_or_non_finite_sides_go_to_the_union() -> None:
     moves: list[Move] = [Linear(0.0, 1.0, 100.0), Linear(-0.0, 2.0, 100.0)]
-    assert placement._extent_fast((1.0, 1.0), moves) is None
-    assert placement._extent_fast((1.0, 1.0), [Linear(math.nan, 1.0, 100.0)]) is None
+    assert placement._extent_of_ends((1.0, 1.0), moves) is None
+    assert placement._extent_of_ends((1.0, 1.0), [Linear(math.nan, 1.0, 100.0)]) is None
     arc = ArcMove(2.0, 0.0, 1.0, 0.0, True, 100.0)  # the half circle over (1, 1)
-    assert repr(placement._extent_fast((0.0, 0.0), [arc])) == "None"
-    assert placement._extent_fast(
+    assert repr(placement._extent_of_ends((0.0, 0.0), [arc])) == "None"
+    assert placement._extent_of_ends(
         (3.0, 3.0), [Linear(4.0, 4.0, 1.0), ArcMove(6.0, 4.0, 5.0, 4.0, True, 1.0)]
-    ) == placement._extent_slow(
+    ) == placement._union_of_boxes(
         (3.0, 3.0), [Linear(4.0, 4.0, 1.0), ArcMove(6.0, 4.0, 5.0, 4.0, True, 1.0)]
     )
 
 
 @pytest.mark.parametrize("seed", range(6))
-def test_zero_sides_kept_only_when_they_are_the_slow_union(seed: int) -> None:
+def test_zero_sides_kept_only_when_they_are_the_union(seed: int) -> None:
     """Programs shifted so that a side is exactly 0 (``--origin lower-left``), some with -0.0."""
     rng = np.random.default_rng(100 + seed)
     kept = 0
@@ -76,7 +76,7 @@ def test_zero_sides_kept_only_when_they_are_the_slow_union(seed: int) -> None:
         scale = 10.0 ** rng.uniform(-3, 3)
         moves = _moves(rng, int(rng.integers(1, 40)), scale)
         start = (float(rng.normal(0, scale)), float(rng.normal(0, scale)))
-        box = placement._extent_slow(start, moves)
+        box = placement._union_of_boxes(start, moves)
         dx, dy = -box[0], -box[1]  # as placement_shift does for lower-left
         if rng.random() < 0.5:
             dx = 0.0  # only Y on zero
@@ -86,19 +86,19 @@ def test_zero_sides_kept_only_when_they_are_the_slow_union(seed: int) -> None:
             k = int(rng.integers(0, len(shifted)))
             m = shifted[k]
             shifted[k] = dataclasses.replace(m, x=-0.0)
-        slow = placement._extent_slow(here, shifted)
-        fast = placement._extent_fast(here, shifted, zero_sides=True)
+        union = placement._union_of_boxes(here, shifted)
+        fast = placement._extent_of_ends(here, shifted, zero_sides=True)
         if fast is not None:
             kept += 1
-            assert repr(fast) == repr(slow)
-        assert placement._extent_fast(here, shifted) is None or 0.0 not in slow
+            assert repr(fast) == repr(union)
+        assert placement._extent_of_ends(here, shifted) is None or 0.0 not in union
     assert kept > 150
 
 
-def test_a_negative_zero_side_goes_to_the_slow_union() -> None:
+def test_a_negative_zero_side_goes_to_the_union() -> None:
     moves: list[Move] = [Linear(0.0, 1.0, 100.0), Linear(-0.0, 2.0, 100.0)]
-    assert placement._extent_fast((1.0, 1.0), moves, zero_sides=True) is None
+    assert placement._extent_of_ends((1.0, 1.0), moves, zero_sides=True) is None
     ok: list[Move] = [Linear(0.0, 1.0, 100.0), Linear(0.0, 2.0, 100.0)]
-    assert repr(placement._extent_fast((1.0, 1.0), ok, zero_sides=True)) == repr(
-        placement._extent_slow((1.0, 1.0), ok)
+    assert repr(placement._extent_of_ends((1.0, 1.0), ok, zero_sides=True)) == repr(
+        placement._union_of_boxes((1.0, 1.0), ok)
     )

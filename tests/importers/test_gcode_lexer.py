@@ -1,8 +1,8 @@
 """The G-code lexer's fast paths equal its character loops exactly (issue 17).
 
 ``_strip_comments`` returns a line without ``; ( ) *`` as it is, and ``_words``
-reads a line in one regular-expression pass; ``_strip_comments_slow`` and
-``_words_slow`` are the loops every line went through before. On random lines
+reads a line in one regular-expression pass; ``_strip_comments_by_char`` and
+``_words_by_char`` are the loops every line went through before. On random lines
 made of G-code words, blanks, comments and every kind of wrong character, the
 results, or the error messages, are identical.
 """
@@ -73,7 +73,7 @@ def test_fast_paths_equal_the_loops_on_random_lines() -> None:
     for _ in range(40000):
         raw = "".join(rng.choice(PIECES) for _ in range(rng.randint(0, 8)))
         fast = _outcome(gcode_lexer._strip_comments, raw, "f:1")
-        assert fast == _outcome(gcode_lexer._strip_comments_slow, raw, "f:1"), raw
+        assert fast == _outcome(gcode_lexer._strip_comments_by_char, raw, "f:1"), raw
         code = "".join(raw.split()).upper()
         fast_words = _outcome(gcode_lexer._words, code, "f:1")
-        assert fast_words == _outcome(gcode_lexer._words_slow, code, "f:1"), code
+        assert fast_words == _outcome(gcode_lexer._words_by_char, code, "f:1"), code
