@@ -59,7 +59,7 @@ class _Starts(Sequence[Point]):
         return (float(self.xy[index, 0]), float(self.xy[index, 1]))
 
 
-def move_starts(program: Program) -> Sequence[Point]:
+def move_starts(program: Program) -> _Starts:
     """The start of each move of ``program`` and the last one's end (see :class:`_Starts`)."""
     moves = program.moves
     xy = np.empty((len(moves) + 1, 2), dtype=np.float64)
@@ -69,28 +69,35 @@ def move_starts(program: Program) -> Sequence[Point]:
     return _Starts(xy)
 
 
-def nominal_arrays(program: Program) -> dict[str, FloatArray]:
+def nominal_arrays(
+    program: Program, starts: Sequence[Point] | None = None
+) -> dict[str, FloatArray]:
     """Per-move nominal geometry as arrays of shape ``(B,)`` (mm; ``kind`` 0 line, 1 arc, 2 rapid).
 
     Keys: ``kind, x0, y0, x1, y1, cx, cy, r, a0, sweep``; ``a0`` is the start
-    angle and ``sweep`` the signed sweep of arcs (radians, CCW positive).
+    angle and ``sweep`` the signed sweep of arcs (radians, CCW positive). The ends are
+    views of one ``(B + 1, 2)`` array of the moves' starts (:func:`move_starts`); the
+    rest six floats a move, built without a row object a move. ``starts``: the program's
+    :func:`move_starts`, when the caller has them already.
     """
-    flat = array("d")  # ten floats a move, no list of tuples beside them (80 bytes a move)
+    if not isinstance(starts, _Starts):
+        starts = move_starts(program)
+    xy = starts.xy
+    flat = array("d")
     start = program.origin
     for move in program.moves:
-        end = (move.x, move.y)
         if isinstance(move, ArcMove):
             arc = segment_of(start, move)
             assert isinstance(arc, Arc)
             a0 = math.atan2(start[1] - move.cy, start[0] - move.cx)
-            flat.extend((1, *start, *end, move.cx, move.cy, arc.radius, a0, arc.sweep))
+            flat.extend((1, move.cx, move.cy, arc.radius, a0, arc.sweep))
         else:
-            kind = 2 if isinstance(move, Rapid) else 0
-            flat.extend((kind, *start, *end, 0.0, 0.0, 0.0, 0.0, 0.0))
-        start = end
-    table = np.frombuffer(flat, dtype=np.float64).reshape(-1, 10)
-    names = ("kind", "x0", "y0", "x1", "y1", "cx", "cy", "r", "a0", "sweep")
-    return {name: table[:, i] for i, name in enumerate(names)}
+            flat.extend((2 if isinstance(move, Rapid) else 0, 0.0, 0.0, 0.0, 0.0, 0.0))
+        start = (move.x, move.y)
+    table = np.frombuffer(flat, dtype=np.float64).reshape(-1, 6)
+    out = {name: table[:, i] for i, name in enumerate(("kind", "cx", "cy", "r", "a0", "sweep"))}
+    out |= {"x0": xy[:-1, 0], "y0": xy[:-1, 1], "x1": xy[1:, 0], "y1": xy[1:, 1]}
+    return out
 
 
 def point_distances(

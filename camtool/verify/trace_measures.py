@@ -191,10 +191,10 @@ class TraceStream:
         self.program = program
         self.block_start = block_start
         self.kernels = kernels
-        self.nominal = deviations.nominal_arrays(program)
+        self.starts = deviations.move_starts(program)
+        self.nominal = deviations.nominal_arrays(program, self.starts)
         self.start = np.asarray(start_mm, dtype=np.float64).reshape(1, 2)
         self.prev: FloatArray = self.start[0]
-        self.starts = deviations.move_starts(program)
         self.runs = contour_measures.contour_runs(program)
         self.next_run = 0
         self.open: _Contour | None = None

@@ -293,12 +293,19 @@ def _peak_per_move(program: Program, measure: Callable[[], object]) -> float:
 
 
 def test_the_nominal_moves_are_built_without_a_row_object_a_move() -> None:
-    """Ten floats a move (80 bytes) and no tuple of them beside: a 12 MB program's
-    616 000 moves peaked 93 MB over the table (a list of tuples, ~230 bytes a move)."""
-    from camtool.verify.deviations import nominal_arrays
+    """The ends are views of the moves' starts (16 bytes a move), the rest six floats a move,
+    and no tuple of them beside: a 12 MB program's 616 000 moves peaked 93 MB over a table
+    of ten floats a move (a list of tuples, ~230 bytes a move); 64 bytes a move now."""
+    from camtool.verify.deviations import move_starts, nominal_arrays
 
     program = _zigzags(40)
-    assert _peak_per_move(program, lambda: nominal_arrays(program)) < 130
+    assert _peak_per_move(program, lambda: nominal_arrays(program)) < 90
+    starts = move_starts(program)
+    nominal = nominal_arrays(program, starts)
+    assert np.shares_memory(nominal["x1"], starts.xy)  # given the starts, not made again
+    ends = np.array([(m.x, m.y) for m in program.moves])
+    assert np.array_equal(nominal["x1"], ends[:, 0]) and np.array_equal(nominal["y1"], ends[:, 1])
+    assert nominal["x0"][0] == program.origin[0] and nominal["y0"][1] == ends[0, 1]
 
 
 def test_capped_feeds_are_named_by_reason_not_a_message_a_move() -> None:
