@@ -270,32 +270,20 @@ def verify_program(
         tool_diameter: tool diameter, mm; the machined edge is the trace swept by
             half of it (0: a scribing point, or a path on the line).
         findings: what planning found (:class:`camtool.toolpath.cuts.Finding`):
-            features it reported as impossible with this tool (a tight corner, a
-            region narrower than the tool) are measured apart from the rest of
-            the drawing (:func:`camtool.verify.drawing_compare.not_cut_groups`).
+            features it reported as impossible with this tool are measured apart from
+            the rest of the drawing (:func:`camtool.verify.drawing_compare.not_cut_groups`).
         planned: the unrounded plan ``program`` was emitted from, in the same
-            coordinates (the error budget's ``rounding`` source); ``None`` when
-            only the code is known.
+            coordinates (the error budget's ``rounding`` source), or ``None``.
         budget: compute the error budget when it is asked for
             (:attr:`Verification.error_budget`); ``False`` skips it.
         chunk_rows: rows simulated and measured at a time when the trace is streamed.
-        stream_above: a trace of more rows than this is streamed (simulated and
-            measured ``chunk_rows`` at a time, :func:`simulate_big`) when it can be.
+        stream_above: a trace of more rows than this is streamed (:func:`simulate_big`).
         source: the file the program was read from, named in the messages of
             :func:`check_area` (``""``: the line alone).
         budget_now: compute the error budget now, told to this progress callback as
             :meth:`Verification.measure_budget` tells it: its sources are re-simulated
-            in forked workers while this process measures the trace and compares it
-            with the drawing (the same budget; ``post --preview`` of the
-            benchmark part took 6.1 s where the two one after the other took 6.7 s).
-            A budget that fails is left to be computed, and to fail, when it is asked
-            for. ``None``: when it is asked for. The kernels the measures need are
-            loaded first (:func:`~camtool.verify.drawing_compare.prepare_comparison`), so each
-            worker inherits them instead of loading them again; the workers are then
-            forked at once, before this process's own measures (their core is idle
-            otherwise; with the kernels loaded while the plan waited for
-            OpenCASCADE, :func:`camtool.accel.cores.meanwhile`, ~0.3 s of that part's
-            preview).
+            in forked workers while this process measures the trace (the same budget).
+            A budget that fails is left to be computed, and to fail, when it is asked for.
 
     A drawing whose box does not overlap the program's (less than
     :data:`MIN_OVERLAP`) is not compared: ``against`` is ``None``,
@@ -311,44 +299,33 @@ def verify_program(
         raise UsageError(f"tool diameter must be >= 0 mm, got {tool_diameter!r}")
     placement = report.check_area(program, machine, source)
     skipped = None if against is None else report._no_overlap(program, against, tool_diameter / 2.0)
-    compared_with = against if skipped is None else None
+    drawing = against if skipped is None else None
     with ExitStack() as stack:  # leaving it stops the budget's workers, if any
-        early = None
-        if budget_now is not None and budget and compared_with is None:
+        early = None  # one source forked as soon as the rows are counted
+        if budget_now is not None and budget and drawing is None:
             early = EarlyBudget(program, machine, planned, tool_diameter, findings, budget_now)
             stack.callback(early.close)
+        streaming = None if early is None else early.start
         trace, streamed = simulate_big(
-            program,
-            machine,
-            compared_with,
-            chunk_rows,
-            stream_above,
-            streaming=None if early is None else early.start,
+            program, machine, drawing, chunk_rows, stream_above, streaming=streaming
         )
-        warnings = report._warnings(program, trace)
-        if skipped is not None:
-            warnings.append(skipped)
         run = None if early is None else early.run_for(trace.row_count)
-        now = budget_now if streamed is None and run is None else None  # else when asked for
-        if now is not None and budget and compared_with is not None:
-            prepare_comparison(compared_with)  # loaded once here, not once per worker
-        inputs = BudgetInputs(
-            program, machine, trace, planned, compared_with, tool_diameter, findings
-        )
-        if now is not None:  # the budget's workers are forked once this process has loaded
-            run = stack.enter_context(BudgetRun(inputs, budget, now))  # what it needs
-        digest = None
-        if streamed is not None:
-            dev, along, contours, thin, digest = streamed
-        else:
-            dev, along, contours, thin = measure_trace(
-                program, trace, cutting=compared_with is not None
+        if budget_now is not None and streamed is None and run is None:  # forked now
+            if budget and drawing is not None:
+                prepare_comparison(drawing)  # loaded once here, not once per worker
+            inputs = BudgetInputs(
+                program, machine, trace, planned, drawing, tool_diameter, findings
             )
+            run = stack.enter_context(BudgetRun(inputs, budget, budget_now))
+        dev, along, contours, thin, digest = streamed or (
+            *measure_trace(program, trace, cutting=drawing is not None),
+            None,
+        )
         compared = None
-        if thin is not None and compared_with is not None:  # the drawing, meanwhile
-            compared = compare_drawing(program, thin, compared_with, tool_diameter, findings)
-        times = report.block_times(trace, program, machine)
-        warnings.extend(timing_warnings(trace, program, machine))
+        if thin is not None and drawing is not None:
+            compared = compare_drawing(program, thin, drawing, tool_diameter, findings)
+        warnings = [*report._warnings(program, trace), *([skipped] if skipped else [])]
+        warnings += timing_warnings(trace, program, machine)
         v = Verification(
             target=name or machine.name,
             program=program,
@@ -357,13 +334,13 @@ def verify_program(
             deviation=dev,
             contours=contours,
             against=compared,
-            block_time_s=times,
+            block_time_s=report.block_times(trace, program, machine),
             warnings=tuple(dict.fromkeys((*warnings, *placement))),
             against_skipped=skipped,
             along=along,
             planned=planned,
             budget=budget,
-            drawing=compared_with,
+            drawing=drawing,
             tool_diameter=tool_diameter,
             findings=tuple(findings),
             cut_digest=digest,
