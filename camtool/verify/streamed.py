@@ -133,8 +133,7 @@ def simulate_big(
 
 
 RELEASE_EVERY = 256
-"""Chunks a streamed trace measures between two :func:`~camtool.accel.collector.release_free`
-(a 12 MB program's verify: 16 000 chunks, 0.03 s of them all)."""
+"""Chunks a streamed trace measures between two :func:`~camtool.accel.collector.release_free`."""
 
 
 def stream_trace(
