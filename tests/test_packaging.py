@@ -14,7 +14,10 @@ def test_every_package_is_listed_in_pyproject() -> None:
     on_disk = {
         ".".join(p.parent.relative_to(ROOT).parts) for p in (ROOT / "camtool").rglob("__init__.py")
     }
-    on_disk.add("camtool_postprocessors")
+    on_disk |= {
+        ".".join(("camtool_postprocessors", *p.parent.relative_to(ROOT / "postprocessors").parts))
+        for p in (ROOT / "postprocessors").rglob("__init__.py")
+    }
     assert config["package-dir"] == {"camtool_postprocessors": "postprocessors"}
     assert (ROOT / "postprocessors" / "__init__.py").is_file()
     assert listed == on_disk

@@ -50,7 +50,7 @@ def load_target_checked(name: str, *, machine_file: Path | str | None = None) ->
     from camtool.verify.motion import library
 
     try:
-        library().check(target.machine)
+        library(target.machine).check(target.machine)
     except InputError as exc:
         source = machine_file if machine_file is not None else name
         raise InputError(f"{source}: {exc}") from exc

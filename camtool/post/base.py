@@ -15,7 +15,7 @@ from collections import Counter
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any, ClassVar, Generic, TypeVar, get_args
+from typing import TYPE_CHECKING, Any, ClassVar, Generic, TypeVar, get_args
 
 from camtool.model.errors import DialectError, InputError, UsageError
 from camtool.model.machine import Machine
@@ -40,6 +40,10 @@ from camtool.toolpath.placement import (
     too_large,
     toolpath_extent,
 )
+
+if TYPE_CHECKING:
+    from camtool.link.spec import LinkHooks
+    from camtool.verify.motion import MotionHooks
 
 
 def check_work_area(
@@ -387,7 +391,7 @@ def from_options(
     """A dialect class built from a target file's ``[dialect_options]`` (keyword arguments).
 
     What a target module's ``post_processor(options, where)`` factory usually
-    returns (see :class:`camtool.post.registry.TomlTargets`).
+    returns (see :class:`camtool.post.registry.TargetPackage`).
 
     Raises:
         InputError: an unknown option or a bad value, naming ``where``.
@@ -442,9 +446,9 @@ def plane_chords(
 class Target:
     """One machine: its dialect (write and read back), its machine profile, its motion model.
 
-    Built by a provider (:class:`camtool.post.registry.TomlTargets`) from a
-    ``<name>.toml`` and its module, or given whole by a plugin; listed by
-    ``camtool targets``.
+    Built from a ``<name>.toml`` alone or by a machine folder's ``__init__.py``
+    (:class:`camtool.post.registry.TargetPackage`), or given whole by a plugin; listed
+    by ``camtool targets``.
 
     Attributes:
         name: the name given to ``--target``.
@@ -456,15 +460,17 @@ class Target:
         spindle_rpm: spindle speed programmed when ``--spindle-rpm`` is not
             given, rev/min; ``None`` programs no spindle commands.
         origin: where the target was found: "builtin", "plugin" or a file path.
-        motion_hook: returns the target's motion model for the verifier (the
-            ``MOTION`` object of its module, or ``None``); called only when
-            :attr:`motion` is read, so listing targets imports no verifier code.
+        motion_hook: returns the target's motion model for the verifier (its folder's
+            ``motion.MOTION``, or ``None``); called only when :attr:`motion` is read, so
+            listing targets imports no verifier code.
         link_table: the target file's ``[link]`` table as written (read and
             checked by :mod:`camtool.link` when a program is sent; empty: the
             target declares no link).
-        link_hook: returns the target's link hooks for ``camtool send`` (the
-            ``LINK`` object of its module ``<stem>_link``, or ``None``); called
-            only when :attr:`link` is read.
+        link_hook: returns the target's link hooks for ``camtool send`` (its folder's
+            ``link.LINK``, or ``None``); called only when :attr:`link` is read.
+        dialect_factory: builds this target's dialect from a ``[dialect_options]`` table,
+            for target files that name the dialect (``dialect = "pic-mmh"``); ``None``
+            for a word-address dialect.
     """
 
     name: str
@@ -475,11 +481,18 @@ class Target:
     source: str = ""
     spindle_rpm: float | None = None
     origin: str = "builtin"
-    motion_hook: Callable[[], Any] | None = field(default=None, compare=False, repr=False)
+    motion_hook: Callable[[], MotionHooks | None] | None = field(
+        default=None, compare=False, repr=False
+    )
     link_table: Mapping[str, Any] = field(
         default_factory=lambda: MappingProxyType({}), compare=False, repr=False
     )
-    link_hook: Callable[[], Any] | None = field(default=None, compare=False, repr=False)
+    link_hook: Callable[[], LinkHooks | None] | None = field(
+        default=None, compare=False, repr=False
+    )
+    dialect_factory: Callable[[Mapping[str, Any], str], PostProcessor] | None = field(
+        default=None, compare=False, repr=False
+    )
 
     def __post_init__(self) -> None:
         if isinstance(self.post, PostProcessor):  # a broken plugin's is reported later
@@ -502,17 +515,11 @@ class Target:
         return self.post.parse(code, source=source)
 
     @property
-    def motion(self) -> Any:
-        """The target's motion model for the verifier (its module's ``MOTION``), or ``None``.
-
-        Loaded on first use (the provider caches it).
-        """
+    def motion(self) -> MotionHooks | None:
+        """The target's motion model for the verifier, or ``None``; imported on first use."""
         return self.motion_hook() if self.motion_hook is not None else None
 
     @property
-    def link(self) -> Any:
-        """The target's link hooks for ``camtool send`` (its module's ``LINK``), or ``None``.
-
-        Loaded on first use (the provider caches it), like :attr:`motion`.
-        """
+    def link(self) -> LinkHooks | None:
+        """The target's link hooks for ``camtool send``, or ``None``; imported on first use."""
         return self.link_hook() if self.link_hook is not None else None

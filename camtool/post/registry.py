@@ -16,11 +16,14 @@ from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, replace
 from importlib import resources
 from pathlib import Path
-from types import MappingProxyType, ModuleType
+from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from importlib import metadata
+
+    from camtool.link.spec import LinkHooks
+    from camtool.verify.motion import MotionHooks
 
 from camtool.model.errors import InputError, UsageError
 from camtool.model.machine import Machine, load_toml, machine_from_table, merge_tables
@@ -60,16 +63,15 @@ DialectFactory = Callable[[Mapping[str, Any], str], PostProcessor]
 (for messages). Raises :class:`InputError` naming the bad key."""
 
 
-class TomlTargets:
-    """A target provider: the ``<name>.toml`` files of a package, with their modules.
+class TargetPackage:
+    """A target provider: a package of machines, one file or one folder each.
 
-    Each ``<name>.toml`` is one target (dialect and machine together). Its
-    Python, if it needs any, is the sibling module ``<package>.<stem>``
-    (``<stem>`` = the name with ``-`` → ``_``); a module whose target declares a
-    ``dialect`` other than ``word-address`` provides that dialect through a
-    ``post_processor(options, where) -> PostProcessor`` factory. The verifier's
-    motion model is the ``MOTION`` object of ``<package>.<stem>_motion`` or of
-    ``<package>.<stem>``. Modules are imported only when a target needs them.
+    A machine that needs no Python is one ``<name>.toml`` (its dialect and its
+    machine together). A machine with Python is one folder ``<stem>/`` (``<stem>`` =
+    the name with ``-`` → ``_``) holding ``<name>.toml`` and an ``__init__.py`` that
+    builds its :class:`Target` as ``TARGET`` (:func:`folder_target`: the dialect
+    factory, the verifier's motion model and the link hooks, each named there).
+    A folder is imported only when its target is asked for.
 
     Args:
         package: the import name of the package holding the files, e.g.
@@ -81,12 +83,20 @@ class TomlTargets:
         self.package = package
 
     def __repr__(self) -> str:
-        return f"TomlTargets({self.package!r})"
+        return f"TargetPackage({self.package!r})"
 
     @functools.cached_property
     def _files(self) -> dict[str, str]:
-        found = resources.files(self.package).iterdir()
-        return {f.name.removesuffix(".toml"): f.name for f in found if f.name.endswith(".toml")}
+        """Target name → its ``.toml`` file, relative to the package (``grbl/grbl.toml``)."""
+        found: dict[str, str] = {}
+        for entry in resources.files(self.package).iterdir():
+            if entry.name.endswith(".toml"):
+                found[entry.name.removesuffix(".toml")] = entry.name
+            elif entry.is_dir() and entry.joinpath("__init__.py").is_file():
+                name = entry.name.replace("_", "-")
+                if entry.joinpath(f"{name}.toml").is_file():
+                    found[name] = f"{entry.name}/{name}.toml"
+        return found
 
     def names(self) -> list[str]:
         """Names of the targets, sorted."""
@@ -104,21 +114,33 @@ class TomlTargets:
         """The cached parse of ``<name>.toml``, shared: read it, never modify it."""
         return _parse_toml(self.package, self._files[name])
 
-    def module(self, name: str, suffix: str = "") -> ModuleType | None:
-        """The module ``<package>.<stem><suffix>`` of target ``name``, or ``None`` if none."""
-        module = f"{self.package}.{name.replace('-', '_')}{suffix}"
-        if importlib.util.find_spec(module) is None:
+    def _folder(self, name: str) -> Target | None:
+        """The ``TARGET`` its folder's ``__init__.py`` builds, or ``None`` for a TOML-only machine.
+
+        Raises:
+            InputError: the folder's module fails to import or gives no :class:`Target`.
+        """
+        file = self._files[name]
+        if "/" not in file:
             return None
-        return importlib.import_module(module)
+        module = f"{self.package}.{file.partition('/')[0]}"
+        try:
+            target = importlib.import_module(module).TARGET
+        except InputError:
+            raise
+        except Exception as exc:  # a third party's bug must not crash the CLI
+            raise InputError(f"{module} is broken: {type(exc).__name__}: {exc}") from exc
+        if not isinstance(target, Target):
+            raise InputError(f"{module}.TARGET is a {type(target).__name__}, not a Target")
+        return target
 
     def dialect(self, dialect: str) -> DialectFactory | None:
-        """The factory of ``dialect`` if a target of this package declares and provides it."""
+        """The factory of ``dialect`` if a machine folder of this package provides it."""
         for name in self.names():
             if self._parsed(name).get("dialect") == dialect:
-                module = self.module(name)
-                factory = getattr(module, "post_processor", None) if module else None
-                if callable(factory):
-                    return factory
+                target = self._folder(name)
+                if target is not None and target.dialect_factory is not None:
+                    return target.dialect_factory
         return None
 
     def dialects(self) -> set[str]:
@@ -134,45 +156,67 @@ class TomlTargets:
                 found.setdefault(machine["profile"], name)
         return found
 
-    def motion(self, name: str) -> Any:
-        """The ``MOTION`` object of target ``name`` (``None`` when it has none)."""
-        for suffix in ("_motion", ""):
-            module = self.module(name, suffix)
-            hooks = getattr(module, "MOTION", None) if module else None
-            if hooks is not None:
-                return hooks
-        return None
-
-    def link(self, name: str) -> Any:
-        """The ``LINK`` object of target ``name`` (``None`` when it has none).
-
-        Found in ``<package>.<stem>_link``, then ``<package>.<stem>``, as
-        :meth:`motion` finds ``MOTION``; :mod:`camtool.link` reads it.
-        """
-        for suffix in ("_link", ""):
-            module = self.module(name, suffix)
-            hooks = getattr(module, "LINK", None) if module else None
-            if hooks is not None:
-                return hooks
-        return None
-
     def target(
         self, name: str, *, machine_file: Path | str | None = None, origin: str = "builtin"
     ) -> Target:
-        """Target ``name`` built from its TOML and its module.
+        """Target ``name``: its folder's ``TARGET``, or built from its TOML alone.
 
         Raises:
             InputError: the file, its machine or its dialect options are invalid.
         """
+        built = self._folder(name)
+        if built is None:
+            return _target_from_table(
+                self.table(name),
+                where=f"{name}.toml",
+                machine_file=machine_file,
+                origin=origin,
+                provider=self,
+            )
+        if machine_file is None and origin == built.origin:
+            return built
         return _target_from_table(
             self.table(name),
             where=f"{name}.toml",
             machine_file=machine_file,
             origin=origin,
             provider=self,
-            motion=functools.partial(_cached_motion, self, name),
-            link=functools.partial(_cached_link, self, name),
+            factory=built.dialect_factory,
+            motion=built.motion_hook,
+            link=built.link_hook,
         )
+
+
+def folder_target(
+    package: str,
+    *,
+    dialect: DialectFactory | None = None,
+    motion: Callable[[], MotionHooks] | None = None,
+    link: Callable[[], LinkHooks] | None = None,
+) -> Target:
+    """The target of a machine folder, built from its ``<name>.toml`` and the Python it names.
+
+    Args:
+        package: the folder's import name (its ``__name__``), e.g.
+            ``"camtool_postprocessors.pic_mmh"``; the target file is ``pic-mmh.toml`` in it.
+        dialect: builds the dialect its file declares by name (``dialect = "pic-mmh"``),
+            when that is not ``word-address``.
+        motion: returns the verifier's motion model (imported when first asked for).
+        link: returns the link hooks of ``camtool send`` (imported when first asked for).
+
+    Raises:
+        InputError: the file, its machine or its dialect options are invalid.
+    """
+    name = package.rpartition(".")[2].replace("_", "-")
+    return _target_from_table(
+        copy.deepcopy(_parse_toml(package, f"{name}.toml")),
+        where=f"{name}.toml",
+        machine_file=None,
+        origin="builtin",
+        factory=dialect,
+        motion=motion,
+        link=link,
+    )
 
 
 @functools.cache
@@ -181,17 +225,7 @@ def _parse_toml(package: str, file: str) -> dict[str, Any]:
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{file}: not valid TOML ({exc})") from exc
-
-
-@functools.cache
-def _cached_motion(provider: TomlTargets, name: str) -> Any:
-    return provider.motion(name)
-
-
-@functools.cache
-def _cached_link(provider: TomlTargets, name: str) -> Any:
-    return provider.link(name)
+        raise InputError(f"{file.rpartition('/')[2]}: not valid TOML ({exc})") from exc
 
 
 @dataclass(frozen=True)
@@ -236,7 +270,7 @@ def _entry_points_on(
 
 
 @functools.cache
-def _builtin_providers() -> tuple[TomlTargets, ...]:
+def _builtin_providers() -> tuple[TargetPackage, ...]:
     """The providers camtool itself registers: :data:`BUILTIN_ENTRY_POINT`'s, loaded directly.
 
     Raises:
@@ -251,7 +285,7 @@ def _builtin_providers() -> tuple[TomlTargets, ...]:
             f"camtool's built-in targets cannot be loaded ({BUILTIN_ENTRY_POINT}: {exc}); "
             "reinstall camtool (pip install -e .)"
         ) from exc
-    if not isinstance(provider, TomlTargets):
+    if not isinstance(provider, TargetPackage):
         raise InputError(
             f"camtool's built-in targets cannot be loaded ({BUILTIN_ENTRY_POINT} is a "
             f"{type(provider).__name__}); reinstall camtool (pip install -e .)"
@@ -259,7 +293,7 @@ def _builtin_providers() -> tuple[TomlTargets, ...]:
     return (provider,)
 
 
-def _builtin(name: str) -> TomlTargets | None:
+def _builtin(name: str) -> TargetPackage | None:
     """The built-in provider of target ``name``, if any."""
     return next((p for p in _builtin_providers() if name in p.names()), None)
 
@@ -269,7 +303,7 @@ def target_names() -> list[str]:
     return sorted({n for p in _builtin_providers() for n in p.names()})
 
 
-def _load_entry(ep: metadata.EntryPoint) -> TomlTargets | Target:
+def _load_entry(ep: metadata.EntryPoint) -> TargetPackage | Target:
     """What a plugin entry point names: a provider, or the single target it gives.
 
     Raises:
@@ -278,7 +312,7 @@ def _load_entry(ep: metadata.EntryPoint) -> TomlTargets | Target:
     where = f"plugin {ep.name!r} ({ep.value})"
     try:
         obj = ep.load()
-        if isinstance(obj, TomlTargets):
+        if isinstance(obj, TargetPackage):
             return obj
         target = obj() if callable(obj) and not isinstance(obj, Target) else obj
     except Exception as exc:  # a third party's bug must not crash the CLI
@@ -287,24 +321,17 @@ def _load_entry(ep: metadata.EntryPoint) -> TomlTargets | Target:
         raise InputError(f"{where} is broken: it gives {type(target).__name__}, not a Target")
     if not isinstance(target.post, PostProcessor):
         raise InputError(f"{where} is broken: its post is not a PostProcessor")
-    motion = target.motion_hook or functools.partial(_module_hook, ep.module, "MOTION")
-    link = target.link_hook or functools.partial(_module_hook, ep.module, "LINK")
-    return replace(target, origin=f"plugin {ep.value}", motion_hook=motion, link_hook=link)
+    return replace(target, origin=f"plugin {ep.value}")
 
 
-def _module_hook(module: str, name: str) -> Any:
-    """The ``MOTION`` (or ``LINK``) object of a one-module plugin (``None`` when it has none)."""
-    return getattr(importlib.import_module(module), name, None)
-
-
-def _plugin_providers() -> Iterator[tuple[metadata.EntryPoint, TomlTargets]]:
+def _plugin_providers() -> Iterator[tuple[metadata.EntryPoint, TargetPackage]]:
     """Third-party providers that load (broken plugins are skipped here)."""
     for ep in _entry_points()[1]:
         try:
             loaded = _load_entry(ep)
         except InputError:
             continue
-        if isinstance(loaded, TomlTargets):
+        if isinstance(loaded, TargetPackage):
             yield ep, loaded
 
 
@@ -404,7 +431,7 @@ def _machine_over(
     return merge_tables(machine, override), f"{where_override} (over {where})"
 
 
-def _dialect(dialect: Any, where: str, provider: TomlTargets | None) -> DialectFactory:
+def _dialect(dialect: Any, where: str, provider: TargetPackage | None) -> DialectFactory:
     """The factory of ``dialect``: the framework's word-address family, or a provider's.
 
     The provider of the target file itself is asked first, then camtool's own
@@ -432,15 +459,19 @@ def _target_from_table(
     where: str,
     machine_file: Path | str | None,
     origin: str,
-    provider: TomlTargets | None = None,
-    motion: Callable[[], Any] | None = None,
-    link: Callable[[], Any] | None = None,
+    provider: TargetPackage | None = None,
+    factory: DialectFactory | None = None,
+    motion: Callable[[], MotionHooks | None] | None = None,
+    link: Callable[[], LinkHooks | None] | None = None,
 ) -> Target:
     unknown = sorted(set(table) - _TOP_KEYS)
     if unknown:
         raise InputError(f"{where}: unknown key(s) {unknown}; known: {sorted(_TOP_KEYS)}")
     options = table.get("dialect_options", {})
-    factory = _dialect(table.get("dialect"), where, provider)
+    if factory is None:
+        factory = _dialect(table.get("dialect"), where, provider)
+    elif table.get("dialect") in (None, WORD_ADDRESS):
+        raise InputError(f"{where}: a folder's dialect factory needs the dialect's name in dialect")
     if not isinstance(options, Mapping):
         raise InputError(f"{where}: dialect_options must be a table")
     machine = table.get("machine", {})
@@ -466,6 +497,7 @@ def _target_from_table(
         motion_hook=motion,
         link_table=MappingProxyType(dict(link_table)),
         link_hook=link,
+        dialect_factory=factory if table.get("dialect") != WORD_ADDRESS else None,
     )
 
 
@@ -520,7 +552,7 @@ def machine_table(name: str) -> tuple[dict[str, Any], str]:
 
     A profile file holds the machine keys at its top level or in a ``[machine]``
     table. A built-in profile is the ``[machine]`` table of the built-in target
-    that declares it (``profile = "mmh-gmm"`` in ``postprocessors/pic-mmh.toml``).
+    that declares it (``profile = "mmh-gmm"`` in ``postprocessors/pic_mmh/pic-mmh.toml``).
     Returns the table and the name to use in messages.
 
     Raises:
@@ -556,33 +588,34 @@ def load_machine(name: str) -> Machine:
     return machine_from_table(table, where=where)
 
 
-def motion_hooks() -> list[tuple[str, Any]]:
-    """The ``MOTION`` object of every target that declares one, as ``(target name, MOTION)``.
+def profile_motion(profile: str) -> MotionHooks | None:
+    """The motion model of the target whose ``[machine]`` table declares ``profile``.
 
-    A target's motion model for the verifier (interpolators, chord rules, timing
-    models, simulators it adds to :mod:`camtool.verify`'s generic library) is the
-    ``MOTION`` attribute of its module ``<package>.<stem>_motion`` (or, for a
-    one-module plugin, of ``<package>.<stem>``; for a plugin naming a single
-    target, of the entry point's module). Built-in targets come first, then
-    plugins (a plugin of a built-in's name is skipped; a broken one too).
-    Modules are imported on the first call only (the verifier asks; listing
-    targets does not).
+    A machine profile names its interpolators, chord rule and timing model in the
+    generic library or in the ``MOTION`` of the target it belongs to
+    (:func:`camtool.verify.motion.library`). Built-in targets are asked first, then
+    plugins (a broken plugin is skipped). ``None`` when no target declares the profile
+    or it has no motion model.
     """
-    found: list[tuple[str, Any]] = []
+    if not profile:
+        return None
     for provider in _builtin_providers():
-        found += [(n, h) for n in provider.names() if (h := _cached_motion(provider, n))]
-    seen = {name for name, _ in found} | set(target_names())
-    for ep in _entry_points()[1]:
-        try:
-            loaded = _load_entry(ep)
-            if isinstance(loaded, Target):
-                pairs = [(ep.name, loaded.motion)]
-            else:
-                pairs = [(n, _cached_motion(loaded, n)) for n in loaded.names()]
-        except Exception:
-            continue
-        for name, hooks in pairs:
-            if hooks is not None and name not in seen:
-                found.append((name, hooks))
-                seen.add(name)
-    return found
+        if (name := provider.profiles().get(profile)) is not None:
+            return provider.target(name).motion
+    for ep, plugin in _plugin_providers():
+        if (name := plugin.profiles().get(profile)) is not None:
+            try:
+                return plugin.target(name, origin=f"plugin {ep.value}").motion
+            except InputError:
+                return None
+    return None
+
+
+def target_motion(name: str) -> MotionHooks | None:
+    """The motion model of target ``name`` (for a qualified piece name ``"grbl:grbl"``).
+
+    Raises:
+        UsageError: no such target.
+        InputError: the target is broken.
+    """
+    return load_target(name).motion

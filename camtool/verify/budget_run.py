@@ -441,7 +441,7 @@ def resimulate(
         CamtoolError: the simulation fails.
     """
     kernels = compiled() if chunk_rows else None
-    if kernels is not None and library().simulator(machine.motion.line) is None:
+    if kernels is not None and library(machine).simulator(machine.motion.line) is None:
         for closed_form in (True, False):  # a count the chunks do not repeat: simulated
             block_start = count_rows(program, machine, sources=sources, closed_form=closed_form)
             try:

@@ -16,7 +16,7 @@ from typing import Any, TypeVar
 import numpy as np
 import numpy.typing as npt
 
-from camtool.model.errors import InputError
+from camtool.model.errors import CamtoolError, InputError
 from camtool.model.machine import Machine, Motion
 from camtool.model.program import ArcMove, Program
 from camtool.model.shapes import Point
@@ -199,42 +199,70 @@ GENERIC = MotionHooks(
 :mod:`camtool.verify.timing`)."""
 
 
+QUALIFIED = ":"
+"""Separates a target's name from its piece's: ``chords = "grbl:grbl"`` names the chord rule
+``grbl`` of target ``grbl`` from a profile that is not GRBL's."""
+
+
 @dataclass(frozen=True)
 class Library:
-    """The pieces a profile may name: the generic library, then every target's ``MOTION``.
+    """The pieces a profile may name: the generic library, then its own target's ``MOTION``.
+
+    A name ``"<target>:<piece>"`` is looked up in that target's ``MOTION`` alone.
 
     Attributes:
-        sources: :data:`GENERIC` first, then each installed target's hooks; the
-            first source that has a name wins.
+        sources: :data:`GENERIC` first, then the hooks of the target the profile belongs
+            to; the first source that has a name wins.
     """
 
     sources: tuple[MotionHooks, ...]
 
+    def _sources(self, name: str) -> tuple[tuple[MotionHooks, ...], str]:
+        """Where ``name`` is looked up, and the piece's name there."""
+        target, qualified, piece = name.partition(QUALIFIED)
+        if not qualified:
+            return self.sources, name
+        from camtool.post.registry import target_motion
+
+        try:
+            hooks = target_motion(target)
+        except CamtoolError:
+            return (), piece
+        return ((hooks,) if hooks is not None else ()), piece
+
     def _find(
         self, pick: Callable[[MotionHooks], Mapping[str, T]], name: str, what: str, where: str
     ) -> T:
-        for hooks in self.sources:
+        sources, piece = self._sources(name)
+        for hooks in sources:
             table = pick(hooks)
-            if name in table:
-                return table[name]
-        raise InputError(f"{where}: unknown {what} {name!r}; valid: {', '.join(self.names(pick))}")
+            if piece in table:
+                return table[piece]
+        raise InputError(f"{where}: unknown {what} {name!r}; {self.valid(pick)}")
 
     def names(self, pick: Callable[[MotionHooks], Mapping[str, Any]]) -> list[str]:
         """Every name of one kind of piece, in lookup order (``pick`` selects the kind)."""
         return list(dict.fromkeys(key for hooks in self.sources for key in pick(hooks)))
 
+    def valid(self, pick: Callable[[MotionHooks], Mapping[str, Any]], *extra: str) -> str:
+        """The valid names for an error message, and how to name another target's."""
+        names = ", ".join([*self.names(pick), *extra])
+        return f"valid: {names} (or <target>{QUALIFIED}<name> for another target's)"
+
     def simulator(self, line: str) -> Simulator | None:
         """The whole simulator a ``line`` name selects, or ``None`` for the step simulator."""
-        for hooks in self.sources:
-            if line in hooks.simulators:
-                return hooks.simulators[line]
+        sources, piece = self._sources(line)
+        for hooks in sources:
+            if piece in hooks.simulators:
+                return hooks.simulators[piece]
         return None
 
     def honours(self, name: str) -> tuple[str, ...]:
         """The error sources the piece ``name`` (a line or a simulator) models itself."""
-        for hooks in self.sources:
-            if name in hooks.lines or name in hooks.simulators:
-                return tuple(hooks.honours.get(name, ()))
+        sources, piece = self._sources(name)
+        for hooks in sources:
+            if piece in hooks.lines or piece in hooks.simulators:
+                return tuple(hooks.honours.get(piece, ()))
         return ()
 
     def line(self, machine: Machine, *, sources: Sources = ALL) -> LineInterpolator:
@@ -246,16 +274,16 @@ class Library:
             InputError: an unknown name (the message lists the valid ones).
             UsageError: the profile lacks a parameter the interpolator needs.
         """
-        name = machine.motion.line
-        for hooks in self.sources:
-            if name in hooks.lines:
-                if name in hooks.honours:
-                    return hooks.lines[name](machine, sources=sources)  # type: ignore[call-arg]
-                return hooks.lines[name](machine)
-        valid = self.names(lambda h: {**h.lines, **h.simulators})
+        found, piece = self._sources(machine.motion.line)
+        for hooks in found:
+            if piece in hooks.lines:
+                if piece in hooks.honours:
+                    return hooks.lines[piece](machine, sources=sources)  # type: ignore[call-arg]
+                return hooks.lines[piece](machine)
+        valid = self.valid(lambda h: {**h.lines, **h.simulators})
         raise InputError(
-            f"{_where(machine, 'motion')}: unknown line interpolator {name!r}; "
-            f"valid: {', '.join(valid)}"
+            f"{_where(machine, 'motion')}: unknown line interpolator {machine.motion.line!r}; "
+            f"{valid}"
         )
 
     def arc(self, machine: Machine) -> ArcInterpolator | None:
@@ -264,16 +292,15 @@ class Library:
         Raises:
             InputError: an unknown name (the message lists the valid ones).
         """
-        name = machine.motion.arc
-        if name == CHORDS:
+        if machine.motion.arc == CHORDS:
             return None
-        for hooks in self.sources:
-            if name in hooks.arcs:
-                return hooks.arcs[name]
-        valid = [*self.names(lambda h: h.arcs), CHORDS]
+        found, piece = self._sources(machine.motion.arc)
+        for hooks in found:
+            if piece in hooks.arcs:
+                return hooks.arcs[piece]
         raise InputError(
-            f"{_where(machine, 'motion')}: unknown arc interpolator {name!r}; "
-            f"valid: {', '.join(valid)}"
+            f"{_where(machine, 'motion')}: unknown arc interpolator {machine.motion.arc!r}; "
+            f"{self.valid(lambda h: h.arcs, CHORDS)}"
         )
 
     def chord_rule(self, machine: Machine) -> ChordRule:
@@ -295,8 +322,8 @@ class Library:
         """
         name = table.get("model")
         if not isinstance(name, str):
-            valid = ", ".join(self.names(lambda h: h.timing))
-            raise InputError(f"{where}: unknown timing model {name!r}; valid: {valid}")
+            valid = self.valid(lambda h: h.timing)
+            raise InputError(f"{where}: unknown timing model {name!r}; {valid}")
         factory = self._find(lambda h: h.timing, name, "timing model", where)
         return factory(table, machine, where)
 
@@ -316,17 +343,18 @@ def _where(machine: Machine, table: str) -> str:
     return f"machine {machine.name!r} [machine.{table}]"
 
 
-def library() -> Library:
-    """The generic library and every installed target's ``MOTION``, looked up now.
+def library(machine: Machine | None = None) -> Library:
+    """The generic library, then the ``MOTION`` of the target ``machine``'s profile belongs to.
 
-    Targets' modules are imported on the first call
-    (:func:`camtool.post.registry.motion_hooks`); a ``MOTION`` that is not a
-    :class:`MotionHooks` is ignored.
+    The profile is ``machine.profile`` (``profile = "grbl"`` in ``grbl.toml``'s
+    ``[machine]`` table; :func:`camtool.post.registry.profile_motion`). A machine with
+    no such profile names the generic library, or another target's pieces qualified
+    (``"grbl:grbl"``). The target's modules are imported on the first call.
     """
-    from camtool.post.registry import motion_hooks
+    from camtool.post.registry import profile_motion
 
-    installed = tuple(h for _, h in motion_hooks() if isinstance(h, MotionHooks))
-    return Library((GENERIC, *installed))
+    hooks = profile_motion(machine.profile) if machine is not None else None
+    return Library((GENERIC, hooks) if hooks is not None else (GENERIC,))
 
 
 def timing_model_from_table(
@@ -343,4 +371,4 @@ def timing_model_from_table(
         InputError: An unknown model or key, or a value of the wrong type or
             out of range, naming ``where`` and the valid choices.
     """
-    return library().timing(table, where=where, machine=machine)
+    return library(machine).timing(table, where=where, machine=machine)

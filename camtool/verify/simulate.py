@@ -111,7 +111,7 @@ class StepController:
         self.block_comp = array("q")  # compensation rows
         self.reversals = [0, 0]
         self.compensations = 0
-        lib = library()
+        lib = library(machine)
         self.line = lib.line(machine, sources=sources)
         # a line whose piece models dynamics may not reach its count (a timer's overshoot)
         self.inexact = sources.dynamics and "dynamics" in lib.honours(machine.motion.line)

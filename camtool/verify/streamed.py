@@ -98,7 +98,7 @@ def simulate_big(
     ``streaming`` is told the rows of a trace about to be streamed, before it is (each
     time it is).
     """
-    if library().simulator(machine.motion.line) is not None:
+    if library(machine).simulator(machine.motion.line) is not None:
         return trace_sources.simulate(program, machine), None
     counted = rows_at_least(program, machine) > stream_above
     if counted:  # it will be streamed: its rows are counted, and with the kernels

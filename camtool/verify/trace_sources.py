@@ -28,7 +28,7 @@ def source_statuses(
     whole simulator models what it honours (``MotionHooks.honours``). Rounding
     is known only with the unrounded plan.
     """
-    lib = library()
+    lib = library(machine)
     line = machine.motion.line
     whole = lib.simulator(line) is not None
     honoured = set(lib.honours(line))
@@ -86,7 +86,7 @@ def simulate(program: Program, machine: Machine, *, sources: Sources = ALL) -> S
         UsageError: the profile lacks a parameter its line model needs, or
             ``sources`` switch off a source the machine's simulator does not model.
     """
-    lib = library()
+    lib = library(machine)
     run = lib.simulator(machine.motion.line)
     if run is not None:
         if sources == ALL:

@@ -20,9 +20,10 @@ ROOT = Path(__file__).resolve().parents[2]
 @pytest.mark.parametrize(
     ("table", "name", "valid"),
     [
-        ('line = "ddaa"', "'ddaa'", ["dda", "bresenham", "timer"]),  # timer: flashcut's MOTION
+        # pic-mmh's profile: the generic pieces and its own; another target's only qualified
+        ('line = "ddaa"', "'ddaa'", ["dda", "bresenham", "<target>:<name>"]),
         ('arc = "dssm"', "'dssm'", ["dsm", "staircase", "chords"]),
-        ('arc = "chords"\nchords = "sagita"', "'sagita'", ["sagitta", "grbl"]),
+        ('arc = "chords"\nchords = "sagita"', "'sagita'", ["sagitta", "<target>:<name>"]),
     ],
 )
 def test_post_refuses_an_unknown_motion_name_in_a_machine_file(
@@ -41,13 +42,14 @@ def test_post_refuses_an_unknown_motion_name_in_a_machine_file(
     assert str(overlay) in err and name in err
     listed = err.split("valid:")[1]
     assert all(v in listed for v in valid)
+    assert "timer" not in listed and "grbl," not in listed  # flashcut's line, GRBL's chords
 
 
 def test_verify_refuses_an_unknown_line_in_a_target_file(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     target = tmp_path / "mine.toml"
-    grbl = (ROOT / "postprocessors" / "grbl.toml").read_text("utf-8")
+    grbl = (ROOT / "postprocessors" / "grbl" / "grbl.toml").read_text("utf-8")
     target.write_text(grbl.replace('line = "bresenham"', 'line = "bresenhem"'), "utf-8")
     assert 'line = "bresenhem"' in target.read_text("utf-8")
     drawing = tmp_path / "r.dxf"

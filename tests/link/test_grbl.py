@@ -291,7 +291,7 @@ GRBL_ANSWERS = {
 
 @pytest.mark.parametrize(("line", "answer"), GRBL_ANSWERS.items())
 def test_the_pre_check_refuses_what_grbl_refuses(line: str, answer: str) -> None:
-    from camtool_postprocessors.grbl_link import refusal
+    from camtool_postprocessors.grbl.link import refusal
 
     code = refusal(line)
     assert (f"error:{code}" if code is not None else "ok") == answer
@@ -313,7 +313,7 @@ def test_a_line_grbl_refuses_is_refused_before_the_first_byte(line: str, simulat
 def test_an_arc_counts_grbls_segments_as_a_lower_bound() -> None:
     import math
 
-    from camtool_postprocessors.grbl_link import arc_blocks
+    from camtool_postprocessors.grbl.link import arc_blocks
 
     # motion_control.c mc_arc: floor(|0.5 θ r| / sqrt(tol (2r - tol))); a half circle of radius
     # 5 mm at $12 = 0.002 mm: 7.854 / 0.14141 = 55.5 -> 55 planner blocks

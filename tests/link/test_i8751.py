@@ -19,7 +19,7 @@ from camtool.link.plan import prepare_send
 from camtool.link.sender import open_port, send_plan
 from camtool.model.errors import LinkError
 from camtool.post.registry import load_target
-from camtool_postprocessors.i8751_packets import Record, encode_stream
+from camtool_postprocessors.i8751.packets import Record, encode_stream
 from tests.link.controls import PauseAt
 
 # 12 moves, 3 packets (5 + 5 + 2): X +100 steps each, Y alternating +50 / -30, one Z plunge

@@ -54,7 +54,7 @@ def run(path: str, code: str = PROGRAM, settle_s: float = 0.02, **options: Any) 
 
 
 def test_the_thesis_g02_is_43_characters_and_longer_than_the_buffer() -> None:
-    from camtool_postprocessors.pic_mmh_link import RECEIVE_BUFFER
+    from camtool_postprocessors.pic_mmh.link import RECEIVE_BUFFER
 
     assert len(THESIS_G02) == 43 > RECEIVE_BUFFER == 35
 

@@ -1,12 +1,13 @@
 """A plugin target brings its own interpolator and timing model: no edit in camtool/.
 
-The plugin is a package of targets like camtool's built-ins
-(tests/plugins/xythen_plugin/: ``TARGETS = TomlTargets(__name__)``, ``xy-then.toml`` and
-``xy_then.py`` with its ``MOTION``). It is registered the way an installed distribution
-registers one: an entry point ``xythen = "tests.plugins.xythen_plugin:TARGETS"`` of the group
-``camtool.postprocessors``. Only the entry-point discovery is patched
-(:func:`importlib.metadata.entry_points`, which :mod:`camtool.post.registry` asks); every
-other step is camtool's own, up to the CLI as a user runs it.
+The plugin is a package of targets like camtool's built-ins (tests/plugins/xythen_plugin/:
+``TARGETS = TargetPackage(__name__)``; its folder ``xy_then/`` holds ``xy-then.toml``,
+``motion.py`` with its ``MOTION`` and the ``__init__.py`` naming it). It is registered the
+way an installed distribution registers one: an entry point
+``xythen = "tests.plugins.xythen_plugin:TARGETS"`` of the group ``camtool.postprocessors``.
+Only the entry-point discovery is patched (:func:`importlib.metadata.entry_points`, which
+:mod:`camtool.post.registry` asks); every other step is camtool's own, up to the CLI as a
+user runs it.
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ from camtool.verify.verifier import verify_program
 from tests.shapes import rectangle_dxf
 
 ROOT = Path(__file__).parents[2]
-TOML = Path(__file__).parent / "xythen_plugin" / "xy-then.toml"
+TOML = Path(__file__).parent / "xythen_plugin" / "xy_then" / "xy-then.toml"
 PROGRAM = Program((Linear(1.0, 2.0, 100.0), Linear(0.0, 0.0, 100.0)))
 ENTRY_POINT = importlib.metadata.EntryPoint(
     name="xythen", value="tests.plugins.xythen_plugin:TARGETS", group=ENTRY_POINT_GROUP

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from camtool.model.program import Linear, Program, Rapid
-from camtool.post.registry import TomlTargets, load_target
+from camtool.post.registry import TargetPackage, load_target
 
 ROOT = Path(__file__).parents[2]
 
@@ -72,7 +72,7 @@ def test_the_example_is_one_file_in_a_provider_package(
     (package / "__init__.py").write_text("", encoding="utf-8")
     (package / "pen-plotter.toml").write_text(example_toml(), encoding="utf-8")
     monkeypatch.syspath_prepend(str(tmp_path))
-    provider = TomlTargets("my_machines")
+    provider = TargetPackage("my_machines")
     assert provider.names() == ["pen-plotter"]
     assert provider.profiles() == {"pen-plotter": "pen-plotter"}
     target = provider.target("pen-plotter", origin="plugin my_machines:TARGETS")

@@ -17,7 +17,7 @@ from camtool.cli.main import main
 
 ROOT = Path(__file__).resolve().parents[2]
 LOGO = str(ROOT / "samples" / "logo.dxf")
-GRBL = (ROOT / "postprocessors" / "grbl.toml").read_text()
+GRBL = (ROOT / "postprocessors" / "grbl" / "grbl.toml").read_text()
 
 MACHINE_OVERLAYS = {
     "steps_per_mm = [1e300, 1e300, 1e300]": "steps_per_mm",

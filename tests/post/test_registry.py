@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import subprocess
@@ -13,7 +14,13 @@ import pytest
 
 from camtool.model.errors import InputError, UsageError
 from camtool.model.program import Linear, Program, Rapid
-from camtool.post.registry import ENTRY_POINT_GROUP, list_targets, load_target, target_names
+from camtool.post.registry import (
+    ENTRY_POINT_GROUP,
+    list_targets,
+    load_machine,
+    load_target,
+    target_names,
+)
 
 ROOT = Path(__file__).parents[2]
 
@@ -177,7 +184,9 @@ def test_a_target_whose_machine_has_z_and_its_dialect_no_z_word_is_refused_at_lo
     tmp_path: Path,
 ) -> None:
     """Not block by block when the program is written: the file names what to change."""
-    valcnc = (Path(__file__).resolve().parents[2] / "postprocessors" / "valcnc.toml").read_text()
+    valcnc = (
+        Path(__file__).resolve().parents[2] / "postprocessors" / "valcnc" / "valcnc.toml"
+    ).read_text()
     text = valcnc.replace('name = "valcnc"', 'name = "noz"').replace("words.XYZIJ", "words.XYIJ")
     text = text.replace('z_moves = "with-xy"', 'z_moves = "none"')
     (tmp_path / "noz.toml").write_text(text)
@@ -211,9 +220,14 @@ def test_the_installed_plugins_are_scanned_once_per_search_path(
         return discover(**params)  # type: ignore[arg-type]
 
     monkeypatch.setattr(importlib.metadata, "entry_points", counting)
+    grbl = load_machine("grbl")
     for _ in range(10):
-        library()
+        library(grbl)  # a built-in profile: its own target's motion, no scan
+    assert scans == []
+    unknown = dataclasses.replace(grbl, profile="not-installed")
+    for _ in range(10):
+        library(unknown)  # a profile no built-in declares: the plugins are asked, once
     assert scans == [ENTRY_POINT_GROUP]
     monkeypatch.syspath_prepend(str(tmp_path))  # another search path: scanned again
-    library()
+    library(unknown)
     assert scans == [ENTRY_POINT_GROUP, ENTRY_POINT_GROUP]

@@ -93,7 +93,7 @@ def test_a_grbl_target_file_that_splits_arcs_posts_and_verifies_the_logo(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """The case a user met: grbl.toml with ``max_arc_deg = 180``, on ``make demo``'s logo."""
-    grbl = (ROOT / "postprocessors" / "grbl.toml").read_text()
+    grbl = (ROOT / "postprocessors" / "grbl" / "grbl.toml").read_text()
     text = grbl.replace('name = "grbl"', 'name = "grbl-180"').replace(
         'arc_check = "grbl"', 'arc_check = "grbl"\nmax_arc_deg = 180.0'
     )

@@ -1,5 +1,5 @@
 """Tests of the Yanez-07 flashcut motion model: timing, timer stepping, chords
-(camtool_postprocessors.flashcut_motion).
+(camtool_postprocessors.flashcut.motion).
 
 Every expected value names its source: a section/requirement of
 docs/references.md, or "analytic" for a property of the model's formula.
@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 
 from camtool.model.errors import UsageError
 from camtool.verify.quantize import steps_from_mm
-from camtool_postprocessors.flashcut_motion import (
+from camtool_postprocessors.flashcut.motion import (
     FlashcutTiming,
     flashcut_arc_points,
     flashcut_block_time_s,

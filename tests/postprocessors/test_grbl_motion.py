@@ -1,5 +1,5 @@
 """Tests of the GRBL motion model: mc_arc chords and the junction speed
-(camtool_postprocessors.grbl_motion).
+(camtool_postprocessors.grbl.motion).
 
 Every expected value names its source: a section/requirement of
 docs/references.md, or "analytic" for a property of the model's formula.
@@ -14,7 +14,7 @@ import pytest
 
 from camtool.model.errors import InputError, UsageError
 from camtool.verify.interpolators import chord_sagitta
-from camtool_postprocessors.grbl_motion import (
+from camtool_postprocessors.grbl.motion import (
     grbl_arc_points,
     grbl_arc_segments,
     grbl_junction_speed_mm_s,

@@ -31,12 +31,12 @@ from camtool.post.registry import load_target
 from camtool.toolpath.options import PlanOptions
 from camtool.verify.interpolators import corte_recto_max_deviation
 from camtool.verify.verifier import verify_code
-from camtool_postprocessors.i8751 import I8751Post, split_count, split_xy
-from camtool_postprocessors.i8751_packets import Record, encode_block, encode_stream
+from camtool_postprocessors.i8751.dialect import I8751Post, split_count, split_xy
+from camtool_postprocessors.i8751.packets import Record, encode_block, encode_stream
 
 SAMPLES = Path(__file__).parents[2] / "samples"
 GOLDEN = Path(__file__).parents[1] / "golden" / "i8751"
-SPM = 100.0  # postprocessors/i8751.toml: the documented placeholder, 0.01 mm per step
+SPM = 100.0  # postprocessors/i8751/i8751.toml: the documented placeholder, 0.01 mm per step
 
 
 def _target(**machine: object) -> tuple[I8751Post, Machine]:
@@ -584,7 +584,7 @@ def test_cli_post_bytes_to_stdout_and_verify_from_stdin() -> None:
 
 
 def _records(code: bytes) -> list[Record]:
-    from camtool_postprocessors.i8751_packets import binary_locator, decode_stream
+    from camtool_postprocessors.i8751.packets import binary_locator, decode_stream
 
     return decode_stream(code, binary_locator("<stdout>"))
 

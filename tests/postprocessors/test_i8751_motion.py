@@ -1,4 +1,4 @@
-"""Tests of the Intf8751 i8751 ramp timing model (camtool_postprocessors.i8751_motion).
+"""Tests of the Intf8751 i8751 ramp timing model (camtool_postprocessors.i8751.motion).
 
 Every expected value names its source: a section/requirement of
 docs/references.md, or "analytic" for a property of the model's formula.
@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from camtool.model.errors import UsageError
-from camtool_postprocessors.i8751_motion import (
+from camtool_postprocessors.i8751.motion import (
     I8751Timing,
     i8751_block_time_s,
     i8751_cruise_x,

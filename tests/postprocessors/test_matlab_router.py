@@ -21,8 +21,8 @@ from camtool.model.errors import DialectError, InputError, ParseError, UsageErro
 from camtool.model.program import ArcMove, Dwell, Linear, Move, Program, Rapid, Spindle
 from camtool.post.registry import load_target
 from camtool.verify.verifier import verify_code
-from camtool_postprocessors.matlab_router import MatlabRouterPost
-from camtool_postprocessors.matlab_router_arrays import matlab_round, router_arrays
+from camtool_postprocessors.matlab_router.arrays import matlab_round, router_arrays
+from camtool_postprocessors.matlab_router.dialect import MatlabRouterPost
 from tests.shapes import STAR_LXY, STAR_VELXY, STAR_XY_01MM
 
 SAMPLES = Path(__file__).parents[2] / "samples"

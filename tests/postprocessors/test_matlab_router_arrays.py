@@ -1,4 +1,4 @@
-"""Tests of the Angel-11 Matlab GUI arrays (camtool_postprocessors.matlab_router_arrays).
+"""Tests of the Angel-11 Matlab GUI arrays (camtool_postprocessors.matlab_router.arrays).
 
 Golden numbers: reference/Angel-11.md §3 (the star worked example, thesis L3183–L3235)
 and §8 R1–R2, R7. Other expectations are analytic (the algorithm's definition).
@@ -12,7 +12,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from camtool.model.errors import DialectError, UsageError
-from camtool_postprocessors.matlab_router_arrays import (
+from camtool_postprocessors.matlab_router.arrays import (
     DEFAULT_SPEED,
     matlab_round,
     points_01mm,

@@ -11,7 +11,7 @@ from camtool.model.machine import Backlash, BacklashRegion
 from camtool.model.program import Linear, Program, Rapid
 from camtool.post.registry import load_target
 from camtool.verify.verifier import verify_program
-from camtool_postprocessors.matlab_router_motion import count_reversals
+from camtool_postprocessors.matlab_router.motion import count_reversals
 
 F = 225.0
 

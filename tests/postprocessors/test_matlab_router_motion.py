@@ -1,4 +1,4 @@
-"""Tests of the Angel-11 DC-servo router model (camtool_postprocessors.matlab_router_motion*).
+"""Tests of the Angel-11 DC-servo router model (camtool_postprocessors.matlab_router.motion*).
 
 Every expected value names its source: a section/table of reference/Angel-11.md, or
 "analytic" when it follows from the model's own equations.
@@ -14,8 +14,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from camtool.model.errors import UsageError
-from camtool_postprocessors.matlab_router_arrays import router_arrays
-from camtool_postprocessors.matlab_router_motion_plant import (
+from camtool_postprocessors.matlab_router.arrays import router_arrays
+from camtool_postprocessors.matlab_router.plant import (
     TABLE_4_1,
     THESIS_PLANT,
     FirmwareIP,
@@ -27,7 +27,7 @@ from camtool_postprocessors.matlab_router_motion_plant import (
     per_axis_plants,
     plant_from_gains,
 )
-from camtool_postprocessors.matlab_router_motion_servo import (
+from camtool_postprocessors.matlab_router.servo import (
     RouterMachine,
     ServoTrace,
     apply_backlash,

@@ -30,7 +30,7 @@ from camtool.post.base import PostResult
 from camtool.post.registry import load_target
 from camtool.toolpath.options import PlanOptions
 from camtool.verify.verifier import verify_code
-from camtool_postprocessors.pic_mmh import FeedTable, PicMmhPost
+from camtool_postprocessors.pic_mmh.dialect import FeedTable, PicMmhPost
 from tests.shapes import golden_arc_dxf
 
 SAMPLES = Path(__file__).parents[2] / "samples"

@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 
 from camtool.model.errors import DialectError, ParseError
 from camtool.post.registry import load_target
-from camtool_postprocessors.pic_mmh_link import (
+from camtool_postprocessors.pic_mmh.link import (
     AXES,
     Backlash,
     Faster,

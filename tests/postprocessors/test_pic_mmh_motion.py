@@ -1,4 +1,4 @@
-"""Tests of the UNAM-GMM pic-mmh timing model (camtool_postprocessors.pic_mmh_motion).
+"""Tests of the UNAM-GMM pic-mmh timing model (camtool_postprocessors.pic_mmh.motion).
 
 Every expected value names its source: a section/requirement of
 docs/references.md, or "analytic" for a property of the model's formula.
@@ -12,7 +12,7 @@ import pytest
 from camtool.model.errors import UsageError
 from camtool.verify.dda import dda_iterations
 from camtool.verify.quantize import steps_from_mm
-from camtool_postprocessors.pic_mmh_motion import (
+from camtool_postprocessors.pic_mmh.motion import (
     PicMmhTiming,
     pic_mmh_block_time_s,
     pic_mmh_step_rate_hz,

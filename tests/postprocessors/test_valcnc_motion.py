@@ -1,5 +1,5 @@
 """Tests of the Munoz-22 valcnc motion model: timing and β chords
-(camtool_postprocessors.valcnc_motion).
+(camtool_postprocessors.valcnc.motion).
 
 Every expected value names its source: a section/requirement of
 docs/references.md, or "analytic" for a property of the model's formula.
@@ -16,7 +16,7 @@ from camtool.model.shapes import chord_count
 from camtool.verify.interpolators import accumulator_dda_line, chord_sagitta, polyline_steps
 from camtool.verify.quantize import steps_from_mm
 from camtool.verify.steparray import positions
-from camtool_postprocessors.valcnc_motion import (
+from camtool_postprocessors.valcnc.motion import (
     ValcncTiming,
     serial_time_s,
     valcnc_arc_points,
@@ -91,5 +91,5 @@ def test_a_serial_speed_is_refused_while_block_bytes_are_not_counted() -> None:
     from camtool.verify.motion import timing_model_from_table
 
     with pytest.raises(InputError, match="serial_baud = 9600 is not modelled yet"):
-        timing_model_from_table({"model": "valcnc", "serial_baud": 9600}, where="v.toml")
-    assert timing_model_from_table({"model": "valcnc", "serial_baud": 0}, where="v.toml")
+        timing_model_from_table({"model": "valcnc:valcnc", "serial_baud": 9600}, where="v.toml")
+    assert timing_model_from_table({"model": "valcnc:valcnc", "serial_baud": 0}, where="v")

@@ -253,7 +253,8 @@ def test_corte_recto_deviation_of_a_100_by_50_move() -> None:
         name="8751 test",
         steps_per_mm=(100.0, 100.0, 100.0),
         work_area_mm=(0.0, 0.0, 100.0, 100.0),
-        motion=profile("valcnc", motion={"line": "corte-recto"}).motion,
+        # a profile of its own: another target's chord rule is named qualified
+        motion=profile("valcnc", motion={"line": "corte-recto", "chords": "valcnc:valcnc"}).motion,
     )
     v = verify_program(Program((Linear(1.0, 0.5, 100.0),)), machine)
     assert v.deviation.max_um == pytest.approx(50 * 50 / math.hypot(100, 50) * 10.0, abs=1e-6)

@@ -16,6 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from camtool.model.errors import InputError, UsageError
+from camtool.post.registry import load_machine
 from camtool.verify.motion import timing_model_from_table
 from camtool.verify.timing import (
     BlockKinematics,
@@ -23,7 +24,7 @@ from camtool.verify.timing import (
     trapezoid_block_time_s,
     trapezoid_time_s,
 )
-from camtool_postprocessors.flashcut_motion import FlashcutTiming
+from camtool_postprocessors.flashcut.motion import FlashcutTiming
 from tests.kinematics import FALSE, assert_seconds, blocks
 
 # ------------------------------------------------------------- rest-to-rest trapezoid, analytic
@@ -123,18 +124,25 @@ def test_models_call_their_functions(model, direct):
 
 
 def test_timing_model_from_table():
-    m = timing_model_from_table({"model": "flashcut", "half_period_ms": 20}, where="t.toml")
+    """A profile names its own target's models; another target's are named qualified."""
+    lmm = load_machine("mmh-lmm")  # the flashcut target's profile
+    m = timing_model_from_table({"model": "flashcut", "half_period_ms": 20}, where="t", machine=lmm)
     assert m == FlashcutTiming(half_period_ms=20)
-    assert timing_model_from_table({"model": "linuxcnc"}, where="t") == TrapezoidTiming()
-    assert timing_model_from_table({"model": "i8751", "cruise": "design"}, where="t").model == (
-        "i8751"
-    )
+    m = timing_model_from_table({"model": "flashcut:flashcut", "half_period_ms": 20}, where="t")
+    assert m == FlashcutTiming(half_period_ms=20)
+    assert timing_model_from_table({"model": "linuxcnc:linuxcnc"}, where="t") == TrapezoidTiming()
+    i8751 = timing_model_from_table({"model": "i8751:i8751", "cruise": "design"}, where="t")
+    assert i8751.model == "i8751"
+    with pytest.raises(InputError, match="unknown timing model 'valcnc'; valid: trapezoid, grbl"):
+        timing_model_from_table({"model": "valcnc"}, where="t", machine=load_machine("grbl"))
     bad = [
-        ({"model": "fanuc"}, "unknown timing model 'fanuc'; valid: .*pic-mmh"),
-        ({"model": "valcnc", "feed": 1}, "unknown valcnc timing key"),
-        ({"model": "flashcut", "half_period_ms": 2}, "half_period_ms"),
-        ({"model": "grbl", "max_rate_mm_min": "fast"}, "must be a number"),
-        ({"model": "i8751", "cruise": "warp"}, "valid: firmware, design"),
+        ({"model": "fanuc"}, "unknown timing model 'fanuc'; valid: trapezoid .*<target>:<name>"),
+        ({"model": "flashcut"}, "unknown timing model 'flashcut'"),
+        ({"model": "nosuch:flashcut"}, "unknown timing model 'nosuch:flashcut'"),
+        ({"model": "valcnc:valcnc", "feed": 1}, "unknown valcnc:valcnc timing key"),
+        ({"model": "flashcut:flashcut", "half_period_ms": 2}, "half_period_ms"),
+        ({"model": "grbl:grbl", "max_rate_mm_min": "fast"}, "must be a number"),
+        ({"model": "i8751:i8751", "cruise": "warp"}, "valid: firmware, design"),
     ]
     for table, message in bad:
         with pytest.raises(InputError, match=message) as err:

@@ -4,7 +4,7 @@ Source: UNAM-GMM §3.2 (Tabla 23, annex A.2, L3474–L3505) and §3.1 (how the
 firmware decodes a string, Fig. 37, L1739–L1770); requirement S000-10. Each
 string is sent on its own over RS-232 and ends with ``;``:
 
-Design notes: docs/internals.md, ``postprocessors/pic_mmh_link.py``.
+Design notes: docs/internals.md, ``postprocessors/pic_mmh/link.py``.
 """
 
 from __future__ import annotations

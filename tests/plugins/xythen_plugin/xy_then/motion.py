@@ -2,7 +2,7 @@
 
 Shows that a target outside camtool brings its own line interpolator and timing
 model through its own ``MOTION`` (:class:`camtool.verify.motion.MotionHooks`)
-with no edit in ``camtool/``; its profile is ``xy-then.toml`` beside this file.
+with no edit in ``camtool/``; its target is ``xy-then.toml`` beside this file.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """The Angel-11 DC-servo wood router's firmware moves, simulated, and their error measures.
 
-Design notes: docs/internals.md, ``postprocessors/matlab_router_motion_servo.py``.
+Design notes: docs/internals.md, ``postprocessors/matlab_router/servo.py``.
 """
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ import numpy.typing as npt
 
 from camtool.model.errors import ToolpathError, UsageError
 from camtool.model.units import TENTH_MM
-from camtool_postprocessors.matlab_router_arrays import RouterArrays, router_arrays
-from camtool_postprocessors.matlab_router_motion_plant import (
+from camtool_postprocessors.matlab_router.arrays import RouterArrays, router_arrays
+from camtool_postprocessors.matlab_router.plant import (
     FIRMWARE_GAINS,
     LAWS,
     TABLE_4_1,

@@ -1,6 +1,6 @@
 """Motion model of the Angel-11 DC-servo router (``matlab-router``): its ``servo`` simulator.
 
-Design notes: docs/internals.md, ``postprocessors/matlab_router_motion.py``.
+Design notes: docs/internals.md, ``postprocessors/matlab_router/motion.py``.
 """
 
 from __future__ import annotations
@@ -17,8 +17,8 @@ from camtool.verify.interpolators import sagitta_chord_points
 from camtool.verify.motion import MotionHooks, StepTrace
 from camtool.verify.sources import ALL, Sources
 from camtool.verify.steparray import STEP_DTYPE, read_only
-from camtool_postprocessors.matlab_router_arrays import points_01mm
-from camtool_postprocessors.matlab_router_motion_servo import (
+from camtool_postprocessors.matlab_router.arrays import points_01mm
+from camtool_postprocessors.matlab_router.servo import (
     RouterMachine,
     apply_backlash,
     simulate_job,

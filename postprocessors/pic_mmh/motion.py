@@ -1,6 +1,6 @@
 """Motion model of the UNAM-GMM GMM PIC controller (``pic-mmh``) for the verifier.
 
-Design notes: docs/internals.md, ``postprocessors/pic_mmh_motion.py``.
+Design notes: docs/internals.md, ``postprocessors/pic_mmh/motion.py``.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 r"""The i8751 host link: packets, 'F' after each, 'A' at the end, and a simulated interface.
 
-Design notes: docs/internals.md, ``postprocessors/i8751_link.py``.
+Design notes: docs/internals.md, ``postprocessors/i8751/link.py``.
 """
 
 from __future__ import annotations
@@ -10,8 +10,8 @@ from typing import TYPE_CHECKING
 from camtool.link.device import Device
 from camtool.link.spec import LinkHooks, LinkSpec, WireBlock
 from camtool.model.errors import InputError
-from camtool_postprocessors.i8751 import is_text
-from camtool_postprocessors.i8751_packets import (
+from camtool_postprocessors.i8751.dialect import is_text
+from camtool_postprocessors.i8751.packets import (
     ACCESS_KEY,
     BACKWARD,
     END_DATA,

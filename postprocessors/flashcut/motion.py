@@ -2,7 +2,7 @@
 
 Three pieces the generic library does not have:
 
-Design notes: docs/internals.md, ``postprocessors/flashcut_motion.py``.
+Design notes: docs/internals.md, ``postprocessors/flashcut/motion.py``.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 r"""GRBL 1.1's serial link: messages decoded, status reports read, resume, and a simulator.
 
-Design notes: docs/internals.md, ``postprocessors/grbl_link.py``.
+Design notes: docs/internals.md, ``postprocessors/grbl/link.py``.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from camtool.link.spec import LineBlocks, LinkHooks, LinkSpec, Status, WireBlock
 from camtool.model.errors import CamtoolError, InputError, ParseError, UsageError
 from camtool.model.program import ArcMove
 from camtool.model.shapes import Arc
-from camtool_postprocessors.grbl_codes import ALARMS, ERRORS
+from camtool_postprocessors.grbl.codes import ALARMS, ERRORS
 
 if TYPE_CHECKING:
     from camtool.model.program import Program

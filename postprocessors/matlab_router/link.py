@@ -1,6 +1,6 @@
 """The matlab-router's USB link: a job is one wire block, and the master that takes it.
 
-Design notes: docs/internals.md, ``postprocessors/matlab_router_link.py``.
+Design notes: docs/internals.md, ``postprocessors/matlab_router/link.py``.
 """
 
 from __future__ import annotations

@@ -3,7 +3,7 @@
 Source: Angel-11 §3 (the GUI, verbatim code in Appendix A.1), §2.7 (the USB
 stream), §2.8 (the master's job), §8 R1–R7 (reference/Angel-11.md).
 
-Design notes: docs/internals.md, ``postprocessors/matlab_router.py``.
+Design notes: docs/internals.md, ``postprocessors/matlab_router/dialect.py``.
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ from camtool.post.base import (
     from_options,
 )
 from camtool.post.numfmt import NumberFormat
-from camtool_postprocessors.matlab_router_arrays import (
+from camtool_postprocessors.matlab_router.arrays import (
     DEFAULT_SPEED,
     RouterArrays,
     points_01mm,
@@ -54,7 +54,7 @@ if TYPE_CHECKING:  # numpy is imported where it is used: `camtool targets` loads
 # **What is the truth.** The firmware never sees ``xy``: the master replays the
 # first point, ``lxy`` (distances) and ``velxy`` (signed speeds, whose signs are the
 # directions, L3229–L3231). The verifier recomputes the speeds from the vertices
-# with the GUI's own rule (:func:`~camtool_postprocessors.matlab_router_arrays.router_arrays`), so a
+# with the GUI's own rule (:func:`~camtool_postprocessors.matlab_router.arrays.router_arrays`), so a
 # file whose arrays disagree with that rule cannot be simulated as the firmware
 # would run it: every ``lxy``/``velxy`` entry must be exactly what the GUI
 # computes from the vertices at the dialect's ``speed``, else a
@@ -829,7 +829,7 @@ class MatlabRouterPost(PostProcessor):
     def parse(self, code: str | bytes, *, source: str = "<code>") -> Program:
         """Read a script or a wire stream (autodetected) back into Rapid + Linear moves.
 
-        See :mod:`camtool_postprocessors.matlab_router`: each job is a Rapid to its
+        See :mod:`camtool_postprocessors.matlab_router.dialect`: each job is a Rapid to its
         first point and a Linear per segment (feed: the major axis's
         ``speed`` in mm/min); the arrays must be exactly the GUI's for the
         vertices at this dialect's ``speed``.

@@ -4,7 +4,7 @@ GRBL's stepper runs the generic Bresenham with AMASS
 (:func:`camtool.verify.interpolators.bresenham_line`, ``bresenham``). What is
 GRBL's own:
 
-Design notes: docs/internals.md, ``postprocessors/grbl_motion.py``.
+Design notes: docs/internals.md, ``postprocessors/grbl/motion.py``.
 """
 
 from __future__ import annotations

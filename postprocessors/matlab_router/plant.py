@@ -4,7 +4,7 @@ Units: speeds are encoder counts (×4 quadrature, 1024 per motor revolution) per
 5 ms sample, "counts/Ts" (Angel-11 §2.3: the thesis's "pulsos/s" are really
 counts per Ts); the command ``u`` is the PWM command in percent, −100…+100.
 
-Design notes: docs/internals.md, ``postprocessors/matlab_router_motion_plant.py``.
+Design notes: docs/internals.md, ``postprocessors/matlab_router/plant.py``.
 """
 
 from __future__ import annotations

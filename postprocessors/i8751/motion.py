@@ -3,7 +3,7 @@
 Its line is the generic "corte recto" (:func:`camtool.verify.interpolators.corte_recto_line`,
 ``corte-recto``); what is the 8751's own is its time model, ``i8751`` (:class:`I8751Timing`).
 
-Design notes: docs/internals.md, ``postprocessors/i8751_motion.py``.
+Design notes: docs/internals.md, ``postprocessors/i8751/motion.py``.
 """
 
 from __future__ import annotations

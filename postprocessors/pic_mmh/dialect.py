@@ -3,7 +3,7 @@
 Source: UNAM-GMM §3 (reference/UNAM-GMM.md), requirements S000-01…08. Example
 block, verbatim from the thesis (L1731)::
 
-Design notes: docs/internals.md, ``postprocessors/pic_mmh.py``.
+Design notes: docs/internals.md, ``postprocessors/pic_mmh/dialect.py``.
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ The GUI (Angel-11 §3, verbatim code in Appendix A.1, thesis L4400–L4515) turn
 the clicked vertices into three integer arrays that the master PIC replays one
 segment at a time:
 
-Design notes: docs/internals.md, ``postprocessors/matlab_router_arrays.py``.
+Design notes: docs/internals.md, ``postprocessors/matlab_router/arrays.py``.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """The ``i8751`` dialect: binary packets for the 8751 serial stepper interface.
 
-Design notes: docs/internals.md, ``postprocessors/i8751.py``.
+Design notes: docs/internals.md, ``postprocessors/i8751/dialect.py``.
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ from camtool.post.base import (
     from_options,
 )
 from camtool.post.numfmt import NumberFormat
-from camtool_postprocessors.i8751_packets import (
+from camtool_postprocessors.i8751.packets import (
     ACCESS_KEY,
     MAX_STEPS,
     MAX_WAIT_S,
@@ -472,7 +472,7 @@ class I8751Post(PostProcessor):
 
         Raises:
             ParseError: anything off the grammar of
-                :mod:`camtool_postprocessors.i8751_packets`, naming ``source`` and the byte
+                :mod:`camtool_postprocessors.i8751.packets`, naming ``source`` and the byte
                 offset (and the dump line).
             UsageError: the dialect is not bound to a machine (use a Target, or
                 :meth:`for_machine`).

@@ -3,7 +3,7 @@
 Source: Intf8751 §3.7 (reference/Intf8751.md, thesis lines 4077–4165,
 4343–4415) and requirements R2–R6. The PC sends, in raw binary (``CHR$``)::
 
-Design notes: docs/internals.md, ``postprocessors/i8751_packets.py``.
+Design notes: docs/internals.md, ``postprocessors/i8751/packets.py``.
 """
 
 from __future__ import annotations
