@@ -190,6 +190,7 @@ def fit_pieces(
     breaks: Sequence[float],
     tolerance: float,
     closed: bool,
+    points_at: PointsFn | None = None,
 ) -> list[Segment]:
     """Fit each piece between ``breaks``; tangents at a piece's end are taken from inside.
 
@@ -202,6 +203,8 @@ def fit_pieces(
         breaks: ascending parameters: both ends and the possible corners between.
         tolerance: largest distance between curve and output, both ways (> 0).
         closed: the curve ends where it starts.
+        points_at: optional, ``point_at`` on an array of parameters at once, bit for bit
+            (:func:`~camtool.geometry.arcfit.fit_curve`).
 
     Returns:
         Segments each starting exactly where the one before ends; empty when the curve is
@@ -219,7 +222,7 @@ def fit_pieces(
         def tangent(t: float, inside: float = inside) -> Point:
             return tangent_at(min(t, inside))
 
-        segs.extend(fit_curve(point_at, tangent, a, b, tolerance))
+        segs.extend(fit_curve(point_at, tangent, a, b, tolerance, points_at=points_at))
     if not segs:
         return segs
     segs = snap(segs)

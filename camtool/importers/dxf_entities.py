@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from camtool.geometry.arcfit import FloatArray, PointsFn
 from camtool.geometry.chain import with_end, with_start
 from camtool.geometry.curves import corner_knots, ellipse, fit_pieces
 from camtool.importers.options import check_curve_size
@@ -561,14 +562,22 @@ def spline_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool]
     xs, ys = [q[0] for q in pts], [q[1] for q in pts]
     _check_size(max(max(xs) - min(xs), max(ys) - min(ys)), tolerance)
 
+    # one evaluator for every point: ezdxf's BSpline.point(t) builds one from the control
+    # points at each call (what BSpline.point does, without the rebuilding)
+    evaluator = spline.evaluator
+
     def point_at(t: float) -> Point:
-        return _xy(spline.point(t))
+        return _xy(evaluator.point(t))
+
+    def tangent_at(t: float) -> Point:
+        return _xy(evaluator.derivative(t, 1)[1])
+
+    def points_at(ts: FloatArray) -> FloatArray:
+        return np.array([(v.x, v.y) for v in evaluator.points(ts)], dtype=np.float64)
 
     gap = distance(point_at(t0), point_at(t1))
     closed = gap <= _RELATIVE * size or (bool(entity.closed) and gap <= tolerance)
-    return _fit(point_at, lambda t: _xy(spline.derivative(t, 1)[1]), breaks, tolerance, closed), (
-        closed
-    )
+    return _fit(point_at, tangent_at, breaks, tolerance, closed, points_at), closed
 
 
 def _check_size(extent: float, tolerance: float) -> None:
@@ -630,10 +639,11 @@ def _fit(
     breaks: Sequence[float],
     tolerance: float,
     closed: bool,
+    points_at: PointsFn | None = None,
 ) -> list[Segment]:
     """:func:`camtool.geometry.curves.fit_pieces`, its failures as :class:`Unsupported`."""
     try:
-        segs = fit_pieces(point_at, tangent_at, breaks, tolerance, closed)
+        segs = fit_pieces(point_at, tangent_at, breaks, tolerance, closed, points_at)
     except GeometryError as exc:
         raise Unsupported("curve could not be fitted", str(exc)) from exc
     if not segs:

@@ -263,3 +263,45 @@ def test_property_random_spline_fit_holds_tolerance(
             return
         (contour,) = read_dxf(path, ImportOptions(tolerance=tol)).contours
     _assert_fits(curve, contour, tol)
+
+
+def test_a_spline_is_evaluated_by_one_evaluator_in_arrays(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """ezdxf's ``BSpline.point(t)`` builds an evaluator from every control point at each call
+    (a dxf2gcode example of 1 186 SPLINEs: 2.7 M builds, 75 of its 84 s); one is built per
+    spline, and the fit's samples are asked for in arrays."""
+    from ezdxf.math import BSpline
+
+    cps = [(10.0 * i, 20.0 * math.sin(i / 2.0)) for i in range(40)]
+    path = write_dxf(
+        tmp_path / "s.dxf", lambda msp: msp.add_open_spline([(*p, 0) for p in cps], degree=3)
+    )
+    built: list[int] = []
+    batches: list[int] = []
+    evaluator = BSpline.evaluator
+
+    class Counting:
+        def __init__(self, inner: Any) -> None:
+            self.inner = inner
+
+        def point(self, t: float) -> Any:
+            return self.inner.point(t)
+
+        def derivative(self, t: float, n: int) -> Any:
+            return self.inner.derivative(t, n)
+
+        def points(self, ts: Any) -> Any:
+            batches.append(len(ts))
+            return self.inner.points(ts)
+
+    def counting(spline: BSpline) -> Counting:
+        built.append(1)
+        return Counting(evaluator.fget(spline))  # type: ignore[attr-defined]
+
+    monkeypatch.setattr(BSpline, "evaluator", property(counting))
+    (contour,) = read_dxf(path).contours
+    assert len(built) == 1
+    assert batches and min(batches) > 1
+    monkeypatch.undo()
+    _assert_fits(_spline_curve(path), contour)
