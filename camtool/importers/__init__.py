@@ -53,7 +53,8 @@ def read_drawing(
             (:func:`camtool.importers.svg.read_svg`).
         check: called with a box (mm, as drawn) within the drawing's extent as soon as
             there is one: by the SVG importer before it fits curves (the extent of its
-            segments' ends), else with the extent of the drawing read. What it raises
+            segments' ends), by the DXF importer as its contours are read (the extent so
+            far), and with the extent of the drawing read. What it raises
             stops the reading; ``camtool post`` refuses there a drawing too large for the
             machine (:func:`camtool.jobs.pipeline.post_path`).
 
@@ -108,7 +109,7 @@ def _read(
 
         progress(Step("reading", name=path.name))
         used = options.curve_tolerance()
-        imported = import_dxf(path, options.at_tolerance(used))
+        imported = import_dxf(path, options.at_tolerance(used), check=check)
         drawing = imported.drawing
         if not imported.converted:  # only LINEs: the same drawing at any tolerance
             used = 0.0

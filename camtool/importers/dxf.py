@@ -9,6 +9,7 @@ import dataclasses
 import logging
 import math
 from collections import Counter
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -24,7 +25,7 @@ from camtool.importers.dxf_entities import (
 from camtool.importers.dxf_style import CONTINUOUS, Style, StyleResolver
 from camtool.importers.options import MAX_COORDINATE_MM, ImportOptions, too_many_entities
 from camtool.model.errors import InputError, UsageError
-from camtool.model.shapes import Contour, Drawing, Line, Mark, Point
+from camtool.model.shapes import BBox, Contour, Drawing, Line, Mark, Point, bbox_union
 from camtool.model.units import INCH, LENGTH_UNITS
 
 # Exact mm per unit for the $INSUNITS codes a shop meets (ezdxf's own factors
@@ -136,22 +137,43 @@ def read_dxf(path: str | Path, options: ImportOptions | None = None) -> Drawing:
     return import_dxf(path, options).drawing
 
 
-def import_dxf(path: str | Path, options: ImportOptions | None = None) -> DxfImport:
+def import_dxf(
+    path: str | Path,
+    options: ImportOptions | None = None,
+    *,
+    check: Callable[[BBox], None] | None = None,
+) -> DxfImport:
     """Read a DXF file like :func:`read_dxf` and also count its entities by type and layer.
+
+    Args:
+        path: the DXF file.
+        options: importer options; ``None`` takes the defaults.
+        check: called, as entities are read, with the extent of the contours read so far
+            (mm, a box within the drawing's): what it raises stops the reading before the
+            other curves are fitted (``camtool post`` refuses there a drawing too large for
+            the machine).
 
     Raises:
         InputError: as :func:`read_dxf`.
         UsageError: ``options.tolerance`` is not > 0.
+        Whatever ``check`` raises.
     """
     path = Path(path)
     options = options or ImportOptions()
     if not options.tolerance > 0:
         raise UsageError(f"the tolerance must be > 0 mm, got {options.tolerance!r}")
     with paused():
-        return _import(path, options)
+        return _import(path, options, check)
 
 
-def _import(path: Path, options: ImportOptions) -> DxfImport:
+_CHECK_EVERY = 4096
+"""Contours of plain LINEs read between two calls of an import's ``check`` (a curve's
+contours are checked as soon as they are read: fitting them is what the check saves)."""
+
+
+def _import(
+    path: Path, options: ImportOptions, check: Callable[[BBox], None] | None = None
+) -> DxfImport:
     doc, damage, repairs = _open(path)
     recovered = damage is not None
     warnings = [] if damage is None else [_damaged(path, damage, repairs)]
@@ -165,8 +187,11 @@ def _import(path: Path, options: ImportOptions) -> DxfImport:
     reader = _Reader(options.tolerance / scale, options.hatch_boundaries, keep, limit, graph)
     reader.styles = StyleResolver(doc)
     try:
-        for entity in msp:
-            reader.read(entity)
+        if check is None:
+            for entity in msp:
+                reader.read(entity)
+        else:
+            _read_checked(reader, msp, scale, check)
     except BadEntity as exc:
         raise InputError(f"{path}: {exc}") from None
     for (kind, reason), count in sorted(reader.skipped.items()):
@@ -195,6 +220,26 @@ def _import(path: Path, options: ImportOptions) -> DxfImport:
         repairs=tuple(repairs),
         converted=reader.converted,
     )
+
+
+def _read_checked(
+    reader: _Reader, entities: Iterable[Any], scale: float, check: Callable[[BBox], None]
+) -> None:
+    """Read ``entities``, calling ``check`` with the extent read so far (mm) as it grows."""
+    box: BBox | None = None
+    done = 0
+    for entity in entities:
+        reader.read(entity)
+        new = len(reader.contours) - done
+        if new and (new >= _CHECK_EVERY or not _one_line(reader.contours[-1])):
+            boxes = [c.bbox() for c in reader.contours[done:]]
+            box = bbox_union(boxes if box is None else [box, *boxes])
+            done = len(reader.contours)
+            check((box[0] * scale, box[1] * scale, box[2] * scale, box[3] * scale))
+
+
+def _one_line(contour: Contour) -> bool:
+    return len(contour.segments) == 1 and type(contour.segments[0]) is Line
 
 
 def _check_size(path: Path, msp: Any, max_entities: int) -> Any:

@@ -127,6 +127,39 @@ def test_a_dxf_is_checked_once_read(tmp_path: Path, monkeypatch: pytest.MonkeyPa
         post_path(path, load_target("grbl"), PlanOptions())
 
 
+def test_a_dxf_is_refused_as_its_contours_are_read_before_the_other_curves_are_fitted(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """dxf2gcode's DRAAK.dxf (1 186 SPLINEs, ~400 mm) for a 10 × 7 mm machine: every spline was
+    fitted (7 s) before the refusal; it comes after the first one, which is larger already."""
+    import camtool.importers.dxf_entities as entities
+
+    def build(msp: Any) -> None:
+        for k in range(30):
+            cps = [(0, 5 * k, 0), (200, 90 + 5 * k, 0), (400, -40 + 5 * k, 0), (640, 30, 0)]
+            msp.add_open_spline(cps, degree=3)
+
+    path = write_dxf(tmp_path / "splines.dxf", build)
+    fitted: list[int] = []
+    spline_segments = entities.spline_segments
+
+    def counting(entity: Any, tolerance: float) -> Any:
+        fitted.append(1)
+        return spline_segments(entity, tolerance)
+
+    monkeypatch.setattr(entities, "spline_segments", counting)
+    monkeypatch.setattr(plan_module, "plan_unplaced", _never)
+    with pytest.raises(DialectError, match=r"at least 640 × .*refused before planning"):
+        post_path(path, load_target("grbl"), PlanOptions())
+    assert len(fitted) == 1
+    # within the travel (--scale 0.25: 160 mm), every spline is read and the job planned
+    fitted.clear()
+    monkeypatch.undo()
+    monkeypatch.setattr(entities, "spline_segments", counting)
+    job = post_path(path, load_target("grbl"), PlanOptions(scale=0.25))
+    assert len(fitted) == 30 and job.result.blocks
+
+
 def test_standard_input_is_checked_too(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
