@@ -152,9 +152,9 @@ def _asked(monkeypatch: pytest.MonkeyPatch) -> list[float]:
     asked: list[float] = []
     import_dxf = dxf_importer.import_dxf
 
-    def noting(path: Path, options: ImportOptions) -> Any:
+    def noting(path: Path, options: ImportOptions, **given: Any) -> Any:
         asked.append(options.tolerance)
-        return import_dxf(path, options)
+        return import_dxf(path, options, **given)
 
     monkeypatch.setattr(dxf_importer, "import_dxf", noting)
     return asked
