@@ -165,15 +165,7 @@ class TargetPackage:
             InputError: the file, its machine or its dialect options are invalid.
         """
         built = self._folder(name)
-        if built is None:
-            return _target_from_table(
-                self.table(name),
-                where=f"{name}.toml",
-                machine_file=machine_file,
-                origin=origin,
-                provider=self,
-            )
-        if machine_file is None and origin == built.origin:
+        if built is not None and machine_file is None and origin == built.origin:
             return built
         return _target_from_table(
             self.table(name),
@@ -181,9 +173,9 @@ class TargetPackage:
             machine_file=machine_file,
             origin=origin,
             provider=self,
-            factory=built.dialect_factory,
-            motion=built.motion_hook,
-            link=built.link_hook,
+            factory=built.dialect_factory if built else None,
+            motion=built.motion_hook if built else None,
+            link=built.link_hook if built else None,
         )
 
 
