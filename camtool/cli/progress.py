@@ -36,7 +36,7 @@ def stage_text(step: Step) -> str:
     """What the stage of ``step`` is doing and how big it is, without the count done.
 
     >>> stage_text(Step("fitting", 10, 30576))
-    'fitting arcs to 30576 curves'
+    'fitting arcs to 2027 curves'
     """
     if step.stage == "reading":
         shapes = f": {step.total} shapes" if step.total else ""

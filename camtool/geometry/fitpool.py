@@ -21,7 +21,7 @@ from camtool.geometry.curves import (
 )
 from camtool.model.shapes import Arc, Line, Segment
 
-__all__ = ["MIN_CURVES", "CurveKey", "fit_key", "fit_many"]
+__all__ = ["MIN_CURVES", "CurveKey", "fit_key", "fit_many", "fit_shared", "moved", "shape_key"]
 
 CurveKey: TypeAlias = tuple[str, tuple[Any, ...]]
 """A curve by kind and exact arguments: ``("cubic", (p0, p1, p2, p3))``, ``("quadratic",
@@ -144,3 +144,99 @@ def _pack(segs: Iterable[Segment]) -> _Packed:
 
 def _unpack(packed: _Packed) -> list[Segment]:
     return [Arc(*p) if len(p) == 4 else Line(*p) for p in packed]
+
+
+SHAPE_DIGITS = 9
+"""Decimals (mm) of a Bézier's control points relative to its start that make its shape
+(:func:`shape_key`): the copies of one part placed apart are one shape, fitted once."""
+
+
+def shape_key(key: CurveKey) -> Any:
+    """A Bézier's control points relative to its start, rounded; ``None`` for other curves.
+
+    Two Béziers of one shape are translates of each other within ~1e-9 mm, far inside the
+    share of the tolerance a fit keeps in hand (:func:`~camtool.geometry.arcfit.fit_curve`
+    uses 97 % of it): the fit of one, :func:`moved` onto the other, holds the tolerance
+    there too. Elliptical arcs are fitted each.
+    """
+    kind, args = key
+    if kind not in _BEZIERS:
+        return None
+    x0, y0 = args[0]
+    rel = tuple((round(x - x0, SHAPE_DIGITS), round(y - y0, SHAPE_DIGITS)) for x, y in args[1:])
+    return (kind, rel)
+
+
+def moved(segs: Sequence[Segment], fitted: CurveKey, copy: CurveKey) -> list[Segment]:
+    """The fit ``segs`` of curve ``fitted`` translated onto ``copy`` of the same shape.
+
+    Every point moves by the difference of the two curves' starts; the first and last points
+    are then set to ``copy``'s own ends exactly, so that the fit starts and ends where its
+    curve does (the numbers may differ from a fit of ``copy`` of its own in their last bits).
+    """
+    (ax, ay), (bx, by) = fitted[1][0], copy[1][0]
+    dx, dy = bx - ax, by - ay
+
+    def at(p: tuple[float, float]) -> tuple[float, float]:
+        return (p[0] + dx, p[1] + dy)
+
+    out: list[Segment] = [
+        Arc(at(s.start), at(s.end), at(s.centre), s.clockwise)
+        if isinstance(s, Arc)
+        else Line(at(s.start), at(s.end))
+        for s in segs
+    ]
+    if out:
+        out[0] = _ends(out[0], start=copy[1][0])
+        out[-1] = _ends(out[-1], end=copy[1][-1])
+    return out
+
+
+def _ends(s: Segment, start: Any = None, end: Any = None) -> Segment:
+    a, b = start or s.start, end or s.end
+    return Arc(a, b, s.centre, s.clockwise) if isinstance(s, Arc) else Line(a, b)
+
+
+def fit_shared(
+    keys: Sequence[CurveKey],
+    tolerance: float,
+    jobs: int | None = None,
+    *,
+    done: Callable[[int, int], None] | None = None,
+) -> list[list[Segment] | None]:
+    """:func:`fit_many` of the first curve of each shape (:func:`shape_key`), moved onto the rest.
+
+    A panelised drawing repeats its parts: each shape is fitted once, on the machine's cores,
+    and its fit :func:`moved` onto every other curve of that shape, in ``keys``' order (the
+    first one met is the one fitted).
+
+    Args:
+        keys: the curves.
+        tolerance: mm (> 0), as for :func:`fit_key`.
+        jobs: worker processes, as for :func:`fit_many`.
+        done: called with the shapes fitted so far and their count (from ``0``).
+
+    Returns:
+        One entry per key, as :func:`fit_many` (``None`` where its shape's fit raised).
+    """
+    first: dict[Any, int] = {}
+    fitted_as: list[int] = []
+    for i, key in enumerate(keys):
+        shape = shape_key(key)
+        fitted_as.append(i if shape is None else first.setdefault(shape, i))
+    distinct = sorted(set(fitted_as))
+    total = len(distinct)
+    if done is not None:
+        done(0, total)
+    told = None if done is None else (lambda n: done(n, total))
+    fits = dict(
+        zip(
+            distinct, fit_many([keys[i] for i in distinct], tolerance, jobs, done=told), strict=True
+        )
+    )
+    out: list[list[Segment] | None] = []
+    for i, key in enumerate(keys):
+        j = fitted_as[i]
+        segs = fits[j]
+        out.append(segs if segs is None or j == i else moved(segs, keys[j], key))
+    return out

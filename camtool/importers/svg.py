@@ -18,7 +18,7 @@ from camtool.accel.collector import collect_young
 from camtool.geometry.arcfit import check_tolerance
 from camtool.geometry.chain import with_end
 from camtool.geometry.curves import merge_arcs, semi_axes_gap
-from camtool.geometry.fitpool import MIN_CURVES, CurveKey, fit_key, fit_many
+from camtool.geometry.fitpool import MIN_CURVES, CurveKey, fit_key, fit_shared, moved, shape_key
 from camtool.importers.options import MAX_COORDINATE_MM, ImportOptions, check_curve_size
 from camtool.importers.svgdoc import (
     LAYER_ATTR,
@@ -293,12 +293,15 @@ class Fitter:
 
     ``done`` holds fits made ahead (in worker processes, :func:`_prefitted`), looked up by
     the key's exact ``repr`` (every float's bits, ``-0.0`` apart from ``0.0``); any other
-    key, or one whose fit failed ahead, is fitted here, as without it.
+    key, or one whose fit failed ahead, is fitted here, as without it. A Bézier of a shape
+    fitted before is that fit moved onto it (:func:`~camtool.geometry.fitpool.fit_shared`
+    ahead, :func:`~camtool.geometry.fitpool.moved` here: the same fits either way).
     """
 
     def __init__(self, tolerance: float, done: dict[str, list[Segment]] | None = None):
         self.tolerance = tolerance
         self.done = done or {}
+        self.shapes: dict[Any, tuple[CurveKey, list[Segment]]] = {}
 
     def __call__(self, key: CurveKey) -> list[Segment]:
         """The fit of ``key`` (a new list), made ahead or here."""
@@ -306,7 +309,14 @@ class Fitter:
             segs = self.done.get(repr(key))
             if segs is not None:
                 return list(segs)
-        return fit_key(key, self.tolerance)
+        shape = shape_key(key)
+        met = self.shapes.get(shape) if shape is not None else None
+        if met is not None:
+            return moved(met[1], met[0], key)
+        segs = fit_key(key, self.tolerance)
+        if shape is not None:
+            self.shapes[shape] = (key, segs)
+        return list(segs)
 
 
 class _Recorder(Fitter):
@@ -351,8 +361,8 @@ def _prefitted(
     Only for at least :data:`~camtool.geometry.fitpool.MIN_CURVES` curves: the shapes are
     converted once with a :class:`_Recorder` to collect the curves in order (a shape that
     fails here fails again, with its message, when converted for real), then
-    :func:`~camtool.geometry.fitpool.fit_many` fits them, telling ``progress`` the
-    ``fitting`` stage (``total``: the distinct curves) as the fits come in.
+    :func:`~camtool.geometry.fitpool.fit_shared` fits each shape once, telling ``progress``
+    the ``fitting`` stage (``total``: the distinct shapes) as the fits come in.
     """
     count = sum(isinstance(seg, _CURVES) for _, segs in drawn for seg in segs or ())
     if count < MIN_CURVES:
@@ -366,9 +376,8 @@ def _prefitted(
         except Exception:  # converted again below, raising in order
             continue
     keys = list({repr(k): k for k in recorder.keys}.items())
-    progress(Step("fitting", 0, len(keys)))
-    fits = fit_many(
-        [k for _, k in keys], tolerance, done=lambda n: progress(Step("fitting", n, len(keys)))
+    fits = fit_shared(
+        [k for _, k in keys], tolerance, done=lambda n, total: progress(Step("fitting", n, total))
     )
     done = {text: segs for (text, _), segs in zip(keys, fits, strict=True) if segs is not None}
     return Fitter(tolerance, done)

@@ -22,7 +22,8 @@ STAGES = (
 )
 """The stages of ``camtool post``, in the order a job meets them (a job may skip some):
 reading the file (``total``: its drawn shapes, once counted), fitting arcs to its curves
-(``total``: distinct curves), making the contours of the shapes (``total``: shapes),
+(``total``: distinct curve shapes, copies placed apart sharing one fit), making the
+contours of the shapes (``total``: shapes),
 planning the toolpath (``total``: contours), within it offsetting the closed contours for
 the tool with OpenCASCADE (``total``: contours offset), writing the code (``total``: moves of the
 program), verifying it (``total``: blocks of code) and its error budget (``total``: the

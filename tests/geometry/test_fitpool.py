@@ -149,3 +149,47 @@ def test_switched_off_fits_serially_and_the_same(monkeypatch: pytest.MonkeyPatch
     monkeypatch.setattr(pool, "ProcessPoolExecutor", no_pool)
     keys = _keys(fitpool.MIN_CURVES)
     assert repr(fit_many(keys, 0.01, jobs=2)) == repr([fit_key(k, 0.01) for k in keys])
+
+
+def _bezier(p: tuple[tuple[float, float], ...]) -> Any:
+    """The cubic Bézier through control points ``p``, evaluated in Bernstein form (the judge)."""
+
+    def point_at(t: float) -> tuple[float, float]:
+        u = 1.0 - t
+        w = (u * u * u, 3 * u * u * t, 3 * u * t * t, t * t * t)
+        x = sum(wi * q[0] for wi, q in zip(w, p, strict=True))
+        return (x, sum(wi * q[1] for wi, q in zip(w, p, strict=True)))
+
+    return point_at
+
+
+def test_copies_of_one_shape_are_fitted_once_and_each_holds_the_tolerance(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A panel of one rounded corner placed 200 times at offsets no float adds exactly: one
+    fit, moved onto every copy, each within the tolerance of its own curve, ending on its ends."""
+    from tests.shapes import two_sided_error
+
+    corner = ((0.0, 0.0), (0.2761, 0.0), (0.5, 0.2239), (0.5, 0.5))
+    keys: list[CurveKey] = []
+    for k in range(200):
+        x, y = 0.1 * k + math.pi / 7, 123.456 - 0.37 * k
+        keys.append(("cubic", tuple((x + cx, y + cy) for cx, cy in corner)))
+    keys.append(("cubic", ((1.0, 1.0), (1.3, 1.0), (1.5, 1.2239), (1.5, 1.5))))  # another shape
+    fitted: list[CurveKey] = []
+
+    def counting(key: CurveKey, tolerance: float) -> Any:
+        fitted.append(key)
+        return fit_key(key, tolerance)
+
+    monkeypatch.setattr(fitpool, "fit_key", counting)
+    told: list[tuple[int, int]] = []
+    fits = fitpool.fit_shared(keys, 0.001, jobs=1, done=lambda n, total: told.append((n, total)))
+    assert fitted == [keys[0], keys[-1]]  # the first copy, and the other shape
+    assert told == [(0, 2), (1, 2), (2, 2)]
+    for key, segs in zip(keys, fits, strict=True):
+        assert segs is not None
+        p = key[1]
+        assert segs[0].start == p[0] and segs[-1].end == p[-1]
+        forward, backward = two_sided_error(_bezier(p), 0.0, 1.0, segs, 0.001, n=400)
+        assert forward <= 0.001 and backward <= 0.001

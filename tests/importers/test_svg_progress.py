@@ -1,8 +1,8 @@
 """The SVG importer tells its stages to a progress callback, and the drawing stays the same.
 
 A drawing built to be large enough for the fit pool (its threshold forced low) must report
-``reading`` (the file, then its shapes one by one), ``fitting`` (the distinct curves, as
-the fits come in) and ``contours`` (the shapes again), in that order; the callback must not
+``reading`` (the file, then its shapes one by one), ``fitting`` (the distinct curve shapes,
+as the fits come in) and ``contours`` (the shapes again), in that order; the callback must not
 change a float of the drawing.
 """
 
@@ -23,10 +23,13 @@ from tests.importers.test_svg_pool import _svg
 pytestmark = pytest.mark.usefixtures("accel_on")
 
 PATHS = 60
-CURVES = PATHS * 5 + 1
-"""Distinct curves of ``_svg(tmp_path, 60)``: each path has five (c, q, a with radii 3 and
-1.5, an ellipse so fitted, s, t); every ninth adds the same zero-length cubic at (10, 10),
-one key however often it is met."""
+SHAPES = PATHS * 2 + 3 + 1
+"""Distinct curve shapes of ``_svg(tmp_path, 60)``, the fits made: each path has five curves
+(c, q, a with radii 3 and 1.5, an ellipse so fitted, s, t). The random cubics (c) and the
+elliptical arcs (a) are each their own; q, s and t have the same control points relative to
+their start in every path (``q 2 3 4 -1``; ``s`` and ``t`` follow a curve of another kind,
+so their first control point is their start), one shape each; every ninth path adds the same
+zero-length cubic at (10, 10), one more."""
 
 
 def _stages(steps: list[Step]) -> list[str]:
@@ -56,9 +59,9 @@ def test_stages_of_a_large_drawing_in_order(
         (i, PATHS, "many.svg") for i in range(PATHS + 1)
     ]  # 0 once counted, then each shape as it is read
     fitting = [s for s in steps if s.stage == "fitting"]
-    assert {s.total for s in fitting} == {CURVES}
+    assert {s.total for s in fitting} == {SHAPES}
     # the start, then one step per chunk of 7 fits as the workers answer, in order
-    expected = [*range(0, CURVES, 7)[1:], CURVES]
+    expected = [*range(0, SHAPES, 7)[1:], SHAPES]
     assert [s.done for s in fitting] == [0, *expected]
     contours = [s for s in steps if s.stage == "contours"]
     assert [(s.done, s.total) for s in contours] == [(i, PATHS) for i in range(PATHS + 1)]
@@ -72,7 +75,7 @@ def test_fits_here_count_one_by_one(tmp_path: Path, monkeypatch: pytest.MonkeyPa
     steps: list[Step] = []
     read_svg(path, progress=steps.append)
     fitting = [s.done for s in steps if s.stage == "fitting"]
-    assert fitting == list(range(9 * 5 + 1 + 1))  # 9 paths × 5 curves + the zero-length one
+    assert fitting == list(range(9 * 2 + 3 + 1 + 1))  # 9 c, 9 a, the q, s, t and zero shapes
 
 
 def test_a_small_drawing_has_no_fitting_stage(tmp_path: Path) -> None:
