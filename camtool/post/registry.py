@@ -606,8 +606,12 @@ def profile_motion(profile: str) -> MotionHooks | None:
 def target_motion(name: str) -> MotionHooks | None:
     """The motion model of target ``name`` (for a qualified piece name ``"grbl:grbl"``).
 
+    Only an installed target's name: a target file's path is not read for a piece's name.
+
     Raises:
-        UsageError: no such target.
+        UsageError: no such target, or a path.
         InputError: the target is broken.
     """
+    if name.endswith(".toml") or "/" in name:
+        raise UsageError(f"{name!r} is a path, not the name of an installed target")
     return load_target(name).motion

@@ -52,7 +52,7 @@ work_area_mm = [0.0, 0.0, 100.0, 100.0]
 def test_every_builtin_with_python_is_one_folder_whose_init_builds_its_target() -> None:
     folders = {p.parent.name for p in (ROOT / "postprocessors").glob("*/__init__.py")}
     assert {name.replace("-", "_") for name in target_names()} == folders
-    assert not list((ROOT / "postprocessors").glob("*.py"))[1:]  # only the package's __init__
+    assert [p.name for p in (ROOT / "postprocessors").glob("*.py")] == ["__init__.py"]
     for name in target_names():
         module = importlib.import_module(f"camtool_postprocessors.{name.replace('-', '_')}")
         assert load_target(name) is module.TARGET
@@ -151,3 +151,22 @@ def test_a_qualified_name_borrows_another_targets_piece_exactly() -> None:
             mine, motion=dataclasses.replace(mine.motion, chords="nosuch:grbl")
         )
         library(bad).check(bad)
+
+
+def test_a_qualified_name_names_an_installed_target_not_a_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``"<target>:<piece>"`` never reads a target file given as a path."""
+    import camtool.post.registry as registry
+
+    read: list[object] = []
+    load_toml = registry.load_toml
+    monkeypatch.setattr(registry, "load_toml", lambda *a: read.append(a) or load_toml(*a))
+    grbl = load_machine("grbl")
+    target_file = tmp_path / "other.toml"
+    target_file.write_text((ROOT / "postprocessors" / "grbl" / "grbl.toml").read_text("utf-8"))
+    for name in (f"{target_file}:grbl", "../grbl.toml:grbl", "grbl.toml:grbl"):
+        asked = dataclasses.replace(grbl, motion=dataclasses.replace(grbl.motion, chords=name))
+        with pytest.raises(InputError, match="unknown chord rule"):
+            library(asked).check(asked)
+    assert read == []
