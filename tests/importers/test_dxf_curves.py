@@ -268,9 +268,8 @@ def test_property_random_spline_fit_holds_tolerance(
 def test_a_spline_is_evaluated_by_one_evaluator_in_arrays(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """ezdxf's ``BSpline.point(t)`` builds an evaluator from every control point at each call
-    (a dxf2gcode example of 1 186 SPLINEs: 2.7 M builds, 75 of its 84 s); one is built per
-    spline, and the fit's samples are asked for in arrays."""
+    """ezdxf's ``BSpline.point(t)`` builds an evaluator from every control point at each call:
+    one is built per spline, and the fit's samples are asked for in arrays."""
     from ezdxf.math import BSpline
 
     cps = [(10.0 * i, 20.0 * math.sin(i / 2.0)) for i in range(40)]

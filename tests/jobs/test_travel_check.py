@@ -130,8 +130,8 @@ def test_a_dxf_is_checked_once_read(tmp_path: Path, monkeypatch: pytest.MonkeyPa
 def test_a_dxf_is_refused_as_its_contours_are_read_before_the_other_curves_are_fitted(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """dxf2gcode's DRAAK.dxf (1 186 SPLINEs, ~400 mm) for a 10 × 7 mm machine: every spline was
-    fitted (7 s) before the refusal; it comes after the first one, which is larger already."""
+    """A drawing of many splines, the first one already larger than the travel: refused after
+    fitting that one (the others are not fitted)."""
     import camtool.importers.dxf_entities as entities
 
     def build(msp: Any) -> None:
