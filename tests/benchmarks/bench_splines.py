@@ -11,16 +11,15 @@ program exports a curve drawn in pieces) and written as a SPLINE of a DXF R2000 
 traits of dxf2gcode's ``DRAAK.dxf`` (a 1.9 MB drawing of 1 186 SPLINEs, most of them many
 spans long): thousands of multi-span splines. Built once per run into a temporary folder.
 
-Timed (best of :data:`RUNS`, wall, cached bytecode): ``camtool inspect`` of the drawing,
-and ``camtool post`` of it to pic-mmh, whose 10 × 7 mm travel refuses the page (exit 1):
-the time to reach the refusal. The goal is 5 s for each (no peer: the time a user waits
-for a drawing of this kind). DRAAK.dxf itself (not in a package this machine reaches):
-``inspect`` 84.5 s before one ezdxf evaluator per spline, 6.9 s after (quiet).
+Timed (the faster of two runs, ``bench_svg.best``; wall, cached bytecode): ``camtool
+inspect`` of the drawing, and ``camtool post`` of it to pic-mmh, whose 10 × 7 mm travel
+refuses the page (exit 1): the time to reach the refusal. The goal is 5 s for each (no
+peer: the time a user waits for a drawing of this kind). DRAAK.dxf itself (not in a package
+this machine reaches) in docs/performance.md.
 """
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import subprocess
@@ -30,10 +29,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from bench_svg import CELL_H, CELL_W, COLUMNS, ICON_MM, ROOT, RUNNER, icons
+from bench_svg import CELL_H, CELL_W, COLUMNS, ICON_MM, ROOT, best, icons
 from table import row
 
-RUNS = 2
 GOAL_S = 5.0
 
 
@@ -94,17 +92,6 @@ def build_dxf(paths: list[Path], out: Path) -> int:
     return count
 
 
-def best(cmd: list[str], env: dict[str, str]) -> dict[str, object]:
-    """The best of :data:`RUNS` runs of ``cmd`` (wall time, peak memory, exit code)."""
-    runs = []
-    for _ in range(RUNS):
-        done = subprocess.run(
-            [sys.executable, "-c", RUNNER, *cmd], capture_output=True, text=True, env=env
-        )
-        runs.append(json.loads(done.stdout))
-    return min(runs, key=lambda r: float(r["wall"]))
-
-
 def main() -> int:
     paths = icons()
     job = "DXF of {n} multi-span SPLINEs (Tango outlines, {size:.1f} MB): camtool {what}"
@@ -133,7 +120,7 @@ def main() -> int:
                 job.format(n=n, size=size, what=what),
                 f"{wall:.2f} s, {mb:.0f} MB" + ("" if ok else f" (exit {got['code']})"),
                 "—",
-                "",
+                "—",
                 None,
                 "absolute",
                 f"< {GOAL_S:g} s",
