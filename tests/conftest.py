@@ -54,3 +54,16 @@ def accel(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> bo
     on = request.param == "accel"
     monkeypatch.setenv(SWITCH, "1" if on else "0")
     return on
+
+
+@pytest.fixture(autouse=True)
+def _fit_kernels_fresh() -> None:
+    """Each test starts as a new process: the compiled curve fitter not yet loaded.
+
+    It loads once a process has fitted :data:`camtool.geometry.arcfit.KERNEL_FROM` curves;
+    without this, whether a test's fits are compiled would depend on the tests run before
+    it (the fits are the same, but the pool's tests count its chunks).
+    """
+    from camtool.geometry.arcfit import FIT_KERNELS
+
+    FIT_KERNELS.forget()

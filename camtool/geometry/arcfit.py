@@ -5,30 +5,35 @@ Design notes: docs/internals.md, ``camtool/geometry/arcfit.py``.
 
 from __future__ import annotations
 
-import functools
 import itertools
 import math
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
-from typing import TypeAlias
+from typing import Any, TypeAlias
 
 import numpy as np
 from numpy._core import umath as _umath
 from numpy.typing import ArrayLike, NDArray
 
+from camtool.accel.loader import KernelsOnDemand
+from camtool.geometry import fiterror
 from camtool.model.errors import GeometryError, InputError, UsageError
-from camtool.model.shapes import TAU, Arc, Line, Point, Segment, chord_count
+from camtool.model.shapes import TAU, Arc, Line, Point, Segment, chord_count, make_arc, make_line
 
 __all__ = [
     "CORNER_ANGLE_DEG",
+    "FIT_KERNELS",
+    "KERNEL_FROM",
     "MAX_DEPTH",
     "MAX_SWEEP",
     "FitStats",
     "chord_equivalent",
     "distances",
     "fit_curve",
+    "fit_limits",
     "fit_polyline",
     "fit_stats",
+    "segments_of",
 ]
 
 FloatArray: TypeAlias = NDArray[np.float64]
@@ -74,30 +79,6 @@ def distances(xy: ArrayLike, segments: Sequence[Segment]) -> FloatArray:
     return out
 
 
-@functools.cache
-def _unit_steps(n: int) -> FloatArray:
-    """``np.linspace(0, 1, n + 1)``, made once per ``n`` (read-only)."""
-    u = np.linspace(0.0, 1.0, n + 1)
-    u.setflags(write=False)
-    return u
-
-
-def sample_segment(seg: Segment, n: int) -> FloatArray:
-    """``(n + 1, 2)`` points evenly along ``seg``, ends included."""
-    u = _unit_steps(n)
-    out = np.empty((n + 1, 2))
-    if isinstance(seg, Line):
-        (x0, y0), (x1, y1) = seg.start, seg.end
-        out[:, 0] = x0 + u * (x1 - x0)
-        out[:, 1] = y0 + u * (y1 - y0)
-        return out
-    a = seg.start_angle + seg.sweep * u
-    r = seg.radius
-    out[:, 0] = seg.centre[0] + r * np.cos(a)
-    out[:, 1] = seg.centre[1] + r * np.sin(a)
-    return out
-
-
 def dist_segment(xy: FloatArray, seg: Segment) -> FloatArray:
     """``(N,)`` distances from ``xy`` ``(N, 2)`` to one line or arc, mm."""
     return dist_line(xy, seg.start, seg.end) if isinstance(seg, Line) else dist_arc(xy, seg)
@@ -124,38 +105,12 @@ def dist_arc(xy: FloatArray, arc: Arc) -> FloatArray:
     return np.where(inside, np.abs(np.hypot(rx, ry) - math.hypot(sx - cx, sy - cy)), ends)
 
 
-def pairwise_dist_line(xy: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
-    """``(N,)`` distance from ``xy[i]`` to the segment ``a[i]``–``b[i]`` (all ``(N, 2)``)."""
-    dx, dy = b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]  # by column: the same floats as einsum's
-    rx, ry = xy[:, 0] - a[:, 0], xy[:, 1] - a[:, 1]
-    ll = dx * dx + dy * dy
-    u = _clip((rx * dx + ry * dy) / np.where(ll > 0, ll, 1.0), 0.0, 1.0)
-    return np.hypot(rx - u * dx, ry - u * dy)
-
-
-def dist_polyline(xy: FloatArray, poly: FloatArray) -> FloatArray:
-    """``(N,)`` distances from ``xy`` ``(N, 2)`` to the polyline through ``poly`` ``(M, 2)``.
-
-    x and y are worked in separate ``(N, M-1)`` arrays (numpy loops over a last axis of 2
-    slowly); each element is the same float operations as before, in the same order
-    (``rx·dx + ry·dy``, ``dx·dx + dy·dy``: what ``einsum`` summed).
-    """
-    px, py = poly[:, 0], poly[:, 1]
-    ax, ay = px[:-1], py[:-1]
-    dx, dy = px[1:] - ax, py[1:] - ay  # (M-1,)
-    rx, ry = xy[:, 0, None] - ax, xy[:, 1, None] - ay  # (N, M-1)
-    ll = dx * dx + dy * dy
-    u = _clip((rx * dx + ry * dy) / np.where(ll > 0, ll, 1.0), 0.0, 1.0)
-    return np.hypot(rx - u * dx, ry - u * dy).min(axis=1)
-
-
 # ---------------------------------------------------------------------------- fit stats
 
 MAX_DEPTH = 40
 """Default limit of midpoint subdivisions in :func:`fit_curve` (2**-40 of the range)."""
 
 _SAMPLES = 32  # coarse intervals per curve piece; the curve is evaluated at 2*_SAMPLES + 1 params
-_SEG_SAMPLES = 16  # intervals per fitted segment for the output -> curve check
 _SAFETY = 0.97  # share of the tolerance the sampled error may use (room for sampling gaps)
 _FLAT = 0.1  # an arc whose sagitta is below _FLAT * tolerance is emitted as a Line
 
@@ -217,6 +172,15 @@ def chord_equivalent(segments: Iterable[Segment], tolerance: float) -> int:
 
 # ---------------------------------------------------------------------------- fit_curve
 
+KERNEL_FROM = 400
+"""Curve fits asked for in this process (this one's included) from which the compiled
+fitter is loaded (``camtool/accel/fitkernels.py``: the same fits; loading numba and its
+cache costs about as much as 400 plain fits of SVG curves). Below it, and with
+``CAMTOOL_ACCEL=0``, every fit is the plain one."""
+
+FIT_KERNELS = KernelsOnDemand("camtool.accel.fitkernels", KERNEL_FROM)
+"""The compiled fitter, once enough curves were fitted."""
+
 
 def fit_curve(
     point_at: Callable[[float], Point],
@@ -271,9 +235,48 @@ def fit_curve(
     tol = check_tolerance(tolerance)
     if not (math.isfinite(t0) and math.isfinite(t1) and t1 > t0):
         raise UsageError(f"curve parameters must be finite with t1 > t0, got {t0!r}, {t1!r}")
-    curve = _Curve(point_at, tangent_at, _SAFETY * tol, max_depth, tolerance, points_at)
-    pieces = _fit_piece(curve, t0, curve.point(t0), t1, curve.point(t1), 0)
-    return _merge(pieces, curve.tol)
+    kernels = FIT_KERNELS.get(1)
+    curve = _Curve(point_at, tangent_at, _SAFETY * tol, max_depth, tolerance, points_at, kernels)
+    with np.errstate(over="ignore", invalid="ignore"):  # an overflow is an error, raised
+        pieces = _fit_piece(curve, t0, curve.point(t0), t1, curve.point(t1), 0)
+    if kernels is None:
+        return _merge(pieces, curve.tol)
+    rows = [_row(seg) for p in pieces for seg in p.segs]
+    if not rows:
+        return []
+    piece = np.array([k for k, p in enumerate(pieces) for _ in p.segs], dtype=np.int64)
+    errors = np.array([p.error for p in pieces])
+    return segments_of(kernels.merge(np.array(rows), piece, errors, curve.tol))
+
+
+def _row(seg: Segment) -> tuple[float, ...]:
+    """A segment as the compiled fitter's row: kind (0 line, 1 ccw, 2 cw), start, end, centre."""
+    if isinstance(seg, Line):
+        return (0.0, *seg.start, *seg.end, 0.0, 0.0)
+    return (2.0 if seg.clockwise else 1.0, *seg.start, *seg.end, *seg.centre)
+
+
+def segments_of(rows: FloatArray) -> list[Segment]:
+    """Segments from the compiled fitter's ``(M, 7)`` rows (kind, start, end, centre), in order."""
+    return [
+        make_line((x0, y0), (x1, y1))
+        if kind == 0
+        else make_arc((x0, y0), (x1, y1), (cx, cy), kind == 2)
+        for kind, x0, y0, x1, y1, cx, cy in rows.tolist()
+    ]
+
+
+def fit_limits(tolerance: float) -> tuple[float, float]:
+    """``(error limit, flat)`` of :func:`fit_curve` at ``tolerance`` mm: 97 % of it, a tenth.
+
+    A piece fits when its sampled error is within the first; an arc whose sagitta is
+    within the second is written as a line.
+
+    Raises:
+        UsageError: ``tolerance`` is not a positive finite number.
+    """
+    tol = check_tolerance(tolerance)
+    return _SAFETY * tol, _FLAT * tol
 
 
 @dataclass(frozen=True)
@@ -292,6 +295,20 @@ class _Curve:
     max_depth: int
     user_tol: float
     points_at: PointsFn | None = None
+    kernels: Any = None  # the compiled fitter's module, for the distances (the same floats)
+
+    def line_error(self, fine: FloatArray, pa: Point, pb: Point) -> float:
+        """Largest distance of the samples ``fine`` from the chord ``pa``–``pb``, mm."""
+        if self.kernels is not None:
+            return float(self.kernels.line_error(fine, pa[0], pa[1], pb[0], pb[1]))
+        return float(fiterror.dist_line(fine, pa, pb).max())
+
+    def error(self, segs: tuple[Segment, ...], fine: FloatArray, pa: Point) -> float:
+        """:func:`~camtool.geometry.fiterror.piece_error` of ``segs`` up to :attr:`tol`."""
+        if self.kernels is not None:
+            rows = np.array([_row(s) for s in segs]).reshape(-1, 7)
+            return float(self.kernels.piece_error(rows, len(segs), fine, *pa, self.tol))
+        return fiterror.piece_error(segs, fine, pa, self.tol)
 
     def point(self, t: float) -> Point:
         return _as_point(self.point_at(t), f"curve point at t={t!r}")
@@ -312,7 +329,7 @@ class _Curve:
         """Unit tangent at ``t``, one-sided into the piece: ``span`` > 0 ahead, < 0 behind."""
         if self.tangent_at is not None:
             dx, dy = _as_point(self.tangent_at(t), f"curve tangent at t={t!r}")
-            norm = math.hypot(dx, dy)
+            norm = fiterror.norm(dx, dy)
             if norm > 1e-9 * speed:
                 return (dx / norm, dy / norm)
         for share in (1e-4, 1e-2, 0.25):  # t + 2h stays inside the piece
@@ -323,7 +340,7 @@ class _Curve:
                 (4 * p1[0] - 3 * p[0] - p2[0]) / (2 * h),
                 (4 * p1[1] - 3 * p[1] - p2[1]) / (2 * h),
             )
-            n1, n2 = math.hypot(*d1), math.hypot(*d2)
+            n1, n2 = fiterror.norm(*d1), fiterror.norm(*d2)
             best, norm = (d2, n2) if n2 >= 0.5 * n1 else (d1, n1)  # cusp: first order
             if norm > 0:
                 return (best[0] / norm, best[1] / norm)
@@ -356,7 +373,7 @@ def _fit_piece(c: _Curve, ta: float, pa: Point, tb: float, pb: Point, depth: int
     fine = c.samples(ta, pa, tb, pb)
     segs = _candidate(c, ta, pa, tb, pb, fine)
     if segs is not None:
-        error = _piece_error(segs, fine, pa, c.tol)
+        error = c.error(segs, fine, pa)
         if error <= c.tol:
             return [_Piece(segs, error)]
     if depth >= c.max_depth:
@@ -373,10 +390,10 @@ def _candidate(
     c: _Curve, ta: float, pa: Point, tb: float, pb: Point, fine: FloatArray
 ) -> tuple[Segment, ...] | None:
     """One line, or a biarc, for the piece; ``None`` when it must be split first."""
-    if float(dist_line(fine, pa, pb).max()) <= c.tol:
+    if c.line_error(fine, pa, pb) <= c.tol:
         return () if pa == pb else (Line(pa, pb),)
     vx, vy = pb[0] - pa[0], pb[1] - pa[1]
-    chord = math.hypot(vx, vy)
+    chord = fiterror.norm(vx, vy)
     if chord == 0.0:
         return None
     speed = chord / (tb - ta)
@@ -403,7 +420,10 @@ def _biarc(pa: Point, s0: Point, pb: Point, s1: Point, flat: float) -> tuple[Seg
     d = vv / (vt + math.sqrt(vt * vt + 2.0 * one_minus_cos * vv))  # stable root
     j = (0.5 * (pa[0] + pb[0] + d * (s0[0] - s1[0])), 0.5 * (pa[1] + pb[1] + d * (s0[1] - s1[1])))
     tiny = 1e-9 * math.sqrt(vv)
-    if math.dist(pa, j) <= tiny or math.dist(j, pb) <= tiny:
+    if (
+        fiterror.norm(j[0] - pa[0], j[1] - pa[1]) <= tiny
+        or fiterror.norm(pb[0] - j[0], pb[1] - j[1]) <= tiny
+    ):
         return (_arc_from(pa, s0, pb, flat),)
     first = _arc_from(pa, s0, j, flat)
     second = _arc_from(pb, (-s1[0], -s1[1]), j, flat).reversed()
@@ -413,7 +433,7 @@ def _biarc(pa: Point, s0: Point, pb: Point, s1: Point, flat: float) -> tuple[Seg
 def _arc_from(p: Point, s: Point, q: Point, flat: float) -> Segment:
     """Arc from ``p`` leaving along unit ``s`` to ``q``; a Line when its sagitta ≤ ``flat``."""
     vx, vy = q[0] - p[0], q[1] - p[1]
-    chord = math.hypot(vx, vy)
+    chord = fiterror.norm(vx, vy)
     nv = -s[1] * vx + s[0] * vy  # left normal · chord
     sin_a, cos_a = nv / chord, (s[0] * vx + s[1] * vy) / chord
     if abs(sin_a) < 1e-12:
@@ -424,30 +444,6 @@ def _arc_from(p: Point, s: Point, q: Point, flat: float) -> Segment:
         return Line(p, q)
     k = (vx * vx + vy * vy) / (2.0 * nv)  # signed radius along the left normal
     return Arc(p, q, (p[0] - k * s[1], p[1] + k * s[0]), k < 0)
-
-
-def _piece_error(
-    segs: Sequence[Segment], fine: FloatArray, pa: Point, limit: float = math.inf
-) -> float:
-    """Two-sided error between the segments and the curve samples ``fine`` ((2n+1, 2)), mm.
-
-    When the curve -> segments distance alone exceeds ``limit`` it is returned at once
-    (the error is then over ``limit`` whatever the other direction gives; the caller only
-    compares it with ``limit``). Otherwise the full two-sided error, always the same float.
-    """
-    if not segs:
-        return float(np.hypot(fine[:, 0] - pa[0], fine[:, 1] - pa[1]).max())
-    forward = float(distances(fine, segs).max())
-    if forward > limit:
-        return forward
-    # the sampled polyline lies within its chord sagitta of the curve; the sagitta of the
-    # fine chords is about a quarter of that of the coarse ones (midpoints of fine[::2])
-    coarse = fine[::2]
-    mids = fine[1::2]
-    sag = pairwise_dist_line(mids, coarse[:-1], coarse[1:]).max() if len(mids) else 0.0
-    out = np.vstack([sample_segment(s, _SEG_SAMPLES) for s in segs])
-    backward = float(dist_polyline(out, fine).max()) + 0.5 * float(sag)
-    return max(forward, backward)
 
 
 def _merge(pieces: Sequence[_Piece], tol: float) -> list[Segment]:
@@ -473,33 +469,42 @@ def _merge(pieces: Sequence[_Piece], tol: float) -> list[Segment]:
 
 
 def _join(a: Segment, b: Segment, tol: float) -> Segment | None:
-    """One segment from ``a.start`` to ``b.end`` when both are lines or arcs of one circle."""
+    """One segment from ``a.start`` to ``b.end`` when both are lines or arcs of one circle.
+
+    In :mod:`~camtool.geometry.fiterror`'s operations (the compiled fitter's twin).
+    """
     if isinstance(a, Line) and isinstance(b, Line):
         return Line(a.start, b.end)
     if not (isinstance(a, Arc) and isinstance(b, Arc)) or a.clockwise != b.clockwise:
         return None
-    if math.dist(a.centre, b.centre) > tol or abs(a.radius - b.radius) > tol:
+    (acx, acy), (bcx, bcy) = a.centre, b.centre
+    ra = fiterror.norm(a.start[0] - acx, a.start[1] - acy)
+    rb = fiterror.norm(b.start[0] - bcx, b.start[1] - bcy)
+    if fiterror.norm(bcx - acx, bcy - acy) > tol or abs(ra - rb) > tol:
         return None
     (x0, y0), (x1, y1) = a.start, b.end
     ux, uy = x1 - x0, y1 - y0
-    chord = math.hypot(ux, uy)
-    if chord <= 1e-9 * a.radius:
+    chord = fiterror.norm(ux, uy)
+    if chord <= 1e-9 * ra:
         return None
     nx, ny = -uy / chord, ux / chord
     mx, my = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
-    cx, cy = 0.5 * (a.centre[0] + b.centre[0]), 0.5 * (a.centre[1] + b.centre[1])
+    cx, cy = 0.5 * (acx + bcx), 0.5 * (acy + bcy)
     lam = (cx - mx) * nx + (cy - my) * ny  # centre on the bisector, nearest the mean centre
     arc = Arc(a.start, b.end, (mx + lam * nx, my + lam * ny), a.clockwise)
-    if abs(arc.sweep) > MAX_SWEEP + 1e-9 or abs(arc.sweep - a.sweep - b.sweep) > 1e-6:
+    sweep = fiterror.arc_sweep(arc)
+    if abs(sweep) > MAX_SWEEP + 1e-9:
+        return None
+    if abs(sweep - fiterror.arc_sweep(a) - fiterror.arc_sweep(b)) > 1e-6:
         return None
     return arc
 
 
 def _hausdorff(seg: Segment, others: Sequence[Segment]) -> float:
     """Sampled two-sided distance between ``seg`` and the union of ``others``, mm."""
-    there = float(distances(sample_segment(seg, 4 * _SEG_SAMPLES), others).max())
-    back = np.vstack([sample_segment(o, _SEG_SAMPLES) for o in others])
-    return max(there, float(dist_segment(back, seg).max()))
+    there = float(fiterror.distances(fiterror.sample(seg, 4 * fiterror.SEG_SAMPLES), others).max())
+    back = np.vstack([fiterror.sample(o) for o in others])
+    return max(there, float(fiterror.distances(back, (seg,)).max()))
 
 
 def _as_point(value: Iterable[float], what: str) -> Point:

@@ -8,9 +8,18 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable, Sequence
 from typing import Any, TypeAlias
 
+import numpy as np
+
 from camtool.accel.cores import default_jobs
 from camtool.accel.pool import map_forked
-from camtool.geometry.arcfit import fit_curve
+from camtool.geometry.arcfit import (
+    FIT_KERNELS,
+    KERNEL_FROM,
+    MAX_DEPTH,
+    fit_curve,
+    fit_limits,
+    segments_of,
+)
 from camtool.geometry.curves import (
     cubic_bezier,
     cubic_bezier_points,
@@ -21,7 +30,17 @@ from camtool.geometry.curves import (
 )
 from camtool.model.shapes import Arc, Line, Segment
 
-__all__ = ["MIN_CURVES", "CurveKey", "fit_key", "fit_many", "fit_shared", "moved", "shape_key"]
+__all__ = [
+    "FIT_KERNELS",
+    "KERNEL_FROM",
+    "MIN_CURVES",
+    "CurveKey",
+    "fit_key",
+    "fit_many",
+    "fit_shared",
+    "moved",
+    "shape_key",
+]
 
 CurveKey: TypeAlias = tuple[str, tuple[Any, ...]]
 """A curve by kind and exact arguments: ``("cubic", (p0, p1, p2, p3))``, ``("quadratic",
@@ -40,6 +59,9 @@ _BEZIERS: dict[str, tuple[Any, Any]] = {
     "quadratic": (quadratic_bezier, quadratic_bezier_points),
 }
 
+_KINDS = {"cubic": 0, "quadratic": 1, "ellipse_arc": 2}
+"""The compiled fitter's curve kinds (``fitkernels.CUBIC``, ``QUADRATIC``, ``ELLIPSE_ARC``)."""
+
 _Packed: TypeAlias = tuple[Any, ...]
 
 
@@ -51,6 +73,11 @@ def fit_key(key: CurveKey, tolerance: float) -> list[Segment]:
         UsageError, GeometryError: from :func:`~camtool.geometry.arcfit.fit_curve`.
     """
     kind, args = key
+    kernels = FIT_KERNELS.get(1)
+    if kernels is not None:
+        segs = _compiled(kernels, key, tolerance)
+        if segs is not None:
+            return segs
     if kind == "ellipse_arc":
         point_at, tangent_at = ellipse_arc(*args)
         points_at = ellipse_arc_points(*args)
@@ -59,6 +86,23 @@ def fit_key(key: CurveKey, tolerance: float) -> list[Segment]:
         point_at, tangent_at = make(args)
         points_at = make_points(args)
     return fit_curve(point_at, tangent_at, 0.0, 1.0, tolerance, points_at=points_at)
+
+
+def _compiled(kernels: Any, key: CurveKey, tolerance: float) -> list[Segment] | None:
+    """The compiled fit of the curve ``key``; ``None`` where the plain fit must answer.
+
+    ``None`` when the fit fails (a point not finite, too many subdivisions): the plain fit
+    then raises with its message. Raises UsageError for a bad tolerance, as the plain fit.
+    """
+    kind, args = key
+    par = np.array(
+        [v for a in args for v in (a if isinstance(a, tuple) else (a,))], dtype=np.float64
+    )
+    limit, flat = fit_limits(tolerance)
+    status, rows, piece, errors = kernels.curve_pieces(_KINDS[kind], par, limit, flat, MAX_DEPTH)
+    if status != kernels.OK:
+        return None
+    return segments_of(kernels.merge(rows, piece, errors, limit))
 
 
 def fit_many(
@@ -74,7 +118,8 @@ def fit_many(
         keys: the curves.
         tolerance: mm (> 0), as for :func:`fit_key`.
         jobs: worker processes; ``None``: :func:`~camtool.accel.cores.default_jobs`. With
-            1, or fewer than :data:`MIN_CURVES` keys, every fit runs in this process.
+            1, fewer than :data:`MIN_CURVES` keys, or the compiled fitter loaded
+            (:data:`FIT_KERNELS`), every fit runs in this process.
         done: called in this process with the number of keys fitted so far, as they
             come in (after each fit here, after each worker's chunk of keys with a pool);
             for a progress report, it does not change the fits.
@@ -84,7 +129,7 @@ def fit_many(
     """
     workers = default_jobs() if jobs is None else max(1, jobs)
     workers = min(workers, -(-len(keys) // _CHUNK))
-    if workers > 1 and len(keys) >= MIN_CURVES:
+    if workers > 1 and len(keys) >= MIN_CURVES and FIT_KERNELS.get(len(keys)) is None:
         packed = _in_pool(keys, tolerance, workers, done)
         if packed is not None:
             return [None if p is None else _unpack(p) for p in packed]

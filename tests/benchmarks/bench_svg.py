@@ -13,9 +13,11 @@ runs it through ``run_all.py``). It
 2. times ``camtool post BIG.svg --target grbl -o OUT`` (defaults a user would use: tolerance,
    order, origin; arcs kept as G02/G03) as a user runs it, a subprocess of
    ``python -m camtool`` with ``PYTHONPATH`` set to this tree, best of :data:`RUNS`;
-3. checks camtool's output sha256 against :data:`EXPECTED_SHA256`, the hash the pre-work code
-   (commit b3b77a5) produced for the same SVG: a mismatch means the emitted G-code changed
-   (issue 17 allows speed work only), and the row says so and is not met;
+3. prints the sha256 of camtool's output and whether it is :data:`EXPECTED_SHA256` (the
+   last known output): informative only. Issue 44 lets the output change wherever every
+   move stays within ``--tolerance`` of the drawing, which the tests check with samplers
+   of their own (``tests/importers/test_curve_tolerance.py``, svgpathtools; the compiled
+   fitter's ``tests/geometry/test_fit_compiled.py``), not by comparing bytes;
 4. times ``vpype read BIG.svg gwrite --profile gcodemm OUT`` (vpype-gcode's g-code profile
    in mm: ``G21``, absolute, one ``G00`` to each line's start then ``G01`` per vertex)
    from ``ROOT/.bench-venv/bin/vpype`` (``make bench-venv``) or ``$VPYPE``; without it the
@@ -131,8 +133,10 @@ PAGE_W, PAGE_H = 192.0, 180.0
 RUNS = 2
 """Best of this many runs of each command."""
 
-EXPECTED_SHA256 = "ed3d87fd6ec62a10c5e767711b50837f0fba24b1364e5780ef44f21e48347d47"
-"""sha256 of ``camtool post tango-213.svg --target grbl`` output at commit b3b77a5."""
+EXPECTED_SHA256 = "263cf860117a6eb78ec448c8b76103011851401476339315db9a1a0b5e6500e5"
+"""sha256 of ``camtool post tango-213.svg --target grbl`` output since each curve shape is
+fitted once and moved onto its copies (commit b805396: the copies' fits differ from fits of
+their own in the last bits; b3b77a5's output was ``ed3d87fd6ec6…``)."""
 
 SVG_NS = "http://www.w3.org/2000/svg"
 XLINK_NS = "http://www.w3.org/1999/xlink"
@@ -284,11 +288,7 @@ def main() -> int:
     )
     note = (
         f"{len(paths)} icons; {blocks} lines, {arcs} G2/G3; output "
-        + (
-            "identical to b3b77a5"
-            if same
-            else f"CHANGED (sha256 {digest[:12]}…, expected {EXPECTED_SHA256[:12]}…)"
-        )
+        + ("as last known" if same else f"changed (sha256 {digest[:12]}…; tests check tolerance)")
         + f"; camtool peak {int(cam['kib']) // 1024} MiB"  # type: ignore[call-overload]
     )
     cam_s = float(cam["wall"])  # type: ignore[arg-type]
@@ -324,7 +324,7 @@ def main() -> int:
         ratio,
         "time",
         "≤ 1.0×",
-        same and ratio <= 1.0,
+        ratio <= 1.0,
         note,
     )
     return 0

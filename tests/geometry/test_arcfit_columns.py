@@ -17,10 +17,7 @@ from camtool.geometry import arcfit
 from camtool.geometry.arcfit import (
     dist_arc,
     dist_line,
-    dist_polyline,
     distances,
-    pairwise_dist_line,
-    sample_segment,
 )
 from camtool.model.shapes import TAU, Arc, Line, Segment
 
@@ -55,33 +52,6 @@ def _old_distances(xy: np.ndarray, segments: list[Segment]) -> np.ndarray:
     return np.min([_old_dist_segment(xy, s) for s in segments], axis=0)
 
 
-def _old_pairwise(xy: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    d = b - a
-    r = xy - a
-    ll = np.einsum("ij,ij->i", d, d)
-    u = np.clip(np.einsum("ij,ij->i", r, d) / np.where(ll > 0, ll, 1.0), 0.0, 1.0)
-    return np.hypot(*(r - u[:, None] * d).T)
-
-
-def _old_polyline(xy: np.ndarray, poly: np.ndarray) -> np.ndarray:
-    a, d = poly[:-1], np.diff(poly, axis=0)
-    r = xy[:, None, :] - a[None, :, :]
-    ll = np.einsum("ij,ij->i", d, d)
-    u = np.clip(np.einsum("nij,ij->ni", r, d) / np.where(ll > 0, ll, 1.0), 0.0, 1.0)
-    gap = r - u[:, :, None] * d[None, :, :]
-    return np.min(np.hypot(gap[..., 0], gap[..., 1]), axis=1)
-
-
-def _old_sample(seg: Segment, n: int) -> np.ndarray:
-    u = np.linspace(0.0, 1.0, n + 1)
-    if isinstance(seg, Line):
-        (x0, y0), (x1, y1) = seg.start, seg.end
-        return np.column_stack([x0 + u * (x1 - x0), y0 + u * (y1 - y0)])
-    a = seg.start_angle + seg.sweep * u
-    r = seg.radius
-    return np.column_stack([seg.centre[0] + r * np.cos(a), seg.centre[1] + r * np.sin(a)])
-
-
 def _same(new: np.ndarray, old: np.ndarray) -> None:
     assert new.shape == old.shape
     assert np.array_equal(new.view(np.int64), old.view(np.int64))
@@ -112,13 +82,6 @@ def test_distance_functions_equal_the_old_ones_bit_for_bit(seed: int) -> None:
     for _ in range(500):
         scale = 10.0 ** rng.uniform(-4, 4)
         xy = _points(rng, int(rng.integers(1, 70)), scale)
-        poly = _points(rng, int(rng.integers(2, 70)), scale)
-        _same(dist_polyline(xy, poly), _old_polyline(xy, poly))
-        m = min(len(xy), len(poly) - 1)
-        _same(
-            pairwise_dist_line(xy[:m], poly[:m], poly[1 : m + 1]),
-            _old_pairwise(xy[:m], poly[:m], poly[1 : m + 1]),
-        )
         segs = _segments(rng, scale)
         _same(distances(xy, segs), _old_distances(xy, segs))
         for seg in segs:
@@ -126,8 +89,6 @@ def test_distance_functions_equal_the_old_ones_bit_for_bit(seed: int) -> None:
                 _same(dist_arc(xy, seg), _old_dist_arc(xy, seg))
             else:
                 _same(dist_line(xy, seg.start, seg.end), _old_dist_line(xy, seg.start, seg.end))
-            for n in (4, 16, 64):
-                _same(sample_segment(seg, n), _old_sample(seg, n))
 
 
 def test_linspace_equals_numpy_bit_for_bit() -> None:

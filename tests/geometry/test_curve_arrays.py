@@ -16,7 +16,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from camtool.geometry import arcfit
+from camtool.geometry import arcfit, fiterror
 from camtool.geometry.arcfit import fit_curve
 from camtool.geometry.curves import (
     cubic_bezier,
@@ -140,9 +140,9 @@ def test_piece_error_early_exit_is_exact_where_it_matters() -> None:
         )  # type: ignore[arg-type]
         if not segs:
             continue
-        full = arcfit._piece_error(segs, fine, tuple(fine[0]))
+        full = fiterror.piece_error(segs, fine, tuple(fine[0]))
         for limit in (full, full * 0.5, full * 2, float(rng.uniform(0, 2 * full + 1e-9))):
-            fast = arcfit._piece_error(segs, fine, tuple(fine[0]), limit)
+            fast = fiterror.piece_error(segs, fine, tuple(fine[0]), limit)
             if fast <= limit or full <= limit:
                 assert fast == full
             else:

@@ -7,6 +7,7 @@ for): the pool must change the speed only, so every segment must be the same, fl
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -19,6 +20,13 @@ from camtool.geometry.fitpool import CurveKey, fit_key, fit_many
 
 # what this file checks is done by the accelerated versions only (docs/architecture.md)
 pytestmark = pytest.mark.usefixtures("accel_on")
+
+
+@pytest.fixture(autouse=True)
+def _plain_fitter() -> Iterator[None]:
+    """The pool's tests keep the compiled fitter unloaded (once loaded, fits run here)."""
+    with fitpool.FIT_KERNELS.off():
+        yield
 
 
 def spy_pool(monkeypatch: pytest.MonkeyPatch) -> list[bool]:

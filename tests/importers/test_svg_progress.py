@@ -48,6 +48,9 @@ def test_stages_of_a_large_drawing_in_order(
     plain = read_svg(path)
     monkeypatch.setattr(svg_module, "MIN_CURVES", 1)
     monkeypatch.setattr(fitpool, "MIN_CURVES", 1)
+    monkeypatch.setattr(
+        fitpool.FIT_KERNELS, "_loaded", (None,)
+    )  # the pool's chunks, not compiled fits
     monkeypatch.setattr(fitpool, "_CHUNK", 7)
     steps: list[Step] = []
     drawing = read_svg(path, progress=steps.append)
