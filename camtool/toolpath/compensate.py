@@ -183,7 +183,9 @@ def _offset_jobs(
     :func:`~camtool.toolpath.offset.offset_all` (in workers of a child process that a crash
     of OpenCASCADE cannot take this one down with), and checked there against shapely's
     buffer with the plan's tolerance; a zero radius needs none, and ``--offset on`` no
-    job at all.
+    job at all. A panel repeats its parts: each shape (:func:`shape_key`) and amount is
+    offset once, and where that offset is OpenCASCADE's, checked, it is :func:`moved` onto
+    the copies; the copies of a fallback or an error are offset each.
     """
     if options.offset == "on":
         return {}
@@ -196,17 +198,82 @@ def _offset_jobs(
             jobs[i] = _OffsetJob(side, _oriented(contour, side), -r if side.inside else r)
     if r == 0:
         return jobs
-    total = len(jobs)
+    first: dict[Any, int] = {}
+    made_as = {
+        i: first.setdefault((shape_key(job.drawn), job.amount), i) for i, job in jobs.items()
+    }
+    answers = _offsets(jobs, sorted(set(made_as.values())), options, progress)
+    again = [i for i, j in made_as.items() if i not in answers and not _exact(answers[j])]
+    answers.update(_offsets(jobs, again, options, progress))
+    for i, j in made_as.items():
+        made = answers[j]
+        if i not in answers and isinstance(made, OffsetResult):
+            answers[i] = moved(made, jobs[j].drawn, jobs[i].drawn)
+    return {i: dataclasses.replace(job, answer=answers[i]) for i, job in jobs.items()}
+
+
+def _offsets(
+    jobs: dict[int, _OffsetJob], chosen: list[int], options: PlanOptions, progress: Progress
+) -> dict[int, Answer]:
+    """:func:`~camtool.toolpath.offset.offset_all` of the ``chosen`` jobs, by index."""
+    if not chosen:
+        return {}
+    total = len(chosen)
     progress(Step("offsetting", 0, total))
-    answers = offset_all(
-        [(job.drawn, job.amount) for job in jobs.values()],
+    made = offset_all(
+        [(jobs[i].drawn, jobs[i].amount) for i in chosen],
         tolerance=options.tolerance,
         done=lambda n: progress(Step("offsetting", n, total)),
     )
-    return {
-        i: dataclasses.replace(job, answer=answer)
-        for (i, job), answer in zip(jobs.items(), answers, strict=True)
-    }
+    return dict(zip(chosen, made, strict=True))
+
+
+def _exact(answer: Answer) -> bool:
+    """Whether ``answer`` is OpenCASCADE's offset, checked against shapely's buffer."""
+    return isinstance(answer, OffsetResult) and answer.fallback is None
+
+
+SHAPE_DIGITS = 9
+"""Decimals (mm) of a contour's points relative to its start that make its shape
+(:func:`shape_key`): the copies of one part in a panel are one shape, offset once."""
+
+
+def shape_key(contour: Contour) -> tuple[Any, ...]:
+    """The contour's segments relative to its start, rounded to :data:`SHAPE_DIGITS`.
+
+    Two contours of one key are translates of each other within ~1e-9 mm, far inside the
+    plan's tolerance (micrometres): the exact offset of one, :func:`moved` onto the other,
+    is the other's exact offset within that.
+    """
+    x0, y0 = contour.start
+
+    def rel(p: Point) -> tuple[float, float]:
+        return (round(p[0] - x0, SHAPE_DIGITS), round(p[1] - y0, SHAPE_DIGITS))
+
+    return tuple(
+        (rel(s.end), rel(s.centre), s.clockwise) if isinstance(s, Arc) else (rel(s.end),)
+        for s in contour.segments
+    )
+
+
+def moved(answer: OffsetResult, made: Contour, copy: Contour) -> OffsetResult:
+    """The offset ``answer`` of contour ``made`` translated onto ``copy`` of the same shape.
+
+    The pieces move by the difference of the two contours' starts and take ``copy``'s
+    layer, source, colour and linetype.
+    """
+    dx, dy = copy.start[0] - made.start[0], copy.start[1] - made.start[1]
+    pieces = tuple(
+        dataclasses.replace(
+            p.transformed(1.0, dx, dy),
+            layer=copy.layer,
+            source=copy.source,
+            colour=copy.colour,
+            linetype=copy.linetype,
+        )
+        for p in answer.pieces
+    )
+    return OffsetResult(pieces, answer.fallback)
 
 
 def _compensated(

@@ -7,6 +7,7 @@ corners into arcs of radius r and keeps concave corners sharp.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from typing import Any
@@ -16,9 +17,10 @@ import pytest
 
 from camtool.model.errors import ToolpathError
 from camtool.model.shapes import Arc, Contour, Line
+from camtool.toolpath import compensate as compensate_module
 from camtool.toolpath import offset as offset_module
 from camtool.toolpath.chain import close_gaps
-from camtool.toolpath.compensate import compensate, tight_corners
+from camtool.toolpath.compensate import compensate, shape_key, tight_corners
 from camtool.toolpath.cuts import Stage
 from camtool.toolpath.offset import offset_checked, offset_contour, offset_pieces
 from camtool.toolpath.options import PlanOptions
@@ -359,3 +361,70 @@ def test_correct_offsets_do_not_gouge() -> None:
     for offset in ("outside", "inside"):
         kinds = _kinds(_run(contours, offset, 2.5))
         assert "gouge" not in kinds and "offset-fallback" not in kinds
+
+
+# --- panels: one offset per shape ------------------------------------------------------------
+
+
+def _panel(copies: int) -> list[Contour]:
+    """``copies`` stadium slots, 30 mm right and 15 mm up of each other, each with a hole,
+    each on its own layer."""
+    out: list[Contour] = []
+    for k in range(copies):
+        dx, dy = 30.0 * k, 15.0 * k
+        for contour in (stadium(dx, dx + 20, dy, 4), circle(dx + 10, dy, 2)):
+            out.append(dataclasses.replace(contour, layer=f"P{k}", source=f"#{k}"))
+    return out
+
+
+def _counting(monkeypatch: pytest.MonkeyPatch) -> list[int]:
+    """Wrap compensate's ``offset_all``: the number of offsets asked for in each call."""
+    calls: list[int] = []
+    real = compensate_module.offset_all
+
+    def counted(items: Any, **kw: Any) -> Any:
+        calls.append(len(items))
+        return real(items, **kw)
+
+    monkeypatch.setattr(compensate_module, "offset_all", counted)
+    return calls
+
+
+def test_a_panel_offsets_each_shape_once_and_moves_it_onto_the_copies(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    calls = _counting(monkeypatch)
+    stage = _run(_panel(4), "outside", 2.0)
+    assert calls == [2]  # one slot and one hole, not eight contours
+    assert len(stage.cuts) == 8
+    for k in range(4):
+        dx, dy = 30.0 * k, 15.0 * k
+        slot, hole = (c for c in stage.cuts if c.path.layer == f"P{k}")
+        # analytic: the slot grown by r = 1 and the hole shrunk by it
+        assert slot.path.bbox() == pytest.approx((dx - 5, dy - 5, dx + 25, dy + 5))
+        assert hole.path.bbox() == pytest.approx((dx + 9, dy - 1, dx + 11, dy + 1))
+        assert slot.path.source == hole.path.source == f"#{k}"
+
+
+def test_a_moved_offset_is_the_copys_own_offset() -> None:
+    together = _run(_panel(3), "outside", 2.0).cuts
+    for k in range(3):
+        alone = _run(_panel(3)[2 * k : 2 * k + 2], "outside", 2.0).cuts
+        mine = [c for c in together if c.path.layer == f"P{k}"]
+        assert [ccw(c.path) for c in mine] == [ccw(c.path) for c in alone]
+        assert two_way_distance([c.path for c in mine], [c.path for c in alone]) <= 1e-9
+
+
+def test_the_copies_of_a_fallback_are_offset_each(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(offset_module, "_occt_offset", _occt_fails)
+    calls = _counting(monkeypatch)
+    stage = _run(_panel(3), "outside", 2.0)
+    assert calls == [2, 4]  # the shapes, then the four copies of their fallbacks
+    assert sum(f.kind == "offset-fallback" for f in stage.findings) == 6
+
+
+def test_mirrored_or_shifted_shapes_are_not_one_shape() -> None:
+    square = rect(0, 0, 10, 10)
+    assert shape_key(square) == shape_key(square.transformed(1.0, 123.456, -7.0))
+    assert shape_key(square) != shape_key(rect(0, 0, 10, 10.001))
+    assert shape_key(square) != shape_key(square.reversed())
