@@ -184,8 +184,9 @@ def _offset_jobs(
     of OpenCASCADE cannot take this one down with), and checked there against shapely's
     buffer with the plan's tolerance; a zero radius needs none, and ``--offset on`` no
     job at all. A panel repeats its parts: each shape (:func:`shape_key`) and amount is
-    offset once, and where that offset is OpenCASCADE's, checked, it is :func:`moved` onto
-    the copies; the copies of a fallback or an error are offset each.
+    offset once and its checked offset (OpenCASCADE's, or the fallback within the
+    tolerance) :func:`moved` onto the copies; where the worker gave no checked offset
+    (it died, or the check raised), the copies are offset each.
     """
     if options.offset == "on":
         return {}
@@ -203,7 +204,11 @@ def _offset_jobs(
         i: first.setdefault((shape_key(job.drawn), job.amount), i) for i, job in jobs.items()
     }
     answers = _offsets(jobs, sorted(set(made_as.values())), options, progress)
-    again = [i for i, j in made_as.items() if i not in answers and not _exact(answers[j])]
+    again = [
+        i
+        for i, j in made_as.items()
+        if i not in answers and not isinstance(answers[j], OffsetResult)
+    ]
     answers.update(_offsets(jobs, again, options, progress))
     for i, j in made_as.items():
         made = answers[j]
@@ -228,11 +233,6 @@ def _offsets(
     return dict(zip(chosen, made, strict=True))
 
 
-def _exact(answer: Answer) -> bool:
-    """Whether ``answer`` is OpenCASCADE's offset, checked against shapely's buffer."""
-    return isinstance(answer, OffsetResult) and answer.fallback is None
-
-
 SHAPE_DIGITS = 9
 """Decimals (mm) of a contour's points relative to its start that make its shape
 (:func:`shape_key`): the copies of one part in a panel are one shape, offset once."""
@@ -242,8 +242,8 @@ def shape_key(contour: Contour) -> tuple[Any, ...]:
     """The contour's segments relative to its start, rounded to :data:`SHAPE_DIGITS`.
 
     Two contours of one key are translates of each other within ~1e-9 mm, far inside the
-    plan's tolerance (micrometres): the exact offset of one, :func:`moved` onto the other,
-    is the other's exact offset within that.
+    plan's tolerance (micrometres): the checked offset of one, :func:`moved` onto the
+    other, is the other's offset within that tolerance and those nanometres.
     """
     x0, y0 = contour.start
 

@@ -415,12 +415,40 @@ def test_a_moved_offset_is_the_copys_own_offset() -> None:
         assert two_way_distance([c.path for c in mine], [c.path for c in alone]) <= 1e-9
 
 
-def test_the_copies_of_a_fallback_are_offset_each(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_fallback_is_moved_onto_the_copies_too(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(offset_module, "_occt_offset", _occt_fails)
     calls = _counting(monkeypatch)
     stage = _run(_panel(3), "outside", 2.0)
-    assert calls == [2, 4]  # the shapes, then the four copies of their fallbacks
-    assert sum(f.kind == "offset-fallback" for f in stage.findings) == 6
+    assert calls == [2]
+    assert sum(f.kind == "offset-fallback" for f in stage.findings) == 6  # one per contour
+    for k in range(3):
+        dx, dy = 30.0 * k, 15.0 * k
+        _slot, hole = (c for c in stage.cuts if c.path.layer == f"P{k}")
+        radii = np.hypot(*(segment_samples(hole.path.segments) - (dx + 10, dy)).T)
+        assert np.all(np.abs(radii - 1.0) <= TOL)  # the hole of radius 2 shrunk by 1
+
+
+def test_without_a_checked_offset_the_copies_are_offset_each(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    calls: list[int] = []
+    real = compensate_module.offset_all
+
+    def worker_died(items: Any, **kw: Any) -> Any:
+        calls.append(len(items))
+        if len(calls) == 1:
+            return [ToolpathError("the offsets' worker died (SIGSEGV)")] * len(items)
+        return real(items, **kw)
+
+    monkeypatch.setattr(compensate_module, "offset_all", worker_died)
+    stage = _run(_panel(3), "outside", 2.0)
+    assert calls == [2, 4]  # the two shapes, then the four copies of theirs
+    assert len(stage.cuts) == 6
+    for k in range(3):
+        dx, dy = 30.0 * k, 15.0 * k
+        slot, hole = (c for c in stage.cuts if c.path.layer == f"P{k}")
+        assert slot.path.bbox() == pytest.approx((dx - 5, dy - 5, dx + 25, dy + 5), abs=TOL)
+        assert hole.path.bbox() == pytest.approx((dx + 9, dy - 1, dx + 11, dy + 1), abs=TOL)
 
 
 def test_mirrored_or_shifted_shapes_are_not_one_shape() -> None:
