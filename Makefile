@@ -34,9 +34,11 @@ lint: $(STAMP)
 typecheck: $(STAMP)
 	$(BIN)/mypy
 
+# The suite in one worker process per core (pytest-xdist; `.venv/bin/pytest` alone runs it
+# in this process, as for a single file).
 unit: $(STAMP)
 	$(BIN)/python tests/corpus/fetch_corpus.py
-	$(BIN)/pytest
+	$(BIN)/pytest -n auto
 
 test: lint typecheck unit
 

@@ -2,7 +2,31 @@
 
 from __future__ import annotations
 
+import json
+from typing import Any
+
 import pytest
+
+_CORPUS_RUNS: list[dict[str, Any]] = []
+"""Under pytest-xdist (``make test``): each worker's corpus cases, as it sent them
+(tests/corpus/conftest.py, ``pytest_sessionfinish``). Kept here: the controller, which
+collects nothing, loads this conftest only."""
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_testnodedown(node: Any, error: Any) -> None:
+    """A pytest-xdist worker ended: keep the corpus cases it sent."""
+    sent = getattr(node, "workeroutput", {}).get("camtool_corpus")
+    if sent:
+        _CORPUS_RUNS.append(json.loads(sent))
+
+
+def pytest_terminal_summary(terminalreporter: Any) -> None:
+    """Under pytest-xdist, the corpus summary of every worker's cases."""
+    if _CORPUS_RUNS:
+        from tests.corpus.conftest import print_summary
+
+        print_summary(terminalreporter, _CORPUS_RUNS)
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:

@@ -341,18 +341,64 @@ def outcome_for(rel: str, target: str) -> Outcome:
     return _OUTCOMES[key]
 
 
-def pytest_terminal_summary(terminalreporter: Any) -> None:
-    """Print the corpus counts and keep them in this run's results.json (path printed)."""
+def _this_run() -> dict[str, Any] | None:
+    """This process's cases as ``results.json`` keeps them, its slowest run and its folder."""
     if not _OUTCOMES:
-        return
-    counts = Counter(o.status for o in _OUTCOMES.values())
-    by_target: dict[str, Counter[str]] = {}
-    for o in _OUTCOMES.values():
-        by_target.setdefault(o.target, Counter())[o.status] += 1
+        return None
     slowest = max((r for o in _OUTCOMES.values() for r in o.runs), key=lambda r: r.seconds)
+    return {
+        "folder": str(out_root()),
+        "slowest": [slowest.seconds, slowest.command()],
+        "results": {
+            "mode": MODE,
+            "counts": dict(Counter(o.status for o in _OUTCOMES.values())),
+            "cases": [
+                {
+                    "file": o.rel,
+                    "target": o.target,
+                    "status": o.status,
+                    "runs": [
+                        {"args": r.args, "rc": r.rc, "s": round(r.seconds, 2)} for r in o.runs
+                    ],
+                    "problems": o.problems,
+                }
+                for o in _OUTCOMES.values()
+            ],
+        },
+    }
+
+
+def pytest_sessionfinish(session: pytest.Session) -> None:
+    """Keep this process's cases in its folder's ``results.json``; a worker also sends them."""
+    run = _this_run()
+    if run is None:
+        return
+    (Path(run["folder"]) / "results.json").write_text(json.dumps(run["results"], indent=1) + "\n")
+    workeroutput = getattr(session.config, "workeroutput", None)
+    if workeroutput is not None:
+        workeroutput["camtool_corpus"] = json.dumps(run)
+
+
+def pytest_terminal_summary(terminalreporter: Any) -> None:
+    """Print the corpus counts of this process and where they are kept (not under xdist:
+    its workers' cases are printed by tests/conftest.py with :func:`print_summary`)."""
+    mine = _this_run()
+    if mine is not None and not hasattr(terminalreporter.config, "workerinput"):
+        print_summary(terminalreporter, [mine])
+
+
+def print_summary(terminalreporter: Any, runs: list[dict[str, Any]]) -> None:
+    """The counts of the cases of ``runs`` (each a :func:`_this_run`), by target, the slowest
+    run, and the folders that keep them."""
+    cases = [case for run in runs for case in run["results"]["cases"]]
+    counts = Counter(case["status"] for case in cases)
+    by_target: dict[str, Counter[str]] = {}
+    for case in cases:
+        by_target.setdefault(case["target"], Counter())[case["status"]] += 1
+    seconds, command = max(run["slowest"] for run in runs)
     terminalreporter.write_sep("-", f"camtool corpus ({MODE})")
     terminalreporter.write_line(
-        f"{len(_OUTCOMES)} cases: {counts['first-try']} ok first try, "
+        f"{len(cases)} cases: {counts['first-try']} ok first try, "
         f"{counts['after-remedy']} ok after the suggested remedy, "
         f"{counts['refused']} refused (nothing to cut), {counts['failed']} failed"
     )
@@ -363,21 +409,6 @@ def pytest_terminal_summary(terminalreporter: Any) -> None:
                 f"  {target:14s} {c['first-try']:4d} first try {c['after-remedy']:4d} "
                 f"after remedy {c['refused']:4d} refused {c['failed']:4d} failed"
             )
-    terminalreporter.write_line(f"slowest run {slowest.seconds:.1f} s: {slowest.command()}")
-    results = {
-        "mode": MODE,
-        "counts": dict(counts),
-        "cases": [
-            {
-                "file": o.rel,
-                "target": o.target,
-                "status": o.status,
-                "runs": [{"args": r.args, "rc": r.rc, "s": round(r.seconds, 2)} for r in o.runs],
-                "problems": o.problems,
-            }
-            for o in _OUTCOMES.values()
-        ],
-    }
-    kept = out_root() / "results.json"
-    kept.write_text(json.dumps(results, indent=1) + "\n")
-    terminalreporter.write_line(f"cases and programs kept in {kept.parent}")
+    terminalreporter.write_line(f"slowest run {seconds:.1f} s: {command}")
+    for run in runs:
+        terminalreporter.write_line(f"cases and programs kept in {run['folder']}")
