@@ -34,11 +34,12 @@ lint: $(STAMP)
 typecheck: $(STAMP)
 	$(BIN)/mypy
 
-# The suite in one worker process per core (pytest-xdist; `.venv/bin/pytest` alone runs it
-# in this process, as for a single file).
+# The suite in one worker process per core, at most 4 (pytest-xdist; each worker loads its
+# own OpenCASCADE, numba and matplotlib); `.venv/bin/pytest` alone runs it in
+# this process, as for a single file.
 unit: $(STAMP)
 	$(BIN)/python tests/corpus/fetch_corpus.py
-	$(BIN)/pytest -n auto
+	$(BIN)/pytest -n auto --maxprocesses 4
 
 test: lint typecheck unit
 
