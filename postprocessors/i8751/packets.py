@@ -1,6 +1,6 @@
 """The byte stream of the 8751 serial stepper interface: records, packets, dump.
 
-Source: Intf8751 §3.7 (reference/Intf8751.md, thesis lines 4077–4165,
+Source: Intf8751 §3.7 (thesis lines 4077–4165,
 4343–4415) and requirements R2–R6. The PC sends, in raw binary (``CHR$``)::
 
 Design notes: docs/internals.md, ``postprocessors/i8751/packets.py``.

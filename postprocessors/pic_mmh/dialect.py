@@ -1,6 +1,6 @@
 """The ``pic-mmh`` dialect: the PIC18F8720 controller of the GMM micro machine tool.
 
-Source: UNAM-GMM §3 (reference/UNAM-GMM.md), requirements S000-01…08. Example
+Source: UNAM-GMM §3, requirements S000-01…08. Example
 block, verbatim from the thesis (L1731)::
 
 Design notes: docs/internals.md, ``postprocessors/pic_mmh/dialect.py``.
