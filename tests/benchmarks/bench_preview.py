@@ -121,10 +121,13 @@ PLATE_ARGS = [
 ]
 
 EXPECTED_SHA256 = {
-    "part": "bca14f5790eda860fc6fdc74317f9c2b333baebf7dd6ee022b5582d7ecc91a21",
-    "plate": "c18812e386da868e1c9da60f2e93cc096f1cee39cacb0ffefc2734c4cd32002d",
+    "part": "85c3cc13e4b7ba615dd29d590268d3f6161958518119c837f7b7fffbb9cfbf83",
+    "plate": "1e0d0fc824a82d415e603ff2ff27c7d9210d2a066c3b4d5f262ba096ed4c57f6",
 }
-"""sha256 of the G-code the pre-work code (b3b77a5) wrote for each job."""
+"""sha256 of the G-code each job writes since 28fa305: the pre-work code's (b3b77a5:
+``bca14f57…`` and ``c18812e3…``) with one header line more, ``(placement: scale 1, shift
+X1.5 Y1.5 mm)``, which tells ``verify --against`` how the drawing was placed; the first-parent
+history from b3b77a5 changes no other byte of either (bisected 25 Nov 2026)."""
 
 RUNNER = r"""
 import json, os, resource, subprocess, sys, time
@@ -241,7 +244,7 @@ def main() -> None:
             digest = sha256(work / code)
             same = digest == EXPECTED_SHA256[name]
             wall, mb = float(m["wall"]), int(m["kib"]) / 1024.0
-            note = "G-code identical to b3b77a5" if same else f"G-code DIFFERS: sha256 {digest}"
+            note = "G-code as recorded (28fa305)" if same else f"G-code DIFFERS: sha256 {digest}"
             if name == "part":
                 row(
                     title,
