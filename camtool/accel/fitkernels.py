@@ -216,19 +216,7 @@ def _biarc(
 def _dist_row(x: float, y: float, row: Any) -> float:
     """``fiterror.dist_line``/``dist_arc`` of one point to one segment row."""
     if row[0] == LINE:
-        ax, ay = row[1], row[2]
-        dx = row[3] - ax
-        dy = row[4] - ay
-        rx = x - ax
-        ry = y - ay
-        ll = dx * dx + dy * dy
-        if ll > 0:
-            u = min(max((rx * dx + ry * dy) / ll, 0.0), 1.0)
-            ex = rx - u * dx
-            ey = ry - u * dy
-        else:
-            ex, ey = rx, ry
-        return math.sqrt(ex * ex + ey * ey)
+        return _seg_dist_line(x, y, (row[1], row[2]), (row[3], row[4]))
     cx, cy = row[5], row[6]
     sx, sy, ex, ey = row[1], row[2], row[3], row[4]
     ux = sx - cx

@@ -10,9 +10,9 @@ runs it, ``camtool batch in -t grbl -o OUT --force --jobs J`` in a subprocess, o
 2). Both output trees must be byte-identical, and identical to the recorded tree: the
 SHA-256 of the sorted (path, bytes) pairs is compared with :data:`EXPECTED_SHA256` (the
 outputs of commit b3b77a5, before issue 17, with the two deliberate changes since), so a
-mismatch means some output changed. The pre-work code refused 13 of these files that camtool now writes
-(:data:`WRITTEN_SINCE`); the comparison leaves them out and the row counts them. Without
-the corpus the row says how to get it.
+mismatch means some output changed. The pre-work code refused 13 of these files that
+camtool now writes (:data:`WRITTEN_SINCE`); the comparison leaves them out and the row
+counts them. Without the corpus the row says how to get it.
 
 The 13: LibreCAD parts whose chained arcs start and end at radii a few µm apart, which
 b3b77a5 refused ("an arc of radius 11.7463 mm cannot be written for grbl ... write more

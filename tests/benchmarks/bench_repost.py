@@ -86,6 +86,7 @@ COPIES = 17
 BIG_COPIES = 170
 """The second row's program: the examples 170 times (10.9 MB, 338 981 lines), where the
 cost per line decides, not start-up (issue 44)."""
+BIG_JOB = "re-post 10.9 MB G-code (338 981 lines) → linuxcnc"
 INPUT_SHA256 = "34f5a0763a3aecd31b31e4c4eabe79f2d86f450f9d7110efc8ad5e899182a7d6"
 OUTPUT_SHA256 = "066d5e41f138562e7c79a351cc69ea781c4c429d084177a6a768707fdeed5e28"
 """camtool re-posting the program to linuxcnc since 35fbe3b: the pre-work output (b3b77a5,
@@ -172,23 +173,20 @@ def peak_kib(cmd: list[str], env: dict[str, str]) -> int:
     return int(done.stdout.split()[-1])
 
 
+def missing(job: str, note: str) -> None:
+    """The row of ``job`` when what it needs is missing (``note`` says what to run)."""
+    row(job, "—", "LinuxCNC rs274", "—", None, "time", f"≤ {GOAL:g}×", False, note=note)
+
+
 def main() -> None:
     """Build the program, time camtool and rs274 on it, print one row."""
     job = "re-post 1.09 MB G-code (33 899 lines) → linuxcnc"
     with tempfile.TemporaryDirectory() as tmp:
         big = build_program(Path(tmp) / "big.ngc")
         if big is None:
-            row(
-                job,
-                "—",
-                "LinuxCNC rs274",
-                "—",
-                None,
-                "time",
-                f"≤ {GOAL:g}×",
-                False,
-                note="corpus not fetched: run `make corpus` (tests/corpus/fetch_corpus.py)",
-            )
+            fetch = "corpus not fetched: run `make corpus` (tests/corpus/fetch_corpus.py)"
+            for name in (job, BIG_JOB):
+                missing(name, fetch)
             return
         data = big.read_bytes()
         same_input = hashlib.sha256(data).hexdigest() == INPUT_SHA256
@@ -255,22 +253,12 @@ def big_row(small_s: float) -> None:
     camtool's output to its end instead, and the note gives the time against the 1 MB
     row's (10× the program: linear is ~10× the time less start-up).
     """
-    job = "re-post 10.9 MB G-code (338 981 lines) → linuxcnc"
+    job = BIG_JOB
     rs = rs274_command()
     with tempfile.TemporaryDirectory() as tmp:
         big = build_program(Path(tmp) / "big.ngc", copies=BIG_COPIES)
         if big is None or rs is None:
-            row(
-                job,
-                "—",
-                "LinuxCNC rs274",
-                "—",
-                None,
-                "time",
-                f"≤ {GOAL:g}×",
-                False,
-                note="corpus or rs274 missing: run `make corpus`",
-            )
+            missing(job, "corpus or rs274 missing: run `make corpus`")
             return
         size = big.stat().st_size
         out = Path(tmp) / "out.ngc"
