@@ -19,7 +19,10 @@ from hypothesis import strategies as st
 from camtool.verify import dda
 from camtool.verify import interpolators as itp
 
-pytestmark = pytest.mark.skipif(dda.compiled() is None, reason="numba not installed")
+pytestmark = pytest.mark.skipif(
+    dda.compiled() is None,
+    reason="compiled kernels off (CAMTOOL_ACCEL=0; CI's first run tests them) or numba missing",
+)
 
 
 @pytest.fixture
