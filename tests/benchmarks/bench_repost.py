@@ -119,7 +119,11 @@ def build_program(dest: Path, copies: int = COPIES) -> Path | None:
 
 
 def rs274_command() -> tuple[list[str], dict[str, str], str] | None:
-    """rs274's command line (without the program), environment and version, or None."""
+    """rs274's command line (without the program), environment and version, or None.
+
+    ``HOME`` is a folder of this process's own: LinuxCNC 2.9 keeps its tool table in
+    ``$HOME/.tool.mmap``, which a running LinuxCNC (or another rs274) shares.
+    """
     manifest = CORPUS / "manifest.json"
     if not manifest.exists():
         return None
@@ -127,7 +131,8 @@ def rs274_command() -> tuple[list[str], dict[str, str], str] | None:
     if entry is None or not (CORPUS / entry["exe"]).exists():
         return None
     libs = os.pathsep.join(str(CORPUS / d) for d in entry["ld_library_path"])
-    env = dict(os.environ, LD_LIBRARY_PATH=libs)
+    home = tempfile.mkdtemp(prefix="camtool-bench-rs274-home-")
+    env = dict(os.environ, LD_LIBRARY_PATH=libs, HOME=home)
     cmd = [str(CORPUS / entry["exe"]), "-t", str(CORPUS / entry["tool_table"]), "-g"]
     debs = sorted((CORPUS / "debs").glob("linuxcnc-uspace_*.deb"))
     version = debs[-1].name.split("_")[1] if debs else "version unknown"

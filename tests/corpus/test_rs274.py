@@ -47,18 +47,24 @@ ROUND_MM = 0.0005 + 1e-9  # the linuxcnc dialect writes 3 decimals
 
 
 def rs274(program: Path, tool_table: Path | None = None) -> subprocess.CompletedProcess[str]:
-    """Run rs274 in batch mode on PROGRAM (``tool_table``: the manifest's, with one tool)."""
+    """Run rs274 in batch mode on PROGRAM (``tool_table``: the manifest's, with one tool).
+
+    LinuxCNC 2.9 shares its tool table through ``$HOME/.tool.mmap``: two rs274 at once (the
+    suite's workers) would read each other's tools. Each run gets a ``HOME`` of its own.
+    """
     assert MANIFEST is not None
     entry = MANIFEST["rs274"]
-    env = dict(
-        os.environ,
-        LD_LIBRARY_PATH=os.pathsep.join(str(CORPUS / d) for d in entry["ld_library_path"]),
-    )
     table = tool_table if tool_table is not None else CORPUS / entry["tool_table"]
     cmd = [str(CORPUS / entry["exe"]), "-t", str(table), "-g"]
-    return subprocess.run(
-        [*cmd, str(program)], capture_output=True, text=True, env=env, timeout=120, check=False
-    )
+    with tempfile.TemporaryDirectory(prefix="camtool-rs274-home-") as home:
+        env = dict(
+            os.environ,
+            HOME=home,
+            LD_LIBRARY_PATH=os.pathsep.join(str(CORPUS / d) for d in entry["ld_library_path"]),
+        )
+        return subprocess.run(
+            [*cmd, str(program)], capture_output=True, text=True, env=env, timeout=120, check=False
+        )
 
 
 def rs274_problem() -> str | None:
