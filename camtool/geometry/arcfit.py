@@ -61,6 +61,13 @@ def check_tolerance(tolerance: float) -> float:
     return tol
 
 
+# Two sets of exact distances, on purpose: these (hypot, atan2) are the polyline fit's and
+# the tests' judge, their floats held by tests/geometry/test_arcfit_columns.py; the curve
+# fit measures with :mod:`camtool.geometry.fiterror` (square roots, cross products), whose
+# floats the compiled fitter reproduces. One set for both would move the polyline fit's
+# decisions at the tolerance by an ulp.
+
+
 def distances(xy: ArrayLike, segments: Sequence[Segment]) -> FloatArray:
     """Distance from each point to the nearest of ``segments`` (exact for lines and arcs).
 
