@@ -573,7 +573,9 @@ def spline_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool]
         return _xy(evaluator.derivative(t, 1)[1])
 
     def points_at(ts: FloatArray) -> FloatArray:
-        return np.array([(v.x, v.y) for v in evaluator.points(ts)], dtype=np.float64)
+        # the (x, y, z) of each Vec3 in a row, without a tuple per point
+        xyz = itertools.chain.from_iterable(evaluator.points(ts))
+        return np.fromiter(xyz, np.float64, count=3 * len(ts)).reshape(-1, 3)[:, :2]
 
     gap = distance(point_at(t0), point_at(t1))
     closed = gap <= _RELATIVE * size or (bool(entity.closed) and gap <= tolerance)

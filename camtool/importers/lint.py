@@ -483,10 +483,15 @@ def duplicates(contours: Sequence[Contour], tolerance: float) -> list[Finding]:
     segs = [(s, k) for k, c in enumerate(contours) for s in c.segments]
     if len(segs) < 2:
         return []
-    boxes = [box(*_grow(s.bbox(), tolerance)) for s, _ in segs]
-    pairs = np.transpose(STRtree(boxes).query(boxes, predicate="intersects"))
+    grown = np.array([s.bbox() for s, _ in segs], dtype=np.float64)
+    grown[:, :2] -= tolerance
+    grown[:, 2:] += tolerance
+    boxes = box(grown[:, 0], grown[:, 1], grown[:, 2], grown[:, 3])
+    found = STRtree(boxes).query(boxes, predicate="intersects")
+    found = found[:, found[0] < found[1]]
+    found = found[:, np.lexsort((found[1], found[0]))]  # by i, then j
     groups: dict[tuple[int, int, str], list[Any]] = {}
-    for i, j in sorted((int(i), int(j)) for i, j in pairs if i < j):
+    for i, j in zip(found[0].tolist(), found[1].tolist(), strict=True):
         (a, ka), (b, kb) = segs[i], segs[j]
         if _same(a, b, tolerance):
             kind, length, where = "duplicate", a.length, a.start
@@ -584,10 +589,6 @@ def _ccw_span(arc: Arc) -> tuple[float, float]:
     sweep = arc.sweep
     start = arc.start_angle if sweep > 0 else arc.start_angle + sweep
     return start % TAU, abs(sweep)
-
-
-def _grow(b: tuple[float, float, float, float], d: float) -> tuple[float, float, float, float]:
-    return (b[0] - d, b[1] - d, b[2] + d, b[3] + d)
 
 
 def _kind(s: Segment) -> str:
