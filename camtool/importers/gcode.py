@@ -40,12 +40,16 @@ _CENTRE_LETTERS = {"xy": ("I", "J"), "zx": ("K", "I"), "yz": ("J", "K")}
 _PLANE_NAMES = {"xy": "XY plane (G17)", "zx": "ZX plane (G18)", "yz": "YZ plane (G19)"}
 
 
-def read_gcode(path: str | Path, *, source_name: str | None = None) -> Program:
+def read_gcode(
+    path: str | Path, *, source_name: str | None = None, feed_mm_min: float | None = None
+) -> Program:
     """Read a G-code file (``.ngc``, ``.nc``, ``.tap``, ``.gcode`` …) into a program.
 
     Args:
         path: the file. UTF-8 (with or without BOM), else read as Latin-1.
         source_name: the name messages give the file (default: ``path``).
+        feed_mm_min: the feed of cuts before the program's first F word (``post
+            --feed``, which then sets every cut's feed); ``None``: such a cut is refused.
 
     Returns:
         The moves in absolute mm, Y up, feeds in mm/min, with the warnings for
@@ -62,20 +66,21 @@ def read_gcode(path: str | Path, *, source_name: str | None = None) -> Program:
         text = _decoded(path.read_bytes())  # the bytes go as soon as they are text
     except OSError as exc:
         raise InputError(f"{source}: cannot read the file ({exc.strerror or exc})") from exc
-    return parse_gcode(text, source=source)
+    return parse_gcode(text, source=source, feed_mm_min=feed_mm_min)
 
 
-def read_gcode_bytes(data: bytes, *, source: str) -> Program:
+def read_gcode_bytes(data: bytes, *, source: str, feed_mm_min: float | None = None) -> Program:
     """Read a G-code file given as its bytes (as :func:`read_gcode` reads the file's).
 
     Args:
         data: the file's bytes: UTF-8 (with or without BOM), else read as Latin-1.
         source: the name messages give the file.
+        feed_mm_min: as :func:`read_gcode`'s.
 
     Raises:
         InputError: as :func:`parse_gcode`.
     """
-    return parse_gcode(_decoded(data), source=source)
+    return parse_gcode(_decoded(data), source=source, feed_mm_min=feed_mm_min)
 
 
 def _decoded(data: bytes) -> str:
@@ -103,12 +108,14 @@ def _lines(text: str) -> Iterator[tuple[str, bool]]:
     yield text[start:], True
 
 
-def parse_gcode(text: str, *, source: str) -> Program:
+def parse_gcode(text: str, *, source: str, feed_mm_min: float | None = None) -> Program:
     """Read G-code text into a program (the rules are in this module's docstring).
 
     Args:
         text: the program; lines end with LF, CR LF or CR.
         source: the name messages give it; line numbers are 1-based file lines.
+        feed_mm_min: the feed of cuts before the first F word, mm/min (> 0), as
+            :func:`read_gcode`'s; ``None``: such a cut is refused.
 
     Raises:
         InputError: O-words, ``#`` parameters, ``[ ]`` expressions, G41/G42,
@@ -122,7 +129,7 @@ def parse_gcode(text: str, *, source: str) -> Program:
     Plain lines take the fast path (:meth:`_Reader.plain`, no word objects) unless
     ``CAMTOOL_ACCEL=0``; :func:`parse_gcode_slow` is the reference, with the same result.
     """
-    return _parse(text, source, plain=accel.enabled())
+    return _parse(text, source, plain=accel.enabled(), feed_mm_min=feed_mm_min)
 
 
 def parse_gcode_slow(text: str, *, source: str) -> Program:
@@ -135,11 +142,12 @@ def parse_gcode_slow(text: str, *, source: str) -> Program:
     return _parse(text, source, plain=False)
 
 
-def _parse(text: str, source: str, *, plain: bool) -> Program:
+def _parse(text: str, source: str, *, plain: bool, feed_mm_min: float | None = None) -> Program:
     """:func:`parse_gcode`; ``plain``: take the plain-line path where it applies."""
     lines = _lines(text)
     rest = (raw for raw, _ in lines)  # the lines after the program's end
     reader = _Reader(source)
+    reader.first_feed = feed_mm_min
     opened = False  # a '%' line before the first block: the next '%' ends the program
     ended = False
     plain_words = PLAIN_WORDS.findall
@@ -196,6 +204,7 @@ class _Reader(PlainLines):
         self.inch = False
         self.units_seen = False
         self.feed_mm_min: float | None = None
+        self.first_feed: float | None = None  # the feed before the first F word (--feed)
         self.coord: str | None = None
         self.home = ""
         self.contour = 1
@@ -327,6 +336,9 @@ class _Reader(PlainLines):
         if motion is not None:
             self.motion = None if motion == "G80" else motion
         home = w.g_name("nonmodal")
+        if home == "G53":
+            self._machine_coordinates(w.args)
+            return used
         if home in ("G28", "G30"):
             if axes and motion not in (None, "G80"):
                 raise InputError(
@@ -391,9 +403,12 @@ class _Reader(PlainLines):
         return tz if "Z" in args and tz is not None and tz != self.z else None
 
     def _feed(self, name: str) -> float:
+        if self.feed_mm_min is None and self.first_feed is not None:
+            return self.first_feed  # post --feed: it sets every cut's feed
         if self.feed_mm_min is None:
             raise InputError(
-                f"{self.where()}: {name} before any F word; set the feed (e.g. F100) first"
+                f"{self.where()}: {name} before any F word; set the feed (e.g. F100) first, "
+                "or give the feed with post --feed"
             )
         if self.feed_mm_min == 0:
             raise InputError(f"{self.where()}: {name} with feed F0; set a feed above 0")
@@ -424,6 +439,10 @@ class _Reader(PlainLines):
         if gives_xy and not self.positioned and z is not None and (tx, ty) == (self.x, self.y):
             self._first_positioning(name, tx, ty, tz, z)
             return
+        if name != "G0":
+            self._feed(name)  # refused without a feed, as LinuxCNC refuses it
+        if not gives_xy and z is None and not self.positioned:
+            return  # moves nowhere, and XY is only assumed: a move there would be a guess
         self.positioned = self.positioned or gives_xy
         if name == "G0":
             self._push(Rapid(tx, ty, z), tx, ty, tz)
@@ -587,6 +606,23 @@ class _Reader(PlainLines):
         ux, uy = (end[0] - start[0]) / chord, (end[1] - start[1]) / chord
         mx, my = (start[0] + end[0]) / 2, (start[1] + end[1]) / 2
         return mx + side * h * uy, my - side * h * ux
+
+    def _machine_coordinates(self, args: dict[str, Word]) -> None:
+        """G53 without axis words: no move (as LinuxCNC); with them, refused.
+
+        A G53 move goes to a position in machine coordinates, which camtool does not know,
+        so it is refused rather than dropped (a dropped retract would leave the next rapid at
+        cutting depth). Without axis words (FreeCAD's Centroid post begins ``G53 G00 G17``)
+        the block moves nowhere; its other codes are read as usual.
+        """
+        words = [str(args[letter]) for letter in "XYZIJKR" if letter in args]
+        if words:
+            raise InputError(
+                f"{self.where()}: G53 {' '.join(words)} moves in machine coordinates, which "
+                "camtool does not know; write the program in part coordinates (e.g. a "
+                "retract as G0 Z with the work offset's clearance height)"
+            )
+        self.notes.add("G53", self.line, "G53 without axis words moves nowhere: read as no move")
 
     def _home(self, name: str, args: dict[str, Word]) -> None:
         """G28/G30: a rapid to the intermediate point, then the axes are unknown.

@@ -131,13 +131,7 @@ G_CODES = MappingProxyType(
             "G54.1 (extended work offsets G54.1 P…) is not supported; use one of G54–G59, "
             "which camtool reads as the part zero",
         ),
-        (
-            "G53",
-            "nonmodal",
-            "error",
-            "G53 moves in machine coordinates, which camtool does not know; "
-            "write the program in part coordinates",
-        ),
+        ("G53", "nonmodal", "read", ""),
         (
             "G5 G5.1 G5.2 G5.3",
             "motion",
@@ -169,7 +163,7 @@ M_CODES = MappingProxyType(
 """M codes by number, read-only."""
 
 READ_CODES = (
-    "G0 G1 G2 G3 G4 G17 G18 G19 G20 G21 G28 G30 G80 G90 G91 G90.1 G91.1 G94 "
+    "G0 G1 G2 G3 G4 G17 G18 G19 G20 G21 G28 G30 G53 G80 G90 G91 G90.1 G91.1 G94 "
     "M0 M1 M2 M3 M4 M5 M6 M30"
 )
 """What camtool reads, for messages about unknown codes."""

@@ -229,13 +229,16 @@ class PlainLines:
         gives_xy = x is not None or y is not None
         if gives_xy and not self.positioned and z_out is not None and (tx, ty) == start:
             return False  # _first_positioning
-        if name == "G0":
-            self.positioned = self.positioned or gives_xy
+        cut = name != "G0"
+        if cut and (feed is None or feed == 0):
+            return False
+        if not gives_xy and z_out is None and not self.positioned:
+            return True  # moves nowhere from an assumed XY: no move (_line)
+        self.positioned = self.positioned or gives_xy
+        if not cut:
             self._plain_push(_rapid(tx, ty, z_out, self._contour(True)), tx, ty, tz, line)
             return True
-        if feed is None or feed == 0:
-            return False
-        self.positioned = self.positioned or gives_xy
+        assert feed is not None  # checked above
         move = _linear(tx, ty, feed, z_out, self._contour(False))
         self._plain_push(move, tx, ty, tz, line)
         return True

@@ -241,6 +241,30 @@ def test_post_existing_gcode_reposts_it(capsys: pytest.CaptureFixture[str]) -> N
     assert "no G20/G21" in err
 
 
+def test_a_freecad_program_without_f_reposts_with_feed_and_no_guessed_move(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The opening of FreeCAD 0.20's LinuxCNC post (PathTests/test_linuxcnc_00.ngc).
+
+    Its tool controller has no feed, so no F word: ``--feed`` gives it. Its ``G0 Z15.00``
+    comes twice before the first XY: the program must not gain a rapid to X0 Y0.
+    """
+    ngc = tmp_path / "freecad.ngc"
+    ngc.write_text(
+        "G17 G90\nG21\n(Default_Tool)\nM6 T2\nM3 S0.00\n(Contour)\nG0 Z15.00\nG90\nG17\n"
+        "G0 Z15.00\nG0 X10.00 Y10.00\nG0 Z10.00\nG1 X10.00 Y10.00 Z9.00\n"
+        "G1 X10.00 Y0.00 Z9.00\nG1 X0.00 Y0.00 Z9.00\nG0 Z15.00\nM2\n"
+    )
+    code, out, err = run(["post", str(ngc), "-t", "linuxcnc"], capsys)
+    assert code == 3 and out == "" and "--feed" in err
+    code, out, err = run(["post", str(ngc), "-t", "linuxcnc", "--feed", "300"], capsys)
+    assert code == 0, err
+    blocks = out.splitlines()
+    first_xy = next(k for k, b in enumerate(blocks) if "X" in b and not b.startswith("("))
+    assert blocks[first_xy] == "G0 X10.000 Y10.000"
+    assert "G1 Z9.000 F300" in blocks
+
+
 def test_gcode_with_z_on_a_2d_target_drops_z_with_a_warning(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from camtool.importers.gcode import parse_gcode, read_gcode
+from camtool.importers.gcode import parse_gcode, parse_gcode_slow, read_gcode
 from camtool.model.errors import InputError
 from camtool.model.program import ArcMove, Linear, Move, Program, Rapid, Spindle, Stop
 from camtool.model.shapes import Arc
@@ -219,9 +219,9 @@ def test_word_syntax(text: str, x: float, y: float) -> None:
 
 
 def test_z_is_carried_when_it_changes_and_helix() -> None:
-    program = parse("G21 G0 Z0\nG1 Z0 F10\nG1 Z-1 X1\nG2 X3 Y0 I1 J0 Z-2\nG1 X4 Z-2\n")
-    assert [m.z for m in program.moves] == [0.0, None, -1.0, -2.0, None]
-    assert isinstance(program.moves[3], ArcMove)
+    program = parse("G21 G0 Z0\nG0 X0 Y0\nG1 Z0 F10\nG1 Z-1 X1\nG2 X3 Y0 I1 J0 Z-2\nG1 X4 Z-2\n")
+    assert [m.z for m in program.moves] == [0.0, None, None, -1.0, -2.0, None]
+    assert isinstance(program.moves[4], ArcMove)
 
 
 def test_contours_start_at_rapids_after_cutting() -> None:
@@ -340,7 +340,8 @@ def test_safe_conversion_warns_once_with_count_and_first_line(block: str, expect
         ("G93", "G93 (inverse-time / per-revolution feed)"),
         ("G95", "G95 (inverse-time / per-revolution feed)"),
         ("G92 X0 Y0", "G92 changes the coordinate offsets"),
-        ("G53 G0 X0", "G53 moves in machine coordinates"),
+        ("G53 G0 X0", "G53 X0 moves in machine coordinates"),
+        ("G53 G0 Z-5", "G53 Z-5 moves in machine coordinates"),
         ("G5.1 X1 Y1 I1 J1", "G5.1 splines"),
         ("G12 X1", "unknown or unsupported code G12"),
         ("M98 P100", "unknown or unsupported code M98"),
@@ -522,3 +523,47 @@ def test_complete_last_line_without_end_of_line_is_read(last: str) -> None:
 
 def test_unclosed_comment_on_a_cut_last_line_stays_a_comment_error() -> None:
     assert "comment '(' is not closed" in refused("G21\nG1 X1 Y1 F10\nG1 X2 (cut X")
+
+
+# -- blocks that move nowhere, G53, a program without F (FreeCAD's posts) ------------------
+
+
+@pytest.mark.parametrize("reader", [parse_gcode, parse_gcode_slow])
+def test_a_block_that_moves_nowhere_before_any_xy_makes_no_move(reader: object) -> None:
+    """Before the first X or Y word the machine's XY is unknown (the reader assumes 0, 0).
+
+    FreeCAD 0.20's LinuxCNC post repeats ``G0 Z15.00`` before its first XY; the second one
+    moves nowhere. Read as a move at the assumed XY, it was written back as ``G0 X0 Y0``:
+    a rapid to a place the program never named.
+    """
+    text = "G21 G90\nG0 Z15\nG0 Z15\nG1 Z15 F100\nG0 X10 Y10\nG1 Z9\nG1 X0\nG0 Z15\nG0 Z15\nM2\n"
+    program = reader(text, source="t.ngc")  # type: ignore[operator]
+    assert [(type(m).__name__, m.x, m.y, m.z) for m in program.moves] == [
+        ("Rapid", 0.0, 0.0, 15.0),  # a Z-only move (the writer writes no X, Y)
+        ("Rapid", 10.0, 10.0, None),
+        ("Linear", 10.0, 10.0, 9.0),
+        ("Linear", 0.0, 10.0, None),
+        ("Rapid", 0.0, 10.0, 15.0),
+        ("Rapid", 0.0, 10.0, None),  # after X and Y are known: the position, as written
+    ]
+
+
+def test_a_cut_that_moves_nowhere_before_any_xy_still_needs_a_feed() -> None:
+    assert "G1 before any F word" in refused("G21 G0 Z5\nG1 Z5\n")
+
+
+def test_g53_without_axis_words_moves_nowhere() -> None:
+    """FreeCAD 0.20's Centroid post begins its programs ``G53 G00 G17``: no axis, no move."""
+    program = parse("G90 G80 G40 G49\nG53 G00 G17\nG21\nG0 X1 Y1\nG1 X2 F100\nM2\n")
+    assert [(m.x, m.y) for m in program.moves] == [(1.0, 1.0), (2.0, 1.0)]
+    assert any("G53 without axis words" in w for w in program.warnings)
+
+
+def test_a_program_without_f_reads_with_the_feed_post_gives() -> None:
+    text = "G21 G90\nG0 X0 Y0 Z5\nG1 Z-1\nG1 X10\nG2 X20 Y0 I5 J0\nM2\n"
+    message = refused(text)
+    assert "G1 before any F word" in message and "--feed" in message
+    program = parse_gcode(text, source="t.ngc", feed_mm_min=300.0)
+    assert [m.feed_mm_min for m in program.moves if not isinstance(m, Rapid)] == [300.0] * 3
+    program = parse_gcode(text.replace("G1 X10", "G1 X10 F50"), source="t.ngc", feed_mm_min=300.0)
+    assert [m.feed_mm_min for m in program.moves if not isinstance(m, Rapid)] == [300, 50, 50]
