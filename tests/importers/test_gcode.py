@@ -567,3 +567,15 @@ def test_a_program_without_f_reads_with_the_feed_post_gives() -> None:
     assert [m.feed_mm_min for m in program.moves if not isinstance(m, Rapid)] == [300.0] * 3
     program = parse_gcode(text.replace("G1 X10", "G1 X10 F50"), source="t.ngc", feed_mm_min=300.0)
     assert [m.feed_mm_min for m in program.moves if not isinstance(m, Rapid)] == [300, 50, 50]
+
+
+@pytest.mark.parametrize("block", ["G00 G80 X1 Y1", "G80 G0 X1 Y1"])
+def test_g80_beside_a_motion_code_leaves_the_motion(block: str) -> None:
+    """CAMotics' ``cameo.nc`` begins ``N1 G00 G17 G21 G40 G49 G80 G90``; LinuxCNC 2.9's
+    rs274 reads ``G0 G80 X1 Y1`` as the rapid (STRAIGHT_TRAVERSE to 1, 1) and ``G1 G80`` as
+    the cut, so camtool reads them so too. Two motion codes other than G80 stay refused."""
+    program = parse(f"G21\n{block}\nG80 G1 X2 F100\nG2 G80 X3 Y1 I0.5 J0\nM2\n")
+    assert [type(m).__name__ for m in program.moves] == ["Rapid", "Linear", "ArcMove"]
+    assert [(m.x, m.y) for m in program.moves] == [(1.0, 1.0), (2.0, 1.0), (3.0, 1.0)]
+    assert "G0 and G1 are both motion codes" in refused("G21\nG0 G1 X1 F10\n")
+    assert "G80 and G80 are both motion codes" in refused("G21\nG80 G80\n")
