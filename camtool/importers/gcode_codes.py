@@ -238,10 +238,11 @@ class BlockWords:
     def _add_code(self, code: Code, where: str) -> None:
         table = self.g if code.name[0] == "G" else self.m
         other = table.get(code.group)
-        if other is not None and code.group == "motion" and "G80" in (code.name, other.name):
-            if code.name != other.name:  # G0 G80 (a CAM's safety line): LinuxCNC moves, so here
-                table["motion"] = other if code.name == "G80" else code
-                return
+        names = {code.name, other.name} if other is not None else set()
+        if other is not None and code.group == "motion" and "G80" in names and len(names) == 2:
+            # G0 G80 (a CAM's safety line): LinuxCNC makes the move, and so does camtool
+            table["motion"] = other if code.name == "G80" else code
+            return
         if other is not None:
             group = code.group.replace("_", " ")
             raise InputError(
