@@ -138,8 +138,11 @@ def svg_drawing(
         warnings.append(f"{path}: skipped {invisible} {noun} with neither fill nor stroke")
     if not contours:
         where = " in the selected layers" if options.layers else ""
+        prefix = f"{path}: "
+        skipped = [w.removeprefix(prefix) for w in warnings if w.startswith(prefix + "skipped")]
+        why = f" ({'; '.join(skipped)})" if skipped else ""  # e.g. only <text>: what to do
         raise InputError(
-            f"{path}: nothing to cut{where}; camtool reads path, rect, circle, ellipse, "
+            f"{path}: nothing to cut{where}{why}; camtool reads path, rect, circle, ellipse, "
             "line, polyline and polygon elements that are drawn"
         )
     return Drawing(tuple(contours), str(path), tuple(warnings)), tolerance

@@ -336,7 +336,11 @@ def test_read_drawing_dispatches_svg() -> None:
             "",
             "nothing to cut; camtool reads path, rect, circle, ellipse, line, polyline and polygon",
         ),
-        ("<text>only text</text>", "nothing to cut"),
+        (
+            "<text>only text</text>",
+            "nothing to cut (skipped 1 <text> element (convert text to paths in the drawing "
+            "program to cut it)); camtool reads path",
+        ),
         ('<rect width="5em" height="1"/>', "bad width '5em': font-relative units (em, ex)"),
         ('<circle r="-5"/>', "circle[1]: bad r '-5': must not be negative"),
         ('<rect x="1e400" width="1" height="1"/>', "rect[1]: bad x '1e400': must be a number"),
