@@ -144,13 +144,21 @@ class _BoxSearch:
         return near, np.sqrt(rk_2), lower, ask
 
     def chosen(self, ends: _LazyTree, rows: IntArray) -> FloatArray:
-        """The distance of samples ``rows`` to the segments of the ends the k-d tree keeps."""
-        x = self.samples[rows]
-        found = ends.tree.query(x, k=nearest_exact.NEAREST_ENDS, workers=nearest_exact.KD_WORKERS)[
-            1
-        ]
-        seg = np.asarray(found).reshape(-1, nearest_exact.NEAREST_ENDS) % len(self.a)
-        return nearest_exact._to_segments(x, self.a[seg], self.b[seg]).min(axis=1)
+        """The distance of samples ``rows`` to the segments of the ends the k-d tree keeps.
+
+        In parts of :data:`NEAREST_CHUNK` rows (each row's distance is its own): the
+        query's and the segments' arrays are ~0.4 kB a row, so all the samples of a long
+        trace at once (360 000 in the budget's ideal trace) would be ~140 MB.
+        """
+        out = np.empty(len(rows), dtype=np.float64)
+        k = nearest_exact.NEAREST_ENDS
+        for i in range(0, len(rows), NEAREST_CHUNK):
+            x = self.samples[rows[i : i + NEAREST_CHUNK]]
+            found = ends.tree.query(x, k=k, workers=nearest_exact.KD_WORKERS)[1]
+            seg = np.asarray(found).reshape(-1, k) % len(self.a)
+            near = nearest_exact._to_segments(x, self.a[seg], self.b[seg])
+            out[i : i + len(x)] = near.min(axis=1)
+        return out
 
     def settled(self, near: FloatArray, rk: FloatArray, lower: FloatArray) -> Any:
         """Where ``near`` is the distance (:func:`nearest_distances`' two tests)."""

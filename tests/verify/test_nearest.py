@@ -83,3 +83,28 @@ def test_the_ends_are_shared_only_when_a_and_b_are_the_halves_of_one_array() -> 
         assert np.array_equal(ends, np.concatenate([a, b]))
         assert (ends is trace) == shared
         assert shared or not np.shares_memory(ends, trace)
+
+
+def test_the_k_d_tree_s_answers_in_parts_are_the_answers_at_once(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Samples whose nearest ends tie go to the k-d tree (``_BoxSearch.chosen``) in parts of
+    ``NEAREST_CHUNK`` rows: the distances are those of one query of all of them, and each
+    is the distance to the nearest segment (shapely)."""
+    from camtool.verify import nearest_search
+
+    if nearest_search.near_kernels() is None:
+        pytest.skip("the compiled search is off (CAMTOOL_ACCEL=0 or no numba)")
+    rng = np.random.default_rng(3)
+    steps = np.arange(2_000, dtype=np.float64)
+    trace = np.c_[steps * 0.5, (steps % 2) * 0.25]
+    samples = np.r_[trace[rng.integers(0, len(trace), 900)], rng.uniform(0, 1000, (300, 2))]
+    search = nearest_search._box_search(samples, trace[:-1], trace[1:])
+    assert search is not None
+    ends = nearest_search._LazyTree(search.points)
+    rows = np.arange(len(samples))
+    whole = search.chosen(ends, rows)
+    monkeypatch.setattr(nearest_search, "NEAREST_CHUNK", 7)
+    assert np.array_equal(search.chosen(ends, rows), whole)
+    truth = _shapely(samples, trace[:-1], trace[1:])
+    assert np.max(np.abs(whole - truth)) <= NEAREST_TOLERANCE_MM
