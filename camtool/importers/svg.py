@@ -142,8 +142,8 @@ def svg_drawing(
         skipped = [w.removeprefix(prefix) for w in warnings if w.startswith(prefix + "skipped")]
         why = f" ({'; '.join(skipped)})" if skipped else ""  # e.g. only <text>: what to do
         raise InputError(
-            f"{path}: nothing to cut{where}{why}; camtool reads path, rect, circle, ellipse, "
-            "line, polyline and polygon elements that are drawn"
+            f"{path}: nothing to cut{where}; camtool reads path, rect, circle, ellipse, "
+            f"line, polyline and polygon elements that are drawn{why}"
         )
     return Drawing(tuple(contours), str(path), tuple(warnings)), tolerance
 

@@ -15,6 +15,7 @@ import pytest
 
 from camtool.importers import read_drawing
 from camtool.jobs.pipeline import post_drawing
+from camtool.model.errors import InputError
 from camtool.model.program import Linear
 from camtool.post.registry import load_target
 from camtool.toolpath.options import PlanOptions
@@ -80,6 +81,29 @@ def test_a_centre_line_is_never_cut_by_default(tmp_path: Path) -> None:
     assert cuts and all(m.y in (0, 20) or m.x in (0, 20) for m in cuts)
     (note,) = [w for w in job.warnings if "layer 'AXES'" in w]
     assert note.startswith("not cut: 1 contour(s) on layer 'AXES' (linetype CENTER")
+    assert note.endswith("(post --layers AXES, or a job operation that selects it)")
+
+
+def test_a_drawing_all_in_a_dash_dot_linetype_names_the_option_that_cuts_it(
+    tmp_path: Path,
+) -> None:
+    """dxf2gcode's DEMO.DXF draws everything on layer 0 in linetype STRICHPUNKT (dash-dot):
+    all construction by the rule, so nothing to cut; the message names the option, which
+    then cuts it."""
+    doc = _doc()
+    doc.linetypes.add("STRICHPUNKT", [10.0, 6.0, -2.0, 0.0, -2.0])
+    doc.layers.get("0").dxf.linetype = "STRICHPUNKT"
+    doc.modelspace().add_lwpolyline([(0, 0), (20, 0), (20, 20), (0, 20)], close=True)
+    path = tmp_path / "Layer 0 only.dxf"
+    doc.saveas(path)
+    with pytest.raises(InputError) as err:
+        post_drawing(read_drawing(path), load_target("grbl"), PlanOptions(depth=1.0))
+    assert "nothing to cut: every contour is construction" in str(err.value)
+    assert "(post --layers 0, or a job operation that selects it)" in str(err.value)
+    job = post_drawing(
+        read_drawing(path), load_target("grbl"), PlanOptions(depth=1.0), layers=("0",)
+    )
+    assert max(m.x for m in job.program.moves) == 20
 
 
 def test_a_centre_line_named_by_its_layer_is_cut(tmp_path: Path) -> None:

@@ -338,8 +338,9 @@ def test_read_drawing_dispatches_svg() -> None:
         ),
         (
             "<text>only text</text>",
-            "nothing to cut (skipped 1 <text> element (convert text to paths in the drawing "
-            "program to cut it)); camtool reads path",
+            "nothing to cut; camtool reads path, rect, circle, ellipse, line, polyline and "
+            "polygon elements that are drawn (skipped 1 <text> element (convert text to paths "
+            "in the drawing program to cut it))",
         ),
         ('<rect width="5em" height="1"/>', "bad width '5em': font-relative units (em, ex)"),
         ('<circle r="-5"/>', "circle[1]: bad r '-5': must not be negative"),
