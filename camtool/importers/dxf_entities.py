@@ -467,7 +467,7 @@ def _polyline(
             continue
         c = bulge_center((x0, y0), (x1, y1), bulge)
         centre = _xy(ocs.to_wcs((c[0], c[1], z)))
-        segs.append(Arc(p0, p1, centre, (bulge < 0) != flipped))
+        segs.append(Arc(p0, p1, centre, bool(bulge < 0) != bool(flipped)))  # numpy bools out
     return segs
 
 

@@ -40,6 +40,7 @@ def test_bulge_sign_gives_direction(tmp_path: Path) -> None:
     ccw, cw = (c.segments[0] for c in read_dxf(write_dxf(tmp_path / "b.dxf", build)).contours)
     assert isinstance(ccw, Arc) and isinstance(cw, Arc)
     assert not ccw.clockwise and cw.clockwise
+    assert type(ccw.clockwise) is bool and type(cw.clockwise) is bool  # not numpy's bool_
     assert ccw.centre == pytest.approx((1.0, 0.0)) and ccw.radius == pytest.approx(1.0)
     # CCW from (0,0) to (2,0) about (1,0) passes below the chord: y_min = -1
     assert ccw.bbox()[1] == pytest.approx(-1.0) and cw.bbox()[3] == pytest.approx(1.0)
