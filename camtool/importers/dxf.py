@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from camtool.accel.collector import paused
+from camtool.geometry.arcfit import FIT_KERNELS
 from camtool.importers.dxf_entities import (
     ZERO_LENGTH,
     BadEntity,
@@ -22,6 +23,7 @@ from camtool.importers.dxf_entities import (
     layer_of,
     line_inside,
 )
+from camtool.importers.dxf_prefit import MIN_SPLINES, fit_ahead, fitted_ahead
 from camtool.importers.dxf_style import CONTINUOUS, Style, StyleResolver
 from camtool.importers.options import MAX_COORDINATE_MM, ImportOptions, too_many_entities
 from camtool.model.errors import InputError, UsageError
@@ -188,9 +190,10 @@ def _import(
     reader.styles = StyleResolver(doc)
     try:
         if check is None:
-            for entity in msp:
-                reader.read(entity)
-        else:
+            with fitted_ahead(_splines_ahead(msp, reader)):
+                for entity in msp:
+                    reader.read(entity)
+        else:  # refused as soon as the drawing is too large: fitted as read
             _read_checked(reader, msp, scale, check)
     except BadEntity as exc:
         raise InputError(f"{path}: {exc}") from None
@@ -220,6 +223,21 @@ def _import(
         repairs=tuple(repairs),
         converted=reader.converted,
     )
+
+
+def _splines_ahead(msp: Any, reader: _Reader) -> dict[int, Any]:
+    """The model space's SPLINEs on the layers read, fitted on the cores (:mod:`.dxf_prefit`)."""
+    from camtool.importers.dxf_entities import check_numbers, layer_of, spline_segments
+
+    splines = [e for e in msp.query("SPLINE") if reader.keep(layer_of(e))]
+    if len(splines) < MIN_SPLINES:
+        return {}
+
+    def check(entity: Any) -> None:
+        check_numbers(entity, "", layer_of(entity), reader.limit)
+
+    FIT_KERNELS.get(len(splines))  # the compiled fitter, loaded once for every worker
+    return fit_ahead(splines, reader.tolerance, spline_segments, check)
 
 
 def _read_checked(

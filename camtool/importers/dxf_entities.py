@@ -21,6 +21,7 @@ import numpy as np
 from camtool.geometry.arcfit import FloatArray, PointsFn
 from camtool.geometry.chain import with_end, with_start
 from camtool.geometry.curves import corner_knots, ellipse, fit_pieces
+from camtool.importers.dxf_prefit import take
 from camtool.importers.options import check_curve_size
 from camtool.model.errors import GeometryError
 from camtool.model.shapes import TAU, Arc, Contour, Line, Point, Segment, distance
@@ -341,7 +342,7 @@ def _segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool]:
     if kind == "ELLIPSE":
         segs, closed = ellipse_segments(entity, tolerance)
     elif kind == "SPLINE":
-        segs, closed = spline_segments(entity, tolerance)
+        segs, closed = take(entity) or spline_segments(entity, tolerance)
     else:
         _check_flat(entity)
         if kind == "LINE":
