@@ -14,6 +14,7 @@ of the reference (ezdxf's ``virtual_entities`` draws its frame too, AutoCAD only
 
 from __future__ import annotations
 
+import itertools
 import math
 from typing import Any
 
@@ -32,7 +33,7 @@ KINDS = ("LINE", "ARC", "CIRCLE", "ELLIPSE", "SPLINE", "LWPOLYLINE", "POLYLINE")
 
 def _dense(poly: np.ndarray, step: float) -> np.ndarray:
     out = [poly[:1]]
-    for p, q in zip(poly[:-1], poly[1:], strict=True):
+    for p, q in itertools.pairwise(poly):
         n = max(1, int(math.dist(p, q) / step))
         out.append(p + (q - p) * np.linspace(0.0, 1.0, n + 1)[1:, None])
     return np.concatenate(out)
@@ -100,7 +101,7 @@ def test_camtool_s_contours_lie_on_ezdxf_s_curves(rel: str) -> None:
     ours = _camtool(read.drawing.contours, step)
     theirs = _reference(path, read.mm_per_unit, step)
     assert len(theirs), f"{rel}: ezdxf draws nothing camtool reads"
-    off, where = cKDTree(theirs).query(ours)
+    off, _ = cKDTree(theirs).query(ours)
     limit = options.tolerance + step + 1e-9 * size
     worst = int(np.argmax(off))
     assert off[worst] <= limit, (

@@ -22,7 +22,8 @@ from tests.shapes import write_dxf
 def _splines(msp: Any) -> None:
     rng = np.random.default_rng(11)
     for k in range(90):  # more than MIN_SPLINES, several spans each
-        cps = np.cumsum(rng.uniform(-3, 3, (9, 2)), axis=0) + (k % 10 * 30, k // 10 * 30)
+        offset = np.array([k % 10 * 30.0, k // 10 * 30.0])
+        cps = np.cumsum(rng.uniform(-3, 3, (9, 2)), axis=0) + offset
         msp.add_open_spline([(x, y, 0.0) for x, y in cps], degree=3)
     bad = msp.add_open_spline([(0, 0, 0), (0, 0, 0), (0, 0, 0), (0, 0, 0)], degree=3)
     bad.dxf.layer = "POINTLIKE"  # a spline that is one point: skipped with a warning
