@@ -335,6 +335,8 @@ def run_job(
         )
     progress(Step("writing", 0, len(program.moves), target.name))
     pieces: tuple[ToolProgram, ...] = ()
+    if target.post.tool_changes == "none" and not job.shorthand:
+        program = loaded_by_hand(program, target)  # one tool: loaded before the program
     if target.post.tool_changes == "none" and len({r.tool.id for r in runs}) > 1:
         pieces = per_tool(program, target, output.fmt)
         result = pieces[0].result
@@ -354,6 +356,29 @@ def run_job(
         report,
         operations=tuple(runs),
         pieces=pieces,
+    )
+
+
+def loaded_by_hand(program: Program, target: Target) -> Program:
+    """``program`` without its one tool change, when that comes before its first move.
+
+    For a target that cannot change tools (:attr:`PostProcessor.tool_changes` ``"none"``):
+    a program of one tool is that tool's program, as :func:`per_tool` writes each tool's
+    (the change is the program's start; the header says which tool to load, and so does a
+    warning, for a dialect without comments). Any other program is returned as it is (the
+    writer refuses a tool change it cannot write, and several tools are :func:`per_tool`'s).
+    """
+    changes = [(i, c) for i, c in program.commands if isinstance(c, ToolChange)]
+    if len(changes) != 1 or changes[0][0] != 0:
+        return program
+    change = changes[0][1]
+    what = f" ({change.description})" if change.description else ""
+    said = f"load T{change.tool}{what} before running: {target.name} cannot change tools"
+    return dataclasses.replace(
+        program,
+        commands=tuple((i, c) for i, c in program.commands if c is not change),
+        notes=(*program.notes, said),
+        warnings=(*program.warnings, f"the tool change to T{change.tool} is not written; {said}"),
     )
 
 

@@ -19,7 +19,7 @@ from camtool.jobs.jobfile import load_job
 from camtool.jobs.pipeline import post_program
 from camtool.jobs.run import run_job
 from camtool.model.errors import DialectError
-from camtool.model.program import Linear, Stop
+from camtool.model.program import Linear, Stop, ToolChange
 from camtool.post.registry import load_target
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -92,3 +92,58 @@ def test_batch_names_each_tools_program_and_refuses_to_overwrite_them(
     capsys.readouterr()
     assert main([*args, "--jobs", "1"]) == 2
     assert "part.T1.ngc" in capsys.readouterr().err
+
+
+ONE_TOOL = """
+[job]
+origin = "lower-left"
+clearance_z = 10.0
+safe_z = 2.0
+
+[[tools]]
+id = 1
+type = "end-mill"
+diameter = 3.0
+feed = 400
+
+[[operations]]
+name = "mark"
+type = "engrave"
+tool = 1
+layers = ["ENGRAVE"]
+depth = 0.3
+"""
+
+
+def test_a_one_tool_job_for_a_machine_without_a_changer_is_that_tool_s_program(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """One tool is one program, as each of several tools' is: no change, "load T1" said.
+
+    Before, the job was refused ("post one program per tool (a job does so ...)"), a remedy
+    that a job of one tool could not follow."""
+    job = tmp_path / "one.toml"
+    job.write_text(ONE_TOOL)
+    done = run_job(read_drawing(PART), load_target("valcnc"), load_job(job))
+    assert not done.pieces
+    assert not any(isinstance(c, ToolChange) for _, c in done.program.commands)
+    assert done.program.notes[-1] == (
+        "load T1 (end-mill 3 mm) before running: valcnc cannot change tools"
+    )
+    out = tmp_path / "one.ngc"
+    assert main(["post", str(PART), "-t", "valcnc", "--job", str(job), "-o", str(out)]) == 0
+    assert "the tool change to T1 is not written; load T1" in capsys.readouterr().err
+    assert out.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["one.ngc", "one.toml"]
+
+
+@pytest.mark.parametrize("target", ["valcnc", "flashcut", "i8751"])
+def test_a_re_posted_program_of_one_tool_is_written_without_its_change(target: str) -> None:
+    """FreeCAD's and CAMotics' programs begin with their one tool change (``M6 T2``)."""
+    from camtool.importers.gcode import parse_gcode
+
+    text = "G21 G90\nM6 T2\nG0 X1 Y1 Z5\nG1 Z-1 F100\nG1 X5\nG0 Z5\nM2\n"
+    done = post_program(parse_gcode(text, source="one.ngc"), load_target(target))
+    assert not done.pieces
+    assert any("the tool change to T2 is not written; load T2" in w for w in done.warnings)
+    two = text.replace("G0 Z5\nM2", "G0 Z5\nM6 T3\nG1 X9 Y9 F100\nM2")
+    assert len(post_program(parse_gcode(two, source="two.ngc"), load_target(target)).pieces) == 2
