@@ -10,6 +10,7 @@ Design notes: docs/internals.md, ``camtool/jobs/run.py``.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 from collections.abc import Sequence
@@ -27,7 +28,7 @@ from camtool.jobs.selection import (
     nothing_selected,
     select,
 )
-from camtool.model.errors import InputError, UsageError
+from camtool.model.errors import DialectError, InputError, UsageError
 from camtool.model.program import (
     Command,
     Dwell,
@@ -335,13 +336,11 @@ def run_job(
         )
     progress(Step("writing", 0, len(program.moves), target.name))
     pieces: tuple[ToolProgram, ...] = ()
-    if target.post.tool_changes == "none" and not job.shorthand:
-        program = loaded_by_hand(program, target)  # one tool: loaded before the program
     if target.post.tool_changes == "none" and len({r.tool.id for r in runs}) > 1:
         pieces = per_tool(program, target, output.fmt)
         result = pieces[0].result
     else:
-        result = target.emit(program, fmt=output.fmt)
+        program, result = emit_one_tool(program, target, output.fmt)
     only = runs[0]
     report = only.report if len(runs) == 1 else None
     if report is not None:
@@ -359,14 +358,35 @@ def run_job(
     )
 
 
+def emit_one_tool(program: Program, target: Target, fmt: str | None) -> tuple[Program, PostResult]:
+    """``target.emit(program)``, or that of :func:`loaded_by_hand` when the target refuses.
+
+    A target that cannot change tools (:attr:`PostProcessor.tool_changes` ``"none"``) and
+    refuses the program's one tool change before its first move writes the program of that
+    one tool instead, as :func:`per_tool` writes each of several tools' (a dialect that
+    writes the change, as pic-mmh's ``M06T01;``, keeps it). Returns the program written
+    and its result.
+
+    Raises:
+        DialectError: the first emission's, when the program without its change is refused
+            too, or it has no such change.
+    """
+    try:
+        return program, target.emit(program, fmt=fmt)
+    except DialectError as exc:
+        refused = exc
+    alone = loaded_by_hand(program, target)
+    if target.post.tool_changes == "none" and alone is not program:
+        with contextlib.suppress(DialectError):
+            return alone, target.emit(alone, fmt=fmt)
+    raise refused
+
+
 def loaded_by_hand(program: Program, target: Target) -> Program:
     """``program`` without its one tool change, when that comes before its first move.
 
-    For a target that cannot change tools (:attr:`PostProcessor.tool_changes` ``"none"``):
-    a program of one tool is that tool's program, as :func:`per_tool` writes each tool's
-    (the change is the program's start; the header says which tool to load, and so does a
-    warning, for a dialect without comments). Any other program is returned as it is (the
-    writer refuses a tool change it cannot write, and several tools are :func:`per_tool`'s).
+    The tool is loaded by hand before the program runs: the header (where the dialect has
+    comments) and a warning say which. Any other program is returned as it is.
     """
     changes = [(i, c) for i, c in program.commands if isinstance(c, ToolChange)]
     if len(changes) != 1 or changes[0][0] != 0:
