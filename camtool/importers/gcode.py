@@ -146,8 +146,7 @@ def _parse(text: str, source: str, *, plain: bool, feed_mm_min: float | None = N
     """:func:`parse_gcode`; ``plain``: take the plain-line path where it applies."""
     lines = _lines(text)
     rest = (raw for raw, _ in lines)  # the lines after the program's end
-    reader = _Reader(source)
-    reader.first_feed = feed_mm_min
+    reader = _Reader(source, first_feed=feed_mm_min)
     opened = False  # a '%' line before the first block: the next '%' ends the program
     ended = False
     plain_words = PLAIN_WORDS.findall
@@ -186,7 +185,7 @@ def _parse(text: str, source: str, *, plain: bool, feed_mm_min: float | None = N
 class _Reader(PlainLines):
     """The modal state of the interpreter and the moves read so far."""
 
-    def __init__(self, source: str) -> None:
+    def __init__(self, source: str, first_feed: float | None = None) -> None:
         self.source = source
         self.notes = Notes(source)
         self.commands = CommandReader(self.notes)
@@ -204,7 +203,7 @@ class _Reader(PlainLines):
         self.inch = False
         self.units_seen = False
         self.feed_mm_min: float | None = None
-        self.first_feed: float | None = None  # the feed before the first F word (--feed)
+        self.first_feed = first_feed  # the feed before the first F word (post --feed)
         self.coord: str | None = None
         self.home = ""
         self.contour = 1
@@ -439,15 +438,13 @@ class _Reader(PlainLines):
         if gives_xy and not self.positioned and z is not None and (tx, ty) == (self.x, self.y):
             self._first_positioning(name, tx, ty, tz, z)
             return
-        if name != "G0":
-            self._feed(name)  # refused without a feed, as LinuxCNC refuses it
+        feed = None if name == "G0" else self._feed(name)  # refused without, as LinuxCNC
         if not gives_xy and z is None and not self.positioned:
             return  # moves nowhere, and XY is only assumed: a move there would be a guess
         self.positioned = self.positioned or gives_xy
-        if name == "G0":
+        if feed is None:
             self._push(Rapid(tx, ty, z), tx, ty, tz)
             return
-        feed = self._feed(name)
         self._start_xy(name)
         self._push(Linear(tx, ty, feed, z), tx, ty, tz)
 

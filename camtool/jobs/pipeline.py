@@ -11,7 +11,7 @@ from camtool.importers import read_drawing, read_drawing_bytes
 from camtool.importers.options import ImportOptions
 from camtool.jobs.header import job_notes
 from camtool.jobs.inputs import is_program_file
-from camtool.jobs.run import OutputOptions, PostJob, emit_one_tool, per_tool, run_job
+from camtool.jobs.run import OutputOptions, PostJob, loaded_by_hand, per_tool, run_job
 from camtool.model.errors import InputError, UsageError
 from camtool.model.program import Move, Program, ToolChange
 from camtool.model.progress import Progress, Step, no_progress
@@ -344,8 +344,8 @@ def post_program(
     if target.post.tool_changes == "none" and changes > 1 and starts_with_change:
         pieces = per_tool(program, target, output.fmt)  # one program per tool
         return PostJob(None, program, target, pieces[0].result, None, 0.0, pieces=pieces)
-    program, result = emit_one_tool(program, target, output.fmt)
-    return PostJob(None, program, target, result, None, 0.0)
+    program = loaded_by_hand(program, target)
+    return PostJob(None, program, target, target.emit(program, fmt=output.fmt), None, 0.0)
 
 
 def _with_spindle(program: Program, rpm: float | None, dwell_s: float = 0.0) -> Program:

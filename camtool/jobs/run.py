@@ -10,7 +10,6 @@ Design notes: docs/internals.md, ``camtool/jobs/run.py``.
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import math
 from collections.abc import Sequence
@@ -28,7 +27,7 @@ from camtool.jobs.selection import (
     nothing_selected,
     select,
 )
-from camtool.model.errors import DialectError, InputError, UsageError
+from camtool.model.errors import InputError, UsageError
 from camtool.model.program import (
     Command,
     Dwell,
@@ -340,7 +339,8 @@ def run_job(
         pieces = per_tool(program, target, output.fmt)
         result = pieces[0].result
     else:
-        program, result = emit_one_tool(program, target, output.fmt)
+        program = loaded_by_hand(program, target)
+        result = target.emit(program, fmt=output.fmt)
     only = runs[0]
     report = only.report if len(runs) == 1 else None
     if report is not None:
@@ -358,38 +358,17 @@ def run_job(
     )
 
 
-def emit_one_tool(program: Program, target: Target, fmt: str | None) -> tuple[Program, PostResult]:
-    """``target.emit(program)``, or that of :func:`loaded_by_hand` when the target refuses.
-
-    A target that cannot change tools (:attr:`PostProcessor.tool_changes` ``"none"``) and
-    refuses the program's one tool change before its first move writes the program of that
-    one tool instead, as :func:`per_tool` writes each of several tools' (a dialect that
-    writes the change, as pic-mmh's ``M06T01;``, keeps it). Returns the program written
-    and its result.
-
-    Raises:
-        DialectError: the first emission's, when the program without its change is refused
-            too, or it has no such change.
-    """
-    try:
-        return program, target.emit(program, fmt=fmt)
-    except DialectError as exc:
-        refused = exc
-    alone = loaded_by_hand(program, target)
-    if target.post.tool_changes == "none" and alone is not program:
-        with contextlib.suppress(DialectError):
-            return alone, target.emit(alone, fmt=fmt)
-    raise refused
-
-
 def loaded_by_hand(program: Program, target: Target) -> Program:
-    """``program`` without its one tool change, when that comes before its first move.
+    """``program`` without its one tool change, when ``target`` cannot change tools.
 
-    The tool is loaded by hand before the program runs: the header (where the dialect has
-    comments) and a warning say which. Any other program is returned as it is.
+    For a target whose :attr:`PostProcessor.tool_changes` is ``"none"``, a program whose
+    only tool change comes before its first move is that tool's program, as :func:`per_tool`
+    writes each of several tools': the tool is loaded by hand before it runs, and the header
+    (where the dialect has comments) and a warning say which. Any other program is returned
+    as it is (the writer refuses a change it cannot write; several tools are ``per_tool``'s).
     """
     changes = [(i, c) for i, c in program.commands if isinstance(c, ToolChange)]
-    if len(changes) != 1 or changes[0][0] != 0:
+    if target.post.tool_changes != "none" or len(changes) != 1 or changes[0][0] != 0:
         return program
     change = changes[0][1]
     what = f" ({change.description})" if change.description else ""

@@ -135,10 +135,9 @@ def construction_notes(contours: Sequence[Contour]) -> list[str]:
         c = first[(layer, linetype)]
         what = f"linetype {linetype}" if linetype else "a construction layer"
         where = f"{c.source} at ({c.start[0]:.4f}, {c.start[1]:.4f}) mm"
-        name = shlex.quote(layer) if layer else "''"
         out.append(
             f"not cut: {count} contour(s) on layer {layer!r} ({what}: construction, not the "
             f"part; first {where}); an operation that names the layer cuts them "
-            f"(post --layers {name}, or a job operation that selects it)"
+            f"(post --layers {shlex.quote(layer)}, or a job operation that selects it)"
         )
     return out

@@ -334,6 +334,11 @@ class PicMmhPost(PostProcessor):
             raise ValueError(f"max_line_chars must be a whole number ≥ 1, not {max_line_chars!r}")
         self.max_line_chars = max_line_chars
 
+    @property
+    def tool_changes(self) -> str:
+        """``"code"``: ``M06T##;`` changes to magazine position T (UNAM-GMM L3455–L3464)."""
+        return "code"
+
     # -- writing ---------------------------------------------------------------
 
     def emit(self, program: Program, machine: Machine, *, fmt: str | None = None) -> PostResult:

@@ -147,3 +147,17 @@ def test_a_re_posted_program_of_one_tool_is_written_without_its_change(target: s
     assert any("the tool change to T2 is not written; load T2" in w for w in done.warnings)
     two = text.replace("G0 Z5\nM2", "G0 Z5\nM6 T3\nG1 X9 Y9 F100\nM2")
     assert len(post_program(parse_gcode(two, source="two.ngc"), load_target(target)).pieces) == 2
+
+
+def test_pic_mmh_changes_tools_in_its_own_code() -> None:
+    """UNAM-GMM's dialect has ``M06T##;``, a change to magazine position T (L3455–L3464):
+    a program of two tools is one pic-mmh program with both changes, not one per tool."""
+    from camtool.importers.gcode import parse_gcode
+
+    text = "G21 G90\nM6 T1\nG0 X1 Y1\nG1 X2 F0.8\nM6 T2\nG1 X3 Y1\nM2\n"
+    done = post_program(parse_gcode(text, source="two.ngc"), load_target("pic-mmh"))
+    assert not done.pieces
+    assert [b for b in str(done.result.code).splitlines() if b.startswith("M06")] == [
+        "M06T01;",
+        "M06T02;",
+    ]
