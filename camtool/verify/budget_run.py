@@ -93,7 +93,9 @@ class EarlyBudget:
         self.tool_diameter, self.findings, self.progress = tool_diameter, findings, progress
         self.run: BudgetRun | None = None
         statuses = trace_sources.source_statuses(program, machine, planned=planned)
-        self.one = sum(s.status == "modelled" for s in statuses) == 1
+        self.one = sum(s.status == "modelled" for s in statuses) == 1 and not (
+            trace_sources.follows_program(program, machine, statuses)  # nothing to simulate
+        )
 
     def start(self, rows: int) -> None:
         """Start the budget of a trace of ``rows`` rows (again, if another count came first).
@@ -223,7 +225,11 @@ class BudgetRun:
     :meth:`gather` joins their figures with the verification's own. A context manager:
     leaving it stops the workers. ``alongside``: this process has work of its own
     meanwhile (a streamed trace to simulate and measure), so even one source is
-    re-simulated in a process of its own (:class:`_ForkedOne`).
+    re-simulated in a process of its own (:class:`_ForkedOne`). A program whose trace
+    without its one source, ``interpolation``, is the program itself
+    (:func:`~camtool.verify.trace_sources.follows_program`, no drawing) is not
+    re-simulated: its figures are the program's own
+    (:func:`~camtool.verify.trace_sources.ideal_figures`).
     """
 
     def __init__(
@@ -246,13 +252,19 @@ class BudgetRun:
         self.modelled = (
             [] if self.skipped else [s.name for s in self.statuses if s.status == "modelled"]
         )
+        self.exact = (
+            self.modelled == ["interpolation"]
+            and inputs.drawing is None
+            and trace_sources.follows_program(inputs.program, inputs.machine, self.statuses)
+        )  # the figures without it are the program's own: nothing to re-simulate
+        self.simulated = [] if self.exact else self.modelled
         self._answered(0)
         work = partial(without_source, inputs)
         self.work: ForkedWork[str, Without] | _ForkedOne[str, Without]
-        if alongside and len(self.modelled) == 1:
-            self.work = _ForkedOne(work, self.modelled[0])
+        if alongside and len(self.simulated) == 1:
+            self.work = _ForkedOne(work, self.simulated[0])
         else:
-            self.work = ForkedWork(work, self.modelled)
+            self.work = ForkedWork(work, self.simulated)
 
     def __enter__(self) -> BudgetRun:
         return self
@@ -280,7 +292,11 @@ class BudgetRun:
                 f"only the first {eb.MAX_CONTOURS} of {len(v.contours)} contours are in the budget"
             )
         without: dict[str, eb.Figures] = {}
-        for name, got in zip(self.modelled, self.work.answers(self._answered), strict=True):
+        if self.exact:
+            figures = trace_sources.ideal_figures(v.program, v.contours, along=v.along is not None)
+            without["interpolation"] = figures
+            self._answered(1)
+        for name, got in zip(self.simulated, self.work.answers(self._answered), strict=True):
             values = got.values | (eb.against_figures(v.against) if got.same else {})
             if got.blocks is not None and got.blocks != [c.blocks for c in v.contours]:
                 # the plan's moves are not the code's: only the whole-program figures compare

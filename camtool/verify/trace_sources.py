@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import math
+from collections.abc import Sequence
+
 import numpy as np
 
 from camtool.accel.memo import LastAnswers
@@ -9,6 +12,8 @@ from camtool.model.errors import UsageError
 from camtool.model.machine import Machine
 from camtool.model.program import ArcMove, Program, Rapid
 from camtool.verify import budget as eb
+from camtool.verify.contour_measures import ContourMeasure
+from camtool.verify.deviations import move_starts
 from camtool.verify.motion import StepTrace, library
 from camtool.verify.simulate import (
     simulate_steps,
@@ -63,6 +68,79 @@ def source_statuses(
         out.append(eb.SourceStatus("rounding", "unknown", "not known from the code alone"))
     else:
         out.append(eb.SourceStatus("rounding", "modelled"))
+    return out
+
+
+EXACT_RADII_MM = 1e-9
+"""Largest difference of an arc's start and end radius, mm, for which the controller with
+``interpolation`` off runs the program's own circle (:func:`follows_program`); it blends
+the two radii along the arc, which the program's circle does not (1e-9 mm is a thousandth
+of the 0.0001 µm a report prints)."""
+
+
+def follows_program(
+    program: Program, machine: Machine, statuses: Sequence[eb.SourceStatus]
+) -> bool:
+    """Whether ``program`` simulated with ``interpolation`` off is the program itself.
+
+    True when ``interpolation`` is the one source ``statuses`` model (no scale, backlash,
+    chords, dynamics or rounding to leave in the trace), the machine's line runs on the
+    step simulator (:func:`simulate`; a target's own simulator may model more), and every
+    arc is a circle both in mm and in steps: equal steps/mm on X and Y, and its end on the
+    circle of its start (:data:`EXACT_RADII_MM`). The ideal controller
+    (:class:`~camtool.verify.simulate.IdealController`) then moves the carriage along the
+    programmed lines and circles, unrounded, so that every figure of the budget is the
+    program's own (:func:`ideal_figures`), with nothing to simulate.
+    """
+    modelled = [s.name for s in statuses if s.status == "modelled"]
+    if modelled != ["interpolation"] or library(machine).simulator(machine.motion.line) is not None:
+        return False
+    arcs = [i for i, move in enumerate(program.moves) if isinstance(move, ArcMove)]
+    if not arcs:
+        return True
+    if machine.steps_per_mm[0] != machine.steps_per_mm[1]:
+        return False
+    starts = move_starts(program)
+    for i in arcs:
+        move = program.moves[i]
+        assert isinstance(move, ArcMove)
+        x0, y0 = starts[i]
+        r0 = math.hypot(x0 - move.cx, y0 - move.cy)
+        r1 = math.hypot(move.x - move.cx, move.y - move.cy)
+        if abs(r1 - r0) > EXACT_RADII_MM:
+            return False
+    return True
+
+
+def ideal_figures(
+    program: Program, contours: Sequence[ContourMeasure], *, along: bool
+) -> eb.Figures:
+    """The budget's figures of a program that its ideal trace follows exactly.
+
+    The trace with ``interpolation`` off of a program that :func:`follows_program`: no
+    deviation and no shortfall (the carriage is on the path and passes every point of
+    it), each contour's extent and fitted circle the nominal ones (size and diameter
+    errors 0), and a closed contour's closure gap the program's own (its end within 1e-6 mm
+    of its start, :func:`~camtool.verify.contour_measures._contour_measure`). ``contours``
+    are the verification's (the full model's), ``along``: whether it measured the
+    shortfall. The re-simulation gives the same figures up to its sampling
+    (:data:`~camtool.verify.simulate.IDEAL_SAMPLES_PER_STEP` rows a step: an arc's chords
+    between them, ~0.01 µm on a 3 mm radius) and the rounding of its sums.
+    """
+    starts = move_starts(program)
+    out: eb.Figures = {"max deviation": 0.0}
+    if along:
+        out["shortfall along the path"] = 0.0
+    for c in contours[: eb.MAX_CONTOURS]:
+        first, last = c.blocks
+        if c.closure_um is not None:
+            out[f"contour {c.number} closure gap"] = (
+                math.dist(starts[first], starts[last + 1]) * 1000.0
+            )
+        out[f"contour {c.number} size error x"] = 0.0
+        out[f"contour {c.number} size error y"] = 0.0
+        if c.circle is not None:
+            out[f"contour {c.number} diameter error"] = 0.0
     return out
 
 

@@ -19,7 +19,7 @@ import pytest
 
 from camtool.accel import cores
 from camtool.model.machine import Backlash, BacklashRegion, Machine
-from camtool.model.program import Linear, Program, Rapid
+from camtool.model.program import ArcMove, Linear, Program, Rapid
 from camtool.model.progress import Step
 from camtool.post.registry import load_target
 from camtool.verify import budget_run, chunked, verifier
@@ -33,10 +33,17 @@ pytestmark = [
 
 
 def _lines(count: int = 8) -> Program:
-    """Long lines back and forth along X, each a little higher: one contour."""
-    moves: list[Linear | Rapid] = [Rapid(0.5, 0.5, contour=1)]
+    """Long lines back and forth along X, each a little higher, then an arc: one contour.
+
+    The quarter circle ends 0.04 nm off the circle of its start (as a rounded end does):
+    the controller with ``interpolation`` off blends the two radii, so the budget's one
+    source is re-simulated (:func:`camtool.verify.trace_sources.follows_program`).
+    """
+    moves: list[Linear | Rapid | ArcMove] = [Rapid(0.5, 0.5, contour=1)]
     for k in range(count):
         moves.append(Linear(6.0 if k % 2 == 0 else 0.5, 0.5 + 0.137 * (k + 1), 300.0, contour=1))
+    x, y = moves[-1].x, moves[-1].y
+    moves.append(ArcMove(x + 0.5, y + 0.5002, x, y + 0.5, False, 300.0, contour=1))
     return Program(tuple(moves), origin=(0.0, 0.0))
 
 
