@@ -27,6 +27,7 @@ from camtool.model.program import (
     PlaneArc,
     Program,
     Rapid,
+    ToolChange,
 )
 from camtool.model.shapes import Point
 from camtool.model.units import INCH
@@ -41,7 +42,11 @@ _PLANE_NAMES = {"xy": "XY plane (G17)", "zx": "ZX plane (G18)", "yz": "YZ plane 
 
 
 def read_gcode(
-    path: str | Path, *, source_name: str | None = None, feed_mm_min: float | None = None
+    path: str | Path,
+    *,
+    source_name: str | None = None,
+    feed_mm_min: float | None = None,
+    length_offsets: bool = False,
 ) -> Program:
     """Read a G-code file (``.ngc``, ``.nc``, ``.tap``, ``.gcode`` …) into a program.
 
@@ -50,6 +55,9 @@ def read_gcode(
         source_name: the name messages give the file (default: ``path``).
         feed_mm_min: the feed of cuts before the program's first F word (``post
             --feed``, which then sets every cut's feed); ``None``: such a cut is refused.
+        length_offsets: the program is read for a target that applies tool length
+            offsets (LinuxCNC's ``G43 H<n>`` after each change to tool ``n``): a ``G43``
+            or ``G49`` whose Z it would not reproduce is refused (:func:`parse_gcode`).
 
     Returns:
         The moves in absolute mm, Y up, feeds in mm/min, with the warnings for
@@ -66,21 +74,26 @@ def read_gcode(
         text = _decoded(path.read_bytes())  # the bytes go as soon as they are text
     except OSError as exc:
         raise InputError(f"{source}: cannot read the file ({exc.strerror or exc})") from exc
-    return parse_gcode(text, source=source, feed_mm_min=feed_mm_min)
+    return parse_gcode(text, source=source, feed_mm_min=feed_mm_min, length_offsets=length_offsets)
 
 
-def read_gcode_bytes(data: bytes, *, source: str, feed_mm_min: float | None = None) -> Program:
+def read_gcode_bytes(
+    data: bytes, *, source: str, feed_mm_min: float | None = None, length_offsets: bool = False
+) -> Program:
     """Read a G-code file given as its bytes (as :func:`read_gcode` reads the file's).
 
     Args:
         data: the file's bytes: UTF-8 (with or without BOM), else read as Latin-1.
         source: the name messages give the file.
         feed_mm_min: as :func:`read_gcode`'s.
+        length_offsets: as :func:`read_gcode`'s.
 
     Raises:
         InputError: as :func:`parse_gcode`.
     """
-    return parse_gcode(_decoded(data), source=source, feed_mm_min=feed_mm_min)
+    return parse_gcode(
+        _decoded(data), source=source, feed_mm_min=feed_mm_min, length_offsets=length_offsets
+    )
 
 
 def _decoded(data: bytes) -> str:
@@ -108,7 +121,9 @@ def _lines(text: str) -> Iterator[tuple[str, bool]]:
     yield text[start:], True
 
 
-def parse_gcode(text: str, *, source: str, feed_mm_min: float | None = None) -> Program:
+def parse_gcode(
+    text: str, *, source: str, feed_mm_min: float | None = None, length_offsets: bool = False
+) -> Program:
     """Read G-code text into a program (the rules are in this module's docstring).
 
     Args:
@@ -116,6 +131,11 @@ def parse_gcode(text: str, *, source: str, feed_mm_min: float | None = None) -> 
         source: the name messages give it; line numbers are 1-based file lines.
         feed_mm_min: the feed of cuts before the first F word, mm/min (> 0), as
             :func:`read_gcode`'s; ``None``: such a cut is refused.
+        length_offsets: read for a target that applies tool length offsets: a ``G43``
+            other than ``G43 H<n>`` after the change to tool ``n`` and before any Z move
+            (where such a target writes its own), and a Z word after a ``G49`` that
+            cancelled one, are refused (its program would put the tool a tool length
+            off); otherwise ``G43`` and ``G49`` are read as no offset, with a warning.
 
     Raises:
         InputError: O-words, ``#`` parameters, ``[ ]`` expressions, G41/G42,
@@ -129,7 +149,13 @@ def parse_gcode(text: str, *, source: str, feed_mm_min: float | None = None) -> 
     Plain lines take the fast path (:meth:`_Reader.plain`, no word objects) unless
     ``CAMTOOL_ACCEL=0``; :func:`parse_gcode_slow` is the reference, with the same result.
     """
-    return _parse(text, source, plain=accel.enabled(), feed_mm_min=feed_mm_min)
+    return _parse(
+        text,
+        source,
+        plain=accel.enabled(),
+        feed_mm_min=feed_mm_min,
+        length_offsets=length_offsets,
+    )
 
 
 def parse_gcode_slow(text: str, *, source: str) -> Program:
@@ -142,11 +168,18 @@ def parse_gcode_slow(text: str, *, source: str) -> Program:
     return _parse(text, source, plain=False)
 
 
-def _parse(text: str, source: str, *, plain: bool, feed_mm_min: float | None = None) -> Program:
+def _parse(
+    text: str,
+    source: str,
+    *,
+    plain: bool,
+    feed_mm_min: float | None = None,
+    length_offsets: bool = False,
+) -> Program:
     """:func:`parse_gcode`; ``plain``: take the plain-line path where it applies."""
     lines = _lines(text)
     rest = (raw for raw, _ in lines)  # the lines after the program's end
-    reader = _Reader(source, first_feed=feed_mm_min)
+    reader = _Reader(source, first_feed=feed_mm_min, length_offsets=length_offsets)
     opened = False  # a '%' line before the first block: the next '%' ends the program
     ended = False
     plain_words = PLAIN_WORDS.findall
@@ -185,7 +218,9 @@ def _parse(text: str, source: str, *, plain: bool, feed_mm_min: float | None = N
 class _Reader(PlainLines):
     """The modal state of the interpreter and the moves read so far."""
 
-    def __init__(self, source: str, first_feed: float | None = None) -> None:
+    def __init__(
+        self, source: str, first_feed: float | None = None, length_offsets: bool = False
+    ) -> None:
         self.source = source
         self.notes = Notes(source)
         self.commands = CommandReader(self.notes)
@@ -205,6 +240,9 @@ class _Reader(PlainLines):
         self.feed_mm_min: float | None = None
         self.first_feed = first_feed  # the feed before the first F word (post --feed)
         self.coord: str | None = None
+        self.length_offsets = length_offsets  # the target writes G43 H<n> after each change
+        self.offset_line = 0  # the G43 whose offset is on (0: none)
+        self.cancelled_line = 0  # the G49 that turned an offset off (0: none)
         self.home = ""
         self.contour = 1
         self.cut_in_contour = False
@@ -282,8 +320,10 @@ class _Reader(PlainLines):
             self.feed_mm_min = f.value * self.scale
         self.commands.block(w, len(self.moves), self.line, self.where())
         for code in (*w.m.values(), *w.g.values()):
-            if code.action == "warn":
+            if code.action == "warn" and not (self.length_offsets and code.group == "length"):
                 self.notes.add(code.name, self.line, code.note)
+        if self.length_offsets:
+            self._length_offset(w)
         if (coord := w.g_name("coord")) is not None:
             if self.coord not in (None, coord):
                 raise InputError(
@@ -297,6 +337,52 @@ class _Reader(PlainLines):
             self.absolute = distance == "G90"
         if (arc_distance := w.g_name("arc_distance")) is not None:
             self.arc_absolute = arc_distance == "G90.1"
+
+    def _length_offset(self, w: BlockWords) -> None:
+        """G43/G49 read for a target that writes ``G43 H<n>`` after each change to tool ``n``.
+
+        Its program reproduces a ``G43`` only where it writes one: right after the change
+        to that tool, before any Z move (an XY move between, as in ``T1 M6``, ``G0 X Y``,
+        ``G43 H1 Z2``, does not depend on it; LinuxCNC's ``G43`` without H takes the tool
+        in the spindle). Any other ``G43`` would leave its Z without the offset, and a Z after a
+        ``G49`` that cancelled one would keep it: the tool a tool length off.
+
+        Raises:
+            InputError: such a ``G43``, or a Z word after such a ``G49``.
+        """
+        code = w.g_name("length")
+        if code == "G43":
+            h = w.args.get("H")
+            changes = [(i, c) for i, c in self.commands.commands if isinstance(c, ToolChange)]
+            changed = changes[-1][1].tool if changes else None
+            fresh = bool(changes) and all(m.z is None for m in self.moves[changes[-1][0] :])
+            wanted = changed if h is None else h.value
+            if not (fresh and wanted == changed):
+                told = "G43" if h is None else f"G43 {h}"
+                why = (
+                    f"right after the change to T{changed:g}, before any Z move"
+                    if changed is not None
+                    else "after a tool change (T<n> M6)"
+                )
+                raise InputError(
+                    f"{self.where()}: {told} applies a tool length offset where camtool does "
+                    f"not write one: the target writes G43 H<n> only {why}, so its program "
+                    f"would put the tool a tool length off; put T{wanted:g} M6 right before "
+                    "it, or remove it if that tool's length offset is 0"
+                    if wanted is not None
+                    else "would put the tool a tool length off; put the tool change (T<n> M6) "
+                    "right before it, or remove it if the tool's length offset is 0"
+                )
+            self.offset_line, self.cancelled_line = self.line, 0
+        elif code == "G49" and self.offset_line:
+            self.offset_line, self.cancelled_line = 0, self.line
+        if self.cancelled_line and "Z" in w.args:
+            raise InputError(
+                f"{self.where()}: {w.args['Z']} after G49 (line {self.cancelled_line}) turned "
+                "the tool length offset off: the target's program keeps the offset of the "
+                "last tool change, so this Z would be a tool length off; move the G49 after "
+                "the program's last Z move, or post for a target without tool length offsets"
+            )
 
     def _check_unused(self, w: BlockWords, used: set[str]) -> None:
         """Refuse words that no code in the block uses (LinuxCNC does the same)."""

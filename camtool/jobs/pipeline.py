@@ -156,7 +156,7 @@ def post_path(
 
     progress(Step("reading", name=Path(path).name))
     return post_program(
-        read_gcode(path, feed_mm_min=plan.feed_mm_min),
+        read_gcode(path, feed_mm_min=plan.feed_mm_min, length_offsets=target.post.length_offsets),
         target,
         output,
         feed_mm_min=plan.feed_mm_min,
@@ -223,7 +223,12 @@ def post_bytes(
     from camtool.importers.gcode import read_gcode_bytes
 
     return post_program(
-        read_gcode_bytes(data, source=name, feed_mm_min=plan.feed_mm_min),
+        read_gcode_bytes(
+            data,
+            source=name,
+            feed_mm_min=plan.feed_mm_min,
+            length_offsets=target.post.length_offsets,
+        ),
         target,
         output,
         feed_mm_min=plan.feed_mm_min,

@@ -322,6 +322,16 @@ class PostProcessor(ABC):
         return "none"
 
     @property
+    def length_offsets(self) -> bool:
+        """True when the dialect applies the tool table's length offset after each tool change.
+
+        LinuxCNC's ``G43 H2`` after ``T2 M6``: the program's Z is the tool tip's with the
+        offset on. A program read for such a target must have its offsets where the
+        dialect writes them (:func:`camtool.importers.gcode.parse_gcode`).
+        """
+        return False
+
+    @property
     def helix(self) -> bool:
         """True when an arc may move Z (a helical arc)."""
         return False

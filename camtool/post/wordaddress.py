@@ -80,6 +80,11 @@ class WordAddressPost(PostProcessor):
             return "code"
         return "stop" if self.spec.stop and self.spec.comment else "none"
 
+    @property
+    def length_offsets(self) -> bool:
+        """True with a ``tool_length_offset`` code (LinuxCNC's ``G43 H<n>`` after each change)."""
+        return bool(self.spec.tool_length_offset)
+
     def emit(self, program: Program, machine: Machine, *, fmt: str | None = None) -> PostResult:
         """Write ``program`` for ``machine`` (rules: the module docstring).
 

@@ -27,6 +27,7 @@ from pathlib import Path
 
 import pytest
 
+from camtool.cli.main import main
 from camtool.jobs.pipeline import post_file
 from camtool.model.program import ArcMove, Linear, Rapid
 from camtool.toolpath.options import PlanOptions
@@ -179,3 +180,52 @@ def _options(extra: list[str]) -> PlanOptions:
     if extra[0] == "--fit" and len(extra) == 3:
         return PlanOptions(fit=(float(extra[1]), float(extra[2])))
     pytest.skip(f"comparison with flags {extra} is not mapped to planning options")
+
+
+OFFSET = re.compile(r"USE_TOOL_LENGTH_OFFSET\(([^)]*)\)")
+
+
+def _offsets_and_moves(stdout: str) -> list[str]:
+    """rs274's tool length offsets and motion calls, in order, a repeated one once."""
+    calls = [
+        line.split("N..... ", 1)[-1].strip()
+        for line in stdout.splitlines()
+        if OFFSET.search(line) or CANON.search(line)
+    ]
+    return [c for i, c in enumerate(calls) if i == 0 or c != calls[i - 1]]
+
+
+@needs_rs274
+def test_a_re_posted_tool_length_offset_is_the_one_rs274_applies(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """G43 H<n> right after T<n> M6 is what the linuxcnc dialect writes: the same offsets.
+
+    The judge is rs274 with a tool table whose tools have lengths (10, 20 and 30 in the
+    table's units): every offset it applies and every move it makes, in order, are those of
+    the program camtool reads, and a program whose G43 camtool would not write is refused
+    (rs274 applies tool 1's length to it; the program without it would be a length off).
+    """
+    table = tmp_path / "lengths.tbl"
+    table.write_text("".join(f"T{n} P{n} Z{10 * n}.0 D3.175 ;\n" for n in (1, 2, 3)))
+    source = tmp_path / "in.ngc"
+    source.write_text(
+        "G21 G90 G17\nT2 M6\nG43 H2\nG0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X10\nG0 Z5\n"
+        "T3 M6\nG43\nG0 X5 Y5\nG1 Z-1\nG0 Z5\nM2\n"
+    )
+    out = tmp_path / "out.ngc"
+    assert main(["post", str(source), "-t", "linuxcnc", "-o", str(out)]) == 0
+    want, got = rs274(source, table), rs274(out, table)
+    assert want.returncode == 0 and got.returncode == 0, got.stderr
+    expected = _offsets_and_moves(want.stdout)
+    assert sum("USE_TOOL_LENGTH_OFFSET" in c for c in expected) == 2
+    # the output's header says G49 first (no offset before the first change)
+    zero = "0.0000 0.0000 0.0000"
+    none = f"USE_TOOL_LENGTH_OFFSET({zero}, {zero}, {zero})"
+    assert _offsets_and_moves(got.stdout) == [none, *expected]
+    lone = tmp_path / "lone.ngc"
+    lone.write_text("G21 G90 G17\nG43 H1\nG0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X10\nG0 Z5\nM2\n")
+    assert "USE_TOOL_LENGTH_OFFSET(0.0000 0.0000 254.0000" in rs274(lone, table).stdout
+    assert main(["post", str(lone), "-t", "linuxcnc", "-o", str(tmp_path / "lone-out.ngc")]) != 0
+    assert "lone.ngc:2: G43 H1 applies a tool length offset" in capsys.readouterr().err
+    assert not (tmp_path / "lone-out.ngc").exists()
