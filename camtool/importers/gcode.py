@@ -20,7 +20,9 @@ from camtool.importers.gcode_plain import ARC_TOL_IN, ARC_TOL_MM, PLAIN_WORDS, P
 from camtool.model.errors import InputError
 from camtool.model.program import (
     ArcMove,
+    Command,
     Home,
+    LengthOffset,
     Linear,
     Move,
     Plane,
@@ -56,8 +58,8 @@ def read_gcode(
         feed_mm_min: the feed of cuts before the program's first F word (``post
             --feed``, which then sets every cut's feed); ``None``: such a cut is refused.
         length_offsets: the program is read for a target that applies tool length
-            offsets (LinuxCNC's ``G43 H<n>`` after each change to tool ``n``): a ``G43``
-            or ``G49`` whose Z it would not reproduce is refused (:func:`parse_gcode`).
+            offsets (LinuxCNC's ``G43 H<n>`` after each change to tool ``n``): its
+            ``G43`` and ``G49`` are kept where they are (:func:`parse_gcode`).
 
     Returns:
         The moves in absolute mm, Y up, feeds in mm/min, with the warnings for
@@ -131,11 +133,12 @@ def parse_gcode(
         source: the name messages give it; line numbers are 1-based file lines.
         feed_mm_min: the feed of cuts before the first F word, mm/min (> 0), as
             :func:`read_gcode`'s; ``None``: such a cut is refused.
-        length_offsets: read for a target that applies tool length offsets: a ``G43``
-            other than ``G43 H<n>`` after the change to tool ``n`` and before any Z move
-            (where such a target writes its own), and a Z word after a ``G49`` that
-            cancelled one, are refused (its program would put the tool a tool length
-            off); otherwise ``G43`` and ``G49`` are read as no offset, with a warning.
+        length_offsets: read for a target that applies tool length offsets itself
+            (LinuxCNC's ``G43 H<n>`` after each change to tool ``n``): a ``G43`` there is
+            the change's, a change without one says so (``ToolChange.length_offset``),
+            and any other ``G43`` or a ``G49`` that cancels one is a ``LengthOffset``
+            command, written where the program had it; otherwise both are read as no
+            offset, with a warning (Z as written).
 
     Raises:
         InputError: O-words, ``#`` parameters, ``[ ]`` expressions, G41/G42,
@@ -241,8 +244,8 @@ class _Reader(PlainLines):
         self.first_feed = first_feed  # the feed before the first F word (post --feed)
         self.coord: str | None = None
         self.length_offsets = length_offsets  # the target writes G43 H<n> after each change
-        self.offset_line = 0  # the G43 whose offset is on (0: none)
-        self.cancelled_line = 0  # the G49 that turned an offset off (0: none)
+        self.offset_on = False  # a G43 applied an offset that no G49 cancelled since
+        self.offset_changes: list[ToolChange] = []  # the changes a G43 followed
         self.home = ""
         self.contour = 1
         self.cut_in_contour = False
@@ -305,7 +308,7 @@ class _Reader(PlainLines):
             (0.0, 0.0),
             self.notes.warnings(),
             lines=self.lines,
-            commands=tuple(self.commands.commands),
+            commands=tuple(self._with_offsets(self.commands.commands)),
         )
 
     # -- modes -------------------------------------------------------------------
@@ -341,14 +344,15 @@ class _Reader(PlainLines):
     def _length_offset(self, w: BlockWords) -> None:
         """G43/G49 read for a target that writes ``G43 H<n>`` after each change to tool ``n``.
 
-        Its program reproduces a ``G43`` only where it writes one: right after the change
-        to that tool, before any Z move (an XY move between, as in ``T1 M6``, ``G0 X Y``,
+        A ``G43`` after the change to that tool and before any Z move is the one the
+        target writes with the change (an XY move between, as in ``T1 M6``, ``G0 X Y``,
         ``G43 H1 Z2``, does not depend on it; LinuxCNC's ``G43`` without H takes the tool
-        in the spindle). Any other ``G43`` would leave its Z without the offset, and a Z after a
-        ``G49`` that cancelled one would keep it: the tool a tool length off.
+        in the spindle); any other ``G43``, and a ``G49`` that cancels an offset, is a
+        :class:`~camtool.model.program.LengthOffset` written where the program had it.
 
         Raises:
-            InputError: such a ``G43``, or a Z word after such a ``G49``.
+            InputError: a ``G43`` without H before any tool change (the tool in the
+                spindle is not known).
         """
         code = w.g_name("length")
         if code == "G43":
@@ -356,33 +360,37 @@ class _Reader(PlainLines):
             changes = [(i, c) for i, c in self.commands.commands if isinstance(c, ToolChange)]
             changed = changes[-1][1].tool if changes else None
             fresh = bool(changes) and all(m.z is None for m in self.moves[changes[-1][0] :])
-            wanted = changed if h is None else h.value
-            if not (fresh and wanted == changed):
-                told = "G43" if h is None else f"G43 {h}"
-                why = (
-                    f"right after the change to T{changed:g}, before any Z move"
-                    if changed is not None
-                    else "after a tool change (T<n> M6)"
-                )
+            wanted = changed if h is None else round(h.value)
+            if wanted is None:
                 raise InputError(
-                    f"{self.where()}: {told} applies a tool length offset where camtool does "
-                    f"not write one: the target writes G43 H<n> only {why}, so its program "
-                    f"would put the tool a tool length off; put T{wanted:g} M6 right before "
-                    "it, or remove it if that tool's length offset is 0"
-                    if wanted is not None
-                    else "would put the tool a tool length off; put the tool change (T<n> M6) "
-                    "right before it, or remove it if the tool's length offset is 0"
+                    f"{self.where()}: G43 without H before any tool change: the tool whose "
+                    "length offset it applies is the one in the spindle, which the program "
+                    "does not say; write G43 H<n> with the tool's number"
                 )
-            self.offset_line, self.cancelled_line = self.line, 0
-        elif code == "G49" and self.offset_line:
-            self.offset_line, self.cancelled_line = 0, self.line
-        if self.cancelled_line and "Z" in w.args:
-            raise InputError(
-                f"{self.where()}: {w.args['Z']} after G49 (line {self.cancelled_line}) turned "
-                "the tool length offset off: the target's program keeps the offset of the "
-                "last tool change, so this Z would be a tool length off; move the G49 after "
-                "the program's last Z move, or post for a target without tool length offsets"
-            )
+            if fresh and wanted == changed:
+                self.offset_changes.append(changes[-1][1])
+            else:
+                self.commands.add(len(self.moves), LengthOffset(int(wanted)))
+            self.offset_on = True
+        elif code == "G49" and self.offset_on:
+            self.commands.add(len(self.moves), LengthOffset(None))
+            self.offset_on = False
+
+    def _with_offsets(self, commands: list[tuple[int, Command]]) -> Iterator[tuple[int, Command]]:
+        """``commands``, read for a target with length offsets: a change without its G43 says so.
+
+        The target writes ``G43 H<n>`` after a change only where the program had one
+        (:attr:`ToolChange.length_offset`): elsewhere the offset in force stays, as it
+        did when the program ran as read.
+        """
+        for index, command in commands:
+            if (
+                self.length_offsets
+                and isinstance(command, ToolChange)
+                and not any(command is c for c in self.offset_changes)
+            ):
+                command = dataclasses.replace(command, length_offset=False)
+            yield index, command
 
     def _check_unused(self, w: BlockWords, used: set[str]) -> None:
         """Refuse words that no code in the block uses (LinuxCNC does the same)."""

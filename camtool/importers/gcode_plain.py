@@ -134,7 +134,6 @@ class PlainLines:
     feed_mm_min: float | None
     contour: int
     cut_in_contour: bool
-    cancelled_line: int
 
     def plain(self, words: list[tuple[str, str]], line: int) -> bool:
         """Execute a plain line as :meth:`run` would, if it is one; False leaves all as it was.
@@ -164,8 +163,6 @@ class PlainLines:
             if letter in args:
                 return False
             args[letter] = value
-        if self.cancelled_line and "Z" in args:
-            return False  # a Z after a G49 that a target may refuse (_Reader._length_offset)
         motion = self.motion
         g = args.pop("G", None)
         if g is not None:

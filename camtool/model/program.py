@@ -86,11 +86,27 @@ class ToolChange:
 
     ``description`` says what the operator loads (``"drill 3 mm"``): a dialect that
     changes tools by hand (a program stop) shows it in its comment; ``""``: nothing
-    known but the number.
+    known but the number. ``length_offset``: a dialect that applies the tool table's
+    length offsets applies the new tool's after the change (LinuxCNC's ``G43 H2``);
+    ``False``: a program read from code had none there, so the offset in force stays.
     """
 
     tool: int
     description: str = ""
+    length_offset: bool = True
+
+
+@dataclass(frozen=True)
+class LengthOffset:
+    """Apply tool ``tool``'s length offset from the tool table (G43 H), or none (G49).
+
+    Only in a program read from code for a dialect that applies length offsets itself
+    (:attr:`ToolChange.length_offset`), where the code applied or cancelled one other
+    than right after a change: the program's Z from here on is measured with it.
+    ``None``: the offset is cancelled (G49).
+    """
+
+    tool: int | None
 
 
 @dataclass(frozen=True)
@@ -245,7 +261,9 @@ class PlaneArc:
         return out
 
 
-Command: TypeAlias = Spindle | Dwell | ToolChange | Stop | DrillCycle | Home | PlaneArc
+Command: TypeAlias = (
+    Spindle | Dwell | ToolChange | LengthOffset | Stop | DrillCycle | Home | PlaneArc
+)
 """A non-motion instruction (see :attr:`Program.commands`)."""
 
 

@@ -22,6 +22,7 @@ from camtool.model.machine import Machine
 from camtool.model.program import (
     Command,
     DrillCycle,
+    LengthOffset,
     Move,
     PlaneArc,
     Program,
@@ -235,6 +236,12 @@ class WriterState(Generic[B]):
         """
         if isinstance(command, DrillCycle | PlaneArc):
             return
+        if isinstance(command, LengthOffset):  # read only for a dialect that writes them
+            what = "G49" if command.tool is None else f"G43 H{command.tool}"
+            raise DialectError(
+                f"{self.where()}: this dialect cannot write the tool length offset {what}, "
+                "and the program's Z is measured with it: post for a target that has one"
+            )
         if isinstance(command, ToolChange | Stop):
             what = (
                 f"a tool change to T{command.tool}"

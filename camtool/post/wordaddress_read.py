@@ -168,9 +168,12 @@ class BlockReader:
             s.commands.append((len(s.moves), Dwell(values["P"])))
         elif key is not None and key == spec.tool_change:
             self._only(codes, values, key, "a tool change", needs="T")
-            s.commands.append((len(s.moves), ToolChange(round(values["T"]))))
+            # with a length offset code, the change has the offset only where one follows
+            change = ToolChange(round(values["T"]), length_offset=not spec.tool_length_offset)
+            s.commands.append((len(s.moves), change))
         elif key is not None and key == spec.tool_length_offset:
             self._only(codes, values, key, "a tool length offset", needs="H")
+            self._offset_after_change(round(values["H"]))
         elif key is not None and key in (spec.stop, spec.optional_stop):
             self._only(codes, values, key, "a program stop")
             optional = key == spec.optional_stop and key != spec.stop
@@ -237,6 +240,12 @@ class BlockReader:
                 f"{letter}{shown} is not in the format of {letter} (e.g. {letter}{example})"
             )
         return value
+
+    def _offset_after_change(self, tool: int) -> None:
+        """The length offset (``G43 H<n>``) the writer puts right after a change to tool n."""
+        commands = self.state.commands
+        if commands and isinstance(last := commands[-1][1], ToolChange) and last.tool == tool:
+            commands[-1] = (commands[-1][0], dataclasses.replace(last, length_offset=True))
 
     def _only(
         self, codes: list[str], values: dict[str, float], key: str, what: str, *, needs: str = ""

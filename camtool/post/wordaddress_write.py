@@ -21,6 +21,7 @@ from camtool.model.program import (
     Command,
     Dwell,
     Home,
+    LengthOffset,
     Linear,
     Move,
     PlaneArc,
@@ -648,8 +649,30 @@ class BlockWriter(WordWriter):
             self._tool_change(command)
         elif isinstance(command, Stop):
             self._stop(command.optional, command.message)
+        elif isinstance(command, LengthOffset):
+            self._length_offset(command)
         elif isinstance(command, Home):
             self.drop(command)
+
+    def _length_offset(self, offset: LengthOffset) -> None:
+        """``G43 H1`` or ``G49`` where a program read from code had it; the next Z again.
+
+        Raises:
+            DialectError: the dialect has no length offset code (or none that cancels).
+        """
+        spec = self.spec
+        cancel = {"G43": "G49"}.get(spec.tool_length_offset or "")
+        code = spec.tool_length_offset if offset.tool is not None else cancel
+        if code is None:
+            what = "G49" if offset.tool is None else f"G43 H{offset.tool}"
+            raise DialectError(
+                f"{self.where()}: {spec.name} cannot write the tool length offset {what}, "
+                "and the program's Z is measured with it; post for a target that has one"
+            )
+        words = [code] if offset.tool is None else [code, "H" + self.text("H", offset.tool)]
+        self.block(words)
+        self.z = None  # measured with another offset: the next Z is written again
+        self.last.pop("Z", None)
 
     def _tool_change(self, change: ToolChange) -> None:
         """``T2 M6`` (and ``G43 H2``), or by hand: spindle off, a comment, a stop."""
@@ -657,7 +680,7 @@ class BlockWriter(WordWriter):
         text = self.text("T", float(change.tool)) if spec.has("T") else str(change.tool)
         if spec.tool_change is not None:
             self.block(["T" + text, spec.tool_change])
-            if spec.tool_length_offset is not None:
+            if spec.tool_length_offset is not None and change.length_offset:
                 self.block([spec.tool_length_offset, "H" + self.text("H", float(change.tool))])
             self.z = None  # the new tool's length: the next Z is written again
             self.last.pop("Z", None)

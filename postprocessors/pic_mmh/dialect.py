@@ -25,6 +25,7 @@ from camtool.model.program import (
     DrillCycle,
     Dwell,
     Home,
+    LengthOffset,
     Linear,
     Move,
     PlaneArc,
@@ -513,6 +514,8 @@ class PicMmhPost(PostProcessor):
             pass  # the moves that follow are the cycle, or the arc's chords: written as they are
         elif isinstance(command, Stop):
             raise DialectError(f"{where}: pic-mmh has no program stop (M0/M1)")
+        elif isinstance(command, LengthOffset):
+            w.drop(command)  # refused: a program's Z measured with an offset pic-mmh lacks
         else:
             blocks = _home(command, where)
             w.blocks.extend(blocks)

@@ -196,22 +196,23 @@ def _offsets_and_moves(stdout: str) -> list[str]:
 
 
 @needs_rs274
-def test_a_re_posted_tool_length_offset_is_the_one_rs274_applies(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
+def test_a_re_posted_tool_length_offset_is_the_one_rs274_applies(tmp_path: Path) -> None:
     """G43 H<n> right after T<n> M6 is what the linuxcnc dialect writes: the same offsets.
+
+    A change with no G43 after it (the last, to T1) keeps the offset in force, in rs274 and
+    in the program camtool writes (no G43 H1 there either).
 
     The judge is rs274 with a tool table whose tools have lengths (10, 20 and 30 in the
     table's units): every offset it applies and every move it makes, in order, are those of
-    the program camtool reads, and a program whose G43 camtool would not write is refused
-    (rs274 applies tool 1's length to it; the program without it would be a length off).
+    the program camtool reads; also for a G43 with no change and a G49 (written where the
+    program had them: dropped, the tool stood a tool length off).
     """
     table = tmp_path / "lengths.tbl"
     table.write_text("".join(f"T{n} P{n} Z{10 * n}.0 D3.175 ;\n" for n in (1, 2, 3)))
     source = tmp_path / "in.ngc"
     source.write_text(
         "G21 G90 G17\nT2 M6\nG43 H2\nG0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X10\nG0 Z5\n"
-        "T3 M6\nG43\nG0 X5 Y5\nG1 Z-1\nG0 Z5\nM2\n"
+        "T3 M6\nG43\nG0 X5 Y5\nG1 Z-1\nG0 Z5\nT1 M6\nG0 X7 Y7\nG1 Z-2\nG0 Z5\nM2\n"
     )
     out = tmp_path / "out.ngc"
     assert main(["post", str(source), "-t", "linuxcnc", "-o", str(out)]) == 0
@@ -223,9 +224,10 @@ def test_a_re_posted_tool_length_offset_is_the_one_rs274_applies(
     zero = "0.0000 0.0000 0.0000"
     none = f"USE_TOOL_LENGTH_OFFSET({zero}, {zero}, {zero})"
     assert _offsets_and_moves(got.stdout) == [none, *expected]
-    lone = tmp_path / "lone.ngc"
-    lone.write_text("G21 G90 G17\nG43 H1\nG0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X10\nG0 Z5\nM2\n")
-    assert "USE_TOOL_LENGTH_OFFSET(0.0000 0.0000 254.0000" in rs274(lone, table).stdout
-    assert main(["post", str(lone), "-t", "linuxcnc", "-o", str(tmp_path / "lone-out.ngc")]) != 0
-    assert "lone.ngc:2: G43 H1 applies a tool length offset" in capsys.readouterr().err
-    assert not (tmp_path / "lone-out.ngc").exists()
+    lone = tmp_path / "lone.ngc"  # LinuxCNC's cds.ngc: G43 H1 with no change, then G49
+    lone.write_text("G21 G90 G17\nG0 X0 Y0 Z5\nG43 H1\nG1 Z-1 F100\nG1 X10\nG49\nG0 Z5\nM2\n")
+    lone_out = tmp_path / "lone-out.ngc"
+    assert main(["post", str(lone), "-t", "linuxcnc", "-o", str(lone_out)]) == 0
+    expected = _offsets_and_moves(rs274(lone, table).stdout)
+    assert "USE_TOOL_LENGTH_OFFSET(0.0000 0.0000 254.0000" in expected[1]
+    assert _offsets_and_moves(rs274(lone_out, table).stdout) == [none, *expected]
