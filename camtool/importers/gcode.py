@@ -30,6 +30,7 @@ from camtool.model.program import (
     Program,
     Rapid,
     ToolChange,
+    WorkOffset,
 )
 from camtool.model.shapes import Point
 from camtool.model.units import INCH
@@ -49,6 +50,7 @@ def read_gcode(
     source_name: str | None = None,
     feed_mm_min: float | None = None,
     length_offsets: bool = False,
+    work_offsets: tuple[str, ...] = (),
 ) -> Program:
     """Read a G-code file (``.ngc``, ``.nc``, ``.tap``, ``.gcode`` …) into a program.
 
@@ -60,6 +62,8 @@ def read_gcode(
         length_offsets: the program is read for a target that applies tool length
             offsets (LinuxCNC's ``G43 H<n>`` after each change to tool ``n``): its
             ``G43`` and ``G49`` are kept where they are (:func:`parse_gcode`).
+        work_offsets: the work offset codes the target writes (``G54`` …): the one the
+            program selects is kept (:func:`parse_gcode`).
 
     Returns:
         The moves in absolute mm, Y up, feeds in mm/min, with the warnings for
@@ -76,11 +80,22 @@ def read_gcode(
         text = _decoded(path.read_bytes())  # the bytes go as soon as they are text
     except OSError as exc:
         raise InputError(f"{source}: cannot read the file ({exc.strerror or exc})") from exc
-    return parse_gcode(text, source=source, feed_mm_min=feed_mm_min, length_offsets=length_offsets)
+    return parse_gcode(
+        text,
+        source=source,
+        feed_mm_min=feed_mm_min,
+        length_offsets=length_offsets,
+        work_offsets=work_offsets,
+    )
 
 
 def read_gcode_bytes(
-    data: bytes, *, source: str, feed_mm_min: float | None = None, length_offsets: bool = False
+    data: bytes,
+    *,
+    source: str,
+    feed_mm_min: float | None = None,
+    length_offsets: bool = False,
+    work_offsets: tuple[str, ...] = (),
 ) -> Program:
     """Read a G-code file given as its bytes (as :func:`read_gcode` reads the file's).
 
@@ -89,12 +104,17 @@ def read_gcode_bytes(
         source: the name messages give the file.
         feed_mm_min: as :func:`read_gcode`'s.
         length_offsets: as :func:`read_gcode`'s.
+        work_offsets: as :func:`read_gcode`'s.
 
     Raises:
         InputError: as :func:`parse_gcode`.
     """
     return parse_gcode(
-        _decoded(data), source=source, feed_mm_min=feed_mm_min, length_offsets=length_offsets
+        _decoded(data),
+        source=source,
+        feed_mm_min=feed_mm_min,
+        length_offsets=length_offsets,
+        work_offsets=work_offsets,
     )
 
 
@@ -124,7 +144,12 @@ def _lines(text: str) -> Iterator[tuple[str, bool]]:
 
 
 def parse_gcode(
-    text: str, *, source: str, feed_mm_min: float | None = None, length_offsets: bool = False
+    text: str,
+    *,
+    source: str,
+    feed_mm_min: float | None = None,
+    length_offsets: bool = False,
+    work_offsets: tuple[str, ...] = (),
 ) -> Program:
     """Read G-code text into a program (the rules are in this module's docstring).
 
@@ -139,6 +164,9 @@ def parse_gcode(
             and any other ``G43`` or a ``G49`` that cancels one is a ``LengthOffset``
             command, written where the program had it; otherwise both are read as no
             offset, with a warning (Z as written).
+        work_offsets: the work offset codes the target writes (``G54`` …): the one the
+            program selects, if among them, is a ``WorkOffset`` command written before its
+            first move; otherwise it is read as the part zero, with a warning.
 
     Raises:
         InputError: O-words, ``#`` parameters, ``[ ]`` expressions, G41/G42,
@@ -158,6 +186,7 @@ def parse_gcode(
         plain=accel.enabled(),
         feed_mm_min=feed_mm_min,
         length_offsets=length_offsets,
+        work_offsets=work_offsets,
     )
 
 
@@ -178,11 +207,17 @@ def _parse(
     plain: bool,
     feed_mm_min: float | None = None,
     length_offsets: bool = False,
+    work_offsets: tuple[str, ...] = (),
 ) -> Program:
     """:func:`parse_gcode`; ``plain``: take the plain-line path where it applies."""
     lines = _lines(text)
     rest = (raw for raw, _ in lines)  # the lines after the program's end
-    reader = _Reader(source, first_feed=feed_mm_min, length_offsets=length_offsets)
+    reader = _Reader(
+        source,
+        first_feed=feed_mm_min,
+        length_offsets=length_offsets,
+        work_offsets=work_offsets,
+    )
     opened = False  # a '%' line before the first block: the next '%' ends the program
     ended = False
     plain_words = PLAIN_WORDS.findall
@@ -222,7 +257,11 @@ class _Reader(PlainLines):
     """The modal state of the interpreter and the moves read so far."""
 
     def __init__(
-        self, source: str, first_feed: float | None = None, length_offsets: bool = False
+        self,
+        source: str,
+        first_feed: float | None = None,
+        length_offsets: bool = False,
+        work_offsets: tuple[str, ...] = (),
     ) -> None:
         self.source = source
         self.notes = Notes(source)
@@ -244,6 +283,7 @@ class _Reader(PlainLines):
         self.first_feed = first_feed  # the feed before the first F word (post --feed)
         self.coord: str | None = None
         self.length_offsets = length_offsets  # the target writes G43 H<n> after each change
+        self.work_offsets = work_offsets  # the work offsets the target writes
         self.offset_on = False  # a G43 applied an offset that no G49 cancelled since
         self.offset_changes: list[ToolChange] = []  # the changes a G43 followed
         self.home = ""
@@ -323,7 +363,10 @@ class _Reader(PlainLines):
             self.feed_mm_min = f.value * self.scale
         self.commands.block(w, len(self.moves), self.line, self.where())
         for code in (*w.m.values(), *w.g.values()):
-            if code.action == "warn" and not (self.length_offsets and code.group == "length"):
+            kept = (self.length_offsets and code.group == "length") or (
+                code.group == "coord" and code.name in self.work_offsets
+            )
+            if code.action == "warn" and not kept:
                 self.notes.add(code.name, self.line, code.note)
         if self.length_offsets:
             self._length_offset(w)
@@ -333,6 +376,8 @@ class _Reader(PlainLines):
                     f"{self.where()}: {coord} after {self.coord}: camtool assumes one work "
                     "offset (the part zero); split the program at the change"
                 )
+            if self.coord is None and coord in self.work_offsets:
+                self.commands.add(len(self.moves), WorkOffset(coord))
             self.coord = coord
         if (plane := w.g_name("plane")) is not None:
             self.plane = _PLANES[plane]

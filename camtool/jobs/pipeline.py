@@ -156,7 +156,12 @@ def post_path(
 
     progress(Step("reading", name=Path(path).name))
     return post_program(
-        read_gcode(path, feed_mm_min=plan.feed_mm_min, length_offsets=target.post.length_offsets),
+        read_gcode(
+            path,
+            feed_mm_min=plan.feed_mm_min,
+            length_offsets=target.post.length_offsets,
+            work_offsets=target.post.work_offsets,
+        ),
         target,
         output,
         feed_mm_min=plan.feed_mm_min,
@@ -228,6 +233,7 @@ def post_bytes(
             source=name,
             feed_mm_min=plan.feed_mm_min,
             length_offsets=target.post.length_offsets,
+            work_offsets=target.post.work_offsets,
         ),
         target,
         output,

@@ -110,6 +110,19 @@ class LengthOffset:
 
 
 @dataclass(frozen=True)
+class WorkOffset:
+    """Select the work offset ``code`` (``"G55"``) the program's coordinates are in.
+
+    Only in a program read from code for a dialect that writes work offsets
+    (``work_offsets`` of its spec): the program chose one, and run in another it would
+    cut elsewhere. Otherwise coordinates are the part zero's, the work offset the
+    user has active.
+    """
+
+    code: str
+
+
+@dataclass(frozen=True)
 class Stop:
     """Program stop (M0), or optional stop (M1) when ``optional``.
 
@@ -262,7 +275,7 @@ class PlaneArc:
 
 
 Command: TypeAlias = (
-    Spindle | Dwell | ToolChange | LengthOffset | Stop | DrillCycle | Home | PlaneArc
+    Spindle | Dwell | ToolChange | LengthOffset | WorkOffset | Stop | DrillCycle | Home | PlaneArc
 )
 """A non-motion instruction (see :attr:`Program.commands`)."""
 

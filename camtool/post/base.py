@@ -28,6 +28,7 @@ from camtool.model.program import (
     Program,
     Stop,
     ToolChange,
+    WorkOffset,
     plane_arcs_as_chords,
     segment_of,
 )
@@ -236,6 +237,11 @@ class WriterState(Generic[B]):
         """
         if isinstance(command, DrillCycle | PlaneArc):
             return
+        if isinstance(command, WorkOffset):  # read only for a dialect that writes them
+            raise DialectError(
+                f"{self.where()}: this dialect cannot select the work offset {command.code}, "
+                "and the program's coordinates are in it: post for a target that has it"
+            )
         if isinstance(command, LengthOffset):  # read only for a dialect that writes them
             what = "G49" if command.tool is None else f"G43 H{command.tool}"
             raise DialectError(
@@ -337,6 +343,15 @@ class PostProcessor(ABC):
         dialect writes them (:func:`camtool.importers.gcode.parse_gcode`).
         """
         return False
+
+    @property
+    def work_offsets(self) -> tuple[str, ...]:
+        """The work offset codes (``G54`` …) the dialect writes for a program that chose one.
+
+        A program read for such a target keeps its own (:func:`camtool.importers.gcode.
+        parse_gcode`); ``()``: coordinates are the part zero's, the offset the user has active.
+        """
+        return ()
 
     @property
     def helix(self) -> bool:

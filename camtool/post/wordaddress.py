@@ -85,6 +85,11 @@ class WordAddressPost(PostProcessor):
         """True with a ``tool_length_offset`` code (LinuxCNC's ``G43 H<n>`` after each change)."""
         return bool(self.spec.tool_length_offset)
 
+    @property
+    def work_offsets(self) -> tuple[str, ...]:
+        """The spec's ``work_offsets`` (LinuxCNC's G54 … G59.3, GRBL's G54 … G59)."""
+        return self.spec.work_offsets
+
     def emit(self, program: Program, machine: Machine, *, fmt: str | None = None) -> PostResult:
         """Write ``program`` for ``machine`` (rules: the module docstring).
 

@@ -112,6 +112,9 @@ class WordAddressSpec:
         tool_change: tool change code; the block is ``T<n> <code>`` (LinuxCNC ``T2 M6``).
         tool_length_offset: code that applies the new tool's length offset after a
             change, followed by the H word (LinuxCNC ``G43 H2``); ``None``: none.
+        work_offsets: the work offset codes the controller has (``G54`` … ``G59.3``): a
+            program read from code that selects one keeps it (written before its first
+            move); ``()``: a program runs in the work offset the user has active.
         stop: program stop code (``M0``): the machine waits for the operator. A
             dialect with a stop and comments but no ``tool_change`` changes tools by
             hand: a comment naming the tool, then the stop (GRBL 1.1).
@@ -153,6 +156,7 @@ class WordAddressSpec:
     dwell: str | None = None
     tool_change: str | None = None
     tool_length_offset: str | None = None
+    work_offsets: tuple[str, ...] = ()
     stop: str | None = None
     optional_stop: str | None = None
     end: tuple[str, ...] = ()
@@ -201,8 +205,9 @@ class WordAddressSpec:
         return _comment_pattern(self.comment).fullmatch(line) is not None
 
     def static_codes(self) -> frozenset[str]:
-        """Codes of the preamble and postamble (no effect on the path when read)."""
-        return frozenset(code for block in self.preamble + self.postamble for code in block)
+        """Codes of the preamble and postamble, and the work offsets (no effect on the path)."""
+        framed = (code for block in self.preamble + self.postamble for code in block)
+        return frozenset((*framed, *self.work_offsets))
 
 
 def _comment_pattern(style: str) -> re.Pattern[str]:
@@ -395,6 +400,10 @@ def _codes(t: _Table) -> dict[str, Any]:
         value = t.get(key)
         out[key] = None if value is None else _code(t, key, value)
     out["end"] = tuple(_code(t, "end", v) for v in t.strings("end"))
+    out["work_offsets"] = tuple(_code(t, "work_offsets", v) for v in t.strings("work_offsets"))
+    for code in out["work_offsets"]:
+        if not re.fullmatch(r"G5[4-9](\.[1-3])?", code):
+            raise t.error("work_offsets", f"a work offset is G54 to G59.3, got {_show(code)}")
     return out
 
 

@@ -30,6 +30,7 @@ from camtool.model.program import (
     Spindle,
     Stop,
     ToolChange,
+    WorkOffset,
 )
 from camtool.model.shapes import FULL_CIRCLE_EPS, Arc, Point, make_arc
 from camtool.post.base import (
@@ -651,7 +652,9 @@ class BlockWriter(WordWriter):
             self._stop(command.optional, command.message)
         elif isinstance(command, LengthOffset):
             self._length_offset(command)
-        elif isinstance(command, Home):
+        elif isinstance(command, WorkOffset) and command.code in self.spec.work_offsets:
+            self.block([command.code])
+        elif isinstance(command, Home | WorkOffset):
             self.drop(command)
 
     def _length_offset(self, offset: LengthOffset) -> None:

@@ -34,6 +34,7 @@ from camtool.model.program import (
     Spindle,
     Stop,
     ToolChange,
+    WorkOffset,
 )
 from camtool.model.shapes import Arc, distance
 from camtool.post.base import (
@@ -514,8 +515,8 @@ class PicMmhPost(PostProcessor):
             pass  # the moves that follow are the cycle, or the arc's chords: written as they are
         elif isinstance(command, Stop):
             raise DialectError(f"{where}: pic-mmh has no program stop (M0/M1)")
-        elif isinstance(command, LengthOffset):
-            w.drop(command)  # refused: a program's Z measured with an offset pic-mmh lacks
+        elif isinstance(command, LengthOffset | WorkOffset):
+            w.drop(command)  # refused: the program's numbers are in an offset pic-mmh lacks
         else:
             blocks = _home(command, where)
             w.blocks.extend(blocks)

@@ -231,3 +231,16 @@ def test_a_re_posted_tool_length_offset_is_the_one_rs274_applies(tmp_path: Path)
     expected = _offsets_and_moves(rs274(lone, table).stdout)
     assert "USE_TOOL_LENGTH_OFFSET(0.0000 0.0000 254.0000" in expected[1]
     assert _offsets_and_moves(rs274(lone_out, table).stdout) == [none, *expected]
+
+
+@needs_rs274
+def test_a_re_posted_work_offset_is_the_one_rs274_selects(tmp_path: Path) -> None:
+    """G55 written as the program chose it: rs274 selects offset 2 for both (SET_G5X_OFFSET)."""
+    source = tmp_path / "g55.ngc"
+    source.write_text("G21 G90 G17 G55\nG0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X10\nG0 Z5\nM2\n")
+    out = tmp_path / "out.ngc"
+    assert main(["post", str(source), "-t", "linuxcnc", "-o", str(out)]) == 0
+    for program in (source, out):
+        done = rs274(program)
+        assert done.returncode == 0, done.stderr
+        assert "SET_G5X_OFFSET(2," in done.stdout, program.name
