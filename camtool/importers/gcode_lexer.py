@@ -109,6 +109,7 @@ def _strip_comments_by_char(raw: str, where: str) -> tuple[str, int | None]:
                 raise InputError(f"{where}: comment '(' is not closed; add ')' on the same line")
             if 0 <= nested < close:
                 raise InputError(f"{where}: nested comment '(... (...' is not allowed; remove it")
+            _check_not_in_word(raw, kept, close, where)
             kept.append(" ")
             i = close + 1
             continue
@@ -119,6 +120,30 @@ def _strip_comments_by_char(raw: str, where: str) -> tuple[str, int | None]:
         kept.append(c)
         i += 1
     return "".join(kept), star_at
+
+
+_WORD_GOES_ON = frozenset("0123456789.+-")
+"""What may follow a word's letter or come within its number: a comment there splits it."""
+
+
+def _check_not_in_word(raw: str, kept: list[str], close: int, where: str) -> None:
+    """Refuse a comment ``(...)`` (ending at ``raw[close]``) inside a word: ``X1(c)0``.
+
+    Blanks inside a number are read as nothing (``X1 0`` is ``X10``, as LinuxCNC reads it),
+    but a comment there is not: LinuxCNC's ``rs274`` stops with "Bad character" at what
+    follows it, so camtool must not read ``X10`` (nor ``X(c)10``, ``X-(c)1``).
+    """
+    before = "".join(kept).rstrip()
+    after = raw[close + 1 :].lstrip()
+    if not before or not after or after[0] not in _WORD_GOES_ON:
+        return
+    if before[-1].isalpha() or before[-1] in _WORD_GOES_ON:
+        tail = re.search(r"[A-Za-z][0-9.+\- ]*$", before)
+        word = (tail[0] if tail else before.split()[-1]).replace(" ", "")
+        raise InputError(
+            f"{where}: a comment inside the word {word!r}...{after[:1]!r}: LinuxCNC refuses "
+            "it (a word's number cannot go on after a comment); move the comment after the word"
+        )
 
 
 def _check_checksum(raw: str, code: str, star_at: int, where: str) -> str:

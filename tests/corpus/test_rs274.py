@@ -244,3 +244,15 @@ def test_a_re_posted_work_offset_is_the_one_rs274_selects(tmp_path: Path) -> Non
         done = rs274(program)
         assert done.returncode == 0, done.stderr
         assert "SET_G5X_OFFSET(2," in done.stdout, program.name
+
+
+@needs_rs274
+def test_rs274_refuses_the_comments_inside_words_that_camtool_refuses(tmp_path: Path) -> None:
+    """The judge of tests/importers/test_gcode_comment_in_word.py's lines."""
+    from tests.importers.test_gcode_comment_in_word import READ, REFUSED, program
+
+    for words in [*REFUSED, *READ]:
+        path = tmp_path / "w.ngc"
+        path.write_text(program(words))
+        done = rs274(path)
+        assert ("PROGRAM_END" in done.stdout) == (words in READ), words
