@@ -285,7 +285,9 @@ class _Reader(PlainLines):
         self.length_offsets = length_offsets  # the target writes G43 H<n> after each change
         self.work_offsets = work_offsets  # the work offsets the target writes
         self.offset_on = False  # a G43 applied an offset that no G49 cancelled since
-        self.offset_changes: list[ToolChange] = []  # the changes a G43 followed
+        self.offset_changes: set[int] = set()  # id() of the changes a G43 followed
+        self.offset_written: set[int] = set()  # id() of the changes a LengthOffset followed
+        self.z_scan: tuple[ToolChange | None, int, bool] = (None, 0, False)  # _z_since_change
         self.home = ""
         self.contour = 1
         self.cut_in_contour = False
@@ -402,9 +404,9 @@ class _Reader(PlainLines):
         code = w.g_name("length")
         if code == "G43":
             h = w.args.get("H")
-            changes = [(i, c) for i, c in self.commands.commands if isinstance(c, ToolChange)]
-            changed = changes[-1][1].tool if changes else None
-            fresh = bool(changes) and all(m.z is None for m in self.moves[changes[-1][0] :])
+            last = self.commands.last_change
+            changed = None if last is None else last[1].tool
+            fresh = last is not None and not self._z_since_change(*last)
             wanted = changed if h is None else round(h.value)
             if wanted is None:
                 raise InputError(
@@ -412,14 +414,33 @@ class _Reader(PlainLines):
                     "length offset it applies is the one in the spindle, which the program "
                     "does not say; write G43 H<n> with the tool's number"
                 )
-            if fresh and wanted == changed:
-                self.offset_changes.append(changes[-1][1])
+            if last is not None and fresh and wanted == changed:
+                if id(last[1]) in self.offset_written:
+                    self._write_offset(LengthOffset(int(wanted)))
+                else:
+                    self.offset_changes.add(id(last[1]))
             else:
-                self.commands.add(len(self.moves), LengthOffset(int(wanted)))
+                self._write_offset(LengthOffset(int(wanted)))
             self.offset_on = True
         elif code == "G49" and self.offset_on:
-            self.commands.add(len(self.moves), LengthOffset(None))
+            self._write_offset(LengthOffset(None))
             self.offset_on = False
+
+    def _write_offset(self, offset: LengthOffset) -> None:
+        """``offset`` where the program has it; after it, no G43 is the last change's own."""
+        self.commands.add(len(self.moves), offset)
+        if self.commands.last_change is not None:
+            self.offset_written.add(id(self.commands.last_change[1]))
+
+    def _z_since_change(self, index: int, change: ToolChange) -> bool:
+        """Whether a move since ``change`` (before move ``index``) gave Z (each move seen once)."""
+        seen, upto, moved = self.z_scan
+        if seen is not change:
+            upto, moved = index, False
+        moves = self.moves
+        moved = moved or any(moves[i].z is not None for i in range(upto, len(moves)))
+        self.z_scan = (change, len(moves), moved)
+        return moved
 
     def _with_offsets(self, commands: list[tuple[int, Command]]) -> Iterator[tuple[int, Command]]:
         """``commands``, read for a target with length offsets: a change without its G43 says so.
@@ -432,7 +453,7 @@ class _Reader(PlainLines):
             if (
                 self.length_offsets
                 and isinstance(command, ToolChange)
-                and not any(command is c for c in self.offset_changes)
+                and id(command) not in self.offset_changes
             ):
                 command = dataclasses.replace(command, length_offset=False)
             yield index, command

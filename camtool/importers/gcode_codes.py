@@ -286,6 +286,7 @@ class CommandReader:
         self.rpm: float | None = None
         self.direction: SpindleDirection = "off"
         self.tool: int | None = None
+        self.last_change: tuple[int, ToolChange] | None = None  # (before move, the change)
         self.tool_line = 0
         self.tool_used = True
 
@@ -363,7 +364,8 @@ class CommandReader:
         if self.tool is None:
             self.notes.add("M6", line, "M6 without a T word: no tool selected, ignored")
             return
-        self.add(index, ToolChange(self.tool))
+        self.last_change = (index, ToolChange(self.tool))
+        self.add(*self.last_change)
         self.tool_used = True
 
     def _spindle(self, name: str, index: int) -> None:

@@ -113,3 +113,22 @@ def test_a_target_without_offsets_refuses_one() -> None:
         target = load_target(name)
         with pytest.raises(DialectError, match="tool length offset G43 H2"):
             target.post.emit(program, target.machine)
+
+
+def test_an_offset_after_the_change_s_own_is_kept_in_order() -> None:
+    """G43 H1, G49, G43 H1 after T1 M6: the second G43 is not the change's (it follows a G49)."""
+    text = HEAD + "T1 M6\nG43 H1\nG49\nG43 H1\n" + CUT + "M2\n"
+    assert [c for _, c in _both(text)] == [ToolChange(1), LengthOffset(None), LengthOffset(1)]
+    text = HEAD + "T1 M6\nG43 H2\nG43 H1\n" + CUT + "M2\n"
+    expected = [ToolChange(1, length_offset=False), LengthOffset(2), LengthOffset(1)]
+    assert [c for _, c in _both(text)] == expected
+
+
+def test_a_program_of_many_changes_and_offsets_is_read() -> None:
+    """A hostile program: 20 000 tool changes, each with its G43, and moves between (each G43
+    looks only at the moves since the one before, not back to the change)."""
+    block = "T{n} M6\nG43 H{n}\nG0 X1 Y1 Z5\nG1 Z-1 F100\nG1 X2\n"
+    text = HEAD + "".join(block.format(n=n % 99 + 1) for n in range(20_000)) + "M2\n"
+    program = gcode._parse(text, "p.ngc", plain=True, length_offsets=True)
+    changes = [c for _, c in program.commands if isinstance(c, ToolChange)]
+    assert len(changes) == 20_000 and all(c.length_offset for c in changes)
