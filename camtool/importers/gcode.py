@@ -17,19 +17,17 @@ from camtool import accel
 from camtool.importers.gcode_codes import BlockWords, CommandReader, Notes
 from camtool.importers.gcode_lexer import Block, Word, cut_mid_word, lex_line
 from camtool.importers.gcode_plain import ARC_TOL_IN, ARC_TOL_MM, PLAIN_WORDS, PlainLines
+from camtool.importers.gcode_target import READ_AS_WRITTEN, LengthOffsets, Reading
 from camtool.model.errors import InputError
 from camtool.model.program import (
     ArcMove,
-    Command,
     Home,
-    LengthOffset,
     Linear,
     Move,
     Plane,
     PlaneArc,
     Program,
     Rapid,
-    ToolChange,
     WorkOffset,
 )
 from camtool.model.shapes import Point
@@ -48,22 +46,15 @@ def read_gcode(
     path: str | Path,
     *,
     source_name: str | None = None,
-    feed_mm_min: float | None = None,
-    length_offsets: bool = False,
-    work_offsets: tuple[str, ...] = (),
+    reading: Reading = READ_AS_WRITTEN,
 ) -> Program:
     """Read a G-code file (``.ngc``, ``.nc``, ``.tap``, ``.gcode`` …) into a program.
 
     Args:
         path: the file. UTF-8 (with or without BOM), else read as Latin-1.
         source_name: the name messages give the file (default: ``path``).
-        feed_mm_min: the feed of cuts before the program's first F word (``post
-            --feed``, which then sets every cut's feed); ``None``: such a cut is refused.
-        length_offsets: the program is read for a target that applies tool length
-            offsets (LinuxCNC's ``G43 H<n>`` after each change to tool ``n``): its
-            ``G43`` and ``G49`` are kept where they are (:func:`parse_gcode`).
-        work_offsets: the work offset codes the target writes (``G54`` …): the one the
-            program selects is kept (:func:`parse_gcode`).
+        reading: what the program is read for (:class:`~camtool.importers.gcode_target.
+            Reading`: ``post --feed``, the target's length and work offsets).
 
     Returns:
         The moves in absolute mm, Y up, feeds in mm/min, with the warnings for
@@ -80,42 +71,26 @@ def read_gcode(
         text = _decoded(path.read_bytes())  # the bytes go as soon as they are text
     except OSError as exc:
         raise InputError(f"{source}: cannot read the file ({exc.strerror or exc})") from exc
-    return parse_gcode(
-        text,
-        source=source,
-        feed_mm_min=feed_mm_min,
-        length_offsets=length_offsets,
-        work_offsets=work_offsets,
-    )
+    return parse_gcode(text, source=source, reading=reading)
 
 
 def read_gcode_bytes(
     data: bytes,
     *,
     source: str,
-    feed_mm_min: float | None = None,
-    length_offsets: bool = False,
-    work_offsets: tuple[str, ...] = (),
+    reading: Reading = READ_AS_WRITTEN,
 ) -> Program:
     """Read a G-code file given as its bytes (as :func:`read_gcode` reads the file's).
 
     Args:
         data: the file's bytes: UTF-8 (with or without BOM), else read as Latin-1.
         source: the name messages give the file.
-        feed_mm_min: as :func:`read_gcode`'s.
-        length_offsets: as :func:`read_gcode`'s.
-        work_offsets: as :func:`read_gcode`'s.
+        reading: as :func:`read_gcode`'s.
 
     Raises:
         InputError: as :func:`parse_gcode`.
     """
-    return parse_gcode(
-        _decoded(data),
-        source=source,
-        feed_mm_min=feed_mm_min,
-        length_offsets=length_offsets,
-        work_offsets=work_offsets,
-    )
+    return parse_gcode(_decoded(data), source=source, reading=reading)
 
 
 def _decoded(data: bytes) -> str:
@@ -147,26 +122,16 @@ def parse_gcode(
     text: str,
     *,
     source: str,
-    feed_mm_min: float | None = None,
-    length_offsets: bool = False,
-    work_offsets: tuple[str, ...] = (),
+    reading: Reading = READ_AS_WRITTEN,
 ) -> Program:
     """Read G-code text into a program (the rules are in this module's docstring).
 
     Args:
         text: the program; lines end with LF, CR LF or CR.
         source: the name messages give it; line numbers are 1-based file lines.
-        feed_mm_min: the feed of cuts before the first F word, mm/min (> 0), as
-            :func:`read_gcode`'s; ``None``: such a cut is refused.
-        length_offsets: read for a target that applies tool length offsets itself
-            (LinuxCNC's ``G43 H<n>`` after each change to tool ``n``): a ``G43`` there is
-            the change's, a change without one says so (``ToolChange.length_offset``),
-            and any other ``G43`` or a ``G49`` that cancels one is a ``LengthOffset``
-            command, written where the program had it; otherwise both are read as no
-            offset, with a warning (Z as written).
-        work_offsets: the work offset codes the target writes (``G54`` …): the one the
-            program selects, if among them, is a ``WorkOffset`` command written before its
-            first move; otherwise it is read as the part zero, with a warning.
+        reading: what the program is read for (:class:`~camtool.importers.gcode_target.
+            Reading`): the feed of cuts before the first F word, and the target's length
+            offsets and work offsets, kept where the program has them.
 
     Raises:
         InputError: O-words, ``#`` parameters, ``[ ]`` expressions, G41/G42,
@@ -180,14 +145,7 @@ def parse_gcode(
     Plain lines take the fast path (:meth:`_Reader.plain`, no word objects) unless
     ``CAMTOOL_ACCEL=0``; :func:`parse_gcode_slow` is the reference, with the same result.
     """
-    return _parse(
-        text,
-        source,
-        plain=accel.enabled(),
-        feed_mm_min=feed_mm_min,
-        length_offsets=length_offsets,
-        work_offsets=work_offsets,
-    )
+    return _parse(text, source, plain=accel.enabled(), reading=reading)
 
 
 def parse_gcode_slow(text: str, *, source: str) -> Program:
@@ -205,19 +163,12 @@ def _parse(
     source: str,
     *,
     plain: bool,
-    feed_mm_min: float | None = None,
-    length_offsets: bool = False,
-    work_offsets: tuple[str, ...] = (),
+    reading: Reading = READ_AS_WRITTEN,
 ) -> Program:
     """:func:`parse_gcode`; ``plain``: take the plain-line path where it applies."""
     lines = _lines(text)
     rest = (raw for raw, _ in lines)  # the lines after the program's end
-    reader = _Reader(
-        source,
-        first_feed=feed_mm_min,
-        length_offsets=length_offsets,
-        work_offsets=work_offsets,
-    )
+    reader = _Reader(source, reading)
     opened = False  # a '%' line before the first block: the next '%' ends the program
     ended = False
     plain_words = PLAIN_WORDS.findall
@@ -256,13 +207,7 @@ def _parse(
 class _Reader(PlainLines):
     """The modal state of the interpreter and the moves read so far."""
 
-    def __init__(
-        self,
-        source: str,
-        first_feed: float | None = None,
-        length_offsets: bool = False,
-        work_offsets: tuple[str, ...] = (),
-    ) -> None:
+    def __init__(self, source: str, reading: Reading = READ_AS_WRITTEN) -> None:
         self.source = source
         self.notes = Notes(source)
         self.commands = CommandReader(self.notes)
@@ -280,14 +225,12 @@ class _Reader(PlainLines):
         self.inch = False
         self.units_seen = False
         self.feed_mm_min: float | None = None
-        self.first_feed = first_feed  # the feed before the first F word (post --feed)
+        self.first_feed = reading.feed_mm_min  # the feed before the first F word (post --feed)
+        self.work_offsets = reading.work_offsets  # the work offsets the target writes
         self.coord: str | None = None
-        self.length_offsets = length_offsets  # the target writes G43 H<n> after each change
-        self.work_offsets = work_offsets  # the work offsets the target writes
-        self.offset_on = False  # a G43 applied an offset that no G49 cancelled since
-        self.offset_changes: set[int] = set()  # id() of the changes a G43 followed
-        self.offset_written: set[int] = set()  # id() of the changes a LengthOffset followed
-        self.z_scan: tuple[ToolChange | None, int, bool] = (None, 0, False)  # _z_since_change
+        self.offsets = (  # the target writes G43 H<n> after each change: kept as read
+            LengthOffsets(self.commands, self.moves) if reading.length_offsets else None
+        )
         self.home = ""
         self.contour = 1
         self.cut_in_contour = False
@@ -350,7 +293,11 @@ class _Reader(PlainLines):
             (0.0, 0.0),
             self.notes.warnings(),
             lines=self.lines,
-            commands=tuple(self._with_offsets(self.commands.commands)),
+            commands=tuple(
+                self.commands.commands
+                if self.offsets is None
+                else self.offsets.commands_out(self.commands.commands)
+            ),
         )
 
     # -- modes -------------------------------------------------------------------
@@ -365,13 +312,13 @@ class _Reader(PlainLines):
             self.feed_mm_min = f.value * self.scale
         self.commands.block(w, len(self.moves), self.line, self.where())
         for code in (*w.m.values(), *w.g.values()):
-            kept = (self.length_offsets and code.group == "length") or (
+            kept = (self.offsets is not None and code.group == "length") or (
                 code.group == "coord" and code.name in self.work_offsets
             )
             if code.action == "warn" and not kept:
                 self.notes.add(code.name, self.line, code.note)
-        if self.length_offsets:
-            self._length_offset(w)
+        if self.offsets is not None:
+            self.offsets.block(w, self.where())
         if (coord := w.g_name("coord")) is not None:
             if self.coord not in (None, coord):
                 raise InputError(
@@ -387,76 +334,6 @@ class _Reader(PlainLines):
             self.absolute = distance == "G90"
         if (arc_distance := w.g_name("arc_distance")) is not None:
             self.arc_absolute = arc_distance == "G90.1"
-
-    def _length_offset(self, w: BlockWords) -> None:
-        """G43/G49 read for a target that writes ``G43 H<n>`` after each change to tool ``n``.
-
-        A ``G43`` after the change to that tool and before any Z move is the one the
-        target writes with the change (an XY move between, as in ``T1 M6``, ``G0 X Y``,
-        ``G43 H1 Z2``, does not depend on it; LinuxCNC's ``G43`` without H takes the tool
-        in the spindle); any other ``G43``, and a ``G49`` that cancels an offset, is a
-        :class:`~camtool.model.program.LengthOffset` written where the program had it.
-
-        Raises:
-            InputError: a ``G43`` without H before any tool change (the tool in the
-                spindle is not known).
-        """
-        code = w.g_name("length")
-        if code == "G43":
-            h = w.args.get("H")
-            last = self.commands.last_change
-            changed = None if last is None else last[1].tool
-            fresh = last is not None and not self._z_since_change(*last)
-            wanted = changed if h is None else round(h.value)
-            if wanted is None:
-                raise InputError(
-                    f"{self.where()}: G43 without H before any tool change: the tool whose "
-                    "length offset it applies is the one in the spindle, which the program "
-                    "does not say; write G43 H<n> with the tool's number"
-                )
-            if last is not None and fresh and wanted == changed:
-                if id(last[1]) in self.offset_written:
-                    self._write_offset(LengthOffset(int(wanted)))
-                else:
-                    self.offset_changes.add(id(last[1]))
-            else:
-                self._write_offset(LengthOffset(int(wanted)))
-            self.offset_on = True
-        elif code == "G49" and self.offset_on:
-            self._write_offset(LengthOffset(None))
-            self.offset_on = False
-
-    def _write_offset(self, offset: LengthOffset) -> None:
-        """``offset`` where the program has it; after it, no G43 is the last change's own."""
-        self.commands.add(len(self.moves), offset)
-        if self.commands.last_change is not None:
-            self.offset_written.add(id(self.commands.last_change[1]))
-
-    def _z_since_change(self, index: int, change: ToolChange) -> bool:
-        """Whether a move since ``change`` (before move ``index``) gave Z (each move seen once)."""
-        seen, upto, moved = self.z_scan
-        if seen is not change:
-            upto, moved = index, False
-        moves = self.moves
-        moved = moved or any(moves[i].z is not None for i in range(upto, len(moves)))
-        self.z_scan = (change, len(moves), moved)
-        return moved
-
-    def _with_offsets(self, commands: list[tuple[int, Command]]) -> Iterator[tuple[int, Command]]:
-        """``commands``, read for a target with length offsets: a change without its G43 says so.
-
-        The target writes ``G43 H<n>`` after a change only where the program had one
-        (:attr:`ToolChange.length_offset`): elsewhere the offset in force stays, as it
-        did when the program ran as read.
-        """
-        for index, command in commands:
-            if (
-                self.length_offsets
-                and isinstance(command, ToolChange)
-                and id(command) not in self.offset_changes
-            ):
-                command = dataclasses.replace(command, length_offset=False)
-            yield index, command
 
     def _check_unused(self, w: BlockWords, used: set[str]) -> None:
         """Refuse words that no code in the block uses (LinuxCNC does the same)."""

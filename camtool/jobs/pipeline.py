@@ -21,6 +21,7 @@ from camtool.post.registry import load_target
 from camtool.toolpath.options import PlanOptions, drawing_only
 
 if TYPE_CHECKING:
+    from camtool.importers.gcode_target import Reading
     from camtool.jobs.job import Job
     from camtool.jobs.run import OperationRun
     from camtool.toolpath.plan import PlanReport
@@ -156,12 +157,7 @@ def post_path(
 
     progress(Step("reading", name=Path(path).name))
     return post_program(
-        read_gcode(
-            path,
-            feed_mm_min=plan.feed_mm_min,
-            length_offsets=target.post.length_offsets,
-            work_offsets=target.post.work_offsets,
-        ),
+        read_gcode(path, reading=reading_for(target, plan)),
         target,
         output,
         feed_mm_min=plan.feed_mm_min,
@@ -228,19 +224,21 @@ def post_bytes(
     from camtool.importers.gcode import read_gcode_bytes
 
     return post_program(
-        read_gcode_bytes(
-            data,
-            source=name,
-            feed_mm_min=plan.feed_mm_min,
-            length_offsets=target.post.length_offsets,
-            work_offsets=target.post.work_offsets,
-        ),
+        read_gcode_bytes(data, source=name, reading=reading_for(target, plan)),
         target,
         output,
         feed_mm_min=plan.feed_mm_min,
         tolerance_mm=plan.tolerance,
         source=name,
     )
+
+
+def reading_for(target: Target, plan: PlanOptions) -> Reading:
+    """How a program posted to ``target`` is read: ``--feed``, the target's offsets."""
+    from camtool.importers.gcode_target import Reading
+
+    post = target.post
+    return Reading(plan.feed_mm_min, post.length_offsets, post.work_offsets)
 
 
 def sized(options: ImportOptions | None, plan: PlanOptions) -> ImportOptions:

@@ -11,6 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from camtool.importers.gcode import parse_gcode, parse_gcode_slow, read_gcode
+from camtool.importers.gcode_target import Reading
 from camtool.model.errors import InputError
 from camtool.model.program import ArcMove, Linear, Move, Program, Rapid, Spindle, Stop
 from camtool.model.shapes import Arc
@@ -563,9 +564,11 @@ def test_a_program_without_f_reads_with_the_feed_post_gives() -> None:
     text = "G21 G90\nG0 X0 Y0 Z5\nG1 Z-1\nG1 X10\nG2 X20 Y0 I5 J0\nM2\n"
     message = refused(text)
     assert "G1 before any F word" in message and "--feed" in message
-    program = parse_gcode(text, source="t.ngc", feed_mm_min=300.0)
+    program = parse_gcode(text, source="t.ngc", reading=Reading(feed_mm_min=300.0))
     assert [m.feed_mm_min for m in program.moves if not isinstance(m, Rapid)] == [300.0] * 3
-    program = parse_gcode(text.replace("G1 X10", "G1 X10 F50"), source="t.ngc", feed_mm_min=300.0)
+    program = parse_gcode(
+        text.replace("G1 X10", "G1 X10 F50"), source="t.ngc", reading=Reading(feed_mm_min=300.0)
+    )
     assert [m.feed_mm_min for m in program.moves if not isinstance(m, Rapid)] == [300, 50, 50]
 
 

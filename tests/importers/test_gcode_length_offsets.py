@@ -15,6 +15,7 @@ from __future__ import annotations
 import pytest
 
 from camtool.importers import gcode
+from camtool.importers.gcode_target import Reading
 from camtool.model.errors import InputError
 from camtool.model.program import LengthOffset, Linear, Program, Rapid, ToolChange
 from camtool.post.registry import load_target
@@ -25,7 +26,10 @@ CUT = "G0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X10\nG0 Z5\n"
 
 def _both(text: str) -> list[tuple[int, object]]:
     """``(before move, command)`` read for a target with length offsets, by both readers."""
-    got = [gcode._parse(text, "p.ngc", plain=plain, length_offsets=True) for plain in (True, False)]
+    got = [
+        gcode._parse(text, "p.ngc", plain=plain, reading=Reading(length_offsets=True))
+        for plain in (True, False)
+    ]
     assert got[0] == got[1]
     return list(got[0].commands)
 
@@ -76,7 +80,12 @@ def test_a_change_without_its_offset_says_so() -> None:
 def test_g43_without_h_before_any_change_is_refused() -> None:
     for plain in (True, False):
         with pytest.raises(InputError, match=r"p.ngc:2: G43 without H before any tool change"):
-            gcode._parse(HEAD + "G43\n" + CUT + "M2\n", "p.ngc", plain=plain, length_offsets=True)
+            gcode._parse(
+                HEAD + "G43\n" + CUT + "M2\n",
+                "p.ngc",
+                plain=plain,
+                reading=Reading(length_offsets=True),
+            )
 
 
 def test_other_targets_read_z_as_written_with_the_warning() -> None:
@@ -129,6 +138,6 @@ def test_a_program_of_many_changes_and_offsets_is_read() -> None:
     looks only at the moves since the one before, not back to the change)."""
     block = "T{n} M6\nG43 H{n}\nG0 X1 Y1 Z5\nG1 Z-1 F100\nG1 X2\n"
     text = HEAD + "".join(block.format(n=n % 99 + 1) for n in range(20_000)) + "M2\n"
-    program = gcode._parse(text, "p.ngc", plain=True, length_offsets=True)
+    program = gcode._parse(text, "p.ngc", plain=True, reading=Reading(length_offsets=True))
     changes = [c for _, c in program.commands if isinstance(c, ToolChange)]
     assert len(changes) == 20_000 and all(c.length_offset for c in changes)

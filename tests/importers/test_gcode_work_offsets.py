@@ -14,6 +14,7 @@ from __future__ import annotations
 import pytest
 
 from camtool.importers import gcode
+from camtool.importers.gcode_target import Reading
 from camtool.model.errors import DialectError
 from camtool.model.program import Linear, Program, Rapid, WorkOffset
 from camtool.post.registry import load_target
@@ -24,10 +25,12 @@ GRBL = ("G54", "G55", "G56", "G57", "G58", "G59")
 
 @pytest.mark.parametrize("plain", [True, False])
 def test_the_selected_offset_is_kept_for_a_target_that_has_it(plain: bool) -> None:
-    program = gcode._parse(TEXT, "p.ngc", plain=plain, work_offsets=GRBL)
+    program = gcode._parse(TEXT, "p.ngc", plain=plain, reading=Reading(work_offsets=GRBL))
     assert program.commands == ((0, WorkOffset("G55")),)  # once, before the first move
     assert not any("G55 work offset" in w for w in program.warnings)
-    other = gcode._parse(TEXT.replace("G55", "G59.1"), "p.ngc", plain=plain, work_offsets=GRBL)
+    other = gcode._parse(
+        TEXT.replace("G55", "G59.1"), "p.ngc", plain=plain, reading=Reading(work_offsets=GRBL)
+    )
     assert other.commands == ()  # GRBL has no G59.1: the part zero, with the warning
     assert any("G59.1 work offset assumed 0" in w for w in other.warnings)
     bare = gcode._parse(TEXT, "p.ngc", plain=plain)
