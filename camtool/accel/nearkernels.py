@@ -462,6 +462,49 @@ def pairs_within(
     return owner, end
 
 
+@numba.njit(cache=True, nogil=True)
+def nodes_within(samples: Any, boxes: Any, offsets: Any, reach: Any) -> Any:  # pragma: no cover
+    """How many boxes of the tree (every level) lie within ``reach[i]`` of each sample.
+
+    The nodes a search to that distance opens (:func:`pairs_within`'s work, and at least
+    :func:`knn`'s to its k-th end): a measure of how much the boxes overlap where the
+    samples are, not of the answer. ``boxes``, ``offsets``: :func:`build`'s.
+
+    Returns:
+        ``(N,)`` int64 counts.
+    """
+    n = len(samples)
+    out = np.zeros(n, dtype=np.int64)
+    top = len(offsets) - 2
+    stack_level = np.empty(64 * FAN, dtype=np.int64)
+    stack_node = np.empty(64 * FAN, dtype=np.int64)
+    for q in range(n):
+        qx = samples[q, 0]
+        qy = samples[q, 1]
+        bound = reach[q] * reach[q]
+        c = 0
+        stack_level[0] = top
+        stack_node[0] = 0
+        sp = 1
+        while sp > 0:
+            sp -= 1
+            level = stack_level[sp]
+            node = stack_node[sp]
+            if _box2(boxes, offsets[level] + node, qx, qy) > bound:
+                continue
+            c += 1
+            if level == 0:
+                continue
+            below = offsets[level - 1]
+            count_below = offsets[level] - below
+            for ch in range(node * FAN, min(count_below, node * FAN + FAN)):
+                stack_level[sp] = level - 1
+                stack_node[sp] = ch
+                sp += 1
+        out[q] = c
+    return out
+
+
 @numba.njit(inline="always")
 def _segment(px: float, py: float, a: Any, b: Any, s: int) -> float:  # pragma: no cover - compiled
     """Distance of ``(px, py)`` to segment ``a[s] → b[s]``, the floats of numpy's form.
@@ -700,6 +743,7 @@ def load_cached() -> None:
         (near_segments, (f2, *tree_of, f2, f2, t.int64)),
         (near_segments, (read_only, *tree_of, f2, f2, t.int64)),
         (pairs_within, (f2, *tree_of, f1, t.int64)),
+        (nodes_within, (f2, f2, i1, f1)),
         (least_of_pairs, (f2, i1, i1, f2, f2)),
     )
     for kernel, types in kernels:

@@ -26,9 +26,12 @@ nearkernels = pytest.importorskip("camtool.accel.nearkernels")
 @pytest.fixture(autouse=True)
 def _compiled(accel_on: None, monkeypatch: pytest.MonkeyPatch) -> None:
     """The compiled search in use from the first call (the default threshold is a load),
-    near samples included (:func:`nearest_search._far` would send those to the k-d tree)."""
+    near samples included (:func:`nearest_search._far`, :func:`~nearest_search._dense` and
+    :func:`~nearest_search._far_kd` would send those to the k-d tree)."""
     assert nearest_search.near_kernels() is nearkernels
     monkeypatch.setattr(nearest_search, "_far", lambda *args: True)
+    monkeypatch.setattr(nearest_search, "_far_kd", lambda *args: True)
+    monkeypatch.setattr(nearest_search, "_dense", lambda *args: False)
 
 
 def _trace(rng: np.random.Generator, kind: int) -> np.ndarray:
@@ -412,3 +415,66 @@ def test_farthest_off_asks_the_tree_for_every_tie_that_may_end_unsure(
     tree = nearkernels.tree(np.concatenate([a, b]), segments=True)
     ask = nearkernels.near_segments(samples, *tree, a, b, 4)[3]
     assert ask.any() and sum(asked) == int(ask.sum())
+
+
+def _zigzag(lines: int, step: float = 0.004) -> np.ndarray:
+    """A trace of ``lines`` 9 mm lines across a 6 mm band and back, ``step`` apart along each."""
+    x = np.arange(0.0, 9.0, step)
+    rows = []
+    for k in range(lines):
+        y = (k * 0.137) % 6.0
+        rows.append(np.c_[x if k % 2 == 0 else x[::-1], np.full(len(x), y)])
+    return np.concatenate(rows)
+
+
+def test_nodes_within_counts_every_box_within_reach() -> None:
+    """Each box within reach of a sample, counted by brute force over every level's boxes
+    (a child's box lies in its parent's, so the search opens exactly those)."""
+    rng = np.random.default_rng(5)
+    pts = _zigzag(12)
+    _, boxes, offsets, _, _ = nearkernels.tree(pts, merge=False)
+    samples = rng.uniform([0.0, 0.0], [9.0, 6.0], (200, 2))
+    reach = rng.uniform(0.0, 0.5, 200)
+    got = nearkernels.nodes_within(samples, boxes, offsets, reach)
+    dx = np.maximum(
+        np.maximum(boxes[None, :, 0] - samples[:, None, 0], 0.0),
+        samples[:, None, 0] - boxes[None, :, 2],
+    )
+    dy = np.maximum(
+        np.maximum(boxes[None, :, 1] - samples[:, None, 1], 0.0),
+        samples[:, None, 1] - boxes[None, :, 3],
+    )
+    want = (dx * dx + dy * dy <= (reach * reach)[:, None]).sum(axis=1)
+    assert got.tolist() == want.tolist()
+
+
+def test_a_trace_that_passes_again_and_again_is_dense(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Samples on a zig-zag of 300 lines 20 µm apart on average: dense; on 3 of its lines,
+    or 2 mm off to the side of the 300: not (the box tree's case)."""
+    monkeypatch.undo()  # the real _dense
+    for lines, off, dense in ((300, 0.0, True), (3, 0.0, False), (300, 2.0, False)):
+        pts = _zigzag(lines)
+        a, b = pts[:-1], pts[1:]
+        tree = nearkernels.tree(np.concatenate([a, b]), segments=True, merge=False)
+        samples = pts[:: max(1, len(pts) // 500)] + np.array([0.0005, 0.0003])
+        if off:  # beside the band, below it
+            samples = samples * np.array([1.0, 0.0]) - np.array([0.0, off])
+        assert nearest_search._dense(samples, tree, 0.002, nearkernels) is dense
+
+
+def test_the_shortfall_of_a_dense_trace_is_the_same_on_either_search(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Batches of path samples against one dense trace's ends, as the shortfall asks them:
+    the k-d tree answers from the first batch on, with the box tree's distances."""
+    monkeypatch.undo()  # the real choice
+    pts = _zigzag(300, step=0.02)  # 270 000 ends: 600 samples ask (KD_ENDS_PER_SAMPLE)
+    a, b = pts[:-1], pts[1:]
+    rng = np.random.default_rng(9)
+    ends = nearest_search._LazyTree(nearest_search._end_points(a, b))
+    batches = [pts[rng.integers(0, len(pts), 600)] + rng.normal(0.0, 0.003, (600, 2)) for _ in "ab"]
+    for samples in batches:
+        want = nearest_search.nearest_distances_kd(samples, a, b)
+        got = nearest_search.farthest_nearest(samples, a, b, ends=ends)
+        assert ends.built()  # the k-d tree's path: nearest_distances_kd's numbers
+        assert got == (float(np.max(want)), int(np.argmax(want)))
