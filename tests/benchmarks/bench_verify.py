@@ -84,6 +84,16 @@ the rows, the exact sum of squares carries every 512 additions (1 024 could wrap
 Two runs: 66.2 M steps **2.08 / 2.09 s, 0.055× / 0.053×** C (584 / 594 M steps/s), 243 /
 244 MB; 13.2 M steps 1.24 / 1.22 s, 0.018×. The goal is met on the 66.2 M-step program,
 with about 8 % to spare; not on the 13.2 M one (start-up 0.8 s). Reports byte-identical.
+
+Tenth pass (25 Nov 2026, quiet; the C peer now runs at ~900 M steps/s): the shortfall of a
+dense trace (these zig-zags' lines lie 30 µm and 6 µm apart) is searched in the k-d tree
+(docs/verify.md, "a trace that passes again and again"). 66.2 M steps 2.57 → 1.99 s,
+255 → 238 MB, 52.5 M steps/s after the start-up: **0.059×** C; 13.2 M steps 1.24 →
+1.12 s, 251 → 235 MB, 33.6 M steps/s after the start-up (0.037×: the k-d tree's 0.2 s
+build is half of what follows the start-up). The 40 half circles (one circle cut 20
+times, also dense) went 1.06 → 1.18 s, 229 → 244 MB with and without the budget: few
+samples, so the tree's build and scipy's import cost more there than they save.
+Reports byte-identical.
 """
 
 from __future__ import annotations
