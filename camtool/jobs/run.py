@@ -308,11 +308,14 @@ def run_job(
         (),
         tuple(m for r in runs for m in r.placed.marks),
     )
-    program = Program(
-        tuple(moves), setup.origin, tuple(dict.fromkeys(warnings)), commands=tuple(commands)
+    # the program built in the call, and ``moves`` emptied: placing it may shift every
+    # move, and each old one goes as its shifted copy is made (no second set at the peak)
+    program, placed_all, shift = place_program(
+        _unplaced(moves, setup.origin, tuple(dict.fromkeys(warnings)), tuple(commands)),
+        placed_all,
+        setup,
+        target.machine,
     )
-    moves.clear()  # the program holds them, and placing it may shift every one
-    program, placed_all, shift = place_program(program, placed_all, setup, target.machine)
     runs = _shifted(runs, placed_all, shift)
     program = dataclasses.replace(
         program,
@@ -356,6 +359,18 @@ def run_job(
         operations=tuple(runs),
         pieces=pieces,
     )
+
+
+def _unplaced(
+    moves: list[Move],
+    origin: Point,
+    warnings: tuple[str, ...],
+    commands: tuple[tuple[int, Command], ...],
+) -> Program:
+    """The job's program before its placement, ``moves`` emptied (the program holds them)."""
+    program = Program(tuple(moves), origin, warnings, commands=commands)
+    moves.clear()
+    return program
 
 
 def loaded_by_hand(program: Program, target: Target) -> Program:

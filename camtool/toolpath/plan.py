@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 from camtool.geometry.arcfit import FitStats, fit_polyline, fit_stats
 from camtool.geometry.chain import chain, joint_distance
 from camtool.model.errors import InputError
-from camtool.model.program import Move, Program, Rapid
+from camtool.model.program import Program, Rapid
 from camtool.model.progress import Progress, no_progress
 from camtool.model.shapes import BBox, Contour, Drawing, Line, Point, Segment, fit_factor
 from camtool.toolpath.chain import close_gaps
@@ -30,7 +30,7 @@ from camtool.toolpath.placement import (
     check_extent,
     larger_than_travel,
     placement_shift,
-    shift_program,
+    shift_moves,
     toolpath_extent,
 )
 from camtool.toolpath.split import MIN_PIECE
@@ -267,7 +267,7 @@ def place_program(
     """The placement stage: move the program so that its work zero lies where asked.
 
     ``options.placement`` (``--origin``) then ``options.translate`` (``--translate``)
-    shift the program's moves (:func:`~camtool.toolpath.placement.shift_program`; the
+    shift the program's moves (:func:`~camtool.toolpath.placement.shift_moves`; the
     start position and the ``--end-position`` rapid, given in work coordinates, stay)
     and the placed drawing alike, so that ``verify --against``
     and previews still line up. With a machine, the program is then checked against
@@ -284,13 +284,20 @@ def place_program(
             the work area of a machine in machine coordinates; the message names
             options that fix it as written.
     """
-    end: tuple[Move, ...] = ()
-    if options.end_position is not None and program.moves:
-        # the end position is given in work coordinates: it stays where it was asked
-        end, program = program.moves[-1:], dataclasses.replace(program, moves=program.moves[:-1])
-    dx, dy = placement_shift(program, options.placement, options.translate)
-    program = shift_program(program, dx, dy)
-    program = dataclasses.replace(program, moves=(*program.moves, *end))
+    moves = list(program.moves)
+    # the end position is given in work coordinates: it stays where it was asked
+    end = [moves.pop()] if options.end_position is not None and moves else []
+    fields = {f.name: getattr(program, f.name) for f in dataclasses.fields(program)}
+    del fields["moves"]
+    dx, dy = placement_shift(Program(tuple(moves), **fields), options.placement, options.translate)
+    # From here the list holds the moves (a caller that passed its program and kept no
+    # reference lets each old move go as its shifted copy replaces it: shift_moves).
+    del program
+    fields["commands"], fields["lines"] = shift_moves(
+        moves, fields["origin"], fields["commands"], fields["lines"], dx, dy
+    )
+    program = Program((*moves, *end), **fields)
+    moves.clear()
     if dx or dy:
         placed = placed.transformed(1.0, dx, dy)
     if machine is not None:

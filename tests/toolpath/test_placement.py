@@ -7,15 +7,20 @@ Y −1.5…61.5 (103 × 63 mm).
 
 from __future__ import annotations
 
+import gc
 import re
+import tracemalloc
 from pathlib import Path
 
 import ezdxf
 import pytest
 
 from camtool.cli.main import main
-from camtool.model.program import ArcMove, Dwell, Linear, Program, Rapid, Spindle
+from camtool.model.program import ArcMove, Dwell, Linear, Move, Program, Rapid, Spindle
+from camtool.model.shapes import Drawing
+from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.placement import placement_shift, shift_program, toolpath_extent
+from camtool.toolpath.plan import place_program
 
 OUTSIDE = ["--offset", "outside", "--tool-diameter", "3"]
 
@@ -259,6 +264,35 @@ def test_a_cut_from_the_start_position_is_reached_by_a_rapid_after_the_shift() -
     assert moved.moves == (Rapid(2, 3), Linear(7, 3, 100), Linear(7, 8, 100))
     # The spindle still starts first; the dwell stays before the second cut.
     assert moved.commands == ((0, Spindle("cw", 1000)), (2, Dwell(1.0)))
+
+
+def _unplaced(moves: list[Move]) -> Program:
+    """A program of ``moves``, the list emptied: the program alone holds them."""
+    program = Program(tuple(moves))
+    moves.clear()
+    return program
+
+
+def test_placing_a_program_does_not_hold_a_second_set_of_its_moves() -> None:
+    """``--origin lower-left`` of 100 000 cuts: each move is let go as its shifted copy is
+    made, so the peak grows by the lists of references (~40 bytes a move), not by a second
+    set of moves (a ``Linear`` and its two new coordinates are over 100 bytes)."""
+    n = 100_000
+    tracemalloc.start()
+    try:
+        moves: list[Move] = [Rapid(10.0, 10.0, z=5.0)]
+        moves += [Linear(10.0 + i, 10.0 + i % 7, 300.0, contour=1) for i in range(1, n)]
+        gc.collect()
+        base = tracemalloc.get_traced_memory()[0]
+        tracemalloc.reset_peak()
+        options = PlanOptions(placement="lower-left")
+        program, _, shift = place_program(_unplaced(moves), Drawing((), "p", ()), options)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert shift == (-10.0, -10.0)
+    assert program.moves[1] == Linear(1.0, 1.0, 300.0, contour=1)
+    assert (peak - base) / n < 64
 
 
 def test_a_chosen_work_zero_inside_the_part_is_not_warned_about(
