@@ -163,6 +163,32 @@ def test_full_circles_edges(radius: int, clockwise: bool) -> None:
         assert len(itp.staircase_arc(30, 0, 30, 0, 0, 0, clockwise)) == 240
 
 
+@pytest.mark.parametrize("start", [0, 1, 7])
+def test_quadrant_loops_grow_a_full_buffer_and_resume_where_they_stopped(start: int) -> None:
+    """The quadrant kernels stop when their buffer is full, grow it and go on (``dx``,
+    ``dy`` made again from ``x``, ``y``): from a buffer of a few rows, the rows, end state
+    and D of the Python runners (UNAM-GMM A.5/A.6) on quarter circles of radius 1 to 5 000,
+    both senses of the growing axis."""
+    kernels = dda.compiled()
+    for radius in (1, 2, 30, 997, 5000):
+        for gx, sx, sy in ((-1, 0, radius), (1, radius, 0)):
+            x, y = (radius, 0) if gx < 0 else (0, radius)
+            for name, kernel in (
+                ("dsm", kernels.dsm_quadrant),
+                ("staircase", kernels.staircase_quadrant),
+            ):
+                runner = itp._dsm_run if name == "dsm" else itp._staircase_run
+                codes = bytearray()
+                want = runner(x, y, 0, gx, -gx, sx, sy, codes)
+                rows = itp._code_rows(codes, 1, -1)
+                out = np.full((start + 3, 2), 9, dtype=np.int8)
+                *got, buffer, at = kernel(x, y, 0, gx, -gx, sx, sy, 1, -1, out, start)
+                assert tuple(got) == want, (name, radius, gx)
+                assert at - start == len(rows)
+                assert np.array_equal(buffer[start:at], rows), (name, radius, gx)
+                assert (buffer[:start] == 9).all()  # the rows before ``at`` kept as given
+
+
 def test_huge_coordinates_stay_on_the_exact_python_path() -> None:
     """Magnitudes past int64 safety never reach the compiled loop (same rows as the plain)."""
     big = 1 << 41
