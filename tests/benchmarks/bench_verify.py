@@ -85,6 +85,9 @@ Two runs: 66.2 M steps **2.08 / 2.09 s, 0.055× / 0.053×** C (584 / 594 M steps
 244 MB; 13.2 M steps 1.24 / 1.22 s, 0.018×. The goal is met on the 66.2 M-step program,
 with about 8 % to spare; not on the 13.2 M one (start-up 0.8 s). Reports byte-identical.
 
+The rows' ratio is issue 44's: camtool's steps/s after the start-up (the whole run's time
+less :data:`STARTUP`'s) over the C loop's; the note gives the whole run's too.
+
 Tenth pass (25 Nov 2026, quiet; the C peer now runs at ~900 M steps/s): the shortfall of a
 dense trace (these zig-zags' lines lie 30 µm and 6 µm apart) is searched in the k-d tree
 (docs/verify.md, "a trace that passes again and again"). 66.2 M steps 2.57 → 1.99 s,
@@ -389,15 +392,18 @@ def verify_row(
         )
         return
     c_rate, version = peer
-    ratio = rate / c_rate
+    # issue 44's rule: the steps/s after the start-up, against the C loop's
+    after = steps / max(wall - start, 1e-9)
+    ratio = after / c_rate
+    note += f"; with the start-up {rate / c_rate:.3f}× C"
     row(
         job,
-        camtool,
+        f"{camtool}; {after / 1e6:.1f} M steps/s after the start-up",
         f"C {version} -O2, A.3 loop on the same lines",
         f"{c_rate / 1e6:.0f} M steps/s",
         ratio,
         "speed",
-        "≥ 0.05×, < 250 MB",
+        "≥ 0.05× after the start-up, < 250 MB",
         rc == 0 and ratio >= 0.05 and rss < 250.0,
         note,
     )
