@@ -187,13 +187,18 @@ def _insert(best: Any, k: int, d2: float) -> None:  # pragma: no cover - compile
 
 
 @numba.njit(inline="always")
-def _scratch() -> tuple[Any, Any, Any, Any]:  # pragma: no cover - compiled
-    """The stacks of one search: node levels and numbers, a node's children and distances."""
+def _scratch(offsets: Any) -> tuple[Any, Any, Any, Any, Any]:  # pragma: no cover - compiled
+    """The scratch of one search in the tree of level ``offsets`` (:func:`build`).
+
+    Node levels and numbers, a node's children and their distances, and room for every
+    leaf (:func:`_leaves_within`).
+    """
     return (
         np.empty(64 * FAN, dtype=np.int64),
         np.empty(64 * FAN, dtype=np.int64),
         np.empty(FAN, dtype=np.int64),
         np.empty(FAN, dtype=np.float64),
+        np.empty(offsets[1], dtype=np.int64),
     )
 
 
@@ -211,7 +216,7 @@ def _knn_one(
     best: Any,
     found: Any,
     found2: Any,
-    work: tuple[Any, Any, Any, Any],
+    work: tuple[Any, Any, Any, Any, Any],
 ) -> tuple[int, int, bool]:  # pragma: no cover - compiled
     """:func:`knn`'s search for one query ``(qx, qy)``.
 
@@ -222,7 +227,7 @@ def _knn_one(
     warm start); ``work`` the scratch stacks. Returns ``(nearest place or -1, count,
     spill)``.
     """
-    stack_level, stack_node, child, child2 = work
+    stack_level, stack_node, child, child2, _ = work
     npts = len(points)
     top = len(offsets) - 2  # the root's level
     # a bound to start from: the k-th nearest of the leaves around the last
@@ -332,7 +337,7 @@ def knn(
     best = np.empty(k, dtype=np.float64)
     found = np.empty(CAP, dtype=np.int64)
     found2 = np.empty(CAP, dtype=np.float64)
-    work = _scratch()
+    work = _scratch(offsets)
     last = 0
     for q in range(n):
         qx, qy = samples[q, 0], samples[q, 1]
@@ -372,7 +377,7 @@ def within(
     found = np.zeros((n, CAP), dtype=np.int64)
     found2 = np.full((n, CAP), np.inf)
     count = np.zeros(n, dtype=np.int64)
-    work = _scratch()
+    work = _scratch(offsets)
     for q in range(n):
         row, row2 = found[q], found2[q]
         qx, qy = samples[q, 0], samples[q, 1]
@@ -411,6 +416,8 @@ def pairs_within(
     n = len(samples)
     counts = np.zeros(n, dtype=np.int64)
     total = 0
+    stack_level, stack_node, _, _, leaves = _scratch(offsets)
+    npts = len(points)
     for fill in range(2):
         if fill == 1:
             owner = np.empty(total, dtype=np.int64)
@@ -419,41 +426,22 @@ def pairs_within(
             owner = np.empty(0, dtype=np.int64)
             end = np.empty(0, dtype=np.int64)
         at = 0
-        top = len(offsets) - 2
-        stack_level = np.empty(64 * FAN, dtype=np.int64)
-        stack_node = np.empty(64 * FAN, dtype=np.int64)
-        npts = len(points)
         for q in range(n):
             qx = samples[q, 0]
             qy = samples[q, 1]
             bound = reach[q] * reach[q]
             c = 0
-            stack_level[0] = top
-            stack_node[0] = 0
-            sp = 1
-            while sp > 0:
-                sp -= 1
-                level = stack_level[sp]
-                node = stack_node[sp]
-                if _box2(boxes, offsets[level] + node, qx, qy) > bound:
-                    continue
-                if level == 0:
-                    for u in range(node * LEAF, min(npts, node * LEAF + LEAF)):
-                        if _point2(points, u, qx, qy) <= bound:
-                            for e in range(start[u], start[u + 1]):
-                                if fill == 1:
-                                    owner[at] = q
-                                    end[at] = ends[e]
-                                    at += 1
-                                c += 1
-                    continue
-                below = offsets[level - 1]
-                count_below = offsets[level] - below
-                for ch in range(node * FAN, min(count_below, node * FAN + FAN)):
-                    if _box2(boxes, below + ch, qx, qy) <= bound:
-                        stack_level[sp] = level - 1
-                        stack_node[sp] = ch
-                        sp += 1
+            m = _leaves_within(qx, qy, bound, boxes, offsets, stack_level, stack_node, leaves)[0]
+            for j in range(m):
+                node = leaves[j]
+                for u in range(node * LEAF, min(npts, node * LEAF + LEAF)):
+                    if _point2(points, u, qx, qy) <= bound:
+                        for e in range(start[u], start[u + 1]):
+                            if fill == 1:
+                                owner[at] = q
+                                end[at] = ends[e]
+                                at += 1
+                            c += 1
             counts[q] = c
             if fill == 0:
                 total += c
@@ -475,34 +463,57 @@ def nodes_within(samples: Any, boxes: Any, offsets: Any, reach: Any) -> Any:  # 
     """
     n = len(samples)
     out = np.zeros(n, dtype=np.int64)
-    top = len(offsets) - 2
-    stack_level = np.empty(64 * FAN, dtype=np.int64)
-    stack_node = np.empty(64 * FAN, dtype=np.int64)
+    stack_level, stack_node, _, _, leaves = _scratch(offsets)
     for q in range(n):
-        qx = samples[q, 0]
-        qy = samples[q, 1]
         bound = reach[q] * reach[q]
-        c = 0
-        stack_level[0] = top
-        stack_node[0] = 0
-        sp = 1
-        while sp > 0:
-            sp -= 1
-            level = stack_level[sp]
-            node = stack_node[sp]
-            if _box2(boxes, offsets[level] + node, qx, qy) > bound:
-                continue
-            c += 1
-            if level == 0:
-                continue
-            below = offsets[level - 1]
-            count_below = offsets[level] - below
-            for ch in range(node * FAN, min(count_below, node * FAN + FAN)):
+        qx, qy = samples[q, 0], samples[q, 1]
+        out[q] = _leaves_within(qx, qy, bound, boxes, offsets, stack_level, stack_node, leaves)[1]
+    return out
+
+
+@numba.njit(inline="always")
+def _leaves_within(
+    qx: float,
+    qy: float,
+    bound: float,
+    boxes: Any,
+    offsets: Any,
+    stack_level: Any,
+    stack_node: Any,
+    leaves: Any,
+) -> tuple[int, int]:  # pragma: no cover - compiled
+    """The leaves whose box lies within ``bound`` (squared) of ``(qx, qy)``, into ``leaves``.
+
+    The tree is searched from its root, a node's children in order (the last pushed is
+    searched first), a child only when its box is within ``bound``. ``stack_level``,
+    ``stack_node``: scratch of ``64·FAN``; ``leaves``: room for every leaf
+    (``offsets[1]``). Returns ``(m, opened)``: ``leaves[:m]`` in the order found, and the
+    boxes within ``bound`` at every level.
+    """
+    stack_level[0] = len(offsets) - 2  # the root's level
+    stack_node[0] = 0
+    sp = 1
+    m = 0
+    opened = 0
+    while sp > 0:
+        sp -= 1
+        level = stack_level[sp]
+        node = stack_node[sp]
+        if _box2(boxes, offsets[level] + node, qx, qy) > bound:
+            continue
+        opened += 1
+        if level == 0:
+            leaves[m] = node
+            m += 1
+            continue
+        below = offsets[level - 1]
+        count_below = offsets[level] - below
+        for ch in range(node * FAN, min(count_below, node * FAN + FAN)):
+            if _box2(boxes, below + ch, qx, qy) <= bound:
                 stack_level[sp] = level - 1
                 stack_node[sp] = ch
                 sp += 1
-        out[q] = c
-    return out
+    return m, opened
 
 
 @numba.njit(inline="always")
@@ -563,7 +574,7 @@ def near_segments(
     best = np.empty(k, dtype=np.float64)
     found = np.empty(CAP, dtype=np.int64)
     found2 = np.empty(CAP, dtype=np.float64)
-    work = _scratch()
+    work = _scratch(offsets)
     last = 0
     for q in range(n):
         qx = samples[q, 0]
@@ -624,42 +635,26 @@ def _ends_within(
     bound2: float,
     found: Any,
     found2: Any,
-    work: tuple[Any, Any, Any, Any],
+    work: tuple[Any, Any, Any, Any, Any],
 ) -> int:  # pragma: no cover - compiled
     """:func:`within` for one query: the ends within ``bound2`` into ``found``/``found2``.
 
     Returns how many there are (only the first :data:`CAP` are kept).
     """
-    stack_level, stack_node, _, _ = work
+    stack_level, stack_node, _, _, leaves = work
     npts = len(points)
-    top = len(offsets) - 2
     c = 0
-    stack_level[0] = top
-    stack_node[0] = 0
-    sp = 1
-    while sp > 0:
-        sp -= 1
-        level = stack_level[sp]
-        node = stack_node[sp]
-        if _box2(boxes, offsets[level] + node, qx, qy) > bound2:
-            continue
-        if level == 0:
-            for u in range(node * LEAF, min(npts, node * LEAF + LEAF)):
-                d2 = _point2(points, u, qx, qy)
-                if d2 <= bound2:
-                    for e in range(start[u], start[u + 1]):
-                        if c < CAP:
-                            found[c] = ends[e]
-                            found2[c] = d2
-                        c += 1
-            continue
-        below = offsets[level - 1]
-        count_below = offsets[level] - below
-        for ch in range(node * FAN, min(count_below, node * FAN + FAN)):
-            if _box2(boxes, below + ch, qx, qy) <= bound2:
-                stack_level[sp] = level - 1
-                stack_node[sp] = ch
-                sp += 1
+    m = _leaves_within(qx, qy, bound2, boxes, offsets, stack_level, stack_node, leaves)[0]
+    for j in range(m):
+        node = leaves[j]
+        for u in range(node * LEAF, min(npts, node * LEAF + LEAF)):
+            d2 = _point2(points, u, qx, qy)
+            if d2 <= bound2:
+                for e in range(start[u], start[u + 1]):
+                    if c < CAP:
+                        found[c] = ends[e]
+                        found2[c] = d2
+                    c += 1
     return c
 
 
