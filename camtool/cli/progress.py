@@ -24,6 +24,7 @@ _TEXTS = {
     "contours": "making contours of {total} shapes",
     "planning": "planning {total} contours",
     "offsetting": "offsetting {total} contours for the tool",
+    "pocketing": "clearing {total} pocket regions",
     "writing": "writing {total} moves for {name}",
     "verifying": "verifying {total} blocks on {name}",
     "budget": "error budget: re-simulating once per error source ({total})",

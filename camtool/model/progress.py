@@ -15,6 +15,7 @@ STAGES = (
     "contours",
     "planning",
     "offsetting",
+    "pocketing",
     "writing",
     "verifying",
     "budget",
@@ -25,7 +26,8 @@ reading the file (``total``: its drawn shapes, once counted), fitting arcs to it
 (``total``: distinct curve shapes, copies placed apart sharing one fit), making the
 contours of the shapes (``total``: shapes),
 planning the toolpath (``total``: contours), within it offsetting the closed contours for
-the tool with OpenCASCADE (``total``: contours offset), writing the code (``total``: moves of the
+the tool with OpenCASCADE (``total``: contours offset), or clearing pockets (``--offset
+pocket``; ``total``: the regions to clear), writing the code (``total``: moves of the
 program), verifying it (``total``: blocks of code) and its error budget (``total``: the
 error sources re-simulated, in forked workers when there are cores for them; ``name``: the
 next source, in order, whose figures are not in yet); ``camtool preview`` reads, then

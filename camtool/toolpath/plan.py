@@ -227,7 +227,7 @@ def _stage(
     if options.offset == "pocket":
         from camtool.toolpath.pocket import pocket
 
-        return pocket(contours, nest, options)
+        return pocket(contours, nest, options, progress=progress)
     from camtool.toolpath.compensate import compensate
 
     return compensate(contours, nest, options, progress=progress)

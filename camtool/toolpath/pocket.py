@@ -24,6 +24,7 @@ from shapely.geometry.polygon import orient
 
 from camtool.geometry.arcfit import fit_polyline
 from camtool.model.errors import InputError, ToolpathError, UsageError
+from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import TAU, Arc, Contour, Line, Point, Segment, distance
 from camtool.model.units import fmt_num
 from camtool.toolpath.cuts import Cut, Finding, Stage, open_left_out, where
@@ -80,7 +81,12 @@ class _Path:
     ring: bool
 
 
-def pocket(contours: Sequence[Contour], nest: Nesting, options: PlanOptions) -> Stage:
+def pocket(
+    contours: Sequence[Contour],
+    nest: Nesting,
+    options: PlanOptions,
+    progress: Progress = no_progress,
+) -> Stage:
     """Clear the inside of every pocket region; open contours are not cut (said in findings).
 
     Args:
@@ -88,6 +94,7 @@ def pocket(contours: Sequence[Contour], nest: Nesting, options: PlanOptions) -> 
         nest: their containment (:func:`~camtool.toolpath.order.nesting`).
         options: ``offset == "pocket"``; the tool, ``stepover``, ``pocket``,
             ``pocket_angle_deg``, ``direction`` and ``tolerance`` are used.
+        progress: told the ``pocketing`` stage (``done`` of ``total`` regions cleared).
 
     Returns:
         Cuts of kind ``"pocket"`` (group = the pocket boundary's index; in each
@@ -102,10 +109,13 @@ def pocket(contours: Sequence[Contour], nest: Nesting, options: PlanOptions) -> 
     """
     cuts: list[Cut] = []
     findings: list[Finding] = []
-    for region in regions(contours, nest, options.tolerance):
+    todo = regions(contours, nest, options.tolerance)
+    progress(Step("pocketing", 0, len(todo)))
+    for done, region in enumerate(todo, start=1):
         region_cuts, found = _pocket_region(region, options)
         cuts.extend(region_cuts)
         findings.extend(found)
+        progress(Step("pocketing", done, len(todo)))
     if not cuts:
         raise ToolpathError(_nothing_message(contours, options))
     findings[:0] = open_left_out(contours, "--offset pocket")
@@ -203,7 +213,13 @@ def _buffer(area: Polygon, amount: float, tol: float) -> list[Polygon]:
 def _levels(
     area: Polygon, r: float, step: float, tol: float, limit: int | None
 ) -> list[list[Polygon]]:
-    """Offsets of ``area`` at ``r + k·step`` until empty (at most ``limit`` levels)."""
+    """Offsets of ``area`` at ``r + k·step`` until empty (at most ``limit`` levels).
+
+    One at a time: the levels are independent (each is ``area`` shrunk once), but GEOS's
+    buffer of a large region holds about a gigabyte while it works; made two at once on
+    two cores, a 300 mm logo with islands (dxf2gcode's ``temple_noir_aplats_negatif.dxf``,
+    32 levels) took 84 s instead of 129 s, and 4.9 GB instead of 2.0 GB.
+    """
     levels: list[list[Polygon]] = []
     while limit is None or len(levels) < limit:
         parts = _buffer(area, r + len(levels) * step, tol)

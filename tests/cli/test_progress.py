@@ -102,6 +102,7 @@ def test_a_closed_stderr_silences_progress_without_failing() -> None:
         (Step("fitting", 0, 400), "fitting arcs to 400 curves"),
         (Step("writing", 0, 7, "valcnc"), "writing 7 moves for valcnc"),
         (Step("offsetting", 2, 9), "offsetting 9 contours for the tool"),
+        (Step("pocketing", 1, 12), "clearing 12 pocket regions"),
     ],
 )
 def test_stage_text_says_how_big_the_work_is(step: Step, text: str) -> None:

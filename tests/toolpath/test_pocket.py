@@ -19,6 +19,7 @@ from shapely import Point as ShapelyPoint
 from shapely.geometry.base import BaseGeometry
 
 from camtool.model.errors import ToolpathError
+from camtool.model.progress import Step
 from camtool.model.shapes import Arc, Contour, Line, Segment
 from camtool.toolpath.cuts import Cut, Stage
 from camtool.toolpath.offset import offset_contour
@@ -312,3 +313,12 @@ def test_a_large_pocket_with_two_islands_keeps_off_them() -> None:
         swept = _swept(stage.cuts, 1.5)
         for island in contours[1:]:
             assert swept.intersection(_shape(island)).area < TOL * _shape(island).length
+
+
+def test_clearing_pockets_tells_its_progress_region_by_region() -> None:
+    """Two separate pockets: the ``pocketing`` stage at 0, 1 and 2 of 2 regions."""
+    contours = [rect(0, 0, 10, 10), rect(20, 0, 30, 10)]
+    options = PlanOptions(offset="pocket", tool_diameter=2.0, feed_mm_min=100.0, tolerance=TOL)
+    steps: list[Step] = []
+    pocket(contours, nesting(contours), options, progress=steps.append)
+    assert steps == [Step("pocketing", n, 2) for n in range(3)]
