@@ -102,8 +102,8 @@ def dsm_quadrant(
 
     Rows go to ``out`` from row ``at`` on (``out`` is grown when full); returns the end
     state, the buffer and the next free row. The loop itself is :func:`_dsm_fill`, which
-    never replaces the buffer: a buffer replaced inside the loop kept numba from keeping it
-    in registers (83 against 700 M iterations/s on the benchmark's circle).
+    never replaces the buffer: a buffer replaced inside the loop is reloaded by numba at
+    every iteration, several times slower (docs/performance.md).
     """
     i = at
     while True:

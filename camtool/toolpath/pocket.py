@@ -215,10 +215,9 @@ def _levels(
 ) -> list[list[Polygon]]:
     """Offsets of ``area`` at ``r + k·step`` until empty (at most ``limit`` levels).
 
-    One at a time: the levels are independent (each is ``area`` shrunk once), but GEOS's
-    buffer of a large region holds about a gigabyte while it works; made two at once on
-    two cores, a 300 mm logo with islands (dxf2gcode's ``temple_noir_aplats_negatif.dxf``,
-    32 levels) took 84 s instead of 129 s, and 4.9 GB instead of 2.0 GB.
+    One at a time, though each level is ``area`` shrunk once and could be made on another
+    core: GEOS's buffer of a large region holds about a gigabyte while it works, and two
+    at once more than double the job's peak (docs/performance.md).
     """
     levels: list[list[Polygon]] = []
     while limit is None or len(levels) < limit:

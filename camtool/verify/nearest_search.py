@@ -484,11 +484,11 @@ lie far from the segments (:func:`_far`): the shortfall's few unsure samples
 KD_ENDS_PER_SAMPLE = 1000
 """Segment ends per sample (this call's) up to which :func:`_box_search` asks whether the
 samples lie near a dense trace (:func:`_dense`) under :data:`BOX_TREE_UP_TO` samples. A
-k-d tree costs ~0.4 µs an end to build and then serves every batch measured against the
-same ends (:class:`_LazyTree`: the shortfall's rounds and batches of one contour); a
-sample near a dense trace costs ~90 µs in the box tree and ~27 µs in the k-d tree (the
-bench's 66 M-step zig-zag: 7 413 samples in 8 calls against 798 120 ends, 0.94 s →
-0.5 s). Only the time depends on it."""
+k-d tree is built once for all the ends and then serves every batch measured against them
+(:class:`_LazyTree`: the shortfall's rounds and batches of one contour), and near a dense
+trace it answers a sample several times faster than the box tree (docs/performance.md);
+for a few samples against many ends its build costs more than it saves. Only the time
+depends on it."""
 
 
 DENSE_NODES_PER_LEVEL = 4
