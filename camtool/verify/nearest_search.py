@@ -522,9 +522,17 @@ def _far(samples: FloatArray, tree: tuple[Any, ...], half: float, kernels: Modul
     longest segment (:data:`FAR_RATIO`), decides. Both give the same distances; only the
     time depends on it.
     """
-    probe = np.ascontiguousarray(samples[:: max(1, len(samples) // FAR_PROBE)])
-    r0_2 = kernels.knn(probe, *tree, 1)[0]
+    return _far_apart(kernels.knn(_probe(samples, FAR_PROBE), *tree, 1)[0], half)
+
+
+def _far_apart(r0_2: FloatArray, half: float) -> bool:
+    """:func:`_far`'s test of the probe's squared nearest-end distances ``r0_2``."""
     return bool(np.median(r0_2) > (FAR_RATIO * half) ** 2)
+
+
+def _probe(samples: FloatArray, count: int) -> FloatArray:
+    """About ``count`` of ``samples``, evenly spread (C-contiguous, for the kernels)."""
+    return np.ascontiguousarray(samples[:: max(1, len(samples) // count)])
 
 
 def _dense(samples: FloatArray, tree: tuple[Any, ...], half: float, kernels: ModuleType) -> bool:
@@ -535,9 +543,9 @@ def _dense(samples: FloatArray, tree: tuple[Any, ...], half: float, kernels: Mod
     of ``tree`` (:func:`camtool.accel.nearkernels.nodes_within`), which counts the box
     tree's work and is the same in every run. Both paths give the same distances.
     """
-    probe = np.ascontiguousarray(samples[:: max(1, len(samples) // DENSE_PROBE)])
+    probe = _probe(samples, DENSE_PROBE)
     r0_2, rk_2 = kernels.knn(probe, *tree, nearest_exact.NEAREST_ENDS)[:2]
-    if np.median(r0_2) > (FAR_RATIO * half) ** 2:
+    if _far_apart(r0_2, half):
         return False
     opened = kernels.nodes_within(probe, tree[1], tree[2], np.sqrt(rk_2))
     levels = len(tree[2]) - 1
@@ -546,9 +554,8 @@ def _dense(samples: FloatArray, tree: tuple[Any, ...], half: float, kernels: Mod
 
 def _far_kd(samples: FloatArray, tree: Any, half: float) -> bool:
     """:func:`_far` asked of scipy's k-d tree ``tree`` of the ends (built already)."""
-    probe = samples[:: max(1, len(samples) // FAR_PROBE)]
-    r0 = tree.query(probe, k=1, workers=nearest_exact.KD_WORKERS)[0]
-    return bool(np.median(np.square(r0)) > (FAR_RATIO * half) ** 2)
+    r0 = tree.query(_probe(samples, FAR_PROBE), k=1, workers=nearest_exact.KD_WORKERS)[0]
+    return _far_apart(np.square(r0), half)
 
 
 def _end_points(a: FloatArray, b: FloatArray) -> FloatArray:
