@@ -23,6 +23,9 @@ __all__ = ["polygons", "quad_segs", "swept_area", "uncut_findings"]
 MAX_REPORTED = 5
 """Uncut pieces reported one by one per pocket; the rest are counted."""
 
+SWEEP_PIECE = 4096
+"""Most points of one piece of a path buffered at once by :func:`swept_area`."""
+
 _MIN_QUAD_SEGS = 8
 _MAX_QUAD_SEGS = 1024
 _CORNER_CAP = math.radians(150.0)  # a turn this sharp is a slot end, not a corner
@@ -50,10 +53,22 @@ def quad_segs(radius: float, tolerance: float) -> int:
 
 
 def swept_area(paths: Sequence[Contour], radius: float, tolerance: float) -> BaseGeometry:
-    """Area a round tool of ``radius`` mm sweeps along ``paths`` (arcs as chords), mm²."""
+    """Area a round tool of ``radius`` mm sweeps along ``paths`` (arcs as chords), mm².
+
+    Each path is buffered in pieces of at most :data:`SWEEP_PIECE` points (consecutive
+    pieces share their end point) and the pieces' areas united: the same area, since the
+    tool's sweep of a path is the union of its sweeps of the path's pieces. GEOS nodes a
+    buffer's whole offset curve at once, and a pocket's linked rings, which pass beside
+    themselves at every step-over, made one buffer of the whole path take seconds.
+    """
     quad = quad_segs(radius, tolerance)
-    lines = [LineString(p.points(tolerance / 4)) for p in paths]
-    return shapely.union_all([line.buffer(radius, quad_segs=quad) for line in lines])
+    pieces = [
+        LineString(xy[i : i + SWEEP_PIECE])
+        for p in paths
+        for xy in (np.asarray(p.points(tolerance / 4), dtype=float),)
+        for i in range(0, max(1, len(xy) - 1), SWEEP_PIECE - 1)
+    ]
+    return shapely.union_all(shapely.buffer(np.array(pieces, dtype=object), radius, quad_segs=quad))
 
 
 def uncut_findings(

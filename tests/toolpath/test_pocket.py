@@ -322,3 +322,26 @@ def test_clearing_pockets_tells_its_progress_region_by_region() -> None:
     steps: list[Step] = []
     pocket(contours, nesting(contours), options, progress=steps.append)
     assert steps == [Step("pocketing", n, 2) for n in range(3)]
+
+
+def test_swept_area_of_a_long_path_is_the_buffer_of_the_whole_path() -> None:
+    # A spiral of 3 turns 0.5 mm apart as ~12 000 chords (three SWEEP_PIECE pieces), swept
+    # by r = 0.2: the pieces' union must be GEOS's buffer of the whole line, computed here
+    # at once, and (the turns 2r apart) a band 2r wide along the line with a disc at its ends.
+    from camtool.toolpath.pocket_uncut import SWEEP_PIECE, quad_segs, swept_area
+
+    n = 3 * SWEEP_PIECE
+    pts = [
+        (
+            (10 - 0.5 * 3 * k / n) * math.cos(math.tau * 3 * k / n),
+            (10 - 0.5 * 3 * k / n) * math.sin(math.tau * 3 * k / n),
+        )
+        for k in range(n + 1)
+    ]
+    path = Contour(tuple(Line(a, b) for a, b in itertools.pairwise(pts)), False)
+    r = 0.2
+    whole = LineString(pts).buffer(r, quad_segs=quad_segs(r, TOL))
+    swept = swept_area([path], r, TOL)
+    assert swept.area == pytest.approx(whole.area, rel=1e-9)
+    assert swept.symmetric_difference(whole).area < 1e-6  # float noise of the cuts, mm²
+    assert swept.area == pytest.approx(2 * r * LineString(pts).length + math.pi * r * r, rel=1e-3)
