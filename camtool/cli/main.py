@@ -173,7 +173,7 @@ def post(
     job_spec = None if job_file is None else read_job(job_file, plan)
     verifying = bool(verify_too or report or preview or max_error_um is not None)
     load_picture = click.get_current_context().with_resource(picture_ahead(preview))
-    progress = StageReporter()
+    progress = click.get_current_context().with_resource(StageReporter())
     try:
         if drawing == "-":
             shared = plan if job_spec is None else job_spec.setup.plan
@@ -296,7 +296,7 @@ def verify(
     drawing = read_input(against) if against is not None else None
     if drawing is not None and isinstance(text, str):
         drawing, tool_diameter = _as_posted(text, drawing, tool_diameter)
-    progress = StageReporter()
+    progress = click.get_current_context().with_resource(StageReporter())
     load_picture = click.get_current_context().with_resource(picture_ahead(preview))
     load_picture()  # matplotlib, on the core the verification's start leaves idle
     v = verify_code(

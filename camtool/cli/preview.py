@@ -100,7 +100,7 @@ def preview(
     load_picture = click.get_current_context().with_resource(picture_ahead(out))
     load_picture()  # matplotlib loads while this process reads the inputs
     chosen = _target(target, machine_file)
-    progress = StageReporter()
+    progress = click.get_current_context().with_resource(StageReporter())
     progress(Step("reading", name=Path(program_name or input_name).name))
     drawing, program = preview_inputs(input_name, program_name, chosen, import_settings(options))
     verification = (

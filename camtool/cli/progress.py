@@ -1,19 +1,27 @@
 """Progress of a long ``camtool post`` on stderr: quiet for short jobs, a line per stage after.
 
+A stage that begins before the threshold and then runs on without another step (one
+GEOS buffer of a huge pocket, one long fit) is shown by a timer at the threshold, so a
+job never runs past it silently.
+
 Design notes: docs/internals.md, ``camtool/cli/progress.py``.
 """
 
 from __future__ import annotations
 
 import sys
+import threading
 import time
 from collections.abc import Callable
+from types import TracebackType
 from typing import TextIO
 
 from camtool.model.progress import Step
 
 AFTER_S = 2.0
 """Seconds a job runs before its progress is shown (shorter jobs print nothing new)."""
+
+_TIMER_SLACK_S = 0.01  # the timer wakes this late, so that its tick finds the time up
 
 REDRAW_S = 0.25
 """Least time between two redraws of a terminal's progress line, s."""
@@ -56,6 +64,11 @@ class StageReporter:
         live: redraw the current stage's line with its count (default: whether the
             stream is a terminal).
         clock: seconds, monotonic (tests pass a fake one).
+        timer: start a thread that calls :meth:`tick` at the threshold (tests call
+            it themselves).
+
+    Use it as a context manager (``with StageReporter() as progress:``): leaving
+    ends the last line and stops the timer, so nothing is written after the command.
     """
 
     def __init__(
@@ -65,6 +78,7 @@ class StageReporter:
         stream: TextIO | None = None,
         live: bool | None = None,
         clock: Callable[[], float] = time.monotonic,
+        timer: bool = True,
     ) -> None:
         self._clock = clock
         self._start = clock()
@@ -77,16 +91,54 @@ class StageReporter:
         self._on_screen = ""  # the live line as drawn
         self._open = False  # a live line without its newline
         self._broken = False  # writing failed once (closed stderr): stay silent
+        self._pending: Step | None = None  # the step running, told before the threshold
+        self._lock = threading.RLock()  # the timer's thread and the job's
+        self._use_timer = timer
+        self._timer: threading.Timer | None = None
+
+    def __enter__(self) -> StageReporter:
+        return self
+
+    def __exit__(
+        self,
+        kind: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()
+        if self._timer is not None:
+            self._timer.cancel()
+            self._timer = None
 
     def __call__(self, step: Step) -> None:
         """Show ``step`` if the job has run long enough (see the module)."""
+        with self._lock:
+            self._report(step)
+
+    def tick(self) -> None:
+        """Show the step still running if the threshold has passed and it is not shown.
+
+        The timer calls this at the threshold; it does nothing after :meth:`close`.
+        """
+        with self._lock:
+            if self._pending is not None and self._clock() - self._start >= self._after:
+                self._report(self._pending)
+
+    def _report(self, step: Step) -> None:
         if self._broken:
             return
         now = self._clock()
         if now - self._start < self._after:
+            self._pending = step
+            if self._use_timer and self._timer is None:
+                wait = self._start + self._after - now + _TIMER_SLACK_S
+                self._timer = threading.Timer(wait, self.tick)
+                self._timer.daemon = True
+                self._timer.start()
             return
+        self._pending = None
         if self._shown != (step.stage, step.total):
-            self.close()
+            self._end_line()
             self._shown = (step.stage, step.total)
             if self._is_live():
                 self._draw(_line(step), now)
@@ -98,7 +150,15 @@ class StageReporter:
                 self._draw(self._latest, now)
 
     def close(self) -> None:
-        """End a redrawn line, with its last count, (call before writing anything else)."""
+        """End a redrawn line, with its last count, (call before writing anything else).
+
+        The step told last is over: the timer will not show it.
+        """
+        with self._lock:
+            self._pending = None
+            self._end_line()
+
+    def _end_line(self) -> None:
         if self._open:
             if self._latest != self._on_screen:
                 self._draw(self._latest, self._clock())

@@ -41,6 +41,13 @@ Ring = tuple[tuple[Segment, ...], bool]
 MAX_POCKET_PATHS = 100_000
 """Most rings (concentric) or lines (zigzag) one pocket region may need; a real job
 (a 1 m pocket with a 10 µm step-over) stays under it."""
+
+MAX_POCKET_WORK = 10_000_000
+"""Most rings (or lines) × outline vertices a job's pockets may need together. Each ring
+is a GEOS buffer of the whole region, its time about proportional to the region's
+vertices (docs/performance.md): a detailed outline with a tool of a few µm would run for
+hours; a real job (a 60 000-vertex outline with a 1 mm tool:
+1.3e6; LibreCAD's ``kin100.dxf`` at 120 mm with a 0.01 mm tool: 5.5e6) stays under it."""
 _ZIGZAG_MARGIN = 0.05  # zigzag lines stop this share of the diameter short of the wall pass
 
 
@@ -110,6 +117,7 @@ def pocket(
     cuts: list[Cut] = []
     findings: list[Finding] = []
     todo = regions(contours, nest, options.tolerance)
+    _check_work(todo, options)
     progress(Step("pocketing", 0, len(todo)))
     for done, region in enumerate(todo, start=1):
         region_cuts, found = _pocket_region(region, options)
@@ -162,7 +170,6 @@ def _pocket_region(region: Region, options: PlanOptions) -> tuple[list[Cut], lis
     step = options.stepover * options.tool_diameter
     climb = options.direction != "conventional"
     zigzag = options.pocket == "zigzag"
-    _check_path_count(region, step, options)
     levels = _levels(region.area, r, step, tol, 1 if zigzag else None)
     if not levels:
         return [], uncut_findings(region.area, region.boundary, [], options)
@@ -179,29 +186,67 @@ def _pocket_region(region: Region, options: PlanOptions) -> tuple[list[Cut], lis
     return cuts, findings
 
 
-def _check_path_count(region: Region, step: float, options: PlanOptions) -> None:
-    """Refuse a pocket needing more than :data:`MAX_POCKET_PATHS` rings or lines, before any.
+def _check_work(todo: Sequence[Region], options: PlanOptions) -> None:
+    """Refuse pockets needing too many rings or too much work, before any is made.
 
-    Rings: at most half the region's smaller bounding-box side over the step-over;
-    zigzag lines: at most its diagonal over the step-over.
+    A region needs at most ``(d - r) / step`` rings, ``d`` its inradius (the largest
+    circle inside it, from GEOS's maximum inscribed circle, an upper bound here), or
+    its diagonal over the step-over in zigzag lines; each costs about one pass over the
+    region's outline vertices.
 
     Raises:
-        UsageError: the bound exceeds the limit (names --stepover, --tool-diameter).
+        UsageError: a region needs more than :data:`MAX_POCKET_PATHS` rings or lines,
+            or the job more than :data:`MAX_POCKET_WORK` rings × vertices (names the
+            region, --stepover and --tool-diameter).
     """
-    x0, y0, x1, y1 = region.area.bounds
-    w, h = x1 - x0, y1 - y0
-    zigzag = options.pocket == "zigzag"
-    span = math.hypot(w, h) if zigzag else max(0.0, min(w, h) / 2 - options.radius)
-    count = span / step
-    if count <= MAX_POCKET_PATHS:
+    step = options.stepover * options.tool_diameter
+    what = "zigzag lines" if options.pocket == "zigzag" else "rings"
+    total, worst, worst_work = 0.0, None, -1.0
+    for region in todo:
+        count = _path_count(region.area, step, options)
+        if count > MAX_POCKET_PATHS:
+            raise UsageError(
+                f"{_pocket_size(region)} would need about {count:.3g} {what} at a step-over "
+                f"of {step:g} mm ({_step_options(options)}), more than the limit of "
+                f"{MAX_POCKET_PATHS} per pocket; give a larger --stepover or tool"
+            )
+        vertices = shapely.get_num_coordinates(region.area)
+        total += count * vertices
+        if count * vertices > worst_work:
+            worst, worst_work = region, count * vertices
+    if total <= MAX_POCKET_WORK or worst is None:
         return
-    what = "zigzag lines" if zigzag else "rings"
+    count = _path_count(worst.area, step, options)
     raise UsageError(
-        f"{where(region.boundary)}: a {fmt_num(w, 3)} × {fmt_num(h, 3)} mm pocket would need "
-        f"about {count:.3g} {what} at a step-over of {step:g} mm (--stepover "
-        f"{options.stepover:g} × --tool-diameter {options.tool_diameter:g} mm), more than the "
-        f"limit of {MAX_POCKET_PATHS} per pocket; give a larger --stepover or tool"
+        f"{_pocket_size(worst)} with {shapely.get_num_coordinates(worst.area)} outline "
+        f"vertices would need about {count:.3g} {what} at a step-over of {step:g} mm "
+        f"({_step_options(options)}); the job's pockets together need {total:.3g} "
+        f"{what} × vertices, more than the limit of {MAX_POCKET_WORK:.3g} for one job (each "
+        "ring a pass over the outline); give a larger --stepover or tool, or a simpler outline"
     )
+
+
+def _path_count(area: Polygon, step: float, options: PlanOptions) -> float:
+    """Upper bound of the rings (or zigzag lines) a region needs at ``step`` mm apart."""
+    x0, y0, x1, y1 = area.bounds
+    w, h = x1 - x0, y1 - y0
+    if options.pocket == "zigzag":
+        return math.hypot(w, h) / step
+    reach = min(w, h) / 2
+    if reach > 0 and area.area > 0:
+        slack = reach / 1000  # the circle's centre is found within it
+        circle = shapely.maximum_inscribed_circle(area, tolerance=slack)
+        reach = min(reach, circle.length + slack)
+    return max(0.0, reach - options.radius) / step
+
+
+def _pocket_size(region: Region) -> str:
+    x0, y0, x1, y1 = region.area.bounds
+    return f"{where(region.boundary)}: a {fmt_num(x1 - x0, 3)} × {fmt_num(y1 - y0, 3)} mm pocket"
+
+
+def _step_options(options: PlanOptions) -> str:
+    return f"--stepover {options.stepover:g} × --tool-diameter {options.tool_diameter:g} mm"
 
 
 def _buffer(area: Polygon, amount: float, tol: float) -> list[Polygon]:

@@ -8,6 +8,7 @@ what it printed before (no new line, stdout untouched).
 from __future__ import annotations
 
 import io
+import time
 from pathlib import Path
 
 import pytest
@@ -33,7 +34,7 @@ class Clock:
 
 def _reporter(live: bool) -> tuple[StageReporter, io.StringIO, Clock]:
     out, clock = io.StringIO(), Clock()
-    return StageReporter(after_s=2.0, stream=out, live=live, clock=clock), out, clock
+    return StageReporter(after_s=2.0, stream=out, live=live, clock=clock, timer=False), out, clock
 
 
 def test_quiet_before_the_threshold_then_a_line_per_stage() -> None:
@@ -86,9 +87,47 @@ def test_a_terminal_line_is_redrawn_at_most_four_times_a_second() -> None:
     )
 
 
+def test_a_stage_that_runs_on_silently_is_shown_when_the_time_is_up() -> None:
+    # One step before the threshold, then none (one long GEOS buffer): the timer's tick
+    # at the threshold shows it; before the threshold, or once the stage is over, not.
+    reporter, out, clock = _reporter(live=False)
+    reporter(Step("pocketing", 0, 1))
+    clock.now += 1.0
+    reporter.tick()
+    assert out.getvalue() == ""
+    clock.now += 1.5
+    reporter.tick()
+    reporter.tick()  # shown once
+    reporter(Step("pocketing", 1, 1))  # the same stage: no new line
+    assert out.getvalue() == "camtool: clearing 1 pocket regions…\n"
+    reporter.close()
+    reporter.tick()
+    assert out.getvalue() == "camtool: clearing 1 pocket regions…\n"
+
+
+def test_a_stage_over_before_the_time_is_up_is_never_shown() -> None:
+    reporter, out, clock = _reporter(live=True)
+    reporter(Step("planning", 0, 3))
+    reporter.close()  # the job writes its own lines now: the stage is over
+    clock.now += 5.0
+    reporter.tick()
+    assert out.getvalue() == ""
+
+
+def test_the_timer_shows_a_silent_stage_on_its_own() -> None:
+    # The real clock and thread: nothing else is told after the first step.
+    out = io.StringIO()
+    with StageReporter(after_s=0.05, stream=out, live=False) as reporter:
+        reporter(Step("pocketing", 0, 2))
+        deadline = time.monotonic() + 60.0  # generous: a loaded machine wakes threads late
+        while not out.getvalue() and time.monotonic() < deadline:
+            time.sleep(0.01)
+    assert out.getvalue() == "camtool: clearing 2 pocket regions…\n"
+
+
 def test_a_closed_stderr_silences_progress_without_failing() -> None:
     out = io.StringIO()
-    reporter = StageReporter(after_s=0.0, stream=out, live=False)
+    reporter = StageReporter(after_s=0.0, stream=out, live=False, timer=False)
     out.close()
     reporter(Step("planning", 0, 3))  # no ValueError: progress is not worth a failure
     reporter.close()

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import re
 from pathlib import Path
 
 import pytest
@@ -21,7 +22,7 @@ from camtool.model.shapes import MAX_CHORDS, Contour, Line, chord_count
 from camtool.toolpath import offset, pocket_uncut
 from camtool.toolpath.chain import close_gaps
 from camtool.toolpath.options import PlanOptions
-from camtool.toolpath.pocket import MAX_POCKET_PATHS
+from camtool.toolpath.pocket import MAX_POCKET_PATHS, MAX_POCKET_WORK
 
 
 def _open(*points: tuple[float, float]) -> Contour:
@@ -140,3 +141,60 @@ def test_a_bad_start_position_is_not_called_the_origin_option() -> None:
     message = str(caught.value)
     assert "--origin" not in message
     assert "PlanOptions.origin" in message
+
+
+def _star_dxf(n: int, outer: float, inner: float) -> str:
+    """A closed R12 POLYLINE of ``n`` vertices, on circles of ``outer`` and ``inner`` mm in
+    turn (a jagged outline no arc fits: one pocket of ``n`` vertices)."""
+    radii = [outer if k % 2 == 0 else inner for k in range(n)]
+    vertices = "".join(
+        f"0\nVERTEX\n8\n0\n10\n{r * math.cos(math.tau * k / n)}\n"
+        f"20\n{r * math.sin(math.tau * k / n)}\n"
+        for k, r in enumerate(radii)
+    )
+    return (
+        "0\nSECTION\n2\nHEADER\n9\n$INSUNITS\n70\n4\n0\nENDSEC\n0\nSECTION\n2\nENTITIES\n"
+        f"0\nPOLYLINE\n8\n0\n66\n1\n70\n1\n{vertices}0\nSEQEND\n0\nENDSEC\n0\nEOF\n"
+    )
+
+
+def test_pocket_refuses_a_job_of_too_many_rings_times_vertices(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # 2 000 vertices on R = 50 and 49 in turn: inradius 49 (an inner vertex), found
+    # within 50 / 1000 mm. A 0.01 mm tool at step-over 0.4 (4 µm) needs
+    # (49 - 0.005) / 0.004 ≈ 12 249 rings, under the ring limit, but 12 249 × 2 001
+    # coordinates ≈ 2.45e7 passes over vertices: refused before any work.
+    drawing = tmp_path / "star.dxf"
+    drawing.write_text(_star_dxf(2000, 50.0, 49.0))
+    out = tmp_path / "out.nc"
+    argv = ["post", str(drawing), "-t", "grbl", "--offset", "pocket", "--tool-diameter", "0.01"]
+    code = main([*argv, "-o", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2
+    found = re.search(r"about (\S+) rings .* need (\S+) rings × vertices", err)
+    assert found is not None, err
+    rings, work = float(found[1]), float(found[2])
+    assert (49 - 0.05 - 0.005) / 0.004 <= rings <= (49 + 0.05 - 0.005) / 0.004 * 1.005
+    assert work == pytest.approx(rings * 2001, rel=0.005)
+    assert f"limit of {MAX_POCKET_WORK:.3g} for one job" in err
+    assert "2001 outline vertices" in err and "--stepover" in err
+    assert not out.exists()
+
+
+def test_the_ring_bound_follows_the_largest_circle_inside_not_the_box() -> None:
+    # An annulus R = 20, r = 14 (bbox 40 × 40): rings fit in its 3 mm half-width only,
+    # (3 - 0.5) / 0.4 = 6.25 with a 1 mm tool; the box alone would allow (20 - 0.5) / 0.4.
+    from shapely import Point as ShapelyPoint
+
+    from camtool.toolpath.options import PlanOptions
+    from camtool.toolpath.pocket import _path_count
+
+    ring = (
+        ShapelyPoint(0, 0)
+        .buffer(20, quad_segs=256)
+        .difference(ShapelyPoint(0, 0).buffer(14, quad_segs=256))
+    )
+    options = PlanOptions(offset="pocket", tool_diameter=1.0, feed_mm_min=100.0)
+    count = _path_count(ring, 0.4, options)
+    assert 6.25 <= count <= 6.25 * 1.05  # an upper bound within the circle's search slack
