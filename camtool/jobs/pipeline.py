@@ -32,10 +32,10 @@ def load_target_checked(name: str, *, machine_file: Path | str | None = None) ->
     """The target ``name`` (:func:`camtool.post.registry.load_target`), its motion names checked.
 
     Every name the machine profile gives in ``[machine.motion]`` (``line``,
-    ``arc``, ``chords``) is resolved now, in the verifier's library and every
-    installed target's ``MOTION``, so that a misspelt name in a target file or a
-    ``--machine`` file is refused before any code is written, not only when the
-    code is verified. (Profiles take any name since targets bring their own.) A
+    ``arc``, ``chords``) and its ``[machine.timing]`` table are resolved now, in
+    the verifier's library and every installed target's ``MOTION``, so that a
+    misspelt name or a value out of range in a target file or a ``--machine`` file
+    is refused before any code is written, not only when the code is verified. (Profiles take any name since targets bring their own.) A
     built-in target without ``machine_file`` is not re-checked: its profile is
     tested with camtool.
 
@@ -52,10 +52,18 @@ def load_target_checked(name: str, *, machine_file: Path | str | None = None) ->
 
     try:
         library(target.machine).check(target.machine)
+        if target.machine.timing:  # its rates time the program's header too, unverified
+            library(target.machine).timing(
+                target.machine.timing, where=_where_timing(target), machine=target.machine
+            )
     except InputError as exc:
         source = machine_file if machine_file is not None else name
         raise InputError(f"{source}: {exc}") from exc
     return target
+
+
+def _where_timing(target: Target) -> str:
+    return f"machine {target.machine.name!r} [machine.timing]"
 
 
 def post_file(

@@ -344,7 +344,7 @@ class _Reader:
         value = self._get(key, default is None)
         if value is None:
             return str(default)
-        if value not in choices:
+        if not isinstance(value, str) or value not in choices:  # a list is not hashable
             raise self._fail(key, f"one of {sorted(choices)}", value)
         return str(value)
 

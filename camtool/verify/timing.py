@@ -418,6 +418,35 @@ per reason (:func:`blocks_by_value`); the verifier warns about
 each (:func:`camtool.verify.clock.timing_warnings`), so no cap is silent."""
 
 
+TIMING_RANGES: dict[str, tuple[float, float, str]] = {
+    "_mm_min": (1e-3, 1e7, "mm/min"),
+    "_mm_s2": (1e-3, 1e8, "mm/s²"),
+}
+"""The physical range of a timing number by its unit (its name's ending; 0 means "none"
+where a model allows it): a rate of ``1e-300`` mm/min would time a program at 10³⁰⁰ s."""
+
+MAX_TIMING_NUMBER = 1e9
+"""Largest magnitude of any other timing number (µs, ms, s, baud, periods)."""
+
+
+def _in_range(key: str, number: float, where: str) -> float:
+    """``number`` if finite and within its unit's range (:data:`TIMING_RANGES`), else refused.
+
+    Raises:
+        InputError: naming ``where``, the key, the range and the unit.
+    """
+    low, high, unit = next(
+        (span for end, span in TIMING_RANGES.items() if key.endswith(end)),
+        (0.0, MAX_TIMING_NUMBER, ""),
+    )
+    if not math.isfinite(number) or (number != 0 and not low <= abs(number) <= high):
+        raise InputError(
+            f"{where}: {key} must be between {low:g} and {high:g}{' ' + unit if unit else ''} "
+            f"(a physical machine), got {number!r}"
+        )
+    return number
+
+
 def timing_from_table(cls: type[Any], table: Mapping[str, Any], *, where: str) -> Any:
     """Build the parameter dataclass ``cls`` from a TOML ``[timing]`` table.
 
@@ -456,7 +485,7 @@ def timing_from_table(cls: type[Any], table: Mapping[str, Any], *, where: str) -
         elif isinstance(value, bool) or not isinstance(value, int | float):
             raise InputError(f"{where}: {key} must be a number, got {value!r}")
         else:
-            kwargs[key] = float(value)
+            kwargs[key] = _in_range(key, float(value), where)
     try:
         return cls(**kwargs)
     except UsageError as exc:

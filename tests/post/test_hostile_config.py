@@ -30,6 +30,14 @@ MACHINE_OVERLAYS = {
     "[machine.motion]\nchord_tolerance_mm = 1e-300": "chord_tolerance_mm",
     "[machine.backlash]\ntrue_um = [1e300, 0, 0]": "true_um",
     "work_area_mm = [0, 0, 1e300, 100]": "work_area_mm",
+    # a list where a name is chosen: refused, not an internal error (it is not hashable)
+    "coordinates = []": "coordinates",
+    "[machine.motion]\nrounding = []": "rounding",
+    # the timing table times the program's header as well: checked before any code
+    '[machine.timing]\nmodel = "grbl"\nmax_rate_mm_min = "x"': "max_rate_mm_min",
+    '[machine.timing]\nmodel = "grbl"\nmax_rate_mm_min = 1e-300': "max_rate_mm_min",
+    '[machine.timing]\nmodel = "grbl"\nacceleration_mm_s2 = 1e308': "acceleration_mm_s2",
+    '[machine.timing]\nmodel = "grbl"\nacceleration_mm_s2 = -10': "acceleration_mm_s2",
 }
 
 TARGET_EDITS = {
