@@ -35,9 +35,9 @@ def load_target_checked(name: str, *, machine_file: Path | str | None = None) ->
     ``arc``, ``chords``) and its ``[machine.timing]`` table are resolved now, in
     the verifier's library and every installed target's ``MOTION``, so that a
     misspelt name or a value out of range in a target file or a ``--machine`` file
-    is refused before any code is written, not only when the code is verified. (Profiles take any name since targets bring their own.) A
-    built-in target without ``machine_file`` is not re-checked: its profile is
-    tested with camtool.
+    is refused before any code is written, not only when the code is verified.
+    (Profiles take any name since targets bring their own.) A built-in target
+    without ``machine_file`` is not re-checked: its profile is tested with camtool.
 
     Raises:
         UsageError: no such target.
