@@ -518,20 +518,22 @@ def _number(table: Mapping[str, Any], key: str, where: str, default: Any) -> Any
     value = table.get(key, default)
     if value is default:
         return value
+    low, high = _LIMITS.get(key, (0.0, 1e6))
     if (
         isinstance(value, bool)
         or not isinstance(value, int | float)
-        or not 0 < value <= _LIMITS.get(key, 1e6)
+        or not (value > 0 and low <= value <= high)
     ):
         raise InputError(
-            f"{where}: {key} must be a positive number up to {_LIMITS.get(key, 1e6):g}, "
+            f"{where}: {key} must be a number from {low:g} to {high:g} (a physical machine), "
             f"not {value!r}"
         )
     return float(value)
 
 
-_LIMITS = {"spindle_rpm": 1e6, "default_feed_mm_min": 1e6}
-"""Largest value of a target file's top-level numbers (rev/min, mm/min); nan is refused."""
+_LIMITS = {"spindle_rpm": (1.0, 1e6), "default_feed_mm_min": (1e-3, 1e6)}
+"""Range of a target file's top-level numbers (rev/min, mm/min); nan is refused. A spindle
+below 1 rev/min does not turn (``M3 S0``)."""
 
 
 def machine_names() -> list[str]:

@@ -637,7 +637,15 @@ class BlockWriter(WordWriter):
             self.spindle = None if command.direction == "off" else command
             words = [code]
             if command.direction != "off" and spec.has("S") and command.rpm > 0:
-                words.append("S" + self.text("S", command.rpm))  # rpm 0: speed not given
+                text = self.text("S", command.rpm)  # rpm 0: speed not given
+                word = spec.word("S")
+                if word is not None and word.number.parse(text) <= 0:  # M3 S0: no cut
+                    raise DialectError(
+                        f"{self.where()}: spindle speed {command.rpm:g} rev/min rounds to "
+                        f"S{text}; the slowest {spec.name} writes is "
+                        f"{word.number.resolution_mm():g} (give --spindle-rpm)"
+                    )
+                words.append("S" + text)
             elif command.direction != "off" and command.rpm > 0:
                 self.counts["speed"] += 1
             self.block(words)

@@ -286,6 +286,10 @@ class _Writer(WriterState[Record]):
             whole -= put
 
 
+MAX_LIFT_MM = 1000.0
+"""Largest ``lift_mm``: no Z axis of a small machine travels a metre."""
+
+
 class I8751Post(PostProcessor):
     """Writer and reader of the i8751 binary protocol (Intf8751 §3.7).
 
@@ -302,7 +306,7 @@ class I8751Post(PostProcessor):
             bound by :meth:`for_machine`, which every Target does).
 
     Raises:
-        ValueError: a negative or non-finite ``lift_mm``, or a placeholder that
+        ValueError: a ``lift_mm`` outside 0 to :data:`MAX_LIFT_MM`, or a placeholder that
             is not three positive numbers.
     """
 
@@ -315,8 +319,13 @@ class I8751Post(PostProcessor):
     def __init__(
         self, *, lift_mm: float = 0.0, placeholder_steps_per_mm: Sequence[float] = ()
     ) -> None:
-        if isinstance(lift_mm, bool) or not (math.isfinite(lift_mm) and lift_mm >= 0):
-            raise ValueError(f"lift_mm must be a number of mm >= 0, not {lift_mm!r}")
+        if isinstance(lift_mm, bool) or not (
+            math.isfinite(lift_mm) and 0 <= lift_mm <= MAX_LIFT_MM
+        ):
+            raise ValueError(
+                f"lift_mm must be a number of mm from 0 to {MAX_LIFT_MM:g} (a physical "
+                f"machine), not {lift_mm!r}"
+            )
         placeholder = tuple(float(v) for v in placeholder_steps_per_mm)
         if placeholder and (len(placeholder) != 3 or min(placeholder) <= 0):
             raise ValueError(
@@ -356,6 +365,11 @@ class I8751Post(PostProcessor):
         has_z = any(m.z is not None for m in program.moves)
         lift = self.lift_mm if machine.has_z and not has_z else 0.0
         lift_steps = _round_steps(lift, machine.steps_per_mm[2])
+        if lift_steps > MAX_STEPS:  # one record lifts, one lowers
+            raise DialectError(
+                f"lift_mm = {self.lift_mm:g} mm is {lift_steps} Z steps, more than one move "
+                f"record holds ({MAX_STEPS}); give a smaller lift_mm in [dialect_options]"
+            )
         w = _Writer(machine.steps_per_mm, lift_steps, program.origin)
         for item in program.items():
             if isinstance(item, Rapid | Linear | ArcMove):

@@ -46,6 +46,8 @@ TARGET_EDITS = {
     ("decimals = 3 ", "decimals = 3\ngrid_mm = 1e-300 #"): "grid_mm",
     ('end = ["M2", "M30"]', 'end = ["M2\u00e9"]'): "end",
     ('modal = ["F"]', 'modal = ["\uff26"]'): "modal",
+    # a spindle below 1 rev/min does not turn: GRBL read "M3 S0" from 1e-300
+    ("spindle_rpm = 1000.0", "spindle_rpm = 1e-300 #"): "spindle_rpm",
 }
 
 
@@ -120,3 +122,47 @@ def test_a_byte_order_mark_is_read_as_utf8(run: Any, tmp_path: Path) -> None:
     code, err = run("post", LOGO, "-t", str(target), "-o", str(out))
     assert code == 0, err
     assert out.exists()
+
+
+def test_a_spindle_speed_that_rounds_to_s0_is_refused(run: Any, tmp_path: Path) -> None:
+    # GRBL writes S with 0 decimals: 0.3 rev/min would be "M3 S0", a spindle that does
+    # not turn under a tool that cuts. Refused, nothing written; 0.6 rounds to S1.
+    out = tmp_path / "out.gcode"
+    args = ("post", LOGO, "-t", "grbl", "--depth", "1", "-o", str(out))
+    code, err = run(*args, "--spindle-rpm", "0.3")
+    assert code != 0 and "rounds to S0" in err and "--spindle-rpm" in err
+    assert "internal error" not in err and not out.exists()
+    code, err = run(*args, "--spindle-rpm", "0.6")
+    assert code == 0, err
+    assert "M3 S1\n" in out.read_text()
+
+
+@pytest.mark.parametrize("lift", ["1e308", "1001"])
+def test_an_i8751_lift_beyond_any_z_travel_is_refused(run: Any, tmp_path: Path, lift: str) -> None:
+    text = (ROOT / "postprocessors" / "i8751" / "i8751.toml").read_text()
+    assert "lift_mm = 1.0" in text
+    target = tmp_path / "i.toml"
+    target.write_text(text.replace("lift_mm = 1.0", f"lift_mm = {lift} #", 1))
+    program = tmp_path / "flat.ngc"  # no Z: the writer lifts around the rapids
+    program.write_text("G0 X1 Y1\nG1 X5 Y1 F100\nG0 X1 Y3\nG1 X5 Y3\nM2\n")
+    out = tmp_path / "out.bin"
+    code, err = run("post", str(program), "-t", str(target), "-o", str(out))
+    assert code == 3, err
+    assert "lift_mm" in err and "i.toml" in err and "internal error" not in err
+    assert not out.exists()
+
+
+def test_an_i8751_lift_of_more_steps_than_a_record_holds_is_refused(
+    run: Any, tmp_path: Path
+) -> None:
+    # 700 mm at the profile's 100 steps/mm: 70 000 Z steps, more than the 65 535 one
+    # move record holds (the lift is one record up, one down; Intf8751 §3.7).
+    text = (ROOT / "postprocessors" / "i8751" / "i8751.toml").read_text()
+    target = tmp_path / "i.toml"
+    target.write_text(text.replace("lift_mm = 1.0", "lift_mm = 700 #", 1))
+    program = tmp_path / "flat.ngc"
+    program.write_text("G0 X1 Y1\nG1 X5 Y1 F100\nM2\n")
+    out = tmp_path / "out.bin"
+    code, err = run("post", str(program), "-t", str(target), "-o", str(out))
+    assert code != 0 and "70000 Z steps" in err and "65535" in err, err
+    assert "internal error" not in err and not out.exists()
