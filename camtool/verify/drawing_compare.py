@@ -343,7 +343,53 @@ def _not_cut(
     if not nominal or not any(f.kind in NOT_CUT_KINDS and f.at is not None for f in findings):
         return []
     nominal_off = _distance_to(samples, nominal) - tool_radius_mm
-    return not_cut_groups(samples, _contour_ids(sizes), nominal_off, findings, tool_radius_mm)
+    chain_of, run_of = _chains(samples, sizes)
+    return not_cut_groups(samples, chain_of, nominal_off, findings, tool_radius_mm, runs=run_of)
+
+
+CHAIN_JOIN_MM = 0.01
+"""Ends of two drawing contours at most this far apart belong to one contour of the plan,
+mm (the default ``--chain-tolerance``: a drawing of loose LINEs is planned as the closed
+contours its lines make, and the plan's findings name those)."""
+
+
+def _chains(samples: FloatArray, sizes: list[int]) -> tuple[IntArray, IntArray]:
+    """``(S,)`` chain and run of each sample of :func:`_sample_drawing`.
+
+    A chain is a set of the drawing's contours joined end to end (within
+    :data:`CHAIN_JOIN_MM`), as the planner chains them: a finding about a planned
+    contour names every drawing contour of its chain. A run is a contour together with
+    the ones before it in the drawing's order that continue it (same chain, its start at
+    the previous one's end): the samples along a run follow the edge, so a stretch off
+    the drawing is not split where one LINE ends and the next begins.
+    """
+    counts = np.asarray(sizes, dtype=np.int64)
+    n = len(counts)
+    first = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
+    last = first + counts - 1
+    parent = list(range(n))
+
+    def root(k: int) -> int:
+        while parent[k] != k:
+            parent[k] = parent[parent[k]]
+            k = parent[k]
+        return k
+
+    if n > 1:
+        from scipy.spatial import cKDTree
+
+        ends = np.concatenate([samples[first], samples[last]])
+        for a, b in cKDTree(ends).query_pairs(CHAIN_JOIN_MM):
+            ra, rb = root(int(a) % n), root(int(b) % n)
+            if ra != rb:
+                parent[max(ra, rb)] = min(ra, rb)
+    chain = np.asarray([root(k) for k in range(n)], dtype=np.int64)
+    run = np.arange(n, dtype=np.int64)
+    if n > 1:  # a contour that goes on from the one before keeps its run number
+        gap = np.hypot(*(samples[first[1:]] - samples[last[:-1]]).T)
+        goes_on = (chain[1:] == chain[:-1]) & (gap <= CHAIN_JOIN_MM)
+        run = np.concatenate([[0], np.cumsum(~goes_on)]).astype(np.int64)
+    return np.repeat(chain, counts), np.repeat(run, counts)
 
 
 def _cut_as_drawn(
@@ -422,6 +468,8 @@ def not_cut_groups(
     nominal_off: FloatArray,
     findings: Sequence[FindingLike],
     tool_radius_mm: float,
+    *,
+    runs: IntArray | None = None,
 ) -> list[tuple[FindingLike, IntArray, Point]]:
     """The drawing points of each feature the plan reported as not cut as drawn.
 
@@ -439,18 +487,23 @@ def not_cut_groups(
 
     Args:
         samples: ``(S, 2)`` drawing points, mm, contour after contour.
-        contour_of: ``(S,)`` index of the contour of each sample.
+        contour_of: ``(S,)`` index of the contour of each sample (of the chain of
+            drawing contours the plan made one contour of: :func:`_chains`).
+        runs: ``(S,)`` index of the run of each sample, where a stretch may go on
+            from one drawing contour into the next (:func:`_chains`); ``None``: the
+            contours of ``contour_of``.
         nominal_off: ``(S,)`` distance of each sample from the programmed path
             minus the tool radius, mm.
         findings: plan findings; only :data:`NOT_CUT_KINDS` with a location count.
         tool_radius_mm: tool radius, mm.
 
     Returns:
-        ``(finding, sample indices, location mm)`` per feature, in finding order.
+        ``(finding, sample indices, location mm)`` per feature, in finding order (the
+        stretches of one finding at one place merged: :func:`_merged`).
     """
     size = np.abs(nominal_off)
     threshold = max(PLAN_TOLERANCE_MM, 3.0 * float(np.median(size)))
-    stretches = _stretches(samples, contour_of, size > threshold)
+    stretches = _stretches(samples, contour_of if runs is None else runs, size > threshold)
     taken = [False] * len(stretches)
     out: list[tuple[FindingLike, IntArray, Point]] = []
     for finding in findings:
@@ -473,6 +526,26 @@ def not_cut_groups(
                         continue
                 where = (float(at[0]), float(at[1]))
             taken[k] = True
+            out.append((finding, index, where))
+    return _merged(out)
+
+
+def _merged(
+    groups: list[tuple[FindingLike, IntArray, Point]],
+) -> list[tuple[FindingLike, IntArray, Point]]:
+    """``groups`` with those of one finding at one place made one feature, in order.
+
+    A feature drawn as several contours not in a row in the drawing (loose LINEs in any
+    order) comes as one stretch per contour: a tight corner's two sides each peak at the
+    drawn vertex, a narrow region's sides are all at the finding's location.
+    """
+    out: list[tuple[FindingLike, IntArray, Point]] = []
+    for finding, index, where in groups:
+        for k, (other, known, at) in enumerate(out):
+            if other is finding and math.dist(at, where) <= CHAIN_JOIN_MM:
+                out[k] = (finding, np.concatenate([known, index]), at)
+                break
+        else:
             out.append((finding, index, where))
     return out
 

@@ -134,3 +134,51 @@ def test_a_stretch_across_a_closed_contours_seam_is_one_feature() -> None:
     flagged = np.array([1, 1, 0, 0, 0, 1, 1, 1, 0, 1], dtype=bool)
     got = [sorted(s.tolist()) for s in _stretches(samples, contour_of, flagged)]
     assert got == [[0, 1, 5, 6], [7], [9]]  # the open line's ends stay apart
+
+
+def loose_plate(order: list[int], reverse: set[int]) -> Drawing:
+    """:func:`plate` as loose LINEs, one open contour each (as most DXF files draw a
+    part), in ``order``, the lines of ``reverse`` drawn end to start."""
+    lines = [seg for contour in plate().contours for seg in contour.segments]
+    out = []
+    for k in order:
+        seg = lines[k]
+        assert isinstance(seg, Line)
+        a, b = (seg.end, seg.start) if k in reverse else (seg.start, seg.end)
+        out.append(Contour((Line(a, b),), False, source=f"LINE #{k}"))
+    return Drawing(tuple(out))
+
+
+@pytest.mark.parametrize(
+    ("order", "reverse"),
+    [
+        (list(range(12)), set()),  # in drawing order, end to start as the outline goes
+        ([5, 0, 9, 3, 11, 7, 1, 10, 4, 2, 8, 6], {0, 3, 4, 10}),  # shuffled, some reversed
+    ],
+)
+def test_loose_lines_are_measured_as_the_contours_they_make(
+    order: list[int], reverse: set[int]
+) -> None:
+    # The plan chains the 12 lines into the outline and the slot, and its findings name
+    # those contours: the same features apart as for the closed polygons, with the same
+    # geometry (the drawn vertex r(√2 − 1) from the fillet); the rest within a few steps.
+    job = post_drawing(
+        loose_plate(order, reverse),
+        load_target("grbl"),
+        PlanOptions(offset="outside", tool_diameter=2 * R),
+    )
+    v = verify_job(job)
+    assert v.against is not None
+    assert v.against.max_um < 12.0
+    found = {(f.kind, round(f.at[0]), round(f.at[1])): f for f in v.against.not_cut}
+    assert len(v.against.not_cut) == 3  # one feature each, not one per line
+    assert set(found) == {
+        ("tight-corner", 25, 32),
+        ("tight-corner", 35, 32),
+        ("offset-vanished", 15, 16),
+    }
+    for key in (("tight-corner", 25, 32), ("tight-corner", 35, 32)):
+        assert found[key].error_um == pytest.approx(CORNER_UM, abs=10.0)
+    slot = found[("offset-vanished", 15, 16)]
+    assert slot.error_um == pytest.approx(SLOT_UM, abs=10.0)
+    assert slot.samples >= 24 / 0.005  # the whole slot outline, its four lines
