@@ -67,18 +67,24 @@ def test_main_figure_is_what_was_cut(verified) -> None:  # type: ignore[no-untyp
     assert verified.max_error_um < 12.0
 
 
-def test_features_apart_with_their_geometry(verified) -> None:  # type: ignore[no-untyped-def]
-    found = {(f.kind, round(f.at[0]), round(f.at[1])): f for f in verified.against.not_cut}
-    assert set(found) == {
-        ("tight-corner", 25, 32),
-        ("tight-corner", 35, 32),
-        ("offset-vanished", 15, 16),
-    }
-    for key in (("tight-corner", 25, 32), ("tight-corner", 35, 32)):
+CORNERS = (("tight-corner", 25, 32), ("tight-corner", 35, 32))
+SLOT = ("offset-vanished", 15, 16)
+
+
+def plate_features(not_cut: tuple[NotCut, ...]) -> dict[tuple[str, int, int], NotCut]:
+    """The plate's three features by kind and rounded place, their errors checked."""
+    found = {(f.kind, round(f.at[0]), round(f.at[1])): f for f in not_cut}
+    assert len(not_cut) == 3  # one feature each
+    assert set(found) == {*CORNERS, SLOT}
+    for key in CORNERS:
         assert found[key].error_um == pytest.approx(CORNER_UM, abs=10.0)
         assert found[key].at == pytest.approx((key[1], key[2]), abs=0.01)  # the drawn vertex
-    slot = found[("offset-vanished", 15, 16)]
-    assert slot.error_um == pytest.approx(SLOT_UM, abs=10.0)
+    assert found[SLOT].error_um == pytest.approx(SLOT_UM, abs=10.0)
+    return found
+
+
+def test_features_apart_with_their_geometry(verified) -> None:  # type: ignore[no-untyped-def]
+    slot = plate_features(verified.against.not_cut)[SLOT]
     assert slot.value == pytest.approx(2.0, abs=0.01)
     assert slot.label == "2 mm wide region"
     # the whole slot outline (24 mm at 5 µm) is in it
@@ -170,15 +176,5 @@ def test_loose_lines_are_measured_as_the_contours_they_make(
     v = verify_job(job)
     assert v.against is not None
     assert v.against.max_um < 12.0
-    found = {(f.kind, round(f.at[0]), round(f.at[1])): f for f in v.against.not_cut}
-    assert len(v.against.not_cut) == 3  # one feature each, not one per line
-    assert set(found) == {
-        ("tight-corner", 25, 32),
-        ("tight-corner", 35, 32),
-        ("offset-vanished", 15, 16),
-    }
-    for key in (("tight-corner", 25, 32), ("tight-corner", 35, 32)):
-        assert found[key].error_um == pytest.approx(CORNER_UM, abs=10.0)
-    slot = found[("offset-vanished", 15, 16)]
-    assert slot.error_um == pytest.approx(SLOT_UM, abs=10.0)
+    slot = plate_features(v.against.not_cut)[SLOT]  # one feature each, not one per line
     assert slot.samples >= 24 / 0.005  # the whole slot outline, its four lines
