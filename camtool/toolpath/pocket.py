@@ -201,7 +201,7 @@ def _check_work(todo: Sequence[Region], options: PlanOptions) -> None:
     """
     step = options.stepover * options.tool_diameter
     what = "zigzag lines" if options.pocket == "zigzag" else "rings"
-    total, worst, worst_work = 0.0, None, -1.0
+    total, worst = 0.0, (-1.0, 0.0, 0, todo[0] if todo else None)  # work, rings, vertices
     for region in todo:
         count = _path_count(region.area, step, options)
         if count > MAX_POCKET_PATHS:
@@ -210,15 +210,15 @@ def _check_work(todo: Sequence[Region], options: PlanOptions) -> None:
                 f"of {step:g} mm ({_step_options(options)}), more than the limit of "
                 f"{MAX_POCKET_PATHS} per pocket; give a larger --stepover or tool"
             )
-        vertices = shapely.get_num_coordinates(region.area)
+        vertices = int(shapely.get_num_coordinates(region.area))
         total += count * vertices
-        if count * vertices > worst_work:
-            worst, worst_work = region, count * vertices
-    if total <= MAX_POCKET_WORK or worst is None:
+        if count * vertices > worst[0]:
+            worst = (count * vertices, count, vertices, region)
+    _, count, vertices, named = worst
+    if total <= MAX_POCKET_WORK or named is None:
         return
-    count = _path_count(worst.area, step, options)
     raise UsageError(
-        f"{_pocket_size(worst)} with {shapely.get_num_coordinates(worst.area)} outline "
+        f"{_pocket_size(named)} with {vertices} outline "
         f"vertices would need about {count:.3g} {what} at a step-over of {step:g} mm "
         f"({_step_options(options)}); the job's pockets together need {total:.3g} "
         f"{what} × vertices, more than the limit of {MAX_POCKET_WORK:.3g} for one job (each "
