@@ -643,7 +643,8 @@ class BlockWriter(WordWriter):
                     raise DialectError(
                         f"{self.where()}: spindle speed {command.rpm:g} rev/min rounds to "
                         f"S{text}; the slowest {spec.name} writes is "
-                        f"{word.number.resolution_mm():g} (give --spindle-rpm)"
+                        f"{word.number.resolution_mm():g} (give a faster --spindle-rpm, or "
+                        "the tool's rpm in the job file)"
                     )
                 words.append("S" + text)
             elif command.direction != "off" and command.rpm > 0:

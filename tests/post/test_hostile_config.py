@@ -166,3 +166,17 @@ def test_an_i8751_lift_of_more_steps_than_a_record_holds_is_refused(
     code, err = run("post", str(program), "-t", str(target), "-o", str(out))
     assert code != 0 and "70000 Z steps" in err and "65535" in err, err
     assert "internal error" not in err and not out.exists()
+
+
+def test_a_job_tools_speed_that_rounds_to_s0_is_refused(run: Any, tmp_path: Path) -> None:
+    # samples/part.toml with its end mill at 0.3 rev/min: "M3 S0" before its first cut.
+    job = (ROOT / "samples" / "part.toml").read_text()
+    assert "rpm = 10000" in job
+    path = tmp_path / "slow.toml"
+    path.write_text(job.replace("rpm = 10000", "rpm = 0.3", 1))
+    out = tmp_path / "out.gcode"
+    code, err = run(
+        "post", str(ROOT / "samples" / "part.dxf"), "-t", "grbl", "--job", str(path), "-o", str(out)
+    )
+    assert code != 0 and "rounds to S0" in err and "the tool's rpm in the job file" in err
+    assert "internal error" not in err and not out.exists()
