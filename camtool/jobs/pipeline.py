@@ -52,18 +52,10 @@ def load_target_checked(name: str, *, machine_file: Path | str | None = None) ->
 
     try:
         library(target.machine).check(target.machine)
-        if target.machine.timing:  # its rates time the program's header too, unverified
-            library(target.machine).timing(
-                target.machine.timing, where=_where_timing(target), machine=target.machine
-            )
     except InputError as exc:
         source = machine_file if machine_file is not None else name
         raise InputError(f"{source}: {exc}") from exc
     return target
-
-
-def _where_timing(target: Target) -> str:
-    return f"machine {target.machine.name!r} [machine.timing]"
 
 
 def post_file(

@@ -220,18 +220,33 @@ class BlockWriter(WordWriter):
         if spec is None:
             self.counts["feed"] += 1
             return
-        text = self.text("F", move.feed_mm_min)
+        text = self._above_zero("F", move.feed_mm_min, "feed", "mm/min", "")
         written = spec.number.parse(text)
-        if written <= 0:
-            raise DialectError(
-                f"{self.where()}: feed {move.feed_mm_min:g} mm/min rounds to F{text}; "
-                f"the smallest feed {self.spec.name} writes is {spec.number.resolution_mm():g}"
-            )
         if abs(written - move.feed_mm_min) > 1e-9 * max(1.0, move.feed_mm_min):
             msg = f"feed {move.feed_mm_min:g} mm/min written as F{text} ({written:g} mm/min)"
             self.warn(msg)
         self._feed_text = (move.feed_mm_min, text)
         self._word("F", text, words)
+
+    def _above_zero(self, letter: str, value: float, what: str, unit: str, hint: str) -> str:
+        """The text of word ``letter`` for ``value`` > 0, refused where it rounds to zero.
+
+        ``F0`` stops the feed and ``M3 S0`` runs a spindle that does not turn: neither is
+        what was asked for.
+
+        Raises:
+            DialectError: naming the block, the value, the smallest the dialect writes
+                and ``hint``.
+        """
+        text = self.text(letter, value)
+        word = self.spec.word(letter)
+        if word is not None and word.number.parse(text) <= 0:
+            raise DialectError(
+                f"{self.where()}: {what} {value:g} {unit} rounds to {letter}{text}; the "
+                f"smallest {what} {self.spec.name} writes is {word.number.resolution_mm():g}"
+                f"{hint}"
+            )
+        return text
 
     # -- arcs --------------------------------------------------------------------
 
@@ -637,16 +652,10 @@ class BlockWriter(WordWriter):
             self.spindle = None if command.direction == "off" else command
             words = [code]
             if command.direction != "off" and spec.has("S") and command.rpm > 0:
-                text = self.text("S", command.rpm)  # rpm 0: speed not given
-                word = spec.word("S")
-                if word is not None and word.number.parse(text) <= 0:  # M3 S0: no cut
-                    raise DialectError(
-                        f"{self.where()}: spindle speed {command.rpm:g} rev/min rounds to "
-                        f"S{text}; the slowest {spec.name} writes is "
-                        f"{word.number.resolution_mm():g} (give a faster --spindle-rpm, or "
-                        "the tool's rpm in the job file)"
-                    )
-                words.append("S" + text)
+                hint = " (give a faster --spindle-rpm, or the tool's rpm in the job file)"
+                words.append(
+                    "S" + self._above_zero("S", command.rpm, "spindle speed", "rev/min", hint)
+                )
             elif command.direction != "off" and command.rpm > 0:
                 self.counts["speed"] += 1
             self.block(words)

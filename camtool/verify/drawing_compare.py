@@ -16,6 +16,7 @@ import numpy.typing as npt
 from camtool.accel.memo import LastAnswers
 from camtool.model.shapes import Drawing, Line, Point, Segment
 from camtool.model.units import fmt_num
+from camtool.toolpath.options import DEFAULT_CHAIN_TOLERANCE
 from camtool.verify import cutting_thin, nearest_exact, nearest_search, path_shortfall
 
 FloatArray = npt.NDArray[np.float64]
@@ -347,7 +348,7 @@ def _not_cut(
     return not_cut_groups(samples, chain_of, nominal_off, findings, tool_radius_mm, runs=run_of)
 
 
-CHAIN_JOIN_MM = 0.01
+CHAIN_JOIN_MM = DEFAULT_CHAIN_TOLERANCE
 """Ends of two drawing contours at most this far apart belong to one contour of the plan,
 mm (the default ``--chain-tolerance``: a drawing of loose LINEs is planned as the closed
 contours its lines make, and the plan's findings name those)."""

@@ -328,15 +328,18 @@ class Library:
         return factory(table, machine, where)
 
     def check(self, machine: Machine) -> None:
-        """Resolve every name ``machine`` uses (not the timing table).
+        """Resolve every name ``machine`` uses, and build its timing table's model if any.
 
         Raises:
-            InputError: the first unknown name, listing the valid ones.
+            InputError: the first unknown name, listing the valid ones, or a timing
+                value of the wrong type or out of range.
         """
         if self.simulator(machine.motion.line) is None:
             self.line(machine)
         if self.arc(machine) is None:
             self.chord_rule(machine)
+        if machine.timing:  # its rates time a program's header too, verified or not
+            self.timing(machine.timing, where=_where(machine, "timing"), machine=machine)
 
 
 def _where(machine: Machine, table: str) -> str:
