@@ -326,9 +326,14 @@ def _as_posted(code: str, drawing: Drawing, tool_diameter: float) -> tuple[Drawi
     A program camtool posted with ``--fit``/``--scale``/``--origin``/``--translate`` says
     where the drawing went (``placement: scale K, shift X Y mm``); without it the
     drawing would be compared where it was drawn, and the registration mistake reported
-    as machining error. A ``--tool-diameter`` of 0 takes the header's tool.
+    as machining error. An offset cut (``offset outside``, ``inside`` or ``pocket``) cuts
+    no open contour: those the planner leaves out (chained at the default tolerances,
+    :func:`camtool.toolpath.plan.chained`) are not compared. A ``--tool-diameter`` of 0
+    takes the header's tool.
     """
-    from camtool.jobs.header import read_placement, read_tool_diameter
+    from camtool.jobs.header import read_offset, read_placement
+    from camtool.toolpath.options import PlanOptions
+    from camtool.toolpath.plan import chained
 
     placement = read_placement(code)
     if placement is not None:
@@ -339,15 +344,25 @@ def _as_posted(code: str, drawing: Drawing, tool_diameter: float) -> tuple[Drawi
             f"(scale {k:g}, shift X{dx:g} Y{dy:g} mm)",
             err=True,
         )
+    offset = read_offset(code)
+    if offset is None:
+        return drawing, tool_diameter
+    side, recorded = offset
+    _, _, left_out = chained(drawing.contours, PlanOptions(offset=side, tool_diameter=recorded))
+    if left_out and len(left_out) < len(drawing.contours):
+        drawing = drawing.without(left_out)
+        click.echo(
+            f"camtool: --against: {len(left_out)} open contour(s) of the drawing not compared: "
+            f"the program's header says offset {side}, which cuts only closed contours",
+            err=True,
+        )
     if tool_diameter == 0:
-        recorded = read_tool_diameter(code)
-        if recorded is not None:
-            click.echo(
-                f"camtool: --against: tool diameter {recorded:g} mm, as the program's header "
-                "says (give --tool-diameter to change it)",
-                err=True,
-            )
-            return drawing, recorded
+        click.echo(
+            f"camtool: --against: tool diameter {recorded:g} mm, as the program's header "
+            "says (give --tool-diameter to change it)",
+            err=True,
+        )
+        return drawing, recorded
     return drawing, tool_diameter
 
 

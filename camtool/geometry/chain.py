@@ -34,6 +34,16 @@ def joint_distance(chain_tolerance: float) -> float:
 def chain(contours: Sequence[Contour], tolerance: float) -> list[Contour]:
     """Join open contours end to end where their ends meet within ``tolerance`` mm.
 
+    :func:`chain_members` without the members.
+    """
+    return chain_members(contours, tolerance)[0]
+
+
+def chain_members(
+    contours: Sequence[Contour], tolerance: float
+) -> tuple[list[Contour], list[tuple[int, ...]]]:
+    """Join open contours end to end where their ends meet within ``tolerance`` mm.
+
     Closed contours pass through unchanged. Open contours are extended forwards
     then backwards, reversing a neighbour where its far end is the one that
     meets; the first contour of a chain keeps its drawn direction. Layer, source,
@@ -46,7 +56,8 @@ def chain(contours: Sequence[Contour], tolerance: float) -> list[Contour]:
             must coincide).
 
     Returns:
-        The chained contours, in the order their first pieces were given.
+        The chained contours, in the order their first pieces were given, and for each
+        the indices in ``contours`` of its pieces (in the order they were joined).
 
     Raises:
         GeometryError: an open contour's end is not finite (importers refuse
@@ -55,6 +66,7 @@ def chain(contours: Sequence[Contour], tolerance: float) -> list[Contour]:
     if not tolerance >= 0:
         raise ValueError(f"chaining tolerance must be ≥ 0 mm, got {tolerance!r}")
     result: list[Contour] = []
+    members: list[tuple[int, ...]] = []
     pieces = list(contours)
     grid = _EndGrid(tolerance, [c for c in pieces if not c.closed])
     for index, contour in enumerate(pieces):
@@ -64,13 +76,16 @@ def chain(contours: Sequence[Contour], tolerance: float) -> list[Contour]:
     for index, contour in enumerate(pieces):
         if contour.closed:
             result.append(contour)
+            members.append((index,))
             continue
         if index in used:
             continue
         used.add(index)
         segs = list(contour.segments)
-        _extend(segs, pieces, grid, used, tolerance, forward=True)
-        _extend(segs, pieces, grid, used, tolerance, forward=False)
+        joined = [index]
+        _extend(segs, pieces, grid, used, joined, tolerance, forward=True)
+        _extend(segs, pieces, grid, used, joined, tolerance, forward=False)
+        members.append(tuple(joined))
         # One line cannot close on itself (zero-length lines are dropped on import);
         # one arc can: a full circle drawn as an ARC from 0° to 360°.
         meets = distance(segs[-1].end, segs[0].start) <= tolerance
@@ -85,7 +100,7 @@ def chain(contours: Sequence[Contour], tolerance: float) -> list[Contour]:
                 tuple(segs), closed, contour.layer, contour.source, contour.colour, contour.linetype
             )
         )
-    return result
+    return result, members
 
 
 def _extend(
@@ -93,6 +108,7 @@ def _extend(
     pieces: Sequence[Contour],
     grid: _EndGrid,
     used: set[int],
+    joined: list[int],
     tolerance: float,
     *,
     forward: bool,
@@ -106,6 +122,7 @@ def _extend(
             return
         index, at_start = found
         used.add(index)
+        joined.append(index)
         piece = pieces[index]
         if forward:
             nxt = piece if at_start else piece.reversed()

@@ -197,6 +197,16 @@ def read_placement(code: str) -> tuple[float, float, float] | None:
 
 def read_tool_diameter(code: str) -> float | None:
     """The tool diameter (mm) of an offset cut a camtool header in ``code`` records, or None."""
+    found = read_offset(code)
+    return None if found is None else found[1]
+
+
+def read_offset(code: str) -> tuple[str, float] | None:
+    """``(side, tool diameter mm)`` of an offset cut a camtool header in ``code`` records.
+
+    ``side`` is ``outside``, ``inside`` or ``pocket``. ``None`` for a program of a cut on
+    the line, of a job of several operations, or without camtool's header.
+    """
     head = code.splitlines()[:60]
     if not any(_CAMTOOL.search(line) for line in head):
         return None
@@ -207,11 +217,11 @@ def read_tool_diameter(code: str) -> float | None:
                 value = float(found[1])
             except ValueError:
                 return None
-            return value if math.isfinite(value) and value > 0 else None
+            return (found[2], value) if math.isfinite(value) and value > 0 else None
     return None
 
 
-_TOOL = re.compile(r"tool diameter ([0-9.eE+-]+) mm, offset (?:outside|inside|pocket)")
+_TOOL = re.compile(r"tool diameter ([0-9.eE+-]+) mm, offset (outside|inside|pocket)")
 
 
 def _work_zero(plan: PlanOptions) -> str:

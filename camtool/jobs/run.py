@@ -80,6 +80,22 @@ class PostJob:
     pieces: tuple[ToolProgram, ...] = ()
 
     @property
+    def cut(self) -> Drawing | None:
+        """What the job cuts: ``placed`` without the contours its operations' plans left out.
+
+        ``placed`` is the operations' drawings one after the other (:attr:`OperationRun.cut`
+        is each one's); ``None`` for a re-posted program.
+        """
+        if self.placed is None:
+            return None
+        left_out: set[int] = set()
+        first = 0
+        for run in self.operations:
+            left_out.update(first + i for i in run.left_out)
+            first += len(run.placed.contours)
+        return self.placed.without(frozenset(left_out))
+
+    @property
     def warnings(self) -> tuple[str, ...]:
         """Warnings of every stage, in pipeline order, without repeats."""
         written = [w for p in self.pieces for w in p.result.warnings] or self.result.warnings
@@ -171,13 +187,15 @@ class OperationRun:
         moves: ``(first, end)``: its moves are ``program.moves[first:end]``.
         contours: ``(first, last)`` contour numbers of its cuts in the program (``(0, -1)``
             when it has none).
-        placed: what it cuts, in the program's work coordinates.
+        placed: what it selects, in the program's work coordinates.
         edge_radius_mm: how far the cut edge lies from the tool path (half the tool for
             a compensated profile, a pocket and a drill; 0 on the line).
         report: what planning found (``None`` for drilling).
         holes: the holes a drill operation drills.
         time_s: its moves' time at their programmed feeds (rapids at the machine's rate
             where its profile gives one), s.
+        left_out: indices in ``placed.contours`` of the contours its plan does not cut
+            (:attr:`camtool.toolpath.plan.Plan.left_out`).
     """
 
     number: int
@@ -190,6 +208,12 @@ class OperationRun:
     report: PlanReport | None
     holes: int = 0
     time_s: float = 0.0
+    left_out: frozenset[int] = frozenset()
+
+    @property
+    def cut(self) -> Drawing:
+        """What it cuts: ``placed`` without the contours its plan left out."""
+        return self.placed.without(self.left_out)
 
     @property
     def label(self) -> str:
@@ -206,6 +230,7 @@ class _Planned:
     report: PlanReport | None
     placed: Drawing
     holes: int = 0
+    left_out: frozenset[int] = frozenset()
 
 
 def run_job(
@@ -292,6 +317,7 @@ def run_job(
                 edge_radius_mm=_edge(op, tool, options),
                 report=planned.report,
                 holes=planned.holes,
+                left_out=planned.left_out,
                 time_s=feed_time_s(moves[first:], target, start=_start(moves, first, setup)),
             )
         )
@@ -526,7 +552,14 @@ def _plan_operation(
             raise
         raise InputError(f"{where}: {exc}") from None
     program = planned.program
-    return _Planned(list(program.moves), [], list(program.warnings), planned.report, planned.placed)
+    return _Planned(
+        list(program.moves),
+        [],
+        list(program.warnings),
+        planned.report,
+        planned.placed,
+        left_out=planned.left_out,
+    )
 
 
 def _drill(

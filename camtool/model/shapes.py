@@ -578,3 +578,10 @@ class Drawing:
         contours = tuple(c.transformed(scale, dx, dy) for c in self.contours)
         marks = tuple(m.transformed(scale, dx, dy) for m in self.marks)
         return Drawing(contours, self.source, self.warnings, marks)
+
+    def without(self, indices: frozenset[int]) -> Drawing:
+        """The drawing without the contours at ``indices`` (itself when there are none)."""
+        if not indices:
+            return self
+        kept = tuple(c for i, c in enumerate(self.contours) if i not in indices)
+        return Drawing(kept, self.source, self.warnings, self.marks)

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from camtool.geometry.arcfit import FitStats, fit_polyline, fit_stats
-from camtool.geometry.chain import chain, joint_distance
+from camtool.geometry.chain import chain_members, joint_distance
 from camtool.model.errors import InputError
 from camtool.model.program import Program, Rapid
 from camtool.model.progress import Progress, no_progress
@@ -118,11 +118,21 @@ class Plan:
 
     ``placed`` is the drawing after ``--scale``/``--fit`` and moved with the program
     by ``--origin``/``--translate``: it lies in the program's work coordinates.
+    ``left_out`` are the indices in ``placed.contours`` of the contours the plan does not
+    cut at all: the pieces of an open chain under ``--offset outside``, ``inside`` or
+    ``pocket`` (a centre line, a construction line across the part; each is an
+    ``open-left-out`` finding). :attr:`cut` is the drawing without them.
     """
 
     program: Program
     report: PlanReport
     placed: Drawing
+    left_out: frozenset[int] = frozenset()
+
+    @property
+    def cut(self) -> Drawing:
+        """``placed`` without the contours the plan left out (what the program cuts)."""
+        return self.placed.without(self.left_out)
 
 
 def plan(drawing: Drawing, options: PlanOptions, machine: Machine | None = None) -> Program:
@@ -167,7 +177,7 @@ def plan_drawing(
     unplaced = plan_unplaced(drawing, options, machine, helix=helix, progress=progress)
     program, placed, shift = place_program(unplaced.program, unplaced.placed, options, machine)
     report = dataclasses.replace(unplaced.report, work_shift=shift)
-    return Plan(program, report, placed)
+    return Plan(program, report, placed, unplaced.left_out)
 
 
 def plan_unplaced(
@@ -193,9 +203,7 @@ def plan_unplaced(
     if machine is not None:
         options.check_machine(machine, machine.name)
     placed = place(drawing, options)
-    joint = joint_distance(options.chain_tolerance)
-    contours = chain(placed.contours, joint)
-    contours, found = close_gaps(contours, options.close_gap, joint)
+    contours, found, left_out = chained(placed.contours, options)
     findings = [*options.ineffective(), *found, *open_gaps(contours, options)]
     stats = None
     if options.fit_arcs:
@@ -218,7 +226,32 @@ def plan_unplaced(
     warnings = tuple(dict.fromkeys((*drawing.warnings, *(f.message for f in findings))))
     program = Program(tuple(moves), options.origin, warnings)
     report = PlanReport(len(contours), len(stage.cuts), tuple(findings), ordering, stats)
-    return Plan(program, report, placed)
+    return Plan(program, report, placed, left_out)
+
+
+def chained(
+    contours: Sequence[Contour], options: PlanOptions
+) -> tuple[list[Contour], list[Finding], frozenset[int]]:
+    """``contours`` chained and their gaps closed as the planner cuts them.
+
+    Ends within ``options.chain_tolerance`` are joined (:func:`chain_members`), then
+    gaps up to ``options.close_gap`` closed (:func:`close_gaps`).
+
+    Returns:
+        The planned contours, mm; the ``closed-gap`` findings; and the indices in
+        ``contours`` of those the plan leaves out (:attr:`Plan.left_out`: the pieces
+        of a chain still open, unless ``options.offset`` is ``on``).
+    """
+    joint = joint_distance(options.chain_tolerance)
+    joined, members = chain_members(contours, joint)
+    joined, found = close_gaps(joined, options.close_gap, joint)
+    left_out = frozenset(
+        i
+        for contour, pieces in zip(joined, members, strict=True)
+        if not contour.closed and options.offset != "on"
+        for i in pieces
+    )
+    return joined, found, left_out
 
 
 def _stage(
