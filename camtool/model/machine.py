@@ -131,6 +131,8 @@ class Machine:
             thesis controllers that store a part zero or start from where the tool
             stands) or the machine's home.
         has_z: whether programs may move Z.
+        z_travel_mm: the Z travel, mm: the most a program's Z may span, from its highest
+            position to its lowest (GRBL's ``$132``); 0 when not known (not checked).
         max_step_rate_hz: highest step frequency the controller sustains, Hz
             (0 = no limit known).
         source: where the numbers come from (a thesis section).
@@ -154,6 +156,7 @@ class Machine:
     work_area_mm: BBox
     coordinates: str = "work"
     has_z: bool = True
+    z_travel_mm: float = 0.0
     max_step_rate_hz: float = 0.0
     source: str = ""
     true_steps_per_mm: tuple[float, float, float] | None = None
@@ -200,6 +203,7 @@ RANGES: dict[str, tuple[float, float, str]] = {
     "true_steps_per_mm": (1e-3, 1e6, "steps/mm"),
     "max_step_rate_hz": (1e-3, 1e7, "Hz"),
     "work_area_mm": (0.0, 1e6, "mm"),
+    "z_travel_mm": (0.0, 1e6, "mm"),
     "chord_tolerance_mm": (1e-5, 10.0, "mm"),
     "chord_segments": (1, 10_000, "chords per arc"),
     "chord_angle_deg": (1e-2, 180.0, "degrees"),
@@ -234,6 +238,7 @@ def machine_from_table(table: Mapping[str, Any], *, where: str) -> Machine:
         work_area_mm=(x0, y0, x1, y1),
         coordinates=r.choice("coordinates", COORDINATES, "work"),
         has_z=r.flag("has_z", True),
+        z_travel_mm=r.number("z_travel_mm", 0.0, nonnegative=True),
         max_step_rate_hz=r.number("max_step_rate_hz", 0.0, nonnegative=True),
         source=r.text("source"),
         true_steps_per_mm=true_steps if "true_steps_per_mm" in table else None,

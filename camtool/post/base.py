@@ -37,6 +37,7 @@ from camtool.model.units import fmt_num
 from camtool.toolpath.placement import (
     EPS_MM,
     check_travel,
+    check_z_travel,
     outside_text,
     place_remedy,
     too_large,
@@ -114,9 +115,14 @@ def check_placement(program: Program, machine: Machine) -> tuple[str, ...]:
     coordinates is checked move by move instead (:func:`check_work_area`, which
     names the block).
 
+    Its Z must span no more than the machine's Z travel, when the profile gives it
+    (:func:`~camtool.toolpath.placement.check_z_travel`), in either coordinates.
+
     Raises:
-        DialectError: the toolpath is larger than the travel (both sizes named).
+        DialectError: the toolpath is larger than the travel (both sizes named), or its
+            Z spans more than the Z travel.
     """
+    check_z_travel(program, machine)
     if machine.coordinates == "machine":
         return ()
     return check_travel(program, machine)

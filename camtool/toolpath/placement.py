@@ -333,6 +333,34 @@ def check_travel(
     return check_extent(toolpath_extent(program), machine, placing)
 
 
+def check_z_travel(program: Program, machine: Machine) -> None:
+    """Refuse a program whose Z spans more than the machine's Z travel (when it is known).
+
+    The span is from the highest Z a move goes to (the clearance height) to the lowest
+    (the deepest cut), mm: wherever the operator sets Z0, the machine must reach both.
+    A profile without ``z_travel_mm`` (0) is not checked.
+
+    Raises:
+        DialectError: naming the span, both heights, the Z travel and what to change.
+    """
+    travel = machine.z_travel_mm
+    if travel <= 0 or not machine.has_z:
+        return
+    zs = [m.z for m in program.moves if m.z is not None]
+    if not zs:
+        return
+    top, bottom = max(zs), min(zs)
+    if top - bottom <= travel + EPS_MM:
+        return
+    raise DialectError(
+        f"the program's Z spans {_mm(top - bottom)} mm (from Z{_num(top)} to Z{_num(bottom)} "
+        f"mm), more than the {_mm(travel)} mm Z travel of {machine.name}: no work zero lets "
+        "the machine reach both; check the depth and the clearance height (--depth, "
+        "--clearance-z, or the job file's), or give the machine's own z_travel_mm "
+        "(--machine FILE.toml)"
+    )
+
+
 def check_extent(box: BBox | None, machine: Machine, placing: Placing | None) -> tuple[str, ...]:
     """:func:`check_travel` of a program whose :func:`toolpath_extent` is ``box``.
 

@@ -30,6 +30,9 @@ MACHINE_OVERLAYS = {
     "[machine.motion]\nchord_tolerance_mm = 1e-300": "chord_tolerance_mm",
     "[machine.backlash]\ntrue_um = [1e300, 0, 0]": "true_um",
     "work_area_mm = [0, 0, 1e300, 100]": "work_area_mm",
+    "z_travel_mm = -5": "z_travel_mm",
+    "z_travel_mm = 1e300": "z_travel_mm",
+    'z_travel_mm = "200"': "z_travel_mm",
     # a list where a name is chosen: refused, not an internal error (it is not hashable)
     "coordinates = []": "coordinates",
     "[machine.motion]\nrounding = []": "rounding",
