@@ -6,6 +6,12 @@ import json
 from typing import Any
 
 import pytest
+from hypothesis import settings
+
+settings.register_profile("camtool", deadline=None)
+settings.load_profile("camtool")
+"""No property test has a deadline: how fast the machine is never decides a test (under
+load, hypothesis's default 200 ms per example failed a DDA property test)."""
 
 _CORPUS_RUNS: list[dict[str, Any]] = []
 """Under pytest-xdist (``make test``): each worker's corpus cases, as it sent them

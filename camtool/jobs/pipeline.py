@@ -458,6 +458,7 @@ def verify_job(
         CamtoolError: the target cannot read its own code back, or its machine
             profile is invalid for the verifier.
     """
+    from camtool.verify.drawing_compare import CHAIN_JOIN_MM
     from camtool.verify.verifier import verify_code
 
     several = len(job.operations) > 1
@@ -474,6 +475,7 @@ def verify_job(
         planned=job.program,
         budget=budget,
         budget_now=budget_now,
+        joint_mm=job.plan.joint_mm if job.plan is not None else CHAIN_JOIN_MM,
     )
     if not several:
         return whole
@@ -494,6 +496,7 @@ def verify_operation(job: PostJob, run: OperationRun) -> Part:
     for the job's target as they are in the job's program; the machined edge is its
     tool's (a drill's hole is the drill's diameter about its centre).
     """
+    from camtool.verify.drawing_compare import CHAIN_JOIN_MM
     from camtool.verify.verifier import Part, verify_code
 
     first, end = run.moves
@@ -517,6 +520,7 @@ def verify_operation(job: PostJob, run: OperationRun) -> Part:
         findings=run.report.placed_findings() if run.report is not None else (),
         planned=alone,
         budget=False,
+        joint_mm=run.report.joint_mm if run.report is not None else CHAIN_JOIN_MM,
     )
     return Part(f"{run.label} T{run.tool.id}", run.moves, v)
 

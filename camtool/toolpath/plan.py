@@ -23,7 +23,7 @@ from camtool.model.shapes import BBox, Contour, Drawing, Line, Point, Segment, f
 from camtool.toolpath.chain import close_gaps
 from camtool.toolpath.cuts import Finding, Stage
 from camtool.toolpath.gaps import open_gaps
-from camtool.toolpath.options import OFFSET_MODES, PlanOptions
+from camtool.toolpath.options import DEFAULT_CHAIN_TOLERANCE, OFFSET_MODES, PlanOptions
 from camtool.toolpath.order import Ordering, nesting, order_cuts
 from camtool.toolpath.placement import (
     Placing,
@@ -68,6 +68,10 @@ class PlanReport:
             by. Findings locate features in the drawing's coordinates (after
             ``--scale``/``--fit``), as their messages say; :meth:`placed_findings`
             gives them in the program's work coordinates.
+        joint_mm: the distance within which planning joined contour ends, mm
+            (:func:`~camtool.geometry.chain.joint_distance` of ``--chain-tolerance``): a
+            finding about a contour names every drawing contour of its chain, and the
+            verification groups the drawing's contours at the same distance.
     """
 
     contours: int
@@ -76,6 +80,7 @@ class PlanReport:
     ordering: Ordering
     fit: FitStats | None
     work_shift: Point = (0.0, 0.0)
+    joint_mm: float = DEFAULT_CHAIN_TOLERANCE
 
     def placed_findings(self) -> tuple[Finding, ...]:
         """The findings with ``at`` in the program's work coordinates (mm)."""
@@ -225,7 +230,14 @@ def plan_unplaced(
         )
     warnings = tuple(dict.fromkeys((*drawing.warnings, *(f.message for f in findings))))
     program = Program(tuple(moves), options.origin, warnings)
-    report = PlanReport(len(contours), len(stage.cuts), tuple(findings), ordering, stats)
+    report = PlanReport(
+        len(contours),
+        len(stage.cuts),
+        tuple(findings),
+        ordering,
+        stats,
+        joint_mm=joint_distance(options.chain_tolerance),
+    )
     return Plan(program, report, placed, left_out)
 
 

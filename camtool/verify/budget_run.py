@@ -45,6 +45,7 @@ from camtool.verify.cutting_thin import (
 )
 from camtool.verify.dda import compiled
 from camtool.verify.drawing_compare import (
+    CHAIN_JOIN_MM,
     FindingLike,
     against_worst,
     prepare_stream,
@@ -88,9 +89,11 @@ class EarlyBudget:
         tool_diameter: float,
         findings: Sequence[FindingLike],
         progress: Progress,
+        joint_mm: float = CHAIN_JOIN_MM,
     ) -> None:
         self.program, self.machine, self.planned = program, machine, planned
         self.tool_diameter, self.findings, self.progress = tool_diameter, findings, progress
+        self.joint_mm = joint_mm
         self.run: BudgetRun | None = None
         statuses = trace_sources.source_statuses(program, machine, planned=planned)
         self.one = sum(s.status == "modelled" for s in statuses) == 1 and not (
@@ -119,6 +122,7 @@ class EarlyBudget:
             self.tool_diameter,
             self.findings,
             rows=rows,
+            joint_mm=self.joint_mm,
         )
         self.run = BudgetRun(inputs, True, self.progress, alongside=True)
 
@@ -174,6 +178,7 @@ def budget_of(v: Verification, progress: Progress = no_progress) -> eb.ErrorBudg
         v.tool_diameter,
         v.findings,
         v.cut_digest,
+        joint_mm=v.joint_mm,
     )
     with BudgetRun(inputs, v.budget, progress) as run:
         return run.gather(v)
@@ -196,6 +201,7 @@ class BudgetInputs:
     findings: Sequence[FindingLike]
     cut_digest: bytes | None = None
     rows: int = -1
+    joint_mm: float = CHAIN_JOIN_MM
 
     @property
     def row_count(self) -> int:
@@ -432,6 +438,7 @@ def without_source(inputs: BudgetInputs, name: str) -> Without:
                 inputs.tool_diameter / 2.0,
                 nominal=trace_sources._nominal_lines(program) if inputs.findings else (),
                 findings=inputs.findings,
+                joint_mm=inputs.joint_mm,
             )
         )
     blocks = [c.blocks for c in contours] if name == "rounding" else None

@@ -27,6 +27,13 @@ NOT_CUT_KINDS = ("tight-corner", "offset-vanished", "uncut")
 """Plan finding kinds that say a feature cannot be cut as drawn with this tool."""
 
 
+CHAIN_JOIN_MM = DEFAULT_CHAIN_TOLERANCE
+"""Ends of two drawing contours at most this far apart belong to one contour of the plan,
+mm, unless the plan says its own (``joint_mm``): the default ``--chain-tolerance`` (a
+drawing of loose LINEs is planned as the closed contours its lines make, and the plan's
+findings name those)."""
+
+
 @dataclass(frozen=True)
 class NotCut:
     """A feature of the drawing the planner reported it cannot cut as drawn.
@@ -199,6 +206,7 @@ def against_drawing(
     nominal: Sequence[FloatArray] = (),
     findings: Sequence[FindingLike] = (),
     overcut: bool = True,
+    joint_mm: float = CHAIN_JOIN_MM,
 ) -> Against:
     """Compare a cutting trace with the drawing it was made from (shapely nearest queries).
 
@@ -226,6 +234,9 @@ def against_drawing(
             location name the features measured apart.
         overcut: measure the overcut (``False``: ``overcut_um`` is 0, for a caller that
             reads only the other figures, as the error budget does).
+        joint_mm: the distance within which the plan joined contour ends, mm
+            (:attr:`~camtool.toolpath.plan.PlanReport.joint_mm`): the drawing's contours
+            are grouped into the plan's chains at it (:func:`_chains`).
     """
     return against_thinned(
         cutting_thin.thin_cutting(points, runs, resolution_mm),
@@ -235,6 +246,7 @@ def against_drawing(
         nominal=nominal,
         findings=findings,
         overcut=overcut,
+        joint_mm=joint_mm,
     )
 
 
@@ -247,6 +259,7 @@ def against_thinned(
     nominal: Sequence[FloatArray] = (),
     findings: Sequence[FindingLike] = (),
     overcut: bool = True,
+    joint_mm: float = CHAIN_JOIN_MM,
 ) -> Against:
     """:func:`against_drawing` of a trace already thinned (:class:`ThinTrace`).
 
@@ -258,7 +271,7 @@ def against_thinned(
         return Against(0.0, 0.0, (0.0, 0.0), 0.0, 0)
     trace = thin.points
     off = nearest_search.nearest_distances(samples, *_chords(thin)) - tool_radius_mm
-    apart = _not_cut(samples, sizes, tool_radius_mm, nominal, findings)
+    apart = _not_cut(samples, sizes, tool_radius_mm, nominal, findings, joint_mm)
     main = _cut_as_drawn(len(samples), apart)
     features = [
         NotCut(
@@ -299,6 +312,7 @@ def against_worst(
     spacing_mm: float = AGAINST_SPACING_MM,
     nominal: Sequence[FloatArray] = (),
     findings: Sequence[FindingLike] = (),
+    joint_mm: float = CHAIN_JOIN_MM,
 ) -> float:
     """``against_thinned(...).max_um`` alone, the same float, for the error budget.
 
@@ -309,7 +323,8 @@ def against_worst(
     samples, sizes = _sample_drawing(drawing, spacing_mm)
     if thin.rows < 2 or len(samples) == 0:
         return 0.0
-    main = _cut_as_drawn(len(samples), _not_cut(samples, sizes, tool_radius_mm, nominal, findings))
+    apart = _not_cut(samples, sizes, tool_radius_mm, nominal, findings, joint_mm)
+    main = _cut_as_drawn(len(samples), apart)
     if not main.any():
         return 0.0
     kept = samples if main.all() else samples[main]
@@ -339,26 +354,28 @@ def _not_cut(
     tool_radius_mm: float,
     nominal: Sequence[FloatArray],
     findings: Sequence[FindingLike],
+    joint_mm: float = CHAIN_JOIN_MM,
 ) -> list[tuple[FindingLike, IntArray, Point]]:
-    """:func:`not_cut_groups` of the drawing's ``samples`` when there is anything to group."""
+    """:func:`not_cut_groups` of the drawing's ``samples`` when there is anything to group.
+
+    The drawing's contours are grouped into chains at ``joint_mm`` (:func:`_chains`).
+    """
     if not nominal or not any(f.kind in NOT_CUT_KINDS and f.at is not None for f in findings):
         return []
     nominal_off = _distance_to(samples, nominal) - tool_radius_mm
-    chain_of, run_of = _chains(samples, sizes)
-    return not_cut_groups(samples, chain_of, nominal_off, findings, tool_radius_mm, runs=run_of)
+    chain_of, run_of = _chains(samples, sizes, joint_mm)
+    return not_cut_groups(
+        samples, chain_of, nominal_off, findings, tool_radius_mm, runs=run_of, joint_mm=joint_mm
+    )
 
 
-CHAIN_JOIN_MM = DEFAULT_CHAIN_TOLERANCE
-"""Ends of two drawing contours at most this far apart belong to one contour of the plan,
-mm (the default ``--chain-tolerance``: a drawing of loose LINEs is planned as the closed
-contours its lines make, and the plan's findings name those)."""
-
-
-def _chains(samples: FloatArray, sizes: list[int]) -> tuple[IntArray, IntArray]:
+def _chains(
+    samples: FloatArray, sizes: list[int], joint_mm: float = CHAIN_JOIN_MM
+) -> tuple[IntArray, IntArray]:
     """``(S,)`` chain and run of each sample of :func:`_sample_drawing`.
 
-    A chain is a set of the drawing's contours joined end to end (within
-    :data:`CHAIN_JOIN_MM`), as the planner chains them: a finding about a planned
+    A chain is a set of the drawing's contours joined end to end (within ``joint_mm``,
+    the plan's joint distance), as the planner chains them: a finding about a planned
     contour names every drawing contour of its chain. A run is a contour together with
     the ones before it in the drawing's order that continue it (same chain, its start at
     the previous one's end): the samples along a run follow the edge, so a stretch off
@@ -380,7 +397,7 @@ def _chains(samples: FloatArray, sizes: list[int]) -> tuple[IntArray, IntArray]:
         from scipy.spatial import cKDTree
 
         ends = np.concatenate([samples[first], samples[last]])
-        for a, b in cKDTree(ends).query_pairs(CHAIN_JOIN_MM):
+        for a, b in cKDTree(ends).query_pairs(joint_mm):
             ra, rb = root(int(a) % n), root(int(b) % n)
             if ra != rb:
                 parent[max(ra, rb)] = min(ra, rb)
@@ -388,7 +405,7 @@ def _chains(samples: FloatArray, sizes: list[int]) -> tuple[IntArray, IntArray]:
     run = np.arange(n, dtype=np.int64)
     if n > 1:  # a contour that goes on from the one before keeps its run number
         gap = np.hypot(*(samples[first[1:]] - samples[last[:-1]]).T)
-        goes_on = (chain[1:] == chain[:-1]) & (gap <= CHAIN_JOIN_MM)
+        goes_on = (chain[1:] == chain[:-1]) & (gap <= joint_mm)
         run = np.concatenate([[0], np.cumsum(~goes_on)]).astype(np.int64)
     return np.repeat(chain, counts), np.repeat(run, counts)
 
@@ -471,6 +488,7 @@ def not_cut_groups(
     tool_radius_mm: float,
     *,
     runs: IntArray | None = None,
+    joint_mm: float = CHAIN_JOIN_MM,
 ) -> list[tuple[FindingLike, IntArray, Point]]:
     """The drawing points of each feature the plan reported as not cut as drawn.
 
@@ -497,6 +515,8 @@ def not_cut_groups(
             minus the tool radius, mm.
         findings: plan findings; only :data:`NOT_CUT_KINDS` with a location count.
         tool_radius_mm: tool radius, mm.
+        joint_mm: the plan's joint distance, mm (the pieces of a closed chain meet
+            within it: :func:`_named_contour`).
 
     Returns:
         ``(finding, sample indices, location mm)`` per feature, in finding order (the
@@ -505,13 +525,24 @@ def not_cut_groups(
     size = np.abs(nominal_off)
     threshold = max(PLAN_TOLERANCE_MM, 3.0 * float(np.median(size)))
     stretches = _stretches(samples, contour_of if runs is None else runs, size > threshold)
+    closed_gaps = [f.value or 0.0 for f in findings if f.kind == "closed-gap"]
+    # the pieces of a contour the plan closed meet within its gap (measured after the
+    # chaining moved their ends by up to the joint distance)
+    meet_mm = joint_mm + max(closed_gaps, default=0.0)
     taken = [False] * len(stretches)
     out: list[tuple[FindingLike, IntArray, Point]] = []
     for finding in findings:
         if finding.kind not in NOT_CUT_KINDS or finding.at is None:
             continue
         at = np.asarray(finding.at, dtype=np.float64)
-        contour = _named_contour(samples, contour_of, at, inside=finding.kind == "offset-vanished")
+        contour = _named_contour(
+            samples,
+            contour_of,
+            at,
+            inside=finding.kind == "offset-vanished",
+            runs=runs,
+            joint_mm=meet_mm,
+        )
         for k, index in enumerate(stretches):
             if taken[k] or contour_of[index[0]] != contour:
                 continue
@@ -579,24 +610,79 @@ def _stretches(
 
 
 def _named_contour(
-    samples: FloatArray, contour_of: IntArray, at: FloatArray, *, inside: bool
+    samples: FloatArray,
+    contour_of: IntArray,
+    at: FloatArray,
+    *,
+    inside: bool,
+    runs: IntArray | None = None,
+    joint_mm: float = CHAIN_JOIN_MM,
 ) -> int:
-    """The contour a finding at ``at`` names: the smallest closed one around it, or the nearest."""
-    if inside:
-        import shapely
+    """The contour a finding at ``at`` names: the smallest closed one around it, or the nearest.
 
-        best, best_area = -1, math.inf
-        point = shapely.Point(at)
-        for c in np.unique(contour_of):
-            ring = samples[contour_of == c]
-            if len(ring) < 4 or math.dist(ring[0], ring[-1]) > 1e-9:
-                continue
-            polygon = shapely.Polygon(ring)
-            if polygon.is_valid and polygon.area < best_area and polygon.contains(point):
-                best, best_area = int(c), polygon.area
+    The nearest when ``at`` lies on the drawing (a closed contour of no area, drawn there
+    and back, is located at its start).
+
+    A contour here may be a chain of several drawing contours (``runs``: the pieces, each
+    sampled in order along the edge, listed in any order and direction, their ends within
+    ``joint_mm``, the plan's joint distance or a gap it closed): it is closed when every
+    piece's end meets another's, and around ``at`` when a ray from ``at`` crosses its
+    pieces an odd number of times (the even-odd rule); the smallest is the one of least
+    bounding box.
+    """
+    gap = np.hypot(*(samples - at).T)
+    nearest = int(np.argmin(gap))
+    if inside and gap[nearest] > 1e-9:  # on the drawing: a region of no area, at its start
+        best = _around(samples, contour_of, at, contour_of if runs is None else runs, joint_mm)
         if best >= 0:
             return best
-    return int(contour_of[np.argmin(np.hypot(*(samples - at).T))])
+    return int(contour_of[nearest])
+
+
+def _around(
+    samples: FloatArray, contour_of: IntArray, at: FloatArray, runs: IntArray, joint_mm: float
+) -> int:
+    """:func:`_named_contour`'s smallest closed contour around ``at``, or -1 when none is."""
+    order = np.argsort(contour_of, kind="stable")  # each contour's samples, in their order
+    cuts = np.flatnonzero(np.diff(contour_of[order])) + 1
+    best, best_area = -1, math.inf
+    for idx in np.split(order, cuts):
+        pts = samples[idx]
+        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        if len(idx) < 4 or not (lo[0] <= at[0] <= hi[0] and lo[1] <= at[1] <= hi[1]):
+            continue
+        area = float((hi[0] - lo[0]) * (hi[1] - lo[1]))
+        if area >= best_area:
+            continue
+        piece = runs[idx]
+        same = piece[1:] == piece[:-1]  # chords join consecutive samples of one piece
+        starts = np.flatnonzero(np.concatenate([[True], ~same]))
+        stops = np.concatenate([starts[1:], [len(idx)]]) - 1
+        if not _ends_meet(np.concatenate([pts[starts], pts[stops]]), joint_mm):
+            continue
+        a, b = pts[:-1][same], pts[1:][same]
+        up = (a[:, 1] > at[1]) != (b[:, 1] > at[1])
+        if not up.any():
+            continue
+        a, b = a[up], b[up]
+        x = a[:, 0] + (at[1] - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
+        if int(np.count_nonzero(x > at[0])) % 2 == 1:
+            best, best_area = int(contour_of[idx[0]]), area
+    return best
+
+
+def _ends_meet(ends: FloatArray, joint_mm: float) -> bool:
+    """Whether each of the pieces' ``ends`` (their starts, then their ends) meets another.
+
+    A closed drawing contour's two ends coincide; the pieces of a closed chain meet end
+    to end within the plan's joint distance ``joint_mm``.
+    """
+    if len(ends) == 2:
+        return math.dist(ends[0], ends[1]) <= joint_mm * (1.0 + 1e-9)
+    from scipy.spatial import cKDTree
+
+    gap, _ = cKDTree(ends).query(ends, k=2)
+    return bool(np.all(gap[:, 1] <= joint_mm * (1.0 + 1e-9)))
 
 
 _DISTANCE_TO: LastAnswers[FloatArray] = LastAnswers()

@@ -38,6 +38,7 @@ from camtool.verify.cutting_thin import (
 from camtool.verify.dda import compiled
 from camtool.verify.deviations import Deviation, deviation
 from camtool.verify.drawing_compare import (
+    CHAIN_JOIN_MM,
     Against,
     FindingLike,
     against_thinned,
@@ -317,6 +318,7 @@ def compare_drawing(
     against: Drawing,
     tool_diameter: float,
     findings: Sequence[FindingLike],
+    joint_mm: float = CHAIN_JOIN_MM,
 ) -> Against:
     """The machined edge of ``program``'s thinned cutting trace against the drawing.
 
@@ -330,6 +332,7 @@ def compare_drawing(
         tool_diameter / 2.0,
         nominal=trace_sources._nominal_lines(program) if findings else (),
         findings=findings,
+        joint_mm=joint_mm,
     )
 
 

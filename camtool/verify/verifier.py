@@ -26,6 +26,7 @@ from camtool.verify.clock import timing_warnings
 from camtool.verify.contour_measures import ContourMeasure
 from camtool.verify.deviations import Deviation
 from camtool.verify.drawing_compare import (
+    CHAIN_JOIN_MM,
     Against,
     FindingLike,
     prepare_comparison,
@@ -85,6 +86,8 @@ class Verification:
         drawing: the drawing given to compare with (the budget measures it again).
         tool_diameter: the tool diameter the drawing was compared with, mm.
         findings: the plan's findings the drawing was compared with.
+        joint_mm: the distance within which the plan joined contour ends, mm (the
+            drawing's contours are grouped into its chains at it).
         parts: the program's parts verified each alone (a job's operations, each with
             its tool against its own drawing); their errors count in the limits.
         cut_digest: the :class:`~camtool.verify.cutting_thin.CutDigest` of the trace's cutting
@@ -110,6 +113,7 @@ class Verification:
     findings: Sequence[FindingLike] = ()
     parts: tuple[Part, ...] = ()
     cut_digest: bytes | None = None
+    joint_mm: float = CHAIN_JOIN_MM
 
     @cached_property
     def error_budget(self) -> eb.ErrorBudget:
@@ -212,11 +216,13 @@ def verify_code(
     planned: Program | None = None,
     budget: bool = True,
     budget_now: Progress | None = None,
+    joint_mm: float = CHAIN_JOIN_MM,
 ) -> Verification:
     """Read ``code`` with ``target``'s reader and verify it on ``target``'s machine.
 
-    ``findings`` are the plan's, ``planned`` the unrounded plan, ``budget`` the error
-    budget switch and ``budget_now`` when it is computed (see :func:`verify_program`).
+    ``findings`` are the plan's, ``joint_mm`` its joint distance, ``planned`` the unrounded
+    plan, ``budget`` the error budget switch and ``budget_now`` when it is computed (see
+    :func:`verify_program`).
 
     Raises:
         ParseError: the code is not valid in the target's dialect (names the line).
@@ -242,6 +248,7 @@ def verify_code(
         budget=budget,
         source=source,
         budget_now=budget_now,
+        joint_mm=joint_mm,
     )
 
 
@@ -259,6 +266,7 @@ def verify_program(
     stream_above: int = STREAM_ROWS,
     source: str = "",
     budget_now: Progress | None = None,
+    joint_mm: float = CHAIN_JOIN_MM,
 ) -> Verification:
     """Simulate ``program`` on ``machine`` and measure the machined error.
 
@@ -272,6 +280,9 @@ def verify_program(
         findings: what planning found (:class:`camtool.toolpath.cuts.Finding`):
             features it reported as impossible with this tool are measured apart from
             the rest of the drawing (:func:`camtool.verify.drawing_compare.not_cut_groups`).
+        joint_mm: the distance within which the plan joined contour ends, mm
+            (:attr:`camtool.toolpath.plan.PlanReport.joint_mm`): the drawing's contours
+            are grouped into the plan's chains at it.
         planned: the unrounded plan ``program`` was emitted from, in the same
             coordinates (the error budget's ``rounding`` source), or ``None``.
         budget: compute the error budget when it is asked for
@@ -303,7 +314,9 @@ def verify_program(
     with ExitStack() as stack:  # leaving it stops the budget's workers, if any
         early = None  # one source forked as soon as the rows are counted
         if budget_now is not None and budget and drawing is None:
-            early = EarlyBudget(program, machine, planned, tool_diameter, findings, budget_now)
+            early = EarlyBudget(
+                program, machine, planned, tool_diameter, findings, budget_now, joint_mm
+            )
             stack.callback(early.close)
         streaming = None if early is None else early.start
         trace, streamed = simulate_big(
@@ -314,7 +327,14 @@ def verify_program(
             if budget and drawing is not None:
                 prepare_comparison(drawing)  # loaded once here, not once per worker
             inputs = BudgetInputs(
-                program, machine, trace, planned, drawing, tool_diameter, findings
+                program,
+                machine,
+                trace,
+                planned,
+                drawing,
+                tool_diameter,
+                findings,
+                joint_mm=joint_mm,
             )
             run = stack.enter_context(BudgetRun(inputs, budget, budget_now))
         dev, along, contours, thin, digest = streamed or (
@@ -323,7 +343,7 @@ def verify_program(
         )
         compared = None
         if thin is not None and drawing is not None:
-            compared = compare_drawing(program, thin, drawing, tool_diameter, findings)
+            compared = compare_drawing(program, thin, drawing, tool_diameter, findings, joint_mm)
         warnings = [*report._warnings(program, trace), *([skipped] if skipped else [])]
         warnings += timing_warnings(trace, program, machine)
         v = Verification(
@@ -343,6 +363,7 @@ def verify_program(
             drawing=drawing,
             tool_diameter=tool_diameter,
             findings=tuple(findings),
+            joint_mm=joint_mm,
             cut_digest=digest,
         )
         if run is not None:

@@ -178,3 +178,64 @@ def test_loose_lines_are_measured_as_the_contours_they_make(
     assert v.against.max_um < 12.0
     slot = plate_features(v.against.not_cut)[SLOT]  # one feature each, not one per line
     assert slot.samples >= 24 / 0.005  # the whole slot outline, its four lines
+
+
+def test_lines_joined_at_a_larger_chain_tolerance_are_grouped_as_the_plan_joined_them() -> None:
+    # Each line of the plate drawn as two LINEs with a 0.1 mm gap at its middle: only
+    # --chain-tolerance 0.2 (which camtool's own warning suggests) makes the outline and
+    # the slot. The comparison groups the drawing's lines at the plan's joint distance,
+    # not the default 0.01 mm: before, each corner's far side and seven of the slot's
+    # eight pieces were counted in the main figure (12 mm: the slot).
+    out = []
+    for k, seg in enumerate(s for c in plate().contours for s in c.segments):
+        assert isinstance(seg, Line)
+        (x0, y0), (x1, y1) = seg.start, seg.end
+        length = math.dist(seg.start, seg.end)
+        u = ((x1 - x0) / length, (y1 - y0) / length)
+        mid = ((x0 + x1) / 2, (y0 + y1) / 2)
+        before = (mid[0] - 0.05 * u[0], mid[1] - 0.05 * u[1])
+        after = (mid[0] + 0.05 * u[0], mid[1] + 0.05 * u[1])
+        out.append(Contour((Line(seg.start, before),), False, source=f"LINE #{k}a"))
+        out.append(Contour((Line(after, seg.end),), False, source=f"LINE #{k}b"))
+    options = PlanOptions(offset="outside", tool_diameter=2 * R, chain_tolerance=0.2)
+    job = post_drawing(Drawing(tuple(out)), load_target("grbl"), options)
+    assert job.plan is not None and job.plan.joint_mm == 0.2
+    v = verify_job(job)
+    assert v.against is not None
+    assert v.against.max_um < 12.0
+    slot = plate_features(v.against.not_cut)[SLOT]
+    assert slot.samples >= (24 - 4 * 0.1) / 0.005  # the whole slot outline, its eight lines
+
+
+def test_a_region_the_plan_closed_or_drew_without_area_is_set_apart() -> None:
+    # Inside a 40 × 30 mm rectangle cut outside with the 3 mm tool: the 2 mm slot drawn
+    # as four loose LINEs with a 0.015 mm gap at one corner (more than the 0.01 mm joint:
+    # the plan closes it, a closed-gap finding), and a line drawn there and back (two
+    # LINEs whose ends meet: a closed contour of no area, its finding at its start). Both
+    # are offset-vanished; before, the comparison named the rectangle around them for
+    # both findings, and kept them in the main figure (15 mm).
+    # Expected from the geometry: the machined edge is the rectangle (5..45, 5..35);
+    # the line's end (25, 20) is 15 mm from it, the slot's top edge 12 mm.
+    outline = _polygon([(5, 5), (45, 5), (45, 35), (5, 35)], "outline")
+    corners = [(10, 15), (20, 15), (20, 17), (10, 17)]
+    slot = [
+        Contour((Line(a, b),), False, source=f"LINE #{k}")
+        for k, (a, b) in enumerate(zip(corners, [*corners[1:], (10, 15.015)], strict=True))
+    ]
+    there = Contour((Line((25, 20), (35, 20)),), False, source="LINE #there")
+    back = Contour((Line((35, 20), (25, 20)),), False, source="LINE #back")
+    job = post_drawing(
+        Drawing((outline, *slot, there, back)),
+        load_target("grbl"),
+        PlanOptions(offset="outside", tool_diameter=2 * R),
+    )
+    assert job.plan is not None
+    kinds = sorted(f.kind for f in job.plan.findings)
+    assert kinds == ["closed-gap", "offset-vanished", "offset-vanished"]
+    v = verify_job(job, budget=False)
+    assert v.against is not None
+    assert v.against.max_um < 12.0
+    apart = sorted(v.against.not_cut, key=lambda f: f.error_um)
+    assert [f.kind for f in apart] == ["offset-vanished", "offset-vanished"]
+    assert apart[0].error_um == pytest.approx(SLOT_UM, abs=10.0)
+    assert apart[1].error_um == pytest.approx(15_000.0, abs=10.0)
