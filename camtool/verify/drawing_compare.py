@@ -620,8 +620,8 @@ def _named_contour(
 ) -> int:
     """The contour a finding at ``at`` names: the smallest closed one around it, or the nearest.
 
-    The nearest when ``at`` lies on the drawing (a closed contour of no area, drawn there
-    and back, is located at its start).
+    When ``at`` lies on the drawing, the contour that starts there (a closed contour of no
+    area, drawn there and back, is located at its start; another may pass through it).
 
     A contour here may be a chain of several drawing contours (``runs``: the pieces, each
     sampled in order along the edge, listed in any order and direction, their ends within
@@ -630,12 +630,17 @@ def _named_contour(
     pieces an odd number of times (the even-odd rule); the smallest is the one of least
     bounding box.
     """
+    pieces = contour_of if runs is None else runs
     gap = np.hypot(*(samples - at).T)
     nearest = int(np.argmin(gap))
-    if inside and gap[nearest] > 1e-9:  # on the drawing: a region of no area, at its start
-        best = _around(samples, contour_of, at, contour_of if runs is None else runs, joint_mm)
+    if inside and gap[nearest] > 1e-9:
+        best = _around(samples, contour_of, at, pieces, joint_mm)
         if best >= 0:
             return best
+    elif inside:  # on the drawing: a region of no area, located at its contour's start
+        on = np.flatnonzero(gap <= 1e-9)
+        first = on[(on == 0) | (pieces[on] != pieces[np.maximum(on - 1, 0)])]
+        nearest = int(first[0]) if len(first) else nearest  # where a contour starts
     return int(contour_of[nearest])
 
 

@@ -239,3 +239,24 @@ def test_a_region_the_plan_closed_or_drew_without_area_is_set_apart() -> None:
     assert [f.kind for f in apart] == ["offset-vanished", "offset-vanished"]
     assert apart[0].error_um == pytest.approx(SLOT_UM, abs=10.0)
     assert apart[1].error_um == pytest.approx(15_000.0, abs=10.0)
+
+
+def test_a_region_without_area_names_the_contour_that_starts_there() -> None:
+    # Two closed polylines of no area end to end (LibreCAD's pe6.dxf draws a terminal so):
+    # A from (25, 20) to (35, 20) and back, B from (35, 20) to (40, 20) and back. B's
+    # finding is at its start (35, 20), which A passes through too: before, both
+    # findings named A and B stayed in the main figure. Expected from the geometry (the
+    # machined edge is the rectangle 5..45 × 5..35): A's far end 15 mm from it, B's 10 mm.
+    outline = _polygon([(5, 5), (45, 5), (45, 35), (5, 35)], "outline")
+    a = Contour((Line((25, 20), (35, 20)), Line((35, 20), (25, 20))), True, source="A")
+    b = Contour((Line((35, 20), (40, 20)), Line((40, 20), (35, 20))), True, source="B")
+    job = post_drawing(
+        Drawing((outline, a, b)),
+        load_target("grbl"),
+        PlanOptions(offset="outside", tool_diameter=2 * R),
+    )
+    v = verify_job(job, budget=False)
+    assert v.against is not None
+    assert v.against.max_um < 12.0
+    errors = sorted(f.error_um for f in v.against.not_cut)
+    assert errors == [pytest.approx(10_000.0, abs=10.0), pytest.approx(15_000.0, abs=10.0)]
