@@ -106,7 +106,8 @@ def pocket(
     Returns:
         Cuts of kind ``"pocket"`` (group = the pocket boundary's index; in each
         group the order given is the cutting order), and findings:
-        ``open-left-out`` (:func:`~camtool.toolpath.cuts.open_left_out`), ``uncut``
+        ``open-left-out`` (:func:`~camtool.toolpath.cuts.open_left_out`), ``offset-vanished``
+        (a pocket outline that encloses no area, width 0, at its start), ``uncut``
         (regions narrower than the tool, with location and area mm²), ``tight-corner``
         (corners left with the tool radius) and ``offset-fallback``.
 
@@ -116,7 +117,8 @@ def pocket(
     """
     cuts: list[Cut] = []
     findings: list[Finding] = []
-    todo = regions(contours, nest, options.tolerance)
+    no_area: list[int] = []
+    todo = regions(contours, nest, options.tolerance, no_area)
     _check_work(todo, options)
     progress(Step("pocketing", 0, len(todo)))
     for done, region in enumerate(todo, start=1):
@@ -126,7 +128,10 @@ def pocket(
         progress(Step("pocketing", done, len(todo)))
     if not cuts:
         raise ToolpathError(_nothing_message(contours, options))
-    findings[:0] = open_left_out(contours, "--offset pocket")
+    findings[:0] = [
+        *open_left_out(contours, "--offset pocket"),
+        *(_no_area(contours[i]) for i in no_area),
+    ]
     return Stage(tuple(cuts), tuple(findings))
 
 
@@ -139,13 +144,17 @@ def _nothing_message(contours: Sequence[Contour], options: PlanOptions) -> str:
     )
 
 
-def regions(contours: Sequence[Contour], nest: Nesting, tolerance: float) -> list[Region]:
+def regions(
+    contours: Sequence[Contour], nest: Nesting, tolerance: float, no_area: list[int] | None = None
+) -> list[Region]:
     """The even-odd regions to clear, one per connected piece of each pocket.
 
     Args:
         contours: contours, mm; open ones are ignored.
         nest: their containment.
         tolerance: arcs become chords within ``tolerance / 4`` mm.
+        no_area: given, the indices of the pocket outlines that enclose no area (drawn
+            there and back) are appended to it: they give no region.
     """
     out: list[Region] = []
     for i, contour in enumerate(contours):
@@ -157,12 +166,30 @@ def regions(contours: Sequence[Contour], nest: Nesting, tolerance: float) -> lis
             if c.closed and i in nest.parents[j] and nest.depth(j) == nest.depth(i) + 1
         )
         area: BaseGeometry = Polygon(contour.points(tolerance / 4)).buffer(0)
+        if area.is_empty and no_area is not None:
+            no_area.append(i)
         for island in islands:
             area = area.difference(Polygon(island.points(tolerance / 4)).buffer(0))
         parts = polygons(area)
         for part in parts:
             out.append(Region(i, contour, orient(part), islands, len(parts) == 1))
     return out
+
+
+def _no_area(contour: Contour) -> Finding:
+    """An ``offset-vanished`` finding of width 0 for a pocket outline that encloses no area.
+
+    Located at its start, as an offset that vanishes on such a contour is
+    (:func:`camtool.toolpath.compensate.compensate`).
+    """
+    return Finding(
+        "offset-vanished",
+        f"{where(contour)}: a closed contour that encloses no area (drawn there and back): "
+        "no pocket to clear there; cut it on its line (--offset on, or an engrave "
+        "operation) or draw it as an outline",
+        contour.start,
+        0.0,
+    )
 
 
 def _pocket_region(region: Region, options: PlanOptions) -> tuple[list[Cut], list[Finding]]:

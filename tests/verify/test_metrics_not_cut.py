@@ -260,3 +260,27 @@ def test_a_region_without_area_names_the_contour_that_starts_there() -> None:
     assert v.against.max_um < 12.0
     errors = sorted(f.error_um for f in v.against.not_cut)
     assert errors == [pytest.approx(10_000.0, abs=10.0), pytest.approx(15_000.0, abs=10.0)]
+
+
+def test_a_pocket_outline_without_area_is_said_and_set_apart() -> None:
+    # A pocket of the rectangle 5..45 × 5..35 and, beside it, a closed polyline of no
+    # area from (60, 20) to (70, 20) and back: no region to clear. Before, the plan said
+    # nothing and its 25 mm counted against the drawing; now an offset-vanished finding
+    # (width 0, at its start) and the feature apart. Expected from the geometry: the
+    # pocket's wall is the rectangle, 25 mm from the line's far end (70, 20).
+    outline = _polygon([(5, 5), (45, 5), (45, 35), (5, 35)], "outline")
+    flat = Contour((Line((60, 20), (70, 20)), Line((70, 20), (60, 20))), True, source="flat")
+    job = post_drawing(
+        Drawing((outline, flat)),
+        load_target("grbl"),
+        PlanOptions(offset="pocket", tool_diameter=2 * R),
+    )
+    assert job.plan is not None
+    said = [f for f in job.plan.findings if f.kind == "offset-vanished"]
+    assert len(said) == 1 and said[0].at == (60, 20) and "encloses no area" in said[0].message
+    v = verify_job(job, budget=False)
+    assert v.against is not None
+    assert v.against.max_um < 12.0
+    flat_apart = [f for f in v.against.not_cut if f.kind == "offset-vanished"]
+    assert len(flat_apart) == 1
+    assert flat_apart[0].error_um == pytest.approx(25_000.0, abs=10.0)
