@@ -71,6 +71,7 @@ FINDING_KINDS = (
     "closed-gap",
     "offset-fallback",
     "offset-vanished",
+    "self-crossing",
     "tight-corner",
     "uncut",
     "gouge",

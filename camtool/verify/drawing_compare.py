@@ -23,7 +23,7 @@ FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 
 
-NOT_CUT_KINDS = ("tight-corner", "offset-vanished", "uncut")
+NOT_CUT_KINDS = ("tight-corner", "offset-vanished", "uncut", "self-crossing")
 """Plan finding kinds that say a feature cannot be cut as drawn with this tool."""
 
 
@@ -58,6 +58,8 @@ class NotCut:
         """A short name: ``"tight corner"``, ``"2 mm wide region"``, ``"uncut region"``."""
         if self.kind == "tight-corner":
             return "tight corner"
+        if self.kind == "self-crossing":
+            return "loops of a self-crossing contour"
         if self.kind == "offset-vanished" and self.value is not None:
             return f"{fmt_num(self.value, 3).rstrip('0').rstrip('.')} mm wide region"
         return "uncut region" if self.kind == "uncut" else "region narrower than the tool"
@@ -500,8 +502,9 @@ def not_cut_groups(
     through its corner whose peak exceeds ``max(2 × threshold, r / 100)`` (the
     finding locates only the first of its corners), an ``offset-vanished`` one
     the stretches of the smallest contour around its location, an ``uncut`` one
-    those within ``max(2r, 2√area)`` of its location on the nearest contour.
-    Stretches no finding names stay in the main figure: the planner did not
+    those within ``max(2r, 2√area)`` of its location on the nearest contour, a
+    ``self-crossing`` one every stretch of the contour through its crossing (the loops
+    its offset left). Stretches no finding names stay in the main figure: the planner did not
     say why they are off.
 
     Args:
@@ -551,6 +554,8 @@ def not_cut_groups(
                 if size[peak] <= max(2.0 * threshold, tool_radius_mm / 100.0):
                     continue
                 where = (float(samples[peak, 0]), float(samples[peak, 1]))
+            elif finding.kind == "self-crossing":  # every loop the offset left: one feature
+                where = (float(at[0]), float(at[1]))
             else:
                 if finding.kind == "uncut":
                     reach = max(2.0 * tool_radius_mm, 2.0 * math.sqrt(max(finding.value or 0, 0)))

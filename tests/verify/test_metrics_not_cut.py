@@ -284,3 +284,29 @@ def test_a_pocket_outline_without_area_is_said_and_set_apart() -> None:
     flat_apart = [f for f in v.against.not_cut if f.kind == "offset-vanished"]
     assert len(flat_apart) == 1
     assert flat_apart[0].error_um == pytest.approx(25_000.0, abs=10.0)
+
+
+def test_a_contour_that_crosses_itself_is_said_and_its_loops_set_apart() -> None:
+    # A closed outline that curls into itself: (0,0) (30,0) (30,30) (10,30) (10,10)
+    # (20,10) (20,20) (0,20), moved by (5, 5); its last edge crosses the one down from
+    # (10,30) at (10,20). The outside offset (shapely's buffer, OpenCASCADE refuses it)
+    # follows the boundary of the area it encloses, (0,0) (30,0) (30,30) (10,30) (10,20)
+    # (0,20): the curl's edges inside are not cut, and before nothing said so. Expected
+    # from the geometry: the curl's corner (20,10) is 10 mm from that boundary (the
+    # bottom and the right side), the farthest of its points.
+    points = [(0, 0), (30, 0), (30, 30), (10, 30), (10, 10), (20, 10), (20, 20), (0, 20)]
+    job = post_drawing(
+        Drawing((_polygon([(x + 5.0, y + 5.0) for x, y in points], "curl"),)),
+        load_target("grbl"),
+        PlanOptions(offset="outside", tool_diameter=2 * R),
+    )
+    assert job.plan is not None
+    said = [f for f in job.plan.findings if f.kind == "self-crossing"]
+    assert len(said) == 1 and said[0].at == pytest.approx((15.0, 25.0))
+    assert "crosses itself" in said[0].message and "--offset on" in said[0].message
+    v = verify_job(job, budget=False)
+    assert v.against is not None
+    assert v.against.max_um < 12.0
+    (loops,) = v.against.not_cut
+    assert loops.kind == "self-crossing" and loops.label == "loops of a self-crossing contour"
+    assert loops.error_um == pytest.approx(10_000.0, abs=10.0)
