@@ -15,7 +15,7 @@ from typing import Any
 from camtool.model.errors import ToolpathError
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import Arc, Contour, Line, Point, Segment
-from camtool.toolpath.cuts import Cut, Finding, Stage, open_left_out, where
+from camtool.toolpath.cuts import Cut, Finding, Stage, open_left_out, self_crossing, where
 from camtool.toolpath.offset import (
     Answer,
     OffsetResult,
@@ -292,7 +292,8 @@ def _compensated(
         return [], [_vanished(contour, options)]
     if result.fallback is not None:
         findings.append(_fallback(contour, result.fallback, options.tolerance))
-        crossing = _self_crossing(contour, options)  # shapely's buffer keeps no loop
+        # shapely's buffer keeps no loop
+        crossing = self_crossing(contour, options.tolerance, f"{options.offset} offset")
         if crossing is not None:
             findings.append(crossing)
     corners = tight_corners(drawn, side.inside, r, options.tolerance)
@@ -396,29 +397,6 @@ def _vanished(contour: Contour, options: PlanOptions) -> Finding:
         f"wide, narrower than the {d:g} mm tool: nothing can be cut there; use a smaller tool",
         (x, y),
         float(width),
-    )
-
-
-def _self_crossing(contour: Contour, options: PlanOptions) -> Finding | None:
-    """A ``self-crossing`` finding when the closed ``contour`` crosses itself, else ``None``.
-
-    Its offset (shapely's buffer of the area it encloses) follows the boundary of that
-    area: the loops of the drawn line inside it are not cut. Located where it crosses
-    (shapely's validity check, GEOS), mm.
-    """
-    from shapely import Polygon, is_valid_reason
-
-    reason = is_valid_reason(Polygon(contour.points(options.tolerance / 4)))
-    if not reason.startswith(("Self-intersection", "Ring Self-intersection")):
-        return None
-    x, y = (float(v) for v in reason[reason.index("[") + 1 : reason.index("]")].split()[:2])
-    return Finding(
-        "self-crossing",
-        f"{where(contour)}: the contour crosses itself (at ({x:.4f}, {y:.4f}) mm): the "
-        f"{options.offset} offset follows the boundary of the area it encloses, and its "
-        "loops inside are not cut; cut it on its line (--offset on, or an engrave "
-        "operation) to follow every loop",
-        (x, y),
     )
 
 

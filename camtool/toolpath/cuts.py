@@ -161,3 +161,32 @@ def open_left_out(contours: Sequence[Contour], side: str) -> list[Finding]:
             )
         )
     return out
+
+
+def self_crossing(contour: Contour, tolerance: float, what: str) -> Finding | None:
+    """A ``self-crossing`` finding when the closed ``contour`` crosses itself, else ``None``.
+
+    ``what`` (``"outside offset"``, ``"pocket"``) is made from shapely's buffer of the
+    area the contour encloses: an offset follows the boundary of that area (the loops of
+    the drawn line inside it are not cut), a pocket clears all of it (through them).
+    Located where it crosses (shapely's validity check, GEOS), mm; arcs are chords
+    within ``tolerance / 4``.
+    """
+    from shapely import Polygon, is_valid_reason
+
+    reason = is_valid_reason(Polygon(contour.points(tolerance / 4)))
+    if not reason.startswith(("Self-intersection", "Ring Self-intersection")):
+        return None
+    x, y = (float(v) for v in reason[reason.index("[") + 1 : reason.index("]")].split()[:2])
+    effect = (
+        "clears the whole area it encloses, through its loops inside"
+        if what == "pocket"
+        else "follows the boundary of the area it encloses, and its loops inside are not cut"
+    )
+    return Finding(
+        "self-crossing",
+        f"{where(contour)}: the contour crosses itself (at ({x:.4f}, {y:.4f}) mm): the "
+        f"{what} {effect}; cut it on its line (--offset on, or an engrave operation) to "
+        "follow every loop",
+        (x, y),
+    )

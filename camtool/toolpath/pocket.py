@@ -27,7 +27,7 @@ from camtool.model.errors import InputError, ToolpathError, UsageError
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import TAU, Arc, Contour, Line, Point, Segment, distance
 from camtool.model.units import fmt_num
-from camtool.toolpath.cuts import Cut, Finding, Stage, open_left_out, where
+from camtool.toolpath.cuts import Cut, Finding, Stage, open_left_out, self_crossing, where
 from camtool.toolpath.offset import offset_contour
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.order import Nesting
@@ -118,7 +118,8 @@ def pocket(
     cuts: list[Cut] = []
     findings: list[Finding] = []
     no_area: list[int] = []
-    todo = regions(contours, nest, options.tolerance, no_area)
+    invalid: list[int] = []
+    todo = regions(contours, nest, options.tolerance, no_area, invalid)
     _check_work(todo, options)
     progress(Step("pocketing", 0, len(todo)))
     for done, region in enumerate(todo, start=1):
@@ -131,6 +132,7 @@ def pocket(
     findings[:0] = [
         *open_left_out(contours, "--offset pocket"),
         *(_no_area(contours[i]) for i in no_area),
+        *filter(None, (self_crossing(contours[i], options.tolerance, "pocket") for i in invalid)),
     ]
     return Stage(tuple(cuts), tuple(findings))
 
@@ -145,7 +147,11 @@ def _nothing_message(contours: Sequence[Contour], options: PlanOptions) -> str:
 
 
 def regions(
-    contours: Sequence[Contour], nest: Nesting, tolerance: float, no_area: list[int] | None = None
+    contours: Sequence[Contour],
+    nest: Nesting,
+    tolerance: float,
+    no_area: list[int] | None = None,
+    invalid: list[int] | None = None,
 ) -> list[Region]:
     """The even-odd regions to clear, one per connected piece of each pocket.
 
@@ -155,6 +161,8 @@ def regions(
         tolerance: arcs become chords within ``tolerance / 4`` mm.
         no_area: given, the indices of the pocket outlines that enclose no area (drawn
             there and back) are appended to it: they give no region.
+        invalid: given, the indices of the pocket outlines that are no valid polygon (one
+            that crosses itself: its region is the area it encloses) are appended to it.
     """
     out: list[Region] = []
     for i, contour in enumerate(contours):
@@ -165,7 +173,10 @@ def regions(
             for j, c in enumerate(contours)
             if c.closed and i in nest.parents[j] and nest.depth(j) == nest.depth(i) + 1
         )
-        area: BaseGeometry = Polygon(contour.points(tolerance / 4)).buffer(0)
+        outline = Polygon(contour.points(tolerance / 4))
+        if invalid is not None and not outline.is_valid:
+            invalid.append(i)
+        area: BaseGeometry = outline.buffer(0)
         if area.is_empty and no_area is not None:
             no_area.append(i)
         for island in islands:

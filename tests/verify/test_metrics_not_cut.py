@@ -310,3 +310,23 @@ def test_a_contour_that_crosses_itself_is_said_and_its_loops_set_apart() -> None
     (loops,) = v.against.not_cut
     assert loops.kind == "self-crossing" and loops.label == "loops of a self-crossing contour"
     assert loops.error_um == pytest.approx(10_000.0, abs=10.0)
+
+
+def test_a_pocket_outline_that_crosses_itself_is_said() -> None:
+    # The curl of the test above pocketed: its region is the area it encloses, so the
+    # pocket clears through the curl's inner edges (before, nothing said so). Expected:
+    # the tool's centre passes over them, so their drawn points are cut r deep (1.5 mm),
+    # apart from the main figure; the rest within a few steps.
+    points = [(0, 0), (30, 0), (30, 30), (10, 30), (10, 10), (20, 10), (20, 20), (0, 20)]
+    job = post_drawing(
+        Drawing((_polygon([(x + 5.0, y + 5.0) for x, y in points], "curl"),)),
+        load_target("grbl"),
+        PlanOptions(offset="pocket", tool_diameter=2 * R),
+    )
+    assert job.plan is not None
+    said = [f for f in job.plan.findings if f.kind == "self-crossing"]
+    assert len(said) == 1 and "clears the whole area it encloses" in said[0].message
+    v = verify_job(job, budget=False)
+    assert v.against is not None and v.against.max_um < 12.0
+    (loops,) = [f for f in v.against.not_cut if f.kind == "self-crossing"]
+    assert loops.error_um == pytest.approx(R * 1000.0, abs=10.0)
