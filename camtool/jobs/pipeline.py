@@ -458,7 +458,7 @@ def verify_job(
         CamtoolError: the target cannot read its own code back, or its machine
             profile is invalid for the verifier.
     """
-    from camtool.verify.drawing_compare import CHAIN_JOIN_MM
+    from camtool.verify.not_cut import CHAIN_JOIN_MM
     from camtool.verify.verifier import verify_code
 
     several = len(job.operations) > 1
@@ -496,7 +496,7 @@ def verify_operation(job: PostJob, run: OperationRun) -> Part:
     for the job's target as they are in the job's program; the machined edge is its
     tool's (a drill's hole is the drill's diameter about its centre).
     """
-    from camtool.verify.drawing_compare import CHAIN_JOIN_MM
+    from camtool.verify.not_cut import CHAIN_JOIN_MM
     from camtool.verify.verifier import Part, verify_code
 
     first, end = run.moves

@@ -29,7 +29,7 @@ from camtool.preview.scene import (
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
-    from camtool.verify.drawing_compare import NotCut
+    from camtool.verify.not_cut import NotCut
     from camtool.verify.verifier import Verification
 
 BINS = 16

@@ -45,12 +45,11 @@ from camtool.verify.cutting_thin import (
 )
 from camtool.verify.dda import compiled
 from camtool.verify.drawing_compare import (
-    CHAIN_JOIN_MM,
-    FindingLike,
     against_worst,
     prepare_stream,
 )
 from camtool.verify.motion import StepTrace, library
+from camtool.verify.not_cut import CHAIN_JOIN_MM, FindingLike
 from camtool.verify.sources import ALL, SOURCES, Sources
 from camtool.verify.streamed import (
     CHUNK_ROWS,

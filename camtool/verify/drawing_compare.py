@@ -8,75 +8,24 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Protocol
 
 import numpy as np
 import numpy.typing as npt
 
 from camtool.accel.memo import LastAnswers
 from camtool.model.shapes import Drawing, Line, Point, Segment
-from camtool.model.units import fmt_num
-from camtool.toolpath.options import DEFAULT_CHAIN_TOLERANCE
 from camtool.verify import cutting_thin, nearest_exact, nearest_search, path_shortfall
+from camtool.verify.not_cut import (
+    CHAIN_JOIN_MM,
+    NOT_CUT_KINDS,
+    FindingLike,
+    NotCut,
+    chains,
+    not_cut_groups,
+)
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
-
-
-NOT_CUT_KINDS = ("tight-corner", "offset-vanished", "uncut", "self-crossing")
-"""Plan finding kinds that say a feature cannot be cut as drawn with this tool."""
-
-
-CHAIN_JOIN_MM = DEFAULT_CHAIN_TOLERANCE
-"""Ends of two drawing contours at most this far apart belong to one contour of the plan,
-mm, unless the plan says its own (``joint_mm``): the default ``--chain-tolerance`` (a
-drawing of loose LINEs is planned as the closed contours its lines make, and the plan's
-findings name those)."""
-
-
-@dataclass(frozen=True)
-class NotCut:
-    """A feature of the drawing the planner reported it cannot cut as drawn.
-
-    Attributes:
-        kind: the plan finding's kind (one of :data:`NOT_CUT_KINDS`).
-        at: where the feature is, mm: the drawing point farthest from the
-            programmed path (a tight corner's vertex) or the finding's location.
-        error_um: largest |d(q, trace) − r| over the drawing points of the feature, µm.
-        samples: drawing points counted in this feature (left out of the main figure).
-        value: the finding's size (a region's width mm, an area mm², ...), or ``None``.
-    """
-
-    kind: str
-    at: Point
-    error_um: float
-    samples: int
-    value: float | None = None
-
-    @property
-    def label(self) -> str:
-        """A short name: ``"tight corner"``, ``"2 mm wide region"``, ``"uncut region"``."""
-        if self.kind == "tight-corner":
-            return "tight corner"
-        if self.kind == "self-crossing":
-            return "loops of a self-crossing contour"
-        if self.kind == "offset-vanished" and self.value is not None:
-            return f"{fmt_num(self.value, 3).rstrip('0').rstrip('.')} mm wide region"
-        return "uncut region" if self.kind == "uncut" else "region narrower than the tool"
-
-
-class FindingLike(Protocol):
-    """What :func:`against_drawing` reads of a plan finding.
-
-    :class:`camtool.toolpath.cuts.Finding` is one.
-    """
-
-    @property
-    def kind(self) -> str: ...  # noqa: D102
-    @property
-    def at(self) -> Point | None: ...  # noqa: D102
-    @property
-    def value(self) -> float | None: ...  # noqa: D102
 
 
 @dataclass(frozen=True)
@@ -238,7 +187,7 @@ def against_drawing(
             reads only the other figures, as the error budget does).
         joint_mm: the distance within which the plan joined contour ends, mm
             (:attr:`~camtool.toolpath.plan.PlanReport.joint_mm`): the drawing's contours
-            are grouped into the plan's chains at it (:func:`_chains`).
+            are grouped into the plan's chains at it (:func:`~camtool.verify.not_cut.chains`).
     """
     return against_thinned(
         cutting_thin.thin_cutting(points, runs, resolution_mm),
@@ -360,56 +309,15 @@ def _not_cut(
 ) -> list[tuple[FindingLike, IntArray, Point]]:
     """:func:`not_cut_groups` of the drawing's ``samples`` when there is anything to group.
 
-    The drawing's contours are grouped into chains at ``joint_mm`` (:func:`_chains`).
+    The drawing's contours are grouped into chains at ``joint_mm`` (:func:`chains`).
     """
     if not nominal or not any(f.kind in NOT_CUT_KINDS and f.at is not None for f in findings):
         return []
     nominal_off = _distance_to(samples, nominal) - tool_radius_mm
-    chain_of, run_of = _chains(samples, sizes, joint_mm)
+    chain_of, run_of = chains(samples, sizes, joint_mm)
     return not_cut_groups(
         samples, chain_of, nominal_off, findings, tool_radius_mm, runs=run_of, joint_mm=joint_mm
     )
-
-
-def _chains(
-    samples: FloatArray, sizes: list[int], joint_mm: float = CHAIN_JOIN_MM
-) -> tuple[IntArray, IntArray]:
-    """``(S,)`` chain and run of each sample of :func:`_sample_drawing`.
-
-    A chain is a set of the drawing's contours joined end to end (within ``joint_mm``,
-    the plan's joint distance), as the planner chains them: a finding about a planned
-    contour names every drawing contour of its chain. A run is a contour together with
-    the ones before it in the drawing's order that continue it (same chain, its start at
-    the previous one's end): the samples along a run follow the edge, so a stretch off
-    the drawing is not split where one LINE ends and the next begins.
-    """
-    counts = np.asarray(sizes, dtype=np.int64)
-    n = len(counts)
-    first = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
-    last = first + counts - 1
-    parent = list(range(n))
-
-    def root(k: int) -> int:
-        while parent[k] != k:
-            parent[k] = parent[parent[k]]
-            k = parent[k]
-        return k
-
-    if n > 1:
-        from scipy.spatial import cKDTree
-
-        ends = np.concatenate([samples[first], samples[last]])
-        for a, b in cKDTree(ends).query_pairs(joint_mm):
-            ra, rb = root(int(a) % n), root(int(b) % n)
-            if ra != rb:
-                parent[max(ra, rb)] = min(ra, rb)
-    chain = np.asarray([root(k) for k in range(n)], dtype=np.int64)
-    run = np.arange(n, dtype=np.int64)
-    if n > 1:  # a contour that goes on from the one before keeps its run number
-        gap = np.hypot(*(samples[first[1:]] - samples[last[:-1]]).T)
-        goes_on = (chain[1:] == chain[:-1]) & (gap <= joint_mm)
-        run = np.concatenate([[0], np.cumsum(~goes_on)]).astype(np.int64)
-    return np.repeat(chain, counts), np.repeat(run, counts)
 
 
 def _cut_as_drawn(
@@ -476,223 +384,6 @@ def _least_nearest(points: FloatArray, samples: FloatArray, sizes: list[int]) ->
     if not maybe.any():
         return upper
     return min(upper, float(np.min(nearest_search.nearest_distances(points[maybe], a, b))))
-
-
-PLAN_TOLERANCE_MM = 0.002
-"""Least distance of the programmed edge from the drawing that counts as "not as drawn", mm."""
-
-
-def not_cut_groups(
-    samples: FloatArray,
-    contour_of: IntArray,
-    nominal_off: FloatArray,
-    findings: Sequence[FindingLike],
-    tool_radius_mm: float,
-    *,
-    runs: IntArray | None = None,
-    joint_mm: float = CHAIN_JOIN_MM,
-) -> list[tuple[FindingLike, IntArray, Point]]:
-    """The drawing points of each feature the plan reported as not cut as drawn.
-
-    A feature is a stretch of one drawing contour where even the *programmed*
-    edge (the nominal path swept by the tool) lies off the drawing by more than
-    a threshold: ``max(PLAN_TOLERANCE_MM, 3 × the median such distance)`` (the
-    median absorbs the dialect's rounding). A stretch belongs to a finding that
-    names its contour: a ``tight-corner`` finding every stretch of the contour
-    through its corner whose peak exceeds ``max(2 × threshold, r / 100)`` (the
-    finding locates only the first of its corners), an ``offset-vanished`` one
-    the stretches of the smallest contour around its location, an ``uncut`` one
-    those within ``max(2r, 2√area)`` of its location on the nearest contour, a
-    ``self-crossing`` one every stretch of the contour through its crossing (the loops
-    its offset left). Stretches no finding names stay in the main figure: the planner did not
-    say why they are off.
-
-    Args:
-        samples: ``(S, 2)`` drawing points, mm, contour after contour.
-        contour_of: ``(S,)`` index of the contour of each sample (of the chain of
-            drawing contours the plan made one contour of: :func:`_chains`).
-        runs: ``(S,)`` index of the run of each sample, where a stretch may go on
-            from one drawing contour into the next (:func:`_chains`); ``None``: the
-            contours of ``contour_of``.
-        nominal_off: ``(S,)`` distance of each sample from the programmed path
-            minus the tool radius, mm.
-        findings: plan findings; only :data:`NOT_CUT_KINDS` with a location count.
-        tool_radius_mm: tool radius, mm.
-        joint_mm: the plan's joint distance, mm (the pieces of a closed chain meet
-            within it: :func:`_named_contour`).
-
-    Returns:
-        ``(finding, sample indices, location mm)`` per feature, in finding order (the
-        stretches of one finding at one place merged: :func:`_merged`).
-    """
-    size = np.abs(nominal_off)
-    threshold = max(PLAN_TOLERANCE_MM, 3.0 * float(np.median(size)))
-    stretches = _stretches(samples, contour_of if runs is None else runs, size > threshold)
-    closed_gaps = [f.value or 0.0 for f in findings if f.kind == "closed-gap"]
-    # the pieces of a contour the plan closed meet within its gap (measured after the
-    # chaining moved their ends by up to the joint distance)
-    meet_mm = joint_mm + max(closed_gaps, default=0.0)
-    taken = [False] * len(stretches)
-    out: list[tuple[FindingLike, IntArray, Point]] = []
-    for finding in findings:
-        if finding.kind not in NOT_CUT_KINDS or finding.at is None:
-            continue
-        at = np.asarray(finding.at, dtype=np.float64)
-        contour = _named_contour(
-            samples,
-            contour_of,
-            at,
-            inside=finding.kind == "offset-vanished",
-            runs=runs,
-            joint_mm=meet_mm,
-        )
-        for k, index in enumerate(stretches):
-            if taken[k] or contour_of[index[0]] != contour:
-                continue
-            peak = int(index[np.argmax(size[index])])
-            if finding.kind == "tight-corner":
-                if size[peak] <= max(2.0 * threshold, tool_radius_mm / 100.0):
-                    continue
-                where = (float(samples[peak, 0]), float(samples[peak, 1]))
-            elif finding.kind == "self-crossing":  # every loop the offset left: one feature
-                where = (float(at[0]), float(at[1]))
-            else:
-                if finding.kind == "uncut":
-                    reach = max(2.0 * tool_radius_mm, 2.0 * math.sqrt(max(finding.value or 0, 0)))
-                    if np.min(np.hypot(*(samples[index] - at).T)) > reach:
-                        continue
-                where = (float(at[0]), float(at[1]))
-            taken[k] = True
-            out.append((finding, index, where))
-    return _merged(out)
-
-
-def _merged(
-    groups: list[tuple[FindingLike, IntArray, Point]],
-) -> list[tuple[FindingLike, IntArray, Point]]:
-    """``groups`` with those of one finding at one place made one feature, in order.
-
-    A feature drawn as several contours not in a row in the drawing (loose LINEs in any
-    order) comes as one stretch per contour: a tight corner's two sides each peak at the
-    drawn vertex, a narrow region's sides are all at the finding's location.
-    """
-    out: list[tuple[FindingLike, IntArray, Point]] = []
-    for finding, index, where in groups:
-        for k, (other, known, at) in enumerate(out):
-            if other is finding and math.dist(at, where) <= CHAIN_JOIN_MM:
-                out[k] = (finding, np.concatenate([known, index]), at)
-                break
-        else:
-            out.append((finding, index, where))
-    return out
-
-
-def _stretches(
-    samples: FloatArray, contour_of: IntArray, flagged: npt.NDArray[np.bool_]
-) -> list[IntArray]:
-    """Runs of consecutive flagged samples of one contour (joined across a closed one's seam)."""
-    out: list[IntArray] = []
-    cuts = np.flatnonzero(np.diff(contour_of)) + 1  # samples come contour after contour
-    for lo, hi in zip([0, *cuts.tolist()], [*cuts.tolist(), len(contour_of)], strict=True):
-        idx = np.arange(lo, hi)
-        f = flagged[idx]
-        if not f.any():
-            continue
-        if f.all():
-            out.append(idx)
-            continue
-        edges = np.flatnonzero(np.diff(f.astype(np.int8)))
-        starts = [0, *(edges + 1).tolist()]
-        pieces = [idx[a:b] for a, b in zip(starts, [*starts[1:], len(idx)], strict=True)]
-        pieces = [p for p in pieces if flagged[p[0]]]
-        closed = math.dist(samples[idx[0]], samples[idx[-1]]) <= 1e-9
-        if (
-            closed and f[0] and f[-1] and len(pieces) > 1
-        ):  # the seam of a closed contour splits one run
-            pieces = [np.concatenate([pieces[-1], pieces[0]]), *pieces[1:-1]]
-        out.extend(pieces)
-    return out
-
-
-def _named_contour(
-    samples: FloatArray,
-    contour_of: IntArray,
-    at: FloatArray,
-    *,
-    inside: bool,
-    runs: IntArray | None = None,
-    joint_mm: float = CHAIN_JOIN_MM,
-) -> int:
-    """The contour a finding at ``at`` names: the smallest closed one around it, or the nearest.
-
-    When ``at`` lies on the drawing, the contour that starts there (a closed contour of no
-    area, drawn there and back, is located at its start; another may pass through it).
-
-    A contour here may be a chain of several drawing contours (``runs``: the pieces, each
-    sampled in order along the edge, listed in any order and direction, their ends within
-    ``joint_mm``, the plan's joint distance or a gap it closed): it is closed when every
-    piece's end meets another's, and around ``at`` when a ray from ``at`` crosses its
-    pieces an odd number of times (the even-odd rule); the smallest is the one of least
-    bounding box.
-    """
-    pieces = contour_of if runs is None else runs
-    gap = np.hypot(*(samples - at).T)
-    nearest = int(np.argmin(gap))
-    if inside and gap[nearest] > 1e-9:
-        best = _around(samples, contour_of, at, pieces, joint_mm)
-        if best >= 0:
-            return best
-    elif inside:  # on the drawing: a region of no area, located at its contour's start
-        on = np.flatnonzero(gap <= 1e-9)
-        first = on[(on == 0) | (pieces[on] != pieces[np.maximum(on - 1, 0)])]
-        nearest = int(first[0]) if len(first) else nearest  # where a contour starts
-    return int(contour_of[nearest])
-
-
-def _around(
-    samples: FloatArray, contour_of: IntArray, at: FloatArray, runs: IntArray, joint_mm: float
-) -> int:
-    """:func:`_named_contour`'s smallest closed contour around ``at``, or -1 when none is."""
-    order = np.argsort(contour_of, kind="stable")  # each contour's samples, in their order
-    cuts = np.flatnonzero(np.diff(contour_of[order])) + 1
-    best, best_area = -1, math.inf
-    for idx in np.split(order, cuts):
-        pts = samples[idx]
-        lo, hi = pts.min(axis=0), pts.max(axis=0)
-        if len(idx) < 4 or not (lo[0] <= at[0] <= hi[0] and lo[1] <= at[1] <= hi[1]):
-            continue
-        area = float((hi[0] - lo[0]) * (hi[1] - lo[1]))
-        if area >= best_area:
-            continue
-        piece = runs[idx]
-        same = piece[1:] == piece[:-1]  # chords join consecutive samples of one piece
-        starts = np.flatnonzero(np.concatenate([[True], ~same]))
-        stops = np.concatenate([starts[1:], [len(idx)]]) - 1
-        if not _ends_meet(np.concatenate([pts[starts], pts[stops]]), joint_mm):
-            continue
-        a, b = pts[:-1][same], pts[1:][same]
-        up = (a[:, 1] > at[1]) != (b[:, 1] > at[1])
-        if not up.any():
-            continue
-        a, b = a[up], b[up]
-        x = a[:, 0] + (at[1] - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
-        if int(np.count_nonzero(x > at[0])) % 2 == 1:
-            best, best_area = int(contour_of[idx[0]]), area
-    return best
-
-
-def _ends_meet(ends: FloatArray, joint_mm: float) -> bool:
-    """Whether each of the pieces' ``ends`` (their starts, then their ends) meets another.
-
-    A closed drawing contour's two ends coincide; the pieces of a closed chain meet end
-    to end within the plan's joint distance ``joint_mm``.
-    """
-    if len(ends) == 2:
-        return math.dist(ends[0], ends[1]) <= joint_mm * (1.0 + 1e-9)
-    from scipy.spatial import cKDTree
-
-    gap, _ = cKDTree(ends).query(ends, k=2)
-    return bool(np.all(gap[:, 1] <= joint_mm * (1.0 + 1e-9)))
 
 
 _DISTANCE_TO: LastAnswers[FloatArray] = LastAnswers()

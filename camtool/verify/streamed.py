@@ -38,12 +38,11 @@ from camtool.verify.cutting_thin import (
 from camtool.verify.dda import compiled
 from camtool.verify.deviations import Deviation, deviation
 from camtool.verify.drawing_compare import (
-    CHAIN_JOIN_MM,
     Against,
-    FindingLike,
     against_thinned,
 )
 from camtool.verify.motion import StepTrace, library
+from camtool.verify.not_cut import CHAIN_JOIN_MM, FindingLike
 from camtool.verify.path_shortfall import AlongPath, along_path
 from camtool.verify.sources import ALL, Sources
 from camtool.verify.steparray import read_only

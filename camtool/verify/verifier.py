@@ -26,12 +26,11 @@ from camtool.verify.clock import timing_warnings
 from camtool.verify.contour_measures import ContourMeasure
 from camtool.verify.deviations import Deviation
 from camtool.verify.drawing_compare import (
-    CHAIN_JOIN_MM,
     Against,
-    FindingLike,
     prepare_comparison,
 )
 from camtool.verify.motion import StepTrace
+from camtool.verify.not_cut import CHAIN_JOIN_MM, FindingLike
 from camtool.verify.path_shortfall import AlongPath
 from camtool.verify.streamed import (
     CHUNK_ROWS,
@@ -279,7 +278,7 @@ def verify_program(
             half of it (0: a scribing point, or a path on the line).
         findings: what planning found (:class:`camtool.toolpath.cuts.Finding`):
             features it reported as impossible with this tool are measured apart from
-            the rest of the drawing (:func:`camtool.verify.drawing_compare.not_cut_groups`).
+            the rest of the drawing (:func:`camtool.verify.not_cut.not_cut_groups`).
         joint_mm: the distance within which the plan joined contour ends, mm
             (:attr:`camtool.toolpath.plan.PlanReport.joint_mm`): the drawing's contours
             are grouped into the plan's chains at it.

@@ -25,7 +25,7 @@ from camtool.jobs.pipeline import post_drawing, verify_job
 from camtool.model.shapes import Contour, Drawing, Line, Point
 from camtool.post.registry import load_target
 from camtool.toolpath.options import PlanOptions
-from camtool.verify.drawing_compare import NotCut
+from camtool.verify.not_cut import NotCut
 from camtool.verify.report import not_cut_text, summary_lines
 
 R = 1.5
@@ -130,7 +130,7 @@ def test_not_cut_text_counts_and_units() -> None:
 def test_a_stretch_across_a_closed_contours_seam_is_one_feature() -> None:
     import numpy as np
 
-    from camtool.verify.drawing_compare import _stretches
+    from camtool.verify.not_cut import _stretches
 
     # a closed square sampled from its corner (0, 0): the flagged corner region wraps around
     ring = np.array([(0, 0), (1, 0), (2, 0), (2, 2), (0, 2), (0, 1), (0, 0)], dtype=np.float64)
