@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING
 from camtool.jobs.drill import drill_moves
 from camtool.jobs.heights import check_heights
 from camtool.jobs.job import Job, Operation, Tool
+from camtool.jobs.job_warnings import holes_cut_outside, overlaps, unselected
 from camtool.jobs.jobfile import as_keys
 from camtool.jobs.selection import (
     Selected,
@@ -324,10 +325,10 @@ def run_job(
         del planned  # its moves are in ``moves``: not kept past the placement's shifted copy
     notes = construction_notes(construction)
     if not job.shorthand:
-        notes.extend(_unselected(scaled, runs, construction))
+        notes.extend(unselected(scaled, runs, construction))
     warnings[len(drawing.warnings) : len(drawing.warnings)] = notes
-    warnings.extend(_overlaps(runs, job))
-    warnings.extend(_holes_cut_outside(runs, job))
+    warnings.extend(overlaps(runs, job))
+    warnings.extend(holes_cut_outside(runs, job))
     placed_all = Drawing(
         tuple(c for r in runs for c in r.placed.contours),
         drawing.source,
@@ -723,78 +724,6 @@ def _shifted(runs: list[OperationRun], placed: Drawing, shift: Point) -> list[Op
         if report is not None:
             report = dataclasses.replace(report, work_shift=shift)
         out.append(dataclasses.replace(run, placed=moved, report=report))
-    return out
-
-
-def _unselected(
-    drawing: Drawing, runs: Sequence[OperationRun], construction: Sequence[Contour]
-) -> list[str]:
-    """One line per layer of the contours no operation selects (construction said apart)."""
-    taken = {id(c) for r in runs for c in r.placed.contours}
-    taken |= {id(c) for c in construction}
-    left: dict[str, list[Contour]] = {}
-    for contour in drawing.contours:
-        if id(contour) not in taken:
-            left.setdefault(contour.layer, []).append(contour)
-    out = []
-    for layer, contours in sorted(left.items()):
-        opened = sum(not c.closed for c in contours)
-        first = contours[0]
-        out.append(
-            f"not cut: {len(contours)} contour(s) on layer {layer!r} ({opened} open; first "
-            f"{first.source or 'contour'} at ({first.start[0]:.4f}, {first.start[1]:.4f}) mm): "
-            "no operation selects them"
-        )
-    return out
-
-
-def _overlaps(runs: Sequence[OperationRun], job: Job) -> list[str]:
-    """A warning for two operations of one kind that cut the same contour."""
-    if job.shorthand:
-        return []
-    out: list[str] = []
-    seen: dict[tuple[str, str], OperationRun] = {}
-    for run in runs:
-        for contour in run.placed.contours:
-            key = (run.operation.kind, contour.source)
-            other = seen.get(key)
-            if other is not None and other.number != run.number and contour.source:
-                out.append(
-                    f"{run.label} cuts {contour.source} on layer {contour.layer!r} again, as "
-                    f"{other.label} does: is one selection too wide?"
-                )
-                break
-            seen[key] = run
-    return out
-
-
-def _holes_cut_outside(runs: Sequence[OperationRun], job: Job) -> list[str]:
-    """A warning for a contour cut on its outside that lies inside another operation's.
-
-    Within one operation a hole is cut on its inside (its nesting says it is a hole); a
-    hole selected alone by an ``outside`` profile is cut outside itself, into the part.
-    """
-    if job.shorthand:
-        return []
-    from camtool.toolpath.order import nesting
-
-    closed = [(r, c) for r in runs for c in r.placed.contours if c.closed]
-    if len(closed) < 2:
-        return []
-    nest = nesting([c for _, c in closed])
-    out: list[str] = []
-    for i, (run, contour) in enumerate(closed):
-        if run.operation.kind != "profile outside":
-            continue
-        around = [closed[j] for j in nest.parents[i] if closed[j][0] is not run]
-        if around and not any(closed[j][0] is run for j in nest.parents[i]):
-            other, outer = around[0]
-            out.append(
-                f"{run.label} cuts {contour.source or 'a contour'} on layer "
-                f"{contour.layer!r} on its outside, but it lies inside "
-                f"{outer.source or 'a contour'} of {other.label}: a hole cut outside itself "
-                'cuts into the part; give that operation side = "inside"'
-            )
     return out
 
 
