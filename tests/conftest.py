@@ -8,6 +8,8 @@ from typing import Any
 import pytest
 from hypothesis import settings
 
+from camtool.cli.main import main
+
 settings.register_profile("camtool", deadline=None)
 settings.load_profile("camtool")
 """No property test has a deadline: how fast the machine is never decides a test (under
@@ -97,3 +99,14 @@ def _fit_kernels_fresh() -> None:
     from camtool.geometry.arcfit import FIT_KERNELS
 
     FIT_KERNELS.forget()
+
+
+@pytest.fixture
+def run(capsys: pytest.CaptureFixture[str]) -> Any:
+    """``run(*args)``: ``camtool ARGS`` in this process, its exit code and stderr."""
+
+    def call(*args: str) -> tuple[int, str]:
+        code = main(list(args))
+        return code, capsys.readouterr().err
+
+    return call

@@ -14,21 +14,11 @@ from typing import Any
 
 import pytest
 
-from camtool.cli.main import main
 from camtool.jobs.header import read_placement, read_tool_diameter
 
 ROOT = Path(__file__).resolve().parents[2]
 PLATE = str(ROOT / "samples" / "plate.dxf")
 OPTIONS = ["--offset", "outside", "--tool-diameter", "3", "--depth", "1"]
-
-
-@pytest.fixture
-def run(capsys: pytest.CaptureFixture[str]) -> Any:
-    def call(*args: str) -> tuple[int, str]:
-        code = main(list(args))
-        return code, capsys.readouterr().err
-
-    return call
 
 
 def test_the_header_says_how_the_drawing_was_scaled_and_moved(run: Any, tmp_path: Path) -> None:

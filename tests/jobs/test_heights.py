@@ -14,7 +14,6 @@ from typing import Any
 
 import pytest
 
-from camtool.cli.main import main
 from camtool.post.registry import load_target
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -22,15 +21,6 @@ LOGO = str(ROOT / "samples" / "logo.dxf")
 PART = str(ROOT / "samples" / "part.dxf")
 
 RESOLUTION = {"grbl": 0.001, "linuxcnc": 0.001, "flashcut": 0.001, "valcnc": 0.04, "i8751": 0.01}
-
-
-@pytest.fixture
-def run(capsys: pytest.CaptureFixture[str]) -> Any:
-    def call(*args: str) -> tuple[int, str]:
-        code = main(list(args))
-        return code, capsys.readouterr().err
-
-    return call
 
 
 @pytest.mark.parametrize("name", sorted(RESOLUTION))

@@ -13,8 +13,6 @@ from typing import Any
 
 import pytest
 
-from camtool.cli.main import main
-
 ROOT = Path(__file__).resolve().parents[2]
 LOGO = str(ROOT / "samples" / "logo.dxf")
 GRBL = (ROOT / "postprocessors" / "grbl" / "grbl.toml").read_text()
@@ -52,15 +50,6 @@ TARGET_EDITS = {
     # a spindle below 1 rev/min does not turn: GRBL read "M3 S0" from 1e-300
     ("spindle_rpm = 1000.0", "spindle_rpm = 1e-300 #"): "spindle_rpm",
 }
-
-
-@pytest.fixture
-def run(capsys: pytest.CaptureFixture[str]) -> Any:
-    def call(*args: str) -> tuple[int, str]:
-        code = main(list(args))
-        return code, capsys.readouterr().err
-
-    return call
 
 
 def _refused(run: Any, tmp_path: Path, *args: str) -> str:

@@ -14,20 +14,9 @@ from typing import Any
 
 import pytest
 
-from camtool.cli.main import main
-
 ROOT = Path(__file__).resolve().parents[2]
 PLATE = str(ROOT / "samples" / "plate.dxf")
 CUT = ["--offset", "outside", "--tool-diameter", "3"]
-
-
-@pytest.fixture
-def run(capsys: pytest.CaptureFixture[str]) -> Any:
-    def call(*args: str) -> tuple[int, str]:
-        code = main(list(args))
-        return code, capsys.readouterr().err
-
-    return call
 
 
 def test_a_depth_beyond_the_z_travel_is_refused_and_nothing_written(

@@ -17,7 +17,6 @@ from typing import Any
 import ezdxf
 import pytest
 
-from camtool.cli.main import main
 from camtool.geometry.chain import chain_members
 from camtool.model.shapes import Contour, Line
 
@@ -37,15 +36,6 @@ def disc(tmp_path: Path) -> Path:
     path = tmp_path / "disc.dxf"
     doc.saveas(path)
     return path
-
-
-@pytest.fixture
-def run(capsys: pytest.CaptureFixture[str]) -> Any:
-    def call(*args: str) -> tuple[int, str]:
-        code = main(list(args))
-        return code, capsys.readouterr().err
-
-    return call
 
 
 OPTIONS = ["--offset", "outside", "--tool-diameter", "3", "--depth", "1"]
