@@ -18,6 +18,7 @@ camtool:
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import pytest
 
@@ -286,6 +287,20 @@ def test_a_pocket_outline_without_area_is_said_and_set_apart() -> None:
     assert flat_apart[0].error_um == pytest.approx(25_000.0, abs=10.0)
 
 
+def _curl_posted(offset: str) -> tuple[Any, Any]:
+    """The curl below, (0,0) (30,0) (30,30) (10,30) (10,10) (20,10) (20,20) (0,20) moved by
+    (5, 5), posted for grbl with ``offset`` and the 3 mm tool; its one self-crossing finding."""
+    points = [(0, 0), (30, 0), (30, 30), (10, 30), (10, 10), (20, 10), (20, 20), (0, 20)]
+    job = post_drawing(
+        Drawing((_polygon([(x + 5.0, y + 5.0) for x, y in points], "curl"),)),
+        load_target("grbl"),
+        PlanOptions(offset=offset, tool_diameter=2 * R),
+    )
+    assert job.plan is not None
+    (said,) = [f for f in job.plan.findings if f.kind == "self-crossing"]
+    return job, said
+
+
 def test_a_contour_that_crosses_itself_is_said_and_its_loops_set_apart() -> None:
     # A closed outline that curls into itself: (0,0) (30,0) (30,30) (10,30) (10,10)
     # (20,10) (20,20) (0,20), moved by (5, 5); its last edge crosses the one down from
@@ -294,16 +309,9 @@ def test_a_contour_that_crosses_itself_is_said_and_its_loops_set_apart() -> None
     # (0,20): the curl's edges inside are not cut, and before nothing said so. Expected
     # from the geometry: the curl's corner (20,10) is 10 mm from that boundary (the
     # bottom and the right side), the farthest of its points.
-    points = [(0, 0), (30, 0), (30, 30), (10, 30), (10, 10), (20, 10), (20, 20), (0, 20)]
-    job = post_drawing(
-        Drawing((_polygon([(x + 5.0, y + 5.0) for x, y in points], "curl"),)),
-        load_target("grbl"),
-        PlanOptions(offset="outside", tool_diameter=2 * R),
-    )
-    assert job.plan is not None
-    said = [f for f in job.plan.findings if f.kind == "self-crossing"]
-    assert len(said) == 1 and said[0].at == pytest.approx((15.0, 25.0))
-    assert "crosses itself" in said[0].message and "--offset on" in said[0].message
+    job, said = _curl_posted("outside")
+    assert said.at == pytest.approx((15.0, 25.0))
+    assert "crosses itself" in said.message and "--offset on" in said.message
     v = verify_job(job, budget=False)
     assert v.against is not None
     assert v.against.max_um < 12.0
@@ -317,15 +325,8 @@ def test_a_pocket_outline_that_crosses_itself_is_said() -> None:
     # pocket clears through the curl's inner edges (before, nothing said so). Expected:
     # the tool's centre passes over them, so their drawn points are cut r deep (1.5 mm),
     # apart from the main figure; the rest within a few steps.
-    points = [(0, 0), (30, 0), (30, 30), (10, 30), (10, 10), (20, 10), (20, 20), (0, 20)]
-    job = post_drawing(
-        Drawing((_polygon([(x + 5.0, y + 5.0) for x, y in points], "curl"),)),
-        load_target("grbl"),
-        PlanOptions(offset="pocket", tool_diameter=2 * R),
-    )
-    assert job.plan is not None
-    said = [f for f in job.plan.findings if f.kind == "self-crossing"]
-    assert len(said) == 1 and "clears the whole area it encloses" in said[0].message
+    job, said = _curl_posted("pocket")
+    assert "clears the whole area it encloses" in said.message
     v = verify_job(job, budget=False)
     assert v.against is not None and v.against.max_um < 12.0
     (loops,) = [f for f in v.against.not_cut if f.kind == "self-crossing"]
