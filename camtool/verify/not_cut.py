@@ -175,20 +175,25 @@ def not_cut_groups(
     # the pieces of a contour the plan closed meet within its gap (measured after the
     # chaining moved their ends by up to the joint distance)
     meet_mm = joint_mm + max(closed_gaps, default=0.0)
+    vanished: list[int] = []  # the contours offset-vanished findings named
     taken = [False] * len(stretches)
     out: list[tuple[FindingLike, IntArray, Point]] = []
     for finding in findings:
         if finding.kind not in NOT_CUT_KINDS or finding.at is None:
             continue
         at = np.asarray(finding.at, dtype=np.float64)
+        inside = finding.kind == "offset-vanished"
         contour = _named_contour(
             samples,
             contour_of,
             at,
-            inside=finding.kind == "offset-vanished",
+            inside=inside,
             runs=runs,
             joint_mm=meet_mm,
+            named=frozenset(vanished),
         )
+        if inside:
+            vanished.append(contour)
         for k, index in enumerate(stretches):
             if taken[k] or contour_of[index[0]] != contour:
                 continue
@@ -265,8 +270,13 @@ def _named_contour(
     inside: bool,
     runs: IntArray | None = None,
     joint_mm: float = CHAIN_JOIN_MM,
+    named: frozenset[int] = frozenset(),
 ) -> int:
     """The contour a finding at ``at`` names: the smallest closed one around it, or the nearest.
+
+    With ``inside``, a contour in ``named`` (another ``offset-vanished`` finding's: the
+    planner gives one a contour) is passed over: two thin bars that cross, each narrower
+    than the tool, have their findings at one place.
 
     When ``at`` lies on the drawing, the contour that starts there (a closed contour of no
     area, drawn there and back, is located at its start; another may pass through it).
@@ -282,7 +292,7 @@ def _named_contour(
     gap = np.hypot(*(samples - at).T)
     nearest = int(np.argmin(gap))
     if inside and gap[nearest] > 1e-9:
-        best = _around(samples, contour_of, at, pieces, joint_mm)
+        best = _around(samples, contour_of, at, pieces, joint_mm, named)
         if best >= 0:
             return best
     elif inside:  # on the drawing: a region of no area, located at its contour's start
@@ -293,9 +303,14 @@ def _named_contour(
 
 
 def _around(
-    samples: FloatArray, contour_of: IntArray, at: FloatArray, runs: IntArray, joint_mm: float
+    samples: FloatArray,
+    contour_of: IntArray,
+    at: FloatArray,
+    runs: IntArray,
+    joint_mm: float,
+    named: frozenset[int] = frozenset(),
 ) -> int:
-    """:func:`_named_contour`'s smallest closed contour around ``at``, or -1 when none is."""
+    """:func:`_named_contour`'s smallest closed contour around ``at`` not in ``named``, or -1."""
     order = np.argsort(contour_of, kind="stable")  # each contour's samples, in their order
     cuts = np.flatnonzero(np.diff(contour_of[order])) + 1
     best, best_area = -1, math.inf
@@ -303,6 +318,8 @@ def _around(
         pts = samples[idx]
         lo, hi = pts.min(axis=0), pts.max(axis=0)
         if len(idx) < 4 or not (lo[0] <= at[0] <= hi[0] and lo[1] <= at[1] <= hi[1]):
+            continue
+        if int(contour_of[idx[0]]) in named:
             continue
         area = float((hi[0] - lo[0]) * (hi[1] - lo[1]))
         if area >= best_area:

@@ -331,3 +331,27 @@ def test_a_pocket_outline_that_crosses_itself_is_said() -> None:
     assert v.against is not None and v.against.max_um < 12.0
     (loops,) = [f for f in v.against.not_cut if f.kind == "self-crossing"]
     assert loops.error_um == pytest.approx(R * 1000.0, abs=10.0)
+
+
+def test_two_crossing_regions_narrower_than_the_tool_each_name_their_own_contour() -> None:
+    # Inside the rectangle 5..45 × 5..35, two 0.8 mm bars that cross at (25, 20), one
+    # along X (20..30), one along Y (15..25): both narrower than the 3 mm tool, their
+    # findings at one place, (25, 20). Before, both named the first bar and the second
+    # stayed in the main figure (Inkscape's gradient.svg: 3 256 µm). Expected from the
+    # geometry: each bar's point farthest from the rectangle is 15 mm from it ((20, 20)
+    # and (24.6, 20) or (25.4, 20)).
+    outline = _polygon([(5, 5), (45, 5), (45, 35), (5, 35)], "outline")
+    across = _polygon([(20, 19.6), (30, 19.6), (30, 20.4), (20, 20.4)], "across")
+    up = _polygon([(24.6, 15), (25.4, 15), (25.4, 25), (24.6, 25)], "up")
+    job = post_drawing(
+        Drawing((outline, across, up)),
+        load_target("grbl"),
+        PlanOptions(offset="outside", tool_diameter=2 * R),
+    )
+    assert job.plan is not None
+    places = [f.at for f in job.plan.findings if f.kind == "offset-vanished"]
+    assert places == [pytest.approx((25.0, 20.0))] * 2
+    v = verify_job(job, budget=False)
+    assert v.against is not None and v.against.max_um < 12.0
+    errors = [f.error_um for f in v.against.not_cut if f.kind == "offset-vanished"]
+    assert errors == [pytest.approx(15_000.0, abs=10.0)] * 2
