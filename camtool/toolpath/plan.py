@@ -126,18 +126,13 @@ class Plan:
     ``left_out`` are the indices in ``placed.contours`` of the contours the plan does not
     cut at all: the pieces of an open chain under ``--offset outside``, ``inside`` or
     ``pocket`` (a centre line, a construction line across the part; each is an
-    ``open-left-out`` finding). :attr:`cut` is the drawing without them.
+    ``open-left-out`` finding); ``placed.without(left_out)`` is what the program cuts.
     """
 
     program: Program
     report: PlanReport
     placed: Drawing
     left_out: frozenset[int] = frozenset()
-
-    @property
-    def cut(self) -> Drawing:
-        """``placed`` without the contours the plan left out (what the program cuts)."""
-        return self.placed.without(self.left_out)
 
 
 def plan(drawing: Drawing, options: PlanOptions, machine: Machine | None = None) -> Program:
