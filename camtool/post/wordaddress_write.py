@@ -10,9 +10,11 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Iterator
+from itertools import islice
 from typing import TYPE_CHECKING, Any
 
-from camtool.accel import conformahead
+from camtool.accel import conformahead, splitwrite
 from camtool.model.errors import DialectError
 from camtool.model.machine import Machine
 from camtool.model.program import (
@@ -105,21 +107,21 @@ class BlockWriter(WordWriter):
         # the keys of instances with that many attributes)
         ahead = conformahead.start(self, program)
         self._conformed_arcs = _Conformed(ahead)
-        index = 0  # of the next move
-        written = 0  # moves written up to here (a plane arc writes its chords' moves)
+        split = None if ahead is not None else splitwrite.start(self, program)
         try:
-            for item in program.items():
-                if isinstance(item, _MOVES):
-                    index += 1
-                    if index > written:
-                        self.move(item)
-                elif isinstance(item, PlaneArc):
-                    written = self.plane_arc(item, index)
-                else:
-                    self.command(item)
+            items = program.items()
+            if split is None:
+                self.write_items(items, 0, 0)
+            else:
+                index, written = self.write_items(islice(items, split.at), 0, 0)
+                if not split.join(self, index, written):
+                    self.write_items(items, index, written)
+                split = None
         finally:
             if ahead is not None:
                 ahead.close()
+            if split is not None:
+                split.close()
         for codes in self.spec.postamble:
             self.block(list(codes))
         if self.spec.end:
@@ -129,6 +131,25 @@ class BlockWriter(WordWriter):
         if self.blocks:
             self._join_blocks()
         return "".join(self._done)
+
+    def write_items(
+        self, items: Iterator[Move | Command | PlaneArc], index: int, written: int
+    ) -> tuple[int, int]:
+        """Write ``items`` (:meth:`Program.items`); the moves taken before are ``index``.
+
+        ``written``: the moves already written (a plane arc writes its chords' moves).
+        Returns ``index`` and ``written`` after ``items``.
+        """
+        for item in items:
+            if isinstance(item, _MOVES):
+                index += 1
+                if index > written:
+                    self.move(item)
+            elif isinstance(item, PlaneArc):
+                written = self.plane_arc(item, index)
+            else:
+                self.command(item)
+        return index, written
 
     # -- moves -------------------------------------------------------------------
 
