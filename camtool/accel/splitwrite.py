@@ -28,7 +28,7 @@ from bisect import bisect_right
 from collections import Counter
 from collections.abc import Iterator
 from contextlib import suppress
-from itertools import chain, islice
+from itertools import islice
 from typing import TYPE_CHECKING, Any
 
 from camtool.accel import enabled
@@ -40,6 +40,13 @@ if TYPE_CHECKING:
 MIN_MOVES = 40_000
 """Moves from which the program is split (~0.2 s of writing; below, the fork, the
 stretch written twice and the hand-over cost about what the second core saves)."""
+MAX_MOVES = 1_000_000
+"""Moves above which it is not: the helper copies the memory it writes to, and counting a
+reference to an object writes to its page (85 MB of the writer's 128 MB on the re-post
+benchmark's 333 540 moves)."""
+SHARE = 0.45
+"""The part of the moves the writer writes itself: it also checks the program's placement
+(~10 % of the writing's time on the re-post benchmark) while the helper writes."""
 WARM = 256
 """Moves the helper writes at least before :attr:`Split.at` to reach the writer's state."""
 FAR = 0.1
@@ -138,15 +145,16 @@ class Split:
 def start(writer: BlockWriter, program: Program) -> Split | None:
     """Fork the helper that writes ``program`` from the middle on; ``None`` when not.
 
-    Call it once ``writer`` has written the blocks before the program's items (header,
-    notes, preamble): the helper is a copy of it. Not under :data:`MIN_MOVES` moves,
-    without a Z move near the middle (:data:`FAR`), on one core, in a worker process,
-    switched off, or when no process can be forked.
+    Call it before ``writer`` writes anything (the helper is a copy of it that throws
+    away what it writes before the middle); the writer checks the program's placement
+    and writes its header meanwhile. Not under :data:`MIN_MOVES` moves or
+    over :data:`MAX_MOVES`, without a Z move near the middle (:data:`FAR`), on one core,
+    in a worker process, switched off, or when no process can be forked.
     """
     moves = program.moves
-    if len(moves) < MIN_MOVES or not enabled():
+    if not MIN_MOVES <= len(moves) <= MAX_MOVES or not enabled():
         return None
-    middle = len(moves) // 2
+    middle = int(len(moves) * SHARE)
     first = _warm_from(program, middle)
     if first is None:
         return None
@@ -203,20 +211,19 @@ def _second_part(writer: BlockWriter, program: Program, first: int, at: int) -> 
     commands and plane arc before it included) to item ``at``, throws those blocks away,
     then writes the rest.
     """
-    items: Iterator[Any] = program.items()
-    index = done = 0  # moves and items taken
-    for item in items:
-        if index == first:  # from here on, as the writer writes, from the move before
-            items = chain((item,), items)
-            before = program.moves[first - 1]
-            writer.here = (before.x, before.y)
-            writer.written = writer.written_xy(writer.here)  # as its XY block wrote it
-            break
+    commands = program.commands
+    done = 0  # commands before move `first`
+    while done < len(commands) and commands[done][0] < first:
+        command = commands[done][1]
+        if not isinstance(command, PlaneArc):  # skipped: compared as `written`
+            writer.command(command)
         done += 1
-        if isinstance(item, _MOVES):
-            index += 1
-        elif not isinstance(item, PlaneArc):
-            writer.command(item)  # a plane arc before is skipped: compared as `written`
+    before = program.moves[first - 1]  # from here on, as the writer writes, from its end
+    writer.here = (before.x, before.y)
+    writer.written = writer.written_xy(writer.here)  # as its XY block wrote it
+    items = _items_from(program, first, done)
+    index = first
+    done += first  # items before move `first`
     index, written = writer.write_items(islice(items, at - done), index, index)
     start = copy.deepcopy(state(writer, index, written))  # `last` changes in place
     writer.blocks.clear()
@@ -233,6 +240,21 @@ def _second_part(writer: BlockWriter, program: Program, first: int, at: int) -> 
         writer._join_blocks()
     out = {name: getattr(writer, name) for name in OUTPUT if name != "blocks"}
     return start, state(writer, index, written), out
+
+
+def _items_from(program: Program, first: int, k: int) -> Iterator[Any]:
+    """:meth:`Program.items` from move ``first`` on (``k``: the commands before it).
+
+    The moves before are not touched (:data:`MAX_MOVES`).
+    """
+    moves, commands = program.moves, program.commands
+    for index in range(first, len(moves)):
+        while k < len(commands) and commands[k][0] == index:
+            yield commands[k][1]
+            k += 1
+        yield moves[index]
+    for _, command in commands[k:]:
+        yield command
 
 
 def state(writer: BlockWriter, index: int, written: int) -> dict[str, Any]:

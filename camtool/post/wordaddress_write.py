@@ -92,23 +92,29 @@ class BlockWriter(WordWriter):
         """
         self.here = program.origin
         self.program = program
-        self.warnings.extend(check_placement(program, self.machine))
-        self.written = (self._round("X", program.origin[0]), self._round("Y", program.origin[1]))
-        self.blocks.extend(self.spec.header)
-        for note in program.notes:
-            comment = self.spec.comment_line(note)
-            if comment is not None:
-                self.blocks.append(comment)
-        for codes in self.spec.preamble:
-            self.block(list(codes))
-        # the arcs' blocks, conformed ahead in a helper when there are many; held
-        # by the memory of conformed arcs, not as a 30th attribute of the writer: that one
-        # made every block of the re-post benchmark ~8 % slower (CPython 3.11 stops sharing
-        # the keys of instances with that many attributes)
-        ahead = conformahead.start(self, program)
-        self._conformed_arcs = _Conformed(ahead)
-        split = None if ahead is not None else splitwrite.start(self, program)
+        # a long program's second half written by a helper meanwhile (it needs none of
+        # what follows), or else the arcs' blocks conformed ahead in a helper when there
+        # are many; held by the memory of conformed arcs, not as a 30th attribute of the
+        # writer: that one made every block of the re-post benchmark ~8 % slower (CPython
+        # 3.11 stops sharing the keys of instances with that many attributes)
+        split = splitwrite.start(self, program)
+        ahead = None
         try:
+            self.warnings.extend(check_placement(program, self.machine))
+            self.written = (
+                self._round("X", program.origin[0]),
+                self._round("Y", program.origin[1]),
+            )
+            self.blocks.extend(self.spec.header)
+            for note in program.notes:
+                comment = self.spec.comment_line(note)
+                if comment is not None:
+                    self.blocks.append(comment)
+            for codes in self.spec.preamble:
+                self.block(list(codes))
+            if split is None:
+                ahead = conformahead.start(self, program)
+            self._conformed_arcs = _Conformed(ahead)
             items = program.items()
             if split is None:
                 self.write_items(items, 0, 0)
