@@ -12,6 +12,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
+from camtool.geometry.area import enclosed
 from camtool.model.errors import ToolpathError
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import Arc, Contour, Line, Point, Segment
@@ -380,10 +381,10 @@ def _turn(a: Point, b: Point) -> float:
 
 def _vanished(contour: Contour, options: PlanOptions) -> Finding:
     """An ``offset-vanished`` finding: where the contour is and how wide it is."""
-    from shapely import Polygon, maximum_inscribed_circle
+    from shapely import maximum_inscribed_circle
 
     tol = options.tolerance / 4
-    poly = Polygon(contour.points(tol)).buffer(0)
+    poly = enclosed(contour.points(tol))
     if poly.is_empty:  # no area (a closed contour that folds back on itself): no width
         (x, y), width = contour.start, 0.0
     else:
@@ -437,10 +438,10 @@ def material(
         offset: ``outside`` or ``inside``.
         tolerance: chord tolerance of the polygons, mm.
     """
-    from shapely import Polygon, box, union_all
+    from shapely import box, union_all
 
     closed = [i for i, c in enumerate(contours) if c.closed]
-    polys = {i: Polygon(contours[i].points(tolerance)).buffer(0) for i in closed}
+    polys = {i: enclosed(contours[i].points(tolerance)) for i in closed}
     keep = 0 if offset == "outside" else 1
     regions = []
     for i in closed:

@@ -28,6 +28,7 @@ from camtool.accel.cores import (
     wait_readable,
     write_record,
 )
+from camtool.geometry.area import enclosed
 from camtool.geometry.chain import chain
 from camtool.model.errors import ToolpathError
 from camtool.model.shapes import Arc, Contour, Line, Point, Segment, distance
@@ -624,9 +625,9 @@ def quad_segs(radius: float, chord_error: float) -> int:
 
 def _buffer(contour: Contour, amount: float, tolerance: float) -> BaseGeometry:
     """The shapely buffer of the contour's polygon, slivers narrower than ``tolerance`` dropped."""
-    from shapely import MultiPolygon, Polygon
+    from shapely import MultiPolygon
 
-    poly = Polygon(contour.points(tolerance / 4)).buffer(0)
+    poly = enclosed(contour.points(tolerance / 4))
     buf = poly.buffer(amount, quad_segs=quad_segs(abs(amount), tolerance / 4))
     parts = [p for p in getattr(buf, "geoms", [buf]) if _wider_than(p, tolerance)]
     return MultiPolygon(parts)

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any
 
+from camtool.geometry.area import enclosed
 from camtool.model.errors import UsageError
 from camtool.model.shapes import Contour, Point, distance
 from camtool.model.units import fmt_point
@@ -42,7 +43,8 @@ def nesting(contours: Sequence[Contour]) -> Nesting:
 
     A contour (open or closed, by its outline: arcs as chords within
     :data:`_NEST_TOLERANCE_MM`) lies inside a closed contour when the closed contour's
-    filled polygon (``buffer(0)`` repairs self-touching outlines) covers it and is
+    filled polygon (:func:`~camtool.geometry.area.enclosed`: the nonzero winding rule where
+    the outline crosses or touches itself) covers it and is
     strictly larger (a polygon covers its own outline and an identical duplicate's).
     Shapely's vectorised constructors and one bulk ``STRtree.query(…, "covered_by")``
     answer as one geometry and one query per contour did (:func:`_nesting_one_by_one`,
@@ -73,7 +75,10 @@ def nesting(contours: Sequence[Contour]) -> Nesting:
         rings = shapely.linearrings(coords[keep], indices=rank[owner[keep]])
     except (ValueError, shapely.errors.GEOSException):
         return _nesting_one_by_one(contours)  # the same contour refused, as before
-    polygons = shapely.buffer(shapely.polygons(rings), 0)
+    raw = shapely.polygons(rings)
+    polygons = shapely.buffer(raw, 0)
+    for k in np.flatnonzero(~shapely.is_valid(raw)).tolist():  # crosses or touches itself
+        polygons[k] = enclosed(shapely.get_coordinates(rings[k]))
     area = np.zeros(len(contours))
     area[closed] = shapely.area(polygons)
     # Candidates by their boxes; a polygon covers its own outline and an identical
@@ -205,11 +210,11 @@ def _chord_counts(radius: Any, sweep: Any, tolerance: float) -> Any:
 
 def _nesting_one_by_one(contours: Sequence[Contour]) -> Nesting:
     """:func:`nesting` with one shapely geometry and one tree query per contour (the reference)."""
-    from shapely import LineString, Polygon, STRtree
+    from shapely import LineString, STRtree
 
     outlines = [LineString(c.points(_NEST_TOLERANCE_MM)) for c in contours]
     closed = [i for i, c in enumerate(contours) if c.closed]
-    polygons = [Polygon(outlines[i].coords).buffer(0) for i in closed]
+    polygons = [enclosed(outlines[i].coords) for i in closed]
     areas = {i: poly.area for i, poly in zip(closed, polygons, strict=True)}
     tree = STRtree(polygons)
     parents: list[tuple[int, ...]] = []

@@ -23,6 +23,7 @@ from shapely.geometry.base import BaseGeometry
 from shapely.geometry.polygon import orient
 
 from camtool.geometry.arcfit import fit_polyline
+from camtool.geometry.area import enclosed
 from camtool.model.errors import InputError, ToolpathError, UsageError
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import TAU, Arc, Contour, Line, Point, Segment, distance
@@ -173,14 +174,14 @@ def regions(
             for j, c in enumerate(contours)
             if c.closed and i in nest.parents[j] and nest.depth(j) == nest.depth(i) + 1
         )
-        outline = Polygon(contour.points(tolerance / 4))
-        if invalid is not None and not outline.is_valid:
+        outline = contour.points(tolerance / 4)
+        if invalid is not None and not Polygon(outline).is_valid:
             invalid.append(i)
-        area: BaseGeometry = outline.buffer(0)
+        area: BaseGeometry = enclosed(outline)
         if area.is_empty and no_area is not None:
             no_area.append(i)
         for island in islands:
-            area = area.difference(Polygon(island.points(tolerance / 4)).buffer(0))
+            area = area.difference(enclosed(island.points(tolerance / 4)))
         parts = polygons(area)
         for part in parts:
             out.append(Region(i, contour, orient(part), islands, len(parts) == 1))
