@@ -14,6 +14,8 @@ from pathlib import Path
 from typing import cast
 
 from camtool import accel
+from camtool.accel.collector import paused
+from camtool.importers import gcode_ahead
 from camtool.importers.gcode_codes import BlockWords, CommandReader, Notes
 from camtool.importers.gcode_lexer import Block, Word, cut_mid_word, lex_line
 from camtool.importers.gcode_plain import ARC_TOL_IN, ARC_TOL_MM, PLAIN_WORDS, PlainLines
@@ -104,18 +106,47 @@ def _decoded(data: bytes) -> str:
 _LINE_END = re.compile(r"\r\n|\r|\n")
 
 
-def _lines(text: str) -> Iterator[tuple[str, bool]]:
-    """The lines of ``text`` one at a time, each with whether it is the last.
+def _lines_at(text: str, start: int) -> Iterator[tuple[str, bool, int]]:
+    """The lines of ``text`` from character ``start`` (a line's first), one at a time.
 
-    Lines end with LF, CR LF or CR (a CR LF is one end); the last line is what follows
-    the last line end, maybe empty: the lines splitting at each end would give, without
-    a list of them all (a 50 MB program is 2.6 million lines).
+    Each with whether it is the last and the character where the next starts. Lines end
+    with LF, CR LF or CR (a CR LF is one end); the last line is what follows the last line
+    end, maybe empty: the lines splitting at each end would give, without a list of them
+    all (a 50 MB program is 2.6 million lines).
     """
-    start = 0
-    for end in _LINE_END.finditer(text):
-        yield text[start : end.start()], False
+    for end in _LINE_END.finditer(text, start):
+        yield text[start : end.start()], False, end.end()
         start = end.end()
-    yield text[start:], True
+    yield text[start:], True, len(text)
+
+
+def _read_ahead(text: str, source: str, reading: Reading, position: int, number: int) -> bytes:
+    """In the helper: the runs of plain lines from character ``position``, read from nothing.
+
+    ``position`` is the start of line ``number + 1`` (:mod:`camtool.importers.gcode_ahead`).
+    Lines that fail are passed over (a run's moves depend on its start alone); the last
+    line, and what follows the program's end, are left to the reader.
+    """
+    reader = _Reader(source, reading)
+    gcode_ahead.seed(reader, text, position)
+    recorder = gcode_ahead.Recorder(reader)
+    plain_words = PLAIN_WORDS.findall
+    for raw, last, after in _lines_at(text, position):
+        number += 1
+        if last:
+            break
+        recorder.before(number)
+        try:
+            if raw.isascii() and reader.plain(plain_words(raw.upper()), number):
+                recorder.plain(number, after)
+                continue
+            recorder.broken()
+            block = lex_line(raw, number, source)
+            if block is not None and reader.run(block):
+                break  # the program's end
+        except InputError:
+            recorder.broken()
+    return recorder.pack()
 
 
 def parse_gcode(
@@ -145,7 +176,8 @@ def parse_gcode(
     Plain lines take the fast path (:meth:`_Reader.plain`, no word objects) unless
     ``CAMTOOL_ACCEL=0``; :func:`parse_gcode_slow` is the reference, with the same result.
     """
-    return _parse(text, source, plain=accel.enabled(), reading=reading)
+    with paused():  # the moves it makes stay; what it frees, counting frees
+        return _parse(text, source, plain=accel.enabled(), reading=reading)
 
 
 def parse_gcode_slow(text: str, *, source: str) -> Program:
@@ -165,35 +197,63 @@ def _parse(
     plain: bool,
     reading: Reading = READ_AS_WRITTEN,
 ) -> Program:
-    """:func:`parse_gcode`; ``plain``: take the plain-line path where it applies."""
-    lines = _lines(text)
-    rest = (raw for raw, _ in lines)  # the lines after the program's end
+    """:func:`parse_gcode`; ``plain``: take the plain-line path where it applies.
+
+    With ``plain``, a long program's later plain lines are read ahead in a forked helper
+    and taken where they fit (:mod:`camtool.importers.gcode_ahead`).
+    """
+    ahead = None
+    if plain:
+        ahead = gcode_ahead.start(
+            text, lambda position, number: _read_ahead(text, source, reading, position, number)
+        )
+    lines = _lines_at(text, 0)
     reader = _Reader(source, reading)
     opened = False  # a '%' line before the first block: the next '%' ends the program
     ended = False
     plain_words = PLAIN_WORDS.findall
-    for number, (raw, last) in enumerate(lines, start=1):
-        if last and (cut := cut_mid_word(raw)) is not None:
-            raise InputError(
-                f"{source}:{number}: the file ends in the middle of a word ({cut!r}, with no "
-                "end of line after it): the last line is incomplete, the file looks "
-                "truncated; copy or export the program again"
-            )
-        if plain and raw.isascii() and reader.plain(plain_words(raw.upper()), number):
-            continue
-        block = lex_line(raw, number, source)
-        if block is None:
-            if raw.lstrip().startswith("%"):
-                if opened:
-                    reader.after_end(rest, number)
+    runs: gcode_ahead.Runs | None = None
+    number = 0
+    try:
+        while True:
+            jumped = False
+            for raw, last, _ in lines:
+                number += 1
+                if ahead is not None and number >= ahead[1]:  # the helper's lines: its runs
+                    data = ahead[0].take()
+                    runs = None if data is None else gcode_ahead.Runs(data)
+                    ahead = None
+                if runs is not None and (run := runs.take(reader, number)) is not None:
+                    number = run.last  # its lines read: on after them
+                    lines = _lines_at(text, run.after)
+                    jumped = True
+                    break
+                if last and (cut := cut_mid_word(raw)) is not None:
+                    raise InputError(
+                        f"{source}:{number}: the file ends in the middle of a word ({cut!r}, "
+                        "with no end of line after it): the last line is incomplete, the file "
+                        "looks truncated; copy or export the program again"
+                    )
+                if plain and raw.isascii() and reader.plain(plain_words(raw.upper()), number):
+                    continue
+                block = lex_line(raw, number, source)
+                if block is None:
+                    if raw.lstrip().startswith("%"):
+                        if opened:
+                            reader.after_end((r for r, _, _ in lines), number)
+                            ended = True
+                            break
+                        opened = not reader.line
+                    continue
+                if reader.run(block):
+                    reader.after_end((r for r, _, _ in lines), number)
                     ended = True
                     break
-                opened = not reader.line
-            continue
-        if reader.run(block):
-            reader.after_end(rest, number)
-            ended = True
-            break
+            if not jumped:
+                break
+    finally:
+        if ahead is not None:
+            ahead[0].close()
     if not ended and reader.line:
         reader.notes.add(
             "end",

@@ -57,15 +57,15 @@ the plain-line interpreter), writing ~0.2 s (~6 µs a block) and the extent ~0.0
 writing would have to run compiled, and a compiled path (numba) costs more to import
 than this whole budget.
 
-Fourth pass (26 Nov 2026, quiet 2-core machine, load average under 1; the 10.9 MB row):
-the second half of a long program is written by a forked helper while the writer checks
-the placement and writes the first (``camtool/accel/splitwrite.py``; taken only when the
-writer's state where the helper starts is the helper's, bit for bit). Run one after the
-other from cached bytecode, 584215e against this tree: 3.10-3.46 s against 2.77-2.90 s,
-the same output bytes; this script: camtool 2.65 s, rs274 1.11 s, 2.39× (was ~3×). In
-process, the writing 1.9 → 1.0 s; reading (1.3-1.5 s, a fork-free pass over the lines
-whose modal state at any line depends on every line before) is now the larger part. The
-2× goal needs ~0.4 s more.
+Fourth pass (26 Nov 2026, 2-core machine, load average about 1; the 10.9 MB row): both
+cores now work in both halves of the job. The writer's second half is written by a forked
+helper while the writer checks the placement and writes the first
+(``camtool/accel/splitwrite.py``); the reader's later plain lines are read ahead by another
+(``camtool/importers/gcode_ahead.py``), and the collector is paused while reading. Each
+helper's part is taken only where the state it started from is the process's own, bit for
+bit. Output bytes unchanged. Run one after the other from cached bytecode, 584215e against
+this tree: 3.75-3.98 s against 2.59-2.72 s; this script: camtool 2.34 s, rs274 1.18 s,
+1.98× (was ~3×; 2.39× with the writer's split alone), peak 158 MB (was 127).
 """
 
 from __future__ import annotations

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import tracemalloc
 
-from camtool.importers.gcode import _lines, parse_gcode
+from camtool.importers.gcode import _lines_at, parse_gcode
 
 
 def _program(lines: int) -> str:
@@ -42,10 +42,11 @@ def test_reading_holds_no_copy_of_the_lines() -> None:
 
 def test_lines_are_read_lazily_and_as_split_would() -> None:
     text = "a\r\nb\rc\n\r\nd"
-    lines = _lines(text)
-    assert next(lines) == ("a", False)  # a generator: one line at a time
-    assert list(lines) == [("b", False), ("c", False), ("", False), ("d", True)]
+    lines = _lines_at(text, 0)
+    assert next(lines) == ("a", False, 3)  # a generator: one line at a time
+    assert list(lines) == [("b", False, 5), ("c", False, 7), ("", False, 9), ("d", True, 10)]
+    assert list(_lines_at(text, 5)) == [("c", False, 7), ("", False, 9), ("d", True, 10)]
     for sample in ("", "\n", "x", "x\n", "\r\r\n\n\r", "a\n\rb\r\n"):
         split = sample.replace("\r\n", "\n").replace("\r", "\n").split("\n")
-        assert [raw for raw, _ in _lines(sample)] == split
-        assert [last for _, last in _lines(sample)] == [False] * (len(split) - 1) + [True]
+        assert [raw for raw, _, _ in _lines_at(sample, 0)] == split
+        assert [last for _, last, _ in _lines_at(sample, 0)] == [False] * (len(split) - 1) + [True]

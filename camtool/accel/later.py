@@ -1,0 +1,83 @@
+"""Work done in a forked helper while this process goes on: its bytes, taken later.
+
+:func:`start` forks a helper that runs a function and sends back the bytes it returns;
+:meth:`Later.take` waits for them. ``None`` everywhere the helper cannot help: switched off
+(``CAMTOOL_ACCEL=0``), no ``fork``, one core, in a worker process, a failed fork, or a helper
+that raised or died; the caller then does the work itself.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from contextlib import suppress
+
+from camtool.accel import enabled
+
+
+class Later:
+    """A forked helper's answer, to :meth:`take` once (or :meth:`close` unread).
+
+    Args:
+        pid: the helper's process id.
+        fd: the read end of the pipe its answer comes through.
+    """
+
+    def __init__(self, pid: int, fd: int) -> None:
+        self.pid = pid
+        self.fd: int | None = fd
+
+    def take(self) -> bytes | None:
+        """The helper's bytes, waited for; ``None`` when it raised or died (or was taken)."""
+        from camtool.accel.cores import read_record
+
+        if self.fd is None:
+            return None
+        try:
+            return read_record(self.fd)
+        finally:
+            self.close()
+
+    def close(self) -> None:
+        """End the helper, its answer unread."""
+        from camtool.accel.cores import end_process
+
+        if self.fd is not None:
+            os.close(self.fd)
+            self.fd = None
+            with suppress(ChildProcessError):
+                end_process(self.pid, kill=True)
+
+
+def start(work: Callable[[], bytes]) -> Later | None:
+    """Fork a helper that runs ``work`` and answers its bytes; ``None`` when not.
+
+    The helper is a copy of this process: ``work`` sees everything as it is now. Not when
+    switched off, without ``fork``, on one core, in a worker process, or when no process
+    can be forked.
+    """
+    if not enabled():
+        return None
+    from camtool.accel.cores import (
+        FORK,
+        default_jobs,
+        fork_with_pipes,
+        in_worker,
+        quiet_crashes,
+        write_record,
+    )
+
+    if not FORK or default_jobs() < 2 or in_worker():
+        return None
+
+    def serve(inbox: int, outbox: int) -> None:
+        quiet_crashes()
+        os.close(inbox)
+        write_record(outbox, work())
+
+    try:
+        pid, to_child, from_child = fork_with_pipes(serve)
+    except OSError:
+        return None
+    os.close(to_child)
+    return Later(pid, from_child)
