@@ -156,3 +156,17 @@ def test_a_helper_that_fails_changes_nothing(how: str, monkeypatch: pytest.Monke
 def test_switched_off_there_is_no_helper(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("CAMTOOL_ACCEL", "0")
     assert gcode_ahead.start("G0 X0 Y0\n" * 10, lambda position, number: b"") is None
+
+
+def test_the_state_compared_is_every_value_a_plain_line_reads() -> None:
+    # a run fits where STATE is the same: every attribute of the reader the plain path
+    # uses must be in it, or be one the reader's run sets itself (its moves, line numbers,
+    # last line, contour count) or the notes (written only before the units are seen,
+    # where no run is taken)
+    import camtool.importers.gcode_plain as plain_module
+
+    source = Path(plain_module.__file__).read_text(encoding="utf-8")
+    used = set(re.findall(r"self\.([a-z][a-z_]*)\b(?!\()", source))
+    own = {"moves", "lines", "line", "contour", "notes"}
+    methods = {name for name in used if callable(getattr(plain_module.PlainLines, name, None))}
+    assert used - methods - own <= set(gcode_ahead.STATE), used - methods - own
