@@ -71,11 +71,6 @@ def _union_of_boxes(start: Point, moves: Sequence[Move]) -> BBox:
     return bbox_union(boxes)
 
 
-_QUAD_COS = tuple(math.cos(k * math.pi / 2) for k in range(4))
-_QUAD_SIN = tuple(math.sin(k * math.pi / 2) for k in range(4))
-"""``cos``/``sin`` of the quadrant angles, as :meth:`Arc.bbox` computes its extremes."""
-
-
 def _extent_of_ends(
     start: Point, moves: Sequence[Move], *, zero_sides: bool = False
 ) -> BBox | None:
@@ -102,25 +97,16 @@ def _extent_of_ends(
         return None
     x0, x1, y0, y1 = min(xs), max(xs), min(ys), max(ys)
     boxes = [(x0, y0, x1, y1)]
-    c0, c1, c2, c3 = _QUAD_COS
-    s0, s1, s2, s3 = _QUAD_SIN
     hx, hy = start
     for move in moves:
-        if isinstance(move, ArcMove):
+        if type(move) is ArcMove:
             cx, cy = move.cx, move.cy
             r = math.hypot(hx - cx, hy - cy)  # Arc.radius
-            # the four extremes strictly inside, each the float Arc.bbox computes
-            inside = (
-                x0 < cx + r * c0 < x1
-                and x0 < cx + r * c1 < x1
-                and x0 < cx + r * c2 < x1
-                and x0 < cx + r * c3 < x1
-                and y0 < cy + r * s0 < y1
-                and y0 < cy + r * s1 < y1
-                and y0 < cy + r * s2 < y1
-                and y0 < cy + r * s3 < y1
-            )
-            if not inside:
+            # The four extremes strictly inside, each the float Arc.bbox computes: c + r·q
+            # for its quadrants' cosines (sines for y) 1, 6e-17, -1, -2e-16 lie within the
+            # floats c - r and c + r (rounding keeps order; r ≥ 0), and those two are
+            # among them: they decide.
+            if not (x0 < cx - r and cx + r < x1 and y0 < cy - r and cy + r < y1):
                 boxes.append(segment_of((hx, hy), move).bbox())
         hx, hy = move.x, move.y
     box = bbox_union(boxes)

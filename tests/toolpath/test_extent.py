@@ -102,3 +102,16 @@ def test_a_negative_zero_side_goes_to_the_union() -> None:
     assert repr(placement._extent_of_ends((1.0, 1.0), ok, zero_sides=True)) == repr(
         placement._union_of_boxes((1.0, 1.0), ok)
     )
+
+
+def test_the_quadrant_extremes_are_within_the_two_that_decide() -> None:
+    # _extent_of_ends tests an arc's extremes c + r·q against the box by c - r and c + r
+    # alone: that holds when the quadrants' cosines and sines are within [-1, 1] and
+    # include 1 and -1 exactly, the very floats Arc.bbox multiplies by
+    from camtool.model.shapes import _QUADRANTS
+
+    cosines = [c for _, c, _ in _QUADRANTS]
+    sines = [s for _, _, s in _QUADRANTS]
+    for values in (cosines, sines):
+        assert all(-1.0 <= v <= 1.0 for v in values)
+        assert 1.0 in values and -1.0 in values
