@@ -74,6 +74,16 @@ def accel_on(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv(SWITCH, "1")
 
 
+@pytest.fixture
+def helpers_on(accel_on: None, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The accelerated versions on, and forked helpers allowed wherever the suite runs (one
+    core, a worker process): for the tests of a helper's work and of its refusals."""
+    from camtool.accel import cores
+
+    monkeypatch.setattr(cores, "default_jobs", lambda: 2)
+    monkeypatch.setattr(cores, "in_worker", lambda: False)
+
+
 @pytest.fixture(params=["accel", "plain"])
 def accel(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> bool:
     """Run the test twice: with the accelerated versions, then with ``CAMTOOL_ACCEL=0``.

@@ -34,11 +34,7 @@ BIG = Machine(name="test bench", steps_per_mm=(1000.0,) * 3, work_area_mm=(-900,
 ARCS = conformahead.MIN_ARCS + 500
 
 
-@pytest.fixture(autouse=True)
-def two_cores(accel_on: None, monkeypatch: pytest.MonkeyPatch) -> None:
-    """A helper may run wherever the tests run (one core, a worker process, CAMTOOL_ACCEL=0)."""
-    monkeypatch.setattr(cores, "default_jobs", lambda: 2)
-    monkeypatch.setattr(cores, "in_worker", lambda: False)
+pytestmark = pytest.mark.usefixtures("helpers_on")
 
 
 TOYS: dict[str, dict[str, Any]] = {

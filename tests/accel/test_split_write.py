@@ -25,7 +25,7 @@ from typing import Any
 
 import pytest
 
-from camtool.accel import cores, splitwrite
+from camtool.accel import splitwrite
 from camtool.importers.gcode import parse_gcode
 from camtool.model.errors import DialectError
 from camtool.model.program import Linear, Move, Program, Rapid
@@ -53,10 +53,8 @@ arcs in inches, pockets), from the corpus (``make corpus``)."""
 
 
 @pytest.fixture(autouse=True)
-def small_split(accel_on: None, monkeypatch: pytest.MonkeyPatch) -> None:
+def small_split(helpers_on: None, monkeypatch: pytest.MonkeyPatch) -> None:
     """Split programs of a few dozen moves, wherever the tests run."""
-    monkeypatch.setattr(cores, "default_jobs", lambda: 2)
-    monkeypatch.setattr(cores, "in_worker", lambda: False)
     monkeypatch.setattr(splitwrite, "MIN_MOVES", 20)
     monkeypatch.setattr(splitwrite, "WARM", 4)
     monkeypatch.setattr(splitwrite, "FAR", 0.5)

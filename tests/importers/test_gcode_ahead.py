@@ -21,7 +21,6 @@ from typing import Any
 
 import pytest
 
-from camtool.accel import cores
 from camtool.importers import gcode_ahead
 from camtool.importers.gcode import parse_gcode, parse_gcode_slow
 from camtool.model.errors import CamtoolError
@@ -43,10 +42,8 @@ END = re.compile(r"^\s*(n\d+\s*)?m0*(2|30)\s*$", re.IGNORECASE)
 
 
 @pytest.fixture(autouse=True)
-def small_programs(accel_on: None, monkeypatch: pytest.MonkeyPatch) -> None:
+def small_programs(helpers_on: None, monkeypatch: pytest.MonkeyPatch) -> None:
     """Read ahead in programs of any size, in runs of at most 50 lines, wherever the tests run."""
-    monkeypatch.setattr(cores, "default_jobs", lambda: 2)
-    monkeypatch.setattr(cores, "in_worker", lambda: False)
     monkeypatch.setattr(gcode_ahead, "MIN_CHARS", 1)
     monkeypatch.setattr(gcode_ahead, "RUN_LINES", 50)
 
