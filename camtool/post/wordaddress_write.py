@@ -40,6 +40,7 @@ from camtool.post.base import (
     check_work_area,
 )
 from camtool.post.wordaddress_spec import PLANE_CODES, WordAddressSpec
+from camtool.post.wordaddress_summary import closing_warnings
 from camtool.post.wordaddress_words import SAME_MM, WordWriter
 
 if TYPE_CHECKING:
@@ -133,7 +134,9 @@ class BlockWriter(WordWriter):
         if self.spec.end:
             self.block([self.spec.end[0]])
         self.blocks.extend(self.spec.footer)
-        self.warnings.extend(self._summary())
+        self.warnings.extend(
+            closing_warnings(self.spec, self.counts, self.grid_error_mm, ARC_CHORD_TOLERANCE_MM)
+        )
         if self.blocks:
             self._join_blocks()
         return "".join(self._done)
@@ -764,41 +767,3 @@ class BlockWriter(WordWriter):
         if comment is not None:
             self.blocks.append(comment)
         self.block([code])
-
-    def _summary(self) -> list[str]:
-        """One warning per kind of thing dropped or converted."""
-        name, d = self.spec.name, self.counts
-        texts = {
-            "feed": f"{name} has no F word: the feed of {d['feed']} cutting block(s) is not "
-            "written; the machine moves at its own speed",
-            "Spindle": f"{name} has no spindle command: {d['Spindle']} spindle command(s) "
-            "dropped; switch the spindle (or tool) on and off by hand",
-            "speed": f"{name}'s {self.spec.spindle_cw or self.spec.spindle_ccw} takes no S "
-            f"word: {d['speed']} spindle speed(s) not written; set the speed on the machine",
-            "Dwell": f"{name} has no dwell: {d['Dwell']} pause(s) dropped",
-            "ToolChange": f"{name} has no tool change: {d['ToolChange']} tool change(s) "
-            "dropped; change tools by hand",
-            "Home": f"{name} has no return to machine zero: {d['Home']} G28-style return(s) "
-            "dropped",
-            "z-split": f"{d['z-split']} move(s) changing XY and Z together written as a Z block "
-            f"and an XY block (Z first when rising, last when plunging): {name} puts Z moves in "
-            "blocks of their own",
-            "arc-chords": f"arcs that no printable centre lets {name}'s arc check accept at "
-            f"{self.spec.quantum_mm():g} mm written as {d['arc-chords']} straight chord(s) "
-            f"within {max(2.0 * self.spec.quantum_mm(), ARC_CHORD_TOLERANCE_MM):g} mm of them",
-            "plane-chords": f"{d['plane-chords']} arc(s) in the ZX or YZ plane whose printed "
-            f"numbers {name}'s arc check refuses, or too small to print, written as their "
-            "chords (a G-code file's within 0.001 mm, as read)",
-            "tiny-arc": f"{d['tiny-arc']} arc(s) too small for the "
-            f"{self.spec.quantum_mm():g} mm the dialect writes were written as straight lines "
-            "(or left out when both ends print the same)",
-        }
-        out = [texts[kind] for kind in texts if d[kind]]
-        if self.grid_error_mm > 0:
-            grids = {w.number.grid_mm for w in self.spec.words.values() if w.number.grid_mm}
-            grid = ", ".join(f"{g:g}" for g in sorted(grids))
-            out.append(
-                f"coordinates rounded to the {grid} mm step grid of {name}: largest change "
-                f"{self.grid_error_mm:.4f} mm"
-            )
-        return out

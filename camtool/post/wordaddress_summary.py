@@ -1,0 +1,62 @@
+"""The word-address writer's closing warnings: one per kind of thing dropped or converted.
+
+:class:`~camtool.post.wordaddress_write.BlockWriter` counts what its dialect cannot write as
+it was asked (a feed without an F word, a spindle speed without S, a move split into a Z and
+an XY block, an arc written as chords...) and words each kind once, after the last block.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+
+from camtool.post.wordaddress_spec import WordAddressSpec
+
+
+def closing_warnings(
+    spec: WordAddressSpec, counts: Counter[str], grid_error_mm: float, chord_tolerance_mm: float
+) -> list[str]:
+    """One warning per kind of thing dropped or converted, in a fixed order.
+
+    Args:
+        spec: the dialect (its name, codes, quantum and step grids).
+        counts: what the writer counted, by kind (``"feed"``, ``"Spindle"``, ``"speed"``,
+            ``"Dwell"``, ``"ToolChange"``, ``"Home"``, ``"z-split"``, ``"arc-chords"``,
+            ``"plane-chords"``, ``"tiny-arc"``); kinds not counted give no warning.
+        grid_error_mm: the largest change of a coordinate rounded to a step grid, mm.
+        chord_tolerance_mm: the chord deviation allowed to an arc written as chords, mm
+            (at least twice the dialect's quantum).
+    """
+    name, d = spec.name, counts
+    texts = {
+        "feed": f"{name} has no F word: the feed of {d['feed']} cutting block(s) is not "
+        "written; the machine moves at its own speed",
+        "Spindle": f"{name} has no spindle command: {d['Spindle']} spindle command(s) "
+        "dropped; switch the spindle (or tool) on and off by hand",
+        "speed": f"{name}'s {spec.spindle_cw or spec.spindle_ccw} takes no S "
+        f"word: {d['speed']} spindle speed(s) not written; set the speed on the machine",
+        "Dwell": f"{name} has no dwell: {d['Dwell']} pause(s) dropped",
+        "ToolChange": f"{name} has no tool change: {d['ToolChange']} tool change(s) "
+        "dropped; change tools by hand",
+        "Home": f"{name} has no return to machine zero: {d['Home']} G28-style return(s) dropped",
+        "z-split": f"{d['z-split']} move(s) changing XY and Z together written as a Z block "
+        f"and an XY block (Z first when rising, last when plunging): {name} puts Z moves in "
+        "blocks of their own",
+        "arc-chords": f"arcs that no printable centre lets {name}'s arc check accept at "
+        f"{spec.quantum_mm():g} mm written as {d['arc-chords']} straight chord(s) "
+        f"within {max(2.0 * spec.quantum_mm(), chord_tolerance_mm):g} mm of them",
+        "plane-chords": f"{d['plane-chords']} arc(s) in the ZX or YZ plane whose printed "
+        f"numbers {name}'s arc check refuses, or too small to print, written as their "
+        "chords (a G-code file's within 0.001 mm, as read)",
+        "tiny-arc": f"{d['tiny-arc']} arc(s) too small for the "
+        f"{spec.quantum_mm():g} mm the dialect writes were written as straight lines "
+        "(or left out when both ends print the same)",
+    }
+    out = [texts[kind] for kind in texts if d[kind]]
+    if grid_error_mm > 0:
+        grids = {w.number.grid_mm for w in spec.words.values() if w.number.grid_mm}
+        grid = ", ".join(f"{g:g}" for g in sorted(grids))
+        out.append(
+            f"coordinates rounded to the {grid} mm step grid of {name}: largest change "
+            f"{grid_error_mm:.4f} mm"
+        )
+    return out
