@@ -38,15 +38,15 @@ if TYPE_CHECKING:
     from camtool.post.wordaddress_write import BlockWriter
 
 MIN_MOVES = 40_000
-"""Moves from which the program is split (~0.2 s of writing; below, the fork, the
-stretch written twice and the hand-over cost about what the second core saves)."""
+"""Moves from which the program is split: below, the fork, the stretch written twice and
+the hand-over cost about what the second core saves (docs/performance.md)."""
 MAX_MOVES = 1_000_000
 """Moves above which it is not: the helper copies the memory it writes to, and counting a
-reference to an object writes to its page (85 MB of the writer's 128 MB on the re-post
-benchmark's 333 540 moves)."""
+reference to an object writes to its page, so its copy grows with its half of the moves
+(docs/performance.md)."""
 SHARE = 0.45
 """The part of the moves the writer writes itself: it also checks the program's placement
-(~10 % of the writing's time on the re-post benchmark) while the helper writes."""
+while the helper writes."""
 WARM = 256
 """Moves the helper writes at least before :attr:`Split.at` to reach the writer's state."""
 FAR = 0.1
