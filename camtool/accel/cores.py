@@ -27,8 +27,10 @@ from camtool.accel import enabled
 
 __all__ = [
     "FORK",
+    "Beside",
     "ForkedWork",
     "ahead",
+    "beside",
     "default_jobs",
     "end_process",
     "fork_process",
@@ -180,6 +182,55 @@ def ahead(items: Iterable[T]) -> Iterator[T]:
         close = getattr(items, "close", None)
         if close is not None:  # a generator left early: its own clean-up, here
             close()
+
+
+class Beside(Generic[T]):
+    """``fn()``, made in a thread from now on, taken later (:func:`beside`)."""
+
+    def __init__(self, fn: Callable[[], T], threaded: bool) -> None:
+        self._fn = fn
+        self._answer: tuple[bool, Any] | None = None
+        self._thread: threading.Thread | None = None
+        if threaded:
+            self._thread = threading.Thread(target=self._make, name="camtool-beside", daemon=True)
+            self._thread.start()
+
+    def _make(self) -> None:
+        try:
+            self._answer = (True, self._fn())
+        except BaseException as exc:  # raised where the answer is taken
+            self._answer = (False, exc)
+
+    def join(self) -> None:
+        """Wait for the thread, if one runs (the answer stays, to be taken or not)."""
+        if self._thread is not None:
+            self._thread.join()
+            self._thread = None
+
+    def result(self) -> T:
+        """``fn()``'s answer (made here if no thread made it); what it raised is raised here."""
+        self.join()
+        if self._answer is None:
+            self._make()
+        assert self._answer is not None
+        ok, value = self._answer
+        if not ok:
+            raise value
+        return value
+
+
+def beside(fn: Callable[[], T]) -> Beside[T]:
+    """``fn()`` started in a thread now, for an answer the caller may take later.
+
+    For work that releases the GIL (scipy's k-d tree build, numba's ``nogil`` kernels)
+    and that the caller is likely to need while the other core has nothing to do: the
+    caller goes on meanwhile. :meth:`Beside.result` waits for the answer; the caller
+    must call :meth:`Beside.join` (or ``result``) before it forks or returns from the
+    step, so that no thread outlives it. With one core, in a worker process
+    (:func:`in_worker`) or with the switch off, no thread starts: ``result`` makes the
+    answer then, and an answer never asked for is never made.
+    """
+    return Beside(fn, default_jobs() >= 2 and not in_worker() and enabled())
 
 
 class ForkedWork(Generic[T, R]):

@@ -550,6 +550,53 @@ def to_line(points: Any, x0: float, y0: float, x1: float, y1: float, out: Any) -
 
 
 @numba.njit(cache=True, nogil=True)
+def window_bounds(
+    samples: Any, centre: Any, a: Any, b: Any, moved: Any, window: int, out: Any
+) -> None:
+    """``path_shortfall._window_bounds`` of one part into ``out``: each sample's bound, mm.
+
+    Sample ``i`` against the polyline pieces ``k = clip(centre[i] + off, 0, m - 1)``,
+    ``off`` from ``-window`` to ``window`` (``m = len(moved) - 1``), each the segment from
+    ``a[moved[k]]`` to ``b[moved[k + 1] - 1]``: the same float operations per piece, in
+    the same order, as ``path_shortfall._segment_formula`` (``t`` 0 for a piece of no
+    length, clipped to [0, 1]; ``sqrt`` of the sum of squares, not ``hypot``), and the
+    least of them as ``np.minimum`` keeps it (a NaN is kept).
+    """
+    m = moved.shape[0] - 1
+    for n in range(samples.shape[0]):
+        px = samples[n, 0]
+        py = samples[n, 1]
+        best = math.inf
+        for off in range(-window, window + 1):
+            k = centre[n] + off
+            if k < 0:
+                k = 0
+            elif k > m - 1:
+                k = m - 1
+            i = moved[k]
+            j = moved[k + 1] - 1
+            ax = a[i, 0]
+            ay = a[i, 1]
+            apx = px - ax
+            apy = py - ay
+            abx = b[j, 0] - ax
+            aby = b[j, 1] - ay
+            length2 = abx * abx + aby * aby
+            dot = apx * abx + apy * aby
+            t = dot / length2 if length2 > 0 else 0.0
+            if t < 0.0:
+                t = 0.0
+            elif t > 1.0:
+                t = 1.0
+            ox = apx - t * abx
+            oy = apy - t * aby
+            d = math.sqrt(ox * ox + oy * oy)
+            if best == best and (d < best or d != d):
+                best = d
+        out[n] = best
+
+
+@numba.njit(cache=True, nogil=True)
 def ideal_motor(rows: Any, total: Any, origin: Any, motor: Any, signs: Any) -> None:
     """The ideal controller's motor after each fractional row, and each row's direction.
 

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from camtool.accel.cores import Beside, beside
 from camtool.accel.loader import KernelsOnDemand
 from camtool.verify import nearest_exact
 
@@ -381,23 +382,42 @@ class _LazyTree:
     def __init__(self, points: FloatArray) -> None:
         self.points = points
         self._tree: Any = None
+        self._beside: Beside[Any] | None = None
         self._boxes: dict[bool, tuple[Any, ...]] = {}
         self._half: float | None = None
 
     def built(self) -> bool:
-        """Whether :attr:`tree` has been built (asked for before)."""
-        return self._tree is not None
+        """Whether :attr:`tree` has been built (asked for before), or is being built beside."""
+        return self._tree is not None or self._beside is not None
 
     @property
     def tree(self) -> Any:
         if self._tree is None:
-            from scipy.spatial import cKDTree
-
-            # the same tree without its own copy of the ends (~13 MB for 800 000): the
-            # points are not written to while it lives; boxes not shrunk to their points
-            # (the same answers; 20 % less to build on a long trace)
-            self._tree = cKDTree(self.points, copy_data=False, compact_nodes=False)
+            self._tree = self._build() if self._beside is None else self._beside.result()
+            self._beside = None
         return self._tree
+
+    def _build(self) -> Any:
+        from scipy.spatial import cKDTree
+
+        # the same tree without its own copy of the ends (~13 MB for 800 000): the
+        # points are not written to while it lives; boxes not shrunk to their points
+        # (the same answers; 20 % less to build on a long trace)
+        return cKDTree(self.points, copy_data=False, compact_nodes=False)
+
+    def build_beside(self) -> None:
+        """Start building :attr:`tree` in a thread (:func:`camtool.accel.cores.beside`).
+
+        For a caller likely to ask for it while the other core is idle. The caller
+        must call :meth:`settle` before it forks or lets these points go.
+        """
+        if self._tree is None and self._beside is None:
+            self._beside = beside(self._build)
+
+    def settle(self) -> None:
+        """Wait for a tree :meth:`build_beside` started, if one is being built."""
+        if self._beside is not None:
+            self._beside.join()
 
     def drop_boxes(self) -> None:
         """Let the compiled search's trees go (the k-d tree answers from now on)."""

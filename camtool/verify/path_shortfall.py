@@ -15,7 +15,7 @@ import numpy.typing as npt
 
 from camtool.model.program import Program, segment_of
 from camtool.model.shapes import Arc, Point
-from camtool.verify import contour_measures, deviations, nearest_exact, nearest_search
+from camtool.verify import contour_measures, dda, deviations, nearest_exact, nearest_search
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -403,6 +403,36 @@ class _Bounded:
         """
         if len(self.samples) == 0:
             return None
+        reach = self.reach
+        if np.isnan(reach).any():  # never from finite samples: the sorted form's order
+            return self._farthest_sorted(floor)
+        if float(np.max(reach)) < floor:
+            return None
+        a, b = self.places.a, self.places.b
+        ends = (
+            self.ends
+            if self.ends is not None
+            else nearest_search._LazyTree(nearest_search._end_points(a, b))
+        )
+        best: tuple[float, int] | None = None
+        known = floor
+        taken = _largest(reach, SHORTFALL_ROUND)
+        for mask in (taken, None):  # the likeliest first, then the others that may reach
+            if mask is None:
+                mask = ~taken & (reach >= known)
+            else:
+                mask &= reach >= known
+            index = np.flatnonzero(mask)  # in sample order: the first of equal ones
+            if len(index) == 0:
+                break
+            far, k = nearest_search.farthest_nearest(self.samples[index], a, b, ends=ends)
+            if best is None or far > best[0] or (far == best[0] and index[k] < best[1]):
+                best = (far, int(index[k]))
+            known = max(known, far)
+        return best
+
+    def _farthest_sorted(self, floor: float) -> tuple[float, int] | None:
+        """:meth:`farthest` by one stable sort of the bounds (the reference; NaN bounds last)."""
         order = np.argsort(-self.reach, kind="stable")  # the likeliest first
         reach = self.reach[order]
         if reach[0] < floor:
@@ -429,6 +459,22 @@ class _Bounded:
         return best
 
 
+def _largest(values: FloatArray, count: int) -> npt.NDArray[np.bool_]:
+    """``(N,)`` mask of the first ``count`` of ``values`` (no NaN) in a stable descending sort.
+
+    The ``count`` largest; of those equal to the smallest taken, the first in order (as
+    ``np.argsort(-values, kind="stable")[:count]``), by one partition instead of a sort.
+    """
+    n = len(values)
+    if count >= n:
+        return np.ones(n, dtype=bool)
+    edge = float(np.partition(values, n - count)[n - count])  # the count-th largest
+    mask = values > edge
+    ties = np.flatnonzero(values == edge)[: count - int(np.count_nonzero(mask))]
+    mask[ties] = True
+    return mask
+
+
 def _largest_magnitude(values: FloatArray) -> float:
     """``max(|values|)`` without an array of the magnitudes (a trace's would be ~6 MB)."""
     return max(abs(float(np.max(values))), abs(float(np.min(values))))
@@ -451,16 +497,22 @@ def _window_bounds(samples: FloatArray, place: FloatArray, places: _Places) -> F
 
     The segments up to :data:`SHORTFALL_WINDOW` on each side of the trace points
     whose places (:class:`_Places`) enclose the sample's. Each is a distance to one
-    segment of the trace, so no less than the distance to them all.
+    segment of the trace, so no less than the distance to them all. Where the step
+    kernels are loaded (a streamed verify), :func:`camtool.accel.kernels.window_bounds`
+    takes the same floats in one pass.
     """
     a, b, moved = places.a, places.b, places.index
     m = len(moved) - 1
     if m == 0:  # the carriage never moved: the one point
         return np.hypot(samples[:, 0] - a[0, 0], samples[:, 1] - a[0, 1])
     out = np.empty(len(samples), dtype=np.float64)
+    kernels = dda.KERNELS.loaded()
     for lo in range(0, len(samples), SHORTFALL_CHUNK):
         part = slice(lo, lo + SHORTFALL_CHUNK)
         centre = np.searchsorted(places.keys, place[part]) - 1
+        if kernels is not None:
+            kernels.window_bounds(samples[part], centre, a, b, moved, SHORTFALL_WINDOW, out[part])
+            continue
         px, py = samples[part, 0], samples[part, 1]
         best = np.full(len(px), np.inf)
         for off in range(-SHORTFALL_WINDOW, SHORTFALL_WINDOW + 1):

@@ -20,6 +20,13 @@ from camtool.verify.circlefit import CircleFit
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 
+TREE_BESIDE_FROM = 100_000
+"""Segment ends of the last contour's thinned trace from which its k-d tree is built in a
+thread while its path is sampled and bounded (:meth:`nearest_search._LazyTree.build_beside`):
+the simulation is over, so the other core is idle. The search then takes the k-d tree's
+path, as for a tree built before (``_LazyTree.built``); both paths give the same
+distances, only the time depends on it."""
+
 
 @dataclass(frozen=True, eq=False)
 class StreamedMeasures:
@@ -372,7 +379,13 @@ class TraceStream:
         segments = len(ends.points) // 2  # a and b: views of the tree's ends, not the trace
         a, b = ends.points[:segments], ends.points[segments:]
         c.kept = []  # the trace is let go: ~6 MB of a 400 000-point contour
-        self._shortfall(c, ends, a, b)
+        beside = self.next_run >= len(self.runs) and len(ends.points) >= TREE_BESIDE_FROM
+        if beside:  # the last contour: the other core has nothing else to do
+            ends.build_beside()
+        try:
+            self._shortfall(c, ends, a, b)
+        finally:
+            ends.settle()
 
     def _shortfall(
         self, c: _Contour, ends: nearest_search._LazyTree, a: FloatArray, b: FloatArray

@@ -224,6 +224,58 @@ def test_ahead_makes_the_items_here_in_a_worker_or_on_one_core(
         assert set(makers) == {threading.current_thread().name}
 
 
+def test_beside_makes_the_answer_in_its_thread_and_raises_its_error_where_taken(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.setattr(cores, "default_jobs", lambda: 2)
+    monkeypatch.setattr(cores, "in_worker", lambda: False)
+    release = threading.Event()
+    makers: list[str] = []
+
+    def make() -> int:
+        makers.append(threading.current_thread().name)
+        release.wait(10)
+        return 42
+
+    later = cores.beside(make)
+    assert _threads_named("camtool-beside")  # started at once, this thread goes on
+    release.set()
+    assert later.result() == 42
+    assert later.result() == 42  # taken again: the same answer, not made again
+    assert makers == ["camtool-beside"]
+    assert not _threads_named("camtool-beside")
+
+    def fail() -> int:
+        raise InputError("tree: no")
+
+    failed = cores.beside(fail)
+    failed.join()  # waiting raises nothing: the error is the answer's
+    assert not _threads_named("camtool-beside")
+    with pytest.raises(InputError, match="tree: no"):
+        failed.result()
+
+
+@pytest.mark.parametrize("how", ["one core", "worker", "off"])
+def test_beside_without_a_thread_makes_the_answer_only_when_asked(
+    how: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(cores, "default_jobs", lambda: 1 if how == "one core" else 2)
+    monkeypatch.setattr(cores, "in_worker", lambda: how == "worker")
+    if how == "off":
+        monkeypatch.setenv("CAMTOOL_ACCEL", "0")
+    made: list[str] = []
+
+    def make() -> int:
+        made.append(threading.current_thread().name)
+        return 7
+
+    never = cores.beside(make)
+    never.join()
+    assert made == []  # not asked for: never made
+    assert cores.beside(make).result() == 7
+    assert made == [threading.current_thread().name]
+
+
 def _no_fork() -> int:
     raise BlockingIOError(11, "Resource temporarily unavailable")
 

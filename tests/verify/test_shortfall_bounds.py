@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import threading
 
 import numpy as np
 import pytest
@@ -21,10 +22,12 @@ from camtool.model.program import ArcMove, Linear, Program, Rapid, segment_of
 from camtool.post.registry import load_target
 from camtool.verify import (
     contour_measures,
+    dda,
     deviations,
     nearest_exact,
     nearest_search,
     path_shortfall,
+    trace_measures,
 )
 from camtool.verify.simulate import simulate_steps
 from tests.verify.programs import TARGETS
@@ -317,7 +320,8 @@ def test_a_streamed_contour_builds_its_search_trees_once(monkeypatch: pytest.Mon
 
     A few samples to measure: the compiled box tree, built once for the contour (its
     form for few samples), and no scipy k-d tree (its build took most of the
-    shortfall's time, for ~100 samples measured). The same shortfall.
+    shortfall's time, for ~100 samples measured). The same shortfall. (The last
+    contour's k-d tree built beside is the next test's; here none is.)
     """
     from camtool.verify.verifier import verify_program
 
@@ -341,6 +345,7 @@ def test_a_streamed_contour_builds_its_search_trees_once(monkeypatch: pytest.Mon
     monkeypatch.setattr(nearest_search, "_ends_tree", ends_tree)
     monkeypatch.setattr(nearest_search._LazyTree, "tree", property(kd_tree))
     monkeypatch.setattr(path_shortfall, "STREAM_SAMPLES", 3000)  # several batches per contour
+    monkeypatch.setattr(trace_measures, "TREE_BESIDE_FROM", 10**12)
     machine = load_target("pic-mmh").machine
     moves = [Rapid(0.5, 0.5, contour=1)]
     for k in range(8):  # long lines along X, back and forth, 0.137 mm apart
@@ -357,3 +362,119 @@ def test_a_streamed_contour_builds_its_search_trees_once(monkeypatch: pytest.Mon
     assert want[3] > 5 * 3000  # path samples: several batches
     assert kd == []
     assert len(builds) == len(set(builds)) >= 1  # each form once for the contour
+
+
+@pytest.mark.usefixtures("helpers_on")
+@pytest.mark.parametrize("beside_from", [0, 10**12])
+def test_the_last_contours_tree_is_built_beside_once_with_the_same_shortfall(
+    beside_from: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The last contour's k-d tree is built in a thread while its samples are bounded.
+
+    Two contours; with the rule on (``TREE_BESIDE_FROM`` 0), the last one's tree is built
+    once, in the ``camtool-beside`` thread, and serves every batch; the first contour's
+    is not. Off, no tree is built beside. The shortfall is the reference's either way.
+    """
+    from camtool.verify.verifier import verify_program
+
+    monkeypatch.setattr(trace_measures, "TREE_BESIDE_FROM", beside_from)
+    monkeypatch.setattr(path_shortfall, "STREAM_SAMPLES", 3000)  # several batches per contour
+    built: list[tuple[int, str]] = []
+    real_build = nearest_search._LazyTree._build
+
+    def build(self: nearest_search._LazyTree) -> object:
+        built.append((len(self.points), threading.current_thread().name))
+        return real_build(self)
+
+    monkeypatch.setattr(nearest_search._LazyTree, "_build", build)
+    machine = load_target("pic-mmh").machine
+    moves: list[Linear | Rapid | ArcMove] = []
+    for c, y0 in ((1, 0.5), (2, 3.5)):
+        moves.append(Rapid(0.5, y0, contour=c))
+        for k in range(6):
+            x = 6.0 if k % 2 == 0 else 0.5
+            moves.append(Linear(x, y0 + 0.137 * (k + 1), 300.0, contour=c))
+    program = Program(tuple(moves), origin=(0.0, 0.0))
+    trace = simulate_steps(program, machine)
+    want = _shortfall_reference(trace.carriage_mm, trace.block_start, trace.start_mm, program)
+    v = verify_program(
+        program, machine, name="pic-mmh", budget=False, chunk_rows=4096, stream_above=10
+    )
+    assert v.along is not None and _shortfall(v.along) == want
+    assert not [t for t in threading.enumerate() if t.name == "camtool-beside"]
+    beside = [n for n, thread in built if thread == "camtool-beside"]
+    if beside_from == 0:
+        assert len(beside) == 1  # the last contour's, once for its batches
+    else:
+        assert beside == []
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_rounds_by_partition_are_the_sorted_ones(seed: int) -> None:
+    """:meth:`_Bounded.farthest` (a partition) against its stable sort, ties and floors included."""
+    rng = np.random.default_rng(seed)
+    for _ in range(300):
+        n = int(rng.integers(1, 3000))
+        count = int(rng.integers(1, 64))
+        if seed % 2:
+            values = rng.integers(0, int(rng.integers(1, 30)), n).astype(np.float64)
+        else:
+            values = rng.random(n)
+        want = np.zeros(n, dtype=bool)
+        want[np.argsort(-values, kind="stable")[:count]] = True
+        assert np.array_equal(path_shortfall._largest(values, count), want)
+    machine = load_target(TARGETS[seed % len(TARGETS)]).machine
+    program = _program(seed)
+    trace = simulate_steps(program, machine)
+    points, block_start = trace.carriage_mm, trace.block_start
+    starts = [program.origin] + [(m.x, m.y) for m in program.moves]
+    nominal = deviations.nominal_arrays(program)
+    first, last = contour_measures.contour_runs(program)[0]
+    lo, hi = int(block_start[first]), int(block_start[last + 1])
+    run = np.vstack([points[lo - 1 : lo] if lo else np.zeros((1, 2)), points[lo:hi]])
+    samples, owner, t = path_shortfall._sample_moves(program, starts, first, last, 0.001)
+    keep = block_start[first + 1 : last + 2] - lo
+    part = {k: v[first : last + 1] for k, v in nominal.items()}
+    bounded = path_shortfall._Bounded.of_run(samples, owner - first, t, run, keep, part)
+    # bounds rounded to a coarse grid: many ties at the round's edge
+    bounded.reach = np.round(bounded.reach, 4)
+    far = bounded._farthest_sorted(0.0)
+    assert far is not None
+    for floor in (0.0, far[0] / 2, far[0], math.nextafter(far[0], 1.0), 2 * far[0] + 1e-3):
+        assert bounded.farthest(floor) == bounded._farthest_sorted(floor)
+
+
+@pytest.mark.parametrize("name", TARGETS)
+def test_the_compiled_window_bounds_are_numpys_bit_for_bit(name: str) -> None:
+    """:func:`camtool.accel.kernels.window_bounds` against the numpy form it replaces.
+
+    Real traces of every target, plus one with rows that do not move (pieces of no
+    length), samples far away, on the trace and NaN (kept, as ``np.minimum`` keeps it).
+    """
+    if dda.compiled() is None:
+        pytest.skip("numba missing")
+    machine = load_target(name).machine
+    program = _program(3)
+    trace = simulate_steps(program, machine)
+    points, block_start = trace.carriage_mm, trace.block_start
+    starts = [program.origin] + [(m.x, m.y) for m in program.moves]
+    nominal = deviations.nominal_arrays(program)
+    rng = np.random.default_rng(len(name))
+    for first, last in contour_measures.contour_runs(program):
+        lo, hi = int(block_start[first]), int(block_start[last + 1])
+        run = np.vstack([points[lo - 1 : lo] if lo else np.zeros((1, 2)), points[lo:hi]])
+        run = np.repeat(run, rng.integers(1, 3, len(run)), axis=0)  # rows that do not move
+        samples, owner, t = path_shortfall._sample_moves(program, starts, first, last, 0.002)
+        extra = np.vstack([run[::97], run[::89] + 5.0, [[np.nan, 1.0]]])
+        samples = np.vstack([samples, extra])
+        place = np.concatenate([owner - first + t, rng.random(len(extra)) * (last - first + 1)])
+        keep = np.minimum(np.cumsum(np.ones(last - first + 1, dtype=np.int64)) * 5, len(run) - 1)
+        part = {k: v[first : last + 1] for k, v in nominal.items()}
+        a, b = path_shortfall._segments(run)
+        places = path_shortfall._Places(a, b, path_shortfall._move_spans(len(run), 1, keep), part)
+        compiled = path_shortfall._window_bounds(samples, place, places)
+        with dda.KERNELS.off():
+            plain = path_shortfall._window_bounds(samples, place, places)
+        assert np.array_equal(compiled, plain, equal_nan=True)
+        assert np.isnan(compiled[-1]) and np.isnan(plain[-1])
+        assert np.all(compiled[:-1] >= 0.0)
