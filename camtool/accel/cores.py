@@ -17,6 +17,7 @@ import select
 import signal
 import sys
 import threading
+import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from contextlib import contextmanager, suppress
@@ -38,6 +39,7 @@ __all__ = [
     "how_ended",
     "in_worker",
     "meanwhile",
+    "patience",
     "quiet_crashes",
     "read_exactly",
     "read_record",
@@ -435,10 +437,46 @@ def how_ended(status: int) -> str:
     return f"exit code {os.waitstatus_to_exitcode(status)}"
 
 
-def read_exactly(fd: int, size: int) -> bytes | None:
-    """``size`` bytes from ``fd``; ``None`` when it ends first (its writer left or died)."""
+HELPER_PATIENCE = 4.0
+"""How many times as long as this process has worked since it forked a helper it then waits
+for the helper's answer (:func:`patience`): the helper's share of the work is about the size
+of this process's, so a helper that takes four times as long has hung (a lock it inherited
+held, the machine out of memory), and this process does that share itself."""
+HELPER_PATIENCE_MIN_S = 10.0
+"""The least time this process waits for a helper's answer, s (a short job on a busy machine)."""
+
+
+def patience(started: float) -> float:
+    """The ``time.monotonic()`` until which to wait for a helper forked at ``started``.
+
+    :data:`HELPER_PATIENCE` times the time since, and at least :data:`HELPER_PATIENCE_MIN_S`.
+    A helper's answer not there by then is taken as none (:func:`read_record`): the caller
+    ends the helper and does its work itself, as for a helper that died.
+    """
+    now = time.monotonic()
+    return now + max(HELPER_PATIENCE_MIN_S, HELPER_PATIENCE * (now - started))
+
+
+def _readable_by(fd: int, deadline: float) -> bool:
+    """Whether ``fd`` can be read before ``time.monotonic()`` reaches ``deadline``."""
+    while True:
+        left = deadline - time.monotonic()
+        if select.select([fd], [], [], max(0.0, left))[0]:
+            return True
+        if left <= 0.0:
+            return False
+
+
+def read_exactly(fd: int, size: int, deadline: float | None = None) -> bytes | None:
+    """``size`` bytes from ``fd``; ``None`` when it ends first (its writer left or died).
+
+    ``deadline``: a ``time.monotonic()`` (:func:`patience`) after which waiting for more
+    bytes gives ``None`` too; ``None``: wait as long as it takes.
+    """
     parts = []
     while size:
+        if deadline is not None and not _readable_by(fd, deadline):
+            return None
         part = os.read(fd, min(size, 1 << 20))
         if not part:
             return None
@@ -470,9 +508,12 @@ def write_record(fd: int, data: bytes) -> None:
     write_all(fd, len(data).to_bytes(8, "little") + data)
 
 
-def read_record(fd: int) -> bytes | None:
-    """The next record :func:`write_record` wrote to ``fd``; ``None`` when it ends first."""
-    head = read_exactly(fd, 8)
+def read_record(fd: int, deadline: float | None = None) -> bytes | None:
+    """The next record :func:`write_record` wrote to ``fd``; ``None`` when it ends first.
+
+    ``deadline``: as for :func:`read_exactly` (``None`` too when it passes first).
+    """
+    head = read_exactly(fd, 8, deadline)
     if head is None:
         return None
-    return read_exactly(fd, int.from_bytes(head, "little"))
+    return read_exactly(fd, int.from_bytes(head, "little"), deadline)

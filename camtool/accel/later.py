@@ -3,12 +3,13 @@
 :func:`start` forks a helper that runs a function and sends back the bytes it returns;
 :meth:`Later.take` waits for them. ``None`` everywhere the helper cannot help: switched off
 (``CAMTOOL_ACCEL=0``), no ``fork``, one core, in a worker process, a failed fork, or a helper
-that raised or died; the caller then does the work itself.
+that raised, died or hung; the caller then does the work itself.
 """
 
 from __future__ import annotations
 
 import os
+import time
 from collections.abc import Callable
 from contextlib import suppress
 
@@ -26,15 +27,20 @@ class Later:
     def __init__(self, pid: int, fd: int) -> None:
         self.pid = pid
         self.fd: int | None = fd
+        self.started = time.monotonic()
 
     def take(self) -> bytes | None:
-        """The helper's bytes, waited for; ``None`` when it raised or died (or was taken)."""
-        from camtool.accel.cores import read_record
+        """The helper's bytes, waited for; ``None`` when it raised or died (or was taken).
+
+        ``None`` too when they are not there by :func:`camtool.accel.cores.patience`'s
+        deadline (a helper that hung): it is ended, and the caller does its work.
+        """
+        from camtool.accel.cores import patience, read_record
 
         if self.fd is None:
             return None
         try:
-            return read_record(self.fd)
+            return read_record(self.fd, patience(self.started))
         finally:
             self.close()
 

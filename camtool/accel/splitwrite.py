@@ -24,6 +24,7 @@ import copy
 import math
 import os
 import pickle
+import time
 from bisect import bisect_right
 from collections import Counter
 from collections.abc import Iterator
@@ -88,6 +89,7 @@ class Split:
         self.at = at
         self.pid = pid
         self.fd = fd
+        self.started = time.monotonic()
 
     def join(self, writer: BlockWriter, index: int, written: int) -> bool:
         """Take the helper's blocks if it started from ``writer``'s state; False: write them.
@@ -97,10 +99,10 @@ class Split:
         the whole program's blocks but its postamble, counts and state as if it had
         written every item itself.
         """
-        from camtool.accel.cores import end_process, read_record
+        from camtool.accel.cores import end_process, patience, read_record
 
-        try:
-            record = read_record(self.fd)
+        try:  # a helper that hung is ended at the deadline: the writer writes the rest
+            record = read_record(self.fd, patience(self.started))
         finally:
             os.close(self.fd)
             with suppress(ChildProcessError):

@@ -349,3 +349,29 @@ def test_switched_off_every_item_runs_here_in_order(monkeypatch: pytest.MonkeyPa
 
     assert list(cores.ahead(made())) == [0, 1, 2]
     assert set(makers) == {threading.current_thread().name}
+
+
+def test_a_record_not_there_by_the_deadline_is_none() -> None:
+    import time
+
+    read, write = os.pipe()
+    try:
+        t0 = time.monotonic()
+        assert cores.read_record(read, time.monotonic() + 0.2) is None  # nothing came
+        assert 0.2 <= time.monotonic() - t0 < 5.0
+        cores.write_record(write, b"answer")
+        assert cores.read_record(read, time.monotonic() + 5.0) == b"answer"
+        os.write(write, (6).to_bytes(8, "little") + b"ans")  # cut short: the rest never comes
+        assert cores.read_record(read, time.monotonic() + 0.2) is None
+    finally:
+        os.close(read)
+        os.close(write)
+
+
+def test_patience_grows_with_the_work_done_since_the_fork(monkeypatch: pytest.MonkeyPatch) -> None:
+    import time
+
+    now = time.monotonic()
+    assert cores.patience(now) - now >= cores.HELPER_PATIENCE_MIN_S
+    long_ago = now - 100.0
+    assert cores.patience(long_ago) - time.monotonic() >= cores.HELPER_PATIENCE * 100.0 - 1.0

@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 import os
 import random
+import threading
 from pathlib import Path
 from typing import Any
 
@@ -187,11 +188,17 @@ def test_a_warning_only_the_helper_gives_is_written_by_the_writer(
     assert split_answers(post, Program(tuple(moves)), monkeypatch) == [False]
 
 
-@pytest.mark.parametrize("how", ["raises", "dies"])
+@pytest.mark.parametrize("how", ["raises", "dies", "hangs"])
 def test_a_helper_that_fails_changes_nothing(how: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    from camtool.accel import cores
+
+    monkeypatch.setattr(cores, "HELPER_PATIENCE_MIN_S", 0.5)  # not the 10 s a user waits
+
     def fail(*args: Any) -> Any:
         if how == "dies":
             os._exit(3)
+        if how == "hangs":
+            threading.Event().wait()  # forever: the writer ends it at the deadline
         raise RuntimeError("helper failed")
 
     monkeypatch.setattr(splitwrite, "_second_part", fail)

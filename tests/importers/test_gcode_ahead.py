@@ -16,6 +16,7 @@ from __future__ import annotations
 import os
 import random
 import re
+import threading
 from pathlib import Path
 from typing import Any
 
@@ -134,14 +135,19 @@ def test_random_programs_read_the_same(monkeypatch: pytest.MonkeyPatch) -> None:
         assert read(text, monkeypatch, ahead=True) == slow(text), text
 
 
-@pytest.mark.parametrize("how", ["raises", "dies"])
+@pytest.mark.parametrize("how", ["raises", "dies", "hangs"])
 def test_a_helper_that_fails_changes_nothing(how: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    from camtool.accel import cores
+
+    monkeypatch.setattr(cores, "HELPER_PATIENCE_MIN_S", 0.5)  # not the 10 s a user waits
     text = examples(2)
     expected = read(text, monkeypatch, ahead=False)
 
     def fail(self: Any) -> bytes:
         if how == "dies":
             os._exit(3)
+        if how == "hangs":
+            threading.Event().wait()  # forever: the reader ends it at the deadline
         raise RuntimeError("helper failed")
 
     monkeypatch.setattr(gcode_ahead.Recorder, "pack", fail)
