@@ -3,11 +3,13 @@
 :func:`start` forks a helper that runs a function and sends back the bytes it returns;
 :meth:`Later.take` waits for them. ``None`` everywhere the helper cannot help: switched off
 (``CAMTOOL_ACCEL=0``), no ``fork``, one core, in a worker process, a failed fork, or a helper
-that raised, died or hung; the caller then does the work itself.
+that raised, died or hung; the caller then does the work itself. :func:`same` tells
+whether a helper's answer started from this process's own state.
 """
 
 from __future__ import annotations
 
+import math
 import os
 import time
 from collections.abc import Callable
@@ -87,3 +89,23 @@ def start(work: Callable[[], bytes]) -> Later | None:
         return None
     os.close(to_child)
     return Later(pid, from_child)
+
+
+def same(a: object, b: object) -> bool:
+    """Whether ``a`` and ``b`` are the same: floats bit for bit, the rest by type and value.
+
+    ``-0.0`` is not ``0.0`` and a NaN is never the same; tuples, lists and dicts are
+    compared item by item, anything else by its type and ``==``.
+    """
+    if type(a) is not type(b):
+        return False
+    if isinstance(a, float):
+        assert isinstance(b, float)
+        return a == b and math.copysign(1.0, a) == math.copysign(1.0, b)
+    if isinstance(a, tuple | list):
+        assert isinstance(b, tuple | list)
+        return len(a) == len(b) and all(same(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, dict):
+        assert isinstance(b, dict)
+        return a.keys() == b.keys() and all(same(a[k], b[k]) for k in a)
+    return a == b

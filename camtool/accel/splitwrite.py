@@ -21,7 +21,6 @@ Design notes: docs/internals.md, ``camtool/accel/splitwrite.py``.
 from __future__ import annotations
 
 import copy
-import math
 import os
 import pickle
 import time
@@ -33,6 +32,7 @@ from itertools import islice
 from typing import TYPE_CHECKING, Any
 
 from camtool.accel import enabled
+from camtool.accel.later import same
 from camtool.model.program import ArcMove, Linear, PlaneArc, Program, Rapid
 
 if TYPE_CHECKING:
@@ -273,23 +273,3 @@ def state(writer: BlockWriter, index: int, written: int) -> dict[str, Any]:
     out["#index"] = index
     out["#written"] = max(index, written)
     return out
-
-
-def same(a: object, b: object) -> bool:
-    """Whether ``a`` and ``b`` are the same: floats bit for bit, the rest by type and value.
-
-    ``-0.0`` is not ``0.0`` and a NaN is never the same; tuples, lists and dicts are
-    compared item by item, anything else by its type and ``==``.
-    """
-    if type(a) is not type(b):
-        return False
-    if isinstance(a, float):
-        assert isinstance(b, float)
-        return a == b and math.copysign(1.0, a) == math.copysign(1.0, b)
-    if isinstance(a, tuple | list):
-        assert isinstance(b, tuple | list)
-        return len(a) == len(b) and all(same(x, y) for x, y in zip(a, b, strict=True))
-    if isinstance(a, dict):
-        assert isinstance(b, dict)
-        return a.keys() == b.keys() and all(same(a[k], b[k]) for k in a)
-    return a == b

@@ -8,7 +8,7 @@ of a long program forks a helper (:func:`start`) that reads the program from its
 from nothing known, and records each run of plain lines it reads: the values it started
 from, its moves and line numbers, the values it ended with. The reader reads the program
 from its start, and at the first line of each recorded run compares its own values with
-the run's, bit for bit (:func:`~camtool.accel.splitwrite.same`). Where they are the same it
+the run's, bit for bit (:func:`~camtool.accel.later.same`). Where they are the same it
 takes the run's moves (their contours numbered on from its own) and goes on after the
 run; where not (the helper did not know yet what came before), it reads the lines itself.
 Every other line (a comment, a tool change, a mode) it reads itself, as before: commands,
@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from camtool.accel import later
-from camtool.accel.splitwrite import same
+from camtool.accel.later import same
 from camtool.importers.gcode_plain import _arc_move, _linear, _rapid
 from camtool.model.program import ArcMove, Linear
 from camtool.model.units import INCH

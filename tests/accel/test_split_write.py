@@ -12,7 +12,7 @@ from. These tests hold, with the split forced on small programs (:data:`MIN_MOVE
 - the refusals: a second part the helper cannot reach the state of (no feed in its
   stretch), a helper that fails, dies, or meets an error (the writer's own error, naming
   its block, as alone), a warning only the helper gave;
-- :func:`splitwrite.same`: floats bit for bit.
+- :func:`camtool.accel.later.same`: floats bit for bit.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from typing import Any
 
 import pytest
 
-from camtool.accel import splitwrite
+from camtool.accel import later, splitwrite
 from camtool.importers.gcode import parse_gcode
 from camtool.model.errors import DialectError
 from camtool.model.program import Linear, Move, Program, Rapid
@@ -213,7 +213,7 @@ def test_switched_off_nothing_is_split(monkeypatch: pytest.MonkeyPatch) -> None:
 
 
 def test_same_compares_floats_bit_for_bit() -> None:
-    same = splitwrite.same
+    same = later.same
     assert same({"here": (1.0, 2.0), "last": {"X": "1"}}, {"here": (1.0, 2.0), "last": {"X": "1"}})
     assert not same((0.0, 1.0), (-0.0, 1.0))
     assert not same(math.nan, math.nan)
