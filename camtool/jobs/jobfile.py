@@ -430,12 +430,20 @@ def _number(
     return number
 
 
+POSITIVE_MAX = 1e7
+"""The largest diameter, feed or speed a job file may give (in its unit): 10 km, 10⁷ mm/min
+or rev/min, far beyond any machine; a larger one is a typo."""
+
+
 def _positive(value: Any, source: str, where: str, unit: str) -> float | None:
     if value is None:
         return None
     number = _number(value, source, where)
-    if not 0 < number <= 1e7:
-        raise InputError(f"{source}: {where} = {number:g} {unit}; give a value > 0")
+    if not 0 < number <= POSITIVE_MAX:
+        raise InputError(
+            f"{source}: {where} = {number:g} {unit}; give a value > 0 and at most "
+            f"{POSITIVE_MAX:g}"
+        )
     return number
 
 

@@ -95,6 +95,10 @@ def test_auto_sequence_drills_first_and_cuts_the_outline_last(tmp_path: Path) ->
         (('side = "outside"', 'side = "outsid"'), r"did you mean 'outside'\?"),
         (("tool = 2", "tool = 7"), r"uses tool 7, which \[\[tools\]\] does not define"),
         (("diameter = 3.0", "diameter = -3.0"), r"tool 1 diameter = -3 mm"),
+        (
+            ("feed = 500", "feed = 1e308"),
+            r"feed = 1e\+308 mm/min; give a value > 0 and at most 1e\+07",
+        ),
         (("depth = 6.0", 'depth = "6"'), r"depth = '6'; give a number"),
         (("tabs = 3", "tabs = 3.5"), r"tabs = 3.5; give a whole number"),
         (("step_down = 2.0", "step_down = -2.0"), r"step_down must be > 0 mm"),
