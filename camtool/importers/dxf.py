@@ -179,7 +179,9 @@ def _import(
     doc, damage, repairs = _open(path)
     recovered = damage is not None
     warnings = [] if damage is None else [_damaged(path, damage, repairs)]
-    units, scale = _units(path, _insunits(path, doc, recovered), warnings, options.units)
+    units, scale = _units(
+        path, _insunits(path, doc, recovered), warnings, options.units, _imperial(doc)
+    )
     msp = doc.modelspace()
     if len(msp) == 0:
         _refuse_empty(path, doc, damage)
@@ -545,8 +547,25 @@ class _captured_log:
         self.logger.propagate = self.propagate
 
 
-def _units(path: Path, code: int, warnings: list[str], given: str | None) -> tuple[str, float]:
+def _imperial(doc: Any) -> bool:
+    """Whether the header says the drawing was made with imperial settings (``$MEASUREMENT = 0``).
+
+    ``$MEASUREMENT`` chooses the hatch and line-type files, not the unit of the
+    coordinates, so it is only a hint for a drawing without ``$INSUNITS``.
+    """
+    try:
+        return "$MEASUREMENT" in doc.header and int(doc.header["$MEASUREMENT"]) == 0
+    except (TypeError, ValueError):
+        return False
+
+
+def _units(
+    path: Path, code: int, warnings: list[str], given: str | None, imperial: bool = False
+) -> tuple[str, float]:
     """The drawing unit and its size in mm: the file's ``$INSUNITS``, else ``--units``.
+
+    ``imperial``: the header's ``$MEASUREMENT`` is 0 (:func:`_imperial`); the warning for
+    a drawing without units then says so, as the likeliest unit is the inch.
 
     Raises:
         InputError: an ``$INSUNITS`` camtool does not know.
@@ -555,9 +574,14 @@ def _units(path: Path, code: int, warnings: list[str], given: str | None) -> tup
     if code == 0:
         if given is not None:
             return given, LENGTH_UNITS[given]
+        hint = (
+            "; its $MEASUREMENT = 0 says it was made with imperial settings: give --units in "
+            "if it was drawn in inches"
+            if imperial
+            else " (give --units in, cm ... if it was drawn in another unit)"
+        )
         warnings.append(
-            f"{path}: drawing has no units ($INSUNITS = 0 or not in the file); assuming mm "
-            "(give --units in, cm ... if it was drawn in another unit)"
+            f"{path}: drawing has no units ($INSUNITS = 0 or not in the file); assuming mm" + hint
         )
         return "mm (assumed)", 1.0
     if code not in _INSUNITS_MM:

@@ -441,8 +441,7 @@ def _positive(value: Any, source: str, where: str, unit: str) -> float | None:
     number = _number(value, source, where)
     if not 0 < number <= POSITIVE_MAX:
         raise InputError(
-            f"{source}: {where} = {number:g} {unit}; give a value > 0 and at most "
-            f"{POSITIVE_MAX:g}"
+            f"{source}: {where} = {number:g} {unit}; give a value > 0 and at most {POSITIVE_MAX:g}"
         )
     return number
 

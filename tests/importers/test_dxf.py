@@ -96,6 +96,23 @@ def test_unitless_drawing_is_taken_as_mm_with_a_warning(tmp_path: Path) -> None:
     assert any("assuming mm" in w for w in d.warnings)
 
 
+@pytest.mark.parametrize("measurement", [0, 1])
+def test_a_unitless_drawing_with_imperial_settings_hints_at_inches(
+    tmp_path: Path, measurement: int
+) -> None:
+    """``$MEASUREMENT = 0`` (imperial) is named in the warning; the coordinates stay mm."""
+    import ezdxf
+
+    path = rectangle_dxf(tmp_path / "u.dxf", insunits=0)
+    doc = ezdxf.readfile(path)
+    doc.header["$MEASUREMENT"] = measurement
+    doc.saveas(path)
+    d = read_dxf(path)
+    assert d.bbox() == (1.0, 1.0, 11.0, 6.0)
+    (warning,) = [w for w in d.warnings if "assuming mm" in w]
+    assert ("$MEASUREMENT = 0" in warning and "--units in" in warning) == (measurement == 0)
+
+
 def test_other_entities_skipped_with_one_warning_per_type(tmp_path: Path) -> None:
     def build(msp: Any) -> None:
         msp.add_line((0, 0), (1, 0))
