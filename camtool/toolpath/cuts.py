@@ -72,6 +72,7 @@ FINDING_KINDS = (
     "offset-fallback",
     "offset-vanished",
     "self-crossing",
+    "overlap",
     "tight-corner",
     "uncut",
     "gouge",

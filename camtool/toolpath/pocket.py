@@ -28,7 +28,15 @@ from camtool.model.errors import InputError, ToolpathError, UsageError
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import TAU, Arc, Contour, Line, Point, Segment, distance
 from camtool.model.units import fmt_num
-from camtool.toolpath.cuts import Cut, Finding, Stage, open_left_out, self_crossing, where
+from camtool.toolpath.cuts import (
+    MAX_LISTED,
+    Cut,
+    Finding,
+    Stage,
+    open_left_out,
+    self_crossing,
+    where,
+)
 from camtool.toolpath.offset import offset_contour
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.order import Nesting
@@ -134,8 +142,73 @@ def pocket(
         *open_left_out(contours, "--offset pocket"),
         *(_no_area(contours[i]) for i in no_area),
         *filter(None, (self_crossing(contours[i], options.tolerance, "pocket") for i in invalid)),
+        *overlaps(contours, nest, options.tolerance),
     ]
     return Stage(tuple(cuts), tuple(findings))
+
+
+OVERLAP_MIN_MM2 = 1e-6
+"""Common area, mm², below which two pocket outlines only touch (a shared edge, rounding)."""
+
+
+def overlaps(contours: Sequence[Contour], nest: Nesting, tolerance: float) -> list[Finding]:
+    """``overlap`` findings: pairs of pocket outlines whose areas overlap, neither inside the other.
+
+    Each outline is cleared as a region of its own (:func:`regions`): the common area
+    twice, and a contour inside both is two outlines deep, so it is cleared as a
+    pocket of its own, not kept as an island. The drawing may mean either, so it is
+    said, with the common area (mm²) at a point inside it (shapely, GEOS). At most
+    :data:`~camtool.toolpath.cuts.MAX_LISTED` pairs are named, the rest counted.
+    """
+    outlines = [i for i, c in enumerate(contours) if c.closed and nest.depth(i) % 2 == 0]
+    if len(outlines) < 2:
+        return []
+    areas = [enclosed(contours[i].points(tolerance / 4)) for i in outlines]
+    left, right = shapely.STRtree(areas).query(areas, predicate="intersects")
+    found: list[tuple[int, int, BaseGeometry]] = []
+    for a, b in sorted((int(a), int(b)) for a, b in zip(left, right, strict=True) if a < b):
+        i, j = outlines[a], outlines[b]
+        if i in nest.parents[j] or j in nest.parents[i]:
+            continue  # one inside the other: an outline in a pocket's island, not an overlap
+        common = areas[a].intersection(areas[b])
+        if common.area > OVERLAP_MIN_MM2:
+            found.append((i, j, common))
+    out = [_overlap(contours, nest, i, j, common) for i, j, common in found[:MAX_LISTED]]
+    if len(found) > MAX_LISTED:
+        rest = found[MAX_LISTED:]
+        out.append(
+            Finding(
+                "overlap",
+                f"{len(rest)} more pairs of pocket outlines overlap, each outline cleared whole",
+                None,
+                float(sum(common.area for _i, _j, common in rest)),
+            )
+        )
+    return out
+
+
+def _overlap(
+    contours: Sequence[Contour], nest: Nesting, i: int, j: int, common: BaseGeometry
+) -> Finding:
+    """The ``overlap`` finding of pocket outlines ``i`` and ``j`` (:func:`overlaps`)."""
+    inside = sum(1 for parents in nest.parents if i in parents and j in parents)
+    spot = common.representative_point()
+    at = (float(spot.x), float(spot.y))
+    kept = (
+        f"; {inside} contour{'s' if inside > 1 else ''} inside both "
+        f"{'are' if inside > 1 else 'is'} cleared as a pocket, not kept as an island"
+        if inside
+        else ""
+    )
+    return Finding(
+        "overlap",
+        f"{where(contours[i])} and {where(contours[j])}: the pocket outlines overlap "
+        f"({fmt_num(common.area, 3)} mm² around ({at[0]:.4f}, {at[1]:.4f}) mm): each is "
+        f"cleared whole, the common area twice{kept}; draw one outline around an area meant "
+        "as one, or pocket them in operations of their own",
+        at,
+        float(common.area),
+    )
 
 
 def _nothing_message(contours: Sequence[Contour], options: PlanOptions) -> str:

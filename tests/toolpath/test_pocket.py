@@ -273,6 +273,46 @@ def test_island_inside_an_island_is_a_new_pocket() -> None:
     assert inner.difference(_shape(contours[2])).area < TOL * 40
 
 
+def test_overlapping_pocket_outlines_are_said_with_their_common_area() -> None:
+    """Two rectangles overlapping 20 × 30 mm and a circle inside both (analysis: 600 mm²)."""
+    contours = [rect(0, 0, 40, 30), rect(20, 0, 60, 30), circle(30, 15, 4)]
+    stage = _plan(contours)
+    (finding,) = [f for f in stage.findings if f.kind == "overlap"]
+    assert finding.value == pytest.approx(600.0, rel=1e-9)
+    assert finding.at is not None and 20 < finding.at[0] < 40 and 0 < finding.at[1] < 30
+    assert "1 contour inside both is cleared as a pocket, not kept as an island" in finding.message
+    assert "at (0.0000, 0.0000) mm and contour at (20.0000, 0.0000) mm" in finding.message
+    # each outline is cleared whole: both groups reach into the common area
+    common = rect(22, 2, 38, 28)
+    for group in (0, 1):
+        swept = _swept([c for c in stage.cuts if c.group == group], 1.0)
+        assert swept.intersection(_shape(common)).area > 0.9 * _shape(common).area
+
+
+@pytest.mark.parametrize(
+    "contours",
+    [
+        [rect(0, 0, 40, 30), rect(10, 5, 30, 25)],  # an island
+        [rect(0, 0, 20, 30), rect(20, 0, 40, 30)],  # a shared edge
+        [rect(0, 0, 20, 30), rect(30, 0, 40, 30)],  # apart
+        [rect(0, 0, 40, 30), rect(10, 5, 30, 25), rect(15, 10, 25, 20)],  # nested three deep
+    ],
+)
+def test_outlines_that_only_nest_or_touch_are_no_overlap(contours: list[Contour]) -> None:
+    assert not [f for f in _plan(contours).findings if f.kind == "overlap"]
+
+
+def test_many_overlaps_are_named_up_to_the_limit_then_counted() -> None:
+    from camtool.toolpath.cuts import MAX_LISTED
+
+    contours = [rect(10.0 * k, 0, 10.0 * k + 15, 10) for k in range(MAX_LISTED + 4)]
+    found = [f for f in _plan(contours).findings if f.kind == "overlap"]
+    assert len(found) == MAX_LISTED + 1
+    assert all(f.value == pytest.approx(50.0) for f in found[:MAX_LISTED])
+    assert found[-1].message.startswith("3 more pairs of pocket outlines overlap")
+    assert found[-1].value == pytest.approx(150.0)
+
+
 def test_open_contours_are_not_cut_by_a_pocket() -> None:
     line = Contour((Line((50, 0), (60, 0)),), False)
     stage = _plan([rect(0, 0, 20, 10), line])
