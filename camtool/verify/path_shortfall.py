@@ -409,11 +409,7 @@ class _Bounded:
         if float(np.max(reach)) < floor:
             return None
         a, b = self.places.a, self.places.b
-        ends = (
-            self.ends
-            if self.ends is not None
-            else nearest_search._LazyTree(nearest_search._end_points(a, b))
-        )
+        ends = self._ends()
         best: tuple[float, int] | None = None
         known = floor
         taken = _largest(reach, SHORTFALL_ROUND)
@@ -426,10 +422,15 @@ class _Bounded:
             if len(index) == 0:
                 break
             far, k = nearest_search.farthest_nearest(self.samples[index], a, b, ends=ends)
-            if best is None or far > best[0] or (far == best[0] and index[k] < best[1]):
-                best = (far, int(index[k]))
+            best = _better(best, far, int(index[k]))
             known = max(known, far)
         return best
+
+    def _ends(self) -> nearest_search._LazyTree:
+        """The search trees of the trace's segment ends: the shared ones, else new ones."""
+        if self.ends is not None:
+            return self.ends
+        return nearest_search._LazyTree(nearest_search._end_points(self.places.a, self.places.b))
 
     def _farthest_sorted(self, floor: float) -> tuple[float, int] | None:
         """:meth:`farthest` by one stable sort of the bounds (the reference; NaN bounds last)."""
@@ -438,11 +439,7 @@ class _Bounded:
         if reach[0] < floor:
             return None
         a, b = self.places.a, self.places.b
-        ends = (
-            self.ends
-            if self.ends is not None
-            else nearest_search._LazyTree(nearest_search._end_points(a, b))
-        )
+        ends = self._ends()
         best: tuple[float, int] | None = None
         known, at, size = floor, 0, SHORTFALL_ROUND
         while at < len(order):
@@ -452,11 +449,17 @@ class _Bounded:
                 break
             index = np.sort(order[at:stop])  # in sample order: the first of equal ones
             far, k = nearest_search.farthest_nearest(self.samples[index], a, b, ends=ends)
-            if best is None or far > best[0] or (far == best[0] and index[k] < best[1]):
-                best = (far, int(index[k]))
+            best = _better(best, far, int(index[k]))
             known = max(known, far)
             at, size = stop, len(order)
         return best
+
+
+def _better(best: tuple[float, int] | None, far: float, at: int) -> tuple[float, int]:
+    """The larger of ``best`` and ``(far, at)``; of equal distances, the first sample's."""
+    if best is None or far > best[0] or (far == best[0] and at < best[1]):
+        return far, at
+    return best
 
 
 def _largest(values: FloatArray, count: int) -> npt.NDArray[np.bool_]:

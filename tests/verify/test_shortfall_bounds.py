@@ -186,15 +186,20 @@ def test_move_spans_name_each_moves_last_row_in_the_thinned_trace(
     assert np.array_equal(thinned[last], run[keep])
 
 
+def _traced(name: str, seed: int) -> tuple[Program, np.ndarray, np.ndarray, list, dict]:
+    """:func:`_program` ``seed`` simulated on target ``name``: the program, its trace's
+    carriage and move offsets, its moves' starts and their nominal arrays."""
+    program = _program(seed)
+    trace = simulate_steps(program, load_target(name).machine)
+    starts = [program.origin] + [(m.x, m.y) for m in program.moves]
+    nominal = deviations.nominal_arrays(program)
+    return program, trace.carriage_mm, trace.block_start, starts, nominal
+
+
 @pytest.mark.parametrize("name", TARGETS)
 def test_a_bound_is_never_below_the_distance_to_the_whole_trace(name: str) -> None:
     """Each bound is a distance to one trace segment: at least the least over them all."""
-    machine = load_target(name).machine
-    program = _program(7)
-    trace = simulate_steps(program, machine)
-    points, block_start = trace.carriage_mm, trace.block_start
-    starts = [program.origin] + [(m.x, m.y) for m in program.moves]
-    nominal = deviations.nominal_arrays(program)
+    program, points, block_start, starts, nominal = _traced(name, 7)
     for first, last in contour_measures.contour_runs(program):
         lo, hi = int(block_start[first]), int(block_start[last + 1])
         run = np.vstack([points[lo - 1 : lo], points[lo:hi]])
@@ -223,23 +228,26 @@ def test_a_bound_is_never_below_the_distance_to_the_whole_trace(name: str) -> No
         assert name == "i8751" or excess < 1e-4
 
 
-@pytest.mark.parametrize("seed", range(6))
-def test_a_floor_leaves_out_only_samples_that_cannot_reach_it(seed: int) -> None:
-    """With a floor the answer is the same when the largest reaches it, else below it."""
-    machine = load_target(TARGETS[seed % len(TARGETS)]).machine
-    program = _program(seed)
-    trace = simulate_steps(program, machine)
-    points, block_start = trace.carriage_mm, trace.block_start
-    starts = [program.origin] + [(m.x, m.y) for m in program.moves]
-    nominal = deviations.nominal_arrays(program)
+def _first_contour_bounded(
+    seed: int,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, path_shortfall._Bounded]:
+    """The first contour of :func:`_program` ``seed`` on a target: samples, run, keep, bounds."""
+    program, points, block_start, starts, nominal = _traced(TARGETS[seed % len(TARGETS)], seed)
     first, last = contour_measures.contour_runs(program)[0]
     lo, hi = int(block_start[first]), int(block_start[last + 1])
     run = np.vstack([points[lo - 1 : lo] if lo else np.zeros((1, 2)), points[lo:hi]])
     samples, owner, t = path_shortfall._sample_moves(program, starts, first, last, 0.001)
     keep = block_start[first + 1 : last + 2] - lo
     part = {k: v[first : last + 1] for k, v in nominal.items()}
-    want = path_shortfall._farthest_from_trace(samples, path_shortfall._thinned(run, keep))
     bounded = path_shortfall._Bounded.of_run(samples, owner - first, t, run, keep, part)
+    return samples, run, keep, bounded
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_floor_leaves_out_only_samples_that_cannot_reach_it(seed: int) -> None:
+    """With a floor the answer is the same when the largest reaches it, else below it."""
+    samples, run, keep, bounded = _first_contour_bounded(seed)
+    want = path_shortfall._farthest_from_trace(samples, path_shortfall._thinned(run, keep))
     for floor in (0.0, want[0] / 2, want[0], math.nextafter(want[0], 1.0), 2 * want[0] + 1e-3):
         got = bounded.farthest(floor)
         if floor <= want[0]:
@@ -423,19 +431,7 @@ def test_the_rounds_by_partition_are_the_sorted_ones(seed: int) -> None:
         want = np.zeros(n, dtype=bool)
         want[np.argsort(-values, kind="stable")[:count]] = True
         assert np.array_equal(path_shortfall._largest(values, count), want)
-    machine = load_target(TARGETS[seed % len(TARGETS)]).machine
-    program = _program(seed)
-    trace = simulate_steps(program, machine)
-    points, block_start = trace.carriage_mm, trace.block_start
-    starts = [program.origin] + [(m.x, m.y) for m in program.moves]
-    nominal = deviations.nominal_arrays(program)
-    first, last = contour_measures.contour_runs(program)[0]
-    lo, hi = int(block_start[first]), int(block_start[last + 1])
-    run = np.vstack([points[lo - 1 : lo] if lo else np.zeros((1, 2)), points[lo:hi]])
-    samples, owner, t = path_shortfall._sample_moves(program, starts, first, last, 0.001)
-    keep = block_start[first + 1 : last + 2] - lo
-    part = {k: v[first : last + 1] for k, v in nominal.items()}
-    bounded = path_shortfall._Bounded.of_run(samples, owner - first, t, run, keep, part)
+    bounded = _first_contour_bounded(seed)[3]
     # bounds rounded to a coarse grid: many ties at the round's edge
     bounded.reach = np.round(bounded.reach, 4)
     far = bounded._farthest_sorted(0.0)
@@ -453,12 +449,7 @@ def test_the_compiled_window_bounds_are_numpys_bit_for_bit(name: str) -> None:
     """
     if dda.compiled() is None:
         pytest.skip("numba missing")
-    machine = load_target(name).machine
-    program = _program(3)
-    trace = simulate_steps(program, machine)
-    points, block_start = trace.carriage_mm, trace.block_start
-    starts = [program.origin] + [(m.x, m.y) for m in program.moves]
-    nominal = deviations.nominal_arrays(program)
+    program, points, block_start, starts, nominal = _traced(name, 3)
     rng = np.random.default_rng(len(name))
     for first, last in contour_measures.contour_runs(program):
         lo, hi = int(block_start[first]), int(block_start[last + 1])
