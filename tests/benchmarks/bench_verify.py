@@ -100,8 +100,8 @@ Reports byte-identical.
 
 Eleventh pass (26 Nov 2026, quiet): the last contour's k-d tree is built in a thread while
 its samples are bounded, the window bounds are compiled and the first round is taken by a
-partition. 13.2 M steps 1.32 → 1.06-1.14 s, 238 MB; after the start-up 0.040×, 0.052×,
-0.055× and 0.064× C in four runs (the start-up itself varies by 0.07 s). Reports
+partition. 13.2 M steps 1.32 → 1.01-1.14 s, 238 MB; after the start-up 0.040×, 0.052×,
+0.055×, 0.064× and 0.0498× C in five runs (the start-up itself varies by 0.1 s). Reports
 byte-identical (docs/performance.md).
 """
 
