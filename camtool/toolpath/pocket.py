@@ -128,7 +128,8 @@ def pocket(
     findings: list[Finding] = []
     no_area: list[int] = []
     invalid: list[int] = []
-    todo = regions(contours, nest, options.tolerance, no_area, invalid)
+    outlines: dict[int, BaseGeometry] = {}
+    todo = regions(contours, nest, options.tolerance, no_area, invalid, outlines)
     _check_work(todo, options)
     progress(Step("pocketing", 0, len(todo)))
     for done, region in enumerate(todo, start=1):
@@ -142,7 +143,7 @@ def pocket(
         *open_left_out(contours, "--offset pocket"),
         *(_no_area(contours[i]) for i in no_area),
         *filter(None, (self_crossing(contours[i], options.tolerance, "pocket") for i in invalid)),
-        *overlaps(contours, nest, options.tolerance),
+        *overlaps(contours, nest, outlines),
     ]
     return Stage(tuple(cuts), tuple(findings))
 
@@ -151,7 +152,9 @@ OVERLAP_MIN_MM2 = 1e-6
 """Common area, mm², below which two pocket outlines only touch (a shared edge, rounding)."""
 
 
-def overlaps(contours: Sequence[Contour], nest: Nesting, tolerance: float) -> list[Finding]:
+def overlaps(
+    contours: Sequence[Contour], nest: Nesting, outlines: dict[int, BaseGeometry]
+) -> list[Finding]:
     """``overlap`` findings: pairs of pocket outlines whose areas overlap, neither inside the other.
 
     Each outline is cleared as a region of its own (:func:`regions`): the common area
@@ -159,15 +162,16 @@ def overlaps(contours: Sequence[Contour], nest: Nesting, tolerance: float) -> li
     pocket of its own, not kept as an island. The drawing may mean either, so it is
     said, with the common area (mm²) at a point inside it (shapely, GEOS). At most
     :data:`~camtool.toolpath.cuts.MAX_LISTED` pairs are named, the rest counted.
+
+    ``outlines``: each pocket outline's index and the area it encloses (:func:`regions`).
     """
-    outlines = [i for i, c in enumerate(contours) if c.closed and nest.depth(i) % 2 == 0]
     if len(outlines) < 2:
         return []
-    areas = [enclosed(contours[i].points(tolerance / 4)) for i in outlines]
+    indices, areas = list(outlines), list(outlines.values())
     left, right = shapely.STRtree(areas).query(areas, predicate="intersects")
     found: list[tuple[int, int, BaseGeometry]] = []
     for a, b in sorted((int(a), int(b)) for a, b in zip(left, right, strict=True) if a < b):
-        i, j = outlines[a], outlines[b]
+        i, j = indices[a], indices[b]
         if i in nest.parents[j] or j in nest.parents[i]:
             continue  # one inside the other: an outline in a pocket's island, not an overlap
         common = areas[a].intersection(areas[b])
@@ -226,6 +230,7 @@ def regions(
     tolerance: float,
     no_area: list[int] | None = None,
     invalid: list[int] | None = None,
+    outlines: dict[int, BaseGeometry] | None = None,
 ) -> list[Region]:
     """The even-odd regions to clear, one per connected piece of each pocket.
 
@@ -237,6 +242,8 @@ def regions(
             there and back) are appended to it: they give no region.
         invalid: given, the indices of the pocket outlines that are no valid polygon (one
             that crosses itself: its region is the area it encloses) are appended to it.
+        outlines: given, each pocket outline's index is mapped in it to the area it
+            encloses, before its islands are taken out (:func:`overlaps` compares them).
     """
     out: list[Region] = []
     for i, contour in enumerate(contours):
@@ -251,6 +258,8 @@ def regions(
         if invalid is not None and not Polygon(outline).is_valid:
             invalid.append(i)
         area: BaseGeometry = enclosed(outline)
+        if outlines is not None:
+            outlines[i] = area
         if area.is_empty and no_area is not None:
             no_area.append(i)
         for island in islands:
