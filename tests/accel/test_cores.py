@@ -358,7 +358,7 @@ def test_a_record_not_there_by_the_deadline_is_none() -> None:
     try:
         t0 = time.monotonic()
         assert cores.read_record(read, time.monotonic() + 0.2) is None  # nothing came
-        assert 0.2 <= time.monotonic() - t0 < 5.0
+        assert time.monotonic() - t0 >= 0.2  # it waited until the deadline
         cores.write_record(write, b"answer")
         assert cores.read_record(read, time.monotonic() + 5.0) == b"answer"
         os.write(write, (6).to_bytes(8, "little") + b"ans")  # cut short: the rest never comes
@@ -369,9 +369,9 @@ def test_a_record_not_there_by_the_deadline_is_none() -> None:
 
 
 def test_patience_grows_with_the_work_done_since_the_fork(monkeypatch: pytest.MonkeyPatch) -> None:
-    import time
+    from types import SimpleNamespace
 
-    now = time.monotonic()
-    assert cores.patience(now) - now >= cores.HELPER_PATIENCE_MIN_S
-    long_ago = now - 100.0
-    assert cores.patience(long_ago) - time.monotonic() >= cores.HELPER_PATIENCE * 100.0 - 1.0
+    monkeypatch.setattr(cores, "time", SimpleNamespace(monotonic=lambda: 1000.0))
+    assert cores.patience(1000.0) == 1000.0 + cores.HELPER_PATIENCE_MIN_S  # just forked
+    assert cores.patience(1000.0 - 1.0) == 1000.0 + cores.HELPER_PATIENCE_MIN_S
+    assert cores.patience(1000.0 - 100.0) == 1000.0 + cores.HELPER_PATIENCE * 100.0
