@@ -85,24 +85,28 @@ def warn(messages: tuple[str, ...] | list[str]) -> None:
 
 P = ParamSpec("P")
 R = TypeVar("R")
-_STAGED: ContextVar[tuple[Staged, list[str | bytes]] | None] = ContextVar("staged", default=None)
+_STAGED: ContextVar[tuple[Staged, list[str | bytes], list[str]] | None] = ContextVar(
+    "staged", default=None
+)
 
 
 def publishes(command: Callable[P, R]) -> Callable[P, R]:
     """Run ``command`` with its outputs published together, at its end, or not at all.
 
     Inside, :func:`write_output` stages each file (:class:`camtool.jobs.output.Staged`)
-    and keeps what goes to stdout; when the command returns, every file is renamed
-    into place and stdout written. When it raises (a report that cannot be written,
-    a verification over its limit is not an error of writing: the limit check runs
-    after), the temporaries are removed and nothing of the run is published.
+    and keeps what goes to stdout, and :func:`say_written` keeps its lines; when the
+    command returns, every file is renamed into place, stdout written, then the lines
+    said (a file that cannot be placed is never reported as written). When it raises (a
+    report that cannot be written; a verification over its limit is not an error of
+    writing: the limit check runs after), the temporaries are removed and nothing of the
+    run is published.
     """
 
     @functools.wraps(command)
     def run(*args: P.args, **kwargs: P.kwargs) -> R:
         from camtool.jobs.output import Staged
 
-        staged: tuple[Staged, list[str | bytes]] = (Staged(), [])
+        staged: tuple[Staged, list[str | bytes], list[str]] = (Staged(), [], [])
         token = _STAGED.set(staged)
         try:
             result = command(*args, **kwargs)
@@ -120,10 +124,25 @@ def publishes(command: Callable[P, R]) -> Callable[P, R]:
     return run
 
 
-def _publish(files: Staged, stdout: list[str | bytes]) -> None:
+def _publish(files: Staged, stdout: list[str | bytes], said: list[str]) -> None:
     files.publish()
     for data in stdout:
         _write_stdout(data)
+    for line in said:
+        click.echo(line, err=True)
+
+
+def say_written(line: str) -> None:
+    """Say ``line`` (``camtool: wrote …``) on stderr once the outputs are in place.
+
+    Inside a command run by :func:`publishes`, after its files are published (not at
+    all when that fails); elsewhere, now.
+    """
+    staged = _STAGED.get()
+    if staged is None:
+        click.echo(line, err=True)
+    else:
+        staged[2].append(line)
 
 
 def write_output(data: str | bytes, out: str) -> None:

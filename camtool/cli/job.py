@@ -12,6 +12,7 @@ from camtool.cli.common import (
     import_options,
     import_settings,
     number_range,
+    say_written,
     write_output,
 )
 
@@ -88,8 +89,7 @@ def init(
     write_output(text, output)
     if output != "-":
         count = sum(line.startswith("[[operations]]") for line in text.splitlines())
-        click.echo(
+        say_written(
             f"camtool: wrote a job of {count} operation(s) to {output}; read it, then: "
-            f"camtool post {drawing} -t TARGET --job {output}",
-            err=True,
+            f"camtool post {drawing} -t TARGET --job {output}"
         )

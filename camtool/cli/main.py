@@ -29,6 +29,7 @@ from camtool.cli.common import (
     post_options,
     publishes,
     read_job,
+    say_written,
     warn,
     write_output,
 )
@@ -130,10 +131,11 @@ def post(
     no_budget: bool,
     **options: Any,
 ) -> None:
-    """Import DRAWING (a .dxf file, or '-' for stdin), plan it, write it for a target.
+    """Import DRAWING (.dxf, .svg, a point list), plan it, write it for a target.
 
     DRAWING may also be an existing G-code program (.ngc, .nc, .gcode, .tap ...):
     it is already a toolpath, so it is re-posted as it is, only --feed applies.
+    '-' reads stdin, a drawing or a program told by its content.
 
     With --verify (implied by --report, --preview or --max-error-um) the written
     code is read back and simulated on the target's machine, as `verify` does.
@@ -141,15 +143,13 @@ def post(
     A job still running after 2 s says on stderr what it is doing, a line per stage.
     """
     from camtool.cli.progress import StageReporter
-    from camtool.jobs.inputs import is_program_file, read_input
+    from camtool.jobs.inputs import STDIN, is_program_file, stdin_kind
     from camtool.jobs.output import check_paths
     from camtool.jobs.pipeline import (
         load_target_checked,
-        post_drawing,
+        post_bytes,
         post_path,
         refuse_planning,
-        sized,
-        travel_check,
         verify_job,
     )
     from camtool.model.progress import Step
@@ -176,17 +176,17 @@ def post(
     progress = click.get_current_context().with_resource(StageReporter())
     try:
         if drawing == "-":
-            shared = plan if job_spec is None else job_spec.setup.plan
-            check = travel_check(plan, chosen) if job_spec is None else None
-            drawn = read_input(drawing, sized(settings, shared), check)
-            job = post_drawing(
-                drawn,
+            data = sys.stdin.buffer.read()
+            job = post_bytes(
+                data,
+                STDIN,
                 chosen,
                 plan,
                 output_options,
-                progress=progress,
-                layers=settings.layers,
+                import_options=settings,
                 job=job_spec,
+                kind=stdin_kind(data),
+                progress=progress,
             )
         else:
             job = post_path(
@@ -215,9 +215,7 @@ def post(
     else:
         write_output(job.result.code, output)
     if output != "-" and not job.pieces:
-        click.echo(
-            f"camtool: wrote {job.result.blocks} blocks for {chosen.name} to {output}", err=True
-        )
+        say_written(f"camtool: wrote {job.result.blocks} blocks for {chosen.name} to {output}")
     if verifying:
         progress(Step("verifying", 0, job.result.blocks, chosen.name))
         load_picture()  # matplotlib, on the core the verification's start leaves idle
@@ -389,10 +387,7 @@ def _write_pieces(job: PostJob, output: str, inputs: list[tuple[str, Any]]) -> N
     order = ", then ".join(
         f"{p} (T{piece.change.tool})" for piece, p in zip(job.pieces, paths, strict=True)
     )
-    click.echo(
-        f"camtool: {name} cannot change tools: wrote one program per tool, run {order}",
-        err=True,
-    )
+    say_written(f"camtool: {name} cannot change tools: wrote one program per tool, run {order}")
 
 
 def _check_preview(preview: str | None) -> None:
@@ -492,14 +487,27 @@ def inspect(drawing: str, as_json: bool, chain_tolerance: float, **options: Any)
     gaps just above the chaining tolerance, with their locations. Ends are chained
     as ``camtool post`` chains them (same --chain-tolerance).
     """
+    import tempfile
+
     from camtool.importers.lint import inspect_drawing
+    from camtool.jobs.inputs import STDIN, drawing_kind
+    from camtool.model.errors import InputError
 
     settings = import_settings(options)
-    report = inspect_drawing(drawing, settings, chain_tolerance=chain_tolerance)
-    if as_json:
-        click.echo(json.dumps(report.to_json(), indent=2))
-    else:
-        click.echo(report.text(), nl=False)
+    if drawing != "-":
+        report = inspect_drawing(drawing, settings, chain_tolerance=chain_tolerance)
+        click.echo(json.dumps(report.to_json(), indent=2) if as_json else report.text(), nl=as_json)
+        return
+    data = sys.stdin.buffer.read()
+    with tempfile.TemporaryDirectory(prefix="camtool-") as tmp:
+        path = Path(tmp) / f"stdin{drawing_kind(data)}"  # the importers read files
+        path.write_bytes(data)
+        try:
+            report = inspect_drawing(path, settings, chain_tolerance=chain_tolerance)
+        except InputError as exc:
+            raise InputError(str(exc).replace(str(path), STDIN)) from exc
+        text = json.dumps(report.to_json(), indent=2) if as_json else report.text()
+        click.echo(text.replace(str(path), STDIN).replace(path.name, STDIN), nl=as_json)
 
 
 @cli.command()

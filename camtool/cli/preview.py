@@ -22,6 +22,7 @@ from camtool.cli.common import (
     number_range,
     picture_ahead,
     publishes,
+    say_written,
     warn,
     write_output,
 )
@@ -122,7 +123,7 @@ def preview(
     progress.close()
     write_output(data, out)
     if out != "-":
-        click.echo(f"camtool: wrote preview {out}", err=True)
+        say_written(f"camtool: wrote preview {out}")
 
 
 def _target(name: str | None, machine_file: Path | None) -> Target | None:

@@ -42,22 +42,102 @@ def is_program_file(name: str | Path) -> bool:
     return Path(name).suffix.lower() in PROGRAM_SUFFIXES
 
 
+STDIN = "<stdin>"
+"""The name messages give standard input."""
+
+_SNIFF_BYTES = 1 << 16
+"""How much of standard input :func:`stdin_kind` looks at."""
+_DXF_CODES = ("0", "999")
+_GCODE_WORD = re.compile(r"/?\s*(?:[A-Za-z]\s*[-+]?\s*[\d.#\[<]|#\s*[\d<])")
+"""The start of a G-code block: a word (``G0``, ``X-1.5``, ``F#1``, ``o<sub>``), a parameter
+(``#1=``, ``#<x>=``), after an optional block delete ``/``."""
+_MATLAB = re.compile(r"[A-Za-z_]\w*\s*=")
+_POINT_ROW = re.compile(r"[-+.\d]")
+_HEADER = re.compile(r"[A-Za-z_]\w*(?:[\s,;]+[A-Za-z_]\w*)*")
+"""A point list's header row: words (``x,y,z``)."""
+
+
+def stdin_kind(data: bytes) -> str:
+    """The kind of the file piped on standard input, as the ending such a file has.
+
+    ``.dxf`` (ASCII: group code 0 then ``SECTION``, or a 999 comment first; binary: its
+    sentinel), ``.svg`` (XML: the first character ``<``), ``.nc`` (a G-code program: its
+    first line that is not a comment, ``(…)``, ``;…`` or ``%``, starts with a word or a
+    parameter; or comments only), ``.m`` (a Matlab assignment, ``xy = [...]``), ``.csv``
+    (a point list: a number first, a ``#`` comment, or a header of words then a row of
+    numbers). Only the first 64 KiB are looked at.
+
+    Raises:
+        InputError: empty, or none of these (the message quotes the first line).
+    """
+    if data.startswith(b"AutoCAD Binary DXF"):
+        return ".dxf"
+    text = data[:_SNIFF_BYTES].decode("utf-8", errors="replace").lstrip("\ufeff \t\r\n")
+    if not text:
+        raise InputError(f"{STDIN}: empty input; pipe a drawing or a program into camtool")
+    if text.startswith("<"):
+        return ".svg"
+    lines = [line.strip() for line in text.splitlines() if line.strip()]
+    if lines[0] in _DXF_CODES and (lines[0] == "999" or lines[1:2] == ["SECTION"]):
+        return ".dxf"
+    for at, line in enumerate(lines):
+        if line[0] in "(;%":
+            continue  # a G-code comment or the tape mark
+        if _GCODE_WORD.match(line):
+            return PROGRAM_SUFFIXES[1]
+        if _MATLAB.match(line):
+            return ".m"
+        if _POINT_ROW.match(line) or line.startswith("#"):
+            return ".csv"
+        if _HEADER.fullmatch(line) and _POINT_ROW.match(
+            lines[at + 1] if at + 1 < len(lines) else ""
+        ):
+            return ".csv"
+        break
+    else:  # comments only: a program (that moves nowhere, which its reader says)
+        return PROGRAM_SUFFIXES[1]
+    raise InputError(
+        f"{STDIN}: cannot tell what it holds (it starts {lines[0][:40]!r}); camtool reads a "
+        "DXF, an SVG, a point list or a G-code program from stdin: save it to a file with "
+        "its ending (.dxf, .svg, .csv, .nc) and give that file"
+    )
+
+
 def read_input(
     name: str,
     settings: ImportOptions | None = None,
     check: Callable[[BBox], None] | None = None,
 ) -> Drawing:
-    """The drawing at ``name`` (``-``: stdin), read by its ending.
+    """The drawing at ``name`` read by its ending (``-``: stdin, read by its kind).
 
     ``check``: as for :func:`camtool.importers.read_drawing`.
 
     Raises:
-        InputError: the drawing cannot be read (see :mod:`camtool.importers`).
+        InputError: the drawing cannot be read (see :mod:`camtool.importers`); stdin holds
+            a program or cannot be told (:func:`stdin_kind`).
         Whatever ``check`` raises.
     """
     if name == "-":
-        return read_drawing_bytes(sys.stdin.buffer.read(), options=settings, check=check)
+        data = sys.stdin.buffer.read()
+        return read_drawing_bytes(
+            data, name=STDIN, suffix=drawing_kind(data), options=settings, check=check
+        )
     return read_drawing(name, settings, check=check)
+
+
+def drawing_kind(data: bytes) -> str:
+    """:func:`stdin_kind` of a drawing.
+
+    Raises:
+        InputError: as :func:`stdin_kind`, or the input is a G-code program.
+    """
+    kind = stdin_kind(data)
+    if kind in PROGRAM_SUFFIXES:
+        raise InputError(
+            f"{STDIN}: holds a G-code program, not a drawing; this needs a drawing "
+            "(DXF, SVG or a point list)"
+        )
+    return kind
 
 
 def read_code(name: str, *, binary: bool = False) -> str | bytes:

@@ -191,12 +191,15 @@ def post_bytes(
     *,
     import_options: ImportOptions | None = None,
     job: Job | None = None,
+    kind: str | None = None,
+    progress: Progress = no_progress,
 ) -> PostJob:
     """Post a file given as its bytes, as :func:`post_path` posts the file ``name``.
 
-    For a process that does not share the file's disk (a batch's Dask worker): the
-    kind is chosen by ``name``'s ending, and messages, warnings and the program's
-    notes name ``name``, so the job is the one :func:`post_path` makes from the file.
+    For a process that does not share the file's disk (a batch's Dask worker), and for
+    standard input: the kind is chosen by ``name``'s ending (or ``kind``, an ending such
+    as ``.svg``), and messages, warnings and the program's notes name ``name``, so the
+    job is the one :func:`post_path` makes from the file.
 
     Args:
         data: the file's bytes.
@@ -206,23 +209,29 @@ def post_bytes(
         output: how the program is written (``None``: the defaults).
         import_options: how the drawing is read (layers, units…).
         job: the operations and tools to run (``None``: ``plan`` is the one operation).
+        kind: the file's ending when ``name`` has none (``<stdin>``).
+        progress: told the stages, as by :func:`post_path`.
 
     Raises:
         UsageError: a planning option given for a program (see :func:`post_path`).
         CamtoolError: from any stage, with its exit code.
     """
     plan = plan if plan is not None else PlanOptions()
-    if not is_program_file(name):
-        suffix = Path(name).suffix
+    suffix = kind if kind is not None else Path(name).suffix
+    if not is_program_file(f"x{suffix}"):
         shared = plan if job is None else job.setup.plan
         options = sized(import_options, shared)
         check = travel_check(plan, target) if job is None else None
+        progress(Step("reading", name=name))
         drawing = read_drawing_bytes(data, name=name, suffix=suffix, options=options, check=check)
         layers = import_options.layers if import_options is not None else None
-        return post_drawing(drawing, target, plan, output, layers=layers, job=job)
+        return post_drawing(
+            drawing, target, plan, output, progress=progress, layers=layers, job=job
+        )
     refuse_planning(name, drawing_only(plan.given()) + (["--job"] if job is not None else []))
     from camtool.importers.gcode import read_gcode_bytes
 
+    progress(Step("reading", name=name))
     return post_program(
         read_gcode_bytes(data, source=name, reading=reading_for(target, plan)),
         target,
@@ -230,6 +239,7 @@ def post_bytes(
         feed_mm_min=plan.feed_mm_min,
         tolerance_mm=plan.tolerance,
         source=name,
+        progress=progress,
     )
 
 
@@ -289,8 +299,9 @@ def refuse_planning(path: str | Path, given: list[str]) -> None:
     """
     if given:
         raise UsageError(
-            f"{path} is already a toolpath (G-code): {', '.join(given)} only apply to "
-            "drawings; plan it in the program that wrote it"
+            f"{path} is already a toolpath (G-code): {', '.join(given)} "
+            f"{'only applies' if len(given) == 1 else 'only apply'} to drawings; plan it in "
+            "the program that wrote it"
         )
 
 

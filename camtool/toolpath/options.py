@@ -374,10 +374,12 @@ class PlanOptions:
             )
         pocket_only = self._changed("stepover", "pocket", "pocket_angle_deg")
         if self.offset != "pocket" and pocket_only:
-            notes.append(f"{', '.join(pocket_only)} only apply to --offset pocket: no effect here")
+            verb = "only applies" if len(pocket_only) == 1 else "only apply"
+            notes.append(f"{', '.join(pocket_only)} {verb} to --offset pocket: no effect here")
         tab_only = self._changed("tab_width", "tab_height")
         if self.tabs == 0 and tab_only:
-            notes.append(f"{', '.join(tab_only)} have no effect without --tabs N")
+            verb = "has" if len(tab_only) == 1 else "have"
+            notes.append(f"{', '.join(tab_only)} {verb} no effect without --tabs N")
         return [Finding("option", note) for note in notes]
 
     def _changed(self, *names: str) -> list[str]:

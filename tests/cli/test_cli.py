@@ -124,7 +124,7 @@ def test_garbage_on_stdin_is_named(capsys: pytest.CaptureFixture[str]) -> None:
         check=False,
     )
     assert proc.returncode == 3
-    assert b"<stdin>: not a readable DXF" in proc.stderr and b"Traceback" not in proc.stderr
+    assert b"<stdin>: cannot tell what it holds" in proc.stderr and b"Traceback" not in proc.stderr
 
 
 def test_fit_brings_a_large_drawing_into_the_work_area(

@@ -66,7 +66,7 @@ def test_a_job_for_a_program_is_refused(run: Any, tmp_path: Path) -> None:
     program = tmp_path / "p.ngc"
     program.write_text("G21 G90\nG0 X0 Y0\nG1 X1 F100\nM2\n")
     code, _, err = run("post", str(program), "-t", "grbl", "--job", JOB)
-    assert code == 2 and "--job only apply to drawings" in err
+    assert code == 2 and "--job only applies to drawings" in err
 
 
 def test_the_job_file_is_an_input_never_overwritten(run: Any, tmp_path: Path) -> None:
