@@ -8,6 +8,7 @@ from __future__ import annotations
 import itertools
 import sys
 from collections.abc import Callable
+from dataclasses import dataclass
 from types import ModuleType
 from typing import Any
 
@@ -140,6 +141,56 @@ NEARBY_MAX_PAIRS = 4_000_000
 """Most (sample, segment) pairs :func:`_nearby_exact` measures; beyond it :func:`_all_exact`."""
 
 
+@dataclass(frozen=True)
+class LongSegments:
+    """The few segments of a trace much longer than the rest, searched apart.
+
+    :func:`_nearby_exact` takes a sample's segments from the ends within ``upper + half``
+    of it, ``half`` half the longest segment: on a trace of 0.9 µm steps with a few
+    18 µm jumps (a backlash take-up, a budget's trace without interpolation), 40 ends a
+    sample where 4 would do. With these, the other segments are searched within
+    ``upper + short_half`` and only these within ``upper + half``.
+
+    Attributes:
+        short_half: half the longest of the other segments, mm.
+        index: ``(L,)`` the long segments' numbers.
+        tree: scipy's k-d tree of their ends, ``concatenate([a[index], b[index]])``.
+    """
+
+    short_half: float
+    index: IntArray
+    tree: Any
+
+
+LONG_SEGMENTS_FEW = 64
+"""At most this many segments, or one in :data:`LONG_SEGMENTS_PER`, are searched apart."""
+LONG_SEGMENTS_PER = 1000
+LONG_SEGMENTS_GAIN = 4.0
+"""Segments are searched apart only where the others' half is this many times smaller."""
+
+
+def long_segments(a: FloatArray, b: FloatArray, half: float) -> LongSegments | None:
+    """The segments ``a → b`` to search apart (:class:`LongSegments`), or ``None``.
+
+    The longest :data:`LONG_SEGMENTS_FEW` (or one in :data:`LONG_SEGMENTS_PER`) and any
+    as long as the longest of them, where the rest are at most ``half / GAIN`` long
+    (``half``: half the longest segment, mm). Lengths as ``half`` is computed, so every
+    other segment is at most ``2 · short_half`` long.
+    """
+    n = len(a)
+    few = max(LONG_SEGMENTS_FEW, n // LONG_SEGMENTS_PER)
+    if n <= few:
+        return None
+    lengths = np.hypot(*(b - a).T)
+    cut = float(np.partition(lengths, n - few - 1)[n - few - 1])
+    if cut / 2.0 * LONG_SEGMENTS_GAIN > half:
+        return None
+    from scipy.spatial import cKDTree
+
+    index = np.flatnonzero(lengths > cut).astype(np.int64)
+    return LongSegments(cut / 2.0, index, cKDTree(np.concatenate([a[index], b[index]])))
+
+
 def _nearby_exact(
     samples: FloatArray,
     upper: FloatArray,
@@ -148,6 +199,7 @@ def _nearby_exact(
     ends: Any,
     half: float,
     need: npt.NDArray[np.bool_] | None = None,
+    long: LongSegments | None = None,
 ) -> FloatArray | None:
     """:func:`_all_exact` over only the segments that can be the nearest, or ``None``.
 
@@ -168,19 +220,82 @@ def _nearby_exact(
         need: ``(U,)`` the samples to measure (``None``: all); the others keep ``upper``.
             The limit counts the pairs of all samples, so which of the two ways gives a
             sample's distance does not depend on ``need``.
+        long: the long segments (:func:`long_segments`): the ends of ``ends`` are then
+            searched within ``upper + long.short_half``, the long segments' within
+            ``upper + half``; every segment within ``upper`` is still among them, so the
+            minimum is the same. The limit still counts the pairs within ``upper + half``:
+            over it, :func:`_all_exact` answers, whose GEOS nearest query can differ from
+            the least GEOS distance in the last bit where segments tie, so the choice
+            between the two ways must not depend on ``long``.
     """
-    reach = (upper + half) * (1.0 + 1e-9) + 1e-12  # a float margin: never leaves one out
+    margin = 1.0 + 1e-9  # and 1e-12 mm: a float margin, never leaves one out
+    reach = (upper + half) * margin + 1e-12
     counts = _counts_within(ends, samples, reach)
-    if counts is None:
+    if counts is None:  # the limit counts these pairs, with or without ``long``: see above
         return None
-    if counts.min() == 0:
+    sources = [_Reach(ends, reach, counts, None)]
+    if long is not None:
+        reach = (upper + long.short_half) * margin + 1e-12
+        sources = [_Reach(ends, reach, _count_all(ends, samples, reach), None)]
+        reach = (upper + half) * margin + 1e-12
+        sources.append(_Reach(long.tree, reach, _count_all(long.tree, samples, reach), long.index))
+    total = np.sum([s.counts for s in sources], axis=0)
+    if total.min() == 0:
         return None  # cannot happen (the segment of ``upper`` is within reach): be safe
     if need is not None:
         out = upper.copy()
         if need.any():
-            out[need] = _nearby_pairs(samples[need], reach[need], counts[need], a, b, ends)
+            out[need] = _nearby_pairs(samples[need], [s.where(need) for s in sources], a, b)
         return out
-    return _nearby_pairs(samples, reach, counts, a, b, ends)
+    return _nearby_pairs(samples, sources, a, b)
+
+
+@dataclass(frozen=True)
+class _Reach:
+    """Ends of one k-d tree within ``reach`` of each sample (``counts`` of them).
+
+    ``index``: the segment of each of the tree's ends, ``index[end % len(index)]``
+    (``None``: ``end % len(a)``, the tree of every segment's ends).
+    """
+
+    tree: Any
+    reach: FloatArray
+    counts: IntArray
+    index: IntArray | None
+
+    def where(self, keep: npt.NDArray[np.bool_]) -> _Reach:
+        """The same for the samples ``keep`` names."""
+        return _Reach(self.tree, self.reach[keep], self.counts[keep], self.index)
+
+    def pairs(self, samples: FloatArray, lo: int, hi: int, m: int) -> tuple[IntArray, IntArray]:
+        """``(owner, segment)`` of samples ``lo:hi`` (owner from 0), sample-major.
+
+        Every end within reach of each sample, and where it is cheaper, a few more: the
+        ``k`` nearest ends of each (``k`` the most any of them has within reach), which
+        hold every end within its reach (one left out would have ``k`` ends nearer, so
+        more than ``k`` within reach). More segments give the same minimum.
+        """
+        counts = self.counts[lo:hi]
+        rows = np.flatnonzero(counts)  # the samples with an end within reach
+        if len(rows) == 0:
+            return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+        counts = counts[rows]
+        total, k = int(np.sum(counts)), int(np.max(counts))
+        at = samples[lo:hi][rows]
+        if k * len(rows) <= 2 * total + KNN_SLACK_PAIRS:  # arrays, not a list per sample
+            got = self.tree.query(at, k=k, workers=KD_WORKERS)[1]
+            end = np.asarray(got, dtype=np.int64).reshape(-1)
+            owner = np.repeat(rows, k)
+        else:
+            found = self.tree.query_ball_point(at, self.reach[lo:hi][rows], workers=KD_WORKERS)
+            owner = np.repeat(rows, counts)
+            end = np.fromiter(itertools.chain.from_iterable(found), dtype=np.int64, count=total)
+        seg = end % m if self.index is None else self.index[end % len(self.index)]
+        return owner, seg
+
+
+KNN_SLACK_PAIRS = 1024
+"""Pairs :meth:`_Reach.pairs` may add to a chunk's to ask the k nearest ends instead of lists."""
 
 
 def _counts_within(ends: Any, samples: FloatArray, reach: FloatArray) -> IntArray | None:
@@ -204,28 +319,45 @@ def _counts_within(ends: Any, samples: FloatArray, reach: FloatArray) -> IntArra
     return np.concatenate(parts) if parts else np.zeros(0, dtype=np.int64)
 
 
+def _count_all(ends: Any, samples: FloatArray, reach: FloatArray) -> IntArray:
+    """How many ends lie within ``reach`` of each sample (:func:`_counts_within`, no limit)."""
+    parts = [
+        np.asarray(
+            ends.query_ball_point(
+                samples[lo : lo + NEARBY_COUNT_CHUNK],
+                reach[lo : lo + NEARBY_COUNT_CHUNK],
+                return_length=True,
+                workers=KD_WORKERS,
+            ),
+            dtype=np.int64,
+        )
+        for lo in range(0, len(samples), NEARBY_COUNT_CHUNK)
+    ]
+    return np.concatenate(parts) if parts else np.zeros(0, dtype=np.int64)
+
+
 NEARBY_COUNT_CHUNK = 1 << 16
 """Samples :func:`_counts_within` counts at once (memory, and an early end over the limit)."""
 
 
 def _nearby_pairs(
-    samples: FloatArray,
-    reach: FloatArray,
-    counts: IntArray,
-    a: FloatArray,
-    b: FloatArray,
-    ends: Any,
+    samples: FloatArray, sources: list[_Reach], a: FloatArray, b: FloatArray
 ) -> FloatArray:
-    """:func:`_nearby_exact`'s GEOS minimum over the ends within ``reach`` (``counts`` of them)."""
+    """:func:`_nearby_exact`'s GEOS minimum over the ends each source finds within reach."""
     out = np.empty(len(samples), dtype=np.float64)
+    counts = np.sum([s.counts for s in sources], axis=0)
     ends_before = np.concatenate([[0], np.cumsum(counts)])
     lo = 0
     while lo < len(samples):  # a few samples at a time: their lists of ends are Python ints
         hi = int(np.searchsorted(ends_before, ends_before[lo] + NEARBY_CHUNK_PAIRS, "right")) - 1
         hi = min(max(hi, lo + 1), len(samples))
-        found = ends.query_ball_point(samples[lo:hi], reach[lo:hi], workers=KD_WORKERS)
-        owner = np.repeat(np.arange(hi - lo), counts[lo:hi])
-        seg = np.fromiter(itertools.chain.from_iterable(found), dtype=np.int64, count=len(owner))
+        found = [s.pairs(samples, lo, hi, len(a)) for s in sources]
+        if len(found) == 1:
+            owner, seg = found[0]
+        else:  # sample-major again: each source's pairs are
+            owner = np.concatenate([f[0] for f in found])
+            order = np.argsort(owner, kind="stable")
+            owner, seg = owner[order], np.concatenate([f[1] for f in found])[order]
         out[lo:hi] = _nearby_min(samples[lo:hi], owner, seg, a, b)
         lo = hi
     return out

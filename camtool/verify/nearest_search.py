@@ -385,6 +385,7 @@ class _LazyTree:
         self._beside: Beside[Any] | None = None
         self._boxes: dict[bool, tuple[Any, ...]] = {}
         self._half: float | None = None
+        self._long: tuple[nearest_exact.LongSegments | None] | None = None
 
     def built(self) -> bool:
         """Whether :attr:`tree` has been built (asked for before), or is being built beside."""
@@ -421,6 +422,12 @@ class _LazyTree:
         """Wait for a tree :meth:`build_beside` started, if one is being built."""
         if self._beside is not None:
             self._beside.join()
+
+    def long(self, half: float) -> nearest_exact.LongSegments | None:
+        """:func:`~camtool.verify.nearest_exact.long_segments` of these ends (made once)."""
+        if self._long is None:
+            self._long = (nearest_exact.long_segments(*_halves(self.points), half),)
+        return self._long[0]
 
     def drop_boxes(self) -> None:
         """Let the compiled search's trees go (the k-d tree answers from now on)."""
@@ -494,7 +501,10 @@ def _nearest_kd(
     for i in range(0, len(samples), NEAREST_CHUNK):
         part = slice(i, i + NEAREST_CHUNK)
         d[part], unsure[part] = nearest_exact._nearest_chunk(samples[part], a, b, tree, half)
-    nearby = partial(nearest_exact._nearby_exact, a=a, b=b, ends=tree, half=half)
+    long = None
+    if unsure.any():  # the exact stage will search: the few long segments apart
+        long = nearest_exact.long_segments(a, b, half) if ends is None else ends.long(half)
+    nearby = partial(nearest_exact._nearby_exact, a=a, b=b, ends=tree, half=half, long=long)
     return nearest_exact._settle_unsure(samples, d, unsure, a, b, nearby, only_max=only_max)
 
 

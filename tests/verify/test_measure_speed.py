@@ -60,6 +60,46 @@ def test_nearby_exact_is_the_all_segments_query_bit_for_bit(seed: int) -> None:
         assert np.array_equal(fast, nearest_exact._all_exact(samples, a, b))
 
 
+def _with_jumps(rng: np.random.Generator, n: int, step: float, jumps: int) -> np.ndarray:
+    """A staircase of ``step`` with ``jumps`` moves 20 steps long (backlash take-ups)."""
+    moves = rng.choice([-step, 0.0, step], size=(n, 2))
+    at = rng.choice(n, size=jumps, replace=False)
+    moves[at] = rng.choice([-20 * step, 20 * step], size=(jumps, 2))
+    return np.cumsum(moves, axis=0)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_long_segments_searched_apart_give_the_all_segments_query_bit_for_bit(seed: int) -> None:
+    """Few long segments among short ones: each found within its own reach, the same minimum."""
+    rng = np.random.default_rng(seed)
+    step = (0.001, 0.004, 0.0005)[seed % 3]
+    pts = _with_jumps(rng, int(rng.integers(3000, 6000)), step, int(rng.integers(1, 40)))
+    a, b = pts[:-1], pts[1:]
+    half = float(np.max(np.hypot(*(b - a).T))) / 2.0
+    long = nearest_exact.long_segments(a, b, half)
+    assert long is not None and long.short_half <= half / 4.0
+    assert np.all(np.hypot(*(b - a).T)[long.index] > 2.0 * long.short_half)
+    samples = pts[rng.integers(0, len(pts), 1500)] + rng.normal(0.0, 2.0 * step, (1500, 2))
+    samples[:300] = (a[long.index[0]] + b[long.index[0]]) / 2.0 + rng.normal(0, step, (300, 2))
+    ends = cKDTree(np.concatenate([a, b]))
+    upper, _ = nearest_exact._nearest_chunk(samples, a, b, ends, half)
+    want = nearest_exact._all_exact(samples, a, b)
+    apart = nearest_exact._nearby_exact(samples, upper, a, b, ends, half, long=long)
+    together = nearest_exact._nearby_exact(samples, upper, a, b, ends, half)
+    assert apart is not None and together is not None
+    assert np.array_equal(apart, want) and np.array_equal(together, want)
+    need = rng.random(len(samples)) < 0.3
+    some = nearest_exact._nearby_exact(samples, upper, a, b, ends, half, need=need, long=long)
+    assert some is not None
+    assert np.array_equal(some[need], want[need]) and np.array_equal(some[~need], upper[~need])
+
+
+def test_segments_of_one_length_are_not_searched_apart() -> None:
+    pts = np.cumsum(np.full((500, 2), [0.004, 0.0]), axis=0)
+    a, b = pts[:-1], pts[1:]
+    assert nearest_exact.long_segments(a, b, 0.002) is None  # the longest is no longer
+
+
 def test_nearby_exact_gives_way_when_too_many_segments_are_near(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
