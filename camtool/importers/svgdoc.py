@@ -194,6 +194,95 @@ def _show(element: ET.Element) -> None:
         element.set("display", "inline")
 
 
+# ---------------------------------------------------------------------------- style sheets
+
+_SIMPLE_SELECTOR = re.compile(r"\*|[A-Za-z][\w-]*|#[\w-]+|\.[\w-]+|[A-Za-z][\w-]*\.[\w-]+")
+"""The selectors svgelements applies: ``*``, ``tag``, ``#id``, ``.class``, ``tag.class``."""
+_CSS_COMMENT = re.compile(r"/\*.*?\*/", re.DOTALL)
+
+
+def _css_rules(text: str) -> list[tuple[str, str]]:
+    """``(selector list, declarations)`` of a style sheet; an at-rule's body as one text."""
+    text = _CSS_COMMENT.sub("", text)
+    rules: list[tuple[str, str]] = []
+    at = 0
+    while (opening := text.find("{", at)) >= 0:
+        depth, end = 1, opening + 1
+        while end < len(text) and depth:
+            depth += {"{": 1, "}": -1}.get(text[end], 0)
+            end += 1
+        rules.append((text[at:opening].strip(), text[opening + 1 : end - 1]))
+        at = end
+    return rules
+
+
+def _hides(declarations: str) -> str | None:
+    """The declaration of ``declarations`` that hides what it styles (``display:none``), if any."""
+    for item in declarations.split(";"):
+        key, _, value = item.partition(":")
+        key, value = key.strip().lower(), value.replace("!important", "").strip().lower()
+        if (key, value) in (
+            ("display", "none"),
+            ("visibility", "hidden"),
+            ("visibility", "collapse"),
+        ):
+            return f"{key}:{value}"
+    return None
+
+
+def hoist_styles(root: ET.Element, parents: dict[ET.Element, ET.Element], name: str) -> list[str]:
+    """Move every ``<style>`` to the start of the document; refuse rules it cannot apply.
+
+    CSS applies a style sheet to the whole document wherever it stands; svgelements applies
+    it only to the elements after it, so a sheet at the end (or moved to the end with the
+    undrawn elements) would hide nothing. svgelements applies rules whose selector names one
+    element (:data:`_SIMPLE_SELECTOR`); a rule with another selector (``g.hidden rect``,
+    ``.a > .b``) that hides what it selects would leave its elements drawn, and cut.
+
+    Returns:
+        Warnings: rules not applied that hide nothing (their colours are not read), and
+        at-rules (``@media``, ``@import``).
+
+    Raises:
+        InputError: a rule svgelements cannot apply sets ``display:none`` or
+            ``visibility:hidden`` (pseudo-classes such as ``:hover`` excepted: they hide
+            nothing in a still picture).
+    """
+    sheets = [e for e in root.iter() if local_name(e) == "style"]
+    ignored: list[str] = []
+    for sheet in sheets:
+        for selectors, declarations in _css_rules(sheet.text or ""):
+            if selectors.startswith("@"):
+                ignored.append(selectors.split("{")[0].strip())
+                continue
+            odd = [
+                s.strip() for s in selectors.split(",") if not _SIMPLE_SELECTOR.fullmatch(s.strip())
+            ]
+            hiding = _hides(declarations)
+            for selector in odd:
+                if hiding is not None and ":" not in selector:
+                    raise InputError(
+                        f"{name}: the <style> rule '{selector}' hides what it selects "
+                        f"({hiding}), but camtool applies only rules that name one element "
+                        "(rect, .class, #id, rect.class), so those elements would be cut; "
+                        f"put {hiding} on the elements themselves (a style attribute), or "
+                        "delete them"
+                    )
+                ignored.append(selector)
+    for position, sheet in enumerate(sheets):
+        parents[sheet].remove(sheet)
+        root.insert(position, sheet)
+        parents[sheet] = root
+    if not ignored:
+        return []
+    shown = ", ".join(f"'{s}'" for s in ignored[:3]) + (" ..." if len(ignored) > 3 else "")
+    return [
+        f"{name}: {len(ignored)} <style> rule(s) not applied ({shown}): camtool applies rules "
+        "that name one element (rect, .class, #id, rect.class); what they style is read "
+        "without them"
+    ]
+
+
 # ---------------------------------------------------------------------------- skipped
 
 
@@ -418,6 +507,7 @@ def prepare(
     warnings: list[str] = []
     matrix, viewport = page_matrix(root, str(path), warnings, units)
     parents = {child: parent for parent in root.iter() for child in parent}
+    warnings += hoist_styles(root, parents, str(path))
     _label_and_check(root, str(path))
     check_use_cycles(root, str(path))
     check_size(root, str(path), max_entities)

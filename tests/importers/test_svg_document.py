@@ -174,6 +174,48 @@ def test_display_none_and_visibility_hidden_are_skipped(tmp_path: Path) -> None:
     assert drawing.warnings == (f"{tmp_path / 't.svg'}: skipped 1 element with visibility:hidden",)
 
 
+@pytest.mark.parametrize("where", ["end", "marker", "group"])
+def test_a_style_sheet_hides_what_it_selects_wherever_it_stands(tmp_path: Path, where: str) -> None:
+    """CSS applies a sheet to the whole document; svgelements only to what follows it."""
+    sheet = "<style>.off { display: none } #gone { visibility: hidden }</style>"
+    shapes = '<path id="a" d="M 0 0 L 1 0" class="off"/><path id="gone" d="M 0 0 L 1 0"/>'
+    shapes += '<path id="kept" d="M 0 0 L 1 0"/>'
+    body = {
+        "end": shapes + sheet,
+        "marker": shapes + f'<defs><marker id="m">{sheet}</marker></defs>',
+        "group": f"<g>{shapes}<g>{sheet}</g></g>",
+    }[where]
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.source for c in drawing.contours] == ["path#kept"]
+
+
+def test_a_rule_that_hides_through_a_selector_camtool_cannot_apply_is_refused(
+    tmp_path: Path,
+) -> None:
+    body = (
+        "<style>/* a comment { } */ g.hidden path { display : none !important }</style>"
+        '<g class="hidden"><path id="a" d="M 0 0 L 1 0"/></g><path id="kept" d="M 0 0 L 1 0"/>'
+    )
+    with pytest.raises(InputError, match=r"t\.svg: the <style> rule 'g\.hidden path' hides"):
+        read_svg(svg(tmp_path, body))
+
+
+def test_rules_that_hide_nothing_still_are_named(tmp_path: Path) -> None:
+    """A pseudo-class or a print style hides nothing on the screen: read, with a warning."""
+    body = (
+        "<style>a:hover path { display: none } @media print { .x { display: none } }"
+        " g > path { stroke: red }</style>"
+        '<path id="x" class="x" d="M 0 0 L 1 0"/><g><path id="y" d="M 0 0 L 1 0"/></g>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.source for c in drawing.contours] == ["path#x", "path#y"]
+    assert drawing.warnings == (
+        f"{tmp_path / 't.svg'}: 3 <style> rule(s) not applied ('a:hover path', '@media print', "
+        "'g > path'): camtool applies rules that name one element (rect, .class, #id, "
+        "rect.class); what they style is read without them",
+    )
+
+
 # ------------------------------------------------------------------ use, skipped constructs
 
 
