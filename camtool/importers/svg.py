@@ -107,7 +107,7 @@ def svg_drawing(
     svg = _parse(path, prepared)
     warnings = list(prepared.warnings)
     contours: list[Contour] = []
-    hidden = invisible = 0
+    hidden = invisible = faded = 0
     drawn: list[tuple[Any, list[Any] | None]] = []
     shapes = list(_shapes(svg))
     progress(Step("reading", 0, len(shapes), path.name))
@@ -115,7 +115,9 @@ def svg_drawing(
         values = shape.values
         if str(values.get("visibility", "visible")).strip().lower() in ("hidden", "collapse"):
             hidden += 1
-        elif _none(values.get("fill")) and _none(values.get("stroke")):
+        elif _transparent(values.get("opacity")):
+            faded += 1
+        elif _unpainted(values, "fill") and _unpainted(values, "stroke"):
             invisible += 1
         else:
             drawn.append((shape, _segments(shape)))
@@ -133,6 +135,8 @@ def svg_drawing(
         progress(Step("contours", i, len(drawn)))
     if hidden:
         warnings.append(f"{path}: skipped {hidden} {_elements(hidden)} with visibility:hidden")
+    if faded:
+        warnings.append(f"{path}: skipped {faded} {_elements(faded)} with opacity 0")
     if invisible:
         noun = _elements(invisible)
         warnings.append(f"{path}: skipped {invisible} {noun} with neither fill nor stroke")
@@ -217,6 +221,21 @@ def _shapes(node: Any) -> Iterator[Any]:
 
 def _none(paint: Any) -> bool:
     return paint is None or str(paint).strip().lower() == "none"
+
+
+def _transparent(opacity: Any) -> bool:
+    """Whether an ``opacity`` value (``0``, ``0.0``, ``0%``) makes what it styles invisible."""
+    text = str(opacity).strip() if opacity is not None else ""
+    try:
+        value = float(text[:-1]) / 100.0 if text.endswith("%") else float(text)
+    except ValueError:
+        return False  # absent or not a number: svgelements draws it, so does camtool
+    return value <= 0.0
+
+
+def _unpainted(values: Any, paint: str) -> bool:
+    """Whether ``fill`` or ``stroke`` paints nothing: ``none``, or its opacity 0."""
+    return _none(values.get(paint)) or _transparent(values.get(f"{paint}-opacity"))
 
 
 def _elements(count: int) -> str:

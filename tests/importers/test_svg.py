@@ -248,6 +248,26 @@ def test_filled_and_stroked_shapes_both_count_but_invisible_ones_do_not(tmp_path
     )
 
 
+def test_shapes_at_opacity_0_are_invisible_and_not_cut(tmp_path: Path) -> None:
+    """What a browser shows is what is cut: opacity 0, or paint whose own opacity is 0."""
+    body = (
+        '<rect id="a" width="10" height="10" opacity="0"/>'
+        '<g style="opacity:0%"><rect id="b" width="10" height="10"/></g>'
+        '<style>.clear { opacity: 0.0 }</style><rect id="c" class="clear" width="1" height="1"/>'
+        '<rect id="d" width="10" height="10" fill="none" stroke="red" stroke-opacity="0"/>'
+        '<rect id="e" width="10" height="10" fill-opacity="0"/>'
+        '<rect id="f" width="10" height="10" fill-opacity="0" stroke="red"/>'
+        '<rect id="g" width="10" height="10" opacity="0.01"/>'
+        '<rect id="h" width="10" height="10" opacity="bogus"/>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.source for c in drawing.contours] == ["rect#f", "rect#g", "rect#h"]
+    assert drawing.warnings == (
+        f"{tmp_path / 't.svg'}: skipped 3 elements with opacity 0",
+        f"{tmp_path / 't.svg'}: skipped 2 elements with neither fill nor stroke",
+    )
+
+
 # ------------------------------------------------------------------ transforms
 
 
