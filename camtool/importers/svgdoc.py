@@ -367,6 +367,52 @@ def move(element: ET.Element, parents: dict[ET.Element, ET.Element], hold: ET.El
     parents[element] = hold
 
 
+_SHAPE_KINDS = frozenset(
+    {"path", "rect", "circle", "ellipse", "line", "polyline", "polygon", "use"}
+)
+
+
+def _has_shapes(element: ET.Element) -> bool:
+    return any(local_name(e) in _SHAPE_KINDS for e in element.iter())
+
+
+def choose_switches(
+    root: ET.Element,
+    parents: dict[ET.Element, ET.Element],
+    hold: ET.Element,
+    name: str,
+    counts: Counter[str],
+) -> None:
+    """Keep of each ``<switch>`` only the child it shows; move the others into ``hold``.
+
+    A ``<switch>`` renders its first direct child whose conditions hold (SVG 1.1 §5.8):
+    ``requiredExtensions`` names extensions camtool has none of (Illustrator's
+    ``<foreignObject>`` beside its artwork), ``requiredFeatures`` holds (SVG 2 dropped
+    it). svgelements draws every child, so alternatives would all be cut. Alternatives
+    with shapes that were dropped are counted (``counts["switch"]``).
+
+    Raises:
+        InputError: a child with shapes chooses by ``systemLanguage``: which one the user
+            sees depends on the viewer's language, which camtool cannot know.
+    """
+    for switch in [e for e in root.iter() if local_name(e) == "switch"]:
+        children = [c for c in switch if isinstance(c.tag, str)]
+        for child in children:
+            if child.get("systemLanguage") is not None and _has_shapes(child):
+                where = child.get(SOURCE_ATTR) or local_name(child) or "an element"
+                raise InputError(
+                    f"{name}: a <switch> shows {where} or another child by the viewer's "
+                    f'language (systemLanguage="{child.get("systemLanguage")}"), which camtool '
+                    "cannot know; keep one of them in the drawing program"
+                )
+        shown = next((c for c in children if not (c.get("requiredExtensions") or "").strip()), None)
+        for child in children:
+            if child is not shown:
+                if _has_shapes(child) and _is_drawn(switch, parents, hold):
+                    counts["switch"] += 1
+                move(child, parents, hold)
+
+
 def count_skipped(root: ET.Element, hold: ET.Element, counts: Counter[str]) -> None:
     """Add to ``counts`` the skipped kinds: clipPath, non-empty defs, drawn text and image."""
 
@@ -515,8 +561,14 @@ def prepare(
     parents[hold] = root
     counts: Counter[str] = Counter()
     select_layers(root, layers, parents, hold, str(path), warnings)
+    choose_switches(root, parents, hold, str(path), counts)
     hold_undrawn(root, parents, hold, counts)
     count_skipped(root, hold, counts)
+    if counts["switch"]:
+        warnings.append(
+            f"{path}: skipped {counts['switch']} child(ren) of <switch> elements with shapes "
+            "(a <switch> shows only its first child that applies)"
+        )
     for kind in ("defs", "clipPath", "mask", "text", "image", "use"):
         if counts[kind]:
             noun = "element" if counts[kind] == 1 else "elements"
