@@ -218,24 +218,24 @@ def test_rules_that_hide_nothing_still_are_named(tmp_path: Path) -> None:
 
 ILLUSTRATOR = """<?xml version="1.0" encoding="utf-8"?>
 <!DOCTYPE svg PUBLIC "-//W3C//DTD SVG 1.1//EN" "http://www.w3.org/Graphics/SVG/1.1/DTD/svg11.dtd" [
-	<!ENTITY ns_extend "http://ns.adobe.com/Extensibility/1.0/">
-	<!ENTITY ns_ai "http://ns.adobe.com/AdobeIllustrator/10.0/">
+    <!ENTITY ns_extend "http://ns.adobe.com/Extensibility/1.0/">
+    <!ENTITY ns_ai "http://ns.adobe.com/AdobeIllustrator/10.0/">
 ]>
 <svg version="1.1" xmlns:x="&ns_extend;" xmlns:i="&ns_ai;" xmlns="http://www.w3.org/2000/svg"
-	 xmlns:xlink="http://www.w3.org/1999/xlink" x="0px" y="0px" width="120px" height="90px"
-	 viewBox="0 0 120 90" xml:space="preserve">
+     xmlns:xlink="http://www.w3.org/1999/xlink" x="0px" y="0px" width="120px" height="90px"
+     viewBox="0 0 120 90" xml:space="preserve">
 <style type="text/css">
-	.st2{fill:none;stroke:#0A1F44;stroke-width:3;stroke-miterlimit:10;}
+    .st2{fill:none;stroke:#0A1F44;stroke-width:3;stroke-miterlimit:10;}
 </style>
 <switch>
-	<foreignObject requiredExtensions="&ns_ai;" x="0" y="0" width="1" height="1">
-		<i:pgfRef  xlink:href="#adobe_illustrator_pgf">
-		</i:pgfRef>
-	</foreignObject>
-	<g i:extraneous="self">
-		<rect id="art" x="10" y="10" class="st2" width="50" height="30"/>
-	</g>
-	<g><rect id="fallback" x="70" y="10" width="10" height="10"/></g>
+    <foreignObject requiredExtensions="&ns_ai;" x="0" y="0" width="1" height="1">
+        <i:pgfRef  xlink:href="#adobe_illustrator_pgf">
+        </i:pgfRef>
+    </foreignObject>
+    <g i:extraneous="self">
+        <rect id="art" x="10" y="10" class="st2" width="50" height="30"/>
+    </g>
+    <g><rect id="fallback" x="70" y="10" width="10" height="10"/></g>
 </switch>
 </svg>
 """
