@@ -413,8 +413,15 @@ def choose_switches(
                 move(child, parents, hold)
 
 
+def _href(element: ET.Element) -> str:
+    return (element.get(XLINK_HREF) or element.get("href") or "").strip()
+
+
 def count_skipped(root: ET.Element, hold: ET.Element, counts: Counter[str]) -> None:
-    """Add to ``counts`` the skipped kinds: clipPath, non-empty defs, drawn text and image."""
+    """Add to ``counts`` the skipped kinds: clipPath, non-empty defs, drawn text and image.
+
+    And a drawn ``<use>`` of another file's element (``use-file``).
+    """
 
     def walk(node: ET.Element, drawn: bool) -> None:
         for child in node:
@@ -428,6 +435,8 @@ def count_skipped(root: ET.Element, hold: ET.Element, counts: Counter[str]) -> N
             elif kind in ("text", "image") and drawn:
                 counts[kind] += 1
                 continue
+            elif kind == "use" and drawn and _href(child)[:1] not in ("", "#"):
+                counts["use-file"] += 1  # another file's element: svgelements places nothing
             walk(child, drawn and kind not in _NOT_DRAWN)
 
     walk(root, True)
@@ -564,6 +573,11 @@ def prepare(
     choose_switches(root, parents, hold, str(path), counts)
     hold_undrawn(root, parents, hold, counts)
     count_skipped(root, hold, counts)
+    if counts["use-file"]:
+        warnings.append(
+            f"{path}: skipped {counts['use-file']} <use> of another file's element (camtool "
+            "reads one file): copy the element into this drawing to cut it"
+        )
     if counts["switch"]:
         warnings.append(
             f"{path}: skipped {counts['switch']} child(ren) of <switch> elements with shapes "

@@ -254,6 +254,18 @@ def test_a_switch_shows_its_first_child_that_applies(tmp_path: Path) -> None:
     )
 
 
+def test_a_use_of_another_files_element_is_named(tmp_path: Path) -> None:
+    body = (
+        '<use xlink:href="parts.svg#gear" x="5"/><use href=""/>'
+        '<defs><use id="d" href="x.svg#y"/></defs><path id="kept" d="M 0 0 L 1 0"/>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.source for c in drawing.contours] == ["path#kept"]
+    assert (
+        f"{tmp_path / 't.svg'}: skipped 1 <use> of another file's element" in (drawing.warnings[0])
+    )
+
+
 def test_a_switch_by_language_is_refused(tmp_path: Path) -> None:
     body = (
         '<switch><path id="fr" systemLanguage="fr" d="M 0 0 L 1 0"/>'
