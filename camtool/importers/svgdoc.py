@@ -283,6 +283,37 @@ def hoist_styles(root: ET.Element, parents: dict[ET.Element, ET.Element], name: 
     ]
 
 
+def _zero_opacity(value: str | None) -> bool:
+    """Whether an ``opacity`` value (``0``, ``0.0``, ``0%``) is 0; not a number: no."""
+    text = (value or "").strip()
+    try:
+        return (float(text[:-1]) / 100.0 if text.endswith("%") else float(text)) <= 0.0
+    except ValueError:
+        return False
+
+
+def fade_under_transparent(root: ET.Element) -> None:
+    """Give every element under an ``opacity:0`` element opacity 0 too.
+
+    A group at opacity 0 shows nothing, whatever its children's own opacity; svgelements
+    passes a group's ``opacity`` down only to children that set none, so a child with
+    ``opacity="1"`` would be drawn, and cut. Its own value is replaced by 0 (the SVG
+    importer then skips it as invisible and counts it).
+    """
+    for element in root.iter():
+        own = _style(element).get("opacity", element.get("opacity"))
+        if not _zero_opacity(own):
+            continue
+        for inner in element.iter():
+            if inner is element or (
+                "opacity" not in _style(inner) and "opacity" not in inner.attrib
+            ):
+                continue
+            style = {k: v for k, v in _style(inner).items() if k != "opacity"}
+            inner.set("style", ";".join(f"{k}:{v}" for k, v in style.items()))
+            inner.set("opacity", "0")
+
+
 # ---------------------------------------------------------------------------- skipped
 
 
@@ -571,6 +602,7 @@ def prepare(
     counts: Counter[str] = Counter()
     select_layers(root, layers, parents, hold, str(path), warnings)
     choose_switches(root, parents, hold, str(path), counts)
+    fade_under_transparent(root)
     hold_undrawn(root, parents, hold, counts)
     count_skipped(root, hold, counts)
     if counts["use-file"]:
