@@ -48,7 +48,7 @@ STDIN = "<stdin>"
 _SNIFF_BYTES = 1 << 16
 """How much of standard input :func:`stdin_kind` looks at."""
 _DXF_CODES = ("0", "999")
-_GCODE_WORD = re.compile(r"/?\s*(?:[A-Za-z]\s*[-+]?\s*[\d.#\[<]|#\s*[\d<])")
+_GCODE_WORD = re.compile(r"/?\s*(?:[A-Za-z]\s*[-+]?\s*[\d.#\[<]|#[\d<])")
 """The start of a G-code block: a word (``G0``, ``X-1.5``, ``F#1``, ``o<sub>``), a parameter
 (``#1=``, ``#<x>=``), after an optional block delete ``/``."""
 _MATLAB = re.compile(r"[A-Za-z_]\w*\s*=")

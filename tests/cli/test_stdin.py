@@ -77,6 +77,7 @@ def test_real_files_are_told_by_their_content() -> None:
         ("x,y\n1,2\n", ".csv"),
         ("X Y Z\n1 2 0\n", ".csv"),
         ("# points\n1;2\n", ".csv"),
+        ("# 1st stroke\n1 2\n3 4\n", ".csv"),  # a comment, not LinuxCNC's #1
         ("-1.5\t2\n", ".csv"),
     ],
 )
