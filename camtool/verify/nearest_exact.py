@@ -172,10 +172,11 @@ LONG_SEGMENTS_GAIN = 4.0
 def long_segments(a: FloatArray, b: FloatArray, half: float) -> LongSegments | None:
     """The segments ``a → b`` to search apart (:class:`LongSegments`), or ``None``.
 
-    The longest :data:`LONG_SEGMENTS_FEW` (or one in :data:`LONG_SEGMENTS_PER`) and any
-    as long as the longest of them, where the rest are at most ``half / GAIN`` long
-    (``half``: half the longest segment, mm). Lengths as ``half`` is computed, so every
-    other segment is at most ``2 · short_half`` long.
+    With ``few`` = :data:`LONG_SEGMENTS_FEW` (or one in :data:`LONG_SEGMENTS_PER`): the
+    segments longer than the ``few + 1``-th longest (at most ``few``; fewer where lengths
+    tie), where that one is at most ``2 · half / GAIN`` long (``half``: half the longest
+    segment, mm). ``short_half`` is half its length; lengths are computed as ``half`` is,
+    so every other segment is at most ``2 · short_half`` long.
     """
     n = len(a)
     few = max(LONG_SEGMENTS_FEW, n // LONG_SEGMENTS_PER)
