@@ -216,6 +216,53 @@ def _css_rules(text: str) -> list[tuple[str, str]]:
     return rules
 
 
+_KEYWORDS = frozenset({"none", "hidden", "collapse", "visible", "inline", "block"})
+"""Values read as keywords, any case (``NONE``); ``currentColor`` stays as svgelements knows it."""
+_IMPORTANT = re.compile(r"\s*!\s*important\s*$", re.IGNORECASE)
+_PRESENTATION = ("display", "visibility", "fill", "stroke")
+
+
+def _declarations(text: str) -> str:
+    """CSS declarations as svgelements compares them: ``display:none``.
+
+    Not ``DISPLAY: None !important``: property names in lower case, keywords too,
+    ``!important`` dropped.
+    """
+    out = []
+    for item in text.split(";"):
+        key, colon, value = item.partition(":")
+        if not colon:
+            out.append(item)  # a piece of a value that held a ';' (a data: URL), kept
+            continue
+        value = _IMPORTANT.sub("", value).strip()
+        out.append(
+            f"{key.strip().lower()}:{value.lower() if value.lower() in _KEYWORDS else value}"
+        )
+    return ";".join(out)
+
+
+def normalize_styles(root: ET.Element) -> None:
+    """Every ``style`` attribute, presentation attribute and style sheet as svgelements reads it.
+
+    CSS property names and keywords are case-insensitive and ``!important`` only ranks a
+    declaration; svgelements compares the text, so ``display:none !important`` or
+    ``DISPLAY: NONE`` hid nothing and the element was cut. A style sheet's rules are written
+    again with their declarations normalized (at-rules as they were).
+    """
+    for element in root.iter():
+        if element.get("style"):
+            element.set("style", _declarations(element.get("style", "")))
+        for attr in _PRESENTATION:
+            value = element.get(attr)
+            if value is not None and value.strip().lower() in _KEYWORDS:
+                element.set(attr, value.strip().lower())
+        if local_name(element) == "style" and element.text:
+            element.text = "\n".join(
+                f"{selectors}{{{body if selectors.startswith('@') else _declarations(body)}}}"
+                for selectors, body in _css_rules(element.text)
+            )
+
+
 def _hides(declarations: str) -> str | None:
     """The declaration of ``declarations`` that hides what it styles (``display:none``), if any."""
     for item in declarations.split(";"):
@@ -593,6 +640,7 @@ def prepare(
     warnings: list[str] = []
     matrix, viewport = page_matrix(root, str(path), warnings, units)
     parents = {child: parent for parent in root.iter() for child in parent}
+    normalize_styles(root)
     warnings += hoist_styles(root, parents, str(path))
     _label_and_check(root, str(path))
     check_use_cycles(root, str(path))

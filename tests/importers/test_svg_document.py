@@ -189,6 +189,21 @@ def test_a_style_sheet_hides_what_it_selects_wherever_it_stands(tmp_path: Path, 
     assert [c.source for c in drawing.contours] == ["path#kept"]
 
 
+def test_important_and_upper_case_hide_as_css_says(tmp_path: Path) -> None:
+    """CSS property names and keywords ignore case; ``!important`` only ranks a declaration."""
+    body = (
+        "<style>.off { DISPLAY: None ! IMPORTANT }</style>"
+        '<path id="a" d="M 0 0 L 1 0" style="display:none !important"/>'
+        '<path id="b" d="M 0 0 L 1 0" style="Visibility: HIDDEN"/>'
+        '<path id="c" d="M 0 0 L 1 0" class="off"/>'
+        '<path id="d" d="M 0 0 L 1 0" display="None"/>'
+        '<path id="e" d="M 0 0 L 1 0" style="fill:NONE;stroke:none !important"/>'
+        '<path id="kept" d="M 0 0 L 1 0" style="fill:url(#Grad);stroke:currentColor"/>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.source for c in drawing.contours] == ["path#kept"]
+
+
 def test_a_rule_that_hides_through_a_selector_camtool_cannot_apply_is_refused(
     tmp_path: Path,
 ) -> None:
