@@ -117,7 +117,7 @@ def svg_drawing(
             hidden += 1
         elif _transparent(values.get("opacity")):
             faded += 1
-        elif _unpainted(values, "fill") and _unpainted(values, "stroke"):
+        elif _unpainted(shape.fill) and _unpainted(shape.stroke):
             invisible += 1
         else:
             drawn.append((shape, _segments(shape)))
@@ -233,9 +233,13 @@ def _transparent(opacity: Any) -> bool:
     return value <= 0.0
 
 
-def _unpainted(values: Any, paint: str) -> bool:
-    """Whether ``fill`` or ``stroke`` paints nothing: ``none``, or its opacity 0."""
-    return _none(values.get(paint)) or _transparent(values.get(f"{paint}-opacity"))
+def _unpainted(color: Any) -> bool:
+    """Whether a shape's ``fill`` or ``stroke`` (svgelements' Color) paints nothing.
+
+    ``none``, or an alpha of 0: ``transparent``, ``rgba(…, 0)``, ``#RRGGBB00``, or a
+    ``fill-opacity``/``stroke-opacity`` of 0, which svgelements folds into the colour.
+    """
+    return color is None or color.value is None or color.alpha == 0
 
 
 def _elements(count: int) -> str:

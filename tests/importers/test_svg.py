@@ -259,14 +259,17 @@ def test_shapes_at_opacity_0_are_invisible_and_not_cut(tmp_path: Path) -> None:
         '<rect id="f" width="10" height="10" fill-opacity="0" stroke="red"/>'
         '<rect id="g" width="10" height="10" opacity="0.01"/>'
         '<rect id="h" width="10" height="10" opacity="bogus"/>'
+        '<rect id="k" width="1" height="1" fill="transparent"/>'
+        '<rect id="l" width="1" height="1" fill="rgba(0, 0, 0, 0)" stroke="#ff000000"/>'
+        '<rect id="m" width="1" height="1" fill="url(#gradient)"/>'
         '<g opacity="0"><g style="opacity:1"><rect id="i" style="opacity:0.5" width="1" '
         'height="1"/><rect id="j" opacity="1" width="1" height="1"/></g></g>'
     )
     drawing = read_svg(svg(tmp_path, body))
-    assert [c.source for c in drawing.contours] == ["rect#f", "rect#g", "rect#h"]
+    assert [c.source for c in drawing.contours] == ["rect#f", "rect#g", "rect#h", "rect#m"]
     assert drawing.warnings == (
         f"{tmp_path / 't.svg'}: skipped 5 elements with opacity 0",
-        f"{tmp_path / 't.svg'}: skipped 2 elements with neither fill nor stroke",
+        f"{tmp_path / 't.svg'}: skipped 4 elements with neither fill nor stroke",
     )
 
 
