@@ -88,6 +88,8 @@ class ImportOptions:
             fitted within ``tolerance`` divided by that factor, and
             :func:`camtool.importers.read_drawing` checks the factor of the drawing it
             read (and fits again, finer, if it must).
+        shown: layers read even where the drawing hides them (a DXF layer that is off
+            or frozen): those a job's operations name. ``layers`` are read so too.
 
     Raises:
         UsageError: ``max_entities`` is not a positive whole number.
@@ -100,6 +102,7 @@ class ImportOptions:
     max_entities: int = MAX_ENTITIES
     scale: float = 1.0
     fit: tuple[float, float] | None = None
+    shown: tuple[str, ...] = ()
 
     def curve_tolerance(self, box: BBox | None = None) -> float:
         """The fitting tolerance at the drawing's size (mm) that is ``tolerance`` once placed.

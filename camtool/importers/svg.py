@@ -103,7 +103,13 @@ def svg_drawing(
     options = options or ImportOptions()
     check_tolerance(options.tolerance)
     progress(Step("reading", name=path.name))
-    prepared = prepare(path, options.layers, max_entities=options.max_entities, units=options.units)
+    prepared = prepare(
+        path,
+        options.layers,
+        max_entities=options.max_entities,
+        units=options.units,
+        shown=options.shown,
+    )
     svg = _parse(path, prepared)
     warnings = list(prepared.warnings)
     contours: list[Contour] = []

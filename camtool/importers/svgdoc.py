@@ -122,11 +122,13 @@ def select_layers(
     hold: ET.Element,
     name: str,
     warnings: list[str],
+    shown: tuple[str, ...] = (),
 ) -> None:
     """Mark layers with :data:`LAYER_ATTR`; keep only ``wanted`` ones (``None``: all).
 
     Unselected drawn content moves into ``hold``; selected layers and their parents are
-    shown. Without a selection, each hidden layer gets a warning.
+    shown. Without a selection, a hidden layer named in ``shown`` (by a job's operation,
+    in any case) is shown with its parents, and each other hidden layer gets a warning.
 
     Raises:
         InputError: a name in ``wanted`` matches no layer label or id (the message lists
@@ -136,8 +138,14 @@ def select_layers(
     for layer in layers:
         layer.set(LAYER_ATTR, _layer_name(layer))
     if wanted is None:
+        named = {n.casefold() for n in shown}
         for layer in layers:
-            if _hidden(layer):
+            if named & {n.casefold() for n in (layer.get("id"), layer.get(_LABEL)) if n}:
+                node: ET.Element | None = layer
+                while node is not None:
+                    _show(node)
+                    node = parents.get(node)
+            elif _hidden(layer):
                 warnings.append(
                     f"{name}: layer {_layer_name(layer)!r} is hidden and was skipped; "
                     "name it with --layers to cut it"
@@ -618,6 +626,7 @@ def prepare(
     *,
     max_entities: int = MAX_ENTITIES,
     units: str | None = None,
+    shown: tuple[str, ...] = (),
 ) -> Prepared:
     """Read, check and prepare the SVG file at ``path`` (see the module docstring).
 
@@ -627,6 +636,7 @@ def prepare(
         max_entities: most elements the document may expand to, ``<use>`` clones
             included (:func:`check_size`).
         units: ``--units``: the user unit of a document without an absolute size.
+        shown: layers read even if hidden (a job's operations name them).
 
     Raises:
         InputError: the file is missing, is not well-formed XML, is not an SVG document,
@@ -648,7 +658,7 @@ def prepare(
     hold = ET.SubElement(root, _tag(root, "defs"))
     parents[hold] = root
     counts: Counter[str] = Counter()
-    select_layers(root, layers, parents, hold, str(path), warnings)
+    select_layers(root, layers, parents, hold, str(path), warnings, shown)
     choose_switches(root, parents, hold, str(path), counts)
     fade_under_transparent(root)
     hold_undrawn(root, parents, hold, counts)

@@ -143,7 +143,7 @@ def post_path(
         with offsets_ahead(plan if job is None else _offsetting(job)):
             drawing = read_drawing(
                 path,
-                sized(import_options, shared),
+                sized(import_options, shared, job),
                 progress=progress,
                 check=travel_check(plan, target) if job is None else None,
             )
@@ -220,7 +220,7 @@ def post_bytes(
     suffix = kind if kind is not None else Path(name).suffix
     if not is_program_file(f"x{suffix}"):
         shared = plan if job is None else job.setup.plan
-        options = sized(import_options, shared)
+        options = sized(import_options, shared, job)
         check = travel_check(plan, target) if job is None else None
         progress(Step("reading", name=name))
         drawing = read_drawing_bytes(data, name=name, suffix=suffix, options=options, check=check)
@@ -251,15 +251,24 @@ def reading_for(target: Target, plan: PlanOptions) -> Reading:
     return Reading(plan.feed_mm_min, post.length_offsets, post.work_offsets)
 
 
-def sized(options: ImportOptions | None, plan: PlanOptions) -> ImportOptions:
+def sized(
+    options: ImportOptions | None, plan: PlanOptions, job: Job | None = None
+) -> ImportOptions:
     """``options`` (``None``: the defaults) for a drawing planned with ``plan``.
 
     With the scale planning gives the drawing (``plan.scale``, ``plan.fit``), so that
     its curves are fitted within the tolerance at that size, in the program
-    (:meth:`~camtool.importers.options.ImportOptions.curve_tolerance`).
+    (:meth:`~camtool.importers.options.ImportOptions.curve_tolerance`); and with the
+    layers ``job``'s operations name read even where the drawing hides them
+    (:attr:`~camtool.importers.options.ImportOptions.shown`).
     """
     base = options if options is not None else ImportOptions()
-    return dataclasses.replace(base, scale=plan.scale, fit=plan.fit)
+    shown = (
+        ()
+        if job is None
+        else tuple(name for op in job.operations for name in (op.select.layers or ()))
+    )
+    return dataclasses.replace(base, scale=plan.scale, fit=plan.fit, shown=shown)
 
 
 def travel_check(plan: PlanOptions, target: Target) -> Callable[[BBox], None] | None:

@@ -111,3 +111,32 @@ def test_linuxcnc_accepts_the_job_program(run: Any, tmp_path: Path) -> None:
     assert changes == ["2", "1"]
     bottoms = re.findall(r"STRAIGHT_FEED\(([-\d.]+), ([-\d.]+), -6\.5000", done.stdout)
     assert len(bottoms) >= 4
+
+
+def test_a_job_cuts_a_layer_the_drawing_hides_when_an_operation_names_it(
+    run: Any, tmp_path: Path
+) -> None:
+    import ezdxf
+
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    doc.layers.add("GUIDE").off()  # switched off in the CAD program
+    doc.modelspace().add_circle((10, 10), 5, dxfattribs={"layer": "GUIDE"})
+    doc.modelspace().add_circle((30, 10), 5, dxfattribs={"layer": "PART"})
+    drawing = tmp_path / "d.dxf"
+    doc.saveas(drawing)
+    job = tmp_path / "j.toml"
+    job.write_text(
+        '[[tools]]\nid = 1\ntype = "end-mill"\ndiameter = 2.0\nfeed = 300\n'
+        '[[operations]]\ntype = "profile"\ntool = 1\nlayers = ["guide"]\nside = "outside"\n'
+        "depth = 1.0\n"
+    )
+    out = tmp_path / "d.ngc"
+    code, _, err = run("post", str(drawing), "-t", "linuxcnc", "--job", str(job), "-o", str(out))
+    assert code == 0, err
+    # the outside profile of the R5 circle at (10, 10) with a 2 mm tool: two halves of R6
+    text = out.read_text()
+    assert "X16.000 Y10.000 I6.000 J0.000" in text and "X4.000 Y10.000 I-6.000 J0.000" in text
+    assert "not cut: 1 contour(s) on layer 'PART'" in err and "off or frozen" not in err
+    code, _, err = run("post", str(drawing), "-t", "linuxcnc", "-o", str(tmp_path / "all.ngc"))
+    assert code == 0 and "skipped 1 entity on layer(s) 'GUIDE', off or frozen" in err

@@ -147,3 +147,50 @@ def test_no_usable_entity(tmp_path: Path) -> None:
 def test_unknown_suffix(tmp_path: Path) -> None:
     with pytest.raises(InputError, match=r"cannot read '\.stl' files"):
         read_drawing(tmp_path / "part.stl")
+
+
+def _hidden_drawing(path: Path) -> Path:
+    """Layers switched off and frozen, an invisible CIRCLE and an invisible block reference.
+
+    Written with ezdxf, whose ``Layer.off()``/``freeze()`` set the LAYER table's colour sign
+    and flag bit 1 as AutoCAD does, and ``invisible`` is group code 60 (DXF reference).
+    """
+
+    def build(msp: Any) -> None:
+        doc = msp.doc
+        doc.layers.add("OFF").off()
+        doc.layers.add("Frozen").freeze()
+        doc.blocks.new("B").add_circle((0, 0), 1.0)
+        msp.add_circle((0, 0), 5.0, dxfattribs={"layer": "OFF"})
+        msp.add_line((0, 0), (9, 0), dxfattribs={"layer": "Frozen"})
+        msp.add_circle((20, 0), 5.0, dxfattribs={"invisible": 1})
+        msp.add_line((0, 20), (9, 20), dxfattribs={"invisible": 1})
+        msp.add_blockref("B", (30, 0), dxfattribs={"invisible": 1})
+        msp.add_circle((40, 0), 5.0, dxfattribs={"layer": "PART"})
+
+    return write_dxf(path, build)
+
+
+def test_hidden_layers_and_invisible_entities_are_not_cut(tmp_path: Path) -> None:
+    """What the CAD program does not show is not cut; the warning says how to cut it."""
+    path = _hidden_drawing(tmp_path / "h.dxf")
+    drawing = read_dxf(path)
+    assert [c.layer for c in drawing.contours] == ["PART"]
+    assert drawing.warnings == (
+        f"{path}: skipped 2 entities on layer(s) 'Frozen', 'OFF', off or frozen in the drawing "
+        "(hidden, so not cut); name the layer in --layers or in a job operation to cut it",
+        f"{path}: skipped 3 invisible entities (the entity's invisible flag is set: not shown, "
+        "so not cut)",
+    )
+
+
+def test_a_hidden_layer_named_is_read(tmp_path: Path) -> None:
+    from camtool.importers.options import ImportOptions
+
+    path = _hidden_drawing(tmp_path / "h.dxf")
+    named = read_dxf(path, ImportOptions(layers=("off", "PART")))
+    assert sorted(c.layer for c in named.contours) == ["OFF", "PART"]
+    assert not any("hidden" in w for w in named.warnings)
+    by_job = read_dxf(path, ImportOptions(shown=("FROZEN",)))  # a job's operation names it
+    assert sorted(c.layer for c in by_job.contours) == ["Frozen", "PART"]
+    assert "'OFF', off or frozen" in by_job.warnings[0]

@@ -140,6 +140,15 @@ def test_hidden_layer_is_skipped_with_a_warning_and_read_when_named() -> None:
     assert vertices(guides.contours[0]) == [(0, 20), (60, 20)]
 
 
+def test_a_hidden_layer_a_job_names_is_read_with_the_others() -> None:
+    """Inkscape 1.2.2's file: a job's operation naming 'guides' (any case) shows the layer."""
+    path = DATA / "inkscape-layers.svg"
+    everything = {c.layer for c in read_svg(path).contours}
+    drawing = read_svg(path, ImportOptions(shown=("guides",)))
+    assert {c.layer for c in drawing.contours} == everything | {"Guides"}
+    assert not any("hidden" in w for w in drawing.warnings)
+
+
 def test_sublayer_selection_and_innermost_layer_name(tmp_path: Path) -> None:
     body = (
         '<g inkscape:groupmode="layer" inkscape:label="Top" style="display:none">'
