@@ -487,11 +487,9 @@ def inspect(drawing: str, as_json: bool, chain_tolerance: float, **options: Any)
     gaps just above the chaining tolerance, with their locations. Ends are chained
     as ``camtool post`` chains them (same --chain-tolerance).
     """
-    import tempfile
-
+    from camtool.importers import bytes_as_file
     from camtool.importers.lint import inspect_drawing
     from camtool.jobs.inputs import STDIN, drawing_kind
-    from camtool.model.errors import InputError
 
     settings = import_settings(options)
     if drawing != "-":
@@ -499,15 +497,10 @@ def inspect(drawing: str, as_json: bool, chain_tolerance: float, **options: Any)
         click.echo(json.dumps(report.to_json(), indent=2) if as_json else report.text(), nl=as_json)
         return
     data = sys.stdin.buffer.read()
-    with tempfile.TemporaryDirectory(prefix="camtool-") as tmp:
-        path = Path(tmp) / f"stdin{drawing_kind(data)}"  # the importers read files
-        path.write_bytes(data)
-        try:
-            report = inspect_drawing(path, settings, chain_tolerance=chain_tolerance)
-        except InputError as exc:
-            raise InputError(str(exc).replace(str(path), STDIN)) from exc
-        text = json.dumps(report.to_json(), indent=2) if as_json else report.text()
-        click.echo(text.replace(str(path), STDIN).replace(path.name, STDIN), nl=as_json)
+    with bytes_as_file(data, drawing_kind(data), STDIN) as path:
+        report = inspect_drawing(path, settings, chain_tolerance=chain_tolerance)
+    text = json.dumps(report.to_json(), indent=2) if as_json else report.text()
+    click.echo(text.replace(str(path), STDIN).replace(path.name, STDIN), nl=as_json)
 
 
 @cli.command()

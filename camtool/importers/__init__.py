@@ -10,7 +10,8 @@ never loads ezdxf or svgelements. The options and limits every importer takes ar
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import NoReturn
 
@@ -135,6 +136,25 @@ def _unknown(path: Path, suffix: str) -> NoReturn:
     )
 
 
+@contextmanager
+def bytes_as_file(data: bytes, suffix: str, name: str) -> Iterator[Path]:
+    """``data`` as a temporary file ending in ``suffix``, removed on leaving.
+
+    The importers read files (each detects the encoding as it does for a file on disk); an
+    :class:`InputError` raised inside names ``name`` (``<stdin>``) instead of the temporary
+    file. What else the caller shows should replace ``str(path)`` with ``name`` likewise.
+    """
+    import tempfile
+
+    with tempfile.TemporaryDirectory(prefix="camtool-") as tmp:
+        path = Path(tmp) / f"stdin{suffix}"
+        path.write_bytes(data)
+        try:
+            yield path
+        except InputError as exc:
+            raise InputError(str(exc).replace(str(path), name)) from exc
+
+
 def read_drawing_bytes(
     data: bytes,
     *,
@@ -145,22 +165,15 @@ def read_drawing_bytes(
 ) -> Drawing:
     """Read a drawing given as bytes (e.g. piped on stdin), of the kind ``suffix`` names.
 
-    The bytes go through a temporary file so that each importer detects the
-    encoding as it does for files; messages name ``name``. ``check``: as for
-    :func:`read_drawing`.
+    Through a temporary file (:func:`bytes_as_file`); messages name ``name``. ``check``:
+    as for :func:`read_drawing`.
 
     Raises:
         InputError: as :func:`read_drawing`.
     """
     import dataclasses
-    import tempfile
 
-    with tempfile.TemporaryDirectory(prefix="camtool-") as tmp:
-        path = Path(tmp) / f"stdin{suffix}"
-        path.write_bytes(data)
-        try:
-            drawing = read_drawing(path, options, check=check)
-        except InputError as exc:
-            raise InputError(str(exc).replace(str(path), name)) from exc
+    with bytes_as_file(data, suffix, name) as path:
+        drawing = read_drawing(path, options, check=check)
     warnings = tuple(w.replace(str(path), name) for w in drawing.warnings)
     return dataclasses.replace(drawing, source=name, warnings=warnings)
