@@ -29,6 +29,7 @@ from camtool.importers.svgdoc import (
     apply,
     compose,
     prepare,
+    zero_opacity,
 )
 from camtool.model.errors import GeometryError, InputError
 from camtool.model.progress import Progress, Step, no_progress
@@ -121,7 +122,7 @@ def svg_drawing(
         values = shape.values
         if str(values.get("visibility", "visible")).strip().lower() in ("hidden", "collapse"):
             hidden += 1
-        elif _transparent(values.get("opacity")):
+        elif zero_opacity(values.get("opacity")):
             faded += 1
         elif _unpainted(shape.fill) and _unpainted(shape.stroke):
             invisible += 1
@@ -227,16 +228,6 @@ def _shapes(node: Any) -> Iterator[Any]:
 
 def _none(paint: Any) -> bool:
     return paint is None or str(paint).strip().lower() == "none"
-
-
-def _transparent(opacity: Any) -> bool:
-    """Whether an ``opacity`` value (``0``, ``0.0``, ``0%``) makes what it styles invisible."""
-    text = str(opacity).strip() if opacity is not None else ""
-    try:
-        value = float(text[:-1]) / 100.0 if text.endswith("%") else float(text)
-    except ValueError:
-        return False  # absent or not a number: svgelements draws it, so does camtool
-    return value <= 0.0
 
 
 def _unpainted(color: Any) -> bool:

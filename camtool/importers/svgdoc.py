@@ -273,15 +273,9 @@ def normalize_styles(root: ET.Element) -> None:
 
 def _hides(declarations: str) -> str | None:
     """The declaration of ``declarations`` that hides what it styles (``display:none``), if any."""
-    for item in declarations.split(";"):
-        key, _, value = item.partition(":")
-        key, value = key.strip().lower(), value.replace("!important", "").strip().lower()
-        if (key, value) in (
-            ("display", "none"),
-            ("visibility", "hidden"),
-            ("visibility", "collapse"),
-        ):
-            return f"{key}:{value}"
+    for item in _declarations(declarations).split(";"):
+        if item in ("display:none", "visibility:hidden", "visibility:collapse"):
+            return item
     return None
 
 
@@ -308,7 +302,7 @@ def hoist_styles(root: ET.Element, parents: dict[ET.Element, ET.Element], name: 
     for sheet in sheets:
         for selectors, declarations in _css_rules(sheet.text or ""):
             if selectors.startswith("@"):
-                ignored.append(selectors.split("{")[0].strip())
+                ignored.append(selectors)
                 continue
             odd = [
                 s.strip() for s in selectors.split(",") if not _SIMPLE_SELECTOR.fullmatch(s.strip())
@@ -338,9 +332,9 @@ def hoist_styles(root: ET.Element, parents: dict[ET.Element, ET.Element], name: 
     ]
 
 
-def _zero_opacity(value: str | None) -> bool:
-    """Whether an ``opacity`` value (``0``, ``0.0``, ``0%``) is 0; not a number: no."""
-    text = (value or "").strip()
+def zero_opacity(value: object) -> bool:
+    """Whether an ``opacity`` value (``0``, ``0.0``, ``0%``) is 0; absent or not a number: no."""
+    text = "" if value is None else str(value).strip()
     try:
         return (float(text[:-1]) / 100.0 if text.endswith("%") else float(text)) <= 0.0
     except ValueError:
@@ -357,7 +351,7 @@ def fade_under_transparent(root: ET.Element) -> None:
     """
     for element in root.iter():
         own = _style(element).get("opacity", element.get("opacity"))
-        if not _zero_opacity(own):
+        if not zero_opacity(own):
             continue
         for inner in element.iter():
             if inner is element or (
