@@ -24,13 +24,11 @@ from camtool.importers.svgdoc import (
     LAYER_ATTR,
     SOURCE_ATTR,
     USE_ATTR,
-    Affine,
     Prepared,
-    apply,
-    compose,
     prepare,
     zero_opacity,
 )
+from camtool.importers.svgpage import Affine, apply, compose
 from camtool.model.errors import GeometryError, InputError
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import (

@@ -14,36 +14,11 @@ import xml.etree.ElementTree as ET
 from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TypeAlias
 
 from camtool.importers import svgcheck
 from camtool.importers.options import MAX_ENTITIES, too_many_entities
-from camtool.model.errors import InputError, UsageError
-from camtool.model.shapes import Point
-from camtool.model.units import LENGTH_UNITS, PX
-
-Affine: TypeAlias = tuple[float, float, float, float, float, float]
-"""``(a, b, c, d, e, f)``: ``x' = a·x + c·y + e``, ``y' = b·x + d·y + f`` (SVG's ``matrix()``)."""
-
-
-def compose(outer: Affine, inner: Affine) -> Affine:
-    """The map ``outer ∘ inner``: ``inner`` is applied first."""
-    a1, b1, c1, d1, e1, f1 = outer
-    a2, b2, c2, d2, e2, f2 = inner
-    return (
-        a1 * a2 + c1 * b2,
-        b1 * a2 + d1 * b2,
-        a1 * c2 + c1 * d2,
-        b1 * c2 + d1 * d2,
-        a1 * e2 + c1 * f2 + e1,
-        b1 * e2 + d1 * f2 + f1,
-    )
-
-
-def apply(m: Affine, x: float, y: float) -> Point:
-    """The image of the point ``(x, y)`` under ``m``."""
-    return (m[0] * x + m[2] * y + m[4], m[1] * x + m[3] * y + m[5])
-
+from camtool.importers.svgpage import Affine, page_matrix
+from camtool.model.errors import InputError
 
 SVG_NS = "http://www.w3.org/2000/svg"
 INKSCAPE_NS = "http://www.inkscape.org/namespaces/inkscape"
@@ -586,7 +561,6 @@ _LENGTH_ATTRS = {
     "line": ("x1", "y1", "x2", "y2"),
 }
 _SIZES = frozenset({"width", "height", "r", "rx", "ry"})
-_PAGE_UNITS_MM = {**{u: LENGTH_UNITS[u] for u in ("mm", "cm", "in", "pt", "px")}, "pc": 25.4 / 6}
 _SKIP_REASONS = {
     "defs": "definitions are cut only where a <use> places them",
     "clipPath": "clipping is not applied: clipped shapes are cut whole",
@@ -698,122 +672,6 @@ def _parse(path: Path) -> ET.Element:
     if local_name(root) != "svg":
         raise InputError(f"{path}: not an SVG document (the root element is <{root.tag}>)")
     return root
-
-
-# ---------------------------------------------------------------------------- page
-
-
-def page_matrix(
-    root: ET.Element, name: str, warnings: list[str], units: str | None = None
-) -> tuple[Affine, tuple[float, float]]:
-    """Map from user units to mm, Y up, and the viewport size in user units.
-
-    Removes ``width``, ``height``, ``viewBox``, ``preserveAspectRatio``, ``x`` and ``y`` from
-    ``root``. Without an absolute ``width`` and ``height`` (missing, or in %) the user unit
-    is ``units`` (``--units``), else the px (1/96 in) with a warning; with a viewBox, one
-    missing side is taken from the viewBox's aspect ratio. Without a page height the Y
-    flip is about the user-unit origin.
-
-    Raises:
-        InputError: a malformed size or viewBox, or a size in a unit with no physical length.
-        UsageError: ``units`` for a document whose size is given in absolute units.
-    """
-    width, width_text = _page_length(root, "width", name)
-    height, height_text = _page_length(root, "height", name)
-    box = _viewbox(root, name)
-    if box is not None and width is not None and height is None:
-        height = width * box[3] / box[2]
-    elif box is not None and height is not None and width is None:
-        width = height * box[2] / box[3]
-    unit = PX
-    if width is None and height is None:
-        relative = [t for t in (width_text, height_text) if t]
-        what = f"relative size {' x '.join(relative)}" if relative else "no width/height"
-        if units is None:
-            warnings.append(f"{name}: {what}; user units taken as px (1/96 in)")
-        else:
-            unit = LENGTH_UNITS[units]
-    elif units is not None:
-        given = " x ".join(str(root.get(a)) for a in ("width", "height") if root.get(a))
-        raise UsageError(
-            f"--units {units}: {name} gives its size ({given}), so its units are known; "
-            "--units is for a drawing without them: leave it out, or use --scale to resize"
-        )
-    if box is None:
-        sx = sy = unit
-        tx = ty = 0.0
-        viewport = (width / PX, height / PX) if width and height else (1000.0, 1000.0)
-    elif width is None or height is None:
-        sx = sy = unit
-        tx, ty = -box[0] * unit, -box[1] * unit
-        height = box[3] * unit
-        viewport = (box[2], box[3])
-    else:
-        sx, sy, tx, ty = _fit_viewbox(width, height, box, root.get("preserveAspectRatio"), name)
-        viewport = (box[2], box[3])
-    for attr in ("width", "height", "viewBox", "preserveAspectRatio", "x", "y"):
-        root.attrib.pop(attr, None)
-    top = height if height is not None else 0.0
-    return (sx, 0.0, 0.0, -sy, tx, top - ty), viewport
-
-
-def _page_length(root: ET.Element, attr: str, name: str) -> tuple[float | None, str]:
-    """``(mm, "")`` for an absolute length, ``(None, text)`` for a % one, else ``(None, "")``."""
-    text = root.get(attr)
-    if text is None or text.strip() in ("", "auto"):
-        return None, ""
-    match = re.fullmatch(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*([a-zA-Z%]*)\s*", text)
-    if match is None:
-        raise InputError(f"{name}: <svg> {attr} {text!r} is not a length")
-    value, unit = float(match.group(1)), match.group(2)
-    if unit == "%":
-        return None, f"{attr}={text.strip()!r}"
-    if unit and unit not in _PAGE_UNITS_MM:
-        known = ", ".join(_PAGE_UNITS_MM)
-        raise InputError(f"{name}: <svg> {attr} {text!r}: unit {unit!r} unknown; use {known}")
-    if value <= 0:
-        raise InputError(f"{name}: <svg> {attr} {text!r} must be positive")
-    return value * _PAGE_UNITS_MM[unit or "px"], ""
-
-
-def _viewbox(root: ET.Element, name: str) -> tuple[float, float, float, float] | None:
-    text = root.get("viewBox")
-    if text is None:
-        return None
-    try:
-        x, y, w, h = (float(v) for v in re.split(r"[\s,]+", text.strip()))
-    except ValueError:
-        raise InputError(f"{name}: viewBox {text!r} must be four numbers") from None
-    if not (w > 0 and h > 0):
-        raise InputError(f"{name}: viewBox {text!r} must have a positive width and height")
-    return (x, y, w, h)
-
-
-def _fit_viewbox(
-    width: float,
-    height: float,
-    box: tuple[float, float, float, float],
-    aspect: str | None,
-    name: str,
-) -> tuple[float, float, float, float]:
-    """``(sx, sy, tx, ty)``: user units to mm, Y down (SVG 1.1 §7.8 preserveAspectRatio)."""
-    words = (aspect or "xMidYMid meet").split()
-    if words and words[0] == "defer":
-        words = words[1:]
-    align = words[0] if words else "xMidYMid"
-    mode = words[1] if len(words) > 1 else "meet"
-    aligns = {"none"} | {f"x{a}Y{b}" for a in ("Min", "Mid", "Max") for b in ("Min", "Mid", "Max")}
-    if align not in aligns or mode not in ("meet", "slice") or len(words) > 2:
-        raise InputError(f"{name}: preserveAspectRatio {aspect!r} is not valid")
-    sx, sy = width / box[2], height / box[3]
-    if align != "none":
-        sx = sy = min(sx, sy) if mode == "meet" else max(sx, sy)
-    share = {"Min": 0.0, "Mid": 0.5, "Max": 1.0}
-    fx = share[align[1:4]] if align != "none" else 0.0
-    fy = share[align[5:8]] if align != "none" else 0.0
-    tx = -box[0] * sx + fx * (width - box[2] * sx)
-    ty = -box[1] * sy + fy * (height - box[3] * sy)
-    return sx, sy, tx, ty
 
 
 # ---------------------------------------------------------------------------- labels, checks
