@@ -62,7 +62,8 @@ def expand_insert(
         :class:`~camtool.importers.dxf_entities.Item` for each placed entity (types in
         :data:`~camtool.importers.dxf_entities.CONVERTED` transformed, others as they
         are, for counting) and :class:`Skip` for content that cannot be placed: a
-        missing block, a block that contains itself, an entity the transform refuses.
+        missing block, a block that contains itself, an external reference (XREF: its
+        content is in another file), an entity the transform refuses.
         ATTRIBs of the INSERTs are yielded as items too (text, to be counted and
         skipped); ATTDEFs (attribute templates) are not.
 
@@ -93,6 +94,12 @@ def _expand(
         reason = f"block {name!r} contains itself"
     elif len(names) >= MAX_NESTING:
         reason = f"blocks nested deeper than {MAX_NESTING} levels"
+    elif _external(block):
+        path = block.block.dxf.get("xref_path", "") or "another file"
+        reason = (
+            f"block {name!r} is an external reference to {path}, which camtool does not read; "
+            "bind it in the CAD program (XREF > Bind) to cut it"
+        )
     if reason:
         yield Skip("INSERT", reason, label, layer, _moved(location(insert), parent))
         return
@@ -104,6 +111,14 @@ def _expand(
         chain = f" in INSERT #{insert.dxf.handle} (block {name!r}{cell}){within}"
         for entity in block:
             yield from _place(entity, matrix, layer, chain, (*names, name), limits)
+
+
+def _external(block: Any) -> bool:
+    """Whether ``block`` (an ezdxf BlockLayout) is an external reference (XREF or overlay)."""
+    try:
+        return bool(block.block.is_xref or block.block.is_xref_overlay)
+    except AttributeError:
+        return False
 
 
 def _place(

@@ -301,3 +301,21 @@ def test_missing_block_is_skipped_with_a_warning(tmp_path: Path) -> None:
     d = read_dxf(write_dxf(tmp_path / "g.dxf", build))
     assert len(d.contours) == 1
     assert any("INSERT" in w and "is missing" in w for w in d.warnings), d.warnings
+
+
+def test_an_external_reference_is_named_not_dropped_silently(tmp_path: Path) -> None:
+    """An XREF's block is empty here (its content is in the other file): say so."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    doc.add_xref_def("parts/bracket.dxf", "BRACKET")  # as AutoCAD's XATTACH writes it
+    doc.modelspace().add_blockref("BRACKET", (10, 10))
+    doc.modelspace().add_circle((50, 0), 5)
+    path = tmp_path / "x.dxf"
+    doc.saveas(path)
+    drawing = read_dxf(path)
+    assert len(drawing.contours) == 1
+    assert drawing.warnings == (
+        f"{path}: skipped 1 INSERT entity (block 'BRACKET' is an external reference to "
+        "parts/bracket.dxf, which camtool does not read; bind it in the CAD program "
+        "(XREF > Bind) to cut it)",
+    )
