@@ -324,9 +324,11 @@ def fade_under_transparent(root: ET.Element) -> None:
     ``opacity="1"`` would be drawn, and cut. Its own value is replaced by 0 (the SVG
     importer then skips it as invisible and counts it).
     """
-    for element in root.iter():
-        own = _style(element).get("opacity", element.get("opacity"))
-        if not zero_opacity(own):
+    stack = list(root)
+    while stack:  # each subtree under an opacity-0 element is walked once, not per level
+        element = stack.pop()
+        if not zero_opacity(_style(element).get("opacity", element.get("opacity"))):
+            stack.extend(element)
             continue
         for inner in element.iter():
             if inner is element or (
@@ -452,6 +454,7 @@ def choose_switches(
     """
     for switch in [e for e in root.iter() if local_name(e) == "switch"]:
         children = [c for c in switch if isinstance(c.tag, str)]
+        drawn = _is_drawn(switch, parents, hold)  # else placed by a <use>, or not at all
         for child in children:
             if child.get("systemLanguage") is not None and _has_shapes(child):
                 where = child.get(SOURCE_ATTR) or local_name(child) or "an element"
@@ -463,7 +466,7 @@ def choose_switches(
         shown = next((c for c in children if not (c.get("requiredExtensions") or "").strip()), None)
         for child in children:
             if child is not shown:
-                if _has_shapes(child) and _is_drawn(switch, parents, hold):
+                if drawn and _has_shapes(child):
                     counts["switch"] += 1
                 move(child, parents, hold)
 

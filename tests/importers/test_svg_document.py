@@ -290,6 +290,15 @@ def test_a_use_of_another_files_element_is_named(tmp_path: Path) -> None:
     )
 
 
+def test_a_switch_a_use_places_shows_its_first_child(tmp_path: Path) -> None:
+    body = (
+        '<defs><switch id="s"><path id="a" d="M 0 0 L 1 0"/><path id="b" d="M 0 5 L 1 5"/>'
+        '</switch></defs><use id="u" xlink:href="#s" x="1"/>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.source for c in drawing.contours] == ["use#u > path#a"]
+
+
 def test_a_switch_by_language_is_refused(tmp_path: Path) -> None:
     body = (
         '<switch><path id="fr" systemLanguage="fr" d="M 0 0 L 1 0"/>'
