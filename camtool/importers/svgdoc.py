@@ -203,6 +203,7 @@ _KEYWORDS = frozenset({"none", "hidden", "collapse", "visible", "inline", "block
 """Values read as keywords, any case (``NONE``); ``currentColor`` stays as svgelements knows it."""
 _IMPORTANT = re.compile(r"\s*!\s*important\s*$", re.IGNORECASE)
 _PRESENTATION = ("display", "visibility", "fill", "stroke")
+_OPACITY = re.compile(r"(?:^|;)\s*opacity\s*:\s*([^;]*)", re.IGNORECASE)
 
 
 def _declarations(text: str) -> str:
@@ -233,16 +234,18 @@ def normalize_styles(root: ET.Element) -> None:
     again with their declarations normalized (at-rules as they were).
     """
     for element in root.iter():
-        if element.get("style"):
-            element.set("style", _declarations(element.get("style", "")))
+        style = element.get("style")
+        if style and ("!" in style or style != style.lower()):  # else nothing to change
+            element.set("style", _declarations(style))
         for attr in _PRESENTATION:
             value = element.get(attr)
-            if value is not None and value.strip().lower() in _KEYWORDS:
+            if value is not None and value != value.lower() and value.strip().lower() in _KEYWORDS:
                 element.set(attr, value.strip().lower())
-        if local_name(element) == "style" and element.text:
-            element.text = "\n".join(
+    for sheet in _elements(root, "style"):
+        if sheet.text:
+            sheet.text = "\n".join(
                 f"{selectors}{{{body if selectors.startswith('@') else _declarations(body)}}}"
-                for selectors, body in _css_rules(element.text)
+                for selectors, body in _css_rules(sheet.text)
             )
 
 
@@ -272,7 +275,7 @@ def hoist_styles(root: ET.Element, parents: dict[ET.Element, ET.Element], name: 
             ``visibility:hidden`` (pseudo-classes such as ``:hover`` excepted: they hide
             nothing in a still picture).
     """
-    sheets = [e for e in root.iter() if local_name(e) == "style"]
+    sheets = _elements(root, "style")
     ignored: list[str] = []
     for sheet in sheets:
         for selectors, declarations in _css_rules(sheet.text or ""):
@@ -327,7 +330,9 @@ def fade_under_transparent(root: ET.Element) -> None:
     stack = list(root)
     while stack:  # each subtree under an opacity-0 element is walked once, not per level
         element = stack.pop()
-        if not zero_opacity(_style(element).get("opacity", element.get("opacity"))):
+        style = element.get("style", "")
+        found = _OPACITY.findall(style) if "opacity" in style else []  # a style's wins, its last
+        if not zero_opacity(found[-1] if found else element.get("opacity")):
             stack.extend(element)
             continue
         for inner in element.iter():
@@ -335,8 +340,8 @@ def fade_under_transparent(root: ET.Element) -> None:
                 "opacity" not in _style(inner) and "opacity" not in inner.attrib
             ):
                 continue
-            style = {k: v for k, v in _style(inner).items() if k != "opacity"}
-            inner.set("style", ";".join(f"{k}:{v}" for k, v in style.items()))
+            kept = {k: v for k, v in _style(inner).items() if k != "opacity"}
+            inner.set("style", ";".join(f"{k}:{v}" for k, v in kept.items()))
             inner.set("opacity", "0")
 
 
@@ -452,7 +457,7 @@ def choose_switches(
         InputError: a child with shapes chooses by ``systemLanguage``: which one the user
             sees depends on the viewer's language, which camtool cannot know.
     """
-    for switch in [e for e in root.iter() if local_name(e) == "switch"]:
+    for switch in _elements(root, "switch"):
         children = [c for c in switch if isinstance(c.tag, str)]
         drawn = _is_drawn(switch, parents, hold)  # else placed by a <use>, or not at all
         for child in children:
@@ -650,6 +655,11 @@ def prepare(
             reason = _SKIP_REASONS[kind]
             warnings.append(f"{path}: skipped {counts[kind]} <{kind}> {noun} ({reason})")
     return Prepared(ET.tostring(root), matrix, viewport, tuple(warnings))
+
+
+def _elements(root: ET.Element, name: str) -> list[ET.Element]:
+    """The SVG elements ``name`` under ``root``, in document order (ElementTree's own search)."""
+    return list(root.iter(_tag(root, name)))
 
 
 def _tag(root: ET.Element, name: str) -> str:
