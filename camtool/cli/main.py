@@ -135,7 +135,7 @@ def post(
 
     DRAWING may also be an existing G-code program (.ngc, .nc, .gcode, .tap ...):
     it is already a toolpath, so it is re-posted as it is, only --feed applies.
-    '-' reads stdin, a drawing or a program told by its content.
+    '-' reads a drawing from stdin, its kind told by its content.
 
     With --verify (implied by --report, --preview or --max-error-um) the written
     code is read back and simulated on the target's machine, as `verify` does.
@@ -143,7 +143,7 @@ def post(
     A job still running after 2 s says on stderr what it is doing, a line per stage.
     """
     from camtool.cli.progress import StageReporter
-    from camtool.jobs.inputs import STDIN, is_program_file, stdin_kind
+    from camtool.jobs.inputs import STDIN, drawing_kind, is_program_file
     from camtool.jobs.output import check_paths
     from camtool.jobs.pipeline import (
         load_target_checked,
@@ -177,6 +177,7 @@ def post(
     try:
         if drawing == "-":
             data = sys.stdin.buffer.read()
+            kind = drawing_kind(data, "if it is RS-274 G-code, save it as FILE.nc and post that")
             job = post_bytes(
                 data,
                 STDIN,
@@ -185,7 +186,7 @@ def post(
                 output_options,
                 import_options=settings,
                 job=job_spec,
-                kind=stdin_kind(data),
+                kind=kind,
                 progress=progress,
             )
         else:

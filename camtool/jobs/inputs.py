@@ -98,8 +98,8 @@ def stdin_kind(data: bytes) -> str:
         return PROGRAM_SUFFIXES[1]
     raise InputError(
         f"{STDIN}: cannot tell what it holds (it starts {lines[0][:40]!r}); camtool reads a "
-        "DXF, an SVG, a point list or a G-code program from stdin: save it to a file with "
-        "its ending (.dxf, .svg, .csv, .nc) and give that file"
+        "DXF, an SVG or a point list from stdin: save it to a file with its ending (.dxf, "
+        ".svg, .csv) and give that file"
     )
 
 
@@ -125,17 +125,22 @@ def read_input(
     return read_drawing(name, settings, check=check)
 
 
-def drawing_kind(data: bytes) -> str:
+def drawing_kind(data: bytes, remedy: str = "this needs a drawing (DXF, SVG, a point list)") -> str:
     """:func:`stdin_kind` of a drawing.
 
+    A program on stdin is refused, not read as G-code: a dialect's code (``pic-mmh``'s
+    ``G01X03600.00Y01400.00F08;`` in µm) looks like G-code, and only a file's ending or a
+    named target says which it is.
+
     Raises:
-        InputError: as :func:`stdin_kind`, or the input is a G-code program.
+        InputError: as :func:`stdin_kind`, or the input is a program (``remedy`` says what
+            to do instead).
     """
     kind = stdin_kind(data)
     if kind in PROGRAM_SUFFIXES:
         raise InputError(
-            f"{STDIN}: holds a G-code program, not a drawing; this needs a drawing "
-            "(DXF, SVG or a point list)"
+            f"{STDIN}: holds a program, which camtool does not read from stdin without "
+            f"knowing its dialect (a target's code looks like G-code); {remedy}"
         )
     return kind
 
@@ -209,6 +214,15 @@ def preview_inputs(
         UsageError: ``program_name`` given while ``input_name`` is not a drawing, or a
             program that cannot be read without a target.
     """
+    if input_name == "-" and target is None:  # no dialect named: a drawing, told by content
+        data = sys.stdin.buffer.read()
+        drawing = read_drawing_bytes(
+            data,
+            name=STDIN,
+            suffix=drawing_kind(data, "give --target NAME to draw it"),
+            options=settings,
+        )
+        return drawing, read_program(program_name, target) if program_name else None
     if input_name != "-" and Path(input_name).suffix.lower() in DRAWING_SUFFIXES:
         if not Path(input_name).is_file():
             raise InputError(f"{input_name}: no such file")

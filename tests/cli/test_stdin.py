@@ -121,26 +121,30 @@ def test_an_svg_from_stdin_is_read_as_svg(tmp_path: Path) -> None:
     assert _header_free(piped.stdout) == _header_free(named.stdout)
 
 
-def test_a_program_from_stdin_is_reposted(tmp_path: Path) -> None:
-    program = b"G21 G90\nG0 X10 Y0\nG1 Z-1 F100\nG2 X0 Y10 I-10 J0 F200\nG0 Z5\nM2\n"
-    (tmp_path / "p.nc").write_bytes(program)
-    piped = camtool(["post", "-", "-t", "grbl"], program)
-    named = camtool(["post", str(tmp_path / "p.nc"), "-t", "grbl"], b"")
-    assert piped.returncode == 0, piped.stderr
-    assert b"G2 X0.000 Y10.000 I-10.000 J0.000 F200" in piped.stdout
-    assert _header_free(piped.stdout) == _header_free(named.stdout)
-    refused = camtool(["post", "-", "-t", "grbl", "--depth", "1"], program)
-    assert refused.returncode == 2
-    assert b"<stdin> is already a toolpath (G-code): --depth only applies" in refused.stderr
+def test_a_program_on_stdin_is_refused_not_guessed() -> None:
+    """pic-mmh's code (fixed-width µm words) looks like G-code: read so, it would be 1000×."""
+    pic = b"G54;\nG90;\nG00X03000.00Y01400.00;\nG01X03600.00Y01400.00F08;\nM30;\n"
+    for args, remedy in (
+        (["post", "-", "-t", "grbl"], b"if it is RS-274 G-code, save it as FILE.nc"),
+        (["preview", "-", "-o", "-"], b"give --target NAME to draw it"),
+        (["inspect", "-"], b"this needs a drawing"),
+    ):
+        done = camtool(args, pic)
+        assert done.returncode == 3 and done.stdout == b""
+        assert b"<stdin>: holds a program, which camtool does not read from stdin" in done.stderr
+        assert remedy in done.stderr
+
+
+def test_preview_draws_a_drawing_from_stdin() -> None:
+    done = camtool(["preview", "-", "-o", "-"], (SAMPLES / "logo.dxf").read_bytes())
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith(b"<svg ") and done.stdout.rstrip().endswith(b"</svg>")
 
 
 def test_inspect_reads_stdin() -> None:
     done = camtool(["inspect", "-"], (SAMPLES / "logo.dxf").read_bytes())
     assert done.returncode == 0, done.stderr
     assert done.stdout.startswith(b"<stdin>\n") and b"contours: 5" in done.stdout
-    program = camtool(["inspect", "-"], b"G0 X1\nM2\n")
-    assert program.returncode == 3
-    assert b"<stdin>: holds a G-code program, not a drawing" in program.stderr
 
 
 @pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full")
