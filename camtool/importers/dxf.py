@@ -232,7 +232,7 @@ def _splines_ahead(msp: Any, reader: _Reader) -> dict[int, Any]:
     """The model space's SPLINEs on the layers read, fitted on the cores (:mod:`.dxf_prefit`)."""
     from camtool.importers.dxf_entities import check_numbers, layer_of, spline_segments
 
-    splines = [e for e in msp.query("SPLINE") if reader.keep(layer_of(e))]
+    splines = [e for e in msp.query("SPLINE") if reader.keep.reads(layer_of(e))]
     if len(splines) < MIN_SPLINES:
         return {}
 
@@ -283,7 +283,9 @@ def _check_size(path: Path, msp: Any, max_entities: int) -> Any:
 class _Reader:
     """Walks model space once; collects contours, skip counts, notes and entity counts."""
 
-    def __init__(self, tolerance: float, hatch: bool, keep: Any, limit: float, graph: Any) -> None:
+    def __init__(
+        self, tolerance: float, hatch: bool, keep: _LayerFilter, limit: float, graph: Any
+    ) -> None:
         self.tolerance = tolerance  # drawing units
         self.hatch = hatch
         self.keep = keep
@@ -637,14 +639,19 @@ class _LayerFilter:
         self.hidden = {k: v for k, v in hidden.items() if k not in named}
         self.dropped: Counter[str] = Counter()
 
-    def __call__(self, layer: str) -> bool:
+    def reads(self, layer: str) -> bool:
+        """Whether entities on ``layer`` are read (nothing counted: a look ahead)."""
         key = layer.casefold()
-        if self.wanted is not None and key not in self.wanted:
-            return False
-        if key in self.hidden:
+        return (self.wanted is None or key in self.wanted) and key not in self.hidden
+
+    def __call__(self, layer: str) -> bool:
+        """:meth:`reads`, for an entity being read: one left out for a hidden layer counts."""
+        if self.reads(layer):
+            return True
+        key = layer.casefold()
+        if key in self.hidden and (self.wanted is None or key in self.wanted):
             self.dropped[self.hidden[key]] += 1
-            return False
-        return True
+        return False
 
 
 def _invisible(entity: Any) -> bool:

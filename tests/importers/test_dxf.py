@@ -162,6 +162,7 @@ def _hidden_drawing(path: Path) -> Path:
         doc.layers.add("Frozen").freeze()
         doc.blocks.new("B").add_circle((0, 0), 1.0)
         msp.add_circle((0, 0), 5.0, dxfattribs={"layer": "OFF"})
+        msp.add_spline([(0, 0), (5, 5), (10, 0), (15, 5)], dxfattribs={"layer": "OFF"})
         msp.add_line((0, 0), (9, 0), dxfattribs={"layer": "Frozen"})
         msp.add_circle((20, 0), 5.0, dxfattribs={"invisible": 1})
         msp.add_line((0, 20), (9, 20), dxfattribs={"invisible": 1})
@@ -177,7 +178,7 @@ def test_hidden_layers_and_invisible_entities_are_not_cut(tmp_path: Path) -> Non
     drawing = read_dxf(path)
     assert [c.layer for c in drawing.contours] == ["PART"]
     assert drawing.warnings == (
-        f"{path}: skipped 2 entities on layer(s) 'Frozen', 'OFF', off or frozen in the drawing "
+        f"{path}: skipped 3 entities on layer(s) 'Frozen', 'OFF', off or frozen in the drawing "
         "(hidden, so not cut); name the layer in --layers or in a job operation to cut it",
         f"{path}: skipped 3 invisible entities (the entity's invisible flag is set: not shown, "
         "so not cut)",
@@ -189,7 +190,7 @@ def test_a_hidden_layer_named_is_read(tmp_path: Path) -> None:
 
     path = _hidden_drawing(tmp_path / "h.dxf")
     named = read_dxf(path, ImportOptions(layers=("off", "PART")))
-    assert sorted(c.layer for c in named.contours) == ["OFF", "PART"]
+    assert sorted(c.layer for c in named.contours) == ["OFF", "OFF", "PART"]
     assert not any("hidden" in w for w in named.warnings)
     by_job = read_dxf(path, ImportOptions(shown=("FROZEN",)))  # a job's operation names it
     assert sorted(c.layer for c in by_job.contours) == ["Frozen", "PART"]
