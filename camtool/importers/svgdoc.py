@@ -168,13 +168,16 @@ def _hidden(element: ET.Element) -> bool:
     return display.strip().lower() == "none"
 
 
+def _set_style(element: ET.Element, name: str, value: str) -> None:
+    """Set ``name`` to ``value`` in ``element``'s style and its attribute (both say the same)."""
+    style = {k: v for k, v in _style(element).items() if k != name}
+    element.set("style", ";".join(f"{k}:{v}" for k, v in [*style.items(), (name, value)]))
+    element.set(name, value)
+
+
 def _show(element: ET.Element) -> None:
     if _hidden(element):
-        style = {k: v for k, v in _style(element).items() if k != "display"}
-        element.set(
-            "style", ";".join(f"{k}:{v}" for k, v in [*style.items(), ("display", "inline")])
-        )
-        element.set("display", "inline")
+        _set_style(element, "display", "inline")
 
 
 # ---------------------------------------------------------------------------- style sheets
@@ -336,13 +339,8 @@ def fade_under_transparent(root: ET.Element) -> None:
             stack.extend(element)
             continue
         for inner in element.iter():
-            if inner is element or (
-                "opacity" not in _style(inner) and "opacity" not in inner.attrib
-            ):
-                continue
-            kept = {k: v for k, v in _style(inner).items() if k != "opacity"}
-            inner.set("style", ";".join(f"{k}:{v}" for k, v in kept.items()))
-            inner.set("opacity", "0")
+            if inner is not element and ("opacity" in inner.attrib or "opacity" in _style(inner)):
+                _set_style(inner, "opacity", "0")
 
 
 # ---------------------------------------------------------------------------- skipped

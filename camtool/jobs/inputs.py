@@ -74,7 +74,9 @@ def stdin_kind(data: bytes) -> str:
         return ".dxf"
     text = data[:_SNIFF_BYTES].decode("utf-8", errors="replace").lstrip("\ufeff \t\r\n")
     if not text:
-        raise InputError(f"{STDIN}: empty input; pipe a drawing or a program into camtool")
+        raise InputError(
+            f"{STDIN}: empty input; pipe a drawing (DXF, SVG, a point list) into camtool"
+        )
     if text.startswith("<"):
         return ".svg"
     lines = [line.strip() for line in text.splitlines() if line.strip()]

@@ -401,12 +401,11 @@ class _LazyTree:
     def _build(self) -> Any:
         from scipy.spatial import cKDTree
 
-        # the same tree without its own copy of the ends (~13 MB for 800 000): the
-        # points are not written to while it lives; boxes not shrunk to their points
-        # (the same answers; 20 % less to build on a long trace); split at the sliding
-        # midpoint, not the median (3x faster to build): the same nearest distances, and
-        # where two ends tie at the k-th, the choice moves a distance the vertex bound
-        # accepts by at most NEAREST_TOLERANCE_MM (docs/performance.md)
+        # no copy of the ends: the points are not written to while the tree lives; boxes
+        # not shrunk to their points, and split at the sliding midpoint, not the median:
+        # quicker to build (the last contour waits for it; docs/performance.md), the same
+        # nearest distances. Where two ends tie at the k-th, the tree's choice moves a
+        # distance the vertex bound accepts by at most NEAREST_TOLERANCE_MM.
         return cKDTree(self.points, copy_data=False, compact_nodes=False, balanced_tree=False)
 
     def build_beside(self) -> None:
