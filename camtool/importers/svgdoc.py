@@ -17,10 +17,10 @@ from pathlib import Path
 
 from camtool.importers import svgcheck
 from camtool.importers.options import MAX_ENTITIES, too_many_entities
+from camtool.importers.svgcss import SVG_NS, apply_style_sheets, local_name, normalize_styles
 from camtool.importers.svgpage import Affine, page_matrix
 from camtool.model.errors import InputError
 
-SVG_NS = "http://www.w3.org/2000/svg"
 INKSCAPE_NS = "http://www.inkscape.org/namespaces/inkscape"
 XLINK_HREF = "{http://www.w3.org/1999/xlink}href"
 _CAMTOOL_NS = "urn:camtool:svg"
@@ -66,17 +66,6 @@ _NOT_DRAWN = frozenset(
     ]
 )
 _HOLD_KINDS = frozenset({"symbol", "marker", "mask", "flowRoot"})
-
-
-def local_name(element: ET.Element) -> str | None:
-    """The tag without the SVG namespace; ``None`` for elements of other namespaces."""
-    tag = element.tag
-    if not isinstance(tag, str):
-        return None  # comments, processing instructions
-    if tag.startswith("{"):
-        ns, _, name = tag[1:].partition("}")
-        return name if ns == SVG_NS else None
-    return tag
 
 
 # ---------------------------------------------------------------------------- layers
@@ -180,137 +169,7 @@ def _show(element: ET.Element) -> None:
         _set_style(element, "display", "inline")
 
 
-# ---------------------------------------------------------------------------- style sheets
-
-_SIMPLE_SELECTOR = re.compile(r"\*|[A-Za-z][\w-]*|#[\w-]+|\.[\w-]+|[A-Za-z][\w-]*\.[\w-]+")
-"""The selectors svgelements applies: ``*``, ``tag``, ``#id``, ``.class``, ``tag.class``."""
-_CSS_COMMENT = re.compile(r"/\*.*?\*/", re.DOTALL)
-
-
-def _css_rules(text: str) -> list[tuple[str, str]]:
-    """``(selector list, declarations)`` of a style sheet; an at-rule's body as one text."""
-    text = _CSS_COMMENT.sub("", text)
-    rules: list[tuple[str, str]] = []
-    at = 0
-    while (opening := text.find("{", at)) >= 0:
-        depth, end = 1, opening + 1
-        while end < len(text) and depth:
-            depth += {"{": 1, "}": -1}.get(text[end], 0)
-            end += 1
-        rules.append((text[at:opening].strip(), text[opening + 1 : end - 1]))
-        at = end
-    return rules
-
-
-_KEYWORDS = frozenset({"none", "hidden", "collapse", "visible", "inline", "block"})
-"""Values read as keywords, any case (``NONE``); ``currentColor`` stays as svgelements knows it."""
-_IMPORTANT = re.compile(r"\s*!\s*important\s*$", re.IGNORECASE)
-_PRESENTATION = ("display", "visibility", "fill", "stroke")
 _OPACITY = re.compile(r"(?:^|;)\s*opacity\s*:\s*([^;]*)", re.IGNORECASE)
-
-
-def _declarations(text: str) -> str:
-    """CSS declarations as svgelements compares them: ``display:none``.
-
-    Not ``DISPLAY: None !important``: property names in lower case, keywords too,
-    ``!important`` dropped.
-    """
-    out = []
-    for item in text.split(";"):
-        key, colon, value = item.partition(":")
-        if not colon:
-            out.append(item)  # a piece of a value that held a ';' (a data: URL), kept
-            continue
-        value = _IMPORTANT.sub("", value).strip()
-        out.append(
-            f"{key.strip().lower()}:{value.lower() if value.lower() in _KEYWORDS else value}"
-        )
-    return ";".join(out)
-
-
-def normalize_styles(root: ET.Element) -> None:
-    """Every ``style`` attribute, presentation attribute and style sheet as svgelements reads it.
-
-    CSS property names and keywords are case-insensitive and ``!important`` only ranks a
-    declaration; svgelements compares the text, so ``display:none !important`` or
-    ``DISPLAY: NONE`` hid nothing and the element was cut. A style sheet's rules are written
-    again with their declarations normalized (at-rules as they were).
-    """
-    for element in root.iter():
-        style = element.get("style")
-        if style and ("!" in style or style != style.lower()):  # else nothing to change
-            element.set("style", _declarations(style))
-        for attr in _PRESENTATION:
-            value = element.get(attr)
-            if value is not None and value != value.lower() and value.strip().lower() in _KEYWORDS:
-                element.set(attr, value.strip().lower())
-    for sheet in _elements(root, "style"):
-        if sheet.text:
-            sheet.text = "\n".join(
-                f"{selectors}{{{body if selectors.startswith('@') else _declarations(body)}}}"
-                for selectors, body in _css_rules(sheet.text)
-            )
-
-
-def _hides(declarations: str) -> str | None:
-    """The declaration of ``declarations`` that hides what it styles (``display:none``), if any."""
-    for item in _declarations(declarations).split(";"):
-        if item in ("display:none", "visibility:hidden", "visibility:collapse"):
-            return item
-    return None
-
-
-def hoist_styles(root: ET.Element, parents: dict[ET.Element, ET.Element], name: str) -> list[str]:
-    """Move every ``<style>`` to the start of the document; refuse rules it cannot apply.
-
-    CSS applies a style sheet to the whole document wherever it stands; svgelements applies
-    it only to the elements after it, so a sheet at the end (or moved to the end with the
-    undrawn elements) would hide nothing. svgelements applies rules whose selector names one
-    element (:data:`_SIMPLE_SELECTOR`); a rule with another selector (``g.hidden rect``,
-    ``.a > .b``) that hides what it selects would leave its elements drawn, and cut.
-
-    Returns:
-        Warnings: rules not applied that hide nothing (their colours are not read), and
-        at-rules (``@media``, ``@import``).
-
-    Raises:
-        InputError: a rule svgelements cannot apply sets ``display:none`` or
-            ``visibility:hidden`` (pseudo-classes such as ``:hover`` excepted: they hide
-            nothing in a still picture).
-    """
-    sheets = _elements(root, "style")
-    ignored: list[str] = []
-    for sheet in sheets:
-        for selectors, declarations in _css_rules(sheet.text or ""):
-            if selectors.startswith("@"):
-                ignored.append(selectors)
-                continue
-            odd = [
-                s.strip() for s in selectors.split(",") if not _SIMPLE_SELECTOR.fullmatch(s.strip())
-            ]
-            hiding = _hides(declarations)
-            for selector in odd:
-                if hiding is not None and ":" not in selector:
-                    raise InputError(
-                        f"{name}: the <style> rule '{selector}' hides what it selects "
-                        f"({hiding}), but camtool applies only rules that name one element "
-                        "(rect, .class, #id, rect.class), so those elements would be cut; "
-                        f"put {hiding} on the elements themselves (a style attribute), or "
-                        "delete them"
-                    )
-                ignored.append(selector)
-    for position, sheet in enumerate(sheets):
-        parents[sheet].remove(sheet)
-        root.insert(position, sheet)
-        parents[sheet] = root
-    if not ignored:
-        return []
-    shown = ", ".join(f"'{s}'" for s in ignored[:3]) + (" ..." if len(ignored) > 3 else "")
-    return [
-        f"{name}: {len(ignored)} <style> rule(s) not applied ({shown}): camtool applies rules "
-        "that name one element (rect, .class, #id, rect.class); what they style is read "
-        "without them"
-    ]
 
 
 def zero_opacity(value: object) -> bool:
@@ -624,8 +483,8 @@ def prepare(
     warnings: list[str] = []
     matrix, viewport = page_matrix(root, str(path), warnings, units)
     parents = {child: parent for parent in root.iter() for child in parent}
+    warnings += apply_style_sheets(root, parents, str(path))
     normalize_styles(root)
-    warnings += hoist_styles(root, parents, str(path))
     _label_and_check(root, str(path))
     check_use_cycles(root, str(path))
     check_size(root, str(path), max_entities)

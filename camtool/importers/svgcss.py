@@ -1,0 +1,318 @@
+"""SVG style sheets applied as CSS does, before svgelements reads the document.
+
+svgelements applies a ``<style>`` sheet in its own order: only to the elements after the
+sheet, the ``#id`` rules before the ``.class`` rules whatever their specificity, an inline
+style above every rule even ``!important`` ones, and only rules whose selector names one
+element. Each of these once cut a shape a browser hides (``.off{display:none !important}``
+over ``style="display:inline"``) or dropped one it shows (``#b{display:inline}`` over
+``.a{display:none}``). :func:`apply_style_sheets` computes the cascade itself and writes the
+result into each element's ``style`` attribute; the sheets are then removed, so svgelements
+reads inline styles only.
+
+The cascade (CSS Cascading and Inheritance Level 4, section 6; Selectors Level 3, section 9
+for specificity), for each property of an element, highest first: an inline ``!important``
+declaration; a sheet's ``!important`` declaration; the inline style; a sheet's declaration;
+the presentation attribute (left where it is: svgelements ranks it below the style). Among
+sheet declarations the more specific selector wins, then the later one. Inheritance is
+svgelements' (it passes a group's style down).
+
+Selectors applied: compound selectors (``*``, a type, ``#id``, ``.class``, any together:
+``path.cut.outer``, ``rect#a``) joined by descendant (space) or child (``>``) combinators.
+Others (attributes ``[x]``, pseudo-classes ``:hover``, sibling combinators ``+``/``~``,
+at-rules ``@media``) are not applied: :func:`apply_style_sheets` refuses such a rule if it
+hides what it selects, and names the others in a warning.
+"""
+
+from __future__ import annotations
+
+import re
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+
+from camtool.model.errors import InputError
+
+SVG_NS = "http://www.w3.org/2000/svg"
+
+
+def local_name(element: ET.Element) -> str | None:
+    """The tag without the SVG namespace; ``None`` for elements of other namespaces."""
+    tag = element.tag
+    if not isinstance(tag, str):
+        return None  # comments, processing instructions
+    if tag.startswith("{"):
+        ns, _, name = tag[1:].partition("}")
+        return name if ns == SVG_NS else None
+    return tag
+
+
+_CSS_COMMENT = re.compile(r"/\*.*?\*/", re.DOTALL)
+_KEYWORDS = frozenset({"none", "hidden", "collapse", "visible", "inline", "block"})
+"""Values read as keywords, any case (``NONE``); ``currentColor`` stays as svgelements knows it."""
+_IMPORTANT = re.compile(r"\s*!\s*important\s*$", re.IGNORECASE)
+_PRESENTATION = ("display", "visibility", "fill", "stroke")
+_COMPOUND = re.compile(r"(\*|[A-Za-z_][\w-]*)?((?:[#.][\w-]+)*)")
+_COMBINATOR_OR_COMPOUND = re.compile(r"\s*(>)\s*|\s+|([^\s>]+)")
+_HIDING = ("display:none", "visibility:hidden", "visibility:collapse")
+
+
+def _css_rules(text: str) -> list[tuple[str, str]]:
+    """``(selector list, declarations)`` of a style sheet; an at-rule's body as one text."""
+    text = _CSS_COMMENT.sub("", text)
+    rules: list[tuple[str, str]] = []
+    at = 0
+    while (opening := text.find("{", at)) >= 0:
+        depth, end = 1, opening + 1
+        while end < len(text) and depth:
+            depth += {"{": 1, "}": -1}.get(text[end], 0)
+            end += 1
+        rules.append((text[at:opening].strip(), text[opening + 1 : end - 1]))
+        at = end
+    return rules
+
+
+def _declaration_list(text: str) -> list[tuple[str, str, bool]]:
+    """``(property, value, important)`` of CSS declarations, in their order.
+
+    Property names in lower case, keywords (:data:`_KEYWORDS`) too; ``!important`` taken off
+    the value. A piece without a colon belongs to the value before it (a ``data:`` URL's
+    ``;``).
+    """
+    out: list[tuple[str, str, bool]] = []
+    for item in text.split(";"):
+        key, colon, value = item.partition(":")
+        if not colon:
+            if out and item.strip():
+                name, before, important = out[-1]
+                out[-1] = (name, f"{before};{item.strip()}", important)
+            continue
+        important = _IMPORTANT.search(value) is not None
+        value = _IMPORTANT.sub("", value).strip()
+        keyword = value.lower()
+        out.append((key.strip().lower(), keyword if keyword in _KEYWORDS else value, important))
+    return out
+
+
+def _style_text(declarations: dict[str, str]) -> str:
+    return ";".join(f"{k}:{v}" for k, v in declarations.items())
+
+
+def normalize_styles(root: ET.Element) -> None:
+    """Every ``style`` attribute and presentation attribute as svgelements reads it.
+
+    CSS property names and keywords are case-insensitive and ``!important`` only ranks a
+    declaration; svgelements compares the text, so ``display:none !important`` or
+    ``DISPLAY: NONE`` hid nothing and the element was cut.
+    """
+    for element in root.iter():
+        style = element.get("style")
+        if style and ("!" in style or style != style.lower()):  # else nothing to change
+            element.set("style", _style_text({k: v for k, v, _ in _declaration_list(style)}))
+        for attr in _PRESENTATION:
+            value = element.get(attr)
+            if value is not None and value != value.lower() and value.strip().lower() in _KEYWORDS:
+                element.set(attr, value.strip().lower())
+
+
+# ---------------------------------------------------------------------------- selectors
+
+
+@dataclass(frozen=True)
+class _Compound:
+    """One compound selector: ``path.cut#a``; ``tag`` ``None`` for any (``*`` or none)."""
+
+    tag: str | None
+    ids: frozenset[str]
+    classes: frozenset[str]
+
+    def matches(self, element: ET.Element, classes: frozenset[str]) -> bool:
+        if self.tag is not None and local_name(element) != self.tag:
+            return False
+        if self.ids and self.ids != {element.get("id")}:
+            return False
+        return self.classes <= classes
+
+
+@dataclass(frozen=True)
+class _Selector:
+    """A selector read right to left, ``parts[0]`` its subject.
+
+    ``child[i]``: whether ``parts[i + 1]`` must be the parent of ``parts[i]`` (``>``) or may
+    be any ancestor (space).
+    """
+
+    parts: tuple[_Compound, ...]
+    child: tuple[bool, ...]
+    specificity: tuple[int, int, int]
+
+
+def _compound(text: str) -> _Compound | None:
+    match = _COMPOUND.fullmatch(text)
+    if match is None or not text:
+        return None
+    names = re.findall(r"[#.][\w-]+", match.group(2))
+    tag = match.group(1)
+    return _Compound(
+        None if tag in (None, "*") else tag,
+        frozenset(n[1:] for n in names if n[0] == "#"),
+        frozenset(n[1:] for n in names if n[0] == "."),
+    )
+
+
+def _selector(text: str) -> _Selector | None:
+    """The selector ``text``, or ``None`` if it uses what :mod:`svgcss` does not apply."""
+    parts: list[_Compound] = []
+    child: list[bool] = []
+    pending_child = False
+    for match in _COMBINATOR_OR_COMPOUND.finditer(text.strip()):
+        if match.group(1):
+            if not parts or pending_child:
+                return None
+            pending_child = True
+        elif match.group(2):
+            compound = _compound(match.group(2))
+            if compound is None:
+                return None
+            if parts:
+                child.append(pending_child)
+            parts.append(compound)
+            pending_child = False
+    if not parts or pending_child:
+        return None
+    ids = sum(len(p.ids) for p in parts)
+    classes = sum(len(p.classes) for p in parts)
+    tags = sum(p.tag is not None for p in parts)
+    return _Selector(tuple(reversed(parts)), tuple(reversed(child)), (ids, classes, tags))
+
+
+def _classes(element: ET.Element) -> frozenset[str]:
+    return frozenset(element.get("class", "").split())
+
+
+def _matches(
+    selector: _Selector, element: ET.Element, parents: dict[ET.Element, ET.Element], at: int = 0
+) -> bool:
+    if not selector.parts[at].matches(element, _classes(element)):
+        return False
+    if at + 1 == len(selector.parts):
+        return True
+    parent = parents.get(element)
+    if selector.child[at]:
+        return parent is not None and _matches(selector, parent, parents, at + 1)
+    while parent is not None:
+        if _matches(selector, parent, parents, at + 1):
+            return True
+        parent = parents.get(parent)
+    return False
+
+
+# ---------------------------------------------------------------------------- the cascade
+
+
+@dataclass(frozen=True)
+class _Rule:
+    selector: _Selector
+    order: int
+    declarations: tuple[tuple[str, str, bool], ...]
+
+
+def apply_style_sheets(
+    root: ET.Element, parents: dict[ET.Element, ET.Element], name: str
+) -> list[str]:
+    """Apply every ``<style>`` sheet to the elements' ``style`` attributes, then remove it.
+
+    See the module docstring for the cascade and the selectors applied. A document without
+    sheets is left as it is.
+
+    Args:
+        root: the ``<svg>`` element.
+        parents: each element's parent (the removed sheets are taken out of it).
+        name: the file, for messages.
+
+    Returns:
+        A warning naming the rules not applied, if any (at-rules, pseudo-classes, attribute
+        selectors, sibling combinators): what they style is read without them.
+
+    Raises:
+        InputError: a rule not applied would hide what it selects (``display:none``,
+            ``visibility:hidden``), so its elements would be cut; pseudo-classes such as
+            ``:hover`` excepted, which hide nothing in a still picture.
+    """
+    sheets = [e for e in root.iter() if local_name(e) == "style"]
+    if not sheets:
+        return []
+    rules: list[_Rule] = []
+    ignored: list[str] = []
+    for sheet in sheets:
+        for selectors, body in _css_rules(sheet.text or ""):
+            if selectors.startswith("@"):
+                ignored.append(selectors)
+                continue
+            declarations = tuple(_declaration_list(body))
+            for text in (s.strip() for s in selectors.split(",")):
+                selector = _selector(text)
+                if selector is not None:
+                    rules.append(_Rule(selector, len(rules), declarations))
+                    continue
+                said = (f"{k}:{v}" for k, v, _ in declarations)
+                hiding = next((d for d in said if d in _HIDING), None)
+                if hiding is not None and ":" not in text:
+                    raise InputError(
+                        f"{name}: the <style> rule '{text}' hides what it selects ({hiding}), "
+                        "but camtool does not apply its selector (it applies types, .class, "
+                        "#id and their descendants), so those elements would be cut; put "
+                        f"{hiding} on the elements themselves (a style attribute), or delete them"
+                    )
+                ignored.append(text)
+    for sheet in sheets:
+        parents[sheet].remove(sheet)
+        del parents[sheet]
+    if rules:
+        _cascade(root, parents, rules)
+    if not ignored:
+        return []
+    shown = ", ".join(f"'{s}'" for s in ignored[:3]) + (" ..." if len(ignored) > 3 else "")
+    return [
+        f"{name}: {len(ignored)} <style> rule(s) not applied ({shown}): camtool applies types, "
+        ".class, #id and their descendants; what they style is read without them"
+    ]
+
+
+def _cascade(root: ET.Element, parents: dict[ET.Element, ET.Element], rules: list[_Rule]) -> None:
+    """Write each element's cascaded style (sheet rules in ``rules``' order) into ``style``."""
+    by_key: dict[str, list[_Rule]] = {}
+    for rule in rules:  # indexed by what the subject names, so each element asks a few rules
+        subject = rule.selector.parts[0]
+        key = (
+            f"#{min(subject.ids)}"
+            if subject.ids
+            else f".{min(subject.classes)}"
+            if subject.classes
+            else subject.tag or "*"
+        )
+        by_key.setdefault(key, []).append(rule)
+    for element in root.iter():
+        tag = local_name(element)
+        if tag is None:
+            continue
+        keys = ["*", tag, *(f".{c}" for c in _classes(element))]
+        if element.get("id"):
+            keys.append(f"#{element.get('id')}")
+        matched = [
+            rule
+            for key in keys
+            for rule in by_key.get(key, ())
+            if _matches(rule.selector, element, parents)
+        ]
+        if not matched:
+            continue
+        matched.sort(key=lambda r: (r.selector.specificity, r.order))
+        normal: dict[str, str] = {}
+        important: dict[str, str] = {}
+        for rule in matched:
+            for key, value, is_important in rule.declarations:
+                (important if is_important else normal)[key] = value
+        inline = _declaration_list(element.get("style", ""))
+        normal.update((k, v) for k, v, i in inline if not i)
+        normal.update(important)
+        normal.update((k, v) for k, v, i in inline if i)
+        element.set("style", _style_text(normal))
