@@ -11,6 +11,9 @@ apt lists exist; as root with no lists it runs ``apt-get update`` once):
   (``usr/share/librecad/library``);
 - ``tango-icon-theme``: the Tango icons, SVG drawn in Inkscape by many hands
   (``usr/share/icons/Tango/scalable``, symlinked aliases skipped);
+- ``breeze-icon-theme``: KDE's Breeze icons, SVG with ``<style>`` sheets (a colour scheme
+  applied by class, ``fill:currentColor``), a varied pick of those with a sheet
+  (``usr/share/icons/breeze``);
 - ``inkscape`` (optional, 20 MB download; only ``usr/share/inkscape/examples/*.svg`` is kept);
 - OpenSCAD's examples exported with ``openscad -o X.dxf`` — only when an ``openscad`` binary is
   already on PATH (the package pulls in Qt; it is not installed here), 2D examples only;
@@ -19,13 +22,13 @@ apt lists exist; as root with no lists it runs ``apt-get update`` once):
   lacks them), used by tests/corpus/test_rs274.py as an independent judge of linuxcnc output.
 
 The result is ``DEST/manifest.json``: the file lists, paths relative to DEST (``full``, and
-a deterministic, varied ``sample`` of :data:`SAMPLE_SIZE` per kind), and the ``rs274``
+a deterministic, varied ``sample``, :data:`SAMPLE_SIZE` of each kind), and the ``rs274``
 command. The script is
 idempotent (a cached package is neither downloaded nor extracted again) and always exits 0:
 when apt or the network is missing it says so and the corpus tests skip with that reason.
 Nothing under DEST is ever committed (``.corpus/`` is in .gitignore).
 
-The first fetch downloads about 47 MB of packages (about 215 MB in DEST once unpacked); ``make
+The first fetch downloads about 50 MB of packages (about 250 MB in DEST once unpacked); ``make
 test`` runs it. ``CAMTOOL_CORPUS=off`` (as for the corpus tests, which then skip) fetches
 nothing and touches no network: ``CAMTOOL_CORPUS=off make test`` works offline at once.
 """
@@ -45,9 +48,12 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_DEST = ROOT / ".corpus"
 MANIFEST = "manifest.json"
-SAMPLE_SIZE = 30
+SAMPLE_SIZE = {"dxf": 30, "svg": 45}
+"""Files of each kind in the sample, an equal share per source (15 SVGs each for three)."""
 TANGO_ICONS = 60
-MANIFEST_VERSION = 1
+BREEZE_ICONS = 60
+MANIFEST_VERSION = 2
+"""Raised when the sources change (2: Breeze added); an older cached manifest is rebuilt."""
 OFF_SWITCH = "CAMTOOL_CORPUS"
 """The environment variable whose value ``off`` skips the fetch (and the corpus tests)."""
 
@@ -65,6 +71,7 @@ HEAVY = {
 LIBRECAD_DIR = "usr/share/librecad/library"
 TANGO_DIR = "usr/share/icons/Tango/scalable"
 INKSCAPE_DIR = "usr/share/inkscape/examples"
+BREEZE_DIR = "usr/share/icons/breeze"
 RS274 = "usr/bin/rs274"
 # rs274's libraries that a plain Debian system lacks, by soname prefix -> package.
 RS274_LIBS = {
@@ -194,6 +201,15 @@ def fetch_tango(dest: Path) -> list[Path]:
     return varied_sample(files_under(root / TANGO_DIR, ".svg"), root / TANGO_DIR, TANGO_ICONS)
 
 
+def fetch_breeze(dest: Path) -> list[Path]:
+    """Breeze's icons with a ``<style>`` sheet: a varied pick of BREEZE_ICONS SVG files."""
+    deb = fetch_deb("breeze-icon-theme", dest / "debs")
+    root = extract(deb, dest / "pkg" / "breeze-icon-theme", [f"./{BREEZE_DIR}/*.svg"])
+    top = root / BREEZE_DIR
+    sheets = [f for f in files_under(top, ".svg") if b"<style" in f.read_bytes()]
+    return varied_sample(sheets, top, BREEZE_ICONS)
+
+
 def fetch_inkscape(dest: Path) -> list[Path]:
     """Inkscape's example drawings (plain .svg only)."""
     deb = fetch_deb("inkscape", dest / "debs")
@@ -266,6 +282,7 @@ def build_manifest(dest: Path) -> dict[str, object]:
     sources = [
         ("dxf", fetch_librecad),
         ("svg", fetch_tango),
+        ("svg", fetch_breeze),
         ("svg", fetch_inkscape),
         ("dxf", fetch_openscad),
     ]
@@ -284,7 +301,9 @@ def build_manifest(dest: Path) -> dict[str, object]:
         full = [_rel(f, dest) for _, files in pool for f in files]
         sample: list[Path] = []
         for i, (top, files) in enumerate(pool):
-            share = (SAMPLE_SIZE - len(sample)) // (len(pool) - i)  # an equal share per source
+            share = (SAMPLE_SIZE[kind] - len(sample)) // (
+                len(pool) - i
+            )  # an equal share per source
             light = [f for f in files if f.name not in HEAVY]
             sample += varied_sample(light, top, share)
         manifest[kind] = {"full": full, "sample": [_rel(f, dest) for f in sample]}
@@ -308,11 +327,15 @@ def main(argv: list[str] | None = None) -> int:
     dest: Path = args.dest.resolve()
     path = dest / MANIFEST
     if path.exists() and not args.refresh:
-        notes = json.loads(path.read_text()).get("notes", [])
-        if not notes:
+        cached = json.loads(path.read_text())
+        notes = cached.get("notes", [])
+        if cached.get("version") != MANIFEST_VERSION:
+            log(f"{path} lists an older set of sources: rebuilding it")
+        elif not notes:
             log(f"cached: {path} (--refresh to rebuild)")
             return 0
-        log(f"retrying what failed last time: {'; '.join(notes)}")
+        else:
+            log(f"retrying what failed last time: {'; '.join(notes)}")
     try:
         _apt_ready()
     except FetchError as exc:
