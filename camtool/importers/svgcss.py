@@ -237,7 +237,7 @@ def apply_style_sheets(
             ``visibility:hidden``), so its elements would be cut; pseudo-classes such as
             ``:hover`` excepted, which hide nothing in a still picture.
     """
-    sheets = [e for e in root.iter() if local_name(e) == "style"]
+    sheets = list(root.iter(f"{{{SVG_NS}}}style" if root.tag.startswith("{") else "style"))
     if not sheets:
         return []
     rules: list[_Rule] = []
