@@ -290,7 +290,8 @@ def run_job(
                     f"{drawing.source or 'the drawing'}: nothing to cut: every contour is "
                     "construction (" + "; ".join(construction_notes(chosen.construction)) + ")"
                 )
-            raise InputError(f"{job.source or 'the job'}: {nothing_selected(scaled, op, where)}")
+            about = drawing.source if job.shorthand else job.source  # the options: the drawing
+            raise InputError(f"{about or 'the job'}: {nothing_selected(scaled, op, where)}")
         last = number == len(sequence)
         try:
             options = _operation_options(target, op, setup, here, last)

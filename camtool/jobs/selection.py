@@ -106,18 +106,26 @@ def select(drawing: Drawing, selection: Selection) -> Selected:
 def nothing_selected(drawing: Drawing, op: Operation, where: str) -> str:
     """Why an operation selects nothing, naming what the drawing does have."""
     s = op.select
+    selects = "select" if where.endswith("options") else "selects"  # "the options select"
+    if not drawing.contours and drawing.marks and not s.points:
+        n = len(drawing.marks)
+        return (
+            f"{where} {selects} nothing: the drawing has no contour, only {n} point"
+            f"{'s' if n > 1 else ''} (DXF POINT entities); a drill operation drills points "
+            "(a job file, docs/jobs.md), or draw the contours to cut"
+        )
     layers = sorted({c.layer for c in drawing.contours} | {m.layer for m in drawing.marks})
     if s.layers is not None:
         present = {name.casefold() for name in layers}
         missing = [n for n in s.layers if n.casefold() not in present]
         if missing:
             return (
-                f"{where} selects layer {', '.join(repr(n) for n in missing)}; the drawing has "
+                f"{where} {selects} layer {', '.join(repr(n) for n in missing)}; the drawing has "
                 f"{', '.join(layers)}"
             )
     colours = sorted({c.colour for c in drawing.contours if c.colour})
     return (
-        f"{where} selects nothing ({s.describe()}): the drawing has layers "
+        f"{where} {selects} nothing ({s.describe()}): the drawing has layers "
         f"{', '.join(layers)}" + (f" and colours {', '.join(colours)}" if colours else "")
     )
 

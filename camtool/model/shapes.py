@@ -566,12 +566,13 @@ class Drawing:
     marks: tuple[Mark, ...] = field(default=())
 
     def bbox(self) -> BBox:
-        """Bounding box of every contour, mm.
+        """Bounding box of every contour and mark (a point's box is the point), mm.
 
         Raises:
-            ValueError: the drawing is empty.
+            ValueError: the drawing has neither contours nor marks.
         """
-        return bbox_union([c.bbox() for c in self.contours])
+        marks = [(*m.at, *m.at) for m in self.marks]
+        return bbox_union([*(c.bbox() for c in self.contours), *marks])
 
     def transformed(self, scale: float, dx: float = 0.0, dy: float = 0.0) -> Drawing:
         """Uniformly scaled about the origin (``scale`` > 0), then translated."""

@@ -194,6 +194,39 @@ def test_a_point_is_drilled_where_it_is(tmp_path: Path) -> None:
     assert [(m.x, m.y, m.z) for m in feeds] == [(12.5, 7.25, -2.0)]  # work zero: the drawing's
 
 
+def test_a_drawing_of_points_only_is_drilled_by_a_job_and_refused_by_a_profile(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A DXF of POINTs alone (ezdxf's MODEL.dxf is one): its box is its points."""
+    from camtool.cli.main import main
+    from tests.shapes import write_dxf
+
+    def build(msp: object) -> None:
+        for at in ((4.0, 3.0), (10.0, 8.5)):
+            msp.add_point(at)  # type: ignore[attr-defined]
+
+    dxf = write_dxf(tmp_path / "points.dxf", build)
+    drawing = read_drawing(dxf)
+    assert drawing.contours == () and drawing.bbox() == (4.0, 3.0, 10.0, 8.5)
+    job = tmp_path / "job.toml"
+    job.write_text(
+        '[[tools]]\nid = 5\ntype = "drill"\ndiameter = 1\n'
+        '[[operations]]\ntype = "drill"\ntool = 5\ndepth = 2\n'
+    )
+    done = run_job(drawing, load_target("grbl"), load_job(job))
+    feeds = [m for m in done.program.moves if isinstance(m, Linear)]
+    assert [(m.x, m.y, m.z) for m in feeds] == [(4.0, 3.0, -2.0), (10.0, 8.5, -2.0)]
+    out = tmp_path / "out.nc"
+    assert main(["inspect", str(dxf)]) == 0
+    capsys.readouterr()
+    assert main(["post", str(dxf), "-t", "grbl", "-o", str(out)]) == 3
+    assert (
+        f"error: {dxf}: the options select nothing: the drawing has no contour, only 2 points"
+        in (capsys.readouterr().err)
+    )
+    assert not out.exists()
+
+
 def test_the_one_operation_shorthand_runs_the_same_path(tmp_path: Path) -> None:
     from camtool.jobs.pipeline import post_drawing
     from camtool.toolpath.options import PlanOptions
