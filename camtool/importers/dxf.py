@@ -54,8 +54,12 @@ _SKIP_REASONS: dict[str, str] = {
         "annotation, not a contour",
     ),
     **dict.fromkeys(
-        ("IMAGE", "WIPEOUT", "PDFUNDERLAY", "DWFUNDERLAY", "DGNUNDERLAY", "OLE2FRAME"),
+        ("IMAGE", "PDFUNDERLAY", "DWFUNDERLAY", "DGNUNDERLAY", "OLE2FRAME"),
         "picture or underlay, not a contour",
+    ),
+    "WIPEOUT": (
+        "a mask: what it covers on screen is still read and cut; trim those lines in the "
+        "CAD program if they are not to be cut"
     ),
     "POINT": "a point has no path to cut",
     **dict.fromkeys(

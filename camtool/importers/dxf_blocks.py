@@ -11,6 +11,7 @@ from typing import Any
 
 from camtool.importers.dxf_entities import (
     CONVERTED,
+    BadEntity,
     Item,
     Unsupported,
     check_numbers,
@@ -68,7 +69,8 @@ def expand_insert(
         skipped); ATTDEFs (attribute templates) are not.
 
     Raises:
-        BadEntity: an INSERT or a block entity holds a NaN, infinite or huge number.
+        BadEntity: an INSERT or a block entity holds a NaN, infinite or huge number; an
+            INSERT (at any depth) has a clipping boundary switched on (XCLIP).
     """
     yield from _expand(insert, layer, None, "", (), (limit, cyclic))
 
@@ -103,6 +105,13 @@ def _expand(
     if reason:
         yield Skip("INSERT", reason, label, layer, _moved(location(insert), parent))
         return
+    if _clipped(insert):
+        raise BadEntity(
+            f"{label} on layer {layer!r} shows only part of block {name!r} (a clipping "
+            "boundary, XCLIP), and camtool reads whole blocks: what the clip hides would be "
+            "cut; delete the clip (XCLIP > Delete) and trim the geometry, or explode the "
+            "block and trim it, in the CAD program"
+        )
     for matrix, cell in _grid(insert):
         if parent is not None:
             from ezdxf.math import Matrix44
@@ -111,6 +120,16 @@ def _expand(
         chain = f" in INSERT #{insert.dxf.handle} (block {name!r}{cell}){within}"
         for entity in block:
             yield from _place(entity, matrix, layer, chain, (*names, name), limits)
+
+
+def _clipped(insert: Any) -> bool:
+    """Whether ``insert`` has a clipping boundary switched on (AutoCAD's XCLIP; ezdxf.xclip)."""
+    from ezdxf.xclip import XClip
+
+    if not insert.has_extension_dict:  # the clip lives in its ACAD_FILTER dictionary
+        return False
+    clip = XClip(insert)
+    return bool(clip.has_clipping_path and clip.is_clipping_enabled)
 
 
 def _external(block: Any) -> bool:

@@ -319,3 +319,31 @@ def test_an_external_reference_is_named_not_dropped_silently(tmp_path: Path) -> 
         "parts/bracket.dxf, which camtool does not read; bind it in the CAD program "
         "(XREF > Bind) to cut it)",
     )
+
+
+@pytest.mark.parametrize("nested", [False, True])
+def test_a_clipped_block_reference_is_refused_not_cut_whole(tmp_path: Path, nested: bool) -> None:
+    """An XCLIP boundary shows part of a block; cutting the whole block cuts what it hides."""
+    from ezdxf.xclip import XClip
+
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    square = doc.blocks.new("SQUARE")
+    square.add_lwpolyline([(0, 0), (40, 0), (40, 40), (0, 40)], close=True)
+    square.add_circle((30, 30), 5)
+    outer = doc.blocks.new("OUTER")
+    inner = (outer if nested else doc.modelspace()).add_blockref("SQUARE", (10, 10))
+    XClip(inner).set_block_clipping_path([(0, 0), (20, 20)])  # the circle is hidden
+    if nested:
+        doc.modelspace().add_blockref("OUTER", (0, 0))
+    path = tmp_path / "clip.dxf"
+    doc.saveas(path)
+    with pytest.raises(
+        InputError,
+        match=r"clip\.dxf: INSERT #\w+ (in INSERT #\w+ \(block 'OUTER'\) )?on layer '0' "
+        "shows only part of block 'SQUARE'",
+    ):
+        read_dxf(path)
+    XClip(inner).disable_clipping()  # a clip switched off shows the whole block: it is read
+    doc.saveas(path)
+    assert len(read_dxf(path).contours) == 2

@@ -106,6 +106,17 @@ def test_image_is_skipped(tmp_path: Path) -> None:
     assert "skipped 1 IMAGE entity (picture or underlay" in _warning(tmp_path / "i.dxf", build)
 
 
+def test_a_wipeout_warns_that_what_it_masks_is_still_cut(tmp_path: Path) -> None:
+    """A WIPEOUT hides what lies under it on screen; camtool does not clip by it."""
+
+    def build(msp: Any) -> None:  # over the line _warning draws
+        msp.add_wipeout([(2, -2), (8, 2)])
+
+    assert "skipped 1 WIPEOUT entity (a mask: what it covers on screen is still read and cut" in (
+        _warning(tmp_path / "w.dxf", build)
+    )
+
+
 def test_text_inside_a_block_is_counted_with_the_rest(tmp_path: Path) -> None:
     def build(msp: Any) -> None:
         msp.add_text("top")
