@@ -102,7 +102,8 @@ class DxfImport:
             by effective layer, sorted.
         notes: the entities that were dropped, each with its location.
         recovered: the file was damaged and read by ezdxf's recover mode.
-        repairs: what recover mode repaired or could not (ezdxf's auditor and log), one
+        repairs: what recover mode repaired or could not (ezdxf's auditor and log), or what
+            ezdxf's reader logged about a file it read without recovering, one
             message each; the user warning only gives their count.
         converted: an entity other than a plain LINE was read, whose contours may
             depend on the tolerance (a fitted curve, a joined boundary); ``False``: the
@@ -183,6 +184,12 @@ def _import(
     doc, damage, repairs = _open(path)
     recovered = damage is not None
     warnings = [] if damage is None else [_damaged(path, damage, repairs)]
+    if damage is None and repairs:
+        warnings.append(
+            f"{path}: ezdxf noted {len(repairs)} problem(s) while reading it ({repairs[0]}); "
+            "check the result (`camtool inspect` lists them), or re-save the file from the "
+            "CAD program"
+        )
     units, scale = _units(
         path, _insunits(path, doc, recovered), warnings, options.units, _imperial(doc)
     )
@@ -466,7 +473,8 @@ def _open(path: Path) -> tuple[Any, str | None, list[str]]:
     if path.stat().st_size == 0:
         raise InputError(f"{path}: empty file; export the drawing again from the CAD program")
     try:
-        return ezdxf.readfile(str(path)), None, []
+        with _captured_log("ezdxf") as noted:  # on stderr as it was, not camtool's words
+            return ezdxf.readfile(str(path)), None, noted
     except OSError as exc:
         if exc.errno is not None:  # a system error; ezdxf's "is not a DXF file" has none
             raise InputError(f"{path}: cannot read the file ({exc.strerror})") from exc

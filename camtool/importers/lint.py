@@ -34,6 +34,7 @@ _KIND_TITLES = {
     "construction": "not cut unless an operation names them (construction, not the part)",
     "skipped": "entities not read",
     "repaired": "repairs made to read a damaged file (ezdxf recover mode)",
+    "noted": "what ezdxf noted while reading the file",
 }
 
 
@@ -228,7 +229,8 @@ def inspect_drawing(
         drawing, units = read.drawing, read.units
         entities, block_entities = read.entity_counts, read.block_entity_counts
         notes = [_note_finding(n) for n in read.notes]
-        notes += [Finding("repaired", r, None) for r in read.repairs]
+        kind = "repaired" if read.recovered else "noted"
+        notes += [Finding(kind, r, None) for r in read.repairs]
     else:
         drawing = read_drawing(path, options)
     chained, findings = check_drawing(

@@ -208,3 +208,27 @@ def test_inspect_lists_the_repairs_of_a_damaged_dxf(tmp_path: Path) -> None:
     (repaired,) = [f for f in report.findings if f.kind == "repaired"]
     assert repaired.message.startswith("fixed: ") and "axis-ratio" in repaired.message
     assert "repairs made to read a damaged file" in report.text()
+
+
+def test_what_ezdxf_logs_while_reading_is_a_warning_not_raw_stderr(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """Two LINEs with one handle (as ezdxf's cc_dxflib.dxf has): read, and said in our words."""
+    path = tmp_path / "dup.dxf"
+    line = "  0\nLINE\n  5\nA1\n  8\n0\n 10\n{x}\n 20\n0\n 30\n0\n 11\n10\n 21\n{y}\n 31\n0\n"
+    path.write_text(
+        "  0\nSECTION\n  2\nENTITIES\n"
+        + line.format(x=0, y=0)
+        + line.format(x=10, y=10)
+        + "  0\nENDSEC\n  0\nEOF\n"
+    )
+    report = inspect_drawing(path)
+    assert capfd.readouterr().err == ""
+    (warning,) = [w for w in report.warnings if "ezdxf noted" in w]
+    assert warning == (
+        f"{path}: ezdxf noted 1 problem(s) while reading it (Found non-unique entity handle "
+        "#A1, data validation is required.); check the result (`camtool inspect` lists them), "
+        "or re-save the file from the CAD program"
+    )
+    assert [f.kind for f in report.findings if f.kind in ("noted", "repaired")] == ["noted"]
+    assert "what ezdxf noted while reading the file" in report.text()
