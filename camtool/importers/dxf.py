@@ -50,7 +50,15 @@ _THREE_D = "3D entity; camtool cuts 2D contours"
 _SKIP_REASONS: dict[str, str] = {
     **dict.fromkeys(("TEXT", "MTEXT", "ATTRIB", "ATTDEF", "RTEXT"), _TEXT),
     **dict.fromkeys(
-        ("DIMENSION", "ARC_DIMENSION", "LEADER", "MULTILEADER", "MLEADER", "TOLERANCE"),
+        (
+            "DIMENSION",
+            "ARC_DIMENSION",
+            "LARGE_RADIAL_DIMENSION",
+            "LEADER",
+            "MULTILEADER",
+            "MLEADER",
+            "TOLERANCE",
+        ),
         "annotation, not a contour",
     ),
     **dict.fromkeys(
