@@ -20,7 +20,8 @@ Selectors applied: compound selectors (``*``, a type, ``#id``, ``.class``, any t
 ``path.cut.outer``, ``rect#a``) joined by descendant (space) or child (``>``) combinators.
 Others (attributes ``[x]``, pseudo-classes ``:hover``, sibling combinators ``+``/``~``,
 at-rules ``@media``) are not applied: :func:`apply_style_sheets` refuses such a rule if it
-hides what it selects, and names the others in a warning.
+hides what it selects, and names the others in a warning (``@font-face`` excepted: a font
+styles nothing).
 """
 
 from __future__ import annotations
@@ -229,8 +230,9 @@ def apply_style_sheets(
         name: the file, for messages.
 
     Returns:
-        A warning naming the rules not applied, if any (at-rules, pseudo-classes, attribute
-        selectors, sibling combinators): what they style is read without them.
+        A warning naming the rules not applied, if any (at-rules but ``@font-face``,
+        pseudo-classes, attribute selectors, sibling combinators): what they style is read
+        without them.
 
     Raises:
         InputError: a rule not applied would hide what it selects (``display:none``,
@@ -245,7 +247,8 @@ def apply_style_sheets(
     for sheet in sheets:
         for selectors, body in _css_rules(sheet.text or ""):
             if selectors.startswith("@"):
-                ignored.append(selectors)
+                if not selectors.lower().startswith("@font-face"):  # a font styles nothing
+                    ignored.append(selectors)
                 continue
             declarations = tuple(_declaration_list(body))
             for text in (s.strip() for s in selectors.split(",")):

@@ -227,7 +227,8 @@ def test_a_rule_that_hides_through_a_selector_camtool_cannot_apply_is_refused(
 def test_rules_that_hide_nothing_still_are_named(tmp_path: Path) -> None:
     """A pseudo-class or a print style hides nothing on the screen: read, with a warning."""
     body = (
-        "<style>a:hover path { display: none } @media print { .x { display: none } }"
+        "<style>@font-face { font-family: Sans; src: url(s.woff) }"
+        " a:hover path { display: none } @media print { .x { display: none } }"
         " path[id=y] { stroke: red }</style>"
         '<path id="x" class="x" d="M 0 0 L 1 0"/><g><path id="y" d="M 0 0 L 1 0"/></g>'
     )
