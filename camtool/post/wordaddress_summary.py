@@ -21,12 +21,15 @@ def closing_warnings(
         spec: the dialect (its name, codes, quantum and step grids).
         counts: what the writer counted, by kind (``"feed"``, ``"Spindle"``, ``"speed"``,
             ``"Dwell"``, ``"ToolChange"``, ``"Home"``, ``"z-split"``, ``"arc-chords"``,
-            ``"plane-chords"``, ``"tiny-arc"``); kinds not counted give no warning.
+            ``"far-centre"``, ``"plane-chords"``, ``"tiny-arc"``); kinds not counted give no
+            warning.
         grid_error_mm: the largest change of a coordinate rounded to a step grid, mm.
         chord_tolerance_mm: the chord deviation allowed to an arc written as chords, mm
             (at least twice the dialect's quantum).
     """
     name, d = spec.name, counts
+    i_word = spec.words.get("I")  # a dialect without arcs has none
+    i_digits = i_word.number.int_digits if i_word is not None else None
     texts = {
         "feed": f"{name} has no F word: the feed of {d['feed']} cutting block(s) is not "
         "written; the machine moves at its own speed",
@@ -45,6 +48,10 @@ def closing_warnings(
         "arc-chords": f"arcs that no printable centre lets {name}'s arc check accept at "
         f"{spec.quantum_mm():g} mm written as {d['arc-chords']} straight chord(s) "
         f"within {max(2.0 * spec.quantum_mm(), chord_tolerance_mm):g} mm of them",
+        "far-centre": f"{d['far-centre']} arc(s) with a centre farther away than {name}'s "
+        f"I and J write ({i_digits} integer digits): almost "
+        f"straight, written as chords within {max(2.0 * spec.quantum_mm(), chord_tolerance_mm):g}"
+        " mm of them",
         "plane-chords": f"{d['plane-chords']} arc(s) in the ZX or YZ plane whose printed "
         f"numbers {name}'s arc check refuses, or too small to print, written as their "
         "chords (a G-code file's within 0.001 mm, as read)",

@@ -522,8 +522,14 @@ class BlockWriter(WordWriter):
         tiny = centre is None or (written == before and not full)
         if centre is not None:
             ci, cj = centre[0] - ox, centre[1] - oy
-            ti, i = printed["I"].get(ci) or self._print("I", ci)
-            tj, j = printed["J"].get(cj) or self._print("J", cj)
+            try:
+                ti, i = printed["I"].get(ci) or self._print("I", ci)
+                tj, j = printed["J"].get(cj) or self._print("J", cj)
+            except DialectError:
+                if not self._beyond_digits(ci, cj):
+                    raise
+                self._far_centre_chords(move, before, end, centre, z)
+                return
             tiny = tiny or (i + ox, j + oy) == before
             if self._arc_floor_mm:
                 tiny = tiny or 2.0 * math.hypot(i + ox - before[0], j + oy - before[1]) <= (
@@ -546,6 +552,36 @@ class BlockWriter(WordWriter):
         self.written = written
         self._feed(move, words)
         self.block(words)
+
+    def _beyond_digits(self, ci: float, cj: float) -> bool:
+        """Whether centre offset ``(ci, cj)`` mm has more integer digits than I or J writes."""
+        for letter, value in (("I", ci), ("J", cj)):
+            number = self.spec.words[letter].number
+            if number.int_digits is None:
+                continue
+            half_unit = 0.5 * 10.0 ** (-number.decimals)  # what rounds up to the next digit
+            if abs(value) * number.scale + half_unit >= 10.0**number.int_digits:
+                return True
+        return False
+
+    def _far_centre_chords(
+        self, move: ArcMove, start: Point, end: Point, centre: Point, z: float | None
+    ) -> None:
+        """Write the arc from ``start`` to ``end`` as chords: its centre is too far to print.
+
+        An arc fitted to an almost straight curve can have a radius of metres, its I or J
+        more integer digits than the dialect writes (FlashCut's four: 9999.999 mm): its
+        chords within :data:`ARC_CHORD_TOLERANCE_MM` (twice the quantum at least) are
+        written instead (counted as ``far-centre``). A helix's Z climbs evenly over them.
+        """
+        tolerance = max(2.0 * self.spec.quantum_mm(), ARC_CHORD_TOLERANCE_MM)
+        points = make_arc(start, end, centre, move.clockwise).points(tolerance)[1:]
+        points[-1] = end
+        z0 = self.z
+        self.counts["far-centre"] += 1
+        for k, point in enumerate(points, start=1):
+            at = z if z is None or z0 is None else z0 + (z - z0) * k / len(points)
+            self._line(Linear(*point, move.feed_mm_min, contour=move.contour), point, at)
 
     # -- arcs in the ZX and YZ planes -----------------------------------------------
 

@@ -131,3 +131,29 @@ def test_the_real_slot_drawing_posts_and_reads_back(name: str, tmp_path: Path) -
         timeout=300,
     )
     assert verified.returncode == 0, verified.stderr[-2000:]  # the controller's arc rule
+
+
+@pytest.mark.parametrize("radius", [20_000.0, 9_999.9996])
+def test_an_almost_straight_arc_whose_centre_no_i_word_holds_is_written_as_chords(
+    radius: float,
+) -> None:
+    """FlashCut writes I and J with four integer digits and three decimals (9999.999 mm).
+
+    An arc fitted to an almost straight piece of an openclipart icon (``source_l.svg`` at
+    ``--fit 19.99 34.99``) had I = 29145.676 mm: the post stopped with "does not fit 4
+    integer digits". Its sagitta over a 2 mm chord is 2²/(8 R) = 0.025 µm, so the chord
+    itself is within the chord tolerance: one G1 block to the arc's end, and a warning.
+    9999.9996 mm rounds to 10000.000 at FlashCut's three decimals: a chord too.
+    """
+    start, end = (5.0, 5.0), (7.0, 5.0)
+    centre = (6.0, 5.0 + math.sqrt(radius**2 - 1.0))
+    program = Program(
+        (Rapid(*start), ArcMove(*end, *centre, False, 300.0, contour=1)), origin=(0.0, 0.0)
+    )
+    result = load_target("flashcut").emit(program)
+    assert not _arc_words(result.code)
+    assert re.search(r"^G0?1 X0*7\.0+ Y0*5\.0+", result.code, re.MULTILINE), result.code
+    assert any(
+        "1 arc(s) with a centre farther away than flashcut's I and J write (4 integer digits)" in w
+        for w in result.warnings
+    )
