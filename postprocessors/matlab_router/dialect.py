@@ -86,6 +86,13 @@ def notes_warnings(notes: RouterWriter, speed: int, tolerance: float) -> list[st
             f"{notes.counts['merged']} vertex(es) rounded onto the previous one at 0.1 mm and "
             f"dropped (first: {notes.notes['merged']})"
         )
+    if notes.counts["held"]:
+        w.append(
+            f"{notes.counts['held']} segment(s) whose shorter axis would move at a speed that "
+            f"rounds to 0 (the job would hang, Angel-11 §4.2) cut into pieces of at most {speed} "
+            f"counts, each end on the 0.1 mm grid within 0.05 mm of the segment (first: "
+            f"{notes.notes['held']})"
+        )
     if notes.trailing_rapid is not None:
         x, y = notes.trailing_rapid
         w.append(
@@ -378,6 +385,7 @@ class MatlabRouterPost(PostProcessor):
                 f"{_place(contours, f'stroke {stroke.number}')} has a coordinate outside "
                 f"0–{INT16_MAX} (0.1 mm): the master's int16 distances from home (L4639)"
             )
+        xy, owners = _held_speeds(xy, owners, self.speed, notes, program)
         n = len(xy) - 1
         parts = math.ceil(n / self.max_segments)
         jobs = []
@@ -507,6 +515,57 @@ def _chords(here: Point, move: ArcMove, tolerance: float, notes: RouterWriter) -
         sagitta = max(sagitta, arc.radius - mid)
     notes.chorded(len(points) - 1, sagitta)
     return points[1:]
+
+
+def _held_speeds(
+    xy: np.ndarray, owners: list[int], speed: int, notes: RouterWriter, program: Program
+) -> tuple[np.ndarray, list[int]]:
+    """Split each segment whose minor-axis speed rounds to 0 into pieces the firmware runs.
+
+    The minor axis's speed is ``round(speed · minor / major)``: 0 when ``minor / major`` is
+    under ``1 / (2 · speed)`` (1 count in 1061 at 480), and the slave then never reaches
+    its count, so the job hangs (Angel-11 §3, §4.2). A piece whose major axis moves at
+    most ``speed`` counts has a speed of at least 1 wherever its minor axis moves, so such
+    a segment is cut into ``ceil(major / speed)`` pieces whose ends are the segment's
+    points at equal steps, rounded to the 0.1 mm grid: each within 0.05 mm of the segment,
+    as every vertex already is after rounding. Other segments are left as they are.
+
+    Args:
+        xy: ``(n + 1, 2)`` vertices of a stroke, 0.1 mm counts.
+        owners: the move index of each segment (``n``), for the warning.
+        speed: the major axis's speed, counts per 5 ms.
+        notes: where the split is counted (``"held"``) for the warning.
+        program: the program, to name the block.
+
+    Returns:
+        The vertices and owners with the split segments' pieces in their place.
+    """
+    import numpy as np
+
+    d = np.abs(np.diff(xy, axis=0))
+    major, minor = d.max(axis=1), d.min(axis=1)
+    hangs = (minor > 0) & (np.rint(speed * minor / np.maximum(major, 1)) == 0)
+    if not hangs.any():
+        return xy, owners
+    points: list[np.ndarray] = [xy[:1]]
+    kept: list[int] = []
+    for i in range(len(xy) - 1):
+        if not hangs[i]:
+            points.append(xy[i + 1 : i + 2])
+            kept.append(owners[i])
+            continue
+        k = math.ceil(int(major[i]) / speed)
+        steps = np.arange(1, k + 1, dtype=np.float64)[:, None] / k
+        piece = xy[i] + (xy[i + 1] - xy[i]) * steps  # away from zero at .5, as Matlab
+        points.append(np.sign(piece) * np.floor(np.abs(piece) + 0.5))
+        kept += [owners[i]] * k
+        move = program.moves[owners[i]]
+        notes.note(
+            "held",
+            f"{notes.where(move.contour, owners[i] + 1)}: {int(minor[i])} in {int(major[i])} "
+            f"counts, in {k} pieces",
+        )
+    return np.concatenate(points).astype(xy.dtype), kept
 
 
 def _check_speeds(job: RouterJob) -> None:
