@@ -222,6 +222,14 @@ def _import(
         plural = "entity" if count == 1 else "entities"
         warnings.append(f"{path}: skipped {count} {kind} {plural} ({reason})")
     warnings += _hidden_warnings(path, keep, reader.invisible)
+    if reader.swapped:
+        label, ratio = reader.swapped[0]
+        warnings.append(
+            f"{path}: {len(reader.swapped)} ELLIPSE(s) with an axis ratio above 1, the DXF "
+            f"range being (0, 1] (first {label}, ratio {ratio:g}): read as the curve their "
+            "numbers describe, the longer axis being the minor one (as ezdxf's auditor "
+            "repairs it by swapping the axes); check it in the preview"
+        )
     if not reader.contours and not reader.marks:
         on = f" on layers {', '.join(options.layers)}" if options.layers else ""
         raise InputError(
@@ -319,6 +327,7 @@ class _Reader:
         self.block_counts: Counter[tuple[str, str]] = Counter()
         self.converted = False  # an entity went through the converters (and the tolerance)
         self.invisible = 0  # entities left out for their invisible flag (group code 60)
+        self.swapped: list[tuple[str, float]] = []  # ELLIPSEs with a ratio above 1
 
     def read(self, entity: Any) -> None:
         from camtool.importers.dxf_blocks import Skip, expand_insert
@@ -393,6 +402,7 @@ class _Reader:
             check_centres,
             check_numbers,
             convert,
+            swapped_axes,
         )
 
         if not self.keep(item.layer):
@@ -410,6 +420,8 @@ class _Reader:
         check_numbers(item.entity, item.label, item.layer, self.limit)
         for part in item.parts:
             check_numbers(part, item.label, item.layer, self.limit)
+        if swapped_axes(item.entity):
+            self.swapped.append((item.label, float(item.entity.dxf.ratio)))
         self.converted = True
         try:
             contours = convert(item, self.tolerance, self.limit)

@@ -81,8 +81,7 @@ def check_numbers(entity: Any, label: str, layer: str, limit: float) -> None:
     Every float attribute (points, radius, angles, scales, bulges, ratio, extrusion ...)
     and the vertex, control point, fit point, knot and weight arrays are checked, so the
     converters downstream can trust them. Also refused: a zero extrusion vector (no
-    plane) and an ELLIPSE axis ratio above 1 (the DXF reference allows (0, 1]; ezdxf's
-    auditor would clamp it, silently changing the part).
+    plane).
 
     Args:
         entity: an ezdxf entity (model space, block content, or a virtual one).
@@ -168,9 +167,17 @@ def _bad_shape(entity: Any) -> str | None:
     extrusion = entity.dxf.get("extrusion", None)
     if extrusion is not None and not math.hypot(*extrusion) > 1e-12:
         return f"extrusion {tuple(float(v) for v in extrusion)} is not a direction"
-    if entity.dxftype() == "ELLIPSE" and not abs(entity.dxf.get("ratio", 1.0)) <= _MAX_RATIO:
-        return f"axis ratio {entity.dxf.ratio:g} is above 1 (the DXF range is (0, 1])"
     return None
+
+
+def swapped_axes(entity: Any) -> bool:
+    """Whether ``entity`` is an ELLIPSE whose axis ratio is above 1 (the DXF range is (0, 1]).
+
+    Its numbers still describe one curve, ``c + M cos t + ratio · (Z × M) sin t``: the
+    minor axis is the longer. It is read as that curve, as ezdxf's auditor repairs it
+    (swapping the axes) and as viewers draw it; the importer warns.
+    """
+    return entity.dxftype() == "ELLIPSE" and abs(entity.dxf.get("ratio", 1.0)) > _MAX_RATIO
 
 
 def check_centres(contours: Sequence[Contour], layer: str, limit: float) -> None:

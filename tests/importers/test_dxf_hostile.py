@@ -21,7 +21,7 @@ from camtool.cli.main import main
 from camtool.importers.dxf import import_dxf, read_dxf
 from camtool.importers.options import MAX_ENTITIES, ImportOptions
 from camtool.model.errors import InputError, UsageError
-from tests.shapes import write_dxf
+from tests.shapes import segment_samples, write_dxf
 
 _ENTITIES = """\
   0
@@ -181,15 +181,26 @@ def test_bad_numbers_are_input_errors_naming_the_entity(
         assert name in message
 
 
-def test_an_ellipse_ratio_above_one_is_refused(tmp_path: Path) -> None:
-    # DXF reference: the ratio is in (0, 1]; ezdxf's auditor would clamp it to 1.
+def test_an_ellipse_ratio_above_one_is_read_as_the_curve_it_describes(tmp_path: Path) -> None:
+    """DXF reference: the ratio is in (0, 1]; dxf-parser's ellipse.dxf has 1.9863 and 4.
+
+    The numbers still give one curve, c + M cos t + ratio · (Z × M) sin t, which viewers
+    draw and ezdxf's auditor keeps (it swaps the axes): read as that, with a warning. With
+    M = (5, 0) and ratio 2 it is the ellipse x²/25 + y²/100 = 1.
+    """
+
     def build(msp: Any) -> None:
         msp.add_ellipse((0, 0), (5, 0), ratio=0.5)
 
     path = write_dxf(tmp_path / "e.dxf", build)
     path.write_text(path.read_text().replace("\n 40\n0.5\n", "\n 40\n2.0\n"))
-    with pytest.raises(InputError, match=r"ELLIPSE #\w+ on layer '0': axis ratio 2 is above 1"):
-        read_dxf(path)
+    drawing = read_dxf(path)
+    (contour,) = drawing.contours
+    assert contour.closed
+    assert drawing.bbox() == pytest.approx((-5.0, -10.0, 5.0, 10.0), abs=1e-3)
+    for x, y in segment_samples(contour.segments, 8):  # within the 1 µm fit tolerance
+        assert math.hypot(x / 5.0, y / 10.0) == pytest.approx(1.0, abs=0.001 / 5.0)
+    assert any("1 ELLIPSE(s) with an axis ratio above 1" in w for w in drawing.warnings)
 
 
 def test_a_negative_arc_radius_is_read_as_autocad_does(tmp_path: Path) -> None:
