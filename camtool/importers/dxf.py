@@ -478,6 +478,8 @@ _PARSER_ERRORS = (
     EOFError,
     IndexError,
     KeyError,
+    AttributeError,  # dxf-parser's blocks.dxf: a VIEWPORT's missing XDATA (ezdxf 1.4)
+    TypeError,
 )
 """What ezdxf's reader raises on damaged files besides DXFError (a DXF cut short in its
 HEADER ends ezdxf's ``dxf_info`` scan with a bare StopIteration)."""

@@ -55,6 +55,10 @@ ZERO_LENGTH = 1e-9
 
 # Entities whose centre or insertion point is stored in their OCS (DXF reference).
 _OCS_POINTS = frozenset({"ARC", "CIRCLE", "TEXT", "ATTRIB", "INSERT", "SHAPE"})
+_WCS_PATHS = frozenset({"LINE", "SPLINE", "POINT"})
+"""Entities whose path is in world coordinates: their extrusion (a SPLINE's normal, a
+LINE's thickness direction) does not place them, so a null one is no damage. AutoCAD 2007
+writes SPLINEs with the normal (0, 0, 0) (bjnortier/dxf's splines.dxf)."""
 _MAX_RATIO = 1.0 + 1e-9  # ELLIPSE minor/major axis ratio, (0, 1] in the DXF reference
 
 
@@ -81,7 +85,7 @@ def check_numbers(entity: Any, label: str, layer: str, limit: float) -> None:
     Every float attribute (points, radius, angles, scales, bulges, ratio, extrusion ...)
     and the vertex, control point, fit point, knot and weight arrays are checked, so the
     converters downstream can trust them. Also refused: a zero extrusion vector (no
-    plane).
+    plane) on an entity placed by it (not a LINE, SPLINE or POINT: :data:`_WCS_PATHS`).
 
     Args:
         entity: an ezdxf entity (model space, block content, or a virtual one).
@@ -165,7 +169,11 @@ def _arrays(entity: Any) -> list[tuple[str, Any]]:
 def _bad_shape(entity: Any) -> str | None:
     """What makes the entity's numbers meaningless though finite, else None."""
     extrusion = entity.dxf.get("extrusion", None)
-    if extrusion is not None and not math.hypot(*extrusion) > 1e-12:
+    if (
+        extrusion is not None
+        and not math.hypot(*extrusion) > 1e-12
+        and entity.dxftype() not in _WCS_PATHS
+    ):
         return f"extrusion {tuple(float(v) for v in extrusion)} is not a direction"
     return None
 

@@ -181,6 +181,22 @@ def test_bad_numbers_are_input_errors_naming_the_entity(
         assert name in message
 
 
+def test_a_spline_with_a_null_normal_is_read_as_autocad_2007_writes_it(tmp_path: Path) -> None:
+    """AutoCAD 2007 writes planar SPLINEs with the normal (0, 0, 0) (bjnortier/dxf's
+    splines.dxf); their control points are in world coordinates, so the normal places
+    nothing: the spline is read (its ends are its first and last control points, clamped)."""
+
+    def build(msp: Any) -> None:
+        spline = msp.add_open_spline([(0, 0), (10, 10), (20, 0), (30, 10)], degree=3)
+        spline.dxf.extrusion = (0, 0, -1)  # -1 becomes 0 below: ezdxf writes no null one
+
+    path = write_dxf(tmp_path / "s.dxf", build)
+    path.write_text(path.read_text().replace("\n230\n-1.0\n", "\n230\n0.0\n"))
+    assert "\n210\n0.0\n220\n0.0\n230\n0.0\n" in path.read_text()
+    (contour,) = read_dxf(path).contours
+    assert contour.start == (0.0, 0.0) and contour.end == (30.0, 10.0)
+
+
 def test_an_ellipse_ratio_above_one_is_read_as_the_curve_it_describes(tmp_path: Path) -> None:
     """DXF reference: the ratio is in (0, 1]; dxf-parser's ellipse.dxf has 1.9863 and 4.
 
@@ -466,3 +482,25 @@ def test_a_curve_too_large_for_the_tolerance_is_refused(tmp_path: Path) -> None:
     with pytest.raises(InputError, match=r"ELLIPSE #\w+ on layer '0': a curve 1e\+09 across"):
         read_dxf(write_dxf(tmp_path / "e.dxf", build))
     assert time.perf_counter() - start < 5
+
+
+def test_a_reader_bug_on_a_hostile_file_is_an_error_naming_the_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """ezdxf 1.4 raises AttributeError on dxf-parser's blocks.dxf (a VIEWPORT without the
+    XDATA it expects); its recover mode then fails on the file's LWPOLYLINE. Both as ezdxf
+    raises them here: a message naming the file, not an internal error."""
+    import ezdxf
+    from ezdxf import recover
+
+    def viewport_bug(name: str) -> None:
+        raise AttributeError("'NoneType' object has no attribute 'get_xlist'")
+
+    def recover_fails(name: str) -> None:
+        raise ezdxf.DXFStructureError("missing 'AcDbPolyline' subclass in LWPOLYLINE(#3AC)")
+
+    path = write_dxf(tmp_path / "blocks.dxf", lambda msp: msp.add_line((0, 0), (1, 0)))
+    monkeypatch.setattr(ezdxf, "readfile", viewport_bug)
+    monkeypatch.setattr(recover, "readfile", recover_fails)
+    with pytest.raises(InputError, match=r"blocks\.dxf: not a readable DXF file \('NoneType'"):
+        read_dxf(path)
