@@ -212,6 +212,11 @@ def _parse(path: Path, prepared: Prepared) -> Any:
     except (ValueError, TypeError, IndexError, KeyError, ZeroDivisionError) as exc:
         raise InputError(f"{path}: svgelements cannot read this SVG ({exc!r})") from exc
     collect_young()
+    if svg is None:  # svgelements' answer to display:none on the root
+        raise InputError(
+            f"{path}: nothing to cut: the <svg> element itself is hidden (display:none), so "
+            "the whole drawing is; remove display:none from it to cut what it holds"
+        )
     return svg
 
 

@@ -582,3 +582,14 @@ def test_not_svg_and_missing_file(tmp_path: Path) -> None:
         read_svg(path)
     with pytest.raises(InputError, match=r"nope\.svg: no such file"):
         read_svg(tmp_path / "nope.svg")
+
+
+def test_a_hidden_root_svg_is_nothing_to_cut(tmp_path: Path) -> None:
+    """resvg's painting/display/none-on-svg.svg: svgelements gives no document at all."""
+    path = tmp_path / "t.svg"
+    path.write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 200 200" display="none">'
+        '<rect x="20" y="20" width="160" height="160"/></svg>'
+    )
+    with pytest.raises(InputError, match=r"t\.svg: nothing to cut: the <svg> element itself is"):
+        read_svg(path)
