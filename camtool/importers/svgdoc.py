@@ -65,6 +65,8 @@ _NOT_DRAWN = frozenset(
         "filter",
     ]
 )
+_SWITCHABLE = _RENDERED | {"foreignObject"}
+"""What a ``<switch>`` may show: rendered elements, not an unknown one (``<random>``)."""
 _HOLD_KINDS = frozenset({"symbol", "marker", "mask", "flowRoot"})
 
 
@@ -304,7 +306,8 @@ def choose_switches(
 ) -> None:
     """Keep of each ``<switch>`` only the child it shows; move the others into ``hold``.
 
-    A ``<switch>`` renders its first direct child whose conditions hold (SVG 1.1 §5.8):
+    A ``<switch>`` renders its first direct child that is a rendered element (not an
+    unknown one, nor ``<title>``) whose conditions hold (SVG 1.1 §5.8, SVG 2 §5.8.1):
     ``requiredExtensions`` names extensions camtool has none of (Illustrator's
     ``<foreignObject>`` beside its artwork), ``requiredFeatures`` holds (SVG 2 dropped
     it). svgelements draws every child, so alternatives would all be cut. Alternatives
@@ -325,12 +328,64 @@ def choose_switches(
                     f'language (systemLanguage="{child.get("systemLanguage")}"), which camtool '
                     "cannot know; keep one of them in the drawing program"
                 )
-        shown = next((c for c in children if not (c.get("requiredExtensions") or "").strip()), None)
+        shown = next(
+            (
+                c
+                for c in children
+                if local_name(c) in _SWITCHABLE and not (c.get("requiredExtensions") or "").strip()
+            ),
+            None,
+        )
         for child in children:
             if child is not shown:
                 if drawn and _has_shapes(child):
                     counts["switch"] += 1
                 move(child, parents, hold)
+
+
+def check_conditions(
+    root: ET.Element,
+    parents: dict[ET.Element, ET.Element],
+    hold: ET.Element,
+    name: str,
+    counts: Counter[str],
+) -> None:
+    """Apply ``requiredExtensions`` and ``systemLanguage`` outside a ``<switch>`` too.
+
+    Any element whose conditions fail is not rendered, with its children (SVG 1.1 §5.8.2,
+    SVG 2 §5.8): one that requires extensions (camtool has none) goes into ``hold`` and is
+    counted (``counts["extensions"]``). Run after :func:`choose_switches`.
+
+    Raises:
+        InputError: an element with shapes, or the ``<svg>`` itself, is shown by the
+            viewer's language (``systemLanguage``), which camtool cannot know; or the
+            ``<svg>`` requires extensions, so nothing is shown.
+    """
+    stack = [root]
+    while stack:
+        element = stack.pop()
+        if element is hold or local_name(element) in _NOT_DRAWN:  # clip paths are not cut
+            continue
+        where = element.get(SOURCE_ATTR) or local_name(element) or "an element"
+        language = element.get("systemLanguage")
+        if language is not None and _has_shapes(element):
+            raise InputError(
+                f"{name}: {where} is shown only to viewers whose language is {language!r} "
+                "(systemLanguage), which camtool cannot know; remove the attribute to cut "
+                "it, or delete the element"
+            )
+        if (element.get("requiredExtensions") or "").strip():
+            if element is root:
+                raise InputError(
+                    f"{name}: nothing to cut: the <svg> element requires extensions "
+                    f"(requiredExtensions={element.get('requiredExtensions')!r}) that no "
+                    "viewer without them shows"
+                )
+            if _has_shapes(element):
+                counts["extensions"] += 1
+            move(element, parents, hold)
+            continue
+        stack.extend(element)
 
 
 def _href(element: ET.Element) -> str:
@@ -493,6 +548,7 @@ def prepare(
     counts: Counter[str] = Counter()
     select_layers(root, layers, parents, hold, str(path), warnings, shown)
     choose_switches(root, parents, hold, str(path), counts)
+    check_conditions(root, parents, hold, str(path), counts)
     fade_under_transparent(root)
     hold_undrawn(root, parents, hold, counts)
     count_skipped(root, hold, counts)
@@ -505,6 +561,11 @@ def prepare(
         warnings.append(
             f"{path}: skipped {counts['switch']} child(ren) of <switch> elements with shapes "
             "(a <switch> shows only its first child that applies)"
+        )
+    if counts["extensions"]:
+        warnings.append(
+            f"{path}: skipped {counts['extensions']} element(s) with shapes that require "
+            "extensions (requiredExtensions), which a viewer without them does not show"
         )
     for kind in ("defs", "clipPath", "mask", "text", "image", "use"):
         if counts[kind]:

@@ -351,6 +351,35 @@ def test_a_switch_by_language_is_refused(tmp_path: Path) -> None:
         read_svg(svg(tmp_path, body))
 
 
+def test_a_switch_passes_over_what_is_not_a_rendered_element(tmp_path: Path) -> None:
+    """resvg's structure/switch/non-SVG-child.svg: an unknown ``<random>`` (or a
+    ``<title>``) is not what a switch shows; the first rendered child is (it was dropped)."""
+    body = (
+        '<switch><random id="r"/><title>t</title><path id="shown" d="M 0 0 L 1 0"/>'
+        '<path id="other" d="M 0 0 L 2 0"/></switch>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.source for c in drawing.contours] == ["path#shown"]
+
+
+def test_conditions_outside_a_switch_apply_too(tmp_path: Path) -> None:
+    """SVG 1.1 §5.8.2: an element whose conditions fail is not rendered, switch or not
+    (resvg's structure/systemLanguage/on-svg.svg renders nothing)."""
+    body = (
+        '<path id="ext" requiredExtensions="http://example.org/x" d="M 0 0 L 1 0"/>'
+        '<clipPath id="c" systemLanguage="ru"><rect width="1" height="1"/></clipPath>'
+        '<path id="kept" d="M 0 0 L 2 0"/>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.source for c in drawing.contours] == ["path#kept"]
+    assert any(
+        "skipped 1 element(s) with shapes that require extensions" in w for w in (drawing.warnings)
+    )
+    body = '<g systemLanguage="ru"><path id="ru" d="M 0 0 L 1 0"/></g><path d="M 0 0 L 2 0"/>'
+    with pytest.raises(InputError, match=r"g\[1\] is shown only to viewers whose language"):
+        read_svg(svg(tmp_path, body))
+
+
 # ------------------------------------------------------------------ use, skipped constructs
 
 
