@@ -9,6 +9,7 @@ Design notes: docs/internals.md, ``camtool/importers/svgdoc.py``.
 
 from __future__ import annotations
 
+import math
 import re
 import xml.etree.ElementTree as ET
 from collections import Counter
@@ -67,6 +68,8 @@ _NOT_DRAWN = frozenset(
 )
 _SWITCHABLE = _RENDERED | {"foreignObject"}
 """What a ``<switch>`` may show: rendered elements, not an unknown one (``<random>``)."""
+_SIZE_NEEDS = {"rect": ("width", "height"), "circle": ("r",), "ellipse": ("rx", "ry")}
+"""The size attributes a shape needs to be drawn (see ``_check``)."""
 _HOLD_KINDS = frozenset({"symbol", "marker", "mask", "flowRoot"})
 
 
@@ -540,6 +543,7 @@ def prepare(
     parents = {child: parent for parent in root.iter() for child in parent}
     warnings += apply_style_sheets(root, parents, str(path))
     normalize_styles(root)
+    resolve_percentages(root, viewport)
     _label_and_check(root, str(path))
     check_use_cycles(root, str(path))
     check_size(root, str(path), max_entities)
@@ -608,6 +612,51 @@ def _parse(path: Path) -> ET.Element:
 # ---------------------------------------------------------------------------- labels, checks
 
 
+_PERCENT = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)%\s*")
+_ACROSS = frozenset({"x", "cx", "width", "x1", "x2"})
+_DOWN = frozenset({"y", "cy", "height", "y1", "y2"})
+
+
+def resolve_percentages(root: ET.Element, viewport: tuple[float, float]) -> None:
+    """Write every percentage length of a shape as user units, as SVG resolves it.
+
+    A percentage is of the nearest viewport's width (``x``, ``cx``, ``width``, ``x1``,
+    ``x2``, a rect's ``rx``), height (``y``, ...; a rect's ``ry``) or normalised diagonal
+    ``sqrt((w² + h²) / 2)`` (``r``; an ellipse's ``rx`` and ``ry`` are of the width and the
+    height) (SVG 1.1 §7.10). The viewport is the document's, or a nested ``<svg>``'s
+    viewBox. svgelements resolved them against other sizes: a rect at ``x="10%"
+    width="50%"`` in a 200 × 100 viewBox was cut from x 10 to 60 instead of 20 to 120.
+
+    Args:
+        root: the ``<svg>`` element.
+        viewport: its viewport's width and height, user units.
+    """
+    stack: list[tuple[ET.Element, tuple[float, float]]] = [(root, viewport)]
+    while stack:
+        element, (w, h) = stack.pop()
+        kind = local_name(element)
+        for attr in _LENGTH_ATTRS.get(kind or "", ()):
+            match = _PERCENT.fullmatch(element.get(attr) or "")
+            if match is None:
+                continue
+            if attr in _ACROSS or (attr == "rx" and kind in ("rect", "ellipse")):
+                base = w
+            elif attr in _DOWN or (attr == "ry" and kind in ("rect", "ellipse")):
+                base = h
+            else:
+                base = math.sqrt((w * w + h * h) / 2.0)
+            element.set(attr, repr(float(match.group(1)) / 100.0 * base))
+        inner = (w, h)
+        if kind == "svg" and element is not root:
+            box = (element.get("viewBox") or "").replace(",", " ").split()
+            try:
+                if len(box) == 4 and float(box[2]) > 0 and float(box[3]) > 0:
+                    inner = (float(box[2]), float(box[3]))
+            except ValueError:
+                pass  # a bad viewBox is refused where it is read
+        stack.extend((child, inner) for child in element)
+
+
 def _label_and_check(root: ET.Element, name: str) -> None:
     seen: Counter[str] = Counter()
     for element in root.iter():
@@ -627,6 +676,7 @@ def _label_and_check(root: ET.Element, name: str) -> None:
 
 
 def _check(element: ET.Element, kind: str) -> None:
+    """Check ``element``'s syntax; give a shape missing its size the size SVG 2 gives it."""
     transform = element.get("transform")
     if transform is not None:
         try:
@@ -640,6 +690,17 @@ def _check(element: ET.Element, kind: str) -> None:
             raise ValueError(f"bad path data: {exc}") from exc
     if kind == "path" and element.get("d") is None:
         element.set("d", "")  # no path data: nothing drawn (svgelements fails on a missing d)
+    if kind in _SIZE_NEEDS:
+        style = _style(element)
+        given = {a for a in _SIZE_NEEDS[kind] if element.get(a) is not None or a in style}
+        # a rect needs both sizes, an ellipse one radius (the other "auto", SVG 2), a
+        # circle its radius: without them nothing is drawn (their value is 0 or auto, SVG 2
+        # §10.2-10.4), where svgelements would draw a size of 1 (a 1 px high rectangle).
+        if not given if kind == "ellipse" else given != set(_SIZE_NEEDS[kind]):
+            element.set(_SIZE_NEEDS[kind][0], "0")
+        elif kind == "ellipse" and len(given) == 1:  # the other radius is "auto": the same
+            (have,) = given  # (a percentage is a length by now: resolve_percentages)
+            element.set("ry" if have == "rx" else "rx", element.get(have) or style[have])
     for attr in _LENGTH_ATTRS.get(kind, ()):
         value = element.get(attr)
         if value is not None:

@@ -5,6 +5,7 @@ Files written by Inkscape 1.2.2 are in tests/data (tests/data/README-svg.md says
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -622,3 +623,48 @@ def test_a_hidden_root_svg_is_nothing_to_cut(tmp_path: Path) -> None:
     )
     with pytest.raises(InputError, match=r"t\.svg: nothing to cut: the <svg> element itself is"):
         read_svg(path)
+
+
+def test_percentages_are_of_the_viewport_width_height_or_diagonal(tmp_path: Path) -> None:
+    """SVG 1.1 §7.10 in a 200 × 100 mm page (viewBox 0 0 200 100, so 1 unit = 1 mm, Y up).
+
+    x-like lengths are of 200, y-like of 100, ``r`` of sqrt((200² + 100²) / 2) = 158.114;
+    inside a nested ``<svg>`` with a viewBox, of that viewBox. svgelements had the rect
+    from x 10 to 60 (expected 20 to 120).
+    """
+    body = (
+        '<rect id="r" x="10%" y="10%" width="50%" height="50%" rx="5%" ry="10%"/>'
+        '<circle id="c" cx="50%" cy="50%" r="10%"/>'
+        '<ellipse id="e" cx="25%" cy="75%" rx="10%" ry="10%"/>'
+        '<line id="l" x1="0%" y1="0%" x2="100%" y2="100%" stroke="black"/>'
+        '<svg x="0" y="0" width="200" height="100" viewBox="0 0 50 50" preserveAspectRatio="none">'
+        '<rect id="n" width="10%" height="10%"/></svg>'
+    )
+    drawing = read_svg(svg(tmp_path, body, 'width="200mm" height="100mm" viewBox="0 0 200 100"'))
+    r = 0.1 * math.sqrt((200**2 + 100**2) / 2)
+    boxes = {c.source: c.bbox() for c in drawing.contours}
+    assert boxes["rect#r"] == pytest.approx((20, 40, 120, 90))
+    assert boxes["circle#c"] == pytest.approx((100 - r, 50 - r, 100 + r, 50 + r))
+    assert boxes["ellipse#e"] == pytest.approx((30, 15, 70, 35))
+    assert boxes["line#l"] == pytest.approx((0, 0, 200, 100))
+    # 10% of the nested 50 × 50 viewBox: 5 × 5 units, stretched 4 × 2 to 20 × 10 mm
+    assert boxes["rect#n"] == pytest.approx((0, 90, 20, 100))
+
+
+def test_a_shape_without_its_size_is_not_drawn_and_an_ellipse_radius_is_auto(
+    tmp_path: Path,
+) -> None:
+    """SVG 2 §10: a rect's missing width or height, a circle's missing r, an ellipse's two
+    missing radii draw nothing (svgelements drew a size of 1: a 60 × 1 rect); one missing
+    radius of an ellipse is ``auto``, the other's (resvg's missing-rx-attribute.svg)."""
+    body = (
+        '<rect id="no-height" x="20" y="20" width="60"/>'
+        '<circle id="no-r" cx="50" cy="50"/>'
+        '<ellipse id="no-radii" cx="50" cy="50"/>'
+        '<ellipse id="ry-only" cx="50" cy="50" ry="30"/>'
+        '<rect id="css-height" x="1" y="1" width="5" style="height:5"/>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    boxes = {c.source: c.bbox() for c in drawing.contours}
+    assert set(boxes) == {"ellipse#ry-only", "rect#css-height"}  # SVG 2: a CSS size counts
+    assert boxes["ellipse#ry-only"] == pytest.approx((20, 20, 80, 80))
