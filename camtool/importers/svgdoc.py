@@ -544,6 +544,7 @@ def prepare(
     warnings += apply_style_sheets(root, parents, str(path))
     normalize_styles(root)
     resolve_percentages(root, viewport)
+    resolve_paint_references(root)
     _label_and_check(root, str(path))
     check_use_cycles(root, str(path))
     check_size(root, str(path), max_entities)
@@ -615,6 +616,38 @@ def _parse(path: Path) -> ET.Element:
 _PERCENT = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)%\s*")
 _ACROSS = frozenset({"x", "cx", "width", "x1", "x2"})
 _DOWN = frozenset({"y", "cy", "height", "y1", "y2"})
+
+
+_PAINT_URL = re.compile(r"\s*url\(\s*['\"]?#([^)'\"]+)['\"]?\s*\)\s*(.*?)\s*")
+_PAINT_SERVERS = frozenset(
+    {"linearGradient", "radialGradient", "pattern", "meshgradient", "hatch", "solidcolor"}
+)
+
+
+def resolve_paint_references(root: ET.Element) -> None:
+    """Write a ``fill`` or ``stroke`` of ``url(#id)`` that paints nothing as its fallback.
+
+    A reference to no element, or to one that is not a paint server (a ``<rect>``), paints
+    with its fallback colour (``url(#g) red``), else not at all (SVG 2 §13.2): a shape
+    filled so and not stroked is invisible. svgelements painted every ``url(…)`` black, so
+    such a shape was cut. A reference to a gradient or pattern is kept (the shape is
+    painted). Run after the style sheets are applied.
+    """
+    servers = {e.get("id") for e in root.iter() if local_name(e) in _PAINT_SERVERS}
+    for element in root.iter():
+        style = element.get("style")
+        declared = _style(element) if style and "url(" in style else {}
+        for name in ("fill", "stroke"):
+            for value, inline in ((element.get(name), False), (declared.get(name), True)):
+                match = _PAINT_URL.fullmatch(value or "")
+                if match is None or match.group(1) in servers:
+                    continue
+                paint = match.group(2) or "none"
+                if inline:
+                    declared[name] = paint
+                    element.set("style", ";".join(f"{k}:{v}" for k, v in declared.items()))
+                else:
+                    element.set(name, paint)
 
 
 def resolve_percentages(root: ET.Element, viewport: tuple[float, float]) -> None:

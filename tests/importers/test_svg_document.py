@@ -668,3 +668,24 @@ def test_a_shape_without_its_size_is_not_drawn_and_an_ellipse_radius_is_auto(
     boxes = {c.source: c.bbox() for c in drawing.contours}
     assert set(boxes) == {"ellipse#ry-only", "rect#css-height"}  # SVG 2: a CSS size counts
     assert boxes["ellipse#ry-only"] == pytest.approx((20, 20, 80, 80))
+
+
+def test_a_paint_reference_to_nothing_paints_its_fallback_or_nothing(tmp_path: Path) -> None:
+    """SVG 2 §13.2: ``url(#id)`` to no element, or to one that is not a paint server, uses
+    its fallback colour, else paints nothing (resvg's painting/fill/funcIRI-* tests).
+    svgelements painted every url() black, so invisible shapes were cut."""
+    body = (
+        '<defs><linearGradient id="g"><stop offset="0" stop-color="red"/></linearGradient>'
+        '<rect id="not-paint" width="1" height="1"/></defs>'
+        '<rect id="missing" width="9" height="9" fill="url(#nope)"/>'
+        '<rect id="missing-none" width="9" height="9" fill="url(#nope) none"/>'
+        '<rect id="missing-red" width="9" height="9" fill="url(#nope) red"/>'
+        '<rect id="gradient" width="9" height="9" style="fill:url(#g)"/>'
+        '<rect id="not-a-server" width="9" height="9" style="fill:url(\'#not-paint\')"/>'
+        '<rect id="stroke" width="9" height="9" fill="none" stroke="url(#nope)"/>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.source for c in drawing.contours] == ["rect#missing-red", "rect#gradient"]
+    assert f"{tmp_path / 't.svg'}: skipped 4 elements with neither fill nor stroke" in (
+        drawing.warnings
+    )
