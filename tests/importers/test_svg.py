@@ -261,6 +261,7 @@ def test_shapes_at_opacity_0_are_invisible_and_not_cut(tmp_path: Path) -> None:
         '<rect id="h" width="10" height="10" opacity="bogus"/>'
         '<rect id="k" width="1" height="1" fill="transparent"/>'
         '<rect id="l" width="1" height="1" fill="rgba(0, 0, 0, 0)" stroke="#ff000000"/>'
+        '<linearGradient id="gradient"><stop offset="0" stop-color="red"/></linearGradient>'
         '<rect id="m" width="1" height="1" fill="url(#gradient)"/>'
         '<g opacity="0"><g style="opacity:1"><rect id="i" style="opacity:0.5" width="1" '
         'height="1"/><rect id="j" opacity="1" width="1" height="1"/></g></g>'
