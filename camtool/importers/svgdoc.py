@@ -546,6 +546,7 @@ def prepare(
     resolve_percentages(root, viewport)
     resolve_paint_references(root)
     _label_and_check(root, str(path))
+    apply_transform_origins(root, viewport, str(path))
     check_use_cycles(root, str(path))
     check_size(root, str(path), max_entities)
     hold = ET.SubElement(root, _tag(root, "defs"))
@@ -648,6 +649,74 @@ def resolve_paint_references(root: ET.Element) -> None:
                     element.set("style", ";".join(f"{k}:{v}" for k, v in declared.items()))
                 else:
                     element.set(name, paint)
+
+
+_ORIGIN_KEYWORDS = {"left": 0.0, "top": 0.0, "center": 50.0, "right": 100.0, "bottom": 100.0}
+_CSS_UNIT_PX = {"": 1.0, "px": 1.0, "mm": 96.0 / 25.4, "cm": 96.0 / 2.54, "in": 96.0,
+                "pt": 96.0 / 72.0, "pc": 16.0}  # fmt: skip
+_ORIGIN_TOKEN = re.compile(r"([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(%|px|mm|cm|in|pt|pc)?")
+
+
+def apply_transform_origins(root: ET.Element, viewport: tuple[float, float], name: str) -> None:
+    """Fold each element's ``transform-origin`` into its ``transform``.
+
+    ``transform="T" transform-origin="ox oy"`` is ``translate(ox oy) T translate(-ox -oy)``
+    (CSS Transforms 1 §6; SVG 2 takes it as a presentation attribute or a style
+    property). Keywords (``left``, ``center``, ``right``, ``top``, ``bottom``) and
+    percentages are of the document's viewport (``transform-box: view-box``, the initial
+    value); one value leaves the other axis at ``center``. svgelements ignored it, so a
+    shape turned about its centre was cut turned about the origin, elsewhere.
+
+    Raises:
+        InputError: a ``transform-origin`` that is not one or two such values (a third,
+            Z, of 0 is allowed), naming the element.
+    """
+    for element in root.iter():
+        style = _style(element)
+        text = style.get("transform-origin", element.get("transform-origin"))
+        if text is None:
+            continue
+        if "transform-origin" in style:
+            del style["transform-origin"]
+            element.set("style", ";".join(f"{k}:{v}" for k, v in style.items()))
+        element.attrib.pop("transform-origin", None)
+        transform = element.get("transform")
+        if not transform or not transform.strip():
+            continue  # no transform: the origin moves nothing
+        origin = _origin(text, viewport)
+        if origin is None:
+            where = element.get(SOURCE_ATTR) or local_name(element) or "an element"
+            raise InputError(
+                f"{name}: {where}: transform-origin {text!r} is not one or two keywords, "
+                "lengths or percentages; apply the transform in the drawing program"
+            )
+        ox, oy = origin
+        element.set("transform", f"translate({ox!r} {oy!r}) {transform} translate({-ox!r} {-oy!r})")
+
+
+def _origin(text: str, viewport: tuple[float, float]) -> tuple[float, float] | None:
+    """``transform-origin`` as user units ``(x, y)``, or ``None`` if it cannot be read."""
+    tokens = text.replace(",", " ").split()
+    z = _ORIGIN_TOKEN.fullmatch(tokens[2]) if len(tokens) == 3 else None
+    if z is not None and float(z.group(1)) == 0.0:  # a Z of 0 moves nothing in the plane
+        tokens = tokens[:2]
+    if not 1 <= len(tokens) <= 2:
+        return None
+    if len(tokens) == 1:
+        tokens = ["center", tokens[0]] if tokens[0] in ("top", "bottom") else [tokens[0], "center"]
+    elif tokens[0] in ("top", "bottom") or tokens[1] in ("left", "right"):
+        tokens = [tokens[1], tokens[0]]  # "top left": the vertical keyword first
+    out: list[float] = []
+    for token, size in zip(tokens, viewport, strict=True):
+        if token in _ORIGIN_KEYWORDS:
+            out.append(_ORIGIN_KEYWORDS[token] / 100.0 * size)
+            continue
+        match = _ORIGIN_TOKEN.fullmatch(token)
+        if match is None:
+            return None
+        value, unit = float(match.group(1)), match.group(2) or ""
+        out.append(value / 100.0 * size if unit == "%" else value * _CSS_UNIT_PX[unit])
+    return out[0], out[1]
 
 
 def resolve_percentages(root: ET.Element, viewport: tuple[float, float]) -> None:

@@ -689,3 +689,34 @@ def test_a_paint_reference_to_nothing_paints_its_fallback_or_nothing(tmp_path: P
     assert f"{tmp_path / 't.svg'}: skipped 4 elements with neither fill nor stroke" in (
         drawing.warnings
     )
+
+
+@pytest.mark.parametrize(
+    "origin",
+    ['transform-origin="50% 50%"', 'transform-origin="center"', 'transform-origin="50px 50"',
+     'style="transform-origin: 50 center"', 'transform-origin="left 50%"'],
+)  # fmt: skip
+def test_transform_origin_turns_a_shape_about_it(tmp_path: Path, origin: str) -> None:
+    """CSS Transforms 1 §6, SVG 2: rotate(45) about (50, 50) of the 100 × 100 viewBox.
+
+    The 20 mm square centred there keeps its centre; its box is 50 ± 10·√2. svgelements
+    ignored the origin and turned it about (0, 0), out of the page. With ``left 50%`` the
+    origin is (0, 50), and the square's centre turns about it.
+    """
+    body = f'<rect id="r" x="40" y="40" width="20" height="20" transform="rotate(45)" {origin}/>'
+    (contour,) = read_svg(svg(tmp_path, body)).contours
+    x0, y0, x1, y1 = contour.bbox()
+    half = 10 * math.sqrt(2)
+    if "left" in origin:  # about (0, 50): (50, 50) goes to (50 cos 45°, 50 + 50 sin 45°)
+        cx, cy = 50 * math.cos(math.pi / 4), 50 + 50 * math.sin(math.pi / 4)
+    else:
+        cx, cy = 50.0, 50.0
+    assert (x0, y0, x1, y1) == pytest.approx(
+        (cx - half, 100 - cy - half, cx + half, 100 - cy + half)
+    )
+
+
+def test_a_transform_origin_camtool_cannot_read_is_refused(tmp_path: Path) -> None:
+    body = '<rect id="r" width="2" height="2" transform="rotate(9)" transform-origin="calc(1px)"/>'
+    with pytest.raises(InputError, match=r"rect#r: transform-origin 'calc\(1px\)' is not one"):
+        read_svg(svg(tmp_path, body))
