@@ -391,6 +391,28 @@ def check_conditions(
         stack.extend(element)
 
 
+def _clipping_viewports(
+    root: ET.Element, parents: dict[ET.Element, ET.Element], hold: ET.Element
+) -> int:
+    """Nested ``<svg>`` elements with shapes that clip them (``overflow`` hidden, the default).
+
+    A nested viewport clips its content to its ``x``, ``y``, ``width``, ``height`` (SVG 1.1
+    §7.2, §14.3.3), as a ``<use>`` of an ``<svg>`` does; svgelements does not, and neither
+    does camtool, which warns instead (resvg's structure/svg/nested-svg-with-rect.svg: a
+    circle shown as a square).
+    """
+    count = 0
+    for element in root.iter(f"{{{SVG_NS}}}svg" if root.tag.startswith("{") else "svg"):
+        if element is root or not _has_shapes(element):
+            continue
+        overflow = _style(element).get("overflow", element.get("overflow", "hidden"))
+        if overflow.strip().lower() in ("visible", "auto"):
+            continue
+        if _is_drawn(element, parents, hold) or element.get("id"):  # placed, or perhaps used
+            count += 1
+    return count
+
+
 def _href(element: ET.Element) -> str:
     return (element.get(XLINK_HREF) or element.get("href") or "").strip()
 
@@ -572,6 +594,13 @@ def prepare(
         warnings.append(
             f"{path}: skipped {counts['extensions']} element(s) with shapes that require "
             "extensions (requiredExtensions), which a viewer without them does not show"
+        )
+    viewports = _clipping_viewports(root, parents, hold)
+    if viewports:
+        warnings.append(
+            f"{path}: {viewports} nested <svg> viewport(s) clip what they hold to their "
+            "size; camtool does not clip, so a shape reaching outside one is cut whole "
+            "(check the preview, or trim it in the drawing program)"
         )
     for kind in ("defs", "clipPath", "mask", "text", "image", "use"):
         if counts[kind]:
