@@ -657,13 +657,19 @@ _PAINT_SERVERS = frozenset(
 def resolve_paint_references(root: ET.Element) -> None:
     """Write a ``fill`` or ``stroke`` of ``url(#id)`` that paints nothing as its fallback.
 
-    A reference to no element, or to one that is not a paint server (a ``<rect>``), paints
-    with its fallback colour (``url(#g) red``), else not at all (SVG 2 §13.2): a shape
+    A reference to no element, to one that is not a paint server (a ``<rect>``), or to a
+    gradient without stops paints with its fallback colour (``url(#g) red``), else not at
+    all (SVG 2 §13.2): a shape
     filled so and not stroked is invisible. svgelements painted every ``url(…)`` black, so
     such a shape was cut. A reference to a gradient or pattern is kept (the shape is
     painted). Run after the style sheets are applied.
     """
-    servers = {e.get("id") for e in root.iter() if local_name(e) in _PAINT_SERVERS}
+    ids = {e.get("id"): e for e in root.iter() if e.get("id")}
+    servers = {
+        ident
+        for ident, e in ids.items()
+        if local_name(e) in _PAINT_SERVERS and (local_name(e) not in _GRADIENTS or _stops(e, ids))
+    }
     for element in root.iter():
         style = element.get("style")
         declared = _style(element) if style and "url(" in style else {}
@@ -746,6 +752,30 @@ def _origin(text: str, viewport: tuple[float, float]) -> tuple[float, float] | N
         value, unit = float(match.group(1)), match.group(2) or ""
         out.append(value / 100.0 * size if unit == "%" else value * _CSS_UNIT_PX[unit])
     return out[0], out[1]
+
+
+_GRADIENTS = frozenset({"linearGradient", "radialGradient"})
+
+
+def _stops(gradient: ET.Element, ids: dict[str | None, ET.Element]) -> bool:
+    """Whether ``gradient`` has ``<stop>``s, its own or those of one it refers to (``href``).
+
+    A gradient without stops paints as ``none`` (SVG 1.1 §13.2.4). Inkscape writes a
+    gradient with coordinates that takes its stops from another; the chain is followed
+    (at most 32 links: a cycle ends it, without stops).
+    """
+    current: ET.Element | None = gradient
+    for _ in range(32):
+        if current is None:
+            return False
+        if any(local_name(c) == "stop" for c in current):
+            return True
+        # any attribute named href: openclipart has files whose xlink namespace is mangled
+        href = next((v for k, v in current.attrib.items() if k.rpartition("}")[2] == "href"), "")
+        href = href.strip()
+        target = ids.get(href[1:]) if href.startswith("#") else None
+        current = target if target is not None and local_name(target) in _GRADIENTS else None
+    return False
 
 
 def resolve_percentages(root: ET.Element, viewport: tuple[float, float]) -> None:

@@ -736,3 +736,30 @@ def test_a_nested_viewport_that_clips_is_warned_about(tmp_path: Path) -> None:
         "camtool does not clip, so a shape reaching outside one is cut whole (check the "
         "preview, or trim it in the drawing program)",
     )
+
+
+def test_a_gradient_without_stops_paints_nothing(tmp_path: Path) -> None:
+    """SVG 1.1 §13.2.4: no stops, painted as none; stops taken through href chains count
+    (Inkscape's gradients with coordinates point to one with the stops)."""
+    body = (
+        '<defs><linearGradient id="stops"><stop offset="0" stop-color="red"/></linearGradient>'
+        '<linearGradient id="chain" xlink:href="#stops" x2="1"/>'
+        '<radialGradient id="chain2" href="#chain"/><linearGradient id="empty"/>'
+        '<linearGradient id="loop1" href="#loop2"/><linearGradient id="loop2" href="#loop1"/>'
+        '<pattern id="p" width="1" height="1"/></defs>'
+        '<rect id="a" width="9" height="9" fill="url(#stops)"/>'
+        '<rect id="b" width="9" height="9" fill="url(#chain)"/>'
+        '<rect id="c" width="9" height="9" fill="url(#chain2)"/>'
+        '<rect id="d" width="9" height="9" fill="url(#empty)"/>'
+        '<rect id="e" width="9" height="9" fill="url(#loop1)"/>'
+        '<rect id="f" width="9" height="9" fill="url(#p)"/>'
+        '<rect id="g" width="9" height="9" fill="url(#empty) blue"/>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.source for c in drawing.contours] == [
+        "rect#a",
+        "rect#b",
+        "rect#c",
+        "rect#f",
+        "rect#g",
+    ]
