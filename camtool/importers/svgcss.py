@@ -93,6 +93,12 @@ def _declaration_list(text: str) -> list[tuple[str, str, bool]]:
     return out
 
 
+def inline_style(element: ET.Element) -> dict[str, str]:
+    """The declarations of ``element``'s ``style`` attribute, ``{property: value}``, as written."""
+    pairs = (item.split(":", 1) for item in element.get("style", "").split(";") if ":" in item)
+    return {k.strip(): v.strip() for k, v in pairs}
+
+
 def _style_text(declarations: dict[str, str]) -> str:
     return ";".join(f"{k}:{v}" for k, v in declarations.items())
 

@@ -9,17 +9,23 @@ Design notes: docs/internals.md, ``camtool/importers/svgdoc.py``.
 
 from __future__ import annotations
 
-import math
 import re
 import xml.etree.ElementTree as ET
 from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
-from camtool.importers import svgcheck
+from camtool.importers import svgcheck, svgvalues
 from camtool.importers.options import MAX_ENTITIES, too_many_entities
-from camtool.importers.svgcss import SVG_NS, apply_style_sheets, local_name, normalize_styles
+from camtool.importers.svgcss import (
+    SVG_NS,
+    apply_style_sheets,
+    inline_style,
+    local_name,
+    normalize_styles,
+)
 from camtool.importers.svgpage import Affine, page_matrix
+from camtool.importers.svgvalues import LENGTH_ATTRS
 from camtool.model.errors import InputError
 
 INKSCAPE_NS = "http://www.inkscape.org/namespaces/inkscape"
@@ -68,8 +74,6 @@ _NOT_DRAWN = frozenset(
 )
 _SWITCHABLE = _RENDERED | {"foreignObject"}
 """What a ``<switch>`` may show: rendered elements, not an unknown one (``<random>``)."""
-_SIZE_NEEDS = {"rect": ("width", "height"), "circle": ("r",), "ellipse": ("rx", "ry")}
-"""The size attributes a shape needs to be drawn (see ``_check``)."""
 _HOLD_KINDS = frozenset({"symbol", "marker", "mask", "flowRoot"})
 
 
@@ -152,19 +156,14 @@ def _prune(
             move(child, parents, hold)
 
 
-def _style(element: ET.Element) -> dict[str, str]:
-    pairs = (item.split(":", 1) for item in element.get("style", "").split(";") if ":" in item)
-    return {k.strip(): v.strip() for k, v in pairs}
-
-
 def _hidden(element: ET.Element) -> bool:
-    display = _style(element).get("display", element.get("display", ""))
+    display = inline_style(element).get("display", element.get("display", ""))
     return display.strip().lower() == "none"
 
 
 def _set_style(element: ET.Element, name: str, value: str) -> None:
     """Set ``name`` to ``value`` in ``element``'s style and its attribute (both say the same)."""
-    style = {k: v for k, v in _style(element).items() if k != name}
+    style = {k: v for k, v in inline_style(element).items() if k != name}
     element.set("style", ";".join(f"{k}:{v}" for k, v in [*style.items(), (name, value)]))
     element.set(name, value)
 
@@ -203,7 +202,9 @@ def fade_under_transparent(root: ET.Element) -> None:
             stack.extend(element)
             continue
         for inner in element.iter():
-            if inner is not element and ("opacity" in inner.attrib or "opacity" in _style(inner)):
+            if inner is not element and (
+                "opacity" in inner.attrib or "opacity" in inline_style(inner)
+            ):
                 _set_style(inner, "opacity", "0")
 
 
@@ -405,7 +406,7 @@ def _clipping_viewports(
     for element in root.iter(f"{{{SVG_NS}}}svg" if root.tag.startswith("{") else "svg"):
         if element is root or not _has_shapes(element):
             continue
-        overflow = _style(element).get("overflow", element.get("overflow", "hidden"))
+        overflow = inline_style(element).get("overflow", element.get("overflow", "hidden"))
         if overflow.strip().lower() in ("visible", "auto"):
             continue
         if _is_drawn(element, parents, hold) or element.get("id"):  # placed, or perhaps used
@@ -499,12 +500,6 @@ def check_size(root: ET.Element, name: str, max_entities: int) -> None:
         raise too_many_entities(name, max_entities)
 
 
-_LENGTH_ATTRS = {
-    "rect": ("x", "y", "width", "height", "rx", "ry"),
-    "circle": ("cx", "cy", "r"),
-    "ellipse": ("cx", "cy", "rx", "ry"),
-    "line": ("x1", "y1", "x2", "y2"),
-}
 _SIZES = frozenset({"width", "height", "r", "rx", "ry"})
 _SKIP_REASONS = {
     "defs": "definitions are cut only where a <use> places them",
@@ -565,10 +560,9 @@ def prepare(
     parents = {child: parent for parent in root.iter() for child in parent}
     warnings += apply_style_sheets(root, parents, str(path))
     normalize_styles(root)
-    resolve_percentages(root, viewport)
-    resolve_paint_references(root)
-    _label_and_check(root, str(path))
-    apply_transform_origins(root, viewport, str(path))
+    svgvalues.resolve_percentages(root, viewport)
+    svgvalues.resolve_paint_references(root)
+    _label_and_check(root, str(path), viewport)
     check_use_cycles(root, str(path))
     check_size(root, str(path), max_entities)
     hold = ET.SubElement(root, _tag(root, "defs"))
@@ -643,182 +637,7 @@ def _parse(path: Path) -> ET.Element:
 # ---------------------------------------------------------------------------- labels, checks
 
 
-_PERCENT = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)%\s*")
-_ACROSS = frozenset({"x", "cx", "width", "x1", "x2"})
-_DOWN = frozenset({"y", "cy", "height", "y1", "y2"})
-
-
-_PAINT_URL = re.compile(r"\s*url\(\s*['\"]?#([^)'\"]+)['\"]?\s*\)\s*(.*?)\s*")
-_PAINT_SERVERS = frozenset(
-    {"linearGradient", "radialGradient", "pattern", "meshgradient", "hatch", "solidcolor"}
-)
-
-
-def resolve_paint_references(root: ET.Element) -> None:
-    """Write a ``fill`` or ``stroke`` of ``url(#id)`` that paints nothing as its fallback.
-
-    A reference to no element, to one that is not a paint server (a ``<rect>``), or to a
-    gradient without stops paints with its fallback colour (``url(#g) red``), else not at
-    all (SVG 2 §13.2): a shape
-    filled so and not stroked is invisible. svgelements painted every ``url(…)`` black, so
-    such a shape was cut. A reference to a gradient or pattern is kept (the shape is
-    painted). Run after the style sheets are applied.
-    """
-    ids = {e.get("id"): e for e in root.iter() if e.get("id")}
-    servers = {
-        ident
-        for ident, e in ids.items()
-        if local_name(e) in _PAINT_SERVERS and (local_name(e) not in _GRADIENTS or _stops(e, ids))
-    }
-    for element in root.iter():
-        style = element.get("style")
-        declared = _style(element) if style and "url(" in style else {}
-        for name in ("fill", "stroke"):
-            for value, inline in ((element.get(name), False), (declared.get(name), True)):
-                match = _PAINT_URL.fullmatch(value or "")
-                if match is None or match.group(1) in servers:
-                    continue
-                paint = match.group(2) or "none"
-                if inline:
-                    declared[name] = paint
-                    element.set("style", ";".join(f"{k}:{v}" for k, v in declared.items()))
-                else:
-                    element.set(name, paint)
-
-
-_ORIGIN_KEYWORDS = {"left": 0.0, "top": 0.0, "center": 50.0, "right": 100.0, "bottom": 100.0}
-_CSS_UNIT_PX = {"": 1.0, "px": 1.0, "mm": 96.0 / 25.4, "cm": 96.0 / 2.54, "in": 96.0,
-                "pt": 96.0 / 72.0, "pc": 16.0}  # fmt: skip
-_ORIGIN_TOKEN = re.compile(r"([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(%|px|mm|cm|in|pt|pc)?")
-
-
-def apply_transform_origins(root: ET.Element, viewport: tuple[float, float], name: str) -> None:
-    """Fold each element's ``transform-origin`` into its ``transform``.
-
-    ``transform="T" transform-origin="ox oy"`` is ``translate(ox oy) T translate(-ox -oy)``
-    (CSS Transforms 1 §6; SVG 2 takes it as a presentation attribute or a style
-    property). Keywords (``left``, ``center``, ``right``, ``top``, ``bottom``) and
-    percentages are of the document's viewport (``transform-box: view-box``, the initial
-    value); one value leaves the other axis at ``center``. svgelements ignored it, so a
-    shape turned about its centre was cut turned about the origin, elsewhere.
-
-    Raises:
-        InputError: a ``transform-origin`` that is not one or two such values (a third,
-            Z, of 0 is allowed), naming the element.
-    """
-    for element in root.iter():
-        style = _style(element)
-        text = style.get("transform-origin", element.get("transform-origin"))
-        if text is None:
-            continue
-        if "transform-origin" in style:
-            del style["transform-origin"]
-            element.set("style", ";".join(f"{k}:{v}" for k, v in style.items()))
-        element.attrib.pop("transform-origin", None)
-        transform = element.get("transform")
-        if not transform or not transform.strip():
-            continue  # no transform: the origin moves nothing
-        origin = _origin(text, viewport)
-        if origin is None:
-            where = element.get(SOURCE_ATTR) or local_name(element) or "an element"
-            raise InputError(
-                f"{name}: {where}: transform-origin {text!r} is not one or two keywords, "
-                "lengths or percentages; apply the transform in the drawing program"
-            )
-        ox, oy = origin
-        element.set("transform", f"translate({ox!r} {oy!r}) {transform} translate({-ox!r} {-oy!r})")
-
-
-def _origin(text: str, viewport: tuple[float, float]) -> tuple[float, float] | None:
-    """``transform-origin`` as user units ``(x, y)``, or ``None`` if it cannot be read."""
-    tokens = text.replace(",", " ").split()
-    z = _ORIGIN_TOKEN.fullmatch(tokens[2]) if len(tokens) == 3 else None
-    if z is not None and float(z.group(1)) == 0.0:  # a Z of 0 moves nothing in the plane
-        tokens = tokens[:2]
-    if not 1 <= len(tokens) <= 2:
-        return None
-    if len(tokens) == 1:
-        tokens = ["center", tokens[0]] if tokens[0] in ("top", "bottom") else [tokens[0], "center"]
-    elif tokens[0] in ("top", "bottom") or tokens[1] in ("left", "right"):
-        tokens = [tokens[1], tokens[0]]  # "top left": the vertical keyword first
-    out: list[float] = []
-    for token, size in zip(tokens, viewport, strict=True):
-        if token in _ORIGIN_KEYWORDS:
-            out.append(_ORIGIN_KEYWORDS[token] / 100.0 * size)
-            continue
-        match = _ORIGIN_TOKEN.fullmatch(token)
-        if match is None:
-            return None
-        value, unit = float(match.group(1)), match.group(2) or ""
-        out.append(value / 100.0 * size if unit == "%" else value * _CSS_UNIT_PX[unit])
-    return out[0], out[1]
-
-
-_GRADIENTS = frozenset({"linearGradient", "radialGradient"})
-
-
-def _stops(gradient: ET.Element, ids: dict[str | None, ET.Element]) -> bool:
-    """Whether ``gradient`` has ``<stop>``s, its own or those of one it refers to (``href``).
-
-    A gradient without stops paints as ``none`` (SVG 1.1 §13.2.4). Inkscape writes a
-    gradient with coordinates that takes its stops from another; the chain is followed
-    (at most 32 links: a cycle ends it, without stops).
-    """
-    current: ET.Element | None = gradient
-    for _ in range(32):
-        if current is None:
-            return False
-        if any(local_name(c) == "stop" for c in current):
-            return True
-        # any attribute named href: openclipart has files whose xlink namespace is mangled
-        href = next((v for k, v in current.attrib.items() if k.rpartition("}")[2] == "href"), "")
-        href = href.strip()
-        target = ids.get(href[1:]) if href.startswith("#") else None
-        current = target if target is not None and local_name(target) in _GRADIENTS else None
-    return False
-
-
-def resolve_percentages(root: ET.Element, viewport: tuple[float, float]) -> None:
-    """Write every percentage length of a shape as user units, as SVG resolves it.
-
-    A percentage is of the nearest viewport's width (``x``, ``cx``, ``width``, ``x1``,
-    ``x2``, a rect's ``rx``), height (``y``, ...; a rect's ``ry``) or normalised diagonal
-    ``sqrt((w² + h²) / 2)`` (``r``; an ellipse's ``rx`` and ``ry`` are of the width and the
-    height) (SVG 1.1 §7.10). The viewport is the document's, or a nested ``<svg>``'s
-    viewBox. svgelements resolved them against other sizes: a rect at ``x="10%"
-    width="50%"`` in a 200 × 100 viewBox was cut from x 10 to 60 instead of 20 to 120.
-
-    Args:
-        root: the ``<svg>`` element.
-        viewport: its viewport's width and height, user units.
-    """
-    stack: list[tuple[ET.Element, tuple[float, float]]] = [(root, viewport)]
-    while stack:
-        element, (w, h) = stack.pop()
-        kind = local_name(element)
-        for attr in _LENGTH_ATTRS.get(kind or "", ()):
-            match = _PERCENT.fullmatch(element.get(attr) or "")
-            if match is None:
-                continue
-            if attr in _ACROSS or (attr == "rx" and kind in ("rect", "ellipse")):
-                base = w
-            elif attr in _DOWN or (attr == "ry" and kind in ("rect", "ellipse")):
-                base = h
-            else:
-                base = math.sqrt((w * w + h * h) / 2.0)
-            element.set(attr, repr(float(match.group(1)) / 100.0 * base))
-        inner = (w, h)
-        if kind == "svg" and element is not root:
-            box = (element.get("viewBox") or "").replace(",", " ").split()
-            try:
-                if len(box) == 4 and float(box[2]) > 0 and float(box[3]) > 0:
-                    inner = (float(box[2]), float(box[3]))
-            except ValueError:
-                pass  # a bad viewBox is refused where it is read
-        stack.extend((child, inner) for child in element)
-
-
-def _label_and_check(root: ET.Element, name: str) -> None:
+def _label_and_check(root: ET.Element, name: str, viewport: tuple[float, float]) -> None:
     seen: Counter[str] = Counter()
     for element in root.iter():
         kind = local_name(element)
@@ -831,13 +650,17 @@ def _label_and_check(root: ET.Element, name: str) -> None:
         if kind == "use":
             element.set(USE_ATTR, label)
         try:
-            _check(element, kind)
+            _check(element, kind, viewport)
         except ValueError as exc:
             raise InputError(f"{name}: {label}: {exc}") from exc
 
 
-def _check(element: ET.Element, kind: str) -> None:
-    """Check ``element``'s syntax; give a shape missing its size the size SVG 2 gives it."""
+def _check(element: ET.Element, kind: str, viewport: tuple[float, float]) -> None:
+    """Check ``element``'s syntax, then read what svgelements reads otherwise than SVG.
+
+    Sizes SVG 2 gives a shape without them and ``transform-origin``
+    (:mod:`camtool.importers.svgvalues`); ``viewport``: user units, for percentages.
+    """
     transform = element.get("transform")
     if transform is not None:
         try:
@@ -851,18 +674,9 @@ def _check(element: ET.Element, kind: str) -> None:
             raise ValueError(f"bad path data: {exc}") from exc
     if kind == "path" and element.get("d") is None:
         element.set("d", "")  # no path data: nothing drawn (svgelements fails on a missing d)
-    if kind in _SIZE_NEEDS:
-        style = _style(element)
-        given = {a for a in _SIZE_NEEDS[kind] if element.get(a) is not None or a in style}
-        # a rect needs both sizes, an ellipse one radius (the other "auto", SVG 2), a
-        # circle its radius: without them nothing is drawn (their value is 0 or auto, SVG 2
-        # §10.2-10.4), where svgelements would draw a size of 1 (a 1 px high rectangle).
-        if not given if kind == "ellipse" else given != set(_SIZE_NEEDS[kind]):
-            element.set(_SIZE_NEEDS[kind][0], "0")
-        elif kind == "ellipse" and len(given) == 1:  # the other radius is "auto": the same
-            (have,) = given  # (a percentage is a length by now: resolve_percentages)
-            element.set("ry" if have == "rx" else "rx", element.get(have) or style[have])
-    for attr in _LENGTH_ATTRS.get(kind, ()):
+    svgvalues.default_sizes(element, kind)
+    svgvalues.fold_transform_origin(element, viewport)
+    for attr in LENGTH_ATTRS.get(kind, ()):
         value = element.get(attr)
         if value is not None:
             try:

@@ -1,0 +1,227 @@
+"""SVG values svgelements reads otherwise than SVG does, rewritten before it reads them.
+
+Each pass here was found by a file a browser draws one way and svgelements another (resvg's
+test suite, whose reference images Chrome agrees with); each rewrites attributes into the
+form svgelements reads as SVG means them:
+
+- :func:`resolve_percentages`: a shape's percentage lengths as user units;
+- :func:`default_sizes`: a shape without its size draws nothing; an ellipse's one radius
+  is both (``auto``);
+- :func:`fold_transform_origin`: ``transform-origin`` into the ``transform``;
+- :func:`resolve_paint_references`: a ``url(#id)`` paint that paints nothing as its
+  fallback.
+
+Sources: SVG 1.1 §7.10 (units), §13.2 (paint servers); SVG 2 §10 (shapes), §13.2
+(paint); CSS Transforms 1 §6.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import xml.etree.ElementTree as ET
+
+from camtool.importers.svgcss import inline_style, local_name
+
+LENGTH_ATTRS = {
+    "rect": ("x", "y", "width", "height", "rx", "ry"),
+    "circle": ("cx", "cy", "r"),
+    "ellipse": ("cx", "cy", "rx", "ry"),
+    "line": ("x1", "y1", "x2", "y2"),
+}
+"""The length attributes of each shape (checked by the document pass, resolved here)."""
+_SIZE_NEEDS = {"rect": ("width", "height"), "circle": ("r",), "ellipse": ("rx", "ry")}
+"""The size attributes a shape needs to be drawn (:func:`default_sizes`)."""
+
+
+def default_sizes(element: ET.Element, kind: str) -> None:
+    """Give a shape without its size the size SVG 2 gives it.
+
+    A rect needs both sizes, an ellipse one radius (the other ``auto``: the same), a circle
+    its radius: without them nothing is drawn (their value is 0 or ``auto``, SVG 2
+    §10.2-10.4), where svgelements drew a size of 1 (a 1 px high rectangle). A size set in
+    the ``style`` (SVG 2 geometry properties) counts. Run after :func:`resolve_percentages`.
+    """
+    needs = _SIZE_NEEDS.get(kind)
+    if needs is None:
+        return
+    style = inline_style(element)
+    given = {a for a in needs if element.get(a) is not None or a in style}
+    if not given if kind == "ellipse" else given != set(needs):
+        element.set(needs[0], "0")
+    elif kind == "ellipse" and len(given) == 1:
+        (have,) = given
+        element.set("ry" if have == "rx" else "rx", element.get(have) or style[have])
+
+
+_PERCENT = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)%\s*")
+_ACROSS = frozenset({"x", "cx", "width", "x1", "x2"})
+_DOWN = frozenset({"y", "cy", "height", "y1", "y2"})
+
+
+_PAINT_URL = re.compile(r"\s*url\(\s*['\"]?#([^)'\"]+)['\"]?\s*\)\s*(.*?)\s*")
+_PAINT_SERVERS = frozenset(
+    {"linearGradient", "radialGradient", "pattern", "meshgradient", "hatch", "solidcolor"}
+)
+
+
+def resolve_paint_references(root: ET.Element) -> None:
+    """Write a ``fill`` or ``stroke`` of ``url(#id)`` that paints nothing as its fallback.
+
+    A reference to no element, to one that is not a paint server (a ``<rect>``), or to a
+    gradient without stops paints with its fallback colour (``url(#g) red``), else not at
+    all (SVG 2 §13.2): a shape
+    filled so and not stroked is invisible. svgelements painted every ``url(…)`` black, so
+    such a shape was cut. A reference to a gradient or pattern is kept (the shape is
+    painted). Run after the style sheets are applied.
+    """
+    ids = {e.get("id"): e for e in root.iter() if e.get("id")}
+    servers = {
+        ident
+        for ident, e in ids.items()
+        if local_name(e) in _PAINT_SERVERS and (local_name(e) not in _GRADIENTS or _stops(e, ids))
+    }
+    for element in root.iter():
+        style = element.get("style")
+        declared = inline_style(element) if style and "url(" in style else {}
+        for name in ("fill", "stroke"):
+            for value, inline in ((element.get(name), False), (declared.get(name), True)):
+                match = _PAINT_URL.fullmatch(value or "")
+                if match is None or match.group(1) in servers:
+                    continue
+                paint = match.group(2) or "none"
+                if inline:
+                    declared[name] = paint
+                    element.set("style", ";".join(f"{k}:{v}" for k, v in declared.items()))
+                else:
+                    element.set(name, paint)
+
+
+_ORIGIN_KEYWORDS = {"left": 0.0, "top": 0.0, "center": 50.0, "right": 100.0, "bottom": 100.0}
+_CSS_UNIT_PX = {"": 1.0, "px": 1.0, "mm": 96.0 / 25.4, "cm": 96.0 / 2.54, "in": 96.0,
+                "pt": 96.0 / 72.0, "pc": 16.0}  # fmt: skip
+_ORIGIN_TOKEN = re.compile(r"([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(%|px|mm|cm|in|pt|pc)?")
+
+
+def fold_transform_origin(element: ET.Element, viewport: tuple[float, float]) -> None:
+    """Fold ``element``'s ``transform-origin`` into its ``transform``.
+
+    ``transform="T" transform-origin="ox oy"`` is ``translate(ox oy) T translate(-ox -oy)``
+    (CSS Transforms 1 §6; SVG 2 takes it as a presentation attribute or a style
+    property). Keywords (``left``, ``center``, ``right``, ``top``, ``bottom``) and
+    percentages are of the document's viewport (``transform-box: view-box``, the initial
+    value); one value leaves the other axis at ``center``. svgelements ignores it, so a
+    shape turned about its centre was cut turned about the origin, elsewhere.
+
+    Raises:
+        ValueError: a ``transform-origin`` that is not one or two such values (a third,
+            Z, of 0 is allowed).
+    """
+    style = inline_style(element)
+    text = style.get("transform-origin", element.get("transform-origin"))
+    if text is None:
+        return
+    if "transform-origin" in style:
+        del style["transform-origin"]
+        element.set("style", ";".join(f"{k}:{v}" for k, v in style.items()))
+    element.attrib.pop("transform-origin", None)
+    transform = element.get("transform")
+    if not transform or not transform.strip():
+        return  # no transform: the origin moves nothing
+    origin = _origin(text, viewport)
+    if origin is None:
+        raise ValueError(
+            f"transform-origin {text!r} is not one or two keywords, lengths or percentages; "
+            "apply the transform in the drawing program"
+        )
+    ox, oy = origin
+    element.set("transform", f"translate({ox!r} {oy!r}) {transform} translate({-ox!r} {-oy!r})")
+
+
+def _origin(text: str, viewport: tuple[float, float]) -> tuple[float, float] | None:
+    """``transform-origin`` as user units ``(x, y)``, or ``None`` if it cannot be read."""
+    tokens = text.replace(",", " ").split()
+    z = _ORIGIN_TOKEN.fullmatch(tokens[2]) if len(tokens) == 3 else None
+    if z is not None and float(z.group(1)) == 0.0:  # a Z of 0 moves nothing in the plane
+        tokens = tokens[:2]
+    if not 1 <= len(tokens) <= 2:
+        return None
+    if len(tokens) == 1:
+        tokens = ["center", tokens[0]] if tokens[0] in ("top", "bottom") else [tokens[0], "center"]
+    elif tokens[0] in ("top", "bottom") or tokens[1] in ("left", "right"):
+        tokens = [tokens[1], tokens[0]]  # "top left": the vertical keyword first
+    out: list[float] = []
+    for token, size in zip(tokens, viewport, strict=True):
+        if token in _ORIGIN_KEYWORDS:
+            out.append(_ORIGIN_KEYWORDS[token] / 100.0 * size)
+            continue
+        match = _ORIGIN_TOKEN.fullmatch(token)
+        if match is None:
+            return None
+        value, unit = float(match.group(1)), match.group(2) or ""
+        out.append(value / 100.0 * size if unit == "%" else value * _CSS_UNIT_PX[unit])
+    return out[0], out[1]
+
+
+_GRADIENTS = frozenset({"linearGradient", "radialGradient"})
+
+
+def _stops(gradient: ET.Element, ids: dict[str | None, ET.Element]) -> bool:
+    """Whether ``gradient`` has ``<stop>``s, its own or those of one it refers to (``href``).
+
+    A gradient without stops paints as ``none`` (SVG 1.1 §13.2.4). Inkscape writes a
+    gradient with coordinates that takes its stops from another; the chain is followed
+    (at most 32 links: a cycle ends it, without stops).
+    """
+    current: ET.Element | None = gradient
+    for _ in range(32):
+        if current is None:
+            return False
+        if any(local_name(c) == "stop" for c in current):
+            return True
+        # any attribute named href: openclipart has files whose xlink namespace is mangled
+        href = next((v for k, v in current.attrib.items() if k.rpartition("}")[2] == "href"), "")
+        href = href.strip()
+        target = ids.get(href[1:]) if href.startswith("#") else None
+        current = target if target is not None and local_name(target) in _GRADIENTS else None
+    return False
+
+
+def resolve_percentages(root: ET.Element, viewport: tuple[float, float]) -> None:
+    """Write every percentage length of a shape as user units, as SVG resolves it.
+
+    A percentage is of the nearest viewport's width (``x``, ``cx``, ``width``, ``x1``,
+    ``x2``, a rect's ``rx``), height (``y``, ...; a rect's ``ry``) or normalised diagonal
+    ``sqrt((w² + h²) / 2)`` (``r``; an ellipse's ``rx`` and ``ry`` are of the width and the
+    height) (SVG 1.1 §7.10). The viewport is the document's, or a nested ``<svg>``'s
+    viewBox. svgelements resolved them against other sizes: a rect at ``x="10%"
+    width="50%"`` in a 200 × 100 viewBox was cut from x 10 to 60 instead of 20 to 120.
+
+    Args:
+        root: the ``<svg>`` element.
+        viewport: its viewport's width and height, user units.
+    """
+    stack: list[tuple[ET.Element, tuple[float, float]]] = [(root, viewport)]
+    while stack:
+        element, (w, h) = stack.pop()
+        kind = local_name(element)
+        for attr in LENGTH_ATTRS.get(kind or "", ()):
+            match = _PERCENT.fullmatch(element.get(attr) or "")
+            if match is None:
+                continue
+            if attr in _ACROSS or (attr == "rx" and kind in ("rect", "ellipse")):
+                base = w
+            elif attr in _DOWN or (attr == "ry" and kind in ("rect", "ellipse")):
+                base = h
+            else:
+                base = math.sqrt((w * w + h * h) / 2.0)
+            element.set(attr, repr(float(match.group(1)) / 100.0 * base))
+        inner = (w, h)
+        if kind == "svg" and element is not root:
+            box = (element.get("viewBox") or "").replace(",", " ").split()
+            try:
+                if len(box) == 4 and float(box[2]) > 0 and float(box[3]) > 0:
+                    inner = (float(box[2]), float(box[3]))
+            except ValueError:
+                pass  # a bad viewBox is refused where it is read
+        stack.extend((child, inner) for child in element)
