@@ -55,6 +55,8 @@ ARC_CHORD_TOLERANCE_MM = 0.002
 """Chord deviation, mm, of an arc no printable centre can write (GRBL's default ``$12``)."""
 _CHORD: Point = (math.nan, math.nan)
 """The centre of a conformed block that is a chord of such an arc (by identity)."""
+_FAR_CHORD: Point = (math.nan, math.nan)
+"""The centre of a chord of an arc whose centre the I and J words cannot hold (by identity)."""
 
 
 class _Conformed(dict[tuple[Any, ...], list[tuple[Point, Point | None]]]):
@@ -366,7 +368,19 @@ class BlockWriter(WordWriter):
     def _conformed_at(
         self, start: Point, end: Point, centre: Point, clockwise: bool, piece: Arc | None = None
     ) -> list[tuple[Point, Point | None]]:
-        """:meth:`_conformed` of the arc from ``start`` to ``end`` (``piece``, made if ``None``)."""
+        """:meth:`_conformed` of the arc from ``start`` to ``end`` (``piece``, made if ``None``).
+
+        An arc whose I or J has more integer digits than the dialect writes (an almost
+        straight piece fitted with a radius of metres: FlashCut's four digits hold 9999.999
+        mm) is its chords within :data:`ARC_CHORD_TOLERANCE_MM` (twice the quantum at least),
+        counted as ``far-centre``.
+        """
+        ox, oy = (0.0, 0.0) if self._absolute_centre else self.written
+        if self._beyond_digits(centre[0] - ox, centre[1] - oy):
+            self.counts["far-centre"] += 1
+            tolerance = max(2.0 * self.spec.quantum_mm(), ARC_CHORD_TOLERANCE_MM)
+            arc = piece if piece is not None else make_arc(start, end, centre, clockwise)
+            return [(point, _FAR_CHORD) for point in arc.points(tolerance)[1:]]
         if self.spec.arc_check == "none":
             return [(end, centre)]
         key = (self.written, end, centre, clockwise, start)
@@ -515,21 +529,16 @@ class BlockWriter(WordWriter):
         before = self.written
         ox, oy = (0.0, 0.0) if self._absolute_centre else before
         ti = tj = ""
-        if centre is _CHORD:
-            self.counts["arc-chords"] += 1
+        if centre is _CHORD or centre is _FAR_CHORD:
+            if centre is _CHORD:  # far centres are counted per arc, in _conformed_at
+                self.counts["arc-chords"] += 1
             self._line(Linear(*end, move.feed_mm_min, contour=move.contour), end, z)
             return
         tiny = centre is None or (written == before and not full)
         if centre is not None:
             ci, cj = centre[0] - ox, centre[1] - oy
-            try:
-                ti, i = printed["I"].get(ci) or self._print("I", ci)
-                tj, j = printed["J"].get(cj) or self._print("J", cj)
-            except DialectError:
-                if not self._beyond_digits(ci, cj):
-                    raise
-                self._far_centre_chords(move, before, end, centre, z)
-                return
+            ti, i = printed["I"].get(ci) or self._print("I", ci)
+            tj, j = printed["J"].get(cj) or self._print("J", cj)
             tiny = tiny or (i + ox, j + oy) == before
             if self._arc_floor_mm:
                 tiny = tiny or 2.0 * math.hypot(i + ox - before[0], j + oy - before[1]) <= (
@@ -563,25 +572,6 @@ class BlockWriter(WordWriter):
             if abs(value) * number.scale + half_unit >= 10.0**number.int_digits:
                 return True
         return False
-
-    def _far_centre_chords(
-        self, move: ArcMove, start: Point, end: Point, centre: Point, z: float | None
-    ) -> None:
-        """Write the arc from ``start`` to ``end`` as chords: its centre is too far to print.
-
-        An arc fitted to an almost straight curve can have a radius of metres, its I or J
-        more integer digits than the dialect writes (FlashCut's four: 9999.999 mm): its
-        chords within :data:`ARC_CHORD_TOLERANCE_MM` (twice the quantum at least) are
-        written instead (counted as ``far-centre``). A helix's Z climbs evenly over them.
-        """
-        tolerance = max(2.0 * self.spec.quantum_mm(), ARC_CHORD_TOLERANCE_MM)
-        points = make_arc(start, end, centre, move.clockwise).points(tolerance)[1:]
-        points[-1] = end
-        z0 = self.z
-        self.counts["far-centre"] += 1
-        for k, point in enumerate(points, start=1):
-            at = z if z is None or z0 is None else z0 + (z - z0) * k / len(points)
-            self._line(Linear(*point, move.feed_mm_min, contour=move.contour), point, at)
 
     # -- arcs in the ZX and YZ planes -----------------------------------------------
 
