@@ -31,6 +31,7 @@ from camtool.post.numfmt import NumberFormat
 from camtool_postprocessors.matlab_router.arrays import (
     DEFAULT_SPEED,
     RouterArrays,
+    matlab_round,
     points_01mm,
     router_arrays,
 )
@@ -544,7 +545,9 @@ def _held_speeds(
 
     d = np.abs(np.diff(xy, axis=0))
     major, minor = d.max(axis=1), d.min(axis=1)
-    hangs = (minor > 0) & (np.rint(speed * minor / np.maximum(major, 1)) == 0)
+    # the minor axis's speed as router_arrays computes it: speed / (major / minor), rounded
+    ratio = np.divide(major, minor, out=np.full(len(d), np.inf), where=minor > 0)
+    hangs = (minor > 0) & (matlab_round(float(speed) / ratio) == 0)
     if not hangs.any():
         return xy, owners
     points: list[np.ndarray] = [xy[:1]]

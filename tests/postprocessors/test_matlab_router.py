@@ -343,6 +343,10 @@ def test_a_segment_whose_minor_axis_speed_rounds_to_zero_is_cut_into_pieces() ->
         and "block 2: 2 in 1940 counts, in 5 pieces" in w
         for w in warnings
     )
+    # 1 in 960: 480/960 = 0.5 rounds half away from zero to 1 (R1): it runs, as it is
+    code, warnings = _emit((Rapid(1.0, 1.0), Linear(97.0, 1.1, FEED)))
+    assert len(MatlabRouterPost().parse(code).moves) == 2
+    assert not any("cut into pieces" in w for w in warnings)
 
 
 def test_conversions_are_warned_once_per_kind() -> None:
