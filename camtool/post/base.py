@@ -158,6 +158,12 @@ B = TypeVar("B")
 COMMAND_KINDS = frozenset(kind.__name__ for kind in get_args(Command))
 """The kinds of :data:`~camtool.model.program.Command` by class name (``"Spindle"``, ...)."""
 
+FAR_FROM_ZERO = (
+    ": the toolpath lies that far from work zero; place the drawing at work zero with "
+    "--origin lower-left, or move it with --translate X Y"
+)
+"""Said after a coordinate too long for its word: the drawing, not the machine, is far off."""
+
 
 class WriterState(Generic[B]):
     """What a dialect writer keeps while it writes one program (one ``emit`` call).

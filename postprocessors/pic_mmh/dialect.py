@@ -38,6 +38,7 @@ from camtool.model.program import (
 )
 from camtool.model.shapes import Arc, distance
 from camtool.post.base import (
+    FAR_FROM_ZERO,
     ContourCounter,
     PostProcessor,
     PostResult,
@@ -445,6 +446,7 @@ class PicMmhPost(PostProcessor):
         except DialectError as exc:
             raise DialectError(
                 f"{w.where(move.contour)}: {letter} = {exc} (µm; at most 99999.99 = 99.99999 mm)"
+                + (FAR_FROM_ZERO if letter in "XY" else "")
             ) from exc
 
     def _xy(self, x: float, y: float, move: Move, w: _Writer) -> str:

@@ -588,3 +588,17 @@ def test_arc_with_a_centre_in_the_field_stays_an_arc() -> None:
     result = target.post.emit(program, target.machine)
     assert "G02X02969.00Y03400.00I03012.00J03040.00F08;" in str(result.code).splitlines()
     assert result.warnings == ()
+
+
+def test_a_coordinate_too_long_for_its_word_names_the_option_that_moves_the_drawing() -> None:
+    """dxf-parser's arc1.dxf lies at X -650.8 mm: 5 integer digits of µm hold 99.99999 mm.
+
+    The drawing, not the machine, is far off: the message names --origin lower-left (which
+    posts it) rather than stopping at the number.
+    """
+    target = load_target("pic-mmh")
+    program = Program((Rapid(-650.8, 1.0), Linear(-650.7, 1.0, 10.0)))
+    with pytest.raises(
+        DialectError, match=r"X = .* does not fit 5 integer digits .*--origin lower-"
+    ):
+        PicMmhPost().emit(program, target.machine)
