@@ -3,8 +3,8 @@
 svgelements applies a ``<style>`` sheet in its own order: only to the elements after the
 sheet, the ``#id`` rules before the ``.class`` rules whatever their specificity, an inline
 style above every rule even ``!important`` ones, and only rules whose selector names one
-element. Each of these once cut a shape a browser hides (``.off{display:none !important}``
-over ``style="display:inline"``) or dropped one it shows (``#b{display:inline}`` over
+element. Each of these would cut a shape a browser hides (``.off{display:none !important}``
+over ``style="display:inline"``) or drop one it shows (``#b{display:inline}`` over
 ``.a{display:none}``). :func:`apply_style_sheets` computes the cascade itself and writes the
 result into each element's ``style`` attribute; the sheets are then removed, so svgelements
 reads inline styles only.
@@ -99,7 +99,8 @@ def inline_style(element: ET.Element) -> dict[str, str]:
     return {k.strip(): v.strip() for k, v in pairs}
 
 
-def _style_text(declarations: dict[str, str]) -> str:
+def style_text(declarations: dict[str, str]) -> str:
+    """``{property: value}`` as the text of a ``style`` attribute (see :func:`inline_style`)."""
     return ";".join(f"{k}:{v}" for k, v in declarations.items())
 
 
@@ -108,12 +109,12 @@ def normalize_styles(root: ET.Element) -> None:
 
     CSS property names and keywords are case-insensitive and ``!important`` only ranks a
     declaration; svgelements compares the text, so ``display:none !important`` or
-    ``DISPLAY: NONE`` hid nothing and the element was cut.
+    ``DISPLAY: NONE`` would hide nothing and the element would be cut.
     """
     for element in root.iter():
         style = element.get("style")
         if style and ("!" in style or style != style.lower()):  # else nothing to change
-            element.set("style", _style_text({k: v for k, v, _ in _declaration_list(style)}))
+            element.set("style", style_text({k: v for k, v, _ in _declaration_list(style)}))
         for attr in _PRESENTATION:
             value = element.get(attr)
             if value is not None and value != value.lower() and value.strip().lower() in _KEYWORDS:
@@ -324,4 +325,4 @@ def _cascade(root: ET.Element, parents: dict[ET.Element, ET.Element], rules: lis
         normal.update((k, v) for k, v, i in inline if not i)
         normal.update(important)
         normal.update((k, v) for k, v, i in inline if i)
-        element.set("style", _style_text(normal))
+        element.set("style", style_text(normal))

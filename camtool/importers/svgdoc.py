@@ -23,6 +23,7 @@ from camtool.importers.svgcss import (
     inline_style,
     local_name,
     normalize_styles,
+    style_text,
 )
 from camtool.importers.svgpage import Affine, page_matrix
 from camtool.importers.svgvalues import LENGTH_ATTRS
@@ -164,7 +165,7 @@ def _hidden(element: ET.Element) -> bool:
 def _set_style(element: ET.Element, name: str, value: str) -> None:
     """Set ``name`` to ``value`` in ``element``'s style and its attribute (both say the same)."""
     style = {k: v for k, v in inline_style(element).items() if k != name}
-    element.set("style", ";".join(f"{k}:{v}" for k, v in [*style.items(), (name, value)]))
+    element.set("style", style_text({**style, name: value}))
     element.set(name, value)
 
 

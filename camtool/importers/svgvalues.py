@@ -1,8 +1,8 @@
 """SVG values svgelements reads otherwise than SVG does, rewritten before it reads them.
 
-Each pass here was found by a file a browser draws one way and svgelements another (resvg's
-test suite, whose reference images Chrome agrees with); each rewrites attributes into the
-form svgelements reads as SVG means them:
+In each case a browser draws the file one way and svgelements another (resvg's test suite,
+whose reference images Chrome agrees with, has a file for each); each pass rewrites the
+attributes into the form svgelements reads as SVG means them:
 
 - :func:`resolve_percentages`: a shape's percentage lengths as user units;
 - :func:`default_sizes`: a shape without its size draws nothing; an ellipse's one radius
@@ -21,7 +21,7 @@ import math
 import re
 import xml.etree.ElementTree as ET
 
-from camtool.importers.svgcss import inline_style, local_name
+from camtool.importers.svgcss import inline_style, local_name, style_text
 
 LENGTH_ATTRS = {
     "rect": ("x", "y", "width", "height", "rx", "ry"),
@@ -39,7 +39,7 @@ def default_sizes(element: ET.Element, kind: str) -> None:
 
     A rect needs both sizes, an ellipse one radius (the other ``auto``: the same), a circle
     its radius: without them nothing is drawn (their value is 0 or ``auto``, SVG 2
-    §10.2-10.4), where svgelements drew a size of 1 (a 1 px high rectangle). A size set in
+    §10.2-10.4), where svgelements draws a size of 1 (a 1 px high rectangle). A size set in
     the ``style`` (SVG 2 geometry properties) counts. Run after :func:`resolve_percentages`.
     """
     needs = _SIZE_NEEDS.get(kind)
@@ -71,8 +71,8 @@ def resolve_paint_references(root: ET.Element) -> None:
     A reference to no element, to one that is not a paint server (a ``<rect>``), or to a
     gradient without stops paints with its fallback colour (``url(#g) red``), else not at
     all (SVG 2 §13.2): a shape
-    filled so and not stroked is invisible. svgelements painted every ``url(…)`` black, so
-    such a shape was cut. A reference to a gradient or pattern is kept (the shape is
+    filled so and not stroked is invisible. svgelements paints every ``url(…)`` black, so
+    such a shape would be cut. A reference to a gradient or pattern is kept (the shape is
     painted). Run after the style sheets are applied.
     """
     ids = {e.get("id"): e for e in root.iter() if e.get("id")}
@@ -92,7 +92,7 @@ def resolve_paint_references(root: ET.Element) -> None:
                 paint = match.group(2) or "none"
                 if inline:
                     declared[name] = paint
-                    element.set("style", ";".join(f"{k}:{v}" for k, v in declared.items()))
+                    element.set("style", style_text(declared))
                 else:
                     element.set(name, paint)
 
@@ -111,7 +111,7 @@ def fold_transform_origin(element: ET.Element, viewport: tuple[float, float]) ->
     property). Keywords (``left``, ``center``, ``right``, ``top``, ``bottom``) and
     percentages are of the document's viewport (``transform-box: view-box``, the initial
     value); one value leaves the other axis at ``center``. svgelements ignores it, so a
-    shape turned about its centre was cut turned about the origin, elsewhere.
+    shape turned about its centre would be cut turned about the origin, elsewhere.
 
     Raises:
         ValueError: a ``transform-origin`` that is not one or two such values (a third,
@@ -123,7 +123,7 @@ def fold_transform_origin(element: ET.Element, viewport: tuple[float, float]) ->
         return
     if "transform-origin" in style:
         del style["transform-origin"]
-        element.set("style", ";".join(f"{k}:{v}" for k, v in style.items()))
+        element.set("style", style_text(style))
     element.attrib.pop("transform-origin", None)
     transform = element.get("transform")
     if not transform or not transform.strip():
@@ -194,8 +194,8 @@ def resolve_percentages(root: ET.Element, viewport: tuple[float, float]) -> None
     ``x2``, a rect's ``rx``), height (``y``, ...; a rect's ``ry``) or normalised diagonal
     ``sqrt((w² + h²) / 2)`` (``r``; an ellipse's ``rx`` and ``ry`` are of the width and the
     height) (SVG 1.1 §7.10). The viewport is the document's, or a nested ``<svg>``'s
-    viewBox. svgelements resolved them against other sizes: a rect at ``x="10%"
-    width="50%"`` in a 200 × 100 viewBox was cut from x 10 to 60 instead of 20 to 120.
+    viewBox. svgelements resolves them against other sizes: a rect at ``x="10%"
+    width="50%"`` in a 200 × 100 viewBox would be cut from x 10 to 60 instead of 20 to 120.
 
     Args:
         root: the ``<svg>`` element.
