@@ -20,6 +20,7 @@ from camtool.importers.dxf_entities import (
     ZERO_LENGTH,
     BadEntity,
     check_numbers,
+    invisible,
     layer_of,
     line_inside,
 )
@@ -330,7 +331,7 @@ class _Reader:
         self.swapped: list[tuple[str, float]] = []  # ELLIPSEs with a ratio above 1
 
     def read(self, entity: Any) -> None:
-        from camtool.importers.dxf_blocks import Skip, expand_insert
+        from camtool.importers.dxf_blocks import HIDDEN, INVISIBLE, Skip, expand_insert
         from camtool.importers.dxf_entities import Item
 
         kind = entity.dxftype()
@@ -343,11 +344,18 @@ class _Reader:
         if kind != "INSERT":
             self._item(Item(entity, f"{kind} #{dxf.handle}", layer))
             return
-        if _invisible(entity):  # a hidden block reference hides its content
+        if invisible(entity):  # a hidden block reference hides its content
             self.invisible += self.keep(layer)
             return
+        if self.keep.freezes(layer):
+            return
         block = self._style(entity, layer)
-        for placed in expand_insert(entity, layer, self.limit, self.cyclic):
+        for placed in expand_insert(entity, layer, self.limit, self.cyclic, self.keep.freezes):
+            if placed is HIDDEN:  # a nested block reference on a frozen layer (counted)
+                continue
+            if placed is INVISIBLE:
+                self.invisible += 1
+                continue
             if isinstance(placed, Skip):
                 self.block_counts[(placed.kind, placed.layer)] += 1
                 if self.keep(placed.layer):
@@ -366,7 +374,7 @@ class _Reader:
         """
         if not self.keep(layer):
             return
-        if _invisible(entity):
+        if invisible(entity):
             self.invisible += 1
             return
         dxf = entity.dxf
@@ -407,7 +415,7 @@ class _Reader:
 
         if not self.keep(item.layer):
             return
-        if _invisible(item.entity):
+        if invisible(item.entity):
             self.invisible += 1
             return
         kind = _kind(item.entity)
@@ -668,10 +676,29 @@ class _LayerFilter:
     entities it leaves out for being hidden.
     """
 
-    def __init__(self, wanted: set[str] | None, hidden: dict[str, str], named: set[str]) -> None:
+    def __init__(
+        self,
+        wanted: set[str] | None,
+        hidden: tuple[dict[str, str], set[str]],
+        named: set[str],
+    ) -> None:
         self.wanted = wanted
-        self.hidden = {k: v for k, v in hidden.items() if k not in named}
+        self.hidden = {k: v for k, v in hidden[0].items() if k not in named}
+        self.frozen = {k for k in hidden[1] if k not in named}
         self.dropped: Counter[str] = Counter()
+        self.frozen_blocks: Counter[str] = Counter()  # block references hidden whole
+
+    def freezes(self, layer: str) -> bool:
+        """Whether a block reference on ``layer`` is hidden with all it holds, and counts it.
+
+        AutoCAD hides everything a block reference places when the reference's layer is
+        frozen, whatever the layers of the block's entities; a layer that is only off
+        hides the entities on that layer (layer 0 ones included), not the others.
+        """
+        if layer.casefold() not in self.frozen:
+            return False
+        self.frozen_blocks[self.hidden.get(layer.casefold(), layer)] += 1
+        return True
 
     def reads(self, layer: str) -> bool:
         """Whether entities on ``layer`` are read (nothing counted: a look ahead)."""
@@ -688,25 +715,21 @@ class _LayerFilter:
         return False
 
 
-def _invisible(entity: Any) -> bool:
-    """Whether ``entity``'s invisible flag (group code 60) is set: the CAD program hides it."""
-    try:
-        return bool(entity.dxf.get("invisible", 0))
-    except (AttributeError, TypeError, ValueError):
-        return False
-
-
-def _hidden_layers(doc: Any) -> dict[str, str]:
-    """The drawing's layers that are off or frozen, by case-folded name."""
-    hidden = {}
+def _hidden_layers(doc: Any) -> tuple[dict[str, str], set[str]]:
+    """The drawing's layers that are off or frozen, by case-folded name; the frozen ones."""
+    hidden, frozen = {}, set()
     for layer in doc.layers:
         try:
-            off = layer.is_off() or layer.is_frozen()
+            cold = bool(layer.is_frozen())
+            off = cold or layer.is_off()
         except (AttributeError, TypeError, ValueError):  # a damaged LAYER entry: shown
-            off = False
+            cold = off = False
+        key = str(layer.dxf.name).casefold()
         if off:
-            hidden[str(layer.dxf.name).casefold()] = str(layer.dxf.name)
-    return hidden
+            hidden[key] = str(layer.dxf.name)
+        if cold:
+            frozen.add(key)
+    return hidden, frozen
 
 
 def _layer_filter(
@@ -735,6 +758,14 @@ def _layer_filter(
 def _hidden_warnings(path: Path, keep: _LayerFilter, invisible: int) -> list[str]:
     """What was left out for being hidden in the drawing, with what cuts it."""
     out = []
+    if keep.frozen_blocks:
+        count = sum(keep.frozen_blocks.values())
+        names = ", ".join(repr(n) for n in sorted(keep.frozen_blocks, key=str.casefold))
+        out.append(
+            f"{path}: skipped {count} block reference(s) (INSERT) on frozen layer(s) {names} "
+            "with everything they place, whatever its layer (hidden, so not cut); name the "
+            "layer in --layers or in a job operation to cut them"
+        )
     if keep.dropped:
         count = sum(keep.dropped.values())
         names = ", ".join(repr(n) for n in sorted(keep.dropped, key=str.casefold))

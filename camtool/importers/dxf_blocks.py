@@ -5,7 +5,7 @@ Design notes: docs/internals.md, ``camtool/importers/dxf_blocks.py``.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -15,6 +15,7 @@ from camtool.importers.dxf_entities import (
     Item,
     Unsupported,
     check_numbers,
+    invisible,
     layer_of,
     location,
 )
@@ -43,8 +44,23 @@ class Skip:
     location: Point | None = None
 
 
+HIDDEN = Skip("INSERT", "hidden", "", "")
+"""Yielded for a nested block reference ``hides`` hides, in place of all it would place."""
+
+INVISIBLE = Skip("INSERT", "invisible", "", "")
+"""Yielded for a nested block reference with its invisible flag (group code 60) set."""
+
+
+def _hides_nothing(layer: str) -> bool:
+    return False
+
+
 def expand_insert(
-    insert: Any, layer: str, limit: float, cyclic: frozenset[str] = frozenset()
+    insert: Any,
+    layer: str,
+    limit: float,
+    cyclic: frozenset[str] = frozenset(),
+    hides: Callable[[str], bool] = _hides_nothing,
 ) -> Iterator[Item | Skip]:
     """Every leaf entity a model-space INSERT (or MINSERT) places, in WCS drawing units.
 
@@ -58,6 +74,10 @@ def expand_insert(
         limit: largest number accepted, drawing units.
         cyclic: blocks on a reference cycle (:attr:`BlockGraph.cyclic`); their INSERTs
             are skipped whole.
+        hides: called with the effective layer of each nested INSERT; true when the CAD
+            program hides the reference with all it places (AutoCAD: its layer is frozen).
+            Such a reference yields :data:`HIDDEN`, one with its invisible flag set
+            :data:`INVISIBLE`.
 
     Yields:
         :class:`~camtool.importers.dxf_entities.Item` for each placed entity (types in
@@ -72,10 +92,10 @@ def expand_insert(
         BadEntity: an INSERT or a block entity holds a NaN, infinite or huge number; an
             INSERT (at any depth) has a clipping boundary switched on (XCLIP).
     """
-    yield from _expand(insert, layer, None, "", (), (limit, cyclic))
+    yield from _expand(insert, layer, None, "", (), (limit, cyclic, hides))
 
 
-_Limits = tuple[float, frozenset[str]]  # (largest number, cyclic block names)
+_Limits = tuple[float, frozenset[str], Callable[[str], bool]]  # number, cyclic blocks, hides
 
 
 def _expand(
@@ -150,7 +170,12 @@ def _place(
     own = layer_of(entity)
     eff = layer if own == "0" else own
     if kind == "INSERT":
-        yield from _expand(entity, eff, matrix, chain, names, limits)
+        if invisible(entity):
+            yield INVISIBLE
+        elif limits[2](eff):
+            yield HIDDEN
+        else:
+            yield from _expand(entity, eff, matrix, chain, names, limits)
         return
     label = f"{kind} #{entity.dxf.handle}{chain}"
     if kind not in CONVERTED:

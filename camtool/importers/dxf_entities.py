@@ -273,6 +273,14 @@ def layer_of(entity: Any) -> str:
     return str(entity.dxf.get("layer", "0"))
 
 
+def invisible(entity: Any) -> bool:
+    """Whether ``entity``'s invisible flag (group code 60) is set: the CAD program hides it."""
+    try:
+        return bool(entity.dxf.get("invisible", 0))
+    except (AttributeError, TypeError, ValueError):
+        return False
+
+
 def location(entity: Any) -> Point | None:
     """A representative WCS point of an entity (start, centre or first vertex), or None."""
     for name in ("start", "center", "insert", "location"):

@@ -195,3 +195,65 @@ def test_a_hidden_layer_named_is_read(tmp_path: Path) -> None:
     by_job = read_dxf(path, ImportOptions(shown=("FROZEN",)))  # a job's operation names it
     assert sorted(c.layer for c in by_job.contours) == ["Frozen", "PART"]
     assert "'OFF', off or frozen" in by_job.warnings[0]
+
+
+def _blocks_on_hidden_layers(path: Path) -> Path:
+    """Block references on an off and on a frozen layer, one nested, content on own layers.
+
+    The rule the expected values come from is AutoCAD's (its help, "Layers: About block
+    references"; QCAD's Teigha visibility test drawings show the same): an entity on layer 0
+    in a block takes the layer of the reference that places it; a reference on a layer that
+    is only off still shows its entities on other layers; a reference on a frozen layer shows
+    nothing it places, at any depth.
+    """
+
+    def build(msp: Any) -> None:
+        doc = msp.doc
+        doc.layers.add("REF_OFF").off()
+        doc.layers.add("REF_FROZEN").freeze()
+        doc.layers.add("NEST_FROZEN").freeze()
+        for name in ("CONTENT", "INNER"):
+            doc.layers.add(name)
+        inner = doc.blocks.new("INNER")
+        inner.add_circle((0, 0), 1.0, dxfattribs={"layer": "INNER"})
+        outer = doc.blocks.new("OUTER")
+        outer.add_line((0, 0), (10, 0), dxfattribs={"layer": "CONTENT"})
+        outer.add_line((0, 5), (10, 5), dxfattribs={"layer": "0"})  # takes the reference's
+        outer.add_blockref("INNER", (5, 10), dxfattribs={"layer": "NEST_FROZEN"})
+        outer.add_blockref("INNER", (5, 20), dxfattribs={"layer": "INNER", "invisible": 1})
+        outer.add_blockref("INNER", (5, 30), dxfattribs={"layer": "0"})
+        msp.add_blockref("OUTER", (0, 0), dxfattribs={"layer": "REF_OFF"})
+        msp.add_blockref("OUTER", (100, 0), dxfattribs={"layer": "REF_FROZEN"})
+        msp.add_blockref("OUTER", (200, 0), dxfattribs={"layer": "PART"})
+
+    return write_dxf(path, build)
+
+
+def test_a_block_reference_on_a_frozen_layer_hides_all_it_places(tmp_path: Path) -> None:
+    from camtool.importers.options import ImportOptions
+
+    path = _blocks_on_hidden_layers(tmp_path / "refs.dxf")
+    drawing = read_dxf(path)
+    placed = sorted((c.layer, round(c.bbox()[0])) for c in drawing.contours)
+    # REF_OFF at x 0: only its CONTENT line and the INNER circle of the layer-0 reference
+    # (its layer-0 line and the layer-0 reference take REF_OFF, which is off: the circle is
+    # on INNER, so it shows). REF_FROZEN at x 100: nothing. PART at x 200: all but the
+    # reference on NEST_FROZEN and the invisible one.
+    assert placed == [
+        ("CONTENT", 0),
+        ("CONTENT", 200),
+        ("INNER", 4),
+        ("INNER", 204),
+        ("PART", 200),
+    ]
+    assert any(
+        "skipped 3 block reference(s) (INSERT) on frozen layer(s) 'NEST_FROZEN', "
+        "'REF_FROZEN' with everything they place" in w
+        for w in drawing.warnings
+    )
+    named = read_dxf(path, ImportOptions(shown=("REF_FROZEN",)))
+    assert sorted(round(c.bbox()[0]) for c in named.contours if 100 <= c.bbox()[0] < 200) == [
+        100,
+        100,
+        104,
+    ]
