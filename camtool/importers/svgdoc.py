@@ -563,6 +563,7 @@ def prepare(
     normalize_styles(root)
     svgvalues.resolve_percentages(root, viewport)
     svgvalues.resolve_paint_references(root)
+    svgvalues.normalize_colours(root)
     _label_and_check(root, str(path), viewport)
     check_use_cycles(root, str(path))
     check_size(root, str(path), max_entities)

@@ -9,10 +9,12 @@ attributes into the form svgelements reads as SVG means them:
   is both (``auto``);
 - :func:`fold_transform_origin`: ``transform-origin`` into the ``transform``;
 - :func:`resolve_paint_references`: a ``url(#id)`` paint that paints nothing as its
-  fallback.
+  fallback;
+- :func:`normalize_colours`: ``rgb()``/``hsl()`` colours in the forms svgelements does
+  not read (fractions, exponents, CSS Color 4's spaces and ``/ alpha``) as ``rgba()``.
 
 Sources: SVG 1.1 §7.10 (units), §13.2 (paint servers); SVG 2 §10 (shapes), §13.2
-(paint); CSS Transforms 1 §6.
+(paint); CSS Transforms 1 §6; CSS Color 4 §5.1 (``rgb()``), §7 (``hsl()``).
 """
 
 from __future__ import annotations
@@ -59,7 +61,7 @@ _ACROSS = frozenset({"x", "cx", "width", "x1", "x2"})
 _DOWN = frozenset({"y", "cy", "height", "y1", "y2"})
 
 
-_PAINT_URL = re.compile(r"\s*url\(\s*['\"]?#([^)'\"]+)['\"]?\s*\)\s*(.*?)\s*")
+_PAINT_URL = re.compile(r"\s*url\(\s*['\"]?#([^)'\"\s]+)['\"]?\s*\)\s*(.*?)\s*")
 _PAINT_SERVERS = frozenset(
     {"linearGradient", "radialGradient", "pattern", "meshgradient", "hatch", "solidcolor"}
 )
@@ -95,6 +97,105 @@ def resolve_paint_references(root: ET.Element) -> None:
                     element.set("style", style_text(declared))
                 else:
                     element.set(name, paint)
+
+
+_COLOUR_FUNCTION = re.compile(r"\s*(rgba?|hsla?)\(([^()]*)\)\s*", re.IGNORECASE)
+_COLOUR_ARG = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?(%|deg|grad|rad|turn)?$")
+_TURNS = {"": 1 / 360, "deg": 1 / 360, "grad": 1 / 400, "rad": 1 / (2 * math.pi), "turn": 1.0}
+
+
+def normalize_colours(root: ET.Element) -> None:
+    """Rewrite ``fill``, ``stroke`` and ``color`` values of ``rgb()``/``hsl()`` as ``rgba()``.
+
+    svgelements reads only integer ``rgb()`` channels with commas: a fraction
+    (``rgb(0.8, 127.5, 14.2)``, SVG 2) makes it drop the whole shape without a word,
+    and CSS Color 4's space-separated form (``rgb(0 128 0 / 50%)``, ``hsl(120deg 100%
+    25%)``) reads as black, which a job selecting by colour would take for another
+    colour. Channels are clamped and rounded to 0–255 (CSS Color 4 §5.1); a value that
+    is not a colour is left for svgelements. Run after the style sheets are applied.
+    """
+    for element in root.iter():
+        style = element.get("style")
+        declared = inline_style(element) if style and "(" in style else {}
+        changed = False
+        for name in ("fill", "stroke", "color"):
+            value = element.get(name)
+            if value and "(" in value:
+                rgba = _rgba(value)
+                if rgba is not None:
+                    element.set(name, rgba)
+            value = declared.get(name)
+            if value and "(" in value:
+                rgba = _rgba(value)
+                if rgba is not None:
+                    declared[name] = rgba
+                    changed = True
+        if changed:
+            element.set("style", style_text(declared))
+
+
+def _rgba(value: str) -> str | None:
+    """``value`` as ``rgba(r,g,b,a)`` with integer channels; None: not an rgb()/hsl() colour."""
+    match = _COLOUR_FUNCTION.fullmatch(value)
+    if match is None:
+        return None
+    kind = match.group(1).lower()[:3]
+    body = match.group(2).strip()
+    alpha_text = None
+    if "/" in body:
+        body, alpha_text = (part.strip() for part in body.split("/", 1))
+    args = [a for a in re.split(r"\s*,\s*|\s+", body) if a]
+    if alpha_text is None and len(args) == 4:
+        alpha_text = args.pop()
+    if len(args) != 3 or not all(_COLOUR_ARG.match(a) for a in args):
+        return None
+    alpha = _alpha(alpha_text)
+    if alpha is None:
+        return None
+    channels = [_channel(a) for a in args] if kind == "rgb" else _hsl(args)
+    if channels is None or any(c is None for c in channels):
+        return None
+    r, g, b = channels
+    return f"rgba({r},{g},{b},{alpha:g})"
+
+
+def _channel(arg: str) -> int | None:
+    if arg.endswith(("deg", "grad", "rad", "turn")):
+        return None
+    number = float(arg.rstrip("%")) * (2.55 if arg.endswith("%") else 1.0)
+    if not math.isfinite(number):
+        return None
+    return math.floor(min(max(number, 0.0), 255.0) + 0.5)
+
+
+def _alpha(text: str | None) -> float | None:
+    if text is None:
+        return 1.0
+    if not _COLOUR_ARG.match(text) or text.endswith(("deg", "grad", "rad", "turn")):
+        return None
+    number = float(text.rstrip("%")) / (100.0 if text.endswith("%") else 1.0)
+    return min(max(number, 0.0), 1.0) if math.isfinite(number) else None
+
+
+def _hsl(args: list[str]) -> list[int] | None:
+    """CSS Color 4 §7.1: hue in degrees (or an angle unit), saturation and lightness."""
+    hue, sat, light = args
+    unit = _COLOUR_ARG.match(hue).group(1) or ""  # type: ignore[union-attr]
+    if unit == "%":
+        return None
+    h = (float(hue[: len(hue) - len(unit)]) * _TURNS[unit]) % 1.0
+    s = min(max(float(sat.rstrip("%")) / 100.0, 0.0), 1.0)
+    lum = min(max(float(light.rstrip("%")) / 100.0, 0.0), 1.0)
+    if not all(math.isfinite(v) for v in (h, s, lum)):
+        return None
+
+    def f(n: float) -> int:
+        k = (n + h * 12.0) % 12.0
+        a = s * min(lum, 1.0 - lum)
+        v = lum - a * max(-1.0, min(k - 3.0, 9.0 - k, 1.0))
+        return math.floor(v * 255.0 + 0.5)
+
+    return [f(0.0), f(8.0), f(4.0)]
 
 
 _ORIGIN_KEYWORDS = {"left": 0.0, "top": 0.0, "center": 50.0, "right": 100.0, "bottom": 100.0}

@@ -763,3 +763,44 @@ def test_a_gradient_without_stops_paints_nothing(tmp_path: Path) -> None:
         "rect#f",
         "rect#g",
     ]
+
+
+def test_a_url_paint_with_spaces_inside_the_parentheses_is_a_reference(tmp_path: Path) -> None:
+    """CSS url(): white space may surround the URL (resvg's structure/svg/funcIRI-parsing)."""
+    body = (
+        '<defs><linearGradient id="g"><stop offset="0" stop-color="red"/></linearGradient></defs>'
+        '<rect id="spaced" width="9" height="9" fill="  url(  #g   )  "/>'
+        '<rect id="in-style" width="9" height="9" style="fill: url( \'#g\' )"/>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.source for c in drawing.contours] == ["rect#spaced", "rect#in-style"]
+
+
+@pytest.mark.parametrize(
+    ("paint", "colour"),
+    [
+        ("rgb(0.8, 127.5, 14.2)", "#01800e"),  # SVG 2 fractions: CSS rounds half up
+        ("rgb(1e2, 0, 0)", "#640000"),
+        ("rgb(0 127 14)", "#007f0e"),  # CSS Color 4 spaces
+        ("rgb(0 127 14 / 50%)", "#007f0e"),
+        ("rgb(10%, 50.5%, 0%)", "#1a8100"),  # 25.5 → 26, 128.775 → 129
+        ("rgb(300, -5, 0)", "#ff0000"),  # clamped
+        ("hsl(120deg 100% 25%)", "#008000"),  # CSS Color 4 §7: CSS green
+        ("hsl(0.5turn, 100%, 50%)", "#00ffff"),  # hue 180°: cyan
+        ("hsla(240, 100%, 50%, 0.5)", "#0000ff"),
+    ],
+)
+def test_rgb_and_hsl_colours_svgelements_does_not_read(
+    tmp_path: Path, paint: str, colour: str
+) -> None:
+    """svgelements dropped a shape filled ``rgb(0.8, 127.5, 14.2)`` without a word (resvg's
+    painting/fill/rgb-color-with-floats) and read CSS Color 4's forms as black."""
+    body = (
+        f'<rect id="attr" width="9" height="9" fill="{paint}"/>'
+        f'<rect id="css" width="9" height="9" style="fill:none; stroke: {paint}"/>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert [(c.source, c.colour) for c in drawing.contours] == [
+        ("rect#attr", colour),
+        ("rect#css", colour),
+    ]
