@@ -11,7 +11,8 @@ attributes into the form svgelements reads as SVG means them:
 - :func:`resolve_paint_references`: a ``url(#id)`` paint that paints nothing as its
   fallback;
 - :func:`normalize_colours`: ``rgb()``/``hsl()`` colours in the forms svgelements does
-  not read (fractions, exponents, CSS Color 4's spaces and ``/ alpha``) as ``rgba()``.
+  not read (fractions, exponents, CSS Color 4's spaces and ``/ alpha``) as ``rgba()``, and
+  opacities clamped to [0, 1].
 
 Sources: SVG 1.1 §7.10 (units), §13.2 (paint servers); SVG 2 §10 (shapes), §13.2
 (paint); CSS Transforms 1 §6; CSS Color 4 §5.1 (``rgb()``), §7 (``hsl()``).
@@ -112,12 +113,35 @@ def normalize_colours(root: ET.Element) -> None:
     and CSS Color 4's space-separated form (``rgb(0 128 0 / 50%)``, ``hsl(120deg 100%
     25%)``) reads as black, which a job selecting by colour would take for another
     colour. Channels are clamped and rounded to 0–255 (CSS Color 4 §5.1); a value that
-    is not a colour is left for svgelements. Run after the style sheets are applied.
+    is not a colour is left for svgelements.
+
+    ``opacity``, ``fill-opacity`` and ``stroke-opacity`` are clamped to [0, 1] (a
+    percentage is of 1), and one that is no number is dropped, its initial value 1 (CSS:
+    an invalid declaration is ignored): svgelements raised on ``fill-opacity="1e400"``.
+    Run after the style sheets are applied.
     """
     for element in root.iter():
+        for name in _OPACITIES:
+            value = element.get(name)
+            if value is not None:
+                clamped = _opacity(value)
+                if clamped is None:
+                    del element.attrib[name]
+                elif clamped != value:
+                    element.set(name, clamped)
         style = element.get("style")
-        declared = inline_style(element) if style and "(" in style else {}
+        declared = inline_style(element) if style and ("(" in style or "opacity" in style) else {}
         changed = False
+        for name in _OPACITIES:
+            value = declared.get(name)
+            if value is not None:
+                clamped = _opacity(value)
+                if clamped != value:
+                    changed = True
+                    if clamped is None:
+                        del declared[name]
+                    else:
+                        declared[name] = clamped
         for name in ("fill", "stroke", "color"):
             value = element.get(name)
             if value and "(" in value:
@@ -132,6 +156,21 @@ def normalize_colours(root: ET.Element) -> None:
                     changed = True
         if changed:
             element.set("style", style_text(declared))
+
+
+_OPACITIES = ("opacity", "fill-opacity", "stroke-opacity")
+_NUMBER = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(%?)\s*")
+
+
+def _opacity(value: str) -> str | None:
+    """An opacity clamped to [0, 1] as written (unchanged when already so); None: no number."""
+    match = _NUMBER.fullmatch(value)
+    if match is None:
+        return None
+    number = float(match.group(1)) / (100.0 if match.group(2) else 1.0)
+    if 0.0 <= number <= 1.0 and not match.group(2):
+        return value
+    return f"{min(max(number, 0.0), 1.0):g}"
 
 
 def _rgba(value: str) -> str | None:

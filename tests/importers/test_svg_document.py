@@ -804,3 +804,28 @@ def test_rgb_and_hsl_colours_svgelements_does_not_read(
         ("rect#attr", colour),
         ("rect#css", colour),
     ]
+
+
+def test_opacities_are_clamped_and_one_that_is_no_number_is_ignored(tmp_path: Path) -> None:
+    """CSS Color 4 §4.2: an opacity is clamped to [0, 1]; an invalid declaration is ignored
+    (initial value 1). svgelements raised OverflowError on ``fill-opacity="1e400"``, which
+    camtool reported as an internal error."""
+    body = (
+        '<rect id="huge" width="9" height="9" fill-opacity="1e400"/>'
+        '<rect id="huge-css" width="9" height="9" style="fill-opacity:1e400; opacity: 5"/>'
+        '<rect id="word" width="9" height="9" fill-opacity="inf"/>'
+        '<rect id="half" width="9" height="9" style="fill-opacity:50%"/>'
+        '<rect id="stroke" width="9" height="9" fill="none" stroke="red" stroke-opacity="1e999"/>'
+        '<rect id="negative" width="9" height="9" fill-opacity="-0.5"/>'
+        '<rect id="negative-css" width="9" height="9" style="opacity:-2%"/>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.source for c in drawing.contours] == [
+        "rect#huge",
+        "rect#huge-css",
+        "rect#word",
+        "rect#half",
+        "rect#stroke",
+    ]
+    assert any("skipped 1 element with opacity 0" in w for w in drawing.warnings)
+    assert any("skipped 1 element with neither fill nor stroke" in w for w in drawing.warnings)
