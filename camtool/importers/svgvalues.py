@@ -121,44 +121,73 @@ def normalize_colours(root: ET.Element) -> None:
     Run after the style sheets are applied.
     """
     for element in root.iter():
+        attrib = element.attrib
+        if not attrib:
+            continue
         for name in _OPACITIES:
-            value = element.get(name)
+            value = attrib.get(name)
             if value is not None:
                 clamped = _opacity(value)
                 if clamped is None:
-                    del element.attrib[name]
+                    del attrib[name]
                 elif clamped != value:
-                    element.set(name, clamped)
-        style = element.get("style")
-        declared = inline_style(element) if style and ("(" in style or "opacity" in style) else {}
-        changed = False
-        for name in _OPACITIES:
-            value = declared.get(name)
-            if value is not None:
-                clamped = _opacity(value)
-                if clamped != value:
-                    changed = True
-                    if clamped is None:
-                        del declared[name]
-                    else:
-                        declared[name] = clamped
-        for name in ("fill", "stroke", "color"):
-            value = element.get(name)
+                    attrib[name] = clamped
+        for name in _PAINTS:
+            value = attrib.get(name)
             if value and "(" in value:
                 rgba = _rgba(value)
                 if rgba is not None:
-                    element.set(name, rgba)
-            value = declared.get(name)
-            if value and "(" in value:
-                rgba = _rgba(value)
-                if rgba is not None:
-                    declared[name] = rgba
-                    changed = True
-        if changed:
-            element.set("style", style_text(declared))
+                    attrib[name] = rgba
+        style = attrib.get("style")
+        if style and _rewritable(style):
+            _restyle(element)
+
+
+def _restyle(element: ET.Element) -> None:
+    """:func:`normalize_colours` for the declarations of ``element``'s ``style``."""
+    declared = inline_style(element)
+    changed = False
+    for name in _OPACITIES:
+        value = declared.get(name)
+        if value is not None:
+            clamped = _opacity(value)
+            if clamped != value:
+                changed = True
+                if clamped is None:
+                    del declared[name]
+                else:
+                    declared[name] = clamped
+    for name in _PAINTS:
+        value = declared.get(name)
+        if value and "(" in value:
+            rgba = _rgba(value)
+            if rgba is not None:
+                declared[name] = rgba
+                changed = True
+    if changed:
+        element.set("style", style_text(declared))
 
 
 _OPACITIES = ("opacity", "fill-opacity", "stroke-opacity")
+_PAINTS = ("fill", "stroke", "color")
+_COLOUR_CALL = re.compile(r"(?:rgb|hsl)a?\(", re.IGNORECASE)
+_ODD_OPACITY = re.compile(
+    r"opacity\s*:(?!\s*(?:[01]|0?\.\d+|1\.0*)\s*(?:!important\s*)?(?:;|$))", re.IGNORECASE
+)
+
+
+def _rewritable(style: str) -> bool:
+    """Whether a ``style`` may hold a colour or an opacity :func:`normalize_colours` rewrites.
+
+    A quick look (Inkscape writes ``opacity:1;fill-opacity:1`` on every element), so that
+    only such styles are parsed.
+    """
+    return bool(
+        ("(" in style and _COLOUR_CALL.search(style))
+        or ("opacity" in style and _ODD_OPACITY.search(style))
+    )
+
+
 _NUMBER = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(%?)\s*")
 
 
