@@ -85,7 +85,8 @@ def read_gcode_bytes(
     """Read a G-code file given as its bytes (as :func:`read_gcode` reads the file's).
 
     Args:
-        data: the file's bytes: UTF-8 (with or without BOM), else read as Latin-1.
+        data: the file's bytes: UTF-8 (with or without BOM), UTF-16 or UTF-32 with their
+            BOM, else read as Latin-1.
         source: the name messages give the file.
         reading: as :func:`read_gcode`'s.
 
@@ -96,9 +97,16 @@ def read_gcode_bytes(
 
 
 def _decoded(data: bytes) -> str:
-    """``data`` as text: UTF-8 (a byte-order mark dropped), else Latin-1."""
+    """``data`` as text: as its byte-order mark says (UTF-8, -16, -32), else UTF-8, else Latin-1.
+
+    A marked file that does not decode is read as Latin-1 too: the reader then names the
+    first character that is no G-code.
+    """
+    from camtool.importers.textfile import marked_encoding
+
+    codec = marked_encoding(data) or "utf-8"
     try:
-        return data.decode("utf-8-sig")
+        return data.decode(codec)
     except UnicodeDecodeError:
         return data.decode("latin-1")
 

@@ -109,14 +109,21 @@ def _scale(value: float, factor: float) -> float:
 def _read_text(path: Path) -> str:
     if not path.is_file():
         raise InputError(f"{path}: no such file")
+    from camtool.importers.textfile import marked_encoding
+
     try:
-        return path.read_text(encoding="utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise InputError(
-            f"{path}: not a UTF-8 text file ({exc.reason} at byte {exc.start})"
-        ) from exc
+        data = path.read_bytes()
     except OSError as exc:
         raise InputError(f"{path}: cannot read the file ({exc})") from exc
+    codec = marked_encoding(data) or "utf-8"
+    try:
+        return data.decode(codec)  # the mark is dropped
+    except UnicodeDecodeError as exc:
+        name = "UTF-8" if codec in ("utf-8", "utf-8-sig") else codec.upper()
+        raise InputError(
+            f"{path}: not a {name} text file ({exc.reason} at byte {exc.start}); save it as "
+            "UTF-8 (or plain ASCII) text"
+        ) from exc
 
 
 def _contour(pts: list[Point], source: str) -> Contour | None:

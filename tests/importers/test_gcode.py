@@ -394,6 +394,9 @@ def test_read_gcode_errors_and_encodings(tmp_path: Path) -> None:
     latin = tmp_path / "pieza.nc"
     latin.write_bytes("(pieza maquinada en el LMM: ñ)\nG1 X1 Y1 F9\nM2\n".encode("latin-1"))
     assert read_gcode(latin, source_name="-").moves == (Linear(1.0, 1.0, 9.0, contour=1),)
+    unicode = tmp_path / "notepad.nc"  # Notepad's "Unicode": UTF-16 LE with its mark
+    unicode.write_bytes("(pièce)\r\nG21 G90\r\nG1 X1 Y1 F9\r\nM2\r\n".encode("utf-16"))
+    assert read_gcode(unicode).moves == (Linear(1.0, 1.0, 9.0, contour=1),)
     with pytest.raises(InputError, match=r"^<stdin>:2: G41"):
         bad = tmp_path / "bad.nc"
         bad.write_text("G21\r\nG41\r\n")

@@ -187,9 +187,26 @@ def test_missing_and_binary_files(tmp_path: Path) -> None:
     with pytest.raises(InputError, match="no such file"):
         read_points(tmp_path / "nope.csv")
     binary = tmp_path / "b.csv"
-    binary.write_bytes(b"\xff\xfe\x00\x81garbage")
+    binary.write_bytes(b"\x00\x81garbage")
     with pytest.raises(InputError, match="not a UTF-8 text file"):
         read_points(binary)
+    binary.write_bytes(b"\xff\xfe\x00\x81garbage")  # a UTF-16 mark, then an odd byte count
+    with pytest.raises(InputError, match="not a UTF-16 text file"):
+        read_points(binary)
+
+
+@pytest.mark.parametrize("encoding", ["utf-16", "utf-16-be", "utf-32", "utf-8-sig"])
+def test_unicode_text_with_a_byte_order_mark(tmp_path: Path, encoding: str) -> None:
+    """Excel's "Unicode Text (*.txt)" is UTF-16 LE with a byte-order mark, tab-separated;
+    the mark names the encoding (Unicode §23.8), so the points are those of the UTF-8 file."""
+    text = "x\ty\r\n0\t0\r\n10\t0\r\n10\t5.5\r\n"
+    data = text.encode(encoding)
+    if encoding == "utf-16-be":
+        data = b"\xfe\xff" + data
+    path = tmp_path / "excel.txt"
+    path.write_bytes(data)
+    (contour,) = read_points(path).contours
+    assert [s.start for s in contour.segments] + [contour.end] == [(0, 0), (10, 0), (10, 5.5)]
 
 
 # ------------------------------------------------------------------ Matlab files
