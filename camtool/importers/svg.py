@@ -112,7 +112,7 @@ def svg_drawing(
     svg = _parse(path, prepared)
     warnings = list(prepared.warnings)
     contours: list[Contour] = []
-    hidden = invisible = faded = 0
+    hidden = invisible = faded = bare_lines = 0
     drawn: list[tuple[Any, list[Any] | None]] = []
     shapes = list(_shapes(svg))
     progress(Step("reading", 0, len(shapes), path.name))
@@ -122,6 +122,8 @@ def svg_drawing(
             hidden += 1
         elif zero_opacity(values.get("opacity")):
             faded += 1
+        elif _unpainted(shape.stroke) and isinstance(shape, se.SimpleLine):
+            bare_lines += 1  # a line has no inside: its fill shows nothing (SVG 2 §10.5)
         elif _unpainted(shape.fill) and _unpainted(shape.stroke):
             invisible += 1
         else:
@@ -145,6 +147,11 @@ def svg_drawing(
     if invisible:
         noun = _elements(invisible)
         warnings.append(f"{path}: skipped {invisible} {noun} with neither fill nor stroke")
+    if bare_lines:
+        warnings.append(
+            f"{path}: skipped {bare_lines} <line> {_elements(bare_lines)} without a stroke (a "
+            "line has no inside to fill, so a viewer shows nothing); give it a stroke to cut it"
+        )
     if not contours:
         where = " in the selected layers" if options.layers else ""
         prefix = f"{path}: "

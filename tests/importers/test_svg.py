@@ -211,7 +211,7 @@ def test_rect_with_rx_and_ry_has_elliptical_corners(tmp_path: Path) -> None:
 
 def test_line_polyline_polygon_ellipse(tmp_path: Path) -> None:
     body = (
-        '<line x1="0" y1="0" x2="10" y2="5"/>'
+        '<line x1="0" y1="0" x2="10" y2="5" stroke="#000"/>'
         '<polyline points="0,10 10,10 10,20"/>'
         '<polygon points="20 20 30 20 30 30"/>'
         '<ellipse cx="50" cy="50" rx="10" ry="5"/>'
@@ -245,6 +245,23 @@ def test_filled_and_stroked_shapes_both_count_but_invisible_ones_do_not(tmp_path
     assert [c.source for c in drawing.contours] == ["rect[1]", "rect[2]"]
     assert drawing.warnings == (
         f"{tmp_path / 't.svg'}: skipped 1 element with neither fill nor stroke",
+    )
+
+
+def test_a_line_without_a_stroke_is_not_shown_so_not_cut(tmp_path: Path) -> None:
+    """SVG 2 §10.5: a ``<line>`` has no inside, so only its stroke paints it; the default
+    fill (black) shows nothing. Stroked, by itself or by its group, it is cut."""
+    body = (
+        '<line id="bare" x1="0" y1="0" x2="50" y2="50"/>'
+        '<line id="filled" x1="0" y1="0" x2="50" y2="50" fill="red"/>'
+        '<g stroke="red"><line id="by-group" x1="0" y1="10" x2="50" y2="60"/></g>'
+        '<line id="own" x1="0" y1="20" x2="50" y2="70" style="stroke:#00f"/>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.source for c in drawing.contours] == ["line#by-group", "line#own"]
+    assert drawing.warnings == (
+        f"{tmp_path / 't.svg'}: skipped 2 <line> elements without a stroke (a line has no "
+        "inside to fill, so a viewer shows nothing); give it a stroke to cut it",
     )
 
 
@@ -335,6 +352,6 @@ def test_non_uniform_scale_or_skew_makes_an_ellipse_that_is_fitted(
 
 
 def test_transform_on_the_shape_and_its_groups_compose(tmp_path: Path) -> None:
-    line = '<line x1="0" y1="0" x2="10" y2="0" transform="translate(5 5)"/>'
+    line = '<line x1="0" y1="0" x2="10" y2="0" stroke="red" transform="translate(5 5)"/>'
     body = f'<g transform="scale(2)">{line}</g>'
     assert vertices(one(read_svg(svg(tmp_path, body)))) == [(10, 90), (30, 90)]
