@@ -249,3 +249,9 @@ def _refuse_special(c: str, code: str, where: str) -> None:
         raise InputError(
             f"{where}: '[ ]' expressions are not supported ({code!r}); write plain numbers"
         )
+    if c == "$" and code.startswith("$"):
+        raise InputError(
+            f"{where}: {code!r} is a GRBL system command (settings, homing, jogging), not "
+            "G-code: camtool reads G-code only; delete the line, and give the command to the "
+            "machine yourself before running the program"
+        )

@@ -332,6 +332,9 @@ def test_safe_conversion_warns_once_with_count_and_first_line(block: str, expect
         ("G1 X#1 F10", "'#' parameters"),
         ("#1 = 5", "'#' parameters"),
         ("G1 X[1+2] F10", "'[ ]' expressions"),
+        ("$H", "'$H' is a GRBL system command"),  # gSender's examples start so
+        ("$32=1", "'$32=1' is a GRBL system command"),
+        ("$J=G91 X10 F100", "'$J=G91X10F100' is a GRBL system command"),
         ("G41 D1", "G41 (cutter radius compensation)"),
         ("G42", "G42 (cutter radius compensation)"),
         ("G18.1", "G18.1 selects a plane in the UVW axes"),
