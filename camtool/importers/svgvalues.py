@@ -124,48 +124,39 @@ def normalize_colours(root: ET.Element) -> None:
         attrib = element.attrib
         if not attrib:
             continue
-        for name in _OPACITIES:
-            value = attrib.get(name)
-            if value is not None:
-                clamped = _opacity(value)
-                if clamped is None:
-                    del attrib[name]
-                elif clamped != value:
-                    attrib[name] = clamped
-        for name in _PAINTS:
-            value = attrib.get(name)
-            if value and "(" in value:
-                rgba = _rgba(value)
-                if rgba is not None:
-                    attrib[name] = rgba
+        _rewrite(attrib)
         style = attrib.get("style")
         if style and _rewritable(style):
-            _restyle(element)
+            declared = inline_style(element)
+            if _rewrite(declared):
+                element.set("style", style_text(declared))
 
 
-def _restyle(element: ET.Element) -> None:
-    """:func:`normalize_colours` for the declarations of ``element``'s ``style``."""
-    declared = inline_style(element)
+def _rewrite(values: dict[str, str]) -> bool:
+    """:func:`normalize_colours` on one element's attributes or style declarations.
+
+    Returns:
+        Whether a value changed (``values`` is changed in place).
+    """
     changed = False
     for name in _OPACITIES:
-        value = declared.get(name)
+        value = values.get(name)
         if value is not None:
             clamped = _opacity(value)
             if clamped != value:
                 changed = True
                 if clamped is None:
-                    del declared[name]
+                    del values[name]
                 else:
-                    declared[name] = clamped
+                    values[name] = clamped
     for name in _PAINTS:
-        value = declared.get(name)
+        value = values.get(name)
         if value and "(" in value:
             rgba = _rgba(value)
-            if rgba is not None:
-                declared[name] = rgba
+            if rgba is not None and rgba != value:
+                values[name] = rgba
                 changed = True
-    if changed:
-        element.set("style", style_text(declared))
+    return changed
 
 
 _OPACITIES = ("opacity", "fill-opacity", "stroke-opacity")
