@@ -49,6 +49,7 @@ _INSUNITS_MM: dict[int, tuple[str, float]] = {
 _TEXT = "text is not cut; explode it to curves in the CAD program"
 _THREE_D = "3D entity; camtool cuts 2D contours"
 _SKIP_REASONS: dict[str, str] = {
+    **dict.fromkeys(("XLINE", "RAY"), "an infinite construction line, not a contour"),
     **dict.fromkeys(("TEXT", "MTEXT", "ATTRIB", "ATTDEF", "RTEXT"), _TEXT),
     **dict.fromkeys(
         (
@@ -235,7 +236,7 @@ def _import(
         on = f" on layers {', '.join(options.layers)}" if options.layers else ""
         raise InputError(
             f"{path}: no usable entity in model space{on}; camtool cuts LINE, ARC, CIRCLE, "
-            "ELLIPSE, SPLINE, LWPOLYLINE and 2D POLYLINE entities (also inside blocks)"
+            "ELLIPSE, SPLINE, LWPOLYLINE, 2D POLYLINE and MLINE entities (also inside blocks)"
             + "".join(f"\n  {w}" for w in warnings)
         )
     contours = tuple(c.transformed(scale, 0.0, 0.0) if scale != 1.0 else c for c in reader.contours)
@@ -421,6 +422,9 @@ class _Reader:
         kind = _kind(item.entity)
         if kind == "POINT":
             self._mark(item, block)
+        if kind == "MLINE":
+            self._mline(item, block)
+            return
         if kind not in CONVERTED or (kind == "HATCH" and not self.hatch):
             reason = _SKIP_REASONS.get(kind, "not a 2D contour camtool cuts")
             self._skip(kind, reason, item.label, item.layer, self._where(item))
@@ -448,6 +452,23 @@ class _Reader:
                 dataclasses.replace(c, colour=style[0], linetype=style[1]) for c in contours
             ]
         self.contours.extend(contours)
+
+    def _mline(self, item: Any, block: Style) -> None:
+        """A model-space MLINE: the lines and arcs of its elements and caps, as drawn.
+
+        Its geometry is what ezdxf draws of it (``MLine.virtual_entities``, from the
+        vertices' miter directions and the MLINESTYLE's element offsets); a fill is not
+        cut. (An MLINE in a block is exploded where the block is placed.)
+        """
+        from camtool.importers.dxf_blocks import mline_parts
+        from camtool.importers.dxf_entities import Item
+
+        parts = mline_parts(item.entity)
+        if isinstance(parts, str):
+            self._skip("MLINE", parts, item.label, item.layer, self._where(item))
+            return
+        for n, part in enumerate(parts, start=1):
+            self._item(Item(part, f"{part.dxftype()} {n} of {item.label}", item.layer), block)
 
     @staticmethod
     def _where(item: Any) -> Point | None:

@@ -169,6 +169,17 @@ def _place(
         return
     own = layer_of(entity)
     eff = layer if own == "0" else own
+    if kind == "MLINE":
+        lines = mline_parts(entity)
+        if isinstance(lines, str):
+            at = _moved(location(entity), matrix)
+            yield Skip(kind, lines, f"MLINE #{entity.dxf.handle}{chain}", eff, at)
+            return
+        for part in lines:  # in block coordinates, placed as the block's own entities are
+            yield from _place(
+                part, matrix, eff, f" of MLINE #{entity.dxf.handle}{chain}", names, limits
+            )
+        return
     if kind == "INSERT":
         if invisible(entity):
             yield INVISIBLE
@@ -188,6 +199,24 @@ def _place(
         yield Skip(kind, exc.reason, label, eff, _moved(location(entity), matrix))
         return
     yield Item(placed, label, eff, parts)
+
+
+def mline_parts(mline: Any) -> list[Any] | str:
+    """The LINE and ARC entities ezdxf draws for an MLINE (its fill left out).
+
+    Returns:
+        The virtual entities, on the MLINE's layer; or, when ezdxf cannot draw it
+        (a missing MLINESTYLE, too few vertices), the reason, for a skip.
+    """
+    from ezdxf.lldxf.const import DXFError
+
+    try:
+        parts = [e for e in mline.virtual_entities() if e.dxftype() in ("LINE", "ARC")]
+    except (DXFError, ValueError, TypeError, AttributeError, IndexError, ZeroDivisionError) as exc:
+        return f"cannot be drawn ({exc})"
+    if not parts:
+        return "draws no line (fewer than two vertices, or no elements in its style)"
+    return parts
 
 
 def _moved(p: Point | None, matrix: Any) -> Point | None:

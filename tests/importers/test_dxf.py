@@ -257,3 +257,43 @@ def test_a_block_reference_on_a_frozen_layer_hides_all_it_places(tmp_path: Path)
         100,
         104,
     ]
+
+
+def test_an_mline_is_cut_as_ezdxf_draws_its_elements(tmp_path: Path) -> None:
+    """AutoCAD's MLINE (parallel lines, walls): its element lines, in model space and in a
+    block placed scaled and turned. Expected: ezdxf's own drawing of it
+    (``MLine.virtual_entities``); in the block, those lines moved by the block reference's
+    matrix (``Insert.matrix44``), so the lines' separation scales with the block as AutoCAD
+    draws it (ezdxf's ``MLine.transform`` keeps the separation: 1 here, not 2)."""
+    import ezdxf
+
+    def build(msp: Any) -> None:
+        msp.add_mline([(0, 10), (50, 10), (50, 40)], dxfattribs={"layer": "WALLS"})
+        block = msp.doc.blocks.new("ROOM")
+        block.add_mline([(0, 0), (10, 0), (10, 5)], close=True)
+        msp.add_blockref("ROOM", (100, 0), dxfattribs={"xscale": 2, "yscale": 2, "rotation": 90})
+        msp.add_xline((0, 0), (1, 1))
+
+    path = write_dxf(tmp_path / "walls.dxf", build)
+    doc = ezdxf.readfile(path)
+    expected = []
+    for entity in doc.modelspace().query("MLINE INSERT"):
+        if entity.dxftype() == "MLINE":
+            lines = list(entity.virtual_entities())
+        else:
+            (mline,) = doc.blocks["ROOM"]
+            lines = [line.transform(entity.matrix44()) for line in mline.virtual_entities()]
+        for line in lines:
+            start, end = line.dxf.start, line.dxf.end
+            expected.append(((start.x, start.y), (end.x, end.y)))
+    drawing = read_dxf(path)
+    got = [(s.start, s.end) for c in drawing.contours for s in c.segments]
+
+    def key(pair: tuple[tuple[float, float], tuple[float, float]]) -> tuple[float, ...]:
+        a, b = sorted(pair)
+        return tuple(round(v, 6) + 0.0 for v in (*a, *b))
+
+    assert sorted(map(key, got)) == sorted(map(key, expected))
+    assert len(expected) == 4 + 6  # two elements: 2 segments open, 3 closed
+    assert {c.layer for c in drawing.contours} == {"WALLS", "0"}
+    assert any("XLINE entity (an infinite construction line" in w for w in drawing.warnings)
