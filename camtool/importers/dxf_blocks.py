@@ -188,7 +188,8 @@ def _place(
         else:
             yield from _expand(entity, eff, matrix, chain, names, limits)
         return
-    label = f"{kind} #{entity.dxf.handle}{chain}"
+    handle = entity.dxf.handle  # None for an MLINE's drawn lines
+    label = f"{kind} #{handle}{chain}" if handle else f"{kind}{chain}"
     if kind not in CONVERTED:
         yield Item(entity, label, eff, at=_moved(location(entity), matrix))
         return
