@@ -5,7 +5,7 @@ and everything a block reference on a frozen layer places (AutoCAD's rule: freez
 reference's layer hides the whole block, switching it off hides only the block's entities
 on that layer and on layer 0). A layer named by ``--layers`` or a job is read all the same.
 
-Design notes: docs/internals.md, ``camtool/importers/dxf.py``.
+Design notes: docs/internals.md, ``camtool/importers/dxf_layers.py``.
 """
 
 from __future__ import annotations
