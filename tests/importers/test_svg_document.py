@@ -816,6 +816,7 @@ def test_opacities_are_clamped_and_one_that_is_no_number_is_ignored(tmp_path: Pa
         '<rect id="word" width="9" height="9" fill-opacity="inf"/>'
         '<rect id="half" width="9" height="9" style="fill-opacity:50%"/>'
         '<rect id="stroke" width="9" height="9" fill="none" stroke="red" stroke-opacity="1e999"/>'
+        '<g fill-opacity="0"><rect id="inherits" width="9" height="9" fill-opacity="inherit"/></g>'
         '<rect id="negative" width="9" height="9" fill-opacity="-0.5"/>'
         '<rect id="negative-css" width="9" height="9" style="opacity:-2%"/>'
     )
@@ -828,4 +829,4 @@ def test_opacities_are_clamped_and_one_that_is_no_number_is_ignored(tmp_path: Pa
         "rect#stroke",
     ]
     assert any("skipped 1 element with opacity 0" in w for w in drawing.warnings)
-    assert any("skipped 1 element with neither fill nor stroke" in w for w in drawing.warnings)
+    assert any("skipped 2 elements with neither fill nor stroke" in w for w in drawing.warnings)
