@@ -152,6 +152,8 @@ def svg_drawing(
             f"{path}: skipped {bare_lines} <line> {_elements(bare_lines)} without a stroke (a "
             "line has no inside to fill, so a viewer shows nothing); give it a stroke to cut it"
         )
+    if prepared.page is not None:
+        warnings += _off_page(path, contours, prepared.page)
     if not contours:
         where = " in the selected layers" if options.layers else ""
         prefix = f"{path}: "
@@ -162,6 +164,34 @@ def svg_drawing(
             f"line, polyline and polygon elements that are drawn{why}"
         )
     return Drawing(tuple(contours), str(path), tuple(warnings)), tolerance
+
+
+_PAGE_SLACK_MM = 0.01
+"""How far outside the page (mm) a contour may lie and still count as on it."""
+
+
+def _off_page(path: Path, contours: list[Contour], page: tuple[float, float]) -> list[str]:
+    """A warning for contours wholly outside the page, which a viewer does not show.
+
+    The root ``<svg>`` clips its content to its viewport (SVG 1.1 §14.3.3); camtool does
+    not clip, so such a contour (an object left beside the page, a shape moved away by a
+    stray transform) would be cut where the drawing program shows nothing.
+    """
+    width, height = page
+    s = _PAGE_SLACK_MM
+    outside = [
+        c
+        for c in contours
+        if (box := c.bbox())[2] < -s or box[0] > width + s or box[3] < -s or box[1] > height + s
+    ]
+    if not outside:
+        return []
+    x0, y0, _, _ = outside[0].bbox()
+    return [
+        f"{path}: {len(outside)} contour(s) lie wholly outside the {width:.4g} × {height:.4g} mm "
+        f"page, where a viewer shows nothing (first {outside[0].source} at ({x0:.4f}, "
+        f"{y0:.4f}) mm); camtool cuts them: delete them or move them onto the page"
+    ]
 
 
 _DISTINCT_MM = 1e-6

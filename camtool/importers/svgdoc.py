@@ -521,12 +521,15 @@ class Prepared:
         matrix: user units to mm, Y up (the page's bottom-left corner at the origin).
         viewport: ``(width, height)`` in user units, for percentage lengths.
         warnings: messages for the user (assumed units, skipped elements, hidden layers).
+        page: ``(width, height)`` of the page in mm, from the origin of ``matrix``'s
+            output; ``None`` when the document has neither a size nor a viewBox.
     """
 
     data: bytes
     matrix: Affine
     viewport: tuple[float, float]
     warnings: tuple[str, ...]
+    page: tuple[float, float] | None = None
 
 
 def prepare(
@@ -557,7 +560,7 @@ def prepare(
     """
     root = _parse(path)
     warnings: list[str] = []
-    matrix, viewport = page_matrix(root, str(path), warnings, units)
+    matrix, viewport, page = page_matrix(root, str(path), warnings, units)
     parents = {child: parent for parent in root.iter() for child in parent}
     warnings += apply_style_sheets(root, parents, str(path))
     normalize_styles(root)
@@ -603,7 +606,7 @@ def prepare(
             noun = "element" if counts[kind] == 1 else "elements"
             reason = _SKIP_REASONS[kind]
             warnings.append(f"{path}: skipped {counts[kind]} <{kind}> {noun} ({reason})")
-    return Prepared(ET.tostring(root), matrix, viewport, tuple(warnings))
+    return Prepared(ET.tostring(root), matrix, viewport, tuple(warnings), page)
 
 
 def _elements(root: ET.Element, name: str) -> list[ET.Element]:

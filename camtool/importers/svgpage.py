@@ -41,8 +41,11 @@ _PAGE_UNITS_MM = {**{u: LENGTH_UNITS[u] for u in ("mm", "cm", "in", "pt", "px")}
 
 def page_matrix(
     root: ET.Element, name: str, warnings: list[str], units: str | None = None
-) -> tuple[Affine, tuple[float, float]]:
-    """Map from user units to mm, Y up, and the viewport size in user units.
+) -> tuple[Affine, tuple[float, float], tuple[float, float] | None]:
+    """Map from user units to mm, Y up; the viewport size in user units; the page in mm.
+
+    The page is ``(width, height)`` in mm, its lower-left corner at the origin of the
+    map's output; ``None`` when the document gives neither a size nor a viewBox.
 
     Removes ``width``, ``height``, ``viewBox``, ``preserveAspectRatio``, ``x`` and ``y`` from
     ``root``. Without an absolute ``width`` and ``height`` (missing, or in %) the user unit
@@ -75,22 +78,27 @@ def page_matrix(
             f"--units {units}: {name} gives its size ({given}), so its units are known; "
             "--units is for a drawing without them: leave it out, or use --scale to resize"
         )
+    page: tuple[float, float] | None = None
     if box is None:
         sx = sy = unit
         tx = ty = 0.0
         viewport = (width / PX, height / PX) if width and height else (1000.0, 1000.0)
+        if width and height:
+            page = (width, height)
     elif width is None or height is None:
         sx = sy = unit
         tx, ty = -box[0] * unit, -box[1] * unit
         height = box[3] * unit
         viewport = (box[2], box[3])
+        page = (box[2] * unit, height)
     else:
         sx, sy, tx, ty = _fit_viewbox(width, height, box, root.get("preserveAspectRatio"), name)
         viewport = (box[2], box[3])
+        page = (width, height)
     for attr in ("width", "height", "viewBox", "preserveAspectRatio", "x", "y"):
         root.attrib.pop(attr, None)
     top = height if height is not None else 0.0
-    return (sx, 0.0, 0.0, -sy, tx, top - ty), viewport
+    return (sx, 0.0, 0.0, -sy, tx, top - ty), viewport, page
 
 
 def _page_length(root: ET.Element, attr: str, name: str) -> tuple[float | None, str]:

@@ -830,3 +830,30 @@ def test_opacities_are_clamped_and_one_that_is_no_number_is_ignored(tmp_path: Pa
     ]
     assert any("skipped 1 element with opacity 0" in w for w in drawing.warnings)
     assert any("skipped 2 elements with neither fill nor stroke" in w for w in drawing.warnings)
+
+
+def test_contours_wholly_outside_the_page_are_cut_with_a_warning(tmp_path: Path) -> None:
+    """SVG 1.1 §14.3.3: the root viewport clips, so a viewer shows nothing of a shape left
+    beside the page or moved away by a stray transform (Fritzing's SMD_crystal_HC49.svg has
+    a rect translated 1 034 px down). camtool cuts what it reads, and says so. A shape that
+    only crosses the page's edge is not named."""
+    body = (
+        '<rect id="on" x="10" y="10" width="20" height="20"/>'
+        '<rect id="across" x="90" y="90" width="20" height="20"/>'
+        '<rect id="away" x="10" y="10" width="5" height="5" transform="translate(0,1034.6)"/>'
+        '<circle id="left" cx="-20" cy="50" r="5"/>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.source for c in drawing.contours] == [
+        "rect#on",
+        "rect#across",
+        "rect#away",
+        "circle#left",
+    ]
+    assert drawing.warnings == (
+        f"{tmp_path / 't.svg'}: 2 contour(s) lie wholly outside the 100 × 100 mm page, where a "
+        "viewer shows nothing (first rect#away at (10.0000, -949.6000) mm); camtool cuts them: "
+        "delete them or move them onto the page",
+    )
+    no_size = read_svg(svg(tmp_path, body, root="", name="n.svg"))  # no page to judge by
+    assert not any("lie wholly outside the" in w for w in no_size.warnings)
