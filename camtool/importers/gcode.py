@@ -102,11 +102,10 @@ def _decoded(data: bytes) -> str:
     A marked file that does not decode is read as Latin-1 too: the reader then names the
     first character that is no G-code.
     """
-    from camtool.importers.textfile import marked_encoding
+    from camtool.importers.textfile import decoded
 
-    codec = marked_encoding(data) or "utf-8"
     try:
-        return data.decode(codec)
+        return decoded(data)
     except UnicodeDecodeError:
         return data.decode("latin-1")
 

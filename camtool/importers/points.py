@@ -109,17 +109,16 @@ def _scale(value: float, factor: float) -> float:
 def _read_text(path: Path) -> str:
     if not path.is_file():
         raise InputError(f"{path}: no such file")
-    from camtool.importers.textfile import marked_encoding
+    from camtool.importers.textfile import decoded
 
     try:
         data = path.read_bytes()
     except OSError as exc:
         raise InputError(f"{path}: cannot read the file ({exc})") from exc
-    codec = marked_encoding(data) or "utf-8"
     try:
-        return data.decode(codec)  # the mark is dropped
+        return decoded(data)
     except UnicodeDecodeError as exc:
-        name = "UTF-8" if codec in ("utf-8", "utf-8-sig") else codec.upper()
+        name = exc.encoding.upper().removesuffix("-SIG")
         raise InputError(
             f"{path}: not a {name} text file ({exc.reason} at byte {exc.start}); save it as "
             "UTF-8 (or plain ASCII) text"

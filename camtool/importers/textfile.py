@@ -25,3 +25,12 @@ def marked_encoding(data: bytes) -> str | None:
         if data.startswith(mark):
             return codec
     return None
+
+
+def decoded(data: bytes, errors: str = "strict") -> str:
+    """``data`` as text in the encoding its byte-order mark names, else UTF-8; the mark dropped.
+
+    Raises:
+        UnicodeDecodeError: (``errors="strict"``) the bytes are not text in that encoding.
+    """
+    return data.decode(marked_encoding(data) or "utf-8", errors)

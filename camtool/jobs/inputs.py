@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from camtool.importers import DRAWING_SUFFIXES, read_drawing, read_drawing_bytes
+from camtool.importers.textfile import decoded
 from camtool.model.errors import InputError, UsageError
 from camtool.model.tomlfile import read_toml_file
 
@@ -72,7 +73,7 @@ def stdin_kind(data: bytes) -> str:
     """
     if data.startswith(b"AutoCAD Binary DXF"):
         return ".dxf"
-    text = data[:_SNIFF_BYTES].decode("utf-8", errors="replace").lstrip("\ufeff \t\r\n")
+    text = decoded(data[:_SNIFF_BYTES], "replace").lstrip("\ufeff \t\r\n")
     if not text:
         raise InputError(
             f"{STDIN}: empty input; pipe a drawing (DXF, SVG, a point list) into camtool"
@@ -150,7 +151,8 @@ def drawing_kind(data: bytes, remedy: str = "this needs a drawing (DXF, SVG, a p
 def read_code(name: str, *, binary: bool = False) -> str | bytes:
     """A code file (``-``: stdin): bytes for a binary dialect, else text.
 
-    Text is read as the G-code importer reads it (UTF-8, a byte-order mark dropped): a
+    Text is read as the G-code importer reads it (UTF-8, or UTF-16/32 with a byte-order
+    mark; the mark dropped): a
     comment may hold any character (``(Linéal)``); the dialect's reader refuses one
     outside a comment, naming the line.
 
@@ -167,11 +169,12 @@ def read_code(name: str, *, binary: bool = False) -> str | bytes:
     if name == "-":
         return sys.stdin.read()
     try:
-        return Path(name).read_text(encoding="utf-8-sig", errors="strict")
+        return decoded(Path(name).read_bytes())
     except FileNotFoundError as exc:
         raise InputError(f"{name}: no such file") from exc
     except UnicodeDecodeError as exc:
-        raise InputError(f"{name}: not a text program (byte {exc.start} is not UTF-8)") from exc
+        code = exc.encoding.upper().removesuffix("-SIG")
+        raise InputError(f"{name}: not a text program (byte {exc.start} is not {code})") from exc
     except OSError as exc:
         raise InputError(f"{name}: cannot read ({exc.strerror or exc})") from exc
 

@@ -191,7 +191,7 @@ def test_missing_and_binary_files(tmp_path: Path) -> None:
     with pytest.raises(InputError, match="not a UTF-8 text file"):
         read_points(binary)
     binary.write_bytes(b"\xff\xfe\x00\x81garbage")  # a UTF-16 mark, then an odd byte count
-    with pytest.raises(InputError, match="not a UTF-16 text file"):
+    with pytest.raises(InputError, match="not a UTF-16-LE text file"):
         read_points(binary)
 
 

@@ -245,3 +245,21 @@ def test_verify_reads_a_comment_in_utf8_as_post_does(
     code, _, err = run(["verify", str(program), "-t", "grbl"], capsys)
     assert code == 3
     assert "ruler.gcode: not a text program (byte 9 is not UTF-8)" in err
+
+
+def test_verify_and_send_read_a_program_saved_as_utf16_as_post_does(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Notepad's "Unicode" is UTF-16 LE with a byte-order mark: the same program as in UTF-8."""
+    text = "G21 G90\r\n(pi\u00e8ce)\r\nG0 X1 Y1\r\nG1 X5 Y1 F300\r\nM2\r\n"
+    plain, wide = tmp_path / "plain.nc", tmp_path / "wide.nc"
+    plain.write_text(text, encoding="utf-8")
+    wide.write_bytes(text.encode("utf-16"))
+    outputs = []
+    for program in (plain, wide):
+        code, out, err = run(["verify", str(program), "-t", "grbl", "--no-budget"], capsys)
+        assert code == 0, err
+        outputs.append(out)
+        code, _, err = run(["send", str(program), "-t", "grbl", "--dry-run"], capsys)
+        assert code == 0, err
+    assert outputs[0].replace("plain.nc", "") == outputs[1].replace("wide.nc", "")
