@@ -29,7 +29,7 @@ from camtool.importers.svgdoc import (
     zero_opacity,
 )
 from camtool.importers.svgpage import Affine, apply, compose
-from camtool.model.errors import GeometryError, InputError
+from camtool.model.errors import GeometryError, InputError, TooLargeError
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import (
     TAU,
@@ -40,6 +40,7 @@ from camtool.model.shapes import (
     Line,
     Point,
     Segment,
+    bbox_union,
     distance,
 )
 
@@ -74,9 +75,9 @@ def svg_drawing(
         options: ``layers`` (Inkscape layer labels or ids; hidden layers named here are read)
             and ``tolerance`` (mm, for Béziers and ellipses, once the drawing is scaled as
             ``scale`` or ``fit`` say: for ``fit``, the factor of the extent of the
-            drawn segments' ends, :func:`_ends_box`) are used; ``units`` is the user
+            drawn segments' ends, :func:`_ends_boxes`) are used; ``units`` is the user
             unit of a document without an absolute size (refused for one with it).
-        check: called with the extent of the drawn segments' ends (:func:`_ends_box`, mm,
+        check: called with the extent of the drawn segments' ends (:func:`_ends_boxes`, mm,
             a box within the drawing's) before any curve is fitted; what it raises stops
             the reading (``camtool post`` refuses there a drawing too large for the
             machine, :func:`camtool.jobs.pipeline.post_path`).
@@ -129,11 +130,24 @@ def svg_drawing(
         else:
             drawn.append((shape, _segments(shape)))
         progress(Step("reading", i, len(shapes), path.name))
-    box = None
+    boxes: list[BBox | None] = []
     if options.fit is not None or check is not None:
-        box = _ends_box(drawn, prepared.matrix)
+        boxes = _ends_boxes(drawn, prepared.matrix)
+    known = [b for b in boxes if b is not None]
+    box = bbox_union(known) if known else None
     if check is not None and box is not None:
-        check(box)
+        try:
+            check(box)
+        except TooLargeError as exc:
+            off = [
+                (_label(shape), b)
+                for (shape, _), b in zip(drawn, boxes, strict=True)
+                if b is not None and _outside(b, prepared.page)
+            ]
+            if not off:
+                raise
+            note = _off_page_text(path, len(off), "shape", *off[0], prepared.page)
+            raise TooLargeError(f"{exc}; {_refusal_note(note, len(off))}") from None
     tolerance = options.curve_tolerance(box)
     fitter = _prefitted(drawn, prepared.matrix, tolerance, progress)
     progress(Step("contours", 0, len(drawn)))
@@ -152,8 +166,16 @@ def svg_drawing(
             f"{path}: skipped {bare_lines} <line> {_elements(bare_lines)} without a stroke (a "
             "line has no inside to fill, so a viewer shows nothing); give it a stroke to cut it"
         )
-    if prepared.page is not None:
-        warnings += _off_page(path, contours, prepared.page)
+    size_note = ""
+    outside = [c for c in contours if _outside(c.bbox(), prepared.page)]
+    if outside:
+        first = outside[0]
+        text = _off_page_text(
+            path, len(outside), "contour", first.source, first.bbox(), prepared.page
+        )
+        them = "them" if len(outside) > 1 else "it"
+        warnings.append(f"{text}; camtool cuts {them}: delete {them} or move {them} onto the page")
+        size_note = _refusal_note(text, len(outside))
     if not contours:
         where = " in the selected layers" if options.layers else ""
         prefix = f"{path}: "
@@ -163,71 +185,87 @@ def svg_drawing(
             f"{path}: nothing to cut{where}; camtool reads path, rect, circle, ellipse, "
             f"line, polyline and polygon elements that are drawn{why}"
         )
-    return Drawing(tuple(contours), str(path), tuple(warnings)), tolerance
+    drawing = Drawing(tuple(contours), str(path), tuple(warnings), size_note=size_note)
+    return drawing, tolerance
 
 
 _PAGE_SLACK_MM = 0.01
 """How far outside the page (mm) a contour may lie and still count as on it."""
 
 
-def _off_page(path: Path, contours: list[Contour], page: tuple[float, float]) -> list[str]:
-    """A warning for contours wholly outside the page, which a viewer does not show.
+def _outside(box: BBox, page: tuple[float, float] | None) -> bool:
+    """Whether ``box`` (mm) lies wholly outside the page (``None``: no page, so never).
 
     The root ``<svg>`` clips its content to its viewport (SVG 1.1 §14.3.3); camtool does
-    not clip, so such a contour (an object left beside the page, a shape moved away by a
-    stray transform) would be cut where the drawing program shows nothing.
+    not clip, so what lies outside it (an object left beside the page, a shape moved
+    away by a stray transform) would be cut where the drawing program shows nothing.
     """
+    if page is None:
+        return False
     width, height = page
     s = _PAGE_SLACK_MM
-    outside = [
-        c
-        for c in contours
-        if (box := c.bbox())[2] < -s or box[0] > width + s or box[3] < -s or box[1] > height + s
-    ]
-    if not outside:
-        return []
-    x0, y0, _, _ = outside[0].bbox()
-    return [
-        f"{path}: {len(outside)} contour(s) lie wholly outside the {width:.4g} × {height:.4g} mm "
-        f"page, where a viewer shows nothing (first {outside[0].source} at ({x0:.4f}, "
-        f"{y0:.4f}) mm); camtool cuts them: delete them or move them onto the page"
-    ]
+    return box[2] < -s or box[0] > width + s or box[3] < -s or box[1] > height + s
+
+
+def _off_page_text(
+    path: Path, count: int, what: str, first: str, box: BBox, page: tuple[float, float] | None
+) -> str:
+    """``PATH: N WHATs lie wholly outside the W × H mm page… (first FIRST at (x, y) mm)``."""
+    width, height = page or (0.0, 0.0)
+    many = f"{count} {what}s lie" if count > 1 else f"1 {what} lies"
+    return (
+        f"{path}: {many} wholly outside the {width:.4g} × {height:.4g} mm page, "
+        f"where a viewer shows nothing (first {first} at ({box[0]:.4f}, {box[1]:.4f}) mm)"
+    )
+
+
+def _refusal_note(text: str, count: int) -> str:
+    """What a refusal of the drawing's size adds when ``count`` shapes lie off the page."""
+    they, them = ("they are", "them") if count > 1 else ("it is", "it")
+    return (
+        f"but {text}: if {they} not part of the job, delete {them} or move {them} onto the "
+        f"page rather than scale the part down with {them} (--fit)"
+    )
 
 
 _DISTINCT_MM = 1e-6
-"""Ends at least this far apart (mm) make a segment :func:`_ends_box` counts: well above
+"""Ends at least this far apart (mm) make a segment :func:`_ends_boxes` counts: well above
 :data:`ZERO_LENGTH_MM`, under which :func:`convert` drops a segment."""
 
 
-def _ends_box(drawn: list[tuple[Any, list[Any] | None]], page: Affine) -> BBox | None:
-    """The extent (mm) of the ends of the drawn shapes' segments, before any curve is fitted.
+def _ends_boxes(drawn: list[tuple[Any, list[Any] | None]], page: Affine) -> list[BBox | None]:
+    """Per drawn shape, the extent (mm) of its segments' ends, before any curve is fitted.
 
     Only the ends of segments whose ends are more than :data:`_DISTINCT_MM` apart are
     taken: such a segment is drawn (:func:`convert` drops only segments of zero length,
     and a fit ends where its curve does), so each end taken is a point of the drawing,
-    and the box lies within the drawing's. So ``--fit``'s factor for it is at least the
-    drawing's (curves fitted for it are fitted at least as finely as the drawing's own
-    factor asks), and a drawing whose box is larger than a machine's travel is larger
-    than it. ``None`` when there is no such end (``Move`` points, and the shapes whose
-    segments svgelements could not give, are left out).
+    and their union lies within the drawing's box. So ``--fit``'s factor for it is at
+    least the drawing's (curves fitted for it are fitted at least as finely as the
+    drawing's own factor asks), and a drawing whose union is larger than a machine's
+    travel is larger than it. ``None`` for a shape with no such end (``Move`` points,
+    and the shapes whose segments svgelements could not give, are left out).
     """
+    return [_shape_ends_box(shape, segments, page) for shape, segments in drawn]
+
+
+def _shape_ends_box(shape: Any, segments: list[Any] | None, page: Affine) -> BBox | None:
+    """One shape's box of :func:`_ends_boxes`."""
+    if not segments:
+        return None
     xs: list[float] = []
     ys: list[float] = []
-    for shape, segments in drawn:
-        if not segments:
+    m = compose(page, affine_of(shape.transform))
+    for seg in segments:
+        if isinstance(seg, se.Move) or seg.start is None or seg.end is None:
             continue
-        m = compose(page, affine_of(shape.transform))
-        for seg in segments:
-            if isinstance(seg, se.Move) or seg.start is None or seg.end is None:
-                continue
-            x0, y0 = apply(m, float(seg.start.x), float(seg.start.y))
-            x1, y1 = apply(m, float(seg.end.x), float(seg.end.y))
-            # a number past MAX_COORDINATE_MM (or not finite) is refused later, with its
-            # own message: it is no extent to judge
-            sane = max(abs(x0), abs(y0), abs(x1), abs(y1)) <= MAX_COORDINATE_MM
-            if sane and math.hypot(x1 - x0, y1 - y0) > _DISTINCT_MM:
-                xs += (x0, x1)
-                ys += (y0, y1)
+        x0, y0 = apply(m, float(seg.start.x), float(seg.start.y))
+        x1, y1 = apply(m, float(seg.end.x), float(seg.end.y))
+        # a number past MAX_COORDINATE_MM (or not finite) is refused later, with its
+        # own message: it is no extent to judge
+        sane = max(abs(x0), abs(y0), abs(x1), abs(y1)) <= MAX_COORDINATE_MM
+        if sane and math.hypot(x1 - x0, y1 - y0) > _DISTINCT_MM:
+            xs += (x0, x1)
+            ys += (y0, y1)
     if not xs:
         return None
     return (min(xs), min(ys), max(xs), max(ys))
@@ -292,10 +330,7 @@ def _contours(
     shape's turn (the error is the one it always was).
     """
     values = shape.values
-    label = str(values.get(SOURCE_ATTR, type(shape).__name__.lower()))
-    use = values.get(USE_ATTR)
-    if use and use != label:
-        label = f"{use} > {label}"
+    label = _label(shape)
     layer = str(values.get(LAYER_ATTR, DEFAULT_LAYER))
     m = compose(page, affine_of(shape.transform))
     try:
@@ -311,6 +346,16 @@ def _contours(
         Contour(segs, closed, layer, f"{label} subpath {k}" if many else label, colour, linetype)
         for k, (segs, closed) in enumerate(subpaths, start=1)
     ]
+
+
+def _label(shape: Any) -> str:
+    """How messages name a drawn shape: its element and id, and the ``<use>`` placing it."""
+    values = shape.values
+    label = str(values.get(SOURCE_ATTR, type(shape).__name__.lower()))
+    use = values.get(USE_ATTR)
+    if use and use != label:
+        label = f"{use} > {label}"
+    return label
 
 
 def _style(values: Any) -> tuple[str, str]:

@@ -12,7 +12,7 @@ from camtool.importers.options import ImportOptions
 from camtool.jobs.header import job_notes
 from camtool.jobs.inputs import is_program_file
 from camtool.jobs.run import OutputOptions, PostJob, loaded_by_hand, per_tool, run_job
-from camtool.model.errors import InputError, UsageError
+from camtool.model.errors import InputError, TooLargeError, UsageError
 from camtool.model.program import Move, Program, ToolChange
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import BBox, Drawing
@@ -450,13 +450,20 @@ def post_drawing(
         job: a job of operations and tools to run instead of ``plan``'s one operation.
 
     Raises:
+        TooLargeError: the toolpath is larger than the travel; with the drawing's
+            :attr:`~camtool.model.shapes.Drawing.size_note` when it has one.
         CamtoolError: from any stage, with its exit code.
     """
     from camtool.jobs.job import Job
 
     if job is None:
         job = Job.single(plan if plan is not None else PlanOptions(), layers)
-    return run_job(drawing, target, job, output, progress=progress)
+    try:
+        return run_job(drawing, target, job, output, progress=progress)
+    except TooLargeError as exc:
+        if not drawing.size_note:
+            raise
+        raise TooLargeError(f"{exc}; {drawing.size_note}") from None
 
 
 def verify_job(

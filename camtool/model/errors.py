@@ -50,6 +50,15 @@ class DialectError(CamtoolError, ValueError):
     """
 
 
+class TooLargeError(DialectError):
+    """A drawing or toolpath is larger than the machine's travel. Exit code 1.
+
+    Its own class so that a caller that knows why the drawing is that large (shapes off
+    an SVG's page, which a viewer does not show) can say so with the refusal, before
+    the user scales the part down with ``--fit``.
+    """
+
+
 class ParseError(InputError):
     """Code in a target's dialect cannot be read back. Exit code 3."""
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 from typing import Any, Generic, TypeAlias, TypeVar, overload
 
 from camtool.model.errors import GeometryError, UsageError
@@ -557,13 +557,15 @@ class Drawing:
     ``warnings`` are messages for the user (skipped entity types, assumed
     units); the CLI prints them on stderr. ``source`` is the file name. ``marks``
     are the drawing's points (DXF POINT entities): only a drill operation that
-    selects them uses them.
+    selects them uses them. ``size_note`` says why the drawing is larger than its
+    file shows (an SVG's shapes off its page), for a refusal of its size ("": none).
     """
 
     contours: tuple[Contour, ...]
     source: str = ""
     warnings: tuple[str, ...] = field(default=())
     marks: tuple[Mark, ...] = field(default=())
+    size_note: str = ""
 
     def bbox(self) -> BBox:
         """Bounding box of every contour and mark (a point's box is the point), mm.
@@ -578,11 +580,11 @@ class Drawing:
         """Uniformly scaled about the origin (``scale`` > 0), then translated."""
         contours = tuple(c.transformed(scale, dx, dy) for c in self.contours)
         marks = tuple(m.transformed(scale, dx, dy) for m in self.marks)
-        return Drawing(contours, self.source, self.warnings, marks)
+        return replace(self, contours=contours, marks=marks)
 
     def without(self, indices: frozenset[int]) -> Drawing:
         """The drawing without the contours at ``indices`` (itself when there are none)."""
         if not indices:
             return self
         kept = tuple(c for i, c in enumerate(self.contours) if i not in indices)
-        return Drawing(kept, self.source, self.warnings, self.marks)
+        return replace(self, contours=kept)

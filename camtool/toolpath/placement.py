@@ -11,7 +11,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from camtool.model.errors import DialectError
+from camtool.model.errors import DialectError, TooLargeError
 from camtool.model.plain import slot_setters
 from camtool.model.program import (
     ArcMove,
@@ -384,7 +384,7 @@ def too_large(box: BBox, machine: Machine, placing: Placing | None) -> None:
     """Refuse a toolpath extent ``box`` larger than the travel of ``machine``.
 
     Raises:
-        DialectError: naming both sizes, ``--fit W H`` that makes it fit (when the
+        TooLargeError: naming both sizes, ``--fit W H`` that makes it fit (when the
             program was planned here) and a larger machine.
     """
     if not larger_than_travel(box, machine):
@@ -392,7 +392,7 @@ def too_large(box: BBox, machine: Machine, placing: Placing | None) -> None:
     w, h = box[2] - box[0], box[3] - box[1]
     tw, th = machine.travel_mm
     fit = _fit_remedy(machine, placing, w, h)
-    raise DialectError(
+    raise TooLargeError(
         f"the toolpath is {_mm(w)} × {_mm(h)} mm, larger than the {_mm(tw)} × {_mm(th)} mm "
         f"travel of {machine.name}; {fit}use a larger machine (--machine FILE.toml "
         "with its work_area_mm)"
@@ -421,7 +421,7 @@ def too_large_drawing(
         slack_mm: how far inside the drawing's points the toolpath may pass, mm.
 
     Raises:
-        DialectError: naming the drawing's size (at least), the travel, ``--fit W H``
+        TooLargeError: naming the drawing's size (at least), the travel, ``--fit W H``
             that makes it fit and a larger machine.
     """
     w, h = (box[2] - box[0]) * scale, (box[3] - box[1]) * scale
@@ -431,7 +431,7 @@ def too_large_drawing(
     tw, th = machine.travel_mm
     fit = _fit_remedy(machine, placing, w, h)
     scaled = f" at --scale {_num(scale)}" if scale != 1.0 else ""
-    raise DialectError(
+    raise TooLargeError(
         f"the drawing is at least {_mm(w)} × {_mm(h)} mm{scaled}, so its toolpath is larger "
         f"than the {_mm(tw)} × {_mm(th)} mm travel of {machine.name} (refused before "
         f"planning); {fit}use a larger machine (--machine FILE.toml with its work_area_mm)"

@@ -185,3 +185,43 @@ def test_a_number_past_the_coordinate_limit_is_refused_as_such(
     err = capsys.readouterr().err
     assert "path[2]" in err and "far too large" in err
     assert "travel" not in err
+
+
+# Fritzing's SMD_crystal_HC49.svg: a 12 × 5 mm part whose one rect a stray transform moved
+# 272 mm off the page. The drawing is "too large" only because of what a viewer does not
+# show, so the refusal's --fit remedy would shrink the part 0.72×: it must name the shape.
+_PART = '<rect id="part" x="10" y="10" width="20" height="20"/>'
+_AWAY = '<rect id="away" x="10" y="10" width="5" height="5" transform="translate(0,400)"/>'
+
+
+@pytest.mark.parametrize("offset", ["on", "inside", "pocket"])
+def test_a_refusal_for_size_names_the_shapes_off_the_page(
+    tmp_path: Path, offset: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Before planning (on) and after it (inside, pocket), the refusal says which shape lies
+    off the page and that deleting it, not --fit, is the remedy when it is no part of the job."""
+    path = svg(tmp_path, _PART + _AWAY)  # a 100 × 100 mm page
+    out = tmp_path / "o.nc"
+    argv = ["post", str(path), "-t", "grbl", "--offset", offset, "--tool-diameter", "1"]
+    assert main([*argv, "-o", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert "larger than the 200 × 200 mm travel" in err
+    assert ("refused before planning" in err) == (offset == "on")
+    noun = "shape" if offset == "on" else "contour"
+    assert f"but {path}: 1 {noun} lies wholly outside the 100 × 100 mm page" in err
+    assert "first rect#away at (10.0000, -315.0000) mm" in err
+    assert "delete it or move it onto the page rather than scale the part down" in err
+    assert not out.exists()
+
+
+def test_a_refusal_for_size_without_shapes_off_the_page_says_nothing_of_the_page(
+    tmp_path: Path,
+) -> None:
+    """A drawing that is large on its own page gets the --fit remedy alone."""
+    root = 'width="1000mm" height="100mm" viewBox="0 0 1000 100"'
+    path = svg(tmp_path, '<rect x="10" y="10" width="900" height="50"/>', root=root)
+    for offset in ("on", "inside"):
+        plan = PlanOptions(offset=offset, tool_diameter=2.0)
+        with pytest.raises(DialectError) as err:
+            post_path(path, load_target("grbl"), plan)
+        assert "--fit" in str(err.value) and "page" not in str(err.value)
