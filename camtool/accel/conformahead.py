@@ -165,9 +165,13 @@ def start(writer: BlockWriter, program: Program) -> ConformAhead | None:
         k = len(calls) - 1  # from the last arc back, until the writer has passed them
         while k >= 0 and k >= AT.unpack_from(shared)[0]:
             found = []
-            for call in calls[k : max(k - BATCH, -1) : -1]:
-                key = key_of(writer, call)
-                blocks = None if key is None else _conformed(writer, key)
+            keys = [key_of(writer, call) for call in calls[k : max(k - BATCH, -1) : -1]]
+            known = [key for key in keys if key is not None]
+            # the arcs the writer's own batch answers (camtool.post.arcbatch) are left to
+            # it: the helper conforms the others, the ones that take the search
+            plain = writer.plain_arcs(known)
+            for key, answered in zip(known, plain, strict=True):
+                blocks = None if answered is not None else _conformed(writer, key)
                 if blocks is not None:
                     found.append((key, blocks))
             first = max(k - BATCH + 1, 0)

@@ -12,7 +12,7 @@ import dataclasses
 import math
 from collections.abc import Iterator
 from itertools import islice
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 from camtool.accel import conformahead, splitwrite
 from camtool.model.errors import DialectError
@@ -44,6 +44,9 @@ from camtool.post.wordaddress_summary import closing_warnings
 from camtool.post.wordaddress_words import SAME_MM, WordWriter
 
 if TYPE_CHECKING:
+    from camtool.post.arcbatch import ArcBatch
+    from camtool.post.arcbatch import Blocks as ArcBlocks
+    from camtool.post.arcbatch import Key as ArcKey
     from camtool.post.arcconform import ArcPiece
 
 
@@ -59,16 +62,23 @@ _FAR_CHORD: Point = (math.nan, math.nan)
 """The centre of a chord of an arc whose centre the I and J words cannot hold (by identity)."""
 
 
+UNMADE = object()
+""":attr:`_Conformed.batch` before the first arc is looked up."""
+
+
 class _Conformed(dict[tuple[Any, ...], list[tuple[Point, Point | None]]]):
     """A writer's memory of the arcs it has conformed, by key (``BlockWriter._conformed_at``).
 
     ``ahead``: the helper conforming the program's arcs meanwhile
-    (:mod:`camtool.accel.conformahead`), or ``None``.
+    (:mod:`camtool.accel.conformahead`), or ``None``; ``batch``: the plain arcs conformed
+    in arrays as the writer nears them (:mod:`camtool.post.arcbatch`), made at the first
+    arc looked up (:data:`UNMADE` until then; ``None``: not used).
     """
 
     def __init__(self, ahead: conformahead.ConformAhead | None = None) -> None:
         super().__init__()
         self.ahead = ahead
+        self.batch: object = UNMADE
 
 
 class BlockWriter(WordWriter):
@@ -394,7 +404,13 @@ class BlockWriter(WordWriter):
                 self.counts["tiny-arc"] += 1
             return known
         zero = 0.0 in key[0] or 0.0 in end or 0.0 in centre or 0.0 in start
-        ahead = None if zero or kept.ahead is None else kept.ahead.take(key)
+        ahead = None
+        if not zero:
+            batch = self._batch()
+            if batch is not None:
+                ahead = batch.take(key)
+            if ahead is None and kept.ahead is not None:
+                ahead = kept.ahead.take(key)
         if ahead is not None:  # what _conform gives: the helper ran conform_arc on the same key
             out = ahead
             if not out:
@@ -408,6 +424,29 @@ class BlockWriter(WordWriter):
                 kept.clear()
             kept[key] = out
         return out
+
+    def _batch(self) -> ArcBatch | None:
+        """The writer's batch of plain arcs (:mod:`camtool.post.arcbatch`), made at first call."""
+        kept = self._conformed_arcs
+        if kept.batch is UNMADE:
+            from camtool.post import arcbatch
+
+            kept.batch = arcbatch.start(self, self.program)
+        return cast("ArcBatch | None", kept.batch)
+
+    def plain_arcs(self, keys: list[ArcKey]) -> list[ArcBlocks | None]:
+        """The blocks the writer's batch gives each arc ``keys`` holds (``None``: not plain).
+
+        For :mod:`camtool.accel.conformahead`'s helper, which leaves those arcs to the
+        writer's batch and conforms the others; all ``None`` when the writer has no batch
+        (:func:`camtool.post.arcbatch.applies`).
+        """
+        batch = self._batch()
+        if batch is None:
+            return [None] * len(keys)
+        from camtool.post.arcbatch import plain_blocks
+
+        return plain_blocks(batch.grid, batch.rule, keys)
 
     def checked(
         self, written: Point, end: Point, centre: Point, clockwise: bool, exact_start: Point

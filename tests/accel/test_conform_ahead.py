@@ -37,6 +37,16 @@ ARCS = conformahead.MIN_ARCS + 500
 pytestmark = pytest.mark.usefixtures("helpers_on")
 
 
+@pytest.fixture(autouse=True)
+def _helper_alone(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The helper without the writer's batch of plain arcs (camtool.post.arcbatch), which
+    would answer most arcs first and leave the helper only the others: these tests are of
+    the helper's answers (tests/post/test_arcbatch.py runs the two together)."""
+    from camtool.post import arcbatch
+
+    monkeypatch.setattr(arcbatch, "applies", lambda writer, program: False)
+
+
 TOYS: dict[str, dict[str, Any]] = {
     # split arcs, a step grid on X/Y/I/J, absolute centres: arcs the writer splits, words
     # whose text also raises its largest grid change
