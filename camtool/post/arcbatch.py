@@ -1,38 +1,13 @@
 """The usual arcs of a program conformed in arrays, a chunk at a time, for the writer.
 
-Most arcs a drawing gives need no search to pass the controller's arc check: the rounded
-exact centre passes (:func:`~camtool.post.arcconform.plainly_passes`, then the
-controller's own check, :func:`~camtool.post.arccheck.arc_error`), and
-:func:`~camtool.post.arcconform.conform_arc` returns that one block. Both tests cost
-~25 µs of Python per arc; here they run on a chunk of arcs in numpy arrays (~1 µs an
-arc), for the arcs the writer is about to write, predicted as
-:mod:`camtool.accel.conformahead` predicts them.
+An answer is given only for an arc whose blocks are surely
+:func:`~camtool.post.arcconform.conform_arc`'s own (the rounded centre plainly passes),
+keyed by the writer's exact arguments; every other arc is the writer's to conform. Behind
+the accel switch (``CAMTOOL_ACCEL=0``: :func:`start` gives ``None``), kept beside the
+rules it computes in arrays, as the search's own array tests are: the accel layer, left
+of ``post``, cannot read them.
 
-Exactness. An answer is given only for an arc where it is surely ``conform_arc``'s own:
-
-- it is keyed by the writer's exact arguments (written start, end, centre, direction,
-  exact start), and looked up by them, so a wrong prediction only misses;
-- the grid indices are the scalar ones (:meth:`~camtool.post.arcconform.Grid.index`'s
-  float path in arrays, the same IEEE operations; any value it leaves, scalar) and the
-  exact arc is the scalar :func:`~camtool.post.arcconform._reference`;
-- the shortcut's bound is computed with numpy's ``hypot``/``arctan2``/``cos``, which may
-  differ from ``math``'s by an ulp: every test of it keeps :data:`~camtool.post.
-  arcconform.SLACK_MM` (10⁻⁹ mm, thousands of ulps at the 10⁴ mm it is used up to) or
-  :data:`~camtool.post.arcconform.SLACK_RAD` from its limit, which is what the scalar
-  shortcut keeps from the search's own numpy tests: an arc it passes, the search passes;
-- GRBL's check is float32 arithmetic (``+ − × √`` and comparisons, correctly rounded
-  in arrays as in scalars) on the printed values, ``k / 10**d`` (the correctly rounded
-  float of the decimal, as :meth:`~camtool.post.arcconform.Grid.value`); LinuxCNC's
-  (doubles, ``math.hypot``) is called as it is, arc by arc;
-- anything else (a grid that is not ``10**-d`` mm, an arc whose ends print the same,
-  a radius over :data:`~camtool.post.arcconform.SHORTCUT_MAX_MM`, a NaN) gets no answer,
-  and the writer conforms it itself.
-
-``tests/post/test_arcbatch.py`` compares every answer with ``conform_arc`` on arcs drawn
-to sit on each limit. It is a speed trick behind the accel switch (``CAMTOOL_ACCEL=0``: no
-answers, :func:`start` gives ``None``), kept beside the rules it computes in arrays as the
-search's own array tests are (:meth:`~camtool.post.arcconform.Solver._passes`): the accel
-layer, left of ``post``, cannot read them.
+Design notes: docs/internals.md, ``camtool/post/arcbatch.py``.
 """
 
 from __future__ import annotations

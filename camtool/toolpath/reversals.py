@@ -80,25 +80,37 @@ def count_reversals(cuts: Sequence[Cut], start: Point) -> tuple[int, int]:
         ``(rx, ry)``: reversals of X and of Y. On a machine that compensates
         every reversal (pic-mmh, UNAM-GMM §5.1) this is the compensation count.
     """
-    state_x = state_y = 0
-    count_x = count_y = 0
+    xs: list[int] = []  # every motion's direction, in order: a reversal is a change
+    ys: list[int] = []
+    eps = MOVE_EPS_MM
     here = start
     for cut in cuts:
         path = cut.path
         to = path.start
         # the rapid here → to as a line (segment_signs of Line(here, to)), then the path
-        rapid = _line_signs(to[0] - here[0], to[1] - here[1])
-        for xs, ys in itertools.chain((rapid,), map(segment_signs, path.segments)):
-            for v in xs:
-                if state_x and v != state_x:
-                    count_x += 1
-                state_x = v
-            for v in ys:
-                if state_y and v != state_y:
-                    count_y += 1
-                state_y = v
+        dx, dy = to[0] - here[0], to[1] - here[1]
+        if dx > eps or dx < -eps:
+            xs.append(1 if dx > 0 else -1)
+        if dy > eps or dy < -eps:
+            ys.append(1 if dy > 0 else -1)
+        for seg in path.segments:  # segment_signs, inlined: ~150 000 segments a drawing
+            if isinstance(seg, Line):
+                dx, dy = seg.end[0] - seg.start[0], seg.end[1] - seg.start[1]
+                if dx > eps or dx < -eps:
+                    xs.append(1 if dx > 0 else -1)
+                if dy > eps or dy < -eps:
+                    ys.append(1 if dy > 0 else -1)
+            else:
+                sx, sy = seg.axis_signs
+                xs += sx
+                ys += sy
         here = path.end
-    return count_x, count_y
+    return _changes(xs), _changes(ys)
+
+
+def _changes(signs: list[int]) -> int:
+    """How many times ``signs`` changes value (runs less one; 0 for none)."""
+    return sum(1 for _ in itertools.groupby(signs)) - 1 if signs else 0
 
 
 @dataclass(frozen=True)
