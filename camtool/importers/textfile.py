@@ -3,7 +3,9 @@
 Windows programs save "Unicode" text as UTF-16 with a byte-order mark (Notepad's
 "Unicode", Excel's "Unicode Text (*.txt)"); read as UTF-8 or Latin-1, every other byte
 is a NUL. The mark says which encoding it is (Unicode 15, §23.8), so such a file is read
-as the text it holds.
+as the text it holds. Without a mark, a file whose every other byte is a NUL and none of
+the others is (ASCII text in UTF-16, as some converters write it) is read as UTF-16 in
+that byte order: G-code and point lists are ASCII, and UTF-8 text holds no NUL.
 """
 
 from __future__ import annotations
@@ -20,10 +22,20 @@ _MARKS = (  # longest first: the UTF-32 LE mark begins with the UTF-16 LE one
 
 
 def marked_encoding(data: bytes) -> str | None:
-    """The codec a byte-order mark at the start of ``data`` names (None: no mark)."""
+    """The codec a byte-order mark at the start of ``data`` names (None: no mark).
+
+    Without a mark, ``utf-16-le`` or ``utf-16-be`` for ASCII text in UTF-16 (every
+    other byte a NUL, none of the others: see the module).
+    """
     for mark, codec in _MARKS:
         if data.startswith(mark):
             return codec
+    if len(data) >= 2 and len(data) % 2 == 0:
+        even, odd = data[0::2], data[1::2]
+        if not odd.strip(b"\0") and b"\0" not in even:
+            return "utf-16-le"
+        if not even.strip(b"\0") and b"\0" not in odd:
+            return "utf-16-be"
     return None
 
 

@@ -400,6 +400,12 @@ def test_read_gcode_errors_and_encodings(tmp_path: Path) -> None:
     unicode = tmp_path / "notepad.nc"  # Notepad's "Unicode": UTF-16 LE with its mark
     unicode.write_bytes("(pièce)\r\nG21 G90\r\nG1 X1 Y1 F9\r\nM2\r\n".encode("utf-16"))
     assert read_gcode(unicode).moves == (Linear(1.0, 1.0, 9.0, contour=1),)
+    for order in ("utf-16-le", "utf-16-be"):  # no mark: every other byte a NUL
+        unicode.write_bytes("(pièce)\r\nG21 G90\r\nG1 X1 Y1 F9\r\nM2\r\n".encode(order))
+        assert read_gcode(unicode).moves == (Linear(1.0, 1.0, 9.0, contour=1),), order
+    unicode.write_bytes(b"G21\r\nG1 X1\x00 Y1 F9\r\n")  # one NUL is no UTF-16: refused
+    with pytest.raises(InputError, match=r"notepad\.nc:2:"):
+        read_gcode(unicode)
     with pytest.raises(InputError, match=r"^<stdin>:2: G41"):
         bad = tmp_path / "bad.nc"
         bad.write_text("G21\r\nG41\r\n")

@@ -195,12 +195,18 @@ def test_missing_and_binary_files(tmp_path: Path) -> None:
         read_points(binary)
 
 
-@pytest.mark.parametrize("encoding", ["utf-16", "utf-16-be", "utf-32", "utf-8-sig"])
+@pytest.mark.parametrize(
+    "encoding", ["utf-16", "utf-16-be", "utf-32", "utf-8-sig", "utf-16-le no mark", "be no mark"]
+)
 def test_unicode_text_with_a_byte_order_mark(tmp_path: Path, encoding: str) -> None:
     """Excel's "Unicode Text (*.txt)" is UTF-16 LE with a byte-order mark, tab-separated;
-    the mark names the encoding (Unicode §23.8), so the points are those of the UTF-8 file."""
+    the mark names the encoding (Unicode §23.8), so the points are those of the UTF-8 file.
+    Without a mark, ASCII text whose every other byte is a NUL is UTF-16 in that order."""
     text = "x\ty\r\n0\t0\r\n10\t0\r\n10\t5.5\r\n"
-    data = text.encode(encoding)
+    if encoding.endswith("no mark"):
+        data = text.encode("utf-16-le" if encoding.startswith("utf-16-le") else "utf-16-be")
+    else:
+        data = text.encode(encoding)
     if encoding == "utf-16-be":
         data = b"\xfe\xff" + data
     path = tmp_path / "excel.txt"
