@@ -510,8 +510,9 @@ class _Reader(PlainLines):
             return self.first_feed  # post --feed: it sets every cut's feed
         if self.feed_mm_min is None:
             raise InputError(
-                f"{self.where()}: {name} before any F word; set the feed (e.g. F100) first, "
-                "or give the feed with post --feed"
+                f"{self.where()}: {name} before any F word, which a controller refuses "
+                "(GRBL: error 22); set the feed (e.g. F100) first, or write the program "
+                "again with camtool post --feed MM_PER_MIN"
             )
         if self.feed_mm_min == 0:
             raise InputError(f"{self.where()}: {name} with feed F0; set a feed above 0")
