@@ -110,6 +110,11 @@ class BlockWriter(WordWriter):
         # are many; held by the memory of conformed arcs, not as a 30th attribute of the
         # writer: that one made every block of the re-post benchmark ~8 % slower (CPython
         # 3.11 stops sharing the keys of instances with that many attributes)
+        # the plain arcs' prediction (a walk of every move) made once, before the helpers
+        # are forked: they share it
+        from camtool.post import arcbatch
+
+        batch = self._conformed_arcs.batch = arcbatch.start(self, program)
         split = splitwrite.start(self, program)
         ahead = None
         try:
@@ -128,6 +133,7 @@ class BlockWriter(WordWriter):
             if split is None:
                 ahead = conformahead.start(self, program)
             self._conformed_arcs = _Conformed(ahead)
+            self._conformed_arcs.batch = batch
             items = program.items()
             if split is None:
                 self.write_items(items, 0, 0)

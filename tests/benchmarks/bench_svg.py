@@ -107,8 +107,9 @@ parse ~1.4 s, the fit 3.7 s on both cores, planning 2.2 s and writing 2.2 s on o
 
 Sixteenth pass (this script alone, 26 Nov 2026 17:36, a noisy machine): camtool 9.13 s
 against vpype 5.55 s, **1.65×** (2.25× in a busier run of the same day before it); output
-the same bytes as before this pass (sha256 ``1962563a316c…``). What changed: the writer's usual arcs are conformed in numpy
-arrays, 512 at a time (``camtool.post.arcbatch``), the writer 4.0 → 1.8 s of CPU.
+the same bytes as before this pass (sha256 ``1962563a316c…``). What changed: the writer's
+usual arcs are conformed in numpy arrays, 512 at a time (``camtool.post.arcbatch``), the
+writer 4.0 → 1.8 s of CPU.
 """
 
 from __future__ import annotations
