@@ -422,26 +422,47 @@ def _href(element: ET.Element) -> str:
 def count_skipped(root: ET.Element, hold: ET.Element, counts: Counter[str]) -> None:
     """Add to ``counts`` the skipped kinds: clipPath, non-empty defs, drawn text and image.
 
-    And a drawn ``<use>`` of another file's element (``use-file``).
+    And a drawn ``<use>`` of another file's element (``use-file``). Text and images a
+    ``<use>`` places (from a ``<symbol>`` or a group in ``<defs>``) count once per
+    ``<use>``; each element placed is walked once (:func:`check_use_cycles` has run).
     """
+    ids = {e.get("id"): e for e in root.iter() if e.get("id")}
+    placed: dict[ET.Element, Counter[str]] = {}
 
-    def walk(node: ET.Element, drawn: bool) -> None:
+    def placed_by_use(target: ET.Element) -> Counter[str]:
+        """The text and images a ``<use>`` of ``target`` draws."""
+        found = placed.get(target)
+        if found is None:
+            kind = local_name(target)
+            found = Counter()
+            if kind in ("text", "image"):
+                found[kind] += 1
+            elif kind == "symbol" or kind not in _NOT_DRAWN:
+                walk(target, True, found)
+            found = placed[target] = Counter({k: found[k] for k in ("text", "image") if found[k]})
+        return found
+
+    def walk(node: ET.Element, drawn: bool, into: Counter[str]) -> None:
         for child in node:
             kind = local_name(child)
             if child is hold or kind is None:
                 continue
             if kind == "clipPath":
-                counts["clipPath"] += 1
+                into["clipPath"] += 1
             elif kind == "defs" and any(local_name(c) not in (None, "style") for c in child):
-                counts["defs"] += 1
+                into["defs"] += 1
             elif kind in ("text", "image") and drawn:
-                counts[kind] += 1
+                into[kind] += 1
                 continue
-            elif kind == "use" and drawn and _href(child)[:1] not in ("", "#"):
-                counts["use-file"] += 1  # another file's element: svgelements places nothing
-            walk(child, drawn and kind not in _NOT_DRAWN)
+            elif kind == "use" and drawn:
+                href = _href(child)
+                if href[:1] not in ("", "#"):
+                    into["use-file"] += 1  # another file's element: svgelements places nothing
+                elif href[:1] == "#" and (target := ids.get(href[1:])) is not None:
+                    into.update(placed_by_use(target))
+            walk(child, drawn and kind not in _NOT_DRAWN, into)
 
-    walk(root, True)
+    walk(root, True, counts)
 
 
 MAX_DEPTH = 256

@@ -437,6 +437,25 @@ def test_skipped_constructs_warn_once_per_kind(tmp_path: Path, body: str, warnin
     assert drawing.warnings[0].startswith(f"{tmp_path / 't.svg'}: {warning}")
 
 
+def test_text_and_images_a_use_places_are_counted_once_per_use(tmp_path: Path) -> None:
+    """A logo kept as a <symbol> with a raster image and a caption, placed twice: a viewer
+    shows two images and two captions, none of which camtool cuts, so the warnings count
+    them (they were silent when only the drawn tree was walked)."""
+    body = (
+        '<symbol id="logo"><image width="5" height="5" href="data:image/png;base64,AAAA"/>'
+        '<text x="1" y="1">ACME</text><path d="M 0 0 L 1 0"/></symbol>'
+        '<defs><g id="tag"><text>2</text></g></defs>'
+        '<use href="#logo" x="3" y="4"/><use href="#logo" x="13" y="4"/><use href="#tag"/>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert len(drawing.contours) == 2  # the symbol's path, placed twice
+    name = tmp_path / "t.svg"
+    assert f"{name}: skipped 3 <text> elements (convert text to paths" in "\n".join(
+        drawing.warnings
+    )
+    assert f"{name}: skipped 2 <image> elements (raster images" in "\n".join(drawing.warnings)
+
+
 def test_symbol_without_viewbox_is_placed(tmp_path: Path) -> None:
     body = '<symbol id="s"><path d="M 0 0 L 1 0"/></symbol><use href="#s" x="3" y="4"/>'
     assert vertices(one(read_svg(svg(tmp_path, body)))) == [(3, 96), (4, 96)]
