@@ -45,6 +45,9 @@ the program (``arc_calls``: 0.9 s for the 333 540 moves of the 10.9 MB re-post b
 ~3 µs a move) and pays for itself only where distinct arcs, each ~25 µs conformed alone,
 are common enough: the Tango SVG benchmark has 42 812 among 89 206 moves, the re-post
 benchmark 1 642 repeated 170 times (the writer reuses their blocks)."""
+MAX_MOVES = 400_000
+"""Moves above which no batch is made: its prediction keeps ~360 bytes an arc (21 MB for
+the Tango benchmark's 58 660 arcs), ~100 MB at this size."""
 CHUNK = 512
 """Arcs conformed in one go: the chunk holding the arc the writer asks for."""
 
@@ -111,12 +114,14 @@ def applies(writer: BlockWriter, program: Program) -> bool:
     """Whether ``writer`` takes answers from a batch for ``program``.
 
     Not switched off, with an arc check on a ``10**-d`` mm grid (else grid values are
-    not ``k / 10**d``), and at least :data:`MIN_ARCS` distinct arcs, one in
-    :data:`MOVES_PER_ARC` moves at least.
+    not ``k / 10**d``), at most :data:`MAX_MOVES` moves, and at least :data:`MIN_ARCS`
+    distinct arcs, one in :data:`MOVES_PER_ARC` moves at least.
     """
     if writer.spec.arc_check == "none" or not enabled():
         return False
     if grid_of(writer).decimals is None:
+        return False
+    if len(program.moves) > MAX_MOVES:
         return False
     centres = [m.cx for m in program.moves if isinstance(m, ArcMove)]
     if len(centres) < MIN_ARCS:

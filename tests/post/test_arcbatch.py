@@ -26,6 +26,7 @@ from camtool.model.errors import CamtoolError
 from camtool.post import arcbatch
 from camtool.post.arccheck import GRBL_TOLERANCE_MM, LINUXCNC_TOLERANCE_MM, MARGIN_MM
 from camtool.post.arcconform import SHORTCUT_MAX_MM, conform_arc
+from camtool.post.registry import load_target
 from tests.accel.test_conform_ahead import BIG, arc_program, post_of
 from tests.post.test_arccheck_shortcut import _arc
 
@@ -220,3 +221,23 @@ def test_with_the_helper_too_the_writer_writes_the_same(
     assert started.ahead is not None
     # the helper answered only arcs the batch leaves: the arcs that take the search
     assert 0 < started.ahead.taken < 0.3 * conformahead.MIN_ARCS
+
+
+def test_no_batch_where_it_would_not_pay(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Repeated arcs (the writer reuses their blocks), too many moves to keep a prediction
+    of, no arc check, a grid that is not 10**-d mm, or the switch off: no batch."""
+    from camtool.model.program import Linear, Program
+    from camtool.post.wordaddress_write import BlockWriter
+
+    monkeypatch.setenv("CAMTOOL_ACCEL", "1")
+    program = arc_program(random.Random(7), 300, messy=False)
+    writer = BlockWriter(post_of("grbl").spec, BIG)
+    assert arcbatch.applies(writer, program)
+    repeated = Program(program.moves * 11)  # 300 distinct arcs in more than 3 000 moves
+    assert not arcbatch.applies(writer, repeated)
+    padded = Program(program.moves + (Linear(1.0, 1.0, 300.0),) * arcbatch.MAX_MOVES)
+    assert not arcbatch.applies(writer, padded)
+    assert not arcbatch.applies(BlockWriter(post_of("toy-grid").spec, BIG), program)
+    assert not arcbatch.applies(BlockWriter(load_target("flashcut").post.spec, BIG), program)
+    monkeypatch.setenv("CAMTOOL_ACCEL", "0")
+    assert not arcbatch.applies(writer, program)
