@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 from camtool.accel import enabled
 from camtool.model.errors import CamtoolError
-from camtool.model.program import ArcMove, Linear, Program, Rapid
+from camtool.model.program import ArcMove, Program
 from camtool.model.shapes import Point
 
 if TYPE_CHECKING:
@@ -207,16 +207,20 @@ def arc_calls(writer: BlockWriter, program: Program) -> list[Call]:
     calls: list[Call] = []
     here = program.origin
     before: Point | None = None
+    z_only = writer.z_only
     for move in program.moves:
         end = (move.x, move.y)
-        if isinstance(move, ArcMove):
+        if type(move) is ArcMove:
             centre = (move.cx, move.cy)
-            if not any(0.0 in p for p in (end, centre, here)) and (
-                before is None or 0.0 not in before
+            if (
+                0.0 not in end
+                and 0.0 not in centre
+                and 0.0 not in here
+                and (before is None or 0.0 not in before)
             ):
                 calls.append((before, end, centre, move.clockwise, here))
             before = end
-        elif not (isinstance(move, (Rapid, Linear)) and writer.z_only(here, move)):
+        elif move.z is None or not z_only(here, move):  # type: ignore[arg-type]  # not an arc
             before = end
         here = end
     return list(dict.fromkeys(calls))  # an arc cut again: the writer reuses its blocks
