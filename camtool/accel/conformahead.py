@@ -17,7 +17,7 @@ from camtool.model.program import ArcMove, Program
 from camtool.model.shapes import Point
 
 if TYPE_CHECKING:
-    from camtool.post.wordaddress_write import BlockWriter
+    from camtool.post.wordaddress_arcs import ArcWriter
 
 Key = tuple[Point, Point, Point, bool, Point]
 """An arc's arguments: ``(written start, end, centre, clockwise, exact start)``, mm."""
@@ -125,7 +125,7 @@ class ConformAhead:
         self.shared.close()
 
 
-def start(writer: BlockWriter, program: Program) -> ConformAhead | None:
+def start(writer: ArcWriter, program: Program) -> ConformAhead | None:
     """Fork the helper that conforms ``program``'s arcs for ``writer``; ``None`` when not.
 
     Call it once ``writer`` holds the program's origin as written (``writer.written``),
@@ -139,7 +139,7 @@ def start(writer: BlockWriter, program: Program) -> ConformAhead | None:
         return None
     # Distinct arcs, told apart by their centre's x (a few ms; an estimate from below): a
     # program that cuts its contours again (at other depths, or copies) has the writer
-    # reuse their blocks (BlockWriter._conformed_at), not conform them again.
+    # reuse their blocks (ArcWriter._conformed_at), not conform them again.
     if len({m.cx for m in program.moves if isinstance(m, ArcMove)}) < MIN_ARCS:
         return None
     from camtool.accel.cores import (  # only here: ~9 ms that a re-post does not need
@@ -192,7 +192,7 @@ Call = tuple["Point | None", Point, Point, bool, Point]
 """An arc as :func:`arc_calls` gives it: ``(before, end, centre, clockwise, exact start)``."""
 
 
-def arc_calls(writer: BlockWriter, program: Program) -> list[Call]:
+def arc_calls(writer: ArcWriter, program: Program) -> list[Call]:
     """Each arc of ``program`` once, in order: ``(before, end, centre, clockwise, start)``.
 
     ``before`` is where the last move writing X and Y before the arc ended, not yet
@@ -226,7 +226,7 @@ def arc_calls(writer: BlockWriter, program: Program) -> list[Call]:
     return list(dict.fromkeys(calls))  # an arc cut again: the writer reuses its blocks
 
 
-def key_of(writer: BlockWriter, call: Call) -> Key | None:
+def key_of(writer: ArcWriter, call: Call) -> Key | None:
     """The arguments ``writer`` will conform the arc ``call`` with, or ``None``.
 
     The start the controller holds is ``before`` as printed (``writer.written`` as the
@@ -247,8 +247,8 @@ def key_of(writer: BlockWriter, call: Call) -> Key | None:
     return (written, end, centre, clockwise, here)
 
 
-def _conformed(writer: BlockWriter, key: Key) -> Blocks | None:
-    """The writer's blocks for the arc ``key`` (``BlockWriter.checked``), or ``None``.
+def _conformed(writer: ArcWriter, key: Key) -> Blocks | None:
+    """The writer's blocks for the arc ``key`` (``ArcWriter.checked``), or ``None``.
 
     ``None`` when the check raises: the writer repeats the arc and says why.
     """

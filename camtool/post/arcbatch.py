@@ -24,7 +24,7 @@ if TYPE_CHECKING:
     import numpy.typing as npt
 
     from camtool.post.arcconform import Grid
-    from camtool.post.wordaddress_write import BlockWriter
+    from camtool.post.wordaddress_arcs import ArcWriter
 
     FloatArray = npt.NDArray[np.floating[Any]]
     BoolArray = npt.NDArray[np.bool_]
@@ -60,7 +60,7 @@ class ArcBatch:
         program: the program it writes.
     """
 
-    def __init__(self, writer: BlockWriter, program: Program) -> None:
+    def __init__(self, writer: ArcWriter, program: Program) -> None:
         from camtool.accel.conformahead import arc_calls
 
         self.writer = writer
@@ -98,19 +98,19 @@ class ArcBatch:
         return keys
 
 
-def start(writer: BlockWriter, program: Program) -> ArcBatch | None:
+def start(writer: ArcWriter, program: Program) -> ArcBatch | None:
     """The batch for ``program``'s arcs, or ``None`` when it does not :func:`apply`."""
     return ArcBatch(writer, program) if applies(writer, program) else None
 
 
-def grid_of(writer: BlockWriter) -> Grid:
+def grid_of(writer: ArcWriter) -> Grid:
     """The grid ``writer`` prints arcs on (its dialect's quantum)."""
     from camtool.post.arcconform import Grid
 
     return Grid.of(writer.spec.quantum_mm())
 
 
-def applies(writer: BlockWriter, program: Program) -> bool:
+def applies(writer: ArcWriter, program: Program) -> bool:
     """Whether ``writer`` takes answers from a batch for ``program``.
 
     Not switched off, with an arc check on a ``10**-d`` mm grid (else grid values are

@@ -12,11 +12,10 @@ import dataclasses
 import math
 from collections.abc import Iterator
 from itertools import islice
-from typing import TYPE_CHECKING, Any, cast
+from typing import TYPE_CHECKING
 
 from camtool.accel import conformahead, splitwrite
 from camtool.model.errors import DialectError
-from camtool.model.machine import Machine
 from camtool.model.program import (
     PLANE_AXES,
     ArcMove,
@@ -39,59 +38,32 @@ from camtool.post.base import (
     check_placement,
     check_work_area,
 )
-from camtool.post.wordaddress_spec import PLANE_CODES, WordAddressSpec
+from camtool.post.wordaddress_arcs import (
+    ARC_CHORD_TOLERANCE_MM,
+    CHORD,
+    FAR_CHORD,
+    ArcWriter,
+    Conformed,
+)
+from camtool.post.wordaddress_spec import PLANE_CODES
 from camtool.post.wordaddress_summary import closing_warnings
-from camtool.post.wordaddress_words import SAME_MM, WordWriter
+from camtool.post.wordaddress_words import SAME_MM
 
 if TYPE_CHECKING:
-    from camtool.post.arcbatch import ArcBatch
-    from camtool.post.arcbatch import Blocks as ArcBlocks
-    from camtool.post.arcbatch import Key as ArcKey
-    from camtool.post.arcconform import ArcPiece
+    pass
 
 
 _MOVES = (Rapid, Linear, ArcMove)
 """The kinds of move (a tuple: ``isinstance`` takes it faster than ``Rapid | Linear | ...``)."""
-_CONFORMED_KEPT = 20_000
-"""Arcs whose blocks a writer keeps (:meth:`BlockWriter._conformed`); then it starts anew."""
-ARC_CHORD_TOLERANCE_MM = 0.002
-"""Chord deviation, mm, of an arc no printable centre can write (GRBL's default ``$12``)."""
-_CHORD: Point = (math.nan, math.nan)
-"""The centre of a conformed block that is a chord of such an arc (by identity)."""
-_FAR_CHORD: Point = (math.nan, math.nan)
-"""The centre of a chord of an arc whose centre the I and J words cannot hold (by identity)."""
 
 
-UNMADE = object()
-""":attr:`_Conformed.batch` before the first arc is looked up."""
-
-
-class _Conformed(dict[tuple[Any, ...], list[tuple[Point, Point | None]]]):
-    """A writer's memory of the arcs it has conformed, by key (``BlockWriter._conformed_at``).
-
-    ``ahead``: the helper conforming the program's arcs meanwhile
-    (:mod:`camtool.accel.conformahead`), or ``None``; ``batch``: the plain arcs conformed
-    in arrays as the writer nears them (:mod:`camtool.post.arcbatch`), made at the first
-    arc looked up (:data:`UNMADE` until then; ``None``: not used).
-    """
-
-    def __init__(self, ahead: conformahead.ConformAhead | None = None) -> None:
-        super().__init__()
-        self.ahead = ahead
-        self.batch: object = UNMADE
-
-
-class BlockWriter(WordWriter):
-    """Writes one program: its moves, arcs and commands as blocks (:class:`WordWriter`).
+class BlockWriter(ArcWriter):
+    """Writes one program: its moves, arcs and commands as blocks (:class:`ArcWriter`).
 
     Args:
         spec: the dialect.
         machine: the machine the program is for (work area, Z axis).
     """
-
-    def __init__(self, spec: WordAddressSpec, machine: Machine) -> None:
-        super().__init__(spec, machine)
-        self._conformed_arcs = _Conformed()
 
     def write(self, program: Program) -> str:
         """The whole program as text.
@@ -132,7 +104,7 @@ class BlockWriter(WordWriter):
                 self.block(list(codes))
             if split is None:
                 ahead = conformahead.start(self, program)
-            self._conformed_arcs = _Conformed(ahead)
+            self._conformed_arcs = Conformed(ahead)
             self._conformed_arcs.batch = batch
             items = program.items()
             if split is None:
@@ -373,179 +345,6 @@ class BlockWriter(WordWriter):
             parts = 1
         return parts
 
-    def _conformed(self, piece: Arc) -> list[tuple[Point, Point | None]]:
-        """End and absolute centre of each block of ``piece`` (after the arc check).
-
-        A centre of ``None`` asks for a straight line: the arc is a few quanta
-        across and no printable centre passes the controller's check.
-        """
-        return self._conformed_at(piece.start, piece.end, piece.centre, piece.clockwise, piece)
-
-    def _conformed_at(
-        self, start: Point, end: Point, centre: Point, clockwise: bool, piece: Arc | None = None
-    ) -> list[tuple[Point, Point | None]]:
-        """:meth:`_conformed` of the arc from ``start`` to ``end`` (``piece``, made if ``None``).
-
-        An arc whose I or J has more integer digits than the dialect writes (an almost
-        straight piece fitted with a radius of metres: FlashCut's four digits hold 9999.999
-        mm) is its chords within :data:`ARC_CHORD_TOLERANCE_MM` (twice the quantum at least),
-        counted as ``far-centre``.
-        """
-        ox, oy = (0.0, 0.0) if self._absolute_centre else self.written
-        if self._beyond_digits(centre[0] - ox, centre[1] - oy):
-            self.counts["far-centre"] += 1
-            tolerance = max(2.0 * self.spec.quantum_mm(), ARC_CHORD_TOLERANCE_MM)
-            arc = piece if piece is not None else make_arc(start, end, centre, clockwise)
-            return [(point, _FAR_CHORD) for point in arc.points(tolerance)[1:]]
-        if self.spec.arc_check == "none":
-            return [(end, centre)]
-        key = (self.written, end, centre, clockwise, start)
-        # The same arc from the same written start (a program that cuts a contour again at
-        # another depth) gives the same blocks: conform_arc is a function of its arguments.
-        # Zeros are left out: -0.0 equals 0.0 as a key, but not as an angle (atan2).
-        kept = self._conformed_arcs
-        known = kept.get(key)
-        if known is not None:
-            if not known:
-                self.counts["tiny-arc"] += 1
-            return known
-        zero = 0.0 in key[0] or 0.0 in end or 0.0 in centre or 0.0 in start
-        ahead = None
-        if not zero:
-            batch = self._batch()
-            if batch is not None:
-                ahead = batch.take(key)
-            if ahead is None and kept.ahead is not None:
-                ahead = kept.ahead.take(key)
-        if ahead is not None:  # what _conform gives: the helper ran conform_arc on the same key
-            out = ahead
-            if not out:
-                self.counts["tiny-arc"] += 1
-        else:
-            out = self._conform(
-                piece if piece is not None else make_arc(start, end, centre, clockwise)
-            )
-        if not zero:
-            if len(kept) >= _CONFORMED_KEPT:
-                kept.clear()
-            kept[key] = out
-        return out
-
-    def _batch(self) -> ArcBatch | None:
-        """The writer's batch of plain arcs (:mod:`camtool.post.arcbatch`), made at first call."""
-        kept = self._conformed_arcs
-        if kept.batch is UNMADE:
-            from camtool.post import arcbatch
-
-            kept.batch = arcbatch.start(self, self.program)
-        return cast("ArcBatch | None", kept.batch)
-
-    def plain_arcs(self, keys: list[ArcKey]) -> list[ArcBlocks | None]:
-        """The blocks the writer's batch gives each arc ``keys`` holds (``None``: not plain).
-
-        For :mod:`camtool.accel.conformahead`'s helper, which leaves those arcs to the
-        writer's batch and conforms the others; all ``None`` when the writer has no batch
-        (:func:`camtool.post.arcbatch.applies`).
-        """
-        batch = self._batch()
-        if batch is None:
-            return [None] * len(keys)
-        from camtool.post.arcbatch import plain_blocks
-
-        return plain_blocks(batch.grid, batch.rule, keys)
-
-    def checked(
-        self, written: Point, end: Point, centre: Point, clockwise: bool, exact_start: Point
-    ) -> list[ArcPiece]:
-        """The blocks of an arc that pass the controller's check (``conform_arc``).
-
-        Args:
-            written: the start the controller holds, as written, mm.
-            end: the exact end, mm.
-            centre: the exact absolute centre, mm.
-            clockwise: G2 when True.
-            exact_start: the exact start, mm.
-
-        A function of its arguments (the rule and the quantum are the dialect's): the
-        writer keeps its answers by them (:meth:`_conformed_at`), and
-        :mod:`camtool.accel.conformahead`'s helper calls it ahead of the writer.
-
-        Raises:
-            DialectError: :func:`~camtool.post.arcconform.conform_arc`'s, without the block.
-        """
-        from camtool.post.arcconform import conform_arc
-
-        quantum = self._quantum
-        if quantum is None:
-            quantum = self._quantum = self.spec.quantum_mm()  # the same for every arc
-        return conform_arc(
-            written,
-            end,
-            centre,
-            clockwise,
-            rule=self.spec.arc_check,
-            quantum_mm=quantum,
-            exact_start=exact_start,
-        )
-
-    def _conform(self, piece: Arc) -> list[tuple[Point, Point | None]]:
-        """:meth:`_conformed` without its memory of the arcs already conformed."""
-        try:
-            out = self.checked(self.written, piece.end, piece.centre, piece.clockwise, piece.start)
-        except DialectError:
-            quantum = self.spec.quantum_mm()
-            if piece.radius <= 10 * quantum:
-                return [(piece.end, None)]
-            equalised = self._conform_equalised(piece, quantum)
-            if equalised is None:
-                # no printable centre passes the controller's check: chords, as the
-                # controller itself would cut the arc (GRBL's $12 arc tolerance)
-                tolerance = max(2.0 * quantum, ARC_CHORD_TOLERANCE_MM)
-                return [(point, _CHORD) for point in piece.points(tolerance)[1:]]
-            out = equalised
-        if not out:
-            self.counts["tiny-arc"] += 1  # rounds away to nothing within a quantum
-        return [(p.end, p.centre) for p in out]
-
-    def _conform_equalised(self, piece: Arc, quantum: float) -> list[ArcPiece] | None:
-        """``piece`` conformed about the centre that puts both its ends at one radius, or None.
-
-        For an arc the arc check refused whose ends lie at different distances from its
-        centre (a joint snapped within ``--chain-tolerance`` keeps an arc's centre, so its
-        start can move off its circle: LinuxCNC's ``conv_slot_l.svg`` gave an arc 3.4 µm
-        apart in radius, which no split could write). The centre moves to the nearest
-        point of its ends' perpendicular bisector; the warning gives both radii and the
-        move. Only when the radii differ by no more than the controller's own absolute
-        tolerance (GRBL 0.005 mm, LinuxCNC 0.028 mm: :func:`~camtool.post.arccheck.
-        max_difference` at radius 0), numbers it would itself take as one arc; ``None``
-        otherwise, or when that does not help (the ends meet, the check still fails): the
-        arc is then written as chords. Only arcs the check refused take this path.
-        """
-        from camtool.post.arccheck import max_difference
-
-        (sx, sy), (ex, ey), (cx, cy) = piece.start, piece.end, piece.centre
-        dx, dy = ex - sx, ey - sy
-        chord = math.hypot(dx, dy)
-        r0, r1 = math.hypot(sx - cx, sy - cy), math.hypot(ex - cx, ey - cy)
-        if chord == 0.0 or r0 == r1 or abs(r1 - r0) > max_difference(self.spec.arc_check, 0.0):
-            return None  # beyond the controller's own absolute tolerance: written as chords
-        nx, ny = -dy / chord, dx / chord
-        mx, my = (sx + ex) / 2.0, (sy + ey) / 2.0
-        along = (cx - mx) * nx + (cy - my) * ny
-        centre = (mx + along * nx, my + along * ny)
-        try:
-            out = self.checked(self.written, piece.end, centre, piece.clockwise, piece.start)
-        except DialectError:
-            return None
-        moved = math.dist(centre, piece.centre)
-        self.warn(
-            f"{self.where()}: the arc starts {r0:.4f} mm and ends {r1:.4f} mm from its centre "
-            f"({abs(r1 - r0) * 1000:.1f} µm apart), more than {self.spec.name}'s arc check "
-            f"takes; written about the centre {moved * 1000:.1f} µm away that puts both ends "
-            f"{math.dist(centre, piece.end):.4f} mm from it"
-        )
-        return out
-
     def _arc_block(
         self,
         move: ArcMove,
@@ -574,8 +373,8 @@ class BlockWriter(WordWriter):
         before = self.written
         ox, oy = (0.0, 0.0) if self._absolute_centre else before
         ti = tj = ""
-        if centre is _CHORD or centre is _FAR_CHORD:
-            if centre is _CHORD:  # far centres are counted per arc, in _conformed_at
+        if centre is CHORD or centre is FAR_CHORD:
+            if centre is CHORD:  # far centres are counted per arc, in _conformed_at
                 self.counts["arc-chords"] += 1
             self._line(Linear(*end, move.feed_mm_min, contour=move.contour), end, z)
             return
@@ -606,17 +405,6 @@ class BlockWriter(WordWriter):
         self.written = written
         self._feed(move, words)
         self.block(words)
-
-    def _beyond_digits(self, ci: float, cj: float) -> bool:
-        """Whether centre offset ``(ci, cj)`` mm has more integer digits than I or J writes."""
-        for letter, value in (("I", ci), ("J", cj)):
-            number = self.spec.words[letter].number
-            if number.int_digits is None:
-                continue
-            half_unit = 0.5 * 10.0 ** (-number.decimals)  # what rounds up to the next digit
-            if abs(value) * number.scale + half_unit >= 10.0**number.int_digits:
-                return True
-        return False
 
     # -- arcs in the ZX and YZ planes -----------------------------------------------
 

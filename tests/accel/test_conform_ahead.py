@@ -162,12 +162,12 @@ def test_predicted_keys_are_the_keys_the_writer_conforms(
     program = arc_program(random.Random(1), ARCS, messy=False)
     looked: list[tuple[Any, ...]] = []
 
-    class Recording(wordaddress_write._Conformed):
+    class Recording(wordaddress_write.Conformed):
         def __setitem__(self, key: Any, value: Any) -> None:
             looked.append(key)
             super().__setitem__(key, value)
 
-    monkeypatch.setattr(wordaddress_write, "_Conformed", Recording)
+    monkeypatch.setattr(wordaddress_write, "Conformed", Recording)
     alone(post, program, monkeypatch)
     writer = BlockWriter(post.spec, BIG)
     origin = program.origin
