@@ -41,13 +41,12 @@ MIN_ARCS = 64
 call is more than the Python it saves)."""
 MOVES_PER_ARC = 10
 """Moves per distinct arc up to which a batch is made. Its prediction walks every move of
-the program (``arc_calls``: 0.9 s for the 333 540 moves of the 10.9 MB re-post benchmark,
-~3 µs a move) and pays for itself only where distinct arcs, each ~25 µs conformed alone,
-are common enough: the Tango SVG benchmark has 42 812 among 89 206 moves, the re-post
-benchmark 1 642 repeated 170 times (the writer reuses their blocks)."""
+the program (a few µs a move) and pays for itself only where distinct arcs, each ~25 µs
+conformed alone, are common: a program that cuts its arcs again (at other depths, or
+copies) has the writer reuse their blocks (docs/internals.md)."""
 MAX_MOVES = 400_000
-"""Moves above which no batch is made: its prediction keeps ~360 bytes an arc (21 MB for
-the Tango benchmark's 58 660 arcs), ~100 MB at this size."""
+"""Moves above which no batch is made: its prediction keeps ~360 bytes an arc, ~100 MB at
+this size."""
 CHUNK = 512
 """Arcs conformed in one go: the chunk holding the arc the writer asks for."""
 
@@ -134,7 +133,7 @@ def plain_blocks(grid: Grid, rule: str, keys: Sequence[Key]) -> list[Blocks | No
     """``conform_arc``'s blocks for each arc ``keys`` gives when the rounded centre plainly passes.
 
     ``None`` for an arc that may need the search (or more): its blocks are not known here.
-    See the module docstring for why an answer is ``conform_arc``'s own.
+    Why an answer is ``conform_arc``'s own: docs/internals.md, ``camtool/post/arcbatch.py``.
     """
     import numpy as np
 

@@ -108,12 +108,14 @@ class ArcWriter(WordWriter):
         zero = 0.0 in key[0] or 0.0 in end or 0.0 in centre or 0.0 in start
         ahead = None
         if not zero:
-            batch = self._batch()
-            if batch is not None:
-                ahead = batch.take(key)
-            if ahead is None and kept.ahead is not None:
+            # the helper first: each lookup tells it where the writer is (it leaves the
+            # batch's plain arcs to it), then the batch
+            if kept.ahead is not None:
                 ahead = kept.ahead.take(key)
-        if ahead is not None:  # what _conform gives: the helper ran conform_arc on the same key
+            batch = self._batch()
+            if ahead is None and batch is not None:
+                ahead = batch.take(key)
+        if ahead is not None:  # what _conform gives: conform_arc on the same key, elsewhere
             out = ahead
             if not out:
                 self.counts["tiny-arc"] += 1

@@ -221,6 +221,8 @@ def test_with_the_helper_too_the_writer_writes_the_same(
     assert started.ahead is not None
     # the helper answered only arcs the batch leaves: the arcs that take the search
     assert 0 < started.ahead.taken < 0.3 * conformahead.MIN_ARCS
+    # and it was told of every lookup, the batch's too: it knows where the writer is
+    assert started.ahead.looks > conformahead.MIN_ARCS
 
 
 def test_no_batch_where_it_would_not_pay(monkeypatch: pytest.MonkeyPatch) -> None:
