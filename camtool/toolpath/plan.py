@@ -387,9 +387,8 @@ def fit_dense(contours: Sequence[Contour], tolerance: float) -> tuple[list[Conto
             if seg is not None:
                 segs.append(seg)
         same = len(segs) == len(contour.segments)
-        out.append(
-            contour if same else Contour(tuple(segs), contour.closed, contour.layer, contour.source)
-        )
+        # the same contour otherwise: its layer, source, colour and linetype kept
+        out.append(contour if same else dataclasses.replace(contour, segments=tuple(segs)))
     return out, total
 
 

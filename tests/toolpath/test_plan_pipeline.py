@@ -74,6 +74,14 @@ def test_dense_polyline_becomes_arcs_and_the_saving_is_reported() -> None:
     gon = Contour(tuple(Line(pts[k], pts[(k + 1) % n]) for k in range(n)), True)
     (fitted,), stats = fit_dense([gon], 0.001)
     assert stats.replaced == n
+    marked = Contour(gon.segments, True, "holes", "circle#c", "#ff0000", "DASHED")
+    ((refitted,), _) = fit_dense([marked], 0.001)  # what the contour was stays
+    assert (refitted.layer, refitted.source, refitted.colour, refitted.linetype) == (
+        "holes",
+        "circle#c",
+        "#ff0000",
+        "DASHED",
+    )
     assert stats.arcs >= 1 and stats.segments == len(fitted.segments) < 10
     for seg in fitted.segments:
         assert isinstance(seg, Arc) and seg.radius == pytest.approx(10.0, abs=1e-3)
