@@ -12,6 +12,7 @@ from __future__ import annotations
 import re
 import xml.etree.ElementTree as ET
 from collections import Counter
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -430,19 +431,15 @@ def count_skipped(root: ET.Element, hold: ET.Element, counts: Counter[str]) -> N
     placed: dict[ET.Element, Counter[str]] = {}
 
     def placed_by_use(target: ET.Element) -> Counter[str]:
-        """The text and images a ``<use>`` of ``target`` draws."""
+        """The text and images a ``<use>`` of ``target`` draws (a symbol: its children)."""
         found = placed.get(target)
         if found is None:
-            kind = local_name(target)
             found = Counter()
-            if kind in ("text", "image"):
-                found[kind] += 1
-            elif kind == "symbol" or kind not in _NOT_DRAWN:
-                walk(target, True, found)
+            walk(target if local_name(target) == "symbol" else [target], True, found)
             found = placed[target] = Counter({k: found[k] for k in ("text", "image") if found[k]})
         return found
 
-    def walk(node: ET.Element, drawn: bool, into: Counter[str]) -> None:
+    def walk(node: Iterable[ET.Element], drawn: bool, into: Counter[str]) -> None:
         for child in node:
             kind = local_name(child)
             if child is hold or kind is None:

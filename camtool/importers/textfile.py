@@ -21,8 +21,8 @@ _MARKS = (  # longest first: the UTF-32 LE mark begins with the UTF-16 LE one
 )
 
 
-def marked_encoding(data: bytes) -> str | None:
-    """The codec a byte-order mark at the start of ``data`` names (None: no mark).
+def text_encoding(data: bytes) -> str | None:
+    """The codec a byte-order mark at the start of ``data`` names, else ``None``.
 
     Without a mark, ``utf-16-le`` or ``utf-16-be`` for ASCII text in UTF-16 (every
     other byte a NUL, none of the others: see the module).
@@ -40,9 +40,9 @@ def marked_encoding(data: bytes) -> str | None:
 
 
 def decoded(data: bytes, errors: str = "strict") -> str:
-    """``data`` as text in the encoding its byte-order mark names, else UTF-8; the mark dropped.
+    """``data`` as text in its :func:`text_encoding`, else UTF-8; a byte-order mark dropped.
 
     Raises:
         UnicodeDecodeError: (``errors="strict"``) the bytes are not text in that encoding.
     """
-    return data.decode(marked_encoding(data) or "utf-8", errors)
+    return data.decode(text_encoding(data) or "utf-8", errors)

@@ -13,7 +13,7 @@ Design notes: docs/internals.md, ``camtool/post/wordaddress_write.py``.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any, cast
+from typing import TYPE_CHECKING, Any
 
 from camtool.accel import conformahead
 from camtool.model.errors import DialectError
@@ -38,23 +38,18 @@ FAR_CHORD: Point = (math.nan, math.nan)
 """The centre of a chord of an arc whose centre the I and J words cannot hold (by identity)."""
 
 
-UNMADE = object()
-""":attr:`_Conformed.batch` before the first arc is looked up."""
-
-
 class Conformed(dict[tuple[Any, ...], list[tuple[Point, Point | None]]]):
     """A writer's memory of the arcs it has conformed, by key (``ArcWriter._conformed_at``).
 
     ``ahead``: the helper conforming the program's arcs meanwhile
     (:mod:`camtool.accel.conformahead`), or ``None``; ``batch``: the plain arcs conformed
-    in arrays as the writer nears them (:mod:`camtool.post.arcbatch`), made at the first
-    arc looked up (:data:`UNMADE` until then; ``None``: not used).
+    in arrays as the writer nears them (:mod:`camtool.post.arcbatch`), or ``None``.
     """
 
     def __init__(self, ahead: conformahead.ConformAhead | None = None) -> None:
         super().__init__()
         self.ahead = ahead
-        self.batch: object = UNMADE
+        self.batch: ArcBatch | None = None
 
 
 class ArcWriter(WordWriter):
@@ -112,7 +107,7 @@ class ArcWriter(WordWriter):
             # batch's plain arcs to it), then the batch
             if kept.ahead is not None:
                 ahead = kept.ahead.take(key)
-            batch = self._batch()
+            batch = kept.batch
             if ahead is None and batch is not None:
                 ahead = batch.take(key)
         if ahead is not None:  # what _conform gives: conform_arc on the same key, elsewhere
@@ -129,15 +124,6 @@ class ArcWriter(WordWriter):
             kept[key] = out
         return out
 
-    def _batch(self) -> ArcBatch | None:
-        """The writer's batch of plain arcs (:mod:`camtool.post.arcbatch`), made at first call."""
-        kept = self._conformed_arcs
-        if kept.batch is UNMADE:
-            from camtool.post import arcbatch
-
-            kept.batch = arcbatch.start(self, self.program)
-        return cast("ArcBatch | None", kept.batch)
-
     def plain_arcs(self, keys: list[ArcKey]) -> list[ArcBlocks | None]:
         """The blocks the writer's batch gives each arc ``keys`` holds (``None``: not plain).
 
@@ -145,7 +131,7 @@ class ArcWriter(WordWriter):
         writer's batch and conforms the others; all ``None`` when the writer has no batch
         (:func:`camtool.post.arcbatch.applies`).
         """
-        batch = self._batch()
+        batch = self._conformed_arcs.batch
         if batch is None:
             return [None] * len(keys)
         from camtool.post.arcbatch import plain_blocks

@@ -444,13 +444,14 @@ def test_text_and_images_a_use_places_are_counted_once_per_use(tmp_path: Path) -
     body = (
         '<symbol id="logo"><image width="5" height="5" href="data:image/png;base64,AAAA"/>'
         '<text x="1" y="1">ACME</text><path d="M 0 0 L 1 0"/></symbol>'
-        '<defs><g id="tag"><text>2</text></g></defs>'
+        '<defs><g id="tag"><text>2</text></g><use id="again" href="#tag"/></defs>'
         '<use href="#logo" x="3" y="4"/><use href="#logo" x="13" y="4"/><use href="#tag"/>'
+        '<use href="#again" x="5"/>'  # a <use> of a <use>: its text shows too
     )
     drawing = read_svg(svg(tmp_path, body))
     assert len(drawing.contours) == 2  # the symbol's path, placed twice
     name = tmp_path / "t.svg"
-    assert f"{name}: skipped 3 <text> elements (convert text to paths" in "\n".join(
+    assert f"{name}: skipped 4 <text> elements (convert text to paths" in "\n".join(
         drawing.warnings
     )
     assert f"{name}: skipped 2 <image> elements (raster images" in "\n".join(drawing.warnings)
