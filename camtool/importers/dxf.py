@@ -16,6 +16,7 @@ from typing import Any
 
 from camtool.accel.collector import paused
 from camtool.geometry.arcfit import FIT_KERNELS
+from camtool.importers.dxf_damage import refuse_guessed_numbers
 from camtool.importers.dxf_entities import (
     ZERO_LENGTH,
     BadEntity,
@@ -147,9 +148,11 @@ def read_dxf(path: str | Path, options: ImportOptions | None = None) -> Drawing:
 
     Raises:
         InputError: the file is missing, empty, not a DXF file or damaged beyond
-            recovery; it uses an unknown ``$INSUNITS`` code; ``options.layers`` names a
-            layer the drawing does not have; or model space (on the selected layers)
-            holds nothing camtool can cut. The message names the file.
+            recovery (a coordinate that is not a number, such as ``2,5``: see
+            :func:`camtool.importers.dxf_damage.refuse_guessed_numbers`); it uses an
+            unknown ``$INSUNITS`` code; ``options.layers`` names a layer the drawing
+            does not have; or model space (on the selected layers) holds nothing
+            camtool can cut. The message names the file.
         UsageError: ``options.tolerance`` is not > 0.
     """
     return import_dxf(path, options).drawing
@@ -542,6 +545,7 @@ def _open(path: Path) -> tuple[Any, str | None, list[str]]:
                 f"mode failed ({_reason(exc)}); re-save or export it as DXF from the CAD "
                 "program"
             ) from None
+    refuse_guessed_numbers(path, messages)
     fixes = [f"fixed: {f.message}" for f in auditor.fixes]
     errors = [f"not fixed: {e.message}" for e in auditor.errors]
     return doc, _reason(first), messages + fixes + errors

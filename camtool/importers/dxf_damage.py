@@ -1,0 +1,127 @@
+"""Damage that ezdxf's recover mode can only guess at: numbers that are not numbers.
+
+Recover mode reads a number it cannot parse the way C's ``strtod`` does, up to the first
+character that does not belong (``recover.py``, ``_search_float``/``_search_int``):
+``"2,5"``, a decimal comma from a program that wrote the numbers in its user's
+language, becomes ``2.0``; ``"1.#QNAN"`` becomes ``1.0``. It logs each such guess as
+``recovered invalid floating point value "2,5" near line 80 as "2.0"``. A guessed
+coordinate of an entity would move the cut with nothing but a warning, so
+:func:`refuse_guessed_numbers` refuses the file when a guess lies in its ENTITIES or
+BLOCKS section. A guess in the header or the tables (``$EXTMIN``, a view) changes
+nothing camtool cuts, and stays a repair that ``camtool inspect`` lists.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from camtool.model.errors import InputError
+
+_GUESS = re.compile(
+    r'^recovered invalid (floating point|integer) value "(.*)" near line (\d+) as "(.*)"$'
+)
+_FLOAT = re.compile(r"[+-]?\d+(\.\d*)?([eE][+-]?\d+)?")
+_INT = re.compile(r"[+-]?\d+")
+HARMLESS_SECTIONS = frozenset({"HEADER", "CLASSES", "TABLES", "THUMBNAILIMAGE"})
+"""Sections whose numbers place nothing camtool cuts (ENTITIES, BLOCKS and OBJECTS do:
+an MLINE's style, for one, is an object)."""
+
+
+@dataclass(frozen=True)
+class Guess:
+    """One number recover mode guessed: the text in the file, its 1-based line, the guess."""
+
+    text: str
+    line: int
+    value: str
+
+
+def guesses(repairs: Sequence[str]) -> list[Guess]:
+    """The numbers among recover mode's repairs that were not numbers as written.
+
+    A value recover mode re-read although it was whole (the ``0`` beside a damaged
+    coordinate of the same point is re-read with it) is not a guess: only text with
+    more than a number in it (after white space is stripped) counts.
+    """
+    out = []
+    for message in repairs:
+        found = _GUESS.match(message)
+        if found is None:
+            continue
+        kind, text, line, value = found.groups()
+        number = _FLOAT if kind == "floating point" else _INT
+        if number.fullmatch(text.strip()) is None:
+            out.append(Guess(text, int(line), value))
+    return out
+
+
+def _places(path: Path, lines: set[int]) -> dict[int, tuple[str, str]]:
+    """For each of ``lines`` of an ASCII DXF file: its section and the entity it is in.
+
+    The file is read as pairs of lines (group code, value); a line's section is the
+    last ``0 SECTION`` / ``2 NAME`` before it, its entity the last ``0 TYPE`` tag.
+    """
+    places: dict[int, tuple[str, str]] = {}
+    section, entity = "", ""
+    last = max(lines)
+    code = b""
+    with path.open("rb") as f:
+        for number, raw in enumerate(f, start=1):
+            text = raw.strip()
+            if number % 2:
+                code = text
+            elif code == b"0":
+                entity = text.decode("ascii", "replace")
+            elif code == b"2" and entity == "SECTION":
+                section = text.decode("ascii", "replace").upper()
+            if number in lines:
+                places[number] = (section, entity)
+            if number >= last:
+                break
+    return places
+
+
+def refuse_guessed_numbers(path: Path, repairs: Sequence[str]) -> None:
+    """Refuse a DXF file whose entities hold a number recover mode had to guess.
+
+    Args:
+        path: the DXF file, read by ezdxf's recover mode.
+        repairs: the messages recover mode logged.
+
+    Raises:
+        InputError: a guessed number lies outside :data:`HARMLESS_SECTIONS` (or where
+            the section cannot be told); the message names the file, the line (as
+            recover mode counts it: near the number, not always on it), the
+            text, the entity and what recover mode would have made of it, and how
+            many such numbers there are.
+    """
+    found = guesses(repairs)
+    if not found:
+        return
+    places = _places(path, {g.line for g in found})
+    cut = [g for g in found if places.get(g.line, ("", ""))[0] not in HARMLESS_SECTIONS]
+    if not cut:
+        return
+    first = cut[0]
+    section, entity = places.get(first.line, ("", ""))
+    where = f" of a {entity} in the {section} section" if section and entity else ""
+    comma = "," in first.text
+    hint = (
+        " (a decimal comma: the program that wrote it used its language's number format; "
+        "a DXF file takes a decimal point)"
+        if comma
+        else ""
+    )
+    more = f"; {len(cut) - 1} more such number(s)" if len(cut) > 1 else ""
+    raise InputError(
+        f"{path}: near line {first.line}: {first.text!r}{where} is not a number{hint}; ezdxf's "
+        f"recover mode would read it as {first.value}, which would move the cut{more}."
+        + (
+            " Export the drawing again as DXF with decimal points"
+            if comma
+            else " Export the drawing again as DXF from the CAD program"
+        )
+    )
