@@ -150,6 +150,7 @@ def _check_checksum(raw: str, code: str, star_at: int, where: str) -> str:
     """Verify a RepRap ``*NN`` checksum and return ``code`` without it."""
     m = _CHECKSUM.search(code)
     if m is None:
+        _refuse_special("[" if "[" in code else "", code, where)  # '*' in an expression
         raise InputError(
             f"{where}: '*' must end the line followed by a checksum (e.g. '*71'): {code!r}"
         )
@@ -203,6 +204,7 @@ def _words_by_char(code: str, where: str) -> list[Word]:
         m = _NUMBER.match(code, i + 1)
         if m is None:
             _refuse_special(code[i + 1 : i + 2], code, where)
+            _refuse_special("[" if "[" in code[i:] else "", code, where)  # X SQRT[2], ...
             raise InputError(f"{where}: letter {c!r} is not followed by a number in {code!r}")
         value = float(m[0])
         if not abs(value) < LARGEST_VALUE:

@@ -332,6 +332,11 @@ def test_safe_conversion_warns_once_with_count_and_first_line(block: str, expect
         ("G1 X#1 F10", "'#' parameters"),
         ("#1 = 5", "'#' parameters"),
         ("G1 X[1+2] F10", "'[ ]' expressions"),
+        # LinuxCNC's own tests (tests/ccomp, tests/interp/bad): a '*' or a function name
+        # inside the brackets was named as a bad checksum or a letter without a number
+        ("G3 X1 Y0 R[.5*SQRT[2]] Z.5", "'[ ]' expressions"),
+        ("G0 X EXISTS[1]", "'[ ]' expressions"),
+        ("G2 X200 I[0.9985 * 100]", "'[ ]' expressions"),
         ("$H", "'$H' is a GRBL system command"),  # gSender's examples start so
         ("$32=1", "'$32=1' is a GRBL system command"),
         ("$J=G91 X10 F100", "'$J=G91X10F100' is a GRBL system command"),
