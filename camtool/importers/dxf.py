@@ -236,6 +236,14 @@ def _import(
             "numbers describe, the longer axis being the minor one (as ezdxf's auditor "
             "repairs it by swapping the axes); check it in the preview"
         )
+    if reader.redegreed:
+        label, declared, implied = reader.redegreed[0]
+        warnings.append(
+            f"{path}: {len(reader.redegreed)} SPLINE(s) whose knots and control points make "
+            f"another degree than the one they declare (first {label}: declared {declared}, "
+            f"its data that of degree {implied}): read at the degree of their data, the one "
+            "curve those numbers describe; check it in the preview"
+        )
     if not reader.contours and not reader.marks:
         on = f" on layers {', '.join(options.layers)}" if options.layers else ""
         raise InputError(
@@ -334,6 +342,7 @@ class _Reader:
         self.converted = False  # an entity went through the converters (and the tolerance)
         self.invisible = 0  # entities left out for their invisible flag (group code 60)
         self.swapped: list[tuple[str, float]] = []  # ELLIPSEs with a ratio above 1
+        self.redegreed: list[tuple[str, int, int]] = []  # SPLINEs read at another degree
 
     def read(self, entity: Any) -> None:
         from camtool.importers.dxf_blocks import HIDDEN, INVISIBLE, Skip, expand_insert
@@ -415,6 +424,7 @@ class _Reader:
             check_centres,
             check_numbers,
             convert,
+            implied_degree,
             swapped_axes,
         )
 
@@ -438,6 +448,9 @@ class _Reader:
             check_numbers(part, item.label, item.layer, self.limit)
         if swapped_axes(item.entity):
             self.swapped.append((item.label, float(item.entity.dxf.ratio)))
+        implied = implied_degree(item.entity)
+        if implied is not None:
+            self.redegreed.append((item.label, int(item.entity.dxf.degree), implied))
         self.converted = True
         try:
             contours = convert(item, self.tolerance, self.limit)

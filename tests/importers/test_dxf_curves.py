@@ -167,6 +167,47 @@ def test_rational_spline_circle_fits_as_its_circle(tmp_path: Path) -> None:
             assert math.hypot(*seg.point_at(k / 16)) == pytest.approx(10.0, abs=TOL)
 
 
+def _circle_as_degree(msp: Any, declared: int, knots: list[float] | None = None) -> None:
+    """A NURBS full circle of radius 10 at (5, 5) (9 control points, the quadratic's
+    12 knots, weights 1 and √2/2), its degree written as ``declared``."""
+    w = math.sqrt(0.5)
+    corners = [(15, 5), (15, 15), (5, 15), (-5, 15), (-5, 5), (-5, -5), (5, -5), (15, -5), (15, 5)]
+    spline = msp.add_rational_spline(
+        [(x, y, 0) for x, y in corners], [1, w, 1, w, 1, w, 1, w, 1], degree=2
+    )
+    spline.knots = knots or [0, 0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 4]
+    spline.dxf.degree = declared
+
+
+def test_a_quadratic_written_as_degree_3_is_read_as_its_circle(tmp_path: Path) -> None:
+    """dxf-parser's ``arcs-as-splines.dxf`` writes its circles so; ezdxf refuses them (12
+    knots where degree 3 needs 13) and camtool skipped them with a warning."""
+    d = read_dxf(write_dxf(tmp_path / "c.dxf", lambda m: _circle_as_degree(m, 3)))
+    (contour,) = d.contours
+    assert contour.closed and all(isinstance(seg, Arc) for seg in contour.segments)
+    for seg in contour.segments:
+        for k in range(17):
+            x, y = seg.point_at(k / 16)
+            assert math.hypot(x - 5, y - 5) == pytest.approx(10.0, abs=TOL)
+    assert contour.length == pytest.approx(20 * math.pi, abs=2 * TOL)
+    (warning,) = [w for w in d.warnings if "SPLINE" in w]
+    assert "declared 3, its data that of degree 2" in warning
+
+
+def test_counts_that_imply_no_clamped_degree_stay_invalid(tmp_path: Path) -> None:
+    """12 knots of 9 control points imply degree 2, but these do not start with three equal
+    knots: no one curve is described, and the SPLINE is skipped as before."""
+    knots = [0, 0, 0.5, 1, 1, 2, 2, 3, 3, 4, 4, 4]
+
+    def build(msp: Any) -> None:
+        msp.add_line((0, 0), (1, 0))
+        _circle_as_degree(msp, 3, knots)
+
+    d = read_dxf(write_dxf(tmp_path / "c.dxf", build))
+    assert len(d.contours) == 1
+    assert any("skipped 1 SPLINE entity (invalid spline data)" in w for w in d.warnings)
+
+
 def test_spline_with_a_corner_knot_keeps_the_corner(tmp_path: Path) -> None:
     # degree 2 with a double inner knot: the curve passes the middle control point
     # with a corner there (C0); the fit must hold around it.
