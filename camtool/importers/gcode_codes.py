@@ -374,4 +374,4 @@ class CommandReader:
             self.add(index, Spindle("off"))
             return
         self.direction = "cw" if name == "M3" else "ccw"
-        self.add(index, Spindle(self.direction, self.rpm or 0.0))
+        self.add(index, Spindle(self.direction, self.rpm))

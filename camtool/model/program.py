@@ -66,11 +66,13 @@ SpindleDirection: TypeAlias = Literal["cw", "ccw", "off"]
 class Spindle:
     """Spindle on clockwise (M03), counter-clockwise (M04) or off (M05).
 
-    ``rpm`` is the programmed speed, rev/min (ignored when ``direction`` is "off").
+    ``rpm`` is the programmed speed, rev/min (ignored when ``direction`` is "off"); 0 is a
+    speed (``S0``: a laser's power off while M4 stays on), ``None`` none programmed: the
+    speed in force stays.
     """
 
     direction: SpindleDirection
-    rpm: float = 0.0
+    rpm: float | None = None
 
 
 @dataclass(frozen=True)

@@ -162,7 +162,7 @@ class BlockReader:
             self._only(codes, values, key, "a spindle", needs="S" if "S" in values else "")
             if direction == "off" and "S" in values:
                 raise self.fail(f"S in a spindle-off block ({key})")
-            s.commands.append((len(s.moves), Spindle(direction, values.get("S", 0.0))))
+            s.commands.append((len(s.moves), Spindle(direction, values.get("S"))))
         elif key is not None and key == spec.dwell:
             self._only(codes, values, key, "a dwell", needs="P")
             s.commands.append((len(s.moves), Dwell(values["P"])))

@@ -540,13 +540,14 @@ class BlockWriter(ArcWriter):
                 return
             self.spindle = None if command.direction == "off" else command
             words = [code]
-            if command.direction != "off" and spec.has("S") and command.rpm > 0:
-                hint = " (give a faster --spindle-rpm, or the tool's rpm in the job file)"
-                words.append(
-                    "S" + self._above_zero("S", command.rpm, "spindle speed", "rev/min", hint)
-                )
-            elif command.direction != "off" and command.rpm > 0:
+            rpm = None if command.direction == "off" else command.rpm
+            if rpm is not None and not spec.has("S"):
                 self.counts["speed"] += 1
+            elif rpm == 0:  # S0 as programmed: a laser's power off with M4 still on
+                words.append("S" + self.text("S", 0.0))
+            elif rpm is not None:
+                hint = " (give a faster --spindle-rpm, or the tool's rpm in the job file)"
+                words.append("S" + self._above_zero("S", rpm, "spindle speed", "rev/min", hint))
             self.block(words)
         elif isinstance(command, Dwell):
             if spec.dwell is None:

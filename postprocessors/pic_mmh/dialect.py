@@ -619,15 +619,18 @@ def _halves(start: tuple[float, float], move: ArcMove) -> list[ArcMove]:
 def _spindle(command: Spindle, where: str, w: _Writer) -> str | None:
     """``M03S####;`` / ``M04S####;`` (rev/min rounded half up), ``M05;``, or ``None``.
 
-    ``None`` (with a warning) for a spindle started without a speed (0 rev/min).
+    ``None`` (with a warning) for a spindle started without a speed (a bare M3).
+
+    Raises:
+        DialectError: a speed outside 1–9999 rev/min once rounded (``S0`` included).
     """
     if command.direction == "off":
         return "M05;"
     rpm = command.rpm
-    if rpm == 0:
+    if rpm is None:
         w.note(
             "rpm-none",
-            f"{where}: spindle on without a speed (0 rev/min, e.g. a bare M3) dropped: "
+            f"{where}: spindle on without a speed (a bare M3) dropped: "
             "M03S####/M04S#### needs 1–9999 rev/min; give the speed with S in the program",
         )
         return None

@@ -100,7 +100,7 @@ def test_flashcut_n_words_comments_and_m_codes_are_tolerated() -> None:
     )
     assert [type(m) for m in program.moves] == [Rapid, Linear, Linear]
     assert program.moves[-1] == Linear(2.0, 2.0, 3.0, contour=1)
-    assert program.commands[1:3] == ((2, Stop()), (2, Spindle("ccw", 0.0)))  # M00: kept
+    assert program.commands[1:3] == ((2, Stop()), (2, Spindle("ccw")))  # M00: kept
 
 
 def test_flashcut_missing_axis_word_keeps_its_value() -> None:

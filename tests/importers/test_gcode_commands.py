@@ -68,7 +68,7 @@ def test_s_changes_a_turning_spindle_only() -> None:
 def test_bare_m3_has_no_speed_and_no_warning() -> None:
     # Gcodetools writes `M3` without S (tests/data/gcodetools-circle.ngc, Munoz-22 §3.3).
     program = read_gcode(DATA / "gcodetools-circle.ngc")
-    assert program.commands == ((0, Spindle("cw", 0.0)), (7, Spindle("off")))
+    assert program.commands == ((0, Spindle("cw")), (7, Spindle("off")))  # rpm None
     assert program.warnings == ()
 
 

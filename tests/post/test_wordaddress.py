@@ -583,7 +583,7 @@ decimals = 1
     back = target.post.parse(result.code)
     for got, want in zip(back.moves, program.moves, strict=True):
         assert math.dist((got.x, got.y), (want.x, want.y)) < 1e-9
-    assert back.commands == ((0, Spindle("cw", 0.0)), (3, Spindle("off")))
+    assert back.commands == ((0, Spindle("cw")), (3, Spindle("off")))
 
 
 # -- comments, header and footer (job notes) ------------------------------------------------
@@ -650,7 +650,7 @@ def test_a_spindle_without_a_speed_writes_no_s0() -> None:
     lines, _ = emit(RS274, (Rapid(1, 1),), commands=((0, Spindle("cw")),))
     assert lines[1] == "M3"
     back = post(RS274).parse("\n".join(lines) + "\n")
-    assert back.commands[0] == (0, Spindle("cw", 0.0))
+    assert back.commands[0] == (0, Spindle("cw"))  # no speed: None
 
 
 def test_grbl_writes_an_arc_within_half_its_arc_tolerance_as_a_line() -> None:
