@@ -547,7 +547,11 @@ class BlockWriter(ArcWriter):
                 words.append("S" + self.text("S", 0.0))
             elif rpm is not None:
                 hint = " (give a faster --spindle-rpm, or the tool's rpm in the job file)"
-                words.append("S" + self._above_zero("S", rpm, "spindle speed", "rev/min", hint))
+                text = self._above_zero("S", rpm, "spindle speed", "rev/min", hint)
+                word = spec.word("S")
+                if word is not None and word.number.parse(text) != rpm:
+                    self.warn(f"spindle speed {rpm:g} rev/min written as S{text}")
+                words.append("S" + text)
             self.block(words)
         elif isinstance(command, Dwell):
             if spec.dwell is None:

@@ -117,16 +117,20 @@ def test_a_byte_order_mark_is_read_as_utf8(run: Any, tmp_path: Path) -> None:
 
 
 def test_a_spindle_speed_that_rounds_to_s0_is_refused(run: Any, tmp_path: Path) -> None:
-    # GRBL writes S with 0 decimals: 0.3 rev/min would be "M3 S0", a spindle that does
-    # not turn under a tool that cuts. Refused, nothing written; 0.6 rounds to S1.
+    # GRBL writes S with 3 decimals: 0.0003 rev/min would be "M3 S0", a spindle that does
+    # not turn under a tool that cuts. Refused, nothing written; 0.0006 rounds to S0.001,
+    # with a warning; 0.6 is written as it is (GRBL reads S as a float: a laser's power).
     out = tmp_path / "out.gcode"
     args = ("post", LOGO, "-t", "grbl", "--depth", "1", "-o", str(out))
-    code, err = run(*args, "--spindle-rpm", "0.3")
+    code, err = run(*args, "--spindle-rpm", "0.0003")
     assert code != 0 and "rounds to S0" in err and "--spindle-rpm" in err
     assert "internal error" not in err and not out.exists()
-    code, err = run(*args, "--spindle-rpm", "0.6")
+    code, err = run(*args, "--spindle-rpm", "0.0006")
     assert code == 0, err
-    assert "M3 S1\n" in out.read_text()
+    assert "M3 S0.001\n" in out.read_text()
+    assert "spindle speed 0.0006 rev/min written as S0.001" in err
+    code, err = run(*args, "--spindle-rpm", "0.6")
+    assert code == 0 and "M3 S0.6\n" in out.read_text() and "written as S" not in err
 
 
 @pytest.mark.parametrize("lift", ["1e308", "1001"])
@@ -161,11 +165,11 @@ def test_an_i8751_lift_of_more_steps_than_a_record_holds_is_refused(
 
 
 def test_a_job_tools_speed_that_rounds_to_s0_is_refused(run: Any, tmp_path: Path) -> None:
-    # samples/part.toml with its end mill at 0.3 rev/min: "M3 S0" before its first cut.
+    # samples/part.toml with its end mill at 0.0003 rev/min: "M3 S0" before its first cut.
     job = (ROOT / "samples" / "part.toml").read_text()
     assert "rpm = 10000" in job
     path = tmp_path / "slow.toml"
-    path.write_text(job.replace("rpm = 10000", "rpm = 0.3", 1))
+    path.write_text(job.replace("rpm = 10000", "rpm = 0.0003", 1))
     out = tmp_path / "out.gcode"
     code, err = run(
         "post", str(ROOT / "samples" / "part.dxf"), "-t", "grbl", "--job", str(path), "-o", str(out)
