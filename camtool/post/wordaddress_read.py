@@ -19,6 +19,7 @@ from camtool.model.program import (
     ArcMove,
     Command,
     Dwell,
+    Home,
     Linear,
     Move,
     Program,
@@ -84,6 +85,8 @@ class BlockReader:
         self.codes = set(self.motions) | set(self.spindle) | set(spec.end) | self.static
         self.codes |= {c for c in (spec.dwell, spec.tool_change) if c}
         self.codes |= {c for c in (spec.tool_length_offset, spec.stop, spec.optional_stop) if c}
+        if spec.home:
+            self.codes |= {spec.home, "G90", "G91"}
 
     def fail(self, text: str) -> ParseError:
         """A ParseError naming the source and line."""
@@ -154,6 +157,8 @@ class BlockReader:
             raise self.fail(f"no word in {raw!r}")
         static = self.static
         key = next((c for c in codes if c not in self.motions and c not in static), None)
+        if spec.home is not None and spec.home in codes:
+            key = spec.home  # G91 G28 Z0: the G91 is the return's
         if key in spec.end:
             self._only(codes, values, key, "the program end")
             s.ended = self.line
@@ -174,6 +179,8 @@ class BlockReader:
         elif key is not None and key == spec.tool_length_offset:
             self._only(codes, values, key, "a tool length offset", needs="H")
             self._offset_after_change(round(values["H"]))
+        elif key is not None and key == spec.home:
+            self._home(codes, values, key)
         elif key is not None and key in (spec.stop, spec.optional_stop):
             self._only(codes, values, key, "a program stop")
             optional = key == spec.optional_stop and key != spec.stop
@@ -240,6 +247,19 @@ class BlockReader:
                 f"{letter}{shown} is not in the format of {letter} (e.g. {letter}{example})"
             )
         return value
+
+    def _home(self, codes: list[str], values: dict[str, float], key: str) -> None:
+        """``G28`` alone (all three axes) or ``G91 G28`` with the axes it names at 0."""
+        axes = "".join(a for a in "XYZ" if a in values)
+        incremental = codes == ["G91", key]
+        if codes not in (["G91", key], [key]) or set(values) - set("XYZ"):
+            raise self.fail(f"a return to the stored position is G91 {key} Z0 or {key} alone")
+        if incremental != bool(axes) or any(values[a] != 0.0 for a in axes):
+            raise self.fail(
+                f"{key} goes through the point where the tool is: G91 {key} with axis words "
+                f"at 0, or {key} alone"
+            )
+        self.state.commands.append((len(self.state.moves), Home(axes or "XYZ")))
 
     def _offset_after_change(self, tool: int) -> None:
         """The length offset (``G43 H<n>``) the writer puts right after a change to tool n."""

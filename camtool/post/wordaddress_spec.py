@@ -32,6 +32,8 @@ MODAL_LETTERS = "GXYZF"
 """Letters ``modal`` may name (``G`` = the motion code)."""
 
 ARC_CENTRES = ("incremental", "absolute")
+HOMES = ("G28",)
+"""The return to the stored position a dialect may write (RS-274's; GRBL and LinuxCNC)."""
 FULL_CIRCLES = ("one-block", "split")
 Z_MOVES = ("own-block", "with-xy", "none")
 ARC_CHECKS = ("none", "grbl", "linuxcnc")
@@ -115,6 +117,11 @@ class WordAddressSpec:
         work_offsets: the work offset codes the controller has (``G54`` … ``G59.3``): a
             program read from code that selects one keeps it (written before its first
             move); ``()``: a program runs in the work offset the user has active.
+        home: ``"G28"``: a program read from code keeps its returns to the machine's
+            stored position (:class:`~camtool.model.program.Home`), written as RS-274
+            writes them: ``G91 G28 Z0`` then ``G90`` for the axes one names (the
+            intermediate point where the tool is), ``G28`` alone for all three;
+            ``None``: they are dropped, with a warning.
         stop: program stop code (``M0``): the machine waits for the operator. A
             dialect with a stop and comments but no ``tool_change`` changes tools by
             hand: a comment naming the tool, then the stop (GRBL 1.1).
@@ -157,6 +164,7 @@ class WordAddressSpec:
     tool_change: str | None = None
     tool_length_offset: str | None = None
     work_offsets: tuple[str, ...] = ()
+    home: str | None = None
     stop: str | None = None
     optional_stop: str | None = None
     end: tuple[str, ...] = ()
@@ -356,6 +364,7 @@ def load_spec(options: Mapping[str, Any], where: str) -> WordAddressSpec:
         comment=t.string("comment", None, choices=COMMENTS),
         header=tuple(t.strings("header")),
         footer=tuple(t.strings("footer")),
+        home=t.string("home", None, choices=HOMES),
         **codes,
     )
     t.done()
@@ -504,6 +513,8 @@ def _check(spec: WordAddressSpec, t: _Table) -> None:
         )
     if spec.dwell and not spec.has("P"):
         raise t.error("dwell", "a dwell code needs a P word (seconds) in words")
+    if spec.home and not (spec.rs274 and all(spec.has(c) for c in "XYZ")):
+        raise t.error("home", "G28 (written G91 G28 Z0, as RS-274) needs rs274 = true and X, Y, Z")
     if spec.tool_change and not spec.has("T"):
         raise t.error("tool_change", "a tool change code needs a T word in words")
     if spec.tool_length_offset and not (spec.tool_change and spec.has("H")):
@@ -515,7 +526,7 @@ def _check(spec: WordAddressSpec, t: _Table) -> None:
     roles = [*spec.motion_codes, *spec.end]
     roles += [c for c in (spec.spindle_cw, spec.spindle_ccw, spec.spindle_off) if c]
     roles += [c for c in (spec.dwell, spec.tool_change, spec.tool_length_offset) if c]
-    roles += [c for c in (spec.stop, spec.optional_stop) if c]
+    roles += [c for c in (spec.stop, spec.optional_stop, spec.home) if c]
     if len(set(roles)) != len(roles):
         twice = sorted({c for c in roles if roles.count(c) > 1})
         raise t.error("", f"code(s) {', '.join(twice)} given two meanings")

@@ -566,8 +566,29 @@ class BlockWriter(ArcWriter):
             self._length_offset(command)
         elif isinstance(command, WorkOffset) and command.code in self.spec.work_offsets:
             self.block([command.code])
+        elif isinstance(command, Home) and spec.home is not None:
+            self._home(command.axes, spec.home)
         elif isinstance(command, Home | WorkOffset):
             self.drop(command)
+
+    def _home(self, axes: str, code: str) -> None:
+        """A return to the stored position: ``G91 G28 Z0``, ``G90`` (``G28`` for XYZ).
+
+        RS-274 writes it so, through the point where the tool is.
+
+        A program's ``G28 G91 Z0`` before its first move is its retract: dropped, the
+        first rapid would run at whatever height the tool was left. The axes it moves
+        are written again in the next move that gives them.
+        """
+        if axes == "XYZ":
+            self.block([code])
+        else:
+            self.block(["G91", code, *(a + self.text(a, 0.0) for a in axes)])
+            self.block(["G90"])
+        for axis in axes:
+            self.last.pop(axis, None)
+        if "Z" in axes:
+            self.z = None
 
     def _length_offset(self, offset: LengthOffset) -> None:
         """``G43 H1`` or ``G49`` where a program read from code had it; the next Z again.
