@@ -7,6 +7,7 @@ Design notes: docs/internals.md, ``camtool/importers/gcode_codes.py``.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Literal
@@ -15,6 +16,8 @@ from camtool.importers.gcode_lexer import Block, Word
 from camtool.model.errors import InputError
 from camtool.model.program import (
     Command,
+    Coolant,
+    CoolantState,
     Dwell,
     Spindle,
     SpindleDirection,
@@ -157,14 +160,19 @@ M_CODES = MappingProxyType(
         ("M3 M4 M5", "spindle", "read", ""),
         ("M0 M1", "stop", "read", ""),
         ("M6", "tool", "read", ""),
-        ("M7 M8 M9", "coolant", "warn", "coolant {code} ignored"),
+        ("M7 M8 M9", "coolant", "read", ""),
     )
 )
 """M codes by number, read-only."""
 
+COOLANT_STATES: Mapping[str, CoolantState] = MappingProxyType(
+    {"M7": "mist", "M8": "flood", "M9": "off"}
+)
+"""The coolant codes and the state each sets."""
+
 READ_CODES = (
     "G0 G1 G2 G3 G4 G17 G18 G19 G20 G21 G28 G30 G53 G80 G90 G91 G90.1 G91.1 G94 "
-    "M0 M1 M2 M3 M4 M5 M6 M30"
+    "M0 M1 M2 M3 M4 M5 M6 M7 M8 M9 M30"
 )
 """What camtool reads, for messages about unknown codes."""
 
@@ -295,7 +303,7 @@ class CommandReader:
         self.commands.append((index, command))
 
     def block(self, w: BlockWords, index: int, line: int, where: str) -> None:
-        """Read the S, T, M6, M3/M4/M5 and G4 words of one block (before its motion).
+        """Read the S, T, M6, M3/M4/M5, M7/M8/M9 and G4 words of one block (before its motion).
 
         Args:
             w: the block's words.
@@ -322,6 +330,8 @@ class CommandReader:
             self._change(index, line)
         if spindle is not None:
             self._spindle(spindle.name, index)
+        if (coolant := w.m.get("coolant")) is not None:  # after the spindle (RS-274 order)
+            self.add(index, Coolant(COOLANT_STATES[coolant.name]))
         if w.g_name("nonmodal") == "G4":
             p = w.args.get("P")
             if p is None or p.value < 0:

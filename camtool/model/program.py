@@ -75,6 +75,20 @@ class Spindle:
     rpm: float | None = None
 
 
+CoolantState: TypeAlias = Literal["mist", "flood", "off"]
+"""Coolant mist (M7), flood (M8; a laser's air assist), or off (M9)."""
+
+
+@dataclass(frozen=True)
+class Coolant:
+    """Coolant on, mist (M07) or flood (M08), or off (M09), as a program read from code had it.
+
+    A laser's air assist is M08 (LightBurn, LaserGRBL): dropped, the material burns.
+    """
+
+    state: CoolantState
+
+
 @dataclass(frozen=True)
 class Dwell:
     """Wait ``seconds`` before the next move (G04)."""
@@ -277,7 +291,16 @@ class PlaneArc:
 
 
 Command: TypeAlias = (
-    Spindle | Dwell | ToolChange | LengthOffset | WorkOffset | Stop | DrillCycle | Home | PlaneArc
+    Spindle
+    | Coolant
+    | Dwell
+    | ToolChange
+    | LengthOffset
+    | WorkOffset
+    | Stop
+    | DrillCycle
+    | Home
+    | PlaneArc
 )
 """A non-motion instruction (see :attr:`Program.commands`)."""
 

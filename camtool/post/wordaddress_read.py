@@ -18,6 +18,8 @@ from camtool.model.errors import DialectError, ParseError
 from camtool.model.program import (
     ArcMove,
     Command,
+    Coolant,
+    CoolantState,
     Dwell,
     Home,
     Linear,
@@ -81,8 +83,15 @@ class BlockReader:
             (spec.spindle_off, "off"),
         )
         self.spindle = {code: direction for code, direction in pairs if code}
+        coolant: tuple[tuple[str | None, CoolantState], ...] = (
+            (spec.coolant_mist, "mist"),
+            (spec.coolant_flood, "flood"),
+            (spec.coolant_off, "off"),
+        )
+        self.coolant = {code: state for code, state in coolant if code}
         self.static = spec.static_codes()
         self.codes = set(self.motions) | set(self.spindle) | set(spec.end) | self.static
+        self.codes |= set(self.coolant)
         self.codes |= {c for c in (spec.dwell, spec.tool_change) if c}
         self.codes |= {c for c in (spec.tool_length_offset, spec.stop, spec.optional_stop) if c}
         if spec.home:
@@ -168,6 +177,9 @@ class BlockReader:
             if direction == "off" and "S" in values:
                 raise self.fail(f"S in a spindle-off block ({key})")
             s.commands.append((len(s.moves), Spindle(direction, values.get("S"))))
+        elif key in self.coolant:
+            self._only(codes, values, key, "a coolant")
+            s.commands.append((len(s.moves), Coolant(self.coolant[key])))
         elif key is not None and key == spec.dwell:
             self._only(codes, values, key, "a dwell", needs="P")
             s.commands.append((len(s.moves), Dwell(values["P"])))

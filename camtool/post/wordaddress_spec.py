@@ -32,6 +32,8 @@ MODAL_LETTERS = "GXYZF"
 """Letters ``modal`` may name (``G`` = the motion code)."""
 
 ARC_CENTRES = ("incremental", "absolute")
+COOLANT_KEYS = ("coolant_mist", "coolant_flood", "coolant_off")
+"""The spec keys of the coolant codes: mist (M7), flood (M8), off (M9)."""
 HOMES = ("G28",)
 """The return to the stored position a dialect may write (RS-274's; GRBL and LinuxCNC)."""
 FULL_CIRCLES = ("one-block", "split")
@@ -110,6 +112,11 @@ class WordAddressSpec:
         spindle_cw: code that starts the spindle clockwise (``None``: none).
         spindle_ccw: code that starts it counter-clockwise.
         spindle_off: code that stops it.
+        coolant_mist: code that turns mist coolant on (``M7``; ``None``: none).
+        coolant_flood: code that turns flood coolant on (``M8``; a laser's air assist).
+        coolant_off: code that turns coolant off (``M9``). A program read from code keeps
+            its coolant commands where the dialect has the code; the others are dropped,
+            with a warning.
         dwell: dwell code, followed by the P word (seconds).
         tool_change: tool change code; the block is ``T<n> <code>`` (LinuxCNC ``T2 M6``).
         tool_length_offset: code that applies the new tool's length offset after a
@@ -160,6 +167,9 @@ class WordAddressSpec:
     spindle_cw: str | None = None
     spindle_ccw: str | None = None
     spindle_off: str | None = None
+    coolant_mist: str | None = None
+    coolant_flood: str | None = None
+    coolant_off: str | None = None
     dwell: str | None = None
     tool_change: str | None = None
     tool_length_offset: str | None = None
@@ -404,7 +414,7 @@ def _codes(t: _Table) -> dict[str, Any]:
         if not code.startswith("G"):
             raise motion.error(m, f"a motion code is a G code, got {_show(code)}")
     out: dict[str, Any] = {"motion_codes": spelled}
-    keys = ("spindle_cw", "spindle_ccw", "spindle_off", "dwell", "tool_change")
+    keys = ("spindle_cw", "spindle_ccw", "spindle_off", "dwell", "tool_change", *COOLANT_KEYS)
     for key in (*keys, "tool_length_offset", "stop", "optional_stop"):
         value = t.get(key)
         out[key] = None if value is None else _code(t, key, value)
@@ -521,12 +531,15 @@ def _check(spec: WordAddressSpec, t: _Table) -> None:
         raise t.error(
             "tool_length_offset", "a tool length offset needs tool_change and an H word in words"
         )
+    if (spec.coolant_mist or spec.coolant_flood) and not spec.coolant_off:
+        raise t.error("coolant_off", "coolant that can be turned on needs a code that turns it off")
     if spec.optional_stop and not spec.stop:
         raise t.error("optional_stop", "an optional stop needs a stop code (stop)")
     roles = [*spec.motion_codes, *spec.end]
     roles += [c for c in (spec.spindle_cw, spec.spindle_ccw, spec.spindle_off) if c]
     roles += [c for c in (spec.dwell, spec.tool_change, spec.tool_length_offset) if c]
     roles += [c for c in (spec.stop, spec.optional_stop, spec.home) if c]
+    roles += [c for c in (spec.coolant_mist, spec.coolant_flood, spec.coolant_off) if c]
     if len(set(roles)) != len(roles):
         twice = sorted({c for c in roles if roles.count(c) > 1})
         raise t.error("", f"code(s) {', '.join(twice)} given two meanings")

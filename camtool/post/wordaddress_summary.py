@@ -20,9 +20,9 @@ def closing_warnings(
     Args:
         spec: the dialect (its name, codes, quantum and step grids).
         counts: what the writer counted, by kind (``"feed"``, ``"Spindle"``, ``"speed"``,
-            ``"Dwell"``, ``"ToolChange"``, ``"Home"``, ``"z-split"``, ``"arc-chords"``,
-            ``"far-centre"``, ``"plane-chords"``, ``"tiny-arc"``); kinds not counted give no
-            warning.
+            ``"Coolant"``, ``"Dwell"``, ``"ToolChange"``, ``"Home"``, ``"z-split"``,
+            ``"arc-chords"``, ``"far-centre"``, ``"plane-chords"``, ``"tiny-arc"``); kinds
+            not counted give no warning.
         grid_error_mm: the largest change of a coordinate rounded to a step grid, mm.
         chord_tolerance_mm: the chord deviation allowed to an arc written as chords, mm
             (at least twice the dialect's quantum).
@@ -37,6 +37,8 @@ def closing_warnings(
         "dropped; switch the spindle (or tool) on and off by hand",
         "speed": f"{name}'s {spec.spindle_cw or spec.spindle_ccw} takes no S "
         f"word: {d['speed']} spindle speed(s) not written; set the speed on the machine",
+        "Coolant": f"{name} has no code for {d['Coolant']} coolant command(s) (M7 mist, M8 "
+        "flood or a laser's air assist, M9 off): dropped; switch it by hand",
         "Dwell": f"{name} has no dwell: {d['Dwell']} pause(s) dropped",
         "ToolChange": f"{name} has no tool change: {d['ToolChange']} tool change(s) "
         "dropped; change tools by hand",

@@ -20,6 +20,7 @@ from camtool.model.program import (
     PLANE_AXES,
     ArcMove,
     Command,
+    Coolant,
     Dwell,
     Home,
     LengthOffset,
@@ -553,6 +554,14 @@ class BlockWriter(ArcWriter):
                     self.warn(f"spindle speed {rpm:g} rev/min written as S{text}")
                 words.append("S" + text)
             self.block(words)
+        elif isinstance(command, Coolant):
+            code = {"mist": spec.coolant_mist, "flood": spec.coolant_flood}.get(
+                command.state, spec.coolant_off
+            )
+            if code is None:
+                self.drop(command)
+            else:
+                self.block([code])
         elif isinstance(command, Dwell):
             if spec.dwell is None:
                 self.drop(command)

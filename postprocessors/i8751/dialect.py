@@ -18,6 +18,7 @@ from camtool.model.machine import Machine
 from camtool.model.program import (
     ArcMove,
     Command,
+    Coolant,
     Dwell,
     Home,
     Linear,
@@ -145,6 +146,7 @@ _DROPPED = {
     Spindle: "spindle command(s): the interface drives only the three axis motors",
     ToolChange: "tool change(s): the interface has no tool changer",
     Home: "home command(s): homing is only proposed in the thesis (Intf8751 §6)",
+    Coolant: "coolant command(s): the interface drives only the three axis motors",
 }
 
 

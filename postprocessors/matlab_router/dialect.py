@@ -59,6 +59,7 @@ COMMAND_REASONS = {
     "Dwell": "the GUI has no pause; the master stops at every vertex anyway",
     "ToolChange": "the router has one tool, changed by hand",
     "Home": "every job homes Z, X and Y before it starts (Angel-11 §2.8 st=0)",
+    "Coolant": "the router has no coolant; switch it by hand",
 }
 """Why each kind of :data:`~camtool.model.program.Command` is not written."""
 

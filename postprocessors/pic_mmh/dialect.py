@@ -22,6 +22,7 @@ from camtool.model.machine import Machine
 from camtool.model.program import (
     ArcMove,
     Command,
+    Coolant,
     DrillCycle,
     Dwell,
     Home,
@@ -519,6 +520,12 @@ class PicMmhPost(PostProcessor):
             raise DialectError(f"{where}: pic-mmh has no program stop (M0/M1)")
         elif isinstance(command, LengthOffset | WorkOffset):
             w.drop(command)  # refused: the program's numbers are in an offset pic-mmh lacks
+        elif isinstance(command, Coolant):
+            w.note(
+                "coolant",
+                f"{where}: coolant {command.state} dropped: pic-mmh has no coolant code "
+                "(UNAM-GMM Tabla 22); switch it by hand",
+            )
         else:
             blocks = _home(command, where)
             w.blocks.extend(blocks)
