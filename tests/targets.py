@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
+from pathlib import Path
+
 from camtool.post.registry import list_targets
 
 _BUILTIN = [e for e in list_targets() if e.origin == "builtin" and e.target is not None]
@@ -11,3 +15,13 @@ TARGETS: tuple[str, ...] = tuple(e.name for e in _BUILTIN)
 
 EXTENSIONS: dict[str, str] = {e.name: e.target.post.suffix for e in _BUILTIN if e.target}
 """The default output format's file ending of each built-in target."""
+
+
+def post_cli(source: Path, target: str, out: Path) -> subprocess.CompletedProcess[str]:
+    """``camtool post SOURCE -t TARGET -o OUT`` as a user runs it (a process of its own)."""
+    return subprocess.run(
+        [sys.executable, "-m", "camtool", "post", str(source), "-t", target, "-o", str(out)],
+        capture_output=True,
+        text=True,
+        check=False,
+    )

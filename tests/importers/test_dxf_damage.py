@@ -11,8 +11,6 @@ refused.
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -22,6 +20,7 @@ from camtool.importers.dxf_damage import guesses
 from camtool.model.errors import InputError
 from camtool.model.shapes import Line
 from tests.shapes import write_dxf
+from tests.targets import post_cli
 
 
 def _square(msp: object) -> None:
@@ -110,12 +109,7 @@ def test_post_writes_nothing_for_such_a_file(tmp_path: Path) -> None:
     good = write_dxf(tmp_path / "square.dxf", _square)
     bad = _replace_value(good, "20", "2.5", "2,5", "LWPOLYLINE")
     out = tmp_path / "square.nc"
-    run = subprocess.run(
-        [sys.executable, "-m", "camtool", "post", str(bad), "-t", "grbl", "-o", str(out)],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
+    run = post_cli(bad, "grbl", out)
     assert run.returncode == 3, run.stderr
     assert "is not a number" in run.stderr and "Traceback" not in run.stderr
     assert not out.exists()

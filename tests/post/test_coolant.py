@@ -10,8 +10,6 @@ it makes between the moves, for the original and for camtool's program.
 from __future__ import annotations
 
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -20,6 +18,7 @@ from camtool.importers import gcode
 from camtool.model.program import Coolant, Linear, Program, Rapid
 from camtool.post.registry import load_target
 from tests.corpus.test_rs274 import needs_rs274, rs274
+from tests.targets import post_cli
 
 PROGRAM = (
     "G21 G90\nM3 S1000\nM8\nG0 X1 Y1\nG1 X5 F300\nM7\nG1 Y5\nM9\nG1 X1\nM8\nG1 Y1\nM9\nM5\nM2\n"
@@ -79,12 +78,7 @@ def test_linuxcnc_re_post_switches_the_coolant_where_the_original_did(tmp_path: 
     original = tmp_path / "coolant.ngc"
     original.write_text(PROGRAM)
     out = tmp_path / "out.ngc"
-    done = subprocess.run(
-        [sys.executable, "-m", "camtool", "post", str(original), "-t", "linuxcnc", "-o", str(out)],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
+    done = post_cli(original, "linuxcnc", out)
     assert done.returncode == 0, done.stderr
     want = _calls(original)
     assert want.count("FLOOD_ON") == 2 and want.count("MIST_ON") == 1

@@ -12,8 +12,6 @@ returns' traverses included.
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -23,6 +21,7 @@ from camtool.model.program import Home, Linear, Program, Rapid
 from camtool.post.registry import load_target
 from camtool.post.wordaddress_read import BlockReader
 from tests.corpus.test_rs274 import ROUND_MM, canon_moves, needs_rs274, rs274
+from tests.targets import post_cli
 
 FUSION = """%
 (1001)
@@ -89,12 +88,7 @@ def test_a_fusion_program_re_posted_moves_as_it_did(target: str, tmp_path: Path)
     original = tmp_path / "1001.nc"
     original.write_text(FUSION)
     out = tmp_path / f"1001-{target}.ngc"
-    done = subprocess.run(
-        [sys.executable, "-m", "camtool", "post", str(original), "-t", target, "-o", str(out)],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
+    done = post_cli(original, target, out)
     assert done.returncode == 0, done.stderr
     assert "G28-style" not in done.stderr  # nothing dropped
     want, got = rs274(original), rs274(out)

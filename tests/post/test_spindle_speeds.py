@@ -10,8 +10,6 @@ the original and of camtool's program, from its canonical calls.
 from __future__ import annotations
 
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -20,6 +18,7 @@ from camtool.importers import gcode
 from camtool.importers.gcode import read_gcode
 from camtool.model.program import Spindle
 from tests.corpus.test_rs274 import needs_rs274, rs274
+from tests.targets import post_cli
 
 LASER = "G21 G90\nM4\nG0 X10 Y10\nG1 X20 S500 F1000\nG1 Y20 S300\nG1 X10 S0\nG1 Y10 S800\nM5\nM2\n"
 CALL = re.compile(r"(SET_SPINDLE_SPEED|START_SPINDLE_\w+|STOP_SPINDLE_TURNING|STRAIGHT_FEED)\(")
@@ -63,12 +62,7 @@ def test_a_laser_program_burns_each_move_at_its_own_power(target: str, tmp_path:
     original = tmp_path / "laser.ngc"
     original.write_text(LASER)
     out = tmp_path / f"laser-{target}.ngc"
-    done = subprocess.run(
-        [sys.executable, "-m", "camtool", "post", str(original), "-t", target, "-o", str(out)],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
+    done = post_cli(original, target, out)
     assert done.returncode == 0, done.stderr
     want = _speeds_at_cuts(original)
     assert want == [(True, 500.0), (True, 300.0), (True, 0.0), (True, 800.0)]
