@@ -54,6 +54,7 @@ class _State:
     commands: list[tuple[int, Command]] = field(default_factory=list)
     contours: ContourCounter = field(default_factory=ContourCounter)
     ended: int = 0
+    spindle: SpindleDirection | None = None  # turning, as last read
 
 
 class ControllerRefusal(ParseError):
@@ -177,6 +178,7 @@ class BlockReader:
             if direction == "off" and "S" in values:
                 raise self.fail(f"S in a spindle-off block ({key})")
             s.commands.append((len(s.moves), Spindle(direction, values.get("S"))))
+            s.spindle = None if direction == "off" else direction
         elif key in self.coolant:
             self._only(codes, values, key, "a coolant")
             s.commands.append((len(s.moves), Coolant(self.coolant[key])))
@@ -303,9 +305,13 @@ class BlockReader:
             raise self.fail("a block without a motion code (" + " ".join(spec.motion_codes) + ")")
         assert s.motion is not None
         allowed = set("XYZF") | (set("IJ") if s.motion in ("cw", "ccw") else set())
+        if spec.rs274 and s.spindle is not None:
+            allowed.add("S")  # a new speed of the turning spindle (a laser's power)
         extra = sorted(set(values) - allowed)
         if extra:
             raise self.fail(f"{', '.join(extra)} not allowed in a {s.motion} motion block")
+        if "S" in values and s.spindle is not None:
+            s.commands.append((len(s.moves), Spindle(s.spindle, values["S"])))
         x, y, z = self._axes(values, s.motion)
         feed = self._feed(values, s.motion)
         if s.motion == "rapid":

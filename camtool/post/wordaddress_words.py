@@ -48,6 +48,7 @@ class WordWriter(WriterState[str]):
         self.spec, self.machine = spec, machine
         self.z: float | None = None
         self.spindle: Spindle | None = None  # turning, as last written
+        self.speed: str | None = None  # an S word for the next motion block (a new speed)
         self.written: Point = (0.0, 0.0)
         self.last: dict[str, str] = {}
         self.grid_error_mm = 0.0

@@ -120,6 +120,7 @@ class BlockWriter(ArcWriter):
                 ahead.close()
             if split is not None:
                 split.close()
+        self._flush_speed()
         for codes in self.spec.postamble:
             self.block(list(codes))
         if self.spec.end:
@@ -230,7 +231,34 @@ class BlockWriter(ArcWriter):
             self._word("Z", self._z_text(z), words, force=xy is None)
         if isinstance(move, Linear):
             self._feed(move, words)
+        self._with_speed(words)
         self.block(words)
+
+    def _with_speed(self, words: list[str]) -> None:
+        """Put a new spindle speed (:attr:`speed`) in this motion block (``G1 X20 S800``).
+
+        A laser program does so: GRBL in laser mode runs on through such blocks, where a
+        block of its own (``M4 S800``) stops the motion to change the speed (gcode.c, a
+        spindle sync). It gets its own block first where the motion block would grow
+        beyond ``max_block_bytes``.
+        """
+        if self.speed is None:
+            return
+        spec = self.spec
+        size = len(spec.separator.join([*words, self.speed]) + spec.block_end + spec.line_end)
+        if spec.max_block_bytes is not None and size > spec.max_block_bytes:
+            self._flush_speed()
+            return
+        words.append(self.speed)
+        self.speed = None
+
+    def _flush_speed(self) -> None:
+        """Write a new spindle speed still waiting for a motion block in a block of its own."""
+        if self.speed is not None and self.spindle is not None:
+            code = self.spec.spindle_cw if self.spindle.direction == "cw" else self.spec.spindle_ccw
+            assert code is not None  # the spindle was turned on with it
+            self.block([code, self.speed])
+        self.speed = None
 
     def _feed(self, move: Linear | ArcMove, words: list[str]) -> None:
         same = self._feed_text
@@ -405,6 +433,7 @@ class BlockWriter(ArcWriter):
         words += ["I" + ti, "J" + tj]
         self.written = written
         self._feed(move, words)
+        self._with_speed(words)
         self.block(words)
 
     # -- arcs in the ZX and YZ planes -----------------------------------------------
@@ -445,6 +474,7 @@ class BlockWriter(ArcWriter):
         for chord in chords:
             self._check_area(here, chord)
             here = (chord.x, chord.y)
+        self._flush_speed()
         for k, words in enumerate(blocks):
             if k == 0:
                 words.insert(0, PLANE_CODES[arc.plane])
@@ -532,6 +562,7 @@ class BlockWriter(ArcWriter):
             DialectError: a tool change or stop the dialect cannot write.
         """
         spec = self.spec
+        self._flush_speed()  # a new speed before this command: in its place, not after it
         if isinstance(command, Spindle):
             code = {"cw": spec.spindle_cw, "ccw": spec.spindle_ccw, "off": spec.spindle_off}[
                 command.direction
@@ -539,6 +570,7 @@ class BlockWriter(ArcWriter):
             if code is None:
                 self.drop(command)
                 return
+            turning = self.spindle
             self.spindle = None if command.direction == "off" else command
             words = [code]
             rpm = None if command.direction == "off" else command.rpm
@@ -553,6 +585,10 @@ class BlockWriter(ArcWriter):
                 if word is not None and word.number.parse(text) != rpm:
                     self.warn(f"spindle speed {rpm:g} rev/min written as S{text}")
                 words.append("S" + text)
+            same = turning is not None and turning.direction == command.direction
+            if spec.rs274 and len(words) == 2 and same:  # a new speed only
+                self.speed = words[1]
+                return
             self.block(words)
         elif isinstance(command, Coolant):
             code = {"mist": spec.coolant_mist, "flood": spec.coolant_flood}.get(
@@ -642,6 +678,7 @@ class BlockWriter(ArcWriter):
         turning = self.spindle
         if turning is not None and spec.spindle_off is not None:
             self.block([spec.spindle_off])
+            self.spindle = None  # stopped: the restart below is a whole M3 S… block
         self._stop(False, what)
         if turning is not None:
             self.command(turning)  # the spindle as it was, for the new tool

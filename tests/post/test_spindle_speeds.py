@@ -4,7 +4,8 @@ A laser program (LaserGRBL, LightBurn) keeps ``M4`` on and changes the power wit
 one move to the next, ``S0`` for a move that must not burn. camtool read ``S0`` as "no speed"
 and wrote a bare ``M4``: the controller kept the power before it, and the move burned. The
 judge is LinuxCNC's ``rs274``: the speed and the spindle state in force at each feed move of
-the original and of camtool's program, from its canonical calls.
+the original and of camtool's program, from its canonical calls. A new speed of the turning
+spindle is written in the next motion block, where the laser program had it.
 """
 
 from __future__ import annotations
@@ -67,4 +68,9 @@ def test_a_laser_program_burns_each_move_at_its_own_power(target: str, tmp_path:
     want = _speeds_at_cuts(original)
     assert want == [(True, 500.0), (True, 300.0), (True, 0.0), (True, 800.0)]
     assert _speeds_at_cuts(out) == want
+    # each new power in its motion block, as the laser program had it: GRBL in laser mode
+    # runs on through them, where an "M4 S300" block of its own stops the motion
+    cuts = [line for line in out.read_text().splitlines() if line.startswith("G1")]
+    assert [line.split()[-1] for line in cuts] == ["S500", "S300", "S0", "S800"]
+    assert not any(line.startswith("M4 S") for line in out.read_text().splitlines())
     assert read_gcode(out).commands  # and camtool reads its own program back
