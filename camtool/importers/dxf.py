@@ -16,7 +16,7 @@ from typing import Any
 
 from camtool.accel.collector import paused
 from camtool.geometry.arcfit import FIT_KERNELS
-from camtool.importers.dxf_damage import refuse_guessed_numbers
+from camtool.importers.dxf_damage import implied_degree, refuse_guessed_numbers
 from camtool.importers.dxf_entities import (
     ZERO_LENGTH,
     BadEntity,
@@ -424,7 +424,6 @@ class _Reader:
             check_centres,
             check_numbers,
             convert,
-            implied_degree,
             swapped_axes,
         )
 

@@ -1,4 +1,4 @@
-"""Damage that ezdxf's recover mode can only guess at: numbers that are not numbers.
+"""Damaged DXF data: numbers recover mode can only guess at, SPLINEs of the wrong degree.
 
 Recover mode reads a number it cannot parse the way C's ``strtod`` does, up to the first
 character that does not belong (``recover.py``, ``_search_float``/``_search_int``):
@@ -13,10 +13,12 @@ nothing camtool cuts, and stays a repair that ``camtool inspect`` lists.
 
 from __future__ import annotations
 
+import itertools
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from camtool.model.errors import InputError
 
@@ -125,3 +127,44 @@ def refuse_guessed_numbers(path: Path, repairs: Sequence[str]) -> None:
             else " Export the drawing again as DXF from the CAD program"
         )
     )
+
+
+MAX_IMPLIED_DEGREE = 11
+"""The highest degree :func:`implied_degree` derives (AutoCAD's SPLINE goes to 11)."""
+
+
+def implied_degree(entity: Any) -> int | None:
+    """The degree a SPLINE's knots and control points imply, where it declares another.
+
+    A B-spline of ``n`` control points and degree ``p`` has ``n + p + 1`` knots, and a
+    clamped one (as CAD programs write them) repeats its first and its last knot
+    exactly ``p + 1`` times (Piegl & Tiller, *The NURBS Book*, 2nd ed., section 2.2).
+    Some exporters write a quadratic's data under degree 3 (dxf-parser's
+    ``arcs-as-splines.dxf``: circles of 9 control points, 12 knots). When the counts
+    imply another degree ``p ≥ 1`` and the knot vector is clamped for exactly that
+    ``p``, the numbers describe one curve and this is its degree.
+
+    Returns:
+        The implied degree, or ``None``: the SPLINE agrees with its declared degree, is
+        stored periodically (``n + 1`` knots), has no control points, or its data fit
+        no degree (it stays invalid).
+    """
+    if entity.dxftype() != "SPLINE":
+        return None
+    count, knots = entity.control_point_count(), list(entity.knots)
+    declared = int(entity.dxf.degree)
+    if count == 0 or len(knots) == count + declared + 1:
+        return None
+    if entity.closed and len(knots) == count + 1:
+        return None
+    p = len(knots) - count - 1
+    weights = len(entity.weights)
+    if not 1 <= p <= MAX_IMPLIED_DEGREE or count < p + 1 or weights not in (0, count):
+        return None
+    ends = knots[: p + 1] + knots[-p - 1 :]
+    clamped = len(set(ends[: p + 1])) == 1 and len(set(ends[p + 1 :])) == 1
+    inner = knots[p + 1 : -p - 1]
+    rising = all(a <= b for a, b in itertools.pairwise(knots)) and knots[0] < knots[-1]
+    if not (clamped and rising and all(knots[0] < k < knots[-1] for k in inner)):
+        return None
+    return p

@@ -21,6 +21,7 @@ import numpy as np
 from camtool.geometry.arcfit import FloatArray, PointsFn
 from camtool.geometry.chain import with_end, with_start
 from camtool.geometry.curves import corner_knots, ellipse, fit_pieces
+from camtool.importers.dxf_damage import implied_degree
 from camtool.importers.dxf_prefit import take
 from camtool.importers.options import check_curve_size
 from camtool.model.errors import GeometryError
@@ -186,47 +187,6 @@ def swapped_axes(entity: Any) -> bool:
     (swapping the axes) and as viewers draw it; the importer warns.
     """
     return entity.dxftype() == "ELLIPSE" and abs(entity.dxf.get("ratio", 1.0)) > _MAX_RATIO
-
-
-MAX_IMPLIED_DEGREE = 11
-"""The highest degree :func:`implied_degree` derives (AutoCAD's SPLINE goes to 11)."""
-
-
-def implied_degree(entity: Any) -> int | None:
-    """The degree a SPLINE's knots and control points imply, where it declares another.
-
-    A B-spline of ``n`` control points and degree ``p`` has ``n + p + 1`` knots, and a
-    clamped one (as CAD programs write them) repeats its first and its last knot
-    exactly ``p + 1`` times (Piegl & Tiller, *The NURBS Book*, 2nd ed., section 2.2).
-    Some exporters write a quadratic's data under degree 3 (dxf-parser's
-    ``arcs-as-splines.dxf``: circles of 9 control points, 12 knots). When the counts
-    imply another degree ``p ≥ 1`` and the knot vector is clamped for exactly that
-    ``p``, the numbers describe one curve and this is its degree.
-
-    Returns:
-        The implied degree, or ``None``: the SPLINE agrees with its declared degree, is
-        stored periodically (``n + 1`` knots), has no control points, or its data fit
-        no degree (it stays invalid).
-    """
-    if entity.dxftype() != "SPLINE":
-        return None
-    count, knots = entity.control_point_count(), list(entity.knots)
-    declared = int(entity.dxf.degree)
-    if count == 0 or len(knots) == count + declared + 1:
-        return None
-    if entity.closed and len(knots) == count + 1:
-        return None
-    p = len(knots) - count - 1
-    weights = len(entity.weights)
-    if not 1 <= p <= MAX_IMPLIED_DEGREE or count < p + 1 or weights not in (0, count):
-        return None
-    ends = knots[: p + 1] + knots[-p - 1 :]
-    clamped = len(set(ends[: p + 1])) == 1 and len(set(ends[p + 1 :])) == 1
-    inner = knots[p + 1 : -p - 1]
-    rising = all(a <= b for a, b in itertools.pairwise(knots)) and knots[0] < knots[-1]
-    if not (clamped and rising and all(knots[0] < k < knots[-1] for k in inner)):
-        return None
-    return p
 
 
 def check_centres(contours: Sequence[Contour], layer: str, limit: float) -> None:
@@ -676,7 +636,7 @@ def _construction(entity: Any) -> Any:
                 int(entity.dxf.degree),
             )
             return BSpline(cps, int(entity.dxf.degree) + 1, knots, weights or None)
-        implied = implied_degree(entity)
+        implied = implied_degree(entity)  # an exporter's quadratic written as degree 3
         if implied is not None:
             return BSpline(
                 [tuple(v) for v in entity.control_points],
