@@ -55,6 +55,9 @@ def test_s0_while_on_is_a_speed_and_a_bare_m4_none(plain: bool) -> None:
     (``None``: the controller's stays); ``S0`` is the speed 0."""
     program = gcode._parse("G21\nM4\nG1 X1 S0 F100\nM2\n", "laser.ngc", plain=plain)
     assert program.commands[:2] == ((0, Spindle("ccw")), (0, Spindle("ccw", 0.0)))
+    bare, s0 = program.commands[0][1], program.commands[1][1]
+    assert isinstance(bare, Spindle) and bare.rpm is None
+    assert isinstance(s0, Spindle) and s0.rpm == 0.0
 
 
 @needs_rs274
