@@ -391,7 +391,8 @@ def _nearby_boxes(
     """
     reach = ((upper + half) * (1.0 + 1e-9) + 1e-12) * (1.0 + 1e-12)
     owner, seg = kernels.pairs_within(np.ascontiguousarray(samples), *tree, reach, NEARBY_MAX_PAIRS)
-    if len(owner) == 0 or len(np.unique(owner)) < len(samples):
+    # ``owner`` ascends (sample-major): its distinct values are one more than its steps
+    if len(owner) == 0 or np.count_nonzero(owner[1:] != owner[:-1]) + 1 < len(samples):
         return None  # over the limit (or, which cannot happen, a sample without one)
     if need is None:
         return _nearby_min(samples, owner, seg, a, b)
