@@ -11,7 +11,7 @@ import re
 from array import array
 from collections.abc import Iterable, Iterator
 from pathlib import Path
-from typing import cast
+from typing import Literal, cast
 
 from camtool import accel
 from camtool.accel.collector import paused
@@ -448,7 +448,7 @@ class _Reader(PlainLines):
                     f"{self.where()}: {home} and {motion} both use the axis words; "
                     "put them in separate blocks"
                 )
-            self._home(home, w.args)
+            self._home("G28" if home == "G28" else "G30", w.args)
             return used | axes
         if self.motion in ("G2", "G3"):
             letters = "XYZRP" + "".join(_CENTRE_LETTERS[self.plane])
@@ -726,11 +726,11 @@ class _Reader(PlainLines):
             )
         self.notes.add("G53", self.line, "G53 without axis words moves nowhere: read as no move")
 
-    def _home(self, name: str, args: dict[str, Word]) -> None:
+    def _home(self, name: Literal["G28", "G30"], args: dict[str, Word]) -> None:
         """G28/G30: a rapid to the intermediate point, then the axes are unknown.
 
-        G28 is kept as a :class:`Home` command on the axes it names (all three
-        when it names none); G30 (a second stored position) is not a command.
+        Kept as a :class:`Home` command on the axes it names (all three when it names
+        none), with its code: G30 is the second stored position, not G28's.
         """
         axes = [letter for letter in "XYZ" if letter in args]
         if axes:
@@ -745,14 +745,11 @@ class _Reader(PlainLines):
         for letter in axes or "XYZ":
             setattr(self, letter.lower(), None)
         self.home = f"{name} on line {self.line}"
-        if name == "G28":
-            self.commands.add(len(self.moves), Home("".join(axes) or "XYZ"))
-            kept = (
-                "kept as a return-to-machine-zero command, but camtool does not know that "
-                "position, so the verifier does not simulate the move"
-            )
-        else:
-            kept = "that move is not in the program (camtool does not know the position)"
+        self.commands.add(len(self.moves), Home("".join(axes) or "XYZ", name))
+        kept = (
+            "kept as a return-to-stored-position command, but camtool does not know that "
+            "position, so the verifier does not simulate the move"
+        )
         self.notes.add(
             name,
             self.line,

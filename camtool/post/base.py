@@ -22,6 +22,7 @@ from camtool.model.machine import Machine
 from camtool.model.program import (
     Command,
     DrillCycle,
+    Home,
     LengthOffset,
     Move,
     PlaneArc,
@@ -104,6 +105,49 @@ def check_written_z(requested: float, written: float, where: str) -> None:
         "top: moves there would run at the surface; raise the height to the dialect's "
         "resolution or more"
     )
+
+
+def check_dropped_homes(program: Program, homes: tuple[str, ...], target: str) -> None:
+    """Refuse a return of Z to a stored position the dialect cannot write, with moves after it.
+
+    A program read from code that runs ``G91 G28 Z0`` (or G30) leaves its tool at the
+    stored height (the top, on most machines); its next moves give X and Y only, and
+    written without the return they would run at the height the tool had before it:
+    a rapid at cutting depth. Such a program is refused, not written. A return at
+    the end of the program, or followed by a move that gives Z, costs nothing when
+    dropped; neither does one in a program that never gives Z (a plotter's, a laser's).
+
+    Args:
+        program: the program to write.
+        homes: the codes of the returns the dialect writes (``()``: none).
+        target: the target's name, for the message.
+
+    Raises:
+        DialectError: a dropped return on Z followed by a move at an unknown height,
+            naming its source line (or move) and the height the tool would stay at.
+    """
+    dropped = [
+        (i, c)
+        for i, c in program.commands
+        if isinstance(c, Home) and "Z" in c.axes and c.code not in homes
+    ]
+    moves = program.moves
+    if not dropped or all(m.z is None for m in moves):
+        return
+    for index, home in dropped:
+        if index >= len(moves) or moves[index].z is not None:
+            continue
+        before = next((m.z for m in reversed(moves[:index]) if m.z is not None), None)
+        line = program.lines[index] if index < len(program.lines) else None
+        where = f"line {line}" if line else f"move {index + 1}"
+        left = f"Z{before:g}" if before is not None else "wherever it was left"
+        raise DialectError(
+            f"{where}: the move after the program's {home.code} return on Z gives no Z, and "
+            f"{target} cannot write that return: written without it, the move would run at "
+            f"the height the tool had before it ({left}), not at the stored position; give "
+            f"a Z move (G0 Z at the clearance height) right after the {home.code}, or post "
+            "for a target that writes it (grbl, linuxcnc)"
+        )
 
 
 def check_placement(program: Program, machine: Machine) -> tuple[str, ...]:
@@ -366,6 +410,15 @@ class PostProcessor(ABC):
         return ()
 
     @property
+    def homes(self) -> tuple[str, ...]:
+        """The returns to stored positions (``"G28"``, ``"G30"``) the dialect writes.
+
+        Any other :class:`~camtool.model.program.Home` is dropped with a warning, or
+        refused where a move after it needs its height (:func:`check_dropped_homes`).
+        """
+        return ()
+
+    @property
     def helix(self) -> bool:
         """True when an arc may move Z (a helical arc)."""
         return False
@@ -549,6 +602,7 @@ class Target:
         the dialect writes them (:attr:`PostProcessor.planes`) and the machine has Z.
         """
         program, warning = plane_chords(program, self)
+        check_dropped_homes(program, self.post.homes, self.name)
         result = self.post.emit(program, self.machine, fmt=fmt)
         if warning:
             result = dataclasses.replace(result, warnings=(*result.warnings, warning))

@@ -86,6 +86,11 @@ class WordAddressPost(PostProcessor):
         return bool(self.spec.tool_length_offset)
 
     @property
+    def homes(self) -> tuple[str, ...]:
+        """The spec's returns to stored positions (G28 and G30 with ``home``)."""
+        return self.spec.homes
+
+    @property
     def work_offsets(self) -> tuple[str, ...]:
         """The spec's ``work_offsets`` (LinuxCNC's G54 … G59.3, GRBL's G54 … G59)."""
         return self.spec.work_offsets

@@ -13,6 +13,7 @@ from __future__ import annotations
 import dataclasses
 import re
 from dataclasses import dataclass, field
+from typing import Literal
 
 from camtool.model.errors import DialectError, ParseError
 from camtool.model.program import (
@@ -95,8 +96,8 @@ class BlockReader:
         self.codes |= set(self.coolant)
         self.codes |= {c for c in (spec.dwell, spec.tool_change) if c}
         self.codes |= {c for c in (spec.tool_length_offset, spec.stop, spec.optional_stop) if c}
-        if spec.home:
-            self.codes |= {spec.home, "G90", "G91"}
+        if spec.homes:
+            self.codes |= {*spec.homes, "G90", "G91"}
 
     def fail(self, text: str) -> ParseError:
         """A ParseError naming the source and line."""
@@ -167,8 +168,9 @@ class BlockReader:
             raise self.fail(f"no word in {raw!r}")
         static = self.static
         key = next((c for c in codes if c not in self.motions and c not in static), None)
-        if spec.home is not None and spec.home in codes:
-            key = spec.home  # G91 G28 Z0: the G91 is the return's
+        home = next((c for c in codes if c in spec.homes), None)
+        if home is not None:
+            key = home  # G91 G28 Z0: the G91 is the return's
         if key in spec.end:
             self._only(codes, values, key, "the program end")
             s.ended = self.line
@@ -193,8 +195,8 @@ class BlockReader:
         elif key is not None and key == spec.tool_length_offset:
             self._only(codes, values, key, "a tool length offset", needs="H")
             self._offset_after_change(round(values["H"]))
-        elif key is not None and key == spec.home:
-            self._home(codes, values, key)
+        elif key is not None and key in spec.homes:
+            self._home(codes, values, "G28" if key == "G28" else "G30")
         elif key is not None and key in (spec.stop, spec.optional_stop):
             self._only(codes, values, key, "a program stop")
             optional = key == spec.optional_stop and key != spec.stop
@@ -262,8 +264,8 @@ class BlockReader:
             )
         return value
 
-    def _home(self, codes: list[str], values: dict[str, float], key: str) -> None:
-        """``G28`` alone (all three axes) or ``G91 G28`` with the axes it names at 0."""
+    def _home(self, codes: list[str], values: dict[str, float], key: Literal["G28", "G30"]) -> None:
+        """``G28`` alone (all three axes) or ``G91 G28`` with the axes it names at 0 (G30 so)."""
         axes = "".join(a for a in "XYZ" if a in values)
         incremental = codes == ["G91", key]
         if codes not in (["G91", key], [key]) or set(values) - set("XYZ"):
@@ -273,7 +275,7 @@ class BlockReader:
                 f"{key} goes through the point where the tool is: G91 {key} with axis words "
                 f"at 0, or {key} alone"
             )
-        self.state.commands.append((len(self.state.moves), Home(axes or "XYZ")))
+        self.state.commands.append((len(self.state.moves), Home(axes or "XYZ", key)))
 
     def _offset_after_change(self, tool: int) -> None:
         """The length offset (``G43 H<n>``) the writer puts right after a change to tool n."""

@@ -125,10 +125,12 @@ class WordAddressSpec:
             program read from code that selects one keeps it (written before its first
             move); ``()``: a program runs in the work offset the user has active.
         home: ``"G28"``: a program read from code keeps its returns to the machine's
-            stored position (:class:`~camtool.model.program.Home`), written as RS-274
-            writes them: ``G91 G28 Z0`` then ``G90`` for the axes one names (the
-            intermediate point where the tool is), ``G28`` alone for all three;
-            ``None``: they are dropped, with a warning.
+            stored positions (:class:`~camtool.model.program.Home`; G28's and G30's,
+            :attr:`homes`), written as RS-274 writes them: ``G91 G28 Z0`` then ``G90``
+            for the axes one names (the intermediate point where the tool is), ``G28``
+            alone for all three; ``None``: they are dropped, with a warning, and
+            refused where a move after one would run at the height it left
+            (:func:`camtool.post.base.check_dropped_homes`).
         stop: program stop code (``M0``): the machine waits for the operator. A
             dialect with a stop and comments but no ``tool_change`` changes tools by
             hand: a comment naming the tool, then the stop (GRBL 1.1).
@@ -189,6 +191,15 @@ class WordAddressSpec:
     def has(self, letter: str) -> bool:
         """True when the dialect has the value word ``letter``."""
         return letter in self.words
+
+    @property
+    def homes(self) -> tuple[str, ...]:
+        """The returns to stored positions written: ``G28`` and ``G30`` with :attr:`home`.
+
+        RS-274's two stored positions (LinuxCNC "G28, G28.1" and "G30, G30.1"; GRBL 1.1
+        the same); ``()`` without ``home``.
+        """
+        return ("G28", "G30") if self.home else ()
 
     def quantum_mm(self) -> float:
         """The coarsest written step of X, Y, I and J, mm: the grid arcs must land on."""
@@ -524,7 +535,9 @@ def _check(spec: WordAddressSpec, t: _Table) -> None:
     if spec.dwell and not spec.has("P"):
         raise t.error("dwell", "a dwell code needs a P word (seconds) in words")
     if spec.home and not (spec.rs274 and all(spec.has(c) for c in "XYZ")):
-        raise t.error("home", "G28 (written G91 G28 Z0, as RS-274) needs rs274 = true and X, Y, Z")
+        raise t.error(
+            "home", "G28 and G30 (written G91 G28 Z0, as RS-274) need rs274 = true and X, Y, Z"
+        )
     if spec.tool_change and not spec.has("T"):
         raise t.error("tool_change", "a tool change code needs a T word in words")
     if spec.tool_length_offset and not (spec.tool_change and spec.has("H")):
@@ -538,7 +551,7 @@ def _check(spec: WordAddressSpec, t: _Table) -> None:
     roles = [*spec.motion_codes, *spec.end]
     roles += [c for c in (spec.spindle_cw, spec.spindle_ccw, spec.spindle_off) if c]
     roles += [c for c in (spec.dwell, spec.tool_change, spec.tool_length_offset) if c]
-    roles += [c for c in (spec.stop, spec.optional_stop, spec.home) if c]
+    roles += [c for c in (spec.stop, spec.optional_stop) if c] + list(spec.homes)
     roles += [c for c in (spec.coolant_mist, spec.coolant_flood, spec.coolant_off) if c]
     if len(set(roles)) != len(roles):
         twice = sorted({c for c in roles if roles.count(c) > 1})

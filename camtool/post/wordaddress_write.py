@@ -611,8 +611,8 @@ class BlockWriter(ArcWriter):
             self._length_offset(command)
         elif isinstance(command, WorkOffset) and command.code in self.spec.work_offsets:
             self.block([command.code])
-        elif isinstance(command, Home) and spec.home is not None:
-            self._home(command.axes, spec.home)
+        elif isinstance(command, Home) and command.code in spec.homes:
+            self._home(command.axes, command.code)
         elif isinstance(command, Home | WorkOffset):
             self.drop(command)
 

@@ -343,6 +343,11 @@ class PicMmhPost(PostProcessor):
         """``"code"``: ``M06T##;`` changes to magazine position T (UNAM-GMM L3455–L3464)."""
         return "code"
 
+    @property
+    def homes(self) -> tuple[str, ...]:
+        """``"G28"``: machine zero, ``G28X0Y0;`` / ``G28Z0;`` (UNAM-GMM Tabla 21); no G30."""
+        return ("G28",)
+
     # -- writing ---------------------------------------------------------------
 
     def emit(self, program: Program, machine: Machine, *, fmt: str | None = None) -> PostResult:
@@ -526,6 +531,8 @@ class PicMmhPost(PostProcessor):
                 f"{where}: coolant {command.state} dropped: pic-mmh has no coolant code "
                 "(UNAM-GMM Tabla 22); switch it by hand",
             )
+        elif command.code != "G28":
+            w.drop(command)  # no second stored position; refused where its height matters
         else:
             blocks = _home(command, where)
             w.blocks.extend(blocks)

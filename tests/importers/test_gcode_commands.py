@@ -80,11 +80,12 @@ def test_g28_is_a_home_command_on_the_axes_it_names() -> None:
         (1, Home("Z")),  # incremental 0: no intermediate move
         (1, Home("XYZ")),
         (2, Home("XY")),  # after the rapid to the intermediate point (0, 0)
-    )  # G30 (a second stored position) is no Home
+        (3, Home("XYZ", "G30")),  # the second stored position, not G28's
+    )
     (g28, g30) = program.warnings
     assert g28.startswith("t.ngc:2: G28 return to the machine's stored position: kept as")
     assert g28.endswith("(3 times)")
-    assert g30.startswith("t.ngc:6: G30 return to the machine's stored position: that move")
+    assert g30.startswith("t.ngc:6: G30 return to the machine's stored position: kept as")
 
 
 def test_tool_selection_without_m6_and_m6_without_tool_warn() -> None:

@@ -1,4 +1,4 @@
-"""A re-posted program's G28 returns are written for GRBL and LinuxCNC, not dropped.
+"""A re-posted program's G28 and G30 returns are written for GRBL and LinuxCNC, not dropped.
 
 Fusion 360's posts begin ``G28 G91 Z0`` / ``G90``: the tool rises to the stored position
 before the first XY rapid, and again before each tool change and at the end. camtool read
@@ -99,3 +99,90 @@ def test_a_fusion_program_re_posted_moves_as_it_did(target: str, tmp_path: Path)
         assert max(abs(u - v) for u, v in zip(p, q, strict=True)) <= ROUND_MM
     # the first move of both is the return's rise, before any XY rapid
     assert a[0][0] == "rapid" and a[0][1][:2] == (0.0, 0.0)
+
+
+G30_MIDWAY = """G21 G90
+G0 Z5
+G0 X0 Y0
+G1 Z-1 F100
+G1 X10 F300
+G91 G30 Z0
+G90
+G0 X20 Y20
+G1 Z-1
+G1 X30
+G0 Z5
+M2
+"""
+"""A cut, the return to the G30 position on Z, a rapid that gives X and Y only, a cut."""
+
+
+@needs_rs274
+@pytest.mark.parametrize("target", ["grbl", "linuxcnc"])
+def test_a_g30_return_is_written_as_g30_and_moves_as_it_did(target: str, tmp_path: Path) -> None:
+    """G30 was dropped (with a warning): the rapid after it ran at Z-1, through the part."""
+    original = tmp_path / "g30.nc"
+    original.write_text(G30_MIDWAY)
+    out = tmp_path / f"g30-{target}.ngc"
+    done = post_cli(original, target, out)
+    assert done.returncode == 0, done.stderr
+    code = out.read_text()
+    assert "G91 G30 Z0.000" in code.splitlines() and "G28" not in code
+    back = load_target(target).post.parse(code)
+    assert [c for _, c in back.commands if isinstance(c, Home)] == [Home("Z", "G30")]
+    want, got = rs274(original), rs274(out)
+    assert want.returncode == 0 and got.returncode == 0, (want.stderr, got.stderr)
+    a, b = canon_moves(want.stdout), canon_moves(got.stdout)
+    assert len(a) == len(b)
+    for (kind, p), (other, q) in zip(a, b, strict=True):
+        assert kind == other
+        assert max(abs(u - v) for u, v in zip(p, q, strict=True)) <= ROUND_MM
+    # rs274's G30 position is its parameters' (all 0 here): the XY rapid runs at Z0, not Z-1
+    rapid = next(p for kind, p in b if kind == "rapid" and p[:2] == (20.0, 20.0))
+    assert rapid[2] == 0.0
+
+
+@pytest.mark.parametrize("code", ["G28", "G30"])
+@pytest.mark.parametrize("target", ["valcnc", "i8751"])
+def test_a_dropped_return_with_moves_after_it_is_refused(
+    code: str, target: str, tmp_path: Path
+) -> None:
+    """valcnc and i8751 write no return: the XY rapid after it would run at Z-1."""
+    original = tmp_path / f"{code}.nc"
+    original.write_text(G30_MIDWAY.replace("G30", code))
+    out = tmp_path / f"{code}.{target}"
+    done = post_cli(original, target, out)
+    assert done.returncode == 1, done.stdout
+    assert "line 8:" in done.stderr and f"{code} return on Z" in done.stderr
+    assert "Z-1" in done.stderr and "Traceback" not in done.stderr
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("tail", ["G0 Z5\nG0 X20 Y20\nM2\n", "M2\n"])
+def test_a_dropped_return_followed_by_a_z_or_by_the_end_is_written(
+    tail: str, tmp_path: Path
+) -> None:
+    """Written without it, the next move gives its own height, or there is none."""
+    original = tmp_path / "end.nc"
+    original.write_text(
+        "G21 G90\nG0 Z5\nG0 X0 Y0\nG1 Z-1 F100\nG1 X10 F300\nG91 G28 Z0\nG90\n" + tail
+    )
+    out = tmp_path / "end.valcnc"
+    done = post_cli(original, "valcnc", out)
+    assert done.returncode == 0, done.stderr
+    assert "G28-style return(s) to a stored machine position dropped" in done.stderr
+    lines = out.read_text().splitlines()
+    after = lines[lines.index("G01X10Y0") + 1 :]
+    assert after == (["G00Z5", "G00X20Y20"] if "X20" in tail else [])
+
+
+def test_pic_mmh_writes_g28_as_machine_zero_and_never_a_g30_as_it() -> None:
+    """pic-mmh's ``G28Z0;`` is machine zero; it has no second stored position."""
+    moves = (Rapid(0.0, 0.0), Linear(1.0, 0.0, 5.0), Rapid(0.5, 0.5))  # no Z word
+    loaded = load_target("pic-mmh")
+    for code, written in (("G28", ["G28Z0;"]), ("G30", [])):
+        home: Home = Home("Z", code)  # type: ignore[arg-type]
+        program = Program(moves, commands=((3, home),))
+        result = loaded.emit(program)
+        blocks = str(result.code).splitlines()
+        assert [b for b in blocks if b.startswith("G28")] == written
