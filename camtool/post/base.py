@@ -24,9 +24,11 @@ from camtool.model.program import (
     DrillCycle,
     Home,
     LengthOffset,
+    Linear,
     Move,
     PlaneArc,
     Program,
+    Rapid,
     Stop,
     ToolChange,
     WorkOffset,
@@ -113,9 +115,11 @@ def check_dropped_homes(program: Program, homes: tuple[str, ...], target: str) -
     A program read from code that runs ``G91 G28 Z0`` (or G30) leaves its tool at the
     stored height (the top, on most machines); its next moves give X and Y only, and
     written without the return they would run at the height the tool had before it:
-    a rapid at cutting depth. Such a program is refused, not written. A return at
-    the end of the program, or followed by a move that gives Z, costs nothing when
-    dropped; neither does one in a program that never gives Z (a plotter's, a laser's).
+    a rapid at cutting depth. A next move that gives Z and X, Y would run from that
+    height on a slant, through what it cut. Such a program is refused, not written.
+    A return at the end of the program, or followed by a move of Z alone, costs
+    nothing when dropped; neither does one in a program that never gives Z (a
+    plotter's, a laser's).
 
     Args:
         program: the program to write.
@@ -135,18 +139,23 @@ def check_dropped_homes(program: Program, homes: tuple[str, ...], target: str) -
     if not dropped or all(m.z is None for m in moves):
         return
     for index, home in dropped:
-        if index >= len(moves) or moves[index].z is not None:
+        if index >= len(moves):
             continue
+        move = moves[index]
+        start = (moves[index - 1].x, moves[index - 1].y) if index else (0.0, 0.0)
+        if move.z is not None and isinstance(move, Rapid | Linear) and (move.x, move.y) == start:
+            continue  # Z alone: from whatever height, it goes where the program says
         before = next((m.z for m in reversed(moves[:index]) if m.z is not None), None)
         line = program.lines[index] if index < len(program.lines) else None
         where = f"line {line}" if line else f"move {index + 1}"
         left = f"Z{before:g}" if before is not None else "wherever it was left"
+        how = "gives no Z" if move.z is None else "moves X or Y with Z"
         raise DialectError(
-            f"{where}: the move after the program's {home.code} return on Z gives no Z, and "
-            f"{target} cannot write that return: written without it, the move would run at "
-            f"the height the tool had before it ({left}), not at the stored position; give "
-            f"a Z move (G0 Z at the clearance height) right after the {home.code}, or post "
-            "for a target that writes it (grbl, linuxcnc)"
+            f"{where}: the move after the program's {home.code} return on Z {how}, and "
+            f"{target} cannot write that return: written without it, the move would run "
+            f"from the height the tool had before it ({left}), not from the stored "
+            f"position; give a move of Z alone (G0 Z at the clearance height) right after "
+            f"the {home.code}, or post for a target that writes it (grbl, linuxcnc)"
         )
 
 

@@ -142,14 +142,16 @@ def test_a_g30_return_is_written_as_g30_and_moves_as_it_did(target: str, tmp_pat
     assert rapid[2] == 0.0
 
 
+@pytest.mark.parametrize("rapid", ["G0 X20 Y20", "G0 X20 Y20 Z5"])
 @pytest.mark.parametrize("code", ["G28", "G30"])
 @pytest.mark.parametrize("target", ["valcnc", "i8751"])
 def test_a_dropped_return_with_moves_after_it_is_refused(
-    code: str, target: str, tmp_path: Path
+    rapid: str, code: str, target: str, tmp_path: Path
 ) -> None:
-    """valcnc and i8751 write no return: the XY rapid after it would run at Z-1."""
+    """valcnc and i8751 write no return: the XY rapid after it would run at Z-1, or rise
+    from Z-1 on a slant through the part (valcnc wrote ``G00X20Y20Z5`` from there)."""
     original = tmp_path / f"{code}.nc"
-    original.write_text(G30_MIDWAY.replace("G30", code))
+    original.write_text(G30_MIDWAY.replace("G30", code).replace("G0 X20 Y20", rapid))
     out = tmp_path / f"{code}.{target}"
     done = post_cli(original, target, out)
     assert done.returncode == 1, done.stdout
