@@ -125,8 +125,9 @@ def _warnings(program: Program, trace: StepTrace) -> list[str]:
     homes = sum(isinstance(c, Home) for _, c in program.commands)
     if homes:
         out.append(
-            f"{homes} return(s) to machine zero (G28) not simulated: machine zero is not "
-            "the part zero, so the move after each is simulated from where the one before ended"
+            f"{homes} return(s) to a stored machine position (G28/G30) not simulated: that "
+            "position is not the part zero, so the move after each is simulated from where "
+            "the one before ended"
         )
     box = program.bbox(cutting_only=True)
     size = max(box[2] - box[0], box[3] - box[1])

@@ -90,7 +90,7 @@ def test_a_fusion_program_re_posted_moves_as_it_did(target: str, tmp_path: Path)
     out = tmp_path / f"1001-{target}.ngc"
     done = post_cli(original, target, out)
     assert done.returncode == 0, done.stderr
-    assert "G28-style" not in done.stderr  # nothing dropped
+    assert "G28/G30 return(s)" not in done.stderr  # nothing dropped
     want, got = rs274(original), rs274(out)
     assert want.returncode == 0 and got.returncode == 0, (want.stderr, got.stderr)
     a, b = canon_moves(want.stdout), canon_moves(got.stdout)
@@ -172,7 +172,7 @@ def test_a_dropped_return_followed_by_a_z_or_by_the_end_is_written(
     out = tmp_path / "end.valcnc"
     done = post_cli(original, "valcnc", out)
     assert done.returncode == 0, done.stderr
-    assert "G28-style return(s) to a stored machine position dropped" in done.stderr
+    assert "G28/G30 return(s) to a stored machine position dropped" in done.stderr
     lines = out.read_text().splitlines()
     after = lines[lines.index("G01X10Y0") + 1 :]
     assert after == (["G00Z5", "G00X20Y20"] if "X20" in tail else [])
