@@ -82,6 +82,17 @@ def test_the_strict_reader_takes_the_writers_returns_only(block: str) -> None:
         reader.read(f"G21 G90 G94 G17\n{block}\nG90\nG0 X1.000 Y1.000 Z1.000\nM2\n")
 
 
+def _same_moves(original: Path, posted: Path) -> list[tuple[str, tuple[float, ...]]]:
+    """``rs274``'s moves of both programs: the same kinds, the same points (±``ROUND_MM``)."""
+    want, got = rs274(original), rs274(posted)
+    assert want.returncode == 0 and got.returncode == 0, (want.stderr, got.stderr)
+    a, b = canon_moves(want.stdout), canon_moves(got.stdout)
+    assert [kind for kind, _ in a] == [kind for kind, _ in b]
+    for (_, p), (_, q) in zip(a, b, strict=True):
+        assert max(abs(u - v) for u, v in zip(p, q, strict=True)) <= ROUND_MM
+    return b
+
+
 @needs_rs274
 @pytest.mark.parametrize("target", ["grbl", "linuxcnc"])
 def test_a_fusion_program_re_posted_moves_as_it_did(target: str, tmp_path: Path) -> None:
@@ -91,12 +102,7 @@ def test_a_fusion_program_re_posted_moves_as_it_did(target: str, tmp_path: Path)
     done = post_cli(original, target, out)
     assert done.returncode == 0, done.stderr
     assert "G28/G30 return(s)" not in done.stderr  # nothing dropped
-    want, got = rs274(original), rs274(out)
-    assert want.returncode == 0 and got.returncode == 0, (want.stderr, got.stderr)
-    a, b = canon_moves(want.stdout), canon_moves(got.stdout)
-    assert [kind for kind, _ in a] == [kind for kind, _ in b]
-    for (_, p), (_, q) in zip(a, b, strict=True):
-        assert max(abs(u - v) for u, v in zip(p, q, strict=True)) <= ROUND_MM
+    a = _same_moves(original, out)
     # the first move of both is the return's rise, before any XY rapid
     assert a[0][0] == "rapid" and a[0][1][:2] == (0.0, 0.0)
 
@@ -130,13 +136,7 @@ def test_a_g30_return_is_written_as_g30_and_moves_as_it_did(target: str, tmp_pat
     assert "G91 G30 Z0.000" in code.splitlines() and "G28" not in code
     back = load_target(target).post.parse(code)
     assert [c for _, c in back.commands if isinstance(c, Home)] == [Home("Z", "G30")]
-    want, got = rs274(original), rs274(out)
-    assert want.returncode == 0 and got.returncode == 0, (want.stderr, got.stderr)
-    a, b = canon_moves(want.stdout), canon_moves(got.stdout)
-    assert len(a) == len(b)
-    for (kind, p), (other, q) in zip(a, b, strict=True):
-        assert kind == other
-        assert max(abs(u - v) for u, v in zip(p, q, strict=True)) <= ROUND_MM
+    b = _same_moves(original, out)
     # rs274's G30 position is its parameters' (all 0 here): the XY rapid runs at Z0, not Z-1
     rapid = next(p for kind, p in b if kind == "rapid" and p[:2] == (20.0, 20.0))
     assert rapid[2] == 0.0
