@@ -25,3 +25,14 @@ def post_cli(source: Path, target: str, out: Path) -> subprocess.CompletedProces
         text=True,
         check=False,
     )
+
+
+def repost_cli(folder: Path, name: str, code: str, target: str) -> tuple[Path, Path]:
+    """Write ``code`` to ``FOLDER/NAME`` and post it for ``target`` (:func:`post_cli`), which
+    must succeed: the original and the posted program's paths."""
+    original = folder / name
+    original.write_text(code)
+    out = folder / f"{original.stem}-{target}.ngc"
+    done = post_cli(original, target, out)
+    assert done.returncode == 0, done.stderr
+    return original, out

@@ -21,7 +21,7 @@ from camtool.model.program import Home, Linear, Program, Rapid
 from camtool.post.registry import load_target
 from camtool.post.wordaddress_read import BlockReader
 from tests.corpus.test_rs274 import ROUND_MM, canon_moves, needs_rs274, rs274
-from tests.targets import post_cli
+from tests.targets import post_cli, repost_cli
 
 FUSION = """%
 (1001)
@@ -96,13 +96,8 @@ def _same_moves(original: Path, posted: Path) -> list[tuple[str, tuple[float, ..
 @needs_rs274
 @pytest.mark.parametrize("target", ["grbl", "linuxcnc"])
 def test_a_fusion_program_re_posted_moves_as_it_did(target: str, tmp_path: Path) -> None:
-    original = tmp_path / "1001.nc"
-    original.write_text(FUSION)
-    out = tmp_path / f"1001-{target}.ngc"
-    done = post_cli(original, target, out)
-    assert done.returncode == 0, done.stderr
-    assert "G28/G30 return(s)" not in done.stderr  # nothing dropped
-    a = _same_moves(original, out)
+    original, out = repost_cli(tmp_path, "1001.nc", FUSION, target)
+    a = _same_moves(original, out)  # every return written: none dropped
     # the first move of both is the return's rise, before any XY rapid
     assert a[0][0] == "rapid" and a[0][1][:2] == (0.0, 0.0)
 
@@ -127,11 +122,7 @@ M2
 @pytest.mark.parametrize("target", ["grbl", "linuxcnc"])
 def test_a_g30_return_is_written_as_g30_and_moves_as_it_did(target: str, tmp_path: Path) -> None:
     """G30 was dropped (with a warning): the rapid after it ran at Z-1, through the part."""
-    original = tmp_path / "g30.nc"
-    original.write_text(G30_MIDWAY)
-    out = tmp_path / f"g30-{target}.ngc"
-    done = post_cli(original, target, out)
-    assert done.returncode == 0, done.stderr
+    original, out = repost_cli(tmp_path, "g30.nc", G30_MIDWAY, target)
     code = out.read_text()
     assert "G91 G30 Z0.000" in code.splitlines() and "G28" not in code
     back = load_target(target).post.parse(code)

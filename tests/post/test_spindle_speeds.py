@@ -19,7 +19,7 @@ from camtool.importers import gcode
 from camtool.importers.gcode import read_gcode
 from camtool.model.program import Spindle
 from tests.corpus.test_rs274 import needs_rs274, rs274
-from tests.targets import post_cli
+from tests.targets import repost_cli
 
 LASER = "G21 G90\nM4\nG0 X10 Y10\nG1 X20 S500 F1000\nG1 Y20 S300\nG1 X10 S0\nG1 Y10 S800\nM5\nM2\n"
 CALL = re.compile(r"(SET_SPINDLE_SPEED|START_SPINDLE_\w+|STOP_SPINDLE_TURNING|STRAIGHT_FEED)\(")
@@ -63,11 +63,7 @@ def test_s0_while_on_is_a_speed_and_a_bare_m4_none(plain: bool) -> None:
 @needs_rs274
 @pytest.mark.parametrize("target", ["grbl", "linuxcnc"])
 def test_a_laser_program_burns_each_move_at_its_own_power(target: str, tmp_path: Path) -> None:
-    original = tmp_path / "laser.ngc"
-    original.write_text(LASER)
-    out = tmp_path / f"laser-{target}.ngc"
-    done = post_cli(original, target, out)
-    assert done.returncode == 0, done.stderr
+    original, out = repost_cli(tmp_path, "laser.ngc", LASER, target)
     want = _speeds_at_cuts(original)
     assert want == [(True, 500.0), (True, 300.0), (True, 0.0), (True, 800.0)]
     assert _speeds_at_cuts(out) == want
