@@ -432,7 +432,7 @@ class _Reader(PlainLines):
     # -- motion ------------------------------------------------------------------
 
     def _motion(self, w: BlockWords) -> set[str]:
-        """Execute G28/G30 or the motion of the block; the letters it used."""
+        """Execute G28/G30/G53 or the motion of the block; the letters it used."""
         used = {"P"} if w.g_name("nonmodal") == "G4" else set()
         axes = {letter for letter in "XYZ" if letter in w.args}
         motion = w.g_name("motion")
@@ -441,7 +441,7 @@ class _Reader(PlainLines):
         home = w.g_name("nonmodal")
         if home == "G53":
             self._machine_coordinates(w.args)
-            return used
+            return used | axes
         if home in ("G28", "G30"):
             if axes and motion not in (None, "G80"):
                 raise InputError(
@@ -710,19 +710,38 @@ class _Reader(PlainLines):
         return mx + side * h * uy, my - side * h * ux
 
     def _machine_coordinates(self, args: dict[str, Word]) -> None:
-        """G53 without axis words: no move (as LinuxCNC); with them, refused.
+        """G53: a rapid to machine zero is a :class:`Home`; no axis words, no move; else refused.
 
-        A G53 move goes to a position in machine coordinates, which camtool does not know,
-        so it is refused rather than dropped (a dropped retract would leave the next rapid at
-        cutting depth). Without axis words (FreeCAD's Centroid post begins ``G53 G00 G17``)
-        the block moves nowhere; its other codes are read as usual.
+        ``G53 G0 Z0`` (the retract of Haas-style and many Fusion 360 posts) rapids to
+        machine zero on the axes it names: kept as a :class:`Home` with code ``"G53"``, the
+        axes unknown after it. Any other G53 move goes to a position in machine
+        coordinates, which camtool does not know, so it is refused rather than dropped (a
+        dropped retract would leave the next rapid at cutting depth). Without axis words
+        (FreeCAD's Centroid post begins ``G53 G00 G17``) the block moves nowhere; its other
+        codes are read as usual.
         """
         words = [str(args[letter]) for letter in "XYZIJKR" if letter in args]
+        axes = "".join(letter for letter in "XYZ" if letter in args)
+        at_zero = len(axes) == len(words) and all(args[a].value == 0 for a in axes)
+        if words and at_zero and self.motion == "G0" and self.absolute:
+            for letter in axes:
+                setattr(self, letter.lower(), None)
+            self.home = f"G53 on line {self.line}"
+            self.commands.add(len(self.moves), Home(axes, "G53"))
+            self.notes.add(
+                "G53",
+                self.line,
+                "G53 G0 rapid to machine zero: kept as a command, but camtool does not know "
+                "where machine zero is, so the verifier does not simulate the move; moves "
+                "after it must give absolute X and Y",
+            )
+            return
         if words:
             raise InputError(
                 f"{self.where()}: G53 {' '.join(words)} moves in machine coordinates, which "
-                "camtool does not know; write the program in part coordinates (e.g. a "
-                "retract as G0 Z with the work offset's clearance height)"
+                "camtool does not know (only a G0 rapid to machine zero, G53 G0 Z0, is "
+                "read); write the program in part coordinates (e.g. a retract as G0 Z with "
+                "the work offset's clearance height)"
             )
         self.notes.add("G53", self.line, "G53 without axis words moves nowhere: read as no move")
 

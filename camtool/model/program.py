@@ -194,17 +194,18 @@ class DrillCycle:
 
 @dataclass(frozen=True)
 class Home:
-    """Return to a stored machine position on ``axes`` ("XY", "Z" or "XYZ") at rapid speed.
+    """Return to a machine position on ``axes`` ("XY", "Z" or "XYZ") at rapid speed.
 
     ``code`` names the position, as RS-274/NGC does (LinuxCNC "G28, G28.1", "G30,
-    G30.1"; GRBL 1.1 the same): ``"G28"`` the first (machine zero on most machines),
-    ``"G30"`` the second. That position is not the part zero and camtool does not know
-    it, so a program's path after a Home is only known again from its next absolute
-    move, and its Z only from the next move that gives Z.
+    G30.1", "G53"; GRBL 1.1 the same): ``"G28"`` the first stored position (machine
+    zero on most machines), ``"G30"`` the second, ``"G53"`` machine zero itself
+    (``G53 G0 Z0``). That position is not the part zero and camtool does not know it,
+    so a program's path after a Home is only known again from its next absolute move,
+    and its Z only from the next move that gives Z.
     """
 
     axes: str = "XY"
-    code: Literal["G28", "G30"] = "G28"
+    code: Literal["G28", "G30", "G53"] = "G28"
 
 
 Plane: TypeAlias = Literal["zx", "yz"]

@@ -196,7 +196,7 @@ class BlockReader:
             self._only(codes, values, key, "a tool length offset", needs="H")
             self._offset_after_change(round(values["H"]))
         elif key is not None and key in spec.homes:
-            self._home(codes, values, "G28" if key == "G28" else "G30")
+            self._home(codes, values, "G28" if key == "G28" else "G30" if key == "G30" else "G53")
         elif key is not None and key in (spec.stop, spec.optional_stop):
             self._only(codes, values, key, "a program stop")
             optional = key == spec.optional_stop and key != spec.stop
@@ -264,9 +264,23 @@ class BlockReader:
             )
         return value
 
-    def _home(self, codes: list[str], values: dict[str, float], key: Literal["G28", "G30"]) -> None:
-        """``G28`` alone (all three axes) or ``G91 G28`` with the axes it names at 0 (G30 so)."""
+    def _home(
+        self, codes: list[str], values: dict[str, float], key: Literal["G28", "G30", "G53"]
+    ) -> None:
+        """A return as the writer writes it: ``G28`` or ``G91 G28 Z0`` (G30 so), ``G53 G0 Z0``.
+
+        ``G28`` alone returns all three axes; ``G91 G28`` and ``G53 G0`` the axes they
+        name, each at 0.
+        """
         axes = "".join(a for a in "XYZ" if a in values)
+        if key == "G53":
+            rapid = self.spec.motion_codes[0]
+            if codes != [key, rapid] or not axes or set(values) - set("XYZ"):
+                raise self.fail(f"a return to machine zero is G53 {rapid} with axis words")
+            if any(values[a] != 0.0 for a in axes):
+                raise self.fail(f"G53 {rapid} goes to machine zero here: its axis words are 0")
+            self.state.commands.append((len(self.state.moves), Home(axes, key)))
+            return
         incremental = codes == ["G91", key]
         if codes not in (["G91", key], [key]) or set(values) - set("XYZ"):
             raise self.fail(f"a return to the stored position is G91 {key} Z0 or {key} alone")

@@ -125,10 +125,11 @@ class WordAddressSpec:
             program read from code that selects one keeps it (written before its first
             move); ``()``: a program runs in the work offset the user has active.
         home: ``"G28"``: a program read from code keeps its returns to the machine's
-            stored positions (:class:`~camtool.model.program.Home`; G28's and G30's,
-            :attr:`homes`), written as RS-274 writes them: ``G91 G28 Z0`` then ``G90``
-            for the axes one names (the intermediate point where the tool is), ``G28``
-            alone for all three; ``None``: they are dropped, with a warning, and
+            stored positions and machine zero (:class:`~camtool.model.program.Home`;
+            G28's, G30's and G53's, :attr:`homes`), written as RS-274 writes them:
+            ``G91 G28 Z0`` then ``G90`` for the axes one names (the intermediate point
+            where the tool is), ``G28`` alone for all three, ``G53 G0 Z0`` for machine
+            zero; ``None``: they are dropped, with a warning, and
             refused where a move after one would run at the height it left
             (:func:`camtool.post.base.check_dropped_homes`).
         stop: program stop code (``M0``): the machine waits for the operator. A
@@ -194,12 +195,12 @@ class WordAddressSpec:
 
     @property
     def homes(self) -> tuple[str, ...]:
-        """The returns to stored positions written: ``G28`` and ``G30`` with :attr:`home`.
+        """The returns written: ``G28``, ``G30`` and ``G53`` (to machine zero) with :attr:`home`.
 
-        RS-274's two stored positions (LinuxCNC "G28, G28.1" and "G30, G30.1"; GRBL 1.1
-        the same); ``()`` without ``home``.
+        RS-274's two stored positions and its machine coordinates (LinuxCNC "G28, G28.1",
+        "G30, G30.1", "G53"; GRBL 1.1 gcode.c the same); ``()`` without ``home``.
         """
-        return ("G28", "G30") if self.home else ()
+        return ("G28", "G30", "G53") if self.home else ()
 
     def quantum_mm(self) -> float:
         """The coarsest written step of X, Y, I and J, mm: the grid arcs must land on."""

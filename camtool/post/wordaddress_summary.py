@@ -42,7 +42,7 @@ def closing_warnings(
         "Dwell": f"{name} has no dwell: {d['Dwell']} pause(s) dropped",
         "ToolChange": f"{name} has no tool change: {d['ToolChange']} tool change(s) "
         "dropped; change tools by hand",
-        "Home": f"{name}: {d['Home']} G28/G30 return(s) to a stored machine position "
+        "Home": f"{name}: {d['Home']} G28/G30/G53 return(s) to a machine position "
         "dropped (camtool does not write them for it); move there by hand if the job needs it",
         "z-split": f"{d['z-split']} move(s) changing XY and Z together written as a Z block "
         f"and an XY block (Z first when rising, last when plunging): {name} puts Z moves in "

@@ -619,13 +619,16 @@ class BlockWriter(ArcWriter):
     def _home(self, axes: str, code: str) -> None:
         """A return to the stored position: ``G91 G28 Z0``, ``G90`` (``G28`` for XYZ).
 
-        RS-274 writes it so, through the point where the tool is.
+        RS-274 writes it so, through the point where the tool is; a return to machine
+        zero is ``G53`` with the rapid code and the axes at 0 (``G53 G0 Z0``).
 
         A program's ``G28 G91 Z0`` before its first move is its retract: dropped, the
         first rapid would run at whatever height the tool was left. The axes it moves
         are written again in the next move that gives them.
         """
-        if axes == "XYZ":
+        if code == "G53":
+            self.block([code, self.spec.motion_codes[0], *(a + self.text(a, 0.0) for a in axes)])
+        elif axes == "XYZ":
             self.block([code])
         else:
             self.block(["G91", code, *(a + self.text(a, 0.0) for a in axes)])

@@ -125,7 +125,7 @@ def _warnings(program: Program, trace: StepTrace) -> list[str]:
     homes = sum(isinstance(c, Home) for _, c in program.commands)
     if homes:
         out.append(
-            f"{homes} return(s) to a stored machine position (G28/G30) not simulated: that "
+            f"{homes} return(s) to a machine position (G28, G30, G53) not simulated: that "
             "position is not the part zero, so the move after each is simulated from where "
             "the one before ended"
         )

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from camtool.importers.gcode import parse_gcode, parse_gcode_slow, read_gcode
 from camtool.importers.gcode_target import Reading
 from camtool.model.errors import InputError
-from camtool.model.program import ArcMove, Linear, Move, Program, Rapid, Spindle, Stop
+from camtool.model.program import ArcMove, Home, Linear, Move, Program, Rapid, Spindle, Stop
 from camtool.model.shapes import Arc
 from camtool.post.registry import load_target
 
@@ -346,8 +346,10 @@ def test_safe_conversion_warns_once_with_count_and_first_line(block: str, expect
         ("G93", "G93 (inverse-time / per-revolution feed)"),
         ("G95", "G95 (inverse-time / per-revolution feed)"),
         ("G92 X0 Y0", "G92 changes the coordinate offsets"),
-        ("G53 G0 X0", "G53 X0 moves in machine coordinates"),
+        ("G53 G1 Z0 F100", "G53 Z0 moves in machine coordinates"),  # a feed, not a rapid
+        ("G53 G0 X0 Y5", "G53 X0 Y5 moves in machine coordinates"),
         ("G53 G0 Z-5", "G53 Z-5 moves in machine coordinates"),
+        ("G91 G53 G0 Z0", "G53 Z0 moves in machine coordinates"),
         ("G5.1 X1 Y1 I1 J1", "G5.1 splines"),
         ("G12 X1", "unknown or unsupported code G12"),
         ("M98 P100", "unknown or unsupported code M98"),
@@ -572,6 +574,15 @@ def test_g53_without_axis_words_moves_nowhere() -> None:
     program = parse("G90 G80 G40 G49\nG53 G00 G17\nG21\nG0 X1 Y1\nG1 X2 F100\nM2\n")
     assert [(m.x, m.y) for m in program.moves] == [(1.0, 1.0), (2.0, 1.0)]
     assert any("G53 without axis words" in w for w in program.warnings)
+
+
+def test_g53_rapid_to_machine_zero_is_a_home_and_leaves_its_axes_unknown() -> None:
+    """``G53 G0 Z0.``, Haas-style posts' retract (and Fusion 360's "G53" safe retracts)."""
+    text = "G21 G90\nG0 X1 Y1 Z2\nG53 G0 Z0.\nG0 X3 Y1\nG53 Z0\nG0 Z5\nG1 X4 F100\nM2\n"
+    program = parse(text)
+    assert program.commands == ((1, Home("Z", "G53")), (2, Home("Z", "G53")))  # G0 modal
+    assert program.moves[1] == Rapid(3.0, 1.0, contour=program.moves[1].contour)  # Z unknown
+    assert any("G53 G0 rapid to machine zero" in w for w in program.warnings)
 
 
 def test_a_program_without_f_reads_with_the_feed_post_gives() -> None:

@@ -73,12 +73,14 @@ def test_returns_are_written_and_read_back(target: str) -> None:
 
 
 @pytest.mark.parametrize(
-    "block", ["G28 Z0.000", "G91 G28", "G91 G28 Z1.000", "G91 G28 Z0.000 F100"]
+    "block",
+    ["G28 Z0.000", "G91 G28", "G91 G28 Z1.000", "G91 G28 Z0.000 F100"]
+    + ["G53 G0 Z1.000", "G53 G1 Z0.000", "G53 G0", "G91 G53 G0 Z0.000"],
 )
 def test_the_strict_reader_takes_the_writers_returns_only(block: str) -> None:
-    """(Another program's G28 forms are read by the RS-274 reader, as before.)"""
+    """(Another program's G28 and G53 forms are read by the RS-274 reader, as before.)"""
     reader = BlockReader(load_target("grbl").post.spec, "t.gcode")
-    with pytest.raises(ParseError, match="G28"):
+    with pytest.raises(ParseError, match="G53" if "G53" in block else "G28"):
         reader.read(f"G21 G90 G94 G17\n{block}\nG90\nG0 X1.000 Y1.000 Z1.000\nM2\n")
 
 
@@ -117,24 +119,37 @@ M2
 """
 """A cut, the return to the G30 position on Z, a rapid that gives X and Y only, a cut."""
 
+RETURNS = {"G28": "G91 G28 Z0\nG90\n", "G30": "G91 G30 Z0\nG90\n", "G53": "G53 G0 Z0.\n"}
+"""Each return on Z as programs write it: G53's is Haas-style posts' (and Fusion 360's)."""
+
+
+def _midway(code: str) -> str:
+    """:data:`G30_MIDWAY` with the return ``code`` (:data:`RETURNS`)."""
+    return G30_MIDWAY.replace(RETURNS["G30"], RETURNS[code])
+
 
 @needs_rs274
+@pytest.mark.parametrize(("code", "written"), [("G30", "G91 G30 Z0.000"), ("G53", "G53 G0 Z0.000")])
 @pytest.mark.parametrize("target", ["grbl", "linuxcnc"])
-def test_a_g30_return_is_written_as_g30_and_moves_as_it_did(target: str, tmp_path: Path) -> None:
-    """G30 was dropped (with a warning): the rapid after it ran at Z-1, through the part."""
-    original, out = repost_cli(tmp_path, "g30.nc", G30_MIDWAY, target)
-    code = out.read_text()
-    assert "G91 G30 Z0.000" in code.splitlines() and "G28" not in code
-    back = load_target(target).post.parse(code)
-    assert [c for _, c in back.commands if isinstance(c, Home)] == [Home("Z", "G30")]
+def test_a_g30_or_g53_return_is_written_as_such_and_moves_as_it_did(
+    code: str, written: str, target: str, tmp_path: Path
+) -> None:
+    """G30 was dropped (with a warning) and G53 refused: the rapid after a dropped one ran
+    at Z-1, through the part."""
+    original, out = repost_cli(tmp_path, f"{code}.nc", _midway(code), target)
+    text = out.read_text()
+    assert written in text.splitlines() and "G28" not in text
+    back = load_target(target).post.parse(text)
+    assert [c for _, c in back.commands if isinstance(c, Home)] == [Home("Z", code)]
     b = _same_moves(original, out)
-    # rs274's G30 position is its parameters' (all 0 here): the XY rapid runs at Z0, not Z-1
+    # rs274's G30 position (its parameters) and machine zero (G54 at 0) are Z0 here: the XY
+    # rapid runs at Z0, not at Z-1
     rapid = next(p for kind, p in b if kind == "rapid" and p[:2] == (20.0, 20.0))
     assert rapid[2] == 0.0
 
 
 @pytest.mark.parametrize("rapid", ["G0 X20 Y20", "G0 X20 Y20 Z5"])
-@pytest.mark.parametrize("code", ["G28", "G30"])
+@pytest.mark.parametrize("code", ["G28", "G30", "G53"])
 @pytest.mark.parametrize("target", ["valcnc", "i8751"])
 def test_a_dropped_return_with_moves_after_it_is_refused(
     rapid: str, code: str, target: str, tmp_path: Path
@@ -142,11 +157,13 @@ def test_a_dropped_return_with_moves_after_it_is_refused(
     """valcnc and i8751 write no return: the XY rapid after it would run at Z-1, or rise
     from Z-1 on a slant through the part (valcnc wrote ``G00X20Y20Z5`` from there)."""
     original = tmp_path / f"{code}.nc"
-    original.write_text(G30_MIDWAY.replace("G30", code).replace("G0 X20 Y20", rapid))
+    text = _midway(code).replace("G0 X20 Y20", rapid)
+    original.write_text(text)
     out = tmp_path / f"{code}.{target}"
     done = post_cli(original, target, out)
     assert done.returncode == 1, done.stdout
-    assert "line 8:" in done.stderr and f"{code} return on Z" in done.stderr
+    line = text.splitlines().index(rapid) + 1
+    assert f"line {line}:" in done.stderr and f"{code} return on Z" in done.stderr
     assert "Z-1" in done.stderr and "Traceback" not in done.stderr
     assert not out.exists()
 
@@ -163,17 +180,17 @@ def test_a_dropped_return_followed_by_a_z_or_by_the_end_is_written(
     out = tmp_path / "end.valcnc"
     done = post_cli(original, "valcnc", out)
     assert done.returncode == 0, done.stderr
-    assert "G28/G30 return(s) to a stored machine position dropped" in done.stderr
+    assert "G28/G30/G53 return(s) to a machine position dropped" in done.stderr
     lines = out.read_text().splitlines()
     after = lines[lines.index("G01X10Y0") + 1 :]
     assert after == (["G00Z5", "G00X20Y20"] if "X20" in tail else [])
 
 
-def test_pic_mmh_writes_g28_as_machine_zero_and_never_a_g30_as_it() -> None:
-    """pic-mmh's ``G28Z0;`` is machine zero; it has no second stored position."""
+def test_pic_mmh_writes_g28_as_machine_zero_and_never_a_g30_or_g53_as_it() -> None:
+    """pic-mmh's ``G28Z0;`` is machine zero; it has no second stored position, no G53."""
     moves = (Rapid(0.0, 0.0), Linear(1.0, 0.0, 5.0), Rapid(0.5, 0.5))  # no Z word
     loaded = load_target("pic-mmh")
-    for code, written in (("G28", ["G28Z0;"]), ("G30", [])):
+    for code, written in (("G28", ["G28Z0;"]), ("G30", []), ("G53", [])):
         home: Home = Home("Z", code)  # type: ignore[arg-type]
         program = Program(moves, commands=((3, home),))
         result = loaded.emit(program)

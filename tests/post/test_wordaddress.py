@@ -253,7 +253,7 @@ def test_what_the_dialect_lacks_is_dropped_with_one_warning_per_kind() -> None:
     assert "toy has no F word: the feed of 2 cutting block(s)" in warnings[0]
     assert "toy has no spindle command: 2 spindle command(s) dropped" in warnings[1]
     assert "toy has no dwell: 1 pause(s) dropped" in warnings[2]
-    assert "1 G28/G30 return(s)" in warnings[3]
+    assert "1 G28/G30/G53 return(s)" in warnings[3]
 
 
 def test_spindle_without_s_word_keeps_the_code_and_warns() -> None:

@@ -23,5 +23,5 @@ def test_dwell_adds_its_seconds_to_the_time() -> None:
 def test_return_to_machine_zero_is_reported_not_simulated() -> None:
     v = verify_program(Program(SQUARE, commands=((3, Home("XY")),)), load_machine("grbl"))
     assert any(
-        "1 return(s) to a stored machine position (G28/G30) not simulated" in w for w in v.warnings
+        "1 return(s) to a machine position (G28, G30, G53) not simulated" in w for w in v.warnings
     )
