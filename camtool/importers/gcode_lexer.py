@@ -17,6 +17,9 @@ from camtool.model.units import LARGEST_VALUE
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)")
 _WORD = re.compile(r"([A-NP-Z])(" + _NUMBER.pattern + ")")
 """A word as :func:`_words_by_char` reads it: a letter (not O) and its number."""
+_PROGRAM_NUMBER = re.compile(r"O\d+")
+"""A Fanuc/Haas program number line (``O01001 (PART)``): no effect on the moves; LinuxCNC's
+interpreter reads a bare O-number as nothing too (its ``rs274`` runs such a file)."""
 _COMMENT_CHARS = re.compile(r"[;()*]")
 _CHECKSUM = re.compile(r"\*(\d+)$")
 _CUT = re.compile(r"[A-Za-z]\s*[+-]?\s*(?:\d[\d\s]*)?\.$|[A-Za-z]\s*[+-]?$")
@@ -50,7 +53,8 @@ class Block:
 def lex_line(raw: str, line: int, source: str) -> Block | None:
     """Split one line into words; ``None`` for a line without words.
 
-    A line with only comments, blanks or a ``%`` tape marker gives ``None``.
+    A line with only comments, blanks, a ``%`` tape marker or a program number
+    (``O01001``, :data:`_PROGRAM_NUMBER`) gives ``None``.
 
     Args:
         raw: the line, without its end-of-line characters.
@@ -74,6 +78,8 @@ def lex_line(raw: str, line: int, source: str) -> Block | None:
     if block_delete:
         code = code[1:]
     code = "".join(code.split()).upper()
+    if _PROGRAM_NUMBER.fullmatch(code):
+        return None  # a program number alone: no words (O-words with more are refused)
     words = _words(code, where)
     if not words:
         if block_delete:

@@ -77,3 +77,16 @@ def test_fast_paths_equal_the_loops_on_random_lines() -> None:
         code = "".join(raw.split()).upper()
         fast_words = _outcome(gcode_lexer._words, code, "f:1")
         assert fast_words == _outcome(gcode_lexer._words_by_char, code, "f:1"), code
+
+
+def test_a_program_number_alone_is_a_line_without_words() -> None:
+    """Fanuc and Haas posts begin ``O01001 (PART)``; LinuxCNC's ``rs274`` runs such a file."""
+    assert gcode_lexer.lex_line("O01001 (PART)", 2, "f") is None
+    assert gcode_lexer.lex_line("o1234", 2, "f") is None
+    for line in ("O100 sub", "O1001 G21", "O<part> call", "O1.5"):
+        try:
+            gcode_lexer.lex_line(line, 2, "f")
+        except InputError as exc:
+            assert "f:2:" in str(exc)
+        else:
+            raise AssertionError(f"{line!r} was read")

@@ -74,8 +74,10 @@ def test_returns_are_written_and_read_back(target: str) -> None:
 
 @pytest.mark.parametrize(
     "block",
-    ["G28 Z0.000", "G91 G28", "G91 G28 Z1.000", "G91 G28 Z0.000 F100"]
-    + ["G53 G0 Z1.000", "G53 G1 Z0.000", "G53 G0", "G91 G53 G0 Z0.000"],
+    [
+        *("G28 Z0.000", "G91 G28", "G91 G28 Z1.000", "G91 G28 Z0.000 F100"),
+        *("G53 G0 Z1.000", "G53 G1 Z0.000", "G53 G0", "G91 G53 G0 Z0.000"),
+    ],
 )
 def test_the_strict_reader_takes_the_writers_returns_only(block: str) -> None:
     """(Another program's G28 and G53 forms are read by the RS-274 reader, as before.)"""
@@ -102,6 +104,42 @@ def test_a_fusion_program_re_posted_moves_as_it_did(target: str, tmp_path: Path)
     a = _same_moves(original, out)  # every return written: none dropped
     # the first move of both is the return's rise, before any XY rapid
     assert a[0][0] == "rapid" and a[0][1][:2] == (0.0, 0.0)
+
+
+HAAS = """%
+O01001 (PART)
+(T1 D=6. CR=0. - ZMIN=-3. - FLAT END MILL)
+G90 G94 G17 G40 G49 G80
+G21
+G53 G0 Z0.
+T1 M6
+S8000 M3
+G54
+G0 X-5. Y0.
+G43 Z15. H1
+G0 Z5.
+G1 Z-1. F300.
+G1 X50. F1000.
+G2 X60. Y10. I0. J10.
+G0 Z15.
+G53 G0 Z0.
+M5
+G53 G0 X0. Y0.
+M30
+%
+"""
+"""A Haas-style post (Fusion 360's "G53" safe retracts): a program number, G53 retracts."""
+
+
+@needs_rs274
+@pytest.mark.parametrize("target", ["grbl", "linuxcnc"])
+def test_a_haas_style_program_re_posted_moves_as_it_did(target: str, tmp_path: Path) -> None:
+    """Refused before: the program number (O-word) and the G53 retracts."""
+    original, out = repost_cli(tmp_path, "1001.nc", HAAS, target)
+    lines = out.read_text().splitlines()
+    assert lines.count("G53 G0 Z0.000") == 2 and "G53 G0 X0.000 Y0.000" in lines
+    b = _same_moves(original, out)
+    assert b[0][0] == "rapid" and b[0][1][2] == 0.0  # machine zero first (G54 at 0)
 
 
 G30_MIDWAY = """G21 G90
