@@ -110,10 +110,10 @@ def check_written_z(requested: float, written: float, where: str) -> None:
 
 
 def check_dropped_homes(program: Program, homes: tuple[str, ...], target: str) -> None:
-    """Refuse a return of Z to a stored position the dialect cannot write, with moves after it.
+    """Refuse a return of Z to a machine position the dialect cannot write, with moves after it.
 
-    A program read from code that runs ``G91 G28 Z0`` (or G30) leaves its tool at the
-    stored height (the top, on most machines); its next moves give X and Y only, and
+    A program read from code that runs ``G91 G28 Z0`` (or G30, or ``G53 G0 Z0``) leaves
+    its tool at that height (the top, on most machines); its next moves give X and Y only, and
     written without the return they would run at the height the tool had before it:
     a rapid at cutting depth. A next move that gives Z and X, Y would run from that
     height on a slant, through what it cut. Such a program is refused, not written.
@@ -153,8 +153,8 @@ def check_dropped_homes(program: Program, homes: tuple[str, ...], target: str) -
         raise DialectError(
             f"{where}: the move after the program's {home.code} return on Z {how}, and "
             f"{target} cannot write that return: written without it, the move would run "
-            f"from the height the tool had before it ({left}), not from the stored "
-            f"position; give a move of Z alone (G0 Z at the clearance height) right after "
+            f"from the height the tool had before it ({left}), not from the "
+            f"{home.code} position; give a move of Z alone (G0 Z at the clearance height) right after "
             f"the {home.code}, or post for a target that writes it (grbl, linuxcnc)"
         )
 
@@ -420,7 +420,7 @@ class PostProcessor(ABC):
 
     @property
     def homes(self) -> tuple[str, ...]:
-        """The returns to stored positions (``"G28"``, ``"G30"``) the dialect writes.
+        """The returns to machine positions (``"G28"``, ``"G30"``, ``"G53"``) the dialect writes.
 
         Any other :class:`~camtool.model.program.Home` is dropped with a warning, or
         refused where a move after it needs its height (:func:`check_dropped_homes`).

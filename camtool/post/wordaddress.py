@@ -87,7 +87,7 @@ class WordAddressPost(PostProcessor):
 
     @property
     def homes(self) -> tuple[str, ...]:
-        """The spec's returns to stored positions (G28 and G30 with ``home``)."""
+        """The spec's returns to machine positions (G28, G30 and G53 with ``home``)."""
         return self.spec.homes
 
     @property
