@@ -153,8 +153,8 @@ def check_dropped_homes(program: Program, homes: tuple[str, ...], target: str) -
         raise DialectError(
             f"{where}: the move after the program's {home.code} return on Z {how}, and "
             f"{target} cannot write that return: written without it, the move would run "
-            f"from the height the tool had before it ({left}), not from the "
-            f"{home.code} position; give a move of Z alone (G0 Z at the clearance height) right after "
+            f"from the height the tool had before it ({left}), not from the {home.code} "
+            "position; give a move of Z alone (G0 Z at the clearance height) right after "
             f"the {home.code}, or post for a target that writes it (grbl, linuxcnc)"
         )
 
