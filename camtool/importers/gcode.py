@@ -17,12 +17,14 @@ from camtool import accel
 from camtool.accel.collector import paused
 from camtool.importers import gcode_ahead
 from camtool.importers.gcode_codes import BlockWords, CommandReader, Notes
+from camtool.importers.gcode_cycles import CYCLES, CycleState
 from camtool.importers.gcode_lexer import Block, Word, cut_mid_word, lex_line
 from camtool.importers.gcode_plain import ARC_TOL_IN, ARC_TOL_MM, PLAIN_WORDS, PlainLines
 from camtool.importers.gcode_target import READ_AS_WRITTEN, LengthOffsets, Reading
 from camtool.model.errors import InputError
 from camtool.model.program import (
     ArcMove,
+    Dwell,
     Home,
     Linear,
     Move,
@@ -299,6 +301,7 @@ class _Reader(PlainLines):
             LengthOffsets(self.commands, self.moves) if reading.length_offsets else None
         )
         self.home = ""
+        self.cycles = CycleState()  # canned cycles' sticky words and retract mode
         self.contour = 1
         self.cut_in_contour = False
 
@@ -401,6 +404,8 @@ class _Reader(PlainLines):
             self.absolute = distance == "G90"
         if (arc_distance := w.g_name("arc_distance")) is not None:
             self.arc_absolute = arc_distance == "G90.1"
+        if (retract := w.g_name("retract")) is not None:
+            self.cycles.retract = "initial" if retract == "G98" else "r-plane"
 
     def _check_unused(self, w: BlockWords, used: set[str]) -> None:
         """Refuse words that no code in the block uses (LinuxCNC does the same)."""
@@ -425,7 +430,7 @@ class _Reader(PlainLines):
                 "Z": "axis words need G0, G1, G2 or G3 (or modal motion) before them",
                 "P": "P belongs to G4 (dwell), G2/G3 (turns) or G64 (tolerance)",
                 "H": "H belongs to G43",
-                "Q": "Q belongs to G64 here (canned cycles are not read)",
+                "Q": "Q belongs to G64, G83 or G73",
             }.get(letter, "I, J, K and R belong to G2/G3 arcs")
             raise InputError(f"{self.where()}: {word} has no code to use it; {hint}")
 
@@ -450,6 +455,12 @@ class _Reader(PlainLines):
                 )
             self._home("G28" if home == "G28" else "G30", w.args)
             return used | axes
+        if self.motion in CYCLES:
+            if motion in CYCLES or axes:
+                self._cycle(w.args)
+                return used | {letter for letter in "XYZRQP" if letter in w.args}
+            return used
+        self.cycles.end_series()
         if self.motion in ("G2", "G3"):
             letters = "XYZRP" + "".join(_CENTRE_LETTERS[self.plane])
             arc_words = {letter for letter in letters if letter in w.args}
@@ -709,16 +720,24 @@ class _Reader(PlainLines):
         mx, my = (start[0] + end[0]) / 2, (start[1] + end[1]) / 2
         return mx + side * h * uy, my - side * h * ux
 
-    def _machine_coordinates(self, args: dict[str, Word]) -> None:
-        """G53: a rapid to machine zero is a :class:`Home`; no axis words, no move; else refused.
+    def _cycle(self, args: dict[str, Word]) -> None:
+        """A canned cycle's command and moves (:meth:`CycleState.hole` says what it refuses)."""
+        code, modes = cast(str, self.motion), (self.absolute, self.plane)
+        here, feed = (self.x, self.y, self.z), self._feed(code)
+        cycle, items = self.cycles.hole(code, args, here, feed, self.scale, modes, self.where())
+        self.commands.add(len(self.moves), cycle)
+        for item in items:
+            if isinstance(item, Dwell):
+                self.commands.add(len(self.moves), item)
+            else:
+                self._push(item, item.x, item.y, self.z if item.z is None else item.z)
+        self.positioned = True
 
-        ``G53 G0 Z0`` (the retract of Haas-style and many Fusion 360 posts) rapids to
-        machine zero on the axes it names: kept as a :class:`Home` with code ``"G53"``, the
-        axes unknown after it. Any other G53 move goes to a position in machine
-        coordinates, which camtool does not know, so it is refused rather than dropped (a
-        dropped retract would leave the next rapid at cutting depth). Without axis words
-        (FreeCAD's Centroid post begins ``G53 G00 G17``) the block moves nowhere; its other
-        codes are read as usual.
+    def _machine_coordinates(self, args: dict[str, Word]) -> None:
+        """G53: ``G53 G0 Z0`` is a :class:`Home` coded ``"G53"``; no axis words, no move.
+
+        Any other G53 move goes where camtool does not know: refused, not dropped (a
+        dropped retract would leave the next rapid at cutting depth).
         """
         words = [str(args[letter]) for letter in "XYZIJKR" if letter in args]
         axes = "".join(letter for letter in "XYZ" if letter in args)

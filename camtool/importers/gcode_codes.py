@@ -102,7 +102,7 @@ G_CODES = MappingProxyType(
             "G64 path blending (with its P/Q tolerances, if any) ignored: the verifier "
             "simulates the target's own path control",
         ),
-        ("G98 G99", "retract", "warn", "{code} canned-cycle return mode ignored (no cycles)"),
+        ("G98 G99", "retract", "read", ""),
         ("G97", "spindle_mode", "warn", "G97 spindle speed mode ignored"),
         ("G17.1 G18.1 G19.1", "plane", "error", _PLANE),
         (
@@ -112,7 +112,8 @@ G_CODES = MappingProxyType(
             "{code} (cutter radius compensation) is not supported: camtool compensates "
             "the tool itself; remove G41/G42 and post the drawing with --offset",
         ),
-        ("G73 G76 G81 G82 G83 G84 G85 G86 G87 G88 G89", "motion", "error", _CANNED),
+        ("G73 G81 G82 G83", "motion", "read", ""),
+        ("G76 G84 G85 G86 G87 G88 G89", "motion", "error", _CANNED),
         (
             "G93 G95",
             "feed_mode",

@@ -164,6 +164,8 @@ class PlainLines:
                 return False
             args[letter] = value
         motion = self.motion
+        if motion is not None and motion not in _PLAIN_MOTION.values():
+            return False  # a canned cycle's X Y: run() drills there
         g = args.pop("G", None)
         if g is not None:
             motion = _PLAIN_G.get(g)

@@ -305,7 +305,6 @@ def test_g80_alone_is_a_no_op() -> None:
         ("G61", "G61 path control mode ignored"),
         ("G64", "G64 path blending (with its P/Q tolerances, if any) ignored"),
         ("G64 P0.01 Q0.01", "G64 path blending (with its P/Q tolerances, if any) ignored"),
-        ("G98", "G98 canned-cycle return mode ignored"),
         ("G97 S1000", "G97 spindle speed mode ignored"),
         ("T2", "tool number T ignored"),
         ("/M5", "'/' block delete: the line is read"),
@@ -341,8 +340,8 @@ def test_safe_conversion_warns_once_with_count_and_first_line(block: str, expect
         ("G42", "G42 (cutter radius compensation)"),
         ("G18.1", "G18.1 selects a plane in the UVW axes"),
         ("G19.1", "G19.1 selects a plane in the UVW axes"),
-        ("G81 X1 Y1 Z-1 R1", "G81 is a canned cycle"),
-        ("G83 X1 Y1 Z-1 R1 Q1", "G83 is a canned cycle"),
+        ("G84 X1 Y1 Z-1 R1", "G84 is a canned cycle"),  # tapping: not read
+        ("G85 X1 Y1 Z-1 R1", "G85 is a canned cycle"),  # boring: not read
         ("G93", "G93 (inverse-time / per-revolution feed)"),
         ("G95", "G95 (inverse-time / per-revolution feed)"),
         ("G92 X0 Y0", "G92 changes the coordinate offsets"),
