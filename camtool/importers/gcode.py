@@ -743,17 +743,7 @@ class _Reader(PlainLines):
         axes = "".join(letter for letter in "XYZ" if letter in args)
         at_zero = len(axes) == len(words) and all(args[a].value == 0 for a in axes)
         if words and at_zero and self.motion == "G0" and self.absolute:
-            for letter in axes:
-                setattr(self, letter.lower(), None)
-            self.home = f"G53 on line {self.line}"
-            self.commands.add(len(self.moves), Home(axes, "G53"))
-            self.notes.add(
-                "G53",
-                self.line,
-                "G53 G0 rapid to machine zero: kept as a command, but camtool does not know "
-                "where machine zero is, so the verifier does not simulate the move; moves "
-                "after it must give absolute X and Y",
-            )
+            self._returned(Home(axes, "G53"), "G53 G0 rapid to machine zero")
             return
         if words:
             raise InputError(
@@ -780,19 +770,20 @@ class _Reader(PlainLines):
                 and ((tx, ty) != (self.x, self.y) or z is not None)
             ):
                 self._push(Rapid(tx, ty, z), tx, ty, tz)
-        for letter in axes or "XYZ":
+        home = Home("".join(axes) or "XYZ", name)
+        self._returned(home, f"{name} return to the machine's stored position")
+
+    def _returned(self, home: Home, what: str) -> None:
+        """Keep ``home`` as a command; the axes it moves are unknown after it (a warning)."""
+        for letter in home.axes:
             setattr(self, letter.lower(), None)
-        self.home = f"{name} on line {self.line}"
-        self.commands.add(len(self.moves), Home("".join(axes) or "XYZ", name))
-        kept = (
-            "kept as a return-to-stored-position command, but camtool does not know that "
-            "position, so the verifier does not simulate the move"
-        )
+        self.home = f"{home.code} on line {self.line}"
+        self.commands.add(len(self.moves), home)
         self.notes.add(
-            name,
+            home.code,
             self.line,
-            f"{name} return to the machine's stored position: {kept}; moves after it must "
-            "give absolute X and Y",
+            f"{what}: kept as a command, but camtool does not know that position, so the "
+            "verifier does not simulate the move; moves after it must give absolute X and Y",
         )
 
 

@@ -1,13 +1,13 @@
-"""A re-posted program's G28 and G30 returns are written for GRBL and LinuxCNC, not dropped.
+"""A re-posted program's returns (G28, G30, G53 G0 Z0) are written for GRBL and LinuxCNC.
 
 Fusion 360's posts begin ``G28 G91 Z0`` / ``G90``: the tool rises to the stored position
-before the first XY rapid, and again before each tool change and at the end. camtool read
-it as a :class:`~camtool.model.program.Home` command and dropped it for every target, with
-a warning, so the re-posted program's first rapid ran at whatever height the tool had been
-left (on the stock, after touching off Z). Both controllers run RS-274's ``G28``
-(GRBL 1.1 gcode.c; LinuxCNC), so the targets now write it as RS-274 does. The judge is
-LinuxCNC's ``rs274``: the original and the re-posted program make the same moves, the
-returns' traverses included.
+before the first XY rapid, and again before each tool change and at the end; Haas-style
+posts retract with ``G53 G0 Z0.``. Dropped, such a return would leave the next rapid at
+whatever height the tool had (on the stock, after touching off Z). Both controllers run
+RS-274's returns (GRBL 1.1 gcode.c; LinuxCNC), so those targets write them as RS-274 does;
+a target that cannot is refused where the move after a return on Z needs its height. The
+judge is LinuxCNC's ``rs274``: the original and the re-posted program make the same moves,
+the returns' traverses included.
 """
 
 from __future__ import annotations
@@ -80,7 +80,7 @@ def test_returns_are_written_and_read_back(target: str) -> None:
     ],
 )
 def test_the_strict_reader_takes_the_writers_returns_only(block: str) -> None:
-    """(Another program's G28 and G53 forms are read by the RS-274 reader, as before.)"""
+    """(Another program's G28 and G53 forms are read by the RS-274 reader.)"""
     reader = BlockReader(load_target("grbl").post.spec, "t.gcode")
     with pytest.raises(ParseError, match="G53" if "G53" in block else "G28"):
         reader.read(f"G21 G90 G94 G17\n{block}\nG90\nG0 X1.000 Y1.000 Z1.000\nM2\n")
@@ -134,7 +134,7 @@ M30
 @needs_rs274
 @pytest.mark.parametrize("target", ["grbl", "linuxcnc"])
 def test_a_haas_style_program_re_posted_moves_as_it_did(target: str, tmp_path: Path) -> None:
-    """Refused before: the program number (O-word) and the G53 retracts."""
+    """The program number is read as no words, the G53 retracts as returns."""
     original, out = repost_cli(tmp_path, "1001.nc", HAAS, target)
     lines = out.read_text().splitlines()
     assert lines.count("G53 G0 Z0.000") == 2 and "G53 G0 X0.000 Y0.000" in lines
@@ -172,8 +172,8 @@ def _midway(code: str) -> str:
 def test_a_g30_or_g53_return_is_written_as_such_and_moves_as_it_did(
     code: str, written: str, target: str, tmp_path: Path
 ) -> None:
-    """G30 was dropped (with a warning) and G53 refused: the rapid after a dropped one ran
-    at Z-1, through the part."""
+    """Written again as such: without it the rapid after it would run at Z-1, through the
+    part."""
     original, out = repost_cli(tmp_path, f"{code}.nc", _midway(code), target)
     text = out.read_text()
     assert written in text.splitlines() and "G28" not in text
@@ -193,7 +193,7 @@ def test_a_dropped_return_with_moves_after_it_is_refused(
     rapid: str, code: str, target: str, tmp_path: Path
 ) -> None:
     """valcnc and i8751 write no return: the XY rapid after it would run at Z-1, or rise
-    from Z-1 on a slant through the part (valcnc wrote ``G00X20Y20Z5`` from there)."""
+    from Z-1 on a slant through the part (``G00X20Y20Z5`` from there)."""
     original = tmp_path / f"{code}.nc"
     text = _midway(code).replace("G0 X20 Y20", rapid)
     original.write_text(text)
