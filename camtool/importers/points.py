@@ -68,7 +68,10 @@ def read_points(path: str | Path, options: ImportOptions | None = None) -> Drawi
     if matlab:
         strokes = _matlab_strokes(text, path, scale)
     else:
-        strokes = _text_strokes(text, path, warnings, scale)
+        try:
+            strokes = _text_strokes(text, path, warnings, scale)
+        except InputError as exc:
+            raise _program_error(text, path) or exc from exc
     contours: list[Contour] = []
     for k, stroke in enumerate(strokes, start=1):
         pts = [(_scale(x, scale), _scale(y, scale)) for x, y in stroke.xy]
@@ -134,6 +137,30 @@ def _contour(pts: list[Point], source: str) -> Contour | None:
 
 
 # ---------------------------------------------------------------------------- text files
+
+
+_PROGRAM_START = re.compile(r"[(%;]|[GgMmNnOo]\s*\d")
+"""How a G-code program's first line starts: a comment, the tape mark, or a G, M, N or O word."""
+
+
+def _program_error(text: str, path: Path) -> InputError | None:
+    """The error for a G-code program saved with a point list's ending (CamBam's ``.txt``).
+
+    ``None`` when the first line that is not blank does not start as a program's does.
+    """
+    for number, raw in enumerate(text.splitlines(), start=1):
+        line = raw.strip()
+        if not line:
+            continue
+        if not _PROGRAM_START.match(line):
+            return None
+        shown = line if len(line) <= 40 else line[:40] + "…"
+        return InputError(
+            f"{path}: line {number}: {shown!r} starts a G-code program, not a point "
+            f"list; camtool re-posts a program by its file ending: save it as {path.stem}.nc "
+            "and post that"
+        )
+    return None
 
 
 def _text_strokes(text: str, path: Path, warnings: list[str], scale: float) -> list[_Stroke]:
