@@ -419,6 +419,14 @@ class _Reader(PlainLines):
                 continue
             if letter in "IJK" and self.motion in ("G2", "G3") and used:
                 first, second = sorted(_CENTRE_LETTERS[self.plane])
+                if word.value == 0:  # FreeCAD's grbl post writes K0 on every XY arc
+                    self.notes.add(
+                        f"{letter}0 arc",
+                        self.line,
+                        f"{word} on an arc in the {_PLANE_NAMES[self.plane]} ignored: a zero "
+                        f"offset off the plane, which GRBL ignores too (LinuxCNC refuses it)",
+                    )
+                    continue
                 raise InputError(
                     f"{self.where()}: {word}: an arc in the {_PLANE_NAMES[self.plane]} takes "
                     f"its centre from {first} and {second}; select the plane of {word.letter} "

@@ -362,7 +362,10 @@ def test_safe_conversion_warns_once_with_count_and_first_line(block: str, expect
         ("G90.1 G2 X3 Y1 I2 F10", "G2 in G90.1 (absolute centre) needs both I and J"),
         ("G2 X3 Y1 I1 J0 R1 F10", "both R and I/J"),
         ("G2 X3 Y1 I1 P2 F10", "multi-turn arcs"),
-        ("G2 X3 Y1 I1 K0 F10", "K0: an arc in the XY plane (G17) takes its centre from I and J"),
+        (
+            "G2 X3 Y1 I1 K0.5 F10",
+            "K0.5: an arc in the XY plane (G17) takes its centre from I and J",
+        ),
         ("G1 X2 Y1", "G1 before any F word"),
         ("G1 X2 Y1 F0", "G1 with feed F0"),
         ("G0 X2 I1", "I1 has no code to use it"),
