@@ -134,7 +134,7 @@ def test_plane_arcs_are_the_chords_every_consumer_sees() -> None:
     ("text", "says"),
     [
         ("G0 X0 Y0\nG18 G2 X1 Z1 I0.5 F100", "unknown Z"),
-        ("G0 X0 Y0 Z0\nG18 G2 X1 Z0 I0.5 J0 F100", "J0: an arc in the ZX plane (G18) takes its"),
+        ("G0 X0 Y0 Z0\nG18 G2 X1 Z0 I0.5 J0.5 F100", "J0.5: an arc in the ZX plane (G18) takes"),
         ("G0 X0 Y0 Z0\nG19 G2 Y1 Z0 I0.5 F100", "in the YZ plane (G19), not I0.5; give J and K"),
         ("G0 X0 Y0 Z0\nG18 G2 X1 Z0 F100", "without a centre in the ZX plane (G18); give I and K"),
         ("G0 X0 Y0 Z0\nG18 G2 X1 Z0 R1 K0 F100", "with both R and I/K"),
@@ -153,8 +153,8 @@ def test_g17_returns_to_xy_arcs_and_k_is_refused_there() -> None:
         "G21 G90\nG0 X0 Y0 Z0\nG18 G2 X1 Z0 I0.5 F100\nG17 G2 X2 Y0 I0.5\nM2\n", source="t"
     )
     assert isinstance(program.moves[-1], ArcMove)
-    with pytest.raises(InputError, match="K0: an arc in the XY plane"):
-        parse_gcode("G21 G90\nG0 X0 Y0 Z0\nG18\nG17 G2 X1 Y0 I0.5 K0 F100\nM2\n", source="t")
+    with pytest.raises(InputError, match=r"K0\.5: an arc in the XY plane"):
+        parse_gcode("G21 G90\nG0 X0 Y0 Z0\nG18\nG17 G2 X1 Y0 I0.5 K0.5 F100\nM2\n", source="t")
 
 
 def test_the_plain_reader_does_not_read_a_modal_plane_arc_as_an_xy_arc() -> None:
