@@ -424,7 +424,7 @@ class _Reader(PlainLines):
                         f"{letter}0 arc",
                         self.line,
                         f"{word} on an arc in the {_PLANE_NAMES[self.plane]} ignored: a zero "
-                        f"offset off the plane, which GRBL ignores too (LinuxCNC refuses it)",
+                        "offset off the plane, which GRBL ignores too (LinuxCNC refuses it)",
                     )
                     continue
                 raise InputError(
