@@ -244,6 +244,13 @@ def _import(
             f"its data that of degree {implied}): read at the degree of their data, the one "
             "curve those numbers describe; check it in the preview"
         )
+    if reader.wide:
+        label, width = reader.wide[0]
+        warnings.append(
+            f"{path}: {len(reader.wide)} polyline(s) drawn with a width (first {label}, "
+            f"{width * scale:.4g} mm wide): camtool cuts a polyline's centre line, not the edges "
+            "of the band it draws; to cut the edges, draw them as contours"
+        )
     if not reader.contours and not reader.marks:
         on = f" on layers {', '.join(options.layers)}" if options.layers else ""
         raise InputError(
@@ -343,6 +350,7 @@ class _Reader:
         self.invisible = 0  # entities left out for their invisible flag (group code 60)
         self.swapped: list[tuple[str, float]] = []  # ELLIPSEs with a ratio above 1
         self.redegreed: list[tuple[str, int, int]] = []  # SPLINEs read at another degree
+        self.wide: list[tuple[str, float]] = []  # polylines drawn with a width (label, widest)
 
     def read(self, entity: Any) -> None:
         from camtool.importers.dxf_blocks import HIDDEN, INVISIBLE, Skip, expand_insert
@@ -447,6 +455,9 @@ class _Reader:
             check_numbers(part, item.label, item.layer, self.limit)
         if swapped_axes(item.entity):
             self.swapped.append((item.label, float(item.entity.dxf.ratio)))
+        width = _width(item.entity, kind)
+        if width > 0.0:
+            self.wide.append((item.label, width))
         implied = implied_degree(item.entity)
         if implied is not None:
             self.redegreed.append((item.label, int(item.entity.dxf.degree), implied))
@@ -503,6 +514,21 @@ class _Reader:
     ) -> None:
         self.skipped[(kind, reason)] += 1
         self.notes.append(DxfNote(label, layer, detail or reason, where))
+
+
+def _width(entity: Any, kind: str) -> float:
+    """The widest a 2D polyline is drawn (its constant, start and end widths), drawing units.
+
+    0.0 for another entity, or a polyline drawn as a line.
+    """
+    if kind == "LWPOLYLINE":
+        ends = [w for start, end in entity.get_points("se") for w in (start, end)]
+        return float(max([entity.dxf.const_width, *ends]))
+    if kind == "POLYLINE" and entity.is_2d_polyline:
+        dxf = entity.dxf
+        ends = [w for v in entity.vertices for w in (v.dxf.start_width, v.dxf.end_width)]
+        return float(max([dxf.default_start_width, dxf.default_end_width, *ends]))
+    return 0.0
 
 
 def _kind(entity: Any) -> str:

@@ -297,3 +297,23 @@ def test_an_mline_is_cut_as_ezdxf_draws_its_elements(tmp_path: Path) -> None:
     assert len(expected) == 4 + 6  # two elements: 2 segments open, 3 closed
     assert {c.layer for c in drawing.contours} == {"WALLS", "0"}
     assert any("XLINE entity (an infinite construction line" in w for w in drawing.warnings)
+
+
+def test_polylines_drawn_with_a_width_are_cut_on_their_centre_line_and_named(
+    tmp_path: Path,
+) -> None:
+    """A width draws a band (QCAD's entities.dxf, centroid symbols); its centre line is cut."""
+
+    def build(msp: Any) -> None:
+        msp.add_lwpolyline([(0, 0), (10, 0)], dxfattribs={"const_width": 2.5})
+        msp.add_lwpolyline([(0, 5, 2.0, 5.0), (10, 5, 0.0, 0.0)], format="xyse")
+        wide = msp.add_polyline2d([(0, 10), (10, 10)])
+        wide.vertices[0].dxf.end_width = 1.0
+        msp.add_lwpolyline([(0, 15), (10, 15)])  # no width: not named
+
+    drawing = read_dxf(write_dxf(tmp_path / "w.dxf", build, insunits=1))  # inches
+    ends = sorted((c.segments[0].start, c.segments[-1].end) for c in drawing.contours)
+    assert ends == [((0.0, y * 25.4), (254.0, y * 25.4)) for y in (0, 5, 10, 15)]
+    (warning,) = [w for w in drawing.warnings if "width" in w]
+    assert "3 polyline(s) drawn with a width (first LWPOLYLINE #" in warning
+    assert "63.5 mm wide" in warning  # 2.5 in
