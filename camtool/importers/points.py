@@ -139,27 +139,28 @@ def _contour(pts: list[Point], source: str) -> Contour | None:
 # ---------------------------------------------------------------------------- text files
 
 
-_PROGRAM_START = re.compile(r"[(%;]|[GgMmNnOo]\s*\d")
-"""How a G-code program's first line starts: a comment, the tape mark, or a G, M, N or O word."""
+_PROGRAM_BLOCK = re.compile(r"(?:[Nn]\s*\d+\s*)?[GgMm]\s*\d+(?:\.\d+)?(?=$|[\s(;%A-Za-z])")
+"""A G-code block: a G or M word first (after a line number), then a word, a blank, a comment
+or the end, as no point-list row has (``G1,4`` is a bad row, not a block)."""
+_PROGRAM_LOOK = 20
+"""How many lines (not blank) are looked at for a block (a program's header comes first)."""
 
 
 def _program_error(text: str, path: Path) -> InputError | None:
     """The error for a G-code program saved with a point list's ending (CamBam's ``.txt``).
 
-    ``None`` when the first line that is not blank does not start as a program's does.
+    ``None`` when none of the first :data:`_PROGRAM_LOOK` lines that are not blank is a
+    G-code block (a ``(10, 20)`` row stays a bad point-list row).
     """
-    for number, raw in enumerate(text.splitlines(), start=1):
-        line = raw.strip()
-        if not line:
-            continue
-        if not _PROGRAM_START.match(line):
-            return None
-        shown = line if len(line) <= 40 else line[:40] + "…"
-        return InputError(
-            f"{path}: line {number}: {shown!r} starts a G-code program, not a point "
-            f"list; camtool re-posts a program by its file ending: save it as {path.stem}.nc "
-            "and post that"
-        )
+    lines = ((n, raw.strip()) for n, raw in enumerate(text.splitlines(), start=1) if raw.strip())
+    for number, line in itertools.islice(lines, _PROGRAM_LOOK):
+        if _PROGRAM_BLOCK.match(line):
+            shown = line if len(line) <= 40 else line[:40] + "…"
+            return InputError(
+                f"{path}: line {number}: {shown!r} is a G-code block: this is a program, not a "
+                f"point list; camtool re-posts a program by its file ending: save it as "
+                f"{path.stem}.nc and post that"
+            )
     return None
 
 

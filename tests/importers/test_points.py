@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -301,18 +302,22 @@ def test_cli_exit_3_names_file_line_and_column(
 
 
 # How CamBam's programs begin (Universal G-code Sender keeps one as test_files/shapeoko.txt),
-# a program without comments, and one after a blank line.
+# a program without comments, and one with line numbers after the tape mark.
 @pytest.mark.parametrize(
     ("text", "line", "shown"),
     [
         (
             "( Made using CamBam - http://www.cambam.co.uk )\n( Untitled )\nG20 G90 G64 G40\n"
             "G0 Z0.125\n",
-            1,
-            "'( Made using CamBam - http://www.cambam.…'",
+            3,
+            "'G20 G90 G64 G40'",
         ),
         ("G21 G90\nG0 X1 Y1\nG1 X2 F100\n", 1, "'G21 G90'"),
-        ("\n%\nN10 G0 X1\n", 2, "'%'"),
+        (
+            "\n%\nN10 G0 X1 Y2 Z3 (a long block, cut in the message)\n",
+            3,
+            "'N10 G0 X1 Y2 Z3 (a long block, cut in th…'",
+        ),
     ],
 )
 def test_a_program_with_a_point_list_ending_is_named_as_one(
@@ -321,12 +326,22 @@ def test_a_program_with_a_point_list_ending_is_named_as_one(
     path = write(tmp_path, "shapeoko.txt", text)
     assert main(["post", str(path), "-t", "grbl", "-o", str(tmp_path / "out.gcode")]) == 3
     err = capsys.readouterr().err
-    assert f"camtool: error: {path}: line {line}: {shown} starts a G-code program" in err
+    assert f"camtool: error: {path}: line {line}: {shown} is a G-code block" in err
     assert "save it as shapeoko.nc" in err
     assert not (tmp_path / "out.gcode").exists()
 
 
-def test_a_point_list_with_a_bad_row_keeps_its_own_message(tmp_path: Path) -> None:
-    path = write(tmp_path, "p.csv", "x,y\n1,2\nG1,4\n")
-    with pytest.raises(InputError, match="line 3, column 1: 'G1' is not a number"):
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("x,y\n1,2\nG1,4\n", "line 3, column 1: 'G1' is not a number"),
+        # a first row of words is a header: the second row is the bad one
+        ("(10.0, 20.0)\n(30.0, 40.0)\n", "line 2, column 1: '(30.0' is not a number"),
+    ],
+)
+def test_a_point_list_with_a_bad_row_keeps_its_own_message(
+    tmp_path: Path, text: str, message: str
+) -> None:
+    path = write(tmp_path, "p.csv", text)
+    with pytest.raises(InputError, match=re.escape(message)):
         read_points(path)
