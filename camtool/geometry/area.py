@@ -18,6 +18,10 @@ if TYPE_CHECKING:
     from numpy.typing import NDArray
     from shapely.geometry.base import BaseGeometry
 
+NODING_GRID_MM = 1e-6
+"""Grid of the snap-rounding noder :func:`enclosed` falls back on, mm (1 nm: far below any
+machine's step, far above float64's rounding of a coordinate of metres)."""
+
 
 def enclosed(points: Sequence[tuple[float, float]]) -> BaseGeometry:
     """The area the closed polyline ``points`` encloses, by the nonzero winding rule, mm.
@@ -26,7 +30,9 @@ def enclosed(points: Sequence[tuple[float, float]]) -> BaseGeometry:
     ``buffer(0)`` does. One that does is noded where it crosses itself (GEOS), its faces
     made (shapely's ``polygonize``), and the faces it winds around at least once, either
     way, united: both lobes of a bow-tie, the centre of a five-pointed star; a face it
-    winds around once each way (a loop drawn back over itself) is left out.
+    winds around once each way (a loop drawn back over itself) is left out. Where GEOS's
+    noder does not converge (a small arc drawn there and back over itself, as boxes.py draws
+    its corners), the line is noded by snap-rounding on a :data:`NODING_GRID_MM` grid.
 
     Args:
         points: the polyline's vertices, mm, the last equal to the first or not (closed
@@ -44,7 +50,13 @@ def enclosed(points: Sequence[tuple[float, float]]) -> BaseGeometry:
     if poly.is_valid:
         return poly.buffer(0)
     ring = np.asarray(poly.exterior.coords, dtype=float)
-    faces = shapely.get_parts(shapely.polygonize(shapely.get_parts(shapely.node(LineString(ring)))))
+    try:
+        noded = shapely.node(LineString(ring))
+    except shapely.errors.GEOSException:
+        # GEOS's noder can fail to converge where the line runs back over itself within
+        # a rounding (a corner arc drawn there and back); snap-rounding always converges.
+        noded = shapely.union_all([LineString(ring)], grid_size=NODING_GRID_MM)
+    faces = shapely.get_parts(shapely.polygonize(shapely.get_parts(noded)))
     kept = [face for face in faces if winding(ring, face.representative_point().coords[0]) != 0]
     if not kept:
         return Polygon()

@@ -19,7 +19,7 @@ import pytest
 from shapely import Point as ShapelyPoint
 from shapely import Polygon
 
-from camtool.geometry.area import enclosed, winding
+from camtool.geometry.area import NODING_GRID_MM, enclosed, winding
 from camtool.geometry.chain import chain
 from camtool.importers.dxf import read_dxf
 from camtool.jobs.pipeline import post_drawing
@@ -144,3 +144,32 @@ def test_a_real_symbol_of_two_triangles_tip_to_tip_is_pocketed_whole() -> None:
     )
     ys = [y for _, y in cut_points(job)]
     assert min(ys) < 14.0 and max(ys) > 26.0  # before: one triangle only
+
+
+RETRACED_TIP = [
+    (130.00136529105552, 20.93346321190394),
+    (130.00034190242886, 20.941703473916743),
+    (130.0, 20.94999999999999),
+    (130.00038053019082, 20.94128442572522),
+    (130.00038053019082, 20.941284425725225),
+    (130.0, 20.94999999999999),
+]
+"""The end of a 0.1 mm corner arc drawn there and back, as boxes.py (its PaperBox example)
+draws a part's outline: GEOS's noder does not converge on it ("Iterated noding failed to
+converge"), which stopped ``camtool post`` with an internal error."""
+
+
+def test_a_corner_arc_drawn_there_and_back_is_noded_and_its_outline_enclosed() -> None:
+    import shapely
+
+    outline = [*RETRACED_TIP, (130.0, 21.0), (131.0, 21.0), (131.0, 20.0), (130.0, 20.0)]
+    with pytest.raises(shapely.errors.GEOSException):  # what the fallback is for
+        shapely.node(shapely.LineString([*outline, outline[0]]))
+    # the tip's way back encloses no area: the outline is the polygon without it
+    simple = Polygon([*RETRACED_TIP[:3], *outline[6:]])
+    assert simple.is_valid
+    area = enclosed(outline)
+    # snap-rounding moves each vertex by at most half a diagonal of the grid
+    slack = simple.length * NODING_GRID_MM
+    assert area.area == pytest.approx(simple.area, abs=slack)
+    assert area.symmetric_difference(simple).area < slack
