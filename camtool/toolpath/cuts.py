@@ -129,6 +129,48 @@ def where(contour: Contour) -> str:
 MAX_LISTED = 10
 """Most contours one kind of finding names one by one; the rest are counted in one line."""
 
+_COUNTED = {
+    "gouge": "place(s) where the tool cuts into the part",
+    "offset-fallback": "contour(s) OpenCASCADE could not offset (shapely's buffer used)",
+    "offset-vanished": "contour(s) the offset left nothing of",
+    "self-crossing": "self-crossing contour(s)",
+    "tight-corner": "contour(s) with inside corners tighter than the tool radius",
+    "uncut": "region(s) narrower than the tool, not cut",
+    "closed-gap": "gap(s) closed with a straight line",
+    "open-gap": "open contour(s) or open end(s)",
+}
+"""How the line that counts a kind's unlisted findings names them (others: by the kind)."""
+
+
+def finding_warnings(findings: Sequence[Finding]) -> list[str]:
+    """The findings' messages as warnings: at most :data:`MAX_LISTED` + 1 lines per kind.
+
+    A kind with more than that keeps its first :data:`MAX_LISTED` messages (repeats
+    dropped) and one line counting the rest; the findings themselves, all of them, stay
+    in the plan report (``--report R.json``: ``plan.findings``). A laser-cut sheet of
+    touching parts under a 3 mm tool would otherwise print one line per overlap: 1 786
+    for boxes.py's Arcade example.
+    """
+    by_kind: dict[str, list[str]] = {}
+    for f in findings:
+        messages = by_kind.setdefault(f.kind, [])
+        if f.message not in messages:
+            messages.append(f.message)
+    out: list[str] = []
+    for f in findings:
+        messages = by_kind[f.kind]
+        if len(messages) <= MAX_LISTED + 1:
+            out.append(f.message)
+        elif f.message in messages[:MAX_LISTED]:
+            out.append(f.message)
+            if f.message == messages[MAX_LISTED - 1]:  # the last one listed: the count follows
+                what = _COUNTED.get(f.kind, f"finding(s) of kind '{f.kind}'")
+                out.append(
+                    f"{len(messages) - MAX_LISTED} more {what}, not listed here "
+                    "(the report of --report R.json lists each one)"
+                )
+    return list(dict.fromkeys(out))
+
 
 def open_left_out(contours: Sequence[Contour], side: str) -> list[Finding]:
     """An ``open-left-out`` finding per open contour of ``contours`` (the first :data:`MAX_LISTED`).

@@ -21,7 +21,7 @@ from camtool.model.program import Program, Rapid
 from camtool.model.progress import Progress, no_progress
 from camtool.model.shapes import BBox, Contour, Drawing, Line, Point, Segment, fit_factor
 from camtool.toolpath.chain import close_gaps
-from camtool.toolpath.cuts import Finding, Stage
+from camtool.toolpath.cuts import Finding, Stage, finding_warnings
 from camtool.toolpath.gaps import open_gaps
 from camtool.toolpath.options import DEFAULT_CHAIN_TOLERANCE, OFFSET_MODES, PlanOptions
 from camtool.toolpath.order import Ordering, nesting, order_cuts
@@ -223,7 +223,7 @@ def plan_unplaced(
             f"none longer than {MIN_PIECE:g} mm after planning; check the drawing's units "
             "(or --scale it)"
         )
-    warnings = tuple(dict.fromkeys((*drawing.warnings, *(f.message for f in findings))))
+    warnings = tuple(dict.fromkeys((*drawing.warnings, *finding_warnings(findings))))
     program = Program(tuple(moves), options.origin, warnings)
     report = PlanReport(
         len(contours),
