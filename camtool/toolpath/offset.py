@@ -11,6 +11,7 @@ import os
 import pickle
 import select
 import sys
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeAlias
@@ -232,6 +233,18 @@ PARALLEL_SEGMENTS = 2000
 two workers at once where this process may use two cores (:func:`offset_all`): OCCT takes
 ~0.1–0.5 ms a segment, so below this a second worker would not pay for its fork."""
 
+OCCT_LIMIT_S = (30.0, 0.02)
+"""Longest an offset job may take in a worker, s: the first plus the second per segment of
+its contour. OpenCASCADE takes ~0.1–1 ms a segment; on some contours it runs for minutes
+and then fails (a 780-segment gear of boxes.py's Planetary2: 362 s), so a job past its
+limit is stopped and answered as an OpenCASCADE failure: shapely's buffer replaces it."""
+
+
+def occt_limit(contour: Contour) -> float:
+    """How long an offset job of ``contour`` may take in a worker, s (:data:`OCCT_LIMIT_S`)."""
+    base, per_segment = OCCT_LIMIT_S
+    return base + per_segment * len(contour.segments)
+
 
 def _workers(jobs: Sequence[tuple[Contour, float]]) -> int:
     """How many workers make ``jobs`` at once: 2 for a large job on 2+ cores, else 1.
@@ -409,6 +422,14 @@ class _Child:
                 return got, self._death()
             if kind == "died":
                 got.append(_crashed(*jobs[len(got)], value))
+            elif kind == "late":
+                contour, amount = jobs[len(got)]
+                got.append(
+                    ToolpathError(
+                        f"{_where(contour)}: offset by {amount:+.4g} mm stopped: OpenCASCADE "
+                        f"did not finish it within {value:.0f} s"
+                    )
+                )
             else:
                 got.append(ToolpathError(value) if kind == "error" else value)
             if done is not None:
@@ -440,8 +461,9 @@ def _serve(inbox: Any, out: Any) -> None:
     The jobs come as ``(workers, tolerance, jobs)``. That many :class:`_Worker` make them,
     one job at a time each, the next job going to the first worker free. Each answer is
     sent on ``out`` as soon as every job before it is answered; a job whose worker died is
-    answered ``("died", how)`` and a new worker takes the place of the dead one. The
-    answers are those of :func:`_answer` in this process, whichever worker made them.
+    answered ``("died", how)``, one past its :func:`occt_limit` is killed and answered
+    ``("late", limit_s)``, and a new worker takes the place of either. The answers are
+    those of :func:`_answer` in this process, whichever worker made them.
     """
     try:
         workers, tolerance, jobs = pickle.load(inbox)
@@ -463,7 +485,15 @@ def _serve(inbox: Any, out: Any) -> None:
                 busy[worker.answers] = worker
                 worker.give(given)
                 given += 1
-            for fd in select.select(list(busy), [], [])[0]:
+            now = time.monotonic()
+            wait = max(0.0, min(w.deadline for w in busy.values()) - now)
+            ready = select.select(list(busy), [], [], wait)[0]
+            now = time.monotonic()
+            for fd in [fd for fd, w in busy.items() if fd not in ready and w.deadline <= now]:
+                worker = busy.pop(fd)  # past its limit: stopped, and a new one takes its place
+                worker.close(kill=True)
+                done[worker.job] = pickle.dumps(("late", occt_limit(jobs[worker.job][0])))
+            for fd in ready:
                 worker = busy[fd]
                 answer = worker.answer()
                 if answer is None:  # it died making its job
@@ -507,11 +537,17 @@ class _Worker:
         self.pid: int | None = pid
         self.given = given
         self.answers = answers
+        self.jobs = jobs
         self.job = -1
+        self.deadline = math.inf
 
     def give(self, job: int) -> None:
-        """Have it make job number ``job`` (a dead worker's pipe is found by :meth:`answer`)."""
+        """Have it make job number ``job``, by :attr:`deadline` (:func:`occt_limit` from now).
+
+        A dead worker's pipe is found by :meth:`answer`.
+        """
         self.job = job
+        self.deadline = time.monotonic() + occt_limit(self.jobs[job][0])
         with contextlib.suppress(OSError):
             os.write(self.given, job.to_bytes(8, "little"))
 

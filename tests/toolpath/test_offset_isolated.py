@@ -113,6 +113,53 @@ def test_a_crash_in_the_child_fails_its_job_only(
         assert _same(got[k], expected[k])
 
 
+def _endless_on(amount: float) -> Any:
+    """OpenCASCADE running on without end for ``amount`` (as it ran 362 s on a gear of
+    boxes.py's Planetary2 example before failing)."""
+    real = offset_module._occt_offset
+
+    def occt(contour: Contour, asked: float) -> Any:
+        if asked == amount:
+            signal.pause()  # until the worker is killed
+        return real(contour, asked)
+
+    return occt
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_a_job_past_its_limit_is_stopped_and_the_others_answered(
+    monkeypatch: pytest.MonkeyPatch, workers: int
+) -> None:
+    """The endless job gets an error naming its limit; the jobs after it, this process's
+    answers (made by a new worker); the limit of every other job is an hour (no timing)."""
+    expected = [offset_pieces(c, a) for c, a in JOBS]
+    stuck = JOBS[1][0]
+    monkeypatch.setattr(offset_module, "_occt_offset", _endless_on(JOBS[1][1]))
+    monkeypatch.setattr(offset_module, "occt_limit", lambda c: 1.0 if c == stuck else 3600.0)
+    monkeypatch.setattr(offset_module, "_workers", lambda jobs: workers)
+    got = offset_all(JOBS)
+    assert len(got) == len(JOBS)
+    late = got[1]
+    assert isinstance(late, ToolpathError)
+    assert "offset by +0.5 mm stopped: OpenCASCADE did not finish it within 1 s" in str(late)
+    for k in (0, 2, 3):
+        assert _same(got[k], expected[k])
+
+
+def test_the_planner_falls_back_where_a_job_was_stopped(monkeypatch: pytest.MonkeyPatch) -> None:
+    contours = [rect(0, 0, 20, 20), circle(10, 10, 3)]  # a plate with a hole
+    options = PlanOptions(offset="outside", tool_diameter=2.0, feed_mm_min=100.0)
+    monkeypatch.setattr(offset_module, "_occt_offset", _endless_on(-1.0))  # the hole's
+    hole = contours[1]
+    monkeypatch.setattr(offset_module, "occt_limit", lambda c: 1.0 if c == hole else 3600.0)
+    monkeypatch.setattr(offset_module, "_workers", lambda jobs: 2)
+    stage = compensate(contours, nesting(contours), options)
+    (fallback,) = [f for f in stage.findings if f.kind == "offset-fallback"]
+    assert "did not finish it within 1 s" in fallback.message
+    assert "used shapely's buffer" in fallback.message
+    assert any(c.group == 1 for c in stage.cuts)  # the hole is still cut
+
+
 MANY = [(circle(0, 0, 1 + k), 0.25 + k / 64) for k in range(24)]
 CRASHING = {0.25 + k / 64 for k in range(24) if k % 3 != 1}  # 16 of 24, the first and last
 
