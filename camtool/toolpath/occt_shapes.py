@@ -4,7 +4,11 @@ from __future__ import annotations
 
 from typing import Any
 
-from camtool.model.shapes import Arc, Contour, Line, Point, Segment
+from camtool.model.errors import ToolpathError
+from camtool.model.shapes import Arc, Contour, Line, Point, Segment, distance
+
+_JOIN_MM = 1e-6
+"""Ends of an offset's edges this close are one point, mm."""
 
 
 def _to_wire(contour: Contour) -> Any:
@@ -74,3 +78,57 @@ _CURVE_NAMES = {
     "GeomAbs_OtherCurve": "OTHER",
 }
 """OCCT curve types by the names build123d's ``GeomType`` gives them."""
+
+
+def _where(contour: Contour) -> str:
+    x, y = contour.start
+    src = f"{contour.source} " if contour.source else ""
+    return f"contour {src}starting at ({x:.4f}, {y:.4f}) mm"
+
+
+def _wire_edges(wire: Any) -> list[Any]:
+    """The edges of a ``TopoDS_Wire`` in connection order (``BRepTools_WireExplorer``)."""
+    from OCP.BRepTools import BRepTools_WireExplorer
+
+    explorer = BRepTools_WireExplorer(wire)
+    edges = []
+    while explorer.More():
+        edges.append(explorer.Current())
+        explorer.Next()
+    return edges
+
+
+def _from_edge(edge: Any, contour: Contour) -> Segment:
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+
+    curve = BRepAdaptor_Curve(edge)
+    kind = _CURVE_NAMES.get(curve.GetType().name, "OTHER")
+    start = _position_at(edge, curve, 0.0)
+    end = _position_at(edge, curve, 1.0)
+    if kind == "LINE":
+        return Line(start, end)
+    if kind == "CIRCLE":
+        c = curve.Circle().Position().Location()
+        centre = (float(c.X()), float(c.Y()))
+        a, b = _position_at(edge, curve, 0.25), _position_at(edge, curve, 0.5)
+        turn = (a[0] - start[0]) * (b[1] - a[1]) - (a[1] - start[1]) * (b[0] - a[0])
+        if distance(start, end) < _JOIN_MM:
+            end = start
+        return Arc(start, end, centre, turn < 0)
+    raise ToolpathError(
+        f"{_where(contour)}: the offset holds a {kind.lower()} curve; camtool emits only "
+        "lines and arcs"
+    )
+
+
+def _position_at(edge: Any, curve: Any, position: float) -> Point:
+    """build123d's ``Edge.position_at(position)``: a fraction of the length, orientation-wise."""
+    from OCP.GCPnts import GCPnts_AbscissaPoint
+    from OCP.TopAbs import TopAbs_Orientation
+
+    length = GCPnts_AbscissaPoint.Length_s(curve)
+    if edge.Orientation() != TopAbs_Orientation.TopAbs_FORWARD:
+        position = 1 - position
+    param = GCPnts_AbscissaPoint(curve, length * position, curve.FirstParameter()).Parameter()
+    p = curve.Value(param)
+    return (float(p.X()), float(p.Y()))

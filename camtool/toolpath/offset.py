@@ -32,13 +32,12 @@ from camtool.accel.cores import (
 from camtool.geometry.area import enclosed
 from camtool.geometry.chain import chain
 from camtool.model.errors import ToolpathError
-from camtool.model.shapes import Arc, Contour, Line, Point, Segment, distance
-from camtool.toolpath.occt_shapes import _CURVE_NAMES, _to_wire
+from camtool.model.shapes import Contour, Point, distance
+from camtool.toolpath.occt_shapes import _JOIN_MM, _from_edge, _to_wire, _where, _wire_edges
 
 if TYPE_CHECKING:
     from shapely.geometry.base import BaseGeometry
 
-_JOIN_MM = 1e-6
 _MAX_QUAD_SEGS = 4096
 
 
@@ -733,12 +732,6 @@ def _oriented(pieces: list[Contour], contour: Contour) -> list[Contour]:
     return out
 
 
-def _where(contour: Contour) -> str:
-    x, y = contour.start
-    src = f"{contour.source} " if contour.source else ""
-    return f"contour {src}starting at ({x:.4f}, {y:.4f}) mm"
-
-
 def _occt_offset(contour: Contour, amount: float) -> list[Any]:
     """OCCT's offset wires (``TopoDS_Wire``); several when the region splits.
 
@@ -763,54 +756,6 @@ def _occt_offset(contour: Contour, amount: float) -> list[Any]:
         wires.append(TopoDS.Wire(explorer.Current()))
         explorer.Next()
     return wires
-
-
-def _wire_edges(wire: Any) -> list[Any]:
-    """The edges of a ``TopoDS_Wire`` in connection order (``BRepTools_WireExplorer``)."""
-    from OCP.BRepTools import BRepTools_WireExplorer
-
-    explorer = BRepTools_WireExplorer(wire)
-    edges = []
-    while explorer.More():
-        edges.append(explorer.Current())
-        explorer.Next()
-    return edges
-
-
-def _from_edge(edge: Any, contour: Contour) -> Segment:
-    from OCP.BRepAdaptor import BRepAdaptor_Curve
-
-    curve = BRepAdaptor_Curve(edge)
-    kind = _CURVE_NAMES.get(curve.GetType().name, "OTHER")
-    start = _position_at(edge, curve, 0.0)
-    end = _position_at(edge, curve, 1.0)
-    if kind == "LINE":
-        return Line(start, end)
-    if kind == "CIRCLE":
-        c = curve.Circle().Position().Location()
-        centre = (float(c.X()), float(c.Y()))
-        a, b = _position_at(edge, curve, 0.25), _position_at(edge, curve, 0.5)
-        turn = (a[0] - start[0]) * (b[1] - a[1]) - (a[1] - start[1]) * (b[0] - a[0])
-        if distance(start, end) < _JOIN_MM:
-            end = start
-        return Arc(start, end, centre, turn < 0)
-    raise ToolpathError(
-        f"{_where(contour)}: the offset holds a {kind.lower()} curve; camtool emits only "
-        "lines and arcs"
-    )
-
-
-def _position_at(edge: Any, curve: Any, position: float) -> Point:
-    """build123d's ``Edge.position_at(position)``: a fraction of the length, orientation-wise."""
-    from OCP.GCPnts import GCPnts_AbscissaPoint
-    from OCP.TopAbs import TopAbs_Orientation
-
-    length = GCPnts_AbscissaPoint.Length_s(curve)
-    if edge.Orientation() != TopAbs_Orientation.TopAbs_FORWARD:
-        position = 1 - position
-    param = GCPnts_AbscissaPoint(curve, length * position, curve.FirstParameter()).Parameter()
-    p = curve.Value(param)
-    return (float(p.X()), float(p.Y()))
 
 
 def _start_near(contour: Contour, p: Point) -> Contour:
