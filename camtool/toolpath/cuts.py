@@ -146,27 +146,25 @@ def finding_warnings(findings: Sequence[Finding]) -> list[str]:
     """The findings' messages as warnings: at most :data:`MAX_LISTED` + 1 lines per kind.
 
     A kind with more than that keeps its first :data:`MAX_LISTED` messages (repeats
-    dropped) and one line counting the rest; the findings themselves, all of them, stay
-    in the plan report (``--report R.json``: ``plan.findings``). A laser-cut sheet of
-    touching parts under a 3 mm tool would otherwise print one line per overlap: 1 786
-    for boxes.py's Arcade example.
+    dropped), in place, and one line counting the rest; the findings themselves, all of
+    them, stay in the plan report (``--report R.json``: ``plan.findings``). Parts closer
+    than the tool would otherwise print a line per overlap.
     """
-    by_kind: dict[str, list[str]] = {}
+    by_kind: dict[str, dict[str, None]] = {}  # distinct messages, in order (dict: linear)
     for f in findings:
-        messages = by_kind.setdefault(f.kind, [])
-        if f.message not in messages:
-            messages.append(f.message)
+        by_kind.setdefault(f.kind, {})[f.message] = None
+    listed = {kind: list(messages)[:MAX_LISTED] for kind, messages in by_kind.items()}
     out: list[str] = []
     for f in findings:
-        messages = by_kind[f.kind]
-        if len(messages) <= MAX_LISTED + 1:
+        rest = len(by_kind[f.kind]) - MAX_LISTED
+        if rest <= 1:
             out.append(f.message)
-        elif f.message in messages[:MAX_LISTED]:
+        elif f.message in listed[f.kind]:
             out.append(f.message)
-            if f.message == messages[MAX_LISTED - 1]:  # the last one listed: the count follows
+            if f.message == listed[f.kind][-1]:  # the last one listed: the count follows
                 what = _COUNTED.get(f.kind, f"finding(s) of kind '{f.kind}'")
                 out.append(
-                    f"{len(messages) - MAX_LISTED} more {what}, not listed here "
+                    f"{rest} more {what}, not listed here "
                     "(the report of --report R.json lists each one)"
                 )
     return list(dict.fromkeys(out))

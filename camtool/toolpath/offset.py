@@ -234,9 +234,9 @@ two workers at once where this process may use two cores (:func:`offset_all`): O
 
 OCCT_LIMIT_S = (30.0, 0.02)
 """Longest an offset job may take in a worker, s: the first plus the second per segment of
-its contour. OpenCASCADE takes ~0.1–1 ms a segment; on some contours it runs for minutes
-and then fails (a 780-segment gear of boxes.py's Planetary2: 362 s), so a job past its
-limit is stopped and answered as an OpenCASCADE failure: shapely's buffer replaces it."""
+its contour. OpenCASCADE takes ~0.1–1 ms a segment, but on some contours it runs for
+minutes and then fails, so a job past its limit is stopped and answered as an OpenCASCADE
+failure: shapely's buffer replaces it."""
 
 
 def occt_limit(contour: Contour) -> float:
