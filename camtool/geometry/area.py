@@ -63,6 +63,21 @@ def enclosed(points: Sequence[tuple[float, float]]) -> BaseGeometry:
     return shapely.union_all(kept)
 
 
+def inscribed_width(area: BaseGeometry, tolerance: float) -> float:
+    """The widest tool that fits in ``area``: twice its largest inscribed circle's radius, mm.
+
+    Args:
+        area: a polygon or multipolygon (:func:`enclosed`), mm; empty gives 0.
+        tolerance: how close to the true radius the search goes (shapely's
+            ``maximum_inscribed_circle``, the pole of inaccessibility), mm.
+    """
+    from shapely import maximum_inscribed_circle
+
+    if area.is_empty:
+        return 0.0
+    return 2.0 * float(maximum_inscribed_circle(area, tolerance).length)
+
+
 def winding(ring: NDArray[np.float64], point: tuple[float, float]) -> int:
     """How many times the closed polyline ``ring`` winds around ``point`` (> 0: anticlockwise).
 

@@ -12,7 +12,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
-from camtool.geometry.area import enclosed
+from camtool.geometry.area import enclosed, inscribed_width
 from camtool.model.errors import ToolpathError
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import Arc, Contour, Line, Point, Segment
@@ -109,7 +109,7 @@ def compensate(
             findings.extend(found)
             vanished.extend(f for f in found if f.kind == "offset-vanished")
     if not cuts and vanished:
-        raise ToolpathError("nothing left to cut: " + "; ".join(f.message for f in vanished))
+        raise ToolpathError(_nothing_left(vanished))
     if options.offset != "on":
         if not cuts:
             raise ToolpathError(_all_open(contours, options.offset))
@@ -117,6 +117,23 @@ def compensate(
     if options.offset != "on":
         findings.extend(gouges(contours, nest, cuts, options))
     return Stage(tuple(cuts), tuple(findings))
+
+
+MAX_IN_ERROR = 3
+"""Vanished contours named in the error when all of them vanish; the rest are counted."""
+
+
+def _nothing_left(vanished: Sequence[Finding]) -> str:
+    """The error when every closed contour is offset away: the first few, and a count."""
+    named = "; ".join(f.message for f in vanished[:MAX_IN_ERROR])
+    rest = len(vanished) - MAX_IN_ERROR
+    if rest > 0:
+        narrowest = min(f.value or 0.0 for f in vanished)
+        named += (
+            f"; and {rest} more closed contour(s) the tool does not fit in "
+            f"({len(vanished)} in all, the narrowest about {narrowest:.3g} mm wide)"
+        )
+    return "nothing left to cut: " + named
 
 
 def _on_line(contour: Contour, index: int, nest: Nesting, options: PlanOptions) -> Cut:
@@ -381,15 +398,13 @@ def _turn(a: Point, b: Point) -> float:
 
 def _vanished(contour: Contour, options: PlanOptions) -> Finding:
     """An ``offset-vanished`` finding: where the contour is and how wide it is."""
-    from shapely import maximum_inscribed_circle
-
     tol = options.tolerance / 4
     poly = enclosed(contour.points(tol))
     if poly.is_empty:  # no area (a closed contour that folds back on itself): no width
         (x, y), width = contour.start, 0.0
     else:
         centre = poly.centroid
-        width = 2.0 * maximum_inscribed_circle(poly, tol).length  # twice the largest inradius
+        width = inscribed_width(poly, tol)
         x, y = float(centre.x), float(centre.y)
     d = options.tool_diameter
     return Finding(

@@ -243,6 +243,20 @@ def test_when_everything_vanishes_planning_stops_with_the_reason() -> None:
         _run([stadium(30, 40, 5, 1.0)], "inside", 3.0)
 
 
+def test_the_error_names_the_first_vanished_contours_and_counts_the_rest() -> None:
+    """Twelve slots, 2 mm wide and one 1.6 mm, under a 3 mm tool: a line a user can read.
+
+    Each slot's width is twice its end radius (analysis), so the narrowest is 1.6 mm.
+    """
+    slots = [stadium(30, 40, 5 + 5 * k, 0.8 if k == 7 else 1.0) for k in range(12)]
+    with pytest.raises(ToolpathError) as caught:
+        _run(slots, "inside", 3.0)
+    message = str(caught.value)
+    assert message.count("narrower than the 3 mm tool") == compensate_module.MAX_IN_ERROR == 3
+    assert "and 9 more closed contour(s) the tool does not fit in" in message
+    assert "(12 in all, the narrowest about 1.6 mm wide)" in message
+
+
 # --- fallback --------------------------------------------------------------------------------
 
 
