@@ -243,15 +243,19 @@ def _profile_op(
         if has_outer
         else f"{what} holds holes of a part only: cut on their inside"
     )
+    mill: float | None = tool
+    tool_line = "tool = {end-mill}"
+    if not has_outer:
+        mill, tool_line = _mill_for_holes(contours, tool)
     lines = [
         f"name = {_quote(key)}",
         'type = "profile"',
-        "tool = {end-mill}",
+        tool_line,
         select,
         "closed = true" + _why("open contours have no side"),
         f'side = "{side}"' + _why(why),
         f"depth = {depth:g}" + _why(f"through the {thickness:g} mm stock"),
-        f"step_down = {min(step, depth):g}" + _why("passes of at most the tool's diameter"),
+        f"step_down = {min(mill or tool, depth):g}" + _why("passes of at most the tool's diameter"),
     ]
     if has_outer:
         shortest = min(c.length for c in contours if id(c) in outer)
@@ -268,7 +272,60 @@ def _profile_op(
                     "part another way"
                 ).lstrip()
             )
-    return _Op(f"profile {side}", tool, tuple(lines))
+    if mill is None:  # no end mill fits: a guess the user must finish
+        return _Op(f"profile {side}", tool, tuple(lines), commented=True)
+    return _Op(f"profile {side}", mill, tuple(lines))
+
+
+END_MILLS_MM = (0.5, 0.8, 1.0, 1.5, 2.0, 2.5, 3.0, 3.175, 4.0, 5.0, 6.0, 6.35, 8.0, 10.0, 12.0)
+"""Common end mill diameters, mm (metric and 1/8", 1/4"): the sizes job init proposes."""
+
+FIT_MARGIN = 0.95
+"""A proposed end mill is at most this fraction of the narrowest hole's width."""
+
+WIDTH_TOLERANCE_MM = 0.01
+"""How closely a hole's width (its largest inscribed circle) is measured, mm."""
+
+
+def _mill_for_holes(contours: Sequence[Contour], tool: float) -> tuple[float | None, str]:
+    """The end mill for a layer of holes cut on their inside, and its ``tool =`` line.
+
+    The job's end mill (``tool``, mm) when it fits in every hole; else the largest of
+    :data:`END_MILLS_MM` within :data:`FIT_MARGIN` of the narrowest hole's width (the
+    diameter of its largest inscribed circle, :func:`~camtool.geometry.area.inscribed_width`),
+    said in the line's comment; ``None`` when none fits (the operation is then left
+    commented out). ``post`` cuts nothing in a hole narrower than its tool, and stops
+    when that is every contour of an operation.
+    """
+    from camtool.geometry.area import enclosed, inscribed_width
+
+    widths = [
+        inscribed_width(enclosed(c.points(WIDTH_TOLERANCE_MM)), WIDTH_TOLERANCE_MM)
+        for c in contours
+    ]
+    narrow = [w for w in widths if w < tool]
+    if not narrow:
+        return tool, "tool = {end-mill}"
+    least = min(narrow)
+    which = (
+        f"all {len(widths)}"
+        if len(narrow) == len(widths)
+        else f"{len(narrow)} of the {len(widths)}"
+    )
+    if len(widths) == 1:
+        which = "the 1"
+    said = (
+        f"{which} hole(s) are narrower than the {tool:g} mm end mill (the narrowest about "
+        f"{least:.3g} mm wide)"
+    )
+    fits = [d for d in END_MILLS_MM if d <= FIT_MARGIN * least]
+    if not fits:
+        return None, "tool = {end-mill}" + _why(
+            f"{said}: no common end mill fits; give this operation a tool that does, then "
+            "uncomment it"
+        )
+    mill = fits[-1]
+    return mill, f"tool = {{end-mill {mill:g}}}" + _why(f"{said}: a {mill:g} mm one cuts them")
 
 
 TAB_WIDTH_MM = 2.0
@@ -325,7 +382,7 @@ def _render(
     tools: dict[tuple[str, float], int] = {}
     ordered = sorted(ops, key=lambda op: (_ORDER[op.kind], op.tool))
     for op in ordered:
-        key = ("drill", op.tool) if op.kind == "drill" else ("end-mill", tool)
+        key = _tool_key(op, tool)
         if not op.commented or key in tools:
             tools.setdefault(key, len(tools) + 1)
     if not tools:
@@ -352,12 +409,12 @@ def _render(
             "",
         ]
     for op in ordered:
-        key = ("drill", op.tool) if op.kind == "drill" else ("end-mill", tool)
-        number = tools.get(key, 1)
+        number = tools.get(_tool_key(op, tool), 1)
         prefix = "# " if op.commented else ""
         out.append(f"{prefix}[[operations]]")
         for line in op.lines:
             line = line.replace("{end-mill}", str(number))
+            line = line.replace(f"{{end-mill {op.tool:g}}}", str(number))
             line = line.replace(f"{{drill {op.tool:g}}}", str(number))
             out.append(prefix + line)
         out.append("")
@@ -365,6 +422,13 @@ def _render(
         out.append("# left out (construction, never cut unless an operation names its layer):")
         out.extend(f"#   {what}: {n} contour(s)" for what, n in sorted(left.items()))
     return "\n".join(out).rstrip() + "\n"
+
+
+def _tool_key(op: _Op, tool: float) -> tuple[str, float]:
+    """The tool an operation uses: its drill, its own end mill, or the job's (``tool``)."""
+    if op.kind == "drill":
+        return ("drill", op.tool)
+    return ("end-mill", op.tool if op.kind.startswith("profile") else tool)
 
 
 def _why(text: str) -> str:

@@ -113,3 +113,57 @@ def test_a_drawing_larger_than_the_machine_is_fitted_and_said_so(tmp_path: Path)
     assert tool["diameter"] == 3.0  # as cut: the ø6 circle at half size
     done = run_job(drawing, load_target("grbl"), job_from_dict(data, source="j.toml"))
     assert done.operations[0].holes == 1
+
+
+def _plate_with_slots(tmp_path: Path, widths: list[float]) -> Path:
+    """A 100 × 50 mm plate (layer EDGE) and 10 mm long rectangular slots (layer SLOTS)."""
+
+    def build(msp: object) -> None:
+        msp.add_lwpolyline(  # type: ignore[attr-defined]
+            [(0, 0), (100, 0), (100, 50), (0, 50)], close=True, dxfattribs={"layer": "EDGE"}
+        )
+        for k, w in enumerate(widths):
+            x = 10.0 + 15.0 * k
+            msp.add_lwpolyline(  # type: ignore[attr-defined]
+                [(x, 20), (x + w, 20), (x + w, 30), (x, 30)],
+                close=True,
+                dxfattribs={"layer": "SLOTS"},
+            )
+
+    return write_dxf(tmp_path / "slots.dxf", build)
+
+
+def test_holes_narrower_than_the_end_mill_get_one_that_fits(tmp_path: Path) -> None:
+    """Slots 2.8 and 6 mm wide under the default 3 mm end mill (boxes.py's finger slots).
+
+    A slot's width is its largest inscribed circle's diameter, 2.8 mm (analysis); the
+    largest common end mill within 95 % of it (2.66 mm) is 2.5 mm. With the 3 mm one the
+    slots operation would stop the post ("nothing left to cut" when every slot is too
+    narrow); with 2.5 mm every slot is cut on its inside.
+    """
+    drawing = read_drawing(_plate_with_slots(tmp_path, [2.8, 2.8, 6.0]))
+    text = initial_job(drawing)
+    data = tomllib.loads(text)
+    slots, edge = data["operations"]
+    tools = {t["id"]: t for t in data["tools"]}
+    assert (slots["side"], tools[slots["tool"]]["diameter"]) == ("inside", 2.5)
+    assert (edge["side"], tools[edge["tool"]]["diameter"]) == ("outside", 3)
+    assert slots["step_down"] == 2.5
+    assert "2 of the 3 hole(s) are narrower than the 3 mm end mill" in text
+    assert "(the narrowest about 2.8 mm wide): a 2.5 mm one cuts them" in text
+    done = run_job(drawing, load_target("grbl"), job_from_dict(data, source="j.toml"))
+    placed_slots = [(10.0 + 15.0 * k, 10.0 + 15.0 * k + w) for k, w in enumerate([2.8, 2.8, 6])]
+    assert done.placed is not None  # the job's lower-left origin moves the plate:
+    dx = done.placed.bbox()[0] - drawing.bbox()[0]
+    cut_x = [m.x - dx for m in done.program.moves if isinstance(m, Linear) and m.z is None]
+    for x0, x1 in placed_slots:  # the 2.5 mm tool's centre runs 1.25 mm inside each slot
+        assert any(abs(x - (x0 + 1.25)) < 1e-6 for x in cut_x), (x0, x1)
+
+
+def test_holes_no_common_end_mill_fits_leave_their_operation_commented(tmp_path: Path) -> None:
+    """0.4 mm slots: 95 % of that is under the smallest common end mill (0.5 mm)."""
+    drawing = read_drawing(_plate_with_slots(tmp_path, [0.4, 0.4]))
+    text = initial_job(drawing)
+    assert [op["layers"] for op in _ops(text)] == [["EDGE"]]
+    assert "# tool = 1  # all 2 hole(s) are narrower than the 3 mm end mill" in text
+    assert "no common end mill fits; give this operation a tool that does" in text
