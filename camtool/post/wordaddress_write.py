@@ -683,6 +683,10 @@ class BlockWriter(ArcWriter):
             self.block([spec.spindle_off])
             self.spindle = None  # stopped: the restart below is a whole M3 S… block
         self._stop(False, what)
+        # the new tool is another length, and its Z zero is set again by hand: the next Z
+        # is written again, so the first move after the change goes to a known height
+        self.z = None
+        self.last.pop("Z", None)
         if turning is not None:
             self.command(turning)  # the spindle as it was, for the new tool
 

@@ -161,3 +161,21 @@ def test_pic_mmh_changes_tools_in_its_own_code() -> None:
         "M06T01;",
         "M06T02;",
     ]
+
+
+def test_after_a_change_by_hand_the_first_move_is_up_to_the_clearance_height() -> None:
+    """GRBL pauses (``M0``) for the operator to change the tool and set Z zero for it again.
+
+    The Z the program left the old tool at means nothing to the new one (another length,
+    another zero), so the first move after each pause rises to the job's clearance height
+    (``clearance_z = 10`` in samples/part.toml) before any X/Y move; the old tool's Z10 was
+    not written again, and the next rapid crossed the part at whatever height the new tool
+    was left.
+    """
+    done = run_job(read_drawing(PART), load_target("grbl"), load_job(JOB))
+    lines = str(done.result.code).splitlines()
+    pauses = [i for i, line in enumerate(lines) if line == "M0"]
+    assert len(pauses) == 2  # T2 (the drill) first, then T1
+    for i in pauses:
+        motion = next(line for line in lines[i + 1 :] if line.startswith(("G0", "G1", "G2")))
+        assert motion == "G0 Z10.000", (lines[i - 1], motion)
