@@ -288,6 +288,7 @@ class _Reader(PlainLines):
         self.z: float | None = None
         self.positioned = False  # no X or Y word yet: the machine's XY is the program's guess
         self.motion: str | None = None
+        self.moded = False  # a motion code (G80 too) was given: no power-on mode is in effect
         self.plane = "xy"
         self.absolute = True
         self.arc_absolute = False
@@ -440,6 +441,12 @@ class _Reader(PlainLines):
                 "H": "H belongs to G43",
                 "Q": "Q belongs to G64, G83 or G73",
             }.get(letter, "I, J, K and R belong to G2/G3 arcs")
+            if letter in "XYZ" and not self.moded:
+                hint += (
+                    " (none is in effect here: LinuxCNC refuses the block, while GRBL moves "
+                    "in its power-on G0, as Fusion 360's GRBL programs expect after a tool "
+                    f"change; write G0 {word} if a rapid is meant)"
+                )
             raise InputError(f"{self.where()}: {word} has no code to use it; {hint}")
 
     # -- motion ------------------------------------------------------------------
@@ -451,6 +458,7 @@ class _Reader(PlainLines):
         motion = w.g_name("motion")
         if motion is not None:
             self.motion = None if motion == "G80" else motion
+            self.moded = True
         home = w.g_name("nonmodal")
         if home == "G53":
             self._machine_coordinates(w.args)

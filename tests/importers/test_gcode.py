@@ -393,6 +393,20 @@ def test_axis_words_before_any_motion_mode() -> None:
     assert refused("G21\nX1 Y1\n").startswith("t.ngc:2: X1 has no code to use it")
 
 
+def test_axis_words_after_a_tool_change_say_what_grbl_would_do() -> None:
+    """Fusion 360's GRBL post writes ``T12 M6`` then ``Z10`` (UGS's circle_test fixture).
+
+    LinuxCNC's rs274 refuses the block ("Cannot use axis values without a g code that
+    uses them"); GRBL moves it in G0, its power-on motion mode. camtool refuses it as
+    LinuxCNC does, and says how to write what GRBL does; after G80 GRBL refuses it too.
+    """
+    message = refused("G21 G90\nG28 G91 Z0\nG90\nT12 M6\nZ10\nG0 X1 Y1\nG1 Z-1 F100\n")
+    assert message.startswith("t.ngc:5: Z10 has no code to use it")
+    assert "GRBL moves in its power-on G0" in message and "write G0 Z10" in message
+    after_g80 = refused("G21\nG1 X1 F100\nG80\nX2\n")
+    assert after_g80.startswith("t.ngc:4: X2 has no code to use it") and "GRBL" not in after_g80
+
+
 def test_program_without_moves() -> None:
     assert "no move" in refused("%\n(only a header)\nG21 M3\nM2\n%\n")
 
