@@ -307,17 +307,14 @@ def _mill_for_holes(contours: Sequence[Contour], tool: float) -> tuple[float | N
     if not narrow:
         return tool, "tool = {end-mill}"
     least = min(narrow)
-    which = (
-        f"all {len(widths)}"
-        if len(narrow) == len(widths)
-        else f"{len(narrow)} of the {len(widths)}"
-    )
     if len(widths) == 1:
-        which = "the 1"
-    said = (
-        f"{which} hole(s) are narrower than the {tool:g} mm end mill (the narrowest about "
-        f"{least:.3g} mm wide)"
-    )
+        said = f"the hole is narrower than the {tool:g} mm end mill (about {least:.3g} mm wide)"
+    else:
+        which = "all" if len(narrow) == len(widths) else f"{len(narrow)} of the"
+        said = (
+            f"{which} {len(widths)} holes are narrower than the {tool:g} mm end mill (the "
+            f"narrowest about {least:.3g} mm wide)"
+        )
     fits = [d for d in END_MILLS_MM if d <= FIT_MARGIN * least]
     if not fits:
         return None, "tool = {end-mill}" + _why(

@@ -149,7 +149,7 @@ def test_holes_narrower_than_the_end_mill_get_one_that_fits(tmp_path: Path) -> N
     assert (slots["side"], tools[slots["tool"]]["diameter"]) == ("inside", 2.5)
     assert (edge["side"], tools[edge["tool"]]["diameter"]) == ("outside", 3)
     assert slots["step_down"] == 2.5
-    assert "2 of the 3 hole(s) are narrower than the 3 mm end mill" in text
+    assert "2 of the 3 holes are narrower than the 3 mm end mill" in text
     assert "(the narrowest about 2.8 mm wide): a 2.5 mm one cuts them" in text
     done = run_job(drawing, load_target("grbl"), job_from_dict(data, source="j.toml"))
     placed_slots = [(10.0 + 15.0 * k, 10.0 + 15.0 * k + w) for k, w in enumerate([2.8, 2.8, 6])]
@@ -165,5 +165,5 @@ def test_holes_no_common_end_mill_fits_leave_their_operation_commented(tmp_path:
     drawing = read_drawing(_plate_with_slots(tmp_path, [0.4, 0.4]))
     text = initial_job(drawing)
     assert [op["layers"] for op in _ops(text)] == [["EDGE"]]
-    assert "# tool = 1  # all 2 hole(s) are narrower than the 3 mm end mill" in text
+    assert "# tool = 1  # all 2 holes are narrower than the 3 mm end mill" in text
     assert "no common end mill fits; give this operation a tool that does" in text
