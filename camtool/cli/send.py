@@ -224,7 +224,7 @@ class _Operator:
             return False
         click.echo(f"\ncamtool: block {done.index} (line {done.line}) sent. {prompt}.", err=True)
         return click.confirm(
-            f"send block {following.index} (line {following.line})?", default=False, err=True
+            f"go on with block {following.index} (line {following.line})?", default=False, err=True
         )
 
 

@@ -152,6 +152,9 @@ class _Driver:
         self.idle_since: float | None = None
         self.put_back: list[str] = []
         self.unknown: list[str] = []
+        self.held_by_controller = ""  # the hold state it reported, not asked for by camtool
+        self.resumed_head: int | None = None  # resumed with it first in flight: a Hold
+        # reported while it still is may be from before the resume
         hooks = plan.hooks
         self.can_halt = bool(self.spec.hold and self.spec.reset and self.spec.status)
         self.can_halt = self.can_halt and (hooks.status or hooks.status_state) is not None
@@ -328,6 +331,9 @@ class _Driver:
                 self._fail()
             if getattr(control, "stop_requested", False):
                 self._operator_stop()
+            if self.held_by_controller:
+                self._controller_hold()
+                continue
             pausing = pausing or control.pause_requested
             if pausing and self.can_halt:
                 pausing = self._hold_pause()
@@ -399,10 +405,47 @@ class _Driver:
             self._halt_and_raise(f"the feed hold was not confirmed (state {state})")
         if control.paused(s.progress()) != "resume":
             self._operator_stop()
-        self.wire.write(self.spec.resume, "resuming (cycle start)")
-        self.answer_since = self.clock.monotonic()
-        self.idle_since = None
+        self._resume()
         return False
+
+    def _controller_hold(self) -> None:
+        """The controller holds on its own: the program's pause (GRBL ``M0``) or its button.
+
+        GRBL answers an ``M0`` only once the operator resumes it (gcode.c: a feed hold
+        inside the line's execution), so the wait for its answer has no bound: the
+        operator is asked (:meth:`Control.between_blocks`, with the comment before the
+        pause, a tool change's) and yes resumes it (cycle start, ``~``); no, or no
+        operator at the terminal, stops the job where it stands.
+        """
+        s, control = self.stream, self.control
+        state, self.held_by_controller = self.held_by_controller, ""
+        k = s.in_flight[0]
+        head = s.block(k)
+        said = f"{self.spec.target} holds ({state}) at block {head.index} (line {head.line}: "
+        said += f"{head.text!r}"
+        before = s.block(k - 1).text if k > 0 else ""
+        if before.startswith(("(", ";")):
+            said += f", after {before!r}"
+        said += "), the program's pause or the machine's feed hold"
+        following = s.block(k + 1) if k + 1 < len(self.plan.blocks) else head
+        prompt = f"{said}: do what it asks, then resume it (cycle start)"
+        if not control.between_blocks(prompt, head, following):
+            if self.can_halt:
+                stopped = self._halt()
+                raise LinkError(
+                    f"{said}; not resumed: stopped {self._where()}{stopped}; {self._unsure()}"
+                )
+            self._operator_stop()
+        self._resume()
+
+    def _resume(self) -> None:
+        """Send the resume byte (cycle start) and restart the clocks of every wait."""
+        self.wire.write(self.spec.resume, "resuming (cycle start)")
+        now = self.clock.monotonic()
+        self.answer_since = now
+        self.idle_since = None
+        self.wire.last_rx = now  # the operator's time was no silence of the controller
+        self.resumed_head = self.stream.in_flight[0] if self.stream.in_flight else None
 
     def _wait_held(self, where: str) -> str:
         """After a feed hold: poll until the controller says it stands (``Hold:0``, ``Idle``).
@@ -448,6 +491,7 @@ class _Driver:
             if status is not None:
                 s.report(status)
                 self._watch_idle(status)
+                self._watch_hold(status)
                 continue
             kind = s.answer(line, self.clock.monotonic())
             if kind in ("ack", "answer", "event", "error"):
@@ -464,6 +508,14 @@ class _Driver:
         if self._status_of(line) is None:
             self.messages.append(line)
             self.unknown.append(line)
+
+    def _watch_hold(self, status: Status) -> None:
+        """A hold camtool did not ask for, with blocks unanswered: the operator's turn."""
+        in_flight = self.stream.in_flight
+        if not status.state.startswith("Hold"):
+            self.resumed_head = None
+        elif in_flight and in_flight[0] != self.resumed_head and self.can_halt:
+            self.held_by_controller = status.state
 
     def _watch_idle(self, status: Status) -> None:
         """A controller that says Idle while blocks wait for their answer will not answer them."""

@@ -492,7 +492,8 @@ class GrblDevice(LineDevice):
     state for ``alarm_at_block``; ``error:9`` for any line while in alarm.
     Status reports say ``Run`` while the planner holds blocks, and carry
     ``Bf:`` when ``$10`` has bit 1 (``$$`` and ``$10=`` are answered). A feed
-    hold stops running (``Hold:0``), ``~`` resumes; a reset empties the buffers,
+    hold stops running (``Hold:0``), ``~`` resumes; ``M0`` holds too, and is answered
+    (and the next line read) only at the ``~`` that resumes it; a reset empties the buffers,
     and raises ``ALARM:3`` only if it came while moving. The position in status
     reports is where the lines that ran leave the tool, read back with
     camtool's reader of the target.
@@ -547,6 +548,8 @@ class GrblDevice(LineDevice):
         self.deaf = False
         self.holds = 0
         self.resets = 0
+        self.paused: bytes | None = None  # an M0's answer, given once the operator resumes
+        self.pauses = 0
 
     def connect(self) -> bytes:
         """GRBL prints its banner when the port opens (an Arduino resets on DTR)."""
@@ -571,6 +574,9 @@ class GrblDevice(LineDevice):
                 self.holds += 1
             elif char == b"~":
                 self.held = False
+                if self.paused is not None:  # the M0 line's execution ends: its answer
+                    out += self.paused
+                    self.paused = None
             elif char == b"\x18":
                 out += self._reset()
             else:
@@ -587,6 +593,7 @@ class GrblDevice(LineDevice):
         moving = self.queued > 0 and not self.held
         self._flush()
         self.held = False
+        self.paused = None
         self.resets += 1
         out = b""
         if moving:
@@ -600,7 +607,7 @@ class GrblDevice(LineDevice):
 
     def _parsable(self) -> bool:
         cut = self.rx.find(self.spec.block_end)
-        if not self.startup_seen or cut < 0 or self.waiting is not None:
+        if not self.startup_seen or cut < 0 or self.waiting is not None or self.paused:
             return False
         if self.queued >= PLANNER_BLOCKS:
             return False
@@ -666,6 +673,12 @@ class GrblDevice(LineDevice):
         count = self._blocks_of(block)
         if not count:
             self.executed.append(block)
+            if "M0" in {f"{a}{n}" for a, n in words(text.decode("latin-1")) if a == "M"}:
+                # gcode.c: M0 is a feed hold inside the line's execution (the planner is
+                # empty, synchronised): no answer, and no line read, until cycle start
+                self.held, self.paused = True, answer
+                self.pauses += 1
+                return b""
             return answer
         entry = [block, 0]
         self.planner.append(entry)

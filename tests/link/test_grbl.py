@@ -325,3 +325,52 @@ def test_an_arc_counts_grbls_segments_as_a_lower_bound() -> None:
     # G4 waits for an empty planner (mc_dwell), M5 too once the program started the spindle
     syncs = [b.text for b in plan.blocks if b.sync]
     assert syncs == ["G4 P1.5", "M5", "M2"]
+
+
+# A job's tool change by hand, as camtool writes it for GRBL (no M6: error 20).
+CHANGE = "M5\n(change to T2: end-mill 3 mm)\nM0\nM3 S1000\nG0 Z5\n"
+PAUSED = PROGRAM.replace("G0 Z5\n", "G0 Z5\n" + CHANGE, 1)
+
+
+class AnswersTurns:
+    """An operator who answers every turn the link gives them with ``answer``."""
+
+    def __init__(self, answer: bool) -> None:
+        self.answer = answer
+        self.pause_requested = False
+        self.prompts: list[str] = []
+
+    def paused(self, progress: Any) -> str:
+        return "stop"
+
+    def between_blocks(self, prompt: str, done: Any, following: Any) -> bool:
+        self.prompts.append(prompt)
+        return self.answer
+
+
+def test_the_programs_pause_waits_for_the_operator_then_resumes(simulate: Any) -> None:
+    """GRBL answers ``M0`` only when cycle start resumes it (gcode.c: a feed hold in the line).
+
+    Before, the unanswered M0 ran out the answer bound and the job was stopped at every
+    tool change; now the operator is asked, with the change's comment, and ``~`` resumes.
+    """
+    sim = simulate("grbl", block_delay_s=0.001)
+    control = AnswersTurns(True)
+    run(sim.path, PAUSED, control=control)
+    (prompt,) = control.prompts
+    assert "holds (Hold:0)" in prompt and "line 13: 'M0'" in prompt
+    assert "after '(change to T2: end-mill 3 mm)'" in prompt
+    assert sim.device.pauses == 1 and not sim.device.held and sim.device.resets == 0
+    assert bytes(sim.device.received) == PAUSED.encode()
+    assert sim.device.position() == pytest.approx(END)
+
+
+def test_a_pause_no_one_resumes_stops_the_job_at_the_pause(simulate: Any) -> None:
+    sim = simulate("grbl", block_delay_s=0.001)
+    with pytest.raises(LinkError, match=r"holds \(Hold:0\) at block 13 \(line 13: 'M0'") as info:
+        run(sim.path, PAUSED, control=AnswersTurns(False))
+    assert "not resumed: stopped" in str(info.value)
+    assert sim.device.resets == 1  # feed hold, reset: position kept, nothing ran past M0
+    received = [b.decode() for b in sim.device.blocks]
+    assert received[-1] == "M0\n" or "M0\n" in received
+    assert lines_run(sim.device) <= 13
