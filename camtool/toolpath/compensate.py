@@ -527,8 +527,15 @@ def _finding(contour: Contour, part: Any, options: PlanOptions) -> Finding:
 def _all_open(contours: Sequence[Contour], side: str) -> str:
     """Why nothing is cut when every contour is open under ``--offset side``."""
     layers = sorted({c.layer for c in contours}, key=str.casefold)
+    named = ", ".join(repr(name) for name in layers[:MAX_IN_ERROR])
+    if len(layers) > MAX_IN_ERROR:
+        named += f" and {len(layers) - MAX_IN_ERROR} more"
+    on = f"layer {named}" if len(layers) == 1 else f"layers {named}"
+    count = "the 1 contour is" if len(contours) == 1 else f"all {len(contours)} contours are"
+    them, their = ("it", "its") if len(contours) == 1 else ("them", "their")
     return (
-        f"nothing to cut: all {len(contours)} contour(s) (layers {', '.join(layers)}) are open, "
-        f"and --offset {side} needs closed contours; cut them on their lines with --offset on "
-        "(or an engrave operation), or close them in the drawing (--close-gap closes small gaps)"
+        f"nothing to cut: {count} open (on {on}), "
+        f"and --offset {side} needs closed contours; cut {them} on {their} lines with --offset on "
+        f"(or an engrave operation), or close {them} in the drawing (--close-gap closes small "
+        "gaps)"
     )

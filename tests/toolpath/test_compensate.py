@@ -182,7 +182,7 @@ def test_open_contours_are_cut_on_the_line_only_with_offset_on() -> None:
 
 def test_only_open_contours_under_a_side_is_nothing_to_cut() -> None:
     line = Contour((Line((30, 0), (40, 0)),), False, "CUT")
-    with pytest.raises(ToolpathError, match=r"all 1 contour\(s\) \(layers CUT\) are open"):
+    with pytest.raises(ToolpathError, match=r"the 1 contour is open \(on layer 'CUT'\)"):
         _run([line], "inside")
 
 
@@ -241,6 +241,21 @@ def test_a_closed_contour_without_area_vanishes_without_a_crash() -> None:
 def test_when_everything_vanishes_planning_stops_with_the_reason() -> None:
     with pytest.raises(ToolpathError, match=r"nothing left to cut.*narrower than the 3 mm tool"):
         _run([stadium(30, 40, 5, 1.0)], "inside", 3.0)
+
+
+def test_only_open_contours_name_their_layers_as_a_user_reads_them() -> None:
+    """QCAD's 181_polyline.dxf: one open polyline on layer 0 was "(layers 0)"."""
+    one = [Contour((Line((0.0, 0.0), (10.0, 0.0)),), False, layer="0")]
+    with pytest.raises(ToolpathError) as caught:
+        _run(one, "outside")
+    assert "nothing to cut: the 1 contour is open (on layer '0')" in str(caught.value)
+    assert "cut it on its lines" in str(caught.value)
+    many = [
+        Contour((Line((0.0, k), (10.0, k)),), False, layer=name) for k, name in enumerate("ABCDE")
+    ]
+    with pytest.raises(ToolpathError) as caught:
+        _run(many, "inside")
+    assert "all 5 contours are open (on layers 'A', 'B', 'C' and 2 more)" in str(caught.value)
 
 
 def test_the_error_names_the_first_vanished_contours_and_counts_the_rest() -> None:
