@@ -24,3 +24,19 @@ class PauseAt:
 
     def between_blocks(self, prompt: str, done: WireBlock, following: WireBlock) -> bool:
         return False
+
+
+class AnswersTurns:
+    """An operator who answers every turn the link gives them with ``answer``."""
+
+    def __init__(self, answer: bool) -> None:
+        self.answer = answer
+        self.pause_requested = False
+        self.prompts: list[str] = []
+
+    def paused(self, progress: Progress) -> str:
+        return "stop"
+
+    def between_blocks(self, prompt: str, done: WireBlock, following: WireBlock) -> bool:
+        self.prompts.append(prompt)
+        return self.answer

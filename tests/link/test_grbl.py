@@ -16,7 +16,7 @@ from camtool.link.plan import prepare_send
 from camtool.link.sender import StopAtPause, open_port, send_plan
 from camtool.model.errors import InputError, LinkError
 from camtool.post.registry import load_target
-from tests.link.controls import PauseAt
+from tests.link.controls import AnswersTurns, PauseAt
 
 # 13 passes over a 10 x 10 mm square, one arc per pass: the tool ends at X10 Y0 Z5.
 PASSES = "".join(
@@ -330,22 +330,6 @@ def test_an_arc_counts_grbls_segments_as_a_lower_bound() -> None:
 # A job's tool change by hand, as camtool writes it for GRBL (no M6: error 20).
 CHANGE = "M5\n(change to T2: end-mill 3 mm)\nM0\nM3 S1000\nG0 Z5\n"
 PAUSED = PROGRAM.replace("G0 Z5\n", "G0 Z5\n" + CHANGE, 1)
-
-
-class AnswersTurns:
-    """An operator who answers every turn the link gives them with ``answer``."""
-
-    def __init__(self, answer: bool) -> None:
-        self.answer = answer
-        self.pause_requested = False
-        self.prompts: list[str] = []
-
-    def paused(self, progress: Any) -> str:
-        return "stop"
-
-    def between_blocks(self, prompt: str, done: Any, following: Any) -> bool:
-        self.prompts.append(prompt)
-        return self.answer
 
 
 def test_the_programs_pause_waits_for_the_operator_then_resumes(simulate: Any) -> None:
