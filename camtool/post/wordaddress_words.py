@@ -47,6 +47,7 @@ class WordWriter(WriterState[str]):
         super().__init__()
         self.spec, self.machine = spec, machine
         self.z: float | None = None
+        self.by_hand: int | None = None  # a tool changed by hand, no Z written since
         self.spindle: Spindle | None = None  # turning, as last written
         self.speed: str | None = None  # an S word for the next motion block (a new speed)
         self.written: Point = (0.0, 0.0)

@@ -170,6 +170,8 @@ class BlockWriter(ArcWriter):
                 move = dataclasses.replace(move, z=None)  # Z does not change as written
             else:
                 self._check_z(move)
+        if self.by_hand is not None:
+            self._after_change_by_hand(start, move)
         if isinstance(move, ArcMove):
             self._arc(start, move)
         else:
@@ -177,6 +179,22 @@ class BlockWriter(ArcWriter):
         self.here = (move.x, move.y)
         if move.z is not None:
             self.z = move.z
+
+    def _after_change_by_hand(self, start: Point, move: Move) -> None:
+        """Warn when the first move after a tool change by hand goes sideways before any Z.
+
+        The new tool has another length and its Z zero is set again by hand: until a Z is
+        written, the tool stands at a height the program does not know. A job's program
+        rises first; a re-posted program moves as it is written, so this says so.
+        """
+        if move.z is None and (move.x, move.y) != start:
+            self.warn(
+                f"{self.where()}: after the tool change to T{self.by_hand} by hand "
+                f"({self.spec.name} pauses with {self.spec.stop}), the program moves X/Y "
+                "before any Z move: that move runs at whatever height the new tool was left; "
+                "add a move up to a safe height after the change"
+            )
+        self.by_hand = None
 
     def _same_z(self, z: float) -> bool:
         """True when ``z`` prints as the Z the controller is at."""
@@ -687,6 +705,7 @@ class BlockWriter(ArcWriter):
         # is written again, so the first move after the change goes to a known height
         self.z = None
         self.last.pop("Z", None)
+        self.by_hand = change.tool
         if turning is not None:
             self.command(turning)  # the spindle as it was, for the new tool
 

@@ -179,3 +179,24 @@ def test_after_a_change_by_hand_the_first_move_is_up_to_the_clearance_height() -
     for i in pauses:
         motion = next(line for line in lines[i + 1 :] if line.startswith(("G0", "G1", "G2")))
         assert motion == "G0 Z10.000", (lines[i - 1], motion)
+
+
+def test_a_re_posted_move_sideways_right_after_a_change_by_hand_is_warned_of() -> None:
+    """A program for a tool changer (``T2 M6`` then ``G0 X20 Y20``) re-posted for GRBL.
+
+    GRBL pauses (``M0``) for the change by hand; the program's next move goes sideways at
+    the height the new tool was left, which camtool keeps (moves as the input gives them)
+    and says. A program that rises first (the change to T1 here) is not warned of.
+    """
+    from camtool.importers.gcode import parse_gcode
+
+    text = (
+        "G21 G90\nT1 M6\nG0 Z5\nG0 X0 Y0\nG1 Z-1 F100\nG1 X10\nG0 Z5\n"
+        "T2 M6\nG0 X20 Y20\nG1 Z-1 F100\nG1 X30\nG0 Z5\nM2\n"
+    )
+    done = post_program(parse_gcode(text, source="m6.ngc"), load_target("grbl"))
+    said = [w for w in done.warnings if "by hand" in w]
+    assert len(said) == 1 and "after the tool change to T2 by hand" in said[0]
+    assert "moves X/Y before any Z move" in said[0]
+    code = str(done.result.code).splitlines()
+    assert code[code.index("(change to T2)") + 2] == "G0 X20.000 Y20.000"  # as it was given
