@@ -16,7 +16,7 @@ from typing import Literal, cast
 from camtool import accel
 from camtool.accel.collector import paused
 from camtool.importers import gcode_ahead
-from camtool.importers.gcode_codes import BlockWords, CommandReader, Notes
+from camtool.importers.gcode_codes import BlockWords, CommandReader, Notes, unused_word
 from camtool.importers.gcode_cycles import CYCLES, CycleState
 from camtool.importers.gcode_lexer import Block, Word, cut_mid_word, lex_line
 from camtool.importers.gcode_plain import ARC_TOL_IN, ARC_TOL_MM, PLAIN_WORDS, PlainLines
@@ -433,21 +433,7 @@ class _Reader(PlainLines):
                     f"its centre from {first} and {second}; select the plane of {word.letter} "
                     "(G17 XY: I J, G18 ZX: I K, G19 YZ: J K) or remove it"
                 )
-            hint = {
-                "X": "axis words need G0, G1, G2 or G3 (or modal motion) before them",
-                "Y": "axis words need G0, G1, G2 or G3 (or modal motion) before them",
-                "Z": "axis words need G0, G1, G2 or G3 (or modal motion) before them",
-                "P": "P belongs to G4 (dwell), G2/G3 (turns) or G64 (tolerance)",
-                "H": "H belongs to G43",
-                "Q": "Q belongs to G64, G83 or G73",
-            }.get(letter, "I, J, K and R belong to G2/G3 arcs")
-            if letter in "XYZ" and not self.moded:
-                hint += (
-                    " (none is in effect here: LinuxCNC refuses the block, while GRBL moves "
-                    "in its power-on G0, as Fusion 360's GRBL programs expect after a tool "
-                    f"change; write G0 {word} if a rapid is meant)"
-                )
-            raise InputError(f"{self.where()}: {word} has no code to use it; {hint}")
+            raise InputError(f"{self.where()}: {unused_word(word, self.moded)}")
 
     # -- motion ------------------------------------------------------------------
 

@@ -193,6 +193,34 @@ OTHER_LETTERS = MappingProxyType(
 )
 """Why letters outside :data:`WORD_LETTERS` are refused."""
 
+_AXES_NEED = "axis words need G0, G1, G2 or G3 (or modal motion) before them"
+UNUSED_LETTERS = MappingProxyType(
+    {
+        **dict.fromkeys("XYZ", _AXES_NEED),
+        "P": "P belongs to G4 (dwell), G2/G3 (turns) or G64 (tolerance)",
+        "H": "H belongs to G43",
+        "Q": "Q belongs to G64, G83 or G73",
+        **dict.fromkeys("IJKR", "I, J, K and R belong to G2/G3 arcs"),
+    }
+)
+"""Which codes use a word the block gives without one of them."""
+
+
+def unused_word(word: Word, moded: bool) -> str:
+    """Why ``word`` is refused in a block without a code that uses it.
+
+    ``moded``: a motion code (G80 too) came before; without one an axis word has no
+    motion to go with, which LinuxCNC refuses and GRBL runs in its power-on ``G0``.
+    """
+    hint = UNUSED_LETTERS[word.letter]
+    if word.letter in "XYZ" and not moded:
+        hint += (
+            " (none is in effect here: LinuxCNC refuses the block, while GRBL moves in its "
+            "power-on G0, as Fusion 360's GRBL programs expect after a tool change; write "
+            f"G0 {word} if a rapid is meant)"
+        )
+    return f"{word} has no code to use it; {hint}"
+
 
 class Notes:
     """Warnings, one per kind: the first line it happened on and how often."""
