@@ -11,6 +11,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+from camtool.link.advice import lost_hint, unsure
 from camtool.link.port import _PortGone, _Wire, open_port, split_lines
 from camtool.link.spec import Status
 from camtool.link.stream import (
@@ -166,7 +167,7 @@ class _Driver:
             self._stream()
             self._finish()
         except _PortGone as exc:
-            raise LinkError(f"{exc}; {self._lost_hint()}") from exc
+            raise LinkError(f"{exc}; {lost_hint(self.stream, self.plan)}") from exc
         except LinkError:
             self._restore_settings()
             raise
@@ -311,7 +312,7 @@ class _Driver:
                 self._take(line)
         raise LinkError(
             f"{self.spec.target}: no status report on {self.wire.name!r} within "
-            f"{self.spec.response_timeout_s:g} s {where}; {self._unsure()}"
+            f"{self.spec.response_timeout_s:g} s {where}; {unsure(self.stream, self.plan)}"
         )
 
     # -- the blocks -------------------------------------------------------------------
@@ -432,9 +433,8 @@ class _Driver:
         if not control.between_blocks(prompt, head, following):
             if self.can_halt:
                 stopped = self._halt()
-                raise LinkError(
-                    f"{said}; not resumed: stopped {self._where()}{stopped}; {self._unsure()}"
-                )
+                ran = unsure(self.stream, self.plan)
+                raise LinkError(f"{said}; not resumed: stopped {self._where()}{stopped}; {ran}")
             self._operator_stop()
         self._resume()
 
@@ -649,48 +649,7 @@ class _Driver:
 
     def _halt_and_raise(self, why: str) -> None:
         stopped = self._halt()
-        raise LinkError(f"{why}{stopped}; {self._unsure()}")
-
-    def _unsure(self) -> str:
-        """What surely ran, what may have run in part, and where to resume."""
-        s = self.stream
-        run = s.surely_run()
-        if s.failed_at is not None:
-            run = min(run, s.failed_at)
-        sent = s.sent_count
-        first = s.first_line_from(run)
-        if first is None:
-            return "every block had run"
-        done = [s.block(k) for k in range(run) if s.block(k).index]
-        known = f"lines up to {done[-1].last_line} surely ran; " if done else ""
-        maybe = [s.block(k) for k in range(run, sent) if s.block(k).index]
-        maybe = [b for b in maybe if s.failed_at is None or b.index != s.block(s.failed_at).index]
-        partly = ""
-        if maybe:
-            span = (
-                f"line {maybe[0].line}"
-                if len(maybe) == 1
-                else f"lines {maybe[0].line}–{maybe[-1].last_line}"
-            )
-            partly = f"{span} had been taken by the controller and may have run, whole or in part; "
-        return f"{known}{partly}{self._resume_advice(first, bool(maybe))}"
-
-    def _resume_advice(self, line: int, partly: bool) -> str:
-        fix = "fix the cause, then " if self.stream.failed_at is not None else ""
-        if not partly:
-            return f"{fix}resume with --from-line {line}"
-        where, arc = self.plan.start_of(line)
-        if not arc:
-            return (
-                f"{fix}resume with --from-line {line} (a straight move re-run from where the "
-                "tool stands ends where it should)"
-            )
-        stand = f" (X{where[0]:g} Y{where[1]:g} Z{where[2]:g})" if where is not None else ""
-        return (
-            f"{fix}line {line} is an arc: if it began, bring the tool back to where it starts"
-            f"{stand} first (an arc re-run from part way has the wrong centre), then resume "
-            f"with --from-line {line}"
-        )
+        raise LinkError(f"{why}{stopped}; {unsure(self.stream, self.plan)}")
 
     def _in_flight_time(self) -> float:
         s = self.stream
@@ -726,7 +685,7 @@ class _Driver:
         else:
             head = f"{self.spec.target}: {words} ({self._where()})"
         if self.can_halt or self.spec.flow == "char-count":
-            raise LinkError(f"{head}{stopped}; {self._unsure()}")
+            raise LinkError(f"{head}{stopped}; {unsure(self.stream, self.plan)}")
         raise LinkError(f"{head}{stopped}; the job stopped {self._where()}; {self._resume_hint()}")
 
     def _resume_hint(self) -> str:
@@ -735,45 +694,12 @@ class _Driver:
             return "every block had been sent"
         return f"fix the cause, then resume with --from-line {line}"
 
-    def _lost_hint(self) -> str:
-        """Where a job stood when the port went: what is known to have run, what may have."""
-        s = self.stream
-        sent = [s.block(k) for k in range(s.sent_count) if s.block(k).index]
-        if not sent:
-            return "no block of the program had been sent"
-        last = sent[-1]
-        if self.spec.flow == "char-count":
-            return self._unsure()
-        if self.spec.flow == "timed" or s.in_flight or s.attempted is not None:
-            confirmed = s.last_done if self.spec.flow != "timed" else None
-            known = (
-                f"blocks up to line {confirmed.line} were confirmed; "
-                if confirmed is not None and confirmed.index
-                else ""
-            )
-            paced = (
-                "this link confirms nothing: camtool sent each block after the one before "
-                f"had its estimated time plus {self.spec.pace_margin:.0%}, so the lines "
-                f"before line {last.line} ran only if the machine kept that pace (a slower "
-                "machine may not have run them yet); "
-                if self.spec.flow == "timed"
-                else ""
-            )
-            return (
-                f"{known}the last block sent was line {last.line} and camtool cannot know "
-                f"whether the blocks after the last confirmed one ran; {paced}look where the "
-                f"tool stands, then resume with --from-line {last.line} if line {last.line} "
-                "did not run, or with the line after it if it did (an earlier line if the "
-                "tool stands before it)"
-            )
-        line = s.resume_line()
-        return f"resume with --from-line {line}" if line else "every block had been sent"
-
     def _operator_stop(self) -> None:
         """The operator stopped the job (Ctrl-C, SIGTERM, 'stop' at a pause)."""
         if self.can_halt:
             stopped = self._halt()
-            raise LinkError(f"stopped by the operator {self._where()}{stopped}; {self._unsure()}")
+            ran = unsure(self.stream, self.plan)
+            raise LinkError(f"stopped by the operator {self._where()}{stopped}; {ran}")
         self._drain()
         self._wait_idle()
         line = self.stream.resume_line()
