@@ -120,7 +120,7 @@ def test_open_contours_with_a_side_are_left_out_with_a_warning(tmp_path: Path) -
     assert any(w.startswith("not cut: open contour") for w in program.warnings)
     # the line from (0, 0) to (1, 0) lies on the square's edge: only the offset square is cut
     assert min(m.y for m in program.moves) == pytest.approx(-0.5)
-    with pytest.raises(ToolpathError, match="are open"):
+    with pytest.raises(ToolpathError, match=r"the 1 contour is open \(on layer .0.\)"):
         plan(Drawing(drawing.contours[1:]), options)
 
 
