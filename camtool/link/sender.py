@@ -431,11 +431,7 @@ class _Driver:
         following = s.block(k + 1) if k + 1 < len(self.plan.blocks) else head
         prompt = f"{said}: do what it asks, then resume it (cycle start)"
         if not control.between_blocks(prompt, head, following):
-            if self.can_halt:
-                stopped = self._halt()
-                ran = unsure(self.stream, self.plan)
-                raise LinkError(f"{said}; not resumed: stopped {self._where()}{stopped}; {ran}")
-            self._operator_stop()
+            self._operator_stop(f"{said}; not resumed: stopped")
         self._resume()
 
     def _resume(self) -> None:
@@ -694,17 +690,16 @@ class _Driver:
             return "every block had been sent"
         return f"fix the cause, then resume with --from-line {line}"
 
-    def _operator_stop(self) -> None:
-        """The operator stopped the job (Ctrl-C, SIGTERM, 'stop' at a pause)."""
+    def _operator_stop(self, why: str = "stopped by the operator") -> None:
+        """The operator stopped the job (Ctrl-C, SIGTERM, 'stop' or 'no' at a pause)."""
         if self.can_halt:
             stopped = self._halt()
-            ran = unsure(self.stream, self.plan)
-            raise LinkError(f"stopped by the operator {self._where()}{stopped}; {ran}")
+            raise LinkError(f"{why} {self._where()}{stopped}; {unsure(self.stream, self.plan)}")
         self._drain()
         self._wait_idle()
         line = self.stream.resume_line()
         rest = f"resume with --from-line {line}" if line else "every block had been sent"
-        raise LinkError(f"stopped by the operator {self._where()}; {rest}")
+        raise LinkError(f"{why} {self._where()}; {rest}")
 
     def _stop(self, why: str) -> None:
         self._drain()
