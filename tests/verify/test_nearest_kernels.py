@@ -371,8 +371,9 @@ def test_farthest_off_is_the_largest_offset_distance_bit_for_bit(
         a, b = pts[:-1], pts[1:]
         reach = float(rng.choice([0.0015, 0.1, 1.5]))
         samples = _samples(rng, pts, 2000, reach=reach)
+        distances = nearest_search.nearest_distances(samples, a, b)
         for offset in (0.0, 0.003, reach):
-            want = float(np.max(np.abs(nearest_search.nearest_distances(samples, a, b) - offset)))
+            want = float(np.max(np.abs(distances - offset)))
             before = built[0]
             with monkeypatch.context() as m:
                 if every:  # not by measuring every distance, its fallback
