@@ -482,17 +482,46 @@ def _segment_samples(seg: Segment, spacing_mm: float) -> int:
     return max(1, math.ceil(seg.length / spacing_mm))
 
 
+ARC_ARRAYS_FROM = 16
+"""Arcs of at least this many sample points are sampled in arrays (below, numpy's calls
+cost more than the points)."""
+
+
 def _sample_contour(segments: tuple[Segment, ...], spacing_mm: float) -> FloatArray:
-    pts: list[Point] = []
-    for seg in segments:
-        n = _segment_samples(seg, spacing_mm)
+    """``(N, 2)`` points along ``segments``, mm, then the last segment's end.
+
+    Each segment gives :func:`_segment_samples` points: its start, then ``k / n`` of the way.
+    A line's points are ``start + (end - start) * k / n``, made for all the contour's lines
+    at once in numpy with the same operations in the same order as one at a time (the
+    same floats); an arc's are :meth:`~camtool.model.shapes.Arc.point_at`'s, their
+    cosines and sines ``math``'s (numpy's may differ in the last bit on some CPUs).
+    """
+    counts = [_segment_samples(seg, spacing_mm) for seg in segments]
+    out = np.empty((sum(counts) + 1, 2), dtype=np.float64)
+    lines: list[tuple[int, int, float, float, float, float]] = []
+    at = 0
+    for seg, n in zip(segments, counts, strict=True):
         if isinstance(seg, Line):
             (x0, y0), (x1, y1) = seg.start, seg.end
-            pts.extend((x0 + (x1 - x0) * k / n, y0 + (y1 - y0) * k / n) for k in range(n))
-        else:
-            pts.extend(seg.point_at(k / n) for k in range(n))
-    pts.append(segments[-1].end)
-    return np.asarray(pts, dtype=np.float64)
+            lines.append((at, n, x0, y0, x1 - x0, y1 - y0))
+        elif n < ARC_ARRAYS_FROM:
+            out[at : at + n] = [seg.point_at(k / n) for k in range(n)]
+        else:  # point_at's operations in arrays, its cosines and sines math's
+            angles = (seg.start_angle + seg.sweep * (np.arange(n) / n)).tolist()
+            (cx, cy), r = seg.centre, seg.radius
+            out[at : at + n, 0] = cx + r * np.fromiter(map(math.cos, angles), np.float64, n)
+            out[at : at + n, 1] = cy + r * np.fromiter(map(math.sin, angles), np.float64, n)
+        at += n
+    out[at] = segments[-1].end
+    if lines:
+        first, n_int, x0, y0, dx, dy = (np.array(column) for column in zip(*lines, strict=True))
+        which = np.repeat(np.arange(len(lines)), n_int)
+        k = np.arange(len(which)) - np.repeat(np.cumsum(n_int) - n_int, n_int)
+        rows = first[which] + k
+        n = n_int.astype(np.float64)[which]
+        out[rows, 0] = x0[which] + dx[which] * k / n
+        out[rows, 1] = y0[which] + dy[which] * k / n
+    return out
 
 
 def _same_contour(sizes: list[int]) -> npt.NDArray[np.bool_]:

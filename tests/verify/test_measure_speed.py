@@ -8,13 +8,14 @@ reports are written from these values.
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
 from camtool.model.program import ArcMove, Linear, Program, Rapid
-from camtool.model.shapes import Arc, Contour, Drawing, Line
+from camtool.model.shapes import Arc, Contour, Drawing, Line, Segment
 from camtool.post.registry import load_target
 from camtool.verify import (
     cutting_thin,
@@ -370,6 +371,46 @@ def test_a_drawing_sampled_into_one_array_is_its_contours_stacked() -> None:
     parts = [drawing_compare._sample_contour(c.segments, 0.013) for c in drawing.contours]
     assert sizes == [len(p) for p in parts]
     assert got.tobytes() == np.vstack(parts).tobytes()
+
+
+def _sampled_one_at_a_time(segments: tuple[Segment, ...], spacing_mm: float) -> np.ndarray:
+    """The contour sampler as it was, a point at a time in Python (the reference)."""
+    pts: list[tuple[float, float]] = []
+    for seg in segments:
+        n = max(1, math.ceil(seg.length / spacing_mm))
+        if isinstance(seg, Line):
+            (x0, y0), (x1, y1) = seg.start, seg.end
+            pts.extend((x0 + (x1 - x0) * k / n, y0 + (y1 - y0) * k / n) for k in range(n))
+        else:
+            pts.extend(seg.point_at(k / n) for k in range(n))
+    pts.append(segments[-1].end)
+    return np.asarray(pts, dtype=np.float64)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_contours_sampled_in_arrays_are_the_points_made_one_at_a_time(seed: int) -> None:
+    """Lines (long, short, of length 0, far from the origin) and arcs: the same floats."""
+    rng = np.random.default_rng(seed)
+    for _ in range(40):
+        scale = float(rng.choice([1e-3, 1.0, 1e3]))
+        at = (float(rng.normal()) * 1e4 if seed % 2 else 0.0, float(rng.normal()) * scale)
+        segments: list[Segment] = []
+        for _ in range(int(rng.integers(1, 30))):
+            start = segments[-1].end if segments else at
+            if rng.random() < 0.3:
+                centre = (start[0] + float(rng.normal()) * scale, start[1] + 0.5 * scale)
+                sweep = float(rng.uniform(-6.0, 6.0))
+                r = math.dist(start, centre)
+                a = math.atan2(start[1] - centre[1], start[0] - centre[0]) + sweep
+                end = (centre[0] + r * math.cos(a), centre[1] + r * math.sin(a))
+                segments.append(Arc(start, end, centre, sweep < 0))
+            else:
+                step = rng.normal(size=2) * scale * float(rng.choice([0.0, 0.01, 1.0, 50.0]))
+                segments.append(Line(start, (start[0] + float(step[0]), start[1] + float(step[1]))))
+        spacing = float(rng.choice([0.001, 0.013, 0.4])) * scale
+        got = drawing_compare._sample_contour(tuple(segments), spacing)
+        want = _sampled_one_at_a_time(tuple(segments), spacing)
+        assert got.tobytes() == want.tobytes()
 
 
 def test_the_cutting_count_is_the_count_of_cutting_rows() -> None:
