@@ -514,13 +514,13 @@ def _sample_contour(segments: tuple[Segment, ...], spacing_mm: float) -> FloatAr
         at += n
     out[at] = segments[-1].end
     if lines:
-        first, n_int, x0, y0, dx, dy = (np.array(column) for column in zip(*lines, strict=True))
-        which = np.repeat(np.arange(len(lines)), n_int)
-        k = np.arange(len(which)) - np.repeat(np.cumsum(n_int) - n_int, n_int)
+        first, sizes, xs, ys, dxs, dys = (np.array(col) for col in zip(*lines, strict=True))
+        which = np.repeat(np.arange(len(lines)), sizes)
+        k = np.arange(len(which)) - np.repeat(np.cumsum(sizes) - sizes, sizes)
         rows = first[which] + k
-        n = n_int.astype(np.float64)[which]
-        out[rows, 0] = x0[which] + dx[which] * k / n
-        out[rows, 1] = y0[which] + dy[which] * k / n
+        steps = sizes.astype(np.float64)[which]
+        out[rows, 0] = xs[which] + dxs[which] * k / steps
+        out[rows, 1] = ys[which] + dys[which] * k / steps
     return out
 
 
