@@ -41,11 +41,10 @@ def pytest_terminal_summary(terminalreporter: Any) -> None:
 def pytest_collection_finish(session: pytest.Session) -> None:
     """What the collection imported and made is moved out of the cyclic collector's sight.
 
-    A worker holds ~520 000 objects of modules (numba, OpenCASCADE, matplotlib, dask) by
-    the end of a run, most of them made by then, and each full collection a test's
-    allocations trigger walked them again. :func:`gc.freeze` leaves them alive and
-    unscanned; what the tests make is collected as before (the collector's time in a
-    ``make test`` worker, measured with ``gc.callbacks``: 21-28 s, then 17-21 s).
+    A worker holds most of its objects by then (the modules of numba, OpenCASCADE,
+    matplotlib, dask), and each full collection a test's allocations trigger walked them
+    again. :func:`gc.freeze` leaves them alive and unscanned; what the tests make is
+    collected as before (the time it saves: docs/performance.md).
     """
     gc.freeze()
 
