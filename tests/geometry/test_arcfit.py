@@ -118,7 +118,7 @@ def assert_two_sided(segs: Sequence[Segment], curve: VecCurve, t0: float, t1: fl
 
 def scalar(curve: VecCurve) -> Callable[[float], tuple[float, float]]:
     """``curve`` at one parameter, as the fitter calls it: its plain-float form where it has
-    one (``curve.scalar``: a Bézier's, an ellipse's; one numpy call a point costs ~20 µs)."""
+    one (``curve.scalar``: a Bézier's, an ellipse's), else the array form on one point."""
     plain = getattr(curve, "scalar", None)
     if plain is not None:
         return plain  # type: ignore[no-any-return]
