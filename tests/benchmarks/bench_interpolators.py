@@ -242,7 +242,7 @@ def main() -> None:
     t0 = time.perf_counter()
     first = first_call_s()
     # load the kernels before timing (a big job does so itself; a tree before issue 17 has none)
-    if getattr(itp, "compiled", lambda: None)() is None:
+    if getattr(dda, "compiled", lambda: None)() is None:
         print("numba not installed: the plain numpy / Python paths are timed", file=sys.stderr)
     extra = f"first call in a fresh process (numba import + cached loops) {first:.2f} s"
     cc = compiler()

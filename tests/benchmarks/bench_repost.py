@@ -18,7 +18,7 @@ Timed in one run, each the best of :data:`RUNS` (wall time, as a user runs them)
 ``PYTHONPATH`` set to this tree, and ``rs274 -t TOOL.TBL -g BIG.ngc`` (output to
 /dev/null) with the manifest's ``LD_LIBRARY_PATH``; camtool's peak memory from a fresh
 runner child (``RUSAGE_CHILDREN``). The output must be byte-identical to the pre-work
-output as recorded (:data:`OUTPUT_SHA256`: b3b77a5's with the tool changes of 35fbe3b); the
+output as recorded (:data:`OUTPUT_SHA256`: b3b77a5's with the changes it names); the
 row says so or says it differs.
 Without ``rs274`` (the corpus without it) the ratio uses :data:`RS274_RECORDED_S`.
 
@@ -100,13 +100,18 @@ BIG_COPIES = 170
 cost per line decides, not start-up (issue 44)."""
 BIG_JOB = "re-post 10.9 MB G-code (338 981 lines) → linuxcnc"
 INPUT_SHA256 = "34f5a0763a3aecd31b31e4c4eabe79f2d86f450f9d7110efc8ad5e899182a7d6"
-OUTPUT_SHA256 = "9f3217e4f780855cde10058a9858fd1dadc5cbc97495dfc2c9c4ae0c7edc607a"
+OUTPUT_SHA256 = "5f8ee1a17bd2cef48bed0a3189ac0f9203a453c900d90dd483ba68591d824a82"
 """camtool re-posting the program to linuxcnc since 35fbe3b: the pre-work output (b3b77a5,
 ``d55c8f55…``) but for its 17 tool changes, each ``M6 T1`` then written ``T1 M6`` and
 ``G43 H1`` (the tool table's length offset after a change, LinuxCNC's way); no other line
 differs (bisected 25 Nov 2026). Since the re-post keeps a program's own length offsets
 (25 Nov 2026), ``G43 H1`` is where ``cds.ngc`` has it, not after each ``T1 M6`` (whose
-program has none there): 17 lines moved, no other line differs."""
+program has none there): 17 lines moved, no other line differs. Since dedd6dd (coolant read
+and written) ``cds.ngc``'s ``M9`` is kept (17 lines added), and since 29a9b1e a new speed of
+the turning spindle goes in the next motion block: its ``M3 S3500`` (the spindle already on
+clockwise) is written ``G0 Z53.340 S3500`` (17 lines fewer); LinuxCNC's ``rs274`` reads
+both programs to the same canonical calls but ``MIST_OFF``/``FLOOD_OFF`` added and the
+repeated ``START_SPINDLE_CLOCKWISE`` gone (bisected 27 Nov 2026)."""
 RS274_RECORDED_S = 0.37
 """rs274 on this program, best of 5 on the 2-core dev machine under load (this docstring)."""
 RUNS = 3
