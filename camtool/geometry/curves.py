@@ -223,12 +223,28 @@ def fit_pieces(
             return tangent_at(min(t, inside))
 
         segs.extend(fit_curve(point_at, tangent, a, b, tolerance, points_at=points_at))
+    return joined_run(segs, closed)
+
+
+def joined_run(segs: Sequence[Segment], closed: bool) -> list[Segment]:
+    """A curve's pieces' fits as one run: each segment starts where the one before ends.
+
+    A closed curve's last point is moved onto its first.
+
+    Args:
+        segs: the pieces' segments, each piece starting where the one before ends (to
+            ~1e-15 mm), mm.
+        closed: the curve ends where it starts (within the tolerance it was fitted to).
+
+    Returns:
+        The segments moved onto each other's ends; empty when ``segs`` is.
+    """
     if not segs:
-        return segs
-    segs = snap(segs)
-    if closed and segs[-1].end != segs[0].start:
-        segs[-1] = with_end(segs[-1], segs[0].start)
-    return segs
+        return []
+    out = snap(segs)
+    if closed and out[-1].end != out[0].start:
+        out[-1] = with_end(out[-1], out[0].start)
+    return out
 
 
 def merge_arcs(segs: list[Segment]) -> list[Segment]:

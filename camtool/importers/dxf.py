@@ -287,8 +287,22 @@ def _splines_ahead(msp: Any, reader: _Reader) -> dict[int, Any]:
     def check(entity: Any) -> None:
         check_numbers(entity, "", layer_of(entity), reader.limit)
 
-    FIT_KERNELS.get(len(splines))  # the compiled fitter, loaded once for every worker
+    if FIT_KERNELS.get(len(splines)) is not None:  # loaded once, for every worker too
+        # the reader fits a clamped quadratic or cubic one as its Bézier spans, compiled,
+        # faster than a worker's answer comes back: only the others go to the pool
+        splines = [e for e in splines if not _bezier_spans(e)]
+        if len(splines) < MIN_SPLINES:
+            return {}
     return fit_ahead(splines, reader.tolerance, spline_segments, check)
+
+
+def _bezier_spans(spline: Any) -> bool:
+    """Whether a SPLINE looks fitted as its Bézier spans (degree 2 or 3, no weights).
+
+    A look at the entity, not its curve: a wrong answer changes where it is fitted, not
+    the fit (:func:`~camtool.importers.dxf_entities.spline_segments` decides).
+    """
+    return int(spline.dxf.degree) in (2, 3) and len(spline.weights) == 0
 
 
 def _read_checked(

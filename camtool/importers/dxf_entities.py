@@ -20,11 +20,12 @@ import numpy as np
 
 from camtool.geometry.arcfit import FloatArray, PointsFn
 from camtool.geometry.chain import with_end, with_start
-from camtool.geometry.curves import corner_knots, ellipse, fit_pieces
+from camtool.geometry.curves import corner_knots, ellipse, fit_pieces, joined_run
+from camtool.geometry.fitpool import fit_key
 from camtool.importers.dxf_damage import implied_degree
 from camtool.importers.dxf_prefit import take
 from camtool.importers.options import check_curve_size
-from camtool.model.errors import GeometryError
+from camtool.model.errors import GeometryError, UsageError
 from camtool.model.shapes import TAU, Arc, Contour, Line, Point, Segment, distance
 
 _RELATIVE = 1e-9  # times the size: a z spread that is still planar, ends that coincide
@@ -555,7 +556,9 @@ def spline_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool]
     The curve is the B-spline over its valid domain ``[u_p, u_n]`` (p the degree,
     n the control point count; the same as ``[0, max_t]`` for clamped splines, the
     periodic part for closed unclamped ones). It is fitted piecewise between knots
-    of multiplicity ≥ p, where the curve may have a corner. Splines given by fit points
+    of multiplicity ≥ p, where the curve may have a corner; a clamped non-rational
+    quadratic or cubic one between every two knots, as the Bézier curves it is there
+    (:func:`_bezier_fits`). Splines given by fit points
     only are rebuilt as AutoCAD does (:func:`ezdxf.math.fit_points_to_cad_cv`, with the
     stored end tangents); a closed one is closed through its first fit point. The contour
     is closed when the spline's ends coincide, or when it is flagged closed and its ends
@@ -604,7 +607,36 @@ def spline_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool]
 
     gap = distance(point_at(t0), point_at(t1))
     closed = gap <= _RELATIVE * size or (bool(entity.closed) and gap <= tolerance)
+    pieces = _bezier_fits(spline, tolerance, closed)
+    if pieces is not None:
+        return pieces, closed
     return _fit(point_at, tangent_at, breaks, tolerance, closed, points_at), closed
+
+
+def _bezier_fits(spline: Any, tolerance: float, closed: bool) -> list[Segment] | None:
+    """A clamped, non-rational quadratic or cubic B-spline fitted as its Bézier spans.
+
+    Between two knots such a spline is one Bézier curve: ezdxf's
+    ``BSpline.bezier_decomposition`` (The NURBS Book, algorithm A5.6) gives their control
+    points, and each is fitted as an SVG path's curves are
+    (:func:`~camtool.geometry.fitpool.fit_key`: compiled once a drawing has enough curves,
+    the same fits either way). A span whose control points all coincide is a point and
+    left out. ``None`` for any other spline, or when a span's fit fails: the caller
+    fits the curve through ezdxf's evaluator, which says why.
+    """
+    if spline.degree not in (2, 3) or spline.is_rational or not spline.is_clamped:
+        return None
+    kind = "cubic" if spline.degree == 3 else "quadratic"
+    segs: list[Segment] = []
+    try:
+        for controls in spline.bezier_decomposition():
+            points = tuple((float(v.x), float(v.y)) for v in controls)
+            if all(q == points[0] for q in points):
+                continue
+            segs.extend(fit_key((kind, points), tolerance))
+    except (GeometryError, UsageError, TypeError, ValueError, ZeroDivisionError):
+        return None
+    return joined_run(segs, closed) or None
 
 
 def _check_size(extent: float, tolerance: float) -> None:

@@ -306,17 +306,10 @@ def test_property_random_spline_fit_holds_tolerance(
     _assert_fits(curve, contour, tol)
 
 
-def test_a_spline_is_evaluated_by_one_evaluator_in_arrays(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """ezdxf's ``BSpline.point(t)`` builds an evaluator from every control point at each call:
-    one is built per spline, and the fit's samples are asked for in arrays."""
+def _counting_evaluators(monkeypatch: pytest.MonkeyPatch) -> tuple[list[int], list[int]]:
+    """Count the ezdxf evaluators built and the lengths of their ``points`` batches."""
     from ezdxf.math import BSpline
 
-    cps = [(10.0 * i, 20.0 * math.sin(i / 2.0)) for i in range(40)]
-    path = write_dxf(
-        tmp_path / "s.dxf", lambda msp: msp.add_open_spline([(*p, 0) for p in cps], degree=3)
-    )
     built: list[int] = []
     batches: list[int] = []
     evaluator = BSpline.evaluator
@@ -340,8 +333,52 @@ def test_a_spline_is_evaluated_by_one_evaluator_in_arrays(
         return Counting(evaluator.fget(spline))  # type: ignore[attr-defined]
 
     monkeypatch.setattr(BSpline, "evaluator", property(counting))
+    return built, batches
+
+
+def test_a_rational_spline_is_evaluated_by_one_evaluator_in_arrays(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """ezdxf's ``BSpline.point(t)`` builds an evaluator from every control point at each call:
+    one is built per spline, and the fit's samples are asked for in arrays."""
+    cps = [(10.0 * i, 20.0 * math.sin(i / 2.0)) for i in range(40)]
+    weights = [1.0 + 0.5 * (i % 3) for i in range(40)]
+    path = write_dxf(
+        tmp_path / "s.dxf",
+        lambda msp: msp.add_rational_spline([(*p, 0) for p in cps], weights, degree=3),
+    )
+    built, batches = _counting_evaluators(monkeypatch)
     (contour,) = read_dxf(path).contours
     assert len(built) == 1
     assert batches and min(batches) > 1
+    monkeypatch.undo()
+    _assert_fits(_spline_curve(path), contour)
+
+
+def test_a_clamped_cubic_spline_is_fitted_as_its_bezier_spans(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Between two knots a clamped non-rational cubic B-spline is one cubic Bézier: each of
+    its 37 spans (40 control points, uniform knots) is fitted as an SVG curve is, none
+    through the evaluator's samples; the fit holds the tolerance against ezdxf's curve."""
+    from camtool.importers import dxf_entities
+
+    cps = [(10.0 * i, 20.0 * math.sin(i / 2.0)) for i in range(40)]
+    path = write_dxf(
+        tmp_path / "s.dxf", lambda msp: msp.add_open_spline([(*p, 0) for p in cps], degree=3)
+    )
+    built, batches = _counting_evaluators(monkeypatch)
+    keys: list[Any] = []
+    fit_key = dxf_entities.fit_key
+
+    def counted(key: Any, tolerance: float) -> Any:
+        keys.append(key)
+        return fit_key(key, tolerance)
+
+    monkeypatch.setattr(dxf_entities, "fit_key", counted)
+    (contour,) = read_dxf(path).contours
+    assert len(built) <= 1 and batches == []
+    assert len(keys) == 40 - 3 and {kind for kind, _ in keys} == {"cubic"}
+    assert keys[0][1][0] == cps[0] and keys[-1][1][-1] == cps[-1]  # a clamped spline's ends
     monkeypatch.undo()
     _assert_fits(_spline_curve(path), contour)
