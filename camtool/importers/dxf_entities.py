@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from camtool.geometry.arcfit import FloatArray, PointsFn
+from camtool.geometry.arcfit import FIT_KERNELS, FloatArray, PointsFn
 from camtool.geometry.chain import with_end, with_start
 from camtool.geometry.curves import corner_knots, ellipse, fit_pieces, joined_run
 from camtool.geometry.fitpool import fit_key
@@ -629,11 +629,11 @@ def _bezier_fits(spline: Any, tolerance: float, closed: bool) -> list[Segment] |
     kind = "cubic" if spline.degree == 3 else "quadratic"
     segs: list[Segment] = []
     try:
-        for controls in spline.bezier_decomposition():
-            points = tuple((float(v.x), float(v.y)) for v in controls)
-            if all(q == points[0] for q in points):
-                continue
-            segs.extend(fit_key((kind, points), tolerance))
+        spans = [tuple((float(v.x), float(v.y)) for v in c) for c in spline.bezier_decomposition()]
+        FIT_KERNELS.get(len(spans))  # a long spline asks for the compiled fitter at once
+        for points in spans:
+            if any(q != points[0] for q in points):  # all in one place: a point, no curve
+                segs.extend(fit_key((kind, points), tolerance))
     except (GeometryError, UsageError, TypeError, ValueError, ZeroDivisionError):
         return None
     return joined_run(segs, closed) or None
