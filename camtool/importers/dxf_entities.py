@@ -629,9 +629,9 @@ def _bezier_fits(spline: Any, tolerance: float, closed: bool) -> list[Segment] |
     kind = "cubic" if spline.degree == 3 else "quadratic"
     segs: list[Segment] = []
     try:
-        spans = [tuple((float(v.x), float(v.y)) for v in c) for c in spline.bezier_decomposition()]
-        FIT_KERNELS.get(len(spans))  # a long spline asks for the compiled fitter at once
-        for points in spans:
+        FIT_KERNELS.get(len(set(spline.knots())))  # a long one asks for the compiled fitter
+        for controls in spline.bezier_decomposition():  # one span at a time
+            points = tuple((float(v.x), float(v.y)) for v in controls)
             if any(q != points[0] for q in points):  # all in one place: a point, no curve
                 segs.extend(fit_key((kind, points), tolerance))
     except (GeometryError, UsageError, TypeError, ValueError, ZeroDivisionError):
