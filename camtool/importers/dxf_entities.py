@@ -558,11 +558,10 @@ def spline_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool]
     periodic part for closed unclamped ones). It is fitted piecewise between knots
     of multiplicity ≥ p, where the curve may have a corner; a clamped non-rational
     quadratic or cubic one between every two knots, as the Bézier curves it is there
-    (:func:`_bezier_fits`). Splines given by fit points
-    only are rebuilt as AutoCAD does (:func:`ezdxf.math.fit_points_to_cad_cv`, with the
-    stored end tangents); a closed one is closed through its first fit point. The contour
-    is closed when the spline's ends coincide, or when it is flagged closed and its ends
-    meet within the tolerance.
+    (:func:`_bezier_fits`). Splines given by fit points only are rebuilt as AutoCAD does
+    (:func:`ezdxf.math.fit_points_to_cad_cv`, with the stored end tangents); a closed one
+    is closed through its first fit point. The contour is closed when the spline's ends
+    coincide, or when it is flagged closed and its ends meet within the tolerance.
 
     Args:
         entity: an ezdxf ``Spline`` (WCS), possibly a virtual one from a block.
@@ -572,7 +571,8 @@ def spline_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool]
         ``(segments, closed)`` in drawing units, Y up.
 
     Raises:
-        Unsupported: invalid spline data, a spline not parallel to XY, or one whose
+        Unsupported: invalid spline data (knots that decrease or that ezdxf cannot
+            evaluate among them), a spline not parallel to XY, or one whose
             curve is a single point.
     """
     spline = _construction(entity)
@@ -586,6 +586,8 @@ def spline_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool]
     t0, t1 = float(knots[p]), float(knots[n])
     if not t1 > t0:
         raise Unsupported("invalid spline data", "empty parameter range")
+    if any(b < a for a, b in itertools.pairwise(knots)):
+        raise Unsupported("invalid spline data", "its knots decrease")
     breaks = [t0, *corner_knots(knots, p, t0, t1), t1]
     xs, ys = [q[0] for q in pts], [q[1] for q in pts]
     _check_size(max(max(xs) - min(xs), max(ys) - min(ys)), tolerance)
@@ -605,12 +607,15 @@ def spline_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool]
         xyz = itertools.chain.from_iterable(evaluator.points(ts))
         return np.fromiter(xyz, np.float64, count=3 * len(ts)).reshape(-1, 3)[:, :2]
 
-    gap = distance(point_at(t0), point_at(t1))
-    closed = gap <= _RELATIVE * size or (bool(entity.closed) and gap <= tolerance)
-    pieces = _bezier_fits(spline, tolerance, closed)
-    if pieces is not None:
-        return pieces, closed
-    return _fit(point_at, tangent_at, breaks, tolerance, closed, points_at), closed
+    try:
+        gap = distance(point_at(t0), point_at(t1))
+        closed = gap <= _RELATIVE * size or (bool(entity.closed) and gap <= tolerance)
+        pieces = _bezier_fits(spline, tolerance, closed)
+        if pieces is not None:
+            return pieces, closed
+        return _fit(point_at, tangent_at, breaks, tolerance, closed, points_at), closed
+    except ZeroDivisionError as exc:  # ezdxf's basis functions on knots a hair apart
+        raise Unsupported("invalid spline data", f"ezdxf cannot evaluate it ({exc})") from exc
 
 
 def _bezier_fits(spline: Any, tolerance: float, closed: bool) -> list[Segment] | None:

@@ -208,6 +208,33 @@ def test_counts_that_imply_no_clamped_degree_stay_invalid(tmp_path: Path) -> Non
     assert any("skipped 1 SPLINE entity (invalid spline data)" in w for w in d.warnings)
 
 
+@pytest.mark.parametrize(
+    ("inner", "why"),
+    [
+        ([0.7, 0.5], "its knots decrease"),  # no B-spline has them
+        ([0.5, 0.5 + 1e-12], "ezdxf cannot evaluate it"),  # ezdxf's basis divides by ~0
+    ],
+)
+def test_a_spline_whose_knots_cannot_be_evaluated_is_skipped_by_name(
+    tmp_path: Path, inner: list[float], why: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Knots that decrease, or that ezdxf's evaluator cannot take, skip the SPLINE with a
+    warning, and ``inspect`` says why (not an internal error, not a curve made up)."""
+    from camtool.cli.main import main
+
+    def build(msp: Any) -> None:
+        msp.add_line((0, 0), (1, 0))
+        spline = msp.add_open_spline([(0, 0, 0), (1, 2, 0), (3, -1, 0), (4, 1, 0), (6, 0, 0)])
+        spline.knots = [0, 0, 0, 0, *inner, 1, 1, 1]
+
+    path = write_dxf(tmp_path / "k.dxf", build)
+    d = read_dxf(path)
+    assert len(d.contours) == 1
+    assert any("skipped 1 SPLINE entity (invalid spline data)" in w for w in d.warnings)
+    assert main(["inspect", str(path)]) == 0
+    assert f"invalid spline data: {why}" in capsys.readouterr().out
+
+
 def test_spline_with_a_corner_knot_keeps_the_corner(tmp_path: Path) -> None:
     # degree 2 with a double inner knot: the curve passes the middle control point
     # with a corner there (C0); the fit must hold around it.
