@@ -38,7 +38,7 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 sys.path.insert(0, str(HERE))
 
-from table import row  # noqa: E402
+from table import camtool_env, row  # noqa: E402
 
 CORPUS = Path(os.environ.get("CAMTOOL_CORPUS_DIR", ROOT / ".corpus"))
 LIBRARY = CORPUS / "pkg/librecad-data/usr/share/librecad/library"
@@ -93,7 +93,7 @@ def tree_hash(folder: Path, leave_out: frozenset[str] = frozenset()) -> str:
 def batch(src: Path, out: Path, jobs: int) -> tuple[float, int]:
     """Wall seconds and exit code of ``camtool batch`` with ``jobs`` worker processes."""
     shutil.rmtree(out, ignore_errors=True)
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), str(ROOT / ".pp")])}
+    env = camtool_env()
     cmd = [sys.executable, "-m", "camtool", "batch", str(src), "-t", "grbl", "-o", str(out)]
     start = time.perf_counter()
     done = subprocess.run(

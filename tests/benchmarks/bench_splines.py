@@ -21,7 +21,6 @@ this machine reaches) in docs/performance.md.
 from __future__ import annotations
 
 import math
-import os
 import subprocess
 import sys
 import tempfile
@@ -29,8 +28,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from bench_svg import CELL_H, CELL_W, COLUMNS, ICON_MM, ROOT, best, icons
-from table import row
+from bench_svg import CELL_H, CELL_W, COLUMNS, ICON_MM, best, icons
+from table import camtool_env, row
 
 GOAL_S = 5.0
 
@@ -98,7 +97,7 @@ def main() -> int:
     if not paths:
         print("bench_splines: no Tango icons (make corpus)", file=sys.stderr)
         return 0
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    env = camtool_env()
     camtool = [sys.executable, "-m", "camtool"]
     with tempfile.TemporaryDirectory() as tmp:
         drawing = Path(tmp) / "splines.dxf"

@@ -9,24 +9,22 @@ under 0.5 s.
 
 from __future__ import annotations
 
-import os
 import subprocess
 import sys
 import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-ROOT = HERE.parents[1]
 sys.path.insert(0, str(HERE))
 
-from table import row  # noqa: E402
+from table import camtool_env, row  # noqa: E402
 
 RUNS = 7
 
 
 def best(argv: list[str]) -> float:
     """Best wall seconds of ``RUNS`` runs of ``argv`` (each must exit 0)."""
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), str(ROOT / ".pp")])}
+    env = camtool_env()
     times = []
     for _ in range(RUNS):
         start = time.perf_counter()

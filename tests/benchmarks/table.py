@@ -13,13 +13,36 @@ for wall times, *camtool's time over the peer's* (``< 1`` means camtool is faste
 from __future__ import annotations
 
 import json
+import os
 import sys
+import tempfile
+from pathlib import Path
 from typing import Literal
 
 PREFIX = "BENCH-ROW "
 """Start of a result line on stdout."""
 
 Kind = Literal["time", "speed", "absolute"]
+
+ROOT = Path(__file__).resolve().parents[2]
+
+PYCACHE = Path(tempfile.gettempdir()) / "camtool-bench-pycache"
+"""Where camtool's bytecode is cached for the benchmarks' runs (``PYTHONPYCACHEPREFIX``)."""
+
+
+def camtool_env() -> dict[str, str]:
+    """The environment camtool runs in, as a user's: this tree first, from cached bytecode.
+
+    ``PYTHONPATH`` is the tree's root and its ``.pp`` (the target plug-ins). An installed
+    camtool runs from bytecode (pip compiles it), and so do its libraries here; a shell with
+    ``PYTHONDONTWRITEBYTECODE`` set would compile every camtool module from source on every
+    run. That variable is dropped and the bytecode goes to :data:`PYCACHE`, written by the
+    first run (each script times the best of several runs, or makes an untimed one first).
+    """
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), str(ROOT / ".pp")]))
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    env["PYTHONPYCACHEPREFIX"] = str(PYCACHE)
+    return env
 
 
 def row(
