@@ -278,7 +278,7 @@ def verify(
     A one-screen summary goes to stderr.
     """
     from camtool.cli.progress import StageReporter
-    from camtool.jobs.inputs import read_code, read_input
+    from camtool.jobs.inputs import check_not_drawing, read_code, read_input
     from camtool.jobs.output import check_paths
     from camtool.jobs.pipeline import load_target_checked
     from camtool.verify.verifier import verify_code
@@ -291,6 +291,7 @@ def verify(
     )
     _check_preview(preview)
     chosen = load_target_checked(target, machine_file=machine_file)
+    check_not_drawing(code, chosen, "verify PROGRAM, with --against {name} to compare")
     text = read_code(code, binary=chosen.post.binary)
     drawing = read_input(against) if against is not None else None
     if drawing is not None and isinstance(text, str):

@@ -81,13 +81,14 @@ def send(
     lost port or a controller that stops answering end the job naming the lines
     that surely ran and the --from-line that resumes it (exit 1).
     """
-    from camtool.jobs.inputs import read_code
+    from camtool.jobs.inputs import check_not_drawing, read_code
     from camtool.jobs.output import check_paths
     from camtool.jobs.pipeline import load_target_checked
     from camtool.link.plan import prepare_send
 
     check_paths([("the program", program)], [("--log", log)], target=target)
     chosen = load_target_checked(target, machine_file=machine_file)
+    check_not_drawing(program, chosen, "send PROGRAM")
     code = read_code(program, binary=chosen.post.binary)
     plan = prepare_send(
         code,

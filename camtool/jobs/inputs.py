@@ -179,6 +179,26 @@ def read_code(name: str, *, binary: bool = False) -> str | bytes:
         raise InputError(f"{name}: cannot read ({exc.strerror or exc})") from exc
 
 
+def check_not_drawing(name: str, target: Target, then: str) -> None:
+    """Refuse a DXF or SVG drawing given where a program is read, saying what to do.
+
+    Args:
+        name: the program's file name as given.
+        target: the target the program is read for.
+        then: what to do with the posted ``PROGRAM`` (``{name}``: the drawing's name),
+            e.g. ``"send PROGRAM"``.
+
+    Raises:
+        InputError: ``name`` ends in ``.dxf`` or ``.svg`` and ``target`` writes no such file.
+    """
+    suffix = Path(name).suffix.lower()
+    if suffix in (".dxf", ".svg") and suffix not in target.post.formats.values():
+        raise InputError(
+            f"{name}: a drawing, not a program. Post it first "
+            f"(camtool post {name} -t {target.name} -o PROGRAM), then " + then.format(name=name)
+        )
+
+
 def read_program(name: str, target: Target | None) -> Program:
     """A program by its ending: the target's dialect, or G-code through the importer.
 

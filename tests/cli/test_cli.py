@@ -497,3 +497,29 @@ def test_an_output_in_a_missing_directory_is_refused_before_any_work(
     a_file.write_text("x")
     code, _, err = run(["post", "part.dxf", "-t", "grbl", "-o", str(a_file / "p.gcode")], capsys)
     assert code == 2 and f"{a_file} is not a directory" in err
+
+
+@pytest.mark.parametrize("drawing", ["logo.dxf", "LOGO.SVG"])
+def test_verify_of_a_drawing_says_to_post_it_first(
+    drawing: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A drawing given as verify's program is refused with what to do, not a parse error."""
+    path = tmp_path / drawing
+    path.write_bytes((SAMPLES / "logo.dxf").read_bytes())
+    code, out, err = run(["verify", str(path), "-t", "grbl"], capsys)
+    assert code == 3 and out == ""
+    assert f"{path}: a drawing, not a program" in err
+    assert f"camtool post {path} -t grbl -o PROGRAM" in err and "--against" in err
+    assert "unexpected character" not in err and "Traceback" not in err
+
+
+def test_send_of_a_drawing_says_to_post_it_first(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``send`` refuses a drawing before it opens any port, saying what to do."""
+    missing_port = tmp_path / "no-such-port"
+    args = ["send", str(SAMPLES / "logo.dxf"), "-t", "grbl", "--port", str(missing_port)]
+    code, out, err = run(args, capsys)
+    assert code == 3 and out == ""
+    assert "logo.dxf: a drawing, not a program" in err and "then send PROGRAM" in err
+    assert str(missing_port) not in err
