@@ -193,6 +193,9 @@ OTHER_LETTERS = MappingProxyType(
 )
 """Why letters outside :data:`WORD_LETTERS` are refused."""
 
+PRINTER_M_CODES = frozenset((82, 83, 84, 104, 106, 107, 109, 140, 190))
+"""M codes only 3D printers use (Marlin: extruder modes, motors off, fan, temperatures)."""
+
 _AXES_NEED = "axis words need G0, G1, G2 or G3 (or modal motion) before them"
 UNUSED_LETTERS = MappingProxyType(
     {
@@ -257,6 +260,9 @@ class BlockWords:
         self.m: dict[str, Code] = {}
         self.args: dict[str, Word] = {}
         for word in block.words:
+            if word.letter == "E":  # named before the block's codes: G92 E0 is a printer's
+                raise InputError(f"{where}: {word} {OTHER_LETTERS['E']}")
+        for word in block.words:
             if word.letter == "N":
                 continue
             if word.letter in "GM":
@@ -303,6 +309,11 @@ def lookup_code(word: Word, where: str) -> Code:
     else:
         whole = word.value == int(word.value) and word.value >= 0
         code = M_CODES.get(int(word.value)) if whole else None
+    if code is None and word.letter == "M" and word.value in PRINTER_M_CODES:
+        raise InputError(
+            f"{where}: {word} is a 3D printer's code (Marlin: temperatures, fans, "
+            "extruder modes, motors off); camtool reads CNC milling programs"
+        )
     if code is None:
         raise InputError(
             f"{where}: unknown or unsupported code {word}; camtool reads {READ_CODES} "

@@ -371,6 +371,10 @@ def test_safe_conversion_warns_once_with_count_and_first_line(block: str, expect
         ("G0 X2 I1", "I1 has no code to use it"),
         ("G4", "G4 dwell needs a P word"),
         ("G1 X2 E0.5 F10", "E0.5 is a 3D-printer extrusion word"),
+        # a Marlin program's start (cncjs's example part.gcode): named as a printer's
+        ("G92 E0", "E0 is a 3D-printer extrusion word"),
+        ("M104 S200", "M104 is a 3D printer's code"),
+        ("M140 S60", "M140 is a 3D printer's code"),
         ("G0 A90", "A90 is an axis camtool does not have"),
         ("G0 X1 (open", "comment '(' is not closed"),
         ("G0 X1 (a (b) c)", "nested comment"),
