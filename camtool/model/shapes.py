@@ -490,14 +490,28 @@ class Contour:
             out.extend(seg.points(tolerance)[1:])
         return out
 
-    def signed_area(self, tolerance: float = 1e-4) -> float:
-        """Signed area in mm² (> 0 counter-clockwise); 0 for open contours."""
+    def signed_area(self) -> float:
+        """Signed area in mm² (> 0 counter-clockwise), exact for lines and arcs; 0 if open.
+
+        The shoelace sum over the segments' chords (and over any gap from one segment's end
+        to the next one's start), plus for each arc the circular segment between its chord
+        and the arc,
+        ``r² (|θ| − sin |θ|) / 2`` with the sign of its sweep ``θ`` (a full circle: π r²).
+        """
         if not self.closed:
             return 0.0
-        pts = self.points(tolerance)
-        return 0.5 * sum(
-            x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(pts, pts[1:] + pts[:1], strict=True)
-        )
+        twice = 0.0
+        hx, hy = self.end  # where the last segment left off: a gap to the next is a chord
+        for seg in self.segments:
+            (x0, y0), (x1, y1) = seg.start, seg.end
+            twice += hx * y0 - x0 * hy + x0 * y1 - x1 * y0
+            hx, hy = x1, y1
+            if type(seg) is Arc:
+                sweep = seg.sweep
+                turn = abs(sweep)
+                bulge = seg.radius * seg.radius * (turn - math.sin(turn))
+                twice += bulge if sweep > 0 else -bulge
+        return 0.5 * twice
 
     def transformed(self, scale: float, dx: float, dy: float) -> Contour:
         """Uniformly scaled about the origin (``scale`` > 0), then translated."""

@@ -25,8 +25,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from bench_svg import best, camtool_env, corpus_dirs
-from table import row
+from bench_svg import best, corpus_dirs
+from table import camtool_env, row
 
 GEARS = Path("pkg/inkscape/usr/share/inkscape/examples/live-path-effects-gears.svg")
 """The part, relative to a corpus directory."""

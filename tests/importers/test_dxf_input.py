@@ -163,14 +163,14 @@ def test_hatch_boundaries_become_closed_contours(tmp_path: Path) -> None:
     assert edges.source == f"HATCH #{handle} path 2"
     assert square.closed and edges.closed and edges.end == edges.start
     # square with a half-circle top: area 100 + π·5²/2 (polygon area with 1e-6 mm chords)
-    assert abs(square.signed_area(1e-6)) == pytest.approx(100 + math.pi * 12.5, rel=1e-6)
+    assert abs(square.signed_area()) == pytest.approx(100 + math.pi * 12.5, rel=1e-6)
     kinds = [type(s) for s in square.segments]
     assert kinds.count(Arc) == 1 and kinds.count(Line) == 3
     # edge path: the 10 x 10 square (20..30) + a half disc of radius 5 on its right, less
     # what lies left of the quarter ellipse (centre (25, 0), semi-axes 5 and 10):
     # 100 + 12.5π - (50 - 50π/4); the ellipse is fitted within 0.001 mm over ~12 mm
     want = 100 + 12.5 * math.pi - (50 - 50 * math.pi / 4)
-    assert abs(edges.signed_area(1e-6)) == pytest.approx(want, abs=0.001 * 12)
+    assert abs(edges.signed_area()) == pytest.approx(want, abs=0.001 * 12)
 
 
 def test_layers_select_and_match_case_insensitively(tmp_path: Path) -> None:
@@ -293,4 +293,4 @@ def test_hatch_spline_edge_is_fitted(tmp_path: Path) -> None:
         write_dxf(tmp_path / "hs.dxf", build), ImportOptions(hatch_boundaries=True)
     ).contours
     assert contour.closed and contour.bbox() == pytest.approx((0, 20, 10, 25), abs=0.001)
-    assert abs(contour.signed_area(1e-6)) == pytest.approx(100 / 3, abs=0.001 * 12)
+    assert abs(contour.signed_area()) == pytest.approx(100 / 3, abs=0.001 * 12)

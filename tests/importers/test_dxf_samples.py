@@ -87,7 +87,7 @@ def test_inkscape_bracket() -> None:
     assert outline.layer == "CUT" and outline.closed
     assert outline.bbox() == pytest.approx((5, 5, 55, 36.25), abs=TOL)
     # 50 x 20 rectangle + 405 mm² under the cubic (Green's theorem on the SVG's Bézier)
-    assert abs(outline.signed_area(1e-6)) == pytest.approx(1405.0, abs=TOL * 120)
+    assert abs(outline.signed_area()) == pytest.approx(1405.0, abs=TOL * 120)
     assert hole.closed and all(isinstance(s, Arc) for s in hole.segments)
     radius_error = 4 * 2.8e-4 + TOL  # cubic Bézier circle error, then the fit
     for seg in hole.segments:

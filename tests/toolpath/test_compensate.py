@@ -206,7 +206,7 @@ def test_dumbbell_shrunk_past_its_waist_gives_two_pieces() -> None:
     r = 1.2
     segment = 0.5 * math.sqrt(r * r - 1) + r * r / 2 * math.asin(1 / r)  # ∫₀¹ √(r² − t²) dt
     for p in pieces:
-        assert p.signed_area(1e-8) == pytest.approx(7.6 * 7.6 + 2 * (r - segment), abs=1e-6)
+        assert p.signed_area() == pytest.approx(7.6 * 7.6 + 2 * (r - segment), abs=1e-6)
     with pytest.raises(ToolpathError, match="splits into 2 pieces"):
         offset_contour(dumbbell(), -1.2)
     stage = _run([dumbbell()], "inside", 2.4)
