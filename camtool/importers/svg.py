@@ -635,8 +635,18 @@ def _line(p0: Point, p1: Point) -> list[Segment]:
 
 
 def _fit(key: CurveKey, fitter: Fitter) -> list[Segment]:
+    """The fit of ``key``, or none when its segments are no longer than a point.
+
+    Their lengths are summed only until the sum is past :data:`ZERO_LENGTH_MM` (the first
+    segment, as a rule): the answer is the whole sum's, since no length is negative.
+    """
     segs = fitter(key)
-    return segs if sum(s.length for s in segs) > ZERO_LENGTH_MM else []
+    total = 0.0
+    for seg in segs:
+        total += seg.length
+        if total > ZERO_LENGTH_MM:
+            return segs
+    return []
 
 
 def _arc(seg: Any, p0: Point, m: Affine, tolerance: float, fitter: Fitter) -> list[Segment]:
