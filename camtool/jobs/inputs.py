@@ -13,6 +13,7 @@ from __future__ import annotations
 import glob
 import os
 import re
+import shlex
 import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -193,9 +194,10 @@ def check_not_drawing(name: str, target: Target, then: str) -> None:
     """
     suffix = Path(name).suffix.lower()
     if suffix in (".dxf", ".svg") and suffix not in target.post.formats.values():
+        quoted = shlex.quote(name)
         raise InputError(
-            f"{name}: a drawing, not a program. Post it first "
-            f"(camtool post {name} -t {target.name} -o PROGRAM), then " + then.format(name=name)
+            f"{name}: a drawing, not a program. Post it first (camtool post {quoted} "
+            f"-t {target.name} -o PROGRAM), then " + then.format(name=quoted)
         )
 
 

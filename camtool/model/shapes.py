@@ -495,8 +495,8 @@ class Contour:
 
         The shoelace sum over the segments' chords (and over any gap from one segment's end
         to the next one's start), plus for each arc the circular segment between its chord
-        and the arc,
-        ``r² (|θ| − sin |θ|) / 2`` with the sign of its sweep ``θ`` (a full circle: π r²).
+        and the arc, ``r² (|θ| − sin |θ|) / 2`` with the sign of its sweep ``θ`` (a full
+        circle: π r²).
         """
         if not self.closed:
             return 0.0

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import shlex
 import stat
 import subprocess
 import sys
@@ -499,7 +500,7 @@ def test_an_output_in_a_missing_directory_is_refused_before_any_work(
     assert code == 2 and f"{a_file} is not a directory" in err
 
 
-@pytest.mark.parametrize("drawing", ["logo.dxf", "LOGO.SVG"])
+@pytest.mark.parametrize("drawing", ["logo.dxf", "LOGO.SVG", "my logo.dxf"])
 def test_verify_of_a_drawing_says_to_post_it_first(
     drawing: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -509,7 +510,8 @@ def test_verify_of_a_drawing_says_to_post_it_first(
     code, out, err = run(["verify", str(path), "-t", "grbl"], capsys)
     assert code == 3 and out == ""
     assert f"{path}: a drawing, not a program" in err
-    assert f"camtool post {path} -t grbl -o PROGRAM" in err and "--against" in err
+    assert f"camtool post {shlex.quote(str(path))} -t grbl -o PROGRAM" in err
+    assert f"--against {shlex.quote(str(path))}" in err
     assert "unexpected character" not in err and "Traceback" not in err
 
 
