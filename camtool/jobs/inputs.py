@@ -190,10 +190,12 @@ def check_not_drawing(name: str, target: Target, then: str) -> None:
             e.g. ``"send PROGRAM"``.
 
     Raises:
-        InputError: ``name`` ends in ``.dxf`` or ``.svg`` and ``target`` writes no such file.
+        InputError: ``name`` is a file ending in ``.dxf`` or ``.svg`` and ``target`` writes
+            no such file (a missing one is left to the reader's "no such file").
     """
     suffix = Path(name).suffix.lower()
-    if suffix in (".dxf", ".svg") and suffix not in target.post.formats.values():
+    drawing = suffix in (".dxf", ".svg") and suffix not in target.post.formats.values()
+    if drawing and Path(name).is_file():
         quoted = shlex.quote(name)
         raise InputError(
             f"{name}: a drawing, not a program. Post it first (camtool post {quoted} "

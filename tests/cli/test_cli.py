@@ -513,6 +513,8 @@ def test_verify_of_a_drawing_says_to_post_it_first(
     assert f"camtool post {shlex.quote(str(path))} -t grbl -o PROGRAM" in err
     assert f"--against {shlex.quote(str(path))}" in err
     assert "unexpected character" not in err and "Traceback" not in err
+    code, _out, err = run(["verify", str(tmp_path / "missing.dxf"), "-t", "grbl"], capsys)
+    assert code == 3 and "missing.dxf: no such file" in err
 
 
 def test_send_of_a_drawing_says_to_post_it_first(
