@@ -105,7 +105,7 @@ ROOT = Path(os.environ.get("CAMTOOL_BENCH_ROOT") or Path(__file__).resolve().par
 """The camtool tree measured (``CAMTOOL_BENCH_ROOT`` measures another, e.g. the pre-work one)."""
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from table import row  # noqa: E402
+from table import camtool_env, row  # noqa: E402
 
 GOAL_S = 3.0
 GOAL_MB = 300.0
@@ -181,9 +181,7 @@ def measure(args: list[str], cwd: Path) -> dict[str, float | int | str]:
     and the first, which writes it, is not timed. Of :data:`RUNS` more: the least wall
     time (the run least disturbed by other work), the largest peak, the first failure.
     """
-    env = {**os.environ, "PYTHONPATH": f"{ROOT}{os.pathsep}{ROOT / '.pp'}"}
-    env.pop("PYTHONDONTWRITEBYTECODE", None)
-    env["PYTHONPYCACHEPREFIX"] = str(cwd / "pycache")
+    env = camtool_env(ROOT, cwd / "pycache")
     runs = [_measure_once(args, cwd, env) for _ in range(RUNS + 1)]
     failed = [r for r in runs if r["rc"] != 0]
     if failed:

@@ -85,7 +85,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from table import row  # noqa: E402
+from table import camtool_env, row  # noqa: E402
 
 CORPUS = Path(os.environ.get("CAMTOOL_CORPUS_DIR", ROOT / ".corpus"))
 PROGRAMS = (
@@ -158,20 +158,6 @@ def rs274_command() -> tuple[list[str], dict[str, str], str] | None:
     return cmd, env, f"LinuxCNC rs274 (linuxcnc-uspace {version})"
 
 
-def camtool_env(pycache: Path) -> dict[str, str]:
-    """The environment camtool runs in: this tree first, its bytecode cached in ``pycache``.
-
-    An installed camtool runs from compiled bytecode (pip compiles it); a tree run with
-    ``PYTHONDONTWRITEBYTECODE`` set would compile every module from source on every
-    run (about 0.1 s of start-up). The bytecode goes to ``pycache``
-    (``PYTHONPYCACHEPREFIX``, a temporary directory), written by an untimed first run.
-    """
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), str(ROOT / ".pp")]))
-    env.pop("PYTHONDONTWRITEBYTECODE", None)
-    env["PYTHONPYCACHEPREFIX"] = str(pycache)
-    return env
-
-
 def best_wall(cmd: list[str], env: dict[str, str], stdout: int | None = None) -> float:
     """Best wall time of :data:`RUNS` runs of ``cmd`` (each must exit 0), s."""
     times = []
@@ -202,7 +188,7 @@ def time_camtool(program: Path, tmp: Path) -> tuple[Path, list[str], dict[str, s
     environment, the best wall time (s, after an untimed run that caches the bytecode) and
     the peak memory (KiB)."""
     out = tmp / "out.ngc"
-    env = camtool_env(tmp / "pycache")
+    env = camtool_env(pycache=tmp / "pycache")
     cmd = [sys.executable, "-m", "camtool", "post", str(program), "--target", "linuxcnc"]
     cmd += ["-o", str(out)]
     subprocess.run(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)

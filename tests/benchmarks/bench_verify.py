@@ -128,7 +128,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(HERE))
 
 from bench_interpolators import cc_version, compiler  # noqa: E402
-from table import row  # noqa: E402
+from table import camtool_env, row  # noqa: E402
 
 LINES = int(os.environ.get("CAMTOOL_BENCH_LINES", "200"))
 """Long lines of the big program (``CAMTOOL_BENCH_LINES`` to change; 200 ≈ 13.2 M steps)."""
@@ -254,28 +254,14 @@ def _steps(um: int) -> int:
 
 
 PYCACHE = Path(tempfile.gettempdir()) / "camtool-bench-verify-pycache"
-"""Where the runs' bytecode is cached (``PYTHONPYCACHEPREFIX``; see :func:`camtool_env`)."""
-
-
-def camtool_env(tree: Path) -> dict[str, str]:
-    """The environment camtool runs in: ``tree`` first, its bytecode cached in :data:`PYCACHE`.
-
-    As ``bench_repost.py`` runs it: an installed camtool runs from compiled bytecode (pip
-    compiles it), while this machine sets ``PYTHONDONTWRITEBYTECODE``, with which every
-    camtool module would be compiled from source on every run (~0.12 s of a verify).
-    :func:`warm` writes the bytecode in an untimed run first.
-    """
-    env = {**os.environ, "PYTHONPATH": f"{tree}{os.pathsep}{tree / '.pp'}"}
-    env.pop("PYTHONDONTWRITEBYTECODE", None)
-    env["PYTHONPYCACHEPREFIX"] = str(PYCACHE)
-    return env
+"""Where the runs' bytecode is cached (``PYTHONPYCACHEPREFIX``; :func:`table.camtool_env`)."""
 
 
 def warm(tree: Path, args: list[str]) -> None:
     """One untimed run of ``camtool ARGS`` in ``tree``: the bytecode it needs is written."""
     subprocess.run(
         [sys.executable, "-m", "camtool", *args],
-        env=camtool_env(tree),
+        env=camtool_env(tree, PYCACHE),
         cwd=tree,
         capture_output=True,
         check=False,
@@ -292,7 +278,7 @@ def measure_cpu(
     tree: Path, args: list[str], repeats: int = REPEATS
 ) -> tuple[float, int, float, float]:
     """:func:`measure` and the best CPU time (user + sys, s, helpers included)."""
-    env = camtool_env(tree)
+    env = camtool_env(tree, PYCACHE)
     best, rss, rc, cpu = float("inf"), 0.0, 0, float("inf")
     for _ in range(repeats):
         out = subprocess.run(
@@ -344,7 +330,7 @@ print(time.perf_counter() - t0)
 
 def startup_s(tree: Path) -> float:
     """Best wall time (s) of :data:`STARTUP` (the interpreter's own start added) in ``tree``."""
-    env = camtool_env(tree)
+    env = camtool_env(tree, PYCACHE)
     best = float("inf")
     for _ in range(REPEATS):
         t0 = time.perf_counter()

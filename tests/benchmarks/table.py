@@ -30,18 +30,18 @@ PYCACHE = Path(tempfile.gettempdir()) / "camtool-bench-pycache"
 """Where camtool's bytecode is cached for the benchmarks' runs (``PYTHONPYCACHEPREFIX``)."""
 
 
-def camtool_env() -> dict[str, str]:
-    """The environment camtool runs in, as a user's: this tree first, from cached bytecode.
+def camtool_env(tree: Path = ROOT, pycache: Path = PYCACHE) -> dict[str, str]:
+    """The environment camtool runs in, as a user's: ``tree`` first, from cached bytecode.
 
     ``PYTHONPATH`` is the tree's root and its ``.pp`` (the target plug-ins). An installed
     camtool runs from bytecode (pip compiles it), and so do its libraries here; a shell with
     ``PYTHONDONTWRITEBYTECODE`` set would compile every camtool module from source on every
-    run. That variable is dropped and the bytecode goes to :data:`PYCACHE`, written by the
+    run. That variable is dropped and the bytecode goes to ``pycache``, written by the
     first run (each script times the best of several runs, or makes an untimed one first).
     """
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), str(ROOT / ".pp")]))
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(tree), str(tree / ".pp")]))
     env.pop("PYTHONDONTWRITEBYTECODE", None)
-    env["PYTHONPYCACHEPREFIX"] = str(PYCACHE)
+    env["PYTHONPYCACHEPREFIX"] = str(pycache)
     return env
 
 
