@@ -20,7 +20,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from camtool.importers import DRAWING_SUFFIXES, read_drawing, read_drawing_bytes
+from camtool.importers import (
+    DRAWING_SUFFIXES,
+    POINT_SUFFIXES,
+    read_drawing,
+    read_drawing_bytes,
+)
 from camtool.importers.textfile import decoded
 from camtool.model.errors import InputError, UsageError
 from camtool.model.tomlfile import read_toml_file
@@ -190,11 +195,13 @@ def check_not_drawing(name: str, target: Target, then: str) -> None:
             e.g. ``"send PROGRAM"``.
 
     Raises:
-        InputError: ``name`` is a file ending in ``.dxf`` or ``.svg`` and ``target`` writes
-            no such file (a missing one is left to the reader's "no such file").
+        InputError: ``name`` is a file with a drawing's ending (DXF, SVG; not a point
+            list's, which a program may share: ``.txt``, ``.m``) that ``target`` does not
+            write (a missing one is left to the reader's "no such file").
     """
     suffix = Path(name).suffix.lower()
-    drawing = suffix in (".dxf", ".svg") and suffix not in target.post.formats.values()
+    drawing = suffix in DRAWING_SUFFIXES and suffix not in POINT_SUFFIXES
+    drawing = drawing and suffix not in target.post.formats.values()
     if drawing and Path(name).is_file():
         quoted = shlex.quote(name)
         raise InputError(

@@ -140,10 +140,8 @@ RUNS = 2
 """Best of this many runs of each command."""
 
 EXPECTED_SHA256 = "1962563a316cd86cdd30033ba4c1b9743617526c1a9b02e9c6be4165b283f5de"
-"""sha256 of ``camtool post tango-213.svg --target grbl`` output as the sixteenth pass left it
-(and as the next sessions kept it). Earlier records: ``263cf860117a…`` once each curve shape
-was fitted once and moved onto its copies (commit b805396: the copies' fits differ from fits
-of their own in the last bits), ``ed3d87fd6ec6…`` at b3b77a5."""
+"""sha256 of ``camtool post tango-213.svg --target grbl`` output as last recorded: whether
+it changed is informative only (the tests judge a change by its tolerance)."""
 
 SVG_NS = "http://www.w3.org/2000/svg"
 XLINK_NS = "http://www.w3.org/1999/xlink"
