@@ -43,12 +43,17 @@ def test_a_square_with_a_notch_and_a_bulge() -> None:
 
 
 def test_a_major_arc_and_a_gap_the_chaining_left() -> None:
-    """Three quarters of a unit disc and its two radii: 3π/4; a 1e-6 gap closes as a chord."""
-    arc = Arc((1.0, 0.0), (0.0, -1.0), (0.0, 0.0), False)  # 270° counter-clockwise
-    pie = Contour((Line((0.0, 0.0), (1.0, 0.0)), arc, Line((0.0, -1.0), (0.0, 0.0))), True)
+    """Three quarters of a unit disc about (5, 5) and its two radii: 3π/4.
+
+    Its last radius stops 1e-3 mm short of the centre: the gap closes as a chord along
+    the same line, so the area is still 3π/4 (left out, the shoelace would lose
+    (5·5 − 5·4.999) / 2 = 0.0025 mm²).
+    """
+    arc = Arc((6.0, 5.0), (5.0, 4.0), (5.0, 5.0), False)  # 270° counter-clockwise
+    pie = Contour((Line((5.0, 5.0), (6.0, 5.0)), arc, Line((5.0, 4.0), (5.0, 5.0))), True)
     assert pie.signed_area() == pytest.approx(3 * math.pi / 4, abs=1e-12)
-    gapped = Contour((Line((0.0, 0.0), (1.0, 0.0)), arc, Line((0.0, -1.0), (0.0, -1e-6))), True)
-    assert gapped.signed_area() == pytest.approx(3 * math.pi / 4, abs=1e-6)
+    gapped = Contour((Line((5.0, 5.0), (6.0, 5.0)), arc, Line((5.0, 4.0), (5.0, 4.999))), True)
+    assert gapped.signed_area() == pytest.approx(3 * math.pi / 4, abs=1e-12)
 
 
 def test_an_open_contour_has_no_area() -> None:
