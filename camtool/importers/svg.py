@@ -19,6 +19,7 @@ from camtool.geometry.arcfit import check_tolerance
 from camtool.geometry.chain import with_end
 from camtool.geometry.curves import merge_arcs, semi_axes_gap
 from camtool.geometry.fitpool import MIN_CURVES, CurveKey, fit_key, fit_shared, moved, shape_key
+from camtool.importers import svgclip
 from camtool.importers.options import MAX_COORDINATE_MM, ImportOptions, check_curve_size
 from camtool.importers.svgdoc import (
     LAYER_ATTR,
@@ -150,10 +151,23 @@ def svg_drawing(
             raise TooLargeError(f"{exc}; {_refusal_note(note, len(off))}") from None
     tolerance = options.curve_tolerance(box)
     fitter = _prefitted(drawn, prepared.matrix, tolerance, progress)
+    clips = svgclip.clipped_shapes(svg, _SHAPES)
+    clipped_away = 0
     progress(Step("contours", 0, len(drawn)))
     for i, (shape, segments) in enumerate(drawn, start=1):
-        contours.extend(_contours(path, shape, segments, prepared.matrix, fitter))
+        made = _contours(path, shape, segments, prepared.matrix, fitter)
+        over = clips.get(id(shape))
+        if over and _hidden_by_clip(path, shape, made, over, prepared.matrix, tolerance):
+            clipped_away += 1
+        else:
+            contours.extend(made)
         progress(Step("contours", i, len(drawn)))
+    if clipped_away:
+        its, them = ("its", "it") if clipped_away == 1 else ("their", "them")
+        warnings.append(
+            f"{path}: skipped {clipped_away} {_elements(clipped_away)} that {its} clip-path "
+            f"hides wholly (a viewer shows nothing of {them})"
+        )
     if hidden:
         warnings.append(f"{path}: skipped {hidden} {_elements(hidden)} with visibility:hidden")
     if faded:
@@ -346,6 +360,56 @@ def _contours(
         Contour(segs, closed, layer, f"{label} subpath {k}" if many else label, colour, linetype)
         for k, (segs, closed) in enumerate(subpaths, start=1)
     ]
+
+
+def _hidden_by_clip(
+    path: Path,
+    shape: Any,
+    contours: list[Contour],
+    clips: tuple[svgclip.Clip, ...],
+    page: Affine,
+    tolerance: float,
+) -> bool:
+    """Whether ``clips`` hide all of ``shape`` (its ``contours``); none of it: ``False``.
+
+    Raises:
+        InputError: a clip hides part of the shape (camtool would cut the hidden part), or
+            its region cannot be worked out (:mod:`camtool.importers.svgclip`).
+    """
+    lines = [c.points(tolerance) for c in contours]
+    filled = not _unpainted(shape.fill)
+    parts = []
+    for clip in clips:
+        try:
+            if clip.why:
+                raise InputError(clip.why)
+            region = svgclip.clip_region(clip, page, affine_of, _clip_subpaths, _SHAPES)
+        except (InputError, GeometryError) as exc:
+            raise InputError(
+                f"{path}: {_label(shape)} is clipped by {svgclip.clip_label(clip, _label)}, "
+                f"whose region camtool cannot work out ({exc}); release the clip in the "
+                "drawing program (Inkscape: Object > Clip > Release) and trim the shape to it "
+                "(Path > Intersection)"
+            ) from None
+        parts.append((svgclip.hidden_part(region, lines, filled), clip))
+    if any(part == "all" for part, _ in parts):
+        return True
+    for part, clip in parts:
+        if part == "part":
+            raise InputError(
+                f"{path}: {svgclip.clip_label(clip, _label)} hides part of {_label(shape)}, "
+                "and camtool cuts whole shapes: the hidden part would be cut; release the "
+                "clip in the drawing program (Inkscape: Object > Clip > Release) and trim the "
+                "shape to it (Path > Intersection), or delete the clip to cut the whole shape"
+            )
+    return False
+
+
+def _clip_subpaths(shape: Any, m: Affine) -> list[list[Point]]:
+    """A clip child's subpaths as points in mm (``m``: its coordinates to mm), finely."""
+    fine = svgclip.CLIP_SLACK_MM / 10
+    subpaths = convert(shape.segments(transformed=False), m, fine)
+    return [Contour(segs, closed).points(fine) for segs, closed in subpaths]
 
 
 def _label(shape: Any) -> str:

@@ -421,7 +421,7 @@ def _href(element: ET.Element) -> str:
 
 
 def count_skipped(root: ET.Element, hold: ET.Element, counts: Counter[str]) -> None:
-    """Add to ``counts`` the skipped kinds: clipPath, non-empty defs, drawn text and image.
+    """Add to ``counts`` the skipped kinds: non-empty defs, drawn text and image.
 
     And a drawn ``<use>`` of another file's element (``use-file``). Text and images a
     ``<use>`` places (from a ``<symbol>`` or a group in ``<defs>``) count once per
@@ -444,9 +444,9 @@ def count_skipped(root: ET.Element, hold: ET.Element, counts: Counter[str]) -> N
             kind = local_name(child)
             if child is hold or kind is None:
                 continue
-            if kind == "clipPath":
-                into["clipPath"] += 1
-            elif kind == "defs" and any(local_name(c) not in (None, "style") for c in child):
+            if kind == "defs" and any(  # a clip is checked where it is used (svgclip)
+                local_name(c) not in (None, "style", "clipPath") for c in child
+            ):
                 into["defs"] += 1
             elif kind in ("text", "image") and drawn:
                 into[kind] += 1
@@ -522,7 +522,6 @@ def check_size(root: ET.Element, name: str, max_entities: int) -> None:
 _SIZES = frozenset({"width", "height", "r", "rx", "ry"})
 _SKIP_REASONS = {
     "defs": "definitions are cut only where a <use> places them",
-    "clipPath": "clipping is not applied: clipped shapes are cut whole",
     "mask": "masks are not applied",
     "text": "convert text to paths in the drawing program to cut it",
     "image": "raster images cannot be cut",
@@ -619,12 +618,52 @@ def prepare(
             "size; camtool does not clip, so a shape reaching outside one is cut whole "
             "(check the preview, or trim it in the drawing program)"
         )
-    for kind in ("defs", "clipPath", "mask", "text", "image", "use"):
+    for kind in ("defs", "mask", "text", "image", "use"):
         if counts[kind]:
             noun = "element" if counts[kind] == 1 else "elements"
             reason = _SKIP_REASONS[kind]
             warnings.append(f"{path}: skipped {counts[kind]} <{kind}> {noun} ({reason})")
+    _clip_paths_first(root)
     return Prepared(ET.tostring(root), matrix, viewport, tuple(warnings), page)
+
+
+_CLIP_CONTENT = frozenset(
+    ["path", "rect", "circle", "ellipse", "line", "polyline", "polygon", "text", "use"]
+)
+"""What a ``<clipPath>``'s region is made of (SVG 1.1 §14.3.5: shapes, text, and ``<use>``
+of a shape or text); any other child (a group, an image, a ``<switch>``) adds nothing."""
+
+
+def _clip_paths_first(root: ET.Element) -> None:
+    """Move every ``<clipPath>`` into a ``<defs>`` that is the document's first child.
+
+    A clip's children are in the user space of the element that references it, whatever
+    lies around the ``<clipPath>`` (SVG 1.1 §14.3.5); svgelements composes the transforms
+    of its ancestors into them, and looks a reference up when it meets it. At the start,
+    under no transform, each clip is known before any reference to it and carries only its
+    own ``transform`` (:mod:`camtool.importers.svgclip`). Children that add nothing to the
+    region (not in :data:`_CLIP_CONTENT`, or a ``<use>`` of anything but a shape or text)
+    are removed, so that svgelements does not read them into it.
+    """
+    clips = _elements(root, "clipPath")
+    if not clips:
+        return
+    parents = {child: parent for parent in root.iter() for child in parent}
+    ids = {e.get("id"): e for e in root.iter() if e.get("id")}
+    front = ET.Element(_tag(root, "defs"))
+    for clip in clips:
+        parents[clip].remove(clip)
+        front.append(clip)
+        for child in list(clip):
+            kind = local_name(child)
+            if kind == "use":
+                href = _href(child)
+                target = ids.get(href[1:]) if href.startswith("#") else None
+                kind = local_name(target) if target is not None else None
+                kind = None if kind == "use" else kind
+            if kind not in _CLIP_CONTENT:
+                clip.remove(child)
+    root.insert(0, front)
 
 
 def _elements(root: ET.Element, name: str) -> list[ET.Element]:

@@ -415,10 +415,6 @@ def test_use_places_a_definition_and_names_both(tmp_path: Path) -> None:
             "skipped 1 <image> element (raster images",
         ),
         (
-            '<clipPath id="c"><rect width="5" height="5"/></clipPath>',
-            "skipped 1 <clipPath> element (clipping is not applied: clipped shapes are cut whole)",
-        ),
-        (
             '<mask id="m"><rect width="5" height="5"/></mask>',
             "skipped 1 <mask> element (masks are not applied)",
         ),
