@@ -387,9 +387,7 @@ def _hidden_by_clip(
         except (InputError, GeometryError) as exc:
             raise InputError(
                 f"{path}: {_label(shape)} is clipped by {svgclip.clip_label(clip, _label)}, "
-                f"whose region camtool cannot work out ({exc}); release the clip in the "
-                "drawing program (Inkscape: Object > Clip > Release) and trim the shape to it "
-                "(Path > Intersection)"
+                f"whose region camtool cannot work out ({exc}); {svgclip.remedy(clip)}"
             ) from None
         parts.append((svgclip.hidden_part(region, lines, filled), clip))
     if any(part == "all" for part, _ in parts):
@@ -398,9 +396,8 @@ def _hidden_by_clip(
         if part == "part":
             raise InputError(
                 f"{path}: {svgclip.clip_label(clip, _label)} hides part of {_label(shape)}, "
-                "and camtool cuts whole shapes: the hidden part would be cut; release the "
-                "clip in the drawing program (Inkscape: Object > Clip > Release) and trim the "
-                "shape to it (Path > Intersection), or delete the clip to cut the whole shape"
+                "and camtool cuts whole shapes: the hidden part would be cut; "
+                f"{svgclip.remedy(clip)}"
             )
     return False
 

@@ -10,6 +10,7 @@ shows nothing of. Here each drawn shape under a ``clip-path`` (its own, or a gro
 - wholly outside one: the viewer shows nothing of it, so it is skipped and counted;
 - partly hidden: refused, naming the shape and the clip (cutting it would cut what the
   clip hides, as a DXF INSERT with an XCLIP would; see ``camtool/importers/dxf_blocks.py``);
+- a nested ``<svg>`` viewport clips too: svgdoc gives it a clip of its rectangle.
 - a clip whose region camtool cannot work out (text in the clip, ``objectBoundingBox``
   units, a clip of the clip or of a child of it, a CSS shape such as ``circle(50%)``):
   refused.
@@ -33,6 +34,7 @@ from typing import Any
 import shapely
 import svgelements as se
 
+from camtool.importers.svgdoc import VIEWPORT_CLIP
 from camtool.importers.svgpage import Affine, compose
 from camtool.model.errors import InputError
 
@@ -193,8 +195,22 @@ def even_odd(subpaths: list[list[tuple[float, float]]]) -> Any:
 
 
 def clip_label(clip: Clip, label: Callable[[Any], str]) -> str:
-    """``clip-path #ID on ELEMENT`` for messages."""
-    name = getattr(clip.target, "id", None)
-    which = f"#{name}" if name else "clip-path"
+    """``the clip-path #ID on ELEMENT``, or ``the viewport of the nested svg#ID``."""
+    name = str(getattr(clip.target, "id", None) or "")
     owner = label(clip.owner)
-    return f"the clip-path {which} on {owner}" if name else f"the clip-path on {owner}"
+    if name.startswith(VIEWPORT_CLIP):
+        return f"the viewport of the nested {owner}"
+    return f"the clip-path #{name} on {owner}" if name else f"the clip-path on {owner}"
+
+
+def remedy(clip: Clip) -> str:
+    """What a user does about a clip that hides part of a shape, or that camtool cannot read."""
+    if str(getattr(clip.target, "id", None) or "").startswith(VIEWPORT_CLIP):
+        return (
+            "trim the shape to the <svg>'s x, y, width and height in the drawing program, or "
+            'set overflow="visible" on the <svg> to cut the whole shape'
+        )
+    return (
+        "release the clip in the drawing program (Inkscape: Object > Clip > Release) and "
+        "trim the shape to it (Path > Intersection), or delete the clip to cut the whole shape"
+    )

@@ -394,26 +394,77 @@ def check_conditions(
         stack.extend(element)
 
 
-def _clipping_viewports(
-    root: ET.Element, parents: dict[ET.Element, ET.Element], hold: ET.Element
+VIEWPORT_CLIP = "camtool-viewport-"
+"""Prefix of the ids of the clips :func:`clip_viewports` makes (svgclip names them as
+viewports)."""
+
+
+def clip_viewports(
+    root: ET.Element,
+    parents: dict[ET.Element, ET.Element],
+    hold: ET.Element,
+    viewport: tuple[float, float],
 ) -> int:
-    """Nested ``<svg>`` elements with shapes that clip them (``overflow`` hidden, the default).
+    """Give each drawn nested ``<svg>`` that clips (``overflow`` hidden, the default) a clip.
 
     A nested viewport clips its content to its ``x``, ``y``, ``width``, ``height`` (SVG 1.1
-    §7.2, §14.3.3), as a ``<use>`` of an ``<svg>`` does; svgelements does not, and neither
-    does camtool, which warns instead (resvg's structure/svg/nested-svg-with-rect.svg: a
-    circle shown as a square).
+    §7.2, §14.3.3; resvg's structure/svg/nested-svg-with-rect.svg: a circle shown as a
+    square); svgelements does not. Each such ``<svg>`` is wrapped in a ``<g>`` with a
+    ``clip-path`` to a ``<clipPath>`` of that rectangle (a percentage of the nearest
+    viewport, ``width`` and ``height`` 100 % when not given), which
+    :mod:`camtool.importers.svgclip` checks as any clip; an SVG 2 ``transform`` on the
+    ``<svg>`` moves to the ``<g>``, as it applies to the viewport too.
+
+    Returns:
+        How many nested ``<svg>`` with shapes a ``<use>`` places (with sizes of its own):
+        those copies clip unchecked.
     """
-    count = 0
-    for element in root.iter(f"{{{SVG_NS}}}svg" if root.tag.startswith("{") else "svg"):
-        if element is root or not _has_shapes(element):
-            continue
+    tag = f"{{{SVG_NS}}}svg" if root.tag.startswith("{") else "svg"
+    sizes: dict[ET.Element, tuple[float, float]] = {}
+    stack = [(root, viewport)]
+    while stack:  # each nested <svg>'s nearest viewport, as percentages resolve against
+        element, size = stack.pop()
+        if local_name(element) == "svg" and element is not root:
+            sizes[element] = size
+            size = svgvalues.viewport_size(element, size)
+        stack.extend((child, size) for child in element)
+    ids = {e.get("id") for e in root.iter() if e.get("id")}
+    used = {_href(e)[1:] for e in root.iter(_tag(root, "use")) if _href(e).startswith("#")}
+    unchecked = made = 0
+    for element in [e for e in root.iter(tag) if e is not root]:
         overflow = inline_style(element).get("overflow", element.get("overflow", "hidden"))
-        if overflow.strip().lower() in ("visible", "auto"):
+        if overflow.strip().lower() in ("visible", "auto") or not _has_shapes(element):
             continue
-        if _is_drawn(element, parents, hold) or element.get("id"):  # placed, or perhaps used
-            count += 1
-    return count
+        unchecked += element.get("id") in used
+        if not _is_drawn(element, parents, hold):
+            continue
+        made += 1
+        name = f"{VIEWPORT_CLIP}{made}"
+        while name in ids:
+            name += "-"
+        width, height = sizes.get(element, viewport)
+        rect = ET.Element(_tag(root, "rect"))
+        for attr, default, base in (
+            ("x", "0", width),
+            ("y", "0", height),
+            ("width", "100%", width),
+            ("height", "100%", height),
+        ):
+            value = element.get(attr) or default
+            match = svgvalues.PERCENT.fullmatch(value)
+            rect.set(attr, repr(float(match.group(1)) / 100.0 * base) if match else value)
+        clip = ET.SubElement(root, _tag(root, "clipPath"), {"id": name})
+        clip.append(rect)
+        parent = parents[element]
+        wrapper = ET.Element(_tag(root, "g"), {"clip-path": f"url(#{name})"})
+        wrapper.set(SOURCE_ATTR, str(element.get(SOURCE_ATTR, "svg")))
+        if element.get("transform") is not None:
+            wrapper.set("transform", element.attrib.pop("transform"))
+        parent.insert(list(parent).index(element), wrapper)
+        parent.remove(element)
+        wrapper.append(element)
+        parents[wrapper], parents[element], parents[clip] = parent, wrapper, root
+    return unchecked
 
 
 def _href(element: ET.Element) -> str:
@@ -611,12 +662,12 @@ def prepare(
             f"{path}: skipped {counts['extensions']} element(s) with shapes that require "
             "extensions (requiredExtensions), which a viewer without them does not show"
         )
-    viewports = _clipping_viewports(root, parents, hold)
+    viewports = clip_viewports(root, parents, hold, viewport)
     if viewports:
         warnings.append(
-            f"{path}: {viewports} nested <svg> viewport(s) clip what they hold to their "
-            "size; camtool does not clip, so a shape reaching outside one is cut whole "
-            "(check the preview, or trim it in the drawing program)"
+            f"{path}: {viewports} nested <svg> viewport(s) placed by a <use> clip what "
+            "they hold to their size there; camtool does not, so a shape reaching outside "
+            "one is cut whole (check the preview, or trim it in the drawing program)"
         )
     for kind in ("defs", "mask", "text", "image", "use"):
         if counts[kind]:

@@ -24,6 +24,8 @@ import math
 import re
 import xml.etree.ElementTree as ET
 
+import svgelements as se
+
 from camtool.importers.svgcss import inline_style, local_name, style_text
 
 LENGTH_ATTRS = {
@@ -33,6 +35,8 @@ LENGTH_ATTRS = {
     "line": ("x1", "y1", "x2", "y2"),
 }
 """The length attributes of each shape (checked by the document pass, resolved here)."""
+_VIEWPORT_ATTRS = ("x", "y", "width", "height")
+"""A nested ``<svg>``'s lengths :func:`resolve_percentages` resolves."""
 _SIZE_NEEDS = {"rect": ("width", "height"), "circle": ("r",), "ellipse": ("rx", "ry")}
 """The size attributes a shape needs to be drawn (:func:`default_sizes`)."""
 
@@ -57,7 +61,7 @@ def default_sizes(element: ET.Element, kind: str) -> None:
         element.set("ry" if have == "rx" else "rx", element.get(have) or style[have])
 
 
-_PERCENT = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)%\s*")
+PERCENT = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)%\s*")
 _ACROSS = frozenset({"x", "cx", "width", "x1", "x2"})
 _DOWN = frozenset({"y", "cy", "height", "y1", "y2"})
 
@@ -359,7 +363,8 @@ def resolve_percentages(root: ET.Element, viewport: tuple[float, float]) -> None
     ``x2``, a rect's ``rx``), height (``y``, ...; a rect's ``ry``) or normalised diagonal
     ``sqrt((w² + h²) / 2)`` (``r``; an ellipse's ``rx`` and ``ry`` are of the width and the
     height) (SVG 1.1 §7.10). The viewport is the document's, or a nested ``<svg>``'s
-    viewBox. svgelements resolves them against other sizes: a rect at ``x="10%"
+    (:func:`viewport_size`), whose own ``x``, ``y``, ``width`` and ``height`` are
+    resolved too. svgelements resolves them against other sizes: a rect at ``x="10%"
     width="50%"`` in a 200 × 100 viewBox would be cut from x 10 to 60 instead of 20 to 120.
 
     Args:
@@ -370,8 +375,9 @@ def resolve_percentages(root: ET.Element, viewport: tuple[float, float]) -> None
     while stack:
         element, (w, h) = stack.pop()
         kind = local_name(element)
-        for attr in LENGTH_ATTRS.get(kind or "", ()):
-            match = _PERCENT.fullmatch(element.get(attr) or "")
+        nested = kind == "svg" and element is not root
+        for attr in _VIEWPORT_ATTRS if nested else LENGTH_ATTRS.get(kind or "", ()):
+            match = PERCENT.fullmatch(element.get(attr) or "")
             if match is None:
                 continue
             if attr in _ACROSS or (attr == "rx" and kind in ("rect", "ellipse")):
@@ -382,11 +388,47 @@ def resolve_percentages(root: ET.Element, viewport: tuple[float, float]) -> None
                 base = math.sqrt((w * w + h * h) / 2.0)
             element.set(attr, repr(float(match.group(1)) / 100.0 * base))
         inner = (w, h)
-        if kind == "svg" and element is not root:
-            box = (element.get("viewBox") or "").replace(",", " ").split()
-            try:
-                if len(box) == 4 and float(box[2]) > 0 and float(box[3]) > 0:
-                    inner = (float(box[2]), float(box[3]))
-            except ValueError:
-                pass  # a bad viewBox is refused where it is read
+        if nested:
+            inner = viewport_size(element, inner)
         stack.extend((child, inner) for child in element)
+
+
+def viewport_size(element: ET.Element, outer: tuple[float, float]) -> tuple[float, float]:
+    """The size, user units, a nested ``<svg>`` gives its content's percentages.
+
+    Its ``viewBox``'s, else its own ``width`` and ``height`` (a percentage of ``outer``,
+    the nearest viewport's size; 100 % when not given) (SVG 1.1 §7.10; resvg's
+    structure/svg/nested-svg-with-relative-width-and-height.svg).
+    """
+    box = viewbox_size(element)
+    if box is not None:
+        return box
+    return (
+        _viewport_length(element.get("width"), outer[0]),
+        _viewport_length(element.get("height"), outer[1]),
+    )
+
+
+def _viewport_length(text: str | None, outer: float) -> float:
+    """A nested ``<svg>``'s ``width`` or ``height`` in user units (px: 96 per inch)."""
+    if text is None:
+        return outer
+    match = PERCENT.fullmatch(text)
+    if match is not None:
+        return float(match.group(1)) / 100.0 * outer
+    try:
+        value = float(se.Length(text).value(ppi=96.0))
+    except (ValueError, TypeError):
+        return outer  # a bad length is refused where it is read
+    return value if math.isfinite(value) else outer
+
+
+def viewbox_size(element: ET.Element) -> tuple[float, float] | None:
+    """``(width, height)`` of ``element``'s ``viewBox``, or ``None`` without a good one."""
+    box = (element.get("viewBox") or "").replace(",", " ").split()
+    try:
+        if len(box) == 4 and float(box[2]) > 0 and float(box[3]) > 0:
+            return (float(box[2]), float(box[3]))
+    except ValueError:
+        pass  # a bad viewBox is refused where it is read
+    return None

@@ -203,3 +203,48 @@ def test_breeze_icons_of_figma_clip_each_frame_to_its_size() -> None:
         read_svg(BREEZE / "actions/16/debug-step-over.svg")
     drawing = read_svg(BREEZE / "actions/16/color-management.svg")  # its clip hides nothing
     assert drawing.contours
+
+
+# ------------------------------------------------------------------ nested <svg> viewports
+
+
+def test_a_nested_viewport_that_hides_part_of_a_shape_is_refused(tmp_path: Path) -> None:
+    # SVG 1.1 §7.2: a nested <svg> clips to its x, y, width, height (resvg's
+    # nested-svg-with-rect.svg shows a square of a circle); one with overflow visible not
+    body = (
+        '<svg id="vp" x="40" y="40" width="20" height="20"><circle id="c" cx="25" cy="25" '
+        'r="30"/></svg>'
+    )
+    with pytest.raises(InputError, match="the viewport of the nested svg#vp hides part of") as e:
+        read_svg(svg(tmp_path, body))
+    assert 'overflow="visible"' in str(e.value)
+    visible = body.replace('<svg id="vp"', '<svg id="vp" overflow="visible"')
+    assert _sources(svg(tmp_path, visible)) == ["circle#c"]
+
+
+def test_a_nested_viewport_of_percentages_clips_its_own_size(tmp_path: Path) -> None:
+    # resvg's nested-svg-with-relative-width-and-height: x, y 25 % and width, height 50 % of
+    # a 200 x 200 viewBox make the viewport 50..150; a rect of 100 % inside it is that
+    # viewport's size (100, not the document's 200), so it lies on the clip's edge: read.
+    # A rect 1 unit wider reaches outside: refused.
+    root = 'width="200mm" height="200mm" viewBox="0 0 200 200"'
+    body = (
+        '<svg x="25%" y="25%" width="50%" height="50%"><rect id="r" width="{w}" '
+        'height="100%" fill="none" stroke="black"/></svg>'
+    )
+    drawing = read_svg(svg(tmp_path, body.format(w="100%"), root=root))
+    assert [c.bbox() for c in drawing.contours] == [pytest.approx((50, 50, 150, 150))]
+    with pytest.raises(InputError, match="hides part of rect#r"):
+        read_svg(svg(tmp_path, body.format(w="101"), root=root))
+
+
+def test_a_nested_viewport_with_a_transform_clips_where_it_is_moved(tmp_path: Path) -> None:
+    # SVG 2: a transform on a nested <svg> moves its viewport too (resvg's
+    # nested-svg-with-transform-and-clip): the 20 x 20 viewport at (30, 30) holds the
+    # square at 32..48 once moved, and the clip is moved with it
+    body = (
+        '<svg width="20" height="20" transform="translate(30 30)"><rect id="r" x="2" y="2" '
+        'width="16" height="16" fill="none" stroke="black"/></svg>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.bbox() for c in drawing.contours] == [pytest.approx((32, 52, 48, 68))]

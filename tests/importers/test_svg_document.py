@@ -738,22 +738,6 @@ def test_a_transform_origin_camtool_cannot_read_is_refused(tmp_path: Path) -> No
         read_svg(svg(tmp_path, body))
 
 
-def test_a_nested_viewport_that_clips_is_warned_about(tmp_path: Path) -> None:
-    """SVG 1.1 §7.2: a nested <svg> clips to its size (resvg's nested-svg-with-rect.svg shows
-    a square of a circle); camtool cuts the circle whole, and says so."""
-    body = (
-        '<svg x="40" y="40" width="20" height="20"><circle id="c" cx="25" cy="25" r="30"/></svg>'
-        '<svg overflow="visible" width="20" height="20"><rect id="r" width="1" height="1"/></svg>'
-    )
-    drawing = read_svg(svg(tmp_path, body))
-    assert [c.source for c in drawing.contours] == ["circle#c", "rect#r"]
-    assert drawing.warnings == (
-        f"{tmp_path / 't.svg'}: 1 nested <svg> viewport(s) clip what they hold to their size; "
-        "camtool does not clip, so a shape reaching outside one is cut whole (check the "
-        "preview, or trim it in the drawing program)",
-    )
-
-
 def test_a_gradient_without_stops_paints_nothing(tmp_path: Path) -> None:
     """SVG 1.1 §13.2.4: no stops, painted as none; stops taken through href chains count
     (Inkscape's gradients with coordinates point to one with the stops)."""
