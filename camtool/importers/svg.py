@@ -165,8 +165,8 @@ def svg_drawing(
     if clipped_away:
         its, them = ("its", "it") if clipped_away == 1 else ("their", "them")
         warnings.append(
-            f"{path}: skipped {clipped_away} {_elements(clipped_away)} that {its} clip-path "
-            f"hides wholly (a viewer shows nothing of {them})"
+            f"{path}: skipped {clipped_away} {_elements(clipped_away)} that {its} clip-path, mask "
+            f"or viewport hides wholly (a viewer shows nothing of {them})"
         )
     if hidden:
         warnings.append(f"{path}: skipped {hidden} {_elements(hidden)} with visibility:hidden")

@@ -26,7 +26,6 @@ for the difference.
 
 from __future__ import annotations
 
-import re
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
@@ -34,15 +33,15 @@ from typing import Any
 import shapely
 import svgelements as se
 
-from camtool.importers.svgdoc import VIEWPORT_CLIP
+from camtool.importers.svgmasks import MASK_CLIP, VIEWPORT_CLIP
 from camtool.importers.svgpage import Affine, compose
+from camtool.importers.svgtree import SOURCE_ATTR
+from camtool.importers.svgvalues import URL_REF
 from camtool.model.errors import InputError
 
 CLIP_SLACK_MM = 0.01
 """How far outside its clip (mm) a shape may reach and still count as inside it (a shape
 on the clip's edge, as a page-sized clip around a page-sized frame)."""
-
-_URL = re.compile(r"""^url\(\s*['"]?#([^'")\s]+)['"]?\s*\)$""")
 
 
 @dataclass
@@ -88,7 +87,7 @@ def _clip_of(element: Any, objects: dict[str, Any]) -> Clip | None:
     text = _clip_text(getattr(element, "values", None) or {})
     if not text:
         return None
-    match = _URL.match(text)
+    match = URL_REF.fullmatch(text)
     if match is None:
         return Clip(element, None, f"clip-path {text!r} is a CSS shape")
     target = getattr(element, "clip_path", None)
@@ -195,22 +194,28 @@ def even_odd(subpaths: list[list[tuple[float, float]]]) -> Any:
 
 
 def clip_label(clip: Clip, label: Callable[[Any], str]) -> str:
-    """``the clip-path #ID on ELEMENT``, or ``the viewport of the nested svg#ID``."""
+    """``the clip-path #ID on ELEMENT``, ``the mask #ID on ELEMENT``, or a nested viewport."""
     name = str(getattr(clip.target, "id", None) or "")
     owner = label(clip.owner)
     if name.startswith(VIEWPORT_CLIP):
         return f"the viewport of the nested {owner}"
+    if name.startswith(MASK_CLIP):
+        mask = str(getattr(clip.target, "values", {}).get(SOURCE_ATTR, "mask")).removeprefix("mask")
+        return f"the mask {mask} on {owner}"
     return f"the clip-path #{name} on {owner}" if name else f"the clip-path on {owner}"
 
 
 def remedy(clip: Clip) -> str:
     """What a user does about a clip that hides part of a shape, or that camtool cannot read."""
-    if str(getattr(clip.target, "id", None) or "").startswith(VIEWPORT_CLIP):
+    name = str(getattr(clip.target, "id", None) or "")
+    if name.startswith(VIEWPORT_CLIP):
         return (
             "trim the shape to the <svg>'s x, y, width and height in the drawing program, or "
             'set overflow="visible" on the <svg> to cut the whole shape'
         )
+    kind = "Mask" if name.startswith(MASK_CLIP) else "Clip"
     return (
-        "release the clip in the drawing program (Inkscape: Object > Clip > Release) and "
-        "trim the shape to it (Path > Intersection), or delete the clip to cut the whole shape"
+        f"release the {kind.lower()} in the drawing program (Inkscape: Object > {kind} > "
+        f"Release) and trim the shape to it (Path > Intersection), or delete the {kind.lower()} "
+        "to cut the whole shape"
     )

@@ -19,26 +19,29 @@ from pathlib import Path
 from camtool.importers import svgcheck, svgvalues
 from camtool.importers.options import MAX_ENTITIES, too_many_entities
 from camtool.importers.svgcss import (
-    SVG_NS,
     apply_style_sheets,
     inline_style,
     local_name,
     normalize_styles,
     style_text,
 )
+from camtool.importers.svgmasks import clip_paths_first, clip_viewports, masks_as_clips
 from camtool.importers.svgpage import Affine, page_matrix
+from camtool.importers.svgtree import (
+    INKSCAPE_NS,
+    LAYER_ATTR,
+    NOT_DRAWN,
+    SOURCE_ATTR,
+    USE_ATTR,
+    XLINK_HREF,
+    elements,
+    has_shapes,
+    href,
+    is_drawn,
+    tag,
+)
 from camtool.importers.svgvalues import LENGTH_ATTRS
 from camtool.model.errors import InputError
-
-INKSCAPE_NS = "http://www.inkscape.org/namespaces/inkscape"
-XLINK_HREF = "{http://www.w3.org/1999/xlink}href"
-_CAMTOOL_NS = "urn:camtool:svg"
-SOURCE_ATTR = f"{{{_CAMTOOL_NS}}}source"
-"""Private attribute holding an element's source label (``path#id``, ``path[3]``)."""
-LAYER_ATTR = f"{{{_CAMTOOL_NS}}}layer"
-"""Private attribute holding a layer group's name; svgelements passes it down to shapes."""
-USE_ATTR = f"{{{_CAMTOOL_NS}}}use"
-"""Private attribute holding a ``<use>``'s label; svgelements passes it down to the clone."""
 
 _GROUPMODE = f"{{{INKSCAPE_NS}}}groupmode"
 _LABEL = f"{{{INKSCAPE_NS}}}label"
@@ -59,19 +62,6 @@ _RENDERED = frozenset(
         "text",
         "image",
         "flowRoot",
-    ]
-)
-_NOT_DRAWN = frozenset(
-    [
-        "defs",
-        "symbol",
-        "marker",
-        "clipPath",
-        "mask",
-        "pattern",
-        "linearGradient",
-        "radialGradient",
-        "filter",
     ]
 )
 _SWITCHABLE = _RENDERED | {"foreignObject"}
@@ -228,7 +218,7 @@ def hold_undrawn(
         bad_use = kind == "use" and _refers_to_symbol_viewbox(element, ids)
         if kind not in _HOLD_KINDS and not bad_use:
             continue
-        drawn = _is_drawn(element, parents, hold)
+        drawn = is_drawn(element, parents, hold)
         if kind == "mask":
             counts["mask"] += 1
         elif drawn and kind in ("flowRoot", "use"):
@@ -275,15 +265,6 @@ def _refers_to_symbol_viewbox(use: ET.Element, ids: dict[str | None, ET.Element]
     return target is not None and local_name(target) == "symbol" and "viewBox" in target.attrib
 
 
-def _is_drawn(element: ET.Element, parents: dict[ET.Element, ET.Element], hold: ET.Element) -> bool:
-    node = element
-    while node in parents:
-        node = parents[node]
-        if node is hold or local_name(node) in _NOT_DRAWN:
-            return False
-    return True
-
-
 def move(element: ET.Element, parents: dict[ET.Element, ET.Element], hold: ET.Element) -> None:
     """Move ``element`` from its parent into ``hold``, keeping ``parents`` up to date."""
     parent = parents.get(element)
@@ -292,15 +273,6 @@ def move(element: ET.Element, parents: dict[ET.Element, ET.Element], hold: ET.El
     parent.remove(element)
     hold.append(element)
     parents[element] = hold
-
-
-_SHAPE_KINDS = frozenset(
-    {"path", "rect", "circle", "ellipse", "line", "polyline", "polygon", "use"}
-)
-
-
-def _has_shapes(element: ET.Element) -> bool:
-    return any(local_name(e) in _SHAPE_KINDS for e in element.iter())
 
 
 def choose_switches(
@@ -323,11 +295,11 @@ def choose_switches(
         InputError: a child with shapes chooses by ``systemLanguage``: which one the user
             sees depends on the viewer's language, which camtool cannot know.
     """
-    for switch in _elements(root, "switch"):
+    for switch in elements(root, "switch"):
         children = [c for c in switch if isinstance(c.tag, str)]
-        drawn = _is_drawn(switch, parents, hold)  # else placed by a <use>, or not at all
+        drawn = is_drawn(switch, parents, hold)  # else placed by a <use>, or not at all
         for child in children:
-            if child.get("systemLanguage") is not None and _has_shapes(child):
+            if child.get("systemLanguage") is not None and has_shapes(child):
                 where = child.get(SOURCE_ATTR) or local_name(child) or "an element"
                 raise InputError(
                     f"{name}: a <switch> shows {where} or another child by the viewer's "
@@ -344,7 +316,7 @@ def choose_switches(
         )
         for child in children:
             if child is not shown:
-                if drawn and _has_shapes(child):
+                if drawn and has_shapes(child):
                     counts["switch"] += 1
                 move(child, parents, hold)
 
@@ -370,11 +342,11 @@ def check_conditions(
     stack = [root]
     while stack:
         element = stack.pop()
-        if element is hold or local_name(element) in _NOT_DRAWN:  # clip paths are not cut
+        if element is hold or local_name(element) in NOT_DRAWN:  # clip paths are not cut
             continue
         where = element.get(SOURCE_ATTR) or local_name(element) or "an element"
         language = element.get("systemLanguage")
-        if language is not None and _has_shapes(element):
+        if language is not None and has_shapes(element):
             raise InputError(
                 f"{name}: {where} is shown only to viewers whose language is {language!r} "
                 "(systemLanguage), which camtool cannot know; remove the attribute to cut "
@@ -387,88 +359,11 @@ def check_conditions(
                     f"(requiredExtensions={element.get('requiredExtensions')!r}) that no "
                     "viewer without them shows"
                 )
-            if _has_shapes(element):
+            if has_shapes(element):
                 counts["extensions"] += 1
             move(element, parents, hold)
             continue
         stack.extend(element)
-
-
-VIEWPORT_CLIP = "camtool-viewport-"
-"""Prefix of the ids of the clips :func:`clip_viewports` makes (svgclip names them as
-viewports)."""
-
-
-def clip_viewports(
-    root: ET.Element,
-    parents: dict[ET.Element, ET.Element],
-    hold: ET.Element,
-    viewport: tuple[float, float],
-) -> int:
-    """Give each drawn nested ``<svg>`` that clips (``overflow`` hidden, the default) a clip.
-
-    A nested viewport clips its content to its ``x``, ``y``, ``width``, ``height`` (SVG 1.1
-    §7.2, §14.3.3; resvg's structure/svg/nested-svg-with-rect.svg: a circle shown as a
-    square); svgelements does not. Each such ``<svg>`` is wrapped in a ``<g>`` with a
-    ``clip-path`` to a ``<clipPath>`` of that rectangle (a percentage of the nearest
-    viewport, ``width`` and ``height`` 100 % when not given), which
-    :mod:`camtool.importers.svgclip` checks as any clip; an SVG 2 ``transform`` on the
-    ``<svg>`` moves to the ``<g>``, as it applies to the viewport too.
-
-    Returns:
-        How many nested ``<svg>`` with shapes a ``<use>`` places (with sizes of its own):
-        those copies clip unchecked.
-    """
-    tag = f"{{{SVG_NS}}}svg" if root.tag.startswith("{") else "svg"
-    sizes: dict[ET.Element, tuple[float, float]] = {}
-    stack = [(root, viewport)]
-    while stack:  # each nested <svg>'s nearest viewport, as percentages resolve against
-        element, size = stack.pop()
-        if local_name(element) == "svg" and element is not root:
-            sizes[element] = size
-            size = svgvalues.viewport_size(element, size)
-        stack.extend((child, size) for child in element)
-    ids = {e.get("id") for e in root.iter() if e.get("id")}
-    used = {_href(e)[1:] for e in root.iter(_tag(root, "use")) if _href(e).startswith("#")}
-    unchecked = made = 0
-    for element in [e for e in root.iter(tag) if e is not root]:
-        overflow = inline_style(element).get("overflow", element.get("overflow", "hidden"))
-        if overflow.strip().lower() in ("visible", "auto") or not _has_shapes(element):
-            continue
-        unchecked += element.get("id") in used
-        if not _is_drawn(element, parents, hold):
-            continue
-        made += 1
-        name = f"{VIEWPORT_CLIP}{made}"
-        while name in ids:
-            name += "-"
-        width, height = sizes.get(element, viewport)
-        rect = ET.Element(_tag(root, "rect"))
-        for attr, default, base in (
-            ("x", "0", width),
-            ("y", "0", height),
-            ("width", "100%", width),
-            ("height", "100%", height),
-        ):
-            value = element.get(attr) or default
-            match = svgvalues.PERCENT.fullmatch(value)
-            rect.set(attr, repr(float(match.group(1)) / 100.0 * base) if match else value)
-        clip = ET.SubElement(root, _tag(root, "clipPath"), {"id": name})
-        clip.append(rect)
-        parent = parents[element]
-        wrapper = ET.Element(_tag(root, "g"), {"clip-path": f"url(#{name})"})
-        wrapper.set(SOURCE_ATTR, str(element.get(SOURCE_ATTR, "svg")))
-        if element.get("transform") is not None:
-            wrapper.set("transform", element.attrib.pop("transform"))
-        parent.insert(list(parent).index(element), wrapper)
-        parent.remove(element)
-        wrapper.append(element)
-        parents[wrapper], parents[element], parents[clip] = parent, wrapper, root
-    return unchecked
-
-
-def _href(element: ET.Element) -> str:
-    return (element.get(XLINK_HREF) or element.get("href") or "").strip()
 
 
 def count_skipped(root: ET.Element, hold: ET.Element, counts: Counter[str]) -> None:
@@ -503,12 +398,12 @@ def count_skipped(root: ET.Element, hold: ET.Element, counts: Counter[str]) -> N
                 into[kind] += 1
                 continue
             elif kind == "use" and drawn:
-                href = _href(child)
-                if href[:1] not in ("", "#"):
+                link = href(child)
+                if link[:1] not in ("", "#"):
                     into["use-file"] += 1  # another file's element: svgelements places nothing
-                elif href[:1] == "#" and (target := ids.get(href[1:])) is not None:
+                elif link[:1] == "#" and (target := ids.get(link[1:])) is not None:
                     into.update(placed_by_use(target))
-            walk(child, drawn and kind not in _NOT_DRAWN, into)
+            walk(child, drawn and kind not in NOT_DRAWN, into)
 
     walk(root, True, counts)
 
@@ -573,7 +468,7 @@ def check_size(root: ET.Element, name: str, max_entities: int) -> None:
 _SIZES = frozenset({"width", "height", "r", "rx", "ry"})
 _SKIP_REASONS = {
     "defs": "definitions are cut only where a <use> places them",
-    "mask": "masks are not applied",
+    "mask": "a mask is not cut: what it hides is checked where it is used",
     "text": "convert text to paths in the drawing program to cut it",
     "image": "raster images cannot be cut",
     "use": "a <use> of a <symbol> with a viewBox is not supported; unlink the clone",
@@ -638,13 +533,14 @@ def prepare(
     _label_and_check(root, str(path), viewport)
     check_use_cycles(root, str(path))
     check_size(root, str(path), max_entities)
-    hold = ET.SubElement(root, _tag(root, "defs"))
+    hold = ET.SubElement(root, tag(root, "defs"))
     parents[hold] = root
     counts: Counter[str] = Counter()
     select_layers(root, layers, parents, hold, str(path), warnings, shown)
     choose_switches(root, parents, hold, str(path), counts)
     check_conditions(root, parents, hold, str(path), counts)
     fade_under_transparent(root)
+    masks_as_clips(root, parents, hold, str(path), viewport)
     hold_undrawn(root, parents, hold, counts)
     count_skipped(root, hold, counts)
     if counts["use-file"]:
@@ -674,56 +570,8 @@ def prepare(
             noun = "element" if counts[kind] == 1 else "elements"
             reason = _SKIP_REASONS[kind]
             warnings.append(f"{path}: skipped {counts[kind]} <{kind}> {noun} ({reason})")
-    _clip_paths_first(root)
+    clip_paths_first(root)
     return Prepared(ET.tostring(root), matrix, viewport, tuple(warnings), page)
-
-
-_CLIP_CONTENT = frozenset(
-    ["path", "rect", "circle", "ellipse", "line", "polyline", "polygon", "text", "use"]
-)
-"""What a ``<clipPath>``'s region is made of (SVG 1.1 §14.3.5: shapes, text, and ``<use>``
-of a shape or text); any other child (a group, an image, a ``<switch>``) adds nothing."""
-
-
-def _clip_paths_first(root: ET.Element) -> None:
-    """Move every ``<clipPath>`` into a ``<defs>`` that is the document's first child.
-
-    A clip's children are in the user space of the element that references it, whatever
-    lies around the ``<clipPath>`` (SVG 1.1 §14.3.5); svgelements composes the transforms
-    of its ancestors into them, and looks a reference up when it meets it. At the start,
-    under no transform, each clip is known before any reference to it and carries only its
-    own ``transform`` (:mod:`camtool.importers.svgclip`). Children that add nothing to the
-    region (not in :data:`_CLIP_CONTENT`, or a ``<use>`` of anything but a shape or text)
-    are removed, so that svgelements does not read them into it.
-    """
-    clips = _elements(root, "clipPath")
-    if not clips:
-        return
-    parents = {child: parent for parent in root.iter() for child in parent}
-    ids = {e.get("id"): e for e in root.iter() if e.get("id")}
-    front = ET.Element(_tag(root, "defs"))
-    for clip in clips:
-        parents[clip].remove(clip)
-        front.append(clip)
-        for child in list(clip):
-            kind = local_name(child)
-            if kind == "use":
-                href = _href(child)
-                target = ids.get(href[1:]) if href.startswith("#") else None
-                kind = local_name(target) if target is not None else None
-                kind = None if kind == "use" else kind
-            if kind not in _CLIP_CONTENT:
-                clip.remove(child)
-    root.insert(0, front)
-
-
-def _elements(root: ET.Element, name: str) -> list[ET.Element]:
-    """The SVG elements ``name`` under ``root``, in document order (ElementTree's own search)."""
-    return list(root.iter(_tag(root, name)))
-
-
-def _tag(root: ET.Element, name: str) -> str:
-    return f"{{{SVG_NS}}}{name}" if root.tag.startswith("{") else name
 
 
 def _parse(path: Path) -> ET.Element:

@@ -66,6 +66,8 @@ _ACROSS = frozenset({"x", "cx", "width", "x1", "x2"})
 _DOWN = frozenset({"y", "cy", "height", "y1", "y2"})
 
 
+URL_REF = re.compile(r"\s*url\(\s*['\"]?#([^)'\"\s]+)['\"]?\s*\)\s*")
+"""A reference to an element of the document, ``url(#id)``: its ``fullmatch`` gives the id."""
 _PAINT_URL = re.compile(r"\s*url\(\s*['\"]?#([^)'\"\s]+)['\"]?\s*\)\s*(.*?)\s*")
 _PAINT_SERVERS = frozenset(
     {"linearGradient", "radialGradient", "pattern", "meshgradient", "hatch", "solidcolor"}
@@ -86,7 +88,8 @@ def resolve_paint_references(root: ET.Element) -> None:
     servers = {
         ident
         for ident, e in ids.items()
-        if local_name(e) in _PAINT_SERVERS and (local_name(e) not in _GRADIENTS or _stops(e, ids))
+        if local_name(e) in _PAINT_SERVERS
+        and (local_name(e) not in _GRADIENTS or gradient_stops(e, ids))
     }
     for element in root.iter():
         style = element.get("style")
@@ -335,25 +338,28 @@ def _origin(text: str, viewport: tuple[float, float]) -> tuple[float, float] | N
 _GRADIENTS = frozenset({"linearGradient", "radialGradient"})
 
 
-def _stops(gradient: ET.Element, ids: dict[str | None, ET.Element]) -> bool:
-    """Whether ``gradient`` has ``<stop>``s, its own or those of one it refers to (``href``).
+def gradient_stops(
+    gradient: ET.Element | None, ids: dict[str | None, ET.Element]
+) -> list[ET.Element]:
+    """The ``<stop>``s ``gradient`` paints with, its own or those of one it refers to (``href``).
 
     A gradient without stops paints as ``none`` (SVG 1.1 §13.2.4). Inkscape writes a
     gradient with coordinates that takes its stops from another; the chain is followed
-    (at most 32 links: a cycle ends it, without stops).
+    (at most 32 links: a cycle ends it, without stops). ``[]`` for no gradient.
     """
-    current: ET.Element | None = gradient
+    current = gradient if gradient is not None and local_name(gradient) in _GRADIENTS else None
     for _ in range(32):
         if current is None:
-            return False
-        if any(local_name(c) == "stop" for c in current):
-            return True
+            return []
+        stops = [c for c in current if local_name(c) == "stop"]
+        if stops:
+            return stops
         # any attribute named href: openclipart has files whose xlink namespace is mangled
         href = next((v for k, v in current.attrib.items() if k.rpartition("}")[2] == "href"), "")
         href = href.strip()
         target = ids.get(href[1:]) if href.startswith("#") else None
         current = target if target is not None and local_name(target) in _GRADIENTS else None
-    return False
+    return []
 
 
 def resolve_percentages(root: ET.Element, viewport: tuple[float, float]) -> None:

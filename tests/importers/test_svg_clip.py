@@ -60,7 +60,10 @@ def test_a_shape_wholly_outside_its_clip_is_skipped(tmp_path: Path) -> None:
     )
     drawing = read_svg(svg(tmp_path, body))
     assert [c.source for c in drawing.contours] == ["circle#in"]
-    assert any("skipped 1 element that its clip-path hides wholly" in w for w in drawing.warnings)
+    assert any(
+        "skipped 1 element that its clip-path, mask or viewport hides wholly" in w
+        for w in drawing.warnings
+    )
 
 
 def test_a_filled_shape_whose_outline_is_hidden_still_shows_its_fill(tmp_path: Path) -> None:
@@ -248,3 +251,102 @@ def test_a_nested_viewport_with_a_transform_clips_where_it_is_moved(tmp_path: Pa
     )
     drawing = read_svg(svg(tmp_path, body))
     assert [c.bbox() for c in drawing.contours] == [pytest.approx((32, 52, 48, 68))]
+
+
+# ------------------------------------------------------------------ masks
+
+
+@pytest.mark.parametrize(
+    ("paint", "outcome"),
+    [
+        ('fill="white"', "read"),  # shows the square whole
+        ('fill="#808080" fill-opacity="0.5"', "read"),  # grey, half opaque: still shows
+        ('fill="url(#light)"', "read"),  # a gradient of white stops, partly opaque
+        ('fill="black"', "skipped"),  # no light: shows nothing
+        ('fill="none"', "skipped"),
+        ('fill="url(#fade)"', "fill 'url(#fade)' may hide in part"),  # a stop of opacity 0
+        ('fill="white" stroke="black"', "stroke 'black' may hide"),
+    ],
+)
+def test_a_mask_is_the_clip_of_its_shapes_when_each_surely_shows_or_hides(
+    tmp_path: Path, paint: str, outcome: str
+) -> None:
+    # CSS Masking 1 §7: a luminance mask shows its element where its content is light and
+    # opaque. The mask's rectangle 10..90 holds the square 20..80 whole.
+    body = (
+        '<linearGradient id="light"><stop offset="0" stop-color="white" stop-opacity="0.4"/>'
+        '<stop offset="1" stop-color="#fff" stop-opacity="0.75"/></linearGradient>'
+        '<linearGradient id="fade"><stop offset="0" stop-color="white" stop-opacity="0"/>'
+        '<stop offset="1" stop-color="white"/></linearGradient>'
+        f'<mask id="m"><rect x="10" y="10" width="80" height="80" {paint}/></mask>'
+        f'<g mask="url(#m)">{SQUARE}/></g>'
+        '<circle id="kept" cx="5" cy="5" r="2" fill="none" stroke="black"/>'
+    )
+    path = svg(tmp_path, body)
+    if outcome == "read":
+        assert _sources(path) == ["rect#sq", "circle#kept"]
+    elif outcome == "skipped":
+        assert _sources(path) == ["circle#kept"]
+    else:
+        with pytest.raises(InputError, match=r"g\[1\] is masked by <mask> #m, which camtool") as e:
+            read_svg(path)
+        assert outcome in str(e.value)
+        assert "Object > Mask > Release" in str(e.value)
+
+
+def test_a_mask_that_shows_part_of_a_shape_is_refused_as_a_mask(tmp_path: Path) -> None:
+    body = (
+        '<mask id="m"><rect width="50" height="100" fill="white"/></mask>'
+        f'{SQUARE} style="mask: url(#m)"/>'
+    )
+    with pytest.raises(InputError, match="the mask #m on rect#sq hides part of rect#sq") as e:
+        read_svg(svg(tmp_path, body))
+    assert "Object > Mask > Release" in str(e.value)
+
+
+def test_a_mask_in_user_space_clips_to_its_rectangle_too(tmp_path: Path) -> None:
+    # maskUnits="userSpaceOnUse": the mask's x, y, width, height (here 0..50 across) bound
+    # what its white page-sized content lets through
+    body = (
+        '<mask id="m" maskUnits="userSpaceOnUse" x="0" y="0" width="50" height="100">'
+        '<rect x="-1000" y="-1000" width="3000" height="3000" fill="white"/></mask>'
+        f'<g mask="url(#m)">{SQUARE}/></g>'
+    )
+    with pytest.raises(InputError, match=r"the mask #m on g.* hides part of rect#sq"):
+        read_svg(svg(tmp_path, body))
+
+
+@pytest.mark.parametrize(
+    ("mask", "why"),
+    [
+        ('<mask id="m" maskContentUnits="objectBoundingBox"><rect width="1" height="1" '
+         'fill="white"/></mask>', 'maskContentUnits="objectBoundingBox"'),
+        ('<mask id="m" x="0" y="0" width="1" height="1"><rect width="100" height="100" '
+         'fill="white"/></mask>', "its rectangle is in objectBoundingBox units"),
+        ('<mask id="m"><text x="10" y="50" fill="white">A</text></mask>', "it holds <text>"),
+        ('<mask id="m"><rect width="100" height="100" fill="white" mask="url(#n)"/></mask>'
+         '<mask id="n"><rect width="100" height="100" fill="white"/></mask>',
+         "has a mask of its own"),
+        ('<mask id="m"><rect width="100" height="100" fill="white"/>'
+         '<rect width="10" height="10" fill="black"/></mask>',
+         "hides part of what lies under it"),
+    ],
+)  # fmt: skip
+def test_a_mask_that_amounts_to_no_clip_is_refused(tmp_path: Path, mask: str, why: str) -> None:
+    with pytest.raises(InputError, match="is masked by <mask> #m, which camtool cannot") as e:
+        read_svg(svg(tmp_path, f'{mask}<g mask="url(#m)">{SQUARE}/></g>'))
+    assert why in str(e.value)
+
+
+LINUXCNC_ICONS = CORPUS / "pkg/linuxcnc/usr/share/icons/hicolor/scalable/apps"
+
+
+@pytest.mark.skipif(not LINUXCNC_ICONS.exists(), reason="corpus not fetched (make corpus)")
+def test_the_linuxcnc_logo_s_shine_masks_hide_nothing() -> None:
+    # LinuxCNC's own icon (Debian's linuxcnc-uspace): ten masks whose content is a
+    # page-sized path filled with a gradient of white stops at opacity 0.38..0.75, so each
+    # masked group shows whole, as before masks were read
+    drawing = read_svg(LINUXCNC_ICONS / "linuxcncicon.svg")
+    sources = {c.source.partition(" subpath")[0] for c in drawing.contours}
+    assert "path#path248" in sources  # in g#g236, under mask #mask224-2-9-8
+    assert not [w for w in drawing.warnings if "hides wholly" in w]

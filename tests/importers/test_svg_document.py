@@ -416,7 +416,8 @@ def test_use_places_a_definition_and_names_both(tmp_path: Path) -> None:
         ),
         (
             '<mask id="m"><rect width="5" height="5"/></mask>',
-            "skipped 1 <mask> element (masks are not applied)",
+            "skipped 1 <mask> element (a mask is not cut: what it hides is checked where it is "
+            "used)",
         ),
         (
             '<symbol id="s" viewBox="0 0 1 1"><path d="M 0 0 L 1 1"/></symbol>'
