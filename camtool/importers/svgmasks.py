@@ -331,6 +331,8 @@ def clip_viewports(
         those copies clip unchecked.
     """
     svg_tag = f"{{{SVG_NS}}}svg" if root.tag.startswith("{") else "svg"
+    if not any(e is not root for e in root.iter(svg_tag)):
+        return 0
     sizes: dict[ET.Element, tuple[float, float]] = {}
     stack = [(root, viewport)]
     while stack:  # each nested <svg>'s nearest viewport, as percentages resolve against
