@@ -383,13 +383,13 @@ def _hidden_by_clip(
         try:
             if clip.why:
                 raise InputError(clip.why)
-            region = svgclip.clip_region(clip, page, affine_of, _clip_subpaths, _SHAPES)
+            svgclip.clip_region(clip, page, affine_of, _clip_subpaths, _SHAPES)
         except (InputError, GeometryError) as exc:
             raise InputError(
                 f"{path}: {_label(shape)} is clipped by {svgclip.clip_label(clip, _label)}, "
                 f"whose region camtool cannot work out ({exc}); {svgclip.remedy(clip)}"
             ) from None
-        parts.append((svgclip.hidden_part(region, lines, filled), clip))
+        parts.append((svgclip.hidden_part(clip, lines, filled), clip))
     if any(part == "all" for part, _ in parts):
         return True
     for part, clip in parts:

@@ -55,7 +55,9 @@ class Clip:
     why: str = ""
     """Why the region cannot be worked out; ``""`` when it can."""
     region: Any = field(default=None, repr=False)
-    """The region in mm on the page (a shapely geometry), once worked out."""
+    """The region in mm on the page (a shapely geometry, prepared), once worked out."""
+    grown: Any = field(default=None, repr=False)
+    """``region`` grown by :data:`CLIP_SLACK_MM` (prepared), once worked out."""
 
 
 def clipped_shapes(svg: Any, shape_types: tuple[type, ...]) -> dict[int, tuple[Clip, ...]]:
@@ -125,8 +127,16 @@ def clip_region(
         even_odd(subpaths(child, compose(owner, affine_of(child.transform))))
         for child in _children(clip.target, shape_types)
     ]
-    clip.region = shapely.union_all(polygons) if polygons else shapely.Polygon()
+    set_region(clip, shapely.union_all(polygons) if polygons else shapely.Polygon())
     return clip.region
+
+
+def set_region(clip: Clip, region: Any) -> None:
+    """Give ``clip`` its ``region`` (mm, a shapely geometry) and the region grown by the slack."""
+    clip.region = region
+    clip.grown = shapely.buffer(region, CLIP_SLACK_MM)
+    shapely.prepare(clip.region)
+    shapely.prepare(clip.grown)
 
 
 def _children(node: Any, shape_types: tuple[type, ...], placed: bool = False) -> Iterator[Any]:
@@ -161,22 +171,23 @@ def _clip_text(values: Any) -> str:
     return "" if text.lower() == "none" else text
 
 
-def hidden_part(region: Any, lines: list[list[tuple[float, float]]], filled: bool) -> str:
-    """How much of a shape ``region`` hides: its outline ``lines`` (points in mm) and fill.
+def hidden_part(clip: Clip, lines: list[list[tuple[float, float]]], filled: bool) -> str:
+    """How much of a shape ``clip`` hides (its region worked out): its ``lines`` and fill.
 
-    ``"none"``: every line lies within :data:`CLIP_SLACK_MM` of the region; ``"all"``: no
-    line meets the region (its edge included), nor (``filled``: the shape is painted
-    inside) does the shape's inside, so a viewer shows nothing of it; else ``"part"`` (a
-    filled rectangle clipped by a star shows a star: its outline is hidden wholly, its
-    fill is not).
+    ``lines``: the shape's outline, points in mm. ``"none"``: every line lies within
+    :data:`CLIP_SLACK_MM` of the region; ``"all"``: no line meets the region (its edge
+    included), nor (``filled``: the shape is painted inside) does the shape's inside, so
+    a viewer shows nothing of it; else ``"part"`` (a filled rectangle clipped by a star
+    shows a star: its outline is hidden wholly, its fill is not).
     """
     outline = shapely.MultiLineString([p for p in lines if len(p) > 1])
+    region = clip.region
     if outline.is_empty:
-        return "none"
-    if not region.is_empty and shapely.buffer(region, CLIP_SLACK_MM).covers(outline):
         return "none"
     if region.is_empty:
         return "all"
+    if clip.grown.covers(outline):
+        return "none"
     if region.intersects(outline):
         return "part"
     if filled and region.intersects(even_odd(lines)):

@@ -16,7 +16,7 @@ import pytest
 import shapely
 
 from camtool.importers.svg import read_svg
-from camtool.importers.svgclip import CLIP_SLACK_MM, even_odd, hidden_part
+from camtool.importers.svgclip import CLIP_SLACK_MM, Clip, even_odd, hidden_part, set_region
 from camtool.model.errors import InputError
 from tests.importers.svgutil import svg
 
@@ -172,8 +172,14 @@ def test_a_reference_to_no_clip_is_ignored_as_viewers_ignore_it(tmp_path: Path) 
     assert _sources(svg(tmp_path, f'{SQUARE} clip-path="url(#missing)"/>')) == ["rect#sq"]
 
 
+def _clip(region: object) -> Clip:
+    clip = Clip(owner=None, target=None)
+    set_region(clip, region)
+    return clip
+
+
 def test_hidden_part_by_the_slack() -> None:
-    region = shapely.box(0, 0, 10, 10)
+    region = _clip(shapely.box(0, 0, 10, 10))
     inside = [[(0.0, 0.0), (10.0, 0.0), (10.0, 10.0)]]
     just_out = [[(0.0, 0.0), (10.0 + CLIP_SLACK_MM / 2, 0.0)]]
     too_far = [[(0.0, 0.0), (10.0 + 2 * CLIP_SLACK_MM, 0.0)]]
@@ -186,7 +192,7 @@ def test_hidden_part_by_the_slack() -> None:
     assert hidden_part(region, [[(20.0, 20.0), (30.0, 20.0)]], filled=False) == "all"
     # touching the region at one point: shown there, so not skipped
     assert hidden_part(region, [[(10.0, 10.0), (20.0, 20.0)]], filled=False) == "part"
-    assert hidden_part(shapely.Polygon(), inside, filled=True) == "all"
+    assert hidden_part(_clip(shapely.Polygon()), inside, filled=True) == "all"
 
 
 def test_even_odd_makes_holes_of_nested_subpaths() -> None:
