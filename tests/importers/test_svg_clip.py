@@ -356,3 +356,33 @@ def test_the_linuxcnc_logo_s_shine_masks_hide_nothing() -> None:
     sources = {c.source.partition(" subpath")[0] for c in drawing.contours}
     assert "path#path248" in sources  # in g#g236, under mask #mask224-2-9-8
     assert not [w for w in drawing.warnings if "hides wholly" in w]
+
+
+@pytest.mark.parametrize(("xlim", "read"), [((0.0, 10.0), True), ((2.0, 8.0), False)])
+def test_matplotlib_clips_each_line_to_its_axes(
+    tmp_path: Path, xlim: tuple[float, float], read: bool
+) -> None:
+    # matplotlib's SVG backend (an exporter camtool does not control) clips every line to
+    # its axes with a <clipPath> of the axes' rectangle: a sine over 0..10 drawn in axes
+    # of 0..10 lies inside it (its ends on the edge); in axes of 2..8 its ends are hidden
+    import numpy as np
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(4, 3))
+    ax = fig.subplots()
+    x = np.linspace(0.0, 10.0, 200)
+    ax.plot(x, np.sin(x))
+    ax.set_xlim(*xlim)
+    ax.axis("off")
+    path = tmp_path / "plot.svg"
+    fig.savefig(path, format="svg")
+    assert "clip-path" in path.read_text(encoding="utf-8")
+    if read:
+        # the open line spans the axes: matplotlib's default subplot from 0.125 to 0.9 of
+        # the 4 in (101.6 mm) figure; the closed contour is the figure's white background
+        (line,) = [c for c in read_svg(path).contours if not c.closed]
+        x0, _, x1, _ = line.bbox()
+        assert (x0, x1) == pytest.approx((0.125 * 101.6, 0.9 * 101.6), abs=1e-6)
+    else:
+        with pytest.raises(InputError, match=r"the clip-path #\w+ on path\[\d+\] hides part of"):
+            read_svg(path)
