@@ -558,7 +558,7 @@ def prepare(
             f"{path}: skipped {counts['extensions']} element(s) with shapes that require "
             "extensions (requiredExtensions), which a viewer without them does not show"
         )
-    viewports = clip_viewports(root, parents, hold, viewport)
+    viewports = clip_viewports(root, parents, hold, viewport, str(path))
     if viewports:
         warnings.append(
             f"{path}: {viewports} nested <svg> viewport(s) placed by a <use> clip what "

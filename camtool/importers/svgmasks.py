@@ -20,7 +20,7 @@ import xml.etree.ElementTree as ET
 
 import svgelements as se
 
-from camtool.importers import svgvalues
+from camtool.importers import svgcheck, svgvalues
 from camtool.importers.svgcss import SVG_NS, inline_style, local_name
 from camtool.importers.svgtree import (
     NOT_DRAWN,
@@ -242,6 +242,10 @@ def _mask_box(mask: ET.Element, viewport: tuple[float, float]) -> tuple[str, str
         given, ("-10%", "-10%", "120%", "120%"), (*viewport, *viewport), strict=True
     ):
         text = value if value is not None else default
+        try:
+            svgcheck.check_length(text, negative=default == "-10%")
+        except ValueError as exc:
+            raise ValueError(f"its rectangle's {text!r}: {exc}") from None
         match = svgvalues.PERCENT.fullmatch(text)
         out.append(repr(float(match.group(1)) / 100.0 * base) if match else text)
     return (out[0], out[1], out[2], out[3])
@@ -315,6 +319,7 @@ def clip_viewports(
     parents: dict[ET.Element, ET.Element],
     hold: ET.Element,
     viewport: tuple[float, float],
+    name: str,
 ) -> int:
     """Give each drawn nested ``<svg>`` that clips (``overflow`` hidden, the default) a clip.
 
@@ -325,6 +330,10 @@ def clip_viewports(
     viewport, ``width`` and ``height`` 100 % when not given), which
     :mod:`camtool.importers.svgclip` checks as any clip; an SVG 2 ``transform`` on the
     ``<svg>`` moves to the ``<g>``, as it applies to the viewport too.
+
+    Raises:
+        InputError: a nested ``<svg>`` whose ``x``, ``y``, ``width`` or ``height`` is not a
+            length (or a negative size), naming it.
 
     Returns:
         How many nested ``<svg>`` with shapes a ``<use>`` places (with sizes of its own):
@@ -352,9 +361,9 @@ def clip_viewports(
         if not is_drawn(element, parents, hold):
             continue
         made += 1
-        name = f"{VIEWPORT_CLIP}{made}"
-        while name in ids:
-            name += "-"
+        clip_id = f"{VIEWPORT_CLIP}{made}"
+        while clip_id in ids:
+            clip_id += "-"
         width, height = sizes.get(element, viewport)
         rect = ET.Element(tag(root, "rect"))
         for attr, default, base in (
@@ -364,11 +373,16 @@ def clip_viewports(
             ("height", "100%", height),
         ):
             value = element.get(attr) or default
+            try:
+                svgcheck.check_length(value, negative=attr in ("x", "y"))
+            except ValueError as exc:
+                where = element.get(SOURCE_ATTR) or "svg"
+                raise InputError(f"{name}: {where}: bad {attr} {value!r}: {exc}") from None
             match = svgvalues.PERCENT.fullmatch(value)
             rect.set(attr, repr(float(match.group(1)) / 100.0 * base) if match else value)
-        clip = ET.SubElement(root, tag(root, "clipPath"), {"id": name})
+        clip = ET.SubElement(root, tag(root, "clipPath"), {"id": clip_id})
         clip.append(rect)
-        _wrap(element, parents, name, root)
+        _wrap(element, parents, clip_id, root)
         parents[clip] = root
     return unchecked
 

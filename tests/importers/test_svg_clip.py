@@ -247,6 +247,16 @@ def test_a_nested_viewport_of_percentages_clips_its_own_size(tmp_path: Path) -> 
         read_svg(svg(tmp_path, body.format(w="101"), root=root))
 
 
+@pytest.mark.parametrize(
+    ("size", "why"), [('width="-5"', "must not be negative"), ('width="abc"', "must be a number")]
+)
+def test_a_nested_viewport_of_a_bad_size_is_refused(tmp_path: Path, size: str, why: str) -> None:
+    body = f'<svg {size} height="50">{SQUARE}/></svg>'
+    with pytest.raises(InputError, match=r"svg\[2\]: bad width") as e:
+        read_svg(svg(tmp_path, body))
+    assert why in str(e.value)
+
+
 def test_a_nested_viewport_with_a_transform_clips_where_it_is_moved(tmp_path: Path) -> None:
     # SVG 2: a transform on a nested <svg> moves its viewport too (resvg's
     # nested-svg-with-transform-and-clip): the 20 x 20 viewport at (30, 30) holds the
@@ -336,6 +346,8 @@ def test_a_mask_in_user_space_clips_to_its_rectangle_too(tmp_path: Path) -> None
         ('<mask id="m"><rect width="100" height="100" fill="white"/>'
          '<rect width="10" height="10" fill="black"/></mask>',
          "hides part of what lies under it"),
+        ('<mask id="m" maskUnits="userSpaceOnUse" width="zz"><rect width="100" height="100" '
+         'fill="white"/></mask>', "its rectangle's 'zz': must be a number"),
     ],
 )  # fmt: skip
 def test_a_mask_that_amounts_to_no_clip_is_refused(tmp_path: Path, mask: str, why: str) -> None:
