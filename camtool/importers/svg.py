@@ -152,12 +152,13 @@ def svg_drawing(
     tolerance = options.curve_tolerance(box)
     fitter = _prefitted(drawn, prepared.matrix, tolerance, progress)
     clips = svgclip.clipped_shapes(svg, _SHAPES)
+    regions: dict[tuple[int, Affine], tuple[Any, Any]] = {}
     clipped_away = 0
     progress(Step("contours", 0, len(drawn)))
     for i, (shape, segments) in enumerate(drawn, start=1):
         made = _contours(path, shape, segments, prepared.matrix, fitter)
         over = clips.get(id(shape))
-        if over and _hidden_by_clip(path, shape, made, over, prepared.matrix, tolerance):
+        if over and _hidden_by_clip(path, shape, made, over, prepared.matrix, tolerance, regions):
             clipped_away += 1
         else:
             contours.extend(made)
@@ -369,8 +370,11 @@ def _hidden_by_clip(
     clips: tuple[svgclip.Clip, ...],
     page: Affine,
     tolerance: float,
+    regions: dict[tuple[int, Affine], tuple[Any, Any]],
 ) -> bool:
     """Whether ``clips`` hide all of ``shape`` (its ``contours``); none of it: ``False``.
+
+    ``regions``: the clips' regions worked out so far (:func:`svgclip.clip_region`).
 
     Raises:
         InputError: a clip hides part of the shape (camtool would cut the hidden part), or
@@ -383,7 +387,7 @@ def _hidden_by_clip(
         try:
             if clip.why:
                 raise InputError(clip.why)
-            svgclip.clip_region(clip, page, affine_of, _clip_subpaths, _SHAPES)
+            svgclip.clip_region(clip, page, affine_of, _clip_subpaths, _SHAPES, regions)
         except (InputError, GeometryError) as exc:
             raise InputError(
                 f"{path}: {_label(shape)} is clipped by {svgclip.clip_label(clip, _label)}, "

@@ -110,11 +110,14 @@ def clip_region(
     affine_of: Callable[[Any], Affine],
     subpaths: Callable[[Any, Affine], list[list[tuple[float, float]]]],
     shape_types: tuple[type, ...],
+    made: dict[tuple[int, Affine], tuple[Any, Any]],
 ) -> Any:
     """The region of ``clip`` in mm on the page (a shapely geometry; empty: hides everything).
 
     ``subpaths(shape, matrix)``: a clip child's subpaths as point lists in mm, closed or
-    not (an open subpath clips as if closed, as it is filled).
+    not (an open subpath clips as if closed, as it is filled). ``made``: the regions
+    worked out so far, by the ``<clipPath>`` and the matrix of the element using it (a
+    plot's every line may name the one clip of its axes).
 
     Raises:
         InputError: (message without the file's name) the clip holds text, or a child
@@ -123,11 +126,17 @@ def clip_region(
     if clip.region is not None:
         return clip.region
     owner = compose(page, affine_of(clip.owner.transform))
+    key = (id(clip.target), owner)
+    known = made.get(key)
+    if known is not None:
+        clip.region, clip.grown = known
+        return clip.region
     polygons = [
         even_odd(subpaths(child, compose(owner, affine_of(child.transform))))
         for child in _children(clip.target, shape_types)
     ]
     set_region(clip, shapely.union_all(polygons) if polygons else shapely.Polygon())
+    made[key] = (clip.region, clip.grown)
     return clip.region
 
 
