@@ -33,8 +33,10 @@ LENGTH_ATTRS = {
     "circle": ("cx", "cy", "r"),
     "ellipse": ("cx", "cy", "rx", "ry"),
     "line": ("x1", "y1", "x2", "y2"),
+    "use": ("x", "y"),
 }
-"""The length attributes of each shape (checked by the document pass, resolved here)."""
+"""The length attributes of each shape, and of ``<use>`` (checked by the document pass,
+resolved here)."""
 _VIEWPORT_ATTRS = ("x", "y", "width", "height")
 """A nested ``<svg>``'s lengths :func:`resolve_percentages` resolves."""
 _SIZE_NEEDS = {"rect": ("width", "height"), "circle": ("r",), "ellipse": ("rx", "ry")}

@@ -656,6 +656,7 @@ def test_percentages_are_of_the_viewport_width_height_or_diagonal(tmp_path: Path
         '<line id="l" x1="0%" y1="0%" x2="100%" y2="100%" stroke="black"/>'
         '<svg x="0" y="0" width="200" height="100" viewBox="0 0 50 50" preserveAspectRatio="none">'
         '<rect id="n" width="10%" height="10%"/></svg>'
+        '<defs><rect id="u" width="10" height="10"/></defs><use href="#u" x="10%" y="50%"/>'
     )
     drawing = read_svg(svg(tmp_path, body, 'width="200mm" height="100mm" viewBox="0 0 200 100"'))
     r = 0.1 * math.sqrt((200**2 + 100**2) / 2)
@@ -666,6 +667,8 @@ def test_percentages_are_of_the_viewport_width_height_or_diagonal(tmp_path: Path
     assert boxes["line#l"] == pytest.approx((0, 0, 200, 100))
     # 10% of the nested 50 × 50 viewBox: 5 × 5 units, stretched 4 × 2 to 20 × 10 mm
     assert boxes["rect#n"] == pytest.approx((0, 90, 20, 100))
+    # a <use> placed at 10 % and 50 % of the page: (20, 50), so from y 40 to 50 once flipped
+    assert boxes["use[1] > rect#u"] == pytest.approx((20, 40, 30, 50))
 
 
 def test_a_shape_without_its_size_is_not_drawn_and_an_ellipse_radius_is_auto(
