@@ -25,7 +25,12 @@ from camtool.importers.svgcss import (
     normalize_styles,
     style_text,
 )
-from camtool.importers.svgmasks import clip_paths_first, clip_viewports, masks_as_clips
+from camtool.importers.svgmasks import (
+    clip_paths_first,
+    clip_viewports,
+    masks_as_clips,
+    symbols_as_viewports,
+)
 from camtool.importers.svgpage import Affine, page_matrix
 from camtool.importers.svgtree import (
     INKSCAPE_NS,
@@ -533,6 +538,9 @@ def prepare(
     _label_and_check(root, str(path), viewport)
     check_use_cycles(root, str(path))
     check_size(root, str(path), max_entities)
+    if symbols_as_viewports(root):
+        svgvalues.resolve_percentages(root, viewport)  # the new viewports' sizes
+        parents = {child: parent for parent in root.iter() for child in parent}
     hold = ET.SubElement(root, tag(root, "defs"))
     parents[hold] = root
     counts: Counter[str] = Counter()

@@ -5,6 +5,8 @@ only where these let it through; camtool cuts whole shapes. This pass turns each
 ``<clipPath>`` that :mod:`camtool.importers.svgclip` compares with the shapes it covers
 (read, skipped, or refused), or refuses what it cannot turn into one:
 
+- :func:`symbols_as_viewports`: a ``<use>`` of a ``<symbol>`` becomes the nested
+  ``<svg>`` it stands for;
 - :func:`clip_viewports`: a nested ``<svg>`` clips to its rectangle;
 - :func:`masks_as_clips`: a mask whose every visible part is sure (white or coloured,
   opaque in part) lets through where its shapes are; any other mask is refused;
@@ -15,6 +17,7 @@ Design notes: docs/internals.md, ``camtool/importers/svgdoc.py``.
 
 from __future__ import annotations
 
+import copy
 import math
 import xml.etree.ElementTree as ET
 
@@ -25,6 +28,7 @@ from camtool.importers.svgcss import SVG_NS, inline_style, local_name
 from camtool.importers.svgtree import (
     NOT_DRAWN,
     SOURCE_ATTR,
+    XLINK_HREF,
     elements,
     has_shapes,
     href,
@@ -309,6 +313,49 @@ def _wrap(
     return wrapper
 
 
+_USE_PLACES = frozenset({"x", "y", "width", "height", "href", XLINK_HREF})
+"""A ``<use>``'s attributes that its generated ``<svg>`` takes (the others go to its ``<g>``)."""
+_SYMBOL_OWN = frozenset({"id", "x", "y", "width", "height", "refX", "refY"})
+"""A ``<symbol>``'s attributes its generated ``<svg>`` does not take."""
+
+
+def symbols_as_viewports(root: ET.Element) -> int:
+    """Replace each ``<use>`` of a ``<symbol>`` by the ``<g>`` and ``<svg>`` it stands for.
+
+    SVG 1.1 §5.6: the use becomes a ``<g>`` with its attributes (its ``transform``, style,
+    clip and mask), holding an ``<svg>`` viewport at the use's ``x``, ``y`` of its
+    ``width`` and ``height`` (100 % when not given), with the symbol's ``viewBox``,
+    ``preserveAspectRatio`` and style, holding copies of the symbol's children. The viewport
+    clips unless ``overflow`` is visible (resvg's structure/symbol tests), which
+    :func:`clip_viewports` then checks. Only the uses the document holds are replaced, not
+    those a copy brings (each is replaced once, whatever it nests).
+
+    Returns:
+        How many uses were replaced.
+    """
+    ids = {e.get("id"): e for e in root.iter() if e.get("id")}
+    parents = {child: parent for parent in root.iter() for child in parent}
+    done = 0
+    for use in [e for e in root.iter() if local_name(e) == "use"]:
+        link = href(use)
+        symbol = ids.get(link[1:]) if link.startswith("#") else None
+        parent = parents.get(use)
+        if symbol is None or local_name(symbol) != "symbol" or parent is None:
+            continue
+        group = ET.Element(tag(root, "g"), {k: v for k, v in use.attrib.items()
+                                            if k not in _USE_PLACES})  # fmt: skip
+        viewport = ET.SubElement(group, tag(root, "svg"))
+        viewport.attrib.update({k: v for k, v in symbol.attrib.items() if k not in _SYMBOL_OWN})
+        viewport.attrib.update({"width": "100%", "height": "100%"})
+        viewport.attrib.update({k: v for k, v in use.attrib.items()
+                                if k in ("x", "y", "width", "height")})  # fmt: skip
+        viewport.extend(copy.deepcopy(child) for child in symbol)
+        parent.insert(list(parent).index(use), group)
+        parent.remove(use)
+        done += 1
+    return done
+
+
 VIEWPORT_CLIP = "camtool-viewport-"
 """Prefix of the ids of the clips :func:`clip_viewports` makes (svgclip names them as
 viewports)."""
@@ -354,6 +401,7 @@ def clip_viewports(
     used = {href(e)[1:] for e in root.iter(tag(root, "use")) if href(e).startswith("#")}
     unchecked = made = 0
     for element in [e for e in root.iter(svg_tag) if e is not root]:
+        _own_viewbox(element, sizes.get(element, viewport))
         overflow = inline_style(element).get("overflow", element.get("overflow", "hidden"))
         if overflow.strip().lower() in ("visible", "auto") or not has_shapes(element):
             continue
@@ -385,6 +433,24 @@ def clip_viewports(
         _wrap(element, parents, clip_id, root)
         parents[clip] = root
     return unchecked
+
+
+def _own_viewbox(element: ET.Element, outer: tuple[float, float]) -> None:
+    """Give a nested ``<svg>`` without a viewBox the viewBox ``0 0 width height``.
+
+    The same viewport (its content unscaled, SVG 1.1 §7.7), which svgelements places at the
+    ``<svg>``'s ``x``, ``y``: without a viewBox it left the content at the parent's origin
+    (resvg's structure/svg/nested-svg-with-rect.svg). A size of 0 shows nothing and is
+    left as it is. A missing ``x`` or ``y`` is written as 0.
+    """
+    for attr in ("x", "y"):  # else svgelements takes an outer viewport's
+        if element.get(attr) is None:
+            element.set(attr, "0")
+    if svgvalues.viewbox_size(element) is not None:
+        return
+    width, height = svgvalues.viewport_size(element, outer)
+    if width > 0 and height > 0:
+        element.set("viewBox", f"0 0 {width!r} {height!r}")
 
 
 _CLIP_CONTENT = frozenset(

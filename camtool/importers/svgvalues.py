@@ -49,8 +49,15 @@ def default_sizes(element: ET.Element, kind: str) -> None:
     A rect needs both sizes, an ellipse one radius (the other ``auto``: the same), a circle
     its radius: without them nothing is drawn (their value is 0 or ``auto``, SVG 2
     §10.2-10.4), where svgelements draws a size of 1 (a 1 px high rectangle). A size set in
-    the ``style`` (SVG 2 geometry properties) counts. Run after :func:`resolve_percentages`.
+    the ``style`` (SVG 2 geometry properties) counts. A rect's or a ``<use>``'s missing
+    ``x`` and ``y`` are written as 0: svgelements passes attributes down, so inside a
+    nested ``<svg>`` it would take that viewport's. Run after :func:`resolve_percentages`.
     """
+    if kind in ("rect", "use"):
+        style = inline_style(element)
+        for attr in ("x", "y"):  # svgelements would take a nested <svg>'s x and y for them
+            if element.get(attr) is None and attr not in style:
+                element.set(attr, "0")
     needs = _SIZE_NEEDS.get(kind)
     if needs is None:
         return

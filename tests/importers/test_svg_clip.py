@@ -257,6 +257,22 @@ def test_a_nested_viewport_of_a_bad_size_is_refused(tmp_path: Path, size: str, w
     assert why in str(e.value)
 
 
+def test_a_nested_viewport_without_a_viewbox_moves_its_content_to_its_x_and_y(
+    tmp_path: Path,
+) -> None:
+    # SVG 1.1 §7.7: the viewport at (40, 30) holds its content unscaled; svgelements left it
+    # at the origin, and gave a rect without x the viewport's x (40: twice over, once the
+    # viewport was moved)
+    body = (
+        '<svg x="40" y="30" width="20" height="20" overflow="visible"><rect id="r" '
+        'width="5" height="5" fill="none" stroke="black"/><path id="p" d="M 1 1 L 4 1" '
+        'stroke="black"/></svg>'
+    )
+    boxes = {c.source: c.bbox() for c in read_svg(svg(tmp_path, body)).contours}
+    assert boxes["rect#r"] == pytest.approx((40, 65, 45, 70))
+    assert boxes["path#p"] == pytest.approx((41, 69, 44, 69))
+
+
 def test_a_nested_viewport_with_a_transform_clips_where_it_is_moved(tmp_path: Path) -> None:
     # SVG 2: a transform on a nested <svg> moves its viewport too (resvg's
     # nested-svg-with-transform-and-clip): the 20 x 20 viewport at (30, 30) holds the
@@ -397,4 +413,39 @@ def test_matplotlib_clips_each_line_to_its_axes(
         assert (x0, x1) == pytest.approx((0.125 * 101.6, 0.9 * 101.6), abs=1e-6)
     else:
         with pytest.raises(InputError, match=r"the clip-path #\w+ on path\[\d+\] hides part of"):
+            read_svg(path)
+
+
+# ------------------------------------------------------------------ symbols
+
+
+def test_a_symbol_with_a_viewbox_is_placed_in_the_viewport_of_its_use(tmp_path: Path) -> None:
+    # resvg's structure/symbol/with-viewBox.svg, in a 200 x 200 page: the use (100 % of the
+    # page) shows the viewBox -100 -100 400 400 at half size, so the rect 20..180 lies at
+    # 60..140 (y flipped: 60..140 too). It was skipped before (a warning).
+    root = 'width="200mm" height="200mm" viewBox="0 0 200 200"'
+    body = (
+        '<symbol id="s" viewBox="-100 -100 400 400"><rect id="r" x="20" y="20" width="160" '
+        'height="160" fill="none" stroke="black"/></symbol><use id="u" href="#s"/>'
+    )
+    (contour,) = read_svg(svg(tmp_path, body, root=root)).contours
+    assert contour.bbox() == pytest.approx((60, 60, 140, 140))
+    assert contour.source == "use#u > rect#r"
+
+
+@pytest.mark.parametrize(("size", "read"), [('width="200" height="200"', True),
+                                            ('width="100" height="100"', False)])  # fmt: skip
+def test_a_symbol_clips_to_the_size_of_its_use(tmp_path: Path, size: str, read: bool) -> None:
+    # resvg's structure/symbol/with-custom-use-size.svg: a symbol is a viewport; the rect
+    # 20..180 fits a use of 200 and reaches outside one of 100
+    root = 'width="200mm" height="200mm" viewBox="0 0 200 200"'
+    body = (
+        '<symbol id="s"><rect id="r" x="20" y="20" width="160" height="160" fill="none" '
+        f'stroke="black"/></symbol><use id="u" href="#s" {size}/>'
+    )
+    path = svg(tmp_path, body, root=root)
+    if read:
+        assert [c.bbox() for c in read_svg(path).contours] == [pytest.approx((20, 20, 180, 180))]
+    else:
+        with pytest.raises(InputError, match=r"the viewport of the nested use#u > symbol#s hides"):
             read_svg(path)
