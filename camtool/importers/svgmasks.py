@@ -299,11 +299,20 @@ def _wrap(
 
     The element's ``transform`` moves to the group: a clip is in the user space of the
     element that references it, its transform included (SVG 1.1 §14.3.5), and so is a
-    mask's content and a nested viewport's rectangle.
+    mask's content and a nested viewport's rectangle. The ``<svg>`` itself (a mask on the
+    whole drawing) keeps its place: its children move into the group.
     """
-    parent = parents[element]
     wrapper = ET.Element(tag(root, "g"), {"clip-path": f"url(#{clip})"})
     wrapper.set(SOURCE_ATTR, str(element.get(SOURCE_ATTR, local_name(element) or "g")))
+    if element is root:
+        for child in list(root):
+            root.remove(child)
+            wrapper.append(child)
+            parents[child] = wrapper
+        root.append(wrapper)
+        parents[wrapper] = root
+        return wrapper
+    parent = parents[element]
     if element.get("transform") is not None:
         wrapper.set("transform", element.attrib.pop("transform"))
     parent.insert(list(parent).index(element), wrapper)

@@ -449,3 +449,11 @@ def test_a_symbol_clips_to_the_size_of_its_use(tmp_path: Path, size: str, read: 
     else:
         with pytest.raises(InputError, match=r"the viewport of the nested use#u > symbol#s hides"):
             read_svg(path)
+
+
+def test_a_mask_on_the_whole_drawing(tmp_path: Path) -> None:
+    # the mask on the <svg> itself: its white half shows the square's left part only
+    root = 'width="100mm" height="100mm" viewBox="0 0 100 100" mask="url(#m)"'
+    body = f'<mask id="m"><rect width="50" height="100" fill="white"/></mask>{SQUARE}/>'
+    with pytest.raises(InputError, match=r"the mask #m on svg\[1\] hides part of rect#sq"):
+        read_svg(svg(tmp_path, body, root=root))
