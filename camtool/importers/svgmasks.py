@@ -342,6 +342,8 @@ def symbols_as_viewports(root: ET.Element) -> int:
     Returns:
         How many uses were replaced.
     """
+    if not elements(root, "symbol"):
+        return 0
     ids = {e.get("id"): e for e in root.iter() if e.get("id")}
     parents = {child: parent for parent in root.iter() for child in parent}
     done = 0
