@@ -46,6 +46,14 @@ MAX_REMEDIES = 3  # a remedy may lead to a second message with a second remedy
 # An input with no geometry (text, images, filters only: several Inkscape examples) is
 # refused with exit 3 and this message, which says what camtool reads; no option helps.
 NOTHING_TO_CUT = "nothing to cut; camtool reads"
+# An SVG whose clip, mask or viewport hides part of a shape (an icon's design, a frame its
+# artwork reaches out of) is refused with exit 3 and one of these: the drawing must be
+# edited, no option helps (camtool/importers/svgclip.py).
+CLIPPED = (
+    "and camtool cuts whole shapes: the hidden part would be cut",
+    "whose region camtool cannot work out",
+    "which camtool cannot read as a clip",
+)
 FETCH_HINT = "run `python tests/corpus/fetch_corpus.py` (make corpus) to fetch it"
 
 
@@ -115,7 +123,8 @@ class Outcome:
     rel: str
     target: str
     runs: list[Run] = field(default_factory=list)
-    status: str = ""  # "first-try", "after-remedy", "refused" (nothing to cut) or "failed"
+    status: str = ""  # "first-try", "after-remedy", "refused" (nothing to cut, or clipped)
+    # or "failed"
     problems: list[str] = field(default_factory=list)
 
     @property
@@ -271,6 +280,9 @@ def resolve(rel: str, target: str) -> Outcome:
         if run.rc == 3 and NOTHING_TO_CUT in run.error:
             outcome.status = "refused"  # text or images only: no option can help
             break
+        if run.rc == 3 and any(text in run.error for text in CLIPPED):
+            outcome.status = "refused"  # what it shows is not what it holds
+            break
         remedy = _follow(src, target, outdir, extra, run, outcome)
         if remedy is None:
             break
@@ -400,7 +412,7 @@ def print_summary(terminalreporter: Any, runs: list[dict[str, Any]]) -> None:
     terminalreporter.write_line(
         f"{len(cases)} cases: {counts['first-try']} ok first try, "
         f"{counts['after-remedy']} ok after the suggested remedy, "
-        f"{counts['refused']} refused (nothing to cut), {counts['failed']} failed"
+        f"{counts['refused']} refused (nothing to cut, or clipped), {counts['failed']} failed"
     )
     for target in TARGETS:
         if target in by_target:

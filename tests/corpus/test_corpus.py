@@ -7,7 +7,8 @@ is posted as a new user first would (``camtool post FILE -t TARGET -o OUT``). It
 options it names, with the values it gives — then posts when followed as written. Small
 machines (pic-mmh is 10 × 7 mm) will need ``--fit``: the message must say so with the sizes.
 A drawing with nothing camtool can cut (text, images or filters only) may be refused with
-exit 3 and "nothing to cut; camtool reads ...": counted apart as "refused".
+exit 3 and "nothing to cut; camtool reads ...", and an SVG whose clip, mask or viewport
+hides part of a shape with exit 3 and a message naming both: counted apart as "refused".
 
 Counts (first try / after remedy / failed) are printed at the end of the run and kept in
 ``results.json`` in the run's own temporary folder (the summary prints where; the corpus
