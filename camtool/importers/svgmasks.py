@@ -41,7 +41,7 @@ MASK_CLIP = "camtool-mask-"
 """Prefix of the ids of the clips :func:`masks_as_clips` makes."""
 
 _FILLED = frozenset({"path", "rect", "circle", "ellipse", "polyline", "polygon"})
-_INHERITED = ("fill", "stroke", "visibility")
+_INHERITED = ("fill", "stroke", "visibility", "fill-opacity", "stroke-opacity")
 
 
 def masks_as_clips(
@@ -133,13 +133,13 @@ def _showing(mask: ET.Element, ids: dict[str | None, ET.Element]) -> list[ET.Ele
             if (own.get(key) or element.get(key) or "none").strip().lower() != "none":
                 raise ValueError(f"{element.get(SOURCE_ATTR)} in it has a {key} of its own")
         here = f"{transform} {element.get('transform', '')}".strip()
-        if kind in ("g", "a", "switch"):
+        if kind in ("g", "a"):
             stack.extend((c, here, style) for c in reversed(list(element)))
             continue
         if kind not in _FILLED and kind != "line":
             raise ValueError(f"it holds <{kind}>, whose light camtool does not work out")
-        fill = "none" if kind == "line" else style.get("fill", "black")
-        stroke = style.get("stroke", "none")
+        fill = "none" if kind == "line" or _clear(style, "fill") else style.get("fill", "black")
+        stroke = "none" if _clear(style, "stroke") else style.get("stroke", "none")
         shows, hides = _paint(fill, element, ids), _none(fill) or _black(fill)
         if not _none(stroke) and not _paint(stroke, element, ids):
             raise ValueError(f"{element.get(SOURCE_ATTR)}'s stroke {stroke!r} may hide")
@@ -169,16 +169,20 @@ def _own(element: ET.Element) -> dict[str, str]:
 
 
 def _hidden(element: ET.Element) -> bool:
-    """``display:none`` or an opacity (``opacity``, ``fill-opacity``) of 0."""
+    """``display:none`` or ``opacity`` 0: nothing of the element, or what it holds, shows."""
     style = inline_style(element)
     if (style.get("display", element.get("display")) or "").strip().lower() == "none":
         return True
-    for key in ("opacity", "fill-opacity"):
-        value = style.get(key, element.get(key))
-        number = _number(value) if value is not None else None
-        if number is not None and number <= 0:
-            return True
-    return False
+    value = style.get("opacity", element.get("opacity"))
+    number = _number(value) if value is not None else None
+    return number is not None and number <= 0
+
+
+def _clear(style: dict[str, str], paint: str) -> bool:
+    """Whether ``fill-opacity`` (or ``stroke-opacity``) of 0 makes ``paint`` paint nothing."""
+    value = style.get(f"{paint}-opacity")
+    number = _number(value) if value is not None else None
+    return number is not None and number <= 0
 
 
 def _number(text: str) -> float | None:

@@ -298,6 +298,8 @@ def test_a_nested_viewport_with_a_transform_clips_where_it_is_moved(tmp_path: Pa
         ('fill="none"', "skipped"),
         ('fill="url(#fade)"', "fill 'url(#fade)' may hide in part"),  # a stop of opacity 0
         ('fill="white" stroke="black"', "stroke 'black' may hide"),
+        # a clear fill leaves its stroke to judge: black hides, so the mask is refused
+        ('fill="white" fill-opacity="0" stroke="black"', "stroke 'black' may hide"),
     ],
 )
 def test_a_mask_is_the_clip_of_its_shapes_when_each_surely_shows_or_hides(
@@ -362,6 +364,8 @@ def test_a_mask_in_user_space_clips_to_its_rectangle_too(tmp_path: Path) -> None
         ('<mask id="m"><rect width="100" height="100" fill="white"/>'
          '<rect width="10" height="10" fill="black"/></mask>',
          "hides part of what lies under it"),
+        ('<mask id="m"><switch><rect width="100" height="100" fill="white"/></switch></mask>',
+         "it holds <switch>"),
         ('<mask id="m" maskUnits="userSpaceOnUse" width="zz"><rect width="100" height="100" '
          'fill="white"/></mask>', "its rectangle's 'zz': must be a number"),
     ],
