@@ -153,16 +153,28 @@ def svg_drawing(
     fitter = _prefitted(drawn, prepared.matrix, tolerance, progress)
     clips = svgclip.clipped_shapes(svg, _SHAPES)
     regions: dict[tuple[int, Affine], tuple[Any, Any]] = {}
-    clipped_away = 0
+    kept: list[int] = []
     progress(Step("contours", 0, len(drawn)))
     for i, (shape, segments) in enumerate(drawn, start=1):
         made = _contours(path, shape, segments, prepared.matrix, fitter)
         over = clips.get(id(shape))
-        if over and _hidden_by_clip(path, shape, made, over, prepared.matrix, tolerance, regions):
-            clipped_away += 1
-        else:
+        if not over or not _hidden_by_clip(
+            path, shape, made, over, prepared.matrix, tolerance, regions
+        ):
             contours.extend(made)
+            kept.append(i - 1)
         progress(Step("contours", i, len(drawn)))
+    clipped_away = len(drawn) - len(kept)
+    if clipped_away and options.fit is not None and known:
+        # --fit scales what is kept: without the hidden shapes' extent, by a larger factor,
+        # which the curves' tolerance must follow (ImportOptions.curve_tolerance)
+        left = [b for b in (boxes[k] for k in kept) if b is not None]
+        finer = options.curve_tolerance(bbox_union(left)) if left else tolerance
+        if finer < tolerance:
+            tolerance, fitter = finer, Fitter(finer)
+            contours = [
+                c for k in kept for c in _contours(path, *drawn[k], prepared.matrix, fitter)
+            ]
     if clipped_away:
         its, them = ("its", "it") if clipped_away == 1 else ("their", "them")
         warnings.append(

@@ -461,3 +461,25 @@ def test_a_mask_on_the_whole_drawing(tmp_path: Path) -> None:
     body = f'<mask id="m"><rect width="50" height="100" fill="white"/></mask>{SQUARE}/>'
     with pytest.raises(InputError, match=r"the mask #m on svg\[1\] hides part of rect#sq"):
         read_svg(svg(tmp_path, body, root=root))
+
+
+def test_fit_tolerance_follows_what_the_clips_leave(tmp_path: Path) -> None:
+    # --fit 100 100 scales the kept curve (a Bézier loop 10 mm wide, 15 high) by 100 / 15,
+    # so its fit must be within 0.001 / 6.67 mm. A shape its clip hides wholly, 80 mm away,
+    # is not cut: measured with it, the factor would be 100 / 85 and the fit about 6 times
+    # too coarse once scaled.
+    from camtool.importers.options import ImportOptions
+    from camtool.importers.svg import svg_drawing
+
+    body = (
+        '<path id="kept" d="M 10 10 C 10 20 20 20 20 10 C 20 0 10 0 10 10 Z" fill="none" '
+        'stroke="black"/><clipPath id="c"><rect width="1" height="1"/></clipPath>'
+        '<circle id="far" cx="92" cy="92" r="3" fill="none" stroke="black" '
+        'clip-path="url(#c)"/>'
+    )
+    options = ImportOptions(tolerance=0.001, fit=(100.0, 100.0))
+    drawing, tolerance = svg_drawing(svg(tmp_path, body), options)
+    assert [c.source for c in drawing.contours] == ["path#kept"]
+    x0, y0, x1, y1 = drawing.contours[0].bbox()
+    # at least as fine as the kept drawing's own factor asks (8.5e-4 with the far circle)
+    assert tolerance <= 0.001 / min(100 / (x1 - x0), 100 / (y1 - y0))
