@@ -426,7 +426,7 @@ def test_matplotlib_clips_each_line_to_its_axes(
 def test_a_symbol_with_a_viewbox_is_placed_in_the_viewport_of_its_use(tmp_path: Path) -> None:
     # resvg's structure/symbol/with-viewBox.svg, in a 200 x 200 page: the use (100 % of the
     # page) shows the viewBox -100 -100 400 400 at half size, so the rect 20..180 lies at
-    # 60..140 (y flipped: 60..140 too). It was skipped before (a warning).
+    # 60..140 (y flipped: 60..140 too)
     root = 'width="200mm" height="200mm" viewBox="0 0 200 200"'
     body = (
         '<symbol id="s" viewBox="-100 -100 400 400"><rect id="r" x="20" y="20" width="160" '
