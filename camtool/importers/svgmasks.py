@@ -140,8 +140,8 @@ def _showing(mask: ET.Element, ids: dict[str | None, ET.Element]) -> list[ET.Ele
             raise ValueError(f"it holds <{kind}>, whose light camtool does not work out")
         fill = "none" if kind == "line" or _clear(style, "fill") else style.get("fill", "black")
         stroke = "none" if _clear(style, "stroke") else style.get("stroke", "none")
-        shows, hides = _paint(fill, element, ids), _none(fill) or _black(fill)
-        if not _none(stroke) and not _paint(stroke, element, ids):
+        shows, hides = _paint(fill, ids), _none(fill) or _black(fill)
+        if not _none(stroke) and not _paint(stroke, ids):
             raise ValueError(f"{element.get(SOURCE_ATTR)}'s stroke {stroke!r} may hide")
         if shows:
             copy = ET.Element(element.tag, dict(element.attrib))
@@ -215,9 +215,8 @@ def _colour(paint: str) -> se.Color | None:
     return colour if colour.value is not None else None
 
 
-def _paint(paint: str, element: ET.Element, ids: dict[str | None, ET.Element]) -> bool:
+def _paint(paint: str, ids: dict[str | None, ET.Element]) -> bool:
     """Whether ``paint`` lets light through everywhere it paints (see :func:`masks_as_clips`)."""
-    del element
     match = svgvalues.URL_REF.fullmatch(paint)
     if match is None:
         colour = _colour(paint)
@@ -229,7 +228,7 @@ def _paint(paint: str, element: ET.Element, ids: dict[str | None, ET.Element]) -
         style = inline_style(stop)
         opacity = _number(style.get("stop-opacity", stop.get("stop-opacity", "1")))
         colour = _colour(style.get("stop-color", stop.get("stop-color", "black")))
-        if opacity is None or opacity <= 0 or colour is None or not _paint(colour.hex, stop, ids):
+        if opacity is None or opacity <= 0 or colour is None or not _paint(colour.hex, ids):
             return False
     return True
 

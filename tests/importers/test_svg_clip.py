@@ -210,8 +210,12 @@ def test_breeze_icons_of_figma_clip_each_frame_to_its_size() -> None:
     # tip off, so the path is refused; debug-run's shapes lie inside: read.
     with pytest.raises(InputError, match=r"clip-path #clip0_9_370 on g\[1\] hides part of"):
         read_svg(BREEZE / "actions/16/debug-step-over.svg")
-    drawing = read_svg(BREEZE / "actions/16/color-management.svg")  # its clip hides nothing
-    assert drawing.contours
+    # color-management's five clipped uses and path lie inside their clips: all read
+    drawing = read_svg(BREEZE / "actions/16/color-management.svg")
+    sources = {c.source for c in drawing.contours}
+    assert {"use#use3393 > path#H", "use#use3395 > path#J", "path#path3397"} <= sources
+    assert {"use#use3399 > path#I", "use#use3403 > path#H"} <= sources
+    assert not [w for w in drawing.warnings if "hides wholly" in w]
 
 
 # ------------------------------------------------------------------ nested <svg> viewports
