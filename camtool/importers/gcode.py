@@ -297,6 +297,7 @@ class _Reader(PlainLines):
         self.feed_mm_min: float | None = None
         self.first_feed = reading.feed_mm_min  # the feed before the first F word (post --feed)
         self.work_offsets = reading.work_offsets  # the work offsets the target writes
+        self.known_start = reading.known_start  # written again: no move from the guessed XY
         self.coord: str | None = None
         self.offsets = (  # the target writes G43 H<n> after each change: kept as read
             LengthOffsets(self.commands, self.moves) if reading.length_offsets else None
@@ -553,6 +554,8 @@ class _Reader(PlainLines):
         tx, ty, tz = self._end_xy(args, name)
         z = self._z_out(args, tz)
         gives_xy = "X" in args or "Y" in args
+        if gives_xy and not self.positioned and self.known_start:
+            self._check_first_xy(args, name)
         if gives_xy and not self.positioned and z is not None and (tx, ty) == (self.x, self.y):
             self._first_positioning(name, tx, ty, tz, z)
             return
@@ -565,6 +568,38 @@ class _Reader(PlainLines):
             return
         self._start_xy(name)
         self._push(Linear(tx, ty, feed, z), tx, ty, tz)
+
+    def _check_first_xy(self, args: dict[str, Word], name: str) -> None:
+        """For a program written again, refuse a first straight move that needs the start.
+
+        Until the program gives X and Y, the reader's (0, 0) is a guess: a controller
+        starts from wherever the tool stands. An absolute move naming both axes ends at
+        the same point either way; one naming a single axis keeps the other axis where
+        the machine stands, and an incremental one moves from there. Either would be
+        written again from the guess (``G0 X3`` as ``G0 X3 Y0``), a move the program
+        did not ask for, so both are refused, as an incremental Z before any absolute
+        Z is (RS-274/NGC: the axes not named keep their current position).
+
+        Raises:
+            InputError: the move names one of X and Y, or names them in G91.
+        """
+        given = [letter for letter in "XY" if letter in args]
+        if not self.absolute:
+            word = args[given[0]]
+            raise InputError(
+                f"{self.where()}: incremental {word} (G91) before the program gives an "
+                "absolute X and Y: the machine would move from wherever it stands, which "
+                "camtool cannot know; give an absolute X and Y (G90) first, e.g. "
+                "G90 G0 X0 Y0 if the program starts at the work zero"
+            )
+        if len(given) == 1:
+            other = "Y" if given[0] == "X" else "X"
+            raise InputError(
+                f"{self.where()}: {name} {args[given[0]]} gives {given[0]} but not {other}, "
+                f"and the program has not given {other} yet: the machine would keep the "
+                f"{other} it stands at, which camtool cannot know; give both X and Y in the "
+                "program's first move (e.g. G0 X0 Y0 if it starts at the work zero)"
+            )
 
     def _first_positioning(
         self, name: str, tx: float, ty: float, tz: float | None, z: float
@@ -594,6 +629,13 @@ class _Reader(PlainLines):
     def _arc(self, args: dict[str, Word]) -> None:
         name = self.motion or "G2"
         feed = self._feed(name)
+        if not self.positioned and self.known_start:  # its centre and end depend on its start
+            raise InputError(
+                f"{self.where()}: {name} starts from where the machine stands before the "
+                "program gives an X and Y, which camtool cannot know: the arc's centre and "
+                "end depend on it; move there first with G0 and absolute X and Y (e.g. "
+                "G0 X0 Y0 if the program starts at the work zero)"
+            )
         start = self._start_xy(name)
         tx, ty, tz = self._end_xy(args, name)
         self.positioned = True

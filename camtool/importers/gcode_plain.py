@@ -229,8 +229,8 @@ class PlainLines:
         tz = self.z if z is None else z * scale
         z_out = tz if z is not None and tz != self.z else None
         gives_xy = x is not None or y is not None
-        if gives_xy and not self.positioned and z_out is not None and (tx, ty) == start:
-            return False  # _first_positioning
+        if gives_xy and not self.positioned:
+            return False  # the first X/Y: _line checks it (_check_first_xy, _first_positioning)
         cut = name != "G0"
         if cut and (feed is None or feed == 0):
             return False
@@ -255,8 +255,8 @@ class PlainLines:
         start: Point,
     ) -> bool:
         """:meth:`_arc` for :meth:`plain`; False (nothing changed) where it would not be plain."""
-        if feed is None or feed == 0:
-            return False
+        if feed is None or feed == 0 or not self.positioned:
+            return False  # from where the machine stands: _arc refuses it
         x, y, z = args.get("X"), args.get("Y"), args.get("Z")
         tx = start[0] if x is None else x * scale
         ty = start[1] if y is None else y * scale

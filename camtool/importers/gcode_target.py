@@ -33,11 +33,17 @@ class Reading:
             ``work_offsets``): the one the program selects, if among them, is a
             ``WorkOffset`` command written before its first move; otherwise it is read as
             the part zero, with a warning.
+        known_start: the program is written again: a move whose end or centre depends on
+            where the machine stands before the program gives X and Y (an incremental X
+            or Y, a move naming one of them, an arc) is refused, naming its line;
+            otherwise it is read from the program's zero, the reader's guess (RS-274/NGC
+            and GRBL start from the machine's position, which camtool cannot know).
     """
 
     feed_mm_min: float | None = None
     length_offsets: bool = False
     work_offsets: tuple[str, ...] = ()
+    known_start: bool = False
 
 
 READ_AS_WRITTEN = Reading()

@@ -244,11 +244,11 @@ def post_bytes(
 
 
 def reading_for(target: Target, plan: PlanOptions) -> Reading:
-    """How a program posted to ``target`` is read: ``--feed``, the target's offsets."""
+    """How a program posted to ``target`` is read: ``--feed``, the target's offsets, its start."""
     from camtool.importers.gcode_target import Reading
 
     post = target.post
-    return Reading(plan.feed_mm_min, post.length_offsets, post.work_offsets)
+    return Reading(plan.feed_mm_min, post.length_offsets, post.work_offsets, known_start=True)
 
 
 def sized(

@@ -266,6 +266,35 @@ def test_a_freecad_program_without_f_reposts_with_feed_and_no_guessed_move(
     assert "G1 Z9.000 F300" in blocks
 
 
+def test_a_relative_program_is_not_reposted_from_a_guessed_start(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A GRBL user's hand-written square in G91: it runs from wherever the tool stands.
+
+    Written again in absolute words it would first rapid to the work zero, at whatever
+    height the tool is: refused, naming the line, with the one-line remedy; nothing is
+    written. With the start given, the same square posts.
+    """
+    square = "G21 G91\nG1 X10 F300\nY10\nX-10\nY-10\nM2\n"
+    ngc = tmp_path / "square.ngc"
+    ngc.write_text(square)
+    out_file = tmp_path / "square.gcode"
+    code, out, err = run(["post", str(ngc), "-t", "grbl", "-o", str(out_file)], capsys)
+    assert code == 3 and out == "" and not out_file.exists()
+    assert "square.ngc:2: incremental X10 (G91) before the program gives" in err
+    assert "G90 G0 X0 Y0" in err and "Traceback" not in err
+    ngc.write_text("G21 G90 G0 X0 Y0\n" + square)
+    code, out, err = run(["post", str(ngc), "-t", "grbl", "-o", str(out_file)], capsys)
+    assert code == 0, err
+    blocks = out_file.read_text().splitlines()
+    assert [b for b in blocks if b.startswith("G1")] == [
+        "G1 X10.000 Y0.000 F300",
+        "G1 X10.000 Y10.000",
+        "G1 X0.000 Y10.000",
+        "G1 X0.000 Y0.000",
+    ]
+
+
 def test_gcode_with_z_on_a_2d_target_drops_z_with_a_warning(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

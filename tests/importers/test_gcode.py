@@ -189,6 +189,57 @@ def test_g91_incremental_xy_and_modal_motion() -> None:
     assert all(isinstance(m, Linear) and m.feed_mm_min == 100.0 for m in program.moves)
 
 
+@pytest.mark.parametrize(
+    ("text", "start"),
+    [
+        ("G21 G91 G1 X1 Y1 F100\n", "t.ngc:1: incremental X1 (G91) before the program gives"),
+        ("G21 G90 G0 Z5\nG91 G0 Y-2\nG1 X1 F9\n", "t.ngc:2: incremental Y-2 (G91) before"),
+        (
+            "G21 G0 X3\nG0 Y4\nG1 X5 Y5 F9\n",
+            "t.ngc:1: G0 X3 gives X but not Y, and the program has not",
+        ),
+        ("G21 G0 Z5\nG1 Y4 Z-1 F9\n", "t.ngc:2: G1 Y4 gives Y but not X"),
+        ("G21 G0 Z5\nG2 X10 Y0 I5 J0 F9\n", "t.ngc:2: G2 starts from where the machine"),
+        ("G21 G0 Z5\nG3 I5 J0 F9\n", "t.ngc:2: G3 starts from where the machine"),
+        ("G21 G0 Z5\nG2 X10 Y0 R5 F9\n", "t.ngc:2: G2 starts from where the machine"),
+        ("G21 G18 G0 Z5\nG2 X10 Z5 I5 K0 F9\n", "t.ngc:2: G2 starts from where the machine"),
+    ],
+)
+def test_a_first_move_that_depends_on_where_the_machine_stands_is_not_written_again(
+    text: str, start: str
+) -> None:
+    """Until the program gives X and Y, the machine is wherever it stands, not at the guess.
+
+    RS-274/NGC keeps an axis a block does not name where it is, and G91 moves from there;
+    rs274 and GRBL take that position from the machine. camtool's (0, 0) is a guess: read
+    for a post, a move whose end or centre depends on it would be written again from the
+    guess (``G0 X3`` as ``G0 X3 Y0``), so it is refused, naming the line and the remedy.
+    Read as written (preview, send), the guess stands, as before.
+    """
+    with pytest.raises(InputError) as info:
+        parse_gcode(text, source="t.ngc", reading=Reading(known_start=True))
+    message = str(info.value)
+    assert message.startswith(start), message
+    assert "cannot know" in message and "G0" in message
+    assert parse(text).moves  # read as written: from the program's zero
+
+
+def test_a_first_move_that_does_not_depend_on_the_start_is_written_again() -> None:
+    """Both axes absolute, a Z alone, a cut to X Y: the same wherever the machine stands."""
+    program = parse_gcode(
+        "G21 G0 Z5\nG1 Z-1 F9\nG1 X2 Y3\nG91 X1\nG90 G2 X5 Y3 R1 F9\n",
+        source="t.ngc",
+        reading=Reading(known_start=True),
+    )
+    assert [(type(m).__name__, m.x, m.y) for m in program.moves] == [
+        ("Rapid", 0.0, 0.0),
+        ("Linear", 0.0, 0.0),
+        ("Linear", 2.0, 3.0),
+        ("Linear", 3.0, 3.0),
+        ("ArcMove", 5.0, 3.0),
+    ]
+
+
 def test_full_circle_without_axis_words() -> None:
     # LinuxCNC centre format: an arc ending where it starts is a full circle.
     program = parse("G21 G0 X5 Y0\nG3 I-5 J0 F60\n")
