@@ -201,11 +201,16 @@ class ArcWriter(WordWriter):
         point of its ends' perpendicular bisector; the warning gives both radii and the
         move. Only when the radii differ by no more than the controller's own absolute
         tolerance (GRBL 0.005 mm, LinuxCNC 0.028 mm: :func:`~camtool.post.arccheck.
-        max_difference` at radius 0), numbers it would itself take as one arc; ``None``
+        max_difference` at radius 0), numbers it would itself take as one arc, and when
+        the circle it gives stays as near the arc as its two radii are apart (plus
+        :data:`~camtool.post.arcconform.DEVIATION_QUANTA`): over a short chord (an arc of
+        nearly 360°) the move grows as radius / chord times the radii's difference, 0.34 mm
+        for 2.9 µm on a 359.5° arc of 10 mm, and would move the whole circle. ``None``
         otherwise, or when that does not help (the ends meet, the check still fails): the
         arc is then written as chords. Only arcs the check refused take this path.
         """
         from camtool.post.arccheck import max_difference
+        from camtool.post.arcconform import DEVIATION_QUANTA
 
         (sx, sy), (ex, ey), (cx, cy) = piece.start, piece.end, piece.centre
         dx, dy = ex - sx, ey - sy
@@ -217,16 +222,20 @@ class ArcWriter(WordWriter):
         mx, my = (sx + ex) / 2.0, (sy + ey) / 2.0
         along = (cx - mx) * nx + (cy - my) * ny
         centre = (mx + along * nx, my + along * ny)
+        moved, radius = math.dist(centre, piece.centre), math.dist(centre, piece.end)
+        # a point of the new circle is at most this far from the arc's circle at its angle
+        off = moved + max(abs(radius - r0), abs(radius - r1))
+        if off > abs(r1 - r0) + DEVIATION_QUANTA * quantum:
+            return None  # it would move the path further than the arc's own radii differ
         try:
             out = self.checked(self.written, piece.end, centre, piece.clockwise, piece.start)
         except DialectError:
             return None
-        moved = math.dist(centre, piece.centre)
         self.warn(
             f"{self.where()}: the arc starts {r0:.4f} mm and ends {r1:.4f} mm from its centre "
             f"({abs(r1 - r0) * 1000:.1f} µm apart), more than {self.spec.name}'s arc check "
             f"takes; written about the centre {moved * 1000:.1f} µm away that puts both ends "
-            f"{math.dist(centre, piece.end):.4f} mm from it"
+            f"{radius:.4f} mm from it"
         )
         return out
 

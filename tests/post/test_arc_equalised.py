@@ -157,3 +157,38 @@ def test_an_almost_straight_arc_whose_centre_no_i_word_holds_is_written_as_chord
         "1 arc(s) with a centre farther away than flashcut's I and J write (4 integer digits)" in w
         for w in result.warnings
     )
+
+
+@pytest.mark.parametrize("name", ["grbl", "linuxcnc"])
+def test_a_nearly_full_circle_keeps_its_centre(name: str) -> None:
+    """An inch program's 359.5° arc, 2.9 µm apart in radius: not a circle moved 0.34 mm.
+
+    Four inch decimals put the end of a 10 mm arc 2.9 µm off its circle; GRBL and LinuxCNC
+    run it as written (within 5 µm). Over its 0.087 mm chord, the centre that equalises
+    the radii lies radius / chord × 2.9 µm = 0.34 mm away, and that circle would cut the
+    whole part 0.34 mm aside. Every point written must stay within the radii's difference
+    and a few quanta of the program's own circle: from analysis of the circle, not from
+    camtool's output.
+    """
+    radius, sweep = 10.0, math.radians(359.5)
+    start = (0.0, radius)
+    end_angle = math.pi / 2 - sweep  # clockwise
+    end = (10.0029 * math.cos(end_angle), 10.0029 * math.sin(end_angle))
+    program = Program(
+        (Rapid(*start), ArcMove(*end, 0.0, 0.0, True, 300.0, contour=1)), origin=(0.0, 0.0)
+    )
+    result = load_target(name).emit(program)
+    assert not [w for w in result.warnings if "written about the centre" in w]
+    x, y = start
+    for line in result.code.splitlines():
+        words = {k: float(v) for k, v in re.findall(r"([XYIJ])(-?[\d.]+)", line)}
+        if not re.match(r"G[123]\b", line):
+            continue
+        nx, ny = words.get("X", x), words.get("Y", y)
+        if "I" in words or "J" in words:  # an arc block: its centre must stay the circle's
+            cx, cy = x + words.get("I", 0.0), y + words.get("J", 0.0)
+            assert math.hypot(cx, cy) <= 0.0029 + 0.002, line
+        # every written point on the program's circle, to its radii and the print grid
+        assert 10.0 - 0.001 <= math.hypot(nx, ny) <= 10.0029 + 0.001, line
+        x, y = nx, ny
+    assert (x, y) == (round(end[0], 3), round(end[1], 3))
