@@ -29,7 +29,15 @@ from camtool.importers.svgdoc import (
     prepare,
     zero_opacity,
 )
-from camtool.importers.svgpage import Affine, apply, compose
+from camtool.importers.svgpage import (
+    Affine,
+    apply,
+    check_travel,
+    compose,
+    off_page_text,
+    outside_page,
+    refusal_note,
+)
 from camtool.model.errors import GeometryError, InputError, TooLargeError
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import (
@@ -136,22 +144,17 @@ def svg_drawing(
         boxes = _ends_boxes(drawn, prepared.matrix)
     known = [b for b in boxes if b is not None]
     box = bbox_union(known) if known else None
+    clips = svgclip.clipped_shapes(svg, _SHAPES)
+    deferred = False  # too large with every shape: checked again without the clipped-away ones
     if check is not None and box is not None:
         try:
-            check(box)
-        except TooLargeError as exc:
-            off = [
-                (_label(shape), b)
-                for (shape, _), b in zip(drawn, boxes, strict=True)
-                if b is not None and _outside(b, prepared.page)
-            ]
-            if not off:
+            check_travel(path, check, box, _labelled(drawn, boxes), prepared.page)
+        except TooLargeError:
+            if not any(id(shape) in clips for shape, _ in drawn):
                 raise
-            note = _off_page_text(path, len(off), "shape", *off[0], prepared.page)
-            raise TooLargeError(f"{exc}; {_refusal_note(note, len(off))}") from None
+            deferred = True
     tolerance = options.curve_tolerance(box)
     fitter = _prefitted(drawn, prepared.matrix, tolerance, progress)
-    clips = svgclip.clipped_shapes(svg, _SHAPES)
     regions: dict[tuple[int, Affine], tuple[Any, Any]] = {}
     kept: list[int] = []
     progress(Step("contours", 0, len(drawn)))
@@ -165,6 +168,12 @@ def svg_drawing(
             kept.append(i - 1)
         progress(Step("contours", i, len(drawn)))
     clipped_away = len(drawn) - len(kept)
+    if deferred and check is not None:
+        left = [b for b in (boxes[k] for k in kept) if b is not None]
+        if left:
+            kept_boxes = [boxes[k] for k in kept]
+            labelled = _labelled([drawn[k] for k in kept], kept_boxes)
+            check_travel(path, check, bbox_union(left), labelled, prepared.page)
     if clipped_away and options.fit is not None and known:
         # --fit scales what is kept: without the hidden shapes' extent, by a larger factor,
         # which the curves' tolerance must follow (ImportOptions.curve_tolerance)
@@ -194,15 +203,15 @@ def svg_drawing(
             "line has no inside to fill, so a viewer shows nothing); give it a stroke to cut it"
         )
     size_note = ""
-    outside = [c for c in contours if _outside(c.bbox(), prepared.page)]
+    outside = [c for c in contours if outside_page(c.bbox(), prepared.page)]
     if outside:
         first = outside[0]
-        text = _off_page_text(
+        text = off_page_text(
             path, len(outside), "contour", first.source, first.bbox(), prepared.page
         )
         them = "them" if len(outside) > 1 else "it"
         warnings.append(f"{text}; camtool cuts {them}: delete {them} or move {them} onto the page")
-        size_note = _refusal_note(text, len(outside))
+        size_note = refusal_note(text, len(outside))
     if not contours:
         where = " in the selected layers" if options.layers else ""
         prefix = f"{path}: "
@@ -214,45 +223,6 @@ def svg_drawing(
         )
     drawing = Drawing(tuple(contours), str(path), tuple(warnings), size_note=size_note)
     return drawing, tolerance
-
-
-_PAGE_SLACK_MM = 0.01
-"""How far outside the page (mm) a contour may lie and still count as on it."""
-
-
-def _outside(box: BBox, page: tuple[float, float] | None) -> bool:
-    """Whether ``box`` (mm) lies wholly outside the page (``None``: no page, so never).
-
-    The root ``<svg>`` clips its content to its viewport (SVG 1.1 §14.3.3); camtool does
-    not clip, so what lies outside it (an object left beside the page, a shape moved
-    away by a stray transform) would be cut where the drawing program shows nothing.
-    """
-    if page is None:
-        return False
-    width, height = page
-    s = _PAGE_SLACK_MM
-    return box[2] < -s or box[0] > width + s or box[3] < -s or box[1] > height + s
-
-
-def _off_page_text(
-    path: Path, count: int, what: str, first: str, box: BBox, page: tuple[float, float] | None
-) -> str:
-    """``PATH: N WHATs lie wholly outside the W × H mm page… (first FIRST at (x, y) mm)``."""
-    width, height = page or (0.0, 0.0)
-    many = f"{count} {what}s lie" if count > 1 else f"1 {what} lies"
-    return (
-        f"{path}: {many} wholly outside the {width:.4g} × {height:.4g} mm page, "
-        f"where a viewer shows nothing (first {first} at ({box[0]:.4f}, {box[1]:.4f}) mm)"
-    )
-
-
-def _refusal_note(text: str, count: int) -> str:
-    """What a refusal of the drawing's size adds when ``count`` shapes lie off the page."""
-    they, them = ("they are", "them") if count > 1 else ("it is", "it")
-    return (
-        f"but {text}: if {they} not part of the job, delete {them} or move {them} onto the "
-        f"page rather than scale the part down with {them} (--fit)"
-    )
 
 
 _DISTINCT_MM = 1e-6
@@ -423,6 +393,13 @@ def _clip_subpaths(shape: Any, m: Affine) -> list[list[Point]]:
     fine = svgclip.CLIP_SLACK_MM / 10
     subpaths = convert(shape.segments(transformed=False), m, fine)
     return [Contour(segs, closed).points(fine) for segs, closed in subpaths]
+
+
+def _labelled(
+    drawn: list[tuple[Any, list[Any] | None]], boxes: list[BBox | None]
+) -> list[tuple[str, BBox | None]]:
+    """Each drawn shape's label and extent, for :func:`~camtool.importers.svgpage.check_travel`."""
+    return [(_label(shape), b) for (shape, _), b in zip(drawn, boxes, strict=True)]
 
 
 def _label(shape: Any) -> str:

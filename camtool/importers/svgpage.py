@@ -7,10 +7,12 @@ from __future__ import annotations
 
 import re
 import xml.etree.ElementTree as ET
+from collections.abc import Callable
+from pathlib import Path
 from typing import TypeAlias
 
-from camtool.model.errors import InputError, UsageError
-from camtool.model.shapes import Point
+from camtool.model.errors import InputError, TooLargeError, UsageError
+from camtool.model.shapes import BBox, Point
 from camtool.model.units import LENGTH_UNITS, PX
 
 Affine: TypeAlias = tuple[float, float, float, float, float, float]
@@ -158,3 +160,71 @@ def _fit_viewbox(
     tx = -box[0] * sx + fx * (width - box[2] * sx)
     ty = -box[1] * sy + fy * (height - box[3] * sy)
     return sx, sy, tx, ty
+
+
+_PAGE_SLACK_MM = 0.01
+"""How far outside the page (mm) a contour may lie and still count as on it."""
+
+
+def outside_page(box: BBox, page: tuple[float, float] | None) -> bool:
+    """Whether ``box`` (mm) lies wholly outside the page (``None``: no page, so never).
+
+    The root ``<svg>`` clips its content to its viewport (SVG 1.1 §14.3.3); camtool does
+    not clip, so what lies outside it (an object left beside the page, a shape moved
+    away by a stray transform) would be cut where the drawing program shows nothing.
+    """
+    if page is None:
+        return False
+    width, height = page
+    s = _PAGE_SLACK_MM
+    return box[2] < -s or box[0] > width + s or box[3] < -s or box[1] > height + s
+
+
+def off_page_text(
+    path: Path, count: int, what: str, first: str, box: BBox, page: tuple[float, float] | None
+) -> str:
+    """``PATH: N WHATs lie wholly outside the W × H mm page… (first FIRST at (x, y) mm)``."""
+    width, height = page or (0.0, 0.0)
+    many = f"{count} {what}s lie" if count > 1 else f"1 {what} lies"
+    return (
+        f"{path}: {many} wholly outside the {width:.4g} × {height:.4g} mm page, "
+        f"where a viewer shows nothing (first {first} at ({box[0]:.4f}, {box[1]:.4f}) mm)"
+    )
+
+
+def refusal_note(text: str, count: int) -> str:
+    """What a refusal of the drawing's size adds when ``count`` shapes lie off the page."""
+    they, them = ("they are", "them") if count > 1 else ("it is", "it")
+    return (
+        f"but {text}: if {they} not part of the job, delete {them} or move {them} onto the "
+        f"page rather than scale the part down with {them} (--fit)"
+    )
+
+
+def check_travel(
+    path: Path,
+    check: Callable[[BBox], None],
+    box: BBox,
+    labelled: list[tuple[str, BBox | None]],
+    page: tuple[float, float] | None,
+) -> None:
+    """``check(box)`` (mm); its TooLargeError names the first shape off the page, if any.
+
+    Args:
+        path: the drawing, for the message.
+        check: the travel check (raises TooLargeError).
+        box: the extent to check, mm.
+        labelled: each shape's label and extent (``None``: no extent), mm.
+        page: the page's width and height, mm (``None``: no page).
+
+    Raises:
+        TooLargeError: from ``check``, with what lies off the page when something does.
+    """
+    try:
+        check(box)
+    except TooLargeError as exc:
+        off = [(label, b) for label, b in labelled if b is not None and outside_page(b, page)]
+        if not off:
+            raise
+        note = off_page_text(path, len(off), "shape", *off[0], page)
+        raise TooLargeError(f"{exc}; {refusal_note(note, len(off))}") from None

@@ -10,6 +10,7 @@ shows and red what it must not.
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 
 import pytest
@@ -487,3 +488,33 @@ def test_fit_tolerance_follows_what_the_clips_leave(tmp_path: Path) -> None:
     x0, y0, x1, y1 = drawing.contours[0].bbox()
     # at least as fine as the kept drawing's own factor asks (8.5e-4 with the far circle)
     assert tolerance <= 0.001 / min(100 / (x1 - x0), 100 / (y1 - y0))
+
+
+def test_a_shape_its_clip_hides_wholly_does_not_count_toward_the_travel(
+    tmp_path: Path,
+) -> None:
+    """The travel check before fitting measures every shape; a clipped-away one is not cut.
+
+    A 10 mm part, and a circle 400 mm away that its clip hides wholly: camtool cuts only
+    the part, so the drawing fits grbl's 300 × 200 mm travel; it used to be refused as too
+    large. A part that is too large by itself is still refused.
+    """
+    from camtool.cli.main import main
+
+    far = (
+        '<clipPath id="c"><rect width="1" height="1"/></clipPath>'
+        '<circle id="far" cx="400" cy="50" r="3" fill="none" stroke="black" '
+        'clip-path="url(#c)"/>'
+    )
+    part = '<rect id="part" x="10" y="10" width="10" height="10" fill="none" stroke="black"/>'
+    root = 'width="500mm" height="100mm" viewBox="0 0 500 100"'
+    out = tmp_path / "part.gcode"
+    args = ["post", str(svg(tmp_path, part + far, root)), "-t", "grbl", "-o", str(out)]
+    assert main(args) == 0
+    code = out.read_text()
+    xs = [float(x) for x in re.findall(r"^G1 X(-?[\d.]+)", code, re.MULTILINE)]
+    assert xs and min(xs) == 10.0 and max(xs) == 20.0  # the part only, not the far circle
+    big = '<rect id="big" x="0" y="0" width="350" height="10" fill="none" stroke="black"/>'
+    out.unlink()
+    args = ["post", str(svg(tmp_path, big + far, root, "big.svg")), "-t", "grbl", "-o", str(out)]
+    assert main(args) == 1 and not out.exists()
