@@ -67,11 +67,16 @@ SEEN = 1_000_000
 def seed(reader: PlainLines, text: str, position: int) -> None:
     """Give the helper's ``reader`` the units, feed and Z the text last set before ``position``.
 
+    The program is taken to have given X and Y by then (``positioned``), as it has at
+    the reader's side wherever a run can fit: a first move that depends on the start is
+    the reader's to refuse, not the helper's.
+
     A guess from the text (the last ``G20``/``G21``, ``F`` and ``Z`` word in the
     :data:`SEEN` characters before, comments and all): a program that sets them once, at
     its top, has no run the helper reads from its own values otherwise. A wrong guess only
     makes the runs read from it fail to fit.
     """
+    reader.positioned = True  # by then the program has given X and Y (else no run fits)
     window = text[max(0, position - SEEN) : position]
     units = [m.group(1) for m in _UNITS.finditer(window)]
     if units:

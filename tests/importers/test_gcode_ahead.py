@@ -24,6 +24,7 @@ import pytest
 
 from camtool.importers import gcode_ahead
 from camtool.importers.gcode import parse_gcode, parse_gcode_slow
+from camtool.importers.gcode_target import Reading
 from camtool.model.errors import CamtoolError
 from tests.importers.test_gcode_plain import LINES
 
@@ -110,6 +111,25 @@ def test_the_examples_read_the_same_with_their_runs_taken(
         assert taken.taken == taken.refused == 0  # no LF to start the helper at
     else:
         assert taken.taken > 10  # the runs after the helper's first: its state is known
+
+
+def test_single_axis_lines_read_for_a_post_are_read_ahead(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A post reads with ``known_start``: the helper, starting mid-program, is positioned.
+
+    Lines naming X alone or Y alone are what a program's first moves may not be (where
+    the machine stands decides them); at 55 % of the text the program has long given X
+    and Y, so the helper reads them and its runs fit.
+    """
+    lines = ["G21 G90", "G0 X0 Y0 Z1", "G1 Z-1 F100"]
+    lines += [f"G1 X{k % 7 * 0.1:.1f}" if k % 2 else f"G1 Y{k * 0.01:.2f}" for k in range(3000)]
+    text = "\n".join([*lines, "M2"]) + "\n"
+    posted = Reading(known_start=True)
+    with monkeypatch.context() as m:
+        m.setattr(gcode_ahead, "MIN_CHARS", 10**12)
+        expected = repr(parse_gcode(text, source="t.ngc", reading=posted))
+    taken = Taken(monkeypatch)
+    assert repr(parse_gcode(text, source="t.ngc", reading=posted)) == expected
+    assert taken.taken > 10 and taken.refused <= 1
 
 
 @pytest.mark.parametrize("units", ["G20", "G21"])
