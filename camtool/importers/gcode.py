@@ -19,7 +19,8 @@ from camtool.importers import gcode_ahead
 from camtool.importers.gcode_codes import BlockWords, CommandReader, Notes, unused_word
 from camtool.importers.gcode_cycles import CYCLES, CycleState
 from camtool.importers.gcode_lexer import Block, Word, cut_mid_word, lex_line
-from camtool.importers.gcode_plain import ARC_TOL_IN, ARC_TOL_MM, PLAIN_WORDS, PlainLines
+from camtool.importers.gcode_plain import ARC_TOL_IN, ARC_TOL_MM, PLAIN_WORDS
+from camtool.importers.gcode_start import StartRules
 from camtool.importers.gcode_target import READ_AS_WRITTEN, LengthOffsets, Reading
 from camtool.model.errors import InputError
 from camtool.model.program import (
@@ -273,7 +274,7 @@ def _parse(
     return reader.program()
 
 
-class _Reader(PlainLines):
+class _Reader(StartRules):
     """The modal state of the interpreter and the moves read so far."""
 
     def __init__(self, source: str, reading: Reading = READ_AS_WRITTEN) -> None:
@@ -311,9 +312,6 @@ class _Reader(PlainLines):
     def scale(self) -> float:
         """Millimetres per unit of the numbers in the current block."""
         return INCH if self.inch else 1.0
-
-    def where(self) -> str:
-        return f"{self.source}:{self.line}"
 
     def run(self, block: Block) -> bool:
         """Execute one block; True when it ends the program (M2/M30)."""
@@ -555,7 +553,7 @@ class _Reader(PlainLines):
         z = self._z_out(args, tz)
         gives_xy = "X" in args or "Y" in args
         if gives_xy and not self.positioned and self.known_start:
-            self._check_first_xy(args, name)
+            self.check_first_xy(args, name)
         if gives_xy and not self.positioned and z is not None and (tx, ty) == (self.x, self.y):
             self._first_positioning(name, tx, ty, tz, z)
             return
@@ -568,38 +566,6 @@ class _Reader(PlainLines):
             return
         self._start_xy(name)
         self._push(Linear(tx, ty, feed, z), tx, ty, tz)
-
-    def _check_first_xy(self, args: dict[str, Word], name: str) -> None:
-        """For a program written again, refuse a first straight move that needs the start.
-
-        Until the program gives X and Y, the reader's (0, 0) is a guess: a controller
-        starts from wherever the tool stands. An absolute move naming both axes ends at
-        the same point either way; one naming a single axis keeps the other axis where
-        the machine stands, and an incremental one moves from there. Either would be
-        written again from the guess (``G0 X3`` as ``G0 X3 Y0``), a move the program
-        did not ask for, so both are refused, as an incremental Z before any absolute
-        Z is (RS-274/NGC: the axes not named keep their current position).
-
-        Raises:
-            InputError: the move names one of X and Y, or names them in G91.
-        """
-        given = [letter for letter in "XY" if letter in args]
-        if not self.absolute:
-            word = args[given[0]]
-            raise InputError(
-                f"{self.where()}: incremental {word} (G91) before the program gives an "
-                "absolute X and Y: the machine would move from wherever it stands, which "
-                "camtool cannot know; give an absolute X and Y (G90) first, e.g. "
-                "G90 G0 X0 Y0 if the program starts at the work zero"
-            )
-        if len(given) == 1:
-            other = "Y" if given[0] == "X" else "X"
-            raise InputError(
-                f"{self.where()}: {name} {args[given[0]]} gives {given[0]} but not {other}, "
-                f"and the program has not given {other} yet: the machine would keep the "
-                f"{other} it stands at, which camtool cannot know; give both X and Y in the "
-                "program's first move (e.g. G0 X0 Y0 if it starts at the work zero)"
-            )
 
     def _first_positioning(
         self, name: str, tx: float, ty: float, tz: float | None, z: float
@@ -629,13 +595,8 @@ class _Reader(PlainLines):
     def _arc(self, args: dict[str, Word]) -> None:
         name = self.motion or "G2"
         feed = self._feed(name)
-        if not self.positioned and self.known_start:  # its centre and end depend on its start
-            raise InputError(
-                f"{self.where()}: {name} starts from where the machine stands before the "
-                "program gives an X and Y, which camtool cannot know: the arc's centre and "
-                "end depend on it; move there first with G0 and absolute X and Y (e.g. "
-                "G0 X0 Y0 if the program starts at the work zero)"
-            )
+        if not self.positioned and self.known_start:
+            self.refuse_first_arc(name)
         start = self._start_xy(name)
         tx, ty, tz = self._end_xy(args, name)
         self.positioned = True

@@ -230,7 +230,7 @@ class PlainLines:
         z_out = tz if z is not None and tz != self.z else None
         gives_xy = x is not None or y is not None
         if gives_xy and not self.positioned:
-            return False  # the first X/Y: _line checks it (_check_first_xy, _first_positioning)
+            return False  # the first X/Y: _line checks it (check_first_xy, _first_positioning)
         cut = name != "G0"
         if cut and (feed is None or feed == 0):
             return False
