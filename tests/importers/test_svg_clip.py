@@ -496,8 +496,8 @@ def test_a_shape_its_clip_hides_wholly_does_not_count_toward_the_travel(
     """The travel check before fitting measures every shape; a clipped-away one is not cut.
 
     A 10 mm part, and a circle 400 mm away that its clip hides wholly: camtool cuts only
-    the part, so the drawing fits grbl's 300 × 200 mm travel; it used to be refused as too
-    large. A part that is too large by itself is still refused.
+    the part, so the drawing fits grbl's 300 × 200 mm travel, though all its shapes
+    together do not. A part that is too large by itself is still refused.
     """
     from camtool.cli.main import main
 
