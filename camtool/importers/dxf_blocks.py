@@ -18,6 +18,7 @@ from camtool.importers.dxf_entities import (
     invisible,
     layer_of,
     location,
+    spline_tool,
 )
 from camtool.model.shapes import Point
 
@@ -229,12 +230,16 @@ def _moved(p: Point | None, matrix: Any) -> Point | None:
 
 
 def _transformed(entity: Any, matrix: Any) -> tuple[Any, tuple[Any, ...]]:
-    """A transformed copy of ``entity``, or the entity and its transformed pieces."""
+    """A transformed copy of ``entity``, or the entity and its transformed pieces.
+
+    A SPLINE (or a HATCH's spline edge) given by fit points only is first given the
+    control points of its curve in block coordinates (:func:`_controlled`).
+    """
     from ezdxf.entities import Ellipse
     from ezdxf.math.transformtools import NonUniformScalingError, TransformError
 
     try:
-        return entity.copy().transform(matrix), ()
+        return _controlled(entity).transform(matrix), ()
     except NonUniformScalingError:
         kind = entity.dxftype()
         if kind in ("ARC", "CIRCLE"):
@@ -249,6 +254,48 @@ def _transformed(entity: Any, matrix: Any) -> tuple[Any, tuple[Any, ...]]:
         raise Unsupported("cannot be scaled non-uniformly") from None
     except (TransformError, NotImplementedError) as exc:
         raise Unsupported(f"cannot be transformed ({exc})") from exc
+
+
+def _controlled(entity: Any) -> Any:
+    """A copy of ``entity`` whose fit-point-only splines are given by their control points.
+
+    The curve through placed fit points is not the placed curve under a non-uniform
+    scale (chord lengths and end tangents change), while a B-spline's control points
+    place it exactly under any affine map (*The NURBS Book*, section 4.2): the curve is
+    built where it was drawn, as a CAD program draws a block, then placed. Splines of a
+    HATCH's edges are built in its OCS.
+
+    Raises:
+        Unsupported: fit points no spline can be built through.
+    """
+    from ezdxf.entities import Spline
+    from ezdxf.entities.boundary_paths import EdgePath, SplineEdge
+    from ezdxf.math import Vec2
+
+    copy = entity.copy()
+    kind = entity.dxftype()
+    if kind == "SPLINE" and not entity.control_point_count() and entity.fit_point_count():
+        copy.apply_construction_tool(spline_tool(entity))
+        copy.fit_points = []
+    elif kind == "HATCH":
+        for path in copy.paths:
+            edges = path.edges if isinstance(path, EdgePath) else []
+            for edge in edges:
+                if isinstance(edge, SplineEdge) and edge.fit_points and not edge.control_points:
+                    drawn = Spline.new(dxfattribs={"degree": edge.degree})
+                    drawn.fit_points = [(v.x, v.y, 0.0) for v in edge.fit_points]
+                    if edge.start_tangent is not None and edge.end_tangent is not None:
+                        drawn.dxf.start_tangent = (edge.start_tangent.x, edge.start_tangent.y, 0)
+                        drawn.dxf.end_tangent = (edge.end_tangent.x, edge.end_tangent.y, 0)
+                    tool = spline_tool(drawn)
+                    edge.control_points = [Vec2(v) for v in tool.control_points]
+                    edge.knot_values = [float(k) for k in tool.knots()]
+                    edge.weights = [float(w) for w in tool.weights()]
+                    edge.rational = int(tool.is_rational)
+                    edge.degree = tool.degree
+                    edge.fit_points = []
+                    edge.start_tangent = edge.end_tangent = None
+    return copy
 
 
 def _grid(insert: Any) -> Iterator[tuple[Any, str]]:

@@ -575,7 +575,7 @@ def spline_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool]
             evaluate among them), a spline not parallel to XY, or one whose
             curve is a single point.
     """
-    spline = _construction(entity)
+    spline = spline_tool(entity)
     pts = spline.control_points
     zs = [p[2] for p in pts]
     size = max(1.0, *(max(abs(p[0]), abs(p[1])) for p in pts))
@@ -651,7 +651,7 @@ def _check_size(extent: float, tolerance: float) -> None:
         raise BadEntity(f"{exc} (drawing units)") from None
 
 
-def _construction(entity: Any) -> Any:
+def spline_tool(entity: Any) -> Any:
     """The entity's BSpline, with AutoCAD-style periodic knot vectors unwrapped."""
     from ezdxf.math import BSpline, fit_points_to_cad_cv
 

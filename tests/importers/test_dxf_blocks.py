@@ -161,6 +161,46 @@ def test_rotation_and_non_uniform_scale(tmp_path: Path) -> None:
     _assert_close(half + edges, poly.segments)
 
 
+FIT_POINTS = [(0.0, 0.0), (15.0, 7.0), (2.0, 14.0), (0.0, 20.0)]
+"""Fit points of a spline drawn in a block: its curve is interpolated where it is drawn."""
+
+
+def _block_curve(fit: list[Point]) -> list[Point]:
+    """The curve through ``fit`` in block coordinates, by ezdxf's own evaluator."""
+    spline = ezdxf.new().modelspace().add_spline([(x, y, 0.0) for x, y in fit])
+    return [(v.x, v.y) for v in spline.construction_tool().flattening(0.00002)]
+
+
+@pytest.mark.parametrize("hatch", [False, True], ids=["spline", "hatch-edge"])
+def test_a_fit_point_spline_under_non_uniform_scale_is_its_block_curve_placed(
+    tmp_path: Path, hatch: bool
+) -> None:
+    # Placing the fit points and interpolating again gives another curve (chord lengths
+    # and end tangents change): a block's curve is placed, not drawn again.
+    place = _placer((5.0, -3.0), 30.0, 3.0, 0.5)
+
+    def build(msp: Any) -> None:
+        block = msp.doc.blocks.new("B")
+        if hatch:
+            path = block.add_hatch().paths.add_edge_path()
+            path.add_spline(fit_points=FIT_POINTS)
+            path.add_line(FIT_POINTS[-1], FIT_POINTS[0])
+        else:
+            block.add_spline([(x, y, 0.0) for x, y in FIT_POINTS])
+        msp.add_blockref("B", (5, -3), dxfattribs={"rotation": 30, "xscale": 3, "yscale": 0.5})
+
+    options = ImportOptions(hatch_boundaries=hatch)
+    (contour,) = read_dxf(write_dxf(tmp_path / "f.dxf", build), options).contours
+    curve = [place(p) for p in _block_curve(FIT_POINTS)]
+    segments = contour.segments
+    if hatch:  # the closing line placed, the curve's segments before it
+        assert contour.closed and isinstance(segments[-1], Line)
+        assert segments[-1].start == pytest.approx(place(FIT_POINTS[-1]))
+        assert segments[-1].end == pytest.approx(place(FIT_POINTS[0]))
+        segments = segments[:-1]
+    _assert_close(curve, segments)
+
+
 def _range(a: float, b: float, n: int = 2000) -> list[float]:
     return [a + (b - a) * k / n for k in range(n + 1)]
 
