@@ -118,6 +118,23 @@ def ellipse(centre: Point, a: Point, b: Point) -> tuple[PointFn, PointFn]:
     return point_at, tangent_at
 
 
+def ellipse_extent(centre: Point, a: Point, b: Point, t0: float, t1: float) -> float:
+    """Width or height, the larger, of the arc of ``c + a·cos t + b·sin t`` over [t0, t1].
+
+    The part of the ellipse a fit follows, not the whole ellipse: a nearly straight arc
+    of an ellipse kilometres across is short. Its box is spanned by the ends and the
+    parameters where x' or y' is zero (``tan t = b_x / a_x``, ``tan t = b_y / a_y``);
+    ``t0 ≤ t1``, rad, at most a turn apart.
+    """
+    point_at, _ = ellipse(centre, a, b)
+    ts = [t0, t1]
+    for e in (math.atan2(b[0], a[0]), math.atan2(b[1], a[1])):
+        first = e + math.pi * math.ceil((t0 - e) / math.pi)
+        ts += [t for k in range(3) if t0 < (t := first + math.pi * k) < t1]
+    xs, ys = zip(*map(point_at, ts), strict=True)
+    return max(max(xs) - min(xs), max(ys) - min(ys))
+
+
 def ellipse_arc(
     centre: Point, a: Point, b: Point, t0: float, sweep: float, p0: Point, p1: Point
 ) -> tuple[PointFn, PointFn]:

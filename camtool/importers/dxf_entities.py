@@ -20,7 +20,7 @@ import numpy as np
 
 from camtool.geometry.arcfit import FIT_KERNELS, FloatArray, PointsFn
 from camtool.geometry.chain import with_end, with_start
-from camtool.geometry.curves import corner_knots, ellipse, fit_pieces, joined_run
+from camtool.geometry.curves import corner_knots, ellipse, ellipse_extent, fit_pieces, joined_run
 from camtool.geometry.fitpool import fit_key
 from camtool.importers.dxf_damage import implied_degree
 from camtool.importers.dxf_prefit import take
@@ -530,7 +530,6 @@ def ellipse_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool
     a, b = math.hypot(mx, my), math.hypot(nx, ny)
     if a <= 0.0 or b <= 0.0:
         raise Unsupported("zero size")
-    _check_size(2.0 * max(a, b), tolerance)
     t0 = float(ce.start_param)
     t1 = float(ce.end_param)
     if t1 <= t0:
@@ -538,6 +537,7 @@ def ellipse_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool
     t1 = min(t1, t0 + TAU)
 
     point_at, tangent_at = ellipse((cx, cy), (mx, my), (nx, ny))
+    _check_size(ellipse_extent((cx, cy), (mx, my), (nx, ny), t0, t1), tolerance)  # cut part
     closed = t1 - t0 >= TAU or (
         t1 - t0 > math.pi and distance(point_at(t0), point_at(t1)) <= tolerance
     )

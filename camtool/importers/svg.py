@@ -17,7 +17,7 @@ import svgelements as se
 from camtool.accel.collector import collect_young
 from camtool.geometry.arcfit import check_tolerance
 from camtool.geometry.chain import with_end
-from camtool.geometry.curves import merge_arcs, semi_axes_gap
+from camtool.geometry.curves import ellipse_extent, merge_arcs, semi_axes_gap
 from camtool.geometry.fitpool import MIN_CURVES, CurveKey, fit_key, fit_shared, moved, shape_key
 from camtool.importers import svgclip
 from camtool.importers.options import MAX_COORDINATE_MM, ImportOptions, check_curve_size
@@ -668,8 +668,13 @@ def _pt(m: Affine, p: Any) -> Point:
 def _check_size(points: Iterable[Point], tolerance: float) -> None:
     """Refuse a curve whose control points span too much for ``tolerance`` (InputError)."""
     xs, ys = zip(*points, strict=True)
+    _check_extent(2.0 * max(max(xs) - min(xs), max(ys) - min(ys)), tolerance)
+
+
+def _check_extent(extent: float, tolerance: float) -> None:
+    """Refuse a curve ``extent`` mm across, too much for ``tolerance`` (InputError)."""
     try:
-        check_curve_size(2.0 * max(max(xs) - min(xs), max(ys) - min(ys)), tolerance)
+        check_curve_size(extent, tolerance)
     except ValueError as exc:
         raise InputError(str(exc).replace(" across", " mm across", 1)) from None
 
@@ -732,8 +737,8 @@ def _arc(seg: Any, p0: Point, m: Affine, tolerance: float, fitter: Fitter) -> li
     if semi_axes_gap(big_a, big_b, cross) <= 0.1 * tolerance:
         return _circular(p0, p1, centre, ccw=cross * sweep > 0.0, sweep=sweep)
     _check(centre, "an ellipse centre")
-    _check_size([centre, (centre[0] + big_a[0], centre[1] + big_a[1]),
-                 (centre[0] + big_b[0], centre[1] + big_b[1]), p0, p1], tolerance)  # fmt: skip
+    ends = (t0, t0 + sweep) if sweep > 0.0 else (t0 + sweep, t0)
+    _check_extent(ellipse_extent(centre, big_a, big_b, *ends), tolerance)  # the part cut
     return _fit(("ellipse_arc", (centre, big_a, big_b, t0, sweep, p0, p1)), fitter)
 
 

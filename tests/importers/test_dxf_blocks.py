@@ -201,6 +201,28 @@ def test_a_fit_point_spline_under_non_uniform_scale_is_its_block_curve_placed(
     _assert_close(curve, segments)
 
 
+def test_a_nearly_straight_bulge_under_non_uniform_scale_is_read(tmp_path: Path) -> None:
+    # bulge 0.0002 over 40 in: an arc of 50 000 in radius, an elliptical arc once placed;
+    # the whole ellipse (about 10⁹ times the 0.001 mm tolerance) was refused as too large
+    # to fit, though the part cut is 40 in long and nearly straight
+    from ezdxf.math import bulge_to_arc
+
+    place = _placer((0.0, 0.0), 30.0, 2.0, 0.5)
+
+    def build(msp: Any) -> None:
+        msp.doc.header["$INSUNITS"] = 1
+        msp.doc.blocks.new("B").add_lwpolyline([(0, 0, 0.0002), (40, 0, 0)], format="xyb")
+        msp.add_blockref("B", (0, 0), dxfattribs={"rotation": 30, "xscale": 2, "yscale": 0.5})
+
+    (contour,) = read_dxf(write_dxf(tmp_path / "b.dxf", build)).contours
+    centre, start, end, radius = bulge_to_arc((0, 0), (40, 0), 0.0002)
+    true = [
+        place((centre.x + radius * math.cos(t), centre.y + radius * math.sin(t)))
+        for t in _range(start, end)
+    ]
+    _assert_close([(25.4 * x, 25.4 * y) for x, y in true], contour.segments)
+
+
 def _range(a: float, b: float, n: int = 2000) -> list[float]:
     return [a + (b - a) * k / n for k in range(n + 1)]
 

@@ -120,3 +120,22 @@ def test_an_elliptical_arc_too_large_for_the_tolerance_is_refused(tmp_path: Path
     path = svg(tmp_path, '<path id="oval" d="m 48,20 a 8,4 0 0 1 -8,1e9"/>')
     message = _refused(path)
     assert "path#oval: a curve" in message and "raise --tolerance" in message
+
+
+def test_a_nearly_straight_arc_of_a_huge_ellipse_is_read(tmp_path: Path) -> None:
+    # radius 500 m over an 80 mm chord, stretched 1.5 times in y: an elliptical arc whose
+    # ellipse is 10⁹ times the 0.001 mm tolerance (once refused as too large to fit); the
+    # part cut is 80 mm long, its sagitta 80² / (8 · 500 000) · 1.5 = 0.0024 mm
+    import numpy as np
+
+    from camtool.geometry.arcfit import distances
+    from tests.shapes import segment_samples
+
+    d = "M 10 10 A 500000 500000 0 0 1 90 10"
+    (contour,) = read_svg(svg(tmp_path, f'<path d="{d}" transform="scale(1 1.5)"/>')).contours
+    x = np.linspace(10.0, 90.0, 4001)
+    true = np.column_stack([x, 85.0 + 0.0024 * (1.0 - ((x - 50.0) / 40.0) ** 2)])
+    # the circle's sagitta is a parabola within (80/2)⁴ / (8 R³) = 2e-12 mm of it
+    assert float(np.max(distances(true, contour.segments))) <= 0.001 + 1e-6
+    ys = np.array(segment_samples(contour.segments))[:, 1]
+    assert float(ys.max()) == pytest.approx(85.0024, abs=0.001)
