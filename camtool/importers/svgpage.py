@@ -62,6 +62,14 @@ def page_matrix(
     width, width_text = _page_length(root, "width", name)
     height, height_text = _page_length(root, "height", name)
     box = _viewbox(root, name)
+    legacy = legacy_inkscape(root, box is not None)
+    if legacy is not None and units is None:  # --units says what the user unit is
+        warnings.append(
+            f"{name}: made by Inkscape {legacy}, which drew 90 px to the inch; its px are read "
+            "as 96 to the inch (CSS, and Inkscape 0.92 and later unless told otherwise), so a "
+            "part drawn there to size comes out 6.25 % small: give --scale 1.066667 (96/90) "
+            "to cut it at the size Inkscape showed"
+        )
     if box is not None and width is not None and height is None:
         height = width * box[3] / box[2]
     elif box is not None and height is not None and width is None:
@@ -101,6 +109,36 @@ def page_matrix(
         root.attrib.pop(attr, None)
     top = height if height is not None else 0.0
     return (sx, 0.0, 0.0, -sy, tx, top - ty), viewport, page
+
+
+INKSCAPE_VERSION = "{http://www.inkscape.org/namespaces/inkscape}version"
+"""The attribute in which Inkscape records the version that saved the document."""
+
+
+def legacy_inkscape(root: ET.Element, has_viewbox: bool) -> str | None:
+    """The version of Inkscape before 0.92 that saved ``root`` with user units in its px.
+
+    Inkscape before 0.92 drew 90 px to the inch, later versions 96 (CSS). The px matter
+    where the page's size is in px (or has no unit) or, without a viewBox, where user
+    units are px: the cases Inkscape's own file update (``sp_file_convert_dpi``) offers
+    to rescale. ``None``: a later version, no version, or a page whose size fixes the
+    user unit (an absolute size with a viewBox).
+    """
+    match = re.match(r"\s*(\d+)\.(\d+)", root.get(INKSCAPE_VERSION, ""))
+    if match is None or (int(match[1]), int(match[2])) >= (0, 92):
+        return None
+    units = [_unit(root.get(a)) for a in ("width", "height")]
+    in_px = units == [None, None] or any(u in ("", "px") for u in units)
+    absolute = any(u in ("mm", "cm", "in", "pt", "pc") for u in units)
+    if in_px or (absolute and not has_viewbox):
+        return root.get(INKSCAPE_VERSION, "").split()[0]
+    return None
+
+
+def _unit(text: str | None) -> str | None:
+    """The unit of a length attribute (``""``: none given); ``None`` when there is no length."""
+    match = re.fullmatch(r"\s*[+-]?[\d.]+(?:[eE][+-]?\d+)?\s*([a-zA-Z%]*)\s*", text or "")
+    return None if match is None else match[1]
 
 
 def _page_length(root: ET.Element, attr: str, name: str) -> tuple[float | None, str]:
