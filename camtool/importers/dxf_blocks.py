@@ -14,6 +14,7 @@ from camtool.importers.dxf_entities import (
     BadEntity,
     Item,
     Unsupported,
+    boundary_entities,
     check_numbers,
     invisible,
     layer_of,
@@ -196,11 +197,39 @@ def _place(
         return
     check_numbers(entity, label, eff, limits[0])
     try:
+        if kind == "HATCH" and (paths := _placed_paths(entity, matrix)) is not None:
+            yield Item(entity, label, eff, paths=paths)
+            return
         placed, parts = _transformed(entity, matrix)
     except Unsupported as exc:
         yield Skip(kind, exc.reason, label, eff, _moved(location(entity), matrix))
         return
     yield Item(placed, label, eff, parts)
+
+
+def _placed_paths(hatch: Any, matrix: Any) -> tuple[tuple[Any, ...], ...] | None:
+    """A HATCH's boundary paths as entities drawn in the block, each placed by ``matrix``.
+
+    Each piece is placed as the entity it is (:func:`_transformed`): ezdxf's own HATCH
+    transform misplaces an ellipse edge under nested scales and mirrors (by 9 mm in a
+    drawing 100 mm across). ``None``: the boundary data cannot be read (the HATCH is
+    placed whole, and reading its boundary says why where it is wanted).
+
+    Raises:
+        Unsupported: a piece cannot be placed.
+    """
+    try:
+        paths = boundary_entities(hatch)
+    except (ValueError, ArithmeticError):
+        return None
+    placed: list[tuple[Any, ...]] = []
+    for path in paths:
+        pieces: list[Any] = []
+        for piece in path:
+            moved, parts = _transformed(piece, matrix)
+            pieces.extend(parts or (moved,))
+        placed.append(tuple(pieces))
+    return tuple(placed)
 
 
 def mline_parts(mline: Any) -> list[Any] | str:
@@ -232,8 +261,8 @@ def _moved(p: Point | None, matrix: Any) -> Point | None:
 def _transformed(entity: Any, matrix: Any) -> tuple[Any, tuple[Any, ...]]:
     """A transformed copy of ``entity``, or the entity and its transformed pieces.
 
-    A SPLINE (or a HATCH's spline edge) given by fit points only is first given the
-    control points of its curve in block coordinates (:func:`_controlled`).
+    A SPLINE given by fit points only is first given the control points of its curve in
+    block coordinates (:func:`_controlled`).
     """
     from ezdxf.entities import Ellipse
     from ezdxf.math.transformtools import NonUniformScalingError, TransformError
@@ -262,39 +291,18 @@ def _controlled(entity: Any) -> Any:
     The curve through placed fit points is not the placed curve under a non-uniform
     scale (chord lengths and end tangents change), while a B-spline's control points
     place it exactly under any affine map (*The NURBS Book*, section 4.2): the curve is
-    built where it was drawn, as a CAD program draws a block, then placed. Splines of a
-    HATCH's edges are built in its OCS.
+    built where it was drawn, as a CAD program draws a block, then placed (a HATCH's
+    spline edges too, as the SPLINEs :func:`_placed_paths` makes of them).
 
     Raises:
         Unsupported: fit points no spline can be built through.
     """
-    from ezdxf.entities import Spline
-    from ezdxf.entities.boundary_paths import EdgePath, SplineEdge
-    from ezdxf.math import Vec2
-
     copy = entity.copy()
-    kind = entity.dxftype()
-    if kind == "SPLINE" and not entity.control_point_count() and entity.fit_point_count():
+    if entity.dxftype() == "SPLINE" and not entity.control_point_count():
+        if not entity.fit_point_count():
+            return copy
         copy.apply_construction_tool(spline_tool(entity))
         copy.fit_points = []
-    elif kind == "HATCH":
-        for path in copy.paths:
-            edges = path.edges if isinstance(path, EdgePath) else []
-            for edge in edges:
-                if isinstance(edge, SplineEdge) and edge.fit_points and not edge.control_points:
-                    drawn = Spline.new(dxfattribs={"degree": edge.degree})
-                    drawn.fit_points = [(v.x, v.y, 0.0) for v in edge.fit_points]
-                    if edge.start_tangent is not None and edge.end_tangent is not None:
-                        drawn.dxf.start_tangent = (edge.start_tangent.x, edge.start_tangent.y, 0)
-                        drawn.dxf.end_tangent = (edge.end_tangent.x, edge.end_tangent.y, 0)
-                    tool = spline_tool(drawn)
-                    edge.control_points = [Vec2(v) for v in tool.control_points]
-                    edge.knot_values = [float(k) for k in tool.knots()]
-                    edge.weights = [float(w) for w in tool.weights()]
-                    edge.rational = int(tool.is_rational)
-                    edge.degree = tool.degree
-                    edge.fit_points = []
-                    edge.start_tangent = edge.end_tangent = None
     return copy
 
 

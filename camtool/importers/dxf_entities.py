@@ -223,8 +223,8 @@ class Item:
         parts: for an entity that had to be exploded to be transformed (a polyline with
             bulges under a non-uniform scale), its transformed pieces in order; the
             contour is joined from them (:func:`join_pieces`).
-        at: where the entity is in WCS drawing units, for messages, when ``entity`` was
-            not transformed (block content that is only counted); else None.
+        at: for block content only counted (not transformed): where it is, WCS units.
+        paths: a HATCH placed by a block (``entity`` as drawn there): its paths' pieces, placed.
     """
 
     entity: Any
@@ -232,6 +232,7 @@ class Item:
     layer: str
     parts: tuple[Any, ...] = field(default=())
     at: Point | None = None
+    paths: tuple[tuple[Any, ...], ...] = field(default=())
 
 
 def convert(item: Item, tolerance: float, limit: float = math.inf) -> list[Contour]:
@@ -430,7 +431,7 @@ def _hatch(item: Item, tolerance: float, limit: float) -> list[Contour]:
     _check_flat(hatch)
     contours: list[Contour] = []
     try:
-        paths = boundary_entities(hatch)
+        paths = [list(p) for p in item.paths] or boundary_entities(hatch)
     except (ValueError, ArithmeticError) as exc:  # e.g. an infinite ellipse edge angle
         raise BadEntity(
             f"{item.label} on layer {item.layer!r}: its boundary path data cannot be read "

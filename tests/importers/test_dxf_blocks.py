@@ -201,6 +201,29 @@ def test_a_fit_point_spline_under_non_uniform_scale_is_its_block_curve_placed(
     _assert_close(curve, segments)
 
 
+def test_a_hatch_s_ellipse_edge_under_nested_scales_and_a_mirror(tmp_path: Path) -> None:
+    # ezdxf's own HATCH transform put this half ellipse 9 mm away from where the two
+    # INSERTs place it: each boundary piece is placed as the entity it is
+    inner = _placer((-48.8, 10.7), 243.0)
+    outer = _placer((40.0, -29.0), 296.0, 1.0, -1.826)
+
+    def build(msp: Any) -> None:
+        path = msp.doc.blocks.new("IN").add_hatch().paths.add_edge_path()
+        path.add_line((-12, -1), (-2, -11))
+        path.add_ellipse((-2, -1), (0, 10), 0.31, 180, 360, ccw=True)
+        path.add_line((-2, 9), (-12, -1))
+        msp.doc.blocks.new("OUT").add_blockref("IN", (-48.8, 10.7), dxfattribs={"rotation": 243})
+        msp.add_blockref("OUT", (40, -29), dxfattribs={"yscale": -1.826, "rotation": 296})
+
+    options = ImportOptions(hatch_boundaries=True)
+    (contour,) = read_dxf(write_dxf(tmp_path / "h.dxf", build), options).contours
+    # the edge c + cos t·M + sin t·ratio·(Z × M), t from π to 2π, then the two lines
+    half = [(-2 - 3.1 * math.sin(t), -1 + 10 * math.cos(t)) for t in _range(math.pi, 2 * math.pi)]
+    true = half + _polyline_points([(-2, 9), (-12, -1), (-2, -11)])
+    assert contour.closed
+    _assert_close([outer(inner(p)) for p in true], contour.segments)
+
+
 def test_a_nearly_straight_bulge_under_non_uniform_scale_is_read(tmp_path: Path) -> None:
     # bulge 0.0002 over 40 in: an arc of 50 000 in radius, an elliptical arc once placed;
     # the whole ellipse (about 10⁹ times the 0.001 mm tolerance) was refused as too large
