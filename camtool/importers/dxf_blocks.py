@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 from camtool.importers.dxf_entities import (
@@ -14,7 +15,6 @@ from camtool.importers.dxf_entities import (
     BadEntity,
     Item,
     Unsupported,
-    boundary_entities,
     check_numbers,
     invisible,
     layer_of,
@@ -196,10 +196,11 @@ def _place(
         yield Item(entity, label, eff, at=_moved(location(entity), matrix))
         return
     check_numbers(entity, label, eff, limits[0])
+    if kind == "HATCH":  # its boundary is placed piece by piece when it is read
+        at = _moved(location(entity), matrix)
+        yield Item(entity, label, eff, at=at, place=partial(_placed, matrix=matrix))
+        return
     try:
-        if kind == "HATCH" and (paths := _placed_paths(entity, matrix)) is not None:
-            yield Item(entity, label, eff, paths=paths)
-            return
         placed, parts = _transformed(entity, matrix)
     except Unsupported as exc:
         yield Skip(kind, exc.reason, label, eff, _moved(location(entity), matrix))
@@ -207,29 +208,17 @@ def _place(
     yield Item(placed, label, eff, parts)
 
 
-def _placed_paths(hatch: Any, matrix: Any) -> tuple[tuple[Any, ...], ...] | None:
-    """A HATCH's boundary paths as entities drawn in the block, each placed by ``matrix``.
+def _placed(piece: Any, matrix: Any) -> tuple[Any, ...]:
+    """A HATCH's boundary piece, an entity drawn in the block, placed by ``matrix``.
 
     Each piece is placed as the entity it is (:func:`_transformed`): ezdxf's own HATCH
-    transform misplaces an ellipse edge under nested scales and mirrors (by 9 mm in a
-    drawing 100 mm across). ``None``: the boundary data cannot be read (the HATCH is
-    placed whole, and reading its boundary says why where it is wanted).
+    transform misplaces an ellipse edge under nested scales and mirrors.
 
     Raises:
-        Unsupported: a piece cannot be placed.
+        Unsupported: the piece cannot be placed.
     """
-    try:
-        paths = boundary_entities(hatch)
-    except (ValueError, ArithmeticError):
-        return None
-    placed: list[tuple[Any, ...]] = []
-    for path in paths:
-        pieces: list[Any] = []
-        for piece in path:
-            moved, parts = _transformed(piece, matrix)
-            pieces.extend(parts or (moved,))
-        placed.append(tuple(pieces))
-    return tuple(placed)
+    moved, parts = _transformed(piece, matrix)
+    return parts or (moved,)
 
 
 def mline_parts(mline: Any) -> list[Any] | str:
@@ -292,7 +281,7 @@ def _controlled(entity: Any) -> Any:
     scale (chord lengths and end tangents change), while a B-spline's control points
     place it exactly under any affine map (*The NURBS Book*, section 4.2): the curve is
     built where it was drawn, as a CAD program draws a block, then placed (a HATCH's
-    spline edges too, as the SPLINEs :func:`_placed_paths` makes of them).
+    spline edges too, as the SPLINEs :func:`_placed` is given).
 
     Raises:
         Unsupported: fit points no spline can be built through.

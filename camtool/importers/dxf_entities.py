@@ -220,11 +220,10 @@ class Item:
         entity: the ezdxf entity, already in WCS drawing units.
         label: how messages name it, e.g. ``"LINE #1A in INSERT #3B (block 'BOLT')"``.
         layer: its effective layer (block content on layer ``0`` takes the INSERT's).
-        parts: for an entity that had to be exploded to be transformed (a polyline with
-            bulges under a non-uniform scale), its transformed pieces in order; the
-            contour is joined from them (:func:`join_pieces`).
-        at: for block content only counted (not transformed): where it is, WCS units.
-        paths: a HATCH placed by a block (``entity`` as drawn there): its paths' pieces, placed.
+        parts: for an entity exploded to be transformed (a polyline with bulges under a
+            non-uniform scale), its pieces placed, in order (:func:`join_pieces` joins them).
+        at: for block content not transformed (counted, or a HATCH): where it is, WCS units.
+        place: for a HATCH in a block (``entity`` as drawn there), places a boundary piece.
     """
 
     entity: Any
@@ -232,7 +231,7 @@ class Item:
     layer: str
     parts: tuple[Any, ...] = field(default=())
     at: Point | None = None
-    paths: tuple[tuple[Any, ...], ...] = field(default=())
+    place: Callable[[Any], tuple[Any, ...]] | None = None
 
 
 def convert(item: Item, tolerance: float, limit: float = math.inf) -> list[Contour]:
@@ -431,12 +430,14 @@ def _hatch(item: Item, tolerance: float, limit: float) -> list[Contour]:
     _check_flat(hatch)
     contours: list[Contour] = []
     try:
-        paths = [list(p) for p in item.paths] or boundary_entities(hatch)
+        paths = boundary_entities(hatch)
     except (ValueError, ArithmeticError) as exc:  # e.g. an infinite ellipse edge angle
         raise BadEntity(
             f"{item.label} on layer {item.layer!r}: its boundary path data cannot be read "
             f"({exc}); the file is damaged: fix or delete the hatch in the CAD program"
         ) from None
+    if item.place is not None:
+        paths = [[q for piece in path for q in item.place(piece)] for path in paths]
     for number, path in enumerate(paths, start=1):
         label = f"{item.label} path {number}"
         for edge in path:
