@@ -111,6 +111,9 @@ def page_matrix(
     return (sx, 0.0, 0.0, -sy, tx, top - ty), viewport, page
 
 
+_LENGTH = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*([a-zA-Z%]*)\s*")
+"""A length attribute: its number and its unit (empty when none is given)."""
+
 INKSCAPE_VERSION = "{http://www.inkscape.org/namespaces/inkscape}version"
 """The attribute in which Inkscape records the version that saved the document."""
 
@@ -137,8 +140,8 @@ def legacy_inkscape(root: ET.Element, has_viewbox: bool) -> str | None:
 
 def _unit(text: str | None) -> str | None:
     """The unit of a length attribute (``""``: none given); ``None`` when there is no length."""
-    match = re.fullmatch(r"\s*[+-]?[\d.]+(?:[eE][+-]?\d+)?\s*([a-zA-Z%]*)\s*", text or "")
-    return None if match is None else match[1]
+    match = _LENGTH.fullmatch(text or "")
+    return None if match is None else match[2]
 
 
 def _page_length(root: ET.Element, attr: str, name: str) -> tuple[float | None, str]:
@@ -146,7 +149,7 @@ def _page_length(root: ET.Element, attr: str, name: str) -> tuple[float | None, 
     text = root.get(attr)
     if text is None or text.strip() in ("", "auto"):
         return None, ""
-    match = re.fullmatch(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*([a-zA-Z%]*)\s*", text)
+    match = _LENGTH.fullmatch(text)
     if match is None:
         raise InputError(f"{name}: <svg> {attr} {text!r} is not a length")
     value, unit = float(match.group(1)), match.group(2)

@@ -202,8 +202,8 @@ def test_a_fit_point_spline_under_non_uniform_scale_is_its_block_curve_placed(
 
 
 def test_a_hatch_s_ellipse_edge_under_nested_scales_and_a_mirror(tmp_path: Path) -> None:
-    # ezdxf's own HATCH transform put this half ellipse 9 mm away from where the two
-    # INSERTs place it: each boundary piece is placed as the entity it is
+    # a rotation, then a mirroring non-uniform scale: ezdxf's own HATCH transform
+    # misplaces this half ellipse; each boundary piece is placed as the entity it is
     inner = _placer((-48.8, 10.7), 243.0)
     outer = _placer((40.0, -29.0), 296.0, 1.0, -1.826)
 
@@ -226,8 +226,8 @@ def test_a_hatch_s_ellipse_edge_under_nested_scales_and_a_mirror(tmp_path: Path)
 
 def test_a_nearly_straight_bulge_under_non_uniform_scale_is_read(tmp_path: Path) -> None:
     # bulge 0.0002 over 40 in: an arc of 50 000 in radius, an elliptical arc once placed;
-    # the whole ellipse (about 10⁹ times the 0.001 mm tolerance) was refused as too large
-    # to fit, though the part cut is 40 in long and nearly straight
+    # its whole ellipse is about 10⁹ times the 0.001 mm tolerance, the part cut 40 in long
+    # and nearly straight: its size is what is judged
     from ezdxf.math import bulge_to_arc
 
     place = _placer((0.0, 0.0), 30.0, 2.0, 0.5)

@@ -124,8 +124,8 @@ def test_an_elliptical_arc_too_large_for_the_tolerance_is_refused(tmp_path: Path
 
 def test_a_nearly_straight_arc_of_a_huge_ellipse_is_read(tmp_path: Path) -> None:
     # radius 500 m over an 80 mm chord, stretched 1.5 times in y: an elliptical arc whose
-    # ellipse is 10⁹ times the 0.001 mm tolerance (once refused as too large to fit); the
-    # part cut is 80 mm long, its sagitta 80² / (8 · 500 000) · 1.5 = 0.0024 mm
+    # ellipse is 10⁹ times the 0.001 mm tolerance, while the part cut is 80 mm long, its
+    # sagitta 80² / (8 · 500 000) · 1.5 = 0.0024 mm
     import numpy as np
 
     from camtool.geometry.arcfit import distances

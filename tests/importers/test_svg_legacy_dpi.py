@@ -9,7 +9,9 @@ units without a viewBox.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -50,7 +52,16 @@ def test_a_page_in_px_from_inkscape_0_48_is_read_at_96_with_the_remedy(
     width, said = _read(_svg(tmp_path, "0.48.4 r9939", size))
     assert width == pytest.approx(93.75, abs=1e-6)
     assert len(said) == 1 and "Inkscape 0.48.4" in said[0] and "--scale 1.066667" in said[0]
-    assert width * 1.066667 == pytest.approx(100.0, abs=1e-4)  # the remedy's size
+
+
+def test_the_remedy_cuts_the_size_inkscape_showed(tmp_path: Path, run: Any) -> None:
+    path = _svg(tmp_path, "0.48.4 r9939", 'width="210mm" height="297mm"')
+    out = tmp_path / "square.ngc"
+    code, err = run("post", str(path), "-t", "linuxcnc", "--scale", "1.066667", "-o", str(out))
+    assert code == 0 and "--scale 1.066667" in err
+    cut = [line for line in out.read_text().splitlines() if line.startswith("G1 X")]
+    xs = [float(re.search(r"X(-?[\d.]+)", line)[1]) for line in cut]  # type: ignore[index]
+    assert max(xs) - min(xs) == pytest.approx(100.0, abs=0.001)
 
 
 @pytest.mark.parametrize(
