@@ -332,7 +332,7 @@ def _contours(
     m = compose(page, affine_of(shape.transform))
     try:
         if segments is None:
-            subpaths = convert(shape.segments(transformed=False), m, fitter.tolerance, fitter)
+            subpaths = convert(shape_segments(shape), m, fitter.tolerance, fitter)
         else:
             subpaths = convert(segments, m, fitter.tolerance, fitter)
     except (GeometryError, InputError) as exc:
@@ -391,7 +391,7 @@ def _hidden_by_clip(
 def _clip_subpaths(shape: Any, m: Affine) -> list[list[Point]]:
     """A clip child's subpaths as points in mm (``m``: its coordinates to mm), finely."""
     fine = svgclip.CLIP_SLACK_MM / 10
-    subpaths = convert(shape.segments(transformed=False), m, fine)
+    subpaths = convert(shape_segments(shape), m, fine)
     return [Contour(segs, closed).points(fine) for segs, closed in subpaths]
 
 
@@ -505,11 +505,42 @@ _CURVES = (se.CubicBezier, se.QuadraticBezier, se.Arc)
 
 
 def _segments(shape: Any) -> list[Any] | None:
-    """The shape's svgelements segments, untransformed; ``None`` where svgelements fails."""
+    """The shape's segments (:func:`shape_segments`); ``None`` where svgelements fails."""
     try:
-        return list(shape.segments(transformed=False))
+        return shape_segments(shape)
     except Exception:  # raised again when the shape's turn comes, after the shapes before it
         return None
+
+
+def shape_segments(shape: Any) -> list[Any]:
+    """The shape's svgelements segments, untransformed, each smooth curve's control as SVG's.
+
+    ``S`` reflects the previous segment's second control point only when that segment is a
+    cubic (``C``/``S``), ``T`` the previous control point only when it is a quadratic
+    (``Q``/``T``); after any other segment the (first) control point is the current point
+    (SVG 1.1 §8.3.6, §8.3.7). svgelements reflects either kind's last control point: ``S``
+    after ``Q`` and ``T`` after ``C`` gave another curve (up to 5 mm off in a random
+    drawing), and every ``T`` chained after such a ``T`` with it.
+
+    Raises:
+        Exception: whatever svgelements raises on the shape's segments.
+    """
+    out = list(shape.segments(transformed=False))
+    moved = False  # out[k - 1] is a quadratic whose control point was corrected
+    for k in range(1, len(out)):
+        seg, before = out[k], out[k - 1]
+        now = False
+        if isinstance(seg, se.CubicBezier) and seg.smooth:
+            if isinstance(before, se.QuadraticBezier):
+                out[k] = se.CubicBezier(seg.start, seg.start, seg.control2, seg.end)
+        elif isinstance(seg, se.QuadraticBezier) and seg.smooth:
+            if isinstance(before, se.CubicBezier):
+                out[k], now = se.QuadraticBezier(seg.start, seg.start, seg.end), True
+            elif moved and isinstance(before, se.QuadraticBezier):
+                control = before.control.reflected_across(seg.start)
+                out[k], now = se.QuadraticBezier(seg.start, control, seg.end), True
+        moved = now
+    return out
 
 
 def _prefitted(

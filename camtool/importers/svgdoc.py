@@ -652,5 +652,7 @@ def _check(element: ET.Element, kind: str, viewport: tuple[float, float]) -> Non
                 svgcheck.check_length(value, negative=attr not in _SIZES)
             except ValueError as exc:
                 raise ValueError(f"bad {attr} {value!r}: {exc}") from exc
+    if kind == "rect":
+        svgvalues.rect_radii(element)
     if kind in ("polyline", "polygon") and element.get("points") is not None:
         svgcheck.check_points(element.get("points", ""))

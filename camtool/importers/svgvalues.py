@@ -7,6 +7,8 @@ attributes into the form svgelements reads as SVG means them:
 - :func:`resolve_percentages`: a shape's percentage lengths as user units;
 - :func:`default_sizes`: a shape without its size draws nothing; an ellipse's one radius
   is both (``auto``);
+- :func:`rect_radii`: a rounded rect's corner radii in user units, each at most half its
+  side;
 - :func:`fold_transform_origin`: ``transform-origin`` into the ``transform``;
 - :func:`resolve_paint_references`: a ``url(#id)`` paint that paints nothing as its
   fallback;
@@ -68,6 +70,48 @@ def default_sizes(element: ET.Element, kind: str) -> None:
     elif kind == "ellipse" and len(given) == 1:
         (have,) = given
         element.set("ry" if have == "rx" else "rx", element.get(have) or style[have])
+
+
+def rect_radii(element: ET.Element) -> None:
+    """Write a rounded ``<rect>``'s corner radii as user units, as SVG sizes them.
+
+    A radius not given is the other one (``auto``), and each is then at most half its side:
+    ``rx`` of the width, ``ry`` of the height (SVG 1.1 §9.2). svgelements applies the limit
+    only when the sizes and radii are plain numbers: ``rx="2mm"`` on a rect 5 units wide,
+    or ``rx="30"`` on one ``10mm`` wide, rounded the corners past the sides, a corner
+    bulging out of the part. Sizes and radii in the ``style`` (SVG 2) count, and are
+    written back as attributes. A length camtool does not read here (``em``, ``ex``, a
+    percentage left in a style) is left as it is. Run after the lengths are checked.
+    """
+    style = inline_style(element)
+    sizes: dict[str, float] = {}
+    for attr in ("width", "height", "rx", "ry"):
+        text = style.get(attr, element.get(attr))
+        if text is None:
+            continue
+        try:
+            value = float(se.Length(text.strip()).value(ppi=96.0))
+        except (ValueError, TypeError):
+            return
+        if not math.isfinite(value):
+            return
+        sizes[attr] = value
+    rx, ry = sizes.get("rx"), sizes.get("ry")
+    if rx is None and ry is None:
+        return
+    rx = ry if rx is None else rx
+    ry = rx if ry is None else ry
+    assert rx is not None and ry is not None
+    limits = (sizes.get("width", 0.0) / 2.0, sizes.get("height", 0.0) / 2.0)
+    for attr, value, limit in (("rx", rx, limits[0]), ("ry", ry, limits[1])):
+        element.set(attr, repr(min(value, limit)))
+        style.pop(attr, None)
+    for attr in ("width", "height"):
+        if attr in style:
+            element.set(attr, repr(sizes[attr]))
+            style.pop(attr)
+    if element.get("style") is not None:
+        element.set("style", style_text(style))
 
 
 PERCENT = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)%\s*")

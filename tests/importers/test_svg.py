@@ -141,6 +141,26 @@ def test_bezier_s_t_reflection_and_tolerance(tmp_path: Path, d: str, explicit: s
         assert a.end == b.start
 
 
+@pytest.mark.parametrize(
+    "d",
+    [
+        "M 10 10 Q 50 90 90 10 S 50 50 10 90",  # S after Q: first control point is (90,10)
+        "M 10 10 C 20 80 50 90 90 10 T 10 90",  # T after C: control point is (90,10)
+        "M 10 10 C 20 80 50 90 90 10 T 10 90 T 50 50 t 20 -30",  # and the T's chained to it
+        "m 10 10 q 40 80 80 0 s -40 40 -80 80 t 30 -20",  # relative, S then T
+    ],
+)
+def test_a_smooth_curve_after_the_other_kind_starts_at_the_current_point(
+    tmp_path: Path, d: str
+) -> None:
+    """SVG 1.1 §8.3.6-7: S reflects only a cubic's control point, T only a quadratic's."""
+    tol = 0.001
+    drawing = read_svg(svg(tmp_path, f'<path d="{d}"/>'), ImportOptions(tolerance=tol))
+    there, back = two_sided_error(list(drawing.contours), true_curve(d, page))
+    assert there <= tol + 1e-6
+    assert back <= tol + 1e-6
+
+
 def test_straight_bezier_is_one_line(tmp_path: Path) -> None:
     contour = one(read_svg(svg(tmp_path, '<path d="M 0 0 C 10 0 20 0 30 0"/>')))
     assert contour.segments == (Line((0.0, 100.0), (30.0, 100.0)),)
@@ -207,6 +227,41 @@ def test_rect_with_rx_and_ry_has_elliptical_corners(tmp_path: Path) -> None:
     )
     assert contour.bbox() == pytest.approx((10, 70, 50, 90))
     assert sum(isinstance(s, Line) for s in contour.segments) >= 4
+
+
+PX_PER_MM = 96 / 25.4
+"""User units (px) in a mm of a length written in mm (CSS: 96 px to the inch)."""
+
+
+@pytest.mark.parametrize(
+    ("attrs", "w", "h", "rx", "ry"),
+    [
+        # rx 2mm is 7.56 units, over half the width: rx 5, ry (auto) 7.56
+        ('width="10" height="20" rx="2mm"', 10, 20, 5, 2 * PX_PER_MM),
+        # the width is 37.8 units: rx 30 is cut to 18.9, ry (auto) stays 30
+        ('width="10mm" height="20mm" rx="30"', 10 * PX_PER_MM, 20 * PX_PER_MM, 5 * PX_PER_MM, 30),
+        # ry 1cm is 37.8 units: ry cut to half the height, rx (auto) to half of 0.4in
+        ('width="0.4in" height="30" ry="1cm"', 38.4, 30, 19.2, 15),
+        # sizes and radius as SVG 2 style properties
+        ('style="width:10mm;height:20mm;rx:30"', 10 * PX_PER_MM, 20 * PX_PER_MM, 5 * PX_PER_MM, 30),
+    ],
+)
+def test_a_rect_radius_in_other_units_is_at_most_half_its_side(
+    tmp_path: Path, attrs: str, w: float, h: float, rx: float, ry: float
+) -> None:
+    """SVG 1.1 §9.2: the radii, in user units, are each cut to half the rect's side."""
+    tol = 0.001
+    body = f'<rect x="5" y="5" {attrs}/>'
+    drawing = read_svg(svg(tmp_path, body), ImportOptions(tolerance=tol))
+    x, y = 5.0, 5.0
+    d = (
+        f"M {x + rx} {y} H {x + w - rx} A {rx} {ry} 0 0 1 {x + w} {y + ry} V {y + h - ry} "
+        f"A {rx} {ry} 0 0 1 {x + w - rx} {y + h} H {x + rx} A {rx} {ry} 0 0 1 {x} {y + h - ry} "
+        f"V {y + ry} A {rx} {ry} 0 0 1 {x + rx} {y} Z"
+    )
+    there, back = two_sided_error(list(drawing.contours), true_curve(d, page))
+    assert there <= tol + 1e-6
+    assert back <= tol + 1e-6
 
 
 def test_line_polyline_polygon_ellipse(tmp_path: Path) -> None:
