@@ -45,7 +45,7 @@ from camtool.importers.svgtree import (
     is_drawn,
     tag,
 )
-from camtool.importers.svgvalues import LENGTH_ATTRS
+from camtool.importers.svgvalues import LENGTH_ATTRS, URL_REF
 from camtool.model.errors import InputError
 
 _GROUPMODE = f"{{{INKSCAPE_NS}}}groupmode"
@@ -372,7 +372,7 @@ def check_conditions(
 
 
 def count_skipped(root: ET.Element, hold: ET.Element, counts: Counter[str]) -> None:
-    """Add to ``counts`` the skipped kinds: non-empty defs, drawn text and image.
+    """Add to ``counts`` the skipped kinds: non-empty defs, drawn text and image, markers.
 
     And a drawn ``<use>`` of another file's element (``use-file``). Text and images a
     ``<use>`` places (from a ``<symbol>`` or a group in ``<defs>``) count once per
@@ -382,19 +382,25 @@ def count_skipped(root: ET.Element, hold: ET.Element, counts: Counter[str]) -> N
     placed: dict[ET.Element, Counter[str]] = {}
 
     def placed_by_use(target: ET.Element) -> Counter[str]:
-        """The text and images a ``<use>`` of ``target`` draws (a symbol: its children)."""
+        """The text, images and markers a ``<use>`` of ``target`` draws (a symbol: its children)."""
         found = placed.get(target)
         if found is None:
             found = Counter()
             walk(target if local_name(target) == "symbol" else [target], True, found)
-            found = placed[target] = Counter({k: found[k] for k in ("text", "image") if found[k]})
+            kinds = ("text", "image", "marker")
+            found = placed[target] = Counter({k: found[k] for k in kinds if found[k]})
         return found
 
-    def walk(node: Iterable[ET.Element], drawn: bool, into: Counter[str]) -> None:
+    def walk(
+        node: Iterable[ET.Element], drawn: bool, into: Counter[str], marked: frozenset[str] = _NO
+    ) -> None:
         for child in node:
             kind = local_name(child)
             if child is hold or kind is None:
                 continue
+            inner = _markers(child, marked, ids)
+            if inner and drawn and kind in _MARKED:
+                into["marker"] += 1
             if kind == "defs" and any(  # a clip is checked where it is used (svgclip)
                 local_name(c) not in (None, "style", "clipPath") for c in child
             ):
@@ -408,9 +414,42 @@ def count_skipped(root: ET.Element, hold: ET.Element, counts: Counter[str]) -> N
                     into["use-file"] += 1  # another file's element: svgelements places nothing
                 elif link[:1] == "#" and (target := ids.get(link[1:])) is not None:
                     into.update(placed_by_use(target))
-            walk(child, drawn and kind not in NOT_DRAWN, into)
+            walk(child, drawn and kind not in NOT_DRAWN, into, inner)
 
     walk(root, True, counts)
+
+
+_NO: frozenset[str] = frozenset()
+_MARKED = frozenset({"path", "line", "polyline", "polygon"})
+"""The shapes a viewer draws markers on (SVG 1.1 §11.6.1)."""
+_MARKER_PROPERTIES = {
+    "marker": ("start", "mid", "end"),
+    "marker-start": ("start",),
+    "marker-mid": ("mid",),
+    "marker-end": ("end",),
+}
+
+
+def _markers(
+    element: ET.Element, inherited: frozenset[str], ids: dict[str | None, ET.Element]
+) -> frozenset[str]:
+    """Which of ``start``, ``mid``, ``end`` get a drawing marker on ``element`` and inherit.
+
+    The marker properties inherit; ``marker`` sets all three, the others one; ``none`` or a
+    reference to no ``<marker>`` with shapes sets none (SVG 1.1 §11.6.2). A ``style``
+    declaration outranks the attribute.
+    """
+    style = inline_style(element)
+    out = set(inherited)
+    for prop, places in _MARKER_PROPERTIES.items():
+        value = style.get(prop, element.get(prop))
+        if value is None:
+            continue
+        ref = URL_REF.fullmatch(value)
+        target = ids.get(ref.group(1)) if ref is not None else None
+        draws = target is not None and local_name(target) == "marker" and has_shapes(target)
+        out = out | set(places) if draws else out - set(places)
+    return frozenset(out)
 
 
 MAX_DEPTH = 256
@@ -477,6 +516,8 @@ _SKIP_REASONS = {
     "text": "convert text to paths in the drawing program to cut it",
     "image": "raster images cannot be cut",
     "use": "a <use> of a <symbol> with a viewBox is not supported; unlink the clone",
+    "marker": "a viewer draws the shapes of its markers at its vertices; camtool cuts the "
+    "shape only: Inkscape's Path > Stroke to Path makes them paths",
 }
 
 
@@ -578,6 +619,10 @@ def prepare(
             noun = "element" if counts[kind] == 1 else "elements"
             reason = _SKIP_REASONS[kind]
             warnings.append(f"{path}: skipped {counts[kind]} <{kind}> {noun} ({reason})")
+    if counts["marker"]:
+        noun = "shape" if counts["marker"] == 1 else "shapes"
+        reason = _SKIP_REASONS["marker"]
+        warnings.append(f"{path}: skipped the markers of {counts['marker']} {noun} ({reason})")
     clip_paths_first(root)
     return Prepared(ET.tostring(root), matrix, viewport, tuple(warnings), page)
 

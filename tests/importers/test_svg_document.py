@@ -455,6 +455,26 @@ def test_text_and_images_a_use_places_are_counted_once_per_use(tmp_path: Path) -
     assert f"{name}: skipped 2 <image> elements (raster images" in "\n".join(drawing.warnings)
 
 
+def test_the_markers_a_viewer_draws_are_counted(tmp_path: Path) -> None:
+    """SVG 1.1 §11.6: the marker properties inherit, ``none`` or an empty marker draws none,
+    and only paths, lines, polylines and polygons get markers."""
+    body = (
+        '<marker id="arrow"><path d="M 0 0 L 2 1 L 0 2 Z"/></marker><marker id="empty"/>'
+        '<g marker-end="url(#arrow)"><path d="M 10 10 L 30 10"/>'  # inherits: drawn
+        '<path d="M 10 20 L 30 20" style="marker-end:none"/>'
+        '<rect x="1" y="1" width="2" height="2"/></g>'  # a rect has no markers
+        '<path d="M 10 30 L 30 30" marker-start="url(#empty)"/>'
+        '<line x1="0" y1="50" x2="9" y2="50" stroke="red" style="marker:url(#arrow)"/>'  # drawn
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert len(drawing.contours) == 5  # the shapes themselves, no marker's
+    assert drawing.warnings == (
+        f"{tmp_path / 't.svg'}: skipped the markers of 2 shapes (a viewer draws the shapes of "
+        "its markers at its vertices; camtool cuts the shape only: Inkscape's Path > Stroke "
+        "to Path makes them paths)",
+    )
+
+
 def test_symbol_without_viewbox_is_placed(tmp_path: Path) -> None:
     body = '<symbol id="s"><path d="M 0 0 L 1 0"/></symbol><use href="#s" x="3" y="4"/>'
     assert vertices(one(read_svg(svg(tmp_path, body)))) == [(3, 96), (4, 96)]
