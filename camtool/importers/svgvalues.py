@@ -80,22 +80,23 @@ def rect_radii(element: ET.Element) -> None:
     only when the sizes and radii are plain numbers: ``rx="2mm"`` on a rect 5 units wide,
     or ``rx="30"`` on one ``10mm`` wide, rounded the corners past the sides, a corner
     bulging out of the part. Sizes and radii in the ``style`` (SVG 2) count, and are
-    written back as attributes. A length camtool does not read here (``em``, ``ex``, a
-    percentage left in a style) is left as it is. Run after the lengths are checked.
+    written back as attributes; ``auto`` is a radius not given. A rect with a length
+    camtool does not read here (``em``, ``ex``, a percentage left in a style) is left as
+    it is. Run after the lengths are checked.
     """
     style = inline_style(element)
     sizes: dict[str, float] = {}
     for attr in ("width", "height", "rx", "ry"):
         text = style.get(attr, element.get(attr))
-        if text is None:
+        if text is None or text.strip() == "auto":
             continue
         try:
-            value = float(se.Length(text.strip()).value(ppi=96.0))
+            length = se.Length(text.strip()).value(ppi=96.0)
         except (ValueError, TypeError):
             return
-        if not math.isfinite(value):
-            return
-        sizes[attr] = value
+        if isinstance(length, se.Length) or not math.isfinite(float(length)):
+            return  # a percentage or a font-relative length: not resolved here
+        sizes[attr] = float(length)
     rx, ry = sizes.get("rx"), sizes.get("ry")
     if rx is None and ry is None:
         return

@@ -242,6 +242,8 @@ PX_PER_MM = 96 / 25.4
         ('width="10mm" height="20mm" rx="30"', 10 * PX_PER_MM, 20 * PX_PER_MM, 5 * PX_PER_MM, 30),
         # ry 1cm is 37.8 units: ry cut to half the height, rx (auto) to half of 0.4in
         ('width="0.4in" height="30" ry="1cm"', 38.4, 30, 19.2, 15),
+        # rx auto is ry (3mm, 11.3 units), each then cut to half its side
+        ('width="10" height="20" style="rx:auto;ry:3mm"', 10, 20, 5, 10),
         # sizes and radius as SVG 2 style properties
         ('style="width:10mm;height:20mm;rx:30"', 10 * PX_PER_MM, 20 * PX_PER_MM, 5 * PX_PER_MM, 30),
     ],
