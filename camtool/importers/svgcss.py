@@ -119,6 +119,43 @@ def normalize_styles(root: ET.Element) -> None:
             value = element.get(attr)
             if value is not None and value != value.lower() and value.strip().lower() in _KEYWORDS:
                 element.set(attr, value.strip().lower())
+        _drop_inherit(element)
+
+
+_INHERITABLE = frozenset(
+    {
+        "fill", "stroke", "color", "display", "visibility", "opacity", "fill-opacity",
+        "stroke-opacity", "fill-rule", "clip-rule", "clip-path", "mask", "filter",
+        "stroke-dasharray", "stroke-width", "marker", "marker-start", "marker-mid",
+        "marker-end", "stop-color", "stop-opacity",
+    }
+)  # fmt: skip
+"""The presentation attributes whose ``inherit`` :func:`_drop_inherit` resolves."""
+
+
+def _drop_inherit(element: ET.Element) -> None:
+    """Remove each ``inherit`` declaration, so the property comes from the parent.
+
+    svgelements reads the keyword as a value: ``stroke="inherit"`` as black, so a shape
+    under ``<g stroke="none">`` was cut where a viewer shows nothing, and a shape under a
+    red group had no colour for a job to select. For an inherited property (``fill``,
+    ``stroke``, ``visibility``, ...) no declaration is ``inherit`` (CSS Cascade 4 §7.3);
+    for the others camtool reads (``display``, ``opacity``, ``clip-path``, ``mask``), the
+    parent's value already applies to the whole group. A ``style`` declaration outranks
+    the attribute, so both go.
+    """
+    style = element.get("style")
+    if style and "inherit" in style.lower():
+        declared = inline_style(element)
+        inherits = [k for k, v in declared.items() if v.strip().lower() == "inherit"]
+        for key in inherits:
+            del declared[key]
+            element.attrib.pop(key, None)
+        if inherits:
+            element.set("style", style_text(declared))
+    for attr in _INHERITABLE.intersection(element.attrib):
+        if element.attrib[attr].strip().lower() == "inherit":
+            del element.attrib[attr]
 
 
 # ---------------------------------------------------------------------------- selectors

@@ -214,6 +214,25 @@ def test_important_and_upper_case_hide_as_css_says(tmp_path: Path) -> None:
     assert [c.source for c in drawing.contours] == ["path#kept"]
 
 
+def test_inherit_takes_the_parents_value_as_css_says(tmp_path: Path) -> None:
+    """``inherit`` is the parent's value (CSS Cascade 4 §7.3), never a colour of its own;
+    a style declaration outranks the attribute, as a style sheet's rule does."""
+    body = (
+        "<style>.k { stroke: INHERIT }</style>"
+        '<g fill="none" stroke="none"><path id="f" d="M 0 0 L 9 0 L 9 9 Z" fill="inherit"/>'
+        '<path id="s" d="M 0 0 L 9 0" stroke="inherit"/>'
+        '<path id="k" class="k" d="M 0 0 L 9 0" stroke="red"/></g>'  # the rule's none wins
+        '<g visibility="hidden" stroke="black"><path id="v" d="M 0 5 L 9 5" '
+        'visibility="inherit"/></g>'
+        '<g fill="none" stroke="#0000ff" stroke-dasharray="4 2">'
+        '<path id="dash" d="M 0 9 L 9 9" stroke-dasharray="inherit"/>'
+        '<path id="blue" d="M 0 8 L 9 8" style="stroke: inherit" stroke="green"/></g>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    got = [(c.source, c.colour, c.linetype) for c in drawing.contours]
+    assert got == [("path#dash", "#0000ff", "DASHED"), ("path#blue", "#0000ff", "DASHED")]
+
+
 def test_a_rule_that_hides_through_a_selector_camtool_cannot_apply_is_refused(
     tmp_path: Path,
 ) -> None:
