@@ -122,39 +122,68 @@ def normalize_styles(root: ET.Element) -> None:
         _drop_inherit(element)
 
 
-_INHERITABLE = frozenset(
-    {
-        "fill", "stroke", "color", "display", "visibility", "opacity", "fill-opacity",
-        "stroke-opacity", "fill-rule", "clip-rule", "clip-path", "mask", "filter",
-        "stroke-dasharray", "stroke-width", "marker", "marker-start", "marker-mid",
-        "marker-end", "stop-color", "stop-opacity",
-    }
-)  # fmt: skip
-"""The presentation attributes whose ``inherit`` :func:`_drop_inherit` resolves."""
+_INITIAL = {
+    "fill": "black",
+    "stroke": "none",
+    "color": "black",
+    "display": "inline",
+    "visibility": "visible",
+    "opacity": "1",
+    "fill-opacity": "1",
+    "stroke-opacity": "1",
+    "fill-rule": "nonzero",
+    "clip-rule": "nonzero",
+    "clip-path": "none",
+    "mask": "none",
+    "filter": "none",
+    "stroke-dasharray": "none",
+    "stroke-width": "1",
+    "marker": "none",
+    "marker-start": "none",
+    "marker-mid": "none",
+    "marker-end": "none",
+    "stop-color": "black",
+    "stop-opacity": "1",
+}
+"""The presentation properties camtool reads, and their initial values (SVG 1.1 Appendix
+N, property index): what :func:`_drop_inherit` writes for ``initial``."""
+_FROM_PARENT = frozenset({"inherit", "unset", "revert", "revert-layer"})
+"""CSS-wide keywords that, for the properties of :data:`_INITIAL`, give the parent's value
+(an inherited property's) or, for the few that are not inherited, one the group already
+shows (``display``, ``opacity``, ``clip-path``, ``mask``)."""
 
 
 def _drop_inherit(element: ET.Element) -> None:
-    """Remove each ``inherit`` declaration, so the property comes from the parent.
+    """Resolve the CSS-wide keywords (``inherit``, ``unset``, ``initial``, ``revert``).
 
-    svgelements reads the keyword as a value: ``stroke="inherit"`` as black, so a shape
+    svgelements reads a keyword as a value: ``stroke="inherit"`` as black, so a shape
     under ``<g stroke="none">`` was cut where a viewer shows nothing, and a shape under a
-    red group had no colour for a job to select. For an inherited property (``fill``,
-    ``stroke``, ``visibility``, ...) no declaration is ``inherit`` (CSS Cascade 4 §7.3);
-    for the others camtool reads (``display``, ``opacity``, ``clip-path``, ``mask``), the
-    parent's value already applies to the whole group. A ``style`` declaration outranks
-    the attribute, so both go.
+    red group had no colour for a job to select. In a ``style`` (a style sheet's rules
+    are there by now): ``inherit``, ``unset`` and ``revert`` remove the declaration, and
+    the attribute it outranks, so the property comes from the parent (CSS Cascade 4
+    §7.3); ``initial`` becomes the property's initial value (``stroke: initial`` is
+    ``none``). As an attribute, ``inherit`` (SVG 1.1) and the keywords that are not valid
+    there alike are removed.
     """
     style = element.get("style")
-    if style and "inherit" in style.lower():
+    if style and any(word in style.lower() for word in ("inherit", "unset", "initial", "revert")):
         declared = inline_style(element)
-        inherits = [k for k, v in declared.items() if v.strip().lower() == "inherit"]
-        for key in inherits:
-            del declared[key]
-            element.attrib.pop(key, None)
-        if inherits:
+        changed = False
+        for key, value in list(declared.items()):
+            word = value.strip().lower()
+            if key not in _INITIAL:
+                continue
+            if word in _FROM_PARENT:
+                del declared[key]
+                element.attrib.pop(key, None)
+                changed = True
+            elif word == "initial":
+                declared[key] = _INITIAL[key]
+                changed = True
+        if changed:
             element.set("style", style_text(declared))
-    for attr in _INHERITABLE.intersection(element.attrib):
-        if element.attrib[attr].strip().lower() == "inherit":
+    for attr in _INITIAL.keys() & element.attrib.keys():
+        if element.attrib[attr].strip().lower() in _FROM_PARENT | {"initial"}:
             del element.attrib[attr]
 
 

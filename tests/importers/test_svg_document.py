@@ -215,22 +215,33 @@ def test_important_and_upper_case_hide_as_css_says(tmp_path: Path) -> None:
 
 
 def test_inherit_takes_the_parents_value_as_css_says(tmp_path: Path) -> None:
-    """``inherit`` is the parent's value (CSS Cascade 4 §7.3), never a colour of its own;
-    a style declaration outranks the attribute, as a style sheet's rule does."""
+    """``inherit``, ``unset`` and ``revert`` give an inherited property the parent's value,
+    ``initial`` its initial one (CSS Cascade 4 §7.3), never a colour of their own; a style
+    declaration outranks the attribute, as a style sheet's rule does."""
     body = (
         "<style>.k { stroke: INHERIT }</style>"
         '<g fill="none" stroke="none"><path id="f" d="M 0 0 L 9 0 L 9 9 Z" fill="inherit"/>'
         '<path id="s" d="M 0 0 L 9 0" stroke="inherit"/>'
-        '<path id="k" class="k" d="M 0 0 L 9 0" stroke="red"/></g>'  # the rule's none wins
+        '<path id="k" class="k" d="M 0 0 L 9 0" stroke="red"/>'  # the rule's none wins
+        '<path id="u" d="M 0 1 L 9 1" style="stroke: unset"/>'
+        '<path id="r" d="M 0 2 L 9 2" style="stroke: revert"/>'
+        '<path id="i" d="M 0 3 L 9 3" style="stroke: initial" stroke="red"/>'  # none
+        '<path id="black" d="M 0 4 L 9 4 L 9 9 Z" style="fill: initial"/></g>'
         '<g visibility="hidden" stroke="black"><path id="v" d="M 0 5 L 9 5" '
-        'visibility="inherit"/></g>'
+        'visibility="inherit"/><path id="vu" d="M 0 6 L 9 6" style="visibility: unset"/>'
+        '<path id="shown" d="M 0 7 L 9 7" style="visibility: initial"/></g>'
         '<g fill="none" stroke="#0000ff" stroke-dasharray="4 2">'
         '<path id="dash" d="M 0 9 L 9 9" stroke-dasharray="inherit"/>'
         '<path id="blue" d="M 0 8 L 9 8" style="stroke: inherit" stroke="green"/></g>'
     )
     drawing = read_svg(svg(tmp_path, body))
     got = [(c.source, c.colour, c.linetype) for c in drawing.contours]
-    assert got == [("path#dash", "#0000ff", "DASHED"), ("path#blue", "#0000ff", "DASHED")]
+    assert got == [
+        ("path#black", "#000000", ""),
+        ("path#shown", "#000000", ""),
+        ("path#dash", "#0000ff", "DASHED"),
+        ("path#blue", "#0000ff", "DASHED"),
+    ]
 
 
 def test_a_rule_that_hides_through_a_selector_camtool_cannot_apply_is_refused(
