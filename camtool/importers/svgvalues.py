@@ -212,17 +212,86 @@ def _rewrite(values: dict[str, str]) -> bool:
                     values[name] = clamped
     for name in _PAINTS:
         value = values.get(name)
-        if value and "(" in value:
-            rgba = _rgba(value)
-            if rgba is not None and rgba != value:
-                values[name] = rgba
-                changed = True
+        if value is None:
+            continue
+        paint = _paint(value)
+        if paint != value:
+            changed = True
+            if paint is None:
+                del values[name]
+            else:
+                values[name] = paint
     return changed
+
+
+def _paint(value: str) -> str | None:
+    """A ``fill``, ``stroke`` or ``color`` as svgelements reads it; ``None``: not a value.
+
+    svgelements reads every value it does not know as black. A value that is no colour
+    (``notacolour``, ``#12``, ``dark blue``, ``rgb(1, 2)``) is an invalid declaration,
+    which CSS ignores (the property then comes from the parent): ``None``. White space
+    around a keyword, ``currentcolor`` in any case, CSS Color 4's ``rebeccapurple`` and
+    ``aliceblue`` (which svgelements reads as another colour) and SVG 1.1's ``#f00
+    icc-color(…)`` are written as it reads them; ``rgb()``/``hsl()`` as :func:`_rgba` writes
+    them. A paint server (``url(…)``), a context paint, a system colour or a colour function
+    camtool does not read (``lab()``) is kept: the shape is painted, whatever the colour.
+    """
+    text = value.strip()
+    low = text.lower()
+    if low == "none" or low.startswith(("url(", "context-")):
+        return "none" if low == "none" else text
+    if low == "currentcolor":
+        return "currentColor"
+    words = low.split(maxsplit=1)
+    if len(words) == 2 and words[1].startswith("icc-color(") and "(" not in words[0]:
+        text = low = words[0]  # SVG 1.1: an sRGB colour, then an ICC colour for a printer
+    if "(" in text:
+        if _COLOUR_CALL.match(text):
+            return _rgba(text) or value  # one it does not read: as svgelements reads it
+        return value  # another colour function: painted
+    if low in _RENAMED:
+        return _RENAMED[low]
+    if _HEX.fullmatch(low) or low == "transparent" or low in _SYSTEM_COLOURS:
+        return text
+    if _IDENT.fullmatch(low) and _named(low):
+        return text
+    return None
+
+
+_HEX = re.compile(r"#(?:[0-9a-f]{3,4}|[0-9a-f]{6}|[0-9a-f]{8})")
+_IDENT = re.compile(r"[a-z]+")
+_RENAMED = {"rebeccapurple": "#663399", "aliceblue": "#f0f8ff"}
+"""CSS Color 4 names svgelements reads as another colour (black; ``#faf8ff``)."""
+_SYSTEM_COLOURS = frozenset(
+    {
+        "canvas", "canvastext", "linktext", "visitedtext", "activetext", "buttonface",
+        "buttontext", "buttonborder", "field", "fieldtext", "highlight", "highlighttext",
+        "selecteditem", "selecteditemtext", "mark", "marktext", "graytext", "accentcolor",
+        "accentcolortext", "activeborder", "activecaption", "appworkspace", "background",
+        "buttonhighlight", "buttonshadow", "captiontext", "inactiveborder", "inactivecaption",
+        "inactivecaptiontext", "infobackground", "infotext", "menu", "menutext", "scrollbar",
+        "threeddarkshadow", "threedface", "threedhighlight", "threedlightshadow",
+        "threedshadow", "window", "windowframe", "windowtext",
+    }
+)  # fmt: skip
+"""CSS Color 4 §6.2 system colours (and the deprecated ones): painted, colour unknown."""
+
+
+def _named(name: str) -> bool:
+    """Whether svgelements knows ``name`` (lower case) as a colour (CSS Color 4 §6.1)."""
+    return name == "black" or se.Color.parse_color_lookup(name) != _BLACK
+
+
+_BLACK = se.Color.rgb_to_int(0, 0, 0)
 
 
 _OPACITIES = ("opacity", "fill-opacity", "stroke-opacity")
 _PAINTS = ("fill", "stroke", "color")
 _COLOUR_CALL = re.compile(r"(?:rgb|hsl)a?\(", re.IGNORECASE)
+_ODD_PAINT = re.compile(
+    r"(?:^|;)\s*(?:fill|stroke|color)\s*:(?!\s*(?:#[0-9a-fA-F]{3,8}|none|url\([^;]*)\s*(?:;|$))"
+)
+"""A paint in a style that is not a hex colour, ``none`` or ``url(…)`` (Inkscape's forms)."""
 _ODD_OPACITY = re.compile(
     r"opacity\s*:(?!\s*(?:[01]|0?\.\d+|1\.0*)\s*(?:!important\s*)?(?:;|$))", re.IGNORECASE
 )
@@ -237,6 +306,7 @@ def _rewritable(style: str) -> bool:
     return bool(
         ("(" in style and _COLOUR_CALL.search(style))
         or ("opacity" in style and _ODD_OPACITY.search(style))
+        or _ODD_PAINT.search(style)
     )
 
 

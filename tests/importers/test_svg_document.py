@@ -244,6 +244,30 @@ def test_inherit_takes_the_parents_value_as_css_says(tmp_path: Path) -> None:
     ]
 
 
+def test_a_paint_that_is_no_colour_is_ignored_as_css_says(tmp_path: Path) -> None:
+    """An invalid ``fill``/``stroke`` declaration is ignored (CSS Syntax 3), so the parent's
+    paint applies; keywords are read in any case and with white space around them."""
+    body = (
+        '<g fill="none" stroke="none" color="#ff0000">'
+        '<path id="name" d="M 0 0 L 9 0" stroke="notacolour"/>'
+        '<path id="hex" d="M 0 1 L 9 1" stroke="#12"/>'
+        '<path id="words" d="M 0 2 L 9 2" stroke="dark blue"/>'
+        '<path id="style" d="M 0 3 L 9 3" style="stroke: bogus" stroke="blue"/>'  # attribute
+        '<path id="spaced" d="M 0 4 L 9 4" stroke="  none  "/>'
+        '<path id="current" d="M 0 5 L 9 5" stroke="CURRENTCOLOR"/>'
+        '<path id="icc" d="M 0 6 L 9 6" stroke="#00ff00 icc-color(acmecmyk, 0.1, 0.2)"/>'
+        '<path id="css4" d="M 0 7 L 9 7" style="stroke:rebeccapurple"/></g>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    got = [(c.source, c.colour) for c in drawing.contours]
+    assert got == [
+        ("path#style", "#0000ff"),
+        ("path#current", "#ff0000"),
+        ("path#icc", "#00ff00"),
+        ("path#css4", "#663399"),
+    ]
+
+
 def test_a_rule_that_hides_through_a_selector_camtool_cannot_apply_is_refused(
     tmp_path: Path,
 ) -> None:
