@@ -107,9 +107,10 @@ def style_text(declarations: dict[str, str]) -> str:
 def normalize_styles(root: ET.Element) -> None:
     """Every ``style`` attribute and presentation attribute as svgelements reads it.
 
-    CSS property names and keywords are case-insensitive and ``!important`` only ranks a
-    declaration; svgelements compares the text, so ``display:none !important`` or
-    ``DISPLAY: NONE`` would hide nothing and the element would be cut.
+    CSS property names and keywords are case-insensitive, white space around a value is
+    not part of it, and ``!important`` only ranks a declaration; svgelements compares the
+    text, so ``display:none !important``, ``DISPLAY: NONE`` or ``display="none "`` would hide
+    nothing and the element would be cut.
     """
     for element in root.iter():
         style = element.get("style")
@@ -117,8 +118,8 @@ def normalize_styles(root: ET.Element) -> None:
             element.set("style", style_text({k: v for k, v, _ in _declaration_list(style)}))
         for attr in _PRESENTATION:
             value = element.get(attr)
-            if value is not None and value != value.lower() and value.strip().lower() in _KEYWORDS:
-                element.set(attr, value.strip().lower())
+            if value is not None and value != (word := value.strip().lower()) and word in _KEYWORDS:
+                element.set(attr, word)
         _drop_inherit(element)
 
 

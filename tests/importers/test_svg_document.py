@@ -200,13 +200,16 @@ def test_a_style_sheet_hides_what_it_selects_wherever_it_stands(tmp_path: Path, 
 
 
 def test_important_and_upper_case_hide_as_css_says(tmp_path: Path) -> None:
-    """CSS property names and keywords ignore case; ``!important`` only ranks a declaration."""
+    """CSS property names and keywords ignore case and the white space around them;
+    ``!important`` only ranks a declaration."""
     body = (
         "<style>.off { DISPLAY: None ! IMPORTANT }</style>"
         '<path id="a" d="M 0 0 L 1 0" style="display:none !important"/>'
         '<path id="b" d="M 0 0 L 1 0" style="Visibility: HIDDEN"/>'
         '<path id="c" d="M 0 0 L 1 0" class="off"/>'
         '<path id="d" d="M 0 0 L 1 0" display="None"/>'
+        '<path id="d2" d="M 0 0 L 1 0" display="none "/>'  # white space is not the value
+        '<path id="v2" d="M 0 0 L 1 0" visibility="\thidden"/>'
         '<path id="e" d="M 0 0 L 1 0" style="fill:NONE;stroke:none !important"/>'
         '<path id="kept" d="M 0 0 L 1 0" style="fill:url(#Grad);stroke:currentColor"/>'
     )
