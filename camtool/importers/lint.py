@@ -491,7 +491,6 @@ def duplicates(contours: Sequence[Contour], tolerance: float) -> list[Finding]:
     boxes = box(grown[:, 0], grown[:, 1], grown[:, 2], grown[:, 3])
     found = STRtree(boxes).query(boxes, predicate="intersects")
     found = found[:, found[0] < found[1]]
-    found = found[:, _may_meet(segs, found[0], found[1], tolerance)]
     found = found[:, np.lexsort((found[1], found[0]))]  # by i, then j
     groups: dict[tuple[int, int, str], list[Any]] = {}
     for i, j in zip(found[0].tolist(), found[1].tolist(), strict=True):
@@ -517,53 +516,6 @@ def duplicates(contours: Sequence[Contour], tolerance: float) -> list[Finding]:
             msg = f"{what} {length:.4g} mm at {_pt(where)}"
         out.append(Finding(kind, msg, where, names))
     return out
-
-
-def _may_meet(segs: Sequence[tuple[Segment, int]], i: Any, j: Any, tol: float) -> Any:
-    """Which pairs ``(i[k], j[k])`` :func:`_same` or :func:`_overlap` may find (a superset).
-
-    Most pairs whose boxes touch are neighbours along a contour, which these numpy tests
-    leave out, so only the rest are judged one by one: two of a kind whose ends meet
-    either way (a duplicate), two lines either of which lies along the other's line, or
-    two arcs on one circle (an overlap). The tolerance is widened by a part in 10⁹ so
-    that no pair the exact tests keep is left out by rounding.
-    """
-    import numpy as np
-
-    reach = tol * (1.0 + 1e-9) + 1e-12
-    arc = np.array([isinstance(s, Arc) for s, _ in segs])
-    ends = np.array([(*s.start, *s.end) for s, _ in segs], dtype=np.float64)
-    circles = np.array(
-        [(*s.centre, s.radius) if isinstance(s, Arc) else (0.0, 0.0, 0.0) for s, _ in segs]
-    )
-    a, b = ends[i], ends[j]
-
-    def near(p: Any, q: Any) -> Any:
-        return np.hypot(p[:, 0] - q[:, 0], p[:, 1] - q[:, 1]) <= reach
-
-    kind = arc[i] == arc[j]
-    ends_meet = (near(a[:, :2], b[:, :2]) & near(a[:, 2:], b[:, 2:])) | (
-        near(a[:, :2], b[:, 2:]) & near(a[:, 2:], b[:, :2])
-    )
-    ca, cb = circles[i], circles[j]
-    one_circle = arc[i] & arc[j] & near(ca, cb) & (np.abs(ca[:, 2] - cb[:, 2]) <= reach)
-    lines = ~arc[i] & ~arc[j]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        along = _along(a, b, reach) | _along(b, a, reach)
-    return (kind & ends_meet) | one_circle | (lines & along)
-
-
-def _along(a: Any, b: Any, reach: float) -> Any:
-    """Whether both ends of each line ``b`` lie within ``reach`` of line ``a``'s line (NaN: yes)."""
-    import numpy as np
-
-    dx, dy = a[:, 2] - a[:, 0], a[:, 3] - a[:, 1]
-    length = np.hypot(dx, dy)
-    ux, uy = dx / length, dy / length
-    off0 = (b[:, 0] - a[:, 0]) * -uy + (b[:, 1] - a[:, 1]) * ux
-    off1 = (b[:, 2] - a[:, 0]) * -uy + (b[:, 3] - a[:, 1]) * ux
-    far = (np.abs(off0) > reach) | (np.abs(off1) > reach)
-    return ~far
 
 
 def short_segments(contours: Sequence[Contour], tiny_mm: float) -> list[Finding]:

@@ -152,60 +152,6 @@ def test_overlapping_collinear_lines_and_arcs() -> None:
     assert arc.sources == ("upper half", "quarter") and "share 7.854 mm" in arc.message
 
 
-def _random_segments(rng: Any, n: int) -> list[Line | Arc]:
-    """Lines and arcs with copies, reversals, collinear and co-circular pieces, within ~tol."""
-    import math
-
-    out: list[Line | Arc] = []
-    for _ in range(n):
-        jig = rng.uniform(-1.2, 1.2, 2) * TOL  # copies off by up to 1.7 tolerances
-        kind = rng.integers(0, 4)
-        if out and kind == 0:  # a copy of an earlier one, perhaps reversed, a little off
-            s = out[rng.integers(0, len(out))]
-            start, end = (s.end, s.start) if rng.random() < 0.5 else (s.start, s.end)
-            start = (start[0] + jig[0], start[1] + jig[1])
-            if isinstance(s, Arc):
-                out.append(Arc(start, end, s.centre, s.clockwise))
-            else:
-                out.append(Line(start, end))
-        elif kind == 1:  # a piece of the line y = x, somewhere along it
-            a, b = sorted(rng.uniform(0, 10, 2))
-            out.append(Line((a, a + jig[1]), (b + 0.01, b + 0.01)))
-        else:  # an arc of one of two circles
-            r = (3.0, 5.0)[kind % 2]
-            t0, t1 = rng.uniform(0, 2 * math.pi, 2)
-            p0 = (20 + r * math.cos(t0), r * math.sin(t0))
-            p1 = (20 + r * math.cos(t1), r * math.sin(t1))
-            out.append(Arc(p0, p1, (20.0 + jig[0], 0.0), bool(rng.integers(0, 2))))
-    return out
-
-
-@pytest.mark.parametrize("seed", range(6))
-def test_the_numpy_prefilter_leaves_out_no_pair_the_checks_would_find(seed: int) -> None:
-    """The duplicate and overlap findings equal those of every pair judged one by one."""
-    from collections import Counter
-
-    import numpy as np
-
-    from camtool.importers import lint
-
-    rng = np.random.default_rng(seed)
-    contours = [Contour((s,), False, "0", f"c{k}") for k, s in enumerate(_random_segments(rng, 60))]
-    for tol in (TOL, 0.05):
-        found = {(f.kind, f.sources) for f in lint.duplicates(contours, tol)}
-        every: Counter[tuple[str, tuple[str, ...]]] = Counter()
-        for i, a in enumerate(contours):
-            for b in contours[i + 1 :]:
-                sa, sb = a.segments[0], b.segments[0]
-                names = (a.source, b.source)
-                if lint._same(sa, sb, tol):
-                    every["duplicate", names] += 1
-                elif lint._overlap(sa, sb, tol) is not None:
-                    every["overlap", names] += 1
-        assert found == set(every)
-        assert len(found) > 5  # the drawing has duplicates and overlaps to find
-
-
 def test_tiny_segments_use_ten_tolerances_by_default() -> None:
     drawing = Drawing(
         (Contour((Line((0, 0), (0.005, 0)), Line((0.005, 0), (5, 0))), False, "0", "p"),)
