@@ -13,8 +13,8 @@ attributes into the form svgelements reads as SVG means them:
 - :func:`resolve_paint_references`: a ``url(#id)`` paint that paints nothing as its
   fallback;
 - :func:`normalize_colours`: ``rgb()``/``hsl()`` colours in the forms svgelements does
-  not read (fractions, exponents, CSS Color 4's spaces and ``/ alpha``) as ``rgba()``, and
-  opacities clamped to [0, 1].
+  not read (fractions, exponents, CSS Color 4's spaces and ``/ alpha``) as ``rgba()``,
+  paints that are no colour dropped, and opacities clamped to [0, 1].
 
 Sources: SVG 1.1 §7.10 (units), §13.2 (paint servers); SVG 2 §10 (shapes), §13.2
 (paint); CSS Transforms 1 §6; CSS Color 4 §5.1 (``rgb()``), §7 (``hsl()``).
@@ -179,6 +179,7 @@ def normalize_colours(root: ET.Element) -> None:
     ``opacity``, ``fill-opacity`` and ``stroke-opacity`` are clamped to [0, 1] (a
     percentage is of 1), and one that is no number is dropped, its initial value 1 (CSS:
     an invalid declaration is ignored): svgelements raised on ``fill-opacity="1e400"``.
+    A ``fill``, ``stroke`` or ``color`` that is no colour is dropped too (:func:`_paint`).
     Run after the style sheets are applied.
     """
     for element in root.iter():
@@ -200,27 +201,18 @@ def _rewrite(values: dict[str, str]) -> bool:
         Whether a value changed (``values`` is changed in place).
     """
     changed = False
-    for name in _OPACITIES:
-        value = values.get(name)
-        if value is not None:
-            clamped = _opacity(value)
-            if clamped != value:
+    for names, read in ((_OPACITIES, _opacity), (_PAINTS, _paint)):
+        for name in names:
+            value = values.get(name)
+            if value is None:
+                continue
+            written = read(value)
+            if written != value:
                 changed = True
-                if clamped is None:
+                if written is None:
                     del values[name]
                 else:
-                    values[name] = clamped
-    for name in _PAINTS:
-        value = values.get(name)
-        if value is None:
-            continue
-        paint = _paint(value)
-        if paint != value:
-            changed = True
-            if paint is None:
-                del values[name]
-            else:
-                values[name] = paint
+                    values[name] = written
     return changed
 
 
@@ -228,7 +220,7 @@ def _paint(value: str) -> str | None:
     """A ``fill``, ``stroke`` or ``color`` as svgelements reads it; ``None``: not a value.
 
     svgelements reads every value it does not know as black. A value that is no colour
-    (``notacolour``, ``#12``, ``dark blue``, ``rgb(1, 2)``) is an invalid declaration,
+    (``notacolour``, ``#12``, ``dark blue``) is an invalid declaration,
     which CSS ignores (the property then comes from the parent): ``None``. White space
     around a keyword, ``currentcolor`` in any case, CSS Color 4's ``rebeccapurple`` and
     ``aliceblue`` (which svgelements reads as another colour) and SVG 1.1's ``#f00
