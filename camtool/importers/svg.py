@@ -518,9 +518,9 @@ def shape_segments(shape: Any) -> list[Any]:
     ``S`` reflects the previous segment's second control point only when that segment is a
     cubic (``C``/``S``), ``T`` the previous control point only when it is a quadratic
     (``Q``/``T``); after any other segment the (first) control point is the current point
-    (SVG 1.1 §8.3.6, §8.3.7). svgelements reflects either kind's last control point: ``S``
-    after ``Q`` and ``T`` after ``C`` gave another curve (up to 5 mm off in a random
-    drawing), and every ``T`` chained after such a ``T`` with it.
+    (SVG 1.1 §8.3.6, §8.3.7). svgelements reflects either kind's last control point, which
+    makes ``S`` after ``Q`` and ``T`` after ``C`` another curve, millimetres off, and every
+    ``T`` chained after such a ``T`` with it.
 
     Raises:
         Exception: whatever svgelements raises on the shape's segments.

@@ -157,9 +157,9 @@ shows (``display``, ``opacity``, ``clip-path``, ``mask``)."""
 def _drop_inherit(element: ET.Element) -> None:
     """Resolve the CSS-wide keywords (``inherit``, ``unset``, ``initial``, ``revert``).
 
-    svgelements reads a keyword as a value: ``stroke="inherit"`` as black, so a shape
-    under ``<g stroke="none">`` was cut where a viewer shows nothing, and a shape under a
-    red group had no colour for a job to select. In a ``style`` (a style sheet's rules
+    svgelements reads a keyword as a value: ``stroke="inherit"`` as black, which would cut
+    a shape under ``<g stroke="none">`` that a viewer does not show, and leave one under a
+    red group without a colour for a job to select. In a ``style`` (a style sheet's rules
     are there by now): ``inherit``, ``unset`` and ``revert`` remove the declaration, and
     the attribute it outranks, so the property comes from the parent (CSS Cascade 4
     §7.3); ``initial`` becomes the property's initial value (``stroke: initial`` is

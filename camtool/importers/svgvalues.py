@@ -77,9 +77,9 @@ def rect_radii(element: ET.Element) -> None:
 
     A radius not given is the other one (``auto``), and each is then at most half its side:
     ``rx`` of the width, ``ry`` of the height (SVG 1.1 §9.2). svgelements applies the limit
-    only when the sizes and radii are plain numbers: ``rx="2mm"`` on a rect 5 units wide,
-    or ``rx="30"`` on one ``10mm`` wide, rounded the corners past the sides, a corner
-    bulging out of the part. Sizes and radii in the ``style`` (SVG 2) count, and are
+    only when the sizes and radii are plain numbers: it would round ``rx="2mm"`` on a rect 5
+    units wide, or ``rx="30"`` on one ``10mm`` wide, past the sides, a corner bulging out of
+    the part. Sizes and radii in the ``style`` (SVG 2) count, and are
     written back as attributes; ``auto`` is a radius not given. A rect with a length
     camtool does not read here (``em``, ``ex``, a percentage left in a style) is left as
     it is. Run after the lengths are checked.
