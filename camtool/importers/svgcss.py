@@ -18,7 +18,7 @@ svgelements' (it passes a group's style down).
 
 Selectors applied: compound selectors (``*``, a type, ``#id``, ``.class``, any together:
 ``path.cut.outer``, ``rect#a``) joined by descendant (space) or child (``>``) combinators.
-Others (attributes ``[x]``, pseudo-classes ``:hover``, sibling combinators ``+``/``~``,
+Others (attributes ``[x]``, pseudo-classes ``:first-child``, sibling combinators ``+``/``~``,
 at-rules ``@media``) are not applied: :func:`apply_style_sheets` refuses such a rule if it
 hides what it selects, and names the others in a warning (``@font-face`` excepted: a font
 styles nothing).
@@ -310,8 +310,9 @@ def apply_style_sheets(
 
     Raises:
         InputError: a rule not applied would hide what it selects (``display:none``,
-            ``visibility:hidden``), so its elements would be cut; pseudo-classes such as
-            ``:hover`` excepted, which hide nothing in a still picture.
+            ``visibility:hidden``, ``opacity:0``), so its elements would be cut; a rule
+            of the user's actions (``:hover``) or of a pseudo-element excepted, which
+            selects nothing in a still picture (:func:`_acted`).
     """
     sheets = list(root.iter(f"{{{SVG_NS}}}style" if root.tag.startswith("{") else "style"))
     if not sheets:
@@ -330,9 +331,8 @@ def apply_style_sheets(
                 if selector is not None:
                     rules.append(_Rule(selector, len(rules), declarations))
                     continue
-                said = (f"{k}:{v}" for k, v, _ in declarations)
-                hiding = next((d for d in said if d in _HIDING), None)
-                if hiding is not None and ":" not in text:
+                hiding = next((f"{k}:{v}" for k, v, _ in declarations if _hides(k, v)), None)
+                if hiding is not None and not _acted(text):
                     raise InputError(
                         f"{name}: the <style> rule '{text}' hides what it selects ({hiding}), "
                         "but camtool does not apply its selector (it applies types, .class, "
@@ -352,6 +352,37 @@ def apply_style_sheets(
         f"{name}: {len(ignored)} <style> rule(s) not applied ({shown}): camtool applies types, "
         ".class, #id and their descendants; what they style is read without them"
     ]
+
+
+def _hides(prop: str, value: str) -> bool:
+    """Whether the declaration hides what it styles (``display:none``, ``opacity:0``, ...)."""
+    if prop == "opacity":
+        text = value.strip()
+        try:
+            number = float(text[:-1] if text.endswith("%") else text)
+        except ValueError:
+            return False
+        return number <= 0.0  # clamped to [0, 1]: at most 0 is 0
+    return f"{prop}:{value}" in _HIDING
+
+
+_ACTIONS = frozenset({"hover", "active", "focus", "focus-visible", "focus-within", "visited"})
+"""Pseudo-classes of the user's actions (Selectors 4 §9): in a still picture they hold for
+no element."""
+
+
+def _acted(selector: str) -> bool:
+    """Whether ``selector`` selects nothing in a still picture.
+
+    It names a pseudo-class of the user's actions (``a:hover path``), outside a ``:not()``,
+    or a pseudo-element (``::before``), which is no SVG shape. A structural pseudo-class
+    (``:first-child``, ``:nth-child(2)``) selects in a still picture as anywhere.
+    """
+    if "::" in selector:
+        return True
+    if ":not(" in selector.lower():
+        return False
+    return any(name.lower() in _ACTIONS for name in re.findall(r":([A-Za-z-]+)", selector))
 
 
 def _cascade(root: ET.Element, parents: dict[ET.Element, ET.Element], rules: list[_Rule]) -> None:

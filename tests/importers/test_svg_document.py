@@ -271,31 +271,43 @@ def test_a_paint_that_is_no_colour_is_ignored_as_css_says(tmp_path: Path) -> Non
     ]
 
 
+@pytest.mark.parametrize(
+    ("rule", "named"),
+    [
+        ("/* a comment { } */ g + path { display : none !important }", r"g \+ path"),
+        # a structural pseudo-class selects in a still picture as anywhere
+        ("g > path:first-child { visibility: hidden }", "g > path:first-child"),
+        ("path:not(:hover) { display: none }", r"path:not\(:hover\)"),
+        ("path[id=a] { opacity: 0% }", r"path\[id=a\]"),
+    ],
+)
 def test_a_rule_that_hides_through_a_selector_camtool_cannot_apply_is_refused(
-    tmp_path: Path,
+    tmp_path: Path, rule: str, named: str
 ) -> None:
     body = (
-        "<style>/* a comment { } */ g + path { display : none !important }</style>"
-        '<g/><path id="a" d="M 0 0 L 1 0"/><path id="kept" d="M 0 0 L 1 0"/>'
+        f"<style>{rule}</style>"
+        '<g><path id="a" d="M 0 0 L 1 0"/><path id="kept" d="M 0 0 L 1 0"/></g>'
     )
-    with pytest.raises(InputError, match=r"t\.svg: the <style> rule 'g \+ path' hides"):
+    with pytest.raises(InputError, match=rf"t\.svg: the <style> rule '{named}' hides"):
         read_svg(svg(tmp_path, body))
 
 
 def test_rules_that_hide_nothing_still_are_named(tmp_path: Path) -> None:
-    """A pseudo-class or a print style hides nothing on the screen: read, with a warning."""
+    """A pseudo-class of the user's actions, a pseudo-element or a print style hides nothing
+    in a still picture: read, with a warning."""
     body = (
         "<style>@font-face { font-family: Sans; src: url(s.woff) }"
         " a:hover path { display: none } @media print { .x { display: none } }"
+        " path::selection { opacity: 0 }"
         " path[id=y] { stroke: red }</style>"
         '<path id="x" class="x" d="M 0 0 L 1 0"/><g><path id="y" d="M 0 0 L 1 0"/></g>'
     )
     drawing = read_svg(svg(tmp_path, body))
     assert [c.source for c in drawing.contours] == ["path#x", "path#y"]
     assert drawing.warnings == (
-        f"{tmp_path / 't.svg'}: 3 <style> rule(s) not applied ('a:hover path', '@media print', "
-        "'path[id=y]'): camtool applies types, .class, #id and their descendants; what they "
-        "style is read without them",
+        f"{tmp_path / 't.svg'}: 4 <style> rule(s) not applied ('a:hover path', '@media print', "
+        "'path::selection' ...): camtool applies types, .class, #id and their descendants; "
+        "what they style is read without them",
     )
 
 
