@@ -421,7 +421,7 @@ def _style(values: Any) -> tuple[str, str]:
     colour = ""
     for key in ("stroke", "fill"):
         paint = str(values.get(key) or "none").strip()
-        if _none(paint) or paint.lower().startswith(("url(", "currentcolor", "inherit")):
+        if _none(paint) or paint.lower().startswith(("url(", "currentcolor")):
             continue
         try:
             rgb = se.Color(paint)

@@ -120,7 +120,7 @@ def normalize_styles(root: ET.Element) -> None:
             value = element.get(attr)
             if value is not None and value != (word := value.strip().lower()) and word in _KEYWORDS:
                 element.set(attr, word)
-        _drop_inherit(element)
+        _css_wide_keywords(element)
 
 
 _INITIAL = {
@@ -147,14 +147,14 @@ _INITIAL = {
     "stop-opacity": "1",
 }
 """The presentation properties camtool reads, and their initial values (SVG 1.1 Appendix
-N, property index): what :func:`_drop_inherit` writes for ``initial``."""
+N, property index): what :func:`_css_wide_keywords` writes for ``initial``."""
 _FROM_PARENT = frozenset({"inherit", "unset", "revert", "revert-layer"})
 """CSS-wide keywords that, for the properties of :data:`_INITIAL`, give the parent's value
 (an inherited property's) or, for the few that are not inherited, one the group already
 shows (``display``, ``opacity``, ``clip-path``, ``mask``)."""
 
 
-def _drop_inherit(element: ET.Element) -> None:
+def _css_wide_keywords(element: ET.Element) -> None:
     """Resolve the CSS-wide keywords (``inherit``, ``unset``, ``initial``, ``revert``).
 
     svgelements reads a keyword as a value: ``stroke="inherit"`` as black, which would cut

@@ -439,6 +439,9 @@ def _markers(
     reference to no ``<marker>`` with shapes sets none (SVG 1.1 §11.6.2). A ``style``
     declaration outranks the attribute.
     """
+    text = element.get("style") or ""
+    if "marker" not in text and _MARKER_PROPERTIES.keys().isdisjoint(element.attrib):
+        return inherited  # sets none: the style is not parsed (most elements)
     style = inline_style(element)
     out = set(inherited)
     for prop, places in _MARKER_PROPERTIES.items():

@@ -163,7 +163,7 @@ def _own(element: ET.Element) -> dict[str, str]:
     out = {}
     for key in _INHERITED:
         value = style.get(key, element.get(key))
-        if value is not None and value.strip().lower() != "inherit":
+        if value is not None:  # CSS-wide keywords are resolved by then (svgcss)
             out[key] = value.strip()
     return out
 
@@ -206,7 +206,7 @@ def _black(paint: str) -> bool:
 
 def _colour(paint: str) -> se.Color | None:
     """The solid colour ``paint`` names; ``None`` for a reference or a keyword of context."""
-    if paint.strip().lower().startswith(("url(", "currentcolor", "inherit", "context-")):
+    if paint.strip().lower().startswith(("url(", "currentcolor", "context-")):
         return None
     try:
         colour = se.Color(paint)

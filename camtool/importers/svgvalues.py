@@ -308,9 +308,8 @@ _NUMBER = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(%?)\s*")
 def _opacity(value: str) -> str | None:
     """An opacity clamped to [0, 1] as written (unchanged when already so); None: no number.
 
-    ``inherit`` is None too: ``fill-opacity`` and ``stroke-opacity`` are inherited anyway
-    (svgelements read the keyword as 1), and a group's ``opacity`` of 0 is given to all
-    under it by :func:`camtool.importers.svgdoc.fade_under_transparent`.
+    CSS-wide keywords (``inherit``) are resolved before
+    (:func:`~camtool.importers.svgcss.normalize_styles`).
     """
     match = _NUMBER.fullmatch(value)
     if match is None:
