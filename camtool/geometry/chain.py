@@ -87,9 +87,9 @@ def chain_members(
         _extend(segs, pieces, grid, used, joined, tolerance, forward=False)
         members.append(tuple(joined))
         # One line cannot close on itself (zero-length lines are dropped on import);
-        # one arc can: a full circle drawn as an ARC from 0° to 360°.
+        # one arc can: a full circle drawn as an ARC from 0° to 360°, not a speck.
         meets = distance(segs[-1].end, segs[0].start) <= tolerance
-        closed = meets and (len(segs) > 1 or isinstance(segs[0], Arc))
+        closed = meets and (len(segs) > 1 or closes_alone(segs[0]))
         if closed:
             segs[-1] = with_end(segs[-1], segs[0].start)
         elif len(segs) == len(contour.segments):  # nothing joined: the contour as it was
@@ -137,17 +137,48 @@ def _extend(
 
 
 def with_start(seg: Segment, p: Point) -> Segment:
-    """``seg`` moved to start exactly at ``p`` (an arc keeps its centre and direction)."""
+    """``seg`` moved to start exactly at ``p`` (an arc keeps its centre and direction).
+
+    An arc shorter than the move may pass its other end: :func:`moved_arc` makes it a line.
+    """
     if isinstance(seg, Line):
         return Line(p, seg.end)
-    return Arc(p, seg.end, seg.centre, seg.clockwise)
+    return moved_arc(seg, p, seg.end)
 
 
 def with_end(seg: Segment, p: Point) -> Segment:
-    """``seg`` moved to end exactly at ``p`` (an arc keeps its centre and direction)."""
+    """``seg`` moved to end exactly at ``p`` (an arc keeps its centre and direction).
+
+    An arc shorter than the move may pass its other end: :func:`moved_arc` makes it a line.
+    """
     if isinstance(seg, Line):
         return Line(seg.start, p)
-    return Arc(seg.start, p, seg.centre, seg.clockwise)
+    return moved_arc(seg, seg.start, p)
+
+
+def moved_arc(arc: Arc, start: Point, end: Point) -> Segment:
+    """``arc`` with its ends moved (by a joint's few µm) to ``start`` and ``end``, mm.
+
+    The arc keeps its centre and direction, unless the move turned it inside out: an arc
+    shorter than the move whose end was moved back past its start (or its start past its
+    end) would run the other way round, nearly its whole circle (a 0.004 mm ARC of radius
+    50 would be cut as a 100 mm circle). Such an arc is the line between the two points
+    instead: it was within the move of both.
+    """
+    moved = Arc(start, end, arc.centre, arc.clockwise)
+    if abs(moved.sweep) > abs(arc.sweep) + math.pi:
+        return Line(start, end)
+    return moved
+
+
+def closes_alone(seg: Segment) -> bool:
+    """Whether one segment whose ends meet is a closed contour: an arc round most of its circle.
+
+    A line never is; an arc whose ends are a joint apart is either nearly a full circle
+    (drawn as an ARC from 0° to 360°, or a path's circle whose end misses its start by
+    a rounding) or a speck shorter than the joint, which stays the open speck it is.
+    """
+    return isinstance(seg, Arc) and abs(seg.sweep) > math.pi
 
 
 class _EndGrid:

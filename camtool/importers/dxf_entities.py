@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from camtool.geometry.arcfit import FIT_KERNELS, FloatArray, PointsFn
-from camtool.geometry.chain import with_end, with_start
+from camtool.geometry.chain import closes_alone, with_end, with_start
 from camtool.geometry.curves import corner_knots, ellipse, ellipse_extent, fit_pieces, joined_run
 from camtool.geometry.fitpool import fit_key
 from camtool.importers.dxf_damage import implied_degree
@@ -345,7 +345,7 @@ def join_pieces(
     out: list[tuple[list[Segment], bool]] = []
     for run in runs:
         closed = distance(run[-1].end, run[0].start) <= tolerance and (
-            len(run) > 1 or isinstance(run[0], Arc)
+            len(run) > 1 or closes_alone(run[0])
         )
         if closed:
             run[-1] = with_end(run[-1], run[0].start)

@@ -16,7 +16,7 @@ import svgelements as se
 
 from camtool.accel.collector import collect_young
 from camtool.geometry.arcfit import check_tolerance
-from camtool.geometry.chain import with_end
+from camtool.geometry.chain import closes_alone, with_end
 from camtool.geometry.curves import ellipse_extent, merge_arcs, semi_axes_gap
 from camtool.geometry.fitpool import MIN_CURVES, CurveKey, fit_key, fit_shared, moved, shape_key
 from camtool.importers import svgclip
@@ -635,7 +635,11 @@ def convert(
     def flush(closed: bool) -> None:
         if current:
             segs = merge_arcs(current)
-            if start is not None and distance(segs[-1].end, start) <= ZERO_LENGTH_MM:
+            if (
+                start is not None
+                and distance(segs[-1].end, start) <= ZERO_LENGTH_MM
+                and (len(segs) > 1 or closes_alone(segs[0]))
+            ):
                 segs[-1] = with_end(segs[-1], start)
                 closed = True
             out.append((tuple(segs), closed))

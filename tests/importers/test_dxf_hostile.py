@@ -8,6 +8,7 @@ values come from the DXF reference ($INSUNITS codes) and from the files written 
 from __future__ import annotations
 
 import math
+import re
 import sys
 import time
 from collections.abc import Callable
@@ -250,6 +251,34 @@ def test_a_tiny_bulge_is_a_line_not_a_huge_arc(tmp_path: Path) -> None:
 
     (contour,) = read_dxf(write_dxf(tmp_path / "b.dxf", build)).contours
     assert type(contour.segments[0]).__name__ == "Line"
+
+
+_ARC_BLOCK = re.compile(r"G[23] X(-?[0-9.]+) Y(-?[0-9.]+)")
+
+
+@pytest.mark.parametrize("target", ["grbl", "linuxcnc"])
+def test_a_speck_arc_is_cut_as_a_speck_not_as_its_whole_circle(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], target: str
+) -> None:
+    # An ARC of 0.005° on radius 50 (0.0044 mm; its ends within the 0.01 mm chaining
+    # tolerance): an arc block that ends where it starts is a whole circle on the
+    # controller, here 100 mm across. The program stays within 0.01 mm of the speck.
+    def build(msp: Any) -> None:
+        msp.add_arc((100, 100), 50, 0, 0.005)
+        msp.add_line((0, 0), (10, 0))
+
+    path = write_dxf(tmp_path / "speck.dxf", build)
+    out = tmp_path / "speck.nc"
+    assert main(["post", str(path), "-t", target, "-o", str(out)]) == 0
+    capsys.readouterr()
+    x = y = None
+    for line in out.read_text().splitlines():
+        words = dict(re.findall(r"([XY])(-?[0-9.]+)", line))
+        end = (float(words.get("X", x or 0.0)), float(words.get("Y", y or 0.0)))
+        if _ARC_BLOCK.match(line):
+            assert end != (x, y), f"a whole circle: {line}"
+            assert math.dist(end, (150.0, 100.0)) < 0.01
+        x, y = end
 
 
 def test_an_arc_centre_beyond_the_limit_is_refused(tmp_path: Path) -> None:

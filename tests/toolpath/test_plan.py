@@ -155,7 +155,9 @@ def test_scale_and_fit_exclude_each_other() -> None:
 
 def test_a_single_arc_whose_ends_meet_is_closed() -> None:
     # Regression: an ARC drawn from 0° to 360° (or an OCCT full-circle edge) was left open.
-    almost = Arc((2.0, 0.0), (2.0, 0.0004), (0.0, 0.0), False)
+    # Counter-clockwise from (2, 0) round to 0.0004 mm short of it: nearly the whole circle
+    # (ending at (2, +0.0004) it would be a speck, which stays open: tests/geometry/test_chain.py).
+    almost = Arc((2.0, 0.0), (2.0, -0.0004), (0.0, 0.0), False)
     (c,) = chain([Contour((almost,), False)], 0.001)
     assert c.closed
     assert isinstance(c.segments[0], Arc) and c.segments[0].is_full_circle
