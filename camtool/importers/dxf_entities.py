@@ -23,6 +23,7 @@ from camtool.geometry.chain import closes_alone, with_end, with_start
 from camtool.geometry.curves import corner_knots, ellipse, ellipse_extent, fit_pieces, joined_run
 from camtool.geometry.fitpool import fit_key
 from camtool.importers.dxf_damage import implied_degree
+from camtool.importers.dxf_hatch import boundary_entities
 from camtool.importers.dxf_prefit import take
 from camtool.importers.options import check_curve_size
 from camtool.model.errors import GeometryError, UsageError
@@ -455,7 +456,21 @@ def _xy(p: Any) -> Point:
 
 
 def _arc(entity: Any) -> Arc:
-    """ARC or CIRCLE in WCS; OCS arcs run counter-clockwise, mirrored ones clockwise."""
+    """ARC or CIRCLE in WCS; OCS arcs run counter-clockwise, mirrored ones clockwise.
+
+    An ARC whose start and end angles are equal is a point, not a whole circle (ezdxf's
+    ``arc_angle_span_deg``; BricsCAD and TrueView draw a point, ezdxf issue 330).
+
+    Raises:
+        Unsupported: ``"zero length"`` for such an ARC.
+    """
+    from ezdxf.math import arc_angle_span_deg
+
+    if (
+        entity.dxftype() == "ARC"
+        and arc_angle_span_deg(float(entity.dxf.start_angle), float(entity.dxf.end_angle)) == 0.0
+    ):
+        raise Unsupported("zero length", "its start and end angles are equal")
     ocs = entity.ocs()
     flipped = entity.dxf.get("extrusion", (0.0, 0.0, 1.0))[2] < 0
     centre = _xy(ocs.to_wcs(entity.dxf.center))
@@ -723,78 +738,3 @@ def _fit(
     if not segs:
         raise Unsupported("zero length")
     return segs
-
-
-# ------------------------------------------------------------------ HATCH boundary paths
-
-
-def boundary_entities(hatch: Any) -> list[list[Any]]:
-    """Per boundary path, its pieces as virtual ezdxf entities in WCS drawing units.
-
-    Args:
-        hatch: an ezdxf ``Hatch`` (or ``MPolygon``), possibly a virtual one from a block.
-
-    Returns:
-        One list per path, the pieces in path order.
-    """
-    from ezdxf.entities import LWPolyline
-    from ezdxf.entities.boundary_paths import EdgePath, PolylinePath
-
-    ocs = hatch.ocs()
-    elevation = float(hatch.dxf.elevation[2])
-    extrusion = hatch.dxf.get("extrusion", (0.0, 0.0, 1.0))
-    paths: list[list[Any]] = []
-    for path in hatch.paths:
-        if isinstance(path, PolylinePath):
-            poly = LWPolyline.new(dxfattribs={"extrusion": extrusion, "elevation": elevation})
-            poly.set_points([tuple(v) for v in path.vertices], format="xyb")
-            poly.closed = path.is_closed
-            paths.append([poly])
-        elif isinstance(path, EdgePath):
-            paths.append([_edge(edge, ocs, elevation, extrusion) for edge in path.edges])
-    return paths
-
-
-def _edge(edge: Any, ocs: Any, elevation: float, extrusion: Any) -> Any:
-    from ezdxf.entities import Arc, Ellipse, Line, Spline
-    from ezdxf.entities.boundary_paths import ArcEdge, EllipseEdge, LineEdge
-    from ezdxf.math import Vec3
-
-    def wcs(v: Any) -> Any:
-        return ocs.to_wcs(Vec3(v).replace(z=elevation))
-
-    if isinstance(edge, LineEdge):
-        return Line.new(dxfattribs={"start": wcs(edge.start), "end": wcs(edge.end)})
-    if isinstance(edge, ArcEdge):
-        return Arc.new(
-            dxfattribs={
-                "center": Vec3(edge.center).replace(z=elevation),
-                "radius": edge.radius,
-                "start_angle": edge.start_angle,
-                "end_angle": edge.end_angle,
-                "extrusion": extrusion,
-            }
-        )
-    if isinstance(edge, EllipseEdge):
-        return Ellipse.new(
-            dxfattribs={
-                "center": wcs(edge.center),
-                "major_axis": ocs.to_wcs(Vec3(edge.major_axis)),
-                "ratio": edge.ratio,
-                "start_param": edge.start_param,
-                "end_param": edge.end_param,
-                "extrusion": extrusion,
-            }
-        )
-    spline = Spline.new(dxfattribs={"degree": edge.degree})
-    spline.control_points = [wcs(v) for v in edge.control_points]
-    if edge.knot_values:
-        spline.knots = edge.knot_values
-    if edge.weights:
-        spline.weights = edge.weights
-    if edge.fit_points:
-        spline.fit_points = [wcs(v) for v in edge.fit_points]
-    if edge.start_tangent is not None and edge.end_tangent is not None:
-        spline.dxf.start_tangent = ocs.to_wcs(Vec3(edge.start_tangent))
-        spline.dxf.end_tangent = ocs.to_wcs(Vec3(edge.end_tangent))
-    return spline

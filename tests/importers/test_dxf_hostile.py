@@ -533,3 +533,20 @@ def test_a_reader_bug_on_a_hostile_file_is_an_error_naming_the_file(
     monkeypatch.setattr(recover, "readfile", recover_fails)
     with pytest.raises(InputError, match=r"blocks\.dxf: not a readable DXF file \('NoneType'"):
         read_dxf(path)
+
+
+def test_an_arc_whose_start_and_end_angles_are_equal_is_a_point_not_a_circle(
+    tmp_path: Path,
+) -> None:
+    # TrueView and BricsCAD draw ARC(45°, 45°) as a point (ezdxf issue 330, whose
+    # arc_angle_span_deg gives 0); its equal ends made it a 100 mm circle. 0° to 360° is
+    # the whole circle.
+    def build(msp: Any) -> None:
+        msp.add_arc((100, 100), 50, 45, 45)
+        msp.add_arc((10, 10), 5, 0, 360)
+
+    read = read_dxf(write_dxf(tmp_path / "eq.dxf", build))
+    (contour,) = read.contours
+    (circle,) = contour.segments
+    assert circle.centre == (10.0, 10.0) and math.isclose(circle.length, 10 * math.pi)
+    assert any("skipped 1 ARC entity (zero length" in w for w in read.warnings)
