@@ -139,9 +139,17 @@ def read_measurements(text: str, coupon: Coupon, *, source: str) -> list[Observa
     names = [h.strip().lower() for h in header]
     for required in ("id", "measured_mm"):
         if required not in names:
+            split = next((d for d in (";", "\t") if len(names) == 1 and d in names[0]), None)
+            hint = (
+                f" (the columns are separated by {split!r}, as a spreadsheet set to a language "
+                "with decimal commas saves them: save it as CSV with commas between the "
+                "columns and points in the numbers)"
+                if split
+                else ""
+            )
             raise InputError(
                 f"{source}: line 1: no '{required}' column (columns: {', '.join(names)}); "
-                f"expected {', '.join(COLUMNS)}"
+                f"expected {', '.join(COLUMNS)}{hint}"
             )
     out: list[Observation] = []
     seen: dict[str, int] = {}
@@ -198,9 +206,11 @@ def _number(
     if not text:
         return None
     if NUMBER.fullmatch(text) is None:
+        comma = NUMBER.fullmatch(text.replace(",", ".", 1)) is not None
+        hint = f"; a decimal comma? write {text.replace(',', '.', 1)}" if comma else ""
         raise InputError(
             f"{source}: line {line}, column '{column}': {text!r} is not a number (plain ASCII "
-            "digits with a decimal point, e.g. 12.345; mm or µm as the column's name says)"
+            f"digits with a decimal point, e.g. 12.345; mm or µm as the column's name says{hint})"
         )
     value = float(text)
     if (

@@ -83,3 +83,22 @@ def test_plain_decimals_are_read(text: str, value: float) -> None:
     sheet = f"id,measured_mm\nLX.p1,{text}\n"
     (got,) = read_measurements(sheet, coupon, source="s.csv")
     assert got.value_mm == value
+
+
+def test_a_decimal_comma_is_refused_with_the_number_it_may_be() -> None:
+    coupon = build_coupon(load_target("grbl"))
+    sheet = 'id,nominal_mm,measured_mm\nLX.p1,15,"15,02"\n'
+    with pytest.raises(
+        InputError, match=r"'15,02' is not a number .*a decimal comma\? write 15\.02"
+    ):
+        read_measurements(sheet, coupon, source="s.csv")
+
+
+@pytest.mark.parametrize("delimiter", [";", "\t"])
+def test_a_sheet_saved_with_semicolons_says_how_to_save_it(delimiter: str) -> None:
+    # a spreadsheet in a decimal-comma language saves "CSV" with ; between the columns
+    coupon = build_coupon(load_target("grbl"))
+    sheet = delimiter.join(["id", "nominal_mm", "measured_mm"]) + "\n"
+    sheet += delimiter.join(["LX.p1", "15", "15,02"]) + "\n"
+    with pytest.raises(InputError, match=r"no 'id' column .*separated by .*commas between"):
+        read_measurements(sheet, coupon, source="s.csv")
