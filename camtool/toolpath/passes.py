@@ -13,6 +13,7 @@ import math
 from collections.abc import Sequence
 from itertools import pairwise
 
+from camtool.geometry.chain import moved_arc
 from camtool.model.errors import ToolpathError, UsageError
 from camtool.model.program import ArcMove, Linear, Move, Rapid
 from camtool.model.shapes import Arc, Segment
@@ -349,11 +350,19 @@ class _Writer:
         self.z = z
 
     def cut(self, seg: Segment, z: float | None) -> None:
-        """Cut along ``seg`` (starting where the tool is), descending to ``z`` if it differs."""
+        """Cut along ``seg`` (starting where the tool is), descending to ``z`` if it differs.
+
+        An arc starts where the tool is, which may lie a few µm off its start (a piece of
+        an arc whose ends are not quite on one circle ends on its start's circle): an arc
+        shorter than that, which the tool's place would turn round into nearly its whole
+        circle, is the line to its end (:func:`~camtool.geometry.chain.moved_arc`).
+        """
         feed = self.options.feed
         if z is not None and self.z is not None and abs(z - self.z) <= Z_EPS:
             z = None
         x, y = seg.end
+        if isinstance(seg, Arc) and seg.start != (self.x, self.y):
+            seg = moved_arc(seg, (self.x, self.y), seg.end)
         if isinstance(seg, Arc):
             if z is not None and not self.helix:
                 self._chords(seg, z)
