@@ -23,9 +23,9 @@ def _speck_joint(msp: Any) -> None:
     """A random drawing whose two ARC specks join two LINEs at ``--chain-tolerance 0.05``.
 
     The ARC of radius 60.5 is 0.000012 mm long; the ARC of radius 135.5 ends 0.0022 mm from
-    it and starts 0.00095 mm from a LINE. The pass ended on the circle of the larger arc's
-    snapped start, 0.0008 mm off its end: the speck, cut from there, went round the wrong
-    way, a 121 mm circle.
+    it and starts 0.00095 mm from a LINE. A pass ends on the circle of the larger arc's
+    snapped start, 0.0008 mm off its end: the speck, cut as an arc from there, would run
+    the other way round its circle, 121 mm across.
     """
     msp.add_arc((94.1453791711659, 51.87974357394093), 6.17279495989217,
                 112.7004938640265, 112.70067849223605)  # fmt: skip
