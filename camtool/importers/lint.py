@@ -16,7 +16,18 @@ from camtool.geometry.chain import chain, joint_distance
 from camtool.importers import read_drawing
 from camtool.importers.options import ImportOptions
 from camtool.model.errors import UsageError
-from camtool.model.shapes import TAU, Arc, BBox, Contour, Drawing, Line, Point, Segment, distance
+from camtool.model.shapes import (
+    FULL_CIRCLE_EPS,
+    TAU,
+    Arc,
+    BBox,
+    Contour,
+    Drawing,
+    Line,
+    Point,
+    Segment,
+    distance,
+)
 
 if TYPE_CHECKING:
     from camtool.importers.dxf import DxfNote
@@ -454,6 +465,7 @@ def gaps(chained: Sequence[Contour], tolerance: float) -> list[Finding]:
     for k, (p, _) in enumerate(ends):
         cells[(math.floor(p[0] / limit), math.floor(p[1] / limit))].append(k)
     out = []
+    said: set[tuple[str, tuple[str, ...]]] = set()
     for k, (p, i) in enumerate(ends):
         cx, cy = math.floor(p[0] / limit), math.floor(p[1] / limit)
         for dx in (-1, 0, 1):
@@ -469,7 +481,9 @@ def gaps(chained: Sequence[Contour], tolerance: float) -> list[Finding]:
                             f"{tolerance:g} mm, so these ends are not joined"
                         )
                         srcs = tuple(dict.fromkeys((_name(chained[i]), _name(chained[j]))))
-                        out.append(Finding("gap", msg, mid, srcs))
+                        if (msg, srcs) not in said:  # two specks' four ends: one gap
+                            said.add((msg, srcs))
+                            out.append(Finding("gap", msg, mid, srcs))
     return out
 
 
@@ -479,19 +493,10 @@ def duplicates(contours: Sequence[Contour], tolerance: float) -> list[Finding]:
     Findings are grouped per pair of contours (two copies of a fitted spline give one
     ``duplicate`` finding that counts its segments), located at the first one found.
     """
-    import numpy as np
-    from shapely import STRtree, box
-
     segs = [(s, k) for k, c in enumerate(contours) for s in c.segments]
     if len(segs) < 2:
         return []
-    grown = np.array([s.bbox() for s, _ in segs], dtype=np.float64)
-    grown[:, :2] -= tolerance
-    grown[:, 2:] += tolerance
-    boxes = box(grown[:, 0], grown[:, 1], grown[:, 2], grown[:, 3])
-    found = STRtree(boxes).query(boxes, predicate="intersects")
-    found = found[:, found[0] < found[1]]
-    found = found[:, np.lexsort((found[1], found[0]))]  # by i, then j
+    found = _candidates([s for s, _ in segs], tolerance)
     groups: dict[tuple[int, int, str], list[Any]] = {}
     for i, j in zip(found[0].tolist(), found[1].tolist(), strict=True):
         (a, ka), (b, kb) = segs[i], segs[j]
@@ -516,6 +521,108 @@ def duplicates(contours: Sequence[Contour], tolerance: float) -> list[Finding]:
             msg = f"{what} {length:.4g} mm at {_pt(where)}"
         out.append(Finding(kind, msg, where, names))
     return out
+
+
+_SLACK = 1e-9
+"""Relative widening of :func:`_candidates`' tests (and absolute, in mm, below 1 mm): numpy's
+``hypot`` and ``atan2`` may differ from :mod:`math`'s in the last bit, and a candidate too
+many costs one exact test, a candidate missed a finding."""
+
+
+def _candidates(segs: Sequence[Segment], tol: float) -> Any:
+    """Pairs that :func:`_same` or :func:`_overlap` may accept: ``(2, m)`` int array, i < j.
+
+    Ordered by ``i``, then ``j``. A superset of the accepted pairs, in arrays: boxes grown by
+    ``tol`` that meet (shapely's ``STRtree`` on their envelopes), both lines with the shorter's
+    ends within ``tol`` of the longer's line, or both arcs with centres and radii within
+    ``tol``. The exact tests decide.
+    """
+    import numpy as np
+    from shapely import STRtree, linestrings
+
+    n = len(segs)
+    nan = (math.nan, math.nan, math.nan)
+    ends = np.array([(*s.start, *s.end) for s in segs], dtype=np.float64)  # x0, y0, x1, y1
+    circle = np.array(  # cx, cy, 1.0 clockwise / 0.0 of arcs; NaN for lines
+        [(*s.centre, float(s.clockwise)) if isinstance(s, Arc) else nan for s in segs],
+        dtype=np.float64,
+    ).reshape(n, 3)
+    grown = _boxes(ends, circle) + np.array([-tol, -tol, tol, tol])
+    grown += _SLACK * np.maximum(1.0, np.abs(grown)) * np.array([-1, -1, 1, 1])
+    corners = grown.reshape(n, 2, 2)
+    diagonals = linestrings(corners)
+    found = STRtree(diagonals).query(diagonals)
+    i, j = found[:, found[0] < found[1]]
+    arc = ~np.isnan(circle[:, 0])
+    radius = np.hypot(ends[:, 0] - circle[:, 0], ends[:, 1] - circle[:, 1])
+    both_arcs = arc[i] & arc[j]
+    near = np.hypot(circle[i, 0] - circle[j, 0], circle[i, 1] - circle[j, 1])
+    close = _within(near, tol) & _within(np.abs(radius[i] - radius[j]), tol)
+    keep = np.where(both_arcs, close, ~arc[i] & ~arc[j] & _collinear(ends, i, j, tol))
+    i, j = i[keep], j[keep]
+    order = np.lexsort((j, i))
+    return np.stack((i[order], j[order]))
+
+
+def _within(value: Any, tol: float) -> Any:
+    import numpy as np
+
+    return value <= tol + _SLACK * np.maximum(1.0, tol)
+
+
+def _collinear(ends: Any, i: Any, j: Any, tol: float) -> Any:
+    """Per pair of lines: the shorter's ends within ``tol`` of the longer's line (or a point)."""
+    import numpy as np
+
+    span = ends[:, 2:] - ends[:, :2]
+    length = np.hypot(span[:, 0], span[:, 1])
+    swap = length[j] > length[i]
+    long, short = np.where(swap, j, i), np.where(swap, i, j)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ux, uy = span[long, 0] / length[long], span[long, 1] / length[long]
+        off = [
+            np.abs(
+                (ends[short, c] - ends[long, 0]) * -uy + (ends[short, c + 1] - ends[long, 1]) * ux
+            )
+            for c in (0, 2)
+        ]
+        scale = np.maximum(np.abs(ends[long]).max(axis=1), length[long])
+        slack = _SLACK * np.maximum(1.0, scale)
+        return ~(length[long] > 0) | ((off[0] <= tol + slack) & (off[1] <= tol + slack))
+
+
+def _boxes(ends: Any, circle: Any) -> Any:
+    """``(n, 4)`` boxes ``(xmin, ymin, xmax, ymax)`` of lines and arcs, as :meth:`Arc.bbox`.
+
+    An arc's box holds its ends and each point of its circle at 0°, 90°, 180° and 270° that
+    its sweep passes; a full circle (ends within :data:`FULL_CIRCLE_EPS` × max(1, r)) all four.
+    """
+    import numpy as np
+
+    x = ends[:, 0::2]
+    y = ends[:, 1::2]
+    box = np.stack((x.min(axis=1), y.min(axis=1), x.max(axis=1), y.max(axis=1)), axis=1)
+    arcs = np.flatnonzero(~np.isnan(circle[:, 0]))
+    if not len(arcs):
+        return box
+    e, (cx, cy, cw) = ends[arcs], circle[arcs].T
+    r = np.hypot(e[:, 0] - cx, e[:, 1] - cy)
+    a0 = np.arctan2(e[:, 1] - cy, e[:, 0] - cx)
+    ccw = np.mod(np.arctan2(e[:, 3] - cy, e[:, 2] - cx) - a0, TAU)
+    full = np.hypot(e[:, 2] - e[:, 0], e[:, 3] - e[:, 1]) <= FULL_CIRCLE_EPS * np.maximum(1.0, r)
+    span = np.where(full | (ccw == 0.0), TAU, np.where(cw == 1.0, TAU - ccw, ccw))
+    for quad, col, sign in (
+        (0.0, 2, 1),
+        (math.pi / 2, 3, 1),
+        (math.pi, 0, -1),
+        (1.5 * math.pi, 1, -1),
+    ):
+        delta = np.where(cw == 1.0, np.mod(a0 - quad, TAU), np.mod(quad - a0, TAU))
+        passed = delta <= span + _SLACK
+        extreme = (cx if col % 2 == 0 else cy) + sign * r
+        outer = np.maximum if sign > 0 else np.minimum
+        box[arcs, col] = np.where(passed, outer(extreme, box[arcs, col]), box[arcs, col])
+    return box
 
 
 def short_segments(contours: Sequence[Contour], tiny_mm: float) -> list[Finding]:
@@ -557,6 +664,8 @@ def _overlap(a: Segment, b: Segment, tol: float) -> tuple[float, Point] | None:
 
 def _line_overlap(a: Line, b: Line, tol: float) -> tuple[float, Point] | None:
     long, short = (a, b) if a.length >= b.length else (b, a)
+    if not long.length > 0:  # two points: duplicates or apart, never overlapping
+        return None
     (x0, y0), (x1, y1) = long.start, long.end
     ux, uy = (x1 - x0) / long.length, (y1 - y0) / long.length
     off = [(p[0] - x0) * -uy + (p[1] - y0) * ux for p in (short.start, short.end)]
