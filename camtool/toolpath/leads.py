@@ -5,6 +5,9 @@ Design notes: docs/internals.md, ``camtool/toolpath/leads.py``.
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+from typing import Any
+
 from camtool.model.shapes import Arc, Point
 from camtool.toolpath.cuts import Cut
 from camtool.toolpath.split import Track, end_tangent, start_tangent
@@ -17,7 +20,41 @@ _CHORD_MM = 1e-4  # chord error of the path polygon
 _NEAR_MM = 1e-3  # sample points this close to the path count as touching it
 
 
-def leads_for(cut: Cut, radius: float) -> tuple[Arc, Arc] | None:
+@dataclass(frozen=True)
+class KeepOff:
+    """The material that stays, of every contour of the plan, and how far lead arcs keep off it.
+
+    A lead arc on its own path's waste side can still reach another contour: a hole's lead
+    the part's outline around it, a part's lead its neighbour in a nest.
+
+    Attributes:
+        material: the material's regions (shapely polygons, mm), as
+            :func:`camtool.toolpath.compensate.material` gives them.
+        distance: the least distance from the material to a lead arc (the tool centre's
+            path), mm: the tool radius less the tolerance.
+        tolerance: chord tolerance of the arcs' polylines, mm (> 0).
+    """
+
+    material: Any
+    distance: float
+    tolerance: float
+    _tree: Any = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        import shapely
+
+        object.__setattr__(self, "_tree", shapely.STRtree(self.material))
+
+    def clear(self, *arcs: Arc) -> bool:
+        """Whether every arc keeps at least :attr:`distance` from every region."""
+        import shapely
+
+        lines = shapely.linestrings([a.points(self.tolerance) for a in arcs])
+        near = self._tree.query(lines, predicate="dwithin", distance=self.distance)
+        return not near.size
+
+
+def leads_for(cut: Cut, radius: float, keep_off: KeepOff | None = None) -> tuple[Arc, Arc] | None:
     """The lead arcs ``cut`` gets for ``--lead-in radius``, or ``None``.
 
     A cut gets them when it is a closed profile with a material side, ``radius``
@@ -28,16 +65,18 @@ def leads_for(cut: Cut, radius: float) -> tuple[Arc, Arc] | None:
         return None
     if cut.material_side is None or not Track.of(cut.path).segments:
         return None
-    fitted = fitted_radius(cut, radius)
+    fitted = fitted_radius(cut, radius, keep_off)
     return _arcs(cut, fitted) if fitted > 0 else None
 
 
-def fitted_radius(cut: Cut, radius: float) -> float:
+def fitted_radius(cut: Cut, radius: float, keep_off: KeepOff | None = None) -> float:
     """The largest of ``radius``, ``radius/2``, … whose lead arcs stay on the waste side; 0: none.
 
     The waste side is the inside of the closed path's polygon when the material
     lies outside it (the right of a counter-clockwise path), else the outside;
     every sampled point of both arcs farther than 1 µm from the path must lie there.
+    With ``keep_off``, both arcs must also keep its distance from the plan's material
+    (:meth:`KeepOff.clear`).
     """
     import shapely
 
@@ -53,7 +92,9 @@ def fitted_radius(cut: Cut, radius: float) -> float:
         xy = shapely.points(points)
         clear = shapely.distance(polygon.exterior, xy) > _NEAR_MM  # off the path itself
         wrong = shapely.contains(polygon, xy) != waste_inside
-        if not bool((wrong & clear).any()):
+        if not bool((wrong & clear).any()) and (
+            keep_off is None or keep_off.clear(lead_in, lead_out)
+        ):
             return radius
         radius /= 2.0
     return 0.0

@@ -18,7 +18,7 @@ from camtool.model.errors import ToolpathError, UsageError
 from camtool.model.program import ArcMove, Linear, Move, Rapid
 from camtool.model.shapes import Arc, Segment
 from camtool.toolpath.cuts import Cut, Finding, where
-from camtool.toolpath.leads import leads_for
+from camtool.toolpath.leads import KeepOff, leads_for
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.split import MIN_PIECE, Track
 
@@ -63,7 +63,12 @@ def emit_moves(
 
 
 def emit(
-    cuts: Sequence[Cut], options: PlanOptions, *, helix: bool = True, z_axis: bool = False
+    cuts: Sequence[Cut],
+    options: PlanOptions,
+    *,
+    helix: bool = True,
+    z_axis: bool = False,
+    keep_off: KeepOff | None = None,
 ) -> tuple[list[Move], list[Finding]]:
     """The moves that cut ``cuts`` in order, with passes, tabs, ramps and lead arcs.
 
@@ -83,6 +88,9 @@ def emit(
             machine gets a Z program cutting at Z 0 (rapids at ``safe_z``); a
             machine without one (``False``, the default) gets a 2D program.
             With a ``depth`` the plan has Z either way.
+        keep_off: the plan's material, from which lead arcs keep the tool
+            (:class:`~camtool.toolpath.leads.KeepOff`); ``None``: each lead is
+            checked against its own path only.
 
     Returns:
         Rapid/Linear/ArcMove moves, absolute mm; ``z`` is ``None`` on every move
@@ -97,6 +105,7 @@ def emit(
     """
     uses_z = options.depth is not None or z_axis
     writer = _Writer(options, helix, uses_z)
+    writer.keep_off = keep_off
     if not uses_z:
         for number, cut in enumerate(cuts, start=1):
             writer.number = number
@@ -238,6 +247,7 @@ class _Writer:
         self._part_here: int | None = None
         self._lift_at: int | None = None
         self.findings: list[Finding] = []
+        self.keep_off: KeepOff | None = None
         self._positioned = False
         ramp = options.ramp_deg
         self.slope = None if ramp is None else math.tan(math.radians(ramp))
@@ -245,7 +255,7 @@ class _Writer:
     def leads(self, cut: Cut) -> tuple[Arc, Arc] | None:
         """The lead arcs of ``cut`` (:func:`leads_for`), saying when they had to shrink."""
         asked = self.options.lead_in
-        leads = leads_for(cut, asked)
+        leads = leads_for(cut, asked, self.keep_off)
         if asked <= 0 or cut.kind != "profile" or cut.material_side is None:
             return leads
         got = 0.0 if leads is None else leads[0].radius

@@ -23,6 +23,7 @@ from camtool.model.shapes import BBox, Contour, Drawing, Line, Point, Segment, f
 from camtool.toolpath.chain import close_gaps
 from camtool.toolpath.cuts import Finding, Stage, finding_warnings
 from camtool.toolpath.gaps import open_gaps
+from camtool.toolpath.leads import KeepOff
 from camtool.toolpath.options import DEFAULT_CHAIN_TOLERANCE, OFFSET_MODES, PlanOptions
 from camtool.toolpath.order import Ordering, nesting, order_cuts
 from camtool.toolpath.placement import (
@@ -215,7 +216,8 @@ def plan_unplaced(
     ordering = order_cuts(stage.cuts, nest, options, backlash)
     findings.extend(ordering.findings)
     z_axis = machine is not None and machine.has_z
-    moves, emitted = emit(ordering.cuts, options, helix=helix, z_axis=z_axis)
+    keep_off = _keep_off(contours, nest, options)
+    moves, emitted = emit(ordering.cuts, options, helix=helix, z_axis=z_axis, keep_off=keep_off)
     findings.extend(emitted)
     if not any(not isinstance(m, Rapid) for m in moves):
         raise InputError(
@@ -259,6 +261,17 @@ def chained(
         for i in pieces
     )
     return joined, found, left_out
+
+
+def _keep_off(contours: Sequence[Contour], nest: Any, options: PlanOptions) -> KeepOff | None:
+    """The material lead arcs keep the tool off, for a profile with ``--lead-in``; else None."""
+    if options.lead_in <= 0 or options.offset not in ("outside", "inside"):
+        return None
+    from camtool.toolpath.compensate import material
+
+    regions = material(contours, nest, options.offset, options.tolerance / 4)
+    distance = options.radius - options.tolerance
+    return KeepOff(regions, distance, options.tolerance) if regions and distance > 0 else None
 
 
 def _stage(
