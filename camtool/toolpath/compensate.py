@@ -115,6 +115,7 @@ def compensate(
             raise ToolpathError(_all_open(contours, options.offset))
         findings[:0] = open_left_out(contours, f"--offset {options.offset}")
     if options.offset != "on":
+        findings.extend(crossings(contours, options.tolerance))
         findings.extend(gouges(contours, nest, cuts, options))
     return Stage(tuple(cuts), tuple(findings))
 
@@ -469,6 +470,60 @@ def material(
         x0, y0, x1, y1 = top.bounds
         regions.append(box(x0 - 10, y0 - 10, x1 + 10, y1 + 10).difference(top))
     return [r for r in regions if not r.is_empty]
+
+
+MAX_CROSSINGS = 100
+"""Most pairs of crossing contours :func:`crossings` reports (the warnings list fewer)."""
+
+
+def crossings(contours: Sequence[Contour], tolerance: float) -> list[Finding]:
+    """``crossing`` findings: two closed contours whose insides overlap, neither inside the other.
+
+    Such a pair has no outside or inside: each is offset on its own, and the tool cuts
+    through the other (a tab marker drawn across a part's outline, two parts drawn over
+    each other). Contours that only touch, or share an edge, are not reported; an overlap
+    counts when it, and what each has outside the other, are wider than the tolerance
+    (twice the area over the perimeter).
+
+    Args:
+        contours: the plan's contours, mm; open ones are ignored.
+        tolerance: mm (> 0); the polygons' chords are within a quarter of it.
+
+    Returns:
+        At most :data:`MAX_CROSSINGS` findings, ``at`` a point of the overlap, ``value`` its
+        area in mm².
+    """
+    from shapely import STRtree, difference, intersection
+
+    closed = [i for i, c in enumerate(contours) if c.closed]
+    if len(closed) < 2:
+        return []
+    polys = [enclosed(contours[i].points(tolerance / 4)) for i in closed]
+    pairs = STRtree(polys).query(polys, predicate="overlaps")
+    out: list[Finding] = []
+    for a, b in zip(*pairs.tolist(), strict=True):
+        if a >= b:
+            continue
+        shared = intersection(polys[a], polys[b])
+        parts = (shared, difference(polys[a], polys[b]), difference(polys[b], polys[a]))
+        if not all(2.0 * g.area > tolerance * g.length for g in parts):
+            continue  # a sliver of chords: touching, or one inside the other
+        p = shared.representative_point()
+        first, second = contours[closed[a]], contours[closed[b]]
+        out.append(
+            Finding(
+                "crossing",
+                f"{where(first)} and {where(second)} cross each other around "
+                f"({p.x:.4f}, {p.y:.4f}) mm: neither is inside the other, so each is offset "
+                "on its own and the tool cuts through the other; fix the drawing, or cut "
+                "them in separate operations (docs/jobs.md)",
+                (float(p.x), float(p.y)),
+                float(shared.area),
+            )
+        )
+        if len(out) >= MAX_CROSSINGS:
+            break
+    return out
 
 
 def gouges(
