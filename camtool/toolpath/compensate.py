@@ -115,8 +115,9 @@ def compensate(
             raise ToolpathError(_all_open(contours, options.offset))
         findings[:0] = open_left_out(contours, f"--offset {options.offset}")
     if options.offset != "on":
-        findings.extend(crossings(contours, options.tolerance))
-        findings.extend(gouges(contours, nest, cuts, options))
+        polys = closed_polygons(contours, options.tolerance / 4)
+        findings.extend(crossings(contours, options.tolerance, polys))
+        findings.extend(gouges(contours, nest, cuts, options, polys))
     return Stage(tuple(cuts), tuple(findings))
 
 
@@ -439,8 +440,20 @@ def _tight(contour: Contour, corners: list[Point], radius: float) -> Finding:
     )
 
 
+def closed_polygons(contours: Sequence[Contour], tolerance: float) -> dict[int, Any]:
+    """The area each closed contour encloses (:func:`~camtool.geometry.area.enclosed`), by index.
+
+    ``tolerance``: chord tolerance of the polygons, mm (> 0).
+    """
+    return {i: enclosed(c.points(tolerance)) for i, c in enumerate(contours) if c.closed}
+
+
 def material(
-    contours: Sequence[Contour], nest: Nesting, offset: str, tolerance: float
+    contours: Sequence[Contour],
+    nest: Nesting,
+    offset: str,
+    tolerance: float,
+    polys: dict[int, Any] | None = None,
 ) -> list[Any]:
     """The material that must stay, as shapely polygons (mm), one per region.
 
@@ -453,11 +466,12 @@ def material(
         nest: their nesting.
         offset: ``outside`` or ``inside``.
         tolerance: chord tolerance of the polygons, mm.
+        polys: :func:`closed_polygons` of ``contours`` at ``tolerance``, when already made.
     """
     from shapely import box, union_all
 
     closed = [i for i, c in enumerate(contours) if c.closed]
-    polys = {i: enclosed(contours[i].points(tolerance)) for i in closed}
+    polys = closed_polygons(contours, tolerance) if polys is None else polys
     keep = 0 if offset == "outside" else 1
     regions = []
     for i in closed:
@@ -476,7 +490,9 @@ MAX_CROSSINGS = 100
 """Most pairs of crossing contours :func:`crossings` reports (the warnings list fewer)."""
 
 
-def crossings(contours: Sequence[Contour], tolerance: float) -> list[Finding]:
+def crossings(
+    contours: Sequence[Contour], tolerance: float, polys: dict[int, Any] | None = None
+) -> list[Finding]:
     """``crossing`` findings: two closed contours whose insides overlap, neither inside the other.
 
     Such a pair has no outside or inside: each is offset on its own, and the tool cuts
@@ -488,6 +504,8 @@ def crossings(contours: Sequence[Contour], tolerance: float) -> list[Finding]:
     Args:
         contours: the plan's contours, mm; open ones are ignored.
         tolerance: mm (> 0); the polygons' chords are within a quarter of it.
+        polys: :func:`closed_polygons` of ``contours`` at a quarter of ``tolerance``, when
+            already made.
 
     Returns:
         At most :data:`MAX_CROSSINGS` findings, ``at`` a point of the overlap, ``value`` its
@@ -498,14 +516,15 @@ def crossings(contours: Sequence[Contour], tolerance: float) -> list[Finding]:
     closed = [i for i, c in enumerate(contours) if c.closed]
     if len(closed) < 2:
         return []
-    polys = [enclosed(contours[i].points(tolerance / 4)) for i in closed]
-    pairs = STRtree(polys).query(polys, predicate="overlaps")
+    made = closed_polygons(contours, tolerance / 4) if polys is None else polys
+    polys_ = [made[i] for i in closed]
+    pairs = STRtree(polys_).query(polys_, predicate="overlaps")
     out: list[Finding] = []
     for a, b in zip(*pairs.tolist(), strict=True):
         if a >= b:
             continue
-        shared = intersection(polys[a], polys[b])
-        parts = (shared, difference(polys[a], polys[b]), difference(polys[b], polys[a]))
+        shared = intersection(polys_[a], polys_[b])
+        parts = (shared, difference(polys_[a], polys_[b]), difference(polys_[b], polys_[a]))
         if not all(2.0 * g.area > tolerance * g.length for g in parts):
             continue  # a sliver of chords: touching, or one inside the other
         p = shared.representative_point()
@@ -527,7 +546,11 @@ def crossings(contours: Sequence[Contour], tolerance: float) -> list[Finding]:
 
 
 def gouges(
-    contours: Sequence[Contour], nest: Nesting, cuts: Sequence[Cut], options: PlanOptions
+    contours: Sequence[Contour],
+    nest: Nesting,
+    cuts: Sequence[Cut],
+    options: PlanOptions,
+    polys: dict[int, Any] | None = None,
 ) -> list[Finding]:
     """``gouge`` findings where a compensated cut's swept area overlaps the material.
 
@@ -537,6 +560,8 @@ def gouges(
         cuts: the cuts; only closed profiles are checked (open contours are cut
             on the line on purpose).
         options: ``offset`` (outside/inside), ``radius``, ``tolerance``.
+        polys: :func:`closed_polygons` of ``contours`` at a quarter of the tolerance, when
+            already made.
 
     Returns:
         One finding per overlapping region and cut: ``at`` its centroid, ``value``
@@ -545,7 +570,7 @@ def gouges(
     from shapely import LineString, STRtree, intersection
 
     tol = options.tolerance / 4
-    regions = material(contours, nest, options.offset, tol)
+    regions = material(contours, nest, options.offset, tol, polys)
     if not regions or options.radius <= 0:
         return []
     tree = STRtree(regions)
