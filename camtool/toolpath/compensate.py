@@ -517,14 +517,14 @@ def crossings(
     if len(closed) < 2:
         return []
     made = closed_polygons(contours, tolerance / 4) if polys is None else polys
-    polys_ = [made[i] for i in closed]
-    pairs = STRtree(polys_).query(polys_, predicate="overlaps")
+    areas = [made[i] for i in closed]
+    pairs = STRtree(areas).query(areas, predicate="overlaps")
     out: list[Finding] = []
     for a, b in zip(*pairs.tolist(), strict=True):
         if a >= b:
             continue
-        shared = intersection(polys_[a], polys_[b])
-        parts = (shared, difference(polys_[a], polys_[b]), difference(polys_[b], polys_[a]))
+        shared = intersection(areas[a], areas[b])
+        parts = (shared, difference(areas[a], areas[b]), difference(areas[b], areas[a]))
         if not all(2.0 * g.area > tolerance * g.length for g in parts):
             continue  # a sliver of chords: touching, or one inside the other
         p = shared.representative_point()
