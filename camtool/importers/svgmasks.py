@@ -327,43 +327,62 @@ def _wrap(
 
 _USE_PLACES = frozenset({"x", "y", "width", "height", "href", XLINK_HREF})
 """A ``<use>``'s attributes that its generated ``<svg>`` takes (the others go to its ``<g>``)."""
+_SIZES = frozenset({"width", "height"})
 _SYMBOL_OWN = frozenset({"id", "x", "y", "width", "height", "refX", "refY"})
 """A ``<symbol>``'s attributes its generated ``<svg>`` does not take."""
 
 
 def symbols_as_viewports(root: ET.Element) -> int:
-    """Replace each ``<use>`` of a ``<symbol>`` by the ``<g>`` and ``<svg>`` it stands for.
+    """Replace each ``<use>`` of a ``<symbol>``, or sizing an ``<svg>``, by what it stands for.
 
     SVG 1.1 §5.6: the use becomes a ``<g>`` with its attributes (its ``transform``, style,
     clip and mask), holding an ``<svg>`` viewport at the use's ``x``, ``y`` of its
     ``width`` and ``height`` (100 % when not given), with the symbol's ``viewBox``,
     ``preserveAspectRatio`` and style, holding copies of the symbol's children. The viewport
     clips unless ``overflow`` is visible (resvg's structure/symbol tests), which
-    :func:`clip_viewports` then checks. Only the uses the document holds are replaced, not
-    those a copy brings (each is replaced once, whatever it nests).
+    :func:`clip_viewports` then checks. A use with a ``width`` or ``height`` of an
+    ``<svg>`` with a ``viewBox`` gives that size to a copy of the ``<svg>`` (svgelements
+    would scale the viewBox into the ``<svg>``'s own size), moved by the use's ``x``,
+    ``y`` (resvg's structure/use/xlink-to-svg-element-with-viewBox.svg). Only the uses
+    the document holds are replaced, not those a copy brings (each is replaced once,
+    whatever it nests).
 
     Returns:
         How many uses were replaced.
     """
-    if not elements(root, "symbol"):
+    nested = any(e is not root for e in elements(root, "svg"))
+    if not elements(root, "symbol") and not nested:
         return 0
     ids = {e.get("id"): e for e in root.iter() if e.get("id")}
     parents = {child: parent for parent in root.iter() for child in parent}
     done = 0
     for use in [e for e in root.iter() if local_name(e) == "use"]:
         link = href(use)
-        symbol = ids.get(link[1:]) if link.startswith("#") else None
+        target = ids.get(link[1:]) if link.startswith("#") else None
         parent = parents.get(use)
-        if symbol is None or local_name(symbol) != "symbol" or parent is None:
+        if target is None or parent is None:
+            continue
+        kind = local_name(target)
+        sized = kind == "svg" and "viewBox" in target.attrib and bool(_SIZES & set(use.attrib))
+        if kind != "symbol" and not sized:
             continue
         group = ET.Element(tag(root, "g"), {k: v for k, v in use.attrib.items()
                                             if k not in _USE_PLACES})  # fmt: skip
-        viewport = ET.SubElement(group, tag(root, "svg"))
-        viewport.attrib.update({k: v for k, v in symbol.attrib.items() if k not in _SYMBOL_OWN})
-        viewport.attrib.update({"width": "100%", "height": "100%"})
-        viewport.attrib.update({k: v for k, v in use.attrib.items()
-                                if k in ("x", "y", "width", "height")})  # fmt: skip
-        viewport.extend(copy.deepcopy(child) for child in symbol)
+        if kind == "symbol":
+            viewport = ET.SubElement(group, tag(root, "svg"))
+            viewport.attrib.update({k: v for k, v in target.attrib.items() if k not in _SYMBOL_OWN})
+            viewport.attrib.update({"width": "100%", "height": "100%"})
+            viewport.attrib.update({k: v for k, v in use.attrib.items()
+                                    if k in ("x", "y", "width", "height")})  # fmt: skip
+            viewport.extend(copy.deepcopy(child) for child in target)
+        else:  # a viewport of no size of its own that only moves, holding the sized copy
+            moved = ET.SubElement(group, tag(root, "svg"), {"overflow": "visible"})
+            moved.attrib.update({k: v for k, v in use.attrib.items() if k in ("x", "y")})
+            sized_copy = copy.deepcopy(target)
+            sized_copy.attrib.pop("id", None)
+            sized_copy.attrib.update({k: v for k, v in use.attrib.items()
+                                      if k in ("width", "height")})  # fmt: skip
+            moved.append(sized_copy)
         parent.insert(list(parent).index(use), group)
         parent.remove(use)
         done += 1

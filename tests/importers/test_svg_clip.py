@@ -460,6 +460,33 @@ def test_a_symbol_clips_to_the_size_of_its_use(tmp_path: Path, size: str, read: 
             read_svg(path)
 
 
+@pytest.mark.parametrize(
+    ("use", "own", "bbox"),
+    [
+        # resvg's structure/use/xlink-to-svg-element-with-viewBox.svg, moved by x, y: the
+        # use's 100 x 150 shows the viewBox 0 0 200 200 at half size, centred (meet): the
+        # circle (100, 100) r 80 at (10 + 50, 5 + 25 + 50) r 40, y flipped on the 200 page
+        ('x="10" y="5" width="100" height="150"', "", (20, 80, 100, 160)),
+        # the use's size wins over the <svg>'s own (SVG 1.1 §5.6)
+        ('x="10" y="5" width="100" height="150"', 'width="50" height="60"', (20, 80, 100, 160)),
+        # width alone: the height is the <svg>'s 100 %, the page's 200; the circle is
+        # scaled by 0.5 and centred in y: (10 + 50, 5 + 50 + 50) r 40
+        ('x="10" y="5" width="100"', "", (20, 55, 100, 135)),
+        # no size on the use: the <svg>'s own 100 x 150, as before
+        ('x="10" y="5"', 'width="100" height="150"', (20, 80, 100, 160)),
+    ],
+)
+def test_a_use_sizes_the_svg_it_places(tmp_path: Path, use: str, own: str, bbox: tuple) -> None:
+    root = 'width="200mm" height="200mm" viewBox="0 0 200 200"'
+    body = (
+        f'<defs><svg id="s" viewBox="0 0 200 200" {own} overflow="visible"><circle id="c" '
+        f'cx="100" cy="100" r="80" fill="none" stroke="black"/></svg></defs>'
+        f'<use id="u" href="#s" {use}/>'
+    )
+    (contour,) = read_svg(svg(tmp_path, body, root=root)).contours
+    assert contour.bbox() == pytest.approx(bbox, abs=1e-9)
+
+
 def test_a_mask_on_the_whole_drawing(tmp_path: Path) -> None:
     # the mask on the <svg> itself: its white half shows the square's left part only
     root = 'width="100mm" height="100mm" viewBox="0 0 100 100" mask="url(#m)"'
