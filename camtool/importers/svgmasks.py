@@ -502,14 +502,19 @@ def clip_paths_first(root: ET.Element) -> None:
     under no transform, each clip is known before any reference to it and carries only its
     own ``transform`` (:mod:`camtool.importers.svgclip`). Children that add nothing to the
     region (not in :data:`_CLIP_CONTENT`, or a ``<use>`` of anything but a shape or text)
-    are removed, so that svgelements does not read them into it.
+    are taken out, so that svgelements does not read them into it; one that holds an
+    element a ``<use>`` places goes to a ``<defs>`` of its own after the clips, where the
+    use still finds it (resvg's structure/use/xlink-to-a-child-of-an-invalid-element.svg:
+    a ``<g>`` in a clip, ignored by the clip, holds the rectangle the use draws).
     """
     clips = elements(root, "clipPath")
     if not clips:
         return
     parents = {child: parent for parent in root.iter() for child in parent}
     ids = {e.get("id"): e for e in root.iter() if e.get("id")}
+    placed = {href(e)[1:] for e in elements(root, "use") if href(e).startswith("#")}
     front = ET.Element(tag(root, "defs"))
+    kept = ET.Element(tag(root, "defs"))
     for clip in clips:
         parents[clip].remove(clip)
         front.append(clip)
@@ -522,4 +527,8 @@ def clip_paths_first(root: ET.Element) -> None:
                 kind = None if kind == "use" else kind
             if kind not in _CLIP_CONTENT:
                 clip.remove(child)
+                if any(e.get("id") in placed for e in child.iter()):
+                    kept.append(child)
     root.insert(0, front)
+    if len(kept):
+        root.insert(1, kept)

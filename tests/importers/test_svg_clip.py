@@ -487,6 +487,19 @@ def test_a_use_sizes_the_svg_it_places(tmp_path: Path, use: str, own: str, bbox:
     assert contour.bbox() == pytest.approx(bbox, abs=1e-9)
 
 
+def test_a_use_places_what_a_clip_ignores(tmp_path: Path) -> None:
+    # resvg's structure/use/xlink-to-a-child-of-an-invalid-element.svg: a <g> is not a
+    # clip's content, so the clip ignores it, but the rect in it is an element like any
+    # other for the <use> that places it: drawn at 20..180 (was dropped without a word)
+    root = 'width="200mm" height="200mm" viewBox="0 0 200 200"'
+    body = (
+        '<clipPath id="c"><g id="g"><rect id="r" x="20" y="20" width="160" height="160" '
+        'fill="green"/></g></clipPath><use id="u" xlink:href="#r"/>'
+    )
+    (contour,) = read_svg(svg(tmp_path, body, root=root)).contours
+    assert contour.bbox() == pytest.approx((20, 20, 180, 180), abs=1e-9)
+
+
 def test_a_mask_on_the_whole_drawing(tmp_path: Path) -> None:
     # the mask on the <svg> itself: its white half shows the square's left part only
     root = 'width="100mm" height="100mm" viewBox="0 0 100 100" mask="url(#m)"'
