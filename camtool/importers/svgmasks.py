@@ -435,8 +435,12 @@ def clip_viewports(
     unchecked = made = 0
     for element in [e for e in root.iter(svg_tag) if e is not root]:
         _own_viewbox(element, sizes.get(element, viewport))
+        empty = 0.0 in svgvalues.viewport_extent(element, sizes.get(element, viewport))
+        if empty:  # shows nothing, whatever its overflow; svgelements reads no document
+            element.attrib.pop("viewBox", None)  # with a viewBox scaled into nothing
         overflow = inline_style(element).get("overflow", element.get("overflow", "hidden"))
-        if overflow.strip().lower() in ("visible", "auto") or not has_shapes(element):
+        visible = overflow.strip().lower() in ("visible", "auto")
+        if (visible and not empty) or not has_shapes(element):
             continue
         unchecked += element.get("id") in used
         if not is_drawn(element, parents, hold):

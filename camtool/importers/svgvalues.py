@@ -35,7 +35,7 @@ LENGTH_ATTRS = {
     "circle": ("cx", "cy", "r"),
     "ellipse": ("cx", "cy", "rx", "ry"),
     "line": ("x1", "y1", "x2", "y2"),
-    "use": ("x", "y"),
+    "use": ("x", "y", "width", "height"),
 }
 """The length attributes of each shape, and of ``<use>`` (checked by the document pass,
 resolved here)."""
@@ -522,8 +522,15 @@ def viewport_size(element: ET.Element, outer: tuple[float, float]) -> tuple[floa
     structure/svg/nested-svg-with-relative-width-and-height.svg).
     """
     box = viewbox_size(element)
-    if box is not None:
-        return box
+    return box if box is not None else viewport_extent(element, outer)
+
+
+def viewport_extent(element: ET.Element, outer: tuple[float, float]) -> tuple[float, float]:
+    """A nested ``<svg>``'s own ``width`` and ``height``, user units (100 % when not given).
+
+    ``outer``: the nearest viewport's size, for percentages. What its viewBox, if any,
+    is scaled into; a 0 shows nothing (SVG 1.1 §7.10: "disables rendering").
+    """
     return (
         _viewport_length(element.get("width"), outer[0]),
         _viewport_length(element.get("height"), outer[1]),

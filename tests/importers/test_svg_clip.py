@@ -262,6 +262,20 @@ def test_a_nested_viewport_of_a_bad_size_is_refused(tmp_path: Path, size: str, w
     assert why in str(e.value)
 
 
+@pytest.mark.parametrize("overflow", ["", 'overflow="visible"'])
+def test_a_nested_viewport_of_no_width_shows_nothing(tmp_path: Path, overflow: str) -> None:
+    # SVG 1.1 §7.10: a width of 0 disables rendering, whatever the overflow; with a
+    # viewBox to scale into it, svgelements read nothing of the whole document, and
+    # camtool said "nothing to cut" for the frame beside it
+    body = (
+        '<rect id="frame" x="1" y="1" width="98" height="98" fill="none" stroke="black"/>'
+        f'<svg width="0" height="50" viewBox="0 0 10 10" {overflow}>{SQUARE}/></svg>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.source for c in drawing.contours] == ["rect#frame"]
+    assert any("hides wholly" in w for w in drawing.warnings)
+
+
 def test_a_nested_viewport_without_a_viewbox_moves_its_content_to_its_x_and_y(
     tmp_path: Path,
 ) -> None:
@@ -485,6 +499,18 @@ def test_a_use_sizes_the_svg_it_places(tmp_path: Path, use: str, own: str, bbox:
     )
     (contour,) = read_svg(svg(tmp_path, body, root=root)).contours
     assert contour.bbox() == pytest.approx(bbox, abs=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("size", "why"), [('width="-5"', "must not be negative"), ('width="abc"', "must be a number")]
+)
+def test_a_use_of_a_bad_size_is_refused(tmp_path: Path, size: str, why: str) -> None:
+    # the size goes to the viewport that the use of a symbol stands for, where svgelements
+    # read nothing of the document: refused as a nested <svg>'s is, naming the use
+    body = f'<symbol id="s" viewBox="0 0 10 10">{SQUARE}/></symbol><use id="u" href="#s" {size}/>'
+    with pytest.raises(InputError, match=r"use#u: bad width") as e:
+        read_svg(svg(tmp_path, body))
+    assert why in str(e.value)
 
 
 def test_a_use_places_what_a_clip_ignores(tmp_path: Path) -> None:
