@@ -434,10 +434,14 @@ def clip_viewports(
     used = {href(e)[1:] for e in root.iter(tag(root, "use")) if href(e).startswith("#")}
     unchecked = made = 0
     for element in [e for e in root.iter(svg_tag) if e is not root]:
-        _own_viewbox(element, sizes.get(element, viewport))
-        empty = 0.0 in svgvalues.viewport_extent(element, sizes.get(element, viewport))
-        if empty:  # shows nothing, whatever its overflow; svgelements reads no document
-            element.attrib.pop("viewBox", None)  # with a viewBox scaled into nothing
+        outer = sizes.get(element, viewport)
+        empty = 0.0 in svgvalues.viewport_extent(element, outer)
+        empty = empty or svgvalues.viewbox_empty(element)
+        _own_viewbox(element, outer)
+        if empty:  # shows nothing, whatever its overflow: clipped to no width, and without
+            _check_size(element, name)  # a viewBox scaled into nothing, which makes
+            element.attrib.pop("viewBox", None)  # svgelements read no document
+            element.set("width", "0")
         overflow = inline_style(element).get("overflow", element.get("overflow", "hidden"))
         visible = overflow.strip().lower() in ("visible", "auto")
         if (visible and not empty) or not has_shapes(element):
@@ -458,11 +462,7 @@ def clip_viewports(
             ("height", "100%", height),
         ):
             value = element.get(attr) or default
-            try:
-                svgcheck.check_length(value, negative=attr in ("x", "y"))
-            except ValueError as exc:
-                where = element.get(SOURCE_ATTR) or "svg"
-                raise InputError(f"{name}: {where}: bad {attr} {value!r}: {exc}") from None
+            _check_length(element, attr, value, name)
             match = svgvalues.PERCENT.fullmatch(value)
             rect.set(attr, repr(float(match.group(1)) / 100.0 * base) if match else value)
         clip = ET.SubElement(root, tag(root, "clipPath"), {"id": clip_id})
@@ -470,6 +470,27 @@ def clip_viewports(
         _wrap(element, parents, clip_id, root)
         parents[clip] = root
     return unchecked
+
+
+def _check_size(element: ET.Element, name: str) -> None:
+    """Refuse a nested ``<svg>`` whose ``width`` or ``height`` is not a length (or < 0)."""
+    for attr in ("width", "height"):
+        value = element.get(attr)
+        if value is not None:
+            _check_length(element, attr, value, name)
+
+
+def _check_length(element: ET.Element, attr: str, value: str, name: str) -> None:
+    """Refuse ``value`` of a nested ``<svg>``'s ``attr`` if it is not a length (or a size < 0).
+
+    Raises:
+        InputError: naming the file, the ``<svg>`` and the attribute.
+    """
+    try:
+        svgcheck.check_length(value, negative=attr in ("x", "y"))
+    except ValueError as exc:
+        where = element.get(SOURCE_ATTR) or "svg"
+        raise InputError(f"{name}: {where}: bad {attr} {value!r}: {exc}") from None
 
 
 def _own_viewbox(element: ET.Element, outer: tuple[float, float]) -> None:

@@ -551,6 +551,19 @@ def _viewport_length(text: str | None, outer: float) -> float:
     return value if math.isfinite(value) else outer
 
 
+def viewbox_empty(element: ET.Element) -> bool:
+    """Whether ``element``'s ``viewBox`` has a width or height of 0, which shows nothing.
+
+    SVG 1.1 §7.7: "A value of zero disables rendering of the element" (a negative one, or
+    a malformed ``viewBox``, only invalidates the attribute).
+    """
+    box = (element.get("viewBox") or "").replace(",", " ").split()
+    try:
+        return len(box) == 4 and 0.0 in (float(box[2]), float(box[3]))
+    except ValueError:
+        return False
+
+
 def viewbox_size(element: ET.Element) -> tuple[float, float] | None:
     """``(width, height)`` of ``element``'s ``viewBox``, or ``None`` without a good one."""
     box = (element.get("viewBox") or "").replace(",", " ").split()

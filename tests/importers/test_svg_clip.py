@@ -263,13 +263,20 @@ def test_a_nested_viewport_of_a_bad_size_is_refused(tmp_path: Path, size: str, w
 
 
 @pytest.mark.parametrize("overflow", ["", 'overflow="visible"'])
-def test_a_nested_viewport_of_no_width_shows_nothing(tmp_path: Path, overflow: str) -> None:
-    # SVG 1.1 §7.10: a width of 0 disables rendering, whatever the overflow; with a
-    # viewBox to scale into it, svgelements read nothing of the whole document, and
-    # camtool said "nothing to cut" for the frame beside it
+@pytest.mark.parametrize(
+    "size",
+    ['width="0" height="50" viewBox="0 0 10 10"', 'width="50" height="50" viewBox="0 0 0 10"'],
+)
+def test_a_nested_viewport_of_no_width_shows_nothing(
+    tmp_path: Path, size: str, overflow: str
+) -> None:
+    # SVG 1.1 §7.10 and §7.7: a width of 0, or a viewBox's, disables rendering, whatever
+    # the overflow. With a viewBox scaled into no width, svgelements read nothing of the
+    # whole document (camtool said "nothing to cut" for the frame beside it); a viewBox of
+    # no width was read as none, and the square cut
     body = (
         '<rect id="frame" x="1" y="1" width="98" height="98" fill="none" stroke="black"/>'
-        f'<svg width="0" height="50" viewBox="0 0 10 10" {overflow}>{SQUARE}/></svg>'
+        f"<svg {size} {overflow}>{SQUARE}/></svg>"
     )
     drawing = read_svg(svg(tmp_path, body))
     assert [c.source for c in drawing.contours] == ["rect#frame"]
