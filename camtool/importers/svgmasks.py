@@ -342,8 +342,8 @@ def symbols_as_viewports(root: ET.Element) -> int:
     clips unless ``overflow`` is visible (resvg's structure/symbol tests), which
     :func:`clip_viewports` then checks. A use with a ``width`` or ``height`` of an
     ``<svg>`` with a ``viewBox`` gives that size to a copy of the ``<svg>`` (svgelements
-    would scale the viewBox into the ``<svg>``'s own size), moved by the use's ``x``,
-    ``y`` (resvg's structure/use/xlink-to-svg-element-with-viewBox.svg). Only the uses
+    would scale the viewBox into the ``<svg>``'s own size), its ``x`` and ``y`` moved by
+    the use's (resvg's structure/use/xlink-to-svg-element-with-viewBox.svg). Only the uses
     the document holds are replaced, not those a copy brings (each is replaced once,
     whatever it nests).
 
@@ -375,18 +375,38 @@ def symbols_as_viewports(root: ET.Element) -> int:
             viewport.attrib.update({k: v for k, v in use.attrib.items()
                                     if k in ("x", "y", "width", "height")})  # fmt: skip
             viewport.extend(copy.deepcopy(child) for child in target)
-        else:  # a viewport of no size of its own that only moves, holding the sized copy
-            moved = ET.SubElement(group, tag(root, "svg"), {"overflow": "visible"})
-            moved.attrib.update({k: v for k, v in use.attrib.items() if k in ("x", "y")})
+        else:  # a copy of the <svg>, of the use's size, moved by the use's x and y
+            try:
+                place = {k: _added(use.get(k), target.get(k)) for k in ("x", "y")}
+            except ValueError:
+                continue  # a bad x or y on the <svg>, refused where it is read
             sized_copy = copy.deepcopy(target)
             sized_copy.attrib.pop("id", None)
-            sized_copy.attrib.update({k: v for k, v in use.attrib.items()
-                                      if k in ("width", "height")})  # fmt: skip
-            moved.append(sized_copy)
+            sized_copy.attrib.update({k: v for k, v in use.attrib.items() if k in _SIZES})
+            sized_copy.attrib.update(place)
+            group.append(sized_copy)
         parent.insert(list(parent).index(use), group)
         parent.remove(use)
         done += 1
     return done
+
+
+def _added(first: str | None, second: str | None) -> str:
+    """The sum, px as text, of two lengths without percentages (a missing one is 0).
+
+    Raises:
+        ValueError: one is not a length.
+    """
+    total = 0.0
+    for text in (first, second):
+        if text:
+            try:
+                total += float(se.Length(text).value(ppi=96.0))
+            except TypeError as exc:  # a percentage svgelements cannot resolve
+                raise ValueError(text) from exc
+    if not math.isfinite(total):
+        raise ValueError(f"{first} + {second}")
+    return repr(total)
 
 
 VIEWPORT_CLIP = "camtool-viewport-"

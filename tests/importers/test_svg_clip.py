@@ -495,6 +495,16 @@ def test_a_symbol_clips_to_the_size_of_its_use(tmp_path: Path, size: str, read: 
         ('x="10" y="5" width="100"', "", (20, 55, 100, 135)),
         # no size on the use: the <svg>'s own 100 x 150, as before
         ('x="10" y="5"', 'width="100" height="150"', (20, 80, 100, 160)),
+        # the <svg>'s own x adds to the use's; 200 x 200, the page: the circle at (103, 100)
+        ('width="200" height="200"', 'x="3" width="50" height="50"', (23, 20, 183, 180)),
+        # at 0, 0 of 100 x 100: the circle at (50, 50) r 40
+        ('x="0" y="0" width="100" height="100"', 'width="50" height="50"', (10, 110, 90, 190)),
+        # as Inkscape writes a clone: 100 %, moved by a transform (20, 30): (120, 130)
+        (
+            'width="100%" height="100%" transform="translate(20 30)"',
+            'width="50" height="50"',
+            (40, -10, 200, 150),
+        ),
     ],
 )
 def test_a_use_sizes_the_svg_it_places(tmp_path: Path, use: str, own: str, bbox: tuple) -> None:
@@ -518,6 +528,19 @@ def test_a_use_of_a_bad_size_is_refused(tmp_path: Path, size: str, why: str) -> 
     with pytest.raises(InputError, match=r"use#u: bad width") as e:
         read_svg(svg(tmp_path, body))
     assert why in str(e.value)
+
+
+def test_a_use_sizes_an_svg_of_a_small_viewbox(tmp_path: Path) -> None:
+    # the <svg>'s viewBox 10 x 10 shown in the use's 100 x 100: scaled by 10, the circle
+    # (5, 5) r 4 at (50, 50) r 40
+    root = 'width="200mm" height="200mm" viewBox="0 0 200 200"'
+    body = (
+        '<defs><svg id="s" width="50" height="50" viewBox="0 0 10 10"><circle id="c" cx="5" '
+        'cy="5" r="4" fill="none" stroke="black"/></svg></defs>'
+        '<use id="u" href="#s" x="0" y="0" width="100" height="100"/>'
+    )
+    (contour,) = read_svg(svg(tmp_path, body, root=root)).contours
+    assert contour.bbox() == pytest.approx((10, 110, 90, 190), abs=1e-9)
 
 
 def test_a_use_places_what_a_clip_ignores(tmp_path: Path) -> None:
