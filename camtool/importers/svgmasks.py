@@ -455,8 +455,7 @@ def clip_viewports(
     unchecked = made = 0
     for element in [e for e in root.iter(svg_tag) if e is not root]:
         outer = sizes.get(element, viewport)
-        empty = 0.0 in svgvalues.viewport_extent(element, outer)
-        empty = empty or svgvalues.viewbox_empty(element)
+        empty = 0.0 in svgvalues.viewport_extent(element, outer) or svgvalues.viewbox_empty(element)
         _own_viewbox(element, outer)
         if empty:  # shows nothing, whatever its overflow: clipped to no width, and without
             _check_size(element, name)  # a viewBox scaled into nothing, which makes

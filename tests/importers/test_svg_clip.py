@@ -546,7 +546,7 @@ def test_a_use_sizes_an_svg_of_a_small_viewbox(tmp_path: Path) -> None:
 def test_a_use_places_what_a_clip_ignores(tmp_path: Path) -> None:
     # resvg's structure/use/xlink-to-a-child-of-an-invalid-element.svg: a <g> is not a
     # clip's content, so the clip ignores it, but the rect in it is an element like any
-    # other for the <use> that places it: drawn at 20..180 (was dropped without a word)
+    # other for the <use> that places it: drawn at 20..180
     root = 'width="200mm" height="200mm" viewBox="0 0 200 200"'
     body = (
         '<clipPath id="c"><g id="g"><rect id="r" x="20" y="20" width="160" height="160" '
