@@ -271,9 +271,8 @@ def test_a_nested_viewport_of_no_width_shows_nothing(
     tmp_path: Path, size: str, overflow: str
 ) -> None:
     # SVG 1.1 §7.10 and §7.7: a width of 0, or a viewBox's, disables rendering, whatever
-    # the overflow. With a viewBox scaled into no width, svgelements read nothing of the
-    # whole document (camtool said "nothing to cut" for the frame beside it); a viewBox of
-    # no width was read as none, and the square cut
+    # the overflow: the square is skipped, the frame beside it cut (svgelements reads
+    # nothing of a document with a viewBox scaled into no width)
     body = (
         '<rect id="frame" x="1" y="1" width="98" height="98" fill="none" stroke="black"/>'
         f"<svg {size} {overflow}>{SQUARE}/></svg>"
@@ -493,7 +492,7 @@ def test_a_symbol_clips_to_the_size_of_its_use(tmp_path: Path, size: str, read: 
         # width alone: the height is the <svg>'s 100 %, the page's 200; the circle is
         # scaled by 0.5 and centred in y: (10 + 50, 5 + 50 + 50) r 40
         ('x="10" y="5" width="100"', "", (20, 55, 100, 135)),
-        # no size on the use: the <svg>'s own 100 x 150, as before
+        # no size on the use: the <svg>'s own 100 x 150
         ('x="10" y="5"', 'width="100" height="150"', (20, 80, 100, 160)),
         # the <svg>'s own x adds to the use's; 200 x 200, the page: the circle at (103, 100)
         ('width="200" height="200"', 'x="3" width="50" height="50"', (23, 20, 183, 180)),
@@ -523,7 +522,7 @@ def test_a_use_sizes_the_svg_it_places(tmp_path: Path, use: str, own: str, bbox:
 )
 def test_a_use_of_a_bad_size_is_refused(tmp_path: Path, size: str, why: str) -> None:
     # the size goes to the viewport that the use of a symbol stands for, where svgelements
-    # read nothing of the document: refused as a nested <svg>'s is, naming the use
+    # would read nothing of the document: refused as a nested <svg>'s is, naming the use
     body = f'<symbol id="s" viewBox="0 0 10 10">{SQUARE}/></symbol><use id="u" href="#s" {size}/>'
     with pytest.raises(InputError, match=r"use#u: bad width") as e:
         read_svg(svg(tmp_path, body))
