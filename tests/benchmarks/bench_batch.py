@@ -17,10 +17,7 @@ counts them. Without the corpus the row says how to get it.
 The 13: LibreCAD parts whose chained arcs start and end at radii a few µm apart, which
 b3b77a5 refused ("an arc of radius 11.7463 mm cannot be written for grbl ... write more
 decimals") and 6e92f55 writes about the equalised centre, with a warning; ``camtool
-verify`` of three of them gives 5.6–6.2 µm deviation. Until 23 Nov 2026 the row said
-"DIFFER from the pre-work outputs" for this reason, and the sixth pass's note blamed the
-environment: b3b77a5 run on the same corpus gives :data:`EXPECTED_SHA256` over 982 files,
-this tree the same 982 files byte for byte plus the 13.
+verify`` of three of them gives 5.6–6.2 µm deviation.
 """
 
 from __future__ import annotations

@@ -18,10 +18,7 @@ N (the client reads each input and ships its bytes, the scheduler sends the task
 the worker returns the outputs' bytes, the client writes them), and the ratio of the
 two times.
 
-Measured on the 2-core dev machine (shared with other jobs), 1 000 LibreCAD DXF for
-grbl, ``--repeat 2``: ``--jobs 2`` 28.0 s, ``--scheduler local:2`` 36.5 s after a
-3.3 s cluster start: +8.5 ms a file, 1.30× (1.42× with the start); outputs identical.
-A single run under a heavier load gave 36.1 s and 48.2 s (1.34×).
+Measurements: docs/performance.md (this script's rows, and its earlier notes).
 """
 
 from __future__ import annotations

@@ -16,32 +16,9 @@ and a checksum of the rows, which this script compares with camtool's rows: equa
 checksums show that the peer did the same work. camtool is timed in-process, best of 3
 (the arrays it returns are the same rows). Without a C compiler the rows say so. The plain
 pure-Python loops (``*_reference``) are timed on a smaller sample and given as notes.
-
-Measured on this 2-core machine shared with 4 other jobs (so under load), best of 3,
-numba 0.68.1, numpy 2.4.6, gcc 12.2.0; two runs:
-
-=====================================  ==============  =============  ==============  ==========
-job                                    before (numpy)  after (numba)  C ``cc -O2``    ratio
-=====================================  ==============  =============  ==============  ==========
-DDA, 75 lines, 12.0 M iterations       28.7 M it/s     344–545 M/s    301–304 M/s     1.1–1.8×
-DSM, full circle R = 2 M, 11.3 M it.   1.0 M it/s      89–163 M/s     210–404 M/s     0.40–0.42×
-=====================================  ==============  =============  ==============  ==========
-
-("before" is the issue's figure; the printed rows give this run's.) The DDA matches the
-literal C loop because camtool computes its closed form (``k(n) = ⌊n·P/HIPO⌋``, near-ties
-re-checked exactly; integer HIPO: the integer register loop), which the compiler
-vectorises, while the register loop of A.3 carries a dependency from one iteration to
-the next; camtool's time includes allocating the rows of every call. Loading the kernels
-in a fresh process (importing numba, its first call, its cache of the compiled loops):
-about 1 s under load; a process that must compile them (no cache yet): about 15 s, once.
 Target: the whole script well under 1 min.
 
-25 Nov 2026 (quiet): the DSM row had fallen to 81–83 M it/s (0.099–0.104× C, at its goal)
-with the kernel unchanged since 22 Nov, where it ran 217–227 M it/s: the quadrant loops
-replaced their buffer inside the loop when it was full, which keeps numba from holding
-the buffer in registers (the loop alone: 83 M it/s; without the replacement 707 M it/s on
-this machine). The loop now runs to its end or a full buffer, and an outer loop grows
-the buffer and resumes it: 498–502 M it/s, 0.63–0.64× C, the same checksum.
+Measurements: docs/performance.md (this script's rows, and its earlier notes).
 """
 
 from __future__ import annotations

@@ -15,25 +15,7 @@ has to find every joint):
 - ``chains``: long polylines of 1000 LINEs each, a dense wave (arc fitting runs
   on them) next to a zigzag (nothing to fit).
 
-Measured on the 2-core dev machine (CPU seconds of the whole ``post``, shared with other
-jobs), before → after the O(n) travel order (issue 14):
-
-=========  ==========================  =============  ==========
-N LINEs    disjoint (N cuts)           squares (N/4)  chains
-=========  ==========================  =============  ==========
-10⁴        116 → 3                     7.2 → 1.8      1.4 → 1.5
-10⁵        hours (O(n²) 2-opt) → 23    → 15           → 12
-10⁶        → 188 (2·10⁶ blocks)        → 147          → 109
-=========  ==========================  =============  ==========
-
-At 10⁵ disjoint lines (profiled) the importer takes about 27 %, planning 52 % (ordering
-30 %, chaining 9 %, nesting 7 %, emission 3 %) and the grbl writer 20 %.
-
-23 Nov 2026 (quiet, wall time of the CLI): 10⁵ disjoint lines took 45.3 s and 1.72 GB, of
-which the open-gap check made a message for each of its 240 000 near pairs of ends and
-reported ten; it now writes out only those (24.8 s, 0.93 GB), and measures the pairs in
-bulk, ``math.dist`` only where it decides a comparison or a reported value: 15.9 s and
-0.38 GB (4·10⁴ lines 9.9 → 6.1 s), the same G-code and findings.
+Measurements: docs/performance.md (this script's rows, and its earlier notes).
 """
 
 from __future__ import annotations

@@ -5,8 +5,9 @@ a grid of 20 × 25 = 500 holes (squares and circles) is planned with each ``--or
 and ``--offset``; every time is printed with its ratio to the baseline of the same
 run, the plain ``--offset on --order travel`` plan (chain, nesting, travel ordering,
 emission). The first OpenCASCADE call (loading its OCP bindings, about 1.5 s) is
-made before timing. Measured on the 2-core dev machine: reversals 1.6×, outside/inside 8×, a
-concentric pocket around the 500 islands (about 200 ring levels) 23× the 0.6 s baseline.
+made before timing.
+
+Measurements: docs/performance.md.
 """
 
 from __future__ import annotations

@@ -19,75 +19,7 @@ measurement (:func:`measure`):
 Each job's G-code is checked byte for byte against the sha256 the pre-work code wrote
 (b3b77a5, /work/wt/base17): a faster picture must not change the program.
 
-Measured on the 2-core development machine, 22 Nov 2026, *under load* (4 other engineers'
-jobs; load average 2.5–7), so every figure is inflated and noisy; the lead re-runs it on a
-quiet machine. Wall time and peak RSS of the CLI as this script measures them:
-
-=====================  ======================  ======================
-job (back to back)     before (b3b77a5)        after (branch h17view)
-=====================  ======================  ======================
-part (--preview)       31.7 s, 661 MB          22.0 s, 663 MB
-plate (make demo)      24.6 s, 522 MB          18.1 s, 525 MB
-=====================  ======================  ======================
-
-(load average 3–4.5, the two trees run one right after the other, same G-code sha256).
-Wall times this loaded say little; the CPU time of the verification and its error budget
-(``verify_job`` + ``error_budget``, one process, ``time.process_time``) compares better:
-part 26.0 s → 15.6 s, plate 19.0 s → 15.8 s; the preview itself is 0.7–0.9 s CPU. Planning
-alone (``post`` without ``--preview``) takes 4.7 s and 420 MB on this part, most of it
-loading OpenCascade for the offsets: the goal of 3 s and 300 MB is not met (see the
-"Speed" paragraph of docs/verify.md for what is left).
-
-Second pass (branch h17p, 22 Nov 2026, *under load*: load average 6–9 from the other
-engineers' jobs, so wall times say little; user + sys CPU time and peak RSS of the CLI,
-``/usr/bin/time``, the two trees run one right after the other, same G-code sha256):
-
-=====================  ======================  ======================
-job                    first pass (b83b9f0)    second pass (h17p)
-=====================  ======================  ======================
-part (--preview)       20.5 s CPU, 606 MB      14.0 s CPU, 616 MB
-plate (make demo)      23.1 s CPU, 524 MB      12.1 s CPU, 520 MB
-=====================  ======================  ======================
-
-(wall 38.7 s → 28.0 s and 44.5 s → 24.4 s at that load.) This script itself, at a lighter
-load (1.2–1.4), first pass then second pass right after: part 18.0 s, 593 MB → 12.5 s,
-602 MB; plate 15.4 s, 511 MB → 9.9 s, 509 MB.
-
-The offsets call OpenCASCADE's OCP bindings without build123d (its import was 2.7 s CPU
-and 160 MB of the 390 MB build123d + OCP take; OCP alone is 0.8 s and 230 MB), and the
-nearest-segment search of the verification runs compiled (numba: its load costs about
-0.5 s and 100–120 MB, which is why the peak did not fall). The goal of 3 s and 300 MB is
-still not met: OCP alone is 230 MB, numba 100 MB more, and the error budget still
-simulates and measures the part four times.
-
-Third pass (22 Nov 2026, quiet, ``make bench`` then this script again once numba's cache of
-the new kernels was written): part 12.3 s, 600 MB; plate 9.7–10.7 s, 499–504 MB; G-code,
-report and PNG identical. The verification's distance searches are cheaper (docs/verify.md,
-"Speed and memory"); planning alone is 2.9 s and 293 MB on this part (OpenCascade), so the
-goal is still out of reach without moving the offsets out of the process and skipping or
-approximating the error budget.
-
-Seventh pass (23 Nov 2026, quiet, ``make bench``): part 6.27 s, 284 MB; plate 5.72 s, 259 MB
-(sixth pass 8.95 s, 596 MB and 7.44 s, 498 MB; G-code, reports and pictures identical).
-The job's own process no longer loads OpenCASCADE (its offsets' child does, started as the
-job begins), and the error budget's sources are re-simulated in forked workers, one per
-core, while the job compares its trace with the drawing (docs/performance.md). The memory
-goal is met (MB here are MiB: ``ru_maxrss`` / 1024; 284 MiB is 298 × 10⁶ bytes); the time
-is not: reading and planning take ~1 s, the verification with its budget ~4.5 s on two
-cores, the picture ~0.6 s.
-
-Tenth pass (23 Nov 2026): each job now runs as :func:`measure` says, from cached bytecode
-(an untimed first run writes it), the best of :data:`RUNS` with the largest peak of them,
-as ``bench_repost.py`` and ``bench_verify.py`` already ran: an installed camtool runs
-from bytecode, and this machine's ``PYTHONDONTWRITEBYTECODE`` had every run compile
-each camtool module from source (ninth pass: the part took 4.67 s in one such run, 4.0–4.1 s
-from cached bytecode).
-
-Thirteenth pass (23 Nov 2026, ``make bench`` at 15:33, quiet): part 2.67 s, 290 MiB; plate
-2.63 s, 248 MiB (twelfth pass 3.01 s and 2.83 s). The PNG is drawn by a child forked as
-the command starts, which imports matplotlib on the core the verification's start leaves
-idle (``camtool.preview.ahead``), and the budget's workers inherit the comparison's
-compiled kernels; the G-code and the PNG are the same bytes. 290 MiB is ~304 × 10⁶ bytes.
+Measurements: docs/performance.md (this script's rows, and its earlier notes).
 """
 
 from __future__ import annotations

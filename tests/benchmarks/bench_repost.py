@@ -22,52 +22,7 @@ output as recorded (:data:`OUTPUT_SHA256`: b3b77a5's with the changes it names);
 row says so or says it differs.
 Without ``rs274`` (the corpus without it) the ratio uses :data:`RS274_RECORDED_S`.
 
-Measured on the 2-core machine, under load (4 other engineers' jobs, load average 5-7),
-so wall times are inflated and noisy: before issue 17 (b3b77a5) camtool took 22.4 s
-wall, 9.5 s of CPU (profile: the arc-check search 18 s, reading 5.3 s of 36 s
-profiled); after: 5.4 s wall, 2.35 s of CPU. rs274 (linuxcnc-uspace
-2.9.0~pre1+git20230208.f1270d6ed7-1+deb12u2): 0.37-0.48 s wall, 0.11-0.15 s CPU. Ratio
-about 14× in wall time under load (was 56×); the issue's goal is ≤ 2×.
-
-Second pass (same machine, load average 5-6, main's code and this one run in turn, both
-from cached bytecode): 3.1 s of CPU (4.4 s wall) before, 1.2 s of CPU (1.8 s wall)
-after; this script: camtool 2.48 s wall, rs274 0.375 s, 6.6×. What changed: plain lines
-are read without word objects (reading 0.7-0.9 s → 0.3 s of CPU), the writer conforms
-each distinct arc once (the program is its three examples 17 times: 1 653 of the 28 101
-arcs are conformed, the others reuse their blocks; on one copy the writer is not faster)
-and formats plain words directly, and a re-post no longer imports the planner (numpy is
-still imported, by the arc check). What is left, in a profile of the whole command:
-the writer's Python per block (about 45 %), the reader (about 30 %), the work-area extent
-of every arc (``check_placement``, about 15 %) and start-up (numpy about 0.07 s).
-
-Third pass (load average 3-5, main's code and this one run in turn from cached bytecode,
-CPU of the whole command, best of 5): 1.27 s → 0.86 s on this program, 0.53 s → 0.37 s
-on the examples once (1 995 lines, no repeats: the note of the row); this script: camtool
-1.08 s wall against 1.91 s for main run right after, rs274 0.27 s, 4.0× (was 7.1× in the
-same minute); peak 55 → 46 MB. What changed: numpy is no longer imported (the arc check
-imports it only for a search, and every arc here passes its shortcut: ~0.1 s), the writer
-prints each coordinate once (text and value read back kept together) and writes an arc's
-usual single block without the general path, ``half_up`` keeps the repr's digits when
-nothing carries, the reader makes its moves without the frozen dataclass ``__init__`` and
-the work-area extent tests arcs inline. What is left (CPU, quiet-machine estimates from
-these ratios): start-up ~0.15 s (Python, click, ``importlib.metadata`` for the entry
-points: camtool's own modules ~0.03 s), reading ~0.17 s (~5 µs a line: two regexes and
-the plain-line interpreter), writing ~0.2 s (~6 µs a block) and the extent ~0.02 s.
-2× (0.5 s wall, start-up included) is not reachable by exact Python alone: reading and
-writing would have to run compiled, and a compiled path (numba) costs more to import
-than this whole budget.
-
-Fourth pass (26 Nov 2026, 2-core machine, load average about 1; the 10.9 MB row): both
-cores now work in both halves of the job. The writer's second half is written by a forked
-helper while the writer checks the placement and writes the first
-(``camtool/accel/splitwrite.py``); the reader's later plain lines are read ahead by another
-(``camtool/importers/gcode_ahead.py``), and the collector is paused while reading. Each
-helper's part is taken only where the state it started from is the process's own, bit for
-bit. The placement check tests an arc's extremes by two floats, not eight (0.22 → 0.145 s).
-Output bytes unchanged. From cached bytecode, 584215e against this tree one after the
-other: 2.83-2.97 s against 2.12-2.22 s before the placement change; this script, three runs
-after it: camtool 2.05-2.12 s, rs274 1.07-1.09 s, 1.92-1.95× (was ~3×), peak ~160 MB (was
-127).
+Measurements: docs/performance.md (this script's rows, and its earlier notes).
 """
 
 from __future__ import annotations

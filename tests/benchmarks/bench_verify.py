@@ -19,12 +19,7 @@ Three rows first (:func:`budget_rows`): ``camtool verify`` with the error budget
 backlash (``--machine`` overlay: one source, the interpolation) and with the profile's (two
 sources), and on one contour of 40 half circles (:func:`arcs_program`, 2.45 M rows, no
 backlash). The goal: with the budget, at most 1.5 times the wall and CPU time of
-``--no-budget`` and at most 250 MB. Second pass (24 Nov 2026, quiet; docs/performance.md):
-1.25 s, 1.69 s CPU, 234 MB against 0.57 s, 0.80 s CPU (2.2×); 1.60 s, 2.06 s CPU, 226 MB
-against 0.56 s, 0.79 s CPU (2.8×); 2.26 s, 3.39 s CPU, 235 MB against 0.90 s, 1.23 s CPU
-(2.8×). The memory goal is met, the time goal is not. Third pass (25 Nov 2026): a budget
-whose one source is the interpolation is the program's own figures, not re-simulated:
-1.04× and 1.04× on the one-source rows; the two sources stay at 2.8× (docs/performance.md).
+``--no-budget`` and at most 250 MB.
 
 Set ``CAMTOOL_BENCH_BASE=/path/to/old/tree`` to run the same two jobs on another tree
 (e.g. the code before issue 17) in the same run: its times and memory are printed, and
@@ -35,80 +30,10 @@ only (the code before issue 17 would hold ~10 GB), once. The start-up (Python, c
 scipy, shapely and numba's cached kernels, :data:`STARTUP`) is measured on its own, and
 each row's note gives the time per step after it.
 
-Measured on the 2-core machine shared with 4 other jobs (so under load, load average ~5;
-the trees run one after the other in the same run, best of 2), camtool b3b77a5 (before
-issue 17), main b83b9f0 (the first pass) and this branch (the trace streamed); C peer
-``cc -O2`` (gcc 12.2.0):
-
-=============================  ===============  =============  ====================  ======
-job                            before b3b77a5   first pass     now (streamed)        vs C
-=============================  ===============  =============  ====================  ======
-verify, 13.2 M steps           18.6 s, 2155 MB  7.6 s, 846 MB  7.0 s, 259 MB         0.007×
-verify, 66.2 M steps           —                —              28.8 s, 440 MB        0.008×
-start-up (imports, kernels)    —                —              3.0 s (1.5 s quiet)   —
-post --verify of the logo      5.5–15.9 s       6.0–17.0 s     12.7 s, 234 MB        —
-=============================  ===============  =============  ====================  ======
-
-Every report is byte-identical before and after. The goals (≥ 0.05× the C loop's
-steps/s, < 250 MB) are not met. The trace is now streamed (simulated and measured in
-chunks of whole moves, never held whole: docs/verify.md "Speed and memory"), which took
-the memory from 846 to ~259 MB; what is left is the start-up (~1.5 s quiet, itself over the
-0.46 s the goal allows at 13.2 M steps) and the path-to-trace distances of the shortfall
-(``nearest_search.nearest_distances``, 2.4–3.5 s of CPU on 400 000 path samples against a
-390 000-point thinned trace, and ~75 MB while it runs; on the 66 M-step program most of
-its 28 s, since the thinned trace's segments are as long as the samples' spacing and far
-more samples miss the cheap vertex bound). Python, numpy, scipy, shapely and the loaded
-kernels are ~160 MB before any trace.
-
-Third pass (22 Nov 2026, ``make bench`` on the quiet machine): 13.2 M steps 2.53 s, 237 MB
-(MiB: this script divides ``ru_maxrss`` by 1024), 0.0096× C (547 M steps/s that run;
-start-up 1.14 s, then 105 ns a step); 66.2 M steps 6.73 s, 250 MB, 0.018× C (84 ns a step).
-Reports byte-identical. What changed: the shortfall measures exactly only the samples that
-can be the largest distance and builds one k-d tree per contour; the nearest ends and ties
-are one compiled pass; an unsure sample's exact distance is GEOS's formula compiled; the
-kernels load before a streamed program's rows are counted (docs/verify.md). The memory goal
-is met on the 13.2 M-step program; the speed goal is not (the start-up alone is over it).
-
-Eighth pass (23 Nov 2026, quiet): the runs now use cached bytecode, as ``bench_repost.py``
-does and as an installed camtool runs (:func:`camtool_env`; this machine sets
-``PYTHONDONTWRITEBYTECODE``, which compiled every camtool module on every run, ~0.12 s),
-after an untimed run that writes it, and the 66.2 M-step row is the best of 2 too. Two
-runs of this script: 13.2 M steps 1.24 / 1.29 s, 0.018× C, 239 MB; 66.2 M steps 2.26 /
-2.38 s, **0.050× / 0.048×** C (584 M steps/s), 242 MB; start-up 0.72 s, then 23–25 ns a
-step. The goal is reached on the 66.2 M-step program in one run of two: at it, not over
-it. Reports byte-identical (docs/verify.md "Speed and memory", docs/performance.md).
-
-Ninth pass (23 Nov 2026, quiet): the thread ahead takes a share of the deviation's
-distances so that both threads take as long a row, the kernels make fewer passes over
-the rows, the exact sum of squares carries every 512 additions (1 024 could wrap a bin).
-Two runs: 66.2 M steps **2.08 / 2.09 s, 0.055× / 0.053×** C (584 / 594 M steps/s), 243 /
-244 MB; 13.2 M steps 1.24 / 1.22 s, 0.018×. The goal is met on the 66.2 M-step program,
-with about 8 % to spare; not on the 13.2 M one (start-up 0.8 s). Reports byte-identical.
-
 The rows' ratio is issue 44's: camtool's steps/s after the start-up (the whole run's time
 less :data:`STARTUP`'s) over the C loop's; the note gives the whole run's too.
 
-Tenth pass (25 Nov 2026, quiet; the C peer now runs at ~900 M steps/s): the shortfall of a
-dense trace (these zig-zags' lines lie 30 µm and 6 µm apart) is searched in the k-d tree
-(docs/verify.md, "a trace that passes again and again"). 66.2 M steps 2.57 → 1.99 s,
-255 → 238 MB, 52.5 M steps/s after the start-up: **0.059×** C; 13.2 M steps 1.24 →
-1.12 s, 251 → 235 MB, 33.6 M steps/s after the start-up (0.037×: the k-d tree's 0.2 s
-build is half of what follows the start-up). The 40 half circles (one circle cut 20
-times, also dense) went 1.06 → 1.18 s, 229 → 244 MB with and without the budget: few
-samples, so the tree's build and scipy's import cost more there than they save.
-Reports byte-identical.
-
-Eleventh pass (26 Nov 2026, quiet): the last contour's k-d tree is built in a thread while
-its samples are bounded, the window bounds are compiled and the first round is taken by a
-partition. 13.2 M steps 1.32 → 1.01-1.14 s, 238 MB; after the start-up 0.040×, 0.052×,
-0.055×, 0.064× and 0.0498× C in five runs (the start-up itself varies by 0.1 s). Reports
-byte-identical (docs/performance.md).
-
-Twelfth pass (26 Nov 2026, quiet): the k-d tree is built by the sliding-midpoint rule, not
-at the median (0.12 → 0.04 s for the 777 000 ends; the measuring thread no longer waits for
-it). 13.2 M steps 0.88-0.90 s, 232 MB, **0.074×, 0.070×, 0.063×** C after the start-up in
-three runs (0.050× before it in the same session); 66.2 M steps 1.66-1.69 s, 0.073-0.074×.
-Reports byte-identical.
+Measurements: docs/performance.md (this script's rows, and its earlier notes).
 """
 
 from __future__ import annotations
