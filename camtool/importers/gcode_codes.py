@@ -83,6 +83,30 @@ G_CODES = MappingProxyType(
         ("G40", "cutter", "warn", "G40 (cutter compensation off) read as a no-op"),
         ("G43", "length", "warn", "G43 tool length offset assumed 0: Z is read as written"),
         ("G49", "length", "warn", "G49 (tool length offset off) read as a no-op"),
+        # the cancels of modes camtool refuses (G16, G68, G51.1 below): a no-op wherever read
+        ("G15", "polar", "warn", "G15 (polar coordinates off) read as a no-op"),
+        ("G69", "rotation", "warn", "G69 (coordinate rotation off) read as a no-op"),
+        ("G50.1", "mirror", "warn", "G50.1 (mirror image off) read as a no-op"),
+        (
+            "G16",
+            "polar",
+            "error",
+            "G16 (polar coordinates: X is a radius, Y an angle) is not supported; ask your "
+            "CAM for cartesian X and Y",
+        ),
+        (
+            "G68 G68.2",
+            "rotation",
+            "error",
+            "{code} rotates the coordinate system, which camtool cannot follow; ask your CAM "
+            "for the moves in part coordinates, without the rotation",
+        ),
+        (
+            "G51.1",
+            "mirror",
+            "error",
+            "G51.1 (mirror image) is not supported; ask your CAM for the mirrored moves",
+        ),
         (
             "G54 G55 G56 G57 G58 G59 G59.1 G59.2 G59.3",
             "coord",

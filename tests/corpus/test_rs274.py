@@ -256,3 +256,34 @@ def test_rs274_refuses_the_comments_inside_words_that_camtool_refuses(tmp_path: 
         path.write_text(program(words))
         done = rs274(path)
         assert ("PROGRAM_END" in done.stdout) == (words in READ), words
+
+
+@needs_rs274
+def test_the_cancels_of_refused_modes_post_as_no_ops(tmp_path: Path) -> None:
+    """G15, G69 and G50.1 in a Fanuc-style header and footer: no move changes.
+
+    Fusion 360's Fanuc post heads a program ``G90 G94 G17 G49 G40 G80`` / ``G69``; Fanuc
+    cancels polar coordinates (G15) and mirror image (G50.1) the same way. The judge is
+    rs274 on the same program without them (LinuxCNC knows none of the three): the moves of
+    camtool's linuxcnc program are its moves, and rs274 accepts that program.
+    """
+    body = "G0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X10\nG3 X20 Y0 I5 J0\nG0 Z5\n"
+    source = tmp_path / "fanuc.nc"
+    source.write_text(
+        f"%\nO1001\nG90 G94 G17 G49 G40 G80\nG21\nG69 G15\nG50.1\n{body}G15\nM30\n%\n"
+    )
+    plain = tmp_path / "plain.ngc"
+    plain.write_text(f"%\nG90 G94 G17 G49 G40 G80\nG21\n{body}M30\n%\n")
+    out = tmp_path / "out.ngc"
+    assert main(["post", str(source), "-t", "linuxcnc", "-o", str(out)]) == 0
+    want, got = rs274(plain), rs274(out)
+    assert want.returncode == 0 and got.returncode == 0, got.stderr
+    expected = canon_moves(want.stdout)
+    assert [k for k, _ in expected] == ["rapid", "line", "line", "arc", "rapid"]
+    # a move to where the tool already is changes nothing (camtool's header rapids to the
+    # safe height first, then in X and Y: here both at X0 Y0 Z5)
+    written = canon_moves(got.stdout)
+    moves = [m for i, m in enumerate(written) if i == 0 or m != written[i - 1]]
+    assert len(moves) == len(expected)
+    for (kind, a), (other, b) in zip(moves, expected, strict=True):
+        assert kind == other and a == pytest.approx(b, abs=ROUND_MM)
