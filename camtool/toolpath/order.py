@@ -5,7 +5,7 @@ Design notes: docs/internals.md, ``camtool/toolpath/order.py``.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any
@@ -264,10 +264,11 @@ class Ordering:
 
     def summary(self) -> list[str]:
         """One or two lines for stderr: reversals and rapids before and after."""
-        d, t, p = (self.reversals[k] for k in ORDER_KEYS)
+        p = self.reversals["planned"]
         rapids = f"rapids {self.travel_mm['drawn']:.3f} → {self.travel_mm['planned']:.3f} mm"
         if self.mode == "travel":
             return [f"order travel: {rapids}; X/Y reversals {p[0]}/{p[1]}"]
+        d, t = self.reversals["drawn"], self.reversals["travel"]
         text = (
             f"order {self.mode}: X/Y reversals {d[0]}/{d[1]} → {p[0]}/{p[1]} "
             f"(travel order {t[0]}/{t[1]}); {rapids}"
@@ -344,22 +345,51 @@ def order_cuts(
         sequences["planned"] = plan.cuts
         axis, point = plan.axis, plan.point
         findings.extend(plan.findings)
-    reversals: dict[str, tuple[int, int]] = {}
     travel: dict[str, float] = {}
     for k, v in sequences.items():
-        same = next((j for j in reversals if sequences[j] is v), None)  # planned = travel
-        reversals[k] = reversals[same] if same else count_reversals(v, origin)
+        same = next((j for j in travel if sequences[j] is v), None)  # planned = travel
         travel[k] = travel[same] if same else _rapids(v, origin)
-    findings.extend(_small_part(sequences["planned"], reversals["planned"], options.order))
+    reversals = ReversalCounts(sequences, origin)
+    findings.extend(_small_part(sequences["planned"], reversals, options.order))
     return Ordering(
         tuple(sequences["planned"]),
         options.order,
-        MappingProxyType(reversals),
+        reversals,
         MappingProxyType(travel),
         axis,
         point,
         tuple(findings),
     )
+
+
+class ReversalCounts(Mapping[str, tuple[int, int]]):
+    """``(x, y)`` axis reversals of each order (:func:`count_reversals`), read-only.
+
+    Each order is counted when first read: the summary of ``--order travel`` reads only
+    the planned one, the drawn order's is read by the report and the search orders'
+    summaries. An order that is the same sequence as another is counted once.
+    """
+
+    def __init__(self, sequences: Mapping[str, Sequence[Cut]], origin: Point) -> None:
+        self._sequences = dict(sequences)
+        self._origin = origin
+        # each key → the first key of the same sequence (the planned order is the travel one)
+        self._first = {
+            k: next(j for j, v in sequences.items() if v is s) for k, s in sequences.items()
+        }
+        self._counted: dict[str, tuple[int, int]] = {}
+
+    def __getitem__(self, key: str) -> tuple[int, int]:
+        first = self._first[key]
+        if first not in self._counted:
+            self._counted[first] = count_reversals(self._sequences[first], self._origin)
+        return self._counted[first]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._sequences)
+
+    def __len__(self) -> int:
+        return len(self._sequences)
 
 
 def _cuts(cuts: Sequence[Cut], seq: Sequence[Step]) -> tuple[Cut, ...]:
@@ -374,9 +404,13 @@ def _rapids(cuts: Sequence[Cut], origin: Point) -> float:
     return total
 
 
-def _small_part(cuts: Sequence[Cut], counts: tuple[int, int], mode: str) -> list[Finding]:
-    """UNAM-GMM S000-19 (L3205–L3211): a part under 1 mm fails after about 16 compensations."""
-    if not cuts or mode == "mirror" or sum(counts) <= MAX_REVERSALS_SMALL:
+def _small_part(cuts: Sequence[Cut], reversals: ReversalCounts, mode: str) -> list[Finding]:
+    """UNAM-GMM S000-19 (L3205–L3211): a part under 1 mm fails after about 16 compensations.
+
+    The part's size is tested first: the planned order's reversals are counted only for a
+    part under 1 mm.
+    """
+    if not cuts or mode == "mirror":
         return []
     x0, y0, x1, y1 = cuts[0].path.bbox()
     for cut in cuts[1:]:
@@ -385,7 +419,8 @@ def _small_part(cuts: Sequence[Cut], counts: tuple[int, int], mode: str) -> list
         b = cut.path.bbox()
         x0, y0, x1, y1 = min(x0, b[0]), min(y0, b[1]), max(x1, b[2]), max(y1, b[3])
     size = max(x1 - x0, y1 - y0)
-    if size >= SMALL_PART_MM:
+    counts = reversals["planned"]
+    if size >= SMALL_PART_MM or sum(counts) <= MAX_REVERSALS_SMALL:
         return []
     better = "--order mirror" if mode == "reversals" else "--order reversals or --order mirror"
     return [

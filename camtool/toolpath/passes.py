@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from itertools import pairwise
+from typing import TYPE_CHECKING
 
 from camtool.geometry.chain import moved_arc
 from camtool.model.errors import ToolpathError, UsageError
@@ -21,6 +22,9 @@ from camtool.toolpath.cuts import Cut, Finding, where
 from camtool.toolpath.leads import KeepOff, leads_for
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.split import MIN_PIECE, Track
+
+if TYPE_CHECKING:
+    from camtool.toolpath.order import Nesting
 
 Z_EPS = 1e-9
 """Z values closer than this (mm) are the same height: no Z move is written between them."""
@@ -69,6 +73,7 @@ def emit(
     helix: bool = True,
     z_axis: bool = False,
     keep_off: KeepOff | None = None,
+    nest: Nesting | None = None,
 ) -> tuple[list[Move], list[Finding]]:
     """The moves that cut ``cuts`` in order, with passes, tabs, ramps and lead arcs.
 
@@ -91,6 +96,10 @@ def emit(
         keep_off: the plan's material, from which lead arcs keep the tool
             (:class:`~camtool.toolpath.leads.KeepOff`); ``None``: each lead is
             checked against its own path only.
+        nest: the nesting of the cuts' groups, when each cut's path is its group's
+            contour itself (one cut per group, reversed or started elsewhere at most:
+            cut on the line), so :func:`parts` need not find it again; ``None``: found
+            from the cut paths.
 
     Returns:
         Rapid/Linear/ArcMove moves, absolute mm; ``z`` is ``None`` on every move
@@ -114,7 +123,7 @@ def emit(
         return writer.moves, writer.findings
     levels = (0.0,) if options.depth is None else pass_depths(options.depth, options.step_down)
     check_ramp(cuts, options, levels)
-    part_of = parts(cuts)
+    part_of = parts(cuts, nest)
     i = 0
     while i < len(cuts):
         j = i + 1
@@ -134,7 +143,7 @@ def emit(
     return writer.moves, writer.findings
 
 
-def parts(cuts: Sequence[Cut]) -> list[int]:
+def parts(cuts: Sequence[Cut], groups: Nesting | None = None) -> list[int]:
     """The part of each cut: the index of its outermost enclosing closed cut (or its own).
 
     A *part* is what comes off the stock in one piece: an outermost closed cut path
@@ -142,7 +151,10 @@ def parts(cuts: Sequence[Cut]) -> list[int]:
     drawing contour (``group``, e.g. the rings of a pocket) are in one part even when
     none of them encloses the others. Containment is tested on the cut paths
     themselves (:func:`camtool.toolpath.order.nesting`), so it is the same before
-    and after tool compensation.
+    and after tool compensation. ``groups``: the nesting of the drawing contours, given
+    when each cut is its group's contour on the line (one cut per group): the cut paths'
+    own nesting, found once by the planner (a path reversed or started at another
+    vertex covers what it covered).
 
     Returns:
         ``(len(cuts),)`` part keys: equal keys, same part.
@@ -151,7 +163,7 @@ def parts(cuts: Sequence[Cut]) -> list[int]:
 
     if not cuts:
         return []
-    nest = nesting([c.path for c in cuts])
+    nest = nesting([c.path for c in cuts]) if groups is None else _by_cut(cuts, groups)
     first_of_group: dict[int, int] = {}
     out: list[int] = []
     areas: dict[int, float] = {}  # each cut's box area, computed once
@@ -167,6 +179,14 @@ def parts(cuts: Sequence[Cut]) -> list[int]:
         key = cuts[outer].group
         out.append(first_of_group.setdefault(key, outer))
     return out
+
+
+def _by_cut(cuts: Sequence[Cut], groups: Nesting) -> Nesting:
+    """``groups`` (indexed by contour) indexed by cut, for one cut per group."""
+    from camtool.toolpath.order import Nesting
+
+    cut_of = {cut.group: i for i, cut in enumerate(cuts)}
+    return Nesting(tuple(tuple(sorted(cut_of[j] for j in groups.parents[c.group])) for c in cuts))
 
 
 def _bbox_area(cut: Cut) -> float:

@@ -21,7 +21,7 @@ from camtool.model.program import Program, Rapid
 from camtool.model.progress import Progress, no_progress
 from camtool.model.shapes import BBox, Contour, Drawing, Line, Point, Segment, fit_factor
 from camtool.toolpath.chain import close_gaps
-from camtool.toolpath.cuts import Finding, Stage, finding_warnings
+from camtool.toolpath.cuts import Cut, Finding, Stage, finding_warnings
 from camtool.toolpath.gaps import open_gaps
 from camtool.toolpath.leads import KeepOff
 from camtool.toolpath.options import DEFAULT_CHAIN_TOLERANCE, OFFSET_MODES, PlanOptions
@@ -217,7 +217,15 @@ def plan_unplaced(
     findings.extend(ordering.findings)
     z_axis = machine is not None and machine.has_z
     keep_off = _keep_off(contours, nest, options)
-    moves, emitted = emit(ordering.cuts, options, helix=helix, z_axis=z_axis, keep_off=keep_off)
+    on_line = _each_its_contour(stage.cuts, contours)
+    moves, emitted = emit(
+        ordering.cuts,
+        options,
+        helix=helix,
+        z_axis=z_axis,
+        keep_off=keep_off,
+        nest=nest if on_line else None,
+    )
     findings.extend(emitted)
     if not any(not isinstance(m, Rapid) for m in moves):
         raise InputError(
@@ -261,6 +269,13 @@ def chained(
         for i in pieces
     )
     return joined, found, left_out
+
+
+def _each_its_contour(cuts: Sequence[Cut], contours: Sequence[Contour]) -> bool:
+    """Whether each contour is cut once, on its own path (``--offset on``, no ``--direction``)."""
+    return len(cuts) == len(contours) and all(
+        cut.group == i and cut.path is contours[i] for i, cut in enumerate(cuts)
+    )
 
 
 def _keep_off(contours: Sequence[Contour], nest: Any, options: PlanOptions) -> KeepOff | None:

@@ -163,6 +163,31 @@ def test_grid_of_holes_reversals_beat_travel_and_drawn(backlash: tuple[float, fl
     assert got.cuts[-1].group == 0
 
 
+def test_each_orders_reversals_are_counted_once_when_read(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``Ordering.reversals`` counts an order when it is read, once; travel = planned once."""
+    import camtool.toolpath.order as order
+
+    calls: list[int] = []
+
+    def counting(cuts: Sequence[Cut], start: Point) -> tuple[int, int]:
+        calls.append(len(cuts))
+        return count_reversals(cuts, start)
+
+    monkeypatch.setattr(order, "count_reversals", counting)
+    cuts, nest = cuts_of(plate_with_grid(3))
+    got = order_cuts(cuts, nest, options("travel"), (0.0, 0.0))
+    assert calls == []  # a 3.5 mm plate, over 1 mm: the small-part finding counts nothing
+    assert got.reversals["planned"] == count_reversals(got.cuts, (0.0, 0.0))
+    assert got.reversals["travel"] == got.reversals["planned"] and len(calls) == 1
+    drawn = got.reversals["drawn"]
+    assert len(calls) == 2 and dict(got.reversals) == {
+        "drawn": drawn,
+        "travel": got.reversals["planned"],
+        "planned": got.reversals["planned"],
+    }
+    assert len(calls) == 2
+
+
 def test_model_matches_the_pic_mmh_compensations_on_lines() -> None:
     """The mmh-gmm profile compensates every reversal (UNAM-GMM §5.1): the simulated
     reversals and compensation count equal the model's for the planned grid order."""

@@ -580,6 +580,33 @@ def test_parts_group_nested_cuts_and_pocket_rings() -> None:
     assert keys[0] == keys[1] and len({keys[1], keys[2], keys[3]}) == 3 and keys[3] == keys[4]
 
 
+def test_parts_from_the_contours_nesting_for_cuts_on_the_line() -> None:
+    """The planner's nesting of the contours gives each cut on the line its part.
+
+    Cuts reordered, reversed and started elsewhere (as the ordering leaves them) lie
+    where their contours lie: the plate's hole and the open line inside it are the
+    plate's part, the far square and the line across nothing are parts of their own.
+    """
+    from camtool.toolpath.order import nesting
+    from camtool.toolpath.passes import parts
+    from camtool.toolpath.travel import oriented
+
+    plate, hole, far = _rect_cw(0, 0, 10, 10), _circle(5, 5, 1), _rect_cw(20, 0, 22, 2)
+    inner = Contour((Line((2.0, 2.0), (3.0, 2.0)),), False)
+    alone = Contour((Line((30.0, 0.0), (31.0, 0.0)),), False)
+    contours = [plate, hole, far, inner, alone]
+    cuts = [
+        Cut(inner.reversed(), 3, "open", may_rotate=False),
+        Cut(hole.reversed(), 1),
+        oriented(Cut(far, 2), 2, False),
+        Cut(alone, 4, "open", may_rotate=False),
+        Cut(plate.reversed(), 0),
+    ]
+    keys = parts(cuts, nesting(contours))
+    assert keys == parts(cuts)
+    assert keys[0] == keys[1] == keys[4] and len({keys[0], keys[2], keys[3]}) == 3
+
+
 def test_end_position_at_clearance_after_the_rise() -> None:
     o = _options(depth=0.5, end_position=(-3.0, 40.0))
     moves = emit_moves([Cut(_rect_cw(1, 1, 2, 2), 0)], o)
