@@ -34,8 +34,8 @@ from camtool.importers.svgpage import (
     apply,
     check_travel,
     compose,
+    contour_off_page,
     off_page_text,
-    outside_page,
     refusal_note,
 )
 from camtool.model.errors import GeometryError, InputError, TooLargeError
@@ -203,7 +203,7 @@ def svg_drawing(
             "line has no inside to fill, so a viewer shows nothing); give it a stroke to cut it"
         )
     size_note = ""
-    outside = [c for c in contours if outside_page(c.bbox(), prepared.page)]
+    outside = [c for c in contours if contour_off_page(c, prepared.page)]
     if outside:
         first = outside[0]
         text = off_page_text(

@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import TypeAlias
 
 from camtool.model.errors import InputError, TooLargeError, UsageError
-from camtool.model.shapes import BBox, Point
+from camtool.model.shapes import BBox, Contour, Point
 from camtool.model.units import LENGTH_UNITS, PX
 
 Affine: TypeAlias = tuple[float, float, float, float, float, float]
@@ -219,6 +219,21 @@ def outside_page(box: BBox, page: tuple[float, float] | None) -> bool:
     width, height = page
     s = _PAGE_SLACK_MM
     return box[2] < -s or box[0] > width + s or box[3] < -s or box[1] > height + s
+
+
+def contour_off_page(contour: Contour, page: tuple[float, float] | None) -> bool:
+    """:func:`outside_page` of ``contour``'s box, its box found only when its start is off the page.
+
+    A contour whose start lies on the page (within the slack) has a box that reaches the
+    page on every side, so it is not wholly outside: most contours are settled by one point.
+    """
+    if page is None:
+        return False
+    x, y = contour.start
+    s = _PAGE_SLACK_MM
+    if -s <= x <= page[0] + s and -s <= y <= page[1] + s:
+        return False
+    return outside_page(contour.bbox(), page)
 
 
 def off_page_text(

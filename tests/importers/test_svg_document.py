@@ -936,6 +936,9 @@ def test_contours_wholly_outside_the_page_are_cut_with_a_warning(tmp_path: Path)
         '<rect id="across" x="90" y="90" width="20" height="20"/>'
         '<rect id="away" x="10" y="10" width="5" height="5" transform="translate(0,1034.6)"/>'
         '<circle id="left" cx="-20" cy="50" r="5"/>'
+        # starting off the page, onto which a line or an arc's bulge comes back
+        '<path id="enter" d="M -20 50 L 50 50 L 50 60 Z"/>'
+        '<circle id="bulge" cx="104" cy="50" r="5"/>'
     )
     drawing = read_svg(svg(tmp_path, body))
     assert [c.source for c in drawing.contours] == [
@@ -943,7 +946,10 @@ def test_contours_wholly_outside_the_page_are_cut_with_a_warning(tmp_path: Path)
         "rect#across",
         "rect#away",
         "circle#left",
+        "path#enter",
+        "circle#bulge",
     ]
+    assert drawing.contours[5].start[0] > 100.0  # its start is off the page
     assert drawing.warnings == (
         f"{tmp_path / 't.svg'}: 2 contours lie wholly outside the 100 × 100 mm page, where a "
         "viewer shows nothing (first rect#away at (10.0000, -949.6000) mm); camtool cuts them: "
