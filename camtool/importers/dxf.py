@@ -73,7 +73,7 @@ _SKIP_REASONS: dict[str, str] = {
         "a mask: what it covers on screen is still read and cut; trim those lines in the "
         "CAD program if they are not to be cut"
     ),
-    "POINT": "a point has no path to cut",
+    "POINT": "a point has no path to cut; a drill operation of a job drills it",
     **dict.fromkeys(
         ("3DFACE", "3DSOLID", "MESH", "BODY", "REGION", "SURFACE", "POLYFACE", "POLYMESH"),
         _THREE_D,

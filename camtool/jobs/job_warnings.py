@@ -8,7 +8,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-from camtool.model.shapes import Contour, Drawing
+from camtool.model.shapes import Contour, Drawing, Mark
 
 if TYPE_CHECKING:
     from camtool.jobs.job import Job
@@ -35,6 +35,23 @@ def unselected(
             "no operation selects them"
         )
     return out
+
+
+def undrilled(drawing: Drawing, drilled: set[int]) -> list[str]:
+    """One line per layer of the drawing's points (DXF POINTs) no operation drills.
+
+    ``drilled``: the ``id`` of each of ``drawing.marks`` an operation selected.
+    """
+    left: dict[str, list[Mark]] = {}
+    for mark in drawing.marks:
+        if id(mark) not in drilled:
+            left.setdefault(mark.layer, []).append(mark)
+    return [
+        f"not drilled: {len(marks)} point(s) on layer {layer!r} (first "
+        f"{marks[0].source or 'POINT'} at ({marks[0].at[0]:.4f}, {marks[0].at[1]:.4f}) mm): no "
+        "operation selects them (a drill operation with points = true drills them)"
+        for layer, marks in sorted(left.items())
+    ]
 
 
 def overlaps(runs: Sequence[OperationRun], job: Job) -> list[str]:

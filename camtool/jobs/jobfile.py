@@ -290,7 +290,10 @@ def _selection(row: Mapping[str, Any], kind: str, source: str, where: str) -> Se
     closed = row.get("closed")
     if closed is not None and not isinstance(closed, bool):
         raise InputError(f"{source}: {where} closed = {closed!r}; give true or false")
-    points = row.get("points", kind == "drill")
+    # a drill drills the points unless it selects by a contour's shape (only the circles of
+    # a diameter, say: `camtool job init` gives one drill per hole size), which no point has
+    shaped = any(row.get(key) is not None for key in ("diameter", "closed", "linetypes"))
+    points = row.get("points", kind == "drill" and not shaped)
     if not isinstance(points, bool):
         raise InputError(f"{source}: {where} points = {points!r}; give true or false")
     return Selection(

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 from camtool.jobs.drill import drill_moves
 from camtool.jobs.heights import check_heights
 from camtool.jobs.job import Job, Operation, Tool
-from camtool.jobs.job_warnings import holes_cut_outside, overlaps, unselected
+from camtool.jobs.job_warnings import holes_cut_outside, overlaps, undrilled, unselected
 from camtool.jobs.jobfile import as_keys
 from camtool.jobs.selection import (
     Selected,
@@ -276,13 +276,16 @@ def run_job(
     warnings: list[str] = list(drawing.warnings)
     runs: list[OperationRun] = []
     construction: list[Contour] = []
+    drilled: set[int] = set()  # the drawing's marks an operation selected, by id
     here: tuple[float, float, float | None] = (*setup.origin, None)
     loaded: int | None = None
     sequence = job.sequenced()
     for number, op in enumerate(sequence, start=1):
         tool = job.tool(op.tool)
         where = _where(job, op, number)
-        chosen = _as_scaled(select(drawing, op.select), drawing, scaled)
+        selected = select(drawing, op.select)
+        drilled.update(id(m) for m in selected.drawing.marks)
+        chosen = _as_scaled(selected, drawing, scaled)
         construction.extend(c for c in chosen.construction if c not in construction)
         if not chosen.drawing.contours and not chosen.drawing.marks:
             if job.shorthand and chosen.construction:
@@ -327,6 +330,7 @@ def run_job(
     notes = construction_notes(construction)
     if not job.shorthand:
         notes.extend(unselected(scaled, runs, construction))
+        notes.extend(undrilled(drawing, drilled))
     warnings[len(drawing.warnings) : len(drawing.warnings)] = notes
     warnings.extend(overlaps(runs, job))
     warnings.extend(holes_cut_outside(runs, job))

@@ -48,7 +48,11 @@ def _warning(path: Path, build: Any, options: ImportOptions | None = None) -> st
             lambda m: m.add_linear_dim(base=(0, 3), p1=(0, 0), p2=(10, 0)).render(),
             "skipped 1 DIMENSION entity (annotation, not a contour)",
         ),
-        (lambda m: m.add_point((1, 1)), "skipped 1 POINT entity (a point has no path to cut)"),
+        (
+            lambda m: m.add_point((1, 1)),
+            "skipped 1 POINT entity (a point has no path to cut; a drill operation of a job "
+            "drills it)",
+        ),
         (
             lambda m: m.add_3dface([(0, 0, 0), (1, 0, 0), (1, 1, 1)]),
             "skipped 1 3DFACE entity (3D entity; camtool cuts 2D contours)",

@@ -68,6 +68,28 @@ def test_a_job_file_becomes_tools_operations_and_setup(tmp_path: Path) -> None:
     assert job.source == "job.toml" and not job.shorthand
 
 
+@pytest.mark.parametrize(
+    ("keys", "points"),
+    [
+        ("", True),  # a drill drills the points of its layers
+        ("diameter = 2.5\n", False),  # only circles of a size: no point has one
+        ("closed = true\n", False),
+        ('linetypes = ["CONTINUOUS"]\n', False),
+        ("diameter = 2.5\npoints = true\n", True),  # asked for: both
+        ("points = false\n", False),
+    ],
+)
+def test_a_drill_selects_points_unless_it_selects_by_shape(
+    tmp_path: Path, keys: str, points: bool
+) -> None:
+    text = (
+        '[[tools]]\nid = 2\ntype = "drill"\ndiameter = 2.5\n'
+        f'[[operations]]\ntype = "drill"\ntool = 2\ndepth = 3\n{keys}'
+    )
+    (drill,) = _job(tmp_path, text).operations
+    assert drill.select.points is points
+
+
 def test_the_bundled_sample_job_loads() -> None:
     job = load_job(ROOT / "samples" / "part.toml")
     assert [op.kind for op in job.operations] == [

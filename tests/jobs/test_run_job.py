@@ -194,6 +194,44 @@ def test_a_point_is_drilled_where_it_is(tmp_path: Path) -> None:
     assert [(m.x, m.y, m.z) for m in feeds] == [(12.5, 7.25, -2.0)]  # work zero: the drawing's
 
 
+def test_a_drill_of_one_hole_size_drills_no_point(tmp_path: Path) -> None:
+    """A drill selecting circles by diameter keeps only them: a point has no diameter.
+
+    LibreCAD's ``elektro/lamp/sg.dxf`` draws a lamp with a ø1.5 mm circle and two POINTs
+    (its connection points). ``camtool job init`` writes a drill for the ø1.5 circles
+    (and the points' drill commented out); the points were drilled too, two holes the
+    job did not ask for. Drilled now: the circle's centre alone, and a warning names the
+    points left; ``points = true`` in the same operation drills them as well.
+    """
+    from camtool.jobs.init import initial_job
+    from tests.shapes import write_dxf
+
+    def build(msp: object) -> None:
+        msp.add_circle((8.5, -3.0), 0.75)  # type: ignore[attr-defined]
+        msp.add_circle((7.5, 0.0), 5.0)  # type: ignore[attr-defined]
+        for at in ((0.0, 0.0), (15.0, 0.0)):
+            msp.add_point(at)  # type: ignore[attr-defined]
+
+    dxf = write_dxf(tmp_path / "lamp.dxf", build)
+    drawing = read_drawing(dxf)
+    text = initial_job(drawing).replace('origin = "lower-left"', 'origin = "drawing"')
+    assert "diameter = 1.5" in text and '# type = "drill"  # 2 point(s)' in text
+    job = tmp_path / "job.toml"
+    job.write_text(text)
+    done = run_job(drawing, load_target("grbl"), load_job(job))
+    drilled = [c for _, c in done.program.commands if isinstance(c, DrillCycle)]
+    assert [(c.x, c.y) for c in drilled] == [(8.5, -3.0)]
+    (left,) = [w for w in done.program.warnings if w.startswith("not drilled")]
+    assert "2 point(s) on layer '0'" in left and "(0.0000, 0.0000) mm" in left
+    only = "diameter = 1.5  # only the circles of this size"
+    assert only in text
+    job.write_text(text.replace(only, f"points = true\n{only}", 1))
+    done = run_job(drawing, load_target("grbl"), load_job(job))
+    drilled = [c for _, c in done.program.commands if isinstance(c, DrillCycle)]
+    assert sorted((c.x, c.y) for c in drilled) == [(0.0, 0.0), (8.5, -3.0), (15.0, 0.0)]
+    assert not any(w.startswith("not drilled") for w in done.program.warnings)
+
+
 def test_a_drawing_of_points_only_is_drilled_by_a_job_and_refused_by_a_profile(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
