@@ -17,12 +17,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from camtool.geometry.chain import chain_members, joint_distance
 from camtool.jobs.drill import drill_moves
 from camtool.jobs.heights import check_heights
 from camtool.jobs.job import Job, Operation, Tool
 from camtool.jobs.job_warnings import holes_cut_outside, overlaps, undrilled, unselected
 from camtool.jobs.jobfile import as_keys
 from camtool.jobs.selection import (
+    ChainedClosed,
     Selected,
     construction_notes,
     nothing_selected,
@@ -277,13 +279,14 @@ def run_job(
     runs: list[OperationRun] = []
     construction: list[Contour] = []
     drilled: set[int] = set()  # the drawing's marks an operation selected, by id
+    chained = _chained_closed(drawing, scaled, joint_distance(setup.chain_tolerance))
     here: tuple[float, float, float | None] = (*setup.origin, None)
     loaded: int | None = None
     sequence = job.sequenced()
     for number, op in enumerate(sequence, start=1):
         tool = job.tool(op.tool)
         where = _where(job, op, number)
-        selected = select(drawing, op.select)
+        selected = select(drawing, op.select, chained)
         drilled.update(id(m) for m in selected.drawing.marks)
         chosen = _as_scaled(selected, drawing, scaled)
         construction.extend(c for c in chosen.construction if c not in construction)
@@ -477,6 +480,25 @@ def _edge(op: Operation, tool: Tool, options: PlanOptions) -> float:
     if op.type == "drill":
         return tool.diameter / 2.0
     return options.radius if options.offset != "on" else 0.0
+
+
+def _chained_closed(drawing: Drawing, scaled: Drawing, joint_mm: float) -> ChainedClosed:
+    """Whether contours of ``drawing`` are closed once chained as the planner chains them.
+
+    They are chained as scaled (``scaled``: ``drawing`` after ``scale``/``fit``, the same
+    contours in order), ``joint_mm`` apart at most (:func:`~camtool.geometry.chain.chain_members`).
+    """
+    as_scaled = {id(a): b for a, b in zip(drawing.contours, scaled.contours, strict=True)}
+
+    def closed(contours: Sequence[Contour]) -> list[bool]:
+        joined, members = chain_members([as_scaled[id(c)] for c in contours], joint_mm)
+        out = [False] * len(contours)
+        for chain, pieces in zip(joined, members, strict=True):
+            for i in pieces:
+                out[i] = chain.closed
+        return out
+
+    return closed
 
 
 def _as_scaled(chosen: Selected, drawing: Drawing, scaled: Drawing) -> Selected:

@@ -9,10 +9,12 @@ names its layer or its linetype: a selection of "everything" never cuts it.
 
 from __future__ import annotations
 
+import dataclasses
 import shlex
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import TypeAlias
 
 from camtool.jobs.job import Operation, Selection
 from camtool.model.construction import construction_layer
@@ -46,15 +48,20 @@ def construction_reason(contour: Contour, selection: Selection) -> str | None:
     return None
 
 
-def matches(contour: Contour, selection: Selection) -> bool:
-    """Whether ``contour`` meets every condition of ``selection`` (construction aside)."""
+def matches(contour: Contour, selection: Selection, *, closed: bool | None = None) -> bool:
+    """Whether ``contour`` meets every condition of ``selection`` (construction aside).
+
+    ``closed``: whether the contour is closed as the planner chains it (a square of four
+    LINEs is), for ``selection.closed``; ``None``: the contour's own ``closed``.
+    """
     if selection.layers is not None and contour.layer.casefold() not in {
         n.casefold() for n in selection.layers
     }:
         return False
     if selection.colours is not None and contour.colour not in selection.colours:
         return False
-    if selection.closed is not None and contour.closed != selection.closed:
+    is_closed = contour.closed if closed is None else closed
+    if selection.closed is not None and is_closed != selection.closed:
         return False
     if selection.linetypes is not None and contour.linetype not in selection.linetypes:
         return False
@@ -87,12 +94,30 @@ def mark_matches(mark: Mark, selection: Selection) -> bool:
     return selection.colours is None or mark.colour in selection.colours
 
 
-def select(drawing: Drawing, selection: Selection) -> Selected:
-    """The contours and marks of ``drawing`` that ``selection`` cuts (see the module)."""
+ChainedClosed: TypeAlias = Callable[[Sequence[Contour]], Sequence[bool]]
+"""Whether each of some contours is closed once they are chained end to end, as the planner
+chains what an operation selects (:func:`camtool.toolpath.plan.chained`)."""
+
+
+def select(
+    drawing: Drawing, selection: Selection, chained: ChainedClosed | None = None
+) -> Selected:
+    """The contours and marks of ``drawing`` that ``selection`` cuts (see the module).
+
+    ``closed = true`` / ``false`` asks whether a contour is closed as it will be cut: a
+    closed shape drawn as several entities (four LINEs, LINEs and ARCs) is one closed
+    contour once chained. ``chained`` tells that of the contours the other conditions
+    keep (chained together, as the planner chains them); ``None``: each contour's own.
+    """
     kept: list[Contour] = []
     construction: list[Contour] = []
+    closed: dict[int, bool] = {}
+    if selection.closed is not None and chained is not None:
+        shape = dataclasses.replace(selection, closed=None)
+        candidates = [c for c in drawing.contours if matches(c, shape)]
+        closed = {id(c): k for c, k in zip(candidates, chained(candidates), strict=True)}
     for contour in drawing.contours:
-        if not matches(contour, selection):
+        if not matches(contour, selection, closed=closed.get(id(contour))):
             continue
         if construction_reason(contour, selection) is None:
             kept.append(contour)

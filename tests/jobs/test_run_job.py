@@ -232,6 +232,50 @@ def test_a_drill_of_one_hole_size_drills_no_point(tmp_path: Path) -> None:
     assert not any(w.startswith("not drilled") for w in done.program.warnings)
 
 
+def test_closed_selects_a_shape_drawn_as_several_entities(tmp_path: Path) -> None:
+    """``closed = true`` (as ``camtool job init`` writes for a profile) keeps a closed chain.
+
+    LibreCAD's ``elektro/dev/dev13.dxf`` draws its outline as four LINEs around a closed
+    LWPOLYLINE. The selection judged each entity alone: the four open LINEs were left out,
+    and the inner shape, now the outermost, was cut on its outside, through the part. As
+    the planner chains them, the LINEs are one closed square: cut outside (the 2 mm tool's
+    centre 1 mm out), the inner rectangle inside it (1 mm in).
+    """
+    from tests.shapes import write_dxf
+
+    def build(msp: object) -> None:
+        corners = [(0, 0), (12, 0), (12, 12), (0, 12)]
+        for a, b in zip(corners, corners[1:] + corners[:1], strict=True):
+            msp.add_line(a, b)  # type: ignore[attr-defined]
+        msp.add_lwpolyline([(4, 4), (8, 4), (8, 8), (4, 8)], close=True)  # type: ignore[attr-defined]
+        msp.add_line((12, 6), (16, 6))  # type: ignore[attr-defined]  # open: not cut
+
+    dxf = write_dxf(tmp_path / "square.dxf", build)
+    job = tmp_path / "job.toml"
+    job.write_text(
+        '[[tools]]\nid = 1\ntype = "end-mill"\ndiameter = 2\n'
+        '[[operations]]\ntype = "profile"\ntool = 1\nclosed = true\nside = "outside"\n'
+        "depth = 1\n"
+    )
+    done = run_job(read_drawing(dxf), load_target("grbl"), load_job(job))
+    z, cuts = 0.0, []  # the moves at the depth (a move that keeps Z has none)
+    for m in done.program.moves:
+        z = m.z if m.z is not None else z
+        if isinstance(m, Linear) and z == -1.0:
+            cuts.append(m)
+    xs = [m.x for m in cuts]
+    assert min(xs) == pytest.approx(-1.0) and max(xs) == pytest.approx(13.0)
+    inner = [m for m in cuts if 4.0 < m.x < 8.0 and 4.0 < m.y < 8.0]
+    assert inner and all(
+        m.x == pytest.approx(5.0)
+        or m.x == pytest.approx(7.0)
+        or m.y == pytest.approx(5.0)
+        or m.y == pytest.approx(7.0)
+        for m in inner
+    )
+    assert any("not cut: 1 contour(s)" in w for w in done.program.warnings)
+
+
 def test_a_drawing_of_points_only_is_drilled_by_a_job_and_refused_by_a_profile(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
