@@ -114,7 +114,11 @@ def select(
     closed: dict[int, bool] = {}
     if selection.closed is not None and chained is not None:
         shape = dataclasses.replace(selection, closed=None)
-        candidates = [c for c in drawing.contours if matches(c, shape)]
+        candidates = [  # what the planner gets: construction is not cut
+            c
+            for c in drawing.contours
+            if matches(c, shape) and construction_reason(c, selection) is None
+        ]
         closed = {id(c): k for c, k in zip(candidates, chained(candidates), strict=True)}
     for contour in drawing.contours:
         if not matches(contour, selection, closed=closed.get(id(contour))):

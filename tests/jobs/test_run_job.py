@@ -239,7 +239,8 @@ def test_closed_selects_a_shape_drawn_as_several_entities(tmp_path: Path) -> Non
     LWPOLYLINE. The selection judged each entity alone: the four open LINEs were left out,
     and the inner shape, now the outermost, was cut on its outside, through the part. As
     the planner chains them, the LINEs are one closed square: cut outside (the 2 mm tool's
-    centre 1 mm out), the inner rectangle inside it (1 mm in).
+    centre 1 mm out), the inner rectangle inside it (1 mm in); a centre line from a corner is
+    construction, which the planner leaves out, so it is not chained with the square either.
     """
     from tests.shapes import write_dxf
 
@@ -249,6 +250,8 @@ def test_closed_selects_a_shape_drawn_as_several_entities(tmp_path: Path) -> Non
             msp.add_line(a, b)  # type: ignore[attr-defined]
         msp.add_lwpolyline([(4, 4), (8, 4), (8, 8), (4, 8)], close=True)  # type: ignore[attr-defined]
         msp.add_line((12, 6), (16, 6))  # type: ignore[attr-defined]  # open: not cut
+        # a centre line from a corner: construction, which the planner does not chain
+        msp.add_line((0, 0), (-5, -5), dxfattribs={"layer": "CENTER"})  # type: ignore[attr-defined]
 
     dxf = write_dxf(tmp_path / "square.dxf", build)
     job = tmp_path / "job.toml"
