@@ -13,10 +13,12 @@ from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
+from camtool.geometry.chain import chain_members, joint_distance
 from camtool.jobs.job import Selection
 from camtool.jobs.selection import circle_of, construction_reason
 from camtool.model.errors import InputError
 from camtool.model.shapes import Contour, Drawing, fit_factor
+from camtool.toolpath.options import DEFAULT_CHAIN_TOLERANCE
 
 DRILL_MAX_MM = 6.5
 """Largest circle drilled (ø6.5 mm: an M6 clearance hole); larger ones are profiled."""
@@ -32,6 +34,7 @@ class _Group:
     key: str
     by: str  # "layers" or "colours"
     contours: list[Contour] = field(default_factory=list)
+    chained: list[Contour] | None = None  # :func:`_chains`
 
 
 @dataclass(frozen=True)
@@ -68,7 +71,7 @@ def initial_job(
         k = fit_factor(drawing.bbox(), _fit_box(tool_diameter, travel_mm))
         drawing = drawing.transformed(k)
     groups = _groups(drawing)
-    outer = _outermost(drawing.contours)
+    outer = _outermost([c for group in groups for c in _chains(group)])
     ops: list[_Op] = []
     left: Counter[str] = Counter()
     for group in groups:
@@ -132,6 +135,18 @@ def _groups(drawing: Drawing) -> list[_Group]:
     return list(by_layer.values())
 
 
+def _chains(group: _Group) -> list[Contour]:
+    """The group's contours but construction, chained end to end (made once per group).
+
+    As a job's selection chains them for ``closed`` (:func:`camtool.jobs.selection.select`,
+    at the job's default chain tolerance): an outline drawn as LINEs is one closed contour.
+    """
+    if group.chained is None:
+        kept = [c for c in group.contours if construction_reason(c, Selection()) is None]
+        group.chained = chain_members(kept, joint_distance(DEFAULT_CHAIN_TOLERANCE))[0]
+    return group.chained
+
+
 def _outermost(contours: Sequence[Contour]) -> set[int]:
     """The ids of the closed contours that lie inside no other closed contour."""
     from camtool.toolpath.order import nesting
@@ -162,8 +177,11 @@ def _ops_of(
     circles: dict[float, list[float]] = {}  # by the diameter to 1 µm: every diameter
     profiled: list[Contour] = []
     opened: list[Contour] = []
-    for contour in kept:
-        circle = circle_of(contour)
+    # a drawn circle is drilled as drawn (the selection's diameter reads each entity); the
+    # rest as chained, closed or open, as the selection's closed = true / false reads them
+    drawn = {id(c) for c in kept}  # a chain of several entities is no drawn circle
+    for contour in _chains(group):
+        circle = circle_of(contour) if id(contour) in drawn else None
         if circle is not None and circle[1] <= DRILL_MAX_MM:
             circles.setdefault(round(circle[1], 3), []).append(circle[1])
         elif contour.closed:

@@ -71,6 +71,33 @@ def test_a_drawing_of_lines_only_is_engraved(tmp_path: Path) -> None:
     assert [op["type"] for op in _ops(text)] == ["engrave"]
 
 
+def test_an_outline_drawn_as_lines_is_a_part_cut_outside(tmp_path: Path) -> None:
+    """A closed outline of LINEs (LibreCAD's ``algoritm/alg11.dxf``: a pentagon) is a part.
+
+    The guesses judged each entity alone: five open LINEs, "lines only", engraved with
+    ``closed = false``, which the selection (chaining them, as the planner does) now reads
+    as one closed contour, so the first job selected nothing. Chained here too: the
+    pentagon is cut outside, and the job posts.
+    """
+    corners = [(0, 0), (20, 0), (26, 18), (10, 30), (-6, 18)]
+
+    def build(msp: object) -> None:
+        for a, b in zip(corners, corners[1:] + corners[:1], strict=True):
+            msp.add_line(a, b)  # type: ignore[attr-defined]
+        msp.add_line((20, 0), (30, -5))  # type: ignore[attr-defined]  # a tail: engraved
+
+    drawing = read_drawing(write_dxf(tmp_path / "pentagon.dxf", build))
+    text = initial_job(drawing)
+    ops = _ops(text)
+    assert [(op["type"], op.get("side")) for op in ops] == [("profile", "outside")]
+    assert '# type = "engrave"  # 1 open contour(s)' in text
+    job = job_from_dict(tomllib.loads(text), source="pentagon.toml")
+    done = run_job(drawing, load_target("grbl"), job)
+    xs = [m.x for m in done.program.moves if isinstance(m, Linear)]
+    # the 1.5 mm tool radius out on both sides of the 32 mm wide pentagon (lower-left zero)
+    assert max(xs) - min(xs) > 33.0
+
+
 def test_a_drawing_of_construction_only_has_nothing_to_cut(tmp_path: Path) -> None:
     def build(msp: object) -> None:
         msp.add_line((0, 0), (10, 0), dxfattribs={"layer": "DIMENSIONS"})  # type: ignore[attr-defined]
