@@ -30,7 +30,7 @@ from camtool.jobs.selection import (
     nothing_selected,
     select,
 )
-from camtool.model.errors import InputError, UsageError
+from camtool.model.errors import InputError, ToolpathError, UsageError
 from camtool.model.program import (
     Command,
     Dwell,
@@ -575,10 +575,11 @@ def _plan_operation(
         planned = plan_unplaced(
             drawing, options, target.machine, helix=target.post.helix, progress=progress
         )
-    except InputError as exc:
+    except (InputError, ToolpathError, UsageError) as exc:
         if where == "the options":
             raise
-        raise InputError(f"{where}: {exc}") from None
+        # said of the job's operation, in its keys (tabs, tab_width), not post's flags
+        raise type(exc)(f"{where}: {as_keys(str(exc))}") from None
     program = planned.program
     return _Planned(
         list(program.moves),

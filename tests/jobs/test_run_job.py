@@ -279,6 +279,27 @@ def test_closed_selects_a_shape_drawn_as_several_entities(tmp_path: Path) -> Non
     assert any("not cut: 1 contour(s)" in w for w in done.program.warnings)
 
 
+def test_a_plan_refused_in_a_job_names_the_operation_and_its_keys(tmp_path: Path) -> None:
+    """Three tabs on a 1 mm square: refused naming the operation and the job's keys."""
+    from camtool.model.errors import ToolpathError
+    from tests.shapes import write_dxf
+
+    def build(msp: object) -> None:
+        msp.add_lwpolyline([(0, 0), (1, 0), (1, 1), (0, 1)], close=True)  # type: ignore[attr-defined]
+
+    dxf = write_dxf(tmp_path / "small.dxf", build)
+    job = tmp_path / "job.toml"
+    job.write_text(
+        '[[tools]]\nid = 1\ntype = "end-mill"\ndiameter = 3\n[[operations]]\nname = "outline"'
+        '\ntype = "profile"\ntool = 1\nside = "outside"\ndepth = 3\ntabs = 3\n'
+    )
+    with pytest.raises(ToolpathError) as caught:
+        run_job(read_drawing(dxf), load_target("grbl"), load_job(job))
+    message = str(caught.value)
+    assert message.startswith("operation 1 ('outline'): 3 tab(s) do not fit")
+    assert "use fewer tabs or a smaller tab_width" in message and "--" not in message
+
+
 def test_a_drawing_of_points_only_is_drilled_by_a_job_and_refused_by_a_profile(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
