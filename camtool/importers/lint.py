@@ -177,7 +177,11 @@ class InspectReport:
         lines += ["", "contours by layer (after chaining):"]
         lines += _layer_table(self.layers)
         if self.styles:
-            lines += ["", "layers, colours and linetypes (what a job selects by):"]
+            lines += [
+                "",
+                "layers, colours and linetypes (what a job selects by), each entity as read "
+                "(closed = true/false judges the chains above):",
+            ]
             lines += _style_table(self.styles)
         if self.warnings:
             lines += ["", "warnings:", *(f"  {w}" for w in self.warnings)]
