@@ -123,7 +123,9 @@ def _engraved(op: _Op) -> tuple[str, ...]:
 def _groups(drawing: Drawing) -> list[_Group]:
     layers = sorted({c.layer for c in drawing.contours}, key=str.casefold)
     colours = sorted({c.colour for c in drawing.contours if c.colour})
-    if len(layers) == 1 and len(colours) > 1:
+    # by colour only when every contour has one: a job selects no contour by "no colour"
+    coloured = all(c.colour for c in drawing.contours)
+    if len(layers) == 1 and len(colours) > 1 and coloured:
         groups = {c: _Group(c, "colours") for c in colours}
         for contour in drawing.contours:
             groups.setdefault(contour.colour, _Group(contour.colour, "colours"))

@@ -340,19 +340,40 @@ def _colour(value: Any, source: str, where: str) -> str:
         r, g, b = aci2rgb(value)
         return f"#{r:02x}{g:02x}{b:02x}"
     if isinstance(value, str):
-        import svgelements as se
-
-        text = value.strip()
-        try:
-            c = se.Color(text)
-        except (ValueError, TypeError):
-            c = None
-        if c is not None and c.value is not None and not text.lower().startswith("url("):
-            return f"#{c.red:02x}{c.green:02x}{c.blue:02x}"
+        rgb = _css_colour(value.strip())
+        if rgb is not None:
+            return rgb
     raise InputError(
         f"{source}: {where} colours: {value!r} is not a colour; give a DXF colour number "
         "(1 red, 2 yellow, 3 green, 4 cyan, 5 blue, 6 magenta, 7 white), a name or #rrggbb"
     )
+
+
+_HEX = re.compile(r"#(?:[0-9a-fA-F]{3}|[0-9a-fA-F]{6})")
+_RGB = re.compile(r"rgb\(\s*[0-9.]+%?\s*,\s*[0-9.]+%?\s*,\s*[0-9.]+%?\s*\)", re.IGNORECASE)
+
+
+def _css_colour(text: str) -> str | None:
+    """``text`` as ``#rrggbb``: ``#rgb``, ``#rrggbb``, ``rgb(…)`` or a CSS keyword; else None.
+
+    svgelements' own parser reads any other word (a typo, ``""``) as black and a string of
+    digits as a number, so it is asked only about what has a colour's form, and a keyword
+    only counts when it is one (the one keyword whose colour is black is ``black``).
+    """
+    import svgelements as se
+
+    name = text.replace(" ", "").lower()
+    if not (_HEX.fullmatch(text) or _RGB.fullmatch(text) or name.isalpha()):
+        return None
+    c = se.Color(text)
+    black = se.Color.rgb_to_int(0, 0, 0)
+    if (
+        c.value is None
+        or c.alpha != 255
+        or (name.isalpha() and c.value == black and name != "black")
+    ):
+        return None
+    return f"#{c.red:02x}{c.green:02x}{c.blue:02x}"
 
 
 # ------------------------------------------------------------------------ values

@@ -90,6 +90,32 @@ def test_a_drill_selects_points_unless_it_selects_by_shape(
     assert drill.select.points is points
 
 
+_PROFILE = (
+    '[[tools]]\nid = 1\ntype = "end-mill"\ndiameter = 3\n'
+    '[[operations]]\ntype = "profile"\ntool = 1\ndepth = 1\n'
+)
+
+
+@pytest.mark.parametrize(
+    "value", ["1", '"red"', '"Red"', '"#F00"', '"#ff0000"', '"rgb(255, 0, 0)"', '"rgb(100%,0%,0%)"']
+)
+def test_a_colour_is_read_as_its_rgb(tmp_path: Path, value: str) -> None:
+    # DXF colour 1 is red (ezdxf's ACI table); red is #ff0000 in CSS Color 3
+    (op,) = _job(tmp_path, f"{_PROFILE}colours = [{value}]\n").operations
+    assert op.select.colours == ("#ff0000",)
+
+
+@pytest.mark.parametrize(
+    "value",
+    ['""', '" "', '"rde"', '"7"', '"transparent"', '"currentColor"', '"#ff000080"', '"#12"'],
+)
+def test_what_is_no_colour_is_refused(tmp_path: Path, value: str) -> None:
+    """svgelements reads any word it does not know (a typo, an empty string) as black:
+    such a job selected the black contours instead of refusing."""
+    with pytest.raises(InputError, match="is not a colour"):
+        _job(tmp_path, f"{_PROFILE}colours = [{value}]\n")
+
+
 def test_the_bundled_sample_job_loads() -> None:
     job = load_job(ROOT / "samples" / "part.toml")
     assert [op.kind for op in job.operations] == [

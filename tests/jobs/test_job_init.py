@@ -98,6 +98,30 @@ def test_an_outline_drawn_as_lines_is_a_part_cut_outside(tmp_path: Path) -> None
     assert max(xs) - min(xs) > 33.0
 
 
+def test_a_drawing_with_an_uncoloured_shape_is_not_split_by_colour(tmp_path: Path) -> None:
+    """Inkscape's ``blend_modes.svg``: 17 coloured shapes and 200 filled by a gradient.
+
+    Grouped by colour, the gradient-filled shapes made an operation ``colours = [""]``,
+    which selected the black shapes a second time (an empty string reads as black in
+    svgelements) and none of its own. One layer, one operation, by layer.
+    """
+    svg = tmp_path / "blend.svg"
+    svg.write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="60mm" '
+        'viewBox="0 0 100 60"><defs><linearGradient id="g"><stop offset="0" '
+        'stop-color="red"/><stop offset="1" stop-color="blue"/></linearGradient></defs>'
+        '<rect x="5" y="5" width="20" height="20" fill="none" stroke="#ff0000"/>'
+        '<rect x="35" y="5" width="20" height="20" fill="none" stroke="#0000ff"/>'
+        '<rect x="65" y="5" width="20" height="20" fill="url(#g)"/></svg>'
+    )
+    drawing = read_drawing(svg)
+    assert sorted(c.colour for c in drawing.contours) == ["", "#0000ff", "#ff0000"]
+    ops = _ops(initial_job(drawing))
+    assert [(op["type"], op.get("layers"), op.get("colours")) for op in ops] == [
+        ("profile", ["0"], None)
+    ]
+
+
 def test_a_drawing_of_construction_only_has_nothing_to_cut(tmp_path: Path) -> None:
     def build(msp: object) -> None:
         msp.add_line((0, 0), (10, 0), dxfattribs={"layer": "DIMENSIONS"})  # type: ignore[attr-defined]
