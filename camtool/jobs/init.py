@@ -278,7 +278,7 @@ def _profile_op(
         f"step_down = {min(mill or tool, depth):g}" + _why("passes of at most the tool's diameter"),
     ]
     if has_outer:
-        shortest = min(c.length for c in contours if id(c) in outer)
+        shortest = min(c.length for c in _parts(contours))
         tabs = _tabs_that_fit(shortest, tool)
         if tabs:
             lines.append(f"tabs = {tabs}" + _why("hold the part to the stock on the last pass"))
@@ -347,6 +347,19 @@ def _mill_for_holes(contours: Sequence[Contour], tool: float) -> tuple[float | N
 
 TAB_WIDTH_MM = 2.0
 """The tab width a job leaves as ``post``'s ``--tab-width`` default."""
+
+
+def _parts(contours: Sequence[Contour]) -> list[Contour]:
+    """The closed contours an outside profile of ``contours`` cuts on their outside.
+
+    Those inside an even number of the others (the even-odd rule the planner cuts by:
+    a part, a part in a hole of another...), each of which gets the operation's tabs.
+    """
+    from camtool.toolpath.order import nesting
+
+    closed = [c for c in contours if c.closed]
+    nest = nesting(closed)
+    return [c for i, c in enumerate(closed) if nest.depth(i) % 2 == 0]
 
 
 def _tabs_that_fit(length: float, tool: float) -> int:

@@ -320,6 +320,11 @@ def _compensated(
     if corners:
         findings.append(_tight(contour, corners, r))
     outside_profile = depth % 2 == 0 and options.offset == "outside"
+    # an outward offset is one loop around the part and, where the tool cannot fill a bay
+    # of the outline, loops inside it (the offset region's holes): only the loop around
+    # frees the part, so only it gets the tabs and leads of an outside profile
+    pieces = result.pieces
+    around = max(range(len(pieces)), key=lambda i: abs(pieces[i].signed_area()))
     cuts = [
         Cut(
             piece,
@@ -327,10 +332,10 @@ def _compensated(
             "profile",
             may_reverse=False,
             may_rotate=True,
-            outside_profile=outside_profile,
+            outside_profile=outside_profile and i == around,
             material_side="right" if side.climb else "left",
         )
-        for piece in result.pieces
+        for i, piece in enumerate(pieces)
     ]
     return cuts, findings
 

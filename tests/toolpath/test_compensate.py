@@ -108,6 +108,23 @@ def test_rectangle_outside_has_corner_arcs_and_grows_by_the_diameter() -> None:
     assert abs(cut.path.signed_area()) == pytest.approx(50 + 2 * 15 + math.pi, abs=1e-3)
 
 
+def test_only_the_loop_around_an_outside_profile_frees_the_part() -> None:
+    """A square ring with a 1 mm slit: the 3 mm tool cannot enter the slit, so the outward
+    offset is a loop around the ring and one inside its 10 mm hole (1.5 mm in from its
+    sides). Only the loop around cuts the part free: it alone
+    is an outside profile (tabs, leads); the loop inside clears the hole."""
+    pts = [(0, 0), (9.5, 0), (9.5, 5), (5, 5), (5, 15), (15, 15), (15, 5), (10.5, 5)]
+    pts += [(10.5, 0), (20, 0), (20, 20), (0, 20), (0, 0)]
+    ring = Contour(tuple(Line(a, b) for a, b in itertools.pairwise(pts)), True)
+    cuts = _run([ring], "outside", 3.0).cuts
+    boxes = {c.outside_profile: c.path.bbox() for c in cuts}
+    assert len(cuts) == 2 and set(boxes) == {True, False}
+    assert boxes[True] == pytest.approx((-1.5, -1.5, 21.5, 21.5))
+    # over the slit's mouth the tool reaches down to 1.5 mm from its corners (9.5, 5) and
+    # (10.5, 5): y = 5 + √(1.5² − 0.5²) = 5 + √2
+    assert boxes[False] == pytest.approx((6.5, 5 + math.sqrt(2.0), 13.5, 13.5))
+
+
 def test_rectangle_inside_shrinks_by_the_diameter_with_sharp_corners() -> None:
     (cut,) = _run([rect(0, 0, 10, 5)], "inside", 2.0).cuts
     assert all(isinstance(s, Line) for s in cut.path.segments)
