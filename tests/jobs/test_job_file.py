@@ -110,8 +110,10 @@ def test_a_colour_is_read_as_its_rgb(tmp_path: Path, value: str) -> None:
     ['""', '" "', '"rde"', '"7"', '"transparent"', '"currentColor"', '"#ff000080"', '"#12"'],
 )
 def test_what_is_no_colour_is_refused(tmp_path: Path, value: str) -> None:
-    """svgelements reads any word it does not know (a typo, an empty string) as black:
-    such a job selected the black contours instead of refusing."""
+    """An empty string, a typo, a keyword that is no colour, a translucent one: refused.
+
+    (svgelements' own parser reads any word it does not know as black, so it is not the
+    judge of what a colour is.)"""
     with pytest.raises(InputError, match="is not a colour"):
         _job(tmp_path, f"{_PROFILE}colours = [{value}]\n")
 

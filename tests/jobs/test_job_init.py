@@ -74,10 +74,10 @@ def test_a_drawing_of_lines_only_is_engraved(tmp_path: Path) -> None:
 def test_an_outline_drawn_as_lines_is_a_part_cut_outside(tmp_path: Path) -> None:
     """A closed outline of LINEs (LibreCAD's ``algoritm/alg11.dxf``: a pentagon) is a part.
 
-    The guesses judged each entity alone: five open LINEs, "lines only", engraved with
-    ``closed = false``, which the selection (chaining them, as the planner does) now reads
-    as one closed contour, so the first job selected nothing. Chained here too: the
-    pentagon is cut outside, and the job posts.
+    job init chains a layer's entities as the operations' ``closed`` selects them (as the
+    planner chains them): the five LINEs are one closed contour, not "lines only" to
+    engrave with ``closed = false`` (which would select nothing). The pentagon is cut
+    outside, and the job posts.
     """
     corners = [(0, 0), (20, 0), (26, 18), (10, 30), (-6, 18)]
 
@@ -101,9 +101,8 @@ def test_an_outline_drawn_as_lines_is_a_part_cut_outside(tmp_path: Path) -> None
 def test_a_drawing_with_an_uncoloured_shape_is_not_split_by_colour(tmp_path: Path) -> None:
     """Inkscape's ``blend_modes.svg``: 17 coloured shapes and 200 filled by a gradient.
 
-    Grouped by colour, the gradient-filled shapes made an operation ``colours = [""]``,
-    which selected the black shapes a second time (an empty string reads as black in
-    svgelements) and none of its own. One layer, one operation, by layer.
+    A job selects no contour by "no colour", so a layer is split by colour only when every
+    shape has one: here one layer, one operation, by layer.
     """
     svg = tmp_path / "blend.svg"
     svg.write_text(

@@ -199,9 +199,9 @@ def test_a_drill_of_one_hole_size_drills_no_point(tmp_path: Path) -> None:
 
     LibreCAD's ``elektro/lamp/sg.dxf`` draws a lamp with a ø1.5 mm circle and two POINTs
     (its connection points). ``camtool job init`` writes a drill for the ø1.5 circles
-    (and the points' drill commented out); the points were drilled too, two holes the
-    job did not ask for. Drilled now: the circle's centre alone, and a warning names the
-    points left; ``points = true`` in the same operation drills them as well.
+    and leaves the points' drill commented out: the circle's centre alone is drilled, and
+    a warning names the points left; ``points = true`` in the same operation drills them
+    as well.
     """
     from camtool.jobs.init import initial_job
     from tests.shapes import write_dxf
@@ -236,9 +236,9 @@ def test_closed_selects_a_shape_drawn_as_several_entities(tmp_path: Path) -> Non
     """``closed = true`` (as ``camtool job init`` writes for a profile) keeps a closed chain.
 
     LibreCAD's ``elektro/dev/dev13.dxf`` draws its outline as four LINEs around a closed
-    LWPOLYLINE. The selection judged each entity alone: the four open LINEs were left out,
-    and the inner shape, now the outermost, was cut on its outside, through the part. As
-    the planner chains them, the LINEs are one closed square: cut outside (the 2 mm tool's
+    LWPOLYLINE. Each LINE alone is open; left out, the inner shape would be the outermost
+    and be cut on its outside, through the part. As the planner chains them, the LINEs
+    are one closed square: cut outside (the 2 mm tool's
     centre 1 mm out), the inner rectangle inside it (1 mm in); a centre line from a corner is
     construction, which the planner leaves out, so it is not chained with the square either.
     """
