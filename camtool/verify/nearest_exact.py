@@ -490,9 +490,20 @@ def _nearby_group(
 
 
 def _nearest_chunk(
-    samples: FloatArray, a: FloatArray, b: FloatArray, ends: Any, half: float
+    samples: FloatArray,
+    a: FloatArray,
+    b: FloatArray,
+    ends: Any,
+    half: float,
+    long: LongSegments | None = None,
 ) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
     """:func:`nearest_distances` of a few samples from the k-d tree of segment ``ends``.
+
+    ``long``: the few long segments (:func:`long_segments`), tested apart: a sample is
+    also settled when no other segment can be nearer with an end beyond the k found
+    (``d + short_half`` below the k-th end) and every long segment lies farther than
+    ``d`` (``d + half`` below its nearest long end). Each test is exact (a segment
+    nearer than ``d`` has an end within ``d + L/2``), so the distances are the same.
 
     Returns:
         The distances and which of them the tests could not settle.
@@ -506,4 +517,8 @@ def _nearest_chunk(
     # exact where every segment that could be nearer had an end among the k found
     # (its nearer end lies within d + L/2), or where the vertex bound is tight enough
     sure = (d + half < r[:, -1]) | (k == 2 * len(a)) | (d - lower <= NEAREST_TOLERANCE_MM)
+    if long is not None and not sure.all():
+        ask = np.flatnonzero(~sure)
+        far_long = np.asarray(long.tree.query(samples[ask], k=1, workers=KD_WORKERS)[0])
+        sure[ask] = (d[ask] + long.short_half < r[ask, -1]) & (d[ask] + half < far_long)
     return d, ~sure

@@ -497,12 +497,11 @@ def _nearest_kd(
     tree = (ends or _LazyTree(_end_points(a, b))).tree
     d = np.empty(len(samples), dtype=np.float64)
     unsure = np.empty(len(samples), dtype=bool)
+    # the few long segments apart, in the cheap tests and in the exact stage
+    long = nearest_exact.long_segments(a, b, half) if ends is None else ends.long(half)
     for i in range(0, len(samples), NEAREST_CHUNK):
         part = slice(i, i + NEAREST_CHUNK)
-        d[part], unsure[part] = nearest_exact._nearest_chunk(samples[part], a, b, tree, half)
-    long = None
-    if unsure.any():  # the exact stage will search: the few long segments apart
-        long = nearest_exact.long_segments(a, b, half) if ends is None else ends.long(half)
+        d[part], unsure[part] = nearest_exact._nearest_chunk(samples[part], a, b, tree, half, long)
     nearby = partial(nearest_exact._nearby_exact, a=a, b=b, ends=tree, half=half, long=long)
     return nearest_exact._settle_unsure(samples, d, unsure, a, b, nearby, only_max=only_max)
 

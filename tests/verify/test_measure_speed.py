@@ -95,6 +95,36 @@ def test_long_segments_searched_apart_give_the_all_segments_query_bit_for_bit(se
     assert np.array_equal(some[need], want[need]) and np.array_equal(some[~need], upper[~need])
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_long_segments_apart_settle_a_sample_only_at_its_true_nearest(seed: int) -> None:
+    """The cheap test with the long segments apart settles only exact distances.
+
+    A line's staircase with 20-step jumps (as a trace with backlash take-ups):
+    half the longest segment is 10 steps, so the plain test settles few samples near the
+    trace. A sample the test settles once the long segments are apart must have the least
+    distance over every segment (the same formula, all segments: bit for bit).
+    """
+    rng = np.random.default_rng(seed)
+    step = (0.001, 0.0009)[seed % 2]
+    moves = np.c_[np.full(4000, step), rng.choice([0.0, step], size=4000)]  # a line's staircase
+    moves[rng.choice(4000, size=30, replace=False)] *= 20.0
+    pts = np.cumsum(moves, axis=0)
+    a, b = pts[:-1], pts[1:]
+    half = float(np.max(np.hypot(*(b - a).T))) / 2.0
+    long = nearest_exact.long_segments(a, b, half)
+    assert long is not None
+    samples = pts[rng.integers(0, len(pts), 800)] + rng.normal(0.0, step / 4, (800, 2))
+    ends = cKDTree(np.concatenate([a, b]))
+    plain, unsure_plain = nearest_exact._nearest_chunk(samples, a, b, ends, half)
+    got, unsure = nearest_exact._nearest_chunk(samples, a, b, ends, half, long)
+    assert np.array_equal(got, plain)
+    newly = unsure_plain & ~unsure
+    assert not (unsure & ~unsure_plain).any()
+    assert newly.sum() > 100  # the case the long segments are for
+    every = np.stack([nearest_exact._to_segments(s[None], a[None], b[None])[0] for s in samples])
+    assert np.array_equal(got[newly], every.min(axis=1)[newly])
+
+
 def test_segments_of_one_length_are_not_searched_apart() -> None:
     pts = np.cumsum(np.full((500, 2), [0.004, 0.0]), axis=0)
     a, b = pts[:-1], pts[1:]
