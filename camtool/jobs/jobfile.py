@@ -222,11 +222,23 @@ def _operation(
         side = _choice(row.get("side", "outside"), SIDES, source, f"{where} side")
     elif "side" in row:
         raise InputError(f"{source}: {where}: side is for profile operations, not {kind}")
+    tab_keys = [k for k in ("tabs", "tab_width", "tab_height") if k in row]
+    if tab_keys and kind != "drill" and side != "outside":
+        what = f"a profile with side = {side!r}" if side else f"{kind} operation"
+        what = what if side else ("an " if kind == "engrave" else "a ") + what
+        raise InputError(
+            f"{source}: {where}: {', '.join(tab_keys)}: tabs hold a part on an outside "
+            f"profile only, and this is {what}; remove "
+            f"{'it' if len(tab_keys) == 1 else 'them'} here"
+        )
     plan = _operation_plan(row, kind, side, tool, setup, source, where)
     select = _selection(row, kind, source, where)
     drill_keys = [k for k in ("peck", "dwell", "hole_tolerance") if k in row]
     if kind != "drill" and drill_keys:
-        raise InputError(f"{source}: {where}: {', '.join(drill_keys)} are for drill operations")
+        raise InputError(
+            f"{source}: {where}: {', '.join(drill_keys)}: only a drill operation takes "
+            f"{'this key; remove it' if len(drill_keys) == 1 else 'these keys; remove them'} here"
+        )
     if kind == "drill" and tool.type not in ("drill", "end-mill"):
         raise InputError(
             f"{source}: {where} drills with tool {number}, a {tool.type}; drill with a drill "
@@ -269,7 +281,10 @@ def _operation_plan(
     if kind in ("drill", "engrave") and values["offset"] == "on":
         values["tool_diameter"] = 0.0  # on the line: no compensation, no "no effect" note
     if kind == "drill":
-        for key in ("tabs", "ramp", "lead_in", "stepover", "pocket", "pocket_angle", "direction"):
+        for key in (
+            *("tabs", "tab_width", "tab_height", "ramp", "lead_in", "stepover"),
+            *("pocket", "pocket_angle", "direction"),
+        ):
             if key in row:
                 raise InputError(f"{source}: {where}: {key} does not apply to drilling")
         if values.get("depth") is None:

@@ -156,16 +156,40 @@ def test_auto_sequence_drills_first_and_cuts_the_outline_last(tmp_path: Path) ->
         (("id = 2", "id = 1"), r"two tools with id 1"),
         (('peck = "chip-break"', 'peck = "chip"'), r"peck = 'chip'"),
         (("depth = 6.5", "depth = 6.5\ntabs = 2"), r"tabs does not apply to drilling"),
+        (("depth = 6.5", "depth = 6.5\ntab_height = 1"), r"tab_height does not apply to drill"),
+        (
+            ('side = "outside"', 'side = "inside"'),
+            r"operation 1: tabs: tabs hold a part on an outside profile only, and this is a "
+            r"profile with side = 'inside'; remove it here",
+        ),
+        (
+            (
+                *('type = "profile"\ntool = 1', 'type = "pocket"\ntool = 1\ntab_width = 4'),
+                *('side = "outside"', ""),
+            ),
+            r"tabs, tab_width: tabs hold a part on an outside profile only, and this is a "
+            r"pocket operation; remove them here",
+        ),
+        (
+            (
+                *('type = "profile"\ntool = 1', 'type = "engrave"\ntool = 1\npeck = "retract"'),
+                *('side = "outside"', ""),
+                *("tabs = 3", ""),
+            ),
+            r"peck: only a drill operation takes this key; remove it here",
+        ),
         (("clearance_z = 8", "clearance_z = 1"), r"clearance_z 1 mm is below safe_z 2 mm"),
     ],
 )
 def test_what_a_job_file_may_not_say_is_refused_naming_it(
-    tmp_path: Path, change: tuple[str, str], message: str
+    tmp_path: Path, change: tuple[str, ...], message: str
 ) -> None:
-    old, new = change
-    assert old in GOOD
+    text = GOOD
+    for old, new in zip(change[::2], change[1::2], strict=True):
+        assert old in text
+        text = text.replace(old, new, 1)
     with pytest.raises(InputError, match=message) as caught:
-        _job(tmp_path, GOOD.replace(old, new, 1))
+        _job(tmp_path, text)
     assert str(caught.value).startswith(f"{tmp_path / 'job.toml'}: ")
 
 
