@@ -79,13 +79,16 @@ def init(
     check_paths(
         [("the input", drawing)], [("-o", output)], target=target, machine_file=machine_file
     )
-    travel = None
+    travel, no_z = None, ""
     if target is not None:
         from camtool.jobs.pipeline import load_target_checked
 
-        travel = load_target_checked(target, machine_file=machine_file).machine.travel_mm
+        machine = load_target_checked(target, machine_file=machine_file).machine
+        travel, no_z = machine.travel_mm, ("" if machine.has_z else target)
     drawn = read_input(drawing, import_settings(options))
-    text = initial_job(drawn, thickness_mm=thickness, tool_diameter=tool_diameter, travel_mm=travel)
+    text = initial_job(
+        drawn, thickness_mm=thickness, tool_diameter=tool_diameter, travel_mm=travel, no_z=no_z
+    )
     write_output(text, output)
     if output != "-":
         count = sum(line.startswith("[[operations]]") for line in text.splitlines())

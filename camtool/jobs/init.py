@@ -9,6 +9,7 @@ Design notes: docs/internals.md, ``camtool/jobs/init.py``.
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -52,6 +53,7 @@ def initial_job(
     tool_diameter: float = 3.0,
     source: str = "",
     travel_mm: tuple[float, float] | None = None,
+    no_z: str = "",
 ) -> str:
     """A job file (TOML text, comments included) for ``drawing``.
 
@@ -64,6 +66,12 @@ def initial_job(
         travel_mm: the target machine's travel ``(x, y)``; a drawing (with the tool
             around it) larger than it gets a ``fit`` that scales it down, said in a
             comment (``None``: no machine in view).
+        no_z: the target machine's name when it has no programmable Z (its depth is set
+            by hand): then no heights, depths, passes or tabs, and no drilling (a hole
+            is profiled on its inside).
+
+    Raises:
+        InputError: nothing to cut, or the tool is as wide as the machine's travel.
     """
     fit = _fit(drawing, tool_diameter, travel_mm)
     k = 1.0
@@ -75,18 +83,30 @@ def initial_job(
     ops: list[_Op] = []
     left: Counter[str] = Counter()
     for group in groups:
-        ops.extend(_ops_of(group, outer, thickness_mm, tool_diameter, left, k))
+        ops.extend(_ops_of(group, outer, thickness_mm, tool_diameter, left, k, drill=not no_z))
     if all(op.kind == "engrave" for op in ops):
         # lines only, no part outline: a drawing to engrave (a sign, a symbol)
         ops = [dataclasses.replace(op, commented=False, lines=_engraved(op)) for op in ops]
-    ops.extend(_marks(drawing, thickness_mm))
+    if no_z:
+        ops = [dataclasses.replace(op, lines=_flat(op.lines)) for op in ops]
+    else:
+        ops.extend(_marks(drawing, thickness_mm))
     if not any(not op.commented for op in ops):
         raise InputError(
             f"{drawing.source or 'the drawing'}: nothing to cut: every contour is construction "
             f"({'; '.join(f'{w}: {n}' for w, n in sorted(left.items()))}); name its layer in "
             "an operation of a job written by hand to cut it"
         )
-    return _render(ops, left, thickness_mm, tool_diameter, source or drawing.source, fit)
+    return _render(ops, left, thickness_mm, tool_diameter, source or drawing.source, fit, no_z)
+
+
+_Z_KEYS = ("depth =", "step_down =", "tabs =", "tab_height =", "# no tabs:")
+"""The lines of an operation a machine without programmable Z has no use for."""
+
+
+def _flat(lines: tuple[str, ...]) -> tuple[str, ...]:
+    """An operation's lines without heights, depths, passes and tabs (no programmable Z)."""
+    return tuple(line for line in lines if not line.startswith(_Z_KEYS))
 
 
 def _fit(drawing: Drawing, tool: float, travel: tuple[float, float] | None) -> tuple[str, ...]:
@@ -98,20 +118,35 @@ def _fit(drawing: Drawing, tool: float, travel: tuple[float, float] | None) -> t
     fw, fh = _fit_box(tool, travel)
     if x1 - x0 <= fw and y1 - y0 <= fh:
         return ()
+    k = fit_factor(drawing.bbox(), (fw, fh))
     return (
         f"fit = [{fw:g}, {fh:g}]"
         + _why(
-            f"the drawing is {x1 - x0:.4g} × {y1 - y0:.4g} mm, larger than the "
-            f"{w:g} × {h:g} mm travel: SCALED DOWN to fit; remove this line on a larger machine"
+            f"the drawing is {x1 - x0:.4g} × {y1 - y0:.4g} mm; with the {tool:g} mm tool "
+            f"around it, larger than the {w:g} × {h:g} mm travel: SCALED DOWN to {k:.3g}×; "
+            "remove this line on a larger machine"
         ),
     )
 
 
 def _fit_box(tool: float, travel: tuple[float, float] | None) -> tuple[float, float]:
-    """The box a drawing must fit for its outside profile to fit ``travel`` (mm)."""
+    """The box a drawing must fit for its outside profile to fit ``travel`` (mm).
+
+    The profile's tool centre runs a tool radius outside the drawing on each side, so
+    the drawing may take the travel less the tool's diameter, less 0.01 mm (as ``post``
+    proposes for a toolpath larger than the travel).
+
+    Raises:
+        InputError: the tool is as wide as the travel: nothing fits.
+    """
     assert travel is not None
-    margin = 2.0 * tool  # the tool's width on both sides of an outside profile
-    return max(travel[0] - margin, 1.0), max(travel[1] - margin, 1.0)
+    fw, fh = (math.floor((t - tool) * 100.0 - 1.0) / 100.0 for t in travel)
+    if fw <= 0 or fh <= 0:
+        raise InputError(
+            f"the {tool:g} mm tool is as wide as the machine's {travel[0]:g} × {travel[1]:g} mm "
+            "travel: give the end mill you will use with --tool-diameter"
+        )
+    return fw, fh
 
 
 def _engraved(op: _Op) -> tuple[str, ...]:
@@ -161,9 +196,19 @@ def _outermost(contours: Sequence[Contour]) -> set[int]:
 
 
 def _ops_of(
-    group: _Group, outer: set[int], thickness: float, tool: float, left: Counter[str], k: float
+    group: _Group,
+    outer: set[int],
+    thickness: float,
+    tool: float,
+    left: Counter[str],
+    k: float,
+    *,
+    drill: bool = True,
 ) -> list[_Op]:
-    """The operations of one layer (or colour); ``k``: the scale the job fits it by."""
+    """The operations of one layer (or colour); ``k``: the scale the job fits it by.
+
+    ``drill``: small circles are drilled (else profiled with the rest: no Z to drill by).
+    """
     select = f"{group.by} = [{_quote(group.key)}]"
     what = f"layer {group.key!r}" if group.by == "layers" else f"colour {group.key}"
     kept: list[Contour] = []
@@ -184,7 +229,7 @@ def _ops_of(
     drawn = {id(c) for c in kept}  # a chain of several entities is no drawn circle
     for contour in _chains(group):
         circle = circle_of(contour) if id(contour) in drawn else None
-        if circle is not None and circle[1] <= DRILL_MAX_MM:
+        if drill and circle is not None and circle[1] <= DRILL_MAX_MM:
             circles.setdefault(round(circle[1], 3), []).append(circle[1])
         elif contour.closed:
             profiled.append(contour)
@@ -408,6 +453,7 @@ def _render(
     tool: float,
     source: str,
     fit: tuple[str, ...] = (),
+    no_z: str = "",
 ) -> str:
     tools: dict[tuple[str, float], int] = {}
     ordered = sorted(ops, key=lambda op: (_ORDER[op.kind], op.tool))
@@ -423,8 +469,17 @@ def _render(
         "",
         "[job]",
         'origin = "lower-left"' + _why("work zero at the toolpath's lower-left corner"),
-        "clearance_z = 10.0" + _why("mm above the top: start, end and tool changes"),
-        "safe_z = 2.0" + _why("mm above the top: rapids within an operation"),
+        *(
+            (
+                f"# {no_z} has no programmable Z: no heights, depths or tabs here; set each "
+                "operation's depth by hand on the machine",
+            )
+            if no_z
+            else (
+                "clearance_z = 10.0" + _why("mm above the top: start, end and tool changes"),
+                "safe_z = 2.0" + _why("mm above the top: rapids within an operation"),
+            )
+        ),
         'sequence = "auto"'
         + _why("drill, engrave, pocket, inside, outside profiles last, by tool"),
         *fit,

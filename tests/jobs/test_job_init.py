@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import tomllib
 from pathlib import Path
 
@@ -12,7 +13,7 @@ from camtool.jobs.init import initial_job
 from camtool.jobs.jobfile import job_from_dict
 from camtool.jobs.run import run_job
 from camtool.model.errors import InputError
-from camtool.model.program import Linear
+from camtool.model.program import ArcMove, Linear
 from camtool.post.registry import load_target
 from tests.corpus.conftest import CORPUS
 from tests.shapes import write_dxf
@@ -154,15 +155,59 @@ def test_a_drawing_larger_than_the_machine_is_fitted_and_said_so(tmp_path: Path)
 
     drawing = read_drawing(write_dxf(tmp_path / "long.dxf", build))
     text = initial_job(drawing, travel_mm=(200.0, 200.0))
-    # 200 mm of travel less the 3 mm tool on both sides: 194 mm, the 388 mm part halved
-    assert "fit = [194, 194]  # the drawing is 388 × 100 mm" in text
+    # the outside profile's tool centre runs 1.5 mm outside the part on each side: the part
+    # may take 200 - 3 mm of travel, less the 0.01 mm post leaves (its --fit proposal)
+    assert "fit = [196.99, 196.99]  # the drawing is 388 × 100 mm; with the 3 mm tool" in text
+    assert f"SCALED DOWN to {196.99 / 388:.3g}×" in text
     data = tomllib.loads(text)
     drill = data["operations"][0]
     assert drill["diameter"] == 6.0  # as drawn: a selection is in the drawing's own mm
     tool = {t["id"]: t for t in data["tools"]}[drill["tool"]]
-    assert tool["diameter"] == 3.0  # as cut: the ø6 circle at half size
+    assert tool["diameter"] == round(6.0 * 196.99 / 388, 3)  # as cut: the ø6 circle scaled
     done = run_job(drawing, load_target("grbl"), job_from_dict(data, source="j.toml"))
     assert done.operations[0].holes == 1
+
+
+def test_a_machine_without_z_gets_no_heights_depths_tabs_or_drilling(tmp_path: Path) -> None:
+    """pic-mmh moves X and Y only (its depth is set by hand): a job of depths it refuses.
+
+    A 6 × 4 mm plate with a ø1.5 mm hole and a 0.5 mm end mill: the hole is profiled on
+    its inside (no plunge to drill with), nothing says a depth, a height or a tab, and the
+    job posts for pic-mmh.
+    """
+
+    def build(msp: object) -> None:
+        msp.add_lwpolyline(  # type: ignore[attr-defined]
+            [(0, 0), (6, 0), (6, 4), (0, 4)], close=True, dxfattribs={"layer": "EDGE"}
+        )
+        msp.add_circle((2, 2), 0.75, dxfattribs={"layer": "EDGE"})  # type: ignore[attr-defined]
+
+    drawing = read_drawing(write_dxf(tmp_path / "small.dxf", build))
+    target = load_target("pic-mmh")
+    assert not target.machine.has_z
+    text = initial_job(drawing, tool_diameter=0.5, travel_mm=target.machine.travel_mm, no_z="x")
+    for key in ("depth", "step_down", "tabs", "tab_height", "clearance_z", "safe_z", "fit"):
+        assert f"{key} =" not in text
+    assert "# x has no programmable Z" in text
+    data = tomllib.loads(text)
+    assert [(op["type"], op.get("side")) for op in data["operations"]] == [("profile", "outside")]
+    done = run_job(drawing, target, job_from_dict(data, source="j.toml"))
+    cuts = [m for m in done.program.moves if isinstance(m, Linear | ArcMove)]
+    # the plate's outside cut runs 0.25 mm outside it: its lower-left is the plate's less that
+    x0, y0 = min(m.x for m in cuts) + 0.25, min(m.y for m in cuts) + 0.25
+    # the hole's inside cut: the tool centre 0.75 - 0.25 mm from the hole's centre
+    around = [m for m in cuts if abs(math.dist((m.x, m.y), (x0 + 2, y0 + 2)) - 0.5) < 0.01]
+    assert len(around) >= 2
+    assert all(m.z is None for m in cuts)
+
+
+def test_a_tool_as_wide_as_the_travel_is_refused(tmp_path: Path) -> None:
+    def build(msp: object) -> None:
+        msp.add_circle((0, 0), 20.0)  # type: ignore[attr-defined]
+
+    drawing = read_drawing(write_dxf(tmp_path / "disc.dxf", build))
+    with pytest.raises(InputError, match=r"the 7 mm tool is as wide as the machine's 10 × 7 mm"):
+        initial_job(drawing, tool_diameter=7.0, travel_mm=(10.0, 7.0))
 
 
 def _plate_with_slots(tmp_path: Path, widths: list[float]) -> Path:
