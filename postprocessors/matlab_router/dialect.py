@@ -64,8 +64,13 @@ COMMAND_REASONS = {
 """Why each kind of :data:`~camtool.model.program.Command` is not written."""
 
 
-def notes_warnings(notes: RouterWriter, speed: int, tolerance: float) -> list[str]:
-    """One warning per kind of conversion the writer made (commands, feeds, arcs, merges)."""
+def notes_warnings(
+    notes: RouterWriter, speed: int, tolerance: float, grid_mm: float = 0.1
+) -> list[str]:
+    """One warning per kind of conversion the writer made (commands, feeds, arcs, merges).
+
+    ``grid_mm``: the grid the vertices were rounded to (the dialect's ``grid_mm``).
+    """
     w = [
         f"{count} {kind} command(s) not written: {COMMAND_REASONS.get(kind, 'no word for it')}"
         for kind, count in notes.dropped()
@@ -80,19 +85,22 @@ def notes_warnings(notes: RouterWriter, speed: int, tolerance: float) -> list[st
     if notes.arcs:
         w.append(
             f"{notes.arcs} arc(s) written as {notes.chords} chords within {tolerance:g} mm "
-            f"(largest sagitta {notes.chord_error_mm:.4f} mm), then rounded to 0.1 mm: the router "
+            f"(largest sagitta {notes.chord_error_mm:.4f} mm), then rounded to {grid_mm:g} mm: the "
+            "router "
             "has straight segments only (Angel-11 §4.1)"
         )
     if notes.counts["merged"]:
         w.append(
-            f"{notes.counts['merged']} vertex(es) rounded onto the previous one at 0.1 mm and "
+            f"{notes.counts['merged']} vertex(es) rounded onto the previous one at {grid_mm:g} mm "
+            "and "
             f"dropped (first: {notes.notes['merged']})"
         )
     if notes.counts["held"]:
         w.append(
             f"{notes.counts['held']} segment(s) whose shorter axis would move at a speed that "
             f"rounds to 0 (the job would hang, Angel-11 §4.2) cut into pieces of at most {speed} "
-            f"counts, each end on the 0.1 mm grid within 0.05 mm of the segment (first: "
+            f"counts, each end on the {grid_mm:g} mm grid within {grid_mm / 2:g} mm of the segment "
+            "(first: "
             f"{notes.notes['held']})"
         )
     if notes.trailing_rapid is not None:
@@ -143,6 +151,9 @@ def jobs_warnings(jobs: list[RouterJob], max_segments: int) -> list[str]:
 
 
 # -- the writer -------------------------------------------------------------------------
+
+CHUNK_MM = 0.2
+"""The listed slave firmware's unit of motion, mm: ``floor(d / 2)`` chunks (Angel-11 §4.2)."""
 
 FIRMWARE_MAX_SEGMENTS = 128
 """Segments (lines) one job holds: the master's ``X_ROUTE[128]`` … arrays (L4625–L4635)."""
@@ -229,6 +240,13 @@ class MatlabRouterPost(PostProcessor):
             GUI's ``fprintf(s,'%c',first_pointy)`` did (L4306); ``y1`` must then
             be 1–127 and not 10 or 13. Default: a decimal number, as the master
             parses it (``atol``, L5017).
+        grid_mm: the grid the vertices are rounded to, 0.2 or 0.1 mm. 0.2 (default):
+            the listed slave moves an axis ``floor(d / 2)`` chunks of 0.2 mm for a
+            distance of ``d`` × 0.1 mm, so it loses 0.1 mm on an odd distance (the losses
+            add up, every move being relative) and on a distance of 1 its chunk counter
+            underflows and the axis runs away (Angel-11 §4.2); on the 0.2 mm grid every
+            distance is whole chunks. 0.1: the GUI's own grid (R1), for a slave that moves
+            exact counts (a 0.1 mm move is then written with a warning).
 
     Raises:
         UsageError: an option out of range or of the wrong type.
@@ -249,6 +267,7 @@ class MatlabRouterPost(PostProcessor):
         max_segments: int = FIRMWARE_MAX_SEGMENTS,
         chord_tolerance_mm: float | None = None,
         first_pointy_as_char: bool = False,
+        grid_mm: float = CHUNK_MM,
     ) -> None:
         if isinstance(speed, bool) or not isinstance(speed, int) or not 1 <= speed <= INT16_MAX:
             raise UsageError(
@@ -276,7 +295,14 @@ class MatlabRouterPost(PostProcessor):
         self.speed = speed
         self.max_segments = max_segments
         self.chord_tolerance_mm = None if chord_tolerance_mm is None else float(chord_tolerance_mm)
+        if isinstance(grid_mm, bool) or grid_mm not in (0.1, CHUNK_MM):
+            raise UsageError(
+                f"grid_mm must be 0.2 (the listed slave's chunk) or 0.1 (the GUI's grid, for a "
+                f"slave that moves exact counts), got {grid_mm!r}"
+            )
         self.first_pointy_as_char = first_pointy_as_char
+        self.grid_mm = float(grid_mm)
+        self.grid = 2 if grid_mm == CHUNK_MM else 1  # in 0.1 mm units
 
     # -- writing ---------------------------------------------------------------
 
@@ -313,7 +339,9 @@ class MatlabRouterPost(PostProcessor):
                 "more (rapids alone are not written)"
             )
         warnings = [*check_placement(program, machine), *notes.warnings]
-        warnings += notes_warnings(notes, self.speed, self._tolerance(program, machine))
+        warnings += notes_warnings(
+            notes, self.speed, self._tolerance(program, machine), self.grid_mm
+        )
         return jobs, warnings + jobs_warnings(jobs, self.max_segments)
 
     def _tolerance(self, program: Program, machine: Machine) -> float:
@@ -365,7 +393,7 @@ class MatlabRouterPost(PostProcessor):
         """Quantise a stroke, drop repeated vertices, split it into jobs of ≤ max_segments."""
         import numpy as np
 
-        xy = points_01mm(np.asarray(stroke.points, dtype=np.float64))
+        xy = points_01mm(np.asarray(stroke.points, dtype=np.float64) / self.grid) * self.grid
         keep = np.ones(len(xy), dtype=bool)
         keep[1:] = (np.diff(xy, axis=0) != 0).any(axis=1)
         owners = [o for o, k in zip(stroke.owners, keep[1:], strict=True) if k]
@@ -378,7 +406,8 @@ class MatlabRouterPost(PostProcessor):
         if len(xy) < 2:
             notes.warnings.append(
                 f"{_place(contours, f'stroke {stroke.number}')} rounds to the "
-                f"single point ({xy[0, 0] / 10:g}, {xy[0, 1] / 10:g}) mm at 0.1 mm and is not "
+                f"single point ({xy[0, 0] / 10:g}, {xy[0, 1] / 10:g}) mm at {self.grid_mm:g} mm "
+                "and is not "
                 "written (a job needs a segment)"
             )
             return []
@@ -387,7 +416,7 @@ class MatlabRouterPost(PostProcessor):
                 f"{_place(contours, f'stroke {stroke.number}')} has a coordinate outside "
                 f"0–{INT16_MAX} (0.1 mm): the master's int16 distances from home (L4639)"
             )
-        xy, owners = _held_speeds(xy, owners, self.speed, notes, program)
+        xy, owners = _held_speeds(xy, owners, self.speed, notes, program, self.grid)
         n = len(xy) - 1
         parts = math.ceil(n / self.max_segments)
         jobs = []
@@ -520,7 +549,12 @@ def _chords(here: Point, move: ArcMove, tolerance: float, notes: RouterWriter) -
 
 
 def _held_speeds(
-    xy: np.ndarray, owners: list[int], speed: int, notes: RouterWriter, program: Program
+    xy: np.ndarray,
+    owners: list[int],
+    speed: int,
+    notes: RouterWriter,
+    program: Program,
+    grid: int = 1,
 ) -> tuple[np.ndarray, list[int]]:
     """Split each segment whose minor-axis speed rounds to 0 into pieces the firmware runs.
 
@@ -529,8 +563,8 @@ def _held_speeds(
     its count, so the job hangs (Angel-11 §3, §4.2). A piece whose major axis moves at
     most ``speed`` counts has a speed of at least 1 wherever its minor axis moves, so such
     a segment is cut into ``ceil(major / speed)`` pieces whose ends are the segment's
-    points at equal steps, rounded to the 0.1 mm grid: each within 0.05 mm of the segment,
-    as every vertex already is after rounding. Other segments are left as they are.
+    points at equal steps, rounded to the vertices' grid: each within half of it of the
+    segment, as every vertex already is after rounding. Other segments are left as they are.
 
     Args:
         xy: ``(n + 1, 2)`` vertices of a stroke, 0.1 mm counts.
@@ -538,6 +572,7 @@ def _held_speeds(
         speed: the major axis's speed, counts per 5 ms.
         notes: where the split is counted (``"held"``) for the warning.
         program: the program, to name the block.
+        grid: the vertices' grid, 0.1 mm counts (1 or 2).
 
     Returns:
         The vertices and owners with the split segments' pieces in their place.
@@ -560,8 +595,8 @@ def _held_speeds(
             continue
         k = math.ceil(int(major[i]) / speed)
         steps = np.arange(1, k + 1, dtype=np.float64)[:, None] / k
-        piece = xy[i] + (xy[i + 1] - xy[i]) * steps  # away from zero at .5, as Matlab
-        points.append(np.sign(piece) * np.floor(np.abs(piece) + 0.5))
+        piece = (xy[i] + (xy[i + 1] - xy[i]) * steps) / grid  # away from zero at .5, as Matlab
+        points.append(np.sign(piece) * np.floor(np.abs(piece) + 0.5) * grid)
         kept += [owners[i]] * k
         move = program.moves[owners[i]]
         notes.note(

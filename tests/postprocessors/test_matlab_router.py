@@ -29,6 +29,9 @@ from tests.shapes import STAR_LXY, STAR_VELXY, STAR_XY_01MM
 SAMPLES = Path(__file__).parents[2] / "samples"
 GOLDEN = Path(__file__).parents[1] / "golden" / "matlab-router"
 TARGET = load_target("matlab-router")
+GUI = str(Path(__file__).parents[1] / "data" / "matlab-router-gui.toml")
+"""The target on the GUI's own 0.1 mm grid: the thesis's arrays, as the GUI wrote them."""
+GUI_TARGET = load_target(GUI)
 MACHINE = TARGET.machine
 FEED = 225.0  # R7: 480 counts / 5 ms at 25 600 counts/mm = 3.75 mm/s on the major axis
 
@@ -45,6 +48,7 @@ THESIS_LINES = [
 def _emit(
     moves: tuple[Move, ...], fmt: str | None = None, **options: object
 ) -> tuple[str, tuple[str, ...]]:
+    options = {"grid_mm": 0.1} | options  # the GUI's grid unless a test says otherwise
     result = MatlabRouterPost(**options).emit(Program(moves), MACHINE, fmt=fmt)  # type: ignore[arg-type]
     assert isinstance(result.code, str)
     return result.code, result.warnings
@@ -73,7 +77,7 @@ def test_star_csv_is_the_thesis_star_in_mm() -> None:
 
 def test_posted_star_has_the_thesis_arrays_exactly() -> None:
     # R2 golden test: lxy, velxy of L3212–L3228; n = 10, first point x = 151, y = 86 (L3233).
-    job = post_file(SAMPLES / "star.csv", "matlab-router")
+    job = post_file(SAMPLES / "star.csv", GUI)
     assert isinstance(job.target.post, MatlabRouterPost)
     (router_job,), warnings = job.target.post.jobs(job.program, MACHINE)
     arrays = router_job.arrays
@@ -86,7 +90,7 @@ def test_posted_star_has_the_thesis_arrays_exactly() -> None:
 
 def test_star_script_shows_the_thesis_text() -> None:
     # R3: the thesis display format; these lines are verbatim thesis text (L3198–L3228).
-    code = str(post_file(SAMPLES / "star.csv", "matlab-router").result.code)
+    code = str(post_file(SAMPLES / "star.csv", GUI).result.code)
     lines = code.splitlines()
     for line in THESIS_LINES:
         assert line in lines
@@ -95,9 +99,7 @@ def test_star_script_shows_the_thesis_text() -> None:
 
 def test_star_wire_is_the_byte_stream_the_gui_sent() -> None:
     # §2.7 / R4: n, x1, y1, lx(1..n), ly(1..n), velx(1..n), vely(1..n), each '%d' then CR.
-    code = post_file(
-        SAMPLES / "star.csv", "matlab-router", output=OutputOptions(fmt="wire")
-    ).result.code
+    code = post_file(SAMPLES / "star.csv", GUI, output=OutputOptions(fmt="wire")).result.code
     values = [10, 151, 86, *STAR_LXY[0], *STAR_LXY[1], *STAR_VELXY[0], *STAR_VELXY[1]]
     assert code == "".join(f"{v}\r" for v in values)
     assert len(values) == 3 + 4 * 10
@@ -105,9 +107,7 @@ def test_star_wire_is_the_byte_stream_the_gui_sent() -> None:
 
 @pytest.mark.parametrize(("fmt", "name"), [("script", "star.m"), ("wire", "star.txt")])
 def test_star_golden_files(fmt: str, name: str, update_golden: bool) -> None:
-    code = str(
-        post_file(SAMPLES / "star.csv", "matlab-router", output=OutputOptions(fmt=fmt)).result.code
-    )
+    code = str(post_file(SAMPLES / "star.csv", GUI, output=OutputOptions(fmt=fmt)).result.code)
     golden = GOLDEN / name
     if update_golden:
         golden.parent.mkdir(parents=True, exist_ok=True)
@@ -120,11 +120,7 @@ def test_star_verifies_end_to_end_with_the_chunk_closure() -> None:
     # floor(d/2) 0.2 mm chunks); the GUI commanded (+0.2, 0). The code is read as the CLI
     # reads it (bytes, CR kept), for both formats.
     for fmt in ("script", "wire"):
-        code = str(
-            post_file(
-                SAMPLES / "star.csv", "matlab-router", output=OutputOptions(fmt=fmt)
-            ).result.code
-        )
+        code = str(post_file(SAMPLES / "star.csv", GUI, output=OutputOptions(fmt=fmt)).result.code)
         v = verify_code(code.encode("ascii"), TARGET)
         end = v.trace.carriage_mm[-1] - np.array([15.1, 8.6])
         assert end == pytest.approx((0.4, -0.2), abs=1e-6)
@@ -132,17 +128,53 @@ def test_star_verifies_end_to_end_with_the_chunk_closure() -> None:
         assert [type(m) for m in v.program.moves] == [Rapid] + [Linear] * 10
 
 
+def test_the_built_in_target_gives_the_listed_slave_whole_chunks_only() -> None:
+    """The listed slave moves an axis floor(d/2) chunks of 0.2 mm (Angel-11 §4.2).
+
+    On the GUI's 0.1 mm grid the star's odd distances lose 0.1 mm each and it ends
+    (+0.4, -0.2) mm from its first point (above). The built-in target rounds the vertices
+    to 0.2 mm, half away from zero: the star from (151, 86) to (153, 86) in 0.1 mm is
+    written from (152, 86) to (154, 86), every distance even, and the servo model ends it
+    exactly there.
+    """
+    job = post_file(SAMPLES / "star.csv", "matlab-router")
+    assert isinstance(job.target.post, MatlabRouterPost)
+    (router_job,), warnings = job.target.post.jobs(job.program, MACHINE)
+    xy = router_job.arrays.xy  # (2, N): x then y
+    assert (xy % 2 == 0).all() and (router_job.arrays.lxy % 2 == 0).all()
+    assert (xy[:, 0].tolist(), xy[:, -1].tolist()) == ([152, 86], [154, 86])
+    assert not any("0.1 mm (first" in w for w in warnings)
+    v = verify_code(str(job.result.code).encode("ascii"), TARGET)
+    assert v.trace.carriage_mm[-1] == pytest.approx((15.4, 8.6), abs=1e-6)
+
+
+def test_a_circle_on_the_built_in_target_has_no_segment_the_slave_runs_away_on() -> None:
+    """Chords of a circle on the 0.1 mm grid include 0.1 mm moves (the slave's d = 1
+    underflow, Angel-11 §4.2: that axis runs away); on the 0.2 mm grid none is left."""
+    circle = (Rapid(65, 50), ArcMove(65, 50, 50, 50, "ccw", FEED))  # r = 15 mm
+    _, gui_warnings = _emit(circle)
+    assert any("move an axis by 0.1 mm" in w for w in gui_warnings)
+    result = MatlabRouterPost().emit(Program(circle), MACHINE)
+    assert not any("move an axis by 0.1 mm" in w for w in result.warnings)
+    program = MatlabRouterPost().parse(str(result.code))
+    ends = [(m.x, m.y) for m in program.moves]
+    steps = np.abs(np.diff(np.round(np.array(ends) * 10).astype(int), axis=0))
+    assert (steps % 2 == 0).all() and len(ends) > 20
+    # every vertex within half the grid's diagonal plus the chords' sagitta of the circle
+    assert all(abs(math.dist(p, (50, 50)) - 15) <= 0.05 + 0.1 * math.sqrt(2) + 1e-9 for p in ends)
+
+
 def test_posted_script_is_read_by_the_points_importer(tmp_path: Path) -> None:
     # The script is a Matlab file of xy/lxy/velxy: camtool's own .m importer reads the strokes.
     path = tmp_path / "star.m"
-    path.write_text(str(post_file(SAMPLES / "star.csv", "matlab-router").result.code))
+    path.write_text(str(post_file(SAMPLES / "star.csv", GUI).result.code))
     (contour,) = read_points(path).contours
     assert [round(p[0] * 10) for p in contour.points(1e-3)] == list(STAR_XY_01MM[0])
 
 
 def test_first_pointy_as_char_reproduces_the_gui_bug() -> None:
     # L4306: fprintf(s,'%c',first_pointy) sends y1 = 86 as the one character 'V' (chr 86).
-    post = MatlabRouterPost(first_pointy_as_char=True)
+    post = MatlabRouterPost(first_pointy_as_char=True, grid_mm=0.1)
     code = str(post.emit(Program(_star_moves()), MACHINE, fmt="wire").code)
     assert code.startswith("10\r151\rV\r249\r")
     assert post.parse(code) == MatlabRouterPost().parse(code.replace("\rV\r", "\r86\r", 1))
@@ -360,7 +392,7 @@ def test_conversions_are_warned_once_per_kind() -> None:
     program = Program(
         moves, commands=((0, Spindle("cw", 10000)), (3, Dwell(1.0)), (5, Spindle("off")))
     )
-    result = MatlabRouterPost().emit(program, MACHINE)
+    result = MatlabRouterPost(grid_mm=0.1).emit(program, MACHINE)
     text = "\n".join(result.warnings)
     assert "2 Spindle command(s) not written" in text and "1 Dwell command(s)" in text
     assert "feeds ignored (100, 300 mm/min)" in text and "225 mm/min" in text
@@ -381,7 +413,7 @@ def test_a_stroke_that_rounds_to_one_point_is_dropped_with_a_warning() -> None:
 
 def test_speed_option_scales_the_arrays_and_the_reader_checks_it() -> None:
     # R7: major axis = speed, minor = round(speed·minor/major): 300·179/249 = 215.66 → 216.
-    post = MatlabRouterPost(speed=300)
+    post = MatlabRouterPost(speed=300, grid_mm=0.1)
     code = str(post.emit(Program(_star_moves()), MACHINE).code)
     assert "[   300   300   -48   300  -300" in code  # 300·55/345 = 47.8 → 48
     assert "    216  -233   300" in code  # 300·179/249 = 215.66, 300·179/230 = 233.48
@@ -397,7 +429,8 @@ def test_speed_option_scales_the_arrays_and_the_reader_checks_it() -> None:
 @pytest.mark.parametrize(
     "options",
     [{"speed": 0}, {"speed": 480.5}, {"speed": True}, {"max_segments": 256}, {"max_segments": 0},
-     {"chord_tolerance_mm": 0}, {"first_pointy_as_char": "yes"}],
+     {"chord_tolerance_mm": 0}, {"first_pointy_as_char": "yes"}, {"grid_mm": 0.3},
+     {"grid_mm": True}, {"grid_mm": "0.2"}],
 )  # fmt: skip
 def test_bad_options_are_usage_errors(options: dict[str, object], tmp_path: Path) -> None:
     with pytest.raises(UsageError):
@@ -512,7 +545,7 @@ def test_cli_post_wire_then_verify(tmp_path: Path) -> None:
             "post",
             str(SAMPLES / "star.csv"),
             "-t",
-            "matlab-router",
+            GUI,
             "--format",
             "wire",
             "-o",

@@ -208,7 +208,8 @@ def test_verify_refuses_machine_coordinates_outside_with_the_post_remedy(
     assert "outside the work area X 0…200, Y 0…200 mm" in err
     assert "post it again with --origin lower-left, or with its --translate moved by " in err
     dx, dy = (float(v) for v in re.findall(r"moved by (\S+) (\S+) mm", err)[0])
-    assert (dx, dy) == (-51.5, -11.5)
+    # the code's far corner: 251.5, 211.5 mm on the router's 0.2 mm grid, half away from zero
+    assert (dx, dy) == (-51.6, -11.6)
     for remedy in (["--origin", "lower-left"], ["--translate", str(150 + dx), str(150 + dy)]):
         assert main([*argv, *remedy, "-o", str(code)]) == 0
         assert main(["verify", str(code), "-t", "matlab-router"]) == 0
