@@ -306,6 +306,25 @@ def test_round_trip_on_the_grid_is_exact(strokes: list[list[tuple[int, int]]], f
 
 @settings(max_examples=60, deadline=None)
 @given(st.lists(st.tuples(st.floats(0, 200), st.floats(0, 200)), min_size=2, max_size=15))
+def test_the_built_in_grid_gives_whole_chunks_only(points: list[tuple[float, float]]) -> None:
+    """On the 0.2 mm grid every distance is even in 0.1 mm (the slave's whole chunks, Angel-11
+    §4.2), slow minor axes cut into pieces included; the stroke's ends are its points rounded
+    half away from zero to 0.2 mm."""
+    try:
+        result = MatlabRouterPost().emit(Program(_stroke_program([points])), MACHINE)
+    except DialectError as exc:  # a stroke that rounds to one point
+        assert "nothing to cut" in str(exc)
+        return
+    back = [(round(m.x * 10), round(m.y * 10)) for m in MatlabRouterPost().parse(result.code).moves]
+    assert all(x % 2 == 0 and y % 2 == 0 for x, y in back)
+    grid = [tuple((2 * matlab_round(np.array(p) * 5.0)).tolist()) for p in points]
+    kept = [p for i, p in enumerate(grid) if i == 0 or p != grid[i - 1]]
+    assert back[0] == kept[0] and back[-1] == kept[-1]
+    assert not any("move an axis by 0.1 mm" in w for w in result.warnings)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.tuples(st.floats(0, 200), st.floats(0, 200)), min_size=2, max_size=15))
 def test_round_trip_rounds_half_away_from_zero(points: list[tuple[float, float]]) -> None:
     # R1: each vertex comes back as matlab_round(x_mm·10)/10, repeats after rounding dropped.
     grid = [tuple(matlab_round(np.array(p) * 10.0).tolist()) for p in points]
