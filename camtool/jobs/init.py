@@ -20,6 +20,7 @@ from camtool.jobs.selection import circle_of, construction_reason
 from camtool.model.errors import InputError
 from camtool.model.shapes import Contour, Drawing, fit_factor
 from camtool.toolpath.options import DEFAULT_CHAIN_TOLERANCE
+from camtool.toolpath.placement import EPS_MM
 
 DRILL_MAX_MM = 6.5
 """Largest circle drilled (ø6.5 mm: an M6 clearance hole); larger ones are profiled."""
@@ -116,8 +117,8 @@ def _fit(drawing: Drawing, tool: float, travel: tuple[float, float] | None) -> t
     x0, y0, x1, y1 = drawing.bbox()
     w, h = travel
     fw, fh = _fit_box(tool, travel)
-    if x1 - x0 <= fw and y1 - y0 <= fh:
-        return ()
+    if x1 - x0 + tool <= w + EPS_MM and y1 - y0 + tool <= h + EPS_MM:
+        return ()  # its outside profile's toolpath fits the travel as it is (as post checks)
     k = fit_factor(drawing.bbox(), (fw, fh))
     return (
         f"fit = [{fw:g}, {fh:g}]"

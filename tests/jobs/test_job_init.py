@@ -201,6 +201,23 @@ def test_a_machine_without_z_gets_no_heights_depths_tabs_or_drilling(tmp_path: P
     assert all(m.z is None for m in cuts)
 
 
+@pytest.mark.parametrize(("width", "fitted"), [(9.0, False), (9.02, True)])
+def test_a_drawing_is_fitted_only_when_its_toolpath_passes_the_travel(
+    tmp_path: Path, width: float, fitted: bool
+) -> None:
+    """With a 1 mm tool the outside profile's toolpath is the drawing plus 1 mm: a 9 × 6 mm
+    plate's is the 10 × 7 mm travel itself and fits; 9.02 mm wide, it does not."""
+
+    def build(msp: object) -> None:
+        msp.add_lwpolyline(  # type: ignore[attr-defined]
+            [(0, 0), (width, 0), (width, 6), (0, 6)], close=True, dxfattribs={"layer": "EDGE"}
+        )
+
+    drawing = read_drawing(write_dxf(tmp_path / "plate.dxf", build))
+    text = initial_job(drawing, tool_diameter=1.0, travel_mm=(10.0, 7.0))
+    assert ("fit = [8.99, 5.99]" in text) == fitted
+
+
 def test_a_tool_as_wide_as_the_travel_is_refused(tmp_path: Path) -> None:
     def build(msp: object) -> None:
         msp.add_circle((0, 0), 20.0)  # type: ignore[attr-defined]
