@@ -331,7 +331,7 @@ class MatlabRouterPost(PostProcessor):
         notes = RouterWriter(program.origin)
         strokes = self._strokes(program, machine, notes)
         for stroke in strokes:
-            notes.blocks.extend(self._stroke_jobs(stroke, program, notes))
+            notes.blocks.extend(self._stroke_jobs(stroke, program, notes, machine))
         jobs = notes.blocks
         if not jobs:
             raise DialectError(
@@ -388,9 +388,14 @@ class MatlabRouterPost(PostProcessor):
         return strokes
 
     def _stroke_jobs(
-        self, stroke: _Stroke, program: Program, notes: RouterWriter
+        self, stroke: _Stroke, program: Program, notes: RouterWriter, machine: Machine
     ) -> list[RouterJob]:
-        """Quantise a stroke, drop repeated vertices, split it into jobs of ≤ max_segments."""
+        """Quantise a stroke, drop repeated vertices, split it into jobs of ≤ max_segments.
+
+        Raises:
+            DialectError: a vertex outside int16, or one that the grid moves out of the
+                machine's work area (a bound off the grid, from ``--machine``).
+        """
         import numpy as np
 
         xy = points_01mm(np.asarray(stroke.points, dtype=np.float64) / self.grid) * self.grid
@@ -415,6 +420,15 @@ class MatlabRouterPost(PostProcessor):
             raise DialectError(
                 f"{_place(contours, f'stroke {stroke.number}')} has a coordinate outside "
                 f"0–{INT16_MAX} (0.1 mm): the master's int16 distances from home (L4639)"
+            )
+        lo, hi = xy.min(axis=0) / 10.0, xy.max(axis=0) / 10.0
+        if machine.outside_work_area((lo[0], lo[1], hi[0], hi[1]), 1e-9):
+            x0, y0, x1, y1 = machine.work_area_mm
+            raise DialectError(
+                f"{_place(contours, f'stroke {stroke.number}')} reaches ({lo[0]:g}, {lo[1]:g})"
+                f"–({hi[0]:g}, {hi[1]:g}) mm on the {self.grid_mm:g} mm grid, outside the work "
+                f"area X {x0:g}…{x1:g}, Y {y0:g}…{y1:g} mm; move the drawing {self.grid_mm / 2:g} "
+                "mm in from the edge (--translate) or give the work area's bounds on the grid"
             )
         xy, owners = _held_speeds(xy, owners, self.speed, notes, program, self.grid)
         n = len(xy) - 1

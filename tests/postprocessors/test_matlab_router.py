@@ -6,6 +6,7 @@ Other expectations are analytic (chord sagitta, the GUI's rounding rule, int16 l
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from collections.abc import Callable
@@ -162,6 +163,18 @@ def test_a_circle_on_the_built_in_target_has_no_segment_the_slave_runs_away_on()
     assert (steps % 2 == 0).all() and len(ends) > 20
     # every vertex within half the grid's diagonal plus the chords' sagitta of the circle
     assert all(abs(math.dist(p, (50, 50)) - 15) <= 0.05 + 0.1 * math.sqrt(2) + 1e-9 for p in ends)
+
+
+def test_a_vertex_the_grid_moves_out_of_the_work_area_is_refused() -> None:
+    """199.9 mm rounds to 200 mm on the 0.2 mm grid: beyond a work area that ends at 199.9
+    mm (a --machine bound off the grid); 0.1 mm further in it rounds to 199.8 mm."""
+    edge = dataclasses.replace(MACHINE, work_area_mm=(0.0, 0.0, 199.9, 199.9))
+    moves = (Rapid(1, 1), Linear(199.9, 1, FEED), Linear(199.9, 50, FEED))
+    with pytest.raises(DialectError, match=r"\(200, 50\) mm on the 0.2 mm grid, outside the work "):
+        MatlabRouterPost().emit(Program(moves), edge)
+    inside = (Rapid(1, 1), Linear(199.8, 1, FEED), Linear(199.8, 50, FEED))
+    code = MatlabRouterPost().emit(Program(inside), edge).code
+    assert max(m.x for m in MatlabRouterPost().parse(code).moves) == pytest.approx(199.8)
 
 
 def test_posted_script_is_read_by_the_points_importer(tmp_path: Path) -> None:
