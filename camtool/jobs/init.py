@@ -74,10 +74,8 @@ def initial_job(
     Raises:
         InputError: nothing to cut, or the tool is as wide as the machine's travel.
     """
-    fit = _fit(drawing, tool_diameter, travel_mm)
-    k = 1.0
+    fit, k = _fit(drawing, tool_diameter, travel_mm)
     if fit:  # sizes as cut (drills, tabs), selections in the drawing's own mm
-        k = fit_factor(drawing.bbox(), _fit_box(tool_diameter, travel_mm))
         drawing = drawing.transformed(k)
     groups = _groups(drawing)
     outer = _outermost([c for group in groups for c in _chains(group)])
@@ -110,16 +108,22 @@ def _flat(lines: tuple[str, ...]) -> tuple[str, ...]:
     return tuple(line for line in lines if not line.startswith(_Z_KEYS))
 
 
-def _fit(drawing: Drawing, tool: float, travel: tuple[float, float] | None) -> tuple[str, ...]:
-    """``fit = [w, h]`` lines when the drawing is larger than the machine's travel."""
+def _fit(
+    drawing: Drawing, tool: float, travel: tuple[float, float] | None
+) -> tuple[tuple[str, ...], float]:
+    """The ``fit = [w, h]`` lines and the scale they give (``()`` and 1: no fit needed).
+
+    A fit when the drawing's outside profile (the tool's radius around it) is larger than
+    the machine's travel.
+    """
     if travel is None or not drawing.contours:
-        return ()
+        return (), 1.0
     x0, y0, x1, y1 = drawing.bbox()
     w, h = travel
-    fw, fh = _fit_box(tool, travel)
     if x1 - x0 + tool <= w + EPS_MM and y1 - y0 + tool <= h + EPS_MM:
-        return ()  # its outside profile's toolpath fits the travel as it is (as post checks)
-    k = fit_factor(drawing.bbox(), (fw, fh))
+        return (), 1.0  # its outside profile's toolpath fits the travel as it is (as post checks)
+    fw, fh = _fit_box(tool, travel)
+    k = fit_factor((x0, y0, x1, y1), (fw, fh))
     return (
         f"fit = [{fw:g}, {fh:g}]"
         + _why(
@@ -127,10 +131,10 @@ def _fit(drawing: Drawing, tool: float, travel: tuple[float, float] | None) -> t
             f"around it, larger than the {w:g} × {h:g} mm travel: SCALED DOWN to {k:.3g}×; "
             "remove this line on a larger machine"
         ),
-    )
+    ), k
 
 
-def _fit_box(tool: float, travel: tuple[float, float] | None) -> tuple[float, float]:
+def _fit_box(tool: float, travel: tuple[float, float]) -> tuple[float, float]:
     """The box a drawing must fit for its outside profile to fit ``travel`` (mm).
 
     The profile's tool centre runs a tool radius outside the drawing on each side, so
@@ -140,7 +144,6 @@ def _fit_box(tool: float, travel: tuple[float, float] | None) -> tuple[float, fl
     Raises:
         InputError: the tool is as wide as the travel: nothing fits.
     """
-    assert travel is not None
     fw, fh = (math.floor((t - tool) * 100.0 - 1.0) / 100.0 for t in travel)
     if fw <= 0 or fh <= 0:
         raise InputError(

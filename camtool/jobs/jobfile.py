@@ -224,8 +224,8 @@ def _operation(
         raise InputError(f"{source}: {where}: side is for profile operations, not {kind}")
     tab_keys = [k for k in ("tabs", "tab_width", "tab_height") if k in row]
     if tab_keys and kind != "drill" and side != "outside":
-        what = f"a profile with side = {side!r}" if side else f"{kind} operation"
-        what = what if side else ("an " if kind == "engrave" else "a ") + what
+        article = "an" if kind == "engrave" else "a"
+        what = f"a profile with side = {side!r}" if side else f"{article} {kind} operation"
         raise InputError(
             f"{source}: {where}: {', '.join(tab_keys)}: tabs hold a part on an outside "
             f"profile only, and this is {what}; remove "
