@@ -6,6 +6,7 @@ Design notes: docs/internals.md, ``camtool/importers/dxf.py``.
 from __future__ import annotations
 
 import dataclasses
+import io
 import logging
 import math
 from collections import Counter
@@ -28,6 +29,7 @@ from camtool.importers.dxf_entities import (
 from camtool.importers.dxf_layers import LayerFilter, hidden_warnings, layer_filter
 from camtool.importers.dxf_prefit import MIN_SPLINES, fit_ahead, fitted_ahead
 from camtool.importers.dxf_style import CONTINUOUS, Style, StyleResolver
+from camtool.importers.dxf_subclass import missing_subclass, with_subclass_markers
 from camtool.importers.options import MAX_COORDINATE_MM, ImportOptions, too_many_entities
 from camtool.model.errors import InputError, UsageError
 from camtool.model.shapes import BBox, Contour, Drawing, Line, Mark, Point, bbox_union
@@ -588,17 +590,34 @@ def _open(path: Path) -> tuple[Any, str | None, list[str]]:
         first: BaseException = exc
     except (ezdxf.DXFError, *_PARSER_ERRORS) as exc:
         first = exc
+    marked = None
     with _captured_log("ezdxf") as messages:
         try:
-            doc, auditor = recover.readfile(str(path))
+            try:
+                doc, auditor = recover.readfile(str(path))
+            except (ezdxf.DXFError, *_PARSER_ERRORS) as exc:
+                if not missing_subclass(_reason(exc)):
+                    raise
+                marked = with_subclass_markers(path.read_bytes())
+                if not marked.counts:
+                    raise
+                messages.clear()
+                doc, auditor = recover.read(io.BytesIO(marked.data))
         except (ezdxf.DXFError, OSError, *_PARSER_ERRORS) as exc:
             raise InputError(
                 f"{path}: not a readable DXF file ({_reason(first)}); even ezdxf's recover "
                 f"mode failed ({_reason(exc)}); re-save or export it as DXF from the CAD "
                 "program"
             ) from None
-    refuse_guessed_numbers(path, messages)
+    refuse_guessed_numbers(path, messages, marked.original_line if marked else None)
     fixes = [f"fixed: {f.message}" for f in auditor.fixes]
+    if marked is not None:  # read with its markers: said first
+        kinds = ", ".join(f"{n} {kind}" for kind, n in sorted(marked.counts.items()))
+        fixes.insert(
+            0,
+            f"fixed: {kinds} without subclass markers (as small DXF writers write them) "
+            "read by their group codes",
+        )
     errors = [f"not fixed: {e.message}" for e in auditor.errors]
     return doc, _reason(first), messages + fixes + errors
 

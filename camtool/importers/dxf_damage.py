@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import itertools
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -86,12 +86,17 @@ def _places(path: Path, lines: set[int]) -> dict[int, tuple[str, str]]:
     return places
 
 
-def refuse_guessed_numbers(path: Path, repairs: Sequence[str]) -> None:
+def refuse_guessed_numbers(
+    path: Path, repairs: Sequence[str], line_of: Callable[[int], int] | None = None
+) -> None:
     """Refuse a DXF file whose entities hold a number recover mode had to guess.
 
     Args:
         path: the DXF file, read by ezdxf's recover mode.
         repairs: the messages recover mode logged.
+        line_of: the file's line of a line recover mode read, when it read a changed
+            copy (:func:`~camtool.importers.dxf_subclass.with_subclass_markers`);
+            ``None``: the same.
 
     Raises:
         InputError: a guessed number lies outside :data:`HARMLESS_SECTIONS` (or where
@@ -103,6 +108,8 @@ def refuse_guessed_numbers(path: Path, repairs: Sequence[str]) -> None:
     found = guesses(repairs)
     if not found:
         return
+    if line_of is not None:
+        found = [Guess(g.text, line_of(g.line), g.value) for g in found]
     places = _places(path, {g.line for g in found})
     cut = [g for g in found if places.get(g.line, ("", ""))[0] not in HARMLESS_SECTIONS]
     if not cut:
