@@ -16,9 +16,18 @@ if TYPE_CHECKING:
 
 
 def unselected(
-    drawing: Drawing, runs: Sequence[OperationRun], construction: Sequence[Contour]
+    drawing: Drawing,
+    runs: Sequence[OperationRun],
+    construction: Sequence[Contour],
+    joint_mm: float,
 ) -> list[str]:
-    """One line per layer of the contours no operation selects (construction said apart)."""
+    """One line per layer of the contours no operation selects (construction said apart).
+
+    They are counted as chained ``joint_mm`` apart at most (as ``camtool inspect`` counts
+    them): four LINEs of an open outline are one open contour.
+    """
+    from camtool.geometry.chain import chain_members
+
     taken = {id(c) for r in runs for c in r.placed.contours}
     taken |= {id(c) for c in construction}
     left: dict[str, list[Contour]] = {}
@@ -26,9 +35,10 @@ def unselected(
         if id(contour) not in taken:
             left.setdefault(contour.layer, []).append(contour)
     out = []
-    for layer, contours in sorted(left.items()):
+    for layer, pieces in sorted(left.items()):
+        contours = chain_members(pieces, joint_mm)[0]
         opened = sum(not c.closed for c in contours)
-        first = contours[0]
+        first = pieces[0]
         out.append(
             f"not cut: {len(contours)} contour(s) on layer {layer!r} ({opened} open; first "
             f"{first.source or 'contour'} at ({first.start[0]:.4f}, {first.start[1]:.4f}) mm): "

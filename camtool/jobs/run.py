@@ -332,7 +332,8 @@ def run_job(
         del planned  # its moves are in ``moves``: not kept past the placement's shifted copy
     notes = construction_notes(construction)
     if not job.shorthand:
-        notes.extend(unselected(scaled, runs, construction))
+        joint = joint_distance(setup.chain_tolerance)
+        notes.extend(unselected(scaled, runs, construction, joint))
         notes.extend(undrilled(drawing, drilled))
     warnings[len(drawing.warnings) : len(drawing.warnings)] = notes
     warnings.extend(overlaps(runs, job))
@@ -581,10 +582,12 @@ def _plan_operation(
         # said of the job's operation, in its keys (tabs, tab_width), not post's flags
         raise type(exc)(f"{where}: {as_keys(str(exc))}") from None
     program = planned.program
+    # said in post's flags: in the job's keys, of its operation
+    flags = {f.message for f in options.ineffective()} if where != "the options" else set()
     return _Planned(
         list(program.moves),
         [],
-        list(program.warnings),
+        [f"{where}: {as_keys(w)}" if w in flags else w for w in program.warnings],
         planned.report,
         planned.placed,
         left_out=planned.left_out,

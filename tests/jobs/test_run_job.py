@@ -420,3 +420,47 @@ def test_each_operation_s_placed_drawing_is_its_share_of_the_job_s(part: object)
     for contour in joined:
         drawn = by_source[contour.source]
         assert _xy(*contour.start) == _xy(drawn.start[0] + SHIFT, drawn.start[1] + SHIFT)
+
+
+def test_what_no_operation_selects_is_counted_as_chained(tmp_path: Path) -> None:
+    """An open outline drawn as four LINEs is one open contour not cut, as inspect says."""
+    from tests.shapes import write_dxf
+
+    def build(msp: object) -> None:
+        msp.add_lwpolyline(  # type: ignore[attr-defined]
+            [(0, 0), (20, 0), (20, 20), (0, 20)], close=True, dxfattribs={"layer": "PART"}
+        )
+        for a, b in [((30, 0), (40, 0)), ((40, 0), (40, 10)), ((40, 10), (30, 10))]:
+            msp.add_line(a, b, dxfattribs={"layer": "SKETCH"})  # type: ignore[attr-defined]
+        msp.add_line((30, 20), (40, 20), dxfattribs={"layer": "SKETCH"})  # type: ignore[attr-defined]
+
+    dxf = write_dxf(tmp_path / "part.dxf", build)
+    job = tmp_path / "job.toml"
+    job.write_text(
+        '[[tools]]\nid = 1\ntype = "end-mill"\ndiameter = 2\n'
+        '[[operations]]\ntype = "profile"\ntool = 1\nlayers = ["PART"]\nside = "outside"\n'
+        "depth = 1\n"
+    )
+    done = run_job(read_drawing(dxf), load_target("grbl"), load_job(job))
+    notes = [w for w in done.program.warnings if w.startswith("not cut: ")]
+    assert len(notes) == 1
+    assert notes[0].startswith("not cut: 2 contour(s) on layer 'SKETCH' (2 open; first LINE")
+
+
+def test_a_tab_key_with_no_tabs_is_said_in_the_jobs_keys(tmp_path: Path) -> None:
+    """``tab_height`` on an outside profile with ``tabs = 0``: named as a key of the operation."""
+    from tests.shapes import write_dxf
+
+    def build(msp: object) -> None:
+        msp.add_lwpolyline([(0, 0), (20, 0), (20, 20), (0, 20)], close=True)  # type: ignore[attr-defined]
+
+    dxf = write_dxf(tmp_path / "plate.dxf", build)
+    job = tmp_path / "job.toml"
+    job.write_text(
+        '[[tools]]\nid = 1\ntype = "end-mill"\ndiameter = 2\n'
+        '[[operations]]\nname = "outline"\ntype = "profile"\ntool = 1\nside = "outside"\n'
+        "depth = 2\ntabs = 0\ntab_height = 1\n"
+    )
+    done = run_job(read_drawing(dxf), load_target("grbl"), load_job(job))
+    said = [w for w in done.program.warnings if "no effect" in w]
+    assert said == ["operation 1 ('outline'): tab_height has no effect without tabs N"]
