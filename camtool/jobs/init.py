@@ -293,18 +293,16 @@ def _profile_op(
     depth = thickness + BREAKTHROUGH_MM
     step = tool
     if pocket:
-        return _Op(
-            "pocket",
-            tool,
-            (
-                f"name = {_quote(key)}",
-                'type = "pocket"' + _why(f"{what}: the layer's name says pocket"),
-                "tool = {end-mill}",
-                select,
-                f"depth = {thickness / 2:g}" + _why("half the stock: set the pocket's depth"),
-                f"step_down = {min(step, thickness / 2):g}" + _why("at most a tool diameter"),
-            ),
+        mill, tool_line = _mill_for_holes(contours, tool, "pocket")
+        pocket_lines = (
+            f"name = {_quote(key)}",
+            'type = "pocket"' + _why(f"{what}: the layer's name says pocket"),
+            tool_line,
+            select,
+            f"depth = {thickness / 2:g}" + _why("half the stock: set the pocket's depth"),
+            f"step_down = {min(mill or step, thickness / 2):g}" + _why("at most a tool diameter"),
         )
+        return _Op("pocket", mill or tool, pocket_lines, commented=mill is None)
     has_outer = any(id(c) in outer for c in contours)
     side = "outside" if has_outer else "inside"
     why = (
@@ -356,8 +354,13 @@ WIDTH_TOLERANCE_MM = 0.01
 """How closely a hole's width (its largest inscribed circle) is measured, mm."""
 
 
-def _mill_for_holes(contours: Sequence[Contour], tool: float) -> tuple[float | None, str]:
+def _mill_for_holes(
+    contours: Sequence[Contour], tool: float, noun: str = "hole"
+) -> tuple[float | None, str]:
     """The end mill for a layer of holes cut on their inside, and its ``tool =`` line.
+
+    ``noun``: what the comment calls them (``"pocket"`` for a layer of pockets, whose
+    clearing needs the same: ``post`` clears nothing narrower than its tool).
 
     The job's end mill (``tool``, mm) when it fits in every hole; else the largest of
     :data:`END_MILLS_MM` within :data:`FIT_MARGIN` of the narrowest hole's width (the
@@ -377,11 +380,11 @@ def _mill_for_holes(contours: Sequence[Contour], tool: float) -> tuple[float | N
         return tool, "tool = {end-mill}"
     least = min(narrow)
     if len(widths) == 1:
-        said = f"the hole is narrower than the {tool:g} mm end mill (about {least:.3g} mm wide)"
+        said = f"the {noun} is narrower than the {tool:g} mm end mill (about {least:.3g} mm wide)"
     else:
         which = "all" if len(narrow) == len(widths) else f"{len(narrow)} of the"
         said = (
-            f"{which} {len(widths)} holes are narrower than the {tool:g} mm end mill (the "
+            f"{which} {len(widths)} {noun}s are narrower than the {tool:g} mm end mill (the "
             f"narrowest about {least:.3g} mm wide)"
         )
     fits = [d for d in END_MILLS_MM if d <= FIT_MARGIN * least]
@@ -391,7 +394,8 @@ def _mill_for_holes(contours: Sequence[Contour], tool: float) -> tuple[float | N
             "uncomment it"
         )
     mill = fits[-1]
-    return mill, f"tool = {{end-mill {mill:g}}}" + _why(f"{said}: a {mill:g} mm one cuts them")
+    them = "it" if len(widths) == 1 else "them"
+    return mill, f"tool = {{end-mill {mill:g}}}" + _why(f"{said}: a {mill:g} mm one cuts {them}")
 
 
 TAB_WIDTH_MM = 2.0
@@ -517,7 +521,8 @@ def _tool_key(op: _Op, tool: float) -> tuple[str, float]:
     """The tool an operation uses: its drill, its own end mill, or the job's (``tool``)."""
     if op.kind == "drill":
         return ("drill", op.tool)
-    return ("end-mill", op.tool if op.kind.startswith("profile") else tool)
+    own = op.kind.startswith("profile") or op.kind == "pocket"
+    return ("end-mill", op.tool if own else tool)
 
 
 def _why(text: str) -> str:

@@ -279,3 +279,39 @@ def test_holes_no_common_end_mill_fits_leave_their_operation_commented(tmp_path:
     assert [op["layers"] for op in _ops(text)] == [["EDGE"]]
     assert "# tool = 1  # all 2 holes are narrower than the 3 mm end mill" in text
     assert "no common end mill fits; give this operation a tool that does" in text
+
+
+def test_a_pocket_narrower_than_the_end_mill_gets_one_that_fits(tmp_path: Path) -> None:
+    """A 2 mm wide pocket under the default 3 mm end mill.
+
+    Its width (largest inscribed circle) is 2 mm; the largest common end mill within 95 %
+    of it (1.9 mm) is 1.5 mm (analysis). With the 3 mm one ``post`` refused the job ("every
+    pocket is narrower than the 3 mm tool"); with 1.5 mm the pocket is cleared, the tool's
+    centre on the slot's centre line (y = 11, within 1 mm of either side less 0.75 mm).
+    """
+
+    def build(msp: object) -> None:
+        msp.add_lwpolyline(  # type: ignore[attr-defined]
+            [(0, 0), (60, 0), (60, 30), (0, 30)], close=True, dxfattribs={"layer": "EDGE"}
+        )
+        msp.add_lwpolyline(  # type: ignore[attr-defined]
+            [(10, 10), (40, 10), (40, 12), (10, 12)], close=True, dxfattribs={"layer": "POCKET"}
+        )
+
+    drawing = read_drawing(write_dxf(tmp_path / "slot.dxf", build))
+    text = initial_job(drawing)
+    data = tomllib.loads(text)
+    pocket = next(op for op in data["operations"] if op["type"] == "pocket")
+    tools = {t["id"]: t["diameter"] for t in data["tools"]}
+    assert tools[pocket["tool"]] == 1.5
+    assert "the pocket is narrower than the 3 mm end mill (about 2 mm wide): a 1.5 mm one" in text
+    edge = next(op for op in data["operations"] if op["type"] == "profile")
+    assert tools[edge["tool"]] == 3
+    done = run_job(drawing, load_target("grbl"), job_from_dict(data, source="j.toml"))
+    run = next(r for r in done.operations if r.operation.type == "pocket")
+    assert done.placed is not None
+    dx, dy = (a - b for a, b in zip(done.placed.bbox()[:2], drawing.bbox()[:2], strict=True))
+    cut = [m for m in done.program.moves[run.moves[0] : run.moves[1]] if isinstance(m, Linear)]
+    assert cut
+    assert all(abs((m.y - dy) - 11.0) <= 1.0 - 0.75 + 1e-6 for m in cut)
+    assert min(m.x - dx for m in cut) >= 10.75 - 1e-6 and max(m.x - dx for m in cut) <= 39.25 + 1e-6
