@@ -291,18 +291,8 @@ def _profile_op(
 ) -> _Op:
     pocket = "pocket" in key.casefold()
     depth = thickness + BREAKTHROUGH_MM
-    step = tool
     if pocket:
-        mill, tool_line = _mill_for_holes(contours, tool, "pocket")
-        pocket_lines = (
-            f"name = {_quote(key)}",
-            'type = "pocket"' + _why(f"{what}: the layer's name says pocket"),
-            tool_line,
-            select,
-            f"depth = {thickness / 2:g}" + _why("half the stock: set the pocket's depth"),
-            f"step_down = {min(mill or step, thickness / 2):g}" + _why("at most a tool diameter"),
-        )
-        return _Op("pocket", mill or tool, pocket_lines, commented=mill is None)
+        return _pocket_op(select, what, contours, thickness, tool, key)
     has_outer = any(id(c) in outer for c in contours)
     side = "outside" if has_outer else "inside"
     why = (
@@ -342,6 +332,22 @@ def _profile_op(
     if mill is None:  # no end mill fits: a guess the user must finish
         return _Op(f"profile {side}", tool, tuple(lines), commented=True)
     return _Op(f"profile {side}", mill, tuple(lines))
+
+
+def _pocket_op(
+    select: str, what: str, contours: list[Contour], thickness: float, tool: float, key: str
+) -> _Op:
+    """A pocket at half the stock, with an end mill that fits its narrowest pocket."""
+    mill, tool_line = _mill_for_holes(contours, tool, "pocket")
+    lines = (
+        f"name = {_quote(key)}",
+        'type = "pocket"' + _why(f"{what}: the layer's name says pocket"),
+        tool_line,
+        select,
+        f"depth = {thickness / 2:g}" + _why("half the stock: set the pocket's depth"),
+        f"step_down = {min(mill or tool, thickness / 2):g}" + _why("at most a tool diameter"),
+    )
+    return _Op("pocket", mill or tool, lines, commented=mill is None)
 
 
 END_MILLS_MM = (0.5, 0.8, 1.0, 1.5, 2.0, 2.5, 3.0, 3.175, 4.0, 5.0, 6.0, 6.35, 8.0, 10.0, 12.0)
