@@ -739,23 +739,28 @@ class _Reader(StartRules):
         self.positioned = True
 
     def _machine_coordinates(self, args: dict[str, Word]) -> None:
-        """G53: ``G53 G0 Z0`` is a :class:`Home` coded ``"G53"``; no axis words, no move.
+        """G53: a G0 rapid in machine coordinates is a :class:`Home` coded ``"G53"``.
 
-        Any other G53 move goes where camtool does not know: refused, not dropped (a
-        dropped retract would leave the next rapid at cutting depth).
+        With its coordinates (``G53 G0 Z0``; Carbide Create's ``G53 G0 Z-5``); no axis
+        words, no move.
+
+        Any other G53 move (G1, or in G91) is refused, not dropped (a dropped retract
+        would leave the next rapid at cutting depth).
         """
         words = [str(args[letter]) for letter in "XYZIJKR" if letter in args]
         axes = "".join(letter for letter in "XYZ" if letter in args)
-        at_zero = len(axes) == len(words) and all(args[a].value == 0 for a in axes)
-        if words and at_zero and self.motion == "G0" and self.absolute:
-            self._returned(Home(axes, "G53"), "G53 G0 rapid to machine zero")
+        if words and len(axes) == len(words) and self.motion == "G0" and self.absolute:
+            at = tuple(args[a].value * self.scale for a in axes)
+            zero = all(v == 0 for v in at)
+            what = "G53 G0 rapid to machine zero" if zero else "G53 G0 rapid in machine coordinates"
+            self._returned(Home(axes, "G53", () if zero else at), what)
             return
         if words:
             raise InputError(
                 f"{self.where()}: G53 {' '.join(words)} moves in machine coordinates, which "
-                "camtool does not know (only a G0 rapid to machine zero, G53 G0 Z0, is "
-                "read); write the program in part coordinates (e.g. a retract as G0 Z with "
-                "the work offset's clearance height)"
+                "camtool reads only as a G0 rapid in absolute mode (G90 G53 G0 Z-5); write "
+                "the program in part coordinates (e.g. a retract as G0 Z with the work "
+                "offset's clearance height)"
             )
         self.notes.add("G53", self.line, "G53 without axis words moves nowhere: read as no move")
 

@@ -198,14 +198,22 @@ class Home:
 
     ``code`` names the position, as RS-274/NGC does (LinuxCNC "G28, G28.1", "G30,
     G30.1", "G53"; GRBL 1.1 the same): ``"G28"`` the first stored position (machine
-    zero on most machines), ``"G30"`` the second, ``"G53"`` machine zero itself
-    (``G53 G0 Z0``). That position is not the part zero and camtool does not know it,
-    so a program's path after a Home is only known again from its next absolute move,
-    and its Z only from the next move that gives Z.
+    zero on most machines), ``"G30"`` the second, ``"G53"`` a rapid in machine
+    coordinates (``G53 G0 Z0``: machine zero; ``G53 G0 Z-5``, Carbide Create's retract:
+    5 mm below it, :attr:`machine_mm`). That position is not the part zero and camtool
+    does not know it, so a program's path after a Home is only known again from its next
+    absolute move, and its Z only from the next move that gives Z.
     """
 
     axes: str = "XY"
     code: Literal["G28", "G30", "G53"] = "G28"
+    machine_mm: tuple[float, ...] = ()
+    """For ``"G53"``: the machine coordinate of each of :attr:`axes`, in order, mm (as
+    written, with no work offset); ``()``: machine zero on each."""
+
+    def machine_at(self, axis: str) -> float:
+        """The machine coordinate ``axis`` (one of :attr:`axes`) goes to, mm (G53)."""
+        return self.machine_mm[self.axes.index(axis)] if self.machine_mm else 0.0
 
 
 Plane: TypeAlias = Literal["zx", "yz"]

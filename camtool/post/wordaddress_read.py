@@ -267,19 +267,19 @@ class BlockReader:
     def _home(
         self, codes: list[str], values: dict[str, float], key: Literal["G28", "G30", "G53"]
     ) -> None:
-        """A return as the writer writes it: ``G28`` or ``G91 G28 Z0`` (G30 so), ``G53 G0 Z0``.
+        """A return as the writer writes it: ``G28`` or ``G91 G28 Z0`` (G30 so), ``G53 G0 Z-5``.
 
-        ``G28`` alone returns all three axes; ``G91 G28`` and ``G53 G0`` the axes they
-        name, each at 0.
+        ``G28`` alone returns all three axes; ``G91 G28`` the axes it names, each at 0;
+        ``G53 G0`` the axes it names, at their machine coordinates.
         """
         axes = "".join(a for a in "XYZ" if a in values)
         if key == "G53":
             rapid = self.spec.motion_codes[0]
             if codes != [key, rapid] or not axes or set(values) - set("XYZ"):
                 raise self.fail(f"a return to machine zero is G53 {rapid} with axis words")
-            if any(values[a] != 0.0 for a in axes):
-                raise self.fail(f"G53 {rapid} goes to machine zero here: its axis words are 0")
-            self.state.commands.append((len(self.state.moves), Home(axes, key)))
+            at = tuple(values[a] for a in axes)
+            home = Home(axes, key, at if any(v != 0.0 for v in at) else ())
+            self.state.commands.append((len(self.state.moves), home))
             return
         incremental = codes == ["G91", key]
         if codes not in (["G91", key], [key]) or set(values) - set("XYZ"):

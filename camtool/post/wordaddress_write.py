@@ -630,22 +630,25 @@ class BlockWriter(ArcWriter):
         elif isinstance(command, WorkOffset) and command.code in self.spec.work_offsets:
             self.block([command.code])
         elif isinstance(command, Home) and command.code in spec.homes:
-            self._home(command.axes, command.code)
+            self._home(command)
         elif isinstance(command, Home | WorkOffset):
             self.drop(command)
 
-    def _home(self, axes: str, code: str) -> None:
+    def _home(self, home: Home) -> None:
         """A return to the stored position: ``G91 G28 Z0``, ``G90`` (``G28`` for XYZ).
 
-        RS-274 writes it so, through the point where the tool is; a return to machine
-        zero is ``G53`` with the rapid code and the axes at 0 (``G53 G0 Z0``).
+        RS-274 writes it so, through the point where the tool is; a rapid in machine
+        coordinates is ``G53`` with the rapid code and the axes at their machine
+        coordinates (``G53 G0 Z0``, ``G53 G0 Z-5``).
 
         A program's ``G28 G91 Z0`` before its first move is its retract: dropped, the
         first rapid would run at whatever height the tool was left. The axes it moves
         are written again in the next move that gives them.
         """
+        axes, code = home.axes, home.code
         if code == "G53":
-            self.block([code, self.spec.motion_codes[0], *(a + self.text(a, 0.0) for a in axes)])
+            at = (a + self.text(a, home.machine_at(a)) for a in axes)
+            self.block([code, self.spec.motion_codes[0], *at])
         elif axes == "XYZ":
             self.block([code])
         else:

@@ -401,9 +401,8 @@ def test_safe_conversion_warns_once_with_count_and_first_line(block: str, expect
         ("G95", "G95 (inverse-time / per-revolution feed)"),
         ("G92 X0 Y0", "G92 changes the coordinate offsets"),
         ("G53 G1 Z0 F100", "G53 Z0 moves in machine coordinates"),  # a feed, not a rapid
-        ("G53 G0 X0 Y5", "G53 X0 Y5 moves in machine coordinates"),
-        ("G53 G0 Z-5", "G53 Z-5 moves in machine coordinates"),
         ("G91 G53 G0 Z0", "G53 Z0 moves in machine coordinates"),
+        ("G91 G53 G0 Z-5", "G53 Z-5 moves in machine coordinates"),
         ("G5.1 X1 Y1 I1 J1", "G5.1 splines"),
         ("G16", "G16 (polar coordinates: X is a radius, Y an angle)"),
         ("G68 X0 Y0 R30", "G68 rotates the coordinate system"),
@@ -662,6 +661,17 @@ def test_g53_rapid_to_machine_zero_is_a_home_and_leaves_its_axes_unknown() -> No
     assert program.commands == ((1, Home("Z", "G53")), (2, Home("Z", "G53")))  # G0 modal
     assert program.moves[1] == Rapid(3.0, 1.0, contour=program.moves[1].contour)  # Z unknown
     assert any("G53 G0 rapid to machine zero" in w for w in program.warnings)
+
+
+def test_a_g53_rapid_elsewhere_keeps_its_machine_coordinates() -> None:
+    """Carbide Create's retract ``G53G0Z-5.000`` (and a G53 rapid in X and Y, in inches)."""
+    text = "G20 G90\nG0 X1 Y1 Z0.2\nG53G0Z-0.2\nG0 X3 Y1 Z0.2\nG1 Z0 F4\nG53 G0 X-1 Y-2\nM2\n"
+    program = parse(text)
+    assert program.commands == (
+        (1, Home("Z", "G53", (-5.08,))),
+        (3, Home("XY", "G53", (-25.4, -50.8))),
+    )
+    assert any("G53 G0 rapid in machine coordinates" in w for w in program.warnings)
 
 
 def test_a_program_without_f_reads_with_the_feed_post_gives() -> None:

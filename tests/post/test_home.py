@@ -76,7 +76,7 @@ def test_returns_are_written_and_read_back(target: str) -> None:
     "block",
     [
         *("G28 Z0.000", "G91 G28", "G91 G28 Z1.000", "G91 G28 Z0.000 F100"),
-        *("G53 G0 Z1.000", "G53 G1 Z0.000", "G53 G0", "G91 G53 G0 Z0.000"),
+        *("G53 G1 Z0.000", "G53 G0", "G91 G53 G0 Z0.000"),
     ],
 )
 def test_the_strict_reader_takes_the_writers_returns_only(block: str) -> None:
@@ -140,6 +140,46 @@ def test_a_haas_style_program_re_posted_moves_as_it_did(target: str, tmp_path: P
     assert lines.count("G53 G0 Z0.000") == 2 and "G53 G0 X0.000 Y0.000" in lines
     b = _same_moves(original, out)
     assert b[0][0] == "rapid" and b[0][1][2] == 0.0  # machine zero first (G54 at 0)
+
+
+CARBIDE = """(Design File: plate.c2d)
+(stockMin:0.00mm, 0.00mm, -12.70mm)
+(stockMax:50.00mm, 50.00mm, 0.00mm)
+G90
+G21
+(Move to safe Z to avoid workholding)
+G53G0Z-5.000
+M05
+(TOOL/MILL,3.18, 0.00, 0.00, 0.00)
+M6T1
+M03S18000
+(PREPARE  Contour 1)
+G0X10.490Y14.186Z5.080
+G1Z-1.270F254.0
+G3X8.967Y14.919I-1.523J-1.217F1016.0
+G1X20.000Y20.000
+G0Z5.080
+M05
+G53G0Z-5.000
+G0X0.000Y0.000
+M02
+"""
+"""Carbide Create's GRBL post: every retract to a safe height is ``G53G0Z-5.000``, a rapid
+to 5 mm below machine zero (Z homes up on a Shapeoko), in machine coordinates."""
+
+
+@needs_rs274
+@pytest.mark.parametrize("target", ["grbl", "linuxcnc"])
+def test_a_carbide_create_program_re_posted_moves_as_it_did(target: str, tmp_path: Path) -> None:
+    """The G53 retracts are kept at their machine coordinate: rs274 moves the same."""
+    original, out = repost_cli(tmp_path, "plate.nc", CARBIDE, target)
+    lines = out.read_text().splitlines()
+    assert lines.count("G53 G0 Z-5.000") == 2
+    b = _same_moves(original, out)
+    assert b[0][0] == "rapid" and b[0][1][2] == -5.0  # G54 at 0: machine Z -5 first
+    back = load_target(target).post.parse(out.read_text())
+    homes = [c for _, c in back.commands if isinstance(c, Home)]
+    assert homes == [Home("Z", "G53", (-5.0,))] * 2
 
 
 G30_MIDWAY = """G21 G90
