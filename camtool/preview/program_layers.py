@@ -233,12 +233,13 @@ def change_marks(program: Program, u: float) -> tuple[Rect | Text, ...]:
 def tab_segments(program: Program) -> list[Segment]:
     """The XY cutting moves that cross a holding tab, mm.
 
-    A tab is crossed at a height above the pass depth around it: a move with
-    XY travel at a constant ``z`` inside a run of cutting moves (between two
-    rapids) where some earlier move of the run cut below ``z`` and some later
-    one goes below it again (as :mod:`camtool.toolpath.passes` writes a tab:
-    rise onto the tab top, cross it, go down). A first, shallower pass of a multi-pass
-    run is not a tab: nothing before it was deeper. Programs without Z have none.
+    A tab is crossed as :mod:`camtool.toolpath.passes` writes one: a straight rise
+    (Z alone) from the pass depth onto the tab top, moves across it at that constant
+    ``z``, then a straight descent (Z alone) below it again, within a run of cutting
+    moves (between two rapids). A first, shallower pass of a multi-pass run is no tab
+    (nothing rose onto it), nor is a stretch at a constant height between moves that
+    change X or Y with Z (a V-carve's or a 3D finish's, as other CAM programs write them).
+    Programs without Z have none.
     """
     out: list[Segment] = []
     run: list[tuple[Segment, float, float]] = []  # one run at a time: memory of a run
@@ -260,23 +261,29 @@ def tab_segments(program: Program) -> list[Segment]:
 def _tabs_of(run: list[tuple[Segment, float, float]]) -> list[Segment]:
     """The tab crossings of one run of ``(segment, z before, z after)`` (:func:`tab_segments`).
 
-    Linear in the run: the lowest Z before each move and after it are running minima.
+    Each stretch of XY moves at one height is a tab when a rise of Z alone ends where
+    it begins and a descent of Z alone starts where it ends; linear in the run.
     """
     out: list[Segment] = []
-    if not run:
-        return out
-    after = [math.inf] * len(run)  # after[i]: the lowest end of the moves after move i
-    for i in range(len(run) - 1, 0, -1):
-        after[i - 1] = min(after[i], run[i][2])
-    before = run[0][1]  # the lowest of the run's start and the ends before move i
-    for i, (seg, z0, z1) in enumerate(run):
-        if i:
-            before = min(before, run[i - 1][2])
-        if abs(z1 - z0) > Z_EPS or (seg.start == seg.end and not isinstance(seg, Arc)):
+    i = 0
+    while i < len(run):
+        seg, z0, z1 = run[i]
+        if not (_plunge(seg) and z1 > z0 + Z_EPS):
+            i += 1
             continue
-        if before < z1 - Z_EPS and after[i] < z1 - Z_EPS:
-            out.append(seg)
+        j = i + 1  # the stretch across the tab: XY moves at z1
+        while j < len(run) and abs(run[j][2] - z1) <= Z_EPS and abs(run[j][1] - z1) <= Z_EPS:
+            j += 1
+        across = [s for s, _, _ in run[i + 1 : j] if not _plunge(s)]
+        if across and j < len(run) and _plunge(run[j][0]) and run[j][2] < z1 - Z_EPS:
+            out.extend(across)
+        i = j
     return out
+
+
+def _plunge(seg: Segment) -> bool:
+    """A move of Z alone (no XY travel)."""
+    return seg.start == seg.end and not isinstance(seg, Arc)
 
 
 def tab_shapes(segments: list[Segment], u: float) -> tuple[Path, ...]:

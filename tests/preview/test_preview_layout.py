@@ -169,6 +169,25 @@ def test_no_tabs_on_a_plain_multi_pass_cut() -> None:
     assert tab_segments(plain) == []
 
 
+def test_no_tabs_in_a_v_carve() -> None:
+    """A V-carve (Carbide Create's, every move X, Y and Z together) that holds its depth
+    for a stretch between deeper moves has no tab: nothing rose onto it by Z alone."""
+    carve = Program(
+        (
+            Rapid(0.0, 0.0, 2.0),
+            Linear(0.0, 0.0, 150.0, z=0.0, contour=1),
+            Linear(1.0, 1.0, 300.0, z=-0.6, contour=1),
+            Linear(2.0, 1.0, 300.0, z=-0.4, contour=1),
+            Linear(3.0, 1.0, 300.0, z=-0.4, contour=1),  # at one height, between deeper
+            Linear(4.0, 1.0, 300.0, z=-0.7, contour=1),
+            Linear(4.0, 1.0, 300.0, z=-0.4, contour=1),  # Z alone up, then a ramp down
+            Linear(5.0, 1.0, 300.0, z=-0.4, contour=1),
+            Linear(6.0, 2.0, 300.0, z=-0.8, contour=1),
+        )
+    )
+    assert tab_segments(carve) == []
+
+
 def test_work_zero_is_marked_when_in_view() -> None:
     near = Program((Rapid(1.0, 1.0), Linear(5.0, 1.0, 100.0, contour=1)))
     assert "zero" in _groups(render_preview(".svg", program=near))
