@@ -8,16 +8,20 @@ lower-left corner, i.e. the outline offset by the 1.5 mm tool radius: a shift of
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from itertools import pairwise
 from pathlib import Path
+from typing import Any
 
 import pytest
 
 from camtool.importers import read_drawing
+from camtool.jobs.job import Job
 from camtool.jobs.jobfile import load_job
 from camtool.jobs.run import run_job
 from camtool.model.errors import InputError
 from camtool.model.program import DrillCycle, Linear, Rapid, Spindle, ToolChange
+from camtool.model.shapes import Drawing
 from camtool.post.registry import load_target
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -242,7 +246,6 @@ def test_closed_selects_a_shape_drawn_as_several_entities(tmp_path: Path) -> Non
     centre 1 mm out), the inner rectangle inside it (1 mm in); a centre line from a corner is
     construction, which the planner leaves out, so it is not chained with the square either.
     """
-    from tests.shapes import write_dxf
 
     def build(msp: object) -> None:
         corners = [(0, 0), (12, 0), (12, 12), (0, 12)]
@@ -253,14 +256,14 @@ def test_closed_selects_a_shape_drawn_as_several_entities(tmp_path: Path) -> Non
         # a centre line from a corner: construction, which the planner does not chain
         msp.add_line((0, 0), (-5, -5), dxfattribs={"layer": "CENTER"})  # type: ignore[attr-defined]
 
-    dxf = write_dxf(tmp_path / "square.dxf", build)
-    job = tmp_path / "job.toml"
-    job.write_text(
+    drawing, job = _job_on(
+        tmp_path,
+        build,
         '[[tools]]\nid = 1\ntype = "end-mill"\ndiameter = 2\n'
         '[[operations]]\ntype = "profile"\ntool = 1\nclosed = true\nside = "outside"\n'
-        "depth = 1\n"
+        "depth = 1\n",
     )
-    done = run_job(read_drawing(dxf), load_target("grbl"), load_job(job))
+    done = run_job(drawing, load_target("grbl"), job)
     z, cuts = 0.0, []  # the moves at the depth (a move that keeps Z has none)
     for m in done.program.moves:
         z = m.z if m.z is not None else z
@@ -282,19 +285,15 @@ def test_closed_selects_a_shape_drawn_as_several_entities(tmp_path: Path) -> Non
 def test_a_plan_refused_in_a_job_names_the_operation_and_its_keys(tmp_path: Path) -> None:
     """Three tabs on a 1 mm square: refused naming the operation and the job's keys."""
     from camtool.model.errors import ToolpathError
-    from tests.shapes import write_dxf
 
-    def build(msp: object) -> None:
-        msp.add_lwpolyline([(0, 0), (1, 0), (1, 1), (0, 1)], close=True)  # type: ignore[attr-defined]
-
-    dxf = write_dxf(tmp_path / "small.dxf", build)
-    job = tmp_path / "job.toml"
-    job.write_text(
+    drawing, job = _square(
+        tmp_path,
+        1.0,
         '[[tools]]\nid = 1\ntype = "end-mill"\ndiameter = 3\n[[operations]]\nname = "outline"'
-        '\ntype = "profile"\ntool = 1\nside = "outside"\ndepth = 3\ntabs = 3\n'
+        '\ntype = "profile"\ntool = 1\nside = "outside"\ndepth = 3\ntabs = 3\n',
     )
     with pytest.raises(ToolpathError) as caught:
-        run_job(read_drawing(dxf), load_target("grbl"), load_job(job))
+        run_job(drawing, load_target("grbl"), job)
     message = str(caught.value)
     assert message.startswith("operation 1 ('outline'): 3 tab(s) do not fit")
     assert "use fewer tabs or a smaller tab_width" in message and "--" not in message
@@ -424,7 +423,6 @@ def test_each_operation_s_placed_drawing_is_its_share_of_the_job_s(part: object)
 
 def test_what_no_operation_selects_is_counted_as_chained(tmp_path: Path) -> None:
     """An open outline drawn as four LINEs is one open contour not cut, as inspect says."""
-    from tests.shapes import write_dxf
 
     def build(msp: object) -> None:
         msp.add_lwpolyline(  # type: ignore[attr-defined]
@@ -434,14 +432,14 @@ def test_what_no_operation_selects_is_counted_as_chained(tmp_path: Path) -> None
             msp.add_line(a, b, dxfattribs={"layer": "SKETCH"})  # type: ignore[attr-defined]
         msp.add_line((30, 20), (40, 20), dxfattribs={"layer": "SKETCH"})  # type: ignore[attr-defined]
 
-    dxf = write_dxf(tmp_path / "part.dxf", build)
-    job = tmp_path / "job.toml"
-    job.write_text(
+    drawing, job = _job_on(
+        tmp_path,
+        build,
         '[[tools]]\nid = 1\ntype = "end-mill"\ndiameter = 2\n'
         '[[operations]]\ntype = "profile"\ntool = 1\nlayers = ["PART"]\nside = "outside"\n'
-        "depth = 1\n"
+        "depth = 1\n",
     )
-    done = run_job(read_drawing(dxf), load_target("grbl"), load_job(job))
+    done = run_job(drawing, load_target("grbl"), job)
     notes = [w for w in done.program.warnings if w.startswith("not cut: ")]
     assert len(notes) == 1
     assert notes[0].startswith("not cut: 2 contour(s) on layer 'SKETCH' (2 open; first LINE")
@@ -449,18 +447,33 @@ def test_what_no_operation_selects_is_counted_as_chained(tmp_path: Path) -> None
 
 def test_a_tab_key_with_no_tabs_is_said_in_the_jobs_keys(tmp_path: Path) -> None:
     """``tab_height`` on an outside profile with ``tabs = 0``: named as a key of the operation."""
-    from tests.shapes import write_dxf
-
-    def build(msp: object) -> None:
-        msp.add_lwpolyline([(0, 0), (20, 0), (20, 20), (0, 20)], close=True)  # type: ignore[attr-defined]
-
-    dxf = write_dxf(tmp_path / "plate.dxf", build)
-    job = tmp_path / "job.toml"
-    job.write_text(
+    drawing, job = _square(
+        tmp_path,
+        20.0,
         '[[tools]]\nid = 1\ntype = "end-mill"\ndiameter = 2\n'
         '[[operations]]\nname = "outline"\ntype = "profile"\ntool = 1\nside = "outside"\n'
-        "depth = 2\ntabs = 0\ntab_height = 1\n"
+        "depth = 2\ntabs = 0\ntab_height = 1\n",
     )
-    done = run_job(read_drawing(dxf), load_target("grbl"), load_job(job))
+    done = run_job(drawing, load_target("grbl"), job)
     said = [w for w in done.program.warnings if "no effect" in w]
     assert said == ["operation 1 ('outline'): tab_height has no effect without tabs N"]
+
+
+def _square(tmp_path: Path, size: float, job_text: str) -> tuple[Drawing, Job]:
+    """A ``size`` mm square (layer 0) and the job ``job_text`` for it, read as post reads them."""
+
+    def build(msp: object) -> None:
+        corners = [(0, 0), (size, 0), (size, size), (0, size)]
+        msp.add_lwpolyline(corners, close=True)  # type: ignore[attr-defined]
+
+    return _job_on(tmp_path, build, job_text)
+
+
+def _job_on(tmp_path: Path, build: Callable[[Any], None], job_text: str) -> tuple[Drawing, Job]:
+    """The drawing ``build(msp)`` fills and the job ``job_text``, read as post reads them."""
+    from tests.shapes import write_dxf
+
+    dxf = write_dxf(tmp_path / "drawing.dxf", build)
+    job = tmp_path / "job.toml"
+    job.write_text(job_text)
+    return read_drawing(dxf), load_job(job)
