@@ -340,9 +340,11 @@ def post_program(
     ``output.spindle_dwell_s`` seconds after it starts. ``source`` (the input's file
     name) goes into the job notes (:func:`job_notes`) unless the program has notes.
     Nothing is added to the program's motion: no move to X0 Y0, no clearance move.
-    A program that starts with a tool change and changes tools again is written one
-    program per tool for a target that cannot change tools (``pieces``); a tool change
-    or stop the target cannot write otherwise is refused, never dropped.
+    A program that changes tools more than once before any cut with another tool (its
+    first change may follow rapids, as pcb2gcode's retract to the tool change height) is
+    written one program per tool for a target that cannot change tools (``pieces``: the
+    rapids are the first program's); a tool change or stop the target cannot write
+    otherwise is refused, never dropped.
     ``progress`` is told the ``writing`` stage (``total``: the program's moves).
 
     Raises:
@@ -368,9 +370,11 @@ def post_program(
         program = dataclasses.replace(program, notes=job_notes(source, target))
     program = _with_spindle(program, output.spindle_rpm, output.spindle_dwell_s)
     progress(Step("writing", 0, len(program.moves), target.name))
-    starts_with_change = any(i == 0 and isinstance(c, ToolChange) for i, c in program.commands)
-    changes = sum(isinstance(c, ToolChange) for _, c in program.commands)
-    if target.post.tool_changes == "none" and changes > 1 and starts_with_change:
+    changes = [i for i, c in program.commands if isinstance(c, ToolChange)]
+    # what runs before the first change runs with that tool: only rapids (pcb2gcode's
+    # retract to the tool change height), never a cut with a tool no program names
+    loaded_first = bool(changes) and all(isinstance(m, Rapid) for m in program.moves[: changes[0]])
+    if target.post.tool_changes == "none" and len(changes) > 1 and loaded_first:
         pieces = per_tool(program, target, output.fmt)  # one program per tool
         return PostJob(None, program, target, pieces[0].result, None, 0.0, pieces=pieces)
     program = loaded_by_hand(program, target)

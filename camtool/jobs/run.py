@@ -38,6 +38,7 @@ from camtool.model.program import (
     Program,
     Rapid,
     Spindle,
+    Stop,
     ToolChange,
 )
 from camtool.model.progress import Progress, Step, no_progress
@@ -437,30 +438,41 @@ def per_tool(program: Program, target: Target, fmt: str | None) -> tuple[ToolPro
 
     Each piece holds the moves from its tool change to the next and the commands among
     them in program order (the spindle stop before a change ends the piece before it;
-    the change itself is the piece's start); its header is the job's, then which program
-    of how many it is and what to load.
+    the change itself is the piece's start; what comes before the first change is the
+    first piece's); its header is the job's, then which program of how many it is and
+    what to load. A stop right after a change (``M6`` then ``M0``, as pcb2gcode pauses
+    for the new tool) is that change's: starting the piece is its resume, said in the
+    header; any other stop is kept.
 
     Raises:
         DialectError: a piece the target cannot write.
     """
     changes = [(i, c) for i, c in program.commands if isinstance(c, ToolChange)]
-    bounds = [i for i, _ in changes] + [len(program.moves)]
+    bounds = [0] + [i for i, _ in changes[1:]] + [len(program.moves)]
     commands: list[list[tuple[int, Command]]] = [[] for _ in changes]
-    piece = 0
+    stopped = [False] * len(changes)  # the change's own stop (M6 M0): the program's start
+    piece, after_change = 0, -1
     for i, command in program.commands:
         if isinstance(command, ToolChange):
             piece = next(k for k, (_, c) in enumerate(changes) if c is command)
+            after_change = i
             continue
+        if isinstance(command, Stop) and i == after_change and not stopped[piece]:
+            stopped[piece] = True
+            continue
+        after_change = -1
         commands[piece].append((i - bounds[piece], command))
     out: list[ToolProgram] = []
     here = program.origin
-    for k, (first, change) in enumerate(changes):
-        moves = program.moves[first : bounds[k + 1]]
+    for k, (_, change) in enumerate(changes):
+        moves = program.moves[bounds[k] : bounds[k + 1]]
         what = f" {change.description}" if change.description else ""
         after = "" if k == 0 else f", after the T{changes[k - 1][1].tool} program"
+        stop = ["the program's stop after this change is this program's start"] * stopped[k]
         notes = (
             *program.notes,
             f"program {k + 1} of {len(changes)}: load T{change.tool}{what}{after}",
+            *stop,
         )
         alone = Program(
             moves,

@@ -200,3 +200,75 @@ def test_a_re_posted_move_sideways_right_after_a_change_by_hand_is_warned_of() -
     assert "moves X/Y before any Z move" in said[0]
     code = str(done.result.code).splitlines()
     assert code[code.index("(change to T2)") + 2] == "G0 X20.000 Y20.000"  # as it was given
+
+
+PCB2GCODE_DRILL = """( pcb2gcode 2.5.0 )
+G94 ( Millimeters per minute feed rate. )
+G21 ( Units == Millimeters. )
+G90 ( Absolute coordinates. )
+G00 S10000 ( RPM spindle speed. )
+G01 F600.00000 ( Feedrate. )
+G00 Z10.00000 (Retract to tool change height)
+T1
+M5      (Spindle stop.)
+(MSG, Change tool bit to drill size 0.8mm)
+M6      (Tool change.)
+M0      (Temporary machine stop.)
+M3      (Spindle on clockwise.)
+G00 Z1.00000
+G00 X2.00000 Y2.00000
+G01 Z-1.50000 F50.00000
+G01 Z1.00000
+G00 X4.00000 Y2.00000
+G01 Z-1.50000
+G01 Z1.00000
+G00 Z10.00000 (Retract to tool change height)
+T2
+M5      (Spindle stop.)
+(MSG, Change tool bit to drill size 1.0mm)
+M6      (Tool change.)
+M0      (Temporary machine stop.)
+M3      (Spindle on clockwise.)
+G00 Z1.00000
+G00 X6.00000 Y3.00000
+G01 Z-1.50000
+G01 Z1.00000
+G00 Z10.00000 (All done -- retract)
+M5      (Spindle off.)
+M9      (Coolant off.)
+M2      (Program end.)
+"""
+"""pcb2gcode's drill file, as its test data has it (testing/gerbv_example/*/expected/drill.ngc):
+a retract to the tool change height before the first change, each change ``M6`` then ``M0``."""
+
+
+def test_a_pcb2gcode_drill_file_is_one_program_per_drill_for_a_machine_without_a_changer(
+    tmp_path: Path,
+) -> None:
+    """The retract before T1 is the first program's; each change's ``M0`` is its program's
+    start (flashcut has no stop, and refused the file); every move is kept, in order."""
+    source = tmp_path / "drill.ngc"
+    source.write_text(PCB2GCODE_DRILL)
+    program = read_gcode(source)
+    job = post_program(program, load_target("flashcut"))
+    assert [p.change.tool for p in job.pieces] == [1, 2]
+    first, second = (p.program for p in job.pieces)
+    assert (first.moves[0].x, first.moves[0].y, first.moves[0].z) == (0.0, 0.0, 10.0)
+    assert [(m.x, m.y) for m in first.moves if m.z == -1.5] == [(2.0, 2.0), (4.0, 2.0)]
+    assert [(m.x, m.y) for m in second.moves if m.z == -1.5] == [(6.0, 3.0)]
+    assert len(first.moves) + len(second.moves) == len(program.moves)
+    assert not any(isinstance(c, Stop) for p in job.pieces for _, c in p.program.commands)
+    assert all(
+        "stop after this change is this program's start" in " ".join(p.program.notes)
+        for p in job.pieces
+    )
+
+
+def test_a_stop_that_is_not_a_changes_own_stays_and_is_refused_where_it_cannot_be_written(
+    tmp_path: Path,
+) -> None:
+    """A stop between two holes (not right after a change) is kept: flashcut refuses it."""
+    source = tmp_path / "drill.ngc"
+    source.write_text(PCB2GCODE_DRILL.replace("G00 X4.00000 Y2.00000", "M0\nG00 X4.00000 Y2.00000"))
+    with pytest.raises(DialectError, match="never dropped"):
+        post_program(read_gcode(source), load_target("flashcut"))
