@@ -9,9 +9,10 @@ from typing import TYPE_CHECKING
 
 from camtool.importers import read_drawing, read_drawing_bytes
 from camtool.importers.options import ImportOptions
+from camtool.jobs.by_hand import changed_before_cutting, loaded_by_hand, per_tool
 from camtool.jobs.header import job_notes
 from camtool.jobs.inputs import is_program_file
-from camtool.jobs.run import OutputOptions, PostJob, loaded_by_hand, per_tool, run_job
+from camtool.jobs.run import OutputOptions, PostJob, run_job
 from camtool.model.errors import InputError, TooLargeError, UsageError
 from camtool.model.program import Move, Program, ToolChange
 from camtool.model.progress import Progress, Step, no_progress
@@ -370,11 +371,8 @@ def post_program(
         program = dataclasses.replace(program, notes=job_notes(source, target))
     program = _with_spindle(program, output.spindle_rpm, output.spindle_dwell_s)
     progress(Step("writing", 0, len(program.moves), target.name))
-    changes = [i for i, c in program.commands if isinstance(c, ToolChange)]
-    # what runs before the first change runs with that tool: only rapids (pcb2gcode's
-    # retract to the tool change height), never a cut with a tool no program names
-    loaded_first = bool(changes) and all(isinstance(m, Rapid) for m in program.moves[: changes[0]])
-    if target.post.tool_changes == "none" and len(changes) > 1 and loaded_first:
+    changes = sum(isinstance(c, ToolChange) for _, c in program.commands)
+    if target.post.tool_changes == "none" and changes > 1 and changed_before_cutting(program):
         pieces = per_tool(program, target, output.fmt)  # one program per tool
         return PostJob(None, program, target, pieces[0].result, None, 0.0, pieces=pieces)
     program = loaded_by_hand(program, target)

@@ -14,10 +14,10 @@ import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 from camtool.geometry.chain import chain_members, joint_distance
+from camtool.jobs.by_hand import ToolProgram, loaded_by_hand, per_tool
 from camtool.jobs.drill import drill_moves
 from camtool.jobs.heights import check_heights
 from camtool.jobs.job import Job, Operation, Tool
@@ -38,7 +38,6 @@ from camtool.model.program import (
     Program,
     Rapid,
     Spindle,
-    Stop,
     ToolChange,
 )
 from camtool.model.progress import Progress, Step, no_progress
@@ -104,28 +103,6 @@ class PostJob:
         """Warnings of every stage, in pipeline order, without repeats."""
         written = [w for p in self.pieces for w in p.result.warnings] or self.result.warnings
         return tuple(dict.fromkeys((*self.program.warnings, *written)))
-
-
-@dataclass(frozen=True)
-class ToolProgram:
-    """One program of a job written per tool (a machine that cannot change tools).
-
-    Attributes:
-        number: its place in the run, 1-based.
-        change: the tool change it starts with (the tool it cuts with, and what it is).
-        program: its moves and commands (its header says which program of how many).
-        result: its code.
-    """
-
-    number: int
-    change: ToolChange
-    program: Program
-    result: PostResult
-
-    def path(self, output: str | Path) -> str:
-        """Where it is written for ``-o output``: ``part.nc`` → ``part.T2.nc``."""
-        out = Path(output)
-        return str(out.with_name(f"{out.stem}.T{self.change.tool}{out.suffix}"))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -408,84 +385,6 @@ def _unplaced(
     program = Program(tuple(moves), origin, warnings, commands=commands)
     moves.clear()
     return program
-
-
-def loaded_by_hand(program: Program, target: Target) -> Program:
-    """``program`` without its one tool change, when ``target`` cannot change tools.
-
-    For a target whose :attr:`PostProcessor.tool_changes` is ``"none"``, a program whose
-    only tool change comes before its first move is that tool's program, as :func:`per_tool`
-    writes each of several tools': the tool is loaded by hand before it runs, and the header
-    (where the dialect has comments) and a warning say which. Any other program is returned
-    as it is (the writer refuses a change it cannot write; several tools are ``per_tool``'s).
-    """
-    changes = [(i, c) for i, c in program.commands if isinstance(c, ToolChange)]
-    if target.post.tool_changes != "none" or len(changes) != 1 or changes[0][0] != 0:
-        return program
-    change = changes[0][1]
-    what = f" ({change.description})" if change.description else ""
-    said = f"load T{change.tool}{what} before running: {target.name} cannot change tools"
-    return dataclasses.replace(
-        program,
-        commands=tuple((i, c) for i, c in program.commands if c is not change),
-        notes=(*program.notes, said),
-        warnings=(*program.warnings, f"the tool change to T{change.tool} is not written; {said}"),
-    )
-
-
-def per_tool(program: Program, target: Target, fmt: str | None) -> tuple[ToolProgram, ...]:
-    """``program`` cut at its tool changes into one program per tool, each written.
-
-    Each piece holds the moves from its tool change to the next and the commands among
-    them in program order (the spindle stop before a change ends the piece before it;
-    the change itself is the piece's start; what comes before the first change is the
-    first piece's); its header is the job's, then which program of how many it is and
-    what to load. A stop right after a change (``M6`` then ``M0``, as pcb2gcode pauses
-    for the new tool) is that change's: starting the piece is its resume, said in the
-    header; any other stop is kept.
-
-    Raises:
-        DialectError: a piece the target cannot write.
-    """
-    changes = [(i, c) for i, c in program.commands if isinstance(c, ToolChange)]
-    bounds = [0] + [i for i, _ in changes[1:]] + [len(program.moves)]
-    commands: list[list[tuple[int, Command]]] = [[] for _ in changes]
-    stopped = [False] * len(changes)  # the change's own stop (M6 M0): the program's start
-    piece, after_change = 0, -1
-    for i, command in program.commands:
-        if isinstance(command, ToolChange):
-            piece = next(k for k, (_, c) in enumerate(changes) if c is command)
-            after_change = i
-            continue
-        if isinstance(command, Stop) and i == after_change and not stopped[piece]:
-            stopped[piece] = True
-            continue
-        after_change = -1
-        commands[piece].append((i - bounds[piece], command))
-    out: list[ToolProgram] = []
-    here = program.origin
-    for k, (_, change) in enumerate(changes):
-        moves = program.moves[bounds[k] : bounds[k + 1]]
-        what = f" {change.description}" if change.description else ""
-        after = "" if k == 0 else f", after the T{changes[k - 1][1].tool} program"
-        stop = ["the program's stop after this change is this program's start"] * stopped[k]
-        notes = (
-            *program.notes,
-            f"program {k + 1} of {len(changes)}: load T{change.tool}{what}{after}",
-            *stop,
-        )
-        alone = Program(
-            moves,
-            here,
-            program.warnings,
-            commands=tuple(commands[k]),
-            notes=notes,
-            tolerance_mm=program.tolerance_mm,
-        )
-        out.append(ToolProgram(k + 1, change, alone, target.emit(alone, fmt=fmt)))
-        if moves:
-            here = (moves[-1].x, moves[-1].y)
-    return tuple(out)
 
 
 def _edge(op: Operation, tool: Tool, options: PlanOptions) -> float:

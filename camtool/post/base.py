@@ -395,7 +395,7 @@ class PostProcessor(ABC):
 
         ``code``: a tool change code (LinuxCNC's ``T2 M6``); ``stop``: by hand, a program
         stop with a comment naming the tool (GRBL 1.1); ``none``: it cannot, and a job of
-        several tools is written as one program per tool (:func:`camtool.jobs.run.per_tool`).
+        several tools is written as one program per tool (:func:`camtool.jobs.by_hand.per_tool`).
         """
         return "none"
 

@@ -272,3 +272,23 @@ def test_a_stop_that_is_not_a_changes_own_stays_and_is_refused_where_it_cannot_b
     source.write_text(PCB2GCODE_DRILL.replace("G00 X4.00000 Y2.00000", "M0\nG00 X4.00000 Y2.00000"))
     with pytest.raises(DialectError, match="never dropped"):
         post_program(read_gcode(source), load_target("flashcut"))
+
+
+def test_a_pcb2gcode_program_of_one_tool_is_that_tools_program(tmp_path: Path) -> None:
+    """pcb2gcode's isolation and outline files: one change (``M6`` ``M0``) after a retract.
+
+    For flashcut (no changer, no stop) the program is written without the change and its
+    stop, saying which tool to load; every move kept. It was refused.
+    """
+    one = PCB2GCODE_DRILL[
+        : PCB2GCODE_DRILL.index("G00 Z10.00000 (Retract to tool change height)\nT2")
+    ]
+    source = tmp_path / "outline.ngc"
+    source.write_text(one + "M2\n")
+    program = read_gcode(source)
+    done = post_program(program, load_target("flashcut"))
+    assert not done.pieces
+    assert done.program.moves == program.moves
+    assert not any(isinstance(c, Stop | ToolChange) for _, c in done.program.commands)
+    assert "the program's stop after this change is this program's start" in done.program.notes
+    assert any("the tool change to T1 is not written; load T1" in w for w in done.warnings)

@@ -1,0 +1,160 @@
+"""Tools loaded by hand: programs for a machine that cannot change tools.
+
+A job of several tools, or a re-posted program whose tool changes all come before any cut
+with another tool, is written one program per tool (:func:`per_tool`); a program of one
+tool is that tool's program (:func:`loaded_by_hand`). Each says which tool to load.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from camtool.model.program import Command, Program, Rapid, Stop, ToolChange
+
+if TYPE_CHECKING:
+    from camtool.post.base import PostResult, Target
+
+
+@dataclass(frozen=True)
+class ToolProgram:
+    """One program of a job written per tool (a machine that cannot change tools).
+
+    Attributes:
+        number: its place in the run, 1-based.
+        change: the tool change it starts with (the tool it cuts with, and what it is).
+        program: its moves and commands (its header says which program of how many).
+        result: its code.
+    """
+
+    number: int
+    change: ToolChange
+    program: Program
+    result: PostResult
+
+    def path(self, output: str | Path) -> str:
+        """Where it is written for ``-o output``: ``part.nc`` → ``part.T2.nc``."""
+        out = Path(output)
+        return str(out.with_name(f"{out.stem}.T{self.change.tool}{out.suffix}"))
+
+
+def loaded_by_hand(program: Program, target: Target) -> Program:
+    """``program`` without its one tool change, when ``target`` cannot change tools.
+
+    For a target whose :attr:`PostProcessor.tool_changes` is ``"none"``, a program whose
+    only tool change comes before any cut (:func:`changed_before_cutting`) is that tool's
+    program, as :func:`per_tool` writes each of several tools': the tool is loaded by hand
+    before it runs, and the header (where the dialect has comments) and a warning say
+    which; the change's own stop (``M6`` then ``M0``) goes with it, said in the header.
+    Any other program is returned as it is (the writer refuses a change it cannot write;
+    several tools are ``per_tool``'s).
+    """
+    changes = [c for _, c in program.commands if isinstance(c, ToolChange)]
+    if target.post.tool_changes != "none" or len(changes) != 1:
+        return program
+    if not changed_before_cutting(program):
+        return program
+    change = changes[0]
+    what = f" ({change.description})" if change.description else ""
+    said = f"load T{change.tool}{what} before running: {target.name} cannot change tools"
+    commands, stopped = _own_stops_dropped(program.commands)
+    stop = [OWN_STOP] if stopped else []
+    return dataclasses.replace(
+        program,
+        commands=tuple((i, c) for i, c in commands if c is not change),
+        notes=(*program.notes, said, *stop),
+        warnings=(*program.warnings, f"the tool change to T{change.tool} is not written; {said}"),
+    )
+
+
+OWN_STOP = "the program's stop after this change is this program's start"
+"""The header line of a program whose tool change's own stop (``M6`` then ``M0``) it drops."""
+
+
+def changed_before_cutting(program: Program) -> bool:
+    """Whether ``program``'s first tool change comes before any cut.
+
+    Only rapids may come before it (pcb2gcode retracts to its tool change height first):
+    they run with the tool the first program names, never a cut with an unnamed one.
+    """
+    first = next((i for i, c in program.commands if isinstance(c, ToolChange)), None)
+    return first is not None and all(isinstance(m, Rapid) for m in program.moves[:first])
+
+
+def _own_stops_dropped(
+    commands: Sequence[tuple[int, Command]],
+) -> tuple[list[tuple[int, Command]], set[int]]:
+    """``commands`` without each tool change's own stop, and the ids of those changes.
+
+    A change's own stop comes right after it, before any move (``M6`` then ``M0``, as
+    pcb2gcode pauses for the new tool): where a program is cut at its changes (or its
+    one change is loaded by hand), starting the program is that stop's resume.
+    """
+    out: list[tuple[int, Command]] = []
+    stopped: set[int] = set()
+    change: ToolChange | None = None
+    at = -1
+    for i, command in commands:
+        if isinstance(command, ToolChange):
+            change, at = command, i
+        elif isinstance(command, Stop) and change is not None and i == at:
+            if id(change) not in stopped:
+                stopped.add(id(change))
+                continue
+        else:
+            change = None
+        out.append((i, command))
+    return out, stopped
+
+
+def per_tool(program: Program, target: Target, fmt: str | None) -> tuple[ToolProgram, ...]:
+    """``program`` cut at its tool changes into one program per tool, each written.
+
+    Each piece holds the moves from its tool change to the next and the commands among
+    them in program order (the spindle stop before a change ends the piece before it;
+    the change itself is the piece's start; what comes before the first change is the
+    first piece's); its header is the job's, then which program of how many it is and
+    what to load. A stop right after a change (``M6`` then ``M0``, as pcb2gcode pauses
+    for the new tool) is that change's: starting the piece is its resume, said in the
+    header; any other stop is kept.
+
+    Raises:
+        DialectError: a piece the target cannot write.
+    """
+    changes = [(i, c) for i, c in program.commands if isinstance(c, ToolChange)]
+    bounds = [0] + [i for i, _ in changes[1:]] + [len(program.moves)]
+    commands: list[list[tuple[int, Command]]] = [[] for _ in changes]
+    kept, stopped = _own_stops_dropped(program.commands)
+    piece = 0
+    for i, command in kept:
+        if isinstance(command, ToolChange):
+            piece = next(k for k, (_, c) in enumerate(changes) if c is command)
+            continue
+        commands[piece].append((i - bounds[piece], command))
+    out: list[ToolProgram] = []
+    here = program.origin
+    for k, (_, change) in enumerate(changes):
+        moves = program.moves[bounds[k] : bounds[k + 1]]
+        what = f" {change.description}" if change.description else ""
+        after = "" if k == 0 else f", after the T{changes[k - 1][1].tool} program"
+        stop = [OWN_STOP] if id(change) in stopped else []
+        notes = (
+            *program.notes,
+            f"program {k + 1} of {len(changes)}: load T{change.tool}{what}{after}",
+            *stop,
+        )
+        alone = Program(
+            moves,
+            here,
+            program.warnings,
+            commands=tuple(commands[k]),
+            notes=notes,
+            tolerance_mm=program.tolerance_mm,
+        )
+        out.append(ToolProgram(k + 1, change, alone, target.emit(alone, fmt=fmt)))
+        if moves:
+            here = (moves[-1].x, moves[-1].y)
+    return tuple(out)
