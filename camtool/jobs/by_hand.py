@@ -60,7 +60,7 @@ def loaded_by_hand(program: Program, target: Target) -> Program:
     change = changes[0]
     what = f" ({change.description})" if change.description else ""
     said = f"load T{change.tool}{what} before running: {target.name} cannot change tools"
-    commands, stopped = _own_stops_dropped(program.commands)
+    commands, stopped = own_stops_dropped(program.commands)
     stop = [OWN_STOP] if stopped else []
     return dataclasses.replace(
         program,
@@ -84,14 +84,16 @@ def changed_before_cutting(program: Program) -> bool:
     return first is not None and all(isinstance(m, Rapid) for m in program.moves[:first])
 
 
-def _own_stops_dropped(
+def own_stops_dropped(
     commands: Sequence[tuple[int, Command]],
 ) -> tuple[list[tuple[int, Command]], set[int]]:
     """``commands`` without each tool change's own stop, and the ids of those changes.
 
     A change's own stop comes right after it, before any move (``M6`` then ``M0``, as
     pcb2gcode pauses for the new tool): where a program is cut at its changes (or its
-    one change is loaded by hand), starting the program is that stop's resume.
+    one change is loaded by hand), starting the program is that stop's resume; where the
+    dialect changes tools by hand with a stop (GRBL 1.1's comment and ``M0``), that stop
+    is it (the machine stops there once, not twice).
     """
     out: list[tuple[int, Command]] = []
     stopped: set[int] = set()
@@ -127,7 +129,7 @@ def per_tool(program: Program, target: Target, fmt: str | None) -> tuple[ToolPro
     changes = [(i, c) for i, c in program.commands if isinstance(c, ToolChange)]
     bounds = [0] + [i for i, _ in changes[1:]] + [len(program.moves)]
     commands: list[list[tuple[int, Command]]] = [[] for _ in changes]
-    kept, stopped = _own_stops_dropped(program.commands)
+    kept, stopped = own_stops_dropped(program.commands)
     piece = 0
     for i, command in kept:
         if isinstance(command, ToolChange):

@@ -9,7 +9,12 @@ from typing import TYPE_CHECKING
 
 from camtool.importers import read_drawing, read_drawing_bytes
 from camtool.importers.options import ImportOptions
-from camtool.jobs.by_hand import changed_before_cutting, loaded_by_hand, per_tool
+from camtool.jobs.by_hand import (
+    changed_before_cutting,
+    loaded_by_hand,
+    own_stops_dropped,
+    per_tool,
+)
 from camtool.jobs.header import job_notes
 from camtool.jobs.inputs import is_program_file
 from camtool.jobs.run import OutputOptions, PostJob, run_job
@@ -376,6 +381,10 @@ def post_program(
         pieces = per_tool(program, target, output.fmt)  # one program per tool
         return PostJob(None, program, target, pieces[0].result, None, 0.0, pieces=pieces)
     program = loaded_by_hand(program, target)
+    if target.post.tool_changes == "stop":  # the change is written as a stop: its own is that
+        program = dataclasses.replace(
+            program, commands=tuple(own_stops_dropped(program.commands)[0])
+        )
     return PostJob(None, program, target, target.emit(program, fmt=output.fmt), None, 0.0)
 
 

@@ -292,3 +292,12 @@ def test_a_pcb2gcode_program_of_one_tool_is_that_tools_program(tmp_path: Path) -
     assert not any(isinstance(c, Stop | ToolChange) for _, c in done.program.commands)
     assert "the program's stop after this change is this program's start" in done.program.notes
     assert any("the tool change to T1 is not written; load T1" in w for w in done.warnings)
+
+
+def test_a_pcb2gcode_change_and_its_own_stop_pause_grbl_once(tmp_path: Path) -> None:
+    """GRBL changes tools by hand with a stop: ``M6`` then ``M0`` is one pause, not two."""
+    source = tmp_path / "drill.ngc"
+    source.write_text(PCB2GCODE_DRILL)
+    lines = str(post_program(read_gcode(source), load_target("grbl")).result.code).splitlines()
+    stops = [i for i, line in enumerate(lines) if line == "M0"]
+    assert [lines[i - 1] for i in stops] == ["(change to T1)", "(change to T2)"]
