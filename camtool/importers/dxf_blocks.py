@@ -257,6 +257,8 @@ def _transformed(entity: Any, matrix: Any) -> tuple[Any, tuple[Any, ...]]:
     from ezdxf.math.transformtools import NonUniformScalingError, TransformError
 
     try:
+        if _sheared(entity, matrix):
+            raise NonUniformScalingError("not a similarity in the entity's plane")
         return _controlled(entity).transform(matrix), ()
     except NonUniformScalingError:
         kind = entity.dxftype()
@@ -272,6 +274,30 @@ def _transformed(entity: Any, matrix: Any) -> tuple[Any, tuple[Any, ...]]:
         raise Unsupported("cannot be scaled non-uniformly") from None
     except (TransformError, NotImplementedError) as exc:
         raise Unsupported(f"cannot be transformed ({exc})") from exc
+
+
+_BULGED = frozenset({"ARC", "CIRCLE", "LWPOLYLINE", "POLYLINE"})
+"""Entities whose arcs ezdxf keeps circular when it transforms them."""
+
+
+def _sheared(entity: Any, matrix: Any) -> bool:
+    """Whether ``matrix`` maps ``entity``'s plane by more than a similarity (a shear).
+
+    ezdxf transforms a CIRCLE, an ARC or a polyline's bulges as circles when the images of
+    the entity's OCS x and y axes are equally long (``transform_extrusion``), without
+    asking that they stay perpendicular: a block rotated by 45° inside a block scaled
+    non-uniformly (``S(1, 2) · R(45°)``: both axes √2.5 long, not perpendicular) made a
+    circle where the placed curve is an ellipse. Such an entity is transformed as the
+    non-uniform case is: arcs as ELLIPSEs, whose transform is exact under any affine map.
+    """
+    if entity.dxftype() not in _BULGED:
+        return False
+    from ezdxf.math import OCS, X_AXIS, Y_AXIS
+
+    ocs = OCS(entity.dxf.get("extrusion", (0.0, 0.0, 1.0)))
+    x, y = matrix.transform_directions((ocs.to_wcs(X_AXIS), ocs.to_wcs(Y_AXIS)))
+    size = x.magnitude * y.magnitude
+    return size > 0.0 and abs(x.dot(y)) > 1e-9 * size
 
 
 def _controlled(entity: Any) -> Any:

@@ -269,6 +269,43 @@ def _assert_close(true: list[Point], segments: tuple[Segment, ...]) -> None:
     assert max(gaps) <= TOL + spacing
 
 
+@pytest.mark.parametrize("angle", [45.0, 135.0])
+def test_arcs_of_a_block_at_45_degrees_in_a_non_uniformly_scaled_block(
+    tmp_path: Path, angle: float
+) -> None:
+    """A block rotated by 45° (or 135°) inside one scaled (1, -2): arcs become ellipses.
+
+    Under S(1, -2)·R(45°) the block's x and y axes are both √2.5 long but no longer
+    perpendicular; ezdxf (1.4) judges such a map by the axes' lengths alone and kept the
+    circle, the arc and the polyline's bulge circular (the circle came out a 4.74 mm
+    radius circle where the placed curve is an ellipse of semi-axes 3 and 6 mm). Expected
+    points: the drawn curves placed by p' = T + R·S·p, inner then outer (analysis).
+    """
+    inner = _placer((3.0, 3.0), angle, 1.5, 1.5)
+    outer = _placer((0.0, 0.0), 0.0, 1.0, -2.0)
+
+    def build(msp: Any) -> None:
+        part = msp.doc.blocks.new("B")
+        part.add_circle((0, 0), 2)
+        part.add_arc((5, 0), 1, 0, 90)
+        part.add_lwpolyline([(0, 0, 0), (3, 0, 0.5), (3, 3, 0)], format="xyb")
+        rotated = {"rotation": angle, "xscale": 1.5, "yscale": 1.5}
+        msp.doc.blocks.new("C").add_blockref("B", (3, 3), dxfattribs=rotated)
+        msp.add_blockref("C", (0, 0), dxfattribs={"yscale": -2})
+
+    contours = read_dxf(write_dxf(tmp_path / "nested45.dxf", build)).contours
+    arc, circle, polyline = sorted(contours, key=lambda c: c.source)  # ARC, CIRCLE, LWPOLYLINE
+    ts = _range(0.0, 2 * math.pi)
+    _assert_close([outer(inner((2 * math.cos(t), 2 * math.sin(t)))) for t in ts], circle.segments)
+    quarter = [(5 + math.cos(t), math.sin(t)) for t in _range(0.0, math.pi / 2)]
+    _assert_close([outer(inner(p)) for p in quarter], arc.segments)
+    # bulge 0.5 from (3, 0) to (3, 3): counter-clockwise about (1.875, 1.5), radius 1.875
+    half = math.atan2(1.5, 1.125)
+    bulge = [(1.875 + 1.875 * math.cos(t), 1.5 + 1.875 * math.sin(t)) for t in _range(-half, half)]
+    true = _polyline_points([(0, 0), (3, 0)]) + bulge
+    _assert_close([outer(inner(p)) for p in true], polyline.segments)
+
+
 def test_minsert_rows_and_columns(tmp_path: Path) -> None:
     def build(msp: Any) -> None:
         msp.doc.blocks.new("HOLE").add_circle((0, 0), 1.0)
