@@ -306,6 +306,52 @@ def test_arcs_of_a_block_at_45_degrees_in_a_non_uniformly_scaled_block(
     _assert_close([outer(inner(p)) for p in true], polyline.segments)
 
 
+@settings(max_examples=int(os.environ.get("CAMTOOL_INSERT_EXAMPLES", "30")), deadline=None)
+@given(
+    angle=st.sampled_from([0.0, 17.5, 45.0, 90.0, 135.0, 225.0, 315.0]),
+    k=st.sampled_from([0.5, 1.0, 1.5]),
+    scales=st.sampled_from([(1.0, 2.0), (1.0, -2.0), (-3.0, 0.5), (2.0, 2.0), (0.25, 1.0)]),
+    outer_angle=st.sampled_from([0.0, 30.0, 45.0]),
+    r=st.floats(0.5, 5.0).map(lambda v: round(v, 2)),
+    start=st.floats(0.0, 300.0).map(lambda v: round(v, 1)),
+)
+def test_property_nested_arcs_are_placed_by_both_inserts(
+    angle: float,
+    k: float,
+    scales: tuple[float, float],
+    outer_angle: float,
+    r: float,
+    start: float,
+) -> None:
+    """A circle and an arc in a block inserted (rotated, scaled) in a block inserted with
+    any scale and rotation: every point is the drawn point placed by p' = T + R·S·p, inner
+    then outer (the DXF reference's INSERT), whatever shear the two make together."""
+    sx, sy = scales
+    inner = _placer((3.0, -2.0), angle, k, k)
+    outer = _placer((10.0, 20.0), outer_angle, sx, sy)
+
+    def build(msp: Any) -> None:
+        part = msp.doc.blocks.new("B")
+        part.add_circle((1, 1), r)
+        part.add_arc((-4, 2), r, start, start + 100.0)
+        placed = {"rotation": angle, "xscale": k, "yscale": k}
+        msp.doc.blocks.new("C").add_blockref("B", (3, -2), dxfattribs=placed)
+        scaled = {"rotation": outer_angle, "xscale": sx, "yscale": sy}
+        msp.add_blockref("C", (10, 20), dxfattribs=scaled)
+
+    with tempfile.TemporaryDirectory() as tmp:
+        contours = read_dxf(write_dxf(Path(tmp) / "nested.dxf", build)).contours
+    arc, circle = sorted(contours, key=lambda c: c.source)  # ARC, CIRCLE
+    ts = _range(0.0, 2 * math.pi, 720)
+    drawn = [(1 + r * math.cos(t), 1 + r * math.sin(t)) for t in ts]
+    _assert_close([outer(inner(p)) for p in drawn], circle.segments)
+    a0 = math.radians(start)
+    sweep = [
+        (-4 + r * math.cos(t), 2 + r * math.sin(t)) for t in _range(a0, a0 + math.radians(100), 360)
+    ]
+    _assert_close([outer(inner(p)) for p in sweep], arc.segments)
+
+
 def test_minsert_rows_and_columns(tmp_path: Path) -> None:
     def build(msp: Any) -> None:
         msp.doc.blocks.new("HOLE").add_circle((0, 0), 1.0)
