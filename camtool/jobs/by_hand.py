@@ -1,8 +1,9 @@
 """Tools loaded by hand: programs for a machine that cannot change tools.
 
-A job of several tools, or a re-posted program whose tool changes all come before any cut
-with another tool, is written one program per tool (:func:`per_tool`); a program of one
-tool is that tool's program (:func:`loaded_by_hand`). Each says which tool to load.
+A job of several tools, or a re-posted program whose first tool change comes before any
+cut (:func:`changed_before_cutting`), is written one program per tool (:func:`per_tool`); a
+program of one tool is that tool's program (:func:`loaded_by_hand`). Each says which tool
+to load.
 """
 
 from __future__ import annotations

@@ -303,7 +303,7 @@ def _profile_op(
     mill: float | None = tool
     tool_line = "tool = {end-mill}"
     if not has_outer:
-        mill, tool_line = _mill_for_holes(contours, tool)
+        mill, tool_line = _mill_that_fits(contours, tool)
     lines = [
         f"name = {_quote(key)}",
         'type = "profile"',
@@ -338,7 +338,7 @@ def _pocket_op(
     select: str, what: str, contours: list[Contour], thickness: float, tool: float, key: str
 ) -> _Op:
     """A pocket at half the stock, with an end mill that fits its narrowest pocket."""
-    mill, tool_line = _mill_for_holes(contours, tool, "pocket")
+    mill, tool_line = _mill_that_fits(contours, tool, "pocket")
     lines = (
         f"name = {_quote(key)}",
         'type = "pocket"' + _why(f"{what}: the layer's name says pocket"),
@@ -360,10 +360,10 @@ WIDTH_TOLERANCE_MM = 0.01
 """How closely a hole's width (its largest inscribed circle) is measured, mm."""
 
 
-def _mill_for_holes(
+def _mill_that_fits(
     contours: Sequence[Contour], tool: float, noun: str = "hole"
 ) -> tuple[float | None, str]:
-    """The end mill for a layer of holes cut on their inside, and its ``tool =`` line.
+    """The end mill for a layer of holes (or pockets) and its ``tool =`` line.
 
     ``noun``: what the comment calls them (``"pocket"`` for a layer of pockets, whose
     clearing needs the same: ``post`` clears nothing narrower than its tool).

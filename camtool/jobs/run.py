@@ -257,7 +257,8 @@ def run_job(
     runs: list[OperationRun] = []
     construction: list[Contour] = []
     drilled: set[int] = set()  # the drawing's marks an operation selected, by id
-    chained = _chained_closed(drawing, scaled, joint_distance(setup.chain_tolerance))
+    joint = joint_distance(setup.chain_tolerance)  # how the planner chains contours
+    chained = _chained_closed(drawing, scaled, joint)
     here: tuple[float, float, float | None] = (*setup.origin, None)
     loaded: int | None = None
     sequence = job.sequenced()
@@ -310,7 +311,6 @@ def run_job(
         del planned  # its moves are in ``moves``: not kept past the placement's shifted copy
     notes = construction_notes(construction)
     if not job.shorthand:
-        joint = joint_distance(setup.chain_tolerance)
         notes.extend(unselected(scaled, runs, construction, joint))
         notes.extend(undrilled(drawing, drilled))
     warnings[len(drawing.warnings) : len(drawing.warnings)] = notes

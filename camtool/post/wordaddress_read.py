@@ -276,7 +276,7 @@ class BlockReader:
         if key == "G53":
             rapid = self.spec.motion_codes[0]
             if codes != [key, rapid] or not axes or set(values) - set("XYZ"):
-                raise self.fail(f"a return to machine zero is G53 {rapid} with axis words")
+                raise self.fail(f"a rapid in machine coordinates is G53 {rapid} with axis words")
             at = tuple(values[a] for a in axes)
             home = Home(axes, key, at if any(v != 0.0 for v in at) else ())
             self.state.commands.append((len(self.state.moves), home))
