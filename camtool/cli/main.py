@@ -491,9 +491,14 @@ def inspect(drawing: str, as_json: bool, chain_tolerance: float, **options: Any)
     """
     from camtool.importers import bytes_as_file
     from camtool.importers.lint import inspect_drawing
-    from camtool.jobs.inputs import STDIN, drawing_kind
+    from camtool.jobs.inputs import STDIN, drawing_kind, is_program_file
 
     settings = import_settings(options)
+    if drawing != "-" and is_program_file(drawing):
+        raise UsageError(
+            f"{drawing}: a G-code program; inspect reads drawings. Read a program back with "
+            f"`camtool verify {drawing} -t TARGET`, or draw it with `camtool preview {drawing}`"
+        )
     if drawing != "-":
         report = inspect_drawing(drawing, settings, chain_tolerance=chain_tolerance)
         click.echo(json.dumps(report.to_json(), indent=2) if as_json else report.text(), nl=as_json)

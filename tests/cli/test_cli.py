@@ -330,6 +330,17 @@ def _square_with_a_gap(path: Path) -> Path:
     return write_dxf(path, lambda msp: [msp.add_line(a, b) for a, b in sides])
 
 
+def test_inspect_of_a_program_says_which_command_reads_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    program = tmp_path / "part.nc"
+    program.write_text("G21 G90\nG0 Z5\nG0 X1 Y1\nG1 Z-1 F100\nG1 X5\nG0 Z5\nM2\n")
+    code, out, err = run(["inspect", str(program)], capsys)
+    assert code == 2 and out == ""
+    assert f"{program}: a G-code program; inspect reads drawings" in err
+    assert f"camtool verify {program} -t TARGET" in err and "Traceback" not in err
+
+
 def test_inspect_joins_the_gaps_post_joins(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
