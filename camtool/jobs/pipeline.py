@@ -522,8 +522,12 @@ def verify_job(
 
 
 def _without_changes(program: Program) -> Program:
-    """``program`` without its tool changes (the moves of a job written per tool)."""
-    commands = tuple((i, c) for i, c in program.commands if not isinstance(c, ToolChange))
+    """``program`` without its tool changes and their own stops, as :func:`per_tool` wrote it.
+
+    The moves of a job written per tool, one program after the other.
+    """
+    kept = own_stops_dropped(program.commands)[0]
+    commands = tuple((i, c) for i, c in kept if not isinstance(c, ToolChange))
     return dataclasses.replace(program, commands=commands)
 
 

@@ -301,3 +301,14 @@ def test_a_pcb2gcode_change_and_its_own_stop_pause_grbl_once(tmp_path: Path) -> 
     lines = str(post_program(read_gcode(source), load_target("grbl")).result.code).splitlines()
     stops = [i for i, line in enumerate(lines) if line == "M0"]
     assert [lines[i - 1] for i in stops] == ["(change to T1)", "(change to T2)"]
+
+
+def test_a_pcb2gcode_drill_file_per_tool_is_verified_as_written(tmp_path: Path) -> None:
+    """``--verify`` reads the programs per tool back one after the other: the changes'
+    own stops are left out there too (it stopped at the first, which flashcut cannot write)."""
+    source = tmp_path / "drill.ngc"
+    source.write_text(PCB2GCODE_DRILL)
+    out = tmp_path / "drill.nc"
+    code = main(["post", str(source), "-t", "flashcut", "-o", str(out), "--verify"])
+    assert code == 0
+    assert (tmp_path / "drill.T1.nc").is_file() and (tmp_path / "drill.T2.nc").is_file()
