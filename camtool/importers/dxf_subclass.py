@@ -103,13 +103,17 @@ _Tag = tuple[bytes, bytes, bool]
 
 
 def _declare_version(out: list[_Tag]) -> None:
-    """Give a file without ``$ACADVER`` the version of its markers (R2000, ``AC1015``).
+    """Give the file the version of its markers (R2000, ``AC1015``) where it says less.
 
-    Without it ezdxf reads the file as DXF R12, whose entities have no subclasses, and
-    takes the markers out again. ``$INSUNITS`` is not added: the file's unit stays unsaid.
+    Without it (no ``$ACADVER``, or one before R2000, which has no LWPOLYLINE) ezdxf
+    reads the file as DXF R12, whose entities have no subclasses, and takes the markers
+    out again. ``$INSUNITS`` is not added: the file's unit stays unsaid.
     """
     codes = [(code, value.strip().upper()) for code, value, _ in out]
     if (b"9", b"$ACADVER") in codes:
+        at = codes.index((b"9", b"$ACADVER")) + 1
+        if at < len(out) and out[at][0] == b"1" and codes[at][1] < b"AC1015":
+            out[at] = (b"1", b"AC1015", False)  # a changed value: no line moves
         return
     version = [(b"9", b"$ACADVER", True), (b"1", b"AC1015", True)]
     for k in range(1, len(codes)):

@@ -11,6 +11,7 @@ of the intact file, not camtool's.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import ezdxf
@@ -111,3 +112,23 @@ def test_entities_with_markers_and_other_entities_are_left_as_they_are(tmp_path:
     assert dict(marked.counts) == {"LWPOLYLINE": 1, "SPLINE": 1}
     assert len(marked.inserted) == 2 * 2 * 2  # two markers of two lines in each entity
     assert marked.data.count(b"$ACADVER") == 1  # the file's own version is kept
+
+
+def test_a_file_that_says_r12_but_holds_lwpolylines_is_read_as_r2000(tmp_path: Path) -> None:
+    """``$ACADVER AC1009`` (R12, which has no LWPOLYLINE) with a marker-less LWPOLYLINE.
+
+    The bulge 0.5 from (20, 0) to (20, 10) is an arc of 4·atan(0.5) rad on a 6.25 mm
+    radius (chord 10 mm), its sagitta 2.5 mm: the closed outline is 20 + 11.591 + 20 +
+    10 mm long and reaches x = 22.5 (analysis).
+    """
+    tags = ["0", "SECTION", "2", "HEADER", "9", "$ACADVER", "1", "AC1009", "9", "$INSUNITS"]
+    tags += ["70", "4", "0", "ENDSEC", "0", "SECTION", "2", "ENTITIES", "0", "LWPOLYLINE"]
+    tags += ["8", "CUT", "90", "4", "70", "1", "10", "0", "20", "0", "10", "20", "20", "0"]
+    tags += ["42", "0.5", "10", "20", "20", "10", "10", "0", "20", "10", "0", "ENDSEC"]
+    path = tmp_path / "r12.dxf"
+    path.write_text("\n".join([*tags, "0", "EOF"]) + "\n")
+    (outline,) = read_dxf(path).contours
+    arc = 6.25 * 4 * math.atan(0.5)
+    assert outline.closed and outline.layer == "CUT"
+    assert outline.length == pytest.approx(50.0 + arc, abs=1e-6)
+    assert max(x for x, _ in outline.points(0.0001)) == pytest.approx(22.5, abs=1e-3)
