@@ -238,8 +238,9 @@ M5      (Spindle off.)
 M9      (Coolant off.)
 M2      (Program end.)
 """
-"""pcb2gcode's drill file, as its test data has it (testing/gerbv_example/*/expected/drill.ngc):
-a retract to the tool change height before the first change, each change ``M6`` then ``M0``."""
+"""A drill file in the form of pcb2gcode 2.5's (its test data: testing/gerbv_example/*/expected/
+drill.ngc), shortened to two drills and three holes, the tool change height 10 mm for
+flashcut's 20 mm of Z: a retract before the first change, each change ``M6`` then ``M0``."""
 
 
 def test_a_pcb2gcode_drill_file_is_one_program_per_drill_for_a_machine_without_a_changer(
