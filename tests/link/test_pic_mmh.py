@@ -120,8 +120,13 @@ def test_a_wrong_echo_stops_naming_the_block_and_sends_stop(simulate: Any) -> No
     assert "--from-line 5" in message
     assert "'A;' sent and echoed: the controller stopped" in message
     assert sim.device.stops == 1  # "A;" right after the wrong echo
-    # the misread block had started to move: the stop aborted it
-    assert sim.device.aborted and sim.device.aborted[-1][0] == 5
+    # the misread block had started to move: the stop aborted it, or, on a busy machine
+    # where the host read the echo late, it had already run to its end (the misread digit
+    # is the feed's: it ends where block 5 ends, and the resume below ends at END either way)
+    if sim.device.aborted:
+        assert sim.device.aborted[-1][0] == 5
+    else:
+        assert sim.device.executed[-1].startswith(b"G01X00150.00Y00150.00F09;")
     assert sim.device.blocks[-1] == b"A;"
     run(sim.path, from_line=5)
     assert sim.device.position() == pytest.approx(END)
