@@ -678,7 +678,8 @@ def _outputs(task: BatchTask, options: BatchOptions, job: PostJob) -> tuple[Batc
         files = [(piece.path(task.code_path), piece.result.code) for piece in job.pieces]
     warnings = job.warnings
     error_um: float | None = None
-    time_s = job.program.cutting_time_s()
+    # at programmed feeds, where the machine runs them; else known only by simulating
+    time_s = job.program.cutting_time_s() if job.target.post.writes_feeds else None
     v = None
     if options.verifying:
         from camtool.jobs.pipeline import report_json, verify_job

@@ -142,7 +142,9 @@ def totals_line(result: BatchResult) -> str:
     )
     if t["max_error_um"] is not None:
         text += f"; max {t['max_error_um']:.2f} µm"
-    return f"{text}; {sum(r.time_s or 0.0 for r in result.rows):.1f} s"
+    untimed = sum(r.time_s is None and r.status != "error" for r in result.rows)
+    but = f" ({untimed} written without a time: --verify times them)" if untimed else ""
+    return f"{text}; {sum(r.time_s or 0.0 for r in result.rows):.1f} s{but}"
 
 
 def progress_line(done: int, total: int, row: BatchRow) -> str:

@@ -390,6 +390,16 @@ class PostProcessor(ABC):
         return None
 
     @property
+    def writes_feeds(self) -> bool:
+        """True when the dialect writes a feed the machine runs at (an F word).
+
+        False where every move runs at the machine's own speed whatever the program
+        asks (valcnc, the 8751, the Matlab router): a program's time at its programmed
+        feeds is then no estimate of the machine's; ``verify`` simulates that one.
+        """
+        return True
+
+    @property
     def tool_changes(self) -> str:
         """How the dialect changes tools: ``"code"``, ``"stop"`` or ``"none"``.
 

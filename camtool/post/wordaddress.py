@@ -74,6 +74,11 @@ class WordAddressPost(PostProcessor):
         return word.number.parse(word.number.format(z))
 
     @property
+    def writes_feeds(self) -> bool:
+        """True when the spec has an F word."""
+        return self.spec.has("F")
+
+    @property
     def tool_changes(self) -> str:
         """``code`` with a ``tool_change`` code, ``stop`` with a stop and comments."""
         if self.spec.tool_change:

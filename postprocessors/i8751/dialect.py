@@ -350,6 +350,11 @@ class I8751Post(PostProcessor):
 
     # -- writing ---------------------------------------------------------------
 
+    @property
+    def writes_feeds(self) -> bool:
+        """False: every move runs at the 8751's delay-loop ramp (Intf8751 §4.4)."""
+        return False
+
     def emit(self, program: Program, machine: Machine, *, fmt: str | None = None) -> PostResult:
         """Write ``program`` as an 8751 session: raw bytes (``bin``) or a dump (``dump``).
 

@@ -306,6 +306,11 @@ class MatlabRouterPost(PostProcessor):
 
     # -- writing ---------------------------------------------------------------
 
+    @property
+    def writes_feeds(self) -> bool:
+        """False: every move runs at 480 counts per 5 ms on its longer axis (Angel-11 §3)."""
+        return False
+
     def emit(self, program: Program, machine: Machine, *, fmt: str | None = None) -> PostResult:
         """Write ``program`` as one job per stroke, in the ``script`` or ``wire`` format.
 

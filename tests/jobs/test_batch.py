@@ -192,6 +192,21 @@ def test_blocks_match_camtool_post(tree: Path) -> None:
     assert row.max_error_um is None and not row.verified
 
 
+def test_a_target_that_writes_no_feed_has_no_time_without_verification(tree: Path) -> None:
+    """valcnc runs every step at 166.667 µs whatever F says (and writes no F): the time at
+    programmed feeds is no estimate of its time, so it is left out, and said in the totals."""
+    from camtool.jobs.batch_report import totals_line
+
+    options = BatchOptions(target="valcnc", output_dir=Path("o"), jobs=1)
+    result = run_batch(plan_batch(["drawings/rect.dxf"], options))
+    (row,) = result.rows
+    assert row.status == "ok" and row.time_s is None
+    assert "(1 written without a time: --verify times them)" in totals_line(result)
+    timed = BatchOptions(target="valcnc", output_dir=Path("v"), jobs=1, verify=True)
+    (verified,) = run_batch(plan_batch(["drawings/rect.dxf"], timed)).rows
+    assert verified.time_s is not None and verified.time_s > 0
+
+
 def test_a_worker_exception_becomes_that_files_error_row(
     tree: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
