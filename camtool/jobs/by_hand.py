@@ -113,6 +113,23 @@ def own_stops_dropped(
     return out, stopped
 
 
+def idle_changes(program: Program) -> list[ToolChange]:
+    """The tool changes after which ``program`` cuts nothing before the next change.
+
+    A change at the program's end, or one changed again at once, loads a tool that
+    never cuts: :func:`per_tool` writes no program for it (its rapids go with the
+    program before, or the first program, its spindle commands nowhere).
+    """
+    every = [(i, c) for i, c in program.commands if isinstance(c, ToolChange)]
+    starts = [i for i, _ in every[1:]] + [len(program.moves)]
+    moves = program.moves
+    return [
+        c
+        for (i, c), end in zip(every, starts, strict=True)
+        if all(isinstance(m, Rapid) for m in moves[i:end])
+    ]
+
+
 def per_tool(program: Program, target: Target, fmt: str | None) -> tuple[ToolProgram, ...]:
     """``program`` cut at its tool changes into one program per tool, each written.
 
@@ -127,16 +144,22 @@ def per_tool(program: Program, target: Target, fmt: str | None) -> tuple[ToolPro
     Raises:
         DialectError: a piece the target cannot write.
     """
-    changes = [(i, c) for i, c in program.commands if isinstance(c, ToolChange)]
+    every = [(i, c) for i, c in program.commands if isinstance(c, ToolChange)]
+    idle = {id(c) for c in idle_changes(program)}
+    changes = [(i, c) for i, c in every if id(c) not in idle] or every[:1]
+    kept_ids = {id(c) for _, c in changes}
     bounds = [0] + [i for i, _ in changes[1:]] + [len(program.moves)]
     commands: list[list[tuple[int, Command]]] = [[] for _ in changes]
     kept, stopped = own_stops_dropped(program.commands)
-    piece = 0
+    piece, idle_tool = 0, False
     for i, command in kept:
         if isinstance(command, ToolChange):
-            piece = next(k for k, (_, c) in enumerate(changes) if c is command)
+            idle_tool = id(command) not in kept_ids
+            if not idle_tool:
+                piece = next(k for k, (_, c) in enumerate(changes) if c is command)
             continue
-        commands[piece].append((i - bounds[piece], command))
+        if not idle_tool:
+            commands[piece].append((i - bounds[piece], command))
     out: list[ToolProgram] = []
     here = program.origin
     for k, (_, change) in enumerate(changes):

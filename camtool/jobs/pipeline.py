@@ -11,6 +11,7 @@ from camtool.importers import read_drawing, read_drawing_bytes
 from camtool.importers.options import ImportOptions
 from camtool.jobs.by_hand import (
     changed_before_cutting,
+    idle_changes,
     loaded_by_hand,
     own_stops_dropped,
     per_tool,
@@ -378,6 +379,11 @@ def post_program(
     progress(Step("writing", 0, len(program.moves), target.name))
     changes = sum(isinstance(c, ToolChange) for _, c in program.commands)
     if target.post.tool_changes == "none" and changes > 1 and changed_before_cutting(program):
+        idle = idle_changes(program)
+        if idle:
+            tools = ", ".join(f"T{c.tool}" for c in idle)
+            note = f"no program for {tools}: the program cuts nothing after changing to it"
+            program = dataclasses.replace(program, warnings=(*program.warnings, note))
         pieces = per_tool(program, target, output.fmt)  # one program per tool
         return PostJob(None, program, target, pieces[0].result, None, 0.0, pieces=pieces)
     program = loaded_by_hand(program, target)

@@ -313,3 +313,24 @@ def test_a_pcb2gcode_drill_file_per_tool_is_verified_as_written(tmp_path: Path) 
     code = main(["post", str(source), "-t", "flashcut", "-o", str(out), "--verify"])
     assert code == 0
     assert (tmp_path / "drill.T1.nc").is_file() and (tmp_path / "drill.T2.nc").is_file()
+
+
+def test_a_change_after_which_nothing_is_cut_gets_no_program(tmp_path: Path) -> None:
+    """T2 loaded at the end, and T3 changed again at once to T4: no program for either
+    (one was written with nothing in it); the rapid before the first change stays the
+    first program's, and every cut is in the program of the tool that makes it."""
+    text = (
+        "G21 G90\nG0 Z5\nT1 M6\nG0 X1 Y1\nG1 Z-1 F100\nG1 X5\nG0 Z5\n"
+        "T3 M6\nM3\nT4 M6\nM3\nG0 X2 Y2\nG1 Z-1\nG1 X3\nG0 Z5\nT2 M6\nM2\n"
+    )
+    source = tmp_path / "idle.ngc"
+    source.write_text(text)
+    program = read_gcode(source)
+    done = post_program(program, load_target("flashcut"))
+    assert [p.change.tool for p in done.pieces] == [1, 4]
+    first, second = (p.program for p in done.pieces)
+    assert (first.moves[0].x, first.moves[0].y, first.moves[0].z) == (0.0, 0.0, 5.0)
+    assert [(m.x, m.y) for m in first.moves if m.z == -1.0] == [(1.0, 1.0)]
+    assert [(m.x, m.y) for m in second.moves if m.z == -1.0] == [(2.0, 2.0)]
+    assert len(first.moves) + len(second.moves) == len(program.moves)
+    assert any("no program for T3, T2: the program cuts nothing after" in w for w in done.warnings)
