@@ -36,7 +36,7 @@ from camtool.cli.common import (
 from camtool.cli.job import job
 from camtool.cli.preview import preview
 from camtool.cli.send import send, simulate_device
-from camtool.model.errors import CamtoolError, UsageError, VerifyLimitError
+from camtool.model.errors import CamtoolError, InputError, UsageError, VerifyLimitError
 from camtool.model.version import __version__
 
 if TYPE_CHECKING:
@@ -495,7 +495,7 @@ def inspect(drawing: str, as_json: bool, chain_tolerance: float, **options: Any)
 
     settings = import_settings(options)
     if drawing != "-" and is_program_file(drawing):
-        raise UsageError(
+        raise InputError(
             f"{drawing}: a G-code program; inspect reads drawings. Read a program back with "
             f"`camtool verify {drawing} -t TARGET`, or draw it with `camtool preview {drawing}`"
         )

@@ -336,7 +336,7 @@ def test_inspect_of_a_program_says_which_command_reads_it(
     program = tmp_path / "part.nc"
     program.write_text("G21 G90\nG0 Z5\nG0 X1 Y1\nG1 Z-1 F100\nG1 X5\nG0 Z5\nM2\n")
     code, out, err = run(["inspect", str(program)], capsys)
-    assert code == 2 and out == ""
+    assert code == 3 and out == ""  # not a drawing: invalid input, as another file type is
     assert f"{program}: a G-code program; inspect reads drawings" in err
     assert f"camtool verify {program} -t TARGET" in err and "Traceback" not in err
 
