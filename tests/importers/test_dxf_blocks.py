@@ -276,9 +276,9 @@ def test_arcs_of_a_block_at_45_degrees_in_a_non_uniformly_scaled_block(
     """A block rotated by 45° (or 135°) inside one scaled (1, -2): arcs become ellipses.
 
     Under S(1, -2)·R(45°) the block's x and y axes are both √2.5 long but no longer
-    perpendicular; ezdxf (1.4) judges such a map by the axes' lengths alone and kept the
-    circle, the arc and the polyline's bulge circular (the circle came out a 4.74 mm
-    radius circle where the placed curve is an ellipse of semi-axes 3 and 6 mm). Expected
+    perpendicular; ezdxf (1.4) judges such a map by the axes' lengths alone and would keep
+    the circle, the arc and the polyline's bulge circular (the circle a 4.74 mm radius
+    circle, where the placed curve is an ellipse of semi-axes 3 and 6 mm). Expected
     points: the drawn curves placed by p' = T + R·S·p, inner then outer (analysis).
     """
     inner = _placer((3.0, 3.0), angle, 1.5, 1.5)

@@ -3,8 +3,8 @@
 Small DXF writers (the gear template generator behind many woodworkers' gear drawings,
 JavaScript and Python DXF writers) write only an ENTITIES section, and their LWPOLYLINEs
 as flat lists of group codes with no ``100 AcDbEntity`` / ``100 AcDbPolyline``
-markers. LibreCAD reads them; ezdxf refuses them in normal and in recover mode, and so
-did camtool ("not a readable DXF file"). The drawings here are ezdxf's own files with
+markers. LibreCAD reads them; ezdxf refuses them in normal and in recover mode, so
+camtool puts the markers in first. The drawings here are ezdxf's own files with
 the markers (and the header) taken out, so the expected geometry is ezdxf's evaluation
 of the intact file, not camtool's.
 """

@@ -285,8 +285,8 @@ def test_a_pocket_narrower_than_the_end_mill_gets_one_that_fits(tmp_path: Path) 
     """A 2 mm wide pocket under the default 3 mm end mill.
 
     Its width (largest inscribed circle) is 2 mm; the largest common end mill within 95 %
-    of it (1.9 mm) is 1.5 mm (analysis). With the 3 mm one ``post`` refused the job ("every
-    pocket is narrower than the 3 mm tool"); with 1.5 mm the pocket is cleared, the tool's
+    of it (1.9 mm) is 1.5 mm (analysis). ``post`` clears nothing narrower than its tool
+    ("every pocket is narrower than the 3 mm tool"); with 1.5 mm the pocket is cleared, the tool's
     centre on the slot's centre line (y = 11, within 1 mm of either side less 0.75 mm).
     """
 

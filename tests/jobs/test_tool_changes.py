@@ -247,7 +247,7 @@ def test_a_pcb2gcode_drill_file_is_one_program_per_drill_for_a_machine_without_a
     tmp_path: Path,
 ) -> None:
     """The retract before T1 is the first program's; each change's ``M0`` is its program's
-    start (flashcut has no stop, and refused the file); every move is kept, in order."""
+    start (flashcut has no stop to write for it); every move is kept, in order."""
     source = tmp_path / "drill.ngc"
     source.write_text(PCB2GCODE_DRILL)
     program = read_gcode(source)
@@ -279,7 +279,7 @@ def test_a_pcb2gcode_program_of_one_tool_is_that_tools_program(tmp_path: Path) -
     """pcb2gcode's isolation and outline files: one change (``M6`` ``M0``) after a retract.
 
     For flashcut (no changer, no stop) the program is written without the change and its
-    stop, saying which tool to load; every move kept. It was refused.
+    stop, saying which tool to load; every move kept.
     """
     one = PCB2GCODE_DRILL[
         : PCB2GCODE_DRILL.index("G00 Z10.00000 (Retract to tool change height)\nT2")
@@ -317,7 +317,7 @@ def test_a_pcb2gcode_drill_file_per_tool_is_verified_as_written(tmp_path: Path) 
 
 def test_a_change_after_which_nothing_is_cut_gets_no_program(tmp_path: Path) -> None:
     """T2 loaded at the end, and T3 changed again at once to T4: no program for either
-    (one was written with nothing in it); the rapid before the first change stays the
+    (it would hold nothing); the rapid before the first change stays the
     first program's, and every cut is in the program of the tool that makes it."""
     text = (
         "G21 G90\nG0 Z5\nT1 M6\nG0 X1 Y1\nG1 Z-1 F100\nG1 X5\nG0 Z5\n"
