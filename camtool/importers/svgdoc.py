@@ -31,7 +31,7 @@ from camtool.importers.svgmasks import (
     masks_as_clips,
     symbols_as_viewports,
 )
-from camtool.importers.svgpage import Affine, page_matrix
+from camtool.importers.svgpage import Affine, illustrator_version, page_matrix
 from camtool.importers.svgtree import (
     INKSCAPE_NS,
     LAYER_ATTR,
@@ -571,8 +571,10 @@ def prepare(
             elements.
     """
     root = _parse(path)
+    with path.open("rb") as file:
+        illustrator = illustrator_version(file.read(4096))
     warnings: list[str] = []
-    matrix, viewport, page = page_matrix(root, str(path), warnings, units)
+    matrix, viewport, page = page_matrix(root, str(path), warnings, units, illustrator)
     parents = {child: parent for parent in root.iter() for child in parent}
     warnings += apply_style_sheets(root, parents, str(path))
     normalize_styles(root)

@@ -42,7 +42,11 @@ _PAGE_UNITS_MM = {**{u: LENGTH_UNITS[u] for u in ("mm", "cm", "in", "pt", "px")}
 
 
 def page_matrix(
-    root: ET.Element, name: str, warnings: list[str], units: str | None = None
+    root: ET.Element,
+    name: str,
+    warnings: list[str],
+    units: str | None = None,
+    illustrator: str | None = None,
 ) -> tuple[Affine, tuple[float, float], tuple[float, float] | None]:
     """Map from user units to mm, Y up; the viewport size in user units; the page in mm.
 
@@ -53,7 +57,8 @@ def page_matrix(
     ``root``. Without an absolute ``width`` and ``height`` (missing, or in %) the user unit
     is ``units`` (``--units``), else the px (1/96 in) with a warning; with a viewBox, one
     missing side is taken from the viewBox's aspect ratio. Without a page height the Y
-    flip is about the user-unit origin.
+    flip is about the user-unit origin. ``illustrator``: the version of Adobe Illustrator
+    that wrote the file (:func:`illustrator_version`), whose px are points.
 
     Raises:
         InputError: a malformed size or viewBox, or a size in a unit with no physical length.
@@ -70,6 +75,15 @@ def page_matrix(
             "part drawn there to size comes out 6.25 % small: give --scale 1.066667 (96/90) "
             "to cut it at the size Inkscape showed"
         )
+    in_points = units is None and _illustrator_px(root, illustrator, box is not None)
+    if in_points:
+        remedy = "--scale 1.333333 (96/72)" if width or height else "--units pt"
+        warnings.append(
+            f"{name}: made by Adobe Illustrator {illustrator}, which writes its points (1/72 "
+            "in) as px; they are read as px of 96 to the inch (CSS, as browsers and Inkscape "
+            f"read them), so a part drawn there to size comes out 25 % small: give {remedy} "
+            "to cut it at the size Illustrator showed"
+        )
     if box is not None and width is not None and height is None:
         height = width * box[3] / box[2]
     elif box is not None and height is not None and width is None:
@@ -78,10 +92,10 @@ def page_matrix(
     if width is None and height is None:
         relative = [t for t in (width_text, height_text) if t]
         what = f"relative size {' x '.join(relative)}" if relative else "no width/height"
-        if units is None:
-            warnings.append(f"{name}: {what}; user units taken as px (1/96 in)")
-        else:
+        if units is not None:
             unit = LENGTH_UNITS[units]
+        elif not in_points:
+            warnings.append(f"{name}: {what}; user units taken as px (1/96 in)")
     elif units is not None:
         given = " x ".join(str(root.get(a)) for a in ("width", "height") if root.get(a))
         raise UsageError(
@@ -130,12 +144,44 @@ def legacy_inkscape(root: ET.Element, has_viewbox: bool) -> str | None:
     match = re.match(r"\s*(\d+)\.(\d+)", root.get(INKSCAPE_VERSION, ""))
     if match is None or (int(match[1]), int(match[2])) >= (0, 92):
         return None
+    if _user_units_in_px(root, has_viewbox):
+        return root.get(INKSCAPE_VERSION, "").split()[0]
+    return None
+
+
+_ILLUSTRATOR = re.compile(rb"<!--\s*Generator:\s*Adobe Illustrator\s+(\d+(?:\.\d+)*)")
+"""The comment Adobe Illustrator's SVG export writes before the root element."""
+
+
+def illustrator_version(head: bytes) -> str | None:
+    """The version of Adobe Illustrator named in ``head``, a file's first bytes; else ``None``."""
+    match = _ILLUSTRATOR.search(head)
+    return None if match is None else match[1].decode("ascii")
+
+
+def _illustrator_px(root: ET.Element, version: str | None, has_viewbox: bool) -> bool:
+    """Whether the user units of a file Illustrator ``version`` wrote are its points.
+
+    Illustrator writes a point of its document as one px (``width="283.46px"`` for 100 mm)
+    and its newer exports give no size at all. A file Inkscape saved again
+    (``inkscape:version``) follows Inkscape's px; a page in absolute units with a viewBox
+    fixes the user unit whoever wrote it.
+    """
+    if version is None or root.get(INKSCAPE_VERSION) is not None:
+        return False
+    return _user_units_in_px(root, has_viewbox)
+
+
+def _user_units_in_px(root: ET.Element, has_viewbox: bool) -> bool:
+    """Whether the page leaves the user unit to the px.
+
+    So it does with a size in px, without a unit or missing, or an absolute size without a
+    viewBox.
+    """
     units = [_unit(root.get(a)) for a in ("width", "height")]
     in_px = units == [None, None] or any(u in ("", "px") for u in units)
     absolute = any(u in ("mm", "cm", "in", "pt", "pc") for u in units)
-    if in_px or (absolute and not has_viewbox):
-        return root.get(INKSCAPE_VERSION, "").split()[0]
-    return None
+    return in_px or (absolute and not has_viewbox)
 
 
 def _unit(text: str | None) -> str | None:
