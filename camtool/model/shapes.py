@@ -23,6 +23,9 @@ TAU = 2.0 * math.pi
 FULL_CIRCLE_EPS = 1e-12
 """An arc is a full circle when its ends are within this times ``max(1, radius)`` mm
 (:attr:`Arc.is_full_circle`; the word-address writer and the ordering test it inline)."""
+SPIRAL_EPS = 1e-9
+"""An arc's ends at radii this times ``max(1, radius)`` mm apart are on one circle
+(:attr:`Arc.spiral`): rounding, not a spiral."""
 
 _T = TypeVar("_T")
 
@@ -227,10 +230,22 @@ class Arc:
         """
         return _shared_signs((arc_axis_signs(self, 0.0), arc_axis_signs(self, math.pi / 2)))
 
+    @cached_property
+    def spiral(self) -> float:
+        """End radius less start radius, mm; 0.0 when they agree within :data:`SPIRAL_EPS`.
+
+        A program read from code may give an arc whose end is off its circle by as much
+        as the reader's tolerance; LinuxCNC cuts it as a spiral whose radius changes
+        linearly with the angle (``pmCirclePoint``), and so do :meth:`point_at` and
+        :meth:`points`, which meet the end exactly.
+        """
+        difference = distance(self.centre, self.end) - self.radius
+        return difference if abs(difference) > SPIRAL_EPS * max(1.0, self.radius) else 0.0
+
     def point_at(self, fraction: float) -> Point:
-        """The point a ``fraction`` (0…1) of the way along the arc."""
+        """The point a ``fraction`` (0…1) of the way along the arc (or its :attr:`spiral`)."""
         a = self.start_angle + self.sweep * fraction
-        r = self.radius
+        r = self.radius + self.spiral * fraction
         return (self.centre[0] + r * math.cos(a), self.centre[1] + r * math.sin(a))
 
     def reversed(self) -> Arc:
@@ -260,14 +275,22 @@ class Arc:
         return (min(xs), min(ys), max(xs), max(ys))
 
     def points(self, tolerance: float) -> list[Point]:
-        """Polyline through the arc whose chords deviate by at most ``tolerance`` mm."""
-        n = chord_count(self.radius, abs(self.sweep), tolerance)
+        """Polyline through the arc (or its :attr:`spiral`), each chord within ``tolerance`` mm."""
+        spiral = self.spiral
+        n = chord_count(self.radius + max(spiral, 0.0), abs(self.sweep), tolerance)
         a0, sweep, r = self.start_angle, self.sweep, self.radius
         cx, cy = self.centre
-        inner = [a0 + sweep * (k / n) for k in range(1, n)]  # as point_at(k / n), bit for bit
+        if spiral:
+            inner = [(a0 + sweep * (k / n), r + spiral * (k / n)) for k in range(1, n)]
+            return [
+                self.start,
+                *((cx + rk * math.cos(a), cy + rk * math.sin(a)) for a, rk in inner),
+                self.end,
+            ]
+        angles = [a0 + sweep * (k / n) for k in range(1, n)]  # as point_at(k / n), bit for bit
         return [
             self.start,
-            *((cx + r * math.cos(a), cy + r * math.sin(a)) for a in inner),
+            *((cx + r * math.cos(a), cy + r * math.sin(a)) for a in angles),
             self.end,
         ]
 

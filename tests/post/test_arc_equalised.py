@@ -19,6 +19,7 @@ import re
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -103,10 +104,66 @@ def test_radii_further_apart_than_the_controller_takes_are_written_as_chords() -
     # each chord end on the arc, to 3 decimals; each chord within 2 µm of the arc
     for p in points:
         assert min(r0, r1) - 0.0008 <= math.dist(p, centre) <= max(r0, r1) + 0.0008
+    # ... of the arc as LinuxCNC cuts it: a spiral, its radius linear in the angle
+    assert _off_spiral(points, START, END, centre, clockwise=False) < 0.0008
     for a, b in itertools.pairwise(points):
         middle = ((a[0] + b[0]) / 2, (a[1] + b[1]) / 2)
         assert math.dist(middle, centre) >= min(r0, r1) - 0.002 - 0.0008
     assert any("written as" in w and "chord(s) within 0.002 mm" in w for w in result.warnings)
+
+
+def _off_spiral(
+    points: list[tuple[float, float]],
+    start: tuple[float, float],
+    end: tuple[float, float],
+    centre: tuple[float, float],
+    clockwise: bool,
+) -> float:
+    """Largest distance, mm, of ``points`` from the spiral LinuxCNC cuts for the arc.
+
+    Its radius changes linearly with the angle from the start's to the end's
+    (posemath ``pmCirclePoint``); the angle of each point is its own.
+    """
+    (cx, cy), sign = centre, -1.0 if clockwise else 1.0
+    a0 = math.atan2(start[1] - cy, start[0] - cx)
+    sweep = (sign * (math.atan2(end[1] - cy, end[0] - cx) - a0)) % math.tau
+    r0, r1 = math.dist(start, centre), math.dist(end, centre)
+    worst = 0.0
+    for x, y in points:
+        turned = (sign * (math.atan2(y - cy, x - cx) - a0)) % math.tau
+        radius = r0 + (r1 - r0) * turned / sweep
+        worst = max(worst, abs(math.dist((x, y), centre) - radius))
+    return worst
+
+
+def test_an_inch_spiral_reposted_for_grbl_follows_the_spiral(tmp_path: Path, run: Any) -> None:
+    """LinuxCNC's own test program ``arc-with-spiral.ngc`` (tests/trajectory-planner).
+
+    Its G2's ends lie 0.0005 in (12.7 µm) apart in radius about a 1.8 mm radius: LinuxCNC
+    takes it (its inch tolerance) and cuts a spiral; GRBL's check refuses it (over 5 µm
+    and over 0.1 %), so the GRBL program has chords. They follow LinuxCNC's spiral to
+    the 3 decimals written; chords about the start's circle alone would leave the whole
+    12.7 µm in the last chord.
+    """
+    source = tmp_path / "arc-with-spiral.ngc"
+    source.write_text(
+        "G90 G20 G64\nF1000\nG0 X0 Y0\nZ0\nG1 X-.1\nG1 X.1\nG3 X.2 R.1\n"
+        "G2 X.3 Y-.1 I.0503535 J-.05\nG1 X.4\nM2\n"
+    )
+    out = tmp_path / "spiral.nc"
+    code, err = run("post", str(source), "-t", "grbl", "-o", str(out))
+    assert code == 0 and "chord(s) within 0.002 mm" in err
+    lines = out.read_text().splitlines()
+    first = next(k for k, line in enumerate(lines) if line.startswith("G3 X5.080 Y0.000"))
+    points = [(5.08, 0.0)]
+    for line in lines[first + 1 :]:
+        words = dict(re.findall(r"([XY])(-?[\d.]+)", line))
+        points.append((float(words["X"]), float(words["Y"])))
+        if points[-1] == (7.62, -2.54):
+            break
+    centre = ((0.2 + 0.0503535) * 25.4, -0.05 * 25.4)
+    assert len(points) > 10 and points[-1] == (7.62, -2.54)
+    assert _off_spiral(points[1:-1], (5.08, 0.0), (7.62, -2.54), centre, True) < 0.0008
 
 
 @pytest.mark.parametrize("name", ["grbl", "linuxcnc"])
