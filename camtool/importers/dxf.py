@@ -19,12 +19,14 @@ from camtool.accel.collector import paused
 from camtool.geometry.arcfit import FIT_KERNELS
 from camtool.importers.dxf_damage import implied_degree, refuse_guessed_numbers
 from camtool.importers.dxf_entities import (
+    THREE_D,
     ZERO_LENGTH,
     BadEntity,
     check_numbers,
     invisible,
     layer_of,
     line_inside,
+    not_flat,
 )
 from camtool.importers.dxf_layers import LayerFilter, hidden_warnings, layer_filter
 from camtool.importers.dxf_prefit import MIN_SPLINES, fit_ahead, fitted_ahead
@@ -51,7 +53,6 @@ _INSUNITS_MM: dict[int, tuple[str, float]] = {
 }
 
 _TEXT = "text is not cut; explode it to curves in the CAD program"
-_THREE_D = "3D entity; camtool cuts 2D contours"
 _SKIP_REASONS: dict[str, str] = {
     **dict.fromkeys(("XLINE", "RAY"), "an infinite construction line, not a contour"),
     **dict.fromkeys(("TEXT", "MTEXT", "ATTRIB", "ATTDEF", "RTEXT"), _TEXT),
@@ -78,7 +79,7 @@ _SKIP_REASONS: dict[str, str] = {
     "POINT": "a point has no path to cut; a drill operation of a job drills it",
     **dict.fromkeys(
         ("3DFACE", "3DSOLID", "MESH", "BODY", "REGION", "SURFACE", "POLYFACE", "POLYMESH"),
-        _THREE_D,
+        THREE_D,
     ),
     **dict.fromkeys(("SOLID", "TRACE"), "filled area; draw its outline to cut it"),
     "HATCH": "a fill; use --hatch-boundaries to cut its boundary paths",
@@ -421,6 +422,9 @@ class _Reader:
             check_numbers(entity, f"LINE #{dxf.handle}", layer, self.limit)  # raises
         start, end = (s.x, s.y), (e.x, e.y)
         label = f"LINE #{dxf.handle}"
+        if s.z != e.z and not_flat((s.z, e.z)):
+            self._skip("LINE", THREE_D, label, layer, start)
+            return
         if math.hypot(end[0] - start[0], end[1] - start[1]) <= ZERO_LENGTH:
             self._skip("LINE", "zero length", label, layer, start)
             return

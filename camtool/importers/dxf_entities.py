@@ -62,6 +62,8 @@ _WCS_PATHS = frozenset({"LINE", "SPLINE", "POINT"})
 """Entities whose path is in world coordinates: their extrusion (a SPLINE's normal, a
 LINE's thickness direction) does not place them, so a null one is no damage. AutoCAD 2007
 writes SPLINEs with the normal (0, 0, 0) (bjnortier/dxf's splines.dxf)."""
+THREE_D = "3D entity; camtool cuts 2D contours"
+"""Why an entity whose points are not at one Z is skipped."""
 _MAX_RATIO = 1.0 + 1e-9  # ELLIPSE minor/major axis ratio, (0, 1] in the DXF reference
 
 
@@ -398,8 +400,18 @@ def _piece(entity: Any, tolerance: float) -> list[Segment]:
         return []
 
 
+def not_flat(zs: Sequence[float]) -> bool:
+    """Whether Z values (drawing units) of one entity's points differ: a 3D entity.
+
+    Differences within 10⁻⁹ of the largest magnitude (at least 1) are rounding.
+    """
+    return bool(zs) and max(zs) - min(zs) > 1e-9 * max(1.0, *(abs(z) for z in zs))
+
+
 def _check_flat(entity: Any) -> None:
     if entity.dxftype() == "LINE":
+        if not_flat((entity.dxf.start.z, entity.dxf.end.z)):
+            raise Unsupported(THREE_D)
         return
     ex, ey, _ = entity.dxf.get("extrusion", (0.0, 0.0, 1.0))
     if abs(ex) > 1e-9 or abs(ey) > 1e-9:
@@ -413,9 +425,8 @@ def _polyline2d(entity: Any) -> list[Segment]:
     """
     vertices = [v.dxf.location for v in entity.vertices if not v.dxf.flags & 16]
     if not entity.is_2d_polyline:
-        zs = [float(v[2]) for v in vertices]
-        if zs and max(zs) - min(zs) > 1e-9 * max(1.0, *(abs(z) for z in zs)):
-            raise Unsupported("3D entity; camtool cuts 2D contours")
+        if not_flat([float(v[2]) for v in vertices]):
+            raise Unsupported(THREE_D)
         segs: list[Segment] = [Line(_xy(a), _xy(b)) for a, b in itertools.pairwise(vertices)]
         if entity.is_closed and len(vertices) > 2:
             segs.append(Line(_xy(vertices[-1]), _xy(vertices[0])))

@@ -20,6 +20,7 @@ from tests.shapes import write_dxf
 def _with_a_line(extra: Any) -> Any:
     def build(msp: Any) -> None:
         msp.add_line((0, 0), (10, 0))
+        msp.doc.blocks.new("B").add_line((1, 1, 2), (4, 1, 5))
         extra(msp)
 
     return build
@@ -32,7 +33,10 @@ def _add_mesh(msp: Any) -> None:
 
 
 def _warning(path: Path, build: Any, options: ImportOptions | None = None) -> str:
-    """The one skip warning a drawing of a line plus ``build``'s entities gives."""
+    """The one skip warning a drawing of a line plus ``build``'s entities gives.
+
+    The drawing has a block ``B`` holding one 3D line, for ``build`` to place or not.
+    """
     d = read_dxf(write_dxf(path, _with_a_line(build)), options)
     assert len(d.contours) == 1, d.contours
     (skip,) = [w for w in d.warnings if "skipped" in w]
@@ -81,6 +85,14 @@ def _warning(path: Path, build: Any, options: ImportOptions | None = None) -> st
             lambda m: m.add_line((5, 5), (5, 5)),
             "skipped 1 LINE entity (zero length)",
         ),
+        (  # a 3D line, as the 3D POLYLINE: its projection is not a contour of the part
+            lambda m: m.add_line((5, 5, 0), (20, 5, 10)),
+            "skipped 1 LINE entity (3D entity; camtool cuts 2D contours)",
+        ),
+        (
+            lambda m: m.add_blockref("B", (0, 0)),
+            "skipped 1 LINE entity (3D entity; camtool cuts 2D contours)",
+        ),
     ],
     ids=[
         "text",
@@ -94,6 +106,8 @@ def _warning(path: Path, build: Any, options: ImportOptions | None = None) -> st
         "solid",
         "tilted",
         "zero",
+        "3dline",
+        "3dline-in-block",
     ],
 )
 def test_unsupported_entities_are_skipped_with_one_warning_per_type(
