@@ -29,6 +29,10 @@ NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
 """A number as point lists write it: ``12``, ``-1.5``, ``.5``, ``3.``, ``1e-3``."""
 _FIELD = re.compile(r"[^,;\s]+")
 """A field: what lies between separators (comma, semicolon, tab, spaces)."""
+_DECIMAL_COMMA = re.compile(r"[+-]?[\d.]*\d,\d[\d.]*")
+"""A comma between two digits: a decimal comma when the row separates its columns otherwise."""
+_OTHER_SEPARATOR = re.compile(r";|\t|[\d.]\s+[+\-.\d]")
+"""A semicolon, a tab or blanks between two numbers: the separators of a decimal-comma row."""
 _NAN = "nan"
 """A field that breaks a stroke (any case: ``NaN``, ``nan``), as Matlab writes it."""
 _IGNORED_MATLAB = ("lxy", "velxy")
@@ -174,6 +178,14 @@ def _text_strokes(text: str, path: Path, warnings: list[str], scale: float) -> l
     for number, raw in enumerate(text.splitlines(), start=1):
         if raw.strip().startswith("#"):
             continue
+        comma = _DECIMAL_COMMA.search(raw)
+        if comma is not None and _OTHER_SEPARATOR.search(raw):
+            raise _Where(path, number, scale).fail(
+                comma.start() + 1,
+                f"{_quote(comma[0])} has a decimal comma (the row separates its columns by "
+                "semicolons, tabs or blanks); camtool reads decimal points: save the file "
+                "with '.' decimals (a spreadsheet's export in an English locale)",
+            )
         fields = [(m[0], m.start() + 1) for m in _FIELD.finditer(raw)]
         values = _row(fields, _Where(path, number, scale), header_allowed=not seen_data)
         if values is None:  # the header

@@ -70,7 +70,7 @@ def test_star_reads_through_read_drawing() -> None:
 
 @pytest.mark.parametrize(
     "row",
-    ["1,2", "1;2", "1\t2", "1 2", "  1 ,  2  ", "1, 2", "1;  2"],
+    ["1,2", "1;2", "1\t2", "1 2", "  1 ,  2  ", "1, 2", "1;  2", "1.0, 2.0", "1.0 , 2"],
 )
 def test_separators(tmp_path: Path, row: str) -> None:
     text = f"{row}\n{row.replace('1', '4').replace('2', '6')}\n"
@@ -164,7 +164,12 @@ def test_single_point_stroke_is_skipped_with_a_warning(tmp_path: Path) -> None:
         ("0,0\n1e308,0\n", "line 2, column 1: '1e308' is out of range (at most 1e+09 mm)"),
         ("0,0\n1,1e400\n", "line 2, column 3: '1e400' is out of range"),
         ("0,0\n1,-1000000000\n", "line 2, column 3: '-1000000000' is out of range"),
-        ("15,1;8,6\n", "line 1: 4 numbers"),
+        # decimal commas, as a spreadsheet in a German or French locale exports: refused
+        ("15,1;8,6\n", "line 1, column 1: '15,1' has a decimal comma"),
+        # one decimal comma a row would read as X,Y,Z = (0, 5, 0): a 10 x 0 mm "part"
+        ("x;y\n0,5;0\n10,5;0\n10,5;20\n", "line 2, column 1: '0,5' has a decimal comma"),
+        ("0\t0\n10\t-2,5\n", "line 2, column 4: '-2,5' has a decimal comma"),
+        ("0 0\n10,25 5\n", "line 2, column 1: '10,25' has a decimal comma"),
         ("x,y\n\n", "no stroke of two or more points"),
         ("", "no stroke of two or more points"),
         ("3,3\n", "no stroke of two or more points"),
