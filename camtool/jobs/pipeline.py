@@ -391,6 +391,17 @@ def post_program(
         program = dataclasses.replace(
             program, commands=tuple(own_stops_dropped(program.commands)[0])
         )
+    elif target.post.tool_changes == "code" and not target.post.stops:
+        kept, stopped = own_stops_dropped(program.commands)
+        if stopped:  # the machine changes the tool itself: nothing to pause for
+            note = (
+                f"{len(stopped)} stop(s) right after a tool change (M6 then M0: a pause to "
+                f"change the tool by hand) not written: {target.name} changes tools itself "
+                "and has no stop"
+            )
+            program = dataclasses.replace(
+                program, commands=tuple(kept), warnings=(*program.warnings, note)
+            )
     return PostJob(None, program, target, target.emit(program, fmt=output.fmt), None, 0.0)
 
 

@@ -410,6 +410,16 @@ class PostProcessor(ABC):
         return "none"
 
     @property
+    def stops(self) -> bool:
+        """True when the dialect writes a program stop (``M0``; ``M1`` too if it has one).
+
+        A dialect without one refuses a stop (:meth:`WriterState.drop`), save the
+        stop right after a tool change, which a dialect changing tools by code needs not
+        (:func:`camtool.jobs.pipeline.post_program`).
+        """
+        return False
+
+    @property
     def length_offsets(self) -> bool:
         """True when the dialect applies the tool table's length offset after each tool change.
 

@@ -86,6 +86,11 @@ class WordAddressPost(PostProcessor):
         return "stop" if self.spec.stop and self.spec.comment else "none"
 
     @property
+    def stops(self) -> bool:
+        """True when the spec has a ``stop`` code."""
+        return bool(self.spec.stop)
+
+    @property
     def length_offsets(self) -> bool:
         """True with a ``tool_length_offset`` code (LinuxCNC's ``G43 H<n>`` after each change)."""
         return bool(self.spec.tool_length_offset)

@@ -304,6 +304,28 @@ def test_a_pcb2gcode_change_and_its_own_stop_pause_grbl_once(tmp_path: Path) -> 
     assert [lines[i - 1] for i in stops] == ["(change to T1)", "(change to T2)"]
 
 
+def test_pic_mmh_changes_pcb2gcodes_tools_itself_without_their_stops(tmp_path: Path) -> None:
+    """pic-mmh changes tools by code (``M06T##;``) and has no stop: a change's own ``M0``
+    (pcb2gcode's pause to change the bit by hand) is not written, said once; a stop of
+    the program's own between two holes is still refused."""
+    source = tmp_path / "drill.ngc"
+    source.write_text(PCB2GCODE_DRILL.replace("S10000", "S9000"))  # pic-mmh's 4 digits
+    done = post_program(read_gcode(source), load_target("pic-mmh"))
+    code = str(done.result.code).splitlines()
+    assert [b for b in code if b.startswith("M06")] == ["M06T01;", "M06T02;"]
+    assert not any(b.startswith(("M00", "M01")) for b in code)
+    assert [w for w in done.warnings if "stop(s) right after a tool change" in w] == [
+        "2 stop(s) right after a tool change (M6 then M0: a pause to change the tool by hand) "
+        "not written: pic-mmh changes tools itself and has no stop"
+    ]
+    between = PCB2GCODE_DRILL.replace("S10000", "S9000").replace(
+        "G00 X4.00000 Y2.00000", "M0\nG00 X4.00000 Y2.00000"
+    )
+    source.write_text(between)
+    with pytest.raises(DialectError, match="no program stop"):
+        post_program(read_gcode(source), load_target("pic-mmh"))
+
+
 def test_a_pcb2gcode_drill_file_per_tool_is_verified_as_written(tmp_path: Path) -> None:
     """``--verify`` reads the programs per tool back one after the other: the changes'
     own stops are left out there too (it stopped at the first, which flashcut cannot write)."""
