@@ -33,6 +33,18 @@ _DECIMAL_COMMA = re.compile(r"[+-]?[\d.]*\d,\d[\d.]*")
 """A comma between two digits: a decimal comma when the row separates its columns otherwise."""
 _OTHER_SEPARATOR = re.compile(r";|\t|[\d.]\s+[+\-.\d]")
 """A semicolon, a tab or blanks between two numbers: the separators of a decimal-comma row."""
+_HEADER_UNITS = {
+    "mm": "mm", "millimeter": "mm", "millimeters": "mm", "millimetre": "mm",
+    "millimetres": "mm", "cm": "cm", "m": "m", "meters": "m", "metres": "m", "in": "in",
+    "inch": "in", "inches": "in", "ft": "ft", "feet": "ft", "um": "um", "µm": "um",
+    "microns": "um",
+}  # fmt: skip
+"""Unit words a header may give, by the name ``--units`` takes for them."""
+_HEADER_UNIT = re.compile(
+    r"[\[(]\s*([a-zµ]+)\s*[\])]|_([a-zµ]+)\b|\b(inch(?:es)?|mil+imet(?:er|re)s?)\b",
+    re.IGNORECASE,
+)
+"""A unit in a header: ``X (in)``, ``x[mm]``, ``x_in``, or a spelt-out inch or millimetre."""
 _NAN = "nan"
 """A field that breaks a stroke (any case: ``NaN``, ``nan``), as Matlab writes it."""
 _IGNORED_MATLAB = ("lxy", "velxy")
@@ -73,7 +85,7 @@ def read_points(path: str | Path, options: ImportOptions | None = None) -> Drawi
         strokes = _matlab_strokes(text, path, scale)
     else:
         try:
-            strokes = _text_strokes(text, path, warnings, scale)
+            strokes = _text_strokes(text, path, warnings, scale, options.units)
         except InputError as exc:
             raise _program_error(text, path) or exc from exc
     contours: list[Contour] = []
@@ -168,7 +180,46 @@ def _program_error(text: str, path: Path) -> InputError | None:
     return None
 
 
-def _text_strokes(text: str, path: Path, warnings: list[str], scale: float) -> list[_Stroke]:
+def _header_units(header: str) -> set[str]:
+    """The units (names ``--units`` takes) a header row names, e.g. ``{"in"}`` for ``X (in)``."""
+    found = set()
+    for match in _HEADER_UNIT.finditer(header):
+        word = next(w for w in match.groups() if w).lower()
+        word = "millimeters" if word.startswith("mil") else word
+        if word in _HEADER_UNITS:
+            found.add(_HEADER_UNITS[word])
+    return found
+
+
+def _check_header(header: str, where: str, given: str | None, warnings: list[str]) -> None:
+    """Refuse a header naming a unit other than the one read (``given``: ``--units``).
+
+    Raises:
+        InputError: the header names a unit other than mm and ``--units`` is not given,
+            or names two units (the columns are read in one).
+    """
+    units = _header_units(header)
+    where = f"{where}: the header {header.strip()!r}"
+    if len(units) > 1:
+        raise InputError(
+            f"{where} names the units {' and '.join(sorted(units))}; camtool reads every "
+            "column in one unit: convert the file to one, and give it with --units"
+        )
+    if not units or units == {given or DEFAULT_UNITS}:
+        return
+    (unit,) = units
+    if given is None:
+        raise InputError(
+            f"{where} gives the unit {unit}, and camtool reads a point list in mm unless "
+            f"--units says otherwise: give --units {unit} (or --units mm if the header is wrong)"
+        )
+    warnings.append(f"{where} names {unit}; read in --units {given}, as asked")
+
+
+def _text_strokes(
+    text: str, path: Path, warnings: list[str], scale: float, given: str | None = None
+) -> list[_Stroke]:
+    """The strokes of a text point list; ``given``: ``--units`` (``None``: not given)."""
     strokes: list[_Stroke] = []
     current: list[tuple[float, float]] = []
     start = 0
@@ -190,6 +241,7 @@ def _text_strokes(text: str, path: Path, warnings: list[str], scale: float) -> l
         values = _row(fields, _Where(path, number, scale), header_allowed=not seen_data)
         if values is None:  # the header
             seen_data = True
+            _check_header(raw, f"{path}: line {number}", given, warnings)
             continue
         seen_data = seen_data or bool(fields)
         if not values or all(math.isnan(v) for v in values):

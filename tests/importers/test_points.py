@@ -13,6 +13,7 @@ from camtool.importers.options import ImportOptions
 from camtool.importers.points import read_points
 from camtool.model.errors import InputError, UsageError
 from camtool.model.shapes import Contour, Line
+from camtool.model.units import LENGTH_UNITS
 
 ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT / "tests" / "data"
@@ -181,6 +182,37 @@ def test_bad_rows_name_file_and_line(tmp_path: Path, text: str, message: str) ->
         read_points(path)
     assert str(err.value).startswith(f"{path}: ")
     assert message in str(err.value)
+
+
+@pytest.mark.parametrize(
+    ("header", "unit"),
+    [("X (in),Y (in)", "in"), ("x[cm];y[cm]", "cm"), ("x_in,y_in", "in"), ("X inches,Y", "in")],
+)
+def test_a_header_naming_a_unit_other_than_mm_needs_units(
+    tmp_path: Path, header: str, unit: str
+) -> None:
+    """A header that says inches, read in mm, would cut the part 25.4 times too small."""
+    path = write(tmp_path, "h.csv", f"{header}\n0,0\n10,0\n10,10\n")
+    with pytest.raises(
+        InputError, match=f"line 1: the header .* gives the unit {unit}.* give --units {unit}"
+    ):
+        read_points(path)
+    drawing = read_points(path, ImportOptions(units=unit))
+    assert vertices(drawing.contours[0])[1] == (10 * LENGTH_UNITS[unit], 0.0)
+    said = read_points(path, ImportOptions(units="mm")).warnings  # the user's word stands
+    assert [w for w in said if f"names {unit}; read in --units mm, as asked" in w]
+
+
+@pytest.mark.parametrize("header", ["x,y", "X (mm),Y (mm)", "x_mm;y_mm", "name,value", "mid,end"])
+def test_a_header_in_mm_or_without_a_unit_is_read_as_before(tmp_path: Path, header: str) -> None:
+    drawing = read_points(write(tmp_path, "h.csv", f"{header}\n0,0\n10,0\n"))
+    assert vertices(drawing.contours[0]) == [(0.0, 0.0), (10.0, 0.0)] and not drawing.warnings
+
+
+def test_a_header_of_two_units_is_refused(tmp_path: Path) -> None:
+    path = write(tmp_path, "h.csv", "X (mm),Y (in)\n0,0\n10,0\n")
+    with pytest.raises(InputError, match="names the units in and mm; camtool reads every column"):
+        read_points(path)
 
 
 def test_unknown_unit_is_a_usage_error_listing_units(tmp_path: Path) -> None:
