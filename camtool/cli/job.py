@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any
 
@@ -15,6 +16,7 @@ from camtool.cli.common import (
     say_written,
     write_output,
 )
+from camtool.model.errors import UsageError
 
 
 @click.group()
@@ -29,8 +31,10 @@ def job() -> None:
     "--output",
     default="-",
     metavar="JOB.toml",
-    help="Where to write the job; '-' (default) is stdout.",
+    help="Where to write the job; '-' (default) is stdout. An existing file (a job you may "
+    "have edited) is refused without --force.",
 )
+@click.option("--force", is_flag=True, help="Replace an existing -o file.")
 @click.option(
     "--thickness",
     type=number_range(min=0, min_open=True, max=1000),
@@ -60,6 +64,7 @@ def job() -> None:
 def init(
     drawing: str,
     output: str,
+    force: bool,
     thickness: float,
     tool_diameter: float,
     target: str | None,
@@ -79,6 +84,11 @@ def init(
     check_paths(
         [("the input", drawing)], [("-o", output)], target=target, machine_file=machine_file
     )
+    if output != "-" and os.path.lexists(output) and not force:
+        raise UsageError(
+            f"-o {output} already exists: a job you may have edited by hand would be replaced; "
+            "give another -o, or --force to replace it"
+        )
     travel, no_z = None, ""
     if target is not None:
         from camtool.jobs.pipeline import load_target_checked

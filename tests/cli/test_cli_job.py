@@ -86,6 +86,18 @@ def test_job_init_then_post(run: Any, tmp_path: Path) -> None:
     assert code == 0, err
 
 
+def test_job_init_never_replaces_a_job_without_force(run: Any, tmp_path: Path) -> None:
+    """A job is edited by hand after job init writes it: running job init again on its
+    name would throw the edits away."""
+    job = tmp_path / "first.toml"
+    job.write_text("# my edits\n")
+    code, _, err = run("job", "init", PART, "-o", str(job))
+    assert code == 2 and "already exists" in err and "--force" in err
+    assert job.read_text() == "# my edits\n"
+    code, _, err = run("job", "init", PART, "-o", str(job), "--force")
+    assert code == 0 and job.read_text().startswith("# camtool job for")
+
+
 def test_batch_job_posts_each_drawing_with_the_job(run: Any, tmp_path: Path) -> None:
     code, _, err = run(
         "batch", PART, "-t", "grbl", "-o", str(tmp_path / "out"), "--job", JOB, "--jobs", "1"
