@@ -507,10 +507,13 @@ def _sample_contour(segments: tuple[Segment, ...], spacing_mm: float) -> FloatAr
         elif n < ARC_ARRAYS_FROM:
             out[at : at + n] = [seg.point_at(k / n) for k in range(n)]
         else:  # point_at's operations in arrays, its cosines and sines math's
-            angles = (seg.start_angle + seg.sweep * (np.arange(n) / n)).tolist()
+            fractions = np.arange(n) / n
+            angles = (seg.start_angle + seg.sweep * fractions).tolist()
             (cx, cy), r = seg.centre, seg.radius
-            out[at : at + n, 0] = cx + r * np.fromiter(map(math.cos, angles), np.float64, n)
-            out[at : at + n, 1] = cy + r * np.fromiter(map(math.sin, angles), np.float64, n)
+            # ends at two radii: a spiral, each point at its own radius, as point_at runs it
+            radii: float | FloatArray = r + seg.spiral * fractions if seg.spiral else r
+            out[at : at + n, 0] = cx + radii * np.fromiter(map(math.cos, angles), np.float64, n)
+            out[at : at + n, 1] = cy + radii * np.fromiter(map(math.sin, angles), np.float64, n)
         at += n
     out[at] = segments[-1].end
     if lines:

@@ -419,7 +419,8 @@ def _sampled_one_at_a_time(segments: tuple[Segment, ...], spacing_mm: float) -> 
 
 @pytest.mark.parametrize("seed", range(4))
 def test_contours_sampled_in_arrays_are_the_points_made_one_at_a_time(seed: int) -> None:
-    """Lines (long, short, of length 0, far from the origin) and arcs: the same floats."""
+    """Lines (long, short, of length 0, far from the origin) and arcs (spirals too): the
+    same floats."""
     rng = np.random.default_rng(seed)
     for _ in range(40):
         scale = float(rng.choice([1e-3, 1.0, 1e3]))
@@ -430,7 +431,8 @@ def test_contours_sampled_in_arrays_are_the_points_made_one_at_a_time(seed: int)
             if rng.random() < 0.3:
                 centre = (start[0] + float(rng.normal()) * scale, start[1] + 0.5 * scale)
                 sweep = float(rng.uniform(-6.0, 6.0))
-                r = math.dist(start, centre)
+                # a spiral now and then: its end at another radius, as code may give it
+                r = math.dist(start, centre) * (1.0 + float(rng.choice([0.0, 0.0, 1e-3])))
                 a = math.atan2(start[1] - centre[1], start[0] - centre[0]) + sweep
                 end = (centre[0] + r * math.cos(a), centre[1] + r * math.sin(a))
                 segments.append(Arc(start, end, centre, sweep < 0))
