@@ -27,6 +27,7 @@ from camtool.importers.svgdoc import (
     USE_ATTR,
     Prepared,
     prepare,
+    unseen_warnings,
     zero_opacity,
 )
 from camtool.importers.svgpage import (
@@ -35,6 +36,7 @@ from camtool.importers.svgpage import (
     check_travel,
     compose,
     contour_off_page,
+    is_background,
     off_page_text,
     refusal_note,
 )
@@ -122,7 +124,7 @@ def svg_drawing(
     svg = _parse(path, prepared)
     warnings = list(prepared.warnings)
     contours: list[Contour] = []
-    hidden = invisible = faded = bare_lines = 0
+    hidden = invisible = faded = bare_lines = background = 0
     drawn: list[tuple[Any, list[Any] | None]] = []
     shapes = list(_shapes(svg))
     progress(Step("reading", 0, len(shapes), path.name))
@@ -161,13 +163,15 @@ def svg_drawing(
     for i, (shape, segments) in enumerate(drawn, start=1):
         made = _contours(path, shape, segments, prepared.matrix, fitter)
         over = clips.get(id(shape))
-        if not over or not _hidden_by_clip(
+        if _unpainted(shape.stroke) and _white(shape.fill) and is_background(made, prepared.page):
+            background += 1  # the page's white background: a viewer shows nothing of it
+        elif not over or not _hidden_by_clip(
             path, shape, made, over, prepared.matrix, tolerance, regions
         ):
             contours.extend(made)
             kept.append(i - 1)
         progress(Step("contours", i, len(drawn)))
-    clipped_away = len(drawn) - len(kept)
+    clipped_away = len(drawn) - len(kept) - background
     if deferred and check is not None:
         left = [b for b in (boxes[k] for k in kept) if b is not None]
         if left:
@@ -190,18 +194,7 @@ def svg_drawing(
             f"{path}: skipped {clipped_away} {_elements(clipped_away)} that {its} clip-path, mask "
             f"or viewport hides wholly (a viewer shows nothing of {them})"
         )
-    if hidden:
-        warnings.append(f"{path}: skipped {hidden} {_elements(hidden)} with visibility:hidden")
-    if faded:
-        warnings.append(f"{path}: skipped {faded} {_elements(faded)} with opacity 0")
-    if invisible:
-        noun = _elements(invisible)
-        warnings.append(f"{path}: skipped {invisible} {noun} with neither fill nor stroke")
-    if bare_lines:
-        warnings.append(
-            f"{path}: skipped {bare_lines} <line> {_elements(bare_lines)} without a stroke (a "
-            "line has no inside to fill, so a viewer shows nothing); give it a stroke to cut it"
-        )
+    warnings += unseen_warnings(path, hidden, faded, invisible, bare_lines, background)
     size_note = ""
     outside = [c for c in contours if contour_off_page(c, prepared.page)]
     if outside:
@@ -312,6 +305,11 @@ def _unpainted(color: Any) -> bool:
     ``fill-opacity``/``stroke-opacity`` of 0, which svgelements folds into the colour.
     """
     return color is None or color.value is None or color.alpha == 0
+
+
+def _white(color: Any) -> bool:
+    """Whether a shape's ``fill`` (svgelements' Color) paints white."""
+    return not _unpainted(color) and (color.red, color.green, color.blue) == (255, 255, 255)
 
 
 def _elements(count: int) -> str:

@@ -706,3 +706,34 @@ def _check(element: ET.Element, kind: str, viewport: tuple[float, float]) -> Non
         svgvalues.rect_radii(element)
     if kind in ("polyline", "polygon") and element.get("points") is not None:
         svgcheck.check_points(element.get("points", ""))
+
+
+def unseen_warnings(
+    path: object, hidden: int, faded: int, invisible: int, bare: int, background: int
+) -> list[str]:
+    """What was skipped because a viewer shows nothing of it: one warning per kind."""
+
+    def elements(count: int) -> str:
+        return "element" if count == 1 else "elements"
+
+    said = []
+    if hidden:
+        said.append(f"{path}: skipped {hidden} {elements(hidden)} with visibility:hidden")
+    if faded:
+        said.append(f"{path}: skipped {faded} {elements(faded)} with opacity 0")
+    if invisible:
+        said.append(
+            f"{path}: skipped {invisible} {elements(invisible)} with neither fill nor stroke"
+        )
+    if bare:
+        said.append(
+            f"{path}: skipped {bare} <line> {elements(bare)} without a stroke (a line has no "
+            "inside to fill, so a viewer shows nothing); give it a stroke to cut it"
+        )
+    if background:
+        said.append(
+            f"{path}: skipped the page's background: a white rectangle as large as the page, "
+            "without a stroke (matplotlib, Figma and draw.io draw one), which a viewer does not "
+            "show on the white page; give it a stroke to cut it"
+        )
+    return said

@@ -7,12 +7,12 @@ from __future__ import annotations
 
 import re
 import xml.etree.ElementTree as ET
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TypeAlias
 
 from camtool.model.errors import InputError, TooLargeError, UsageError
-from camtool.model.shapes import BBox, Contour, Point
+from camtool.model.shapes import BBox, Contour, Line, Point
 from camtool.model.units import LENGTH_UNITS, PX
 
 Affine: TypeAlias = tuple[float, float, float, float, float, float]
@@ -330,3 +330,24 @@ def check_travel(
             raise
         note = off_page_text(path, len(off), "shape", *off[0], page)
         raise TooLargeError(f"{exc}; {refusal_note(note, len(off))}") from None
+
+
+def is_background(contours: Sequence[Contour], page: tuple[float, float] | None) -> bool:
+    """Whether ``contours`` are one rectangle of lines covering the whole page.
+
+    Asked of a white shape without a stroke: the background matplotlib's figures, Figma's
+    frames and draw.io's pages draw, which a viewer does not show on the white page. Its
+    corners may be off the page's by 0.1 % of its larger side (at least 0.01 mm); ``page``
+    in mm, its lower-left corner at the origin (:func:`page_matrix`).
+    """
+    if page is None or len(contours) != 1 or not contours[0].closed:
+        return False
+    segments = contours[0].segments
+    if len(segments) != 4 or not all(isinstance(s, Line) for s in segments):
+        return False
+    slack = max(0.01, 1e-3 * max(page))
+    sides = all(
+        min(abs(s.end[0] - s.start[0]), abs(s.end[1] - s.start[1])) <= slack for s in segments
+    )
+    corners = zip(contours[0].bbox(), (0.0, 0.0, *page), strict=True)
+    return sides and all(abs(a - b) <= slack for a, b in corners)
