@@ -162,6 +162,20 @@ _PROGRAM_LOOK = 20
 """How many lines (not blank) are looked at for a block (a program's header comes first)."""
 
 
+_NUMBER_ROW = re.compile(rf"\s*{NUMBER.pattern}(?:\s*[,;\s]\s*{NUMBER.pattern}){{1,2}}\s*[,;]?\s*$")
+"""A row of two or three numbers, as a point list writes them."""
+
+
+def holds_rows(text: str) -> bool:
+    """Whether ``text``, a ``.txt`` file's first lines, is a point list or a program.
+
+    So it is with a row of 2 or 3 numbers or a G-code block; a note (a README) has neither.
+    """
+    return any(
+        _NUMBER_ROW.match(line) or _PROGRAM_BLOCK.match(line.strip()) for line in text.splitlines()
+    )
+
+
 def _program_error(text: str, path: Path) -> InputError | None:
     """The error for a G-code program saved with a point list's ending (CamBam's ``.txt``).
 

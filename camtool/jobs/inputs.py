@@ -40,6 +40,9 @@ if TYPE_CHECKING:
 
 _MAGIC = re.compile(r"[*?[]")
 
+NOTE_PEEK_BYTES = 65536
+"""How much of a ``.txt`` file a batch reads to tell a point list from a note."""
+
 PROGRAM_SUFFIXES = (".ngc", ".nc", ".gcode", ".tap", ".cnc", ".gc", ".g")
 """File endings read as existing G-code programs (re-posted, not planned)."""
 
@@ -405,7 +408,25 @@ def _walk(directory: Path, root: Path, skip: Path | None) -> list[BatchInput]:
 
 
 def _readable(path: Path) -> bool:
-    return path.suffix.lower() in readable_suffixes()
+    """Whether a batch found ``path`` in a folder or a glob posts it.
+
+    Its ending is one camtool reads; a ``.txt`` must also hold a row of numbers or a
+    G-code block in its first 64 KiB (:func:`~camtool.importers.points.holds_rows`): a
+    README or a licence beside the drawings is passed over, not an error.
+    """
+    suffix = path.suffix.lower()
+    if suffix not in readable_suffixes():
+        return False
+    if suffix != ".txt":
+        return True
+    from camtool.importers.points import holds_rows
+
+    try:
+        with path.open("rb") as file:
+            head = file.read(NOTE_PEEK_BYTES)
+    except OSError:
+        return True  # posting it says what is wrong
+    return holds_rows(decoded(head, errors="replace"))
 
 
 def _below(path: Path, directory: Path) -> bool:

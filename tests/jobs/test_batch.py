@@ -69,6 +69,24 @@ def test_directory_is_searched_recursively_skipping_hidden_and_unknown(tree: Pat
     assert found[2].path == tree / "rect.dxf"
 
 
+def test_a_text_note_beside_the_drawings_is_passed_over_a_point_list_is_not(tree: Path) -> None:
+    """A README or a licence saved as .txt holds no row of numbers and no G-code block:
+    found in a folder or a glob it is no point list to post (it was an error in the
+    batch's table); a point list, a program saved as .txt, or a note named on the command
+    line are posted (the last two with their own error)."""
+    (tree / "README.txt").write_text("Cut from 6 mm plywood with a 3 mm end mill.\n")
+    (tree / "parts" / "LICENSE.txt").write_text("CC-BY 4.0\n", encoding="utf-16")
+    (tree / "parts" / "trace.txt").write_text("# x y\n0 0\n10 0\n")
+    (tree / "parts" / "eu.txt").write_text("x;y\n0,5;0\n")  # a bad point list, posted
+    (tree / "parts" / "cambam.txt").write_text("G21 G90\nG0 X0 Y0\n")  # a program as .txt
+    for found in (expand_inputs([str(tree)]), expand_inputs(["drawings/**/*.txt"])):
+        names = {i.path.name for i in found}
+        assert {"trace.txt", "eu.txt", "cambam.txt"} <= names
+        assert not {"README.txt", "LICENSE.txt"} & names
+    named = expand_inputs(["drawings/README.txt"])
+    assert [i.path.name for i in named] == ["README.txt"]
+
+
 def test_files_and_globs_are_sorted_and_deduplicated(tree: Path) -> None:
     found = expand_inputs(["drawings/rect.dxf", "drawings/**/*.ngc", "drawings/parts", "drawings"])
     paths = [i.path.as_posix() for i in found]
