@@ -14,6 +14,7 @@ from camtool.cli.common import (
     import_settings,
     number_range,
     say_written,
+    warn,
     write_output,
 )
 from camtool.model.errors import UsageError
@@ -96,6 +97,7 @@ def init(
         machine = load_target_checked(target, machine_file=machine_file).machine
         travel, no_z = machine.travel_mm, ("" if machine.has_z else target)
     drawn = read_input(drawing, import_settings(options))
+    warn(list(drawn.warnings))  # what the guesses below rest on (units assumed, skipped)
     text = initial_job(
         drawn, thickness_mm=thickness, tool_diameter=tool_diameter, travel_mm=travel, no_z=no_z
     )

@@ -6,6 +6,7 @@ import re
 from pathlib import Path
 from typing import Any
 
+import ezdxf
 import pytest
 
 from camtool.cli.main import main
@@ -84,6 +85,18 @@ def test_job_init_then_post(run: Any, tmp_path: Path) -> None:
     out = tmp_path / "part.gcode"
     code, _, err = run("post", PART, "-t", "grbl", "--job", str(job), "-o", str(out))
     assert code == 0, err
+
+
+def test_job_init_says_what_its_guesses_rest_on(run: Any, tmp_path: Path) -> None:
+    """The drawing's warnings (here: no units, mm assumed) come before the job: every
+    guess in it (what is drilled, the end mill, the fit) is measured in those units."""
+    drawing = tmp_path / "plate.dxf"
+    doc = ezdxf.new("R2000")
+    doc.header["$INSUNITS"] = 0
+    doc.modelspace().add_lwpolyline([(0, 0), (2, 0), (2, 1.5), (0, 1.5)], close=True)
+    doc.saveas(drawing)
+    code, _, err = run("job", "init", str(drawing), "-o", str(tmp_path / "plate.toml"))
+    assert code == 0 and "warning: " in err and "assuming mm" in err
 
 
 def test_job_init_never_replaces_a_job_without_force(run: Any, tmp_path: Path) -> None:
