@@ -31,8 +31,9 @@ _FIELD = re.compile(r"[^,;\s]+")
 """A field: what lies between separators (comma, semicolon, tab, spaces)."""
 _DECIMAL_COMMA = re.compile(r"[+-]?[\d.]*\d,\d[\d.]*")
 """A comma between two digits: a decimal comma when the row separates its columns otherwise."""
-_OTHER_SEPARATOR = re.compile(r";|\t|[\d.]\s+[+\-.\d]")
-"""A semicolon, a tab or blanks between two numbers: the separators of a decimal-comma row."""
+_OTHER_SEPARATOR = re.compile(r";|[\d.]\s+[+\-.\d]")
+"""A semicolon, or tabs or blanks between two numbers: the separators of a decimal-comma row
+(not a row's trailing blanks)."""
 _HEADER_UNITS = {
     "mm": "mm", "millimeter": "mm", "millimeters": "mm", "millimetre": "mm",
     "millimetres": "mm", "cm": "cm", "m": "m", "meters": "m", "metres": "m", "in": "in",

@@ -71,7 +71,7 @@ def test_star_reads_through_read_drawing() -> None:
 
 @pytest.mark.parametrize(
     "row",
-    ["1,2", "1;2", "1\t2", "1 2", "  1 ,  2  ", "1, 2", "1;  2", "1.0, 2.0", "1.0 , 2"],
+    ["1,2", "1;2", "1\t2", "1 2", "  1 ,  2  ", "1, 2", "1;  2", "1.0, 2.0", "1.0 , 2", "1,2\t"],
 )
 def test_separators(tmp_path: Path, row: str) -> None:
     text = f"{row}\n{row.replace('1', '4').replace('2', '6')}\n"
