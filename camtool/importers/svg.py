@@ -26,6 +26,7 @@ from camtool.importers.svgdoc import (
     SOURCE_ATTR,
     USE_ATTR,
     Prepared,
+    element_noun,
     prepare,
     unseen_warnings,
     zero_opacity,
@@ -147,12 +148,12 @@ def svg_drawing(
     known = [b for b in boxes if b is not None]
     box = bbox_union(known) if known else None
     clips = svgclip.clipped_shapes(svg, _SHAPES)
-    deferred = False  # too large with every shape: checked again without the clipped-away ones
+    deferred = False  # too large with every shape: checked again without the unseen ones
     if check is not None and box is not None:
         try:
             check_travel(path, check, box, _labelled(drawn, boxes), prepared.page)
         except TooLargeError:
-            if not any(id(shape) in clips for shape, _ in drawn):
+            if not any(id(shape) in clips or _unseen_fill(shape) for shape, _ in drawn):
                 raise
             deferred = True
     tolerance = options.curve_tolerance(box)
@@ -163,7 +164,7 @@ def svg_drawing(
     for i, (shape, segments) in enumerate(drawn, start=1):
         made = _contours(path, shape, segments, prepared.matrix, fitter)
         over = clips.get(id(shape))
-        if _unpainted(shape.stroke) and _white(shape.fill) and is_background(made, prepared.page):
+        if _unseen_fill(shape) and is_background(made, prepared.page):
             background += 1  # the page's white background: a viewer shows nothing of it
         elif not over or not _hidden_by_clip(
             path, shape, made, over, prepared.matrix, tolerance, regions
@@ -178,7 +179,7 @@ def svg_drawing(
             kept_boxes = [boxes[k] for k in kept]
             labelled = _labelled([drawn[k] for k in kept], kept_boxes)
             check_travel(path, check, bbox_union(left), labelled, prepared.page)
-    if clipped_away and options.fit is not None and known:
+    if (clipped_away or background) and options.fit is not None and known:
         # --fit scales what is kept: without the hidden shapes' extent, by a larger factor,
         # which the curves' tolerance must follow (ImportOptions.curve_tolerance)
         left = [b for b in (boxes[k] for k in kept) if b is not None]
@@ -191,8 +192,8 @@ def svg_drawing(
     if clipped_away:
         its, them = ("its", "it") if clipped_away == 1 else ("their", "them")
         warnings.append(
-            f"{path}: skipped {clipped_away} {_elements(clipped_away)} that {its} clip-path, mask "
-            f"or viewport hides wholly (a viewer shows nothing of {them})"
+            f"{path}: skipped {clipped_away} {element_noun(clipped_away)} that {its} clip-path, "
+            f"mask or viewport hides wholly (a viewer shows nothing of {them})"
         )
     warnings += unseen_warnings(path, hidden, faded, invisible, bare_lines, background)
     size_note = ""
@@ -307,13 +308,11 @@ def _unpainted(color: Any) -> bool:
     return color is None or color.value is None or color.alpha == 0
 
 
-def _white(color: Any) -> bool:
-    """Whether a shape's ``fill`` (svgelements' Color) paints white."""
-    return not _unpainted(color) and (color.red, color.green, color.blue) == (255, 255, 255)
-
-
-def _elements(count: int) -> str:
-    return "element" if count == 1 else "elements"
+def _unseen_fill(shape: Any) -> bool:
+    """Whether a shape is filled white without a stroke: unseen on the white page."""
+    fill = shape.fill
+    white = not _unpainted(fill) and (fill.red, fill.green, fill.blue) == (255, 255, 255)
+    return white and _unpainted(shape.stroke)
 
 
 def _contours(

@@ -712,22 +712,18 @@ def unseen_warnings(
     path: object, hidden: int, faded: int, invisible: int, bare: int, background: int
 ) -> list[str]:
     """What was skipped because a viewer shows nothing of it: one warning per kind."""
-
-    def elements(count: int) -> str:
-        return "element" if count == 1 else "elements"
-
     said = []
     if hidden:
-        said.append(f"{path}: skipped {hidden} {elements(hidden)} with visibility:hidden")
+        said.append(f"{path}: skipped {hidden} {element_noun(hidden)} with visibility:hidden")
     if faded:
-        said.append(f"{path}: skipped {faded} {elements(faded)} with opacity 0")
+        said.append(f"{path}: skipped {faded} {element_noun(faded)} with opacity 0")
     if invisible:
         said.append(
-            f"{path}: skipped {invisible} {elements(invisible)} with neither fill nor stroke"
+            f"{path}: skipped {invisible} {element_noun(invisible)} with neither fill nor stroke"
         )
     if bare:
         said.append(
-            f"{path}: skipped {bare} <line> {elements(bare)} without a stroke (a line has no "
+            f"{path}: skipped {bare} <line> {element_noun(bare)} without a stroke (a line has no "
             "inside to fill, so a viewer shows nothing); give it a stroke to cut it"
         )
     if background:
@@ -737,3 +733,8 @@ def unseen_warnings(
             "show on the white page; give it a stroke to cut it"
         )
     return said
+
+
+def element_noun(count: int) -> str:
+    """``element`` or ``elements``, as ``count`` asks."""
+    return "element" if count == 1 else "elements"

@@ -9,7 +9,9 @@ units in a 4 x 3 in figure whose axes fill it.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -70,3 +72,31 @@ def test_only_a_white_page_sized_rectangle_without_a_stroke_is_the_background(
     drawing = read_drawing(svg(tmp_path, shape + circle), ImportOptions())
     assert len(drawing.contours) == 1 + kept
     assert len([w for w in drawing.warnings if SAID in w]) == 1 - kept
+
+
+def test_the_background_counts_neither_toward_fit_nor_toward_the_travel(
+    tmp_path: Path, run: Any
+) -> None:
+    """--fit scales what is cut, so the curves are fitted for the part's scale, not the
+    page's (by analysis: the 20 x 16 mm ellipse scaled to --fit 100 100, k = 5, every
+    point of its arcs within --tolerance of it once scaled). A page larger than the
+    travel is no refusal when what is cut fits (it was refused before planning)."""
+    page = 'width="200mm" height="200mm" viewBox="0 0 200 200"'
+    ellipse = '<ellipse cx="100" cy="100" rx="10" ry="8" fill="none" stroke="black"/>'
+    path = svg(tmp_path, '<rect width="200" height="200" fill="#fff"/>' + ellipse, page)
+    out = tmp_path / "fit.ngc"
+    code, err = run("post", str(path), "-t", "linuxcnc", "--fit", "100", "100", "-o", str(out))
+    assert code == 0 and SAID in err
+    fitted = read_drawing(path, ImportOptions(fit=(100.0, 100.0)))
+    (contour,) = fitted.contours
+    x0, _, x1, _ = contour.bbox()
+    k = 100.0 / (x1 - x0)  # the scale --fit gives (rx 10: 20 mm wide)
+
+    def off(x: float, y: float) -> float:  # to first order: |F| / |grad F| of the ellipse
+        u, v = (x - 100.0) / 10.0, (y - 100.0) / 8.0
+        return abs(u * u + v * v - 1.0) / math.hypot(2 * u / 10.0, 2 * v / 8.0)
+
+    worst = max(off(x, y) for s in contour.segments for x, y in s.points(1e-5))
+    assert worst * k <= 0.001 + 1e-6  # within --tolerance once scaled
+    code, err = run("post", str(path), "-t", "pic-mmh", "--scale", "0.3", "-o", str(out))
+    assert code == 0, err  # 6 x 4.8 mm in the 10 x 7 mm travel; the 60 mm page is not cut
