@@ -27,8 +27,9 @@ LAYER = "0"
 
 NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
 """A number as point lists write it: ``12``, ``-1.5``, ``.5``, ``3.``, ``1e-3``."""
-_FIELD = re.compile(r"[^,;\s]+")
-"""A field: what lies between separators (comma, semicolon, tab, spaces)."""
+_FIELD = re.compile(r'"([^"]*)"|[^,;\s]+')
+"""A field: what lies between separators (comma, semicolon, tab, spaces), or between
+double quotes (a CSV writer quoting every field: ``"1.5","2"``)."""
 _DECIMAL_COMMA = re.compile(r"[+-]?[\d.]*\d,\d[\d.]*")
 """A comma between two digits: a decimal comma when the row separates its columns otherwise."""
 _OTHER_SEPARATOR = re.compile(r";|[\d.]\s+[+\-.\d]")
@@ -252,7 +253,9 @@ def _text_strokes(
                 "semicolons, tabs or blanks); camtool reads decimal points: save the file "
                 "with '.' decimals (a spreadsheet's export in an English locale)",
             )
-        fields = [(m[0], m.start() + 1) for m in _FIELD.finditer(raw)]
+        fields = [
+            (m[0] if m[1] is None else m[1].strip(), m.start() + 1) for m in _FIELD.finditer(raw)
+        ]
         values = _row(fields, _Where(path, number, scale), header_allowed=not seen_data)
         if values is None:  # the header
             seen_data = True

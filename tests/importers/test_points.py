@@ -71,7 +71,10 @@ def test_star_reads_through_read_drawing() -> None:
 
 @pytest.mark.parametrize(
     "row",
-    ["1,2", "1;2", "1\t2", "1 2", "  1 ,  2  ", "1, 2", "1;  2", "1.0, 2.0", "1.0 , 2", "1,2\t"],
+    [
+        *("1,2", "1;2", "1\t2", "1 2", "  1 ,  2  ", "1, 2", "1;  2", "1.0, 2.0", "1.0 , 2"),
+        *("1,2\t", '"1","2"', '"1";"2"', '" 1 ", "2"'),  # a trailing tab; quoted fields (RFC 4180)
+    ],
 )
 def test_separators(tmp_path: Path, row: str) -> None:
     text = f"{row}\n{row.replace('1', '4').replace('2', '6')}\n"
@@ -171,6 +174,9 @@ def test_single_point_stroke_is_skipped_with_a_warning(tmp_path: Path) -> None:
         ("x;y\n0,5;0\n10,5;0\n10,5;20\n", "line 2, column 1: '0,5' has a decimal comma"),
         ("0\t0\n10\t-2,5\n", "line 2, column 4: '-2,5' has a decimal comma"),
         ("0 0\n10,25 5\n", "line 2, column 1: '10,25' has a decimal comma"),
+        ('"0,5";"0"\n', "line 1, column 2: '0,5' has a decimal comma"),
+        ('"0","0"\n"0,5","0"\n', "line 2, column 1: '0,5' is not a number; rows are"),
+        ('"0,0\n1,1\n', """line 1, column 1: '"0' is not a number"""),  # an unclosed quote
         ("x,y\n\n", "no stroke of two or more points"),
         ("", "no stroke of two or more points"),
         ("3,3\n", "no stroke of two or more points"),
