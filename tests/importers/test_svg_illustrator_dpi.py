@@ -102,3 +102,18 @@ def test_an_illustrator_file_inkscape_saved_again_gets_inkscapes_word_only() -> 
     drawing = read_drawing(KMPLOT, ImportOptions())
     assert not [w for w in drawing.warnings if "Adobe Illustrator" in w]
     assert [w for w in drawing.warnings if "Inkscape 0.44" in w]
+
+
+KIG = CORPUS / "pkg/breeze-icon-theme/usr/share/icons/breeze/apps/48/kig.svg"
+
+
+@pytest.mark.skipif(not KIG.exists(), reason="corpus not fetched (make corpus)")
+def test_a_real_illustrator_10_file_is_said_to_be_in_points() -> None:
+    # Breeze's kig icon (Debian's breeze-icon-theme) as Illustrator 10 saved it, its styles
+    # in DTD entities: width="128" (Illustrator's points: 45.16 mm) read as 128 px, 33.87 mm
+    drawing = read_drawing(KIG, ImportOptions())
+    said = [w for w in drawing.warnings if "Adobe Illustrator" in w]
+    assert len(said) == 1 and "Illustrator 10.0" in said[0] and "--scale 1.333333" in said[0]
+    x0, y0, x1, y1 = drawing.bbox()
+    page = 128 * 25.4 / 96
+    assert 0 <= x0 < x1 <= page + 1e-6 and 0 <= y0 < y1 <= page + 1e-6
