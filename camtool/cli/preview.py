@@ -104,8 +104,13 @@ def preview(
     progress = click.get_current_context().with_resource(StageReporter())
     progress(Step("reading", name=Path(program_name or input_name).name))
     drawing, program = preview_inputs(input_name, program_name, chosen, import_settings(options))
+    said = [
+        *(drawing.warnings if drawing is not None else ()),
+        *(program.warnings if program else ()),
+    ]
+    warn(list(dict.fromkeys(said)))  # what the picture rests on (units assumed, skipped)
     verification = (
-        _verify(program, drawing, chosen, tool_diameter, program_name or input_name)
+        _verify(program, drawing, chosen, tool_diameter, program_name or input_name, said)
         if verify_too
         else None
     )
@@ -142,7 +147,9 @@ def _verify(
     target: Target | None,
     tool_diameter: float,
     source: str,
+    said: list[str],
 ) -> Verification:
+    """The program simulated on ``target``; its warnings printed but for those ``said``."""
     if target is None or program is None:
         raise UsageError(
             "--verify simulates a program on a machine: give a program (INPUT or --program) "
@@ -158,7 +165,7 @@ def _verify(
         tool_diameter=tool_diameter,
         source=source,
     )
-    warn(v.warnings)
+    warn([w for w in v.warnings if w not in said])
     click.echo(
         f"camtool: verified on {target.name}: max deviation {v.deviation.max_um:.2f} µm, "
         f"≈ {v.time_s:.1f} s",

@@ -181,3 +181,24 @@ def test_a_bad_preview_ending_is_refused_before_anything_is_written(
     assert code == 2
     assert "a preview is .png or .svg, not '.jpg'" in err
     assert not out.exists() and not report.exists() and not (work / "x.jpg").exists()
+
+
+def test_the_picture_says_what_it_rests_on_once(
+    work: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The drawing's and the program's warnings (units assumed) come with the picture, as
+    with post; with --verify, not a second time."""
+    monkeypatch.chdir(work)
+    (work / "plain.ngc").write_text("G90\nG0 X0 Y0\nG1 X2 Y1 F100\nM2\n", encoding="ascii")
+    said = "no G20/G21 before the first move: coordinates read as mm"
+    code, _, err = run(["preview", "plain.ngc", "-t", "grbl", "--verify", "-o", "a.svg"], capsys)
+    assert code == 0 and err.count(said) == 1
+    svg_path = work / "ai.svg"
+    svg_path.write_text(
+        "<!-- Generator: Adobe Illustrator 27.0.0, SVG Export Plug-In -->\n"
+        '<svg xmlns="http://www.w3.org/2000/svg" width="72px" height="72px" viewBox="0 0 72 72">'
+        '<rect x="10" y="10" width="40" height="40" fill="none" stroke="#000"/></svg>',
+        encoding="utf-8",
+    )
+    code, _, err = run(["preview", "ai.svg", "-o", "b.svg"], capsys)
+    assert code == 0 and err.count("made by Adobe Illustrator 27.0.0") == 1
