@@ -294,6 +294,8 @@ def verify(
     check_not_drawing(code, chosen, "verify PROGRAM, with --against {name} to compare")
     text = read_code(code, binary=chosen.post.binary)
     drawing = read_input(against) if against is not None else None
+    if drawing is not None:
+        warn([f"--against: {w}" for w in drawing.warnings])  # what the comparison rests on
     if drawing is not None and isinstance(text, str):
         drawing, tool_diameter = _as_posted(text, drawing, tool_diameter)
     progress = click.get_current_context().with_resource(StageReporter())

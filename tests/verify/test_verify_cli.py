@@ -6,6 +6,7 @@ import json
 import math
 from pathlib import Path
 
+import ezdxf
 import pytest
 
 from camtool.cli.main import main
@@ -90,6 +91,22 @@ def test_against_the_drawing(logo_pic: Path, capsys: pytest.CaptureFixture[str])
     assert code == 0 and against["samples"] > 100
     # a scribed path (no offset) lies on the drawing up to the backlash residuals (<= 20 µm)
     assert 0 < against["max_um"] < 20.0
+
+
+def test_the_drawing_compared_says_its_warnings(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--against reads a drawing: what reading it warned of (here: no units, mm assumed)
+    is said, as post says it, since the comparison is measured in those units."""
+    drawing = tmp_path / "plate.dxf"
+    doc = ezdxf.new("R2000")
+    doc.header["$INSUNITS"] = 0
+    doc.modelspace().add_lwpolyline([(0, 0), (2, 0), (2, 1.5), (0, 1.5)], close=True)
+    doc.saveas(drawing)
+    program = tmp_path / "plate.nc"
+    assert run(["post", str(drawing), "-t", "grbl", "-o", str(program)], capsys)[0] == 0
+    code, _, err = run(["verify", str(program), "-t", "grbl", "--against", str(drawing)], capsys)
+    assert code == 0 and err.count("--against: ") >= 1 and "assuming mm" in err
 
 
 def test_post_verify_matches_verify(
