@@ -62,9 +62,11 @@ _GCODE_WORD = re.compile(r"/?\s*(?:[A-Za-z]\s*[-+]?\s*[\d.#\[<]|#[\d<])")
 """The start of a G-code block: a word (``G0``, ``X-1.5``, ``F#1``, ``o<sub>``), a parameter
 (``#1=``, ``#<x>=``), after an optional block delete ``/``."""
 _MATLAB = re.compile(r"[A-Za-z_]\w*\s*=")
-_POINT_ROW = re.compile(r"[-+.\d]")
-_HEADER = re.compile(r"[A-Za-z_]\w*(?:[\s,;]+[A-Za-z_]\w*)*")
-"""A point list's header row: words (``x,y,z``)."""
+_POINT_ROW = re.compile(r'"?[-+.\d]')
+"""The start of a point list's row: a number, perhaps quoted (``"1.5","2"``)."""
+_HEADER = re.compile(r"[A-Za-z_]\w*(?:[\s,;]+[A-Za-z_]\w*)*|[^\d<]*[A-Za-z][^\d]*")
+"""A point list's header row: words (``x,y,z``, ``x1;y1``), or any line of letters without
+digits (``X (in),Y (in)``, ``"x","y"``)."""
 
 
 def stdin_kind(data: bytes) -> str:
@@ -95,8 +97,8 @@ def stdin_kind(data: bytes) -> str:
     for at, line in enumerate(lines):
         if line[0] in "(;%":
             continue  # a G-code comment or the tape mark
-        if _GCODE_WORD.match(line):
-            return PROGRAM_SUFFIXES[1]
+        if _GCODE_WORD.match(line) and "," not in re.split(r"[(;]", line, maxsplit=1)[0]:
+            return PROGRAM_SUFFIXES[1]  # a comma outside a comment is no G-code: a header
         if _MATLAB.match(line):
             return ".m"
         if _POINT_ROW.match(line) or line.startswith("#"):

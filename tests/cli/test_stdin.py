@@ -79,6 +79,11 @@ def test_real_files_are_told_by_their_content() -> None:
         ("# points\n1;2\n", ".csv"),
         ("# 1st stroke\n1 2\n3 4\n", ".csv"),  # a comment, not LinuxCNC's #1
         ("-1.5\t2\n", ".csv"),
+        # headers of units or quotes (read_points takes them): a comma is no G-code
+        ("X (in),Y (in)\n0,0\n", ".csv"),
+        ('"x","y"\n"0","1"\n', ".csv"),
+        ("x1,y1\n0,0\n", ".csv"),
+        ("G1 X1 Y1 (a, b)\n", ".nc"),  # a comma in a comment
     ],
 )
 def test_kinds_from_their_first_lines(text: str, kind: str) -> None:
