@@ -232,6 +232,26 @@ def _check_header(header: str, where: str, given: str | None, warnings: list[str
     warnings.append(f"{where} names {unit}; read in --units {given}, as asked")
 
 
+_HEADER_NAME = re.compile(r"\s*([A-Za-z]+)\s*(?:[\[(].*|_[A-Za-zµ]+)?")
+"""A header field's column name without its unit: ``X (in)``, ``x[mm]``, ``x_mm`` → ``x``."""
+
+
+def _header_columns(header: str) -> tuple[int, int, int | None] | None:
+    """The columns of X, Y and Z (0-based) a header names, when it names X and Y.
+
+    ``None`` when it does not (the columns are then X, Y, Z in that order). A header
+    cell left empty is a row number's (pandas writes its index so: ``,x,y``).
+    """
+    cells = re.split(r"[,;\t]" if re.search(r"[,;\t]", header) else r"\s+", header.strip())
+    names = []
+    for cell in cells:
+        match = _HEADER_NAME.fullmatch(cell.strip().strip('"').strip())
+        names.append(match[1].lower() if match else None)
+    if "x" not in names or "y" not in names:
+        return None
+    return names.index("x"), names.index("y"), names.index("z") if "z" in names else None
+
+
 def _text_strokes(
     text: str, path: Path, warnings: list[str], scale: float, given: str | None = None
 ) -> list[_Stroke]:
@@ -242,6 +262,7 @@ def _text_strokes(
     columns: int | None = None
     z_range: list[float] = []
     seen_data = False
+    picks: tuple[int, int, int | None] | None = None  # X, Y, Z columns the header names
     for number, raw in enumerate(text.splitlines(), start=1):
         if raw.strip().startswith("#"):
             continue
@@ -260,6 +281,7 @@ def _text_strokes(
         if values is None:  # the header
             seen_data = True
             _check_header(raw, f"{path}: line {number}", given, warnings)
+            picks = _header_columns(raw)
             continue
         seen_data = seen_data or bool(fields)
         if not values or all(math.isnan(v) for v in values):
@@ -274,17 +296,28 @@ def _text_strokes(
                 f"{path}: line {number}: {len(values)} numbers where the rows above have "
                 f"{columns}; every row is X,Y or every row is X,Y,Z"
             )
+        ix, iy, iz = picks or (0, 1, 2)
+        if max(ix, iy) >= columns:
+            raise InputError(
+                f"{path}: line {number}: {columns} numbers, but the header names X and Y "
+                f"columns {ix + 1} and {iy + 1}"
+            )
         if not current:
             start = number
-        current.append((values[0], values[1]))
-        if columns == 3:
+        current.append((values[ix], values[iy]))
+        if iz is not None and iz < columns:
             z_range = (
-                [min(z_range[0], values[2]), max(z_range[1], values[2])]
+                [min(z_range[0], values[iz]), max(z_range[1], values[iz])]
                 if z_range
-                else [values[2]] * 2
+                else [values[iz]] * 2
             )
     if current:
         strokes.append(_Stroke(tuple(current), start))
+    if picks is not None and picks[:2] != (0, 1):
+        warnings.append(
+            f"{path}: X and Y read from columns {picks[0] + 1} and {picks[1] + 1}, as the "
+            "header names them"
+        )
     if z_range and z_range[0] != z_range[1]:
         warnings.append(
             f"{path}: Z varies from {z_range[0]:g} to {z_range[1]:g} (file units); camtool "

@@ -215,6 +215,32 @@ def test_a_header_in_mm_or_without_a_unit_is_read_as_before(tmp_path: Path, head
     assert vertices(drawing.contours[0]) == [(0.0, 0.0), (10.0, 0.0)] and not drawing.warnings
 
 
+@pytest.mark.parametrize(
+    ("text", "columns"),
+    [
+        # pandas' DataFrame.to_csv writes its index first, under an empty header cell
+        (",x,y\n0,0.0,0.0\n1,10.0,0.0\n2,10.0,5.0\n", (2, 3)),
+        ("y,x\n0,0\n0,10\n5,10\n", (2, 1)),
+        ("id;X (mm);Y (mm)\n1;0;0\n2;10;0\n3;10;5\n", (2, 3)),
+    ],
+)
+def test_a_header_naming_x_and_y_says_which_columns_they_are(
+    tmp_path: Path, text: str, columns: tuple[int, int]
+) -> None:
+    """Read by position, pandas' index was X and the part 2 x 10 mm; by the names, the
+    10 x 5 mm rectangle the rows hold."""
+    drawing = read_points(write(tmp_path, "p.csv", text))
+    assert vertices(drawing.contours[0]) == [(0.0, 0.0), (10.0, 0.0), (10.0, 5.0)]
+    said = f"X and Y read from columns {columns[0]} and {columns[1]}, as the header names them"
+    assert [w for w in drawing.warnings if said in w]
+
+
+def test_a_header_naming_more_columns_than_the_rows_have_is_refused(tmp_path: Path) -> None:
+    path = write(tmp_path, "p.csv", "id,x,y\n0,1\n2,3\n")
+    with pytest.raises(InputError, match="line 2: 2 numbers, but the header names X and Y "):
+        read_points(path)
+
+
 def test_a_header_of_two_units_is_refused(tmp_path: Path) -> None:
     path = write(tmp_path, "h.csv", "X (mm),Y (in)\n0,0\n10,0\n")
     with pytest.raises(InputError, match="names the units in and mm; camtool reads every column"):
