@@ -249,7 +249,11 @@ def _header_columns(header: str) -> tuple[int, int, int | None] | None:
         names.append(match[1].lower() if match else None)
     if "x" not in names or "y" not in names:
         return None
-    return names.index("x"), names.index("y"), names.index("z") if "z" in names else None
+    ix, iy = names.index("x"), names.index("y")
+    if "z" in names:
+        return ix, iy, names.index("z")
+    # a third column the header does not name at all is Z, as without a header
+    return ix, iy, 2 if len(names) < 3 and 2 not in (ix, iy) else None
 
 
 def _text_strokes(

@@ -235,6 +235,14 @@ def test_a_header_naming_x_and_y_says_which_columns_they_are(
     assert [w for w in drawing.warnings if said in w]
 
 
+def test_a_third_column_the_header_does_not_name_is_z_as_without_a_header(
+    tmp_path: Path,
+) -> None:
+    drawing = read_points(write(tmp_path, "p.csv", "x,y\n0,0,0\n10,0,1\n10,5,2\n"))
+    assert vertices(drawing.contours[0]) == [(0.0, 0.0), (10.0, 0.0), (10.0, 5.0)]
+    assert [w for w in drawing.warnings if "Z varies from 0 to 2" in w]
+
+
 def test_a_header_naming_more_columns_than_the_rows_have_is_refused(tmp_path: Path) -> None:
     path = write(tmp_path, "p.csv", "id,x,y\n0,1\n2,3\n")
     with pytest.raises(InputError, match="line 2: 2 numbers, but the header names X and Y "):
