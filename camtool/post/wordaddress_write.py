@@ -142,15 +142,29 @@ class BlockWriter(ArcWriter):
         Returns ``index`` and ``written`` after ``items``.
         """
         for item in items:
-            if isinstance(item, _MOVES):
-                index += 1
-                if index > written:
-                    self.move(item)
-            elif isinstance(item, PlaneArc):
-                written = self.plane_arc(item, index)
-            else:
-                self.command(item)
+            try:
+                if isinstance(item, _MOVES):
+                    index += 1
+                    if index > written:
+                        self.move(item)
+                elif isinstance(item, PlaneArc):
+                    written = self.plane_arc(item, index)
+                else:
+                    self.command(item)
+            except DialectError as exc:
+                raise self._from_source(exc, item, index) from None
         return index, written
+
+    def _from_source(self, exc: DialectError, item: object, index: int) -> DialectError:
+        """``exc`` naming the line of the program read from code it comes from, if any.
+
+        A move is move ``index - 1`` of the program; a command stands before move ``index``.
+        """
+        if isinstance(item, (*_MOVES, PlaneArc)):
+            line, where = self.program.line_of(index - 1), "input line"
+        else:
+            line, where = self.program.line_of(index), "before input line"
+        return exc if line is None else DialectError(f"{exc} ({where} {line})")
 
     # -- moves -------------------------------------------------------------------
 

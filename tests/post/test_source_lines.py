@@ -1,0 +1,44 @@
+"""A re-posted program's refusal names the line of the input it comes from.
+
+The word-address writer numbers its own blocks ("contour 1, block 3"); for a program read
+from code the user edits the input, so the message also names the input's line: the
+move's own, or for a command (a stop, a tool change) the line of the move it stands
+before. Expected lines are read off the test programs below.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from camtool.importers.gcode import parse_gcode
+from camtool.jobs.pipeline import post_program
+from camtool.model.errors import DialectError
+from camtool.post.registry import load_target
+
+FAST = "G21 G90\nG0 X1 Y1\nG0 Z1\n(the feed below has 5 integer digits)\nG1 Z-1 F25400\nM2\n"
+STOP = "G21 G90\nG0 X1 Y1\nG1 Z-1 F100\n(pause)\nM1\n\nG1 X2 Y1\nM2\n"
+
+
+@pytest.mark.parametrize(
+    ("text", "said"),
+    [
+        (FAST, "does not fit 4 integer digits (value 25400); flashcut writes at most 4 "
+         "integer digits (input line 5)"),
+        (STOP, "flashcut has no optional stop (M1); a stop is never dropped: post the program "
+         "for a target that stops, or take the stop out of it (before input line 7)"),
+    ],
+)  # fmt: skip
+def test_a_refusal_names_the_input_line(text: str, said: str) -> None:
+    with pytest.raises(DialectError) as refused:
+        post_program(parse_gcode(text, source="in.ngc"), load_target("flashcut"))
+    assert str(refused.value).endswith(said)
+
+
+def test_a_drawing_s_refusal_names_no_input_line() -> None:
+    """A planned program has no source lines: the message is the writer's alone."""
+    from camtool.model.program import Linear, Program, Rapid
+
+    program = Program((Rapid(1.0, 1.0), Linear(2.0, 1.0, 25400.0, contour=1)), origin=(0, 0))
+    with pytest.raises(DialectError) as refused:
+        load_target("flashcut").emit(program)
+    assert "input line" not in str(refused.value)
