@@ -158,12 +158,15 @@ class BlockWriter(ArcWriter):
     def _from_source(self, exc: DialectError, item: object, index: int) -> DialectError:
         """``exc`` naming the line of the program read from code it comes from, if any.
 
-        A move is move ``index - 1`` of the program; a command stands before move ``index``.
+        A move is move ``index - 1`` of the program; a command stands before move ``index``,
+        or after the last move when there is none.
         """
         if isinstance(item, (*_MOVES, PlaneArc)):
             line, where = self.program.line_of(index - 1), "input line"
-        else:
+        elif index < len(self.program.moves):
             line, where = self.program.line_of(index), "before input line"
+        else:
+            line, where = self.program.line_of(index - 1), "after input line"
         return exc if line is None else DialectError(f"{exc} ({where} {line})")
 
     # -- moves -------------------------------------------------------------------

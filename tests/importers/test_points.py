@@ -13,7 +13,6 @@ from camtool.importers.options import ImportOptions
 from camtool.importers.points import read_points
 from camtool.model.errors import InputError, UsageError
 from camtool.model.shapes import Contour, Line
-from camtool.model.units import LENGTH_UNITS
 
 ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT / "tests" / "data"
@@ -191,11 +190,16 @@ def test_bad_rows_name_file_and_line(tmp_path: Path, text: str, message: str) ->
 
 
 @pytest.mark.parametrize(
-    ("header", "unit"),
-    [("X (in),Y (in)", "in"), ("x[cm];y[cm]", "cm"), ("x_in,y_in", "in"), ("X inches,Y", "in")],
+    ("header", "unit", "mm"),
+    [
+        ("X (in),Y (in)", "in", 254.0),  # 10 in = 254 mm (25.4 mm to the inch, exactly)
+        ("x[cm];y[cm]", "cm", 100.0),
+        ("x_in,y_in", "in", 254.0),
+        ("X inches,Y", "in", 254.0),
+    ],
 )
 def test_a_header_naming_a_unit_other_than_mm_needs_units(
-    tmp_path: Path, header: str, unit: str
+    tmp_path: Path, header: str, unit: str, mm: float
 ) -> None:
     """A header that says inches, read in mm, would cut the part 25.4 times too small."""
     path = write(tmp_path, "h.csv", f"{header}\n0,0\n10,0\n10,10\n")
@@ -204,7 +208,7 @@ def test_a_header_naming_a_unit_other_than_mm_needs_units(
     ):
         read_points(path)
     drawing = read_points(path, ImportOptions(units=unit))
-    assert vertices(drawing.contours[0])[1] == (10 * LENGTH_UNITS[unit], 0.0)
+    assert vertices(drawing.contours[0])[1] == (pytest.approx(mm, abs=1e-9), 0.0)
     said = read_points(path, ImportOptions(units="mm")).warnings  # the user's word stands
     assert [w for w in said if f"names {unit}; read in --units mm, as asked" in w]
 

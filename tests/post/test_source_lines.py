@@ -17,6 +17,7 @@ from camtool.post.registry import load_target
 
 FAST = "G21 G90\nG0 X1 Y1\nG0 Z1\n(the feed below has 5 integer digits)\nG1 Z-1 F25400\nM2\n"
 STOP = "G21 G90\nG0 X1 Y1\nG1 Z-1 F100\n(pause)\nM1\n\nG1 X2 Y1\nM2\n"
+LAST = "G21 G90\nG0 X1 Y1\nG1 Z-1 F100\nG1 X2 Y1\n(pause at the end)\nM1\nM2\n"
 
 
 @pytest.mark.parametrize(
@@ -26,6 +27,7 @@ STOP = "G21 G90\nG0 X1 Y1\nG1 Z-1 F100\n(pause)\nM1\n\nG1 X2 Y1\nM2\n"
          "integer digits (input line 5)"),
         (STOP, "flashcut has no optional stop (M1); a stop is never dropped: post the program "
          "for a target that stops, or take the stop out of it (before input line 7)"),
+        (LAST, "take the stop out of it (after input line 4)"),  # no move after it
     ],
 )  # fmt: skip
 def test_a_refusal_names_the_input_line(text: str, said: str) -> None:
