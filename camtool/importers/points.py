@@ -166,15 +166,39 @@ _PROGRAM_LOOK = 20
 
 _NUMBER_ROW = re.compile(rf"\s*{NUMBER.pattern}(?:\s*[,;\s]\s*{NUMBER.pattern}){{1,2}}\s*[,;]?\s*$")
 """A row of two or three numbers, as a point list writes them."""
+_EXCEL_SEPARATOR = re.compile(r'\s*"?sep=(.?)"?\s*', re.IGNORECASE)
+"""Excel's first line naming the column separator (``sep=;``), which it writes for a CSV
+to open the same in every locale."""
 
 
 def holds_rows(text: str) -> bool:
     """Whether ``text``, a ``.txt`` file's first lines, is a point list or a program.
 
-    So it is with a row of 2 or 3 numbers or a G-code block; a note (a README) has neither.
+    So it is with a row of 2 or 3 numbers, a first line naming X and Y over a row of
+    numbers (a wide table's header), or a G-code block; a note (a README) has none of them.
     """
-    return any(
-        _NUMBER_ROW.match(line) or _PROGRAM_BLOCK.match(line.strip()) for line in text.splitlines()
+    lines = [line.strip() for line in text.splitlines() if line.strip()]
+    lines = lines[1:] if lines and _EXCEL_SEPARATOR.fullmatch(lines[0]) else lines
+    rows = [line for line in lines if not line.startswith("#")]
+    if len(rows) > 1 and _under_header(rows[0], rows[1]):
+        return True  # a header naming X and Y over a row of numbers
+    if rows and lines[0].startswith("#") and _under_header(lines[0][1:], rows[0]):
+        return True  # numpy's header comment
+    return any(_NUMBER_ROW.match(line) or _PROGRAM_BLOCK.match(line.strip()) for line in lines)
+
+
+def _under_header(header: str, row: str) -> bool:
+    """Whether ``row`` is a row of the table ``header`` heads.
+
+    So it is when the header names X and Y, and the row has as many cells, with numbers in
+    the X and Y columns.
+    """
+    columns = _header_columns(header)
+    if columns is None:
+        return False
+    cells = _cells(row, columns.separator)
+    return len(cells) == len(columns.names) and all(
+        NUMBER.fullmatch(cells[i][0].strip('"')) for i in (columns.x, columns.y)
     )
 
 
@@ -236,13 +260,40 @@ _HEADER_NAME = re.compile(r"\s*([A-Za-z]+)\s*(?:[\[(].*|_[A-Za-zµ]+)?")
 """A header field's column name without its unit: ``X (in)``, ``x[mm]``, ``x_mm`` → ``x``."""
 
 
-def _header_columns(header: str) -> tuple[int, int, int | None] | None:
-    """The columns of X, Y and Z (0-based) a header names, when it names X and Y.
+@dataclass(frozen=True)
+class _Columns:
+    """What a header naming X and Y says: their columns (0-based), Z's, every cell's name."""
+
+    x: int
+    y: int
+    z: int | None
+    names: tuple[str | None, ...]
+    """Each header cell's column name, lower case (``None``: empty, or not a name)."""
+    separator: str | None
+    """``,``, ``;`` or a tab, or ``None`` for blanks (which leave no empty cell)."""
+
+    def positional(self, cells: int) -> bool:
+        """Whether a row of ``cells`` cells is read by the header's names.
+
+        So it is when it has as many cells as the header, or the header has more than X,
+        Y and Z (the other columns are not read).
+        """
+        return cells == len(self.names) or len(self.names) > 3
+
+    def others(self) -> list[str]:
+        """The named columns that are not read."""
+        kept = (self.x, self.y, self.z)
+        return [name for i, name in enumerate(self.names) if name and i not in kept]
+
+
+def _header_columns(header: str) -> _Columns | None:
+    """The columns a header names X, Y and Z in, when it names X and Y.
 
     ``None`` when it does not (the columns are then X, Y, Z in that order). A header
     cell left empty is a row number's (pandas writes its index so: ``,x,y``).
     """
-    cells = re.split(r"[,;\t]" if re.search(r"[,;\t]", header) else r"\s+", header.strip())
+    separator = next((s for s in ",;\t" if s in header), None)
+    cells = header.strip().split(separator) if separator else header.split()
     names = []
     for cell in cells:
         match = _HEADER_NAME.fullmatch(cell.strip().strip('"').strip())
@@ -251,9 +302,49 @@ def _header_columns(header: str) -> tuple[int, int, int | None] | None:
         return None
     ix, iy = names.index("x"), names.index("y")
     if "z" in names:
-        return ix, iy, names.index("z")
-    # a third column the header does not name at all is Z, as without a header
-    return ix, iy, 2 if len(names) < 3 and 2 not in (ix, iy) else None
+        iz: int | None = names.index("z")
+    else:  # a third column the header does not name at all is Z, as without a header
+        iz = 2 if len(names) < 3 and 2 not in (ix, iy) else None
+    return _Columns(ix, iy, iz, tuple(names), separator)
+
+
+def _cells(raw: str, separator: str | None) -> list[tuple[str, int]]:
+    """The cells of a row as ``(text, 1-based column)``, empty ones too.
+
+    ``separator``: a comma, semicolon or tab; ``None``: fields as :data:`_FIELD` finds them.
+    """
+    if separator is None:
+        return [
+            (m[0] if m[1] is None else m[1].strip(), m.start() + 1) for m in _FIELD.finditer(raw)
+        ]
+    cells, at = [], 0
+    for part in raw.split(separator):
+        text = part.strip()
+        cells.append((text.strip('"').strip(), at + len(part) - len(part.lstrip()) + 1))
+        at += len(part) + 1
+    return cells
+
+
+def _named(raw: str, where: _Where, columns: _Columns) -> list[tuple[str, int]]:
+    """The X, Y (and Z) cells of a row read by the header's names, in that order.
+
+    Raises:
+        InputError: the row ends before the X or Y column, or one of them is empty.
+    """
+    cells = _cells(raw, columns.separator)
+    if cells == [("", 1)]:
+        return []
+    picked = []
+    for axis, index in zip("XYZ", (columns.x, columns.y, columns.z), strict=True):
+        if index is None or (axis == "Z" and (index >= len(cells) or not cells[index][0])):
+            continue  # Z is only looked at (whether it varies)
+        if index >= len(cells) or not cells[index][0]:
+            raise InputError(
+                f"{where.path}: line {where.line}: no value in column {index + 1}, which the "
+                f"header names {axis}; every row needs its X and Y"
+            )
+        picked.append(cells[index])
+    return picked
 
 
 def _text_strokes(
@@ -266,26 +357,25 @@ def _text_strokes(
     columns: int | None = None
     z_range: list[float] = []
     seen_data = False
-    picks: tuple[int, int, int | None] | None = None  # X, Y, Z columns the header names
+    header: _Columns | None = None  # the X, Y, Z columns the header names
+    excel = _excel_separator_line(text, path)
     for number, raw in enumerate(text.splitlines(), start=1):
-        if raw.strip().startswith("#"):
+        if raw.strip().startswith("#") or number == excel:
+            named_in_comment = _header_columns(raw.strip()[1:])
+            if not seen_data and header is None and named_in_comment is not None:
+                # numpy's savetxt writes its header so (genfromtxt's names=True reads it)
+                _check_header(raw, f"{path}: line {number}", given, warnings)
+                header = named_in_comment
             continue
-        comma = _DECIMAL_COMMA.search(raw)
-        if comma is not None and _OTHER_SEPARATOR.search(raw):
-            raise _Where(path, number, scale).fail(
-                comma.start() + 1,
-                f"{_quote(comma[0])} has a decimal comma (the row separates its columns by "
-                "semicolons, tabs or blanks); camtool reads decimal points: save the file "
-                "with '.' decimals (a spreadsheet's export in an English locale)",
-            )
-        fields = [
-            (m[0] if m[1] is None else m[1].strip(), m.start() + 1) for m in _FIELD.finditer(raw)
-        ]
-        values = _row(fields, _Where(path, number, scale), header_allowed=not seen_data)
+        where = _Where(path, number, scale)
+        _refuse_decimal_comma(raw, where)
+        named = header is not None and header.positional(len(_cells(raw, header.separator)))
+        fields = _named(raw, where, header) if named and header else _cells(raw, None)
+        values = _row(fields, where, header_allowed=not seen_data)
         if values is None:  # the header
             seen_data = True
             _check_header(raw, f"{path}: line {number}", given, warnings)
-            picks = _header_columns(raw)
+            header = _header_columns(raw)
             continue
         seen_data = seen_data or bool(fields)
         if not values or all(math.isnan(v) for v in values):
@@ -293,23 +383,27 @@ def _text_strokes(
                 strokes.append(_Stroke(tuple(current), start))
             current = []
             continue
-        if columns is None:
-            columns = len(values)
-        elif len(values) != columns:
-            raise InputError(
-                f"{path}: line {number}: {len(values)} numbers where the rows above have "
-                f"{columns}; every row is X,Y or every row is X,Y,Z"
-            )
-        ix, iy, iz = picks or (0, 1, 2)
-        if max(ix, iy) >= columns:
-            raise InputError(
-                f"{path}: line {number}: {columns} numbers, but the header names X and Y "
-                f"columns {ix + 1} and {iy + 1}"
-            )
+        iz: int | None = 2
+        if named:
+            ix, iy = 0, 1  # _named gave X, Y (and Z) in that order
+        else:
+            ix, iy, iz = (header.x, header.y, header.z) if header else (0, 1, 2)
+            if columns is None:
+                columns = len(values)
+            elif len(values) != columns:
+                raise InputError(
+                    f"{path}: line {number}: {len(values)} numbers where the rows above have "
+                    f"{columns}; every row is X,Y or every row is X,Y,Z"
+                )
+            if max(ix, iy) >= columns:
+                raise InputError(
+                    f"{path}: line {number}: {columns} numbers, but the header names X and Y "
+                    f"columns {ix + 1} and {iy + 1}"
+                )
         if not current:
             start = number
         current.append((values[ix], values[iy]))
-        if iz is not None and iz < columns:
+        if iz is not None and iz < len(values):
             z_range = (
                 [min(z_range[0], values[iz]), max(z_range[1], values[iz])]
                 if z_range
@@ -317,17 +411,63 @@ def _text_strokes(
             )
     if current:
         strokes.append(_Stroke(tuple(current), start))
-    if picks is not None and picks[:2] != (0, 1):
-        warnings.append(
-            f"{path}: X and Y read from columns {picks[0] + 1} and {picks[1] + 1}, as the "
-            "header names them"
-        )
+    _header_warnings(header, path, warnings)
     if z_range and z_range[0] != z_range[1]:
         warnings.append(
             f"{path}: Z varies from {z_range[0]:g} to {z_range[1]:g} (file units); camtool "
             "reads X and Y only (the drawing is 2D; depths come from --depth)"
         )
     return strokes
+
+
+def _header_warnings(header: _Columns | None, path: Path, warnings: list[str]) -> None:
+    """Say which columns the header's names made X and Y, and which named ones are not read."""
+    if header is None:
+        return
+    if (header.x, header.y) != (0, 1):
+        warnings.append(
+            f"{path}: X and Y read from columns {header.x + 1} and {header.y + 1}, as the "
+            "header names them"
+        )
+    if header.others():
+        warnings.append(
+            f"{path}: column(s) {', '.join(repr(n) for n in header.others())} not read "
+            "(camtool reads the columns the header names X and Y, and Z)"
+        )
+
+
+def _excel_separator_line(text: str, path: Path) -> int | None:
+    """The number of the first line when it is Excel's ``sep=`` line, else ``None``.
+
+    Raises:
+        InputError: it names a separator other than a comma, semicolon, tab or blank.
+    """
+    for number, raw in enumerate(text.splitlines(), start=1):
+        if not raw.strip():
+            continue
+        match = _EXCEL_SEPARATOR.fullmatch(raw)
+        if match is None:
+            return None
+        if not match[1] or match[1] not in ",; \t":
+            raise InputError(
+                f"{path}: line {number}: {raw.strip()!r} names the column separator "
+                f"{match[1]!r}; camtool reads columns separated by a comma, semicolon, tab "
+                "or spaces: export the file with one of them"
+            )
+        return number
+    return None
+
+
+def _refuse_decimal_comma(raw: str, where: _Where) -> None:
+    """Refuse a comma between two digits in a row separated otherwise (a decimal comma)."""
+    comma = _DECIMAL_COMMA.search(raw)
+    if comma is not None and _OTHER_SEPARATOR.search(raw):
+        raise where.fail(
+            comma.start() + 1,
+            f"{_quote(comma[0])} has a decimal comma (the row separates its columns by "
+            "semicolons, tabs or blanks); camtool reads decimal points: save the file "
+            "with '.' decimals (a spreadsheet's export in an English locale)",
+        )
 
 
 @dataclass(frozen=True)
@@ -370,7 +510,8 @@ def _row(
         return [math.nan] * len(fields)
     if len(fields) not in (2, 3):
         raise InputError(
-            f"{where.path}: line {where.line}: {len(fields)} numbers; rows are X,Y or X,Y,Z"
+            f"{where.path}: line {where.line}: {len(fields)} numbers; rows are X,Y or X,Y,Z "
+            "(more columns need a header naming the X and Y columns: x,y,z,...)"
         )
     return [_in_range(text, col, where) for text, col in fields]
 

@@ -62,6 +62,8 @@ _GCODE_WORD = re.compile(r"/?\s*(?:[A-Za-z]\s*[-+]?\s*[\d.#\[<]|#[\d<])")
 """The start of a G-code block: a word (``G0``, ``X-1.5``, ``F#1``, ``o<sub>``), a parameter
 (``#1=``, ``#<x>=``), after an optional block delete ``/``."""
 _MATLAB = re.compile(r"[A-Za-z_]\w*\s*=")
+_EXCEL_SEPARATOR = re.compile(r'"?sep=.?"?', re.IGNORECASE)
+"""Excel's first line naming a CSV's column separator (``sep=;``)."""
 _POINT_ROW = re.compile(r'"?[-+.\d]')
 """The start of a point list's row: a number, perhaps quoted (``"1.5","2"``)."""
 _HEADER = re.compile(r"[A-Za-z_]\w*(?:[\s,;]+[A-Za-z_]\w*)*|[^\d<]*[A-Za-z][^\d]*")
@@ -76,8 +78,8 @@ def stdin_kind(data: bytes) -> str:
     sentinel), ``.svg`` (XML: the first character ``<``), ``.nc`` (a G-code program: its
     first line that is not a comment, ``(…)``, ``;…`` or ``%``, starts with a word or a
     parameter; or comments only), ``.m`` (a Matlab assignment, ``xy = [...]``), ``.csv``
-    (a point list: a number first, a ``#`` comment, or a header of words then a row of
-    numbers). Only the first 64 KiB are looked at.
+    (a point list: a number first, a ``#`` comment, Excel's ``sep=;``, or a header of words
+    then a row of numbers). Only the first 64 KiB are looked at.
 
     Raises:
         InputError: empty, or none of these (the message quotes the first line).
@@ -99,6 +101,8 @@ def stdin_kind(data: bytes) -> str:
             continue  # a G-code comment or the tape mark
         if _GCODE_WORD.match(line) and "," not in re.split(r"[(;]", line, maxsplit=1)[0]:
             return PROGRAM_SUFFIXES[1]  # a comma outside a comment is no G-code: a header
+        if at == 0 and _EXCEL_SEPARATOR.fullmatch(line):
+            return ".csv"  # Excel's line naming the separator, not a Matlab assignment
         if _MATLAB.match(line):
             return ".m"
         if _POINT_ROW.match(line) or line.startswith("#"):

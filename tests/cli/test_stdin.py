@@ -84,6 +84,7 @@ def test_real_files_are_told_by_their_content() -> None:
         ('"x","y"\n"0","1"\n', ".csv"),
         ("x1,y1\n0,0\n", ".csv"),
         ("G1 X1 Y1 (a, b)\n", ".nc"),  # a comma in a comment
+        ("sep=;\nx;y\n0;0\n", ".csv"),  # Excel's separator line, no Matlab assignment
     ],
 )
 def test_kinds_from_their_first_lines(text: str, kind: str) -> None:

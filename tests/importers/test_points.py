@@ -10,7 +10,7 @@ import pytest
 from camtool.cli.main import main
 from camtool.importers import DRAWING_SUFFIXES, read_drawing
 from camtool.importers.options import ImportOptions
-from camtool.importers.points import read_points
+from camtool.importers.points import holds_rows, read_points
 from camtool.model.errors import InputError, UsageError
 from camtool.model.shapes import Contour, Line
 
@@ -250,6 +250,70 @@ def test_a_third_column_the_header_does_not_name_is_z_as_without_a_header(
 def test_a_header_naming_more_columns_than_the_rows_have_is_refused(tmp_path: Path) -> None:
     path = write(tmp_path, "p.csv", "id,x,y\n0,1\n2,3\n")
     with pytest.raises(InputError, match="line 2: 2 numbers, but the header names X and Y "):
+        read_points(path)
+
+
+@pytest.mark.parametrize(
+    ("text", "x_column"),
+    [
+        # a CMM's or spreadsheet's table: a point id, a name, X, Y, Z, a feed left empty
+        ("id,name,x,y,z,feed\n1,P1,0,0,0,100\n2,P2,10,0,0,\n3,,10,5,-1,100\n", 3),
+        ("id;X;Y;Z;feed\n1;0;0;0;100\n2;10;0;0;100\n3;10;5;-1;100\n", 2),
+        ("id\tx\ty\tz\tfeed\n1\t0\t0\t0\t100\n2\t10\t0\t0\t\n3\t10\t5\t-1\t100\n", 2),
+        ("id x y z feed\n1 0 0 0 100\n2 10 0 0 100\n3 10 5 -1 100\n", 2),
+    ],
+)
+def test_a_table_of_more_columns_is_read_by_the_names_of_its_header(
+    tmp_path: Path, text: str, x_column: int
+) -> None:
+    """The header names X, Y and Z among other columns: the rows hold the 10 x 5 mm
+    corner (0,0) (10,0) (10,5); columns not named X, Y or Z are not read (text or empty)."""
+    drawing = read_points(write(tmp_path, "t.csv", text))
+    assert vertices(drawing.contours[0]) == [(0.0, 0.0), (10.0, 0.0), (10.0, 5.0)]
+    assert [w for w in drawing.warnings if f"from columns {x_column} and {x_column + 1}" in w]
+    assert [w for w in drawing.warnings if re.search(r"column\(s\) 'id',.* 'feed' not read", w)]
+    assert [w for w in drawing.warnings if "Z varies from -1 to 0" in w]
+
+
+def test_numpy_s_header_comment_names_the_columns(tmp_path: Path) -> None:
+    """numpy.savetxt writes its header as a comment (``# id x y z``), which genfromtxt's
+    ``names=True`` reads as the header: so does camtool."""
+    np = pytest.importorskip("numpy")
+    table = [[1, 0, 0, 0, 100], [2, 10.5, 0, 0, 100], [3, 10.5, 5.25, 0, 100]]
+    path = tmp_path / "np.txt"
+    np.savetxt(path, np.array(table), header="id x y z feed")
+    assert path.read_text().startswith("# id x y z feed\n")
+    drawing = read_points(path)
+    assert vertices(drawing.contours[0]) == [(0.0, 0.0), (10.5, 0.0), (10.5, 5.25)]
+    assert holds_rows(path.read_text())
+
+
+def test_a_row_of_a_table_without_its_x_or_y_value_is_refused(tmp_path: Path) -> None:
+    path = write(tmp_path, "t.csv", "id,x,y,z,feed\n1,0,0,0,100\n2,,0,0,100\n")
+    with pytest.raises(InputError, match="line 3: no value in column 2, which the header names X"):
+        read_points(path)
+
+
+def test_more_than_three_numbers_without_a_header_naming_x_and_y_is_refused(
+    tmp_path: Path,
+) -> None:
+    for text in ("1,0,0,0,100\n2,10,0,0,100\n", "a,b,c,d\n1,0,0,0\n"):
+        with pytest.raises(InputError, match=r"line [12]: [45] numbers; .* a header naming the X"):
+            read_points(write(tmp_path, "t.csv", text))
+
+
+@pytest.mark.parametrize("first", ["sep=;", '"sep=;"', "SEP=;"])
+def test_excel_s_line_naming_the_separator_is_not_a_row(tmp_path: Path, first: str) -> None:
+    """Excel writes ``sep=;`` first so that the CSV opens the same in every locale."""
+    drawing = read_points(write(tmp_path, "e.csv", f"{first}\r\nx;y\r\n0;0\r\n10;0\r\n10;5\r\n"))
+    assert vertices(drawing.contours[0]) == [(0.0, 0.0), (10.0, 0.0), (10.0, 5.0)]
+
+
+def test_excel_s_separator_line_naming_a_separator_camtool_does_not_read_is_refused(
+    tmp_path: Path,
+) -> None:
+    path = write(tmp_path, "e.csv", "sep=|\nx|y\n0|0\n10|0\n")
+    with pytest.raises(InputError, match=r"line 1: 'sep=\|' names the column separator '\|'"):
         read_points(path)
 
 

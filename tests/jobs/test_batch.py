@@ -79,10 +79,12 @@ def test_a_text_note_beside_the_drawings_is_passed_over_a_point_list_is_not(tree
     (tree / "parts" / "trace.txt").write_text("# x y\n0 0\n10 0\n")
     (tree / "parts" / "eu.txt").write_text("x;y\n0,5;0\n")  # a bad point list, posted
     (tree / "parts" / "cambam.txt").write_text("G21 G90\nG0 X0 Y0\n")  # a program as .txt
+    (tree / "parts" / "cmm.txt").write_text("sep=,\nid,name,x,y,z\n1,P1,0,0,0\n")  # a table
+    (tree / "parts" / "notes.txt").write_text("Parts\n\nX and Y\n2024 is the year\n")
     for found in (expand_inputs([str(tree)]), expand_inputs(["drawings/**/*.txt"])):
         names = {i.path.name for i in found}
-        assert {"trace.txt", "eu.txt", "cambam.txt"} <= names
-        assert not {"README.txt", "LICENSE.txt"} & names
+        assert {"trace.txt", "eu.txt", "cambam.txt", "cmm.txt"} <= names
+        assert not {"README.txt", "LICENSE.txt", "notes.txt"} & names
     named = expand_inputs(["drawings/README.txt"])
     assert [i.path.name for i in named] == ["README.txt"]
 
