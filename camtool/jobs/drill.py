@@ -1,7 +1,7 @@
 """A drill operation: the holes a selection names, drilled nearest first with a cycle each.
 
 The holes are the circles of the selection (each as large as its drill, within the
-operation's ``hole_tolerance``) and its points; each gets a
+operation's ``hole_tolerance``; a circle drawn in pieces, chained) and its points; each gets a
 :class:`~camtool.model.program.DrillCycle` whose moves (:func:`camtool.model.drilling.expand`)
 every dialect can write, and which LinuxCNC writes as its canned cycle.
 """
@@ -12,6 +12,7 @@ import dataclasses
 import math
 from collections.abc import Sequence
 
+from camtool.geometry.chain import chain, joint_distance
 from camtool.jobs.job import Operation, Tool
 from camtool.model.drilling import expand
 from camtool.model.errors import InputError
@@ -39,7 +40,7 @@ def drill_moves(
         InputError: a selected contour is no circle, or a hole's size is not the drill's
             within ``op.hole_tolerance``, naming ``where``, the contour and its layer.
     """
-    holes = _holes(drawing, op, tool, where)
+    holes = _holes(drawing, op, tool, joint_distance(options.chain_tolerance), where)
     assert options.depth is not None  # a drill operation's depth is required when loaded
     clearance = options.clearance
     moves: list[Move] = []
@@ -78,10 +79,14 @@ def drill_moves(
     return moves, commands, len(holes)
 
 
-def _holes(drawing: Drawing, op: Operation, tool: Tool, where: str) -> list[Point]:
-    """The centres of the holes a drill operation drills, each checked against its drill."""
+def _holes(drawing: Drawing, op: Operation, tool: Tool, joint_mm: float, where: str) -> list[Point]:
+    """The centres of the holes a drill operation drills, each checked against its drill.
+
+    The contours are chained first, ``joint_mm`` apart at most, as the planner chains
+    them: a circle drawn as two ARCs is one hole.
+    """
     out: list[Point] = []
-    for contour in drawing.contours:
+    for contour in chain(drawing.contours, joint_mm):
         circle = circle_of(contour)
         name = f"{contour.source or 'contour'} on layer {contour.layer!r}"
         if circle is None:

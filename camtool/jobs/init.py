@@ -228,11 +228,10 @@ def _ops_of(
     circles: dict[float, list[float]] = {}  # by the diameter to 1 µm: every diameter
     profiled: list[Contour] = []
     opened: list[Contour] = []
-    # a drawn circle is drilled as drawn (the selection's diameter reads each entity); the
-    # rest as chained, closed or open, as the selection's closed = true / false reads them
-    drawn = {id(c) for c in kept}  # a chain of several entities is no drawn circle
+    # as chained, as the selection's closed and diameter read them: a circle drawn as two
+    # ARCs is a circle, a square of four LINEs closed
     for contour in _chains(group):
-        circle = circle_of(contour) if id(contour) in drawn else None
+        circle = circle_of(contour)
         if drill and circle is not None and circle[1] <= DRILL_MAX_MM:
             circles.setdefault(round(circle[1], 3), []).append(circle[1])
         elif contour.closed:

@@ -24,8 +24,9 @@ from camtool.jobs.job import Job, Operation, Tool
 from camtool.jobs.job_warnings import holes_cut_outside, overlaps, undrilled, unselected
 from camtool.jobs.jobfile import as_keys
 from camtool.jobs.selection import (
-    ChainedClosed,
+    Chaining,
     Selected,
+    Shape,
     construction_notes,
     nothing_selected,
     select,
@@ -41,7 +42,7 @@ from camtool.model.program import (
     ToolChange,
 )
 from camtool.model.progress import Progress, Step, no_progress
-from camtool.model.shapes import Contour, Drawing, Point
+from camtool.model.shapes import Arc, Contour, Drawing, Point, circle_of
 from camtool.toolpath.options import PlanOptions
 
 if TYPE_CHECKING:
@@ -258,14 +259,14 @@ def run_job(
     construction: list[Contour] = []
     drilled: set[int] = set()  # the drawing's marks an operation selected, by id
     joint = joint_distance(setup.chain_tolerance)  # how the planner chains contours
-    chained = _chained_closed(drawing, scaled, joint)
+    chaining = _chaining(drawing, scaled, joint)
     here: tuple[float, float, float | None] = (*setup.origin, None)
     loaded: int | None = None
     sequence = job.sequenced()
     for number, op in enumerate(sequence, start=1):
         tool = job.tool(op.tool)
         where = _where(job, op, number)
-        selected = select(drawing, op.select, chained)
+        selected = select(drawing, op.select, chaining)
         drilled.update(id(m) for m in selected.drawing.marks)
         chosen = _as_scaled(selected, drawing, scaled)
         construction.extend(c for c in chosen.construction if c not in construction)
@@ -394,23 +395,29 @@ def _edge(op: Operation, tool: Tool, options: PlanOptions) -> float:
     return options.radius if options.offset != "on" else 0.0
 
 
-def _chained_closed(drawing: Drawing, scaled: Drawing, joint_mm: float) -> ChainedClosed:
-    """Whether contours of ``drawing`` are closed once chained as the planner chains them.
+def _chaining(drawing: Drawing, scaled: Drawing, joint_mm: float) -> Chaining:
+    """What contours of ``drawing`` are once chained as the planner chains them.
 
     They are chained as scaled (``scaled``: ``drawing`` after ``scale``/``fit``, the same
-    contours in order), ``joint_mm`` apart at most (:func:`~camtool.geometry.chain.chain_members`).
+    contours in order), ``joint_mm`` apart at most (:func:`~camtool.geometry.chain.chain_members`);
+    a chain that is a whole circle gives the circle of its first piece as drawn.
     """
     as_scaled = {id(a): b for a, b in zip(drawing.contours, scaled.contours, strict=True)}
 
-    def closed(contours: Sequence[Contour]) -> list[bool]:
+    def shapes(contours: Sequence[Contour]) -> list[Shape]:
         joined, members = chain_members([as_scaled[id(c)] for c in contours], joint_mm)
-        out = [False] * len(contours)
+        out = [Shape(False, None)] * len(contours)
         for chain, pieces in zip(joined, members, strict=True):
+            circle = None
+            if circle_of(chain) is not None:  # its pieces are arcs of one centre and radius
+                first = contours[pieces[0]].segments[0]
+                assert isinstance(first, Arc)
+                circle = (first.centre, 2.0 * first.radius)
             for i in pieces:
-                out[i] = chain.closed
+                out[i] = Shape(chain.closed, circle)
         return out
 
-    return closed
+    return shapes
 
 
 def _as_scaled(chosen: Selected, drawing: Drawing, scaled: Drawing) -> Selected:

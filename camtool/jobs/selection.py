@@ -18,7 +18,7 @@ from typing import TypeAlias
 
 from camtool.jobs.job import Operation, Selection
 from camtool.model.construction import construction_layer
-from camtool.model.shapes import Contour, Drawing, Mark, circle_of
+from camtool.model.shapes import Contour, Drawing, Mark, Point, circle_of
 
 
 @dataclass(frozen=True)
@@ -48,11 +48,28 @@ def construction_reason(contour: Contour, selection: Selection) -> str | None:
     return None
 
 
-def matches(contour: Contour, selection: Selection, *, closed: bool | None = None) -> bool:
+Circle: TypeAlias = tuple[Point, float]
+"""A circle's centre and diameter, mm (:func:`~camtool.model.shapes.circle_of`)."""
+
+
+@dataclass(frozen=True)
+class Shape:
+    """What a contour is once chained with its neighbours, as the planner chains them.
+
+    ``closed``: the chain is closed (a square of four LINEs is); ``circle``: the chain is
+    a whole circle (two ARCs of one centre and radius are), its centre and diameter in the
+    drawing's own mm, else ``None``.
+    """
+
+    closed: bool
+    circle: Circle | None
+
+
+def matches(contour: Contour, selection: Selection, shape: Shape | None = None) -> bool:
     """Whether ``contour`` meets every condition of ``selection`` (construction aside).
 
-    ``closed``: whether the contour is closed as the planner chains it (a square of four
-    LINEs is), for ``selection.closed``; ``None``: the contour's own ``closed``.
+    ``shape``: what the contour is once chained (:class:`Shape`), for ``selection.closed``,
+    ``diameter`` and ``except_diameter``; ``None``: the contour's own.
     """
     if selection.layers is not None and contour.layer.casefold() not in {
         n.casefold() for n in selection.layers
@@ -60,20 +77,19 @@ def matches(contour: Contour, selection: Selection, *, closed: bool | None = Non
         return False
     if selection.colours is not None and contour.colour not in selection.colours:
         return False
-    is_closed = contour.closed if closed is None else closed
+    is_closed = contour.closed if shape is None else shape.closed
     if selection.closed is not None and is_closed != selection.closed:
         return False
     if selection.linetypes is not None and contour.linetype not in selection.linetypes:
         return False
-    if selection.diameter is not None:
-        circle = circle_of(contour)
-        if circle is None or not _within(circle[1], selection.diameter):
-            return False
-    if selection.except_diameter is not None:
-        circle = circle_of(contour)
-        if circle is not None and _within(circle[1], selection.except_diameter):
-            return False
-    return True
+    if selection.diameter is None and selection.except_diameter is None:
+        return True
+    circle = circle_of(contour) if shape is None else shape.circle
+    d = None if circle is None else circle[1]
+    if selection.diameter is not None and (d is None or not _within(d, selection.diameter)):
+        return False
+    span = selection.except_diameter
+    return span is None or d is None or not _within(d, span)
 
 
 def _within(d: float, span: tuple[float, float]) -> bool:
@@ -94,34 +110,34 @@ def mark_matches(mark: Mark, selection: Selection) -> bool:
     return selection.colours is None or mark.colour in selection.colours
 
 
-ChainedClosed: TypeAlias = Callable[[Sequence[Contour]], Sequence[bool]]
-"""Whether each of some contours is closed once they are chained end to end, as the planner
-chains what an operation selects (:func:`camtool.toolpath.plan.chained`)."""
+Chaining: TypeAlias = Callable[[Sequence[Contour]], Sequence[Shape]]
+"""What each of some contours is once they are chained end to end, as the planner chains
+what an operation selects (:func:`camtool.toolpath.plan.chained`)."""
 
 
-def select(
-    drawing: Drawing, selection: Selection, chained: ChainedClosed | None = None
-) -> Selected:
+def select(drawing: Drawing, selection: Selection, chaining: Chaining | None = None) -> Selected:
     """The contours and marks of ``drawing`` that ``selection`` cuts (see the module).
 
-    ``closed = true`` / ``false`` asks whether a contour is closed as it will be cut: a
-    closed shape drawn as several entities (four LINEs, LINEs and ARCs) is one closed
-    contour once chained. ``chained`` tells that of the contours the other conditions
-    keep (chained together, as the planner chains them); ``None``: each contour's own.
+    ``closed``, ``diameter`` and ``except_diameter`` ask what a contour is as it will be
+    cut: a closed shape drawn as several entities (four LINEs, LINEs and ARCs) is one
+    closed contour once chained, a circle drawn as two ARCs one circle. ``chaining`` tells
+    that of the contours the other conditions keep (chained together, as the planner
+    chains them); ``None``: each contour's own.
     """
     kept: list[Contour] = []
     construction: list[Contour] = []
-    closed: dict[int, bool] = {}
-    if selection.closed is not None and chained is not None:
-        shape = dataclasses.replace(selection, closed=None)
+    shapes: dict[int, Shape] = {}
+    asks = (selection.closed, selection.diameter, selection.except_diameter)
+    if chaining is not None and any(a is not None for a in asks):
+        loose = dataclasses.replace(selection, closed=None, diameter=None, except_diameter=None)
         candidates = [  # what the planner gets: construction is not cut
             c
             for c in drawing.contours
-            if matches(c, shape) and construction_reason(c, selection) is None
+            if matches(c, loose) and construction_reason(c, selection) is None
         ]
-        closed = {id(c): k for c, k in zip(candidates, chained(candidates), strict=True)}
+        shapes = {id(c): k for c, k in zip(candidates, chaining(candidates), strict=True)}
     for contour in drawing.contours:
-        if not matches(contour, selection, closed=closed.get(id(contour))):
+        if not matches(contour, selection, shapes.get(id(contour))):
             continue
         if construction_reason(contour, selection) is None:
             kept.append(contour)

@@ -236,6 +236,53 @@ def test_a_drill_of_one_hole_size_drills_no_point(tmp_path: Path) -> None:
     assert not any(w.startswith("not drilled") for w in done.program.warnings)
 
 
+def test_a_circle_drawn_as_arcs_is_a_hole_to_drill_and_no_profile(tmp_path: Path) -> None:
+    """A ø3 hole drawn as two ARCs (as converters and some CAD exports draw circles) is one
+    circle once chained: ``job init`` drills it with the CIRCLE of the same size, the
+    written drill's ``diameter`` selects it, the profile's ``except_diameter`` leaves it.
+    Before, it was profiled on its inside with the 3 mm mill: nothing cut, a warning.
+    """
+    from camtool.jobs.init import initial_job
+    from tests.shapes import write_dxf
+
+    def build(msp: object) -> None:
+        msp.add_lwpolyline([(0, 0), (60, 0), (60, 40), (0, 40)], close=True)  # type: ignore[attr-defined]
+        msp.add_arc((15, 20), 1.5, 0, 180)  # type: ignore[attr-defined]
+        msp.add_arc((15, 20), 1.5, 180, 360)  # type: ignore[attr-defined]
+        msp.add_circle((45, 20), 1.5)  # type: ignore[attr-defined]
+        msp.add_arc((30, 20), 1.5, 90, 0)  # type: ignore[attr-defined]  # 3/4 of a turn, open
+
+    drawing = read_drawing(write_dxf(tmp_path / "arcs.dxf", build))
+    text = initial_job(drawing).replace('origin = "lower-left"', 'origin = "drawing"')
+    assert "2 circle(s) of ø3 mm on layer '0': small, drilled" in text
+    job = tmp_path / "job.toml"
+    job.write_text(text)
+    done = run_job(drawing, load_target("grbl"), load_job(job))
+    drilled = [c for _, c in done.program.commands if isinstance(c, DrillCycle)]
+    assert sorted((c.x, c.y) for c in drilled) == [(15.0, 20.0), (45.0, 20.0)]
+    profile = done.operations[-1]
+    assert profile.operation.kind == "profile outside"
+    assert [(c.source or "").split()[0] for c in profile.placed.contours] == ["LWPOLYLINE"]
+    assert not any("narrower than the 3 mm tool" in w for w in done.program.warnings)
+
+
+def test_a_drill_selecting_half_a_circle_refuses_it(tmp_path: Path) -> None:
+    from tests.shapes import write_dxf
+
+    def build(msp: object) -> None:
+        msp.add_arc((15, 20), 1.5, 0, 180, dxfattribs={"layer": "H"})  # type: ignore[attr-defined]
+        msp.add_arc((15, 20), 1.5, 180, 300, dxfattribs={"layer": "H"})  # type: ignore[attr-defined]
+
+    drawing = read_drawing(write_dxf(tmp_path / "half.dxf", build))
+    job = tmp_path / "job.toml"
+    job.write_text(
+        '[[tools]]\nid = 1\ntype = "drill"\ndiameter = 3\n'
+        '[[operations]]\ntype = "drill"\ntool = 1\nlayers = ["H"]\ndepth = 2\n'
+    )
+    with pytest.raises(InputError, match="which is not a circle"):
+        run_job(drawing, load_target("grbl"), load_job(job))
+
+
 def test_closed_selects_a_shape_drawn_as_several_entities(tmp_path: Path) -> None:
     """``closed = true`` (as ``camtool job init`` writes for a profile) keeps a closed chain.
 
