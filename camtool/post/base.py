@@ -159,6 +159,23 @@ def check_dropped_homes(program: Program, homes: tuple[str, ...], target: str) -
         )
 
 
+def input_line(program: Program, index: int, *, move: bool) -> str:
+    """Where an item of ``program`` read from code comes from, for messages.
+
+    ``index``: the move's index in ``program.moves``, or for a command the index of the move
+    it stands before (``len(program.moves)``: after the last). ``"input line N"`` for a
+    move, ``"before input line N"`` / ``"after input line N"`` for a command; empty when the
+    program was not read from code.
+    """
+    if move:
+        line, where = program.line_of(index), "input line"
+    elif index < len(program.moves):
+        line, where = program.line_of(index), "before input line"
+    else:
+        line, where = program.line_of(index - 1), "after input line"
+    return "" if line is None else f"{where} {line}"
+
+
 def check_placement(program: Program, machine: Machine) -> tuple[str, ...]:
     """The work-coordinate rule for a program about to be written (or verified).
 
@@ -243,6 +260,8 @@ class WriterState(Generic[B]):
         here: where the program has reached, mm (the end of the last move
             written).
         contour: the contour of the move being written (0: the moves have none).
+        source: the line of the program read from code that the item being written
+            comes from (:func:`input_line`; empty: none).
         arcs: arcs written as chords.
         chords: chords written for them.
         chord_error_mm: largest chord error (sagitta) of those chords, mm.
@@ -256,6 +275,7 @@ class WriterState(Generic[B]):
         self.notes: dict[str, str] = {}
         self.here: Point = here
         self.contour = 0
+        self.source = ""
         self.arcs = 0
         self.chords = 0
         self.chord_error_mm = 0.0
@@ -264,13 +284,17 @@ class WriterState(Generic[B]):
     def where(self, contour: int | None = None, block: int | None = None) -> str:
         """The place for a message: ``"contour C, block B"``, or ``"block B"`` without a contour.
 
+        A program read from code adds the line it comes from (:attr:`source`):
+        ``"block 4 (input line 3)"``.
+
         Args:
             contour: the contour (``None``: :attr:`contour`; 0: none).
             block: the 1-based block (``None``: the one about to be written).
         """
         contour = self.contour if contour is None else contour
         block = len(self.blocks) + 1 if block is None else block
-        return f"contour {contour}, block {block}" if contour else f"block {block}"
+        place = f"contour {contour}, block {block}" if contour else f"block {block}"
+        return f"{place} ({self.source})" if self.source else place
 
     def warn(self, message: str) -> None:
         """Add ``message`` to :attr:`warnings` unless it is there already."""

@@ -38,6 +38,7 @@ from camtool.model.shapes import FULL_CIRCLE_EPS, Arc, Point, make_arc
 from camtool.post.base import (
     check_placement,
     check_work_area,
+    input_line,
 )
 from camtool.post.wordaddress_arcs import (
     ARC_CHORD_TOLERANCE_MM,
@@ -161,13 +162,9 @@ class BlockWriter(ArcWriter):
         A move is move ``index - 1`` of the program; a command stands before move ``index``,
         or after the last move when there is none.
         """
-        if isinstance(item, (*_MOVES, PlaneArc)):
-            line, where = self.program.line_of(index - 1), "input line"
-        elif index < len(self.program.moves):
-            line, where = self.program.line_of(index), "before input line"
-        else:
-            line, where = self.program.line_of(index - 1), "after input line"
-        return exc if line is None else DialectError(f"{exc} ({where} {line})")
+        move = isinstance(item, (*_MOVES, PlaneArc))
+        where = input_line(self.program, index - 1 if move else index, move=move)
+        return DialectError(f"{exc} ({where})") if where else exc
 
     # -- moves -------------------------------------------------------------------
 

@@ -38,6 +38,7 @@ from camtool.post.base import (
     check_work_area,
     check_written_z,
     from_options,
+    input_line,
 )
 from camtool.post.numfmt import NumberFormat
 from camtool_postprocessors.i8751.packets import (
@@ -378,12 +379,17 @@ class I8751Post(PostProcessor):
                 f"record holds ({MAX_STEPS}); give a smaller lift_mm in [dialect_options]"
             )
         w = _Writer(machine.steps_per_mm, lift_steps, program.origin)
+        index = 0  # of the next move
         for item in program.items():
             if isinstance(item, Rapid | Linear | ArcMove):
+                w.source = input_line(program, index, move=True)
                 self._move(w, item, machine, program)
                 w.here = (item.x, item.y)
+                index += 1
             else:
+                w.source = input_line(program, index, move=False)
                 self._command(w, item)
+        w.source = ""
         warnings = (*check_placement(program, machine), *self._warnings(w, program, machine))
         if fmt == "bin":
             return PostResult(encode_stream(w.blocks), len(w.blocks), warnings, fmt)

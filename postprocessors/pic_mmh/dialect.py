@@ -47,6 +47,7 @@ from camtool.post.base import (
     check_placement,
     check_work_area,
     from_options,
+    input_line,
 )
 from camtool.post.numfmt import NumberFormat, format_int
 
@@ -365,17 +366,20 @@ class PicMmhPost(PostProcessor):
         w = _Writer(["G54;", "G90;"], program.origin)
         w.warnings.extend(check_placement(program, machine))
         homed = False
-        for move, commands in _steps(program):
+        for index, (move, commands) in enumerate(_steps(program)):
+            w.source = input_line(program, index, move=False)
             for command in commands:
                 homed = self._command(command, move.contour if move else 0, w) or homed
             if move is None:
                 continue
+            w.source = input_line(program, index, move=True)
             start = w.here
             self._check_move(move, w, homed)
             check_work_area(start, move, machine, w.where(move.contour), program)
             homed = homed and not isinstance(move, Rapid)
             self._move(start, move, machine, w, _tolerance(program, machine))
             w.here = (move.x, move.y)
+        w.source = ""
         w.blocks.append("M30;")
         self._rate_warnings(machine, w)
         self._length_warning(w)

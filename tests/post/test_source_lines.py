@@ -8,6 +8,8 @@ before. Expected lines are read off the test programs below.
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
 from camtool.importers.gcode import parse_gcode
@@ -34,6 +36,26 @@ def test_a_refusal_names_the_input_line(text: str, said: str) -> None:
     with pytest.raises(DialectError) as refused:
         post_program(parse_gcode(text, source="in.ngc"), load_target("flashcut"))
     assert str(refused.value).endswith(said)
+
+
+# pic-mmh's feed table ends at F99 = 9.9 mm/min, its spindle field at 9999 rev/min; its
+# blocks: G54; G90; then one per move (the refused one is block 5)
+PIC_FEED = "G21 G90\nG0 X1 Y1\nG1 X2 Y1 F5\n(too fast for the table)\nG1 X3 Y1 F100\nM2\n"
+PIC_SPINDLE = "G21 G90\nG0 X1 Y1\nG1 X2 Y1 F5\nS20000 M3\nG1 X3 Y1\nM2\n"
+
+
+@pytest.mark.parametrize(
+    ("text", "said"),
+    [
+        (PIC_FEED, "block 5 (input line 5): feed 100 mm/min is outside F01–F99"),
+        (PIC_SPINDLE, "block 5 (before input line 5): spindle speed 20000 rev/min"),
+    ],
+)
+def test_pic_mmh_s_own_writer_names_the_input_line(text: str, said: str) -> None:
+    """pic-mmh writes its fixed-width blocks with a writer of its own: its refusals of a
+    re-posted program name the input's line as the word-address writer's do."""
+    with pytest.raises(DialectError, match=re.escape(said)):
+        post_program(parse_gcode(text, source="in.ngc"), load_target("pic-mmh"))
 
 
 def test_a_drawing_s_refusal_names_no_input_line() -> None:
