@@ -602,7 +602,8 @@ def convert(
     """Turn svgelements path segments (local coordinates) into subpaths in mm, Y up.
 
     Each ``Move`` starts a subpath; ``Close`` draws the line back to the subpath's start
-    (unless already there) and closes it. A subpath whose last point is within 1e-9 mm of
+    (unless within ``tolerance`` of it: the last segment is then moved to end there) and
+    closes it. A subpath whose last point is within 1e-9 mm of
     its first is closed too. Zero-length segments are dropped; consecutive arcs on one
     circle (a ``<circle>``'s quarters, an arc split in two) are merged.
 
@@ -629,12 +630,12 @@ def convert(
     start: Point | None = None
     cursor: Point | None = None
 
-    def flush(closed: bool) -> None:
+    def flush(closed: bool, snap: float = ZERO_LENGTH_MM) -> None:
         if current:
             segs = merge_arcs(current)
             if (
                 start is not None
-                and distance(segs[-1].end, start) <= ZERO_LENGTH_MM
+                and distance(segs[-1].end, start) <= snap
                 and (len(segs) > 1 or closes_alone(segs[0]))
             ):
                 segs[-1] = with_end(segs[-1], start)
@@ -650,9 +651,13 @@ def convert(
         if cursor is None or start is None:  # svgelements always starts with Move
             start = cursor = _pt(m, seg.start)
         if isinstance(seg, se.Close):
-            if distance(cursor, start) > ZERO_LENGTH_MM:
+            # a gap within the tolerance is the rounding of relative coordinates (CorelDRAW's
+            # 2 decimals): the last segment ends at the start, no closing line a spike thin
+            gap = distance(cursor, start)
+            alone = len(current) == 1 and not closes_alone(current[0])
+            if gap > tolerance or (gap > ZERO_LENGTH_MM and alone):
                 current.append(Line(cursor, start))
-            flush(True)
+            flush(True, snap=tolerance)
             cursor = start
             continue
         new = segment(seg, cursor, m, tolerance, fitter)

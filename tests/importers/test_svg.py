@@ -198,6 +198,27 @@ def test_lineto_after_closepath_starts_from_the_subpath_start(tmp_path: Path) ->
     assert vertices(contours[1]) == [(10, 90), (0, 90)]
 
 
+@pytest.mark.parametrize(
+    ("gap", "sides"),
+    [
+        (0.0009, 4),  # within the 0.001 mm tolerance: CorelDRAW's rounding, no closing line
+        (0.0011, 5),  # beyond it: the closing line Z draws
+    ],
+)
+def test_z_within_the_tolerance_of_the_start_moves_the_last_segment_there(
+    tmp_path: Path, gap: float, sides: int
+) -> None:
+    """Relative coordinates rounded to 2 decimals (CorelDRAW) end a closed path a hair
+    from its start: Z's line of 0.0009 mm made a spike that offsetting read as the contour
+    crossing itself. Within ``--tolerance`` the last segment ends at the start instead."""
+    d = f"m 10 10 l 20 0 l 0 20 l -20 0 l 0 {-20 + gap:.4f} z"
+    contour = one(read_svg(svg(tmp_path, f'<path d="{d}"/>')))
+    assert contour.closed and len(contour.segments) == sides
+    assert contour.segments[-1].end == contour.start == (10.0, 90.0)
+    if sides == 4:  # the last side runs from (10, 70) to the start, no 0.0009 mm line
+        assert contour.segments[-1].start == (10.0, 70.0)
+
+
 # ------------------------------------------------------------------ basic shapes
 
 
