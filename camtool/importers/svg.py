@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import io
 import math
-import re
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import Any, TypeAlias
@@ -41,6 +40,7 @@ from camtool.importers.svgpage import (
     off_page_text,
     refusal_note,
 )
+from camtool.importers.svgstyle import style_of
 from camtool.model.errors import GeometryError, InputError, TooLargeError
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import (
@@ -295,10 +295,6 @@ def _shapes(node: Any) -> Iterator[Any]:
             yield from _shapes(child)
 
 
-def _none(paint: Any) -> bool:
-    return paint is None or str(paint).strip().lower() == "none"
-
-
 def _unpainted(color: Any) -> bool:
     """Whether a shape's ``fill`` or ``stroke`` (svgelements' Color) paints nothing.
 
@@ -335,7 +331,7 @@ def _contours(
     except (GeometryError, InputError) as exc:
         raise InputError(f"{path}: {label}: {exc}") from exc
     many = len(subpaths) > 1
-    colour, linetype = _style(values)
+    colour, linetype = style_of(values)
     return [
         Contour(segs, closed, layer, f"{label} subpath {k}" if many else label, colour, linetype)
         for k, (segs, closed) in enumerate(subpaths, start=1)
@@ -407,41 +403,6 @@ def _label(shape: Any) -> str:
     if use and use != label:
         label = f"{use} > {label}"
     return label
-
-
-def _style(values: Any) -> tuple[str, str]:
-    """The shape's colour (its stroke, else its fill, as ``#rrggbb``) and linetype.
-
-    A stroke with a ``stroke-dasharray`` of dashes is ``"DASHED"`` (a construction line,
-    :mod:`camtool.model.construction`); else ``""``.
-    """
-    colour = ""
-    for key in ("stroke", "fill"):
-        paint = str(values.get(key) or "none").strip()
-        if _none(paint) or paint.lower().startswith(("url(", "currentcolor")):
-            continue
-        try:
-            rgb = se.Color(paint)
-        except (ValueError, TypeError):
-            continue
-        if rgb.value is not None:
-            colour = f"#{rgb.red:02x}{rgb.green:02x}{rgb.blue:02x}"
-            break
-    return colour, ("DASHED" if _dashed(values) else "")
-
-
-def _dashed(values: Any) -> bool:
-    """Whether the shape is stroked with dashes (a ``stroke-dasharray`` with a length > 0)."""
-    if _none(values.get("stroke")):
-        return False
-    dashes = str(values.get("stroke-dasharray") or "").replace(",", " ").split()
-    lengths = []
-    for text in dashes:
-        try:
-            lengths.append(float(re.sub(r"[a-z%]+$", "", text.lower())))
-        except ValueError:
-            return False  # not a dash array camtool can read: drawn as a line
-    return any(v > 0 for v in lengths)
 
 
 # ------------------------------------------------------------------ curve fits, ahead

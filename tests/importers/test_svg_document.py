@@ -6,6 +6,7 @@ Files written by Inkscape 1.2.2 are in tests/data (tests/data/README-svg.md says
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -245,6 +246,39 @@ def test_inherit_takes_the_parents_value_as_css_says(tmp_path: Path) -> None:
         ("path#dash", "#0000ff", "DASHED"),
         ("path#blue", "#0000ff", "DASHED"),
     ]
+
+
+SHAPER = (
+    '<svg xmlns="http://www.w3.org/2000/svg" '
+    'xmlns:shaper="http://www.shapertools.com/namespaces/shaper" viewBox="0 0 200 100" '
+    'width="200mm" height="100mm">'
+    # a sheet-layout tool's sheet border and a group of guides: not the part
+    '<rect id="sheet" x="0" y="0" width="200" height="100" fill="none" stroke="blue" '
+    'shaper:cutType="guide"/>'
+    '<g shaper:cutType="GUIDE"><path id="centre" d="M 100 0 L 100 100" stroke="#0068FF"/></g>'
+    '<rect id="part" x="20" y="20" width="60" height="40" fill="black" stroke="black" '
+    'shaper:cutType="outside"/></svg>'
+)
+
+
+def test_a_shaper_origin_guide_is_construction_and_not_cut(tmp_path: Path) -> None:
+    """Shaper Origin's ``shaper:cutType="guide"`` (Shaper Tools' export, sheet-layout tools
+    writing their sheet's border so) marks a line that is not cut: read as the linetype
+    GUIDE, construction, which a job cuts only when an operation names it. Posted, the
+    part alone is cut: a 60 x 40 mm rectangle at (20, 40)-(80, 80) mm, Y up."""
+    path = tmp_path / "sheet.svg"
+    path.write_text(SHAPER, encoding="utf-8")
+    drawing = read_svg(path)
+    got = [(c.source, c.linetype) for c in drawing.contours]
+    assert got == [("rect#sheet", "GUIDE"), ("path#centre", "GUIDE"), ("rect#part", "")]
+    from camtool.cli.main import main
+
+    out = tmp_path / "sheet.ngc"
+    assert main(["post", str(path), "-t", "linuxcnc", "-o", str(out)]) == 0
+    xy = [
+        (float(x), float(y)) for x, y in re.findall(r"G1 X(-?[\d.]+) Y(-?[\d.]+)", out.read_text())
+    ]
+    assert xy and {x for x, _ in xy} <= {20.0, 80.0} and {y for _, y in xy} <= {40.0, 80.0}
 
 
 def test_a_paint_that_is_no_colour_is_ignored_as_css_says(tmp_path: Path) -> None:

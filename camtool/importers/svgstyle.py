@@ -1,0 +1,64 @@
+"""A drawn SVG shape's colour and linetype, as jobs select by them.
+
+The colour is the stroke's, else the fill's (SVG 1.1 §11.2-11.4, paint); the linetype
+says construction (:mod:`camtool.model.construction`): a stroke of dashes
+(``stroke-dasharray``, §11.4), or a Shaper Origin guide (``shaper:cutType="guide"``, the
+attribute Shaper Tools' own SVG export and many sheet-layout tools write).
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Any
+
+import svgelements as se
+
+_SHAPER_CUT_TYPE = "{http://www.shapertools.com/namespaces/shaper}cutType"
+"""Shaper Origin's attribute saying how a shape is cut; ``guide``: not at all."""
+
+
+def style_of(values: Any) -> tuple[str, str]:
+    """The shape's colour (its stroke, else its fill, as ``#rrggbb``) and linetype.
+
+    A Shaper Origin guide (``shaper:cutType="guide"``, on the shape or a group: a sheet's
+    border, a centre line) is ``"GUIDE"``; a stroke with a ``stroke-dasharray`` of dashes
+    is ``"DASHED"``: construction lines (:mod:`camtool.model.construction`); else ``""``.
+    """
+    if str(values.get(_SHAPER_CUT_TYPE, "")).strip().lower() == "guide":
+        return _colour(values), "GUIDE"
+    return _colour(values), ("DASHED" if _dashed(values) else "")
+
+
+def _colour(values: Any) -> str:
+    """The shape's stroke, else its fill, as ``#rrggbb`` (``""``: neither paints)."""
+    colour = ""
+    for key in ("stroke", "fill"):
+        paint = str(values.get(key) or "none").strip()
+        if _none(paint) or paint.lower().startswith(("url(", "currentcolor")):
+            continue
+        try:
+            rgb = se.Color(paint)
+        except (ValueError, TypeError):
+            continue
+        if rgb.value is not None:
+            colour = f"#{rgb.red:02x}{rgb.green:02x}{rgb.blue:02x}"
+            break
+    return colour
+
+
+def _dashed(values: Any) -> bool:
+    """Whether the shape is stroked with dashes (a ``stroke-dasharray`` with a length > 0)."""
+    if _none(values.get("stroke")):
+        return False
+    dashes = str(values.get("stroke-dasharray") or "").replace(",", " ").split()
+    lengths = []
+    for text in dashes:
+        try:
+            lengths.append(float(re.sub(r"[a-z%]+$", "", text.lower())))
+        except ValueError:
+            return False  # not a dash array camtool can read: drawn as a line
+    return any(v > 0 for v in lengths)
+
+
+def _none(paint: Any) -> bool:
+    return paint is None or str(paint).strip().lower() == "none"
