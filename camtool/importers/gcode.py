@@ -21,7 +21,7 @@ from camtool.importers.gcode_cycles import CYCLES, CycleState
 from camtool.importers.gcode_lexer import Block, Word, cut_mid_word, lex_line
 from camtool.importers.gcode_plain import ARC_TOL_IN, ARC_TOL_MM, PLAIN_WORDS
 from camtool.importers.gcode_start import StartRules
-from camtool.importers.gcode_target import READ_AS_WRITTEN, LengthOffsets, Reading
+from camtool.importers.gcode_target import READ_AS_WRITTEN, LengthOffsets, Reading, path_control
 from camtool.model.errors import InputError
 from camtool.model.program import (
     ArcMove,
@@ -297,7 +297,7 @@ class _Reader(StartRules):
         self.units_seen = False
         self.feed_mm_min: float | None = None
         self.first_feed = reading.feed_mm_min  # the feed before the first F word (post --feed)
-        self.work_offsets = reading.work_offsets  # the work offsets the target writes
+        self.reading = reading  # the offsets and path control modes the target writes
         self.known_start = reading.known_start  # written again: no move from the guessed XY
         self.coord: str | None = None
         self.offsets = (  # the target writes G43 H<n> after each change: kept as read
@@ -382,11 +382,10 @@ class _Reader(StartRules):
             self.feed_mm_min = f.value * self.scale
         self.commands.block(w, len(self.moves), self.line, self.where())
         for code in (*w.m.values(), *w.g.values()):
-            kept = (self.offsets is not None and code.group == "length") or (
-                code.group == "coord" and code.name in self.work_offsets
-            )
-            if code.action == "warn" and not kept:
+            if code.action == "warn" and not self.reading.keeps(code):
                 self.notes.add(code.name, self.line, code.note)
+        if (path := w.g_name("path")) in self.reading.path_controls:
+            self.commands.add(len(self.moves), path_control(w, str(path), self.scale, self.where()))
         if self.offsets is not None:
             self.offsets.block(w, self.where())
         if (coord := w.g_name("coord")) is not None:
@@ -395,7 +394,7 @@ class _Reader(StartRules):
                     f"{self.where()}: {coord} after {self.coord}: camtool assumes one work "
                     "offset (the part zero); split the program at the change"
                 )
-            if self.coord is None and coord in self.work_offsets:
+            if self.coord is None and coord in self.reading.work_offsets:
                 self.commands.add(len(self.moves), WorkOffset(coord))
             self.coord = coord
         if (plane := w.g_name("plane")) is not None:

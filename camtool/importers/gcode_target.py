@@ -14,9 +14,9 @@ import dataclasses
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 
-from camtool.importers.gcode_codes import BlockWords, CommandReader
+from camtool.importers.gcode_codes import BlockWords, Code, CommandReader
 from camtool.model.errors import InputError
-from camtool.model.program import Command, LengthOffset, Move, ToolChange
+from camtool.model.program import Command, LengthOffset, Move, PathControl, ToolChange
 
 
 @dataclass(frozen=True)
@@ -33,6 +33,10 @@ class Reading:
             ``work_offsets``): the one the program selects, if among them, is a
             ``WorkOffset`` command written before its first move; otherwise it is read as
             the part zero, with a warning.
+        path_controls: the path control codes the target writes (``G61``, ``G61.1``,
+            ``G64``; its dialect's ``path_controls``): the program's are kept as
+            :class:`~camtool.model.program.PathControl` commands (:func:`path_control`);
+            otherwise they are ignored, with a warning.
         known_start: the program is written again: a move whose end or centre depends on
             where the machine stands before the program gives X and Y (an incremental X
             or Y, a move naming one of them, an arc) is refused, naming its line;
@@ -44,6 +48,13 @@ class Reading:
     length_offsets: bool = False
     work_offsets: tuple[str, ...] = ()
     known_start: bool = False
+    path_controls: tuple[str, ...] = ()
+
+    def keeps(self, code: Code) -> bool:
+        """Whether a code the reader otherwise ignores with a warning is kept for the target."""
+        if code.group == "length":
+            return self.length_offsets
+        return code.name in (self.work_offsets if code.group == "coord" else self.path_controls)
 
 
 READ_AS_WRITTEN = Reading()
@@ -129,3 +140,22 @@ class LengthOffsets:
             if isinstance(command, ToolChange) and id(command) not in self.own:
                 command = dataclasses.replace(command, length_offset=False)
             yield index, command
+
+
+def path_control(w: BlockWords, code: str, scale: float, where: str) -> PathControl:
+    """The block's path control mode ``code``, its G64 P and Q in mm (``scale``: mm per unit).
+
+    Raises:
+        InputError: a negative tolerance (LinuxCNC refuses it too), naming ``where``.
+    """
+    p, q = w.args.get("P"), w.args.get("Q")
+    for word in (p, q):
+        if code == "G64" and word is not None and word.value < 0:
+            raise InputError(f"{where}: G64 {word}: a blending tolerance is ≥ 0 (0: none)")
+    if code != "G64":
+        return PathControl(code)
+    return PathControl(
+        code,
+        None if p is None else p.value * scale,
+        None if q is None else q.value * scale,
+    )

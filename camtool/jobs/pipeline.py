@@ -255,7 +255,13 @@ def reading_for(target: Target, plan: PlanOptions) -> Reading:
     from camtool.importers.gcode_target import Reading
 
     post = target.post
-    return Reading(plan.feed_mm_min, post.length_offsets, post.work_offsets, known_start=True)
+    return Reading(
+        plan.feed_mm_min,
+        post.length_offsets,
+        post.work_offsets,
+        known_start=True,
+        path_controls=post.path_controls,
+    )
 
 
 def sized(

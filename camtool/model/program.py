@@ -139,6 +139,22 @@ class WorkOffset:
 
 
 @dataclass(frozen=True)
+class PathControl:
+    """The path control mode a program read from code selects (RS-274/NGC §3.5.14).
+
+    ``code``: ``"G61"`` exact path, ``"G61.1"`` exact stop, ``"G64"`` blending, with its
+    tolerance ``tolerance_mm`` (P) and naive CAM tolerance ``naive_mm`` (Q), mm
+    (``None``: not given). Only for a dialect that writes the code (``path_controls`` of
+    its spec): LinuxCNC run without the program's ``G64 P0.001`` blends corners by as
+    much as its own default allows.
+    """
+
+    code: str
+    tolerance_mm: float | None = None
+    naive_mm: float | None = None
+
+
+@dataclass(frozen=True)
 class Stop:
     """Program stop (M0), or optional stop (M1) when ``optional``.
 
@@ -310,6 +326,7 @@ Command: TypeAlias = (
     | ToolChange
     | LengthOffset
     | WorkOffset
+    | PathControl
     | Stop
     | DrillCycle
     | Home

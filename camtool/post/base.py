@@ -463,6 +463,15 @@ class PostProcessor(ABC):
         return ()
 
     @property
+    def path_controls(self) -> tuple[str, ...]:
+        """The path control codes (``G61``, ``G61.1``, ``G64``) the dialect writes.
+
+        A program read for such a target keeps its own (:class:`~camtool.model.program.
+        PathControl`); ``()``: the machine's own mode applies.
+        """
+        return ()
+
+    @property
     def homes(self) -> tuple[str, ...]:
         """The returns to machine positions (``"G28"``, ``"G30"``, ``"G53"``) the dialect writes.
 

@@ -105,6 +105,11 @@ class WordAddressPost(PostProcessor):
         """The spec's ``work_offsets`` (LinuxCNC's G54 … G59.3, GRBL's G54 … G59)."""
         return self.spec.work_offsets
 
+    @property
+    def path_controls(self) -> tuple[str, ...]:
+        """The spec's ``path_controls`` (LinuxCNC's G61, G61.1 and G64)."""
+        return self.spec.path_controls
+
     def emit(self, program: Program, machine: Machine, *, fmt: str | None = None) -> PostResult:
         """Write ``program`` for ``machine`` (rules: the module docstring).
 

@@ -124,6 +124,10 @@ class WordAddressSpec:
         work_offsets: the work offset codes the controller has (``G54`` … ``G59.3``): a
             program read from code that selects one keeps it (written before its first
             move); ``()``: a program runs in the work offset the user has active.
+        path_controls: the path control codes the controller has (``G61``, ``G61.1``,
+            ``G64`` with its P and Q tolerances in mm): a program read from code keeps
+            its own where it had them (``rs274`` reads them back); ``()``: they are
+            ignored, with a warning.
         home: ``"G28"``: a program read from code keeps its returns to the machine's
             stored positions and machine zero (:class:`~camtool.model.program.Home`;
             G28's, G30's and G53's, :attr:`homes`), written as RS-274 writes them:
@@ -177,6 +181,7 @@ class WordAddressSpec:
     tool_change: str | None = None
     tool_length_offset: str | None = None
     work_offsets: tuple[str, ...] = ()
+    path_controls: tuple[str, ...] = ()
     home: str | None = None
     stop: str | None = None
     optional_stop: str | None = None
@@ -238,6 +243,10 @@ class WordAddressSpec:
         """Codes of the preamble and postamble, and the work offsets (no effect on the path)."""
         framed = (code for block in self.preamble + self.postamble for code in block)
         return frozenset((*framed, *self.work_offsets))
+
+
+PATH_CONTROLS = ("G61", "G61.1", "G64")
+"""The RS-274/NGC path control codes (exact path, exact stop, blending)."""
 
 
 def _comment_pattern(style: str) -> re.Pattern[str]:
@@ -435,6 +444,10 @@ def _codes(t: _Table) -> dict[str, Any]:
     for code in out["work_offsets"]:
         if not re.fullmatch(r"G5[4-9](\.[1-3])?", code):
             raise t.error("work_offsets", f"a work offset is G54 to G59.3, got {_show(code)}")
+    out["path_controls"] = tuple(_code(t, "path_controls", v) for v in t.strings("path_controls"))
+    for code in out["path_controls"]:
+        if code not in PATH_CONTROLS:
+            raise t.error("path_controls", f"a path control code is G61, G61.1 or G64, got {code}")
     return out
 
 
@@ -527,6 +540,8 @@ def _check(spec: WordAddressSpec, t: _Table) -> None:
         raise t.error(
             "planes", f"arcs in the ZX and YZ planes need Z, I, J and K words; {missing} missing"
         )
+    if spec.path_controls and not spec.rs274:
+        raise t.error("path_controls", "path control modes need rs274 = true (read back by it)")
     if spec.planes and not (spec.helix and spec.rs274):
         raise t.error("planes", "arcs in other planes need helix = true and rs274 = true")
     if spec.has("K") and not spec.planes:

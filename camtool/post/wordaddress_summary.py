@@ -20,8 +20,9 @@ def closing_warnings(
     Args:
         spec: the dialect (its name, codes, quantum and step grids).
         counts: what the writer counted, by kind (``"feed"``, ``"Spindle"``, ``"speed"``,
-            ``"Coolant"``, ``"Dwell"``, ``"ToolChange"``, ``"Home"``, ``"z-split"``,
-            ``"arc-chords"``, ``"far-centre"``, ``"plane-chords"``, ``"tiny-arc"``); kinds
+            ``"Coolant"``, ``"Dwell"``, ``"ToolChange"``, ``"Home"``, ``"PathControl"``,
+            ``"z-split"``, ``"arc-chords"``, ``"far-centre"``, ``"plane-chords"``,
+            ``"tiny-arc"``); kinds
             not counted give no warning.
         grid_error_mm: the largest change of a coordinate rounded to a step grid, mm.
         chord_tolerance_mm: the chord deviation allowed to an arc written as chords, mm
@@ -44,6 +45,8 @@ def closing_warnings(
         "dropped; change tools by hand",
         "Home": f"{name}: {d['Home']} G28/G30/G53 return(s) to a machine position "
         "dropped (camtool does not write them for it); move there by hand if the job needs it",
+        "PathControl": f"{name} has no path control code: {d['PathControl']} G61/G61.1/G64 "
+        "mode(s) dropped; the machine's own mode applies",
         "z-split": f"{d['z-split']} move(s) changing XY and Z together written as a Z block "
         f"and an XY block (Z first when rising, last when plunging): {name} puts Z moves in "
         "blocks of their own",

@@ -26,6 +26,7 @@ from camtool.model.program import (
     LengthOffset,
     Linear,
     Move,
+    PathControl,
     PlaneArc,
     Program,
     Rapid,
@@ -643,10 +644,24 @@ class BlockWriter(ArcWriter):
             self._length_offset(command)
         elif isinstance(command, WorkOffset) and command.code in self.spec.work_offsets:
             self.block([command.code])
+        elif isinstance(command, PathControl) and command.code in self.spec.path_controls:
+            given = zip("PQ", (command.tolerance_mm, command.naive_mm), strict=True)
+            self.block([command.code, *(k + self._tolerance(v) for k, v in given if v is not None)])
         elif isinstance(command, Home) and command.code in spec.homes:
             self._home(command)
-        elif isinstance(command, Home | WorkOffset):
+        elif isinstance(command, Home | WorkOffset | PathControl):
             self.drop(command)
+
+    def _tolerance(self, mm: float) -> str:
+        """A G64 tolerance (mm) as written: rounded down, never looser than asked.
+
+        A positive one below the dialect's quantum is written as the quantum, not as 0:
+        LinuxCNC reads ``G64 P0`` as no tolerance at all, blending at any cost.
+        """
+        quantum = self.spec.quantum_mm()
+        if mm > 0:
+            mm = max(quantum, math.floor(mm / quantum + 1e-6) * quantum)
+        return self.text("X", mm)
 
     def _home(self, home: Home) -> None:
         """A return to the stored position: ``G91 G28 Z0``, ``G90`` (``G28`` for XYZ).

@@ -29,6 +29,7 @@ from camtool.model.program import (
     LengthOffset,
     Linear,
     Move,
+    PathControl,
     PlaneArc,
     Program,
     Rapid,
@@ -527,8 +528,8 @@ class PicMmhPost(PostProcessor):
             pass  # the moves that follow are the cycle, or the arc's chords: written as they are
         elif isinstance(command, Stop):
             raise DialectError(f"{where}: pic-mmh has no program stop (M0/M1)")
-        elif isinstance(command, LengthOffset | WorkOffset):
-            w.drop(command)  # refused: the program's numbers are in an offset pic-mmh lacks
+        elif isinstance(command, LengthOffset | WorkOffset | PathControl):
+            w.drop(command)  # offsets refused: the program's numbers are in one pic-mmh lacks
         elif isinstance(command, Coolant):
             w.note(
                 "coolant",

@@ -246,6 +246,85 @@ def test_a_re_posted_work_offset_is_the_one_rs274_selects(tmp_path: Path) -> Non
         assert "SET_G5X_OFFSET(2," in done.stdout, program.name
 
 
+_CONTROL = re.compile(
+    r"(USE_LENGTH_UNITS|SET_MOTION_CONTROL_MODE|SET_NAIVECAM_TOLERANCE|STRAIGHT_FEED)\(([^)]*)\)"
+)
+
+
+def _controls(stdout: str) -> list[tuple[str, str, float | None]]:
+    """rs274's path control calls, each with its tolerance in mm, and a mark per feed move."""
+    out: list[tuple[str, str, float | None]] = []
+    scale = 1.0
+    for call, args in _CONTROL.findall(stdout):
+        if call == "USE_LENGTH_UNITS":
+            scale = 25.4 if "INCHES" in args else 1.0
+        elif call == "STRAIGHT_FEED":
+            out.append(("feed", "", None))
+        else:
+            mode, _, tolerance = args.rpartition(", ") if "," in args else ("", "", args)
+            value = float(tolerance) * scale if re.fullmatch(r"[\d.]+", tolerance) else None
+            out.append((call, mode or (tolerance if value is None else ""), value))
+    return out
+
+
+@needs_rs274
+@pytest.mark.parametrize(
+    ("modes", "units"),
+    [
+        (("G64 P0.01 Q0.005", "G61", "G61.1", "G64"), "G21"),
+        (("G64 P0.001",), "G20"),  # 0.0254 mm: written 0.025, rounded down, never looser
+        (("G64 P0.0004",), "G21"),  # below the 0.001 mm printed: 0.001, never P0 (no limit)
+    ],
+)
+def test_a_re_posted_path_control_mode_is_the_one_rs274_sets(
+    tmp_path: Path, modes: tuple[str, ...], units: str
+) -> None:
+    """F-Engrave writes G64 P0.001 for its engraving; LinuxCNC run without it blends
+    corners by its own default. The judge is rs274: its path control calls, in order with
+    the moves, for the program camtool writes are the input's (G61 exact path, G61.1 exact
+    stop, G64 with its P and Q in mm): tolerances as written, rounded down to the 3
+    decimals printed but a positive one never to 0, which rs274 shows is no limit at all
+    (``G64 P0`` and ``G64`` both set CANON_CONTINUOUS, 0)."""
+    source = tmp_path / "in.ngc"
+    cuts = "".join(f"{m}\nG1 X{k + 1} F10\n" for k, m in enumerate(modes))
+    source.write_text(f"{units} G90 G17\nG0 X0 Y0 Z1\nG1 Z0 F10\n{cuts}M2\n")
+    out = tmp_path / "out.ngc"
+    assert main(["post", str(source), "-t", "linuxcnc", "-o", str(out)]) == 0
+    want, got = rs274(source), rs274(out)
+    assert want.returncode == 0 and got.returncode == 0, got.stderr
+    expected, written = _controls(want.stdout), _controls(got.stdout)
+    assert [(c, m) for c, m, _ in written] == [(c, m) for c, m, _ in expected]
+    for (_, _, asked), (_, _, put) in zip(expected, written, strict=True):
+        if asked is None:
+            assert put is None
+        elif asked == 0:
+            assert put == 0  # G64 alone: no limit, as asked
+        else:
+            assert 0 < put <= max(asked, 0.001) + 1e-9 and put > asked - 0.001
+    assert any(c == "SET_MOTION_CONTROL_MODE" for c, _, _ in written)
+
+
+def test_path_controls_are_the_rs274_codes_for_a_dialect_read_back_by_rs274() -> None:
+    from camtool.model.errors import InputError
+    from camtool.post.wordaddress_spec import load_spec
+
+    ok = {"words": {"XYZ": {}}, "rs274": True, "path_controls": ["G61", "G64"]}
+    assert load_spec(ok, "m.toml").path_controls == ("G61", "G64")
+    with pytest.raises(InputError, match=r"a path control code is G61, G61\.1 or G64, got G65"):
+        load_spec({**ok, "path_controls": ["G65"]}, "m.toml")
+    with pytest.raises(InputError, match="path control modes need rs274 = true"):
+        load_spec({**ok, "rs274": False}, "m.toml")
+
+
+def test_a_target_without_path_controls_reads_them_as_before(tmp_path: Path) -> None:
+    """GRBL has no G64: the mode is ignored with the warning it always had, nothing written."""
+    source = tmp_path / "in.ngc"
+    source.write_text("G21 G90\nG64 P0.01\nG0 X0 Y0\nG1 X1 F10\nM2\n")
+    out = tmp_path / "out.gcode"
+    assert main(["post", str(source), "-t", "grbl", "-o", str(out)]) == 0
+    assert "G64" not in out.read_text()
+
+
 @needs_rs274
 def test_rs274_refuses_the_comments_inside_words_that_camtool_refuses(tmp_path: Path) -> None:
     """The judge of tests/importers/test_gcode_comment_in_word.py's lines."""
