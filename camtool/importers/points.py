@@ -360,7 +360,9 @@ def _text_strokes(
     header: _Columns | None = None  # the X, Y, Z columns the header names
     excel = _excel_separator_line(text, path)
     for number, raw in enumerate(text.splitlines(), start=1):
-        if raw.strip().startswith("#") or number == excel:
+        if number == excel:
+            continue
+        if raw.strip().startswith("#"):
             named_in_comment = _header_columns(raw.strip()[1:])
             if not seen_data and header is None and named_in_comment is not None:
                 # numpy's savetxt writes its header so (genfromtxt's names=True reads it)
