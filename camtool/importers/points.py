@@ -373,6 +373,12 @@ def _text_strokes(
         _refuse_decimal_comma(raw, where)
         named = header is not None and header.positional(len(_cells(raw, header.separator)))
         fields = _named(raw, where, header) if named and header else _cells(raw, None)
+        if header is not None and not named and len(fields) > 3:
+            raise InputError(
+                f"{path}: line {number}: {len(fields)} numbers, but the header names "
+                f"{len(header.names)} columns; name every column in the header (x and y the "
+                "X and Y ones), and camtool reads those two"
+            )
         values = _row(fields, where, header_allowed=not seen_data)
         if values is None:  # the header
             seen_data = True

@@ -300,6 +300,8 @@ def test_more_than_three_numbers_without_a_header_naming_x_and_y_is_refused(
     for text in ("1,0,0,0,100\n2,10,0,0,100\n", "a,b,c,d\n1,0,0,0\n"):
         with pytest.raises(InputError, match=r"line [12]: [45] numbers; .* a header naming the X"):
             read_points(write(tmp_path, "t.csv", text))
+    with pytest.raises(InputError, match="line 2: 4 numbers, but the header names 2 columns"):
+        read_points(write(tmp_path, "t.csv", "x;y\n1;2;3;4\n"))
 
 
 @pytest.mark.parametrize("first", ["sep=;", '"sep=;"', "SEP=;"])
