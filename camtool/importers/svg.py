@@ -40,7 +40,7 @@ from camtool.importers.svgpage import (
     off_page_text,
     refusal_note,
 )
-from camtool.importers.svgstyle import style_of
+from camtool.importers.svgstyle import shaper_layer, style_of
 from camtool.model.errors import GeometryError, InputError, TooLargeError
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import (
@@ -321,7 +321,7 @@ def _contours(
     """
     values = shape.values
     label = _label(shape)
-    layer = str(values.get(LAYER_ATTR, DEFAULT_LAYER))
+    layer = str(values.get(LAYER_ATTR) or shaper_layer(values) or DEFAULT_LAYER)
     m = compose(page, affine_of(shape.transform))
     try:
         if segments is None:

@@ -15,6 +15,16 @@ import svgelements as se
 
 _SHAPER_CUT_TYPE = "{http://www.shapertools.com/namespaces/shaper}cutType"
 """Shaper Origin's attribute saying how a shape is cut; ``guide``: not at all."""
+SHAPER_LAYER = "shaper "
+"""The layer of a shape outside any Inkscape layer that Shaper's ``cutType`` says how to cut:
+``"shaper outside"``, ``"shaper inside"``, ``"shaper pocket"``, ``"shaper online"``."""
+SHAPER_CUTS = ("outside", "inside", "pocket", "online")
+
+
+def shaper_layer(values: Any) -> str | None:
+    """The layer named for the shape's Shaper cut type (:data:`SHAPER_LAYER`), or ``None``."""
+    cut = str(values.get(_SHAPER_CUT_TYPE, "")).strip().lower()
+    return SHAPER_LAYER + cut if cut in SHAPER_CUTS else None
 
 
 def style_of(values: Any) -> tuple[str, str]:

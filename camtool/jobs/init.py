@@ -114,16 +114,18 @@ def _fit(
     """The ``fit = [w, h]`` lines and the scale they give (``()`` and 1: no fit needed).
 
     A fit when the drawing's outside profile (the tool's radius around it) is larger than
-    the machine's travel.
+    the machine's travel; construction (a sheet's border drawn as a guide, centre lines)
+    is not cut, so it does not count, as ``post``'s travel check does not count it.
     """
-    if travel is None or not drawing.contours:
+    cut = tuple(c for c in drawing.contours if construction_reason(c, Selection()) is None)
+    if travel is None or not (cut or drawing.marks):
         return (), 1.0
-    x0, y0, x1, y1 = drawing.bbox()
+    x0, y0, x1, y1 = Drawing(cut, drawing.source, (), drawing.marks).bbox()
     w, h = travel
     if x1 - x0 + tool <= w + EPS_MM and y1 - y0 + tool <= h + EPS_MM:
         return (), 1.0  # its outside profile's toolpath fits the travel as it is (as post checks)
     fw, fh = _fit_box(tool, travel)
-    k = fit_factor((x0, y0, x1, y1), (fw, fh))
+    k = fit_factor(drawing.bbox(), (fw, fh))  # as post fits it: the whole drawing's extent
     return (
         f"fit = [{fw:g}, {fh:g}]"
         + _why(
@@ -228,11 +230,14 @@ def _ops_of(
     circles: dict[float, list[float]] = {}  # by the diameter to 1 µm: every diameter
     profiled: list[Contour] = []
     opened: list[Contour] = []
+    online = _shaper_cut(group.key) == "online"  # cut on the line: engraved, closed or not
     # as chained, as the selection's closed and diameter read them: a circle drawn as two
     # ARCs is a circle, a square of four LINEs closed
     for contour in _chains(group):
         circle = circle_of(contour)
-        if drill and circle is not None and circle[1] <= DRILL_MAX_MM:
+        if online:
+            opened.append(contour)
+        elif drill and circle is not None and circle[1] <= DRILL_MAX_MM:
             circles.setdefault(round(circle[1], 3), []).append(circle[1])
         elif contour.closed:
             profiled.append(contour)
@@ -251,7 +256,7 @@ def _ops_of(
             op = dataclasses.replace(op, lines=(*op.lines[:4], skip, *op.lines[4:]))
         out.append(op)
     if opened:
-        out.append(_engrave_op(select, what, len(opened)))
+        out.append(_engrave_op(select, what, len(opened), closed_too=online))
     return out
 
 
@@ -292,10 +297,13 @@ def _profile_op(
     depth = thickness + BREAKTHROUGH_MM
     if pocket:
         return _pocket_op(select, what, contours, thickness, tool, key)
-    has_outer = any(id(c) in outer for c in contours)
+    cut = _shaper_cut(key)
+    has_outer = cut == "outside" if cut else any(id(c) in outer for c in contours)
     side = "outside" if has_outer else "inside"
     why = (
-        f"{what} holds an outermost contour: cut outside it (its holes inside)"
+        f"Shaper's cut type of {what}"
+        if cut
+        else f"{what} holds an outermost contour: cut outside it (its holes inside)"
         if has_outer
         else f"{what} holds holes of a part only: cut on their inside"
     )
@@ -431,16 +439,32 @@ def _tabs_that_fit(length: float, tool: float) -> int:
     return max(0, min(3, int(0.9 * length // need)))
 
 
-def _engrave_op(select: str, what: str, count: int) -> _Op:
+def _engrave_op(select: str, what: str, count: int, *, closed_too: bool = False) -> _Op:
+    """A shallow line on the paths of the open contours, left commented out.
+
+    ``closed_too``: of every contour (Shaper's "online" cut type); the depth is the user's.
+    """
+    kind = "" if closed_too else "open "
     lines = (
         'type = "engrave"'
-        + _why(f"{count} open contour(s) on {what}: not cut unless you uncomment this"),
+        + _why(f"{count} {kind}contour(s) on {what}: not cut unless you uncomment this"),
         "tool = {end-mill}",
         select,
-        "closed = false",
+        *(() if closed_too else ("closed = false",)),
         "depth = 0.2" + _why("a shallow line on its path"),
     )
     return _Op("engrave", 0.0, lines, commented=True)
+
+
+def _shaper_cut(key: str) -> str | None:
+    """The cut type of a layer ``key`` the SVG importer named for Shaper's ``cutType``.
+
+    ``None`` for any other layer or a colour (``#rrggbb``).
+    """
+    from camtool.importers.svgstyle import SHAPER_CUTS, SHAPER_LAYER
+
+    cut = key.removeprefix(SHAPER_LAYER)
+    return cut if key.startswith(SHAPER_LAYER) and cut in SHAPER_CUTS else None
 
 
 def _marks(drawing: Drawing, thickness: float) -> list[_Op]:

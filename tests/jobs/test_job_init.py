@@ -315,3 +315,41 @@ def test_a_pocket_narrower_than_the_end_mill_gets_one_that_fits(tmp_path: Path) 
     assert cut
     assert all(abs((m.y - dy) - 11.0) <= 1.0 - 0.75 + 1e-6 for m in cut)
     assert min(m.x - dx for m in cut) >= 10.75 - 1e-6 and max(m.x - dx for m in cut) <= 39.25 + 1e-6
+
+
+SHAPER = """<svg xmlns="http://www.w3.org/2000/svg"
+  xmlns:shaper="http://www.shapertools.com/namespaces/shaper"
+  viewBox="0 0 200 100" width="200mm" height="100mm">
+  <rect x="0" y="0" width="200" height="100" fill="none" stroke="blue" shaper:cutType="guide"/>
+  <rect x="20" y="20" width="60" height="40" fill="black" stroke="black" shaper:cutType="outside"/>
+  <circle cx="40" cy="40" r="1.5" fill="white" stroke="black" shaper:cutType="inside"/>
+  <rect x="100" y="20" width="60" height="40" fill="black" stroke="black" shaper:cutType="inside"/>
+  <rect x="50" y="45" width="20" height="10" fill="#7F7F7F" shaper:cutType="pocket"/>
+  <path d="M 120 30 L 140 30 L 140 50 Z" fill="none" stroke="#7F7F7F" shaper:cutType="online"/>
+</svg>"""
+
+
+def test_shaper_s_cut_types_make_the_operations(tmp_path: Path) -> None:
+    """An SVG in Shaper Origin's format says how each shape is cut (``shaper:cutType``):
+    each cut type is a layer, and its operation follows it: the 60 x 40 mm rectangle
+    marked inside is cut inside although nothing surrounds it, the pocket is pocketed, the
+    ø3 hole drilled, the on-line triangle engraved (commented out, closed as it is). The
+    sheet's 200 x 100 mm border is a guide: not cut, and not counted against the 200 x
+    200 mm travel, which the part alone fits (no fit, no scaling down)."""
+    path = tmp_path / "sheet.svg"
+    path.write_text(SHAPER, encoding="utf-8")
+    drawing = read_drawing(path)
+    assert {c.layer for c in drawing.contours} == {
+        "0", "shaper outside", "shaper inside", "shaper pocket", "shaper online"
+    }  # fmt: skip
+    text = initial_job(drawing, travel_mm=(200.0, 200.0))
+    assert "fit =" not in text and "SCALED" not in text
+    kinds = [(op["type"], op.get("side"), tuple(op["layers"])) for op in _ops(text)]  # type: ignore[arg-type]
+    assert kinds == [
+        ("drill", None, ("shaper inside",)),
+        ("pocket", None, ("shaper pocket",)),
+        ("profile", "inside", ("shaper inside",)),
+        ("profile", "outside", ("shaper outside",)),
+    ]
+    engrave = text.split('# type = "engrave"')[1].split("[[operations]]")[0]
+    assert "shaper online" in engrave and "closed" not in engrave
