@@ -13,28 +13,44 @@ from typing import Any
 
 import svgelements as se
 
-_SHAPER_CUT_TYPE = "{http://www.shapertools.com/namespaces/shaper}cutType"
-"""Shaper Origin's attribute saying how a shape is cut; ``guide``: not at all."""
+_SHAPER = "{http://www.shapertools.com/namespaces/shaper}"
+_SHAPER_ATTRIBUTES = (_SHAPER + "cutType", _SHAPER + "pathType")
+"""How Shaper Origin's format says a shape is cut: ``shaper:cutType`` (Shaper's SVG
+reference), or ``shaper:pathType`` (Shaper's Fusion 360 add-in); ``guide``: not at all."""
+_SHAPER_NAMES = {
+    "outside": "outside", "exterior": "outside", "inside": "inside", "interior": "inside",
+    "pocket": "pocket", "online": "online", "on-line": "online", "guide": "guide",
+}  # fmt: skip
+"""Each value those attributes take (any case: ``onLine``), by camtool's name for it."""
 SHAPER_LAYER = "shaper "
-"""The layer of a shape outside any Inkscape layer that Shaper's ``cutType`` says how to cut:
+"""The layer of a shape outside any Inkscape layer that Shaper's cut type says how to cut:
 ``"shaper outside"``, ``"shaper inside"``, ``"shaper pocket"``, ``"shaper online"``."""
 SHAPER_CUTS = ("outside", "inside", "pocket", "online")
 
 
+def _shaper_cut(values: Any) -> str | None:
+    """The shape's Shaper cut type, by camtool's name (:data:`_SHAPER_NAMES`), or ``None``."""
+    for key in _SHAPER_ATTRIBUTES:
+        name = _SHAPER_NAMES.get(str(values.get(key, "")).strip().lower())
+        if name:
+            return name
+    return None
+
+
 def shaper_layer(values: Any) -> str | None:
     """The layer named for the shape's Shaper cut type (:data:`SHAPER_LAYER`), or ``None``."""
-    cut = str(values.get(_SHAPER_CUT_TYPE, "")).strip().lower()
+    cut = _shaper_cut(values)
     return SHAPER_LAYER + cut if cut in SHAPER_CUTS else None
 
 
 def style_of(values: Any) -> tuple[str, str]:
     """The shape's colour (its stroke, else its fill, as ``#rrggbb``) and linetype.
 
-    A Shaper Origin guide (``shaper:cutType="guide"``, on the shape or a group: a sheet's
+    A Shaper Origin guide (``shaper:cutType`` or ``pathType="guide"``, on it or a group: a sheet's
     border, a centre line) is ``"GUIDE"``; a stroke with a ``stroke-dasharray`` of dashes
     is ``"DASHED"``: construction lines (:mod:`camtool.model.construction`); else ``""``.
     """
-    if str(values.get(_SHAPER_CUT_TYPE, "")).strip().lower() == "guide":
+    if _shaper_cut(values) == "guide":
         return _colour(values), "GUIDE"
     return _colour(values), ("DASHED" if _dashed(values) else "")
 

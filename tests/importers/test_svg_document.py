@@ -281,6 +281,32 @@ def test_a_shaper_origin_guide_is_construction_and_not_cut(tmp_path: Path) -> No
     assert xy and {x for x, _ in xy} <= {20.0, 80.0} and {y for _, y in xy} <= {40.0, 80.0}
 
 
+@pytest.mark.parametrize(
+    ("attribute", "layer", "linetype"),
+    [
+        ('shaper:cutType="outside"', "shaper outside", ""),
+        ('shaper:pathType="exterior"', "shaper outside", ""),  # Shaper's Fusion 360 add-in
+        ('shaper:pathType="interior"', "shaper inside", ""),
+        ('shaper:cutType="onLine"', "shaper online", ""),
+        ('shaper:cutType="Pocket"', "shaper pocket", ""),
+        ('shaper:pathType="guide"', "0", "GUIDE"),
+        ('shaper:cutType="sideways"', "0", ""),  # no cut type camtool knows: as without
+    ],
+)
+def test_shaper_s_cut_types_name_the_layer(
+    tmp_path: Path, attribute: str, layer: str, linetype: str
+) -> None:
+    """A Shaper cut type names the layer of a shape in no Inkscape layer (a job selects by
+    it); an Inkscape layer keeps its name."""
+    ns = 'xmlns:shaper="http://www.shapertools.com/namespaces/shaper"'
+    body = f'<rect x="10" y="10" width="20" height="10" stroke="black" {attribute}/>'
+    root = f'{ns} width="100mm" height="100mm" viewBox="0 0 100 100"'
+    (contour,) = read_svg(svg(tmp_path, body, root=root)).contours
+    assert (contour.layer, contour.linetype) == (layer, linetype)
+    in_layer = f'<g inkscape:groupmode="layer" inkscape:label="Cuts">{body}</g>'
+    assert read_svg(svg(tmp_path, in_layer, root=root)).contours[0].layer == "Cuts"
+
+
 def test_a_paint_that_is_no_colour_is_ignored_as_css_says(tmp_path: Path) -> None:
     """An invalid ``fill``/``stroke`` declaration is ignored (CSS Syntax 3), so the parent's
     paint applies; keywords are read in any case and with white space around them."""
