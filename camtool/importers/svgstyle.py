@@ -37,10 +37,37 @@ def _shaper_cut(values: Any) -> str | None:
     return None
 
 
+_SHAPER_DEPTH = re.compile(r"\s*(\d+\.?\d*|\.\d+)\s*(mm|cm|in)\s*", re.IGNORECASE)
+"""A ``shaper:cutDepth`` camtool reads: a number and its unit (``6.0mm``, ``0.25in``)."""
+_DEPTH_UNITS = {"mm": 1.0, "cm": 10.0, "in": 25.4}
+
+
 def shaper_layer(values: Any) -> str | None:
-    """The layer named for the shape's Shaper cut type (:data:`SHAPER_LAYER`), or ``None``."""
+    """The layer named for the shape's Shaper cut type and depth, or ``None``.
+
+    ``"shaper pocket"``, with the depth when ``shaper:cutDepth`` gives one in mm, cm or in:
+    ``"shaper pocket 4mm"`` (:data:`SHAPER_LAYER`; read back by :func:`shaper_cut_of`).
+    """
     cut = _shaper_cut(values)
-    return SHAPER_LAYER + cut if cut in SHAPER_CUTS else None
+    if cut not in SHAPER_CUTS:
+        return None
+    depth = _SHAPER_DEPTH.fullmatch(str(values.get(_SHAPER + "cutDepth", "")))
+    mm = float(depth[1]) * _DEPTH_UNITS[depth[2].lower()] if depth else 0.0
+    return f"{SHAPER_LAYER}{cut}" + (f" {mm:g}mm" if mm > 0 else "")
+
+
+def shaper_cut_of(layer: str) -> tuple[str, float | None] | None:
+    """The cut type and depth (mm; ``None``: not given) a :func:`shaper_layer` name says.
+
+    ``None`` for any other layer name.
+    """
+    words = layer.split(" ")
+    if len(words) not in (2, 3) or words[0] != SHAPER_LAYER.strip() or words[1] not in SHAPER_CUTS:
+        return None
+    if len(words) == 2:
+        return words[1], None
+    depth = _SHAPER_DEPTH.fullmatch(words[2])
+    return (words[1], float(depth[1])) if depth and depth[2] == "mm" else None
 
 
 def style_of(values: Any) -> tuple[str, str]:

@@ -230,7 +230,10 @@ def _ops_of(
     circles: dict[float, list[float]] = {}  # by the diameter to 1 µm: every diameter
     profiled: list[Contour] = []
     opened: list[Contour] = []
-    online = _shaper_cut(group.key) == "online"  # cut on the line: engraved, closed or not
+    shaper = _shaper_cut(group.key)
+    online = (
+        shaper is not None and shaper[0] == "online"
+    )  # cut on the line: engraved, closed or not
     # as chained, as the selection's closed and diameter read them: a circle drawn as two
     # ARCs is a circle, a square of four LINEs closed
     for contour in _chains(group):
@@ -256,7 +259,8 @@ def _ops_of(
             op = dataclasses.replace(op, lines=(*op.lines[:4], skip, *op.lines[4:]))
         out.append(op)
     if opened:
-        out.append(_engrave_op(select, what, len(opened), closed_too=online))
+        depth = shaper[1] if shaper else None
+        out.append(_engrave_op(select, what, len(opened), closed_too=online, depth=depth))
     return out
 
 
@@ -294,10 +298,11 @@ def _profile_op(
     key: str,
 ) -> _Op:
     pocket = "pocket" in key.casefold()
-    depth = thickness + BREAKTHROUGH_MM
+    shaper = _shaper_cut(key)
+    cut, given = shaper if shaper else (None, None)
+    depth = given or thickness + BREAKTHROUGH_MM
     if pocket:
-        return _pocket_op(select, what, contours, thickness, tool, key)
-    cut = _shaper_cut(key)
+        return _pocket_op(select, what, contours, thickness, tool, key, given)
     has_outer = cut == "outside" if cut else any(id(c) in outer for c in contours)
     side = "outside" if has_outer else "inside"
     why = (
@@ -318,7 +323,8 @@ def _profile_op(
         select,
         "closed = true" + _why("open contours have no side"),
         f'side = "{side}"' + _why(why),
-        f"depth = {depth:g}" + _why(f"through the {thickness:g} mm stock"),
+        f"depth = {depth:g}"
+        + _why("Shaper's cut depth" if given else f"through the {thickness:g} mm stock"),
         f"step_down = {min(mill or tool, depth):g}" + _why("passes of at most the tool's diameter"),
     ]
     if has_outer:
@@ -342,17 +348,28 @@ def _profile_op(
 
 
 def _pocket_op(
-    select: str, what: str, contours: list[Contour], thickness: float, tool: float, key: str
+    select: str,
+    what: str,
+    contours: list[Contour],
+    thickness: float,
+    tool: float,
+    key: str,
+    given: float | None = None,
 ) -> _Op:
-    """A pocket at half the stock, with an end mill that fits its narrowest pocket."""
+    """A pocket with an end mill that fits its narrowest pocket.
+
+    At half the stock, or ``given``: Shaper's depth, mm.
+    """
     mill, tool_line = _mill_that_fits(contours, tool, "pocket")
+    depth = given or thickness / 2
     lines = (
         f"name = {_quote(key)}",
         'type = "pocket"' + _why(f"{what}: the layer's name says pocket"),
         tool_line,
         select,
-        f"depth = {thickness / 2:g}" + _why("half the stock: set the pocket's depth"),
-        f"step_down = {min(mill or tool, thickness / 2):g}" + _why("at most a tool diameter"),
+        f"depth = {depth:g}"
+        + _why("Shaper's cut depth" if given else "half the stock: set the pocket's depth"),
+        f"step_down = {min(mill or tool, depth):g}" + _why("at most a tool diameter"),
     )
     return _Op("pocket", mill or tool, lines, commented=mill is None)
 
@@ -439,10 +456,12 @@ def _tabs_that_fit(length: float, tool: float) -> int:
     return max(0, min(3, int(0.9 * length // need)))
 
 
-def _engrave_op(select: str, what: str, count: int, *, closed_too: bool = False) -> _Op:
+def _engrave_op(
+    select: str, what: str, count: int, *, closed_too: bool = False, depth: float | None = None
+) -> _Op:
     """A shallow line on the paths of the open contours, left commented out.
 
-    ``closed_too``: of every contour (Shaper's "online" cut type); the depth is the user's.
+    ``closed_too``: of every contour (Shaper's "online" cut type); ``depth``: Shaper's.
     """
     kind = "" if closed_too else "open "
     lines = (
@@ -451,20 +470,21 @@ def _engrave_op(select: str, what: str, count: int, *, closed_too: bool = False)
         "tool = {end-mill}",
         select,
         *(() if closed_too else ("closed = false",)),
-        "depth = 0.2" + _why("a shallow line on its path"),
+        f"depth = {depth:g}" + _why("Shaper's cut depth")
+        if depth
+        else "depth = 0.2" + _why("a shallow line on its path"),
     )
     return _Op("engrave", 0.0, lines, commented=True)
 
 
-def _shaper_cut(key: str) -> str | None:
-    """The cut type of a layer ``key`` the SVG importer named for Shaper's ``cutType``.
+def _shaper_cut(key: str) -> tuple[str, float | None] | None:
+    """The cut type and depth (mm) of a layer ``key`` named for Shaper's format.
 
-    ``None`` for any other layer or a colour (``#rrggbb``).
+    (:func:`camtool.importers.svgstyle.shaper_layer`); ``None`` for any other layer.
     """
-    from camtool.importers.svgstyle import SHAPER_CUTS, SHAPER_LAYER
+    from camtool.importers.svgstyle import shaper_cut_of
 
-    cut = key.removeprefix(SHAPER_LAYER)
-    return cut if key.startswith(SHAPER_LAYER) and cut in SHAPER_CUTS else None
+    return shaper_cut_of(key)
 
 
 def _marks(drawing: Drawing, thickness: float) -> list[_Op]:

@@ -291,6 +291,12 @@ def test_a_shaper_origin_guide_is_construction_and_not_cut(tmp_path: Path) -> No
         ('shaper:cutType="Pocket"', "shaper pocket", ""),
         ('shaper:pathType="guide"', "0", "GUIDE"),
         ('shaper:cutType="sideways"', "0", ""),  # no cut type camtool knows: as without
+        # the depth, in mm, when cutDepth gives it with a unit (0.25 in = 6.35 mm)
+        ('shaper:cutType="pocket" shaper:cutDepth="6.0mm"', "shaper pocket 6mm", ""),
+        ('shaper:cutType="inside" shaper:cutDepth="0.25in"', "shaper inside 6.35mm", ""),
+        ('shaper:pathType="exterior" shaper:cutDepth="1.2 cm"', "shaper outside 12mm", ""),
+        ('shaper:cutType="pocket" shaper:cutDepth="15"', "shaper pocket", ""),  # no unit
+        ('shaper:cutType="online" shaper:cutDepth="0"', "shaper online", ""),
     ],
 )
 def test_shaper_s_cut_types_name_the_layer(

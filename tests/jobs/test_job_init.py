@@ -353,3 +353,30 @@ def test_shaper_s_cut_types_make_the_operations(tmp_path: Path) -> None:
     ]
     engrave = text.split('# type = "engrave"')[1].split("[[operations]]")[0]
     assert "shaper online" in engrave and "closed" not in engrave
+
+
+def test_shaper_s_cut_depths_are_the_operations_depths(tmp_path: Path) -> None:
+    """Shaper's ``cutDepth`` per shape (a stepped tray: an outline through 15 mm stock,
+    pockets 4 and 10 mm deep) gives an operation per cut type and depth, at that depth,
+    where job init otherwise guesses (through the stock, pockets at half of it)."""
+    ns = 'xmlns:shaper="http://www.shapertools.com/namespaces/shaper"'
+    path = tmp_path / "tray.svg"
+    path.write_text(
+        f'<svg xmlns="http://www.w3.org/2000/svg" {ns} width="220mm" height="140mm" '
+        'viewBox="0 0 220 140">'
+        '<rect x="10" y="10" width="200" height="120" rx="10" fill="#fff" stroke="#000" '
+        'shaper:pathType="exterior" shaper:cutDepth="15.0mm"/>'
+        '<rect x="25" y="25" width="60" height="90" rx="5" fill="#a0a0a0" stroke="#000" '
+        'shaper:pathType="pocket" shaper:cutDepth="4.0mm"/>'
+        '<rect x="115" y="25" width="80" height="90" rx="5" fill="#404040" stroke="#000" '
+        'shaper:pathType="pocket" shaper:cutDepth="10.0mm"/></svg>',
+        encoding="utf-8",
+    )
+    text = initial_job(read_drawing(path), thickness_mm=6.0)
+    got = {op["layers"][0]: (op["type"], op["depth"]) for op in _ops(text)}  # type: ignore[index]
+    assert got == {
+        "shaper outside 15mm": ("profile", 15),
+        "shaper pocket 4mm": ("pocket", 4),
+        "shaper pocket 10mm": ("pocket", 10),
+    }
+    assert text.count("# Shaper's cut depth") == 3
