@@ -151,7 +151,7 @@ def path_control(w: BlockWords, code: str, scale: float, where: str) -> PathCont
     p, q = w.args.get("P"), w.args.get("Q")
     for word in (p, q):
         if code == "G64" and word is not None and word.value < 0:
-            raise InputError(f"{where}: G64 {word}: a blending tolerance is ≥ 0 (0: none)")
+            raise InputError(f"{where}: G64 {word}: a blending tolerance is ≥ 0 (0: no limit)")
     if code != "G64":
         return PathControl(code)
     return PathControl(

@@ -316,6 +316,18 @@ def test_path_controls_are_the_rs274_codes_for_a_dialect_read_back_by_rs274() ->
         load_spec({**ok, "rs274": False}, "m.toml")
 
 
+def test_a_negative_blending_tolerance_is_refused_at_its_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """LinuxCNC refuses ``G64 P-1``; camtool too, naming the line, writing nothing."""
+    source = tmp_path / "in.ngc"
+    source.write_text("G21 G90\nG0 X0 Y0\nG64 P-1\nG1 X1 F10\nM2\n")
+    out = tmp_path / "out.ngc"
+    assert main(["post", str(source), "-t", "linuxcnc", "-o", str(out)]) == 3
+    assert "in.ngc:3: G64 P-1: a blending tolerance is ≥ 0" in capsys.readouterr().err
+    assert not out.exists()
+
+
 def test_a_target_without_path_controls_reads_them_as_before(tmp_path: Path) -> None:
     """GRBL has no G64: the mode is ignored with the warning it always had, nothing written."""
     source = tmp_path / "in.ngc"
