@@ -209,8 +209,8 @@ def test_z_within_the_tolerance_of_the_start_moves_the_last_segment_there(
     tmp_path: Path, gap: float, sides: int
 ) -> None:
     """Relative coordinates rounded to 2 decimals (CorelDRAW) end a closed path a hair
-    from its start: Z's line of 0.0009 mm made a spike that offsetting read as the contour
-    crossing itself. Within ``--tolerance`` the last segment ends at the start instead."""
+    from its start: Z's line of 0.0009 mm would be a spike that offsetting reads as the
+    contour crossing itself. Within ``--tolerance`` the last segment ends at the start."""
     d = f"m 10 10 l 20 0 l 0 20 l -20 0 l 0 {-20 + gap:.4f} z"
     contour = one(read_svg(svg(tmp_path, f'<path d="{d}"/>')))
     assert contour.closed and len(contour.segments) == sides

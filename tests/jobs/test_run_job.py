@@ -239,8 +239,8 @@ def test_a_drill_of_one_hole_size_drills_no_point(tmp_path: Path) -> None:
 def test_a_circle_drawn_as_arcs_is_a_hole_to_drill_and_no_profile(tmp_path: Path) -> None:
     """A ø3 hole drawn as two ARCs (as converters and some CAD exports draw circles) is one
     circle once chained: ``job init`` drills it with the CIRCLE of the same size, the
-    written drill's ``diameter`` selects it, the profile's ``except_diameter`` leaves it.
-    Before, it was profiled on its inside with the 3 mm mill: nothing cut, a warning.
+    written drill's ``diameter`` selects it, the profile's ``except_diameter`` leaves it
+    (profiled on its inside, a 3 mm mill cuts nothing in it).
     """
     from camtool.jobs.init import initial_job
     from tests.shapes import write_dxf
