@@ -40,7 +40,7 @@ from camtool.importers.svgpage import (
     off_page_text,
     refusal_note,
 )
-from camtool.importers.svgstyle import shaper_layer, style_of
+from camtool.importers.svgstyle import SHAPER_LAYER, shaper_layer, style_of
 from camtool.model.errors import GeometryError, InputError, TooLargeError
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import (
@@ -115,9 +115,10 @@ def svg_drawing(
     options = options or ImportOptions()
     check_tolerance(options.tolerance)
     progress(Step("reading", name=path.name))
+    inkscape, named = _wanted_layers(path, options.layers)
     prepared = prepare(
         path,
-        options.layers,
+        inkscape,
         max_entities=options.max_entities,
         units=options.units,
         shown=options.shown,
@@ -196,6 +197,8 @@ def svg_drawing(
             f"mask or viewport hides wholly (a viewer shows nothing of {them})"
         )
     warnings += unseen_warnings(path, hidden, faded, invisible, bare_lines, background)
+    if named:
+        contours = _on_layers(path, contours, named)
     size_note = ""
     outside = [c for c in contours if contour_off_page(c, prepared.page)]
     if outside:
@@ -217,6 +220,41 @@ def svg_drawing(
         )
     drawing = Drawing(tuple(contours), str(path), tuple(warnings), size_note=size_note)
     return drawing, tolerance
+
+
+def _wanted_layers(
+    path: Path, layers: tuple[str, ...] | None
+) -> tuple[tuple[str, ...] | None, tuple[str, ...]]:
+    """``--layers`` as Inkscape layers (for :func:`prepare`) and layers of shapes outside them.
+
+    Those (``0``, Shaper's ``shaper pocket 4mm``) are kept after reading (:func:`_on_layers`).
+
+    Raises:
+        InputError: both kinds are named (the first would drop the second's shapes).
+    """
+    if layers is None:
+        return None, ()
+    named = tuple(n for n in layers if n == DEFAULT_LAYER or n.startswith(SHAPER_LAYER))
+    inkscape = tuple(n for n in layers if n not in named)
+    if named and inkscape:
+        raise InputError(
+            f"{path}: --layers names Inkscape layers ({', '.join(map(repr, inkscape))}) and "
+            f"the layers of shapes outside them ({', '.join(map(repr, named))}); name one "
+            "kind, or select them by operations of a job"
+        )
+    return (None if named else inkscape), named
+
+
+def _on_layers(path: Path, contours: list[Contour], named: tuple[str, ...]) -> list[Contour]:
+    """The contours on the layers ``named``; an unknown name is an InputError listing them."""
+    there = sorted({c.layer for c in contours}, key=str.casefold)
+    unknown = [n for n in named if n not in there]
+    if unknown:
+        raise InputError(
+            f"{path}: no layer named {', '.join(map(repr, unknown))}; its layers are "
+            + ", ".join(map(repr, there))
+        )
+    return [c for c in contours if c.layer in named]
 
 
 _DISTINCT_MM = 1e-6
@@ -613,7 +651,8 @@ def convert(
             start = cursor = _pt(m, seg.start)
         if isinstance(seg, se.Close):
             # a gap within the tolerance is the rounding of relative coordinates (CorelDRAW's
-            # 2 decimals): the last segment ends at the start, no closing line a spike thin
+            # 2 decimals): the last segment is moved to end at the start, rather than a
+            # closing line as thin as a spike (offsetting reads it as the contour crossing)
             gap = distance(cursor, start)
             alone = len(current) == 1 and not closes_alone(current[0])
             if gap > tolerance or (gap > ZERO_LENGTH_MM and alone):

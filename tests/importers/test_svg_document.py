@@ -313,6 +313,25 @@ def test_shaper_s_cut_types_name_the_layer(
     assert read_svg(svg(tmp_path, in_layer, root=root)).contours[0].layer == "Cuts"
 
 
+def test_layers_picks_the_layers_camtool_names_shapes_outside_inkscape_layers(
+    tmp_path: Path,
+) -> None:
+    """``--layers`` takes the layers ``camtool inspect`` lists for shapes in no Inkscape
+    layer (``0``, a Shaper cut type's), as a job's operations do: the pocket alone, or the
+    guides the construction warning says ``--layers 0`` cuts; an unknown one is refused
+    naming those there are, and a mix with Inkscape layers is refused."""
+    path = tmp_path / "sheet.svg"
+    path.write_text(SHAPER, encoding="utf-8")
+    picked = read_svg(path, ImportOptions(layers=("shaper outside",))).contours
+    assert [c.source for c in picked] == ["rect#part"]
+    guides = read_svg(path, ImportOptions(layers=("0",))).contours
+    assert [c.source for c in guides] == ["rect#sheet", "path#centre"]
+    with pytest.raises(InputError, match="no layer named 'shaper pocket'; its layers are '0'"):
+        read_svg(path, ImportOptions(layers=("shaper pocket",)))
+    with pytest.raises(InputError, match=r"--layers names Inkscape layers \('Cuts'\) and the"):
+        read_svg(path, ImportOptions(layers=("Cuts", "0")))
+
+
 def test_a_paint_that_is_no_colour_is_ignored_as_css_says(tmp_path: Path) -> None:
     """An invalid ``fill``/``stroke`` declaration is ignored (CSS Syntax 3), so the parent's
     paint applies; keywords are read in any case and with white space around them."""
