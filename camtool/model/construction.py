@@ -17,14 +17,24 @@ DASHED_FAMILIES = ("CENTER", "DASH", "HIDDEN", "PHANTOM", "DOT", "DIVIDE", "BORD
 families, with their ``2`` and ``X2`` variants; LibreCAD's ``DashLine``, ``CenterLine``...)."""
 
 _CONSTRUCTION_LAYER = re.compile(
-    r"(?:^|[^a-z])(?:constr[a-z]*|hilf[a-z]*|helpers?|aux[a-z]*|guides?|ref|references?|"
-    r"dims?|dimensions?|bema(?:ss|ß)ung[a-z]*|cotas?|annot[a-z]*|notes?|text|title|"
-    r"cent(?:er|re)(?:[ _-]?lines?)?|axis|axes|hidden|defpoints)(?:[^a-z]|$)",
+    r"(?:^|[^a-z])(?:constr[a-z]*|hilf[a-z]*|helpers?|aux[a-z]*|ref|references?|"
+    r"dims?|dimensions?|bema(?:ss|ß)ung[a-z]*|cotas?|anno(?:t[a-z]*)?|notes?|title|"
+    r"hidden|defpoints)(?:[^a-z]|$)",
     re.IGNORECASE,
 )
-"""Layer names that say construction, dimensions, annotation or centre lines (AutoCAD's
-``Defpoints`` too), in English and a few shop languages; a word of the name, so
-``OUTLINE`` or ``POCKET`` never match."""
+"""Layer names with a word that says construction, dimensions or annotation (AutoCAD's
+``Defpoints`` too), in English and a few shop languages: a word of the name, so ``OUTLINE``
+or ``POCKET`` never match, and ``A-ANNO-NOTE`` or ``Dimension (ISO)`` do."""
+
+_CONSTRUCTION_ALONE = re.compile(
+    r"^[^a-z]*(?:cent(?:er|re)|axis|axes|guides?)(?:[ _-]?(?:lines?|marks?))?"
+    r"(?:[^a-z(]*\([^)]*\))*[^a-z]*$",
+    re.IGNORECASE,
+)
+"""Layer names that are centre lines, axes or guides and nothing else (``CENTER``,
+``Centerline (ISO)``, ``Center Mark (ISO)``, ``2-AXES``, ``Guides``). These words also name
+parts, so with another word they do not match: ``Center_Drawer``, OpenSCAD's
+``fan_side_center``, ``X_Axis_Plate``, ``Guide_Rail`` are cut."""
 
 
 def dashed_name(linetype: str) -> bool:
@@ -35,4 +45,4 @@ def dashed_name(linetype: str) -> bool:
 
 def construction_layer(layer: str) -> bool:
     """Whether the layer name ``layer`` says it holds construction, not the part."""
-    return bool(_CONSTRUCTION_LAYER.search(layer))
+    return bool(_CONSTRUCTION_LAYER.search(layer) or _CONSTRUCTION_ALONE.match(layer))

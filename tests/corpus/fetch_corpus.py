@@ -15,6 +15,8 @@ apt lists exist; as root with no lists it runs ``apt-get update`` once):
   applied by class, ``fill:currentColor``), a varied pick of those with a sheet
   (``usr/share/icons/breeze``);
 - ``inkscape`` (optional, 20 MB download; only ``usr/share/inkscape/examples/*.svg`` is kept);
+- ``openscad`` (3 MB download; only ``usr/share/openscad/examples/*/*.dxf`` is kept): the DXF
+  outlines OpenSCAD's examples extrude, one layer per extruded part (``fan_side_center``);
 - OpenSCAD's examples exported with ``openscad -o X.dxf`` — only when an ``openscad`` binary is
   already on PATH (the package pulls in Qt; it is not installed here), 2D examples only;
 - ``linuxcnc-uspace`` + ``libboost-python1.74.0``: the ``rs274`` stand-alone G-code
@@ -52,8 +54,9 @@ SAMPLE_SIZE = {"dxf": 30, "svg": 45}
 """Files of each kind in the sample, an equal share per source (15 SVGs each for three)."""
 TANGO_ICONS = 60
 BREEZE_ICONS = 60
-MANIFEST_VERSION = 2
-"""Raised when the sources change (2: Breeze added); an older cached manifest is rebuilt."""
+MANIFEST_VERSION = 3
+"""Raised when the sources change (2: Breeze added, 3: OpenSCAD's example DXFs); an older
+cached manifest is rebuilt."""
 OFF_SWITCH = "CAMTOOL_CORPUS"
 """The environment variable whose value ``off`` skips the fetch (and the corpus tests)."""
 
@@ -71,6 +74,7 @@ HEAVY = {
 LIBRECAD_DIR = "usr/share/librecad/library"
 TANGO_DIR = "usr/share/icons/Tango/scalable"
 INKSCAPE_DIR = "usr/share/inkscape/examples"
+OPENSCAD_DIR = "usr/share/openscad/examples"
 BREEZE_DIR = "usr/share/icons/breeze"
 RS274 = "usr/bin/rs274"
 # rs274's libraries that a plain Debian system lacks, by soname prefix -> package.
@@ -217,6 +221,13 @@ def fetch_inkscape(dest: Path) -> list[Path]:
     return files_under(root / INKSCAPE_DIR, ".svg")
 
 
+def fetch_openscad_examples(dest: Path) -> list[Path]:
+    """The DXF files of OpenSCAD's examples, from the package (no openscad binary needed)."""
+    deb = fetch_deb("openscad", dest / "debs")
+    root = extract(deb, dest / "pkg" / "openscad", [f"./{OPENSCAD_DIR}/*/*.dxf"])
+    return files_under(root / OPENSCAD_DIR, ".dxf")
+
+
 def fetch_openscad(dest: Path) -> list[Path]:
     """OpenSCAD's examples exported to DXF with the installed ``openscad`` (2D ones only)."""
     exe = shutil.which("openscad")
@@ -279,7 +290,8 @@ def build_manifest(dest: Path) -> dict[str, object]:
     """Fetch every source that can be had; return the manifest (missing sources noted)."""
     notes: list[str] = []
     pools: dict[str, list[tuple[Path, list[Path]]]] = {"dxf": [], "svg": []}
-    sources = [
+    sources = [  # a source's share of the sample left unused goes to the sources after it
+        ("dxf", fetch_openscad_examples),
         ("dxf", fetch_librecad),
         ("svg", fetch_tango),
         ("svg", fetch_breeze),

@@ -43,3 +43,31 @@ def test_job_init_then_post_on_grbl_and_linuxcnc(rel: str, tmp_path: Path) -> No
     table.write_text("".join(f"T{t.id} P{t.id} D{t.diameter:g} Z0 ;{t.type}\n" for t in job.tools))
     judged = rs274(program, table)
     assert judged.returncode == 0, judged.stderr[-500:]
+
+
+def test_openscad_fan_parts_are_cut_and_its_dimensions_are_not() -> None:
+    """OpenSCAD's example009 (a fan) keeps one layer per extruded part; ``fan_side_center``
+    is a part (its circle is the hub's bore), ``dim`` holds dimension lines. The circles
+    come from ezdxf, not from camtool."""
+    full = (MANIFEST or {}).get("dxf", {}).get("full", [])
+    rel = next((f for f in full if f.endswith("example009.dxf")), None)
+    if rel is None:
+        pytest.skip(skip_reason())
+    import ezdxf
+
+    msp = ezdxf.readfile(CORPUS / rel).modelspace()
+    bores = sorted(2 * c.dxf.radius for c in msp.query('CIRCLE[layer=="fan_side_center"]'))
+    assert bores == [6.0]
+    assert msp.query('LINE[layer=="dim"]')
+    drawing = read_drawing(CORPUS / rel)
+    grbl = load_target("grbl")
+    text = initial_job(drawing, travel_mm=grbl.machine.travel_mm)
+    job = job_from_dict(tomllib.loads(text), source="init.toml")
+    drills = [op for op in job.operations if op.type == "drill"]
+    assert any(
+        op.select.layers == ("fan_side_center",) and op.select.diameter == (6.0, 6.0)
+        for op in drills
+    )
+    assert "layer 'dim': construction layer 'dim'" in text
+    done = run_job(drawing, grbl, job)
+    assert not any("fan_side_center" in w and "construction" in w for w in done.warnings)

@@ -112,7 +112,22 @@ def test_a_centre_line_named_by_its_layer_is_cut(tmp_path: Path) -> None:
     assert any(isinstance(m, Linear) and (m.x, m.y) == (25, 10) for m in job.program.moves)
 
 
-@pytest.mark.parametrize("layer", ["DIMENSIONS", "Construction", "Hilfslinien"])
+# Names from real drawings: Autodesk Inventor's ISO/ANSI layers (the Voron build plate),
+# the AIA layer standard's annotation group, a bare CENTERLINE layer (LibreCAD's library).
+@pytest.mark.parametrize(
+    "layer",
+    [
+        "DIMENSIONS",
+        "Construction",
+        "Hilfslinien",
+        "CENTERLINE",
+        "Center Mark (ISO)",
+        "Centerline (ISO)",
+        "A-ANNO-NOTE",
+        "Title - Kova (ANSI)",
+        "Guides",
+    ],
+)
 def test_a_construction_layer_is_left_out(tmp_path: Path, layer: str) -> None:
     doc = _doc()
     msp = doc.modelspace()
@@ -123,6 +138,27 @@ def test_a_construction_layer_is_left_out(tmp_path: Path, layer: str) -> None:
     job = post_drawing(read_drawing(path), load_target("grbl"), PlanOptions(depth=1.0))
     assert max(m.x for m in job.program.moves) == 20
     assert any(f"on layer {layer!r} (a construction layer" in w for w in job.warnings)
+
+
+# Parts named with a word that alone would name construction: a cabinet's centre drawer
+# (an Inkscape layer of a laser-cut drawer set), OpenSCAD's example009 fan (one layer per
+# extruded part), a CNC build's axis plate and guide rail, and text exploded to curves on
+# layer TEXT, as camtool's warning about TEXT entities advises.
+@pytest.mark.parametrize(
+    "layer", ["Center_Drawer", "fan_side_center", "X_Axis_Plate", "Guide_Rail", "TEXT"]
+)
+def test_a_part_layer_named_with_a_construction_word_is_cut(tmp_path: Path, layer: str) -> None:
+    doc = _doc()
+    msp = doc.modelspace()
+    msp.add_lwpolyline([(0, 0), (20, 0), (20, 20), (0, 20)], close=True)
+    msp.add_lwpolyline(
+        [(30, 0), (40, 0), (40, 10), (30, 10)], close=True, dxfattribs={"layer": layer}
+    )
+    path = tmp_path / "p.dxf"
+    doc.saveas(path)
+    job = post_drawing(read_drawing(path), load_target("grbl"), PlanOptions(depth=1.0))
+    assert max(m.x for m in job.program.moves if m.x is not None) == 40
+    assert not any("not cut" in w for w in job.warnings)
 
 
 def test_inspect_lists_layers_colours_linetypes_and_construction() -> None:
