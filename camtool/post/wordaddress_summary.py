@@ -31,13 +31,15 @@ def closing_warnings(
     name, d = spec.name, counts
     i_word = spec.words.get("I")  # a dialect without arcs has none
     i_digits = i_word.number.int_digits if i_word is not None else None
+    codes = [c for c in (spec.spindle_cw, spec.spindle_ccw) if c]
+    spindle = f"{'/'.join(codes)} take" if len(codes) > 1 else f"{''.join(codes)} takes"
     texts = {
         "feed": f"{name} has no F word: the feed of {d['feed']} cutting block(s) is not "
         "written; the machine moves at its own speed",
         "Spindle": f"{name} has no spindle command: {d['Spindle']} spindle command(s) "
         "dropped; switch the spindle (or tool) on and off by hand",
-        "speed": f"{name}'s {spec.spindle_cw or spec.spindle_ccw} takes no S "
-        f"word: {d['speed']} spindle speed(s) not written; set the speed on the machine",
+        "speed": f"{name}'s {spindle} no S word: {d['speed']} spindle speed(s) not "
+        "written; set the speed on the machine",
         "Coolant": f"{name} has no code for {d['Coolant']} coolant command(s) (M7 mist, M8 "
         "flood or a laser's air assist, M9 off): dropped; switch it by hand",
         "Dwell": f"{name} has no dwell: {d['Dwell']} pause(s) dropped",

@@ -107,6 +107,14 @@ def test_r7_z_in_blocks_of_its_own_with_a_decimal_everywhere() -> None:
     assert all(GRAMMAR.match(line) for line in lines)
 
 
+def test_a_counter_clockwise_spindle_is_written_and_its_speed_warned_by_both_codes() -> None:
+    # L1068-1076: the app writes M03 and M04 without an S word.
+    program = Program((Rapid(0, 0), Linear(1, 0, 3.0)), commands=((0, Spindle("ccw", 900.0)),))
+    result = TARGET.emit(program)
+    assert str(result.code).splitlines()[0] == "M04"
+    assert result.warnings[0].startswith("flashcut's M03/M04 take no S word: 1 spindle speed")
+
+
 def test_full_circle_is_written_as_two_halves() -> None:
     # start == end is not described for the VB6 app (§4.4): two halves work either way.
     lines = emit((Rapid(6, 5), ArcMove(6, 5, 5, 5, True, 3.0)))
