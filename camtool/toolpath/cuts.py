@@ -83,6 +83,7 @@ FINDING_KINDS = (
     "option",
     "arc-fit",
     "ordering",
+    "copy",
 )
 """Kinds of :class:`Finding`, the keys of the plan report's ``findings`` counts."""
 
@@ -140,6 +141,7 @@ _COUNTED = {
     "uncut": "region(s) narrower than the tool, not cut",
     "closed-gap": "gap(s) closed with a straight line",
     "open-gap": "open contour(s) or open end(s)",
+    "copy": "contour(s) that repeat another on its path, each cut once",
 }
 """How the line that counts a kind's unlisted findings names them (others: by the kind)."""
 

@@ -198,14 +198,17 @@ def plan_unplaced(
     Raises:
         As :func:`plan_drawing`, except the travel check.
     """
+    from camtool.toolpath.copies import drop_copies
     from camtool.toolpath.passes import emit
 
     _ = options.feed  # no feed (the target's not filled in): refused before any work
     if machine is not None:
         options.check_machine(machine, machine.name)
     placed = place(drawing, options)
-    contours, found, left_out = chained(placed.contours, options)
-    findings = [*options.ineffective(), *found, *open_gaps(contours, options)]
+    chain, found, left_out = chained(placed.contours, options)
+    kept, _, copied = drop_copies(chain, options.tolerance)
+    contours = [chain[i] for i in kept]
+    findings = [*options.ineffective(), *found, *copied, *open_gaps(contours, options)]
     stats = None
     if options.fit_arcs:
         contours, stats = fit_dense(contours, options.tolerance)

@@ -1,0 +1,110 @@
+"""Contours drawn twice: a fill and its outline, a copy stacked on the original.
+
+Drawing programs write one shape twice more often than users know: LibreOffice Draw and
+Impress export a filled and outlined shape as a fill path and a stroke path of the same
+points, icon sets draw a highlight as an outline over its own fill, and CAD drawings stack
+copies of an entity (``camtool inspect`` lists them as duplicate segments). Planned as
+drawn, each copy is cut again on the same path: a second pass of a pen, a drag knife or a
+laser, or a mill re-cutting its own groove. The planner cuts each path once and says so.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from camtool.model.shapes import Arc, Contour, Point, Segment
+from camtool.toolpath.cuts import Finding
+
+
+def drop_copies(
+    contours: Sequence[Contour], tolerance: float
+) -> tuple[list[int], dict[int, int], list[Finding]]:
+    """Which of ``contours`` to plan: each path once, with a ``copy`` finding per copy.
+
+    A copy is open or closed as an earlier contour is and has as many segments, of the same
+    kinds, with every end and arc centre within ``tolerance`` mm of the earlier one's, run
+    either way and, when closed, from any of its vertices. Lines and arcs only: a copy
+    split differently (an arc where the other has chords) is not found and is cut twice,
+    as drawn.
+
+    Args:
+        contours: the contours of one operation as chained, mm. Copies are looked for
+            after chaining: a LibreCAD diamond whose middle line is drawn twice chains
+            into one closed outline only through both; two stacked LINEs alone chain into
+            one there-and-back contour and stay so.
+        tolerance: how far two ends may differ and still be one, mm (> 0).
+
+    Returns:
+        The indices of the contours kept, in order; each copy's index mapped to its
+        original's; and a finding per copy (the warnings name the first few and count the
+        rest, :func:`~camtool.toolpath.cuts.finding_warnings`).
+    """
+    from camtool.model.units import fmt_point
+
+    quantum = 4.0 * tolerance
+    seen: dict[tuple[object, ...], list[int]] = {}
+    kept: list[int] = []
+    copies: dict[int, int] = {}
+    for i, contour in enumerate(contours):
+        key = _key(contour, quantum)
+        bucket = seen.setdefault(key, [])
+        first = next((j for j in bucket if _same(contours[j], contour, tolerance)), None)
+        if first is None:
+            bucket.append(i)
+            kept.append(i)
+        else:
+            copies[i] = first
+    findings = [
+        Finding(
+            "copy",
+            f"contour {contours[i].source} at {fmt_point(contours[i].start)} mm repeats "
+            f"contour {contours[j].source} on its path (a fill and its outline, or a copy on "
+            "top of it): cut once",
+            contours[i].start,
+        )
+        for i, j in copies.items()
+    ]
+    return kept, copies, findings
+
+
+def _key(contour: Contour, quantum: float) -> tuple[object, ...]:
+    """What two copies share for sure: closedness, segment count, the box on a coarse grid."""
+    x0, y0, x1, y1 = contour.bbox()
+    box = tuple(round(v / quantum) for v in (x0, y0, x1, y1))
+    return (contour.closed, len(contour.segments), box)
+
+
+def _same(a: Contour, b: Contour, tolerance: float) -> bool:
+    """Whether ``b`` runs on ``a``'s path (either way; from any vertex when closed)."""
+    for other in (b, b.reversed()):
+        if not a.closed:
+            if _aligned(a.segments, other.segments, 0, tolerance):
+                return True
+            continue
+        start = other.segments[0].start
+        for shift, seg in enumerate(a.segments):
+            if _near(seg.start, start, tolerance) and _aligned(
+                a.segments, other.segments, shift, tolerance
+            ):
+                return True
+    return False
+
+
+def _aligned(a: Sequence[Segment], b: Sequence[Segment], shift: int, tolerance: float) -> bool:
+    n = len(a)
+    return all(_same_segment(a[(i + shift) % n], b[i], tolerance) for i in range(n))
+
+
+def _same_segment(s: Segment, t: Segment, tolerance: float) -> bool:
+    if type(s) is not type(t):
+        return False
+    if not (_near(s.start, t.start, tolerance) and _near(s.end, t.end, tolerance)):
+        return False
+    if isinstance(s, Arc):
+        assert isinstance(t, Arc)
+        return s.clockwise == t.clockwise and _near(s.centre, t.centre, tolerance)
+    return True
+
+
+def _near(p: Point, q: Point, tolerance: float) -> bool:
+    return abs(p[0] - q[0]) <= tolerance and abs(p[1] - q[1]) <= tolerance

@@ -1,0 +1,119 @@
+"""A path drawn twice is cut once (camtool.toolpath.copies).
+
+Expected values are from the drawings: every plunge is at a contour's start, so the number
+of plunges to the depth is the number of paths cut.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import ezdxf
+import pytest
+
+from camtool.importers import read_drawing
+from camtool.jobs.pipeline import post_drawing
+from camtool.model.program import Linear
+from camtool.model.shapes import Contour, Drawing, Line, make_arc
+from camtool.post.registry import load_target
+from camtool.toolpath.options import PlanOptions
+
+# LibreOffice Impress's SVG export of an arrow shape (a CustomShape): the fill path, with the
+# two zero-length subpaths LibreOffice adds at the shape's box corners, then the same outline
+# as a stroke path, then the corners again as stroke paths of their own.
+LIBREOFFICE = """<svg version="1.2" width="281mm" height="154mm" viewBox="0 0 38100 25400"
+ preserveAspectRatio="xMidYMid" fill-rule="evenodd" stroke-width="28.222"
+ xmlns="http://www.w3.org/2000/svg">
+ <g class="com.sun.star.drawing.CustomShape"><g id="id3">
+  <rect class="BoundingBox" stroke="none" fill="none" x="3212" y="18808" width="639" height="1866"/>
+  <path fill="rgb(250,166,26)" stroke="none" d="M 3372,20671 L 3372,19274 3213,19274 3531,18809 \
+3849,19274 3690,19274 3690,20671 3372,20671 Z M 3213,18809 L 3213,18809 Z \
+M 3849,20672 L 3849,20672 Z"/>
+  <path fill="none" stroke="rgb(52,101,164)" d="M 3372,20671 L 3372,19274 3213,19274 3531,18809 \
+3849,19274 3690,19274 3690,20671 3372,20671 Z"/>
+  <path fill="none" stroke="rgb(52,101,164)" d="M 3213,18809 L 3213,18809 Z"/>
+  <path fill="none" stroke="rgb(52,101,164)" d="M 3849,20672 L 3849,20672 Z"/>
+ </g></g>
+</svg>
+"""
+
+
+def test_a_libreoffice_shape_exported_as_fill_and_outline_is_cut_once(tmp_path: Path) -> None:
+    path = tmp_path / "arrow.svg"
+    path.write_text(LIBREOFFICE)
+    drawing = read_drawing(path)
+    job = post_drawing(drawing, load_target("linuxcnc"), PlanOptions(depth=1.0))
+    plunges = [m for m in job.program.moves if isinstance(m, Linear) and m.z == -1.0]
+    assert len(plunges) == 1
+    (note,) = [w for w in job.warnings if "repeats" in w]
+    assert note.endswith("on its path (a fill and its outline, or a copy on top of it): cut once")
+    for options in ({"offset": "outside"}, {"offset": "pocket"}):
+        job = post_drawing(
+            drawing, load_target("linuxcnc"), PlanOptions(depth=1.0, tool_diameter=0.5, **options)
+        )
+        assert not any("overlap" in w for w in job.warnings)  # the pocket: one outline, not two
+
+
+def test_stacked_dxf_shapes_are_cut_once_whatever_their_start_and_direction(
+    tmp_path: Path,
+) -> None:
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    msp.add_circle((20, 20), 3)
+    msp.add_circle((20, 20), 3)
+    msp.add_lwpolyline([(30, 0), (40, 0), (40, 10), (30, 10)], close=True)
+    msp.add_lwpolyline([(40, 10), (40, 0), (30, 0), (30, 10)], close=True)  # reversed, rotated
+    path = tmp_path / "stacked.dxf"
+    doc.saveas(path)
+    job = post_drawing(read_drawing(path), load_target("linuxcnc"), PlanOptions(depth=1.0))
+    cuts = [m for m in job.program.moves if isinstance(m, Linear) and m.z == -1.0]
+    assert len(cuts) == 2  # the circle, the square
+    assert sum("repeats" in w for w in job.warnings) == 2
+
+
+@pytest.mark.parametrize("shift", [0.0, 0.01])
+def test_only_a_path_on_the_same_path_within_the_tolerance_is_a_copy(shift: float) -> None:
+    square = Contour(
+        tuple(
+            Line(a, b)
+            for a, b in zip(
+                [(0, 0), (10, 0), (10, 10), (0, 10)],
+                [(10, 0), (10, 10), (0, 10), (0, 0)],
+                strict=True,
+            )
+        ),
+        True,
+        source="a",
+    )
+    near = Contour(
+        tuple(
+            Line((a[0] + shift, a[1]), (b[0] + shift, b[1]))
+            for a, b in ((s.start, s.end) for s in square.segments)
+        ),
+        True,
+        source="b",
+    )
+    # A square sharing one edge with the first is not a copy of it; a circle and a half
+    # circle on the same centre are not copies either.
+    beside = Contour(
+        tuple(
+            Line(a, b)
+            for a, b in zip(
+                [(10, 0), (20, 0), (20, 10), (10, 10)],
+                [(20, 0), (20, 10), (10, 10), (10, 0)],
+                strict=True,
+            )
+        ),
+        True,
+        source="c",
+    )
+    circle = Contour((make_arc((35, 5), (35, 5), (30, 5), False),), True, source="d")
+    half = Contour((make_arc((35, 5), (25, 5), (30, 5), False),), False, source="e")
+    job = post_drawing(
+        Drawing((square, near, beside, circle, half)),
+        load_target("linuxcnc"),
+        PlanOptions(depth=1.0, tolerance=0.001),
+    )
+    cuts = [m for m in job.program.moves if isinstance(m, Linear) and m.z == -1.0]
+    assert len(cuts) == (4 if shift == 0.0 else 5)
