@@ -14,9 +14,10 @@ import pytest
 from camtool.importers import read_drawing
 from camtool.jobs.pipeline import post_drawing
 from camtool.model.program import Linear
-from camtool.model.shapes import Contour, Drawing, Line, make_arc
+from camtool.model.shapes import Contour, Drawing, make_arc
 from camtool.post.registry import load_target
 from camtool.toolpath.options import PlanOptions
+from tests.toolpath.contours import circle, rect
 
 # LibreOffice Impress's SVG export of an arrow shape (a CustomShape): the fill path, with the
 # two zero-length subpaths LibreOffice adds at the shape's box corners, then the same outline
@@ -74,44 +75,12 @@ def test_stacked_dxf_shapes_are_cut_once_whatever_their_start_and_direction(
 
 @pytest.mark.parametrize("shift", [0.0, 0.01])
 def test_only_a_path_on_the_same_path_within_the_tolerance_is_a_copy(shift: float) -> None:
-    square = Contour(
-        tuple(
-            Line(a, b)
-            for a, b in zip(
-                [(0, 0), (10, 0), (10, 10), (0, 10)],
-                [(10, 0), (10, 10), (0, 10), (0, 0)],
-                strict=True,
-            )
-        ),
-        True,
-        source="a",
-    )
-    near = Contour(
-        tuple(
-            Line((a[0] + shift, a[1]), (b[0] + shift, b[1]))
-            for a, b in ((s.start, s.end) for s in square.segments)
-        ),
-        True,
-        source="b",
-    )
     # A square sharing one edge with the first is not a copy of it; a circle and a half
     # circle on the same centre are not copies either.
-    beside = Contour(
-        tuple(
-            Line(a, b)
-            for a, b in zip(
-                [(10, 0), (20, 0), (20, 10), (10, 10)],
-                [(20, 0), (20, 10), (10, 10), (10, 0)],
-                strict=True,
-            )
-        ),
-        True,
-        source="c",
-    )
-    circle = Contour((make_arc((35, 5), (35, 5), (30, 5), False),), True, source="d")
-    half = Contour((make_arc((35, 5), (25, 5), (30, 5), False),), False, source="e")
+    square, near, beside = rect(0, 0, 10, 10), rect(shift, 0, 10 + shift, 10), rect(10, 0, 20, 10)
+    half = Contour((make_arc((35, 5), (25, 5), (30, 5), False),), False)
     job = post_drawing(
-        Drawing((square, near, beside, circle, half)),
+        Drawing((square, near, beside, circle(30, 5, 5), half)),
         load_target("linuxcnc"),
         PlanOptions(depth=1.0, tolerance=0.001),
     )
