@@ -15,9 +15,14 @@ from collections.abc import Sequence
 from camtool.model.shapes import Arc, Contour, Point, Segment
 from camtool.toolpath.cuts import Finding
 
+SAME_MM = 0.001
+"""How far two ends or centres may differ for two contours to be one path, mm: 1 µm, below
+the step of every machine camtool writes for, so the two would be one cut. Not
+``--tolerance``: at 0.5 mm two circles 0.3 mm apart (a thin ring) would be one."""
+
 
 def drop_copies(
-    contours: Sequence[Contour], tolerance: float
+    contours: Sequence[Contour], tolerance: float = SAME_MM
 ) -> tuple[list[int], dict[int, int], list[Finding]]:
     """Which of ``contours`` to plan: each path once, with a ``copy`` finding per copy.
 

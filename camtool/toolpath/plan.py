@@ -206,7 +206,7 @@ def plan_unplaced(
         options.check_machine(machine, machine.name)
     placed = place(drawing, options)
     chain, found, left_out = chained(placed.contours, options)
-    kept, _, copied = drop_copies(chain, options.tolerance)
+    kept, _, copied = drop_copies(chain)
     contours = [chain[i] for i in kept]
     findings = [*options.ineffective(), *found, *copied, *open_gaps(contours, options)]
     stats = None

@@ -74,15 +74,31 @@ def test_stacked_dxf_shapes_are_cut_once_whatever_their_start_and_direction(
 
 
 @pytest.mark.parametrize("shift", [0.0, 0.01])
-def test_only_a_path_on_the_same_path_within_the_tolerance_is_a_copy(shift: float) -> None:
+def test_only_a_contour_on_the_same_path_is_a_copy(shift: float) -> None:
     # A square sharing one edge with the first is not a copy of it; a circle and a half
-    # circle on the same centre are not copies either.
+    # circle on the same centre are not copies either. A square 0.01 mm off is not one
+    # even when --tolerance allows more (it is the arc fit's tolerance, not the drawing's).
     square, near, beside = rect(0, 0, 10, 10), rect(shift, 0, 10 + shift, 10), rect(10, 0, 20, 10)
     half = Contour((make_arc((35, 5), (25, 5), (30, 5), False),), False)
     job = post_drawing(
         Drawing((square, near, beside, circle(30, 5, 5), half)),
         load_target("linuxcnc"),
-        PlanOptions(depth=1.0, tolerance=0.001),
+        PlanOptions(depth=1.0, tolerance=0.05),
     )
     cuts = [m for m in job.program.moves if isinstance(m, Linear) and m.z == -1.0]
     assert len(cuts) == (4 if shift == 0.0 else 5)
+
+
+def test_a_thin_ring_is_two_circles_whatever_the_tolerance(tmp_path: Path) -> None:
+    # Two circles 0.3 mm apart on one centre: a ring's walls, both cut at --tolerance 0.5.
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4
+    doc.modelspace().add_circle((20, 20), 10)
+    doc.modelspace().add_circle((20, 20), 10.3)
+    path = tmp_path / "ring.dxf"
+    doc.saveas(path)
+    options = PlanOptions(depth=1.0, tolerance=0.5)
+    job = post_drawing(read_drawing(path), load_target("linuxcnc"), options)
+    cuts = [m for m in job.program.moves if isinstance(m, Linear) and m.z == -1.0]
+    assert len(cuts) == 2
+    assert not any("repeats" in w for w in job.warnings)
