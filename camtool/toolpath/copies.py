@@ -23,8 +23,8 @@ the step of every machine camtool writes for, so the two would be one cut. Not
 
 def drop_copies(
     contours: Sequence[Contour], tolerance: float = SAME_MM
-) -> tuple[list[int], dict[int, int], list[Finding]]:
-    """Which of ``contours`` to plan: each path once, with a ``copy`` finding per copy.
+) -> tuple[list[Contour], list[Finding]]:
+    """``contours`` with each path once, and a ``copy`` finding per copy left out.
 
     A copy is open or closed as an earlier contour is and has as many segments, of the same
     kinds, with every end and arc centre within ``tolerance`` mm of the earlier one's, run
@@ -40,9 +40,9 @@ def drop_copies(
         tolerance: how far two ends may differ and still be one, mm (> 0).
 
     Returns:
-        The indices of the contours kept, in order; each copy's index mapped to its
-        original's; and a finding per copy (the warnings name the first few and count the
-        rest, :func:`~camtool.toolpath.cuts.finding_warnings`).
+        The contours kept, in their order, and a finding per copy naming the contour it
+        repeats (the warnings name the first few and count the rest,
+        :func:`~camtool.toolpath.cuts.finding_warnings`).
     """
     from camtool.model.units import fmt_point
 
@@ -69,7 +69,7 @@ def drop_copies(
         )
         for i, j in copies.items()
     ]
-    return kept, copies, findings
+    return [contours[i] for i in kept], findings
 
 
 def _key(contour: Contour, quantum: float) -> tuple[object, ...]:

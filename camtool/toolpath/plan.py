@@ -205,9 +205,8 @@ def plan_unplaced(
     if machine is not None:
         options.check_machine(machine, machine.name)
     placed = place(drawing, options)
-    chain, found, left_out = chained(placed.contours, options)
-    kept, _, copied = drop_copies(chain)
-    contours = [chain[i] for i in kept]
+    contours, found, left_out = chained(placed.contours, options)
+    contours, copied = drop_copies(contours)
     findings = [*options.ineffective(), *found, *copied, *open_gaps(contours, options)]
     stats = None
     if options.fit_arcs:
