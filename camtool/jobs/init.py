@@ -81,8 +81,11 @@ def initial_job(
     outer = _outermost([c for group in groups for c in _chains(group)])
     ops: list[_Op] = []
     left: Counter[str] = Counter()
+    cut: list[tuple[_Group, list[_Op]]] = []
     for group in groups:
-        ops.extend(_ops_of(group, outer, thickness_mm, tool_diameter, left, k, drill=not no_z))
+        made = _ops_of(group, outer, thickness_mm, tool_diameter, left, k, drill=not no_z)
+        ops.extend(_repeated(group, made, cut))
+        cut.append((group, made))
     if all(op.kind == "engrave" for op in ops):
         # lines only, no part outline: a drawing to engrave (a sign, a symbol)
         ops = [dataclasses.replace(op, commented=False, lines=_engraved(op)) for op in ops]
@@ -216,7 +219,7 @@ def _ops_of(
     ``drill``: small circles are drilled (else profiled with the rest: no Z to drill by).
     """
     select = f"{group.by} = [{_quote(group.key)}]"
-    what = f"layer {group.key!r}" if group.by == "layers" else f"colour {group.key}"
+    what = _what(group)
     kept: list[Contour] = []
     for contour in group.contours:
         reason = construction_reason(contour, Selection())
@@ -262,6 +265,47 @@ def _ops_of(
         depth = shaper[1] if shaper else None
         out.append(_engrave_op(select, what, len(opened), closed_too=online, depth=depth))
     return out
+
+
+def _repeated(group: _Group, made: list[_Op], cut: list[tuple[_Group, list[_Op]]]) -> list[_Op]:
+    """``made``, commented out when each contour of ``group`` lies on an earlier group's path.
+
+    A filled and outlined shape exported as a fill path and a stroke path (LibreOffice
+    Draw and Impress) is one shape in two colours: the earlier group's operation of the
+    same kind cuts it, and ``post`` would cut this one's copy once only
+    (:func:`~camtool.toolpath.copies.drop_copies`).
+    """
+    from camtool.toolpath.copies import drop_copies
+
+    kinds = {op.kind for op in made if not op.commented}
+    earlier = [
+        (_what(g), _chains(g))
+        for g, ops in cut
+        if kinds and kinds <= {op.kind for op in ops if not op.commented}
+    ]
+    chains = _chains(group)
+    if not earlier or not chains or drop_copies(chains, cut_before=earlier)[0]:
+        return made
+    others = " and ".join(
+        w
+        for w, theirs in earlier
+        if len(drop_copies(chains, cut_before=[(w, theirs)])[0]) < len(chains)
+    )
+    why = _why(
+        f"each contour of {_what(group)} lies on one of {others} (a fill and its outline): "
+        "cut there; not cut twice unless you uncomment this"
+    )
+    return [
+        dataclasses.replace(
+            op, commented=True, lines=(op.lines[0].split("  # ")[0] + why, *op.lines[1:])
+        )
+        for op in made
+    ]
+
+
+def _what(group: _Group) -> str:
+    """How comments name a group: ``"layer 'OUTLINE'"``, ``"colour #ff0000"``."""
+    return f"layer {group.key!r}" if group.by == "layers" else f"colour {group.key}"
 
 
 def _drawn(d: float, k: float) -> float:

@@ -20,13 +20,17 @@ def unselected(
     runs: Sequence[OperationRun],
     construction: Sequence[Contour],
     joint_mm: float,
+    cut: Sequence[Contour] = (),
 ) -> list[str]:
     """One line per layer of the contours no operation selects (construction said apart).
 
     They are counted as chained ``joint_mm`` apart at most (as ``camtool inspect`` counts
-    them): four LINEs of an open outline are one open contour.
+    them): four LINEs of an open outline are one open contour. A chain on the path of one
+    of ``cut`` (the operations' contours as planned: a fill whose outline an operation
+    cuts) is cut there and not counted.
     """
     from camtool.geometry.chain import chain_members
+    from camtool.toolpath.copies import drop_copies
 
     taken = {id(c) for r in runs for c in r.placed.contours}
     taken |= {id(c) for c in construction}
@@ -36,9 +40,11 @@ def unselected(
             left.setdefault(contour.layer, []).append(contour)
     out = []
     for layer, pieces in sorted(left.items()):
-        contours = chain_members(pieces, joint_mm)[0]
+        contours = drop_copies(chain_members(pieces, joint_mm)[0], cut_before=[("", cut)])[0]
+        if not contours:
+            continue
         opened = sum(not c.closed for c in contours)
-        first = pieces[0]
+        first = contours[0]
         out.append(
             f"not cut: {len(contours)} contour(s) on layer {layer!r} ({opened} open; first "
             f"{first.source or 'contour'} at ({first.start[0]:.4f}, {first.start[1]:.4f}) mm): "

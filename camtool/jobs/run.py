@@ -213,6 +213,7 @@ class _Planned:
     placed: Drawing
     holes: int = 0
     left_out: frozenset[int] = frozenset()
+    paths: tuple[Contour, ...] = ()
 
 
 def run_job(
@@ -263,6 +264,7 @@ def run_job(
     here: tuple[float, float, float | None] = (*setup.origin, None)
     loaded: int | None = None
     sequence = job.sequenced()
+    cut: list[tuple[Operation, str, tuple[Contour, ...]]] = []  # each operation's paths
     for number, op in enumerate(sequence, start=1):
         tool = job.tool(op.tool)
         where = _where(job, op, number)
@@ -289,7 +291,11 @@ def run_job(
             commands.extend(_tool_change(len(moves), tool, loaded, output, target))
             loaded = tool.id
         first = len(moves)
-        planned = _plan_operation(chosen.drawing, op, tool, options, target, here, where, progress)
+        alike = [(w, paths) for o, w, paths in cut if _cuts_alike(o, op)]
+        planned = _plan_operation(
+            chosen.drawing, op, tool, options, target, here, where, progress, alike
+        )
+        cut.append((op, where, planned.paths))
         offset = _last_contour(moves)
         _join(moves, commands, planned, offset)
         warnings.extend(planned.warnings)
@@ -300,7 +306,7 @@ def run_job(
                 operation=op,
                 tool=tool,
                 moves=(first, len(moves)),
-                contours=(offset + 1, _last_contour(moves)),
+                contours=_numbers(offset, moves),
                 placed=planned.placed,
                 edge_radius_mm=_edge(op, tool, options),
                 report=planned.report,
@@ -312,7 +318,9 @@ def run_job(
         del planned  # its moves are in ``moves``: not kept past the placement's shifted copy
     notes = construction_notes(construction)
     if not job.shorthand:
-        notes.extend(unselected(scaled, runs, construction, joint))
+        notes.extend(
+            unselected(scaled, runs, construction, joint, [p for *_, ps in cut for p in ps])
+        )
         notes.extend(undrilled(drawing, drilled))
     warnings[len(drawing.warnings) : len(drawing.warnings)] = notes
     warnings.extend(overlaps(runs, job))
@@ -441,6 +449,21 @@ def _as_scaled(chosen: Selected, drawing: Drawing, scaled: Drawing) -> Selected:
     )
 
 
+def _cuts_alike(a: Operation, b: Operation) -> bool:
+    """Whether ``a`` and ``b`` cut a path alike: same type, tool, side and planning options.
+
+    A contour ``b`` selects on the path of one ``a`` cut is then cut again to the same
+    depth with the same tool (a fill and its outline put in two operations by their
+    colours); drills count their holes apart.
+    """
+    return a.type != "drill" and (a.type, a.tool, a.side, a.plan) == (
+        b.type,
+        b.tool,
+        b.side,
+        b.plan,
+    )
+
+
 def _where(job: Job, op: Operation, number: int) -> str:
     """How messages name an operation (the shorthand is the command's options)."""
     if job.shorthand:
@@ -482,8 +505,13 @@ def _plan_operation(
     here: tuple[float, float, float | None],
     where: str,
     progress: Progress,
+    cut_before: Sequence[tuple[str, Sequence[Contour]]] = (),
 ) -> _Planned:
-    """The moves of one operation, in drawing coordinates (scaled, not yet placed)."""
+    """The moves of one operation, in drawing coordinates (scaled, not yet placed).
+
+    ``cut_before``: the paths of the earlier operations that cut alike, by name
+    (:func:`~camtool.toolpath.plan.plan_unplaced`).
+    """
     if op.type == "drill":
         return _drill(drawing, op, tool, options, here, where)
     from camtool.toolpath.plan import plan_unplaced
@@ -492,7 +520,12 @@ def _plan_operation(
         raise InputError(f"{where} selects only points, which only a drill operation drills")
     try:
         planned = plan_unplaced(
-            drawing, options, target.machine, helix=target.post.helix, progress=progress
+            drawing,
+            options,
+            target.machine,
+            helix=target.post.helix,
+            progress=progress,
+            cut_before=cut_before,
         )
     except (InputError, ToolpathError, UsageError) as exc:
         if where == "the options":
@@ -509,6 +542,7 @@ def _plan_operation(
         planned.report,
         planned.placed,
         left_out=planned.left_out,
+        paths=planned.paths,
     )
 
 
@@ -556,6 +590,12 @@ def _spindle_around(program: Program, output: OutputOptions, target: Target) -> 
     if not rpm or any(isinstance(c, Spindle) for _, c in program.commands):
         return program
     return program.with_spindle(rpm, dwell_s=output.spindle_dwell_s)
+
+
+def _numbers(offset: int, moves: Sequence[Move]) -> tuple[int, int]:
+    """An operation's ``(first, last)`` contour numbers, ``(0, -1)`` when it cuts none."""
+    last = _last_contour(moves)
+    return (offset + 1, last) if last > offset else (0, -1)
 
 
 def _last_contour(moves: Sequence[Move]) -> int:

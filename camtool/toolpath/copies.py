@@ -22,7 +22,10 @@ the step of every machine camtool writes for, so the two would be one cut. Not
 
 
 def drop_copies(
-    contours: Sequence[Contour], tolerance: float = SAME_MM
+    contours: Sequence[Contour],
+    tolerance: float = SAME_MM,
+    *,
+    cut_before: Sequence[tuple[str, Sequence[Contour]]] = (),
 ) -> tuple[list[Contour], list[Finding]]:
     """``contours`` with each path once, and a ``copy`` finding per copy left out.
 
@@ -38,6 +41,9 @@ def drop_copies(
             into one closed outline only through both; two stacked LINEs alone chain into
             one there-and-back contour and stay so.
         tolerance: how far two ends may differ and still be one, mm (> 0).
+        cut_before: ``(who, contours)`` of the earlier operations of a job that cut as
+            this one does (same tool, type, side and options): a contour on one of their
+            paths is their copy (``who`` names the operation in the finding).
 
     Returns:
         The contours kept, in their order, and a finding per copy naming the contour it
@@ -47,29 +53,30 @@ def drop_copies(
     from camtool.model.units import fmt_point
 
     quantum = 4.0 * tolerance
-    seen: dict[tuple[object, ...], list[int]] = {}
-    kept: list[int] = []
-    copies: dict[int, int] = {}
-    for i, contour in enumerate(contours):
-        key = _key(contour, quantum)
-        bucket = seen.setdefault(key, [])
-        first = next((j for j in bucket if _same(contours[j], contour, tolerance)), None)
+    seen: dict[tuple[object, ...], list[tuple[Contour, str]]] = {}
+    for who, earlier in cut_before:
+        for contour in earlier:
+            seen.setdefault(_key(contour, quantum), []).append((contour, who))
+    kept: list[Contour] = []
+    findings: list[Finding] = []
+    for contour in contours:
+        bucket = seen.setdefault(_key(contour, quantum), [])
+        first = next(((c, w) for c, w in bucket if _same(c, contour, tolerance)), None)
         if first is None:
-            bucket.append(i)
-            kept.append(i)
-        else:
-            copies[i] = first
-    findings = [
-        Finding(
-            "copy",
-            f"contour {contours[i].source} at {fmt_point(contours[i].start)} mm repeats "
-            f"contour {contours[j].source} on its path (a fill and its outline, or a copy on "
-            "top of it): cut once",
-            contours[i].start,
+            bucket.append((contour, ""))
+            kept.append(contour)
+            continue
+        other, who = first
+        repeats = f"contour {other.source}, which {who} cuts," if who else f"contour {other.source}"
+        findings.append(
+            Finding(
+                "copy",
+                f"contour {contour.source} at {fmt_point(contour.start)} mm repeats {repeats} "
+                "on its path (a fill and its outline, or a copy on top of it): cut once",
+                contour.start,
+            )
         )
-        for i, j in copies.items()
-    ]
-    return [contours[i] for i in kept], findings
+    return kept, findings
 
 
 def _key(contour: Contour, quantum: float) -> tuple[object, ...]:

@@ -128,12 +128,15 @@ class Plan:
     cut at all: the pieces of an open chain under ``--offset outside``, ``inside`` or
     ``pocket`` (a centre line, a construction line across the part; each is an
     ``open-left-out`` finding); ``placed.without(left_out)`` is what the program cuts.
+    ``paths`` are the contours as chained that it plans (each path once, in the drawing's
+    coordinates): what a later operation of a job that cuts alike need not cut again.
     """
 
     program: Program
     report: PlanReport
     placed: Drawing
     left_out: frozenset[int] = frozenset()
+    paths: tuple[Contour, ...] = ()
 
 
 def plan(drawing: Drawing, options: PlanOptions, machine: Machine | None = None) -> Program:
@@ -188,12 +191,17 @@ def plan_unplaced(
     *,
     helix: bool = True,
     progress: Progress = no_progress,
+    cut_before: Sequence[tuple[str, Sequence[Contour]]] = (),
 ) -> Plan:
     """:func:`plan_drawing` without its placement stage: the program in drawing coordinates.
 
     The drawing is scaled (``--scale``/``--fit``) and planned as :func:`plan_drawing`
     plans it; ``options.placement``, ``translate`` and the travel check are not applied
     (:func:`place_program` does that, once for a whole job of several operations).
+    ``cut_before`` are the :attr:`Plan.paths` of a job's earlier operations that cut as
+    this one does, each with the operation's name (:func:`~camtool.toolpath.copies.drop_copies`):
+    a contour on one of their paths is not cut again, and when every contour is, the
+    program has no moves.
 
     Raises:
         As :func:`plan_drawing`, except the travel check.
@@ -206,7 +214,8 @@ def plan_unplaced(
         options.check_machine(machine, machine.name)
     placed = place(drawing, options)
     contours, found, left_out = chained(placed.contours, options)
-    contours, copied = drop_copies(contours)
+    contours, copied = drop_copies(contours, cut_before=cut_before)
+    paths = tuple(contours)
     findings = [*options.ineffective(), *found, *copied, *open_gaps(contours, options)]
     stats = None
     if options.fit_arcs:
@@ -229,7 +238,7 @@ def plan_unplaced(
         nest=nest if on_line else None,
     )
     findings.extend(emitted)
-    if not any(not isinstance(m, Rapid) for m in moves):
+    if (paths or not copied) and not any(not isinstance(m, Rapid) for m in moves):
         raise InputError(
             f"{drawing.source or 'the drawing'}: nothing to cut: {len(contours)} contour(s), "
             f"none longer than {MIN_PIECE:g} mm after planning; check the drawing's units "
@@ -245,7 +254,7 @@ def plan_unplaced(
         stats,
         joint_mm=joint_distance(options.chain_tolerance),
     )
-    return Plan(program, report, placed, left_out)
+    return Plan(program, report, placed, left_out, paths)
 
 
 def chained(
@@ -294,6 +303,8 @@ def _keep_off(contours: Sequence[Contour], nest: Any, options: PlanOptions) -> K
 def _stage(
     contours: Sequence[Contour], nest: Any, options: PlanOptions, progress: Progress
 ) -> Stage:
+    if not contours:  # each a copy of an earlier operation's (``cut_before``)
+        return Stage(())
     if options.offset == "pocket":
         from camtool.toolpath.pocket import pocket
 

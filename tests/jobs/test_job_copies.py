@@ -1,0 +1,143 @@
+"""A path two operations of a job select alike is cut once (a fill and its outline).
+
+LibreOffice Draw and Impress export a filled, outlined shape as a fill path (the fill's
+colour) and a stroke path (the line's colour) of the same points; ``camtool job init``
+makes one operation per colour, so the shape is selected twice. Expected values come from
+the geometry: a 40 × 20 mm rectangle cut on its outside by a 3 mm end mill is a path
+2·(40 + 20) + 2π·1.5 mm long (straight sides and quarter-circle corners around each
+vertex), at the operation's depth.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from pathlib import Path
+
+from camtool.importers import read_drawing
+from camtool.jobs.init import initial_job
+from camtool.jobs.jobfile import job_from_dict, load_job
+from camtool.jobs.run import PostJob, run_job
+from camtool.model.program import ArcMove, Move, Rapid, segment_of
+from camtool.model.shapes import Contour, Drawing
+from camtool.post.registry import load_target
+from tests.toolpath.contours import circle, rect
+
+PERIMETER = 2 * (40 + 20) + 2 * math.pi * 1.5
+
+_OPERATION = """
+[[operations]]
+type = "profile"
+tool = 1
+side = "outside"
+colours = ["{colour}"]
+depth = {depth}
+"""
+
+
+def _job(tmp_path: Path, *ops: tuple[str, float]) -> Path:
+    text = '[[tools]]\nid = 1\ntype = "end-mill"\ndiameter = 3\n'
+    text += "".join(_OPERATION.format(colour=c, depth=d) for c, d in ops)
+    path = tmp_path / "job.toml"
+    path.write_text(text)
+    return path
+
+
+def _painted(contour: Contour, colour: str, source: str) -> Contour:
+    return dataclasses.replace(contour, colour=colour, source=source)
+
+
+def _drawing(*contours: Contour) -> Drawing:
+    return Drawing(contours, "shapes.svg")
+
+
+def _fill_and_outline() -> tuple[Contour, Contour]:
+    square = rect(10, 10, 50, 30)
+    return _painted(square, "#ffcc00", "path[2]"), _painted(square, "#000000", "path[3]")
+
+
+def _feed_at(post: PostJob, number: int, z: float) -> float:
+    """The XY length operation ``number`` cuts at Z ``z`` (level feeds only), mm."""
+    first, end = post.operations[number - 1].moves
+    moves: list[Move] = list(post.program.moves)
+    height = None  # Z before each move
+    for move in moves[:first]:
+        height = move.z if move.z is not None else height
+    total = 0.0
+    for i in range(first, end):
+        move = moves[i]
+        after = move.z if move.z is not None else height
+        if not isinstance(move, Rapid) and height == after == z and i > 0:
+            start = (moves[i - 1].x, moves[i - 1].y)
+            if isinstance(move, ArcMove):
+                total += segment_of(start, move).length
+            else:
+                total += math.dist(start, (move.x, move.y))
+        height = after
+    return total
+
+
+def test_a_fill_and_its_outline_in_two_operations_are_cut_once(tmp_path: Path) -> None:
+    fill, outline = _fill_and_outline()
+    job = load_job(_job(tmp_path, ("#ffcc00", 1), ("#000000", 1)))
+    post = run_job(_drawing(fill, outline), load_target("linuxcnc"), job)
+    second = post.operations[1]
+    assert math.isclose(_feed_at(post, 1, -1.0), PERIMETER, rel_tol=1e-6)
+    assert second.moves[0] == second.moves[1]  # nothing left for the outline
+    assert any(
+        "path[3]" in w and "repeats contour path[2], which operation 1 cuts" in w
+        for w in post.warnings
+    )
+    assert not any("no operation selects" in w for w in post.warnings)
+    header = [n for n in post.program.notes if n.startswith("2. ")]
+    assert header == [
+        "2. profile outside T1: nothing left to cut, each contour on an earlier operation's path"
+    ]
+
+
+def test_only_the_copies_are_left_out_of_an_operation_that_has_more(tmp_path: Path) -> None:
+    fill, outline = _fill_and_outline()
+    hole = _painted(circle(100, 20, 5), "#000000", "path[4]")  # outlined only
+    job = load_job(_job(tmp_path, ("#ffcc00", 1), ("#000000", 1)))
+    post = run_job(_drawing(fill, outline, hole), load_target("linuxcnc"), job)
+    # the circle alone: 2π(5 + 1.5) on its outside
+    assert math.isclose(_feed_at(post, 2, -1.0), 2 * math.pi * 6.5, rel_tol=1e-6)
+
+
+def test_a_copy_cut_deeper_by_a_later_operation_is_cut_again(tmp_path: Path) -> None:
+    fill, outline = _fill_and_outline()
+    job = load_job(_job(tmp_path, ("#ffcc00", 1), ("#000000", 2)))
+    post = run_job(_drawing(fill, outline), load_target("linuxcnc"), job)
+    assert math.isclose(_feed_at(post, 1, -1.0), PERIMETER, rel_tol=1e-6)
+    assert math.isclose(_feed_at(post, 2, -2.0), PERIMETER, rel_tol=1e-6)
+    assert not any("repeats" in w for w in post.warnings)
+
+
+_LIBREOFFICE = """<?xml version="1.0" encoding="UTF-8"?>
+<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="50mm" viewBox="0 0 10000 5000">
+ <g class="com.sun.star.drawing.CustomShape">
+  <path fill="rgb(114,159,207)" stroke="none" d="M 1000,1000 L 5000,1000
+   5000,3000 1000,3000 1000,1000 Z"/>
+  <path fill="none" stroke="rgb(52,101,164)" d="M 1000,1000 L 5000,1000
+   5000,3000 1000,3000 1000,1000 Z"/>
+ </g>
+</svg>
+"""  # the shape of LibreOffice Draw's SVG export: fill path, then its outline
+
+
+def test_job_init_leaves_a_libreoffice_shapes_fill_to_its_outline(tmp_path: Path) -> None:
+    svg = tmp_path / "shape.svg"
+    svg.write_text(_LIBREOFFICE)
+    drawing = read_drawing(svg)
+    text = initial_job(drawing)
+    job = job_from_dict(tomllib.loads(text), source="shape.toml")
+    # an operation per colour, in their order: the outline's first, the fill's left to it
+    assert [op.select.colours for op in job.operations] == [("#3465a4",)]
+    assert (
+        '# name = "#729fcf"  # each contour of colour #729fcf lies on one of colour #3465a4' in text
+    )
+    post = run_job(drawing, load_target("linuxcnc"), job)
+    # one path round the rectangle on the last pass, less the gaps over its 2 tabs
+    assert PERIMETER - 20 < _feed_at(post, 1, -3.5) < PERIMETER
+    assert not any("no operation selects" in w for w in post.warnings)
