@@ -10,6 +10,7 @@ laser, or a mill re-cutting its own groove. The planner cuts each path once and 
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 
 from camtool.model.shapes import Arc, Contour, Point, Segment
@@ -77,6 +78,60 @@ def drop_copies(
             )
         )
     return kept, findings
+
+
+def one_way(
+    contours: Sequence[Contour], tolerance: float = SAME_MM
+) -> tuple[list[Contour], list[Finding]]:
+    """``contours``, each that comes back on its own path cut one way, with a finding each.
+
+    Two stacked copies of a line (or of a run of lines and arcs) chain end to end into a
+    contour that goes out and back on one path, closed when it ends where it began: the
+    tool would cut the line twice and, closed, find no area in it. Each such contour
+    becomes its way out, an open contour (within ``tolerance`` mm, as :func:`drop_copies`).
+
+    Returns:
+        The contours, in their order (the others the same objects), and a ``copy``
+        finding per contour cut one way.
+    """
+    from camtool.model.units import fmt_point
+
+    out: list[Contour] = []
+    findings: list[Finding] = []
+    for contour in contours:
+        way = _one_way(contour, tolerance)
+        out.append(way)
+        if way is not contour:
+            findings.append(
+                Finding(
+                    "copy",
+                    f"contour {contour.source} at {fmt_point(contour.start)} mm runs back on "
+                    "its own path (a line drawn twice, end to end): cut one way",
+                    contour.start,
+                )
+            )
+    return out, findings
+
+
+def _one_way(contour: Contour, tolerance: float) -> Contour:
+    """``contour``, or its way out when it comes back on the same path (an open contour).
+
+    Two stacked copies of a line (or of a run of lines and arcs) chain end to end into a
+    contour that goes out and back, closed when it ends where it began.
+    """
+    segments = contour.segments
+    n = len(segments)
+    if n % 2:
+        return contour
+    k = n // 2
+    for shift in range(n if contour.closed else 1):
+        turn = segments[(shift + k - 1) % n]
+        if not _same_segment(turn.reversed(), segments[(shift + k) % n], tolerance):
+            continue
+        way = [segments[(shift + i) % n] for i in range(n)]
+        if all(_same_segment(way[k - 1 - i].reversed(), way[k + i], tolerance) for i in range(k)):
+            return dataclasses.replace(contour, segments=tuple(way[:k]), closed=False)
+    return contour
 
 
 def _key(contour: Contour, quantum: float) -> tuple[object, ...]:

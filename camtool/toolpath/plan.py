@@ -21,6 +21,7 @@ from camtool.model.program import Program, Rapid
 from camtool.model.progress import Progress, no_progress
 from camtool.model.shapes import BBox, Contour, Drawing, Line, Point, Segment, fit_factor
 from camtool.toolpath.chain import close_gaps
+from camtool.toolpath.copies import drop_copies, one_way
 from camtool.toolpath.cuts import Cut, Finding, Stage, finding_warnings
 from camtool.toolpath.gaps import open_gaps
 from camtool.toolpath.leads import KeepOff
@@ -206,7 +207,6 @@ def plan_unplaced(
     Raises:
         As :func:`plan_drawing`, except the travel check.
     """
-    from camtool.toolpath.copies import drop_copies
     from camtool.toolpath.passes import emit
 
     _ = options.feed  # no feed (the target's not filled in): refused before any work
@@ -263,16 +263,20 @@ def chained(
     """``contours`` chained and their gaps closed as the planner cuts them.
 
     Ends within ``options.chain_tolerance`` are joined (:func:`chain_members`), then
-    gaps up to ``options.close_gap`` closed (:func:`close_gaps`).
+    gaps up to ``options.close_gap`` closed (:func:`close_gaps`); a contour that comes
+    back on its own path (a line drawn twice) is cut one way
+    (:func:`~camtool.toolpath.copies.one_way`).
 
     Returns:
-        The planned contours, mm; the ``closed-gap`` findings; and the indices in
+        The planned contours, mm; the ``closed-gap`` and ``copy`` findings; and the indices in
         ``contours`` of those the plan leaves out (:attr:`Plan.left_out`: the pieces
         of a chain still open, unless ``options.offset`` is ``on``).
     """
     joint = joint_distance(options.chain_tolerance)
     joined, members = chain_members(contours, joint)
     joined, found = close_gaps(joined, options.close_gap, joint)
+    joined, back = one_way(joined)
+    found.extend(back)
     left_out = frozenset(
         i
         for contour, pieces in zip(joined, members, strict=True)

@@ -6,6 +6,7 @@ of plunges to the depth is the number of paths cut.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import ezdxf
@@ -13,8 +14,9 @@ import pytest
 
 from camtool.importers import read_drawing
 from camtool.jobs.pipeline import post_drawing
+from camtool.model.errors import ToolpathError
 from camtool.model.program import Linear
-from camtool.model.shapes import Contour, Drawing, make_arc
+from camtool.model.shapes import Contour, Drawing, Line, make_arc
 from camtool.post.registry import load_target
 from camtool.toolpath.options import PlanOptions
 from tests.toolpath.contours import circle, rect
@@ -102,3 +104,51 @@ def test_a_thin_ring_is_two_circles_whatever_the_tolerance(tmp_path: Path) -> No
     cuts = [m for m in job.program.moves if isinstance(m, Linear) and m.z == -1.0]
     assert len(cuts) == 2
     assert not any("repeats" in w for w in job.warnings)
+
+
+def _feed_length(moves: list[object]) -> float:
+    """The XY length fed at Z -1, mm (lines only)."""
+    total, here = 0.0, None
+    for move in moves:
+        xy = (move.x, move.y)  # type: ignore[attr-defined]
+        if isinstance(move, Linear) and move.z in (None, -1.0) and here is not None:
+            total += math.dist(here, xy)
+        here = xy
+    return total
+
+
+@pytest.mark.parametrize(
+    "second",
+    [
+        [(0, 0), (30, 0), (30, 20)],  # the polyline drawn again the same way
+        [(30, 20), (30, 0), (0, 0)],  # and back the other way
+    ],
+)
+def test_a_line_drawn_twice_end_to_end_is_cut_one_way(tmp_path: Path, second: list) -> None:
+    # Stacked copies of an open polyline chain end to end into a contour that runs out and
+    # back on one path: cut out only, 30 + 20 mm of feed.
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4
+    doc.modelspace().add_lwpolyline([(0, 0), (30, 0), (30, 20)])
+    doc.modelspace().add_lwpolyline(second)
+    path = tmp_path / "twice.dxf"
+    doc.saveas(path)
+    job = post_drawing(read_drawing(path), load_target("linuxcnc"), PlanOptions(depth=1.0))
+    assert math.isclose(_feed_length(list(job.program.moves)), 50.0)
+    assert sum("runs back on its own path" in w for w in job.warnings) == 1
+    # with a side, it is what it is: an open line, left out and said so
+    outside = PlanOptions(depth=1.0, offset="outside", tool_diameter=3.0)
+    with pytest.raises(ToolpathError, match="the 1 contour is open"):
+        post_drawing(read_drawing(path), load_target("linuxcnc"), outside)
+
+
+def test_a_closed_outline_through_a_line_drawn_twice_keeps_both() -> None:
+    # Two triangles sharing their middle edge, that edge drawn once for each: one closed
+    # contour runs through both copies (out along the edge and back), not a retrace of
+    # itself, and is cut whole.
+    a, b, c, d = (0.0, 0.0), (10.0, 0.0), (10.0, 10.0), (20.0, 0.0)
+    lines = [Line(a, b), Line(b, c), Line(c, a), Line(b, c), Line(c, d), Line(d, b)]
+    drawing = Drawing(tuple(Contour((seg,), False) for seg in lines))
+    job = post_drawing(drawing, load_target("linuxcnc"), PlanOptions(depth=1.0))
+    assert math.isclose(_feed_length(list(job.program.moves)), sum(s.length for s in lines))
+    assert not any("runs back" in w for w in job.warnings)
