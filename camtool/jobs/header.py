@@ -128,7 +128,7 @@ def _operation_line(run: OperationRun, target: Target) -> str:
     plan = op.plan
     head = f"{run.number}. {op.kind}{name} T{run.tool.id}"
     if run.moves[0] == run.moves[1] and op.type != "drill":
-        return f"{head}: nothing left to cut, each contour on an earlier operation's path"
+        return f"{head}: nothing left to cut (its paths cut before)"
     if op.type == "drill":
         what = f"{_count(run.holes, 'hole')}, {plan.depth:g} deep"
         if plan.step_down is not None and plan.depth is not None and plan.step_down < plan.depth:

@@ -68,15 +68,18 @@ def drop_copies(
             kept.append(contour)
             continue
         other, who = first
-        repeats = f"contour {other.source}, which {who} cuts," if who else f"contour {other.source}"
-        findings.append(
-            Finding(
-                "copy",
-                f"contour {contour.source} at {fmt_point(contour.start)} mm repeats {repeats} "
-                "on its path (a fill and its outline, or a copy on top of it): cut once",
-                contour.start,
+        here = f"contour {contour.source} at {fmt_point(contour.start)} mm"
+        if who and other.source == contour.source:  # selected again: the job says so
+            message = f"{here}: {who} cuts it already: cut once"
+        else:
+            repeats = (
+                f"contour {other.source}, which {who} cuts," if who else f"contour {other.source}"
             )
-        )
+            message = (
+                f"{here} repeats {repeats} on its path (a fill and its outline, or a copy on "
+                "top of it): cut once"
+            )
+        findings.append(Finding("copy", message, contour.start))
     return kept, findings
 
 

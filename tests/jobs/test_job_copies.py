@@ -91,9 +91,7 @@ def test_a_fill_and_its_outline_in_two_operations_are_cut_once(tmp_path: Path) -
     )
     assert not any("no operation selects" in w for w in post.warnings)
     header = [n for n in post.program.notes if n.startswith("2. ")]
-    assert header == [
-        "2. profile outside T1: nothing left to cut, each contour on an earlier operation's path"
-    ]
+    assert header == ["2. profile outside T1: nothing left to cut (its paths cut before)"]
 
 
 def test_only_the_copies_are_left_out_of_an_operation_that_has_more(tmp_path: Path) -> None:
@@ -141,3 +139,16 @@ def test_job_init_leaves_a_libreoffice_shapes_fill_to_its_outline(tmp_path: Path
     # one path round the rectangle on the last pass, less the gaps over its 2 tabs
     assert PERIMETER - 20 < _feed_at(post, 1, -3.5) < PERIMETER
     assert not any("no operation selects" in w for w in post.warnings)
+
+
+def test_a_contour_two_operations_select_alike_is_cut_by_the_first(tmp_path: Path) -> None:
+    outline = _painted(rect(10, 10, 50, 30), "#000000", "LWPOLYLINE #8F")
+    job = load_job(_job(tmp_path, ("#000000", 1), ("#000000", 1)))
+    post = run_job(_drawing(outline), load_target("linuxcnc"), job)
+    assert math.isclose(_feed_at(post, 1, -1.0), PERIMETER, rel_tol=1e-6)
+    assert post.operations[1].moves[0] == post.operations[1].moves[1]
+    assert (
+        "contour LWPOLYLINE #8F at (10.0000, 10.0000) mm: operation 1 cuts it already: cut once"
+        in (post.warnings)
+    )
+    assert any("is one selection too wide?" in w for w in post.warnings)
