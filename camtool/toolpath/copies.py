@@ -13,7 +13,8 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Sequence
 
-from camtool.model.shapes import Arc, Contour, Point, Segment
+from camtool.geometry.chain import closes_alone, with_end
+from camtool.model.shapes import Arc, Contour, Point, Segment, distance
 from camtool.toolpath.cuts import Finding
 
 SAME_MM = 0.001
@@ -84,14 +85,16 @@ def drop_copies(
 
 
 def one_way(
-    contours: Sequence[Contour], tolerance: float = SAME_MM
+    contours: Sequence[Contour], joint_mm: float, tolerance: float = SAME_MM
 ) -> tuple[list[Contour], list[Finding]]:
     """``contours``, each that comes back on its own path cut one way, with a finding each.
 
     Two stacked copies of a line (or of a run of lines and arcs) chain end to end into a
     contour that goes out and back on one path, closed when it ends where it began: the
-    tool would cut the line twice and, closed, find no area in it. Each such contour
-    becomes its way out, an open contour (within ``tolerance`` mm, as :func:`drop_copies`).
+    tool would cut the path twice and, closed, find no area in it. Each such contour
+    (within ``tolerance`` mm, as :func:`drop_copies`) becomes its way out: open, unless its
+    own ends are ``joint_mm`` apart at most, as chaining closes a contour (two copies of
+    a circle drawn as an ARC a hair short of 360° are that circle, closed).
 
     Returns:
         The contours, in their order (the others the same objects), and a ``copy``
@@ -102,46 +105,61 @@ def one_way(
     out: list[Contour] = []
     findings: list[Finding] = []
     for contour in contours:
-        way = _one_way(contour, tolerance)
+        way = _one_way(contour, tolerance, joint_mm)
         out.append(way)
         if way is not contour:
             findings.append(
                 Finding(
                     "copy",
                     f"contour {contour.source} at {fmt_point(contour.start)} mm runs back on "
-                    "its own path (a line drawn twice, end to end): cut one way",
+                    "its own path (drawn twice, end to end): cut one way",
                     contour.start,
                 )
             )
     return out, findings
 
 
-def _one_way(contour: Contour, tolerance: float) -> Contour:
-    """``contour``, or its way out when it comes back on the same path (an open contour).
+def _one_way(contour: Contour, tolerance: float, joint_mm: float) -> Contour:
+    """``contour``, or its way out when it comes back on the same path.
 
     Two stacked copies of a line (or of a run of lines and arcs) chain end to end into a
-    contour that goes out and back, closed when it ends where it began.
+    contour that goes out and back, closed when it ends where it began; chained, it starts
+    at a copy's end, where it turns back (a closed contour that does not is left as it is).
     """
     segments = contour.segments
     n = len(segments)
     if n % 2:
         return contour
     k = n // 2
-    for shift in range(n if contour.closed else 1):
-        turn = segments[(shift + k - 1) % n]
-        if not _same_segment(turn.reversed(), segments[(shift + k) % n], tolerance):
-            continue
-        way = [segments[(shift + i) % n] for i in range(n)]
-        if all(_same_segment(way[k - 1 - i].reversed(), way[k + i], tolerance) for i in range(k)):
-            return dataclasses.replace(contour, segments=tuple(way[:k]), closed=False)
-    return contour
+    turn, back = segments[k - 1], segments[k]
+    if not (_near(turn.start, back.end, tolerance) and _near(turn.end, back.start, tolerance)):
+        return contour  # no turn half way: most contours end here
+    if contour.closed and not _near(segments[-1].start, segments[0].end, tolerance):
+        return contour
+    if not all(
+        _same_segment(segments[k - 1 - i].reversed(), segments[k + i], tolerance) for i in range(k)
+    ):
+        return contour
+    way = list(segments[:k])
+    meets = distance(way[-1].end, way[0].start) <= joint_mm
+    closed = meets and (k > 1 or closes_alone(way[0]))
+    if closed:
+        way[-1] = with_end(way[-1], way[0].start)
+    return dataclasses.replace(contour, segments=tuple(way), closed=closed)
 
 
 def _key(contour: Contour, quantum: float) -> tuple[object, ...]:
-    """What two copies share for sure: closedness, segment count, the box on a coarse grid."""
-    x0, y0, x1, y1 = contour.bbox()
-    box = tuple(round(v / quantum) for v in (x0, y0, x1, y1))
-    return (contour.closed, len(contour.segments), box)
+    """What two copies share for sure: closedness, segment count, lowest vertex x and y.
+
+    The lowest x and y of the vertices, on a coarse grid, are the same from any start and
+    either way round, and need no arc's bounds worked out.
+    """
+    segments = contour.segments
+    low_x = min(s.start[0] for s in segments)
+    low_y = min(s.start[1] for s in segments)
+    if not contour.closed:
+        low_x, low_y = min(low_x, contour.end[0]), min(low_y, contour.end[1])
+    return (contour.closed, len(segments), round(low_x / quantum), round(low_y / quantum))
 
 
 def _same(a: Contour, b: Contour, tolerance: float) -> bool:

@@ -275,7 +275,7 @@ def chained(
     joint = joint_distance(options.chain_tolerance)
     joined, members = chain_members(contours, joint)
     joined, found = close_gaps(joined, options.close_gap, joint)
-    joined, back = one_way(joined)
+    joined, back = one_way(joined, joint)
     found.extend(back)
     left_out = frozenset(
         i

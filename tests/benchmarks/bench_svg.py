@@ -62,13 +62,17 @@ PAGE_W, PAGE_H = 192.0, 180.0
 RUNS = 2
 """Best of this many runs of each command."""
 
-EXPECTED_SHA256 = "030b9790753ec62dba87c59f85b260dd8d0242424de08c1bd65a203edf539505"
+EXPECTED_SHA256 = "b5048dafcde8440d438d24f1de6f02c3e10534f4eb573764a865c62027045261"
 """sha256 of ``camtool post tango-213.svg --target grbl`` output as last recorded: whether
 it changed is informative only (the tests judge a change by its tolerance). It moved from
 ``1962563a…`` (89 215 blocks) on 29 Nov 2026 when a layer named ``Text`` stopped being
 construction (the icons' 249 shapes on such layers are now cut, as vpype draws them too:
 92 876 blocks, ``9b65769e…``), then when a contour on the path of another (an icon's
-outline drawn over its own fill) began to be cut once (91 224 blocks)."""
+outline drawn over its own fill) began to be cut once (91 224 blocks, ``030b9790…``), and
+again when a contour that runs out and back on one path (two copies of an open path
+chained end to end: six in the icons, such as ``i191``'s paperclip drawn as ``path7053``
+and ``path7057``) began to be cut one way, and copies began to be found by their lowest
+vertex rather than their box on a grid (one more found: ``i58-path1935``): 91 103 blocks."""
 
 SVG_NS = "http://www.w3.org/2000/svg"
 XLINK_NS = "http://www.w3.org/1999/xlink"

@@ -6,6 +6,7 @@ of plunges to the depth is the number of paths cut.
 
 from __future__ import annotations
 
+import itertools
 import math
 from pathlib import Path
 
@@ -15,7 +16,7 @@ import pytest
 from camtool.importers import read_drawing
 from camtool.jobs.pipeline import post_drawing
 from camtool.model.errors import ToolpathError
-from camtool.model.program import Linear
+from camtool.model.program import ArcMove, Linear, segment_of
 from camtool.model.shapes import Contour, Drawing, Line, make_arc
 from camtool.post.registry import load_target
 from camtool.toolpath.options import PlanOptions
@@ -152,3 +153,29 @@ def test_a_closed_outline_through_a_line_drawn_twice_keeps_both() -> None:
     job = post_drawing(drawing, load_target("linuxcnc"), PlanOptions(depth=1.0))
     assert math.isclose(_feed_length(list(job.program.moves)), sum(s.length for s in lines))
     assert not any("runs back" in w for w in job.warnings)
+
+
+def test_two_copies_of_a_circle_drawn_as_an_arc_short_of_360_are_one_closed_circle(
+    tmp_path: Path,
+) -> None:
+    # LibreCAD's kinetics/kin47.dxf: ARCs from 270° to 269.99999427° (a gap of 0.25 µm),
+    # each drawn twice. Chained out and back they are one circle: cut once, and closed, so
+    # a side cuts it (an open arc would be left out).
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4
+    for _ in range(2):
+        doc.modelspace().add_arc((20, 20), 2.5, 270.0, 269.99999427)
+    path = tmp_path / "arcs.dxf"
+    doc.saveas(path)
+    drawing = read_drawing(path)
+    outside = PlanOptions(depth=1.0, offset="outside", tool_diameter=1.0)
+    job = post_drawing(drawing, load_target("linuxcnc"), outside)
+    assert sum("runs back on its own path" in w for w in job.warnings) == 1
+    # one lap of the tool centre, on a circle of radius 2.5 + 0.5 mm
+    arcs = [m for m in job.program.moves if isinstance(m, ArcMove) and m.z in (None, -1.0)]
+    lap = sum(
+        segment_of((p.x, p.y), m).length
+        for p, m in itertools.pairwise(job.program.moves)
+        if m in arcs
+    )
+    assert math.isclose(lap, 2 * math.pi * 3.0, rel_tol=1e-6)
