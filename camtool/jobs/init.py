@@ -19,6 +19,7 @@ from camtool.jobs.job import Selection
 from camtool.jobs.selection import circle_of, construction_reason
 from camtool.model.errors import InputError
 from camtool.model.shapes import Contour, Drawing, fit_factor
+from camtool.toolpath.copies import one_way
 from camtool.toolpath.options import DEFAULT_CHAIN_TOLERANCE
 from camtool.toolpath.placement import EPS_MM
 
@@ -185,11 +186,13 @@ def _chains(group: _Group) -> list[Contour]:
     """The group's contours but construction, chained end to end (made once per group).
 
     As a job's selection chains them for ``closed`` (:func:`camtool.jobs.selection.select`,
-    at the job's default chain tolerance): an outline drawn as LINEs is one closed contour.
+    at the job's default chain tolerance): an outline drawn as LINEs is one closed contour,
+    a line drawn twice one open line (:func:`~camtool.toolpath.copies.one_way`).
     """
     if group.chained is None:
         kept = [c for c in group.contours if construction_reason(c, Selection()) is None]
-        group.chained = chain_members(kept, joint_distance(DEFAULT_CHAIN_TOLERANCE))[0]
+        joint = joint_distance(DEFAULT_CHAIN_TOLERANCE)
+        group.chained = one_way(chain_members(kept, joint)[0], joint)[0]
     return group.chained
 
 

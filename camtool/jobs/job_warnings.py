@@ -30,7 +30,7 @@ def unselected(
     cuts) is cut there and not counted.
     """
     from camtool.geometry.chain import chain_members
-    from camtool.toolpath.copies import drop_copies
+    from camtool.toolpath.copies import drop_copies, one_way
 
     taken = {id(c) for r in runs for c in r.placed.contours}
     taken |= {id(c) for c in construction}
@@ -40,7 +40,8 @@ def unselected(
             left.setdefault(contour.layer, []).append(contour)
     out = []
     for layer, pieces in sorted(left.items()):
-        contours = drop_copies(chain_members(pieces, joint_mm)[0], cut_before=[("", cut)])[0]
+        chains = one_way(chain_members(pieces, joint_mm)[0], joint_mm)[0]
+        contours = drop_copies(chains, cut_before=[("", cut)])[0]
         if not contours:
             continue
         opened = sum(not c.closed for c in contours)

@@ -43,6 +43,7 @@ from camtool.model.program import (
 )
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import Arc, Contour, Drawing, Point, circle_of
+from camtool.toolpath.copies import one_way
 from camtool.toolpath.options import PlanOptions
 
 if TYPE_CHECKING:
@@ -414,6 +415,7 @@ def _chaining(drawing: Drawing, scaled: Drawing, joint_mm: float) -> Chaining:
 
     def shapes(contours: Sequence[Contour]) -> list[Shape]:
         joined, members = chain_members([as_scaled[id(c)] for c in contours], joint_mm)
+        joined = one_way(joined, joint_mm)[0]  # a line drawn twice is an open line
         out = [Shape(False, None)] * len(contours)
         for chain, pieces in zip(joined, members, strict=True):
             circle = None

@@ -14,6 +14,7 @@ import dataclasses
 import math
 import tomllib
 from pathlib import Path
+from typing import Any
 
 from camtool.importers import read_drawing
 from camtool.jobs.init import initial_job
@@ -22,6 +23,7 @@ from camtool.jobs.run import PostJob, run_job
 from camtool.model.program import ArcMove, Move, Rapid, segment_of
 from camtool.model.shapes import Contour, Drawing
 from camtool.post.registry import load_target
+from tests.shapes import write_dxf
 from tests.toolpath.contours import circle, rect
 
 PERIMETER = 2 * (40 + 20) + 2 * math.pi * 1.5
@@ -152,3 +154,24 @@ def test_a_contour_two_operations_select_alike_is_cut_by_the_first(tmp_path: Pat
         in (post.warnings)
     )
     assert any("is one selection too wide?" in w for w in post.warnings)
+
+
+def test_a_line_drawn_twice_is_an_open_line_to_job_init_and_to_a_selection(
+    tmp_path: Path,
+) -> None:
+    # Two copies of a LINE chain out and back, ending where they began: a closed contour
+    # to chaining alone, but an open line to cut. job init offers it to an engrave
+    # operation (commented out) and the profile's closed = true does not select it.
+    def build(msp: Any) -> None:
+        msp.add_lwpolyline([(0, 0), (60, 0), (60, 40), (0, 40)], close=True)
+        msp.add_line((10, 20), (50, 20))
+        msp.add_line((50, 20), (10, 20))
+
+    drawing = read_drawing(write_dxf(tmp_path / "plate.dxf", build))
+    text = initial_job(drawing)
+    assert '# type = "engrave"  # 1 open contour(s) on layer' in text
+    job = job_from_dict(tomllib.loads(text), source="plate.toml")
+    post = run_job(drawing, load_target("linuxcnc"), job)
+    (profile,) = post.operations
+    assert [c.source for c in profile.placed.contours] == [drawing.contours[0].source]
+    assert any(w.startswith("not cut: 1 contour(s) on layer '0' (1 open;") for w in post.warnings)
