@@ -540,7 +540,8 @@ def verify_job(
     )
     if not several:
         return whole
-    parts = tuple(verify_operation(job, run) for run in job.operations)
+    # an operation left with nothing (each contour cut by an earlier one) has no code
+    parts = tuple(verify_operation(job, r) for r in job.operations if r.moves[0] < r.moves[1])
     return dataclasses.replace(whole, parts=parts)
 
 

@@ -317,6 +317,7 @@ def run_job(
             )
         )
         del planned  # its moves are in ``moves``: not kept past the placement's shifted copy
+    _end_at(moves, options)
     notes = construction_notes(construction)
     if not job.shorthand:
         notes.extend(
@@ -592,6 +593,26 @@ def _spindle_around(program: Program, output: OutputOptions, target: Target) -> 
     if not rpm or any(isinstance(c, Spindle) for _, c in program.commands):
         return program
     return program.with_spindle(rpm, dwell_s=output.spindle_dwell_s)
+
+
+def _end_at(moves: list[Move], options: PlanOptions) -> None:
+    """The job's ``end_position`` rapid, at clearance, when its last operation wrote none.
+
+    The last operation's plan ends the program there; a drill operation's cycles, and an
+    operation each of whose contours an earlier one cut, plan no such move. The rapid
+    goes last, as :func:`~camtool.toolpath.plan.place_program` expects it (it keeps it
+    where it was asked, in work coordinates, as the plan's own).
+    """
+    from camtool.toolpath.plan import is_end_move
+
+    if options.end_position is None or not moves or is_end_move(moves[-1], options):
+        return
+    last = moves[-1]
+    z = _z_of(moves)
+    if z is not None and z < options.clearance:
+        moves.append(Rapid(last.x, last.y, options.clearance, contour=0))
+        z = options.clearance
+    moves.append(Rapid(*options.end_position, z, contour=0))
 
 
 def _numbers(offset: int, moves: Sequence[Move]) -> tuple[int, int]:

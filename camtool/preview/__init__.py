@@ -145,12 +145,16 @@ def _resolution_mm(machine: Machine | None, target: Target | None) -> float | No
 def _sections(
     program: Program | None, sections: Sequence[tuple[str, int, int]] | None
 ) -> tuple[tuple[str, int, int], ...]:
-    """The sections drawn in colours: given, or the program's tools; none for one."""
+    """The sections drawn in colours: given, or the program's tools; none for one.
+
+    A section of no moves (a job's operation left with nothing to cut) is not drawn.
+    """
     from camtool.preview.program_layers import sections_of
 
     if program is None:
         return ()
     chosen = tuple(sections) if sections is not None else sections_of(program)
+    chosen = tuple(s for s in chosen if s[2] > s[1])  # not an operation left with nothing
     return chosen if len(chosen) > 1 else ()
 
 

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 from camtool.geometry.arcfit import FitStats, fit_polyline, fit_stats
 from camtool.geometry.chain import chain_members, joint_distance
 from camtool.model.errors import InputError
-from camtool.model.program import Program, Rapid
+from camtool.model.program import Move, Program, Rapid
 from camtool.model.progress import Progress, no_progress
 from camtool.model.shapes import BBox, Contour, Drawing, Line, Point, Segment, fit_factor
 from camtool.toolpath.chain import close_gaps
@@ -346,6 +346,21 @@ def scaling(drawing: Drawing, options: PlanOptions) -> tuple[float, float, float
     return (k, x0 * (1 - k), y0 * (1 - k))
 
 
+def is_end_move(move: Move, options: PlanOptions) -> bool:
+    """Whether ``move`` is the ``--end-position`` rapid a plan ends with.
+
+    A rapid of no contour to exactly ``options.end_position`` (in work coordinates: the
+    placement leaves it where it was asked, :func:`place_program`).
+    """
+    end = options.end_position
+    return (
+        end is not None
+        and isinstance(move, Rapid)
+        and move.contour == 0
+        and (move.x, move.y) == (float(end[0]), float(end[1]))
+    )
+
+
 def place_program(
     program: Program, placed: Drawing, options: PlanOptions, machine: Machine | None = None
 ) -> tuple[Program, Drawing, Point]:
@@ -371,7 +386,7 @@ def place_program(
     """
     moves = list(program.moves)
     # the end position is given in work coordinates: it stays where it was asked
-    end = [moves.pop()] if options.end_position is not None and moves else []
+    end = [moves.pop()] if moves and is_end_move(moves[-1], options) else []
     fields = {f.name: getattr(program, f.name) for f in dataclasses.fields(program)}
     del fields["moves"]
     dx, dy = placement_shift(Program(tuple(moves), **fields), options.placement, options.translate)

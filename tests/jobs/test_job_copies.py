@@ -11,11 +11,15 @@ vertex), at the operation's depth.
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 import tomllib
 from pathlib import Path
 from typing import Any
 
+import pytest
+
+from camtool.cli.main import main
 from camtool.importers import read_drawing
 from camtool.jobs.init import initial_job
 from camtool.jobs.jobfile import job_from_dict, load_job
@@ -175,3 +179,21 @@ def test_a_line_drawn_twice_is_an_open_line_to_job_init_and_to_a_selection(
     (profile,) = post.operations
     assert [c.source for c in profile.placed.contours] == [drawing.contours[0].source]
     assert any(w.startswith("not cut: 1 contour(s) on layer '0' (1 open;") for w in post.warnings)
+
+
+def test_a_job_with_an_operation_left_with_nothing_is_verified_and_previewed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # The operation left with nothing has no code to read back: verified, reported and
+    # drawn are the operations that cut; the program is written.
+    svg = tmp_path / "shape.svg"
+    svg.write_text(_LIBREOFFICE)
+    job = _job(tmp_path, ("#729fcf", 1), ("#3465a4", 1))
+    out, png, report = tmp_path / "shape.ngc", tmp_path / "shape.png", tmp_path / "r.json"
+    args = ["post", str(svg), "-t", "grbl", "--job", str(job), "-o", str(out)]
+    code = main([*args, "--preview", str(png), "--report", str(report)])
+    err = capsys.readouterr().err
+    assert code == 0, err
+    assert out.is_file() and png.stat().st_size > 0
+    operations = json.loads(report.read_text())["operations"]
+    assert [o["operation"] for o in operations] == ["operation 1 (profile outside) T1"]
