@@ -85,7 +85,11 @@ def drop_copies(
 
 
 def one_way(
-    contours: Sequence[Contour], joint_mm: float, tolerance: float = SAME_MM
+    contours: Sequence[Contour],
+    joint_mm: float,
+    tolerance: float = SAME_MM,
+    *,
+    open_too: bool = True,
 ) -> tuple[list[Contour], list[Finding]]:
     """``contours``, each that comes back on its own path cut one way, with a finding each.
 
@@ -94,7 +98,10 @@ def one_way(
     tool would cut the path twice and, closed, find no area in it. Each such contour
     (within ``tolerance`` mm, as :func:`drop_copies`) becomes its way out: open, unless its
     own ends are ``joint_mm`` apart at most, as chaining closes a contour (two copies of
-    a circle drawn as an ARC a hair short of 360° are that circle, closed).
+    a circle drawn as an ARC a hair short of 360° are that circle, closed). With
+    ``open_too`` false a contour whose way out is open is kept as drawn: cut with a side,
+    a closed polyline drawn out and back (LibreCAD's terminals) is a region of no area,
+    and the offset says so (``offset-vanished``).
 
     Returns:
         The contours, in their order (the others the same objects), and a ``copy``
@@ -106,6 +113,8 @@ def one_way(
     findings: list[Finding] = []
     for contour in contours:
         way = _one_way(contour, tolerance, joint_mm)
+        if not (open_too or way.closed):
+            way = contour
         out.append(way)
         if way is not contour:
             findings.append(

@@ -264,8 +264,9 @@ def chained(
 
     Ends within ``options.chain_tolerance`` are joined (:func:`chain_members`), then
     gaps up to ``options.close_gap`` closed (:func:`close_gaps`); a contour that comes
-    back on its own path (a line drawn twice) is cut one way
-    (:func:`~camtool.toolpath.copies.one_way`).
+    back on its own path is cut one way (:func:`~camtool.toolpath.copies.one_way`): a
+    circle drawn twice as one closed circle, a line drawn twice as one open line on the
+    line (``offset`` ``on``; with a side it stays the region of no area it was drawn as).
 
     Returns:
         The planned contours, mm; the ``closed-gap`` and ``copy`` findings; and the indices in
@@ -275,7 +276,7 @@ def chained(
     joint = joint_distance(options.chain_tolerance)
     joined, members = chain_members(contours, joint)
     joined, found = close_gaps(joined, options.close_gap, joint)
-    joined, back = one_way(joined, joint)
+    joined, back = one_way(joined, joint, open_too=options.offset == "on")
     found.extend(back)
     left_out = frozenset(
         i

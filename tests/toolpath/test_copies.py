@@ -137,9 +137,9 @@ def test_a_line_drawn_twice_end_to_end_is_cut_one_way(tmp_path: Path, second: li
     job = post_drawing(read_drawing(path), load_target("linuxcnc"), PlanOptions(depth=1.0))
     assert math.isclose(_feed_length(list(job.program.moves)), 50.0)
     assert sum("runs back on its own path" in w for w in job.warnings) == 1
-    # with a side, it is what it is: an open line, left out and said so
+    # with a side, it stays the region of no area it was drawn as, and is said so
     outside = PlanOptions(depth=1.0, offset="outside", tool_diameter=3.0)
-    with pytest.raises(ToolpathError, match="the 1 contour is open"):
+    with pytest.raises(ToolpathError, match="is about 0 mm wide"):
         post_drawing(read_drawing(path), load_target("linuxcnc"), outside)
 
 
