@@ -401,9 +401,29 @@ def _plan(values: Mapping[str, object], source: str, where: str) -> PlanOptions:
         raise InputError(f"{source}: {where}: {as_keys(str(exc))}") from None
 
 
+_OFFSET = re.compile(
+    r"--offset ((?:outside|inside|on|pocket)(?:(?:, | or )(?:outside|inside|on|pocket))*)"
+)
+"""``post``'s ``--offset`` with its values: a profile's ``side`` or a pocket operation in a job."""
+
+
 def as_keys(message: str) -> str:
-    """``message`` with ``post``'s flags named as job file keys (``step_down``)."""
-    return _FLAG.sub(lambda m: _key_of(m.group(1)), message)
+    """``message`` with ``post``'s flags named as job file keys (``step_down``).
+
+    ``--offset outside or inside`` becomes ``side = "outside" or "inside"`` (a job's
+    profile has a side; ``--offset pocket`` is a pocket operation).
+    """
+    return _FLAG.sub(lambda m: _key_of(m.group(1)), _OFFSET.sub(_sides, message))
+
+
+def _sides(match: re.Match[str]) -> str:
+    """``--offset`` and its values as a job says them (:func:`as_keys`)."""
+    words = re.split(r", | or ", match.group(1))
+    sides = [f'"{w}"' for w in words if w != "pocket"]
+    out = f"side = {' or '.join(sides)}" if sides else ""
+    if "pocket" in words:
+        out += (", or " if out else "") + "a pocket operation"
+    return out
 
 
 def _key_of(flag_name: str) -> str:

@@ -179,6 +179,11 @@ def test_auto_sequence_drills_first_and_cuts_the_outline_last(tmp_path: Path) ->
             r"peck: only a drill operation takes this key; remove it here",
         ),
         (("clearance_z = 8", "clearance_z = 1"), r"clearance_z 1 mm is below safe_z 2 mm"),
+        (
+            ('side = "outside"', 'side = "on"\nlead_in = 1', "tabs = 3", ""),
+            r'operation 1: lead_in needs a side to approach from: use side = "outside" or '
+            r'"inside"$',  # post's --offset, as the job says it
+        ),
     ],
 )
 def test_what_a_job_file_may_not_say_is_refused_naming_it(
