@@ -27,14 +27,18 @@ _CONSTRUCTION_LAYER = re.compile(
 or ``POCKET`` never match, and ``A-ANNO-NOTE`` or ``Dimension (ISO)`` do."""
 
 _CONSTRUCTION_ALONE = re.compile(
-    r"^[^a-z]*(?:cent(?:er|re)|axis|axes|guides?)(?:[ _-]?(?:lines?|marks?))?"
-    r"(?:[^a-z(]*\([^)]*\))*[^a-z]*$",
+    r"^[^a-z]*(?:cent(?:er|re)|axis|axes|guides?|borders?|threads?|hatch(?:ing)?|"
+    r"(?:section|break)[ _-]?lines?)(?:[ _-]?(?:lines?|marks?))?"
+    r"(?:[ _]+-[ _]+[a-z]+)?(?:[^a-z(]*\([^)]*\))*[^a-z]*$",
     re.IGNORECASE,
 )
-"""Layer names that are centre lines, axes or guides and nothing else (``CENTER``,
-``Centerline (ISO)``, ``Center Mark (ISO)``, ``2-AXES``, ``Guides``). These words also name
-parts, so with another word they do not match: ``Center_Drawer``, OpenSCAD's
-``fan_side_center``, ``X_Axis_Plate``, ``Guide_Rail`` are cut."""
+"""Layer names that are centre lines, axes or guides, or a drawing sheet's border, thread,
+hatch, section or break lines, and nothing else (``CENTER``, ``Centerline (ISO)``,
+``Center Mark (ISO)``, ``2-AXES``, ``Guides``; Autodesk Inventor's ``Border (ANSI)``,
+``Border - Kova (ANSI)``, a style's name after the dash, ``Section Line (ANSI)``,
+``Break Line (ISO)``, ``Thread Lines``, ``Hatch (ISO)``). These words also name parts, so
+with another word they do not match: ``Center_Drawer``, OpenSCAD's ``fan_side_center``,
+``X_Axis_Plate``, ``Guide_Rail``, ``Border_Panel``, ``Hatch_Cover`` are cut."""
 
 
 def dashed_name(linetype: str) -> bool:

@@ -112,8 +112,9 @@ def test_a_centre_line_named_by_its_layer_is_cut(tmp_path: Path) -> None:
     assert any(isinstance(m, Linear) and (m.x, m.y) == (25, 10) for m in job.program.moves)
 
 
-# Names from real drawings: Autodesk Inventor's ISO/ANSI layers (the Voron build plate),
-# the AIA layer standard's annotation group, a bare CENTERLINE layer (LibreCAD's library).
+# Names from real drawings: Autodesk Inventor's ISO/ANSI layers (the Voron build plate:
+# its sheet's border, title block, section and break lines), the AIA layer standard's
+# annotation group, a bare CENTERLINE layer and a sheet's bare border (LibreCAD's library).
 @pytest.mark.parametrize(
     "layer",
     [
@@ -126,6 +127,12 @@ def test_a_centre_line_named_by_its_layer_is_cut(tmp_path: Path) -> None:
         "A-ANNO-NOTE",
         "Title - Kova (ANSI)",
         "Guides",
+        "Border - Kova (ANSI)",
+        "Border (ANSI)",
+        "Section Line - Kova (ANSI)",
+        "Break Line (ISO)",
+        "Hatch (ISO)",
+        "border",
     ],
 )
 def test_a_construction_layer_is_left_out(tmp_path: Path, layer: str) -> None:
@@ -145,7 +152,17 @@ def test_a_construction_layer_is_left_out(tmp_path: Path, layer: str) -> None:
 # extruded part), a CNC build's axis plate and guide rail, and text exploded to curves on
 # layer TEXT, as camtool's warning about TEXT entities advises.
 @pytest.mark.parametrize(
-    "layer", ["Center_Drawer", "fan_side_center", "X_Axis_Plate", "Guide_Rail", "TEXT"]
+    "layer",
+    [
+        "Center_Drawer",
+        "fan_side_center",
+        "X_Axis_Plate",
+        "Guide_Rail",
+        "TEXT",
+        "Border_Panel",
+        "Hatch_Cover",
+        "Section_A",
+    ],
 )
 def test_a_part_layer_named_with_a_construction_word_is_cut(tmp_path: Path, layer: str) -> None:
     doc = _doc()

@@ -63,6 +63,30 @@ def test_a_layer_of_holes_only_is_cut_on_their_inside(tmp_path: Path) -> None:
     ]
 
 
+def test_a_part_on_a_drawing_sheet_is_cut_outside_not_inside_the_sheets_border(
+    tmp_path: Path,
+) -> None:
+    # An Autodesk Inventor drawing exported to DXF (the Voron build plate's): the part on
+    # 'Visible (ISO)', the sheet's frame on 'Border - Kova (ANSI)' around it. Taken for a
+    # part, the frame made the part's outline a hole of it, cut on its inside: the part
+    # came out a tool's diameter small.
+    def build(msp: object) -> None:
+        visible = {"layer": "Visible (ISO)"}
+        msp.add_lwpolyline(  # type: ignore[attr-defined]
+            [(0, 0), (840, 0), (840, 530), (0, 530)], close=True,
+            dxfattribs={"layer": "Border - Kova (ANSI)"},
+        )  # fmt: skip
+        msp.add_lwpolyline(  # type: ignore[attr-defined]
+            [(100, 100), (300, 100), (300, 250), (100, 250)], close=True, dxfattribs=visible
+        )
+        msp.add_circle((200, 175), 20, dxfattribs=visible)  # type: ignore[attr-defined]
+
+    text = initial_job(read_drawing(write_dxf(tmp_path / "sheet.dxf", build)))
+    kinds = [(op["type"], op.get("side"), tuple(op["layers"])) for op in _ops(text)]  # type: ignore[arg-type]
+    assert kinds == [("profile", "outside", ("Visible (ISO)",))]  # the hole inside, by nesting
+    assert "layer 'Border - Kova (ANSI)': construction layer" in text
+
+
 def test_a_drawing_of_lines_only_is_engraved(tmp_path: Path) -> None:
     def build(msp: object) -> None:
         msp.add_line((0, 0), (10, 0))  # type: ignore[attr-defined]
