@@ -28,7 +28,7 @@ or ``POCKET`` never match, and ``A-ANNO-NOTE`` or ``Dimension (ISO)`` do."""
 
 _CONSTRUCTION_ALONE = re.compile(
     r"^[^a-z]*(?:cent(?:er|re)|axis|axes|guides?|borders?|threads?|hatch(?:ing)?|"
-    r"(?:section|break)[ _-]?lines?)(?:[ _-]?(?:lines?|marks?))?"
+    r"bends?(?:[ _-]?(?:up|down))?|(?:section|break)[ _-]?lines?)(?:[ _-]?(?:lines?|marks?))?"
     r"(?:[ _]+-[ _]+[a-z]+)?(?:[^a-z(]*\([^)]*\))*[^a-z]*$",
     re.IGNORECASE,
 )
@@ -36,9 +36,19 @@ _CONSTRUCTION_ALONE = re.compile(
 hatch, section or break lines, and nothing else (``CENTER``, ``Centerline (ISO)``,
 ``Center Mark (ISO)``, ``2-AXES``, ``Guides``; Autodesk Inventor's ``Border (ANSI)``,
 ``Border - Kova (ANSI)``, a style's name after the dash, ``Section Line (ANSI)``,
-``Break Line (ISO)``, ``Thread Lines``, ``Hatch (ISO)``). These words also name parts, so
+``Break Line (ISO)``, ``Thread Lines``, ``Hatch (ISO)``; a sheet-metal flat pattern's
+``BEND``, ``Bend Lines``, ``BEND_DOWN``). These words also name parts, so
 with another word they do not match: ``Center_Drawer``, OpenSCAD's ``fan_side_center``,
 ``X_Axis_Plate``, ``Guide_Rail``, ``Border_Panel``, ``Hatch_Cover`` are cut."""
+
+
+_INVENTOR_FLAT = re.compile(
+    r"^IV_(?:BEND(?:_DOWN)?|TANGENT|ROLL(?:_TANGENT)?|ARC_CENTERS|TOOL_CENTER(?:_DOWN)?)$",
+    re.IGNORECASE,
+)
+"""Autodesk Inventor's flat-pattern DXF layers that are not the cut (its "Layer Mapping for
+Export Flat Pattern Reference"): bend centre and extent lines, roll lines, arc centre and
+punch tool centre marks. ``IV_OUTER_PROFILE`` and ``IV_INTERIOR_PROFILES`` are the cut."""
 
 
 def dashed_name(linetype: str) -> bool:
@@ -49,4 +59,8 @@ def dashed_name(linetype: str) -> bool:
 
 def construction_layer(layer: str) -> bool:
     """Whether the layer name ``layer`` says it holds construction, not the part."""
-    return bool(_CONSTRUCTION_LAYER.search(layer) or _CONSTRUCTION_ALONE.match(layer))
+    return bool(
+        _CONSTRUCTION_LAYER.search(layer)
+        or _CONSTRUCTION_ALONE.match(layer)
+        or _INVENTOR_FLAT.match(layer)
+    )

@@ -114,7 +114,8 @@ def test_a_centre_line_named_by_its_layer_is_cut(tmp_path: Path) -> None:
 
 # Names from real drawings: Autodesk Inventor's ISO/ANSI layers (the Voron build plate:
 # its sheet's border, title block, section and break lines), the AIA layer standard's
-# annotation group, a bare CENTERLINE layer and a sheet's bare border (LibreCAD's library).
+# annotation group, a bare CENTERLINE layer and a sheet's bare border (LibreCAD's library),
+# Inventor's flat-pattern layers of bend lines and centre marks (its export's layer map).
 @pytest.mark.parametrize(
     "layer",
     [
@@ -133,6 +134,10 @@ def test_a_centre_line_named_by_its_layer_is_cut(tmp_path: Path) -> None:
         "Break Line (ISO)",
         "Hatch (ISO)",
         "border",
+        "IV_BEND",
+        "IV_ARC_CENTERS",
+        "IV_TANGENT",
+        "Bend Lines",
     ],
 )
 def test_a_construction_layer_is_left_out(tmp_path: Path, layer: str) -> None:
@@ -162,6 +167,9 @@ def test_a_construction_layer_is_left_out(tmp_path: Path, layer: str) -> None:
         "Border_Panel",
         "Hatch_Cover",
         "Section_A",
+        "IV_OUTER_PROFILE",
+        "IV_INTERIOR_PROFILES",
+        "Bend_Bracket",
     ],
 )
 def test_a_part_layer_named_with_a_construction_word_is_cut(tmp_path: Path, layer: str) -> None:
