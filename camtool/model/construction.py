@@ -43,12 +43,14 @@ with another word they do not match: ``Center_Drawer``, OpenSCAD's ``fan_side_ce
 
 
 _INVENTOR_FLAT = re.compile(
-    r"^IV_(?:BEND(?:_DOWN)?|TANGENT|ROLL(?:_TANGENT)?|ARC_CENTERS|TOOL_CENTER(?:_DOWN)?)$",
+    r"^IV_(?:BEND(?:_UP|_DOWN)?|TANGENT|ROLL(?:_TANGENT)?|ARC_CENTERS?|TOOL_CENTER(?:_DOWN)?|"
+    r"FEATURE_PROFILES(?:_DOWN)?|ALTREP_(?:FRONT|BACK))$",
     re.IGNORECASE,
 )
 """Autodesk Inventor's flat-pattern DXF layers that are not the cut (its "Layer Mapping for
 Export Flat Pattern Reference"): bend centre and extent lines, roll lines, arc centre and
-punch tool centre marks. ``IV_OUTER_PROFILE`` and ``IV_INTERIOR_PROFILES`` are the cut."""
+punch tool centre marks, the edges of formed features and punches' alternative drawings.
+``IV_OUTER_PROFILE`` and ``IV_INTERIOR_PROFILES`` are the cut."""
 
 
 def dashed_name(linetype: str) -> bool:

@@ -137,6 +137,7 @@ def test_a_centre_line_named_by_its_layer_is_cut(tmp_path: Path) -> None:
         "IV_BEND",
         "IV_ARC_CENTERS",
         "IV_TANGENT",
+        "IV_FEATURE_PROFILES_DOWN",
         "Bend Lines",
     ],
 )
