@@ -18,7 +18,7 @@ families, with their ``2`` and ``X2`` variants; LibreCAD's ``DashLine``, ``Cente
 
 _CONSTRUCTION_LAYER = re.compile(
     r"(?:^|[^a-z])(?:constr[a-z]*|hilf[a-z]*|helpers?|aux[a-z]*|ref|references?|"
-    r"dims?|dimensions?|bema(?:ss|ß)ung[a-z]*|cotas?|anno(?:t[a-z]*)?|notes?|title|"
+    r"dims?|dimensions?|bema(?:ss|ß)ung[a-z]*|cotas?|anno(?:t[a-z]*)?|notes?|title(?:blocks?)?|"
     r"hidden|defpoints)(?:[^a-z]|$)",
     re.IGNORECASE,
 )
@@ -28,6 +28,7 @@ or ``POCKET`` never match, and ``A-ANNO-NOTE`` or ``Dimension (ISO)`` do."""
 
 _CONSTRUCTION_ALONE = re.compile(
     r"^[^a-z]*(?:cent(?:er|re)|axis|axes|guides?|borders?|threads?|hatch(?:ing)?|"
+    r"(?:sheet|drawing|page)[ _-]?(?:borders?|frames?)|"
     r"bends?(?:[ _-]?(?:up|down))?|(?:section|break)[ _-]?lines?)(?:[ _-]?(?:lines?|marks?))?"
     r"(?:[ _]+-[ _]+[a-z]+)?(?:[^a-z(]*\([^)]*\))*[^a-z]*$",
     re.IGNORECASE,
@@ -36,7 +37,8 @@ _CONSTRUCTION_ALONE = re.compile(
 hatch, section or break lines, and nothing else (``CENTER``, ``Centerline (ISO)``,
 ``Center Mark (ISO)``, ``2-AXES``, ``Guides``; Autodesk Inventor's ``Border (ANSI)``,
 ``Border - Kova (ANSI)``, a style's name after the dash, ``Section Line (ANSI)``,
-``Break Line (ISO)``, ``Thread Lines``, ``Hatch (ISO)``; a sheet-metal flat pattern's
+``Break Line (ISO)``, ``Thread Lines``, ``Hatch (ISO)``, ``Sheet Border``, ``DRAWING_FRAME``;
+a sheet-metal flat pattern's
 ``BEND``, ``Bend Lines``, ``BEND_DOWN``). These words also name parts, so
 with another word they do not match: ``Center_Drawer``, OpenSCAD's ``fan_side_center``,
 ``X_Axis_Plate``, ``Guide_Rail``, ``Border_Panel``, ``Hatch_Cover`` are cut."""

@@ -139,6 +139,8 @@ def test_a_centre_line_named_by_its_layer_is_cut(tmp_path: Path) -> None:
         "IV_TANGENT",
         "IV_FEATURE_PROFILES_DOWN",
         "Bend Lines",
+        "TITLEBLOCK",
+        "Sheet Border",
     ],
 )
 def test_a_construction_layer_is_left_out(tmp_path: Path, layer: str) -> None:
@@ -171,6 +173,7 @@ def test_a_construction_layer_is_left_out(tmp_path: Path, layer: str) -> None:
         "IV_OUTER_PROFILE",
         "IV_INTERIOR_PROFILES",
         "Bend_Bracket",
+        "Bike_Frame",
     ],
 )
 def test_a_part_layer_named_with_a_construction_word_is_cut(tmp_path: Path, layer: str) -> None:
