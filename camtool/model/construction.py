@@ -33,15 +33,15 @@ _CONSTRUCTION_ALONE = re.compile(
     r"(?:[ _]+-[ _]+[a-z]+)?(?:[^a-z(]*\([^)]*\))*[^a-z]*$",
     re.IGNORECASE,
 )
-"""Layer names that are centre lines, axes or guides, or a drawing sheet's border, thread,
-hatch, section or break lines, and nothing else (``CENTER``, ``Centerline (ISO)``,
-``Center Mark (ISO)``, ``2-AXES``, ``Guides``; Autodesk Inventor's ``Border (ANSI)``,
-``Border - Kova (ANSI)``, a style's name after the dash, ``Section Line (ANSI)``,
-``Break Line (ISO)``, ``Thread Lines``, ``Hatch (ISO)``, ``Sheet Border``, ``DRAWING_FRAME``;
-a sheet-metal flat pattern's
-``BEND``, ``Bend Lines``, ``BEND_DOWN``). These words also name parts, so
-with another word they do not match: ``Center_Drawer``, OpenSCAD's ``fan_side_center``,
-``X_Axis_Plate``, ``Guide_Rail``, ``Border_Panel``, ``Hatch_Cover`` are cut."""
+"""Layer names that are centre lines, axes or guides, a drawing sheet's border, frame,
+hatching, thread, section or break lines, or a flat pattern's bend lines, and nothing else
+(``CENTER``, ``Centerline (ISO)``, ``Center Mark (ISO)``, ``2-AXES``, ``Guides``; Autodesk
+Inventor's ``Border (ANSI)`` and ``Border - Kova (ANSI)``, a style's name after the dash,
+``Section Line (ANSI)``, ``Break Line (ISO)``, ``Thread Lines``, ``Hatch (ISO)``; ``Sheet
+Border``, ``DRAWING_FRAME``; ``BEND``, ``Bend Lines``, ``BEND_DOWN``). These words also
+name parts, so with another word they do not match: ``Center_Drawer``, OpenSCAD's
+``fan_side_center``, ``X_Axis_Plate``, ``Guide_Rail``, ``Border_Panel``, ``Hatch_Cover``,
+``Bend_Bracket`` are cut."""
 
 
 _INVENTOR_FLAT = re.compile(
