@@ -288,15 +288,15 @@ def run_job(
             if job.shorthand:
                 raise
             raise InputError(f"{job.source or 'the job'}: {where}: {as_keys(str(exc))}") from None
-        if not job.shorthand and tool.id != loaded:
-            commands.extend(_tool_change(len(moves), tool, loaded, output, target))
-            loaded = tool.id
         first = len(moves)
         alike = [(w, paths) for o, w, paths in cut if _cuts_alike(o, op)]
         planned = _plan_operation(
             chosen.drawing, op, tool, options, target, here, where, progress, alike
         )
         cut.append((op, where, planned.paths))
+        if not job.shorthand and tool.id != loaded and planned.moves:  # none: nothing to cut
+            commands.extend(_tool_change(len(moves), tool, loaded, output, target))
+            loaded = tool.id
         offset = _last_contour(moves)
         _join(moves, commands, planned, offset)
         warnings.extend(planned.warnings)

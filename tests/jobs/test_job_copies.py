@@ -24,7 +24,7 @@ from camtool.importers import read_drawing
 from camtool.jobs.init import initial_job
 from camtool.jobs.jobfile import job_from_dict, load_job
 from camtool.jobs.run import PostJob, run_job
-from camtool.model.program import ArcMove, Move, Rapid, segment_of
+from camtool.model.program import ArcMove, Move, Rapid, ToolChange, segment_of
 from camtool.model.shapes import Contour, Drawing
 from camtool.post.registry import load_target
 from tests.shapes import write_dxf
@@ -197,3 +197,21 @@ def test_a_job_with_an_operation_left_with_nothing_is_verified_and_previewed(
     assert out.is_file() and png.stat().st_size > 0
     operations = json.loads(report.read_text())["operations"]
     assert [o["operation"] for o in operations] == ["operation 1 (profile outside) T1"]
+
+
+def test_no_tool_change_for_an_operation_left_with_nothing(tmp_path: Path) -> None:
+    # The outline, a drill between, the outline again alike: the third has nothing left,
+    # so the program asks for no change back to the end mill after drilling.
+    job = _job(tmp_path, ("#000000", 1))
+    text = job.read_text().replace(
+        "[[tools]]", '[[tools]]\nid = 2\ntype = "drill"\ndiameter = 2\n\n[[tools]]', 1
+    )
+    text += '\n[[operations]]\ntype = "drill"\ntool = 2\ncolours = ["#ff0000"]\ndepth = 1\n'
+    text += _OPERATION.format(colour="#000000", depth=1)
+    job.write_text(text)
+    hole = _painted(circle(70, 20, 1), "#ff0000", "CIRCLE #90")
+    outline = _painted(rect(10, 10, 50, 30), "#000000", "LWPOLYLINE #8F")
+    post = run_job(_drawing(outline, hole), load_target("grbl"), load_job(job))
+    changes = [c.tool for _, c in post.program.commands if isinstance(c, ToolChange)]
+    assert changes == [1, 2]
+    assert post.operations[2].moves[0] == post.operations[2].moves[1]
