@@ -350,7 +350,7 @@ def _as_posted(code: str, drawing: Drawing, tool_diameter: float) -> tuple[Drawi
     if offset is None:
         return drawing, tool_diameter
     side, recorded = offset
-    _, _, left_out = chained(drawing.contours, PlanOptions(offset=side, tool_diameter=recorded))
+    _, _, left_out, _ = chained(drawing.contours, PlanOptions(offset=side, tool_diameter=recorded))
     if left_out and len(left_out) < len(drawing.contours):
         drawing = drawing.without(left_out)
         click.echo(

@@ -28,7 +28,7 @@ def drop_copies(
     tolerance: float = SAME_MM,
     *,
     cut_before: Sequence[tuple[str, Sequence[Contour]]] = (),
-) -> tuple[list[Contour], list[Finding]]:
+) -> tuple[list[Contour], list[Finding], list[int]]:
     """``contours`` with each path once, and a ``copy`` finding per copy left out.
 
     A copy is open or closed as an earlier contour is and has as many segments, of the same
@@ -48,20 +48,22 @@ def drop_copies(
             paths is their copy (``who`` names the operation in the finding).
 
     Returns:
-        The contours kept, in their order, and a finding per copy naming the contour it
+        The contours kept, in their order; a finding per copy naming the contour it
         repeats (the warnings name the first few and count the rest,
-        :func:`~camtool.toolpath.cuts.finding_warnings`).
+        :func:`~camtool.toolpath.cuts.finding_warnings`); and the indices in ``contours``
+        of the copies of ``cut_before``'s paths (cut by the earlier operations, not here).
     """
     from camtool.model.units import fmt_point
 
     quantum = 4.0 * tolerance
     seen: dict[tuple[object, ...], list[tuple[Contour, str]]] = {}
-    for who, earlier in cut_before:
-        for contour in earlier:
+    for who, paths in cut_before:
+        for contour in paths:
             seen.setdefault(_key(contour, quantum), []).append((contour, who))
     kept: list[Contour] = []
     findings: list[Finding] = []
-    for contour in contours:
+    repeated: list[int] = []  # copies of ``cut_before``'s paths
+    for index, contour in enumerate(contours):
         bucket = seen.setdefault(_key(contour, quantum), [])
         first = next(((c, w) for c, w in bucket if _same(c, contour, tolerance)), None)
         if first is None:
@@ -69,6 +71,8 @@ def drop_copies(
             kept.append(contour)
             continue
         other, who = first
+        if who:
+            repeated.append(index)
         here = f"contour {contour.source} at {fmt_point(contour.start)} mm"
         if who and other.source == contour.source:  # selected again: the job says so
             message = f"{here}: {who} cuts it already: cut once"
@@ -81,7 +85,7 @@ def drop_copies(
                 "top of it): cut once"
             )
         findings.append(Finding("copy", message, contour.start))
-    return kept, findings
+    return kept, findings, repeated
 
 
 def one_way(

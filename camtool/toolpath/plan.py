@@ -128,7 +128,9 @@ class Plan:
     ``left_out`` are the indices in ``placed.contours`` of the contours the plan does not
     cut at all: the pieces of an open chain under ``--offset outside``, ``inside`` or
     ``pocket`` (a centre line, a construction line across the part; each is an
-    ``open-left-out`` finding); ``placed.without(left_out)`` is what the program cuts.
+    ``open-left-out`` finding), and of a contour on the path of one an earlier operation
+    of a job cuts (``cut_before``, a ``copy`` finding); ``placed.without(left_out)`` is
+    what the program cuts.
     ``paths`` are the contours as chained that it plans (each path once, in the drawing's
     coordinates): what a later operation of a job that cuts alike need not cut again.
     """
@@ -213,8 +215,9 @@ def plan_unplaced(
     if machine is not None:
         options.check_machine(machine, machine.name)
     placed = place(drawing, options)
-    contours, found, left_out = chained(placed.contours, options)
-    contours, copied = drop_copies(contours, cut_before=cut_before)
+    contours, found, left_out, members = chained(placed.contours, options)
+    contours, copied, earlier = drop_copies(contours, cut_before=cut_before)
+    left_out |= {i for j in earlier for i in members[j]}  # cut by an earlier operation
     paths = tuple(contours)
     findings = [*options.ineffective(), *found, *copied, *open_gaps(contours, options)]
     stats = None
@@ -238,7 +241,7 @@ def plan_unplaced(
         nest=nest if on_line else None,
     )
     findings.extend(emitted)
-    if (paths or not copied) and not any(not isinstance(m, Rapid) for m in moves):
+    if (paths or not earlier) and not any(not isinstance(m, Rapid) for m in moves):
         raise InputError(
             f"{drawing.source or 'the drawing'}: nothing to cut: {len(contours)} contour(s), "
             f"none longer than {MIN_PIECE:g} mm after planning; check the drawing's units "
@@ -259,7 +262,7 @@ def plan_unplaced(
 
 def chained(
     contours: Sequence[Contour], options: PlanOptions
-) -> tuple[list[Contour], list[Finding], frozenset[int]]:
+) -> tuple[list[Contour], list[Finding], frozenset[int], list[tuple[int, ...]]]:
     """``contours`` chained and their gaps closed as the planner cuts them.
 
     Ends within ``options.chain_tolerance`` are joined (:func:`chain_members`), then
@@ -269,9 +272,10 @@ def chained(
     line (``offset`` ``on``; with a side it stays the region of no area it was drawn as).
 
     Returns:
-        The planned contours, mm; the ``closed-gap`` and ``copy`` findings; and the indices in
+        The planned contours, mm; the ``closed-gap`` and ``copy`` findings; the indices in
         ``contours`` of those the plan leaves out (:attr:`Plan.left_out`: the pieces
-        of a chain still open, unless ``options.offset`` is ``on``).
+        of a chain still open, unless ``options.offset`` is ``on``); and each planned
+        contour's pieces, as indices in ``contours``.
     """
     joint = joint_distance(options.chain_tolerance)
     joined, members = chain_members(contours, joint)
@@ -284,7 +288,7 @@ def chained(
         if not contour.closed and options.offset != "on"
         for i in pieces
     )
-    return joined, found, left_out
+    return joined, found, left_out, members
 
 
 def _each_its_contour(cuts: Sequence[Cut], contours: Sequence[Contour]) -> bool:

@@ -23,6 +23,7 @@ from camtool.cli.main import main
 from camtool.importers import read_drawing
 from camtool.jobs.init import initial_job
 from camtool.jobs.jobfile import job_from_dict, load_job
+from camtool.jobs.pipeline import verify_job
 from camtool.jobs.run import PostJob, run_job
 from camtool.model.program import ArcMove, Move, Rapid, ToolChange, segment_of
 from camtool.model.shapes import Contour, Drawing
@@ -107,6 +108,10 @@ def test_only_the_copies_are_left_out_of_an_operation_that_has_more(tmp_path: Pa
     post = run_job(_drawing(fill, outline, hole), load_target("linuxcnc"), job)
     # the circle alone: 2π(5 + 1.5) on its outside
     assert math.isclose(_feed_at(post, 2, -1.0), 2 * math.pi * 6.5, rel_tol=1e-6)
+    # and verified alone against the circle, not the rectangle operation 1 cuts (which
+    # would be ~20 mm from its code): a few µm of the controller's own rounding
+    second = verify_job(post, budget=False).parts[1].verification
+    assert second.against is not None and second.against.max_um < 12.0
 
 
 def test_a_copy_cut_deeper_by_a_later_operation_is_cut_again(tmp_path: Path) -> None:
