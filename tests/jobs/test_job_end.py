@@ -4,8 +4,8 @@ The planner ends an operation's moves with the ``end_position`` rapid; a drill o
 cycles and an operation left with nothing to cut (each contour cut by an earlier one) end
 without it. The program must still end there, at clearance, and the placement must not
 take the last move for that rapid: it keeps the end rapid where it was asked (work
-coordinates) while it shifts every other move, so a cycle's retract kept unshifted became
-a rapid out of the hole, sideways from the bottom. Expected values are the job's: the
+coordinates) while it shifts every other move, so a cycle's retract kept unshifted would
+be a rapid out of the hole, sideways from the bottom. Expected values are the job's: the
 bundled plate (samples/part.dxf, 80 × 60 mm) with work zero at the toolpath's lower-left
 corner, clearance 5 mm, end position X0 Y0; the code is read back with a reader of the
 test's own (G0/G1/G2/G3 and their X, Y, Z words).

@@ -68,8 +68,8 @@ def test_a_part_on_a_drawing_sheet_is_cut_outside_not_inside_the_sheets_border(
 ) -> None:
     # An Autodesk Inventor drawing exported to DXF (the Voron build plate's): the part on
     # 'Visible (ISO)', the sheet's frame on 'Border - Kova (ANSI)' around it. Taken for a
-    # part, the frame made the part's outline a hole of it, cut on its inside: the part
-    # came out a tool's diameter small.
+    # part, the frame would make the part's outline a hole of it, cut on its inside: the
+    # part a tool's diameter small.
     def build(msp: object) -> None:
         visible = {"layer": "Visible (ISO)"}
         msp.add_lwpolyline(  # type: ignore[attr-defined]
