@@ -639,8 +639,10 @@ def _damaged(path: Path, reason: str, repairs: list[str]) -> str:
 
 def _reason(exc: BaseException) -> str:
     """An exception as a short phrase: its message, else its type's name."""
-    if isinstance(exc, StopIteration | EOFError):
+    if isinstance(exc, EOFError):
         return "the file ends too early"
+    if isinstance(exc, StopIteration):  # ezdxf ran out of a table's or block's tags
+        return "a table or block ends before it begins: a stray ENDTAB or ENDBLK"
     text = " ".join("".join(c if c.isprintable() else " " for c in str(exc)).split())
     text = text if len(text) <= 120 else text[:117] + "..."
     return text or type(exc).__name__

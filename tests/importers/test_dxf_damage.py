@@ -113,3 +113,26 @@ def test_post_writes_nothing_for_such_a_file(tmp_path: Path) -> None:
     assert run.returncode == 3, run.stderr
     assert "is not a number" in run.stderr and "Traceback" not in run.stderr
     assert not out.exists()
+
+
+_STRAY_ENDS = """  0\nSECTION\n  2\nHEADER\n  9\n$ACADVER\n  1\nAC1009\n  0\nENDSEC
+  0\nSECTION\n  2\nTABLES\n  0\nTABLE\n  2\nLAYER\n 70\n1\n  0\nLAYER\n  2\n0\n 70\n0
+ 62\n7\n  6\nCONTINUOUS\n  0\nENDTAB\n  0\nENDTAB\n  0\nENDSEC
+  0\nSECTION\n  2\nBLOCKS\n  0\nENDBLK\n  0\nENDBLK\n  0\nENDSEC
+  0\nSECTION\n  2\nENTITIES
+  0\nCIRCLE\n  8\n0\n 10\n0.0\n 20\n0.0\n 40\n100.0
+  0\nCIRCLE\n  8\n0\n 10\n0.0\n 20\n0.0\n 40\n25.0
+  0\nENDSEC\n  0\nEOF\n"""
+"""A DXF as small hand-written generators write it: an ENDTAB and an ENDBLK too many (a
+measuring plate's generator on GitHub writes this header; its circles are the part)."""
+
+
+def test_a_stray_endtab_is_named_not_taken_for_a_truncated_file(tmp_path: Path) -> None:
+    path = tmp_path / "plate.dxf"
+    path.write_text(_STRAY_ENDS)
+    drawing = import_dxf(path).drawing
+    assert sorted(round(c.bbox()[2], 6) for c in drawing.contours) == [25.0, 100.0]
+    damaged = [w for w in drawing.warnings if "damaged DXF file" in w]
+    assert len(damaged) == 1
+    assert "stray ENDTAB or ENDBLK" in damaged[0]
+    assert "ends too early" not in damaged[0]
