@@ -86,8 +86,8 @@ def job_files() -> dict[Path, str]:
     from camtool.jobs.run import run_job
 
     drawing = read_drawing(ROOT / "samples" / "part.dxf")
-    job = run_job(drawing, load_target("grbl"), load_job(ROOT / "samples" / "part.toml"))
-    title = "samples/part.dxf + samples/part.toml → grbl"
+    job = run_job(drawing, load_target("linuxcnc"), load_job(ROOT / "samples" / "part.toml"))
+    title = "samples/part.dxf + samples/part.toml → linuxcnc"
     svg = render_preview(".svg", program=job.program, target=job.target, title=title)
     page = ROOT / "docs" / "jobs.md"
     text = page.read_text(encoding="utf-8")

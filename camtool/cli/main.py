@@ -391,7 +391,10 @@ def _write_pieces(job: PostJob, output: str, inputs: list[tuple[str, Any]]) -> N
     order = ", then ".join(
         f"{p} (T{piece.change.tool})" for piece, p in zip(job.pieces, paths, strict=True)
     )
-    say_written(f"camtool: {name} cannot change tools: wrote one program per tool, run {order}")
+    zero = "; set Z zero for each tool before its program" if job.target.machine.has_z else ""
+    say_written(
+        f"camtool: {name} cannot change tools: wrote one program per tool, run {order}{zero}"
+    )
 
 
 def _check_preview(preview: str | None) -> None:

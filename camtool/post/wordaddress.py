@@ -80,10 +80,15 @@ class WordAddressPost(PostProcessor):
 
     @property
     def tool_changes(self) -> str:
-        """``code`` with a ``tool_change`` code, ``stop`` with a stop and comments."""
+        """How the spec changes tools: ``code``, ``stop`` or ``none``.
+
+        ``code`` with a ``tool_change`` code; ``stop`` when it changes tools ``by_hand``
+        with a stop (and comments); else ``none``, one program per tool.
+        """
         if self.spec.tool_change:
             return "code"
-        return "stop" if self.spec.stop and self.spec.comment else "none"
+        by_stop = self.spec.by_hand == "stop" and self.spec.stop and self.spec.comment
+        return "stop" if by_stop else "none"
 
     @property
     def stops(self) -> bool:

@@ -38,6 +38,8 @@ HOMES = ("G28",)
 """The return to the stored position a dialect may write (RS-274's; GRBL and LinuxCNC)."""
 FULL_CIRCLES = ("one-block", "split")
 Z_MOVES = ("own-block", "with-xy", "none")
+BY_HAND = ("programs", "stop")
+"""How a dialect without a tool change code changes tools (``by_hand``)."""
 ARC_CHECKS = ("none", "grbl", "linuxcnc")
 LINE_ENDS = ("\n", "\r\n")
 COMMENTS = ("()", ";")
@@ -136,9 +138,12 @@ class WordAddressSpec:
             zero; ``None``: they are dropped, with a warning, and
             refused where a move after one would run at the height it left
             (:func:`camtool.post.base.check_dropped_homes`).
-        stop: program stop code (``M0``): the machine waits for the operator. A
-            dialect with a stop and comments but no ``tool_change`` changes tools by
-            hand: a comment naming the tool, then the stop (GRBL 1.1).
+        stop: program stop code (``M0``): the machine waits for the operator.
+        by_hand: how a dialect without ``tool_change`` changes tools: ``"programs"``,
+            one program per tool (the operator sets Z zero for each tool between
+            them, GRBL 1.1: no Z zero can be set while its ``M0`` pauses), or
+            ``"stop"`` (with a stop and comments), one program whose change is a
+            comment naming the tool, then the stop (for tools preset in length).
         optional_stop: optional stop code (``M1``); ``None``: an optional stop is
             written as a stop.
         end: program-end codes; the writer ends with the first, the reader
@@ -184,6 +189,7 @@ class WordAddressSpec:
     path_controls: tuple[str, ...] = ()
     home: str | None = None
     stop: str | None = None
+    by_hand: str = "programs"
     optional_stop: str | None = None
     end: tuple[str, ...] = ()
     comment: str | None = None
@@ -396,6 +402,7 @@ def load_spec(options: Mapping[str, Any], where: str) -> WordAddressSpec:
         header=tuple(t.strings("header")),
         footer=tuple(t.strings("footer")),
         home=t.string("home", None, choices=HOMES),
+        by_hand=t.string("by_hand", "programs", choices=BY_HAND),
         **codes,
     )
     t.done()
@@ -554,6 +561,8 @@ def _check(spec: WordAddressSpec, t: _Table) -> None:
         raise t.error(
             "home", "G28 and G30 (written G91 G28 Z0, as RS-274) need rs274 = true and X, Y, Z"
         )
+    if spec.by_hand == "stop" and not (spec.stop and spec.comment):
+        raise t.error("by_hand", "changing tools with a stop needs a stop code and a comment")
     if spec.tool_change and not spec.has("T"):
         raise t.error("tool_change", "a tool change code needs a T word in words")
     if spec.tool_length_offset and not (spec.tool_change and spec.has("H")):

@@ -116,7 +116,9 @@ def test_batch_job_posts_each_drawing_with_the_job(run: Any, tmp_path: Path) -> 
         "batch", PART, "-t", "grbl", "-o", str(tmp_path / "out"), "--job", JOB, "--jobs", "1"
     )
     assert code == 0, err
-    assert "(job part.toml: 4 operations)" in (tmp_path / "out" / "part.gcode").read_text()
+    for tool in (2, 1):  # two tools: GRBL gets one program per tool
+        text = (tmp_path / "out" / f"part.T{tool}.gcode").read_text()
+        assert "(job part.toml: 4 operations)" in text
 
 
 TOOL_TABLE = "T1 P1 D3.0 Z0 ;end mill\nT2 P2 D3.2 Z0 ;drill\n"

@@ -2,8 +2,9 @@
 
 Expected behaviour from the controllers' documents: LinuxCNC changes tools with ``T2 M6``
 and applies the length offset with ``G43 H2`` ("M6 Tool Change", "G43"); GRBL 1.1 has no
-M6 (gcode.c answers error:20) and pauses at ``M0``; the thesis machines without a changer
-or a stop get one program per tool.
+M6 (gcode.c answers error:20) and reads no line while its ``M0`` pauses, so it gets one
+program per tool, as the thesis machines without a changer or a stop do (or, asked for,
+one program with a pause at each change).
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from camtool.jobs.pipeline import post_program
 from camtool.jobs.run import run_job
 from camtool.model.errors import DialectError
 from camtool.model.program import Linear, Stop, ToolChange
+from camtool.post.base import Target
 from camtool.post.registry import load_target
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -163,8 +165,41 @@ def test_pic_mmh_changes_tools_in_its_own_code() -> None:
     ]
 
 
-def test_after_a_change_by_hand_the_first_move_is_up_to_the_clearance_height() -> None:
-    """GRBL pauses (``M0``) for the operator to change the tool and set Z zero for it again.
+def _grbl_by_stop(tmp_path: Path) -> Target:
+    """GRBL changing tools with a pause in one program (``by_hand = "stop"``, as a target
+    file of a user whose tools are preset in length writes it)."""
+    text = (ROOT / "postprocessors" / "grbl" / "grbl.toml").read_text()
+    assert 'by_hand = "programs"' in text
+    path = tmp_path / "grbl-stop.toml"
+    path.write_text(text.replace('by_hand = "programs"', 'by_hand = "stop"'))
+    return load_target(str(path))
+
+
+def test_a_grbl_job_of_two_tools_is_one_program_per_tool(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """GRBL reads no line while its ``M0`` pauses (gcode.c: the pause is a feed hold inside
+    the line's execution): no jog, no ``G10 L20``, so no Z zero can be set for a new tool
+    there. Each tool gets its own program, run after Z zero is set for that tool; each
+    rises to the clearance height before any X/Y move."""
+    done = run_job(read_drawing(PART), load_target("grbl"), load_job(JOB))
+    assert [p.change.tool for p in done.pieces] == [2, 1]
+    for piece in done.pieces:
+        lines = str(piece.result.code).splitlines()
+        assert "M0" not in lines and not any("change to" in line for line in lines)
+        motion = [line for line in lines if line.startswith(("G0 ", "G1 ", "G2 ", "G3 "))]
+        assert motion[0] == "G0 Z10.000"
+    assert [m for p in done.pieces for m in p.program.moves] == list(done.program.moves)
+    out = tmp_path / "part.gcode"
+    assert main(["post", str(PART), "-t", "grbl", "--job", str(JOB), "-o", str(out)]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["part.T1.gcode", "part.T2.gcode"]
+    assert "set Z zero for each tool before its program" in capsys.readouterr().err
+
+
+def test_after_a_change_by_hand_the_first_move_is_up_to_the_clearance_height(
+    tmp_path: Path,
+) -> None:
+    """GRBL pauses (``M0``) for the operator to change a tool preset in length.
 
     The Z the program left the old tool at means nothing to the new one (another length,
     another zero), so the first move after each pause rises to the job's clearance height
@@ -172,7 +207,7 @@ def test_after_a_change_by_hand_the_first_move_is_up_to_the_clearance_height() -
     not written again, and the next rapid crossed the part at whatever height the new tool
     was left.
     """
-    done = run_job(read_drawing(PART), load_target("grbl"), load_job(JOB))
+    done = run_job(read_drawing(PART), _grbl_by_stop(tmp_path), load_job(JOB))
     lines = str(done.result.code).splitlines()
     pauses = [i for i, line in enumerate(lines) if line == "M0"]
     assert len(pauses) == 2  # T2 (the drill) first, then T1
@@ -181,7 +216,9 @@ def test_after_a_change_by_hand_the_first_move_is_up_to_the_clearance_height() -
         assert motion == "G0 Z10.000", (lines[i - 1], motion)
 
 
-def test_a_re_posted_move_sideways_right_after_a_change_by_hand_is_warned_of() -> None:
+def test_a_re_posted_move_sideways_right_after_a_change_by_hand_is_warned_of(
+    tmp_path: Path,
+) -> None:
     """A program for a tool changer (``T2 M6`` then ``G0 X20 Y20``) re-posted for GRBL.
 
     GRBL pauses (``M0``) for the change by hand; the program's next move goes sideways at
@@ -194,7 +231,7 @@ def test_a_re_posted_move_sideways_right_after_a_change_by_hand_is_warned_of() -
         "G21 G90\nT1 M6\nG0 Z5\nG0 X0 Y0\nG1 Z-1 F100\nG1 X10\nG0 Z5\n"
         "T2 M6\nG0 X20 Y20\nG1 Z-1 F100\nG1 X30\nG0 Z5\nM2\n"
     )
-    done = post_program(parse_gcode(text, source="m6.ngc"), load_target("grbl"))
+    done = post_program(parse_gcode(text, source="m6.ngc"), _grbl_by_stop(tmp_path))
     said = [w for w in done.warnings if "by hand" in w]
     assert len(said) == 1 and "after the tool change to T2 by hand" in said[0]
     assert "moves X/Y before any Z move" in said[0]
@@ -296,10 +333,11 @@ def test_a_pcb2gcode_program_of_one_tool_is_that_tools_program(tmp_path: Path) -
 
 
 def test_a_pcb2gcode_change_and_its_own_stop_pause_grbl_once(tmp_path: Path) -> None:
-    """GRBL changes tools by hand with a stop: ``M6`` then ``M0`` is one pause, not two."""
+    """Changing tools by hand with a stop: ``M6`` then ``M0`` is one pause, not two."""
     source = tmp_path / "drill.ngc"
     source.write_text(PCB2GCODE_DRILL)
-    lines = str(post_program(read_gcode(source), load_target("grbl")).result.code).splitlines()
+    target = _grbl_by_stop(tmp_path)
+    lines = str(post_program(read_gcode(source), target).result.code).splitlines()
     stops = [i for i, line in enumerate(lines) if line == "M0"]
     assert [lines[i - 1] for i in stops] == ["(change to T1)", "(change to T2)"]
 

@@ -100,6 +100,11 @@ def emit(
         ({"words": {"XYZIJ": {}}, "helix": True, "z_moves": "own-block"}, "helix: a helix needs"),
         ({"words": {"XY": {}}, "dwell": "G4"}, "dwell: a dwell code needs a P word"),
         ({"words": {"XY": {}}, "tool_change": "M6"}, "tool_change: a tool change code needs a T"),
+        ({"words": {"XY": {}}, "by_hand": "stop"}, "by_hand: changing tools with a stop needs"),
+        (
+            {"words": {"XY": {}}, "by_hand": "pause"},
+            r'by_hand: expected one of \["programs", "stop"\]',
+        ),
         ({"words": {"XYT": {"decimals": 3}}}, "words.T.decimals: a tool number is an integer"),
         ({"words": {"XYI": {}}}, "words: arcs need both I and J words; J is missing"),
         ({"words": {"XY": {}}, "modal": ["I"]}, 'modal: expected letters among .*, got "I"'),
