@@ -11,10 +11,12 @@ laser, or a mill re-cutting its own groove. The planner cuts each path once and 
 from __future__ import annotations
 
 import dataclasses
+import itertools
+import math
 from collections.abc import Sequence
 
 from camtool.geometry.chain import closes_alone, with_end
-from camtool.model.shapes import Arc, Contour, Point, Segment, distance
+from camtool.model.shapes import Arc, Contour, Line, Point, Segment, distance
 from camtool.toolpath.cuts import Finding
 
 SAME_MM = 0.001
@@ -31,11 +33,14 @@ def drop_copies(
 ) -> tuple[list[Contour], list[Finding], list[int]]:
     """``contours`` with each path once, and a ``copy`` finding per copy left out.
 
-    A copy is open or closed as an earlier contour is and has as many segments, of the same
-    kinds, with every end and arc centre within ``tolerance`` mm of the earlier one's, run
-    either way and, when closed, from any of its vertices. Lines and arcs only: a copy
-    split differently (an arc where the other has chords) is not found and is cut twice,
-    as drawn.
+    A copy is open or closed as an earlier contour is and runs on its path: once runs of
+    collinear lines and of arcs on one circle are joined in each (:func:`_canonical`, for
+    the comparison only: a square of four LINEs is the copy of a polyline square starting
+    at another corner, an edge split in two included; a CIRCLE of two ARCs), the two have
+    as many segments, of the same kinds, with every end and arc centre within
+    ``tolerance`` mm of the other's, run either way and, when closed, from any vertex. A
+    copy drawn with other kinds (chords where the other has an arc) is not found and is
+    cut twice, as drawn.
 
     Args:
         contours: the contours of one operation as chained, mm. Copies are looked for
@@ -56,18 +61,20 @@ def drop_copies(
     from camtool.model.units import fmt_point
 
     quantum = 4.0 * tolerance
-    seen: dict[tuple[object, ...], list[tuple[Contour, str]]] = {}
+    seen: dict[tuple[object, ...], list[tuple[Contour, Contour, str]]] = {}
     for who, paths in cut_before:
         for contour in paths:
-            seen.setdefault(_key(contour, quantum), []).append((contour, who))
+            path = _canonical(contour, tolerance)
+            seen.setdefault(_key(path, quantum), []).append((path, contour, who))
     kept: list[Contour] = []
     findings: list[Finding] = []
     repeated: list[int] = []  # copies of ``cut_before``'s paths
     for index, contour in enumerate(contours):
-        bucket = seen.setdefault(_key(contour, quantum), [])
-        first = next(((c, w) for c, w in bucket if _same(c, contour, tolerance)), None)
+        path = _canonical(contour, tolerance)
+        bucket = seen.setdefault(_key(path, quantum), [])
+        first = next(((c, w) for p, c, w in bucket if _same(p, path, tolerance)), None)
         if first is None:
-            bucket.append((contour, ""))
+            bucket.append((path, contour, ""))
             kept.append(contour)
             continue
         other, who = first
@@ -159,6 +166,132 @@ def _one_way(contour: Contour, tolerance: float, joint_mm: float) -> Contour:
     if closed:
         way[-1] = with_end(way[-1], way[0].start)
     return dataclasses.replace(contour, segments=tuple(way), closed=closed)
+
+
+def _canonical(contour: Contour, tolerance: float) -> Contour:
+    """``contour`` with each run of collinear lines, and of arcs on one circle, joined.
+
+    For comparing paths only (what is cut stays as drawn): consecutive lines that go on
+    in one direction, every vertex between them within ``tolerance`` mm of the line
+    through the run's ends, become one line; consecutive arcs of one direction, with
+    their centres and radii within ``tolerance`` of the first's and less than a turn
+    together, one arc (:data:`_RUN_MAX` segments at most). A closed contour's last and
+    first runs join too, so that it begins at a corner; one that is a whole circle then
+    begins at its point of angle 0 (+X from the centre).
+    """
+    segments = contour.segments
+    if len(segments) == 1:
+        if contour.closed and isinstance(segments[0], Arc):
+            return _from_zero(contour, segments[0])
+        return contour
+    pairs = itertools.pairwise((segments[-1], *segments) if contour.closed else segments)
+    if not any(_may_go_on(a, b, tolerance) for a, b in pairs):  # the first after the last
+        return contour  # most contours: a corner or a new centre at every vertex
+    runs: list[list[Segment]] = []
+    for seg in segments:
+        if (
+            runs
+            and len(runs[-1]) < _RUN_MAX
+            and _may_go_on(runs[-1][-1], seg, tolerance)
+            and _goes_on(runs[-1], [seg], tolerance)
+        ):
+            runs[-1].append(seg)
+        else:
+            runs.append([seg])
+    wrap = len(runs[-1]) + len(runs[0]) <= _RUN_MAX
+    if (
+        contour.closed
+        and len(runs) > 1
+        and wrap
+        and _may_go_on(runs[-1][-1], runs[0][0], tolerance)
+        and _goes_on(runs[-1], runs[0], tolerance)
+    ):
+        runs[0] = runs.pop() + runs[0]
+    merged = [_joined(run) for run in runs]
+    if contour.closed and len(merged) == 1 and isinstance(merged[0], Arc):
+        return _from_zero(contour, merged[0])
+    if len(merged) == len(segments):
+        return contour
+    return dataclasses.replace(contour, segments=tuple(merged))
+
+
+def _from_zero(contour: Contour, arc: Arc) -> Contour:
+    """``contour``, a whole circle ``arc``, as the one arc from its point of angle 0."""
+    zero = (arc.centre[0] + arc.radius, arc.centre[1])
+    return dataclasses.replace(contour, segments=(Arc(zero, zero, arc.centre, arc.clockwise),))
+
+
+def _may_go_on(a: Segment, b: Segment, tolerance: float) -> bool:
+    """A quick test: whether ``b`` may go on from ``a`` on its line or circle (:func:`_goes_on`).
+
+    Two lines: ``a``'s end within ``tolerance`` of the line from ``a``'s start to ``b``'s
+    end, going on one way; two arcs: one direction, centres within ``tolerance``.
+    """
+    if type(a) is not type(b):
+        return False
+    if type(a) is Arc:
+        return (
+            a.clockwise == b.clockwise  # type: ignore[union-attr]
+            and abs(a.centre[0] - b.centre[0]) <= tolerance  # type: ignore[union-attr]
+            and abs(a.centre[1] - b.centre[1]) <= tolerance  # type: ignore[union-attr]
+        )
+    (x0, y0), (x1, y1), (x2, y2) = a.start, a.end, b.end
+    ax, ay, bx, by = x1 - x0, y1 - y0, x2 - x1, y2 - y1
+    if ax * bx + ay * by <= 0.0:
+        return False
+    cross = ax * by - ay * bx  # twice the triangle's area: the joint's distance × the chord
+    return cross * cross <= tolerance * tolerance * ((x2 - x0) ** 2 + (y2 - y0) ** 2)
+
+
+_RUN_MAX = 64
+"""Segments joined at most into one (each joining checks the run's every vertex again): a
+copy drawn with more in a row is not found, and is cut twice as drawn."""
+
+_TURN = 2.0 * math.pi + 1e-9
+"""A whole turn, radians: arcs joined in :func:`_canonical` sweep no more."""
+
+
+def _goes_on(run: Sequence[Segment], more: Sequence[Segment], tolerance: float) -> bool:
+    """Whether the segments ``more`` continue ``run`` on one line or circle, one way."""
+    if all(isinstance(s, Line) for s in (*run, *more)):
+        start, end = run[0].start, more[-1].end
+        dx, dy = end[0] - start[0], end[1] - start[1]
+        length = math.hypot(dx, dy)
+        if length <= tolerance:
+            return False
+        for seg in (*run, *more):
+            along = (seg.end[0] - seg.start[0]) * dx + (seg.end[1] - seg.start[1]) * dy
+            if along <= 0.0:  # turns back
+                return False
+        for seg in (*run[1:], *more):  # every vertex between the ends
+            px, py = seg.start[0] - start[0], seg.start[1] - start[1]
+            if abs(px * dy - py * dx) > tolerance * length:
+                return False
+        return True
+    if all(isinstance(s, Arc) for s in (*run, *more)):
+        first = run[0]
+        assert isinstance(first, Arc)
+        return (
+            all(
+                isinstance(s, Arc)
+                and s.clockwise == first.clockwise
+                and _near(s.centre, first.centre, tolerance)
+                and abs(s.radius - first.radius) <= tolerance
+                for s in more
+            )
+            and sum(abs(s.sweep) for s in (*run, *more) if isinstance(s, Arc)) <= _TURN
+        )
+    return False
+
+
+def _joined(run: Sequence[Segment]) -> Segment:
+    """A run :func:`_goes_on` accepted, as one segment."""
+    first = run[0]
+    if len(run) == 1:
+        return first
+    if isinstance(first, Arc):
+        return Arc(first.start, run[-1].end, first.centre, first.clockwise)
+    return Line(first.start, run[-1].end)
 
 
 def _key(contour: Contour, quantum: float) -> tuple[object, ...]:

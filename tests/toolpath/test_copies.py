@@ -179,3 +179,69 @@ def test_two_copies_of_a_circle_drawn_as_an_arc_short_of_360_are_one_closed_circ
         if m in arcs
     )
     assert math.isclose(lap, 2 * math.pi * 3.0, rel_tol=1e-6)
+
+
+def _arc_radii(job: object) -> list[float]:
+    """The radius of each arc of the program, from its end and centre (the offset's side)."""
+    return sorted(
+        round(math.hypot(m.x - m.cx, m.y - m.cy), 6)
+        for m in job.program.moves  # type: ignore[attr-defined]
+        if isinstance(m, ArcMove)
+    )
+
+
+def test_a_copy_split_differently_is_cut_once_and_its_hole_stays_a_hole(tmp_path: Path) -> None:
+    """A polyline square and the same square as LINEs from another corner, one edge split.
+
+    Cut twice, the copy also made the circle inside them two squares deep, so the outside
+    profile took the hole for a part and cut round it outside: a 10 mm hole 13 mm wide.
+    Expected from the drawing: one square; the hole cut inside, on radius 5 - 1.5 mm.
+    """
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    msp.add_lwpolyline([(0, 0), (40, 0), (40, 30), (0, 30)], close=True)
+    for a, b in [((40, 30), (0, 30)), ((0, 30), (0, 0)), ((0, 0), (25, 0)), ((25, 0), (40, 0))]:
+        msp.add_line(a, b)
+    msp.add_line((40, 0), (40, 30))
+    msp.add_circle((20, 15), 5)
+    path = tmp_path / "square-twice.dxf"
+    doc.saveas(path)
+    options = PlanOptions(depth=3.0, offset="outside", tool_diameter=3.0)
+    job = post_drawing(read_drawing(path), load_target("linuxcnc"), options)
+    plunges = [m for m in job.program.moves if isinstance(m, Linear) and m.z == -3.0]
+    assert len(plunges) == 2  # the hole, the square once
+    assert _arc_radii(job) == [1.5] * 4 + [3.5] * 2  # the square's corners, the hole
+    assert sum("repeats" in w for w in job.warnings) == 1
+
+
+def test_a_circle_of_two_arcs_is_a_copy_of_a_circle() -> None:
+    halves = Contour(
+        (make_arc((30, 10), (30, 0), (30, 5), True), make_arc((30, 0), (30, 10), (30, 5), True)),
+        True,
+    )
+    job = post_drawing(
+        Drawing((circle(30, 5, 5), halves)), load_target("linuxcnc"), PlanOptions(depth=1.0)
+    )
+    plunges = [m for m in job.program.moves if isinstance(m, Linear) and m.z == -1.0]
+    assert len(plunges) == 1
+
+
+@pytest.mark.parametrize("bow", [0.002, 0.05])
+def test_lines_joined_only_where_every_vertex_is_on_the_line(bow: float) -> None:
+    """A bottom edge of 40 short lines bowed ``bow`` mm at its middle, against a straight one.
+
+    Each vertex is within 1 µm of the line through its neighbours' ends (the bend at each
+    is tiny), but not of the edge: they are two paths, both cut.
+    """
+    n = 40
+    points = [(40.0 * k / n, bow * math.sin(math.pi * k / n)) for k in range(n + 1)]
+    bowed = [Line(points[k], points[k + 1]) for k in range(n)]
+    bowed += [Line((40, 0), (40, 30)), Line((40, 30), (0, 30)), Line((0, 30), (0, 0))]
+    job = post_drawing(
+        Drawing((rect(0, 0, 40, 30), Contour(tuple(bowed), True))),
+        load_target("linuxcnc"),
+        PlanOptions(depth=1.0),
+    )
+    plunges = [m for m in job.program.moves if isinstance(m, Linear) and m.z == -1.0]
+    assert len(plunges) == 2
