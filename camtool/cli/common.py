@@ -554,7 +554,8 @@ _POST_OPTIONS = (
         type=(NUMBER, NUMBER),
         default=None,
         metavar="W H",
-        help="Scale the drawing uniformly to fit W x H mm, about its lower-left corner.",
+        help="Scale the drawing uniformly so that what is cut fits W x H mm (construction, "
+        "such as centre lines or a sheet's border, left out), about its lower-left corner.",
     ),
     click.option(
         "--origin",

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import NoReturn
 
 from camtool.importers.options import ImportOptions
+from camtool.model.construction import fit_extent
 from camtool.model.errors import InputError
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import BBox, Drawing, fit_factor
@@ -71,7 +72,7 @@ def read_drawing(
     if options.fit is None:
         return drawing
     for margin in _REFIT_MARGINS:
-        k = fit_factor(drawing.bbox(), options.fit)
+        k = fit_factor(fit_extent(drawing), options.fit)  # as planning will scale it
         k = 1.0 if math.isinf(k) else k
         if used * k <= options.tolerance:
             return drawing

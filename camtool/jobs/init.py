@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from camtool.geometry.chain import chain_members, joint_distance
 from camtool.jobs.job import Selection
 from camtool.jobs.selection import circle_of, construction_reason
+from camtool.model.construction import fit_extent
 from camtool.model.errors import InputError
 from camtool.model.shapes import Contour, Drawing, fit_factor
 from camtool.toolpath.copies import one_way
@@ -129,7 +130,7 @@ def _fit(
     if x1 - x0 + tool <= w + EPS_MM and y1 - y0 + tool <= h + EPS_MM:
         return (), 1.0  # its outside profile's toolpath fits the travel as it is (as post checks)
     fw, fh = _fit_box(tool, travel)
-    k = fit_factor(drawing.bbox(), (fw, fh))  # as post fits it: the whole drawing's extent
+    k = fit_factor(fit_extent(drawing), (fw, fh))  # as post fits it: construction aside
     return (
         f"fit = [{fw:g}, {fh:g}]"
         + _why(

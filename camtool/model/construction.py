@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import re
 
+from camtool.model.shapes import BBox, Contour, Drawing
+
 DASHED_FAMILIES = ("CENTER", "DASH", "HIDDEN", "PHANTOM", "DOT", "DIVIDE", "BORDER", "ACAD_ISO")
 """Linetype name stems that are not continuous (AutoCAD's ``acad.lin`` and ``acadiso.lin``
 families, with their ``2`` and ``X2`` variants; LibreCAD's ``DashLine``, ``CenterLine``...)."""
@@ -68,3 +70,27 @@ def construction_layer(layer: str) -> bool:
         or _CONSTRUCTION_ALONE.match(layer)
         or _INVENTOR_FLAT.match(layer)
     )
+
+
+def is_construction(contour: Contour) -> bool:
+    """Whether a selection of everything leaves ``contour`` uncut.
+
+    So it does for a linetype that is not continuous (``contour.linetype`` is set only for
+    those) and on a construction layer (:func:`construction_layer`).
+    """
+    return bool(contour.linetype) or construction_layer(contour.layer)
+
+
+def fit_extent(drawing: Drawing) -> BBox:
+    """The extent ``--fit W H`` scales into W × H mm: the drawing's, construction left out.
+
+    Centre lines run past the part and a sheet's border frames it; neither is cut, so
+    neither counts: what is cut is what fits (and holds the fit's tolerance). The marks
+    (points to drill) count, but for those on a construction layer. A drawing of
+    construction only has its whole extent.
+    """
+    cut = tuple(c for c in drawing.contours if not is_construction(c))
+    marks = tuple(m for m in drawing.marks if not construction_layer(m.layer))
+    if not cut and not marks:
+        return drawing.bbox()
+    return Drawing(cut, drawing.source, (), marks).bbox()

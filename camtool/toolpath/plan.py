@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 from camtool.geometry.arcfit import FitStats, fit_polyline, fit_stats
 from camtool.geometry.chain import chain_members, joint_distance
+from camtool.model.construction import fit_extent
 from camtool.model.errors import InputError
 from camtool.model.program import Move, Program, Rapid
 from camtool.model.progress import Progress, no_progress
@@ -340,11 +341,12 @@ def place(drawing: Drawing, options: PlanOptions) -> Drawing:
 def scaling(drawing: Drawing, options: PlanOptions) -> tuple[float, float, float]:
     """``(k, dx, dy)``: :func:`place` maps a drawing point ``p`` to ``k·p + (dx, dy)``, mm.
 
-    ``--scale`` scales about the drawing's origin; ``--fit`` about its lower-left corner.
+    ``--scale`` scales about the drawing's origin; ``--fit`` about the lower-left corner
+    of what is cut (:func:`~camtool.model.construction.fit_extent`).
     """
     if options.fit is None:
         return (options.scale, 0.0, 0.0)
-    x0, y0, _, _ = box = drawing.bbox()
+    x0, y0, _, _ = box = fit_extent(drawing)  # construction (centre lines, a border) aside
     k = fit_factor(box, options.fit)
     if math.isinf(k):
         return (1.0, 0.0, 0.0)

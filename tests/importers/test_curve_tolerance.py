@@ -258,3 +258,18 @@ def test_a_scale_too_large_for_the_tolerance_says_the_tolerance_was_divided(
     with pytest.raises(InputError, match=r"--scale and --fit divide it") as err:
         read_drawing(path, ImportOptions(scale=1e6))
     assert "path#bez" in str(err.value) and "1e-09" in str(err.value)
+
+
+def test_fit_scales_and_fits_what_is_cut_not_a_dashed_guide(tmp_path: Path) -> None:
+    """A dashed guide four times the frame's size is not cut, so ``--fit 400 400`` scales
+    the frame and its curve by 4 (not by 1, the guide's), and the curve holds the
+    tolerance at that size (the importer fits it for the factor planning uses)."""
+    guide = (
+        '<path id="guide" d="M -150 -150 H 250 V 250 H -150 Z" fill="none" stroke="black" '
+        'stroke-dasharray="4 2"/>'
+    )
+    placed = _placed(svg(tmp_path, FRAME + BEZ + guide), ImportOptions(fit=(400.0, 400.0)))
+    curve = true_curve(BEZ_D, lambda xy: 4.0 * page(xy), n=40001)
+    there, back = svg_error(_named(placed, "bez"), curve)
+    assert there <= TOL, f"the curve is {there * 1000:.3f} µm from its arcs"
+    assert back <= TOL, f"the arcs are {back * 1000:.3f} µm from the curve"

@@ -142,6 +142,37 @@ def test_fit_scales_uniformly_about_the_lower_left_corner(tmp_path: Path) -> Non
     )  # limited by the width
 
 
+def test_fit_scales_what_is_cut_not_the_centre_lines_past_it(tmp_path: Path) -> None:
+    """A 40 × 30 plate whose centre lines run 5 mm past it, and a border on its own layer.
+
+    ``--fit 100 100`` fits the plate: 100 × 75 mm (factor 2.5, from its width), not the
+    sheet's 297 mm border nor the 50 mm span of the centre lines (factor 2.0, 80 × 60).
+    """
+    import ezdxf
+
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4
+    doc.linetypes.add("CENTER", pattern=[2.0, 1.25, -0.25, 0.25, -0.25])
+    msp = doc.modelspace()
+    msp.add_lwpolyline([(10, 10), (50, 10), (50, 40), (10, 40)], close=True)
+    msp.add_circle((30, 25), 5)
+    msp.add_line((5, 25), (55, 25), dxfattribs={"linetype": "CENTER"})
+    msp.add_line((30, 5), (30, 45), dxfattribs={"linetype": "CENTER"})
+    doc.layers.add("Sheet Border")
+    msp.add_lwpolyline(
+        [(-100, -100), (197, -100), (197, 110), (-100, 110)],
+        close=True,
+        dxfattribs={"layer": "Sheet Border"},
+    )
+    path = tmp_path / "plate.dxf"
+    doc.saveas(path)
+    from camtool.jobs.pipeline import post_drawing
+    from camtool.post.registry import load_target
+
+    job = post_drawing(read_dxf(path), load_target("linuxcnc"), PlanOptions(fit=(100.0, 100.0)))
+    assert job.program.bbox(cutting_only=True) == pytest.approx((10.0, 10.0, 110.0, 85.0))
+
+
 def test_scale_about_the_origin(tmp_path: Path) -> None:
     drawing = read_dxf(rectangle_dxf(tmp_path / "r.dxf", 10, 5))
     program = plan(drawing, PlanOptions(feed_mm_min=1.0, scale=0.5))
