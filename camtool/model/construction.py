@@ -29,15 +29,17 @@ _CONSTRUCTION_LAYER = re.compile(
 or ``POCKET`` never match, and ``A-ANNO-NOTE`` or ``Dimension (ISO)`` do."""
 
 _CONSTRUCTION_ALONE = re.compile(
-    r"^[^a-z]*(?:cent(?:er|re)|axis|axes|guides?|borders?|threads?|hatch(?:ing)?|"
+    r"^[^a-z]*(?:cent(?:er|re)|axis|axes|guides?|borders?|threads?|hatch(?:ing)?|origins?|"
+    r"datums?|"
     r"(?:sheet|drawing|page)[ _-]?(?:borders?|frames?)|"
     r"bends?(?:[ _-]?(?:up|down))?|(?:section|break)[ _-]?lines?)(?:[ _-]?(?:lines?|marks?))?"
     r"(?:[ _]+-[ _]+[a-z]+)?(?:[^a-z(]*\([^)]*\))*[^a-z]*$",
     re.IGNORECASE,
 )
-"""Layer names that are centre lines, axes or guides, a drawing sheet's border, frame,
-hatching, thread, section or break lines, or a flat pattern's bend lines, and nothing else
-(``CENTER``, ``Centerline (ISO)``, ``Center Mark (ISO)``, ``2-AXES``, ``Guides``; Autodesk
+"""Layer names that are centre lines, axes or guides, an origin or datum mark, a drawing
+sheet's border, frame, hatching, thread, section or break lines, or a flat pattern's bend
+lines, and nothing else (``CENTER``, ``Centerline (ISO)``, ``Center Mark (ISO)``,
+``2-AXES``, ``Guides``; a laser panel's ``ORIGIN`` crosshair, ``Datum``; Autodesk
 Inventor's ``Border (ANSI)`` and ``Border - Kova (ANSI)``, a style's name after the dash,
 ``Section Line (ANSI)``, ``Break Line (ISO)``, ``Thread Lines``, ``Hatch (ISO)``; ``Sheet
 Border``, ``DRAWING_FRAME``; ``BEND``, ``Bend Lines``, ``BEND_DOWN``). These words also

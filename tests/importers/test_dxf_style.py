@@ -115,7 +115,8 @@ def test_a_centre_line_named_by_its_layer_is_cut(tmp_path: Path) -> None:
 # Names from real drawings: Autodesk Inventor's ISO/ANSI layers (the Voron build plate:
 # its sheet's border, title block, section and break lines), the AIA layer standard's
 # annotation group, a bare CENTERLINE layer and a sheet's bare border (LibreCAD's library),
-# Inventor's flat-pattern layers of bend lines and centre marks (its export's layer map).
+# Inventor's flat-pattern layers of bend lines and centre marks (its export's layer map),
+# a laser panel generator's ORIGIN crosshair (CUT, SCORE, TEXT, ORIGIN layers on GitHub).
 @pytest.mark.parametrize(
     "layer",
     [
@@ -141,6 +142,8 @@ def test_a_centre_line_named_by_its_layer_is_cut(tmp_path: Path) -> None:
         "Bend Lines",
         "TITLEBLOCK",
         "Sheet Border",
+        "ORIGIN",
+        "Datum",
     ],
 )
 def test_a_construction_layer_is_left_out(tmp_path: Path, layer: str) -> None:
@@ -174,6 +177,7 @@ def test_a_construction_layer_is_left_out(tmp_path: Path, layer: str) -> None:
         "IV_INTERIOR_PROFILES",
         "Bend_Bracket",
         "Bike_Frame",
+        "Origin_Plate",
     ],
 )
 def test_a_part_layer_named_with_a_construction_word_is_cut(tmp_path: Path, layer: str) -> None:
