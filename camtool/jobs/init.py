@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from camtool.geometry.chain import chain_members, joint_distance
 from camtool.jobs.job import Selection
 from camtool.jobs.selection import circle_of, construction_reason
-from camtool.model.construction import fit_extent
+from camtool.model.construction import fit_extent, is_construction
 from camtool.model.errors import InputError
 from camtool.model.shapes import Contour, Drawing, fit_factor
 from camtool.toolpath.copies import one_way
@@ -122,15 +122,15 @@ def _fit(
     the machine's travel; construction (a sheet's border drawn as a guide, centre lines)
     is not cut, so it does not count, as ``post``'s travel check does not count it.
     """
-    cut = tuple(c for c in drawing.contours if construction_reason(c, Selection()) is None)
+    cut = any(not is_construction(c) for c in drawing.contours)
     if travel is None or not (cut or drawing.marks):
         return (), 1.0
-    x0, y0, x1, y1 = Drawing(cut, drawing.source, (), drawing.marks).bbox()
+    x0, y0, x1, y1 = box = fit_extent(drawing)  # as post fits it: construction aside
     w, h = travel
     if x1 - x0 + tool <= w + EPS_MM and y1 - y0 + tool <= h + EPS_MM:
         return (), 1.0  # its outside profile's toolpath fits the travel as it is (as post checks)
     fw, fh = _fit_box(tool, travel)
-    k = fit_factor(fit_extent(drawing), (fw, fh))  # as post fits it: construction aside
+    k = fit_factor(box, (fw, fh))
     return (
         f"fit = [{fw:g}, {fh:g}]"
         + _why(
