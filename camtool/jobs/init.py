@@ -191,7 +191,7 @@ def _chains(group: _Group) -> list[Contour]:
     a line drawn twice one open line (:func:`~camtool.toolpath.copies.one_way`).
     """
     if group.chained is None:
-        kept = [c for c in group.contours if construction_reason(c, Selection()) is None]
+        kept = [c for c in group.contours if not is_construction(c)]
         joint = joint_distance(DEFAULT_CHAIN_TOLERANCE)
         group.chained = one_way(chain_members(kept, joint)[0], joint)[0]
     return group.chained

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from typing import TypeAlias
 
 from camtool.jobs.job import Operation, Selection
-from camtool.model.construction import construction_layer
+from camtool.model.construction import construction_layer, is_construction
 from camtool.model.shapes import Contour, Drawing, Mark, Point, circle_of
 
 
@@ -35,7 +35,13 @@ class Selected:
 
 
 def construction_reason(contour: Contour, selection: Selection) -> str | None:
-    """Why ``contour`` is construction that ``selection`` does not name, or ``None``."""
+    """Why ``contour`` is construction that ``selection`` does not name, or ``None``.
+
+    Never a reason for a contour that is not construction at all
+    (:func:`~camtool.model.construction.is_construction`, which ``--fit`` also follows).
+    """
+    if not is_construction(contour):
+        return None
     named_layer = selection.layers is not None and contour.layer.casefold() in {
         n.casefold() for n in selection.layers
     }

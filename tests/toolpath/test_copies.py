@@ -193,8 +193,8 @@ def _arc_radii(job: object) -> list[float]:
 def test_a_copy_split_differently_is_cut_once_and_its_hole_stays_a_hole(tmp_path: Path) -> None:
     """A polyline square and the same square as LINEs from another corner, one edge split.
 
-    Cut twice, the copy also made the circle inside them two squares deep, so the outside
-    profile took the hole for a part and cut round it outside: a 10 mm hole 13 mm wide.
+    Were the copy not found, the circle would lie inside two squares: the outside profile
+    would take the hole for a part and cut round it outside, a 10 mm hole 13 mm wide.
     Expected from the drawing: one square; the hole cut inside, on radius 5 - 1.5 mm.
     """
     doc = ezdxf.new()
