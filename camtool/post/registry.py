@@ -420,7 +420,47 @@ def _machine_over(
     if machine_file is None:
         return machine, where
     override, where_override = machine_table(str(machine_file))
-    return merge_tables(machine, override), f"{where_override} (over {where})"
+    merged = _pieces_kept(machine, override, merge_tables(machine, override))
+    return merged, f"{where_override} (over {where})"
+
+
+_PIECES = (
+    ("motion", "line", lambda h: {**h.lines, **h.simulators}),
+    ("motion", "arc", lambda h: h.arcs),
+    ("motion", "chords", lambda h: h.chords),
+    ("timing", "model", lambda h: h.timing),
+)
+"""The keys of a ``[machine]`` table that name a motion piece, and where it is found."""
+
+
+def _pieces_kept(
+    base: Mapping[str, Any], override: Mapping[str, Any], merged: dict[str, Any]
+) -> dict[str, Any]:
+    """``merged`` with the base's own motion pieces kept when ``override`` renames the profile.
+
+    The profile names the target whose ``MOTION`` an unqualified piece name is looked
+    up in (:func:`camtool.verify.motion.library`). A machine file that renames it (a
+    user naming their machine ``profile = "shapeoko"``) keeps the pieces the base named
+    from its target's ``MOTION`` and did not set itself: they are qualified with the base's
+    target (``chords = "grbl"`` becomes ``"grbl:grbl"``). A name of the generic library
+    stays as it is (no built-in target gives a piece a generic name; a test keeps it so).
+    """
+    old, new = base.get("profile"), override.get("profile")
+    if not isinstance(old, str) or not old or new == old:
+        return merged
+    target = next((p.profiles()[old] for p in _builtin_providers() if old in p.profiles()), None)
+    hooks = profile_motion(old)
+    if target is None or hooks is None:
+        return merged
+    for table, key, pick in _PIECES:
+        section = merged.get(table)
+        own = override.get(table)
+        if not isinstance(section, Mapping) or (isinstance(own, Mapping) and key in own):
+            continue
+        name = section.get(key)
+        if isinstance(name, str) and name in pick(hooks):
+            merged[table] = {**section, key: f"{target}:{name}"}
+    return merged
 
 
 def _dialect(dialect: Any, where: str, provider: TargetPackage | None) -> DialectFactory:

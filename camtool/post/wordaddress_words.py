@@ -75,7 +75,7 @@ class WordWriter(WriterState[str]):
         # controller then does is undefined (the verifier refuses it). Such an arc lies
         # within $12 of its chord, so it is written as a line (a millionth to spare).
         motion = machine.motion
-        grbl_chords = motion.arc == "chords" and motion.chords == "grbl"
+        grbl_chords = motion.arc == "chords" and motion.chords in ("grbl", "grbl:grbl")
         self._arc_floor_mm = motion.chord_tolerance_mm * (1 + 1e-6) if grbl_chords else 0.0
         self._one_part = spec.max_arc_deg >= 360.0  # an arc but a full circle is one block
         _, _, self._cw, self._ccw = spec.motion_codes

@@ -20,9 +20,9 @@ import pytest
 from camtool.link.spec import LinkHooks
 from camtool.model.errors import InputError
 from camtool.model.machine import machine_from_table
-from camtool.model.program import ArcMove, Linear, Program
+from camtool.model.program import ArcMove, Linear, Program, Rapid
 from camtool.post.registry import TargetPackage, load_machine, load_target, target_names
-from camtool.verify.motion import MotionHooks, library
+from camtool.verify.motion import GENERIC, QUALIFIED, MotionHooks, library
 from camtool.verify.verifier import verify_program
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -151,6 +151,41 @@ def test_a_qualified_name_borrows_another_targets_piece_exactly() -> None:
             mine, motion=dataclasses.replace(mine.motion, chords="nosuch:grbl")
         )
         library(bad).check(bad)
+
+
+def test_a_machine_file_that_renames_the_profile_keeps_the_targets_own_pieces(
+    tmp_path: Path,
+) -> None:
+    """``--machine`` laying ``profile = "shapeoko"`` over GRBL names the user's machine; the
+    chord rule, line and timing GRBL's profile names stay GRBL's (a rename changes no step),
+    and a piece the file sets itself is its own."""
+    grbl = load_target("grbl")
+    renamed = tmp_path / "shapeoko.toml"
+    renamed.write_text('[machine]\nprofile = "shapeoko"\nname = "Shapeoko 3"\n')
+    mine = load_target("grbl", machine_file=renamed).machine
+    assert mine.profile == "shapeoko" and mine.motion.chords == f"grbl{QUALIFIED}grbl"
+    arc = Program((Linear(10.0, 0.0, 300.0), ArcMove(0.0, 10.0, 0.0, 0.0, False, 300.0)))
+    ours, theirs = verify_program(arc, mine), verify_program(arc, grbl.machine)
+    assert ours.trace.row_count == theirs.trace.row_count > 1000
+    assert np.array_equal(np.asarray(ours.trace.rows), np.asarray(theirs.trace.rows))
+    assert np.array_equal(ours.block_time_s, theirs.block_time_s)
+    # GRBL's writer knows its chord rule under either name: an arc of radius <= $12 / 2,
+    # which GRBL's mc_arc cannot divide into chords, is written as a line
+    tiny = Program((Rapid(0.0, 0.0), ArcMove(0.0015, 0.0, 0.00075, 0.0, True, 300.0)))
+    written = load_target("grbl", machine_file=renamed).emit(tiny).code
+    assert str(written) == str(grbl.emit(tiny).code)
+    assert not any(line.startswith("G2 ") for line in str(written).splitlines())
+    # a piece the target declares is never one of the generic library's: qualifying it
+    # cannot swap a generic piece for the target's
+    for name in target_names():
+        hooks = load_target(name).motion
+        for kind in ("lines", "arcs", "chords", "timing", "simulators"):
+            assert not set(getattr(hooks, kind)) & set(getattr(GENERIC, kind)), (name, kind)
+    own = tmp_path / "own.toml"
+    own.write_text('[machine]\nprofile = "shapeoko"\n[machine.motion]\nchords = "sagitta"\n')
+    machine = load_target("grbl", machine_file=own).machine
+    assert machine.motion.chords == "sagitta"
+    assert library(machine).chord_rule(machine) is library().chord_rule(machine)
 
 
 def test_a_qualified_name_names_an_installed_target_not_a_file(
