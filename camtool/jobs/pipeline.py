@@ -348,8 +348,9 @@ def post_program(
     by hand, UNAM-GMM S000-08) Z is dropped with a warning: Z-only moves go, XY moves keep their
     kind, as the thesis users edited VisiCAM output by hand (UNAM-GMM §3.8).
     ``output.fmt`` is the dialect's output format (default: its first);
-    ``output.spindle_rpm`` > 0 starts the spindle before the first move and stops it
-    after the last (when the program has no spindle commands of its own), waiting
+    ``output.spindle_rpm`` > 0 starts the spindle (after a first Z-only rapid:
+    :meth:`~camtool.model.program.Program.with_spindle`) and stops it after the last
+    (when the program has no spindle commands of its own), waiting
     ``output.spindle_dwell_s`` seconds after it starts. ``source`` (the input's file
     name) goes into the job notes (:func:`job_notes`) unless the program has notes.
     Nothing is added to the program's motion: no move to X0 Y0, no clearance move.

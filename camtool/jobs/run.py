@@ -40,6 +40,7 @@ from camtool.model.program import (
     Rapid,
     Spindle,
     ToolChange,
+    spindle_start,
 )
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import Arc, Contour, Drawing, Point, circle_of
@@ -295,7 +296,8 @@ def run_job(
         )
         cut.append((op, where, planned.paths))
         if not job.shorthand and tool.id != loaded and planned.moves:  # none: nothing to cut
-            commands.extend(_tool_change(len(moves), tool, loaded, output, target))
+            at = spindle_start(planned.moves, 0, _position(moves, here)[:2])
+            commands.extend(_tool_change(len(moves), at, tool, loaded, output, target))
             loaded = tool.id
         offset = _last_contour(moves)
         _join(moves, commands, planned, offset)
@@ -564,18 +566,27 @@ def _drill(
 
 
 def _tool_change(
-    index: int, tool: Tool, loaded: int | None, output: OutputOptions, target: Target
+    index: int,
+    after: int,
+    tool: Tool,
+    loaded: int | None,
+    output: OutputOptions,
+    target: Target,
 ) -> list[tuple[int, Command]]:
-    """Spindle off (when a tool turns), the change, the spindle on for the new tool."""
+    """Spindle off (when a tool turns), the change, the spindle on for the new tool.
+
+    The change goes before move ``index``, the spindle start ``after`` moves later (1:
+    after the operation's rise to clearance, 0: at once).
+    """
     rpm = _rpm(tool, output, target)
     out: list[tuple[int, Command]] = []
     if loaded is not None and rpm:
         out.append((index, Spindle("off")))
     out.append((index, ToolChange(tool.id, tool.describe())))
     if rpm:
-        out.append((index, Spindle("cw", rpm)))
+        out.append((index + after, Spindle("cw", rpm)))
         if output.spindle_dwell_s > 0:
-            out.append((index, Dwell(output.spindle_dwell_s)))
+            out.append((index + after, Dwell(output.spindle_dwell_s)))
     return out
 
 
@@ -588,7 +599,10 @@ def _rpm(tool: Tool, output: OutputOptions, target: Target) -> float:
 
 
 def _spindle_around(program: Program, output: OutputOptions, target: Target) -> Program:
-    """The shorthand's spindle: on before the first move, off after the last."""
+    """The shorthand's spindle: on after the first rise, off after the last move.
+
+    :meth:`~camtool.model.program.Program.with_spindle` places it.
+    """
     rpm = target.spindle_rpm if output.spindle_rpm is None else output.spindle_rpm
     if not rpm or any(isinstance(c, Spindle) for _, c in program.commands):
         return program

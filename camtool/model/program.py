@@ -448,10 +448,11 @@ class Program:
     def with_spindle(
         self, rpm: float, direction: SpindleDirection = "cw", *, dwell_s: float = 0.0
     ) -> Program:
-        """A copy that starts the spindle before the first move and stops it after the last.
+        """A copy that starts the spindle and stops it after the last move.
 
-        ``dwell_s`` > 0 waits that long after the spindle starts (spin-up), before the
-        first move.
+        The spindle starts before the first move, or after it when that move is a
+        Z-only rapid (:func:`spindle_start`). ``dwell_s`` > 0 waits that long after the
+        spindle starts (spin-up), before the tool moves on.
 
         Raises:
             ValueError: ``rpm`` is not positive, ``direction`` is "off" or ``dwell_s`` < 0.
@@ -459,9 +460,10 @@ class Program:
         if not rpm > 0 or direction == "off" or not dwell_s >= 0:
             raise ValueError("spindle speed must be > 0 rev/min and the direction cw or ccw")
         end = len(self.moves)
-        start: tuple[tuple[int, Command], ...] = ((0, Spindle(direction, rpm)),)
+        at = spindle_start(self.moves, 0, self.origin)
+        start: tuple[tuple[int, Command], ...] = ((at, Spindle(direction, rpm)),)
         if dwell_s > 0:
-            start = (*start, (0, Dwell(dwell_s)))
+            start = (*start, (at, Dwell(dwell_s)))
         commands = (*start, *self.commands, (end, Spindle("off")))
         return dataclasses.replace(self, commands=commands)
 
@@ -560,6 +562,23 @@ class Program:
                 continue
             total += math.hypot(seg.length, dz) / move.feed_mm_min * 60.0
         return total
+
+
+def spindle_start(moves: Sequence[Move], index: int, here: Point) -> int:
+    """Where a spindle that turns for ``moves[index:]`` starts: the index of a move.
+
+    After ``moves[index]`` when that move is a Z-only rapid from ``here`` (XY within
+    1 nm), the rise to clearance a program or an operation starts with; else before it.
+    A program starts where the operator set Z zero, the tool on the stock's top: the
+    spindle starts once the tool is clear of it, as the posts of GRBL and LinuxCNC
+    users' CAM programs order it.
+    """
+    if index < len(moves):
+        move = moves[index]
+        still = math.dist(here, (move.x, move.y)) <= 1e-6
+        if isinstance(move, Rapid) and move.z is not None and still:
+            return index + 1
+    return index
 
 
 def segment_of(start: Point, move: Move) -> Segment:

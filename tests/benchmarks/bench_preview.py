@@ -53,13 +53,16 @@ PLATE_ARGS = [
 ]
 
 EXPECTED_SHA256 = {
-    "part": "85c3cc13e4b7ba615dd29d590268d3f6161958518119c837f7b7fffbb9cfbf83",
-    "plate": "1e0d0fc824a82d415e603ff2ff27c7d9210d2a066c3b4d5f262ba096ed4c57f6",
+    "part": "1f28206f41c1dbc7bf682b76cc40c783be8e14faa0de0c2721aa5b3e7474b3f6",
+    "plate": "e2e333134236e60c620e6597d67292aaa371ebf6d760d709295a4138fb2cb728",
 }
 """sha256 of the G-code each job writes since 28fa305: the pre-work code's (b3b77a5:
 ``bca14f57…`` and ``c18812e3…``) with one header line more, ``(placement: scale 1, shift
 X1.5 Y1.5 mm)``, which tells ``verify --against`` how the drawing was placed; the first-parent
-history from b3b77a5 changes no other byte of either (bisected 25 Nov 2026)."""
+history from b3b77a5 changes no other byte of either (bisected 25 Nov 2026). Since the
+spindle starts after the first rise to clearance (29 Nov 2026) the program's ``M3 S1000``
+and ``G0 Z5.000`` change places; with them swapped back both are ``85c3cc13…`` and
+``1e0d0fc8…`` again."""
 
 RUNNER = r"""
 import json, os, resource, subprocess, sys, time
@@ -174,7 +177,7 @@ def main() -> None:
             digest = sha256(work / code)
             same = digest == EXPECTED_SHA256[name]
             wall, mb = float(m["wall"]), int(m["kib"]) / 1024.0
-            note = "G-code as recorded (28fa305)" if same else f"G-code DIFFERS: sha256 {digest}"
+            note = "G-code as recorded" if same else f"G-code DIFFERS: sha256 {digest}"
             if name == "part":
                 row(
                     title,

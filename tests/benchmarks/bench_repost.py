@@ -55,7 +55,7 @@ BIG_COPIES = 170
 cost per line decides, not start-up (issue 44)."""
 BIG_JOB = "re-post 10.9 MB G-code (338 981 lines) → linuxcnc"
 INPUT_SHA256 = "34f5a0763a3aecd31b31e4c4eabe79f2d86f450f9d7110efc8ad5e899182a7d6"
-OUTPUT_SHA256 = "5f8ee1a17bd2cef48bed0a3189ac0f9203a453c900d90dd483ba68591d824a82"
+OUTPUT_SHA256 = "5271e0ad418b92c35eaf3486a2af4291dffba952db3384ca827f85d534fe1e57"
 """camtool re-posting the program to linuxcnc since 35fbe3b: the pre-work output (b3b77a5,
 ``d55c8f55…``) but for its 17 tool changes, each ``M6 T1`` then written ``T1 M6`` and
 ``G43 H1`` (the tool table's length offset after a change, LinuxCNC's way); no other line
@@ -66,7 +66,10 @@ and written) ``cds.ngc``'s ``M9`` is kept (17 lines added), and since 29a9b1e a 
 the turning spindle goes in the next motion block: its ``M3 S3500`` (the spindle already on
 clockwise) is written ``G0 Z53.340 S3500`` (17 lines fewer); LinuxCNC's ``rs274`` reads
 both programs to the same canonical calls but ``MIST_OFF``/``FLOOD_OFF`` added and the
-repeated ``START_SPINDLE_CLOCKWISE`` gone (bisected 27 Nov 2026)."""
+repeated ``START_SPINDLE_CLOCKWISE`` gone (bisected 27 Nov 2026). Since c68e26f (a re-post
+keeps its path control mode) the examples' ``G64 P0.25`` and ``g64`` are written, as
+``G64 P0.250`` and ``G64`` (34 lines added, no other line differs; ``5f8ee1a1…`` before,
+bisected 29 Nov 2026)."""
 RS274_RECORDED_S = 0.37
 """rs274 on this program, best of 5 on the 2-core dev machine under load (this docstring)."""
 RUNS = 3

@@ -121,11 +121,15 @@ def test_a_z_coupon_starts_and_ends_like_every_planned_program(name: str) -> Non
 
 @pytest.mark.parametrize(("name", "rpm"), [("grbl", 1000.0), ("linuxcnc", 12000.0)])
 def test_the_spindle_runs_for_the_whole_coupon(name: str, rpm: float) -> None:
-    from camtool.model.program import Spindle
+    from camtool.model.program import Rapid, Spindle
 
     program = build_coupon(load_target(name)).program
     spindle = [(i, c) for i, c in program.commands if isinstance(c, Spindle)]
-    assert spindle[0][0] == 0 and spindle[0][1].rpm == rpm and spindle[0][1].direction == "cw"
+    # it starts once the tool has risen off the stock's top (a Z-only rapid), before any
+    # move in X or Y
+    assert spindle[0][0] == 1 and spindle[0][1].rpm == rpm and spindle[0][1].direction == "cw"
+    rise = program.moves[0]
+    assert isinstance(rise, Rapid) and (rise.x, rise.y) == program.origin and rise.z > 0
     assert spindle[-1] == (len(program.moves), Spindle("off"))
 
 

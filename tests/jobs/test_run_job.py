@@ -120,8 +120,16 @@ def test_a_tool_change_comes_between_drilling_and_milling(part: object) -> None:
     z_before = [m.z for m in program.moves[:engrave_first] if m.z is not None][-1]
     assert z_before == 10.0
     around = [c for i, c in program.commands if i == engrave_first]
-    assert around[:2] == [Spindle("off"), ToolChange(1, "end-mill 3 mm")]
-    assert around[2] == Spindle("cw", 10000.0)
+    assert around == [Spindle("off"), ToolChange(1, "end-mill 3 mm")]
+    # the new tool's spindle starts after the operation's Z-only rise to clearance
+    rise = program.moves[engrave_first]
+    assert (rise.x, rise.y) == (
+        program.moves[engrave_first - 1].x,
+        program.moves[engrave_first - 1].y,
+    )
+    assert rise.z == 10.0
+    after = [c for i, c in program.commands if i == engrave_first + 1]
+    assert after == [Spindle("cw", 10000.0)]
 
 
 def test_the_header_lists_the_tools_and_the_operations_in_order(part: object) -> None:

@@ -181,7 +181,7 @@ def test_a_grbl_job_of_two_tools_is_one_program_per_tool(
     """GRBL reads no line while its ``M0`` pauses (gcode.c: the pause is a feed hold inside
     the line's execution): no jog, no ``G10 L20``, so no Z zero can be set for a new tool
     there. Each tool gets its own program, run after Z zero is set for that tool; each
-    rises to the clearance height before any X/Y move."""
+    rises to the clearance height, then starts the spindle, before any X/Y move."""
     done = run_job(read_drawing(PART), load_target("grbl"), load_job(JOB))
     assert [p.change.tool for p in done.pieces] == [2, 1]
     for piece in done.pieces:
@@ -189,6 +189,9 @@ def test_a_grbl_job_of_two_tools_is_one_program_per_tool(
         assert "M0" not in lines and not any("change to" in line for line in lines)
         motion = [line for line in lines if line.startswith(("G0 ", "G1 ", "G2 ", "G3 "))]
         assert motion[0] == "G0 Z10.000"
+        # the operator set Z zero on the stock's top: the spindle starts once it has risen
+        spindle = next(i for i, line in enumerate(lines) if line.startswith("M3"))
+        assert lines.index(motion[0]) < spindle < lines.index(motion[1])
     assert [m for p in done.pieces for m in p.program.moves] == list(done.program.moves)
     out = tmp_path / "part.gcode"
     assert main(["post", str(PART), "-t", "grbl", "--job", str(JOB), "-o", str(out)]) == 0

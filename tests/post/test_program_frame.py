@@ -6,6 +6,8 @@ i8751) is posted through the CLI and its code read back with the target's own re
 - the first move is Z only, up to the clearance height, from wherever the machine is
   (the reader starts at X0 Y0, so its XY must not change);
 - no rapid moves XY below safe Z, and no Z-only rapid goes below safe Z;
+- the spindle starts after that first rise, once the tool is off the stock's top where
+  Z zero was set, and before any other move;
 - the program ends with a Z-only rise to clearance, then the spindle stops;
 - without ``--depth`` the cuts run at Z 0 and a warning says so;
 - the header (job notes as comments where the dialect has them) is deterministic.
@@ -83,8 +85,8 @@ def test_start_is_z_only_to_clearance_and_the_end_rises_before_the_spindle_stops
         ]
         assert "Z8" in motion[0] and "X" not in motion[0] and "Y" not in motion[0]
     spindle = [(i, c) for i, c in program.commands if isinstance(c, Spindle)]
-    if spindle:  # grbl, linuxcnc, flashcut: on before the first move, off after the last
-        assert spindle[0][0] == 0 and spindle[-1] == (len(program.moves), Spindle("off"))
+    if spindle:  # grbl, linuxcnc, flashcut: on after the first rise, off after the last move
+        assert spindle[0][0] == 1 and spindle[-1] == (len(program.moves), Spindle("off"))
 
 
 def test_no_depth_on_grbl_cuts_at_the_top_and_says_so(
@@ -95,7 +97,7 @@ def test_no_depth_on_grbl_cuts_at_the_top_and_says_so(
     _check_heights(program, 2.0, 5.0)  # the defaults: safe Z 2 mm, clearance max(5, 2)
     assert {m.z for m in program.moves if not isinstance(m, Rapid) and m.z is not None} == {0.0}
     lines = data.decode().splitlines()
-    assert lines[lines.index("M3 S1000") + 1] == "G0 Z5.000"
+    assert lines[lines.index("M3 S1000") - 1] == "G0 Z5.000"
     assert lines[-3:] == ["G0 Z5.000", "M5", "M2"]
 
 
@@ -119,7 +121,7 @@ def test_header_names_the_job_and_two_runs_are_byte_identical(
     assert first == second
     lines = first.decode().splitlines()
     k = SCALE[target]
-    assert lines[:9] == [
+    assert lines[:8] == [
         f"(camtool {__version__}: logo.dxf for {target})",
         f"(placement: scale {k:g}, shift X0 Y0 mm)",  # --scale, about the drawing's origin
         f"(--scale {k:g}: the drawing at {100 * k:g} % of its size)",
@@ -128,8 +130,8 @@ def test_header_names_the_job_and_two_runs_are_byte_identical(
         "(depth 2 mm in passes of 1 mm)",
         "(safe Z 2 mm, clearance Z 5 mm above the top)",
         "G21 G90 G94 G17" + (" G40 G49 G80" if target == "linuxcnc" else ""),
-        "M3 S" + ("1000" if target == "grbl" else "12000"),
     ]
+    assert lines[8:10] == ["G0 Z5.000", "M3 S" + ("1000" if target == "grbl" else "12000")]
 
 
 def test_a_long_file_name_is_cut_to_grbl_line_limit(
@@ -149,7 +151,8 @@ def test_spindle_dwell_is_written_after_the_spindle_starts(
     assert main(["post", str(LOGO), "-t", "grbl", "--scale", "20", "--spindle-dwell", "2.5"]) == 0
     lines = capsys.readouterr().out.splitlines()
     start = lines.index("M3 S1000")
-    assert lines[start + 1 : start + 3] == ["G4 P2.5", "G0 Z5.000"]
+    assert lines[start - 1 : start + 2] == ["G0 Z5.000", "M3 S1000", "G4 P2.5"]
+    assert lines[start + 2].startswith("G0 X")  # then to the first cut, the spindle up to speed
 
 
 def test_end_position_rapids_there_at_clearance(

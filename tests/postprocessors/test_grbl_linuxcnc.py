@@ -79,14 +79,14 @@ def test_logo_golden(target: str, update_golden: bool) -> None:
     lines = code.splitlines()
     # The RS-274 frame: the job as comments, the modal safety line (mm, absolute, feed per
     # minute, XY plane; LinuxCNC also compensation, length offset and canned cycle off),
-    # spindle S/M3 … M5, M2 at the end.
+    # the rise to clearance, spindle S/M3 … M5, M2 at the end.
     notes = [line for line in lines if line.startswith("(")]
     assert lines[: len(notes)] == notes
     assert notes[0] == f"(camtool {__version__}: logo.dxf for {target})"
     safety = "G21 G90 G94 G17" + (" G40 G49 G80" if target == "linuxcnc" else "")
     assert lines[len(notes)] == safety
-    assert re.fullmatch(r"M3 S\d+", lines[len(notes) + 1])
-    assert lines[len(notes) + 2] == "G0 Z5.000"  # first move: Z only, up to clearance
+    assert lines[len(notes) + 1] == "G0 Z5.000"  # first move: Z only, up to clearance
+    assert re.fullmatch(r"M3 S\d+", lines[len(notes) + 2])  # then the spindle, off the stock
     assert lines[-3:] == ["G0 Z5.000", "M5", "M2"]  # up to clearance, then spindle off
     assert all(len(line) + 1 <= (80 if target == "grbl" else 255) for line in lines)
 

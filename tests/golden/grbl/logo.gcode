@@ -6,8 +6,8 @@
 (depth none: cuts at Z 0, the top of the stock)
 (safe Z 2 mm, clearance Z 5 mm above the top)
 G21 G90 G94 G17
-M3 S1000
 G0 Z5.000
+M3 S1000
 G0 X60.000 Y28.000
 G0 Z2.000
 G1 Z0.000 F150
