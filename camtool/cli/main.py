@@ -379,17 +379,19 @@ def _write_pieces(job: PostJob, output: str, inputs: list[tuple[str, Any]]) -> N
 
     name = job.target.name
     if output == "-":
+        suffix = job.target.post.suffix
+        names = ", ".join(piece.path(f"FILE{suffix}") for piece in job.pieces)
         raise UsageError(
-            f"{name} cannot change tools, so this job of {len(job.pieces)} tools is "
-            f"{len(job.pieces)} programs, one per tool: give -o FILE{job.target.post.suffix} "
-            "(they are written as FILE.T<n>" + job.target.post.suffix + ")"
+            f"{name} cannot change tools, so this program of {len(job.pieces)} tools is "
+            f"{len(job.pieces)} programs, one per tool: give -o FILE{suffix} "
+            f"(they are written as {names})"
         )
     paths = [piece.path(output) for piece in job.pieces]
     check_outputs(inputs, [("-o", p) for p in paths])
     for piece, path in zip(job.pieces, paths, strict=True):
         write_output(piece.result.code, path)
     order = ", then ".join(
-        f"{p} (T{piece.change.tool})" for piece, p in zip(job.pieces, paths, strict=True)
+        f"{p} ({piece.tool})" for piece, p in zip(job.pieces, paths, strict=True)
     )
     zero = "; set Z zero for each tool before its program" if job.target.machine.has_z else ""
     say_written(

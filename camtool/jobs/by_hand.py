@@ -1,9 +1,10 @@
 """Tools loaded by hand: programs for a machine that cannot change tools.
 
-A job of several tools, or a re-posted program whose first tool change comes before any
-cut (:func:`changed_before_cutting`), is written one program per tool (:func:`per_tool`); a
-program of one tool is that tool's program (:func:`loaded_by_hand`). Each says which tool
-to load.
+A job of several tools, or a re-posted program that changes tools, is written one program
+per tool (:func:`per_tool`; a re-post that cuts before its first change starts with a
+program for the tool loaded at its start); a program whose one change comes before any cut
+(:func:`changed_before_cutting`) is that tool's program (:func:`loaded_by_hand`). Each says
+which tool to load.
 """
 
 from __future__ import annotations
@@ -26,20 +27,31 @@ class ToolProgram:
 
     Attributes:
         number: its place in the run, 1-based.
-        change: the tool change it starts with (the tool it cuts with, and what it is).
+        change: the tool change it starts with (the tool it cuts with, and what it is);
+            ``None`` for a re-posted program's part before its first change, which cuts
+            with the tool loaded when the program starts (the program names none).
         program: its moves and commands (its header says which program of how many).
         result: its code.
     """
 
     number: int
-    change: ToolChange
+    change: ToolChange | None
     program: Program
     result: PostResult
 
     def path(self, output: str | Path) -> str:
-        """Where it is written for ``-o output``: ``part.nc`` → ``part.T2.nc``."""
+        """Where it is written for ``-o output``: ``part.nc`` → ``part.T2.nc``.
+
+        The part of a re-post before its first change: ``part.start.nc``.
+        """
         out = Path(output)
-        return str(out.with_name(f"{out.stem}.T{self.change.tool}{out.suffix}"))
+        which = "start" if self.change is None else f"T{self.change.tool}"
+        return str(out.with_name(f"{out.stem}.{which}{out.suffix}"))
+
+    @property
+    def tool(self) -> str:
+        """The tool it cuts with, in words: ``"T2"``, or the tool loaded at the start."""
+        return "the tool loaded at the start" if self.change is None else f"T{self.change.tool}"
 
 
 def loaded_by_hand(program: Program, target: Target) -> Program:
@@ -113,6 +125,20 @@ def own_stops_dropped(
     return out, stopped
 
 
+def sideways_first(number: int, change: ToolChange | None, name: str) -> str:
+    """The warning for a program per tool whose first move goes sideways before any Z.
+
+    Its Z zero was just set for the new tool, on the stock's top: a re-posted program
+    moves as the input gives it (it expected the tool change to leave the tool up).
+    """
+    tool = "the tool loaded at the start" if change is None else f"T{change.tool}"
+    return (
+        f"{name} program {number} ({tool}) moves X/Y before any Z move: that move runs at "
+        "the height where Z zero was set for the tool, on the stock's top; add a move up to "
+        "a safe height after the tool change in the input"
+    )
+
+
 def idle_changes(program: Program) -> list[ToolChange]:
     """The tool changes after which ``program`` cuts nothing before the next change.
 
@@ -135,19 +161,24 @@ def per_tool(program: Program, target: Target, fmt: str | None) -> tuple[ToolPro
 
     Each piece holds the moves from its tool change to the next and the commands among
     them in program order (the spindle stop before a change ends the piece before it;
-    the change itself is the piece's start; what comes before the first change is the
-    first piece's); its header is the job's, then which program of how many it is and
-    what to load. A stop right after a change (``M6`` then ``M0``, as pcb2gcode pauses
-    for the new tool) is that change's: starting the piece is its resume, said in the
-    header; any other stop is kept.
+    the change itself is the piece's start; rapids before the first change are the first
+    piece's, and a re-post that cuts before it gets a piece of its own for them, with the
+    tool loaded at its start: GRBL's ``M0`` reads no line, so no Z zero could be set for
+    the new tool within one program); its header is the job's, then which program of how
+    many it is and what to load. A stop right after a change (``M6`` then ``M0``, as
+    pcb2gcode pauses for the new tool) is that change's: starting the piece is its resume,
+    said in the header; any other stop is kept.
 
     Raises:
         DialectError: a piece the target cannot write.
     """
     every = [(i, c) for i, c in program.commands if isinstance(c, ToolChange)]
     idle = {id(c) for c in idle_changes(program)}
-    changes = [(i, c) for i, c in every if id(c) not in idle] or every[:1]
-    kept_ids = {id(c) for _, c in changes}
+    found = [(i, c) for i, c in every if id(c) not in idle] or every[:1]
+    changes: list[tuple[int, ToolChange | None]] = list(found)
+    if not changed_before_cutting(program):  # it cuts with the tool loaded at its start
+        changes.insert(0, (0, None))
+    kept_ids = {id(c) for _, c in found}
     bounds = [0] + [i for i, _ in changes[1:]] + [len(program.moves)]
     commands: list[list[tuple[int, Command]]] = [[] for _ in changes]
     kept, stopped = own_stops_dropped(program.commands)
@@ -164,18 +195,24 @@ def per_tool(program: Program, target: Target, fmt: str | None) -> tuple[ToolPro
     here = program.origin
     for k, (_, change) in enumerate(changes):
         moves = program.moves[bounds[k] : bounds[k + 1]]
-        what = f" {change.description}" if change.description else ""
-        after = "" if k == 0 else f", after the T{changes[k - 1][1].tool} program"
-        stop = [OWN_STOP] if id(change) in stopped else []
+        before = changes[k - 1][1] if k else None
+        after = f", after the {'start' if before is None else f'T{before.tool}'} program"
+        if change is None:
+            load = "with the tool loaded at the start (the program names none)"
+        else:
+            load = f"load T{change.tool}" + (f" {change.description}" if change.description else "")
+        stop = [OWN_STOP] if change is not None and id(change) in stopped else []
         notes = (
             *program.notes,
-            f"program {k + 1} of {len(changes)}: load T{change.tool}{what}{after}",
+            f"program {k + 1} of {len(changes)}: {load}{after if k else ''}",
             *stop,
         )
+        sideways = k > 0 and moves and moves[0].z is None and (moves[0].x, moves[0].y) != here
+        warned = (sideways_first(k + 1, change, target.name),) if sideways else ()
         alone = Program(
             moves,
             here,
-            program.warnings,
+            (*program.warnings, *warned),
             commands=tuple(commands[k]),
             notes=notes,
             tolerance_mm=program.tolerance_mm,

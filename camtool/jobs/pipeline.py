@@ -385,14 +385,20 @@ def post_program(
     program = _with_spindle(program, output.spindle_rpm, output.spindle_dwell_s)
     progress(Step("writing", 0, len(program.moves), target.name))
     changes = sum(isinstance(c, ToolChange) for _, c in program.commands)
-    if target.post.tool_changes == "none" and changes > 1 and changed_before_cutting(program):
+    cuts_first = changes > 0 and not changed_before_cutting(program)
+    if target.post.tool_changes == "none" and (changes > 1 or cuts_first):
         idle = idle_changes(program)
         if idle:
             tools = ", ".join(f"T{c.tool}" for c in idle)
             note = f"no program for {tools}: the program cuts nothing after changing to it"
             program = dataclasses.replace(program, warnings=(*program.warnings, note))
-        pieces = per_tool(program, target, output.fmt)  # one program per tool
-        return PostJob(None, program, target, pieces[0].result, None, 0.0, pieces=pieces)
+        if cuts_first and len(idle) == changes:  # one tool cuts, the one loaded at the start
+            commands = own_stops_dropped(program.commands)[0]
+            kept = tuple((i, c) for i, c in commands if not isinstance(c, ToolChange))
+            program = dataclasses.replace(program, commands=kept)
+        else:
+            pieces = per_tool(program, target, output.fmt)  # one program per tool
+            return PostJob(None, program, target, pieces[0].result, None, 0.0, pieces=pieces)
     program = loaded_by_hand(program, target)
     if target.post.tool_changes == "stop":  # the change is written as a stop: its own is that
         program = dataclasses.replace(

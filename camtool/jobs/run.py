@@ -104,7 +104,8 @@ class PostJob:
     @property
     def warnings(self) -> tuple[str, ...]:
         """Warnings of every stage, in pipeline order, without repeats."""
-        written = [w for p in self.pieces for w in p.result.warnings] or self.result.warnings
+        pieces = [w for p in self.pieces for w in (*p.program.warnings, *p.result.warnings)]
+        written = pieces or self.result.warnings
         return tuple(dict.fromkeys((*self.program.warnings, *written)))
 
 

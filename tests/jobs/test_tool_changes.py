@@ -15,7 +15,7 @@ import pytest
 
 from camtool.cli.main import main
 from camtool.importers import read_drawing
-from camtool.importers.gcode import read_gcode
+from camtool.importers.gcode import parse_gcode, read_gcode
 from camtool.jobs.jobfile import load_job
 from camtool.jobs.pipeline import post_program
 from camtool.jobs.run import run_job
@@ -141,7 +141,6 @@ def test_a_one_tool_job_for_a_machine_without_a_changer_is_that_tool_s_program(
 @pytest.mark.parametrize("target", ["valcnc", "flashcut", "i8751"])
 def test_a_re_posted_program_of_one_tool_is_written_without_its_change(target: str) -> None:
     """FreeCAD's and CAMotics' programs begin with their one tool change (``M6 T2``)."""
-    from camtool.importers.gcode import parse_gcode
 
     text = "G21 G90\nM6 T2\nG0 X1 Y1 Z5\nG1 Z-1 F100\nG1 X5\nG0 Z5\nM2\n"
     done = post_program(parse_gcode(text, source="one.ngc"), load_target(target))
@@ -154,7 +153,6 @@ def test_a_re_posted_program_of_one_tool_is_written_without_its_change(target: s
 def test_pic_mmh_changes_tools_in_its_own_code() -> None:
     """UNAM-GMM's dialect has ``M06T##;``, a change to magazine position T (L3455–L3464):
     a program of two tools is one pic-mmh program with both changes, not one per tool."""
-    from camtool.importers.gcode import parse_gcode
 
     text = "G21 G90\nM6 T1\nG0 X1 Y1\nG1 X2 F0.8\nM6 T2\nG1 X3 Y1\nM2\n"
     done = post_program(parse_gcode(text, source="two.ngc"), load_target("pic-mmh"))
@@ -228,7 +226,6 @@ def test_a_re_posted_move_sideways_right_after_a_change_by_hand_is_warned_of(
     the height the new tool was left, which camtool keeps (moves as the input gives them)
     and says. A program that rises first (the change to T1 here) is not warned of.
     """
-    from camtool.importers.gcode import parse_gcode
 
     text = (
         "G21 G90\nT1 M6\nG0 Z5\nG0 X0 Y0\nG1 Z-1 F100\nG1 X10\nG0 Z5\n"
@@ -240,6 +237,68 @@ def test_a_re_posted_move_sideways_right_after_a_change_by_hand_is_warned_of(
     assert "moves X/Y before any Z move" in said[0]
     code = str(done.result.code).splitlines()
     assert code[code.index("(change to T2)") + 2] == "G0 X20.000 Y20.000"  # as it was given
+
+
+CUTS_THEN_CHANGES = (
+    "G21 G90\nM3 S10000\nG0 Z5\nG0 X0 Y0\nG1 Z-1 F100\nG1 X10 F300\nG0 Z5\nM5\n"
+    "T2 M6\nM3 S8000\nG0 Z5\nG0 X20 Y0\nG1 Z-1 F100\nG1 X30 F300\nG0 Z5\nM5\nM2\n"
+)
+"""A program for a tool changer that cuts with the tool loaded at its start, then changes."""
+
+
+def test_a_re_post_that_cuts_before_its_first_change_is_one_program_per_tool_on_grbl(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """GRBL's ``M0`` reads no line while it pauses, so no Z zero can be set for T2 inside one
+    program: the part before the change is a program of its own (the tool the input starts
+    with, which it names none), then T2's; no stop, no change comment, every move kept."""
+    source = tmp_path / "cuts.ngc"
+    source.write_text(CUTS_THEN_CHANGES)
+    program = read_gcode(source)
+    done = post_program(program, load_target("grbl"))
+    assert [p.change and p.change.tool for p in done.pieces] == [None, 2]
+    first, second = (p.program for p in done.pieces)
+    assert [(m.x, m.y) for m in first.moves if isinstance(m, Linear)] == [(0, 0), (10, 0)]
+    assert [(m.x, m.y) for m in second.moves if isinstance(m, Linear)] == [(20, 0), (30, 0)]
+    assert [*first.moves, *second.moves] == list(program.moves)
+    for piece in done.pieces:
+        lines = str(piece.result.code).splitlines()
+        assert "M0" not in lines and not any("change to" in line for line in lines)
+    out = tmp_path / "cuts.gcode"
+    assert main(["post", str(source), "-t", "grbl", "-o", str(out)]) == 0
+    written = sorted(p.name for p in tmp_path.iterdir() if p.suffix == ".gcode")
+    assert written == ["cuts.T2.gcode", "cuts.start.gcode"]
+    err = capsys.readouterr().err
+    assert "cuts.start.gcode (the tool loaded at the start), then" in err
+    assert "moves X/Y before any Z move" not in err  # T2's program rises first
+
+
+def test_a_change_at_the_end_of_a_re_post_that_cut_before_it_writes_one_program() -> None:
+    """``T2 M6`` just before ``M2`` (nothing cut with T2): no program for T2, no stop at the
+    end; the one program cuts with the tool loaded at its start, as the input does."""
+    text = CUTS_THEN_CHANGES.split("T2 M6")[0] + "T2 M6\nM0\nM2\n"
+    done = post_program(parse_gcode(text, source="end.ngc"), load_target("grbl"))
+    assert done.pieces == ()
+    lines = str(done.result.code).splitlines()
+    assert "M0" not in lines and not any("T2" in line for line in lines)
+    assert [line for line in lines if line.startswith("G1 X")] == ["G1 X10.000 Y0.000 F300"]
+    assert "no program for T2: the program cuts nothing after changing to it" in done.warnings
+
+
+def test_a_program_per_tool_that_moves_sideways_first_is_warned_of(tmp_path: Path) -> None:
+    """Without its ``G0 Z5`` after ``T2 M6``, T2's program would go sideways at the height
+    its Z zero was set, on the stock's top: kept as the input gives it, and said."""
+    source = tmp_path / "cuts.ngc"
+    source.write_text(CUTS_THEN_CHANGES.replace("M3 S8000\nG0 Z5\n", "M3 S8000\n"))
+    done = post_program(read_gcode(source), load_target("grbl"))
+    said = [w for w in done.warnings if "before any Z move" in w]
+    assert said == [
+        "grbl program 2 (T2) moves X/Y before any Z move: that move runs at the height where "
+        "Z zero was set for the tool, on the stock's top; add a move up to a safe height "
+        "after the tool change in the input"
+    ]
+    code = str(done.pieces[1].result.code).splitlines()
+    assert code[code.index("M3 S8000") + 1] == "G0 X20.000 Y0.000"  # as the input gives it
 
 
 PCB2GCODE_DRILL = """( pcb2gcode 2.5.0 )
