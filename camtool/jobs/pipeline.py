@@ -393,9 +393,9 @@ def post_program(
             note = f"no program for {tools}: the program cuts nothing after changing to it"
             program = dataclasses.replace(program, warnings=(*program.warnings, note))
         if cuts_first and len(idle) == changes:  # one tool cuts, the one loaded at the start
-            commands = own_stops_dropped(program.commands)[0]
-            kept = tuple((i, c) for i, c in commands if not isinstance(c, ToolChange))
-            program = dataclasses.replace(program, commands=kept)
+            own = own_stops_dropped(program.commands)[0]
+            alone = tuple((i, c) for i, c in own if not isinstance(c, ToolChange))
+            program = dataclasses.replace(program, commands=alone)
         else:
             pieces = per_tool(program, target, output.fmt)  # one program per tool
             return PostJob(None, program, target, pieces[0].result, None, 0.0, pieces=pieces)
