@@ -14,10 +14,14 @@ import dataclasses
 import itertools
 import math
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 from camtool.geometry.chain import closes_alone, with_end
 from camtool.model.shapes import Arc, Contour, Line, Point, Segment, distance
 from camtool.toolpath.cuts import Finding
+
+if TYPE_CHECKING:
+    from camtool.toolpath.order import Nesting
 
 SAME_MM = 0.001
 """How far two ends or centres may differ for two contours to be one path, mm: 1 µm, below
@@ -93,6 +97,50 @@ def drop_copies(
             )
         findings.append(Finding("copy", message, contour.start))
     return kept, findings, repeated
+
+
+def drop_near_copies(
+    contours: Sequence[Contour], nest: Nesting
+) -> tuple[list[Contour], list[Finding], Nesting]:
+    """``contours`` without the closed ones that run within ``NEAR_MM`` of an earlier one.
+
+    An outline drawn twice a few µm off (a copy moved by a snap, an export of the same shape
+    rounded two ways, a circle over its polygon) is not a :func:`drop_copies` copy, yet
+    planned as drawn the two cross or nest, and everything inside lies two outlines deep:
+    a hole taken for an island and cut on its outside. ``nest.near`` (the pairs
+    :func:`~camtool.toolpath.order.nesting` found within
+    :data:`~camtool.toolpath.order.NEAR_MM` all along) names them; of each pair the one of
+    more segments (a circle's polygon), or the later of as many, is left out, said in a
+    ``copy`` finding, and the nesting follows.
+
+    Returns:
+        The contours kept, in their order; a finding per one left out; their nesting.
+    """
+    from camtool.model.units import fmt_num, fmt_point
+
+    dropped: dict[int, tuple[int, float]] = {}
+    for i, j, gap in nest.near:
+        if i not in dropped and j not in dropped:
+            if len(contours[j].segments) < len(contours[i].segments):
+                i, j = j, i
+            dropped[j] = (i, gap)
+    if not dropped:
+        return list(contours), [], nest
+    findings = []
+    for j in sorted(dropped):
+        i, gap = dropped[j]
+        copy = contours[j]
+        findings.append(
+            Finding(
+                "copy",
+                f"contour {copy.source} at {fmt_point(copy.start)} mm runs within "
+                f"{fmt_num(gap)} mm of contour {contours[i].source} all along (the outline "
+                "drawn twice, a little off): cut once",
+                copy.start,
+            )
+        )
+    kept = [c for k, c in enumerate(contours) if k not in dropped]
+    return kept, findings, nest.without(set(dropped))
 
 
 def one_way(

@@ -28,14 +28,50 @@ class Nesting:
 
     ``parents[i]`` lists the indices of the closed contours that contain contour
     ``i``; ``depth(i)`` is their count (0 = outermost). Even depth is an outer
-    boundary of material, odd depth a hole (even-odd rule).
+    boundary of material, odd depth a hole (even-odd rule). ``near`` lists the closed
+    contours ``(i, j, gap)``, ``i < j``, whose outlines lie within :data:`NEAR_MM` of each
+    other all along (their Hausdorff distance ``gap``, mm): one outline drawn twice a little
+    off (:func:`~camtool.toolpath.copies.drop_near_copies`).
     """
 
     parents: tuple[tuple[int, ...], ...]
+    near: tuple[tuple[int, int, float], ...] = ()
 
     def depth(self, index: int) -> int:
         """Number of closed contours around contour ``index``."""
         return len(self.parents[index])
+
+    def without(self, left_out: set[int]) -> Nesting:
+        """The nesting of the contours but ``left_out``, indexed as they are kept.
+
+        Containment is decided pair by pair, so this is what :func:`nesting` finds for the
+        contours kept.
+        """
+        index: dict[int, int] = {}
+        for i in range(len(self.parents)):
+            if i not in left_out:
+                index[i] = len(index)
+        parents = tuple(
+            tuple(index[p] for p in ps if p not in left_out)
+            for i, ps in enumerate(self.parents)
+            if i not in left_out
+        )
+        near = tuple(
+            (index[i], index[j], gap)
+            for i, j, gap in self.near
+            if i not in left_out and j not in left_out
+        )
+        return Nesting(parents, near)
+
+
+_NEAR_SAMPLE_MM = 0.5
+"""The longest segment of the outlines :func:`_near` measures, mm."""
+
+NEAR_MM = 0.01
+"""How close a closed contour may run to another all along and be that outline drawn
+again a little off, mm: 10 µm, the default ``--chain-tolerance``, a wall no tool cuts.
+Fixed, not the chaining distance: ``--chain-tolerance 0.5`` would make a thin ring one
+outline."""
 
 
 def nesting(contours: Sequence[Contour]) -> Nesting:
@@ -94,7 +130,47 @@ def nesting(contours: Sequence[Contour]) -> Nesting:
     parents: list[list[int]] = [[] for _ in contours]
     for i, j in zip(which[order].tolist(), parent[order].tolist(), strict=True):
         parents[i].append(j)
-    return Nesting(tuple(tuple(p) for p in parents))
+    return Nesting(tuple(tuple(p) for p in parents), _near(outlines, closed))
+
+
+def _near(outlines: Any, closed: list[int]) -> tuple[tuple[int, int, float], ...]:
+    """The closed contours whose outlines lie within :data:`NEAR_MM` all along (Nesting.near).
+
+    Pairs whose boxes differ by at most :data:`NEAR_MM` on every side are measured:
+    shapely's discrete Hausdorff distance of their vertices (each one's distance to the
+    other outline; a lower bound), then for those within :data:`NEAR_MM` with their
+    segments cut to :data:`_NEAR_SAMPLE_MM` at most (arcs are already chords within
+    :data:`_NEST_TOLERANCE_MM`).
+    """
+    import numpy as np
+    import shapely
+
+    rings = outlines[closed]
+    bounds = shapely.bounds(rings)
+    # sorted by xmin, the contours after each one whose xmin is within NEAR_MM of its own
+    by_x = np.argsort(bounds[:, 0], kind="stable")
+    xs = bounds[by_x, 0]
+    rank = np.arange(len(xs))
+    after = np.searchsorted(xs, xs + NEAR_MM, side="right") - rank - 1  # how many follow
+    first = np.repeat(rank, after)
+    step = np.arange(len(first)) - np.repeat(np.cumsum(after) - after, after)  # 0, 1, ...
+    second = first + 1 + step
+    a, b = np.minimum(by_x[first], by_x[second]), np.maximum(by_x[first], by_x[second])
+    pick = np.abs(bounds[a] - bounds[b]).max(axis=1) <= NEAR_MM
+    a, b = a[pick], b[pick]
+    within = shapely.hausdorff_distance(rings[a], rings[b]) <= NEAR_MM
+    a, b = a[within], b[within]
+    if not len(a):
+        return ()
+    gaps = shapely.hausdorff_distance(
+        shapely.segmentize(rings[a], _NEAR_SAMPLE_MM), shapely.segmentize(rings[b], _NEAR_SAMPLE_MM)
+    )
+    ids = np.asarray(closed, dtype=np.int64)
+    found = np.flatnonzero(gaps <= NEAR_MM)
+    return tuple(
+        (int(ids[a[k]]), int(ids[b[k]]), float(gaps[k]))
+        for k in found[np.lexsort((b[found], a[found]))]
+    )
 
 
 def _outline_coords(contours: Sequence[Contour], tolerance: float) -> tuple[Any, Any]:
@@ -221,7 +297,9 @@ def _nesting_one_by_one(contours: Sequence[Contour]) -> Nesting:
     for i, outline in enumerate(outlines):
         around = (closed[k] for k in tree.query(outline, predicate="covered_by"))
         parents.append(tuple(sorted(j for j in around if areas[j] > areas.get(i, 0.0))))
-    return Nesting(tuple(parents))
+    import numpy as np
+
+    return Nesting(tuple(parents), _near(np.array(outlines, dtype=object), closed))
 
 
 MAX_SEARCH_CUTS = 5000

@@ -22,7 +22,7 @@ from camtool.model.program import Move, Program, Rapid
 from camtool.model.progress import Progress, no_progress
 from camtool.model.shapes import BBox, Contour, Drawing, Line, Point, Segment, fit_factor
 from camtool.toolpath.chain import close_gaps
-from camtool.toolpath.copies import drop_copies, one_way
+from camtool.toolpath.copies import drop_copies, drop_near_copies, one_way
 from camtool.toolpath.cuts import Cut, Finding, Stage, finding_warnings
 from camtool.toolpath.gaps import open_gaps
 from camtool.toolpath.leads import KeepOff
@@ -220,11 +220,12 @@ def plan_unplaced(
     contours, copied, earlier = drop_copies(contours, cut_before=cut_before)
     left_out |= {i for j in earlier for i in members[j]}  # cut by an earlier operation
     paths = tuple(contours)
-    findings = [*options.ineffective(), *found, *copied, *open_gaps(contours, options)]
+    gaps = open_gaps(contours, options)
     stats = None
     if options.fit_arcs:
         contours, stats = fit_dense(contours, options.tolerance)
-    nest = nesting(contours)
+    contours, near, nest = drop_near_copies(contours, nesting(contours))
+    findings = [*options.ineffective(), *found, *copied, *near, *gaps]
     stage = _stage(contours, nest, options, progress)
     findings.extend(stage.findings)
     backlash = (0.0, 0.0) if machine is None else _backlash_weights(machine)

@@ -76,11 +76,12 @@ def test_stacked_dxf_shapes_are_cut_once_whatever_their_start_and_direction(
     assert sum("repeats" in w for w in job.warnings) == 2
 
 
-@pytest.mark.parametrize("shift", [0.0, 0.01])
+@pytest.mark.parametrize("shift", [0.0, 0.02])
 def test_only_a_contour_on_the_same_path_is_a_copy(shift: float) -> None:
     # A square sharing one edge with the first is not a copy of it; a circle and a half
-    # circle on the same centre are not copies either. A square 0.01 mm off is not one
-    # even when --tolerance allows more (it is the arc fit's tolerance, not the drawing's).
+    # circle on the same centre are not copies either. A square 0.02 mm off is not one
+    # even when --tolerance allows more (it is the arc fit's tolerance, not the drawing's),
+    # nor is it within the 0.01 mm of an outline drawn twice a little off.
     square, near, beside = rect(0, 0, 10, 10), rect(shift, 0, 10 + shift, 10), rect(10, 0, 20, 10)
     half = Contour((make_arc((35, 5), (25, 5), (30, 5), False),), False)
     job = post_drawing(
@@ -232,16 +233,84 @@ def test_lines_joined_only_where_every_vertex_is_on_the_line(bow: float) -> None
     """A bottom edge of 40 short lines bowed ``bow`` mm at its middle, against a straight one.
 
     Each vertex is within 1 µm of the line through its neighbours' ends (the bend at each
-    is tiny), but not of the edge: they are two paths, both cut.
+    is tiny), but not of the edge: they are not copies. (Bowed 2 µm, the planner then
+    cuts them once as an outline drawn twice a little off: the test after the next.)
     """
+    from camtool.toolpath.copies import drop_copies
+
     n = 40
     points = [(40.0 * k / n, bow * math.sin(math.pi * k / n)) for k in range(n + 1)]
     bowed = [Line(points[k], points[k + 1]) for k in range(n)]
     bowed += [Line((40, 0), (40, 30)), Line((40, 30), (0, 30)), Line((0, 30), (0, 0))]
+    kept, found, _ = drop_copies([rect(0, 0, 40, 30), Contour(tuple(bowed), True)])
+    assert len(kept) == 2 and not found
+
+
+def _square_twice_and_a_hole(tmp_path: Path, off: float) -> Path:
+    """A 40 mm square, the same square ``off`` mm up and right, a 10 mm hole inside both."""
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    msp.add_lwpolyline([(0, 0), (40, 0), (40, 40), (0, 40)], close=True)
+    corners = [(0, 0), (40, 0), (40, 40), (0, 40)]
+    msp.add_lwpolyline([(x + off, y + off) for x, y in corners], close=True)
+    msp.add_circle((20, 20), 5)
+    path = tmp_path / "near.dxf"
+    doc.saveas(path)
+    return path
+
+
+def test_an_outline_drawn_twice_a_little_off_is_cut_once_and_its_hole_stays_a_hole(
+    tmp_path: Path,
+) -> None:
+    """Two squares 5 µm apart cross each other: were both cut, the circle would lie two
+    outlines deep and the outside profile would cut round it, a 10 mm hole 13 mm wide.
+    Expected from the drawing: the hole on radius 5 - 1.5 mm, one square (corners 1.5)."""
+    options = PlanOptions(depth=3.0, offset="outside", tool_diameter=3.0)
     job = post_drawing(
-        Drawing((rect(0, 0, 40, 30), Contour(tuple(bowed), True))),
-        load_target("linuxcnc"),
-        PlanOptions(depth=1.0),
+        read_drawing(_square_twice_and_a_hole(tmp_path, 0.005)), load_target("linuxcnc"), options
     )
-    plunges = [m for m in job.program.moves if isinstance(m, Linear) and m.z == -1.0]
+    plunges = [m for m in job.program.moves if isinstance(m, Linear) and m.z == -3.0]
     assert len(plunges) == 2
+    assert _arc_radii(job) == [1.5] * 4 + [3.5] * 2
+    said = [w for w in job.warnings if "all along" in w]
+    assert len(said) == 1 and "runs within 0.0071 mm of contour LWPOLYLINE" in said[0]
+
+
+def test_outlines_further_apart_than_10_um_are_both_cut(tmp_path: Path) -> None:
+    """15 µm apart (21 µm at the corners) they are two outlines, as drawn; the nesting then
+    says the tool cuts into the part, as before."""
+    options = PlanOptions(depth=3.0, offset="outside", tool_diameter=3.0)
+    job = post_drawing(
+        read_drawing(_square_twice_and_a_hole(tmp_path, 0.015)), load_target("linuxcnc"), options
+    )
+    plunges = [m for m in job.program.moves if isinstance(m, Linear) and m.z == -3.0]
+    assert len(plunges) == 3
+    assert not any("all along" in w for w in job.warnings)
+
+
+def test_a_circle_drawn_over_its_polygon_is_cut_once_as_the_circle() -> None:
+    """A 72-gon on a 5 mm circle lies within 5 (1 - cos 2.5°) = 4.8 µm of it: the circle,
+    of fewer segments, is kept, whichever was drawn first."""
+    ring = [
+        (30 + 5 * math.cos(k * math.pi / 36), 5 + 5 * math.sin(k * math.pi / 36)) for k in range(72)
+    ]
+    gon = Contour(tuple(Line(a, b) for a, b in itertools.pairwise([*ring, ring[0]])), True)
+    for drawn in [(gon, circle(30, 5, 5)), (circle(30, 5, 5), gon)]:
+        job = post_drawing(Drawing(drawn), load_target("linuxcnc"), PlanOptions(depth=1.0))
+        plunges = [m for m in job.program.moves if isinstance(m, Linear) and m.z == -1.0]
+        assert len(plunges) == 1
+        assert sum(isinstance(m, ArcMove) for m in job.program.moves) >= 1
+        assert not any(isinstance(m, Linear) and m.z is None for m in job.program.moves)
+
+
+def test_the_nesting_without_a_contour_is_the_nesting_of_the_others() -> None:
+    from camtool.toolpath.order import nesting
+
+    contours = [rect(0, 0, 40, 40), rect(0.005, 0.005, 40.005, 40.005), circle(20, 20, 5)]
+    contours.append(rect(18, 18, 22, 22))
+    whole = nesting(contours)
+    assert whole.near[0][:2] == (0, 1) and whole.near[0][2] == pytest.approx(0.005 * 2**0.5)
+    for left in range(4):
+        kept = [c for k, c in enumerate(contours) if k != left]
+        assert whole.without({left}).parents == nesting(kept).parents
