@@ -207,7 +207,13 @@ def per_tool(program: Program, target: Target, fmt: str | None) -> tuple[ToolPro
             f"program {k + 1} of {len(changes)}: {load}{after if k else ''}",
             *stop,
         )
-        sideways = k > 0 and moves and moves[0].z is None and (moves[0].x, moves[0].y) != here
+        sideways = (
+            k > 0
+            and target.machine.has_z
+            and moves
+            and moves[0].z is None
+            and (moves[0].x, moves[0].y) != here
+        )
         warned = (sideways_first(k + 1, change, target.name),) if sideways else ()
         alone = Program(
             moves,

@@ -299,6 +299,9 @@ def test_a_program_per_tool_that_moves_sideways_first_is_warned_of(tmp_path: Pat
     ]
     code = str(done.pieces[1].result.code).splitlines()
     assert code[code.index("M3 S8000") + 1] == "G0 X20.000 Y0.000"  # as the input gives it
+    # a machine without Z (the router's pen is set by hand) has no such height to warn of
+    router = post_program(read_gcode(source), load_target("matlab-router"))
+    assert len(router.pieces) == 2 and not any("before any Z" in w for w in router.warnings)
 
 
 PCB2GCODE_DRILL = """( pcb2gcode 2.5.0 )
