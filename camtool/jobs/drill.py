@@ -18,6 +18,7 @@ from camtool.model.drilling import expand
 from camtool.model.errors import InputError
 from camtool.model.program import Command, DrillCycle, Dwell, Move, Rapid
 from camtool.model.shapes import Drawing, Point, circle_of
+from camtool.toolpath.copies import one_way
 from camtool.toolpath.options import PlanOptions
 
 
@@ -83,10 +84,12 @@ def _holes(drawing: Drawing, op: Operation, tool: Tool, joint_mm: float, where: 
     """The centres of the holes a drill operation drills, each checked against its drill.
 
     The contours are chained first, ``joint_mm`` apart at most, as the planner chains
-    them: a circle drawn as two ARCs is one hole.
+    them: a circle drawn as two ARCs is one hole, and so is a circle drawn twice (two
+    copies of an ARC a hair short of 360° chain into a path out and back,
+    :func:`~camtool.toolpath.copies.one_way`).
     """
     out: list[Point] = []
-    for contour in chain(drawing.contours, joint_mm):
+    for contour in one_way(chain(drawing.contours, joint_mm), joint_mm)[0]:
         circle = circle_of(contour)
         name = f"{contour.source or 'contour'} on layer {contour.layer!r}"
         if circle is None:

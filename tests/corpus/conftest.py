@@ -54,6 +54,10 @@ CLIPPED = (
     "whose region camtool cannot work out",
     "which camtool cannot read as a clip",
 )
+# A DXF with no entity in model space (LibreCAD's library keeps a few: templates/empty.dxf,
+# elektro/audio/s1.dxf and speak2.dxf) is refused with exit 3 and one of these: there is no
+# drawing to read, and no option helps (camtool/importers/dxf.py).
+EMPTY = ("the drawing is empty (no entity in model space)", "with nothing left in model space")
 FETCH_HINT = "run `python tests/corpus/fetch_corpus.py` (make corpus) to fetch it"
 
 
@@ -280,8 +284,8 @@ def resolve(rel: str, target: str) -> Outcome:
         if run.rc == 3 and NOTHING_TO_CUT in run.error:
             outcome.status = "refused"  # text or images only: no option can help
             break
-        if run.rc == 3 and any(text in run.error for text in CLIPPED):
-            outcome.status = "refused"  # what it shows is not what it holds
+        if run.rc == 3 and any(text in run.error for text in (*CLIPPED, *EMPTY)):
+            outcome.status = "refused"  # what it shows is not what it holds, or nothing
             break
         remedy = _follow(src, target, outdir, extra, run, outcome)
         if remedy is None:

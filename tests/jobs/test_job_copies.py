@@ -220,3 +220,26 @@ def test_no_tool_change_for_an_operation_left_with_nothing(tmp_path: Path) -> No
     changes = [c.tool for _, c in post.program.commands if isinstance(c, ToolChange)]
     assert changes == [1, 2]
     assert post.operations[2].moves[0] == post.operations[2].moves[1]
+
+
+def test_a_hole_drawn_twice_as_an_arc_short_of_360_is_drilled_once(tmp_path: Path) -> None:
+    """LibreCAD's kinetics/kin47.dxf draws its 5 mm holes as two copies of an ARC from 270°
+    to 269.99999427°: chained end to end (the second reversed) they are a path out and
+    back, no circle, and the drill operation that ``job init`` proposed for them refused
+    it. Expected from the drawing: one hole at the ARC's centre."""
+    import ezdxf
+
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4
+    for _ in range(2):
+        doc.modelspace().add_arc((5, 10), 2.5, 270.0, 269.99999427)
+    path = tmp_path / "arcs.dxf"
+    doc.saveas(path)
+    job = tmp_path / "drill.toml"
+    job.write_text(
+        '[[tools]]\nid = 1\ntype = "drill"\ndiameter = 5\n'
+        '[[operations]]\ntype = "drill"\ntool = 1\nlayers = ["0"]\ndepth = 3\n'
+    )
+    done = run_job(read_drawing(path), load_target("linuxcnc"), load_job(job))
+    holes = [(m.x, m.y) for m in done.program.moves if m.z == -3.0]
+    assert holes == [(5.0, 10.0)]
