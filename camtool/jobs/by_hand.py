@@ -51,7 +51,12 @@ class ToolProgram:
     @property
     def tool(self) -> str:
         """The tool it cuts with, in words: ``"T2"``, or the tool loaded at the start."""
-        return "the tool loaded at the start" if self.change is None else f"T{self.change.tool}"
+        return _tool(self.change)
+
+
+def _tool(change: ToolChange | None) -> str:
+    """:attr:`ToolProgram.tool` of a program that starts with ``change``."""
+    return "the tool loaded at the start" if change is None else f"T{change.tool}"
 
 
 def loaded_by_hand(program: Program, target: Target) -> Program:
@@ -131,9 +136,8 @@ def sideways_first(number: int, change: ToolChange | None, name: str) -> str:
     Its Z zero was just set for the new tool, on the stock's top: a re-posted program
     moves as the input gives it (it expected the tool change to leave the tool up).
     """
-    tool = "the tool loaded at the start" if change is None else f"T{change.tool}"
     return (
-        f"{name} program {number} ({tool}) moves X/Y before any Z move: that move runs at "
+        f"{name} program {number} ({_tool(change)}) moves X/Y before any Z move: that move runs at "
         "the height where Z zero was set for the tool, on the stock's top; add a move up to "
         "a safe height after the tool change in the input"
     )
@@ -195,18 +199,13 @@ def per_tool(program: Program, target: Target, fmt: str | None) -> tuple[ToolPro
     here = program.origin
     for k, (_, change) in enumerate(changes):
         moves = program.moves[bounds[k] : bounds[k + 1]]
-        before = changes[k - 1][1] if k else None
-        after = f", after the {'start' if before is None else f'T{before.tool}'} program"
         if change is None:
             load = "with the tool loaded at the start (the program names none)"
         else:
             load = f"load T{change.tool}" + (f" {change.description}" if change.description else "")
+        after = f", after program {k} ({_tool(changes[k - 1][1])})" if k else ""
         stop = [OWN_STOP] if change is not None and id(change) in stopped else []
-        notes = (
-            *program.notes,
-            f"program {k + 1} of {len(changes)}: {load}{after if k else ''}",
-            *stop,
-        )
+        notes = (*program.notes, f"program {k + 1} of {len(changes)}: {load}{after}", *stop)
         sideways = (
             k > 0
             and target.machine.has_z

@@ -61,7 +61,7 @@ def test_a_job_for_a_machine_without_a_changer_is_one_program_per_tool() -> None
     assert [p.change.tool for p in done.pieces] == [2, 1]
     assert done.pieces[0].path("out/part.ngc") == "out/part.T2.ngc"
     assert done.pieces[1].program.notes[-1] == (
-        "program 2 of 2: load T1 end-mill 3 mm, after the T2 program"
+        "program 2 of 2: load T1 end-mill 3 mm, after program 1 (T2)"
     )
     # together the pieces are the job's moves, in order
     moves = [m for p in done.pieces for m in p.program.moves]
