@@ -441,8 +441,8 @@ def _pieces_kept(
     The profile names the target whose ``MOTION`` an unqualified piece name is looked
     up in (:func:`camtool.verify.motion.library`). A machine file that renames it (a
     user naming their machine ``profile = "shapeoko"``) keeps the pieces the base named
-    from its target's ``MOTION`` and did not set itself: they are qualified with the base's
-    target (``chords = "grbl"`` becomes ``"grbl:grbl"``). A name of the generic library
+    from its built-in target's ``MOTION`` and did not set itself: they are qualified with
+    that target (``chords = "grbl"`` becomes ``"grbl:grbl"``). A name of the generic library
     stays as it is (no built-in target gives a piece a generic name; a test keeps it so).
     """
     old, new = base.get("profile"), override.get("profile")

@@ -102,7 +102,7 @@ def drop_copies(
 def drop_near_copies(
     contours: Sequence[Contour], nest: Nesting
 ) -> tuple[list[Contour], list[Finding], Nesting]:
-    """``contours`` without the closed ones that run within ``NEAR_MM`` of an earlier one.
+    """``contours`` without one of each pair of closed contours within 10 µm all along.
 
     An outline drawn twice a few µm off (a copy moved by a snap, an export of the same shape
     rounded two ways, a circle over its polygon) is not a :func:`drop_copies` copy, yet
