@@ -136,7 +136,8 @@ def nesting(contours: Sequence[Contour]) -> Nesting:
 def _near(outlines: Any, closed: list[int]) -> tuple[tuple[int, int, float], ...]:
     """The closed contours whose outlines lie within :data:`NEAR_MM` all along (Nesting.near).
 
-    Pairs whose boxes differ by at most :data:`NEAR_MM` on every side are measured:
+    Pairs whose boxes differ by at most :data:`NEAR_MM` on every side
+    (:func:`_same_boxes`) are measured:
     shapely's discrete Hausdorff distance of their vertices (each one's distance to the
     other outline; a lower bound), then for those within :data:`NEAR_MM` with their
     segments cut to :data:`_NEAR_SAMPLE_MM` at most (arcs are already chords within
@@ -146,18 +147,7 @@ def _near(outlines: Any, closed: list[int]) -> tuple[tuple[int, int, float], ...
     import shapely
 
     rings = outlines[closed]
-    bounds = shapely.bounds(rings)
-    # sorted by xmin, the contours after each one whose xmin is within NEAR_MM of its own
-    by_x = np.argsort(bounds[:, 0], kind="stable")
-    xs = bounds[by_x, 0]
-    rank = np.arange(len(xs))
-    after = np.searchsorted(xs, xs + NEAR_MM, side="right") - rank - 1  # how many follow
-    first = np.repeat(rank, after)
-    step = np.arange(len(first)) - np.repeat(np.cumsum(after) - after, after)  # 0, 1, ...
-    second = first + 1 + step
-    a, b = np.minimum(by_x[first], by_x[second]), np.maximum(by_x[first], by_x[second])
-    pick = np.abs(bounds[a] - bounds[b]).max(axis=1) <= NEAR_MM
-    a, b = a[pick], b[pick]
+    a, b = _same_boxes(shapely.bounds(rings), NEAR_MM)
     within = shapely.hausdorff_distance(rings[a], rings[b]) <= NEAR_MM
     a, b = a[within], b[within]
     if not len(a):
@@ -282,6 +272,38 @@ def _chord_counts(radius: Any, sweep: Any, tolerance: float) -> Any:
         len(odd),
     )
     return n
+
+
+def _same_boxes(bounds: Any, near: float) -> tuple[Any, Any]:
+    """The pairs ``(a, b)`` (int64 arrays, ``a < b``) of rows of ``bounds`` within ``near``.
+
+    ``bounds`` is ``(n, 4)``: boxes ``(xmin, ymin, xmax, ymax)``, mm. The boxes are put in
+    cells ``2·near`` wide on each side, once for each of the 16 ways of shifting the cells
+    by ``near`` or not on each side: two values within ``near`` share a cell in one of the
+    two shifts of their side, so two boxes within ``near`` share their four cells in one of
+    the 16. Only boxes that share cells are compared, so boxes lined up on one edge (a
+    thousand parts at X0) cost no more than boxes apart.
+    """
+    import itertools
+
+    import numpy as np
+
+    found: set[tuple[int, int]] = set()
+    for shift in itertools.product((0.0, near), repeat=4):
+        cells = np.floor((bounds + np.asarray(shift)) / (2.0 * near)).astype(np.int64)
+        order = np.lexsort(cells.T[::-1])
+        ordered = cells[order]
+        new = np.r_[True, (ordered[1:] != ordered[:-1]).any(axis=1)]
+        starts = np.flatnonzero(new)
+        sizes = np.diff(np.r_[starts, len(order)])
+        shared = sizes > 1
+        for start, size in zip(starts[shared].tolist(), sizes[shared].tolist(), strict=True):
+            group = sorted(order[start : start + size].tolist())
+            found.update(itertools.combinations(group, 2))
+    pairs = np.array(sorted(found), dtype=np.int64).reshape(-1, 2)
+    a, b = pairs[:, 0], pairs[:, 1]
+    keep = np.abs(bounds[a] - bounds[b]).max(axis=1) <= near if len(a) else np.zeros(0, bool)
+    return a[keep], b[keep]
 
 
 def _nesting_one_by_one(contours: Sequence[Contour]) -> Nesting:

@@ -644,3 +644,22 @@ def test_chord_counts_refuse_as_chord_count() -> None:
         _chord_counts(np.array([1.0, 1e9]), np.array([1.0, 6.0]), 1e-6)
     with pytest.raises(GeometryError, match="must be finite"):
         _chord_counts(np.array([1.0, math.nan]), np.array([1.0, 1.0]), 1e-3)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_boxes_within_the_near_distance_are_every_such_pair(seed: int) -> None:
+    """The near-copy search's candidates are exactly the pairs of boxes within 10 µm on all
+    four sides (by comparing every pair), boxes packed 50 µm wide so that many are."""
+    from camtool.toolpath.order import _same_boxes
+
+    rng = np.random.default_rng(seed)
+    boxes = rng.uniform(0.0, 0.05, (300, 4))
+    boxes[:100, 0] = 0.0  # a hundred lined up on one edge
+    a, b = _same_boxes(boxes, 0.01)
+    every = {
+        (i, j)
+        for i in range(len(boxes))
+        for j in range(i + 1, len(boxes))
+        if np.abs(boxes[i] - boxes[j]).max() <= 0.01
+    }
+    assert set(zip(a.tolist(), b.tolist(), strict=True)) == every and len(every) > 100
