@@ -12,7 +12,6 @@ import dataclasses
 import math
 from collections.abc import Iterator
 from itertools import islice
-from typing import TYPE_CHECKING
 
 from camtool.accel import conformahead, splitwrite
 from camtool.model.errors import DialectError
@@ -52,12 +51,13 @@ from camtool.post.wordaddress_spec import PLANE_CODES
 from camtool.post.wordaddress_summary import closing_warnings
 from camtool.post.wordaddress_words import SAME_MM
 
-if TYPE_CHECKING:
-    pass
-
-
 _MOVES = (Rapid, Linear, ArcMove)
 """The kinds of move (a tuple: ``isinstance`` takes it faster than ``Rapid | Linear | ...``)."""
+
+FEED_NOISE = 1e-6
+"""A written feed this far from the asked one (relative) is the same feed: an inch program's
+``F19.68504`` is 500.000016 mm/min, written ``F500`` without a warning. A feed the dialect
+rounds further (``F99.6`` as ``F100``) is warned of."""
 
 
 class BlockWriter(ArcWriter):
@@ -304,7 +304,7 @@ class BlockWriter(ArcWriter):
             return
         text = self._above_zero("F", move.feed_mm_min, "feed", "mm/min", "")
         written = spec.number.parse(text)
-        if abs(written - move.feed_mm_min) > 1e-9 * max(1.0, move.feed_mm_min):
+        if abs(written - move.feed_mm_min) > FEED_NOISE * max(1.0, move.feed_mm_min):
             msg = f"feed {move.feed_mm_min:g} mm/min written as F{text} ({written:g} mm/min)"
             self.warn(msg)
         self._feed_text = (move.feed_mm_min, text)

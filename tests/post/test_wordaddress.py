@@ -277,6 +277,14 @@ def test_feed_rounding_is_warned_once() -> None:
     assert warnings == ("feed 99.6 mm/min written as F100 (100 mm/min)",)
 
 
+def test_feed_from_inches_is_not_warned_of() -> None:
+    # F19.68504 in/min (a pcb2gcode inch program's 500 mm/min) is 500.000016 mm/min.
+    options = {"words": {"XY": {}, "F": {"decimals": 0}}}
+    lines, warnings = emit(options, (Rapid(0, 0), Linear(1, 0, 19.68504 * 25.4)))
+    assert lines[1] == "G1 X1.000 Y0.000 F500"
+    assert warnings == ()
+
+
 def test_feed_that_rounds_to_zero_is_an_error() -> None:
     with pytest.raises(DialectError, match=r"block 2: feed 0.4 mm/min rounds to F0"):
         emit({"words": {"XY": {}, "F": {"decimals": 0}}}, (Rapid(0, 0), Linear(1, 0, 0.4)))
