@@ -430,7 +430,7 @@ class CommandReader:
         self.notes.add(
             "T",
             self.tool_line,
-            "tool number T ignored: no M6 after it changes to that tool",
+            f"tool number T{self.tool} ignored: no M6 after it changes to that tool",
         )
         self.tool_used = True
 

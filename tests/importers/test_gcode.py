@@ -361,7 +361,7 @@ def test_g80_alone_is_a_no_op() -> None:
         ("G15", "G15 (polar coordinates off) read as a no-op"),
         ("G69", "G69 (coordinate rotation off) read as a no-op"),
         ("G50.1", "G50.1 (mirror image off) read as a no-op"),
-        ("T2", "tool number T ignored"),
+        ("T2", "tool number T2 ignored"),
         ("/M5", "'/' block delete: the line is read"),
     ],
 )

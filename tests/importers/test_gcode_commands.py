@@ -92,7 +92,7 @@ def test_tool_selection_without_m6_and_m6_without_tool_warn() -> None:
     program = parse("G21 T4\nG0 X1 Y1\nT5\nM6\nT6\nG1 X2 F9\nM6\nT7\nM2\n")
     assert program.commands == ((1, ToolChange(5)), (2, ToolChange(6)))
     assert program.warnings == (
-        "t.ngc:1: tool number T ignored: no M6 after it changes to that tool (2 times)",
+        "t.ngc:1: tool number T4 ignored: no M6 after it changes to that tool (2 times)",
     )  # T4 (replaced by T5) and T7 (the program ends)
     lonely = parse("G21 M6\nG1 X1 Y1 F9\nM2\n")
     assert lonely.commands == ()
