@@ -247,6 +247,7 @@ def _parse(
                 if plain and raw.isascii() and reader.plain(plain_words(raw.upper()), number):
                     continue
                 block = lex_line(raw, number, source)
+                reader.commands.operator_message(len(reader.moves), raw)
                 if block is None:
                     if raw.lstrip().startswith("%"):
                         if opened:

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Literal
 
-from camtool.importers.gcode_lexer import Block, Word
+from camtool.importers.gcode_lexer import Block, Word, operator_message
 from camtool.model.errors import InputError
 from camtool.model.program import (
     Command,
@@ -361,6 +361,19 @@ class CommandReader:
         self.last_change: tuple[int, ToolChange] | None = None  # (before move, the change)
         self.tool_line = 0
         self.tool_used = True
+        self.message: tuple[int, str] | None = None  # (before move, text) of a (MSG, ...)
+
+    def operator_message(self, index: int, raw: str) -> None:
+        """Note line ``raw``'s ``(MSG, text)``, before move ``index``, if it has one.
+
+        LinuxCNC shows the text to the operator. It goes with a stop (M0, M1) that comes
+        before the next move (pcb2gcode's "Change tool bit to mill diameter 0.12000mm"
+        before its ``M0``): the stop's message. Any other is a comment, dropped as every
+        comment is.
+        """
+        said = operator_message(raw) if "(" in raw else None
+        if said is not None and (text := " ".join(said.split())):
+            self.message = (index, text)
 
     def add(self, index: int, command: Command) -> None:
         """Keep ``command`` to run before move ``index``."""
@@ -411,13 +424,15 @@ class CommandReader:
         """M0 (``optional``: M1) before move ``index``: a :class:`Stop`, never dropped.
 
         A tool selected (``T``) with no ``M6`` since is changed by hand at this stop (a
-        drill program's ``T02`` then ``M00``): the stop's message names it.
+        drill program's ``T02`` then ``M00``): the stop's message names it, then the
+        text of a ``(MSG, ...)`` since the last move (:meth:`operator_message`).
         """
-        message = ""
+        said = [self.message[1]] if self.message is not None and self.message[0] == index else []
+        self.message = None
         if not self.tool_used and self.tool is not None:
-            message = f"change to T{self.tool}"
+            said.insert(0, f"change to T{self.tool}")
             self.tool_used = True
-        self.add(index, Stop(optional, message))
+        self.add(index, Stop(optional, ": ".join(said)))
 
     def _select(self, value: float, text: str, line: int, where: str) -> None:
         if value < 0 or value != int(value):

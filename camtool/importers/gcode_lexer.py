@@ -88,6 +88,15 @@ def lex_line(raw: str, line: int, source: str) -> Block | None:
     return Block(line, tuple(words), block_delete)
 
 
+_MSG = re.compile(r"\(\s*MSG\s*,([^)]*)\)", re.IGNORECASE)
+
+
+def operator_message(raw: str) -> str | None:
+    """The text of LinuxCNC's message to the operator on line ``raw``: ``(MSG, text)``."""
+    found = _MSG.search(raw)
+    return None if found is None else found.group(1)
+
+
 def _strip_comments(raw: str, where: str) -> tuple[str, int | None]:
     """The line without comments, and the index in ``raw`` of a ``*`` outside them.
 

@@ -79,7 +79,7 @@ def loaded_by_hand(program: Program, target: Target) -> Program:
     what = f" ({change.description})" if change.description else ""
     said = f"load T{change.tool}{what} before running: {target.name} cannot change tools"
     commands, stopped = own_stops_dropped(program.commands)
-    stop = [OWN_STOP] if stopped else []
+    stop = [line for m in stopped.values() for line in own_stop_notes(m)]
     return dataclasses.replace(
         program,
         commands=tuple((i, c) for i, c in commands if c is not change),
@@ -104,8 +104,11 @@ def changed_before_cutting(program: Program) -> bool:
 
 def own_stops_dropped(
     commands: Sequence[tuple[int, Command]],
-) -> tuple[list[tuple[int, Command]], set[int]]:
-    """``commands`` without each tool change's own stop, and the ids of those changes.
+) -> tuple[list[tuple[int, Command]], dict[int, str]]:
+    """``commands`` without each tool change's own stop; those changes' ids and messages.
+
+    Each change's id maps to its own stop's message (``""``: none; :func:`own_stop_notes`
+    say it in a header).
 
     A change's own stop comes right after it, before any move (``M6`` then ``M0``, as
     pcb2gcode pauses for the new tool): where a program is cut at its changes (or its
@@ -114,7 +117,7 @@ def own_stops_dropped(
     is it (the machine stops there once, not twice).
     """
     out: list[tuple[int, Command]] = []
-    stopped: set[int] = set()
+    stopped: dict[int, str] = {}
     change: ToolChange | None = None
     at = -1
     for i, command in commands:
@@ -122,12 +125,17 @@ def own_stops_dropped(
             change, at = command, i
         elif isinstance(command, Stop) and change is not None and i == at:
             if id(change) not in stopped:
-                stopped.add(id(change))
+                stopped[id(change)] = command.message
                 continue
         else:
             change = None
         out.append((i, command))
     return out, stopped
+
+
+def own_stop_notes(message: str) -> list[str]:
+    """The header lines for a dropped own stop: :data:`OWN_STOP`, then what it said."""
+    return [OWN_STOP, f"its message: {message}"] if message else [OWN_STOP]
 
 
 def sideways_first(number: int, change: ToolChange | None, name: str) -> str:
@@ -204,7 +212,7 @@ def per_tool(program: Program, target: Target, fmt: str | None) -> tuple[ToolPro
         else:
             load = f"load T{change.tool}" + (f" {change.description}" if change.description else "")
         after = f", after program {k} ({_tool(changes[k - 1][1])})" if k else ""
-        stop = [OWN_STOP] if change is not None and id(change) in stopped else []
+        stop = own_stop_notes(stopped[id(change)]) if change and id(change) in stopped else []
         notes = (*program.notes, f"program {k + 1} of {len(changes)}: {load}{after}", *stop)
         sideways = (
             k > 0

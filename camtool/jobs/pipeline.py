@@ -401,9 +401,12 @@ def post_program(
             return PostJob(None, program, target, pieces[0].result, None, 0.0, pieces=pieces)
     program = loaded_by_hand(program, target)
     if target.post.tool_changes == "stop":  # the change is written as a stop: its own is that
-        program = dataclasses.replace(
-            program, commands=tuple(own_stops_dropped(program.commands)[0])
-        )
+        kept, stopped = own_stops_dropped(program.commands)
+        said = [  # what the own stop said (a (MSG, ...) before it) goes with the change
+            (i, _said_with(c, stopped.get(id(c), "")) if isinstance(c, ToolChange) else c)
+            for i, c in kept
+        ]
+        program = dataclasses.replace(program, commands=tuple(said))
     elif target.post.tool_changes == "code" and not target.post.stops:
         kept, stopped = own_stops_dropped(program.commands)
         if stopped:  # the machine changes the tool itself: nothing to pause for
@@ -550,6 +553,13 @@ def verify_job(
     # an operation left with nothing (each contour cut by an earlier one) has no code
     parts = tuple(verify_operation(job, r) for r in job.operations if r.moves[0] < r.moves[1])
     return dataclasses.replace(whole, parts=parts)
+
+
+def _said_with(change: ToolChange, message: str) -> ToolChange:
+    """``change`` saying ``message`` (its dropped own stop's) where it says nothing itself."""
+    if not message or change.description:
+        return change
+    return dataclasses.replace(change, description=message)
 
 
 def _without_changes(program: Program) -> Program:

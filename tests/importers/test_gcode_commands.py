@@ -9,7 +9,7 @@ import pytest
 from camtool.importers.gcode import parse_gcode, read_gcode
 from camtool.jobs.pipeline import post_program
 from camtool.model.errors import InputError
-from camtool.model.program import Dwell, Home, Linear, Program, Rapid, Spindle, ToolChange
+from camtool.model.program import Dwell, Home, Linear, Program, Rapid, Spindle, Stop, ToolChange
 from camtool.post.registry import load_target
 
 DATA = Path(__file__).parents[1] / "data"
@@ -86,6 +86,21 @@ def test_g28_is_a_home_command_on_the_axes_it_names() -> None:
     assert g28.startswith("t.ngc:2: G28 return to the machine's stored position: kept as")
     assert g28.endswith("(3 times)")
     assert g30.startswith("t.ngc:6: G30 return to the machine's stored position: kept as")
+
+
+def test_an_operator_message_goes_with_the_stop_after_it() -> None:
+    """LinuxCNC shows ``(MSG, ...)`` to the operator: pcb2gcode names the bit to load there,
+    before its ``M0``. The text is the stop's message (after the tool a ``T`` selected);
+    one with a move before the stop is a comment like any other."""
+    program = parse(
+        "G21 G0 X0 Y0 Z5\nT3\n(MSG, Change tool bit to mill  diameter 0.12000mm)\nM0\n"
+        "G1 X1 Y1 F100\n(msg,after the move)\nG1 X2 Y2\nM1\n(MSG,)\nM0\nM2\n"
+    )
+    assert [c for _, c in program.commands] == [
+        Stop(False, "change to T3: Change tool bit to mill diameter 0.12000mm"),
+        Stop(True, ""),
+        Stop(False, ""),
+    ]
 
 
 def test_tool_selection_without_m6_and_m6_without_tool_warn() -> None:

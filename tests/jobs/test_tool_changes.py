@@ -365,6 +365,11 @@ def test_a_pcb2gcode_drill_file_is_one_program_per_drill_for_a_machine_without_a
         "stop after this change is this program's start" in " ".join(p.program.notes)
         for p in job.pieces
     )
+    said = [[n for n in p.program.notes if n.startswith("its message")] for p in job.pieces]
+    assert said == [  # the (MSG, ...) before each change's M0, in its program's header
+        ["its message: Change tool bit to drill size 0.8mm"],
+        ["its message: Change tool bit to drill size 1.0mm"],
+    ]
 
 
 def test_a_stop_that_is_not_a_changes_own_stays_and_is_refused_where_it_cannot_be_written(
@@ -404,7 +409,10 @@ def test_a_pcb2gcode_change_and_its_own_stop_pause_grbl_once(tmp_path: Path) -> 
     target = _grbl_by_stop(tmp_path)
     lines = str(post_program(read_gcode(source), target).result.code).splitlines()
     stops = [i for i, line in enumerate(lines) if line == "M0"]
-    assert [lines[i - 1] for i in stops] == ["(change to T1)", "(change to T2)"]
+    assert [lines[i - 1] for i in stops] == [  # with the (MSG, ...) of the own stop
+        "(change to T1: Change tool bit to drill size 0.8mm)",
+        "(change to T2: Change tool bit to drill size 1.0mm)",
+    ]
 
 
 def test_pic_mmh_changes_pcb2gcodes_tools_itself_without_their_stops(tmp_path: Path) -> None:
