@@ -440,12 +440,15 @@ def _flatten(program: Program, target: str) -> Program:
         return program
     here = program.origin
     moves: list[Move] = []
+    lines: list[int] = []  # the input line of each kept move, for messages
     new_index = []  # old move index -> index in the flattened program
-    for move in program.moves:
+    for i, move in enumerate(program.moves):
         new_index.append(len(moves))
         if (move.x, move.y) == here and not hasattr(move, "cx"):
             continue  # a Z-only move
         moves.append(dataclasses.replace(move, z=None))
+        if program.lines:
+            lines.append(program.lines[i])
         here = (move.x, move.y)
     new_index.append(len(moves))
     commands = tuple((new_index[i], c) for i, c in program.commands)
@@ -458,7 +461,7 @@ def _flatten(program: Program, target: str) -> Program:
         program,
         moves=tuple(moves),
         warnings=(*program.warnings, warning),
-        lines=(),
+        lines=tuple(lines),
         commands=commands,
     )
 

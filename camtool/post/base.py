@@ -41,6 +41,7 @@ from camtool.toolpath.placement import (
     EPS_MM,
     check_travel,
     check_z_travel,
+    moved_remedy,
     outside_text,
     place_remedy,
     too_large,
@@ -53,7 +54,13 @@ if TYPE_CHECKING:
 
 
 def check_work_area(
-    start: Point, move: Move, machine: Machine, where: str, program: Program
+    start: Point,
+    move: Move,
+    machine: Machine,
+    where: str,
+    program: Program,
+    *,
+    reposted: bool = False,
 ) -> None:
     """Machine coordinates: refuse a move (an arc by its extremes) outside the work area.
 
@@ -66,6 +73,8 @@ def check_work_area(
         machine: the machine profile (``work_area_mm``, ``coordinates``).
         where: the contour and block for the message ("contour 3, block 12").
         program: the whole program, for the remedy (by how much to move it).
+        reposted: ``program`` is a re-posted one (G-code another program wrote), which
+            camtool does not move: the remedy is to move it where it was written.
 
     Raises:
         DialectError: the move reaches outside the work area, naming ``where``,
@@ -77,10 +86,11 @@ def check_work_area(
     if machine.outside_work_area(box, EPS_MM):
         whole = toolpath_extent(program) or box
         too_large(whole, machine, None)
+        extent = bbox_union([whole, box])
+        remedy = moved_remedy(extent, machine) if reposted else place_remedy(extent, machine, None)
         raise DialectError(
             f"{where}: reaches X {fmt_num(box[0])}…{fmt_num(box[2])}, Y {fmt_num(box[1])}…"
-            f"{fmt_num(box[3])} mm, {outside_text(machine)}; "
-            f"{place_remedy(bbox_union([whole, box]), machine, None)}"
+            f"{fmt_num(box[3])} mm, {outside_text(machine)}; {remedy}"
         )
 
 

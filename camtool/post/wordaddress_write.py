@@ -219,7 +219,10 @@ class BlockWriter(ArcWriter):
 
     def _check_area(self, start: Point, move: Move) -> None:
         if self.machine.coordinates != "work":  # in work coordinates any position runs
-            check_work_area(start, move, self.machine, self.where(), self.program)
+            program = self.program
+            check_work_area(
+                start, move, self.machine, self.where(), program, reposted=bool(program.lines)
+            )
 
     def _check_z(self, move: Move) -> None:
         if not self.spec.has("Z") or not self.machine.has_z:

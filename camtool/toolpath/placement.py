@@ -473,6 +473,20 @@ def place_remedy(box: BBox, machine: Machine, placing: Placing | None) -> str:
     return text
 
 
+def moved_remedy(box: BBox, machine: Machine) -> str:
+    """How to bring a re-posted program of extent ``box`` inside the area.
+
+    camtool does not move one (``--origin`` and ``--translate`` are for drawings): the
+    program that wrote it does, by the shift :func:`place_remedy` would give.
+    """
+    move = _inside_shift(box, machine)
+    by = f" by X{_num(move[0])} Y{_num(move[1])} mm" if move is not None else ""
+    return (
+        f"move the program{by} in the program that wrote it (its work zero), then post it "
+        "again: camtool re-posts a program where it is"
+    )
+
+
 def _inside_shift(box: BBox, machine: Machine) -> Point | None:
     """A shift that brings ``box`` inside the work area, or ``None`` if none prints exactly.
 

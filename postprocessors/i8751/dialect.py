@@ -398,7 +398,7 @@ class I8751Post(PostProcessor):
 
     def _move(self, w: _Writer, move: Move, machine: Machine, program: Program) -> None:
         start, w.contour = w.here, move.contour
-        check_work_area(start, move, machine, w.where(), program)
+        check_work_area(start, move, machine, w.where(), program, reposted=bool(program.lines))
         if move.z is not None and not machine.has_z:
             raise DialectError(f"{w.where()}: Z = {move.z:g} mm but {machine.name} has no Z")
         if isinstance(move, Rapid):

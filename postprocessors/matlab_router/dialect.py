@@ -26,6 +26,7 @@ from camtool.post.base import (
     check_placement,
     check_work_area,
     from_options,
+    input_line,
 )
 from camtool.post.numfmt import NumberFormat
 from camtool_postprocessors.matlab_router.arrays import (
@@ -543,15 +544,19 @@ def _matrix(name: str, arr: np.ndarray) -> list[str]:
 def _check_move(
     notes: RouterWriter, move: Move, index: int, machine: Machine, program: Program
 ) -> None:
-    """Z and work-area checks of one move from ``notes.here`` (``index`` 0-based)."""
-    where = notes.where(move.contour, index + 1)
+    """Z and work-area checks of one move from ``notes.here`` (``index`` 0-based).
+
+    A program read from code names the move's input line too (:func:`input_line`).
+    """
+    line = input_line(program, index, move=True)
+    where = notes.where(move.contour, index + 1) + (f" ({line})" if line else "")
     if move.z is not None:
         raise DialectError(
             f"{where}: matlab-router has no Z (the Matlab GUI is 2D; the Z slave only lowers "
             "the tool by a fixed 100 units at each job's start, Angel-11 §2.8 L6544); "
             "set the depth by hand"
         )
-    check_work_area(notes.here, move, machine, where, program)
+    check_work_area(notes.here, move, machine, where, program, reposted=bool(program.lines))
 
 
 def _chords(here: Point, move: ArcMove, tolerance: float, notes: RouterWriter) -> list[Point]:

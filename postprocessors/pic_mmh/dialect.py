@@ -376,7 +376,9 @@ class PicMmhPost(PostProcessor):
             w.source = input_line(program, index, move=True)
             start = w.here
             self._check_move(move, w, homed)
-            check_work_area(start, move, machine, w.where(move.contour), program)
+            check_work_area(
+                start, move, machine, w.where(move.contour), program, reposted=bool(program.lines)
+            )
             homed = homed and not isinstance(move, Rapid)
             self._move(start, move, machine, w, _tolerance(program, machine))
             w.here = (move.x, move.y)

@@ -391,6 +391,28 @@ def test_point_outside_the_work_area_names_contour_and_block() -> None:
         _emit((Rapid(150, 195), ArcMove(170, 195, 160, 195, True, FEED)))
 
 
+def test_a_reposted_program_outside_the_area_names_its_line_and_is_moved_where_it_was_written(
+    tmp_path: Path,
+) -> None:
+    """G-code from another program (its Z dropped: the router has none) reaching X -0.5:
+    the refusal names the input line, and the remedy is to move it where it was written
+    (``--origin`` and ``--translate`` are refused for G-code)."""
+    source = tmp_path / "cambam.nc"
+    source.write_text(
+        "G21 G90\nG0 Z3\nG0 X2 Y2\nG1 Z-1 F300\nG1 X10 Y2 F2000\nG1 X-0.5 Y5\nG0 Z3\nM30\n"
+    )
+    with pytest.raises(DialectError) as refused:
+        post_file(source, "matlab-router")
+    text = str(refused.value)
+    assert text.startswith(
+        "contour 1, block 3 (input line 6): reaches X -0.5000…10.0000, Y 2.0000…"
+    )
+    assert text.endswith(
+        "move the program by X0.5 Y0 mm in the program that wrote it (its work zero), then "
+        "post it again: camtool re-posts a program where it is"
+    )
+
+
 def test_a_segment_whose_minor_axis_speed_rounds_to_zero_is_cut_into_pieces() -> None:
     """§3: vely = 480/(1940/2) = 0.49 rounds to 0: the slave never reaches its count (§4.2).
 
