@@ -368,7 +368,7 @@ def check_extent(box: BBox | None, machine: Machine, placing: Placing | None) ->
     # work zero as drawn is worth a word; one the user placed (--origin, --translate) or
     # one another program chose (code read back, placing None) is what was asked for
     chosen = placing is None or placing.placement != "drawing" or placing.translate != (0.0, 0.0)
-    return _zero_warnings(box, machine, chosen=chosen)
+    return _zero_warnings(box, machine, chosen=chosen, planned=placing is not None)
 
 
 def larger_than_travel(box: BBox, machine: Machine) -> bool:
@@ -528,11 +528,15 @@ def _fit_remedy(machine: Machine, placing: Placing | None, w: float, h: float) -
     return text + " or "
 
 
-def _zero_warnings(box: BBox, machine: Machine, *, chosen: bool) -> tuple[str, ...]:
+def _zero_warnings(
+    box: BBox, machine: Machine, *, chosen: bool, planned: bool = True
+) -> tuple[str, ...]:
     """The work-coordinate warnings of :func:`check_travel` (one message).
 
     ``chosen``: the user placed work zero (``--origin center``, ``--translate``), so a
     toolpath on both sides of it is what was asked for: no warning for that.
+    ``planned``: the program was planned here, so ``--origin`` can move it (code read
+    back, another program's G-code above all, is moved where it was written).
     """
     across = [
         (axis, lo, hi)
@@ -553,7 +557,13 @@ def _zero_warnings(box: BBox, machine: Machine, *, chosen: bool) -> tuple[str, .
             f"the toolpath spans {axis} {_mm(lo)}…{_mm(hi)} mm, so work zero (X0 Y0) lies "
             f"{_mm(max(hi, 0.0) - min(lo, 0.0))} mm from its far side, more than the "
             f"{_mm(t)} mm {axis} travel of {machine.name}: work zero cannot be a point the "
-            "tool reaches; use --origin lower-left or set it with an offset",
+            "tool reaches; "
+            + (
+                "use --origin lower-left or set it with an offset"
+                if planned
+                else "set it with an offset from a point the tool reaches, or move the "
+                "program in the program that wrote it"
+            ),
         )
     if across and not chosen:
         spans = ", ".join(f"{axis} {_mm(lo)}…{_mm(hi)}" for axis, lo, hi in across)

@@ -91,6 +91,20 @@ def test_a_toolpath_across_work_zero_is_warned_about_once(
     assert "work zero" not in err
 
 
+def test_a_reposted_program_far_from_work_zero_is_not_told_to_use_origin(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """pcb2gcode's outline at X 116…253 mm: work zero lies 253 mm from its far side, more
+    than GRBL's 200 mm. ``--origin`` is refused for G-code, so the warning does not name it."""
+    source = tmp_path / "outline.ngc"
+    source.write_text("G21 G90\nG0 Z5\nG0 X116 Y10\nG1 Z-1 F100\nG1 X253 Y10\nG0 Z5\nM2\n")
+    code, err = post([str(source), "-t", "grbl", "-o", str(tmp_path / "out.gcode")], capsys)
+    assert code == 0
+    assert "work zero (X0 Y0) lies 253 mm from its far side, more than the 200 mm X" in err
+    assert "set it with an offset from a point the tool reaches, or move the program" in err
+    assert "--origin" not in err
+
+
 def test_the_start_position_and_the_lift_there_stay(tmp_path: Path) -> None:
     out = tmp_path / "p.gcode"
     args = [str(plate(tmp_path / "p.dxf")), "-t", "grbl", *OUTSIDE, "--depth", "1"]
