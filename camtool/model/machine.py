@@ -394,9 +394,13 @@ class _Reader:
         span = RANGES.get(key)
         if span is not None and number != 0 and not span[0] <= abs(number) <= span[1]:
             low, high, unit = span
-            raise self._fail(
-                key, f"between {low:g} and {high:g} {unit} (a physical machine)", value
-            )
+            if positive or nonnegative:
+                want = f"between {low:g} and {high:g} {unit}"
+            elif low == 0:  # a signed number (work_area_mm): its size is bounded
+                want = f"from -{high:g} to {high:g} {unit}"
+            else:
+                want = f"of magnitude {low:g} to {high:g} {unit}"
+            raise self._fail(key, f"{want} (a physical machine)", value)
         return number
 
     def floats(

@@ -186,7 +186,9 @@ def input_line(program: Program, index: int, *, move: bool) -> str:
     return "" if line is None else f"{where} {line}"
 
 
-def check_placement(program: Program, machine: Machine) -> tuple[str, ...]:
+def check_placement(
+    program: Program, machine: Machine, *, reposted: bool = False
+) -> tuple[str, ...]:
     """The work-coordinate rule for a program about to be written (or verified).
 
     The toolpath must be no larger than the machine's travel; where its work zero
@@ -197,12 +199,13 @@ def check_placement(program: Program, machine: Machine) -> tuple[str, ...]:
 
     Its Z must span no more than the machine's Z travel, when the profile gives it
     (:func:`~camtool.toolpath.placement.check_z_travel`), in either coordinates.
+    ``reposted``: a writer's re-posted G-code (remedies name the program that wrote it).
 
     Raises:
         DialectError: the toolpath is larger than the travel (both sizes named), or its
             Z spans more than the Z travel.
     """
-    check_z_travel(program, machine)
+    check_z_travel(program, machine, reposted=reposted)
     if machine.coordinates == "machine":
         return ()
     return check_travel(program, machine)
@@ -243,6 +246,12 @@ FAR_FROM_ZERO = (
     "--origin lower-left, or move it with --translate X Y"
 )
 """Said after a coordinate too long for its word: the drawing, not the machine, is far off."""
+FAR_FROM_ZERO_CODE = (
+    ": the toolpath lies that far from work zero; move it nearer in the program that wrote "
+    "it (its work zero): camtool re-posts a program where it is"
+)
+""":data:`FAR_FROM_ZERO` for a re-posted program (``--origin`` and ``--translate`` are for
+drawings)."""
 
 
 class WriterState(Generic[B]):

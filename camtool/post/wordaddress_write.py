@@ -93,7 +93,9 @@ class BlockWriter(ArcWriter):
         split = splitwrite.start(self, program)
         ahead = None
         try:
-            self.warnings.extend(check_placement(program, self.machine))
+            self.warnings.extend(
+                check_placement(program, self.machine, reposted=bool(program.lines))
+            )
             self.written = (
                 self._round("X", program.origin[0]),
                 self._round("Y", program.origin[1]),

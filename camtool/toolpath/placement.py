@@ -319,12 +319,13 @@ def check_travel(
     return check_extent(toolpath_extent(program), machine, placing)
 
 
-def check_z_travel(program: Program, machine: Machine) -> None:
+def check_z_travel(program: Program, machine: Machine, *, reposted: bool = False) -> None:
     """Refuse a program whose Z spans more than the machine's Z travel (when it is known).
 
     The span is from the highest Z a move goes to (the clearance height) to the lowest
     (the deepest cut), mm: wherever the operator sets Z0, the machine must reach both.
-    A profile without ``z_travel_mm`` (0) is not checked.
+    A profile without ``z_travel_mm`` (0) is not checked. ``reposted``: the program is
+    G-code another program wrote (its heights are changed there, not by options).
 
     Raises:
         DialectError: naming the span, both heights, the Z travel and what to change.
@@ -338,12 +339,16 @@ def check_z_travel(program: Program, machine: Machine) -> None:
     top, bottom = max(zs), min(zs)
     if top - bottom <= travel + EPS_MM:
         return
+    where = (
+        "in the program that wrote it"
+        if reposted
+        else "(--depth, --clearance-z, or the job file's)"
+    )
     raise DialectError(
         f"the program's Z spans {_mm(top - bottom)} mm (from Z{_num(top)} to Z{_num(bottom)} "
         f"mm), more than the {_mm(travel)} mm Z travel of {machine.name}: no work zero lets "
-        "the machine reach both; check the depth and the clearance height (--depth, "
-        "--clearance-z, or the job file's), or give the machine's own z_travel_mm "
-        "(--machine FILE.toml)"
+        f"the machine reach both; check the depth and the clearance height {where}, or give "
+        "the machine's own z_travel_mm (--machine FILE.toml)"
     )
 
 

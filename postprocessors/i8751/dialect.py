@@ -390,7 +390,10 @@ class I8751Post(PostProcessor):
                 w.source = input_line(program, index, move=False)
                 self._command(w, item)
         w.source = ""
-        warnings = (*check_placement(program, machine), *self._warnings(w, program, machine))
+        warnings = (
+            *check_placement(program, machine, reposted=bool(program.lines)),
+            *self._warnings(w, program, machine),
+        )
         if fmt == "bin":
             return PostResult(encode_stream(w.blocks), len(w.blocks), warnings, fmt)
         text = dump_stream(w.blocks, machine.steps_per_mm, self._header(w, machine))

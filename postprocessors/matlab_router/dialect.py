@@ -344,7 +344,10 @@ class MatlabRouterPost(PostProcessor):
                 "nothing to cut: a matlab-router job needs at least one segment of 0.1 mm or "
                 "more (rapids alone are not written)"
             )
-        warnings = [*check_placement(program, machine), *notes.warnings]
+        warnings = [
+            *check_placement(program, machine, reposted=bool(program.lines)),
+            *notes.warnings,
+        ]
         warnings += notes_warnings(
             notes, self.speed, self._tolerance(program, machine), self.grid_mm
         )

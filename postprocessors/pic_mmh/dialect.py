@@ -41,6 +41,7 @@ from camtool.model.program import (
 from camtool.model.shapes import Arc, distance
 from camtool.post.base import (
     FAR_FROM_ZERO,
+    FAR_FROM_ZERO_CODE,
     ContourCounter,
     PostProcessor,
     PostResult,
@@ -365,7 +366,7 @@ class PicMmhPost(PostProcessor):
         """
         self.check_format(fmt)
         w = _Writer(["G54;", "G90;"], program.origin)
-        w.warnings.extend(check_placement(program, machine))
+        w.warnings.extend(check_placement(program, machine, reposted=bool(program.lines)))
         homed = False
         for index, (move, commands) in enumerate(_steps(program)):
             w.source = input_line(program, index, move=False)
@@ -459,7 +460,7 @@ class PicMmhPost(PostProcessor):
         except DialectError as exc:
             raise DialectError(
                 f"{w.where(move.contour)}: {letter} = {exc} (µm; at most 99999.99 = 99.99999 mm)"
-                + (FAR_FROM_ZERO if letter in "XY" else "")
+                + ((FAR_FROM_ZERO_CODE if w.source else FAR_FROM_ZERO) if letter in "XY" else "")
             ) from exc
 
     def _xy(self, x: float, y: float, move: Move, w: _Writer) -> str:

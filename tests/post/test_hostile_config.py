@@ -71,6 +71,14 @@ def test_a_machine_value_out_of_its_physical_range_is_refused(
     assert MACHINE_OVERLAYS[overlay] in err and "m.toml" in err
 
 
+def test_a_work_area_corner_is_refused_with_the_range_it_has(run: Any, tmp_path: Path) -> None:
+    """A corner may lie below 0 (a machine homed at its centre): the range says so."""
+    machine = tmp_path / "m.toml"
+    machine.write_text("[machine]\nwork_area_mm = [-2e6, 0, 100, 100]\n")
+    err = _refused(run, tmp_path, "-t", "grbl", "--machine", str(machine))
+    assert "work_area_mm must be from -1e+06 to 1e+06 mm (a physical machine)" in err
+
+
 @pytest.mark.parametrize("edit", sorted(TARGET_EDITS))
 def test_a_target_value_a_controller_cannot_take_is_refused(
     run: Any, tmp_path: Path, edit: tuple[str, str]

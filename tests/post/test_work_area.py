@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+from typing import Any
+
 import pytest
 
 from camtool.model.errors import DialectError, InputError
@@ -65,3 +68,23 @@ def test_a_suggested_translation_is_not_rounded_up_by_float_noise() -> None:
     machine = load_machine("router-2011")
     box = (-1.5, -7.0000000001, 41.5, 30.344)
     assert place_remedy(box, machine, Placing()).endswith("--translate 1.5 7")
+
+
+@pytest.mark.parametrize("target", ["pic-mmh", "flashcut"])
+def test_a_reposted_coordinate_too_long_for_its_word_is_moved_where_it_was_written(
+    run: Any, tmp_path: Path, target: str
+) -> None:
+    """pic-mmh writes at most 99.99999 mm (5 integer digits of µm), flashcut 4 integer
+    digits of mm: a re-posted program that far out is moved in the program that wrote it
+    (``--origin`` and ``--translate`` are refused for G-code)."""
+    machine = tmp_path / "wide.toml"
+    machine.write_text("[machine]\nwork_area_mm = [0, 0, 900000, 900000]\n")
+    far = 150.0 if target == "pic-mmh" else 15000.0
+    program = tmp_path / "far.ngc"
+    program.write_text(f"G21 G90\nG0 Z5\nG0 X{far} Y1\nG1 Z-1 F100\nG1 X{far + 5} Y1\nG0 Z5\nM2\n")
+    out = tmp_path / "out.txt"
+    code, err = run("post", str(program), "-t", target, "--machine", str(machine), "-o", str(out))
+    assert code != 0 and not out.exists()
+    assert "integer digits" in err and "(input line 3)" in err
+    assert "move it nearer in the program that wrote it (its work zero)" in err
+    assert "--origin" not in err and "--translate" not in err

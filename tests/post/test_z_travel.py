@@ -52,6 +52,8 @@ def test_a_re_posted_program_is_checked_too_and_a_machine_file_may_give_more(
     out = tmp_path / "out.gcode"
     code, err = run("post", str(program), "-t", "grbl", "-o", str(out))
     assert code != 0 and "Z spans 260 mm" in err and not out.exists()
+    # the heights are changed where the program was written: --depth is refused for G-code
+    assert "clearance height in the program that wrote it" in err and "--depth" not in err
     code, err = run("verify", str(program), "-t", "grbl")
     assert code != 0 and "Z spans 260 mm" in err
     machine = tmp_path / "tall.toml"
