@@ -182,7 +182,7 @@ def test_a_warning_only_the_helper_gives_is_written_by_the_writer(
 ) -> None:
     # a feed GRBL writes rounded (a warning naming the feed) only in the second half
     moves = lines(200)
-    moves[150:] = [Linear(m.x, m.y, 300.00004, m.z) for m in moves[150:]]
+    moves[150:] = [Linear(m.x, m.y, 300.04, m.z) for m in moves[150:]]
     post = post_of("grbl")
     assert "written as" in alone(post, Program(tuple(moves)), monkeypatch)
     assert split_answers(post, Program(tuple(moves)), monkeypatch) == [False]
