@@ -482,6 +482,11 @@ class Program:
             return False
         return not any(index < i < index + arc.moves for i, _ in self.commands)
 
+    @property
+    def from_code(self) -> bool:
+        """Whether the program was read from code (its moves have input lines): re-posted."""
+        return bool(self.lines)
+
     def line_of(self, index: int) -> int | None:
         """Source line of move ``index``, or None when the program was not read from code."""
         return self.lines[index] if 0 <= index < len(self.lines) else None

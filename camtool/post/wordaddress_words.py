@@ -153,7 +153,7 @@ class WordWriter(WriterState[str]):
                 f"{self.where()}: {letter} = {exc} (value {value:g}); "
                 f"{self.spec.name} writes at most {number.int_digits} integer digits"
                 + (
-                    (FAR_FROM_ZERO_CODE if self.program.lines else FAR_FROM_ZERO)
+                    (FAR_FROM_ZERO_CODE if self.program.from_code else FAR_FROM_ZERO)
                     if letter in "XY"
                     else ""
                 )

@@ -93,9 +93,7 @@ class BlockWriter(ArcWriter):
         split = splitwrite.start(self, program)
         ahead = None
         try:
-            self.warnings.extend(
-                check_placement(program, self.machine, reposted=bool(program.lines))
-            )
+            self.warnings.extend(check_placement(program, self.machine, reposted=program.from_code))
             self.written = (
                 self._round("X", program.origin[0]),
                 self._round("Y", program.origin[1]),
@@ -223,7 +221,7 @@ class BlockWriter(ArcWriter):
         if self.machine.coordinates != "work":  # in work coordinates any position runs
             program = self.program
             check_work_area(
-                start, move, self.machine, self.where(), program, reposted=bool(program.lines)
+                start, move, self.machine, self.where(), program, reposted=program.from_code
             )
 
     def _check_z(self, move: Move) -> None:

@@ -391,7 +391,7 @@ class I8751Post(PostProcessor):
                 self._command(w, item)
         w.source = ""
         warnings = (
-            *check_placement(program, machine, reposted=bool(program.lines)),
+            *check_placement(program, machine, reposted=program.from_code),
             *self._warnings(w, program, machine),
         )
         if fmt == "bin":
@@ -401,7 +401,7 @@ class I8751Post(PostProcessor):
 
     def _move(self, w: _Writer, move: Move, machine: Machine, program: Program) -> None:
         start, w.contour = w.here, move.contour
-        check_work_area(start, move, machine, w.where(), program, reposted=bool(program.lines))
+        check_work_area(start, move, machine, w.where(), program, reposted=program.from_code)
         if move.z is not None and not machine.has_z:
             raise DialectError(f"{w.where()}: Z = {move.z:g} mm but {machine.name} has no Z")
         if isinstance(move, Rapid):

@@ -345,7 +345,7 @@ class MatlabRouterPost(PostProcessor):
                 "more (rapids alone are not written)"
             )
         warnings = [
-            *check_placement(program, machine, reposted=bool(program.lines)),
+            *check_placement(program, machine, reposted=program.from_code),
             *notes.warnings,
         ]
         warnings += notes_warnings(
@@ -559,7 +559,7 @@ def _check_move(
             "the tool by a fixed 100 units at each job's start, Angel-11 §2.8 L6544); "
             "set the depth by hand"
         )
-    check_work_area(notes.here, move, machine, where, program, reposted=bool(program.lines))
+    check_work_area(notes.here, move, machine, where, program, reposted=program.from_code)
 
 
 def _chords(here: Point, move: ArcMove, tolerance: float, notes: RouterWriter) -> list[Point]:

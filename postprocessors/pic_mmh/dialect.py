@@ -366,7 +366,7 @@ class PicMmhPost(PostProcessor):
         """
         self.check_format(fmt)
         w = _Writer(["G54;", "G90;"], program.origin)
-        w.warnings.extend(check_placement(program, machine, reposted=bool(program.lines)))
+        w.warnings.extend(check_placement(program, machine, reposted=program.from_code))
         homed = False
         for index, (move, commands) in enumerate(_steps(program)):
             w.source = input_line(program, index, move=False)
@@ -378,7 +378,7 @@ class PicMmhPost(PostProcessor):
             start = w.here
             self._check_move(move, w, homed)
             check_work_area(
-                start, move, machine, w.where(move.contour), program, reposted=bool(program.lines)
+                start, move, machine, w.where(move.contour), program, reposted=program.from_code
             )
             homed = homed and not isinstance(move, Rapid)
             self._move(start, move, machine, w, _tolerance(program, machine))
