@@ -46,6 +46,17 @@ def golden_arc_dxf(path: Path) -> Path:
     return write_dxf(path, build)
 
 
+def kin47_arcs_dxf(path: Path, centre: Point) -> Path:
+    """A 5 mm hole as LibreCAD's kinetics/kin47.dxf draws it: two copies of an ARC of radius
+    2.5 mm about ``centre`` from 270° to 269.99999427° (a gap of 0.25 µm)."""
+
+    def build(msp: Any) -> None:
+        for _ in range(2):
+            msp.add_arc(centre, 2.5, 270.0, 269.99999427)
+
+    return write_dxf(path, build)
+
+
 def rectangle_dxf(path: Path, w: float = 10.0, h: float = 5.0, *, insunits: int = 4) -> Path:
     """A closed LWPOLYLINE rectangle ``w`` × ``h`` with its lower-left corner at (1, 1)."""
 

@@ -28,7 +28,7 @@ from camtool.jobs.run import PostJob, run_job
 from camtool.model.program import ArcMove, Move, Rapid, ToolChange, segment_of
 from camtool.model.shapes import Contour, Drawing
 from camtool.post.registry import load_target
-from tests.shapes import write_dxf
+from tests.shapes import kin47_arcs_dxf, write_dxf
 from tests.toolpath.contours import circle, rect
 
 PERIMETER = 2 * (40 + 20) + 2 * math.pi * 1.5
@@ -227,14 +227,7 @@ def test_a_hole_drawn_twice_as_an_arc_short_of_360_is_drilled_once(tmp_path: Pat
     to 269.99999427°: chained end to end (the second reversed) they are a path out and
     back, no circle, and the drill operation that ``job init`` proposed for them refused
     it. Expected from the drawing: one hole at the ARC's centre."""
-    import ezdxf
-
-    doc = ezdxf.new()
-    doc.header["$INSUNITS"] = 4
-    for _ in range(2):
-        doc.modelspace().add_arc((5, 10), 2.5, 270.0, 269.99999427)
-    path = tmp_path / "arcs.dxf"
-    doc.saveas(path)
+    path = kin47_arcs_dxf(tmp_path / "arcs.dxf", (5.0, 10.0))
     job = tmp_path / "drill.toml"
     job.write_text(
         '[[tools]]\nid = 1\ntype = "drill"\ndiameter = 5\n'

@@ -20,6 +20,7 @@ from camtool.model.program import ArcMove, Linear, segment_of
 from camtool.model.shapes import Contour, Drawing, Line, make_arc
 from camtool.post.registry import load_target
 from camtool.toolpath.options import PlanOptions
+from tests.shapes import kin47_arcs_dxf
 from tests.toolpath.contours import circle, rect
 
 # LibreOffice Impress's SVG export of an arrow shape (a CustomShape): the fill path, with the
@@ -162,13 +163,7 @@ def test_two_copies_of_a_circle_drawn_as_an_arc_short_of_360_are_one_closed_circ
     # LibreCAD's kinetics/kin47.dxf: ARCs from 270° to 269.99999427° (a gap of 0.25 µm),
     # each drawn twice. Chained out and back they are one circle: cut once, and closed, so
     # a side cuts it (an open arc would be left out).
-    doc = ezdxf.new()
-    doc.header["$INSUNITS"] = 4
-    for _ in range(2):
-        doc.modelspace().add_arc((20, 20), 2.5, 270.0, 269.99999427)
-    path = tmp_path / "arcs.dxf"
-    doc.saveas(path)
-    drawing = read_drawing(path)
+    drawing = read_drawing(kin47_arcs_dxf(tmp_path / "arcs.dxf", (20.0, 20.0)))
     outside = PlanOptions(depth=1.0, offset="outside", tool_diameter=1.0)
     job = post_drawing(drawing, load_target("linuxcnc"), outside)
     assert sum("runs back on its own path" in w for w in job.warnings) == 1
