@@ -7,6 +7,11 @@ STAMP := $(VENV)/.installed
 
 .PHONY: demo test lint typecheck unit bench bench-venv docs clean corpus
 
+# Python caches compiled bytecode (__pycache__/, ignored by git) whatever the calling shell
+# says: with PYTHONDONTWRITEBYTECODE set, every test worker, every camtool started by a test
+# and pytest's assertion rewriting compiled their sources again on each start.
+unexport PYTHONDONTWRITEBYTECODE
+
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
