@@ -17,7 +17,9 @@ its verified pictures (``make_gallery.py``); the planning examples of
 docs/toolpaths.md and their pictures (``make_toolpaths.py``). ``--check`` only
 reports whether the committed docs are current (exit 1 if not; the PNG, drawn
 by matplotlib whose bytes vary between versions, only has to exist); the tests
-run it.
+run it with ``--without-gallery-pictures`` (the gallery page is checked, its
+pictures are not made), and compare the pictures the gallery page's own commands
+write with the committed ones (tests/docs/test_documented_commands.py).
 """
 
 from __future__ import annotations
@@ -41,8 +43,11 @@ _VERIFY = re.compile(r"(<!-- verify:begin -->\n).*?(<!-- verify:end -->)", re.S)
 VERIFY_PNG = ROOT / "docs" / "targets" / "pic-mmh-logo-verify.png"
 
 
-def generated() -> dict[Path, str]:
-    """Every generated docs file with its current content."""
+def generated(gallery_pictures: bool = True) -> dict[Path, str]:
+    """Every generated docs file with its current content.
+
+    The gallery's pictures only while ``gallery_pictures`` (:func:`make_gallery.gallery_files`).
+    """
     files: dict[Path, str] = {}
     for target in target_names():
         found = page_sample(target)
@@ -69,7 +74,7 @@ def generated() -> dict[Path, str]:
     files.update(job_files())
     from make_gallery import gallery_files
 
-    files.update(gallery_files())
+    files.update(gallery_files(gallery_pictures))
     from make_toolpaths import toolpath_files
 
     files.update(toolpath_files())
@@ -168,7 +173,7 @@ def verify_png() -> bytes:
 
 def main(argv: list[str]) -> int:
     """Write the generated docs, or with ``--check`` list the stale ones."""
-    files = generated()
+    files = generated(gallery_pictures="--without-gallery-pictures" not in argv)
     stale = [p for p, text in files.items() if not p.exists() or p.read_text("utf-8") != text]
     if "--check" in argv:
         if not VERIFY_PNG.is_file():

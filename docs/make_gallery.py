@@ -19,7 +19,7 @@ from make_docs import ROOT, page_sample, post_sample
 
 from camtool.jobs.pipeline import verify_job
 from camtool.model.errors import CamtoolError
-from camtool.post.registry import target_names
+from camtool.post.registry import load_target, target_names
 from camtool.preview import render_preview
 
 GALLERY = ROOT / "docs" / "gallery"
@@ -36,8 +36,13 @@ annotated with its code line, and zoomed in the inset on the right. How to read 
 """
 
 
-def gallery_files() -> dict[Path, str]:
-    """docs/gallery.md and one SVG per target that has a page and a sample, with content."""
+def gallery_files(pictures: bool = True) -> dict[Path, str]:
+    """docs/gallery.md and one SVG per target that has a page and a sample, with content.
+
+    ``pictures=False``: the page alone, without posting or verifying a sample (each target
+    taken as drawn). The tests check it so, and compare the pictures that the page's own
+    commands write (tests/docs/test_documented_commands.py) with the committed ones.
+    """
     files: dict[Path, str] = {}
     sections, missing = [], []
     for target in target_names():
@@ -46,6 +51,9 @@ def gallery_files() -> dict[Path, str]:
             missing.append(f"- `{target}`: no page with a sample marker yet")
             continue
         spec = found[2][2]
+        if not pictures:
+            sections.append(_section(target, spec, load_target(target).description))
+            continue
         try:
             job = post_sample(target, spec)
             verification = verify_job(job)

@@ -303,6 +303,24 @@ def test_page_runs_as_written(
     finally:
         run.close()
     assert not run.failures, "\n".join(run.failures)
+    if page == GALLERY_PAGE:
+        _same_pictures(tmp_path / "docs" / "gallery", ROOT / "docs" / "gallery")
+
+
+GALLERY_PAGE = ROOT / "docs" / "gallery.md"
+
+
+def _same_pictures(written: Path, committed: Path) -> None:
+    """The gallery's commands, run as written, drew the committed pictures byte for byte.
+
+    tests/test_docs.py checks the gallery page without making its pictures
+    (``make_docs.py --without-gallery-pictures``): this is where they are checked, once.
+    """
+    want = sorted(p.name for p in committed.glob("*.svg"))
+    assert want, f"no pictures in {committed}"
+    assert sorted(p.name for p in written.glob("*.svg")) == want
+    stale = [n for n in want if (written / n).read_bytes() != (committed / n).read_bytes()]
+    assert not stale, f"docs/gallery/ pictures differ from what the page draws: {stale} (make docs)"
 
 
 def test_only_marked_lines_are_skipped() -> None:
