@@ -209,13 +209,20 @@ def fade_under_transparent(root: ET.Element) -> None:
 
 
 def hold_undrawn(
-    root: ET.Element, parents: dict[ET.Element, ET.Element], hold: ET.Element, counts: Counter[str]
+    root: ET.Element,
+    parents: dict[ET.Element, ET.Element],
+    hold: ET.Element,
+    counts: Counter[str],
+    placed: frozenset[str] = frozenset(),
 ) -> None:
     """Move what svgelements would draw by mistake into ``hold`` and count it.
 
     svgelements draws the children of elements it does not know (``<mask>``, ``<symbol>``,
     ``<marker>``, ``<flowRoot>``) as if they were in a group, and draws a ``<symbol>``
-    placed by ``<use>`` without the symbol's viewBox.
+    placed by ``<use>`` without the symbol's viewBox. A ``<symbol>`` whose id is not in
+    ``placed`` (the ids the document's ``<use>`` elements named) is counted (``symbol``):
+    a viewer draws a symbol only where a ``<use>`` places it, and Inkscape's symbol
+    libraries are files of nothing else.
     """
     ids = {e.get("id"): e for e in root.iter() if e.get("id")}
     for element in list(root.iter()):
@@ -228,6 +235,8 @@ def hold_undrawn(
             counts["mask"] += 1
         elif drawn and kind in ("flowRoot", "use"):
             counts["text" if kind == "flowRoot" else "use"] += 1
+        elif kind == "symbol" and element.get("id") not in placed:
+            counts["symbol"] += 1
         if drawn or kind != "use":
             move(element, parents, hold)
 
@@ -515,6 +524,7 @@ def check_size(root: ET.Element, name: str, max_entities: int) -> None:
 _SIZES = frozenset({"width", "height", "r", "rx", "ry"})
 _SKIP_REASONS = {
     "defs": "definitions are cut only where a <use> places them",
+    "symbol": "no <use> places them, and a symbol is drawn and cut only where one does",
     "mask": "a mask is not cut: what it hides is checked where it is used",
     "text": "convert text to paths in the drawing program to cut it",
     "image": "raster images cannot be cut",
@@ -584,6 +594,7 @@ def prepare(
     _label_and_check(root, str(path), viewport)
     check_use_cycles(root, str(path))
     check_size(root, str(path), max_entities)
+    placed = frozenset(href(e)[1:] for e in root.iter() if local_name(e) == "use")
     if symbols_as_viewports(root):
         svgvalues.resolve_percentages(root, viewport)  # the new viewports' sizes
         parents = {child: parent for parent in root.iter() for child in parent}
@@ -595,7 +606,7 @@ def prepare(
     check_conditions(root, parents, hold, str(path), counts)
     fade_under_transparent(root)
     masks_as_clips(root, parents, hold, str(path), viewport)
-    hold_undrawn(root, parents, hold, counts)
+    hold_undrawn(root, parents, hold, counts, placed)
     count_skipped(root, hold, counts)
     if counts["use-file"]:
         warnings.append(
@@ -619,7 +630,7 @@ def prepare(
             "they hold to their size there; camtool does not, so a shape reaching outside "
             "one is cut whole (check the preview, or trim it in the drawing program)"
         )
-    for kind in ("defs", "mask", "text", "image", "use"):
+    for kind in ("defs", "symbol", "mask", "text", "image", "use"):
         if counts[kind]:
             noun = "element" if counts[kind] == 1 else "elements"
             reason = _SKIP_REASONS[kind]

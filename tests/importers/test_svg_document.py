@@ -579,6 +579,12 @@ def test_use_places_a_definition_and_names_both(tmp_path: Path) -> None:
             '<symbol id="s" viewBox="0 0 1 1"><path d="M 0 0 L 1 1"/></symbol>',
             "skipped 1 <use> element (a <use> of a <symbol> with a viewBox is not supported",
         ),
+        (  # symbols nothing places, in and out of <defs> (a viewer draws neither)
+            '<symbol id="a"><path d="M 0 0 L 1 0"/></symbol>'
+            '<defs><symbol id="b"><path d="M 0 0 L 1 1"/></symbol></defs>',
+            "skipped 2 <symbol> elements (no <use> places them, and a symbol is drawn and cut "
+            "only where one does)",
+        ),
     ],
 )
 def test_skipped_constructs_warn_once_per_kind(tmp_path: Path, body: str, warning: str) -> None:
@@ -632,6 +638,21 @@ def test_the_markers_a_viewer_draws_are_counted(tmp_path: Path) -> None:
 def test_symbol_without_viewbox_is_placed(tmp_path: Path) -> None:
     body = '<symbol id="s"><path d="M 0 0 L 1 0"/></symbol><use href="#s" x="3" y="4"/>'
     assert vertices(one(read_svg(svg(tmp_path, body)))) == [(3, 96), (4, 96)]
+
+
+def test_a_symbol_library_is_refused_naming_its_symbols(tmp_path: Path) -> None:
+    """Inkscape's symbol libraries (Debian's inkscape-open-symbols) hold ``<symbol>``s and
+    nothing that places one: a viewer shows an empty page, and the refusal says why."""
+    body = (
+        '<defs><symbol id="a"><path d="M 0 0 L 1 0"/></symbol></defs>'
+        '<symbol id="b"><circle cx="2" cy="2" r="1"/></symbol>'
+        '<symbol id="c"><rect width="1" height="1"/></symbol>'
+        '<use href="#b"/>'  # b is placed, so it is cut
+    )
+    assert len(read_svg(svg(tmp_path, body)).contours) == 1
+    library = body.replace('<use href="#b"/>', "")
+    with pytest.raises(InputError, match=r"nothing to cut; .*\(skipped 3 <symbol> elements "):
+        read_svg(svg(tmp_path, library))
 
 
 def test_links_and_nested_svg_viewports(tmp_path: Path) -> None:
