@@ -148,6 +148,9 @@ class WordAddressSpec:
             written as a stop.
         end: program-end codes; the writer ends with the first, the reader
             accepts any of them.
+        operator_messages: a stop's message is written ``(MSG, text)``, which an RS-274/NGC
+            controller shows the operator as it reaches the line (LinuxCNC's G-code
+            reference, "Messages"); otherwise as a plain comment. Needs ``comment = "()"``.
         comment: how the dialect writes a comment line (:data:`COMMENTS`):
             ``"()"`` or ``";"``; ``None``: it has no comments, and the job notes
             (:attr:`Program.notes <camtool.model.program.Program.notes>`) are not written.
@@ -193,6 +196,7 @@ class WordAddressSpec:
     optional_stop: str | None = None
     end: tuple[str, ...] = ()
     comment: str | None = None
+    operator_messages: bool = False
     header: tuple[str, ...] = ()
     footer: tuple[str, ...] = ()
 
@@ -217,8 +221,10 @@ class WordAddressSpec:
         """The coarsest written step of X, Y, I and J, mm: the grid arcs must land on."""
         return max(self.words[c].number.resolution_mm() for c in "XYIJ" if c in self.words)
 
-    def comment_line(self, text: str) -> str | None:
+    def comment_line(self, text: str, prefix: str = "") -> str | None:
         """``text`` as one comment line of this dialect, ``None`` without comments.
+
+        ``prefix`` (such as ``"MSG, "``) is written before the text, inside the comment.
 
         Characters a comment cannot hold are replaced: anything outside printable
         ASCII by ``?``, and ``(``/``)`` by ``[``/``]`` (RS-274 comments do not
@@ -229,7 +235,7 @@ class WordAddressSpec:
             return None
         clean = "".join(c if " " <= c <= "~" else "?" for c in text)
         clean = clean.replace("(", "[").replace(")", "]").strip()
-        wrap = ("(", ")") if self.comment == "()" else ("; ", "")
+        wrap = ("(" + prefix, ")") if self.comment == "()" else ("; " + prefix, "")
         room = None
         if self.max_block_bytes is not None:
             room = self.max_block_bytes - len(self.line_end) - sum(map(len, wrap))
@@ -399,6 +405,7 @@ def load_spec(options: Mapping[str, Any], where: str) -> WordAddressSpec:
         modal=_modal(t, words),
         arc_check=t.string("arc_check", "none", choices=ARC_CHECKS),
         comment=t.string("comment", None, choices=COMMENTS),
+        operator_messages=t.flag("operator_messages", False),
         header=tuple(t.strings("header")),
         footer=tuple(t.strings("footer")),
         home=t.string("home", None, choices=HOMES),
@@ -540,6 +547,8 @@ def _check(spec: WordAddressSpec, t: _Table) -> None:
     if spec.has("Z") != (spec.z_moves != "none"):
         want = '"own-block" or "with-xy"' if spec.has("Z") else '"none" (there is no Z word)'
         raise t.error("z_moves", f"expected {want}, got {_show(spec.z_moves)}")
+    if spec.operator_messages and spec.comment != "()":
+        raise t.error("operator_messages", '(MSG, ...) messages need comment = "()"')
     if spec.helix and spec.z_moves != "with-xy":
         raise t.error("helix", 'a helix needs z_moves = "with-xy"')
     if spec.planes and not all(spec.has(c) for c in "ZIJK"):

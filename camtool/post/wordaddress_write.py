@@ -745,7 +745,11 @@ class BlockWriter(ArcWriter):
             self.command(turning)  # the spindle as it was, for the new tool
 
     def _stop(self, optional: bool, message: str) -> None:
-        """A program stop (``M0``; ``M1`` when ``optional``), after a comment saying why."""
+        """A program stop (``M0``; ``M1`` when ``optional``), after a comment saying why.
+
+        The comment is a ``(MSG, ...)`` the controller shows where the dialect has
+        :attr:`~camtool.post.wordaddress_spec.WordAddressSpec.operator_messages`.
+        """
         spec = self.spec
         code = (spec.optional_stop or spec.stop) if optional else spec.stop
         if code is None:
@@ -755,7 +759,8 @@ class BlockWriter(ArcWriter):
                 f"{self.where()}: {spec.name} has no {kind}{reason}; a stop is never dropped: "
                 "post the program for a target that stops, or take the stop out of it"
             )
-        comment = spec.comment_line(message) if message else None
+        prefix = "MSG, " if spec.operator_messages else ""
+        comment = spec.comment_line(message, prefix) if message else None
         if comment is not None:
             self.blocks.append(comment)
         self.block([code])

@@ -99,6 +99,10 @@ def emit(
         ({"words": {"XYZ": {}}, "z_moves": "none"}, 'z_moves: expected "own-block" or "with-xy"'),
         ({"words": {"XYZIJ": {}}, "helix": True, "z_moves": "own-block"}, "helix: a helix needs"),
         ({"words": {"XY": {}}, "dwell": "G4"}, "dwell: a dwell code needs a P word"),
+        (
+            {"words": {"XY": {}}, "comment": ";", "operator_messages": True},
+            r'operator_messages: \(MSG, ...\) messages need comment = "\(\)"',
+        ),
         ({"words": {"XY": {}}, "tool_change": "M6"}, "tool_change: a tool change code needs a T"),
         ({"words": {"XY": {}}, "by_hand": "stop"}, "by_hand: changing tools with a stop needs"),
         (

@@ -36,6 +36,7 @@ from camtool.post.arccheck import arc_error
 from camtool.post.registry import load_target
 from camtool.post.wordaddress import WordAddressPost, word_address_dialect
 from camtool.toolpath.options import PlanOptions
+from tests.corpus.test_rs274 import needs_rs274, rs274
 
 ROOT = Path(__file__).parents[2]
 TARGETS = ("grbl", "linuxcnc")
@@ -125,6 +126,27 @@ def test_dwell_tool_change_and_helix() -> None:
     grbl = code_of("grbl", program).splitlines()
     assert grbl[1:3] == ["(change to T2: drill 3 mm)", "M0"]
     assert "M6" not in "\n".join(grbl)
+
+
+@needs_rs274
+def test_linuxcnc_shows_a_stops_reason_to_the_operator(tmp_path: Path) -> None:
+    """LinuxCNC's "Messages": a ``(MSG, ...)`` comment is shown as the line is reached, so a
+    stop's reason is written so (a plain comment would pause with nothing said); GRBL 1.1
+    shows no comment, and keeps a plain one. The judge is ``rs274``'s MESSAGE call."""
+    moves = (Rapid(0, 0, z=5.0), Linear(0, 0, 100.0, z=-1.0), Rapid(0, 0, z=5.0))
+    stop = Stop(message="change to T2: drill (3 mm)")
+    program = Program(moves, commands=((2, stop),))
+    code = code_of("linuxcnc", program)
+    lines = code.splitlines()
+    i = lines.index("M0")
+    assert lines[i - 1] == "(MSG, change to T2: drill [3 mm])"  # comments do not nest
+    path = tmp_path / "stop.ngc"
+    path.write_text(code, encoding="ascii")
+    out = rs274(path).stdout
+    assert 'MESSAGE(" change to T2: drill [3 mm]")' in out
+    assert out.index("MESSAGE(") < out.index("PROGRAM_STOP()")
+    grbl = code_of("grbl", program).splitlines()
+    assert grbl[grbl.index("M0") - 1] == "(change to T2: drill [3 mm])"
 
 
 def test_grbl_stops_the_spindle_for_a_tool_change_and_starts_it_again() -> None:
