@@ -208,7 +208,7 @@ def check_placement(
     check_z_travel(program, machine, reposted=reposted)
     if machine.coordinates == "machine":
         return ()
-    return check_travel(program, machine)
+    return check_travel(program, machine, planned=not reposted)
 
 
 class ContourCounter:

@@ -287,7 +287,11 @@ class Placing:
 
 
 def check_travel(
-    program: Program, machine: Machine, placing: Placing | None = None
+    program: Program,
+    machine: Machine,
+    placing: Placing | None = None,
+    *,
+    planned: bool | None = None,
 ) -> tuple[str, ...]:
     """Refuse a program ``machine`` cannot run; warn where its work zero needs care.
 
@@ -307,6 +311,9 @@ def check_travel(
         machine: the machine profile.
         placing: how the program was placed (``None``: not planned here, a program
             read from code); the remedy names options that work as written.
+        planned: whether ``--origin`` can move the program (it was planned from a
+            drawing), for a warning's remedy; ``None``: when ``placing`` is given. A
+            writer passes it, holding a planned program without its placing.
 
     Returns:
         Warnings for the user (empty when nothing needs care).
@@ -316,7 +323,7 @@ def check_travel(
             coordinates) reaches outside the work area; the message gives both sizes
             and a remedy.
     """
-    return check_extent(toolpath_extent(program), machine, placing)
+    return check_extent(toolpath_extent(program), machine, placing, planned=planned)
 
 
 def check_z_travel(program: Program, machine: Machine, *, reposted: bool = False) -> None:
@@ -352,7 +359,9 @@ def check_z_travel(program: Program, machine: Machine, *, reposted: bool = False
     )
 
 
-def check_extent(box: BBox | None, machine: Machine, placing: Placing | None) -> tuple[str, ...]:
+def check_extent(
+    box: BBox | None, machine: Machine, placing: Placing | None, *, planned: bool | None = None
+) -> tuple[str, ...]:
     """:func:`check_travel` of a program whose :func:`toolpath_extent` is ``box``.
 
     For a caller that has the box already (one walk of the moves, not one per check).
@@ -373,7 +382,8 @@ def check_extent(box: BBox | None, machine: Machine, placing: Placing | None) ->
     # work zero as drawn is worth a word; one the user placed (--origin, --translate) or
     # one another program chose (code read back, placing None) is what was asked for
     chosen = placing is None or placing.placement != "drawing" or placing.translate != (0.0, 0.0)
-    return _zero_warnings(box, machine, chosen=chosen, planned=placing is not None)
+    planned = placing is not None if planned is None else planned
+    return _zero_warnings(box, machine, chosen=chosen, planned=planned)
 
 
 def larger_than_travel(box: BBox, machine: Machine) -> bool:

@@ -91,6 +91,21 @@ def test_a_toolpath_across_work_zero_is_warned_about_once(
     assert "work zero" not in err
 
 
+def test_a_drawing_far_from_work_zero_is_warned_once_and_told_to_use_origin(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The plate drawn at X 150: its outside profile spans X 148.5…251.5 mm, so work zero
+    lies 251.5 mm from its far side, more than GRBL's 200 mm. The planner warns with
+    ``--origin``; the writer checks the same rule and must neither repeat it nor give the
+    remedy of G-code read back (FreeCAD's A0 templates with ``--fit`` were told both)."""
+    dxf = str(plate(tmp_path / "p.dxf", x0=150.0))
+    code, err = post([dxf, "-t", "grbl", *OUTSIDE, "-o", str(tmp_path / "out.gcode")], capsys)
+    assert code == 0
+    assert err.count("work zero cannot be a point the tool reaches") == 1
+    assert "lies 251.5 mm from its far side" in err and "use --origin lower-left" in err
+    assert "in the program that wrote it" not in err
+
+
 def test_a_reposted_program_far_from_work_zero_is_not_told_to_use_origin(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
