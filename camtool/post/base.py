@@ -187,7 +187,7 @@ def input_line(program: Program, index: int, *, move: bool) -> str:
 
 
 def check_placement(
-    program: Program, machine: Machine, *, reposted: bool = False
+    program: Program, machine: Machine, *, reposted: bool | None = None
 ) -> tuple[str, ...]:
     """The work-coordinate rule for a program about to be written (or verified).
 
@@ -199,12 +199,16 @@ def check_placement(
 
     Its Z must span no more than the machine's Z travel, when the profile gives it
     (:func:`~camtool.toolpath.placement.check_z_travel`), in either coordinates.
-    ``reposted``: a writer's re-posted G-code (remedies name the program that wrote it).
+    ``reposted``: G-code camtool did not plan (remedies name the program that wrote it);
+    ``None``: whether ``program`` was read from code (:attr:`Program.from_code`), as a
+    writer's is. A verification says which, as its code is always read back.
 
     Raises:
         DialectError: the toolpath is larger than the travel (both sizes named), or its
             Z spans more than the Z travel.
     """
+    if reposted is None:
+        reposted = program.from_code
     check_z_travel(program, machine, reposted=reposted)
     if machine.coordinates == "machine":
         return ()

@@ -93,7 +93,7 @@ class BlockWriter(ArcWriter):
         split = splitwrite.start(self, program)
         ahead = None
         try:
-            self.warnings.extend(check_placement(program, self.machine, reposted=program.from_code))
+            self.warnings.extend(check_placement(program, self.machine))
             self.written = (
                 self._round("X", program.origin[0]),
                 self._round("Y", program.origin[1]),

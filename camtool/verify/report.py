@@ -85,7 +85,9 @@ def _short(value: float) -> str:
     return "0" if text in ("-0", "") else text
 
 
-def check_area(program: Program, machine: Machine, source: str = "") -> tuple[str, ...]:
+def check_area(
+    program: Program, machine: Machine, source: str = "", *, reposted: bool = True
+) -> tuple[str, ...]:
     """The rule ``post`` applies (:func:`camtool.post.base.check_placement`), on read code.
 
     Work coordinates: the toolpath must fit the travel (warnings where work zero needs
@@ -96,6 +98,9 @@ def check_area(program: Program, machine: Machine, source: str = "") -> tuple[st
         machine: the machine it is checked against.
         source: the file the code was read from; every refusal then starts with it
             (``FILE: line 7: reaches …``, ``FILE: the toolpath is …``).
+        reposted: the code was not planned here from a drawing (a file verified or sent
+            as it is): a work-zero warning names the program that wrote it, not
+            ``--origin`` (the writer's and the planner's own words otherwise).
 
     Raises:
         DialectError: the program cannot run on ``machine`` (with the remedy).
@@ -108,7 +113,7 @@ def check_area(program: Program, machine: Machine, source: str = "") -> tuple[st
                 line = program.line_of(index)
                 where = f"line {line}" if line is not None else f"move {index + 1}"
                 check_work_area(start, move, machine, where, program)
-        return check_placement(program, machine)
+        return check_placement(program, machine, reposted=reposted)
     except DialectError as exc:
         if not source:
             raise

@@ -307,7 +307,8 @@ def verify_program(
     """
     if tool_diameter < 0:
         raise UsageError(f"tool diameter must be >= 0 mm, got {tool_diameter!r}")
-    placement = report.check_area(program, machine, source)
+    reposted = planned is None or planned.from_code  # not planned here from a drawing
+    placement = report.check_area(program, machine, source, reposted=reposted)
     skipped = None if against is None else report._no_overlap(program, against, tool_diameter / 2.0)
     drawing = against if skipped is None else None
     with ExitStack() as stack:  # leaving it stops the budget's workers, if any

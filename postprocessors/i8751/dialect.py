@@ -391,7 +391,7 @@ class I8751Post(PostProcessor):
                 self._command(w, item)
         w.source = ""
         warnings = (
-            *check_placement(program, machine, reposted=program.from_code),
+            *check_placement(program, machine),
             *self._warnings(w, program, machine),
         )
         if fmt == "bin":

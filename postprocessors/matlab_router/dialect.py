@@ -345,7 +345,7 @@ class MatlabRouterPost(PostProcessor):
                 "more (rapids alone are not written)"
             )
         warnings = [
-            *check_placement(program, machine, reposted=program.from_code),
+            *check_placement(program, machine),
             *notes.warnings,
         ]
         warnings += notes_warnings(

@@ -366,7 +366,7 @@ class PicMmhPost(PostProcessor):
         """
         self.check_format(fmt)
         w = _Writer(["G54;", "G90;"], program.origin)
-        w.warnings.extend(check_placement(program, machine, reposted=program.from_code))
+        w.warnings.extend(check_placement(program, machine))
         homed = False
         for index, (move, commands) in enumerate(_steps(program)):
             w.source = input_line(program, index, move=False)

@@ -99,7 +99,8 @@ def test_a_drawing_far_from_work_zero_is_warned_once_and_told_to_use_origin(
     ``--origin``; the writer checks the same rule and must neither repeat it nor give the
     remedy of G-code read back (FreeCAD's A0 templates with ``--fit`` were told both)."""
     dxf = str(plate(tmp_path / "p.dxf", x0=150.0))
-    code, err = post([dxf, "-t", "grbl", *OUTSIDE, "-o", str(tmp_path / "out.gcode")], capsys)
+    out = ["-o", str(tmp_path / "out.gcode"), "--verify", "--no-budget"]  # verify checks too
+    code, err = post([dxf, "-t", "grbl", *OUTSIDE, *out], capsys)
     assert code == 0
     assert err.count("work zero cannot be a point the tool reaches") == 1
     assert "lies 251.5 mm from its far side" in err and "use --origin lower-left" in err
@@ -118,6 +119,12 @@ def test_a_reposted_program_far_from_work_zero_is_not_told_to_use_origin(
     assert "work zero (X0 Y0) lies 253 mm from its far side, more than the 200 mm X" in err
     assert "set it with an offset from a point the tool reaches, or move the program" in err
     assert "--origin" not in err
+    # verifying or sending the file as it is: the same advice (neither takes --origin)
+    for command in (["verify", "--no-budget"], ["send", "--dry-run"]):
+        assert main([command[0], str(source), "-t", "grbl", *command[1:]]) == 0
+        err = capsys.readouterr().err
+        assert "move the program in the program that wrote it" in err
+        assert "--origin" not in err
 
 
 def test_the_start_position_and_the_lift_there_stay(tmp_path: Path) -> None:
