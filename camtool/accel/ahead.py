@@ -2,9 +2,11 @@
 
 A command that will need a slow import late (matplotlib for a PNG: ~0.3 s) forks a
 :class:`Helper` early; told to :meth:`~Helper.load` where this process leaves a core idle, it
-imports what it needs; asked once, it answers and leaves. Where there is no ``fork``, in a
-worker process, when the fork fails or the helper dies, the caller does the work itself
-(the same answer). :class:`HelperAhead` holds a process's one helper of a kind.
+imports what it needs; asked once, it answers and leaves. An answer may come in parts
+(:meth:`~Helper.parts`), each taken as this process needs it while the helper makes the
+next. Where there is no ``fork``, in a worker process, when the fork fails or the helper
+dies, the caller does the work itself (the same answer). :class:`HelperAhead` holds a
+process's one helper of a kind.
 """
 
 from __future__ import annotations
@@ -12,13 +14,15 @@ from __future__ import annotations
 import contextlib
 import os
 import signal
-from collections.abc import Callable
+import time
+from collections.abc import Callable, Generator, Iterable
 
 from camtool.accel.cores import (
     FORK,
     end_process,
     fork_with_pipes,
     in_worker,
+    patience,
     quiet_crashes,
     read_record,
     write_record,
@@ -33,13 +37,16 @@ class Helper:
 
     Args:
         prepare: run in the helper when it is told to load (an import).
-        answer: run in the helper on the one request's bytes; its bytes are sent back.
+        answer: run in the helper on the one request's bytes; its bytes are sent back, or
+            each of the parts it yields, in order (for :meth:`parts`).
 
     Raises:
         OSError: it cannot be forked now (:func:`~camtool.accel.cores.fork_with_pipes`).
     """
 
-    def __init__(self, prepare: Callable[[], None], answer: Callable[[bytes], bytes]) -> None:
+    def __init__(
+        self, prepare: Callable[[], None], answer: Callable[[bytes], bytes | Iterable[bytes]]
+    ) -> None:
         def serve(inbox: int, out: int) -> None:  # in the helper
             signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C
             quiet_crashes()
@@ -48,9 +55,12 @@ class Helper:
             prepare()
             data = read_record(inbox)
             if data is not None:
-                write_record(out, answer(data))
+                answered = answer(data)
+                for part in [answered] if isinstance(answered, bytes) else answered:
+                    write_record(out, part)
 
         pid, inbox, out = fork_with_pipes(serve)
+        self.started = time.monotonic()
         self.pid: int | None = pid
         self.inbox: int | None = inbox
         self.out: int | None = out
@@ -79,6 +89,35 @@ class Helper:
         finally:
             self.close()
 
+    def parts(self, request: bytes, count: int) -> Generator[bytes, None, None]:
+        """The ``count`` parts of its answer to ``request``, each read when asked for.
+
+        The request is sent now; each part is waited for until
+        :func:`~camtool.accel.cores.patience` from the fork. The parts stop early where it
+        sent no more (it died, or hung). It leaves after the last part, or when the
+        iteration is closed (or :meth:`close` is called).
+        """
+        self.load()
+        assert self.inbox is not None and self.out is not None
+        out = self.out
+        try:
+            write_record(self.inbox, request)
+        except OSError:  # it died before it read the request: no parts
+            self.close()
+        return self._parts(out, count)
+
+    def _parts(self, out: int, count: int) -> Generator[bytes, None, None]:
+        try:
+            for _ in range(count):
+                if self.out != out:  # closed meanwhile: the fd may be another file's now
+                    return
+                part = read_record(out, patience(self.started))
+                if part is None:
+                    return
+                yield part
+        finally:
+            self.close()
+
     def close(self) -> None:
         """Close the pipes, end it (if it has not) and wait for it (idempotent)."""
         for fd in self.fds():
@@ -102,7 +141,9 @@ class HelperAhead:
         helper: the helper started and not yet used, else ``None``.
     """
 
-    def __init__(self, prepare: Callable[[], None], answer: Callable[[bytes], bytes]) -> None:
+    def __init__(
+        self, prepare: Callable[[], None], answer: Callable[[bytes], bytes | Iterable[bytes]]
+    ) -> None:
         self.prepare, self.answer = prepare, answer
         self.helper: Helper | None = None
         self._hooked = False
@@ -132,8 +173,30 @@ class HelperAhead:
         helper, self.helper = self.helper, None
         return None if helper is None else helper.ask(request)
 
+    def parts(self, request: bytes, count: int) -> Generator[bytes, None, None] | None:
+        """The helper's answer in ``count`` parts (:meth:`Helper.parts`); ``None``: no helper.
+
+        The helper stays this object's (:meth:`stop` ends it) until its last part is read.
+        """
+        helper = self.helper
+        if helper is None:
+            return None
+        parts = helper.parts(request, count)
+
+        def taken() -> Generator[bytes, None, None]:
+            try:
+                yield from parts
+            finally:
+                if self.helper is helper:
+                    self.helper = None
+
+        return taken()
+
     def stop(self) -> None:
-        """End the helper if it was not used (idempotent; a command's ``finally``)."""
+        """End the helper if it was not used or its parts not all read (idempotent).
+
+        A command's ``finally``.
+        """
         helper, self.helper = self.helper, None
         if helper is not None:
             helper.close()

@@ -5,11 +5,16 @@ Design notes: docs/internals.md, ``camtool/geometry/fitpool.py``.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Sequence
+import pickle
+from collections.abc import Callable, Generator, Iterable, Iterator, Sequence
+from contextlib import contextmanager, suppress
+from pathlib import Path
 from typing import Any, TypeAlias
 
 import numpy as np
 
+from camtool.accel import enabled
+from camtool.accel.ahead import HelperAhead
 from camtool.accel.cores import default_jobs
 from camtool.accel.pool import map_forked
 from camtool.geometry.arcfit import (
@@ -31,15 +36,20 @@ from camtool.geometry.curves import (
 from camtool.model.shapes import Arc, Line, Segment
 
 __all__ = [
+    "AHEAD_FROM_BYTES",
     "FIT_KERNELS",
     "KERNEL_FROM",
     "MIN_CURVES",
     "CurveKey",
+    "SharedFits",
     "fit_key",
     "fit_many",
     "fit_shared",
+    "fitter_ahead",
     "moved",
     "shape_key",
+    "start_ahead",
+    "stop_ahead",
 ]
 
 CurveKey: TypeAlias = tuple[str, tuple[Any, ...]]
@@ -172,6 +182,101 @@ def _fit_chunk(task: tuple[list[CurveKey], float]) -> list[_Packed | None]:
     return out
 
 
+AHEAD_FROM_BYTES = 1 << 18
+"""A drawing file of at least this many bytes (256 KiB) starts the fitter ahead
+(:func:`start_ahead`): enough, in the SVGs measured, for :data:`MIN_CURVES` curves."""
+
+_WARM_UP: CurveKey = ("cubic", ((0.0, 0.0), (1.0, 2.0), (3.0, 2.0), (4.0, 0.0)))
+"""A curve the helper fits once it has loaded the compiled fitter: numba loads a kernel's
+cached machine code at its first call."""
+
+
+def _load_ahead() -> None:
+    """In the helper: load the compiled fitter (:data:`FIT_KERNELS`) and its kernels."""
+    if FIT_KERNELS.get(KERNEL_FROM) is not None:
+        fit_key(_WARM_UP, 0.01)
+
+
+_PART = 256
+"""Fits in a part of the helper's answer (:func:`_fit_ahead`): ~15 ms of compiled fits, so
+the first part comes soon and this process takes each as it needs it."""
+
+
+def _fit_ahead(request: bytes) -> Iterator[bytes]:
+    """In the helper: the packed fits of the pickled ``(keys, tolerance)``, by parts.
+
+    Each part is :data:`_PART` keys' fits, pickled. One part, ``None`` pickled, when the
+    compiled fitter could not be loaded (no numba): the plain fits are the caller's, on
+    its pool.
+    """
+    keys, tolerance = pickle.loads(request)
+    if FIT_KERNELS.loaded() is None:
+        yield pickle.dumps(None)
+        return
+    for at in range(0, len(keys), _PART):
+        fits = _fit_chunk((keys[at : at + _PART], tolerance))
+        yield pickle.dumps(fits, protocol=pickle.HIGHEST_PROTOCOL)
+
+
+FITTER = HelperAhead(_load_ahead, _fit_ahead)
+"""This process's fitter started ahead (:func:`start_ahead`), used by one :class:`SharedFits`."""
+
+
+def start_ahead(size: int) -> None:
+    """Start a helper that loads the compiled fitter now, for a drawing file of ``size`` bytes.
+
+    Loading numba and the fitter's cached kernels costs ~0.6 s of one core; a big SVG's
+    reader spends its first seconds on the document's XML and svgelements' parse, on one
+    core, before its first fit. The helper (:class:`~camtool.accel.ahead.HelperAhead`)
+    loads them on the other core meanwhile, and :class:`SharedFits` then sends it the
+    curves (the same fits: the same compiled code, its answer pickled bit for bit). Started only
+    with the accel layer on, from :data:`AHEAD_FROM_BYTES`, on two cores or more, where
+    this process has not loaded the fitter itself; the caller calls :func:`stop_ahead`
+    when its reading ends, however it ends.
+    """
+    if size < AHEAD_FROM_BYTES or not enabled() or default_jobs() < 2:
+        return
+    if FIT_KERNELS.loaded() is None:
+        FITTER.start()
+        FITTER.load()
+
+
+def stop_ahead() -> None:
+    """End the helper :func:`start_ahead` started if no fit used it (idempotent)."""
+    FITTER.stop()
+
+
+@contextmanager
+def fitter_ahead(path: Path) -> Iterator[None]:
+    """:func:`start_ahead` for the drawing file at ``path``, :func:`stop_ahead` at the end."""
+    with suppress(OSError):  # a missing file: the reader says so
+        start_ahead(path.stat().st_size)
+    try:
+        yield
+    finally:
+        stop_ahead()
+
+
+def _parts_ahead(keys: Sequence[CurveKey], tolerance: float) -> Generator[Any, None, None] | None:
+    """The helper's packed fits of ``keys``, by parts (lists, in order); ``None``: no helper.
+
+    A part that is not a list (or the parts ending early) means the helper could not fit
+    them all: it died, hung (:func:`~camtool.accel.cores.patience`) or has no numba.
+    Closing the parts ends the helper.
+    """
+    request = pickle.dumps((list(keys), tolerance), protocol=pickle.HIGHEST_PROTOCOL)
+    parts = FITTER.parts(request, -(-len(keys) // _PART))
+    return None if parts is None else _unpickled(parts)
+
+
+def _unpickled(parts: Generator[bytes, None, None]) -> Generator[Any, None, None]:
+    try:
+        for part in parts:
+            yield pickle.loads(part)
+    finally:
+        parts.close()
+
+
 def _fit_or_none(key: CurveKey, tolerance: float) -> list[Segment] | None:
     try:
         return fit_key(key, tolerance)
@@ -242,6 +347,78 @@ def _ends(s: Segment, start: Any = None, end: Any = None) -> Segment:
     return Arc(a, b, s.centre, s.clockwise) if isinstance(s, Arc) else Line(a, b)
 
 
+class SharedFits:
+    """:func:`fit_many` of the first curve of each shape (:func:`shape_key`), moved onto the rest.
+
+    A panelised drawing repeats its parts: each shape is fitted once, on the machine's cores,
+    and its fit :func:`moved` onto every other curve of that shape (the first one met, in
+    ``keys``' order, is the one fitted). With a helper started ahead (:func:`start_ahead`),
+    the distinct shapes go to it at once, and :meth:`get` takes its fits part by part as
+    they are asked for, while it fits the next; a part it could not send is fitted here.
+
+    Args:
+        keys: the curves.
+        tolerance: mm (> 0), as for :func:`fit_key`.
+        jobs: worker processes, as for :func:`fit_many` (``1``: no helper either).
+        done: called with the shapes fitted so far and their count (from ``0``); with a
+            helper, only ``0``: the fits are taken as :meth:`get` needs them.
+    """
+
+    def __init__(
+        self,
+        keys: Sequence[CurveKey],
+        tolerance: float,
+        jobs: int | None = None,
+        *,
+        done: Callable[[int, int], None] | None = None,
+    ) -> None:
+        self.keys, self.tolerance, self.jobs = keys, tolerance, jobs
+        first: dict[Any, int] = {}
+        self.fitted_as: list[int] = []
+        for i, key in enumerate(keys):
+            shape = shape_key(key)
+            self.fitted_as.append(i if shape is None else first.setdefault(shape, i))
+        self.distinct = sorted(set(self.fitted_as))
+        total = len(self.distinct)
+        if done is not None:
+            done(0, total)
+        self.fits: dict[int, list[Segment] | None] = {}
+        workers = default_jobs() if jobs is None else max(1, jobs)
+        self.coming: Generator[Any, None, None] | None = None
+        if workers > 1 and total >= MIN_CURVES and FIT_KERNELS.loaded() is None:
+            self.coming = _parts_ahead([keys[i] for i in self.distinct], tolerance)
+        if self.coming is None:
+            told = None if done is None else (lambda n: done(n, total))
+            fits = fit_many([keys[i] for i in self.distinct], tolerance, jobs, done=told)
+            self.fits = dict(zip(self.distinct, fits, strict=True))
+
+    def get(self, i: int) -> list[Segment] | None:
+        """The fit of ``keys[i]``: :func:`fit_key`'s, or its shape's :func:`moved` onto it.
+
+        ``None`` where that fit raised.
+        """
+        j = self.fitted_as[i]
+        while j not in self.fits:
+            self._take()
+        segs = self.fits[j]
+        return segs if segs is None or j == i else moved(segs, self.keys[j], self.keys[i])
+
+    def _take(self) -> None:
+        """The helper's next part; where it has none, the rest of the fits made here."""
+        assert self.coming is not None
+        have = len(self.fits)
+        part = next(self.coming, None)
+        if not isinstance(part, list) or not part or have + len(part) > len(self.distinct):
+            self.coming.close()  # the helper is ended (it died, hung or has no numba)
+            self.coming = None
+            rest = self.distinct[have:]
+            fits = fit_many([self.keys[i] for i in rest], self.tolerance, self.jobs)
+            self.fits.update(zip(rest, fits, strict=True))
+            return
+        for n, packed in enumerate(part, start=have):
+            self.fits[self.distinct[n]] = None if packed is None else _unpack(packed)
+
+
 def fit_shared(
     keys: Sequence[CurveKey],
     tolerance: float,
@@ -249,39 +426,10 @@ def fit_shared(
     *,
     done: Callable[[int, int], None] | None = None,
 ) -> list[list[Segment] | None]:
-    """:func:`fit_many` of the first curve of each shape (:func:`shape_key`), moved onto the rest.
-
-    A panelised drawing repeats its parts: each shape is fitted once, on the machine's cores,
-    and its fit :func:`moved` onto every other curve of that shape, in ``keys``' order (the
-    first one met is the one fitted).
-
-    Args:
-        keys: the curves.
-        tolerance: mm (> 0), as for :func:`fit_key`.
-        jobs: worker processes, as for :func:`fit_many`.
-        done: called with the shapes fitted so far and their count (from ``0``).
+    """Every fit of :class:`SharedFits` (same arguments), in ``keys``' order.
 
     Returns:
         One entry per key, as :func:`fit_many` (``None`` where its shape's fit raised).
     """
-    first: dict[Any, int] = {}
-    fitted_as: list[int] = []
-    for i, key in enumerate(keys):
-        shape = shape_key(key)
-        fitted_as.append(i if shape is None else first.setdefault(shape, i))
-    distinct = sorted(set(fitted_as))
-    total = len(distinct)
-    if done is not None:
-        done(0, total)
-    told = None if done is None else (lambda n: done(n, total))
-    fits = dict(
-        zip(
-            distinct, fit_many([keys[i] for i in distinct], tolerance, jobs, done=told), strict=True
-        )
-    )
-    out: list[list[Segment] | None] = []
-    for i, key in enumerate(keys):
-        j = fitted_as[i]
-        segs = fits[j]
-        out.append(segs if segs is None or j == i else moved(segs, keys[j], key))
-    return out
+    fits = SharedFits(keys, tolerance, jobs, done=done)
+    return [fits.get(i) for i in range(len(keys))]

@@ -17,7 +17,15 @@ from camtool.accel.collector import collect_young
 from camtool.geometry.arcfit import check_tolerance
 from camtool.geometry.chain import closes_alone, with_end
 from camtool.geometry.curves import ellipse_extent, merge_arcs, semi_axes_gap
-from camtool.geometry.fitpool import MIN_CURVES, CurveKey, fit_key, fit_shared, moved, shape_key
+from camtool.geometry.fitpool import (
+    MIN_CURVES,
+    CurveKey,
+    SharedFits,
+    fit_key,
+    fitter_ahead,
+    moved,
+    shape_key,
+)
 from camtool.importers import svgclip
 from camtool.importers.options import MAX_COORDINATE_MM, ImportOptions, check_curve_size
 from camtool.importers.svgdoc import (
@@ -40,7 +48,13 @@ from camtool.importers.svgpage import (
     off_page_text,
     refusal_note,
 )
-from camtool.importers.svgstyle import SHAPER_LAYER, shaper_layer, style_of
+from camtool.importers.svgstyle import (
+    DEFAULT_LAYER,
+    on_layers,
+    shaper_layer,
+    style_of,
+    wanted_layers,
+)
 from camtool.model.errors import GeometryError, InputError, TooLargeError
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import (
@@ -55,9 +69,6 @@ from camtool.model.shapes import (
     bbox_union,
     distance,
 )
-
-DEFAULT_LAYER = "0"
-"""Contour.layer of shapes outside any Inkscape layer (the DXF default layer's name)."""
 
 _SHAPES = (se.Path, se.Rect, se.Circle, se.Ellipse, se.SimpleLine, se.Polyline, se.Polygon)
 
@@ -114,8 +125,19 @@ def svg_drawing(
     path = Path(path)
     options = options or ImportOptions()
     check_tolerance(options.tolerance)
+    with fitter_ahead(path):
+        return _drawing(path, options, progress, check)
+
+
+def _drawing(
+    path: Path,
+    options: ImportOptions,
+    progress: Progress,
+    check: Callable[[BBox], None] | None,
+) -> tuple[Drawing, float]:
+    """:func:`svg_drawing`'s work."""
     progress(Step("reading", name=path.name))
-    inkscape, named = _wanted_layers(path, options.layers)
+    inkscape, named = wanted_layers(path, options.layers)
     prepared = prepare(
         path,
         inkscape,
@@ -198,7 +220,7 @@ def svg_drawing(
         )
     warnings += unseen_warnings(path, hidden, faded, invisible, bare_lines, background)
     if named:
-        contours = _on_layers(path, contours, named)
+        contours = on_layers(path, contours, named)
     size_note = ""
     outside = [c for c in contours if contour_off_page(c, prepared.page)]
     if outside:
@@ -220,41 +242,6 @@ def svg_drawing(
         )
     drawing = Drawing(tuple(contours), str(path), tuple(warnings), size_note=size_note)
     return drawing, tolerance
-
-
-def _wanted_layers(
-    path: Path, layers: tuple[str, ...] | None
-) -> tuple[tuple[str, ...] | None, tuple[str, ...]]:
-    """``--layers`` as Inkscape layers (for :func:`prepare`) and layers of shapes outside them.
-
-    Those (``0``, Shaper's ``shaper pocket 4mm``) are kept after reading (:func:`_on_layers`).
-
-    Raises:
-        InputError: both kinds are named (the first would drop the second's shapes).
-    """
-    if layers is None:
-        return None, ()
-    named = tuple(n for n in layers if n == DEFAULT_LAYER or n.startswith(SHAPER_LAYER))
-    inkscape = tuple(n for n in layers if n not in named)
-    if named and inkscape:
-        raise InputError(
-            f"{path}: --layers names Inkscape layers ({', '.join(map(repr, inkscape))}) and "
-            f"the layers of shapes outside them ({', '.join(map(repr, named))}); name one "
-            "kind, or select them by operations of a job"
-        )
-    return (None if named else inkscape), named
-
-
-def _on_layers(path: Path, contours: list[Contour], named: tuple[str, ...]) -> list[Contour]:
-    """The contours on the layers ``named``; an unknown name is an InputError listing them."""
-    there = sorted({c.layer for c in contours}, key=str.casefold)
-    unknown = [n for n in named if n not in there]
-    if unknown:
-        raise InputError(
-            f"{path}: no layer named {', '.join(map(repr, unknown))}; its layers are "
-            + ", ".join(map(repr, there))
-        )
-    return [c for c in contours if c.layer in named]
 
 
 _DISTINCT_MM = 1e-6
@@ -449,22 +436,26 @@ def _label(shape: Any) -> str:
 class Fitter:
     """Fits curves by :data:`~camtool.geometry.fitpool.CurveKey` within ``tolerance`` mm.
 
-    ``done`` holds fits made ahead (in worker processes, :func:`_prefitted`), looked up by
-    the key's exact ``repr`` (every float's bits, ``-0.0`` apart from ``0.0``); any other
-    key, or one whose fit failed ahead, is fitted here, as without it. A Bézier of a shape
-    fitted before is that fit moved onto it (:func:`~camtool.geometry.fitpool.fit_shared`
-    ahead, :func:`~camtool.geometry.fitpool.moved` here: the same fits either way).
+    ``done`` holds fits made ahead (on the machine's cores, :func:`_prefitted`), ``index``
+    their keys' places by the key's exact ``repr`` (every float's bits, ``-0.0`` apart from
+    ``0.0``); any other key, or one whose fit failed ahead, is fitted here, as without it.
+    A Bézier of a shape fitted before is that fit moved onto it
+    (:class:`~camtool.geometry.fitpool.SharedFits` ahead,
+    :func:`~camtool.geometry.fitpool.moved` here: the same fits either way).
     """
 
-    def __init__(self, tolerance: float, done: dict[str, list[Segment]] | None = None):
+    def __init__(
+        self, tolerance: float, done: SharedFits | None = None, index: dict[str, int] | None = None
+    ):
         self.tolerance = tolerance
-        self.done = done or {}
+        self.done, self.index = done, index or {}
         self.shapes: dict[Any, tuple[CurveKey, list[Segment]]] = {}
 
     def __call__(self, key: CurveKey) -> list[Segment]:
         """The fit of ``key`` (a new list), made ahead or here."""
-        if self.done:
-            segs = self.done.get(repr(key))
+        if self.done is not None:
+            i = self.index.get(repr(key))
+            segs = None if i is None else self.done.get(i)
             if segs is not None:
                 return list(segs)
         shape = shape_key(key)
@@ -550,8 +541,9 @@ def _prefitted(
     Only for at least :data:`~camtool.geometry.fitpool.MIN_CURVES` curves: the shapes are
     converted once with a :class:`_Recorder` to collect the curves in order (a shape that
     fails here fails again, with its message, when converted for real), then
-    :func:`~camtool.geometry.fitpool.fit_shared` fits each shape once, telling ``progress``
-    the ``fitting`` stage (``total``: the distinct shapes) as the fits come in.
+    :class:`~camtool.geometry.fitpool.SharedFits` fits each shape once, telling ``progress``
+    the ``fitting`` stage (``total``: the distinct shapes) as the fits come in (with a
+    helper started ahead, the fits are taken as the contours need them).
     """
     count = sum(isinstance(seg, _CURVES) for _, segs in drawn for seg in segs or ())
     if count < MIN_CURVES:
@@ -564,12 +556,11 @@ def _prefitted(
             convert(segments, compose(page, affine_of(shape.transform)), tolerance, recorder)
         except Exception:  # converted again below, raising in order
             continue
-    keys = list({repr(k): k for k in recorder.keys}.items())
-    fits = fit_shared(
-        [k for _, k in keys], tolerance, done=lambda n, total: progress(Step("fitting", n, total))
+    keys = {repr(k): k for k in recorder.keys}
+    fits = SharedFits(
+        list(keys.values()), tolerance, done=lambda n, total: progress(Step("fitting", n, total))
     )
-    done = {text: segs for (text, _), segs in zip(keys, fits, strict=True) if segs is not None}
-    return Fitter(tolerance, done)
+    return Fitter(tolerance, fits, {text: i for i, text in enumerate(keys)})
 
 
 # ------------------------------------------------------------------ path segments to mm

@@ -1,17 +1,23 @@
-"""A drawn SVG shape's colour and linetype, as jobs select by them.
+"""A drawn SVG shape's colour, linetype and layer, as jobs and ``--layers`` select by them.
 
 The colour is the stroke's, else the fill's (SVG 1.1 §11.2-11.4, paint); the linetype
 says construction (:mod:`camtool.model.construction`): a stroke of dashes
 (``stroke-dasharray``, §11.4), or a Shaper Origin guide (``shaper:cutType="guide"``, the
-attribute Shaper Tools' own SVG export and many sheet-layout tools write).
+attribute Shaper Tools' own SVG export and many sheet-layout tools write). A shape outside
+any Inkscape layer is on layer ``0`` (:data:`DEFAULT_LAYER`), or on the layer its Shaper cut
+type names (:data:`SHAPER_LAYER`).
 """
 
 from __future__ import annotations
 
 import re
+from pathlib import Path
 from typing import Any
 
 import svgelements as se
+
+from camtool.model.errors import InputError
+from camtool.model.shapes import Contour
 
 _SHAPER = "{http://www.shapertools.com/namespaces/shaper}"
 _SHAPER_ATTRIBUTES = (_SHAPER + "cutType", _SHAPER + "pathType")
@@ -22,6 +28,8 @@ _SHAPER_NAMES = {
     "pocket": "pocket", "online": "online", "on-line": "online", "guide": "guide",
 }  # fmt: skip
 """Each value those attributes take (any case: ``onLine``), by camtool's name for it."""
+DEFAULT_LAYER = "0"
+"""Contour.layer of shapes outside any Inkscape layer (the DXF default layer's name)."""
 SHAPER_LAYER = "shaper "
 """The layer of a shape outside any Inkscape layer that Shaper's cut type says how to cut:
 ``"shaper outside"``, ``"shaper inside"``, ``"shaper pocket"``, ``"shaper online"``."""
@@ -115,3 +123,38 @@ def _dashed(values: Any) -> bool:
 
 def _none(paint: Any) -> bool:
     return paint is None or str(paint).strip().lower() == "none"
+
+
+def wanted_layers(
+    path: Path, layers: tuple[str, ...] | None
+) -> tuple[tuple[str, ...] | None, tuple[str, ...]]:
+    """``--layers`` as Inkscape layers (for :func:`prepare`) and layers of shapes outside them.
+
+    Those (``0``, Shaper's ``shaper pocket 4mm``) are kept after reading (:func:`on_layers`).
+
+    Raises:
+        InputError: both kinds are named (the first would drop the second's shapes).
+    """
+    if layers is None:
+        return None, ()
+    named = tuple(n for n in layers if n == DEFAULT_LAYER or n.startswith(SHAPER_LAYER))
+    inkscape = tuple(n for n in layers if n not in named)
+    if named and inkscape:
+        raise InputError(
+            f"{path}: --layers names Inkscape layers ({', '.join(map(repr, inkscape))}) and "
+            f"the layers of shapes outside them ({', '.join(map(repr, named))}); name one "
+            "kind, or select them by operations of a job"
+        )
+    return (None if named else inkscape), named
+
+
+def on_layers(path: Path, contours: list[Contour], named: tuple[str, ...]) -> list[Contour]:
+    """The contours on the layers ``named``; an unknown name is an InputError listing them."""
+    there = sorted({c.layer for c in contours}, key=str.casefold)
+    unknown = [n for n in named if n not in there]
+    if unknown:
+        raise InputError(
+            f"{path}: no layer named {', '.join(map(repr, unknown))}; its layers are "
+            + ", ".join(map(repr, there))
+        )
+    return [c for c in contours if c.layer in named]
