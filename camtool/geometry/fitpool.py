@@ -229,10 +229,10 @@ def start_ahead(size: int) -> None:
     reader spends its first seconds on the document's XML and svgelements' parse, on one
     core, before its first fit. The helper (:class:`~camtool.accel.ahead.HelperAhead`)
     loads them on the other core meanwhile, and :class:`SharedFits` then sends it the
-    curves (the same fits: the same compiled code, its answer pickled bit for bit). Started only
-    with the accel layer on, from :data:`AHEAD_FROM_BYTES`, on two cores or more, where
-    this process has not loaded the fitter itself; the caller calls :func:`stop_ahead`
-    when its reading ends, however it ends.
+    curves (the same fits: the same compiled code, its answer pickled bit for bit).
+    Started only with the accel layer on, from :data:`AHEAD_FROM_BYTES`, on two cores or
+    more, where this process has not loaded the fitter itself; the caller calls
+    :func:`stop_ahead` when its reading ends, however it ends.
     """
     if size < AHEAD_FROM_BYTES or not enabled() or default_jobs() < 2:
         return
