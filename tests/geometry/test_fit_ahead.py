@@ -23,6 +23,7 @@ from camtool.geometry.fitpool import AHEAD_FROM_BYTES, SharedFits, fit_key, fit_
 from camtool.importers.options import ImportOptions
 from camtool.importers.svg import svg_drawing
 from tests.geometry.test_fitpool import _keys
+from tests.preview.test_ahead import _gone
 
 pytest.importorskip("numba")
 pytestmark = [
@@ -68,14 +69,6 @@ def _spy(monkeypatch: pytest.MonkeyPatch) -> list[bool]:
 
     monkeypatch.setattr(fitpool, "_parts_ahead", spy)
     return sent
-
-
-def _gone(pid: int) -> bool:
-    try:
-        os.waitpid(pid, os.WNOHANG)
-    except ChildProcessError:
-        return True
-    return False
 
 
 def _started() -> int:
