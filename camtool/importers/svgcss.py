@@ -35,15 +35,28 @@ from camtool.model.errors import InputError
 SVG_NS = "http://www.w3.org/2000/svg"
 
 
+_LOCAL_NAMES: dict[object, str | None] = {}
+""":func:`local_name` by tag, for the first :data:`_LOCAL_NAMES_KEPT` tags met (every pass
+over a document asks it of every element)."""
+_LOCAL_NAMES_KEPT = 1024
+
+
 def local_name(element: ET.Element) -> str | None:
     """The tag without the SVG namespace; ``None`` for elements of other namespaces."""
     tag = element.tag
+    try:
+        return _LOCAL_NAMES[tag]
+    except KeyError:
+        pass
+    name: str | None = tag
     if not isinstance(tag, str):
-        return None  # comments, processing instructions
-    if tag.startswith("{"):
-        ns, _, name = tag[1:].partition("}")
-        return name if ns == SVG_NS else None
-    return tag
+        name = None  # comments, processing instructions
+    elif tag.startswith("{"):
+        ns, _, local = tag[1:].partition("}")
+        name = local if ns == SVG_NS else None
+    if len(_LOCAL_NAMES) < _LOCAL_NAMES_KEPT:
+        _LOCAL_NAMES[tag] = name
+    return name
 
 
 _CSS_COMMENT = re.compile(r"/\*.*?\*/", re.DOTALL)
