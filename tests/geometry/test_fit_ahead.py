@@ -18,6 +18,7 @@ from typing import Any
 
 import pytest
 
+from camtool.accel import cores
 from camtool.geometry import fitpool
 from camtool.geometry.fitpool import AHEAD_FROM_BYTES, SharedFits, fit_key, fit_shared
 from camtool.importers.options import ImportOptions
@@ -35,8 +36,10 @@ pytestmark = [
 @pytest.fixture(autouse=True)
 def _unloaded(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
     """This process as a new one (the compiled fitter not loaded), on two cores; no helper
-    left at the end."""
+    left at the end. A helper is waited for as long as it takes: on a loaded machine its
+    numba may take longer to load than the patience a command gives it."""
     monkeypatch.setattr(fitpool, "default_jobs", lambda: 2)
+    monkeypatch.setattr(cores, "HELPER_PATIENCE_MIN_S", 3600.0)
     fitpool.FIT_KERNELS.forget()
     try:
         yield
