@@ -128,9 +128,10 @@ def _none(paint: Any) -> bool:
 def wanted_layers(
     path: Path, layers: tuple[str, ...] | None
 ) -> tuple[tuple[str, ...] | None, tuple[str, ...]]:
-    """``--layers`` as Inkscape layers (for :func:`prepare`) and layers of shapes outside them.
+    """``--layers`` split: Inkscape layers, and layers of shapes outside them.
 
-    Those (``0``, Shaper's ``shaper pocket 4mm``) are kept after reading (:func:`on_layers`).
+    The first are for :func:`camtool.importers.svgdoc.prepare`; the second (``0``, Shaper's
+    ``shaper pocket 4mm``) are kept after reading (:func:`on_layers`).
 
     Raises:
         InputError: both kinds are named (the first would drop the second's shapes).
