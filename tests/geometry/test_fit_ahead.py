@@ -202,3 +202,21 @@ def test_a_big_svg_reads_the_same_with_the_helper_and_leaves_none(
     monkeypatch.setenv("CAMTOOL_ACCEL", "0")
     plain, _ = svg_drawing(path, ImportOptions())
     assert drawing.contours == plain.contours
+
+
+def test_a_real_svg_over_the_threshold_reads_the_same_with_the_helper(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """LinuxCNC's lathe-macro drawing (334 KB, Inkscape; fetched with ``rs274``)."""
+    from tests.corpus.conftest import CORPUS
+
+    path = CORPUS / "pkg/linuxcnc/usr/share/linuxcnc/ncfiles/macros/lathe/LatheMacro.svg"
+    if not path.is_file():
+        pytest.skip(f"{path} not fetched (python tests/corpus/fetch_corpus.py)")
+    assert path.stat().st_size >= AHEAD_FROM_BYTES
+    sent = _spy(monkeypatch)
+    drawing, tolerance = svg_drawing(path, ImportOptions(fit=(190.0, 190.0)))
+    assert sent == [True]
+    monkeypatch.setenv("CAMTOOL_ACCEL", "0")
+    plain, plain_tolerance = svg_drawing(path, ImportOptions(fit=(190.0, 190.0)))
+    assert (drawing.contours, tolerance) == (plain.contours, plain_tolerance)
