@@ -80,11 +80,13 @@ def kill_pool(pool: Any) -> None:
     The pool's processes are its private ``_processes`` (CPython's since 3.2; the
     public ``kill_workers`` comes only with Python 3.14). With its workers gone the
     pool's own thread sees them die and ends, so nothing waits for a file in flight;
-    it is waited for (its private ``_executor_manager_thread``): ending the interpreter
-    while it closes its wake-up pipe let CPython's exit hook write to the closed pipe and
-    print a traceback (``OSError: [Errno 9] Bad file descriptor``).
+    it is waited for (its private ``_executor_manager_thread``, taken before ``shutdown``,
+    which forgets it): ending the interpreter while it closes its wake-up pipe let
+    CPython's exit hook write to the closed pipe and print a traceback (``OSError: [Errno
+    9] Bad file descriptor``).
     """
     processes = list((getattr(pool, "_processes", None) or {}).values())
+    manager = getattr(pool, "_executor_manager_thread", None)
     for process in processes:
         with contextlib.suppress(OSError, ValueError):
             process.kill()
@@ -92,7 +94,6 @@ def kill_pool(pool: Any) -> None:
         with contextlib.suppress(OSError, ValueError, AssertionError):
             process.join(KILL_WAIT_S)
     pool.shutdown(wait=False, cancel_futures=True)
-    manager = getattr(pool, "_executor_manager_thread", None)
     if manager is not None:
         manager.join(KILL_WAIT_S)
 
