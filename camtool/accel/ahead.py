@@ -2,20 +2,24 @@
 
 A command that will need a slow import late (matplotlib for a PNG: ~0.3 s) forks a
 :class:`Helper` early; told to :meth:`~Helper.load` where this process leaves a core idle, it
-imports what it needs; asked once, it answers and leaves. An answer may come in parts
-(:meth:`~Helper.parts`), each taken as this process needs it while the helper makes the
-next. Where there is no ``fork``, in a worker process, when the fork fails or the helper
-dies, the caller does the work itself (the same answer). :class:`HelperAhead` holds a
-process's one helper of a kind.
+imports what it needs; asked once, it answers and leaves. A streamed helper takes requests
+as this process makes them (:meth:`~Helper.send`) and answers each in parts, which this
+process takes as it needs them (:meth:`~Helper.take`) while the helper makes the next.
+Where there is no ``fork``, in a worker process, when the fork fails or the helper dies,
+the caller does the work itself (the same answer). :class:`HelperAhead` holds a process's
+one helper of a kind.
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
+import queue
 import signal
+import threading
 import time
-from collections.abc import Callable, Generator, Iterable
+from collections.abc import Callable, Iterator
+from typing import Any
 
 from camtool.accel.cores import (
     FORK,
@@ -37,27 +41,34 @@ class Helper:
 
     Args:
         prepare: run in the helper when it is told to load (an import).
-        answer: run in the helper on the one request's bytes; its bytes are sent back, or
-            each of the parts it yields, in order (for :meth:`parts`).
+        answer: run in the helper on the one request's bytes; its bytes are sent back. A
+            ``streamed`` helper's runs on the requests as they come (an iterator, ended by
+            :meth:`end`) and yields the parts of its answers, each sent back as it comes.
+        streamed: requests and answers by parts (:meth:`send`, :meth:`end`, :meth:`take`)
+            rather than one :meth:`ask`.
 
     Raises:
         OSError: it cannot be forked now (:func:`~camtool.accel.cores.fork_with_pipes`).
     """
 
     def __init__(
-        self, prepare: Callable[[], None], answer: Callable[[bytes], bytes | Iterable[bytes]]
+        self, prepare: Callable[[], None], answer: Callable[[Any], Any], *, streamed: bool = False
     ) -> None:
         def serve(inbox: int, out: int) -> None:  # in the helper
             signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C
             quiet_crashes()
             if os.read(inbox, 1) != _LOAD:
                 return  # the pipe ended first: the job ended or failed
+            if streamed:
+                requests = _requests(inbox)  # read as they come, even while loading
+                prepare()
+                for part in answer(requests):
+                    write_record(out, part)
+                return
             prepare()
             data = read_record(inbox)
             if data is not None:
-                answered = answer(data)
-                for part in [answered] if isinstance(answered, bytes) else answered:
-                    write_record(out, part)
+                write_record(out, answer(data))
 
         pid, inbox, out = fork_with_pipes(serve)
         self.started = time.monotonic()
@@ -89,34 +100,32 @@ class Helper:
         finally:
             self.close()
 
-    def parts(self, request: bytes, count: int) -> Generator[bytes, None, None]:
-        """The ``count`` parts of its answer to ``request``, each read when asked for.
-
-        The request is sent now; each part is waited for until
-        :func:`~camtool.accel.cores.patience` from the fork. The parts stop early where it
-        sent no more (it died, or hung). It leaves after the last part, or when the
-        iteration is closed (or :meth:`close` is called).
-        """
+    def send(self, request: bytes) -> bool:
+        """Send a streamed helper one more request; ``False`` (and it is ended) if it died."""
         self.load()
-        assert self.inbox is not None and self.out is not None
-        out = self.out
+        if self.inbox is None:
+            return False
         try:
             write_record(self.inbox, request)
-        except OSError:  # it died before it read the request: no parts
+        except OSError:
             self.close()
-        return self._parts(out, count)
+            return False
+        return True
 
-    def _parts(self, out: int, count: int) -> Generator[bytes, None, None]:
-        try:
-            for _ in range(count):
-                if self.out != out:  # closed meanwhile: the fd may be another file's now
-                    return
-                part = read_record(out, patience(self.started))
-                if part is None:
-                    return
-                yield part
-        finally:
+    def end(self) -> bool:
+        """Tell a streamed helper that no request follows (:meth:`send`)."""
+        return self.send(b"")
+
+    def take(self) -> bytes | None:
+        """A streamed helper's next part, in the order it made them.
+
+        Waited for until :func:`~camtool.accel.cores.patience` from the fork; ``None`` when
+        it sends no more (it died, hung, or was ended): it is then ended.
+        """
+        part = None if self.out is None else read_record(self.out, patience(self.started))
+        if part is None:
             self.close()
+        return part
 
     def close(self) -> None:
         """Close the pipes, end it (if it has not) and wait for it (idempotent)."""
@@ -142,9 +151,9 @@ class HelperAhead:
     """
 
     def __init__(
-        self, prepare: Callable[[], None], answer: Callable[[bytes], bytes | Iterable[bytes]]
+        self, prepare: Callable[[], None], answer: Callable[[Any], Any], *, streamed: bool = False
     ) -> None:
-        self.prepare, self.answer = prepare, answer
+        self.prepare, self.answer, self.streamed = prepare, answer, streamed
         self.helper: Helper | None = None
         self._hooked = False
 
@@ -161,7 +170,7 @@ class HelperAhead:
             os.register_at_fork(after_in_child=self._forget_in_child)
             self._hooked = True
         with contextlib.suppress(OSError):  # no fork now: the work is done here
-            self.helper = Helper(self.prepare, self.answer)
+            self.helper = Helper(self.prepare, self.answer, streamed=self.streamed)
 
     def load(self) -> None:
         """Tell the helper to load now: call it where this process leaves a core idle."""
@@ -173,27 +182,28 @@ class HelperAhead:
         helper, self.helper = self.helper, None
         return None if helper is None else helper.ask(request)
 
-    def parts(self, request: bytes, count: int) -> Generator[bytes, None, None] | None:
-        """The helper's answer in ``count`` parts (:meth:`Helper.parts`); ``None``: no helper.
+    def send(self, request: bytes) -> bool:
+        """:meth:`Helper.send` to the streamed helper; ``False``: no helper (any more)."""
+        return self.helper is not None and self._kept(self.helper.send(request))
 
-        The helper stays this object's (:meth:`stop` ends it) until its last part is read.
-        """
-        helper = self.helper
-        if helper is None:
-            return None
-        parts = helper.parts(request, count)
+    def end(self) -> bool:
+        """:meth:`Helper.end`; ``False``: no helper (any more)."""
+        return self.helper is not None and self._kept(self.helper.end())
 
-        def taken() -> Generator[bytes, None, None]:
-            try:
-                yield from parts
-            finally:
-                if self.helper is helper:
-                    self.helper = None
+    def take(self) -> bytes | None:
+        """:meth:`Helper.take`; ``None``: no helper (any more), or no more parts."""
+        part = None if self.helper is None else self.helper.take()
+        self._kept(part is not None)
+        return part
 
-        return taken()
+    def _kept(self, alive: bool) -> bool:
+        """``alive``, the helper dropped (it was ended) when not."""
+        if not alive:
+            self.stop()
+        return alive
 
     def stop(self) -> None:
-        """End the helper if it was not used or its parts not all read (idempotent).
+        """End the helper if it was not used or its parts not all taken (idempotent).
 
         A command's ``finally``.
         """
@@ -208,3 +218,24 @@ class HelperAhead:
                 with contextlib.suppress(OSError):
                     os.close(fd)
         self.helper = None
+
+
+def _requests(inbox: int) -> Iterator[bytes]:
+    """In a streamed helper: the requests from ``inbox`` in order, read by a thread.
+
+    The thread reads each as it comes, so this process's :meth:`Helper.send` never waits
+    for the helper to take the last request (while it writes a part this process has not
+    taken yet, both would wait for ever). It ends at the empty request (:meth:`Helper.end`)
+    or at the end of the pipe.
+    """
+    arrived: queue.SimpleQueue[bytes | None] = queue.SimpleQueue()
+
+    def read() -> None:
+        while True:
+            request = read_record(inbox)
+            arrived.put(request or None)
+            if not request:
+                return
+
+    threading.Thread(target=read, daemon=True).start()
+    return iter(arrived.get, None)

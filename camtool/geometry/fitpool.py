@@ -6,7 +6,7 @@ Design notes: docs/internals.md, ``camtool/geometry/fitpool.py``.
 from __future__ import annotations
 
 import pickle
-from collections.abc import Callable, Generator, Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import Any, TypeAlias
@@ -202,23 +202,24 @@ _PART = 256
 the first part comes soon and this process takes each as it needs it."""
 
 
-def _fit_ahead(request: bytes) -> Iterator[bytes]:
-    """In the helper: the packed fits of the pickled ``(keys, tolerance)``, by parts.
+def _fit_ahead(requests: Iterator[bytes]) -> Iterator[bytes]:
+    """In the helper: the packed fits of each pickled ``(tolerance, keys)``, by parts.
 
-    Each part is :data:`_PART` keys' fits, pickled. One part, ``None`` pickled, when the
-    compiled fitter could not be loaded (no numba): the plain fits are the caller's, on
-    its pool.
+    Each part is the fits of at most :data:`_PART` keys, pickled, in the keys' order. One
+    part, ``None`` pickled, when the compiled fitter could not be loaded (no numba): the
+    plain fits are the caller's, on its pool.
     """
-    keys, tolerance = pickle.loads(request)
-    if FIT_KERNELS.loaded() is None:
-        yield pickle.dumps(None)
-        return
-    for at in range(0, len(keys), _PART):
-        fits = _fit_chunk((keys[at : at + _PART], tolerance))
-        yield pickle.dumps(fits, protocol=pickle.HIGHEST_PROTOCOL)
+    for request in requests:
+        tolerance, keys = pickle.loads(request)
+        if FIT_KERNELS.loaded() is None:
+            yield pickle.dumps(None)
+            return
+        for at in range(0, len(keys), _PART):
+            fits = _fit_chunk((keys[at : at + _PART], tolerance))
+            yield pickle.dumps(fits, protocol=pickle.HIGHEST_PROTOCOL)
 
 
-FITTER = HelperAhead(_load_ahead, _fit_ahead)
+FITTER = HelperAhead(_load_ahead, _fit_ahead, streamed=True)
 """This process's fitter started ahead (:func:`start_ahead`), used by one :class:`SharedFits`."""
 
 
@@ -255,26 +256,6 @@ def fitter_ahead(path: Path) -> Iterator[None]:
         yield
     finally:
         stop_ahead()
-
-
-def _parts_ahead(keys: Sequence[CurveKey], tolerance: float) -> Generator[Any, None, None] | None:
-    """The helper's packed fits of ``keys``, by parts (lists, in order); ``None``: no helper.
-
-    A part that is not a list (or the parts ending early) means the helper could not fit
-    them all: it died, hung (:func:`~camtool.accel.cores.patience`) or has no numba.
-    Closing the parts ends the helper.
-    """
-    request = pickle.dumps((list(keys), tolerance), protocol=pickle.HIGHEST_PROTOCOL)
-    parts = FITTER.parts(request, -(-len(keys) // _PART))
-    return None if parts is None else _unpickled(parts)
-
-
-def _unpickled(parts: Generator[bytes, None, None]) -> Generator[Any, None, None]:
-    try:
-        for part in parts:
-            yield pickle.loads(part)
-    finally:
-        parts.close()
 
 
 def _fit_or_none(key: CurveKey, tolerance: float) -> list[Segment] | None:
@@ -352,71 +333,101 @@ class SharedFits:
 
     A panelised drawing repeats its parts: each shape is fitted once, on the machine's cores,
     and its fit :func:`moved` onto every other curve of that shape (the first one met, in
-    ``keys``' order, is the one fitted). With a helper started ahead (:func:`start_ahead`),
-    the distinct shapes go to it at once, and :meth:`get` takes its fits part by part as
-    they are asked for, while it fits the next; a part it could not send is fitted here.
+    the order :meth:`add` is given them, is the one fitted). With a helper started ahead
+    (:func:`start_ahead`), the new shapes go to it as they are added, :data:`_PART` at a
+    time, so that it fits them while the caller goes on, and :meth:`get` takes its fits
+    part by part as they are asked for; what it could not send is fitted here.
 
     Args:
-        keys: the curves.
         tolerance: mm (> 0), as for :func:`fit_key`.
         jobs: worker processes, as for :func:`fit_many` (``1``: no helper either).
-        done: called with the shapes fitted so far and their count (from ``0``); with a
-            helper, only ``0``: the fits are taken as :meth:`get` needs them.
     """
 
-    def __init__(
-        self,
-        keys: Sequence[CurveKey],
-        tolerance: float,
-        jobs: int | None = None,
-        *,
-        done: Callable[[int, int], None] | None = None,
-    ) -> None:
-        self.keys, self.tolerance, self.jobs = keys, tolerance, jobs
-        first: dict[Any, int] = {}
-        self.fitted_as: list[int] = []
-        for i, key in enumerate(keys):
-            shape = shape_key(key)
-            self.fitted_as.append(i if shape is None else first.setdefault(shape, i))
-        self.distinct = sorted(set(self.fitted_as))
+    def __init__(self, tolerance: float, jobs: int | None = None) -> None:
+        self.tolerance, self.jobs = tolerance, jobs
+        self.keys: list[CurveKey] = []
+        self.fitted_as: list[int] = []  # per key, the key whose fit it takes
+        self.distinct: list[int] = []  # the keys fitted, in order
+        self.fits: dict[int, list[Segment] | None] = {}
+        self.sent = self.taken = 0  # of distinct: sent to the helper, taken from it
+        self._first: dict[Any, int] = {}
+        workers = default_jobs() if jobs is None else max(1, jobs)
+        self.ahead = workers > 1 and FIT_KERNELS.loaded() is None and FITTER.helper is not None
+        self.closed = False
+
+    def add(self, key: CurveKey) -> int:
+        """Add the curve ``key``; its index for :meth:`get`."""
+        i = len(self.keys)
+        self.keys.append(key)
+        shape = shape_key(key)
+        j = i if shape is None else self._first.setdefault(shape, i)
+        self.fitted_as.append(j)
+        if j == i:
+            self.distinct.append(i)
+            if self.ahead and len(self.distinct) - self.sent >= _PART:
+                self._send()
+        return i
+
+    def close(self, done: Callable[[int, int], None] | None = None) -> None:
+        """No more curves: the last ones go to the helper, or all are fitted here now.
+
+        ``done`` is called with the shapes fitted so far and their count (from ``0``);
+        with a helper, only ``0``: its fits are taken as :meth:`get` needs them.
+        """
+        self.closed = True
         total = len(self.distinct)
         if done is not None:
             done(0, total)
-        self.fits: dict[int, list[Segment] | None] = {}
-        workers = default_jobs() if jobs is None else max(1, jobs)
-        self.coming: Generator[Any, None, None] | None = None
-        if workers > 1 and total >= MIN_CURVES and FIT_KERNELS.loaded() is None:
-            self.coming = _parts_ahead([keys[i] for i in self.distinct], tolerance)
-        if self.coming is None:
-            told = None if done is None else (lambda n: done(n, total))
-            fits = fit_many([keys[i] for i in self.distinct], tolerance, jobs, done=told)
-            self.fits = dict(zip(self.distinct, fits, strict=True))
+        if self.ahead:
+            self._send()
+            if self.ahead and FITTER.end():
+                return
+        told = None if done is None else (lambda n: done(n, total))
+        self._fit_here(told)
 
     def get(self, i: int) -> list[Segment] | None:
-        """The fit of ``keys[i]``: :func:`fit_key`'s, or its shape's :func:`moved` onto it.
+        """The fit of curve ``i``: :func:`fit_key`'s, or its shape's :func:`moved` onto it.
 
-        ``None`` where that fit raised.
+        ``None`` where that fit raised. Only once :meth:`close` was called.
         """
+        assert self.closed
         j = self.fitted_as[i]
         while j not in self.fits:
             self._take()
         segs = self.fits[j]
         return segs if segs is None or j == i else moved(segs, self.keys[j], self.keys[i])
 
+    def _send(self) -> None:
+        """The shapes added since the last send, to the helper (none left: no helper)."""
+        batch = [self.keys[i] for i in self.distinct[self.sent :]]
+        if not batch:
+            return
+        request = pickle.dumps((self.tolerance, batch), protocol=pickle.HIGHEST_PROTOCOL)
+        if FITTER.send(request):
+            self.sent = len(self.distinct)
+        else:
+            self.ahead = False  # it died: what it did not send is fitted here
+
     def _take(self) -> None:
         """The helper's next part; where it has none, the rest of the fits made here."""
-        assert self.coming is not None
-        have = len(self.fits)
-        part = next(self.coming, None)
-        if not isinstance(part, list) or not part or have + len(part) > len(self.distinct):
-            self.coming.close()  # the helper is ended (it died, hung or has no numba)
-            self.coming = None
-            rest = self.distinct[have:]
-            fits = fit_many([self.keys[i] for i in rest], self.tolerance, self.jobs)
-            self.fits.update(zip(rest, fits, strict=True))
+        part = FITTER.take() if self.ahead else None
+        fits = None if part is None else pickle.loads(part)
+        if not isinstance(fits, list) or not fits or self.taken + len(fits) > self.sent:
+            FITTER.stop()  # it died, hung or has no numba
+            self.ahead = False
+            self._fit_here()
             return
-        for n, packed in enumerate(part, start=have):
-            self.fits[self.distinct[n]] = None if packed is None else _unpack(packed)
+        for packed in fits:
+            self.fits[self.distinct[self.taken]] = None if packed is None else _unpack(packed)
+            self.taken += 1
+        if self.taken == len(self.distinct):
+            FITTER.stop()  # it has sent every fit: it leaves
+
+    def _fit_here(self, done: Callable[[int], None] | None = None) -> None:
+        rest = self.distinct[self.taken :]
+        fits = fit_many([self.keys[i] for i in rest], self.tolerance, self.jobs, done=done)
+        self.fits.update(zip(rest, fits, strict=True))
+        self.taken = len(self.distinct)
 
 
 def fit_shared(
@@ -426,10 +437,13 @@ def fit_shared(
     *,
     done: Callable[[int, int], None] | None = None,
 ) -> list[list[Segment] | None]:
-    """Every fit of :class:`SharedFits` (same arguments), in ``keys``' order.
+    """Every fit of a :class:`SharedFits` given ``keys`` in order (``done``: its :meth:`close`'s).
 
     Returns:
         One entry per key, as :func:`fit_many` (``None`` where its shape's fit raised).
     """
-    fits = SharedFits(keys, tolerance, jobs, done=done)
+    fits = SharedFits(tolerance, jobs)
+    for key in keys:
+        fits.add(key)
+    fits.close(done)
     return [fits.get(i) for i in range(len(keys))]

@@ -469,19 +469,21 @@ class Fitter:
 
 
 class _Recorder(Fitter):
-    """Notes the keys instead of fitting; answers a line to the curve's end.
+    """Adds the keys to ``fits`` (each once) instead of fitting; answers a line to the curve's end.
 
     The line stands for the fit only to carry the pen on to the next segment's key (a fit
     ends exactly at the curve's end, unless it is dropped as of zero length: the keys that
     follow then differ and are fitted when met, see :class:`Fitter`).
     """
 
-    def __init__(self, tolerance: float):
-        super().__init__(tolerance)
-        self.keys: list[CurveKey] = []
+    def __init__(self, tolerance: float, fits: SharedFits):
+        super().__init__(tolerance, fits)
 
     def __call__(self, key: CurveKey) -> list[Segment]:
-        self.keys.append(key)
+        text = repr(key)
+        if text not in self.index:
+            assert self.done is not None
+            self.index[text] = self.done.add(key)
         args = key[1]
         if key[0] == "ellipse_arc":
             return [Line(args[5], args[6])]
@@ -539,16 +541,17 @@ def _prefitted(
     """A :class:`Fitter` holding the fits of the drawing's curves, made on every core.
 
     Only for at least :data:`~camtool.geometry.fitpool.MIN_CURVES` curves: the shapes are
-    converted once with a :class:`_Recorder` to collect the curves in order (a shape that
-    fails here fails again, with its message, when converted for real), then
-    :class:`~camtool.geometry.fitpool.SharedFits` fits each shape once, telling ``progress``
-    the ``fitting`` stage (``total``: the distinct shapes) as the fits come in (with a
-    helper started ahead, the fits are taken as the contours need them).
+    converted once with a :class:`_Recorder` to give the curves, in order, to a
+    :class:`~camtool.geometry.fitpool.SharedFits` (a shape that fails here fails again,
+    with its message, when converted for real), which fits each shape once, telling
+    ``progress`` the ``fitting`` stage (``total``: the distinct shapes) as the fits come
+    in (with a helper started ahead, it fits them as they are given, and the fits are
+    taken as the contours need them).
     """
     count = sum(isinstance(seg, _CURVES) for _, segs in drawn for seg in segs or ())
     if count < MIN_CURVES:
         return Fitter(tolerance)
-    recorder = _Recorder(tolerance)
+    recorder = _Recorder(tolerance, SharedFits(tolerance))
     for shape, segments in drawn:
         if segments is None:
             continue
@@ -556,11 +559,9 @@ def _prefitted(
             convert(segments, compose(page, affine_of(shape.transform)), tolerance, recorder)
         except Exception:  # converted again below, raising in order
             continue
-    keys = {repr(k): k for k in recorder.keys}
-    fits = SharedFits(
-        list(keys.values()), tolerance, done=lambda n, total: progress(Step("fitting", n, total))
-    )
-    return Fitter(tolerance, fits, {text: i for i, text in enumerate(keys)})
+    assert recorder.done is not None
+    recorder.done.close(lambda n, total: progress(Step("fitting", n, total)))
+    return Fitter(tolerance, recorder.done, recorder.index)
 
 
 # ------------------------------------------------------------------ path segments to mm

@@ -2,9 +2,9 @@
 
 The judge is the plain fit made in this process (:func:`fit_key` with the compiled fitter
 off), which the compiled fitter equals bit for bit (tests/geometry/test_fit_compiled.py):
-the helper may change the speed only. Whatever becomes of the helper (killed before or
-while its parts come, stopped, without numba, never used) the fits must come out the
-same, and no process may be left behind.
+the helper may change the speed only. Whatever becomes of the helper (killed before the
+curves are sent or while its parts come, stopped, without numba, never used) the fits
+must come out the same, and no process may be left behind.
 """
 
 from __future__ import annotations
@@ -60,18 +60,26 @@ def plain() -> list[Any]:
 
 
 def _spy(monkeypatch: pytest.MonkeyPatch) -> list[bool]:
-    """Whether each :class:`SharedFits` sent its curves to the helper (a fallback to the
-    fits made here would hide that it did not)."""
-    sent: list[bool] = []
-    parts = fitpool._parts_ahead
+    """For each part asked of the helper, whether it came (a fallback to the fits made
+    here would hide that none did)."""
+    taken: list[bool] = []
+    take = fitpool.FITTER.take
 
-    def spy(*args: Any) -> Any:
-        out = parts(*args)
-        sent.append(out is not None)
-        return out
+    def spy() -> bytes | None:
+        part = take()
+        taken.append(part is not None)
+        return part
 
-    monkeypatch.setattr(fitpool, "_parts_ahead", spy)
-    return sent
+    monkeypatch.setattr(fitpool.FITTER, "take", spy)
+    return taken
+
+
+def _shared(keys: list[fitpool.CurveKey]) -> SharedFits:
+    fits = SharedFits(0.01)
+    for key in keys:
+        fits.add(key)
+    fits.close()
+    return fits
 
 
 def _started() -> int:
@@ -84,11 +92,11 @@ def _started() -> int:
 def test_the_helper_fits_what_this_process_fits(
     plain: list[Any], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    sent = _spy(monkeypatch)
+    taken = _spy(monkeypatch)
     pid = _started()
     counts: list[tuple[int, int]] = []
     assert fit_shared(KEYS, 0.01, done=lambda n, total: counts.append((n, total))) == plain
-    assert sent == [True]
+    assert taken and all(taken)
     assert counts == [(0, len(KEYS))]  # the fits are taken as they are needed
     assert fitpool.FIT_KERNELS.loaded() is None  # numba stayed out of this process
     assert fitpool.FITTER.helper is None and _gone(pid)
@@ -97,34 +105,45 @@ def test_the_helper_fits_what_this_process_fits(
 def test_copies_of_a_shape_take_its_fit_from_the_helper(monkeypatch: pytest.MonkeyPatch) -> None:
     keys = KEYS[: fitpool.MIN_CURVES]
     moved_copy = ("cubic", tuple((x + 7.5, y - 2.25) for x, y in keys[0][1]))
-    sent = _spy(monkeypatch)
+    taken = _spy(monkeypatch)
     _started()
     fits = fit_shared([*keys, moved_copy], 0.01)
-    assert sent == [True]
+    assert taken and all(taken)
     with fitpool.FIT_KERNELS.off():
         assert fits == fit_shared([*keys, moved_copy], 0.01, jobs=1)
 
 
-@pytest.mark.parametrize("when", ["before the request", "after the first part"])
+@pytest.mark.parametrize(
+    "when", ["before the curves", "between two batches of curves", "after the first part"]
+)
 def test_a_killed_helper_changes_nothing(
     when: str, plain: list[Any], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    sent = _spy(monkeypatch)
+    taken = _spy(monkeypatch)
     pid = _started()
-    if when == "before the request":
+    if when == "before the curves":
         os.kill(pid, signal.SIGKILL)
-    fits = SharedFits(KEYS, 0.01)
+    fits = SharedFits(0.01)
+    for i, key in enumerate(KEYS):
+        if when == "between two batches of curves" and i == fitpool._PART + 1:
+            os.kill(pid, signal.SIGKILL)  # after the first batch went out
+        fits.add(key)
+    fits.close()
     first = fits.get(0)
     if when == "after the first part":
         os.kill(pid, signal.SIGKILL)
     assert [first] + [fits.get(i) for i in range(1, len(KEYS))] == plain
-    assert sent == [True]
+    if when == "after the first part":
+        assert taken[0]
+    elif when == "before the curves":
+        assert True not in taken
+    # between two batches: the first batch's part may have come before the kill
     assert fitpool.FITTER.helper is None and _gone(pid)
 
 
 def test_a_helper_stopped_while_its_parts_come_changes_nothing(plain: list[Any]) -> None:
     pid = _started()
-    fits = SharedFits(KEYS, 0.01)
+    fits = _shared(KEYS)
     first = fits.get(0)
     fitpool.stop_ahead()  # the reader's end, as when it failed on a later shape
     assert _gone(pid)
@@ -140,7 +159,7 @@ def test_a_helper_without_numba_leaves_the_fits_here(plain: list[Any]) -> None:
 
 @pytest.mark.parametrize(
     "why",
-    ["small file", "switched off", "one core", "already loaded", "jobs=1", "few curves"],
+    ["small file", "switched off", "one core", "already loaded", "jobs=1"],
 )
 def test_no_helper_fits_where_it_would_not_pay(
     why: str, plain: list[Any], monkeypatch: pytest.MonkeyPatch
@@ -154,11 +173,11 @@ def test_no_helper_fits_where_it_would_not_pay(
         assert fitpool.FIT_KERNELS.get(fitpool.KERNEL_FROM) is not None
     fitpool.start_ahead(size)
     started = fitpool.FITTER.helper is not None
-    assert started == (why in ("jobs=1", "few curves"))
-    sent = _spy(monkeypatch)
-    keys = KEYS[: fitpool.MIN_CURVES - (why == "few curves")]
+    assert started == (why == "jobs=1")
+    taken = _spy(monkeypatch)
+    keys = KEYS[: fitpool.MIN_CURVES]
     assert fit_shared(keys, 0.01, jobs=1 if why == "jobs=1" else None) == plain[: len(keys)]
-    assert True not in sent
+    assert taken == []
     fitpool.stop_ahead()
     assert fitpool.FITTER.helper is None
 
@@ -186,7 +205,7 @@ def test_a_big_svg_reads_the_same_with_the_helper_and_leaves_none(
     path = tmp_path / "big.svg"
     _big_svg(path, 420)
     assert path.stat().st_size >= AHEAD_FROM_BYTES
-    sent = _spy(monkeypatch)
+    taken = _spy(monkeypatch)
     started: list[int] = []
     start = fitpool.start_ahead
 
@@ -197,7 +216,7 @@ def test_a_big_svg_reads_the_same_with_the_helper_and_leaves_none(
 
     monkeypatch.setattr(fitpool, "start_ahead", spy_start)
     drawing, _ = svg_drawing(path, ImportOptions())
-    assert sent == [True] and len(started) == 1
+    assert taken and all(taken) and len(started) == 1
     assert fitpool.FITTER.helper is None and _gone(started[0])
     monkeypatch.setenv("CAMTOOL_ACCEL", "0")
     plain, _ = svg_drawing(path, ImportOptions())
@@ -214,9 +233,9 @@ def test_a_real_svg_over_the_threshold_reads_the_same_with_the_helper(
     if not path.is_file():
         pytest.skip(f"{path} not fetched (python tests/corpus/fetch_corpus.py)")
     assert path.stat().st_size >= AHEAD_FROM_BYTES
-    sent = _spy(monkeypatch)
+    taken = _spy(monkeypatch)
     drawing, tolerance = svg_drawing(path, ImportOptions(fit=(190.0, 190.0)))
-    assert sent == [True]
+    assert taken and all(taken)
     monkeypatch.setenv("CAMTOOL_ACCEL", "0")
     plain, plain_tolerance = svg_drawing(path, ImportOptions(fit=(190.0, 190.0)))
     assert (drawing.contours, tolerance) == (plain.contours, plain_tolerance)
