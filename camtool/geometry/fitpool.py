@@ -198,8 +198,8 @@ def _load_ahead() -> None:
 
 
 _PART = 256
-"""Fits in a part of the helper's answer (:func:`_fit_ahead`): ~15 ms of compiled fits, so
-the first part comes soon and this process takes each as it needs it."""
+"""Curves in a request to the helper and fits in a part of its answer (:func:`_fit_ahead`):
+few enough that the first part comes soon and this process takes each as it needs it."""
 
 
 def _fit_ahead(requests: Iterator[bytes]) -> Iterator[bytes]:
@@ -226,11 +226,12 @@ FITTER = HelperAhead(_load_ahead, _fit_ahead, streamed=True)
 def start_ahead(size: int) -> None:
     """Start a helper that loads the compiled fitter now, for a drawing file of ``size`` bytes.
 
-    Loading numba and the fitter's cached kernels costs ~0.6 s of one core; a big SVG's
-    reader spends its first seconds on the document's XML and svgelements' parse, on one
-    core, before its first fit. The helper (:class:`~camtool.accel.ahead.HelperAhead`)
-    loads them on the other core meanwhile, and :class:`SharedFits` then sends it the
-    curves (the same fits: the same compiled code, its answer pickled bit for bit).
+    Loading numba and the fitter's cached kernels takes a core a while (figures:
+    docs/performance.md); a big SVG's reader spends its first seconds on the document's
+    XML and svgelements' parse, on one core, before its first fit. The helper
+    (:class:`~camtool.accel.ahead.HelperAhead`) loads them on the other core meanwhile,
+    and :class:`SharedFits` then sends it the curves (the same fits: the same compiled
+    code, its answer pickled bit for bit).
     Started only with the accel layer on, from :data:`AHEAD_FROM_BYTES`, on two cores or
     more, where this process has not loaded the fitter itself; the caller calls
     :func:`stop_ahead` when its reading ends, however it ends.

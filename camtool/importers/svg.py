@@ -469,15 +469,12 @@ class Fitter:
 
 
 class _Recorder(Fitter):
-    """Adds the keys to ``fits`` (each once) instead of fitting; answers a line to the curve's end.
+    """Gives the keys to its ``done`` (each once) instead of fitting; answers a line to the end.
 
     The line stands for the fit only to carry the pen on to the next segment's key (a fit
     ends exactly at the curve's end, unless it is dropped as of zero length: the keys that
     follow then differ and are fitted when met, see :class:`Fitter`).
     """
-
-    def __init__(self, tolerance: float, fits: SharedFits):
-        super().__init__(tolerance, fits)
 
     def __call__(self, key: CurveKey) -> list[Segment]:
         text = repr(key)
@@ -551,7 +548,8 @@ def _prefitted(
     count = sum(isinstance(seg, _CURVES) for _, segs in drawn for seg in segs or ())
     if count < MIN_CURVES:
         return Fitter(tolerance)
-    recorder = _Recorder(tolerance, SharedFits(tolerance))
+    fits = SharedFits(tolerance)
+    recorder = _Recorder(tolerance, fits)
     for shape, segments in drawn:
         if segments is None:
             continue
@@ -559,9 +557,8 @@ def _prefitted(
             convert(segments, compose(page, affine_of(shape.transform)), tolerance, recorder)
         except Exception:  # converted again below, raising in order
             continue
-    assert recorder.done is not None
-    recorder.done.close(lambda n, total: progress(Step("fitting", n, total)))
-    return Fitter(tolerance, recorder.done, recorder.index)
+    fits.close(lambda n, total: progress(Step("fitting", n, total)))
+    return Fitter(tolerance, fits, recorder.index)
 
 
 # ------------------------------------------------------------------ path segments to mm
