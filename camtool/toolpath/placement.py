@@ -25,6 +25,7 @@ from camtool.model.program import (
 )
 from camtool.model.shapes import BBox, Point, bbox_union
 from camtool.model.units import fmt_num
+from camtool.toolpath.options import PLACEMENTS
 
 if TYPE_CHECKING:
     from camtool.model.machine import Machine
@@ -132,15 +133,15 @@ def placement_shift(program: Program, placement: str, translate: Point) -> Point
         ValueError: ``placement`` is not one of
             :data:`~camtool.toolpath.options.PLACEMENTS`.
     """
-    box = toolpath_extent(program)
-    if placement == "drawing" or box is None:
+    if placement not in PLACEMENTS:
+        raise ValueError(f"unknown placement {placement!r}")
+    box = None if placement == "drawing" else toolpath_extent(program)  # drawing: not needed
+    if box is None:
         ref = (0.0, 0.0)
     elif placement == "lower-left":
         ref = (box[0], box[1])
-    elif placement == "center":
+    else:  # center
         ref = ((box[0] + box[2]) / 2.0, (box[1] + box[3]) / 2.0)
-    else:
-        raise ValueError(f"unknown placement {placement!r}")
     return (translate[0] - ref[0], translate[1] - ref[1])
 
 
