@@ -702,12 +702,13 @@ def feed_time_s(
     rate = target.machine.timing.get("max_rate_mm_min")
     x, y, z = start
     total = 0.0
-    from camtool.model.program import ArcMove, segment_of
+    from camtool.model.program import ArcMove
+    from camtool.model.shapes import arc_length
 
     for move in moves:
         nz = z if move.z is None else move.z
         xy = (
-            segment_of((x, y), move).length
+            arc_length((x, y), (move.x, move.y), (move.cx, move.cy), move.clockwise)
             if isinstance(move, ArcMove)
             else math.dist((x, y), (move.x, move.y))
         )

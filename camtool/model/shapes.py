@@ -72,6 +72,30 @@ def distance(a: Point, b: Point) -> float:
     return math.hypot(b[0] - a[0], b[1] - a[1])
 
 
+def arc_sweep(
+    start: Point, end: Point, centre: Point, clockwise: bool, radius: float, start_angle: float
+) -> float:
+    """:attr:`Arc.sweep` of that arc, radians (> 0 counter-clockwise), the same float.
+
+    ``radius`` and ``start_angle`` are the arc's :attr:`Arc.radius` and
+    :attr:`Arc.start_angle`; :func:`arc_length` computes them, :class:`Arc` keeps them.
+    """
+    if distance(start, end) <= FULL_CIRCLE_EPS * max(1.0, radius):  # Arc.is_full_circle
+        return -TAU if clockwise else TAU
+    end_angle = math.atan2(end[1] - centre[1], end[0] - centre[0])  # Arc.end_angle
+    ccw = (end_angle - start_angle) % TAU
+    if ccw == 0.0:
+        ccw = TAU
+    return -(TAU - ccw) if clockwise else ccw
+
+
+def arc_length(start: Point, end: Point, centre: Point, clockwise: bool) -> float:
+    """:attr:`Arc.length` of that arc, mm, the same float, without making the :class:`Arc`."""
+    radius = distance(centre, start)
+    start_angle = math.atan2(start[1] - centre[1], start[0] - centre[0])
+    return abs(arc_sweep(start, end, centre, clockwise, radius, start_angle)) * radius
+
+
 def fit_factor(box: BBox, fit: tuple[float, float]) -> float:
     """The uniform scale ``--fit W H`` applies to a drawing of extent ``box`` (mm).
 
@@ -208,12 +232,9 @@ class Arc:
 
         Its magnitude lies in (0, 2π]; a full circle has magnitude 2π.
         """
-        if self.is_full_circle:
-            return -TAU if self.clockwise else TAU
-        ccw = (self.end_angle - self.start_angle) % TAU
-        if ccw == 0.0:
-            ccw = TAU
-        return -(TAU - ccw) if self.clockwise else ccw
+        return arc_sweep(
+            self.start, self.end, self.centre, self.clockwise, self.radius, self.start_angle
+        )
 
     @cached_property
     def length(self) -> float:
