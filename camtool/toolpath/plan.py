@@ -450,7 +450,10 @@ def fit_dense(contours: Sequence[Contour], tolerance: float) -> tuple[list[Conto
             if isinstance(seg, Line):
                 run.append(seg)
                 continue
-            total += _fit_run(run, tolerance, segs)
+            if len(run) >= MIN_FIT_RUN:
+                total += _fit_run(run, tolerance, segs)
+            else:  # too short to fit (_fit_run's first rule, here: most runs are)
+                segs.extend(run)
             run = []
             if seg is not None:
                 segs.append(seg)
