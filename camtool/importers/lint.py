@@ -519,7 +519,10 @@ def duplicates(contours: Sequence[Contour], tolerance: float) -> list[Finding]:
         names = tuple(dict.fromkeys((_name(contours[ka]), _name(contours[kb]))))
         if kind == "duplicate":
             what = f"duplicate {seg}" if count == 1 else f"{count} duplicate segments"
-            msg = f"{what} at {_pt(where)}, {length:.4g} mm: cut twice"
+            msg = (
+                f"{what} at {_pt(where)}, {length:.4g} mm: drawn twice, so cut twice unless "
+                "a whole contour repeats another (post then cuts it once and says so)"
+            )
         else:
             what = f"overlapping {seg}s share" if count == 1 else f"{count} overlaps share"
             msg = f"{what} {length:.4g} mm at {_pt(where)}"

@@ -232,3 +232,20 @@ def test_what_ezdxf_logs_while_reading_is_a_warning_not_raw_stderr(
     )
     assert [f.kind for f in report.findings if f.kind in ("noted", "repaired")] == ["noted"]
     assert "what ezdxf noted while reading the file" in report.text()
+
+
+def test_a_whole_copy_is_not_said_to_be_cut_twice(tmp_path: Path) -> None:
+    """Two polylines on one square: inspect finds the duplicate, post cuts the square once."""
+    from camtool.importers import read_drawing
+    from camtool.toolpath.copies import drop_copies
+
+    def twice(msp: Any) -> None:
+        for _ in range(2):
+            msp.add_lwpolyline([(0, 0), (10, 0), (10, 10), (0, 10)], close=True)
+
+    path = write_dxf(tmp_path / "copy.dxf", twice)
+    done = inspect_drawing(path, ImportOptions())
+    (dup,) = [f for f in done.findings if f.kind == "duplicate"]
+    assert "unless a whole contour repeats another" in dup.message
+    kept, findings, _ = drop_copies(check_drawing(read_drawing(path), TOL)[0])
+    assert len(kept) == 1 and "cut once" in findings[0].message
