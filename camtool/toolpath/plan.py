@@ -452,7 +452,7 @@ def fit_dense(contours: Sequence[Contour], tolerance: float) -> tuple[list[Conto
                 continue
             if len(run) >= MIN_FIT_RUN:
                 total += _fit_run(run, tolerance, segs)
-            else:  # too short to fit (_fit_run's first rule, here: most runs are)
+            else:  # too short to fit: most runs are
                 segs.extend(run)
             run = []
             if seg is not None:
@@ -464,9 +464,10 @@ def fit_dense(contours: Sequence[Contour], tolerance: float) -> tuple[list[Conto
 
 
 def _fit_run(run: list[Line], tolerance: float, out: list[Segment]) -> FitStats:
-    if len(run) < MIN_FIT_RUN:
-        out.extend(run)
-        return FitStats(0, 0, 0)
+    """Append ``run``'s fit to ``out`` when it has fewer segments, else ``run``; its stats.
+
+    ``run`` holds :data:`MIN_FIT_RUN` lines or more (:func:`fit_dense` keeps shorter ones).
+    """
     points = [run[0].start, *(s.end for s in run)]
     fitted = fit_polyline(points, tolerance)
     if len(fitted) >= len(run):
