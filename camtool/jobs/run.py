@@ -33,6 +33,7 @@ from camtool.jobs.selection import (
 )
 from camtool.model.errors import InputError, ToolpathError, UsageError
 from camtool.model.program import (
+    ArcMove,
     Command,
     Dwell,
     Move,
@@ -43,7 +44,7 @@ from camtool.model.program import (
     spindle_start,
 )
 from camtool.model.progress import Progress, Step, no_progress
-from camtool.model.shapes import Arc, Contour, Drawing, Point, circle_of
+from camtool.model.shapes import Arc, Contour, Drawing, Point, arc_length, circle_of
 from camtool.toolpath.copies import one_way
 from camtool.toolpath.options import PlanOptions
 
@@ -702,9 +703,6 @@ def feed_time_s(
     rate = target.machine.timing.get("max_rate_mm_min")
     x, y, z = start
     total = 0.0
-    from camtool.model.program import ArcMove
-    from camtool.model.shapes import arc_length
-
     for move in moves:
         nz = z if move.z is None else move.z
         xy = (
