@@ -142,7 +142,7 @@ before = loaded()
 if sys.argv[1] == "warm":
     kernels.load_cached()
 warm = loaded()
-plan = PlanOptions(offset="outside", tool_diameter=3.0, depth=3.0, step_down=1.0)
+plan = PlanOptions(offset="outside", tool_diameter=3.0, depth=1.0)
 job = post_path(Path(sys.argv[2]), load_target("grbl"), plan)
 v = verify_job(job)
 v.error_budget  # its sources re-simulated and measured in this process
