@@ -31,6 +31,7 @@ from camtool.jobs.selection import (
     nothing_selected,
     select,
 )
+from camtool.jobs.travel import refuse_too_large
 from camtool.model.errors import InputError, ToolpathError, UsageError
 from camtool.model.program import (
     ArcMove,
@@ -261,7 +262,7 @@ def run_job(
     commands: list[tuple[int, Command]] = []
     warnings: list[str] = list(drawing.warnings)
     runs: list[OperationRun] = []
-    construction: list[Contour] = []
+    construction: dict[int, Contour] = {}  # by id: a contour two operations leave, once
     drilled: set[int] = set()  # the drawing's marks an operation selected, by id
     joint = joint_distance(setup.chain_tolerance)  # how the planner chains contours
     chaining = _chaining(drawing, scaled, joint)
@@ -269,13 +270,16 @@ def run_job(
     loaded: int | None = None
     sequence = job.sequenced()
     cut: list[tuple[Operation, str, tuple[Contour, ...]]] = []  # each operation's paths
-    for number, op in enumerate(sequence, start=1):
+    selections = [select(drawing, op.select, chaining) for op in sequence]
+    refuse_too_large(
+        job, sequence, [_as_scaled(s, drawing, scaled) for s in selections], setup, target
+    )
+    for number, (op, selected) in enumerate(zip(sequence, selections, strict=True), start=1):
         tool = job.tool(op.tool)
         where = _where(job, op, number)
-        selected = select(drawing, op.select, chaining)
         drilled.update(id(m) for m in selected.drawing.marks)
         chosen = _as_scaled(selected, drawing, scaled)
-        construction.extend(c for c in chosen.construction if c not in construction)
+        construction.update((id(c), c) for c in chosen.construction)
         if not chosen.drawing.contours and not chosen.drawing.marks:
             if job.shorthand and chosen.construction:
                 raise InputError(
@@ -322,10 +326,12 @@ def run_job(
         )
         del planned  # its moves are in ``moves``: not kept past the placement's shifted copy
     _end_at(moves, options)
-    notes = construction_notes(construction)
+    notes = construction_notes(list(construction.values()))
     if not job.shorthand:
         notes.extend(
-            unselected(scaled, runs, construction, joint, [p for *_, ps in cut for p in ps])
+            unselected(
+                scaled, runs, list(construction.values()), joint, [p for *_, ps in cut for p in ps]
+            )
         )
         notes.extend(undrilled(drawing, drilled))
     warnings[len(drawing.warnings) : len(drawing.warnings)] = notes

@@ -225,3 +225,106 @@ def test_a_refusal_for_size_without_shapes_off_the_page_says_nothing_of_the_page
         with pytest.raises(DialectError) as err:
             post_path(path, load_target("grbl"), plan)
         assert "--fit" in str(err.value) and "page" not in str(err.value)
+
+
+# A job: the box of what its profiles cut on the line or outside (and its engravings) is
+# within the toolpath's extent, so a job larger than the travel is refused before any of
+# its operations is planned (ezdxf's edgeminer 1_polylines.dxf, 224 m across, with the job
+# `job init` wrote: 51 s of planning to the same refusal).
+def _job(tmp_path: Path, operations: str) -> Any:
+    from camtool.jobs.jobfile import load_job
+
+    path = tmp_path / "job.toml"
+    path.write_text(
+        '[job]\norigin = "lower-left"\n\n[[tools]]\nid = 1\ndiameter = 3\n\n'
+        '[[tools]]\nid = 2\ntype = "drill"\ndiameter = 2\n\n' + operations
+    )
+    return load_job(path)
+
+
+def _layers(tmp_path: Path) -> Path:
+    """Layer BIG: a 640 × 30 mm rectangle; A: a 150 mm line at x 0…150; B: a 20 mm square at
+    x 300…320; HOLES: two 2 mm circles 600 mm apart."""
+
+    def build(msp: Any) -> None:
+        msp.add_lwpolyline(
+            [(0, 0), (640, 0), (640, 30), (0, 30)], close=True, dxfattribs={"layer": "BIG"}
+        )
+        msp.add_line((0, 100), (150, 100), dxfattribs={"layer": "A"})
+        msp.add_lwpolyline(
+            [(300, 100), (320, 100), (320, 120), (300, 120)], close=True, dxfattribs={"layer": "B"}
+        )
+        for x in (10.0, 610.0):
+            msp.add_circle((x, 60), 1.0, dxfattribs={"layer": "HOLES"})
+
+    return write_dxf(tmp_path / "layers.dxf", build)
+
+
+def _op(kind: str, layer: str, extra: str = "") -> str:
+    tool = 2 if kind == "drill" else 1
+    return (
+        f'[[operations]]\ntype = "{kind}"\ntool = {tool}\nlayers = ["{layer}"]\n'
+        f"depth = 1\n{extra}\n"
+    )
+
+
+@pytest.mark.parametrize(
+    ("operations", "size"),
+    [
+        (_op("profile", "BIG", 'side = "outside"'), r"640 × 30"),
+        (_op("profile", "BIG", 'side = "on"'), r"640 × 30"),
+        # each fits the travel alone; together they span 320 mm
+        (_op("engrave", "A") + _op("profile", "B", 'side = "outside"'), r"320 × 20"),
+    ],
+    ids=["outside", "on", "two-operations"],
+)
+def test_a_job_larger_than_the_travel_is_refused_before_planning(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, operations: str, size: str
+) -> None:
+    from camtool.importers import read_drawing
+    from camtool.jobs.run import run_job
+
+    drawing = read_drawing(_layers(tmp_path))
+    job = _job(tmp_path, operations)
+    monkeypatch.setattr(plan_module, "plan_unplaced", _never)
+    with pytest.raises(DialectError, match=rf"at least {size} mm.*refused before planning"):
+        run_job(drawing, load_target("grbl"), job)
+
+
+@pytest.mark.parametrize(
+    "operations",
+    [
+        _op("pocket", "BIG"),
+        _op("profile", "BIG", 'side = "inside"'),
+        _op("drill", "HOLES"),  # at the holes' centres: 600 mm apart, not their circles'
+    ],
+    ids=["pocket", "inside", "drill"],
+)
+def test_a_job_s_pockets_inside_profiles_and_drills_are_judged_after_planning(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, operations: str
+) -> None:
+    from camtool.importers import read_drawing
+    from camtool.jobs.run import run_job
+
+    drawing = read_drawing(_layers(tmp_path))
+    planned: list[bool] = []
+    plan_unplaced = plan_module.plan_unplaced
+
+    def noting(*args: Any, **kwargs: Any) -> Any:
+        planned.append(True)
+        return plan_unplaced(*args, **kwargs)
+
+    monkeypatch.setattr(plan_module, "plan_unplaced", noting)
+    with pytest.raises(DialectError, match=r"^the toolpath is (6\d\d|600)(\.\d+)? × "):
+        run_job(drawing, load_target("grbl"), _job(tmp_path, operations))
+    assert planned == ([] if "drill" in operations else [True])
+
+
+def test_a_job_within_the_travel_is_planned(tmp_path: Path) -> None:
+    from camtool.importers import read_drawing
+    from camtool.jobs.run import run_job
+
+    drawing = read_drawing(_layers(tmp_path))
+    job = run_job(drawing, load_target("grbl"), _job(tmp_path, _op("engrave", "A")))
+    xs = [m.x for m in job.program.moves if m.x is not None]
+    assert max(xs) - min(xs) == pytest.approx(150.0, abs=1e-6)
