@@ -96,12 +96,28 @@ def initial_job(
     else:
         ops.extend(_marks(drawing, thickness_mm))
     if not any(not op.commented for op in ops):
-        raise InputError(
-            f"{drawing.source or 'the drawing'}: nothing to cut: every contour is construction "
+        raise InputError(_nothing_to_cut(drawing, left))
+    return _render(ops, left, thickness_mm, tool_diameter, source or drawing.source, fit, no_z)
+
+
+def _nothing_to_cut(drawing: Drawing, left: Counter[str]) -> str:
+    """Why ``job init`` writes no job: every contour is construction, or there is none."""
+    about = f"{drawing.source or 'the drawing'}: nothing to cut"
+    if left:
+        return (
+            f"{about}: every contour is construction "
             f"({'; '.join(f'{w}: {n}' for w, n in sorted(left.items()))}); name its layer in "
             "an operation of a job written by hand to cut it"
         )
-    return _render(ops, left, thickness_mm, tool_diameter, source or drawing.source, fit, no_z)
+    n = len(drawing.marks)
+    if not n:
+        return f"{about}: the drawing has no contour"
+    layers = sorted({m.layer for m in drawing.marks}, key=str.casefold)
+    on = f"layer{'s' if len(layers) > 1 else ''} {', '.join(repr(x) for x in layers)}"
+    return (
+        f"{about}: the drawing has no contour, only {n} point{'s' if n > 1 else ''} (on {on}); "
+        "a drill operation of a job written by hand drills points (docs/jobs.md)"
+    )
 
 
 _Z_KEYS = ("depth =", "step_down =", "tabs =", "tab_height =", "# no tabs:")

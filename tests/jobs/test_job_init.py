@@ -154,6 +154,22 @@ def test_a_drawing_of_construction_only_has_nothing_to_cut(tmp_path: Path) -> No
         initial_job(read_drawing(write_dxf(tmp_path / "dims.dxf", build)))
 
 
+def test_a_drawing_of_points_only_says_so_and_names_the_drill_operation(tmp_path: Path) -> None:
+    """ezdxf's MODEL.dxf and Leica_Disto_S910.dxf: points, no contour; not "construction"."""
+
+    def build(msp: object) -> None:
+        for x in (0.0, 10.0, 20.0):
+            msp.add_point((x, 5.0), dxfattribs={"layer": "PTS"})  # type: ignore[attr-defined]
+
+    with pytest.raises(InputError) as err:
+        initial_job(read_drawing(write_dxf(tmp_path / "points.dxf", build)))
+    assert str(err.value) == (
+        f"{tmp_path / 'points.dxf'}: nothing to cut: the drawing has no contour, only 3 points "
+        "(on layer 'PTS'); a drill operation of a job written by hand drills points "
+        "(docs/jobs.md)"
+    )
+
+
 @pytest.mark.skipif(not KIN42.exists(), reason="the LibreCAD corpus is not fetched")
 def test_kin42_job_cuts_the_disc_and_not_its_diameter_lines() -> None:
     drawing = read_drawing(KIN42)
