@@ -268,14 +268,30 @@ def convert(item: Item, tolerance: float, limit: float = math.inf) -> list[Conto
 
 
 def layer_of(entity: Any) -> str:
-    """The entity's own layer name; ``"0"`` when it has none.
+    """The entity's own layer name (:func:`layer_name`); ``"0"`` when it has none.
 
     An entity may leave out group code 8 (R12 files do), and an entity of a type ezdxf
     does not know has no ``layer`` attribute at all (asking raises DXFAttributeError).
     """
     if not entity.dxf.is_supported("layer"):
         return "0"
-    return str(entity.dxf.get("layer", "0"))
+    return layer_name(str(entity.dxf.get("layer", "0")))
+
+
+def layer_name(raw: str) -> str:
+    r"""A layer name as the CAD program shows it: ``\U+039B`` written as ``Λ``.
+
+    A DXF file of R12 or older (a single-byte code page) writes a character its code page
+    lacks as ``\U+xxxx``; ezdxf decodes that notation in what it recovers
+    (``ezdxf.recover``), not in what it reads (``ezdxf.decode_dxf_unicode``). Decoded
+    here, a layer is selected (``--layers``, a job's ``layers``) and named by the name the
+    user sees in the CAD program.
+    """
+    if "\\U+" not in raw:
+        return raw
+    import ezdxf
+
+    return str(ezdxf.decode_dxf_unicode(raw))
 
 
 def invisible(entity: Any) -> bool:

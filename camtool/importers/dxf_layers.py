@@ -14,7 +14,7 @@ from collections import Counter
 from pathlib import Path
 from typing import Any
 
-from camtool.importers.dxf_entities import layer_of
+from camtool.importers.dxf_entities import layer_name, layer_of
 from camtool.model.errors import InputError
 
 
@@ -74,9 +74,10 @@ def hidden_layers(doc: Any) -> tuple[dict[str, str], set[str]]:
             off = cold or layer.is_off()
         except (AttributeError, TypeError, ValueError):  # a damaged LAYER entry: shown
             cold = off = False
-        key = str(layer.dxf.name).casefold()
+        name = layer_name(str(layer.dxf.name))
+        key = name.casefold()
         if off:
-            hidden[key] = str(layer.dxf.name)
+            hidden[key] = name
         if cold:
             frozen.add(key)
     return hidden, frozen
@@ -93,7 +94,8 @@ def layer_filter(
     named = {name.casefold() for name in (*(layers or ()), *shown)}
     if layers is None:
         return LayerFilter(None, hidden_layers(doc), named)
-    present = {layer.dxf.name for layer in doc.layers} | {layer_of(e) for e in doc.modelspace()}
+    present = {layer_name(str(layer.dxf.name)) for layer in doc.layers}
+    present |= {layer_of(e) for e in doc.modelspace()}
     by_key = {name.casefold(): name for name in present}
     unknown = [name for name in layers if name.casefold() not in by_key]
     if unknown:

@@ -24,6 +24,7 @@ class StyleResolver:
         self.doc = doc
         self._layers: dict[str, Style] = {}
         self._dashed: dict[str, bool] = {}
+        self._by_decoded: dict[str, Any] | None = None
 
     def style(self, entity: Any, layer: str, block: Style = CONTINUOUS) -> Style:
         """The colour and linetype ``entity`` on effective ``layer`` is drawn with.
@@ -58,7 +59,7 @@ class StyleResolver:
         from ezdxf.colors import aci2rgb
 
         table = self.doc.layers
-        record = table.get(name) if table.has_entry(name) else None
+        record = table.get(name) if table.has_entry(name) else self._decoded().get(name.casefold())
         if record is None:
             return "#ffffff", ""
         dxf = record.dxf
@@ -67,6 +68,19 @@ class StyleResolver:
         colour = _hex_int(true) if true is not None else _hex(aci2rgb(aci if aci < 256 else 7))
         linetype = str(dxf.get("linetype", "CONTINUOUS") or "CONTINUOUS").upper()
         return colour, (linetype if self._is_dashed(linetype) else "")
+
+    def _decoded(self) -> dict[str, Any]:
+        """The layer table's records by decoded, case-folded name, made on first need.
+
+        The names entities give (:func:`~camtool.importers.dxf_entities.layer_name`).
+        """
+        if self._by_decoded is None:
+            from camtool.importers.dxf_entities import layer_name
+
+            self._by_decoded = {}
+            for record in self.doc.layers:
+                self._by_decoded.setdefault(layer_name(str(record.dxf.name)).casefold(), record)
+        return self._by_decoded
 
     def _colour(self, dxf: Any, layer_colour: str, block_colour: str) -> str:
         from ezdxf.colors import aci2rgb

@@ -214,3 +214,39 @@ def test_inspect_lists_layers_colours_linetypes_and_construction() -> None:
         "circles": 0,
         "points": 0,
     }
+
+
+def _greek_r12(tmp_path: Path) -> Path:
+    """An R12 file (code page ANSI_1252) with Greek layer names, which ezdxf writes in the
+    ``\\U+xxxx`` notation, as AutoCAD does: a centre line on ΟΣΕΣ (linetype CENTER by
+    layer) across a circle on ΚΥΚΛΟΣ."""
+    doc = ezdxf.new("R12", setup=True)
+    doc.layers.add("ΟΣΕΣ", linetype="CENTER")
+    doc.layers.add("ΚΥΚΛΟΣ")
+    msp = doc.modelspace()
+    msp.add_line((-5, 10), (25, 10), dxfattribs={"layer": "ΟΣΕΣ"})
+    msp.add_circle((10, 10), 5, dxfattribs={"layer": "ΚΥΚΛΟΣ"})
+    path = tmp_path / "greek.dxf"
+    doc.saveas(path)
+    assert b"\\U+039" in path.read_bytes()  # the notation, not the letters
+    return path
+
+
+def test_an_r12_layer_name_in_unicode_notation_is_read_as_the_cad_program_shows_it(
+    tmp_path: Path,
+) -> None:
+    from camtool.importers.options import ImportOptions
+
+    path = _greek_r12(tmp_path)
+    drawing = read_drawing(path)
+    assert sorted((c.layer, c.linetype) for c in drawing.contours) == [
+        ("ΚΥΚΛΟΣ", ""),
+        ("ΟΣΕΣ", "CENTER"),  # its layer's linetype found under the decoded name
+    ]
+    (circle,) = read_drawing(path, ImportOptions(layers=("κυκλοσ",))).contours
+    assert circle.layer == "ΚΥΚΛΟΣ"
+    job = post_drawing(drawing, load_target("grbl"), PlanOptions(depth=1.0))
+    cuts = [m for m in job.program.moves if isinstance(m, Linear) and m.z is None]
+    assert not cuts  # the circle is cut as arcs; the centre line is not cut at all
+    (note,) = [w for w in job.warnings if "ΟΣΕΣ" in w]
+    assert note.startswith("not cut: 1 contour(s) on layer 'ΟΣΕΣ' (linetype CENTER")
