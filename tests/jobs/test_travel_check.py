@@ -42,6 +42,19 @@ def _never(*_: Any, **__: Any) -> Any:
     raise AssertionError("called after the drawing was found too large")
 
 
+def _planned(monkeypatch: pytest.MonkeyPatch) -> list[bool]:
+    """A list that gets ``True`` each time an operation is planned."""
+    planned: list[bool] = []
+    plan_unplaced = plan_module.plan_unplaced
+
+    def noting(*args: Any, **kwargs: Any) -> Any:
+        planned.append(True)
+        return plan_unplaced(*args, **kwargs)
+
+    monkeypatch.setattr(plan_module, "plan_unplaced", noting)
+    return planned
+
+
 def test_the_travel_is_grbls() -> None:
     assert load_target("grbl").machine.travel_mm == (GRBL_TRAVEL, GRBL_TRAVEL)
 
@@ -103,14 +116,7 @@ def test_inside_offsets_and_pockets_are_judged_after_planning(
         '<rect x="0" y="0" width="1000" height="50" fill="none" stroke="black"/>',
         root='width="1010mm" height="100mm" viewBox="0 0 1010 100"',
     )
-    planned: list[bool] = []
-    plan_unplaced = plan_module.plan_unplaced
-
-    def noting(*args: Any, **kwargs: Any) -> Any:
-        planned.append(True)
-        return plan_unplaced(*args, **kwargs)
-
-    monkeypatch.setattr(plan_module, "plan_unplaced", noting)
+    planned = _planned(monkeypatch)
     with pytest.raises(DialectError, match=r"^the toolpath is 99\d(\.\d+)? × "):
         post_path(path, load_target("grbl"), PlanOptions(offset=offset, tool_diameter=3.0))
     assert planned == [True]
@@ -307,14 +313,7 @@ def test_a_job_s_pockets_inside_profiles_and_drills_are_judged_after_planning(
     from camtool.jobs.run import run_job
 
     drawing = read_drawing(_layers(tmp_path))
-    planned: list[bool] = []
-    plan_unplaced = plan_module.plan_unplaced
-
-    def noting(*args: Any, **kwargs: Any) -> Any:
-        planned.append(True)
-        return plan_unplaced(*args, **kwargs)
-
-    monkeypatch.setattr(plan_module, "plan_unplaced", noting)
+    planned = _planned(monkeypatch)
     with pytest.raises(DialectError, match=r"^the toolpath is (6\d\d|600)(\.\d+)? × "):
         run_job(drawing, load_target("grbl"), _job(tmp_path, operations))
     assert planned == ([] if "drill" in operations else [True])
