@@ -271,9 +271,8 @@ def run_job(
     sequence = job.sequenced()
     cut: list[tuple[Operation, str, tuple[Contour, ...]]] = []  # each operation's paths
     selections = [select(drawing, op.select, chaining) for op in sequence]
-    refuse_too_large(
-        job, sequence, [_as_scaled(s, drawing, scaled) for s in selections], setup, target
-    )
+    scaled_selections = [(s, _as_scaled(s, drawing, scaled)) for s in selections]
+    refuse_too_large(job, sequence, scaled_selections, chaining, setup, target)
     for number, (op, selected) in enumerate(zip(sequence, selections, strict=True), start=1):
         tool = job.tool(op.tool)
         where = _where(job, op, number)

@@ -327,3 +327,32 @@ def test_a_job_within_the_travel_is_planned(tmp_path: Path) -> None:
     job = run_job(drawing, load_target("grbl"), _job(tmp_path, _op("engrave", "A")))
     xs = [m.x for m in job.program.moves if m.x is not None]
     assert max(xs) - min(xs) == pytest.approx(150.0, abs=1e-6)
+
+
+def test_an_outside_profile_s_open_contours_are_not_counted(tmp_path: Path) -> None:
+    """The planner leaves an open chain out of an outside profile: a 400 mm open line beside
+    a 20 mm square on one layer is no reason to refuse it. A 400 mm square of four LINEs is
+    closed once chained, and is one."""
+    from camtool.importers import read_drawing
+    from camtool.jobs.run import run_job
+
+    def build(msp: Any) -> None:
+        msp.add_lwpolyline(
+            [(0, 0), (20, 0), (20, 20), (0, 20)], close=True, dxfattribs={"layer": "P"}
+        )
+        msp.add_line((0, 50), (400, 50), dxfattribs={"layer": "P"})
+        for a, b in [
+            ((0, 100), (400, 100)),
+            ((400, 100), (400, 120)),
+            ((400, 120), (0, 120)),
+            ((0, 120), (0, 100)),
+        ]:
+            msp.add_line(a, b, dxfattribs={"layer": "Q"})
+
+    drawing = read_drawing(write_dxf(tmp_path / "open.dxf", build))
+    outside = 'side = "outside"'
+    job = run_job(drawing, load_target("grbl"), _job(tmp_path, _op("profile", "P", outside)))
+    xs = [m.x for m in job.program.moves if m.x is not None]
+    assert max(xs) - min(xs) == pytest.approx(23.0, abs=1e-6)  # the square and the tool
+    with pytest.raises(DialectError, match=r"at least 400 × 20 mm.*refused before planning"):
+        run_job(drawing, load_target("grbl"), _job(tmp_path, _op("profile", "Q", outside)))
