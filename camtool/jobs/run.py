@@ -271,13 +271,14 @@ def run_job(
     sequence = job.sequenced()
     cut: list[tuple[Operation, str, tuple[Contour, ...]]] = []  # each operation's paths
     selections = [select(drawing, op.select, chaining) for op in sequence]
-    scaled_selections = [(s, _as_scaled(s, drawing, scaled)) for s in selections]
-    refuse_too_large(job, sequence, scaled_selections, chaining, setup, target)
-    for number, (op, selected) in enumerate(zip(sequence, selections, strict=True), start=1):
+    selections_scaled = [(s, _as_scaled(s, drawing, scaled)) for s in selections]
+    refuse_too_large(job, sequence, selections_scaled, chaining, setup, target)
+    for number, (op, (selected, chosen)) in enumerate(
+        zip(sequence, selections_scaled, strict=True), start=1
+    ):
         tool = job.tool(op.tool)
         where = _where(job, op, number)
         drilled.update(id(m) for m in selected.drawing.marks)
-        chosen = _as_scaled(selected, drawing, scaled)
         construction.update((id(c), c) for c in chosen.construction)
         if not chosen.drawing.contours and not chosen.drawing.marks:
             if job.shorthand and chosen.construction:
