@@ -282,6 +282,10 @@ HANDSHAKES = ("", "dtr-dsr")
 """Values of ``[link] handshake``."""
 _POSITIVE = ("banner_timeout_s", "response_timeout_s")
 _COUNTS = ("baud", "rx_buffer_bytes", "max_block_bytes")
+MAX_BUFFER_BYTES = 1 << 20
+"""Largest ``rx_buffer_bytes`` and ``max_block_bytes`` taken (1 MiB): a controller's
+receive buffer or line is bytes to a few KiB (GRBL's 127, grblHAL's 1 KiB); a larger
+number is a typing error that would let the sender overflow the real buffer."""
 
 
 def link_spec(target: Target) -> LinkSpec:
@@ -350,6 +354,11 @@ def _checked(key: str, value: Any, where: str) -> Any:
     if key in _COUNTS:
         if value != int(value) or value <= 0:
             raise InputError(f"{where}: {key} must be a whole number > 0, not {value!r}")
+        if key != "baud" and value > MAX_BUFFER_BYTES:
+            raise InputError(
+                f"{where}: {key} must be at most {MAX_BUFFER_BYTES} bytes (a controller's "
+                f"buffer), not {value!r}"
+            )
         return int(value)
     if value < 0 or (key in _POSITIVE and value == 0):
         raise InputError(f"{where}: {key} must be > 0, not {value!r}")

@@ -207,3 +207,19 @@ def test_sigterm_stops_the_job_as_the_operator_would(job: Path) -> None:
     assert "stopped by the operator" in err
     assert "feed hold, then a reset (spindle and coolant off" in err
     assert "--from-line" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("key", ["rx_buffer_bytes", "max_block_bytes"])
+def test_a_buffer_larger_than_any_controller_s_is_refused(
+    job: Path, tmp_path: Path, key: str, capsys: Any
+) -> None:
+    """A buffer of 10**30 bytes would have the sender never wait for room: the real
+    controller's buffer would overflow and drop characters."""
+    grbl = Path(__file__).resolve().parents[2] / "postprocessors" / "grbl" / "grbl.toml"
+    text = grbl.read_text().replace("[link]\n", f"[link]\n{key} = {10**30}\n", 1)
+    text = text.replace("rx_buffer_bytes = 127", "") if key == "rx_buffer_bytes" else text
+    target = tmp_path / "big.toml"
+    target.write_text(text)
+    code, out, err = run(["send", str(job), "-t", str(target), "--dry-run"], capsys)
+    assert code == 3 and out == ""
+    assert f"{key} must be at most 1048576 bytes" in err
