@@ -285,26 +285,26 @@ def sized(
 
 
 def travel_check(plan: PlanOptions, target: Target) -> Callable[[BBox], None] | None:
-    """The check of a drawing's size against the travel before planning, or ``None``.
+    """The check of a drawing's size against the travel as it is read, or ``None``.
 
     Only where the toolpath passes within the chaining and fitting tolerances of every
-    point of the drawing: ``--offset on`` (each contour cut on its line) or ``outside``
-    (open contours on their line; a closed one's cut outside it, or, for a hole, inside
-    a contour whose cut is outside), without ``--fit`` (which scales the drawing into a
-    box). Then :func:`~camtool.toolpath.placement.too_large_drawing` refuses a drawing
-    larger than the travel as soon as the importer knows its extent, before its curves
-    are fitted; inside offsets and pockets, whose cuts can vanish, are checked after
-    planning only, as every program is.
+    point of the drawing: ``--offset on`` (each contour cut on its line), without ``--fit``
+    (which scales the drawing into a box). Then
+    :func:`~camtool.toolpath.placement.too_large_drawing` refuses a drawing larger than
+    the travel as soon as the importer knows its extent, before its curves are fitted.
+    An outside offset cuts only the contours that are closed once chained (an open one is
+    left out, said in a warning), which the importer does not know: its drawing is judged
+    once read, before planning (:func:`camtool.jobs.travel.refuse_too_large`); inside
+    offsets and pockets, whose cuts can vanish, after planning only, as every program is.
     """
-    if plan.fit is not None or plan.offset not in ("on", "outside"):
+    if plan.fit is not None or plan.offset != "on":
         return None
     from camtool.geometry.chain import joint_distance
     from camtool.toolpath.placement import Placing, too_large_drawing
 
     machine = target.machine
     slack = joint_distance(plan.chain_tolerance) + plan.tolerance
-    tool = plan.radius if plan.offset == "outside" else 0.0
-    margin = 2.0 * (tool + plan.lead_in)
+    margin = 2.0 * plan.lead_in
     placing = Placing(plan.placement, plan.translate, (margin, margin))
 
     def check(box: BBox) -> None:

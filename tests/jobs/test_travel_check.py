@@ -59,20 +59,41 @@ def test_the_travel_is_grbls() -> None:
     assert load_target("grbl").machine.travel_mm == (GRBL_TRAVEL, GRBL_TRAVEL)
 
 
-@pytest.mark.parametrize("offset", ["on", "outside"])
 def test_a_drawing_wider_than_the_travel_is_refused_before_any_fit(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, offset: str
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     path = _wide(tmp_path, 1000.0)
     monkeypatch.setattr(svg_importer, "_prefitted", _never)
     monkeypatch.setattr(plan_module, "plan_unplaced", _never)
-    plan = PlanOptions(offset=offset, tool_diameter=2.0)
+    plan = PlanOptions(offset="on")
     with pytest.raises(DialectError, match=r"at least 1000 × \d+(\.\d+)? mm") as err:
         post_path(path, load_target("grbl"), plan)
     assert "refused before planning" in str(err.value)
     assert "--fit" in str(err.value) and "travel of GRBL" in str(err.value)
     with pytest.raises(DialectError, match="refused before planning"):
         post_bytes(path.read_bytes(), path.name, load_target("grbl"), plan)
+
+
+_RECT = '<rect x="0" y="0" width="{w}" height="20" fill="none" stroke="black"/>'
+
+
+def test_an_outside_offset_is_judged_once_read_by_what_it_cuts(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An outside offset cuts only closed contours: a 1000 mm open path beside a 20 mm
+    square is left out (with a warning), so it is no reason to refuse the square; a
+    1000 mm rectangle is refused once read, before planning."""
+    plan = PlanOptions(offset="outside", tool_diameter=2.0)
+    square = _wide(tmp_path, 1000.0, _RECT.format(w=20))
+    job = post_path(square, load_target("grbl"), plan)
+    xs = [m.x for m in job.program.moves if m.x is not None]
+    assert max(xs) - min(xs) == pytest.approx(22.0, abs=1e-6)
+    assert any("not cut: open contour" in w for w in job.warnings)
+    monkeypatch.setattr(plan_module, "plan_unplaced", _never)
+    root = 'width="1010mm" height="100mm" viewBox="0 0 1010 100"'
+    wide = svg(tmp_path, _RECT.format(w=1000), root=root, name="rect.svg")
+    with pytest.raises(DialectError, match=r"at least 1000 × 20 mm.*refused before planning"):
+        post_path(wide, load_target("grbl"), plan)
 
 
 def test_the_cli_refuses_it_with_exit_code_1_and_writes_nothing(
