@@ -221,19 +221,20 @@ _PART = '<rect id="part" x="10" y="10" width="20" height="20"/>'
 _AWAY = '<rect id="away" x="10" y="10" width="5" height="5" transform="translate(0,400)"/>'
 
 
-@pytest.mark.parametrize("offset", ["on", "inside", "pocket"])
+@pytest.mark.parametrize("offset", ["on", "outside", "inside", "pocket"])
 def test_a_refusal_for_size_names_the_shapes_off_the_page(
     tmp_path: Path, offset: str, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """Before planning (on) and after it (inside, pocket), the refusal says which shape lies
-    off the page and that deleting it, not --fit, is the remedy when it is no part of the job."""
+    """Before planning (on: as read; outside: once read) and after it (inside, pocket), the
+    refusal says which shape lies off the page and that deleting it, not --fit, is the
+    remedy when it is no part of the job."""
     path = svg(tmp_path, _PART + _AWAY)  # a 100 × 100 mm page
     out = tmp_path / "o.nc"
     argv = ["post", str(path), "-t", "grbl", "--offset", offset, "--tool-diameter", "1"]
     assert main([*argv, "-o", str(out)]) == 1
     err = capsys.readouterr().err
     assert "larger than the 200 × 200 mm travel" in err
-    assert ("refused before planning" in err) == (offset == "on")
+    assert ("refused before planning" in err) == (offset in ("on", "outside"))
     noun = "shape" if offset == "on" else "contour"
     assert f"but {path}: 1 {noun} lies wholly outside the 100 × 100 mm page" in err
     assert "first rect#away at (10.0000, -315.0000) mm" in err
