@@ -35,6 +35,28 @@ KD_WORKERS = -1
 answered alone, so the distances do not depend on it; only the wall time does."""
 
 
+def beyond_kth(d: FloatArray, rk: FloatArray, half: float) -> npt.NDArray[np.bool_]:
+    """Where no segment with both ends ``rk`` or farther can come nearer than ``d``.
+
+    A segment of length ``L <= 2·half`` whose ends both lie at least ``rk`` from a
+    sample comes no nearer than ``sqrt(rk² − half²)``: its nearest point is an end, or the
+    foot of the perpendicular, within ``L/2`` of an end along the segment. So ``d`` (the
+    distance to some segment) is the least when ``d² + half² < rk²``. This holds wherever
+    the looser ``d + half < rk`` (the triangle inequality) does.
+    """
+    return np.asarray(d * d + half * half < rk * rk)
+
+
+def within_reach(upper: FloatArray, half: float) -> FloatArray:
+    """How far from a sample the ends of every segment nearer than ``upper`` lie, at most, mm.
+
+    ``sqrt(upper² + half²)`` (:func:`beyond_kth`: a segment at most ``2·half`` long with
+    both ends farther lies farther than ``upper``), widened by a billionth and 1e-12 mm for
+    the rounding of the distances: a float margin that never leaves one out.
+    """
+    return np.sqrt(upper * upper + half * half) * (1.0 + 1e-9) + 1e-12
+
+
 def _to_segments(p: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
     """``(N, K)`` distances of points ``p`` ``(N, 2)`` to segments ``a → b`` ``(N, K, 2)``."""
     ab = b - a
@@ -138,18 +160,34 @@ ALL_EXACT_CHUNK = 1 << 16
 
 
 NEARBY_MAX_PAIRS = 4_000_000
-"""Most (sample, segment) pairs :func:`_nearby_exact` measures; beyond it :func:`_all_exact`."""
+"""Most (sample, segment) pairs :func:`_nearby_exact` measures for a few samples (and the
+box tree gives at once); beyond :func:`pair_limit`, :func:`_all_exact` answers."""
+
+
+NEARBY_PAIRS_PER_SAMPLE = 64
+"""(Sample, segment) pairs per sample :func:`pair_limit` allows beyond
+:data:`NEARBY_MAX_PAIRS`: below it the pairs cost less than GEOS's nearest query of every
+segment (samples a tool radius from a trace cut in two passes have ~40)."""
+
+
+def pair_limit(samples: int) -> int:
+    """Most (sample, segment) pairs the exact stage measures for ``samples`` samples.
+
+    :data:`NEARBY_MAX_PAIRS`, or :data:`NEARBY_PAIRS_PER_SAMPLE` a sample when more;
+    beyond it :func:`_all_exact` answers (GEOS's nearest query over every segment).
+    """
+    return max(NEARBY_MAX_PAIRS, NEARBY_PAIRS_PER_SAMPLE * samples)
 
 
 @dataclass(frozen=True)
 class LongSegments:
     """The few segments of a trace much longer than the rest, searched apart.
 
-    :func:`_nearby_exact` takes a sample's segments from the ends within ``upper + half``
-    of it, ``half`` half the longest segment: on a trace of 0.9 µm steps with a few
-    18 µm jumps (a backlash take-up, a budget's trace without interpolation), 40 ends a
-    sample where 4 would do. With these, the other segments are searched within
-    ``upper + short_half`` and only these within ``upper + half``.
+    :func:`_nearby_exact` takes a sample's segments from the ends within
+    :func:`within_reach` of ``upper`` and ``half``, half the longest segment: on a trace of
+    0.9 µm steps with a few 18 µm jumps (a backlash take-up, a budget's trace without
+    interpolation), 40 ends a sample where 4 would do. With these, the other segments are
+    searched within the reach of ``short_half`` and only these within that of ``half``.
 
     Attributes:
         short_half: half the longest of the other segments, mm.
@@ -204,12 +242,12 @@ def _nearby_exact(
 ) -> FloatArray | None:
     """:func:`_all_exact` over only the segments that can be the nearest, or ``None``.
 
-    A segment lies within ``L/2 <= half`` of one of its ends, so one whose ends are both
-    farther than ``upper + half`` from a sample lies farther than ``upper``, the distance
-    to a segment already found: it cannot be the nearest. The same GEOS distance is
+    A segment whose ends both lie farther than ``sqrt(upper² + half²)`` from a sample
+    lies farther than ``upper``, the distance to a segment already found
+    (:func:`beyond_kth`, :func:`within_reach`): it cannot be the nearest. The same GEOS distance is
     taken over the rest, so the minimum is the one :func:`_all_exact` finds, without
     building a tree of every segment for a few samples. ``None`` when the segments near
-    the samples are too many (over :data:`NEARBY_MAX_PAIRS` pairs).
+    the samples are too many (over :func:`pair_limit` pairs).
 
     Args:
         samples: ``(U, 2)`` query points, mm.
@@ -222,23 +260,22 @@ def _nearby_exact(
             The limit counts the pairs of all samples, so which of the two ways gives a
             sample's distance does not depend on ``need``.
         long: the long segments (:func:`long_segments`): the ends of ``ends`` are then
-            searched within ``upper + long.short_half``, the long segments' within
-            ``upper + half``; every segment within ``upper`` is still among them, so the
-            minimum is the same. The limit still counts the pairs within ``upper + half``:
+            searched within the reach of ``long.short_half``, the long segments' within
+            that of ``half``; every segment within ``upper`` is still among them, so the
+            minimum is the same. The limit still counts the pairs within that of ``half``:
             over it, :func:`_all_exact` answers, whose GEOS nearest query can differ from
             the least GEOS distance in the last bit where segments tie, so the choice
             between the two ways must not depend on ``long``.
     """
-    margin = 1.0 + 1e-9  # and 1e-12 mm: a float margin, never leaves one out
-    reach = (upper + half) * margin + 1e-12
+    reach = within_reach(upper, half)
     counts = _counts_within(ends, samples, reach)
     if counts is None:  # the limit counts these pairs, with or without ``long``: see above
         return None
     sources = [_Reach(ends, reach, counts, None)]
     if long is not None:
-        reach = (upper + long.short_half) * margin + 1e-12
+        reach = within_reach(upper, long.short_half)
         sources = [_Reach(ends, reach, _count_all(ends, samples, reach), None)]
-        reach = (upper + half) * margin + 1e-12
+        reach = within_reach(upper, half)
         sources.append(_Reach(long.tree, reach, _count_all(long.tree, samples, reach), long.index))
     total = np.sum([s.counts for s in sources], axis=0)
     if total.min() == 0:
@@ -304,17 +341,17 @@ def _counts_within(ends: Any, samples: FloatArray, reach: FloatArray) -> IntArra
 
     Counted :data:`NEARBY_COUNT_CHUNK` samples at a time (scipy's count holds a list per
     sample while it runs: ~400 MB for 5.9 M samples in one call), stopping as soon as the
-    running total passes :data:`NEARBY_MAX_PAIRS`: the answer of one count of them all.
+    running total passes :func:`pair_limit`: the answer of one count of them all.
     """
     parts: list[IntArray] = []
-    total = 0
+    total, limit = 0, pair_limit(len(samples))
     for lo in range(0, len(samples), NEARBY_COUNT_CHUNK):
         part = slice(lo, lo + NEARBY_COUNT_CHUNK)
         near = ends.query_ball_point(
             samples[part], reach[part], return_length=True, workers=KD_WORKERS
         )
         total += int(np.sum(near))
-        if total > NEARBY_MAX_PAIRS:
+        if total > limit:
             return None
         parts.append(np.asarray(near, dtype=np.int64))
     return np.concatenate(parts) if parts else np.zeros(0, dtype=np.int64)
@@ -389,19 +426,39 @@ def _nearby_boxes(
         kernels: :mod:`camtool.accel.nearkernels`.
         need: as for :func:`_nearby_exact` (the limit counts every sample's pairs).
     """
-    reach = ((upper + half) * (1.0 + 1e-9) + 1e-12) * (1.0 + 1e-12)
-    owner, seg = kernels.pairs_within(np.ascontiguousarray(samples), *tree, reach, NEARBY_MAX_PAIRS)
-    # ``owner`` ascends (sample-major): its distinct values are one more than its steps
-    if len(owner) == 0 or np.count_nonzero(owner[1:] != owner[:-1]) + 1 < len(samples):
-        return None  # over the limit (or, which cannot happen, a sample without one)
-    if need is None:
-        return _nearby_min(samples, owner, seg, a, b)
+    reach = within_reach(upper, half) * (1.0 + 1e-12)
+    samples = np.ascontiguousarray(samples)
     out = upper.copy()
-    if need.any():
-        keep = need[owner]
-        renumber = np.cumsum(need) - 1  # a needed sample's place among the needed
-        out[need] = _nearby_min(samples[need], renumber[owner[keep]], seg[keep], a, b)
+    budget = pair_limit(len(samples))
+    lo, step = 0, NEARBY_BOX_SAMPLES
+    while lo < len(samples):
+        hi = min(len(samples), lo + step)
+        cap = min(NEARBY_MAX_PAIRS, budget)
+        owner, seg = kernels.pairs_within(samples[lo:hi], *tree, reach[lo:hi], cap)
+        if len(owner) == 0 and cap == NEARBY_MAX_PAIRS and hi - lo > 1:
+            step = max(1, (hi - lo) // 2)  # too many pairs at once: fewer samples
+            continue
+        # ``owner`` ascends (sample-major): its distinct values are one more than its steps
+        if len(owner) == 0 or np.count_nonzero(owner[1:] != owner[:-1]) + 1 < hi - lo:
+            return None  # over the limit (or, which cannot happen, a sample without one)
+        budget -= len(owner)
+        part = slice(lo, hi)
+        if need is None:
+            out[part] = _nearby_min(samples[part], owner, seg, a, b)
+        elif need[part].any():
+            wanted = need[part]
+            keep = wanted[owner]
+            renumber = np.cumsum(wanted) - 1  # a needed sample's place among the needed
+            out[lo:hi][wanted] = _nearby_min(
+                samples[part][wanted], renumber[owner[keep]], seg[keep], a, b
+            )
+        lo = hi
     return out
+
+
+NEARBY_BOX_SAMPLES = 1 << 16
+"""Samples :func:`_nearby_boxes` asks the box tree for at once (fewer when their pairs
+are over :data:`NEARBY_MAX_PAIRS`): memory, not the answer."""
 
 
 NEARBY_CHUNK_PAIRS = 50_000
@@ -499,11 +556,7 @@ def _nearest_chunk(
 ) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
     """:func:`nearest_distances` of a few samples from the k-d tree of segment ``ends``.
 
-    ``long``: the few long segments (:func:`long_segments`), tested apart: a sample is
-    also settled when no other segment can be nearer with an end beyond the k found
-    (``d + short_half`` below the k-th end) and every long segment lies farther than
-    ``d`` (``d + half`` below its nearest long end). Each test is exact (a segment
-    nearer than ``d`` has an end within ``d + L/2``), so the distances are the same.
+    ``long``: the few long segments (:func:`long_segments`), tested apart (:func:`settled`).
 
     Returns:
         The distances and which of them the tests could not settle.
@@ -514,11 +567,42 @@ def _nearest_chunk(
     seg = np.asarray(index).reshape(len(samples), k) % len(a)
     d = _to_segments(samples, a[seg], b[seg]).min(axis=1)
     lower = np.sqrt(np.maximum(r[:, 0] ** 2 - half * half, 0.0))
-    # exact where every segment that could be nearer had an end among the k found
-    # (its nearer end lies within d + L/2), or where the vertex bound is tight enough
-    sure = (d + half < r[:, -1]) | (k == 2 * len(a)) | (d - lower <= NEAREST_TOLERANCE_MM)
+    if k == 2 * len(a):  # every segment's ends found
+        return d, np.zeros(len(samples), dtype=bool)
+    return d, ~settled(samples, d, r[:, -1], lower, half, long)
+
+
+def settled(
+    samples: FloatArray,
+    d: FloatArray,
+    rk: FloatArray,
+    lower: FloatArray,
+    half: float,
+    long: LongSegments | None,
+) -> npt.NDArray[np.bool_]:
+    """Where ``d``, the distance to the segments of a sample's k nearest ends, is the least.
+
+    Exact where no segment that could be nearer was left out (:func:`beyond_kth` of the
+    k-th end's distance ``rk``), or where the vertex bound ``lower`` (``sqrt(r0² − half²)``,
+    ``r0`` the nearest end) is within :data:`NEAREST_TOLERANCE_MM`. With the few long
+    segments (``long``: :func:`long_segments`), a sample is also settled when no other
+    segment can be nearer (:func:`beyond_kth` of ``rk`` and ``long.short_half``) and
+    every long one lies farther (its nearest long end, ``half``). Both searches
+    (:mod:`camtool.verify.nearest_search`) settle by this, so they give the same distances.
+
+    Args:
+        samples: ``(N, 2)`` the query points, mm.
+        d: ``(N,)`` distances, mm.
+        rk: ``(N,)`` the k-th nearest end's distance, mm.
+        lower: ``(N,)`` the vertex bound, mm.
+        half: half the longest segment, mm.
+        long: the long segments, or ``None``.
+    """
+    sure = beyond_kth(d, rk, half) | (d - lower <= NEAREST_TOLERANCE_MM)
     if long is not None and not sure.all():
         ask = np.flatnonzero(~sure)
         far_long = np.asarray(long.tree.query(samples[ask], k=1, workers=KD_WORKERS)[0])
-        sure[ask] = (d[ask] + long.short_half < r[ask, -1]) & (d[ask] + half < far_long)
-    return d, ~sure
+        sure[ask] = beyond_kth(d[ask], rk[ask], long.short_half) & beyond_kth(
+            d[ask], far_long, half
+        )
+    return sure

@@ -33,11 +33,11 @@ def nearest_distances(
 
     Exact to :data:`NEAREST_TOLERANCE_MM`. The segments owning the
     :data:`NEAREST_ENDS` nearest segment ends (a scipy k-d tree) give a distance
-    ``d``; it is the true one when the k-th end lies farther than ``d + L/2``
-    (``L`` the longest segment: a nearer segment has an end within that), or
-    when the nearest end ``r`` bounds it tightly, ``sqrt(r² − L²/4) ≤ d``
-    (a segment whose ends are both ``r`` or more away comes no nearer than
-    that). Samples neither test settles get shapely's exact nearest query.
+    ``d``; it is the true one when the k-th end ``rk`` lies so far that a segment with
+    both ends beyond it comes no nearer, ``d² + L²/4 < rk²`` (``L`` the longest
+    segment), or when the nearest end ``r`` bounds it tightly, ``sqrt(r² − L²/4) ≤ d``
+    (:func:`~camtool.verify.nearest_exact.settled`). Samples neither test settles get
+    GEOS's distance to the segments with an end near enough to be nearer.
 
     With numba (:func:`near_kernels`), the nearest ends come from
     :func:`camtool.accel.nearkernels.knn`, the k-d tree's answer bit for bit
@@ -102,7 +102,7 @@ def _nearest(
             rows = np.flatnonzero(ask) + i
             near[rows - i] = search.chosen(ends, rows)
         d[part] = near
-        unsure[part] = ~search.settled(near, rk, lower)
+        unsure[part] = ~search.settled(part, near, rk, lower)
     return nearest_exact._settle_unsure(
         search.samples, d, unsure, search.a, search.b, search.nearby, only_max=only_max
     )
@@ -120,6 +120,7 @@ class _BoxSearch:
         points: ``concatenate([a, b])``, the ends (as the k-d tree of ties holds them).
         tree: their search tree (:func:`_ends_tree`).
         kernels: :mod:`camtool.accel.nearkernels`.
+        long: the few long segments (:func:`~camtool.verify.nearest_exact.long_segments`).
     """
 
     samples: FloatArray
@@ -129,6 +130,7 @@ class _BoxSearch:
     points: FloatArray
     tree: tuple[Any, ...]
     kernels: ModuleType
+    long: nearest_exact.LongSegments | None
 
     def measure(self, part: slice) -> tuple[FloatArray, FloatArray, FloatArray, Any]:
         """``near``, ``rk``, ``lower`` and ``ask`` of the samples ``part``.
@@ -161,9 +163,12 @@ class _BoxSearch:
             out[i : i + len(x)] = near.min(axis=1)
         return out
 
-    def settled(self, near: FloatArray, rk: FloatArray, lower: FloatArray) -> Any:
-        """Where ``near`` is the distance (:func:`nearest_distances`' two tests)."""
-        return (near + self.half < rk) | (near - lower <= nearest_exact.NEAREST_TOLERANCE_MM)
+    def settled(self, rows: Any, near: FloatArray, rk: FloatArray, lower: FloatArray) -> Any:
+        """Where ``near`` is the distance of the samples ``rows`` (a slice or indices).
+
+        :func:`camtool.verify.nearest_exact.settled`, the k-d tree path's tests.
+        """
+        return nearest_exact.settled(self.samples[rows], near, rk, lower, self.half, self.long)
 
     def nearby(self, samples: FloatArray, upper: FloatArray, need: Any = None) -> FloatArray | None:
         """:func:`_nearby_boxes` among these segments."""
@@ -207,7 +212,7 @@ def _box_search(
         ends.drop_boxes()  # the k-d tree answers these ends from now on
         return None
     tree = ends.boxes(len(samples), kernels)
-    return _BoxSearch(samples, a, b, half, ends.points, tree, kernels)
+    return _BoxSearch(samples, a, b, half, ends.points, tree, kernels, ends.long(half))
 
 
 def farthest_off(samples: FloatArray, a: FloatArray, b: FloatArray, offset: float) -> float:
@@ -247,7 +252,7 @@ def farthest_off(samples: FloatArray, a: FloatArray, b: FloatArray, offset: floa
     for i in range(0, n, NEAREST_CHUNK):
         part = slice(i, i + NEAREST_CHUNK)
         d[part], kth[part], lower[part], ask[part] = search.measure(part)
-    sure = ~ask & search.settled(d, kth, lower)
+    sure = ~ask & search.settled(slice(None), d, kth, lower)
     best = _largest_off(d[sure], offset)
     slack = 1e-12 + 64.0 * float(np.spacing(np.max(np.abs(search.samples))))
     low = lower * (1.0 - 1e-9) - slack
@@ -257,7 +262,7 @@ def farthest_off(samples: FloatArray, a: FloatArray, b: FloatArray, offset: floa
     if asked.any():  # the k-d tree's choice, as _nearest takes it
         rows = np.flatnonzero(asked)
         d[rows] = search.chosen(_LazyTree(search.points), rows)
-        sure[rows] = search.settled(d[rows], kth[rows], lower[rows])
+        sure[rows] = search.settled(rows, d[rows], kth[rows], lower[rows])
         best = max(best, _largest_off(d[rows[sure[rows]]], offset))
     unsure = ~sure & (asked | ~ask)
     if unsure.any():  # _settle_unsure's exact stage, only where a distance can be the largest

@@ -131,6 +131,91 @@ def test_segments_of_one_length_are_not_searched_apart() -> None:
     assert nearest_exact.long_segments(a, b, 0.002) is None  # the longest is no longer
 
 
+def _brute(samples: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``(N, M)`` distances of every sample to every segment (numpy, the textbook formula)."""
+    ab = b - a
+    t = np.clip(
+        np.einsum("nmj,mj->nm", samples[:, None, :] - a, ab)
+        / np.maximum(np.einsum("mj,mj->m", ab, ab), 1e-300),
+        0.0,
+        1.0,
+    )
+    foot = a + t[..., None] * ab
+    return np.asarray(np.hypot(*(samples[:, None, :] - foot).transpose(2, 0, 1)))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_segment_bounds_hold_for_every_segment(seed: int) -> None:
+    """The two bounds of the exact stage, against every segment's distance.
+
+    A segment nearer than ``upper`` has an end within
+    :func:`~camtool.verify.nearest_exact.within_reach` (so the pairs of the exact stage hold
+    the nearest), and where :func:`~camtool.verify.nearest_exact.beyond_kth` says so, the
+    segments of the k nearest ends hold the nearest one. Segments of many lengths, up to
+    ``2·half``; samples near them and a tool radius off.
+    """
+    rng = np.random.default_rng(seed)
+    m = 300
+    a = rng.uniform(0.0, 3.0, (m, 2))
+    b = a + rng.normal(0.0, float(rng.choice([0.01, 0.2])), (m, 2))
+    half = float(np.max(np.hypot(*(b - a).T))) / 2.0
+    samples = np.concatenate(
+        [a[:100] + rng.normal(0.0, 0.05, (100, 2)), rng.uniform(-1, 4, (200, 2))]
+    )
+    every = _brute(samples, a, b)
+    ends = np.concatenate([a, b])
+    to_end = np.hypot(*(samples[:, None, :] - ends).transpose(2, 0, 1))
+    to_seg_end = np.minimum(to_end[:, :m], to_end[:, m:])  # each segment's nearer end
+    upper = every[np.arange(len(samples)), rng.integers(0, m, len(samples))]
+    reach = nearest_exact.within_reach(upper, half)
+    nearer = every <= upper[:, None]
+    assert np.all(to_seg_end[nearer] <= np.broadcast_to(reach[:, None], nearer.shape)[nearer])
+    k = nearest_exact.NEAREST_ENDS
+    order = np.argsort(to_end, axis=1)[:, :k]
+    rk = np.take_along_axis(to_end, order[:, -1:], axis=1)[:, 0]
+    d = np.take_along_axis(every, order % m, axis=1).min(axis=1)
+    sure = nearest_exact.beyond_kth(d, rk, half)
+    assert sure.any()
+    assert np.allclose(d[sure], every.min(axis=1)[sure], rtol=0.0, atol=1e-12)
+
+
+def test_samples_a_tool_radius_from_a_trace_are_settled_or_measured_near(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Samples 1.5 mm from a straight trace of 0.05 mm steps at y = 0: exactly 1.5 mm.
+
+    Cut once, the k-th end's bound (:func:`~camtool.verify.nearest_exact.beyond_kth`)
+    settles every sample (``d + L/2 < rk`` settled none, and the vertex bound left those
+    near a vertex). Cut twice with the second pass's vertices half a step along (as a
+    thinned trace gives them), a sample's 4 nearest ends lie within a step and leave it
+    unsure; the exact stage then measures the few segments with an end within
+    ``sqrt(d² + L²/4)`` (:func:`~camtool.verify.nearest_exact.within_reach`): a handful a
+    sample, never GEOS's query over every segment.
+    """
+    x = np.arange(0.0, 20.0, 0.05)
+    first = np.c_[x, np.zeros_like(x)]
+    samples = np.c_[np.linspace(5.0, 15.0, 2001), np.full(2001, 1.5)]
+    a, b = first[:-1], first[1:]
+    half = float(np.max(np.hypot(*(b - a).T))) / 2.0
+    d, unsure = nearest_exact._nearest_chunk(samples, a, b, cKDTree(np.concatenate([a, b])), half)
+    assert not unsure.any()
+    assert np.allclose(d, 1.5, rtol=0.0, atol=1e-12)
+
+    def refused(*args: object) -> np.ndarray:
+        raise AssertionError("GEOS's query of every segment asked")
+
+    monkeypatch.setattr(nearest_exact, "_all_exact", refused)
+    second = first + np.array([0.025, 0.0])
+    a, b = np.concatenate([first[:-1], second[:-1]]), np.concatenate([first[1:], second[1:]])
+    ends = cKDTree(np.concatenate([a, b]))
+    d, unsure = nearest_exact._nearest_chunk(samples, a, b, ends, half)
+    assert unsure.mean() > 0.5
+    near = ends.query_ball_point(samples, nearest_exact.within_reach(d, half), return_length=True)
+    assert np.max(near) <= 8
+    for search in (nearest_search.nearest_distances, nearest_search.nearest_distances_kd):
+        assert np.all(search(samples, a, b) == 1.5)
+
+
 def test_nearby_exact_gives_way_when_too_many_segments_are_near(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
@@ -139,6 +224,7 @@ def test_nearby_exact_gives_way_when_too_many_segments_are_near(
     ends = cKDTree(np.concatenate([a, b]))
     samples = pts[:50] + 0.001
     upper, _ = nearest_exact._nearest_chunk(samples, a, b, ends, 0.002)
+    monkeypatch.setattr(nearest_exact, "NEARBY_PAIRS_PER_SAMPLE", 0)
     monkeypatch.setattr(nearest_exact, "NEARBY_MAX_PAIRS", 10)
     assert nearest_exact._nearby_exact(samples, upper, a, b, ends, 0.002) is None
     monkeypatch.setattr(nearest_exact, "NEARBY_MAX_PAIRS", 10**9)
@@ -289,6 +375,7 @@ def test_farthest_nearest_is_the_max_of_every_distance(
             samples = np.insert(samples, [far // 2, far], samples[far] + 5 * step, axis=0)
         for limit in (nearest_exact.NEARBY_MAX_PAIRS, 0):
             monkeypatch.setattr(nearest_exact, "NEARBY_MAX_PAIRS", limit)
+            monkeypatch.setattr(nearest_exact, "NEARBY_PAIRS_PER_SAMPLE", 64 if limit else 0)
             want = _farthest_reference(samples, a, b)
             got = nearest_search.farthest_nearest(samples, a, b)
             assert got[1] == want[1]
@@ -301,10 +388,10 @@ def test_farthest_nearest_measures_few_unsure_samples(monkeypatch: pytest.Monkey
     """Unsure samples far below the largest settled distance are not measured exactly."""
     monkeypatch.setattr(nearest_search, "near_kernels", lambda work=0: None)
     x = np.arange(0.0, 4.0, 0.004)
-    pts = np.c_[x, np.zeros_like(x)]  # a straight trace of 4 µm steps
-    a, b = pts[:-1], pts[1:]
-    # 10 µm above each vertex: the vertex bound is loose (unsure); 0.5 mm above a
-    # segment's middle: settled by it, and the farthest
+    pts = np.c_[x, np.zeros_like(x)]  # a straight trace of 4 µm steps, cut twice
+    a, b = np.concatenate([pts[:-1]] * 2), np.concatenate([pts[1:]] * 2)
+    # 10 µm above each vertex: its 4 nearest ends are at it and the vertex bound is
+    # loose (unsure); 0.5 mm above a segment's middle: settled by it, and the farthest
     above = pts[:300] + np.array([0.0, 0.01])
     samples = np.concatenate([above, [[0.002, 0.5]]])
     measured: list[int] = []
@@ -377,11 +464,17 @@ def test_the_counts_within_reach_are_scipys_or_none_over_the_limit(
     reach = rng.uniform(0.0, 0.05, 400)
     once = ends.query_ball_point(samples, reach, return_length=True)
     monkeypatch.setattr(nearest_exact, "NEARBY_COUNT_CHUNK", int(rng.integers(1, 50)))
+    monkeypatch.setattr(nearest_exact, "NEARBY_PAIRS_PER_SAMPLE", 0)
     monkeypatch.setattr(nearest_exact, "NEARBY_MAX_PAIRS", int(np.sum(once)))
     got = nearest_exact._counts_within(ends, samples, reach)
     assert got is not None and np.array_equal(got, once)
     monkeypatch.setattr(nearest_exact, "NEARBY_MAX_PAIRS", int(np.sum(once)) - 1)
     assert nearest_exact._counts_within(ends, samples, reach) is None
+    # or so many pairs a sample, beyond the pairs measured at once
+    monkeypatch.setattr(nearest_exact, "NEARBY_MAX_PAIRS", 1)
+    monkeypatch.setattr(nearest_exact, "NEARBY_PAIRS_PER_SAMPLE", -(-int(np.sum(once)) // 400))
+    got = nearest_exact._counts_within(ends, samples, reach)
+    assert got is not None and np.array_equal(got, once)
 
 
 def test_a_drawing_sampled_into_one_array_is_its_contours_stacked() -> None:

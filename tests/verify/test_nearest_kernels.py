@@ -176,12 +176,50 @@ def test_nearby_boxes_is_the_kd_tree_nearby_query_bit_for_bit(seed: int) -> None
         assert np.array_equal(fast, nearest_exact._nearby_exact(samples, upper, a, b, ends, half))
 
 
+@pytest.mark.parametrize("seed", range(3))
+def test_nearby_boxes_in_parts_is_the_whole_answer_bit_for_bit(
+    seed: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Samples asked a few at a time, fewer where their pairs are over the pairs at once.
+
+    The pairs of all samples are over :data:`NEARBY_MAX_PAIRS` (made small here) but
+    within :func:`~camtool.verify.nearest_exact.pair_limit`'s allowance a sample: the
+    same minimum as one query of them all, and for the samples ``need`` names.
+    """
+    rng = np.random.default_rng(300 + seed)
+    pts = _trace(rng, 4 * seed + 1)
+    a, b = pts[:-1], pts[1:]
+    samples = _samples(rng, pts, 300, reach=1.5)
+    half = float(np.max(np.hypot(*(b - a).T))) / 2.0
+    upper, _ = nearest_exact._nearest_chunk(samples, a, b, cKDTree(np.concatenate([a, b])), half)
+    tree = nearkernels.tree(np.concatenate([a, b]))
+    need = rng.random(len(samples)) < 0.5
+    whole = nearest_exact._nearby_boxes(samples, upper, a, b, tree, half, nearkernels)
+    some = nearest_exact._nearby_boxes(samples, upper, a, b, tree, half, nearkernels, need)
+    assert whole is not None and some is not None
+    reach = nearest_exact.within_reach(upper, half) * (1.0 + 1e-12)
+    owner, _ = nearkernels.pairs_within(samples, *tree, reach, 10**9)
+    most = int(np.bincount(owner).max())  # the pairs of one sample must fit at once
+    assert len(owner) > 4 * most
+    monkeypatch.setattr(nearest_exact, "NEARBY_BOX_SAMPLES", int(rng.integers(2, 40)))
+    monkeypatch.setattr(nearest_exact, "NEARBY_MAX_PAIRS", 2 * most)
+    monkeypatch.setattr(nearest_exact, "NEARBY_PAIRS_PER_SAMPLE", 10**6)
+    parts = nearest_exact._nearby_boxes(samples, upper, a, b, tree, half, nearkernels)
+    assert parts is not None and parts.tobytes() == whole.tobytes()
+    parts = nearest_exact._nearby_boxes(samples, upper, a, b, tree, half, nearkernels, need)
+    assert parts is not None and parts.tobytes() == some.tobytes()
+    assert np.array_equal(some[~need], upper[~need])
+    monkeypatch.setattr(nearest_exact, "NEARBY_PAIRS_PER_SAMPLE", 0)  # over the limit
+    assert nearest_exact._nearby_boxes(samples, upper, a, b, tree, half, nearkernels) is None
+
+
 def test_nearby_boxes_gives_way_over_the_pair_limit(monkeypatch: pytest.MonkeyPatch) -> None:
     pts = _trace(np.random.default_rng(3), 1)
     a, b = pts[:-1], pts[1:]
     tree = nearkernels.tree(np.concatenate([a, b]))
     samples = pts[:50] + 0.001
     upper = np.full(50, 0.01)
+    monkeypatch.setattr(nearest_exact, "NEARBY_PAIRS_PER_SAMPLE", 0)
     monkeypatch.setattr(nearest_exact, "NEARBY_MAX_PAIRS", 10)
     assert nearest_exact._nearby_boxes(samples, upper, a, b, tree, 0.002, nearkernels) is None
 
