@@ -14,7 +14,13 @@ import numpy.typing as npt
 
 from camtool.accel.memo import LastAnswers
 from camtool.model.shapes import Drawing, Line, Point, Segment
-from camtool.verify import cutting_thin, nearest_exact, nearest_search, path_shortfall
+from camtool.verify import (
+    cutting_thin,
+    nearest_along,
+    nearest_exact,
+    nearest_search,
+    path_shortfall,
+)
 from camtool.verify.not_cut import (
     CHAIN_JOIN_MM,
     NOT_CUT_KINDS,
@@ -414,11 +420,21 @@ def _distance_to(samples: FloatArray, lines: Sequence[FloatArray]) -> FloatArray
 
 
 def _distance_to_now(samples: FloatArray, lines: Sequence[FloatArray]) -> FloatArray:
-    """:func:`_distance_to` without the kept answer."""
+    """:func:`_distance_to` without the kept answer: GEOS's distances.
+
+    Shapely's nearest query, or the same floats from
+    :func:`~camtool.verify.nearest_along.along_distances` (the drawing's points come along
+    its contours).
+    """
     import shapely
 
     chords = [np.stack([p[:-1], p[1:]], axis=1) for p in lines if len(p) > 1]
     singles = [p for p in lines if len(p) == 1]
+    if chords or singles:
+        ends = np.concatenate(chords + [np.stack([p, p], axis=1) for p in singles])
+        along = nearest_along.along_distances(samples, ends[:, 0], ends[:, 1])
+        if along is not None:
+            return along
     parts = []
     if chords:
         parts.append(shapely.linestrings(np.concatenate(chords)))
