@@ -69,23 +69,25 @@ def along_distances(samples: FloatArray, a: FloatArray, b: FloatArray) -> FloatA
     rho = np.maximum.reduceat(spread, first) * (1.0 + 1e-9)
     sets = [_Ends(a, b, index, centre) for index in _by_length(a, b)]
     upper = np.min([e.r0 for e in sets], axis=0)  # the centre's nearest end
-    count, segments = _merged([e.within(centre, upper, rho) for e in sets], len(first))
+    reach = [e.reach(upper, rho) for e in sets]
+    count = np.sum([e.count(centre, r) for e, r in zip(sets, reach, strict=True)], axis=0)
     out = np.empty(n, dtype=np.float64)
     wide = count > ALONG_MAX_CANDIDATES
     if wide.any():  # GEOS's query over every segment for these
         rows = np.flatnonzero(wide[block_of])
         out[rows] = nearest_exact._all_exact(samples[rows], a, b)
-    before = np.cumsum(count) - count  # each block's first segment in ``segments``
     narrow = np.flatnonzero(~wide)
     lo = 0
-    while lo < len(narrow):  # blocks whose pairs fit at once
+    while lo < len(narrow):  # blocks whose pairs fit at once: their lists of ends only
         pairs = np.cumsum(count[narrow[lo:]] * size[narrow[lo:]])
         hi = lo + max(1, int(np.searchsorted(pairs, nearest_exact.NEARBY_MAX_PAIRS, "right")))
         blocks = narrow[lo:hi]
+        found = [e.within(centre[blocks], r[blocks]) for e, r in zip(sets, reach, strict=True)]
+        got, segments = _merged(found, len(blocks))
         rows = _spans(first[blocks], size[blocks])
-        per_row = np.repeat(count[blocks], size[blocks])  # the segments of each sample's block
+        per_row = np.repeat(got, size[blocks])  # the segments of each sample's block
         owner = np.repeat(np.arange(len(rows)), per_row)
-        at = _spans(np.repeat(before[blocks], size[blocks]), per_row)
+        at = _spans(np.repeat(np.cumsum(got) - got, size[blocks]), per_row)
         out[rows] = nearest_exact._nearby_min(samples[rows], owner, segments[at], a, b)
         lo = hi
     return out
@@ -136,16 +138,23 @@ class _Ends:
         r0 = self.tree.query(centre, k=1, workers=nearest_exact.KD_WORKERS)[0]
         self.r0 = np.asarray(r0, dtype=np.float64)
 
-    def within(
-        self, centre: FloatArray, upper: FloatArray, rho: FloatArray
-    ) -> tuple[IntArray, IntArray]:
-        """The segments with an end near enough to be the nearest of a block's samples.
+    def reach(self, upper: FloatArray, rho: FloatArray) -> FloatArray:
+        """How far from a block's centre the segments nearest to its samples have an end.
 
         A sample within ``rho`` of its block's centre lies at most ``upper + rho`` from a
-        segment (``upper``: an end's distance from the centre). Returns the count of each
-        block's ends and their segments, block after block (a segment may come twice).
+        segment (``upper``: an end's distance from the centre).
         """
-        reach = nearest_exact.within_reach(upper + rho, self.half) + rho + 1e-12
+        return nearest_exact.within_reach(upper + rho, self.half) + rho + 1e-12
+
+    def count(self, centre: FloatArray, reach: FloatArray) -> IntArray:
+        """How many ends lie within ``reach`` of each centre (no lists made)."""
+        got = self.tree.query_ball_point(
+            centre, reach, return_length=True, workers=nearest_exact.KD_WORKERS
+        )
+        return np.asarray(got, dtype=np.int64)
+
+    def within(self, centre: FloatArray, reach: FloatArray) -> tuple[IntArray, IntArray]:
+        """Each block's ends within ``reach``: their count and segments, block after block."""
         found = self.tree.query_ball_point(centre, reach, workers=nearest_exact.KD_WORKERS)
         count = np.fromiter((len(f) for f in found), dtype=np.int64, count=len(found))
         ends = np.fromiter(
