@@ -249,13 +249,48 @@ FAR_FROM_ZERO = (
     ": the toolpath lies that far from work zero; place the drawing at work zero with "
     "--origin lower-left, or move it with --translate X Y"
 )
-"""Said after a coordinate too long for its word: the drawing, not the machine, is far off."""
+"""Said after a coordinate too long for its word: the drawing, not the machine, is far off
+(:func:`far_from_zero` says so only where the toolpath is small enough to fit)."""
 FAR_FROM_ZERO_CODE = (
     ": the toolpath lies that far from work zero; move it nearer in the program that wrote "
     "it (its work zero): camtool re-posts a program where it is"
 )
 """:data:`FAR_FROM_ZERO` for a re-posted program (``--origin`` and ``--translate`` are for
 drawings)."""
+
+
+def far_from_zero(program: Program, letter: str, reach_mm: float | None) -> str:
+    """What to do about an X or Y value too long for its word, said after the error.
+
+    :data:`FAR_FROM_ZERO_CODE` for a re-posted program. For a drawing's toolpath:
+    :data:`FAR_FROM_ZERO` when its width and height fit the word from work zero;
+    ``--origin center`` when only their halves do (the words write ± values); else that
+    the part itself is larger than the words can hold: scale it or cut it in parts.
+
+    Args:
+        program: the program being written.
+        letter: ``"X"`` or ``"Y"``.
+        reach_mm: about the largest magnitude the word writes, mm
+            (:meth:`~camtool.post.numfmt.NumberFormat.reach_mm`; ``None``: unknown).
+    """
+    if program.from_code:
+        return FAR_FROM_ZERO_CODE
+    box = toolpath_extent(program)
+    if reach_mm is None or box is None:
+        return FAR_FROM_ZERO
+    w, h = box[2] - box[0], box[3] - box[1]
+    if max(w, h) <= reach_mm:
+        return FAR_FROM_ZERO
+    size = f": the toolpath is {fmt_num(w)} × {fmt_num(h)} mm"
+    if max(w, h) <= 2.0 * reach_mm:
+        return (
+            f"{size}, more than the {letter} word holds from work zero one way "
+            f"({fmt_num(reach_mm)} mm): put work zero at its centre with --origin center"
+        )
+    return (
+        f"{size}, more than the {letter} word holds either way from work zero "
+        f"(±{fmt_num(reach_mm)} mm): scale it down (--fit W H or --scale) or cut it in parts"
+    )
 
 
 class WriterState(Generic[B]):

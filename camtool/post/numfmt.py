@@ -85,6 +85,15 @@ class NumberFormat:
             q = (value * scale).quantize(exp, rounding=ROUND_HALF_UP)
         return q if q != 0 else Decimal(0).quantize(exp)
 
+    def reach_mm(self) -> float | None:
+        """About the largest magnitude this format can write, mm (``None``: no limit).
+
+        For advice only (how far from work zero a toolpath may lie): :meth:`format` decides.
+        """
+        if self.int_digits is None:
+            return None
+        return (10.0**self.int_digits - 10.0 ** (-self.decimals)) / self.scale
+
     def resolution_mm(self) -> float:
         """The smallest step this format can write, mm (the grid when coarser)."""
         step = 10.0 ** (-self.decimals) / self.scale

@@ -13,7 +13,7 @@ from camtool.model.errors import DialectError
 from camtool.model.machine import Machine
 from camtool.model.program import Linear, Program, Rapid, Spindle
 from camtool.model.shapes import Point
-from camtool.post.base import FAR_FROM_ZERO, FAR_FROM_ZERO_CODE, WriterState, check_written_z
+from camtool.post.base import WriterState, check_written_z, far_from_zero
 from camtool.post.wordaddress_spec import WordAddressSpec
 
 SAME_MM = 1e-9
@@ -152,11 +152,7 @@ class WordWriter(WriterState[str]):
             raise DialectError(
                 f"{self.where()}: {letter} = {exc} (value {value:g}); "
                 f"{self.spec.name} writes at most {number.int_digits} integer digits"
-                + (
-                    (FAR_FROM_ZERO_CODE if self.program.from_code else FAR_FROM_ZERO)
-                    if letter in "XY"
-                    else ""
-                )
+                + (far_from_zero(self.program, letter, number.reach_mm()) if letter in "XY" else "")
             ) from exc
         if number.grid_mm is not None:
             self.grid_error_mm = max(self.grid_error_mm, abs(number.parse(text) - value))

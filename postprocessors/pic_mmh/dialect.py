@@ -40,14 +40,13 @@ from camtool.model.program import (
 )
 from camtool.model.shapes import Arc, distance
 from camtool.post.base import (
-    FAR_FROM_ZERO,
-    FAR_FROM_ZERO_CODE,
     ContourCounter,
     PostProcessor,
     PostResult,
     WriterState,
     check_placement,
     check_work_area,
+    far_from_zero,
     from_options,
     input_line,
 )
@@ -285,11 +284,13 @@ class _Writer(WriterState[str]):
     Attributes:
         fast: blocks over the machine's step rate by feed code:
             ``code → [(block, contour), ...]`` (S000-05).
+        program: the program being written (for the advice after a value too long).
     """
 
-    def __init__(self, blocks: list[str], here: tuple[float, float]) -> None:
+    def __init__(self, blocks: list[str], here: tuple[float, float], program: Program) -> None:
         super().__init__(blocks, here=here)
         self.fast: dict[int, list[tuple[int, int]]] = {}
+        self.program = program
 
 
 class PicMmhPost(PostProcessor):
@@ -365,7 +366,7 @@ class PicMmhPost(PostProcessor):
                 message names the contour and block.
         """
         self.check_format(fmt)
-        w = _Writer(["G54;", "G90;"], program.origin)
+        w = _Writer(["G54;", "G90;"], program.origin, program)
         w.warnings.extend(check_placement(program, machine))
         homed = False
         for index, (move, commands) in enumerate(_steps(program)):
@@ -460,7 +461,11 @@ class PicMmhPost(PostProcessor):
         except DialectError as exc:
             raise DialectError(
                 f"{w.where(move.contour)}: {letter} = {exc} (µm; at most 99999.99 = 99.99999 mm)"
-                + ((FAR_FROM_ZERO_CODE if w.source else FAR_FROM_ZERO) if letter in "XY" else "")
+                + (
+                    far_from_zero(w.program, letter, self.coord.reach_mm())
+                    if letter in "XY"
+                    else ""
+                )
             ) from exc
 
     def _xy(self, x: float, y: float, move: Move, w: _Writer) -> str:

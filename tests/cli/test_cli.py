@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import shlex
 import stat
 import subprocess
@@ -219,6 +220,40 @@ def test_value_over_its_field_names_contour_and_block(
     )
     assert code == 1 and out == "" and not dest.exists()
     assert "contour 1, block 4: X = 151000.00 does not fit 5 integer digits" in err
+
+
+@pytest.mark.parametrize(
+    ("width", "origin", "advice"),
+    [
+        (150, "lower-left", "put work zero at its centre with --origin center"),
+        (190, "drawing", "put work zero at its centre with --origin center"),
+        (250, "lower-left", "scale it down (--fit W H or --scale) or cut it in parts"),
+        (250, "center", "scale it down (--fit W H or --scale) or cut it in parts"),
+    ],
+)
+def test_a_part_wider_than_its_word_is_told_what_fits(
+    width: int, origin: str, advice: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A table larger than pic-mmh's numbers: ``--origin lower-left`` is not the advice.
+
+    5 integer digits of µm hold ±99.99999 mm from work zero. A part up to 200 mm wide
+    fits them from its centre (and is posted so); a wider one fits no work zero.
+    """
+    machine = tmp_path / "big.toml"
+    machine.write_text(BIG_MACHINE.replace("200.0, 200.0", "600.0, 600.0"))
+    drawing = str(rectangle_dxf(tmp_path / "r.dxf", width, 1))
+    dest = tmp_path / "out.pic"
+    args = ["post", drawing, "-t", "pic-mmh", "--machine", str(machine), "-o", str(dest)]
+    code, out, err = run([*args, "--origin", origin], capsys)
+    assert code == 1 and out == "" and not dest.exists()
+    assert "does not fit 5 integer digits" in err and advice in err
+    assert "--origin lower-left" not in err
+    if width < 200:
+        code, _, err = run([*args, "--origin", "center"], capsys)
+        assert code == 0, err
+        xs = [float(x) for x in re.findall(r"X(-?\d+\.\d+)", dest.read_text())]
+        assert max(abs(x) for x in xs) <= 99999.99
+        assert max(xs) - min(xs) >= width * 1000.0
 
 
 def test_machine_file_with_an_unknown_key(

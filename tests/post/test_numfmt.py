@@ -288,3 +288,15 @@ def test_memo_is_not_part_of_equality() -> None:
     a, b = NumberFormat(), NumberFormat()
     a.format(1.5)
     assert a == b and hash(a) == hash(b) and repr(a) == repr(b)
+
+
+def test_the_reach_of_a_format_is_its_largest_number_in_mm() -> None:
+    """5 integer digits of µm with 2 decimals: 99999.99 µm; 4 digits of inches: 9999.9999 in."""
+    microns = NumberFormat(scale=1000.0, decimals=2, int_digits=5)
+    assert microns.reach_mm() == pytest.approx(99.99999, abs=1e-12)
+    microns.format(microns.reach_mm())  # the largest fits
+    with pytest.raises(DialectError):
+        microns.format(100.0)
+    inches = NumberFormat(scale=1 / 25.4, decimals=4, int_digits=4)
+    assert inches.reach_mm() == pytest.approx(9999.9999 * 25.4)
+    assert NumberFormat(decimals=3).reach_mm() is None
