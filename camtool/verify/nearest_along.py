@@ -36,7 +36,9 @@ def along_distances(samples: FloatArray, a: FloatArray, b: FloatArray) -> FloatA
     ``c``: one k-d tree query a block gives every segment that can be the nearest of its
     samples, and GEOS's distance to each of them (compiled:
     :func:`~camtool.verify.nearest_exact._nearby_min`) gives the least, the distance
-    shapely's nearest query over all segments gives. Blocks with more than
+    shapely's nearest query over all segments gives. Segments longer than
+    :data:`LONG_FACTOR` × the median are searched apart, within the reach of their own
+    longest (:func:`_by_length`). Blocks with more than
     :data:`ALONG_MAX_CANDIDATES` ends near them (samples far apart, or long segments)
     get that query itself.
 
