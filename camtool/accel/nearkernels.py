@@ -721,19 +721,22 @@ def load_cached() -> None:
     first call in a process, ~10–15 ms for each of these. A verification that forks the
     error budget's workers (:func:`camtool.verify.drawing_compare.prepare_comparison`) calls this
     first, so the workers inherit them instead of each loading them again (the
-    benchmark part: ~0.08 s of each worker's CPU, while every core is busy). A signature
-    no comparison uses would be loaded for
+    benchmark part: ~0.08 s of each worker's CPU, while every core is busy). The samples
+    of a drawing come read-only (they are kept between comparisons), hence the second
+    type of :func:`near_segments`. A signature no comparison uses would be loaded for
     nothing; the tests hold this list to the one a real verification uses. Only the time
     depends on it.
     """
     t = numba.types
     f1, f2, i1 = t.Array(t.float64, 1, "C"), t.Array(t.float64, 2, "C"), t.Array(t.int64, 1, "C")
+    read_only = t.Array(t.float64, 2, "C", readonly=True)
     tree_of = (f2, f2, i1, i1, i1)  # points, boxes, offsets, start, ends (:func:`tree`)
     kernels = (
         (_fill, (f2, f2, i1)),
         (_merge, (t.Array(t.uint64, 2, "C"), t.int64)),
         (knn, (f2, *tree_of, t.int64)),
         (near_segments, (f2, *tree_of, f2, f2, t.int64)),
+        (near_segments, (read_only, *tree_of, f2, f2, t.int64)),
         (pairs_within, (f2, *tree_of, f1, t.int64)),
         (nodes_within, (f2, f2, i1, f1)),
         (least_of_pairs, (f2, i1, i1, f2, f2)),

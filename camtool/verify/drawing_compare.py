@@ -227,7 +227,7 @@ def against_thinned(
     if thin.rows < 2 or len(samples) == 0:
         return Against(0.0, 0.0, (0.0, 0.0), 0.0, 0)
     trace = thin.points
-    off = _to_trace(samples, thin) - tool_radius_mm
+    off = nearest_search.nearest_distances(samples, *_chords(thin)) - tool_radius_mm
     apart = _not_cut(samples, sizes, tool_radius_mm, nominal, findings, joint_mm)
     main = _cut_as_drawn(len(samples), apart)
     features = [
@@ -273,9 +273,8 @@ def against_worst(
 ) -> float:
     """``against_thinned(...).max_um`` alone, the same float, for the error budget.
 
-    With numba every point's distance is taken a block at a time, as
-    :func:`against_thinned` takes them (:func:`_to_trace`); without, it is measured exactly
-    only where it can be the largest (:func:`farthest_off`). The arguments are
+    The distance to the drawing of the samples cut as drawn is measured exactly only
+    where it can be the largest (:func:`farthest_off`); the arguments are
     :func:`against_thinned`'s.
     """
     samples, sizes = _sample_drawing(drawing, spacing_mm)
@@ -285,24 +284,8 @@ def against_worst(
     main = _cut_as_drawn(len(samples), apart)
     if not main.any():
         return 0.0
-    along = nearest_along.along_distances(samples, *_chords(thin))
-    if along is not None:  # every distance, as against_thinned takes them
-        return float(np.max(np.abs(along[main] - tool_radius_mm))) * 1000.0
     kept = samples if main.all() else samples[main]
     return nearest_search.farthest_off(kept, *_chords(thin), tool_radius_mm) * 1000.0
-
-
-def _to_trace(samples: FloatArray, thin: cutting_thin.ThinTrace) -> FloatArray:
-    """Each drawing point's distance to the machined edge (the thinned trace's chords), mm.
-
-    GEOS's distances a block of points at a time
-    (:func:`~camtool.verify.nearest_along.along_distances`: the points come along the
-    drawing's contours), or without numba :func:`~camtool.verify.nearest_search.nearest_distances`.
-    :func:`against_worst` takes the same ones.
-    """
-    a, b = _chords(thin)
-    along = nearest_along.along_distances(samples, a, b)
-    return along if along is not None else nearest_search.nearest_distances(samples, a, b)
 
 
 def _chords(thin: cutting_thin.ThinTrace) -> tuple[FloatArray, FloatArray]:

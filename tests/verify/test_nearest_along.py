@@ -104,24 +104,3 @@ def test_without_the_compiled_distance_the_comparison_asks_shapely(
     monkeypatch.setenv(accel.SWITCH, "0")
     assert nearest_along.along_distances(samples, a, b) is None
     assert drawing_compare._distance_to_now(samples, lines).tobytes() == want.tobytes()
-
-
-def test_the_drawing_s_distance_to_the_machined_edge_is_geos_s(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    """The comparison's distances to the thinned trace: GEOS's, with or without numba.
-
-    Without the compiled search :func:`~camtool.verify.nearest_search.nearest_distances`
-    answers, exact to its 0.01 µm.
-    """
-    from camtool.verify import cutting_thin
-
-    rng = np.random.default_rng(11)
-    samples, a, b = _part(rng)
-    trace = np.concatenate([a[:200], b[199:200]])  # one run of the path's first chords
-    thin = cutting_thin.ThinTrace(trace, None, len(trace))
-    want = _geos(samples, trace[:-1], trace[1:])
-    assert drawing_compare._to_trace(samples, thin).tobytes() == want.tobytes()
-    monkeypatch.setenv(accel.SWITCH, "0")
-    plain = drawing_compare._to_trace(samples, thin)
-    assert np.allclose(plain, want, rtol=0.0, atol=nearest_exact.NEAREST_TOLERANCE_MM)
