@@ -166,8 +166,8 @@ box tree gives at once); beyond :func:`pair_limit`, :func:`_all_exact` answers."
 
 NEARBY_PAIRS_PER_SAMPLE = 64
 """(Sample, segment) pairs per sample :func:`pair_limit` allows beyond
-:data:`NEARBY_MAX_PAIRS`: below it the pairs cost less than GEOS's nearest query of every
-segment (samples a tool radius from a trace cut in two passes have ~40)."""
+:data:`NEARBY_MAX_PAIRS`: below it the compiled pairs cost less than GEOS's nearest query
+over every segment (docs/performance.md); only the time depends on it."""
 
 
 def pair_limit(samples: int) -> int:
