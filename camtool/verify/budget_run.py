@@ -269,7 +269,7 @@ class BudgetRun:
         if alongside and len(self.simulated) == 1:
             self.work = _ForkedOne(work, self.simulated[0])
         else:
-            self.work = ForkedWork(work, self.simulated)
+            self.work = ForkedWork(work, self.simulated, jobs=_jobs(rows))
 
     def __enter__(self) -> BudgetRun:
         return self
@@ -376,6 +376,19 @@ class _ForkedOne(Generic[T, R]):
             with suppress(ChildProcessError):
                 end_process(self.pid, kill=True)
             self.pid = None
+
+
+def _jobs(rows: int) -> int:
+    """Worker processes for re-simulations of a trace of ``rows`` rows.
+
+    A re-simulation of more than :data:`CHUNK_ROWS` rows is streamed on two threads of its
+    own (:func:`stream_trace`: one simulates the next chunk while the other measures this
+    one), but in a worker process on one (:func:`~camtool.accel.cores.ahead` runs there
+    in turn). So it takes two cores: on two, the sources run one after the other in this
+    process (less wall and CPU time than a worker each: docs/performance.md).
+    """
+    cores = default_jobs()
+    return max(1, cores // 2) if rows > CHUNK_ROWS else cores
 
 
 @dataclass(frozen=True)

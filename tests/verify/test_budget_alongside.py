@@ -193,3 +193,16 @@ def test_an_error_in_the_stream_leaves_no_helper_behind(monkeypatch: pytest.Monk
     pid = int(events[1].split()[1])
     with pytest.raises(ChildProcessError):  # the helper was ended and waited for
         os.waitpid(pid, os.WNOHANG)
+
+
+@pytest.mark.parametrize(
+    ("cores_here", "rows", "jobs"), [(2, 70_000, 1), (4, 70_000, 2), (2, 5_000, 2)]
+)
+def test_streamed_sources_take_two_cores_each(
+    monkeypatch: pytest.MonkeyPatch, cores_here: int, rows: int, jobs: int
+) -> None:
+    """A streamed re-simulation runs two threads here but one in a worker process, so on
+    two cores its sources run here in turn; a short one (not streamed) takes one core."""
+    monkeypatch.setattr(budget_run, "default_jobs", lambda: cores_here)
+    assert budget_run.CHUNK_ROWS < 70_000 and budget_run.CHUNK_ROWS > 5_000
+    assert budget_run._jobs(rows) == jobs
