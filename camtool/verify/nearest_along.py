@@ -137,7 +137,7 @@ class _Ends:
         self.index = index
         self.half = float(np.max(np.hypot(*(b[index] - a[index]).T))) / 2.0
         self.tree = cKDTree(np.concatenate([a[index], b[index]]))
-        r0 = self.tree.query(centre, k=1, workers=nearest_exact.KD_WORKERS)[0]
+        r0 = self.tree.query(centre, k=1, workers=nearest_exact.kd_workers(len(centre)))[0]
         self.r0 = np.asarray(r0, dtype=np.float64)
 
     def reach(self, upper: FloatArray, rho: FloatArray) -> FloatArray:
@@ -151,13 +151,14 @@ class _Ends:
     def count(self, centre: FloatArray, reach: FloatArray) -> IntArray:
         """How many ends lie within ``reach`` of each centre (no lists made)."""
         got = self.tree.query_ball_point(
-            centre, reach, return_length=True, workers=nearest_exact.KD_WORKERS
+            centre, reach, return_length=True, workers=nearest_exact.kd_workers(len(centre))
         )
         return np.asarray(got, dtype=np.int64)
 
     def within(self, centre: FloatArray, reach: FloatArray) -> tuple[IntArray, IntArray]:
         """Each block's ends within ``reach``: their count and segments, block after block."""
-        found = self.tree.query_ball_point(centre, reach, workers=nearest_exact.KD_WORKERS)
+        workers = nearest_exact.kd_workers(len(centre))
+        found = self.tree.query_ball_point(centre, reach, workers=workers)
         count = np.fromiter((len(f) for f in found), dtype=np.int64, count=len(found))
         ends = np.fromiter(
             itertools.chain.from_iterable(found), dtype=np.int64, count=int(np.sum(count))

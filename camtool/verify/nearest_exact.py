@@ -34,6 +34,20 @@ KD_WORKERS = -1
 """Threads of the k-d tree queries (scipy's ``workers``; -1: one per core). Each query is
 answered alone, so the distances do not depend on it; only the wall time does."""
 
+KD_THREADS_FROM = 1024
+"""Query points from which a k-d tree query runs on :data:`KD_WORKERS` threads
+(:func:`kd_workers`)."""
+
+
+def kd_workers(points: int) -> int:
+    """The ``workers`` of a scipy k-d tree query of ``points`` points.
+
+    scipy starts its threads anew for every query; below :data:`KD_THREADS_FROM` points
+    that costs more than the second core saves (a job's shortfall asks a small query for
+    each of thousands of contours), so such a query runs on one thread.
+    """
+    return KD_WORKERS if points >= KD_THREADS_FROM else 1
+
 
 def beyond_kth(d: FloatArray, rk: FloatArray, half: float) -> npt.NDArray[np.bool_]:
     """Where no segment with both ends ``rk`` or farther can come nearer than ``d``.
@@ -321,11 +335,13 @@ class _Reach:
         total, k = int(np.sum(counts)), int(np.max(counts))
         at = samples[lo:hi][rows]
         if k * len(rows) <= 2 * total + KNN_SLACK_PAIRS:  # arrays, not a list per sample
-            got = self.tree.query(at, k=k, workers=KD_WORKERS)[1]
+            got = self.tree.query(at, k=k, workers=kd_workers(len(at)))[1]
             end = np.asarray(got, dtype=np.int64).reshape(-1)
             owner = np.repeat(rows, k)
         else:
-            found = self.tree.query_ball_point(at, self.reach[lo:hi][rows], workers=KD_WORKERS)
+            found = self.tree.query_ball_point(
+                at, self.reach[lo:hi][rows], workers=kd_workers(len(at))
+            )
             owner = np.repeat(rows, counts)
             end = np.fromiter(itertools.chain.from_iterable(found), dtype=np.int64, count=total)
         seg = end % m if self.index is None else self.index[end % len(self.index)]
@@ -348,7 +364,7 @@ def _counts_within(ends: Any, samples: FloatArray, reach: FloatArray) -> IntArra
     for lo in range(0, len(samples), NEARBY_COUNT_CHUNK):
         part = slice(lo, lo + NEARBY_COUNT_CHUNK)
         near = ends.query_ball_point(
-            samples[part], reach[part], return_length=True, workers=KD_WORKERS
+            samples[part], reach[part], return_length=True, workers=kd_workers(len(samples))
         )
         total += int(np.sum(near))
         if total > limit:
@@ -365,7 +381,7 @@ def _count_all(ends: Any, samples: FloatArray, reach: FloatArray) -> IntArray:
                 samples[lo : lo + NEARBY_COUNT_CHUNK],
                 reach[lo : lo + NEARBY_COUNT_CHUNK],
                 return_length=True,
-                workers=KD_WORKERS,
+                workers=kd_workers(len(samples)),
             ),
             dtype=np.int64,
         )
@@ -562,7 +578,7 @@ def _nearest_chunk(
         The distances and which of them the tests could not settle.
     """
     k = min(NEAREST_ENDS, 2 * len(a))
-    r, index = ends.query(samples, k=k, workers=KD_WORKERS)
+    r, index = ends.query(samples, k=k, workers=kd_workers(len(samples)))
     r = np.asarray(r, dtype=np.float64).reshape(len(samples), k)
     seg = np.asarray(index).reshape(len(samples), k) % len(a)
     d = _to_segments(samples, a[seg], b[seg]).min(axis=1)
@@ -601,7 +617,7 @@ def settled(
     sure = beyond_kth(d, rk, half) | (d - lower <= NEAREST_TOLERANCE_MM)
     if long is not None and not sure.all():
         ask = np.flatnonzero(~sure)
-        far_long = np.asarray(long.tree.query(samples[ask], k=1, workers=KD_WORKERS)[0])
+        far_long = np.asarray(long.tree.query(samples[ask], k=1, workers=kd_workers(len(ask)))[0])
         sure[ask] = beyond_kth(d[ask], rk[ask], long.short_half) & beyond_kth(
             d[ask], far_long, half
         )

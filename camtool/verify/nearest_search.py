@@ -157,7 +157,7 @@ class _BoxSearch:
         k = nearest_exact.NEAREST_ENDS
         for i in range(0, len(rows), NEAREST_CHUNK):
             x = self.samples[rows[i : i + NEAREST_CHUNK]]
-            found = ends.tree.query(x, k=k, workers=nearest_exact.KD_WORKERS)[1]
+            found = ends.tree.query(x, k=k, workers=nearest_exact.kd_workers(len(x)))[1]
             seg = np.asarray(found).reshape(-1, k) % len(self.a)
             near = nearest_exact._to_segments(x, self.a[seg], self.b[seg])
             out[i : i + len(x)] = near.min(axis=1)
@@ -591,7 +591,8 @@ def _dense(samples: FloatArray, tree: tuple[Any, ...], half: float, kernels: Mod
 
 def _far_kd(samples: FloatArray, tree: Any, half: float) -> bool:
     """:func:`_far` asked of scipy's k-d tree ``tree`` of the ends (built already)."""
-    r0 = tree.query(_probe(samples, FAR_PROBE), k=1, workers=nearest_exact.KD_WORKERS)[0]
+    probe = _probe(samples, FAR_PROBE)
+    r0 = tree.query(probe, k=1, workers=nearest_exact.kd_workers(len(probe)))[0]
     return _far_apart(np.square(r0), half)
 
 

@@ -108,3 +108,37 @@ def test_the_k_d_tree_s_answers_in_parts_are_the_answers_at_once(
     assert np.array_equal(search.chosen(ends, rows), whole)
     truth = _shapely(samples, trace[:-1], trace[1:])
     assert np.max(np.abs(whole - truth)) <= NEAREST_TOLERANCE_MM
+
+
+@pytest.mark.parametrize(("samples", "threads"), [(200, False), (4_000, True)])
+def test_only_queries_of_many_points_start_threads(
+    monkeypatch: pytest.MonkeyPatch, samples: int, threads: bool
+) -> None:
+    """scipy starts its worker threads at every query: a small one (a job's shortfall asks
+    one per contour, thousands of them) runs on one thread, with the same distances."""
+    import threading
+
+    from camtool.accel.cores import default_jobs
+    from camtool.verify import nearest_exact
+    from camtool.verify.nearest_search import nearest_distances_kd
+
+    if threads and default_jobs() < 2:
+        pytest.skip("one core: every query runs on one thread")
+    monkeypatch.setattr(nearest_exact, "KD_WORKERS", -1)
+    rng = np.random.default_rng(7)
+    a = rng.uniform(0, 10, (300, 2))
+    b = a + rng.uniform(-0.2, 0.2, (300, 2))
+    x = rng.uniform(0, 10, (samples, 2))
+    started: list[int] = []
+    real = threading.Thread.start
+
+    def start(self: threading.Thread) -> None:
+        started.append(1)
+        real(self)
+
+    monkeypatch.setattr(threading.Thread, "start", start)
+    got = nearest_distances_kd(x, a, b)
+    assert bool(started) is threads
+    lines = shapely.linestrings(np.stack([a, b], axis=1))
+    want = shapely.distance(shapely.points(x)[:, None], lines[None, :]).min(axis=1)
+    assert np.all(np.abs(got - want) <= NEAREST_TOLERANCE_MM)
