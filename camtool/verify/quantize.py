@@ -46,8 +46,39 @@ def steps_from_mm(value_mm: float, step_mm: float, rounding: Rounding = "half_ev
         raise UsageError(f"step size must be a positive number of mm, got {step_mm!r}")
     if not math.isfinite(value_mm):
         raise UsageError(f"length must be a finite number of mm, got {value_mm!r}")
+    fast = _far_from_a_tie(float(value_mm) / float(step_mm), rounding)
+    if fast is not None:
+        return fast
     q = Decimal(repr(float(value_mm))) / Decimal(repr(float(step_mm)))
     if rounding == "trunc":
         return int(q)
     mode = {"half_even": ROUND_HALF_EVEN, "half_up": ROUND_HALF_UP, "floor": ROUND_FLOOR}
     return int(q.to_integral_value(rounding=mode[rounding]))
+
+
+TIE_MARGIN = 1e-9
+"""Relative distance from a rounding boundary beyond which :func:`_far_from_a_tie` answers."""
+
+
+def _far_from_a_tie(q: float, rounding: Rounding) -> int | None:
+    """:func:`steps_from_mm`'s answer from the binary quotient ``q``, or ``None``: ask Decimal.
+
+    The binary quotient of two floats and the decimal one of their shortest reprs differ
+    by a few parts in 10¹⁶ of it; one farther than :data:`TIE_MARGIN` (relative) from
+    every boundary of ``rounding`` (the halves for ``half_even`` and ``half_up``, the
+    integers for ``floor`` and ``trunc``) rounds as the decimal one does, where the rules
+    can differ only on a boundary. Nearer (0.3 mm / 0.1 mm is 2.9999999999999996 in
+    binary, 3 in decimal) or beyond 2⁵² (no fraction left), ``None``.
+    """
+    if not abs(q) < 2.0**52:
+        return None
+    low = math.floor(q)
+    frac = q - low  # within an ulp of q: far below the margin
+    margin = TIE_MARGIN * (1.0 + abs(q))
+    if rounding in ("half_even", "half_up"):
+        if abs(frac - 0.5) <= margin:
+            return None
+        return int(low) + (1 if frac > 0.5 else 0)
+    if frac <= margin or frac >= 1.0 - margin:
+        return None
+    return int(low) if rounding == "floor" or q >= 0 else int(low) + 1

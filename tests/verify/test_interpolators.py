@@ -7,6 +7,7 @@ or "analytic" for a property that follows from the geometry or the algorithm's d
 from __future__ import annotations
 
 import math
+from decimal import Decimal
 
 import numpy as np
 import pytest
@@ -259,6 +260,44 @@ def test_steps_from_mm_rules():
     assert steps_from_mm(-0.001, 0.0019, "floor") == -1
     assert steps_from_mm(-0.001, 0.0019, "trunc") == 0
     assert steps_from_mm(8.0, 0.04) == 200  # Munoz-22 §8 S004-R08: 8 mm → 200 steps
+
+
+def _decimal_steps(value: float, step: float, rounding: str) -> int:
+    """The rule's definition: the decimal quotient of the shortest reprs, rounded."""
+    from decimal import ROUND_FLOOR, ROUND_HALF_EVEN, ROUND_HALF_UP
+
+    q = Decimal(repr(value)) / Decimal(repr(step))
+    if rounding == "trunc":
+        return int(q)
+    mode = {"half_even": ROUND_HALF_EVEN, "half_up": ROUND_HALF_UP, "floor": ROUND_FLOOR}
+    return int(q.to_integral_value(rounding=mode[rounding]))
+
+
+STEP_SIZES = [0.0019, 1 / 250, 1 / 80, 0.001, 0.0125, 0.005, 1 / 3, 0.01, 2.54 / 4000, 0.04]
+
+
+@given(
+    st.sampled_from(STEP_SIZES),
+    st.one_of(
+        st.floats(-500, 500, allow_nan=False),
+        st.integers(-(10**6), 10**6),  # whole steps: every rule's boundary for floor and trunc
+        st.tuples(st.integers(-500, 500), st.integers(0, 4)),  # a value written with 0-4 decimals
+    ),
+    st.sampled_from([1.0, 0.5, 1.5, -0.5]),
+    st.sampled_from(["half_even", "half_up", "floor", "trunc"]),
+)
+def test_steps_from_mm_is_the_decimal_rule_on_and_off_its_boundaries(
+    step: float, raw: object, half: float, rounding: str
+) -> None:
+    """Values on a rule's boundaries (whole and half steps, in binary a hair off) and
+    between them round as the decimal quotient of their shortest reprs does."""
+    if isinstance(raw, tuple):
+        value = round(raw[0] * 0.9731, raw[1])
+    elif isinstance(raw, int):  # a whole or half number of steps in decimal (0.0057 mm)
+        value = float(Decimal(raw) * Decimal(repr(step)) * Decimal(repr(half)))
+    else:
+        value = float(raw)
+    assert steps_from_mm(value, step, rounding) == _decimal_steps(value, step, rounding)
 
 
 @pytest.mark.parametrize(
