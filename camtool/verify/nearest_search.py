@@ -95,16 +95,63 @@ def _nearest(
     ends = ends or _LazyTree(search.points)
     d = np.empty(len(samples), dtype=np.float64)
     unsure = np.zeros(len(samples), dtype=bool)
+    tied: list[tuple[IntArray, FloatArray, FloatArray]] = []  # only_max: asked last, if need be
     for i in range(0, len(samples), NEAREST_CHUNK):
         part = slice(i, i + NEAREST_CHUNK)
         near, rk, lower, ask = search.measure(part)
         if ask.any():  # ends tie at the k-th distance and the k-d tree's choice matters
             rows = np.flatnonzero(ask) + i
-            near[rows - i] = search.chosen(ends, rows)
+            if only_max:
+                tied.append((rows, rk[rows - i], lower[rows - i]))
+                near[rows - i] = 0.0  # below every distance until they are asked
+            else:
+                near[rows - i] = search.chosen(ends, rows)
         d[part] = near
         unsure[part] = ~search.settled(part, near, rk, lower)
-    return nearest_exact._settle_unsure(
+        if only_max and ask.any():
+            unsure[np.flatnonzero(ask) + i] = False  # asked last
+    d = nearest_exact._settle_unsure(
         search.samples, d, unsure, search.a, search.b, search.nearby, only_max=only_max
+    )
+    if tied:
+        _ask_reaching(search, ends, d, tied)
+    return d
+
+
+def _ask_reaching(
+    search: _BoxSearch,
+    ends: _LazyTree,
+    d: FloatArray,
+    tied: list[tuple[IntArray, FloatArray, FloatArray]],
+) -> None:
+    """Measure the tied samples of :func:`_nearest` (``only_max``) where they can be largest.
+
+    ``d``, updated in place, holds every other sample's distance where it can be the
+    largest, an upper bound below it elsewhere, and 0 for the tied ones (``tied``: their
+    rows, the k-th end's distance ``rk`` and the vertex bound ``lower``). Each segment the
+    k-d tree can keep for a tied sample has an end within ``rk`` of it, so its distance is
+    at most ``rk`` (widened as :func:`~camtool.verify.nearest_exact._reaching` widens a
+    bound); one whose bound is below the largest of ``d`` can be neither the largest nor
+    tie with it, and keeps the bound. The others are asked the k-d tree, and measured
+    exactly where its segments do not settle them, as :func:`_nearest` measures every
+    tied sample otherwise: the largest distance and its first sample are the same, and
+    the k-d tree of the ends is built only when a tied sample can be the largest.
+    """
+    rows = np.concatenate([r for r, _, _ in tied])
+    rk = np.concatenate([k for _, k, _ in tied])
+    lower = np.concatenate([low for _, _, low in tied])
+    slack = 1e-12 + 64.0 * float(np.spacing(np.max(np.abs(search.samples))))
+    high = rk * (1.0 + 1e-9) + slack
+    reach = high >= float(np.max(d))
+    d[rows[~reach]] = high[~reach]
+    asked = rows[reach]
+    if len(asked) == 0:
+        return
+    d[asked] = search.chosen(ends, asked)
+    unsure = np.zeros(len(d), dtype=bool)
+    unsure[asked] = ~search.settled(asked, d[asked], rk[reach], lower[reach])
+    nearest_exact._settle_unsure(
+        search.samples, d, unsure, search.a, search.b, search.nearby, only_max=True
     )
 
 

@@ -11,6 +11,8 @@ repeated), samples far from the trace (a drawing point a tool radius away). Equa
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pytest
 from scipy.spatial import cKDTree
@@ -517,3 +519,49 @@ def test_the_shortfall_of_a_dense_trace_is_the_same_on_either_search(
         got = nearest_search.farthest_nearest(samples, a, b, ends=ends)
         assert ends.built()  # the k-d tree's path: nearest_distances_kd's numbers
         assert got == (float(np.max(want)), int(np.argmax(want)))
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_farthest_nearest_is_the_largest_distance_and_its_first_sample(seed: int) -> None:
+    """Step-grid traces tie ends at the k-th distance for many samples: measured last,
+    only where they can be the largest, they leave the largest and its first sample as
+    every distance measured gives them (the k-d tree path, bit for bit)."""
+    rng = np.random.default_rng(300 + seed)
+    for kind in range(12):
+        pts = _trace(rng, kind)
+        a, b = pts[:-1], pts[1:]
+        samples = _samples(rng, pts, 2000, reach=float(rng.choice([0.0015, 0.1, 1.5])))
+        want = nearest_search.nearest_distances_kd(samples, a, b)
+        got = nearest_search.farthest_nearest(samples, a, b)
+        assert got == (float(np.max(want)), int(np.argmax(want)))
+
+
+def test_ties_that_cannot_be_the_largest_build_no_k_d_tree(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Samples on and beside a stepped trace, and one far off it: the samples whose ends
+    tie lie a few steps from the trace, far below the largest, so the k-d tree of the
+    ends is never built."""
+    rng = np.random.default_rng(5)
+    pts = _trace(rng, 1)  # a random walk on a 4 µm grid
+    a, b = pts[:-1], pts[1:]
+    samples = _samples(rng, pts, 2000, reach=0.0015)
+    far = pts.max(axis=0) + 1.0
+    samples = np.concatenate([samples, [far]])  # the farthest, at least 1 mm off
+    asked: list[int] = []
+    real = nearest_search._ask_reaching
+
+    def spy(*args: Any) -> None:
+        asked.append(sum(len(rows) for rows, _, _ in args[3]))  # (search, ends, d, tied)
+        real(*args)
+
+    monkeypatch.setattr(nearest_search, "_ask_reaching", spy)
+    builds: list[int] = []
+    build = nearest_search._LazyTree._build
+    monkeypatch.setattr(
+        nearest_search._LazyTree, "_build", lambda self: builds.append(1) or build(self)
+    )
+    got = nearest_search.farthest_nearest(samples, a, b)
+    assert asked and asked[0] > 0  # ties there were
+    assert not builds
+    assert got[1] == len(samples) - 1
+    want = nearest_search.nearest_distances_kd(samples, a, b)
+    assert got == (float(np.max(want)), int(np.argmax(want)))
