@@ -132,6 +132,36 @@ def bresenham_line(dx: int, dy: int, *, amass: bool = True) -> StepArray:
     return dda._rows(dda._sign(dx), dda._sign(dy), kx, ky)
 
 
+def bresenham_lines(
+    dx: npt.NDArray[np.int64], dy: npt.NDArray[np.int64], *, amass: bool = True
+) -> tuple[StepArray, npt.NDArray[np.int64]]:
+    """:func:`bresenham_line` of many lines at once (the chords of an arc), the same rows.
+
+    Args:
+        dx: ``(L,)`` X moves, steps, signed.
+        dy: ``(L,)`` Y moves, steps, signed.
+        amass: As in :func:`bresenham_line`.
+
+    Returns:
+        The lines' rows one after the other, ``(sum of max(|dx|, |dy|), 2) int8``, and
+        ``(L,)`` the first row of each line (a zero move has none: the next line's).
+    """
+    dx, dy = np.asarray(dx, dtype=np.int64), np.asarray(dy, dtype=np.int64)
+    big = np.maximum(np.abs(dx), np.abs(dy))
+    first = np.cumsum(big) - big
+    line = np.repeat(np.arange(len(big)), big)
+    n = np.arange(len(line), dtype=np.int64) - first[line] + 1  # the step event, from 1
+    events = big[line]
+    out = np.empty((len(line), 2), dtype=np.int8)
+    for col, d in ((0, dx), (1, dy)):
+        k = _bresenham_counts(np.abs(d)[line], events, n, amass)  # type: ignore[arg-type]
+        before = np.empty_like(k)
+        before[1:] = k[:-1]
+        before[n == 1] = 0  # each line's counter starts anew
+        np.multiply(k - before, np.sign(d)[line], out=out[:, col], casting="unsafe")
+    return out, first
+
+
 def bresenham_line_rows(dx: int, dy: int) -> int:
     """How many rows :func:`bresenham_line` ``(dx, dy)`` gives, without making them.
 

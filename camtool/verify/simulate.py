@@ -23,7 +23,7 @@ from camtool.model.machine import Backlash, Machine
 from camtool.model.program import ArcMove, Move, Program
 from camtool.model.shapes import Point, distance
 from camtool.verify.dda import compiled
-from camtool.verify.interpolators import sagitta_chord_points
+from camtool.verify.interpolators import bresenham_line, bresenham_lines, sagitta_chord_points
 from camtool.verify.motion import StepTrace, library
 from camtool.verify.quantize import Rounding, steps_from_mm
 from camtool.verify.sources import ALL, Sources
@@ -35,6 +35,12 @@ FloatArray = npt.NDArray[np.float64]
 
 IDEAL_SAMPLES_PER_STEP = 4
 """Samples per step of the dominant axis of the ideal controller (``interpolation`` off)."""
+
+LINES_AT_ONCE: dict[Callable[..., Any], Callable[..., tuple[StepArray, npt.NDArray[np.int64]]]] = {
+    bresenham_line: bresenham_lines,
+}
+"""Line interpolators whose rows of many lines (an arc's chords) one call makes, and it."""
+
 FINE_CHORD_STEPS = 0.1
 """Sagitta of the chords, in steps, when the ``chords`` source is off."""
 
@@ -226,8 +232,14 @@ class StepController:
                 return self.line(0, 0), [0], 0
             rows = self.arc(*self.pos, *end, *centre, move.clockwise)
             return rows, [], len(rows)
+        lattice = self._chord_lattice(start_mm, move, end)
+        at_once = LINES_AT_ONCE.get(self.line)
+        if at_once is not None:  # every chord's rows in one call
+            chords = np.diff(np.asarray(lattice, dtype=np.int64), axis=0)
+            joined, first = at_once(chords[:, 0], chords[:, 1])
+            return joined, first.tolist(), int(np.abs(chords).max(axis=1, initial=0).sum())
         parts, starts, offset, dominant = [], [], 0, 0
-        for (x0, y0), (x1, y1) in itertools.pairwise(self._chord_lattice(start_mm, move, end)):
+        for (x0, y0), (x1, y1) in itertools.pairwise(lattice):
             rows = self.line(x1 - x0, y1 - y0)
             parts.append(rows)
             starts.append(offset)

@@ -21,6 +21,7 @@ from camtool.verify.interpolators import (
     accumulator_dda_line,
     accumulator_dda_reference,
     bresenham_line,
+    bresenham_lines,
     bresenham_reference,
     chord_sagitta,
     circular_dda_arc,
@@ -510,3 +511,19 @@ def test_polyline_steps_joins_lines():
     assert tuple(positions(steps)[-1]) == (13, 7)
     with pytest.raises(UsageError):
         polyline_steps(np.array([[0.0, 0.0], [1.0, 1.0]]))
+
+
+@given(st.lists(st.tuples(small, small), max_size=12), st.booleans())
+def test_bresenham_lines_are_the_lines_one_after_the_other(
+    moves: list[tuple[int, int]], amass: bool
+) -> None:
+    """analytic: many lines at once (an arc's chords) are each line's rows, concatenated,
+    and each starts where the lines before it end (zero moves included)."""
+    dx = np.array([m[0] for m in moves], dtype=np.int64)
+    dy = np.array([m[1] for m in moves], dtype=np.int64)
+    rows, first = bresenham_lines(dx, dy, amass=amass)
+    each = [bresenham_reference(x, y, amass=amass) for x, y in moves]
+    want = np.concatenate(each) if each else np.zeros((0, 2), dtype=np.int8)
+    assert rows.dtype == np.int8
+    assert np.array_equal(rows, want)
+    assert first.tolist() == list(np.cumsum([0] + [len(e) for e in each])[:-1])
