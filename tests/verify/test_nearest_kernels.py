@@ -68,8 +68,11 @@ def _samples(rng: np.random.Generator, pts: np.ndarray, n: int, reach: float) ->
     return samples[np.argsort(samples[:, 0] + samples[:, 1], kind="stable")]
 
 
-@pytest.mark.parametrize("seed", range(4))
+@pytest.mark.parametrize("seed", [*range(4), *range(300, 304)])
 def test_nearest_distances_equal_the_kd_tree_path_bit_for_bit(seed: int) -> None:
+    """And the largest of them and its first sample (:func:`farthest_nearest`): step-grid
+    traces tie ends at the k-th distance for many samples, which it measures last, only
+    where they can be the largest."""
     rng = np.random.default_rng(seed)
     for kind in range(12):
         pts = _trace(rng, kind)
@@ -78,6 +81,8 @@ def test_nearest_distances_equal_the_kd_tree_path_bit_for_bit(seed: int) -> None
         got = nearest_search.nearest_distances(samples, a, b)
         want = nearest_search.nearest_distances_kd(samples, a, b)
         assert np.array_equal(got.view(np.int64), want.view(np.int64))
+        farthest = nearest_search.farthest_nearest(samples, a, b)
+        assert farthest == (float(np.max(want)), int(np.argmax(want)))
 
 
 @pytest.mark.parametrize("merge", [True, False])
@@ -518,21 +523,6 @@ def test_the_shortfall_of_a_dense_trace_is_the_same_on_either_search(
         want = nearest_search.nearest_distances_kd(samples, a, b)
         got = nearest_search.farthest_nearest(samples, a, b, ends=ends)
         assert ends.built()  # the k-d tree's path: nearest_distances_kd's numbers
-        assert got == (float(np.max(want)), int(np.argmax(want)))
-
-
-@pytest.mark.parametrize("seed", range(4))
-def test_farthest_nearest_is_the_largest_distance_and_its_first_sample(seed: int) -> None:
-    """Step-grid traces tie ends at the k-th distance for many samples: measured last,
-    only where they can be the largest, they leave the largest and its first sample as
-    every distance measured gives them (the k-d tree path, bit for bit)."""
-    rng = np.random.default_rng(300 + seed)
-    for kind in range(12):
-        pts = _trace(rng, kind)
-        a, b = pts[:-1], pts[1:]
-        samples = _samples(rng, pts, 2000, reach=float(rng.choice([0.0015, 0.1, 1.5])))
-        want = nearest_search.nearest_distances_kd(samples, a, b)
-        got = nearest_search.farthest_nearest(samples, a, b)
         assert got == (float(np.max(want)), int(np.argmax(want)))
 
 
