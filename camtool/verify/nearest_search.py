@@ -299,6 +299,7 @@ def farthest_off(samples: FloatArray, a: FloatArray, b: FloatArray, offset: floa
     for i in range(0, n, NEAREST_CHUNK):
         part = slice(i, i + NEAREST_CHUNK)
         d[part], kth[part], lower[part], ask[part] = search.measure(part)
+    d[ask] = 0.0  # unset there (the k-d tree's choice matters): a number until asked
     sure = ~ask & search.settled(slice(None), d, kth, lower)
     best = _largest_off(d[sure], offset)
     slack = 1e-12 + 64.0 * float(np.spacing(np.max(np.abs(search.samples))))

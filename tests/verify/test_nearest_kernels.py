@@ -555,3 +555,34 @@ def test_ties_that_cannot_be_the_largest_build_no_k_d_tree(monkeypatch: pytest.M
     assert got[1] == len(samples) - 1
     want = nearest_search.nearest_distances_kd(samples, a, b)
     assert got == (float(np.max(want)), int(np.argmax(want)))
+
+
+def test_what_the_search_leaves_unset_for_ties_is_never_read(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The compiled search leaves a tied sample's distance unset (whatever the memory
+    held): the largest distances come out the same, and no arithmetic warns, whatever it is."""
+    import warnings
+
+    measure = nearest_search._BoxSearch.measure
+
+    def unset(self: nearest_search._BoxSearch, part: slice) -> tuple[np.ndarray, ...]:
+        near, rk, lower, ask = measure(self, part)
+        near[ask] = 1e300  # what an unset float may hold
+        return near, rk, lower, ask
+
+    rng = np.random.default_rng(11)
+    pts = _trace(rng, 1)  # a random walk on a step grid: many ties
+    a, b = pts[:-1], pts[1:]
+    samples = _samples(rng, pts, 2000, reach=0.1)
+    want = nearest_search.nearest_distances_kd(samples, a, b)
+    monkeypatch.setattr(nearest_search._BoxSearch, "measure", unset)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for offset in (0.0, 0.1):
+            got = nearest_search.farthest_off(samples, a, b, offset)
+            assert got == float(np.max(np.abs(want - offset)))
+        assert nearest_search.farthest_nearest(samples, a, b) == (
+            float(np.max(want)),
+            int(np.argmax(want)),
+        )
