@@ -88,12 +88,18 @@ def accumulator_dda_reference(dx: int, dy: int) -> StepArray:
 
 
 def _bresenham_counts(
-    m: int, big: int, n: npt.NDArray[np.int64], amass: bool
+    m: int | npt.NDArray[np.int64],
+    big: int | npt.NDArray[np.int64],
+    n: npt.NDArray[np.int64],
+    amass: bool,
 ) -> npt.NDArray[np.int64]:
-    """Steps of an axis with ``m`` steps after ``n`` step events of a ``big``-event block."""
+    """Steps of an axis with ``m`` steps after ``n`` step events of a ``big``-event block.
+
+    Integers or arrays of one length each (every line's own ``m`` and ``big``).
+    """
     if amass:  # counter = big/2 exactly (block counts pre-scaled by 2^MAX_AMASS_LEVEL)
-        return (big + 2 * n * m - 1) // (2 * big)
-    return (big // 2 + n * m - 1) // big
+        return np.asarray((big + 2 * n * m - 1) // (2 * big), dtype=np.int64)
+    return np.asarray((big // 2 + n * m - 1) // big, dtype=np.int64)
 
 
 def bresenham_line(dx: int, dy: int, *, amass: bool = True) -> StepArray:
@@ -154,7 +160,7 @@ def bresenham_lines(
     events = big[line]
     out = np.empty((len(line), 2), dtype=np.int8)
     for col, d in ((0, dx), (1, dy)):
-        k = _bresenham_counts(np.abs(d)[line], events, n, amass)  # type: ignore[arg-type]
+        k = _bresenham_counts(np.abs(d)[line], events, n, amass)
         before = np.empty_like(k)
         before[1:] = k[:-1]
         before[n == 1] = 0  # each line's counter starts anew

@@ -96,9 +96,17 @@ def _reaching(upper: FloatArray, settled: FloatArray, samples: FloatArray) -> np
     """
     if len(settled) == 0:
         return np.ones(len(upper), dtype=bool)
-    top = float(np.max(settled))
-    slack = 1e-12 + 64.0 * float(np.spacing(np.max(np.abs(samples))))
-    return np.asarray(upper * (1.0 + 1e-9) + slack >= top)
+    return np.asarray(widened(upper, samples) >= float(np.max(settled)))
+
+
+def rounding_slack(samples: FloatArray) -> float:
+    """1e-12 mm and 64 ulps of the largest coordinate of ``samples``, mm (:func:`_reaching`)."""
+    return 1e-12 + 64.0 * float(np.spacing(np.max(np.abs(samples))))
+
+
+def widened(upper: FloatArray, samples: FloatArray) -> FloatArray:
+    """Upper bounds of distances widened by :func:`_reaching`'s margin for two formulas."""
+    return upper * (1.0 + 1e-9) + rounding_slack(samples)
 
 
 def _settle_unsure(

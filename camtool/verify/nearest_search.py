@@ -140,8 +140,7 @@ def _ask_reaching(
     rows = np.concatenate([r for r, _, _ in tied])
     rk = np.concatenate([k for _, k, _ in tied])
     lower = np.concatenate([low for _, _, low in tied])
-    slack = 1e-12 + 64.0 * float(np.spacing(np.max(np.abs(search.samples))))
-    high = rk * (1.0 + 1e-9) + slack
+    high = nearest_exact.widened(rk, search.samples)
     reach = high >= float(np.max(d))
     d[rows[~reach]] = high[~reach]
     asked = rows[reach]
@@ -302,9 +301,9 @@ def farthest_off(samples: FloatArray, a: FloatArray, b: FloatArray, offset: floa
     d[ask] = 0.0  # unset there (the k-d tree's choice matters): a number until asked
     sure = ~ask & search.settled(slice(None), d, kth, lower)
     best = _largest_off(d[sure], offset)
-    slack = 1e-12 + 64.0 * float(np.spacing(np.max(np.abs(search.samples))))
+    slack = nearest_exact.rounding_slack(search.samples)
     low = lower * (1.0 - 1e-9) - slack
-    high = kth * (1.0 + 1e-9) + slack
+    high = nearest_exact.widened(kth, search.samples)
     surely = high - lower <= nearest_exact.NEAREST_TOLERANCE_MM  # sure whatever the k-d tree keeps
     asked = ask & (~surely | _can_reach(high, low, offset, best))
     if asked.any():  # the k-d tree's choice, as _nearest takes it
