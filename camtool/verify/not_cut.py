@@ -175,28 +175,26 @@ def not_cut_groups(
     # the pieces of a contour the plan closed meet within its gap (measured after the
     # chaining moved their ends by up to the joint distance)
     meet_mm = joint_mm + max(closed_gaps, default=0.0)
-    vanished: list[int] = []  # the contours offset-vanished findings named
+    vanished: set[int] = set()  # the contours offset-vanished findings named
     taken = [False] * len(stretches)
+    of_contour: dict[int, list[int]] = {}  # each contour's stretches, in order
+    for k, index in enumerate(stretches):
+        of_contour.setdefault(int(contour_of[index[0]]), []).append(k)
+    drawing: _Contours | None = None  # indexed at the first finding
     out: list[tuple[FindingLike, IntArray, Point]] = []
     for finding in findings:
         if finding.kind not in NOT_CUT_KINDS or finding.at is None:
             continue
         at = np.asarray(finding.at, dtype=np.float64)
         inside = finding.kind == "offset-vanished"
-        contour = _named_contour(
-            samples,
-            contour_of,
-            at,
-            inside=inside,
-            runs=runs,
-            joint_mm=meet_mm,
-            named=frozenset(vanished),
-        )
+        drawing = drawing or _Contours(samples, contour_of, runs)
+        contour = drawing.named(at, inside=inside, joint_mm=meet_mm, named=vanished)
         if inside:
-            vanished.append(contour)
-        for k, index in enumerate(stretches):
-            if taken[k] or contour_of[index[0]] != contour:
+            vanished.add(contour)
+        for k in of_contour.get(contour, ()):
+            if taken[k]:
                 continue
+            index = stretches[k]
             peak = int(index[np.argmax(size[index])])
             if finding.kind == "tight-corner":
                 if size[peak] <= max(2.0 * threshold, tool_radius_mm / 100.0):
@@ -225,12 +223,16 @@ def _merged(
     drawn vertex, a narrow region's sides are all at the finding's location.
     """
     out: list[tuple[FindingLike, IntArray, Point]] = []
+    of_finding: dict[int, list[int]] = {}  # each finding's features in ``out``, in order
     for finding, index, where in groups:
-        for k, (other, known, at) in enumerate(out):
-            if other is finding and math.dist(at, where) <= CHAIN_JOIN_MM:
+        mine = of_finding.setdefault(id(finding), [])
+        for k in mine:
+            known, at = out[k][1], out[k][2]
+            if math.dist(at, where) <= CHAIN_JOIN_MM:
                 out[k] = (finding, np.concatenate([known, index]), at)
                 break
         else:
+            mine.append(len(out))
             out.append((finding, index, where))
     return out
 
@@ -262,83 +264,100 @@ def _stretches(
     return out
 
 
-def _named_contour(
-    samples: FloatArray,
-    contour_of: IntArray,
-    at: FloatArray,
-    *,
-    inside: bool,
-    runs: IntArray | None = None,
-    joint_mm: float = CHAIN_JOIN_MM,
-    named: frozenset[int] = frozenset(),
-) -> int:
-    """The contour a finding at ``at`` names: the smallest closed one around it, or the nearest.
+class _Contours:
+    """The drawing's samples by contour, indexed once for every finding (:meth:`named`).
 
-    With ``inside``, a contour in ``named`` (another ``offset-vanished`` finding's: the
-    planner gives one a contour) is passed over: two thin bars that cross, each narrower
-    than the tool, have their findings at one place.
-
-    When ``at`` lies on the drawing, the contour that starts there (a closed contour of no
-    area, drawn there and back, is located at its start; another may pass through it).
-
-    A contour here may be a chain of several drawing contours (``runs``: the pieces, each
-    sampled in order along the edge, listed in any order and direction, their ends within
-    ``joint_mm``, the plan's joint distance or a gap it closed): it is closed when every
-    piece's end meets another's, and around ``at`` when a ray from ``at`` crosses its
-    pieces an odd number of times (the even-odd rule); the smallest is the one of least
-    bounding box.
+    ``contour_of``: ``(S,)`` each sample's contour (a chain of drawing contours,
+    :func:`chains`); ``runs``: its piece (``None``: the contours). A finding's nearest
+    samples come from a k-d tree (scipy's ``cKDTree``) and the contours around it from
+    their bounding boxes, so that each finding costs what lies near it, not the whole
+    drawing; the answers are those of a scan of every sample (the same distances,
+    ``numpy.hypot``, and the first sample of least distance).
     """
-    pieces = contour_of if runs is None else runs
-    gap = np.hypot(*(samples - at).T)
-    nearest = int(np.argmin(gap))
-    if inside and gap[nearest] > 1e-9:
-        best = _around(samples, contour_of, at, pieces, joint_mm, named)
-        if best >= 0:
-            return best
-    elif inside:  # on the drawing: a region of no area, located at its contour's start
-        on = np.flatnonzero(gap <= 1e-9)
-        first = on[(on == 0) | (pieces[on] != pieces[np.maximum(on - 1, 0)])]
-        nearest = int(first[0]) if len(first) else nearest  # where a contour starts
-    return int(contour_of[nearest])
 
+    def __init__(self, samples: FloatArray, contour_of: IntArray, runs: IntArray | None) -> None:
+        self.samples, self.contour_of = samples, contour_of
+        self.pieces = contour_of if runs is None else runs
+        order = np.argsort(contour_of, kind="stable")  # each contour's samples, in their order
+        cuts = np.flatnonzero(np.diff(contour_of[order])) + 1
+        self.groups = np.split(order, cuts)
+        starts = np.concatenate([[0], cuts]).astype(np.int64)
+        ordered = samples[order]
+        self.lo = np.minimum.reduceat(ordered, starts, axis=0)
+        self.hi = np.maximum.reduceat(ordered, starts, axis=0)
+        self.sizes = np.diff(np.concatenate([starts, [len(order)]]))
+        from scipy.spatial import cKDTree
 
-def _around(
-    samples: FloatArray,
-    contour_of: IntArray,
-    at: FloatArray,
-    runs: IntArray,
-    joint_mm: float,
-    named: frozenset[int] = frozenset(),
-) -> int:
-    """:func:`_named_contour`'s smallest closed contour around ``at`` not in ``named``, or -1."""
-    order = np.argsort(contour_of, kind="stable")  # each contour's samples, in their order
-    cuts = np.flatnonzero(np.diff(contour_of[order])) + 1
-    best, best_area = -1, math.inf
-    for idx in np.split(order, cuts):
-        pts = samples[idx]
-        lo, hi = pts.min(axis=0), pts.max(axis=0)
-        if len(idx) < 4 or not (lo[0] <= at[0] <= hi[0] and lo[1] <= at[1] <= hi[1]):
-            continue
-        if int(contour_of[idx[0]]) in named:
-            continue
-        area = float((hi[0] - lo[0]) * (hi[1] - lo[1]))
-        if area >= best_area:
-            continue
-        piece = runs[idx]
-        same = piece[1:] == piece[:-1]  # chords join consecutive samples of one piece
-        starts = np.flatnonzero(np.concatenate([[True], ~same]))
-        stops = np.concatenate([starts[1:], [len(idx)]]) - 1
-        if not _ends_meet(np.concatenate([pts[starts], pts[stops]]), joint_mm):
-            continue
-        a, b = pts[:-1][same], pts[1:][same]
-        up = (a[:, 1] > at[1]) != (b[:, 1] > at[1])
-        if not up.any():
-            continue
-        a, b = a[up], b[up]
-        x = a[:, 0] + (at[1] - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
-        if int(np.count_nonzero(x > at[0])) % 2 == 1:
-            best, best_area = int(contour_of[idx[0]]), area
-    return best
+        self.tree = cKDTree(samples)
+
+    def _within(self, at: FloatArray, reach: float) -> tuple[IntArray, FloatArray]:
+        """The samples within ``reach`` of ``at`` (and a little more), by index, and their gaps."""
+        near = np.asarray(
+            sorted(self.tree.query_ball_point(at, reach * (1.0 + 1e-9) + 1e-12)), dtype=np.int64
+        )
+        return near, np.hypot(*(self.samples[near] - at).T)
+
+    def named(self, at: FloatArray, *, inside: bool, joint_mm: float, named: set[int]) -> int:
+        """The contour a finding at ``at`` names: the smallest closed one around it, or the nearest.
+
+        With ``inside``, a contour in ``named`` (another ``offset-vanished`` finding's: the
+        planner gives one a contour) is passed over: two thin bars that cross, each narrower
+        than the tool, have their findings at one place.
+
+        When ``at`` lies on the drawing, the contour that starts there (a closed contour of
+        no area, drawn there and back, is located at its start; another may pass through it).
+
+        A contour here may be a chain of several drawing contours (the pieces, each sampled
+        in order along the edge, listed in any order and direction, their ends within
+        ``joint_mm``, the plan's joint distance or a gap it closed): it is closed when every
+        piece's end meets another's, and around ``at`` when a ray from ``at`` crosses its
+        pieces an odd number of times (the even-odd rule); the smallest is the one of least
+        bounding box.
+        """
+        least = float(self.tree.query(at)[0])
+        near, gap = self._within(at, least)
+        nearest = int(near[np.argmin(gap)])  # the first sample of least distance
+        if inside and float(np.min(gap)) > 1e-9:
+            best = self._around(at, joint_mm, named)
+            if best >= 0:
+                return best
+        elif inside:  # on the drawing: a region of no area, located at its contour's start
+            near, gap = self._within(at, 1e-9)
+            on = near[gap <= 1e-9]
+            pieces = self.pieces
+            first = on[(on == 0) | (pieces[on] != pieces[np.maximum(on - 1, 0)])]
+            nearest = int(first[0]) if len(first) else nearest  # where a contour starts
+        return int(self.contour_of[nearest])
+
+    def _around(self, at: FloatArray, joint_mm: float, named: set[int]) -> int:
+        """:meth:`named`'s smallest closed contour around ``at`` not in ``named``, or -1."""
+        lo, hi = self.lo, self.hi
+        holds = (self.sizes >= 4) & (lo[:, 0] <= at[0]) & (at[0] <= hi[:, 0])
+        holds &= (lo[:, 1] <= at[1]) & (at[1] <= hi[:, 1])
+        best, best_area = -1, math.inf
+        for g in np.flatnonzero(holds).tolist():
+            idx = self.groups[g]
+            if int(self.contour_of[idx[0]]) in named:
+                continue
+            area = float((hi[g, 0] - lo[g, 0]) * (hi[g, 1] - lo[g, 1]))
+            if area >= best_area:
+                continue
+            pts = self.samples[idx]
+            piece = self.pieces[idx]
+            same = piece[1:] == piece[:-1]  # chords join consecutive samples of one piece
+            starts = np.flatnonzero(np.concatenate([[True], ~same]))
+            stops = np.concatenate([starts[1:], [len(idx)]]) - 1
+            if not _ends_meet(np.concatenate([pts[starts], pts[stops]]), joint_mm):
+                continue
+            a, b = pts[:-1][same], pts[1:][same]
+            up = (a[:, 1] > at[1]) != (b[:, 1] > at[1])
+            if not up.any():
+                continue
+            a, b = a[up], b[up]
+            x = a[:, 0] + (at[1] - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
+            if int(np.count_nonzero(x > at[0])) % 2 == 1:
+                best, best_area = int(self.contour_of[idx[0]]), area
+        return best
 
 
 def _ends_meet(ends: FloatArray, joint_mm: float) -> bool:

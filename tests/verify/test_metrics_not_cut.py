@@ -17,6 +17,7 @@ camtool:
 
 from __future__ import annotations
 
+import itertools
 import math
 from typing import Any
 
@@ -355,3 +356,87 @@ def test_two_crossing_regions_narrower_than_the_tool_each_name_their_own_contour
     assert v.against is not None and v.against.max_um < 12.0
     errors = [f.error_um for f in v.against.not_cut if f.kind == "offset-vanished"]
     assert errors == [pytest.approx(15_000.0, abs=10.0)] * 2
+
+
+def _scan_named(
+    samples: Any, contour_of: Any, runs: Any, at: Any, inside: bool, joint: float, named: set[int]
+) -> int:
+    """The contour a finding names, by a scan of every sample and every contour (the rule of
+    :class:`camtool.verify.not_cut._Contours`, written out plainly as the reference)."""
+    import numpy as np
+
+    from camtool.verify.not_cut import _ends_meet
+
+    gap = np.hypot(*(samples - at).T)
+    nearest = int(np.argmin(gap))
+    if inside and gap[nearest] > 1e-9:
+        best, best_area = -1, math.inf
+        for c in sorted(set(contour_of.tolist())):
+            idx = np.flatnonzero(contour_of == c)
+            pts = samples[idx]
+            lo, hi = pts.min(axis=0), pts.max(axis=0)
+            if len(idx) < 4 or c in named or not (lo <= at).all() or not (at <= hi).all():
+                continue
+            area = float((hi[0] - lo[0]) * (hi[1] - lo[1]))
+            if area >= best_area:
+                continue
+            piece = runs[idx]
+            same = piece[1:] == piece[:-1]
+            starts = np.flatnonzero(np.concatenate([[True], ~same]))
+            stops = np.concatenate([starts[1:], [len(idx)]]) - 1
+            if not _ends_meet(np.concatenate([pts[starts], pts[stops]]), joint):
+                continue
+            a, b = pts[:-1][same], pts[1:][same]
+            crossed = 0
+            for (ax, ay), (bx, by) in zip(a, b, strict=True):
+                if (ay > at[1]) != (by > at[1]):
+                    crossed += ax + (at[1] - ay) * (bx - ax) / (by - ay) > at[0]
+            if crossed % 2 == 1:
+                best, best_area = int(c), area
+        if best >= 0:
+            return best
+    elif inside:
+        on = [int(k) for k in np.flatnonzero(gap <= 1e-9)]
+        first = [k for k in on if k == 0 or runs[k] != runs[k - 1]]
+        nearest = first[0] if first else nearest
+    return int(contour_of[nearest])
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_the_indexed_contour_lookup_names_what_a_scan_of_every_sample_names(seed: int) -> None:
+    """Squares on a coarse grid (shared corners and edges: ties of distance), nested
+    ones, chains of two open pieces, findings on samples, on edges and in between: the
+    k-d tree and bounding boxes give the contour that the scan of every sample gives."""
+    import numpy as np
+
+    from camtool.verify.not_cut import _Contours
+
+    rng = np.random.default_rng(seed)
+    points, contour_of, runs = [], [], []
+    piece = 0
+    for c in range(int(rng.integers(2, 9))):
+        x0, y0 = rng.integers(0, 4, size=2).astype(float)
+        side = float(rng.integers(1, 4))
+        square = [(x0, y0), (x0 + side, y0), (x0 + side, y0 + side), (x0, y0 + side)]
+        ring = [*square, square[0]]
+        split = bool(rng.integers(0, 2))  # a chain of two pieces, meeting at their ends
+        for k, (a, b) in enumerate(itertools.pairwise(ring)):
+            if split and k == 2:
+                piece += 1
+            for t in np.linspace(0.0, 1.0, 3)[: -1 if k < 3 else None]:
+                points.append((a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])))
+                contour_of.append(c)
+                runs.append(piece)
+        piece += 1
+    samples = np.asarray(points, dtype=np.float64)
+    contour_of_a = np.asarray(contour_of, dtype=np.int64)
+    runs_a = np.asarray(runs, dtype=np.int64)
+    index = _Contours(samples, contour_of_a, runs_a)
+    named: set[int] = set()
+    for _ in range(40):
+        at = rng.integers(0, 14, size=2) / 2.0 + (rng.random(2) * 0.5 if rng.random() < 0.3 else 0)
+        inside = bool(rng.integers(0, 2))
+        want = _scan_named(samples, contour_of_a, runs_a, at, inside, 0.01, named)
+        assert index.named(at, inside=inside, joint_mm=0.01, named=named) == want
+        if inside and rng.random() < 0.3:
+            named.add(want)
