@@ -220,7 +220,7 @@ def post(
     if verifying:
         progress(Step("verifying", 0, job.result.blocks, chosen.name))
         load_picture()  # matplotlib, on the core the verification's start leaves idle
-        verified = verify_job(job, budget=not no_budget, budget_now=progress)
+        verified = verify_job(job, budget=not no_budget, budget_now=progress, progress=progress)
         _measure_budget(verified, progress)
         _finish_verification(
             verified,
@@ -281,6 +281,7 @@ def verify(
     from camtool.jobs.inputs import check_not_drawing, read_code, read_input
     from camtool.jobs.output import check_paths
     from camtool.jobs.pipeline import load_target_checked
+    from camtool.model.progress import Step
     from camtool.verify.verifier import verify_code
 
     check_paths(
@@ -301,6 +302,7 @@ def verify(
     progress = click.get_current_context().with_resource(StageReporter())
     load_picture = click.get_current_context().with_resource(picture_ahead(preview))
     load_picture()  # matplotlib, on the core the verification's start leaves idle
+    progress(Step("verifying", 0, 0, chosen.name))
     v = verify_code(
         text,
         chosen,
@@ -309,6 +311,7 @@ def verify(
         tool_diameter=tool_diameter,
         budget=not no_budget,
         budget_now=progress,
+        progress=progress,
     )
     _measure_budget(v, progress)
     _finish_verification(

@@ -35,6 +35,8 @@ _TEXTS = {
     "pocketing": "clearing {total} pocket regions",
     "writing": "writing {total} moves for {name}",
     "verifying": "verifying {total} blocks on {name}",
+    "simulating": "simulating {total} interpolator iterations",
+    "comparing": "comparing {total} cutting rows with the drawing",
     "budget": "error budget: re-simulating once per error source ({total})",
     "drawing": "drawing {total} moves",
 }
@@ -50,6 +52,8 @@ def stage_text(step: Step) -> str:
     if step.stage == "reading":
         shapes = f": {step.total} shapes" if step.total else ""
         return f"reading {step.name}{shapes}"
+    if step.stage == "verifying" and not step.total:
+        return f"verifying the program on {step.name}"
     template = _TEXTS.get(step.stage)
     return step.stage if template is None else template.format(total=step.total, name=step.name)
 

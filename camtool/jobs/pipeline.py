@@ -514,7 +514,11 @@ def post_drawing(
 
 
 def verify_job(
-    job: PostJob, *, budget: bool = True, budget_now: Progress | None = None
+    job: PostJob,
+    *,
+    budget: bool = True,
+    budget_now: Progress | None = None,
+    progress: Progress = no_progress,
 ) -> Verification:
     """Verify what ``job`` emitted: read its code back and simulate it against its drawing.
 
@@ -522,7 +526,8 @@ def verify_job(
     with this tool are measured apart (:func:`camtool.verify.verifier.verify_program`),
     and so does the unrounded plan, so that the error budget knows what rounding
     the emitted numbers costs (``budget=False``: no error budget; ``budget_now``: it
-    is computed now, told to that progress callback, as ``verify_program`` says).
+    is computed now, told to that progress callback, as ``verify_program`` says;
+    ``progress``: where the whole program's verification is).
 
     A job of several operations is verified whole (deviation, contours, time), and each
     operation again alone against the drawing it cuts, with its own tool
@@ -550,6 +555,7 @@ def verify_job(
         budget=budget,
         budget_now=budget_now,
         joint_mm=job.plan.joint_mm if job.plan is not None else CHAIN_JOIN_MM,
+        progress=progress,
     )
     if not several:
         return whole

@@ -18,6 +18,8 @@ STAGES = (
     "pocketing",
     "writing",
     "verifying",
+    "simulating",
+    "comparing",
     "budget",
     "drawing",
 )
@@ -28,7 +30,10 @@ contours of the shapes (``total``: shapes),
 planning the toolpath (``total``: contours), within it offsetting the closed contours for
 the tool with OpenCASCADE (``total``: contours offset), or clearing pockets (``--offset
 pocket``; ``total``: the regions to clear), writing the code (``total``: moves of the
-program), verifying it (``total``: blocks of code) and its error budget (``total``: the
+program), verifying it (``total``: blocks of code; 0: not counted), within it simulating
+the machine (``total``: the interpolator's iterations, ``done`` as they are measured; a
+long trace, streamed) and comparing the machined edge with the drawing (``total``: the
+cutting rows compared), and its error budget (``total``: the
 error sources re-simulated, in forked workers when there are cores for them; ``name``: the
 next source, in order, whose figures are not in yet); ``camtool preview`` reads, then
 draws the picture (``total``: the program's moves)."""

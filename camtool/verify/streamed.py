@@ -18,6 +18,7 @@ from camtool.accel.cores import (
 )
 from camtool.model.machine import Machine
 from camtool.model.program import Program, Rapid
+from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import Drawing
 from camtool.verify import trace_sources
 from camtool.verify.chunked import (
@@ -73,6 +74,7 @@ def simulate_big(
     stream_above: int,
     *,
     streaming: Callable[[int], None] | None = None,
+    progress: Progress = no_progress,
 ) -> tuple[StepTrace, Streamed | None]:
     """The trace of ``program``, and its measures when they were taken as it streamed.
 
@@ -96,7 +98,7 @@ def simulate_big(
     thread (:func:`~camtool.accel.cores.ahead`), say where each move's rows start; should
     they not agree with the count, the offsets are simulated and the trace streamed again.
     ``streaming`` is told the rows of a trace about to be streamed, before it is (each
-    time it is).
+    time it is); ``progress``, the rows measured as it streams (a ``simulating`` step).
     """
     if library(machine).simulator(machine.motion.line) is not None:
         return trace_sources.simulate(program, machine), None
@@ -114,7 +116,9 @@ def simulate_big(
     try:
         if streaming is not None:
             streaming(int(got[-1]))
-        streamed = stream_trace(program, machine, against, chunk_rows, got, kernels)
+        streamed = stream_trace(
+            program, machine, against, chunk_rows, got, kernels, progress=progress
+        )
         release_free()  # the simulation's and the measures' freed pages
         if streamed is None and counted:  # the count was not the rows': count them again
             got = simulate_or_count(program, machine, stream_above)
@@ -122,7 +126,9 @@ def simulate_big(
                 return got, None
             if streaming is not None:
                 streaming(int(got[-1]))
-            streamed = stream_trace(program, machine, against, chunk_rows, got, kernels)
+            streamed = stream_trace(
+                program, machine, against, chunk_rows, got, kernels, progress=progress
+            )
     except NotStreamable:
         return trace_sources.simulate(program, machine), None
     if streamed is None:
@@ -146,6 +152,7 @@ def stream_trace(
     *,
     sources: Sources = ALL,
     rms: bool = True,
+    progress: Progress = no_progress,
 ) -> tuple[StepTrace, Streamed] | None:
     """:func:`simulate_big`'s streamed trace and measures, its moves at ``block_start``.
 
@@ -153,6 +160,7 @@ def stream_trace(
     (the measures, which were told those offsets, are then not the trace's).
     ``sources``: the error sources simulated (the error budget's re-simulations);
     ``rms=False``: the deviation's rms is not measured (NaN; the budget has no use for it).
+    ``progress`` is told the rows measured after each chunk (a ``simulating`` step).
 
     Raises:
         NotStreamable: the rows are not whole steps.
@@ -162,6 +170,8 @@ def stream_trace(
     stream = TraceStream(program, block_start, summary["start_mm"], kernels, rms=rms)
     cutting = None if against is None else cutting_stream(program, block_start)
     share = Share()
+    total, done = int(block_start[-1]), 0
+    progress(Step("simulating", 0, total))
 
     def made() -> Iterator[tuple[TraceChunk, Any]]:  # in the thread ahead
         clock = time.perf_counter()
@@ -201,6 +211,8 @@ def stream_trace(
         if cutting is not None:
             cutting.add(chunk.carriage_mm, pre[0])  # the rows' moves, made with the distances
         share.measured(time.perf_counter() - measuring, rows)
+        done += len(chunk.rows)
+        progress(Step("simulating", min(done, total), total))
     summary = sim.trace_summary()
     if not np.array_equal(summary["block_start"], block_start):
         return None

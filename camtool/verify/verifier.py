@@ -16,7 +16,7 @@ import numpy as np
 from camtool.model.errors import CamtoolError, InputError, UsageError
 from camtool.model.machine import Machine
 from camtool.model.program import Dwell, Program, Rapid
-from camtool.model.progress import Progress, no_progress
+from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import Drawing
 from camtool.model.units import fmt_num
 from camtool.verify import budget as eb
@@ -216,12 +216,13 @@ def verify_code(
     budget: bool = True,
     budget_now: Progress | None = None,
     joint_mm: float = CHAIN_JOIN_MM,
+    progress: Progress = no_progress,
 ) -> Verification:
     """Read ``code`` with ``target``'s reader and verify it on ``target``'s machine.
 
     ``findings`` are the plan's, ``joint_mm`` its joint distance, ``planned`` the unrounded
-    plan, ``budget`` the error budget switch and ``budget_now`` when it is computed (see
-    :func:`verify_program`).
+    plan, ``budget`` the error budget switch and ``budget_now`` when it is computed, and
+    ``progress`` where a long one is (see :func:`verify_program`).
 
     Raises:
         ParseError: the code is not valid in the target's dialect (names the line).
@@ -248,6 +249,7 @@ def verify_code(
         source=source,
         budget_now=budget_now,
         joint_mm=joint_mm,
+        progress=progress,
     )
 
 
@@ -266,6 +268,7 @@ def verify_program(
     source: str = "",
     budget_now: Progress | None = None,
     joint_mm: float = CHAIN_JOIN_MM,
+    progress: Progress = no_progress,
 ) -> Verification:
     """Simulate ``program`` on ``machine`` and measure the machined error.
 
@@ -294,6 +297,8 @@ def verify_program(
             :meth:`Verification.measure_budget` tells it: its sources are re-simulated
             in forked workers while this process measures the trace (the same budget).
             A budget that fails is left to be computed, and to fail, when it is asked for.
+        progress: told the rows of a streamed trace as they are measured (``simulating``)
+            and the start of the drawing comparison (``comparing``).
 
     A drawing whose box does not overlap the program's (less than
     :data:`MIN_OVERLAP`) is not compared: ``against`` is ``None``,
@@ -320,7 +325,13 @@ def verify_program(
             stack.callback(early.close)
         streaming = None if early is None else early.start
         trace, streamed = simulate_big(
-            program, machine, drawing, chunk_rows, stream_above, streaming=streaming
+            program,
+            machine,
+            drawing,
+            chunk_rows,
+            stream_above,
+            streaming=streaming,
+            progress=progress,
         )
         run = None if early is None else early.run_for(trace.row_count)
         if budget_now is not None and streamed is None and run is None:  # forked now
@@ -343,6 +354,7 @@ def verify_program(
         )
         compared = None
         if thin is not None and drawing is not None:
+            progress(Step("comparing", 0, thin.rows))
             compared = compare_drawing(program, thin, drawing, tool_diameter, findings, joint_mm)
         warnings = [*report._warnings(program, trace), *([skipped] if skipped else [])]
         warnings += timing_warnings(trace, program, machine)

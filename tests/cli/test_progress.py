@@ -142,6 +142,9 @@ def test_a_closed_stderr_silences_progress_without_failing() -> None:
         (Step("writing", 0, 7, "valcnc"), "writing 7 moves for valcnc"),
         (Step("offsetting", 2, 9), "offsetting 9 contours for the tool"),
         (Step("pocketing", 1, 12), "clearing 12 pocket regions"),
+        (Step("verifying", 0, 0, "grbl"), "verifying the program on grbl"),
+        (Step("simulating", 10, 1200), "simulating 1200 interpolator iterations"),
+        (Step("comparing", 0, 50), "comparing 50 cutting rows with the drawing"),
     ],
 )
 def test_stage_text_says_how_big_the_work_is(step: Step, text: str) -> None:
@@ -217,20 +220,27 @@ def test_a_long_job_tells_its_stages_and_keeps_its_output(
     assert stages[4].startswith("camtool: planning ") and stages[4].endswith(" contours…")
     assert stages[5].startswith("camtool: writing ") and stages[5].endswith(" moves for grbl…")
     assert stages[6].startswith("camtool: verifying ") and stages[6].endswith(" blocks on grbl…")
-    assert len(stages) == 7
+    assert stages[7].startswith("camtool: comparing ") and stages[7].endswith(" with the drawing…")
+    assert len(stages) == 8
 
 
 def test_a_long_verification_tells_its_error_budget(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """Threshold 0 and the budget on: one line for the budget after the verifying line.
+    """Threshold 0 and the budget on: a line for the budget after the verifying line.
 
     grbl's profile models interpolation, chords and (post --verify) rounding for a
-    drawing with arcs: three sources. The summary is what it is without progress.
+    drawing with arcs: three sources. Its workers start before the drawing comparison,
+    whose line comes next; the budget's line again when this process waits for them.
+    The summary is what it is without progress.
     """
     stages = _stage_lines([str(_svg(tmp_path, 3)), "-t", "grbl", "--verify"], capsys, monkeypatch)
-    assert stages[-2].startswith("camtool: verifying ")
-    assert stages[-1] == "camtool: error budget: re-simulating once per error source (3)…"
+    budget = "camtool: error budget: re-simulating once per error source (3)…"
+    assert stages[-4].startswith("camtool: verifying ")
+    assert stages[-3] == stages[-1] == budget
+    words = stages[-2].split()
+    assert words[:2] == ["camtool:", "comparing"] and int(words[2]) > 0
+    assert words[3:] == ["cutting", "rows", "with", "the", "drawing…"]
 
 
 def test_a_long_job_with_offsets_tells_its_offsetting_stage(

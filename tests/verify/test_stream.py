@@ -479,3 +479,33 @@ def test_a_streamed_picture_keeps_the_rows_around_the_worst_point(
     kept = {tuple(p) for p in v.trace.carriage_mm.tolist()}
     assert {tuple(p) for p in near.tolist()} <= kept
     assert len(v.trace.carriage_mm) < len(whole.carriage_mm)  # still thinned elsewhere
+
+
+def test_a_streamed_verification_tells_its_rows_as_they_are_measured() -> None:
+    """``progress`` hears the rows measured after each chunk, rising to the trace's
+    iterations, then the comparison with the drawing and its cutting rows."""
+    from camtool.model.progress import Step
+
+    target = load_target("pic-mmh")
+    program = _program(0)
+    heard: list[Step] = []
+    v = verify_program(
+        program,
+        target.machine,
+        name="pic-mmh",
+        budget=False,
+        against=_drawn(program),
+        tool_diameter=0.2,
+        chunk_rows=53,
+        stream_above=10,
+        progress=heard.append,
+    )
+    assert isinstance(v.trace, StreamedTrace)
+    rows = [s for s in heard if s.stage == "simulating"]
+    assert {s.total for s in rows} == {v.trace.total_rows}
+    done = [s.done for s in rows]
+    assert done[0] == 0 and done[-1] == v.trace.total_rows and done == sorted(done)
+    assert len(rows) > 2  # a step per chunk
+    comparing = [s for s in heard if s.stage == "comparing"]
+    assert len(comparing) == 1 and comparing[0].total > 0
+    assert heard.index(comparing[0]) > heard.index(rows[-1])
