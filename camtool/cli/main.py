@@ -569,24 +569,29 @@ cli.add_command(simulate_device)
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the CLI; turn every error into a message and an exit code, never a traceback."""
+    """Run the CLI; turn every error into a message and an exit code, never a traceback.
+
+    Ctrl-C ends a command with exit code 130, SIGTERM with 143 (:class:`TerminateAsInterrupt`):
+    each unwinds it, so a file half written is removed and the output left as it was.
+    """
+    from camtool.jobs.batch_stop import TerminateAsInterrupt
+
     try:
-        code = cli.main(args=argv, prog_name="camtool", standalone_mode=False)
+        with TerminateAsInterrupt():
+            code = cli.main(args=argv, prog_name="camtool", standalone_mode=False)
     except click.exceptions.Exit as exc:
         return int(exc.exit_code)
     except click.ClickException as exc:
         exc.show()
         return int(exc.exit_code)
-    except click.Abort:
-        click.echo("camtool: aborted", err=True)
-        return 130
+    except click.Abort as exc:
+        return _aborted(exc)
     except CamtoolError as exc:
         click.echo(f"camtool: error: {exc}", err=True)
         return exc.exit_code
     except Exception as exc:  # a bug: still a message, never a traceback
         if _interrupted(exc):
-            click.echo("camtool: aborted", err=True)
-            return 130
+            return _aborted(exc)
         click.echo(
             f"camtool: internal error: {type(exc).__name__}: {exc} (please report it)", err=True
         )
@@ -594,8 +599,21 @@ def main(argv: list[str] | None = None) -> int:
     return code if isinstance(code, int) else 0  # a command's ctx.exit(n) returns n here
 
 
-def _interrupted(exc: BaseException) -> bool:
-    """Whether ``exc`` comes of Ctrl-C (a KeyboardInterrupt in its chain of causes).
+def _aborted(exc: BaseException) -> int:
+    """Say that Ctrl-C (exit code 130) or SIGTERM (143) stopped the command; its exit code."""
+    from camtool.jobs.batch_stop import Terminated
+
+    if _interrupted(exc, Terminated):
+        click.echo("camtool: stopped (SIGTERM)", err=True)
+        return 143
+    click.echo("camtool: aborted", err=True)
+    return 130
+
+
+def _interrupted(exc: BaseException, kind: type[BaseException] = KeyboardInterrupt) -> bool:
+    """Whether ``exc`` comes of Ctrl-C (a ``kind``, KeyboardInterrupt, in its chain of causes).
+
+    ``kind=Terminated``: whether it comes of SIGTERM.
 
     A compiled kernel (numba) interrupted mid-call raises ``SystemError: ... returned a
     result with an exception set`` from the KeyboardInterrupt.
@@ -603,7 +621,7 @@ def _interrupted(exc: BaseException) -> bool:
     seen: set[int] = set()
     cause: BaseException | None = exc
     while cause is not None and id(cause) not in seen:
-        if isinstance(cause, KeyboardInterrupt):
+        if isinstance(cause, kind):
             return True
         seen.add(id(cause))
         cause = cause.__cause__ or cause.__context__

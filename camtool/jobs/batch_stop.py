@@ -19,6 +19,57 @@ class Terminated(KeyboardInterrupt):
     """SIGTERM, raised as Ctrl-C is, so that a batch stops the same way (:class:`Interrupts`)."""
 
 
+class TerminateAsInterrupt:
+    """A SIGTERM handler that raises :class:`Terminated` in the process that installs it.
+
+    A command stopped by SIGTERM (``timeout``, a CI runner, ``kill``) then unwinds as
+    after Ctrl-C: a file being written loses its temporary file, the output is left as it
+    was, and the exit code is 143. A process forked after it is installed (a helper, a
+    pool's worker) inherits the handler: there SIGTERM ends the process as it did before
+    (the handler puts the default back and sends the signal again).
+
+    A forked process gets SIGTERM's default back at once (``os.register_at_fork``): a
+    signal that came before Python's own handlers run there would be lost.
+
+    Use it as a context manager in the main thread: the handler is installed only over
+    Python's default (not over ``nohup``'s ignore, nor a caller's own handler), and the
+    one before is put back at the end. :class:`Interrupts` takes it for a default.
+    """
+
+    def __init__(self) -> None:
+        self.owner = os.getpid()
+        self._previous: Any = None
+
+    def __enter__(self) -> TerminateAsInterrupt:
+        main = threading.current_thread() is threading.main_thread()
+        if main and signal.getsignal(signal.SIGTERM) == signal.SIG_DFL:
+            self._previous = signal.signal(signal.SIGTERM, self)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._previous is not None:
+            signal.signal(signal.SIGTERM, self._previous)
+            self._previous = None
+
+    def __call__(self, signum: int, frame: object) -> None:
+        """The handler: raise :class:`Terminated` here; in a forked process, end by SIGTERM."""
+        if os.getpid() != self.owner:  # a forked helper: end as before
+            signal.signal(signal.SIGTERM, signal.SIG_DFL)
+            os.kill(os.getpid(), signal.SIGTERM)
+            return
+        raise Terminated()
+
+
+def _default_in_child() -> None:
+    """After a fork, in the child: SIGTERM's default again where the handler was in place."""
+    with contextlib.suppress(ValueError):  # not the main thread: nothing to put back
+        if isinstance(signal.getsignal(signal.SIGTERM), TerminateAsInterrupt):
+            signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+os.register_at_fork(after_in_child=_default_in_child)
+
+
 class Interrupts:
     """Ctrl-C (SIGINT) and SIGTERM while a batch runs: the first one stops it, cleanly.
 
@@ -28,7 +79,8 @@ class Interrupts:
     recorded. Signals that follow are ignored: the batch is already stopping
     (killing its workers, releasing its output folder), and a second Ctrl-C must not
     cut that short. Only a signal whose handler is Python's default is taken over
-    (SIGINT raising ``KeyboardInterrupt``, SIGTERM ending the process): one ignored
+    (SIGINT raising ``KeyboardInterrupt``, SIGTERM ending the process or
+    :class:`TerminateAsInterrupt`'s): one ignored
     (``nohup``) or handled by the caller is left alone. The handlers are restored at
     the end; outside the main thread nothing changes.
     """
@@ -42,7 +94,8 @@ class Interrupts:
         if threading.current_thread() is threading.main_thread():
             defaults = {signal.SIGINT: signal.default_int_handler, signal.SIGTERM: signal.SIG_DFL}
             for signum, default in defaults.items():
-                if signal.getsignal(signum) == default:
+                now = signal.getsignal(signum)
+                if now == default or isinstance(now, TerminateAsInterrupt):
                     self._previous[signum] = signal.signal(signum, self._handle)
         return self
 

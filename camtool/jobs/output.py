@@ -178,9 +178,11 @@ class Staged:
                 os.fsync(fd)
             finally:
                 os.close(fd)
-        except OSError as exc:
+        except BaseException as exc:  # an error, Ctrl-C or SIGTERM: no temporary left
             tmp.unlink(missing_ok=True)
-            raise CamtoolError(f"{path}: cannot write ({reason(exc)})") from exc
+            if isinstance(exc, OSError):
+                raise CamtoolError(f"{path}: cannot write ({reason(exc)})") from exc
+            raise
         self._renames.append((tmp, target))
 
     def publish(self) -> None:
