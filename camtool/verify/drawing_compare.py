@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from camtool.accel.collector import release_free
 from camtool.accel.memo import LastAnswers
 from camtool.model.shapes import Drawing, Line, Point, Segment
 from camtool.verify import (
@@ -228,7 +229,9 @@ def against_thinned(
         return Against(0.0, 0.0, (0.0, 0.0), 0.0, 0)
     trace = thin.points
     off = nearest_search.nearest_distances(samples, *_chords(thin)) - tool_radius_mm
+    release_free()  # each search's freed pages back, before the next allocates its own
     apart = _not_cut(samples, sizes, tool_radius_mm, nominal, findings, joint_mm)
+    release_free()
     main = _cut_as_drawn(len(samples), apart)
     features = [
         NotCut(
@@ -344,6 +347,11 @@ OVERCUT_PRUNE_FROM = 20_000
 """Trace points from which :func:`_least_nearest` measures only those that can be nearest."""
 
 
+OVERCUT_BOUND_ROWS = 1 << 20
+"""Trace points :func:`_least_nearest` bounds at a time (~60 MB of temporaries; a trace of
+31 M points took 1.5 GB at once)."""
+
+
 OVERCUT_ANCHOR = 4
 """Every how many trace points :func:`_least_nearest` measures first, to bound the others:
 on the benchmark part (369 000 thinned trace points 1.5 mm from 112 000 drawing
@@ -379,13 +387,16 @@ def _least_nearest(points: FloatArray, samples: FloatArray, sizes: list[int]) ->
         path_shortfall._largest_magnitude(points), path_shortfall._largest_magnitude(samples)
     )
     slack = nearest_exact.NEAREST_TOLERANCE_MM + 1e-12 + 128.0 * float(np.spacing(scale))
-    left = np.minimum(np.arange(n) // every, len(anchors) - 1)
-    right = np.minimum(left + 1, len(anchors) - 1)
-    lower = np.full(n, -math.inf)
-    for side in (left, right):
-        gap = np.hypot(*(points - points[anchors[side]]).T) * (1.0 + 1e-9)
-        np.maximum(lower, got[side] * (1.0 - 1e-9) - gap - slack, out=lower)
-    maybe = lower <= upper
+    maybe = np.empty(n, dtype=bool)
+    for lo in range(0, n, OVERCUT_BOUND_ROWS):  # the bounds' temporaries a part at a time
+        hi = min(n, lo + OVERCUT_BOUND_ROWS)
+        left = np.minimum(np.arange(lo, hi) // every, len(anchors) - 1)
+        right = np.minimum(left + 1, len(anchors) - 1)
+        lower = np.full(hi - lo, -math.inf)
+        for side in (left, right):
+            gap = np.hypot(*(points[lo:hi] - points[anchors[side]]).T) * (1.0 + 1e-9)
+            np.maximum(lower, got[side] * (1.0 - 1e-9) - gap - slack, out=lower)
+        maybe[lo:hi] = lower <= upper
     maybe[anchors] = False  # measured
     if not maybe.any():
         return upper

@@ -20,6 +20,10 @@ ALONG_BLOCK = 16
 """Consecutive samples :func:`along_distances` gives one search of the segments near them."""
 
 
+ALONG_PART_BLOCKS = 1 << 16
+"""Blocks whose spread :func:`along_distances` measures at a time (~1 M samples)."""
+
+
 ALONG_MAX_CANDIDATES = 512
 """Segment ends near a block beyond which its samples get GEOS's nearest query instead."""
 
@@ -66,9 +70,14 @@ def along_distances(samples: FloatArray, a: FloatArray, b: FloatArray) -> FloatA
     first = np.arange(0, n, ALONG_BLOCK)
     size = np.minimum(ALONG_BLOCK, n - first)
     centre = samples[first + size // 2]
-    block_of = np.repeat(np.arange(len(first)), size)
-    spread = np.hypot(*(samples - centre[block_of]).T)
-    rho = np.maximum.reduceat(spread, first) * (1.0 + 1e-9)
+    rho = np.empty(len(first), dtype=np.float64)
+    part = ALONG_BLOCK * ALONG_PART_BLOCKS
+    for lo in range(0, n, part):  # each block's spread, the temporaries a part at a time
+        k0, k1 = lo // ALONG_BLOCK, min(len(first), (lo + part) // ALONG_BLOCK)
+        hi = min(n, lo + part)
+        spread = np.hypot(*(samples[lo:hi] - np.repeat(centre[k0:k1], size[k0:k1], axis=0)).T)
+        rho[k0:k1] = np.maximum.reduceat(spread, first[k0:k1] - lo)
+    rho *= 1.0 + 1e-9
     sets = [_Ends(a, b, index, centre) for index in _by_length(a, b)]
     upper = np.min([e.r0 for e in sets], axis=0)  # the centre's nearest end
     reach = [e.reach(upper, rho) for e in sets]
@@ -76,7 +85,7 @@ def along_distances(samples: FloatArray, a: FloatArray, b: FloatArray) -> FloatA
     out = np.empty(n, dtype=np.float64)
     wide = count > ALONG_MAX_CANDIDATES
     if wide.any():  # GEOS's query over every segment for these
-        rows = np.flatnonzero(wide[block_of])
+        rows = np.flatnonzero(np.repeat(wide, size))
         out[rows] = nearest_exact._all_exact(samples[rows], a, b)
     narrow = np.flatnonzero(~wide)
     lo = 0

@@ -72,6 +72,11 @@ def test_along_distances_are_geos_nearest_query_bit_for_bit(
     monkeypatch.setattr(nearest_exact, "NEARBY_MAX_PAIRS", 5000)
     got = nearest_along.along_distances(samples, a, b)
     assert got is not None and got.tobytes() == want.tobytes()
+    # the blocks' spreads a few blocks at a time (the last part short, its last block too)
+    for blocks in (1, 3):
+        monkeypatch.setattr(nearest_along, "ALONG_PART_BLOCKS", blocks)
+        got = nearest_along.along_distances(samples[:-5], a, b)
+        assert got is not None and got.tobytes() == want[:-5].tobytes()
 
 
 def test_samples_out_of_order_are_still_exact() -> None:

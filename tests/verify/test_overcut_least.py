@@ -90,3 +90,17 @@ def test_every_point_an_anchor_or_a_candidate(monkeypatch: pytest.MonkeyPatch) -
     for every in (1, 2, 1000, 20_000):
         monkeypatch.setattr(drawing_compare, "OVERCUT_ANCHOR", every)
         assert drawing_compare._least_nearest(points, samples, sizes) == want
+
+
+@pytest.mark.parametrize("rows", [1, 7, 4096])
+def test_the_bounds_taken_a_part_at_a_time_find_the_same_least(
+    rows: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Parts of ``OVERCUT_BOUND_ROWS`` points (edges between anchors, a lone point, one
+    anchor's neighbours split): the least distance of every point, as in one part."""
+    monkeypatch.setattr(drawing_compare, "OVERCUT_PRUNE_FROM", 0)
+    monkeypatch.setattr(drawing_compare, "OVERCUT_BOUND_ROWS", rows)
+    rng = np.random.default_rng(rows)
+    samples, sizes = _drawing(rng)
+    points = _trace(rng, 9001 if rows > 1 else 801, gouges=3)
+    assert drawing_compare._least_nearest(points, samples, sizes) == _plain(points, samples, sizes)
