@@ -1,4 +1,4 @@
-"""Stopping a batch: Ctrl-C and SIGTERM taken while it runs, its pool's workers killed.
+"""Stopping a command on SIGTERM as on Ctrl-C; a batch stopped cleanly, its pool's workers killed.
 
 The first signal stops the batch at once (:class:`Interrupts`); the pool's workers are
 killed and reaped (:func:`kill_pool`) and die with the batch if it dies first
@@ -24,12 +24,10 @@ class TerminateAsInterrupt:
 
     A command stopped by SIGTERM (``timeout``, a CI runner, ``kill``) then unwinds as
     after Ctrl-C: a file being written loses its temporary file, the output is left as it
-    was, and the exit code is 143. A process forked after it is installed (a helper, a
-    pool's worker) inherits the handler: there SIGTERM ends the process as it did before
-    (the handler puts the default back and sends the signal again).
-
-    A forked process gets SIGTERM's default back at once (``os.register_at_fork``): a
-    signal that came before Python's own handlers run there would be lost.
+    was, and the exit code is 143. A process forked while it is installed (a helper, a
+    pool's worker) gets SIGTERM's default back at once (``os.register_at_fork``: a signal
+    that came before Python's handlers ran there would be lost), so SIGTERM ends it as
+    before; should the handler run there all the same, it does the same.
 
     Use it as a context manager in the main thread: the handler is installed only over
     Python's default (not over ``nohup``'s ignore, nor a caller's own handler), and the

@@ -45,10 +45,8 @@ def test_sigterm_mid_write_removes_the_temporary_file_and_keeps_the_old_output(
 ) -> None:
     out = tmp_path / "part.nc"
     out.write_text("the program of yesterday\n")
-    env = {
-        **os.environ,
-        "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]),
-    }
+    paths = [str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(paths)}
     argv = ["post", str(ROOT / "samples" / "part.dxf"), "-t", "grbl", "-o", str(out)]
     process = subprocess.Popen(
         [sys.executable, "-c", STALLED_WRITE, *argv],
