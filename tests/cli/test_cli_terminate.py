@@ -19,7 +19,7 @@ from camtool.accel.cores import end_process, fork_process
 from camtool.jobs.batch_stop import TerminateAsInterrupt
 
 ROOT = Path(__file__).parents[2]
-BOUND_S = 120.0
+BOUND_S = 300.0
 """How long the command may take to reach its write, and then to exit, s."""
 
 STALLED_WRITE = """
