@@ -66,6 +66,19 @@ def block_times_s(trace: StepTrace, program: Program, machine: Machine) -> npt.N
     return times
 
 
+def time_assumption(trace: StepTrace, machine: Machine) -> str:
+    """What :func:`block_times_s` assumed that a reader of the estimate should know, or ``""``.
+
+    The timing model's ``assumes`` (the rest-to-rest trapezoid: an upper bound); nothing
+    for a target simulator's own times or a profile without a timing table.
+    """
+    if trace.block_time_s is not None or not machine.timing:
+        return ""
+    where = f"machine {machine.name!r} [machine.timing]"
+    model = timing_model_from_table(machine.timing, where=where, machine=machine)
+    return str(getattr(model, "assumes", ""))
+
+
 def _plane_arc_spans(program: Program) -> list[tuple[int, int]]:
     """``[start, stop)`` move ranges that are the chords of a G18/G19 arc the code holds.
 

@@ -14,7 +14,7 @@ from camtool.model.shapes import BBox, Drawing
 from camtool.model.units import fmt_num
 from camtool.model.version import __version__
 from camtool.verify import budget as eb
-from camtool.verify.clock import block_times_s
+from camtool.verify.clock import block_times_s, time_assumption
 from camtool.verify.contour_measures import ContourMeasure
 from camtool.verify.drawing_compare import (
     Against,
@@ -183,7 +183,8 @@ def summary_lines(v: Verification) -> list[str]:
         if a.not_cut:
             lines.append("  " + not_cut_text(a))
     lines.extend(part_lines(v))
-    lines.append(f"  estimated time {time_text(v.time_s)}")
+    assumed = time_assumption(v.trace, v.machine)
+    lines.append(f"  estimated time {time_text(v.time_s)}" + (f" ({assumed})" if assumed else ""))
     lines.extend(f"  {line}" for line in eb.text_lines(v.error_budget))
     return lines
 

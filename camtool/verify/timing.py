@@ -348,6 +348,9 @@ class TrapezoidTiming:
     """
 
     model: ClassVar[str] = "trapezoid"
+    assumes: ClassVar[str] = "every block from rest to rest: an upper bound"
+    """What the times assume, said with the estimate: a controller that blends its blocks
+    (GRBL's planner, LinuxCNC's G64) is faster."""
     acceleration_mm_s2: float = DEFAULT_ACCELERATION_MM_S2
     max_rate_mm_min: float = DEFAULT_MAX_RATE_MM_MIN
 

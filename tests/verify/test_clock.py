@@ -51,3 +51,25 @@ def test_a_helix_is_as_long_as_its_arc_and_its_drop() -> None:
     program = Program((Rapid(10.0, 0.0, 0.0), quarter))
     arc = math.pi / 2 * 10.0
     assert program.path_lengths() == pytest.approx([10.0, math.hypot(arc, 3.0)])
+
+
+def test_a_rest_to_rest_estimate_says_it_is_an_upper_bound() -> None:
+    """grbl's and linuxcnc's trapezoids stop at every block, which their planners do not:
+    the summary says so; pic-mmh's step clock and a profile without a timing table (the
+    programmed feeds) add nothing."""
+    from camtool.verify.report import summary_lines
+
+    program = Program((Linear(6.0, 0.0, 60.0), Linear(6.0, 8.0, 120.0), Rapid(0.0, 0.0)))
+
+    def time_line(machine: object) -> str:
+        v = verify_program(program, machine)  # type: ignore[arg-type]
+        return next(ln for ln in summary_lines(v) if "estimated time" in ln)
+
+    for name in ("grbl", "linuxcnc"):
+        assert time_line(load_machine(name)).endswith(
+            " (every block from rest to rest: an upper bound)"
+        )
+    assert time_line(no_timing()).endswith(" s")
+    pic = Program((Linear(0.5, 0.0, 0.8), Linear(0.5, 0.4, 0.8)))
+    v = verify_program(pic, load_target("pic-mmh").machine)
+    assert next(ln for ln in summary_lines(v) if "estimated time" in ln).endswith(" s")
