@@ -16,7 +16,7 @@ from camtool.model.errors import InputError
 from camtool.model.machine import Machine
 from camtool.model.program import PlaneArc, Program, Rapid, SourceLines
 from camtool.verify.motion import StepTrace, timing_model_from_table
-from camtool.verify.timing import BlockKinematics
+from camtool.verify.timing import BlockKinematics, TimingModel
 
 
 def block_kinematics(trace: StepTrace, program: Program) -> BlockKinematics:
@@ -52,8 +52,7 @@ def block_times_s(trace: StepTrace, program: Program, machine: Machine) -> npt.N
         return np.asarray(trace.block_time_s, dtype=np.float64)
     if not machine.timing:
         return _at_feed(program, machine)
-    where = f"machine {machine.name!r} [machine.timing]"
-    model = timing_model_from_table(machine.timing, where=where, machine=machine)
+    model = _timing_model(machine)
     blocks = block_kinematics(trace, program)
     times = np.array(model.block_time_s(blocks), dtype=np.float64)
     spans = _plane_arc_spans(program)
@@ -66,6 +65,16 @@ def block_times_s(trace: StepTrace, program: Program, machine: Machine) -> npt.N
     return times
 
 
+def _timing_model(machine: Machine) -> TimingModel:
+    """The model of ``machine``'s ``[machine.timing]`` table (which must not be empty).
+
+    Raises:
+        InputError: the table names an unknown model or key.
+    """
+    where = f"machine {machine.name!r} [machine.timing]"
+    return timing_model_from_table(machine.timing, where=where, machine=machine)
+
+
 def time_assumption(trace: StepTrace, machine: Machine) -> str:
     """What :func:`block_times_s` assumed that a reader of the estimate should know, or ``""``.
 
@@ -74,8 +83,7 @@ def time_assumption(trace: StepTrace, machine: Machine) -> str:
     """
     if trace.block_time_s is not None or not machine.timing:
         return ""
-    where = f"machine {machine.name!r} [machine.timing]"
-    model = timing_model_from_table(machine.timing, where=where, machine=machine)
+    model = _timing_model(machine)
     return str(getattr(model, "assumes", ""))
 
 
@@ -126,8 +134,7 @@ def timing_warnings(trace: StepTrace, program: Program, machine: Machine) -> lis
     """
     if trace.block_time_s is not None or not machine.timing:
         return []
-    where = f"machine {machine.name!r} [machine.timing]"
-    model = timing_model_from_table(machine.timing, where=where, machine=machine)
+    model = _timing_model(machine)
     capped = getattr(model, "capped_blocks", None)
     if capped is None:
         return []

@@ -348,8 +348,8 @@ OVERCUT_PRUNE_FROM = 20_000
 
 
 OVERCUT_BOUND_ROWS = 1 << 20
-"""Trace points :func:`_least_nearest` bounds at a time (~60 MB of temporaries; a trace of
-31 M points took 1.5 GB at once)."""
+"""Trace points :func:`_least_nearest` bounds at a time (~60 MB of temporaries, whatever
+the trace's length)."""
 
 
 OVERCUT_ANCHOR = 4

@@ -403,7 +403,9 @@ class TimingModel(Protocol):
     """A timing model: parameters (a frozen dataclass) and the seconds each block takes.
 
     ``model`` names it as a ``[machine.timing]`` table does; ``block_time_s`` returns
-    ``(B,) float64`` seconds, read-only, for the ``B`` blocks of ``blocks``.
+    ``(B,) float64`` seconds, read-only, for the ``B`` blocks of ``blocks``. An optional
+    ``assumes`` class attribute says what a reader of the estimate should know
+    (:func:`camtool.verify.clock.time_assumption`; :class:`TrapezoidTiming`'s upper bound).
     """
 
     model: ClassVar[str]
