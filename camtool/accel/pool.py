@@ -9,7 +9,7 @@ from __future__ import annotations
 import multiprocessing
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
-from typing import TypeVar
+from typing import Any, TypeVar
 
 from camtool.accel import enabled
 from camtool.accel.cores import in_worker
@@ -66,3 +66,24 @@ def each_threaded(function: Callable[[Task], object], tasks: Sequence[Task]) -> 
 
     with ThreadPoolExecutor(max_workers=threads) as pool:
         list(pool.map(function, tasks))
+
+
+def parts_threaded(fill: Callable[[slice], Any], size: int, part: int, dtype: Any = object) -> Any:
+    """``fill(slice(0, size))``: a ``(size,)`` array, ``part`` rows at a time on every core.
+
+    ``fill`` gives the rows of the slice it is given, each row a function of that row's
+    input alone, in work that releases the GIL (a vectorised shapely function: GEOS's
+    answer for one geometry is the same whichever thread computes it), so the array is
+    the one a single call gives. In order, in this thread, with ``CAMTOOL_ACCEL=0``, on
+    one core, or for one part (:func:`each_threaded`).
+    """
+    import numpy as np
+
+    out = np.empty(size, dtype=dtype)
+
+    def one(lo: int) -> None:
+        at = slice(lo, min(size, lo + part))
+        out[at] = fill(at)
+
+    each_threaded(one, range(0, size, part))
+    return out

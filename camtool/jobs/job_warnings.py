@@ -102,8 +102,9 @@ def holes_cut_outside(runs: Sequence[OperationRun], job: Job) -> list[str]:
     from camtool.toolpath.order import nesting
 
     closed = [(r, c) for r in runs for c in r.placed.contours if c.closed]
-    if len(closed) < 2:
-        return []
+    outside = any(r.operation.kind == "profile outside" for r, _ in closed)
+    if not outside or len({id(r) for r, _ in closed}) < 2:
+        return []  # no contour of an outside profile, or none of another operation
     nest = nesting([c for _, c in closed])
     out: list[str] = []
     for i, (run, contour) in enumerate(closed):

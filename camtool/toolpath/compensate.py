@@ -12,6 +12,8 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from camtool.geometry.area import enclosed, inscribed_width
 from camtool.model.errors import ToolpathError
 from camtool.model.progress import Progress, Step, no_progress
@@ -95,6 +97,8 @@ def compensate(
     findings: list[Finding] = []
     vanished: list[Finding] = []
     jobs = _offset_jobs(contours, nest, options, progress)
+    # the areas the checks below and a vanished contour's finding measure, made once
+    polys = closed_polygons(contours, options.tolerance / 4) if options.offset != "on" else {}
     for i, contour in enumerate(contours):
         if not contour.closed:
             if options.offset == "on":
@@ -104,7 +108,7 @@ def compensate(
         elif options.offset == "on":
             cuts.append(_on_line(contour, i, nest, options))
         else:
-            made, found = _compensated(contour, i, nest, options, jobs[i])
+            made, found = _compensated(contour, i, nest, options, jobs[i], polys[i])
             cuts.extend(made)
             findings.extend(found)
             vanished.extend(f for f in found if f.kind == "offset-vanished")
@@ -115,7 +119,6 @@ def compensate(
             raise ToolpathError(_all_open(contours, options.offset))
         findings[:0] = open_left_out(contours, f"--offset {options.offset}")
     if options.offset != "on":
-        polys = closed_polygons(contours, options.tolerance / 4)
         findings.extend(crossings(contours, options.tolerance, polys))
         findings.extend(gouges(contours, nest, cuts, options, polys))
     return Stage(tuple(cuts), tuple(findings))
@@ -297,9 +300,13 @@ def moved(answer: OffsetResult, made: Contour, copy: Contour) -> OffsetResult:
 
 
 def _compensated(
-    contour: Contour, index: int, nest: Nesting, options: PlanOptions, job: _OffsetJob
+    contour: Contour, index: int, nest: Nesting, options: PlanOptions, job: _OffsetJob, area: Any
 ) -> tuple[list[Cut], list[Finding]]:
-    """The cuts of one closed contour offset to the tool's side (``job``), and what was found."""
+    """The cuts of one closed contour offset to the tool's side (``job``), and what was found.
+
+    ``area``: what the contour encloses (:func:`closed_polygons` at a quarter of the
+    tolerance).
+    """
     depth = nest.depth(index)
     side, drawn = job.side, job.drawn
     r = options.radius
@@ -309,7 +316,7 @@ def _compensated(
         result = offset_checked(drawn, job.amount, options.tolerance, occt=job.answer)
     findings: list[Finding] = []
     if not result.pieces:
-        return [], [_vanished(contour, options)]
+        return [], [_vanished(contour, options, area)]
     if result.fallback is not None:
         findings.append(_fallback(contour, result.fallback, options.tolerance))
         # shapely's buffer keeps no loop
@@ -403,10 +410,13 @@ def _turn(a: Point, b: Point) -> float:
     return math.atan2(a[0] * b[1] - a[1] * b[0], a[0] * b[0] + a[1] * b[1])
 
 
-def _vanished(contour: Contour, options: PlanOptions) -> Finding:
-    """An ``offset-vanished`` finding: where the contour is and how wide it is."""
+def _vanished(contour: Contour, options: PlanOptions, poly: Any) -> Finding:
+    """An ``offset-vanished`` finding: where the contour is and how wide it is.
+
+    ``poly``: the area the contour encloses (:func:`closed_polygons` at a quarter of the
+    tolerance).
+    """
     tol = options.tolerance / 4
-    poly = enclosed(contour.points(tol))
     if poly.is_empty:  # no area (a closed contour that folds back on itself): no width
         (x, y), width = contour.start, 0.0
     else:
@@ -550,6 +560,10 @@ def crossings(
     return out
 
 
+GEOS_PART = 32
+"""Cuts or pairs :func:`gouges` gives a thread at a time (a few ms of GEOS work)."""
+
+
 def gouges(
     contours: Sequence[Contour],
     nest: Nesting,
@@ -572,27 +586,37 @@ def gouges(
         One finding per overlapping region and cut: ``at`` its centroid, ``value``
         its area in mm².
     """
-    from shapely import LineString, STRtree, intersection
+    from shapely import STRtree, buffer, intersection, linestrings
+
+    from camtool.accel.pool import parts_threaded
 
     tol = options.tolerance / 4
     regions = material(contours, nest, options.offset, tol, polys)
     if not regions or options.radius <= 0:
         return []
-    tree = STRtree(regions)
+    profiles = [cut for cut in cuts if cut.kind == "profile"]
+    if not profiles:
+        return []
     segs = quad_segs(options.radius, tol)
+    paths = np.empty(len(profiles), dtype=object)
+    paths[:] = [linestrings(cut.path.points(tol)) for cut in profiles]
+    swept = parts_threaded(
+        lambda part: buffer(paths[part], options.radius, quad_segs=segs), len(paths), GEOS_PART
+    )
+    # each cut's regions in the order the tree gives them for that cut alone
+    cut_of, region_of = STRtree(regions).query(swept, predicate="intersects")
+    held = np.empty(len(regions), dtype=object)
+    held[:] = regions
+    overlaps = parts_threaded(
+        lambda part: intersection(swept[cut_of[part]], held[region_of[part]]),
+        len(cut_of),
+        GEOS_PART,
+    )
     out: list[Finding] = []
-    for cut in cuts:
-        if cut.kind != "profile":
-            continue
-        swept = LineString(cut.path.points(tol)).buffer(options.radius, quad_segs=segs)
-        for k in tree.query(swept, predicate="intersects"):
-            overlap = intersection(swept, regions[k])
-            for part in getattr(overlap, "geoms", [overlap]):
-                if (
-                    part.geom_type == "Polygon"
-                    and 2.0 * part.area > options.tolerance * part.length
-                ):
-                    out.append(_finding(contours[cut.group], part, options))
+    for k, overlap in zip(cut_of.tolist(), overlaps, strict=True):
+        for part in getattr(overlap, "geoms", [overlap]):
+            if part.geom_type == "Polygon" and 2.0 * part.area > options.tolerance * part.length:
+                out.append(_finding(contours[profiles[k].group], part, options))
     return out
 
 

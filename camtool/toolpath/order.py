@@ -74,6 +74,10 @@ Fixed, not the chaining distance: ``--chain-tolerance 0.5`` would make a thin ri
 outline."""
 
 
+COVER_PART = 256
+"""Pairs :func:`nesting` gives a thread at a time to GEOS's ``covered_by``."""
+
+
 def nesting(contours: Sequence[Contour]) -> Nesting:
     """Find which closed contours contain which contours.
 
@@ -84,7 +88,8 @@ def nesting(contours: Sequence[Contour]) -> Nesting:
     strictly larger (a polygon covers its own outline and an identical duplicate's).
     Shapely's vectorised constructors and one bulk ``STRtree.query(…, "covered_by")``
     answer as one geometry and one query per contour did (:func:`_nesting_one_by_one`,
-    kept for the tests): the same coordinates, the same GEOS predicate.
+    kept for the tests): the same coordinates, the same GEOS predicate (asked of the
+    candidate pairs in parts on every core, :func:`camtool.accel.pool.parts_threaded`).
 
     Args:
         contours: contours in mm.
@@ -94,6 +99,8 @@ def nesting(contours: Sequence[Contour]) -> Nesting:
     """
     import numpy as np
     import shapely
+
+    from camtool.accel.pool import parts_threaded
 
     if not contours:
         return Nesting(())
@@ -124,7 +131,12 @@ def nesting(contours: Sequence[Contour]) -> Nesting:
     parent = np.asarray(closed, dtype=np.int64)[around]
     larger = area[parent] > np.where(in_closed[which], area[which], 0.0)
     which, around, parent = which[larger], around[larger], parent[larger]
-    covered = shapely.covered_by(outlines[which], polygons[around])
+    covered = parts_threaded(
+        lambda part: shapely.covered_by(outlines[which[part]], polygons[around[part]]),
+        len(which),
+        COVER_PART,
+        dtype=bool,
+    )
     which, parent = which[covered], parent[covered]
     order = np.lexsort((parent, which))
     parents: list[list[int]] = [[] for _ in contours]

@@ -567,10 +567,14 @@ def _nest_scene(seed: int) -> list[Contour]:
 
 
 @pytest.mark.parametrize("seed", range(8))
-def test_bulk_nesting_is_the_one_by_one_nesting(seed: int, monkeypatch: pytest.MonkeyPatch) -> None:
-    # the vectorised shapely path must give exactly the per-contour queries' relation
+def test_bulk_nesting_is_the_one_by_one_nesting(
+    seed: int, accel: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # the vectorised shapely path must give exactly the per-contour queries' relation,
+    # its pairs asked in parts of a few on threads (accel) or in this thread
     from camtool.toolpath import order
 
+    monkeypatch.setattr(order, "COVER_PART", 5)
     contours = _nest_scene(seed)
     reference = order._nesting_one_by_one(contours)
     monkeypatch.setattr(order, "_nesting_one_by_one", None)  # no fallback taken
