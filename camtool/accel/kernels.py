@@ -88,6 +88,39 @@ def dda_ties(cx: float, cy: float, n_rows: int, window: float) -> Any:
 
 
 @numba.njit(cache=True, nogil=True)
+def bresenham_rows(dx: Any, dy: Any, amass: bool, out: Any) -> None:
+    """The rows of GRBL's Bresenham lines ``(dx[j], dy[j])`` steps, one after the other.
+
+    ``out``: ``(sum of max(|dx|, |dy|), 2) int8``, filled. Step event ``n`` of a line of
+    ``big`` events leaves an axis of ``m`` steps at ``(big + 2·n·m − 1) // (2·big)``
+    pulses with AMASS, ``(big // 2 + n·m − 1) // big`` without: the integers of
+    :func:`camtool.verify.interpolators._bresenham_counts`, a row the pulses since the
+    event before, signed as the move.
+    """
+    i = 0
+    for j in range(len(dx)):
+        ax = abs(dx[j])
+        ay = abs(dy[j])
+        sx = 1 if dx[j] > 0 else (-1 if dx[j] < 0 else 0)
+        sy = 1 if dy[j] > 0 else (-1 if dy[j] < 0 else 0)
+        big = max(ax, ay)
+        kx0 = 0
+        ky0 = 0
+        for n in range(1, big + 1):
+            if amass:
+                kx = (big + 2 * n * ax - 1) // (2 * big)
+                ky = (big + 2 * n * ay - 1) // (2 * big)
+            else:
+                kx = (big // 2 + n * ax - 1) // big
+                ky = (big // 2 + n * ay - 1) // big
+            out[i, 0] = (kx - kx0) * sx
+            out[i, 1] = (ky - ky0) * sy
+            kx0 = kx
+            ky0 = ky
+            i += 1
+
+
+@numba.njit(cache=True, nogil=True)
 def _grow(out: Any, i: int) -> Any:
     grown = np.empty((2 * out.shape[0] + 64, 2), dtype=np.int8)
     grown[:i] = out[:i]

@@ -132,6 +132,11 @@ def bresenham_line(dx: int, dy: int, *, amass: bool = True) -> StepArray:
     big = max(abs(dx), abs(dy))
     if big == 0:
         return empty_steps()
+    jit = dda.compiled(big)
+    if jit is not None:  # the same integers (camtool.accel.kernels)
+        rows = np.empty((big, 2), dtype=np.int8)
+        jit.bresenham_rows(np.array([dx]), np.array([dy]), amass, rows)
+        return freeze(rows)
     n = np.arange(1, big + 1, dtype=np.int64)
     kx = _bresenham_counts(abs(dx), big, n, amass)
     ky = _bresenham_counts(abs(dy), big, n, amass)
@@ -155,6 +160,12 @@ def bresenham_lines(
     dx, dy = np.asarray(dx, dtype=np.int64), np.asarray(dy, dtype=np.int64)
     big = np.maximum(np.abs(dx), np.abs(dy))
     first = np.cumsum(big) - big
+    total = int(first[-1] + big[-1]) if len(big) else 0
+    jit = dda.compiled(total)
+    if jit is not None:  # the same integers, line by line (camtool.accel.kernels)
+        rows = np.empty((total, 2), dtype=np.int8)
+        jit.bresenham_rows(dx, dy, amass, rows)
+        return rows, first
     line = np.repeat(np.arange(len(big)), big)
     n = np.arange(len(line), dtype=np.int64) - first[line] + 1  # the step event, from 1
     events = big[line]

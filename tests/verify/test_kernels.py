@@ -339,3 +339,34 @@ def test_simulation_with_and_without_kernels_is_identical(machine_name: str) -> 
         else:
             assert a == b, f.name
     assert fast.compensations > 0 or machine_name != "mmh-gmm"
+
+
+@pytest.mark.parametrize("amass", [True, False])
+@pytest.mark.parametrize(("dx", "dy"), EDGE_LINES)
+def test_bresenham_edges_equal_grbl_s_counter_loop(dx: int, dy: int, amass: bool) -> None:
+    """Analytic (grbl ``stepper.c``): the compiled Bresenham line is the counter loop."""
+    if max(abs(dx), abs(dy)) > 300_000:
+        pytest.skip("the reference loop is Python: kept to lines of a few 100 000 steps")
+    fast = itp.bresenham_line(dx, dy, amass=amass)
+    assert _same(fast, itp.bresenham_reference(dx, dy, amass=amass))
+    assert _same(fast, _plain(lambda: itp.bresenham_line(dx, dy, amass=amass)))
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.lists(st.tuples(st.integers(-3000, 3000), st.integers(-3000, 3000)), max_size=20),
+    st.booleans(),
+)
+def test_bresenham_lines_compiled_equal_the_numpy_path(
+    moves: list[tuple[int, int]], amass: bool
+) -> None:
+    """Many lines at once (an arc's chords): the compiled rows are the numpy path's, and
+    each line's the counter loop's."""
+    dx = np.array([m[0] for m in moves], dtype=np.int64)
+    dy = np.array([m[1] for m in moves], dtype=np.int64)
+    rows, first = itp.bresenham_lines(dx, dy, amass=amass)
+    plain_rows, plain_first = _plain(lambda: itp.bresenham_lines(dx, dy, amass=amass))
+    assert _same(rows, plain_rows)
+    assert np.array_equal(first, plain_first)
+    each = [itp.bresenham_reference(x, y, amass=amass) for x, y in moves]
+    assert _same(rows, np.concatenate(each) if each else np.zeros((0, 2), dtype=np.int8))
