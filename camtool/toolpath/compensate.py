@@ -562,6 +562,9 @@ def crossings(
 
 GEOS_PART = 32
 """Cuts or pairs :func:`gouges` gives a thread at a time (a few ms of GEOS work)."""
+GOUGE_BATCH = 128
+"""Cuts whose sweeps and overlaps :func:`gouges` holds at once: an outside cut's sweep
+overlaps its own part by a sliver all along, so each overlap is as long as the cut."""
 
 
 def gouges(
@@ -586,27 +589,39 @@ def gouges(
         One finding per overlapping region and cut: ``at`` its centroid, ``value``
         its area in mm².
     """
-    from shapely import STRtree, buffer, intersection, linestrings
-
-    from camtool.accel.pool import parts_threaded
+    from shapely import STRtree
 
     tol = options.tolerance / 4
     regions = material(contours, nest, options.offset, tol, polys)
     if not regions or options.radius <= 0:
         return []
     profiles = [cut for cut in cuts if cut.kind == "profile"]
-    if not profiles:
-        return []
+    held = np.empty(len(regions), dtype=object)
+    held[:] = regions
+    tree = STRtree(regions)
+    out: list[Finding] = []
+    for lo in range(0, len(profiles), GOUGE_BATCH):  # the sweeps and overlaps of a batch held
+        out += _batch_gouges(contours, profiles[lo : lo + GOUGE_BATCH], tree, held, options)
+    return out
+
+
+def _batch_gouges(
+    contours: Sequence[Contour], batch: Sequence[Cut], tree: Any, held: Any, options: PlanOptions
+) -> list[Finding]:
+    """:func:`gouges` of the profile cuts ``batch`` against the material ``held`` (``tree``)."""
+    from shapely import buffer, intersection, linestrings
+
+    from camtool.accel.pool import parts_threaded
+
+    tol = options.tolerance / 4
     segs = quad_segs(options.radius, tol)
-    paths = np.empty(len(profiles), dtype=object)
-    paths[:] = [linestrings(cut.path.points(tol)) for cut in profiles]
+    paths = np.empty(len(batch), dtype=object)
+    paths[:] = [linestrings(cut.path.points(tol)) for cut in batch]
     swept = parts_threaded(
         lambda part: buffer(paths[part], options.radius, quad_segs=segs), len(paths), GEOS_PART
     )
     # each cut's regions in the order the tree gives them for that cut alone
-    cut_of, region_of = STRtree(regions).query(swept, predicate="intersects")
-    held = np.empty(len(regions), dtype=object)
-    held[:] = regions
+    cut_of, region_of = tree.query(swept, predicate="intersects")
     overlaps = parts_threaded(
         lambda part: intersection(swept[cut_of[part]], held[region_of[part]]),
         len(cut_of),
@@ -616,7 +631,7 @@ def gouges(
     for k, overlap in zip(cut_of.tolist(), overlaps, strict=True):
         for part in getattr(overlap, "geoms", [overlap]):
             if part.geom_type == "Polygon" and 2.0 * part.area > options.tolerance * part.length:
-                out.append(_finding(contours[profiles[k].group], part, options))
+                out.append(_finding(contours[batch[k].group], part, options))
     return out
 
 

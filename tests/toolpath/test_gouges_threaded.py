@@ -62,12 +62,14 @@ def _plate(rows: int, columns: int, gap: float) -> list[Contour]:
 
 
 @pytest.mark.parametrize(("side", "diameter"), [("outside", 3.0), ("inside", 4.5)])
+@pytest.mark.parametrize("batch", [7, 128])
 def test_the_threaded_check_finds_what_each_cut_checked_alone_finds(
-    side: str, diameter: float, accel: bool
+    side: str, diameter: float, batch: int, accel: bool, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     # 9 × 9 squares 2 mm apart: a 3 mm tool outside sweeps 1 mm into each neighbour (four
     # gouges a square inside the grid); inside, a 4.5 mm tool in the 4 mm holes cuts the
     # walls around them. Over GEOS_PART cuts and pairs: several parts, on threads.
+    monkeypatch.setattr(compensate_module, "GOUGE_BATCH", batch)  # cuts held at once
     contours = _plate(9, 9, 2.0)
     options = PlanOptions(offset=side, tool_diameter=diameter, feed_mm_min=100.0)
     nest = nesting(contours)
