@@ -229,20 +229,23 @@ LONG_SEGMENTS_GAIN = 4.0
 """Segments are searched apart only where the others' half is this many times smaller."""
 
 
-def long_segments(a: FloatArray, b: FloatArray, half: float) -> LongSegments | None:
+def long_segments(
+    a: FloatArray, b: FloatArray, half: float, lengths: FloatArray | None = None
+) -> LongSegments | None:
     """The segments ``a → b`` to search apart (:class:`LongSegments`), or ``None``.
 
     With ``few`` = :data:`LONG_SEGMENTS_FEW` (or one in :data:`LONG_SEGMENTS_PER`): the
     segments longer than the ``few + 1``-th longest (at most ``few``; fewer where lengths
     tie), where that one is at most ``2 · half / GAIN`` long (``half``: half the longest
     segment, mm). ``short_half`` is half its length; lengths are computed as ``half`` is,
-    so every other segment is at most ``2 · short_half`` long.
+    so every other segment is at most ``2 · short_half`` long. ``lengths``: those lengths,
+    ``np.hypot(*(b - a).T)``, when the caller has them already.
     """
     n = len(a)
     few = max(LONG_SEGMENTS_FEW, n // LONG_SEGMENTS_PER)
     if n <= few:
         return None
-    lengths = np.hypot(*(b - a).T)
+    lengths = np.hypot(*(b - a).T) if lengths is None else lengths
     cut = float(np.partition(lengths, n - few - 1)[n - few - 1])
     if cut / 2.0 * LONG_SEGMENTS_GAIN > half:
         return None

@@ -250,6 +250,8 @@ def _box_search(
         kd = not _far_kd(samples, ends.tree, half)
     elif len(samples) > BOX_TREE_UP_TO:
         kd = not _far(samples, ends.boxes(len(samples), kernels, any_built=True), half, kernels)
+    elif len(samples) < DENSE_PROBE_FROM and len(ends.points) < DENSE_PROBE_ENDS:
+        kd = False  # the probe would cost about what these samples' search costs
     elif len(samples) * KD_ENDS_PER_SAMPLE >= len(ends.points):
         kd = _dense(samples, ends.boxes(len(samples), kernels, any_built=True), half, kernels)
     else:
@@ -437,6 +439,7 @@ class _LazyTree:
         self._beside: Beside[Any] | None = None
         self._boxes: dict[bool, tuple[Any, ...]] = {}
         self._half: float | None = None
+        self._lengths: FloatArray | None = None
         self._long: tuple[nearest_exact.LongSegments | None] | None = None
 
     def built(self) -> bool:
@@ -477,7 +480,9 @@ class _LazyTree:
     def long(self, half: float) -> nearest_exact.LongSegments | None:
         """:func:`~camtool.verify.nearest_exact.long_segments` of these ends (made once)."""
         if self._long is None:
-            self._long = (nearest_exact.long_segments(*_halves(self.points), half),)
+            lengths = self._segment_lengths()
+            self._long = (nearest_exact.long_segments(*_halves(self.points), half, lengths),)
+            self._lengths = None  # asked for by half and long only, once each
         return self._long[0]
 
     def drop_boxes(self) -> None:
@@ -487,9 +492,15 @@ class _LazyTree:
     def half(self) -> float:
         """Half the longest of the segments ``a[i] → b[i]`` whose ends these points are, mm."""
         if self._half is None:
-            a, b = _halves(self.points)
-            self._half = float(np.max(np.hypot(*(b - a).T))) / 2.0
+            self._half = float(np.max(self._segment_lengths())) / 2.0
         return self._half
+
+    def _segment_lengths(self) -> FloatArray:
+        """The lengths of the segments ``a[i] → b[i]``, mm (kept until :meth:`long` asks)."""
+        if self._lengths is None:
+            a, b = _halves(self.points)
+            self._lengths = np.hypot(*(b - a).T)
+        return self._lengths
 
     def boxes(
         self, samples: int, kernels: ModuleType, *, any_built: bool = False
@@ -584,6 +595,18 @@ bench's 40 lines: 15 boxes in 7 levels); where it passes again and again, its bo
 
 DENSE_PROBE = 256
 """Samples :func:`_dense` looks at (evenly spread)."""
+
+
+DENSE_PROBE_FROM = 4 * DENSE_PROBE
+"""Samples from which :func:`_box_search` asks :func:`_dense`: fewer, against fewer than
+:data:`DENSE_PROBE_ENDS` ends (a small contour's path samples and trace), search the box
+tree whatever the trace, as the probe alone would search a quarter of them or more. Both
+give the same distances; only the time depends on it."""
+
+DENSE_PROBE_ENDS = 1 << 17
+"""Segment ends from which a few samples still ask :func:`_dense` (:data:`DENSE_PROBE_FROM`):
+near a long dense trace the box tree opens many of its boxes for each sample, and the
+k-d tree built once serves every later batch."""
 
 
 FAR_PROBE = 1000

@@ -586,3 +586,29 @@ def test_what_the_search_leaves_unset_for_ties_is_never_read(
             float(np.max(want)),
             int(np.argmax(want)),
         )
+
+
+def test_a_small_contour_s_few_samples_search_the_box_tree_without_a_probe(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A few path samples against a small dense trace (fewer than DENSE_PROBE_FROM samples
+    and DENSE_PROBE_ENDS ends): the box tree answers them without the probe that would
+    choose between the trees, with the k-d tree's distances; against a long trace the
+    probe is still asked."""
+    monkeypatch.undo()  # the real choice
+    probed: list[int] = []
+    real = nearest_search._dense
+    monkeypatch.setattr(
+        nearest_search, "_dense", lambda *args: probed.append(len(args[0])) or real(*args)
+    )
+    rng = np.random.default_rng(3)
+    for lines, want_probe in ((4, False), (300, True)):
+        pts = _zigzag(lines, step=0.02)
+        a, b = pts[:-1], pts[1:]
+        assert (2 * len(a) < nearest_search.DENSE_PROBE_ENDS) is not want_probe
+        samples = pts[rng.integers(0, len(pts), 600)] + rng.normal(0.0, 0.003, (600, 2))
+        probed.clear()
+        want = nearest_search.nearest_distances_kd(samples, a, b)
+        got = nearest_search.farthest_nearest(samples, a, b)
+        assert got == (float(np.max(want)), int(np.argmax(want)))
+        assert bool(probed) is want_probe
