@@ -595,7 +595,10 @@ def test_a_small_contour_s_few_samples_search_the_box_tree_without_a_probe(
     and DENSE_PROBE_ENDS ends): the box tree answers them without the probe that would
     choose between the trees, with the k-d tree's distances; against a long trace the
     probe is still asked."""
+    from camtool.accel import SWITCH
+
     monkeypatch.undo()  # the real choice
+    monkeypatch.setenv(SWITCH, "1")  # undone with the rest: the compiled search still
     probed: list[int] = []
     real = nearest_search._dense
     monkeypatch.setattr(
