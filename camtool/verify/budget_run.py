@@ -384,11 +384,18 @@ def _jobs(rows: int) -> int:
     A re-simulation of more than :data:`CHUNK_ROWS` rows is streamed on two threads of its
     own (:func:`stream_trace`: one simulates the next chunk while the other measures this
     one), but in a worker process on one (:func:`~camtool.accel.cores.ahead` runs there
-    in turn). So it takes two cores: on two, the sources run one after the other in this
-    process (less wall and CPU time than a worker each: docs/performance.md).
+    in turn). So a long one, of more than :data:`IN_TURN_FROM` rows, takes two cores: on
+    two, the sources run one after the other in this process (less wall and CPU time, and
+    less memory in all, than a worker each: docs/performance.md). A shorter one, of a few
+    chunks, gains little from its second thread: a worker each, started as the
+    verification starts, runs beside it.
     """
     cores = default_jobs()
-    return max(1, cores // 2) if rows > CHUNK_ROWS else cores
+    return max(1, cores // 2) if rows > IN_TURN_FROM else cores
+
+
+IN_TURN_FROM = 16 * CHUNK_ROWS
+"""Rows of a trace from which :func:`_jobs` gives each re-simulation two cores (~1 M)."""
 
 
 @dataclass(frozen=True)
