@@ -378,8 +378,8 @@ class _ForkedOne(Generic[T, R]):
             self.pid = None
 
 
-def _jobs(rows: int) -> int:
-    """Worker processes for re-simulations of a trace of ``rows`` rows.
+def _jobs(rows: int) -> int | None:
+    """Worker processes for re-simulations of a trace of ``rows`` rows (``None``: a core each).
 
     A re-simulation of more than :data:`CHUNK_ROWS` rows is streamed on two threads of its
     own (:func:`stream_trace`: one simulates the next chunk while the other measures this
@@ -388,10 +388,10 @@ def _jobs(rows: int) -> int:
     two, the sources run one after the other in this process (less wall and CPU time, and
     less memory in all, than a worker each: docs/performance.md). A shorter one, of a few
     chunks, gains little from its second thread: a worker each, started as the
-    verification starts, runs beside it.
+    verification starts, runs beside it (:class:`~camtool.accel.cores.ForkedWork`'s own
+    count, ``None``).
     """
-    cores = default_jobs()
-    return max(1, cores // 2) if rows > IN_TURN_FROM else cores
+    return max(1, default_jobs() // 2) if rows > IN_TURN_FROM else None
 
 
 IN_TURN_FROM = 16 * CHUNK_ROWS

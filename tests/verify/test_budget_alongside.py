@@ -197,14 +197,14 @@ def test_an_error_in_the_stream_leaves_no_helper_behind(monkeypatch: pytest.Monk
 
 @pytest.mark.parametrize(
     ("cores_here", "rows", "jobs"),
-    [(2, 2_600_000, 1), (4, 2_600_000, 2), (2, 440_000, 2), (2, 5_000, 2)],
+    [(2, 2_600_000, 1), (4, 2_600_000, 2), (2, 440_000, None), (2, 5_000, None)],
 )
 def test_long_streamed_sources_take_two_cores_each(
-    monkeypatch: pytest.MonkeyPatch, cores_here: int, rows: int, jobs: int
+    monkeypatch: pytest.MonkeyPatch, cores_here: int, rows: int, jobs: int | None
 ) -> None:
     """A long streamed re-simulation runs two threads here but one in a worker process, so
     on two cores its sources run here in turn; one of a few chunks (a part's 440 000 rows),
-    or not streamed, takes one core."""
+    or not streamed, takes one core (``None``: the workers' own count, a core each)."""
     monkeypatch.setattr(budget_run, "default_jobs", lambda: cores_here)
     assert budget_run.CHUNK_ROWS < 440_000 < budget_run.IN_TURN_FROM < 2_600_000
     assert budget_run._jobs(rows) == jobs
