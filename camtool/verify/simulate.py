@@ -36,6 +36,11 @@ FloatArray = npt.NDArray[np.float64]
 IDEAL_SAMPLES_PER_STEP = 4
 """Samples per step of the dominant axis of the ideal controller (``interpolation`` off)."""
 
+IDEAL_REST_STEPS = 8
+"""Steps of the dominant axis a row of a line's straight rest may span, ideal controller
+(:meth:`IdealController._line_shape`): longer rows would make fewer, but the nearest-segment
+search of the shortfall slows where a few segments are much longer than the rest."""
+
 LINES_AT_ONCE: dict[Callable[..., Any], Callable[..., tuple[StepArray, npt.NDArray[np.int64]]]] = {
     bresenham_line: bresenham_lines,
 }
@@ -369,7 +374,53 @@ class IdealController(StepController):
     ``dynamics`` still runs on the rounded counts so that a line that does not
     reach its count (a timer's overshoot) keeps its net displacement per axis.
     The trace's ``rows`` then hold only each sample's direction.
+
+    A programmed line (not a chord) longer than the true backlash can take up is made
+    of its first samples and longer rows for the rest (:meth:`_line_shape`): past the
+    take-up the carriage moves along a straight line, which those rows draw as its
+    samples do (the same extent, end and distances to the path, which a straight run
+    reaches at its ends), and a long program's trace is not tens of millions of rows.
     """
+
+    def __init__(self, machine: Machine, origin: Point, sources: Sources = ALL) -> None:
+        super().__init__(machine, origin, sources)
+        lash, true = machine.backlash, machine.real_steps_per_mm
+        self.takeup = tuple(
+            max(
+                [abs(lash.true_um[axis])] + [abs(r.true_um) for r in lash.regions if r.axis == name]
+            )
+            / 1000.0
+            * true[axis]
+            for axis, name in ((0, "x"), (1, "y"))
+        )
+        """The most motor travel per axis a reversal's take-up lasts, steps (the largest true
+        backlash of the axis, anywhere)."""
+        self.travel = [math.inf, math.inf]
+        """Each axis's motor travel since its last reversal, steps: ``inf`` before its first
+        run (which starts in contact), 0 after an arc (its reversals are not followed)."""
+
+    def _line_shape(self, dx: float, dy: float, n: int) -> tuple[int, int]:
+        """``(samples, rest)``: rows of an ``n``-sample line of ``(dx, dy)`` steps.
+
+        A reversal's take-up lasts until the axis's motor has moved its :attr:`takeup`
+        since the reversal (:attr:`travel`, kept here): the samples up to that point, and
+        one more (a margin for the rounding of the sums), are made, and the rest of the
+        line as ``rest`` equal rows of at most
+        :data:`IDEAL_REST_STEPS` steps; ``(n, 0)`` (every sample) when that would save
+        no row. Call it once a line, before the line's reversals are taken.
+        """
+        dense = 1
+        for axis, d in ((0, dx), (1, dy)):
+            if not d:
+                continue
+            sign, before = (1 if d > 0 else -1), self.direction[axis]
+            travel = self.travel[axis] if before == sign else (math.inf if before == 0 else 0.0)
+            need = self.takeup[axis] - travel
+            if need > 0:
+                dense = max(dense, math.ceil(need * n / abs(d)) + 1)
+            self.travel[axis] = travel + abs(d)
+        rest = -(-(n - dense) // (IDEAL_SAMPLES_PER_STEP * IDEAL_REST_STEPS))
+        return (n, 0) if dense + rest >= n else (dense, rest)
 
     def compensation_steps(self) -> tuple[float, float]:
         """Compensation per axis and reversal, fractional steps (nothing rounds them)."""
@@ -390,6 +441,8 @@ class IdealController(StepController):
         """Run one move from ``start_mm`` continuously (samples, exact compensation)."""
         end = (self.to_steps(move.x, 0), self.to_steps(move.y, 1))
         rows: npt.NDArray[Any]
+        if isinstance(move, ArcMove):
+            self.travel = [0.0, 0.0]  # wherever the arc turns, a take-up may follow it
         if isinstance(move, ArcMove) and self.arc is not None:
             rows = self._ideal_arc(start_mm, move)
             line_starts: list[int] = []
@@ -403,7 +456,7 @@ class IdealController(StepController):
                 offset += len(part)
             rows = np.concatenate(parts) if parts else np.zeros((0, 2))
         else:
-            rows, line_starts = self._ideal_line(self.pos, end), [0]
+            rows, line_starts = self._ideal_line(self.pos, end, whole=False), [0]
         self.steps.extend((0, 0, 0))
         self.dominant.append(0)
         rows, comp, _ = self._compensate(rows, line_starts)
@@ -422,7 +475,10 @@ class IdealController(StepController):
         Every row of a straight line moves the axis the same way: a reversal, if any, is
         at its first row (the same rows and signs as the row-by-row scan).
         """
-        if not len(column) or column.min() != column.max():
+        if not len(column):
+            return super()._reversals(column, axis)
+        lo, hi = column.min(), column.max()
+        if not (lo > 0 or hi < 0 or lo == hi == 0):  # not one direction: scanned
             return super()._reversals(column, axis)
         none = np.zeros(0, dtype=np.int64)
         if column[0] == 0:
@@ -455,6 +511,8 @@ class IdealController(StepController):
         """
         assert not self.inexact
         end = (self.to_steps(move.x, 0), self.to_steps(move.y, 1))
+        if isinstance(move, ArcMove):
+            self.travel = [0.0, 0.0]  # as block() keeps it
         if isinstance(move, ArcMove) and self.arc is not None:
             if any(self.comp_steps):
                 self.block(start_mm, move)
@@ -468,13 +526,18 @@ class IdealController(StepController):
                 self._count_line(b[0] - a[0], b[1] - a[1]) for a, b in itertools.pairwise(lattice)
             )
         else:
-            rows = self._count_line(end[0] - self.pos[0], end[1] - self.pos[1])
+            rows = self._count_line(end[0] - self.pos[0], end[1] - self.pos[1], whole=False)
         self.counts.append(rows)
         self.pos = end  # type: ignore[assignment]
 
-    def _count_line(self, dx: float, dy: float) -> int:
-        """Rows of the ideal line of ``(dx, dy)`` with its compensations; the directions kept."""
+    def _count_line(self, dx: float, dy: float, *, whole: bool = True) -> int:
+        """Rows of the ideal line of ``(dx, dy)`` with its compensations; the directions kept.
+
+        ``whole``: every sample a row (a chord); else as :meth:`_ideal_line` makes a line.
+        """
         rows = self._line_rows(dx, dy)
+        if not whole and rows:
+            rows = sum(self._line_shape(dx, dy, rows))
         if rows == 0:
             return 0
         for axis, d in ((0, dx), (1, dy)):
@@ -496,7 +559,13 @@ class IdealController(StepController):
             return 0
         return max(1, math.ceil(IDEAL_SAMPLES_PER_STEP * max(abs(dx), abs(dy))))
 
-    def _ideal_line(self, a: tuple[float, float], b: tuple[float, float]) -> FloatArray:
+    def _ideal_line(
+        self, a: tuple[float, float], b: tuple[float, float], *, whole: bool = True
+    ) -> FloatArray:
+        """The rows of the ideal line from ``a`` to ``b`` (fractional steps).
+
+        ``whole``: every sample a row (a chord); else as :meth:`_line_shape` says.
+        """
         dx, dy = b[0] - a[0], b[1] - a[1]
         counted = (
             self.line(round(b[0]) - round(a[0]), round(b[1]) - round(a[1])) if self.inexact else ()
@@ -509,7 +578,14 @@ class IdealController(StepController):
         n = self._line_rows(dx, dy)
         if n == 0:
             return np.zeros((0, 2), dtype=np.float64)
-        return np.tile(np.asarray([[dx / n, dy / n]], dtype=np.float64), (n, 1))
+        sample = np.asarray([[dx / n, dy / n]], dtype=np.float64)
+        dense, rest = (n, 0) if whole else self._line_shape(dx, dy, n)
+        if not rest:
+            return np.tile(sample, (n, 1))
+        rows = np.empty((dense + rest, 2), dtype=np.float64)
+        rows[:dense] = sample
+        rows[dense:] = ((dx - dense * (dx / n)) / rest, (dy - dense * (dy / n)) / rest)
+        return rows
 
     def _arc_rows(
         self, start_mm: Point, move: ArcMove
