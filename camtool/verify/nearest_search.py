@@ -424,6 +424,14 @@ TIED_CHUNK = 2_000
 """Samples :func:`_tied` measures at once."""
 
 
+KD_LEAF_SIZE = 64
+"""Points a leaf of :class:`_LazyTree`'s k-d tree holds (scipy's default is 16). scipy grows
+the tree's nodes in a vector that doubles as it fills: with 16 a leaf, building the tree of
+a 2.6 M-row contour's ~1.4 M thinned ends raised the verification's peak by 28-44 MB, with
+64 by about half as much, in the same time (docs/performance.md). A leaf's size changes how
+the tree is searched, not what it finds."""
+
+
 class _LazyTree:
     """The search structures of some points, each built when first asked for.
 
@@ -461,7 +469,13 @@ class _LazyTree:
         # quicker to build (the last contour waits for it; docs/performance.md), the same
         # nearest distances. Where two ends tie at the k-th, the tree's choice moves a
         # distance the vertex bound accepts by at most NEAREST_TOLERANCE_MM.
-        return cKDTree(self.points, copy_data=False, compact_nodes=False, balanced_tree=False)
+        return cKDTree(
+            self.points,
+            leafsize=KD_LEAF_SIZE,
+            copy_data=False,
+            compact_nodes=False,
+            balanced_tree=False,
+        )
 
     def build_beside(self) -> None:
         """Start building :attr:`tree` in a thread (:func:`camtool.accel.cores.beside`).
