@@ -296,21 +296,36 @@ def _nearby_exact(
     counts = _counts_within(ends, samples, reach)
     if counts is None:  # the limit counts these pairs, with or without ``long``: see above
         return None
-    sources = [_Reach(ends, reach, counts, None)]
-    if long is not None:
-        reach = within_reach(upper, long.short_half)
-        sources = [_Reach(ends, reach, _count_all(ends, samples, reach), None)]
-        reach = within_reach(upper, half)
-        sources.append(_Reach(long.tree, reach, _count_all(long.tree, samples, reach), long.index))
-    total = np.sum([s.counts for s in sources], axis=0)
-    if total.min() == 0:
-        return None  # cannot happen (the segment of ``upper`` is within reach): be safe
-    if need is not None:
-        out = upper.copy()
-        if need.any():
-            out[need] = _nearby_pairs(samples[need], [s.where(need) for s in sources], a, b)
-        return out
-    return _nearby_pairs(samples, sources, a, b)
+    out = upper.copy() if need is not None else np.empty(len(samples), dtype=np.float64)
+    for lo in range(0, len(samples), NEARBY_BLOCK):  # each sample's minimum is its own
+        part = slice(lo, lo + NEARBY_BLOCK)
+        at, up = samples[part], upper[part]
+        sources = [_Reach(ends, reach[part], counts[part], None)]
+        if long is not None:
+            near = within_reach(up, long.short_half)
+            sources = [_Reach(ends, near, _count_all(ends, at, near), None)]
+            sources.append(
+                _Reach(long.tree, reach[part], _count_all(long.tree, at, reach[part]), long.index)
+            )
+        total = sources[0].counts if len(sources) == 1 else sources[0].counts + sources[1].counts
+        if total.min() == 0:
+            return None  # cannot happen (the segment of ``upper`` is within reach): be safe
+        if need is None:
+            out[part] = _nearby_pairs(at, sources, a, b)
+            continue
+        keep = need[part]
+        if keep.any():
+            out[lo : lo + len(keep)][keep] = _nearby_pairs(
+                at[keep], [s.where(keep) for s in sources], a, b
+            )
+    return out
+
+
+NEARBY_BLOCK = 1 << 20
+"""Unsure samples :func:`_nearby_exact` measures at once once the pair limit is passed (the
+reaches, counts and pairs of a block: ~100 bytes a sample; 8 M samples of a big job's
+drawing comparison at once took ~1 GB). Each sample's minimum is its own: blocks do not
+change it."""
 
 
 @dataclass(frozen=True)

@@ -69,9 +69,17 @@ def _with_jumps(rng: np.random.Generator, n: int, step: float, jumps: int) -> np
     return np.cumsum(moves, axis=0)
 
 
+@pytest.mark.parametrize("block", [None, 97])
 @pytest.mark.parametrize("seed", range(6))
-def test_long_segments_searched_apart_give_the_all_segments_query_bit_for_bit(seed: int) -> None:
-    """Few long segments among short ones: each found within its own reach, the same minimum."""
+def test_long_segments_searched_apart_give_the_all_segments_query_bit_for_bit(
+    monkeypatch: pytest.MonkeyPatch, seed: int, block: int | None
+) -> None:
+    """Few long segments among short ones: each found within its own reach, the same minimum.
+
+    ``block``: the unsure samples measured 97 at a time (``NEARBY_BLOCK``), the same answers.
+    """
+    if block is not None:
+        monkeypatch.setattr(nearest_exact, "NEARBY_BLOCK", block)
     rng = np.random.default_rng(seed)
     step = (0.001, 0.004, 0.0005)[seed % 3]
     pts = _with_jumps(rng, int(rng.integers(3000, 6000)), step, int(rng.integers(1, 40)))
