@@ -405,9 +405,9 @@ class IdealController(StepController):
         A reversal's take-up lasts until the axis's motor has moved its :attr:`takeup`
         since the reversal (:attr:`travel`, kept here): the samples up to that point, and
         one more (a margin for the rounding of the sums), are made, and the rest of the
-        line as ``rest`` equal rows of at most
-        :data:`IDEAL_REST_STEPS` steps; ``(n, 0)`` (every sample) when that would save
-        no row. Call it once a line, before the line's reversals are taken.
+        line as ``rest`` equal rows of at most :data:`IDEAL_REST_STEPS` steps; ``(n, 0)``
+        (every sample) when that would save no row. Call it once a line, before the
+        line's reversals are taken.
         """
         dense = 1
         for axis, d in ((0, dx), (1, dy)):
