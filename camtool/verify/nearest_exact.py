@@ -322,10 +322,9 @@ def _nearby_exact(
 
 
 NEARBY_BLOCK = 1 << 20
-"""Unsure samples :func:`_nearby_exact` measures at once once the pair limit is passed (the
-reaches, counts and pairs of a block: ~100 bytes a sample; 8 M samples of a big job's
-drawing comparison at once took ~1 GB). Each sample's minimum is its own: blocks do not
-change it."""
+"""Unsure samples :func:`_nearby_exact` measures at once once the pair limit is passed: a
+block's reaches, counts and pairs take ~100 bytes a sample, and a big drawing comparison
+has millions of unsure samples. Each sample's minimum is its own: blocks do not change it."""
 
 
 @dataclass(frozen=True)

@@ -426,10 +426,9 @@ TIED_CHUNK = 2_000
 
 KD_LEAF_SIZE = 64
 """Points a leaf of :class:`_LazyTree`'s k-d tree holds (scipy's default is 16). scipy grows
-the tree's nodes in a vector that doubles as it fills: with 16 a leaf, building the tree of
-a 2.6 M-row contour's ~1.4 M thinned ends raised the verification's peak by 28-44 MB, with
-64 by about half as much, in the same time (docs/performance.md). A leaf's size changes how
-the tree is searched, not what it finds."""
+the tree's nodes in a vector that doubles as it fills, so fewer, larger leaves lower the
+peak of memory while a long contour's tree is built, for the same time (figures:
+docs/performance.md). A leaf's size changes how the tree is searched, not what it finds."""
 
 
 class _LazyTree:
