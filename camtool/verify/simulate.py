@@ -376,7 +376,8 @@ class IdealController(StepController):
     The trace's ``rows`` then hold only each sample's direction.
 
     A programmed line (not a chord) longer than the true backlash can take up is made
-    of its first samples and longer rows for the rest (:meth:`_line_shape`): past the
+    of its first samples and longer rows for the rest (:meth:`_line_shape`; not for a
+    comparison with the drawing: ``Sources.sampled_lines``): past the
     take-up the carriage moves along a straight line, which those rows draw as its
     samples do (the same extent, end and distances to the path, which a straight run
     reaches at its ends), and a long program's trace is not tens of millions of rows.
@@ -398,6 +399,8 @@ class IdealController(StepController):
         self.travel = [math.inf, math.inf]
         """Each axis's motor travel since its last reversal, steps: ``inf`` before its first
         run (which starts in contact), 0 after an arc (its reversals are not followed)."""
+        self.whole_lines = sources.sampled_lines
+        """Every sample of a line a row (:attr:`~camtool.verify.sources.Sources.sampled_lines`)."""
 
     def _line_shape(self, dx: float, dy: float, n: int) -> tuple[int, int]:
         """``(samples, rest)``: rows of an ``n``-sample line of ``(dx, dy)`` steps.
@@ -456,7 +459,7 @@ class IdealController(StepController):
                 offset += len(part)
             rows = np.concatenate(parts) if parts else np.zeros((0, 2))
         else:
-            rows, line_starts = self._ideal_line(self.pos, end, whole=False), [0]
+            rows, line_starts = self._ideal_line(self.pos, end, whole=self.whole_lines), [0]
         self.steps.extend((0, 0, 0))
         self.dominant.append(0)
         rows, comp, _ = self._compensate(rows, line_starts)
@@ -526,7 +529,8 @@ class IdealController(StepController):
                 self._count_line(b[0] - a[0], b[1] - a[1]) for a, b in itertools.pairwise(lattice)
             )
         else:
-            rows = self._count_line(end[0] - self.pos[0], end[1] - self.pos[1], whole=False)
+            dx, dy = end[0] - self.pos[0], end[1] - self.pos[1]
+            rows = self._count_line(dx, dy, whole=self.whole_lines)
         self.counts.append(rows)
         self.pos = end  # type: ignore[assignment]
 

@@ -41,6 +41,11 @@ class Sources:
             timer's overshoot, a servo's lag); off: the ideal version of the piece.
         rounding: the code's numbers as written; off: the unrounded plan (only
             known when the plan is at hand, not from the code alone).
+        sampled_lines: not a source: with ``interpolation`` off, every sample of a
+            line a row, as the drawing comparison needs (it thins a trace to every
+            k-th row, k read from its first rows, so its rows must be of one length);
+            ``False``: a line's straight rest in longer rows
+            (:meth:`~camtool.verify.simulate.IdealController._line_shape`).
     """
 
     interpolation: bool = True
@@ -49,6 +54,7 @@ class Sources:
     backlash: bool = True
     dynamics: bool = True
     rounding: bool = True
+    sampled_lines: bool = False
 
     def without(self, name: str) -> Sources:
         """These switches with ``name`` off.

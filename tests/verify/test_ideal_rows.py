@@ -11,12 +11,15 @@ the error budget's figures the same.
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 
+from camtool.cli.main import main
 from camtool.model.machine import Backlash, BacklashRegion, Machine
 from camtool.model.program import ArcMove, Linear, Program, Rapid
 from camtool.post.registry import load_target
@@ -27,6 +30,7 @@ from camtool.verify.chunked import count_rows
 from camtool.verify.sources import ALL
 
 WITHOUT = ALL.without("interpolation")
+SAMPLES = Path(__file__).resolve().parents[2] / "samples"
 
 
 def _program() -> Program:
@@ -151,3 +155,34 @@ def test_the_budget_without_interpolation_has_the_samples_figures(
     assert got["max deviation"] > 1.0  # the backlash shows
     for key, value in expected.items():
         assert got[key] == pytest.approx(value, abs=1e-6), key
+
+
+def test_a_budget_against_the_drawing_samples_every_line(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """With a drawing, interpolation off keeps every sample: its comparison thins by count.
+
+    The drawing comparison keeps every k-th cutting row, k read from the trace's first
+    rows: rows of two lengths would make its chords cut the corners between moves (the
+    demo logo's distance to the drawing without interpolation moved by 0.08 µm). So
+    ``post --report`` gives the budget of every sample, figure for figure.
+    """
+    machine = tmp_path / "lash.toml"
+    machine.write_text(
+        "[machine.backlash]\ntrue_um = [25.0, 18.0, 0.0]\ncompensation_um = [20.0, 20.0, 0.0]\n"
+        "regions = []\n"
+    )
+
+    def budget(name: str) -> Any:
+        report = tmp_path / f"{name}.json"
+        args = ["post", str(SAMPLES / "logo.dxf"), "-t", "pic-mmh", "--fit", "9", "6"]
+        args += ["--machine", str(machine), "--report", str(report)]
+        assert main([*args, "-o", str(tmp_path / f"{name}.pic")]) == 0, capsys.readouterr().err
+        return json.loads(report.read_text())["error_budget"]
+
+    got = budget("rows")
+    with monkeypatch.context() as patch:
+        _every_sample(patch)
+        expected = budget("samples")
+    assert any(f["figure"] == "distance to the drawing" for f in got["figures"])
+    assert got == expected
