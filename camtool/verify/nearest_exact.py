@@ -299,10 +299,10 @@ def _nearby_exact(
     out = upper.copy() if need is not None else np.empty(len(samples), dtype=np.float64)
     for lo in range(0, len(samples), NEARBY_BLOCK):  # each sample's minimum is its own
         part = slice(lo, lo + NEARBY_BLOCK)
-        at, up = samples[part], upper[part]
+        at = samples[part]
         sources = [_Reach(ends, reach[part], counts[part], None)]
         if long is not None:
-            near = within_reach(up, long.short_half)
+            near = within_reach(upper[part], long.short_half)
             sources = [_Reach(ends, near, _count_all(ends, at, near), None)]
             sources.append(
                 _Reach(long.tree, reach[part], _count_all(long.tree, at, reach[part]), long.index)
@@ -315,7 +315,7 @@ def _nearby_exact(
             continue
         keep = need[part]
         if keep.any():
-            out[lo : lo + len(keep)][keep] = _nearby_pairs(
+            out[part][keep] = _nearby_pairs(  # a view of out: written through
                 at[keep], [s.where(keep) for s in sources], a, b
             )
     return out

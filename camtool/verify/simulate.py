@@ -399,8 +399,6 @@ class IdealController(StepController):
         self.travel = [math.inf, math.inf]
         """Each axis's motor travel since its last reversal, steps: ``inf`` before its first
         run (which starts in contact), 0 after an arc (its reversals are not followed)."""
-        self.whole_lines = sources.sampled_lines
-        """Every sample of a line a row (:attr:`~camtool.verify.sources.Sources.sampled_lines`)."""
 
     def _line_shape(self, dx: float, dy: float, n: int) -> tuple[int, int]:
         """``(samples, rest)``: rows of an ``n``-sample line of ``(dx, dy)`` steps.
@@ -459,7 +457,10 @@ class IdealController(StepController):
                 offset += len(part)
             rows = np.concatenate(parts) if parts else np.zeros((0, 2))
         else:
-            rows, line_starts = self._ideal_line(self.pos, end, whole=self.whole_lines), [0]
+            rows, line_starts = (
+                self._ideal_line(self.pos, end, whole=self.sources.sampled_lines),
+                [0],
+            )
         self.steps.extend((0, 0, 0))
         self.dominant.append(0)
         rows, comp, _ = self._compensate(rows, line_starts)
@@ -530,7 +531,7 @@ class IdealController(StepController):
             )
         else:
             dx, dy = end[0] - self.pos[0], end[1] - self.pos[1]
-            rows = self._count_line(dx, dy, whole=self.whole_lines)
+            rows = self._count_line(dx, dy, whole=self.sources.sampled_lines)
         self.counts.append(rows)
         self.pos = end  # type: ignore[assignment]
 
