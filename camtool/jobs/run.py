@@ -297,9 +297,15 @@ def run_job(
             raise InputError(f"{job.source or 'the job'}: {where}: {as_keys(str(exc))}") from None
         first = len(moves)
         alike = [(w, paths) for o, w, paths in cut if _cuts_alike(o, op)]
-        planned = _plan_operation(
-            chosen.drawing, op, tool, options, target, here, where, progress, alike
-        )
+        try:
+            planned = _plan_operation(
+                chosen.drawing, op, tool, options, target, here, where, progress, alike
+            )
+        except (InputError, ToolpathError, UsageError) as exc:
+            if job.shorthand or not job.source:
+                raise
+            # its message starts with ``where``: said of the job file's operation, by the file
+            raise type(exc)(f"{job.source}: {exc}") from None
         cut.append((op, where, planned.paths))
         if not job.shorthand and tool.id != loaded and planned.moves:  # none: nothing to cut
             at = spindle_start(planned.moves, 0, _position(moves, here)[:2])

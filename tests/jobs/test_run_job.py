@@ -173,8 +173,9 @@ def test_a_drill_of_another_size_than_its_holes_is_refused(
     path = tmp_path / "job.toml"
     path.write_text(text)
     drawing = read_drawing(ROOT / "samples" / "part.dxf")
-    with pytest.raises(InputError, match=message):
+    with pytest.raises(InputError, match=message) as caught:
         run_job(drawing, load_target("grbl"), load_job(path))
+    assert str(caught.value).startswith("job.toml: operation 1 ('holes'): hole CIRCLE #")
 
 
 def test_a_drill_operation_refuses_what_is_not_a_hole(tmp_path: Path) -> None:
@@ -182,8 +183,10 @@ def test_a_drill_operation_refuses_what_is_not_a_hole(tmp_path: Path) -> None:
     path = tmp_path / "job.toml"
     path.write_text(text)
     drawing = read_drawing(ROOT / "samples" / "part.dxf")
-    with pytest.raises(InputError, match=r"which is not a circle"):
+    with pytest.raises(InputError, match=r"which is not a circle") as caught:
         run_job(drawing, load_target("grbl"), load_job(path))
+    # the message names the job file, then its operation
+    assert str(caught.value).startswith("job.toml: operation 1 ('holes') drills LWPOLYLINE #")
 
 
 def test_a_point_is_drilled_where_it_is(tmp_path: Path) -> None:
@@ -350,7 +353,7 @@ def test_a_plan_refused_in_a_job_names_the_operation_and_its_keys(tmp_path: Path
     with pytest.raises(ToolpathError) as caught:
         run_job(drawing, load_target("grbl"), job)
     message = str(caught.value)
-    assert message.startswith("operation 1 ('outline'): 3 tab(s) do not fit")
+    assert message.startswith("job.toml: operation 1 ('outline'): 3 tab(s) do not fit")
     assert "use fewer tabs or a smaller tab_width" in message and "--" not in message
 
 
