@@ -255,17 +255,19 @@ def cut_mid_word(raw: str) -> str | None:
     return m[0].replace(" ", "") if m else None
 
 
+_PLAIN = (
+    "camtool reads plain numbers: post the program again from its CAM program without "
+    "variables, or post the drawing it was made from (DXF, SVG)"
+)
+"""What to do with a program written with variables or expressions (pstoedit's G-code, say)."""
+
+
 def _refuse_special(c: str, code: str, where: str) -> None:
     """Raise for the parameter and expression characters of RS-274/NGC."""
     if c == "#":
-        raise InputError(
-            f"{where}: '#' parameters are not supported ({code!r}); "
-            "write plain numbers (post the program again without variables)"
-        )
+        raise InputError(f"{where}: '#' parameters are not supported ({code!r}); {_PLAIN}")
     if c and c in "[]":
-        raise InputError(
-            f"{where}: '[ ]' expressions are not supported ({code!r}); write plain numbers"
-        )
+        raise InputError(f"{where}: '[ ]' expressions are not supported ({code!r}); {_PLAIN}")
     if c == "$" and code.startswith("$"):
         raise InputError(
             f"{where}: {code!r} is a GRBL system command (settings, homing, jogging), not "

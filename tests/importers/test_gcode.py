@@ -451,6 +451,17 @@ def test_refused_construct_names_line_and_construct(block: str, construct: str) 
     assert construct in message
 
 
+def test_a_program_written_with_variables_is_refused_with_what_to_do() -> None:
+    """pstoedit's ``gcode`` format (its header, as pstoedit 3.78 writes it) sets variables."""
+    header = "G20\nG90\n#1000 = 0.100  ( safe Z )\nG01 Z#1000 F#1001\n"
+    message = refused(header)
+    assert message.startswith("t.ngc:3: '#' parameters are not supported ('#1000=0.100')")
+    assert "post the drawing it was made from (DXF, SVG)" in message
+    expression = refused("G21\nG0 X[1*72] Y1\n")
+    assert expression.startswith("t.ngc:2: '[ ]' expressions are not supported")
+    assert "without variables" in expression
+
+
 def test_axis_words_before_any_motion_mode() -> None:
     assert refused("G21\nX1 Y1\n").startswith("t.ngc:2: X1 has no code to use it")
 
