@@ -19,7 +19,14 @@ from camtool.importers import gcode_ahead
 from camtool.importers.gcode_codes import BlockWords, CommandReader, Notes, unused_word
 from camtool.importers.gcode_cycles import CYCLES, CycleState
 from camtool.importers.gcode_lexer import Block, Word, cut_mid_word, lex_line
-from camtool.importers.gcode_plain import ARC_TOL_IN, ARC_TOL_MM, PLAIN_WORDS
+from camtool.importers.gcode_plain import (
+    ARC_TOL_IN,
+    ARC_TOL_MM,
+    PLAIN_WORDS,
+    R_TOL_IN,
+    R_TOL_MM,
+    arc_end_off,
+)
 from camtool.importers.gcode_start import StartRules
 from camtool.importers.gcode_target import READ_AS_WRITTEN, LengthOffsets, Reading, path_control
 from camtool.model.errors import InputError
@@ -690,14 +697,14 @@ class _Reader(StartRules):
         if r_start == 0:
             raise InputError(f"{self.where()}: {name} centre is its start point (radius 0)")
         small, large = self._tolerance()
-        off = abs(r_start - r_end)
-        if off > large or (off > small and off > 0.001 * r_start):
+        if arc_end_off(r_start, r_end, small, large):
+            off = abs(r_start - r_end)
             mode = "absolute (G90.1)" if self.arc_absolute else "incremental from the start (G91.1)"
             raise InputError(
                 f"{self.where()}: {name} end point is {off:.4g} mm off its circle (radius "
-                f"{r_start:.4f} mm at the start, {r_end:.4f} mm at the end; the limit is "
-                f"{small:g} mm and 0.1 % of the radius); the centre words are read as {mode}: "
-                "check them or export with more decimals"
+                f"{r_start:.4f} mm at the start, {r_end:.4f} mm at the end; LinuxCNC allows "
+                f"{small:.4f} mm, or 0.1 % of the larger radius up to {large:.2f} mm); the "
+                f"centre words are read as {mode}: check them or export with more decimals"
             )
 
     def _centre_r(
@@ -713,7 +720,7 @@ class _Reader(StartRules):
         if r == 0:
             raise InputError(f"{self.where()}: {name} with R0; give the arc's radius")
         half = chord / 2
-        if abs(r) < half - self._tolerance()[0]:
+        if abs(r) < half - (R_TOL_IN if self.inch else R_TOL_MM) * self.scale:
             raise InputError(
                 f"{self.where()}: {name} {r_word}: radius {abs(r):.4f} mm is less than half "
                 f"the distance to the end point ({half:.4f} mm); check R"

@@ -23,10 +23,35 @@ from camtool.model.program import (
 from camtool.model.shapes import Point
 from camtool.model.units import INCH, LARGEST_VALUE
 
-ARC_TOL_MM = (0.005, 0.5)
-"""LinuxCNC arc end tolerance in mm: (with 0.1 % of the radius, absolute ceiling)."""
-ARC_TOL_IN = (0.0005, 0.05)
-"""The same in inches (G20)."""
+ARC_TOL_MM = (2 * 0.01 * math.sqrt(2), 100 * 2 * 0.01 * math.sqrt(2))
+"""How far (mm, in G21) the end of an I/J arc may lie off its circle, as LinuxCNC's
+interpreter allows it (``interp_arc.cc`` ``arc_data_ijk`` with the defaults of
+``interp_internal.hh``, ``CENTER_ARC_RADIUS_TOLERANCE_MM``): the radii to the start and to
+the end may differ by more than the first (≈ 0.0283 mm) only within 0.1 % of the larger
+radius, and never by more than the second (100 times it). Measured against LinuxCNC 2.9's
+``rs274`` (tests/importers/test_gcode.py). GRBL's and LinuxCNC's own checks of the numbers
+written are :mod:`camtool.post.arccheck`'s."""
+ARC_TOL_IN = (2 * 0.001 * math.sqrt(2), 100 * 2 * 0.001 * math.sqrt(2))
+"""The same in inches (G20: ``CENTER_ARC_RADIUS_TOLERANCE_INCH``)."""
+R_TOL_IN = 0.00005
+"""How much (in, in G20) an R arc's radius may fall short of half its chord, read as a half
+circle: LinuxCNC's ``RADIUS_TOLERANCE_INCH`` (``arc_data_r``), also the radius under which
+it calls an arc "zero-radius". Measured against LinuxCNC 2.9's ``rs274``."""
+R_TOL_MM = R_TOL_IN * 25.4
+"""The same in mm (``RADIUS_TOLERANCE_MM``, 0.00127 mm)."""
+SPIRAL_RELATIVE = 0.001
+"""LinuxCNC's ``SPIRAL_RELATIVE_TOLERANCE``: of the larger radius."""
+
+
+def arc_end_off(r_start: float, r_end: float, small: float, large: float) -> bool:
+    """Whether an I/J arc of radii ``r_start``, ``r_end`` (mm) is refused (:data:`ARC_TOL_MM`).
+
+    ``small``, ``large``: :data:`ARC_TOL_MM` (or :data:`ARC_TOL_IN`) in the program's scale.
+    """
+    off = abs(r_start - r_end)
+    return off > large or (off > small and off > SPIRAL_RELATIVE * max(r_start, r_end))
+
+
 _PLAIN_NUMBER = r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)"
 PLAIN_WORDS = re.compile(r"[ \t]*([GXYZIJRFN](?=[+-]?\.?[0-9])|)(" + _PLAIN_NUMBER + r"|[^ \t].*)")
 """The words of a plain line (:meth:`_Reader.plain`), found in the line in upper case: a
@@ -262,8 +287,6 @@ class PlainLines:
         ty = start[1] if y is None else y * scale
         tz = self.z if z is None else z * scale
         end = (tx, ty)
-        small, large = ARC_TOL_IN if self.inch else ARC_TOL_MM
-        small, large = small * scale, large * scale
         r_value, i, j = args.get("R"), args.get("I"), args.get("J")
         if r_value is not None:
             if i is not None or j is not None:
@@ -273,7 +296,7 @@ class PlainLines:
             if chord == 0 or r == 0:
                 return False
             half = chord / 2
-            if abs(r) < half - small:
+            if abs(r) < half - (R_TOL_IN if self.inch else R_TOL_MM) * scale:
                 return False
             h = math.sqrt(max(r * r - half * half, 0.0))
             side = (1.0 if name == "G2" else -1.0) * (1.0 if r > 0 else -1.0)
@@ -294,8 +317,8 @@ class PlainLines:
             r_start, r_end = math.dist(start, (cx, cy)), math.dist(end, (cx, cy))
             if r_start == 0:
                 return False
-            off = abs(r_start - r_end)
-            if off > large or (off > small and off > 0.001 * r_start):
+            small, large = ARC_TOL_IN if self.inch else ARC_TOL_MM
+            if arc_end_off(r_start, r_end, small * scale, large * scale):
                 return False
         z_out = tz if z is not None and tz != self.z else None
         self.positioned = True

@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
+from camtool.importers.gcode_plain import ARC_TOL_MM, R_TOL_MM, SPIRAL_RELATIVE
 from camtool.model.errors import UsageError
 from camtool.model.shapes import Point
 
@@ -29,13 +30,13 @@ GRBL_CEILING_MM = 0.5
 """GRBL ``gcode.c``: radius difference never accepted above this, mm."""
 GRBL_ANGULAR_EPSILON = 5e-7
 """GRBL ``config.h`` ``ARC_ANGULAR_TRAVEL_EPSILON``, rad: below it a travel is a full turn."""
-LINUXCNC_TOLERANCE_MM = 2 * 0.01 * math.sqrt(2)
-"""LinuxCNC ``CENTER_ARC_RADIUS_TOLERANCE_MM`` default (2·0.01·√2 ≈ 0.0283 mm)."""
-LINUXCNC_RELATIVE = 0.001
+LINUXCNC_TOLERANCE_MM, LINUXCNC_CEILING_MM = ARC_TOL_MM
+"""LinuxCNC ``CENTER_ARC_RADIUS_TOLERANCE_MM`` default (2·0.01·√2 ≈ 0.0283 mm), and the
+difference ``arc_data_ijk`` refuses outright (100 × it, ≈ 2.83 mm): the rule the G-code
+reader reads any program by (:data:`~camtool.importers.gcode_plain.ARC_TOL_MM`)."""
+LINUXCNC_RELATIVE = SPIRAL_RELATIVE
 """LinuxCNC ``SPIRAL_RELATIVE_TOLERANCE``: relative to the larger radius."""
-LINUXCNC_CEILING_MM = 100 * LINUXCNC_TOLERANCE_MM
-"""LinuxCNC ``arc_data_ijk``: 100 × the tolerance is refused outright (≈ 2.83 mm)."""
-LINUXCNC_MIN_RADIUS_MM = 0.00005 * 25.4
+LINUXCNC_MIN_RADIUS_MM = R_TOL_MM
 """LinuxCNC ``RADIUS_TOLERANCE_MM`` (0.00127 mm): smaller radii are "zero-radius"."""
 MARGIN_MM = 2e-4
 """Distance conformed blocks keep from every limit, mm (float32 noise at ±1000 mm)."""

@@ -338,6 +338,29 @@ def test_a_target_without_path_controls_reads_them_as_before(tmp_path: Path) -> 
 
 
 @needs_rs274
+def test_the_arcs_camtool_reads_are_the_ones_rs274_runs(tmp_path: Path) -> None:
+    """The judge of tests/importers/test_gcode.py's arcs at LinuxCNC's tolerances."""
+    from tests.importers.test_gcode import ARC_ENDS, arc_program
+
+    for units, arc, runs in ARC_ENDS:
+        path = tmp_path / "a.ngc"
+        path.write_text(arc_program(units, arc) + "M2\n")
+        done = rs274(path)
+        assert ("PROGRAM_END" in done.stdout) == runs, (units, arc, done.stderr[-300:])
+
+
+@needs_rs274
+def test_rs274_runs_dxf2gcodes_spiral_arcs_and_camtools_re_post_of_them(tmp_path: Path) -> None:
+    """tests/data/dxf2gcode-spiral-arcs.ngc: arcs up to 0.0265 mm off their circles."""
+    source = Path(__file__).resolve().parents[1] / "data" / "dxf2gcode-spiral-arcs.ngc"
+    assert "PROGRAM_END" in rs274(source).stdout
+    out = tmp_path / "re.ngc"
+    assert main(["post", str(source), "-t", "linuxcnc", "-o", str(out)]) == 0
+    done = rs274(out)
+    assert done.returncode == 0 and "PROGRAM_END" in done.stdout, done.stderr[-300:]
+
+
+@needs_rs274
 def test_rs274_refuses_the_comments_inside_words_that_camtool_refuses(tmp_path: Path) -> None:
     """The judge of tests/importers/test_gcode_comment_in_word.py's lines."""
     from tests.importers.test_gcode_comment_in_word import READ, REFUSED, program
