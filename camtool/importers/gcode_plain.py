@@ -47,9 +47,10 @@ def arc_end_off(r_start: float, r_end: float, small: float, large: float) -> boo
     """Whether an I/J arc of radii ``r_start``, ``r_end`` (mm) is refused (:data:`ARC_TOL_MM`).
 
     ``small``, ``large``: :data:`ARC_TOL_MM` (or :data:`ARC_TOL_IN`) in the program's scale.
+    The same float operations as ``arc_data_ijk`` (``abs_err``, ``rel_err``); ``r_start`` > 0.
     """
     off = abs(r_start - r_end)
-    return off > large or (off > small and off > SPIRAL_RELATIVE * max(r_start, r_end))
+    return off > large or (off / max(r_start, r_end) > SPIRAL_RELATIVE and off > small)
 
 
 _PLAIN_NUMBER = r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)"
