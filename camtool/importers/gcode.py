@@ -19,14 +19,7 @@ from camtool.importers import gcode_ahead
 from camtool.importers.gcode_codes import BlockWords, CommandReader, Notes, unused_word
 from camtool.importers.gcode_cycles import CYCLES, CycleState
 from camtool.importers.gcode_lexer import Block, Word, cut_mid_word, lex_line
-from camtool.importers.gcode_plain import (
-    ARC_TOL_IN,
-    ARC_TOL_MM,
-    PLAIN_WORDS,
-    R_TOL_IN,
-    R_TOL_MM,
-    arc_end_off,
-)
+from camtool.importers.gcode_plain import PLAIN_WORDS, arc_end_off, arc_limits, spiral_note
 from camtool.importers.gcode_start import StartRules
 from camtool.importers.gcode_target import READ_AS_WRITTEN, LengthOffsets, Reading, path_control
 from camtool.model.errors import InputError
@@ -658,10 +651,6 @@ class _Reader(StartRules):
         for x, y, z in points[1:]:
             self._push(Linear(x, y, feed, z), x, y, z)
 
-    def _tolerance(self) -> tuple[float, float]:
-        small, large = ARC_TOL_IN if self.inch else ARC_TOL_MM
-        return small * self.scale, large * self.scale
-
     def _centre_ij(
         self,
         args: dict[str, Word],
@@ -696,9 +685,9 @@ class _Reader(StartRules):
         r_start, r_end = math.dist(start, centre), math.dist(end, centre)
         if r_start == 0:
             raise InputError(f"{self.where()}: {name} centre is its start point (radius 0)")
-        small, large = self._tolerance()
+        small, large, _ = arc_limits(self.inch, self.scale)
+        off = abs(r_start - r_end)
         if arc_end_off(r_start, r_end, small, large):
-            off = abs(r_start - r_end)
             mode = "absolute (G90.1)" if self.arc_absolute else "incremental from the start (G91.1)"
             raise InputError(
                 f"{self.where()}: {name} end point is {off:.4g} mm off its circle (radius "
@@ -706,6 +695,9 @@ class _Reader(StartRules):
                 f"{small:.4f} mm, or 0.1 % of the larger radius up to {large:.2f} mm); the "
                 f"centre words are read as {mode}: check them or export with more decimals"
             )
+        note = spiral_note(name, off)
+        if note:  # one note however many arcs: the first one's line, and a count
+            self.notes.add("spiral", self.line, note)
 
     def _centre_r(
         self, r_word: Word, start: Point, end: Point, clockwise: bool, name: str
@@ -720,7 +712,7 @@ class _Reader(StartRules):
         if r == 0:
             raise InputError(f"{self.where()}: {name} with R0; give the arc's radius")
         half = chord / 2
-        if abs(r) < half - (R_TOL_IN if self.inch else R_TOL_MM) * self.scale:
+        if abs(r) < half - arc_limits(self.inch, self.scale)[2]:
             raise InputError(
                 f"{self.where()}: {name} {r_word}: radius {abs(r):.4f} mm is less than half "
                 f"the distance to the end point ({half:.4f} mm); check R"

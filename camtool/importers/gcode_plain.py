@@ -43,6 +43,33 @@ SPIRAL_RELATIVE = 0.001
 """LinuxCNC's ``SPIRAL_RELATIVE_TOLERANCE``: of the larger radius."""
 
 
+SPIRAL_NOTE_MM = 0.005
+"""An I/J arc whose radii differ by more than this (mm; GRBL's own tolerance, which any
+controller takes as one arc) is read with a note: LinuxCNC cuts it as a spiral, GRBL
+refuses it beyond 0.1 % of its radius, and the verifier's machines cut the circle of its
+start radius closed by a chord to the end written."""
+
+
+def spiral_note(name: str, off: float) -> str | None:
+    """The note for a ``name`` arc (``G2``, ``G3``) whose radii differ by ``off`` mm, if any."""
+    if off <= SPIRAL_NOTE_MM:
+        return None
+    return (
+        f"{name} ends {off:.4f} mm off its circle, read as written (LinuxCNC cuts it as a "
+        "spiral; verify cuts it on its start's circle, then a chord to its end: the offset "
+        "shows in its deviation)"
+    )
+
+
+def arc_limits(inch: bool, scale: float) -> tuple[float, float, float]:
+    """``(small, large, r_short)``, mm, for a program in inches (``inch``) or mm, times ``scale``.
+
+    :data:`ARC_TOL_MM` (or :data:`ARC_TOL_IN`) and :data:`R_TOL_MM` (or :data:`R_TOL_IN`).
+    """
+    (small, large), r_short = (ARC_TOL_IN, R_TOL_IN) if inch else (ARC_TOL_MM, R_TOL_MM)
+    return small * scale, large * scale, r_short * scale
+
+
 def arc_end_off(r_start: float, r_end: float, small: float, large: float) -> bool:
     """Whether an I/J arc of radii ``r_start``, ``r_end`` (mm) is refused (:data:`ARC_TOL_MM`).
 
@@ -297,7 +324,7 @@ class PlainLines:
             if chord == 0 or r == 0:
                 return False
             half = chord / 2
-            if abs(r) < half - (R_TOL_IN if self.inch else R_TOL_MM) * scale:
+            if abs(r) < half - arc_limits(self.inch, scale)[2]:
                 return False
             h = math.sqrt(max(r * r - half * half, 0.0))
             side = (1.0 if name == "G2" else -1.0) * (1.0 if r > 0 else -1.0)
@@ -318,9 +345,8 @@ class PlainLines:
             r_start, r_end = math.dist(start, (cx, cy)), math.dist(end, (cx, cy))
             if r_start == 0:
                 return False
-            small, large = ARC_TOL_IN if self.inch else ARC_TOL_MM
-            if arc_end_off(r_start, r_end, small * scale, large * scale):
-                return False
+            if abs(r_start - r_end) > SPIRAL_NOTE_MM:
+                return False  # refused, or read with a note: _Reader._check_radius
         z_out = tz if z is not None and tz != self.z else None
         self.positioned = True
         self.cut_in_contour = True  # _contour(False)

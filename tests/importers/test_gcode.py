@@ -335,6 +335,13 @@ def test_arc_end_tolerance_of_linuxcnc(units: str, arc: str, runs: bool) -> None
 def test_an_arc_off_its_circle_is_named_with_linuxcncs_limits() -> None:
     ok = parse("G21 G1 X0 Y0 F1\nG2 X20.004 Y0 I10 J0\n")  # accepted as written
     assert ok.moves[1] == ArcMove(20.004, 0.0, 10.0, 0.0, True, 1.0, contour=1)
+    assert not any("off its circle" in w for w in ok.warnings)  # within 0.005 mm: no note
+    noted = parse("G21 G1 X0 Y0 F1\nG2 X40.027 Y0 I20 J0\nG2 X80.047 Y0 I20 J0\n")
+    assert [w for w in noted.warnings if "off its circle" in w] == [
+        "t.ngc:2: G2 ends 0.0270 mm off its circle, read as written (LinuxCNC cuts it as a "
+        "spiral; verify cuts it on its start's circle, then a chord to its end: the offset "
+        "shows in its deviation) (2 times)"
+    ]
     message = refused("G21 G1 X0 Y0 F1\nG2 X40.029 Y0 I20 J0\n")
     assert message.startswith("t.ngc:2: G2 end point is 0.029 mm off its circle")
     assert "LinuxCNC allows 0.0283 mm, or 0.1 % of the larger radius up to 2.83 mm" in message

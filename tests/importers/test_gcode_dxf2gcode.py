@@ -9,6 +9,7 @@ arcs written in inches with 3 decimals, so each arc's end lies up to 0.00104 in 
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import pytest
@@ -54,3 +55,26 @@ def test_re_posted_its_arcs_are_ones_the_controller_takes(target: str) -> None:
     out = post_program(read_gcode(DXF2GCODE), load_target(target), OutputOptions())
     v = verify_code(out.result.code, load_target(target), source="re.nc", budget=False)
     assert v.deviation.points > 0
+
+
+def test_its_arcs_off_their_circles_are_noted_once_with_their_count() -> None:
+    """The note counts the arcs whose radii differ by over 0.005 mm, from the file's numbers."""
+    here, off = None, []
+    for number, line in enumerate(DXF2GCODE.read_text().splitlines(), start=1):
+        words = dict(re.findall(r"([XYIJ])\s*(-?[\d.]+)", line.split("(")[0]))
+        if line.startswith("G2") and here is not None:
+            cx, cy = here[0] + float(words["I"]), here[1] + float(words["J"])
+            end = (float(words["X"]), float(words["Y"]))
+            gap = abs(math.dist(here, (cx, cy)) - math.dist(end, (cx, cy))) * 25.4  # in → mm
+            if gap > 0.005:
+                off.append((number, gap))
+        if "X" in words and "Y" in words:
+            here = (float(words["X"]), float(words["Y"]))
+    notes = [w for w in read_gcode(DXF2GCODE).warnings if "off its circle" in w]
+    first, gap = off[0]
+    assert notes == [
+        f"{DXF2GCODE}:{first}: G2 ends {gap:.4f} mm off its circle, read as written (LinuxCNC "
+        "cuts it as a spiral; verify cuts it on its start's circle, then a chord to its end: "
+        f"the offset shows in its deviation) ({len(off)} times)"
+    ]
+    assert read_gcode(DXF2GCODE).moves  # read, not refused
