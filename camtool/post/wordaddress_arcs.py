@@ -194,10 +194,12 @@ class ArcWriter(WordWriter):
     def _conform_equalised(self, piece: Arc, quantum: float) -> list[ArcPiece] | None:
         """``piece`` conformed about the centre that puts both its ends at one radius, or None.
 
-        For an arc the arc check refused whose ends lie at different distances from its
-        centre (a joint snapped within ``--chain-tolerance`` keeps an arc's centre, so its
-        start can move off its circle: LinuxCNC's ``conv_slot_l.svg`` gave an arc 3.4 µm
-        apart in radius, which no split could write). The centre moves to the nearest
+        For an arc :func:`~camtool.post.arcconform.conform_arc` could not write (no printed
+        centre the arc check takes within its deviation bound) whose ends lie at different
+        distances from its centre (a joint snapped within ``--chain-tolerance`` keeps an
+        arc's centre, so its start can move off its circle: LinuxCNC's ``conv_slot_l.svg``
+        gave an arc 3.4 µm apart in radius, which no split could write; a program read from
+        code may end an arc off its circle). The centre moves to the nearest
         point of its ends' perpendicular bisector; the warning gives both radii and the
         move. Only when the radii differ by no more than the controller's own absolute
         tolerance (GRBL 0.005 mm, LinuxCNC 0.028 mm: :func:`~camtool.post.arccheck.
@@ -207,7 +209,7 @@ class ArcWriter(WordWriter):
         nearly 360°) the move grows as radius / chord times the radii's difference, 0.34 mm
         for 2.9 µm on a 359.5° arc of 10 mm, and would move the whole circle. ``None``
         otherwise, or when that does not help (the ends meet, the check still fails): the
-        arc is then written as chords. Only arcs the check refused take this path.
+        arc is then written as chords. Only arcs conform_arc could not write take this path.
         """
         from camtool.post.arccheck import max_difference
         from camtool.post.arcconform import DEVIATION_QUANTA
@@ -233,8 +235,9 @@ class ArcWriter(WordWriter):
             return None
         self.warn(
             f"{self.where()}: the arc starts {r0:.4f} mm and ends {r1:.4f} mm from its centre "
-            f"({abs(r1 - r0) * 1000:.1f} µm apart), more than {self.spec.name}'s arc check "
-            f"takes; written about the centre {moved * 1000:.1f} µm away that puts both ends "
+            f"({abs(r1 - r0) * 1000:.1f} µm apart): no printed centre near it gives an arc "
+            f"{self.spec.name}'s arc check takes within {DEVIATION_QUANTA * quantum * 1000:g} µm "
+            f"of it; written about the centre {moved * 1000:.1f} µm away that puts both ends "
             f"{radius:.4f} mm from it"
         )
         return out
