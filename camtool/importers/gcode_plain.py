@@ -41,8 +41,6 @@ R_TOL_MM = R_TOL_IN * 25.4
 """The same in mm (``RADIUS_TOLERANCE_MM``, 0.00127 mm)."""
 SPIRAL_RELATIVE = 0.001
 """LinuxCNC's ``SPIRAL_RELATIVE_TOLERANCE``: of the larger radius."""
-
-
 SPIRAL_NOTE_MM = 0.005
 """An I/J arc whose radii differ by more than this (mm; GRBL's own tolerance, which any
 controller takes as one arc) is read with a note: LinuxCNC cuts it as a spiral, GRBL
@@ -71,10 +69,11 @@ def arc_limits(inch: bool, scale: float) -> tuple[float, float, float]:
 
 
 def arc_end_off(r_start: float, r_end: float, small: float, large: float) -> bool:
-    """Whether an I/J arc of radii ``r_start``, ``r_end`` (mm) is refused (:data:`ARC_TOL_MM`).
+    """Whether LinuxCNC refuses an I/J arc of radii ``r_start``, ``r_end`` (mm, both > 0).
 
     ``small``, ``large``: :data:`ARC_TOL_MM` (or :data:`ARC_TOL_IN`) in the program's scale.
-    The same float operations as ``arc_data_ijk`` (``abs_err``, ``rel_err``); ``r_start`` > 0.
+    The same float operations as ``arc_data_ijk`` (``abs_err``, ``rel_err``): the reader
+    reads by it, and :func:`camtool.post.arccheck.arc_error` checks LinuxCNC's output by it.
     """
     off = abs(r_start - r_end)
     return off > large or (off / max(r_start, r_end) > SPIRAL_RELATIVE and off > small)

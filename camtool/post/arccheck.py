@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-from camtool.importers.gcode_plain import ARC_TOL_MM, R_TOL_MM, SPIRAL_RELATIVE
+from camtool.importers.gcode_plain import ARC_TOL_MM, R_TOL_MM, SPIRAL_RELATIVE, arc_end_off
 from camtool.model.errors import UsageError
 from camtool.model.shapes import Point
 
@@ -117,11 +117,9 @@ def _linuxcnc_error(start: Point, end: Point, centre: Point) -> str | None:
     radii = f"r1={r1:.4f} r2={r2:.4f} mm"
     if r1 < LINUXCNC_MIN_RADIUS_MM or r2 < LINUXCNC_MIN_RADIUS_MM:
         return f"linuxcnc: zero-radius arc ({radii}, the limit is {LINUXCNC_MIN_RADIUS_MM} mm)"
-    abs_err = abs(r1 - r2)
-    rel_err = abs_err / max(r1, r2)
-    if abs_err > LINUXCNC_CEILING_MM or (
-        rel_err > LINUXCNC_RELATIVE and abs_err > LINUXCNC_TOLERANCE_MM
-    ):
+    if arc_end_off(r1, r2, LINUXCNC_TOLERANCE_MM, LINUXCNC_CEILING_MM):
+        abs_err = abs(r1 - r2)
+        rel_err = abs_err / max(r1, r2)
         return (
             f"linuxcnc: radius to end of arc differs from radius to start ({radii}, "
             f"abs_err={abs_err:.4g} mm, rel_err={100 * rel_err:.4f} %; the limit is "
