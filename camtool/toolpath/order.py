@@ -21,6 +21,11 @@ from camtool.toolpath.travel import Step, drawn_order, oriented, precedence, tra
 
 _NEST_TOLERANCE_MM = 1e-4
 
+_TOUCH_MM = 2 * _NEST_TOLERANCE_MM
+"""How far a contour may leave a closed contour's chord polygon and lie inside it, mm: that
+polygon lies up to :data:`_NEST_TOLERANCE_MM` inside the curve it stands for, so a contour
+touching the curve from within may lie that far outside it (:func:`_touching_inside`)."""
+
 
 @dataclass(frozen=True)
 class Nesting:
@@ -84,7 +89,8 @@ def nesting(contours: Sequence[Contour]) -> Nesting:
     A contour (open or closed, by its outline: arcs as chords within
     :data:`_NEST_TOLERANCE_MM`) lies inside a closed contour when the closed contour's
     filled polygon (:func:`~camtool.geometry.area.enclosed`: the nonzero winding rule where
-    the outline crosses or touches itself) covers it and is
+    the outline crosses or touches itself) covers it, or it lies within :data:`_TOUCH_MM` of
+    that polygon all along (touching its edge from within, :func:`_touching_inside`), and is
     strictly larger (a polygon covers its own outline and an identical duplicate's).
     Shapely's vectorised constructors and one bulk ``STRtree.query(…, "covered_by")``
     answer as one geometry and one query per contour did (:func:`_nesting_one_by_one`,
@@ -137,12 +143,48 @@ def nesting(contours: Sequence[Contour]) -> Nesting:
         COVER_PART,
         dtype=bool,
     )
+    covered |= _touching_inside(outlines, polygons, which, around, covered)
     which, parent = which[covered], parent[covered]
     order = np.lexsort((parent, which))
     parents: list[list[int]] = [[] for _ in contours]
     for i, j in zip(which[order].tolist(), parent[order].tolist(), strict=True):
         parents[i].append(j)
     return Nesting(tuple(tuple(p) for p in parents), _near(outlines, closed))
+
+
+def _touching_inside(outlines: Any, polygons: Any, which: Any, around: Any, covered: Any) -> Any:
+    """Of the pairs ``covered_by`` refused, those inside, touching the polygon's edge.
+
+    Their outline lies within :data:`_TOUCH_MM` of the polygon all along. A circle drawn
+    touching its parent's edge from inside (a hole tangent to the outline) is covered by
+    the parent's filled circle, but not always by the polygon of its chords, which lies up
+    to :data:`_NEST_TOLERANCE_MM` inside it: where the two meet, the test is decided by
+    the last bits of two cosines. Read as an outline of its own, such a hole would be cut
+    on the wrong side, into the part. A contour that leaves the polygon by more crosses it
+    (thinner than the tolerance, :func:`~camtool.toolpath.compensate.crossings` does not
+    report it). Only pairs whose boxes allow it are measured, each polygon grown once
+    (``(N,)`` bool, like ``covered``).
+    """
+    import numpy as np
+    import shapely
+
+    out = np.zeros(len(which), dtype=bool)
+    todo = np.flatnonzero(~covered)
+    if not len(todo):
+        return out
+    inner = shapely.bounds(outlines[which[todo]])
+    outer = shapely.bounds(polygons[around[todo]])
+    fits = np.all(inner[:, :2] >= outer[:, :2] - _TOUCH_MM, axis=1) & np.all(
+        inner[:, 2:] <= outer[:, 2:] + _TOUCH_MM, axis=1
+    )
+    todo = todo[fits]
+    if not len(todo):
+        return out
+    grown = np.empty(len(polygons), dtype=object)
+    used = np.unique(around[todo])
+    grown[used] = shapely.buffer(polygons[used], _TOUCH_MM, quad_segs=2)
+    out[todo] = shapely.covered_by(outlines[which[todo]], grown[around[todo]])
+    return out
 
 
 def _near(outlines: Any, closed: list[int]) -> tuple[tuple[int, int, float], ...]:
@@ -328,9 +370,17 @@ def _nesting_one_by_one(contours: Sequence[Contour]) -> Nesting:
     areas = {i: poly.area for i, poly in zip(closed, polygons, strict=True)}
     tree = STRtree(polygons)
     parents: list[tuple[int, ...]] = []
+    grown = [poly.buffer(_TOUCH_MM, quad_segs=2) for poly in polygons]
     for i, outline in enumerate(outlines):
-        around = (closed[k] for k in tree.query(outline, predicate="covered_by"))
-        parents.append(tuple(sorted(j for j in around if areas[j] > areas.get(i, 0.0))))
+        around = set(tree.query(outline, predicate="covered_by").tolist())
+        x0, y0, x1, y1 = outline.bounds
+        for k in tree.query(outline):  # touching its edge from within (_touching_inside)
+            a0, b0, a1, b1 = polygons[k].bounds
+            box = x0 >= a0 - _TOUCH_MM and y0 >= b0 - _TOUCH_MM
+            if box and x1 <= a1 + _TOUCH_MM and y1 <= b1 + _TOUCH_MM and grown[k].covers(outline):
+                around.add(int(k))
+        inside = (closed[k] for k in around)
+        parents.append(tuple(sorted(j for j in inside if areas[j] > areas.get(i, 0.0))))
     import numpy as np
 
     return Nesting(tuple(parents), _near(np.array(outlines, dtype=object), closed))
