@@ -161,9 +161,9 @@ def _touching_inside(outlines: Any, polygons: Any, which: Any, around: Any, cove
     to :data:`_NEST_TOLERANCE_MM` inside it: where the two meet, the test is decided by
     the last bits of two cosines. Read as an outline of its own, such a hole would be cut
     on the wrong side, into the part. A contour that leaves the polygon by more crosses it
-    (thinner than the tolerance, :func:`~camtool.toolpath.compensate.crossings` does not
-    report it). Only pairs whose boxes allow it are measured, each polygon grown once
-    (``(N,)`` bool, like ``covered``).
+    (:func:`~camtool.toolpath.compensate.crossings` reports the pair when what lies on
+    either side is wider than the tolerance). Only pairs whose boxes allow it are measured,
+    each polygon grown once (``(N,)`` bool, like ``covered``).
     """
     import numpy as np
     import shapely
