@@ -162,8 +162,8 @@ def _touching_inside(outlines: Any, polygons: Any, which: Any, around: Any, cove
     the last bits of two cosines. Read as an outline of its own, such a hole would be cut
     on the wrong side, into the part. A contour that leaves the polygon by more crosses it
     (:func:`~camtool.toolpath.compensate.crossings` reports the pair when what lies on
-    either side is wider than the tolerance). Only pairs whose boxes allow it are measured,
-    each polygon grown once (``(N,)`` bool, like ``covered``).
+    either side is wider than the tolerance). Only pairs whose boxes and first points allow
+    it are measured, each polygon grown once (``(N,)`` bool, like ``covered``).
     """
     import numpy as np
     import shapely
@@ -178,6 +178,8 @@ def _touching_inside(outlines: Any, polygons: Any, which: Any, around: Any, cove
         inner[:, 2:] <= outer[:, 2:] + _TOUCH_MM, axis=1
     )
     todo = todo[fits]
+    starts = shapely.get_point(outlines[which[todo]], 0)  # as near as the whole must be
+    todo = todo[shapely.dwithin(polygons[around[todo]], starts, _TOUCH_MM)]
     if not len(todo):
         return out
     grown = np.empty(len(polygons), dtype=object)
