@@ -19,12 +19,14 @@ that the 3-decimal output rounds to.
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import subprocess
 import tempfile
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from camtool.cli.main import main
@@ -103,6 +105,36 @@ def canon_moves(stdout: str) -> list[tuple[str, tuple[float, ...]]]:
         else:
             moves.append(("rapid" if name == "STRAIGHT_TRAVERSE" else "line", v[:3]))
     return moves
+
+
+def arc_points(
+    start: tuple[float, float],
+    end: tuple[float, float],
+    centre: tuple[float, float],
+    rotation: float,
+    step_mm: float,
+    full_mm: float = 1e-9,
+) -> list[tuple[float, float]]:
+    """Points at most ~``step_mm`` apart along an ``ARC_FEED``, its start left out, its end last.
+
+    ``rotation`` > 0 is counter-clockwise (rs274's sign); ends closer than ``full_mm`` make a
+    whole circle. The radius goes linearly from the start's to the end's, as LinuxCNC's
+    ``pmCirclePoint`` takes an arc whose end is off its circle.
+    """
+    (x, y), (ex, ey), (cx, cy) = start, end, centre
+    a0 = math.atan2(y - cy, x - cx)
+    sweep = 0.0 if math.dist(start, end) < full_mm else math.atan2(ey - cy, ex - cx) - a0
+    if rotation > 0:
+        sweep = sweep % (2 * math.pi) or 2 * math.pi
+    else:
+        sweep = -((-sweep) % (2 * math.pi) or 2 * math.pi)
+    r0, r1 = math.hypot(x - cx, y - cy), math.hypot(ex - cx, ey - cy)
+    n = max(2, int(abs(sweep) * max(r0, r1) / step_mm))
+    out = []
+    for t in np.linspace(0.0, 1.0, n + 1)[1:]:
+        r = r0 + (r1 - r0) * t
+        out.append((cx + r * math.cos(a0 + sweep * t), cy + r * math.sin(a0 + sweep * t)))
+    return out
 
 
 def planned_moves(program_moves: tuple[object, ...]) -> list[tuple[str, tuple[float, ...]]]:

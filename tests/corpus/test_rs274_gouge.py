@@ -7,7 +7,7 @@ each circle inside another is its hole, even-odd), not from camtool's reading: t
 centre must stay at least the tool radius from it (less 0.005 mm for the 3 decimals and the
 arcs' chords), outside it for ``outside``, inside it for ``pocket``. ``kinetics/kin82.dxf``
 and ``kin124.dxf`` draw holes touching their outline from inside: read as outlines of their
-own, they were cut on the wrong side, through the part.
+own, they would be cut on the wrong side, through the part.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ import pytest
 import shapely
 
 from tests.corpus.conftest import CORPUS
-from tests.corpus.test_rs274 import canon_moves, needs_rs274, rs274
+from tests.corpus.test_rs274 import arc_points, canon_moves, needs_rs274, rs274
 
 KINETICS = CORPUS / "pkg/librecad-data/usr/share/librecad/library/kinetics"
 TOOL_MM = 1.0
@@ -45,22 +45,14 @@ def _cutting_points(stdout: str) -> np.ndarray:
     points: list[tuple[float, float]] = []
     x = y = z = 0.0
     for kind, v in canon_moves(stdout):
-        if kind == "arc":
-            ex, ey, cx, cy, rotation, ez = v
-            a0, a1 = math.atan2(y - cy, x - cx), math.atan2(ey - cy, ex - cx)
-            sweep = (a1 - a0) % math.tau if rotation > 0 else -((a0 - a1) % math.tau)
-            sweep = sweep or math.copysign(math.tau, rotation)  # a whole circle
-            r0, r1 = math.hypot(x - cx, y - cy), math.hypot(ex - cx, ey - cy)
-            if z < 0 and ez < 0:
-                n = int(abs(sweep) * max(r0, r1) / STEP_MM) + 2
-                for t in np.linspace(0.0, 1.0, n):
-                    r, a = r0 + (r1 - r0) * t, a0 + sweep * t
-                    points.append((cx + r * math.cos(a), cy + r * math.sin(a)))
-        else:
-            ex, ey, ez = v
-            if kind == "line" and z < 0 and ez < 0:
-                n = int(math.hypot(ex - x, ey - y) / STEP_MM) + 2
-                points += [(x + (ex - x) * t, y + (ey - y) * t) for t in np.linspace(0, 1, n)]
+        ex, ey, ez = (v[0], v[1], v[5]) if kind == "arc" else v
+        if kind != "rapid" and z < 0 and ez < 0:
+            if kind == "arc":
+                along = arc_points((x, y), (ex, ey), (v[2], v[3]), v[4], STEP_MM)
+            else:
+                n = int(math.hypot(ex - x, ey - y) / STEP_MM) + 1
+                along = [(x + (ex - x) * t, y + (ey - y) * t) for t in np.linspace(0, 1, n + 1)]
+            points += [(x, y), *along]
         x, y, z = ex, ey, ez
     return np.array(points)
 

@@ -27,7 +27,7 @@ import pytest
 from scipy.spatial import cKDTree
 
 from camtool.cli.main import main
-from tests.corpus.test_rs274 import needs_rs274, rs274
+from tests.corpus.test_rs274 import arc_points, needs_rs274, rs274
 
 CANON = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|USE_LENGTH_UNITS|SET_FEED_RATE)\(")
 PATH_MM = 0.01
@@ -162,22 +162,9 @@ def _path(stdout: str) -> tuple[np.ndarray, list[float]]:
         v = [float(a) * scale for a in args.split(",")]
         start = points[-1]
         if name == "ARC_FEED":
-            ex, ey, cx, cy, turn = v[0], v[1], v[2], v[3], v[4] / scale
-            a0 = math.atan2(start[1] - cy, start[0] - cx)
-            sweep = math.atan2(ey - cy, ex - cx) - a0
-            if math.dist(start, (ex, ey)) < 0.003:  # a full circle, its start printed in
-                sweep = 0.0  # the unit before a G20/G21 change and its end in the new one
-            if turn > 0:
-                sweep = sweep % (2 * math.pi) or 2 * math.pi
-            else:
-                sweep = -((-sweep) % (2 * math.pi) or 2 * math.pi)
-            r0, r1 = math.hypot(start[0] - cx, start[1] - cy), math.hypot(ex - cx, ey - cy)
-            n = max(2, int(abs(sweep) * max(r0, r1) / STEP_MM))
-            for t in np.linspace(0.0, 1.0, n + 1)[1:]:
-                r = r0 + (r1 - r0) * t
-                points.append(
-                    (cx + r * math.cos(a0 + sweep * t), cy + r * math.sin(a0 + sweep * t))
-                )
+            # a full circle's start may be printed in the unit before a G20/G21 change and
+            # its end in the new one: ends within 0.003 mm are one point
+            points += arc_points(start, (v[0], v[1]), (v[2], v[3]), v[4], STEP_MM, full_mm=0.003)
         else:
             n = max(1, int(math.dist(start, v[:2]) / STEP_MM))
             for t in np.linspace(0.0, 1.0, n + 1)[1:]:

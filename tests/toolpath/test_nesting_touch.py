@@ -1,11 +1,10 @@
 """A closed contour touching another's edge from inside is inside it (a hole, by even-odd).
 
-Found on LibreCAD's own library drawing ``kinetics/kin82.dxf``: a ø5 mm circle drawn
-inside a ø15 mm circle, touching it at one point. The nesting test asked GEOS whether the
-small circle's chords lie in the big circle's chord polygon; where the two circles meet,
-that was decided by the last bits of two cosines, and it said no. The hole was then read
-as an outline of its own: ``--offset outside`` cut it 1 mm too large, through the part
-(with a warning that blamed the tool), ``--offset inside`` on its wrong side, silently.
+LibreCAD's library drawing ``kinetics/kin82.dxf`` has a ø5 mm circle inside a ø15 mm
+circle, touching it at one point. Nesting compares the circles' chord polygons, and where
+they meet the answer depends on the last bits of two cosines; read as an outline of its
+own, the hole would be cut 1 mm too large under ``--offset outside`` (through the part)
+and on its wrong side under ``--offset inside``.
 
 Expected values by analysis: a hole of radius 2.5 cut outside the material by a 1 mm tool
 is cut at radius 2.0 about its centre, the outline of radius 7.5 at 8.0.
