@@ -415,7 +415,7 @@ _PLAIN_SEGMENTS = plain_fields(Line) == ("start", "end") and plain_fields(Arc) =
 (:func:`camtool.model.plain.plain_fields`)."""
 
 
-_SIGN_EPS = 1e-9
+SIGN_EPS = 1e-9
 """Turning points closer than this (rad) to an arc's ends do not count."""
 
 
@@ -431,7 +431,7 @@ def arc_axis_signs(arc: Arc, phase: float) -> tuple[int, ...]:
         d
         for q in (phase, phase + math.pi)
         for d in ((s * (q - a0)) % TAU,)
-        if _SIGN_EPS < d < total - _SIGN_EPS
+        if SIGN_EPS < d < total - SIGN_EPS
     )
     bounds = [0.0, *turns, total]
     out = []

@@ -9,13 +9,14 @@ Design notes: docs/internals.md, ``camtool/toolpath/reversals.py``.
 from __future__ import annotations
 
 import itertools
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
-from camtool.model.shapes import Line, Point, Segment
+from camtool.model.shapes import SIGN_EPS, TAU, Arc, Line, Point, Segment
 from camtool.toolpath.cuts import Cut
 from camtool.toolpath.travel import Step, ends, oriented, rapid_mm, travel_order
 
@@ -70,7 +71,9 @@ def count_reversals(cuts: Sequence[Cut], start: Point) -> tuple[int, int]:
     and each cut's path as given (its start, its direction), with the model of
     this module: the first motion of each axis sets its direction without
     counting; an axis that does not move keeps its direction; arcs reverse X at
-    their left/right extreme points and Y at their top/bottom ones.
+    their left/right extreme points and Y at their top/bottom ones (the signs of
+    :func:`~camtool.model.shapes.arc_axis_signs`, every arc's at once:
+    :func:`_arc_runs`).
 
     Args:
         cuts: cuts in cutting order, paths in mm.
@@ -80,8 +83,11 @@ def count_reversals(cuts: Sequence[Cut], start: Point) -> tuple[int, int]:
         ``(rx, ry)``: reversals of X and of Y. On a machine that compensates
         every reversal (pic-mmh, UNAM-GMM §5.1) this is the compensation count.
     """
-    xs: list[int] = []  # every motion's direction, in order: a reversal is a change
+    # each motion's direction per axis, in order: +1/-1, 0 where the axis stands
+    # still, _ARC for an arc (its first and last directions come from _arc_runs)
+    xs: list[int] = []
     ys: list[int] = []
+    arcs: list[Arc] = []
     eps = MOVE_EPS_MM
     here = start
     for cut in cuts:
@@ -89,28 +95,81 @@ def count_reversals(cuts: Sequence[Cut], start: Point) -> tuple[int, int]:
         to = path.start
         # the rapid here → to as a line (segment_signs of Line(here, to)), then the path
         dx, dy = to[0] - here[0], to[1] - here[1]
-        if dx > eps or dx < -eps:
-            xs.append(1 if dx > 0 else -1)
-        if dy > eps or dy < -eps:
-            ys.append(1 if dy > 0 else -1)
+        xs.append(0 if -eps <= dx <= eps else (1 if dx > 0 else -1))
+        ys.append(0 if -eps <= dy <= eps else (1 if dy > 0 else -1))
         for seg in path.segments:  # segment_signs, inlined: ~150 000 segments a drawing
             if isinstance(seg, Line):
                 dx, dy = seg.end[0] - seg.start[0], seg.end[1] - seg.start[1]
-                if dx > eps or dx < -eps:
-                    xs.append(1 if dx > 0 else -1)
-                if dy > eps or dy < -eps:
-                    ys.append(1 if dy > 0 else -1)
+                xs.append(0 if -eps <= dx <= eps else (1 if dx > 0 else -1))
+                ys.append(0 if -eps <= dy <= eps else (1 if dy > 0 else -1))
             else:
-                sx, sy = seg.axis_signs
-                xs += sx
-                ys += sy
+                xs.append(_ARC)
+                ys.append(_ARC)
+                arcs.append(seg)
         here = path.end
-    return _changes(xs), _changes(ys)
+    start_angle = np.fromiter((a.start_angle for a in arcs), np.float64, len(arcs))
+    sweep = np.fromiter((a.sweep for a in arcs), np.float64, len(arcs))
+    rx = _changes(np.array(xs, np.int8), *_arc_runs(start_angle, sweep, 0.0))
+    ry = _changes(np.array(ys, np.int8), *_arc_runs(start_angle, sweep, math.pi / 2))
+    return rx, ry
 
 
-def _changes(signs: list[int]) -> int:
-    """How many times ``signs`` changes value (runs less one; 0 for none)."""
-    return sum(1 for _ in itertools.groupby(signs)) - 1 if signs else 0
+_ARC = 2
+"""The mark of an arc among :func:`count_reversals`' line directions."""
+
+
+def _arc_runs(
+    start_angle: npt.NDArray[np.float64], sweep: npt.NDArray[np.float64], phase: float
+) -> tuple[npt.NDArray[np.int8], npt.NDArray[np.int8], int]:
+    """First and last direction (+1/-1) of one axis along each arc, and its reversals inside.
+
+    :func:`~camtool.model.shapes.arc_axis_signs` of every arc at once, the same floats
+    in the same order: X for ``phase`` 0, Y for π/2; ``start_angle`` and ``sweep`` are
+    the arcs' (radians, ``(N,)``). An arc has at most two turning points inside it (a
+    half turn apart), so at most three pieces; the third value is how many times the
+    direction changes from piece to piece, summed over the arcs.
+    """
+    s = np.where(sweep > 0, 1.0, -1.0)
+    total = np.abs(sweep)
+    inside = []  # each turning point's distance along the arc (rad), NaN where not inside
+    for q in (phase, phase + math.pi):
+        d = (s * (q - start_angle)) % TAU
+        inside.append(np.where((d > SIGN_EPS) & (d < total - SIGN_EPS), d, np.nan))
+    low, high = np.fmin(*inside), np.fmax(*inside)
+    zero = np.zeros_like(total)
+
+    def direction(b0: npt.NDArray[np.float64], b1: npt.NDArray[np.float64]) -> npt.NDArray[np.int8]:
+        """The direction in the middle of the piece from ``b0`` to ``b1`` (rad along)."""
+        v = -s * np.sin(start_angle + s * (b0 + b1) / 2 - phase)
+        return np.where(v > 0, 1, -1).astype(np.int8)
+
+    first = direction(zero, np.where(np.isnan(low), total, low))
+    last = direction(np.where(np.isnan(high), zero, high), total)
+    two = low < high  # both inside (False where either is NaN)
+    middle = direction(np.where(two, low, zero), np.where(two, high, total))
+    one = ~np.isnan(low) & ~two
+    turns = np.count_nonzero(two & (first != middle)) + np.count_nonzero(two & (middle != last))
+    return first, last, int(turns + np.count_nonzero(one & (first != last)))
+
+
+def _changes(
+    directions: npt.NDArray[np.int8],
+    first: npt.NDArray[np.int8],
+    last: npt.NDArray[np.int8],
+    inside: int,
+) -> int:
+    """Reversals of one axis: ``directions`` of every motion (see :func:`count_reversals`).
+
+    The arcs (marked :data:`_ARC`, in order) start with ``first``, end with ``last`` and
+    reverse ``inside`` times within them; a motion of 0 (the axis still) keeps the
+    direction.
+    """
+    arc = directions == _ARC
+    starts, ends = directions.copy(), directions.copy()
+    starts[arc], ends[arc] = first, last
+    moving = starts != 0
+    starts, ends = starts[moving], ends[moving]
+    return inside + int(np.count_nonzero(ends[:-1] != starts[1:]))
 
 
 @dataclass(frozen=True)

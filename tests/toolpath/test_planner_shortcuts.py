@@ -3,7 +3,7 @@
 Each is compared on many random inputs, for exact equality (every float's bits, not
 approximately): :meth:`Track.pieces` (which skips the segments before ``s0`` and stops
 after ``s1``) with a walk over every segment of every lap; :func:`segment_signs` (kept
-on the arc) and :func:`count_reversals` (rapids and arcs by their kept signs) with the
+on the arc) and :func:`count_reversals` (every arc's signs at once, in arrays) with the
 signs computed afresh; :meth:`Arc.bbox` (quadrant cosines computed once) with the
 per-call formula; :func:`sub_segment` on a whole segment (the segment itself) with the
 piece rebuilt from its ends; a shifted move with ``dataclasses.replace``'s.
