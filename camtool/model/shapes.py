@@ -280,8 +280,18 @@ class Arc:
 
     def bbox(self) -> BBox:
         """Bounding box, including the extreme points of the circle the arc passes."""
-        xs = [self.start[0], self.end[0]]
-        ys = [self.start[1], self.end[1]]
+        # min()/max() of [start, end, the extremes passed], kept as they go (the same
+        # floats: a later value replaces only a strictly smaller/larger one)
+        (x0, y0), (ex, ey) = self.start, self.end
+        x1, y1 = x0, y0
+        if ex < x0:
+            x0 = ex
+        elif ex > x1:
+            x1 = ex
+        if ey < y0:
+            y0 = ey
+        elif ey > y1:
+            y1 = ey
         cx, cy = self.centre
         r = self.radius
         a0, sweep = self.start_angle, self.sweep
@@ -291,9 +301,16 @@ class Arc:
             # distance travelled along the sweep direction to reach angle `quad`
             delta = (quad - a0) % TAU if ccw else (a0 - quad) % TAU
             if delta <= span:
-                xs.append(cx + r * cos_q)
-                ys.append(cy + r * sin_q)
-        return (min(xs), min(ys), max(xs), max(ys))
+                x, y = cx + r * cos_q, cy + r * sin_q
+                if x < x0:
+                    x0 = x
+                elif x > x1:
+                    x1 = x
+                if y < y0:
+                    y0 = y
+                elif y > y1:
+                    y1 = y
+        return (x0, y0, x1, y1)
 
     def points(self, tolerance: float) -> list[Point]:
         """Polyline through the arc (or its :attr:`spiral`), each chord within ``tolerance`` mm."""
