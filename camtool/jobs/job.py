@@ -34,6 +34,9 @@ MAX_TOOL_NUMBER = 99_999
 
 MAX_JOB_BYTES = 1_000_000
 """Largest job file read (a job of a thousand operations is a few hundred kB)."""
+MAX_DRAWN_DIAMETER_MM = 1e6
+"""Largest circle diameter a selection names, mm as drawn: a drawing in metres (a site plan,
+scaled down by ``fit``) has circles of metres, which ``camtool job init`` names as they are."""
 
 
 @checked_keywords()
@@ -113,7 +116,7 @@ class Selection:
             if not isinstance(span, tuple) or len(span) != 2:
                 raise UsageError(f"Selection.{name} must be (min, max) in mm, got {span!r}")
             for value in span:
-                _check_number(f"Selection.{name}", value, "mm", low=0.0, high=1000.0)
+                _check_number(f"Selection.{name}", value, "mm", low=0.0, high=MAX_DRAWN_DIAMETER_MM)
             if span[0] > span[1]:
                 raise UsageError(
                     f"Selection.{name} must be (min, max) with min ≤ max, got {span!r}"

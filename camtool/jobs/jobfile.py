@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from camtool.jobs.job import (
+    MAX_DRAWN_DIAMETER_MM,
     MAX_JOB_BYTES,
     MAX_TOOL_NUMBER,
     OPERATION_TYPES,
@@ -332,12 +333,12 @@ def _diameters(value: Any, source: str, where: str) -> tuple[float, float] | Non
             raise InputError(
                 f"{source}: {where} diameter = {value!r}; give one diameter or [min, max] in mm"
             )
-        lo = _number(value[0], source, f"{where} diameter", low=0.0, high=1e6)
-        hi = _number(value[1], source, f"{where} diameter", low=0.0, high=1e6)
+        lo = _number(value[0], source, f"{where} diameter", low=0.0, high=MAX_DRAWN_DIAMETER_MM)
+        hi = _number(value[1], source, f"{where} diameter", low=0.0, high=MAX_DRAWN_DIAMETER_MM)
         if lo > hi:
             raise InputError(f"{source}: {where} diameter = [{lo:g}, {hi:g}]: min above max")
         return (lo, hi)
-    d = _number(value, source, f"{where} diameter", low=0.0, high=1e6)
+    d = _number(value, source, f"{where} diameter", low=0.0, high=MAX_DRAWN_DIAMETER_MM)
     return (d, d)
 
 

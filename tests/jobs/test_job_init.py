@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 import tomllib
 from pathlib import Path
 
@@ -420,3 +421,50 @@ def test_shaper_s_cut_depths_are_the_operations_depths(tmp_path: Path) -> None:
         "shaper pocket 10mm": ("pocket", 10),
     }
     assert text.count("# Shaper's cut depth") == 3
+
+
+def test_a_site_plan_in_metres_far_from_zero_is_drilled_where_its_circles_are(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A drawing in metres, millions of mm from 0 (map coordinates), with circles over 1 m.
+
+    ``job init`` names the circles as drawn (ø1.5 m = 1500 mm) and fits the plan into the
+    travel; ``post --job`` must take the job it wrote: the diameter selects the circles, and
+    the tool's place between operations is a point of the drawing, however far from 0.
+    The holes' positions, by analysis: the same direction as drawn, at most the travel apart.
+    """
+    import ezdxf
+
+    from camtool.cli.main import main
+
+    doc = ezdxf.new(units=6)  # $INSUNITS 6: metres
+    msp = doc.modelspace()
+    x0, y0 = 3438.0, 1725.0  # m: 3.4e6 mm from 0
+    msp.add_lwpolyline(
+        [(x0, y0), (x0 + 200, y0), (x0 + 200, y0 + 150), (x0, y0 + 150)],
+        close=True,
+        dxfattribs={"layer": "SITE"},
+    )
+    for cx, cy in ((x0 + 50, y0 + 40), (x0 + 150, y0 + 100)):
+        msp.add_circle((cx, cy), 0.75, dxfattribs={"layer": "WELLS"})
+    drawing = tmp_path / "site.dxf"
+    doc.saveas(drawing)
+    job = tmp_path / "site.toml"
+    assert main(["job", "init", str(drawing), "-t", "grbl", "-o", str(job)]) == 0
+    assert "diameter = 1500" in job.read_text()
+    out = tmp_path / "site.nc"
+    code = main(["post", str(drawing), "--job", str(job), "-t", "grbl", "-o", str(out)])
+    assert code == 0, capsys.readouterr().err
+    loads = re.compile(r"\(program \d+ of \d+: load T\d+ drill ")
+    (drill,) = [p for p in tmp_path.glob("site.T*.nc") if loads.search(p.read_text())]
+    lines = drill.read_text().splitlines()
+    holes = []  # a rapid to XY, down to safe Z, then feed down: a hole's first peck
+    for k, line in enumerate(lines[:-2]):
+        xy = re.fullmatch(r"G0 X(-?[\d.]+) Y(-?[\d.]+)", line)
+        if xy and lines[k + 1].startswith("G0 Z") and lines[k + 2].startswith("G1 Z"):
+            holes.append((float(xy[1]), float(xy[2])))
+    holes = sorted(set(holes))
+    assert len(holes) == 2, holes
+    (ax, ay), (bx, by) = holes
+    assert all(0.0 <= v <= 200.0 for v in (ax, ay, bx, by))  # GRBL's 200 × 200 mm travel
+    assert math.atan2(by - ay, bx - ax) == pytest.approx(math.atan2(60.0, 100.0), abs=1e-4)
