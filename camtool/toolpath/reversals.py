@@ -165,11 +165,11 @@ def _changes(
     direction.
     """
     arc = directions == _ARC
-    starts, ends = directions.copy(), directions.copy()
-    starts[arc], ends[arc] = first, last
-    moving = starts != 0
-    starts, ends = starts[moving], ends[moving]
-    return inside + int(np.count_nonzero(ends[:-1] != starts[1:]))
+    heads, tails = directions.copy(), directions.copy()  # each motion's first, last
+    heads[arc], tails[arc] = first, last
+    moving = heads != 0
+    heads, tails = heads[moving], tails[moving]
+    return inside + int(np.count_nonzero(tails[:-1] != heads[1:]))
 
 
 @dataclass(frozen=True)
