@@ -104,8 +104,16 @@ def check_numbers(entity: Any, label: str, layer: str, limit: float) -> None:
     """
     what = _bad_number(entity, limit)
     if what is not None:
+        text, finite = what
+        if finite:  # a drawing in map coordinates (UTM northings are thousands of km)
+            raise BadEntity(
+                f"{label} on layer {layer!r}: {text}, beyond ±{_short(limit)} drawing units "
+                "from 0, as far as camtool plans with sub-micrometre precision; move the "
+                "drawing near 0 in the CAD program (a plan in map coordinates) or fix the "
+                "entity, and export again"
+            )
         raise BadEntity(
-            f"{label} on layer {layer!r}: {what}, not a finite number within ±{_short(limit)} "
+            f"{label} on layer {layer!r}: {text}, not a finite number within ±{_short(limit)} "
             "(drawing units); the file is damaged: fix or delete the entity in the CAD "
             "program and export again"
         )
@@ -117,8 +125,12 @@ def check_numbers(entity: Any, label: str, layer: str, limit: float) -> None:
         )
 
 
-def _bad_number(entity: Any, limit: float) -> str | None:
-    """``"<attribute> <value>"`` of the first number out of range, else None."""
+def _bad_number(entity: Any, limit: float) -> tuple[str, bool] | None:
+    """The first number out of range, else None.
+
+    Returns ``("<attribute> <value>", finite)``: ``finite`` when its numbers are all finite
+    (then only too large: a drawing far from 0), not when one is NaN or infinite.
+    """
     from ezdxf.math import Vec2, Vec3
 
     kind = entity.dxftype()
@@ -129,25 +141,27 @@ def _bad_number(entity: Any, limit: float) -> str | None:
     for name, value in entity.dxf.all_existing_dxf_attribs().items():
         if isinstance(value, float):
             if not abs(value) <= limit:
-                return f"{name} {value:g}"
+                return f"{name} {value:g}", math.isfinite(value)
         elif (
             isinstance(value, tuple | Vec2 | Vec3)
             and all(isinstance(v, float) for v in value)
             and not all(abs(v) <= limit for v in value)
         ):
-            return f"{name} ({', '.join(f'{v:g}' for v in value)})"
+            return f"{name} ({', '.join(f'{v:g}' for v in value)})", all(
+                math.isfinite(v) for v in value
+            )
     for name, rows in _arrays(entity):
         values = np.asarray(rows, dtype=float)
         if values.size and not bool((np.abs(values) <= limit).all()):
             values = values.reshape(len(values), -1)
             k = int(np.flatnonzero(~(np.abs(values) <= limit).all(axis=1))[0])
             shown = ", ".join(f"{v:g}" for v in values[k])
-            return f"{name} {k + 1} ({shown})"
+            return f"{name} {k + 1} ({shown})", bool(np.isfinite(values[k]).all())
     if kind == "POLYLINE":
         for k, vertex in enumerate(entity.vertices, start=1):
             what = _bad_number(vertex, limit)
             if what is not None:
-                return f"vertex {k} {what}"
+                return f"vertex {k} {what[0]}", what[1]
     return None
 
 

@@ -116,6 +116,24 @@ def test_a_line_with_a_bad_coordinate_is_an_input_error(tmp_path: Path, value: s
     assert "\n" not in message
 
 
+@pytest.mark.parametrize(
+    ("value", "far"),
+    [("5.4e9", True), ("2e9", True), ("1e300", True), ("nan", False), ("-inf", False)],
+)
+def test_a_number_too_large_is_told_apart_from_one_not_a_number(
+    tmp_path: Path, value: str, far: bool
+) -> None:
+    """A finite coordinate past the bound is a drawing far from 0 (a plan in map
+    coordinates: UTM northings are thousands of km), told to be moved near 0; NaN and
+    infinity are a damaged file."""
+    path = _text_dxf(tmp_path / "a.dxf", header=_insunits(4), x1=value)
+    with pytest.raises(InputError) as info:
+        read_dxf(path)
+    message = str(info.value)
+    assert ("move the drawing near 0" in message) is far
+    assert ("the file is damaged" in message) is not far
+
+
 def _one(build: Callable[[Any], None]) -> Callable[[Any], None]:
     def add(msp: Any) -> None:
         msp.add_line((0, 0), (10, 0))
