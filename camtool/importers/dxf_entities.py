@@ -117,10 +117,10 @@ def check_numbers(entity: Any, label: str, layer: str, limit: float) -> None:
             "(drawing units); the file is damaged: fix or delete the entity in the CAD "
             "program and export again"
         )
-    what = _bad_shape(entity)
-    if what is not None:
+    shape = _bad_shape(entity)
+    if shape is not None:
         raise BadEntity(
-            f"{label} on layer {layer!r}: {what}; the file is damaged: fix or delete the "
+            f"{label} on layer {layer!r}: {shape}; the file is damaged: fix or delete the "
             "entity in the CAD program and export again"
         )
 
