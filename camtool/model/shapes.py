@@ -282,16 +282,9 @@ class Arc:
         """Bounding box, including the extreme points of the circle the arc passes."""
         # min()/max() of [start, end, the extremes passed], kept as they go (the same
         # floats: a later value replaces only a strictly smaller/larger one)
-        (x0, y0), (ex, ey) = self.start, self.end
-        x1, y1 = x0, y0
-        if ex < x0:
-            x0 = ex
-        elif ex > x1:
-            x1 = ex
-        if ey < y0:
-            y0 = ey
-        elif ey > y1:
-            y1 = ey
+        (sx, sy), (ex, ey) = self.start, self.end
+        x0, x1 = (ex if ex < sx else sx), (ex if ex > sx else sx)
+        y0, y1 = (ey if ey < sy else sy), (ey if ey > sy else sy)
         cx, cy = self.centre
         r = self.radius
         a0, sweep = self.start_angle, self.sweep

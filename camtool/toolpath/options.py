@@ -239,8 +239,9 @@ class PlanOptions:
             if name.endswith("_deg") or name == "stepover":
                 continue  # checked against their own ranges below
             if name == "origin":
-                continue  # a point of the drawing's own frame (a job's tool between
-                # operations), not a length: a site plan in metres lies 1e6 mm and more from 0
+                # a point of the drawing's own frame (a job's tool between operations),
+                # not a length: a site plan in metres lies 1e6 mm and more from 0
+                continue
             if abs(value) > limit:
                 raise UsageError(
                     f"{flag(name)} {value:g} is beyond ±{limit:g}"
