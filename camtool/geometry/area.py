@@ -30,7 +30,10 @@ def enclosed(points: Sequence[tuple[float, float]]) -> BaseGeometry:
     ``buffer(0)`` does. One that does is noded where it crosses itself (GEOS), its faces
     made (shapely's ``polygonize``), and the faces it winds around at least once, either
     way, united: both lobes of a bow-tie, the centre of a five-pointed star; a face it
-    winds around once each way (a loop drawn back over itself) is left out. Where GEOS's
+    winds around once each way (a loop drawn back over itself) is left out, and so is a
+    face less than :data:`NODING_GRID_MM` wide on average (twice its area over its
+    perimeter): the slivers between an arc's chords drawn one way and back the other,
+    whose points differ by roundings. Where GEOS's
     noder does not converge (a small arc drawn there and back over itself, as boxes.py draws
     its corners), the line is noded by snap-rounding on a :data:`NODING_GRID_MM` grid.
 
@@ -57,7 +60,12 @@ def enclosed(points: Sequence[tuple[float, float]]) -> BaseGeometry:
         # a rounding (a corner arc drawn there and back); snap-rounding always converges.
         noded = shapely.union_all([LineString(ring)], grid_size=NODING_GRID_MM)
     faces = shapely.get_parts(shapely.polygonize(shapely.get_parts(noded)))
-    kept = [face for face in faces if winding(ring, face.representative_point().coords[0]) != 0]
+    kept = [
+        face
+        for face in faces
+        if 2.0 * face.area > face.length * NODING_GRID_MM  # wider than a rounding, on average
+        and winding(ring, face.representative_point().coords[0]) != 0
+    ]
     if not kept:
         return Polygon()
     return shapely.union_all(kept)

@@ -142,7 +142,14 @@ def pocket(
     findings[:0] = [
         *open_left_out(contours, "--offset pocket"),
         *(_no_area(contours[i]) for i in no_area),
-        *filter(None, (self_crossing(contours[i], options.tolerance, "pocket") for i in invalid)),
+        *filter(
+            None,
+            (
+                self_crossing(contours[i], options.tolerance, "pocket")
+                for i in invalid
+                if i not in no_area  # drawn there and back: said so above
+            ),
+        ),
         *overlaps(contours, nest, outlines),
     ]
     return Stage(tuple(cuts), tuple(findings))

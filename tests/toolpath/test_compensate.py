@@ -255,6 +255,22 @@ def test_a_closed_contour_without_area_vanishes_without_a_crash() -> None:
     assert "(20.0000, 5.0000)" in finding.message and "1 mm tool" in finding.message
 
 
+def test_an_arc_drawn_there_and_back_vanishes_as_a_line_does() -> None:
+    """Two copies of one ARC chain into a closed contour of no area (LibreCAD's
+    ``power_station/ed128.dxf`` draws its bottom half-circle twice). Its chords one way
+    and the other differ by roundings: the slivers between them are no area either.
+    Before, the outside offset cut five short slots along the arc, with exit 0.
+    """
+    ccw = Arc((20.0, 5.0), (30.0, 5.0), (25.0, 5.0), False)
+    there_and_back = Contour((ccw, Arc((30.0, 5.0), (20.0, 5.0), (25.0, 5.0), True)), True)
+    for side in ("outside", "inside"):
+        stage = _run([rect(0, 0, 50, 10), there_and_back], side, 1.0)
+        assert [c.group for c in stage.cuts] == [0]  # the part is cut, nothing at the arc
+        (finding,) = [f for f in stage.findings if f.kind == "offset-vanished"]
+        assert finding.at == (20.0, 5.0) and finding.value == 0.0
+        assert not [f for f in stage.findings if f.kind in ("self-crossing", "offset-fallback")]
+
+
 def test_when_everything_vanishes_planning_stops_with_the_reason() -> None:
     with pytest.raises(ToolpathError, match=r"nothing left to cut.*narrower than the 3 mm tool"):
         _run([stadium(30, 40, 5, 1.0)], "inside", 3.0)

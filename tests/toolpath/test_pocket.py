@@ -385,3 +385,14 @@ def test_swept_area_of_a_long_path_is_the_buffer_of_the_whole_path() -> None:
     assert swept.area == pytest.approx(whole.area, rel=1e-9)
     assert swept.symmetric_difference(whole).area < 1e-6  # float noise of the cuts, mm²
     assert swept.area == pytest.approx(2 * r * LineString(pts).length + math.pi * r * r, rel=1e-3)
+
+
+def test_an_arc_drawn_there_and_back_is_a_pocket_of_no_area_not_one_that_crosses_itself() -> None:
+    # two copies of one ARC chained: no area to clear, said once (not also "crosses itself",
+    # which the chords one way and back, a rounding apart, made it look as if it did)
+    ccw = Arc((20.0, 5.0), (30.0, 5.0), (25.0, 5.0), False)
+    there_and_back = Contour((ccw, Arc((30.0, 5.0), (20.0, 5.0), (25.0, 5.0), True)), True)
+    stage = _plan([rect(0, 20, 50, 30), there_and_back], 1.0)
+    kinds = [f.kind for f in stage.findings if f.at == (20.0, 5.0)]
+    assert kinds == ["offset-vanished"]
+    assert not [f for f in stage.findings if f.kind == "self-crossing"]
