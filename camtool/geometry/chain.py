@@ -46,9 +46,13 @@ def chain_members(
 
     Closed contours pass through unchanged. Open contours are extended forwards
     then backwards, reversing a neighbour where its far end is the one that
-    meets; the first contour of a chain keeps its drawn direction. Layer, source,
-    colour and linetype of a chain are its first piece's; an open contour that joins
-    nothing is returned as it was (the same object).
+    meets; the first contour of a chain keeps its drawn direction. Where more than
+    two ends meet (a T, two rectangles drawn with a side in common), an open chain that
+    comes back to a point it passed is split there: the loop between is a closed contour
+    of its own (:func:`_loops`), not buried in an open chain a side offset leaves out. A
+    chain that closes stays one contour (two triangles tip to tip, one figure of eight).
+    Layer, source, colour and linetype of a chain are its first piece's (its lowest
+    index); an open contour that joins nothing is returned as it was (the same object).
 
     Args:
         contours: contours as read, mm.
@@ -57,7 +61,7 @@ def chain_members(
 
     Returns:
         The chained contours, in the order their first pieces were given, and for each
-        the indices in ``contours`` of its pieces (in the order they were joined).
+        the indices in ``contours`` of its pieces (in their order along it).
 
     Raises:
         GeometryError: an open contour's end is not finite (importers refuse
@@ -81,59 +85,171 @@ def chain_members(
         if index in used:
             continue
         used.add(index)
-        segs = list(contour.segments)
-        joined = [index]
-        _extend(segs, pieces, grid, used, joined, tolerance, forward=True)
-        _extend(segs, pieces, grid, used, joined, tolerance, forward=False)
-        members.append(tuple(joined))
+        parts: list[tuple[int, list[Segment]]] = [(index, list(contour.segments))]
+        _extend(parts, pieces, grid, used, tolerance, forward=True)
+        _extend(parts, pieces, grid, used, tolerance, forward=False)
+        segs = [seg for _, piece in parts for seg in piece]
         # One line cannot close on itself (zero-length lines are dropped on import);
         # one arc can: a full circle drawn as an ARC from 0° to 360°, not a speck.
-        meets = distance(segs[-1].end, segs[0].start) <= tolerance
-        closed = meets and (len(segs) > 1 or closes_alone(segs[0]))
-        if closed:
+        if _closes(segs, tolerance):
             segs[-1] = with_end(segs[-1], segs[0].start)
-        elif len(segs) == len(contour.segments):  # nothing joined: the contour as it was
-            result.append(contour)
+            result.append(_joined(segs, True, contour))
+            members.append(tuple(i for i, _ in parts))
             continue
-        result.append(
-            Contour(
-                tuple(segs), closed, contour.layer, contour.source, contour.colour, contour.linetype
-            )
-        )
+        if len(parts) == 1:
+            result.append(contour)  # nothing joined: the contour as it was
+            members.append((index,))
+            continue
+        if not _may_loop(parts, tolerance):
+            result.append(_joined(segs, False, contour))
+            members.append(tuple(i for i, _ in parts))
+            continue
+        for closed, run in sorted(
+            _loops(parts, tolerance), key=lambda cr: min(i for i, _ in cr[1])
+        ):
+            segs = [seg for _, piece in run for seg in piece]
+            if closed:
+                segs[-1] = with_end(segs[-1], segs[0].start)
+            first = pieces[min(i for i, _ in run)]  # the seed, where it is in the run
+            result.append(_joined(segs, closed, first))
+            members.append(tuple(i for i, _ in run))
     return result, members
 
 
+def _closes(segs: Sequence[Segment], tolerance: float) -> bool:
+    """Whether a run of segments ending within ``tolerance`` of its start is closed."""
+    meets = distance(segs[-1].end, segs[0].start) <= tolerance
+    return meets and (len(segs) > 1 or closes_alone(segs[0]))
+
+
+_FEW_JOINTS = 12
+"""Most joints :func:`_may_loop` compares pair by pair; more are binned in arrays."""
+
+
+def _may_loop(parts: list[tuple[int, list[Segment]]], tolerance: float) -> bool:
+    """Whether two joints of an open chain may be within ``tolerance`` of each other.
+
+    The joints are its ends and the points its pieces meet; a loop in it needs two of
+    them to meet (:func:`_loops`). Exact for a few joints; for more, two points within
+    ``tolerance`` share a cell of one of four grids of cells ``4 × tolerance`` wide (or
+    wider on a huge drawing), shifted by half a cell along X, Y or both, so a ``False``
+    is sure and a ``True`` only a maybe.
+    """
+    points = [parts[0][1][0].start, *(piece[-1].end for _, piece in parts)]
+    if len(points) <= _FEW_JOINTS:
+        return any(
+            distance(p, q) <= tolerance for i, p in enumerate(points) for q in points[i + 1 :]
+        )
+    import numpy as np  # here: a re-post of lines chains nothing this long, and loads none
+
+    xy = np.array(points, dtype=float)
+    size = max(4.0 * tolerance, float(np.abs(xy).max()) / _MAX_CELLS) or 1.0
+    for shift in ((0.0, 0.0), (0.5, 0.0), (0.0, 0.5), (0.5, 0.5)):
+        cells = np.floor(xy / size + shift)  # whole numbers within ±2⁴⁰: exact
+        keys = cells[:, 0] + 1j * cells[:, 1]
+        if len(np.unique(keys)) < len(keys):
+            return True
+    return False
+
+
+def _joined(segs: list[Segment], closed: bool, first: Contour) -> Contour:
+    """A chain of ``segs`` named and styled as its piece ``first``."""
+    return Contour(tuple(segs), closed, first.layer, first.source, first.colour, first.linetype)
+
+
+def _loops(
+    parts: list[tuple[int, list[Segment]]], tolerance: float
+) -> list[tuple[bool, list[tuple[int, list[Segment]]]]]:
+    """An open chain's pieces as closed loops and what is left of the chain.
+
+    Where several pieces' ends meet at one point (a drawing's T or X, two rectangles
+    sharing a side), the chain follows one of them and may come back to a point it has
+    passed: the pieces between are a closed loop in the chain. Each such loop is taken
+    out as a closed contour (the latest point met again first, so the smallest loops),
+    and the pieces left join where it was (the next one moved by at most ``tolerance``
+    onto the end before it). Only the points where pieces meet count, not the vertices
+    inside a piece (a polyline drawn crossing itself stays one contour).
+
+    Args:
+        parts: the chain's pieces in order, each (index, its segments, oriented and
+            snapped end to start).
+        tolerance: the chaining distance, mm.
+
+    Returns:
+        ``(closed, pieces)`` per contour: the loops taken out, then the chain's rest
+        (closed when it ends where it starts), if anything is left.
+    """
+    reach = max(max(abs(v) for v in (*piece[0].start, *piece[-1].end)) for _, piece in parts)
+    size = max(tolerance, reach / _MAX_CELLS) or 1.0
+    out: list[tuple[bool, list[tuple[int, list[Segment]]]]] = []
+    stack: list[tuple[int, list[Segment]]] = []
+    starts: dict[tuple[int, int], list[int]] = defaultdict(list)  # cell → stack positions
+
+    def cell(p: Point) -> tuple[int, int]:
+        return (math.floor(p[0] / size), math.floor(p[1] / size))
+
+    def met(p: Point) -> int | None:
+        """The latest stack position whose start meets ``p`` and closes a loop there."""
+        cx, cy = cell(p)
+        best = None
+        for dx in (-1, 0, 1):
+            for dy in (-1, 0, 1):
+                for k in starts.get((cx + dx, cy + dy), ()):
+                    if (best is None or k > best) and distance(
+                        stack[k][1][0].start, p
+                    ) <= tolerance:
+                        last = stack[k][1]  # a loop of one piece: as a chain of one closes
+                        if k < len(stack) - 1 or len(last) > 1 or closes_alone(last[0]):
+                            best = k
+        return best
+
+    for index, segs in parts:
+        if stack and segs[0].start != stack[-1][1][-1].end:
+            segs = [with_start(segs[0], stack[-1][1][-1].end), *segs[1:]]
+        starts[cell(segs[0].start)].append(len(stack))
+        stack.append((index, segs))
+        k = met(segs[-1].end)
+        if k is not None:
+            out.append((True, stack[k:]))
+            for gone in range(k, len(stack)):
+                starts[cell(stack[gone][1][0].start)].remove(gone)
+            del stack[k:]
+    if stack:
+        rest = [seg for _, piece in stack for seg in piece]
+        out.append((_closes(rest, tolerance), stack))
+    return out
+
+
 def _extend(
-    segs: list[Segment],
+    parts: list[tuple[int, list[Segment]]],
     pieces: Sequence[Contour],
     grid: _EndGrid,
     used: set[int],
-    joined: list[int],
     tolerance: float,
     *,
     forward: bool,
 ) -> None:
     while True:
-        here = segs[-1].end if forward else segs[0].start
-        if not forward and distance(here, segs[-1].end) <= tolerance and len(segs) > 1:
+        here = parts[-1][1][-1].end if forward else parts[0][1][0].start
+        several = len(parts) > 1 or len(parts[0][1]) > 1
+        if not forward and several and distance(here, parts[-1][1][-1].end) <= tolerance:
             return  # already closed
         found = grid.nearest(here, used)
         if found is None:
             return
         index, at_start = found
         used.add(index)
-        joined.append(index)
         piece = pieces[index]
         if forward:
             nxt = piece if at_start else piece.reversed()
             new = list(nxt.segments)
             new[0] = with_start(new[0], here)
-            segs.extend(new)
+            parts.append((index, new))
         else:
             prv = piece.reversed() if at_start else piece
             new = list(prv.segments)
             new[-1] = with_end(new[-1], here)
-            segs[:0] = new
+            parts.insert(0, (index, new))
 
 
 def with_start(seg: Segment, p: Point) -> Segment:

@@ -1,11 +1,18 @@
-"""Chaining keeps what it does not join: the same objects, and a chain's first piece's style."""
+"""Chaining keeps what it does not join (the same objects, a chain's first piece's style) and takes
+the loops an open chain passes through out as closed contours."""
 
 from __future__ import annotations
 
+import itertools
 import math
 
-from camtool.geometry.chain import chain, with_end, with_start
+import pytest
+
+from camtool.geometry.area import enclosed
+from camtool.geometry.chain import chain, chain_members, with_end, with_start
 from camtool.model.shapes import Arc, Contour, Line
+from camtool.toolpath.options import PlanOptions
+from camtool.toolpath.plan import chained
 
 
 def test_a_contour_that_joins_nothing_is_returned_as_it_was() -> None:
@@ -85,3 +92,120 @@ def test_a_speck_chain_closed_by_moving_its_arc_back_cuts_no_circle() -> None:
     out = chain([Contour((Line(a, speck.start),), False), Contour((speck,), False)], 0.01)
     assert len(out) == 1
     assert sum(s.length for s in out[0].segments) < 0.02
+
+
+# -- a loop the chain passes through: taken out closed ------------------------------------------
+
+
+def _lines(ends: list[tuple[tuple[float, float], tuple[float, float]]]) -> list[Contour]:
+    return [Contour((Line(a, b),), False, "0", f"LINE #{k}") for k, (a, b) in enumerate(ends, 1)]
+
+
+def _continuous(contour: Contour) -> bool:
+    segs = contour.segments
+    inner = all(a.end == b.start for a, b in itertools.pairwise(segs))
+    return inner and (not contour.closed or segs[-1].end == segs[0].start)
+
+
+def test_a_square_with_a_tail_at_its_corner_is_a_closed_square_and_an_open_tail() -> None:
+    # The tail comes first, so the chain starts on it, runs round the square back to (0, 0)
+    # and ends there: one open chain with the square inside, which a side offset left out.
+    pieces = _lines(
+        [
+            ((-1.0, 0.0), (0.0, 0.0)),
+            ((0.0, 0.0), (1.0, 0.0)),
+            ((1.0, 0.0), (1.0, 1.0)),
+            ((1.0, 1.0), (0.0, 1.0)),
+            ((0.0, 1.0), (0.0, 0.0)),
+        ]
+    )
+    joined, members = chain_members(pieces, 0.01)
+    assert [c.closed for c in joined] == [False, True]
+    assert members[0] == (0,) and sorted(members[1]) == [1, 2, 3, 4]
+    tail, square = joined
+    assert tail.source == "LINE #1" and square.source == "LINE #2"  # its lowest piece
+    assert len(square.segments) == 4 and _continuous(square)
+    assert abs(enclosed(square.points(0.01)).area - 1.0) < 1e-12
+
+
+def test_a_loop_closing_a_joint_off_its_start_is_closed_exactly_and_the_rest_joins_on() -> None:
+    # The square's last side ends 0.006 mm short of (0, 0), within the 0.01 mm joint;
+    # a line then leaves from there: the line must start where the rest of the chain ends.
+    pieces = _lines(
+        [
+            ((-1.0, 0.0), (0.0, 0.0)),
+            ((0.0, 0.0), (1.0, 0.0)),
+            ((1.0, 0.0), (1.0, 1.0)),
+            ((1.0, 1.0), (0.0, 1.0)),
+            ((0.0, 1.0), (0.0, 0.006)),
+            ((0.0, 0.006), (0.0, -2.0)),
+        ]
+    )
+    joined, members = chain_members(pieces, 0.01)
+    assert [c.closed for c in joined] == [False, True]
+    rest, square = joined
+    assert sorted(members[0]) == [0, 5] and sorted(members[1]) == [1, 2, 3, 4]
+    assert _continuous(rest) and _continuous(square)
+    assert [s.start for s in rest.segments] == [(-1.0, 0.0), (0.0, 0.0)]
+    assert rest.end == (0.0, -2.0) and square.start == (0.0, 0.0)
+
+
+def test_three_bands_drawn_as_lines_give_two_closed_bands_and_the_middle_s_open_sides() -> None:
+    # A DIP-8 footprint's silkscreen (fritzing-parts' svg/core/pcb/sparkfun-digitalic_dil08_
+    # pcb.svg, in its SVG units, Y down): a 10.16 mm square cut into three bands by two
+    # lines across, its left side notched by a semicircle. The top band comes first and
+    # closes; the chain from the bottom band's first line runs round the bottom band and,
+    # at its corner (10.2616, 7.6962), on up the middle band's right side: the bottom band
+    # was buried in an open chain, which a side offset leaves out.
+    x0, x1, ys = 0.1016, 10.2616, (0.0762, 2.6162, 7.6962, 10.2362)
+    ends = [
+        ((x1, ys[0]), (x0, ys[0])),
+        ((x0, ys[3]), (x1, ys[3])),
+        ((x1, ys[0]), (x1, ys[1])),
+        ((x0, ys[0]), (x0, ys[1])),
+        ((x0, ys[3]), (x0, ys[2])),
+        ((x0, ys[1]), (x1, ys[1])),
+        ((x0, ys[1]), (x0, 4.1402)),
+        ((x1, ys[1]), (x1, ys[2])),
+        ((x0, ys[2]), (x1, ys[2])),
+        ((x0, ys[2]), (x0, 6.1722)),
+        ((x1, ys[2]), (x1, ys[3])),
+    ]
+    pieces = _lines(ends)
+    notch = Arc((x0, 6.1722), (x0, 4.1402), (x0, 5.1562), True)
+    pieces.insert(5, Contour((notch,), False, "0", "path[1]"))
+    joined = chain(pieces, 0.01)
+    closed = sorted(c.bbox() for c in joined if c.closed)
+    band = pytest.approx
+    assert closed == [band((x0, ys[0], x1, ys[1])), band((x0, ys[2], x1, ys[3]))]
+    assert all(_continuous(c) for c in joined)
+    sides = {frozenset((c.start, c.end)): c for c in joined if not c.closed}
+    right, left = frozenset({(x1, ys[1]), (x1, ys[2])}), frozenset({(x0, ys[1]), (x0, ys[2])})
+    assert set(sides) == {right, left}
+    assert len(sides[right].segments) == 1 and len(sides[left].segments) == 3
+    assert sum(len(c.segments) for c in joined) == len(pieces)
+    # what --offset outside leaves out: the middle band's sides (the notch is piece 5)
+    left_out = chained(pieces, PlanOptions(offset="outside", tool_diameter=0.2))[2]
+    assert left_out == {5, 7, 8, 10}
+
+
+def test_a_chain_that_closes_through_a_point_it_passes_stays_one_figure_of_eight() -> None:
+    # two triangles tip to tip drawn as one run of six lines, as LibreCAD's Gunn diode
+    tip = (0.0, 20.0)
+    corners = [tip, (-5.0, 10.0), (5.0, 10.0), tip, (-5.0, 30.0), (5.0, 30.0), tip]
+    pieces = _lines(list(itertools.pairwise(corners)))
+    ((joined,), members) = chain_members(pieces, 0.01)
+    assert joined.closed and len(joined.segments) == 6 and sorted(members[0]) == list(range(6))
+
+
+def test_a_long_tail_s_loop_is_found_among_many_joints() -> None:
+    # 15 lines of zigzag, then a unit square at its end: 20 joints, more than are
+    # compared pair by pair, so the loop is first found by binning them in grids
+    zig = [(float(k), float(k % 2)) for k in range(16)]
+    x, y = zig[-1]
+    corners = [(x, y), (x + 1.0, y), (x + 1.0, y + 1.0), (x, y + 1.0), (x, y)]
+    ends = list(itertools.pairwise(zig)) + list(itertools.pairwise(corners))
+    joined, members = chain_members(_lines(ends), 0.001)
+    assert [c.closed for c in joined] == [False, True]
+    assert members[0] == tuple(range(15)) and sorted(members[1]) == [15, 16, 17, 18]
+    assert joined[1].bbox() == (x, y, x + 1.0, y + 1.0)
