@@ -107,18 +107,19 @@ def _continuous(contour: Contour) -> bool:
     return inner and (not contour.closed or segs[-1].end == segs[0].start)
 
 
+TAIL_AND_THREE_SIDES = [
+    ((-1.0, 0.0), (0.0, 0.0)),
+    ((0.0, 0.0), (1.0, 0.0)),
+    ((1.0, 0.0), (1.0, 1.0)),
+    ((1.0, 1.0), (0.0, 1.0)),
+]
+"""A 1 mm tail ending at (0, 0), then a unit square's sides from there, all but the last."""
+
+
 def test_a_square_with_a_tail_at_its_corner_is_a_closed_square_and_an_open_tail() -> None:
     # The tail comes first, so the chain starts on it, runs round the square back to (0, 0)
     # and ends there: one open chain with the square inside, which a side offset left out.
-    pieces = _lines(
-        [
-            ((-1.0, 0.0), (0.0, 0.0)),
-            ((0.0, 0.0), (1.0, 0.0)),
-            ((1.0, 0.0), (1.0, 1.0)),
-            ((1.0, 1.0), (0.0, 1.0)),
-            ((0.0, 1.0), (0.0, 0.0)),
-        ]
-    )
+    pieces = _lines([*TAIL_AND_THREE_SIDES, ((0.0, 1.0), (0.0, 0.0))])
     joined, members = chain_members(pieces, 0.01)
     assert [c.closed for c in joined] == [False, True]
     assert members[0] == (0,) and sorted(members[1]) == [1, 2, 3, 4]
@@ -132,14 +133,7 @@ def test_a_loop_closing_a_joint_off_its_start_is_closed_exactly_and_the_rest_joi
     # The square's last side ends 0.006 mm short of (0, 0), within the 0.01 mm joint;
     # a line then leaves from there: the line must start where the rest of the chain ends.
     pieces = _lines(
-        [
-            ((-1.0, 0.0), (0.0, 0.0)),
-            ((0.0, 0.0), (1.0, 0.0)),
-            ((1.0, 0.0), (1.0, 1.0)),
-            ((1.0, 1.0), (0.0, 1.0)),
-            ((0.0, 1.0), (0.0, 0.006)),
-            ((0.0, 0.006), (0.0, -2.0)),
-        ]
+        [*TAIL_AND_THREE_SIDES, ((0.0, 1.0), (0.0, 0.006)), ((0.0, 0.006), (0.0, -2.0))]
     )
     joined, members = chain_members(pieces, 0.01)
     assert [c.closed for c in joined] == [False, True]
