@@ -48,8 +48,9 @@ def chain_members(
     then backwards, reversing a neighbour where its far end is the one that
     meets; the first contour of a chain keeps its drawn direction. Where more than
     two ends meet (a T, two rectangles drawn with a side in common), an open chain that
-    comes back to a point it passed is split there: the loop between is a closed contour
-    of its own (:func:`_loops`), not buried in an open chain a side offset leaves out. A
+    comes back to a point it passed (within :data:`LOOP_JOINT_MM`) is split there: the loop
+    between is a closed contour of its own (:func:`_loops`), not buried in an open chain a
+    side offset leaves out. A
     chain that closes stays one contour (two triangles tip to tip, one figure of eight).
     Layer, source, colour and linetype of a chain are its first piece's (its lowest
     index); an open contour that joins nothing is returned as it was (the same object).
@@ -100,17 +101,16 @@ def chain_members(
             result.append(contour)  # nothing joined: the contour as it was
             members.append((index,))
             continue
-        if not _may_loop(parts, tolerance):
+        meet = min(tolerance, LOOP_JOINT_MM)
+        if not _may_loop(parts, meet):
             result.append(_joined(segs, False, contour))
             members.append(tuple(i for i, _ in parts))
             continue
-        for closed, run in sorted(
-            _loops(parts, tolerance), key=lambda cr: min(i for i, _ in cr[1])
-        ):
+        for closed, run in sorted(_loops(parts, meet), key=lambda cr: min(i for i, _ in cr[1])):
             segs = [seg for _, piece in run for seg in piece]
             if closed:
                 segs[-1] = with_end(segs[-1], segs[0].start)
-            first = pieces[min(i for i, _ in run)]  # the seed, where it is in the run
+            first = pieces[min(i for i, _ in run)]  # its first drawn piece: the seed, if there
             result.append(_joined(segs, closed, first))
             members.append(tuple(i for i, _ in run))
     return result, members
@@ -120,6 +120,23 @@ def _closes(segs: Sequence[Segment], tolerance: float) -> bool:
     """Whether a run of segments ending within ``tolerance`` of its start is closed."""
     meets = distance(segs[-1].end, segs[0].start) <= tolerance
     return meets and (len(segs) > 1 or closes_alone(segs[0]))
+
+
+LOOP_JOINT_MM = 0.001
+"""Farthest apart (mm) two joints of an open chain are for it to close a loop there
+(:func:`_loops`), whatever the chaining tolerance: where pieces meet at a T or an X in a
+drawing their ends coincide, while a larger ``--chain-tolerance`` (to bridge gaps) would
+otherwise close a loop over every detail smaller than it (an arc of 0.2 mm LINEs at 0.5 mm
+would be cut as 30 triangles)."""
+
+
+def _cell_size(distance_mm: float, reach: float) -> float:
+    """Width of a square cell to bin points ``distance_mm`` apart in, mm.
+
+    ``distance_mm``, or wider on a drawing so large (``reach``, the largest coordinate)
+    that cell numbers would pass :data:`_MAX_CELLS`; 1.0 when both are 0.
+    """
+    return max(distance_mm, reach / _MAX_CELLS) or 1.0
 
 
 _FEW_JOINTS = 12
@@ -143,7 +160,7 @@ def _may_loop(parts: list[tuple[int, list[Segment]]], tolerance: float) -> bool:
     import numpy as np  # here: a re-post of lines chains nothing this long, and loads none
 
     xy = np.array(points, dtype=float)
-    size = max(4.0 * tolerance, float(np.abs(xy).max()) / _MAX_CELLS) or 1.0
+    size = _cell_size(4.0 * tolerance, float(np.abs(xy).max()))
     for shift in ((0.0, 0.0), (0.5, 0.0), (0.0, 0.5), (0.5, 0.5)):
         cells = np.floor(xy / size + shift)  # whole numbers within ±2⁴⁰: exact
         keys = cells[:, 0] + 1j * cells[:, 1]
@@ -172,15 +189,16 @@ def _loops(
 
     Args:
         parts: the chain's pieces in order, each (index, its segments, oriented and
-            snapped end to start).
-        tolerance: the chaining distance, mm.
+            snapped end to start); the chain does not close.
+        tolerance: how far apart two joints may be to be one, mm
+            (:data:`LOOP_JOINT_MM` at most).
 
     Returns:
-        ``(closed, pieces)`` per contour: the loops taken out, then the chain's rest
-        (closed when it ends where it starts), if anything is left.
+        ``(closed, pieces)`` per contour: the loops taken out (closed), then the rest of
+        the chain (open), if any is left.
     """
     reach = max(max(abs(v) for v in (*piece[0].start, *piece[-1].end)) for _, piece in parts)
-    size = max(tolerance, reach / _MAX_CELLS) or 1.0
+    size = _cell_size(tolerance, reach)
     out: list[tuple[bool, list[tuple[int, list[Segment]]]]] = []
     stack: list[tuple[int, list[Segment]]] = []
     starts: dict[tuple[int, int], list[int]] = defaultdict(list)  # cell → stack positions
@@ -214,9 +232,8 @@ def _loops(
             for gone in range(k, len(stack)):
                 starts[cell(stack[gone][1][0].start)].remove(gone)
             del stack[k:]
-    if stack:
-        rest = [seg for _, piece in stack for seg in piece]
-        out.append((_closes(rest, tolerance), stack))
+    if stack:  # starts where the chain does and ends where it ends: open, as it is
+        out.append((False, stack))
     return out
 
 
@@ -317,7 +334,7 @@ class _EndGrid:
                 f"contour {src}at {fmt_point(bad.start)} mm: an end point is not finite; "
                 "check the drawing"
             )
-        self.size = max(tolerance, reach / _MAX_CELLS) or 1.0  # 1.0: every end at (0, 0)
+        self.size = _cell_size(tolerance, reach)
         self.tolerance = tolerance
         self.cells: dict[tuple[int, int], list[tuple[int, bool, Point]]] = defaultdict(list)
 

@@ -130,10 +130,10 @@ def test_a_square_with_a_tail_at_its_corner_is_a_closed_square_and_an_open_tail(
 
 
 def test_a_loop_closing_a_joint_off_its_start_is_closed_exactly_and_the_rest_joins_on() -> None:
-    # The square's last side ends 0.006 mm short of (0, 0), within the 0.01 mm joint;
+    # The square's last side ends 0.6 µm short of (0, 0), within LOOP_JOINT_MM (1 µm);
     # a line then leaves from there: the line must start where the rest of the chain ends.
     pieces = _lines(
-        [*TAIL_AND_THREE_SIDES, ((0.0, 1.0), (0.0, 0.006)), ((0.0, 0.006), (0.0, -2.0))]
+        [*TAIL_AND_THREE_SIDES, ((0.0, 1.0), (0.0, 0.0006)), ((0.0, 0.0006), (0.0, -2.0))]
     )
     joined, members = chain_members(pieces, 0.01)
     assert [c.closed for c in joined] == [False, True]
@@ -203,3 +203,16 @@ def test_a_long_tail_s_loop_is_found_among_many_joints() -> None:
     assert [c.closed for c in joined] == [False, True]
     assert members[0] == tuple(range(15)) and sorted(members[1]) == [15, 16, 17, 18]
     assert joined[1].bbox() == (x, y, x + 1.0, y + 1.0)
+
+
+def test_a_wide_chaining_tolerance_makes_no_loop_of_details_smaller_than_it() -> None:
+    # An open 270° arc of radius 2.5 drawn as 60 LINEs of 0.196 mm (2.5 × 2 sin 2.25°),
+    # chained at 0.5 mm (a value the gap warnings suggest): every other joint lies within
+    # 0.5 mm of the one before, but no piece meets there. One open chain, as drawn.
+    corners = [
+        (10.0 + 2.5 * math.cos(math.radians(4.5 * k)), 10.0 + 2.5 * math.sin(math.radians(4.5 * k)))
+        for k in range(61)
+    ]
+    joined, members = chain_members(_lines(list(itertools.pairwise(corners))), 0.5)
+    assert [c.closed for c in joined] == [False] and members[0] == tuple(range(60))
+    assert [s.start for s in joined[0].segments] == corners[:-1]
