@@ -258,8 +258,8 @@ def test_a_closed_contour_without_area_vanishes_without_a_crash() -> None:
 def test_an_arc_drawn_there_and_back_vanishes_as_a_line_does() -> None:
     """Two copies of one ARC chain into a closed contour of no area (LibreCAD's
     ``power_station/ed128.dxf`` draws its bottom half-circle twice). Its chords one way
-    and the other differ by roundings: the slivers between them are no area either.
-    Before, the outside offset cut five short slots along the arc, with exit 0.
+    and the other differ by roundings: the slivers between them are no area either, not a
+    region to cut round (as slots along the arc).
     """
     ccw = Arc((20.0, 5.0), (30.0, 5.0), (25.0, 5.0), False)
     there_and_back = Contour((ccw, Arc((30.0, 5.0), (20.0, 5.0), (25.0, 5.0), True)), True)
