@@ -46,6 +46,7 @@ from camtool.model.program import (
 )
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import Arc, Contour, Drawing, Point, arc_length, circle_of
+from camtool.toolpath.chain import close_gaps
 from camtool.toolpath.copies import one_way
 from camtool.toolpath.options import PlanOptions
 
@@ -265,7 +266,7 @@ def run_job(
     construction: dict[int, Contour] = {}  # by id: a contour two operations leave, once
     drilled: set[int] = set()  # the drawing's marks an operation selected, by id
     joint = joint_distance(setup.chain_tolerance)  # how the planner chains contours
-    chaining = _chaining(drawing, scaled, joint)
+    chaining = _chaining(drawing, scaled, joint, setup.close_gap)
     here: tuple[float, float, float | None] = (*setup.origin, None)
     loaded: int | None = None
     sequence = job.sequenced()
@@ -421,17 +422,20 @@ def _edge(op: Operation, tool: Tool, options: PlanOptions) -> float:
     return options.radius if options.offset != "on" else 0.0
 
 
-def _chaining(drawing: Drawing, scaled: Drawing, joint_mm: float) -> Chaining:
+def _chaining(drawing: Drawing, scaled: Drawing, joint_mm: float, close_gap: float) -> Chaining:
     """What contours of ``drawing`` are once chained as the planner chains them.
 
     They are chained as scaled (``scaled``: ``drawing`` after ``scale``/``fit``, the same
-    contours in order), ``joint_mm`` apart at most (:func:`~camtool.geometry.chain.chain_members`);
+    contours in order), ``joint_mm`` apart at most (:func:`~camtool.geometry.chain.chain_members`),
+    and a chain whose own ends lie within ``close_gap`` (mm) is closed, as the planner
+    closes it (:func:`~camtool.toolpath.chain.close_gaps`: ``closed = true`` selects it);
     a chain that is a whole circle gives the circle of its first piece as drawn.
     """
     as_scaled = {id(a): b for a, b in zip(drawing.contours, scaled.contours, strict=True)}
 
     def shapes(contours: Sequence[Contour]) -> list[Shape]:
         joined, members = chain_members([as_scaled[id(c)] for c in contours], joint_mm)
+        joined = close_gaps(joined, close_gap, joint_mm)[0]
         joined = one_way(joined, joint_mm)[0]  # a line drawn twice is an open line
         out = [Shape(False, None)] * len(contours)
         for chain, pieces in zip(joined, members, strict=True):

@@ -535,3 +535,58 @@ def _job_on(tmp_path: Path, build: Callable[[Any], None], job_text: str) -> tupl
     job = tmp_path / "job.toml"
     job.write_text(job_text)
     return read_drawing(dxf), load_job(job)
+
+
+def _outline_open_at_a_corner(msp: object) -> None:
+    """A 20 × 20 mm outline whose last corner is not drawn, as boxes.py leaves some parts.
+
+    boxes.py rounds each corner with an arc of its ``burn`` (0.1 mm) and, on some parts,
+    ends the outline before the last one: its ends lie 0.1·√2 ≈ 0.1414 mm apart, over
+    the default ``close_gap`` (0.02 mm). A 4 × 4 mm hole lies inside.
+    """
+    msp.add_lwpolyline(  # type: ignore[attr-defined]
+        [(0.1, 0), (20, 0), (20, 20), (0, 20), (0, 0.1)], dxfattribs={"layer": "PART"}
+    )
+    msp.add_lwpolyline(  # type: ignore[attr-defined]
+        [(8, 8), (12, 8), (12, 12), (8, 12)], close=True, dxfattribs={"layer": "PART"}
+    )
+
+
+_CLOSED_OUTSIDE = (
+    '[[tools]]\nid = 1\ntype = "end-mill"\ndiameter = 2\n'
+    '[[operations]]\ntype = "profile"\ntool = 1\nclosed = true\nside = "outside"\n'
+    'layers = ["PART"]\ndepth = 1\n'
+)
+
+
+def test_close_gap_closes_an_outline_for_a_closed_selection(tmp_path: Path) -> None:
+    """``close_gap`` closes a chain before ``closed = true`` judges it, as the planner does.
+
+    With ``close_gap = 0.2`` the planner would close the outline's 0.1414 mm gap with a
+    line; the selection judged the chain as drawn (open), so the part was left out (not
+    cut) while the option said it would be closed. Cut outside it, the 2 mm tool's
+    centre runs 1 mm out of the 20 mm square: X from -1 to 21; the hole is cut inside
+    (X from 9 to 11), not outside as the outermost contour it was while the outline was open.
+    """
+    drawing, job = _job_on(
+        tmp_path, _outline_open_at_a_corner, "[job]\nclose_gap = 0.2\n" + _CLOSED_OUTSIDE
+    )
+    done = run_job(drawing, load_target("grbl"), job)
+    z, xs = 0.0, []
+    for m in done.program.moves:
+        z = m.z if m.z is not None else z
+        if isinstance(m, Linear) and z == -1.0:
+            xs.append(m.x)
+    assert min(xs) == pytest.approx(-1.0) and max(xs) == pytest.approx(21.0)
+    inner = [x for x in xs if 5.0 < x < 15.0]
+    assert inner and min(inner) == pytest.approx(9.0) and max(inner) == pytest.approx(11.0)
+    assert not [w for w in done.program.warnings if w.startswith("not cut: ")]
+    assert [w for w in done.program.warnings if "closed a 0.1414 mm gap" in w]
+
+
+def test_without_close_gap_the_open_outline_is_not_cut(tmp_path: Path) -> None:
+    """At the default ``close_gap`` the outline stays open: not selected, and said so."""
+    drawing, job = _job_on(tmp_path, _outline_open_at_a_corner, _CLOSED_OUTSIDE)
+    done = run_job(drawing, load_target("grbl"), job)
+    notes = [w for w in done.program.warnings if w.startswith("not cut: ")]
+    assert len(notes) == 1 and "(1 open; first LWPOLYLINE" in notes[0]
