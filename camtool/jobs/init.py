@@ -19,9 +19,13 @@ from camtool.jobs.job import Selection
 from camtool.jobs.selection import circle_of, construction_reason
 from camtool.model.construction import fit_extent, is_construction
 from camtool.model.errors import InputError
-from camtool.model.shapes import Contour, Drawing, fit_factor
+from camtool.model.shapes import Contour, Drawing, distance, fit_factor
+from camtool.model.units import fmt_num
+from camtool.toolpath.chain import GAP_SHARE, close_gaps
 from camtool.toolpath.copies import one_way
-from camtool.toolpath.options import DEFAULT_CHAIN_TOLERANCE
+from camtool.toolpath.cuts import where
+from camtool.toolpath.gaps import option_value
+from camtool.toolpath.options import DEFAULT_CHAIN_TOLERANCE, DEFAULT_CLOSE_GAP
 from camtool.toolpath.placement import EPS_MM
 
 DRILL_MAX_MM = 6.5
@@ -29,6 +33,14 @@ DRILL_MAX_MM = 6.5
 
 BREAKTHROUGH_MM = 0.5
 """How far a through cut goes below the stock (into the spoil board)."""
+
+NEAR_CLOSED_MM = 0.5
+"""An open outline whose own ends lie at most this far apart (mm), and under
+:data:`NEAR_CLOSED_SHARE` of its length, is one the drawing meant closed: ``job init``
+sets ``close_gap`` to close it (boxes.py leaves a part's last corner, 0.14 mm, undrawn)."""
+
+NEAR_CLOSED_SHARE = 0.01
+"""See :data:`NEAR_CLOSED_MM`: a larger gap for its length is drawn open on purpose."""
 
 
 @dataclass
@@ -38,6 +50,8 @@ class _Group:
     key: str
     by: str  # "layers" or "colours"
     contours: list[Contour] = field(default_factory=list)
+    close_gap: float = DEFAULT_CLOSE_GAP  # mm: the job's ``close_gap``
+    joined: list[Contour] | None = None  # :func:`_joined`
     chained: list[Contour] | None = None  # :func:`_chains`
 
 
@@ -80,6 +94,9 @@ def initial_job(
     if fit:  # sizes as cut (drills, tabs), selections in the drawing's own mm
         drawing = drawing.transformed(k)
     groups = _groups(drawing)
+    close_gap, gap = _close_gap(groups)
+    for group in groups:
+        group.close_gap = close_gap
     outer = _outermost([c for group in groups for c in _chains(group)])
     ops: list[_Op] = []
     left: Counter[str] = Counter()
@@ -97,7 +114,9 @@ def initial_job(
         ops.extend(_marks(drawing, thickness_mm))
     if not any(not op.commented for op in ops):
         raise InputError(_nothing_to_cut(drawing, left))
-    return _render(ops, left, thickness_mm, tool_diameter, source or drawing.source, fit, no_z)
+    return _render(
+        ops, left, thickness_mm, tool_diameter, source or drawing.source, (*fit, *gap), no_z
+    )
 
 
 def _nothing_to_cut(drawing: Drawing, left: Counter[str]) -> str:
@@ -199,29 +218,116 @@ def _groups(drawing: Drawing) -> list[_Group]:
     return list(by_layer.values())
 
 
-def _chains(group: _Group) -> list[Contour]:
+def _joined(group: _Group) -> list[Contour]:
     """The group's contours but construction, chained end to end (made once per group).
 
-    As a job's selection chains them for ``closed`` (:func:`camtool.jobs.selection.select`,
-    at the job's default chain tolerance): an outline drawn as LINEs is one closed contour,
-    a line drawn twice one open line (:func:`~camtool.toolpath.copies.one_way`).
+    At the job's default chain tolerance, as a job's selection chains them
+    (:func:`camtool.jobs.selection.select`): an outline drawn as LINEs is one closed contour.
+    """
+    if group.joined is None:
+        kept = [c for c in group.contours if not is_construction(c)]
+        group.joined = chain_members(kept, joint_distance(DEFAULT_CHAIN_TOLERANCE))[0]
+    return group.joined
+
+
+def _chains(group: _Group) -> list[Contour]:
+    """:func:`_joined`'s chains as the job cuts them (made once per group).
+
+    As a job's selection judges them for ``closed``: gaps up to the job's ``close_gap``
+    closed (:func:`~camtool.toolpath.chain.close_gaps`), a line drawn twice one open line
+    (:func:`~camtool.toolpath.copies.one_way`).
     """
     if group.chained is None:
-        kept = [c for c in group.contours if not is_construction(c)]
         joint = joint_distance(DEFAULT_CHAIN_TOLERANCE)
-        group.chained = one_way(chain_members(kept, joint)[0], joint)[0]
+        closed = close_gaps(_joined(group), group.close_gap, joint)[0]
+        group.chained = one_way(closed, joint)[0]
     return group.chained
 
 
+def _close_gap(groups: Sequence[_Group]) -> tuple[float, tuple[str, ...]]:
+    """The job's ``close_gap`` (mm) and its ``[job]`` line (none for the default).
+
+    An open chain whose own ends lie within :data:`NEAR_CLOSED_MM` and
+    :data:`NEAR_CLOSED_SHARE` of its length was meant closed. ``close_gap`` closes every
+    open chain whose gap is within it and under :data:`~camtool.toolpath.chain.GAP_SHARE`
+    of its length, so it is set just above the largest such gap only while no chain
+    drawn open on purpose (a larger gap for its length) is within it; a value the default
+    (:data:`~camtool.toolpath.options.DEFAULT_CLOSE_GAP`) covers needs no line.
+    """
+    joint = joint_distance(DEFAULT_CHAIN_TOLERANCE)
+    meant: list[tuple[float, Contour]] = []
+    limit = math.inf  # the least gap of a chain drawn open that close_gaps would close
+    for group in groups:
+        for chain in _joined(group):
+            gap = distance(chain.end, chain.start)
+            if chain.closed or gap <= joint or gap >= GAP_SHARE * chain.length:
+                continue  # closed, or left open by close_gaps whatever the value
+            if gap <= NEAR_CLOSED_MM and gap < NEAR_CLOSED_SHARE * chain.length:
+                meant.append((gap, chain))
+            else:
+                limit = min(limit, gap)
+    value, taken = "", 0
+    for gap, _ in sorted(meant, key=lambda t: t[0]):
+        if float(option_value(gap)) >= limit:
+            break
+        value, taken = option_value(gap), taken + 1
+    if not value or float(value) <= DEFAULT_CLOSE_GAP:
+        return DEFAULT_CLOSE_GAP, ()
+    shut = sorted(meant, key=lambda t: t[0])[:taken]
+    first = min((c for _, c in shut), key=lambda c: (c.start[1], c.start[0]))
+    return float(value), (
+        f"close_gap = {value}"
+        + _why(
+            f"{taken} outline(s) end up to {fmt_num(shut[-1][0], 4)} mm from their start "
+            f"(first {where(first)}): closed with a straight line; 0 leaves them open, not cut"
+        ),
+    )
+
+
 def _outermost(contours: Sequence[Contour]) -> set[int]:
-    """The ids of the closed contours that lie inside no other closed contour."""
+    """The ids of the closed contours that lie inside no other closed contour.
+
+    Inside as the planner nests them (:func:`~camtool.toolpath.order.nesting`), or mostly
+    inside: a contour that crosses a larger one's outline with more than
+    :data:`MOSTLY_INSIDE` of its area within it is a hole of that part drawn across its
+    edge (boxes.py's slots open at a part's edge poke 0.1 mm out of its outline), not a
+    part (shapely's intersection of the areas, :func:`~camtool.geometry.area.enclosed`).
+    """
     from camtool.toolpath.order import nesting
 
     closed = [c for c in contours if c.closed and not c.linetype]
     if not closed:
         return set()
     nest = nesting(closed)
-    return {id(c) for i, c in enumerate(closed) if not nest.parents[i]}
+    top = [c for i, c in enumerate(closed) if not nest.parents[i]]
+    return {id(c) for c in top} - _mostly_inside(top)
+
+
+MOSTLY_INSIDE = 0.5
+"""Share of a contour's area within a larger closed contour that makes it a hole of it."""
+
+
+def _mostly_inside(contours: Sequence[Contour]) -> set[int]:
+    """The ids of those of ``contours`` (closed) mostly inside a larger one of them."""
+    if len(contours) < 2:
+        return set()
+    import shapely
+
+    from camtool.geometry.area import enclosed
+
+    areas = [enclosed(c.points(_AREA_TOLERANCE_MM)) for c in contours]
+    a, b = shapely.STRtree(areas).query(areas, predicate="intersects")
+    out: set[int] = set()
+    for i, j in zip(a.tolist(), b.tolist(), strict=True):
+        small, large = areas[i], areas[j]
+        inside = i != j and large.area > small.area > 0
+        if inside and small.intersection(large).area > MOSTLY_INSIDE * small.area:
+            out.add(id(contours[i]))
+    return out
+
+
+_AREA_TOLERANCE_MM = 0.01
+"""Chord tolerance of the areas :func:`_mostly_inside` compares (mm)."""
 
 
 def _ops_of(

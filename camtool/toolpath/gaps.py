@@ -90,7 +90,7 @@ def open_gaps(contours: Sequence[Contour], options: PlanOptions) -> list[Finding
             Finding(
                 "open-gap",
                 f"{kept - MAX_REPORTED} more open end(s) lie near another (gaps up to "
-                f"{fmt_num(largest, 4)} mm); --chain-tolerance {_option_value(largest)} joins "
+                f"{fmt_num(largest, 4)} mm); --chain-tolerance {option_value(largest)} joins "
                 "them all",
                 value=largest,
             )
@@ -162,10 +162,10 @@ def _finding(
     (ia, pa), (ib, pb) = a, b
     mid = ((pa[0] + pb[0]) / 2, (pa[1] + pb[1]) / 2)
     if ia == ib:
-        fix = f"--close-gap {_option_value(gap)} closes it"
+        fix = f"--close-gap {option_value(gap)} closes it"
         what = f"{where(contours[ia])} stays open: its ends are {fmt_num(gap, 4)} mm apart"
     else:
-        fix = f"--chain-tolerance {_option_value(gap)} joins them"
+        fix = f"--chain-tolerance {option_value(gap)} joins them"
         what = (
             f"{where(contours[ia])} ends {fmt_num(gap, 4)} mm from {where(contours[ib])}, "
             "so both stay open"
@@ -173,8 +173,11 @@ def _finding(
     return Finding("open-gap", f"{what} at {fmt_point(mid)} mm; {fix}", mid, gap)
 
 
-def _option_value(gap: float) -> str:
-    """A round option value just above ``gap`` mm (two significant digits, rounded up)."""
+def option_value(gap: float) -> str:
+    """A round option value just above ``gap`` mm (two significant digits, rounded up).
+
+    ``gap`` > 0; ``0.1414`` gives ``"0.15"``, ``0.04`` ``"0.041"``.
+    """
     digits = 1 - math.floor(math.log10(gap))
     step = 10.0**-digits
     return f"{math.ceil(gap / step * (1 + 1e-9)) * step:.{max(digits, 0)}f}"

@@ -38,6 +38,10 @@ PLACEMENTS = ("drawing", "lower-left", "center")
 zero (X0 Y0 of the program) lies: the drawing's own origin, the toolpath's lower-left
 corner, or its centre."""
 
+DEFAULT_CLOSE_GAP = 0.02
+"""Default ``--close-gap`` (mm): a contour whose own ends lie this close is closed, with a
+warning (:func:`camtool.toolpath.chain.close_gaps`)."""
+
 DEFAULT_CHAIN_TOLERANCE = 0.01
 """Default distance (mm) within which entity ends are joined into one contour.
 
@@ -170,7 +174,7 @@ class PlanOptions:
     tab_height: float = 0.5
     order: str = "travel"
     lead_in: float = 0.0
-    close_gap: float = 0.02
+    close_gap: float = DEFAULT_CLOSE_GAP
     fit_arcs: bool = True
     feed_mm_min: float | None = None
     tolerance: float = 0.001

@@ -21,7 +21,7 @@ from camtool.model.shapes import Contour, Line
 from camtool.model.units import fmt_num
 from camtool.toolpath.chain import GAP_SHARE
 from camtool.toolpath.cuts import Finding
-from camtool.toolpath.gaps import MAX_REPORTED, NEAR_GAP_FACTOR, _finding, _option_value, open_gaps
+from camtool.toolpath.gaps import MAX_REPORTED, NEAR_GAP_FACTOR, _finding, open_gaps, option_value
 from camtool.toolpath.options import PlanOptions
 
 
@@ -58,7 +58,7 @@ def _reference(contours: Sequence[Contour], options: PlanOptions) -> list[Findin
             Finding(
                 "open-gap",
                 f"{len(found) - MAX_REPORTED} more open end(s) lie near another (gaps up to "
-                f"{fmt_num(largest, 4)} mm); --chain-tolerance {_option_value(largest)} joins "
+                f"{fmt_num(largest, 4)} mm); --chain-tolerance {option_value(largest)} joins "
                 "them all",
                 value=largest,
             )

@@ -1,0 +1,111 @@
+"""``camtool job init`` on parts drawn for a laser cutter, as boxes.py draws them.
+
+boxes.py (florianfesti/boxes) draws a part's outline black and its inner cuts blue, on one
+layer; on some parts the outline ends before its last corner's 0.1 mm rounding, 0.1·√2 ≈
+0.1414 mm from its start (its ``examples/AgricolaInsert.svg``, ``BreadBox.svg``,
+``FlexBook.svg``...), and a slot open at the part's edge is a blue rectangle poking
+0.094 mm out of the outline (``AgricolaInsert.svg``'s ``path[106]``). The drawings here
+keep those traits at sizes easy to check by hand.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from camtool.importers import read_drawing
+from camtool.jobs.init import initial_job
+from camtool.jobs.jobfile import job_from_dict
+from camtool.jobs.run import run_job
+from camtool.model.program import Linear
+from camtool.post.registry import load_target
+from tests.shapes import write_dxf
+
+# a 100 × 60 mm page in mm, Y down: the outline from x 10 to 60, y 10 to 50, open at its
+# corner (10, 10); a 10 × 10 mm hole inside; a slot at the right edge, 0.1 mm out of it
+_PART = (
+    '<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="60mm" viewBox="0 0 100 60">'
+    '<path d="M 10.1 10 H 60 V 50 H 10 V 10.1" stroke="rgb(0,0,0)" fill="none"/>'
+    '<path d="M 30 20 H 40 V 30 H 30 Z" stroke="rgb(0,0,255)" fill="none"/>'
+    '<path d="M 55 35 H 60.1 V 40 H 55 Z" stroke="rgb(0,0,255)" fill="none"/>'
+    "</svg>"
+)
+
+
+def _ops(text: str) -> list[dict[str, object]]:
+    return list(tomllib.loads(text)["operations"])
+
+
+def test_an_outline_open_at_a_corner_is_closed_and_cut_with_its_holes_inside(
+    tmp_path: Path,
+) -> None:
+    """The outline is a part (``close_gap`` closes it), so the blue shapes are its holes.
+
+    Left open, the outline was an engraving to uncomment, the part was not cut, and the
+    blue colour held "outermost" contours: cut on their outside, into the part. The slot
+    poking 0.1 mm out of the edge is a hole too (nearly all of it lies in the part). Cut
+    with the 3 mm end mill, the part's toolpath lies 1.5 mm outside its 50 × 40 mm
+    outline and the hole's 1.5 mm inside its 10 mm square (work zero lower-left: the
+    outline's toolpath starts at 0).
+    """
+    svg = tmp_path / "box.svg"
+    svg.write_text(_PART)
+    drawing = read_drawing(svg)
+    text = initial_job(drawing, thickness_mm=3.0)
+    assert tomllib.loads(text)["job"]["close_gap"] == 0.15
+    assert "1 outline(s) end up to 0.1414 mm from their start" in text
+    sides = [(op["colours"], op["side"]) for op in _ops(text)]
+    assert sides == [(["#0000ff"], "inside"), (["#000000"], "outside")]
+    job = job_from_dict(tomllib.loads(text), source="box.toml")
+    done = run_job(drawing, load_target("grbl"), job)
+    z, xs, ys = 0.0, [], []
+    for m in done.program.moves:
+        z = m.z if m.z is not None else z
+        if isinstance(m, Linear) and z < 0:
+            xs.append(m.x)
+            ys.append(m.y)
+    assert min(xs) == pytest.approx(0.0) and max(xs) == pytest.approx(53.0)
+    assert min(ys) == pytest.approx(0.0) and max(ys) == pytest.approx(43.0)
+    # the hole: x 30..40 in the drawing, 21.5..31.5 from work zero; its toolpath 23..30
+    hole = [x for x in xs if 20.0 < x < 33.0]
+    assert hole and min(hole) == pytest.approx(23.0) and max(hole) == pytest.approx(30.0)
+    assert any("closed a 0.1414 mm gap" in w for w in done.program.warnings)
+
+
+def _outline_and_c(c_gap: float) -> object:
+    """An 80 × 40 mm outline open 0.1414 mm at a corner, and a "C" open ``c_gap`` mm.
+
+    The C (about 10 mm long) is drawn open on purpose: its gap is over 1 % of its length.
+    """
+
+    def build(msp: object) -> None:
+        msp.add_lwpolyline([(0.1, 0), (80, 0), (80, 40), (0, 40), (0, 0.1)])  # type: ignore[attr-defined]
+        msp.add_lwpolyline(  # type: ignore[attr-defined]
+            [(100 + c_gap, 0), (102.5, 0), (102.5, 2.5), (100, 2.5), (100, 0)]
+        )
+
+    return build
+
+
+def test_close_gap_stops_short_of_a_shape_drawn_open(tmp_path: Path) -> None:
+    """``close_gap`` is set just above the outline's gap and under the C's (0.3 mm)."""
+    drawing = read_drawing(write_dxf(tmp_path / "c.dxf", _outline_and_c(0.3)))
+    text = initial_job(drawing)
+    assert tomllib.loads(text)["job"]["close_gap"] == 0.15
+    assert [op["side"] for op in _ops(text)] == ["outside"]
+    assert '# type = "engrave"  # 1 open contour(s)' in text  # the C
+
+
+def test_no_close_gap_when_it_would_close_a_shape_drawn_open(tmp_path: Path) -> None:
+    """A C open 0.12 mm (1.2 % of its length) is under the 0.15 mm the outline needs.
+
+    ``close_gap = 0.15`` would close the C too (post closes a gap under a tenth of its
+    contour's length), so none is set: both stay open, and a drawing of open lines only
+    is engraved.
+    """
+    drawing = read_drawing(write_dxf(tmp_path / "c.dxf", _outline_and_c(0.12)))
+    text = initial_job(drawing)
+    assert "close_gap" not in tomllib.loads(text)["job"]
+    assert [(op["type"], op["closed"]) for op in _ops(text)] == [("engrave", False)]
