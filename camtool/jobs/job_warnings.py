@@ -21,15 +21,19 @@ def unselected(
     construction: Sequence[Contour],
     joint_mm: float,
     cut: Sequence[Contour] = (),
+    close_gap: float = 0.0,
 ) -> list[str]:
     """One line per layer of the contours no operation selects (construction said apart).
 
-    They are counted as chained ``joint_mm`` apart at most (as ``camtool inspect`` counts
-    them): four LINEs of an open outline are one open contour. A chain on the path of one
-    of ``cut`` (the operations' contours as planned: a fill whose outline an operation
-    cuts) is cut there and not counted.
+    They are counted as chained ``joint_mm`` apart at most, gaps up to ``close_gap`` closed
+    (as the planner would cut them): four LINEs of an open outline are one open contour.
+    A chain on the path of one of ``cut`` (the operations' contours as planned: a fill
+    whose outline an operation cuts) is cut there and not counted. Open chains whose own
+    ends nearly meet (:func:`_near_closed`) are counted with the ``close_gap`` that closes
+    them: left out of a ``closed = true`` selection, they may be parts drawn for a laser.
     """
     from camtool.geometry.chain import chain_members
+    from camtool.toolpath.chain import close_gaps
     from camtool.toolpath.copies import drop_copies, one_way
 
     taken = {id(c) for r in runs for c in r.placed.contours}
@@ -40,7 +44,8 @@ def unselected(
             left.setdefault(contour.layer, []).append(contour)
     out = []
     for layer, pieces in sorted(left.items()):
-        chains = one_way(chain_members(pieces, joint_mm)[0], joint_mm)[0]
+        chains = close_gaps(chain_members(pieces, joint_mm)[0], close_gap, joint_mm)[0]
+        chains = one_way(chains, joint_mm)[0]
         contours = drop_copies(chains, cut_before=[("", cut)])[0]
         if not contours:
             continue
@@ -49,9 +54,37 @@ def unselected(
         out.append(
             f"not cut: {len(contours)} contour(s) on layer {layer!r} ({opened} open; first "
             f"{first.source or 'contour'} at ({first.start[0]:.4f}, {first.start[1]:.4f}) mm): "
-            "no operation selects them"
+            "no operation selects them" + _near_closed(contours, joint_mm)
         )
     return out
+
+
+def _near_closed(contours: Sequence[Contour], joint_mm: float) -> str:
+    """What closes the open ``contours`` whose own ends lie near (as ``post`` reports them).
+
+    Near: further apart than ``joint_mm``, within ``max(0.1 mm, NEAR_GAP_FACTOR ×
+    joint_mm)`` (:func:`camtool.toolpath.gaps.open_gaps`' reach) and under ``GAP_SHARE`` of
+    the contour's length (what ``close_gap`` closes). ``""`` when none is.
+    """
+    from camtool.model.shapes import distance
+    from camtool.model.units import fmt_num
+    from camtool.toolpath.chain import GAP_SHARE
+    from camtool.toolpath.gaps import NEAR_GAP_FACTOR, option_value
+
+    reach = max(0.1, NEAR_GAP_FACTOR * joint_mm)
+    gaps = [
+        gap
+        for c in contours
+        if not c.closed
+        and joint_mm < (gap := distance(c.end, c.start)) <= reach
+        and gap < GAP_SHARE * c.length
+    ]
+    if not gaps:
+        return ""
+    return (
+        f"; {len(gaps)} of them end within {fmt_num(max(gaps), 4)} mm of their start: "
+        f"close_gap = {option_value(max(gaps))} in [job] closes them"
+    )
 
 
 def undrilled(drawing: Drawing, drilled: set[int]) -> list[str]:

@@ -337,7 +337,12 @@ def run_job(
     if not job.shorthand:
         notes.extend(
             unselected(
-                scaled, runs, list(construction.values()), joint, [p for *_, ps in cut for p in ps]
+                scaled,
+                runs,
+                list(construction.values()),
+                joint,
+                [p for *_, ps in cut for p in ps],
+                setup.close_gap,
             )
         )
         notes.extend(undrilled(drawing, drilled))

@@ -585,8 +585,14 @@ def test_close_gap_closes_an_outline_for_a_closed_selection(tmp_path: Path) -> N
 
 
 def test_without_close_gap_the_open_outline_is_not_cut(tmp_path: Path) -> None:
-    """At the default ``close_gap`` the outline stays open: not selected, and said so."""
+    """At the default ``close_gap`` the outline stays open: not selected, and said so.
+
+    The note says what closes it: its ends are 0.1414 mm apart, so ``close_gap = 0.15``.
+    """
     drawing, job = _job_on(tmp_path, _outline_open_at_a_corner, _CLOSED_OUTSIDE)
     done = run_job(drawing, load_target("grbl"), job)
     notes = [w for w in done.program.warnings if w.startswith("not cut: ")]
     assert len(notes) == 1 and "(1 open; first LWPOLYLINE" in notes[0]
+    assert notes[0].endswith(
+        "; 1 of them end within 0.1414 mm of their start: close_gap = 0.15 in [job] closes them"
+    )
