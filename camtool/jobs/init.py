@@ -97,7 +97,7 @@ def initial_job(
     close_gap, gap = _close_gap(groups)
     for group in groups:
         group.close_gap = close_gap
-    outer = _outermost([c for group in groups for c in _chains(group)])
+    outer = _outermost([(group, c) for group in groups for c in _chains(group)])
     ops: list[_Op] = []
     left: Counter[str] = Counter()
     cut: list[tuple[_Group, list[_Op]]] = []
@@ -284,8 +284,12 @@ def _close_gap(groups: Sequence[_Group]) -> tuple[float, tuple[str, ...]]:
     )
 
 
-def _outermost(contours: Sequence[Contour]) -> set[int]:
-    """The ids of the closed contours that lie inside no other closed contour.
+def _outermost(chains: Sequence[tuple[_Group, Contour]]) -> tuple[set[int], dict[int, str]]:
+    """Which closed contours are parts, and which are holes of another group's parts.
+
+    Returns the ids of the closed contours that lie inside no other closed contour, and
+    for each closed contour every contour around which is of another group (a hole on a
+    layer of its own), that group's name (:func:`_what`), by id.
 
     Inside as the planner nests them (:func:`~camtool.toolpath.order.nesting`), or mostly
     inside: a contour that crosses a larger one's outline with more than
@@ -295,34 +299,42 @@ def _outermost(contours: Sequence[Contour]) -> set[int]:
     """
     from camtool.toolpath.order import nesting
 
-    closed = [c for c in contours if c.closed and not c.linetype]
+    closed = [(g, c) for g, c in chains if c.closed and not c.linetype]
     if not closed:
-        return set()
-    nest = nesting(closed)
-    top = [c for i, c in enumerate(closed) if not nest.parents[i]]
-    return {id(c) for c in top} - _mostly_inside(top)
+        return set(), {}
+    nest = nesting([c for _, c in closed])
+    top = [i for i in range(len(closed)) if not nest.parents[i]]
+    across = _mostly_inside([closed[i][1] for i in top])
+    around = {i: tuple(nest.parents[i]) for i in range(len(closed))}
+    around.update({top[k]: (top[j],) for k, j in across.items()})
+    foreign = {
+        id(c): _what(closed[parents[0]][0])
+        for i, (g, c) in enumerate(closed)
+        if (parents := around[i]) and all(closed[j][0] is not g for j in parents)
+    }
+    return {id(closed[i][1]) for i in top if i not in {top[k] for k in across}}, foreign
 
 
 MOSTLY_INSIDE = 0.5
 """Share of a contour's area within a larger closed contour that makes it a hole of it."""
 
 
-def _mostly_inside(contours: Sequence[Contour]) -> set[int]:
-    """The ids of those of ``contours`` (closed) mostly inside a larger one of them."""
+def _mostly_inside(contours: Sequence[Contour]) -> dict[int, int]:
+    """For each of ``contours`` (closed) mostly inside a larger one, that one's index, by index."""
     if len(contours) < 2:
-        return set()
+        return {}
     import shapely
 
     from camtool.geometry.area import enclosed
 
     areas = [enclosed(c.points(_AREA_TOLERANCE_MM)) for c in contours]
     a, b = shapely.STRtree(areas).query(areas, predicate="intersects")
-    out: set[int] = set()
+    out: dict[int, int] = {}
     for i, j in zip(a.tolist(), b.tolist(), strict=True):
         small, large = areas[i], areas[j]
         inside = i != j and large.area > small.area > 0
         if inside and small.intersection(large).area > MOSTLY_INSIDE * small.area:
-            out.add(id(contours[i]))
+            out.setdefault(i, j)
     return out
 
 
@@ -332,7 +344,7 @@ _AREA_TOLERANCE_MM = 0.01
 
 def _ops_of(
     group: _Group,
-    outer: set[int],
+    outer: tuple[set[int], dict[int, str]],
     thickness: float,
     tool: float,
     left: Counter[str],
@@ -462,7 +474,7 @@ def _profile_op(
     select: str,
     what: str,
     contours: list[Contour],
-    outer: set[int],
+    nested: tuple[set[int], dict[int, str]],
     thickness: float,
     tool: float,
     key: str,
@@ -473,12 +485,14 @@ def _profile_op(
     depth = given or thickness + BREAKTHROUGH_MM
     if pocket:
         return _pocket_op(select, what, contours, thickness, tool, key, given)
+    outer, foreign = nested
     has_outer = cut == "outside" if cut else any(id(c) in outer for c in contours)
     side = "outside" if has_outer else "inside"
     why = (
         f"Shaper's cut type of {what}"
         if cut
         else f"{what} holds an outermost contour: cut outside it (its holes inside)"
+        + _foreign_holes(contours, foreign)
         if has_outer
         else f"{what} holds holes of a part only: cut on their inside"
     )
@@ -515,6 +529,17 @@ def _profile_op(
     if mill is None:  # no end mill fits: a guess the user must finish
         return _Op(f"profile {side}", tool, tuple(lines), commented=True)
     return _Op(f"profile {side}", mill, tuple(lines))
+
+
+def _foreign_holes(contours: Sequence[Contour], foreign: dict[int, str]) -> str:
+    """What an outside profile of ``contours`` does to those that are holes of other parts."""
+    holes = [foreign[id(c)] for c in contours if id(c) in foreign]
+    if not holes:
+        return ""
+    return (
+        f"; but {len(holes)} of its contours lie inside {holes[0]}'s parts and are cut "
+        "outside too, into them: give those a layer or colour of their own, cut inside"
+    )
 
 
 def _pocket_op(

@@ -124,17 +124,22 @@ def overlaps(runs: Sequence[OperationRun], job: Job) -> list[str]:
     return out
 
 
-def holes_cut_outside(runs: Sequence[OperationRun], job: Job) -> list[str]:
+def holes_cut_outside(
+    runs: Sequence[OperationRun], job: Job, paths: Sequence[Sequence[Contour]]
+) -> list[str]:
     """A warning for a contour cut on its outside that lies inside another operation's.
 
     Within one operation a hole is cut on its inside (its nesting says it is a hole); a
     hole selected alone by an ``outside`` profile is cut outside itself, into the part.
+    ``paths``: each run's contours as its plan chained them (gaps closed:
+    :attr:`camtool.toolpath.plan.Plan.paths`), in the order of ``runs``; a hole drawn open
+    by a hair, which the planner closes and cuts, is judged closed.
     """
     if job.shorthand:
         return []
     from camtool.toolpath.order import nesting
 
-    closed = [(r, c) for r in runs for c in r.placed.contours if c.closed]
+    closed = [(r, c) for r, ps in zip(runs, paths, strict=True) for c in ps if c.closed]
     outside = any(r.operation.kind == "profile outside" for r, _ in closed)
     if not outside or len({id(r) for r, _ in closed}) < 2:
         return []  # no contour of an outside profile, or none of another operation

@@ -348,7 +348,7 @@ def run_job(
         notes.extend(undrilled(drawing, drilled))
     warnings[len(drawing.warnings) : len(drawing.warnings)] = notes
     warnings.extend(overlaps(runs, job))
-    warnings.extend(holes_cut_outside(runs, job))
+    warnings.extend(holes_cut_outside(runs, job, [ps for *_, ps in cut]))
     placed_all = Drawing(
         tuple(c for r in runs for c in r.placed.contours),
         drawing.source,

@@ -109,3 +109,31 @@ def test_no_close_gap_when_it_would_close_a_shape_drawn_open(tmp_path: Path) -> 
     text = initial_job(drawing)
     assert "close_gap" not in tomllib.loads(text)["job"]
     assert [(op["type"], op["closed"]) for op in _ops(text)] == [("engrave", False)]
+
+
+def test_holes_of_another_colour_s_part_in_an_outside_colour_are_named(tmp_path: Path) -> None:
+    """A colour holding a part's hole and a shape of its own says the hole is cut into the part.
+
+    boxes.py's ``Gears.svg``: blue holds two gears' shaft holes and two circles drawn
+    apart. One profile per colour cannot cut both right: the blue one is cut outside (its
+    circles are outermost), and its comment says that its contours inside the black part
+    are cut outside too, into it, and what to do.
+    """
+    svg = tmp_path / "gear.svg"
+    svg.write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="60mm" viewBox="0 0 100 60">'
+        '<path d="M 10 10 H 50 V 50 H 10 Z" stroke="rgb(0,0,0)" fill="none"/>'
+        '<path d="M 25 25 H 35 V 35 H 25 Z" stroke="rgb(0,0,255)" fill="none"/>'
+        '<circle cx="80" cy="30" r="8" stroke="rgb(0,0,255)" fill="none"/>'
+        "</svg>"
+    )
+    text = initial_job(read_drawing(svg))
+    blue = next(
+        line for line in text.splitlines() if line.startswith('side = "outside"  # colour #0000ff')
+    )
+    assert blue.endswith(
+        "; but 1 of its contours lie inside colour #000000's parts and are cut outside too, "
+        "into them: give those a layer or colour of their own, cut inside"
+    )
+    black = next(line for line in text.splitlines() if "colour #000000 holds" in line)
+    assert "but" not in black

@@ -596,3 +596,35 @@ def test_without_close_gap_the_open_outline_is_not_cut(tmp_path: Path) -> None:
     assert notes[0].endswith(
         "; 1 of them end within 0.1414 mm of their start: close_gap = 0.15 in [job] closes them"
     )
+
+
+def test_a_hole_closed_by_close_gap_and_cut_outside_is_warned_about(tmp_path: Path) -> None:
+    """The hole check judges contours as the plan chained them, gaps closed.
+
+    boxes.py's ``Gears.svg`` draws a gear's shaft hole open by 0.1 mm; with ``close_gap``
+    the planner closes it and, under an outside profile, cuts it outside itself into the
+    gear. Judged as drawn (open) it was no hole, and the program gouged the part unwarned.
+    Here a 10 × 10 mm hole open 0.1414 mm at a corner, inside a closed 40 × 40 mm part.
+    """
+
+    def build(msp: object) -> None:
+        msp.add_lwpolyline(  # type: ignore[attr-defined]
+            [(0, 0), (40, 0), (40, 40), (0, 40)], close=True, dxfattribs={"layer": "EDGE"}
+        )
+        msp.add_lwpolyline(  # type: ignore[attr-defined]
+            [(15.1, 15), (25, 15), (25, 25), (15, 25), (15, 15.1)], dxfattribs={"layer": "HOLE"}
+        )
+
+    drawing, job = _job_on(
+        tmp_path,
+        build,
+        "[job]\nclose_gap = 0.2\n"
+        '[[tools]]\nid = 1\ntype = "end-mill"\ndiameter = 2\n'
+        '[[operations]]\ntype = "profile"\ntool = 1\nlayers = ["HOLE"]\nclosed = true\n'
+        'side = "outside"\ndepth = 1\n'
+        '[[operations]]\ntype = "profile"\ntool = 1\nlayers = ["EDGE"]\nside = "outside"\n'
+        "depth = 1\n",
+    )
+    done = run_job(drawing, load_target("grbl"), job)
+    (warning,) = [w for w in done.warnings if "a hole cut outside itself" in w]
+    assert warning.startswith("operation 1 (profile outside) cuts LWPOLYLINE")
