@@ -291,11 +291,12 @@ def _outermost(chains: Sequence[tuple[_Group, Contour]]) -> tuple[set[int], dict
     for each closed contour every contour around which is of another group (a hole on a
     layer of its own), that group's name (:func:`_what`), by id.
 
-    Inside as the planner nests them (:func:`~camtool.toolpath.order.nesting`), or mostly
-    inside: a contour that crosses a larger one's outline with more than
-    :data:`MOSTLY_INSIDE` of its area within it is a hole of that part drawn across its
-    edge (boxes.py's slots open at a part's edge poke 0.1 mm out of its outline), not a
-    part (shapely's intersection of the areas, :func:`~camtool.geometry.area.enclosed`).
+    Inside as the planner nests them (:func:`~camtool.toolpath.order.nesting`), or across
+    the edge: a contour that crosses a larger one's outline with more than
+    :data:`CUTOUT_SHARE` of its area within it is a cutout of that part drawn across its
+    edge (boxes.py's slots open at a part's edge poke 0.1 mm out of its outline, a notch
+    in ``OttoBody.svg`` lies 63 % outside), not a part (shapely's intersection of the
+    areas, :func:`~camtool.geometry.area.enclosed`).
     """
     from camtool.toolpath.order import nesting
 
@@ -304,7 +305,7 @@ def _outermost(chains: Sequence[tuple[_Group, Contour]]) -> tuple[set[int], dict
         return set(), {}
     nest = nesting([c for _, c in closed])
     top = [i for i in range(len(closed)) if not nest.parents[i]]
-    across = _mostly_inside([closed[i][1] for i in top])
+    across = _across_an_edge([closed[i][1] for i in top])
     around = {i: tuple(nest.parents[i]) for i in range(len(closed))}
     around.update({top[k]: (top[j],) for k, j in across.items()})
     foreign = {
@@ -315,12 +316,13 @@ def _outermost(chains: Sequence[tuple[_Group, Contour]]) -> tuple[set[int], dict
     return {id(closed[i][1]) for i in top if i not in {top[k] for k in across}}, foreign
 
 
-MOSTLY_INSIDE = 0.5
-"""Share of a contour's area within a larger closed contour that makes it a hole of it."""
+CUTOUT_SHARE = 0.01
+"""Share of a contour's area within a larger closed contour whose outline it crosses that
+makes it a cutout of it (a slot or notch at the part's edge); less is a touch."""
 
 
-def _mostly_inside(contours: Sequence[Contour]) -> dict[int, int]:
-    """For each of ``contours`` (closed) mostly inside a larger one, that one's index, by index."""
+def _across_an_edge(contours: Sequence[Contour]) -> dict[int, int]:
+    """For each of ``contours`` (closed) that is a cutout of a larger one, its index, by index."""
     if len(contours) < 2:
         return {}
     import shapely
@@ -333,13 +335,13 @@ def _mostly_inside(contours: Sequence[Contour]) -> dict[int, int]:
     for i, j in zip(a.tolist(), b.tolist(), strict=True):
         small, large = areas[i], areas[j]
         inside = i != j and large.area > small.area > 0
-        if inside and small.intersection(large).area > MOSTLY_INSIDE * small.area:
+        if inside and small.intersection(large).area > CUTOUT_SHARE * small.area:
             out.setdefault(i, j)
     return out
 
 
 _AREA_TOLERANCE_MM = 0.01
-"""Chord tolerance of the areas :func:`_mostly_inside` compares (mm)."""
+"""Chord tolerance of the areas :func:`_across_an_edge` compares (mm)."""
 
 
 def _ops_of(

@@ -137,3 +137,22 @@ def test_holes_of_another_colour_s_part_in_an_outside_colour_are_named(tmp_path:
     )
     black = next(line for line in text.splitlines() if "colour #000000 holds" in line)
     assert "but" not in black
+
+
+def test_a_notch_drawn_across_a_part_s_edge_is_cut_inside(tmp_path: Path) -> None:
+    """A blue square two thirds outside the black outline is a notch: cut on its inside.
+
+    boxes.py's ``OttoBody.svg`` draws a 3.8 mm notch 2.4 mm past a part's edge (37 % of
+    it inside); as the only blue shape outside every black one it made the blue colour
+    "hold an outermost contour", cut outside, into the part around it.
+    """
+    svg = tmp_path / "notch.svg"
+    svg.write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="60mm" viewBox="0 0 100 60">'
+        '<path d="M 10 10 H 50 V 50 H 10 Z" stroke="rgb(0,0,0)" fill="none"/>'
+        '<path d="M 48.6 28 H 52.4 V 31.8 H 48.6 Z" stroke="rgb(0,0,255)" fill="none"/>'
+        "</svg>"
+    )
+    text = initial_job(read_drawing(svg))
+    sides = [(op["colours"], op["side"]) for op in _ops(text)]
+    assert sides == [(["#0000ff"], "inside"), (["#000000"], "outside")]
