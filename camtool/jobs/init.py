@@ -13,6 +13,7 @@ import math
 from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 from camtool.geometry.chain import chain_members, joint_distance
 from camtool.jobs.job import Selection
@@ -329,12 +330,16 @@ def _across_an_edge(contours: Sequence[Contour]) -> dict[int, int]:
 
     from camtool.geometry.area import enclosed
 
-    areas = [enclosed(c.points(_AREA_TOLERANCE_MM)) for c in contours]
-    a, b = shapely.STRtree(areas).query(areas, predicate="intersects")
+    boxes = shapely.box(*zip(*(c.bbox() for c in contours), strict=True))
+    a, b = shapely.STRtree(boxes).query(boxes, predicate="intersects")
+    pairs = [(i, j) for i, j in zip(a.tolist(), b.tolist(), strict=True) if i != j]
+    areas: dict[int, Any] = {}  # only of the contours whose boxes meet another's
+    for k in sorted({k for pair in pairs for k in pair}):
+        areas[k] = enclosed(contours[k].points(_AREA_TOLERANCE_MM))
     out: dict[int, int] = {}
-    for i, j in zip(a.tolist(), b.tolist(), strict=True):
+    for i, j in pairs:
         small, large = areas[i], areas[j]
-        inside = i != j and large.area > small.area > 0
+        inside = large.area > small.area > 0 and small.intersects(large)
         if inside and small.intersection(large).area > CUTOUT_SHARE * small.area:
             out.setdefault(i, j)
     return out
