@@ -288,9 +288,9 @@ def _close_gap(groups: Sequence[_Group]) -> tuple[float, tuple[str, ...]]:
 def _outermost(chains: Sequence[tuple[_Group, Contour]]) -> tuple[set[int], dict[int, str]]:
     """Which closed contours are parts, and which are holes of another group's parts.
 
-    Returns the ids of the closed contours that lie inside no other closed contour, and
-    for each closed contour every contour around which is of another group (a hole on a
-    layer of its own), that group's name (:func:`_what`), by id.
+    Returns the ids of the closed contours that lie inside no other closed contour, and,
+    by id, the closed contours whose surrounding contours are all of other groups (holes on
+    a layer of their own), each with the name (:func:`_what`) of the group around it.
 
     Inside as the planner nests them (:func:`~camtool.toolpath.order.nesting`), or across
     the edge: a contour that crosses a larger one's outline with more than
@@ -314,7 +314,8 @@ def _outermost(chains: Sequence[tuple[_Group, Contour]]) -> tuple[set[int], dict
         for i, (g, c) in enumerate(closed)
         if (parents := around[i]) and all(closed[j][0] is not g for j in parents)
     }
-    return {id(closed[i][1]) for i in top if i not in {top[k] for k in across}}, foreign
+    cutouts = {top[k] for k in across}
+    return {id(closed[i][1]) for i in top if i not in cutouts}, foreign
 
 
 CUTOUT_SHARE = 0.01
