@@ -22,8 +22,7 @@ from camtool.model.construction import fit_extent, is_construction
 from camtool.model.errors import InputError
 from camtool.model.shapes import Contour, Drawing, distance, fit_factor
 from camtool.model.units import fmt_num
-from camtool.toolpath.chain import GAP_SHARE, close_gaps
-from camtool.toolpath.copies import one_way
+from camtool.toolpath.chain import GAP_SHARE, as_cut
 from camtool.toolpath.cuts import where
 from camtool.toolpath.gaps import option_value
 from camtool.toolpath.options import DEFAULT_CHAIN_TOLERANCE, DEFAULT_CLOSE_GAP
@@ -234,14 +233,13 @@ def _joined(group: _Group) -> list[Contour]:
 def _chains(group: _Group) -> list[Contour]:
     """:func:`_joined`'s chains as the job cuts them (made once per group).
 
-    As a job's selection judges them for ``closed``: gaps up to the job's ``close_gap``
-    closed (:func:`~camtool.toolpath.chain.close_gaps`), a line drawn twice one open line
-    (:func:`~camtool.toolpath.copies.one_way`).
+    As a job's selection judges them for ``closed``
+    (:func:`~camtool.toolpath.chain.as_cut`): gaps up to the job's ``close_gap`` closed, a
+    line drawn twice one open line.
     """
     if group.chained is None:
         joint = joint_distance(DEFAULT_CHAIN_TOLERANCE)
-        closed = close_gaps(_joined(group), group.close_gap, joint)[0]
-        group.chained = one_way(closed, joint)[0]
+        group.chained = as_cut(_joined(group), group.close_gap, joint)[0]
     return group.chained
 
 
@@ -267,14 +265,15 @@ def _close_gap(groups: Sequence[_Group]) -> tuple[float, tuple[str, ...]]:
                 meant.append((gap, chain))
             else:
                 limit = min(limit, gap)
+    meant.sort(key=lambda t: t[0])
     value, taken = "", 0
-    for gap, _ in sorted(meant, key=lambda t: t[0]):
+    for gap, _ in meant:
         if float(option_value(gap)) >= limit:
             break
         value, taken = option_value(gap), taken + 1
     if not value or float(value) <= DEFAULT_CLOSE_GAP:
         return DEFAULT_CLOSE_GAP, ()
-    shut = sorted(meant, key=lambda t: t[0])[:taken]
+    shut = meant[:taken]
     first = min((c for _, c in shut), key=lambda c: (c.start[1], c.start[0]))
     return float(value), (
         f"close_gap = {value}"

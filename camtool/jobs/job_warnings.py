@@ -33,8 +33,8 @@ def unselected(
     them: left out of a ``closed = true`` selection, they may be parts drawn for a laser.
     """
     from camtool.geometry.chain import chain_members
-    from camtool.toolpath.chain import close_gaps
-    from camtool.toolpath.copies import drop_copies, one_way
+    from camtool.toolpath.chain import as_cut
+    from camtool.toolpath.copies import drop_copies
 
     taken = {id(c) for r in runs for c in r.placed.contours}
     taken |= {id(c) for c in construction}
@@ -44,8 +44,7 @@ def unselected(
             left.setdefault(contour.layer, []).append(contour)
     out = []
     for layer, pieces in sorted(left.items()):
-        chains = close_gaps(chain_members(pieces, joint_mm)[0], close_gap, joint_mm)[0]
-        chains = one_way(chains, joint_mm)[0]
+        chains = as_cut(chain_members(pieces, joint_mm)[0], close_gap, joint_mm)[0]
         contours = drop_copies(chains, cut_before=[("", cut)])[0]
         if not contours:
             continue
@@ -62,16 +61,16 @@ def unselected(
 def _near_closed(contours: Sequence[Contour], joint_mm: float) -> str:
     """What closes the open ``contours`` whose own ends lie near (as ``post`` reports them).
 
-    Near: further apart than ``joint_mm``, within ``max(0.1 mm, NEAR_GAP_FACTOR ×
-    joint_mm)`` (:func:`camtool.toolpath.gaps.open_gaps`' reach) and under ``GAP_SHARE`` of
-    the contour's length (what ``close_gap`` closes). ``""`` when none is.
+    Near: further apart than ``joint_mm``, within :func:`camtool.toolpath.gaps.near_reach`
+    (as ``post`` reports gaps) and under ``GAP_SHARE`` of the contour's length (what
+    ``close_gap`` closes). ``""`` when none is.
     """
     from camtool.model.shapes import distance
     from camtool.model.units import fmt_num
     from camtool.toolpath.chain import GAP_SHARE
-    from camtool.toolpath.gaps import NEAR_GAP_FACTOR, option_value
+    from camtool.toolpath.gaps import near_reach, option_value
 
-    reach = max(0.1, NEAR_GAP_FACTOR * joint_mm)
+    reach = near_reach(joint_mm)
     gaps = [
         gap
         for c in contours

@@ -46,8 +46,7 @@ from camtool.model.program import (
 )
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import Arc, Contour, Drawing, Point, arc_length, circle_of
-from camtool.toolpath.chain import close_gaps
-from camtool.toolpath.copies import one_way
+from camtool.toolpath.chain import as_cut
 from camtool.toolpath.options import PlanOptions
 
 if TYPE_CHECKING:
@@ -440,8 +439,7 @@ def _chaining(drawing: Drawing, scaled: Drawing, joint_mm: float, close_gap: flo
 
     def shapes(contours: Sequence[Contour]) -> list[Shape]:
         joined, members = chain_members([as_scaled[id(c)] for c in contours], joint_mm)
-        joined = close_gaps(joined, close_gap, joint_mm)[0]
-        joined = one_way(joined, joint_mm)[0]  # a line drawn twice is an open line
+        joined = as_cut(joined, close_gap, joint_mm)[0]  # a line drawn twice: one open line
         out = [Shape(False, None)] * len(contours)
         for chain, pieces in zip(joined, members, strict=True):
             circle = None

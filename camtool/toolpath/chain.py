@@ -2,7 +2,8 @@
 
 Chaining (contours whose ends meet within the tolerance, joined exactly) is the shared
 :func:`camtool.geometry.chain.chain`; :func:`close_gaps` then closes contours whose ends
-nearly meet (a larger gap, reported).
+nearly meet (a larger gap, reported), and :func:`as_cut` takes chains the way the planner
+cuts them (gaps closed, paths drawn out and back taken one way).
 """
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ from collections.abc import Sequence
 
 from camtool.model.shapes import Contour, Line, distance
 from camtool.model.units import fmt_point
+from camtool.toolpath.copies import one_way
 from camtool.toolpath.cuts import Finding, where
 
 GAP_SHARE = 0.1
@@ -66,3 +68,29 @@ def close_gaps(
             )
         )
     return out, findings
+
+
+def as_cut(
+    joined: Sequence[Contour], close_gap: float, joint_mm: float, *, open_too: bool = True
+) -> tuple[list[Contour], list[Finding]]:
+    """Chained contours as the planner cuts them, one per chain, in order.
+
+    Gaps up to ``close_gap`` mm closed (:func:`close_gaps`), then each contour that comes
+    back on its own path taken one way (:func:`~camtool.toolpath.copies.one_way`): in that
+    order, which every judge of what is cut shares (the planner, a job's selection and its
+    not-cut note, ``job init``).
+
+    Args:
+        joined: contours chained ``joint_mm`` apart at most
+            (:func:`~camtool.geometry.chain.chain_members`), mm.
+        close_gap: largest gap closed, mm (≥ 0).
+        joint_mm: the chaining distance, mm.
+        open_too: an open contour drawn out and back is taken one way too (as
+            :func:`~camtool.toolpath.copies.one_way`'s); the planner under a side keeps it.
+
+    Returns:
+        The contours, and the ``closed-gap`` and ``copy`` findings.
+    """
+    closed, found = close_gaps(joined, close_gap, joint_mm)
+    out, back = one_way(closed, joint_mm, open_too=open_too)
+    return out, found + back

@@ -55,7 +55,7 @@ def open_gaps(contours: Sequence[Contour], options: PlanOptions) -> list[Finding
     if len(ends) < 2:
         return []
     joint = joint_distance(options.chain_tolerance)
-    near = max(0.1, NEAR_GAP_FACTOR * joint)
+    near = near_reach(joint)
     xy = np.array([p for _, p in ends], dtype=np.float64)
     owner = np.array([index for index, _ in ends])
     points = shapely.points(xy)
@@ -96,6 +96,15 @@ def open_gaps(contours: Sequence[Contour], options: PlanOptions) -> list[Finding
             )
         )
     return out
+
+
+def near_reach(joint_mm: float) -> float:
+    """How far apart (mm) open ends may lie and still be reported as a gap to join.
+
+    ``max(0.1 mm, NEAR_GAP_FACTOR × joint_mm)`` for the chaining distance ``joint_mm``:
+    further apart, they are meant to be apart.
+    """
+    return max(0.1, NEAR_GAP_FACTOR * joint_mm)
 
 
 class _Exact:

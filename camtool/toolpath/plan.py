@@ -21,8 +21,8 @@ from camtool.model.errors import InputError
 from camtool.model.program import Move, Program, Rapid
 from camtool.model.progress import Progress, no_progress
 from camtool.model.shapes import BBox, Contour, Drawing, Line, Point, Segment, fit_factor
-from camtool.toolpath.chain import close_gaps
-from camtool.toolpath.copies import drop_copies, drop_near_copies, one_way
+from camtool.toolpath.chain import as_cut
+from camtool.toolpath.copies import drop_copies, drop_near_copies
 from camtool.toolpath.cuts import Cut, Finding, Stage, finding_warnings
 from camtool.toolpath.gaps import open_gaps
 from camtool.toolpath.leads import KeepOff
@@ -281,9 +281,7 @@ def chained(
     """
     joint = joint_distance(options.chain_tolerance)
     joined, members = chain_members(contours, joint)
-    joined, found = close_gaps(joined, options.close_gap, joint)
-    joined, back = one_way(joined, joint, open_too=options.offset == "on")
-    found.extend(back)
+    joined, found = as_cut(joined, options.close_gap, joint, open_too=options.offset == "on")
     left_out = frozenset(
         i
         for contour, pieces in zip(joined, members, strict=True)
