@@ -18,13 +18,19 @@ from camtool.model.shapes import Contour, Point
 from camtool.toolpath.cuts import Cut, Finding, where
 from camtool.toolpath.options import PlanOptions
 
-__all__ = ["polygons", "quad_segs", "swept_area", "uncut_findings"]
+__all__ = ["polygons", "quad_segs", "sweep_piece", "swept_area", "uncut_findings"]
 
 MAX_REPORTED = 5
 """Uncut pieces reported one by one per pocket; the rest are counted."""
 
 SWEEP_PIECE = 4096
 """Most points of one piece of a path buffered at once by :func:`swept_area`."""
+
+MIN_SWEEP_PIECE = 64
+"""Fewest points a piece is cut to for a small step-over (:func:`sweep_piece`)."""
+
+_PIECE_STEPOVER = 0.4
+"""The step-over (fraction of the tool diameter) at which pieces hold :data:`SWEEP_PIECE` points."""
 
 _MIN_QUAD_SEGS = 8
 _MAX_QUAD_SEGS = 1024
@@ -52,21 +58,38 @@ def quad_segs(radius: float, tolerance: float) -> int:
     return min(_MAX_QUAD_SEGS, max(_MIN_QUAD_SEGS, math.ceil(math.pi / 2 / chord_angle)))
 
 
-def swept_area(paths: Sequence[Contour], radius: float, tolerance: float) -> BaseGeometry:
+def sweep_piece(stepover: float) -> int:
+    """Points per piece for :func:`swept_area` of a pocket cut at ``stepover`` (fraction, (0, 1]).
+
+    A pocket's passes lie a step-over apart, so about ``1 / stepover`` of them pass
+    within the tool's width of each other, and a piece holding many passes overlaps
+    itself that many times: GEOS's buffer of such a piece costs far more than the union
+    of smaller pieces' buffers (a 0.3 % step-over with pieces of :data:`SWEEP_PIECE`
+    points: seconds per pocket). The pieces shrink with the step-over, from
+    :data:`SWEEP_PIECE` points at :data:`_PIECE_STEPOVER` to :data:`MIN_SWEEP_PIECE`.
+    """
+    scaled = round(SWEEP_PIECE * stepover / _PIECE_STEPOVER)
+    return min(SWEEP_PIECE, max(MIN_SWEEP_PIECE, scaled))
+
+
+def swept_area(
+    paths: Sequence[Contour], radius: float, tolerance: float, *, piece: int = SWEEP_PIECE
+) -> BaseGeometry:
     """Area a round tool of ``radius`` mm sweeps along ``paths`` (arcs as chords), mm².
 
-    Each path is buffered in pieces of at most :data:`SWEEP_PIECE` points (consecutive
-    pieces share their end point) and the pieces' areas united: the same area, since the
-    tool's sweep of a path is the union of its sweeps of the path's pieces. GEOS nodes a
+    Each path is buffered in pieces of at most ``piece`` points (≥ 2; consecutive pieces
+    share their end point) and the pieces' areas united: the same area, since the tool's
+    sweep of a path is the union of its sweeps of the path's pieces. GEOS nodes a
     buffer's whole offset curve at once, and a pocket's linked rings, which pass beside
-    themselves at every step-over, made one buffer of the whole path take seconds.
+    themselves at every step-over, made one buffer of the whole path take seconds
+    (:func:`sweep_piece` sizes the pieces for a pocket's step-over).
     """
     quad = quad_segs(radius, tolerance)
     pieces = [
-        LineString(xy[i : i + SWEEP_PIECE])
+        LineString(xy[i : i + piece])
         for p in paths
         for xy in (np.asarray(p.points(tolerance / 4), dtype=float),)
-        for i in range(0, max(1, len(xy) - 1), SWEEP_PIECE - 1)
+        for i in range(0, max(1, len(xy) - 1), piece - 1)
     ]
     return shapely.union_all(shapely.buffer(np.array(pieces, dtype=object), radius, quad_segs=quad))
 
@@ -99,7 +122,8 @@ def uncut_findings(
                 area.area,
             )
         ]
-    swept = swept_area([c.path for c in cuts], options.radius + tol, tol)
+    piece = sweep_piece(options.stepover)
+    swept = swept_area([c.path for c in cuts], options.radius + tol, tol, piece=piece)
     threshold = (0.01 * d) ** 2
     pieces = [p for p in polygons(area.difference(swept)) if p.area > threshold]
     centres, zone = _corners(area, options.radius)

@@ -364,10 +364,12 @@ def test_clearing_pockets_tells_its_progress_region_by_region() -> None:
     assert steps == [Step("pocketing", n, 2) for n in range(3)]
 
 
-def test_swept_area_of_a_long_path_is_the_buffer_of_the_whole_path() -> None:
-    # A spiral of 3 turns 0.5 mm apart as ~12 000 chords (three SWEEP_PIECE pieces), swept
-    # by r = 0.2: the pieces' union must be GEOS's buffer of the whole line, computed here
-    # at once, and (the turns 2r apart) a band 2r wide along the line with a disc at its ends.
+@pytest.mark.parametrize("piece", [4096, 64, 2])
+def test_swept_area_of_a_long_path_is_the_buffer_of_the_whole_path(piece: int) -> None:
+    # A spiral of 3 turns 0.5 mm apart as ~12 000 chords (three pieces of SWEEP_PIECE
+    # points, or ~190 of the smallest, or one per chord), swept by r = 0.2: the pieces'
+    # union must be GEOS's buffer of the whole line, computed here at once, and (the turns
+    # 2r apart) a band 2r wide along the line with a disc at its ends.
     from camtool.toolpath.pocket_uncut import SWEEP_PIECE, quad_segs, swept_area
 
     n = 3 * SWEEP_PIECE
@@ -381,10 +383,51 @@ def test_swept_area_of_a_long_path_is_the_buffer_of_the_whole_path() -> None:
     path = Contour(tuple(Line(a, b) for a, b in itertools.pairwise(pts)), False)
     r = 0.2
     whole = LineString(pts).buffer(r, quad_segs=quad_segs(r, TOL))
-    swept = swept_area([path], r, TOL)
-    assert swept.area == pytest.approx(whole.area, rel=1e-9)
-    assert swept.symmetric_difference(whole).area < 1e-6  # float noise of the cuts, mm²
+    swept = swept_area([path], r, TOL, piece=piece)
+    if piece == SWEEP_PIECE:
+        assert swept.area == pytest.approx(whole.area, rel=1e-9)
+        assert swept.symmetric_difference(whole).area < 1e-6  # float noise of the cuts, mm²
+    else:
+        # each join between pieces is two round caps' chords instead of the one line's
+        # join: both within TOL / 4 of the true circle (quad_segs), so the areas differ by
+        # at most a band TOL / 4 thick along the outline
+        assert swept.symmetric_difference(whole).area <= TOL / 4 * whole.length
     assert swept.area == pytest.approx(2 * r * LineString(pts).length + math.pi * r * r, rel=1e-3)
+
+
+def test_a_small_stepover_sweeps_its_pocket_in_pieces_that_hold_few_passes(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # At a step-over of 0.3 % of a 3 mm tool, ~110 passes lie within the tool's width of
+    # each other; a rectangle's rings are 4-8 points each, so a piece of SWEEP_PIECE points
+    # would hold hundreds of passes over one another (a job took 100 s and 3 GB in GEOS's
+    # buffer of them). The uncut check must cut its path into pieces of at most
+    # MIN_SWEEP_PIECE points there, and of SWEEP_PIECE at the default step-over.
+    import shapely
+
+    from camtool.toolpath import pocket_uncut
+    from camtool.toolpath.pocket_uncut import MIN_SWEEP_PIECE, SWEEP_PIECE
+
+    biggest: list[int] = []
+    real = shapely.buffer
+
+    def spy(geometry: object, *args: object, **kw: object) -> object:
+        sizes = shapely.get_num_coordinates(geometry)
+        biggest.append(int(sizes.max()) if hasattr(sizes, "max") else int(sizes))
+        return real(geometry, *args, **kw)
+
+    monkeypatch.setattr(pocket_uncut.shapely, "buffer", spy)
+    stage = _plan([rect(0, 0, 12, 8)], 3.0, stepover=0.003)
+    assert biggest and max(biggest) <= MIN_SWEEP_PIECE
+    passes = sum(len(c.path.segments) for c in stage.cuts)
+    assert passes > 10 * MIN_SWEEP_PIECE  # the path is far longer than one piece
+    assert not [f for f in stage.findings if f.kind == "uncut"]  # nothing left between passes
+    biggest.clear()
+    _plan([rect(0, 0, 12, 8)], 3.0)
+    assert 2 < max(biggest) <= SWEEP_PIECE
+    assert pocket_uncut.sweep_piece(0.4) == SWEEP_PIECE
+    assert pocket_uncut.sweep_piece(0.1) == SWEEP_PIECE // 4
+    assert pocket_uncut.sweep_piece(1e-6) == MIN_SWEEP_PIECE
 
 
 def test_an_arc_drawn_there_and_back_is_a_pocket_of_no_area_not_one_that_crosses_itself() -> None:
