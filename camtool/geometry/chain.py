@@ -46,7 +46,9 @@ def chain_members(
 
     Closed contours pass through unchanged. Open contours are extended forwards
     then backwards, reversing a neighbour where its far end is the one that
-    meets; the first contour of a chain keeps its drawn direction. Where more than
+    meets; the first contour of a chain keeps its drawn direction. A gap wider than
+    :data:`FREE_JOINT_MM` joins a piece (or closes a chain) only if it is at most
+    :data:`JOINT_SHARE` of that piece's (chain's) length. Where more than
     two ends meet (a T, two rectangles drawn with a side in common), an open chain that
     comes back to a point it passed (within :data:`LOOP_JOINT_MM`) is split there: the loop
     between is a closed contour of its own (:func:`_loops`), not buried in an open chain a
@@ -117,9 +119,34 @@ def chain_members(
 
 
 def _closes(segs: Sequence[Segment], tolerance: float) -> bool:
-    """Whether a run of segments ending within ``tolerance`` of its start is closed."""
-    meets = distance(segs[-1].end, segs[0].start) <= tolerance
-    return meets and (len(segs) > 1 or closes_alone(segs[0]))
+    """Whether a run of segments ending within ``tolerance`` of its start is closed.
+
+    A gap wider than :data:`FREE_JOINT_MM` closes it only if it is short beside the
+    run (:func:`_bridges`).
+    """
+    gap = distance(segs[-1].end, segs[0].start)
+    if gap > tolerance or not (len(segs) > 1 or closes_alone(segs[0])):
+        return False
+    return _bridges(gap, Contour(tuple(segs), False))
+
+
+FREE_JOINT_MM = 0.01
+"""Gaps up to this (mm; the default ``--chain-tolerance``) join whatever the pieces' lengths."""
+
+JOINT_SHARE = 0.5
+"""A wider gap joins only a piece (or closes a chain) at least ``1 / JOINT_SHARE`` times as
+long as the gap: a wide ``--chain-tolerance`` bridges gaps between pieces drawn to meet,
+and must not snap one short line onto another a few of its lengths away (two 10 mm lines
+50 mm apart at ``--chain-tolerance 100`` made a line there and back: one was never cut)."""
+
+
+def _bridges(gap: float, piece: Contour) -> bool:
+    """Whether a joint across ``gap`` mm may join (or close) ``piece``.
+
+    Its length is measured only for a gap wider than :data:`FREE_JOINT_MM`, and not kept
+    (:meth:`~camtool.model.shapes.Contour.length_unkept`).
+    """
+    return gap <= FREE_JOINT_MM or gap <= JOINT_SHARE * piece.length_unkept()
 
 
 LOOP_JOINT_MM = 0.001
@@ -255,8 +282,11 @@ def _extend(
         if found is None:
             return
         index, at_start = found
-        used.add(index)
         piece = pieces[index]
+        end = piece.segments[0].start if at_start else piece.segments[-1].end
+        if not _bridges(distance(here, end), piece):
+            return  # a gap as long as the piece is no joint: the piece is another line
+        used.add(index)
         if forward:
             nxt = piece if at_start else piece.reversed()
             new = list(nxt.segments)

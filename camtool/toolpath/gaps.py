@@ -13,7 +13,7 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
-from camtool.geometry.chain import joint_distance
+from camtool.geometry.chain import FREE_JOINT_MM, JOINT_SHARE, joint_distance
 from camtool.model.shapes import Contour, Point
 from camtool.model.units import fmt_num, fmt_point
 from camtool.toolpath.chain import GAP_SHARE
@@ -33,9 +33,12 @@ def open_gaps(contours: Sequence[Contour], options: PlanOptions) -> list[Finding
 
     An end is *near* when the nearest other open end (of another contour, or the
     contour's own other end) is further than the chaining tolerance but within
-    ``max(0.1 mm, NEAR_GAP_FACTOR × tolerance)``. The message names the contour, the gap
-    and the ``--chain-tolerance`` (another contour) or ``--close-gap`` (its own
-    ends) that would join it.
+    ``max(0.1 mm, NEAR_GAP_FACTOR × tolerance)``, and the gap is one chaining would
+    bridge: under a tenth of the contour's length for its own ends (a "C" is drawn open),
+    and for two contours within :data:`~camtool.geometry.chain.FREE_JOINT_MM` or under
+    :data:`~camtool.geometry.chain.JOINT_SHARE` of the shorter one's length. The message
+    names the contour, the gap and the ``--chain-tolerance`` (another contour) or
+    ``--close-gap`` (its own ends) that would join it.
 
     Args:
         contours: chained and closed-where-possible contours, mm.
@@ -74,6 +77,14 @@ def open_gaps(contours: Sequence[Contour], options: PlanOptions) -> list[Finding
             share = GAP_SHARE * contours[owner[a[k]]].length_unkept()
             keep[k] = not exact.above(np.array([k]), share, inclusive=True)[0]  # a "C": drawn
             # open on purpose (close_gaps leaves it too)
+        wide = exact.above(np.arange(len(a)), FREE_JOINT_MM)
+        for k in np.flatnonzero(keep & wide & (owner[a] != owner[b])):
+            # two contours: ends further apart than half the shorter one are drawn
+            # apart, and no --chain-tolerance joins them (geometry.chain.JOINT_SHARE)
+            shorter = min(
+                contours[owner[a[k]]].length_unkept(), contours[owner[b[k]]].length_unkept()
+            )
+            keep[k] = not exact.above(np.array([k]), JOINT_SHARE * shorter)[0]
         near_gaps = np.flatnonzero(keep)  # the near gaps, in the order the tree gives them
         if len(near_gaps):
             kept += len(near_gaps)

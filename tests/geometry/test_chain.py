@@ -216,3 +216,27 @@ def test_a_wide_chaining_tolerance_makes_no_loop_of_details_smaller_than_it() ->
     joined, members = chain_members(_lines(list(itertools.pairwise(corners))), 0.5)
     assert [c.closed for c in joined] == [False] and members[0] == tuple(range(60))
     assert [s.start for s in joined[0].segments] == corners[:-1]
+
+
+def test_a_wide_chain_tolerance_does_not_snap_a_line_onto_another_lengths_away() -> None:
+    # Two 10 mm lines 50 mm apart at a 100 mm tolerance: snapped end to end they would
+    # make a line there and back (one of them never cut). A gap of more than half of
+    # a piece's length is no joint; the lines stay as drawn, each open.
+    lines = _lines([((0.0, 0.0), (10.0, 0.0)), ((60.0, 0.0), (70.0, 0.0))])
+    out = chain(lines, 100.0)
+    assert [(c.closed, c.start, c.end) for c in out] == [
+        (False, (0.0, 0.0), (10.0, 0.0)),
+        (False, (60.0, 0.0), (70.0, 0.0)),
+    ]
+    # a square drawn open by 0.5 mm at one corner (40 mm round) still closes at 0.6 mm,
+    # and pieces 10 mm long still join across 0.5 mm gaps
+    sides = [((0.5, 0.0), (10.0, 0.0)), ((10.0, 0.0), (10.0, 10.0)), ((10.0, 10.0), (0.0, 10.0))]
+    square = _lines([*sides, ((0.0, 10.0), (0.0, 0.0))])
+    assert [c.closed for c in chain(square, 0.6)] == [True]
+    apart = _lines([((0.0, 0.0), (10.0, 0.0)), ((10.5, 0.0), (20.0, 0.0))])
+    joined = chain(apart, 0.6)
+    assert len(joined) == 1
+    assert (joined[0].start, joined[0].end) == ((0.0, 0.0), (20.0, 0.0))
+    # but a chain shorter than twice its closing gap does not close
+    corner = _lines([((0.0, 0.0), (1.0, 0.0)), ((1.0, 0.0), (1.0, 1.0))])
+    assert [c.closed for c in chain(corner, 2.0)] == [False]

@@ -16,7 +16,7 @@ from collections.abc import Sequence
 import numpy as np
 import pytest
 
-from camtool.geometry.chain import joint_distance
+from camtool.geometry.chain import FREE_JOINT_MM, JOINT_SHARE, joint_distance
 from camtool.model.shapes import Contour, Line
 from camtool.model.units import fmt_num
 from camtool.toolpath.chain import GAP_SHARE
@@ -50,6 +50,9 @@ def _reference(contours: Sequence[Contour], options: PlanOptions) -> list[Findin
     for (a, b), gap in sorted(best.items(), key=lambda item: item[1]):
         if ends[a][0] == ends[b][0] and gap >= GAP_SHARE * contours[ends[a][0]].length:
             continue
+        shorter = min(contours[ends[a][0]].length, contours[ends[b][0]].length)
+        if ends[a][0] != ends[b][0] and gap > max(FREE_JOINT_MM, JOINT_SHARE * shorter):
+            continue  # drawn apart: no chaining tolerance joins them
         found.append((gap, _finding(contours, ends[a], ends[b], gap, options)))
     out = [f for _, f in found[:MAX_REPORTED]]
     if len(found) > MAX_REPORTED:
@@ -70,14 +73,18 @@ def _line(x0: float, y0: float, x1: float, y1: float) -> Contour:
     return Contour((Line((x0, y0), (x1, y1)),), False)
 
 
-def _grid(n: int, seed: int) -> list[Contour]:
-    """Loose 0.5 mm lines on a 1 mm grid, some drawn backwards (bench_large's "disjoint")."""
+def _grid(n: int, seed: int, length: float) -> list[Contour]:
+    """Loose lines ``length`` mm long on a 1 mm grid, some drawn backwards.
+
+    0.5 mm: bench_large's "disjoint", every gap too wide beside its lines to join; 0.95 mm:
+    gaps of 0.05 mm between a row's lines, which chaining would bridge.
+    """
     rng = random.Random(seed)
     out = []
     side = math.ceil(math.sqrt(n))
     for k in range(n):
         x, y = float(k % side), float(k // side)
-        out.append(_line(x + 0.5, y, x, y) if rng.random() < 0.3 else _line(x, y, x + 0.5, y))
+        out.append(_line(x + length, y, x, y) if rng.random() < 0.3 else _line(x, y, x + length, y))
     rng.shuffle(out)
     return out
 
@@ -102,9 +109,13 @@ def _at_the_limits(seed: int) -> list[Contour]:
 
 @pytest.mark.parametrize("seed", range(4))
 def test_loose_lines_on_a_grid_give_the_same_findings(seed: int) -> None:
-    contours = _grid(900 + 37 * seed, seed)
-    options = PlanOptions(chain_tolerance=0.02 * (seed + 1))
-    assert open_gaps(contours, options) == _reference(contours, options)
+    options = PlanOptions(chain_tolerance=0.01 * (seed + 1))
+    near = _grid(900 + 37 * seed, seed, 0.95)
+    found = open_gaps(near, options)
+    assert found == _reference(near, options)
+    assert len(found) == MAX_REPORTED + 1  # the row's gaps, and the line counting the rest
+    apart = _grid(900 + 37 * seed, seed, 0.5)
+    assert open_gaps(apart, options) == _reference(apart, options) == []
 
 
 @pytest.mark.parametrize("seed", range(6))
