@@ -537,8 +537,8 @@ _POST_OPTIONS = (
         default=0.001,
         show_default=True,
         metavar="MM",
-        help="Curve tolerance (mm): fitted arcs, flattened curves and chords stay this "
-        "close to what they replace (chaining uses --chain-tolerance).",
+        help="Curve tolerance (mm, at most 1): fitted arcs, flattened curves and chords stay "
+        "this close to what they replace (chaining uses --chain-tolerance).",
     ),
     click.option(
         "--scale",

@@ -289,6 +289,11 @@ class PlanOptions:
                 f"--tolerance must be at least {MIN_TOLERANCE_MM:g} mm (1 nm, below every "
                 f"machine step camtool writes for), got {self.tolerance!r}"
             )
+        if self.tolerance > MAX_TOLERANCE_MM:
+            raise UsageError(
+                f"--tolerance must be at most {MAX_TOLERANCE_MM:g} mm (the fitted arcs and "
+                f"lines may lie that far from the drawing), got {self.tolerance!r}"
+            )
         if self.close_gap < 0:
             raise UsageError(f"--close-gap must be ≥ 0 mm, got {self.close_gap!r}")
         if not 0 < self.stepover <= 1:
@@ -422,6 +427,10 @@ MAX_SCALE = 1e6
 
 MIN_TOLERANCE_MM = 1e-6
 """Smallest ``--tolerance`` (mm): chords and fitted arcs finer than 1 nm only cost time."""
+
+MAX_TOLERANCE_MM = 1.0
+"""Largest ``--tolerance`` (mm): the toolpath may lie this far from the drawing, already
+coarser than any part is cut to; a larger value is a slip (10 for 0.010)."""
 
 MAX_PASSES = 10_000
 """Most depth passes a plan may have (``--depth`` / ``--step-down``)."""

@@ -113,3 +113,34 @@ def test_a_negative_tool_diameter_is_refused_naming_the_option_before_any_readin
     err = capsys.readouterr().err
     assert "--tool-diameter" in err and "-1" in err
     assert "O100" not in err and "O-word" not in err
+
+
+@pytest.mark.parametrize("value", ["10", "1.5"])
+def test_a_tolerance_past_a_millimetre_is_refused_as_a_slip(
+    value: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # --tolerance 10 let every fitted arc and line lie 10 mm from the drawing: a pocket's
+    # rounded ring corners were cut square, with exit 0 (10 for 0.010, a slip); 1 mm is
+    # the most a toolpath may stray, for post, a re-post and a job's [job] tolerance alike
+    out = tmp_path / "p.gcode"
+    code = main(
+        ["post", str(SAMPLES / "plate.dxf"), "-t", "grbl", "-o", str(out), "--tolerance", value]
+    )
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert "--tolerance must be at most 1 mm" in err and f"got {float(value)!r}" in err
+    assert not out.exists()
+    job = tmp_path / "j.toml"
+    job.write_text(
+        (SAMPLES / "part.toml").read_text().replace("[job]", f"[job]\ntolerance = {value}")
+    )
+    code = main(
+        ["post", str(SAMPLES / "part.dxf"), "-t", "grbl", "-o", str(out), "--job", str(job)]
+    )
+    assert code == 3
+    assert "[job]: tolerance must be at most 1 mm" in capsys.readouterr().err
+    assert not out.exists() and not list(tmp_path.glob("p*"))
+    code = main(
+        ["post", str(SAMPLES / "plate.dxf"), "-t", "grbl", "-o", str(out), "--tolerance", "1"]
+    )
+    assert code == 0, capsys.readouterr().err
