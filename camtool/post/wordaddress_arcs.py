@@ -32,6 +32,25 @@ _CONFORMED_KEPT = 20_000
 """Arcs whose blocks a writer keeps (:meth:`ArcWriter._conformed`); then it starts anew."""
 ARC_CHORD_TOLERANCE_MM = 0.002
 """Chord deviation, mm, of an arc no printable centre can write (GRBL's default ``$12``)."""
+TINY_ARC_MM = 0.01
+"""An arc of at most this radius (mm) that no printed centre writes within ten quanta of
+the dialect is a speck: a line to its end. A larger one is a line only where it lies within
+a quantum of that line (:func:`_near_its_chord`): a dialect of whole millimetres must not
+drop a 7 mm circle."""
+
+
+def _near_its_chord(arc: Arc, quantum: float) -> bool:
+    """Whether every point of ``arc`` lies within ``quantum`` mm of the line start to end."""
+    (x0, y0), (x1, y1) = arc.start, arc.end
+    dx, dy = x1 - x0, y1 - y0
+    length2 = dx * dx + dy * dy
+    for x, y in arc.points(quantum / 4):
+        t = 0.0 if length2 == 0.0 else max(0.0, min(1.0, ((x - x0) * dx + (y - y0) * dy) / length2))
+        if math.hypot(x - x0 - t * dx, y - y0 - t * dy) > quantum:
+            return False
+    return True
+
+
 CHORD: Point = (math.nan, math.nan)
 """The centre of a conformed block that is a chord of such an arc (by identity)."""
 FAR_CHORD: Point = (math.nan, math.nan)
@@ -178,7 +197,9 @@ class ArcWriter(WordWriter):
             out = self.checked(self.written, piece.end, piece.centre, piece.clockwise, piece.start)
         except DialectError:
             quantum = self.spec.quantum_mm()
-            if piece.radius <= 10 * quantum:
+            if piece.radius <= 10 * quantum and (
+                piece.radius <= TINY_ARC_MM or _near_its_chord(piece, quantum)
+            ):
                 return [(piece.end, None)]
             equalised = self._conform_equalised(piece, quantum)
             if equalised is None:

@@ -6,6 +6,7 @@ test_grbl_linuxcnc.py; here a dialect is whatever a [dialect_options] table says
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 from pathlib import Path
@@ -391,6 +392,36 @@ def test_arc_too_small_for_the_resolution_becomes_a_line() -> None:
     lines, warnings = emit(options, (Rapid(1, 1), ArcMove(1.0006, 1, 1.0003, 1, True, 100.0)))
     assert lines[1] == "G1 X1.001 Y1.000"
     assert "1 arc(s) too small for the 0.001 mm" in warnings[-1]
+
+
+def test_an_arc_of_millimetres_at_a_dialect_of_whole_millimetres_is_chords_not_one_line() -> None:
+    # A 240° arc of radius 7.3 mm no printed centre writes within GRBL's arc check at
+    # 0 decimals: it was "too small for the 1 mm the dialect writes" and became one line
+    # from its start to its end, 11 mm from the arc's far side (exit 0). It is chords now:
+    # by analysis each within 2 quanta of the arc (the chord tolerance) plus the half
+    # quantum each printed end may move, so every point of the arc lies within 2.71 mm
+    # of the written path.
+    c, r = (20.4, 20.3), 7.3
+    a0, a1 = math.radians(-40.0), math.radians(200.0)
+    start = (c[0] + r * math.cos(a0), c[1] + r * math.sin(a0))
+    end = (c[0] + r * math.cos(a1), c[1] + r * math.sin(a1))
+    options = {"words": {"XYIJ": {"decimals": 0}}, "arc_check": "grbl"}
+    lines, warnings = emit(options, (Rapid(*start), ArcMove(*end, *c, False, 100.0)))
+    assert not [w for w in warnings if "too small" in w]
+    path = [tuple(float(v) for v in re.findall(r"[XY](-?\d+)", line)) for line in lines]
+    assert lines[0].startswith("G0") and all(line.startswith("G1") for line in lines[1:])
+
+    def apart(p: tuple[float, float]) -> float:
+        best = math.inf
+        for (x0, y0), (x1, y1) in itertools.pairwise(path):
+            dx, dy = x1 - x0, y1 - y0
+            t = max(0.0, min(1.0, ((p[0] - x0) * dx + (p[1] - y0) * dy) / (dx * dx + dy * dy)))
+            best = min(best, math.hypot(p[0] - x0 - t * dx, p[1] - y0 - t * dy))
+        return best
+
+    samples = [a0 + (a1 - a0) * k / 400 for k in range(401)]
+    worst = max(apart((c[0] + r * math.cos(a), c[1] + r * math.sin(a))) for a in samples)
+    assert worst <= 2.0 + math.sqrt(0.5), worst
 
 
 def test_an_arc_whose_ends_print_the_same_is_a_tiny_arc_or_a_full_circle() -> None:
