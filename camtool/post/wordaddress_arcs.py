@@ -33,22 +33,20 @@ _CONFORMED_KEPT = 20_000
 ARC_CHORD_TOLERANCE_MM = 0.002
 """Chord deviation, mm, of an arc no printable centre can write (GRBL's default ``$12``)."""
 TINY_ARC_MM = 0.01
-"""An arc of at most this radius (mm) that no printed centre writes within ten quanta of
-the dialect is a speck: a line to its end. A larger one is a line only where it lies within
-a quantum of that line (:func:`_near_its_chord`): a dialect of whole millimetres must not
-drop a 7 mm circle."""
+"""Radius (mm) up to which an arc that no printed centre writes (and of under ten quanta) is
+a speck, written as a line to its end. A larger one is a line only where it lies within a
+quantum of that line (:func:`_near_its_chord`), else chords: a dialect of whole millimetres
+must not cut a 130° arc of 6 mm radius as one straight line."""
 
 
 def _near_its_chord(arc: Arc, quantum: float) -> bool:
     """Whether every point of ``arc`` lies within ``quantum`` mm of the line start to end."""
-    (x0, y0), (x1, y1) = arc.start, arc.end
-    dx, dy = x1 - x0, y1 - y0
-    length2 = dx * dx + dy * dy
-    for x, y in arc.points(quantum / 4):
-        t = 0.0 if length2 == 0.0 else max(0.0, min(1.0, ((x - x0) * dx + (y - y0) * dy) / length2))
-        if math.hypot(x - x0 - t * dx, y - y0 - t * dy) > quantum:
-            return False
-    return True
+    import numpy as np  # here: only an arc no printed centre writes comes this way
+
+    from camtool.geometry.arcfit import dist_line
+
+    xy = np.asarray(arc.points(quantum / 4), dtype=float)
+    return bool(dist_line(xy, arc.start, arc.end).max() <= quantum)
 
 
 CHORD: Point = (math.nan, math.nan)

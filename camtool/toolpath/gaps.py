@@ -64,6 +64,7 @@ def open_gaps(contours: Sequence[Contour], options: PlanOptions) -> list[Finding
     points = shapely.points(xy)
     tree = shapely.STRtree(points)
     least: list[tuple[float, int, int, int]] = []  # (gap, pair number, a, b)
+    lengths: dict[int, float] = {}  # of the contours a wide gap was judged against
     kept, largest, offset = 0, 0.0, 0
     for lo in range(0, len(points), _QUERY_CHUNK):
         # the pairs of a run of ends at a time: all of them at once are ~100 bytes a pair,
@@ -82,7 +83,7 @@ def open_gaps(contours: Sequence[Contour], options: PlanOptions) -> list[Finding
             # two contours: ends further apart than half the shorter one are drawn
             # apart, and no --chain-tolerance joins them (geometry.chain.JOINT_SHARE)
             shorter = min(
-                contours[owner[a[k]]].length_unkept(), contours[owner[b[k]]].length_unkept()
+                _length(contours, lengths, owner[a[k]]), _length(contours, lengths, owner[b[k]])
             )
             keep[k] = not exact.above(np.array([k]), JOINT_SHARE * shorter)[0]
         near_gaps = np.flatnonzero(keep)  # the near gaps, in the order the tree gives them
@@ -107,6 +108,14 @@ def open_gaps(contours: Sequence[Contour], options: PlanOptions) -> list[Finding
             )
         )
     return out
+
+
+def _length(contours: Sequence[Contour], known: dict[int, float], index: Any) -> float:
+    """Contour ``index``'s length, mm, measured once (``known``), not kept on the contour."""
+    i = int(index)
+    if i not in known:
+        known[i] = contours[i].length_unkept()
+    return known[i]
 
 
 def near_reach(joint_mm: float) -> float:
