@@ -137,7 +137,7 @@ JOINT_SHARE = 0.5
 """A wider gap joins only a piece (or closes a chain) at least ``1 / JOINT_SHARE`` times as
 long as the gap: a wide ``--chain-tolerance`` bridges gaps between pieces drawn to meet,
 and must not snap one short line onto another a few of its lengths away (two 10 mm lines
-50 mm apart at ``--chain-tolerance 100`` made a line there and back: one was never cut)."""
+50 mm apart at ``--chain-tolerance 100`` would make a line there and back, one never cut)."""
 
 
 def _bridges(gap: float, piece: Contour) -> bool:

@@ -119,9 +119,9 @@ def test_a_negative_tool_diameter_is_refused_naming_the_option_before_any_readin
 def test_a_tolerance_past_a_millimetre_is_refused_as_a_slip(
     value: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    # --tolerance 10 let every fitted arc and line lie 10 mm from the drawing: a pocket's
-    # rounded ring corners were cut square, with exit 0 (10 for 0.010, a slip); 1 mm is
-    # the most a toolpath may stray, for post, a re-post and a job's [job] tolerance alike
+    # --tolerance 10 would let every fitted arc and line lie 10 mm from the drawing (a
+    # pocket's rounded ring corners cut square): 10 for 0.010, a slip. 1 mm is the most a
+    # toolpath may stray, for post, a re-post and a job's [job] tolerance alike
     out = tmp_path / "p.gcode"
     code = main(
         ["post", str(SAMPLES / "plate.dxf"), "-t", "grbl", "-o", str(out), "--tolerance", value]

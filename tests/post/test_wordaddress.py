@@ -396,9 +396,9 @@ def test_arc_too_small_for_the_resolution_becomes_a_line() -> None:
 
 def test_an_arc_of_millimetres_at_a_dialect_of_whole_millimetres_is_chords_not_one_line() -> None:
     # A 240° arc of radius 7.3 mm no printed centre writes within GRBL's arc check at
-    # 0 decimals: it was "too small for the 1 mm the dialect writes" and became one line
-    # from its start to its end, 11 mm from the arc's far side (exit 0). It is chords now:
-    # by analysis each within 2 quanta of the arc (the chord tolerance) plus the half
+    # 0 decimals is not "too small for the 1 mm the dialect writes": one line from its
+    # start to its end would lie 11 mm from the arc's far side. It is chords, by analysis
+    # each within 2 quanta of the arc (the chord tolerance) plus the half
     # quantum each printed end may move, so every point of the arc lies within 2.71 mm
     # of the written path.
     c, r = (20.4, 20.3), 7.3

@@ -400,8 +400,8 @@ def test_a_small_stepover_sweeps_its_pocket_in_pieces_that_hold_few_passes(
 ) -> None:
     # At a step-over of 0.3 % of a 3 mm tool, ~110 passes lie within the tool's width of
     # each other; a rectangle's rings are 4-8 points each, so a piece of SWEEP_PIECE points
-    # would hold hundreds of passes over one another (a job took 100 s and 3 GB in GEOS's
-    # buffer of them). The uncut check must cut its path into pieces of at most
+    # would hold hundreds of passes over one another, which GEOS buffers far more slowly
+    # than many short pieces. The uncut check must cut its path into pieces of at most
     # MIN_SWEEP_PIECE points there, and of SWEEP_PIECE at the default step-over.
     import shapely
 
