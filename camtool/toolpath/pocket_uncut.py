@@ -64,9 +64,9 @@ def sweep_piece(stepover: float) -> int:
     A pocket's passes lie a step-over apart, so about ``1 / stepover`` of them pass
     within the tool's width of each other, and a piece holding many passes overlaps
     itself that many times: GEOS's buffer of such a piece costs far more than the union
-    of smaller pieces' buffers (a 0.3 % step-over with pieces of :data:`SWEEP_PIECE`
-    points: seconds per pocket). The pieces shrink with the step-over, from
-    :data:`SWEEP_PIECE` points at :data:`_PIECE_STEPOVER` to :data:`MIN_SWEEP_PIECE`.
+    of smaller pieces' buffers (docs/performance.md). The pieces shrink with the
+    step-over, from :data:`SWEEP_PIECE` points at :data:`_PIECE_STEPOVER` to
+    :data:`MIN_SWEEP_PIECE`.
     """
     scaled = round(SWEEP_PIECE * stepover / _PIECE_STEPOVER)
     return min(SWEEP_PIECE, max(MIN_SWEEP_PIECE, scaled))
