@@ -80,8 +80,8 @@ def swept_area(
     Each path is buffered in pieces of at most ``piece`` points (≥ 2; consecutive pieces
     share their end point) and the pieces' areas united: the same area, since the tool's
     sweep of a path is the union of its sweeps of the path's pieces. GEOS nodes a
-    buffer's whole offset curve at once, and a pocket's linked rings, which pass beside
-    themselves at every step-over, made one buffer of the whole path take seconds
+    buffer's whole offset curve at once, and a pocket's linked rings pass beside
+    themselves at every step-over, so one buffer of the whole path is far slower
     (:func:`sweep_piece` sizes the pieces for a pocket's step-over).
     """
     quad = quad_segs(radius, tolerance)
