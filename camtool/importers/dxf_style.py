@@ -102,12 +102,20 @@ class StyleResolver:
         return found
 
     def _judge(self, name: str) -> bool:
+        """Whether linetype ``name`` is not continuous.
+
+        By its pattern where the file gives one, else by its name: an LTYPE entry without
+        pattern groups (as dxflib writes them) or one not in the table, which CAD programs
+        draw by name.
+        """
         if name in ("CONTINUOUS", "BYLAYER", "BYBLOCK", ""):
             return False
         table = self.doc.linetypes
         if table.has_entry(name):
+            linetype = table.get(name)
             try:
-                return bool(table.get(name).simplified_line_pattern())
+                if len(linetype.pattern_tags):
+                    return bool(linetype.simplified_line_pattern())
             except (ValueError, TypeError, AttributeError, IndexError):
                 pass  # a damaged pattern: judged by its name
         return dashed_name(name)

@@ -7,6 +7,7 @@ colour (group 420) wins over the ACI number.
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 from typing import Any
 
@@ -62,6 +63,42 @@ def test_a_linetype_whose_pattern_is_solid_is_continuous(tmp_path: Path) -> None
     doc.saveas(path)
     (contour,) = read_drawing(path).contours
     assert contour.linetype == ""
+
+
+def _without_patterns(text: str) -> str:
+    """DXF ``text`` with its LTYPE entries' pattern groups (3, 72, 73, 40, 49, 74) taken out,
+    as dxflib writes them (ezdxf writes no such entry)."""
+    lines = text.splitlines()
+    kept: list[str] = []
+    record = ""
+    for code, value in zip(lines[::2], lines[1::2], strict=True):
+        if code.strip() == "0":
+            record = value.strip()
+        elif record == "LTYPE" and code.strip() in ("3", "72", "73", "40", "49", "74"):
+            continue
+        kept += [code, value]
+    return "\n".join(kept) + "\n"
+
+
+def test_a_linetype_entry_without_a_pattern_is_judged_by_its_name(tmp_path: Path) -> None:
+    """dxflib (QCAD's DXF library) writes LTYPE entries with a name and no pattern groups
+    (QCAD's own ``libraries/default/Mechanics/M4_c.dxf``: ``DASHDOT`` on its axes); CAD
+    programs and ezdxf's drawing add-on draw those by their name, so a ``DASHDOT`` is a
+    centre line, not continuous, and a name of no dashed family stays continuous."""
+    doc = ezdxf.new("R2000")
+    doc.header["$INSUNITS"] = 4
+    for name in ("DASHDOT", "PLAIN"):
+        doc.linetypes.add(name, pattern=[10.0, 6.0, -2.0, 0.0, -2.0])
+    msp = doc.modelspace()
+    msp.add_line((0, 0), (1, 0), dxfattribs={"linetype": "DASHDOT"})
+    msp.add_line((0, 1), (1, 1), dxfattribs={"linetype": "PLAIN"})
+    path = tmp_path / "dxflib.dxf"
+    text = io.StringIO()
+    doc.write(text)
+    path.write_text(_without_patterns(text.getvalue()))
+    assert len(ezdxf.readfile(path).linetypes.get("DASHDOT").pattern_tags) == 0
+    got = {round(c.start[1]): c.linetype for c in read_drawing(path).contours}
+    assert got == {0: "DASHDOT", 1: ""}
 
 
 def _crossed_square(tmp_path: Path) -> Path:
