@@ -104,19 +104,20 @@ class StyleResolver:
     def _judge(self, name: str) -> bool:
         """Whether linetype ``name`` is not continuous.
 
-        By its pattern where the file gives one, else by its name: an LTYPE entry without
-        pattern groups (as dxflib writes them) or one not in the table, which CAD programs
-        draw by name.
+        By its pattern where the file gives one: a gap in it (a negative element, group 49;
+        a complex linetype's text and shapes sit in such gaps, so ``---GAS---`` is not
+        continuous); else by its name: an LTYPE entry without pattern groups (as dxflib
+        writes them) or one not in the table, which CAD programs draw by name.
         """
         if name in ("CONTINUOUS", "BYLAYER", "BYBLOCK", ""):
             return False
         table = self.doc.linetypes
         if table.has_entry(name):
-            linetype = table.get(name)
+            tags = table.get(name).pattern_tags.tags
             try:
-                if len(linetype.pattern_tags):
-                    return bool(linetype.simplified_line_pattern())
-            except (ValueError, TypeError, AttributeError, IndexError):
+                if len(tags):
+                    return any(tag.code == 49 and float(tag.value) < 0 for tag in tags)
+            except (ValueError, TypeError, AttributeError):
                 pass  # a damaged pattern: judged by its name
         return dashed_name(name)
 

@@ -65,6 +65,25 @@ def test_a_linetype_whose_pattern_is_solid_is_continuous(tmp_path: Path) -> None
     assert contour.linetype == ""
 
 
+def test_a_complex_linetype_with_gaps_is_not_continuous(tmp_path: Path) -> None:
+    """AutoCAD's ``ltypeshp.lin`` linetypes carry text or shapes in their gaps (``GAS_LINE``
+    ``----GAS----``: QCAD's ``DrawCSV_Ltype_test.dxf`` uses it); ezdxf's simplified pattern
+    of such a linetype is empty, its pattern groups (49) still hold the gaps."""
+    doc = _doc()
+    doc.linetypes.add(
+        "GASLINE",
+        pattern='A,.5,-.2,["GAS",STANDARD,S=.1,U=0.0,X=-0.1,Y=-.05],-.25',
+        description="Gas line ----GAS----GAS----",
+        length=0.95,
+    )
+    assert not doc.linetypes.get("GASLINE").simplified_line_pattern()
+    doc.modelspace().add_line((0, 0), (1, 0), dxfattribs={"linetype": "GASLINE"})
+    path = tmp_path / "gas.dxf"
+    doc.saveas(path)
+    (contour,) = read_drawing(path).contours
+    assert contour.linetype == "GASLINE"
+
+
 def _without_patterns(text: str) -> str:
     """DXF ``text`` with its LTYPE entries' pattern groups (3, 72, 73, 40, 49, 74) taken out,
     as dxflib writes them (ezdxf writes no such entry)."""
