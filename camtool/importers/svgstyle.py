@@ -108,7 +108,12 @@ def _colour(values: Any) -> str:
 
 
 def _dashed(values: Any) -> bool:
-    """Whether the shape is stroked with dashes (a ``stroke-dasharray`` with a length > 0)."""
+    """Whether the shape is stroked with gaps: a ``stroke-dasharray`` with a gap > 0.
+
+    The list repeats to an even count, its second, fourth... lengths the gaps; a negative
+    length makes the value invalid, so ignored (SVG 2 §13.5.5): drawn as a line, as is
+    ``40 0`` (no gap) or a sum of zero.
+    """
     if _none(values.get("stroke")):
         return False
     dashes = str(values.get("stroke-dasharray") or "").replace(",", " ").split()
@@ -118,7 +123,11 @@ def _dashed(values: Any) -> bool:
             lengths.append(float(re.sub(r"[a-z%]+$", "", text.lower())))
         except ValueError:
             return False  # not a dash array camtool can read: drawn as a line
-    return any(v > 0 for v in lengths)
+    if any(not v >= 0 for v in lengths):
+        return False
+    if len(lengths) % 2:
+        lengths *= 2
+    return any(gap > 0 for gap in lengths[1::2])
 
 
 def _none(paint: Any) -> bool:

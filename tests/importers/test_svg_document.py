@@ -248,6 +248,30 @@ def test_inherit_takes_the_parents_value_as_css_says(tmp_path: Path) -> None:
     ]
 
 
+@pytest.mark.parametrize(
+    ("dasharray", "linetype"),
+    [
+        ("4 2", "DASHED"),
+        ("0 4", "DASHED"),  # dots: zero-length dashes, 4 apart
+        ("5 10 15", "DASHED"),  # odd: repeated, 5 10 15 5 10 15
+        ("40 0", ""),  # no gap: a line
+        ("4 0 6", "DASHED"),  # repeated, 4 0 6 4 0 6: gaps 0, 4 and 6
+        ("4 0 6 0", ""),  # dashes of 4 and 6, no gap
+        ("0 0", ""),  # a sum of zero draws as none (SVG 2 §13.5.5)
+        ("20 40 -20", ""),  # a negative length: invalid, ignored
+        ("none", ""),
+    ],
+)
+def test_a_stroke_is_dashed_only_where_its_dash_array_has_gaps(
+    tmp_path: Path, dasharray: str, linetype: str
+) -> None:
+    """resvg's ``painting/stroke-dasharray`` tests (``negative-values``, ``zero-sum``,
+    ``n-0``) render these as a solid line; a solid line is the part, cut by default."""
+    body = f'<path id="p" d="M 0 0 L 9 0" stroke="red" stroke-dasharray="{dasharray}"/>'
+    (contour,) = read_svg(svg(tmp_path, body)).contours
+    assert contour.linetype == linetype
+
+
 SHAPER = (
     '<svg xmlns="http://www.w3.org/2000/svg" '
     'xmlns:shaper="http://www.shapertools.com/namespaces/shaper" viewBox="0 0 200 100" '
