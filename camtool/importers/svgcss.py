@@ -306,7 +306,9 @@ class _Rule:
 def apply_style_sheets(
     root: ET.Element, parents: dict[ET.Element, ET.Element], name: str
 ) -> list[str]:
-    """Apply every ``<style>`` sheet to the elements' ``style`` attributes, then remove it.
+    """Apply every CSS ``<style>`` sheet to the elements' ``style`` attributes, then remove it.
+
+    A sheet whose ``type`` is not ``text/css`` is removed unapplied.
 
     See the module docstring for the cascade and the selectors applied. A document without
     sheets is left as it is.
@@ -333,6 +335,8 @@ def apply_style_sheets(
     rules: list[_Rule] = []
     ignored: list[str] = []
     for sheet in sheets:
+        if sheet.get("type", "").strip().lower() not in ("", "text/css"):
+            continue  # a sheet in another language: ignored (SVG 1.1 §6.16), as browsers do
         for selectors, body in _css_rules(sheet.text or ""):
             if selectors.startswith("@"):
                 if not selectors.lower().startswith("@font-face"):  # a font styles nothing

@@ -451,6 +451,22 @@ def test_style_sheets_cascade_as_css_says(tmp_path: Path) -> None:
     ]
 
 
+def test_a_style_sheet_in_another_language_is_not_applied(tmp_path: Path) -> None:
+    """A ``<style>`` whose ``type`` is not ``text/css`` is ignored (SVG 1.1 §6.16; resvg's
+    ``structure/style/invalid-type``): the shape keeps its own fill."""
+    body = (
+        '<style type="no-a-css">.fil { fill: red; display: none }</style>'
+        '<style type=" TEXT/CSS ">.blue { fill: blue }</style>'
+        '<rect id="r" class="fil" width="9" height="9" fill="green"/>'
+        '<rect id="b" class="blue" width="9" height="9"/>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert [(c.source, c.colour) for c in drawing.contours] == [
+        ("rect#r", "#008000"),
+        ("rect#b", "#0000ff"),
+    ]
+
+
 def test_a_group_a_rule_makes_transparent_hides_its_children(tmp_path: Path) -> None:
     """Group opacity multiplies: a child's own ``opacity:1`` under a group at 0 shows nothing."""
     body = (
