@@ -87,11 +87,13 @@ def _css_rules(text: str) -> list[tuple[str, str]]:
 def _declaration_list(text: str) -> list[tuple[str, str, bool]]:
     """``(property, value, important)`` of CSS declarations, in their order.
 
-    Property names in lower case, keywords (:data:`_KEYWORDS`) too; ``!important`` taken off
-    the value. A piece without a colon belongs to the value before it (a ``data:`` URL's
-    ``;``).
+    Property names in lower case, keywords (:data:`_KEYWORDS`) too; comments and
+    ``!important`` taken off. A piece without a colon belongs to the value before it (a
+    ``data:`` URL's ``;``).
     """
     out: list[tuple[str, str, bool]] = []
+    if "/*" in text:
+        text = _CSS_COMMENT.sub("", text)
     for item in text.split(";"):
         key, colon, value = item.partition(":")
         if not colon:
@@ -121,13 +123,14 @@ def normalize_styles(root: ET.Element) -> None:
     """Every ``style`` attribute and presentation attribute as svgelements reads it.
 
     CSS property names and keywords are case-insensitive, white space around a value is
-    not part of it, and ``!important`` only ranks a declaration; svgelements compares the
-    text, so ``display:none !important``, ``DISPLAY: NONE`` or ``display="none "`` would hide
-    nothing and the element would be cut.
+    not part of it, a comment is white space and ``!important`` only ranks a declaration;
+    svgelements compares the text, so ``display:none !important``, ``DISPLAY: NONE``,
+    ``display:none/* off */`` or ``display="none "`` would hide nothing and the element
+    would be cut.
     """
     for element in root.iter():
         style = element.get("style")
-        if style and ("!" in style or style != style.lower()):  # else nothing to change
+        if style and ("!" in style or "/*" in style or style != style.lower()):
             element.set("style", style_text({k: v for k, v, _ in _declaration_list(style)}))
         for attr in _PRESENTATION:
             value = element.get(attr)

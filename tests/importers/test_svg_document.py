@@ -451,6 +451,19 @@ def test_style_sheets_cascade_as_css_says(tmp_path: Path) -> None:
     ]
 
 
+def test_a_comment_in_a_style_attribute_is_white_space(tmp_path: Path) -> None:
+    """CSS comments may stand anywhere white space may (CSS Syntax 3 §4.3.2): resvg's
+    ``structure/style-attribute/comments`` fills its square green; a ``display:none``
+    followed by a comment still hides its shape, which is then not cut."""
+    body = (
+        '<rect id="hidden" width="9" height="9" style="display:none/* off */"/>'
+        '<rect id="hidden2" width="9" height="9" style="/* a */ display : none"/>'
+        '<rect id="green" width="9" height="9" style="/*text*/fill:green/*text*/"/>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert [(c.source, c.colour) for c in drawing.contours] == [("rect#green", "#008000")]
+
+
 def test_a_style_sheet_in_another_language_is_not_applied(tmp_path: Path) -> None:
     """A ``<style>`` whose ``type`` is not ``text/css`` is ignored (SVG 1.1 §6.16; resvg's
     ``structure/style/invalid-type``): the shape keeps its own fill."""
