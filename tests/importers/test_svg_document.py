@@ -451,6 +451,11 @@ def test_style_sheets_cascade_as_css_says(tmp_path: Path) -> None:
     ]
 
 
+def _colours(tmp_path: Path, body: str) -> list[tuple[str, str]]:
+    """``(source, colour)`` of each contour read from an SVG of ``body``."""
+    return [(c.source, c.colour) for c in read_svg(svg(tmp_path, body)).contours]
+
+
 def test_a_comment_in_a_style_attribute_is_white_space(tmp_path: Path) -> None:
     """CSS comments may stand anywhere white space may (CSS Syntax 3 §4.3.2): resvg's
     ``structure/style-attribute/comments`` fills its square green; a ``display:none``
@@ -460,8 +465,7 @@ def test_a_comment_in_a_style_attribute_is_white_space(tmp_path: Path) -> None:
         '<rect id="hidden2" width="9" height="9" style="/* a */ display : none"/>'
         '<rect id="green" width="9" height="9" style="/*text*/fill:green/*text*/"/>'
     )
-    drawing = read_svg(svg(tmp_path, body))
-    assert [(c.source, c.colour) for c in drawing.contours] == [("rect#green", "#008000")]
+    assert _colours(tmp_path, body) == [("rect#green", "#008000")]
 
 
 def test_a_style_sheet_in_another_language_is_not_applied(tmp_path: Path) -> None:
@@ -473,11 +477,7 @@ def test_a_style_sheet_in_another_language_is_not_applied(tmp_path: Path) -> Non
         '<rect id="r" class="fil" width="9" height="9" fill="green"/>'
         '<rect id="b" class="blue" width="9" height="9"/>'
     )
-    drawing = read_svg(svg(tmp_path, body))
-    assert [(c.source, c.colour) for c in drawing.contours] == [
-        ("rect#r", "#008000"),
-        ("rect#b", "#0000ff"),
-    ]
+    assert _colours(tmp_path, body) == [("rect#r", "#008000"), ("rect#b", "#0000ff")]
 
 
 def test_a_group_a_rule_makes_transparent_hides_its_children(tmp_path: Path) -> None:
@@ -487,8 +487,7 @@ def test_a_group_a_rule_makes_transparent_hides_its_children(tmp_path: Path) -> 
         '<g class="gone"><path id="a" d="M 0 0 L 1 0" style="opacity:1"/></g>'
         '<g class="seen"><path id="kept" d="M 0 0 L 1 0"/></g>'
     )
-    drawing = read_svg(svg(tmp_path, body))
-    assert [(c.source, c.colour) for c in drawing.contours] == [("path#kept", "#ff0000")]
+    assert _colours(tmp_path, body) == [("path#kept", "#ff0000")]
 
 
 ILLUSTRATOR = """<?xml version="1.0" encoding="utf-8"?>
