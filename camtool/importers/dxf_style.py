@@ -113,8 +113,8 @@ class StyleResolver:
             return False
         table = self.doc.linetypes
         if table.has_entry(name):
-            tags = table.get(name).pattern_tags.tags
             try:
+                tags = table.get(name).pattern_tags.tags
                 if len(tags):
                     return any(tag.code == 49 and float(tag.value) < 0 for tag in tags)
             except (ValueError, TypeError, AttributeError):
