@@ -55,14 +55,19 @@ def test_colours_and_linetypes_resolve_through_layer_and_block(tmp_path: Path) -
     }
 
 
+def _linetype_of_a_line(doc: Any, linetype: str, tmp_path: Path) -> str:
+    """The linetype camtool reads for one LINE drawn in ``linetype`` in ``doc``."""
+    doc.modelspace().add_line((0, 0), (1, 0), dxfattribs={"linetype": linetype})
+    path = tmp_path / "line.dxf"
+    doc.saveas(path)
+    (contour,) = read_drawing(path).contours
+    return str(contour.linetype)
+
+
 def test_a_linetype_whose_pattern_is_solid_is_continuous(tmp_path: Path) -> None:
     doc = _doc()
     doc.linetypes.add("K5LT_SOLID", pattern=[0.0], description="solid")
-    doc.modelspace().add_line((0, 0), (1, 0), dxfattribs={"linetype": "K5LT_SOLID"})
-    path = tmp_path / "solid.dxf"
-    doc.saveas(path)
-    (contour,) = read_drawing(path).contours
-    assert contour.linetype == ""
+    assert _linetype_of_a_line(doc, "K5LT_SOLID", tmp_path) == ""
 
 
 def test_a_complex_linetype_with_gaps_is_not_continuous(tmp_path: Path) -> None:
@@ -77,11 +82,7 @@ def test_a_complex_linetype_with_gaps_is_not_continuous(tmp_path: Path) -> None:
         length=0.95,
     )
     assert not doc.linetypes.get("GASLINE").simplified_line_pattern()
-    doc.modelspace().add_line((0, 0), (1, 0), dxfattribs={"linetype": "GASLINE"})
-    path = tmp_path / "gas.dxf"
-    doc.saveas(path)
-    (contour,) = read_drawing(path).contours
-    assert contour.linetype == "GASLINE"
+    assert _linetype_of_a_line(doc, "GASLINE", tmp_path) == "GASLINE"
 
 
 def _without_patterns(text: str) -> str:
