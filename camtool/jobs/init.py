@@ -493,16 +493,25 @@ def _profile_op(
     if pocket:
         return _pocket_op(select, what, contours, thickness, tool, key, given)
     outer, foreign = nested
-    has_outer = cut == "outside" if cut else any(id(c) in outer for c in contours)
+    tops = sum(1 for c in contours if id(c) in outer)
+    holes = [foreign[id(c)] for c in contours if id(c) in foreign]
+    # one side per operation: that of most of the contours whose side is known (boxes.py's
+    # Lamp.svg: 605 blue holes in black parts, 2 blue squares in parts drawn open)
+    has_outer = cut == "outside" if cut else tops > 0 and tops >= len(holes)
     side = "outside" if has_outer else "inside"
-    why = (
-        f"Shaper's cut type of {what}"
-        if cut
-        else f"{what} holds an outermost contour: cut outside it (its holes inside)"
-        + _foreign_holes(contours, foreign)
-        if has_outer
-        else f"{what} holds holes of a part only: cut on their inside"
-    )
+    if cut:
+        why = f"Shaper's cut type of {what}"
+    elif has_outer:
+        why = f"{what} holds an outermost contour: cut outside it (its holes inside)"
+        why += _foreign_holes(holes)
+    elif tops:
+        why = (
+            f"{what} holds {len(holes)} holes of {holes[0]}'s parts: cut on their inside; but "
+            f"{tops} of its contours lie inside no part and are cut inside too: if those are "
+            "parts, give them a layer or colour of their own, cut outside"
+        )
+    else:
+        why = f"{what} holds holes of a part only: cut on their inside"
     mill: float | None = tool
     tool_line = "tool = {end-mill}"
     if not has_outer:
@@ -538,9 +547,11 @@ def _profile_op(
     return _Op(f"profile {side}", mill, tuple(lines))
 
 
-def _foreign_holes(contours: Sequence[Contour], foreign: dict[int, str]) -> str:
-    """What an outside profile of ``contours`` does to those that are holes of other parts."""
-    holes = [foreign[id(c)] for c in contours if id(c) in foreign]
+def _foreign_holes(holes: Sequence[str]) -> str:
+    """What an outside profile does to its contours that are holes of other groups' parts.
+
+    ``holes``: per such contour, the name (:func:`_what`) of the group around it.
+    """
     if not holes:
         return ""
     return (

@@ -139,6 +139,47 @@ def test_holes_of_another_colour_s_part_in_an_outside_colour_are_named(tmp_path:
     assert "but" not in black
 
 
+def test_a_colour_mostly_of_another_colour_s_holes_is_cut_inside(tmp_path: Path) -> None:
+    """Three blue holes in the black part and one blue square apart: blue is cut inside.
+
+    boxes.py's ``Lamp.svg`` draws 605 blue holes in black parts and 2 blue squares whose
+    black parts are drawn open (not chained closed): cut outside, as its 2 "outermost"
+    contours asked, the 605 holes came out a tool diameter too wide. The side of most of
+    the contours wins, and the comment names the others. With the 3 mm end mill, each
+    10 mm hole's toolpath lies 1.5 mm inside it: work zero is the lower-left of the part's
+    toolpath, 1.5 mm outside its outline at x 10, so the holes at x 15..25, 35..45 and
+    55..65 in the drawing are cut from x 16.5 - 8.5 = 8 to 63.5 - 8.5 = 55 mm.
+    """
+    svg = tmp_path / "lamp.svg"
+    svg.write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" width="120mm" height="60mm" viewBox="0 0 120 60">'
+        '<path d="M 10 10 H 70 V 50 H 10 Z" stroke="rgb(0,0,0)" fill="none"/>'
+        '<path d="M 15 25 H 25 V 35 H 15 Z" stroke="rgb(0,0,255)" fill="none"/>'
+        '<path d="M 35 25 H 45 V 35 H 35 Z" stroke="rgb(0,0,255)" fill="none"/>'
+        '<path d="M 55 25 H 65 V 35 H 55 Z" stroke="rgb(0,0,255)" fill="none"/>'
+        '<path d="M 90 25 H 100 V 35 H 90 Z" stroke="rgb(0,0,255)" fill="none"/>'
+        "</svg>"
+    )
+    drawing = read_drawing(svg)
+    text = initial_job(drawing, thickness_mm=3.0)
+    sides = [(op["colours"], op["side"]) for op in _ops(text)]
+    assert sides == [(["#0000ff"], "inside"), (["#000000"], "outside")]
+    blue = next(line for line in text.splitlines() if line.startswith('side = "inside"'))
+    assert blue.endswith(
+        "# colour #0000ff holds 3 holes of colour #000000's parts: cut on their inside; but 1 "
+        "of its contours lie inside no part and are cut inside too: if those are parts, give "
+        "them a layer or colour of their own, cut outside"
+    )
+    job = job_from_dict(tomllib.loads(text), source="lamp.toml")
+    done = run_job(drawing, load_target("grbl"), job)
+    z, holes = 0.0, []
+    for m in done.program.moves:
+        z = m.z if m.z is not None else z
+        if isinstance(m, Linear) and z < 0 and 1.0 < m.x < 60.0 and 10.0 < m.y < 33.0:
+            holes.append(m.x)
+    assert min(holes) == pytest.approx(8.0) and max(holes) == pytest.approx(55.0)
+
+
 def test_a_notch_drawn_across_a_part_s_edge_is_cut_inside(tmp_path: Path) -> None:
     """A blue square two thirds outside the black outline is a notch: cut on its inside.
 
