@@ -16,6 +16,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from camtool.geometry.chain import chain_members, joint_distance
+from camtool.jobs.init_mills import mill_between, mill_that_fits
+from camtool.jobs.init_mills import why as _why
 from camtool.jobs.job import Selection
 from camtool.jobs.selection import circle_of, construction_reason
 from camtool.model.construction import fit_extent, is_construction
@@ -98,11 +100,12 @@ def initial_job(
     for group in groups:
         group.close_gap = close_gap
     outer = _outermost([(group, c) for group in groups for c in _chains(group)])
+    parts = [c for group in groups for c in _chains(group) if id(c) in outer[0]]
     ops: list[_Op] = []
     left: Counter[str] = Counter()
     cut: list[tuple[_Group, list[_Op]]] = []
     for group in groups:
-        made = _ops_of(group, outer, thickness_mm, tool_diameter, left, k, drill=not no_z)
+        made = _ops_of(group, (*outer, parts), thickness_mm, tool_diameter, left, k, drill=not no_z)
         ops.extend(_repeated(group, made, cut))
         cut.append((group, made))
     if all(op.kind == "engrave" for op in ops):
@@ -351,7 +354,7 @@ _AREA_TOLERANCE_MM = 0.01
 
 def _ops_of(
     group: _Group,
-    outer: tuple[set[int], dict[int, str]],
+    outer: tuple[set[int], dict[int, str], list[Contour]],
     thickness: float,
     tool: float,
     left: Counter[str],
@@ -360,6 +363,9 @@ def _ops_of(
     drill: bool = True,
 ) -> list[_Op]:
     """The operations of one layer (or colour); ``k``: the scale the job fits it by.
+
+    ``outer``: the ids of the outermost closed contours, the holes of other groups' parts
+    (:func:`_outermost`), and the outermost contours themselves (every group's parts).
 
     ``drill``: small circles are drilled (else profiled with the rest: no Z to drill by).
     """
@@ -481,7 +487,7 @@ def _profile_op(
     select: str,
     what: str,
     contours: list[Contour],
-    nested: tuple[set[int], dict[int, str]],
+    nested: tuple[set[int], dict[int, str], list[Contour]],
     thickness: float,
     tool: float,
     key: str,
@@ -492,7 +498,7 @@ def _profile_op(
     depth = given or thickness + BREAKTHROUGH_MM
     if pocket:
         return _pocket_op(select, what, contours, thickness, tool, key, given)
-    outer, foreign = nested
+    outer, foreign, parts = nested
     tops = sum(1 for c in contours if id(c) in outer)
     holes = [foreign[id(c)] for c in contours if id(c) in foreign]
     # one side per operation: that of most of the contours whose side is known (boxes.py's
@@ -512,10 +518,10 @@ def _profile_op(
         )
     else:
         why = f"{what} holds holes of a part only: cut on their inside"
-    mill: float | None = tool
-    tool_line = "tool = {end-mill}"
-    if not has_outer:
-        mill, tool_line = _mill_that_fits(contours, tool)
+    if has_outer:
+        mill, tool_line = mill_between([c for c in contours if id(c) in outer], parts, tool)
+    else:
+        mill, tool_line = mill_that_fits(contours, tool)
     lines = [
         f"name = {_quote(key)}",
         'type = "profile"',
@@ -529,7 +535,7 @@ def _profile_op(
     ]
     if has_outer:
         shortest = min(c.length for c in _parts(contours))
-        tabs = _tabs_that_fit(shortest, tool)
+        tabs = _tabs_that_fit(shortest, mill or tool)
         if tabs:
             lines.append(f"tabs = {tabs}" + _why("hold the part to the stock on the last pass"))
             lines.append(
@@ -573,7 +579,7 @@ def _pocket_op(
 
     At half the stock, or ``given``: Shaper's depth, mm.
     """
-    mill, tool_line = _mill_that_fits(contours, tool, "pocket")
+    mill, tool_line = mill_that_fits(contours, tool, "pocket")
     depth = given or thickness / 2
     lines = (
         f"name = {_quote(key)}",
@@ -585,60 +591,6 @@ def _pocket_op(
         f"step_down = {min(mill or tool, depth):g}" + _why("at most a tool diameter"),
     )
     return _Op("pocket", mill or tool, lines, commented=mill is None)
-
-
-END_MILLS_MM = (0.5, 0.8, 1.0, 1.5, 2.0, 2.5, 3.0, 3.175, 4.0, 5.0, 6.0, 6.35, 8.0, 10.0, 12.0)
-"""Common end mill diameters, mm (metric and 1/8", 1/4"): the sizes job init proposes."""
-
-FIT_MARGIN = 0.95
-"""A proposed end mill is at most this fraction of the narrowest hole's width."""
-
-WIDTH_TOLERANCE_MM = 0.01
-"""How closely a hole's width (its largest inscribed circle) is measured, mm."""
-
-
-def _mill_that_fits(
-    contours: Sequence[Contour], tool: float, noun: str = "hole"
-) -> tuple[float | None, str]:
-    """The end mill for a layer of holes (or pockets) and its ``tool =`` line.
-
-    ``noun``: what the comment calls them (``"pocket"`` for a layer of pockets, whose
-    clearing needs the same: ``post`` clears nothing narrower than its tool).
-
-    The job's end mill (``tool``, mm) when it fits in every hole; else the largest of
-    :data:`END_MILLS_MM` within :data:`FIT_MARGIN` of the narrowest hole's width (the
-    diameter of its largest inscribed circle, :func:`~camtool.geometry.area.inscribed_width`),
-    said in the line's comment; ``None`` when none fits (the operation is then left
-    commented out). ``post`` cuts nothing in a hole narrower than its tool, and stops
-    when that is every contour of an operation.
-    """
-    from camtool.geometry.area import enclosed, inscribed_width
-
-    widths = [
-        inscribed_width(enclosed(c.points(WIDTH_TOLERANCE_MM)), WIDTH_TOLERANCE_MM)
-        for c in contours
-    ]
-    narrow = [w for w in widths if w < tool]
-    if not narrow:
-        return tool, "tool = {end-mill}"
-    least = min(narrow)
-    if len(widths) == 1:
-        said = f"the {noun} is narrower than the {tool:g} mm end mill (about {least:.3g} mm wide)"
-    else:
-        which = "all" if len(narrow) == len(widths) else f"{len(narrow)} of the"
-        said = (
-            f"{which} {len(widths)} {noun}s are narrower than the {tool:g} mm end mill (the "
-            f"narrowest about {least:.3g} mm wide)"
-        )
-    fits = [d for d in END_MILLS_MM if d <= FIT_MARGIN * least]
-    if not fits:
-        return None, "tool = {end-mill}" + _why(
-            f"{said}: no common end mill fits; give this operation a tool that does, then "
-            "uncomment it"
-        )
-    mill = fits[-1]
-    them = "it" if len(widths) == 1 else "them"
-    return mill, f"tool = {{end-mill {mill:g}}}" + _why(f"{said}: a {mill:g} mm one cuts {them}")
 
 
 TAB_WIDTH_MM = 2.0
@@ -785,10 +737,6 @@ def _tool_key(op: _Op, tool: float) -> tuple[str, float]:
         return ("drill", op.tool)
     own = op.kind.startswith("profile") or op.kind == "pocket"
     return ("end-mill", op.tool if own else tool)
-
-
-def _why(text: str) -> str:
-    return f"  # {text}"
 
 
 def _quote(text: str) -> str:

@@ -10,6 +10,7 @@ keep those traits at sizes easy to check by hand.
 
 from __future__ import annotations
 
+import re
 import tomllib
 from pathlib import Path
 
@@ -197,3 +198,45 @@ def test_a_notch_drawn_across_a_part_s_edge_is_cut_inside(tmp_path: Path) -> Non
     text = initial_job(read_drawing(svg))
     sides = [(op["colours"], op["side"]) for op in _ops(text)]
     assert sides == [(["#0000ff"], "inside"), (["#000000"], "outside")]
+
+
+def _two_parts(gap: float) -> str:
+    """Two 20 × 20 mm parts side by side, ``gap`` mm apart (an SVG page in mm)."""
+    x = 30.0 + gap
+    return (
+        '<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="60mm" viewBox="0 0 100 60">'
+        '<path d="M 10 10 H 30 V 30 H 10 Z" stroke="rgb(0,0,0)" fill="none"/>'
+        f'<path d="M {x} 10 H {x + 20} V 30 H {x} Z" stroke="rgb(0,0,0)" fill="none"/>'
+        "</svg>"
+    )
+
+
+@pytest.mark.parametrize(("gap", "mill"), [(1.5, 1.0), (2.2, 2.0), (3.0, 3.0), (8.0, 3.0)])
+def test_parts_closer_than_the_tool_get_an_end_mill_that_fits_between_them(
+    tmp_path: Path, gap: float, mill: float
+) -> None:
+    """boxes.py spaces parts half a stock thickness apart (1.5 mm for 3 mm), for a laser.
+
+    A 3 mm end mill's cut, 3 mm wide outside each part, took 1.5 mm of the neighbour
+    (``post`` warned, after the job was written). The largest common end mill within 95 %
+    of the gap is proposed instead: 1 mm for 1.5 mm (1.425 mm at most), 2 mm for 2.2 mm;
+    a gap of the tool's width or more keeps the 3 mm one. The job's program then cuts
+    into neither part.
+    """
+    svg = tmp_path / "parts.svg"
+    svg.write_text(_two_parts(gap))
+    drawing = read_drawing(svg)
+    text = initial_job(drawing, thickness_mm=3.0)
+    job = tomllib.loads(text)
+    assert [t["diameter"] for t in job["tools"]] == [mill]
+    tool_line = next(line for line in text.splitlines() if line.startswith("tool = "))
+    if mill < 3.0:
+        # across the gap between the facing edges (y 30..50 with Y up), at one of them
+        at = re.search(rf"parts {gap:g} mm apart at \((\S+), (\S+)\) mm", tool_line)
+        assert at, tool_line
+        assert float(at[1]) == pytest.approx(30 + gap / 2) and 30.0 <= float(at[2]) <= 50.0
+        assert f"a {mill:g} mm one fits" in tool_line
+    else:
+        assert "#" not in tool_line
+    done = run_job(drawing, load_target("grbl"), job_from_dict(job, source="parts.toml"))
+    assert not [w for w in done.program.warnings if "cuts into the part" in w]
