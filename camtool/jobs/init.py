@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from camtool.geometry.chain import chain_members, joint_distance
-from camtool.jobs.init_mills import mill_between, mill_that_fits
+from camtool.jobs.init_mills import Parts, mill_between, mill_that_fits
 from camtool.jobs.init_mills import why as _why
 from camtool.jobs.job import Selection
 from camtool.jobs.selection import circle_of, construction_reason
@@ -100,7 +100,7 @@ def initial_job(
     for group in groups:
         group.close_gap = close_gap
     outer = _outermost([(group, c) for group in groups for c in _chains(group)])
-    parts = [c for group in groups for c in _chains(group) if id(c) in outer[0]]
+    parts = Parts([c for group in groups for c in _chains(group) if id(c) in outer[0]])
     ops: list[_Op] = []
     left: Counter[str] = Counter()
     cut: list[tuple[_Group, list[_Op]]] = []
@@ -354,7 +354,7 @@ _AREA_TOLERANCE_MM = 0.01
 
 def _ops_of(
     group: _Group,
-    outer: tuple[set[int], dict[int, str], list[Contour]],
+    outer: tuple[set[int], dict[int, str], Parts],
     thickness: float,
     tool: float,
     left: Counter[str],
@@ -365,7 +365,7 @@ def _ops_of(
     """The operations of one layer (or colour); ``k``: the scale the job fits it by.
 
     ``outer``: the ids of the outermost closed contours, the holes of other groups' parts
-    (:func:`_outermost`), and the outermost contours themselves (every group's parts).
+    (:func:`_outermost`), and every group's parts (the outermost contours themselves).
 
     ``drill``: small circles are drilled (else profiled with the rest: no Z to drill by).
     """
@@ -487,7 +487,7 @@ def _profile_op(
     select: str,
     what: str,
     contours: list[Contour],
-    nested: tuple[set[int], dict[int, str], list[Contour]],
+    nested: tuple[set[int], dict[int, str], Parts],
     thickness: float,
     tool: float,
     key: str,
@@ -518,6 +518,7 @@ def _profile_op(
         )
     else:
         why = f"{what} holds holes of a part only: cut on their inside"
+    mill: float | None
     if has_outer:
         mill, tool_line = mill_between([c for c in contours if id(c) in outer], parts, tool)
     else:

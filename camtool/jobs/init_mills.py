@@ -6,6 +6,8 @@ Design notes: docs/internals.md, ``camtool/jobs/init.py``.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from functools import cached_property
+from typing import Any
 
 from camtool.model.shapes import Contour, Point
 from camtool.model.units import fmt_point
@@ -70,21 +72,48 @@ def mill_that_fits(
     return mill, f"tool = {{end-mill {mill:g}}}" + why(f"{said}: a {mill:g} mm one cuts {them}")
 
 
-def mill_between(
-    parts: Sequence[Contour], others: Sequence[Contour], tool: float
-) -> tuple[float | None, str]:
-    """The end mill an outside profile of ``parts`` cuts with, and its ``tool =`` line.
+class Parts:
+    """The drawing's parts (its outermost closed contours) and the areas they enclose, mm.
+
+    The areas (:func:`~camtool.geometry.area.enclosed`) and their shapely ``STRtree`` are
+    made once, when :func:`mill_between` first asks, and shared by every operation.
+    """
+
+    def __init__(self, contours: Sequence[Contour]) -> None:
+        self.contours = tuple(contours)
+        self._index = {id(c): i for i, c in enumerate(self.contours)}
+
+    @cached_property
+    def areas(self) -> tuple[Any, ...]:
+        """Each part's area (a shapely polygon or multipolygon), in :attr:`contours`' order."""
+        from camtool.geometry.area import enclosed
+
+        return tuple(enclosed(c.points(WIDTH_TOLERANCE_MM)) for c in self.contours)
+
+    @cached_property
+    def tree(self) -> Any:
+        """A shapely ``STRtree`` of :attr:`areas`."""
+        import shapely
+
+        return shapely.STRtree(self.areas)
+
+    def index(self, contour: Contour) -> int | None:
+        """``contour``'s place among the parts, or ``None`` when it is none of them."""
+        return self._index.get(id(contour))
+
+
+def mill_between(mine: Sequence[Contour], parts: Parts, tool: float) -> tuple[float, str]:
+    """The end mill an outside profile of ``mine`` cuts with, and its ``tool =`` line.
 
     Each part's toolpath lies the tool's radius outside it, so its cut is the tool's
-    diameter wide: a neighbour closer than that (another of ``parts`` or of ``others``,
-    the drawing's other outermost closed contours, mm) loses material to it (boxes.py
+    diameter wide: another of ``parts`` closer than that loses material to it (boxes.py
     spaces its parts half a stock thickness apart, for a laser's kerf). The job's end mill
     (``tool``, mm) when no two are closer than it, or when they touch or overlap (nothing
     fits there: ``post`` names where the tool cuts into a part); else the largest of
     :data:`END_MILLS_MM` within :data:`FIT_MARGIN` of the narrowest gap, said in the
     comment with where it is, or the job's when none fits (the comment says so).
     """
-    gap = _narrowest_gap(parts, others, tool)
+    gap = _narrowest_gap(mine, parts, tool)
     if gap is None:
         return tool, "tool = {end-mill}"
     width, at = gap
@@ -104,31 +133,25 @@ def mill_between(
 
 
 def _narrowest_gap(
-    parts: Sequence[Contour], others: Sequence[Contour], tool: float
+    mine: Sequence[Contour], parts: Parts, tool: float
 ) -> tuple[float, Point] | None:
-    """The smallest gap under ``tool`` between one of ``parts`` and another contour, mm.
+    """The smallest gap under ``tool`` between one of ``mine`` and another part, mm.
 
     Gaps of zero (touching, overlapping) are not counted. Returns the gap and the middle
     of the shortest line across it (shapely's ``distance`` and ``shortest_line`` between
-    the areas the contours enclose, :func:`~camtool.geometry.area.enclosed`), or ``None``.
+    the parts' areas), or ``None``.
     """
     import shapely
 
-    from camtool.geometry.area import enclosed
-
-    mine = {id(c) for c in parts}
-    every = [*parts, *(c for c in others if id(c) not in mine)]
-    areas = [enclosed(c.points(WIDTH_TOLERANCE_MM)) for c in every]
-    tree = shapely.STRtree(areas)
     best: tuple[float, Point] | None = None
-    for i in range(len(parts)):
-        for j in tree.query(areas[i], predicate="dwithin", distance=tool):
-            j = int(j)
-            if j == i or (j < len(parts) and j < i):
-                continue
-            d = float(shapely.distance(areas[i], areas[j]))
-            if 0.0 < d < tool and (best is None or d < best[0]):
-                line = shapely.shortest_line(areas[i], areas[j])
-                (x0, y0), (x1, y1) = line.coords
+    for contour in mine:
+        i = parts.index(contour)
+        if i is None:
+            continue
+        here = parts.areas[i]
+        for j in parts.tree.query(here, predicate="dwithin", distance=tool).tolist():
+            d = float(shapely.distance(here, parts.areas[j]))
+            if j != i and 0.0 < d < tool and (best is None or d < best[0]):
+                (x0, y0), (x1, y1) = shapely.shortest_line(here, parts.areas[j]).coords
                 best = (d, ((x0 + x1) / 2.0, (y0 + y1) / 2.0))
     return best

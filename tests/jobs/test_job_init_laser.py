@@ -145,8 +145,8 @@ def test_a_colour_mostly_of_another_colour_s_holes_is_cut_inside(tmp_path: Path)
 
     boxes.py's ``Lamp.svg`` draws 605 blue holes in black parts and 2 blue squares whose
     black parts are drawn open (not chained closed): cut outside, as its 2 "outermost"
-    contours asked, the 605 holes came out a tool diameter too wide. The side of most of
-    the contours wins, and the comment names the others. With the 3 mm end mill, each
+    contours would ask, the 605 holes would be a tool diameter too wide. The side of most
+    of the contours wins, and the comment names the others. With the 3 mm end mill, each
     10 mm hole's toolpath lies 1.5 mm inside it: work zero is the lower-left of the part's
     toolpath, 1.5 mm outside its outline at x 10, so the holes at x 15..25, 35..45 and
     55..65 in the drawing are cut from x 16.5 - 8.5 = 8 to 63.5 - 8.5 = 55 mm.
@@ -217,11 +217,11 @@ def test_parts_closer_than_the_tool_get_an_end_mill_that_fits_between_them(
 ) -> None:
     """boxes.py spaces parts half a stock thickness apart (1.5 mm for 3 mm), for a laser.
 
-    A 3 mm end mill's cut, 3 mm wide outside each part, took 1.5 mm of the neighbour
-    (``post`` warned, after the job was written). The largest common end mill within 95 %
-    of the gap is proposed instead: 1 mm for 1.5 mm (1.425 mm at most), 2 mm for 2.2 mm;
-    a gap of the tool's width or more keeps the 3 mm one. The job's program then cuts
-    into neither part.
+    A 3 mm end mill's cut, 3 mm wide outside each part, would take 1.5 mm of the
+    neighbour (``post`` warns, but only once the job is written). The largest common end
+    mill within 95 % of the gap is proposed instead: 1 mm for 1.5 mm (1.425 mm at most),
+    2 mm for 2.2 mm; a gap of the tool's width or more keeps the 3 mm one. The job's
+    program then cuts into neither part.
     """
     svg = tmp_path / "parts.svg"
     svg.write_text(_two_parts(gap))
