@@ -13,6 +13,8 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
+import numpy as np
+
 from camtool.geometry.chain import FREE_JOINT_MM, JOINT_SHARE, joint_distance
 from camtool.model.shapes import Contour, Point
 from camtool.model.units import fmt_num, fmt_point
@@ -48,7 +50,6 @@ def open_gaps(contours: Sequence[Contour], options: PlanOptions) -> list[Finding
         The findings (``at`` the gap's midpoint, ``value`` the gap, mm), nearest first,
         at most :data:`MAX_REPORTED` plus one summary.
     """
-    import numpy as np
     import shapely
 
     ends: list[tuple[int, Point]] = []
@@ -64,7 +65,7 @@ def open_gaps(contours: Sequence[Contour], options: PlanOptions) -> list[Finding
     points = shapely.points(xy)
     tree = shapely.STRtree(points)
     least: list[tuple[float, int, int, int]] = []  # (gap, pair number, a, b)
-    lengths: dict[int, float] = {}  # of the contours a wide gap was judged against
+    lengths = np.full(len(contours), np.nan)  # of the contours a gap was judged against
     kept, largest, offset = 0, 0.0, 0
     for lo in range(0, len(points), _QUERY_CHUNK):
         # the pairs of a run of ends at a time: all of them at once are ~100 bytes a pair,
@@ -74,18 +75,18 @@ def open_gaps(contours: Sequence[Contour], options: PlanOptions) -> list[Finding
         a, b = a[a < b], b[a < b]  # each pair once, in the order the tree gives them
         exact = _Exact(xy, a, b)
         keep = exact.above(np.arange(len(a)), joint)
-        for k in np.flatnonzero(keep & (owner[a] == owner[b])):  # a contour's own two ends
-            share = GAP_SHARE * contours[owner[a[k]]].length_unkept()
-            keep[k] = not exact.above(np.array([k]), share, inclusive=True)[0]  # a "C": drawn
-            # open on purpose (close_gaps leaves it too)
-        wide = exact.above(np.arange(len(a)), FREE_JOINT_MM)
-        for k in np.flatnonzero(keep & wide & (owner[a] != owner[b])):
-            # two contours: ends further apart than half the shorter one are drawn
-            # apart, and no --chain-tolerance joins them (geometry.chain.JOINT_SHARE)
-            shorter = min(
-                _length(contours, lengths, owner[a[k]]), _length(contours, lengths, owner[b[k]])
-            )
-            keep[k] = not exact.above(np.array([k]), JOINT_SHARE * shorter)[0]
+        own = np.flatnonzero(keep & (owner[a] == owner[b]))  # a contour's own two ends
+        share = GAP_SHARE * _lengths(contours, lengths, owner[a[own]])
+        keep[own] = ~exact.above(own, share, inclusive=True)  # a "C": drawn open on
+        # purpose (close_gaps leaves it too)
+        two = np.flatnonzero(keep & exact.above(np.arange(len(a)), FREE_JOINT_MM))
+        two = two[owner[a[two]] != owner[b[two]]]
+        # two contours: ends further apart than half the shorter one are drawn apart, and
+        # no --chain-tolerance joins them (geometry.chain.JOINT_SHARE)
+        shorter = np.minimum(
+            _lengths(contours, lengths, owner[a[two]]), _lengths(contours, lengths, owner[b[two]])
+        )
+        keep[two] = ~exact.above(two, JOINT_SHARE * shorter)
         near_gaps = np.flatnonzero(keep)  # the near gaps, in the order the tree gives them
         if len(near_gaps):
             kept += len(near_gaps)
@@ -110,12 +111,15 @@ def open_gaps(contours: Sequence[Contour], options: PlanOptions) -> list[Finding
     return out
 
 
-def _length(contours: Sequence[Contour], known: dict[int, float], index: Any) -> float:
-    """Contour ``index``'s length, mm, measured once (``known``), not kept on the contour."""
-    i = int(index)
-    if i not in known:
-        known[i] = contours[i].length_unkept()
-    return known[i]
+def _lengths(contours: Sequence[Contour], known: Any, indices: Any) -> Any:
+    """The lengths (mm) of contours ``indices`` (an int array).
+
+    Each is measured once into ``known`` (one per contour, NaN until measured), not kept on
+    the contours.
+    """
+    need = np.unique(indices[np.isnan(known[indices])])
+    known[need] = [contours[int(i)].length_unkept() for i in need]
+    return known[indices]
 
 
 def near_reach(joint_mm: float) -> float:
@@ -136,8 +140,6 @@ class _Exact:
     """
 
     def __init__(self, xy: Any, a: Any, b: Any) -> None:
-        import numpy as np
-
         self.xy, self.a, self.b = xy, a, b
         d = xy[b] - xy[a]
         self.rough = np.hypot(d[:, 0], d[:, 1])
@@ -145,22 +147,22 @@ class _Exact:
     def gap(self, k: int) -> float:
         return math.dist(self.xy[self.a[k]], self.xy[self.b[k]])
 
-    def above(self, ks: Any, limit: float, *, inclusive: bool = False) -> Any:
-        """``(len(ks),) bool``: gap ``> limit`` (``>=`` with ``inclusive``) for pairs ``ks``."""
-        import numpy as np
+    def above(self, ks: Any, limit: Any, *, inclusive: bool = False) -> Any:
+        """``(len(ks),) bool``: gap ``> limit`` (``>=`` with ``inclusive``) for pairs ``ks``.
 
+        ``limit`` is one limit (mm) or one per pair (``(len(ks),)``).
+        """
         rough = self.rough[ks]
+        limit = np.broadcast_to(np.asarray(limit, dtype=np.float64), rough.shape)
         out = rough > limit
-        near = np.flatnonzero(np.abs(rough - limit) <= _MARGIN * max(limit, 1e-300))
+        near = np.flatnonzero(np.abs(rough - limit) <= _MARGIN * np.maximum(limit, 1e-300))
         for i in near:
             gap = self.gap(int(ks[i]))
-            out[i] = gap >= limit if inclusive else gap > limit
+            out[i] = gap >= limit[i] if inclusive else gap > limit[i]
         return out
 
     def smallest(self, ks: Any, count: int) -> list[int]:
         """The ``count`` pairs of ``ks`` with the least gaps, least first, ties in ``ks`` order."""
-        import numpy as np
-
         if len(ks) == 0:
             return []
         rough = self.rough[ks]
