@@ -265,10 +265,6 @@ class BudgetRun:
         )  # the figures without it are the program's own: nothing to re-simulate
         self.simulated = [] if self.exact else self.modelled
         self._answered(0)
-        if self.simulated and inputs.drawing is not None:
-            # each worker compares its trace with the drawing (scipy's k-d tree); loaded
-            # here, once, the forked workers inherit it instead of each loading it again
-            import scipy.spatial  # noqa: F401
         work = partial(without_source, inputs)
         self.work: ForkedWork[str, Without] | _ForkedOne[str, Without]
         if alongside and len(self.simulated) == 1:

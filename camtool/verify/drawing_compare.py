@@ -84,12 +84,15 @@ def prepare_comparison(drawing: Drawing) -> None:
     """Ahead of comparing traces with ``drawing`` here and in forked workers: make them once.
 
     The drawing's points are sampled now (and kept, as every comparison keeps its last
-    drawing's) and, for a drawing of at least :data:`PREPARE_KERNELS_FROM` points, the
-    compiled nearest search is loaded (:func:`near_kernels`) with the machine code of the
-    kernels a comparison calls (:func:`_load_kernels`), so that workers forked next
-    inherit both instead of each making them again (its loading alone is ~0.5 s). Only the
-    time depends on it: the figures are the same.
+    drawing's), scipy's k-d tree is loaded (the worst-distance search of every comparison
+    builds one, :class:`~camtool.verify.nearest_search._LazyTree`) and, for a drawing of at
+    least :data:`PREPARE_KERNELS_FROM` points, the compiled nearest search
+    (:func:`near_kernels`) with the machine code of the kernels a comparison calls
+    (:func:`_load_kernels`), so that workers forked next inherit them instead of each
+    loading them again. Only the time depends on it: the figures are the same.
     """
+    import scipy.spatial  # noqa: F401
+
     samples, _ = _sample_drawing(drawing, AGAINST_SPACING_MM)
     if len(samples) >= PREPARE_KERNELS_FROM:
         _load_kernels()
