@@ -33,6 +33,7 @@ from camtool.importers.svgdoc import (
     SOURCE_ATTR,
     USE_ATTR,
     Prepared,
+    Unseen,
     element_noun,
     prepare,
     unseen_warnings,
@@ -53,6 +54,9 @@ from camtool.importers.svgstyle import (
     on_layers,
     shaper_layer,
     style_of,
+    unpainted,
+    unseen_fill,
+    unstroked,
     wanted_layers,
 )
 from camtool.model.errors import GeometryError, InputError, TooLargeError
@@ -148,20 +152,23 @@ def _drawing(
     svg = _parse(path, prepared)
     warnings = list(prepared.warnings)
     contours: list[Contour] = []
-    hidden = invisible = faded = bare_lines = background = 0
+    unseen = Unseen()
     drawn: list[tuple[Any, list[Any] | None]] = []
     shapes = list(_shapes(svg))
     progress(Step("reading", 0, len(shapes), path.name))
     for i, shape in enumerate(shapes, start=1):
         values = shape.values
+        line = isinstance(shape, se.SimpleLine)  # no inside: its fill shows nothing (SVG 2 §10.5)
         if str(values.get("visibility", "visible")).strip().lower() in ("hidden", "collapse"):
-            hidden += 1
+            unseen.hidden += 1
         elif zero_opacity(values.get("opacity")):
-            faded += 1
-        elif _unpainted(shape.stroke) and isinstance(shape, se.SimpleLine):
-            bare_lines += 1  # a line has no inside: its fill shows nothing (SVG 2 §10.5)
-        elif _unpainted(shape.fill) and _unpainted(shape.stroke):
-            invisible += 1
+            unseen.faded += 1
+        elif not unpainted(shape.stroke) and unstroked(shape) and (line or unpainted(shape.fill)):
+            unseen.thin += 1
+        elif unpainted(shape.stroke) and line:
+            unseen.bare += 1
+        elif unpainted(shape.fill) and unpainted(shape.stroke):
+            unseen.invisible += 1
         else:
             drawn.append((shape, _segments(shape)))
         progress(Step("reading", i, len(shapes), path.name))
@@ -176,7 +183,7 @@ def _drawing(
         try:
             check_travel(path, check, box, _labelled(drawn, boxes), prepared.page)
         except TooLargeError:
-            if not any(id(shape) in clips or _unseen_fill(shape) for shape, _ in drawn):
+            if not any(id(shape) in clips or unseen_fill(shape) for shape, _ in drawn):
                 raise
             deferred = True
     tolerance = options.curve_tolerance(box)
@@ -187,22 +194,22 @@ def _drawing(
     for i, (shape, segments) in enumerate(drawn, start=1):
         made = _contours(path, shape, segments, prepared.matrix, fitter)
         over = clips.get(id(shape))
-        if _unseen_fill(shape) and is_background(made, prepared.page):
-            background += 1  # the page's white background: a viewer shows nothing of it
+        if unseen_fill(shape) and is_background(made, prepared.page):
+            unseen.background += 1  # the page's white background: a viewer shows nothing of it
         elif not over or not _hidden_by_clip(
             path, shape, made, over, prepared.matrix, tolerance, regions
         ):
             contours.extend(made)
             kept.append(i - 1)
         progress(Step("contours", i, len(drawn)))
-    clipped_away = len(drawn) - len(kept) - background
+    clipped_away = len(drawn) - len(kept) - unseen.background
     if deferred and check is not None:
         left = [b for b in (boxes[k] for k in kept) if b is not None]
         if left:
             kept_boxes = [boxes[k] for k in kept]
             labelled = _labelled([drawn[k] for k in kept], kept_boxes)
             check_travel(path, check, bbox_union(left), labelled, prepared.page)
-    if (clipped_away or background) and options.fit is not None and known:
+    if (clipped_away or unseen.background) and options.fit is not None and known:
         # --fit scales what is kept: without the hidden shapes' extent, by a larger factor,
         # which the curves' tolerance must follow (ImportOptions.curve_tolerance)
         left = [b for b in (boxes[k] for k in kept) if b is not None]
@@ -218,7 +225,7 @@ def _drawing(
             f"{path}: skipped {clipped_away} {element_noun(clipped_away)} that {its} clip-path, "
             f"mask or viewport hides wholly (a viewer shows nothing of {them})"
         )
-    warnings += unseen_warnings(path, hidden, faded, invisible, bare_lines, background)
+    warnings += unseen_warnings(path, unseen)
     if named:
         contours = on_layers(path, contours, named)
     size_note = ""
@@ -320,22 +327,6 @@ def _shapes(node: Any) -> Iterator[Any]:
             yield from _shapes(child)
 
 
-def _unpainted(color: Any) -> bool:
-    """Whether a shape's ``fill`` or ``stroke`` (svgelements' Color) paints nothing.
-
-    ``none``, or an alpha of 0: ``transparent``, ``rgba(…, 0)``, ``#RRGGBB00``, or a
-    ``fill-opacity``/``stroke-opacity`` of 0, which svgelements folds into the colour.
-    """
-    return color is None or color.value is None or color.alpha == 0
-
-
-def _unseen_fill(shape: Any) -> bool:
-    """Whether a shape is filled white without a stroke: unseen on the white page."""
-    fill = shape.fill
-    white = not _unpainted(fill) and (fill.red, fill.green, fill.blue) == (255, 255, 255)
-    return white and _unpainted(shape.stroke)
-
-
 def _contours(
     path: Path, shape: Any, segments: list[Any] | None, page: Affine, fitter: Fitter
 ) -> list[Contour]:
@@ -381,7 +372,7 @@ def _hidden_by_clip(
             its region cannot be worked out (:mod:`camtool.importers.svgclip`).
     """
     lines = [c.points(tolerance) for c in contours]
-    filled = not _unpainted(shape.fill)
+    filled = not unpainted(shape.fill)
     parts = []
     for clip in clips:
         try:

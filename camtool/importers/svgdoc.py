@@ -719,11 +719,23 @@ def _check(element: ET.Element, kind: str, viewport: tuple[float, float]) -> Non
         svgcheck.check_points(element.get("points", ""))
 
 
-def unseen_warnings(
-    path: object, hidden: int, faded: int, invisible: int, bare: int, background: int
-) -> list[str]:
+@dataclass
+class Unseen:
+    """Counts of the shapes a viewer shows nothing of, by why (:func:`unseen_warnings`)."""
+
+    hidden: int = 0  # visibility:hidden or collapse
+    faded: int = 0  # opacity 0
+    invisible: int = 0  # neither fill nor stroke
+    thin: int = 0  # a stroke of width 0, and no fill (or a <line>)
+    bare: int = 0  # a <line> without a stroke
+    background: int = 0  # the page's white background
+
+
+def unseen_warnings(path: object, unseen: Unseen) -> list[str]:
     """What was skipped because a viewer shows nothing of it: one warning per kind."""
     said = []
+    hidden, faded, invisible = unseen.hidden, unseen.faded, unseen.invisible
+    thin, bare, background = unseen.thin, unseen.bare, unseen.background
     if hidden:
         said.append(f"{path}: skipped {hidden} {element_noun(hidden)} with visibility:hidden")
     if faded:
@@ -731,6 +743,11 @@ def unseen_warnings(
     if invisible:
         said.append(
             f"{path}: skipped {invisible} {element_noun(invisible)} with neither fill nor stroke"
+        )
+    if thin:
+        said.append(
+            f"{path}: skipped {thin} {element_noun(thin)} whose only paint is a stroke of "
+            "stroke-width 0, which a viewer does not draw; give it a stroke width to cut it"
         )
     if bare:
         said.append(

@@ -91,9 +91,11 @@ def style_of(values: Any) -> tuple[str, str]:
 
 
 def _colour(values: Any) -> str:
-    """The shape's stroke, else its fill, as ``#rrggbb`` (``""``: neither paints)."""
+    """The shape's stroke (of a width), else its fill, as ``#rrggbb`` (``""``: neither)."""
     colour = ""
     for key in ("stroke", "fill"):
+        if key == "stroke" and zero_width(values.get("stroke-width")):
+            continue  # a stroke of width 0 shows nothing: the fill's colour is seen
         paint = str(values.get(key) or "none").strip()
         if _none(paint) or paint.lower().startswith(("url(", "currentcolor")):
             continue
@@ -114,8 +116,8 @@ def _dashed(values: Any) -> bool:
     length makes the value invalid, so ignored (SVG 2 §13.5.5): drawn as a line, as is
     ``40 0`` (no gap) or a sum of zero.
     """
-    if _none(values.get("stroke")):
-        return False
+    if _none(values.get("stroke")) or zero_width(values.get("stroke-width")):
+        return False  # no stroke shows: the shape is its fill
     dashes = str(values.get("stroke-dasharray") or "").replace(",", " ").split()
     lengths = []
     for text in dashes:
@@ -168,3 +170,45 @@ def on_layers(path: Path, contours: list[Contour], named: tuple[str, ...]) -> li
             + ", ".join(map(repr, there))
         )
     return [c for c in contours if c.layer in named]
+
+
+_ZERO_WIDTH = re.compile(
+    r"\s*[+-]?(?:0+\.?0*|\.0+)(?:e[+-]?\d+)?"
+    r"(?:px|pt|pc|mm|cm|in|q|em|ex|rem|ch|vw|vh|vmin|vmax|%)?\s*",
+    re.IGNORECASE,
+)
+
+
+def zero_width(value: object) -> bool:
+    """Whether a ``stroke-width`` value (``0``, ``0.0``, ``0px``, ``0%``) is zero.
+
+    A stroke of width zero paints nothing (SVG 1.1 §11.4, ``stroke-width``: "A zero value
+    causes no stroke to be painted"; SVG 2 §13.5.4). Absent, negative or not a length: no
+    (a negative width is an error viewers draw differently; the shape is kept).
+    """
+    return value is not None and _ZERO_WIDTH.fullmatch(str(value)) is not None
+
+
+def unpainted(color: Any) -> bool:
+    """Whether a shape's ``fill`` or ``stroke`` (svgelements' Color) paints nothing.
+
+    ``none``, or an alpha of 0: ``transparent``, ``rgba(…, 0)``, ``#RRGGBB00``, or a
+    ``fill-opacity``/``stroke-opacity`` of 0, which svgelements folds into the colour.
+    """
+    return color is None or color.value is None or color.alpha == 0
+
+
+def unstroked(shape: Any) -> bool:
+    """Whether a shape's stroke paints nothing.
+
+    It has no paint (:func:`unpainted`), or a ``stroke-width`` of zero, its own or
+    inherited (:func:`zero_width`).
+    """
+    return unpainted(shape.stroke) or zero_width(shape.values.get("stroke-width"))
+
+
+def unseen_fill(shape: Any) -> bool:
+    """Whether a shape is filled white without a stroke: unseen on the white page."""
+    fill = shape.fill
+    white = not unpainted(fill) and (fill.red, fill.green, fill.blue) == (255, 255, 255)
+    return white and unstroked(shape)

@@ -343,6 +343,43 @@ def test_a_line_without_a_stroke_is_not_shown_so_not_cut(tmp_path: Path) -> None
     )
 
 
+def test_a_stroke_of_width_0_paints_nothing_so_an_unfilled_shape_is_not_cut(
+    tmp_path: Path,
+) -> None:
+    """SVG 1.1 §11.4: "A zero value causes no stroke to be painted". react-icons' Material
+    icons put ``stroke="currentColor" stroke-width="0"`` on the root, so the icon's
+    unfilled 24 × 24 frame, ``M0 0h24v24H0z``, shows nothing: cut, it would be a square
+    around the part. A fill still shows (and gives the colour, not the stroke), a width
+    above 0 or a negative one (an error viewers draw) is drawn, and a dash array on a
+    stroke that is not drawn does not make a filled shape construction."""
+    body = (
+        '<g stroke="currentColor" fill="currentColor" stroke-width="0">'
+        '<path id="frame" fill="none" d="M0 0h24v24H0z"/>'
+        '<circle id="icon" cx="12" cy="12" r="10"/></g>'
+        "<style>.zero { stroke-width: 0 }</style>"
+        '<rect id="a" x="30" width="5" height="5" fill="none" stroke="red" class="zero"/>'
+        '<rect id="b" x="40" width="5" height="5" fill="none" stroke="red" '
+        'style="stroke-width:0.0px"/>'
+        '<line id="c" x1="0" y1="30" x2="50" y2="30" stroke="red" stroke-width="0%"/>'
+        '<rect id="d" x="50" width="5" height="5" fill="#00f" stroke="red" stroke-width="0" '
+        'stroke-dasharray="4 2"/>'
+        '<rect id="e" x="60" width="5" height="5" fill="none" stroke="red" '
+        'stroke-width="0.001"/>'
+        '<rect id="f" x="70" width="5" height="5" fill="none" stroke="red" stroke-width="-1"/>'
+        '<g stroke-width="0"><rect id="g" x="80" width="5" height="5" fill="none" '
+        'stroke="red" stroke-width="1"/></g>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    sources = [c.source for c in drawing.contours]
+    assert sources == ["circle#icon", "rect#d", "rect#e", "rect#f", "rect#g"]
+    filled = drawing.contours[1]
+    assert (filled.colour, filled.linetype) == ("#0000ff", "")
+    assert drawing.warnings == (
+        f"{tmp_path / 't.svg'}: skipped 4 elements whose only paint is a stroke of "
+        "stroke-width 0, which a viewer does not draw; give it a stroke width to cut it",
+    )
+
+
 def test_shapes_at_opacity_0_are_invisible_and_not_cut(tmp_path: Path) -> None:
     """What a browser shows is what is cut: opacity 0, or paint whose own opacity is 0."""
     body = (
