@@ -623,13 +623,7 @@ def prepare(
             f"{path}: skipped {counts['extensions']} element(s) with shapes that require "
             "extensions (requiredExtensions), which a viewer without them does not show"
         )
-    viewports = clip_viewports(root, parents, hold, viewport, str(path))
-    if viewports:
-        warnings.append(
-            f"{path}: {viewports} nested <svg> viewport(s) placed by a <use> clip what "
-            "they hold to their size there; camtool does not, so a shape reaching outside "
-            "one is cut whole (check the preview, or trim it in the drawing program)"
-        )
+    clip_viewports(root, parents, hold, viewport, str(path))
     for kind in ("defs", "symbol", "mask", "text", "image", "use"):
         if counts[kind]:
             noun = "element" if counts[kind] == 1 else "elements"

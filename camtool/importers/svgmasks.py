@@ -341,9 +341,10 @@ def symbols_as_viewports(root: ET.Element) -> int:
     ``preserveAspectRatio`` and style, holding copies of the symbol's children. The viewport
     clips unless ``overflow`` is visible (resvg's structure/symbol tests), which
     :func:`clip_viewports` then checks. A use with a ``width`` or ``height`` of an
-    ``<svg>`` with a ``viewBox`` gives that size to a copy of the ``<svg>`` (svgelements
-    would scale the viewBox into the ``<svg>``'s own size), its ``x`` and ``y`` moved by
-    the use's (resvg's structure/use/xlink-to-svg-element-with-viewBox.svg). Only the uses
+    ``<svg>`` gives that size to a copy of the ``<svg>`` (svgelements would scale a viewBox
+    into the ``<svg>``'s own size, and clip to it), its ``x`` and ``y`` moved by the use's
+    (resvg's structure/use/xlink-to-svg-element-with-viewBox.svg and
+    xlink-to-svg-element-with-rect.svg). Only the uses
     the document holds are replaced, not those a copy brings (each is replaced once,
     whatever it nests).
 
@@ -363,7 +364,7 @@ def symbols_as_viewports(root: ET.Element) -> int:
         if target is None or parent is None:
             continue
         kind = local_name(target)
-        sized = kind == "svg" and "viewBox" in target.attrib and bool(_SIZES & set(use.attrib))
+        sized = kind == "svg" and bool(_SIZES & set(use.attrib))
         if kind != "symbol" and not sized:
             continue
         group = ET.Element(tag(root, "g"), {k: v for k, v in use.attrib.items()
@@ -420,7 +421,7 @@ def clip_viewports(
     hold: ET.Element,
     viewport: tuple[float, float],
     name: str,
-) -> int:
+) -> None:
     """Give each drawn nested ``<svg>`` that clips (``overflow`` hidden, the default) a clip.
 
     A nested viewport clips its content to its ``x``, ``y``, ``width``, ``height`` (SVG 1.1
@@ -431,17 +432,17 @@ def clip_viewports(
     :mod:`camtool.importers.svgclip` checks as any clip; an SVG 2 ``transform`` on the
     ``<svg>`` moves to the ``<g>``, as it applies to the viewport too.
 
+    A ``<use>`` that places the ``<svg>`` (run after :func:`symbols_as_viewports`, so one
+    without a size of its own) or a group holding it copies the clip too: the ``<svg>``'s
+    id moves to the ``<g>``, and an ``<svg>`` in ``<defs>`` is given its clip as well.
+
     Raises:
         InputError: a nested ``<svg>`` whose ``x``, ``y``, ``width`` or ``height`` is not a
             length (or a negative size), naming it.
-
-    Returns:
-        How many nested ``<svg>`` with shapes a ``<use>`` places (with sizes of its own):
-        those copies clip unchecked.
     """
     svg_tag = f"{{{SVG_NS}}}svg" if root.tag.startswith("{") else "svg"
     if not any(e is not root for e in root.iter(svg_tag)):
-        return 0
+        return
     sizes: dict[ET.Element, tuple[float, float]] = {}
     stack = [(root, viewport)]
     while stack:  # each nested <svg>'s nearest viewport, as percentages resolve against
@@ -452,7 +453,7 @@ def clip_viewports(
         stack.extend((child, size) for child in element)
     ids = {e.get("id") for e in root.iter() if e.get("id")}
     used = {href(e)[1:] for e in root.iter(tag(root, "use")) if href(e).startswith("#")}
-    unchecked = made = 0
+    made = 0
     for element in [e for e in root.iter(svg_tag) if e is not root]:
         outer = sizes.get(element, viewport)
         empty = 0.0 in svgvalues.viewport_extent(element, outer) or svgvalues.viewbox_empty(element)
@@ -465,8 +466,9 @@ def clip_viewports(
         visible = overflow.strip().lower() in ("visible", "auto")
         if (visible and not empty) or not has_shapes(element):
             continue
-        unchecked += element.get("id") in used
-        if not is_drawn(element, parents, hold):
+        own_id = element.get("id")
+        placed = own_id in used or _in_placed(element, parents, used)
+        if not placed and not is_drawn(element, parents, hold):
             continue
         made += 1
         clip_id = f"{VIEWPORT_CLIP}{made}"
@@ -486,9 +488,25 @@ def clip_viewports(
             rect.set(attr, repr(float(match.group(1)) / 100.0 * base) if match else value)
         clip = ET.SubElement(root, tag(root, "clipPath"), {"id": clip_id})
         clip.append(rect)
-        _wrap(element, parents, clip_id, root)
+        wrapper = _wrap(element, parents, clip_id, root)
+        if own_id in used:  # a <use> of the <svg> copies the group, clip and all
+            wrapper.set("id", element.attrib.pop("id"))
         parents[clip] = root
-    return unchecked
+
+
+def _in_placed(element: ET.Element, parents: dict[ET.Element, ET.Element], used: set[str]) -> bool:
+    """Whether an element that holds ``element`` is one a ``<use>`` places (its id in ``used``).
+
+    A ``<use>`` of a group in ``<defs>`` draws the nested ``<svg>`` inside it, clip and all
+    (a ``<use>`` of a ``<use>`` of a ``<symbol>``: resvg's
+    structure/symbol/indirect-symbol-reference.svg).
+    """
+    node = element
+    while node in parents:
+        node = parents[node]
+        if node.get("id") in used:
+            return True
+    return False
 
 
 def _check_size(element: ET.Element, name: str) -> None:

@@ -480,6 +480,52 @@ def test_a_symbol_clips_to_the_size_of_its_use(tmp_path: Path, size: str, read: 
             read_svg(path)
 
 
+@pytest.mark.parametrize(("side", "read"), [("40", True), ("160", False)])
+def test_a_symbol_placed_by_a_use_of_a_use_clips_to_the_inner_use(
+    tmp_path: Path, side: str, read: bool
+) -> None:
+    # resvg's structure/symbol/indirect-symbol-reference.svg: a <use> in <defs> sizes the
+    # symbol's viewport 100 x 100 and moves it by (40, 40); the drawn <use> places that use.
+    # The rect 20..20+side lies at 60..60+side: 60..100 fits the viewport 40..140; 60..220
+    # reaches outside it (a viewer shows 60..140), so it is refused, not cut whole
+    root = 'width="200mm" height="200mm" viewBox="0 0 200 200"'
+    body = (
+        f'<defs><symbol id="s"><rect id="r" x="20" y="20" width="{side}" height="{side}" '
+        'fill="none" stroke="black"/></symbol><use id="inner" href="#s" width="100" '
+        'height="100" transform="translate(40 40)"/></defs><use id="outer" href="#inner"/>'
+    )
+    path = svg(tmp_path, body, root=root)
+    if read:
+        assert [c.bbox() for c in read_svg(path).contours] == [pytest.approx((60, 100, 100, 140))]
+    else:
+        with pytest.raises(InputError, match=r"the viewport of the nested .*symbol#s hides"):
+            read_svg(path)
+
+
+@pytest.mark.parametrize("size", ['width="100" height="150"', ""])
+@pytest.mark.parametrize(("r", "read"), [("10", True), ("60", False)])
+def test_a_use_of_an_svg_without_a_viewbox_clips_to_its_viewport(
+    tmp_path: Path, size: str, r: str, read: bool
+) -> None:
+    # resvg's structure/use/xlink-to-svg-element-with-rect.svg: the <svg> in <defs> at
+    # (40, 40) is a viewport of the use's size (100 x 150), else its own (80 x 80), its
+    # content not scaled. The circle (20, 20) r 10 lies at (60, 60), inside either; r 60
+    # reaches outside it (a viewer shows a part of it), so it is refused, not cut whole
+    root = 'width="200mm" height="200mm" viewBox="0 0 200 200"'
+    body = (
+        '<defs><svg id="v" x="40" y="40" width="80" height="80"><circle id="c" cx="20" '
+        f'cy="20" r="{r}" fill="none" stroke="black"/></svg></defs><use id="u" href="#v" {size}/>'
+    )
+    path = svg(tmp_path, body, root=root)
+    if read:
+        assert [c.bbox() for c in read_svg(path).contours] == [
+            pytest.approx((50, 130, 70, 150), abs=1e-9)
+        ]
+    else:
+        with pytest.raises(InputError, match=r"the viewport of the nested use#u > svg#v hides"):
+            read_svg(path)
+
+
 @pytest.mark.parametrize(
     ("use", "own", "bbox"),
     [
