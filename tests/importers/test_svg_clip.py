@@ -462,6 +462,15 @@ def test_a_symbol_with_a_viewbox_is_placed_in_the_viewport_of_its_use(tmp_path: 
     assert contour.source == "use#u > rect#r"
 
 
+def read_or_refused(path: Path, read: bool, bbox: tuple[float, ...], refusal: str) -> None:
+    """``path`` reads as one contour of ``bbox`` (``read``), else is refused (``refusal``)."""
+    if read:
+        assert [c.bbox() for c in read_svg(path).contours] == [pytest.approx(bbox, abs=1e-9)]
+    else:
+        with pytest.raises(InputError, match=refusal):
+            read_svg(path)
+
+
 @pytest.mark.parametrize(("size", "read"), [('width="200" height="200"', True),
                                             ('width="100" height="100"', False)])  # fmt: skip
 def test_a_symbol_clips_to_the_size_of_its_use(tmp_path: Path, size: str, read: bool) -> None:
@@ -472,12 +481,8 @@ def test_a_symbol_clips_to_the_size_of_its_use(tmp_path: Path, size: str, read: 
         '<symbol id="s"><rect id="r" x="20" y="20" width="160" height="160" fill="none" '
         f'stroke="black"/></symbol><use id="u" href="#s" {size}/>'
     )
-    path = svg(tmp_path, body, root=root)
-    if read:
-        assert [c.bbox() for c in read_svg(path).contours] == [pytest.approx((20, 20, 180, 180))]
-    else:
-        with pytest.raises(InputError, match=r"the viewport of the nested use#u > symbol#s hides"):
-            read_svg(path)
+    refusal = r"the viewport of the nested use#u > symbol#s hides"
+    read_or_refused(svg(tmp_path, body, root=root), read, (20, 20, 180, 180), refusal)
 
 
 @pytest.mark.parametrize(("side", "read"), [("40", True), ("160", False)])
@@ -494,12 +499,8 @@ def test_a_symbol_placed_by_a_use_of_a_use_clips_to_the_inner_use(
         'fill="none" stroke="black"/></symbol><use id="inner" href="#s" width="100" '
         'height="100" transform="translate(40 40)"/></defs><use id="outer" href="#inner"/>'
     )
-    path = svg(tmp_path, body, root=root)
-    if read:
-        assert [c.bbox() for c in read_svg(path).contours] == [pytest.approx((60, 100, 100, 140))]
-    else:
-        with pytest.raises(InputError, match=r"the viewport of the nested .*symbol#s hides"):
-            read_svg(path)
+    refusal = r"the viewport of the nested .*symbol#s hides"
+    read_or_refused(svg(tmp_path, body, root=root), read, (60, 100, 100, 140), refusal)
 
 
 @pytest.mark.parametrize("size", ['width="100" height="150"', ""])
@@ -516,14 +517,8 @@ def test_a_use_of_an_svg_without_a_viewbox_clips_to_its_viewport(
         '<defs><svg id="v" x="40" y="40" width="80" height="80"><circle id="c" cx="20" '
         f'cy="20" r="{r}" fill="none" stroke="black"/></svg></defs><use id="u" href="#v" {size}/>'
     )
-    path = svg(tmp_path, body, root=root)
-    if read:
-        assert [c.bbox() for c in read_svg(path).contours] == [
-            pytest.approx((50, 130, 70, 150), abs=1e-9)
-        ]
-    else:
-        with pytest.raises(InputError, match=r"the viewport of the nested use#u > svg#v hides"):
-            read_svg(path)
+    refusal = r"the viewport of the nested use#u > svg#v hides"
+    read_or_refused(svg(tmp_path, body, root=root), read, (50, 130, 70, 150), refusal)
 
 
 @pytest.mark.parametrize(
