@@ -54,11 +54,11 @@ def page_matrix(
     map's output; ``None`` when the document gives neither a size nor a viewBox.
 
     Removes ``width``, ``height``, ``viewBox``, ``preserveAspectRatio``, ``x`` and ``y`` from
-    ``root``. Without an absolute ``width`` and ``height`` (missing, or in %) the user unit
-    is ``units`` (``--units``), else the px (1/96 in) with a warning; with a viewBox, one
-    missing side is taken from the viewBox's aspect ratio. Without a page height the Y
-    flip is about the user-unit origin. ``illustrator``: the version of Adobe Illustrator
-    that wrote the file (:func:`illustrator_version`), whose px are points.
+    ``root``. Without an absolute ``width`` and ``height`` (missing, or relative: ``%``,
+    ``em``) the user unit is ``units`` (``--units``), else the px (1/96 in) with a warning;
+    with a viewBox, one missing side is taken from the viewBox's aspect ratio. Without a
+    page height the Y flip is about the user-unit origin. ``illustrator``: the version of
+    Adobe Illustrator that wrote the file (:func:`illustrator_version`), whose px are points.
 
     Raises:
         InputError: a malformed size or viewBox, or a size in a unit with no physical length.
@@ -190,8 +190,16 @@ def _unit(text: str | None) -> str | None:
     return None if match is None else match[2]
 
 
+_RELATIVE_UNITS = frozenset({"%", "em", "ex", "rem", "ch", "vw", "vh", "vmin", "vmax"})
+"""Units of a page size relative to what shows the file (its window, its font): react-icons
+write ``width="1em" height="1em"``, sized by the text around the icon."""
+
+
 def _page_length(root: ET.Element, attr: str, name: str) -> tuple[float | None, str]:
-    """``(mm, "")`` for an absolute length, ``(None, text)`` for a % one, else ``(None, "")``."""
+    """A page length: ``(mm, "")`` absolute, ``(None, text)`` relative, else ``(None, "")``.
+
+    Relative: in a unit of :data:`_RELATIVE_UNITS` (``%``, ``em``...).
+    """
     text = root.get(attr)
     if text is None or text.strip() in ("", "auto"):
         return None, ""
@@ -199,7 +207,7 @@ def _page_length(root: ET.Element, attr: str, name: str) -> tuple[float | None, 
     if match is None:
         raise InputError(f"{name}: <svg> {attr} {text!r} is not a length")
     value, unit = float(match.group(1)), match.group(2)
-    if unit == "%":
+    if unit in _RELATIVE_UNITS:
         return None, f"{attr}={text.strip()!r}"
     if unit and unit not in _PAGE_UNITS_MM:
         known = ", ".join(_PAGE_UNITS_MM)

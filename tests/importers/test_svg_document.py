@@ -86,6 +86,15 @@ def test_one_size_missing_is_taken_from_the_viewbox(tmp_path: Path) -> None:
             'width="100%" height="100%" viewBox="0 0 96 96"',
             "relative size width='100%' x height='100%'",
         ),
+        # react-icons: the icon is as large as the text around it (CSS Values 4 §6.1)
+        (
+            'width="1em" height="1em" viewBox="0 0 96 96"',
+            "relative size width='1em' x height='1em'",
+        ),
+        (
+            'width="2ex" height="5vh" viewBox="0 0 96 96"',
+            "relative size width='2ex' x height='5vh'",
+        ),
     ],
 )
 def test_no_absolute_size_means_px_with_a_warning(tmp_path: Path, root: str, warning: str) -> None:
@@ -837,8 +846,8 @@ def test_bad_input_names_file_and_element(tmp_path: Path, body: str, message: st
     ("root", "message"),
     [
         (
-            'width="10em" height="10mm"',
-            "<svg> width '10em': unit 'em' unknown; use mm, cm, in, pt, px, pc",
+            'width="10ft" height="10mm"',
+            "<svg> width '10ft': unit 'ft' unknown; use mm, cm, in, pt, px, pc",
         ),
         ('width="wide" height="10mm"', "<svg> width 'wide' is not a length"),
         ('width="-5mm" height="10mm"', "<svg> width '-5mm' must be positive"),
