@@ -121,13 +121,16 @@ def select_layers(
                     "name it with --layers to cut it"
                 )
         return
-    names = {n: e for e in layers for n in (e.get("id"), e.get(_LABEL)) if n}
+    names: dict[str, list[ET.Element]] = {}  # labels repeat: "Cut" in each part's layer
+    for layer in layers:
+        for label in {layer.get("id"), layer.get(_LABEL)} - {None, ""}:
+            names.setdefault(str(label), []).append(layer)
     unknown = [w for w in wanted if w not in names]
     if unknown:
         there = ", ".join(repr(_layer_name(e)) for e in layers)
         have = f"its layers are {there}" if layers else "it has no Inkscape layers"
         raise InputError(f"{name}: no layer named {', '.join(map(repr, unknown))}; {have}")
-    selected = {names[w] for w in wanted}
+    selected = {layer for w in wanted for layer in names[w]}
     ancestors: set[ET.Element] = set()
     for layer in selected:
         node = layer

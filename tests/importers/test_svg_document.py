@@ -177,6 +177,25 @@ def test_sublayer_selection_and_innermost_layer_name(tmp_path: Path) -> None:
     assert [(c.source, c.layer) for c in everything.contours] == [("path#c", "0")]
 
 
+def test_every_layer_of_a_repeated_label_is_selected(tmp_path: Path) -> None:
+    """Inkscape keeps ids unique but not labels: a sublayer "Cut" in each part's layer.
+    ``--layers Cut`` selects both, not only the last one."""
+    body = (
+        '<g inkscape:groupmode="layer" id="l1" inkscape:label="Part A">'
+        '<g inkscape:groupmode="layer" id="l2" inkscape:label="Cut"><path id="a" d="M 0 0 L 1 0"/>'
+        '</g><g inkscape:groupmode="layer" id="l3" inkscape:label="Engrave">'
+        '<path id="b" d="M 0 0 L 2 0"/></g></g>'
+        '<g inkscape:groupmode="layer" id="l4" inkscape:label="Part B">'
+        '<g inkscape:groupmode="layer" id="l5" inkscape:label="Cut"><path id="c" d="M 0 0 L 3 0"/>'
+        "</g></g>"
+    )
+    path = svg(tmp_path, body)
+    cut = read_svg(path, ImportOptions(layers=("Cut",)))
+    assert [(c.source, c.layer) for c in cut.contours] == [("path#a", "Cut"), ("path#c", "Cut")]
+    by_id = read_svg(path, ImportOptions(layers=("l5", "Engrave")))
+    assert [c.source for c in by_id.contours] == ["path#b", "path#c"]
+
+
 def test_display_none_and_visibility_hidden_are_skipped(tmp_path: Path) -> None:
     body = (
         "<style>.off { display: none }</style>"
