@@ -35,6 +35,7 @@ from camtool.importers.svgpage import Affine, illustrator_version, page_matrix
 from camtool.importers.svgtree import (
     INKSCAPE_NS,
     LAYER_ATTR,
+    LIBRECAD_NS,
     NOT_DRAWN,
     SOURCE_ATTR,
     USE_ATTR,
@@ -50,6 +51,8 @@ from camtool.model.errors import InputError
 
 _GROUPMODE = f"{{{INKSCAPE_NS}}}groupmode"
 _LABEL = f"{{{INKSCAPE_NS}}}label"
+_LC_LAYER = f"{{{LIBRECAD_NS}}}layername"
+"""LibreCAD's "Export as MakerCAM SVG" writes each layer as a ``<g lc:layername="…">``."""
 _RENDERED = frozenset(
     [
         "g",
@@ -78,11 +81,24 @@ _HOLD_KINDS = frozenset({"symbol", "marker", "mask", "flowRoot"})
 
 
 def _layer_name(element: ET.Element) -> str:
-    return element.get(_LABEL) or element.get("id") or str(element.get(SOURCE_ATTR, "g"))
+    return (
+        element.get(_LABEL)
+        or element.get(_LC_LAYER)
+        or element.get("id")
+        or str(element.get(SOURCE_ATTR, "g"))
+    )
+
+
+def _layer_names(layer: ET.Element) -> set[str]:
+    """The names ``--layers`` and a job's operations select ``layer`` by: label and id."""
+    return {n for n in (layer.get(_LABEL), layer.get(_LC_LAYER), layer.get("id")) if n}
 
 
 def _is_layer(element: ET.Element) -> bool:
-    return local_name(element) == "g" and element.get(_GROUPMODE) == "layer"
+    """An Inkscape layer, or a LibreCAD one (:data:`_LC_LAYER`)."""
+    return local_name(element) == "g" and (
+        element.get(_GROUPMODE) == "layer" or bool(element.get(_LC_LAYER))
+    )
 
 
 def select_layers(
@@ -110,7 +126,7 @@ def select_layers(
     if wanted is None:
         named = {n.casefold() for n in shown}
         for layer in layers:
-            if named & {n.casefold() for n in (layer.get("id"), layer.get(_LABEL)) if n}:
+            if named & {n.casefold() for n in _layer_names(layer)}:
                 node: ET.Element | None = layer
                 while node is not None:
                     _show(node)
@@ -123,8 +139,8 @@ def select_layers(
         return
     names: dict[str, list[ET.Element]] = {}  # labels repeat: "Cut" in each part's layer
     for layer in layers:
-        for label in {layer.get("id"), layer.get(_LABEL)} - {None, ""}:
-            names.setdefault(str(label), []).append(layer)
+        for label in _layer_names(layer):
+            names.setdefault(label, []).append(layer)
     unknown = [w for w in wanted if w not in names]
     if unknown:
         there = ", ".join(repr(_layer_name(e)) for e in layers)

@@ -16,9 +16,11 @@ from typing import Any
 
 import svgelements as se
 
+from camtool.importers.svgtree import LIBRECAD_NS
 from camtool.model.errors import InputError
 from camtool.model.shapes import Contour
 
+_LC_CONSTRUCTION = f"{{{LIBRECAD_NS}}}is_construction"
 _SHAPER = "{http://www.shapertools.com/namespaces/shaper}"
 _SHAPER_ATTRIBUTES = (_SHAPER + "cutType", _SHAPER + "pathType")
 """How Shaper Origin's format says a shape is cut: ``shaper:cutType`` (Shaper's SVG
@@ -82,11 +84,15 @@ def style_of(values: Any) -> tuple[str, str]:
     """The shape's colour (its stroke, else its fill, as ``#rrggbb``) and linetype.
 
     A Shaper Origin guide (``shaper:cutType`` or ``pathType="guide"``, on it or a group: a sheet's
-    border, a centre line) is ``"GUIDE"``; a stroke with a ``stroke-dasharray`` of dashes
-    is ``"DASHED"``: construction lines (:mod:`camtool.model.construction`); else ``""``.
+    border, a centre line) is ``"GUIDE"``; a shape on a LibreCAD construction layer
+    (``lc:is_construction="true"``, written when its SVG export is asked for them) is
+    ``"CONSTRUCTION"``; a stroke with a ``stroke-dasharray`` of dashes is ``"DASHED"``:
+    construction lines (:mod:`camtool.model.construction`); else ``""``.
     """
     if _shaper_cut(values) == "guide":
         return _colour(values), "GUIDE"
+    if str(values.get(_LC_CONSTRUCTION, "")).strip().lower() == "true":
+        return _colour(values), "CONSTRUCTION"
     return _colour(values), ("DASHED" if _dashed(values) else "")
 
 

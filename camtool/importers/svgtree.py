@@ -10,6 +10,7 @@ import xml.etree.ElementTree as ET
 from camtool.importers.svgcss import SVG_NS, local_name
 
 INKSCAPE_NS = "http://www.inkscape.org/namespaces/inkscape"
+LIBRECAD_NS = "https://librecad.org"
 XLINK_HREF = "{http://www.w3.org/1999/xlink}href"
 CAMTOOL_NS = "urn:camtool:svg"
 SOURCE_ATTR = f"{{{CAMTOOL_NS}}}source"

@@ -15,6 +15,7 @@ import pytest
 from camtool.importers import read_drawing, read_drawing_bytes
 from camtool.importers.options import ImportOptions
 from camtool.importers.svg import read_svg
+from camtool.model.construction import is_construction
 from camtool.model.errors import InputError, UsageError
 from camtool.model.shapes import Arc
 from tests.importers.svgutil import (
@@ -194,6 +195,36 @@ def test_every_layer_of_a_repeated_label_is_selected(tmp_path: Path) -> None:
     assert [(c.source, c.layer) for c in cut.contours] == [("path#a", "Cut"), ("path#c", "Cut")]
     by_id = read_svg(path, ImportOptions(layers=("l5", "Engrave")))
     assert [c.source for c in by_id.contours] == ["path#b", "path#c"]
+
+
+def test_librecad_layers_name_the_contours_and_its_construction_layers_are_not_cut(
+    tmp_path: Path,
+) -> None:
+    """LibreCAD's "Export as MakerCAM SVG" (lc_makercamsvg.cpp, LibreCAD 2.2) writes each
+    layer as ``<g lc:layername=… lc:is_construction=…>`` in its own namespace, and a frozen
+    one (when asked to) with ``style="display: none;"``."""
+    layer = '<g lc:layername="{}" lc:is_locked="false" lc:is_construction="{}" {}fill="none" '
+    layer += 'stroke="black" stroke-width="1">{}</g>'
+    body = (
+        layer.format("0", "false", "", '<path id="plate" d="M10,40 L90,40 L90,10 L10,10 Z"/>')
+        + layer.format("holes", "false", "", '<circle id="hole" cx="20" cy="25" r="3"/>')
+        + layer.format("helper", "true", "", '<line id="axis" x1="0" y1="25" x2="100" y2="25"/>')
+        + layer.format("off", "false", 'style="display: none;" ', '<circle cx="5" cy="5" r="1"/>')
+    )
+    root = 'xmlns:lc="https://librecad.org" width="100mm" height="50mm" viewBox="0 0 100 50"'
+    path = svg(tmp_path, body, root=root)
+    drawing = read_svg(path)
+    assert [(c.source, c.layer, c.linetype) for c in drawing.contours] == [
+        ("path#plate", "0", ""),
+        ("circle#hole", "holes", ""),
+        ("line#axis", "helper", "CONSTRUCTION"),
+    ]
+    assert is_construction(drawing.contours[2])
+    assert f"{path}: layer 'off' is hidden and was skipped; name it with --layers to cut it" in (
+        drawing.warnings
+    )
+    holes = read_svg(path, ImportOptions(layers=("holes",)))
+    assert [c.source for c in holes.contours] == ["circle#hole"]
 
 
 def test_display_none_and_visibility_hidden_are_skipped(tmp_path: Path) -> None:
