@@ -19,6 +19,7 @@ from camtool.importers import gcode_ahead
 from camtool.importers.gcode_codes import BlockWords, CommandReader, Notes, unused_word
 from camtool.importers.gcode_cycles import CYCLES, CycleState
 from camtool.importers.gcode_lexer import Block, Word, cut_mid_word, lex_line
+from camtool.importers.gcode_params import expand_parameters
 from camtool.importers.gcode_plain import PLAIN_WORDS, arc_end_off, arc_limits, spiral_note
 from camtool.importers.gcode_start import StartRules
 from camtool.importers.gcode_target import READ_AS_WRITTEN, LengthOffsets, Reading, path_control
@@ -175,18 +176,18 @@ def parse_gcode(
             offsets and work offsets, kept where the program has them.
 
     Raises:
-        InputError: O-words, ``#`` parameters, ``[ ]`` expressions, G41/G42,
-            G18/G19, canned cycles, G93/G95, coordinate-offset codes, unknown
-            G/M codes or letters, two codes of one modal group, a repeated word,
-            a word no code uses, a cut before any F, an arc without centre or
-            whose end is off its circle beyond tolerance, a number out of range,
-            a last line cut in the middle of a word, no move at all, or no
-            cutting move.
+        InputError: O-words, ``#`` parameters but numbered ones set to numbers
+            (:mod:`~camtool.importers.gcode_params`), ``[ ]`` expressions, G41/G42, G93/G95,
+            coordinate-offset codes, unknown G/M codes or letters, two codes of one modal
+            group, a repeated word, a word no code uses, a cut before any F, an arc without
+            centre or off its circle beyond tolerance, a number out of range, a last line
+            cut in a word, no move at all, or no cutting move.
 
     Plain lines take the fast path (:meth:`_Reader.plain`, no word objects) unless
     ``CAMTOOL_ACCEL=0``; :func:`parse_gcode_slow` is the reference, with the same result.
     """
     with paused():  # the moves it makes stay; what it frees, counting frees
+        text = expand_parameters(text, source)  # numbered parameters read as their numbers
         return _parse(text, source, plain=accel.enabled(), reading=reading)
 
 
@@ -197,7 +198,7 @@ def parse_gcode_slow(text: str, *, source: str) -> Program:
     lines (:meth:`_Reader.plain`) without making words, to the same program with
     the same warnings and errors (tests/importers/test_gcode_plain.py compares the two).
     """
-    return _parse(text, source, plain=False)
+    return _parse(expand_parameters(text, source), source, plain=False)
 
 
 def _parse(

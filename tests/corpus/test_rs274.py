@@ -433,3 +433,26 @@ def test_the_cancels_of_refused_modes_post_as_no_ops(tmp_path: Path) -> None:
     assert len(moves) == len(expected)
     for (kind, a), (other, b) in zip(moves, expected, strict=True):
         assert kind == other and a == pytest.approx(b, abs=ROUND_MM)
+
+
+@needs_rs274
+def test_numbered_parameters_are_read_as_rs274_reads_them(tmp_path: Path) -> None:
+    """tests/importers/test_gcode_params.py's programs, a gEDA PCB export in inches and one
+    that sets parameters on a line that reads them: rs274 cuts the original and camtool's
+    linuxcnc re-post along the same moves, within the 3-decimal rounding."""
+    from tests.importers.test_gcode_params import GEDA, PARALLEL
+
+    for name, text in (("geda", GEDA), ("wizard", PARALLEL)):
+        source = tmp_path / f"{name}.ngc"
+        source.write_text(text)
+        out = tmp_path / f"{name}-out.ngc"
+        assert main(["post", str(source), "-t", "linuxcnc", "-o", str(out)]) == 0
+        want, got = rs274(source), rs274(out)
+        assert want.returncode == 0 and got.returncode == 0, got.stderr[-300:]
+        scale = 25.4 if "CANON_UNITS_INCHES" in want.stdout else 1.0
+        cuts = [tuple(scale * v for v in xyz) for k, xyz in canon_moves(want.stdout) if k == "line"]
+        again = [xyz for kind, xyz in canon_moves(got.stdout) if kind == "line"]
+        printed = 0.00005 * scale  # rs274 prints 4 decimals of the program's unit
+        assert len(cuts) == len(again) >= 2
+        for a, b in zip(cuts, again, strict=True):
+            assert a == pytest.approx(b, abs=ROUND_MM + printed), name

@@ -422,8 +422,8 @@ def test_safe_conversion_warns_once_with_count_and_first_line(block: str, expect
     ("block", "construct"),
     [
         ("O100 sub", "O-word"),
-        ("G1 X#1 F10", "'#' parameters"),
-        ("#1 = 5", "'#' parameters"),
+        ("G1 X#1 F10", "#1 is read before any line of the program sets it"),
+        ("#<depth> = 5", "'#' parameters"),
         ("G1 X[1+2] F10", "'[ ]' expressions"),
         # LinuxCNC's own tests (tests/ccomp, tests/interp/bad): a '*' or a function name
         # inside the brackets was named as a bad checksum or a letter without a number
@@ -494,11 +494,15 @@ def test_refused_construct_names_line_and_construct(block: str, construct: str) 
 
 
 def test_a_program_written_with_variables_is_refused_with_what_to_do() -> None:
-    """pstoedit's ``gcode`` format (its header, as pstoedit 3.78 writes it) sets variables."""
-    header = "G20\nG90\n#1000 = 0.100  ( safe Z )\nG01 Z#1000 F#1001\n"
-    message = refused(header)
-    assert message.startswith("t.ngc:3: '#' parameters are not supported ('#1000=0.100')")
+    """pstoedit's ``gcode`` format (its header, as pstoedit 3.78 writes it) sets variables,
+    which are read (tests/importers/test_gcode_params.py), and scales each point with an
+    expression, which is not: refused at the first, and a variable it never sets too."""
+    header = "G20\nG90\n#1000 = 0.100  ( safe Z )\n#1003 = 0.0041  ( x scale factor )\n"
+    message = refused(header + "G00 Z#1000\nG00 X[#1003*12.5] Y0\n")
+    assert message.startswith("t.ngc:6: '[ ]' expressions are not supported ('G00 X[#1003*12.5]")
     assert "post the drawing it was made from (DXF, SVG)" in message
+    unset = refused(header + "G01 Z#1000 F#1001\n")
+    assert unset.startswith("t.ngc:5: #1001 is read before any line of the program sets it")
     expression = refused("G21\nG0 X[1*72] Y1\n")
     assert expression.startswith("t.ngc:2: '[ ]' expressions are not supported")
     assert "without variables" in expression

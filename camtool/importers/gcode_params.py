@@ -1,0 +1,127 @@
+"""RS-274/NGC numbered parameters set to plain numbers: ``#100=2.0 (safe Z)`` … ``G0 Z#100``.
+
+gEDA PCB's G-code export and LinuxCNC's G-code wizard scripts (engraving, dials) set a few
+numbered parameters to numbers at the top of the program and read them as word values.
+:func:`expand_parameters` writes each read as the number it holds, line by line, before the
+program is lexed, so the reader sees plain words. The rules are LinuxCNC's ("Parameters"
+in its G-code overview): a parameter is set by ``#n=value``; all the parameters a line reads
+are read before any it sets is set ("parameter setting is done in parallel"); a value
+is a number, or another parameter, with a sign.
+
+What is left as it stands, for the lexer to refuse with its own message: a line with an
+expression (``[ ]``), a named parameter (``#<name>``), an indirect one (``##1``), or a
+block-delete ``/``. A parameter read before any line sets it (LinuxCNC reads 0, or the value
+a previous run saved) and a system parameter (``#5061``… offsets and probe results, above
+:data:`LAST_USER`) are refused: camtool cannot know their values.
+"""
+
+from __future__ import annotations
+
+import re
+
+from camtool.model.errors import InputError
+
+LAST_USER = 5000
+"""The last numbered parameter a program sets for itself; above it LinuxCNC keeps its own
+(probe results, coordinate-system offsets, the tool in the spindle)."""
+
+_NUM = r"(?:\d+\.?\d*|\.\d+)"
+_SET = re.compile(rf"#\s*(\d+)\s*=\s*([+-]?)\s*(?:({_NUM})|#\s*(\d+))\s*")
+"""An assignment: ``#n=`` a signed number or a signed parameter."""
+_READ = re.compile(r"([+-]?)\s*#\s*(\d+)")
+"""A parameter read as a word's value (a sign before it negates it)."""
+_COMMENT = re.compile(r"\([^)]*\)|;.*")
+_LINE = re.compile(r"([^\r\n]*)(\r\n|\r|\n|$)")
+"""A line and its end, as the reader splits them (LF, CR LF or CR)."""
+
+
+def expand_parameters(text: str, source: str) -> str:
+    """``text`` with each read of a numbered parameter set to a number written as that number.
+
+    Lines keep their number and their comments; an assignment leaves a blank. A line this
+    does not understand is kept as it stands (the lexer names what it holds).
+
+    Raises:
+        InputError: a parameter read before any line sets it, or a system parameter (above
+            :data:`LAST_USER`) read or set; the message names ``source:line``.
+    """
+    if "#" not in text:
+        return text
+    values: dict[int, str] = {}
+    out = []
+    for number, m in enumerate(_LINE.finditer(text), start=1):
+        if not m[0]:
+            break  # the empty match at the end of the text
+        line = m[1]
+        if "#" in line:
+            line = _expand_line(line, values, f"{source}:{number}")
+        out.append(line + m[2])
+    return "".join(out)
+
+
+def _expand_line(raw: str, values: dict[int, str], where: str) -> str:
+    """One line with its reads written as numbers; its sets go into ``values`` after."""
+    parts = _split_comments(raw)
+    code = "".join(text for text, comment in parts if not comment)
+    if any(c in code for c in "[]<") or "##" in code.replace(" ", "") or code.lstrip()[:1] == "/":
+        return raw  # an expression, a named or indirect parameter, a block delete: refused later
+    sets: dict[int, str] = {}
+    out = []
+    for text, comment in parts:
+        if not comment:
+            text = _SET.sub(lambda m: _assign(m, values, sets, where), text)
+            text = _READ.sub(lambda m: _signed(m[1], _value(int(m[2]), values, where)), text)
+        out.append(text)
+    values.update(sets)  # a line's sets after all its reads
+    return "".join(out)
+
+
+def _split_comments(raw: str) -> list[tuple[str, bool]]:
+    """``raw`` cut into ``(text, is_comment)`` runs: ``( … )`` and a ``;`` to the end."""
+    parts: list[tuple[str, bool]] = []
+    at = 0
+    for m in _COMMENT.finditer(raw):
+        parts.append((raw[at : m.start()], False))
+        parts.append((m[0], True))
+        at = m.end()
+    parts.append((raw[at:], False))
+    return parts
+
+
+def _assign(m: re.Match[str], values: dict[int, str], sets: dict[int, str], where: str) -> str:
+    """Note the set ``#n=value`` of the match for after the line; it leaves a blank."""
+    number = _user(int(m[1]), where)
+    held = m[3] if m[3] is not None else _value(int(m[4]), values, where)
+    sets[number] = _signed(m[2], held)
+    return " "
+
+
+def _value(number: int, values: dict[int, str], where: str) -> str:
+    """The number parameter ``number`` holds, as written."""
+    _user(number, where)
+    if number not in values:
+        raise InputError(
+            f"{where}: #{number} is read before any line of the program sets it (LinuxCNC "
+            "reads 0, or the value a run before saved): set it with #n=value first"
+        )
+    return values[number]
+
+
+def _user(number: int, where: str) -> int:
+    """``number`` if a program may set and read it (1 to :data:`LAST_USER`), else refused."""
+    if not 1 <= number <= LAST_USER:
+        raise InputError(
+            f"{where}: #{number} is a parameter the controller keeps (offsets, probe results, "
+            f"the tool), not one the program sets (#1 to #{LAST_USER}): camtool cannot know "
+            "its value; post the program again with plain numbers"
+        )
+    return number
+
+
+def _signed(sign: str, text: str) -> str:
+    """``text`` (a number, maybe signed) with ``sign`` applied exactly: ``-`` of ``-2``: ``2``."""
+    if sign != "-":
+        return text
+    if text.startswith("-"):
+        return text[1:]
+    return "-" + text.removeprefix("+")

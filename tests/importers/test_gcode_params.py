@@ -1,0 +1,97 @@
+"""Numbered parameters set to numbers (``#100=2.0`` … ``Z#100``), read as those numbers.
+
+The rules are LinuxCNC's ("Parameters", G-code overview): a line reads all its parameters
+before it sets any; a sign before ``#n`` negates it. tests/corpus/test_rs274.py has LinuxCNC's
+own interpreter judge the same programs.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from camtool.importers.gcode import parse_gcode, parse_gcode_slow
+from camtool.importers.gcode_params import expand_parameters
+from camtool.model.errors import InputError
+from camtool.model.program import Linear, Rapid
+
+GEDA = """(Created by G-code exporter)
+(600 dpi)
+(Unit: inch)
+(Board size: 0.50x0.50 inches)#100=0.002000  (safe Z)
+#101=-0.000050  (cutting depth)
+(---------------------------------)
+G17 G20 G90 G64 P0.003 M3 S3000 M7 F1
+G0 Z#100
+(polygon 1)
+G0 X0.073333 Y0.410000    (start point)
+G1 Z#101
+G1 X0.065000 Y0.401667
+G0 Z#100
+M5 M9 M2
+"""
+"""The head of a program by gEDA PCB's G-code exporter (its own comments and layout)."""
+
+PARALLEL = """#1 = 5.0 ( Safe Z )
+#2 = -0.5 ( Engraving Depth Z )
+#3=10
+#4 = -#3 (#4 is -10)
+G21 G90 G17
+G0 Z#1
+G0 X#3 Y-#4
+G1 Z#2 F100
+G1 X-#3 Y#4 #4=#3 #3=-3
+G1 X#3 Y#4 Z-#2
+M2
+"""
+"""A wizard-style program: its line 9 reads #3 = 10 and #4 = -10, then sets #4 = 10 and
+#3 = -3, which line 10 reads (LinuxCNC's rs274 moves: (10, 10), (-10, -10), (-3, 10, 0.5))."""
+
+
+def test_a_gEDA_export_reads_its_safe_z_and_depth_in_inches() -> None:
+    program = parse_gcode(GEDA, source="board.ngc")
+    rapids = [m for m in program.moves if isinstance(m, Rapid)]
+    cuts = [m for m in program.moves if isinstance(m, Linear)]
+    assert rapids[0].z == pytest.approx(0.002 * 25.4, abs=1e-12)
+    assert (cuts[0].x, cuts[0].y, cuts[0].z) == pytest.approx(
+        (0.073333 * 25.4, 0.41 * 25.4, -0.00005 * 25.4), abs=1e-12
+    )
+    assert rapids[-1].z == pytest.approx(0.002 * 25.4, abs=1e-12)
+
+
+@pytest.mark.parametrize("parse", [parse_gcode, parse_gcode_slow])
+def test_a_line_reads_its_parameters_before_it_sets_any(parse: object) -> None:
+    program = parse(PARALLEL, source="wizard.ngc")  # type: ignore[operator]
+    ends = [(m.x, m.y, m.z) for m in program.moves if isinstance(m, Rapid | Linear)]
+    assert ends == [
+        (0.0, 0.0, 5.0),  # Z5 from the start, X and Y where they were
+        (10.0, 10.0, None),  # None: Z stays
+        (10.0, 10.0, -0.5),
+        (-10.0, -10.0, None),
+        (-3.0, 10.0, 0.5),
+    ]
+
+
+def test_lines_keep_their_numbers_comments_and_messages() -> None:
+    text = "#1=2 (set #1)\r\nG0 X#1 (MSG, at #1)\rG0 Y-#1 ; #1\n(#1 only here)"
+    assert expand_parameters(text, "t.ngc") == (
+        " (set #1)\r\nG0 X2 (MSG, at #1)\rG0 Y-2 ; #1\n(#1 only here)"
+    )
+    assert expand_parameters("G0 X1\n", "t.ngc") == "G0 X1\n"
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("G21\nG0 Z#7\n", "t.ngc:2: #7 is read before any line of the program sets it"),
+        ("#2=#3\n", "t.ngc:1: #3 is read before any line"),
+        ("#8=1 G0 X#8\n", "t.ngc:1: #8 is read before any line"),  # set after the read
+        ("G0 Z#5220\n", "t.ngc:1: #5220 is a parameter the controller keeps"),
+        ("#5211=0\n", "t.ngc:1: #5211 is a parameter the controller keeps"),
+        ("#<depth>=1\nG1 Z#<depth>\n", "t.ngc:1: '#' parameters are not supported"),
+        ("#1=2\nG1 X[#1*2] F10\n", "t.ngc:2: '[ ]' expressions are not supported"),
+        ("#1=2\n##1=3\n", "t.ngc:2: '#' parameters are not supported"),
+    ],
+)
+def test_what_camtool_cannot_know_is_refused_at_its_line(text: str, message: str) -> None:
+    with pytest.raises(InputError, match=message.replace("[", r"\[").replace("]", r"\]")):
+        parse_gcode(text + "G1 X1 F10\nM2\n", source="t.ngc")
