@@ -56,8 +56,8 @@ from camtool.importers.svgstyle import (
     style_of,
     unpainted,
     unseen_fill,
-    unstroked,
     wanted_layers,
+    zero_width,
 )
 from camtool.model.errors import GeometryError, InputError, TooLargeError
 from camtool.model.progress import Progress, Step, no_progress
@@ -163,7 +163,11 @@ def _drawing(
             unseen.hidden += 1
         elif zero_opacity(values.get("opacity")):
             unseen.faded += 1
-        elif not unpainted(shape.stroke) and unstroked(shape) and (line or unpainted(shape.fill)):
+        elif (
+            not unpainted(shape.stroke)
+            and zero_width(values.get("stroke-width"))
+            and (line or unpainted(shape.fill))
+        ):
             unseen.thin += 1
         elif unpainted(shape.stroke) and line:
             unseen.bare += 1

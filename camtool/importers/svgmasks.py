@@ -344,9 +344,8 @@ def symbols_as_viewports(root: ET.Element) -> int:
     ``<svg>`` gives that size to a copy of the ``<svg>`` (svgelements would scale a viewBox
     into the ``<svg>``'s own size, and clip to it), its ``x`` and ``y`` moved by the use's
     (resvg's structure/use/xlink-to-svg-element-with-viewBox.svg and
-    xlink-to-svg-element-with-rect.svg). Only the uses
-    the document holds are replaced, not those a copy brings (each is replaced once,
-    whatever it nests).
+    xlink-to-svg-element-with-rect.svg). Only the uses the document holds are replaced, not
+    those a copy brings (each is replaced once, whatever it nests).
 
     Returns:
         How many uses were replaced.

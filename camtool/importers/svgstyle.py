@@ -204,7 +204,7 @@ def unpainted(color: Any) -> bool:
     return color is None or color.value is None or color.alpha == 0
 
 
-def unstroked(shape: Any) -> bool:
+def _unstroked(shape: Any) -> bool:
     """Whether a shape's stroke paints nothing.
 
     It has no paint (:func:`unpainted`), or a ``stroke-width`` of zero, its own or
@@ -217,4 +217,4 @@ def unseen_fill(shape: Any) -> bool:
     """Whether a shape is filled white without a stroke: unseen on the white page."""
     fill = shape.fill
     white = not unpainted(fill) and (fill.red, fill.green, fill.blue) == (255, 255, 255)
-    return white and unstroked(shape)
+    return white and _unstroked(shape)

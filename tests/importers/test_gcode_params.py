@@ -7,12 +7,14 @@ own interpreter judge the same programs.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import pytest
 
 from camtool.importers.gcode import parse_gcode, parse_gcode_slow
 from camtool.importers.gcode_params import expand_parameters
 from camtool.model.errors import InputError
-from camtool.model.program import Linear, Rapid
+from camtool.model.program import Linear, Program, Rapid
 
 GEDA = """(Created by G-code exporter)
 (600 dpi)
@@ -59,8 +61,8 @@ def test_a_gEDA_export_reads_its_safe_z_and_depth_in_inches() -> None:
 
 
 @pytest.mark.parametrize("parse", [parse_gcode, parse_gcode_slow])
-def test_a_line_reads_its_parameters_before_it_sets_any(parse: object) -> None:
-    program = parse(PARALLEL, source="wizard.ngc")  # type: ignore[operator]
+def test_a_line_reads_its_parameters_before_it_sets_any(parse: Callable[..., Program]) -> None:
+    program = parse(PARALLEL, source="wizard.ngc")
     ends = [(m.x, m.y, m.z) for m in program.moves if isinstance(m, Rapid | Linear)]
     assert ends == [
         (0.0, 0.0, 5.0),  # Z5 from the start, X and Y where they were
