@@ -38,7 +38,7 @@ def _compiled(accel_on: None, monkeypatch: pytest.MonkeyPatch) -> None:
 
 def _trace(rng: np.random.Generator, kind: int) -> np.ndarray:
     """A staircase or an arc on a step grid, sometimes repeated in passes."""
-    n = int(rng.integers(3, 3000))
+    n = int(rng.integers(3, 1500))
     step = (0.004, 0.0005, 0.25, 0.001)[kind % 4]
     if kind % 2:
         pts = np.cumsum(rng.choice([-step, 0.0, step], size=(n, 2)), axis=0)
@@ -77,7 +77,7 @@ def test_nearest_distances_equal_the_kd_tree_path_bit_for_bit(seed: int) -> None
     for kind in range(12):
         pts = _trace(rng, kind)
         a, b = pts[:-1], pts[1:]
-        samples = _samples(rng, pts, 2000, reach=float(rng.choice([0.0015, 0.1, 1.5])))
+        samples = _samples(rng, pts, 1000, reach=float(rng.choice([0.0015, 0.1, 1.5])))
         got = nearest_search.nearest_distances(samples, a, b)
         want = nearest_search.nearest_distances_kd(samples, a, b)
         assert np.array_equal(got.view(np.int64), want.view(np.int64))
@@ -93,7 +93,7 @@ def test_knn_finds_the_kd_trees_ends_where_they_are_one_set(seed: int, merge: bo
     for kind in range(12):
         pts = _trace(rng, kind)
         points = np.concatenate([pts[:-1], pts[1:]])
-        samples = _samples(rng, pts, 2000, reach=0.5)
+        samples = _samples(rng, pts, 1000, reach=0.5)
         tree = nearkernels.tree(points, merge=merge)
         for k in (1, 4, 7):
             r0, rk, index, state = nearkernels.knn(samples, *tree, k)
@@ -295,7 +295,7 @@ def test_near_segments_is_the_numpy_form_bit_for_bit(seed: int) -> None:
         pts = _trace(rng, kind)
         a, b = np.ascontiguousarray(pts[:-1]), np.ascontiguousarray(pts[1:])
         points = np.concatenate([a, b])
-        samples = _samples(rng, pts, 2000, reach=float(rng.choice([0.0015, 0.1, 1.5])))
+        samples = _samples(rng, pts, 1000, reach=float(rng.choice([0.0015, 0.1, 1.5])))
         every = nearkernels.tree(points, merge=False)  # the reference: each end its own place
         want = nearest_search._near_segments_numpy(samples, a, b, every, nearkernels)
         places = nearkernels.tree(points, segments=True)  # as nearest_distances builds it
