@@ -265,7 +265,19 @@ _PLAIN = (
 def _refuse_special(c: str, code: str, where: str) -> None:
     """Raise for the parameter and expression characters of RS-274/NGC."""
     if c == "#":
-        raise InputError(f"{where}: '#' parameters are not supported ({code!r}); {_PLAIN}")
+        kind = (
+            "'[ ]' expressions"
+            if "[" in code
+            else "named parameters ('#<name>')"
+            if "<" in code
+            else "indirect parameters ('##n')"
+            if "##" in code
+            else "'#' parameters on this line"
+        )
+        raise InputError(
+            f"{where}: {kind} are not supported ({code!r}); camtool reads numbered parameters "
+            f"set to numbers ('#1=2.5', then 'X#1') and {_PLAIN.removeprefix('camtool reads ')}"
+        )
     if c and c in "[]":
         raise InputError(f"{where}: '[ ]' expressions are not supported ({code!r}); {_PLAIN}")
     if c == "$" and code.startswith("$"):

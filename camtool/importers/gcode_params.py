@@ -39,7 +39,8 @@ def expand_parameters(text: str, source: str) -> str:
     """``text`` with each read of a numbered parameter set to a number written as that number.
 
     Lines keep their number and their comments; an assignment leaves a blank. A line this
-    does not understand is kept as it stands (the lexer names what it holds).
+    does not understand is kept as it stands (the lexer names what it holds), and so is
+    every line after it: what such a line sets is not known, and the lexer stops at it first.
 
     Raises:
         InputError: a parameter read before any line sets it, or a system parameter (above
@@ -54,17 +55,24 @@ def expand_parameters(text: str, source: str) -> str:
             break  # the empty match at the end of the text
         line = m[1]
         if "#" in line:
-            line = _expand_line(line, values, f"{source}:{number}")
+            expanded = _expand_line(line, values, f"{source}:{number}")
+            if expanded is None:  # the rest as it stands: the lexer refuses this line
+                out.append(text[m.start() :])
+                break
+            line = expanded
         out.append(line + m[2])
     return "".join(out)
 
 
-def _expand_line(raw: str, values: dict[int, str], where: str) -> str:
-    """One line with its reads written as numbers; its sets go into ``values`` after."""
+def _expand_line(raw: str, values: dict[int, str], where: str) -> str | None:
+    """One line with its reads written as numbers; its sets go into ``values`` after.
+
+    ``None`` for a line with an expression, a named or indirect parameter or a block delete.
+    """
     parts = _split_comments(raw)
     code = "".join(text for text, comment in parts if not comment)
     if any(c in code for c in "[]<") or "##" in code.replace(" ", "") or code.lstrip()[:1] == "/":
-        return raw  # an expression, a named or indirect parameter, a block delete: refused later
+        return None
     sets: dict[int, str] = {}
     out = []
     for text, comment in parts:
