@@ -9,8 +9,9 @@ are read before any it sets is set ("parameter setting is done in parallel"); a 
 is a number, or another parameter, with a sign.
 
 What is left as it stands, for the lexer to refuse with its own message: a line with an
-expression (``[ ]``), a named parameter (``#<name>``), an indirect one (``##1``), or a
-block-delete ``/``. A parameter read before any line sets it (LinuxCNC reads 0, or the value
+expression (``[ ]``), a named parameter (``#<name>``) or an indirect one (``##1``). A
+block-delete line (``/``) with a parameter is refused: whether it runs is the controller's
+switch. A parameter read before any line sets it (LinuxCNC reads 0, or the value
 a previous run saved) and a system parameter (``#5061``… offsets and probe results, above
 :data:`LAST_USER`) are refused: camtool cannot know their values.
 """
@@ -43,8 +44,9 @@ def expand_parameters(text: str, source: str) -> str:
     every line after it: what such a line sets is not known, and the lexer stops at it first.
 
     Raises:
-        InputError: a parameter read before any line sets it, or a system parameter (above
-            :data:`LAST_USER`) read or set; the message names ``source:line``.
+        InputError: a parameter read before any line sets it, a system parameter (above
+            :data:`LAST_USER`) read or set, or one on a block-delete line; the message names
+            ``source:line``.
     """
     if "#" not in text:
         return text
@@ -67,11 +69,19 @@ def expand_parameters(text: str, source: str) -> str:
 def _expand_line(raw: str, values: dict[int, str], where: str) -> str | None:
     """One line with its reads written as numbers; its sets go into ``values`` after.
 
-    ``None`` for a line with an expression, a named or indirect parameter or a block delete.
+    ``None`` for a line with an expression, a named or indirect parameter.
     """
     parts = _split_comments(raw)
     code = "".join(text for text, comment in parts if not comment)
-    if any(c in code for c in "[]<") or "##" in code.replace(" ", "") or code.lstrip()[:1] == "/":
+    if "#" not in code:
+        return raw  # in a comment only
+    if code.lstrip()[:1] == "/":
+        raise InputError(
+            f"{where}: a block-delete line ('/') sets or reads a parameter: whether it runs "
+            "depends on the controller's block-delete switch, which camtool cannot know; "
+            "remove the line or its '/'"
+        )
+    if any(c in code for c in "[]<") or "##" in code.replace(" ", ""):
         return None
     sets: dict[int, str] = {}
     out = []

@@ -80,6 +80,8 @@ def test_lines_keep_their_numbers_comments_and_messages() -> None:
         " (set #1)\r\nG0 X2 (MSG, at #1)\rG0 Y-2 ; #1\n(#1 only here)"
     )
     assert expand_parameters("G0 X1\n", "t.ngc") == "G0 X1\n"
+    # a block-delete line with '#' in its comment only holds no parameter
+    assert expand_parameters("/G0 X1 (#1 here)\n", "t.ngc") == "/G0 X1 (#1 here)\n"
 
 
 @pytest.mark.parametrize(
@@ -96,7 +98,7 @@ def test_lines_keep_their_numbers_comments_and_messages() -> None:
         # what a line camtool cannot evaluate sets is not known: refused there, not where read
         ("#1=[1+2]\nG1 X#1 F10\n", "t.ngc:1: '[ ]' expressions are not supported"),
         ("#1=5\n#<a>=2\n#1=#<a>\nG1 X#1 F10\n", "t.ngc:2: named parameters"),
-        ("#1=5\n/#1=6\nG1 X#1 F10\n", "t.ngc:2: '#' parameters on this line are not"),
+        ("#1=5\n/#1=6\nG1 X#1 F10\n", "t.ngc:2: a block-delete line ('/') sets or reads"),
     ],
 )
 def test_what_camtool_cannot_know_is_refused_at_its_line(text: str, message: str) -> None:
