@@ -6,7 +6,10 @@ numbered parameters to numbers at the top of the program and read them as word v
 program is lexed, so the reader sees plain words. The rules are LinuxCNC's ("Parameters"
 in its G-code overview): a parameter is set by ``#n=value``; all the parameters a line reads
 are read before any it sets is set ("parameter setting is done in parallel"); a value
-is a number, or another parameter, with a sign.
+is a number, or another parameter, with a sign; a read comes right after its word's letter
+(``X#1``, ``X-#1``); spaces do not count (``#1 .5`` is ``#1.5``, which names no parameter).
+A ``#`` anywhere else, or a parameter number that is not whole, is refused as LinuxCNC
+refuses it.
 
 What is left as it stands, for the lexer to refuse with its own message: a line with an
 expression (``[ ]``), a named parameter (``#<name>``) or an indirect one (``##1``). A
@@ -26,11 +29,14 @@ LAST_USER = 5000
 """The last numbered parameter a program sets for itself; above it LinuxCNC keeps its own
 (probe results, coordinate-system offsets, the tool in the spindle)."""
 
-_NUM = r"(?:\d+\.?\d*|\.\d+)"
-_SET = re.compile(rf"#\s*(\d+)\s*=\s*([+-]?)\s*(?:({_NUM})|#\s*(\d+))\s*")
-"""An assignment: ``#n=`` a signed number or a signed parameter."""
-_READ = re.compile(r"([+-]?)\s*#\s*(\d+)")
-"""A parameter read as a word's value (a sign before it negates it)."""
+_NUM = r"(?:\d+\.?\d*|\.\d+)(?![\d.])"
+"""A number, not followed by more digits or a point (``5.5.5`` is none)."""
+_SET = re.compile(rf"#({_NUM})=([+-]?)(?:({_NUM})|#({_NUM}))")
+"""An assignment in a line without spaces: ``#n=`` a signed number or a signed parameter."""
+_READ = re.compile(rf"(?<=[A-Za-z])([+-]?)#({_NUM})")
+"""A parameter read as a word's value, right after the word's letter (a sign between them
+negates it): ``X#1``, ``X-#1``. A ``#`` anywhere else starts a setting for LinuxCNC."""
+_SPACE = re.compile(r"\s+")
 _COMMENT = re.compile(r"\([^)]*\)|;.*")
 _LINE = re.compile(r"([^\r\n]*)(\r\n|\r|\n|$)")
 """A line and its end, as the reader splits them (LF, CR LF or CR)."""
@@ -86,9 +92,17 @@ def _expand_line(raw: str, values: dict[int, str], where: str) -> str | None:
     sets: dict[int, str] = {}
     out = []
     for text, comment in parts:
-        if not comment:
+        if not comment:  # LinuxCNC reads a line without its spaces: `#1 .5` is `#1.5`
+            text = _SPACE.sub("", text)
             text = _SET.sub(lambda m: _assign(m, values, sets, where), text)
-            text = _READ.sub(lambda m: _signed(m[1], _value(int(m[2]), values, where)), text)
+            text = _READ.sub(
+                lambda m: _signed(m[1], _value(_index(m[2], where), values, where)), text
+            )
+            if "#" in text:
+                raise InputError(
+                    f"{where}: a '#' in {code.strip()!r} is neither a word's value ('X#1') nor a "
+                    "setting ('#1=2.5'), which LinuxCNC refuses; write the number itself"
+                )
         out.append(text)
     values.update(sets)  # a line's sets after all its reads
     return "".join(out)
@@ -108,10 +122,21 @@ def _split_comments(raw: str) -> list[tuple[str, bool]]:
 
 def _assign(m: re.Match[str], values: dict[int, str], sets: dict[int, str], where: str) -> str:
     """Note the set ``#n=value`` of the match for after the line; it leaves a blank."""
-    number = _user(int(m[1]), where)
-    held = m[3] if m[3] is not None else _value(int(m[4]), values, where)
+    number = _user(_index(m[1], where), where)
+    held = m[3] if m[3] is not None else _value(_index(m[4], where), values, where)
     sets[number] = _signed(m[2], held)
     return " "
+
+
+def _index(text: str, where: str) -> int:
+    """The parameter number ``text`` names: a whole number (``1.0`` is 1), else refused."""
+    value = float(text)
+    if value != int(value):
+        raise InputError(
+            f"{where}: #{text} names no parameter: a parameter's number is a whole number "
+            "(LinuxCNC refuses the line)"
+        )
+    return int(value)
 
 
 def _value(number: int, values: dict[int, str], where: str) -> str:

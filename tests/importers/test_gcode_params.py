@@ -77,7 +77,7 @@ def test_a_line_reads_its_parameters_before_it_sets_any(parse: Callable[..., Pro
 def test_lines_keep_their_numbers_comments_and_messages() -> None:
     text = "#1=2 (set #1)\r\nG0 X#1 (MSG, at #1)\rG0 Y-#1 ; #1\n(#1 only here)"
     assert expand_parameters(text, "t.ngc") == (
-        " (set #1)\r\nG0 X2 (MSG, at #1)\rG0 Y-2 ; #1\n(#1 only here)"
+        " (set #1)\r\nG0X2(MSG, at #1)\rG0Y-2; #1\n(#1 only here)"
     )
     assert expand_parameters("G0 X1\n", "t.ngc") == "G0 X1\n"
     # a block-delete line with '#' in its comment only holds no parameter
@@ -98,6 +98,10 @@ def test_lines_keep_their_numbers_comments_and_messages() -> None:
         # what a line camtool cannot evaluate sets is not known: refused there, not where read
         ("#1=[1+2]\nG1 X#1 F10\n", "t.ngc:1: '[ ]' expressions are not supported"),
         ("#1=5\n#<a>=2\n#1=#<a>\nG1 X#1 F10\n", "t.ngc:2: named parameters"),
+        # LinuxCNC reads a line without its spaces, and a value right after its letter
+        ("#1=5\nG1 X#1 .5 F10\n", "t.ngc:2: #1.5 names no parameter"),
+        ("#1=5\nG1 X1#1 F10\n", "t.ngc:2: a '#' in 'G1 X1#1 F10' is neither a word's value"),
+        ("#1=5.5.5\n", "t.ngc:1: a '#' in '#1=5.5.5' is neither"),
         ("#1=5\n/#1=6\nG1 X#1 F10\n", "t.ngc:2: a block-delete line ('/') sets or reads"),
     ],
 )
