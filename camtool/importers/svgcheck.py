@@ -5,10 +5,14 @@ Design notes: docs/internals.md, ``camtool/importers/svgcheck.py``.
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+_BARE_POINT = re.compile(r"\d\.(?!\d)")
+"""A number's decimal point with no digit after it ("300.", "2.e-4"): SVG's grammar reads it,
+svgelements stops reading the path or point list there and keeps what came before."""
 _SEPARATORS = " \t\r\n\f,"
 _ARITY = {"m": 2, "l": 2, "h": 1, "v": 1, "c": 6, "s": 4, "q": 4, "t": 2, "a": 7, "z": 0}
 _LENGTH = re.compile(
@@ -25,8 +29,12 @@ _TRANSFORM_ARGS = {
 _TRANSFORM_ITEM = re.compile(r"[\s,]*([A-Za-z]+)\s*\(([^()]*)\)[\s,]*")
 
 
-def check_path_data(d: str) -> None:
+def check_path_data(d: str) -> str:
     """Check ``d`` against the SVG path data grammar, arc flags included.
+
+    Returns:
+        ``d`` as svgelements reads it whole: a 0 written after each decimal point that
+        has no digit after it (``300.`` becomes ``300.0``, the same number).
 
     Raises:
         ValueError: the data does not start with a moveto, holds an unknown command, a
@@ -35,6 +43,7 @@ def check_path_data(d: str) -> None:
     pos, n = 0, len(d)
     command: str | None = None
     args = 0
+    bare: list[int] = []  # where a 0 goes after a bare decimal point
 
     def close_command() -> None:
         if command is None:
@@ -68,8 +77,13 @@ def check_path_data(d: str) -> None:
         match = _NUMBER.match(d, pos)
         if match is None:
             raise ValueError(f"cannot read a number at character {pos} ({d[pos : pos + 12]!r})")
+        point = _BARE_POINT.search(match.group())
+        if point is not None:
+            bare.append(pos + point.end())
         pos, args = match.end(), args + 1
     close_command()
+    cuts = [0, *bare, n]
+    return "0".join(d[a:b] for a, b in itertools.pairwise(cuts))
 
 
 def check_transform(text: str) -> None:
@@ -115,15 +129,21 @@ def check_length(text: str, *, negative: bool = True) -> None:
         raise ValueError("must not be negative")
 
 
-def check_points(text: str) -> None:
+def check_points(text: str) -> str:
     """Check a ``points`` attribute (polyline, polygon): an even count of numbers.
+
+    Returns:
+        The numbers as svgelements reads them all, one space apart, a 0 written after each
+        decimal point that has no digit after it (``50.`` becomes ``50.0``).
 
     Raises:
         ValueError: a token is not a number, or the count is odd.
     """
-    count = len(_numbers(text, "points"))
-    if count % 2:
+    numbers = _numbers(text, "points")
+    if len(numbers) % 2:
+        count = len(numbers)
         raise ValueError(f"points must be x,y pairs, got an odd count of numbers ({count})")
+    return " ".join(_BARE_POINT.sub(lambda m: m.group() + "0", number) for number in numbers)
 
 
 def _numbers(text: str, what: str) -> list[str]:

@@ -712,7 +712,7 @@ def _check(element: ET.Element, kind: str, viewport: tuple[float, float]) -> Non
             raise ValueError(f"bad transform {transform!r}: {exc}") from exc
     if kind == "path" and element.get("d") is not None:
         try:
-            svgcheck.check_path_data(element.get("d", ""))
+            element.set("d", svgcheck.check_path_data(element.get("d", "")))
         except ValueError as exc:
             raise ValueError(f"bad path data: {exc}") from exc
     if kind == "path" and element.get("d") is None:
@@ -729,7 +729,7 @@ def _check(element: ET.Element, kind: str, viewport: tuple[float, float]) -> Non
     if kind == "rect":
         svgvalues.rect_radii(element)
     if kind in ("polyline", "polygon") and element.get("points") is not None:
-        svgcheck.check_points(element.get("points", ""))
+        element.set("points", svgcheck.check_points(element.get("points", "")))
 
 
 @dataclass
