@@ -52,6 +52,8 @@ from camtool.importers.svgpage import (
 from camtool.importers.svgstyle import (
     DEFAULT_LAYER,
     on_layers,
+    open_fills,
+    open_fills_warning,
     shaper_layer,
     style_of,
     unpainted,
@@ -194,6 +196,7 @@ def _drawing(
     fitter = _prefitted(drawn, prepared.matrix, tolerance, progress)
     regions: dict[tuple[int, Affine], tuple[Any, Any]] = {}
     kept: list[int] = []
+    opened: list[Contour] = []  # open contours a viewer fills as if closed
     progress(Step("contours", 0, len(drawn)))
     for i, (shape, segments) in enumerate(drawn, start=1):
         made = _contours(path, shape, segments, prepared.matrix, fitter)
@@ -205,6 +208,7 @@ def _drawing(
         ):
             contours.extend(made)
             kept.append(i - 1)
+            opened += open_fills(shape, made)
         progress(Step("contours", i, len(drawn)))
     clipped_away = len(drawn) - len(kept) - unseen.background
     if deferred and check is not None:
@@ -229,6 +233,8 @@ def _drawing(
             f"{path}: skipped {clipped_away} {element_noun(clipped_away)} that {its} clip-path, "
             f"mask or viewport hides wholly (a viewer shows nothing of {them})"
         )
+    if opened:
+        warnings.append(open_fills_warning(path, len(opened), opened[0].source))
     warnings += unseen_warnings(path, unseen)
     if named:
         contours = on_layers(path, contours, named)

@@ -18,7 +18,7 @@ import svgelements as se
 
 from camtool.importers.svgtree import LIBRECAD_NS
 from camtool.model.errors import InputError
-from camtool.model.shapes import Contour
+from camtool.model.shapes import Contour, Line
 
 _LC_CONSTRUCTION = f"{{{LIBRECAD_NS}}}is_construction"
 _SHAPER = "{http://www.shapertools.com/namespaces/shaper}"
@@ -218,3 +218,32 @@ def unseen_fill(shape: Any) -> bool:
     fill = shape.fill
     white = not unpainted(fill) and (fill.red, fill.green, fill.blue) == (255, 255, 255)
     return white and _unstroked(shape)
+
+
+def open_fills(shape: Any, contours: list[Contour]) -> list[Contour]:
+    """The open contours of ``shape`` whose fill a viewer paints as if they were closed.
+
+    A fill closes each open subpath with a straight line from its end to its start (SVG 1.1
+    §11.3: "The fill operation implicitly closes open subpaths"; SVG 2 §13.3), so a viewer
+    shows a region whose edge camtool, cutting the subpath as drawn, cuts only in part.
+    None for a shape without a visible fill (:func:`unpainted`) or a ``<line>``, nor for a
+    contour of one line, whose fill has no area (Inkscape's straight lines that kept a fill
+    colour).
+    """
+    if isinstance(shape, se.SimpleLine) or unpainted(shape.fill):
+        return []
+    return [
+        c
+        for c in contours
+        if not c.closed and (len(c.segments) > 1 or not isinstance(c.segments[0], Line))
+    ]
+
+
+def open_fills_warning(path: object, count: int, first: str) -> str:
+    """The warning for ``count`` contours :func:`open_fills` found, the first labelled ``first``."""
+    noun, verb, it = ("subpath", "is", "it") if count == 1 else ("subpaths", "are", "each")
+    return (
+        f"{path}: {count} filled open {noun} (first: {first}) {verb} cut as drawn, open, while "
+        f"a viewer fills {it} as if a line joined its end to its start: close the path (Z) in "
+        "the drawing program to cut the whole edge of the fill, or give it fill:none"
+    )

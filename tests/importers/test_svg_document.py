@@ -46,7 +46,9 @@ from tests.importers.svgutil import (
     ],
 )
 def test_units(tmp_path: Path, root: str, mm_per_unit: float) -> None:
-    drawing = read_svg(svg(tmp_path, '<path d="M 0 0 L 1 0 L 1 1"/>', root))
+    drawing = read_svg(
+        svg(tmp_path, '<path d="M 0 0 L 1 0 L 1 1" fill="none" stroke="red"/>', root)
+    )
     a, b, c = vertices(one(drawing))
     assert b[0] - a[0] == pytest.approx(mm_per_unit, rel=1e-12)
     assert c[1] - b[1] == pytest.approx(-mm_per_unit, rel=1e-12)  # Y flipped
