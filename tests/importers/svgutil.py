@@ -111,4 +111,5 @@ def arc_only(drawing: Drawing) -> Arc:
     return seg
 
 
-HALF = '<path d="M 10 50 A 20 20 0 0 1 50 50" fill="none" stroke="black"/>'  # clockwise, centre (30, 50), r 20
+HALF = '<path d="M 10 50 A 20 20 0 0 1 50 50" fill="none" stroke="black"/>'
+"""A half circle, clockwise, centre (30, 50), r 20, stroked (a fill would show it closed)."""
