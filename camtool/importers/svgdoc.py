@@ -692,6 +692,8 @@ def _label_and_check(root: ET.Element, name: str, viewport: tuple[float, float])
         element.set(SOURCE_ATTR, label)
         if kind == "use":
             element.set(USE_ATTR, label)
+        if kind in ("clipPath", "mask"):  # display does not apply to them (SVG 1.1 §14.3.5,
+            _show(element)  # §14.4): a viewer clips by one even with display:none on it
         try:
             _check(element, kind, viewport)
         except ValueError as exc:

@@ -179,6 +179,19 @@ def _clip(region: object) -> Clip:
     return clip
 
 
+@pytest.mark.parametrize("hide", ['display="none"', 'style="display:none"'])
+def test_a_clip_path_clips_with_display_none_on_it(tmp_path: Path, hide: str) -> None:
+    """display does not apply to a <clipPath> (SVG 1.1 §14.3.5; resvg's
+    painting/display/none-on-clipPath paints the clipped rect green): it still clips."""
+    clip = f'<defs><clipPath id="c" {hide}><circle cx="50" cy="50" r="20"/></clipPath></defs>'
+    inside = '<circle id="in" cx="50" cy="50" r="10" fill="green" clip-path="url(#c)"/>'
+    outside = '<rect id="out" width="10" height="10" fill="green" clip-path="url(#c)"/>'
+    assert _sources(svg(tmp_path, clip + inside + outside)) == ["circle#in"]
+    across = '<rect id="all" width="100" height="100" fill="green" clip-path="url(#c)"/>'
+    with pytest.raises(InputError, match=r"the clip-path #c on rect#all hides part of rect#all"):
+        read_svg(svg(tmp_path, clip + across))
+
+
 def test_hidden_part_by_the_slack() -> None:
     region = _clip(shapely.box(0, 0, 10, 10))
     inside = [[(0.0, 0.0), (10.0, 0.0), (10.0, 10.0)]]
