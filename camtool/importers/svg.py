@@ -51,6 +51,8 @@ from camtool.importers.svgpage import (
 )
 from camtool.importers.svgstyle import (
     DEFAULT_LAYER,
+    filter_of,
+    filtered_warning,
     on_layers,
     open_fills,
     open_fills_warning,
@@ -197,6 +199,7 @@ def _drawing(
     regions: dict[tuple[int, Affine], tuple[Any, Any]] = {}
     kept: list[int] = []
     opened: list[Contour] = []  # open contours a viewer fills as if closed
+    filtered: list[tuple[str, str]] = []  # (label, filter id) of shapes drawn through one
     progress(Step("contours", 0, len(drawn)))
     for i, (shape, segments) in enumerate(drawn, start=1):
         made = _contours(path, shape, segments, prepared.matrix, fitter)
@@ -209,6 +212,8 @@ def _drawing(
             contours.extend(made)
             kept.append(i - 1)
             opened += open_fills(shape, made)
+            if made and (name := filter_of(shape)) is not None:
+                filtered.append((made[0].source, name))
         progress(Step("contours", i, len(drawn)))
     clipped_away = len(drawn) - len(kept) - unseen.background
     if deferred and check is not None:
@@ -235,6 +240,8 @@ def _drawing(
         )
     if opened:
         warnings.append(open_fills_warning(path, len(opened), opened[0].source))
+    if filtered:
+        warnings.append(filtered_warning(path, len(filtered), *filtered[0]))
     warnings += unseen_warnings(path, unseen)
     if named:
         contours = on_layers(path, contours, named)

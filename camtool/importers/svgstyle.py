@@ -247,3 +247,28 @@ def open_fills_warning(path: object, count: int, first: str) -> str:
         f"a viewer fills {it} as if a line joined its end to its start: close the path (Z) in "
         "the drawing program to cut the whole edge of the fill, or give it fill:none"
     )
+
+
+_FILTER_URL = re.compile(r"\s*url\(\s*['\"]?#?([^)'\"]*)['\"]?\s*\)", re.IGNORECASE)
+
+
+def filter_of(shape: Any) -> str | None:
+    """The id of the ``<filter>`` a shape is drawn through (its own or a group's), or ``None``.
+
+    A filter changes what a viewer shows of the shape (Filter Effects 1: a blur, a shadow,
+    ``feOffset`` moving it, ``feMorphology`` growing or shrinking it, a flood over it),
+    while camtool cuts the shape's own outline.
+    """
+    match = _FILTER_URL.match(str(shape.values.get("filter") or ""))
+    return match.group(1) if match else None
+
+
+def filtered_warning(path: object, count: int, first: str, name: str) -> str:
+    """The warning for ``count`` shapes drawn through a filter, the first ``first``."""
+    noun = "shape" if count == 1 else "shapes"
+    return (
+        f"{path}: {count} {noun} drawn through a filter (first: {first}, filter #{name}) cut "
+        "along their own outline, not as the filter shows them (blurred, shadowed, moved by "
+        "an offset, grown or shrunk); check the preview, or remove the filter in the drawing "
+        "program (Inkscape: Filters > Remove Filters)"
+    )
