@@ -609,6 +609,7 @@ def prepare(
     normalize_styles(root)
     svgvalues.resolve_percentages(root, viewport)
     svgvalues.resolve_paint_references(root)
+    svgvalues.resolve_context_paints(root, parents)
     svgvalues.normalize_colours(root)
     _label_and_check(root, str(path), viewport)
     check_use_cycles(root, str(path))

@@ -29,6 +29,7 @@ import xml.etree.ElementTree as ET
 import svgelements as se
 
 from camtool.importers.svgcss import inline_style, local_name, style_text
+from camtool.importers.svgtree import href
 
 LENGTH_ATTRS = {
     "rect": ("x", "y", "width", "height", "rx", "ry"),
@@ -159,6 +160,52 @@ def resolve_paint_references(root: ET.Element) -> None:
                     element.set("style", style_text(declared))
                 else:
                     element.set(name, paint)
+
+
+_CONTEXT_HOSTS = frozenset({"defs", "symbol", "marker", "pattern", "clipPath", "mask"})
+"""Elements whose content is drawn only where something places it (a ``<use>``, a marker's
+path): there a context paint has a context element."""
+
+
+def resolve_context_paints(root: ET.Element, parents: dict[ET.Element, ET.Element]) -> None:
+    """Write ``context-fill`` and ``context-stroke`` as ``none`` where nothing gives them a paint.
+
+    A context paint is the fill or stroke of the context element: the ``<use>`` that places
+    the content, or the shape a marker is on; with no context element it is no paint (SVG 2
+    §13.2: ``context-fill`` on a shape drawn where it stands shows nothing). svgelements read
+    it as painted, so such a shape was cut. Kept where a context element may exist: inside
+    ``<defs>``, ``<symbol>``, ``<marker>``, ``<pattern>``, a clip or a mask, and in (or under)
+    an element a ``<use>`` places.
+    """
+    placed = {href(e)[1:] for e in root.iter() if local_name(e) == "use"}
+    for element in root.iter():
+        style = element.get("style")
+        declared = inline_style(element) if style and "context-" in style.lower() else {}
+        found = [
+            (name, inline)
+            for name in ("fill", "stroke")
+            for inline, value in ((False, element.get(name)), (True, declared.get(name)))
+            if value is not None and value.strip().lower() in ("context-fill", "context-stroke")
+        ]
+        if not found or _in_context(element, parents, placed):
+            continue
+        for name, inline in found:
+            if inline:
+                declared[name] = "none"
+                element.set("style", style_text(declared))
+            else:
+                element.set(name, "none")
+
+
+def _in_context(
+    element: ET.Element, parents: dict[ET.Element, ET.Element], placed: set[str]
+) -> bool:
+    node: ET.Element | None = element
+    while node is not None:
+        if local_name(node) in _CONTEXT_HOSTS or node.get("id") in placed:
+            return True
+        node = parents.get(node)
+    return False
 
 
 _COLOUR_FUNCTION = re.compile(r"\s*(rgba?|hsla?)\(([^()]*)\)\s*", re.IGNORECASE)
