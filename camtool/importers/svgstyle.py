@@ -17,6 +17,7 @@ from typing import Any
 import svgelements as se
 
 from camtool.importers.svgtree import LIBRECAD_NS
+from camtool.importers.svgvalues import URL_REF
 from camtool.model.errors import InputError
 from camtool.model.shapes import Contour, Line
 
@@ -249,9 +250,6 @@ def open_fills_warning(path: object, count: int, first: str) -> str:
     )
 
 
-_FILTER_URL = re.compile(r"\s*url\(\s*['\"]?#?([^)'\"]*)['\"]?\s*\)", re.IGNORECASE)
-
-
 def filter_of(shape: Any) -> str | None:
     """The id of the ``<filter>`` a shape is drawn through (its own or a group's), or ``None``.
 
@@ -259,7 +257,7 @@ def filter_of(shape: Any) -> str | None:
     ``feOffset`` moving it, ``feMorphology`` growing or shrinking it, a flood over it),
     while camtool cuts the shape's own outline.
     """
-    match = _FILTER_URL.match(str(shape.values.get("filter") or ""))
+    match = URL_REF.fullmatch(str(shape.values.get("filter") or ""))
     return match.group(1) if match else None
 
 
