@@ -66,12 +66,10 @@ def test_a_point_with_no_digit_on_either_side_is_still_refused(tmp_path: Path, d
 
 def _spellings(value: int) -> st.SearchStrategy[str]:
     """Texts the SVG grammar reads as ``value`` (an integer here, so every form is exact)."""
-    sign = "-" if value < 0 else ""
     n = abs(value)
     forms = [f"{n}", f"{n}.", f"{n}.0", f"{n}.e0", f"{n}.E+0", f"{n * 10}.e-1", f"{n}e0"]
-    if sign == "":
-        forms += [f"+{n}", f"+{n}."]
-    return st.sampled_from([sign + f if not f.startswith("+") else f for f in forms])
+    signs = ["-"] if value < 0 else ["", "+"]
+    return st.sampled_from([sign + form for sign in signs for form in forms])
 
 
 @settings(max_examples=60)
