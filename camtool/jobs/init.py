@@ -478,7 +478,8 @@ def _drill_op(
         select,
         size + _why("only the circles of this size"),
         f"depth = {depth:g}" + _why(f"through the {thickness:g} mm stock"),
-        f"step_down = {max(d, 1.0):g}" + _why("peck about a diameter deep (G83)"),
+        f"step_down = {max(d, 1.0):g}"
+        + _why("peck about a diameter deep (G83)" if d >= 1.0 else "peck 1 mm at a time (G83)"),
     )
     return _Op("drill", d, lines)
 

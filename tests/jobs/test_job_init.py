@@ -468,3 +468,18 @@ def test_a_site_plan_in_metres_far_from_zero_is_drilled_where_its_circles_are(
     (ax, ay), (bx, by) = holes
     assert all(0.0 <= v <= 200.0 for v in (ax, ay, bx, by))  # GRBL's 200 × 200 mm travel
     assert math.atan2(by - ay, bx - ax) == pytest.approx(math.atan2(60.0, 100.0), abs=1e-4)
+
+
+def test_a_drill_pecks_a_diameter_deep_and_never_less_than_1_mm(tmp_path: Path) -> None:
+    """Pecks of a diameter; a micro drill's are 1 mm, and its comment says so, not "a diameter"."""
+
+    def build(msp: object) -> None:
+        msp.add_circle((10, 10), 0.25, dxfattribs={"layer": "SMALL"})  # type: ignore[attr-defined]
+        msp.add_circle((30, 10), 2.5, dxfattribs={"layer": "BIG"})  # type: ignore[attr-defined]
+
+    text = initial_job(read_drawing(write_dxf(tmp_path / "h.dxf", build)), thickness_mm=4.0)
+    pecks = {op["diameter"]: op["step_down"] for op in _ops(text) if op["type"] == "drill"}
+    assert pecks == {0.5: 1.0, 5.0: 5.0}
+    lines = [ln for ln in text.splitlines() if ln.startswith("step_down")]
+    assert lines == ["step_down = 1  # peck 1 mm at a time (G83)",
+                     "step_down = 5  # peck about a diameter deep (G83)"]  # fmt: skip
