@@ -20,14 +20,15 @@ from camtool.jobs.init_mills import Parts, mill_between, mill_that_fits
 from camtool.jobs.init_mills import why as _why
 from camtool.jobs.job import Selection
 from camtool.jobs.selection import circle_of, construction_reason
+from camtool.jobs.travel import refuse_small_box
 from camtool.model.construction import fit_extent, is_construction
 from camtool.model.errors import InputError
-from camtool.model.shapes import Contour, Drawing, distance, fit_factor
+from camtool.model.shapes import Contour, Drawing, bbox_union, distance, fit_factor
 from camtool.model.units import fmt_num
 from camtool.toolpath.chain import GAP_SHARE, as_cut
 from camtool.toolpath.cuts import where
 from camtool.toolpath.gaps import option_value
-from camtool.toolpath.options import DEFAULT_CHAIN_TOLERANCE, DEFAULT_CLOSE_GAP
+from camtool.toolpath.options import DEFAULT_CHAIN_TOLERANCE, DEFAULT_CLOSE_GAP, PlanOptions
 from camtool.toolpath.placement import EPS_MM
 
 DRILL_MAX_MM = 6.5
@@ -90,8 +91,14 @@ def initial_job(
             is profiled on its inside).
 
     Raises:
-        InputError: nothing to cut, or the tool is as wide as the machine's travel.
+        InputError: nothing to cut, cuts too small for any tool (a unit set wrong:
+            :func:`~camtool.jobs.travel.refuse_small_box`), or the tool is as wide as the
+            machine's travel.
     """
+    if drawing.contours:  # a unit set wrong: the job's post would refuse it
+        defaults = PlanOptions()
+        box = bbox_union([c.bbox() for c in drawing.contours])
+        refuse_small_box(box, defaults.tolerance, defaults.chain_tolerance, drawing.source)
     fit, k = _fit(drawing, tool_diameter, travel_mm)
     if fit:  # sizes as cut (drills, tabs), selections in the drawing's own mm
         drawing = drawing.transformed(k)
@@ -394,7 +401,7 @@ def _ops_of(
         circle = circle_of(contour)
         if online:
             opened.append(contour)
-        elif drill and circle is not None and circle[1] <= DRILL_MAX_MM:
+        elif drill and circle is not None and 0.0 < round(circle[1], 3) <= DRILL_MAX_MM:
             circles.setdefault(round(circle[1], 3), []).append(circle[1])
         elif contour.closed:
             profiled.append(contour)

@@ -31,7 +31,7 @@ from camtool.jobs.selection import (
     nothing_selected,
     select,
 )
-from camtool.jobs.travel import refuse_too_large
+from camtool.jobs.travel import refuse_too_large, refuse_too_small
 from camtool.model.errors import InputError, ToolpathError, UsageError
 from camtool.model.program import (
     ArcMove,
@@ -273,6 +273,7 @@ def run_job(
     selections = [select(drawing, op.select, chaining) for op in sequence]
     selections_scaled = [(s, _as_scaled(s, drawing, scaled)) for s in selections]
     refuse_too_large(job, sequence, selections_scaled, chaining, setup, target)
+    refuse_too_small(selections_scaled, setup, drawing.source)
     for number, (op, (selected, chosen)) in enumerate(
         zip(sequence, selections_scaled, strict=True), start=1
     ):

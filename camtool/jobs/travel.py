@@ -1,4 +1,6 @@
-"""A job refused before planning when its toolpath cannot fit the machine's travel.
+"""A job refused before planning: too large for the travel, or too small for any tool.
+
+Too small: a drawing whose unit is set wrong (a part in mm that says µm).
 
 Design notes: docs/internals.md, ``camtool/jobs/travel.py``.
 """
@@ -11,7 +13,8 @@ from typing import TYPE_CHECKING
 from camtool.geometry.chain import joint_distance
 from camtool.jobs.job import Job, Operation
 from camtool.jobs.selection import Chaining, Selected
-from camtool.model.shapes import bbox_union
+from camtool.model.errors import InputError
+from camtool.model.shapes import BBox, bbox_union
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.placement import Placing, too_large_drawing
 
@@ -71,3 +74,61 @@ def refuse_too_large(
     slack = joint_distance(setup.chain_tolerance) + setup.tolerance
     placing = Placing(setup.placement, setup.translate, (margin, margin))
     too_large_drawing(bbox_union(boxes), target.machine, placing, slack_mm=slack)
+
+
+SMALLEST_TOLERANCES = 10.0
+"""A drawing's cuts must span more than this many ``--tolerance`` on their longer side."""
+SMALLEST_JOINTS = 2.0
+"""... and more than this many chaining distances (ends closer than one are joined)."""
+
+
+def refuse_too_small(
+    selections: Sequence[tuple[Selected, Selected]],
+    setup: PlanOptions,
+    source: str,
+) -> None:
+    """Refuse, before planning, a job whose cuts span next to nothing: a unit set wrong.
+
+    The contours the operations select, as scaled, must span more
+    than :data:`SMALLEST_TOLERANCES` curve tolerances and :data:`SMALLEST_JOINTS`
+    chaining distances on their longer side; a smaller drawing (a part in mm whose DXF
+    says µm, ``$INSUNITS`` 13) has its lines joined, merged and fitted away within those
+    tolerances, and its program would cut a dot where a part was drawn. The drawing's
+    points (``marks``, drilled) are left out: one hole spans nothing. So is a job scaled
+    into a box (``fit``).
+
+    Args:
+        selections: each operation's selection, as drawn and as scaled (``scale``).
+        setup: the job's shared options (``fit``, ``tolerance``, ``chain_tolerance``).
+        source: the drawing's name, for the message.
+
+    Raises:
+        InputError: naming the span, the limit and the remedies (units, scale, tolerances).
+    """
+    if setup.fit is not None:
+        return
+    boxes = [c.bbox() for _, scaled in selections for c in scaled.drawing.contours]
+    if boxes:
+        refuse_small_box(bbox_union(boxes), setup.tolerance, setup.chain_tolerance, source)
+
+
+def refuse_small_box(box: BBox, tolerance: float, chain_tolerance: float, source: str) -> None:
+    """:func:`refuse_too_small` of cuts whose box is ``box`` (mm), at those tolerances (mm).
+
+    Raises:
+        InputError: as :func:`refuse_too_small`.
+    """
+    x0, y0, x1, y1 = box
+    joint = joint_distance(chain_tolerance)
+    limit = max(SMALLEST_TOLERANCES * tolerance, SMALLEST_JOINTS * joint)
+    if max(x1 - x0, y1 - y0) >= limit:
+        return
+    raise InputError(
+        f"{source or 'the drawing'}: its cuts span only {x1 - x0:.4g} × {y1 - y0:.4g} mm, "
+        f"under {limit:g} mm ({SMALLEST_TOLERANCES:g} times the {tolerance:g} mm "
+        f"tolerance, {SMALLEST_JOINTS:g} times the {joint:g} mm within which ends are "
+        "joined): its lines would be joined and merged, and the tool would cut next to "
+        "nothing of it. Check the drawing's units (a DXF's $INSUNITS, an SVG's width and "
+        "height) and scale it (--scale, --fit W H; a job's scale or fit), or for a part "
+        "this small give a finer --tolerance and --chain-tolerance"
+    )

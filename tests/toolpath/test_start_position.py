@@ -45,5 +45,6 @@ def test_a_drawing_too_small_to_cut_is_an_error_not_an_empty_program(
     points.write_text("0,0\n1e-300,1e-300\n2e-300,0\n")
     out = tmp_path / "p.nc"
     assert main(["post", str(points), "-t", "valcnc", "-o", str(out)]) == 3
-    assert "nothing to cut" in capsys.readouterr().err
+    # refused before planning, as too small for any tool (camtool/jobs/travel.py)
+    assert "its cuts span only 2e-300 × 1e-300 mm" in capsys.readouterr().err
     assert not out.exists()
