@@ -23,7 +23,7 @@ from camtool.jobs.selection import circle_of, construction_reason
 from camtool.jobs.travel import refuse_small_box
 from camtool.model.construction import fit_extent, is_construction
 from camtool.model.errors import InputError
-from camtool.model.shapes import Contour, Drawing, bbox_union, distance, fit_factor
+from camtool.model.shapes import Contour, Drawing, distance, fit_factor
 from camtool.model.units import fmt_num
 from camtool.toolpath.chain import GAP_SHARE, as_cut
 from camtool.toolpath.cuts import where
@@ -95,10 +95,8 @@ def initial_job(
             :func:`~camtool.jobs.travel.refuse_small_box`), or the tool is as wide as the
             machine's travel.
     """
-    if drawing.contours:  # a unit set wrong: the job's post would refuse it
-        defaults = PlanOptions()
-        box = bbox_union([c.bbox() for c in drawing.contours])
-        refuse_small_box(box, defaults.tolerance, defaults.chain_tolerance, drawing.source)
+    defaults = PlanOptions()  # a unit set wrong: the job's post would refuse it
+    refuse_small_box(drawing.contours, defaults.tolerance, defaults.chain_tolerance, drawing.source)
     fit, k = _fit(drawing, tool_diameter, travel_mm)
     if fit:  # sizes as cut (drills, tabs), selections in the drawing's own mm
         drawing = drawing.transformed(k)

@@ -7,14 +7,14 @@ Design notes: docs/internals.md, ``camtool/jobs/travel.py``.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from typing import TYPE_CHECKING
 
 from camtool.geometry.chain import joint_distance
 from camtool.jobs.job import Job, Operation
 from camtool.jobs.selection import Chaining, Selected
 from camtool.model.errors import InputError
-from camtool.model.shapes import BBox, bbox_union
+from camtool.model.shapes import BBox, Contour, bbox_union
 from camtool.toolpath.options import PlanOptions
 from camtool.toolpath.placement import Placing, too_large_drawing
 
@@ -107,22 +107,31 @@ def refuse_too_small(
     """
     if setup.fit is not None:
         return
-    boxes = [c.bbox() for _, scaled in selections for c in scaled.drawing.contours]
-    if boxes:
-        refuse_small_box(bbox_union(boxes), setup.tolerance, setup.chain_tolerance, source)
+    contours = (c for _, scaled in selections for c in scaled.drawing.contours)
+    refuse_small_box(contours, setup.tolerance, setup.chain_tolerance, source)
 
 
-def refuse_small_box(box: BBox, tolerance: float, chain_tolerance: float, source: str) -> None:
-    """:func:`refuse_too_small` of cuts whose box is ``box`` (mm), at those tolerances (mm).
+def refuse_small_box(
+    contours: Iterable[Contour], tolerance: float, chain_tolerance: float, source: str
+) -> None:
+    """:func:`refuse_too_small` of ``contours`` (mm) at those tolerances (mm).
+
+    Their boxes are joined until they span the limit: a drawing of any size reads a few.
 
     Raises:
         InputError: as :func:`refuse_too_small`.
     """
-    x0, y0, x1, y1 = box
     joint = joint_distance(chain_tolerance)
     limit = max(SMALLEST_TOLERANCES * tolerance, SMALLEST_JOINTS * joint)
-    if max(x1 - x0, y1 - y0) >= limit:
+    box: BBox | None = None
+    for contour in contours:
+        c = contour.bbox()
+        box = c if box is None else bbox_union([box, c])
+        if max(box[2] - box[0], box[3] - box[1]) >= limit:
+            return
+    if box is None:
         return
+    x0, y0, x1, y1 = box
     raise InputError(
         f"{source or 'the drawing'}: its cuts span only {x1 - x0:.4g} × {y1 - y0:.4g} mm, "
         f"under {limit:g} mm ({SMALLEST_TOLERANCES:g} times the {tolerance:g} mm "
