@@ -221,7 +221,8 @@ def _layout(name: str, options: BatchOptions, several: bool) -> tuple[str, str, 
         )
     tools: tuple[int, ...] = ()
     if options.job is not None and target.post.tool_changes == "none":
-        used = tuple(dict.fromkeys(op.tool for op in options.job.sequenced()))
+        order = [op.tool for op in options.job.sequenced()]  # a change where the tool differs
+        used = tuple(t for k, t in enumerate(order) if k == 0 or t != order[k - 1])
         tools = used if len(used) > 1 else ()
     return target.name, target.post.formats[fmt], tools
 

@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from camtool.jobs.batch_report import summary_table as summary_table  # camtool.batch API
+from camtool.jobs.by_hand import needs_numbers, program_path
 from camtool.model.errors import CamtoolError
 
 if TYPE_CHECKING:
@@ -27,7 +28,8 @@ class BatchTask:
         target: the target it is posted for when the batch has several (``None``:
             the batch's only target).
         tools: for a job on a target that cannot change tools, the T numbers of its
-            programs, one per tool (``code_path`` then names none of them: each is
+            programs in the order they run, one per tool change (``code_path`` then names
+            none of them: each is :func:`~camtool.jobs.by_hand.program_path`'s
             ``<name>.T<n><ending>``); empty: one program at ``code_path``.
     """
 
@@ -42,7 +44,8 @@ class BatchTask:
     def outputs(self) -> tuple[str, ...]:
         """Every path this task writes."""
         base = Path(self.code_path)
-        codes = [str(base.with_name(f"{base.stem}.T{t}{base.suffix}")) for t in self.tools]
+        numbered = needs_numbers(self.tools)
+        codes = [program_path(base, k, t, numbered) for k, t in enumerate(self.tools, 1)]
         paths = (*(codes or [self.code_path]), self.report_path, self.preview_path)
         return tuple(p for p in paths if p is not None)
 

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from camtool.model.program import Command, Program, Rapid, Stop, ToolChange
+from camtool.model.program import Command, Coolant, Move, Program, Rapid, Spindle, Stop, ToolChange
 
 if TYPE_CHECKING:
     from camtool.post.base import PostResult, Target
@@ -38,20 +38,38 @@ class ToolProgram:
     change: ToolChange | None
     program: Program
     result: PostResult
+    numbered: bool = False
 
     def path(self, output: str | Path) -> str:
-        """Where it is written for ``-o output``: ``part.nc`` → ``part.T2.nc``.
-
-        The part of a re-post before its first change: ``part.start.nc``.
-        """
-        out = Path(output)
-        which = "start" if self.change is None else f"T{self.change.tool}"
-        return str(out.with_name(f"{out.stem}.{which}{out.suffix}"))
+        """Where it is written for ``-o output``: :func:`program_path` of its tool."""
+        tool = None if self.change is None else self.change.tool
+        return program_path(output, self.number, tool, self.numbered)
 
     @property
     def tool(self) -> str:
         """The tool it cuts with, in words: ``"T2"``, or the tool loaded at the start."""
         return _tool(self.change)
+
+
+def program_path(output: str | Path, number: int, tool: int | None, numbered: bool) -> str:
+    """Where the program of ``tool`` (``None``: the tool loaded at the start) is written.
+
+    For ``-o part.nc``: ``part.T2.nc``, and ``part.start.nc`` for the part of a re-post
+    before its first change. When a tool comes back (a job cut in the file's order, T1
+    then T2 then T1 again: :func:`needs_numbers`), every program's name begins with its
+    place in the run: ``part.1.T1.nc``, ``part.2.T2.nc``, ``part.3.T1.nc``; one name per
+    tool would write the last T1 program over the first.
+    """
+    out = Path(output)
+    which = "start" if tool is None else f"T{tool}"
+    if numbered:
+        which = f"{number}.{which}"
+    return str(out.with_name(f"{out.stem}.{which}{out.suffix}"))
+
+
+def needs_numbers(tools: Sequence[int | None]) -> bool:
+    """Whether programs of ``tools`` (in the order they run) need :func:`program_path`'s numbers."""
+    return len(set(tools)) < len(tools)
 
 
 def _tool(change: ToolChange | None) -> str:
@@ -156,7 +174,8 @@ def idle_changes(program: Program) -> list[ToolChange]:
 
     A change at the program's end, or one changed again at once, loads a tool that
     never cuts: :func:`per_tool` writes no program for it (its rapids go with the
-    program before, or the first program, its spindle commands nowhere).
+    program before, or the first program; the spindle and coolant its commands leave on
+    are started by the next program that cuts).
     """
     every = [(i, c) for i, c in program.commands if isinstance(c, ToolChange)]
     starts = [i for i, _ in every[1:]] + [len(program.moves)]
@@ -179,7 +198,12 @@ def per_tool(program: Program, target: Target, fmt: str | None) -> tuple[ToolPro
     the new tool within one program); its header is the job's, then which program of how
     many it is and what to load. A stop right after a change (``M6`` then ``M0``, as
     pcb2gcode pauses for the new tool) is that change's: starting the piece is its resume,
-    said in the header; any other stop is kept.
+    said in the header; any other stop is kept. Each piece runs alone (the one before
+    ended with ``M2``; Z zero was set again on the stock): one that moves sideways before
+    any Z first rises to the Z the input's tool was at its change (above the work; else a
+    warning), and one that cuts before starting the spindle or coolant the input had on
+    there starts them where the change was; both said in its header. Names:
+    :func:`program_path`.
 
     Raises:
         DialectError: a piece the target cannot write.
@@ -205,6 +229,7 @@ def per_tool(program: Program, target: Target, fmt: str | None) -> tuple[ToolPro
             commands[piece].append((i - bounds[piece], command))
     out: list[ToolProgram] = []
     here = program.origin
+    numbered = needs_numbers([None if c is None else c.tool for _, c in changes])
     for k, (_, change) in enumerate(changes):
         moves = program.moves[bounds[k] : bounds[k + 1]]
         if change is None:
@@ -214,23 +239,83 @@ def per_tool(program: Program, target: Target, fmt: str | None) -> tuple[ToolPro
         after = f", after program {k} ({_tool(changes[k - 1][1])})" if k else ""
         stop = own_stop_notes(stopped[id(change)]) if change and id(change) in stopped else []
         notes = (*program.notes, f"program {k + 1} of {len(changes)}: {load}{after}", *stop)
-        sideways = (
-            k > 0
-            and target.machine.has_z
-            and moves
-            and moves[0].z is None
-            and (moves[0].x, moves[0].y) != here
-        )
-        warned = (sideways_first(k + 1, change, target.name),) if sideways else ()
+        own = commands[k]
+        warned: tuple[str, ...] = ()
+        rose = 0
+        if k > 0 and target.machine.has_z and _sideways(moves, here):
+            z = next((m.z for m in reversed(program.moves[: bounds[k]]) if m.z is not None), None)
+            if z is not None and z > 0:  # up to where the input's tool was when it changed
+                moves = (Rapid(here[0], here[1], z), *moves)
+                own, rose = [(j + 1, c) for j, c in own], 1
+                notes = (*notes, f"rises to Z{z:g} first: the input's height at its tool change")
+            else:
+                warned = (sideways_first(k + 1, change, target.name),)
+        if change is not None:  # the change's place in the piece, after a rise
+            at = next(j for j, c in program.commands if c is change) - bounds[k] + rose
+            resumed = _resumed(program, change, moves, own)
+            own = [*((at, c) for c in resumed), *own]
+            notes = (
+                *notes,
+                *(f"{_said(c)} as at the input's tool change" for c in resumed),
+            )
         alone = Program(
-            moves,
+            tuple(moves),
             here,
             (*program.warnings, *warned),
-            commands=tuple(commands[k]),
+            commands=tuple(sorted(own, key=lambda jc: jc[0])),
             notes=notes,
             tolerance_mm=program.tolerance_mm,
         )
-        out.append(ToolProgram(k + 1, change, alone, target.emit(alone, fmt=fmt)))
+        out.append(ToolProgram(k + 1, change, alone, target.emit(alone, fmt=fmt), numbered))
         if moves:
             here = (moves[-1].x, moves[-1].y)
     return tuple(out)
+
+
+def _sideways(moves: Sequence[Move], here: tuple[float, float]) -> bool:
+    """Whether ``moves`` (a program per tool, from ``here``) go sideways before any Z move."""
+    for m in moves:
+        if m.z is not None:
+            return False
+        if (m.x, m.y) != here:
+            return True
+    return False
+
+
+def _resumed(
+    program: Program, change: ToolChange, moves: Sequence[Move], own: Sequence[tuple[int, Command]]
+) -> list[Command]:
+    """The spindle and coolant ``program`` has on at ``change`` that its piece does not set.
+
+    A program per tool starts with the machine stopped (the program before ended with
+    ``M2``, which stops both on GRBL and LinuxCNC), so where the input turned the spindle
+    on before the change (before an idle one, or before the program's first) and the piece
+    cuts before it starts it again, it is started where the change was.
+    """
+    spindle: Spindle | None = None
+    rpm: float | None = None
+    coolant: Coolant | None = None
+    for _, c in program.commands:
+        if c is change:
+            break
+        if isinstance(c, Spindle):
+            rpm = c.rpm if c.rpm is not None else rpm
+            spindle = None if c.direction == "off" else Spindle(c.direction, rpm)
+        elif isinstance(c, Coolant):
+            coolant = None if c.state == "off" else c
+    cut = next((j for j, m in enumerate(moves) if not isinstance(m, Rapid)), len(moves))
+    before = [c for j, c in own if j <= cut]
+    out: list[Command] = []
+    if spindle is not None and not any(isinstance(c, Spindle) for c in before):
+        out.append(spindle)
+    if coolant is not None and not any(isinstance(c, Coolant) for c in before):
+        out.append(coolant)
+    return out
+
+
+def _said(command: Command) -> str:
+    """A resumed spindle or coolant command in words, for a program's header."""
+    if isinstance(command, Spindle):
+        speed = f", {command.rpm:g} rev/min" if command.rpm is not None else ""
+        return f"spindle on ({command.direction}{speed})"
+    return f"coolant on ({command.state})" if isinstance(command, Coolant) else ""

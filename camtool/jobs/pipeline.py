@@ -392,10 +392,16 @@ def post_program(
             tools = ", ".join(f"T{c.tool}" for c in idle)
             note = f"no program for {tools}: the program cuts nothing after changing to it"
             program = dataclasses.replace(program, warnings=(*program.warnings, note))
+        gone = {id(c) for c in idle}
+        busy = dataclasses.replace(  # without the changes after which nothing is cut
+            program, commands=tuple((i, c) for i, c in program.commands if id(c) not in gone)
+        )
         if cuts_first and len(idle) == changes:  # one tool cuts, the one loaded at the start
             own = own_stops_dropped(program.commands)[0]
             alone = tuple((i, c) for i, c in own if not isinstance(c, ToolChange))
             program = dataclasses.replace(program, commands=alone)
+        elif changes - len(idle) == 1 and changed_before_cutting(busy):
+            program = busy  # one tool cuts, loaded before any cut: its program is -o's
         else:
             pieces = per_tool(program, target, output.fmt)  # one program per tool
             return PostJob(None, program, target, pieces[0].result, None, 0.0, pieces=pieces)

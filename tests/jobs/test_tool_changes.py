@@ -20,7 +20,7 @@ from camtool.jobs.jobfile import load_job
 from camtool.jobs.pipeline import post_program
 from camtool.jobs.run import run_job
 from camtool.model.errors import DialectError
-from camtool.model.program import Linear, Stop, ToolChange
+from camtool.model.program import Linear, Rapid, Stop, ToolChange
 from camtool.post.base import Target
 from camtool.post.registry import load_target
 
@@ -262,10 +262,15 @@ def test_a_re_post_that_cuts_before_its_first_change_is_one_program_per_tool_on_
     first, second = (p.program for p in done.pieces)
     assert [(m.x, m.y) for m in first.moves if isinstance(m, Linear)] == [(0, 0), (10, 0)]
     assert [(m.x, m.y) for m in second.moves if isinstance(m, Linear)] == [(20, 0), (30, 0)]
-    assert [*first.moves, *second.moves] == list(program.moves)
+    # T2's program first rises to Z5, where the input's tool was at the change (its own
+    # "G0 Z5" after "T2 M6" moves nothing in the input, so it is no move of the input's)
+    assert second.moves[0] == Rapid(10.0, 0.0, 5.0)
+    assert [*first.moves, *second.moves[1:]] == list(program.moves)
     for piece in done.pieces:
         lines = str(piece.result.code).splitlines()
         assert "M0" not in lines and not any("change to" in line for line in lines)
+    code = [ln for ln in str(done.pieces[1].result.code).splitlines() if not ln.startswith("(")]
+    assert code[1:4] == ["G0 Z5.000", "M3 S8000", "G0 X10.000 Y0.000"]
     out = tmp_path / "cuts.gcode"
     assert main(["post", str(source), "-t", "grbl", "-o", str(out)]) == 0
     written = sorted(p.name for p in tmp_path.iterdir() if p.suffix == ".gcode")
@@ -287,11 +292,32 @@ def test_a_change_at_the_end_of_a_re_post_that_cut_before_it_writes_one_program(
     assert "no program for T2: the program cuts nothing after changing to it" in done.warnings
 
 
-def test_a_program_per_tool_that_moves_sideways_first_is_warned_of(tmp_path: Path) -> None:
-    """Without its ``G0 Z5`` after ``T2 M6``, T2's program would go sideways at the height
-    its Z zero was set, on the stock's top: kept as the input gives it, and said."""
+def test_a_program_per_tool_that_moves_sideways_first_rises_to_the_input_s_height(
+    tmp_path: Path,
+) -> None:
+    """Without its ``G0 Z5`` after ``T2 M6`` the input goes sideways at Z5, where its tool
+    was at the change; T2's program, whose Z zero was just set on the stock's top, rises
+    there first instead of going sideways on the stock."""
     source = tmp_path / "cuts.ngc"
     source.write_text(CUTS_THEN_CHANGES.replace("M3 S8000\nG0 Z5\n", "M3 S8000\n"))
+    done = post_program(read_gcode(source), load_target("grbl"))
+    assert not [w for w in done.warnings if "before any Z move" in w]
+    code = str(done.pieces[1].result.code).splitlines()
+    assert "(rises to Z5 first: the input's height at its tool change)" in code
+    start = code.index("G0 Z5.000")
+    assert code[start : start + 3] == ["G0 Z5.000", "M3 S8000", "G0 X20.000 Y0.000"]
+
+
+def test_a_program_per_tool_sideways_where_the_input_set_no_height_is_warned_of(
+    tmp_path: Path,
+) -> None:
+    """An input that never set Z before its change (drawn flat) gives no height to rise
+    to: T2's program goes sideways as the input gives it, and that is said."""
+    source = tmp_path / "flat.ngc"
+    source.write_text(
+        "G21 G90\nM3 S1000\nG0 X0 Y0\nG1 X10 F300\nM5\nT2 M6\nM3 S1000\n"
+        "G0 X20 Y0\nG1 X30 F300\nM5\nM2\n"
+    )
     done = post_program(read_gcode(source), load_target("grbl"))
     said = [w for w in done.warnings if "before any Z move" in w]
     assert said == [
@@ -300,7 +326,7 @@ def test_a_program_per_tool_that_moves_sideways_first_is_warned_of(tmp_path: Pat
         "after the tool change in the input"
     ]
     code = str(done.pieces[1].result.code).splitlines()
-    assert code[code.index("M3 S8000") + 1] == "G0 X20.000 Y0.000"  # as the input gives it
+    assert code[code.index("M3 S1000") + 1] == "G0 X20.000 Y0.000"  # as the input gives it
     # a machine without Z (the router's pen is set by hand) has no such height to warn of
     router = post_program(read_gcode(source), load_target("matlab-router"))
     assert len(router.pieces) == 2 and not any("before any Z" in w for w in router.warnings)
@@ -467,5 +493,7 @@ def test_a_change_after_which_nothing_is_cut_gets_no_program(tmp_path: Path) -> 
     assert (first.moves[0].x, first.moves[0].y, first.moves[0].z) == (0.0, 0.0, 5.0)
     assert [(m.x, m.y) for m in first.moves if m.z == -1.0] == [(1.0, 1.0)]
     assert [(m.x, m.y) for m in second.moves if m.z == -1.0] == [(2.0, 2.0)]
-    assert len(first.moves) + len(second.moves) == len(program.moves)
+    # T4's goes sideways first in the input, at Z5: its program rises there first
+    assert second.moves[0] == Rapid(5.0, 1.0, 5.0)
+    assert len(first.moves) + len(second.moves) == len(program.moves) + 1
     assert any("no program for T3, T2: the program cuts nothing after" in w for w in done.warnings)
