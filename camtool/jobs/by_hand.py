@@ -15,7 +15,17 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from camtool.model.program import Command, Coolant, Move, Program, Rapid, Spindle, Stop, ToolChange
+from camtool.model.program import (
+    Command,
+    Coolant,
+    Move,
+    Program,
+    Rapid,
+    Spindle,
+    Stop,
+    ToolChange,
+    WorkOffset,
+)
 
 if TYPE_CHECKING:
     from camtool.post.base import PostResult, Target
@@ -201,8 +211,9 @@ def per_tool(program: Program, target: Target, fmt: str | None) -> tuple[ToolPro
     said in the header; any other stop is kept. Each piece runs alone (the one before
     ended with ``M2``; Z zero was set again on the stock): one that moves sideways before
     any Z first rises to the Z the input's tool was at its change (above the work; else a
-    warning), and one that cuts before starting the spindle or coolant the input had on
-    there starts them where the change was; both said in its header. Names:
+    warning), and one that moves or cuts before selecting the work offset or starting the
+    spindle or coolant the input had there does so where the change was; both said in
+    its header. Names:
     :func:`program_path`.
 
     Raises:
@@ -252,8 +263,9 @@ def per_tool(program: Program, target: Target, fmt: str | None) -> tuple[ToolPro
                 warned = (sideways_first(k + 1, change, target.name),)
         if change is not None:  # the change's place in the piece, after a rise
             at = next(j for j, c in program.commands if c is change) - bounds[k] + rose
-            resumed = _resumed(program, change, moves, own)
-            own = [*((at, c) for c in resumed), *own]
+            offset, resumed = _resumed(program, change, moves, own, at)
+            own = [*((at - rose, c) for c in offset), *((at, c) for c in resumed), *own]
+            resumed = [*offset, *resumed]
             notes = (
                 *notes,
                 *(f"{_said(c)} as at the input's tool change" for c in resumed),
@@ -283,18 +295,26 @@ def _sideways(moves: Sequence[Move], here: tuple[float, float]) -> bool:
 
 
 def _resumed(
-    program: Program, change: ToolChange, moves: Sequence[Move], own: Sequence[tuple[int, Command]]
-) -> list[Command]:
-    """The spindle and coolant ``program`` has on at ``change`` that its piece does not set.
+    program: Program,
+    change: ToolChange,
+    moves: Sequence[Move],
+    own: Sequence[tuple[int, Command]],
+    at: int,
+) -> tuple[list[Command], list[Command]]:
+    """What ``program`` has in force at ``change`` that its piece does not set again.
 
-    A program per tool starts with the machine stopped (the program before ended with
-    ``M2``, which stops both on GRBL and LinuxCNC), so where the input turned the spindle
-    on before the change (before an idle one, or before the program's first) and the piece
-    cuts before it starts it again, it is started where the change was.
+    The work offset (before the piece's first move), then the spindle and coolant (before
+    its first cut). A program per tool starts as a program does (the program before
+    ended with ``M2``, which on GRBL and LinuxCNC stops the spindle and coolant and
+    selects G54), so where the input selected another work offset, or turned the spindle
+    on, before the change (before an idle one, or before the program's first) and the
+    piece does not do it again before it moves (cuts), it is done where the change was
+    (``at``: its place).
     """
     spindle: Spindle | None = None
     rpm: float | None = None
     coolant: Coolant | None = None
+    offset: WorkOffset | None = None
     for _, c in program.commands:
         if c is change:
             break
@@ -303,6 +323,8 @@ def _resumed(
             spindle = None if c.direction == "off" else Spindle(c.direction, rpm)
         elif isinstance(c, Coolant):
             coolant = None if c.state == "off" else c
+        elif isinstance(c, WorkOffset):
+            offset = c
     cut = next((j for j, m in enumerate(moves) if not isinstance(m, Rapid)), len(moves))
     before = [c for j, c in own if j <= cut]
     out: list[Command] = []
@@ -310,12 +332,15 @@ def _resumed(
         out.append(spindle)
     if coolant is not None and not any(isinstance(c, Coolant) for c in before):
         out.append(coolant)
-    return out
+    placed = any(isinstance(c, WorkOffset) for j, c in own if j <= at)
+    return ([offset] if offset is not None and not placed else []), out
 
 
 def _said(command: Command) -> str:
-    """A resumed spindle or coolant command in words, for a program's header."""
+    """A resumed work offset, spindle or coolant command in words, for a program's header."""
     if isinstance(command, Spindle):
         speed = f", {command.rpm:g} rev/min" if command.rpm is not None else ""
         return f"spindle on ({command.direction}{speed})"
+    if isinstance(command, WorkOffset):
+        return f"work offset {command.code}"
     return f"coolant on ({command.state})" if isinstance(command, Coolant) else ""

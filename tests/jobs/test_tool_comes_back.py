@@ -148,3 +148,52 @@ def test_one_tool_changed_to_twice_is_one_program_where_asked(tmp_path: Path) ->
     blocks = (out / "p.nc").read_text().splitlines()
     assert "G1 X10.000 Y0.000 F300" in blocks and "M3 S1000" in blocks
     assert "load T1 before running: grbl cannot change tools" in " ".join(blocks)
+
+
+FUSION_STYLE = """%
+(T1  D=3.175 - flat end mill)
+(T2  D=2. - drill)
+G90 G94
+G17
+G21
+T1 M6
+S10000 M3
+G55
+G0 X10. Y10.
+G0 Z15.
+G1 Z-3. F300.
+G1 X40. F1000.
+G0 Z15.
+M5
+T2 M6
+S5000 M3
+G0 X25. Y20.
+G0 Z5.
+G1 Z-4. F200.
+G0 Z15.
+M5
+M30
+%
+"""
+"""Two tools in work offset G55, each change followed by its spindle start and then a move
+sideways before any Z, as a CAM post for a tool changer writes them."""
+
+
+def test_the_second_program_keeps_the_work_offset_and_rises_before_it_moves(
+    tmp_path: Path,
+) -> None:
+    """``M2`` at the end of T1's program selects G54 again (GRBL, LinuxCNC): T2's program
+    without G55 would drill 25, 20 from another zero. It selects G55 before any move,
+    rises to Z15 (where the input's tool was at the change), then goes to the hole."""
+    source = tmp_path / "two.nc"
+    source.write_text(FUSION_STYLE)
+    out = tmp_path / "out"
+    out.mkdir()
+    code, err = _run("post", str(source), "-t", "grbl", "-o", str(out / "p.nc"))
+    assert code == 0, err
+    blocks = [ln for ln in (out / "p.T2.nc").read_text().splitlines() if not ln.startswith("(")]
+    moves = [i for i, ln in enumerate(blocks) if ln.startswith(("G0", "G1"))]
+    assert blocks.index("G55") < moves[0]
+    assert blocks[moves[0]] == "G0 Z15.000"
+    assert blocks[moves[1]] == "G0 X25.000 Y20.000"
+    assert "M3 S5000" in blocks[: moves[1]]
