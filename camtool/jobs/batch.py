@@ -9,6 +9,7 @@ import contextlib
 import dataclasses
 import json
 import os
+import re
 import signal
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -285,10 +286,22 @@ def _check_inside(tasks: Sequence[BatchTask], output_dir: Path) -> None:
 
 
 def _refuse_existing(tasks: Sequence[BatchTask], options: BatchOptions) -> None:
-    """Without ``force``, outputs of a previous run (the first few named) are refused."""
+    """Without ``force``, outputs of a previous run (the first few named) are refused.
+
+    Besides each task's planned outputs, the programs per tool a previous run wrote for
+    its code (``part.T2.gcode``, ``part.start.gcode``, ``part.1.T1.gcode``): a re-posted
+    program's are known only once it is read.
+    """
     named = [t for t in (options.report,) if t is not None and t != "-"]
     named += [out for task in tasks for out in task.outputs]
-    existing = sorted(out for out in named if os.path.lexists(out))
+    pieces: dict[str, dict[tuple[str, str], list[str]]] = {}  # by folder, by stem and ending
+    for task in tasks:
+        base = Path(task.code_path)
+        folder = str(base.parent)
+        if folder not in pieces:
+            pieces[folder] = _pieces_in(folder)
+        named += [str(base.parent / n) for n in pieces[folder].get((base.stem, base.suffix), [])]
+    existing = sorted({out for out in named if os.path.lexists(out)})
     if existing:
         shown = ", ".join(existing[:SHOWN_EXISTING])
         more = len(existing) - SHOWN_EXISTING
@@ -297,6 +310,25 @@ def _refuse_existing(tasks: Sequence[BatchTask], options: BatchOptions) -> None:
             f"{len(existing)} output(s) exist already: {shown}{rest}; "
             "use --force to overwrite them, or another -o"
         )
+
+
+_PIECE = re.compile(r"(.+?)\.(?:(\d+)\.)?(?:T\d+|start)(\.[^.]+)?")
+"""A program per tool's name (:func:`camtool.jobs.by_hand.program_path`): stem, number, ending."""
+
+
+def _pieces_in(folder: str) -> dict[tuple[str, str], list[str]]:
+    """The names in ``folder`` of programs per tool, by the stem and ending of their ``-o``."""
+    found: dict[tuple[str, str], list[str]] = {}
+    with contextlib.suppress(OSError):
+        for name in os.listdir(folder):
+            m = _PIECE.fullmatch(name)
+            if m is None:
+                continue
+            ending = m[3] or ""
+            found.setdefault((m[1], ending), []).append(name)
+            if m[2] is not None:  # "a.1.T1.nc" may also be "a.1"'s own T1 program
+                found.setdefault((f"{m[1]}.{m[2]}", ending), []).append(name)
+    return found
 
 
 def run(

@@ -197,3 +197,25 @@ def test_the_second_program_keeps_the_work_offset_and_rises_before_it_moves(
     assert blocks[moves[0]] == "G0 Z15.000"
     assert blocks[moves[1]] == "G0 X25.000 Y20.000"
     assert "M3 S5000" in blocks[: moves[1]]
+
+
+def test_a_second_batch_keeps_the_programs_per_tool_of_the_first_without_force(
+    tmp_path: Path,
+) -> None:
+    """A re-posted program's programs per tool are known only once it is read: the check of
+    existing outputs missed them, and a second batch wrote over them without ``--force``."""
+    source = tmp_path / "in" / "two.nc"
+    source.parent.mkdir()
+    source.write_text(FUSION_STYLE)
+    out = tmp_path / "out"
+    code, err = _run("batch", str(source), "-t", "grbl", "-o", str(out))
+    assert code == 0, err
+    assert sorted(p.name for p in out.iterdir()) == ["two.T1.gcode", "two.T2.gcode"]
+    (out / "two.T1.gcode").write_text("kept\n")
+    code, err = _run("batch", str(source), "-t", "grbl", "-o", str(out))
+    assert code == 2
+    assert "2 output(s) exist already" in err and "two.T1.gcode" in err
+    assert (out / "two.T1.gcode").read_text() == "kept\n"
+    code, err = _run("batch", str(source), "-t", "grbl", "-o", str(out), "--force")
+    assert code == 0, err
+    assert (out / "two.T1.gcode").read_text() != "kept\n"
