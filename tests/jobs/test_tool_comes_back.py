@@ -60,6 +60,17 @@ def _run(*args: str) -> tuple[int, str]:
     return code, err.getvalue()
 
 
+def _post_program(tmp_path: Path, name: str, text: str) -> Path:
+    """Post the G-code ``text`` (as ``name``) to grbl, ``-o out/p.nc``; the folder ``out``."""
+    source = tmp_path / name
+    source.write_text(text)
+    out = tmp_path / "out"
+    out.mkdir()
+    code, err = _run("post", str(source), "-t", "grbl", "-o", str(out / "p.nc"))
+    assert code == 0, err
+    return out
+
+
 def _programs(folder: Path) -> dict[str, list[str]]:
     return {p.name: p.read_text().splitlines() for p in sorted(folder.iterdir())}
 
@@ -86,8 +97,8 @@ def test_a_tool_that_comes_back_gets_a_program_of_its_own_numbered_in_the_run(
 
 
 def test_a_batch_writes_the_first_program_of_a_tool_that_comes_back_too(tmp_path: Path) -> None:
-    """The batch named both T1 programs ``part.T1.gcode``: the outline's overwrote the
-    pocket's, and the pocket was never cut, with exit 0."""
+    """Both T1 programs would share ``part.T1.gcode``, the outline's in place of the
+    pocket's: each is written, the pocket's first."""
     job = tmp_path / "j.toml"
     job.write_text(JOB, encoding="utf-8")
     code, err = _run("batch", str(ROOT / "samples/part.dxf"), "-t", "grbl", "--job", str(job),
@@ -103,13 +114,8 @@ def test_a_batch_writes_the_first_program_of_a_tool_that_comes_back_too(tmp_path
 def test_each_program_starts_the_spindle_the_input_had_running_at_its_change(
     tmp_path: Path,
 ) -> None:
-    """The M3 after the idle T1 went nowhere: T2's and T3's programs cut with it off."""
-    source = tmp_path / "idle.ngc"
-    source.write_text(IDLE_THEN_CUTS)
-    out = tmp_path / "out"
-    out.mkdir()
-    code, err = _run("post", str(source), "-t", "grbl", "-o", str(out / "p.nc"))
-    assert code == 0, err
+    """The M3 after the idle T1 belongs to no program of its own: T2's and T3's start it."""
+    out = _post_program(tmp_path, "idle.ngc", IDLE_THEN_CUTS)
     written = _programs(out)
     assert list(written) == ["p.T2.nc", "p.T3.nc"]
     for lines in written.values():
@@ -122,12 +128,7 @@ def test_each_program_starts_the_spindle_the_input_had_running_at_its_change(
 
 
 def test_a_program_that_starts_its_own_spindle_gets_no_second_start(tmp_path: Path) -> None:
-    source = tmp_path / "own.ngc"
-    source.write_text(IDLE_THEN_CUTS.replace("T3 M6\n", "T3 M6\nM3 S2000\n"))
-    out = tmp_path / "out"
-    out.mkdir()
-    code, err = _run("post", str(source), "-t", "grbl", "-o", str(out / "p.nc"))
-    assert code == 0, err
+    out = _post_program(tmp_path, "own.ngc", IDLE_THEN_CUTS.replace("T3 M6\n", "T3 M6\nM3 S2000\n"))
     blocks = [ln for ln in (out / "p.T3.nc").read_text().splitlines() if not ln.startswith("(")]
     assert [ln for ln in blocks if ln.startswith("M3")] == ["M3 S2000"]
 
@@ -135,15 +136,12 @@ def test_a_program_that_starts_its_own_spindle_gets_no_second_start(tmp_path: Pa
 def test_one_tool_changed_to_twice_is_one_program_where_asked(tmp_path: Path) -> None:
     """``T1 M6`` written twice (the first changes to a tool that cuts nothing): one tool
     cuts, loaded before any cut, so its program is ``-o``'s, as for a single change."""
-    source = tmp_path / "twice.ngc"
-    source.write_text(
+    out = _post_program(
+        tmp_path,
+        "twice.ngc",
         "G21 G90\nT1 M6\nG0 Z5\nT1 M6\nM3 S1000\nG0 X0 Y0\nG1 Z-1 F100\nG1 X10 F300\n"
-        "G0 Z5\nM5\nM2\n"
+        "G0 Z5\nM5\nM2\n",
     )
-    out = tmp_path / "out"
-    out.mkdir()
-    code, err = _run("post", str(source), "-t", "grbl", "-o", str(out / "p.nc"))
-    assert code == 0, err
     assert [p.name for p in out.iterdir()] == ["p.nc"]
     blocks = (out / "p.nc").read_text().splitlines()
     assert "G1 X10.000 Y0.000 F300" in blocks and "M3 S1000" in blocks
@@ -185,12 +183,7 @@ def test_the_second_program_keeps_the_work_offset_and_rises_before_it_moves(
     """``M2`` at the end of T1's program selects G54 again (GRBL, LinuxCNC): T2's program
     without G55 would drill 25, 20 from another zero. It selects G55 before any move,
     rises to Z15 (where the input's tool was at the change), then goes to the hole."""
-    source = tmp_path / "two.nc"
-    source.write_text(FUSION_STYLE)
-    out = tmp_path / "out"
-    out.mkdir()
-    code, err = _run("post", str(source), "-t", "grbl", "-o", str(out / "p.nc"))
-    assert code == 0, err
+    out = _post_program(tmp_path, "two.nc", FUSION_STYLE)
     blocks = [ln for ln in (out / "p.T2.nc").read_text().splitlines() if not ln.startswith("(")]
     moves = [i for i, ln in enumerate(blocks) if ln.startswith(("G0", "G1"))]
     assert blocks.index("G55") < moves[0]
@@ -202,8 +195,8 @@ def test_the_second_program_keeps_the_work_offset_and_rises_before_it_moves(
 def test_a_second_batch_keeps_the_programs_per_tool_of_the_first_without_force(
     tmp_path: Path,
 ) -> None:
-    """A re-posted program's programs per tool are known only once it is read: the check of
-    existing outputs missed them, and a second batch wrote over them without ``--force``."""
+    """A re-posted program's programs per tool are known only once it is read: a second
+    batch finds them all the same, and overwrites them only with ``--force``."""
     source = tmp_path / "in" / "two.nc"
     source.parent.mkdir()
     source.write_text(FUSION_STYLE)
