@@ -110,17 +110,33 @@ def accel(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> bo
     return on
 
 
-@pytest.fixture(autouse=True)
-def _fit_kernels_fresh() -> None:
-    """Each test starts as a new process: the compiled curve fitter not yet loaded.
+FRESH_FIT_FIXTURES = frozenset({"accel_on", "helpers_on", "accel", "fit_kernels_fresh"})
+"""Fixtures whose tests start with the compiled curve fitter not loaded, as a new process."""
 
-    It loads once a process has fitted :data:`camtool.geometry.arcfit.KERNEL_FROM` curves;
-    without this, whether a test's fits are compiled would depend on the tests run before
-    it (the fits are the same, but the pool's tests count its chunks).
+
+@pytest.fixture
+def fit_kernels_fresh() -> None:
+    """The compiled curve fitter not yet loaded, as in a new process (see below)."""
+
+
+@pytest.fixture(autouse=True)
+def _fit_kernels(request: pytest.FixtureRequest) -> None:
+    """Each test starts with the compiled curve fitter loaded, as a process that has fitted
+    :data:`camtool.geometry.arcfit.KERNEL_FROM` curves; with ``CAMTOOL_ACCEL=0`` (CI's
+    second run) every fit is the plain one.
+
+    The fits are the same either way (tests/geometry/test_fit_compiled.py); the compiled
+    ones spare the suite's thousands of small drawings the plain fit's time. A test of the
+    accelerated versions (``accel_on``, ``helpers_on``, ``accel``) or one that asks for
+    ``fit_kernels_fresh`` starts as a new process instead: nothing loaded, nothing counted,
+    so its fits go to the pool or a helper as a user's would. Without this fixture, which
+    way a test's fits went would depend on the tests run before it.
     """
     from camtool.geometry.arcfit import FIT_KERNELS
 
     FIT_KERNELS.forget()
+    if FRESH_FIT_FIXTURES.isdisjoint(request.fixturenames):
+        FIT_KERNELS.get(FIT_KERNELS.threshold)
 
 
 @pytest.fixture

@@ -32,6 +32,7 @@ def _splines(msp: Any) -> None:
     msp.add_blockref("CURL", (400, 0), dxfattribs={"xscale": 2.0, "rotation": 30})
 
 
+@pytest.mark.usefixtures("fit_kernels_fresh")  # the splines go to the pool, as a new process's
 def test_splines_fitted_ahead_read_as_fitted_in_order(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
