@@ -44,10 +44,8 @@ from camtool.importers.svgpage import (
     apply,
     check_travel,
     compose,
-    contour_off_page,
     is_background,
-    off_page_text,
-    refusal_note,
+    page_warnings,
 )
 from camtool.importers.svgstyle import (
     DEFAULT_LAYER,
@@ -245,16 +243,8 @@ def _drawing(
     warnings += unseen_warnings(path, unseen)
     if named:
         contours = on_layers(path, contours, named)
-    size_note = ""
-    outside = [c for c in contours if contour_off_page(c, prepared.page)]
-    if outside:
-        first = outside[0]
-        text = off_page_text(
-            path, len(outside), "contour", first.source, first.bbox(), prepared.page
-        )
-        them = "them" if len(outside) > 1 else "it"
-        warnings.append(f"{text}; camtool cuts {them}: delete {them} or move {them} onto the page")
-        size_note = refusal_note(text, len(outside))
+    off_page, size_note = page_warnings(path, contours, prepared.page)
+    warnings += off_page
     if not contours:
         where = " in the selected layers" if options.layers else ""
         prefix = f"{path}: "

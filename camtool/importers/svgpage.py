@@ -302,6 +302,61 @@ def off_page_text(
     )
 
 
+_BEYOND_MM = 0.1
+"""How far beyond the page (mm) a contour on it must reach for a warning: less is a sliver
+no one sees (a stroke's half-width over the edge, a rounding of the page size)."""
+
+
+def beyond_page(box: BBox, page: tuple[float, float]) -> float:
+    """How far (mm, >= 0) ``box`` reaches beyond the page on its farthest side."""
+    width, height = page
+    return max(-box[0], -box[1], box[2] - width, box[3] - height, 0.0)
+
+
+def page_warnings(
+    path: Path, contours: list[Contour], page: tuple[float, float] | None
+) -> tuple[list[str], str]:
+    """Warnings for the contours off the page, and what a refusal of the drawing's size adds.
+
+    The root ``<svg>`` clips its content to the page (SVG 1.1 §14.3.3) and camtool cuts
+    whole contours: one wholly outside the page is cut where a viewer shows nothing, one
+    that reaches beyond it (by more than :data:`_BEYOND_MM`: Fritzing's part legs,
+    art over an Illustrator artboard's edge) is cut whole where a viewer shows only its
+    part on the page. Each kind gets a warning that counts them and names one (the first
+    outside, the farthest beyond); the note (``""`` when none is wholly outside) is
+    :func:`refusal_note`'s.
+    """
+    if page is None:
+        return [], ""
+    outside: list[Contour] = []
+    beyond: list[tuple[float, Contour]] = []
+    for contour in contours:
+        if contour_off_page(contour, page):
+            outside.append(contour)
+        elif (reach := beyond_page(contour.bbox(), page)) > _BEYOND_MM:
+            beyond.append((reach, contour))
+    warnings: list[str] = []
+    note = ""
+    if outside:
+        first = outside[0]
+        text = off_page_text(path, len(outside), "contour", first.source, first.bbox(), page)
+        them = "them" if len(outside) > 1 else "it"
+        warnings.append(f"{text}; camtool cuts {them}: delete {them} or move {them} onto the page")
+        note = refusal_note(text, len(outside))
+    if beyond:
+        reach, first = max(beyond, key=lambda pair: pair[0])
+        box = first.bbox()
+        many = f"{len(beyond)} contours reach" if len(beyond) > 1 else "1 contour reaches"
+        them = "them" if len(beyond) > 1 else "it"
+        warnings.append(
+            f"{path}: {many} beyond the {page[0]:.4g} × {page[1]:.4g} mm page, where a viewer "
+            f"shows only the part on the page (farthest: {first.source} at ({box[0]:.4f}, "
+            f"{box[1]:.4f}) mm, {reach:.4g} mm beyond); camtool cuts {them} whole: trim "
+            f"{them} to the page in the drawing program if the rest is not to be cut"
+        )
+    return warnings, note
+
+
 def refusal_note(text: str, count: int) -> str:
     """What a refusal of the drawing's size adds when ``count`` shapes lie off the page."""
     they, them = ("they are", "them") if count > 1 else ("it is", "it")

@@ -1149,7 +1149,7 @@ def test_contours_wholly_outside_the_page_are_cut_with_a_warning(tmp_path: Path)
     """SVG 1.1 §14.3.3: the root viewport clips, so a viewer shows nothing of a shape left
     beside the page or moved away by a stray transform (Fritzing's SMD_crystal_HC49.svg has
     a rect translated 1 034 px down). camtool cuts what it reads, and says so. A shape that
-    only crosses the page's edge is not named."""
+    crosses the page's edge is not named there: a second warning counts those."""
     body = (
         '<rect id="on" x="10" y="10" width="20" height="20"/>'
         '<rect id="across" x="90" y="90" width="20" height="20"/>'
@@ -1173,6 +1173,10 @@ def test_contours_wholly_outside_the_page_are_cut_with_a_warning(tmp_path: Path)
         f"{tmp_path / 't.svg'}: 2 contours lie wholly outside the 100 × 100 mm page, where a "
         "viewer shows nothing (first rect#away at (10.0000, -949.6000) mm); camtool cuts them: "
         "delete them or move them onto the page",
+        f"{tmp_path / 't.svg'}: 3 contours reach beyond the 100 × 100 mm page, where a viewer "
+        "shows only the part on the page (farthest: path#enter at (-20.0000, 40.0000) mm, 20 mm "
+        "beyond); camtool cuts them whole: trim them to the page in the drawing program if the "
+        "rest is not to be cut",
     )
     no_size = read_svg(svg(tmp_path, body, root="", name="n.svg"))  # no page to judge by
-    assert not any("wholly outside the" in w for w in no_size.warnings)
+    assert not any("outside the" in w or "beyond the" in w for w in no_size.warnings)
