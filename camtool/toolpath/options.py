@@ -257,9 +257,10 @@ class PlanOptions:
         if self.depth is not None and self.step_down is not None and self.step_down > 0:
             passes = self.depth / self.step_down
             if passes > MAX_PASSES:
+                count = f"{passes:.0f}" if passes < 1e9 else f"{passes:.3g}"
                 raise UsageError(
                     f"--depth {self.depth:g} with --step-down {self.step_down:g} mm makes "
-                    f"{passes:.0f} passes, more than the limit of {MAX_PASSES}; give a larger "
+                    f"{count} passes, more than the limit of {MAX_PASSES}; give a larger "
                     "--step-down"
                 )
 

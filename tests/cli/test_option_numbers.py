@@ -71,6 +71,12 @@ def test_pass_count_is_bounded() -> None:
     with pytest.raises(UsageError, match="--step-down"):
         PlanOptions(feed_mm_min=100.0, depth=3.0, step_down=1e-9)
     PlanOptions(feed_mm_min=100.0, depth=3.0, step_down=3.0 / MAX_PASSES)
+    with pytest.raises(UsageError, match="makes 45000 passes, more than the limit") as small:
+        PlanOptions(feed_mm_min=100.0, depth=45.0, step_down=0.001)
+    assert "--depth 45 with --step-down 0.001 mm" in str(small.value)
+    # a step of 1e-300 mm: the count in a few digits, not 300 of them
+    with pytest.raises(UsageError, match=r"makes 3e\+300 passes, more than the limit"):
+        PlanOptions(feed_mm_min=100.0, depth=3.0, step_down=1e-300)
 
 
 def test_clearance_below_safe_z_is_refused() -> None:
