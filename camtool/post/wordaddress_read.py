@@ -39,6 +39,11 @@ from camtool.post.wordaddress_spec import WordAddressSpec
 _WORD = re.compile(r"([A-Za-z])([^A-Za-z]*)")
 _UPPER_WORD = re.compile(r"[A-Z][^A-Za-z]*")
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)")
+_CLEAN_WORD = re.compile(r"[A-Za-z][^A-Za-z\s]*")
+"""A token that passes every check of :meth:`BlockReader.words` on its form (one letter, no
+space): the blocks the writer writes, tested once instead of check by check."""
+_KEPT_VALUES = 4096
+"""Distinct words whose values a reader keeps (a program repeats its F, Z and many X/Y)."""
 
 
 @dataclass
@@ -77,6 +82,7 @@ class BlockReader:
         self.spec, self.source = spec, source
         self.state = _State()
         self.line = 0
+        self.values: dict[tuple[str, str], float] = {}  # (letter, text) -> value, checked
         rapid, linear, cw, ccw = spec.motion_codes
         self.motions = {rapid: "rapid", linear: "linear", cw: "cw", ccw: "ccw"}
         pairs: tuple[tuple[str | None, SpindleDirection], ...] = (
@@ -130,6 +136,8 @@ class BlockReader:
         Raises:
             ParseError: a nested or unclosed ``(``, or a ``)`` without ``(``.
         """
+        if "(" not in raw and ")" not in raw and ";" not in raw:
+            return raw  # no comment
         pieces: list[str] = []
         start = i = 0
         while i < len(raw) and raw[i] != ";":
@@ -221,7 +229,8 @@ class BlockReader:
             tokens = [m.group(0) for m in _WORD.finditer(body)]
             if "".join(tokens) != body:
                 raise self.fail(f"{spec.name} writes no spaces or other characters: {raw!r}")
-        for token in tokens:
+        clean = all(map(_CLEAN_WORD.fullmatch, tokens))
+        for token in () if clean else tokens:  # the first bad token's own message
             glued = len(_UPPER_WORD.findall(token)) > 1
             if not token or glued or any(c.isspace() for c in token):
                 raise self.fail(f"words must be separated by one space: {raw!r}")
@@ -244,6 +253,17 @@ class BlockReader:
 
     def value(self, letter: str, text: str) -> float:
         """The value of word ``letter`` written as ``text``, mm (or its word's unit)."""
+        kept = self.values.get((letter, text))
+        if kept is not None:
+            return kept
+        value = self._checked_value(letter, text)
+        if len(self.values) >= _KEPT_VALUES:
+            self.values.clear()
+        self.values[(letter, text)] = value
+        return value
+
+    def _checked_value(self, letter: str, text: str) -> float:
+        """:meth:`value`, parsed and checked against the word's format."""
         spec = self.spec.word(letter)
         if spec is None:
             known = " ".join(sorted(self.spec.words))
