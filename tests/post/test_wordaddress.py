@@ -473,6 +473,8 @@ FLASHLIKE: dict[str, Any] = {
         ("G01 X1e3 Y1.0", "'X1e3' is not a word"),
         ("G01  X1.0 Y1.0", "separated by one space"),
         ("G01X1.0 Y1.0", "separated by one space"),
+        ("G01\tX1.0 Y1.0", "separated by one space"),  # a tab within one space-split word
+        ("G01 X1.0 Y1.0 (a note)", "'\\(a' is not a word"),  # FLASHLIKE has no comments
         ("G01 X1.0", "missing Y word"),  # both X and Y (Yanez-07 R4)
         ("G1 X1.0 Y1.0", "unknown code 'G1'"),
         ("G17", "unknown code 'G17'"),
