@@ -8,7 +8,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
-from camtool.model.errors import UsageError
+from camtool.model.errors import DialectError, UsageError
 from camtool.toolpath.passes import pass_depths
 
 if TYPE_CHECKING:
@@ -34,7 +34,10 @@ def check_heights(target: Target, plan: PlanOptions) -> None:
         return
 
     def write(z: float) -> float:
-        written = target.post.written_z(z, target.machine)
+        try:
+            written = target.post.written_z(z, target.machine)
+        except DialectError:  # too long for the Z word: not a rounding; the Z travel check
+            return z  # (or the writer, naming the block) refuses it
         return 0.0 if written is None else written + 0.0  # -0.0 reads as 0
 
     step = _resolution(write)
