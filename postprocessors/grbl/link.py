@@ -332,19 +332,70 @@ def _word(letter: str, value: float, seen: set[str], groups: set[tuple[str, ...]
     return None
 
 
+MAX_DIGITS = 8
+"""``nuts_bolts.c`` ``MAX_INT_DIGITS``: the digits of a number ``read_float`` keeps (leading
+zeros count); an integer digit after them reads as 0, a decimal one is dropped."""
+MISREAD = 0.0005
+"""How far (in the program's units) a number read short must move to be refused: half the
+0.001 of the codes camtool writes; ``X12.34567891`` read as 12.345678 is sent."""
+_LONG = re.compile(r"[0-9.]{9,}")
+"""A run that may hold more than :data:`MAX_DIGITS` digits (a quick test first)."""
+
+
+def misread(text: str) -> str | None:
+    """The first number of ``text`` GRBL 1.1 reads as another, as ``X238379.324 as X238379.32``.
+
+    ``read_float`` keeps the first :data:`MAX_DIGITS` digits: a number whose dropped digits
+    amount to :data:`MISREAD` or more moves the machine elsewhere than written, with no
+    error. ``None`` when every number reads as written, to less than that (``$`` lines are
+    not checked).
+    """
+    line = kept_characters(text)
+    if not line or line.startswith("$") or not _LONG.search(line):
+        return None
+    for word in _WORD.finditer(line):
+        letter, number = word.groups()
+        kept, count, dropped, decimal = [], 0, False, False
+        for ch in number:
+            decimal |= ch == "."
+            if ch.isdigit():
+                count += 1
+                if count > MAX_DIGITS:
+                    dropped |= ch != "0"
+                    if decimal:
+                        continue
+                    ch = "0"
+            kept.append(ch)
+        read = "".join(kept).rstrip(".")
+        if dropped and abs(float(number) - float(read)) >= MISREAD:
+            return f"{letter}{number} as {letter}{read}"
+    return None
+
+
 def check(blocks: Sequence[WireBlock], source: str) -> None:
-    """Refuse, before the first byte, a line GRBL 1.1h would answer with ``error:N``.
+    """Refuse, before the first byte, a line GRBL 1.1h refuses or misreads.
+
+    A line it would answer with ``error:N`` (:func:`refusal`), or with a number it would
+    read as another (:func:`misread`).
 
     Raises:
         InputError: naming the file, the line, the text and GRBL's own words.
     """
     for block in blocks:
         error = refusal(block.text)
+        where = f"line {block.line}" if block.index else "a restore line"
         if error is not None:
-            where = f"line {block.line}" if block.index else "a restore line"
             raise InputError(
                 f"{source}, {where}: {block.text!r}: GRBL 1.1 would refuse it with "
                 f"{decode(f'error:{error}')}; nothing was sent: change the line (or post "
+                "the drawing again for grbl)"
+            )
+        wrong = misread(block.text)
+        if wrong is not None:
+            raise InputError(
+                f"{source}, {where}: {block.text!r}: GRBL 1.1 reads the first {MAX_DIGITS} "
+                f"digits of a number (nuts_bolts.c read_float): it would read {wrong}; "
+                "nothing was sent: write it with fewer digits, nearer its work zero (or post "
                 "the drawing again for grbl)"
             )
 

@@ -52,6 +52,22 @@ def test_what_grbl_would_refuse_is_refused_before_sending(tmp_path: Path, capsys
     assert "error:20 (Unsupported command" in err
 
 
+def test_a_number_grbl_would_read_short_is_refused_before_sending(
+    tmp_path: Path, capsys: Any
+) -> None:
+    # GRBL 1.1's read_float keeps 8 digits (nuts_bolts.c MAX_INT_DIGITS): X400000.125 moves
+    # to X400000.12, with no error. Six decimals lose less than 0.0005 and are sent.
+    path = tmp_path / "far.gcode"
+    path.write_text("G21 G90\nG0 X400000 Y0\nG1 Z-1 F100\nG1 X400000.125\nM2\n")
+    code, out, err = run(["send", str(path), "-t", "grbl", "--dry-run"], capsys)
+    assert code == 3 and out == ""
+    assert "far.gcode, line 4: 'G1 X400000.125': GRBL 1.1 reads the first 8 digits" in err
+    assert "it would read X400000.125 as X400000.12;" in err
+    path.write_text("G21 G90\nG0 X12.345678 Y0\nG1 Z-1 F100\nG1 X12.3456789 Y1.0000001\nM2\n")
+    code, _, err = run(["send", str(path), "-t", "grbl", "--dry-run"], capsys)
+    assert code == 0, err
+
+
 def test_dry_run_from_line_shows_the_restore(job: Path, capsys: Any) -> None:
     code, out, _ = run(["send", str(job), "-t", "grbl", "--dry-run", "--from-line", "8"], capsys)
     assert code == 0

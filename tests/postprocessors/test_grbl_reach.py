@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
+from decimal import Decimal
 from pathlib import Path
 from typing import Any
 
@@ -35,9 +36,8 @@ def host(value: np.float32, factor: float) -> np.float32:
     return F32(float(value) * factor)
 
 
-def read_float(text: str, times: Callable[[np.float32, float], np.float32]) -> np.float32:
-    """GRBL 1.1 ``nuts_bolts.c`` ``read_float`` of a word's number (``MAX_INT_DIGITS`` 8)."""
-    negative = text.startswith("-")
+def kept_digits(text: str) -> tuple[int, int]:
+    """``read_float``'s integer and power of ten (``MAX_INT_DIGITS`` 8; leading zeros count)."""
     intval, exp, ndigit, decimal = 0, 0, 0, False
     for ch in text.lstrip("+-"):
         if ch.isdigit():
@@ -51,6 +51,12 @@ def read_float(text: str, times: Callable[[np.float32, float], np.float32]) -> n
             decimal = True
         else:
             break
+    return intval, exp
+
+
+def read_float(text: str, times: Callable[[np.float32, float], np.float32]) -> np.float32:
+    """GRBL 1.1 ``nuts_bolts.c`` ``read_float`` of a word's number."""
+    intval, exp = kept_digits(text)
     value = F32(intval)
     if value != 0:
         while exp <= -2:
@@ -59,7 +65,7 @@ def read_float(text: str, times: Callable[[np.float32, float], np.float32]) -> n
             value = times(value, 0.1)
         while exp > 0:
             value, exp = times(value, 10.0), exp - 1
-    return -value if negative else value
+    return -value if text.startswith("-") else value
 
 
 def arc_errors(program: str, times: Callable[[np.float32, float], np.float32]) -> list[str]:
@@ -153,3 +159,18 @@ def test_the_same_arcs_further_out_are_refused_by_grbl_and_by_camtool(
     assert code == 1
     assert "X = 4000" in err and "4 integer digits" in err and "--origin lower-left" in err
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "text", ["X238379.324", "Y-100000.5", "I12345.6789", "X0.000000012", "X123456789", "Z1.5"]
+)
+def test_send_refuses_exactly_the_numbers_grbl_reads_000_5_or_more_off(text: str) -> None:
+    """``misread`` against the digits the transcribed ``read_float`` keeps."""
+    from camtool_postprocessors.grbl.link import misread
+
+    intval, exp = kept_digits(text[1:])
+    kept = Decimal(intval).scaleb(exp) * (-1 if text[1] == "-" else 1)
+    found = misread(f"G1 {text}")
+    assert (found is not None) == (abs(Decimal(text[1:]) - kept) >= Decimal("0.0005"))
+    if found is not None:
+        assert Decimal(found.split(" as ")[1][1:]) == kept
