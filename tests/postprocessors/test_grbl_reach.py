@@ -6,7 +6,8 @@ and scaled by 0.01 and 0.1 in float32, as on the AVR; in doubles rounded to floa
 grbl-sim on a PC) and ``gcode.c``'s radius check of a centre-format arc (error 33), on the
 program's text as written. The grbl target writes at most 4 integer digits (9999.999 mm):
 beyond 16777.216 mm ``read_float`` no longer reads 1 µm, and arcs a few metres further fail
-the check.
+the check; its I, J and K hold 5 (8 digits in all): an arc of a centre farther off is
+written as chords.
 """
 
 from __future__ import annotations
@@ -174,3 +175,33 @@ def test_send_refuses_exactly_the_numbers_grbl_reads_000_5_or_more_off(text: str
     assert (found is not None) == (abs(Decimal(text[1:]) - kept) >= Decimal("0.0005"))
     if found is not None:
         assert Decimal(found.split(" as ")[1][1:]) == kept
+
+
+def test_an_arc_of_a_centre_beyond_eight_digits_is_written_as_chords(
+    tmp_path: Path, run: Any
+) -> None:
+    """A 200 m radius ARC (its J would read -200029.99 for -200029.997): chords within
+    0.002 mm of the circle, judged by ezdxf's own arc (its construction tool), and every
+    number GRBL reads as written."""
+    from camtool_postprocessors.grbl.link import misread
+
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4
+    centre, radius = (25.0, -200000.0123), 200030.0
+    doc.modelspace().add_arc(centre, radius, 89.99, 90.01)
+    doc.saveas(tmp_path / "flat.dxf")
+    out = tmp_path / "flat.gcode"
+    code, err = run("post", str(tmp_path / "flat.dxf"), "-t", "grbl", "-o", str(out))
+    assert code == 0, err
+    assert "1 arc(s) with a centre farther away than grbl's I and J write" in err
+    blocks = [b for b in out.read_text().splitlines() if not b.startswith("(")]
+    assert not any(re.match(r"G[23] ", b) for b in blocks)
+    assert all(misread(b) is None for b in blocks)
+    arc = ezdxf.math.ConstructionArc(centre, radius, 89.99, 90.01)
+    points = re.findall(r"G[01] X(\S+) Y(\S+)", "\n".join(blocks))  # its start, its chords
+    path = [(float(x), float(y)) for x, y in points]
+    assert len(path) >= 3
+    for x, y in path:
+        assert abs(np.hypot(x - centre[0], y - centre[1]) - radius) <= 0.002 + 0.0005
+    for end in (arc.start_point, arc.end_point):
+        assert min(np.hypot(x - end.x, y - end.y) for x, y in path) <= 0.0005
