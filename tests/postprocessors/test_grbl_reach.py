@@ -5,8 +5,8 @@ The judge is a transcription of GRBL 1.1's own C code, not camtool's: ``nuts_bol
 and scaled by 0.01 and 0.1 in float32, as on the AVR; in doubles rounded to float32, as in
 grbl-sim on a PC) and ``gcode.c``'s radius check of a centre-format arc (error 33), on the
 program's text as written. The grbl target writes at most 4 integer digits (9999.999 mm):
-beyond 16777.216 mm ``read_float`` no longer reads 1 µm, and arcs a few metres further fail
-the check; its I, J and K hold 5 (8 digits in all): an arc of a centre farther off is
+beyond 16777.216 mm ``read_float`` no longer reads 1 µm, and small arcs 40 m out fail the
+check; its I, J and K hold 5 (8 digits in all): an arc of a centre farther off is
 written as chords.
 """
 
