@@ -219,14 +219,20 @@ def _import(
     reader = _Reader(options.tolerance / scale, options.hatch_boundaries, keep, limit, graph)
     reader.styles = StyleResolver(doc)
     try:
-        if check is None:
-            with fitted_ahead(_splines_ahead(msp, reader)):
-                for entity in msp:
-                    reader.read(entity)
-        else:  # refused as soon as the drawing is too large: fitted as read
-            _read_checked(reader, msp, scale, check)
+        with _captured_log("ezdxf") as logged:  # in camtool's words, not a bare line
+            if check is None:
+                with fitted_ahead(_splines_ahead(msp, reader)):
+                    for entity in msp:
+                        reader.read(entity)
+            else:  # refused as soon as the drawing is too large: fitted as read
+                _read_checked(reader, msp, scale, check)
     except BadEntity as exc:
         raise InputError(f"{path}: {exc}") from None
+    if logged:
+        warnings.append(
+            f"{path}: ezdxf logged {len(logged)} message(s) while reading the entities "
+            f"(first: {logged[0]}); check the result in the preview"
+        )
     for (kind, reason), count in sorted(reader.skipped.items()):
         plural = "entity" if count == 1 else "entities"
         warnings.append(f"{path}: skipped {count} {kind} {plural} ({reason})")

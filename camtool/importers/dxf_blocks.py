@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
-from functools import partial
+from functools import cache, partial
 from typing import Any
 
 from camtool.importers.dxf_entities import (
@@ -265,7 +265,7 @@ def _transformed(entity: Any, matrix: Any) -> tuple[Any, tuple[Any, ...]]:
         if kind in ("ARC", "CIRCLE"):
             if entity.dxf.radius == 0:
                 raise Unsupported("zero length") from None
-            circle = entity.copy()
+            circle = geometry_copy(entity)
             circle.dxf.radius = abs(entity.dxf.radius)  # AutoCAD ignores the sign
             return Ellipse.from_arc(circle).transform(matrix), ()
         if kind in ("LWPOLYLINE", "POLYLINE"):
@@ -300,6 +300,31 @@ def _sheared(entity: Any, matrix: Any) -> bool:
     return size > 0.0 and abs(x.dot(y)) > 1e-9 * size
 
 
+@cache
+def _geometry_only() -> Any:
+    from ezdxf.entities.copy import CopySettings, CopyStrategy
+
+    return CopyStrategy(
+        CopySettings(
+            copy_extension_dict=False,
+            copy_xdata=False,
+            copy_appdata=False,
+            copy_proxy_graphic=False,
+            set_source_of_copy=False,
+        )
+    )
+
+
+def geometry_copy(entity: Any) -> Any:
+    """A copy of ``entity`` with its geometry only (ezdxf ``CopySettings``).
+
+    Its extension dictionary, XDATA and application data stay behind: camtool reads no
+    more than the geometry, and ezdxf cannot copy some objects other programs keep there
+    (TurboCAD's TCOPTIONALDATA), which it logged on stderr once per placement.
+    """
+    return entity.copy(copy_strategy=_geometry_only())
+
+
 def _controlled(entity: Any) -> Any:
     """A copy of ``entity`` whose fit-point-only splines are given by their control points.
 
@@ -312,7 +337,7 @@ def _controlled(entity: Any) -> Any:
     Raises:
         Unsupported: fit points no spline can be built through.
     """
-    copy = entity.copy()
+    copy = geometry_copy(entity)
     if entity.dxftype() == "SPLINE" and not entity.control_point_count():
         if not entity.fit_point_count():
             return copy

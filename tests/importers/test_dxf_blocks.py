@@ -9,6 +9,7 @@ few hundred passed when this was written).
 
 from __future__ import annotations
 
+import io
 import itertools
 import math
 import os
@@ -515,3 +516,53 @@ def test_a_clipped_block_reference_is_refused_not_cut_whole(tmp_path: Path, nest
     XClip(inner).disable_clipping()  # a clip switched off shows the whole block: it is read
     doc.saveas(path)
     assert len(read_dxf(path).contours) == 2
+
+
+def _block_with_foreign_data(path: Path) -> Path:
+    """A block's LINE (0, 0)-(10, 0) placed at (5, 5) turned 30°, the LINE carrying an
+    extension dictionary that owns an object of a class ezdxf does not know (TurboCAD
+    writes TCOPTIONALDATA there): ezdxf can read it but not copy it."""
+    doc = ezdxf.new("R2010", units=4)
+    line = doc.blocks.new("B").add_line((0, 0), (10, 0))
+    owner = line.new_extension_dict()
+    owner.dictionary.dxf.hard_owned = 1
+    owner.add_xrecord("TCOPT").reset([(1, "foreign")])
+    doc.modelspace().add_blockref("B", (5, 5), dxfattribs={"rotation": 30})
+    text = io.StringIO()
+    doc.write(text)
+    foreign = text.getvalue().replace("\n  0\nXRECORD\n", "\n  0\nTCOPTIONALDATA\n")
+    path.write_text(foreign.replace("AcDbXrecord", "AcDbTCOptionalData"))
+    return path
+
+
+def test_data_other_programs_attach_to_a_block_entity_is_left_behind(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """Placing a block copies its entities' geometry only: ezdxf, asked to copy the object
+    it cannot, logged a line on stderr per placement, outside camtool's messages."""
+    drawing = read_dxf(_block_with_foreign_data(tmp_path / "tc.dxf"))
+    assert not [w for w in drawing.warnings if "ezdxf" in w], drawing.warnings
+    assert not [r for r in caplog.records if r.name.startswith("ezdxf")]
+    (contour,) = drawing.contours
+    place = _placer((5.0, 5.0), 30.0)
+    assert contour.start == pytest.approx(place((0.0, 0.0)), abs=1e-9)
+    assert contour.end == pytest.approx(place((10.0, 0.0)), abs=1e-9)
+
+
+def test_what_ezdxf_logs_while_the_entities_are_read_is_a_warning(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    """Anything ezdxf logs while the entities are read and placed becomes one warning that
+    names the file, not a bare line of ezdxf's on stderr (here: a full copy of the entity)."""
+    import camtool.importers.dxf_blocks as blocks
+
+    monkeypatch.setattr(blocks, "geometry_copy", lambda entity: entity.copy())
+    path = _block_with_foreign_data(tmp_path / "tc.dxf")
+    drawing = read_dxf(path)
+    (noted,) = [w for w in drawing.warnings if "ezdxf" in w]
+    assert noted.startswith(
+        f"{path}: ezdxf logged 1 message(s) while reading the entities (first: copy process "
+        "ignored TCOPTIONALDATA(#"
+    )
+    assert noted.endswith("); check the result in the preview"), noted
+    assert not [r for r in caplog.records if r.name.startswith("ezdxf")]
