@@ -291,6 +291,8 @@ class _Writer(WriterState[str]):
         super().__init__(blocks, here=here)
         self.fast: dict[int, list[tuple[int, int]]] = {}
         self.program = program
+        self.substep = 0  # arcs written as G01: their centre on an end's step
+        self.substep_off = 0.0  # mm, the farthest such an arc lies from its G01
 
 
 class PicMmhPost(PostProcessor):
@@ -388,6 +390,13 @@ class PicMmhPost(PostProcessor):
         w.blocks.append("M30;")
         self._rate_warnings(machine, w)
         self._length_warning(w)
+        if w.substep:
+            w.warnings.append(
+                f"{w.substep} arc(s) whose centre falls on the step of their start or end "
+                f"({_step_um(machine)} µm steps), which the controller's arc interpolation "
+                "(UNAM-GMM A.6) cannot run, written as G01 lines to their ends (within "
+                f"{w.substep_off * 1000:.3g} µm of the arc)"
+            )
         if w.arcs:
             tol = _tolerance(program, machine)
             w.warnings.append(
@@ -441,11 +450,46 @@ class PicMmhPost(PostProcessor):
                     w.blocks.append(f"G01{self._xy(x, y, half, w)}{f};")
                 w.blocks.append(f"G01{xy}{f};")
                 w.chorded(len(points) - 1)
+            elif self._centre_on_an_end(here, half, machine):
+                off = 2 * distance(here, (half.cx, half.cy))  # the arc lies within 2r of it
+                if off > tolerance:
+                    raise DialectError(
+                        f"{w.where(half.contour)}: an arc of radius {off / 2 * 1000:.3g} µm "
+                        f"has its centre on the step of its start or end ({_step_um(machine)} "
+                        "µm steps): the controller's arc interpolation (UNAM-GMM A.6) cannot "
+                        f"run it, and its chord lies up to {off * 1000:.3g} µm off, beyond "
+                        f"--tolerance {tolerance:g} mm; draw the detail larger or give a "
+                        "larger --tolerance"
+                    )
+                w.blocks.append(f"G01{xy}{f};")
+                w.substep += 1
+                w.substep_off = max(w.substep_off, off)
             else:
                 g = "G02" if half.clockwise else "G03"
                 ij = self._word("I", half.cx, half, w) + self._word("J", half.cy, half, w)
                 w.blocks.append(f"{g}{xy}{ij}{f};")
             here = (half.x, half.y)
+
+    def _centre_on_an_end(self, start: tuple[float, float], arc: ArcMove, machine: Machine) -> bool:
+        """Whether ``arc``'s printed centre is its printed start's or end's step.
+
+        The numbers are those written (µm, two decimals), in the machine's steps as its
+        profile rounds them: the steps the controller's direct search (UNAM-GMM A.6)
+        starts from. A centre on the start's step is an arc of radius 0, which the
+        interpolation cannot run; one on the end's step ends nowhere on its circle.
+        """
+        from camtool.verify.quantize import Rounding, steps_from_mm
+
+        def steps(x: float, y: float) -> tuple[int, int]:
+            return (
+                steps_from_mm(self.coord.parse(self.coord.format(x)), 1 / spm[0], rounding),
+                steps_from_mm(self.coord.parse(self.coord.format(y)), 1 / spm[1], rounding),
+            )
+
+        spm = machine.steps_per_mm
+        rounding: Rounding = machine.motion.rounding  # type: ignore[assignment]  # checked on load
+        centre = steps(arc.cx, arc.cy)
+        return centre in (steps(*start), steps(arc.x, arc.y))
 
     def _fits(self, value_mm: float) -> bool:
         """True when ``value_mm`` fits the 5-integer-digit µm field."""
@@ -611,6 +655,11 @@ class PicMmhPost(PostProcessor):
             return Linear(x, y, feed, contour=contour)
         cx, cy = self.coord.parse(m["i"]), self.coord.parse(m["j"])
         return ArcMove(x, y, cx, cy, g == 2, feed, contour=contour)
+
+
+def _step_um(machine: Machine) -> str:
+    """The machine's X step, µm, for messages (``"0.14"``)."""
+    return f"{1000 / machine.steps_per_mm[0]:.3g}"
 
 
 def _tolerance(program: Program, machine: Machine) -> float:

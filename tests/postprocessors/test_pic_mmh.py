@@ -602,3 +602,36 @@ def test_a_coordinate_too_long_for_its_word_names_the_option_that_moves_the_draw
         DialectError, match=r"X = .* does not fit 5 integer digits .*--origin lower-"
     ):
         PicMmhPost().emit(program, target.machine)
+
+
+def test_an_arc_whose_centre_is_on_its_start_step_is_written_as_its_chord() -> None:
+    # 140 nm steps (UNAM-GMM S000-12): 1.0 mm is 7142.857 steps, 7143; the centre 0.05 µm
+    # right of the start, 1.00005 mm = 7143.214 steps, is the same step: a direct search
+    # (A.6) from a start on its centre has radius 0. The half circle ends at 1.0001 mm
+    # (7143.571 steps, 7144) and lies within 2r = 0.1 µm of the chord to it. An arc of
+    # 0.3 µm radius (centre 7145.0 steps) is two steps off its start and stays an arc.
+    target = load_target("pic-mmh")
+    program = Program(
+        (
+            Rapid(1.0, 1.0),
+            ArcMove(1.0001, 1.0, 1.00005, 1.0, False, 0.8),
+            ArcMove(1.0007, 1.0, 1.0004, 1.0, False, 0.8),
+        )
+    )
+    result = target.post.emit(program, target.machine)
+    lines = str(result.code).splitlines()
+    assert lines[2:5] == [
+        "G00X01000.00Y01000.00;",
+        "G01X01000.10Y01000.00F08;",
+        "G03X01000.70Y01000.00I01000.40J01000.00F08;",
+    ]
+    assert result.warnings == (
+        "1 arc(s) whose centre falls on the step of their start or end (0.14 µm steps), which "
+        "the controller's arc interpolation (UNAM-GMM A.6) cannot run, written as G01 lines "
+        "to their ends (within 0.1 µm of the arc)",
+    )
+    # read back and run by the modelled controller (a radius-0 arc is refused there)
+    assert math.isfinite(verify_code(str(result.code), target).max_error_um)
+
+    with pytest.raises(DialectError, match=r"block 4: an arc of radius 0\.05 µm has its centre"):
+        target.post.emit(Program(program.moves, tolerance_mm=0.00005), target.machine)
