@@ -320,7 +320,7 @@ def geometry_copy(entity: Any) -> Any:
 
     Its extension dictionary, XDATA and application data stay behind: camtool reads no
     more than the geometry, and ezdxf cannot copy some objects other programs keep there
-    (TurboCAD's TCOPTIONALDATA), which it logged on stderr once per placement.
+    (TurboCAD's TCOPTIONALDATA): copying them makes it log a line on stderr.
     """
     return entity.copy(copy_strategy=_geometry_only())
 

@@ -451,7 +451,9 @@ class PicMmhPost(PostProcessor):
                 w.blocks.append(f"G01{xy}{f};")
                 w.chorded(len(points) - 1)
             elif self._centre_on_an_end(here, half, machine):
-                off = 2 * distance(here, (half.cx, half.cy))  # the arc lies within 2r of it
+                # every point of the arc is within 2r of both ends, so of the chord
+                centre = (half.cx, half.cy)
+                off = 2 * max(distance(here, centre), distance((half.x, half.y), centre))
                 if off > tolerance:
                     raise DialectError(
                         f"{w.where(half.contour)}: an arc of radius {off / 2 * 1000:.3g} µm "
@@ -478,6 +480,11 @@ class PicMmhPost(PostProcessor):
         starts from. A centre on the start's step is an arc of radius 0, which the
         interpolation cannot run; one on the end's step ends nowhere on its circle.
         """
+        spm = machine.steps_per_mm
+        centre = (arc.cx, arc.cy)
+        near = min(distance(start, centre), distance((arc.x, arc.y), centre))
+        if near > 2 / min(spm[0], spm[1]):  # two steps apart: never the same step
+            return False
         from camtool.verify.quantize import Rounding, steps_from_mm
 
         def steps(x: float, y: float) -> tuple[int, int]:
@@ -486,10 +493,8 @@ class PicMmhPost(PostProcessor):
                 steps_from_mm(self.coord.parse(self.coord.format(y)), 1 / spm[1], rounding),
             )
 
-        spm = machine.steps_per_mm
         rounding: Rounding = machine.motion.rounding  # type: ignore[assignment]  # checked on load
-        centre = steps(arc.cx, arc.cy)
-        return centre in (steps(*start), steps(arc.x, arc.y))
+        return steps(*centre) in (steps(*start), steps(arc.x, arc.y))
 
     def _fits(self, value_mm: float) -> bool:
         """True when ``value_mm`` fits the 5-integer-digit µm field."""
