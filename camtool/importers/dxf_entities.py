@@ -194,6 +194,13 @@ def _bad_shape(entity: Any) -> str | None:
         and entity.dxftype() not in _WCS_PATHS
     ):
         return f"extrusion {tuple(float(v) for v in extrusion)} is not a direction"
+    if entity.dxftype() == "INSERT":  # MINSERT too: ezdxf reads both as Insert
+        for axis in ("xscale", "yscale"):
+            if entity.dxf.get(axis, 1.0) == 0.0:
+                # The DXF reference asks a non-zero scale: an X or Y scale 0 folds the block
+                # onto a line (ezdxf cannot transform it either). A Z scale 0 only flattens
+                # what is already flat, so it is read.
+                return f"{axis} 0: a block inserted at scale 0 has no size"
     return None
 
 

@@ -169,6 +169,21 @@ def _insert_nan_scale(msp: Any) -> None:
     msp.add_blockref("B", (0, 0), dxfattribs={"xscale": math.nan})
 
 
+def _insert_scale(axis: str) -> Callable[[Any], None]:
+    def build(msp: Any) -> None:
+        block = msp.doc.blocks.new("B")
+        block.add_lwpolyline([(0, 0), (10, 0), (10, 10)])
+        block.add_arc((5, 5), 3, 0, 90)
+        msp.add_blockref("B", (50, 50), dxfattribs={axis: 7})  # 7 becomes 0 below
+
+    build.__name__ = f"_insert_zero_{axis}"
+    return build
+
+
+_INSERT_ZERO_X = _insert_scale("xscale")
+_INSERT_ZERO_Y = _insert_scale("yscale")
+
+
 def _zero_extrusion(msp: Any) -> None:
     msp.add_arc((0, 0), 5, 0, 90, dxfattribs={"extrusion": (0, 0, -1)})  # -1 becomes 0 below
 
@@ -183,6 +198,8 @@ def _zero_extrusion(msp: Any) -> None:
         (_spline_huge, ("SPLINE #", "control point 2", "1e+20")),  # was: a CPU spin
         (_insert_nan_scale, ("INSERT #", "xscale nan")),  # was: skipped as zero length
         (_zero_extrusion, ("ARC #", "extrusion (0.0, 0.0, 0.0) is not a direction")),
+        (_INSERT_ZERO_X, ("INSERT #", "xscale 0", "no size")),  # was: internal error
+        (_INSERT_ZERO_Y, ("INSERT #", "yscale 0", "no size")),  # (ezdxf's ZeroDivisionError)
     ],
 )
 def test_bad_numbers_are_input_errors_naming_the_entity(
@@ -191,6 +208,10 @@ def test_bad_numbers_are_input_errors_naming_the_entity(
     path = write_dxf(tmp_path / "bad.dxf", _one(build))
     if build is _zero_extrusion:  # ezdxf will not write a null extrusion itself
         path.write_text(path.read_text().replace("\n230\n-1.0\n", "\n230\n0.0\n"))
+    if build in (_INSERT_ZERO_X, _INSERT_ZERO_Y):  # nor a scale of 0
+        text = path.read_text()
+        assert text.count("\n7.0\n") == 1
+        path.write_text(text.replace("\n7.0\n", "\n0.0\n"))
     with pytest.raises(InputError) as info:
         read_dxf(path)
     message = str(info.value)
@@ -198,6 +219,23 @@ def test_bad_numbers_are_input_errors_naming_the_entity(
     assert "on layer '0'" in message
     for name in names:
         assert name in message
+
+
+def test_an_insert_at_z_scale_0_is_read_as_its_flat_content(tmp_path: Path) -> None:
+    """A Z scale of 0 (out of the DXF range) flattens only Z: the block's flat content,
+    placed at (50, 50), is the same as at Z scale 1 (an open polyline and an arc of radius 3
+    about (55, 55), from the file's numbers)."""
+
+    def build(msp: Any) -> None:
+        _insert_scale("zscale")(msp)
+
+    path = write_dxf(tmp_path / "z.dxf", build)
+    text = path.read_text()
+    assert text.count("\n7.0\n") == 1
+    path.write_text(text.replace("\n7.0\n", "\n0.0\n"))
+    drawing = read_dxf(path)
+    ends = sorted((c.start, c.end) for c in drawing.contours)
+    assert ends == [((50.0, 50.0), (60.0, 60.0)), ((58.0, 55.0), (55.0, 58.0))]
 
 
 def test_a_spline_with_a_null_normal_is_read_as_autocad_2007_writes_it(tmp_path: Path) -> None:
