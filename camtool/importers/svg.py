@@ -51,6 +51,7 @@ from camtool.importers.svgstyle import (
     DEFAULT_LAYER,
     filter_of,
     filtered_warning,
+    flattened,
     on_layers,
     open_fills,
     open_fills_warning,
@@ -175,6 +176,8 @@ def _drawing(
             unseen.bare += 1
         elif unpainted(shape.fill) and unpainted(shape.stroke):
             unseen.invisible += 1
+        elif flattened(shape.transform):
+            unseen.flat += 1
         else:
             drawn.append((shape, _segments(shape)))
         progress(Step("reading", i, len(shapes), path.name))

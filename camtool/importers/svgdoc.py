@@ -745,6 +745,7 @@ class Unseen:
     thin: int = 0  # a stroke of width 0, and no fill (or a <line>)
     bare: int = 0  # a <line> without a stroke
     background: int = 0  # the page's white background
+    flat: int = 0  # a transform that is not invertible (scale(0), matrix(1 1 1 1 0 0))
 
 
 def unseen_warnings(path: object, unseen: Unseen) -> list[str]:
@@ -769,6 +770,12 @@ def unseen_warnings(path: object, unseen: Unseen) -> list[str]:
         said.append(
             f"{path}: skipped {bare} <line> {element_noun(bare)} without a stroke (a line has no "
             "inside to fill, so a viewer shows nothing); give it a stroke to cut it"
+        )
+    if unseen.flat:
+        said.append(
+            f"{path}: skipped {unseen.flat} {element_noun(unseen.flat)} whose transform is not "
+            "invertible (a scale of 0 on an axis, or a matrix that folds the plane onto a "
+            "line), which a viewer does not draw"
         )
     if background:
         said.append(

@@ -10,6 +10,7 @@ type names (:data:`SHAPER_LAYER`).
 
 from __future__ import annotations
 
+import math
 import re
 from pathlib import Path
 from typing import Any
@@ -194,6 +195,26 @@ def zero_width(value: object) -> bool:
     (a negative width is an error viewers draw differently; the shape is kept).
     """
     return value is not None and _ZERO_WIDTH.fullmatch(str(value)) is not None
+
+
+def flattened(matrix: Any) -> bool:
+    """Whether a shape's transform is not invertible: ``scale(0, 1)``, ``matrix(1 1 1 1 0 0)``.
+
+    ``matrix``: svgelements' ``Matrix`` of the shape, its groups' transforms included.
+
+    Such a shape is not displayed (CSS Transforms 1 §6, "The Transform Rendering Model":
+    an object whose transformation matrix is non-invertible does not get displayed), though
+    its points still exist, folded onto a line. Singular: ``|ad - bc|`` at most 10⁻¹⁴ of
+    the largest of ``a``, ``b``, ``c``, ``d`` squared (the rounding of a product of
+    transforms that is singular in exact arithmetic, such as ``rotate(10) matrix(1 2 2 4 0 0)
+    rotate(20)``, whose determinant comes out 4.4e-16).
+    """
+    a, b, c, d = (float(matrix.a), float(matrix.b), float(matrix.c), float(matrix.d))
+    size = max(abs(a), abs(b), abs(c), abs(d))
+    if not 0.0 < size < math.inf:  # NaN or infinite: refused where the points are checked
+        return size == 0.0
+    a, b, c, d = a / size, b / size, c / size, d / size  # no overflow for scale(1e200)
+    return not abs(a * d - b * c) > 1e-14
 
 
 def unpainted(color: Any) -> bool:

@@ -409,6 +409,31 @@ def test_shapes_at_opacity_0_are_invisible_and_not_cut(tmp_path: Path) -> None:
 # ------------------------------------------------------------------ transforms
 
 
+def test_shapes_under_a_transform_that_is_not_invertible_are_not_cut(tmp_path: Path) -> None:
+    """CSS Transforms 1 §6: an element whose matrix is non-invertible is not displayed.
+
+    ``scale(0, 1)`` folds the rectangle onto the line x = 0 and ``matrix(1 1 1 1 0 0)``
+    the circle onto y = x: their points exist, but no viewer draws them. ``rotate(10)
+    matrix(1 2 2 4 0 0) rotate(20)`` is singular but for rounding (its determinant comes out
+    4.4e-16, not 0); ``scale(1, 0.001)`` is invertible.
+    """
+    body = (
+        '<rect id="a" width="10" height="10" fill="none" stroke="red" transform="scale(0, 1)"/>'
+        '<g transform="matrix(1 1 1 1 0 0)"><circle id="b" cx="5" cy="5" r="2"/></g>'
+        '<g transform="rotate(10) matrix(1 2 2 4 0 0) rotate(20)"><rect id="c" width="4" '
+        'height="4"/></g>'
+        '<rect id="d" width="10" height="10" transform="scale(1, 0.001)"/>'
+        '<rect id="e" x="20" width="10" height="10"/>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.source for c in drawing.contours] == ["rect#d", "rect#e"]
+    assert drawing.warnings == (
+        f"{tmp_path / 't.svg'}: skipped 3 elements whose transform is not invertible (a scale "
+        "of 0 on an axis, or a matrix that folds the plane onto a line), which a viewer does "
+        "not draw",
+    )
+
+
 def test_nested_translate(tmp_path: Path) -> None:
     body = f'<g transform="translate(5, -10)"><g transform="translate(1 2)">{HALF}</g></g>'
     arc = arc_only(read_svg(svg(tmp_path, body)))
