@@ -306,7 +306,7 @@ class _Reader(StartRules):
             LengthOffsets(self.commands, self.moves) if reading.length_offsets else None
         )
         self.home = ""
-        self.cycles = CycleState()  # canned cycles' sticky words and retract mode
+        self.cycles = CycleState(note=lambda text: self.notes.add("G98", self.line, text))
         self.contour = 1
         self.cut_in_contour = False
 

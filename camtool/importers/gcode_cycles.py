@@ -15,6 +15,7 @@ cycles in the ZX or YZ plane, and a series that changes between G98 and G99.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal
 
@@ -35,7 +36,7 @@ class CycleState:
     and ``cycle_il`` (the height the series began at).
     """
 
-    retract: Literal["initial", "r-plane"] = "initial"
+    retract: Literal["initial", "r-plane"] | None = None  # None: no G98/G99 read yet
     r_z: float | None = None
     bottom_z: float | None = None
     peck_mm: float | None = None
@@ -43,6 +44,7 @@ class CycleState:
     last: str | None = None  # the cycle of the block before (LinuxCNC's motion mode)
     initial_z: float | None = None  # the height the series began at (``cycle_il``)
     series_retract: str | None = None
+    note: Callable[[str], None] = lambda text: None  # a warning for the line being read
 
     def end_series(self) -> None:
         """A block that is no cycle: the next cycle starts a series (and needs R and Z)."""
@@ -100,14 +102,21 @@ class CycleState:
             raise InputError(
                 f"{where}: {code} bottom Z{bottom_z / scale:g} is not below R{r_z / scale:g}"
             )
+        retract = self.retract or "initial"
+        if self.retract is None:
+            self.note(
+                f"{code} with neither G98 nor G99 given: it returns to the height its series "
+                "began at (G98, as Fanuc and Haas controls start); LinuxCNC starts in G99 and "
+                "would return to the R plane, lower; write G98 or G99 to say which"
+            )
         if self.initial_z is None:
-            self.initial_z, self.series_retract = hz, self.retract
-        elif self.series_retract != self.retract:
+            self.initial_z, self.series_retract = hz, retract
+        elif self.series_retract != retract:
             raise InputError(
                 f"{where}: the cycle series changes between G98 and G99; end it with G80 "
                 "and start the next series with its own R and Z"
             )
-        start_z = self.initial_z if self.retract == "initial" else hz
+        start_z = self.initial_z if retract == "initial" else hz
         cycle = DrillCycle(
             CYCLES[code],
             x,
@@ -117,7 +126,7 @@ class CycleState:
             feed_mm_min,
             peck_mm=peck,
             dwell_s=dwell or 0.0,
-            retract=self.retract,
+            retract=retract,
         )
         items = expand(cycle, (hx, hy, start_z))
         self.r_z, self.bottom_z, self.last = r_z, bottom_z, code

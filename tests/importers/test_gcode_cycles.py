@@ -131,3 +131,39 @@ def test_a_cycles_x_y_is_never_read_as_a_straight_cut() -> None:
     program = parse_gcode(text + "G80\nM2\n", source="c.ngc")
     assert sum(isinstance(c, DrillCycle) for _, c in program.commands) == 399
     assert min(m.z for m in program.moves if m.z is not None) == -1.0
+
+
+_UNSTATED = "G21 G90\nG0 X0 Y0 Z5\nF100\nG81 X1 Y1 Z-1 R1\nX3\nG80\nM2\n"
+"""Two holes from Z5 with neither G98 nor G99 in the program."""
+
+
+def test_a_cycle_without_g98_or_g99_returns_to_its_start_height_and_says_so() -> None:
+    """G98 (the series' start height, Z5 here, above R1) is the higher return, the one Fanuc
+    and Haas controls start in; the warning says so and names the first line."""
+    from camtool.importers.gcode import parse_gcode
+
+    program = parse_gcode(_UNSTATED, source="c.ngc")
+    after_bottom = [program.moves[i + 1].z for i, m in enumerate(program.moves[:-1]) if m.z == -1.0]
+    assert after_bottom == [5.0, 5.0]
+    (warning,) = [w for w in program.warnings if "G98" in w]
+    assert warning.startswith("c.ngc:4: G81 with neither G98 nor G99 given")
+    assert warning.endswith("(2 times)")
+    stated = parse_gcode(_UNSTATED.replace("G81", "G99 G81"), source="c.ngc")
+    assert not [w for w in stated.warnings if "G98" in w]
+    assert [stated.moves[i + 1].z for i, m in enumerate(stated.moves[:-1]) if m.z == -1.0] == [
+        1.0,
+        1.0,
+    ]
+
+
+@needs_rs274
+def test_linuxcnc_starts_in_g99_as_the_warning_says(tmp_path: Path) -> None:
+    """The warning's claim, judged by LinuxCNC's own interpreter: without G98/G99 its
+    holes return to the R plane (Z1), not to Z5."""
+    path = tmp_path / "unstated.ngc"
+    path.write_text(_UNSTATED)
+    done = rs274(path)
+    assert done.returncode == 0, done.stderr
+    moves = _moving(canon_moves(done.stdout))
+    after_bottom = [moves[i + 1][1][2] for i, (_, p) in enumerate(moves[:-1]) if p[2] == -1.0]
+    assert after_bottom == [1.0, 1.0]
