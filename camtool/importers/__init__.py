@@ -24,8 +24,13 @@ from camtool.model.shapes import BBox, Drawing, fit_factor
 POINT_SUFFIXES = (".csv", ".txt", ".xy", ".m")
 """File endings of unitless point lists, the only inputs ``--units`` applies to."""
 
-DRAWING_SUFFIXES = (".dxf", ".svg", *POINT_SUFFIXES)
-"""File name endings the importers read, lowercase."""
+DRAWING_SUFFIXES = (".dxf", ".svg", ".svgz", *POINT_SUFFIXES)
+"""File name endings the importers read, lowercase (``.svgz``: an SVG compressed by gzip,
+as Inkscape saves "Compressed Inkscape SVG")."""
+
+MAX_SVGZ_BYTES = 256 << 20
+"""Most bytes a ``.svgz`` may expand to (256 MiB, twice the largest SVG camtool was tried
+on): a gzip bomb (a few MB expanding to gigabytes) is refused before memory runs out."""
 
 
 def read_drawing(
@@ -102,6 +107,8 @@ def _read(
     :func:`read_drawing`.
     """
     suffix = path.suffix.lower()
+    if suffix == ".svgz":
+        return _read_svgz(path, options, progress, check)
     if suffix == ".svg":
         from camtool.importers.svg import svg_drawing
 
@@ -125,6 +132,63 @@ def _read(
     if check is not None:
         check(drawing.bbox())
     return drawing, used
+
+
+def _read_svgz(
+    path: Path,
+    options: ImportOptions,
+    progress: Progress,
+    check: Callable[[BBox], None] | None,
+) -> tuple[Drawing, float]:
+    """The SVG that ``path`` holds compressed, read as a ``.svg``; messages name ``path``."""
+    import dataclasses
+
+    from camtool.importers.svg import svg_drawing
+
+    data = gunzipped(path)
+    with bytes_as_file(data, ".svg", str(path)) as plain:
+        del data
+
+        def named(step: Step) -> None:  # "reading penguins.svgz", not the temporary file
+            progress(dataclasses.replace(step, name=path.name) if step.name == plain.name else step)
+
+        drawing, used = svg_drawing(plain, options, progress=named, check=check)
+    warnings = tuple(w.replace(str(plain), str(path)) for w in drawing.warnings)
+    return dataclasses.replace(drawing, source=str(path), warnings=warnings), used
+
+
+def gunzipped(path: Path) -> bytes:
+    """The bytes of the gzip file at ``path`` decompressed (a file not in gzip: as it is).
+
+    Raises:
+        InputError: the file is missing or unreadable, damaged, or expands past
+            :data:`MAX_SVGZ_BYTES`.
+    """
+    import gzip
+    import zlib
+
+    try:
+        with path.open("rb") as file:
+            if file.read(2) != b"\x1f\x8b":  # no gzip header: an uncompressed SVG so named
+                file.seek(0)
+                return file.read()
+        with gzip.open(path, "rb") as packed:
+            data = packed.read(MAX_SVGZ_BYTES + 1)
+    except FileNotFoundError:
+        raise InputError(f"{path}: no such file") from None
+    except (gzip.BadGzipFile, EOFError, zlib.error) as exc:
+        raise InputError(
+            f"{path}: damaged gzip data ({exc}); save the drawing again as .svg"
+        ) from None
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read it ({exc.strerror or exc})") from None
+    if len(data) > MAX_SVGZ_BYTES:
+        raise InputError(
+            f"{path}: expands to more than {MAX_SVGZ_BYTES >> 20} MiB once decompressed (a "
+            "gzip bomb, or an SVG larger than camtool reads compressed); if it is a real "
+            "drawing, decompress it (gunzip -S .svgz) and post the .svg"
+        )
+    return data
 
 
 def _unknown(path: Path, suffix: str) -> NoReturn:

@@ -75,17 +75,20 @@ def stdin_kind(data: bytes) -> str:
     """The kind of the file piped on standard input, as the ending such a file has.
 
     ``.dxf`` (ASCII: group code 0 then ``SECTION``, or a 999 comment first; binary: its
-    sentinel), ``.svg`` (XML: the first character ``<``), ``.nc`` (a G-code program: its
-    first line that is not a comment, ``(…)``, ``;…`` or ``%``, starts with a word or a
-    parameter; or comments only), ``.m`` (a Matlab assignment, ``xy = [...]``), ``.csv``
-    (a point list: a number first, a ``#`` comment, Excel's ``sep=;``, or a header of words
-    then a row of numbers). Only the first 64 KiB are looked at.
+    sentinel), ``.svg`` (XML: the first character ``<``), ``.svgz`` (gzip's magic number),
+    ``.nc`` (a G-code program: its first line that is not a comment, ``(…)``, ``;…`` or
+    ``%``, starts with a word or a parameter; or comments only), ``.m`` (a Matlab
+    assignment, ``xy = [...]``), ``.csv`` (a point list: a number first, a ``#`` comment,
+    Excel's ``sep=;``, or a header of words then a row of numbers). Only the first 64 KiB
+    are looked at.
 
     Raises:
         InputError: empty, or none of these (the message quotes the first line).
     """
     if data.startswith(b"AutoCAD Binary DXF"):
         return ".dxf"
+    if data.startswith(b"\x1f\x8b"):  # gzip: a compressed SVG (.svgz)
+        return ".svgz"
     text = decoded(data[:_SNIFF_BYTES], "replace").lstrip("\ufeff \t\r\n")
     if not text:
         raise InputError(
