@@ -317,17 +317,26 @@ def _bezier_spans(spline: Any) -> bool:
 def _read_checked(
     reader: _Reader, entities: Iterable[Any], scale: float, check: Callable[[BBox], None]
 ) -> None:
-    """Read ``entities``, calling ``check`` with the extent read so far (mm) as it grows."""
+    """Read ``entities``, calling ``check`` with the extent read so far (mm) as it grows.
+
+    A block reference's content counts as each entity of it is placed (MINSERT cells too).
+    """
     box: BBox | None = None
     done = 0
-    for entity in entities:
-        reader.read(entity)
+
+    def checkpoint() -> None:
+        nonlocal box, done
         new = len(reader.contours) - done
         if new and (new >= _CHECK_EVERY or not _one_line(reader.contours[-1])):
             boxes = [c.bbox() for c in reader.contours[done:]]
             box = bbox_union(boxes if box is None else [box, *boxes])
             done = len(reader.contours)
             check((box[0] * scale, box[1] * scale, box[2] * scale, box[3] * scale))
+
+    reader.checkpoint = checkpoint
+    for entity in entities:
+        reader.read(entity)
+        checkpoint()
 
 
 def _one_line(contour: Contour) -> bool:
@@ -374,6 +383,7 @@ class _Reader:
         self.swapped: list[tuple[str, float]] = []  # ELLIPSEs with a ratio above 1
         self.redegreed: list[tuple[str, int, int]] = []  # SPLINEs read at another degree
         self.wide: list[tuple[str, float]] = []  # polylines drawn with a width (label, widest)
+        self.checkpoint: Callable[[], None] = lambda: None  # called as a block places content
 
     def read(self, entity: Any) -> None:
         from camtool.importers.dxf_blocks import HIDDEN, INVISIBLE, Skip, expand_insert
@@ -410,6 +420,7 @@ class _Reader:
             else:
                 self.block_counts[(placed.entity.dxftype(), placed.layer)] += 1
                 self._item(placed, block)
+                self.checkpoint()  # a MINSERT of 10⁶ cells too large is refused at once
 
     def _line(self, entity: Any, layer: str) -> None:
         """A model-space LINE, read as ``_item`` would read it, without its machinery.

@@ -187,6 +187,35 @@ def test_a_dxf_is_refused_as_its_contours_are_read_before_the_other_curves_are_f
     assert len(fitted) == 30 and job.result.blocks
 
 
+def test_a_minsert_is_refused_as_its_cells_are_placed_not_after_all_of_them(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """One MINSERT of 300 × 300 cells 11 mm apart (3 299 mm wide; a hostile file of 10⁶
+    cells took minutes and gigabytes to be refused): the check runs as the cells are placed,
+    so the refusal comes once the cells read so far span the 200 mm travel (19 columns of
+    the first row), not after the 90 000 cells."""
+    import camtool.importers.dxf as dxf_importer
+
+    def build(msp: Any) -> None:
+        block = msp.doc.blocks.new("SQUARE")
+        block.add_lwpolyline([(0, 0), (10, 0), (10, 10), (0, 10)], close=True)
+        msp.add_blockref("SQUARE", (0, 0)).grid(size=(300, 300), spacing=(11, 11))
+
+    path = write_dxf(tmp_path / "grid.dxf", build)
+    read: list[int] = []
+    item = dxf_importer._Reader._item
+
+    def counting(self: Any, *args: Any, **kwargs: Any) -> Any:
+        read.append(1)
+        return item(self, *args, **kwargs)
+
+    monkeypatch.setattr(dxf_importer._Reader, "_item", counting)
+    monkeypatch.setattr(plan_module, "plan_unplaced", _never)
+    with pytest.raises(DialectError, match=r"at least 20\d × 10 mm, .*refused before planning"):
+        post_path(path, load_target("grbl"), PlanOptions())
+    assert len(read) == 19  # columns 0..18: the 19th cell ends at 208 mm
+
+
 def test_standard_input_is_checked_too(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
