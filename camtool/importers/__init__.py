@@ -17,7 +17,7 @@ from typing import NoReturn
 
 from camtool.importers.options import ImportOptions
 from camtool.model.construction import fit_extent
-from camtool.model.errors import InputError
+from camtool.model.errors import CamtoolError, InputError
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import BBox, Drawing, fit_factor
 
@@ -153,8 +153,22 @@ def _read_svgz(
             progress(dataclasses.replace(step, name=path.name) if step.name == plain.name else step)
 
         drawing, used = svg_drawing(plain, options, progress=named, check=check)
-    warnings = tuple(w.replace(str(plain), str(path)) for w in drawing.warnings)
-    return dataclasses.replace(drawing, source=str(path), warnings=warnings), used
+    return renamed(drawing, plain, str(path)), used
+
+
+def renamed(drawing: Drawing, path: Path, name: str) -> Drawing:
+    """``drawing``, read from the temporary file ``path``, named ``name`` instead.
+
+    Its source, warnings and size note (``<stdin>``, or the ``.svgz`` it was decompressed from).
+    """
+    import dataclasses
+
+    return dataclasses.replace(
+        drawing,
+        source=name,
+        warnings=tuple(w.replace(str(path), name) for w in drawing.warnings),
+        size_note=drawing.size_note.replace(str(path), name),
+    )
 
 
 def gunzipped(path: Path) -> bytes:
@@ -205,9 +219,10 @@ def _unknown(path: Path, suffix: str) -> NoReturn:
 def bytes_as_file(data: bytes, suffix: str, name: str) -> Iterator[Path]:
     """``data`` as a temporary file ending in ``suffix``, removed on leaving.
 
-    The importers read files (each detects the encoding as it does for a file on disk); an
-    :class:`InputError` raised inside names ``name`` (``<stdin>``) instead of the temporary
-    file. What else the caller shows should replace ``str(path)`` with ``name`` likewise.
+    The importers read files (each detects the encoding as it does for a file on disk); a
+    :class:`~camtool.model.errors.CamtoolError` raised inside names ``name`` (``<stdin>``)
+    instead of the temporary file (its type kept). What else the caller shows should replace
+    ``str(path)`` with ``name`` likewise (:func:`renamed`).
     """
     import tempfile
 
@@ -216,8 +231,8 @@ def bytes_as_file(data: bytes, suffix: str, name: str) -> Iterator[Path]:
         path.write_bytes(data)
         try:
             yield path
-        except InputError as exc:
-            raise InputError(str(exc).replace(str(path), name)) from exc
+        except CamtoolError as exc:  # an InputError, or a TooLargeError from ``check``
+            raise type(exc)(str(exc).replace(str(path), name)) from exc
 
 
 def read_drawing_bytes(
@@ -236,9 +251,6 @@ def read_drawing_bytes(
     Raises:
         InputError: as :func:`read_drawing`.
     """
-    import dataclasses
-
     with bytes_as_file(data, suffix, name) as path:
         drawing = read_drawing(path, options, check=check)
-    warnings = tuple(w.replace(str(path), name) for w in drawing.warnings)
-    return dataclasses.replace(drawing, source=name, warnings=warnings)
+    return renamed(drawing, path, name)

@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 
 import camtool.importers as importers
-from camtool.importers import read_drawing
+from camtool.importers import read_drawing, read_drawing_bytes
 from camtool.jobs.inputs import stdin_kind
 from camtool.model.errors import InputError
 from tests.importers.svgutil import svg
@@ -89,3 +89,40 @@ def test_an_svgz_piped_on_stdin_posts_as_the_file_does(tmp_path: Path) -> None:
     assert b"<stdin>" in piped.splitlines()[0]
     assert piped.splitlines()[1:] == named.splitlines()[1:]
     assert b"G2" in named or b"G3" in named  # the circle, as arcs
+
+
+OFF_PAGE = (
+    '<rect x="10" y="10" width="20" height="20" fill="none" stroke="black"/>'
+    '<rect x="400" y="10" width="20" height="20" fill="none" stroke="black"/>'
+)
+"""One square on the 100 × 100 mm page, one wholly off it (so the drawing is 410 mm wide)."""
+
+
+def test_the_note_on_shapes_off_the_page_names_the_input_not_a_temporary_file(
+    tmp_path: Path,
+) -> None:
+    plain = svg(tmp_path, OFF_PAGE)
+    note = read_drawing(plain).size_note
+    assert note.startswith(f"but {plain}: 1 contour lies wholly outside the 100 × 100 mm page")
+    packed = _compressed(plain)
+    assert read_drawing(packed).size_note == note.replace(str(plain), str(packed))
+    piped = read_drawing_bytes(plain.read_bytes(), suffix=".svg")
+    assert piped.size_note == note.replace(str(plain), "<stdin>")
+
+
+def test_a_refusal_for_size_while_reading_stdin_names_stdin(tmp_path: Path) -> None:
+    """The early travel check raises inside the reading of the temporary file: the refusal
+    keeps its exit code (1) and names ``<stdin>``."""
+    data = svg(tmp_path, OFF_PAGE).read_bytes()
+    for piped in (data, gzip.compress(data)):
+        done = subprocess.run(
+            [sys.executable, "-m", "camtool", "post", "-", "-t", "grbl", "-o", "-"],
+            input=piped,
+            capture_output=True,
+            check=False,
+        )
+        message = done.stderr.decode()
+        assert done.returncode == 1, message
+        assert "larger than the 200 × 200 mm travel" in message
+        assert "but <stdin>: 1 shape lies wholly outside" in message
+        assert "camtool-" not in message and "stdin.svg" not in message
