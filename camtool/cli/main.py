@@ -131,7 +131,7 @@ def post(
     no_budget: bool,
     **options: Any,
 ) -> None:
-    """Import DRAWING (.dxf, .svg, a point list), plan it, write it for a target.
+    """Import DRAWING (.dxf, .svg, .svgz, a point list), plan it, write it for a target.
 
     DRAWING may also be an existing G-code program (.ngc, .nc, .gcode, .tap ...):
     it is already a toolpath, so it is re-posted as it is, only --feed applies.
