@@ -9,6 +9,7 @@ never loads ezdxf or svgelements. The options and limits every importer takes ar
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -29,8 +30,8 @@ DRAWING_SUFFIXES = (".dxf", ".svg", ".svgz", *POINT_SUFFIXES)
 as Inkscape saves "Compressed Inkscape SVG")."""
 
 MAX_SVGZ_BYTES = 256 << 20
-"""Most bytes a ``.svgz`` may expand to (256 MiB, twice the largest SVG camtool was tried
-on): a gzip bomb (a few MB expanding to gigabytes) is refused before memory runs out."""
+"""Most bytes a ``.svgz`` may expand to (256 MiB, 50 times the 5 MB page of the SVG
+benchmark): a gzip bomb (a few MB expanding to gigabytes) is refused before memory runs out."""
 
 
 def read_drawing(
@@ -141,13 +142,9 @@ def _read_svgz(
     check: Callable[[BBox], None] | None,
 ) -> tuple[Drawing, float]:
     """The SVG that ``path`` holds compressed, read as a ``.svg``; messages name ``path``."""
-    import dataclasses
-
     from camtool.importers.svg import svg_drawing
 
-    data = gunzipped(path)
-    with bytes_as_file(data, ".svg", str(path)) as plain:
-        del data
+    with bytes_as_file(gunzipped(path), ".svg", str(path)) as plain:  # held while written only
 
         def named(step: Step) -> None:  # "reading penguins.svgz", not the temporary file
             progress(dataclasses.replace(step, name=path.name) if step.name == plain.name else step)
@@ -161,8 +158,6 @@ def renamed(drawing: Drawing, path: Path, name: str) -> Drawing:
 
     Its source, warnings and size note (``<stdin>``, or the ``.svgz`` it was decompressed from).
     """
-    import dataclasses
-
     return dataclasses.replace(
         drawing,
         source=name,
@@ -229,6 +224,7 @@ def bytes_as_file(data: bytes, suffix: str, name: str) -> Iterator[Path]:
     with tempfile.TemporaryDirectory(prefix="camtool-") as tmp:
         path = Path(tmp) / f"stdin{suffix}"
         path.write_bytes(data)
+        del data  # the importer reads the file: a large input is not held twice
         try:
             yield path
         except CamtoolError as exc:  # an InputError, or a TooLargeError from ``check``

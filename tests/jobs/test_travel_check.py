@@ -190,10 +190,10 @@ def test_a_dxf_is_refused_as_its_contours_are_read_before_the_other_curves_are_f
 def test_a_minsert_is_refused_as_its_cells_are_placed_not_after_all_of_them(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """One MINSERT of 300 × 300 cells 11 mm apart (3 299 mm wide; a hostile file of 10⁶
-    cells took minutes and gigabytes to be refused): the check runs as the cells are placed,
-    so the refusal comes once the cells read so far span the 200 mm travel (19 columns of
-    the first row), not after the 90 000 cells."""
+    """One MINSERT of 300 × 300 cells 11 mm apart (3 299 mm wide): the check runs as the
+    cells are placed, so the refusal comes once the cells read so far span more than the
+    200 mm travel (19 cells of the first row: the 19th ends at 18 × 11 + 10 = 208 mm), not
+    after the 90 000 cells (a hostile file holds 10⁶)."""
     import camtool.importers.dxf as dxf_importer
 
     def build(msp: Any) -> None:
