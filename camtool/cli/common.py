@@ -300,7 +300,8 @@ def import_options(command: Callable[..., None]) -> Callable[..., None]:
         default=None,
         metavar="N",
         help="Refuse a drawing that expands to more than N entities (DXF blocks and "
-        "MINSERT grids, SVG <use> clones, counted before expanding) [default: 5000000].",
+        "MINSERT grids, SVG <use> clones, counted before expanding) [default: 5000000, "
+        "of which blocks and clones may add 250000 to the entities the file holds].",
     )(command)
     command = click.option(
         "--hatch-boundaries",

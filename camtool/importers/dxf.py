@@ -32,7 +32,7 @@ from camtool.importers.dxf_layers import LayerFilter, hidden_warnings, layer_fil
 from camtool.importers.dxf_prefit import MIN_SPLINES, fit_ahead, fitted_ahead
 from camtool.importers.dxf_style import CONTINUOUS, Style, StyleResolver
 from camtool.importers.dxf_subclass import missing_subclass, with_subclass_markers
-from camtool.importers.options import MAX_COORDINATE_MM, ImportOptions, too_many_entities
+from camtool.importers.options import MAX_COORDINATE_MM, ImportOptions
 from camtool.model.errors import InputError, UsageError
 from camtool.model.shapes import BBox, Contour, Drawing, Line, Mark, Point, bbox_union
 from camtool.model.units import INCH, LENGTH_UNITS
@@ -214,7 +214,9 @@ def _import(
     if len(msp) == 0:
         _refuse_empty(path, doc, damage)
     keep = layer_filter(path, doc, options.layers, options.shown)
-    graph = _check_size(path, msp, options.max_entities)
+    from camtool.importers.dxf_blocks import checked_block_graph
+
+    graph = checked_block_graph(str(path), msp, options.max_entities)
     limit = MAX_COORDINATE_MM / max(scale, 1.0)
     reader = _Reader(options.tolerance / scale, options.hatch_boundaries, keep, limit, graph)
     reader.styles = StyleResolver(doc)
@@ -341,23 +343,6 @@ def _read_checked(
 
 def _one_line(contour: Contour) -> bool:
     return len(contour.segments) == 1 and type(contour.segments[0]) is Line
-
-
-def _check_size(path: Path, msp: Any, max_entities: int) -> Any:
-    """The block graph of model space; refuse a drawing that expands past the limit.
-
-    Raises:
-        InputError: more than ``max_entities`` entities once blocks are expanded.
-    """
-    from camtool.importers.dxf_blocks import block_graph, expanded_count
-
-    if len(msp) > max_entities:
-        raise too_many_entities(str(path), max_entities)
-    inserts = [e for e in msp if e.dxftype() == "INSERT"]
-    graph = block_graph(inserts, max_entities)
-    if expanded_count(inserts, len(msp) - len(inserts), graph, max_entities) > max_entities:
-        raise too_many_entities(str(path), max_entities)
-    return graph
 
 
 class _Reader:

@@ -21,6 +21,7 @@ from camtool.importers.dxf_entities import (
     location,
     spline_tool,
 )
+from camtool.importers.options import check_expansion, entity_limit, too_many_entities
 from camtool.model.shapes import Point
 
 MAX_NESTING = 32
@@ -398,10 +399,36 @@ class BlockGraph:
         sizes: per reached block, how many entities one placement of it expands to
             (nested INSERTs, their ATTRIBs and MINSERT cells included), saturated at
             ``limit + 1``.
+        held: how many entities the reached blocks hold in the file (each block once;
+            INSERTs and their ATTRIBs included, ATTDEFs left out).
     """
 
     cyclic: frozenset[str]
     sizes: dict[str, int]
+    held: int = 0
+
+
+def checked_block_graph(name: str, msp: Any, max_entities: int | None) -> BlockGraph:
+    """The block graph of model space ``msp``; refuse a drawing that expands past the limits.
+
+    Args:
+        name: the file, as messages name it.
+        msp: the model space (ezdxf).
+        max_entities: ``--max-entities`` (``None``: the defaults).
+
+    Raises:
+        InputError: too many entities once blocks are expanded
+            (:func:`~camtool.importers.options.check_expansion`).
+    """
+    limit = entity_limit(max_entities)
+    if len(msp) > limit:
+        raise too_many_entities(name, limit)
+    inserts = [e for e in msp if e.dxftype() == "INSERT"]
+    graph = block_graph(inserts, limit)
+    count = expanded_count(inserts, len(msp) - len(inserts), graph, limit)
+    held = len(msp) + sum(len(i.attribs) for i in inserts) + graph.held
+    check_expansion(name, count, held, max_entities, "block references")
+    return graph
 
 
 def block_graph(inserts: Iterable[Any], limit: int) -> BlockGraph:
@@ -438,7 +465,8 @@ def block_graph(inserts: Iterable[Any], limit: int) -> BlockGraph:
         for insert in children[name]:
             total = min(cap, total + insert_size(insert, sizes, cyclic, cap))
         sizes[name] = total
-    return BlockGraph(frozenset(cyclic), sizes)
+    held = sum(contents.values()) + sum(1 + len(i.attribs) for c in children.values() for i in c)
+    return BlockGraph(frozenset(cyclic), sizes, held)
 
 
 def insert_size(insert: Any, sizes: dict[str, int], cyclic: Iterable[str], cap: int) -> int:

@@ -19,8 +19,17 @@ from camtool.model.shapes import BBox, fit_factor
 from camtool.model.units import LARGEST_VALUE
 
 MAX_ENTITIES = 5_000_000
-"""Default :attr:`ImportOptions.max_entities`: 10 × the largest real job camtool was
-measured on (10⁵–10⁶ LINEs); block "laughs" expand to 10³⁰ and are refused before expanding."""
+"""Most entities a drawing may expand to without ``--max-entities``: 10 × the largest real
+job camtool was measured on (10⁵–10⁶ LINEs); block "laughs" expand to 10³⁰ and are refused
+before expanding."""
+
+MAX_EXPANSION = 250_000
+"""Most entities a drawing's block references (DXF INSERT, MINSERT) and ``<use>`` clones
+(SVG) may add to those its file holds, without ``--max-entities``. Each entity read costs
+memory (several kB in ezdxf or svgelements, docs/performance.md), and references cost
+nothing in the file: a 40 kB SVG of 5 000 ``<use>`` of a row of 1 000 clones, under
+:data:`MAX_ENTITIES`, would ask for tens of GB. Entities the file holds itself are not
+limited by it (their memory grows with the file's size)."""
 
 MAX_COORDINATE_MM = LARGEST_VALUE
 """Largest coordinate magnitude, mm (1000 km), an importer accepts; beyond it (and for
@@ -55,6 +64,41 @@ def check_curve_size(extent: float, tolerance: float) -> None:
         )
 
 
+def check_expansion(
+    name: str, expanded: int, held: int, max_entities: int | None, references: str
+) -> None:
+    """Refuse a drawing that expands to too many entities.
+
+    Args:
+        name: the file, as messages name it.
+        expanded: the entities the drawing expands to (at least ``held``; the counts may
+            stop above the limit, :func:`entity_limit` + 1).
+        held: the entities its file holds (model space and the blocks it places, their
+            attributes included; every SVG element).
+        max_entities: ``--max-entities``; ``None``: :data:`MAX_ENTITIES` in all, of which
+            references may add at most :data:`MAX_EXPANSION`.
+        references: what places the entities again, for the message (``"<use> clones"``).
+
+    Raises:
+        InputError: over either limit; the message names ``--max-entities``.
+    """
+    limit = entity_limit(max_entities)
+    if expanded > limit:
+        raise too_many_entities(name, limit)
+    if max_entities is None and expanded - held > MAX_EXPANSION:
+        raise InputError(
+            f"{name}: its {references} expand the {held:,} entities the file holds to "
+            f"{expanded:,}, more than the {MAX_EXPANSION:,} they may add without "
+            "--max-entities (each costs memory to read: together, gigabytes); if the "
+            f"drawing really holds that many, allow them with --max-entities {expanded}"
+        )
+
+
+def entity_limit(max_entities: int | None) -> int:
+    """The most entities a drawing may expand to: ``max_entities`` or :data:`MAX_ENTITIES`."""
+    return MAX_ENTITIES if max_entities is None else max_entities
+
+
 def too_many_entities(name: str, limit: int) -> InputError:
     """The error for a drawing that expands to more than ``limit`` entities."""
     return InputError(
@@ -80,6 +124,8 @@ class ImportOptions:
         max_entities: most entities a drawing may expand to (DXF block references and
             MINSERT grids, SVG ``<use>`` clones, counted before anything is expanded);
             a drawing over it is refused with an :class:`InputError` naming this limit.
+            ``None``: :data:`MAX_ENTITIES`, of which references may add at most
+            :data:`MAX_EXPANSION` to the entities the file holds (:func:`check_expansion`).
         scale: the uniform scale planning will apply to the drawing (``--scale``; 1:
             none). ``tolerance`` holds once scaled: curves are fitted within
             ``tolerance / scale`` at the drawing's size (:meth:`curve_tolerance`).
@@ -99,7 +145,7 @@ class ImportOptions:
     tolerance: float = 0.001
     units: str | None = None
     hatch_boundaries: bool = False
-    max_entities: int = MAX_ENTITIES
+    max_entities: int | None = None
     scale: float = 1.0
     fit: tuple[float, float] | None = None
     shown: tuple[str, ...] = ()
@@ -125,8 +171,9 @@ class ImportOptions:
         return replace(self, tolerance=tolerance, scale=1.0, fit=None)
 
     def __post_init__(self) -> None:
-        if isinstance(self.max_entities, bool) or not (
-            isinstance(self.max_entities, int) and self.max_entities >= 1
+        if self.max_entities is not None and (
+            isinstance(self.max_entities, bool)
+            or not (isinstance(self.max_entities, int) and self.max_entities >= 1)
         ):
             raise UsageError(
                 f"--max-entities must be a whole number >= 1, got {self.max_entities!r}"

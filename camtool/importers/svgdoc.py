@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from camtool.importers import svgcheck, svgvalues
-from camtool.importers.options import MAX_ENTITIES, too_many_entities
+from camtool.importers.options import check_expansion, entity_limit
 from camtool.importers.svgcss import (
     apply_style_sheets,
     inline_style,
@@ -488,7 +488,7 @@ MAX_DEPTH = 256
 dozen levels); deeper is refused before anything walks the tree recursively."""
 
 
-def check_size(root: ET.Element, name: str, max_entities: int) -> None:
+def check_size(root: ET.Element, name: str, max_entities: int | None) -> None:
     """Refuse a document nested too deep or expanding to too many elements.
 
     Every element counts once per place it is drawn: a ``<use>`` counts itself plus
@@ -498,12 +498,12 @@ def check_size(root: ET.Element, name: str, max_entities: int) -> None:
     :func:`check_use_cycles`.
 
     Raises:
-        InputError: nesting deeper than :data:`MAX_DEPTH`, or more than
-            ``max_entities`` elements once ``<use>`` clones are expanded (the message
-            names the ``--max-entities`` option).
+        InputError: nesting deeper than :data:`MAX_DEPTH`, or too many elements once
+            ``<use>`` clones are expanded (:func:`~camtool.importers.options.check_expansion`
+            of ``max_entities``; the message names the ``--max-entities`` option).
     """
     ids = {e.get("id"): e for e in root.iter() if e.get("id")}
-    cap = max_entities + 1
+    cap = entity_limit(max_entities) + 1
     size: dict[ET.Element, int] = {}
     depth: dict[ET.Element, int] = {}
 
@@ -536,8 +536,7 @@ def check_size(root: ET.Element, name: str, max_entities: int) -> None:
                 f"{name}: {label}: elements nested deeper than {MAX_DEPTH} levels "
                 "(<use> clones followed); flatten the groups in the drawing program"
             )
-    if size[root] > max_entities:
-        raise too_many_entities(name, max_entities)
+    check_expansion(name, size[root], len(size), max_entities, "<use> clones")
 
 
 _SIZES = frozenset({"width", "height", "r", "rx", "ry"})
@@ -577,7 +576,7 @@ def prepare(
     path: Path,
     layers: tuple[str, ...] | None,
     *,
-    max_entities: int = MAX_ENTITIES,
+    max_entities: int | None = None,
     units: str | None = None,
     shown: tuple[str, ...] = (),
 ) -> Prepared:
@@ -587,7 +586,7 @@ def prepare(
         path: the SVG file.
         layers: Inkscape layer names (labels or ids) to keep; ``None`` keeps everything.
         max_entities: most elements the document may expand to, ``<use>`` clones
-            included (:func:`check_size`).
+            included; ``None``: the defaults (:func:`check_size`).
         units: ``--units``: the user unit of a document without an absolute size.
         shown: layers read even if hidden (a job's operations name them).
 
@@ -596,8 +595,7 @@ def prepare(
             has malformed path data, transforms, lengths, points, size or viewBox, a
             name in ``layers`` matches no layer (the message lists the layers there are),
             a ``<use>`` that places itself, nesting deeper than
-            :data:`MAX_DEPTH` or more than ``max_entities``
-            elements.
+            :data:`MAX_DEPTH` or too many elements (:func:`check_size`).
     """
     root = _parse(path)
     with path.open("rb") as file:

@@ -18,6 +18,7 @@ from typing import Any
 import ezdxf
 import pytest
 
+import camtool.importers.options as options_module
 from camtool.cli.main import main
 from camtool.importers.dxf import import_dxf, read_dxf
 from camtool.importers.options import MAX_ENTITIES, ImportOptions
@@ -452,6 +453,48 @@ def test_a_huge_minsert_grid_is_refused(tmp_path: Path) -> None:
 
     error, seconds = _timed(write_dxf(tmp_path / "grid.dxf", build))
     assert seconds < 5 and "--max-entities" in str(error)
+
+
+def _grid(rows: int, columns: int) -> Callable[[Any], None]:
+    """A MINSERT of ``rows`` × ``columns`` cells of a block of one LINE, 2 mm apart."""
+
+    def build(msp: Any) -> None:
+        msp.doc.blocks.new("B").add_line((0, 0), (1, 0))
+        msp.add_blockref("B", (0, 0)).grid(size=(rows, columns), spacing=(2, 2))
+
+    return build
+
+
+def test_block_references_may_add_a_bounded_number_unless_the_limit_is_given(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # The file holds 2 entities (the MINSERT, the block's LINE); it expands to the MINSERT
+    # and its 20 × 20 LINEs: 401, so the references add 399.
+    path = write_dxf(tmp_path / "grid.dxf", _grid(20, 20))
+    monkeypatch.setattr(options_module, "MAX_EXPANSION", 398)
+    error, _ = _timed(path)
+    assert "its block references expand the 2 entities the file holds to 401, more than " in (
+        str(error)
+    )
+    assert "allow them with --max-entities 401" in str(error)
+    assert len(read_dxf(path, ImportOptions(max_entities=401)).contours) == 400
+    monkeypatch.setattr(options_module, "MAX_EXPANSION", 399)
+    assert len(read_dxf(path).contours) == 400
+
+
+def test_a_million_cell_minsert_within_the_travel_is_refused_before_any_cell_is_read(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # 1 000 × 1 000 cells of a 1 mm LINE: a 2 kB file that ezdxf would expand to 10^6
+    # entities (gigabytes), under the 5 000 000 of --max-entities.
+    import camtool.importers.dxf as dxf_importer
+
+    def never(*args: Any, **kwargs: Any) -> None:
+        raise AssertionError("a cell was read")
+
+    monkeypatch.setattr(dxf_importer._Reader, "_item", never)
+    error, _ = _timed(write_dxf(tmp_path / "grid.dxf", _grid(1000, 1000)))
+    assert "expand the 2 entities the file holds to 1,000,001" in str(error)
 
 
 def test_the_limit_counts_exactly_and_can_be_raised(tmp_path: Path) -> None:

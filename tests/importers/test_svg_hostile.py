@@ -13,7 +13,9 @@ import time
 from pathlib import Path
 
 import pytest
+import svgelements as se
 
+import camtool.importers.options as options_module
 from camtool.cli.main import main
 from camtool.importers.options import MAX_ENTITIES, ImportOptions
 from camtool.importers.svg import read_svg
@@ -93,6 +95,44 @@ def test_the_use_count_is_exact_and_can_be_raised(tmp_path: Path) -> None:
     path = svg(tmp_path, _use_laugh(3, 2))
     assert len(read_svg(path, ImportOptions(max_entities=80)).contours) == 8
     _refused(path, ImportOptions(max_entities=79))
+
+
+def test_clones_may_add_a_bounded_number_of_elements_unless_the_limit_is_given(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # The same file: 13 elements (<svg>, <defs>, a0, three groups of two <use>, the last
+    # <use>) expanding to 80 (above): the clones add 67.
+    path = svg(tmp_path, _use_laugh(3, 2))
+    monkeypatch.setattr(options_module, "MAX_EXPANSION", 66)
+    message = _refused(path)
+    assert "its <use> clones expand the 13 entities the file holds to 80, more than the 66 " in (
+        message
+    )
+    assert "allow them with --max-entities 80" in message
+    assert len(read_svg(path, ImportOptions(max_entities=80)).contours) == 8
+    monkeypatch.setattr(options_module, "MAX_EXPANSION", 67)
+    assert len(read_svg(path).contours) == 8
+
+
+def test_a_small_file_of_many_clones_is_refused_before_it_is_parsed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # 300 <use> of a row of 1 000 clones of one path: 40 kB of SVG, 1 304 elements (<svg>,
+    # <defs>, the path, the row and its 1 000 <use>, the 300 <use>) that expand to
+    # 1 + (1 + 1 + 2 001) + 300 · (1 + 2 001) = 602 604 (a clone of the path 2, the row
+    # 1 + 1 000 · 2): 600 000 objects of svgelements (gigabytes), under the 5 000 000 of
+    # --max-entities.
+    row = "".join(f'<use xlink:href="#p" x="{i}"/>' for i in range(1000))
+    body = f'<defs><path id="p" d="M 0 0 L 0.5 0"/><g id="row">{row}</g></defs>'
+    body += "".join(f'<use xlink:href="#row" y="{j}"/>' for j in range(300))
+
+    def never(*args: object, **kwargs: object) -> None:
+        raise AssertionError("parsed")
+
+    monkeypatch.setattr(se.SVG, "parse", never)
+    message = _refused(svg(tmp_path, body))
+    assert "its <use> clones expand the 1,304 entities the file holds to 602,604" in message
+    assert "--max-entities 602604" in message
 
 
 def test_post_of_a_hostile_svg_exits_3_with_one_line(
