@@ -18,7 +18,7 @@ from typing import Any
 from camtool.geometry.chain import chain_members, joint_distance
 from camtool.jobs.init_mills import Parts, mill_between, mill_that_fits
 from camtool.jobs.init_mills import why as _why
-from camtool.jobs.job import Selection
+from camtool.jobs.job import MAX_TOOLS, Selection
 from camtool.jobs.selection import circle_of, construction_reason
 from camtool.jobs.travel import refuse_small_box
 from camtool.model.construction import fit_extent, is_construction
@@ -692,6 +692,12 @@ def _render(
             tools.setdefault(key, len(tools) + 1)
     if not tools:
         tools[("end-mill", tool)] = 1
+    if len(tools) > MAX_TOOLS:
+        raise InputError(
+            f"{source}: its first job would need {len(tools)} tools (a drill for each hole "
+            f"diameter, an end mill for each size of part), more than the {MAX_TOOLS} a job "
+            "may hold; round the holes' diameters to the drills you have in the drawing"
+        )
     out = [
         f"# camtool job for {source}: a first guess; read each line and change what is not so.",
         "# Post it with: camtool post DRAWING -t TARGET --job THIS.toml",

@@ -34,6 +34,10 @@ MAX_TOOL_NUMBER = 99_999
 
 MAX_JOB_BYTES = 1_000_000
 """Largest job file read (a job of a thousand operations is a few hundred kB)."""
+MAX_TOOLS = 1000
+"""Most tools a job's tool table may hold: more than a tool changer holds. Each program
+a job writes lists them (and its operations) in its header, and a machine without a tool
+changer gets one program per tool, so what a job writes grows as the square of it."""
 MAX_DRAWN_DIAMETER_MM = 1e6
 """Largest circle diameter a selection names, mm as drawn: a drawing in metres (a site plan,
 scaled down by ``fit``) has circles of metres, which ``camtool job init`` names as they are."""

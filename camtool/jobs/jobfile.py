@@ -19,6 +19,7 @@ from camtool.jobs.job import (
     MAX_DRAWN_DIAMETER_MM,
     MAX_JOB_BYTES,
     MAX_TOOL_NUMBER,
+    MAX_TOOLS,
     OPERATION_TYPES,
     PECKS,
     SEQUENCES,
@@ -155,6 +156,11 @@ def _tools(rows: Any, source: str) -> tuple[Tool, ...]:
             f"{source}: no [[tools]]: a job needs a tool table (id, type, diameter of each tool)"
         )
     rows = _array(rows, source, "[[tools]]")
+    if len(rows) > MAX_TOOLS:
+        raise InputError(
+            f"{source}: {len(rows)} [[tools]], more than the {MAX_TOOLS} a job may hold; "
+            "list the tools its operations use (one part, one job)"
+        )
     tools: dict[int, Tool] = {}
     for n, row in enumerate(rows, start=1):
         where = f"[[tools]] {n}"

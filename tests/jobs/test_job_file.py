@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from camtool.jobs.job import Job
+from camtool.jobs.job import MAX_TOOLS, Job
 from camtool.jobs.jobfile import load_job
 from camtool.model.errors import InputError
 
@@ -241,3 +241,18 @@ def test_command_line_shared_options_replace_the_files(tmp_path: Path) -> None:
     job = load_job(path, overrides={"placement": "center", "translate": (1.0, 2.0)})
     assert job.setup.plan.placement == "center" and job.setup.plan.translate == (1.0, 2.0)
     assert all(op.plan.placement == "center" for op in job.operations)
+
+
+def _tools_job(count: int) -> str:
+    """A job of ``count`` end mills and one operation using the first."""
+    tools = "".join(f"[[tools]]\nid = {n}\ndiameter = 3\n" for n in range(1, count + 1))
+    return tools + '[[operations]]\ntype = "engrave"\ntool = 1\ndepth = 0.5\n'
+
+
+def test_a_tool_table_of_more_tools_than_a_job_may_hold_is_refused(tmp_path: Path) -> None:
+    # Each program of a job lists its tools and operations, and a machine without a tool
+    # changer gets one program per tool: 5 000 tools wrote 5 000 programs of 10 000 header
+    # lines each (3 GB) from a 0.7 MB file. MAX_TOOLS holds more than a tool changer.
+    assert len(_job(tmp_path, _tools_job(MAX_TOOLS)).tools) == MAX_TOOLS
+    with pytest.raises(InputError, match=rf"{MAX_TOOLS + 1} \[\[tools\]\], more than the "):
+        _job(tmp_path, _tools_job(MAX_TOOLS + 1))

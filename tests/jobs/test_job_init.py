@@ -483,3 +483,17 @@ def test_a_drill_pecks_a_diameter_deep_and_never_less_than_1_mm(tmp_path: Path) 
     lines = [ln for ln in text.splitlines() if ln.startswith("step_down")]
     assert lines == ["step_down = 1  # peck 1 mm at a time (G83)",
                      "step_down = 5  # peck about a diameter deep (G83)"]  # fmt: skip
+
+
+def test_a_first_job_that_would_hold_more_tools_than_a_job_may_is_refused(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # The sample plate's first job has two tools (the 3.2 mm drill, the 3 mm end mill):
+    # under a limit of one, the job post --job would refuse is not written.
+    import camtool.jobs.init as init_module
+
+    drawing = read_drawing(ROOT / "samples" / "part.dxf")
+    assert len(tomllib.loads(initial_job(drawing, source="part.dxf"))["tools"]) == 2
+    monkeypatch.setattr(init_module, "MAX_TOOLS", 1)
+    with pytest.raises(InputError, match=r"^part.dxf: its first job would need 2 tools"):
+        initial_job(drawing, source="part.dxf")
