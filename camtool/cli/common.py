@@ -603,7 +603,8 @@ _POST_OPTIONS = (
         default=0.0,
         show_default=True,
         metavar="S",
-        help="Wait S seconds after starting the spindle, before the first move (G4).",
+        help="Wait S seconds (at most 3600) after starting the spindle, before the first move "
+        "(G4).",
     ),
     click.option(
         "--format",
@@ -618,7 +619,7 @@ _POST_OPTIONS = (
         type=number_range(min=0),
         default=None,
         metavar="RPM",
-        help="Spindle on (M03) at RPM before the first move and off (M05) after the last; "
-        "0 writes no spindle commands [default: the target's].",
+        help="Spindle on (M03) at RPM (at most 1000000) before the first move and off (M05) "
+        "after the last; 0 writes no spindle commands [default: the target's].",
     ),
 )

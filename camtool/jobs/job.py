@@ -34,6 +34,11 @@ MAX_TOOL_NUMBER = 99_999
 
 MAX_JOB_BYTES = 1_000_000
 """Largest job file read (a job of a thousand operations is a few hundred kB)."""
+MAX_RPM = 1e6
+"""Largest spindle speed a tool or ``--spindle-rpm`` may give, rev/min: beyond any spindle
+(a larger one is a typo, and fixed-width dialects have no room for it)."""
+MAX_DWELL_S = 3600.0
+"""Longest wait a drill's ``dwell`` or ``--spindle-dwell`` may give, s."""
 MAX_TOOLS = 1000
 """Most tools a job's tool table may hold: more than a tool changer holds. Each program
 a job writes lists them (and its operations) in its header, and a machine without a tool
@@ -79,7 +84,7 @@ class Tool:
         for name in ("rpm", "feed_mm_min", "plunge_feed_mm_min"):
             value = getattr(self, name)
             if value is not None:
-                _check_number(f"Tool.{name}", value, "", low=0.0, high=1e6, above=True)
+                _check_number(f"Tool.{name}", value, "", low=0.0, high=MAX_RPM, above=True)
 
     def describe(self) -> str:
         """``"drill 3 mm"`` (or the tool's name): what the operator is asked to load."""
@@ -187,7 +192,7 @@ class Operation:
             raise UsageError(
                 f"unknown Operation.peck {self.peck!r}; choose one of {', '.join(PECKS)}"
             )
-        _check_number("Operation.dwell_s", self.dwell_s, "s", low=0.0, high=3600.0)
+        _check_number("Operation.dwell_s", self.dwell_s, "s", low=0.0, high=MAX_DWELL_S)
         _check_number("Operation.hole_tolerance", self.hole_tolerance, "mm", low=0.0, high=1000.0)
 
     @property
@@ -292,6 +297,18 @@ class Job:
             return (_STAGE[op.kind], first_use[op.tool], index)
 
         return tuple(op for _, op in sorted(enumerate(self.operations), key=key))
+
+
+def check_spindle(rpm: float | None, dwell_s: float) -> None:
+    """Refuse a ``--spindle-rpm`` or ``--spindle-dwell`` outside what a machine runs.
+
+    Raises:
+        UsageError: ``rpm`` (``None``: the target's) is not within 0…:data:`MAX_RPM`,
+            or ``dwell_s`` not within 0…:data:`MAX_DWELL_S` (NaN included).
+    """
+    if rpm is not None:
+        _check_number("--spindle-rpm", rpm, "rev/min", low=0.0, high=MAX_RPM)
+    _check_number("--spindle-dwell", dwell_s, "s", low=0.0, high=MAX_DWELL_S)
 
 
 def _check_number(

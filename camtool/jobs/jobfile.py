@@ -17,7 +17,9 @@ from typing import Any
 
 from camtool.jobs.job import (
     MAX_DRAWN_DIAMETER_MM,
+    MAX_DWELL_S,
     MAX_JOB_BYTES,
+    MAX_RPM,
     MAX_TOOL_NUMBER,
     MAX_TOOLS,
     OPERATION_TYPES,
@@ -259,7 +261,7 @@ def _operation(
         name=name,
         side=side,
         peck=_choice(row.get("peck", "retract"), PECKS, source, f"{where} peck"),
-        dwell_s=_number(row.get("dwell", 0.0), source, f"{where} dwell", low=0.0, high=3600.0),
+        dwell_s=_number(row.get("dwell", 0.0), source, f"{where} dwell", low=0.0, high=MAX_DWELL_S),
         hole_tolerance=_number(
             row.get("hole_tolerance", 0.05), source, f"{where} hole_tolerance", low=0.0, high=100.0
         ),
@@ -496,9 +498,9 @@ def _number(
     return number
 
 
-POSITIVE_MAX = 1e7
-"""The largest diameter, feed or speed a job file may give (in its unit): 10 km, 10⁷ mm/min
-or rev/min, far beyond any machine; a larger one is a typo."""
+POSITIVE_MAX = MAX_RPM
+"""The largest feed or speed a job file may give (in its unit): 10⁶ mm/min or rev/min, far
+beyond any machine; a larger one is a typo."""
 
 
 def _positive(value: Any, source: str, where: str, unit: str) -> float | None:

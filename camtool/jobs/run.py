@@ -20,7 +20,7 @@ from camtool.geometry.chain import chain_members, joint_distance
 from camtool.jobs.by_hand import ToolProgram, loaded_by_hand, per_tool
 from camtool.jobs.drill import drill_moves
 from camtool.jobs.heights import check_heights
-from camtool.jobs.job import Job, Operation, Tool
+from camtool.jobs.job import Job, Operation, Tool, check_spindle
 from camtool.jobs.job_warnings import holes_cut_outside, overlaps, undrilled, unselected
 from camtool.jobs.jobfile import as_keys
 from camtool.jobs.selection import (
@@ -124,11 +124,17 @@ class OutputOptions:
             spindle; a re-posted program gets spindle commands only when > 0 and it
             has none of its own.
         spindle_dwell_s: wait this long after the spindle starts, s (``--spindle-dwell``).
+
+    Raises:
+        UsageError: a speed or wait no machine runs (:func:`~camtool.jobs.job.check_spindle`).
     """
 
     fmt: str | None = None
     spindle_rpm: float | None = None
     spindle_dwell_s: float = 0.0
+
+    def __post_init__(self) -> None:
+        check_spindle(self.spindle_rpm, self.spindle_dwell_s)
 
 
 def plan_options(target: Target, plan: PlanOptions | None = None) -> PlanOptions:

@@ -715,8 +715,8 @@ def _spindle(command: Spindle, where: str, w: _Writer) -> str | None:
             "M03S####/M04S#### needs 1–9999 rev/min; give the speed with S in the program",
         )
         return None
-    finite = math.isfinite(rpm) and rpm > 0
-    whole = int(Decimal(repr(float(rpm))).quantize(Decimal(1), ROUND_HALF_UP)) if finite else 0
+    writable = math.isfinite(rpm) and 0 < rpm < MAX_RPM + 1  # and few digits to round
+    whole = int(Decimal(repr(float(rpm))).quantize(Decimal(1), ROUND_HALF_UP)) if writable else 0
     if not 1 <= whole <= MAX_RPM:
         raise DialectError(
             f"{where}: spindle speed {rpm:g} rev/min does not fit M03S####/M04S#### "

@@ -334,6 +334,8 @@ def backlash_command(axis: str, um: float) -> str:
     """
     if isinstance(um, bool) or not isinstance(um, int | float) or not math.isfinite(um):
         raise DialectError(f"backlash {um!r} µm is not a number")
+    if not -1e6 < um < 1e6:  # no compensation; and more digits than Decimal's 28 to round
+        raise DialectError(f"backlash {um:g} µm does not round to 0–999 µm")
     whole = int(Decimal(repr(float(um))).quantize(Decimal(1), ROUND_HALF_UP))
     return Backlash(cast(Axis, axis.upper() if isinstance(axis, str) else axis), whole).to_string()
 

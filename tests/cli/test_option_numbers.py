@@ -44,6 +44,34 @@ def test_non_finite_option_is_a_usage_error_naming_it(
 
 
 @pytest.mark.parametrize(
+    ("args", "said"),
+    [
+        # was: linuxcnc wrote M3 S1000000000000000000000000000000 (exit 0), pic-mmh stopped
+        # with an internal InvalidOperation, grbl a 300-digit block in its message
+        (["--spindle-rpm", "1e30"], "--spindle-rpm must be ≥ 0 and ≤ 1e+06 rev/min, got 1e+30"),
+        (["--spindle-dwell", "1e300"], "--spindle-dwell must be ≥ 0 and ≤ 3600 s, got 1e+300"),
+    ],
+)
+@pytest.mark.parametrize("target", ["linuxcnc", "pic-mmh", "grbl"])
+def test_absurd_spindle_options_are_refused_before_planning(
+    args: list[str], said: str, target: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "p.nc"
+    code = main(["post", str(SAMPLES / "plate.dxf"), "-t", target, "-o", str(out), *args])
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert err == f"camtool: error: {said}\n"
+    assert not out.exists()
+
+
+def test_a_spindle_speed_up_to_the_limit_is_written_as_given(tmp_path: Path) -> None:
+    out = tmp_path / "p.ngc"
+    args = ["post", str(SAMPLES / "plate.dxf"), "-t", "linuxcnc", "-o", str(out)]
+    assert main([*args, "--spindle-rpm", "1000000"]) == 0
+    assert "M3 S1000000" in out.read_text().splitlines()
+
+
+@pytest.mark.parametrize(
     ("field", "value"),
     [
         ("tab_height", math.nan),
