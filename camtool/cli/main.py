@@ -38,6 +38,7 @@ from camtool.cli.preview import preview
 from camtool.cli.send import send, simulate_device
 from camtool.model.errors import CamtoolError, InputError, UsageError, VerifyLimitError
 from camtool.model.version import __version__
+from camtool.toolpath.options import MAX_TOOL_DIAMETER_MM
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -249,7 +250,7 @@ def post(
 )
 @click.option(
     "--tool-diameter",
-    type=number_range(min=0),
+    type=number_range(min=0, max=MAX_TOOL_DIAMETER_MM),
     default=0.0,
     show_default=True,
     metavar="MM",

@@ -27,6 +27,7 @@ from camtool.cli.common import (
     write_output,
 )
 from camtool.model.errors import UsageError
+from camtool.toolpath.options import MAX_TOOL_DIAMETER_MM
 
 if TYPE_CHECKING:
     from camtool.model.program import Program
@@ -57,7 +58,7 @@ if TYPE_CHECKING:
 @MACHINE
 @click.option(
     "--tool-diameter",
-    type=number_range(min=0),
+    type=number_range(min=0, max=MAX_TOOL_DIAMETER_MM),
     default=0.0,
     metavar="MM",
     help="Draw the tool width along the cuts (and sweep the trace with it for --verify).",

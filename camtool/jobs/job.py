@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 from camtool.model.errors import UsageError
 from camtool.model.keywords import checked_keywords
-from camtool.toolpath.options import PlanOptions
+from camtool.toolpath.options import MAX_TOOL_DIAMETER_MM, PlanOptions
 
 TOOL_TYPES = ("end-mill", "drill", "v-bit", "engraver")
 """Valid values of ``Tool.type``."""
@@ -80,7 +80,7 @@ class Tool:
             raise UsageError(
                 f"unknown Tool.type {self.type!r}; choose one of {', '.join(TOOL_TYPES)}"
             )
-        _check_number("Tool.diameter", self.diameter, "mm", low=0.0, high=1000.0)
+        _check_number("Tool.diameter", self.diameter, "mm", low=0.0, high=MAX_TOOL_DIAMETER_MM)
         for name in ("rpm", "feed_mm_min", "plunge_feed_mm_min"):
             value = getattr(self, name)
             if value is not None:

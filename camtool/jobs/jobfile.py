@@ -35,7 +35,7 @@ from camtool.jobs.job import (
     Tool,
 )
 from camtool.model.errors import InputError, UsageError
-from camtool.toolpath.options import PLACEMENTS, PlanOptions, flag
+from camtool.toolpath.options import MAX_TOOL_DIAMETER_MM, PLACEMENTS, PlanOptions, flag
 
 _JOB_KEYS: dict[str, str] = {
     "origin": "placement",
@@ -174,7 +174,7 @@ def _tools(rows: Any, source: str) -> tuple[Tool, ...]:
             raise InputError(f"{source}: two tools with id {number}; give each tool its own id")
         kind = _choice(row.get("type", "end-mill"), TOOL_TYPES, source, f"{where} type")
         diameter = _number(row.get("diameter"), source, f"{where} diameter", required=True)
-        if not 0 < diameter <= 1000:
+        if not 0 < diameter <= MAX_TOOL_DIAMETER_MM:
             raise InputError(
                 f"{source}: {where} diameter = {diameter:g} mm; give the tool's cutting "
                 "diameter in mm (> 0)"

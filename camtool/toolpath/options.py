@@ -281,6 +281,11 @@ class PlanOptions:
     def _check_tool(self) -> None:
         if self.tool_diameter < 0:
             raise UsageError(f"--tool-diameter must be ≥ 0 mm, got {self.tool_diameter!r}")
+        if self.tool_diameter > MAX_TOOL_DIAMETER_MM:
+            raise UsageError(
+                f"--tool-diameter {self.tool_diameter:g} mm is more than "
+                f"{MAX_TOOL_DIAMETER_MM:g} mm: no cutter is that wide; check the value and its unit"
+            )
         if self.offset != "on" and self.tool_diameter <= 0:
             raise UsageError(f"--offset {self.offset} needs --tool-diameter MM (> 0)")
         if self.feed_mm_min is not None and self.feed_mm_min <= 0:
@@ -425,6 +430,9 @@ MAX_LENGTH_MM = 1e6
 
 MAX_SCALE = 1e6
 """Largest ``--scale`` factor (and 1/this the smallest)."""
+
+MAX_TOOL_DIAMETER_MM = 1000.0
+"""Largest tool diameter (mm) an option or a job's tool may give: wider than any cutter."""
 
 MIN_TOLERANCE_MM = 1e-6
 """Smallest ``--tolerance`` (mm): chords and fitted arcs finer than 1 nm only cost time."""

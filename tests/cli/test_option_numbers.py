@@ -178,3 +178,38 @@ def test_a_tolerance_past_a_millimetre_is_refused_as_a_slip(
         ["post", str(SAMPLES / "plate.dxf"), "-t", "grbl", "-o", str(out), "--tolerance", "1"]
     )
     assert code == 0, capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        # was: preview stopped with an internal GEOSException (a sweep 1e300 mm wide), verify
+        # printed a numpy overflow warning and distances of 300 digits with exit 0
+        ["preview", "-o", "p.png"],
+        ["verify"],
+    ],
+)
+def test_a_tool_wider_than_any_cutter_is_refused_by_verify_and_preview(
+    command: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    program = tmp_path / "p.nc"
+    assert main(["post", str(SAMPLES / "plate.dxf"), "-t", "grbl", "-o", str(program)]) == 0
+    capsys.readouterr()
+    args = [command[0], str(program), "-t", "grbl", *command[1:], "--tool-diameter", "1e300"]
+    code = main([a if a != "p.png" else str(tmp_path / a) for a in args])
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert "--tool-diameter" in err and "1000" in err
+    assert not (tmp_path / "p.png").exists()
+
+
+def test_post_names_the_option_of_a_tool_wider_than_any_cutter(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # was: "Tool.diameter must be ≥ 0 and ≤ 1000 mm, got 100000.0" (the job's field, not the option)
+    out = tmp_path / "p.nc"
+    args = ["--tool-diameter", "1e5", "--offset", "outside"]
+    assert main(["post", str(SAMPLES / "plate.dxf"), "-t", "grbl", "-o", str(out), *args]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("camtool: error: --tool-diameter 100000 mm is more than 1000 mm")
+    assert not out.exists()
