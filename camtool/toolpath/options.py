@@ -247,10 +247,10 @@ class PlanOptions:
                 # not a length: a site plan in metres lies 1e6 mm and more from 0
                 continue
             if abs(value) > limit:
+                unit = "" if name in ("scale", "tabs") else " mm"  # a factor, a count
                 raise UsageError(
-                    f"{flag(name)} {value:g} is beyond ±{limit:g}"
-                    f"{'' if name == 'scale' else ' mm'}: no machine camtool writes for is "
-                    "that large; check the value and its unit"
+                    f"{flag(name)} {value:g} is beyond ±{limit:g}{unit}: no machine camtool "
+                    "writes for is that large; check the value and its unit"
                 )
         if self.scale < 1.0 / MAX_SCALE:
             raise UsageError(f"--scale must be at least {1.0 / MAX_SCALE:g}, got {self.scale!r}")

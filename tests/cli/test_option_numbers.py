@@ -213,3 +213,19 @@ def test_post_names_the_option_of_a_tool_wider_than_any_cutter(
     err = capsys.readouterr().err
     assert err.startswith("camtool: error: --tool-diameter 100000 mm is more than 1000 mm")
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "said"),
+    [
+        ("depth", 1e300, "--depth 1e+300 is beyond ±1e+06 mm: no machine"),
+        ("scale", 1e300, "--scale 1e+300 is beyond ±1e+06: no machine"),
+        ("tabs", 10**9, "--tabs 1e+09 is beyond ±1e+06: no machine"),  # a count, not mm
+    ],
+)
+def test_an_absurd_magnitude_is_refused_in_the_option_s_unit(
+    field: str, value: float, said: str
+) -> None:
+    with pytest.raises(UsageError) as caught:
+        PlanOptions(feed_mm_min=100.0, **{field: value})
+    assert str(caught.value).startswith(said)
