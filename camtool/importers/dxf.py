@@ -33,7 +33,7 @@ from camtool.importers.dxf_prefit import MIN_SPLINES, fit_ahead, fitted_ahead
 from camtool.importers.dxf_style import CONTINUOUS, Style, StyleResolver
 from camtool.importers.dxf_subclass import missing_subclass, with_subclass_markers
 from camtool.importers.options import MAX_COORDINATE_MM, ImportOptions
-from camtool.model.errors import InputError, UsageError
+from camtool.model.errors import InputError, UsageError, not_a_file
 from camtool.model.shapes import BBox, Contour, Drawing, Line, Mark, Point, bbox_union
 from camtool.model.units import INCH, LENGTH_UNITS
 
@@ -584,7 +584,7 @@ def _open(path: Path) -> tuple[Any, str | None, list[str]]:
     from ezdxf import recover
 
     if not path.is_file():
-        raise InputError(f"{path}: no such file")
+        raise not_a_file(path)
     if path.stat().st_size == 0:
         raise InputError(f"{path}: empty file; export the drawing again from the CAD program")
     try:

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from camtool.importers.options import ImportOptions
-from camtool.model.errors import InputError, UsageError
+from camtool.model.errors import InputError, UsageError, not_a_file
 from camtool.model.shapes import Contour, Drawing, Line, Point
 from camtool.model.units import LARGEST_VALUE, LENGTH_UNITS
 
@@ -129,7 +129,7 @@ def _scale(value: float, factor: float) -> float:
 
 def _read_text(path: Path) -> str:
     if not path.is_file():
-        raise InputError(f"{path}: no such file")
+        raise not_a_file(path)
     from camtool.importers.textfile import decoded
 
     try:

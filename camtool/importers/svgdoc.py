@@ -47,7 +47,7 @@ from camtool.importers.svgtree import (
     tag,
 )
 from camtool.importers.svgvalues import LENGTH_ATTRS, URL_REF
-from camtool.model.errors import InputError
+from camtool.model.errors import InputError, not_a_file
 
 _GROUPMODE = f"{{{INKSCAPE_NS}}}groupmode"
 _LABEL = f"{{{INKSCAPE_NS}}}label"
@@ -657,7 +657,7 @@ def prepare(
 
 def _parse(path: Path) -> ET.Element:
     if not path.is_file():
-        raise InputError(f"{path}: no such file")
+        raise not_a_file(path)
     try:
         root = ET.parse(path).getroot()
     except ET.ParseError as exc:

@@ -334,11 +334,11 @@ def expand_inputs(inputs: Sequence[str], *, exclude: Path | None = None) -> tupl
             and lists the readable endings); checked for every input before any
             work starts.
     """
-    skip = exclude.resolve() if exclude is not None else None
+    skip = _real(exclude) if exclude is not None else None
     found: dict[Path, BatchInput] = {}
     for text in inputs:
         for item in _expand_one(text, skip):
-            found.setdefault(item.path.resolve(), item)
+            found.setdefault(_real(item.path), item)
     return tuple(sorted(found.values(), key=lambda item: item.path.as_posix()))
 
 
@@ -360,6 +360,15 @@ def _expand_one(text: str, skip: Path | None) -> list[BatchInput]:
         what = "holds" if path.is_dir() else "matches"
         raise InputError(f"{text}: {what} no file camtool reads ({endings})")
     return items
+
+
+def _real(path: Path) -> Path:
+    """``path`` with its symbolic links followed (``os.path.realpath``).
+
+    A link in a loop is left as it is, where ``Path.resolve`` raises: the file is then
+    refused when it is read, in its own row of the batch.
+    """
+    return Path(os.path.realpath(path))
 
 
 def _rebase(items: list[BatchInput]) -> list[BatchInput]:
@@ -386,12 +395,12 @@ def _glob(pattern: str, skip: Path | None) -> list[BatchInput]:
     parts = Path(pattern).parts
     fixed = next((i for i, part in enumerate(parts) if _MAGIC.search(part)), len(parts))
     root = Path(*parts[:fixed]) if fixed else Path()
-    if skip is not None and _below(root.resolve(), skip):
+    if skip is not None and _below(_real(root), skip):
         skip = None  # the user globbed inside the output directory on purpose
     items: list[BatchInput] = []
     for match in sorted(glob.glob(pattern, recursive=True)):
         path = Path(match)
-        if skip is not None and _below(path.resolve(), skip):
+        if skip is not None and _below(_real(path), skip):
             continue
         if path.is_dir():
             items.extend(_walk(path, root, skip))
@@ -407,7 +416,7 @@ def _walk(directory: Path, root: Path, skip: Path | None) -> list[BatchInput]:
         dirs[:] = sorted(
             d
             for d in dirs
-            if not d.startswith(".") and (skip is None or (Path(here) / d).resolve() != skip)
+            if not d.startswith(".") and (skip is None or _real(Path(here) / d) != skip)
         )
         for name in sorted(files):
             path = Path(here) / name

@@ -26,6 +26,29 @@ class InputError(CamtoolError, ValueError):
     exit_code = 3
 
 
+def not_a_file(path: object) -> InputError:
+    """The error for an input ``path`` that is not a regular file: what it is instead.
+
+    Missing, a folder, a symbolic link that leads nowhere (or round in a loop), or a FIFO,
+    socket or device (not opened: reading one can block or never end).
+    """
+    import os
+    import stat
+
+    try:
+        mode = os.stat(str(path)).st_mode
+    except OSError:
+        if os.path.islink(str(path)):
+            return InputError(f"{path}: a symbolic link that leads to no file (or round a loop)")
+        return InputError(f"{path}: no such file")
+    if stat.S_ISDIR(mode):
+        return InputError(f"{path}: a folder, not a file; name a drawing or a program in it")
+    return InputError(
+        f"{path}: not a regular file (a FIFO, a socket or a device); camtool reads drawings "
+        "and programs from files, or from standard input with '-'"
+    )
+
+
 class ToolpathError(CamtoolError, ValueError):
     """A toolpath cannot be planned (e.g. an offset fails). Exit code 1."""
 

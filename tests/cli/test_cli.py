@@ -602,3 +602,30 @@ def test_send_of_a_drawing_says_to_post_it_first(
     assert code == 3 and out == ""
     assert "logo.dxf: a drawing, not a program" in err and "then send PROGRAM" in err
     assert str(missing_port) not in err
+
+
+@pytest.mark.parametrize("ending", [".dxf", ".svg", ".csv"])
+def test_a_drawing_path_that_is_not_a_file_is_named_for_what_it_is(
+    ending: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # was "no such file" for each: a FIFO (not opened: it could block), a folder, a link
+    # to nothing or round a loop
+    fifo, folder = tmp_path / f"fifo{ending}", tmp_path / f"folder{ending}"
+    os.mkfifo(fifo)
+    folder.mkdir()
+    (tmp_path / f"dangling{ending}").symlink_to("nowhere")
+    (tmp_path / f"loop{ending}").symlink_to(f"loop{ending}")
+    said = {
+        fifo: "not a regular file (a FIFO, a socket or a device)",
+        folder: "a folder, not a file",
+        tmp_path / f"dangling{ending}": "a symbolic link that leads to no file",
+        tmp_path / f"loop{ending}": "a symbolic link that leads to no file (or round a loop)",
+        tmp_path / f"missing{ending}": "no such file",
+    }
+    for path, what in said.items():
+        code, out, err = run(
+            ["post", str(path), "-t", "grbl", "-o", str(tmp_path / "o.nc")], capsys
+        )
+        assert code == 3 and out == "", err
+        assert err.startswith(f"camtool: error: {path}: {what}")
+    assert not (tmp_path / "o.nc").exists()

@@ -69,6 +69,24 @@ def test_directory_is_searched_recursively_skipping_hidden_and_unknown(tree: Pat
     assert found[2].path == tree / "rect.dxf"
 
 
+def test_symbolic_links_in_a_loop_are_one_failed_row_not_an_internal_error(
+    tree: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # was: "internal error: RuntimeError: Symlink loop" (Path.resolve) before any file
+    # was posted. A file link and a folder link that loop, and one to nothing.
+    os.symlink("b.dxf", tree / "a.dxf")
+    os.symlink("a.dxf", tree / "b.dxf")
+    os.symlink("loop", tree / "loop")
+    os.symlink("nowhere.svg", tree / "dangling.svg")
+    code, out, err = run([str(tree), "-t", "grbl", "-o", "out"], capsys)
+    assert code == 3, err
+    for name in ("a.dxf", "b.dxf", "dangling.svg"):
+        assert f"{tree / name}: a symbolic link that leads to no file (or round a loop)" in err
+    assert "internal error" not in err
+    written = sorted(p.name for p in Path("out").rglob("*.gcode"))
+    assert written == ["l.gcode", "rect.gcode", "small.gcode"]
+
+
 def test_a_text_note_beside_the_drawings_is_passed_over_a_point_list_is_not(tree: Path) -> None:
     """A README or a licence saved as .txt holds no row of numbers and no G-code block:
     found in a folder or a glob it is no point list to post (it was an error in the
