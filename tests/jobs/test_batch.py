@@ -78,7 +78,7 @@ def test_symbolic_links_in_a_loop_are_one_failed_row_not_an_internal_error(
     os.symlink("a.dxf", tree / "b.dxf")
     os.symlink("loop", tree / "loop")
     os.symlink("nowhere.svg", tree / "dangling.svg")
-    code, out, err = run([str(tree), "-t", "grbl", "-o", "out"], capsys)
+    code, _out, err = run([str(tree), "-t", "grbl", "-o", "out"], capsys)
     assert code == 3, err
     for name in ("a.dxf", "b.dxf", "dangling.svg"):
         assert f"{tree / name}: a symbolic link that leads to no file (or round a loop)" in err
