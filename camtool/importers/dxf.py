@@ -573,6 +573,7 @@ _PARSER_ERRORS = (
     KeyError,
     AttributeError,  # dxf-parser's blocks.dxf: a VIEWPORT's missing XDATA (ezdxf 1.4)
     TypeError,
+    AssertionError,  # ezdxf's layouts audit asserts each name is text (a damaged LAYOUT)
 )
 """What ezdxf's reader raises on damaged files besides DXFError (a DXF cut short in its
 HEADER ends ezdxf's ``dxf_info`` scan with a bare StopIteration)."""

@@ -201,6 +201,10 @@ def _bad_shape(entity: Any) -> str | None:
                 # onto a line (ezdxf cannot transform it either). A Z scale 0 only flattens
                 # what is already flat, so it is read.
                 return f"{axis} 0: a block inserted at scale 0 has no size"
+    if entity.dxftype() == "POLYLINE":
+        for k, vertex in enumerate(entity.vertices, start=1):
+            if vertex.dxf.get("location", None) is None:
+                return f"vertex {k} has no location (group codes 10 and 20)"
     return None
 
 

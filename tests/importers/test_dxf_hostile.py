@@ -652,3 +652,34 @@ def test_an_arc_whose_start_and_end_angles_are_equal_is_a_point_not_a_circle(
     (circle,) = contour.segments
     assert circle.centre == (10.0, 10.0) and math.isclose(circle.length, 10 * math.pi)
     assert any("skipped 1 ARC entity (zero length" in w for w in read.warnings)
+
+
+def test_an_assertion_in_ezdxf_s_recover_mode_is_a_damaged_file_not_an_internal_error(
+    tmp_path: Path,
+) -> None:
+    # Found by fuzzing samples/part.dxf: a group code "E74" sends the file to recover mode,
+    # and a group code 74 made 0 leaves a layout name that is not text, which ezdxf's
+    # audit asserts (was: "internal error: AssertionError").
+    lines = (Path(__file__).parents[2] / "samples" / "part.dxf").read_text().split("\n")
+    assert lines[1740] == " 74" and lines[6274] == " 74"
+    lines[1740], lines[6274] = "E74", " 0"
+    path = tmp_path / "part.dxf"
+    path.write_text("\n".join(lines))
+    with pytest.raises(InputError, match=r"not a readable DXF file .*recover mode failed"):
+        read_dxf(path)
+
+
+def test_a_polyline_vertex_without_its_location_is_a_damaged_entity(tmp_path: Path) -> None:
+    # Found by fuzzing samples/logo.dxf: a VERTEX whose group code 10 was damaged has no
+    # location in ezdxf (was: "internal error: TypeError: 'NoneType' object is not
+    # subscriptable" while converting the POLYLINE).
+    def build(msp: Any) -> None:
+        polyline = msp.add_polyline2d([(0, 0), (10, 0), (10, 10), (0, 10)], close=True)
+        polyline.vertices[2].dxf.discard("location")
+
+    with pytest.raises(InputError) as caught:
+        read_dxf(write_dxf(tmp_path / "damaged.dxf", build))
+    assert "POLYLINE #" in str(caught.value)
+    assert "vertex 3 has no location (group codes 10 and 20); the file is damaged" in str(
+        caught.value
+    )
