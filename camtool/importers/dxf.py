@@ -210,7 +210,13 @@ def _import(
     units, scale = _units(
         path, _insunits(path, doc, recovered), warnings, options.units, _imperial(doc)
     )
-    msp = doc.modelspace()
+    try:
+        msp = doc.modelspace()
+    except KeyError:  # a damaged file ezdxf recovered without its Model layout
+        raise InputError(
+            f"{path}: no model space (its *Model_Space block record or Model layout is "
+            "damaged); re-save or export it as DXF from the CAD program"
+        ) from None
     if len(msp) == 0:
         _refuse_empty(path, doc, damage)
     keep = layer_filter(path, doc, options.layers, options.shown)

@@ -683,3 +683,20 @@ def test_a_polyline_vertex_without_its_location_is_a_damaged_entity(tmp_path: Pa
     assert "vertex 3 has no location (group codes 10 and 20); the file is damaged" in str(
         caught.value
     )
+
+
+def test_a_file_whose_model_layout_is_lost_is_refused_naming_it(tmp_path: Path) -> None:
+    # Found by fuzzing LibreCAD's library/elektro/connector/c8.dxf (dxflib): its layout
+    # dictionary's "Model" entry made to point to handle -99999; ezdxf recovers a document
+    # without a model space (was: "internal error: KeyError: 'MODEL'").
+    from tests.corpus.conftest import CORPUS
+
+    c8 = CORPUS / "pkg/librecad-data/usr/share/librecad/library/elektro/connector/c8.dxf"
+    if not c8.is_file():
+        pytest.skip("the corpus is not fetched (python tests/corpus/fetch_corpus.py)")
+    text, count = re.subn(r"(\n  3\r?\nModel\r?\n350\r?\n)22(\r?\n)", r"\1-99999\2", c8.read_text())
+    assert count == 1
+    path = tmp_path / "lost.dxf"
+    path.write_text(text)
+    with pytest.raises(InputError, match=r"lost\.dxf: no model space \(its \*Model_Space"):
+        read_dxf(path)
