@@ -11,6 +11,7 @@ import logging
 import math
 from collections import Counter
 from collections.abc import Callable, Iterable
+from contextlib import suppress
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -765,9 +766,13 @@ def _units(
 
 def _refuse_empty(path: Path, doc: Any, damage: str | None) -> None:
     """Model space is empty: say whether the drawing is in paper space instead."""
-    layouts = [lay for lay in doc.layouts if not lay.is_modelspace and len(lay)]
+    layouts = []
+    for lay in doc.layouts:
+        with suppress(AttributeError, KeyError, TypeError):  # a layout damaged past repair
+            if not lay.is_modelspace and len(lay):
+                layouts.append(lay.name)
     if layouts:
-        names = ", ".join(repr(lay.name) for lay in layouts)
+        names = ", ".join(repr(name) for name in layouts)
         raise InputError(
             f"{path}: model space is empty; the drawing is in paper space (layout {names}), "
             "which camtool does not read; move it to model space in the CAD program"

@@ -700,3 +700,33 @@ def test_a_file_whose_model_layout_is_lost_is_refused_naming_it(tmp_path: Path) 
     path.write_text(text)
     with pytest.raises(InputError, match=r"lost\.dxf: no model space \(its \*Model_Space"):
         read_dxf(path)
+
+
+def test_a_damaged_layout_does_not_stop_the_empty_model_space_message(tmp_path: Path) -> None:
+    # Found by fuzzing LibreCAD's library/elektro/coil/L7.dxf: five damaged lines leave
+    # ezdxf's recovered document with nothing in model space and a layout whose block
+    # record lost its attributes (was: "internal error: AttributeError: 'BlockRecord'
+    # object has no attribute 'dxf'" while looking for a drawing in paper space).
+    from tests.corpus.conftest import CORPUS
+
+    l7 = CORPUS / "pkg/librecad-data/usr/share/librecad/library/elektro/coil/L7.dxf"
+    if not l7.is_file():
+        pytest.skip("the corpus is not fetched (python tests/corpus/fetch_corpus.py)")
+    lines = l7.read_text().split("\n")
+    damage = {
+        735: (
+            "Center (2x) ________  __  ________  __  _____",
+            "Center (2x) ________  __  ______P_  __  _____",
+        ),
+        748: (" 74", " 360"),
+        1122: ("100", "1e308"),
+        1192: ("  3", "  0"),
+        1544: ("  3", "  -1e308"),
+    }
+    for k, (was, now) in damage.items():
+        assert lines[k] == was
+        lines[k] = now
+    path = tmp_path / "damaged.dxf"
+    path.write_text("\n".join(lines))
+    with pytest.raises(InputError, match=r"damaged DXF file .* with nothing left in model space"):
+        read_dxf(path)
