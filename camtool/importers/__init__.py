@@ -18,7 +18,7 @@ from typing import NoReturn
 
 from camtool.importers.options import ImportOptions
 from camtool.model.construction import fit_extent
-from camtool.model.errors import CamtoolError, InputError
+from camtool.model.errors import CamtoolError, InputError, not_a_file
 from camtool.model.progress import Progress, Step, no_progress
 from camtool.model.shapes import BBox, Drawing, fit_factor
 
@@ -184,7 +184,7 @@ def gunzipped(path: Path) -> bytes:
         with gzip.open(path, "rb") as packed:
             data = packed.read(MAX_SVGZ_BYTES + 1)
     except FileNotFoundError:
-        raise InputError(f"{path}: no such file") from None
+        raise not_a_file(path) from None
     except (gzip.BadGzipFile, EOFError, zlib.error) as exc:
         raise InputError(
             f"{path}: damaged gzip data ({exc}); save the drawing again as .svg"

@@ -405,7 +405,7 @@ class BlockGraph:
 
     cyclic: frozenset[str]
     sizes: dict[str, int]
-    held: int = 0
+    held: int
 
 
 def checked_block_graph(name: str, msp: Any, max_entities: int | None) -> BlockGraph:

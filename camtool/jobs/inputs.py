@@ -27,7 +27,7 @@ from camtool.importers import (
     read_drawing_bytes,
 )
 from camtool.importers.textfile import decoded
-from camtool.model.errors import InputError, UsageError
+from camtool.model.errors import InputError, UsageError, not_a_file
 from camtool.model.tomlfile import read_toml_file
 
 if TYPE_CHECKING:
@@ -181,7 +181,7 @@ def read_code(name: str, *, binary: bool = False) -> str | bytes:
         try:
             return sys.stdin.buffer.read() if name == "-" else Path(name).read_bytes()
         except FileNotFoundError as exc:
-            raise InputError(f"{name}: no such file") from exc
+            raise not_a_file(name) from exc
         except OSError as exc:
             raise InputError(f"{name}: cannot read ({exc.strerror or exc})") from exc
     if name == "-":
@@ -189,7 +189,7 @@ def read_code(name: str, *, binary: bool = False) -> str | bytes:
     try:
         return decoded(Path(name).read_bytes())
     except FileNotFoundError as exc:
-        raise InputError(f"{name}: no such file") from exc
+        raise not_a_file(name) from exc
     except UnicodeDecodeError as exc:
         code = exc.encoding.upper().removesuffix("-SIG")
         raise InputError(f"{name}: not a text program (byte {exc.start} is not {code})") from exc
@@ -235,7 +235,7 @@ def read_program(name: str, target: Target | None) -> Program:
         UsageError: neither a G-code ending nor a target to read it with.
     """
     if name != "-" and not Path(name).is_file():
-        raise InputError(f"{name}: no such file")
+        raise not_a_file(name)
     suffix = Path(name).suffix.lower()
     if target is not None and (not is_program_file(name) or suffix in target.post.formats.values()):
         return target.post.parse(read_code(name, binary=target.post.binary), source=name)
@@ -273,7 +273,7 @@ def preview_inputs(
         return drawing, read_program(program_name, target) if program_name else None
     if input_name != "-" and Path(input_name).suffix.lower() in DRAWING_SUFFIXES:
         if not Path(input_name).is_file():
-            raise InputError(f"{input_name}: no such file")
+            raise not_a_file(input_name)
         drawing = read_drawing(input_name, settings)
         program = read_program(program_name, target) if program_name else None
         return drawing, program

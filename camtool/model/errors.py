@@ -7,6 +7,9 @@ resemble, as ezdxf does (``DXFValueError(DXFError, ValueError)``).
 
 from __future__ import annotations
 
+import os
+import stat
+
 
 class CamtoolError(Exception):
     """Base of every error camtool raises on purpose. Exit code 1."""
@@ -32,9 +35,6 @@ def not_a_file(path: object) -> InputError:
     Missing, a folder, a symbolic link that leads nowhere (or round in a loop), or a FIFO,
     socket or device (not opened: reading one can block or never end).
     """
-    import os
-    import stat
-
     try:
         mode = os.stat(str(path)).st_mode
     except OSError:

@@ -629,3 +629,15 @@ def test_a_drawing_path_that_is_not_a_file_is_named_for_what_it_is(
         assert code == 3 and out == "", err
         assert err.startswith(f"camtool: error: {path}: {what}")
     assert not (tmp_path / "o.nc").exists()
+
+
+def test_verify_names_a_program_path_that_is_a_link_to_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    link = tmp_path / "gone.nc"
+    link.symlink_to("nowhere.nc")
+    code, out, err = run(["verify", str(link), "-t", "grbl"], capsys)
+    assert code == 3 and out == ""
+    assert (
+        err == f"camtool: error: {link}: a symbolic link that leads to no file (or round a loop)\n"
+    )
