@@ -20,7 +20,7 @@ from camtool.importers.gcode_codes import BlockWords, CommandReader, Notes, unus
 from camtool.importers.gcode_cycles import CYCLES, CycleState
 from camtool.importers.gcode_lexer import Block, Word, cut_mid_word, lex_line
 from camtool.importers.gcode_params import expand_parameters
-from camtool.importers.gcode_plain import PLAIN_WORDS, arc_end_off, arc_limits, spiral_note
+from camtool.importers.gcode_plain import arc_end_off, arc_limits, plain_words, spiral_note
 from camtool.importers.gcode_start import StartRules
 from camtool.importers.gcode_target import READ_AS_WRITTEN, LengthOffsets, Reading, path_control
 from camtool.model.errors import InputError
@@ -141,14 +141,13 @@ def _read_ahead(text: str, source: str, reading: Reading, position: int, number:
     reader = _Reader(source, reading)
     gcode_ahead.seed(reader, text, position)
     recorder = gcode_ahead.Recorder(reader)
-    plain_words = PLAIN_WORDS.findall
     for raw, last, after in _lines_at(text, position):
         number += 1
         if last:
             break
         recorder.before(number)
         try:
-            if raw.isascii() and reader.plain(plain_words(raw.upper()), number):
+            if raw.isascii() and reader.plain(plain_words(raw), number):
                 recorder.plain(number, after)
                 continue
             recorder.broken()
@@ -222,7 +221,6 @@ def _parse(
     reader = _Reader(source, reading)
     opened = False  # a '%' line before the first block: the next '%' ends the program
     ended = False
-    plain_words = PLAIN_WORDS.findall
     runs: gcode_ahead.Runs | None = None
     number = 0
     try:
@@ -245,7 +243,7 @@ def _parse(
                         "with no end of line after it): the last line is incomplete, the file "
                         "looks truncated; copy or export the program again"
                     )
-                if plain and raw.isascii() and reader.plain(plain_words(raw.upper()), number):
+                if plain and raw.isascii() and reader.plain(plain_words(raw), number):
                     continue
                 block = lex_line(raw, number, source)
                 reader.commands.operator_message(len(reader.moves), raw)

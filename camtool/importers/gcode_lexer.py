@@ -11,18 +11,18 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from camtool.model.errors import InputError
+from camtool.model.errors import InputError, quoted
 from camtool.model.units import LARGEST_VALUE
 
-_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)")
+_NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)")
 _WORD = re.compile(r"([A-NP-Z])(" + _NUMBER.pattern + ")")
 """A word as :func:`_words_by_char` reads it: a letter (not O) and its number."""
-_PROGRAM_NUMBER = re.compile(r"O\d+")
+_PROGRAM_NUMBER = re.compile(r"O[0-9]+")
 """A Fanuc/Haas program number line (``O01001 (PART)``): no effect on the moves; LinuxCNC's
 interpreter reads a bare O-number as nothing too (its ``rs274`` runs such a file)."""
 _COMMENT_CHARS = re.compile(r"[;()*]")
-_CHECKSUM = re.compile(r"\*(\d+)$")
-_CUT = re.compile(r"[A-Za-z]\s*[+-]?\s*(?:\d[\d\s]*)?\.$|[A-Za-z]\s*[+-]?$")
+_CHECKSUM = re.compile(r"\*([0-9]+)$")
+_CUT = re.compile(r"[A-Za-z]\s*+[+-]?\s*+(?:[0-9][0-9\s]*+)?\.$|[A-Za-z]\s*+[+-]?$")
 """The end of a line cut inside a word: ``X12.``, ``X-``, ``Y`` (spaces may sit inside)."""
 
 
@@ -70,7 +70,7 @@ def lex_line(raw: str, line: int, source: str) -> Block | None:
     code = code.strip()
     if code.startswith("%"):
         if code[1:].strip():
-            raise InputError(f"{where}: text after the '%' tape marker: {code!r}; remove it")
+            raise InputError(f"{where}: text after the '%' tape marker: {quoted(code)}; remove it")
         return None
     if star_at is not None:
         code = _check_checksum(raw, code, star_at, where)
@@ -109,8 +109,13 @@ def _strip_comments(raw: str, where: str) -> tuple[str, int | None]:
 
 
 def _strip_comments_by_char(raw: str, where: str) -> tuple[str, int | None]:
-    """:func:`_strip_comments` of any line, character by character (naming what is wrong)."""
+    """:func:`_strip_comments` of any line, character by character (naming what is wrong).
+
+    Linear in the line's length, however many comments it holds: each comment looks only
+    at the last character kept before it and the first one after it.
+    """
     kept: list[str] = []
+    solid = -1  # index in ``kept`` of its last non-blank character
     star_at: int | None = None
     i = 0
     while i < len(raw):
@@ -119,12 +124,11 @@ def _strip_comments_by_char(raw: str, where: str) -> tuple[str, int | None]:
             break
         if c == "(":
             close = raw.find(")", i + 1)
-            nested = raw.find("(", i + 1)
             if close < 0:
                 raise InputError(f"{where}: comment '(' is not closed; add ')' on the same line")
-            if 0 <= nested < close:
+            if raw.find("(", i + 1, close) >= 0:
                 raise InputError(f"{where}: nested comment '(... (...' is not allowed; remove it")
-            _check_not_in_word(raw, kept, close, where)
+            _check_not_in_word(raw, kept, solid, close, where)
             kept.append(" ")
             i = close + 1
             continue
@@ -133,30 +137,36 @@ def _strip_comments_by_char(raw: str, where: str) -> tuple[str, int | None]:
         if c == "*" and star_at is None:
             star_at = i
         kept.append(c)
+        if not c.isspace():
+            solid = len(kept) - 1
         i += 1
     return "".join(kept), star_at
 
 
 _WORD_GOES_ON = frozenset("0123456789.+-")
 """What may follow a word's letter or come within its number: a comment there splits it."""
+_BLANKS = re.compile(r"\s*")
 
 
-def _check_not_in_word(raw: str, kept: list[str], close: int, where: str) -> None:
+def _check_not_in_word(raw: str, kept: list[str], solid: int, close: int, where: str) -> None:
     """Refuse a comment ``(...)`` (ending at ``raw[close]``) inside a word: ``X1(c)0``.
 
+    ``kept[solid]`` is the last non-blank character kept before the comment (``solid``
+    is -1 when there is none).
     Blanks inside a number are read as nothing (``X1 0`` is ``X10``, as LinuxCNC reads it),
     but a comment there is not: LinuxCNC's ``rs274`` stops with "Bad character" at what
     follows it, so camtool must not read ``X10`` (nor ``X(c)10``, ``X-(c)1``).
     """
-    before = "".join(kept).rstrip()
-    after = raw[close + 1 :].lstrip()
-    if not before or not after or after[0] not in _WORD_GOES_ON:
+    after_at = _BLANKS.match(raw, close + 1).end()  # type: ignore[union-attr]
+    if solid < 0 or after_at == len(raw) or raw[after_at] not in _WORD_GOES_ON:
         return
-    if before[-1].isalpha() or before[-1] in _WORD_GOES_ON:
+    last = kept[solid]
+    if last.isalpha() or last in _WORD_GOES_ON:
+        before = "".join(kept[: solid + 1])  # only on the way to the error
         tail = re.search(r"[A-Za-z][0-9.+\- ]*$", before)
         word = (tail[0] if tail else before.split()[-1]).replace(" ", "")
         raise InputError(
-            f"{where}: a comment inside the word {word!r}...{after[:1]!r}: LinuxCNC refuses "
+            f"{where}: a comment inside the word {word!r}...{raw[after_at]!r}: LinuxCNC refuses "
             "it (a word's number cannot go on after a comment); move the comment after the word"
         )
 
@@ -167,14 +177,16 @@ def _check_checksum(raw: str, code: str, star_at: int, where: str) -> str:
     if m is None:
         _refuse_special("[" if "[" in code else "", code, where)  # '*' in an expression
         raise InputError(
-            f"{where}: '*' must end the line followed by a checksum (e.g. '*71'): {code!r}"
+            f"{where}: '*' must end the line followed by a checksum (e.g. '*71'): {quoted(code)}"
         )
     expected = 0
     for byte in raw[:star_at].encode("latin-1", errors="replace"):
         expected ^= byte
-    if int(m[1]) != expected:
+    digits = m[1].lstrip("0")
+    if len(digits) > 3 or int(m[1]) != expected:  # a checksum is one byte, 0 to 255
+        shown = m[1] if len(m[1]) <= 12 else f"{m[1][:8]}... ({len(m[1])} digits)"
         raise InputError(
-            f"{where}: checksum *{m[1]} does not match the line (computed *{expected}); "
+            f"{where}: checksum *{shown} does not match the line (computed *{expected}); "
             "the line was damaged: export the program again"
         )
     return code[: m.start()]
@@ -210,17 +222,18 @@ def _words_by_char(code: str, where: str) -> list[Word]:
         c = code[i]
         _refuse_special(c, code, where)
         if not ("A" <= c <= "Z"):
-            raise InputError(f"{where}: unexpected character {c!r} in {code!r}")
+            raise InputError(f"{where}: unexpected character {c!r} in {quoted(code)}")
         if c == "O":
             raise InputError(
-                f"{where}: O-word {code!r} (subroutines, loops, conditions) is not supported; "
-                "expand the program in your CAM (a Fanuc program number line can be deleted)"
+                f"{where}: O-word {quoted(code)} (subroutines, loops, conditions) is not "
+                "supported; expand the program in your CAM (a Fanuc program number line can be "
+                "deleted)"
             )
         m = _NUMBER.match(code, i + 1)
         if m is None:
             _refuse_special(code[i + 1 : i + 2], code, where)
             _refuse_special("[" if "[" in code[i:] else "", code, where)  # X SQRT[2], ...
-            raise InputError(f"{where}: letter {c!r} is not followed by a number in {code!r}")
+            raise InputError(f"{where}: letter {c!r} is not followed by a number in {quoted(code)}")
         value = float(m[0])
         if not abs(value) < LARGEST_VALUE:
             shown = m[0] if len(m[0]) <= 20 else f"{m[0][:12]}... ({len(m[0])} characters)"
@@ -275,14 +288,15 @@ def _refuse_special(c: str, code: str, where: str) -> None:
             else "'#' parameters on this line"
         )
         raise InputError(
-            f"{where}: {kind} are not supported ({code!r}); camtool reads numbered parameters "
-            f"set to numbers ('#1=2.5', then 'X#1') and {_PLAIN.removeprefix('camtool reads ')}"
+            f"{where}: {kind} are not supported ({quoted(code)}); camtool reads numbered "
+            "parameters set to numbers ('#1=2.5', then 'X#1') and "
+            f"{_PLAIN.removeprefix('camtool reads ')}"
         )
     if c and c in "[]":
-        raise InputError(f"{where}: '[ ]' expressions are not supported ({code!r}); {_PLAIN}")
+        raise InputError(f"{where}: '[ ]' expressions are not supported ({quoted(code)}); {_PLAIN}")
     if c == "$" and code.startswith("$"):
         raise InputError(
-            f"{where}: {code!r} is a GRBL system command (settings, homing, jogging), not "
+            f"{where}: {quoted(code)} is a GRBL system command (settings, homing, jogging), not "
             "G-code: camtool reads G-code only; delete the line, and give the command to the "
             "machine yourself before running the program"
         )

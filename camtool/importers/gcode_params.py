@@ -23,13 +23,13 @@ from __future__ import annotations
 
 import re
 
-from camtool.model.errors import InputError
+from camtool.model.errors import InputError, quoted
 
 LAST_USER = 5000
 """The last numbered parameter a program sets for itself; above it LinuxCNC keeps its own
 (probe results, coordinate-system offsets, the tool in the spindle)."""
 
-_NUM = r"(?:\d+\.?\d*|\.\d+)(?![\d.])"
+_NUM = r"(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?![0-9.])"
 """A number, not followed by more digits or a point (``5.5.5`` is none)."""
 _SET = re.compile(rf"#({_NUM})=([+-]?)(?:({_NUM})|#({_NUM}))")
 """An assignment in a line without spaces: ``#n=`` a signed number or a signed parameter."""
@@ -100,8 +100,8 @@ def _expand_line(raw: str, values: dict[int, str], where: str) -> str | None:
             )
             if "#" in text:
                 raise InputError(
-                    f"{where}: a '#' in {code.strip()!r} is neither a word's value ('X#1') nor a "
-                    "setting ('#1=2.5'), which LinuxCNC refuses; write the number itself"
+                    f"{where}: a '#' in {quoted(code.strip())} is neither a word's value ('X#1') "
+                    "nor a setting ('#1=2.5'), which LinuxCNC refuses; write the number itself"
                 )
         out.append(text)
     values.update(sets)  # a line's sets after all its reads

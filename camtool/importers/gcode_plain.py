@@ -87,6 +87,18 @@ words only. Anything else (a comment, another letter or character, a blank insid
 gives a pair whose letter is empty (the rest of the line its text): the line is not plain
 and goes to the lexer. A line with a non-ASCII character goes there unsearched. One search
 per line: the line no longer has to match a pattern of the whole line first."""
+_FIND_PLAIN = PLAIN_WORDS.findall
+
+
+def plain_words(raw: str) -> list[tuple[str, str]]:
+    """What :data:`PLAIN_WORDS` finds in line ``raw`` in upper case, its end blanks left out.
+
+    Blanks that end a line match nothing: ``findall`` would try each of them as a start and
+    run to the end of the line from there, a time quadratic in their number.
+    """
+    return _FIND_PLAIN(raw.upper().rstrip(" \t"))
+
+
 _PLAIN_MOTION = {0: "G0", 10: "G1", 20: "G2", 30: "G3"}
 _PLAIN_G = {0.0: "G0", 1.0: "G1", 2.0: "G2", 3.0: "G3"}
 """:data:`_PLAIN_MOTION` by the G word's value, for the values ``g_key`` gives those keys."""

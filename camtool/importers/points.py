@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from camtool.importers.options import ImportOptions
-from camtool.model.errors import InputError, UsageError, not_a_file
+from camtool.model.errors import InputError, UsageError, not_a_file, quoted
 from camtool.model.shapes import Contour, Drawing, Line, Point
 from camtool.model.units import LARGEST_VALUE, LENGTH_UNITS
 
@@ -25,7 +25,7 @@ de una decima de milímetro")."""
 LAYER = "0"
 """Contour.layer of every stroke (point lists have no layers)."""
 
-NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
 """A number as point lists write it: ``12``, ``-1.5``, ``.5``, ``3.``, ``1e-3``."""
 _FIELD = re.compile(r'"([^"]*)"|[^,;\s]+')
 """A field: what lies between separators (comma, semicolon, tab, spaces), or between
@@ -537,7 +537,7 @@ def _in_range(text: str, column: int, where: _Where) -> float:
 
 
 def _quote(text: str) -> str:
-    return repr(text) if len(text) <= 24 else f"{text[:16]!r}... ({len(text)} characters)"
+    return quoted(text, 24)
 
 
 def _why_not(text: str) -> str:

@@ -29,6 +29,17 @@ class InputError(CamtoolError, ValueError):
     exit_code = 3
 
 
+def quoted(text: str, limit: int = 80) -> str:
+    """``repr(text)`` for a message, or its start and its length when it is long.
+
+    A text longer than ``limit`` characters shows as ``'G1X1Y2G1X1Y2'... (1000000
+    characters)``, so that a hostile line still gives a message of one readable line.
+    """
+    if len(text) <= limit:
+        return repr(text)
+    return f"{text[: limit * 2 // 3]!r}... ({len(text)} characters)"
+
+
 def not_a_file(path: object) -> InputError:
     """The error for an input ``path`` that is not a regular file: what it is instead.
 

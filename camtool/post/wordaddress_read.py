@@ -38,7 +38,7 @@ from camtool.post.wordaddress_spec import WordAddressSpec
 
 _WORD = re.compile(r"([A-Za-z])([^A-Za-z]*)")
 _UPPER_WORD = re.compile(r"[A-Z][^A-Za-z]*")
-_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)")
+_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)", re.ASCII)
 _CLEAN_WORD = re.compile(r"[A-Za-z][^A-Za-z\s]*")
 """A token that passes every check of :meth:`BlockReader.words` on its form (one letter, no
 space): the blocks the writer writes, tested once instead of check by check."""
