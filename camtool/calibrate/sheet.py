@@ -16,14 +16,14 @@ from pathlib import Path
 
 from camtool.calibrate.coupon import Coupon, Measure
 from camtool.calibrate.fitdata import Observation
-from camtool.model.errors import InputError
+from camtool.model.errors import InputError, quoted
 from camtool.model.machine import Machine
 from camtool.model.tomlfile import read_small_text
 from camtool.model.units import LARGEST_VALUE, fmt_num
 
 SHEET_BYTES = 1 << 20
 """The largest sheet read, bytes (a coupon's filled-in sheet is under 20 KB)."""
-NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?", re.ASCII)
+NUMBER = re.compile(r"[+-]?+(\d++\.?+\d*+|\.\d++)([eE][+-]?+\d++)?+", re.ASCII)
 """A plain ASCII decimal (``12``, ``12.5``, ``.5``, ``1.2e-3``): what a sheet's number may be.
 Python's ``float`` also takes ``1_5``, full-width and Arabic-Indic digits, ``inf`` and ``nan``."""
 
@@ -209,8 +209,9 @@ def _number(
         comma = NUMBER.fullmatch(text.replace(",", ".", 1)) is not None
         hint = f"; a decimal comma? write {text.replace(',', '.', 1)}" if comma else ""
         raise InputError(
-            f"{source}: line {line}, column '{column}': {text!r} is not a number (plain ASCII "
-            f"digits with a decimal point, e.g. 12.345; mm or µm as the column's name says{hint})"
+            f"{source}: line {line}, column '{column}': {quoted(text)} is not a number (plain "
+            "ASCII digits with a decimal point, e.g. 12.345; mm or µm as the column's name "
+            f"says{hint})"
         )
     value = float(text)
     if (
@@ -221,7 +222,7 @@ def _number(
     ):
         want = "> 0" if positive else ">= 0"
         raise InputError(
-            f"{source}: line {line}, column '{column}': {text!r} must be a finite number {want} "
-            f"and under {LARGEST_VALUE:g}"
+            f"{source}: line {line}, column '{column}': {quoted(text)} must be a finite number "
+            f"{want} and under {LARGEST_VALUE:g}"
         )
     return value

@@ -36,7 +36,13 @@ from camtool.cli.common import (
 from camtool.cli.job import job
 from camtool.cli.preview import preview
 from camtool.cli.send import send, simulate_device
-from camtool.model.errors import CamtoolError, InputError, UsageError, VerifyLimitError
+from camtool.model.errors import (
+    CamtoolError,
+    InputError,
+    UsageError,
+    VerifyLimitError,
+    readable,
+)
 from camtool.model.version import __version__
 from camtool.toolpath.options import MAX_TOOL_DIAMETER_MM
 
@@ -588,7 +594,7 @@ def main(argv: list[str] | None = None) -> int:
     except click.Abort as exc:
         return _aborted(exc)
     except CamtoolError as exc:
-        click.echo(f"camtool: error: {exc}", err=True)
+        click.echo(f"camtool: error: {readable(str(exc))}", err=True)
         return exc.exit_code
     except Exception as exc:  # a bug: still a message, never a traceback
         if _interrupted(exc):

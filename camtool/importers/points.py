@@ -25,14 +25,19 @@ de una decima de milímetro")."""
 LAYER = "0"
 """Contour.layer of every stroke (point lists have no layers)."""
 
-NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
-"""A number as point lists write it: ``12``, ``-1.5``, ``.5``, ``3.``, ``1e-3``."""
+NUMBER = re.compile(r"[+-]?+(?:\d++\.?+\d*+|\.\d++)(?:[eE][+-]?+\d++)?+", re.ASCII)
+"""A number as point lists write it: ``12``, ``-1.5``, ``.5``, ``3.``, ``1e-3``.
+
+Its quantifiers are possessive (``++``, ``*+``), here and in the other patterns of point
+lists: a hostile row of a million digits or blanks is matched in time linear in its
+length, not quadratic (each possessive run is the only one that can match)."""
 _FIELD = re.compile(r'"([^"]*)"|[^,;\s]+')
 """A field: what lies between separators (comma, semicolon, tab, spaces), or between
 double quotes (a CSV writer quoting every field: ``"1.5","2"``)."""
-_DECIMAL_COMMA = re.compile(r"[+-]?[\d.]*\d,\d[\d.]*")
-"""A comma between two digits: a decimal comma when the row separates its columns otherwise."""
-_OTHER_SEPARATOR = re.compile(r";|[\d.]\s+[+\-.\d]")
+_DIGIT_COMMA = re.compile(r"\d,\d")
+"""A comma between two digits: a decimal comma when the row separates its columns otherwise
+(:func:`_decimal_comma` widens it to the number it stands in)."""
+_OTHER_SEPARATOR = re.compile(r";|[\d.]\s++[+\-.\d]")
 """A semicolon, or tabs or blanks between two numbers: the separators of a decimal-comma row
 (not a row's trailing blanks)."""
 _HEADER_UNITS = {
@@ -164,7 +169,10 @@ _PROGRAM_LOOK = 20
 """How many lines (not blank) are looked at for a block (a program's header comes first)."""
 
 
-_NUMBER_ROW = re.compile(rf"\s*{NUMBER.pattern}(?:\s*[,;\s]\s*{NUMBER.pattern}){{1,2}}\s*[,;]?\s*$")
+_NUMBER_ROW = re.compile(
+    rf"\s*+{NUMBER.pattern}(?:(?:\s*+[,;]\s*+|\s++){NUMBER.pattern}){{1,2}}\s*+[,;]?+\s*+$",
+    re.ASCII,
+)
 """A row of two or three numbers, as a point list writes them."""
 _EXCEL_SEPARATOR = re.compile(r'\s*"?sep=(.?)"?\s*', re.IGNORECASE)
 """Excel's first line naming the column separator (``sep=;``), which it writes for a CSV
@@ -468,14 +476,34 @@ def _excel_separator_line(text: str, path: Path) -> int | None:
 
 def _refuse_decimal_comma(raw: str, where: _Where) -> None:
     """Refuse a comma between two digits in a row separated otherwise (a decimal comma)."""
-    comma = _DECIMAL_COMMA.search(raw)
+    comma = _decimal_comma(raw)
     if comma is not None and _OTHER_SEPARATOR.search(raw):
+        start, number = comma
         raise where.fail(
-            comma.start() + 1,
-            f"{_quote(comma[0])} has a decimal comma (the row separates its columns by "
+            start + 1,
+            f"{_quote(number)} has a decimal comma (the row separates its columns by "
             "semicolons, tabs or blanks); camtool reads decimal points: save the file "
             "with '.' decimals (a spreadsheet's export in an English locale)",
         )
+
+
+def _decimal_comma(raw: str) -> tuple[int, str] | None:
+    """The first number of ``raw`` with a comma between two digits, and where it starts.
+
+    The number is the run of digits and points around the first such comma, with a sign
+    before it (``-1.5,25``); a scan out from the comma, linear in the row's length.
+    """
+    found = _DIGIT_COMMA.search(raw)
+    if found is None:
+        return None
+    start, end = found.start(), found.end()
+    while start > 0 and (raw[start - 1].isdecimal() or raw[start - 1] == "."):
+        start -= 1
+    if start > 0 and raw[start - 1] in "+-":
+        start -= 1
+    while end < len(raw) and (raw[end].isdecimal() or raw[end] == "."):
+        end += 1
+    return start, raw[start:end]
 
 
 @dataclass(frozen=True)

@@ -58,7 +58,7 @@ STDIN = "<stdin>"
 _SNIFF_BYTES = 1 << 16
 """How much of standard input :func:`stdin_kind` looks at."""
 _DXF_CODES = ("0", "999")
-_GCODE_WORD = re.compile(r"/?\s*(?:[A-Za-z]\s*[-+]?\s*[\d.#\[<]|#[\d<])")
+_GCODE_WORD = re.compile(r"/?\s*+(?:[A-Za-z]\s*+[-+]?\s*+[\d.#\[<]|#[\d<])")
 """The start of a G-code block: a word (``G0``, ``X-1.5``, ``F#1``, ``o<sub>``), a parameter
 (``#1=``, ``#<x>=``), after an optional block delete ``/``."""
 _MATLAB = re.compile(r"[A-Za-z_]\w*\s*=")
@@ -66,9 +66,10 @@ _EXCEL_SEPARATOR = re.compile(r'"?sep=.?"?', re.IGNORECASE)
 """Excel's first line naming a CSV's column separator (``sep=;``)."""
 _POINT_ROW = re.compile(r'"?[-+.\d]')
 """The start of a point list's row: a number, perhaps quoted (``"1.5","2"``)."""
-_HEADER = re.compile(r"[A-Za-z_]\w*(?:[\s,;]+[A-Za-z_]\w*)*|[^\d<]*[A-Za-z][^\d]*")
+_HEADER = re.compile(r"[A-Za-z_]\w*+(?:[\s,;]++[A-Za-z_]\w*+)*+|[^\d<A-Za-z]*+[A-Za-z]\D*+")
 """A point list's header row: words (``x,y,z``, ``x1;y1``), or any line of letters without
-digits (``X (in),Y (in)``, ``"x","y"``)."""
+digits (``X (in),Y (in)``, ``"x","y"``). Possessive quantifiers (``*+``) keep the match
+linear in the line's length (each run is the only one that can match)."""
 
 
 def stdin_kind(data: bytes) -> str:

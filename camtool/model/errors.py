@@ -40,6 +40,23 @@ def quoted(text: str, limit: int = 80) -> str:
     return f"{text[: limit * 2 // 3]!r}... ({len(text)} characters)"
 
 
+MAX_MESSAGE = 2000
+"""The longest message :func:`readable` shows whole, in characters."""
+
+
+def readable(message: str) -> str:
+    """``message``, its middle left out when it is longer than :data:`MAX_MESSAGE`.
+
+    The start (the file, line and what is wrong) and the end (what to do) are kept: a
+    message that quotes a hostile input whole stays a message a user can read.
+    """
+    if len(message) <= MAX_MESSAGE:
+        return message
+    head, tail = MAX_MESSAGE * 2 // 3, MAX_MESSAGE // 4
+    left_out = len(message) - head - tail
+    return f"{message[:head]} ... ({left_out} characters left out) ... {message[-tail:]}"
+
+
 def not_a_file(path: object) -> InputError:
     """The error for an input ``path`` that is not a regular file: what it is instead.
 

@@ -15,7 +15,7 @@ import re
 from dataclasses import dataclass, field
 from typing import Literal
 
-from camtool.model.errors import DialectError, ParseError
+from camtool.model.errors import DialectError, ParseError, quoted
 from camtool.model.program import (
     ArcMove,
     Command,
@@ -38,7 +38,7 @@ from camtool.post.wordaddress_spec import WordAddressSpec
 
 _WORD = re.compile(r"([A-Za-z])([^A-Za-z]*)")
 _UPPER_WORD = re.compile(r"[A-Z][^A-Za-z]*")
-_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)", re.ASCII)
+_NUMBER = re.compile(r"[+-]?+(?:\d++\.?+\d*+|\.\d++)", re.ASCII)  # possessive: linear
 _CLEAN_WORD = re.compile(r"[A-Za-z][^A-Za-z\s]*")
 """A token that passes every check of :meth:`BlockReader.words` on its form (one letter, no
 space): the blocks the writer writes, tested once instead of check by check."""
@@ -142,15 +142,15 @@ class BlockReader:
         start = i = 0
         while i < len(raw) and raw[i] != ";":
             if raw[i] == ")":
-                raise self.fail(f"')' without '(' in {raw!r}")
+                raise self.fail(f"')' without '(' in {quoted(raw)}")
             if raw[i] != "(":
                 i += 1
                 continue
             end = raw.find(")", i + 1)
             if end < 0:
-                raise self.fail(f"comment '(' is not closed on its line: {raw!r}")
+                raise self.fail(f"comment '(' is not closed on its line: {quoted(raw)}")
             if "(" in raw[i + 1 : end]:
-                raise self.fail(f"nested comment '(... (...' in {raw!r}")
+                raise self.fail(f"nested comment '(... (...' in {quoted(raw)}")
             pieces.append(raw[start:i])
             start = i = end + 1
         if start == 0 and i == len(raw):
@@ -164,7 +164,7 @@ class BlockReader:
         """Read one non-blank line."""
         spec, s = self.spec, self.state
         if s.ended:
-            raise self.fail(f"{raw!r} after the program end on line {s.ended}")
+            raise self.fail(f"{quoted(raw)} after the program end on line {s.ended}")
         size = len((raw + spec.line_end).encode("ascii", errors="replace"))
         if spec.max_block_bytes is not None and size > spec.max_block_bytes:
             raise self.fail(
@@ -173,7 +173,7 @@ class BlockReader:
             )
         codes, values = self.words(raw)
         if not codes and not values:
-            raise self.fail(f"no word in {raw!r}")
+            raise self.fail(f"no word in {quoted(raw)}")
         static = self.static
         key = next((c for c in codes if c not in self.motions and c not in static), None)
         home = next((c for c in codes if c in spec.homes), None)
@@ -221,27 +221,29 @@ class BlockReader:
         body = raw
         if spec.block_end:
             if not raw.endswith(spec.block_end):
-                raise self.fail(f"block does not end with {spec.block_end!r}: {raw!r}")
+                raise self.fail(f"block does not end with {spec.block_end!r}: {quoted(raw)}")
             body = raw[: -len(spec.block_end)]
         if spec.separator:
             tokens = body.split(spec.separator)
         else:
             tokens = [m.group(0) for m in _WORD.finditer(body)]
             if "".join(tokens) != body:
-                raise self.fail(f"{spec.name} writes no spaces or other characters: {raw!r}")
+                raise self.fail(f"{spec.name} writes no spaces or other characters: {quoted(raw)}")
         clean = all(map(_CLEAN_WORD.fullmatch, tokens))
         for token in () if clean else tokens:  # the first bad token's own message
             glued = len(_UPPER_WORD.findall(token)) > 1
             if not token or glued or any(c.isspace() for c in token):
-                raise self.fail(f"words must be separated by one space: {raw!r}")
+                raise self.fail(f"words must be separated by one space: {quoted(raw)}")
             if not _WORD.fullmatch(token):
-                raise self.fail(f"{token!r} is not a word (a letter and a number) in {raw!r}")
+                raise self.fail(
+                    f"{quoted(token)} is not a word (a letter and a number) in {quoted(raw)}"
+                )
         codes: list[str] = []
         values: dict[str, float] = {}
         for token in tokens:
             letter, text = token[0], token[1:]
             if letter in values or (letter in "GM" and token in codes):
-                raise self.fail(f"{letter} appears twice in {raw!r}")
+                raise self.fail(f"{letter} appears twice in {quoted(raw)}")
             if letter in "GM":
                 if token not in self.codes:
                     known = " ".join(sorted(self.codes))

@@ -17,7 +17,7 @@ from decimal import ROUND_HALF_UP, Decimal
 from types import MappingProxyType
 from typing import Any, ClassVar
 
-from camtool.model.errors import DialectError, ParseError
+from camtool.model.errors import DialectError, ParseError, quoted
 from camtool.model.machine import Machine
 from camtool.model.program import (
     ArcMove,
@@ -632,7 +632,7 @@ class PicMmhPost(PostProcessor):
                 continue
             m = _BLOCK.match(line)
             if m is None:
-                raise ParseError(f"{source}:{number}: not a pic-mmh block: {line!r}")
+                raise ParseError(f"{source}:{number}: not a pic-mmh block: {quoted(line)}")
             moves.append(self._read_move(m, number, source, contours.next(m["g"] == "0")))
             lines.append(number)
         return Program(tuple(moves), lines=tuple(lines), commands=tuple(commands))
@@ -654,7 +654,7 @@ class PicMmhPost(PostProcessor):
             (lo, _), (hi, _) = self.feeds.lowest, self.feeds.highest
             codes = f"F{lo:02d}–F{hi:02d}" if hi - lo + 1 == len(self.feeds.codes) else "its codes"
             raise ParseError(
-                f"{source}:{number}: F{m['f']} is not in the feed table ({codes}): {m[0]!r}"
+                f"{source}:{number}: F{m['f']} is not in the feed table ({codes}): {quoted(m[0])}"
             )
         if g == 1:
             return Linear(x, y, feed, contour=contour)
