@@ -92,3 +92,15 @@ def test_a_long_message_keeps_its_start_and_its_end() -> None:
     left_out = len(message) - (MAX_MESSAGE * 2 // 3) - (MAX_MESSAGE // 4)
     assert f" ... ({left_out} characters left out) ... " in shown
     assert readable("short") == "short"
+
+
+def test_the_cli_shortens_a_long_message_and_keeps_what_to_do(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    drawing = Path(__file__).parents[2] / "samples" / "logo.dxf"
+    code = main(["post", str(drawing), "-t", "A" * 20_000, "-o", str(tmp_path / "o.nc")])
+    err = capsys.readouterr().err
+    assert code != 0 and err.startswith("camtool: error: unknown target 'AAA")
+    assert "characters left out" in err and len(err) < MAX_MESSAGE + 100
+    assert err.rstrip().endswith("(or a target .toml file)")  # what to do is kept
+    assert not (tmp_path / "o.nc").exists()
