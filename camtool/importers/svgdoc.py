@@ -652,6 +652,7 @@ def prepare(
         reason = _SKIP_REASONS["marker"]
         warnings.append(f"{path}: skipped the markers of {counts['marker']} {noun} ({reason})")
     clip_paths_first(root)
+    svgvalues.drop_gradients(root)
     return Prepared(ET.tostring(root), matrix, viewport, tuple(warnings), page)
 
 
