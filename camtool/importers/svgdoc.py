@@ -18,6 +18,7 @@ from pathlib import Path
 
 from camtool.importers import svgcheck, svgvalues
 from camtool.importers.options import check_expansion, entity_limit
+from camtool.importers.svgcontent import hold_unrendered
 from camtool.importers.svgcss import (
     apply_style_sheets,
     inline_style,
@@ -625,6 +626,7 @@ def prepare(
     fade_under_transparent(root)
     masks_as_clips(root, parents, hold, str(path), viewport)
     hold_undrawn(root, parents, hold, counts, placed)
+    warnings += hold_unrendered(root, hold, str(path))
     count_skipped(root, hold, counts)
     if counts["use-file"]:
         warnings.append(

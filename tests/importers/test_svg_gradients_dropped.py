@@ -62,14 +62,18 @@ BODY = (
 
 
 def test_gradients_with_nothing_drawn_in_them_are_taken_out(tmp_path: Path) -> None:
-    """Kept: one a ``<use>`` places (its clone would hold it), and one holding a shape."""
+    """Kept: one a ``<use>`` places (its clone would hold it), and one holding a shape.
+
+    ``drawn-in``'s shape stands where SVG draws none: it goes to the hold first
+    (``svgcontent``), and the gradient with it.
+    """
     path = svg(tmp_path, BODY)
     kept = _kinds(prepare(path, None).data)
-    assert kept.count("linearGradient") + kept.count("radialGradient") == 3
+    assert kept.count("linearGradient") + kept.count("radialGradient") == 2
     data = prepare(path, None).data.decode()
-    for gone in ('"stops"', '"chain"', '"animated"', '"loose"'):
+    for gone in ('"stops"', '"chain"', '"animated"', '"loose"', '"drawn-in"'):
         assert gone not in data
-    for there in ('"placed"', '"holder"', '"drawn-in"'):
+    for there in ('"placed"', '"holder"', '"in-group"'):
         assert there in data
 
 
