@@ -40,8 +40,7 @@ def hold_unrendered(root: ET.Element, hold: ET.Element, name: str) -> list[str]:
     Returns:
         The warning that counts the shapes moved and names the first; ``[]`` for none.
     """
-    parents = {child: parent for parent in root.iter() for child in parent}
-    found: list[ET.Element] = []
+    found: list[tuple[ET.Element, ET.Element]] = []  # (the element, its parent)
     stack = [root]
     while stack:
         node = stack.pop()
@@ -53,20 +52,20 @@ def hold_unrendered(root: ET.Element, hold: ET.Element, name: str) -> list[str]:
             if renders:
                 stack.append(child)
             elif has_shapes(child):
-                found.append(child)  # with everything inside it
+                found.append((child, node))  # with everything inside it
     if not found:
         return []
     order = {e: i for i, e in enumerate(root.iter())}
-    found.sort(key=order.__getitem__)
-    shapes = [e for element in found for e in element.iter() if local_name(e) in SHAPE_KINDS]
+    found.sort(key=lambda pair: order[pair[0]])
+    shapes = [e for element, _ in found for e in element.iter() if local_name(e) in SHAPE_KINDS]
     first = shapes[0]
-    kind = str(parents[first].tag).rpartition("}")[2]
-    for element in found:
-        parents[element].remove(element)
+    host = str(found[0][1].tag).rpartition("}")[2]
+    for element, parent in found:
+        parent.remove(element)
         hold.append(element)
     many = f"{len(shapes)} shapes" if len(shapes) > 1 else "1 shape"
     return [
         f"{name}: skipped {many} placed where SVG draws none (first: {first.get(SOURCE_ATTR)} "
-        f"inside a <{kind}>; shapes are drawn in <svg>, <g>, <a> and <switch> elements): a "
+        f"inside a <{host}>; shapes are drawn in <svg>, <g>, <a> and <switch> elements): a "
         "viewer shows nothing of them; move them into a group in the drawing program to cut them"
     ]

@@ -56,7 +56,7 @@ def test_a_group_in_a_title_goes_whole_and_each_shape_counts(tmp_path: Path) -> 
     drawing = read_svg(svg(tmp_path, body))
     assert [c.source for c in drawing.contours] == ["path#kept"]
     (said,) = [w for w in drawing.warnings if "where SVG draws none" in w]
-    assert "skipped 3 shapes placed where SVG draws none (first: path#one inside a <g>" in said
+    assert "skipped 3 shapes placed where SVG draws none (first: path#one inside a <title>" in said
 
 
 def test_a_use_draws_its_target_not_its_children(tmp_path: Path) -> None:
