@@ -21,16 +21,18 @@ from camtool.importers.svgtree import NOT_DRAWN, SHAPE_KINDS, SOURCE_ATTR, has_s
 _RENDERS_CHILDREN = frozenset({"svg", "g", "a", "switch"})
 """Elements whose shape children a viewer draws where they stand."""
 _PASSED = frozenset(NOT_DRAWN - {"linearGradient", "radialGradient", "filter"})
-"""Containers of shapes drawn only where something places them, or not at all, which
-svgelements and the passes before this one deal with (``<defs>``, ``<symbol>``,
-``<marker>``, clips, masks, patterns), as the hold: not looked into."""
+"""Containers whose shapes are drawn only where something places them (a ``<use>``, a
+clip's reference), or not at all (``<defs>``, ``<symbol>``, ``<marker>``, clips, masks,
+patterns), as the hold's: their shape children stand where SVG draws shapes, and what is
+placed where it draws none inside them is moved without a warning (nothing of it shows
+where it stands; a ``<use>`` of its host, or the clip, would have drawn it)."""
 
 
 def hold_unrendered(root: ET.Element, hold: ET.Element, name: str) -> list[str]:
     """Move what is placed where SVG draws no shapes, and holds shapes, into ``hold``.
 
     A shape, ``<use>`` or element holding one, whose parent is neither ``<svg>``, ``<g>``,
-    ``<a>`` nor ``<switch>``, outside the definitions (:data:`_PASSED`) and ``hold``.
+    ``<a>`` nor ``<switch>`` (nor one of :data:`_PASSED`, nor ``hold``).
 
     Args:
         root: the ``<svg>`` element.
@@ -38,31 +40,34 @@ def hold_unrendered(root: ET.Element, hold: ET.Element, name: str) -> list[str]:
         name: the file, for the warning.
 
     Returns:
-        The warning that counts the shapes moved and names the first; ``[]`` for none.
+        The warning that counts the shapes moved from where they would have been drawn
+        (outside :data:`_PASSED` and ``hold``) and names the first; ``[]`` for none.
     """
-    found: list[tuple[ET.Element, ET.Element]] = []  # (the element, its parent)
-    stack = [root]
+    found: list[tuple[ET.Element, ET.Element, bool]] = []  # (element, its parent, drawn)
+    stack = [(root, True)]
     while stack:
-        node = stack.pop()
+        node, drawn = stack.pop()
         kind = local_name(node)
-        if node is hold or kind in _PASSED:
-            continue  # drawn only where a <use> places it, or not at all
         renders = kind in _RENDERS_CHILDREN
+        if node is hold or kind in _PASSED:
+            renders, drawn = True, False  # its shapes are drawn where something places them
         for child in node:
             if renders:
-                stack.append(child)
+                stack.append((child, drawn))
             elif has_shapes(child):
-                found.append((child, node))  # with everything inside it
+                found.append((child, node, drawn))  # with everything inside it
     if not found:
         return []
     order = {e: i for i, e in enumerate(root.iter())}
-    found.sort(key=lambda pair: order[pair[0]])
-    shapes = [e for element, _ in found for e in element.iter() if local_name(e) in SHAPE_KINDS]
-    first = shapes[0]
-    host = str(found[0][1].tag).rpartition("}")[2]
-    for element, parent in found:
+    shown = sorted(((e, p) for e, p, drawn in found if drawn), key=lambda pair: order[pair[0]])
+    for element, parent, _ in found:
         parent.remove(element)
         hold.append(element)
+    if not shown:
+        return []
+    shapes = [e for element, _ in shown for e in element.iter() if local_name(e) in SHAPE_KINDS]
+    first = shapes[0]
+    host = str(shown[0][1].tag).rpartition("}")[2]
     many = f"{len(shapes)} shapes" if len(shapes) > 1 else "1 shape"
     return [
         f"{name}: skipped {many} placed where SVG draws none (first: {first.get(SOURCE_ATTR)} "

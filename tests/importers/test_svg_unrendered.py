@@ -78,3 +78,36 @@ def test_a_use_of_a_shape_moved_out_of_a_title_still_draws_it(tmp_path: Path) ->
     body = '<title><path id="t" d="M 0 0 L 10 0"/></title><use id="u" href="#t" x="5"/>'
     drawing = read_svg(svg(tmp_path, body))
     assert [c.source for c in drawing.contours] == ["use#u > path#t"]
+
+
+@pytest.mark.parametrize(
+    "defs",
+    [
+        '<linearGradient id="host"><path id="in" d="M 0 0 L 9 9"/></linearGradient>',
+        '<title id="host"><path id="in" d="M 0 0 L 9 9"/></title>',
+        '<g id="host"><text><path id="in" d="M 0 0 L 9 9"/></text></g>',
+    ],
+)
+def test_a_use_of_an_element_holding_shapes_where_svg_draws_none_draws_none_of_them(
+    tmp_path: Path, defs: str
+) -> None:
+    """SVG 1.1 §5.6: a ``<use>`` draws its target as the target would be drawn: a gradient
+    or a title draws nothing, a group not a path inside its text. svgelements cloned the
+    target's content whole. No warning: nothing was shown where the shape stands."""
+    body = f'<defs>{defs}</defs><use id="u" href="#host"/><path id="kept" d="M 5 5 L 9 0"/>'
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.source for c in drawing.contours] == ["path#kept"]
+    assert not [w for w in drawing.warnings if "where SVG draws none" in w]
+
+
+def test_a_symbol_placed_by_a_use_draws_its_shapes_not_one_in_its_desc(tmp_path: Path) -> None:
+    """The placed symbol is drawn where the ``<use>`` stands (a nested viewport), so the
+    shape in its ``<desc>`` would have been cut there: the warning names it."""
+    body = (
+        '<symbol id="s"><desc><path id="in" d="M 0 0 L 9 9"/></desc>'
+        '<path id="shown" d="M 0 5 L 9 5"/></symbol><use id="u" href="#s"/>'
+    )
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.source for c in drawing.contours] == ["use#u > path#shown"]
+    assert any("skipped 1 shape placed where SVG draws none (first: path#in inside a <desc>"
+               in w for w in drawing.warnings)  # fmt: skip
