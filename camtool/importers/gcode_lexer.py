@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from typing import NoReturn
 
 from camtool.model.errors import InputError, quoted
 from camtool.model.units import LARGEST_VALUE
@@ -24,6 +25,18 @@ _COMMENT_CHARS = re.compile(r"[;()*]")
 _CHECKSUM = re.compile(r"\*([0-9]+)$")
 _CUT = re.compile(r"[A-Za-z]\s*+[+-]?\s*+(?:[0-9][0-9\s]*+)?\.$|[A-Za-z]\s*+[+-]?$")
 """The end of a line cut inside a word: ``X12.``, ``X-``, ``Y`` (spaces may sit inside)."""
+MAX_WORDS = 64
+"""Most words one line may hold. A block holds each letter once, G codes once per modal
+group and at most four M codes (LinuxCNC's interpreter): about 45 words. More is a program
+whose line ends were lost, or no G-code: refused at the first word past the limit, before
+the rest of the line is made into words."""
+_LONG_LINE = 255
+"""Longest line whose blanks :func:`lex_line` drops by splitting it (LinuxCNC's interpreter
+refuses any longer line: ``LINELEN`` in its ``rs274ngc.hh``); a longer one is translated,
+which makes no piece per word."""
+_NO_BLANKS = {c: None for c in range(0x3001) if chr(c).isspace()}
+"""``str.translate`` table that deletes what ``str.split()`` splits at (no code point above
+U+3000 is a blank)."""
 
 
 @dataclass(frozen=True)
@@ -77,7 +90,9 @@ def lex_line(raw: str, line: int, source: str) -> Block | None:
     block_delete = code.startswith("/")
     if block_delete:
         code = code[1:]
-    code = "".join(code.split()).upper()
+    code = (
+        "".join(code.split()) if len(code) <= _LONG_LINE else code.translate(_NO_BLANKS)
+    ).upper()
     if _PROGRAM_NUMBER.fullmatch(code):
         return None  # a program number alone: no words (O-words with more are refused)
     words = _words(code, where)
@@ -209,6 +224,8 @@ def _words(code: str, where: str) -> list[Word]:
             return _words_by_char(code, where)
         words.append(Word(m[1], value, text))
         pos = m.end()
+        if len(words) > MAX_WORDS:
+            _too_many_words(code, where)
     if pos != len(code):
         return _words_by_char(code, where)
     return words
@@ -243,7 +260,22 @@ def _words_by_char(code: str, where: str) -> list[Word]:
             )
         words.append(Word(c, value, m[0]))
         i = m.end()
+        if len(words) > MAX_WORDS:
+            _too_many_words(code, where)
     return words
+
+
+def _too_many_words(code: str, where: str) -> NoReturn:
+    """Refuse line ``code``: it holds more than :data:`MAX_WORDS` words.
+
+    Raises:
+        InputError: naming ``where`` and the line's start.
+    """
+    raise InputError(
+        f"{where}: more than {MAX_WORDS} words on one line ({quoted(code)}); a block holds "
+        "each letter once (G and M codes once per modal group): the file's line ends may have "
+        "been lost, or it is no G-code; split the line into its blocks"
+    )
 
 
 def cut_mid_word(raw: str) -> str | None:

@@ -94,9 +94,18 @@ def plain_words(raw: str) -> list[tuple[str, str]]:
     """What :data:`PLAIN_WORDS` finds in line ``raw`` in upper case, its end blanks left out.
 
     Blanks that end a line match nothing: ``findall`` would try each of them as a start and
-    run to the end of the line from there, a time quadratic in their number.
+    run to the end of the line from there, a time quadratic in their number. A line longer
+    than :data:`PLAIN_LINE_CHARS` is not searched (one pair with an empty letter: not plain):
+    the lexer reads it, or refuses it before making its words.
     """
+    if len(raw) > PLAIN_LINE_CHARS:
+        return [("", "")]
     return _FIND_PLAIN(raw.upper().rstrip(" \t"))
+
+
+PLAIN_LINE_CHARS = 4096
+"""Longest line :func:`plain_words` searches: a plain line holds nine words at most, so
+longer is blanks (read by the lexer the same) or a line the lexer refuses."""
 
 
 _PLAIN_MOTION = {0: "G0", 10: "G1", 20: "G2", 30: "G3"}
