@@ -323,11 +323,20 @@ def _check_work(todo: Sequence[Region], options: PlanOptions) -> None:
     region's outline vertices.
 
     Raises:
-        UsageError: a region needs more than :data:`MAX_POCKET_PATHS` rings or lines,
-            or the job more than :data:`MAX_POCKET_WORK` rings × vertices (names the
-            region, --stepover and --tool-diameter).
+        UsageError: the step-over is finer than ``tolerance`` (each ring is fitted within
+            it, so rings closer than it are not told apart and may cross); a region needs
+            more than :data:`MAX_POCKET_PATHS` rings or lines, or the job more than
+            :data:`MAX_POCKET_WORK` rings × vertices (names the region, --stepover and
+            --tool-diameter).
     """
     step = options.stepover * options.tool_diameter
+    if step < options.tolerance:
+        raise UsageError(
+            f"a pocket step-over of {step:g} mm ({_step_options(options)}) is finer than "
+            f"--tolerance {options.tolerance:g} mm, within which each ring is fitted to its "
+            "offset: neighbouring passes could not be told apart; give a --stepover of "
+            f"at least {options.tolerance / options.tool_diameter:.3g}, or a finer --tolerance"
+        )
     what = "zigzag lines" if options.pocket == "zigzag" else "rings"
     total, worst = 0.0, (-1.0, 0.0, 0, todo[0] if todo else None)  # work, rings, vertices
     for region in todo:

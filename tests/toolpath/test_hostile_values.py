@@ -117,13 +117,38 @@ def test_pocket_refuses_more_rings_than_the_limit(
     drawing.write_text(SQUARE_DXF)
     out = tmp_path / "out.nc"
     argv = ["post", str(drawing), "-t", "grbl", "--offset", "pocket", "--tool-diameter", "3"]
-    code = main([*argv, *args, "-o", str(out)])
+    # a tolerance as fine as these step-overs: a coarser one is refused first (below)
+    code = main([*argv, "--tolerance", "1e-6", *args, "-o", str(out)])
     err = capsys.readouterr().err
     assert code == 2
     assert count in err
     assert f"limit of {MAX_POCKET_PATHS} per pocket" in err
     assert "--stepover" in err and "internal error" not in err
     assert not out.exists()
+
+
+@pytest.mark.parametrize("style", ["concentric", "zigzag"])
+def test_pocket_refuses_a_step_over_finer_than_the_tolerance(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], style: str
+) -> None:
+    # 0.0001 × 3 mm = 0.3 µm between rings fitted within 1 µm (the default --tolerance):
+    # refused before any ring is made (it took minutes and gigabytes to plan)
+    drawing = tmp_path / "square.dxf"
+    drawing.write_text(SQUARE_DXF)
+    out = tmp_path / "out.nc"
+    argv = ["post", str(drawing), "-t", "grbl", "--offset", "pocket", "--pocket", style]
+    code = main([*argv, "--tool-diameter", "3", "--stepover", "0.0001", "-o", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert "step-over of 0.0003 mm (--stepover 0.0001 × --tool-diameter 3 mm)" in err
+    assert "finer than --tolerance 0.001 mm" in err and "at least 0.000333" in err
+    assert not out.exists()
+    # a step-over of 4 × 0.124 mm under --tolerance 0.5 is refused; 4 × 0.125 mm is planned
+    coarse = [*argv, "--tool-diameter", "4", "--tolerance", "0.5", "-o", str(out)]
+    assert main([*coarse, "--stepover", "0.124"]) == 2
+    assert "step-over of 0.496 mm" in capsys.readouterr().err and not out.exists()
+    assert main([*coarse, "--stepover", "0.125"]) == 0, capsys.readouterr().err
+    assert out.exists()
 
 
 def test_closed_gap_message_never_prints_minus_zero() -> None:
