@@ -311,7 +311,7 @@ def test_post_with_offsets_and_a_png_when_no_process_can_be_forked(
 ) -> None:
     # Under a process limit or out of memory, the offsets' child, its workers, the
     # picture's child and the budget's workers cannot start: the job is done here, the
-    # same program and picture (it was "internal error: BlockingIOError" before).
+    # same program and picture (not "internal error: BlockingIOError").
     from camtool.cli.main import main
 
     plate = Path(__file__).resolve().parents[2] / "samples" / "plate.dxf"

@@ -608,7 +608,7 @@ def test_send_of_a_drawing_says_to_post_it_first(
 def test_a_drawing_path_that_is_not_a_file_is_named_for_what_it_is(
     ending: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    # was "no such file" for each: a FIFO (not opened: it could block), a folder, a link
+    # not "no such file" for each: a FIFO (not opened: it could block), a folder, a link
     # to nothing or round a loop
     fifo, folder = tmp_path / f"fifo{ending}", tmp_path / f"folder{ending}"
     os.mkfifo(fifo)

@@ -46,7 +46,7 @@ def test_non_finite_option_is_a_usage_error_naming_it(
 @pytest.mark.parametrize(
     ("args", "said"),
     [
-        # was: linuxcnc wrote M3 S1000000000000000000000000000000 (exit 0), pic-mmh stopped
+        # not: linuxcnc wrote M3 S1000000000000000000000000000000 (exit 0), pic-mmh stopped
         # with an internal InvalidOperation, grbl a 300-digit block in its message
         (["--spindle-rpm", "1e30"], "--spindle-rpm must be ≥ 0 and ≤ 1e+06 rev/min, got 1e+30"),
         (["--spindle-dwell", "1e300"], "--spindle-dwell must be ≥ 0 and ≤ 3600 s, got 1e+300"),
@@ -183,7 +183,7 @@ def test_a_tolerance_past_a_millimetre_is_refused_as_a_slip(
 @pytest.mark.parametrize(
     "command",
     [
-        # was: preview stopped with an internal GEOSException (a sweep 1e300 mm wide), verify
+        # not: preview stopped with an internal GEOSException (a sweep 1e300 mm wide), verify
         # printed a numpy overflow warning and distances of 300 digits with exit 0
         ["preview", "-o", "p.png"],
         ["verify"],
@@ -206,7 +206,7 @@ def test_a_tool_wider_than_any_cutter_is_refused_by_verify_and_preview(
 def test_post_names_the_option_of_a_tool_wider_than_any_cutter(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    # was: "Tool.diameter must be ≥ 0 and ≤ 1000 mm, got 100000.0" (the job's field, not the option)
+    # not: "Tool.diameter must be ≥ 0 and ≤ 1000 mm, got 100000.0" (the job's field, not the option)
     out = tmp_path / "p.nc"
     args = ["--tool-diameter", "1e5", "--offset", "outside"]
     assert main(["post", str(SAMPLES / "plate.dxf"), "-t", "grbl", "-o", str(out), *args]) == 2

@@ -107,7 +107,7 @@ def test_a_header_without_insunits_is_mm_with_a_warning(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("value", ["nan", "inf", "-inf", "1e400", "1e300", "2e9"])
 def test_a_line_with_a_bad_coordinate_is_an_input_error(tmp_path: Path, value: str) -> None:
-    # was: dropped as "zero length" (NaN) or an internal OverflowError (inf) later on
+    # not: dropped as "zero length" (NaN) or an internal OverflowError (inf) later on
     path = _text_dxf(tmp_path / "a.dxf", header=_insunits(4), x1=value)
     with pytest.raises(InputError) as info:
         read_dxf(path)
@@ -192,14 +192,14 @@ def _zero_extrusion(msp: Any) -> None:
 @pytest.mark.parametrize(
     ("build", "names"),
     [
-        (_arc_nan_start, ("ARC #", "start_angle nan")),  # was: skipped as zero length
-        (_ellipse_inf_param, ("ELLIPSE #", "end_param inf")),  # was: exit 2, fit_curve's usage
-        (_bulge_inf, ("LWPOLYLINE #", "bulge", "inf")),  # was: internal ZeroDivisionError
-        (_polyline_bulge_nan, ("POLYLINE #", "vertex 1 bulge nan")),  # was: an arc, exit 0
-        (_spline_huge, ("SPLINE #", "control point 2", "1e+20")),  # was: a CPU spin
-        (_insert_nan_scale, ("INSERT #", "xscale nan")),  # was: skipped as zero length
+        (_arc_nan_start, ("ARC #", "start_angle nan")),  # not: skipped as zero length
+        (_ellipse_inf_param, ("ELLIPSE #", "end_param inf")),  # not: exit 2, fit_curve's usage
+        (_bulge_inf, ("LWPOLYLINE #", "bulge", "inf")),  # not: internal ZeroDivisionError
+        (_polyline_bulge_nan, ("POLYLINE #", "vertex 1 bulge nan")),  # not: an arc, exit 0
+        (_spline_huge, ("SPLINE #", "control point 2", "1e+20")),  # not: a CPU spin
+        (_insert_nan_scale, ("INSERT #", "xscale nan")),  # not: skipped as zero length
         (_zero_extrusion, ("ARC #", "extrusion (0.0, 0.0, 0.0) is not a direction")),
-        (_INSERT_ZERO_X, ("INSERT #", "xscale 0", "no size")),  # was: internal error
+        (_INSERT_ZERO_X, ("INSERT #", "xscale 0", "no size")),  # not: internal error
         (_INSERT_ZERO_Y, ("INSERT #", "yscale 0", "no size")),  # (ezdxf's ZeroDivisionError)
     ],
 )
@@ -375,7 +375,7 @@ def test_an_entity_without_a_layer_is_on_layer_0(tmp_path: Path) -> None:
     ],
 )
 def test_a_truncated_dxf_is_an_input_error(tmp_path: Path, text: str) -> None:
-    # was: an internal StopIteration from ezdxf's dxf_info
+    # not: an internal StopIteration from ezdxf's dxf_info
     path = tmp_path / "cut.dxf"
     path.write_text(text)
     with pytest.raises(InputError, match="damaged DXF file") as info:
@@ -583,7 +583,7 @@ def test_max_entities_on_every_command_that_reads_drawings(
 
 
 def test_an_infinite_integer_group_code_is_an_input_error(tmp_path: Path) -> None:
-    # was: an internal OverflowError (int(float("inf"))) from ezdxf's tag compiler
+    # not: an internal OverflowError (int(float("inf"))) from ezdxf's tag compiler
     path = _text_dxf(tmp_path / "a.dxf", header=_insunits(4))
     path.write_text(path.read_text().replace("  8\n0\n", "  8\n0\n 62\ninf\n"))
     with pytest.raises(InputError, match="not a readable DXF file") as info:
@@ -592,7 +592,7 @@ def test_an_infinite_integer_group_code_is_an_input_error(tmp_path: Path) -> Non
 
 
 def test_an_entity_of_an_unknown_type_without_a_layer_is_skipped(tmp_path: Path) -> None:
-    # was: an internal DXFAttributeError ("layer" is no attribute of an unknown entity)
+    # not: an internal DXFAttributeError ("layer" is no attribute of an unknown entity)
     path = _text_dxf(tmp_path / "a.dxf", header=_insunits(4))
     widget = "  0\nWIDGET\n  5\n1F\n 10\n1.0\n 20\n1.0\n"
     path.write_text(path.read_text().replace("  0\nLINE\n", widget + "  0\nLINE\n"))
@@ -659,7 +659,7 @@ def test_an_assertion_in_ezdxf_s_recover_mode_is_a_damaged_file_not_an_internal_
 ) -> None:
     # Found by fuzzing samples/part.dxf: a group code "E74" sends the file to recover mode,
     # and a group code 74 made 0 leaves a layout name that is not text, which ezdxf's
-    # audit asserts (was: "internal error: AssertionError").
+    # audit asserts (not: "internal error: AssertionError").
     lines = (Path(__file__).parents[2] / "samples" / "part.dxf").read_text().split("\n")
     assert lines[1740] == " 74" and lines[6274] == " 74"
     lines[1740], lines[6274] = "E74", " 0"
@@ -671,7 +671,7 @@ def test_an_assertion_in_ezdxf_s_recover_mode_is_a_damaged_file_not_an_internal_
 
 def test_a_polyline_vertex_without_its_location_is_a_damaged_entity(tmp_path: Path) -> None:
     # Found by fuzzing samples/logo.dxf: a VERTEX whose group code 10 was damaged has no
-    # location in ezdxf (was: "internal error: TypeError: 'NoneType' object is not
+    # location in ezdxf (not: "internal error: TypeError: 'NoneType' object is not
     # subscriptable" while converting the POLYLINE).
     def build(msp: Any) -> None:
         polyline = msp.add_polyline2d([(0, 0), (10, 0), (10, 10), (0, 10)], close=True)
@@ -688,7 +688,7 @@ def test_a_polyline_vertex_without_its_location_is_a_damaged_entity(tmp_path: Pa
 def test_a_file_whose_model_layout_is_lost_is_refused_naming_it(tmp_path: Path) -> None:
     # Found by fuzzing LibreCAD's library/elektro/connector/c8.dxf (dxflib): its layout
     # dictionary's "Model" entry made to point to handle -99999; ezdxf recovers a document
-    # without a model space (was: "internal error: KeyError: 'MODEL'").
+    # without a model space (not: "internal error: KeyError: 'MODEL'").
     from tests.corpus.conftest import CORPUS
 
     c8 = CORPUS / "pkg/librecad-data/usr/share/librecad/library/elektro/connector/c8.dxf"
@@ -705,7 +705,7 @@ def test_a_file_whose_model_layout_is_lost_is_refused_naming_it(tmp_path: Path) 
 def test_a_damaged_layout_does_not_stop_the_empty_model_space_message(tmp_path: Path) -> None:
     # Found by fuzzing LibreCAD's library/elektro/coil/L7.dxf: five damaged lines leave
     # ezdxf's recovered document with nothing in model space and a layout whose block
-    # record lost its attributes (was: "internal error: AttributeError: 'BlockRecord'
+    # record lost its attributes (not: "internal error: AttributeError: 'BlockRecord'
     # object has no attribute 'dxf'" while looking for a drawing in paper space).
     from tests.corpus.conftest import CORPUS
 

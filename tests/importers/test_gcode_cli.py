@@ -127,7 +127,7 @@ def test_post_of_a_rapid_only_program_is_an_input_error(
 def test_verify_of_code_with_nothing_to_cut_says_so(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], text: str, what: str
 ) -> None:
-    # was: "internal error: ValueError: bbox of nothing"
+    # not: "internal error: ValueError: bbox of nothing"
     code, _, err = run(["verify", write(tmp_path, "r.gcode", text), "-t", "grbl"], capsys)
     assert code == 3
     assert f"r.gcode: no cutting move in the code ({what}): nothing to verify" in err

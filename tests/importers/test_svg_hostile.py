@@ -39,9 +39,9 @@ def _refused(path: Path, options: ImportOptions | None = None) -> str:
 @pytest.mark.parametrize(
     ("d", "shown"),
     [
-        ("M 0 0 C 1e20 0 5 5 10 10", "(1e+20, 100)"),  # was: a CPU spin in fitting
-        ("M 0 0 C 1e12 0 5 5 10 10", "(1e+12, 100)"),  # was: internal ZeroDivisionError
-        ("M 0 0 L 1e300 5", "(1e+300, 95)"),  # was: posted, then a 300-digit message
+        ("M 0 0 C 1e20 0 5 5 10 10", "(1e+20, 100)"),  # not: a CPU spin in fitting
+        ("M 0 0 C 1e12 0 5 5 10 10", "(1e+12, 100)"),  # not: internal ZeroDivisionError
+        ("M 0 0 L 1e300 5", "(1e+300, 95)"),  # not: posted, then a 300-digit message
         ("M 0 0 L 1e400 5", "(inf, nan)"),
     ],
 )
@@ -147,7 +147,7 @@ def test_post_of_a_hostile_svg_exits_3_with_one_line(
 
 
 def test_an_unknown_xml_encoding_is_an_input_error(tmp_path: Path) -> None:
-    # was: an internal LookupError from the XML parser (found by fuzzing)
+    # not: an internal LookupError from the XML parser (found by fuzzing)
     path = tmp_path / "enc.svg"
     path.write_text(
         '<?xml version="1.0" encoding="UTF1e-320"?>\n<svg xmlns="http://www.w3.org/2000/svg"/>'

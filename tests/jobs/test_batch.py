@@ -72,7 +72,7 @@ def test_directory_is_searched_recursively_skipping_hidden_and_unknown(tree: Pat
 def test_symbolic_links_in_a_loop_are_one_failed_row_not_an_internal_error(
     tree: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    # was: "internal error: RuntimeError: Symlink loop" (Path.resolve) before any file
+    # not: "internal error: RuntimeError: Symlink loop" (Path.resolve) before any file
     # was posted. A file link and a folder link that loop, and one to nothing.
     os.symlink("b.dxf", tree / "a.dxf")
     os.symlink("a.dxf", tree / "b.dxf")

@@ -149,7 +149,7 @@ def test_auto_sequence_drills_first_and_cuts_the_outline_last(tmp_path: Path) ->
             ("feed = 500", "feed = 1e308"),
             r"feed = 1e\+308 mm/min; give a value > 0 and at most 1e\+06",
         ),
-        (  # was: "Tool.feed_mm_min must be > 0 and ≤ 1e+06", naming neither file nor tool
+        (  # not: "Tool.feed_mm_min must be > 0 and ≤ 1e+06", naming neither file nor tool
             ("feed = 500", "feed = 5e6"),
             r"tool 1 feed = 5e\+06 mm/min; give a value > 0 and at most 1e\+06",
         ),

@@ -45,7 +45,7 @@ def test_the_matlab_arrays_above_verify(tmp_path: Path, capsys: pytest.CaptureFi
 def test_matlab_router_value_beyond_int16_is_refused(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], number: str
 ) -> None:
-    # was: "internal error: OverflowError: Python int too large to convert to C long"
+    # not: "internal error: OverflowError: Python int too large to convert to C long"
     text = MATLAB.replace("[     0    10    20", f"[     0    {number}    20")
     code, err = verify(tmp_path, capsys, "t.m", text, "matlab-router")
     assert code == 3

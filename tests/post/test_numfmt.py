@@ -63,7 +63,7 @@ def test_format_int() -> None:
 def test_non_finite_values_are_a_dialect_error_naming_the_value(
     value: float, fmt: NumberFormat
 ) -> None:
-    # was: decimal.InvalidOperation, an "internal error" at the CLI
+    # not: decimal.InvalidOperation, an "internal error" at the CLI
     with pytest.raises(DialectError, match=f"cannot write {value!r}: the value is not a finite"):
         fmt.format(value)
 

@@ -27,8 +27,8 @@ from tests.kinematics import FALSE, assert_seconds, blocks
 
 
 def test_model_calls_its_function():
-    # the timing model's dataclass runs its block-time function (was parametrized in
-    # tests/verify/test_timing.py::test_models_call_their_functions)
+    # the timing model's dataclass runs its block-time function (the
+    # other models: tests/verify/test_timing.py::test_models_call_their_functions)
     model, direct = (
         FlashcutTiming(half_period_ms=20),
         lambda b: flashcut_block_time_s(

@@ -24,8 +24,8 @@ from tests.kinematics import assert_seconds, blocks
 
 
 def test_model_calls_its_function():
-    # the timing model's dataclass runs its block-time function (was parametrized in
-    # tests/verify/test_timing.py::test_models_call_their_functions)
+    # the timing model's dataclass runs its block-time function (the
+    # other models: tests/verify/test_timing.py::test_models_call_their_functions)
     model, direct = (
         I8751Timing(wait_t1_s=1),
         lambda b: i8751_block_time_s(b.dominant_steps, b.steps[:, 2], wait_t1_s=1),

@@ -248,7 +248,7 @@ def test_star_cruise_and_job_time(star_trace) -> None:  # type: ignore[no-untype
 
 
 def test_star_simulates_one_row_per_sample() -> None:
-    # work done, not wall time (was "< 1.0 s"): the job is simulated once, one
+    # work done, not wall time: the job is simulated once, one
     # position row per 5 ms sample of its simulated time (plus the first point)
     trace = simulate_job(STAR, RouterMachine(stop="coast", qei="firmware"))
     assert len(trace.positions_mm) == round(trace.time_s / trace.ts_s) + 1

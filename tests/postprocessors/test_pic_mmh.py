@@ -306,7 +306,7 @@ def test_dwell_warnings_are_counted_once_per_kind() -> None:
         (Spindle("ccw", 0.4), r"spindle speed 0.4 rev/min does not fit"),
         (Spindle("cw", -5), r"spindle speed -5 rev/min does not fit"),
         (Spindle("cw", math.nan), r"spindle speed nan rev/min does not fit"),
-        # more digits than decimal's 28 to round to whole rev/min (was: InvalidOperation)
+        # more digits than decimal's 28 to round to whole rev/min (not: InvalidOperation)
         (Spindle("cw", 1e30), r"spindle speed 1e\+30 rev/min does not fit"),
         (ToolChange(100), r"contour 1, block 3: tool 100 does not fit M06T## \(0–99"),
         (ToolChange(-1), r"tool -1 does not fit"),

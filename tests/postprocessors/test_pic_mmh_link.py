@@ -132,7 +132,7 @@ def test_backlash_command_from_the_thesis_compensations() -> None:
     assert backlash_command("Y", 168.5) == "BY169;"
     assert backlash_command("X", 192.5) == "BX193;"
     assert backlash_commands(load_target("pic-mmh").machine) == ("BX204;", "BY178;")
-    for bad in (999.5, -0.6, float("nan"), True, 1e30, -1e30):  # 1e30: was InvalidOperation
+    for bad in (999.5, -0.6, float("nan"), True, 1e30, -1e30):  # 1e30: not an InvalidOperation
         with pytest.raises(DialectError):
             backlash_command("X", bad)
     with pytest.raises(DialectError, match="axis 'Q'"):

@@ -21,8 +21,8 @@ from tests.kinematics import FALSE, assert_seconds, blocks
 
 
 def test_model_calls_its_function():
-    # the timing model's dataclass runs its block-time function (was parametrized in
-    # tests/verify/test_timing.py::test_models_call_their_functions)
+    # the timing model's dataclass runs its block-time function (the
+    # other models: tests/verify/test_timing.py::test_models_call_their_functions)
     model, direct = (
         PicMmhTiming(),
         lambda b: pic_mmh_block_time_s(

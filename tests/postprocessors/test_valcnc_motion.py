@@ -26,8 +26,8 @@ from tests.kinematics import assert_seconds, blocks
 
 
 def test_model_calls_its_function():
-    # the timing model's dataclass runs its block-time function (was parametrized in
-    # tests/verify/test_timing.py::test_models_call_their_functions)
+    # the timing model's dataclass runs its block-time function (the
+    # other models: tests/verify/test_timing.py::test_models_call_their_functions)
     model, direct = ValcncTiming(), lambda b: valcnc_block_time_s(b.iterations)
     b = blocks()
     t = model.block_time_s(b)

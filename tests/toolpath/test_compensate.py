@@ -277,7 +277,7 @@ def test_when_everything_vanishes_planning_stops_with_the_reason() -> None:
 
 
 def test_only_open_contours_name_their_layers_as_a_user_reads_them() -> None:
-    """QCAD's 181_polyline.dxf: one open polyline on layer 0 was "(layers 0)"."""
+    """QCAD's 181_polyline.dxf: one open polyline on layer 0, "(on layer '0')" not "(layers 0)"."""
     one = [Contour((Line((0.0, 0.0), (10.0, 0.0)),), False, layer="0")]
     with pytest.raises(ToolpathError) as caught:
         _run(one, "outside")

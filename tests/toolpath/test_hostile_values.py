@@ -84,7 +84,7 @@ def test_fit_polyline_of_no_points_says_so() -> None:
 
 
 def test_quad_segs_of_a_ratio_below_float_resolution_are_the_most_allowed() -> None:
-    # 1e-12 / 4 / 1e6 = 2.5e-19: 1 - that == 1.0 and acos gives 0 (was a division by zero)
+    # 1e-12 / 4 / 1e6 = 2.5e-19: 1 - that == 1.0 and acos gives 0 (not a division by zero)
     assert pocket_uncut.quad_segs(1e6, 1e-12) == pocket_uncut._MAX_QUAD_SEGS
     assert offset.quad_segs(1e6, 1e-19) == offset._MAX_QUAD_SEGS
 
