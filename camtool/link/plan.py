@@ -8,7 +8,7 @@ from __future__ import annotations
 import bisect
 from array import array
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
@@ -144,6 +144,11 @@ class SendPlan:
         for block, seconds in zip(self.blocks, self.block_time_s, strict=True):
             where = f"block {block.index} line {block.line}" if block.index else "restore"
             extra = f", {block.events} feedback events" if block.events else ""
+            if block.quiet_end:
+                extra = (
+                    f", feedback events not known (it starts where the tool stands): done "
+                    f"after {fmt_num(spec.quiet_end_s, 3)} s without one"
+                )
             extra += f", answer {block.ack!r}" if block.ack else ""
             text = block.text.replace("\r", " ")
             text = text if len(text) <= 60 else text[:57] + "..."
@@ -211,6 +216,11 @@ def prepare_send(
         blocks = hooks.expect(blocks, program, target)
     times = _block_times(blocks, program, move_times)
     first = _first_block(blocks, from_line, source)
+    if first and hooks.feedback is not None and blocks[first].events:
+        # the tool stands where the stopped job left it, not where line N-1 ends: the first
+        # block's step count is not known, its end is the controller's silence
+        blocks = list(blocks)
+        blocks[first] = replace(blocks[first], quiet_end=True)
     restore: list[WireBlock] = []
     if first and hooks.resume is not None:
         restore = hooks.resume(blocks[:first], blocks[first], spec)

@@ -497,6 +497,9 @@ class _Driver:
                 self.report(s.progress())
             elif kind == "push":
                 self._push(line)
+        if s.quiet(self.clock.monotonic()):
+            self.answer_since = self.clock.monotonic()
+            self.report(s.progress())
         if s.in_flight and not s.failure:
             self._keep_alive()
 

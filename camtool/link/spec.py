@@ -49,6 +49,12 @@ class WireBlock:
         sync: the controller answers the block only after every block before
             it has run (GRBL: ``G4``, ``M3``/``M4``/``M5``, coolant, ``M0``,
             ``M2``: protocol_buffer_synchronize); its answer says they ran.
+        quiet_end: its feedback events are not known ahead, so ``events`` is only
+            the estimate from the program's start: the first block a resumed job
+            sends on a feedback link, which runs from wherever the stopped job left
+            the tool (part way along it, or at its end). It is done once the
+            controller has sent nothing for the link's ``quiet_end_s`` after its
+            answer or its last event, however many came.
     """
 
     index: int
@@ -61,6 +67,7 @@ class WireBlock:
     note: str = ""
     queued: int = 0
     sync: bool = False
+    quiet_end: bool = False
 
     @property
     def text(self) -> str:
@@ -194,6 +201,7 @@ class LinkSpec:
     ignore: tuple[str, ...] = ()
     abort: bytes = b""
     settle_s: float = 0.0
+    quiet_end_s: float = 1.0
 
     def wire_time_s(self, nbytes: int) -> float:
         """Seconds ``nbytes`` take on the wire at :attr:`baud`, 8N1 (10 bits a byte)."""
@@ -280,7 +288,7 @@ _BYTES = ("block_end", "wake", "startup", "status", "hold", "resume", "reset", "
 _TEXT = ("how", "source", "ack", "error", "alarm", "banner", "operator_between_blocks")
 HANDSHAKES = ("", "dtr-dsr")
 """Values of ``[link] handshake``."""
-_POSITIVE = ("banner_timeout_s", "response_timeout_s")
+_POSITIVE = ("banner_timeout_s", "response_timeout_s", "quiet_end_s")
 _COUNTS = ("baud", "rx_buffer_bytes", "max_block_bytes")
 MAX_BUFFER_BYTES = 1 << 20
 """Largest ``rx_buffer_bytes`` and ``max_block_bytes`` taken (1 MiB): a controller's
@@ -332,7 +340,14 @@ def _spec_from_table(table: dict[str, Any], name: str, where: str) -> LinkSpec:
     unanswered = not values.get("ack") and not values.get("echo")
     if answered and values.get("protocol") == "stream" and unanswered:
         raise InputError(f"{where}: flow {values.get('flow', 'ack')!r} needs ack")
-    return LinkSpec(**values)
+    spec = LinkSpec(**values)
+    if spec.quiet_end_s >= spec.response_timeout_s:
+        raise InputError(
+            f"{where}: quiet_end_s ({spec.quiet_end_s:g} s) must be shorter than "
+            f"response_timeout_s ({spec.response_timeout_s:g} s), after which a silent "
+            "controller counts as lost"
+        )
+    return spec
 
 
 def _checked(key: str, value: Any, where: str) -> Any:

@@ -168,6 +168,7 @@ class Stream:
         self.head_acked = False
         self.events_left = 0
         self.events = 0
+        self.quiet_since = 0.0
         self.status: Status | None = None
         self.status_answered = 0
         self.queue_size = 0
@@ -274,8 +275,9 @@ class Stream:
             return "error"
         if self.block(k).sync:
             self.synced = k + 1
-        if self.block(k).events:
+        if self.block(k).events or self.block(k).quiet_end:
             self.head_acked, self.events_left = True, self.block(k).events
+            self.quiet_since = now
             return "answer"
         self._complete(now)
         return "ack"
@@ -296,11 +298,30 @@ class Stream:
                 "moves other than camtool's interpolator predicts"
             )
             return "error"
+        if self.block(self.in_flight[0]).quiet_end:
+            self.quiet_since = now  # its count is not known: only silence ends it
+            return "event"
         self.events_left -= 1
         if self.events_left:
             return "event"
         self._complete(now)
         return "ack"
+
+    def quiet(self, now: float) -> bool:
+        """Whether the running block of unknown step count ended: silence since ``now``'s past.
+
+        A :attr:`~camtool.link.spec.WireBlock.quiet_end` block, answered, is done once no
+        event has come for the link's ``quiet_end_s`` (real seconds, never scaled: the
+        next block sent while it still moves would abort it). Completes it then.
+        """
+        if not self.in_flight or not self.head_acked:
+            return False
+        if not self.block(self.in_flight[0]).quiet_end:
+            return False
+        if now - self.quiet_since < self.spec.quiet_end_s:
+            return False
+        self._complete(now)
+        return True
 
     def _complete(self, now: float) -> None:
         """The head block is done (answered, all its feedback in); the controller may stay busy."""

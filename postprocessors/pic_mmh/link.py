@@ -24,6 +24,7 @@ from camtool.model.machine import Machine
 if TYPE_CHECKING:
     from camtool.model.program import Program
     from camtool.post.base import Target
+    from camtool.verify.motion import StepTrace
 
 Axis: TypeAlias = Literal["X", "Y", "Z"]
 """An axis letter of the mode strings (UNAM-GMM §3.6 ``axis``)."""
@@ -427,7 +428,11 @@ def step_events(program: Program, machine: Machine) -> dict[int, bytes]:
 
     if not program.moves:
         return {}
-    trace = simulate(program, machine)
+    return _events_by_line(simulate(program, machine), program)
+
+
+def _events_by_line(trace: StepTrace, program: Program) -> dict[int, bytes]:
+    """:func:`step_events` of ``program`` from its step simulation ``trace``."""
     out: dict[int, bytearray] = {}
     for move in range(len(program.moves)):
         line = program.line_of(move) or 0
@@ -484,13 +489,16 @@ class PicMmhDevice(Device):
     is the steps of camtool's interpolator for it, sent as feedback bytes
     (:func:`feedback_byte`) ``steps_per_tick`` at a time. Anything received
     while a motion runs aborts it (the PIC checks its receive flag after every
-    step, L1801–L1807): :attr:`aborted` lists ``(block, steps sent, steps)``.
+    step, L1801–L1807): :attr:`aborted` lists ``(block, steps sent, steps)``, and a
+    ``G00`` line to where the motion stopped joins :attr:`executed` (the PIC's position
+    after the steps it made: a block sent again makes only the steps left of it).
     ``A;`` stops a motion too (:attr:`stops`). Mode strings are echoed and
     otherwise not modelled.
 
     ``fail_at_block`` is a transmission error: the PIC stores that string with
     its last digit changed (echoed and run as misread); ``drop_at_block``
-    closes the port when that string arrives.
+    closes the port when that string arrives; :attr:`stop_after` ``(block, steps)``
+    stops that block's motion after so many steps, silently (a stop at the machine).
 
     Args:
         spec: the pic-mmh link.
@@ -518,6 +526,8 @@ class PicMmhDevice(Device):
         self.motion = bytearray()
         self.motion_steps = 0
         self.running: bytes | None = None
+        self.stepping: tuple[StepTrace, Program, int] | None = None
+        self.stop_after: tuple[int, int] | None = None
         self.aborted: list[tuple[int, int, int]] = []
         self.stops = 0
         self.lost = 0
@@ -546,8 +556,15 @@ class PicMmhDevice(Device):
             if self.rx:  # a new string arrived: "Alto" (L1801-L1807)
                 self._abort()
                 return b""
-            batch = bytes(self.motion[: self.steps_per_tick])
-            del self.motion[: self.steps_per_tick]
+            count = self.steps_per_tick
+            if self.stop_after is not None and self.stop_after[0] == len(self.blocks):
+                count = min(count, self.stop_after[1] - (self.motion_steps - len(self.motion)))
+                if count <= 0:  # stopped at the machine: no more steps, nothing said
+                    self.stop_after = None
+                    self._abort()
+                    return b""
+            batch = bytes(self.motion[:count])
+            del self.motion[:count]
             if not self.motion and self.running is not None:
                 self.executed.append(self.running)
                 self.running = None
@@ -563,7 +580,35 @@ class PicMmhDevice(Device):
         done = self.motion_steps - len(self.motion)
         self.aborted.append((len(self.blocks), done, self.motion_steps))
         self.motion.clear()
+        if self.running is not None and done and self.stepping is not None:
+            self.executed.append(self._stopped_at(done, *self.stepping))
         self.running = None
+
+    def _stopped_at(self, done: int, trace: StepTrace, program: Program, line: int) -> bytes:
+        """A ``G00`` line to where the PIC stands after ``done`` feedback bytes of ``line``.
+
+        The PIC's logical position (whole steps: the steps of the line's rows sent so
+        far, backlash-compensation rows left out, from where the line started), so that
+        what runs next starts there, as on the machine: the same line sent again makes
+        only the steps left of it.
+        """
+        moves = [m for m in range(len(program.moves)) if program.line_of(m) == line]
+        first, last = moves[0], moves[-1]
+        rows = slice(int(trace.block_start[first]), int(trace.block_start[last + 1]))
+        moved, count = [0, 0], 0
+        for row, compensation in zip(
+            trace.rows[rows].tolist(), trace.compensation[rows].tolist(), strict=True
+        ):
+            for axis, step in enumerate(row):
+                if step and count < done:
+                    count += 1
+                    moved[axis] += 0 if compensation else step
+        start = trace.logical_end[first - 1] if first else (0, 0)
+        assert self.target is not None
+        per_mm = self.target.machine.steps_per_mm
+        x, y = ((int(start[a]) + moved[a]) / per_mm[a] for a in (0, 1))
+        coord = self.target.post.coord  # type: ignore[attr-defined]
+        return f"G00X{coord.format(x)}Y{coord.format(y)};\n".encode()
 
     def _string(self, string: bytes) -> bytes:
         self.received += string
@@ -591,8 +636,13 @@ class PicMmhDevice(Device):
             program = self.target.parse(code)
         except ParseError:
             return  # "no ejecuta tarea alguna" (L1755-L1757)
-        self.motion = bytearray(step_events(program, self.target.machine).get(len(lines), b""))
+        from camtool.verify.trace_sources import simulate
+
+        trace = simulate(program, self.target.machine) if program.moves else None
+        events = {} if trace is None else _events_by_line(trace, program)
+        self.motion = bytearray(events.get(len(lines), b""))
         self.motion_steps = len(self.motion)
+        self.stepping = None if trace is None else (trace, program, len(lines))
         line = string + b"\n"
         if self.motion:
             self.running = line

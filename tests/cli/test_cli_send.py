@@ -239,3 +239,22 @@ def test_a_buffer_larger_than_any_controller_s_is_refused(
     code, out, err = run(["send", str(job), "-t", str(target), "--dry-run"], capsys)
     assert code == 3 and out == ""
     assert f"{key} must be at most 1048576 bytes" in err
+
+
+@pytest.mark.parametrize(("quiet", "refused"), [(5.0, True), (4.9, False)])
+def test_a_quiet_end_as_long_as_the_response_timeout_is_refused(
+    job: Path, tmp_path: Path, quiet: float, refused: bool, capsys: Any
+) -> None:
+    """The silence that ends a resumed block must come before the one that calls the
+    controller lost (grbl's response_timeout_s is 5 s)."""
+    grbl = Path(__file__).resolve().parents[2] / "postprocessors" / "grbl" / "grbl.toml"
+    text = grbl.read_text().replace("[link]\n", f"[link]\nquiet_end_s = {quiet}\n", 1)
+    assert "response_timeout_s = 5.0" in text
+    target = tmp_path / "quiet.toml"
+    target.write_text(text)
+    code, _, err = run(["send", str(job), "-t", str(target), "--dry-run"], capsys)
+    if refused:
+        assert code == 3
+        assert "quiet_end_s (5 s) must be shorter than response_timeout_s (5 s)" in err
+    else:
+        assert code == 0, err

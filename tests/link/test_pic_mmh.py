@@ -37,15 +37,22 @@ PROGRAM = (
 )
 WIRE = PROGRAM.replace("\n", "").encode()  # the strings, without the file's line ends
 END = (0.05, 0.02, 0.0)  # G00X00050.00Y00020.00: µm
+STEP_MM = 140e-6  # the GMM MMH-1's step: 140 nm (UNAM-GMM S000-12)
 
 
-def plan_for(code: str, settle_s: float = 0.02, **options: Any) -> Any:
+def plan_for(code: str, settle_s: float = 0.02, link: Any = None, **options: Any) -> Any:
     plan = prepare_send(code, load_target("pic-mmh"), source="job.txt", **options)
-    return dataclasses.replace(plan, spec=dataclasses.replace(plan.spec, settle_s=settle_s))
+    spec = dataclasses.replace(plan.spec, settle_s=settle_s, **(link or {}))
+    return dataclasses.replace(plan, spec=spec)
+
+
+LINK_KEYS = ("quiet_end_s", "response_timeout_s")
+"""``run``'s options that change the link's spec (shorter waits for the tests)."""
 
 
 def run(path: str, code: str = PROGRAM, settle_s: float = 0.02, **options: Any) -> Any:
-    plan = plan_for(code, settle_s, from_line=options.pop("from_line", None))
+    link = {key: options.pop(key) for key in LINK_KEYS if key in options}
+    plan = plan_for(code, settle_s, link, from_line=options.pop("from_line", None))
     port = open_port(path, plan.spec.baud)
     try:
         return send_plan(port, plan, port_name=path, time_scale=0.0, **options)
@@ -121,20 +128,53 @@ def test_a_wrong_echo_stops_naming_the_block_and_sends_stop(simulate: Any, ticks
     assert "--from-line 5" in message
     assert "'A;' sent and echoed: the controller stopped" in message
     assert sim.device.stops == 1  # "A;" right after the wrong echo
-    # the misread block had started to move: the stop aborted it, or, on a busy machine
-    # where the host read the echo late, it had already run to its end (the misread digit
-    # is the feed's, so it ends where block 5 ends). The machinist resumes from where the
-    # tool stands: block 5 again if it was stopped, block 6 if it ran (block 5 again would
-    # be a move of no length, whose step feedback the sender would wait for in vain).
+    # the misread block had started to move: the stop aborted it part way, or, on a busy
+    # machine where the host read the echo late, it had already run to its end (the
+    # misread digit is the feed's, so it ends where block 5 ends). Either way the job
+    # resumes at block 5, as the message says: its step count from where the tool stands
+    # (some of the block's, or none) is not the program's, so the silence ends it
     if sim.device.aborted:
         assert sim.device.aborted[-1][0] == 5
-        resume_at = 5
     else:
         assert sim.device.executed[-1].startswith(b"G01X00150.00Y00150.00F09;")
-        resume_at = 6
     assert sim.device.blocks[-1] == b"A;"
-    run(sim.path, from_line=resume_at)
+    before = len(sim.device.blocks)
+    run(sim.path, from_line=5, quiet_end_s=0.3)
     assert sim.device.position() == pytest.approx(END)
+    assert sim.device.blocks[before:] == [s.encode() for s in PROGRAM.splitlines()[4:]]
+
+
+@pytest.mark.parametrize(
+    ("stop", "advised", "resume", "stands"),
+    [
+        # block 4 (line 4) runs from X 100 to 150 µm: 714 to 1071 steps of 140 nm in X
+        ((4, 1), 4, 4, (715 * STEP_MM, 714 * STEP_MM)),
+        ((4, 200), 4, 4, (914 * STEP_MM, 714 * STEP_MM)),
+        ((4, 356), 4, 4, (1070 * STEP_MM, 714 * STEP_MM)),
+        # block 4 ran to its end and block 5 made no step; a machinist unsure whether
+        # block 4 ran resumes at it: it runs nothing
+        ((5, 0), 5, 4, (0.15, 0.1)),  # where line 4 ends, as written
+    ],
+)
+def test_a_job_stopped_at_the_machine_resumes_from_where_the_tool_stands(
+    simulate: Any,
+    stop: tuple[int, int],
+    advised: int,
+    resume: int,
+    stands: tuple[float, float],
+) -> None:
+    """The block sent again makes only the steps left of it (or none), and the job goes on."""
+    sim = simulate("pic-mmh", steps_per_tick=100)  # the stop comes at its step all the same
+    sim.device.stop_after = stop
+    with pytest.raises(LinkError, match=f"resume with --from-line {advised}$"):
+        run(sim.path, response_timeout_s=1.0)
+    assert sim.device.aborted == [(stop[0], stop[1], sim.device.aborted[0][2])]
+    assert sim.device.position()[:2] == pytest.approx(stands, abs=1e-9)
+    before = len(sim.device.blocks)
+    run(sim.path, from_line=resume, quiet_end_s=0.3)
+    assert sim.device.position() == pytest.approx(END)
+    assert sim.device.blocks[before:] == [s.encode() for s in PROGRAM.splitlines()[resume - 1 :]]
+    assert len(sim.device.aborted) == 1  # nothing after the resume was cut short
 
 
 def test_a_strict_35_character_buffer_truncates_the_g02_and_the_echo_shows_it(
@@ -214,3 +254,22 @@ def test_the_cli_dry_run_and_send(simulate: Any, tmp_path: Path, capsys: Any) ->
     assert main(["send", str(job), "-t", "pic-mmh", "--port", sim.path, "--baud", "19200"]) == 1
     err = capsys.readouterr().err
     assert "disappeared" in err and "Traceback" not in err
+
+
+def test_the_resumed_block_is_not_ended_while_its_steps_still_come(simulate: Any) -> None:
+    """Steps 0.1 s apart, the silence that ends the block 0.3 s: it runs to its end.
+
+    Line 4 sent again from where it stopped (200 of its 357 steps made) makes its last
+    157 in batches of 20, one every 0.1 s once resumed: the block ends only after the
+    last, or the next string would cut its motion short (a new string aborts a motion).
+    """
+    code = PROGRAM.split("G01X00150.00Y00150.00F08;")[0] + "M30;\n"  # lines 1-4, then M30
+    sim = simulate("pic-mmh", steps_per_tick=20)
+    sim.device.stop_after = (4, 200)
+    with pytest.raises(LinkError, match=r"resume with --from-line 4$"):
+        run(sim.path, code, response_timeout_s=1.0)
+    sim.server.block_delay_s = 0.1
+    run(sim.path, code, from_line=4, quiet_end_s=0.3)
+    assert len(sim.device.aborted) == 1  # the stop at the machine only
+    assert sim.device.position()[:2] == pytest.approx((0.15, 0.1))
+    assert sim.device.blocks[-2:] == [b"G01X00150.00Y00100.00F08;", b"M30;"]
