@@ -216,11 +216,8 @@ def prepare_send(
         blocks = hooks.expect(blocks, program, target)
     times = _block_times(blocks, program, move_times)
     first = _first_block(blocks, from_line, source)
-    if first and hooks.feedback is not None and blocks[first].events:
-        # the tool stands where the stopped job left it, not where line N-1 ends: the first
-        # block's step count is not known, its end is the controller's silence
-        blocks = list(blocks)
-        blocks[first] = replace(blocks[first], quiet_end=True)
+    if first and hooks.feedback is not None:
+        blocks = _quiet_first_motion(blocks, first)
     restore: list[WireBlock] = []
     if first and hooks.resume is not None:
         restore = hooks.resume(blocks[:first], blocks[first], spec)
@@ -242,6 +239,21 @@ def prepare_send(
         warnings=tuple(dict.fromkeys(warnings)),
         verification=verification,
     )
+
+
+def _quiet_first_motion(blocks: Sequence[WireBlock], first: int) -> Sequence[WireBlock]:
+    """``blocks`` with the first motion from ``first`` on ending on silence (``quiet_end``).
+
+    A resumed job starts where the stopped one left the tool, not where line N-1 ends:
+    the steps of its first block that moves (feedback events) are not known; the blocks
+    after it start where it ends, as predicted.
+    """
+    moving = next((k for k in range(first, len(blocks)) if blocks[k].events), None)
+    if moving is None:
+        return blocks
+    out = list(blocks)
+    out[moving] = replace(out[moving], quiet_end=True)
+    return out
 
 
 def _read_back(data: bytes, target: Target, source: str) -> Program:
