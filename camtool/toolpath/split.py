@@ -192,7 +192,12 @@ class Track:
                 b = base + ends[i]
                 lo, hi = max(a, s0), min(b, s1)
                 if hi - lo > MIN_PIECE:
-                    out.append((sub_segment(segments[i], lo - a, hi - a), hi))
+                    # a piece that runs to the segment's end (or from its start) is told so
+                    # exactly: ``b - a`` is its length only to the rounding of ``ends``
+                    seg = segments[i]
+                    at = 0.0 if lo == a else lo - a
+                    to = seg.length if hi == b else hi - a
+                    out.append((sub_segment(seg, at, to), hi))
                 i += 1
             lap += 1
             if not self.closed:

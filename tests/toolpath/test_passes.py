@@ -144,6 +144,29 @@ def test_track_pieces_cover_the_span(s0: float, span: float) -> None:
         assert math.dist(seg.end, track.point_at(s_end)) < 1e-9
 
 
+def test_track_pieces_keep_the_segments_ends_exactly() -> None:
+    """Whole segments come back as they are, and pieces meet exactly where segments did.
+
+    The cumulative lengths (``Track.ends``) carry rounding: ``ends[i] - ends[i - 1]`` is
+    not each segment's length to the last bit, which must not turn a whole segment into a
+    rebuilt one whose end is an interpolated point a rounding off.
+    """
+    corners = [(0.1 * k + 0.013 * k * k, 0.7 * math.sin(k)) for k in range(40)]
+    segments = tuple(Line(a, b) for a, b in pairwise([*corners, corners[0]]))
+    track = Track.from_segments(segments, True)
+    whole = track.pieces(0.0, track.length)
+    assert [seg for seg, _ in whole] == list(segments)
+    assert all(seg is original for (seg, _), original in zip(whole, segments, strict=True))
+    mid = 0.5 * segments[0].length  # from the middle of the first, round to it again
+    around = track.pieces(mid, mid + track.length)
+    assert len(around) == len(segments) + 1
+    inner = zip(around[1:-1], segments[1:], strict=True)
+    assert all(seg is original for (seg, _), original in inner)
+    assert around[0][0].end == segments[0].end and around[-1][0].start == segments[0].start
+    for (a, _), (b, _) in pairwise(around):
+        assert a.end == b.start
+
+
 def test_track_reversed_maps_arc_length() -> None:
     track = Track.of(_rounded_rect())
     back = track.reversed()

@@ -50,7 +50,11 @@ def count_reversals_afresh(cuts: list[Cut], start: tuple[float, float]) -> tuple
 
 
 def pieces_of_every_segment(track: Track, s0: float, s1: float) -> list[tuple[Segment, float]]:
-    """:meth:`Track.pieces` walking every segment of every lap."""
+    """:meth:`Track.pieces` walking every segment of every lap.
+
+    A piece that reaches a segment's end (starts at its start) takes that end (start)
+    exactly, as the module promises; any other split point is a fraction of its length.
+    """
     span = track._span(s0, s1)
     if span is None:
         return []
@@ -64,7 +68,9 @@ def pieces_of_every_segment(track: Track, s0: float, s1: float) -> list[tuple[Se
             a, b = base + (ends[i - 1] if i else 0.0), base + ends[i]
             lo, hi = max(a, s0), min(b, s1)
             if hi - lo > MIN_PIECE:
-                out.append((_piece(seg, (lo - a) / seg.length, (hi - a) / seg.length), hi))
+                f0 = 0.0 if lo == a else (lo - a) / seg.length
+                f1 = 1.0 if hi == b else (hi - a) / seg.length
+                out.append((_piece(seg, f0, f1), hi))
         lap += 1
         if not track.closed:
             break
