@@ -147,7 +147,7 @@ class SendPlan:
             if block.quiet_end:
                 extra = (
                     f", feedback events not known (it starts where the tool stands): done "
-                    f"after {fmt_num(spec.quiet_end_s, 3)} s without one"
+                    f"after {spec.quiet_end_s:g} s without one"
                 )
             extra += f", answer {block.ack!r}" if block.ack else ""
             text = block.text.replace("\r", " ")
