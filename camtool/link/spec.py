@@ -347,6 +347,12 @@ def _spec_from_table(table: dict[str, Any], name: str, where: str) -> LinkSpec:
             f"response_timeout_s ({spec.response_timeout_s:g} s), after which a silent "
             "controller counts as lost"
         )
+    if spec.quiet_end_s <= spec.settle_s:
+        raise InputError(
+            f"{where}: quiet_end_s ({spec.quiet_end_s:g} s) must be longer than settle_s "
+            f"({spec.settle_s:g} s, the quiet after a block's last step): a silence that short "
+            "may fall between two steps, and the next block would cut the motion short"
+        )
     return spec
 
 

@@ -258,3 +258,17 @@ def test_a_quiet_end_as_long_as_the_response_timeout_is_refused(
         assert "quiet_end_s (5 s) must be shorter than response_timeout_s (5 s)" in err
     else:
         assert code == 0, err
+
+
+def test_a_quiet_end_no_longer_than_the_settle_time_is_refused(
+    job: Path, tmp_path: Path, capsys: Any
+) -> None:
+    """pic-mmh's settle_s is 0.25 s: a quiet end as short could fall between two steps."""
+    pic = Path(__file__).resolve().parents[2] / "postprocessors" / "pic_mmh" / "pic-mmh.toml"
+    text = pic.read_text()
+    assert "settle_s = 0.25" in text and "quiet_end_s = 1.0" in text
+    target = tmp_path / "pic.toml"
+    target.write_text(text.replace("quiet_end_s = 1.0", "quiet_end_s = 0.25"))
+    code, _, err = run(["send", str(job), "-t", str(target), "--dry-run"], capsys)
+    assert code == 3
+    assert "quiet_end_s (0.25 s) must be longer than settle_s (0.25 s" in err
