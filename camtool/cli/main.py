@@ -41,6 +41,7 @@ from camtool.model.errors import (
     InputError,
     UsageError,
     VerifyLimitError,
+    out_of_memory,
     readable,
 )
 from camtool.model.version import __version__
@@ -596,6 +597,9 @@ def main(argv: list[str] | None = None) -> int:
     except CamtoolError as exc:
         click.echo(f"camtool: error: {readable(str(exc))}", err=True)
         return exc.exit_code
+    except MemoryError as exc:
+        click.echo(f"camtool: error: {out_of_memory(exc)}", err=True)
+        return 1
     except Exception as exc:  # a bug: still a message, never a traceback
         if _interrupted(exc):
             return _aborted(exc)

@@ -57,6 +57,18 @@ def readable(message: str) -> str:
     return f"{message[:head]} ... ({left_out} characters left out) ... {message[-tail:]}"
 
 
+def out_of_memory(exc: MemoryError) -> str:
+    """What to say when the memory ran out (exit code 1): not a bug, a job too large.
+
+    numpy names the array it could not allocate; Python's own ``MemoryError`` says nothing.
+    """
+    detail = f" ({exc})" if str(exc) else ""
+    return (
+        f"out of memory{detail}: the job needs more memory than this machine has; check the "
+        "drawing's size and units and the machine profile (steps_per_mm), or split the job"
+    )
+
+
 def not_a_file(path: object) -> InputError:
     """The error for an input ``path`` that is not a regular file: what it is instead.
 

@@ -641,3 +641,31 @@ def test_verify_names_a_program_path_that_is_a_link_to_nothing(
     assert (
         err == f"camtool: error: {link}: a symbolic link that leads to no file (or round a loop)\n"
     )
+
+
+def test_memory_running_out_is_said_so_and_writes_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """numpy's MemoryError (a trace of 50 million rows on a machine without the memory for
+    it) is a job too large for the machine, not "internal error: MemoryError"; the output
+    file is left as it was (here: not there)."""
+    from camtool.jobs import pipeline
+
+    def too_large(*args: object, **kwargs: object) -> None:
+        raise MemoryError(
+            "Unable to allocate 763. MiB for an array with shape (50000000, 2) and data type "
+            "float64"
+        )
+
+    monkeypatch.setattr(pipeline, "run_job", too_large)
+    out = tmp_path / "logo.nc"
+    code, stdout, err = run(
+        ["post", str(SAMPLES / "logo.dxf"), "-t", "grbl", "-o", str(out)], capsys
+    )
+    assert code == 1 and stdout == ""
+    assert err.startswith("camtool: error: out of memory (Unable to allocate 763. MiB")
+    assert "steps_per_mm" in err and "internal error" not in err
+    assert not out.exists()
+    monkeypatch.setattr(pipeline, "run_job", lambda *a, **k: (_ for _ in ()).throw(MemoryError()))
+    code, _, err = run(["post", str(SAMPLES / "logo.dxf"), "-t", "grbl", "-o", str(out)], capsys)
+    assert code == 1 and err.startswith("camtool: error: out of memory: the job needs")

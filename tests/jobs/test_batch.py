@@ -260,6 +260,22 @@ def test_a_worker_exception_becomes_that_files_error_row(
     assert row.error == "internal error: RuntimeError: bug on drawings/rect.dxf"
 
 
+def test_memory_running_out_on_one_file_is_its_error_row(
+    tree: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import camtool.jobs.batch
+
+    def too_large(file: str, options: BatchOptions) -> None:
+        raise MemoryError("Unable to allocate 763. MiB for an array")
+
+    monkeypatch.setattr(camtool.jobs.batch, "_post_job", too_large)
+    plan = plan_batch(["drawings/rect.dxf"], BatchOptions(target="pic-mmh", output_dir=Path("o")))
+    row = post_one(plan.tasks[0], plan.options)
+    assert (row.status, row.exit_code) == ("error", 1)
+    assert row.error.startswith("out of memory (Unable to allocate 763. MiB for an array): ")
+    assert "internal error" not in row.error
+
+
 def test_jobs_two_gives_the_same_outputs_as_jobs_one(tree: Path) -> None:
     reports = []
     for jobs in (1, 2):
