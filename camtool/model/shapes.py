@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field, fields, replace
 from typing import Any, Generic, TypeAlias, TypeVar, overload
 
@@ -528,7 +528,7 @@ class Contour:
         """Bounding box ``(xmin, ymin, xmax, ymax)``, mm (computed once, then kept)."""
         box: BBox | None = self.__dict__.get("_bbox")
         if box is None:
-            box = segments_box(self.segments)
+            box = bbox_union([s.bbox() for s in self.segments])
             self.__dict__["_bbox"] = box
         return box
 
@@ -574,36 +574,6 @@ class Contour:
 
 
 share_keys(Contour, (*_kept(Contour), "_bbox"))
-
-
-def segments_box(segments: Sequence[Segment]) -> BBox:
-    """``bbox_union`` of the segments' boxes, without the boxes of arcs that cannot widen it.
-
-    The box of the segments' ends comes first. An arc whose circle's extremes ``c ± r`` (the
-    farthest floats :meth:`Arc.bbox` adds, ``c + r·cos(kπ/2)`` and the sines) lie strictly
-    inside it gives no side, so its box (its angles and sweep) is not made. Sides are the
-    same floats as the full union's; a box with a side of zero or not finite is the full
-    union itself (``min``/``max`` keep the first of equal values, which decides the sign
-    of a zero).
-
-    Raises:
-        ValueError: no segment (``bbox_union``'s "bbox of nothing").
-    """
-    if not segments:
-        return bbox_union([])
-    xs = [s.start[0] for s in segments] + [s.end[0] for s in segments]
-    ys = [s.start[1] for s in segments] + [s.end[1] for s in segments]
-    x0, x1, y0, y1 = min(xs), max(xs), min(ys), max(ys)
-    if not (x0 and x1 and y0 and y1 and math.isfinite(sum(xs) + sum(ys))):
-        return bbox_union([s.bbox() for s in segments])
-    boxes = [(x0, y0, x1, y1)]
-    for s in segments:
-        if type(s) is Arc:
-            cx, cy = s.centre
-            r = s.radius  # a centre not finite compares false: its box is made
-            if not (x0 < cx - r and cx + r < x1 and y0 < cy - r and cy + r < y1):
-                boxes.append(s.bbox())
-    return boxes[0] if len(boxes) == 1 else bbox_union(boxes)
 
 
 def circle_of(contour: Contour) -> tuple[Point, float] | None:

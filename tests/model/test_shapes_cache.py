@@ -9,7 +9,6 @@ from __future__ import annotations
 import gc
 import math
 import pickle
-import struct
 import sys
 import tracemalloc
 from collections.abc import Callable
@@ -19,18 +18,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from camtool.model.shapes import (
-    TAU,
-    Arc,
-    Contour,
-    Line,
-    bbox_union,
-    chord_count,
-    distance,
-    make_arc,
-    make_line,
-    segments_box,
-)
+from camtool.model.shapes import TAU, Arc, Contour, chord_count, distance, make_arc, make_line
 from camtool.toolpath.reversals import segment_signs
 
 coord = st.floats(-500.0, 500.0, allow_nan=False, allow_infinity=False)
@@ -154,69 +142,3 @@ def test_a_lines_and_a_contours_kept_values_cost_only_themselves() -> None:
     contours = [Contour((line, line.reversed()), True) for line in lines]
     # the length (a float) and the box (a 4-tuple of floats: 72 + 16 + 4 × 24 at most)
     assert _kept_bytes(contours, lambda c: (c.length, c.bbox())) <= 24 + 88 + 96 + 8
-
-
-_EDGE = st.sampled_from([0.0, -0.0, 1.0, -1.0, 5e-324, 1e308, -1e308, math.inf, math.nan])
-_VALUE = st.one_of(st.floats(-20.0, 20.0), _EDGE)
-_ANY_POINT = st.tuples(_VALUE, _VALUE)
-
-
-@st.composite
-def _chains(draw: Any) -> list[Any]:
-    """Lines and arcs end to end (arcs' centres anywhere, ends maybe off their circle)."""
-    here = draw(_ANY_POINT)
-    out = []
-    for _ in range(draw(st.integers(1, 6))):
-        there = draw(_ANY_POINT)
-        if draw(st.booleans()):
-            out.append(Line(here, there))
-        else:
-            out.append(Arc(here, there, draw(_ANY_POINT), draw(st.booleans())))
-        here = there
-    return out
-
-
-def _bits(box: tuple[float, ...]) -> tuple[bytes, ...]:
-    return tuple(struct.pack("<d", v) for v in box)
-
-
-@settings(max_examples=3000, deadline=None)
-@given(_chains())
-def test_a_contour_box_is_the_union_of_its_segments_boxes_to_the_bit(segments: list[Any]) -> None:
-    """Arcs that cannot widen the box of the ends are left out: the very same floats
-    (signed zeros, infinities and NaN included), as ``bbox_union`` of every box gives."""
-    expected = bbox_union([s.bbox() for s in segments])
-    assert _bits(segments_box(segments)) == _bits(expected)
-    assert _bits(Contour(tuple(segments), False).bbox()) == _bits(expected)
-
-
-@pytest.mark.parametrize(
-    "segments",
-    [
-        # the ends' box meets 0.0 first, the union of boxes -0.0 (the first segment's box)
-        [Line((1.0, 1.0), (-0.0, 2.0)), Line((0.0, 2.0), (1.0, 1.0))],
-        # an arc whose centre is not finite: its box is made (and adds nothing)
-        [Line((1.0, 1.0), (2.0, 2.0)), Arc((2.0, 2.0), (1.0, 1.0), (math.nan, 1.0), False)],
-    ],
-)
-def test_a_contour_box_with_a_zero_or_a_nan_is_the_full_union(segments: list[Any]) -> None:
-    expected = bbox_union([s.bbox() for s in segments])
-    assert _bits(segments_box(segments)) == _bits(expected)
-
-
-def test_a_contour_box_skips_the_arcs_inside_it() -> None:
-    """A quarter circle inside a square of lines: its box is not made."""
-    square = [
-        Line((0.5, 0.5), (10.0, 0.5)),
-        Line((10.0, 0.5), (10.0, 10.0)),
-        Line((10.0, 10.0), (0.5, 10.0)),
-    ]
-    inside = Arc((6.0, 5.0), (5.0, 6.0), (5.0, 5.0), False)
-    assert segments_box([*square, inside]) == (0.5, 0.5, 10.0, 10.0)
-    assert "start_angle" not in inside.__dict__  # its angles never computed
-    bulging = Arc((6.0, 5.0), (5.0, 6.0), (5.0, 5.0), True)  # the long way: round to x 1
-    assert segments_box([*square, bulging]) == (0.5, 0.5, 10.0, 10.0)
-    wide = Arc((9.0, 5.0), (5.0, 9.0), (5.0, 5.0), True)  # r 4: reaches x 1 > 0.5, inside
-    assert segments_box([*square, wide]) == (0.5, 0.5, 10.0, 10.0)
-    out = Arc((10.0, 5.0), (5.0, 10.0), (5.0, 5.0), True)  # r 5 reaches x 0 and y 0
-    assert segments_box([*square, out]) == pytest.approx((0.0, 0.0, 10.0, 10.0))
