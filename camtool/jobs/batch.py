@@ -23,7 +23,7 @@ from camtool.jobs.batch_report import summary_table as summary_table  # camtool.
 from camtool.jobs.batch_stop import Interrupts, Terminated, kill_pool, worker_init
 from camtool.jobs.inputs import BatchInput, expand_inputs
 from camtool.jobs.pipeline import OutputOptions
-from camtool.model.errors import CamtoolError, InputError, UsageError, out_of_memory
+from camtool.model.errors import CamtoolError, InputError, UsageError, unexpected
 from camtool.model.version import __version__
 from camtool.toolpath.options import PlanOptions
 
@@ -654,10 +654,8 @@ def _posted(task: BatchTask, options: BatchOptions) -> tuple[BatchRow, Files]:
         return _outputs(task, options, _post_job(task.file, _for(task, options)))
     except CamtoolError as exc:
         return _error_row(task, exc.exit_code, str(exc)), ()
-    except MemoryError as exc:
-        return _error_row(task, 1, out_of_memory(exc)), ()
-    except Exception as exc:  # a bug on one file must not stop the batch
-        return _error_row(task, 1, f"internal error: {type(exc).__name__}: {exc}"), ()
+    except Exception as exc:  # a bug on one file (or no memory left) must not stop the batch
+        return _error_row(task, 1, unexpected(exc)), ()
 
 
 def post_data(
@@ -689,10 +687,8 @@ def post_data(
         return row, files, __version__
     except CamtoolError as exc:
         return _error_row(task, exc.exit_code, str(exc)), (), __version__
-    except MemoryError as exc:
-        return _error_row(task, 1, out_of_memory(exc)), (), __version__
-    except Exception as exc:  # a bug on one file must not stop the batch
-        return _error_row(task, 1, f"internal error: {type(exc).__name__}: {exc}"), (), __version__
+    except Exception as exc:  # a bug on one file (or no memory left) must not stop the batch
+        return _error_row(task, 1, unexpected(exc)), (), __version__
 
 
 def _for(task: BatchTask, options: BatchOptions) -> BatchOptions:

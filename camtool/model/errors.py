@@ -69,6 +69,16 @@ def out_of_memory(exc: MemoryError) -> str:
     )
 
 
+def unexpected(exc: Exception) -> str:
+    """The message of an exception that is no :class:`CamtoolError` (exit code 1).
+
+    The memory ran out (:func:`out_of_memory`), or an internal error: a bug.
+    """
+    if isinstance(exc, MemoryError):
+        return out_of_memory(exc)
+    return f"internal error: {type(exc).__name__}: {exc}"
+
+
 def not_a_file(path: object) -> InputError:
     """The error for an input ``path`` that is not a regular file: what it is instead.
 
