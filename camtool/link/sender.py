@@ -497,8 +497,9 @@ class _Driver:
                 self.report(s.progress())
             elif kind == "push":
                 self._push(line)
-        if s.quiet(self.clock.monotonic()):
-            self.answer_since = self.clock.monotonic()
+        read = self.clock.monotonic()  # after the lines: the silence runs to here
+        if s.quiet(read):
+            self.answer_since = read
             self.report(s.progress())
         if s.in_flight and not s.failure:
             self._keep_alive()

@@ -308,11 +308,11 @@ class Stream:
         return "ack"
 
     def quiet(self, now: float) -> bool:
-        """Whether the running block of unknown step count ended: silence since ``now``'s past.
+        """Whether the running block of unknown step count has ended by ``now``; completes it.
 
         A :attr:`~camtool.link.spec.WireBlock.quiet_end` block, answered, is done once no
         event has come for the link's ``quiet_end_s`` (real seconds, never scaled: the
-        next block sent while it still moves would abort it). Completes it then.
+        next block sent while it still moves would abort it).
         """
         if not self.in_flight or not self.head_acked:
             return False

@@ -46,8 +46,8 @@ def plan_for(code: str, settle_s: float = 0.02, link: Any = None, **options: Any
     return dataclasses.replace(plan, spec=spec)
 
 
-LINK_KEYS = ("quiet_end_s", "response_timeout_s")
-"""``run``'s options that change the link's spec (shorter waits for the tests)."""
+LINK_KEYS = ("response_timeout_s",)
+"""``run``'s options that change the link's spec (a shorter wait for a silent controller)."""
 
 
 def run(path: str, code: str = PROGRAM, settle_s: float = 0.02, **options: Any) -> Any:
@@ -139,7 +139,7 @@ def test_a_wrong_echo_stops_naming_the_block_and_sends_stop(simulate: Any, ticks
         assert sim.device.executed[-1].startswith(b"G01X00150.00Y00150.00F09;")
     assert sim.device.blocks[-1] == b"A;"
     before = len(sim.device.blocks)
-    run(sim.path, from_line=5, quiet_end_s=0.3)
+    run(sim.path, from_line=5)  # the link's own quiet end: 1 s without a step
     assert sim.device.position() == pytest.approx(END)
     assert sim.device.blocks[before:] == [s.encode() for s in PROGRAM.splitlines()[4:]]
 
@@ -170,12 +170,12 @@ def test_a_job_stopped_at_the_machine_resumes_from_where_the_tool_stands(
     sim = simulate("pic-mmh", steps_per_tick=100)  # the stop comes at its step all the same
     sim.device.stop_after = stop
     with pytest.raises(LinkError, match=f"resume with --from-line {advised}$"):
-        run(sim.path, response_timeout_s=1.0)
+        run(sim.path, response_timeout_s=2.0)
     assert sim.device.aborted == [(stop[0], stop[1], sim.device.aborted[0][2])]
     if stands is not None:
         assert sim.device.position()[:2] == pytest.approx(stands, abs=1e-9)
     before = len(sim.device.blocks)
-    run(sim.path, from_line=resume, quiet_end_s=0.3)
+    run(sim.path, from_line=resume)
     assert sim.device.position() == pytest.approx(END)
     assert sim.device.blocks[before:] == [s.encode() for s in PROGRAM.splitlines()[resume - 1 :]]
     assert len(sim.device.aborted) == 1  # nothing after the resume was cut short
@@ -261,19 +261,20 @@ def test_the_cli_dry_run_and_send(simulate: Any, tmp_path: Path, capsys: Any) ->
 
 
 def test_the_resumed_block_is_not_ended_while_its_steps_still_come(simulate: Any) -> None:
-    """Steps 0.1 s apart, the silence that ends the block 0.3 s: it runs to its end.
+    """Steps 0.3 s apart, the silence that ends the block 1 s: it runs to its end.
 
     Line 4 sent again from where it stopped (200 of its 357 steps made) makes its last
-    157 in batches of 20, one every 0.1 s once resumed: the block ends only after the
-    last, or the next string would cut its motion short (a new string aborts a motion).
+    157 in 8 batches of 20, one every 0.3 s once resumed (2.4 s, longer than the quiet
+    end): the block ends only after the last, or the next string would cut its motion
+    short (a new string aborts a motion).
     """
     code = PROGRAM.split("G01X00150.00Y00150.00F08;")[0] + "M30;\n"  # lines 1-4, then M30
     sim = simulate("pic-mmh", steps_per_tick=20)
     sim.device.stop_after = (4, 200)
     with pytest.raises(LinkError, match=r"resume with --from-line 4$"):
-        run(sim.path, code, response_timeout_s=1.0)
-    sim.server.block_delay_s = 0.1
-    run(sim.path, code, from_line=4, quiet_end_s=0.3)
+        run(sim.path, code, response_timeout_s=2.0)
+    sim.server.block_delay_s = 0.3
+    run(sim.path, code, from_line=4)
     assert len(sim.device.aborted) == 1  # the stop at the machine only
     assert sim.device.position()[:2] == pytest.approx((0.15, 0.1))
     assert sim.device.blocks[-2:] == [b"G01X00150.00Y00100.00F08;", b"M30;"]

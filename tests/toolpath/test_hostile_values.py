@@ -132,7 +132,7 @@ def test_pocket_refuses_a_step_over_finer_than_the_tolerance(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], style: str
 ) -> None:
     # 0.0001 × 3 mm = 0.3 µm between rings fitted within 1 µm (the default --tolerance):
-    # refused before any ring is made (it took minutes and gigabytes to plan)
+    # refused before any ring is made
     drawing = tmp_path / "square.dxf"
     drawing.write_text(SQUARE_DXF)
     out = tmp_path / "out.nc"
