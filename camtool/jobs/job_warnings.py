@@ -103,24 +103,60 @@ def undrilled(drawing: Drawing, drilled: set[int]) -> list[str]:
     ]
 
 
+OVERLAPS_LISTED = 3
+"""Operations :func:`overlaps` names one by one; the rest share one warning."""
+
+
 def overlaps(runs: Sequence[OperationRun], job: Job) -> list[str]:
-    """A warning for two operations of one kind that cut the same contour."""
+    """A warning for two operations of one kind that cut the same contour.
+
+    The first :data:`OVERLAPS_LISTED` such operations are named with their contour; the
+    others share one warning that numbers them (a job of hundreds of operations with one
+    selection would write hundreds of lines).
+    """
     if job.shorthand:
         return []
     out: list[str] = []
     seen: dict[tuple[str, str], OperationRun] = {}
+    more: list[int] = []
     for run in runs:
         for contour in run.placed.contours:
             key = (run.operation.kind, contour.source)
             other = seen.get(key)
             if other is not None and other.number != run.number and contour.source:
-                out.append(
-                    f"{run.label} cuts {contour.source} on layer {contour.layer!r} again, as "
-                    f"{other.label} does: is one selection too wide?"
-                )
+                if len(out) < OVERLAPS_LISTED:
+                    out.append(
+                        f"{run.label} cuts {contour.source} on layer {contour.layer!r} again, "
+                        f"as {other.label} does: is one selection too wide?"
+                    )
+                else:
+                    more.append(run.number)
                 break
             seen[key] = run
+    if more:
+        them = "operation" if len(more) == 1 else "operations"
+        out.append(
+            f"{len(more)} more {them} ({_numbers(more)}) cut a contour again that an "
+            "earlier operation of their kind cuts: is a selection too wide?"
+        )
     return out
+
+
+def _numbers(numbers: Sequence[int]) -> str:
+    """``[1, 2, 5, 6, 7, 9]`` as ``"1, 2, 5-7, 9"``: runs of three or more as ranges."""
+    parts: list[str] = []
+    start = prev = numbers[0]
+    for n in (*numbers[1:], None):
+        if n is not None and n == prev + 1:
+            prev = n
+            continue
+        if prev - start < 2:  # one number, or two: "5, 6"
+            parts += [str(k) for k in range(start, prev + 1)]
+        else:
+            parts.append(f"{start}-{prev}")
+        if n is not None:
+            start = prev = n
+    return ", ".join(parts)
 
 
 def holes_cut_outside(

@@ -236,3 +236,33 @@ def test_a_hole_drawn_twice_as_an_arc_short_of_360_is_drilled_once(tmp_path: Pat
     done = run_job(read_drawing(path), load_target("linuxcnc"), load_job(job))
     holes = [(m.x, m.y) for m in done.program.moves if m.z == -3.0]
     assert holes == [(5.0, 10.0)]
+
+
+def test_many_operations_that_select_one_layer_share_one_warning_past_the_third(
+    tmp_path: Path,
+) -> None:
+    # operations 1-12 engrave the ENGRAVE layer, operation 7 drills the holes: operations
+    # 2-4 are named with the contour, the other eight (5, 6, 8-13) counted in one line
+    root = Path(__file__).resolve().parents[2]
+    engrave = '\n[[operations]]\ntype = "engrave"\ntool = 1\nlayers = ["ENGRAVE"]\ndepth = 0.3\n'
+    drill = (
+        '\n[[operations]]\ntype = "drill"\ntool = 2\nlayers = ["HOLES"]\ndepth = 6.5\n'
+        "step_down = 2.0\n"
+    )
+    head = (root / "samples" / "part.toml").read_text().split("[[operations]]")[0]
+    job_file = tmp_path / "many.toml"
+    job_file.write_text(head + engrave * 6 + drill + engrave * 6)
+    post = run_job(
+        read_drawing(root / "samples" / "part.dxf"), load_target("grbl"), load_job(job_file)
+    )
+    again = [w for w in post.warnings if "again" in w]
+    assert [w.split(" (")[0] for w in again[:3]] == [
+        "operation 2",
+        "operation 3",
+        "operation 4",
+    ]
+    assert all("LWPOLYLINE #95 on layer 'ENGRAVE'" in w for w in again[:3])
+    assert again[3:] == [
+        "8 more operations (5, 6, 8-13) cut a contour again that an earlier operation of "
+        "their kind cuts: is a selection too wide?"
+    ]
