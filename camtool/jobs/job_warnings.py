@@ -6,6 +6,7 @@ Each is a line for the user (stderr, the program's header); none changes the pro
 from __future__ import annotations
 
 from collections.abc import Sequence
+from itertools import groupby
 from typing import TYPE_CHECKING
 
 from camtool.model.shapes import Contour, Drawing, Mark
@@ -145,17 +146,9 @@ def overlaps(runs: Sequence[OperationRun], job: Job) -> list[str]:
 def _numbers(numbers: Sequence[int]) -> str:
     """``[1, 2, 5, 6, 7, 9]`` as ``"1, 2, 5-7, 9"``: runs of three or more as ranges."""
     parts: list[str] = []
-    start = prev = numbers[0]
-    for n in (*numbers[1:], None):
-        if n is not None and n == prev + 1:
-            prev = n
-            continue
-        if prev - start < 2:  # one number, or two: "5, 6"
-            parts += [str(k) for k in range(start, prev + 1)]
-        else:
-            parts.append(f"{start}-{prev}")
-        if n is not None:
-            start = prev = n
+    for _, pairs in groupby(enumerate(numbers), lambda pair: pair[1] - pair[0]):
+        run = [n for _, n in pairs]  # consecutive numbers
+        parts += [f"{run[0]}-{run[-1]}"] if len(run) > 2 else [str(n) for n in run]
     return ", ".join(parts)
 
 

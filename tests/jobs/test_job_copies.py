@@ -241,8 +241,9 @@ def test_a_hole_drawn_twice_as_an_arc_short_of_360_is_drilled_once(tmp_path: Pat
 def test_many_operations_that_select_one_layer_share_one_warning_past_the_third(
     tmp_path: Path,
 ) -> None:
-    # operations 1-12 engrave the ENGRAVE layer, operation 7 drills the holes: operations
-    # 2-4 are named with the contour, the other eight (5, 6, 8-13) counted in one line
+    # operations 1-6 and 8-13 engrave the ENGRAVE layer, operation 7 drills the holes:
+    # operations 2-4 are named with the contour, the other eight (5, 6, 8-13) counted in
+    # one line
     root = Path(__file__).resolve().parents[2]
     engrave = '\n[[operations]]\ntype = "engrave"\ntool = 1\nlayers = ["ENGRAVE"]\ndepth = 0.3\n'
     drill = (
