@@ -180,11 +180,17 @@ def parse_gcode(
             coordinate-offset codes, unknown G/M codes or letters, two codes of one modal
             group, a repeated word, a word no code uses, a cut before any F, an arc without
             centre or off its circle beyond tolerance, a number out of range, a last line
-            cut in a word, no move at all, or no cutting move.
+            cut in a word, an empty text (nothing but blanks), no move at all, or no
+            cutting move.
 
     Plain lines take the fast path (:meth:`_Reader.plain`, no word objects) unless
     ``CAMTOOL_ACCEL=0``; :func:`parse_gcode_slow` is the reference, with the same result.
     """
+    if not text or text.isspace():  # stops at the first character that is not a blank
+        raise InputError(
+            f"{source}: empty file (nothing but blanks); export the program again from the "
+            "CAM program"
+        )
     with paused():  # the moves it makes stay; what it frees, counting frees
         text = expand_parameters(text, source)  # numbered parameters read as their numbers
         return _parse(text, source, plain=accel.enabled(), reading=reading)

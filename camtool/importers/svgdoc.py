@@ -662,6 +662,10 @@ def _parse(path: Path) -> ET.Element:
     if not path.is_file():
         raise not_a_file(path)
     try:
+        if path.stat().st_size == 0:
+            raise InputError(
+                f"{path}: empty file; export the drawing again from the drawing program"
+            )
         root = ET.parse(path).getroot()
     except ET.ParseError as exc:
         line, column = exc.position

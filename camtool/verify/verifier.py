@@ -226,10 +226,12 @@ def verify_code(
 
     Raises:
         ParseError: the code is not valid in the target's dialect (names the line).
-        InputError: the code holds no cutting move (nothing to verify).
+        InputError: the code is empty or holds no cutting move (nothing to verify).
         DialectError: the program does not fit the machine; the message starts with
             ``source`` (:func:`check_area`).
     """
+    if not code or code.isspace():
+        raise InputError(f"{source}: empty file (nothing but blanks): nothing to verify")
     program = target.post.parse(code, source=source)
     if all(isinstance(move, Rapid) for move in program.moves):
         moves = f"only {len(program.moves)} rapid move(s)" if program.moves else "no move"

@@ -121,7 +121,6 @@ def test_post_of_a_rapid_only_program_is_an_input_error(
     [
         ("G21 G90 G17\nG0 X0.000 Y0.000\nG0 X10.000 Y10.000\nM2\n", "only 2 rapid move(s)"),
         ("G21 G90 G17\nM2\n", "no move"),
-        ("", "no move"),
     ],
 )
 def test_verify_of_code_with_nothing_to_cut_says_so(
@@ -131,15 +130,35 @@ def test_verify_of_code_with_nothing_to_cut_says_so(
     code, _, err = run(["verify", write(tmp_path, "r.gcode", text), "-t", "grbl"], capsys)
     assert code == 3
     assert f"r.gcode: no cutting move in the code ({what}): nothing to verify" in err
+
+
+@pytest.mark.parametrize("text", ["", " \n\t\n"])
+def test_verify_of_an_empty_file_says_it_is_empty(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], text: str
+) -> None:
+    code, _, err = run(["verify", write(tmp_path, "r.gcode", text), "-t", "grbl"], capsys)
+    assert code == 3
+    assert "r.gcode: empty file (nothing but blanks): nothing to verify" in err
     assert "internal error" not in err
 
 
+@pytest.mark.parametrize("text", ["", "\n\n  \t\r\n"])
 def test_empty_drawing_file_is_an_input_error(
+    text: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, _, err = run(["post", write(tmp_path, "e.ngc", text), "-t", "grbl"], capsys)
+    assert code == 3
+    assert "e.ngc: empty file (nothing but blanks); export the program again" in err
+
+
+def test_a_program_of_comments_only_has_no_move(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    code, _, err = run(["post", write(tmp_path, "e.ngc", ""), "-t", "grbl"], capsys)
+    """Not empty: it has lines, none of them a move (UGS's comment fixture is such a file)."""
+    text = "; Empty command with comment\n(Another empty command with comment)\n\nG0 ; c\nG1 (c)\n"
+    code, _, err = run(["post", write(tmp_path, "c.ngc", text), "-t", "grbl"], capsys)
     assert code == 3
-    assert "e.ngc: no move (G0, G1, G2, G3) found" in err
+    assert "c.ngc: no move (G0, G1, G2, G3) found" in err
 
 
 # -- truncated programs (issue 14) ----------------------------------------------------------

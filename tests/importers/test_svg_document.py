@@ -931,6 +931,14 @@ def test_malformed_xml_names_line_and_column(tmp_path: Path) -> None:
         read_svg(path)
 
 
+def test_an_empty_file_is_called_empty(tmp_path: Path) -> None:
+    """Not "malformed XML at line 1, column 1 (no element found)": the file has nothing."""
+    path = tmp_path / "empty.svg"
+    path.write_bytes(b"")
+    with pytest.raises(InputError, match=r"empty.svg: empty file; export the drawing again"):
+        read_svg(path)
+
+
 def test_not_svg_and_missing_file(tmp_path: Path) -> None:
     path = tmp_path / "x.svg"
     path.write_text("<html><body/></html>")
