@@ -401,13 +401,21 @@ def check_conditions(
 
 
 def count_skipped(root: ET.Element, hold: ET.Element, counts: Counter[str]) -> None:
-    """Add to ``counts`` the skipped kinds: non-empty defs, drawn text and image, markers.
+    """Add to ``counts`` the skipped kinds: defs, drawn text and image, markers.
+
+    A ``<defs>`` counts when it holds an element a ``<use>`` could place and none does
+    (:data:`_PLACEABLE`): a viewer draws nothing of it, and a user may have drawn it
+    there. Gradients, markers, clips, masks, patterns, filters and symbols (counted
+    apart) are what a ``<defs>`` is for: the drawing is the same with or without them.
 
     And a drawn ``<use>`` of another file's element (``use-file``). Text and images a
     ``<use>`` places (from a ``<symbol>`` or a group in ``<defs>``) count once per
     ``<use>``; each element placed is walked once (:func:`check_use_cycles` has run).
     """
     ids = {e.get("id"): e for e in root.iter() if e.get("id")}
+    placed_ids = {
+        link[1:] for e in root.iter() if local_name(e) == "use" and (link := href(e))[:1] == "#"
+    }
     placed: dict[ET.Element, Counter[str]] = {}
 
     def placed_by_use(target: ET.Element) -> Counter[str]:
@@ -430,8 +438,8 @@ def count_skipped(root: ET.Element, hold: ET.Element, counts: Counter[str]) -> N
             inner = _markers(child, marked, ids)
             if inner and drawn and kind in _MARKED:
                 into["marker"] += 1
-            if kind == "defs" and any(  # a clip is checked where it is used (svgclip)
-                local_name(c) not in (None, "style", "clipPath") for c in child
+            if kind == "defs" and any(
+                local_name(c) in _PLACEABLE and c.get("id") not in placed_ids for c in child
             ):
                 into["defs"] += 1
             elif kind in ("text", "image") and drawn:
@@ -449,6 +457,11 @@ def count_skipped(root: ET.Element, hold: ET.Element, counts: Counter[str]) -> N
 
 
 _NO: frozenset[str] = frozenset()
+_PLACEABLE = frozenset(
+    {"path", "rect", "circle", "ellipse", "line", "polyline", "polygon", "g", "a", "switch"}
+    | {"svg", "use", "text", "image"}
+)
+"""Elements a ``<defs>`` holds that a ``<use>`` of them draws (SVG 1.1 §5.6)."""
 _MARKED = frozenset({"path", "line", "polyline", "polygon"})
 """The shapes a viewer draws markers on (SVG 1.1 §11.6.1)."""
 _MARKER_PROPERTIES = {

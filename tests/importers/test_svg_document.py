@@ -659,10 +659,33 @@ def test_use_places_a_definition_and_names_both(tmp_path: Path) -> None:
     contour = one(drawing)
     assert vertices(contour) == [(5, 93), (15, 93)]
     assert contour.source == "use#u1 > path#d1"
-    assert drawing.warnings == (
-        f"{tmp_path / 't.svg'}: skipped 1 <defs> element (definitions are cut only where a "
-        "<use> places them)",
-    )
+    assert drawing.warnings == ()  # the <use> places all the <defs> holds
+
+
+@pytest.mark.parametrize(
+    ("defs", "warned"),
+    [
+        ('<path id="d1" d="M 0 0 L 10 0"/><path id="d2" d="M 0 0 L 0 10"/>', True),  # d2
+        ('<g><path d="M 0 0 L 10 0"/></g>', True),  # a group nothing places
+        ('<text id="t">hi</text>', True),
+        (
+            '<linearGradient id="g"><stop offset="0"/></linearGradient>'
+            '<marker id="m"><path d="M 0 0 L 1 1"/></marker>'
+            '<clipPath id="c"><rect width="5" height="5"/></clipPath>'
+            '<pattern id="p" width="2" height="2"><rect width="1" height="1"/></pattern>'
+            '<filter id="f"/><style>path { stroke: black }</style>',
+            False,  # what an Inkscape file's <defs> holds: the drawing is the same without it
+        ),
+    ],
+)
+def test_a_defs_is_warned_of_when_it_holds_a_shape_no_use_places(
+    tmp_path: Path, defs: str, warned: bool
+) -> None:
+    body = f'<defs>{defs}</defs><use xlink:href="#d1" x="5"/><path d="M 0 0 L 1 1" stroke="red"/>'
+    warnings = read_svg(svg(tmp_path, body)).warnings
+    said = [w for w in warnings if "<defs>" in w]
+    expected = "skipped 1 <defs> element (definitions are cut only where a <use> places them)"
+    assert said == ([f"{tmp_path / 't.svg'}: {expected}"] if warned else [])
 
 
 @pytest.mark.parametrize(
