@@ -12,7 +12,6 @@ from __future__ import annotations
 import re
 import xml.etree.ElementTree as ET
 from collections import Counter
-from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -33,6 +32,7 @@ from camtool.importers.svgmasks import (
     symbols_as_viewports,
 )
 from camtool.importers.svgpage import Affine, illustrator_version, page_matrix
+from camtool.importers.svgskipped import count_skipped
 from camtool.importers.svgtree import (
     INKSCAPE_NS,
     LAYER_ATTR,
@@ -47,7 +47,7 @@ from camtool.importers.svgtree import (
     is_drawn,
     tag,
 )
-from camtool.importers.svgvalues import LENGTH_ATTRS, URL_REF
+from camtool.importers.svgvalues import LENGTH_ATTRS
 from camtool.model.errors import InputError, not_a_file
 
 _GROUPMODE = f"{{{INKSCAPE_NS}}}groupmode"
@@ -398,103 +398,6 @@ def check_conditions(
             move(element, parents, hold)
             continue
         stack.extend(element)
-
-
-def count_skipped(root: ET.Element, hold: ET.Element, counts: Counter[str]) -> None:
-    """Add to ``counts`` the skipped kinds: defs, drawn text and image, markers.
-
-    A ``<defs>`` counts when it holds an element a ``<use>`` could place and none does
-    (:data:`_PLACEABLE`): a viewer draws nothing of it, and a user may have drawn it
-    there. Gradients, markers, clips, masks, patterns, filters and symbols (counted
-    apart) are what a ``<defs>`` is for: the drawing is the same with or without them.
-
-    And a drawn ``<use>`` of another file's element (``use-file``). Text and images a
-    ``<use>`` places (from a ``<symbol>`` or a group in ``<defs>``) count once per
-    ``<use>``; each element placed is walked once (:func:`check_use_cycles` has run).
-    """
-    ids = {e.get("id"): e for e in root.iter() if e.get("id")}
-    placed_ids = {
-        link[1:] for e in root.iter() if local_name(e) == "use" and (link := href(e))[:1] == "#"
-    }
-    placed: dict[ET.Element, Counter[str]] = {}
-
-    def placed_by_use(target: ET.Element) -> Counter[str]:
-        """The text, images and markers a ``<use>`` of ``target`` draws (a symbol: its children)."""
-        found = placed.get(target)
-        if found is None:
-            found = Counter()
-            walk(target if local_name(target) == "symbol" else [target], True, found)
-            kinds = ("text", "image", "marker")
-            found = placed[target] = Counter({k: found[k] for k in kinds if found[k]})
-        return found
-
-    def walk(
-        node: Iterable[ET.Element], drawn: bool, into: Counter[str], marked: frozenset[str] = _NO
-    ) -> None:
-        for child in node:
-            kind = local_name(child)
-            if child is hold or kind is None:
-                continue
-            inner = _markers(child, marked, ids)
-            if inner and drawn and kind in _MARKED:
-                into["marker"] += 1
-            if kind == "defs" and any(
-                local_name(c) in _PLACEABLE and c.get("id") not in placed_ids for c in child
-            ):
-                into["defs"] += 1
-            elif kind in ("text", "image") and drawn:
-                into[kind] += 1
-                continue
-            elif kind == "use" and drawn:
-                link = href(child)
-                if link[:1] not in ("", "#"):
-                    into["use-file"] += 1  # another file's element: svgelements places nothing
-                elif link[:1] == "#" and (target := ids.get(link[1:])) is not None:
-                    into.update(placed_by_use(target))
-            walk(child, drawn and kind not in NOT_DRAWN, into, inner)
-
-    walk(root, True, counts)
-
-
-_NO: frozenset[str] = frozenset()
-_PLACEABLE = frozenset(
-    {"path", "rect", "circle", "ellipse", "line", "polyline", "polygon", "g", "a", "switch"}
-    | {"svg", "use", "text", "image"}
-)
-"""Elements a ``<defs>`` holds that a ``<use>`` of them draws (SVG 1.1 §5.6)."""
-_MARKED = frozenset({"path", "line", "polyline", "polygon"})
-"""The shapes a viewer draws markers on (SVG 1.1 §11.6.1)."""
-_MARKER_PROPERTIES = {
-    "marker": ("start", "mid", "end"),
-    "marker-start": ("start",),
-    "marker-mid": ("mid",),
-    "marker-end": ("end",),
-}
-
-
-def _markers(
-    element: ET.Element, inherited: frozenset[str], ids: dict[str | None, ET.Element]
-) -> frozenset[str]:
-    """Which of ``start``, ``mid``, ``end`` get a drawing marker on ``element`` and inherit.
-
-    The marker properties inherit; ``marker`` sets all three, the others one; ``none`` or a
-    reference to no ``<marker>`` with shapes sets none (SVG 1.1 §11.6.2). A ``style``
-    declaration outranks the attribute.
-    """
-    text = element.get("style") or ""
-    if "marker" not in text and _MARKER_PROPERTIES.keys().isdisjoint(element.attrib):
-        return inherited  # sets none: the style is not parsed (most elements)
-    style = inline_style(element)
-    out = set(inherited)
-    for prop, places in _MARKER_PROPERTIES.items():
-        value = style.get(prop, element.get(prop))
-        if value is None:
-            continue
-        ref = URL_REF.fullmatch(value)
-        target = ids.get(ref.group(1)) if ref is not None else None
-        draws = target is not None and local_name(target) == "marker" and has_shapes(target)
-        out = out | set(places) if draws else out - set(places)
-    return frozenset(out)
 
 
 MAX_DEPTH = 256
