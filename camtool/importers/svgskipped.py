@@ -27,7 +27,8 @@ def count_skipped(root: ET.Element, hold: ET.Element, counts: Counter[str]) -> N
 
     And a drawn ``<use>`` of another file's element (``use-file``). Text and images a
     ``<use>`` places (from a ``<symbol>`` or a group in ``<defs>``) count once per
-    ``<use>``; each element placed is walked once (:func:`check_use_cycles` has run).
+    ``<use>``; each element placed is walked once
+    (:func:`~camtool.importers.svgdoc.check_use_cycles` has run).
     """
     ids = {e.get("id"): e for e in root.iter() if e.get("id")}
     placed_ids = {
