@@ -23,6 +23,7 @@ from camtool.importers.gcode_params import expand_parameters
 from camtool.importers.gcode_plain import arc_end_off, arc_limits, plain_words, spiral_note
 from camtool.importers.gcode_start import StartRules
 from camtool.importers.gcode_target import READ_AS_WRITTEN, LengthOffsets, Reading, path_control
+from camtool.importers.textfile import decoded_or_latin1
 from camtool.model.errors import InputError
 from camtool.model.program import (
     ArcMove,
@@ -74,7 +75,7 @@ def read_gcode(
     path = Path(path)
     source = source_name or str(path)
     try:
-        text = _decoded(path.read_bytes())  # the bytes go as soon as they are text
+        text = decoded_or_latin1(path.read_bytes())  # the bytes go as soon as they are text
     except OSError as exc:
         raise InputError(f"{source}: cannot read the file ({exc.strerror or exc})") from exc
     return parse_gcode(text, source=source, reading=reading)
@@ -97,21 +98,7 @@ def read_gcode_bytes(
     Raises:
         InputError: as :func:`parse_gcode`.
     """
-    return parse_gcode(_decoded(data), source=source, reading=reading)
-
-
-def _decoded(data: bytes) -> str:
-    """``data`` as text: as its byte-order mark says (UTF-8, -16, -32), else UTF-8, else Latin-1.
-
-    A marked file that does not decode is read as Latin-1 too: the reader then names the
-    first character that is no G-code.
-    """
-    from camtool.importers.textfile import decoded
-
-    try:
-        return decoded(data)
-    except UnicodeDecodeError:
-        return data.decode("latin-1")
+    return parse_gcode(decoded_or_latin1(data), source=source, reading=reading)
 
 
 _LINE_END = re.compile(r"\r\n|\r|\n")

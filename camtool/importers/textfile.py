@@ -46,3 +46,15 @@ def decoded(data: bytes, errors: str = "strict") -> str:
         UnicodeDecodeError: (``errors="strict"``) the bytes are not text in that encoding.
     """
     return data.decode(text_encoding(data) or "utf-8", errors)
+
+
+def decoded_or_latin1(data: bytes) -> str:
+    """:func:`decoded`, or Latin-1 where that fails: every byte is then one character.
+
+    For G-code: a marked file that does not decode is read as Latin-1 too, and the reader
+    names the first character that is no G-code.
+    """
+    try:
+        return decoded(data)
+    except UnicodeDecodeError:
+        return data.decode("latin-1")
