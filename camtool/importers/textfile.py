@@ -52,9 +52,10 @@ def decoded_or_latin1(data: bytes) -> str:
     """:func:`decoded`, or Latin-1 where that fails: every byte is then one character.
 
     For G-code: a marked file that does not decode is read as Latin-1 too, and the reader
-    names the first character that is no G-code.
+    names the first character that is no G-code. A UTF-8 mark is dropped first (an editor
+    wrote it, and a byte after it that is no UTF-8 is the one to name, not the mark).
     """
     try:
         return decoded(data)
     except UnicodeDecodeError:
-        return data.decode("latin-1")
+        return data.removeprefix(codecs.BOM_UTF8).decode("latin-1")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import codecs
 import dataclasses
 import math
 from pathlib import Path
@@ -536,6 +537,10 @@ def test_read_gcode_errors_and_encodings(tmp_path: Path) -> None:
     latin = tmp_path / "pieza.nc"
     latin.write_bytes("(pieza maquinada en el LMM: ñ)\nG1 X1 Y1 F9\nM2\n".encode("latin-1"))
     assert read_gcode(latin, source_name="-").moves == (Linear(1.0, 1.0, 9.0, contour=1),)
+    # a UTF-8 mark, then a byte no UTF-8 holds: the mark is not what the message names
+    latin.write_bytes(codecs.BOM_UTF8 + b"G21\nG1 X1 Y1 F9\n\xe9M2\n")
+    with pytest.raises(InputError, match=r"pieza\.nc:3: unexpected character"):
+        read_gcode(latin)
     unicode = tmp_path / "notepad.nc"  # Notepad's "Unicode": UTF-16 LE with its mark
     unicode.write_bytes("(pièce)\r\nG21 G90\r\nG1 X1 Y1 F9\r\nM2\r\n".encode("utf-16"))
     assert read_gcode(unicode).moves == (Linear(1.0, 1.0, 9.0, contour=1),)
