@@ -90,9 +90,10 @@ def lex_line(raw: str, line: int, source: str) -> Block | None:
     block_delete = code.startswith("/")
     if block_delete:
         code = code[1:]
-    code = (
-        "".join(code.split()) if len(code) <= _LONG_LINE else code.translate(_NO_BLANKS)
-    ).upper()
+    code = "".join(code.split()) if len(code) <= _LONG_LINE else code.translate(_NO_BLANKS)
+    if not code.isascii():
+        _refuse_non_ascii(code, where)
+    code = code.upper()
     if _PROGRAM_NUMBER.fullmatch(code):
         return None  # a program number alone: no words (O-words with more are refused)
     words = _words(code, where)
@@ -101,6 +102,20 @@ def lex_line(raw: str, line: int, source: str) -> Block | None:
             return Block(line, (), True)
         return None
     return Block(line, tuple(words), block_delete)
+
+
+def _refuse_non_ascii(code: str, where: str) -> NoReturn:
+    """Refuse a character outside ASCII in a line's words (comments are already out).
+
+    Named as it is in the file, before any case change: Python upper-cases some letters
+    outside ASCII to ASCII ones (``'ı'`` to ``I``, ``'ſ'`` to ``S``, ``'ﬀ'`` to ``FF``), which
+    would read a word LinuxCNC's ``rs274`` refuses ("Bad character") as a valid one.
+    """
+    c = next(c for c in code if not c.isascii())
+    raise InputError(
+        f"{where}: unexpected character {c!r} in {quoted(code)}: G-code words are ASCII "
+        "letters and numbers; remove it or put it in a comment '( )'"
+    )
 
 
 _MSG = re.compile(r"\(\s*MSG\s*,([^)]*)\)", re.IGNORECASE)

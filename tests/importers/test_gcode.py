@@ -480,6 +480,12 @@ def test_safe_conversion_warns_once_with_count_and_first_line(block: str, expect
         ("G0 X1 (open", "comment '(' is not closed"),
         ("G0 X1 (a (b) c)", "nested comment"),
         ("G0 X1 @", "unexpected character '@'"),
+        # letters Python upper-cases to ASCII ones ('ı' to I, 'ſ' to S, 'ﬀ' to FF): rs274
+        # refuses each ("Bad character"), so read as words they would make a wrong move
+        ("G2 X3 Y1 \u0131 1 J0 F10", "unexpected character '\u0131' in 'G2X3Y1\u01311J0F10'"),
+        ("G1 X2 F10 \u017f100", "unexpected character '\u017f'"),
+        ("G1 X2 \ufb0010", "unexpected character '\ufb00'"),
+        ("G1 X2 Y1 F10 \u00e9", "unexpected character '\u00e9' in 'G1X2Y1F10\u00e9'"),
         ("G0 X", "letter 'X' is not followed by a number"),
         ("G1 X1 F-5", "negative feed F-5"),
         ("G80 X1", "X1 has no code to use it"),
