@@ -9,14 +9,14 @@ import itertools
 import math
 import re
 
-_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
-_BARE_POINT = re.compile(r"\d\.(?!\d)")
+_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
+_BARE_POINT = re.compile(r"\d\.(?!\d)", re.ASCII)
 """A number's decimal point with no digit after it ("300.", "2.e-4"): SVG's grammar reads it,
 svgelements stops reading the path or point list there and keeps what came before."""
 _SEPARATORS = " \t\r\n\f,"
 _ARITY = {"m": 2, "l": 2, "h": 1, "v": 1, "c": 6, "s": 4, "q": 4, "t": 2, "a": 7, "z": 0}
 _LENGTH = re.compile(
-    r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(mm|cm|in|pt|pc|px|em|ex|%)?\s*"
+    r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(mm|cm|in|pt|pc|px|em|ex|%)?\s*", re.ASCII
 )
 _TRANSFORM_ARGS = {
     "matrix": (6,),
@@ -26,7 +26,7 @@ _TRANSFORM_ARGS = {
     "skewX": (1,),
     "skewY": (1,),
 }
-_TRANSFORM_ITEM = re.compile(r"[\s,]*([A-Za-z]+)\s*\(([^()]*)\)[\s,]*")
+_TRANSFORM_ITEM = re.compile(r"[\s,]*([A-Za-z]+)\s*\(([^()]*)\)[\s,]*", re.ASCII)
 
 
 _S = r"[ \t\r\n\f,]*+"
@@ -43,7 +43,7 @@ _COMMAND = (
     f"(?:[MmLlTt](?:{_run_of(2)})++|[HhVv](?:{_run_of(1)})++|[Cc](?:{_run_of(6)})++"
     f"|[SsQq](?:{_run_of(4)})++|[Aa](?:{_run_of(3)}{_FLAG}{_FLAG}{_run_of(2)})++|[Zz])"
 )
-_WELL_FORMED = re.compile(f"{_S}(?=[Mm])(?:{_COMMAND}{_S})*+")
+_WELL_FORMED = re.compile(f"{_S}(?=[Mm])(?:{_COMMAND}{_S})*+", re.ASCII)
 """Path data :func:`check_path_data` reads without a fault, in one possessive match (no
 backtracking): each command with a multiple of its count of numbers, numbers split where
 its lexer splits them. What it does not match is read by the lexer, which says what is

@@ -125,7 +125,9 @@ def page_matrix(
     return (sx, 0.0, 0.0, -sy, tx, top - ty), viewport, page
 
 
-_LENGTH = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*([a-zA-Z%]*)\s*")
+_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
+"""A number as SVG's grammar writes it."""
+_LENGTH = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*([a-zA-Z%]*)\s*", re.ASCII)
 """A length attribute: its number and its unit (empty when none is given)."""
 
 INKSCAPE_VERSION = "{http://www.inkscape.org/namespaces/inkscape}version"
@@ -221,10 +223,12 @@ def _viewbox(root: ET.Element, name: str) -> tuple[float, float, float, float] |
     text = root.get("viewBox")
     if text is None:
         return None
-    try:
-        x, y, w, h = (float(v) for v in re.split(r"[\s,]+", text.strip()))
-    except ValueError:
-        raise InputError(f"{name}: viewBox {text!r} must be four numbers") from None
+    numbers = re.split(r"[\s,]+", text.strip(" \t\r\n\f"), flags=re.ASCII)
+    if len(numbers) != 4 or not all(_NUMBER.fullmatch(v) for v in numbers):
+        # as SVG's grammar writes numbers: Python's float() would also read "1_00", "inf"
+        # and digits of other scripts, which a browser refuses (and ignores the viewBox)
+        raise InputError(f"{name}: viewBox {text!r} must be four numbers")
+    x, y, w, h = (float(v) for v in numbers)
     if not (w > 0 and h > 0):
         raise InputError(f"{name}: viewBox {text!r} must have a positive width and height")
     return (x, y, w, h)

@@ -49,7 +49,7 @@ def _shaper_cut(values: Any) -> str | None:
     return None
 
 
-_SHAPER_DEPTH = re.compile(r"\s*(\d+\.?\d*|\.\d+)\s*(mm|cm|in)\s*", re.IGNORECASE)
+_SHAPER_DEPTH = re.compile(r"\s*(\d+\.?\d*|\.\d+)\s*(mm|cm|in)\s*", re.IGNORECASE | re.ASCII)
 """A ``shaper:cutDepth`` camtool reads: a number and its unit (``6.0mm``, ``0.25in``)."""
 _DEPTH_UNITS = {"mm": 1.0, "cm": 10.0, "in": 25.4}
 

@@ -116,7 +116,7 @@ def rect_radii(element: ET.Element) -> None:
         element.set("style", style_text(style))
 
 
-PERCENT = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)%\s*")
+PERCENT = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)%\s*", re.ASCII)
 _ACROSS = frozenset({"x", "cx", "width", "x1", "x2"})
 _DOWN = frozenset({"y", "cy", "height", "y1", "y2"})
 
@@ -209,7 +209,9 @@ def _in_context(
 
 
 _COLOUR_FUNCTION = re.compile(r"\s*(rgba?|hsla?)\(([^()]*)\)\s*", re.IGNORECASE)
-_COLOUR_ARG = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?(%|deg|grad|rad|turn)?$")
+_COLOUR_ARG = re.compile(
+    r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?(%|deg|grad|rad|turn)?$", re.ASCII
+)
 _TURNS = {"": 1 / 360, "deg": 1 / 360, "grad": 1 / 400, "rad": 1 / (2 * math.pi), "turn": 1.0}
 
 
@@ -349,7 +351,7 @@ def _rewritable(style: str) -> bool:
     )
 
 
-_NUMBER = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(%?)\s*")
+_NUMBER = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(%?)\s*", re.ASCII)
 
 
 def _opacity(value: str) -> str | None:
@@ -434,7 +436,9 @@ def _hsl(args: list[str]) -> list[int] | None:
 _ORIGIN_KEYWORDS = {"left": 0.0, "top": 0.0, "center": 50.0, "right": 100.0, "bottom": 100.0}
 _CSS_UNIT_PX = {"": 1.0, "px": 1.0, "mm": 96.0 / 25.4, "cm": 96.0 / 2.54, "in": 96.0,
                 "pt": 96.0 / 72.0, "pc": 16.0}  # fmt: skip
-_ORIGIN_TOKEN = re.compile(r"([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(%|px|mm|cm|in|pt|pc)?")
+_ORIGIN_TOKEN = re.compile(
+    r"([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(%|px|mm|cm|in|pt|pc)?", re.ASCII
+)
 
 
 def fold_transform_origin(element: ET.Element, viewport: tuple[float, float]) -> None:

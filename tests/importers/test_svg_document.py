@@ -928,6 +928,12 @@ def test_bad_input_names_file_and_element(tmp_path: Path, body: str, message: st
         ('width="-5mm" height="10mm"', "<svg> width '-5mm' must be positive"),
         ('viewBox="0 0 10"', "viewBox '0 0 10' must be four numbers"),
         ('viewBox="0 0 0 10"', "viewBox '0 0 0 10' must have a positive width and height"),
+        # numbers Python's float() reads and SVG's grammar does not (a browser ignores the
+        # viewBox or the size): read, the page would be 10 times another size than drawn
+        ('viewBox="0 0 1_0 10"', "viewBox '0 0 1_0 10' must be four numbers"),
+        ('viewBox="0 0 inf 10"', "viewBox '0 0 inf 10' must be four numbers"),
+        ('viewBox="0 0 \u0661\u0660 10"', "viewBox '0 0 \u0661\u0660 10' must be four numbers"),
+        ('width="\u0661\u0660mm" height="10mm"', "<svg> width '\u0661\u0660mm' is not a length"),
         (
             'width="1mm" height="1mm" viewBox="0 0 1 1" preserveAspectRatio="middle"',
             "preserveAspectRatio",
