@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from camtool.geometry.chain import chain_members, joint_distance
+from camtool.jobs.init_holes import around_note, around_smaller, smallest_at
 from camtool.jobs.init_mills import Parts, mill_between, mill_that_fits
 from camtool.jobs.init_mills import why as _why
 from camtool.jobs.job import MAX_TOOLS, Selection
@@ -106,11 +107,15 @@ def initial_job(
         group.close_gap = close_gap
     outer = _outermost([(group, c) for group in groups for c in _chains(group)])
     parts = Parts([c for group in groups for c in _chains(group) if id(c) in outer[0]])
+    circles = (circle_of(c) for group in groups for c in _chains(group))
+    smallest = smallest_at(c for c in circles if c is not None)
     ops: list[_Op] = []
     left: Counter[str] = Counter()
     cut: list[tuple[_Group, list[_Op]]] = []
     for group in groups:
-        made = _ops_of(group, (*outer, parts), thickness_mm, tool_diameter, left, k, drill=not no_z)
+        made = _ops_of(
+            group, (*outer, parts, smallest), thickness_mm, tool_diameter, left, k, drill=not no_z
+        )
         ops.extend(_repeated(group, made, cut))
         cut.append((group, made))
     if all(op.kind == "engrave" for op in ops):
@@ -359,7 +364,7 @@ _AREA_TOLERANCE_MM = 0.01
 
 def _ops_of(
     group: _Group,
-    outer: tuple[set[int], dict[int, str], Parts],
+    outer: tuple[set[int], dict[int, str], Parts, dict[tuple[float, float], float]],
     thickness: float,
     tool: float,
     left: Counter[str],
@@ -370,7 +375,8 @@ def _ops_of(
     """The operations of one layer (or colour); ``k``: the scale the job fits it by.
 
     ``outer``: the ids of the outermost closed contours, the holes of other groups' parts
-    (:func:`_outermost`), and every group's parts (the outermost contours themselves).
+    (:func:`_outermost`), every group's parts (the outermost contours themselves), and the
+    smallest circle about each centre of the drawing (:func:`.init_holes.smallest_at`).
 
     ``drill``: small circles are drilled (else profiled with the rest: no Z to drill by).
     """
@@ -387,6 +393,7 @@ def _ops_of(
         return []
     out: list[_Op] = []
     circles: dict[float, list[float]] = {}  # by the diameter to 1 µm: every diameter
+    around: Counter[float] = Counter()  # drawn around a smaller circle: by that key, and 0.0
     profiled: list[Contour] = []
     opened: list[Contour] = []
     shaper = _shaper_cut(group.key)
@@ -401,15 +408,20 @@ def _ops_of(
             opened.append(contour)
         elif drill and circle is not None and 0.0 < round(circle[1], 3) <= DRILL_MAX_MM:
             circles.setdefault(round(circle[1], 3), []).append(circle[1])
+            around[round(circle[1], 3)] += around_smaller(*circle, outer[3])
         elif contour.closed:
             profiled.append(contour)
+            around[0.0] += circle is not None and around_smaller(*circle, outer[3])
         else:
             opened.append(contour)
     for d, exact in sorted(circles.items()):
         span = (_drawn(min(exact), k), _drawn(max(exact), k))
-        out.append(_drill_op(select, what, d, span, thickness, len(exact)))
+        out.append(_drill_op(select, what, d, span, thickness, len(exact), around[d]))
     if profiled:
-        op = _profile_op(select, what, profiled, outer, thickness, tool, group.key)
+        op = _profile_op(select, what, profiled, outer[:3], thickness, tool, group.key)
+        if around[0.0]:
+            note = _why(around_note(around[0.0], "cut", "of its circles")).lstrip()
+            op = dataclasses.replace(op, lines=(*op.lines, note))
         if circles:
             lo = _drawn(min(min(v) for v in circles.values()), k)
             hi = _drawn(max(max(v) for v in circles.values()), k)
@@ -470,15 +482,27 @@ def _drawn(d: float, k: float) -> float:
 
 
 def _drill_op(
-    select: str, what: str, d: float, span: tuple[float, float], thickness: float, count: int
+    select: str,
+    what: str,
+    d: float,
+    span: tuple[float, float],
+    thickness: float,
+    count: int,
+    around: int = 0,
 ) -> _Op:
-    """A drill per hole size: the circles whose diameter rounds to ``d`` (to 1 µm)."""
+    """A drill per hole size: the circles whose diameter rounds to ``d`` (to 1 µm).
+
+    ``around``: how many of them are drawn around a smaller circle (said in the comment).
+    """
     depth = thickness + BREAKTHROUGH_MM
     lo, hi = round(span[0], 6), round(span[1], 6)  # selections match to 1e-6 of the value
     size = f"diameter = {lo!r}" if lo == hi else f"diameter = [{lo!r}, {hi!r}]"
+    why = f"{count} circle(s) of ø{d:g} mm on {what}: small, drilled"
+    if around:
+        why += "; " + around_note(around, "drilled")
     lines = (
         f"name = {_quote(f'holes {d:g}')}",
-        'type = "drill"' + _why(f"{count} circle(s) of ø{d:g} mm on {what}: small, drilled"),
+        'type = "drill"' + _why(why),
         f"tool = {{drill {d:g}}}",
         select,
         size + _why("only the circles of this size"),

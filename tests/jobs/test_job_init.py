@@ -497,3 +497,38 @@ def test_a_first_job_that_would_hold_more_tools_than_a_job_may_is_refused(
     monkeypatch.setattr(init_module, "MAX_TOOLS", 1)
     with pytest.raises(InputError, match=r"^part.dxf: its first job would need 2 tools"):
         initial_job(drawing, source="part.dxf")
+
+
+def test_a_circle_drawn_around_a_smaller_one_is_named_a_possible_counterbore(
+    tmp_path: Path,
+) -> None:
+    """A counterbore in plan is two circles about one centre: the larger is cut through,
+    as drawn, and the job file says which circles those are (not the inner holes, not a
+    circle drawn twice)."""
+
+    def build(msp: object) -> None:
+        add = msp.add_circle  # type: ignore[attr-defined]
+        msp.add_lwpolyline([(0, 0), (60, 0), (60, 40), (0, 40)], close=True)  # type: ignore[attr-defined]
+        add((10, 10), 1.6)  # ø3.2 through, in a ø6 counterbore: both drilled
+        add((10, 10), 3.0)
+        add((50, 10), 1.6)  # a plain ø3.2 hole, drawn twice
+        add((50, 10), 1.6)
+        add((30, 20), 3.3)  # ø6.6 in a ø11 counterbore: both larger than a drill, profiled
+        add((30, 20), 5.5)
+
+    text = initial_job(read_drawing(write_dxf(tmp_path / "cb.dxf", build)), thickness_mm=5.0)
+    lines = text.splitlines()
+    small = next(line for line in lines if "circle(s) of ø3.2 mm" in line)
+    large = next(line for line in lines if "circle(s) of ø6 mm" in line)
+    assert "around" not in small
+    assert large.endswith(
+        "small, drilled; 1 of them around a smaller circle at their centre (a counterbore, or "
+        "a thread's outer diameter, drawn in plan?): drilled through the stock here; if so, give "
+        "them an operation of their own with its depth"
+    )
+    assert "# 1 of its circles around a smaller circle at their centre" in text
+    assert [(op["type"], op.get("diameter")) for op in _ops(text)] == [
+        ("drill", 3.2),
+        ("drill", 6.0),
+        ("profile", None),
+    ]
