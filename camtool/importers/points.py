@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from camtool.importers.options import ImportOptions
+from camtool.importers.textfile import text_lines
 from camtool.model.errors import InputError, UsageError, not_a_file, quoted
 from camtool.model.shapes import Contour, Drawing, Line, Point
 from camtool.model.units import LARGEST_VALUE, LENGTH_UNITS
@@ -185,7 +186,7 @@ def holds_rows(text: str) -> bool:
     So it is with a row of 2 or 3 numbers, a first line naming X and Y over a row of
     numbers (a wide table's header), or a G-code block; a note (a README) has none of them.
     """
-    lines = [line.strip() for line in text.splitlines() if line.strip()]
+    lines = [line.strip() for line in text_lines(text) if line.strip()]
     lines = lines[1:] if lines and _EXCEL_SEPARATOR.fullmatch(lines[0]) else lines
     rows = [line for line in lines if not line.startswith("#")]
     if len(rows) > 1 and _under_header(rows[0], rows[1]):
@@ -216,7 +217,7 @@ def _program_error(text: str, path: Path) -> InputError | None:
     ``None`` when none of the first :data:`_PROGRAM_LOOK` lines that are not blank is a
     G-code block (a ``(10, 20)`` row stays a bad point-list row).
     """
-    lines = ((n, raw.strip()) for n, raw in enumerate(text.splitlines(), start=1) if raw.strip())
+    lines = ((n, raw.strip()) for n, raw in enumerate(text_lines(text), start=1) if raw.strip())
     for number, line in itertools.islice(lines, _PROGRAM_LOOK):
         if _PROGRAM_BLOCK.match(line):
             shown = line if len(line) <= 40 else line[:40] + "…"
@@ -367,7 +368,7 @@ def _text_strokes(
     seen_data = False
     header: _Columns | None = None  # the X, Y, Z columns the header names
     excel = _excel_separator_line(text, path)
-    for number, raw in enumerate(text.splitlines(), start=1):
+    for number, raw in enumerate(text_lines(text), start=1):
         if number == excel:
             continue
         if raw.strip().startswith("#"):
@@ -458,7 +459,7 @@ def _excel_separator_line(text: str, path: Path) -> int | None:
     Raises:
         InputError: it names a separator other than a comma, semicolon, tab or blank.
     """
-    for number, raw in enumerate(text.splitlines(), start=1):
+    for number, raw in enumerate(text_lines(text), start=1):
         if not raw.strip():
             continue
         match = _EXCEL_SEPARATOR.fullmatch(raw)

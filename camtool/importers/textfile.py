@@ -11,6 +11,7 @@ that byte order: G-code and point lists are ASCII, and UTF-8 text holds no NUL.
 from __future__ import annotations
 
 import codecs
+import re
 
 _MARKS = (  # longest first: the UTF-32 LE mark begins with the UTF-16 LE one
     (codecs.BOM_UTF32_LE, "utf-32"),
@@ -59,3 +60,27 @@ def decoded_or_latin1(data: bytes) -> str:
         return decoded(data)
     except UnicodeDecodeError:
         return data.removeprefix(codecs.BOM_UTF8).decode("latin-1")
+
+
+_LINE_END = re.compile(r"\r\n|\r|\n")
+
+
+def text_lines(text: str) -> list[str]:
+    """``text`` split at its line ends: LF, CR LF and CR only, without the ends.
+
+    ``str.splitlines`` also splits at a form feed, a vertical tab, U+001C-U+001E, U+0085,
+    U+2028 and U+2029, which Python's own file reading (universal newlines), numpy's
+    ``loadtxt`` and a controller keep inside the line: a point list's ``# note`` holding a
+    U+2028 would give a row of the numbers after it. As ``splitlines``, a last line end
+    gives no empty line after it.
+    """
+    if text.isascii() and not any(c in text for c in _ASCII_BREAKS):
+        return text.splitlines()  # the same lines, made faster
+    lines = _LINE_END.split(text)
+    if lines[-1] == "":
+        lines.pop()
+    return lines
+
+
+_ASCII_BREAKS = "\x0b\x0c\x1c\x1d\x1e"
+"""The line breaks of ``str.splitlines`` in ASCII other than LF and CR."""

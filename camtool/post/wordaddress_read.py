@@ -15,6 +15,7 @@ import re
 from dataclasses import dataclass, field
 from typing import Literal
 
+from camtool.importers.textfile import text_lines
 from camtool.model.errors import DialectError, ParseError, quoted
 from camtool.model.program import (
     ArcMove,
@@ -120,7 +121,7 @@ class BlockReader:
                 code = code.decode("ascii")
             except UnicodeDecodeError as exc:
                 raise ParseError(f"{self.source}: byte {exc.start} is not ASCII text") from exc
-        for number, raw in enumerate(code.splitlines(), start=1):
+        for number, raw in enumerate(text_lines(code), start=1):
             self.line = number
             if self.spec.is_comment(raw):
                 continue  # the writer's own notes and tape marks

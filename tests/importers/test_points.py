@@ -104,6 +104,19 @@ def test_header_blank_lines_nan_rows_and_comments_split_strokes(tmp_path: Path) 
     assert all(c.layer == "0" for c in drawing.contours)
 
 
+@pytest.mark.parametrize("brk", ["\u2028", "\u2029", "\x85", "\x0c", "\x0b", "\x1e"])
+def test_a_comment_ends_at_its_line_end_only(tmp_path: Path, brk: str) -> None:
+    """``str.splitlines`` also breaks a line at these; numpy's ``loadtxt`` (the judge here)
+    and Python's own file reading keep them in the comment, and so must the reader: else
+    the numbers after one in a ``#`` comment would be a first point to cut from."""
+    import numpy as np
+
+    path = write(tmp_path, "p.txt", f"# measured{brk}1 2\n0 0\n10 0\n10 10\n")
+    expected = [tuple(row) for row in np.loadtxt(path, encoding="utf-8").tolist()]
+    assert expected == [(0.0, 0.0), (10.0, 0.0), (10.0, 10.0)]
+    assert [vertices(c) for c in read_points(path).contours] == [expected]
+
+
 def test_closed_when_last_point_equals_first_and_repeats_dropped(tmp_path: Path) -> None:
     text = "0,0\n10,0\n10,0\n10,10\n0,0\n"
     contour = read_points(write(tmp_path, "sq.xy", text)).contours[0]

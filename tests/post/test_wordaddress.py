@@ -474,6 +474,9 @@ FLASHLIKE: dict[str, Any] = {
         ("G01  X1.0 Y1.0", "separated by one space"),
         ("G01X1.0 Y1.0", "separated by one space"),
         ("G01\tX1.0 Y1.0", "separated by one space"),  # a tab within one space-split word
+        # a form feed or U+2028 is no line end (str.splitlines would make two blocks of it)
+        ("G01 X1.0\x0cG01 Y1.0", "separated by one space"),
+        ("G01 X1.0 Y1.0\u2028G01 X2.0 Y1.0", "separated by one space"),
         ("G01 X1.0 Y1.0 (a note)", "'\\(a' is not a word"),  # FLASHLIKE has no comments
         ("G01 X1.0", "missing Y word"),  # both X and Y (Yanez-07 R4)
         ("G1 X1.0 Y1.0", "unknown code 'G1'"),
