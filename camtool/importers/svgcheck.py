@@ -9,7 +9,8 @@ import itertools
 import math
 import re
 
-_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
+NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
+"""A number as SVG's grammar writes it (ASCII digits: Python's ``float`` reads more)."""
 _BARE_POINT = re.compile(r"\d\.(?!\d)", re.ASCII)
 """A number's decimal point with no digit after it ("300.", "2.e-4"): SVG's grammar reads it,
 svgelements stops reading the path or point list there and keeps what came before."""
@@ -30,7 +31,7 @@ _TRANSFORM_ITEM = re.compile(r"[\s,]*([A-Za-z]+)\s*\(([^()]*)\)[\s,]*", re.ASCII
 
 
 _S = r"[ \t\r\n\f,]*+"
-_N = r"(?>[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)"  # _NUMBER, as its match takes it
+_N = r"(?>[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)"  # NUMBER, as its match takes it
 
 
 def _run_of(count: int) -> str:
@@ -102,7 +103,7 @@ def _read_path_data(d: str) -> str:
                 raise ValueError(f"arc flag must be 0 or 1, got {char!r} at character {pos}")
             pos, args = pos + 1, args + 1
             continue
-        match = _NUMBER.match(d, pos)
+        match = NUMBER.match(d, pos)
         if match is None:
             raise ValueError(f"cannot read a number at character {pos} ({d[pos : pos + 12]!r})")
         point = _BARE_POINT.search(match.group())
@@ -180,7 +181,7 @@ def _numbers(text: str, what: str) -> list[str]:
     for token in tokens:
         pos = 0
         while pos < len(token):  # "1-2" and "1.5.5" are two numbers each
-            match = _NUMBER.match(token, pos)
+            match = NUMBER.match(token, pos)
             if match is None:
                 raise ValueError(f"{what}: cannot read a number in {token!r}")
             out.append(match.group())

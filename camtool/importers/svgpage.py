@@ -11,6 +11,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TypeAlias
 
+from camtool.importers.svgcheck import NUMBER
 from camtool.model.errors import InputError, TooLargeError, UsageError
 from camtool.model.shapes import BBox, Contour, Line, Point
 from camtool.model.units import LENGTH_UNITS, PX
@@ -125,8 +126,6 @@ def page_matrix(
     return (sx, 0.0, 0.0, -sy, tx, top - ty), viewport, page
 
 
-_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
-"""A number as SVG's grammar writes it."""
 _LENGTH = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*([a-zA-Z%]*)\s*", re.ASCII)
 """A length attribute: its number and its unit (empty when none is given)."""
 
@@ -224,7 +223,7 @@ def _viewbox(root: ET.Element, name: str) -> tuple[float, float, float, float] |
     if text is None:
         return None
     numbers = re.split(r"[\s,]+", text.strip(" \t\r\n\f"), flags=re.ASCII)
-    if len(numbers) != 4 or not all(_NUMBER.fullmatch(v) for v in numbers):
+    if len(numbers) != 4 or not all(NUMBER.fullmatch(v) for v in numbers):
         # as SVG's grammar writes numbers: Python's float() would also read "1_00", "inf"
         # and digits of other scripts, which a browser refuses (and ignores the viewBox)
         raise InputError(f"{name}: viewBox {text!r} must be four numbers")

@@ -114,7 +114,7 @@ def initial_job(
     cut: list[tuple[_Group, list[_Op]]] = []
     for group in groups:
         made = _ops_of(
-            group, (*outer, parts, smallest), thickness_mm, tool_diameter, left, k, drill=not no_z
+            group, (*outer, parts), thickness_mm, tool_diameter, left, k, smallest, drill=not no_z
         )
         ops.extend(_repeated(group, made, cut))
         cut.append((group, made))
@@ -364,19 +364,21 @@ _AREA_TOLERANCE_MM = 0.01
 
 def _ops_of(
     group: _Group,
-    outer: tuple[set[int], dict[int, str], Parts, dict[tuple[float, float], float]],
+    outer: tuple[set[int], dict[int, str], Parts],
     thickness: float,
     tool: float,
     left: Counter[str],
     k: float,
+    smallest: dict[tuple[float, float], float],
     *,
     drill: bool = True,
 ) -> list[_Op]:
     """The operations of one layer (or colour); ``k``: the scale the job fits it by.
 
     ``outer``: the ids of the outermost closed contours, the holes of other groups' parts
-    (:func:`_outermost`), every group's parts (the outermost contours themselves), and the
-    smallest circle about each centre of the drawing (:func:`.init_holes.smallest_at`).
+    (:func:`_outermost`), and every group's parts (the outermost contours themselves).
+    ``smallest``: the smallest circle about each centre of the drawing
+    (:func:`.init_holes.smallest_at`).
 
     ``drill``: small circles are drilled (else profiled with the rest: no Z to drill by).
     """
@@ -408,17 +410,17 @@ def _ops_of(
             opened.append(contour)
         elif drill and circle is not None and 0.0 < round(circle[1], 3) <= DRILL_MAX_MM:
             circles.setdefault(round(circle[1], 3), []).append(circle[1])
-            around[round(circle[1], 3)] += around_smaller(*circle, outer[3])
+            around[round(circle[1], 3)] += around_smaller(*circle, smallest)
         elif contour.closed:
             profiled.append(contour)
-            around[0.0] += circle is not None and around_smaller(*circle, outer[3])
+            around[0.0] += circle is not None and around_smaller(*circle, smallest)
         else:
             opened.append(contour)
     for d, exact in sorted(circles.items()):
         span = (_drawn(min(exact), k), _drawn(max(exact), k))
         out.append(_drill_op(select, what, d, span, thickness, len(exact), around[d]))
     if profiled:
-        op = _profile_op(select, what, profiled, outer[:3], thickness, tool, group.key)
+        op = _profile_op(select, what, profiled, outer, thickness, tool, group.key)
         if around[0.0]:
             note = _why(around_note(around[0.0], "cut", "of its circles")).lstrip()
             op = dataclasses.replace(op, lines=(*op.lines, note))
