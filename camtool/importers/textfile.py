@@ -6,6 +6,9 @@ is a NUL. The mark says which encoding it is (Unicode 15, §23.8), so such a fil
 as the text it holds. Without a mark, a file whose every other byte is a NUL and none of
 the others is (ASCII text in UTF-16, as some converters write it) is read as UTF-16 in
 that byte order: G-code and point lists are ASCII, and UTF-8 text holds no NUL.
+
+Their lines end at LF, CR LF or CR only (:func:`text_lines`), as a controller and numpy
+read them.
 """
 
 from __future__ import annotations

@@ -264,6 +264,7 @@ def test_g0_with_f_keeps_f_modal() -> None:
         ("G 0 1 X 1 . 5 Y 2", 1.5, 2.0),
         ("N0010G01X1Y2(comment)", 1.0, 2.0),
         ("/G1 X1 Y2", 1.0, 2.0),
+        ("G1\u00a0X1\u00a0.5 Y2", 1.5, 2.0),  # a no-break space is a blank, as a space is
     ],
 )
 def test_word_syntax(text: str, x: float, y: float) -> None:
