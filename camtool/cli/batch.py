@@ -17,6 +17,7 @@ import click
 from camtool.cli.common import (
     JOB,
     MACHINE,
+    WholeNumber,
     import_options,
     number_range,
     output_settings,
@@ -63,7 +64,7 @@ def _post_options(command: Callable[..., None]) -> Callable[..., None]:
 @click.option(
     "--jobs",
     "-j",
-    type=click.IntRange(min=1),
+    type=WholeNumber(min=1),
     default=None,
     metavar="N",
     help="Worker processes [default: all cores]; 1 runs in this process.",

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from camtool.cli.common import MACHINE, publishes, warn, write_output
+from camtool.cli.common import MACHINE, number_range, publishes, warn, write_output
 from camtool.model.errors import UsageError
 
 TARGET = click.option(
@@ -97,7 +97,7 @@ def coupon(
 )
 @click.option(
     "--max-correction",
-    type=click.FloatRange(min=0, min_open=True, max=1000),
+    type=number_range(min=0, max=1000, min_open=True),
     default=20.0,
     show_default=True,
     metavar="PCT",

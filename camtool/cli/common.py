@@ -49,7 +49,7 @@ class FiniteFloat(click.FloatRange):
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
         """The value as a finite float in range, or a usage error naming the option."""
-        if isinstance(value, str) and "_" in value:
+        if isinstance(value, str) and not plain_digits(value):
             self.fail(f"{value!r} is not a number", param, ctx)
         rv = super().convert(value, param, ctx)
         if not math.isfinite(rv):
@@ -61,6 +61,28 @@ class FiniteFloat(click.FloatRange):
         if self.min is None and self.max is None:
             return ""
         return super()._describe_range()
+
+
+def plain_digits(text: str) -> bool:
+    """Whether ``text`` is written as G-code, TOML and a shell user write numbers.
+
+    Python's ``float`` and ``int`` also read ``1_5`` (15, where ``1.5`` was meant) and the
+    digits of other scripts (``١``, full-width ``１``): such a value is refused, naming the
+    option, rather than read as a number the user may not have meant.
+    """
+    return text.isascii() and "_" not in text
+
+
+class WholeNumber(click.IntRange):
+    """An integer option of ASCII digits (:func:`plain_digits`), within an optional range."""
+
+    name = "integer"
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        """The value as an int in range, or a usage error naming the option."""
+        if isinstance(value, str) and not plain_digits(value):
+            self.fail(f"{value!r} is not a whole number", param, ctx)
+        return super().convert(value, param, ctx)
 
 
 NUMBER = FiniteFloat()
@@ -296,7 +318,7 @@ def import_options(command: Callable[..., None]) -> Callable[..., None]:
 
     command = click.option(
         "--max-entities",
-        type=click.IntRange(min=1),
+        type=WholeNumber(min=1),
         default=None,
         metavar="N",
         help="Refuse a drawing that expands to more than N entities (DXF blocks and "
@@ -470,7 +492,7 @@ _POST_OPTIONS = (
     ),
     click.option(
         "--tabs",
-        type=click.IntRange(min=0),
+        type=WholeNumber(min=0),
         default=0,
         show_default=True,
         metavar="N",

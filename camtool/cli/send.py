@@ -16,7 +16,7 @@ from typing import IO, TYPE_CHECKING, Any
 
 import click
 
-from camtool.cli.common import MACHINE, number_range, warn
+from camtool.cli.common import MACHINE, WholeNumber, number_range, warn
 from camtool.model.errors import UsageError
 
 if TYPE_CHECKING:
@@ -33,7 +33,7 @@ if TYPE_CHECKING:
     metavar="DEVICE|URL",
     help="Serial device (/dev/ttyUSB0, COM3, /dev/pts/N) or pyserial URL (socket://HOST:PORT).",
 )
-@click.option("--baud", type=click.IntRange(min=1), default=None, help="Override the link's baud.")
+@click.option("--baud", type=WholeNumber(min=1), default=None, help="Override the link's baud.")
 @click.option("--dry-run", is_flag=True, help="Check and print the protocol plan; open no port.")
 @click.option("--verify", is_flag=True, help="Predict the machined error before sending.")
 @click.option(
@@ -52,7 +52,7 @@ if TYPE_CHECKING:
 )
 @click.option(
     "--from-line",
-    type=click.IntRange(min=1),
+    type=WholeNumber(min=1),
     default=None,
     metavar="N",
     help="Resume at source line N (the modal state before it is restored where the link can).",
@@ -258,9 +258,9 @@ class _Bar:
 @click.command("simulate-device")
 @click.option("-t", "--target", required=True, help="Target whose controller to simulate.")
 @click.option("--pty", "use_pty", is_flag=True, required=True, help="Serve on a pseudo-terminal.")
-@click.option("--fail-at-block", type=click.IntRange(min=1), default=None, metavar="N")
+@click.option("--fail-at-block", type=WholeNumber(min=1), default=None, metavar="N")
 @click.option("--error", default="", metavar="CODE", help="The controller's error code there.")
-@click.option("--drop-at-block", type=click.IntRange(min=1), default=None, metavar="N")
+@click.option("--drop-at-block", type=WholeNumber(min=1), default=None, metavar="N")
 @click.option(
     "--block-delay-ms",
     type=number_range(min=0),

@@ -30,6 +30,13 @@ TABS = ["--tabs", "2", "--depth", "3", "--offset", "outside", "--tool-diameter",
         (["--spindle-rpm", "inf"], "--spindle-rpm"),
         (["--translate", "nan", "0"], "--translate"),
         (["--tolerance", "1_0"], "--tolerance"),
+        # Python's float and int read the digits of every script: --fit ١٠٠ 50 was 100 × 50,
+        # --depth １ (full-width) 1 mm, --tabs 1_0 ten tabs
+        (["--fit", "\u0661\u0660\u0660", "50"], "--fit"),
+        (["--depth", "\uff11"], "--depth"),
+        (["--tabs", "1_0", *TABS[2:]], "--tabs"),
+        (["--tabs", "\u0662", *TABS[2:]], "--tabs"),
+        (["--max-entities", "1_000"], "--max-entities"),
     ],
 )
 def test_non_finite_option_is_a_usage_error_naming_it(
