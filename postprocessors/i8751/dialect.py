@@ -215,19 +215,23 @@ class _Writer(WriterState[Record]):
     def steps(self, value_mm: float, axis: int) -> int:
         return _round_steps(value_mm, self.spm[axis])
 
-    def goto(self, x: float, y: float, z: float | None, *, rapid: bool = False) -> None:
-        """Records from the current position to ``(x, y[, z])``: X/Y pieces, then Z.
+    def goto(self, x: float, y: float, z: float | None, *, checked: bool = True) -> None:
+        """Records from the current position to ``(x, y[, z])``.
 
-        A record runs X/Y before Z (Intf8751 §3.7), so a move that also changes Z
-        runs its X/Y at the old height. A *rapid* that rises goes up first (Z-only
-        records, then X/Y), so it never travels at the cutting depth it leaves.
+        A record runs X/Y before Z (Intf8751 §3.7). A move that goes down runs its X/Y
+        at the old height, then Z (one record); a move that rises, a cut as well as a
+        rapid, goes up first (a Z-only record, then X/Y), so its X/Y never runs below
+        the height the program gives: the tool stays on or above the programmed path.
+        ``checked``: refuse a height above the stock written at its top
+        (:func:`check_written_z`; not for a helix's inner chords).
         """
         target = [self.steps(x, 0), self.steps(y, 1)]
         if z is None:
             target.append(self.pos[2])
         else:
             target.append(self.steps(z, 2))
-            check_written_z(z, target[2] / self.spm[2], self.where())
+            if checked:
+                check_written_z(z, target[2] / self.spm[2], self.where())
         dx, dy, dz = (t - p for t, p in zip(target, self.pos, strict=True))
         xy = split_xy(dx, dy)
         zs = split_count(dz)
@@ -236,7 +240,7 @@ class _Writer(WriterState[Record]):
         if xy and zs:
             self.counts["xyz"] += 1
         records = [Record((px, py, 0)) for px, py in xy]
-        if rapid and dz > 0:
+        if dz > 0:
             records = [Record((0, 0, n)) for n in zs] + records
         else:
             if records and zs:
@@ -416,8 +420,15 @@ class I8751Post(PostProcessor):
         points = [(move.x, move.y)]
         if isinstance(move, ArcMove):
             points = self._chords(w, start, move, _tolerance(program, machine))
+        # a helix's Z in equal parts over its chords, as the arc's XY: each chord's
+        # staircase (goto) stays within one part of the programmed helix, above it
+        z0 = w.pos[2] / w.spm[2]
+        n = len(points)
         for k, (x, y) in enumerate(points, start=1):
-            w.goto(x, y, move.z if k == len(points) else None, rapid=isinstance(move, Rapid))
+            if move.z is None or k == n:
+                w.goto(x, y, move.z)
+            else:
+                w.goto(x, y, z0 + (move.z - z0) * k / n, checked=False)
         if len(w.blocks) == before:
             w.counts["tiny"] += 1
 
@@ -536,7 +547,9 @@ def _count_warnings(c: Counter[str]) -> list[str]:
     if c["xyz"]:
         out.append(
             f"{c['xyz']} move(s) change X/Y and Z together: the 8751 runs X/Y first, then Z "
-            "(Intf8751 §4.3, R11; a rising rapid goes up first); they read back as two moves"
+            "(Intf8751 §4.3, R11), so each is written going down as X/Y then Z, rising as Z "
+            "then X/Y (the tool never below the programmed path, a step above it at most); "
+            "they read back as two moves"
         )
     if c["split"]:
         out.append(

@@ -268,14 +268,58 @@ def test_rapids_without_lift_cut_and_say_so() -> None:
     assert [type(m) for m in post.parse(result.code).moves] == [Linear, Linear]
 
 
-def test_z_with_xy_runs_xy_first() -> None:
+def test_z_with_xy_runs_xy_first_going_down() -> None:
     # R4/R11: X/Y, wait T1, Z, wait T2 — Z never moves with X/Y.
     post, machine = _target()
-    result = post.emit(Program((Linear(1, 2, 60, z=0.5),)), machine)
-    assert result.code == bytes.fromhex("13 01 03 00 64 02 03 00 C8 00 00 03 03 00 32 00 00 45 54")
+    result = post.emit(Program((Linear(1, 2, 60, z=-0.5),)), machine)
+    assert result.code == bytes.fromhex("13 01 03 00 64 02 03 00 C8 00 00 03 04 00 32 00 00 45 54")
     assert any("X/Y first, then Z" in w for w in result.warnings)
     back = post.parse(result.code).moves
-    assert [(m.x, m.y, m.z) for m in back] == [(1, 2, None), (1, 2, 0.5)]
+    assert [(m.x, m.y, m.z) for m in back] == [(1, 2, None), (1, 2, -0.5)]
+
+
+def test_a_cut_that_rises_goes_up_first() -> None:
+    # a cut from Z -5 rising to Z -1 over 10 mm (a V-carve's or a 3-D finish's climb):
+    # X/Y first would run the whole 10 mm at Z -5, 4 mm under the path's end; Z first
+    # keeps the tool on or above the programmed line (as a rising rapid already did)
+    post, machine = _target()
+    program = Program((Linear(0, 0, 60, z=-5), Linear(10, 0, 60, z=-1)))
+    result = post.emit(program, machine)
+    back = post.parse(result.code).moves
+    z, path = 0.0, []
+    for m in back:
+        z = z if m.z is None else m.z
+        path.append((m.x, m.y, z))
+    assert path == [(0, 0, -5), (0, 0, -1), (10, 0, -1)]
+    assert any("rising as Z then X/Y" in w for w in result.warnings)
+
+
+def test_a_helix_climbs_or_descends_over_its_chords() -> None:
+    # a helix down from Z 0 to Z -2 over the upper half circle of radius 5 about (5, 0), then
+    # back up to Z 0 over the lower half: the height in equal parts over the chords (not a
+    # half circle at Z 0, then a 2 mm plunge), each chord run at the higher of its two
+    # heights (down: X/Y then Z; up: Z then X/Y), so no point is below the helix and none
+    # more than one chord's part of the height above it
+    post, machine = _target()
+    down = ArcMove(10, 0, 5, 0, True, 60, z=-2)
+    up = ArcMove(0, 0, 5, 0, True, 60, z=0)
+    result = post.emit(Program((Linear(0, 0, 60, z=0), down, up)), machine)
+    z, path = 0.0, []
+    for m in post.parse(result.code).moves:
+        z = z if m.z is None else m.z
+        path.append((m.x, m.y, z))
+    half = path.index((10, 0, -2))
+    corners = {p[:2] for p in path}
+    assert len(corners) >= 16  # chords within the profile's 0.01 mm of a 5 mm radius
+    step = 2 / ((len(corners) - 1) // 2)  # the height of one chord's part, about
+    for k, (x, y, z) in enumerate(path):
+        angle = math.atan2(y, x - 5)  # π → 0 going down, 0 → -π coming up
+        if k <= half:
+            helix = -2 * (1 - angle / math.pi) if k else 0.0
+        else:
+            helix = -2 * (1 + angle / math.pi) if (x, y) != (0, 0) else 0.0
+        assert helix - 0.01 <= z <= helix + 1.5 * step + 0.01, (k, x, y, z, helix)
+    assert path[-1] == (0, 0, 0)
 
 
 def test_dwells_become_waits_and_commands_are_dropped_with_warnings() -> None:
@@ -411,7 +455,7 @@ _sub = st.floats(min_value=-0.45, max_value=0.45)
 def _programs(draw: st.DrawFn) -> tuple[Program, list[tuple[int, int, int]]]:
     """Random moves in the work area, each at least one step from the last on the axes it
     moves; and the step positions the reader must give back (X/Y, then Z, per move; Z, then
-    X/Y for a rapid that rises)."""
+    X/Y for a move that rises)."""
     moves: list[Move] = []
     expected: list[tuple[int, int, int]] = []
     here = [0, 0, 0]
@@ -427,8 +471,8 @@ def _programs(draw: st.DrawFn) -> tuple[Program, list[tuple[int, int, int]]]:
         zmm = None if z is None else (z + (draw(_sub) if z else 0.0)) / SPM
         kind = draw(st.sampled_from(["rapid", "line"]))
         moves.append(Rapid(xmm, ymm, zmm) if kind == "rapid" else Linear(xmm, ymm, 60.0, zmm))
-        if kind == "rapid" and z is not None and z > here[2] and (x, y) != tuple(here[:2]):
-            # a rising rapid goes up first, then across (never across at the old depth)
+        if z is not None and z > here[2] and (x, y) != tuple(here[:2]):
+            # a rising move goes up first, then across (never across at the old depth)
             expected += [(here[0], here[1], z), (x, y, z)]
             here = [x, y, z]
             continue
