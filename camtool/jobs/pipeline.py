@@ -440,10 +440,18 @@ def _with_spindle(program: Program, rpm: float | None, dwell_s: float = 0.0) -> 
 
 
 def _flatten(program: Program, target: str) -> Program:
-    """The program without Z (see :func:`post_program`); unchanged when it has none."""
+    """The program without Z (see :func:`post_program`); unchanged when it has none.
+
+    A cut that starts and ends above the stock (Z > 0) in a program that cuts at or
+    below Z 0 is travel at the feed (a retract done with ``G1``, a move between
+    cuts): without Z it would cut, so it is written as a rapid, the target's travel.
+    """
+    from camtool.model.program import Rapid
+
     depths = {m.z for m in program.moves if m.z is not None}
     if not depths:
         return program
+    above = _feeds_above_stock(program)
     here = program.origin
     moves: list[Move] = []
     lines: list[int] = []  # the input line of each kept move, for messages
@@ -452,17 +460,26 @@ def _flatten(program: Program, target: str) -> Program:
         new_index.append(len(moves))
         if (move.x, move.y) == here and not hasattr(move, "cx"):
             continue  # a Z-only move
-        moves.append(dataclasses.replace(move, z=None))
+        if i in above:
+            moves.append(Rapid(move.x, move.y, contour=move.contour))
+        else:
+            moves.append(dataclasses.replace(move, z=None))
         if program.lines:
             lines.append(program.lines[i])
         here = (move.x, move.y)
     new_index.append(len(moves))
     commands = tuple((new_index[i], c) for i, c in program.commands)
     dropped = len(program.moves) - len(moves)
+    travel = sum(1 for i in above if new_index[i] != new_index[i + 1])
     warning = (
         f"{target} has no Z axis: {dropped} Z-only move(s) dropped and Z removed from the "
         f"others ({len(depths)} Z level(s) in the program); set the depth by hand"
     )
+    if travel:
+        warning += (
+            f"; {travel} cut(s) above the stock (Z > 0 all along: travel at the feed) "
+            "written as rapids, since without Z they would cut"
+        )
     return dataclasses.replace(
         program,
         moves=tuple(moves),
@@ -470,6 +487,29 @@ def _flatten(program: Program, target: str) -> Program:
         lines=tuple(lines),
         commands=commands,
     )
+
+
+def _feeds_above_stock(program: Program) -> set[int]:
+    """Indices of the cuts that start and end above Z 0, if the program cuts at or below it.
+
+    A program that never cuts at or below Z 0 has its zero elsewhere (on the machine's
+    bed): none is taken for travel then. A move whose start height is not known yet is
+    not taken either.
+    """
+    from camtool.model.program import Rapid
+
+    z: float | None = None
+    above: set[int] = set()
+    cuts_below = False
+    for i, move in enumerate(program.moves):
+        end = move.z if move.z is not None else z
+        if not isinstance(move, Rapid):
+            if z is not None and end is not None and z > 0 and end > 0:
+                above.add(i)
+            elif end is not None and (end <= 0 or (z is not None and z <= 0)):
+                cuts_below = True
+        z = end
+    return above if cuts_below else set()
 
 
 def post_drawing(

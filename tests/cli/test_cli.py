@@ -341,6 +341,37 @@ def test_gcode_with_z_on_a_2d_target_drops_z_with_a_warning(
     assert "3 Z-only move(s) dropped" in err and "2 Z level(s)" in err
 
 
+@pytest.mark.parametrize("bed_zero", [False, True])
+def test_a_cut_above_the_stock_is_travel_on_a_2d_target(
+    bed_zero: bool, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a program that lifts with G1 and crosses to its next cut at the feed, 1 mm above the
+    # stock: with Z dropped, the crossing X1 Y0 -> X2 Y1 was a cut through the part. It is
+    # travel (a rapid: a job boundary on the router, a G00 on the scriber); the two cuts
+    # stay cuts. A program whose cuts are all above 0 (its zero on the bed) is left as it is
+    lift = 10 if bed_zero else 0
+    ngc = tmp_path / "lift.ngc"
+    ngc.write_text(
+        f"G21 G90\nG0 X0 Y0 Z{2 + lift}\nG1 Z{-1 + lift} F100\nG1 X1\nG1 Z{1 + lift}\n"
+        f"G1 X2 Y1\nG1 Z{-1 + lift}\nG1 X3\nG0 Z{5 + lift}\nM2\n"
+    )
+    out_file = tmp_path / "lift.m"
+    code, _, err = run(["post", str(ngc), "-t", "matlab-router", "-o", str(out_file)], capsys)
+    assert code == 0, err
+    from camtool.model.program import Linear, Rapid
+    from camtool.post.registry import load_target
+
+    moves = load_target("matlab-router").parse(out_file.read_text()).moves
+    cuts = [(m.x, m.y) for m in moves if isinstance(m, Linear)]
+    if bed_zero:
+        assert cuts == [(1, 0), (2, 1), (3, 1)]
+        assert "above the stock" not in err
+    else:
+        assert cuts == [(1, 0), (3, 1)]  # the crossing is not cut
+        assert [(m.x, m.y) for m in moves if isinstance(m, Rapid)] == [(0, 0), (2, 1)]
+        assert "1 cut(s) above the stock (Z > 0 all along" in err
+
+
 def test_drawing_options_on_gcode_are_refused(capsys: pytest.CaptureFixture[str]) -> None:
     args = ["post", str(DATA / "flashcut-seed001.nc"), "-t", "pic-mmh", "--offset", "outside"]
     code, out, err = run(args, capsys)
