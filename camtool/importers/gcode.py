@@ -246,7 +246,11 @@ def _parse(
                             reader.after_end((r for r, _, _ in lines), number)
                             ended = True
                             break
-                        opened = not reader.line
+                        if reader.line:  # no '%' opened the program: LinuxCNC stops here
+                            _refuse_blocks_after(source, number, (r for r, _, _ in lines))
+                            ended = True
+                            break
+                        opened = True
                     continue
                 if reader.run(block):
                     reader.after_end((r for r, _, _ in lines), number)
@@ -265,6 +269,31 @@ def _parse(
             "moves are all there",
         )
     return reader.program()
+
+
+def _refuse_blocks_after(source: str, percent_line: int, rest: Iterable[str]) -> None:
+    """Refuse a block after a '%' that closes a program no '%' opened.
+
+    A '%' is a tape marker: on the first line it opens the program and the next one ends
+    it. One after the program began, with none before it, is an error for LinuxCNC
+    (``rs274``: "Bad character '%' used"), which stops there: the lines after it never
+    run. With only comments and blank lines after it, it is read as the program's end.
+
+    Raises:
+        InputError: a line with words after it, naming both lines.
+    """
+    for number, raw in enumerate(rest, start=percent_line + 1):
+        try:
+            has_words = lex_line(raw, number, source) is not None
+        except InputError:
+            has_words = True
+        if has_words:
+            raise InputError(
+                f"{source}:{percent_line}: this '%' ends the program (no '%' opened it on its "
+                f"first line, and LinuxCNC stops at it: \"Bad character '%'\"), but line "
+                f"{number} goes on: if the program ends here, delete the lines after the '%'; "
+                "if not, delete the '%'"
+            )
 
 
 class _Reader(StartRules):

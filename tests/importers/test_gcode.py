@@ -659,10 +659,19 @@ def test_missing_end_warns_once_naming_the_last_block() -> None:
     )
 
 
-def test_percent_after_the_first_block_does_not_open_a_program() -> None:
-    # LinuxCNC takes '%' as a delimiter only on the first line; later it changes nothing here
-    program = parse("G21\n%\nG1 X1 Y1 F10\nM2\n")
-    assert program.warnings == ()
+def test_percent_after_the_first_block_ends_the_program_or_is_refused() -> None:
+    # LinuxCNC takes '%' as a delimiter on the first line only: later, rs274 stops at it with
+    # "Bad character '%' used" (checked by hand), so the lines after it never run. camtool
+    # read on through it, and wrote the cut of line 3; with nothing but comments after it,
+    # the '%' ends the program
+    message = refused("G21\n%\nG1 X1 Y1 F10\nM2\n")
+    assert message.startswith("t.ngc:2: this '%' ends the program (no '%' opened it")
+    assert "but line 3 goes on" in message
+    message = refused("G21\nG1 X1 Y1 F10\n%\n(more)\n\nG1 X2\n")
+    assert message.startswith("t.ngc:3: this '%' ends the program") and "line 6 goes on" in message
+    program = parse("G21\nG1 X1 Y1 F10\n%\n(the end)\n\n")
+    assert program.moves == (Linear(1.0, 1.0, 10.0, contour=1),)
+    assert program.warnings == ()  # a '%' ends it: not "the file may be truncated"
 
 
 @pytest.mark.parametrize(
