@@ -18,7 +18,14 @@ from camtool.accel.collector import paused
 from camtool.importers import gcode_ahead
 from camtool.importers.gcode_codes import BlockWords, CommandReader, Notes, unused_word
 from camtool.importers.gcode_cycles import CYCLES, CycleState
-from camtool.importers.gcode_lexer import Block, Word, cut_mid_word, lex_line
+from camtool.importers.gcode_lexer import (
+    Block,
+    Word,
+    cut_mid_word,
+    lex_line,
+    lines_with_words,
+    refuse_words_after_percent,
+)
 from camtool.importers.gcode_params import expand_parameters
 from camtool.importers.gcode_plain import arc_end_off, arc_limits, plain_words, spiral_note
 from camtool.importers.gcode_start import StartRules
@@ -247,7 +254,7 @@ def _parse(
                             ended = True
                             break
                         if reader.line:  # no '%' opened the program: LinuxCNC stops here
-                            _refuse_blocks_after(source, number, (r for r, _, _ in lines))
+                            refuse_words_after_percent((r for r, _, _ in lines), number, source)
                             ended = True
                             break
                         opened = True
@@ -269,31 +276,6 @@ def _parse(
             "moves are all there",
         )
     return reader.program()
-
-
-def _refuse_blocks_after(source: str, percent_line: int, rest: Iterable[str]) -> None:
-    """Refuse a block after a '%' that closes a program no '%' opened.
-
-    A '%' is a tape marker: on the first line it opens the program and the next one ends
-    it. One after the program began, with none before it, is an error for LinuxCNC
-    (``rs274``: "Bad character '%' used"), which stops there: the lines after it never
-    run. With only comments and blank lines after it, it is read as the program's end.
-
-    Raises:
-        InputError: a line with words after it, naming both lines.
-    """
-    for number, raw in enumerate(rest, start=percent_line + 1):
-        try:
-            has_words = lex_line(raw, number, source) is not None
-        except InputError:
-            has_words = True
-        if has_words:
-            raise InputError(
-                f"{source}:{percent_line}: this '%' ends the program (no '%' opened it on its "
-                f"first line, and LinuxCNC stops at it: \"Bad character '%'\"), but line "
-                f"{number} goes on: if the program ends here, delete the lines after the '%'; "
-                "if not, delete the '%'"
-            )
 
 
 class _Reader(StartRules):
@@ -354,14 +336,9 @@ class _Reader(StartRules):
     def after_end(self, rest: Iterable[str], end_line: int) -> None:
         """Warn about lines with words after M2/M30 on ``end_line``."""
         count, first = 0, 0
-        for number, raw in enumerate(rest, start=end_line + 1):
-            try:
-                has_words = lex_line(raw, number, self.source) is not None
-            except InputError:
-                has_words = True
-            if has_words:
-                count += 1
-                first = first or number
+        for number in lines_with_words(rest, end_line + 1, self.source):
+            count += 1
+            first = first or number
         if count:
             plural = "line" if count == 1 else "lines"
             self.notes.add(

@@ -9,6 +9,7 @@ Design notes: docs/internals.md, ``camtool/importers/gcode_lexer.py``.
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from typing import NoReturn
 
@@ -313,6 +314,41 @@ def cut_mid_word(raw: str) -> str | None:
         return None
     m = _CUT.search(raw)
     return m[0].replace(" ", "") if m else None
+
+
+def lines_with_words(rest: Iterable[str], first: int, source: str) -> Iterator[int]:
+    """The numbers of the lines of ``rest`` (the first is line ``first``) that hold words.
+
+    A line the lexer refuses counts as one: it is neither blank nor a comment.
+    """
+    for number, raw in enumerate(rest, start=first):
+        try:
+            words = lex_line(raw, number, source) is not None
+        except InputError:
+            words = True
+        if words:
+            yield number
+
+
+def refuse_words_after_percent(rest: Iterable[str], percent_line: int, source: str) -> None:
+    """Refuse a line with words after a '%' that ends a program no '%' opened.
+
+    A '%' is a tape marker: on the first line it opens the program, and the next one ends
+    it. One after the program began, with none before it, is an error for LinuxCNC
+    (``rs274``: "Bad character '%' used"), which stops there: the lines after it never
+    run. With only comments and blank lines after it, it is the program's end.
+
+    Raises:
+        InputError: naming the '%' line and the first line with words after it.
+    """
+    number = next(lines_with_words(rest, percent_line + 1, source), None)
+    if number is not None:
+        raise InputError(
+            f"{source}:{percent_line}: this '%' ends the program (no '%' opened it on its "
+            f"first line, and LinuxCNC stops at it: \"Bad character '%'\"), but line "
+            f"{number} goes on: if the program ends here, delete the lines after the '%'; "
+            "if not, delete the '%'"
+        )
 
 
 _PLAIN = (
