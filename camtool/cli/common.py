@@ -64,7 +64,7 @@ class FiniteFloat(click.FloatRange):
 
 
 def plain_digits(text: str) -> bool:
-    """Whether ``text`` is written as G-code, TOML and a shell user write numbers.
+    """Whether ``text`` is in ASCII without ``_``, as G-code and machine panels write numbers.
 
     Python's ``float`` and ``int`` also read ``1_5`` (15, where ``1.5`` was meant) and the
     digits of other scripts (``١``, full-width ``１``): such a value is refused, naming the

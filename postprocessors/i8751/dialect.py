@@ -548,8 +548,8 @@ def _count_warnings(c: Counter[str]) -> list[str]:
         out.append(
             f"{c['xyz']} move(s) change X/Y and Z together: the 8751 runs X/Y first, then Z "
             "(Intf8751 §4.3, R11), so each is written going down as X/Y then Z, rising as Z "
-            "then X/Y (the tool never below the programmed path, a step above it at most); "
-            "they read back as two moves"
+            "then X/Y: the tool runs on or above the programmed path, never below it; they "
+            "read back as two moves"
         )
     if c["split"]:
         out.append(
