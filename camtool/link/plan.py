@@ -150,7 +150,7 @@ class SendPlan:
                     f"after {spec.quiet_end_s:g} s without one"
                 )
             extra += f", answer {block.ack!r}" if block.ack else ""
-            text = block.text.replace("\r", " ")
+            text = block.shown.replace("\r", " ")
             text = text if len(text) <= 60 else text[:57] + "..."
             yield f"{where}: {len(block.data)} bytes, {fmt_num(seconds, 3)} s{extra}: {text}"
 

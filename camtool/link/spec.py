@@ -71,8 +71,19 @@ class WireBlock:
 
     @property
     def text(self) -> str:
-        """The block as text for messages, without its terminator (or its note)."""
+        """The block's bytes as Latin-1 text, without its terminator (or its note).
+
+        One character per byte, as a controller counts them (the checks read this).
+        """
         return self.note or self.data.decode("latin-1").rstrip("\r\n")
+
+    @property
+    def shown(self) -> str:
+        """The block as the file writes it, for messages, without its terminator (or note).
+
+        Decoded as UTF-8; a byte that is not UTF-8 is shown as a backslash escape.
+        """
+        return self.note or self.data.decode("utf-8", "backslashreplace").rstrip("\r\n")
 
 
 class LineBlocks(Sequence[WireBlock]):

@@ -386,14 +386,14 @@ def check(blocks: Sequence[WireBlock], source: str) -> None:
         where = f"line {block.line}" if block.index else "a restore line"
         if error is not None:
             raise InputError(
-                f"{source}, {where}: {block.text!r}: GRBL 1.1 would refuse it with "
+                f"{source}, {where}: {block.shown!r}: GRBL 1.1 would refuse it with "
                 f"{decode(f'error:{error}')}; nothing was sent: change the line (or post "
                 "the drawing again for grbl)"
             )
         wrong = misread(block.text)
         if wrong is not None:
             raise InputError(
-                f"{source}, {where}: {block.text!r}: GRBL 1.1 reads the first {MAX_DIGITS} "
+                f"{source}, {where}: {block.shown!r}: GRBL 1.1 reads the first {MAX_DIGITS} "
                 f"digits of a number (nuts_bolts.c read_float): it would read {wrong}; "
                 "nothing was sent: write it with fewer digits, nearer its work zero (or post "
                 "the drawing again for grbl)"

@@ -310,6 +310,18 @@ def test_a_line_grbl_refuses_is_refused_before_the_first_byte(line: str, simulat
     assert not sim.device.received  # nothing was sent
 
 
+def test_a_refused_line_is_quoted_as_the_file_writes_it() -> None:
+    # a no-break space between words (UTF-8 C2 A0): GRBL answers error:1 for the byte C2,
+    # which the check sees (one character per byte); the message quoted the Latin-1 reading
+    # of the two bytes, 'G1Â\xa0X10', a letter that is not in the file
+    code = PROGRAM.replace("M5\n", "G1\u00a0X10 Y0\nM5\n")
+    with pytest.raises(InputError) as refused:
+        prepare_send(code.encode("utf-8"), load_target("grbl"), source="job.gcode")
+    message = str(refused.value)
+    assert "'G1\\xa0X10 Y0': GRBL 1.1 would refuse it with error:1" in message
+    assert "\u00c2" not in message
+
+
 def test_an_arc_counts_grbls_segments_as_a_lower_bound() -> None:
     import math
 
