@@ -16,9 +16,7 @@ _BARE_POINT = re.compile(r"\d\.(?!\d)", re.ASCII)
 svgelements stops reading the path or point list there and keeps what came before."""
 _SEPARATORS = " \t\r\n\f,"
 _ARITY = {"m": 2, "l": 2, "h": 1, "v": 1, "c": 6, "s": 4, "q": 4, "t": 2, "a": 7, "z": 0}
-_LENGTH = re.compile(
-    r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(mm|cm|in|pt|pc|px|em|ex|%)?\s*", re.ASCII
-)
+_LENGTH = re.compile(rf"\s*({NUMBER.pattern})(mm|cm|in|pt|pc|px|em|ex|%)?\s*", re.ASCII)
 _TRANSFORM_ARGS = {
     "matrix": (6,),
     "translate": (1, 2),
@@ -31,7 +29,7 @@ _TRANSFORM_ITEM = re.compile(r"[\s,]*([A-Za-z]+)\s*\(([^()]*)\)[\s,]*", re.ASCII
 
 
 _S = r"[ \t\r\n\f,]*+"
-_N = r"(?>[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)"  # NUMBER, as its match takes it
+_N = rf"(?>{NUMBER.pattern})"  # NUMBER, as its match takes it
 
 
 def _run_of(count: int) -> str:

@@ -126,7 +126,7 @@ def page_matrix(
     return (sx, 0.0, 0.0, -sy, tx, top - ty), viewport, page
 
 
-_LENGTH = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*([a-zA-Z%]*)\s*", re.ASCII)
+_LENGTH = re.compile(rf"\s*({NUMBER.pattern})\s*([a-zA-Z%]*)\s*", re.ASCII)
 """A length attribute: its number and its unit (empty when none is given)."""
 
 INKSCAPE_VERSION = "{http://www.inkscape.org/namespaces/inkscape}version"

@@ -28,6 +28,7 @@ import xml.etree.ElementTree as ET
 
 import svgelements as se
 
+from camtool.importers.svgcheck import NUMBER
 from camtool.importers.svgcss import inline_style, local_name, style_text
 from camtool.importers.svgtree import href
 
@@ -116,7 +117,7 @@ def rect_radii(element: ET.Element) -> None:
         element.set("style", style_text(style))
 
 
-PERCENT = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)%\s*", re.ASCII)
+PERCENT = re.compile(rf"\s*({NUMBER.pattern})%\s*", re.ASCII)
 _ACROSS = frozenset({"x", "cx", "width", "x1", "x2"})
 _DOWN = frozenset({"y", "cy", "height", "y1", "y2"})
 
@@ -209,9 +210,7 @@ def _in_context(
 
 
 _COLOUR_FUNCTION = re.compile(r"\s*(rgba?|hsla?)\(([^()]*)\)\s*", re.IGNORECASE)
-_COLOUR_ARG = re.compile(
-    r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?(%|deg|grad|rad|turn)?$", re.ASCII
-)
+_COLOUR_ARG = re.compile(rf"{NUMBER.pattern}(%|deg|grad|rad|turn)?$", re.ASCII)
 _TURNS = {"": 1 / 360, "deg": 1 / 360, "grad": 1 / 400, "rad": 1 / (2 * math.pi), "turn": 1.0}
 
 
@@ -351,7 +350,7 @@ def _rewritable(style: str) -> bool:
     )
 
 
-_NUMBER = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(%?)\s*", re.ASCII)
+_NUMBER = re.compile(rf"\s*({NUMBER.pattern})(%?)\s*", re.ASCII)
 
 
 def _opacity(value: str) -> str | None:
@@ -436,9 +435,7 @@ def _hsl(args: list[str]) -> list[int] | None:
 _ORIGIN_KEYWORDS = {"left": 0.0, "top": 0.0, "center": 50.0, "right": 100.0, "bottom": 100.0}
 _CSS_UNIT_PX = {"": 1.0, "px": 1.0, "mm": 96.0 / 25.4, "cm": 96.0 / 2.54, "in": 96.0,
                 "pt": 96.0 / 72.0, "pc": 16.0}  # fmt: skip
-_ORIGIN_TOKEN = re.compile(
-    r"([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(%|px|mm|cm|in|pt|pc)?", re.ASCII
-)
+_ORIGIN_TOKEN = re.compile(rf"({NUMBER.pattern})(%|px|mm|cm|in|pt|pc)?", re.ASCII)
 
 
 def fold_transform_origin(element: ET.Element, viewport: tuple[float, float]) -> None:
