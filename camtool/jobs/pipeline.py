@@ -452,6 +452,7 @@ def _flatten(program: Program, target: str) -> Program:
     if not depths:
         return program
     above = _feeds_above_stock(program)
+    travel = 0  # the cuts above the stock written as rapids
     here = program.origin
     moves: list[Move] = []
     lines: list[int] = []  # the input line of each kept move, for messages
@@ -462,6 +463,7 @@ def _flatten(program: Program, target: str) -> Program:
             continue  # a Z-only move
         if i in above:
             moves.append(Rapid(move.x, move.y, contour=move.contour))
+            travel += 1
         else:
             moves.append(dataclasses.replace(move, z=None))
         if program.lines:
@@ -470,7 +472,6 @@ def _flatten(program: Program, target: str) -> Program:
     new_index.append(len(moves))
     commands = tuple((new_index[i], c) for i, c in program.commands)
     dropped = len(program.moves) - len(moves)
-    travel = sum(1 for i in above if new_index[i] != new_index[i + 1])
     warning = (
         f"{target} has no Z axis: {dropped} Z-only move(s) dropped and Z removed from the "
         f"others ({len(depths)} Z level(s) in the program); set the depth by hand"
