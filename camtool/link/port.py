@@ -39,8 +39,22 @@ def open_port(port: str, baud: int) -> Any:
         raise LinkError(f"cannot open port {port!r}: {exc}") from exc
 
 
+MAX_UNENDED = 4096
+"""Most bytes :class:`_Wire` holds without a whole answer in them. A controller's answers
+are lines of tens of bytes (GRBL's longest, a ``$$`` setting or ``[GC:…]``, under 100);
+a stream of bytes with no line end is a wrong baud rate or a wrong device, and is not
+kept growing while the job waits for an answer."""
+
+
 class _PortGone(LinkError):
     """The port failed under the driver (the driver adds where the job stood)."""
+
+
+class Garbled(LinkError):
+    """The controller sent :data:`MAX_UNENDED` bytes that make no answer.
+
+    The driver adds where the job stood, and stops the machine when blocks are in flight.
+    """
 
 
 class _Wire:
@@ -62,6 +76,7 @@ class _Wire:
         self.last_rx = self.clock.monotonic()
         self.split = split or split_lines
         self.unread: list[str] = []
+        self.garbled = False
 
     def write(self, data: bytes, where: str) -> None:
         try:
@@ -121,7 +136,19 @@ class _Wire:
             if self.log:
                 self.log.record("<", data)
             self.buffer += data
-        return self.split(self.buffer)
+        answers = self.split(self.buffer)
+        if len(self.buffer) > MAX_UNENDED:
+            head = bytes(self.buffer[:24]).decode("latin-1")
+            self.buffer.clear()
+            if self.garbled:  # said once; the stop that follows reads on without them
+                return answers
+            self.garbled = True
+            raise Garbled(
+                f"port {self.name!r} sent more than {MAX_UNENDED} bytes {where} with no "
+                f"answer in them (they begin {head!r}): is the controller set to the "
+                "machine file's baud rate, and is this its port?"
+            )
+        return answers
 
 
 def split_lines(buffer: bytearray) -> list[str]:

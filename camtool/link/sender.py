@@ -9,10 +9,10 @@ from __future__ import annotations
 import contextlib
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NoReturn
 
 from camtool.link.advice import lost_hint, unsure
-from camtool.link.port import _PortGone, _Wire, open_port, split_lines
+from camtool.link.port import Garbled, _PortGone, _Wire, open_port, split_lines
 from camtool.link.spec import Status
 from camtool.link.stream import (
     POLL_S,
@@ -122,6 +122,9 @@ WAIT_FACTOR = 3.0
 """An answer may take this many times the timing model's estimate (plus the link's
 ``response_timeout_s``) before the controller counts as lost: the estimate is a model,
 the controller's planner may be slower (overrides, acceleration), never this much."""
+MAX_MESSAGES = 1000
+"""Most push messages a job keeps for its result (a wrong baud rate on a link whose
+answers are single bytes makes one of every byte); the rest are counted."""
 IDLE_GRACE_S = 0.5
 """Reports of ``Idle`` (every :data:`STATUS_PERIOD_S`) with blocks unanswered for this
 long, beyond the head block's own time, mean the controller will not answer them."""
@@ -152,7 +155,8 @@ class _Driver:
         self.answer_since = self.clock.monotonic()
         self.idle_since: float | None = None
         self.put_back: list[str] = []
-        self.unknown: list[str] = []
+        self.unknown: list[str] = []  # the last five
+        self.untold = 0  # messages past MAX_MESSAGES, counted, not kept
         self.held_by_controller = ""  # the hold state it reported, not asked for by camtool
         self.resumed_head: int | None = None  # resumed with it first in flight: a Hold
         # reported while it still is may be from before the resume
@@ -177,8 +181,13 @@ class _Driver:
             self.plan.total_bytes,
             self.clock.monotonic() - start,
             self.stream.max_buffered,
-            tuple(self.messages),
+            tuple(self._told()),
         )
+
+    def _told(self) -> list[str]:
+        if not self.untold:
+            return self.messages
+        return [*self.messages, f"… and {self.untold} more messages, not kept"]
 
     # -- start-up -------------------------------------------------------------------
 
@@ -481,7 +490,10 @@ class _Driver:
     def _read(self, now: float) -> None:
         s = self.stream
         wait = POLL_S if s.in_flight or not s.queue else max(0.0, min(POLL_S, s.ready_at - now))
-        lines = self.wire.lines(wait, f"while sending ({self._where()})")
+        try:
+            lines = self.wire.lines(wait, f"while sending ({self._where()})")
+        except Garbled as exc:
+            self._halt_and_raise(str(exc))
         for line in lines:
             status = self._status_of(line)
             if status is not None:
@@ -506,8 +518,11 @@ class _Driver:
 
     def _push(self, line: str) -> None:
         if self._status_of(line) is None:
-            self.messages.append(line)
-            self.unknown.append(line)
+            if len(self.messages) < MAX_MESSAGES:
+                self.messages.append(line)
+            else:
+                self.untold += 1
+            self.unknown = [*self.unknown[-4:], line]
 
     def _watch_hold(self, status: Status) -> None:
         """A hold camtool did not ask for, with blocks unanswered: the operator's turn."""
@@ -647,7 +662,7 @@ class _Driver:
             + ")"
         )
 
-    def _halt_and_raise(self, why: str) -> None:
+    def _halt_and_raise(self, why: str) -> NoReturn:
         stopped = self._halt()
         raise LinkError(f"{why}{stopped}; {unsure(self.stream, self.plan)}")
 

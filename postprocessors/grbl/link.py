@@ -553,7 +553,10 @@ class GrblDevice(LineDevice):
     (GRBL takes it and the next as one line: one ``ok`` fewer);
     ``mute_at_block`` answers no line from that one on (status reports go on);
     ``deaf_at_block`` answers nothing at all from then on; ``ack_word`` answers
-    lines with another word (``"OK"``); ``run_forever`` reports ``Run`` forever.
+    lines with another word (``"OK"``); ``run_forever`` reports ``Run`` forever;
+    ``noise_at_block`` answers that line with 8 KiB of bytes and no line end (a wrong baud
+    rate, or noise on the wire); ``chatter_at_block`` sends 1 500 ``[MSG:…]`` lines before
+    that line's answer.
 
     Args:
         spec: the grbl link.
@@ -575,6 +578,8 @@ class GrblDevice(LineDevice):
         deaf_at_block: int | None = None,
         ack_word: str = "ok",
         run_forever: bool = False,
+        noise_at_block: int | None = None,
+        chatter_at_block: int | None = None,
         **options: object,
     ) -> None:
         super().__init__(spec, **options)
@@ -586,6 +591,8 @@ class GrblDevice(LineDevice):
         self.deaf_at_block = deaf_at_block
         self.ack_word = ack_word
         self.run_forever = run_forever
+        self.noise_at_block = noise_at_block
+        self.chatter_at_block = chatter_at_block
         self.state = "Idle"
         self.held = False
         self.max_rx = 0
@@ -708,6 +715,11 @@ class GrblDevice(LineDevice):
         number = len(self.blocks) + 1
         if number == self.deaf_at_block:
             self.deaf = True
+        if number == self.noise_at_block:
+            return bytes(range(128, 256)) * 64
+        if number == self.chatter_at_block:
+            self.chatter_at_block = None
+            return b"".join(b"[MSG:%d]" % k + ANSWER_END for k in range(1500)) + self._parse(block)
         if number == self.alarm_at_block:
             self.received += block
             self.blocks.append(block)

@@ -235,6 +235,26 @@ def test_a_controller_that_stops_answering_is_named_within_a_bound(
     assert "--from-line" in str(info.value) or "nothing was sent" in str(info.value)
 
 
+def test_bytes_without_a_line_end_stop_the_job_not_fill_the_memory(simulate: Any) -> None:
+    # a wrong baud rate reads GRBL's answers as bytes with no line end: the sender held them
+    # all while it waited for an `ok`; it now stops the machine at 4 KiB of them and says why
+    sim = simulate("grbl", noise_at_block=40)
+    with pytest.raises(LinkError, match="more than 4096 bytes while sending") as info:
+        run_quick(sim, PROGRAM)
+    message = str(info.value)
+    assert "baud rate" in message and "--from-line" in message
+    assert sim.device.resets == 1  # held and reset: blocks were in flight
+
+
+def test_a_controller_that_says_too_much_is_counted_not_kept(simulate: Any) -> None:
+    sim = simulate("grbl", chatter_at_block=10)
+    result = run_quick(sim, PROGRAM)
+    assert result.messages[:2] == ("[MSG:0]", "[MSG:1]")
+    assert result.messages[999] == "[MSG:999]"
+    assert result.messages[1000:] == ("… and 500 more messages, not kept",)
+    assert sim.device.received == PROGRAM.encode()  # the job itself ran whole
+
+
 def test_a_controller_that_runs_forever_is_stopped(simulate: Any) -> None:
     # the program's estimate is a few seconds; a GRBL still saying Run far beyond 3 times it
     # (plus the timeout) is held and reset
