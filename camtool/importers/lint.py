@@ -65,7 +65,7 @@ class StyleCount:
     """Contours drawn one way: on one layer, in one colour and linetype (before chaining).
 
     A job selects by these (docs/jobs.md). ``circles`` are whole circles (drillable),
-    ``points`` the DXF POINTs of the layer and colour.
+    ``points`` the points (DXF POINTs, SVG dots) of the layer and colour.
     """
 
     layer: str

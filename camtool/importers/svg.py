@@ -29,7 +29,6 @@ from camtool.geometry.fitpool import (
 from camtool.importers import svgclip
 from camtool.importers.options import MAX_COORDINATE_MM, ImportOptions, check_curve_size
 from camtool.importers.svgdoc import (
-    LAYER_ATTR,
     SOURCE_ATTR,
     USE_ATTR,
     Prepared,
@@ -39,6 +38,7 @@ from camtool.importers.svgdoc import (
     unseen_warnings,
     zero_opacity,
 )
+from camtool.importers.svgdots import dots_warning, draws_dots, shape_marks
 from camtool.importers.svgpage import (
     Affine,
     apply,
@@ -48,14 +48,13 @@ from camtool.importers.svgpage import (
     page_warnings,
 )
 from camtool.importers.svgstyle import (
-    DEFAULT_LAYER,
     filter_of,
     filtered_warning,
     flattened,
+    layer_of,
     on_layers,
     open_fills,
     open_fills_warning,
-    shaper_layer,
     style_of,
     unpainted,
     unseen_fill,
@@ -71,6 +70,7 @@ from camtool.model.shapes import (
     Contour,
     Drawing,
     Line,
+    Mark,
     Point,
     Segment,
     bbox_union,
@@ -78,6 +78,8 @@ from camtool.model.shapes import (
 )
 
 _SHAPES = (se.Path, se.Rect, se.Circle, se.Ellipse, se.SimpleLine, se.Polyline, se.Polygon)
+_STROKED = (se.Path, se.SimpleLine, se.Polyline, se.Polygon)
+"""Shapes whose zero-length subpaths are dots (a zero radius or size draws nothing)."""
 
 
 def read_svg(
@@ -155,6 +157,7 @@ def _drawing(
     svg = _parse(path, prepared)
     warnings = list(prepared.warnings)
     contours: list[Contour] = []
+    marks: list[Mark] = []  # dots (camtool.importers.svgdots)
     unseen = Unseen()
     drawn: list[tuple[Any, list[Any] | None]] = []
     shapes = list(_shapes(svg))
@@ -211,6 +214,9 @@ def _drawing(
             path, shape, made, over, prepared.matrix, tolerance, regions
         ):
             contours.extend(made)
+            if isinstance(shape, _STROKED) and draws_dots(shape):
+                m = compose(prepared.matrix, affine_of(shape.transform))
+                marks += shape_marks(shape, segments, m, _label(shape))
             kept.append(i - 1)
             opened += open_fills(shape, made)
             if made and (name := filter_of(shape)) is not None:
@@ -245,10 +251,13 @@ def _drawing(
         warnings.append(filtered_warning(path, len(filtered), *filtered[0]))
     warnings += unseen_warnings(path, unseen)
     if named:
-        contours = on_layers(path, contours, named)
+        contours = on_layers(path, contours, named, (m.layer for m in marks))
+        marks = [m for m in marks if m.layer in named]
     off_page, size_note = page_warnings(path, contours, prepared.page)
     warnings += off_page
-    if not contours:
+    if marks:
+        warnings.append(dots_warning(path, marks))
+    if not contours and not marks:
         where = " in the selected layers" if options.layers else ""
         prefix = f"{path}: "
         skipped = [w.removeprefix(prefix) for w in warnings if w.startswith(prefix + "skipped")]
@@ -257,7 +266,7 @@ def _drawing(
             f"{path}: nothing to cut{where}; camtool reads path, rect, circle, ellipse, "
             f"line, polyline and polygon elements that are drawn{why}"
         )
-    drawing = Drawing(tuple(contours), str(path), tuple(warnings), size_note=size_note)
+    drawing = Drawing(tuple(contours), str(path), tuple(warnings), tuple(marks), size_note)
     return drawing, tolerance
 
 
@@ -347,7 +356,7 @@ def _contours(
     """
     values = shape.values
     label = _label(shape)
-    layer = str(values.get(LAYER_ATTR) or shaper_layer(values) or DEFAULT_LAYER)
+    layer = layer_of(values)
     m = compose(page, affine_of(shape.transform))
     try:
         if segments is None:

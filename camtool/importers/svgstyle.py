@@ -12,12 +12,13 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
 import svgelements as se
 
-from camtool.importers.svgtree import LIBRECAD_NS
+from camtool.importers.svgtree import LAYER_ATTR, LIBRECAD_NS
 from camtool.importers.svgvalues import URL_REF
 from camtool.model.errors import InputError
 from camtool.model.shapes import Contour, Line
@@ -52,6 +53,11 @@ def _shaper_cut(values: Any) -> str | None:
 _SHAPER_DEPTH = re.compile(r"\s*(\d+\.?\d*|\.\d+)\s*(mm|cm|in)\s*", re.IGNORECASE | re.ASCII)
 """A ``shaper:cutDepth`` camtool reads: a number and its unit (``6.0mm``, ``0.25in``)."""
 _DEPTH_UNITS = {"mm": 1.0, "cm": 10.0, "in": 25.4}
+
+
+def layer_of(values: Any) -> str:
+    """The layer a shape is on: its Inkscape layer, else its Shaper cut's, else the default."""
+    return str(values.get(LAYER_ATTR) or shaper_layer(values) or DEFAULT_LAYER)
 
 
 def shaper_layer(values: Any) -> str | None:
@@ -168,9 +174,14 @@ def wanted_layers(
     return (None if named else inkscape), named
 
 
-def on_layers(path: Path, contours: list[Contour], named: tuple[str, ...]) -> list[Contour]:
-    """The contours on the layers ``named``; an unknown name is an InputError listing them."""
-    there = sorted({c.layer for c in contours}, key=str.casefold)
+def on_layers(
+    path: Path, contours: list[Contour], named: tuple[str, ...], others: Iterable[str] = ()
+) -> list[Contour]:
+    """The contours on the layers ``named``; an unknown name is an InputError listing them.
+
+    ``others``: the layers of what else the drawing holds (its marks), which are known too.
+    """
+    there = sorted({c.layer for c in contours} | set(others), key=str.casefold)
     unknown = [n for n in named if n not in there]
     if unknown:
         raise InputError(

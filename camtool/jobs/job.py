@@ -106,7 +106,7 @@ class Selection:
             holes a drill operation drills), mm.
         linetypes: linetype names (upper case): only these; naming one selects it even
             when it is construction (CENTER, DASHED...). ``None``: any continuous one.
-        points: the drawing's points (DXF POINTs) too (drill operations).
+        points: the drawing's points (DXF POINTs, SVG dots) too (drill operations).
     """
 
     layers: tuple[str, ...] | None = None

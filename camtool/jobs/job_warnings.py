@@ -88,7 +88,7 @@ def _near_closed(contours: Sequence[Contour], joint_mm: float) -> str:
 
 
 def undrilled(drawing: Drawing, drilled: set[int]) -> list[str]:
-    """One line per layer of the drawing's points (DXF POINTs) no operation drills.
+    """One line per layer of the drawing's points (DXF POINTs, SVG dots) no operation drills.
 
     ``drilled``: the ``id`` of each of ``drawing.marks`` an operation selected.
     """

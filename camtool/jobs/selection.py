@@ -162,8 +162,8 @@ def nothing_selected(drawing: Drawing, op: Operation, where: str) -> str:
         n = len(drawing.marks)
         return (
             f"{where} {selects} nothing: the drawing has no contour, only {n} point"
-            f"{'s' if n > 1 else ''} (DXF POINT entities); a drill operation drills points "
-            "(a job file, docs/jobs.md), or draw the contours to cut"
+            f"{'s' if n > 1 else ''} (DXF POINT entities, SVG dots); a drill operation drills "
+            "points (a job file, docs/jobs.md), or draw the contours to cut"
         )
     layers = sorted({c.layer for c in drawing.contours} | {m.layer for m in drawing.marks})
     if s.layers is not None:

@@ -602,7 +602,7 @@ def circle_of(contour: Contour) -> tuple[Point, float] | None:
 
 @dataclass(frozen=True)
 class Mark:
-    """A point of the drawing (a DXF POINT): nothing to cut, a place to drill.
+    """A point of the drawing (a DXF POINT, an SVG dot): nothing to cut, a place to drill.
 
     ``at`` in mm; ``layer``, ``source``, ``colour`` as a :class:`Contour`'s.
     """
@@ -624,7 +624,7 @@ class Drawing:
 
     ``warnings`` are messages for the user (skipped entity types, assumed
     units); the CLI prints them on stderr. ``source`` is the file name. ``marks``
-    are the drawing's points (DXF POINT entities): only a drill operation that
+    are the drawing's points (DXF POINT entities, SVG dots): only a drill operation that
     selects them uses them. ``size_note`` says why the drawing is larger than its
     file shows (an SVG's shapes off its page), for a refusal of its size ("": none).
     """
