@@ -3,7 +3,8 @@
 The expected marks come from the rule of SVG 1.1 §11.4 (``stroke-linecap``; SVG 2 §13.5.4):
 a zero-length subpath is drawn with ``round`` or ``square`` caps and not with ``butt``, a
 lone ``moveto`` never, and from the drawing's coordinates (a 100 × 100 mm page whose
-viewBox is in mm: ``(x, y)`` is ``(x, 100 - y)`` mm, Y up).
+viewBox is in mm: ``(x, y)`` is ``(x, 100 - y)`` mm, Y up). Chromium's rendering of the
+first test's file, checked by hand, draws dots at ``a`` to ``e`` and nothing at the others.
 """
 
 from __future__ import annotations
