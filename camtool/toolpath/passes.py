@@ -316,7 +316,9 @@ class _Writer:
 
         With Z the tool first rises by a Z-only rapid (to ``clearance`` at the start
         and when :attr:`part` changes, else to ``safe_z``), moves in XY at that
-        height and comes down by a Z-only rapid to ``safe_z``.
+        height and comes down by a Z-only rapid to ``safe_z``. A new part that starts
+        where the tool stands (parts touching at a point) needs no travel: the tool
+        rises to ``safe_z`` only, as between two cuts of one part.
         """
         if not self.uses_z:
             self.add(Rapid(x, y, contour=self.number))
@@ -324,7 +326,8 @@ class _Writer:
             return
         o = self.options
         new_part = self._part_here is None or self.part != self._part_here
-        self.lift(o.clearance if new_part else o.safe_z)
+        stays = self._positioned and (x, y) == (self.x, self.y)
+        self.lift(o.clearance if new_part and not stays else o.safe_z)
         self._part_here = self.part
         if (x, y) != (self.x, self.y) or not self._positioned:
             # XY only (Z stays): the first one is written even at the start position,

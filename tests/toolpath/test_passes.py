@@ -593,6 +593,33 @@ def test_clearance_between_parts_safe_z_within_a_part() -> None:
     assert lifts == [(1, -1.0, 1.0), (3, -1.0, 5.0), (3, -1.0, 1.0), (4, -1.0, 5.0)]
 
 
+def test_a_part_that_starts_where_the_last_one_ended_needs_no_clearance() -> None:
+    # two squares touching at a corner, each a part of its own: the second starts where the
+    # first ends, so the tool retracts to safe Z and plunges again; a rise to clearance (for
+    # the clamps, on a travel there is none of) and back would be two moves for nothing
+    a, b = _rect_cw(0, 0, 10, 10), _rect_cw(10, 10, 20, 20)
+    a = Contour(a.segments[2:] + a.segments[:2], True)  # from (10, 10), where b starts
+    o = _options(depth=1.0, safe_z=2.0, clearance_z=7.0)
+    moves = emit_moves([Cut(a, 0), Cut(b, 1)], o)
+    _check_safe(moves, 2.0, 7.0)
+    k = next(i for i, m in enumerate(moves) if m.contour == 2)
+    last_cut = max(i for i, m in enumerate(moves[:k]) if isinstance(m, Linear))
+    assert moves[last_cut + 1 : k + 1] == [
+        Rapid(10.0, 10.0, 2.0, contour=1),  # up to safe Z only, where the tool stands
+        Linear(10.0, 10.0, PLUNGE, -1.0, contour=2),
+    ]
+    # apart, the second part is reached at clearance, as before
+    far = Contour(
+        tuple(
+            Line((x + 5, y + 5), (u + 5, v + 5))
+            for (x, y), (u, v) in ((s.start, s.end) for s in b.segments)
+        ),
+        True,
+    )
+    moves = emit_moves([Cut(a, 0), Cut(far, 1)], o)
+    assert [m.z for m in moves if m.contour == 2 and isinstance(m, Rapid)][:1] == [7.0]
+
+
 def test_parts_group_nested_cuts_and_pocket_rings() -> None:
     from camtool.toolpath.passes import parts
 
