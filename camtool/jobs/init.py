@@ -693,6 +693,7 @@ def _marks(drawing: Drawing, thickness: float) -> list[_Op]:
         'type = "drill"' + _why(f"{len(drawing.marks)} point(s): drilled if you uncomment this"),
         "tool = {drill 3}",
         f"layers = [{', '.join(_quote(n) for n in layers)}]",
+        'points = "only"' + _why("not the contours of these layers"),
         f"depth = {thickness + BREAKTHROUGH_MM:g}",
     )
     return [_Op("drill", 3.0, lines, commented=True)]

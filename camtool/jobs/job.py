@@ -107,6 +107,7 @@ class Selection:
         linetypes: linetype names (upper case): only these; naming one selects it even
             when it is construction (CENTER, DASHED...). ``None``: any continuous one.
         points: the drawing's points (DXF POINTs, SVG dots) too (drill operations).
+        contours: ``False``: no contour at all, the points alone (``points = "only"``).
     """
 
     layers: tuple[str, ...] | None = None
@@ -116,6 +117,7 @@ class Selection:
     except_diameter: tuple[float, float] | None = None
     linetypes: tuple[str, ...] | None = None
     points: bool = False
+    contours: bool = True
 
     def __post_init__(self) -> None:
         for name in ("diameter", "except_diameter"):

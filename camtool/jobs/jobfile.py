@@ -318,8 +318,18 @@ def _selection(row: Mapping[str, Any], kind: str, source: str, where: str) -> Se
     # a diameter, say: `camtool job init` gives one drill per hole size), which no point has
     shaped = any(row.get(key) is not None for key in ("diameter", "closed", "linetypes"))
     points = row.get("points", kind == "drill" and not shaped)
-    if not isinstance(points, bool):
-        raise InputError(f"{source}: {where} points = {points!r}; give true or false")
+    alone = points == "only"  # the points, no contour: where they share a layer with outlines
+    if not (isinstance(points, bool) or alone):
+        raise InputError(
+            f'{source}: {where} points = {points!r}; give true, false or "only" (the points '
+            "alone, no contour)"
+        )
+    given = [key for key in ("diameter", "except_diameter", "closed", "linetypes") if key in row]
+    if alone and given:
+        raise InputError(
+            f'{source}: {where} points = "only" selects no contour, so {given[0]} has nothing '
+            f"to choose from; leave it out, or give points = true"
+        )
     return Selection(
         layers=None if layers is None else _names(layers, source, f"{where} layers"),
         colours=None if colours is None else tuple(_colour(c, source, where) for c in colours),
@@ -329,7 +339,8 @@ def _selection(row: Mapping[str, Any], kind: str, source: str, where: str) -> Se
         linetypes=None
         if linetypes is None
         else tuple(n.upper() for n in _names(linetypes, source, f"{where} linetypes")),
-        points=points,
+        points=alone or points,
+        contours=not alone,
     )
 
 

@@ -77,9 +77,10 @@ def matches(contour: Contour, selection: Selection, shape: Shape | None = None) 
     ``shape``: what the contour is once chained (:class:`Shape`), for ``selection.closed``,
     ``diameter`` and ``except_diameter``; ``None``: the contour's own.
     """
-    if selection.layers is not None and contour.layer.casefold() not in {
-        n.casefold() for n in selection.layers
-    }:
+    if not selection.contours or (
+        selection.layers is not None
+        and contour.layer.casefold() not in {n.casefold() for n in selection.layers}
+    ):
         return False
     if selection.colours is not None and contour.colour not in selection.colours:
         return False

@@ -88,6 +88,20 @@ def test_a_drill_selects_points_unless_it_selects_by_shape(
     )
     (drill,) = _job(tmp_path, text).operations
     assert drill.select.points is points
+    assert drill.select.contours  # every contour the other keys keep, as well
+
+
+def test_points_only_selects_no_contour_and_takes_no_shape_key(tmp_path: Path) -> None:
+    text = (
+        '[[tools]]\nid = 2\ntype = "drill"\ndiameter = 2.5\n'
+        '[[operations]]\ntype = "drill"\ntool = 2\ndepth = 3\npoints = "only"\n'
+    )
+    (drill,) = _job(tmp_path, text).operations
+    assert drill.select.points and not drill.select.contours
+    with pytest.raises(InputError, match='points = "only" selects no contour, so diameter'):
+        _job(tmp_path, text + "diameter = 2.5\n")
+    with pytest.raises(InputError, match='give true, false or "only"'):
+        _job(tmp_path, text.replace('"only"', '"alone"'))
 
 
 _PROFILE = (

@@ -245,6 +245,16 @@ def test_a_drill_of_one_hole_size_drills_no_point(tmp_path: Path) -> None:
     drilled = [c for _, c in done.program.commands if isinstance(c, DrillCycle)]
     assert sorted((c.x, c.y) for c in drilled) == [(0.0, 0.0), (8.5, -3.0), (15.0, 0.0)]
     assert not any(w.startswith("not drilled") for w in done.program.warnings)
+    # the points' drill `job init` leaves commented out, uncommented as it stands: the two
+    # points alone (the ø10 circle on their layer is the profile's, no hole for this drill)
+    lines = text.splitlines()
+    start = lines.index('# type = "drill"  # 2 point(s): drilled if you uncomment this') - 1
+    block = [line.removeprefix("# ") for line in lines[start : start + 6]]
+    assert block[4] == 'points = "only"  # not the contours of these layers'
+    job.write_text("\n".join(lines[:start] + block + lines[start + 6 :]) + "\n")
+    done = run_job(drawing, load_target("grbl"), load_job(job))
+    drilled = [c for _, c in done.program.commands if isinstance(c, DrillCycle)]
+    assert sorted((c.x, c.y) for c in drilled) == [(0.0, 0.0), (8.5, -3.0), (15.0, 0.0)]
 
 
 def test_a_circle_drawn_as_arcs_is_a_hole_to_drill_and_no_profile(tmp_path: Path) -> None:
