@@ -297,8 +297,22 @@ def read_job(path: Path, plan: PlanOptions) -> Job:
     from camtool.jobs.jobfile import load_job, operation_flags, shared_overrides
     from camtool.jobs.run import refuse_operation_options
 
-    refuse_operation_options(operation_flags(plan))
-    return load_job(path, overrides=shared_overrides(plan))
+    given = given_options()
+    refuse_operation_options(operation_flags(plan, given))
+    return load_job(path, overrides=shared_overrides(plan, given))
+
+
+def given_options() -> frozenset[str]:
+    """The parameters of the running command that its command line (or environment) set.
+
+    An option given with its default value is given: ``--origin drawing`` must replace a
+    job file's ``origin`` as ``--origin center`` does.
+    """
+    ctx = click.get_current_context(silent=True)
+    if ctx is None:
+        return frozenset()
+    told = (click.core.ParameterSource.COMMANDLINE, click.core.ParameterSource.ENVIRONMENT)
+    return frozenset(name for name in ctx.params if ctx.get_parameter_source(name) in told)
 
 
 MACHINE = click.option(

@@ -11,7 +11,7 @@ import dataclasses
 import difflib
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -586,29 +586,33 @@ def _known(table: Mapping[str, Any], keys: tuple[str, ...], source: str, where: 
             )
 
 
-def shared_overrides(plan: PlanOptions) -> dict[str, object]:
-    """The shared (``[job]``) options of ``plan`` that differ from their defaults.
+def shared_overrides(plan: PlanOptions, given: Collection[str] = ()) -> dict[str, object]:
+    """The shared (``[job]``) options of ``plan`` given on the command line.
 
     For ``post --job`` with ``--origin``, ``--translate``, ``--scale``... on the command
-    line: they replace the job file's values.
+    line: they replace the job file's values. ``given``: the fields the command line
+    named (its default value too: ``--origin drawing`` replaces a file's ``lower-left``);
+    a field that differs from its default counts as given as well.
     """
     fields = PlanOptions.__dataclass_fields__
     return {
         name: getattr(plan, name)
         for name in SETUP_FIELDS
-        if getattr(plan, name) != fields[name].default
+        if name in given or getattr(plan, name) != fields[name].default
     }
 
 
-def operation_flags(plan: PlanOptions) -> list[str]:
+def operation_flags(plan: PlanOptions, given: Collection[str] = ()) -> list[str]:
     """The per-operation options of ``plan`` given on the command line (as flags).
 
     With ``--job`` these belong in the job file's operations: ``post`` refuses them.
+    ``given`` as for :func:`shared_overrides`.
     """
     fields = PlanOptions.__dataclass_fields__
     shared = {*SETUP_FIELDS, "origin"}
     return [
         flag(f.name)
         for f in dataclasses.fields(PlanOptions)
-        if f.name not in shared and getattr(plan, f.name) != fields[f.name].default
+        if f.name not in shared
+        and (f.name in given or getattr(plan, f.name) != fields[f.name].default)
     ]

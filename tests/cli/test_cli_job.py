@@ -36,6 +36,28 @@ def test_post_job_writes_one_program_for_the_whole_part(run: Any, tmp_path: Path
     assert "not cut: 10 contour(s) on layer 'CENTER'" in err
 
 
+def test_a_shared_option_given_at_its_default_still_replaces_the_files(
+    run: Any, tmp_path: Path
+) -> None:
+    # `--origin drawing` is the option's default, and was taken for "not given": the file's
+    # origin = "lower-left" stood, and the program's work zero was not where the command
+    # line put it.
+    job = Path(JOB)
+    assert 'origin = "lower-left"' in job.read_text()
+    out = tmp_path / "part.ngc"
+    code, _, err = run(
+        "post", PART, "-t", "linuxcnc", "--job", str(job), "--origin", "drawing", "-o", str(out)
+    )
+    assert code == 0, err
+    assert "(work zero X0 Y0: the drawing's origin)" in out.read_text()
+    code, _, err = run("post", PART, "-t", "linuxcnc", "--job", str(job), "-o", str(out))
+    assert code == 0, err
+    assert "(work zero X0 Y0: the toolpath's lower-left corner)" in out.read_text()
+    # a per-operation option given at its default is refused as any other value is
+    got, _, err = run("post", PART, "-t", "grbl", "--job", str(job), "--offset", "on", "-o", "-")
+    assert got == 2 and "--offset: with --job" in err
+
+
 @pytest.mark.parametrize(
     ("extra", "code", "message"),
     [
