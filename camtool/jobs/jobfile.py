@@ -142,6 +142,9 @@ def _setup(table: Mapping[str, Any], source: str, overrides: Mapping[str, object
     for key, value in table.items():
         if key != "sequence":
             values[_JOB_KEYS[key]] = _value(value, _JOB_KEYS[key], source, f"[job] {key}")
+    if overrides.keys() & {"scale", "fit"}:  # one choice, the drawing's size: theirs
+        values.pop("scale", None)
+        values.pop("fit", None)
     values.update(overrides)
     sequence = table.get("sequence", "file")
     if sequence not in SEQUENCES:

@@ -53,6 +53,15 @@ def test_a_shared_option_given_at_its_default_still_replaces_the_files(
     code, _, err = run("post", PART, "-t", "linuxcnc", "--job", str(job), "-o", str(out))
     assert code == 0, err
     assert "(work zero X0 Y0: the toolpath's lower-left corner)" in out.read_text()
+    # the size is one choice: --scale 1 replaces a file's fit (it was refused as both, or
+    # at 1, its default, left the file's fit to scale the part)
+    fitted = tmp_path / "fitted.toml"
+    fitted.write_text(job.read_text().replace("[job]\n", "[job]\nfit = [40, 40]\n", 1))
+    code, _, err = run(
+        "post", PART, "-t", "linuxcnc", "--job", str(fitted), "--scale", "1", "-o", str(out)
+    )
+    assert code == 0, err
+    assert out.read_text().splitlines()[1].startswith("(placement: scale 1, ")
     # a per-operation option given at its default is refused as any other value is
     got, _, err = run("post", PART, "-t", "grbl", "--job", str(job), "--offset", "on", "-o", "-")
     assert got == 2 and "--offset: with --job" in err

@@ -259,6 +259,13 @@ def test_command_line_shared_options_replace_the_files(tmp_path: Path) -> None:
     job = load_job(path, overrides={"placement": "center", "translate": (1.0, 2.0)})
     assert job.setup.plan.placement == "center" and job.setup.plan.translate == (1.0, 2.0)
     assert all(op.plan.placement == "center" for op in job.operations)
+    # the drawing's size is one choice: the command line's scale replaces the file's fit
+    path.write_text(GOOD.replace("[job]\n", "[job]\nfit = [40, 40]\n", 1))
+    assert load_job(path).setup.plan.fit == (40.0, 40.0)
+    plan = load_job(path, overrides={"scale": 2.0}).setup.plan
+    assert (plan.scale, plan.fit) == (2.0, None)
+    plan = load_job(path, overrides={"fit": (10.0, 20.0)}).setup.plan
+    assert (plan.scale, plan.fit) == (1.0, (10.0, 20.0))
 
 
 def _tools_job(count: int) -> str:
