@@ -38,7 +38,7 @@ from camtool.importers.svgdoc import (
     unseen_warnings,
     zero_opacity,
 )
-from camtool.importers.svgdots import dots_warning, draws_dots, shape_marks
+from camtool.importers.svgdots import dots_warning, draws_dots, shape_marks, unclipped
 from camtool.importers.svgpage import (
     Affine,
     apply,
@@ -216,7 +216,7 @@ def _drawing(
             contours.extend(made)
             if isinstance(shape, _STROKED) and draws_dots(shape):
                 m = compose(prepared.matrix, affine_of(shape.transform))
-                marks += shape_marks(shape, segments, m, _label(shape))
+                marks += unclipped(shape_marks(shape, segments, m, _label(shape)), over or ())
             kept.append(i - 1)
             opened += open_fills(shape, made)
             if made and (name := filter_of(shape)) is not None:

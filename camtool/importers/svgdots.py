@@ -51,6 +51,18 @@ def shape_marks(shape: Any, segments: Sequence[Any] | None, m: Affine, label: st
     return [Mark(at, layer, label, colour) for at in dots(segments, m)]
 
 
+def unclipped(marks: list[Mark], clips: Sequence[Any]) -> list[Mark]:
+    """The ``marks`` whose point each of ``clips`` shows (its region, grown by its slack).
+
+    ``clips``: :class:`~camtool.importers.svgclip.Clip` with their regions worked out. A
+    dot whose centre a clip hides is not shown where it would be drilled: it is left out,
+    as a shape that a clip hides wholly is.
+    """
+    import shapely
+
+    return [k for k in marks if all(c.grown.covers(shapely.Point(k.at)) for c in clips)]
+
+
 def dots(segments: Sequence[Any], m: Affine) -> list[Point]:
     """The start of every subpath of ``segments`` that draws and does not move, mapped by ``m``.
 

@@ -96,3 +96,19 @@ def test_a_layer_of_dots_can_be_named(tmp_path: Path) -> None:
     assert [m.layer for m in holes.marks] == ["Holes"] and not holes.contours
     edge = read_drawing(svg, ImportOptions(layers=("Edge",)))
     assert not edge.marks and [c.source for c in edge.contours] == ["rect#frame"]
+
+
+def test_a_dot_a_clip_hides_is_left_out(tmp_path: Path) -> None:
+    # the clip shows the left half of the page: the line of `p` and the dot at (20, 20) lie
+    # in it, the dot at (80, 80) does not (a viewer shows nothing there, so nothing to drill)
+    body = (
+        '<clipPath id="left"><rect x="0" y="0" width="50" height="100"/></clipPath>'
+        '<g clip-path="url(#left)">'
+        '<path id="p" d="M 10 10 L 30 10 M 20 20 Z M 80 80 Z" stroke="black" '
+        'stroke-linecap="round" fill="none"/></g>'
+    )
+    svg = tmp_path / "clipped.svg"
+    svg.write_text(PAGE.format(body))
+    drawing = read_drawing(svg)
+    assert [m.at for m in drawing.marks] == [(20.0, 80.0)]
+    assert [c.source for c in drawing.contours] == ["path#p"]
