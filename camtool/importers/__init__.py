@@ -78,7 +78,8 @@ def read_drawing(
     if options.fit is None:
         return drawing
     for margin in _REFIT_MARGINS:
-        k = fit_factor(fit_extent(drawing), options.fit)  # as planning will scale it
+        # as planning will scale it, or larger (it counts only the marks a job drills)
+        k = fit_factor(fit_extent(drawing, marks=False), options.fit)
         k = 1.0 if math.isinf(k) else k
         if used * k <= options.tolerance:
             return drawing

@@ -173,7 +173,8 @@ def _fit(
     cut = any(not is_construction(c) for c in drawing.contours)
     if travel is None or not (cut or drawing.marks):
         return (), 1.0
-    x0, y0, x1, y1 = box = fit_extent(drawing)  # as post fits it: construction aside
+    # as post fits it: construction aside, and the points (their drill is commented out)
+    x0, y0, x1, y1 = box = fit_extent(drawing, marks=False)
     w, h = travel
     if x1 - x0 + tool <= w + EPS_MM and y1 - y0 + tool <= h + EPS_MM:
         return (), 1.0  # its outside profile's toolpath fits the travel as it is (as post checks)

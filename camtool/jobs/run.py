@@ -30,6 +30,7 @@ from camtool.jobs.selection import (
     construction_notes,
     nothing_selected,
     select,
+    with_drilled_marks,
 )
 from camtool.jobs.travel import refuse_too_large, refuse_too_small
 from camtool.model.errors import InputError, ToolpathError, UsageError
@@ -262,7 +263,8 @@ def run_job(
 
     output = output if output is not None else OutputOptions()
     setup = plan_options(target, job.setup.plan)
-    scaled = place(drawing, setup)
+    sized = with_drilled_marks(drawing, [op.select for op in job.operations])
+    scaled = place(drawing, setup, sized)
     progress(Step("planning", 0, len(drawing.contours)))
     moves: list[Move] = []
     commands: list[tuple[int, Command]] = []
@@ -378,7 +380,7 @@ def run_job(
             setup if job.shorthand else None,
             job,
             runs,
-            placement=_placement(drawing, setup, shift),
+            placement=_placement(sized, setup, shift),
         ),
         tolerance_mm=setup.tolerance,
         warnings=(*program.warnings, *surface_warnings(runs, target)),

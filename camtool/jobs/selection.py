@@ -117,6 +117,16 @@ def mark_matches(mark: Mark, selection: Selection) -> bool:
     return selection.colours is None or mark.colour in selection.colours
 
 
+def with_drilled_marks(drawing: Drawing, selections: Sequence[Selection]) -> Drawing:
+    """``drawing`` with only the marks one of ``selections`` selects: what ``--fit`` sizes.
+
+    A point no drill drills is not cut, so it takes no part in the size (a far POINT made
+    the part of a plain ``post --fit`` smaller than asked).
+    """
+    kept = tuple(m for m in drawing.marks if any(mark_matches(m, s) for s in selections))
+    return drawing if len(kept) == len(drawing.marks) else dataclasses.replace(drawing, marks=kept)
+
+
 Chaining: TypeAlias = Callable[[Sequence[Contour]], Sequence[Shape]]
 """What each of some contours is once they are chained end to end, as the planner chains
 what an operation selects (:func:`camtool.toolpath.plan.chained`)."""

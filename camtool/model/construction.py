@@ -83,16 +83,21 @@ def is_construction(contour: Contour) -> bool:
     return bool(contour.linetype) or construction_layer(contour.layer)
 
 
-def fit_extent(drawing: Drawing) -> BBox:
+def fit_extent(drawing: Drawing, *, marks: bool = True) -> BBox:
     """The extent ``--fit W H`` scales into W × H mm: the drawing's, construction left out.
 
     Centre lines run past the part and a sheet's border frames it; neither is cut, so
     neither counts: what is cut is what fits (and holds the fit's tolerance). The marks
-    (points to drill) count, but for those on a construction layer. A drawing of
-    construction only has its whole extent.
+    (points to drill) count, but for those on a construction layer: a job passes the
+    drawing with the marks its drills drill (a mark nothing drills is not cut either).
+    ``marks=False``: the contours' alone while there are any (the importer's guess before
+    the job is known, never smaller a factor than the job's). A drawing of construction
+    only has its whole extent.
     """
     cut = tuple(c for c in drawing.contours if not is_construction(c))
-    marks = tuple(m for m in drawing.marks if not construction_layer(m.layer))
-    if not cut and not marks:
+    points = tuple(m for m in drawing.marks if not construction_layer(m.layer))
+    if cut and not marks:
+        points = ()
+    if not cut and not points:
         return drawing.bbox()
-    return Drawing(cut, drawing.source, (), marks).bbox()
+    return Drawing(cut, drawing.source, (), points).bbox()

@@ -329,9 +329,13 @@ def _backlash_weights(machine: Machine) -> tuple[float, float]:
     return (max(b.true_um[0], b.compensation_um[0]), max(b.true_um[1], b.compensation_um[1]))
 
 
-def place(drawing: Drawing, options: PlanOptions) -> Drawing:
-    """The drawing scaled as ``options.scale`` or ``options.fit`` ask (mm)."""
-    k, dx, dy = scaling(drawing, options)
+def place(drawing: Drawing, options: PlanOptions, sized: Drawing | None = None) -> Drawing:
+    """The drawing scaled as ``options.scale`` or ``options.fit`` ask (mm).
+
+    ``sized``: what ``--fit`` sizes (the drawing with the marks a job drills; ``None``:
+    the drawing), :func:`scaling`.
+    """
+    k, dx, dy = scaling(sized if sized is not None else drawing, options)
     if (k, dx, dy) == (1.0, 0.0, 0.0):
         return drawing
     return drawing.transformed(k, dx, dy)

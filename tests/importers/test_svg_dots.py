@@ -11,10 +11,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from camtool.importers import read_drawing
+from camtool.jobs.job import Job
 from camtool.jobs.jobfile import load_job
 from camtool.jobs.run import run_job
-from camtool.model.program import DrillCycle
+from camtool.model.program import DrillCycle, Rapid
 from camtool.post.registry import load_target
 
 PAGE = (
@@ -112,3 +115,34 @@ def test_a_dot_a_clip_hides_is_left_out(tmp_path: Path) -> None:
     drawing = read_drawing(svg)
     assert [m.at for m in drawing.marks] == [(20.0, 80.0)]
     assert [c.source for c in drawing.contours] == ["path#p"]
+
+
+def test_fit_sizes_what_is_cut_and_a_dot_is_cut_only_when_drilled(tmp_path: Path) -> None:
+    # a 10 mm square and a dot 70 mm away: a plain post cuts the square alone, so --fit 50 50
+    # makes it 50 mm (k = 5); a job that drills the dot fits both in 50 mm (80 mm wide
+    # from the square's left to the dot: k = 50 / 80)
+    from camtool.toolpath.options import PlanOptions
+
+    body = (
+        '<rect id="sq" x="10" y="80" width="10" height="10" fill="none" stroke="black"/>'
+        '<path id="dot" d="M 90 10 Z" stroke="black" stroke-width="2" stroke-linecap="round"/>'
+    )
+    svg = tmp_path / "far.svg"
+    svg.write_text(PAGE.format(body))
+    drawing = read_drawing(svg)
+    plain = Job.single(PlanOptions(fit=(50.0, 50.0), placement="lower-left"))
+    done = run_job(drawing, load_target("linuxcnc"), plain)
+    xs = [m.x for m in done.program.moves if not isinstance(m, Rapid)]
+    assert max(xs) - min(xs) == pytest.approx(50.0)
+    job = tmp_path / "job.toml"
+    job.write_text(
+        '[job]\norigin = "lower-left"\nfit = [50, 50]\n'
+        '[[tools]]\nid = 1\ntype = "drill"\ndiameter = 1\n'
+        '[[operations]]\ntype = "drill"\ntool = 1\npoints = "only"\ndepth = 1\n'
+        '[[operations]]\ntype = "engrave"\ntool = 1\nclosed = true\ndepth = 0.5\n'
+    )
+    done = run_job(drawing, load_target("linuxcnc"), load_job(job))
+    (hole,) = [c for _, c in done.program.commands if isinstance(c, DrillCycle)]
+    square = [m.x for m in done.program.moves if not isinstance(m, Rapid) and m.x < hole.x]
+    assert hole.x - min(square) == pytest.approx(50.0)  # 80 mm × 50 / 80
+    assert max(square) - min(square) == pytest.approx(10.0 * 50.0 / 80.0)
