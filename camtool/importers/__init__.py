@@ -131,8 +131,8 @@ def _read(
         drawing, used = read_points(path, options), 0.0
     else:
         _unknown(path, suffix)
-    if check is not None:
-        check(drawing.bbox())
+    if check is not None and drawing.contours:  # a point is cut only by a job's drill
+        check(Drawing(drawing.contours).bbox())
     return drawing, used
 
 

@@ -67,6 +67,32 @@ def test_a_shared_option_given_at_its_default_still_replaces_the_files(
     assert got == 2 and "--offset: with --job" in err
 
 
+def test_a_point_nothing_drills_is_not_judged_against_the_travel(run: Any, tmp_path: Path) -> None:
+    # a 10 mm square and a POINT 890 mm away: a plain post cuts the square alone, so the
+    # point is no reason to refuse the drawing as larger than GRBL's 200 mm; a job that
+    # drills the point and cuts the square is refused, its toolpath 890 mm across
+    from tests.shapes import write_dxf
+
+    def build(msp: Any) -> None:
+        msp.add_lwpolyline([(10, 10), (20, 10), (20, 20), (10, 20)], close=True)
+        msp.add_point((900, 900))
+
+    dxf = write_dxf(tmp_path / "far.dxf", build)
+    out = tmp_path / "far.gcode"
+    code, _, err = run("post", str(dxf), "-t", "grbl", "-o", str(out))
+    assert code == 0, err
+    assert "G1 X20.000 Y10.000" in out.read_text()
+    job = tmp_path / "job.toml"
+    job.write_text(
+        '[[tools]]\nid = 1\ntype = "drill"\ndiameter = 1\n'
+        '[[operations]]\ntype = "drill"\ntool = 1\npoints = "only"\ndepth = 1\n'
+        '[[operations]]\ntype = "engrave"\ntool = 1\nclosed = true\ndepth = 0.5\n'
+    )
+    out.unlink()
+    code, _, err = run("post", str(dxf), "-t", "grbl", "--job", str(job), "-o", str(out))
+    assert code == 1 and "larger than the 200 × 200 mm travel" in err and not out.exists()
+
+
 @pytest.mark.parametrize(
     ("extra", "code", "message"),
     [
