@@ -120,8 +120,8 @@ def mark_matches(mark: Mark, selection: Selection) -> bool:
 def with_drilled_marks(drawing: Drawing, selections: Sequence[Selection]) -> Drawing:
     """``drawing`` with only the marks one of ``selections`` selects: what ``--fit`` sizes.
 
-    A point no drill drills is not cut, so it takes no part in the size (a far POINT made
-    the part of a plain ``post --fit`` smaller than asked).
+    A point no drill drills is not cut, so it takes no part in the size (a far POINT would
+    make the part of a plain ``post --fit`` smaller than asked).
     """
     kept = tuple(m for m in drawing.marks if any(mark_matches(m, s) for s in selections))
     return drawing if len(kept) == len(drawing.marks) else dataclasses.replace(drawing, marks=kept)

@@ -39,9 +39,9 @@ def test_post_job_writes_one_program_for_the_whole_part(run: Any, tmp_path: Path
 def test_a_shared_option_given_at_its_default_still_replaces_the_files(
     run: Any, tmp_path: Path
 ) -> None:
-    # `--origin drawing` is the option's default, and was taken for "not given": the file's
-    # origin = "lower-left" stood, and the program's work zero was not where the command
-    # line put it.
+    # `--origin drawing` is the option's default, and given it replaces the file's
+    # origin = "lower-left" as any other value would: the work zero is where the command
+    # line puts it, not where the file did
     job = Path(JOB)
     assert 'origin = "lower-left"' in job.read_text()
     out = tmp_path / "part.ngc"
@@ -53,8 +53,8 @@ def test_a_shared_option_given_at_its_default_still_replaces_the_files(
     code, _, err = run("post", PART, "-t", "linuxcnc", "--job", str(job), "-o", str(out))
     assert code == 0, err
     assert "(work zero X0 Y0: the toolpath's lower-left corner)" in out.read_text()
-    # the size is one choice: --scale 1 replaces a file's fit (it was refused as both, or
-    # at 1, its default, left the file's fit to scale the part)
+    # the size is one choice: --scale 1 replaces a file's fit (not refused as both, and at
+    # 1, its default, the part keeps its size)
     fitted = tmp_path / "fitted.toml"
     fitted.write_text(job.read_text().replace("[job]\n", "[job]\nfit = [40, 40]\n", 1))
     code, _, err = run(

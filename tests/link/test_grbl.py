@@ -236,8 +236,9 @@ def test_a_controller_that_stops_answering_is_named_within_a_bound(
 
 
 def test_bytes_without_a_line_end_stop_the_job_not_fill_the_memory(simulate: Any) -> None:
-    # a wrong baud rate reads GRBL's answers as bytes with no line end: the sender held them
-    # all while it waited for an `ok`; it now stops the machine at 4 KiB of them and says why
+    # a wrong baud rate reads GRBL's answers as bytes with no line end: rather than hold
+    # them all while it waits for an `ok`, the sender stops the machine at 4 KiB of them
+    # and says why
     sim = simulate("grbl", noise_at_block=40)
     with pytest.raises(LinkError, match="more than 4096 bytes while sending") as info:
         run_quick(sim, PROGRAM)
