@@ -756,6 +756,7 @@ def _render(
             f"diameter = {d:g}" + _why("mm; set it to the tool you load"),
             "",
         ]
+    first = next(iter(tools))
     for op in ordered:
         number = tools.get(_tool_key(op, tool), 1)
         prefix = "# " if op.commented else ""
@@ -763,6 +764,8 @@ def _render(
         for line in op.lines:
             line = line.replace("{end-mill}", str(number))
             line = line.replace(f"{{end-mill {op.tool:g}}}", str(number))
+            if f"{{drill {op.tool:g}}}" in line and first[0] != "drill":  # no drill listed
+                line += _why(f"the {first[1]:g} mm {first[0]}: add a [[tools]] drill, give its id")
             line = line.replace(f"{{drill {op.tool:g}}}", str(number))
             out.append(prefix + line)
         out.append("")
