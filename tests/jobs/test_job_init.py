@@ -6,6 +6,7 @@ import math
 import re
 import tomllib
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -159,24 +160,23 @@ def test_the_points_drill_says_when_the_tool_it_names_is_no_drill(tmp_path: Path
     # a plate with two POINTs: the commented drill of the points names tool 1, the plate's
     # end mill, the only tool listed; the line says so. With a hole drilled too, tool 1 is
     # that drill and nothing needs saying.
-    def build(with_hole: bool) -> object:
-        def add(msp: object) -> None:
-            msp.add_lwpolyline(  # type: ignore[attr-defined]
-                [(0, 0), (40, 0), (40, 30), (0, 30)], close=True
-            )
+    def points_drill(name: str, with_hole: bool) -> tuple[str, str]:
+        """The tool line of the points' commented drill, and the whole job."""
+
+        def build(msp: Any) -> None:
+            msp.add_lwpolyline([(0, 0), (40, 0), (40, 30), (0, 30)], close=True)
             for at in ((10.0, 10.0), (30.0, 20.0)):
-                msp.add_point(at)  # type: ignore[attr-defined]
+                msp.add_point(at)
             if with_hole:
-                msp.add_circle((20.0, 15.0), 1.5)  # type: ignore[attr-defined]
+                msp.add_circle((20.0, 15.0), 1.5)
 
-        return add
+        text = initial_job(read_drawing(write_dxf(tmp_path / name, build)))
+        return text.split('# type = "drill"  # 2 point(s)', 1)[1].splitlines()[1], text
 
-    text = initial_job(read_drawing(write_dxf(tmp_path / "a.dxf", build(False))))  # type: ignore[arg-type]
-    tool_line = text.split('# type = "drill"  # 2 point(s)', 1)[1].splitlines()[1]
-    assert tool_line == "# tool = 1  # the 3 mm end-mill: add a [[tools]] drill, give its id"
-    text = initial_job(read_drawing(write_dxf(tmp_path / "b.dxf", build(True))))  # type: ignore[arg-type]
-    tool_line = text.split('# type = "drill"  # 2 point(s)', 1)[1].splitlines()[1]
-    assert tool_line == "# tool = 1" and 'type = "drill"\ndiameter = 3' in text
+    line, _ = points_drill("a.dxf", with_hole=False)
+    assert line == "# tool = 1  # the 3 mm end-mill: add a [[tools]] drill, give its id"
+    line, text = points_drill("b.dxf", with_hole=True)
+    assert line == "# tool = 1" and 'type = "drill"\ndiameter = 3' in text
 
 
 def test_a_drawing_of_points_only_says_so_and_names_the_drill_operation(tmp_path: Path) -> None:
