@@ -466,6 +466,8 @@ _SKIP_REASONS = {
     "use": "a <use> of a <symbol> with a viewBox is not supported; unlink the clone",
     "marker": "a viewer draws the shapes of its markers at its vertices; camtool cuts the "
     "shape only: Inkscape's Path > Stroke to Path makes them paths",
+    "pattern": "a viewer fills them with the pattern's lines or shapes; camtool cuts the "
+    "outline only: Inkscape's Object > Pattern > Pattern to Objects makes them shapes",
 }
 
 
@@ -569,6 +571,12 @@ def prepare(
         noun = "shape" if counts["marker"] == 1 else "shapes"
         reason = _SKIP_REASONS["marker"]
         warnings.append(f"{path}: skipped the markers of {counts['marker']} {noun} ({reason})")
+    if counts["pattern"]:
+        noun = "shape" if counts["pattern"] == 1 else "shapes"
+        reason = _SKIP_REASONS["pattern"]
+        warnings.append(
+            f"{path}: skipped the pattern fill of {counts['pattern']} {noun} ({reason})"
+        )
     clip_paths_first(root)
     svgvalues.drop_gradients(root)
     return Prepared(ET.tostring(root), matrix, viewport, tuple(warnings), page)

@@ -30,7 +30,7 @@ import svgelements as se
 
 from camtool.importers.svgcheck import NUMBER
 from camtool.importers.svgcss import inline_style, local_name, style_text
-from camtool.importers.svgtree import href
+from camtool.importers.svgtree import SHAPE_KINDS, href
 
 LENGTH_ATTRS = {
     "rect": ("x", "y", "width", "height", "rx", "ry"),
@@ -137,7 +137,10 @@ def resolve_paint_references(root: ET.Element) -> None:
     gradient without stops paints with its fallback colour (``url(#g) red``), else not at
     all (SVG 2 §13.2): a shape
     filled so and not stroked is invisible. svgelements paints every ``url(…)`` black, so
-    such a shape would be cut. A reference to a gradient or pattern is kept (the shape is
+    such a shape would be cut. A ``<pattern>`` without children (its own or, through
+    ``href``, another's: :func:`pattern_content`) is no paint server, as for Chromium; one
+    whose children draw nothing (:func:`pattern_draws`) paints nothing, whatever the
+    fallback. A reference to a gradient or a pattern that draws is kept (the shape is
     painted). Run after the style sheets are applied.
     """
     ids = {e.get("id"): e for e in root.iter() if e.get("id")}
@@ -146,16 +149,21 @@ def resolve_paint_references(root: ET.Element) -> None:
         for ident, e in ids.items()
         if local_name(e) in _PAINT_SERVERS
         and (local_name(e) not in _GRADIENTS or gradient_stops(e, ids))
+        and (local_name(e) != "pattern" or pattern_content(e, ids) is not None)
     }
+    blank = {
+        i for i in servers if local_name(ids[i]) == "pattern" and not pattern_draws(ids[i], ids)
+    }
+    painting = servers - blank
     for element in root.iter():
         style = element.get("style")
         declared = inline_style(element) if style and "url(" in style else {}
         for name in ("fill", "stroke"):
             for value, inline in ((element.get(name), False), (declared.get(name), True)):
                 match = _PAINT_URL.fullmatch(value or "")
-                if match is None or match.group(1) in servers:
+                if match is None or match.group(1) in painting:
                     continue
-                paint = match.group(2) or "none"
+                paint = "none" if match.group(1) in blank else match.group(2) or "none"
                 if inline:
                     declared[name] = paint
                     element.set("style", style_text(declared))
@@ -524,6 +532,38 @@ def gradient_stops(
         current = target if target is not None and local_name(target) in _GRADIENTS else None
     return []
 
+
+def pattern_draws(server: ET.Element, ids: dict[str | None, ET.Element]) -> bool:
+    """Whether the paint server ``server`` draws something inside what it fills.
+
+    An SVG 2 ``<hatch>`` always draws lines; a ``<pattern>`` draws when its content
+    (:func:`pattern_content`) holds a shape, text or image.
+    """
+    if local_name(server) == "hatch":
+        return True
+    content = pattern_content(server, ids)
+    return content is not None and any(local_name(e) in _PATTERN_CONTENT for e in content.iter())
+
+
+def pattern_content(server: ET.Element, ids: dict[str | None, ET.Element]) -> ET.Element | None:
+    """The ``<pattern>`` whose children ``server`` draws; ``None``: none in its chain has any.
+
+    A pattern without children takes those of the pattern its ``href`` names, and so on
+    (SVG 1.1 §13.3; a cycle ends it). ``None`` for an element that is not a pattern.
+    """
+    seen: set[ET.Element] = set()
+    node: ET.Element | None = server
+    while node is not None and local_name(node) == "pattern" and node not in seen:
+        seen.add(node)
+        if len(node):
+            return node
+        link = href(node)
+        node = ids.get(link[1:]) if link[:1] == "#" else None
+    return None
+
+
+_PATTERN_CONTENT = SHAPE_KINDS | {"text", "image"}
+"""What a pattern draws when it holds it: shapes, ``<use>``, text and images."""
 
 _GRADIENT_CONTENT = frozenset({*_GRADIENTS, "stop", "animate", "set"})
 """What a gradient holds that svgelements reads into plain elements and draws nothing of."""
