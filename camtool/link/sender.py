@@ -289,6 +289,9 @@ class _Driver:
             while self.clock.monotonic() < deadline:
                 got = self.wire.lines(POLL_S, "at start-up")
                 for n, line in enumerate(got):
+                    why = self.plan.hooks.firmware and self.plan.hooks.firmware(line)
+                    if why:
+                        raise LinkError(f"{spec.target}: {why}; nothing was sent")
                     if line.startswith(spec.banner) or (wake and self._status_of(line)):
                         self.wire.put_back(got[n + 1 :])
                         return True

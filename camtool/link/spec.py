@@ -278,6 +278,9 @@ class LinkHooks:
             refuse, before the first byte: raises
             :class:`~camtool.model.errors.DialectError` naming the line (GRBL:
             words and codes its gcode.c does not take).
+        firmware: ``line -> reason or None``: why the link cannot stream to the
+            controller that said ``line`` at start-up (GRBL: a version before 1.1);
+            ``send`` stops there, before the first byte of the program.
     """
 
     frame: Callable[[bytes, LinkSpec, str], Sequence[WireBlock]] | None = None
@@ -291,6 +294,7 @@ class LinkHooks:
     status: Callable[[str], Status | None] | None = None
     setup: Callable[[Callable[[str], list[str]]], list[str]] | None = None
     check: Callable[[Sequence[WireBlock], str], None] | None = None
+    firmware: Callable[[str], str | None] | None = None
 
 
 NO_HOOKS = LinkHooks()

@@ -1,6 +1,39 @@
-"""GRBL 1.1's error and alarm codes with their messages (gnea/grbl doc/csv)."""
+"""GRBL 1.1's error and alarm codes with their messages (gnea/grbl doc/csv).
+
+And the firmware a controller's first words name (:func:`firmware`).
+"""
 
 from __future__ import annotations
+
+import re
+
+_BANNER = re.compile(r"Grbl (\d+)\.(\d+)(\S*)")
+_OLD_STATUS = re.compile(r"<[A-Za-z]+,")
+
+
+def firmware(line: str) -> str | None:
+    """Why ``send`` cannot stream to the controller that said ``line``; ``None``: no reason.
+
+    A banner of a GRBL older than 1.1 (``Grbl 0.9j ['$' for help]``, ``Grbl 0.8c``) or a
+    status report in their format (``<Idle,MPos:…,WPos:…>``; GRBL 1.1 writes
+    ``<Idle|MPos:…>``): camtool's GRBL link is GRBL 1.1's protocol (interface.md: status
+    reports, ``Bf:`` buffer counts, ``error:N``, ``Hold:0``), which those do not speak.
+    Versions 1.1 and later (FluidNC says ``Grbl 3.7``) pass.
+    """
+    banner = _BANNER.match(line)
+    if banner is not None and (int(banner.group(1)), int(banner.group(2))) < (1, 1):
+        version = banner.group(0).removeprefix("Grbl ")
+        return f"the controller is GRBL {version} (its start-up line: {line.strip()!r})" + _OLD
+    if _OLD_STATUS.match(line):
+        return f"the controller answers in GRBL 0.9's status format ({line.strip()!r})" + _OLD
+    return None
+
+
+_OLD = (
+    ": camtool's grbl link speaks GRBL 1.1's protocol (status reports, buffer counts, error "
+    "codes), which GRBL before 1.1 does not speak; update the firmware to GRBL 1.1, or stream "
+    "the program with a sender made for that version"
+)
 
 ERRORS: dict[int, tuple[str, str]] = {
     1: (

@@ -18,7 +18,7 @@ from camtool.link.spec import LineBlocks, LinkHooks, LinkSpec, Status, WireBlock
 from camtool.model.errors import CamtoolError, InputError, ParseError, UsageError
 from camtool.model.program import ArcMove
 from camtool.model.shapes import Arc
-from camtool_postprocessors.grbl.codes import ALARMS, ERRORS
+from camtool_postprocessors.grbl.codes import ALARMS, ERRORS, firmware
 
 if TYPE_CHECKING:
     from camtool.model.program import Program
@@ -822,5 +822,6 @@ LINK = LinkHooks(
     setup=setup,
     expect=expect,
     check=check,
+    firmware=firmware,
 )
 """GRBL's link hooks (``camtool send -t grbl``, ``camtool simulate-device -t grbl``)."""

@@ -12,10 +12,13 @@ from typing import Any
 
 import pytest
 
+from camtool.link.device import PtyServer
 from camtool.link.plan import prepare_send
 from camtool.link.sender import StopAtPause, open_port, send_plan
+from camtool.link.spec import link_spec
 from camtool.model.errors import InputError, LinkError
 from camtool.post.registry import load_target
+from camtool_postprocessors.grbl.link import GrblDevice
 from tests.link.controls import AnswersTurns, PauseAt
 
 # 13 passes over a 10 x 10 mm square, one arc per pass: the tool ends at X10 Y0 Z5.
@@ -178,6 +181,40 @@ def test_a_controller_in_alarm_gets_nothing(simulate: Any) -> None:
     with pytest.raises(LinkError, match="alarm state"):
         run(sim.path, PROGRAM)
     assert len(sim.device.received) == before
+
+
+class _Grbl09(GrblDevice):
+    """GRBL 0.9j as it answers (grbl v0.9j report.c): its start-up line, and status reports
+    whose fields follow the state after commas, ``<Idle,MPos:…,WPos:…>``."""
+
+    says_banner = True
+
+    def _banner(self) -> bytes:
+        return b"\r\nGrbl 0.9j ['$' for help]\r\n" if self.says_banner else b""
+
+    def status_report(self) -> bytes:
+        return b"<Idle,MPos:0.000,0.000,0.000,WPos:0.000,0.000,0.000>\r\n"
+
+
+@pytest.mark.parametrize("banner", [True, False], ids=["banner", "no-banner"])
+def test_a_grbl_older_than_1_1_is_named_and_sent_nothing(banner: bool) -> None:
+    # GRBL 0.9's status reports, settings and errors are not 1.1's (interface.md): the
+    # send stops at start-up, naming the version, before any byte of the program
+    target = load_target("grbl")
+    device = _Grbl09(link_spec(target), target=target)
+    device.says_banner = banner
+    server = PtyServer(device, block_delay_s=0.0005)
+    server.start()
+    try:
+        with pytest.raises(LinkError) as info:
+            run(server.path, PROGRAM)
+    finally:
+        server.stop()
+    said = "is GRBL 0.9j (its start-up line" if banner else "answers in GRBL 0.9's status format"
+    assert f"grbl: the controller {said}" in str(info.value)
+    assert "update the firmware to GRBL 1.1" in str(info.value)
+    assert str(info.value).endswith("nothing was sent")
+    assert bytes(device.received).strip(b"?") == b""  # status queries at most
 
 
 def test_an_error_on_the_last_block_fails_the_job(simulate: Any) -> None:
