@@ -167,7 +167,10 @@ class _Driver:
     def run(self) -> SendResult:
         start = self.clock.monotonic()
         try:
-            self._start_up()
+            try:
+                self._start_up()
+            except Garbled as exc:  # before the program: nothing of it is in flight
+                raise LinkError(f"{exc}; nothing of the program was sent") from exc
             self._stream()
             self._finish()
         except _PortGone as exc:

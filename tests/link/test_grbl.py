@@ -217,6 +217,28 @@ def test_a_grbl_older_than_1_1_is_named_and_sent_nothing(banner: bool) -> None:
     assert bytes(device.received).strip(b"?") == b""  # status queries at most
 
 
+class _Noisy(GrblDevice):
+    """A GRBL heard at the wrong baud rate from the start: its banner is bytes, no line end."""
+
+    def _banner(self) -> bytes:
+        return bytes(range(128, 256)) * 64  # 8 KiB
+
+
+def test_noise_at_start_up_says_nothing_was_sent() -> None:
+    target = load_target("grbl")
+    device = _Noisy(link_spec(target), target=target)
+    server = PtyServer(device, block_delay_s=0.0005)
+    server.start()
+    try:
+        with pytest.raises(LinkError) as info:
+            run(server.path, PROGRAM)
+    finally:
+        server.stop()
+    assert "with no answer in them" in str(info.value)
+    assert str(info.value).endswith("; nothing of the program was sent")
+    assert b"G21" not in bytes(device.received)
+
+
 def test_an_error_on_the_last_block_fails_the_job(simulate: Any) -> None:
     # GRBL answers every line `ok` or `error:N` (interface.md); the job is done only when the
     # last line's answer has come: an `error:20` there is a failed job, not "sent N blocks"
