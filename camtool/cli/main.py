@@ -223,6 +223,7 @@ def post(
         _write_pieces(job, output, [("the input", drawing), ("the --job file", job_file)])
     else:
         write_output(job.result.code, output)
+        _earlier_pieces(output, [])
     if output != "-" and not job.pieces:
         say_written(f"camtool: wrote {job.result.blocks} blocks for {chosen.name} to {output}")
     if verifying:
@@ -401,6 +402,7 @@ def _write_pieces(job: PostJob, output: str, inputs: list[tuple[str, Any]]) -> N
     check_outputs(inputs, [("-o", p) for p in paths])
     for piece, path in zip(job.pieces, paths, strict=True):
         write_output(piece.result.code, path)
+    _earlier_pieces(output, paths)
     order = ", then ".join(
         f"{p} ({piece.tool})" for piece, p in zip(job.pieces, paths, strict=True)
     )
@@ -408,6 +410,31 @@ def _write_pieces(job: PostJob, output: str, inputs: list[tuple[str, Any]]) -> N
     say_written(
         f"camtool: {name} cannot change tools: wrote one program per tool, run {order}{zero}"
     )
+
+
+def _earlier_pieces(output: str, written: list[str]) -> None:
+    """Warn of the programs per tool an earlier run left beside ``-o output``.
+
+    A job split per tool writes ``part.T1.nc``, ``part.T2.nc``...; run again with other
+    tools (or as one program) it leaves the earlier ones, which an operator could take
+    for this run's. They are named, not deleted (a file camtool did not write this time
+    is the user's).
+    """
+    from camtool.jobs.by_hand import pieces_beside
+
+    if output == "-":
+        return
+    left = [p for p in pieces_beside(output) if p not in written]
+    if left:
+        shown = ", ".join(left[:4]) + (f" and {len(left) - 4} more" if len(left) > 4 else "")
+        warn(
+            [
+                f"{shown}: {'a program' if len(left) == 1 else 'programs'} per tool from an "
+                f"earlier run, not part of what this run wrote to {output}: delete "
+                f"{'it' if len(left) == 1 else 'them'} so that no one runs "
+                f"{'it' if len(left) == 1 else 'them'} by mistake"
+            ]
+        )
 
 
 def _check_preview(preview: str | None) -> None:

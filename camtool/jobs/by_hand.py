@@ -10,6 +10,8 @@ which tool to load.
 from __future__ import annotations
 
 import dataclasses
+import os
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -75,6 +77,22 @@ def program_path(output: str | Path, number: int, tool: int | None, numbered: bo
     if numbered:
         which = f"{number}.{which}"
     return str(out.with_name(f"{out.stem}.{which}{out.suffix}"))
+
+
+def pieces_beside(output: str | Path) -> list[str]:
+    """The programs per tool (:func:`program_path`'s names for ``-o output``) in its folder.
+
+    ``part.T2.nc``, ``part.start.nc``, ``part.1.T1.nc`` for ``-o part.nc``: those an earlier
+    run left are not this run's; the caller names them. Sorted; ``[]`` when the folder
+    cannot be read.
+    """
+    out = Path(output)
+    name = re.compile(rf"{re.escape(out.stem)}\.(?:\d+\.)?(?:T\d+|start){re.escape(out.suffix)}")
+    try:
+        found = os.listdir(out.parent)
+    except OSError:
+        return []
+    return sorted(str(out.with_name(n)) for n in found if name.fullmatch(n))
 
 
 def needs_numbers(tools: Sequence[int | None]) -> bool:

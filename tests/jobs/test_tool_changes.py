@@ -199,6 +199,31 @@ def test_a_grbl_job_of_two_tools_is_one_program_per_tool(
     assert "set Z zero for each tool before its program" in capsys.readouterr().err
 
 
+def test_programs_per_tool_an_earlier_run_left_are_named_not_deleted(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An operator runs every ``part.T*.gcode`` in the folder: one an earlier run wrote
+    (another job, or a tool this one no longer uses) would cut what this job does not ask
+    for. Each run names those it did not write; it deletes nothing it did not write."""
+    (tmp_path / "part.T3.gcode").write_text("G0 X0\n")  # an earlier job's third tool
+    (tmp_path / "part.2.T1.gcode").write_text("G0 X0\n")  # a job whose tool came back
+    (tmp_path / "part.T1.nc").write_text("G0 X0\n")  # another ending: another -o
+    (tmp_path / "other.T1.gcode").write_text("G0 X0\n")  # another stem
+    out = tmp_path / "part.gcode"
+    capsys.readouterr()
+    assert main(["post", str(PART), "-t", "grbl", "--job", str(JOB), "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    earlier = f"{tmp_path / 'part.2.T1.gcode'}, {tmp_path / 'part.T3.gcode'}: programs per tool"
+    assert f"camtool: warning: {earlier} from an earlier run" in err
+    assert "part.T1.gcode," not in err.split("warning:")[1]  # written now: not named
+    assert (tmp_path / "part.T3.gcode").read_text() == "G0 X0\n"  # kept, as the user left it
+    # one program (a machine with a changer) beside the pieces of a run for GRBL
+    assert main(["post", str(PART), "-t", "linuxcnc", "--job", str(JOB), "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    names = ", ".join(str(tmp_path / f"part.{n}.gcode") for n in ("2.T1", "T1", "T2", "T3"))
+    assert f"camtool: warning: {names}: programs per tool from an earlier run" in err
+
+
 def test_after_a_change_by_hand_the_first_move_is_up_to_the_clearance_height(
     tmp_path: Path,
 ) -> None:
