@@ -183,6 +183,18 @@ def test_a_controller_in_alarm_gets_nothing(simulate: Any) -> None:
     assert len(sim.device.received) == before
 
 
+def _refused_by(device: GrblDevice) -> pytest.ExceptionInfo[LinkError]:
+    """The LinkError a send of PROGRAM to ``device`` (on a pseudo-terminal) ends with."""
+    server = PtyServer(device, block_delay_s=0.0005)
+    server.start()
+    try:
+        with pytest.raises(LinkError) as info:
+            run(server.path, PROGRAM)
+    finally:
+        server.stop()
+    return info
+
+
 class _Grbl09(GrblDevice):
     """GRBL 0.9j as it answers (grbl v0.9j report.c): its start-up line, and status reports
     whose fields follow the state after commas, ``<Idle,MPos:…,WPos:…>``."""
@@ -200,16 +212,9 @@ class _Grbl09(GrblDevice):
 def test_a_grbl_older_than_1_1_is_named_and_sent_nothing(banner: bool) -> None:
     # GRBL 0.9's status reports, settings and errors are not 1.1's (interface.md): the
     # send stops at start-up, naming the version, before any byte of the program
-    target = load_target("grbl")
-    device = _Grbl09(link_spec(target), target=target)
+    device = _Grbl09(link_spec(load_target("grbl")), target=load_target("grbl"))
     device.says_banner = banner
-    server = PtyServer(device, block_delay_s=0.0005)
-    server.start()
-    try:
-        with pytest.raises(LinkError) as info:
-            run(server.path, PROGRAM)
-    finally:
-        server.stop()
+    info = _refused_by(device)
     said = "is GRBL 0.9j (its start-up line" if banner else "answers in GRBL 0.9's status format"
     assert f"grbl: the controller {said}" in str(info.value)
     assert "update the firmware to GRBL 1.1" in str(info.value)
@@ -225,15 +230,8 @@ class _Noisy(GrblDevice):
 
 
 def test_noise_at_start_up_says_nothing_was_sent() -> None:
-    target = load_target("grbl")
-    device = _Noisy(link_spec(target), target=target)
-    server = PtyServer(device, block_delay_s=0.0005)
-    server.start()
-    try:
-        with pytest.raises(LinkError) as info:
-            run(server.path, PROGRAM)
-    finally:
-        server.stop()
+    device = _Noisy(link_spec(load_target("grbl")), target=load_target("grbl"))
+    info = _refused_by(device)
     assert "with no answer in them" in str(info.value)
     assert str(info.value).endswith("; nothing of the program was sent")
     assert b"G21" not in bytes(device.received)
