@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from camtool.model.errors import UsageError
@@ -215,6 +215,9 @@ def test_fixed_chunking_executes_what_was_written() -> None:
 def test_chunk_rule_loses_under_0_2_mm_per_axis_and_segment(points: list) -> None:  # type: ignore[type-arg]
     # Analytic (R12): floor(d/2)·0.2 mm is within [d·0.1 − 0.1, d·0.1] mm, same sign.
     arrays = router_arrays(points)
+    # an axis that moves at a speed rounded to 0 never ends its move (the job hangs, Angel-11
+    # §4.2): the writer cuts such a segment into pieces, so it is not the chunk rule's case
+    assume(not np.any((arrays.lxy != 0) & (arrays.velxy == 0)))
     inc = chunked_increments(arrays, RouterMachine())
     written = arrays.increments.T * 2560
     assert np.all(np.abs(inc) <= np.abs(written))
