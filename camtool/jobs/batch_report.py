@@ -56,6 +56,8 @@ def _options(options: BatchOptions) -> dict[str, Any]:
             }
         elif f.name == "output":
             out.update(dataclasses.asdict(value))
+        elif f.name == "job":  # ``--job``: the job file's name, as the headers say it
+            out["job"] = (value.source or None) if value is not None else None
         else:
             out[f.name] = _json(value)
     out["verify"] = options.verifying  # also when implied by preview or max_error_um

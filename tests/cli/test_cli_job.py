@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import re
 from pathlib import Path
 from typing import Any
@@ -169,13 +170,18 @@ def test_job_init_never_replaces_a_job_without_force(run: Any, tmp_path: Path) -
 
 
 def test_batch_job_posts_each_drawing_with_the_job(run: Any, tmp_path: Path) -> None:
+    report = tmp_path / "batch.json"
     code, _, err = run(
-        "batch", PART, "-t", "grbl", "-o", str(tmp_path / "out"), "--job", JOB, "--jobs", "1"
-    )
+        "batch", PART, "-t", "grbl", "-o", str(tmp_path / "out"), "--job", JOB, "--jobs", "1",
+        "--report", str(report),
+    )  # fmt: skip
     assert code == 0, err
     for tool in (2, 1):  # two tools: GRBL gets one program per tool
         text = (tmp_path / "out" / f"part.T{tool}.gcode").read_text()
         assert "(job part.toml: 4 operations)" in text
+    # the report names the job file among the options that shaped the programs, as the
+    # programs' headers name it
+    assert json.loads(report.read_text())["options"]["job"] == "part.toml"
 
 
 TOOL_TABLE = "T1 P1 D3.0 Z0 ;end mill\nT2 P2 D3.2 Z0 ;drill\n"
