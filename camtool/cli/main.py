@@ -413,28 +413,12 @@ def _write_pieces(job: PostJob, output: str, inputs: list[tuple[str, Any]]) -> N
 
 
 def _earlier_pieces(output: str, written: list[str]) -> None:
-    """Warn of the programs per tool an earlier run left beside ``-o output``.
+    """Warn of the programs per tool an earlier run left beside ``-o output`` (not stdout)."""
+    from camtool.jobs.by_hand import earlier_pieces
 
-    A job split per tool writes ``part.T1.nc``, ``part.T2.nc``...; run again with other
-    tools (or as one program) it leaves the earlier ones, which an operator could take
-    for this run's. They are named, not deleted (a file camtool did not write this time
-    is the user's).
-    """
-    from camtool.jobs.by_hand import pieces_beside
-
-    if output == "-":
-        return
-    left = [p for p in pieces_beside(output) if p not in written]
-    if left:
-        shown = ", ".join(left[:4]) + (f" and {len(left) - 4} more" if len(left) > 4 else "")
-        warn(
-            [
-                f"{shown}: {'a program' if len(left) == 1 else 'programs'} per tool from an "
-                f"earlier run, not part of what this run wrote to {output}: delete "
-                f"{'it' if len(left) == 1 else 'them'} so that no one runs "
-                f"{'it' if len(left) == 1 else 'them'} by mistake"
-            ]
-        )
+    message = None if output == "-" else earlier_pieces(output, written)
+    if message is not None:
+        warn([message])
 
 
 def _check_preview(preview: str | None) -> None:

@@ -21,6 +21,7 @@ from camtool.jobs.batch_plan import BatchInterrupted, BatchPlan, BatchResult, Ba
 from camtool.jobs.batch_report import batch_report
 from camtool.jobs.batch_report import summary_table as summary_table  # camtool.batch API
 from camtool.jobs.batch_stop import Interrupts, Terminated, kill_pool, worker_init
+from camtool.jobs.by_hand import earlier_pieces
 from camtool.jobs.inputs import BatchInput, expand_inputs
 from camtool.jobs.pipeline import OutputOptions
 from camtool.model.errors import CamtoolError, InputError, UsageError, unexpected
@@ -709,7 +710,8 @@ def _outputs(task: BatchTask, options: BatchOptions, job: PostJob) -> tuple[Batc
     files: list[tuple[str, str | bytes]] = [(task.code_path, job.result.code)]
     if job.pieces:  # a target that cannot change tools: one program per tool
         files = [(piece.path(task.code_path), piece.result.code) for piece in job.pieces]
-    warnings = job.warnings
+    earlier = earlier_pieces(task.code_path, [path for path, _ in files])  # left by --force
+    warnings = job.warnings + ((earlier,) if earlier else ())
     error_um: float | None = None
     # at programmed feeds, where the machine runs them; else known only by simulating
     time_s = job.program.cutting_time_s() if job.target.post.writes_feeds else None

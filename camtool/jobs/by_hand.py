@@ -95,6 +95,26 @@ def pieces_beside(output: str | Path) -> list[str]:
     return sorted(str(out.with_name(n)) for n in found if name.fullmatch(n))
 
 
+def earlier_pieces(output: str | Path, written: Sequence[str]) -> str | None:
+    """A warning naming the programs per tool beside ``output`` that this run did not write.
+
+    A job split per tool writes ``part.T1.nc``, ``part.T2.nc``...; run again with other
+    tools (or as one program) it leaves the earlier ones, which an operator could take for
+    this run's. They are named, not deleted (a file this run did not write is the user's).
+    ``None`` when there are none (``written``: the paths this run wrote).
+    """
+    left = [p for p in pieces_beside(output) if p not in written]
+    if not left:
+        return None
+    one = len(left) == 1
+    shown = ", ".join(left[:4]) + (f" and {len(left) - 4} more" if len(left) > 4 else "")
+    return (
+        f"{shown}: {'a program' if one else 'programs'} per tool from an earlier run, not "
+        f"part of what this run wrote to {output}: delete {'it' if one else 'them'} so that "
+        f"no one runs {'it' if one else 'them'} by mistake"
+    )
+
+
 def needs_numbers(tools: Sequence[int | None]) -> bool:
     """Whether programs of ``tools`` (in the order they run) need :func:`program_path`'s numbers."""
     return len(set(tools)) < len(tools)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import json
 from pathlib import Path
 
 from camtool.cli.main import main
@@ -209,6 +210,14 @@ def test_a_second_batch_keeps_the_programs_per_tool_of_the_first_without_force(
     assert code == 2
     assert "2 output(s) exist already" in err and "two.T1.gcode" in err
     assert (out / "two.T1.gcode").read_text() == "kept\n"
-    code, err = _run("batch", str(source), "-t", "grbl", "-o", str(out), "--force")
+    (out / "two.T7.gcode").write_text("another job's\n")  # a tool this program has not
+    report = tmp_path / "batch.json"
+    code, err = _run(
+        "batch", str(source), "-t", "grbl", "-o", str(out), "--force", "--report", str(report)
+    )
     assert code == 0, err
     assert (out / "two.T1.gcode").read_text() != "kept\n"
+    # --force overwrites what the batch writes; the program of T7 it names, and keeps
+    assert (out / "two.T7.gcode").read_text() == "another job's\n"
+    (row,) = json.loads(report.read_text())["files"]
+    assert f"{out / 'two.T7.gcode'}: a program per tool from an earlier run" in row["warnings"][-1]
