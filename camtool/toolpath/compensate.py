@@ -320,7 +320,8 @@ def _compensated(
     if result.fallback is not None:
         findings.append(_fallback(contour, result.fallback, options.tolerance))
         # shapely's buffer keeps no loop
-        crossing = self_crossing(contour, options.tolerance, f"{options.offset} offset")
+        where_cut = "inside" if side.inside else "outside"  # as the tool runs (a hole: inside)
+        crossing = self_crossing(contour, options.tolerance, f"{where_cut} offset")
         if crossing is not None:
             findings.append(crossing)
     corners = tight_corners(drawn, side.inside, r, options.tolerance)

@@ -302,6 +302,22 @@ def _curl_posted(offset: str) -> tuple[Any, Any]:
     return job, said
 
 
+def test_a_hole_that_crosses_itself_is_said_to_be_offset_inside() -> None:
+    # The curl as a hole of a 40 mm square: an outside profile cuts the hole on its inside
+    # (the even-odd nesting), so the finding names the inside offset, as the tool runs
+    points = [(0, 0), (30, 0), (30, 30), (10, 30), (10, 10), (20, 10), (20, 20), (0, 20)]
+    square = _polygon([(0.0, 0.0), (40.0, 0.0), (40.0, 40.0), (0.0, 40.0)], "square")
+    curl = _polygon([(x + 5.0, y + 5.0) for x, y in points], "curl")
+    job = post_drawing(
+        Drawing((square, curl)), load_target("grbl"), PlanOptions(offset="outside", tool_diameter=1)
+    )
+    assert job.plan is not None
+    (said,) = [f for f in job.plan.findings if f.kind == "self-crossing"]
+    assert "the inside offset follows the boundary of the area it encloses" in said.message
+    _, alone = _curl_posted("outside")  # the curl alone is a part: cut on its outside
+    assert "the outside offset follows the boundary" in alone.message
+
+
 def test_a_contour_that_crosses_itself_is_said_and_its_loops_set_apart() -> None:
     # A closed outline that curls into itself: (0,0) (30,0) (30,30) (10,30) (10,10)
     # (20,10) (20,20) (0,20), moved by (5, 5); its last edge crosses the one down from
