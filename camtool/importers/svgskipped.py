@@ -29,9 +29,9 @@ def count_skipped(root: ET.Element, hold: ET.Element, counts: Counter[str]) -> N
     ``<hatch>``, counts as ``pattern``: camtool cuts the shape's outline, not the lines or
     dots the pattern paints inside it (matplotlib's hatched bars).
 
-    And a drawn ``<use>`` of another file's element (``use-file``). Text and images a
-    ``<use>`` places (from a ``<symbol>`` or a group in ``<defs>``) count once per
-    ``<use>``; each element placed is walked once
+    And a drawn ``<use>`` of another file's element (``use-file``). Text, images, markers
+    and pattern-filled shapes a ``<use>`` places (from a ``<symbol>`` or a group in
+    ``<defs>``) count once per ``<use>``; each element placed is walked once
     (:func:`~camtool.importers.svgdoc.check_use_cycles` has run).
     """
     ids = {e.get("id"): e for e in root.iter() if e.get("id")}
@@ -42,12 +42,12 @@ def count_skipped(root: ET.Element, hold: ET.Element, counts: Counter[str]) -> N
     patterns = _drawing_patterns(ids)
 
     def placed_by_use(target: ET.Element) -> Counter[str]:
-        """The text, images and markers a ``<use>`` of ``target`` draws (a symbol: its children)."""
+        """The text, images, markers and pattern fills a ``<use>`` of ``target`` draws."""
         found = placed.get(target)
         if found is None:
             found = Counter()
             walk(target if local_name(target) == "symbol" else [target], True, found)
-            kinds = ("text", "image", "marker")
+            kinds = ("text", "image", "marker", "pattern")
             found = placed[target] = Counter({k: found[k] for k in kinds if found[k]})
         return found
 

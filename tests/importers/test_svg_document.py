@@ -790,11 +790,13 @@ def test_the_shapes_a_pattern_fills_are_counted(tmp_path: Path) -> None:
         '<rect x="40" y="0" width="5" height="5" fill="url(#empty) red"/>'  # red: cut
         '<rect x="60" y="0" width="5" height="5" fill="url(#blank) red"/>'  # paints nothing
         '<rect x="50" y="0" width="5" height="5" fill="red" style="fill:url(#h) none"/>'
+        '<defs><rect id="r" width="2" height="2" fill="url(#h)"/></defs>'
+        '<use href="#r" x="70"/><use href="#r" x="80"/>'  # a viewer draws the stripes twice
     )
     drawing = read_svg(svg(tmp_path, body))
-    assert len(drawing.contours) == 6  # the outlines, not the pattern's lines nor rect x=60
+    assert len(drawing.contours) == 8  # the outlines, not the pattern's lines nor rect x=60
     assert drawing.warnings == (
-        f"{tmp_path / 't.svg'}: skipped the pattern fill of 3 shapes (a viewer fills them "
+        f"{tmp_path / 't.svg'}: skipped the pattern fill of 5 shapes (a viewer fills them "
         "with the pattern's lines or shapes; camtool cuts the outline only: Inkscape's "
         "Object > Pattern > Pattern to Objects makes them shapes)",
         f"{tmp_path / 't.svg'}: skipped 1 element with neither fill nor stroke",  # x=60
