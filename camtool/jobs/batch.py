@@ -710,7 +710,8 @@ def _outputs(task: BatchTask, options: BatchOptions, job: PostJob) -> tuple[Batc
     files: list[tuple[str, str | bytes]] = [(task.code_path, job.result.code)]
     if job.pieces:  # a target that cannot change tools: one program per tool
         files = [(piece.path(task.code_path), piece.result.code) for piece in job.pieces]
-    earlier = earlier_pieces(task.code_path, [path for path, _ in files])  # left by --force
+    written = [path for path, _ in files]  # without --force, any earlier one was refused
+    earlier = earlier_pieces(task.code_path, written) if options.force else None
     warnings = job.warnings + ((earlier,) if earlier else ())
     error_um: float | None = None
     # at programmed feeds, where the machine runs them; else known only by simulating
