@@ -27,6 +27,7 @@ from camtool.jobs.selection import (
     Chaining,
     Selected,
     Shape,
+    as_chained,
     construction_notes,
     nothing_selected,
     select,
@@ -308,7 +309,7 @@ def run_job(
         alike = [(w, paths) for o, w, paths in cut if _cuts_alike(o, op)]
         try:
             planned = _plan_operation(
-                chosen.drawing, op, tool, options, target, here, where, progress, alike
+                as_chained(chosen).drawing, op, tool, options, target, here, where, progress, alike
             )
         except (InputError, ToolpathError, UsageError) as exc:
             if job.shorthand or not job.source:
@@ -448,16 +449,17 @@ def _chaining(drawing: Drawing, scaled: Drawing, joint_mm: float, close_gap: flo
 
     def shapes(contours: Sequence[Contour]) -> list[Shape]:
         joined, members = chain_members([as_scaled[id(c)] for c in contours], joint_mm)
-        joined = as_cut(joined, close_gap, joint_mm)[0]  # a line drawn twice: one open line
+        cut = as_cut(joined, close_gap, joint_mm)[0]  # a line drawn twice: one open line
         out = [Shape(False, None)] * len(contours)
-        for chain, pieces in zip(joined, members, strict=True):
+        for drawn, chain, pieces in zip(joined, cut, members, strict=True):
             circle = None
             if circle_of(chain) is not None:  # its pieces are arcs of one centre and radius
                 first = contours[pieces[0]].segments[0]
                 assert isinstance(first, Arc)
                 circle = (first.centre, 2.0 * first.radius)
+            shape = Shape(chain.closed, circle, drawn if chain.closed else None)
             for i in pieces:
-                out[i] = Shape(chain.closed, circle)
+                out[i] = shape
         return out
 
     return shapes
@@ -481,6 +483,7 @@ def _as_scaled(chosen: Selected, drawing: Drawing, scaled: Drawing) -> Selected:
             tuple(marks[id(m)] for m in picked.marks),
         ),
         tuple(contours[id(c)] for c in chosen.construction),
+        chosen.chains,  # made of the scaled contours already
     )
 
 

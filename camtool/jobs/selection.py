@@ -28,10 +28,14 @@ class Selected:
     Attributes:
         drawing: the contours and marks it cuts (the drawing's source and warnings kept).
         construction: the construction contours its selection held but leaves uncut.
+        chains: for each of ``drawing.contours``, the closed chain it is a piece of as the
+            selection chained it (:attr:`Shape.chain`), or ``None``; empty when the
+            selection chained nothing. :func:`as_chained` cuts those chains.
     """
 
     drawing: Drawing
     construction: tuple[Contour, ...] = ()
+    chains: tuple[Contour | None, ...] = ()
 
 
 def construction_reason(contour: Contour, selection: Selection) -> str | None:
@@ -64,11 +68,13 @@ class Shape:
 
     ``closed``: the chain is closed (a square of four LINEs is); ``circle``: the chain is
     a whole circle (two ARCs of one centre and radius are), its centre and diameter in the
-    drawing's own mm, else ``None``.
+    drawing's own mm, else ``None``; ``chain``: the closed chain itself, as the drawing is
+    placed (after ``scale``/``fit``, mm), its gaps not yet closed, else ``None``.
     """
 
     closed: bool
     circle: Circle | None
+    chain: Contour | None = None
 
 
 def matches(contour: Contour, selection: Selection, shape: Shape | None = None) -> bool:
@@ -162,7 +168,33 @@ def select(drawing: Drawing, selection: Selection, chaining: Chaining | None = N
             construction.append(contour)
     marks = tuple(m for m in drawing.marks if mark_matches(m, selection))
     chosen = Drawing(tuple(kept), drawing.source, drawing.warnings, marks)
-    return Selected(chosen, tuple(construction))
+    chains = tuple(shapes[id(c)].chain for c in kept) if shapes else ()
+    return Selected(chosen, tuple(construction), chains)
+
+
+def as_chained(selected: Selected) -> Selected:
+    """``selected`` with each closed chain the selection found in place of its pieces.
+
+    Where more than two ends meet, chaining depends on what else is there: the layer's
+    open lines that end at a vertex two loops share steer which way each loop goes on.
+    The selection chained the operation's whole layer (as ``job init`` does, to tell a
+    part from its holes); the planner, given only the pieces of closed chains, could join
+    them otherwise (two loops that touch into one figure, a hole into its part). Given
+    the chains themselves, closed, it cuts them as they were selected. Each chain takes
+    the place of its first piece; contours in no closed chain stay as they are.
+    """
+    if not any(selected.chains):
+        return selected
+    contours: list[Contour] = []
+    seen: set[int] = set()
+    for contour, chain in zip(selected.drawing.contours, selected.chains, strict=True):
+        if chain is None:
+            contours.append(contour)
+        elif id(chain) not in seen:
+            seen.add(id(chain))
+            contours.append(chain)
+    drawing = dataclasses.replace(selected.drawing, contours=tuple(contours))
+    return Selected(drawing, selected.construction)
 
 
 def nothing_selected(drawing: Drawing, op: Operation, where: str) -> str:
