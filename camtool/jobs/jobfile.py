@@ -35,6 +35,7 @@ from camtool.jobs.job import (
     Tool,
 )
 from camtool.model.errors import InputError, UsageError
+from camtool.model.tomlfile import as_toml
 from camtool.toolpath.options import MAX_TOOL_DIAMETER_MM, PLACEMENTS, PlanOptions, flag
 
 _JOB_KEYS: dict[str, str] = {
@@ -149,7 +150,7 @@ def _setup(table: Mapping[str, Any], source: str, overrides: Mapping[str, object
     sequence = table.get("sequence", "file")
     if sequence not in SEQUENCES:
         raise InputError(
-            f"{source}: [job] sequence = {sequence!r}; choose one of {', '.join(SEQUENCES)}"
+            f"{source}: [job] sequence = {as_toml(sequence)}; choose one of {', '.join(SEQUENCES)}"
         )
     plan = _plan(values, source, "[job]")
     return Setup(plan=plan, sequence=sequence)
@@ -237,7 +238,7 @@ def _operation(
     tab_keys = [k for k in ("tabs", "tab_width", "tab_height") if k in row]
     if tab_keys and kind != "drill" and side != "outside":
         article = "an" if kind == "engrave" else "a"
-        what = f"a profile with side = {side!r}" if side else f"{article} {kind} operation"
+        what = f"a profile with side = {as_toml(side)}" if side else f"{article} {kind} operation"
         raise InputError(
             f"{source}: {where}: {', '.join(tab_keys)}: tabs hold a part on an outside "
             f"profile only, and this is {what}; remove "
@@ -316,7 +317,7 @@ def _selection(row: Mapping[str, Any], kind: str, source: str, where: str) -> Se
         linetypes = [linetypes]
     closed = row.get("closed")
     if closed is not None and not isinstance(closed, bool):
-        raise InputError(f"{source}: {where} closed = {closed!r}; give true or false")
+        raise InputError(f"{source}: {where} closed = {as_toml(closed)}; give true or false")
     # a drill drills the points unless it selects by a contour's shape (only the circles of
     # a diameter, say: `camtool job init` gives one drill per hole size), which no point has
     shaped = any(row.get(key) is not None for key in ("diameter", "closed", "linetypes"))
@@ -324,7 +325,7 @@ def _selection(row: Mapping[str, Any], kind: str, source: str, where: str) -> Se
     alone = points == "only"  # the points, no contour: where they share a layer with outlines
     if not (isinstance(points, bool) or alone):
         raise InputError(
-            f'{source}: {where} points = {points!r}; give true, false or "only" (the points '
+            f'{source}: {where} points = {as_toml(points)}; give true, false or "only" (the points '
             "alone, no contour)"
         )
     given = [key for key in ("diameter", "except_diameter", "closed", "linetypes") if key in row]
@@ -353,7 +354,8 @@ def _diameters(value: Any, source: str, where: str) -> tuple[float, float] | Non
     if isinstance(value, list):
         if len(value) != 2:
             raise InputError(
-                f"{source}: {where} diameter = {value!r}; give one diameter or [min, max] in mm"
+                f"{source}: {where} diameter = {as_toml(value)}; "
+                "give one diameter or [min, max] in mm"
             )
         lo = _number(value[0], source, f"{where} diameter", low=0.0, high=MAX_DRAWN_DIAMETER_MM)
         hi = _number(value[1], source, f"{where} diameter", low=0.0, high=MAX_DRAWN_DIAMETER_MM)
@@ -367,7 +369,7 @@ def _diameters(value: Any, source: str, where: str) -> tuple[float, float] | Non
 def _colour(value: Any, source: str, where: str) -> str:
     """A colour as ``#rrggbb``: an ACI number (DXF), a CSS name or ``#rrggbb``."""
     if isinstance(value, bool):
-        raise InputError(f"{source}: {where} colours: {value!r} is not a colour")
+        raise InputError(f"{source}: {where} colours: {as_toml(value)} is not a colour")
     if isinstance(value, int):
         if not 1 <= value <= 255:
             raise InputError(
@@ -382,7 +384,7 @@ def _colour(value: Any, source: str, where: str) -> str:
         if rgb is not None:
             return rgb
     raise InputError(
-        f"{source}: {where} colours: {value!r} is not a colour; give a DXF colour number "
+        f"{source}: {where} colours: {as_toml(value)} is not a colour; give a DXF colour number "
         "(1 red, 2 yellow, 3 green, 4 cyan, 5 blue, 6 magenta, 7 white), a name or #rrggbb"
     )
 
@@ -461,11 +463,13 @@ def _value(value: Any, fieldname: str, source: str, where: str) -> object:
     default = PlanOptions.__dataclass_fields__[fieldname].default
     if fieldname in ("translate", "end_position", "fit"):
         if not (isinstance(value, list) and len(value) == 2):
-            raise InputError(f"{source}: {where} = {value!r}; give two numbers, [x, y] in mm")
+            raise InputError(
+                f"{source}: {where} = {as_toml(value)}; give two numbers, [x, y] in mm"
+            )
         return (_number(value[0], source, where), _number(value[1], source, where))
     if fieldname in ("fit_arcs", "reverse_open"):
         if not isinstance(value, bool):
-            raise InputError(f"{source}: {where} = {value!r}; give true or false")
+            raise InputError(f"{source}: {where} = {as_toml(value)}; give true or false")
         return value
     if fieldname == "tabs":
         return _int(value, source, where, 0, 1000)
@@ -503,10 +507,10 @@ def _number(
     if value is None and required:
         raise InputError(f"{source}: {where} is missing; give a number")
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise InputError(f"{source}: {where} = {value!r}; give a number")
+        raise InputError(f"{source}: {where} = {as_toml(value)}; give a number")
     number = float(value)
     if not math.isfinite(number):
-        raise InputError(f"{source}: {where} = {value!r}; give a finite number")
+        raise InputError(f"{source}: {where} = {as_toml(value)}; give a finite number")
     if not low <= number <= high:
         raise InputError(f"{source}: {where} = {number:g} is outside {low:g}…{high:g}")
     return number
@@ -534,7 +538,7 @@ def _int(
     if value is None and required:
         raise InputError(f"{source}: {where} is missing; give a whole number")
     if isinstance(value, bool) or not isinstance(value, int):
-        raise InputError(f"{source}: {where} = {value!r}; give a whole number")
+        raise InputError(f"{source}: {where} = {as_toml(value)}; give a whole number")
     if not low <= value <= high:
         raise InputError(f"{source}: {where} = {value} is outside {low}…{high}")
     return value
@@ -542,7 +546,7 @@ def _int(
 
 def _text(value: Any, source: str, where: str) -> str:
     if not isinstance(value, str):
-        raise InputError(f"{source}: {where} = {value!r}; give a text in quotes")
+        raise InputError(f"{source}: {where} = {as_toml(value)}; give a text in quotes")
     if len(value) > 200 or any(not c.isprintable() for c in value):
         raise InputError(f"{source}: {where}: give a short text on one line")
     return value
@@ -550,7 +554,7 @@ def _text(value: Any, source: str, where: str) -> str:
 
 def _names(values: Any, source: str, where: str) -> tuple[str, ...]:
     if not isinstance(values, list) or not values:
-        raise InputError(f"{source}: {where} = {values!r}; give a list of names")
+        raise InputError(f"{source}: {where} = {as_toml(values)}; give a list of names")
     return tuple(_text(v, source, where) for v in values)
 
 
@@ -561,8 +565,10 @@ def _choice(
         raise InputError(f"{source}: {where} is missing; choose one of {', '.join(choices)}")
     if value not in choices:
         hint = difflib.get_close_matches(str(value), choices, n=1)
-        mean = f" (did you mean {hint[0]!r}?)" if hint else ""
-        raise InputError(f"{source}: {where} = {value!r}{mean}; choose one of {', '.join(choices)}")
+        mean = f" (did you mean {as_toml(hint[0])}?)" if hint else ""
+        raise InputError(
+            f"{source}: {where} = {as_toml(value)}{mean}; choose one of {', '.join(choices)}"
+        )
     return str(value)
 
 

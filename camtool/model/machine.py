@@ -19,7 +19,7 @@ from typing import Any
 
 from camtool.model.errors import InputError
 from camtool.model.shapes import BBox
-from camtool.model.tomlfile import SMALL_TOML_BYTES, read_toml_file
+from camtool.model.tomlfile import SMALL_TOML_BYTES, as_toml, read_toml_file
 
 ROUNDINGS = ("half_even", "half_up", "floor", "trunc")
 """mm → steps rounding rules (:func:`camtool.verify.quantize.steps_from_mm`)."""
@@ -294,12 +294,12 @@ class _Reader:
 
     def __init__(self, table: Mapping[str, Any], path: str, where: str) -> None:
         if not isinstance(table, Mapping):
-            raise InputError(f"{where}: {path} must be a table, got {table!r}")
+            raise InputError(f"{where}: {path} must be a table, got {as_toml(table)}")
         self.data, self.path, self.where = table, path, where
         self.seen: set[str] = set()
 
     def _fail(self, key: str, want: str, value: Any) -> InputError:
-        return InputError(f"{self.where}: {self.path}.{key} must be {want}, got {value!r}")
+        return InputError(f"{self.where}: {self.path}.{key} must be {want}, got {as_toml(value)}")
 
     def _get(self, key: str, required: bool) -> Any:
         self.seen.add(key)

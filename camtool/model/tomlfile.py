@@ -9,6 +9,9 @@ deeper than such a file needs (tomllib recurses per level).
 
 from __future__ import annotations
 
+import datetime
+import json
+import math
 import os
 import re
 import stat
@@ -91,3 +94,36 @@ def read_toml_file(path: str | Path, *, what: str, limit_bytes: int) -> dict[str
         raise InputError(f"{name}: the {what} is not valid TOML ({exc})") from None
     except RecursionError:
         raise InputError(f"{name}: the {what} nests arrays or tables too deeply") from None
+
+
+def as_toml(value: object) -> str:
+    """``value`` as a TOML file writes it, for messages that quote a key's value.
+
+    ``true``/``false``, a string in double quotes (JSON's escapes, which TOML's basic
+    strings share; DEL escaped), ``inf``/``nan``, arrays in brackets, tables inline, dates
+    in ISO 8601 (TOML 1.0): ``side = false`` is quoted as written, not as Python's ``False``.
+    """
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return _toml_string(value)
+    if isinstance(value, float) and not math.isfinite(value):
+        return "nan" if math.isnan(value) else ("inf" if value > 0 else "-inf")
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(as_toml(v) for v in value) + "]"
+    if isinstance(value, dict):
+        pairs = (f"{_toml_key(str(k))} = {as_toml(v)}" for k, v in value.items())
+        return "{ " + ", ".join(pairs) + " }" if value else "{}"
+    if isinstance(value, datetime.date | datetime.time):
+        return value.isoformat()
+    return str(value)
+
+
+def _toml_key(key: str) -> str:
+    """A key bare when TOML allows it, else quoted."""
+    return key if re.fullmatch(r"[A-Za-z0-9_-]+", key) else _toml_string(key)
+
+
+def _toml_string(text: str) -> str:
+    """A TOML basic string: JSON's escapes, and DEL escaped too (TOML forbids it bare)."""
+    return json.dumps(text, ensure_ascii=False).replace("\x7f", "\\u007f")

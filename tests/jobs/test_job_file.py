@@ -156,7 +156,11 @@ def test_auto_sequence_drills_first_and_cuts_the_outline_last(tmp_path: Path) ->
     ("change", "message"),
     [
         (("depth = 6.0", "dept = 6.0"), r"unknown key 'dept'; did you mean 'depth'\?"),
-        (('side = "outside"', 'side = "outsid"'), r"did you mean 'outside'\?"),
+        (('side = "outside"', 'side = "outsid"'), r'side = "outsid" \(did you mean "outside"\?\)'),
+        # quoted as the file writes it, not as Python's False or ['a', 'b']
+        (('side = "outside"', "side = false"), r"side = false; choose one of outside"),
+        (('side = "outside"', 'side = ["on"]'), r'side = \["on"\]; choose one of outside'),
+        (("tabs = 3", "tabs = true"), r"tabs = true; give a whole number"),
         (("tool = 2", "tool = 7"), r"uses tool 7, which \[\[tools\]\] does not define"),
         (("diameter = 3.0", "diameter = -3.0"), r"tool 1 diameter = -3 mm"),
         (
@@ -167,18 +171,18 @@ def test_auto_sequence_drills_first_and_cuts_the_outline_last(tmp_path: Path) ->
             ("feed = 500", "feed = 5e6"),
             r"tool 1 feed = 5e\+06 mm/min; give a value > 0 and at most 1e\+06",
         ),
-        (("depth = 6.0", 'depth = "6"'), r"depth = '6'; give a number"),
+        (("depth = 6.0", 'depth = "6"'), r'depth = "6"; give a number'),
         (("tabs = 3", "tabs = 3.5"), r"tabs = 3.5; give a whole number"),
         (("step_down = 2.0", "step_down = -2.0"), r"step_down must be > 0 mm"),
         (("[job]", "[jobs]"), r"unknown key 'jobs'; did you mean 'job'\?"),
         (("id = 2", "id = 1"), r"two tools with id 1"),
-        (('peck = "chip-break"', 'peck = "chip"'), r"peck = 'chip'"),
+        (('peck = "chip-break"', 'peck = "chip"'), r'peck = "chip"'),
         (("depth = 6.5", "depth = 6.5\ntabs = 2"), r"tabs does not apply to drilling"),
         (("depth = 6.5", "depth = 6.5\ntab_height = 1"), r"tab_height does not apply to drill"),
         (
             ('side = "outside"', 'side = "inside"'),
             r"operation 1: tabs: tabs hold a part on an outside profile only, and this is a "
-            r"profile with side = 'inside'; remove it here",
+            r'profile with side = "inside"; remove it here',
         ),
         (
             (
