@@ -295,7 +295,7 @@ class _Driver:
                     why = self.plan.hooks.firmware and self.plan.hooks.firmware(line)
                     if why:
                         raise LinkError(f"{spec.target}: {why}; nothing was sent")
-                    if line.startswith(spec.banner) or (wake and self._status_of(line)):
+                    if _is_banner(line, spec.banner) or (wake and self._status_of(line)):
                         self.wire.put_back(got[n + 1 :])
                         return True
                     self.messages.append(line)
@@ -653,7 +653,7 @@ class _Driver:
             banner = False
             while not banner and self.clock.monotonic() < deadline:
                 for line in self.wire.lines(POLL_S, "stopping (reset)"):
-                    banner = banner or (bool(spec.banner) and line.startswith(spec.banner))
+                    banner = banner or (bool(spec.banner) and _is_banner(line, spec.banner))
                     if not banner:
                         self._take(line)
         except LinkError:
@@ -763,3 +763,12 @@ class _Driver:
                     f"it had left plus {self.spec.response_timeout_s:g} s"
                 )
             self.clock.sleep(STATUS_PERIOD_S)
+
+
+def _is_banner(line: str, banner: str) -> bool:
+    """Whether ``line`` starts with the link's ``banner``, case ignored.
+
+    GRBL's forks spell their name their own way: ``Grbl 1.1h``, ``GrblHAL 1.1f``,
+    ``grblHAL 1.1f``, FluidNC's ``Grbl 3.7`` and ``GrblHal 3.4``.
+    """
+    return line.casefold().startswith(banner.casefold())

@@ -448,3 +448,25 @@ def test_a_pause_no_one_resumes_stops_the_job_at_the_pause(simulate: Any) -> Non
     received = [b.decode() for b in sim.device.blocks]
     assert received[-1] == "M0\n" or "M0\n" in received
     assert lines_run(sim.device) <= 13
+
+
+class _GrblHal(GrblDevice):
+    """grblHAL as it starts (grblHAL core report.c): ``GrblHAL 1.1f ['$' or '$HELP' for
+    help]``; its status reports and answers are GRBL 1.1's."""
+
+    def _banner(self) -> bytes:
+        return b"\r\nGrblHAL 1.1f ['$' or '$HELP' for help]\r\n"
+
+
+def test_grblhal_s_banner_starts_the_job() -> None:
+    # taken for GRBL's banner: the job starts on it, not after the banner's time is out and
+    # a status query answers, with the banner passed on as a message of the controller
+    device = _GrblHal(link_spec(load_target("grbl")), target=load_target("grbl"))
+    server = PtyServer(device, block_delay_s=0.0005)
+    server.start()
+    try:
+        result = run(server.path, PROGRAM)
+    finally:
+        server.stop()
+    assert bytes(device.received) == PROGRAM.encode()
+    assert result.messages == ()
