@@ -349,6 +349,8 @@ def scaling(drawing: Drawing, options: PlanOptions) -> tuple[float, float, float
     """
     if options.fit is None:
         return (options.scale, 0.0, 0.0)
+    if not drawing.contours and not drawing.marks:  # nothing to size: refused as not cut
+        return (1.0, 0.0, 0.0)
     x0, y0, _, _ = box = fit_extent(drawing)  # construction (centre lines, a border) aside
     k = fit_factor(box, options.fit)
     if math.isinf(k):

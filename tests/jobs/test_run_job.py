@@ -398,6 +398,11 @@ def test_a_drawing_of_points_only_is_drilled_by_a_job_and_refused_by_a_profile(
         in (capsys.readouterr().err)
     )
     assert not out.exists()
+    # --fit has nothing to size (no drill drills the points): the same refusal, not a bbox
+    # of nothing as an internal error
+    assert main(["post", str(dxf), "-t", "grbl", "--fit", "100", "100", "-o", str(out)]) == 3
+    assert "the options select nothing" in capsys.readouterr().err
+    assert not out.exists()
 
 
 def test_the_one_operation_shorthand_runs_the_same_path(tmp_path: Path) -> None:
