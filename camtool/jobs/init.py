@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from camtool.geometry.chain import chain_members, joint_distance
-from camtool.jobs.init_holes import around_note, around_smaller, smallest_at
+from camtool.jobs.init_holes import around_note, around_smaller, hole_sizes, smallest_at
 from camtool.jobs.init_mills import Parts, mill_between, mill_that_fits
 from camtool.jobs.init_mills import why as _why
 from camtool.jobs.job import MAX_TOOLS, Selection
@@ -395,8 +395,8 @@ def _ops_of(
     if not kept:
         return []
     out: list[_Op] = []
-    circles: dict[float, list[float]] = {}  # by the diameter to 1 µm: every diameter
-    around: Counter[float] = Counter()  # drawn around a smaller circle: by that key, and 0.0
+    drilled: list[tuple[float, bool]] = []  # each circle drilled: diameter, drawn around a smaller
+    around: Counter[float] = Counter()  # drawn around a smaller circle: by hole size, and 0.0
     profiled: list[Contour] = []
     opened: list[Contour] = []
     shaper = _shaper_cut(group.key)
@@ -410,13 +410,13 @@ def _ops_of(
         if online:
             opened.append(contour)
         elif drill and circle is not None and 0.0 < round(circle[1], 3) <= DRILL_MAX_MM:
-            circles.setdefault(round(circle[1], 3), []).append(circle[1])
-            around[round(circle[1], 3)] += around_smaller(*circle, smallest)
+            drilled.append((circle[1], around_smaller(*circle, smallest)))
         elif contour.closed:
             profiled.append(contour)
             around[0.0] += circle is not None and around_smaller(*circle, smallest)
         else:
             opened.append(contour)
+    circles = hole_sizes(drilled, around)
     for d, exact in sorted(circles.items()):
         span = (_drawn(min(exact), k), _drawn(max(exact), k))
         out.append(_drill_op(select, what, d, span, thickness, len(exact), around[d]))

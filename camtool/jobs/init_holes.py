@@ -1,4 +1,4 @@
-"""``camtool job init``'s circles drawn around a smaller circle at their centre.
+"""``camtool job init``'s drilled circles: their hole sizes, and circles drawn around a smaller one.
 
 A plan view draws a counterbore as two circles about one centre (the hole and the
 counterbore), and a tapped hole by its drill circle and the thread's outer diameter
@@ -11,7 +11,8 @@ Design notes: docs/internals.md, ``camtool/jobs/init.py``.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections import Counter
+from collections.abc import Iterable, Sequence
 
 from camtool.model.shapes import Point
 
@@ -54,3 +55,32 @@ def around_note(count: int, cut: str, which: str = "of them") -> str:
         f"thread's outer diameter, drawn in plan?): {cut} through the stock here; if so, give "
         "them an operation of their own with its depth"
     )
+
+
+HOLE_SIZE_GAP_MM = 0.0005
+"""Circles whose diameters lie closer than this (mm) to the next are one hole size."""
+
+
+def hole_sizes(
+    drilled: Sequence[tuple[float, bool]], around: Counter[float]
+) -> dict[float, list[float]]:
+    """The drilled circles' diameters (mm) by hole size, each size its diameter to 1 µm.
+
+    Sorted diameters closer than :data:`HOLE_SIZE_GAP_MM` to their neighbour are one size
+    (named by their median, rounded to 1 µm): two circles of 1.33349 and 1.33351 mm, which
+    an exporter's floats put either side of a rounding, are one hole drilled by one drill,
+    and two sizes' selections never take each other's circles. ``around`` counts, by size,
+    the circles drawn around a smaller circle.
+    """
+    sizes: dict[float, list[float]] = {}
+    runs: list[list[tuple[float, bool]]] = []
+    for hole in sorted(drilled):
+        if runs and hole[0] - runs[-1][-1][0] < HOLE_SIZE_GAP_MM:
+            runs[-1].append(hole)
+        else:
+            runs.append([hole])
+    for run in runs:
+        d = round(run[len(run) // 2][0], 3)
+        sizes.setdefault(d, []).extend(diameter for diameter, _ in run)
+        around[d] += sum(drawn_around for _, drawn_around in run)
+    return sizes

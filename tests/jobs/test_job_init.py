@@ -65,6 +65,27 @@ def test_a_layer_of_holes_only_is_cut_on_their_inside(tmp_path: Path) -> None:
     ]
 
 
+def test_circles_of_one_size_either_side_of_a_rounding_are_one_drill(tmp_path: Path) -> None:
+    # Fritzing's gEDA footprints (CAPPR-508P-450D): two pins of ø1.3335 mm whose floats fall
+    # either side of 1.3335, rounded to 1 µm as 1.333 and 1.334: one hole size, drilled once
+    def build(msp: object) -> None:
+        msp.add_circle((10, 10), 1.33349 / 2, dxfattribs={"layer": "PINS"})  # type: ignore[attr-defined]
+        msp.add_circle((15.08, 10), 1.33351 / 2, dxfattribs={"layer": "PINS"})  # type: ignore[attr-defined]
+        msp.add_circle((20, 10), 0.8, dxfattribs={"layer": "PINS"})  # type: ignore[attr-defined]
+
+    drawing = read_drawing(write_dxf(tmp_path / "pins.dxf", build))
+    text = initial_job(drawing, thickness_mm=1.6)
+    drills = [op for op in _ops(text) if op["type"] == "drill"]
+    assert len(drills) == 2 and len(tomllib.loads(text)["tools"]) == 2
+    job = job_from_dict(tomllib.loads(text), source="pins.toml")
+    done = run_job(drawing, load_target("linuxcnc"), job)
+    assert not [w for w in done.warnings if "again" in w]
+    bottoms = [(m.x, m.y) for m in done.program.moves if isinstance(m, Linear) and m.z == -2.1]
+    # each hole once (work zero at the lower-left hole's centre: the job's origin)
+    assert [x for x, _ in sorted(bottoms)] == pytest.approx([0.0, 5.08, 10.0])
+    assert [y for _, y in bottoms] == [0.0, 0.0, 0.0]
+
+
 def test_a_part_on_a_drawing_sheet_is_cut_outside_not_inside_the_sheets_border(
     tmp_path: Path,
 ) -> None:
