@@ -17,7 +17,7 @@ from typing import Any
 
 from camtool.geometry.chain import chain_members, joint_distance
 from camtool.jobs.init_holes import around_note, around_smaller, hole_sizes, smallest_at
-from camtool.jobs.init_mills import Parts, mill_between, mill_that_fits
+from camtool.jobs.init_mills import END_MILLS_MM, Parts, mill_between, mill_that_fits
 from camtool.jobs.init_mills import why as _why
 from camtool.jobs.job import MAX_TOOLS, Selection
 from camtool.jobs.selection import circle_of, construction_reason
@@ -126,15 +126,26 @@ def initial_job(
     else:
         ops.extend(_marks(drawing, thickness_mm))
     if not any(not op.commented for op in ops):
-        raise InputError(_nothing_to_cut(drawing, left))
+        raise InputError(_nothing_to_cut(drawing, left, ops))
     return _render(
         ops, left, thickness_mm, tool_diameter, source or drawing.source, (*fit, *gap), no_z
     )
 
 
-def _nothing_to_cut(drawing: Drawing, left: Counter[str]) -> str:
-    """Why ``job init`` writes no job: every contour is construction, or there is none."""
+def _nothing_to_cut(drawing: Drawing, left: Counter[str], ops: Sequence[_Op] = ()) -> str:
+    """Why ``job init`` writes no job: no tool fits, every contour is construction, or none is."""
     about = f"{drawing.source or 'the drawing'}: nothing to cut"
+    unfit = [  # operations commented out as no end mill fits: their tool lines say why
+        f"{op.lines[3]}: {line.split('  # ', 1)[1].split(': no common')[0]}"  # its selection
+        for op in ops
+        for line in op.lines
+        if line.startswith("tool =") and ": no common end mill fits" in line
+    ]
+    if unfit:
+        return (
+            f"{about} with a common end mill (the smallest {min(END_MILLS_MM):g} mm): "
+            f"{'; '.join(unfit)}; write a job naming a tool that fits (docs/jobs.md)"
+        )
     if left:
         return (
             f"{about}: every contour is construction "

@@ -86,6 +86,26 @@ def test_circles_of_one_size_either_side_of_a_rounding_are_one_drill(tmp_path: P
     assert [y for _, y in bottoms] == [0.0, 0.0, 0.0]
 
 
+def test_pockets_no_common_end_mill_fits_are_named_not_called_no_contour(tmp_path: Path) -> None:
+    # pads 0.3 mm wide (a footprint's, Fritzing's SparkFun-QFN20) on a layer whose name says
+    # pocket: the smallest end mill job init knows is 0.5 mm, so its guess stays commented
+    # and no job is written; the refusal says why, not that the drawing has no contour
+    def build(msp: object) -> None:
+        for x in (0.0, 1.2):
+            msp.add_lwpolyline(  # type: ignore[attr-defined]
+                [(x, 0), (x + 0.3, 0), (x + 0.3, 0.65), (x, 0.65)],
+                close=True,
+                dxfattribs={"layer": "POCKETS"},
+            )
+
+    with pytest.raises(InputError) as caught:
+        initial_job(read_drawing(write_dxf(tmp_path / "pads.dxf", build)))
+    message = str(caught.value)
+    assert "has no contour" not in message
+    assert "nothing to cut with a common end mill (the smallest 0.5 mm)" in message
+    assert 'layers = ["POCKETS"]: all 2 pockets are narrower than the 3 mm end mill' in message
+
+
 def test_a_part_on_a_drawing_sheet_is_cut_outside_not_inside_the_sheets_border(
     tmp_path: Path,
 ) -> None:
