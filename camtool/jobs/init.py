@@ -65,6 +65,7 @@ class _Op:
     tool: float  # diameter, mm; a drill's is its hole's
     lines: tuple[str, ...]
     commented: bool = False
+    unfit: str = ""  # why no common end mill fits its contours (it stays commented out)
 
 
 def initial_job(
@@ -135,12 +136,7 @@ def initial_job(
 def _nothing_to_cut(drawing: Drawing, left: Counter[str], ops: Sequence[_Op] = ()) -> str:
     """Why ``job init`` writes no job: no tool fits, every contour is construction, or none is."""
     about = f"{drawing.source or 'the drawing'}: nothing to cut"
-    unfit = [  # operations commented out as no end mill fits: their tool lines say why
-        f"{op.lines[3]}: {line.split('  # ', 1)[1].split(': no common')[0]}"  # its selection
-        for op in ops
-        for line in op.lines
-        if line.startswith("tool =") and ": no common end mill fits" in line
-    ]
+    unfit = [f"{op.lines[3]}: {op.unfit}" for op in ops if op.unfit]  # by its selection line
     if unfit:
         return (
             f"{about} with a common end mill (the smallest {min(END_MILLS_MM):g} mm): "
@@ -407,7 +403,7 @@ def _ops_of(
         return []
     out: list[_Op] = []
     drilled: list[tuple[float, bool]] = []  # each circle drilled: diameter, drawn around a smaller
-    around: Counter[float] = Counter()  # drawn around a smaller circle: by hole size, and 0.0
+    around: Counter[float] = Counter()  # profiled circles drawn around a smaller circle (0.0)
     profiled: list[Contour] = []
     opened: list[Contour] = []
     shaper = _shaper_cut(group.key)
@@ -427,10 +423,12 @@ def _ops_of(
             around[0.0] += circle is not None and around_smaller(*circle, smallest)
         else:
             opened.append(contour)
-    circles = hole_sizes(drilled, around)
+    sizes = hole_sizes(drilled)
+    circles = {d: [diameter for diameter, _ in holes] for d, holes in sizes.items()}
     for d, exact in sorted(circles.items()):
         span = (_drawn(min(exact), k), _drawn(max(exact), k))
-        out.append(_drill_op(select, what, d, span, thickness, len(exact), around[d]))
+        inside = sum(drawn_around for _, drawn_around in sizes[d])
+        out.append(_drill_op(select, what, d, span, thickness, len(exact), inside))
     if profiled:
         op = _profile_op(select, what, profiled, outer, thickness, tool, group.key)
         if around[0.0]:
@@ -563,10 +561,11 @@ def _profile_op(
     else:
         why = f"{what} holds holes of a part only: cut on their inside"
     mill: float | None
+    unfit = ""
     if has_outer:
         mill, tool_line = mill_between([c for c in contours if id(c) in outer], parts, tool)
     else:
-        mill, tool_line = mill_that_fits(contours, tool)
+        mill, tool_line, unfit = mill_that_fits(contours, tool)
     lines = [
         f"name = {_quote(key)}",
         'type = "profile"',
@@ -594,7 +593,7 @@ def _profile_op(
                 ).lstrip()
             )
     if mill is None:  # no end mill fits: a guess the user must finish
-        return _Op(f"profile {side}", tool, tuple(lines), commented=True)
+        return _Op(f"profile {side}", tool, tuple(lines), commented=True, unfit=unfit)
     return _Op(f"profile {side}", mill, tuple(lines))
 
 
@@ -624,7 +623,7 @@ def _pocket_op(
 
     At half the stock, or ``given``: Shaper's depth, mm.
     """
-    mill, tool_line = mill_that_fits(contours, tool, "pocket")
+    mill, tool_line, unfit = mill_that_fits(contours, tool, "pocket")
     depth = given or thickness / 2
     lines = (
         f"name = {_quote(key)}",
@@ -635,7 +634,7 @@ def _pocket_op(
         + _why("Shaper's cut depth" if given else "half the stock: set the pocket's depth"),
         f"step_down = {min(mill or tool, depth):g}" + _why("at most a tool diameter"),
     )
-    return _Op("pocket", mill or tool, lines, commented=mill is None)
+    return _Op("pocket", mill or tool, lines, commented=mill is None, unfit=unfit)
 
 
 TAB_WIDTH_MM = 2.0

@@ -11,7 +11,6 @@ Design notes: docs/internals.md, ``camtool/jobs/init.py``.
 
 from __future__ import annotations
 
-from collections import Counter
 from collections.abc import Iterable, Sequence
 
 from camtool.model.shapes import Point
@@ -61,18 +60,16 @@ HOLE_SIZE_GAP_MM = 0.0005
 """Circles whose diameters lie closer than this (mm) to the next are one hole size."""
 
 
-def hole_sizes(
-    drilled: Sequence[tuple[float, bool]], around: Counter[float]
-) -> dict[float, list[float]]:
-    """The drilled circles' diameters (mm) by hole size, each size its diameter to 1 µm.
+def hole_sizes(drilled: Sequence[tuple[float, bool]]) -> dict[float, list[tuple[float, bool]]]:
+    """The drilled circles by hole size, each size its diameter (mm) to 1 µm.
 
+    ``drilled``: each circle's diameter, mm, and whether it is drawn around a smaller one.
     Sorted diameters closer than :data:`HOLE_SIZE_GAP_MM` to their neighbour are one size
     (named by their median, rounded to 1 µm): two circles of 1.33349 and 1.33351 mm, which
     an exporter's floats put either side of a rounding, are one hole drilled by one drill,
-    and two sizes' selections never take each other's circles. ``around`` counts, by size,
-    the circles drawn around a smaller circle.
+    and two sizes' selections never take each other's circles.
     """
-    sizes: dict[float, list[float]] = {}
+    sizes: dict[float, list[tuple[float, bool]]] = {}
     runs: list[list[tuple[float, bool]]] = []
     for hole in sorted(drilled):
         if runs and hole[0] - runs[-1][-1][0] < HOLE_SIZE_GAP_MM:
@@ -80,7 +77,5 @@ def hole_sizes(
         else:
             runs.append([hole])
     for run in runs:
-        d = round(run[len(run) // 2][0], 3)
-        sizes.setdefault(d, []).extend(diameter for diameter, _ in run)
-        around[d] += sum(drawn_around for _, drawn_around in run)
+        sizes.setdefault(round(run[len(run) // 2][0], 3), []).extend(run)
     return sizes

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from functools import cached_property
-from typing import Any
+from typing import Any, NamedTuple
 
 from camtool.model.shapes import Contour, Point
 from camtool.model.units import fmt_point
@@ -28,9 +28,19 @@ WIDTH_TOLERANCE_MM = 0.01
 """How closely a hole's width (its largest inscribed circle) is measured, mm."""
 
 
-def mill_that_fits(
-    contours: Sequence[Contour], tool: float, noun: str = "hole"
-) -> tuple[float | None, str]:
+class MillFit(NamedTuple):
+    """What :func:`mill_that_fits` answers.
+
+    ``diameter``: the end mill, mm (``None``: no common one fits); ``line``: its ``tool =``
+    line; ``unfit``: when none fits, why (which contours, how narrow), else ``""``.
+    """
+
+    diameter: float | None
+    line: str
+    unfit: str = ""
+
+
+def mill_that_fits(contours: Sequence[Contour], tool: float, noun: str = "hole") -> MillFit:
     """The end mill for a layer of holes (or pockets) and its ``tool =`` line.
 
     ``noun``: what the comment calls them (``"pocket"`` for a layer of pockets, whose
@@ -51,7 +61,7 @@ def mill_that_fits(
     ]
     narrow = [w for w in widths if w < tool]
     if not narrow:
-        return tool, "tool = {end-mill}"
+        return MillFit(tool, "tool = {end-mill}")
     least = min(narrow)
     if len(widths) == 1:
         said = f"the {noun} is narrower than the {tool:g} mm end mill (about {least:.3g} mm wide)"
@@ -63,13 +73,13 @@ def mill_that_fits(
         )
     fits = [d for d in END_MILLS_MM if d <= FIT_MARGIN * least]
     if not fits:
-        return None, "tool = {end-mill}" + why(
-            f"{said}: no common end mill fits; give this operation a tool that does, then "
-            "uncomment it"
-        )
+        advice = "no common end mill fits; give this operation a tool that does, then uncomment it"
+        return MillFit(None, "tool = {end-mill}" + why(f"{said}: {advice}"), said)
     mill = fits[-1]
     them = "it" if len(widths) == 1 else "them"
-    return mill, f"tool = {{end-mill {mill:g}}}" + why(f"{said}: a {mill:g} mm one cuts {them}")
+    return MillFit(
+        mill, f"tool = {{end-mill {mill:g}}}" + why(f"{said}: a {mill:g} mm one cuts {them}")
+    )
 
 
 class Parts:
