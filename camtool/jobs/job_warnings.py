@@ -18,7 +18,7 @@ if TYPE_CHECKING:
 
 def unselected(
     drawing: Drawing,
-    runs: Sequence[OperationRun],
+    selected: Sequence[Contour],
     construction: Sequence[Contour],
     joint_mm: float,
     cut: Sequence[Contour] = (),
@@ -26,6 +26,8 @@ def unselected(
 ) -> list[str]:
     """One line per layer of the contours no operation selects (construction said apart).
 
+    ``selected``: the contours of ``drawing`` the operations select (the pieces, as drawn:
+    an operation may cut the chains they make, :func:`~camtool.jobs.selection.as_chained`).
     They are counted as chained ``joint_mm`` apart at most, gaps up to ``close_gap`` closed
     (as the planner would cut them): four LINEs of an open outline are one open contour.
     A chain on the path of one of ``cut`` (the operations' contours as planned: a fill
@@ -37,7 +39,7 @@ def unselected(
     from camtool.toolpath.chain import as_cut
     from camtool.toolpath.copies import drop_copies
 
-    taken = {id(c) for r in runs for c in r.placed.contours}
+    taken = {id(c) for c in selected}
     taken |= {id(c) for c in construction}
     left: dict[str, list[Contour]] = {}
     for contour in drawing.contours:

@@ -347,7 +347,7 @@ def run_job(
         notes.extend(
             unselected(
                 scaled,
-                runs,
+                [c for _, chosen in selections_scaled for c in chosen.drawing.contours],
                 list(construction.values()),
                 joint,
                 [p for *_, ps in cut for p in ps],

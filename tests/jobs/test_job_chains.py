@@ -18,6 +18,9 @@ from __future__ import annotations
 import math
 import re
 from pathlib import Path
+from typing import Any
+
+import pytest
 
 from camtool.cli.main import main
 from tests.shapes import write_dxf
@@ -80,3 +83,24 @@ def test_the_hole_touching_its_part_where_a_line_ends_is_cut_inside(tmp_path: Pa
     diamond = {(round(x, 3), round(y, 3)) for x, y in tips}
     assert diamond <= points
     assert {(-1.5, 100.0), (101.5, 0.0)} <= points  # the square's sides, offset outside
+
+
+def test_a_circle_drawn_as_two_arcs_and_drilled_is_not_called_uncut(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the drill cuts the circle the selection chained of the two ARCs; neither ARC is left
+    # over for the job's "not cut" note
+    def build(msp: Any) -> None:
+        msp.add_arc((10, 10), 3, 0, 180)
+        msp.add_arc((10, 10), 3, 180, 360)
+
+    drawing = write_dxf(tmp_path / "hole.dxf", build)
+    job = tmp_path / "job.toml"
+    job.write_text(
+        '[job]\norigin = "drawing"\n[[tools]]\nid = 1\ntype = "drill"\ndiameter = 6\n'
+        '[[operations]]\ntype = "drill"\ntool = 1\ndiameter = 6\ndepth = 3\n'
+    )
+    out = tmp_path / "hole.ngc"
+    assert main(["post", str(drawing), "-t", "linuxcnc", "--job", str(job), "-o", str(out)]) == 0
+    assert "not cut" not in capsys.readouterr().err
+    assert "G0 X10.000 Y10.000" in out.read_text()
