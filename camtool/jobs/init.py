@@ -133,7 +133,7 @@ def initial_job(
     )
 
 
-def _nothing_to_cut(drawing: Drawing, left: Counter[str], ops: Sequence[_Op] = ()) -> str:
+def _nothing_to_cut(drawing: Drawing, left: Counter[str], ops: Sequence[_Op]) -> str:
     """Why ``job init`` writes no job: no tool fits, every contour is construction, or none is."""
     about = f"{drawing.source or 'the drawing'}: nothing to cut"
     unfit = [f"{op.lines[3]}: {op.unfit}" for op in ops if op.unfit]  # by its selection line

@@ -64,32 +64,8 @@ RUNS = 2
 
 EXPECTED_SHA256 = "e2737cbefa070279b5dcad8d760dafb6fe8cd926c4ff941ba4fef53f319e8db1"
 """sha256 of ``camtool post tango-213.svg --target grbl`` output as last recorded: whether
-it changed is informative only (the tests judge a change by its tolerance). It moved from
-``1962563a…`` (89 215 blocks) on 29 Nov 2026 when a layer named ``Text`` stopped being
-construction (the icons' 249 shapes on such layers are now cut, as vpype draws them too:
-92 876 blocks, ``9b65769e…``), then when a contour on the path of another (an icon's
-outline drawn over its own fill) began to be cut once (91 224 blocks, ``030b9790…``), and
-again when a contour that runs out and back on one path (two copies of an open path
-chained end to end: six in the icons, such as ``i191``'s paperclip drawn as ``path7053``
-and ``path7057``) began to be cut one way, and copies began to be found by their lowest
-vertex rather than their box on a grid (one more found: ``i58-path1935``): 91 103 blocks
-(``b5048daf…``). Then copies began to be compared with their runs of collinear lines and
-of arcs on one circle joined: one more found (``i210-path13297``, a circle of two arcs
-over ``i210-path13295``): 4 484 cuts instead of 4 485, still 91 103 blocks (the travel
-order changed with it, and with it which moves between cuts rise to clearance:
-``3de9da73…``). Then the spindle began to start after the first rise to clearance: its
-``M3 S1000`` and ``G0 Z5.000`` change places, no other byte (``c91d9fb1…``). Then a closed
-contour within 10 µm of another all along began to be cut once: 18 found (a grey fill and
-its gradient-filled twin 0.03 px off in each of the weather icons ``i205``-``i212``, 9.1 µm
-at the page's scale; ``i174-path13``, 3 µm; ``i57-path1935``, 0.1 µm): 4 466 cuts, 90 757
-blocks (``4adc0881…``). Then a contour touching another's edge from inside (within 0.2 µm
-of its chord polygon: shapes sharing an edge, 87 of the icons' contours, such as
-``i9-path4194`` along ``i9-rect4174``) began to be inside it: the same 4 466 cuts, in a
-travel order that cuts these inside first, 90 754 blocks (``2b29d356…``). Then the
-environment was installed again (numpy 2.4.6, shapely 2.2.0, svgelements 1.9.6, ezdxf 1.4.5,
-numba 0.68.1): the code of ``f0ef829``, whose run found ``2b29d356…``, writes
-``e2737cbe…`` (90 749 lines) in it, as the code after it does: the environment changed these
-bytes, not a commit."""
+it changed is informative only (the tests judge a change by its tolerance). Why each
+recorded value changed: docs/performance.md, "The SVG row's recorded output"."""
 
 SVG_NS = "http://www.w3.org/2000/svg"
 XLINK_NS = "http://www.w3.org/1999/xlink"
