@@ -149,6 +149,10 @@ def test_an_unknown_keyword_names_the_valid_ones(
     ("make", "message"),
     [
         (lambda: PlanOptions(tool_diameter=-3.0), "--tool-diameter must be ≥ 0 mm, got -3.0"),
+        (
+            lambda: PlanOptions(offset="outside", tool_diameter=1e-300),
+            "--tool-diameter 1e-300 mm is less than 0.001 mm: no cutter is that narrow",
+        ),
         (lambda: PlanOptions(depth=math.nan), "--depth must be a finite number, got nan"),
         (lambda: PlanOptions(feed_mm_min=-1.0), "--feed must be > 0 mm/min"),
         (lambda: PlanOptions(placement="centre"), "unknown --origin 'centre'; choose one of"),

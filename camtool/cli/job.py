@@ -18,6 +18,7 @@ from camtool.cli.common import (
     write_output,
 )
 from camtool.model.errors import UsageError
+from camtool.toolpath.options import MIN_TOOL_DIAMETER_MM
 
 
 @click.group()
@@ -46,7 +47,7 @@ def job() -> None:
 )
 @click.option(
     "--tool-diameter",
-    type=number_range(min=0, min_open=True, max=100),
+    type=number_range(min=MIN_TOOL_DIAMETER_MM, max=100),
     default=3.0,
     show_default=True,
     metavar="MM",

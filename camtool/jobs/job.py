@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 from camtool.model.errors import UsageError
 from camtool.model.keywords import checked_keywords
-from camtool.toolpath.options import MAX_TOOL_DIAMETER_MM, PlanOptions
+from camtool.toolpath.options import MAX_TOOL_DIAMETER_MM, MIN_TOOL_DIAMETER_MM, PlanOptions
 
 TOOL_TYPES = ("end-mill", "drill", "v-bit", "engraver")
 """Valid values of ``Tool.type``."""
@@ -56,7 +56,8 @@ class Tool:
     Attributes:
         id: the T number (≥ 0).
         type: one of :data:`TOOL_TYPES`.
-        diameter: cutting diameter, mm (> 0).
+        diameter: cutting diameter, mm: 0 (no tool: its centre on the drawing) or
+            ``MIN_TOOL_DIAMETER_MM``…``MAX_TOOL_DIAMETER_MM``.
         name: what the operator loads, for comments (``""``: from type and diameter).
         rpm: spindle speed, rev/min (``None``: the target's).
         feed_mm_min: cutting feed, mm/min (``None``: the target's).
@@ -81,6 +82,11 @@ class Tool:
                 f"unknown Tool.type {self.type!r}; choose one of {', '.join(TOOL_TYPES)}"
             )
         _check_number("Tool.diameter", self.diameter, "mm", low=0.0, high=MAX_TOOL_DIAMETER_MM)
+        if 0 < self.diameter < MIN_TOOL_DIAMETER_MM:
+            raise UsageError(
+                f"Tool.diameter {self.diameter:g} mm is less than {MIN_TOOL_DIAMETER_MM:g} mm: "
+                "no cutter is that narrow (0: no tool, its centre on the drawing)"
+            )
         for name in ("rpm", "feed_mm_min", "plunge_feed_mm_min"):
             value = getattr(self, name)
             if value is not None:

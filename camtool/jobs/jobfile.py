@@ -36,7 +36,13 @@ from camtool.jobs.job import (
 )
 from camtool.model.errors import InputError, UsageError
 from camtool.model.tomlfile import as_toml
-from camtool.toolpath.options import MAX_TOOL_DIAMETER_MM, PLACEMENTS, PlanOptions, flag
+from camtool.toolpath.options import (
+    MAX_TOOL_DIAMETER_MM,
+    MIN_TOOL_DIAMETER_MM,
+    PLACEMENTS,
+    PlanOptions,
+    flag,
+)
 
 _JOB_KEYS: dict[str, str] = {
     "origin": "placement",
@@ -178,10 +184,10 @@ def _tools(rows: Any, source: str) -> tuple[Tool, ...]:
             raise InputError(f"{source}: two tools with id {number}; give each tool its own id")
         kind = _choice(row.get("type", "end-mill"), TOOL_TYPES, source, f"{where} type")
         diameter = _number(row.get("diameter"), source, f"{where} diameter", required=True)
-        if not 0 < diameter <= MAX_TOOL_DIAMETER_MM:
+        if not MIN_TOOL_DIAMETER_MM <= diameter <= MAX_TOOL_DIAMETER_MM:
             raise InputError(
                 f"{source}: {where} diameter = {diameter:g} mm; give the tool's cutting "
-                "diameter in mm (> 0)"
+                f"diameter in mm ({MIN_TOOL_DIAMETER_MM:g}…{MAX_TOOL_DIAMETER_MM:g})"
             )
         tools[number] = Tool(
             id=number,

@@ -286,6 +286,12 @@ class PlanOptions:
                 f"--tool-diameter {self.tool_diameter:g} mm is more than "
                 f"{MAX_TOOL_DIAMETER_MM:g} mm: no cutter is that wide; check the value and its unit"
             )
+        if 0 < self.tool_diameter < MIN_TOOL_DIAMETER_MM:
+            raise UsageError(
+                f"--tool-diameter {self.tool_diameter:g} mm is less than "
+                f"{MIN_TOOL_DIAMETER_MM:g} mm: no cutter is that narrow; check the value and "
+                "its unit (0 means no tool: its centre follows the drawing)"
+            )
         if self.offset != "on" and self.tool_diameter <= 0:
             raise UsageError(f"--offset {self.offset} needs --tool-diameter MM (> 0)")
         if self.feed_mm_min is not None and self.feed_mm_min <= 0:
@@ -433,6 +439,11 @@ MAX_SCALE = 1e6
 
 MAX_TOOL_DIAMETER_MM = 1000.0
 """Largest tool diameter (mm) an option or a job's tool may give: wider than any cutter."""
+
+MIN_TOOL_DIAMETER_MM = 0.001
+"""Smallest tool diameter (mm) an option or a job's tool may give, 0 (no tool) aside: 1 µm,
+narrower than any cutter; far below it the offset kernels lose a half-diameter in the
+coordinates' float precision and call a region narrower than the tool."""
 
 MIN_TOLERANCE_MM = 1e-6
 """Smallest ``--tolerance`` (mm): chords and fitted arcs finer than 1 nm only cost time."""

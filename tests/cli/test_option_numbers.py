@@ -222,6 +222,19 @@ def test_post_names_the_option_of_a_tool_wider_than_any_cutter(
     assert not out.exists()
 
 
+def test_post_refuses_a_tool_narrower_than_any_cutter(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a half-diameter of 5e-301 mm is lost in the offset's float arithmetic: the plate's
+    # outline was called "narrower than the tool" and left out, with exit 0
+    out = tmp_path / "p.nc"
+    args = ["--tool-diameter", "1e-300", "--offset", "outside"]
+    assert main(["post", str(SAMPLES / "plate.dxf"), "-t", "grbl", "-o", str(out), *args]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("camtool: error: --tool-diameter 1e-300 mm is less than 0.001 mm")
+    assert not out.exists()
+
+
 @pytest.mark.parametrize(
     ("field", "value", "said"),
     [

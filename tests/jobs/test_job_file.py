@@ -163,6 +163,8 @@ def test_auto_sequence_drills_first_and_cuts_the_outline_last(tmp_path: Path) ->
         (("tabs = 3", "tabs = true"), r"tabs = true; give a whole number"),
         (("tool = 2", "tool = 7"), r"uses tool 7, which \[\[tools\]\] does not define"),
         (("diameter = 3.0", "diameter = -3.0"), r"tool 1 diameter = -3 mm"),
+        # far below 1 µm, an offset's half-diameter is lost in the coordinates' precision
+        (("diameter = 3.0", "diameter = 1e-300"), r"tool 1 diameter = 1e-300 mm; .*0\.001…1000"),
         (
             ("feed = 500", "feed = 1e308"),
             r"feed = 1e\+308 mm/min; give a value > 0 and at most 1e\+06",
