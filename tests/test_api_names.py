@@ -150,6 +150,10 @@ def test_an_unknown_keyword_names_the_valid_ones(
     [
         (lambda: PlanOptions(tool_diameter=-3.0), "--tool-diameter must be ≥ 0 mm, got -3.0"),
         (
+            lambda: PlanOptions(pocket_angle_deg=1e300),
+            "--pocket-angle is an angle within ±360 degrees from +X, got 1e+300",
+        ),
+        (
             lambda: PlanOptions(offset="outside", tool_diameter=1e-300),
             "--tool-diameter 1e-300 mm is less than 0.001 mm: no cutter is that narrow",
         ),

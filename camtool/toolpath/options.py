@@ -312,6 +312,12 @@ class PlanOptions:
             raise UsageError(
                 f"--stepover is a fraction of the tool diameter in (0, 1], got {self.stepover!r}"
             )
+        if abs(self.pocket_angle_deg) > 360:
+            # 1e300 % 180 is a number, but not one the user chose
+            raise UsageError(
+                f"--pocket-angle is an angle within ±360 degrees from +X, got "
+                f"{self.pocket_angle_deg!r}"
+            )
         if self.lead_in < 0:
             raise UsageError(f"--lead-in must be ≥ 0 mm, got {self.lead_in!r}")
         if self.lead_in > 0 and self.offset in ("on", "pocket"):
