@@ -518,12 +518,12 @@ def _target_from_table(
     built = machine_from_table(machine, where=where_machine)
     _check_z_word(post, built, where, where_machine)
     return Target(
-        name=str(table.get("name", Path(where).stem)),
-        description=str(table.get("description", "")),
+        name=_text(table, "name", where, Path(where).stem),
+        description=_text(table, "description", where, ""),
         post=post,
         machine=built,
         default_feed_mm_min=_number(table, "default_feed_mm_min", where, 100.0),
-        source=str(table.get("source", "")),
+        source=_text(table, "source", where, ""),
         spindle_rpm=_number(table, "spindle_rpm", where, None),
         origin=origin,
         motion_hook=motion,
@@ -552,6 +552,21 @@ def _check_z_word(post: PostProcessor, machine: Machine, where: str, where_machi
         "writes no Z word: give the dialect a Z word (z_moves and a Z in [dialect_options."
         "words]) or set has_z = false for a machine whose depth is set by hand"
     )
+
+
+def _text(table: Mapping[str, Any], key: str, where: str, default: str) -> str:
+    """A target file's ``name``, ``description`` or ``source``: one printable line of text.
+
+    Raises:
+        InputError: not a string (``name = 1e308`` was written as ``1e+308``), or a control
+            character in it (a line break would end the message that names the target).
+    """
+    value = table.get(key, default)
+    if not isinstance(value, str) or not value.isprintable() or (key == "name" and not value):
+        raise InputError(
+            f"{where}: {key} must be one line of printable text in quotes, not {value!r}"
+        )
+    return value
 
 
 def _number(table: Mapping[str, Any], key: str, where: str, default: Any) -> Any:

@@ -49,6 +49,11 @@ TARGET_EDITS = {
     ('modal = ["F"]', 'modal = ["\uff26"]'): "modal",
     # a spindle below 1 rev/min does not turn: GRBL read "M3 S0" from 1e-300
     ("spindle_rpm = 1000.0", "spindle_rpm = 1e-300 #"): "spindle_rpm",
+    # the name was written with str(): "wrote 35 blocks for 1e+308"
+    ('name = "grbl"', "name = 1e308"): "name must be one line of printable text",
+    # a line break in what the messages name the target by
+    ('name = "grbl"', 'name = "grbl\\nM3"'): "name must be one line of printable text",
+    ('description = "GRBL 1.1 controller', 'description = ["x"] #'): "description must be one line",
 }
 
 
