@@ -627,3 +627,19 @@ def _check_static(t: _Table, key: str, code: str, spec: WordAddressSpec, roles: 
         raise t.error(key, 'G90.1 (absolute arc centre) needs arc_centre = "absolute"')
     if code[0] == "G" and value == 91.1 and spec.arc_centre != "incremental":
         raise t.error(key, 'G91.1 (incremental arc centre) needs arc_centre = "incremental"')
+    if code[0] == "G" and value in _UNIT_CODES:
+        unit, per_mm = _UNIT_CODES[value]
+        for letter in "XYZIJK":
+            word = spec.words.get(letter)
+            if word is not None and not math.isclose(word.number.scale, per_mm, rel_tol=1e-9):
+                raise t.error(
+                    key,
+                    f"{code} sets {unit}, but words.{letter} has scale = "
+                    f"{word.number.scale:g} (units written per mm): the controller would read "
+                    f"every {letter} in {unit}, {word.number.scale / per_mm:.4g} times the "
+                    f"distance meant; give that word scale = {per_mm!r}, or the code of its unit",
+                )
+
+
+_UNIT_CODES = {20.0: ("inches", 1.0 / 25.4), 21.0: ("mm", 1.0)}
+"""RS-274's unit codes (G20, G21): the unit and the word scale (units written per mm)."""

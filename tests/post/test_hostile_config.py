@@ -49,6 +49,8 @@ TARGET_EDITS = {
     ('modal = ["F"]', 'modal = ["\uff26"]'): "modal",
     # a spindle below 1 rev/min does not turn: GRBL read "M3 S0" from 1e-300
     ("spindle_rpm = 1000.0", "spindle_rpm = 1e-300 #"): "spindle_rpm",
+    # every X written in mm, read by GRBL in inches: 25.4 times the distance, exit 0
+    ('preamble = ["G21 G90', 'preamble = ["G20 G90'): "G20 sets inches, but words.X has scale = 1",
     # the name was written with str(): "wrote 35 blocks for 1e+308"
     ('name = "grbl"', "name = 1e308"): "name must be one line of printable text",
     # a line break in what the messages name the target by
