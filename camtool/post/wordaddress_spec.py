@@ -623,6 +623,17 @@ def _check_static(t: _Table, key: str, code: str, spec: WordAddressSpec, roles: 
         raise t.error(key, f"{code} is a motion code; the {key} holds setup codes only")
     if code[0] == "G" and value == 91:
         raise t.error(key, "G91 (incremental coordinates): camtool writes absolute coordinates")
+    if code[0] == "G" and value not in _SETUP_G:
+        raise t.error(
+            key,
+            f"{code} is not a setup code camtool can write before its own moves (it would "
+            "change how they are read: a plane, feed mode, compensation, cycle or offset); "
+            f"the {key} may hold {_SETUP_G_TEXT} and M codes",
+        )
+    if code[0] == "M" and value in _FLOW_M:
+        raise t.error(
+            key, f"{code} changes tools or the program's flow; the {key} holds setup codes only"
+        )
     if code[0] == "G" and value == 90.1 and spec.arc_centre != "absolute":
         raise t.error(key, 'G90.1 (absolute arc centre) needs arc_centre = "absolute"')
     if code[0] == "G" and value == 91.1 and spec.arc_centre != "incremental":
@@ -640,6 +651,27 @@ def _check_static(t: _Table, key: str, code: str, spec: WordAddressSpec, roles: 
                     f"distance meant; give that word scale = {per_mm!r}, or the code of its unit",
                 )
 
+
+_SETUP_G = frozenset(
+    {17.0, 20.0, 21.0, 40.0, 43.0, 49.0, 54.0, 55.0, 56.0, 57.0, 58.0, 59.0, 59.1, 59.2, 59.3}
+    | {61.0, 61.1, 64.0, 80.0, 90.0, 90.1, 91.0, 91.1, 94.0, 97.0, 98.0, 99.0}
+    | {8.0, 13.1, 15.0, 50.0, 50.1, 67.0, 69.0}
+)
+"""G codes a preamble or postamble may hold (G91 and the arc-centre modes are checked
+apart): the XY plane, units, feed per minute, absolute distance, work offsets (G54-G59.3),
+path control, tool length offset on (G43) and the cancels (compensation G40, length offset
+G49, cycles G80, polar G15, scaling G50, mirror G50.1, macros G67, rotation G69, polar
+interpolation G13.1, diameter mode G8, constant surface speed G97) and cycle return
+(G98, G99), as LinuxCNC's and Fanuc's G-code lists name them. Refused: another plane
+(G18/G19: camtool's arcs are in XY), inverse-time or per-revolution feed (G93/G95), cutter
+compensation (G41/G42), G92 offsets, diameter mode (G7), polar coordinates (G16), motion
+and cycles."""
+
+_SETUP_G_TEXT = "G17, G20/G21, G40, G43, G49, G54-G59.3, G61/G61.1/G64, G80, G90, G94"
+
+_FLOW_M = frozenset((6.0, 61.0, 98.0, 99.0))
+"""M codes refused in a preamble or postamble: tool change (M6, M61) and subprogram call
+and return (M98, M99: a return in the main program runs it again from its start)."""
 
 _UNIT_CODES = {20.0: ("inches", 1.0 / 25.4), 21.0: ("mm", 1.0)}
 """RS-274's unit codes (G20, G21): the unit and the word scale (units written per mm)."""

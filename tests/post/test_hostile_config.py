@@ -51,6 +51,15 @@ TARGET_EDITS = {
     ("spindle_rpm = 1000.0", "spindle_rpm = 1e-300 #"): "spindle_rpm",
     # every X written in mm, read by GRBL in inches: 25.4 times the distance, exit 0
     ('preamble = ["G21 G90', 'preamble = ["G20 G90'): "G20 sets inches, but words.X has scale = 1",
+    # codes that change how camtool's own blocks are read, written with exit 0: arcs in
+    # the XZ plane, F as inverse time or per revolution, every move offset by the tool
+    # table's radius, a G92 offset restored, a main program run again from its start
+    ('preamble = ["G21 G90 G94 G17"]', 'preamble = ["G21 G90 G17 G18"]'): "G18 is not a setup",
+    ('preamble = ["G21 G90 G94 G17"]', 'preamble = ["G21 G90 G17 G93"]'): "G93 is not a setup",
+    ('preamble = ["G21 G90 G94 G17"]', 'preamble = ["G21 G90 G17 G95"]'): "G95 is not a setup",
+    ('preamble = ["G21 G90 G94 G17"]', 'preamble = ["G21 G90 G17 G41"]'): "G41 is not a setup",
+    ('preamble = ["G21 G90 G94 G17"]', 'preamble = ["G21 G92.3"]'): "G92.3 is not a setup",
+    ('preamble = ["G21 G90 G94 G17"]', 'preamble = ["G21 G90"]\npostamble = ["M99"]'): "M99",
     # the name was written with str(): "wrote 35 blocks for 1e+308"
     ('name = "grbl"', "name = 1e308"): "name must be one line of printable text",
     # a line break in what the messages name the target by
