@@ -438,6 +438,11 @@ def _code(t: _Table, key: str, value: Any) -> str:
     return value
 
 
+def _same_code(code: str, other: str) -> bool:
+    """``G04`` is ``G4``: one letter, one number."""
+    return code[0] == other[0] and float(code[1:]) == float(other[1:])
+
+
 def _codes(t: _Table) -> dict[str, Any]:
     """The code keys: motion codes, spindle, dwell, tool change and end."""
     motion = t.table("motion_codes")
@@ -445,15 +450,27 @@ def _codes(t: _Table) -> dict[str, Any]:
     given = {m: motion.get(m) for m in MOTIONS}
     spelled = tuple(_code(motion, m, defaults[m] if v is None else v) for m, v in given.items())
     motion.done()
-    for m, code in zip(MOTIONS, spelled, strict=True):
-        if not code.startswith("G"):
-            raise motion.error(m, f"a motion code is a G code, got {_show(code)}")
+    for m, code, number in zip(MOTIONS, spelled, range(4), strict=True):
+        # a spelling only: rapid = "G1" cut every rapid at feed and every cut at rapid
+        if not _same_code(code, f"G{number}"):
+            raise motion.error(
+                m, f"the {m} code is G{number} (spelled G{number} or G0{number}), got {_show(code)}"
+            )
     out: dict[str, Any] = {"motion_codes": spelled}
     keys = ("spindle_cw", "spindle_ccw", "spindle_off", "dwell", "tool_change", *COOLANT_KEYS)
     for key in (*keys, "tool_length_offset", "stop", "optional_stop"):
         value = t.get(key)
         out[key] = None if value is None else _code(t, key, value)
+        fixed = _FIXED_G.get(key)
+        code = out[key]
+        if code is not None and fixed is not None and not _same_code(code, fixed):
+            raise t.error(key, f"the {key} code is {fixed}, got {_show(code)}")
+        if code is not None and fixed is None and not code.startswith("M"):
+            raise t.error(key, f"{key} is an M code (a G code moves or sets a mode), got {code}")
     out["end"] = tuple(_code(t, "end", v) for v in t.strings("end"))
+    for code in out["end"]:
+        if not code.startswith("M"):
+            raise t.error("end", f"an end code is an M code (M2, M30), got {_show(code)}")
     out["work_offsets"] = tuple(_code(t, "work_offsets", v) for v in t.strings("work_offsets"))
     for code in out["work_offsets"]:
         if not re.fullmatch(r"G5[4-9](\.[1-3])?", code):
@@ -651,6 +668,10 @@ def _check_static(t: _Table, key: str, code: str, spec: WordAddressSpec, roles: 
                     f"distance meant; give that word scale = {per_mm!r}, or the code of its unit",
                 )
 
+
+_FIXED_G = {"dwell": "G4", "tool_length_offset": "G43"}
+"""The code keys that are G codes, each of one number in every G-code dialect (RS-274,
+LinuxCNC, Fanuc); the other code keys are M codes, whose numbers vary by controller."""
 
 _SETUP_G = frozenset(
     {17.0, 20.0, 21.0, 40.0, 43.0, 49.0, 54.0, 55.0, 56.0, 57.0, 58.0, 59.0, 59.1, 59.2, 59.3}

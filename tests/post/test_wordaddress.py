@@ -131,8 +131,19 @@ def emit(
         ),
         (
             {"words": {"XY": {}}, "motion_codes": {"cw": "M3"}},
-            "motion_codes.cw: a motion code is a G",
+            "motion_codes.cw: the cw code is G2",
         ),
+        (  # a spelling, not a meaning: every rapid at feed, every cut at rapid
+            {"words": {"XY": {}}, "motion_codes": {"rapid": "G1", "linear": "G0"}},
+            'motion_codes.rapid: the rapid code is G0 .spelled G0 or G00., got "G1"',
+        ),
+        (  # every arc the other way round
+            {"words": {"XYIJ": {}}, "motion_codes": {"cw": "G03", "ccw": "G02"}},
+            'motion_codes.cw: the cw code is G2 .spelled G2 or G02., got "G03"',
+        ),
+        ({"words": {"XYP": {}}, "dwell": "G92"}, 'dwell: the dwell code is G4, got "G92"'),
+        ({"words": {"XY": {}}, "spindle_cw": "G5"}, "spindle_cw is an M code"),
+        ({"words": {"XY": {}}, "end": ["G0"]}, "end: an end code is an M code"),
         (
             {"words": {"XY": {}}, "motion_codes": {"cw": 2}},
             "motion_codes.cw: expected a code such as",
