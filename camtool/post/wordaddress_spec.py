@@ -555,12 +555,38 @@ def _number_format(t: _Table) -> NumberFormat:
     return number
 
 
+def _check_arc_grid(spec: WordAddressSpec, t: _Table) -> None:
+    """X and Y write one step, and I and J that step or a whole fraction of it.
+
+    Conformed arcs (:mod:`camtool.post.arcconform`) put an arc's ends and centre on
+    one grid, the coarsest step of X, Y, I and J: ends written more finely than it are
+    off it, and a centre on it must be printable by I and J.
+    """
+    steps = {c: spec.words[c].number.resolution_mm() for c in "XYIJ" if c in spec.words}
+    grid = max(steps.values())
+    ends = [steps[c] for c in "XY" if c in steps]
+    ratios = [grid / steps[c] for c in "IJ"]
+    if all(math.isclose(s, grid, rel_tol=1e-9) for s in ends) and all(
+        abs(r - round(r)) < 1e-6 for r in ratios
+    ):
+        return
+    written = ", ".join(f"{c} {step:g} mm" for c, step in steps.items())
+    raise t.error(
+        "words",
+        f'an arc\'s ends and centre are placed on one grid (arc_check = "{spec.arc_check}"), '
+        f"but the words write {written}: give X and Y one step (decimals, scale, grid_mm), "
+        "and I and J that step or a finer one that divides it",
+    )
+
+
 def _check(spec: WordAddressSpec, t: _Table) -> None:
     """Cross-key rules (each error names the key to change)."""
     if spec.arc_check != "none" or "I" in spec.words or "J" in spec.words:
         for letter in "IJ":
             if letter not in spec.words:
                 raise t.error("words", f"arcs need both I and J words; {letter} is missing")
+        if spec.arc_check != "none":
+            _check_arc_grid(spec, t)
     if spec.has("Z") != (spec.z_moves != "none"):
         want = '"own-block" or "with-xy"' if spec.has("Z") else '"none" (there is no Z word)'
         raise t.error("z_moves", f"expected {want}, got {_show(spec.z_moves)}")

@@ -8,6 +8,7 @@ no stepper makes a million steps per mm, no controller writes 30 decimals.
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 from typing import Any
 
@@ -60,6 +61,11 @@ TARGET_EDITS = {
     ('preamble = ["G21 G90 G94 G17"]', 'preamble = ["G21 G90 G17 G41"]'): "G41 is not a setup",
     ('preamble = ["G21 G90 G94 G17"]', 'preamble = ["G21 G92.3"]'): "G92.3 is not a setup",
     ('preamble = ["G21 G90 G94 G17"]', 'preamble = ["G21 G90"]\npostamble = ["M99"]'): "M99",
+    # arc centres on a coarser grid than the ends: "internal error: the arc start (1.1,
+    # 0.25) is not on the 1.0 mm grid"
+    ("[dialect_options.words.IJK]\ndecimals = 3", "[dialect_options.words.IJK]\ndecimals = 0"): (
+        "but the words write X 0.001 mm, Y 0.001 mm, I 1 mm, J 1 mm"
+    ),
     # the name was written with str(): "wrote 35 blocks for 1e+308"
     ('name = "grbl"', "name = 1e308"): "name must be one line of printable text",
     # a line break in what the messages name the target by
@@ -200,3 +206,15 @@ def test_a_job_tools_speed_that_rounds_to_s0_is_refused(run: Any, tmp_path: Path
     )
     assert code != 0 and "rounds to S0" in err and "the tool's rpm in the job file" in err
     assert "internal error" not in err and not out.exists()
+
+
+def test_arc_centres_finer_than_the_ends_are_written(run: Any, tmp_path: Path) -> None:
+    """Centres at 0.1 µm, ends at 1 µm: each centre on the ends' grid prints exactly."""
+    old = "[dialect_options.words.IJK]\ndecimals = 3"
+    target = tmp_path / "fine.toml"
+    target.write_text(GRBL.replace(old, "[dialect_options.words.IJK]\ndecimals = 4", 1))
+    out = tmp_path / "out.gcode"
+    code, err = run("post", LOGO, "-t", str(target), "--origin", "lower-left", "-o", str(out))
+    assert code == 0, err
+    arcs = re.findall(r"^G[23] .* I-?\d+\.(\d+) J-?\d+\.(\d+)$", out.read_text(), re.M)
+    assert arcs and all(len(i) == len(j) == 4 for i, j in arcs)
