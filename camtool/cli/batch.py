@@ -24,6 +24,7 @@ from camtool.cli.common import (
     plan_settings,
     post_options,
     read_job,
+    refuse_operation_flags,
     write_output,
 )
 from camtool.model.errors import CamtoolError, InputError, UsageError, VerifyLimitError
@@ -118,8 +119,9 @@ def batch(inputs: tuple[str, ...], layers: str | None, verify_too: bool, **optio
     from camtool.jobs.batch_report import batch_report, failure_line, summary_table, unwritten_lines
 
     names = tuple(n.strip() for n in layers.split(",") if n.strip()) if layers else None
-    planning, output = plan_settings(options), output_settings(options)
     job_file = options.pop("job_file")
+    refuse_operation_flags(job_file)
+    planning, output = plan_settings(options), output_settings(options)
     job = None if job_file is None else read_job(job_file, planning)
     settings = BatchOptions(
         layers=names, verify=verify_too, plan=planning, output=output, job=job, **options

@@ -302,6 +302,20 @@ def read_job(path: Path, plan: PlanOptions) -> Job:
     return load_job(path, overrides=shared_overrides(plan, given))
 
 
+def refuse_operation_flags(job_file: Path | None) -> None:
+    """With ``--job``, refuse the per-operation options given, before they are checked.
+
+    Raises:
+        UsageError: ``--offset``, ``--depth``... with ``--job``.
+    """
+    if job_file is None:
+        return
+    from camtool.jobs.jobfile import operation_flags
+    from camtool.jobs.run import refuse_operation_options
+
+    refuse_operation_options(operation_flags(None, given_options()))
+
+
 def given_options() -> frozenset[str]:
     """The parameters of the running command that its command line (or environment) set.
 

@@ -29,6 +29,7 @@ from camtool.cli.common import (
     post_options,
     publishes,
     read_job,
+    refuse_operation_flags,
     say_written,
     warn,
     write_output,
@@ -177,6 +178,7 @@ def post(
     if drawing != "-" and is_program_file(drawing):
         given = drawing_only(options) + (["--job"] if job_file is not None else [])
         refuse_planning(drawing, given)  # before checking them
+    refuse_operation_flags(job_file)
     plan = plan_settings(options)
     job_spec = None if job_file is None else read_job(job_file, plan)
     verifying = bool(verify_too or report or preview or max_error_um is not None)

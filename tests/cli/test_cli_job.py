@@ -100,6 +100,10 @@ def test_a_point_nothing_drills_is_not_judged_against_the_travel(run: Any, tmp_p
         (["--depth", "3"], 2, "--depth: with --job, each operation has its own"),
         (["--offset", "outside", "--tool-diameter", "3"], 2, "--offset, --tool-diameter"),
         (["--feed", "100"], 2, "--feed: with --job"),
+        # refused for the job, not checked as one operation first ("--offset inside needs
+        # --tool-diameter MM", "--tabs need --depth MM")
+        (["--offset", "inside"], 2, "--offset: with --job, each operation has its own"),
+        (["--tabs", "2"], 2, "--tabs: with --job, each operation has its own"),
     ],
 )
 def test_per_operation_options_with_a_job_are_refused(
@@ -109,6 +113,10 @@ def test_per_operation_options_with_a_job_are_refused(
     got, _, err = run("post", PART, "-t", "grbl", "--job", JOB, "-o", str(out), *extra)
     assert got == code and message in err
     assert not out.exists()
+    batch = tmp_path / "batch"
+    got, _, err = run("batch", PART, "-t", "grbl", "--job", JOB, "-o", str(batch), *extra)
+    assert got == code and message in err
+    assert not batch.exists()
 
 
 def test_a_bad_job_file_is_exit_3_and_writes_nothing(run: Any, tmp_path: Path) -> None:
