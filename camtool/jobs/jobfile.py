@@ -308,6 +308,13 @@ def _operation_plan(
                 raise InputError(f"{source}: {where}: {key} does not apply to drilling")
         if values.get("depth") is None:
             raise InputError(f"{source}: {where}: a drill operation needs a depth (mm)")
+    if kind in ("engrave", "profile"):
+        for key in ("stepover", "pocket", "pocket_angle"):
+            if key in row:  # read for nothing: a slip, or an operation meant as a pocket
+                raise InputError(
+                    f"{source}: {where}: {key} applies to a pocket operation, not to this "
+                    f"{kind} operation; remove it here"
+                )
     return _plan(values, source, where)
 
 
@@ -345,7 +352,9 @@ def _selection(row: Mapping[str, Any], kind: str, source: str, where: str) -> Se
         colours=None if colours is None else tuple(_colour(c, source, where) for c in colours),
         closed=closed,
         diameter=_diameters(row.get("diameter"), source, where),
-        except_diameter=_diameters(row.get("except_diameter"), source, where),
+        except_diameter=_diameters(
+            row.get("except_diameter"), source, where, key="except_diameter"
+        ),
         linetypes=None
         if linetypes is None
         else tuple(n.upper() for n in _names(linetypes, source, f"{where} linetypes")),
@@ -354,21 +363,22 @@ def _selection(row: Mapping[str, Any], kind: str, source: str, where: str) -> Se
     )
 
 
-def _diameters(value: Any, source: str, where: str) -> tuple[float, float] | None:
+def _diameters(
+    value: Any, source: str, where: str, *, key: str = "diameter"
+) -> tuple[float, float] | None:
     if value is None:
         return None
     if isinstance(value, list):
         if len(value) != 2:
             raise InputError(
-                f"{source}: {where} diameter = {as_toml(value)}; "
-                "give one diameter or [min, max] in mm"
+                f"{source}: {where} {key} = {as_toml(value)}; give one diameter or [min, max] in mm"
             )
-        lo = _number(value[0], source, f"{where} diameter", low=0.0, high=MAX_DRAWN_DIAMETER_MM)
-        hi = _number(value[1], source, f"{where} diameter", low=0.0, high=MAX_DRAWN_DIAMETER_MM)
+        lo = _number(value[0], source, f"{where} {key}", low=0.0, high=MAX_DRAWN_DIAMETER_MM)
+        hi = _number(value[1], source, f"{where} {key}", low=0.0, high=MAX_DRAWN_DIAMETER_MM)
         if lo > hi:
-            raise InputError(f"{source}: {where} diameter = [{lo:g}, {hi:g}]: min above max")
+            raise InputError(f"{source}: {where} {key} = [{lo:g}, {hi:g}]: min above max")
         return (lo, hi)
-    d = _number(value, source, f"{where} diameter", low=0.0, high=MAX_DRAWN_DIAMETER_MM)
+    d = _number(value, source, f"{where} {key}", low=0.0, high=MAX_DRAWN_DIAMETER_MM)
     return (d, d)
 
 

@@ -163,6 +163,14 @@ def test_auto_sequence_drills_first_and_cuts_the_outline_last(tmp_path: Path) ->
         (("tabs = 3", "tabs = true"), r"tabs = true; give a whole number"),
         (("tool = 2", "tool = 7"), r"uses tool 7, which \[\[tools\]\] does not define"),
         (("diameter = 3.0", "diameter = -3.0"), r"tool 1 diameter = -3 mm"),
+        (  # the key that was refused, not "diameter"
+            ('side = "outside"', 'side = "outside"\nexcept_diameter = [4, 3]'),
+            r"operation 1 except_diameter = \[4, 3\]: min above max",
+        ),
+        (  # read for nothing: the profile has no pocket to step over
+            ('side = "outside"', 'side = "outside"\nstepover = 0.4'),
+            r"operation 1: stepover applies to a pocket operation, not to this profile",
+        ),
         # far below 1 µm, an offset's half-diameter is lost in the coordinates' precision
         (("diameter = 3.0", "diameter = 1e-300"), r"tool 1 diameter = 1e-300 mm; .*0\.001…1000"),
         (
