@@ -210,28 +210,24 @@ def test_a_tool_wider_than_any_cutter_is_refused_by_verify_and_preview(
     assert not (tmp_path / "p.png").exists()
 
 
-def test_post_names_the_option_of_a_tool_wider_than_any_cutter(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+@pytest.mark.parametrize(
+    ("diameter", "said"),
+    [
+        # not: "Tool.diameter must be ≥ 0 and ≤ 1000 mm, got 100000.0" (the job's field)
+        ("1e5", "--tool-diameter 100000 mm is more than 1000 mm"),
+        # a half-diameter of 5e-301 mm is lost in the offset's float arithmetic: the
+        # plate's outline was called "narrower than the tool" and left out, with exit 0
+        ("1e-300", "--tool-diameter 1e-300 mm is less than 0.001 mm"),
+    ],
+)
+def test_post_refuses_a_tool_no_cutter_has_naming_the_option(
+    diameter: str, said: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    # not: "Tool.diameter must be ≥ 0 and ≤ 1000 mm, got 100000.0" (the job's field, not the option)
     out = tmp_path / "p.nc"
-    args = ["--tool-diameter", "1e5", "--offset", "outside"]
+    args = ["--tool-diameter", diameter, "--offset", "outside"]
     assert main(["post", str(SAMPLES / "plate.dxf"), "-t", "grbl", "-o", str(out), *args]) == 2
     err = capsys.readouterr().err
-    assert err.startswith("camtool: error: --tool-diameter 100000 mm is more than 1000 mm")
-    assert not out.exists()
-
-
-def test_post_refuses_a_tool_narrower_than_any_cutter(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    # a half-diameter of 5e-301 mm is lost in the offset's float arithmetic: the plate's
-    # outline was called "narrower than the tool" and left out, with exit 0
-    out = tmp_path / "p.nc"
-    args = ["--tool-diameter", "1e-300", "--offset", "outside"]
-    assert main(["post", str(SAMPLES / "plate.dxf"), "-t", "grbl", "-o", str(out), *args]) == 2
-    err = capsys.readouterr().err
-    assert err.startswith("camtool: error: --tool-diameter 1e-300 mm is less than 0.001 mm")
+    assert err.startswith(f"camtool: error: {said}")
     assert not out.exists()
 
 
