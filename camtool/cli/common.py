@@ -290,20 +290,22 @@ JOB = click.option(
 def read_job(path: Path, plan: PlanOptions) -> Job:
     """The job file at ``path``, with the shared options given on the command line.
 
+    The per-operation options are refused before ``plan`` is made
+    (:func:`refuse_operation_flags`).
+
     Raises:
-        UsageError: a per-operation option (``--depth``, ``--offset``...) was given too.
         InputError: the job file is invalid (:func:`camtool.jobs.jobfile.load_job`).
     """
-    from camtool.jobs.jobfile import load_job, operation_flags, shared_overrides
-    from camtool.jobs.run import refuse_operation_options
+    from camtool.jobs.jobfile import load_job, shared_overrides
 
-    given = given_options()
-    refuse_operation_options(operation_flags(plan, given))
-    return load_job(path, overrides=shared_overrides(plan, given))
+    return load_job(path, overrides=shared_overrides(plan, given_options()))
 
 
 def refuse_operation_flags(job_file: Path | None) -> None:
     """With ``--job``, refuse the per-operation options given, before they are checked.
+
+    Checked together as one operation first, ``--offset inside`` would be refused for
+    wanting a ``--tool-diameter`` rather than for belonging in the job file.
 
     Raises:
         UsageError: ``--offset``, ``--depth``... with ``--job``.
@@ -313,7 +315,7 @@ def refuse_operation_flags(job_file: Path | None) -> None:
     from camtool.jobs.jobfile import operation_flags
     from camtool.jobs.run import refuse_operation_options
 
-    refuse_operation_options(operation_flags(None, given_options()))
+    refuse_operation_options(operation_flags(given_options()))
 
 
 def given_options() -> frozenset[str]:

@@ -627,22 +627,14 @@ def shared_overrides(plan: PlanOptions, given: Collection[str] = ()) -> dict[str
     }
 
 
-def operation_flags(plan: PlanOptions | None, given: Collection[str] = ()) -> list[str]:
-    """The per-operation options of ``plan`` given on the command line (as flags).
+def operation_flags(given: Collection[str]) -> list[str]:
+    """The per-operation options among ``given`` (their flags), as :func:`shared_overrides`.
 
     With ``--job`` these belong in the job file's operations: ``post`` refuses them.
-    ``given`` as for :func:`shared_overrides`; ``plan`` ``None``: the ``given`` ones alone
-    (before the options are checked together: ``--offset inside`` is refused for the
-    job, not for wanting a ``--tool-diameter``).
     """
-    fields = PlanOptions.__dataclass_fields__
     shared = {*SETUP_FIELDS, "origin"}
     return [
         flag(f.name)
         for f in dataclasses.fields(PlanOptions)
-        if f.name not in shared
-        and (
-            f.name in given
-            or (plan is not None and getattr(plan, f.name) != fields[f.name].default)
-        )
+        if f.name not in shared and f.name in given
     ]

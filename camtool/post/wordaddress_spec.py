@@ -714,7 +714,8 @@ interpolation G13.1, diameter mode G8, constant surface speed G97) and cycle ret
 compensation (G41/G42), G92 offsets, diameter mode (G7), polar coordinates (G16), motion
 and cycles."""
 
-_SETUP_G_TEXT = "G17, G20/G21, G40, G43, G49, G54-G59.3, G61/G61.1/G64, G80, G90, G94"
+_SETUP_G_TEXT = ", ".join(f"G{code:g}" for code in sorted(_SETUP_G - {91.0}))
+"""The codes of :data:`_SETUP_G` a message names (G91 is refused apart)."""
 
 _FLOW_M = frozenset((6.0, 61.0, 98.0, 99.0))
 """M codes refused in a preamble or postamble: tool change (M6, M61) and subprogram call
