@@ -7,8 +7,11 @@ an XY block, an arc written as chords...) and words each kind once, after the la
 
 from __future__ import annotations
 
+import itertools
 from collections import Counter
+from collections.abc import Sequence
 
+from camtool.model.program import Program
 from camtool.post.wordaddress_spec import WordAddressSpec
 
 
@@ -75,3 +78,45 @@ def closing_warnings(
             f"{grid_error_mm:.4f} mm"
         )
     return out
+
+
+def rounding_warnings(
+    spec: WordAddressSpec, program: Program, steps_per_mm: Sequence[float], tolerance_mm: float
+) -> list[str]:
+    """A warning when the X and Y words round the toolpath's positions further than it may move.
+
+    A dialect whose X or Y word writes fewer decimals than the tolerance needs (a target
+    file's ``decimals = 0``: whole millimetres) moves each position up to half its step.
+    Where the largest change, measured on the program's moves (``|v − round(v / s)·s|``,
+    ``s`` the word's :meth:`~camtool.post.numfmt.NumberFormat.resolution_mm`), is more than
+    ``tolerance_mm`` and more than half a motor step (the machine cannot stand nearer),
+    the user is told the step and how far. Words on a step grid are warned of by their
+    grid error (:func:`closing_warnings`). Nothing is measured where the step is fine
+    enough (half of it within both limits), so the usual dialects pay nothing.
+
+    Args:
+        spec: the dialect.
+        program: the program written, mm.
+        steps_per_mm: the machine's motor steps per mm, ``(x, y, z)``.
+        tolerance_mm: how far a position may move, mm (``--tolerance``).
+    """
+    words = [spec.words[c].number for c in "XY" if c in spec.words]
+    if not words or any(w.grid_mm is not None for w in words):
+        return []
+    step = max(w.resolution_mm() for w in words)
+    allowed = max(tolerance_mm, 0.5 / min(steps_per_mm[:2]))
+    if not step / 2.0 > allowed or not program.moves:
+        return []
+    import numpy as np
+
+    xy = np.fromiter(itertools.chain.from_iterable((m.x, m.y) for m in program.moves), np.float64)
+    xy = xy[np.isfinite(xy)]
+    change = float(np.abs(xy - np.rint(xy / step) * step).max()) if len(xy) else 0.0
+    if not change > allowed:
+        return []
+    return [
+        f"{spec.name} writes X and Y to {step:g} mm: positions written up to {change:.4f} mm "
+        f"from the toolpath, more than the {tolerance_mm:g} mm tolerance (--tolerance); give "
+        "its X and Y words more decimals (target file: decimals), or check the part with "
+        "--verify"
+    ]

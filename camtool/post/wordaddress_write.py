@@ -48,7 +48,7 @@ from camtool.post.wordaddress_arcs import (
     Conformed,
 )
 from camtool.post.wordaddress_spec import PLANE_CODES
-from camtool.post.wordaddress_summary import closing_warnings
+from camtool.post.wordaddress_summary import closing_warnings, rounding_warnings
 from camtool.post.wordaddress_words import SAME_MM
 
 _MOVES = (Rapid, Linear, ArcMove)
@@ -130,6 +130,12 @@ class BlockWriter(ArcWriter):
         self.blocks.extend(self.spec.footer)
         self.warnings.extend(
             closing_warnings(self.spec, self.counts, self.grid_error_mm, ARC_CHORD_TOLERANCE_MM)
+        )
+        tolerance = program.tolerance_mm
+        if tolerance is None:
+            tolerance = self.machine.motion.chord_tolerance_mm
+        self.warnings.extend(
+            rounding_warnings(self.spec, program, self.machine.steps_per_mm, tolerance)
         )
         if self.blocks:
             self._join_blocks()

@@ -1,0 +1,69 @@
+"""X and Y words coarser than the tolerance: the user is told how far positions moved.
+
+Expected values by analysis: a word of ``decimals = 0`` writes 10.3 as 10 and 15.7 as 16
+(0.3 mm each way) and 20.2 as 20 (0.2 mm); an inch word of 4 decimals steps 0.00254 mm, so
+it moves a position 0.00127 mm at most, under half the 0.0125 mm step of 80 steps/mm.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import ezdxf
+
+from camtool.model.machine import Machine
+from camtool.model.program import Linear, Program, Rapid
+from camtool.post.wordaddress import word_address_dialect
+
+WHOLE_MM: dict[str, Any] = {"words": {"XYIJ": {"decimals": 0}, "F": {"decimals": 0}}}
+"""A dialect writing X, Y, I and J in whole millimetres."""
+
+ROUTER = Machine(name="router", steps_per_mm=(80.0,) * 3, work_area_mm=(0, 0, 300, 300))
+"""80 steps/mm: a step of 0.0125 mm."""
+
+
+def warnings_of(options: dict[str, Any], *moves: Any, tolerance: float = 0.001) -> list[str]:
+    program = Program(tuple(moves), tolerance_mm=tolerance)
+    result = word_address_dialect(options, "toy.toml").emit(program, ROUTER)
+    return [w for w in result.warnings if "writes X and Y" in w]
+
+
+def test_whole_millimetres_say_how_far_the_positions_moved() -> None:
+    said = warnings_of(WHOLE_MM, Rapid(10.3, 20.2), Linear(15.7, 20.2, 300.0))
+    assert len(said) == 1
+    assert "toy writes X and Y to 1 mm: positions written up to 0.3000 mm" in said[0]
+    assert "more than the 0.001 mm tolerance (--tolerance)" in said[0]
+
+
+def test_positions_on_the_step_or_within_the_tolerance_are_not_warned_of() -> None:
+    assert not warnings_of(WHOLE_MM, Rapid(10.0, 20.0), Linear(16.0, 20.0, 300.0))
+    moves = (Rapid(10.3, 20.2), Linear(15.7, 20.2, 300.0))
+    assert not warnings_of(WHOLE_MM, *moves, tolerance=0.5)
+
+
+def test_a_step_under_half_a_motor_step_is_not_warned_of() -> None:
+    inch = 1.0 / 25.4
+    options = {"words": {"XYIJ": {"decimals": 4, "scale": inch}, "F": {"decimals": 1}}}
+    assert not warnings_of(options, Rapid(10.3, 20.2), Linear(15.71, 20.23, 300.0))
+
+
+def test_post_with_a_target_file_of_whole_millimetres_warns(tmp_path: Path, run: Any) -> None:
+    target = tmp_path / "coarse.toml"
+    target.write_text(
+        'name = "coarse"\ndescription = "whole millimetres"\ndialect = "word-address"\n'
+        "[dialect_options.words.XYZIJ]\ndecimals = 0\n"
+        '[machine]\nprofile = "coarse"\nname = "coarse"\nsteps_per_mm = [80.0, 80.0, 80.0]\n'
+        "work_area_mm = [0.0, 0.0, 300.0, 300.0]\n",
+        encoding="utf-8",
+    )
+    doc = ezdxf.new()
+    doc.units = ezdxf.units.MM
+    doc.modelspace().add_lwpolyline([(10.3, 20.2), (15.7, 20.2), (15.7, 25.4)])
+    drawing = tmp_path / "part.dxf"
+    doc.saveas(drawing)
+    out = tmp_path / "part.nc"
+    code, err = run("post", str(drawing), "-t", str(target), "-o", str(out))
+    assert code == 0
+    assert "coarse writes X and Y to 1 mm: positions written up to 0.4000 mm" in err
+    assert "X10 Y20" in out.read_text(encoding="utf-8")
