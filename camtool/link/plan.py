@@ -208,13 +208,10 @@ def prepare_send(
 
     warnings = [*program.warnings, *spec.warnings, *check_area(program, target.machine, source)]
     _check_depth(program, max_depth_mm if max_depth_mm is not None else spec.max_depth_mm, source)
-    verification, move_times = _times(program, target, verify, max_error_um)
-    move_times = _with_z(program, target, move_times)
     frame = hooks.frame or frame_lines
     blocks = frame(data, spec, source)
     if hooks.expect is not None:
         blocks = hooks.expect(blocks, program, target)
-    times = _block_times(blocks, program, move_times)
     first = _first_block(blocks, from_line, source)
     if first and hooks.feedback is not None:
         blocks = _quiet_first_motion(blocks, first)
@@ -222,10 +219,12 @@ def prepare_send(
     if first and hooks.resume is not None:
         restore = hooks.resume(blocks[:first], blocks[first], spec)
     sent: Sequence[WireBlock] = Joined(restore, blocks, first) if first or restore else blocks
+    if hooks.check is not None:  # before the timing, which simulates every step
+        hooks.check(sent, source)
+    verification, move_times = _times(program, target, verify, max_error_um)
+    times = _block_times(blocks, program, _with_z(program, target, move_times))
     sent_times = array("d", [0.0] * len(restore))
     sent_times.extend(times[first:])
-    if hooks.check is not None:
-        hooks.check(sent, source)
     return SendPlan(
         target=target.name,
         spec=spec,

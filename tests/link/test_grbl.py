@@ -388,6 +388,22 @@ def test_a_line_grbl_refuses_is_refused_before_the_first_byte(line: str, simulat
     assert not sim.device.received  # nothing was sent
 
 
+def test_a_refused_line_is_refused_before_the_moves_are_timed(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # The timing simulates every step: a 400 m move at GRBL's 250 steps/mm is 10^8 rows
+    # (2.8 GB), which the refusal of its 9-digit number must not wait for.
+    import camtool.link.plan as plan
+
+    def timed(*args: Any) -> Any:
+        raise AssertionError("the moves were timed before the check")
+
+    monkeypatch.setattr(plan, "_times", timed)
+    code = "G21 G90\nG0 X400000 Y0\nG1 Z-1 F100\nG1 X400000.125\nM2\n"
+    with pytest.raises(InputError, match=r"far\.gcode, line 4: 'G1 X400000\.125'"):
+        prepare_send(code, load_target("grbl"), source="far.gcode")
+
+
 def test_a_refused_line_is_quoted_as_the_file_writes_it() -> None:
     # a no-break space between words (UTF-8 C2 A0): GRBL answers error:1 for the byte C2,
     # which the check sees (one character per byte); the message quoted the Latin-1 reading
