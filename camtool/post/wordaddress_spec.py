@@ -508,6 +508,13 @@ def _modal(t: _Table, words: Mapping[str, WordSpec]) -> frozenset[str]:
     return frozenset(letters) & (frozenset("G") | frozenset(words))
 
 
+POSITION_LETTERS = "XYZIJK"
+"""The words that write a position or an arc centre (mm on the machine)."""
+MAX_POSITION_STEP_MM = 10.0
+"""The coarsest step a position word may write, mm: whole centimetres (a machine's step is
+far finer; a coarser word puts the whole part on a grid wider than its details)."""
+
+
 def _words(t: _Table) -> dict[str, WordSpec]:
     """The ``words`` table; a key of several letters (``XYIJ``) sets each of them."""
     words: dict[str, WordSpec] = {}
@@ -516,6 +523,17 @@ def _words(t: _Table) -> dict[str, WordSpec]:
         if not key or any(c not in WORD_LETTERS for c in key):
             raise t.error(key, f"unknown word; words are among {_show(list(WORD_LETTERS))}")
         number = _number_format(sub)
+        step = number.resolution_mm()
+        if step > MAX_POSITION_STEP_MM and any(c in POSITION_LETTERS for c in key):
+            raise t.error(
+                key,
+                f"scale {number.scale:g} with decimals = {number.decimals}"
+                + ("" if number.grid_mm is None else f" on grid_mm {number.grid_mm:g}")
+                + f" writes a position in steps of {step:g} mm, coarser than "
+                f"{MAX_POSITION_STEP_MM:g} mm: every move would land on that grid; give the "
+                "scale of the unit written (units per mm: 1 for mm, 0.03937 for inches), more "
+                "decimals or the machine's step as grid_mm",
+            )
         for letter in key:
             if letter in words:
                 raise t.error(key, f"word {letter} is defined twice")

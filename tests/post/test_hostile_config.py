@@ -66,6 +66,12 @@ TARGET_EDITS = {
     ("[dialect_options.words.IJK]\ndecimals = 3", "[dialect_options.words.IJK]\ndecimals = 0"): (
         "but the words write X 0.001 mm, Y 0.001 mm, I 1 mm, J 1 mm"
     ),
+    # every position on a grid of kilometres: the part written as moves to X0 Y0, exit 0
+    ("decimals = 3 ", "decimals = 0\nscale = 0.000001 #"): (
+        "words.XYZ: scale 1e-06 with decimals = 0 writes a position in steps of 1e+06 mm, "
+        "coarser than 10 mm"
+    ),
+    ("decimals = 3 ", "decimals = 0\ngrid_mm = 20.0 #"): "on grid_mm 20 writes a position",
     # the name was written with str(): "wrote 35 blocks for 1e+308"
     ('name = "grbl"', "name = 1e308"): "name must be one line of printable text",
     # a line break in what the messages name the target by
@@ -206,6 +212,26 @@ def test_a_job_tools_speed_that_rounds_to_s0_is_refused(run: Any, tmp_path: Path
     )
     assert code != 0 and "rounds to S0" in err and "the tool's rpm in the job file" in err
     assert "internal error" not in err and not out.exists()
+
+
+def test_a_word_of_whole_centimetres_is_taken(run: Any, tmp_path: Path) -> None:
+    """X, Y, I, J, K in whole cm (scale 0.1, 0 decimals): a 10 mm step, the coarsest allowed."""
+    text = GRBL.replace('preamble = ["G21 G90 G94 G17"]', 'preamble = ["G90 G94 G17"]', 1)
+    for old, new in (
+        ("[dialect_options.words.XYZ]\n", "[dialect_options.words.Z]\n"),
+        (
+            "[dialect_options.words.IJK]\ndecimals = 3",
+            "[dialect_options.words.XYIJK]\ndecimals = 0",
+        ),
+    ):
+        assert old in text
+        text = text.replace(old, new, 1)
+    target = tmp_path / "cm.toml"
+    target.write_text(text.replace("decimals = 0", "decimals = 0\nscale = 0.1", 1))
+    out = tmp_path / "out.gcode"
+    code, err = run("post", LOGO, "-t", str(target), "--origin", "lower-left", "-o", str(out))
+    assert code == 0, err
+    assert "cm writes X and Y to 10 mm: positions written up to" in err
 
 
 def test_arc_centres_finer_than_the_ends_are_written(run: Any, tmp_path: Path) -> None:
