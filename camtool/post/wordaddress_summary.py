@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import itertools
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 
 from camtool.model.program import Program
 from camtool.post.wordaddress_spec import WordAddressSpec
@@ -83,15 +83,16 @@ def closing_warnings(
 def rounding_warnings(
     spec: WordAddressSpec, program: Program, steps_per_mm: Sequence[float], tolerance_mm: float
 ) -> list[str]:
-    """A warning when the X and Y words round the toolpath's positions further than it may move.
+    """Warnings when the X and Y, or the Z, words move the program's positions too far.
 
-    A dialect whose X or Y word writes fewer decimals than the tolerance needs (a target
-    file's ``decimals = 0``: whole millimetres) moves each position up to half its step.
-    Where the largest change, measured on the program's moves (``|v − round(v / s)·s|``,
-    ``s`` the word's :meth:`~camtool.post.numfmt.NumberFormat.resolution_mm`), is more than
-    ``tolerance_mm`` and more than half a motor step (the machine cannot stand nearer),
-    the user is told the step and how far. Words on a step grid are warned of by their
-    grid error (:func:`closing_warnings`). Nothing is measured where the step is fine
+    A dialect whose words write fewer decimals than the tolerance needs (a target file's
+    ``decimals = 0``: whole millimetres) moves each position up to half its step, and a
+    depth too (``--depth 1.5`` written as ``Z-2``). Where the largest change, measured on
+    the program's moves (``|v − round(v / s)·s|``, ``s`` the word's
+    :meth:`~camtool.post.numfmt.NumberFormat.resolution_mm`), is more than
+    ``tolerance_mm`` and more than half a motor step of the axis (the machine cannot stand
+    nearer), the user is told the step and how far. Words on a step grid are warned of by
+    their grid error (:func:`closing_warnings`). Nothing is measured where the step is fine
     enough (half of it within both limits), so the usual dialects pay nothing.
 
     Args:
@@ -100,23 +101,57 @@ def rounding_warnings(
         steps_per_mm: the machine's motor steps per mm, ``(x, y, z)``.
         tolerance_mm: how far a position may move, mm (``--tolerance``).
     """
-    words = [spec.words[c].number for c in "XY" if c in spec.words]
-    if not words or any(w.grid_mm is not None for w in words):
-        return []
-    step = max(w.resolution_mm() for w in words)
+    out = []
     allowed = max(tolerance_mm, 0.5 / min(steps_per_mm[:2]))
-    if not step / 2.0 > allowed or not program.moves:
-        return []
+    plane = _coarse(spec, "XY", allowed)
+    if plane is not None:
+        xy = itertools.chain.from_iterable((m.x, m.y) for m in program.moves)
+        change, _, _ = _largest_change(xy, plane)
+        if change > allowed:
+            out.append(
+                f"{spec.name} writes X and Y to {plane:g} mm: positions written up to "
+                f"{change:.4f} mm from the toolpath, more than the {tolerance_mm:g} mm "
+                "tolerance (--tolerance); give its X and Y words more decimals (target file: "
+                "decimals), or check the part with --verify"
+            )
+    allowed = max(tolerance_mm, 0.5 / steps_per_mm[2])
+    height = _coarse(spec, "Z", allowed)
+    if height is not None:
+        z = (m.z for m in program.moves if m.z is not None)
+        change, planned, written = _largest_change(z, height)
+        if change > allowed:
+            out.append(
+                f"{spec.name} writes Z to {height:g} mm: heights written up to {change:.4f} mm "
+                f"from those planned (Z{planned:g} as Z{written:g}), more than the "
+                f"{tolerance_mm:g} mm tolerance; give depths and heights in steps of "
+                f"{height:g} mm (--depth, --step-down, --safe-z), or its Z word more decimals"
+            )
+    return out
+
+
+def _coarse(spec: WordAddressSpec, letters: str, allowed: float) -> float | None:
+    """The step of the words ``letters`` when half of it is over ``allowed`` mm, else ``None``.
+
+    ``None`` too where a word is missing or on a step grid.
+    """
+    words = [spec.words[c].number for c in letters if c in spec.words]
+    if not words or any(w.grid_mm is not None for w in words):
+        return None
+    step = max(w.resolution_mm() for w in words)
+    return step if step / 2.0 > allowed else None
+
+
+def _largest_change(numbers: Iterable[float], step: float) -> tuple[float, float, float]:
+    """``(change, value, written)`` of the finite number that rounding to ``step`` moves most.
+
+    ``(0, 0, 0)`` without finite numbers. (numpy is loaded here, for a coarse dialect only.)
+    """
     import numpy as np
 
-    xy = np.fromiter(itertools.chain.from_iterable((m.x, m.y) for m in program.moves), np.float64)
-    xy = xy[np.isfinite(xy)]
-    change = float(np.abs(xy - np.rint(xy / step) * step).max()) if len(xy) else 0.0
-    if not change > allowed:
-        return []
-    return [
-        f"{spec.name} writes X and Y to {step:g} mm: positions written up to {change:.4f} mm "
-        f"from the toolpath, more than the {tolerance_mm:g} mm tolerance (--tolerance); give "
-        "its X and Y words more decimals (target file: decimals), or check the part with "
-        "--verify"
-    ]
+    values = np.fromiter(numbers, np.float64)
+    values = values[np.isfinite(values)]
+    if not len(values):
+        return 0.0, 0.0, 0.0
+    written = np.rint(values / step) * step
+    k = int(np.argmax(np.abs(written - values)))
+    return float(abs(written[k] - values[k])), float(values[k]), float(written[k]) + 0.0

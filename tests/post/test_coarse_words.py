@@ -1,4 +1,4 @@
-"""X and Y words coarser than the tolerance: the user is told how far positions moved.
+"""X, Y and Z words coarser than the tolerance: the user is told how far positions moved.
 
 Expected values by analysis: a word of ``decimals = 0`` writes 10.3 as 10 and 15.7 as 16
 (0.3 mm each way) and 20.2 as 20 (0.2 mm); an inch word of 4 decimals steps 0.00254 mm, so
@@ -23,10 +23,12 @@ ROUTER = Machine(name="router", steps_per_mm=(80.0,) * 3, work_area_mm=(0, 0, 30
 """80 steps/mm: a step of 0.0125 mm."""
 
 
-def warnings_of(options: dict[str, Any], *moves: Any, tolerance: float = 0.001) -> list[str]:
+def warnings_of(
+    options: dict[str, Any], *moves: Any, tolerance: float = 0.001, kind: str = "writes X and Y"
+) -> list[str]:
     program = Program(tuple(moves), tolerance_mm=tolerance)
     result = word_address_dialect(options, "toy.toml").emit(program, ROUTER)
-    return [w for w in result.warnings if "writes X and Y" in w]
+    return [w for w in result.warnings if kind in w]
 
 
 def test_whole_millimetres_say_how_far_the_positions_moved() -> None:
@@ -46,6 +48,20 @@ def test_a_step_under_half_a_motor_step_is_not_warned_of() -> None:
     inch = 1.0 / 25.4
     options = {"words": {"XYIJ": {"decimals": 4, "scale": inch}, "F": {"decimals": 1}}}
     assert not warnings_of(options, Rapid(10.3, 20.2), Linear(15.71, 20.23, 300.0))
+
+
+def test_a_depth_written_deeper_is_said_with_the_depth_asked() -> None:
+    # 1.5 mm rounds half away from zero: Z-2, half a millimetre deeper than planned
+    options = {"words": {"XYZIJ": {"decimals": 0}, "F": {"decimals": 0}}}
+    moves = (Rapid(10.0, 20.0, 5.0), Linear(10.0, 20.0, 100.0, z=-1.5), Linear(16, 20, 300.0))
+    said = warnings_of(options, *moves, kind="writes Z")
+    assert said == [
+        "toy writes Z to 1 mm: heights written up to 0.5000 mm from those planned (Z-1.5 as "
+        "Z-2), more than the 0.001 mm tolerance; give depths and heights in steps of 1 mm "
+        "(--depth, --step-down, --safe-z), or its Z word more decimals"
+    ]
+    whole = (Rapid(10.0, 20.0, 5.0), Linear(10.0, 20.0, 100.0, z=-2.0), Linear(16, 20, 300.0))
+    assert not warnings_of(options, *whole, kind="writes Z")
 
 
 def test_post_with_a_target_file_of_whole_millimetres_warns(tmp_path: Path, run: Any) -> None:
