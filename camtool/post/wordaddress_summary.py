@@ -12,6 +12,7 @@ from collections import Counter
 from collections.abc import Iterable, Sequence
 
 from camtool.model.program import Program
+from camtool.post.numfmt import NumberFormat
 from camtool.post.wordaddress_spec import WordAddressSpec
 
 
@@ -109,8 +110,8 @@ def rounding_warnings(
         change, _, _ = _largest_change(xy, plane)
         if change > allowed:
             out.append(
-                f"{spec.name} writes X and Y to {plane:g} mm: positions written up to "
-                f"{change:.4f} mm from the toolpath, more than the {tolerance_mm:g} mm "
+                f"{spec.name} writes X and Y to {plane.resolution_mm():g} mm: positions written "
+                f"up to {change:.4f} mm from the toolpath, more than the {tolerance_mm:g} mm "
                 "tolerance (--tolerance); give its X and Y words more decimals (target file: "
                 "decimals), or check the part with --verify"
             )
@@ -120,30 +121,33 @@ def rounding_warnings(
         z = (m.z for m in program.moves if m.z is not None)
         change, planned, written = _largest_change(z, height)
         if change > allowed:
+            step = height.resolution_mm()
             out.append(
-                f"{spec.name} writes Z to {height:g} mm: heights written up to {change:.4f} mm "
+                f"{spec.name} writes Z to {step:g} mm: heights written up to {change:.4f} mm "
                 f"from those planned (Z{planned:g} as Z{written:g}), more than the "
                 f"{tolerance_mm:g} mm tolerance; give depths and heights in steps of "
-                f"{height:g} mm (--depth, --step-down, --safe-z), or its Z word more decimals"
+                f"{step:g} mm (--depth, --step-down, --safe-z), or its Z word more decimals"
             )
     return out
 
 
-def _coarse(spec: WordAddressSpec, letters: str, allowed: float) -> float | None:
-    """The step of the words ``letters`` when half of it is over ``allowed`` mm, else ``None``.
+def _coarse(spec: WordAddressSpec, letters: str, allowed: float) -> NumberFormat | None:
+    """The coarsest format of the words ``letters`` when half its step is over ``allowed`` mm.
 
-    ``None`` too where a word is missing or on a step grid.
+    ``None`` where it is not, or where a word is missing or on a step grid.
     """
     words = [spec.words[c].number for c in letters if c in spec.words]
     if not words or any(w.grid_mm is not None for w in words):
         return None
-    step = max(w.resolution_mm() for w in words)
-    return step if step / 2.0 > allowed else None
+    number = max(words, key=lambda w: w.resolution_mm())
+    return number if number.resolution_mm() / 2.0 > allowed else None
 
 
-def _largest_change(numbers: Iterable[float], step: float) -> tuple[float, float, float]:
-    """``(change, value, written)`` of the finite number that rounding to ``step`` moves most.
+def _largest_change(numbers: Iterable[float], number: NumberFormat) -> tuple[float, float, float]:
+    """``(change, value, written)`` of the finite number that ``number`` moves most, mm.
 
+    Found on the step (``|v − round(v / s)·s|``: a tie moves half a step either way), then
+    written and read back by ``number`` itself (half away from zero: ``-2.5`` as ``-3``).
     ``(0, 0, 0)`` without finite numbers. (numpy is loaded here, for a coarse dialect only.)
     """
     import numpy as np
@@ -152,6 +156,7 @@ def _largest_change(numbers: Iterable[float], step: float) -> tuple[float, float
     values = values[np.isfinite(values)]
     if not len(values):
         return 0.0, 0.0, 0.0
-    written = np.rint(values / step) * step
-    k = int(np.argmax(np.abs(written - values)))
-    return float(abs(written[k] - values[k])), float(values[k]), float(written[k]) + 0.0
+    step = number.resolution_mm()
+    value = float(values[int(np.argmax(np.abs(np.rint(values / step) * step - values)))])
+    written = number.parse(number.format(value)) + 0.0  # -0.0 reads as 0
+    return abs(written - value), value, written

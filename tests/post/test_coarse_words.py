@@ -62,6 +62,9 @@ def test_a_depth_written_deeper_is_said_with_the_depth_asked() -> None:
     ]
     whole = (Rapid(10.0, 20.0, 5.0), Linear(10.0, 20.0, 100.0, z=-2.0), Linear(16, 20, 300.0))
     assert not warnings_of(options, *whole, kind="writes Z")
+    # -2.5 is a tie too: written half away from zero, Z-3, as the word writes it (not Z-2)
+    tie = (Rapid(10.0, 20.0, 5.0), Linear(10.0, 20.0, 100.0, z=-2.5), Linear(16, 20, 300.0))
+    assert "(Z-2.5 as Z-3)" in warnings_of(options, *tie, kind="writes Z")[0]
 
 
 def test_post_with_a_target_file_of_whole_millimetres_warns(tmp_path: Path, run: Any) -> None:
