@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import csv
 import io
+import re
 import tomllib
 from collections.abc import Callable
 from pathlib import Path
@@ -81,6 +82,31 @@ def test_a_complete_sheet_gives_the_true_values_and_the_grbl_settings(
     assert table["backlash"]["true_um"][:2] == pytest.approx([60.0, 600.0], abs=4.0)  # a step
     # the controller's settings that make the machine cut true sizes: $100/$101 = true steps/mm
     assert "$100=252.0" in err and "$101=248.5" in err and "$102=" not in err
+
+
+def test_a_misread_row_is_named_before_the_settings_and_in_the_overlay(
+    tmp_path: Path, template, capsys
+) -> None:
+    # LX.p1 (15 mm) read 1 mm long: no steps/mm and backlash of a machine give that row with
+    # the others, so about 1 mm of it stays (over 0.25 mm and 2 % of 15 mm); every other row
+    # fits within microns
+    misread = _sheet(
+        tmp_path / "s.csv",
+        template,
+        EVERY_XY,
+        TRUE,
+        lambda row, v: v + 1.0 if row == "LX.p1" else v,
+    )
+    code, err, overlay = _fit(tmp_path, misread, capsys)
+    assert code == 0, err
+    caution = [line for line in err.splitlines() if "caution:" in line]
+    assert len(caution) == 1 and "caution: 1 of 30 row(s)" in caution[0]
+    assert re.search(r"LX\.p1 \(0\.9\d\d mm\);", caution[0]), caution[0]
+    assert err.index("caution:") < err.index("to cut true sizes")
+    assert "# caution: 1 of 30 row(s)" in overlay.read_text()
+    whole = _sheet(tmp_path / "t.csv", template, EVERY_XY, TRUE)
+    code, err, overlay = _fit(tmp_path, whole, capsys)
+    assert code == 0 and "caution" not in err and "caution" not in overlay.read_text()
 
 
 def test_a_sheet_without_y_lines_is_refused_naming_the_rows_to_measure(
