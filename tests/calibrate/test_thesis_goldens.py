@@ -295,3 +295,15 @@ def test_observations_keep_their_compensation(pic: Target) -> None:
     on = predict(read, pic.machine)
     assert on["U.back"] - on["U.out"] == pytest.approx(0.014, abs=0.0002)  # 204 − 190 over
     assert replace(f).id == "U"
+
+
+def test_the_theses_rows_are_all_explained(
+    valcnc: FitResult, tabla_13: FitResult, tabla_15: FitResult
+) -> None:
+    """No row of Munoz-22's tables 14-16 or UNAM-GMM's tablas 13 and 15 draws a caution."""
+    from camtool.calibrate.fit import unexplained
+
+    for result in (valcnc, tabla_13, tabla_15):
+        worst = max(abs(r.residual_um) for r in result.residuals)
+        assert not unexplained(result), worst
+        assert worst < 100.0  # within 0.1 mm, as the threshold's note says
