@@ -703,7 +703,7 @@ def unexplained(result: FitResult) -> list[Residual]:
 
 
 def caution_lines(result: FitResult) -> list[str]:
-    """A caution before the values when rows stay unexplained (empty when none does)."""
+    """A caution, said before the settings, naming the rows :func:`unexplained` finds (or none)."""
     rows = unexplained(result)
     if not rows:
         return []
