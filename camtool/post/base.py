@@ -619,6 +619,17 @@ def from_options(
         raise InputError(f"{where}: invalid dialect_options ({exc})") from exc
 
 
+def program_tolerance(program: Program, machine: Machine) -> float:
+    """How far a written position may stray from ``program``'s, mm.
+
+    The program's ``tolerance_mm`` (``--tolerance``), else the machine's
+    ``motion.chord_tolerance_mm`` (:class:`~camtool.model.program.Program`).
+    """
+    if program.tolerance_mm is not None:
+        return program.tolerance_mm
+    return machine.motion.chord_tolerance_mm
+
+
 def plane_chords(
     program: Program, target: Target, tolerance_mm: float | None = None
 ) -> tuple[Program, str]:
@@ -639,9 +650,7 @@ def plane_chords(
     if target.post.planes and target.machine.has_z:
         return program, ""
     if tolerance_mm is None:
-        tolerance_mm = program.tolerance_mm
-    if tolerance_mm is None:
-        tolerance_mm = target.machine.motion.chord_tolerance_mm
+        tolerance_mm = program_tolerance(program, target.machine)
     # a chord's Z and XY in two blocks: a staircase (a machine without Z drops Z anyway)
     apart = target.machine.has_z and not target.post.z_with_xy
     out, done = plane_arcs_as_chords(program, tolerance_mm, tolerance_mm if apart else None)

@@ -701,7 +701,7 @@ def _check_static(t: _Table, key: str, code: str, spec: WordAddressSpec, roles: 
         raise t.error(key, 'G91.1 (incremental arc centre) needs arc_centre = "incremental"')
     if code[0] == "G" and value in _UNIT_CODES:
         unit, per_mm = _UNIT_CODES[value]
-        for letter in "XYZIJK":
+        for letter in POSITION_LETTERS:
             word = spec.words.get(letter)
             if word is not None and not math.isclose(word.number.scale, per_mm, rel_tol=1e-9):
                 raise t.error(

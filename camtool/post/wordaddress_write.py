@@ -39,6 +39,7 @@ from camtool.post.base import (
     check_placement,
     check_work_area,
     input_line,
+    program_tolerance,
 )
 from camtool.post.wordaddress_arcs import (
     ARC_CHORD_TOLERANCE_MM,
@@ -131,9 +132,7 @@ class BlockWriter(ArcWriter):
         self.warnings.extend(
             closing_warnings(self.spec, self.counts, self.grid_error_mm, ARC_CHORD_TOLERANCE_MM)
         )
-        tolerance = program.tolerance_mm
-        if tolerance is None:
-            tolerance = self.machine.motion.chord_tolerance_mm
+        tolerance = program_tolerance(program, self.machine)
         self.warnings.extend(
             rounding_warnings(self.spec, program, self.machine.steps_per_mm, tolerance)
         )

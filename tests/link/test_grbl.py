@@ -391,8 +391,8 @@ def test_a_line_grbl_refuses_is_refused_before_the_first_byte(line: str, simulat
 def test_a_refused_line_is_refused_before_the_moves_are_timed(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    # The timing simulates every step: a 400 m move at GRBL's 250 steps/mm is 10^8 rows
-    # (2.8 GB), which the refusal of its 9-digit number must not wait for.
+    # The timing simulates every step: a 400 m move at GRBL's 250 steps/mm is 10^8 rows,
+    # which the refusal of its 9-digit number must not wait for.
     import camtool.link.plan as plan
 
     def timed(*args: Any) -> Any:

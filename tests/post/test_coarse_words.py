@@ -24,10 +24,14 @@ ROUTER = Machine(name="router", steps_per_mm=(80.0,) * 3, work_area_mm=(0, 0, 30
 
 
 def warnings_of(
-    options: dict[str, Any], *moves: Any, tolerance: float = 0.001, kind: str = "writes X and Y"
+    options: dict[str, Any],
+    *moves: Any,
+    tolerance: float = 0.001,
+    kind: str = "writes X and Y",
+    machine: Machine = ROUTER,
 ) -> list[str]:
     program = Program(tuple(moves), tolerance_mm=tolerance)
-    result = word_address_dialect(options, "toy.toml").emit(program, ROUTER)
+    result = word_address_dialect(options, "toy.toml").emit(program, machine)
     return [w for w in result.warnings if kind in w]
 
 
@@ -45,9 +49,16 @@ def test_positions_on_the_step_or_within_the_tolerance_are_not_warned_of() -> No
 
 
 def test_a_step_under_half_a_motor_step_is_not_warned_of() -> None:
+    # 0.40005 in (10.16127 mm) is written 0.4001 in: 0.00127 mm more, over the 0.001 mm
+    # tolerance but under half the router's 0.0125 mm step; a machine of 1000 steps/mm
+    # (half a step 0.0005 mm) stands nearer, so there it is said
     inch = 1.0 / 25.4
     options = {"words": {"XYIJ": {"decimals": 4, "scale": inch}, "F": {"decimals": 1}}}
-    assert not warnings_of(options, Rapid(10.3, 20.2), Linear(15.71, 20.23, 300.0))
+    moves = (Rapid(10.0, 20.0), Linear(0.40005 * 25.4, 20.0, 300.0))
+    assert not warnings_of(options, *moves)
+    fine = Machine(name="fine", steps_per_mm=(1000.0,) * 3, work_area_mm=(0, 0, 300, 300))
+    said = warnings_of(options, *moves, machine=fine)
+    assert len(said) == 1 and "positions written up to 0.0013 mm" in said[0]
 
 
 def test_a_depth_written_deeper_is_said_with_the_depth_asked() -> None:
