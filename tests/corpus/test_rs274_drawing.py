@@ -1,10 +1,11 @@
 """Where LinuxCNC's interpreter moves the tool lies on the curves ezdxf draws: the whole chain.
 
-The corpus DXFs (LibreCAD's parts and symbols, OpenSCAD's examples) that post to linuxcnc at
-the first try, as a new user posts them (``camtool post FILE -t linuxcnc -o OUT``: the tool
-centre on the drawing, work zero at the drawing's origin), are read back by ``rs274``
-(test_rs274.py) and every feed move is sampled along its line or arc. Each point must lie
-near the drawing as ezdxf itself evaluates it (test_dxf_reference.py's reference: its
+The corpus DXFs (LibreCAD's parts and symbols, OpenSCAD's examples) that post to linuxcnc or
+grbl at the first try, as a new user posts them (``camtool post FILE -t TARGET -o OUT``: the
+tool centre on the drawing, work zero at the drawing's origin), are read back by ``rs274``
+(test_rs274.py; the grbl dialect writes RS-274 words it reads as GRBL does) and every feed
+move is sampled along its line or arc. Each point must lie near the drawing as ezdxf itself
+evaluates it (test_dxf_reference.py's reference: its
 ``ARC``/``CIRCLE``/``ELLIPSE``/``SPLINE`` evaluators, polylines' bulge arcs, blocks exploded),
 not as camtool reads it: one judge for reading, chaining, ordering, arc fitting, the
 writer's words and its arc check at once. A mirrored OCS arc, a lost block transform, a
@@ -59,11 +60,12 @@ def fed_points(stdout: str) -> np.ndarray:
 
 
 @needs_rs274
+@pytest.mark.parametrize("target", ["linuxcnc", "grbl"])
 @pytest.mark.parametrize("rel", DXF or ["<none>"], ids=case_id)
-def test_rs274_feeds_lie_on_ezdxf_s_curves(rel: str) -> None:
+def test_rs274_feeds_lie_on_ezdxf_s_curves(rel: str, target: str) -> None:
     from scipy.spatial import cKDTree
 
-    outcome = outcome_for(rel, "linuxcnc")
+    outcome = outcome_for(rel, target)
     if outcome.status != "first-try":
         pytest.skip(f"not posted as drawn (see test_corpus): {outcome.status}")
     done = rs274(outcome.final.output)
