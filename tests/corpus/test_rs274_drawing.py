@@ -45,16 +45,13 @@ def fed_points(stdout: str) -> np.ndarray:
     pts: list[tuple[float, float]] = []
     here: tuple[float, float] | None = None
     for kind, v in canon_moves(stdout):
-        if kind == "arc":
-            end = (v[0], v[1])
-            if here is not None:
-                pts.extend(arc_points(here, end, (v[2], v[3]), v[4], STEP_MM))
-        else:
-            end = (v[0], v[1])
-            if kind == "line" and here is not None:
-                n = max(1, int(math.dist(here, end) / STEP_MM))
-                for t in np.linspace(0.0, 1.0, n + 1):
-                    pts.append((here[0] + (end[0] - here[0]) * t, here[1] + (end[1] - here[1]) * t))
+        end = (v[0], v[1])
+        if here is not None and kind == "arc":
+            pts.extend(arc_points(here, end, (v[2], v[3]), v[4], STEP_MM))
+        elif here is not None and kind == "line":
+            n = max(1, int(math.dist(here, end) / STEP_MM))
+            for t in np.linspace(0.0, 1.0, n + 1):
+                pts.append((here[0] + (end[0] - here[0]) * t, here[1] + (end[1] - here[1]) * t))
         here = end
     return np.array(pts).reshape(-1, 2)
 
