@@ -577,7 +577,8 @@ def ellipse_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool
     ``m = extrusion × M · ratio`` (DXF reference, ELLIPSE); an extrusion of (0, 0, −1)
     therefore runs clockwise seen from +Z. An ellipse sweeping more than half a turn
     whose two ends meet within the tolerance is closed (full): CAD programs that round
-    ``end_param`` to 6.28318 still give a closed contour.
+    ``end_param`` to 6.28318 still give a closed contour. Equal parameters give a point, not
+    a whole ellipse, as for an ARC (:func:`_arc`; ezdxf's ``ellipse_param_span``).
 
     Args:
         entity: an ezdxf ``Ellipse`` (WCS), possibly a virtual one from a block.
@@ -587,10 +588,15 @@ def ellipse_segments(entity: Any, tolerance: float) -> tuple[list[Segment], bool
         ``(segments, closed)`` in drawing units, Y up.
 
     Raises:
-        Unsupported: the ellipse is not parallel to XY, or has zero size.
+        Unsupported: the ellipse is not parallel to XY, has zero size, or ``"zero
+            length"`` (equal start and end parameters).
     """
+    from ezdxf.math import ellipse_param_span
+
     if not math.hypot(*entity.dxf.major_axis) > 0.0:
         raise Unsupported("zero size")  # ezdxf's construction tool refuses a null axis
+    if ellipse_param_span(float(entity.dxf.start_param), float(entity.dxf.end_param)) == 0.0:
+        raise Unsupported("zero length", "its start and end parameters are equal")
     ce = entity.construction_tool()
     ex, ey, ez = ce.extrusion
     if abs(ex) > 1e-9 or abs(ey) > 1e-9 or abs(ce.major_axis[2]) > 1e-9 * ce.major_axis.magnitude:

@@ -654,6 +654,36 @@ def test_an_arc_whose_start_and_end_angles_are_equal_is_a_point_not_a_circle(
     assert any("skipped 1 ARC entity (zero length" in w for w in read.warnings)
 
 
+def test_an_ellipse_whose_start_and_end_parameters_are_equal_is_a_point_not_a_whole_one(
+    tmp_path: Path,
+) -> None:
+    # The same rule for ELLIPSE (ezdxf issue 330 names it with ARC; ezdxf's
+    # ellipse_param_span gives 0). A HATCH's ellipse edge is read as an ELLIPSE, and so are
+    # the arcs of a block placed with unequal scales: their whole circles stay whole.
+    # Parameters 0 to 2π and 1 to 1 + 2π are whole ellipses.
+    def build(msp: Any) -> None:
+        msp.add_ellipse((100, 100), (50, 0), ratio=0.5, start_param=1.0, end_param=1.0)
+        msp.add_ellipse((10, 10), (5, 0), ratio=0.5, start_param=0.0, end_param=math.tau)
+        msp.add_ellipse((40, 10), (5, 0), ratio=0.5, start_param=1.0, end_param=1.0 + math.tau)
+        hatch = msp.add_hatch()
+        hatch.paths.add_edge_path().add_ellipse((100, 0), (5, 0), 0.5, 60, 60)
+        block = msp.doc.blocks.new("HOLE")
+        block.add_arc((0, 0), 2, 30, 390)
+        msp.add_blockref("HOLE", (70, 10), dxfattribs={"xscale": 2, "yscale": 1})
+
+    path = write_dxf(tmp_path / "eq.dxf", build)
+    read = read_dxf(path, ImportOptions(hatch_boundaries=True))
+    # each contour by its left edge (fitted within 0.001 mm): the two whole ellipses, the
+    # arc placed as an ellipse
+    assert sorted((round(c.bbox()[0], 2), c.closed) for c in read.contours) == [
+        (5.0, True),
+        (35.0, True),
+        (66.0, True),
+    ]
+    assert any("skipped 1 ELLIPSE entity (zero length" in w for w in read.warnings)
+    assert any("skipped 1 HATCH entity (no boundary path)" in w for w in read.warnings)
+
+
 def test_an_assertion_in_ezdxf_s_recover_mode_is_a_damaged_file_not_an_internal_error(
     tmp_path: Path,
 ) -> None:
