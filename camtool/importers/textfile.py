@@ -52,16 +52,45 @@ def decoded(data: bytes, errors: str = "strict") -> str:
     return data.decode(text_encoding(data) or "utf-8", errors)
 
 
+class BinaryData(ValueError):
+    """Bytes that are no text in any encoding camtool reads (:func:`decoded_or_latin1`).
+
+    Attributes:
+        offset: the first byte that says so, from the start of the file.
+        line: its line (1 for the first; lines end at LF, CR LF or CR).
+    """
+
+    def __init__(self, offset: int, line: int, byte: int) -> None:
+        super().__init__(f"byte {offset}, on line {line}, is 0x{byte:02X}")
+        self.offset, self.line, self.byte = offset, line, byte
+
+
+_CONTROL = re.compile(rb"[\x00-\x08\x0e-\x19\x1b-\x1f]")
+"""C0 control bytes that no text holds: tab, LF, VT, FF and CR are text, and so is SUB
+(0x1A, the end-of-file mark of CP/M and DOS editors)."""
+_LINE_END_BYTES = re.compile(rb"\r\n|\r|\n")
+
+
 def decoded_or_latin1(data: bytes) -> str:
     """:func:`decoded`, or Latin-1 where that fails: every byte is then one character.
 
     For G-code: a marked file that does not decode is read as Latin-1 too, and the reader
     names the first character that is no G-code. A UTF-8 mark is dropped first (an editor
     wrote it, and a byte after it that is no UTF-8 is the one to name, not the mark).
+    Latin-1 text holds no C0 control byte but tab, the line ends and SUB: bytes that are
+    no UTF-8 and hold one are binary data (a compressed file, an archive), not text.
+
+    Raises:
+        BinaryData: the bytes are no UTF-8 and hold such a control byte.
     """
     try:
         return decoded(data)
     except UnicodeDecodeError:
+        control = _CONTROL.search(data)
+        if control is not None:
+            offset = control.start()
+            line = 1 + len(_LINE_END_BYTES.findall(data, 0, offset))
+            raise BinaryData(offset, line, data[offset]) from None
         return data.removeprefix(codecs.BOM_UTF8).decode("latin-1")
 
 

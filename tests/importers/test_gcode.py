@@ -563,6 +563,35 @@ def test_read_gcode_errors_and_encodings(tmp_path: Path) -> None:
         read_gcode(bad, source_name="<stdin>")
 
 
+def test_binary_data_is_named_as_such_not_read_as_latin_1(tmp_path: Path) -> None:
+    import gzip
+    import io
+    import zipfile
+
+    program = b"G21 G90\nG0 X1 Y1\nG1 X5 Y1 F100 (#1 pass)\nM2\n"
+    packed = tmp_path / "part.nc"
+    # a gzip file starts 1F 8B (RFC 1952); a zip archive "PK" 03 04 (PKWARE's APPNOTE 4.3.7)
+    packed.write_bytes(gzip.compress(program, mtime=0))
+    with pytest.raises(InputError, match=r"part\.nc: binary data, not a G-code text file: "):
+        read_gcode(packed)
+    with pytest.raises(InputError, match=r"byte 0, on line 1, is 0x1F.*compressed"):
+        read_gcode(packed)
+    archive = io.BytesIO()
+    with zipfile.ZipFile(archive, "w") as zipped:
+        zipped.writestr("part.nc", program)
+    packed.write_bytes(archive.getvalue())
+    with pytest.raises(InputError, match=r"byte 2, on line 1, is 0x03"):
+        read_gcode(packed)
+    # Windows-1252 text (an en dash 0x96 in a comment) ending in DOS's end-of-file mark is
+    # text, read as Latin-1; so is a program whose only odd byte is a NUL, in UTF-8
+    dos = tmp_path / "dos.nc"
+    dos.write_bytes(b"(L\xe4nge \x96 10 mm)\r\nG21\r\nG1 X1 Y1 F9\r\nM2\r\n\x1a")
+    assert read_gcode(dos).moves == (Linear(1.0, 1.0, 9.0, contour=1),)
+    dos.write_bytes(b"G21\nG1 X1 Y1 F9\n\x00\nM2\n")
+    with pytest.raises(InputError, match=r"dos\.nc:3: unexpected character"):
+        read_gcode(dos)
+
+
 # -- properties (Munoz-22 S004-R03: G91 and R-form read to the same points) ---------------
 
 coords = st.integers(-50_000, 50_000).map(lambda n: n / 1000)
