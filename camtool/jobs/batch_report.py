@@ -109,8 +109,8 @@ def summary_table(result: BatchResult) -> str:
     """The end-of-batch table: one line per file and a totals line (plain text).
 
     Columns: file, target (only in a batch of several targets), status, blocks,
-    predicted max error (µm, ``-`` when not verified), time (s; verified time, else
-    at programmed feeds), and a note (the error, or the number of warnings). Each
+    predicted max error (µm, ``-`` when not verified), machining time (s; verified
+    time, else at programmed feeds), and a note (the error, or the number of warnings). Each
     line ends with a newline.
     """
     width = min(max([len("file")] + [len(r.file) for r in result.rows]), FILE_COLUMN_MAX)
@@ -122,21 +122,21 @@ def summary_table(result: BatchResult) -> str:
 
     lines = [
         f"{'file':<{width}}  {target('target')}{'status':<10}  {'blocks':>6}  {'max µm':>9}  "
-        f"{'time s':>9}  note"
+        f"{'machining s':>11}  note"
     ]
     for row in result.rows:
         note = message(row) if row.error else _warning_count(row)
         lines.append(
             f"{_shorten(row.file, width):<{width}}  {target(row.target)}{row.status:<10}  "
             f"{_int(row.blocks):>6}  {_fixed(row.max_error_um, 2):>9}  "
-            f"{_fixed(row.time_s, 1):>9}  {note}".rstrip()
+            f"{_fixed(row.time_s, 1):>11}  {note}".rstrip()
         )
     lines.append(totals_line(result))
     return "\n".join(lines) + "\n"
 
 
 def totals_line(result: BatchResult) -> str:
-    """``3 files: 1 ok, 1 over the limit, 1 error; 50 blocks; max 14.07 µm; 6804.2 s``."""
+    """``3 files: 1 ok, 1 over the limit, 1 error; 50 blocks; max 14.07 µm; 6804.2 s machining``."""
     t = totals(result.rows)
     text = (
         f"{t['files']} file(s): {t['ok']} ok, {t['over_limit']} over the limit, "
@@ -146,14 +146,15 @@ def totals_line(result: BatchResult) -> str:
         text += f"; max {t['max_error_um']:.2f} µm"
     untimed = sum(r.time_s is None and r.status != "error" for r in result.rows)
     but = f" ({untimed} written without a time: --verify times them)" if untimed else ""
-    return f"{text}; {sum(r.time_s or 0.0 for r in result.rows):.1f} s{but}"
+    return f"{text}; {sum(r.time_s or 0.0 for r in result.rows):.1f} s machining{but}"
 
 
 def progress_line(done: int, total: int, row: BatchRow) -> str:
-    """One finished file, for a log: ``[3/12] ok  a.dxf → out/a.pic  41 blocks  12.3 µm  2.1 s``.
+    """One finished file, for a log (its machining time, not how long it took to post).
 
-    An error shows its message instead of the outputs; an over-limit file shows
-    both. In a batch of several targets the file is followed by ``for <target>``.
+    ``[3/12] ok  a.dxf → out/a.pic  41 blocks  12.3 µm  2.1 s machining``. An error shows
+    its message instead of the outputs; an over-limit file shows both. In a batch of
+    several targets the file is followed by ``for <target>``.
     """
     head = f"[{done}/{total}] {row.status}  {row.file}"
     if row.target is not None:
@@ -164,7 +165,7 @@ def progress_line(done: int, total: int, row: BatchRow) -> str:
     if row.max_error_um is not None:
         text += f"  {row.max_error_um:.1f} µm"
     if row.time_s is not None:
-        text += f"  {row.time_s:.1f} s"
+        text += f"  {row.time_s:.1f} s machining"
     return f"{text}: {row.error}" if row.error else text
 
 

@@ -441,7 +441,10 @@ def test_non_tty_progress_lines(tree: Path, capsys: pytest.CaptureFixture[str]) 
     assert sorted(line.split("]")[0] for line in lines) == ["[1/4", "[2/4", "[3/4", "[4/4"]
     rect = next(line for line in lines if "drawings/rect.dxf" in line)
     blocks = post_file("drawings/rect.dxf", "pic-mmh").result.blocks
-    assert rect.split("] ")[1] == f"ok  drawings/rect.dxf → out/rect.pic  {blocks} blocks  450.0 s"
+    assert (
+        rect.split("] ")[1]
+        == f"ok  drawings/rect.dxf → out/rect.pic  {blocks} blocks  450.0 s machining"
+    )
     bad = next(line for line in lines if "bad.dxf" in line)
     assert bad.split("] ")[1].startswith("error  drawings/bad.dxf: not a readable DXF")
 
@@ -457,10 +460,10 @@ def test_summary_table_columns() -> None:
     )
     text = summary_table(BatchResult(BatchOptions(target="t", output_dir=Path("o")), rows))
     assert text.splitlines() == [
-        "file   status      blocks     max µm     time s  note",
-        "a.dxf  ok               8      29.44      539.6",
-        "b.dxf  error            -          -          -  not a readable DXF",
-        "2 file(s): 1 ok, 0 over the limit, 1 error(s); 8 blocks; max 29.44 µm; 539.6 s",
+        "file   status      blocks     max µm  machining s  note",
+        "a.dxf  ok               8      29.44        539.6",
+        "b.dxf  error            -          -            -  not a readable DXF",
+        "2 file(s): 1 ok, 0 over the limit, 1 error(s); 8 blocks; max 29.44 µm; 539.6 s machining",
     ]
     assert progress_line(2, 2, rows[1]) == "[2/2] error  b.dxf: not a readable DXF"
 
