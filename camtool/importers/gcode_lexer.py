@@ -364,16 +364,14 @@ def _refuse_special(c: str, code: str, where: str) -> None:
         kind = (
             "'[ ]' expressions"
             if "[" in code
-            else "named parameters ('#<name>')"
-            if "<" in code
             else "indirect parameters ('##n')"
             if "##" in code
             else "'#' parameters on this line"
         )
         raise InputError(
-            f"{where}: {kind} are not supported ({quoted(code)}); camtool reads numbered "
-            "parameters set to numbers ('#1=2.5', then 'X#1') and "
-            f"{_PLAIN.removeprefix('camtool reads ')}"
+            f"{where}: {kind} are not supported ({quoted(code)}); camtool reads "
+            "parameters set to numbers ('#1=2.5' or '#<depth>=2.5', then 'X#1' or "
+            f"'Z#<depth>') and {_PLAIN.removeprefix('camtool reads ')}"
         )
     if c and c in "[]":
         raise InputError(f"{where}: '[ ]' expressions are not supported ({quoted(code)}); {_PLAIN}")

@@ -1,22 +1,26 @@
-"""RS-274/NGC numbered parameters set to plain numbers: ``#100=2.0 (safe Z)`` … ``G0 Z#100``.
+"""RS-274/NGC parameters set to plain numbers: ``#100=2.0 (safe Z)`` … ``G0 Z#100``.
 
 gEDA PCB's G-code export and LinuxCNC's G-code wizard scripts (engraving, dials) set a few
-numbered parameters to numbers at the top of the program and read them as word values.
-:func:`expand_parameters` writes each read as the number it holds, line by line, before the
-program is lexed, so the reader sees plain words. The rules are LinuxCNC's ("Parameters"
-in its G-code overview): a parameter is set by ``#n=value``; all the parameters a line reads
-are read before any it sets is set ("parameter setting is done in parallel"); a value
-is a number, or another parameter, with a sign; a read comes right after its word's letter
-(``X#1``, ``X-#1``); spaces do not count (``#1 .5`` is ``#1.5``, which names no parameter).
-A ``#`` anywhere else, or a parameter number that is not whole, is refused as LinuxCNC
-refuses it.
+numbered parameters to numbers at the top of the program and read them as word values;
+hand-written LinuxCNC programs and some plotters' G-code name them (``#<pen_up>=-12`` …
+``G1 Z#<pen_up>``). :func:`expand_parameters` writes each read as the number it holds, line
+by line, before the program is lexed, so the reader sees plain words. The rules are
+LinuxCNC's ("Parameters" in its G-code overview): a parameter is set by ``#n=value`` or
+``#<name>=value``; all the parameters a line reads are read before any it sets is set
+("parameter setting is done in parallel"); a value is a number, or another parameter, with
+a sign; a read comes right after its word's letter (``X#1``, ``X-#<depth>``); spaces do not
+count (``#1 .5`` is ``#1.5``, which names no parameter; ``#<pen up>`` is ``#<penup>``), nor
+does the case of a name. A ``#`` anywhere else, a parameter number that is not whole, or a
+digit right after a name (``X#<a>5``) is refused as LinuxCNC refuses it.
 
 What is left as it stands, for the lexer to refuse with its own message: a line with an
-expression (``[ ]``), a named parameter (``#<name>``) or an indirect one (``##1``). A
-block-delete line (``/``) with a parameter is refused: whether it runs is the controller's
-switch. A parameter read before any line sets it (LinuxCNC reads 0, or the value
-a previous run saved) and a system parameter (``#5061``… offsets and probe results, above
-:data:`LAST_USER`) are refused: camtool cannot know their values.
+expression (``[ ]``) or an indirect parameter (``##1``). A block-delete line (``/``) with a
+parameter is refused: whether it runs is the controller's switch. A parameter read before
+any line sets it (LinuxCNC reads 0 for a number, or the value a previous run saved, and
+refuses a name it has not met) and the controller's own (``#5061``… offsets and probe
+results, above :data:`LAST_USER`; names that begin with ``_``, globals such as ``#<_x>``,
+the position, which LinuxCNC does not let a program set) are refused: camtool cannot know
+their values.
 """
 
 from __future__ import annotations
@@ -29,13 +33,21 @@ LAST_USER = 5000
 """The last numbered parameter a program sets for itself; above it LinuxCNC keeps its own
 (probe results, coordinate-system offsets, the tool in the spindle)."""
 
+Key = int | str
+"""A parameter: its number, or its name in lower case (``#<Depth>`` is ``"depth"``)."""
+
 _NUM = r"(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?![0-9.])"
 """A number, not followed by more digits or a point (``5.5.5`` is none)."""
-_SET = re.compile(rf"#({_NUM})=([+-]?)(?:({_NUM})|#({_NUM}))")
-"""An assignment in a line without spaces: ``#n=`` a signed number or a signed parameter."""
-_READ = re.compile(rf"(?<=[A-Za-z])([+-]?)#({_NUM})")
+_NAME = r"<([^<>#\[\]]+)>(?![0-9.])"
+"""A parameter's name in angle brackets, not followed by a digit or a point (LinuxCNC
+refuses ``X#<a>5``: "Bad character '5'")."""
+_SET = re.compile(rf"#(?:({_NUM})|{_NAME})=([+-]?)(?:({_NUM})|#({_NUM})|#{_NAME})")
+"""An assignment in a line without spaces: ``#n=`` or ``#<name>=`` a signed number or a
+signed parameter."""
+_READ = re.compile(rf"(?<=[A-Za-z])([+-]?)#(?:({_NUM})|{_NAME})")
 """A parameter read as a word's value, right after the word's letter (a sign between them
-negates it): ``X#1``, ``X-#1``. A ``#`` anywhere else starts a setting for LinuxCNC."""
+negates it): ``X#1``, ``X-#1``, ``Z#<depth>``. A ``#`` anywhere else starts a setting for
+LinuxCNC."""
 _SPACE = re.compile(r"\s+")
 _COMMENT = re.compile(r"\([^)]*\)|;.*")
 _LINE = re.compile(r"([^\r\n]*)(\r\n|\r|\n|$)")
@@ -51,12 +63,12 @@ def expand_parameters(text: str, source: str) -> str:
 
     Raises:
         InputError: a parameter read before any line sets it, a system parameter (above
-            :data:`LAST_USER`) read or set, or one on a block-delete line; the message names
-            ``source:line``.
+            :data:`LAST_USER`) or a global name (``#<_x>``) read or set, or one on a
+            block-delete line; the message names ``source:line``.
     """
     if "#" not in text:
         return text
-    values: dict[int, str] = {}
+    values: dict[Key, str] = {}
     out = []
     for number, m in enumerate(_LINE.finditer(text), start=1):
         if not m[0]:
@@ -72,10 +84,10 @@ def expand_parameters(text: str, source: str) -> str:
     return "".join(out)
 
 
-def _expand_line(raw: str, values: dict[int, str], where: str) -> str | None:
+def _expand_line(raw: str, values: dict[Key, str], where: str) -> str | None:
     """One line with its reads written as numbers; its sets go into ``values`` after.
 
-    ``None`` for a line with an expression, a named or indirect parameter.
+    ``None`` for a line with an expression or an indirect parameter.
     """
     parts = _split_comments(raw)
     code = "".join(text for text, comment in parts if not comment)
@@ -87,16 +99,16 @@ def _expand_line(raw: str, values: dict[int, str], where: str) -> str | None:
             "depends on the controller's block-delete switch, which camtool cannot know; "
             "remove the line or its '/'"
         )
-    if any(c in code for c in "[]<") or "##" in code.replace(" ", ""):
+    if any(c in code for c in "[]") or "##" in code.replace(" ", ""):
         return None
-    sets: dict[int, str] = {}
+    sets: dict[Key, str] = {}
     out = []
     for text, comment in parts:
         if not comment:  # LinuxCNC reads a line without its spaces: `#1 .5` is `#1.5`
             text = _SPACE.sub("", text)
             text = _SET.sub(lambda m: _assign(m, values, sets, where), text)
             text = _READ.sub(
-                lambda m: _signed(m[1], _value(_index(m[2], where), values, where)), text
+                lambda m: _signed(m[1], _value(_key(m[2], m[3], where), values, where)), text
             )
             if "#" in text:
                 raise InputError(
@@ -120,12 +132,28 @@ def _split_comments(raw: str) -> list[tuple[str, bool]]:
     return parts
 
 
-def _assign(m: re.Match[str], values: dict[int, str], sets: dict[int, str], where: str) -> str:
-    """Note the set ``#n=value`` of the match for after the line; it leaves a blank."""
-    number = _user(_index(m[1], where), where)
-    held = m[3] if m[3] is not None else _value(_index(m[4], where), values, where)
-    sets[number] = _signed(m[2], held)
+def _assign(m: re.Match[str], values: dict[Key, str], sets: dict[Key, str], where: str) -> str:
+    """Note the set ``#n=value`` or ``#<name>=value`` of the match for after the line.
+
+    It leaves a blank.
+    """
+    key = _user(_key(m[1], m[2], where), where)
+    held = m[4] if m[4] is not None else _value(_key(m[5], m[6], where), values, where)
+    sets[key] = _signed(m[3], held)
     return " "
+
+
+def _key(number: str | None, name: str | None, where: str) -> Key:
+    """The parameter a match names: ``number`` (:func:`_index`) or ``name``, case-folded."""
+    if number is not None:
+        return _index(number, where)
+    assert name is not None
+    return name.casefold()
+
+
+def _shown(key: Key) -> str:
+    """``#12`` or ``#<depth>``, as a message names the parameter."""
+    return f"#{key}" if isinstance(key, int) else f"#<{key}>"
 
 
 def _index(text: str, where: str) -> int:
@@ -139,26 +167,44 @@ def _index(text: str, where: str) -> int:
     return int(value)
 
 
-def _value(number: int, values: dict[int, str], where: str) -> str:
-    """The number parameter ``number`` holds, as written."""
-    _user(number, where)
-    if number not in values:
-        raise InputError(
-            f"{where}: #{number} is read before any line of the program sets it (LinuxCNC "
-            "reads 0, or the value a run before saved): set it with #n=value first"
+def _value(key: Key, values: dict[Key, str], where: str) -> str:
+    """The number the parameter ``key`` holds, as written."""
+    _user(key, where)
+    if key not in values:
+        reads = (
+            "reads 0, or the value a run before saved"
+            if isinstance(key, int)
+            else "refuses it: 'named parameter not defined'"
         )
-    return values[number]
-
-
-def _user(number: int, where: str) -> int:
-    """``number`` if a program may set and read it (1 to :data:`LAST_USER`), else refused."""
-    if not 1 <= number <= LAST_USER:
         raise InputError(
-            f"{where}: #{number} is a parameter the controller keeps (offsets, probe results, "
+            f"{where}: {_shown(key)} is read before any line of the program sets it "
+            f"(LinuxCNC {reads}): set it with {_shown(key)}=value first"
+        )
+    return values[key]
+
+
+def _user(key: Key, where: str) -> Key:
+    """``key`` if a program may set and read it, else refused.
+
+    Numbers 1 to :data:`LAST_USER`; names that do not begin with ``_`` (LinuxCNC's globals,
+    among them its own read-only ones: ``#<_x>``, ``#<_metric>``).
+    """
+    if isinstance(key, str):
+        if key.startswith("_"):
+            raise InputError(
+                f"{where}: {_shown(key)} is a global parameter, a name under which LinuxCNC "
+                "keeps its own values too (the position #<_x>, the units #<_metric>), which "
+                "a program cannot set: camtool reads a program's own named parameters "
+                "(#<name>, without '_'); post the program again with plain numbers"
+            )
+        return key
+    if not 1 <= key <= LAST_USER:
+        raise InputError(
+            f"{where}: #{key} is a parameter the controller keeps (offsets, probe results, "
             f"the tool), not one the program sets (#1 to #{LAST_USER}): camtool cannot know "
             "its value; post the program again with plain numbers"
         )
-    return number
+    return key
 
 
 def _signed(sign: str, text: str) -> str:

@@ -437,12 +437,13 @@ def test_the_cancels_of_refused_modes_post_as_no_ops(tmp_path: Path) -> None:
 
 @needs_rs274
 def test_numbered_parameters_are_read_as_rs274_reads_them(tmp_path: Path) -> None:
-    """tests/importers/test_gcode_params.py's programs, a gEDA PCB export in inches and one
-    that sets parameters on a line that reads them: rs274 cuts the original and camtool's
-    linuxcnc re-post along the same moves, within the 3-decimal rounding."""
-    from tests.importers.test_gcode_params import GEDA, PARALLEL
+    """tests/importers/test_gcode_params.py's programs, a gEDA PCB export in inches, one
+    that sets parameters on a line that reads them and a pen plotter's of named ones: rs274
+    cuts the original and camtool's linuxcnc re-post along the same moves, within the
+    3-decimal rounding."""
+    from tests.importers.test_gcode_params import GEDA, PARALLEL, PLOTTER
 
-    for name, text in (("geda", GEDA), ("wizard", PARALLEL)):
+    for name, text in (("geda", GEDA), ("wizard", PARALLEL), ("plotter", PLOTTER)):
         source = tmp_path / f"{name}.ngc"
         source.write_text(text)
         out = tmp_path / f"{name}-out.ngc"
@@ -471,6 +472,14 @@ def test_numbered_parameters_are_read_as_rs274_reads_them(tmp_path: Path) -> Non
         ("G1 X#01 Y0", "moved"),  # #1
         ("G1 X - #1 Y0", "moved"),  # -5
         ("G1 X#1 2 Y0", "unset"),  # #12, which nothing set: LinuxCNC reads 0, camtool refuses
+        ("G1 X#<a>5 Y0", "refused"),  # "Bad character '5'"
+        ("G1 X#<a> .5 Y0", "refused"),
+        ("G1 X#<b> Y0", "refused"),  # "Named parameter #<b> not defined"
+        ("G1 X - #< A > Y0", "moved"),  # -5: spaces and case do not count
+        ("G1 X#<a>Y#1", "moved"),
+        ("#<a>=7 G1 X#<a> Y0", "moved"),  # 5: read before the line sets 7
+        ("G1 X#<_x> Y0", "unset"),  # the position: LinuxCNC's own, camtool refuses
+        ("#<_x>=1 G1 X1 Y0", "refused"),  # "Cannot assign to read-only parameter"
     ],
 )
 def test_a_parameter_read_never_gives_a_move_rs274_does_not_make(
@@ -479,7 +488,7 @@ def test_a_parameter_read_never_gives_a_move_rs274_does_not_make(
     """Where LinuxCNC refuses a line, camtool refuses it; where LinuxCNC moves, camtool writes
     the same move, or refuses a parameter read before any line sets it; never another move."""
     source = tmp_path / "p.ngc"
-    source.write_text(f"G21 G90\n#1=5\nG0 X0 Y0 Z1\nG1 Z0 F100\n{line} F100\nM2\n")
+    source.write_text(f"G21 G90\n#1=5\n#<a>=5\nG0 X0 Y0 Z1\nG1 Z0 F100\n{line} F100\nM2\n")
     out = tmp_path / "out.ngc"
     want = rs274(source)
     assert (want.returncode != 0) == (outcome == "refused"), want.stderr[-200:]

@@ -425,7 +425,7 @@ def test_safe_conversion_warns_once_with_count_and_first_line(block: str, expect
     [
         ("O100 sub", "O-word"),
         ("G1 X#1 F10", "#1 is read before any line of the program sets it"),
-        ("#<depth> = 5", "named parameters ('#<name>') are not supported"),
+        ("#<_depth> = 5", "#<_depth> is a global parameter"),
         ("G1 X[1+2] F10", "'[ ]' expressions"),
         # LinuxCNC's own tests (tests/ccomp, tests/interp/bad): a '*' or a function name
         # inside the brackets was named as a bad checksum or a letter without a number

@@ -1,4 +1,4 @@
-"""Numbered parameters set to numbers (``#100=2.0`` … ``Z#100``), read as those numbers.
+"""Parameters set to numbers (``#100=2.0`` … ``Z#100``, ``#<depth>=1``), read as those numbers.
 
 The rules are LinuxCNC's ("Parameters", G-code overview): a line reads all its parameters
 before it sets any; a sign before ``#n`` negates it. tests/corpus/test_rs274.py has LinuxCNC's
@@ -74,6 +74,36 @@ def test_a_line_reads_its_parameters_before_it_sets_any(parse: Callable[..., Pro
     ]
 
 
+PLOTTER = """G21 ; All units in mm
+G90 ; Set to absolute mode
+; Parameters
+#<pen_up> = -12
+#<Pen_Down> = -13.5
+G00 X35.000001 Y14.999999
+G01 Z#<pen_down> F100.0(Penetrate)
+G01 X25.000000 Y4.999998 F400.000000
+G01 Z#<PEN_UP>
+#<pen up> = -#<pen_down> (spaces do not count: #<penup>)
+G01 Z#<penup> X#<pen_up>
+M2
+"""
+"""A pen plotter's program, as a G-code generator for Inkscape writes it (named parameters
+for the pen's heights, in any case): its last lines set ``#<penup>`` to 13.5 and read it
+(LinuxCNC's rs274 moves: (35, 15, -13.5), (25, 5, -13.5), (25, 5, -12), (-12, 5, 13.5))."""
+
+
+@pytest.mark.parametrize("parse", [parse_gcode, parse_gcode_slow])
+def test_named_parameters_are_read_as_numbered_ones_are(parse: Callable[..., Program]) -> None:
+    program = parse(PLOTTER, source="plot.ngc")
+    ends = [(m.x, m.y, m.z) for m in program.moves if isinstance(m, Linear)]
+    assert ends == [
+        (35.000001, 14.999999, -13.5),
+        (25.0, 4.999998, None),
+        (25.0, 4.999998, -12.0),
+        (-12.0, 4.999998, 13.5),
+    ]
+
+
 def test_lines_keep_their_numbers_comments_and_messages() -> None:
     text = "#1=2 (set #1)\r\nG0 X#1 (MSG, at #1)\rG0 Y-#1 ; #1\n(#1 only here)"
     assert expand_parameters(text, "t.ngc") == (
@@ -92,12 +122,18 @@ def test_lines_keep_their_numbers_comments_and_messages() -> None:
         ("#8=1 G0 X#8\n", "t.ngc:1: #8 is read before any line"),  # set after the read
         ("G0 Z#5220\n", "t.ngc:1: #5220 is a parameter the controller keeps"),
         ("#5211=0\n", "t.ngc:1: #5211 is a parameter the controller keeps"),
-        ("#<depth>=1\nG1 Z#<depth>\n", "t.ngc:1: named parameters ('#<name>') are not"),
+        ("G1 Z#<depth> F10\n", "t.ngc:1: #<depth> is read before any line of the program"),
+        ("#<a>=5 #<b>=#<a>\n", "t.ngc:1: #<a> is read before any line"),  # LinuxCNC: 0
+        ("#<_x>=5\n", "t.ngc:1: #<_x> is a global parameter"),  # LinuxCNC: read-only
+        ("G1 X#<_metric> F10\n", "t.ngc:1: #<_metric> is a global parameter"),
+        ("#<a>=5\nG1 X#<a>5 F10\n", "t.ngc:2: a '#' in 'G1 X#<a>5 F10' is neither"),
+        ("#<>=1\n", "t.ngc:1: a '#' in '#<>=1' is neither"),
+        ("#<a>=[1+2]\n", "t.ngc:1: '[ ]' expressions are not supported"),
         ("#1=2\nG1 X[#1*2] F10\n", "t.ngc:2: '[ ]' expressions are not supported"),
         ("#1=2\n##1=3\n", "t.ngc:2: indirect parameters ('##n') are not supported"),
         # what a line camtool cannot evaluate sets is not known: refused there, not where read
         ("#1=[1+2]\nG1 X#1 F10\n", "t.ngc:1: '[ ]' expressions are not supported"),
-        ("#1=5\n#<a>=2\n#1=#<a>\nG1 X#1 F10\n", "t.ngc:2: named parameters"),
+        ("#1=5\n#1=[#1*2]\nG1 X#1 F10\n", "t.ngc:2: '[ ]' expressions"),
         # LinuxCNC reads a line without its spaces, and a value right after its letter
         ("#1=5\nG1 X#1 .5 F10\n", "t.ngc:2: #1.5 names no parameter"),
         ("#1=5\nG1 X1#1 F10\n", "t.ngc:2: a '#' in 'G1 X1#1 F10' is neither a word's value"),
