@@ -48,6 +48,9 @@ _READ = re.compile(rf"(?<=[A-Za-z])([+-]?)#(?:({_NUM})|{_NAME})")
 """A parameter read as a word's value, right after the word's letter (a sign between them
 negates it): ``X#1``, ``X-#1``, ``Z#<depth>``. A ``#`` anywhere else starts a setting for
 LinuxCNC."""
+_O_WORD = re.compile(r"\s*(?:/\s*)?(?:[Nn]\s*[0-9.]+\s*)?[Oo]\s*[<0-9]")
+"""A line that begins with an O-word (``o<circles> sub``, ``O100 while``), after a block
+delete and a line number."""
 _SPACE = re.compile(r"\s+")
 _COMMENT = re.compile(r"\([^)]*\)|;.*")
 _LINE = re.compile(r"([^\r\n]*)(\r\n|\r|\n|$)")
@@ -55,11 +58,13 @@ _LINE = re.compile(r"([^\r\n]*)(\r\n|\r|\n|$)")
 
 
 def expand_parameters(text: str, source: str) -> str:
-    """``text`` with each read of a numbered parameter set to a number written as that number.
+    """``text`` with each read of a parameter set to a number written as that number.
 
     Lines keep their number and their comments; an assignment leaves a blank. A line this
     does not understand is kept as it stands (the lexer names what it holds), and so is
     every line after it: what such a line sets is not known, and the lexer stops at it first.
+    So is an O-word's line (a subroutine, a loop: what runs after it, with which
+    parameters, is not known; the lexer refuses it), with or without a parameter.
 
     Raises:
         InputError: a parameter read before any line sets it, a system parameter (above
@@ -74,6 +79,9 @@ def expand_parameters(text: str, source: str) -> str:
         if not m[0]:
             break  # the empty match at the end of the text
         line = m[1]
+        if ("o" in line or "O" in line) and _O_WORD.match(line):
+            out.append(text[m.start() :])  # the rest as it stands: the lexer refuses it
+            break
         if "#" in line:
             expanded = _expand_line(line, values, f"{source}:{number}")
             if expanded is None:  # the rest as it stands: the lexer refuses this line

@@ -129,6 +129,11 @@ def test_lines_keep_their_numbers_comments_and_messages() -> None:
         ("#<a>=5\nG1 X#<a>5 F10\n", "t.ngc:2: a '#' in 'G1 X#<a>5 F10' is neither"),
         ("#<>=1\n", "t.ngc:1: a '#' in '#<>=1' is neither"),
         ("#<a>=[1+2]\n", "t.ngc:1: '[ ]' expressions are not supported"),
+        # a subroutine's own parameters (#1 its first argument) are not read at all: the
+        # O-word's line comes first, as in LinuxCNC's circles.ngc
+        ("o<circles> sub\n#<radius> = #1 (R)\n", "t.ngc:1: O-word"),
+        ("N10 O100 sub\nG1 X#1 F10\n", "t.ngc:1: O-word"),
+        ("#1=2\n/ o100 if [#1 GT 1]\nG1 X#1 F10\n", "t.ngc:2: O-word"),
         ("#1=2\nG1 X[#1*2] F10\n", "t.ngc:2: '[ ]' expressions are not supported"),
         ("#1=2\n##1=3\n", "t.ngc:2: indirect parameters ('##n') are not supported"),
         # what a line camtool cannot evaluate sets is not known: refused there, not where read
