@@ -49,8 +49,10 @@ _READ = re.compile(rf"(?<=[A-Za-z])([+-]?)#(?:({_NUM})|{_NAME})")
 negates it): ``X#1``, ``X-#1``, ``Z#<depth>``. A ``#`` anywhere else starts a setting for
 LinuxCNC."""
 _O_WORD = re.compile(r"\s*(?:/\s*)?(?:[Nn]\s*[0-9.]+\s*)?[Oo]\s*[<0-9]")
-"""A line that begins with an O-word (``o<circles> sub``, ``O100 while``), after a block
-delete and a line number."""
+"""A line that begins with an O-word (``o<circles> sub``, ``O100 while``) or a program
+number, after a block delete and a line number."""
+_PROGRAM_NUMBER = re.compile(r"[Oo][0-9]+")
+"""A program number line's words (the lexer's rule)."""
 _SPACE = re.compile(r"\s+")
 _COMMENT = re.compile(r"\([^)]*\)|;.*")
 _LINE = re.compile(r"([^\r\n]*)(\r\n|\r|\n|$)")
@@ -79,7 +81,7 @@ def expand_parameters(text: str, source: str) -> str:
         if not m[0]:
             break  # the empty match at the end of the text
         line = m[1]
-        if ("o" in line or "O" in line) and _O_WORD.match(line):
+        if ("o" in line or "O" in line) and _o_word(line):
             out.append(text[m.start() :])  # the rest as it stands: the lexer refuses it
             break
         if "#" in line:
@@ -90,6 +92,18 @@ def expand_parameters(text: str, source: str) -> str:
             line = expanded
         out.append(line + m[2])
     return "".join(out)
+
+
+def _o_word(raw: str) -> bool:
+    """Whether the line ``raw`` holds an O-word the lexer refuses (:data:`_O_WORD`).
+
+    A program number alone (``O1000 (PART)``, Fanuc's and Haas's first line) is none: the
+    lexer reads it as nothing, and the parameters after it are read.
+    """
+    if not _O_WORD.match(raw):
+        return False
+    code = "".join(text for text, comment in _split_comments(raw) if not comment)
+    return not _PROGRAM_NUMBER.fullmatch(_SPACE.sub("", code.strip().removeprefix("/")))
 
 
 def _expand_line(raw: str, values: dict[Key, str], where: str) -> str | None:

@@ -104,6 +104,14 @@ def test_named_parameters_are_read_as_numbered_ones_are(parse: Callable[..., Pro
     ]
 
 
+def test_a_program_number_line_is_no_o_word_to_stop_at() -> None:
+    # Fanuc's and Haas's first line names the program: the parameters after it are read
+    # (rs274 reads a bare O-number as nothing too); an O-word with more is refused there
+    text = "%\nO1000 (PART)\nG21 G90\n#1=5\nG0 X#1 Y0\n/ o0002\nG0 Y-#1\nG1 X0 F9\nM30\n%\n"
+    ends = [(m.x, m.y) for m in parse_gcode(text, source="t.nc").moves if isinstance(m, Rapid)]
+    assert ends == [(5.0, 0.0), (5.0, -5.0)]
+
+
 def test_lines_keep_their_numbers_comments_and_messages() -> None:
     text = "#1=2 (set #1)\r\nG0 X#1 (MSG, at #1)\rG0 Y-#1 ; #1\n(#1 only here)"
     assert expand_parameters(text, "t.ngc") == (
