@@ -30,7 +30,7 @@ from camtool.importers.gcode_params import expand_parameters
 from camtool.importers.gcode_plain import arc_end_off, arc_limits, plain_words, spiral_note
 from camtool.importers.gcode_start import StartRules
 from camtool.importers.gcode_target import READ_AS_WRITTEN, LengthOffsets, Reading, path_control
-from camtool.importers.textfile import BinaryData, decoded_or_latin1
+from camtool.importers.textfile import program_text
 from camtool.model.errors import InputError
 from camtool.model.program import (
     ArcMove,
@@ -65,7 +65,8 @@ def read_gcode(
     """Read a G-code file (``.ngc``, ``.nc``, ``.tap``, ``.gcode`` …) into a program.
 
     Args:
-        path: the file. UTF-8 (with or without BOM), else read as Latin-1.
+        path: the file. UTF-8 (with or without BOM), else read as Latin-1 (binary data is
+            refused).
         source_name: the name messages give the file (default: ``path``).
         reading: what the program is read for (:class:`~camtool.importers.gcode_target.
             Reading`: ``post --feed``, the target's length and work offsets).
@@ -82,7 +83,7 @@ def read_gcode(
     path = Path(path)
     source = source_name or str(path)
     try:
-        text = _text(path.read_bytes(), source)  # the bytes go as soon as they are text
+        text = program_text(path.read_bytes(), source)  # the bytes go as soon as they are text
     except OSError as exc:
         raise InputError(f"{source}: cannot read the file ({exc.strerror or exc})") from exc
     return parse_gcode(text, source=source, reading=reading)
@@ -105,23 +106,7 @@ def read_gcode_bytes(
     Raises:
         InputError: as :func:`parse_gcode`.
     """
-    return parse_gcode(_text(data, source), source=source, reading=reading)
-
-
-def _text(data: bytes, source: str) -> str:
-    """The program's bytes as text (:func:`~camtool.importers.textfile.decoded_or_latin1`).
-
-    Raises:
-        InputError: the bytes are binary data, not text; the message names the byte.
-    """
-    try:
-        return decoded_or_latin1(data)
-    except BinaryData as exc:
-        raise InputError(
-            f"{source}: binary data, not a G-code text file: {exc}, a control character "
-            "that no text holds; is it compressed (.gz, .zip), an archive or another "
-            "program's own file? Give camtool the program as text (.nc, .ngc, .gcode, .tap)"
-        ) from None
+    return parse_gcode(program_text(data, source), source=source, reading=reading)
 
 
 _LINE_END = re.compile(r"\r\n|\r|\n")

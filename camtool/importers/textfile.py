@@ -8,13 +8,16 @@ the others is (ASCII text in UTF-16, as some converters write it) is read as UTF
 that byte order: G-code and point lists are ASCII, and UTF-8 text holds no NUL.
 
 Their lines end at LF, CR LF or CR only (:func:`text_lines`), as a controller and numpy
-read them.
+read them. A G-code program that is no UTF-8 is read as Latin-1, unless it holds binary data
+(:func:`program_text`).
 """
 
 from __future__ import annotations
 
 import codecs
 import re
+
+from camtool.model.errors import InputError
 
 _MARKS = (  # longest first: the UTF-32 LE mark begins with the UTF-16 LE one
     (codecs.BOM_UTF32_LE, "utf-32"),
@@ -92,6 +95,22 @@ def decoded_or_latin1(data: bytes) -> str:
             line = 1 + len(_LINE_END_BYTES.findall(data, 0, offset))
             raise BinaryData(offset, line, data[offset]) from None
         return data.removeprefix(codecs.BOM_UTF8).decode("latin-1")
+
+
+def program_text(data: bytes, source: str) -> str:
+    """A G-code program's bytes as text (:func:`decoded_or_latin1`).
+
+    Raises:
+        InputError: the bytes are binary data, not text; the message names the byte.
+    """
+    try:
+        return decoded_or_latin1(data)
+    except BinaryData as exc:
+        raise InputError(
+            f"{source}: binary data, not a G-code text file: {exc}, a control character "
+            "that no text holds; is it compressed (.gz, .zip), an archive or another "
+            "program's own file? Give camtool the program as text (.nc, .ngc, .gcode, .tap)"
+        ) from None
 
 
 _LINE_END = re.compile(r"\r\n|\r|\n")
