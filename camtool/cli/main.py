@@ -6,6 +6,7 @@ stdout carries data only; messages go to stderr. Exit codes: 0 ok, 1 error,
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import sys
 from pathlib import Path
@@ -292,6 +293,7 @@ def verify(
     from camtool.jobs.inputs import check_not_drawing, read_code, read_input
     from camtool.jobs.output import check_paths
     from camtool.jobs.pipeline import load_target_checked
+    from camtool.link.plan import controller_refusal
     from camtool.model.progress import Step
     from camtool.verify.verifier import verify_code
 
@@ -325,6 +327,10 @@ def verify(
         progress=progress,
     )
     _measure_budget(v, progress)
+    refused = controller_refusal(text, chosen, code)
+    if refused is not None:  # the program verifies, and the controller would stop at it
+        said = f"{refused}; camtool send refuses the program, sending nothing"
+        v = dataclasses.replace(v, warnings=(*v.warnings, said))
     _finish_verification(
         v,
         report,

@@ -21,7 +21,13 @@ from camtool.link.spec import (
     link_hooks,
     link_spec,
 )
-from camtool.model.errors import DialectError, InputError, UsageError, VerifyLimitError
+from camtool.model.errors import (
+    DialectError,
+    InputError,
+    LinkError,
+    UsageError,
+    VerifyLimitError,
+)
 from camtool.model.program import ArcMove, Dwell, Program
 from camtool.model.units import fmt_num
 
@@ -220,7 +226,10 @@ def prepare_send(
         restore = hooks.resume(blocks[:first], blocks[first], spec)
     sent: Sequence[WireBlock] = Joined(restore, blocks, first) if first or restore else blocks
     if hooks.check is not None:  # before the timing, which simulates every step
-        hooks.check(sent, source)
+        try:
+            hooks.check(sent, source)
+        except InputError as exc:
+            raise InputError(f"{exc}; nothing was sent") from None
     verification, move_times = _times(program, target, verify, max_error_um)
     times = _block_times(blocks, program, _with_z(program, target, move_times))
     sent_times = array("d", [0.0] * len(restore))
@@ -238,6 +247,27 @@ def prepare_send(
         warnings=tuple(dict.fromkeys(warnings)),
         verification=verification,
     )
+
+
+def controller_refusal(code: str | bytes, target: Target, source: str) -> str | None:
+    """The first line of ``code`` that ``target``'s controller refuses, in its link's words.
+
+    What :func:`prepare_send` refuses before the first byte (the link's ``check`` hook:
+    GRBL's own word and code rules), for ``camtool verify`` to say. ``None`` for a program
+    the check accepts, and for a target without a link or a check.
+    """
+    try:
+        spec, hooks = link_spec(target), link_hooks(target)
+    except (LinkError, InputError):  # no link, or a [link] table only send reads
+        return None
+    if hooks.check is None:
+        return None
+    data = code.encode("utf-8") if isinstance(code, str) else code
+    try:
+        hooks.check((hooks.frame or frame_lines)(data, spec, source), source)
+    except InputError as exc:
+        return str(exc)
+    return None
 
 
 def _quiet_first_motion(blocks: Sequence[WireBlock], first: int) -> Sequence[WireBlock]:

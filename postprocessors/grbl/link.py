@@ -387,15 +387,15 @@ def check(blocks: Sequence[WireBlock], source: str) -> None:
         if error is not None:
             raise InputError(
                 f"{source}, {where}: {block.shown!r}: GRBL 1.1 would refuse it with "
-                f"{decode(f'error:{error}')}; nothing was sent: change the line (or post "
-                "the drawing again for grbl)"
+                f"{decode(f'error:{error}')}; change the line (or post the drawing again "
+                "for grbl)"
             )
         wrong = misread(block.text)
         if wrong is not None:
             raise InputError(
                 f"{source}, {where}: {block.shown!r}: GRBL 1.1 reads the first {MAX_DIGITS} "
                 f"digits of a number (nuts_bolts.c read_float): it would read {wrong}; "
-                "nothing was sent: write it with fewer digits, nearer its work zero (or post "
+                "write it with fewer digits, nearer its work zero (or post "
                 "the drawing again for grbl)"
             )
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import signal
 import subprocess
 import sys
@@ -50,6 +51,27 @@ def test_what_grbl_would_refuse_is_refused_before_sending(tmp_path: Path, capsys
     assert code == 3
     assert "cambam.ngc, line 1: 'G21 G90 G64 P0.25 G40': GRBL 1.1 would refuse it" in err
     assert "error:20 (Unsupported command" in err
+
+
+def test_verify_says_what_send_would_refuse(tmp_path: Path, capsys: Any) -> None:
+    # The same CamBam-style header: the program verifies (the reader takes G64), and the
+    # summary and the report say that GRBL stops at its first line, in send's words.
+    # LinuxCNC runs it, and camtool's own grbl program passes the check.
+    path = tmp_path / "cambam.ngc"
+    path.write_text("G21 G90 G64 P0.25 G40\nG0 Z5\nG0 X1 Y1\nG1 Z-0.5 F100\nG1 X2\nG0 Z5\nM2\n")
+    report = tmp_path / "r.json"
+    code, _, err = run(["verify", str(path), "-t", "grbl", "--report", str(report)], capsys)
+    assert code == 0
+    said = "cambam.ngc, line 1: 'G21 G90 G64 P0.25 G40': GRBL 1.1 would refuse it with error:20"
+    assert f"camtool: warning: {tmp_path}/{said}" in err
+    assert "camtool send refuses the program, sending nothing" in err
+    assert any(said in w for w in json.loads(report.read_text())["warnings"])
+    code, _, err = run(["verify", str(path), "-t", "linuxcnc"], capsys)
+    assert code == 0 and "would refuse" not in err
+    posted = tmp_path / "square.gcode"
+    assert main(["post", str(path), "-t", "grbl", "-o", str(posted)]) == 0
+    code, _, err = run(["verify", str(posted), "-t", "grbl"], capsys)
+    assert code == 0 and "would refuse" not in err
 
 
 def test_a_number_grbl_would_read_short_is_refused_before_sending(
