@@ -265,7 +265,7 @@ def controller_refusal(code: str | bytes, target: Target, source: str) -> str | 
     data = code.encode("utf-8") if isinstance(code, str) else code
     try:
         hooks.check((hooks.frame or frame_lines)(data, spec, source), source)
-    except InputError as exc:
+    except (InputError, DialectError) as exc:  # GRBL's check raises the first, a plugin's may
         return str(exc)
     return None
 
