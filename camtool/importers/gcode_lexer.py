@@ -64,6 +64,14 @@ class Block:
     block_delete: bool = False
 
 
+def program_number(code: str) -> bool:
+    """Whether a line's code is a program number alone (:data:`_PROGRAM_NUMBER`).
+
+    ``code``: the line without its comments, blanks and block-delete ``/``, in any case.
+    """
+    return _PROGRAM_NUMBER.fullmatch(code.upper()) is not None
+
+
 def lex_line(raw: str, line: int, source: str) -> Block | None:
     """Split one line into words; ``None`` for a line without words.
 
@@ -95,7 +103,7 @@ def lex_line(raw: str, line: int, source: str) -> Block | None:
     if not code.isascii():
         _refuse_non_ascii(code, where)
     code = code.upper()
-    if _PROGRAM_NUMBER.fullmatch(code):
+    if program_number(code):
         return None  # a program number alone: no words (O-words with more are refused)
     words = _words(code, where)
     if not words:

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import re
 
+from camtool.importers.gcode_lexer import program_number
 from camtool.model.errors import InputError, quoted
 
 LAST_USER = 5000
@@ -48,11 +49,9 @@ _READ = re.compile(rf"(?<=[A-Za-z])([+-]?)#(?:({_NUM})|{_NAME})")
 """A parameter read as a word's value, right after the word's letter (a sign between them
 negates it): ``X#1``, ``X-#1``, ``Z#<depth>``. A ``#`` anywhere else starts a setting for
 LinuxCNC."""
-_O_WORD = re.compile(r"\s*(?:/\s*)?(?:[Nn]\s*[0-9.]+\s*)?[Oo]\s*[<0-9]")
+_O_WORD = re.compile(r"\s*(?:\([^)]*\)\s*)*(?:/\s*)?(?:[Nn]\s*[0-9.]+\s*)?[Oo]\s*[<0-9]")
 """A line that begins with an O-word (``o<circles> sub``, ``O100 while``) or a program
-number, after a block delete and a line number."""
-_PROGRAM_NUMBER = re.compile(r"[Oo][0-9]+")
-"""A program number line's words (the lexer's rule)."""
+number, after comments, a block delete and a line number."""
 _SPACE = re.compile(r"\s+")
 _COMMENT = re.compile(r"\([^)]*\)|;.*")
 _LINE = re.compile(r"([^\r\n]*)(\r\n|\r|\n|$)")
@@ -103,7 +102,7 @@ def _o_word(raw: str) -> bool:
     if not _O_WORD.match(raw):
         return False
     code = "".join(text for text, comment in _split_comments(raw) if not comment)
-    return not _PROGRAM_NUMBER.fullmatch(_SPACE.sub("", code.strip().removeprefix("/")))
+    return not program_number(_SPACE.sub("", code.strip().removeprefix("/")))
 
 
 def _expand_line(raw: str, values: dict[Key, str], where: str) -> str | None:

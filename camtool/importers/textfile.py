@@ -58,14 +58,9 @@ def decoded(data: bytes, errors: str = "strict") -> str:
 class BinaryData(ValueError):
     """Bytes that are no text in any encoding camtool reads (:func:`decoded_or_latin1`).
 
-    Attributes:
-        offset: the first byte that says so, from the start of the file.
-        line: its line (1 for the first; lines end at LF, CR LF or CR).
+    Its message names the first byte that says so, from the start of the file, and its line
+    (1 for the first; lines end at LF, CR LF or CR).
     """
-
-    def __init__(self, offset: int, line: int, byte: int) -> None:
-        super().__init__(f"byte {offset}, on line {line}, is 0x{byte:02X}")
-        self.offset, self.line, self.byte = offset, line, byte
 
 
 _CONTROL = re.compile(rb"[\x00-\x08\x0e-\x19\x1b-\x1f]")
@@ -93,7 +88,7 @@ def decoded_or_latin1(data: bytes) -> str:
         if control is not None:
             offset = control.start()
             line = 1 + len(_LINE_END_BYTES.findall(data, 0, offset))
-            raise BinaryData(offset, line, data[offset]) from None
+            raise BinaryData(f"byte {offset}, on line {line}, is 0x{data[offset]:02X}") from None
         return data.removeprefix(codecs.BOM_UTF8).decode("latin-1")
 
 

@@ -141,6 +141,7 @@ def test_lines_keep_their_numbers_comments_and_messages() -> None:
         # O-word's line comes first, as in LinuxCNC's circles.ngc
         ("o<circles> sub\n#<radius> = #1 (R)\n", "t.ngc:1: O-word"),
         ("N10 O100 sub\nG1 X#1 F10\n", "t.ngc:1: O-word"),
+        ("(first) O100 sub\nG1 X#1 F10\n", "t.ngc:1: O-word"),  # after a comment
         ("#1=2\n/ o100 if [#1 GT 1]\nG1 X#1 F10\n", "t.ngc:2: O-word"),
         ("#1=2\nG1 X[#1*2] F10\n", "t.ngc:2: '[ ]' expressions are not supported"),
         ("#1=2\n##1=3\n", "t.ngc:2: indirect parameters ('##n') are not supported"),
