@@ -231,8 +231,7 @@ def against_thinned(
     if thin.rows < 2 or len(samples) == 0:
         return Against(0.0, 0.0, (0.0, 0.0), 0.0, 0)
     trace = thin.points
-    off = nearest_search.nearest_distances(samples, *_chords(thin)) - tool_radius_mm
-    release_free()  # each search's freed pages back, before the next allocates its own
+    off = _off_drawing(samples, thin, tool_radius_mm)
     apart = _not_cut(samples, sizes, tool_radius_mm, nominal, findings, joint_mm)
     release_free()
     main = _cut_as_drawn(len(samples), apart)
@@ -265,6 +264,30 @@ def against_thinned(
         samples=len(samples),
         not_cut=tuple(features),
     )
+
+
+AGAINST_BLOCK = 1 << 18
+"""Drawing samples :func:`against_thinned` measures at once against one trace: the nearest
+search's working arrays (its unsure samples, their bounds, their nearby ends) exist for one
+block at a time, not for the whole drawing. Only the memory depends on it."""
+
+
+def _off_drawing(samples: FloatArray, thin: cutting_thin.ThinTrace, radius: float) -> FloatArray:
+    """``d(q, trace) − radius`` for each drawing sample ``q`` (``(N, 2)`` mm), mm.
+
+    :func:`~camtool.verify.nearest_search.nearest_distances`, :data:`AGAINST_BLOCK`
+    samples at a time, every block against the same search trees of the trace's ends:
+    the same distances as one call.
+    """
+    a, b = _chords(thin)
+    ends = nearest_search.lazy_ends(a, b)
+    off = np.empty(len(samples), dtype=np.float64)
+    for lo in range(0, len(samples), AGAINST_BLOCK):
+        block = samples[lo : lo + AGAINST_BLOCK]
+        off[lo : lo + len(block)] = nearest_search.nearest_distances(block, a, b, ends=ends)
+        release_free()  # each search's freed pages back, before the next allocates its own
+    off -= radius
+    return off
 
 
 def against_worst(

@@ -679,6 +679,16 @@ def _far_kd(samples: FloatArray, tree: Any, half: float) -> bool:
     return _far_apart(np.square(r0), half)
 
 
+def lazy_ends(a: FloatArray, b: FloatArray) -> _LazyTree:
+    """The search trees of the segments ``a → b`` (``(M, 2)`` mm each), built when first asked.
+
+    For a caller that measures several batches of samples against the same segments: pass
+    it as :func:`nearest_distances`'s ``ends`` to every batch (the same distances as one
+    call with all the samples).
+    """
+    return _LazyTree(_end_points(a, b))
+
+
 def _end_points(a: FloatArray, b: FloatArray) -> FloatArray:
     """``concatenate([a, b])``: the segments' ends, as the searches' trees hold them.
 

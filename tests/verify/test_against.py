@@ -26,3 +26,53 @@ def test_a_rapid_between_two_cuts_is_not_a_cut() -> None:
     assert split.rms_um == pytest.approx(1000.0, abs=1e-6)
     joined = against_drawing(points, drawing, 0.0)  # one run: the joint crosses the line
     assert joined.rms_um < 1000.0
+
+
+def test_the_drawing_measured_in_blocks_is_measured_as_one(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # A 20 mm circle (four arcs) and a 30 mm square, cut by a wobbling trace 0.5 mm
+    # outside each (tool radius 0.5): thousands of drawing samples, measured a block of
+    # 97 at a time (the last block short), must give what one block gives, and the
+    # largest error must be the one shapely measures from the same samples to the trace.
+    import math
+
+    import shapely
+
+    from camtool.model.shapes import Arc
+    from camtool.verify import drawing_compare
+
+    quarter = [(60.0, 50.0), (50.0, 60.0), (40.0, 50.0), (50.0, 40.0), (60.0, 50.0)]
+    arcs = tuple(Arc(quarter[k], quarter[k + 1], (50.0, 50.0), False) for k in range(4))
+    square = Contour(
+        tuple(
+            Line(p, q)
+            for p, q in zip(
+                [(0.0, 0.0), (30.0, 0.0), (30.0, 30.0), (0.0, 30.0)],
+                [(30.0, 0.0), (30.0, 30.0), (0.0, 30.0), (0.0, 0.0)],
+                strict=True,
+            )
+        ),
+        True,
+    )
+    drawing = Drawing((Contour(arcs, True), square))
+    t = np.linspace(0.0, 2.0 * math.pi, 4001)
+    wobble = 0.5 + 0.003 * np.sin(37.0 * t)
+    circle = np.column_stack(
+        [50.0 + (10.0 + wobble) * np.cos(t), 50.0 + (10.0 + wobble) * np.sin(t)]
+    )
+    s = np.linspace(0.0, 1.0, 1001)
+    side = np.column_stack([s * 31.0 - 0.5, np.full_like(s, -0.5 - 0.002 * np.sin(50.0 * s))])
+    points = np.vstack([circle, side])
+    runs = np.repeat([0, 1], [len(circle), len(side)])
+
+    whole = against_drawing(points, drawing, 0.5, runs=runs)
+    monkeypatch.setattr(drawing_compare, "AGAINST_BLOCK", 97)
+    blocks = against_drawing(points, drawing, 0.5, runs=runs)
+    assert blocks == whole
+    assert whole.samples > 97 * 10 and whole.samples % 97  # many blocks, the last short
+
+    samples, _ = drawing_compare._sample_drawing(drawing, drawing_compare.AGAINST_SPACING_MM)
+    traces = shapely.multilinestrings([shapely.linestrings(circle), shapely.linestrings(side)])
+    off = shapely.distance(shapely.points(samples), traces) - 0.5
+    assert whole.max_um == pytest.approx(float(np.max(np.abs(off))) * 1000.0, abs=0.05)
