@@ -317,6 +317,19 @@ def against_worst(
     return nearest_search.farthest_off(kept, *_chords(thin), tool_radius_mm) * 1000.0
 
 
+def _halves(joined: npt.NDArray[np.bool_], points: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """``(points[:-1][joined], points[1:][joined])``, the two halves of one array.
+
+    The nearest search's trees hold a segment's ends as that array
+    (:func:`~camtool.verify.nearest_search.nearest_distances`): no second copy of every end.
+    """
+    count = int(np.count_nonzero(joined))
+    ends = np.empty((2 * count, 2), dtype=np.float64)
+    np.compress(joined, points[:-1], axis=0, out=ends[:count])
+    np.compress(joined, points[1:], axis=0, out=ends[count:])
+    return ends[:count], ends[count:]
+
+
 def _chords(thin: cutting_thin.ThinTrace) -> tuple[FloatArray, FloatArray]:
     """The machined edge's segments: ``(a, b)`` joining consecutive rows of a run of ``thin``.
 
@@ -327,11 +340,7 @@ def _chords(thin: cutting_thin.ThinTrace) -> tuple[FloatArray, FloatArray]:
     joined = np.ones(len(trace) - 1, dtype=bool) if runs is None else runs[1:] == runs[:-1]
     if not joined.any():
         joined[:] = True
-    count = int(np.count_nonzero(joined))
-    ends = np.empty((2 * count, 2), dtype=np.float64)  # a then b: the search's ends, no copy
-    np.compress(joined, trace[:-1], axis=0, out=ends[:count])
-    np.compress(joined, trace[1:], axis=0, out=ends[count:])
-    return ends[:count], ends[count:]
+    return _halves(joined, trace)
 
 
 def _not_cut(
@@ -398,8 +407,7 @@ def _least_nearest(points: FloatArray, samples: FloatArray, sizes: list[int]) ->
     least anchor's distance are measured; each point's distance is its own, so the
     least of them is the least of all, bit for bit. ``inf`` without chords.
     """
-    same = _same_contour(sizes)
-    a, b = samples[:-1][same], samples[1:][same]
+    a, b = _halves(_same_contour(sizes), samples)
     n = len(points)
     if n == 0 or len(a) == 0:
         return math.inf
@@ -407,7 +415,8 @@ def _least_nearest(points: FloatArray, samples: FloatArray, sizes: list[int]) ->
         return float(np.min(nearest_search.nearest_distances(points, a, b)))
     every = OVERCUT_ANCHOR
     anchors = np.append(np.arange(0, n - 1, every), n - 1)
-    got = nearest_search.nearest_distances(points[anchors], a, b)
+    ends = nearest_search.lazy_ends(a, b)  # the chords' search trees, built once for both
+    got = nearest_search.nearest_distances(points[anchors], a, b, ends=ends)
     upper = float(np.min(got))
     scale = max(
         path_shortfall._largest_magnitude(points), path_shortfall._largest_magnitude(samples)
@@ -426,7 +435,8 @@ def _least_nearest(points: FloatArray, samples: FloatArray, sizes: list[int]) ->
     maybe[anchors] = False  # measured
     if not maybe.any():
         return upper
-    return min(upper, float(np.min(nearest_search.nearest_distances(points[maybe], a, b))))
+    nearest = nearest_search.nearest_distances(points[maybe], a, b, ends=ends)
+    return min(upper, float(np.min(nearest)))
 
 
 _DISTANCE_TO: LastAnswers[FloatArray] = LastAnswers()
