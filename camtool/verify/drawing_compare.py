@@ -230,7 +230,6 @@ def against_thinned(
     samples, sizes = _sample_drawing(drawing, spacing_mm)
     if thin.rows < 2 or len(samples) == 0:
         return Against(0.0, 0.0, (0.0, 0.0), 0.0, 0)
-    trace = thin.points
     off = _off_drawing(samples, thin, tool_radius_mm)
     apart = _not_cut(samples, sizes, tool_radius_mm, nominal, findings, joint_mm)
     release_free()
@@ -245,21 +244,29 @@ def against_thinned(
         )
         for finding, index, at in apart
     ]
-    if main.all():  # no feature apart: the arrays themselves, not copies
-        kept, kept_at = off, samples
+    if main.all():  # no feature apart: the array itself, not a copy
+        kept, rows = off, None
     elif main.any():
-        kept, kept_at = off[main], samples[main]
+        kept, rows = off[main], np.flatnonzero(main)
     else:
-        kept, kept_at = np.zeros(1), np.zeros((1, 2))
+        kept, rows = np.zeros(1), None
     worst = int(np.argmax(np.abs(kept)))
+    max_um = float(abs(kept[worst])) * 1000.0
+    rms_um = float(np.sqrt(np.mean(kept * kept))) * 1000.0
+    if main.any():
+        row = worst if rows is None else int(rows[worst])
+        at_mm = (float(samples[row, 0]), float(samples[row, 1]))
+    else:
+        at_mm = (0.0, 0.0)
+    del off, kept, rows, main, apart  # not held while the overcut's search builds its trees
     overcut_um = 0.0
     if overcut and tool_radius_mm > 0:
-        least = _least_nearest(trace, samples, sizes)
+        least = _least_nearest(thin.points, samples, sizes)
         overcut_um = max(0.0, float(tool_radius_mm - least)) * 1000.0
     return Against(
-        max_um=float(abs(kept[worst])) * 1000.0,
-        rms_um=float(np.sqrt(np.mean(kept * kept))) * 1000.0,
-        at_mm=(float(kept_at[worst, 0]), float(kept_at[worst, 1])),
+        max_um=max_um,
+        rms_um=rms_um,
+        at_mm=at_mm,
         overcut_um=overcut_um,
         samples=len(samples),
         not_cut=tuple(features),

@@ -76,3 +76,37 @@ def test_the_drawing_measured_in_blocks_is_measured_as_one(
     traces = shapely.multilinestrings([shapely.linestrings(circle), shapely.linestrings(side)])
     off = shapely.distance(shapely.points(samples), traces) - 0.5
     assert whole.max_um == pytest.approx(float(np.max(np.abs(off))) * 1000.0, abs=0.05)
+
+
+def test_the_worst_point_is_found_among_the_samples_cut_as_drawn() -> None:
+    # A 1 mm square the tool could not enter (an offset-vanished finding at its centre,
+    # its samples first) and a 10 mm line y = 0 cut with a 0.5 mm radius along y = 0.5,
+    # with a 10 µm bump at x = 7 (slopes of 1 in 50). From analysis: the largest error of
+    # what was cut as drawn is at the drawing point (7, 0) below the bump, whose nearest
+    # trace points lie on the slopes, 0.51 / √(1 + 0.02²) away, less the radius: 9.898 µm.
+    # The square is reported apart.
+    from types import SimpleNamespace
+
+    square = Contour(
+        tuple(
+            Line(p, q)
+            for p, q in zip(
+                [(20.0, 20.0), (21.0, 20.0), (21.0, 21.0), (20.0, 21.0)],
+                [(21.0, 20.0), (21.0, 21.0), (20.0, 21.0), (20.0, 20.0)],
+                strict=True,
+            )
+        ),
+        True,
+    )
+    drawing = Drawing((square, Contour((Line((0.0, 0.0), (10.0, 0.0)),), False)))
+    x = np.linspace(0.0, 10.0, 4001)
+    trace = np.column_stack([x, 0.5 + 0.01 * np.clip(1.0 - np.abs(x - 7.0) / 0.5, 0.0, None)])
+    nominal = [np.array([[0.0, 0.5], [10.0, 0.5]])]
+    vanished = SimpleNamespace(kind="offset-vanished", at=(20.5, 20.5), value=None)
+    against = against_drawing(trace, drawing, 0.5, nominal=nominal, findings=[vanished])
+    assert [f.kind for f in against.not_cut] == ["offset-vanished"]
+    import math
+
+    expected_um = (0.51 / math.sqrt(1.0 + 0.02**2) - 0.5) * 1000.0
+    assert against.max_um == pytest.approx(expected_um, abs=0.001)
+    assert against.at_mm == pytest.approx((7.0, 0.0), abs=0.005)
