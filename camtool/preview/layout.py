@@ -28,6 +28,7 @@ from camtool.preview.scene import (
     Style,
     Text,
     expand,
+    mark_box,
     nice_length,
     polyline,
     ramp_colour,
@@ -169,6 +170,10 @@ def _main_layers(c: Content, u: float, frame: BBox, pixel_mm: float) -> list[Lay
         layers.append(pl.work_area_layer(c.work_area, u))
     if c.drawing is not None and c.drawing.contours:
         layers.append(pl.drawing_layer(c.drawing, u))
+    v = c.verification
+    worst = None
+    if v is not None and v.deviation.block >= 0:
+        worst = tl.worst_layer("worst", v, u, view=frame)
     program = []
     if c.program is not None:
         program = pl.program_layers(
@@ -178,9 +183,11 @@ def _main_layers(c: Content, u: float, frame: BBox, pixel_mm: float) -> list[Lay
             sections=c.sections,
             pixel_mm=pixel_mm,
             frame=frame,
+            clear=[mark_box(s) for s in worst.shapes if isinstance(s, Text | Circle)]
+            if worst
+            else [],
         )
     layers.extend(layer for layer in program if layer.id == "tool-width")
-    v = c.verification
     if v is not None:
         points, run, dev_um = tl.cutting_trace(v)
         pieces = tl.binned_polylines(points, run, dev_um, tolerance=u / 5.0, top_um=tl.top_um(v))
@@ -189,8 +196,8 @@ def _main_layers(c: Content, u: float, frame: BBox, pixel_mm: float) -> list[Lay
     layers.append(pl.zero_layer(frame, u))
     if v is not None and v.against is not None and v.against.not_cut:
         layers.append(tl.not_cut_layer("not-cut", v.against.not_cut, u))
-    if v is not None and v.deviation.block >= 0:
-        layers.append(tl.worst_layer("worst", v, u, view=frame))
+    if worst is not None:
+        layers.append(worst)
     return [layer for layer in layers if layer.shapes]
 
 

@@ -135,6 +135,7 @@ def program_layers(
     sections: Sequence[Section] = (),
     pixel_mm: float | None = None,
     frame: BBox | None = None,
+    clear: Sequence[BBox] = (),
 ) -> list[Layer]:
     """Tool width, rapids, cuts, starts, order and tool changes of ``program``.
 
@@ -156,9 +157,11 @@ def program_layers(
         frame: the main panel's frame, mm: order numbers are kept inside it, clear of
             each other, of the tool numbers and of the work zero's label
             (:func:`order_labels`). ``None``: not bounded.
+        clear: boxes (mm) the order numbers keep clear of too: the worst point's ring and
+            its label, which say more.
     """
     if pixel_mm is not None and len(program.moves) > DETAIL_MOVES:
-        return _dense_layers(program, u, pixel_mm, edge_radius_mm, sections, frame)
+        return _dense_layers(program, u, pixel_mm, edge_radius_mm, sections, frame, clear)
     all_runs = runs_of(program, [first for _, first, _ in sections])
     runs = [run.segments for run in all_runs]
     first = numbered(all_runs)
@@ -175,7 +178,7 @@ def program_layers(
         Layer("cuts", _cut_paths(all_runs, sections, u)),
         Layer("tabs", tab_shapes(tab_segments(program), u)),
         Layer("starts", tuple(s for i in shown for s in _start_marker(runs[i], u))),
-        Layer("order", order_labels(program, runs, first, shown, u, frame)),
+        Layer("order", order_labels(program, runs, first, shown, u, frame, clear)),
         Layer("tool-changes", change_marks(program, u)),
     ]
     return [layer for layer in layers if layer.shapes]
@@ -188,13 +191,15 @@ def order_labels(
     shown: list[int],
     u: float,
     frame: BBox | None,
+    clear: Sequence[BBox] = (),
 ) -> tuple[Text, ...]:
     """The order numbers of the ``shown`` runs (:func:`~camtool.preview.scene.place_labels`).
 
     Inside ``frame`` (when given) and clear of each other, of the tool numbers
-    (:func:`change_marks`) and of the work zero's label (:func:`zero_label`).
+    (:func:`change_marks`), of the work zero's label (:func:`zero_label`) and of the
+    boxes of ``clear`` (mm).
     """
-    taken = [text_box(t) for t in change_marks(program, u) if isinstance(t, Text)]
+    taken = [*clear, *(text_box(t) for t in change_marks(program, u) if isinstance(t, Text))]
     if frame is not None and (zero := zero_label(frame, u)) is not None:
         taken.append(text_box(zero))
     numbers = [_number(first.index(i) + 1, runs[i], u) for i in shown]
@@ -406,6 +411,7 @@ def _dense_layers(
     edge_radius_mm: float,
     sections: Sequence[Section],
     frame: BBox | None,
+    clear: Sequence[BBox],
 ) -> list[Layer]:
     """:func:`program_layers` of a big program, drawn at the picture's resolution.
 
@@ -461,7 +467,7 @@ def _dense_layers(
         ),
         Layer("tabs", (Segments(tabs.thinned(), Style(TAB_COLOUR, 1.0 * u)),) if tabs else ()),
         Layer("starts", tuple(s for i in shown for s in _start_marker(segments[i], u))),
-        Layer("order", order_labels(program, segments, first, shown, u, frame)),
+        Layer("order", order_labels(program, segments, first, shown, u, frame, clear)),
         Layer("tool-changes", change_marks(program, u)),
     ]
     return [layer for layer in layers if layer.shapes]

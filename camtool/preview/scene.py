@@ -216,6 +216,14 @@ def text_box(t: Text) -> BBox:
     return (x, t.at[1] - 0.3 * t.size, x + w, t.at[1] + 0.9 * t.size)
 
 
+def mark_box(shape: Text | Circle) -> BBox:
+    """The box a label or a ring takes (window units): :func:`text_box`, or the circle's."""
+    if isinstance(shape, Text):
+        return text_box(shape)
+    (x, y), r = shape.centre, shape.radius
+    return (x - r, y - r, x + r, y + r)
+
+
 def kept_indices(n: int, limit: int = MAX_LABELS) -> list[int]:
     """Which of ``n`` marks of one kind a picture shows: all up to ``limit``, else every k-th.
 

@@ -215,3 +215,69 @@ def test_not_cut_features_are_marked(suffix: str) -> None:
     assert labels == ["2 mm wide region", "tight corner", "tight corner"]
     title = _title(data)
     assert any("3 features not cut as drawn with this tool (max 12.0 mm)" in t for t in title)
+
+
+def test_order_numbers_keep_clear_of_the_worst_points_label() -> None:
+    # 40 short cuts on a 2 mm grid: their numbers sit by their starts. A box over the
+    # middle of the grid (where the worst point's ring and label are drawn) must hold
+    # none of them when it is given to keep clear of (each is moved aside, or hidden where
+    # no place near its start is free); without it some sit there. The numbers that were
+    # clear of it stay.
+    from camtool.preview.program_layers import program_layers
+
+    moves = []
+    for i in range(40):
+        x, y = float(i % 8) * 2.0, float(i // 8) * 2.0
+        moves += [Rapid(x, y), Linear(x + 1.0, y, 100.0, contour=i + 1)]
+    program = Program(tuple(moves))
+    worst = (4.0, 3.0, 12.0, 6.0)
+
+    def numbers(layers: list[Layer]) -> tuple[set[str], set[str]]:
+        """The order numbers shown, and those whose box meets ``worst``."""
+        order = next(layer for layer in layers if layer.id == "order")
+        texts = [t for t in order.shapes if isinstance(t, Text)]
+        meets = {
+            t.text
+            for t in texts
+            if (b := text_box(t))[0] < worst[2]
+            and worst[0] < b[2]
+            and b[1] < worst[3]
+            and worst[1] < b[3]
+        }
+        return {t.text for t in texts}, meets
+
+    shown, meets = numbers(program_layers(program, 0.2))
+    assert len(shown) == 40 and meets
+    shown_clear, meets_clear = numbers(program_layers(program, 0.2, clear=[worst]))
+    assert not meets_clear
+    assert shown - meets <= shown_clear
+
+
+def test_the_preview_keeps_the_order_numbers_clear_of_the_worst_point(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # A verified job's picture: the order numbers are placed clear of the worst point's
+    # ring and of its label ("max … µm, line N"), which a number written over it misread.
+    from camtool.jobs.pipeline import post_drawing, verify_job
+    from camtool.post.registry import load_target
+    from camtool.preview import program_layers as pl
+    from camtool.toolpath.options import PlanOptions
+    from tests.verify.test_metrics_not_cut import R, plate
+
+    job = post_drawing(
+        plate(), load_target("grbl"), PlanOptions(offset="outside", tool_diameter=2 * R)
+    )
+    v = verify_job(job)
+    asked: list[object] = []
+    plain = pl.program_layers
+
+    def program_layers(*args: object, **kwargs: object) -> object:
+        asked.append(kwargs.get("clear"))
+        return plain(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(pl, "program_layers", program_layers)
+    render_preview(".svg", verification=v, drawing=job.placed, edge_radius_mm=R)
+    (clear,) = asked
+    wx, wy = v.deviation.at_mm
+    assert isinstance(clear, list) and len(clear) == 3  # the ring, its dot, the label
+    assert all(b[0] <= wx <= b[2] and b[1] <= wy <= b[3] for b in clear[:2])
