@@ -13,6 +13,13 @@ def _line(y: float) -> np.ndarray:
     return np.column_stack([np.linspace(0.0, 10.0, 2001), np.full(2001, y)])
 
 
+def _square(x: float, y: float, side: float) -> Contour:
+    """The closed square of ``side`` mm with its lower-left corner at ``(x, y)``, as four lines."""
+    corners = [(x, y), (x + side, y), (x + side, y + side), (x, y + side)]
+    ends = corners[1:] + corners[:1]
+    return Contour(tuple(Line(p, q) for p, q in zip(corners, ends, strict=True)), True)
+
+
 def test_a_rapid_between_two_cuts_is_not_a_cut() -> None:
     # A drawn line y = 5 from x = 0 to 10, cut on the line (tool radius 0) by two passes at
     # y = 4 and y = 6, each 1 mm away. Their trace points, concatenated, would join (10, 4) to
@@ -44,17 +51,7 @@ def test_the_drawing_measured_in_blocks_is_measured_as_one(
 
     quarter = [(60.0, 50.0), (50.0, 60.0), (40.0, 50.0), (50.0, 40.0), (60.0, 50.0)]
     arcs = tuple(Arc(quarter[k], quarter[k + 1], (50.0, 50.0), False) for k in range(4))
-    square = Contour(
-        tuple(
-            Line(p, q)
-            for p, q in zip(
-                [(0.0, 0.0), (30.0, 0.0), (30.0, 30.0), (0.0, 30.0)],
-                [(30.0, 0.0), (30.0, 30.0), (0.0, 30.0), (0.0, 0.0)],
-                strict=True,
-            )
-        ),
-        True,
-    )
+    square = _square(0.0, 0.0, 30.0)
     drawing = Drawing((Contour(arcs, True), square))
     t = np.linspace(0.0, 2.0 * math.pi, 4001)
     wobble = 0.5 + 0.003 * np.sin(37.0 * t)
@@ -87,17 +84,7 @@ def test_the_worst_point_is_found_among_the_samples_cut_as_drawn() -> None:
     # The square is reported apart.
     from types import SimpleNamespace
 
-    square = Contour(
-        tuple(
-            Line(p, q)
-            for p, q in zip(
-                [(20.0, 20.0), (21.0, 20.0), (21.0, 21.0), (20.0, 21.0)],
-                [(21.0, 20.0), (21.0, 21.0), (20.0, 21.0), (20.0, 20.0)],
-                strict=True,
-            )
-        ),
-        True,
-    )
+    square = _square(20.0, 20.0, 1.0)
     drawing = Drawing((square, Contour((Line((0.0, 0.0), (10.0, 0.0)),), False)))
     x = np.linspace(0.0, 10.0, 4001)
     trace = np.column_stack([x, 0.5 + 0.01 * np.clip(1.0 - np.abs(x - 7.0) / 0.5, 0.0, None)])
