@@ -310,8 +310,13 @@ def verify(
     drawing = read_input(against) if against is not None else None
     if drawing is not None:
         warn([f"--against: {w}" for w in drawing.warnings])  # what the comparison rests on
+    skipped = None
     if drawing is not None and isinstance(text, str):
-        drawing, tool_diameter = _as_posted(text, drawing, tool_diameter)
+        skipped = _job_not_compared(text, chosen.name)
+        if skipped is None:
+            drawing, tool_diameter = _as_posted(text, drawing, tool_diameter)
+        else:
+            drawing = None
     progress = click.get_current_context().with_resource(StageReporter())
     load_picture = click.get_current_context().with_resource(picture_ahead(preview))
     load_picture()  # matplotlib, on the core the verification's start leaves idle
@@ -326,6 +331,8 @@ def verify(
         budget_now=progress,
         progress=progress,
     )
+    if skipped is not None:
+        v = dataclasses.replace(v, against_skipped=skipped, warnings=(*v.warnings, skipped))
     _measure_budget(v, progress)
     refused = controller_refusal(text, chosen, code)
     if refused is not None:  # the program verifies, and the controller would stop at it
@@ -339,6 +346,29 @@ def verify(
         drawing=drawing,
         edge_radius_mm=tool_diameter / 2.0,
         strict=strict,
+    )
+
+
+def _job_not_compared(code: str, target: str) -> str | None:
+    """Why the --against drawing of a job's program is not compared (``None``: not a job's).
+
+    Each operation of a job file cuts what its selection keeps with its own tool; the
+    program records neither, so the distance of its cuts to the whole drawing (centre lines
+    and construction included, at the tool centre) would be read as machining error.
+    ``post --job --verify`` compares each operation with what it cuts.
+    """
+    from camtool.jobs.header import read_job
+
+    job = read_job(code)
+    if job is None:
+        return None
+    name, count = job
+    operations = f"{count} operation{'s' if count != 1 else ''}"
+    return (
+        f"--against: the program is the job {name or 'of the command line'} ({operations}), "
+        "each operation cutting what it selects with its own tool, which the program does "
+        f"not record; `camtool post DRAWING -t {target} --job {name or 'FILE.toml'} "
+        "--verify` compares each with what it cuts; not compared"
     )
 
 

@@ -226,6 +226,26 @@ def read_offset(code: str) -> tuple[str, float] | None:
 _TOOL = re.compile(r"tool diameter ([0-9.eE+-]+) mm, offset (outside|inside|pocket)")
 
 
+def read_job(code: str) -> tuple[str, int] | None:
+    """``(job file, operations)`` a camtool header in ``code`` records for a job, or ``None``.
+
+    The line :func:`job_notes` writes for a job file's program (``job part.toml: 3
+    operations``); ``None`` for a program of ``post``'s own options, or without camtool's
+    header (another tool's comment is never taken).
+    """
+    head = code.splitlines()[:60]
+    if not any(_CAMTOOL.search(line) for line in head):
+        return None
+    for line in head:
+        found = _JOB.search(line)
+        if found is not None:
+            return found["name"], int(found["n"])
+    return None
+
+
+_JOB = re.compile(r"\bjob (?P<name>.*): (?P<n>[0-9]+) operations?\b")
+
+
 def _work_zero(plan: PlanOptions) -> str:
     """Where X0 Y0 of the program lies, for the job notes (``--origin``, ``--translate``)."""
     where = {

@@ -250,7 +250,7 @@ def _against_line(v: Verification) -> str:
     """The title line of the drawing comparison ("" when no drawing was given)."""
     a = v.against
     if a is None:
-        return "" if v.against_skipped is None else "the drawing does not overlap: not compared"
+        return "" if v.against_skipped is None else "the drawing: not compared (see the warnings)"
     text = f"against the drawing: max {fmt_num(a.max_um, 2)} µm"
     if a.not_cut:
         n = len(a.not_cut)

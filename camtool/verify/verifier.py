@@ -75,7 +75,7 @@ class Verification:
         block_time_s: ``(B,)`` float64 estimated time of each move, s.
         warnings: what a machinist should know before cutting.
         against_skipped: why a drawing that was given was not compared (the
-            program and the drawing do not overlap), else ``None``; then
+            program and the drawing do not overlap; a job's program), else ``None``; then
             ``against`` is ``None`` and no limit can be judged against it.
         along: the programmed path seen from the trace (the shortfall, the
             error at every move's end), ``None`` for a verification built by hand.
@@ -185,14 +185,14 @@ class Verification:
 
         The limit judges what was cut as drawn (``strict``: also the features the
         planner reported it cannot cut with this tool). A drawing that was given but
-        not compared (it does not overlap the program) fails: it cannot pass unjudged.
+        not compared (:attr:`against_skipped`) fails: it cannot pass unjudged.
         """
         skipped = [p.label for p in self.parts if p.verification.against_skipped is not None]
         if self.against_skipped is not None or skipped:
             where = f" of {', '.join(skipped)}" if skipped else ""
             return (
                 f"--max-error-um {limit_um:g} cannot be judged: the drawing{where} was not "
-                "compared (it does not overlap the program; see the warning above)"
+                "compared (see the warning above)"
             )
         error = self.strict_error_um if strict else self.max_error_um
         if error <= limit_um:

@@ -50,3 +50,41 @@ def test_verify_against_places_the_drawing_as_posted(run: Any, tmp_path: Path) -
 def test_a_comment_of_another_tool_is_not_read() -> None:
     foreign = "(placement: scale 2, shift X5 Y5 mm)\nG0 X1 Y1\n"
     assert read_placement(foreign) is None
+
+
+PART, PART_JOB = str(ROOT / "samples" / "part.dxf"), str(ROOT / "samples" / "part.toml")
+
+
+def test_verify_against_does_not_compare_a_jobs_program(run: Any, tmp_path: Path) -> None:
+    # samples/part.toml drills with a 3.2 mm drill and cuts the pocket and outline with a
+    # 3 mm end mill; its CENTER lines are cut by no operation. The program records none of
+    # that, so its distance to the whole drawing would be read as machining error: the
+    # drawing is not compared, the report says why, and a limit cannot pass unjudged.
+    out, report = tmp_path / "part.ngc", tmp_path / "report.json"
+    code, err = run("post", PART, "-t", "linuxcnc", "--job", PART_JOB, "-o", str(out))
+    assert code == 0, err
+    args = ["verify", str(out), "-t", "linuxcnc", "--against", PART, "--report", str(report)]
+    code, err = run(*args)
+    assert code == 0, err
+    assert "the program is the job part.toml (4 operations)" in err
+    assert "--job part.toml --verify" in err
+    data = json.loads(report.read_text())
+    assert data["against"] is None
+    assert "the program is the job part.toml" in data["against_skipped"]
+    code, err = run(*args, "--max-error-um", "1000")
+    assert code == 4, err
+    assert "--max-error-um 1000 cannot be judged" in err
+
+
+def test_the_job_a_header_names_is_read_from_camtools_header_only(run: Any, tmp_path: Path) -> None:
+    from camtool.jobs.header import read_job
+
+    out = tmp_path / "part.ngc"
+    code, err = run("post", PART, "-t", "linuxcnc", "--job", PART_JOB, "-o", str(out))
+    assert code == 0, err
+    assert read_job(out.read_text()) == ("part.toml", 4)
+    plain = tmp_path / "plate.nc"
+    code, err = run("post", PLATE, "-t", "grbl", *OPTIONS, "-o", str(plain))
+    assert code == 0, err
+    assert read_job(plain.read_text()) is None
+    assert read_job("(job part.toml: 4 operations)\nG0 X1 Y1\n") is None  # another tool's
