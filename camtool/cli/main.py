@@ -396,6 +396,7 @@ def _as_posted(code: str, drawing: Drawing, tool_diameter: float) -> tuple[Drawi
             f"(scale {k:g}, shift X{dx:g} Y{dy:g} mm)",
             err=True,
         )
+    drawing = _as_selected(code, drawing)
     offset = read_offset(code)
     if offset is None:
         return drawing, tool_diameter
@@ -416,6 +417,54 @@ def _as_posted(code: str, drawing: Drawing, tool_diameter: float) -> tuple[Drawi
         )
         return drawing, recorded
     return drawing, tool_diameter
+
+
+def _as_selected(code: str, drawing: Drawing) -> Drawing:
+    """The --against drawing without what ``post`` did not cut: its selection, as recorded.
+
+    ``post``'s one operation cuts the layers ``--layers`` named (the header's ``layers:``
+    line), else every layer, and never construction it was not asked for by name (centre
+    and hidden lines, dimension layers: :func:`camtool.jobs.selection.construction_reason`).
+    A re-posted program, a job's and another tool's have no such header: nothing is left
+    out here.
+
+    Raises:
+        UsageError: the header names a layer the drawing does not have (another drawing,
+            or a name the program's comments could not hold): nothing could be compared
+            as it was cut.
+    """
+    from camtool.jobs.header import read_layers, read_single
+    from camtool.jobs.job import Selection
+    from camtool.jobs.selection import construction_reason, matches
+
+    if not read_single(code):
+        return drawing
+    layers = read_layers(code)
+    if layers is not None:
+        have = {c.layer.casefold() for c in drawing.contours}
+        missing = [n for n in layers if n.casefold() not in have]
+        if missing:
+            raise UsageError(
+                f"--against: the program was posted with --layers {','.join(layers)}, and "
+                f"the drawing has no layer {missing[0]!r} (its layers: "
+                f"{', '.join(sorted({c.layer for c in drawing.contours}))}); give the "
+                "drawing the program was posted from, or verify without --against"
+            )
+    selection = Selection(layers=layers)
+    left = frozenset(
+        i
+        for i, c in enumerate(drawing.contours)
+        if not matches(c, selection) or construction_reason(c, selection) is not None
+    )
+    if left and len(left) < len(drawing.contours):
+        why = f"not on its layers {', '.join(layers)}" if layers else "construction"
+        click.echo(
+            f"camtool: --against: {len(left)} contour(s) of the drawing not compared: "
+            f"the program's header says post cut none of them ({why})",
+            err=True,
+        )
+        return drawing.without(left)
+    return drawing
 
 
 def _write_pieces(job: PostJob, output: str, inputs: list[tuple[str, Any]]) -> None:

@@ -85,6 +85,9 @@ def job_notes(
     elif plan.offset == "pocket":
         tool += f" ({plan.pocket}, stepover {plan.stepover:g})"
     notes.append(tool)
+    layers = job.operations[0].select.layers if job is not None and job.operations else None
+    if layers:  # --layers: what verify --against compares (read_layers)
+        notes.append(f"layers: {', '.join(layers)}")
     notes.append(_work_zero(plan))
     if not target.machine.has_z:
         notes.append("no Z axis: set the depth by hand")
@@ -243,6 +246,38 @@ def read_job(code: str) -> tuple[str, int] | None:
     return None
 
 
+def read_layers(code: str) -> tuple[str, ...] | None:
+    """The layers ``post --layers`` cut, as a camtool header in ``code`` records them.
+
+    ``None`` without such a line (every layer but construction was cut), or without
+    camtool's header. The names are as the dialect's comments hold them (``(``, ``)`` and
+    characters outside printable ASCII replaced, a long line cut short): a name the
+    drawing does not have is the caller's to refuse.
+    """
+    head = code.splitlines()[:60]
+    if not any(_CAMTOOL.search(line) for line in head):
+        return None
+    for line in head:
+        found = _LAYERS.search(line)
+        if found is not None:
+            return tuple(n.strip() for n in found[1].split(", ") if n.strip())
+    return None
+
+
+def read_single(code: str) -> bool:
+    """Whether ``code`` is a program camtool planned from a drawing with ``post``'s options.
+
+    Its header (camtool's first line, then the tool line :func:`job_notes` writes for one
+    operation): not a job file's program, nor a re-posted one.
+    """
+    head = code.splitlines()[:60]
+    if not any(_CAMTOOL.search(line) for line in head):
+        return False
+    return any(_TOOL.search(line) or _ON.search(line) for line in head)
+
+
+_LAYERS = re.compile(r"\blayers: (.*?)\)?$")
+_ON = re.compile(r"offset on: the tool centre follows the drawing")
 _JOB = re.compile(r"\bjob (?P<name>.*): (?P<n>[0-9]+) operations?\b")
 
 

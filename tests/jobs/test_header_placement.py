@@ -88,3 +88,43 @@ def test_the_job_a_header_names_is_read_from_camtools_header_only(run: Any, tmp_
     assert code == 0, err
     assert read_job(plain.read_text()) is None
     assert read_job("(job part.toml: 4 operations)\nG0 X1 Y1\n") is None  # another tool's
+
+
+def test_verify_against_leaves_out_the_construction_post_did_not_cut(
+    run: Any, tmp_path: Path
+) -> None:
+    # samples/part.dxf cut on its lines: post cuts every contour but the ten CENTER lines
+    # (construction). Compared with them, the program read 12 500 µm off (a hole's centre
+    # line is 12.5 mm from the nearest cut); from analysis the cut follows the drawing, so
+    # only the dialect's rounding and the machine's steps are left, a few µm.
+    out, report = tmp_path / "part.ngc", tmp_path / "report.json"
+    code, err = run("post", PART, "-t", "linuxcnc", "-o", str(out))
+    assert code == 0, err
+    code, err = run(
+        "verify", str(out), "-t", "linuxcnc", "--against", PART, "--report", str(report)
+    )
+    assert code == 0, err
+    assert "10 contour(s) of the drawing not compared" in err and "(construction)" in err
+    assert json.loads(report.read_text())["against"]["max_um"] < 20.0
+
+
+def test_verify_against_compares_the_layers_post_cut(run: Any, tmp_path: Path) -> None:
+    # post --layers OUTLINE cuts the 80 × 60 mm outline alone; the header records it, and
+    # verify --against compares that layer alone (the holes and the pocket 25 mm away
+    # read 25 000 µm before). Another drawing without that layer is refused.
+    out, report = tmp_path / "outline.ngc", tmp_path / "report.json"
+    code, err = run("post", PART, "-t", "linuxcnc", "--layers", "OUTLINE", *OPTIONS, "-o", str(out))
+    assert code == 0, err
+    from camtool.jobs.header import read_layers
+
+    assert read_layers(out.read_text()) == ("OUTLINE",)
+    code, err = run(
+        "verify", str(out), "-t", "linuxcnc", "--against", PART, "--report", str(report)
+    )
+    assert code == 0, err
+    assert "not on its layers OUTLINE" in err
+    assert json.loads(report.read_text())["against"]["max_um"] < 20.0
+    code, err = run("verify", str(out), "-t", "linuxcnc", "--against", PLATE)
+    assert code == 2, err
+    assert "the drawing has no layer 'OUTLINE'" in err
+    assert read_layers("(layers: OUTLINE)\nG0 X1 Y1\n") is None  # another tool's comment
