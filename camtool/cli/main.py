@@ -441,12 +441,11 @@ def _as_selected(code: str, drawing: Drawing) -> Drawing:
         return drawing
     layers = read_layers(code)
     if layers is not None:
-        have = {c.layer.casefold() for c in drawing.contours}
-        missing = [n for n in layers if n.casefold() not in have]
+        layers, missing = _recorded_layers(layers, {c.layer for c in drawing.contours})
         if missing:
             raise UsageError(
-                f"--against: the program was posted with --layers {','.join(layers)}, and "
-                f"the drawing has no layer {missing[0]!r} (its layers: "
+                f"--against: the program's header says it was posted with --layers "
+                f"{','.join(layers)}, and the drawing has no layer {missing!r} (its layers: "
                 f"{', '.join(sorted({c.layer for c in drawing.contours}))}); give the "
                 "drawing the program was posted from, or verify without --against"
             )
@@ -465,6 +464,30 @@ def _as_selected(code: str, drawing: Drawing) -> Drawing:
         )
         return drawing.without(left)
     return drawing
+
+
+def _recorded_layers(recorded: tuple[str, ...], have: set[str]) -> tuple[tuple[str, ...], str]:
+    """The drawing's layers among ``have`` that the header's names ``recorded`` stand for.
+
+    A name is as the program's comments hold it (:func:`comment_text`: any case, non-ASCII
+    as ``?``, parentheses as brackets; the last one cut short with ``...`` on a long
+    line), so each layer is compared in that form. Returns ``(layers, "")``, or
+    ``(recorded, name)`` with the first recorded name no layer stands for.
+    """
+    from camtool.post.wordaddress_spec import comment_text
+
+    held = {layer: comment_text(layer).casefold() for layer in have}
+    found: list[str] = []
+    for name in recorded:
+        key = name.casefold()
+        if key.endswith("..."):
+            hits = [layer for layer, text in held.items() if text.startswith(key[:-3])]
+        else:
+            hits = [layer for layer, text in held.items() if text == key]
+        if not hits:
+            return recorded, name
+        found.extend(sorted(hits))
+    return tuple(dict.fromkeys(found)), ""
 
 
 def _write_pieces(job: PostJob, output: str, inputs: list[tuple[str, Any]]) -> None:

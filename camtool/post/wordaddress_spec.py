@@ -233,8 +233,7 @@ class WordAddressSpec:
         """
         if self.comment is None:
             return None
-        clean = "".join(c if " " <= c <= "~" else "?" for c in text)
-        clean = clean.replace("(", "[").replace(")", "]").strip()
+        clean = comment_text(text)
         wrap = ("(" + prefix, ")") if self.comment == "()" else ("; " + prefix, "")
         room = None
         if self.max_block_bytes is not None:
@@ -259,6 +258,16 @@ class WordAddressSpec:
 
 PATH_CONTROLS = ("G61", "G61.1", "G64")
 """The RS-274/NGC path control codes (exact path, exact stop, blending)."""
+
+
+def comment_text(text: str) -> str:
+    """``text`` as a comment holds it: outside printable ASCII ``?``, ``(``/``)`` ``[``/``]``.
+
+    RS-274 comments do not nest; surrounding spaces dropped
+    (:meth:`WordAddressSpec.comment_line`, which also cuts a long line short).
+    """
+    clean = "".join(c if " " <= c <= "~" else "?" for c in text)
+    return clean.replace("(", "[").replace(")", "]").strip()
 
 
 def _comment_pattern(style: str) -> re.Pattern[str]:

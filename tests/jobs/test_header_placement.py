@@ -128,3 +128,29 @@ def test_verify_against_compares_the_layers_post_cut(run: Any, tmp_path: Path) -
     assert code == 2, err
     assert "the drawing has no layer 'OUTLINE'" in err
     assert read_layers("(layers: OUTLINE)\nG0 X1 Y1\n") is None  # another tool's comment
+
+
+def test_layers_the_comments_could_not_hold_whole_are_still_found(run: Any, tmp_path: Path) -> None:
+    # Six 10 mm squares, each on its layer; post --layers names five: one with non-ASCII
+    # letters and parentheses (a comment holds them as '?' and brackets), four long ones
+    # (GRBL's 80-byte line cuts the header's list short with '...'). verify --against
+    # finds the five from what the header holds, and leaves out the sixth alone.
+    import ezdxf
+
+    names = ["Kontur-Äußen (1)", *(f"very-long-layer-name-number-{k:02d}" for k in range(4))]
+    doc = ezdxf.new(units=4)
+    for k, name in enumerate([*names, "other"]):
+        doc.layers.add(name)
+        x = 12.0 * k
+        square = [(x, 0.0), (x + 10.0, 0.0), (x + 10.0, 10.0), (x, 10.0)]
+        doc.modelspace().add_lwpolyline(square, close=True, dxfattribs={"layer": name})
+    drawing, out = tmp_path / "layers.dxf", tmp_path / "layers.nc"
+    doc.saveas(drawing)
+    code, err = run("post", str(drawing), "-t", "grbl", "--layers", ",".join(names), "-o", str(out))
+    assert code == 0, err
+    assert "(layers: Kontur-?u?en [1], very-long-layer-name-number-00, " in out.read_text()
+    assert "...)" in out.read_text()
+    code, err = run("verify", str(out), "-t", "grbl", "--against", str(drawing))
+    assert code == 0, err
+    assert "1 contour(s) of the drawing not compared" in err
+    assert "against the drawing: max 0.00 µm" in err
