@@ -182,13 +182,10 @@ def _placement_lines(placement: tuple[float, float, float], plan: PlanOptions | 
 def read_placement(code: str) -> tuple[float, float, float] | None:
     """The placement a camtool header in ``code`` records, or ``None``.
 
-    Only the first 60 lines are read, and only after camtool's own first line
+    Only the first lines are read, and only with camtool's own first line among them
     (``camtool VERSION: NAME for TARGET``): another tool's comment is never taken.
     """
-    head = code.splitlines()[:60]
-    if not any(_CAMTOOL.search(line) for line in head):
-        return None
-    for line in head:
+    for line in _header(code):
         found = PLACEMENT.search(line)
         if found is not None:
             try:
@@ -212,10 +209,7 @@ def read_offset(code: str) -> tuple[str, float] | None:
     ``side`` is ``outside``, ``inside`` or ``pocket``. ``None`` for a program of a cut on
     the line, of a job of several operations, or without camtool's header.
     """
-    head = code.splitlines()[:60]
-    if not any(_CAMTOOL.search(line) for line in head):
-        return None
-    for line in head:
+    for line in _header(code):
         found = _TOOL.search(line)
         if found is not None:
             try:
@@ -236,10 +230,7 @@ def read_job(code: str) -> tuple[str, int] | None:
     operations``); ``None`` for a program of ``post``'s own options, or without camtool's
     header (another tool's comment is never taken).
     """
-    head = code.splitlines()[:60]
-    if not any(_CAMTOOL.search(line) for line in head):
-        return None
-    for line in head:
+    for line in _header(code):
         found = _JOB.search(line)
         if found is not None:
             return found["name"], int(found["n"])
@@ -254,10 +245,7 @@ def read_layers(code: str) -> tuple[str, ...] | None:
     characters outside printable ASCII replaced, a long line cut short): a name the
     drawing does not have is the caller's to refuse.
     """
-    head = code.splitlines()[:60]
-    if not any(_CAMTOOL.search(line) for line in head):
-        return None
-    for line in head:
+    for line in _header(code):
         found = _LAYERS.search(line)
         if found is not None:
             return tuple(n.strip() for n in found[1].split(", ") if n.strip())
@@ -270,10 +258,24 @@ def read_single(code: str) -> bool:
     Its header (camtool's first line, then the tool line :func:`job_notes` writes for one
     operation): not a job file's program, nor a re-posted one.
     """
-    head = code.splitlines()[:60]
-    if not any(_CAMTOOL.search(line) for line in head):
-        return False
-    return any(_TOOL.search(line) or _ON.search(line) for line in head)
+    return any(_TOOL.search(line) or _ON.search(line) for line in _header(code))
+
+
+def _header(code: str) -> list[str]:
+    """The first :data:`HEADER_LINES` lines of ``code`` when camtool's own header is among them.
+
+    Else none: another tool's comment is never taken. Only the start of the text is split
+    (a program of millions of lines is not).
+    """
+    head = code[:HEADER_CHARS].splitlines()[:HEADER_LINES]
+    return head if any(_CAMTOOL.search(line) for line in head) else []
+
+
+HEADER_LINES = 60
+"""Lines of a program the header readers look at (camtool's notes come first)."""
+
+HEADER_CHARS = 1 << 16
+"""Characters of a program split into lines for them: :data:`HEADER_LINES` lines and more."""
 
 
 _LAYERS = re.compile(r"\blayers: (.*?)\)?$")
