@@ -94,9 +94,9 @@ def test_verify_against_leaves_out_the_construction_post_did_not_cut(
     run: Any, tmp_path: Path
 ) -> None:
     # samples/part.dxf cut on its lines: post cuts every contour but the ten CENTER lines
-    # (construction). Compared with them, the program read 12 500 µm off (a hole's centre
-    # line is 12.5 mm from the nearest cut); from analysis the cut follows the drawing, so
-    # only the dialect's rounding and the machine's steps are left, a few µm.
+    # (construction), which verify leaves out too: a hole's centre line lies 12.5 mm from
+    # the nearest cut and would count as 12 500 µm of error. From analysis the cut follows
+    # the drawing, so only the dialect's rounding and the machine's steps are left, a few µm.
     out, report = tmp_path / "part.ngc", tmp_path / "report.json"
     code, err = run("post", PART, "-t", "linuxcnc", "-o", str(out))
     assert code == 0, err
@@ -110,8 +110,8 @@ def test_verify_against_leaves_out_the_construction_post_did_not_cut(
 
 def test_verify_against_compares_the_layers_post_cut(run: Any, tmp_path: Path) -> None:
     # post --layers OUTLINE cuts the 80 × 60 mm outline alone; the header records it, and
-    # verify --against compares that layer alone (the holes and the pocket 25 mm away
-    # read 25 000 µm before). Another drawing without that layer is refused.
+    # verify --against compares that layer alone (the holes and the pocket, 25 mm away,
+    # would count as 25 000 µm of error). Another drawing without that layer is refused.
     out, report = tmp_path / "outline.ngc", tmp_path / "report.json"
     code, err = run("post", PART, "-t", "linuxcnc", "--layers", "OUTLINE", *OPTIONS, "-o", str(out))
     assert code == 0, err
