@@ -7,11 +7,12 @@ from __future__ import annotations
 
 from typing import Any
 
-from camtool.model.construction import dashed_name
+from camtool.model.construction import LAYER_FLAGS, dashed_name
 
 Style = tuple[str, str]
 """``(colour, linetype)``: ``"#rrggbb"`` (``""``: unknown) and the upper-case linetype
-name when it is not continuous (``""``: continuous)."""
+name when it is not continuous (``""``: continuous), or a layer's flag that says its
+entities are not the part (:data:`~camtool.model.construction.LAYER_FLAGS`)."""
 
 CONTINUOUS: Style = ("", "")
 """No colour known, continuous."""
@@ -39,6 +40,8 @@ class StyleResolver:
             return self.layer_style(layer)
         by_layer = self.layer_style(layer)
         colour = self._colour(dxf, by_layer[0], block[0])
+        if by_layer[1] in LAYER_FLAGS:  # the layer's, whatever line the entity is drawn in
+            return colour, by_layer[1]
         linetype = str(dxf.get("linetype", "BYLAYER") or "BYLAYER").upper()
         if linetype == "BYLAYER":
             dashed = by_layer[1]
@@ -49,7 +52,11 @@ class StyleResolver:
         return colour, dashed
 
     def layer_style(self, layer: str) -> Style:
-        """The colour and linetype of ``layer`` (white and continuous when it is missing)."""
+        """The colour and linetype of ``layer`` (white and continuous when it is missing).
+
+        The linetype is ``"CONSTRUCTION"`` for a LibreCAD construction layer and
+        ``"NO-PLOT"`` for a layer whose plot flag is off (:func:`layer_flag`).
+        """
         found = self._layers.get(layer)
         if found is None:
             found = self._layers[layer] = self._read_layer(layer)
@@ -66,6 +73,9 @@ class StyleResolver:
         true = dxf.get("true_color")
         aci = abs(int(dxf.get("color", 7) or 7))
         colour = _hex_int(true) if true is not None else _hex(aci2rgb(aci if aci < 256 else 7))
+        flag = layer_flag(record)
+        if flag:
+            return colour, flag
         linetype = str(dxf.get("linetype", "CONTINUOUS") or "CONTINUOUS").upper()
         return colour, (linetype if self._is_dashed(linetype) else "")
 
@@ -120,6 +130,26 @@ class StyleResolver:
             except (ValueError, TypeError, AttributeError):
                 pass  # a damaged pattern: judged by its name
         return dashed_name(name)
+
+
+def layer_flag(record: Any) -> str:
+    """What the LAYER table entry ``record`` says of its entities: not the part, or ``""``.
+
+    ``"CONSTRUCTION"``: LibreCAD's construction layer, written as the layer's extended data
+    of the application ``LibreCad`` with a 1070 value of 1 (LibreCAD's DXF filter reads it
+    so); ``"NO-PLOT"``: the plot flag (group 290) is 0, the layer is not printed (AutoCAD's
+    and LibreCAD's layer property). A damaged entry is read as a plain layer.
+    """
+    try:
+        if record.has_xdata("LibreCad") and any(
+            tag.code == 1070 and int(tag.value) == 1 for tag in record.get_xdata("LibreCad")
+        ):
+            return "CONSTRUCTION"
+        if int(record.dxf.get("plot", 1)) == 0:
+            return "NO-PLOT"
+    except (AttributeError, TypeError, ValueError):
+        pass
+    return ""
 
 
 def _hex(rgb: Any) -> str:

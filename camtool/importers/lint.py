@@ -304,7 +304,7 @@ def _style_table(styles: tuple[StyleCount, ...]) -> list[str]:
 
 def _construction(drawing: Drawing) -> list[Finding]:
     """A ``construction`` finding per layer and linetype that ``post`` leaves uncut."""
-    from camtool.model.construction import construction_layer
+    from camtool.model.construction import construction_layer, line_kind
 
     groups: dict[tuple[str, str], list[Contour]] = {}
     for c in drawing.contours:
@@ -312,7 +312,7 @@ def _construction(drawing: Drawing) -> list[Finding]:
             groups.setdefault((c.layer, c.linetype), []).append(c)
     out = []
     for (layer, linetype), contours in sorted(groups.items()):
-        what = f"linetype {linetype}" if linetype else "a construction layer"
+        what = line_kind(linetype)
         first = contours[0]
         out.append(
             Finding(

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from typing import TypeAlias
 
 from camtool.jobs.job import Operation, Selection
-from camtool.model.construction import construction_layer, is_construction
+from camtool.model.construction import construction_layer, is_construction, line_kind
 from camtool.model.shapes import Contour, Drawing, Mark, Point, circle_of
 
 
@@ -52,7 +52,7 @@ def construction_reason(contour: Contour, selection: Selection) -> str | None:
     if contour.linetype:
         named = selection.linetypes is not None and contour.linetype in selection.linetypes
         if not (named or named_layer):
-            return f"linetype {contour.linetype}"
+            return line_kind(contour.linetype)
     if construction_layer(contour.layer) and not named_layer:
         return f"construction layer {contour.layer!r}"
     return None
@@ -235,7 +235,7 @@ def construction_notes(contours: Sequence[Contour]) -> list[str]:
     out = []
     for (layer, linetype), count in sorted(groups.items()):
         c = first[(layer, linetype)]
-        what = f"linetype {linetype}" if linetype else "a construction layer"
+        what = line_kind(linetype)
         where = f"{c.source} at ({c.start[0]:.4f}, {c.start[1]:.4f}) mm"
         out.append(
             f"not cut: {count} contour(s) on layer {layer!r} ({what}: construction, not the "

@@ -59,6 +59,30 @@ punch tool centre marks, the edges of formed features and punches' alternative d
 ``IV_OUTER_PROFILE`` and ``IV_INTERIOR_PROFILES`` are the cut."""
 
 
+LAYER_FLAGS = {
+    "CONSTRUCTION": "a LibreCAD construction layer",
+    "NO-PLOT": "a layer that does not plot",
+    "GUIDE": "a Shaper Origin guide",
+}
+"""What an importer writes in place of a contour's linetype when the drawing itself marks
+the contour as not the part, whatever its line looks like, and how a message says it: a
+LibreCAD construction layer (its DXF LAYER's extended data ``LibreCad`` 1070 = 1, its SVG's
+``lc:is_construction``; LibreCAD draws such layers' lines endless and never prints them),
+a DXF layer whose plot flag is off (group 290 = 0: AutoCAD's and LibreCAD's "do not
+print", where drawings keep construction and viewport frames), a Shaper Origin guide."""
+
+
+def line_kind(linetype: str) -> str:
+    """How a message names a contour's ``linetype`` that is not continuous.
+
+    ``"linetype DASHED"``, or a :data:`LAYER_FLAGS` phrase; ``""`` (continuous) is named by
+    its layer's name instead: ``"a construction layer"``.
+    """
+    if not linetype:
+        return "a construction layer"
+    return LAYER_FLAGS.get(linetype, f"linetype {linetype}")
+
+
 def dashed_name(linetype: str) -> bool:
     """Whether the linetype ``linetype`` (any case) is by its name not continuous."""
     name = linetype.upper()

@@ -15,6 +15,7 @@ import ezdxf
 import pytest
 
 from camtool.importers import read_drawing
+from camtool.importers.options import ImportOptions
 from camtool.jobs.pipeline import post_drawing
 from camtool.model.errors import InputError
 from camtool.model.program import Linear
@@ -307,3 +308,69 @@ def test_an_r12_layer_name_in_unicode_notation_is_read_as_the_cad_program_shows_
     assert not cuts  # the circle is cut as arcs; the centre line is not cut at all
     (note,) = [w for w in job.warnings if "ΟΣΕΣ" in w]
     assert note.startswith("not cut: 1 contour(s) on layer 'ΟΣΕΣ' (linetype CENTER")
+
+
+def _flagged(tmp_path: Path, flag: str, linetype: str = "BYLAYER") -> Path:
+    """A 20 mm square on layer ``PART`` and a LINE across it on layer ``AID``, flagged so.
+
+    ``flag``: ``"librecad"`` gives ``AID`` the extended data LibreCAD writes for a
+    construction layer (application ``LibreCad``, 1070 = 1, as its DXF filter's
+    ``writeLayers`` does); ``"librecad-0"`` the same with 0; ``"no-plot"`` clears the
+    layer's plot flag (group 290 = 0); ``""`` leaves it plain.
+    """
+    doc = _doc()
+    doc.appids.add("LibreCad")
+    aid = doc.layers.add("AID")
+    if flag.startswith("librecad"):
+        aid.set_xdata("LibreCad", [(1070, 0 if flag.endswith("-0") else 1)])
+    elif flag == "no-plot":
+        aid.dxf.plot = 0
+    msp = doc.modelspace()
+    msp.add_lwpolyline(
+        [(0, 0), (20, 0), (20, 20), (0, 20)], close=True, dxfattribs={"layer": "PART"}
+    )
+    msp.add_line((-5, 10), (25, 10), dxfattribs={"layer": "AID", "linetype": linetype})
+    path = tmp_path / f"flag-{flag or 'plain'}.dxf"
+    doc.saveas(path)
+    return path
+
+
+@pytest.mark.parametrize(
+    ("flag", "phrase"),
+    [("librecad", "a LibreCAD construction layer"), ("no-plot", "a layer that does not plot")],
+)
+@pytest.mark.parametrize("linetype", ["BYLAYER", "CONTINUOUS", "DASHED"])
+def test_a_layer_the_drawing_flags_as_not_the_part_is_left_out(
+    tmp_path: Path, flag: str, phrase: str, linetype: str
+) -> None:
+    """The line across the square would cut it in two: the flag is the layer's, so it
+    holds whatever line the entity is drawn in; naming the layer cuts it."""
+    path = _flagged(tmp_path, flag, linetype)
+    text = path.read_text()
+    if flag == "librecad":  # the group codes as LibreCAD writes them, after the layer's own
+        assert "1001\nLibreCad\n1070\n1\n" in text
+    job = post_drawing(read_drawing(path), load_target("grbl"), PlanOptions(depth=1.0))
+    fed = [(m.x, m.y) for m in job.program.moves if isinstance(m, Linear)]
+    assert min(x for x, _ in fed) == 0 and max(x for x, _ in fed) == 20
+    assert not any(y == 10 for _, y in fed)
+    assert any(f"on layer 'AID' ({phrase}: construction, not the part" in w for w in job.warnings)
+    named = post_drawing(
+        read_drawing(path, ImportOptions(layers=("PART", "AID"))),
+        load_target("grbl"),
+        PlanOptions(depth=1.0),
+        layers=("PART", "AID"),
+    )
+    assert {(m.x, m.y) for m in named.program.moves if isinstance(m, Linear)} >= {
+        (-5, 10),
+        (25, 10),
+    }
+
+
+@pytest.mark.parametrize("flag", ["", "librecad-0"])
+def test_a_plain_layer_is_cut(tmp_path: Path, flag: str) -> None:
+    """A plotted layer, or LibreCAD's data with 0 (its filter sets construction only on 1)."""
+    job = post_drawing(
+        read_drawing(_flagged(tmp_path, flag)), load_target("grbl"), PlanOptions(depth=1.0)
+    )
+    fed = {(m.x, m.y) for m in job.program.moves if isinstance(m, Linear)}
+    assert {(-5, 10), (25, 10)} <= fed
