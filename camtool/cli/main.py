@@ -425,8 +425,9 @@ def _as_selected(code: str, drawing: Drawing) -> Drawing:
     ``post``'s one operation cuts the layers ``--layers`` named (the header's ``layers:``
     line), else every layer, and never construction it was not asked for by name (centre
     and hidden lines, dimension layers: :func:`camtool.jobs.selection.construction_reason`).
-    A re-posted program, a job's and another tool's have no such header: nothing is left
-    out here.
+    A job's program and another tool's have no such header: nothing is left out here. A
+    re-posted program has the header of the program it came from
+    (:func:`camtool.jobs.header.carried_notes`).
 
     Raises:
         UsageError: the header names a layer the drawing does not have (another drawing,

@@ -47,6 +47,7 @@ def job_notes(
     job: Job | None = None,
     runs: Sequence[OperationRun] = (),
     placement: tuple[float, float, float] = (1.0, 0.0, 0.0),
+    carried: tuple[str, ...] = (),
 ) -> tuple[str, ...]:
     """The job, in a few lines for the top of the program (comments where the dialect has them).
 
@@ -66,6 +67,8 @@ def job_notes(
             dy)`` mm (``--scale``/``--fit``, ``--origin``, ``--translate``); written as
             ``placement: scale K, shift XdX YdY mm`` unless it is the identity, so that
             ``verify --against`` can place the drawing again (:func:`read_placement`).
+        carried: for a re-posted program, the notes of the input's camtool header
+            (:func:`carried_notes`), written after the line that says it is re-posted.
     """
     from camtool.model.version import __version__
 
@@ -76,7 +79,7 @@ def job_notes(
     if job is not None and plan is None:
         return (*notes, *_job_lines(job, runs, target))
     if plan is None:
-        return (*notes, "re-posted program: moves as the input gives them")
+        return (*notes, REPOSTED, *carried)
     tool = f"tool diameter {plan.tool_diameter:g} mm, offset {plan.offset}"
     if plan.offset == "on":
         tool = "offset on: the tool centre follows the drawing"
@@ -177,6 +180,49 @@ def _placement_lines(placement: tuple[float, float, float], plan: PlanOptions | 
     elif k != 1.0:
         lines.append(f"--scale {k:g}: the drawing at {100 * k:.4g} % of its size")
     return lines
+
+
+REPOSTED = "re-posted program: moves as the input gives them"
+"""The note that says a program is re-posted, after camtool's first line."""
+CARRIED_FROM = "its header: "
+"""Before the input's first line among a re-posted program's notes."""
+
+
+def carried_notes(code: str) -> tuple[str, ...]:
+    """The notes of camtool's header at the top of ``code``, for a program re-posted from it.
+
+    Re-posting moves nothing, so what the header says of the cut (its placement, tool and
+    offset, layers, job, work zero, depths) still holds for the re-posted program, and
+    ``verify --against`` reads it there as in the program it came from. The header is the
+    run of whole-line comments (``(…)`` or ``; …``) at the top (blank and ``%`` lines
+    skipped) when its first is camtool's own (``camtool VERSION: NAME for TARGET``),
+    which is carried as ``its header: …``; a re-posted program's own first two lines are
+    left out and the rest carried as they are. ``()`` for any other program: another
+    tool's comments are never taken.
+    """
+    texts: list[str] = []
+    for line in code[:HEADER_CHARS].lstrip("\ufeff").splitlines()[:HEADER_LINES]:
+        text = _comment_of(line)
+        if text is None:
+            if line.strip() in ("", "%"):
+                continue
+            break
+        texts.append(text)
+    if not texts or not _CAMTOOL.fullmatch(texts[0]):
+        return ()
+    if texts[1:2] == [REPOSTED]:
+        return tuple(texts[2:])
+    return (CARRIED_FROM + texts[0], *texts[1:])
+
+
+def _comment_of(line: str) -> str | None:
+    """The text of ``line`` when it is one whole comment, ``(…)`` or ``; …``, else ``None``."""
+    text = line.strip()
+    if text.startswith("(") and text.endswith(")") and ")" not in text[1:-1]:
+        return text[1:-1].strip()
+    if text.startswith(";"):
+        return text[1:].strip()
+    return None
 
 
 def read_placement(code: str) -> tuple[float, float, float] | None:

@@ -16,7 +16,7 @@ from camtool.jobs.by_hand import (
     own_stops_dropped,
     per_tool,
 )
-from camtool.jobs.header import job_notes
+from camtool.jobs.header import HEADER_CHARS, carried_notes, job_notes
 from camtool.jobs.inputs import is_program_file
 from camtool.jobs.run import OutputOptions, PostJob, run_job
 from camtool.model.errors import InputError, TooLargeError, UsageError
@@ -163,14 +163,18 @@ def post_path(
     from camtool.importers.gcode import read_gcode
 
     progress(Step("reading", name=Path(path).name))
+    program = read_gcode(path, reading=reading_for(target, plan))
+    with Path(path).open("rb") as file:  # read just now: its header, for the notes
+        head = file.read(HEADER_CHARS).decode("utf-8", "replace")
     return post_program(
-        read_gcode(path, reading=reading_for(target, plan)),
+        program,
         target,
         output,
         feed_mm_min=plan.feed_mm_min,
         tolerance_mm=plan.tolerance,
         source=str(path),
         progress=progress,
+        carried=carried_notes(head),
     )
 
 
@@ -247,6 +251,7 @@ def post_bytes(
         tolerance_mm=plan.tolerance,
         source=name,
         progress=progress,
+        carried=carried_notes(data[:HEADER_CHARS].decode("utf-8", "replace")),
     )
 
 
@@ -336,6 +341,7 @@ def post_program(
     tolerance_mm: float | None = None,
     source: str = "",
     progress: Progress = no_progress,
+    carried: tuple[str, ...] = (),
 ) -> PostJob:
     """Re-post an existing program (e.g. G-code another CAM wrote) for a target.
 
@@ -352,7 +358,9 @@ def post_program(
     :meth:`~camtool.model.program.Program.with_spindle`) and stops it after the last
     (when the program has no spindle commands of its own), waiting
     ``output.spindle_dwell_s`` seconds after it starts. ``source`` (the input's file
-    name) goes into the job notes (:func:`job_notes`) unless the program has notes.
+    name) goes into the job notes (:func:`job_notes`) unless the program has notes, and
+    ``carried`` after them: the notes of the input's camtool header
+    (:func:`~camtool.jobs.header.carried_notes`), which still hold as nothing moves.
     Nothing is added to the program's motion: no move to X0 Y0, no clearance move.
     A program that changes tools more than once before any cut with another tool (its
     first change may follow rapids, as pcb2gcode's retract to the tool change height) is
@@ -381,7 +389,7 @@ def post_program(
     if not target.machine.has_z:
         program = _flatten(program, target.name)
     if not program.notes:
-        program = dataclasses.replace(program, notes=job_notes(source, target))
+        program = dataclasses.replace(program, notes=job_notes(source, target, carried=carried))
     program = _with_spindle(program, output.spindle_rpm, output.spindle_dwell_s)
     progress(Step("writing", 0, len(program.moves), target.name))
     changes = sum(isinstance(c, ToolChange) for _, c in program.commands)

@@ -15,6 +15,7 @@ from typing import Any
 import pytest
 
 from camtool.jobs.header import read_placement, read_tool_diameter
+from camtool.model.version import __version__
 
 ROOT = Path(__file__).resolve().parents[2]
 PLATE = str(ROOT / "samples" / "plate.dxf")
@@ -154,3 +155,45 @@ def test_layers_the_comments_could_not_hold_whole_are_still_found(run: Any, tmp_
     assert code == 0, err
     assert "1 contour(s) of the drawing not compared" in err
     assert "against the drawing: max 0.00 µm" in err
+
+
+def test_a_reposted_program_keeps_what_its_header_says_of_the_cut(run: Any, tmp_path: Path) -> None:
+    # post --layers OUTLINE --offset outside (the 80 × 60 mm outline alone, with a 3 mm
+    # tool), re-posted for LinuxCNC, then that for GRBL: re-posting moves nothing, so the
+    # header's tool, offset and layers still hold, and verify --against compares the
+    # re-post as it compares the program it came from. Without them the whole drawing was
+    # compared at the tool centre: 31 500 µm (the holes, 25 mm in, and the tool's radius).
+    first, again, third = tmp_path / "o.nc", tmp_path / "o.ngc", tmp_path / "o2.nc"
+    report = tmp_path / "report.json"
+    code, err = run("post", PART, "-t", "grbl", "--layers", "OUTLINE", *OPTIONS, "-o", str(first))
+    assert code == 0, err
+    code, err = run("post", str(first), "-t", "linuxcnc", "-o", str(again))
+    assert code == 0, err
+    code, err = run("post", str(again), "-t", "grbl", "-o", str(third))
+    assert code == 0, err
+    lines = third.read_text().splitlines()
+    assert lines[:4] == [
+        f"(camtool {__version__}: o.ngc for grbl)",
+        "(re-posted program: moves as the input gives them)",
+        f"(its header: camtool {__version__}: part.dxf for grbl)",
+        "(tool diameter 3 mm, offset outside)",
+    ]
+    assert "(layers: OUTLINE)" in lines and lines.count("(depth 1 mm)") == 1
+    for program, target in ((again, "linuxcnc"), (third, "grbl")):
+        args = ["verify", str(program), "-t", target, "--against", PART]
+        code, err = run(*args, "--report", str(report))
+        assert code == 0, err
+        assert "not on its layers OUTLINE" in err and "tool diameter 3 mm" in err
+        assert json.loads(report.read_text())["against"]["max_um"] < 20.0
+
+
+def test_only_camtools_own_header_is_carried() -> None:
+    from camtool.jobs.header import carried_notes
+
+    mine = "\ufeff%\n(camtool 0.1.0: a.dxf for grbl)\n\n(depth 1 mm)\nG0 X1 Y1\n(later)\n"
+    assert carried_notes(mine) == ("its header: camtool 0.1.0: a.dxf for grbl", "depth 1 mm")
+    semicolons = "; camtool 0.1.0: a.dxf for x\n; depth 1 mm\nG0 X1\n"
+    assert carried_notes(semicolons) == ("its header: camtool 0.1.0: a.dxf for x", "depth 1 mm")
+    # another tool's header, or camtool's name further down, is not camtool's header
+    assert carried_notes("(Fusion 360 post)\n(camtool 0.1.0: a.dxf for grbl)\nG0 X1\n") == ()
+    assert carried_notes("(tool diameter 3 mm, offset outside)\nG0 X1\n") == ()
