@@ -379,11 +379,12 @@ def _as_posted(code: str, drawing: Drawing, tool_diameter: float) -> tuple[Drawi
     where the drawing went (``placement: scale K, shift X Y mm``); without it the
     drawing would be compared where it was drawn, and the registration mistake reported
     as machining error. An offset cut (``offset outside``, ``inside`` or ``pocket``) cuts
-    no open contour: those the planner leaves out (chained at the default tolerances,
+    no open contour: those the planner leaves out (chained at the header's
+    ``--chain-tolerance`` and ``--close-gap``, else the defaults,
     :func:`camtool.toolpath.plan.chained`) are not compared. A ``--tool-diameter`` of 0
     takes the header's tool.
     """
-    from camtool.jobs.header import read_offset, read_placement
+    from camtool.jobs.header import read_chaining, read_offset, read_placement
     from camtool.toolpath.options import PlanOptions
     from camtool.toolpath.plan import chained
 
@@ -401,7 +402,11 @@ def _as_posted(code: str, drawing: Drawing, tool_diameter: float) -> tuple[Drawi
     if offset is None:
         return drawing, tool_diameter
     side, recorded = offset
-    _, _, left_out, _ = chained(drawing.contours, PlanOptions(offset=side, tool_diameter=recorded))
+    plan = PlanOptions(offset=side, tool_diameter=recorded)
+    chaining = read_chaining(code)
+    if chaining is not None:  # post's --chain-tolerance and --close-gap
+        plan = dataclasses.replace(plan, chain_tolerance=chaining[0], close_gap=chaining[1])
+    _, _, left_out, _ = chained(drawing.contours, plan)
     if left_out and len(left_out) < len(drawing.contours):
         drawing = drawing.without(left_out)
         click.echo(

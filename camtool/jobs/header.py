@@ -14,6 +14,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from camtool.toolpath.options import DEFAULT_CHAIN_TOLERANCE, DEFAULT_CLOSE_GAP
+
 if TYPE_CHECKING:
     from camtool.jobs.job import Job
     from camtool.jobs.run import OperationRun
@@ -91,6 +93,11 @@ def job_notes(
     layers = job.operations[0].select.layers if job is not None and job.operations else None
     if layers:  # --layers: what verify --against compares (read_layers)
         notes.append(f"layers: {', '.join(layers)}")
+    if (plan.chain_tolerance, plan.close_gap) != (DEFAULT_CHAIN_TOLERANCE, DEFAULT_CLOSE_GAP):
+        notes.append(  # which contours closed, so cut by a side (read_chaining)
+            f"chaining: ends within {plan.chain_tolerance:.12g} mm joined, gaps up to "
+            f"{plan.close_gap:.12g} mm closed"
+        )
     notes.append(_work_zero(plan))
     if not target.machine.has_z:
         notes.append("no Z axis: set the depth by hand")
@@ -267,6 +274,28 @@ def read_offset(code: str) -> tuple[str, float] | None:
 
 
 _TOOL = re.compile(r"tool diameter ([0-9.eE+-]+) mm, offset (outside|inside|pocket)")
+
+
+def read_chaining(code: str) -> tuple[float, float] | None:
+    """``(--chain-tolerance, --close-gap)``, mm, a camtool header in ``code`` records.
+
+    Written only when either is not the default: ``None`` then (the defaults hold), for
+    a value that is not a finite number ≥ 0, and without camtool's header.
+    """
+    for line in _header(code):
+        found = _CHAINING.search(line)
+        if found is not None:
+            try:
+                values = float(found["t"]), float(found["g"])
+            except ValueError:
+                return None
+            return values if all(math.isfinite(v) and v >= 0 for v in values) else None
+    return None
+
+
+_CHAINING = re.compile(
+    r"chaining: ends within (?P<t>[0-9.eE+-]+) mm joined, gaps up to (?P<g>[0-9.eE+-]+) mm closed"
+)
 
 
 def read_job(code: str) -> tuple[str, int] | None:

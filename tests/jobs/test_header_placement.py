@@ -197,3 +197,39 @@ def test_only_camtools_own_header_is_carried() -> None:
     # another tool's header, or camtool's name further down, is not camtool's header
     assert carried_notes("(Fusion 360 post)\n(camtool 0.1.0: a.dxf for grbl)\nG0 X1\n") == ()
     assert carried_notes("(tool diameter 3 mm, offset outside)\nG0 X1\n") == ()
+
+
+def test_verify_against_closes_the_gaps_post_closed(run: Any, tmp_path: Path) -> None:
+    # A 40 × 30 mm outline drawn open (its ends 0.3 mm apart) and a closed 20 × 20 mm
+    # square. post --close-gap 0.5 closes the outline and cuts it outside; the header
+    # records that, so verify --against compares the outline too instead of leaving it
+    # out as an open contour no side cuts. Against the same drawing with the outline
+    # 0.2 mm wider the program is then seen to cut 0.2 mm into the part: 200 µm of
+    # overcut from analysis (left out, only the square would be measured, a few µm).
+    import ezdxf
+
+    def drawing(width: float) -> Path:
+        doc = ezdxf.new(units=4)
+        outline = [(0, 0), (width, 0), (width, 30), (0, 30), (0, 0.3)]
+        doc.modelspace().add_lwpolyline(outline)
+        doc.modelspace().add_lwpolyline([(60, 0), (80, 0), (80, 20), (60, 20)], close=True)
+        path = tmp_path / f"gap-{width:g}.dxf"
+        doc.saveas(path)
+        return path
+
+    out, report = tmp_path / "gap.nc", tmp_path / "r.json"
+    posting = ["--offset", "outside", "--tool-diameter", "3", "--close-gap", "0.5"]
+    code, err = run("post", str(drawing(40)), "-t", "grbl", *posting, "-o", str(out))
+    assert code == 0, err
+    from camtool.jobs.header import read_chaining
+
+    assert read_chaining(out.read_text()) == (0.01, 0.5)
+    for width, overcut in ((40, 4.6), (40.2, 200.0)):
+        args = ["verify", str(out), "-t", "grbl", "--against", str(drawing(width))]
+        code, err = run(*args, "--report", str(report))
+        assert code == 0, err
+        assert "not compared" not in err
+        assert json.loads(report.read_text())["against"]["overcut_um"] == pytest.approx(
+            overcut, abs=5
+        )
+    assert read_chaining("(chaining: ends within 0.1 mm joined, gaps up to 1 mm closed)") is None
