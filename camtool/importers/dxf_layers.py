@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from camtool.importers.dxf_entities import layer_name, layer_of
+from camtool.importers.options import layer_list
 from camtool.model.errors import InputError
 
 
@@ -102,7 +103,7 @@ def layer_filter(
         listed = ", ".join(repr(n) for n in unknown)
         raise InputError(
             f"{path}: no layer {listed} in the drawing; its layers are "
-            + ", ".join(sorted(present, key=str.casefold))
+            + layer_list(sorted(present, key=str.casefold))
         )
     return LayerFilter({name.casefold() for name in layers}, hidden_layers(doc), named)
 

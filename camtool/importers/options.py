@@ -11,6 +11,7 @@ points) and every caller that builds options (jobs, cli) imports them from here.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 from camtool.model.errors import InputError, UsageError
@@ -106,6 +107,21 @@ def too_many_entities(name: str, limit: int) -> InputError:
         "MINSERT grids and <use> clones included), the --max-entities limit; if it really "
         "holds that many, raise the limit with --max-entities N"
     )
+
+
+def layer_list(names: Sequence[str]) -> str:
+    """The layers ``names`` for a message: each quoted, and how to name one with a comma.
+
+    ``--layers`` splits at commas, so a layer named ``Outline, top`` cannot be given there:
+    the message says where it can (a job file's ``layers`` list).
+    """
+    text = ", ".join(map(repr, names))
+    if any("," in name for name in names):
+        text += (
+            " (--layers splits names at commas: name a layer whose name holds one in a job "
+            "file's layers list)"
+        )
+    return text
 
 
 @checked_keywords({"fit_mm": "fit"})

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from camtool.importers import svgcheck, svgvalues
-from camtool.importers.options import check_expansion, entity_limit
+from camtool.importers.options import check_expansion, entity_limit, layer_list
 from camtool.importers.svgcontent import hold_unrendered
 from camtool.importers.svgcss import (
     apply_style_sheets,
@@ -144,7 +144,7 @@ def select_layers(
             names.setdefault(label, []).append(layer)
     unknown = [w for w in wanted if w not in names]
     if unknown:
-        there = ", ".join(repr(_layer_name(e)) for e in layers)
+        there = layer_list([_layer_name(e) for e in layers])
         have = f"its layers are {there}" if layers else "it has no Inkscape layers"
         raise InputError(f"{name}: no layer named {', '.join(map(repr, unknown))}; {have}")
     selected = {layer for w in wanted for layer in names[w]}

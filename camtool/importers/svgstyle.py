@@ -18,6 +18,7 @@ from typing import Any
 
 import svgelements as se
 
+from camtool.importers.options import layer_list
 from camtool.importers.svgtree import LAYER_ATTR, LIBRECAD_NS
 from camtool.importers.svgvalues import URL_REF
 from camtool.model.errors import InputError
@@ -186,7 +187,7 @@ def on_layers(
     if unknown:
         raise InputError(
             f"{path}: no layer named {', '.join(map(repr, unknown))}; its layers are "
-            + ", ".join(map(repr, there))
+            + layer_list(there)
         )
     return [c for c in contours if c.layer in named]
 

@@ -215,6 +215,34 @@ def test_unknown_layer_lists_the_layers_present(tmp_path: Path) -> None:
         read_drawing(path, ImportOptions(layers=("CUTS",)))
 
 
+def test_a_layer_named_with_a_comma_is_listed_whole_and_said_where_to_name_it(
+    run: Any, tmp_path: Path
+) -> None:
+    # --layers splits at commas, so "Outline, top" reaches the reader as two names; the
+    # refusal lists each layer quoted (one name, not two) and points to a job file,
+    # whose layers list names it whole and cuts its square.
+    def build(msp: Any) -> None:
+        msp.doc.layers.add("Outline, top")
+        square = [(0, 0), (10, 0), (10, 10), (0, 10)]
+        msp.add_lwpolyline(square, close=True, dxfattribs={"layer": "Outline, top"})
+
+    path = write_dxf(tmp_path / "l.dxf", build)
+    code, err = run("post", str(path), "-t", "grbl", "--layers", "Outline, top")
+    assert code == 3, err
+    assert "its layers are '0', 'Defpoints', 'Outline, top' (--layers splits" in err
+    assert "in a job file's layers list" in err
+    job = tmp_path / "job.toml"
+    job.write_text(
+        '[[tools]]\nid = 1\ntype = "end-mill"\ndiameter = 1.0\nfeed = 300\n\n'
+        '[[operations]]\nname = "o"\ntype = "profile"\ntool = 1\n'
+        'layers = ["Outline, top"]\nside = "on"\ndepth = 1.0\n'
+    )
+    out = tmp_path / "o.nc"
+    code, err = run("post", str(path), "-t", "grbl", "--job", str(job), "-o", str(out))
+    assert code == 0, err
+    assert "G1 X10.000 Y0.000" in out.read_text()
+
+
 def test_layer_with_nothing_usable_says_which_layers(tmp_path: Path) -> None:
     def build(msp: Any) -> None:
         msp.doc.layers.add("NOTES")
