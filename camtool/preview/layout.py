@@ -195,7 +195,9 @@ def _main_layers(c: Content, u: float, frame: BBox, pixel_mm: float) -> list[Lay
     layers.extend(layer for layer in program if layer.id != "tool-width")
     layers.append(pl.zero_layer(frame, u))
     if v is not None and v.against is not None and v.against.not_cut:
-        layers.append(tl.not_cut_layer("not-cut", v.against.not_cut, u))
+        marks = [mark_box(s) for s in worst.shapes if isinstance(s, Text | Circle)] if worst else []
+        numbers = [mark_box(s) for layer in program for s in layer.shapes if isinstance(s, Text)]
+        layers.append(tl.not_cut_layer("not-cut", v.against.not_cut, u, clear=marks + numbers))
     if worst is not None:
         layers.append(worst)
     return [layer for layer in layers if layer.shapes]

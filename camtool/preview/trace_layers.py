@@ -143,10 +143,14 @@ def not_cut_marker(at: Point, u: float) -> tuple[Polylines, ...]:
     return (Polylines((ring,), Style("#ffffff", 0.5 * u, fill=NOT_CUT_COLOUR), closed=True),)
 
 
-def not_cut_layer(layer_id: str, features: Sequence[NotCut], u: float) -> Layer:
+def not_cut_layer(
+    layer_id: str, features: Sequence[NotCut], u: float, *, clear: Sequence[BBox] = ()
+) -> Layer:
     """A diamond and a short label (``"tight corner"``) on each feature not cut as drawn.
 
-    Labels are thinned and moved apart (:func:`camtool.preview.scene.place_labels`).
+    Labels are thinned and moved apart (:func:`camtool.preview.scene.place_labels`), and
+    clear of the boxes ``clear`` (window units: the order numbers, the worst point's ring
+    and label), each moved aside, or hidden where no place near its feature is free.
     """
     shapes: list[Polylines | Text] = []
     labels = []
@@ -157,7 +161,7 @@ def not_cut_layer(layer_id: str, features: Sequence[NotCut], u: float) -> Layer:
                 (f.at[0] + 1.8 * u, f.at[1] + 1.2 * u), f.label, 2.4 * u, NOT_CUT_COLOUR, halo=True
             )
         )
-    shapes.extend(place_labels(labels, limit=12))
+    shapes.extend(place_labels(labels, limit=12, taken=list(clear)))
     return Layer(layer_id, tuple(shapes))
 
 

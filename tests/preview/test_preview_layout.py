@@ -281,3 +281,60 @@ def test_the_preview_keeps_the_order_numbers_clear_of_the_worst_point(
     wx, wy = v.deviation.at_mm
     assert isinstance(clear, list) and len(clear) == 3  # the ring, its dot, the label
     assert all(b[0] <= wx <= b[2] and b[1] <= wy <= b[3] for b in clear[:2])
+
+
+def test_not_cut_labels_keep_clear_of_the_order_numbers_and_the_worst_point() -> None:
+    # Five tight corners 3 mm apart along a line: each label is asked for just up and to
+    # the right of its diamond. A box over that strip (standing for the worst point's
+    # ring and label, or an order number) must hold none of them when it is given to keep
+    # clear of; without it every one sits there. Each is moved aside or hidden, never
+    # written over it.
+    from camtool.preview.trace_layers import not_cut_layer
+    from camtool.verify.not_cut import NotCut
+
+    features = [NotCut("tight-corner", (3.0 * k, 0.0), 100.0, 10) for k in range(5)]
+    box = (-1.0, 0.05, 16.0, 1.0)
+
+    def meets(layer: Layer) -> int:
+        texts = [t for t in layer.shapes if isinstance(t, Text)]
+        return sum(
+            1
+            for t in texts
+            if (b := text_box(t))[0] < box[2] and box[0] < b[2] and b[1] < box[3] and box[1] < b[3]
+        )
+
+    assert meets(not_cut_layer("not-cut", features, 0.2)) == 5
+    clear = not_cut_layer("not-cut", features, 0.2, clear=[box])
+    assert meets(clear) == 0
+    assert sum(isinstance(s, Text) for s in clear.shapes) == 5  # moved aside, none hidden
+
+
+def test_the_preview_keeps_the_not_cut_labels_clear_of_the_worst_point_and_the_numbers(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # The plate with tight corners and a narrow region: its picture places the not-cut
+    # labels clear of the worst point's ring, dot and label and of every order number.
+    from camtool.jobs.pipeline import post_drawing, verify_job
+    from camtool.post.registry import load_target
+    from camtool.preview import trace_layers as tl
+    from camtool.toolpath.options import PlanOptions
+    from tests.verify.test_metrics_not_cut import R, plate
+
+    job = post_drawing(
+        plate(), load_target("grbl"), PlanOptions(offset="outside", tool_diameter=2 * R)
+    )
+    v = verify_job(job)
+    asked: list[object] = []
+    plain = tl.not_cut_layer
+
+    def not_cut_layer(*args: object, **kwargs: object) -> object:
+        asked.append(kwargs.get("clear"))
+        return plain(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(tl, "not_cut_layer", not_cut_layer)
+    groups = _groups(render_preview(".svg", verification=v, drawing=job.placed, edge_radius_mm=R))
+    (clear,) = asked
+    numbers = [t for t in groups["order"].iter(f"{NS}text")]
+    assert isinstance(clear, list) and len(clear) == 3 + len(numbers) and numbers
+    wx, wy = v.deviation.at_mm
+    assert all(b[0] <= wx <= b[2] and b[1] <= wy <= b[3] for b in clear[:2])
