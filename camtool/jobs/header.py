@@ -8,13 +8,20 @@ of the same job (no date, no absolute path), so programs stay byte-for-byte repr
 
 from __future__ import annotations
 
-import math
 import re
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from camtool.toolpath.options import DEFAULT_CHAIN_TOLERANCE, DEFAULT_CLOSE_GAP
+from camtool.model.units import LARGEST_VALUE
+from camtool.toolpath.options import (
+    DEFAULT_CHAIN_TOLERANCE,
+    DEFAULT_CLOSE_GAP,
+    MAX_LENGTH_MM,
+    MAX_SCALE,
+    MAX_TOOL_DIAMETER_MM,
+    MIN_TOOL_DIAMETER_MM,
+)
 
 if TYPE_CHECKING:
     from camtool.jobs.job import Job
@@ -236,7 +243,10 @@ def read_placement(code: str) -> tuple[float, float, float] | None:
     """The placement a camtool header in ``code`` records, or ``None``.
 
     Only the first lines are read, and only with camtool's own first line among them
-    (``camtool VERSION: NAME for TARGET``): another tool's comment is never taken.
+    (``camtool VERSION: NAME for TARGET``): another tool's comment is never taken. Nor
+    is a value ``post`` never writes (a scale beyond its ``--scale`` range, a shift of
+    :data:`~camtool.model.units.LARGEST_VALUE` mm or more, NaN): an edited or damaged
+    header, read as none. So for the tool and the chaining (the options' own ranges).
     """
     for line in _header(code):
         found = PLACEMENT.search(line)
@@ -245,7 +255,7 @@ def read_placement(code: str) -> tuple[float, float, float] | None:
                 k, dx, dy = (float(found[g]) for g in ("k", "dx", "dy"))
             except ValueError:
                 return None
-            if k > 0 and all(math.isfinite(v) for v in (k, dx, dy)):
+            if 1.0 / MAX_SCALE <= k <= MAX_SCALE and max(abs(dx), abs(dy)) < LARGEST_VALUE:
                 return (k, dx, dy)
     return None
 
@@ -269,7 +279,8 @@ def read_offset(code: str) -> tuple[str, float] | None:
                 value = float(found[1])
             except ValueError:
                 return None
-            return (found[2], value) if math.isfinite(value) and value > 0 else None
+            fits = MIN_TOOL_DIAMETER_MM <= value <= MAX_TOOL_DIAMETER_MM
+            return (found[2], value) if fits else None
     return None
 
 
@@ -289,7 +300,7 @@ def read_chaining(code: str) -> tuple[float, float] | None:
                 values = float(found["t"]), float(found["g"])
             except ValueError:
                 return None
-            return values if all(math.isfinite(v) and v >= 0 for v in values) else None
+            return values if all(0 <= v <= MAX_LENGTH_MM for v in values) else None
     return None
 
 

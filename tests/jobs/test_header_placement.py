@@ -233,3 +233,30 @@ def test_verify_against_closes_the_gaps_post_closed(run: Any, tmp_path: Path) ->
             overcut, abs=5
         )
     assert read_chaining("(chaining: ends within 0.1 mm joined, gaps up to 1 mm closed)") is None
+
+
+@pytest.mark.parametrize(
+    "line",
+    [
+        "(placement: scale 1e300, shift X0 Y0 mm)",
+        "(placement: scale 1, shift X1e300 Y0 mm)",
+        "(placement: scale nan, shift X0 Y0 mm)",
+        "(placement: scale 1e-7, shift X0 Y0 mm)",
+        "(tool diameter 1e300 mm, offset outside)",
+        "(tool diameter 0.0000001 mm, offset outside)",
+        "(chaining: ends within 0.01 mm joined, gaps up to 1e300 mm closed)",
+        "(chaining: ends within inf mm joined, gaps up to 0.5 mm closed)",
+    ],
+)
+def test_a_header_value_post_never_writes_is_not_read(line: str) -> None:
+    # An edited or damaged header: a value beyond the range of post's own option (its
+    # --scale, --tool-diameter, --close-gap checks) is read as no such line, so that
+    # verify --against neither places the drawing 1e300 mm away nor refuses an option
+    # the user never gave.
+    from camtool.jobs.header import read_chaining, read_offset
+
+    code = f"(camtool 0.1.0: a.dxf for grbl)\n{line}\nG0 X1 Y1\n"
+    assert (read_placement(code), read_offset(code), read_chaining(code)) == (None, None, None)
+    sane = code.replace("1e300", "2").replace("nan", "1").replace("inf", "0.1")
+    sane = sane.replace("1e-7", "0.5").replace("0.0000001", "3")
+    assert (read_placement(sane), read_offset(sane), read_chaining(sane)).count(None) == 2
