@@ -180,7 +180,9 @@ PLACEMENT = re.compile(
     r"placement: scale (?P<k>[-+0-9.eE]+), shift X(?P<dx>[-+0-9.eE]+) Y(?P<dy>[-+0-9.eE]+) mm"
 )
 """The header line :func:`job_notes` writes for a drawing scaled or moved (any comment style)."""
-_CAMTOOL = re.compile(r"camtool \S+: .* for \S+")
+_CAMTOOL = re.compile(r"camtool \S+: (?:.* for \S+|.*\.\.\.)")
+"""camtool's first line, ``camtool VERSION: NAME for TARGET``, or cut short with ``...`` at
+the dialect's line limit (a long file name: GRBL's 80 bytes)."""
 
 
 def _placement_lines(placement: tuple[float, float, float], plan: PlanOptions | None) -> list[str]:

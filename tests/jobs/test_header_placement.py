@@ -260,3 +260,27 @@ def test_a_header_value_post_never_writes_is_not_read(line: str) -> None:
     sane = code.replace("1e300", "2").replace("nan", "1").replace("inf", "0.1")
     sane = sane.replace("1e-7", "0.5").replace("0.0000001", "3")
     assert (read_placement(sane), read_offset(sane), read_chaining(sane)).count(None) == 2
+
+
+def test_a_header_cut_short_at_the_line_limit_is_still_camtools(run: Any, tmp_path: Path) -> None:
+    # A drawing named for a customer's order: GRBL's 80-byte line cuts camtool's first
+    # line short ("...)", the target lost), and the header was then not read at all:
+    # verify --against compared the plate where it was drawn and at the tool centre, the
+    # 1.5 mm shift and the tool's 1.5 mm radius read as 9 060 µm. Read, the drawing is
+    # placed and the tool's edge follows it within the dialect's rounding and the
+    # machine's steps: a few µm of overcut, from analysis.
+    name = "a-very-long-drawing-file-name-from-a-customer-order-number-12345-rev-C.dxf"
+    drawing, out, report = tmp_path / name, tmp_path / "long.nc", tmp_path / "r.json"
+    drawing.write_bytes(Path(PLATE).read_bytes())
+    placing = ["--origin", "lower-left"]
+    code, err = run("post", str(drawing), "-t", "grbl", *OPTIONS, *placing, "-o", str(out))
+    assert code == 0, err
+    first = out.read_text().splitlines()[0]
+    assert first.endswith("...)") and " for grbl" not in first
+    assert read_placement(out.read_text()) == (1.0, 1.5, 1.5)
+    code, err = run(
+        "verify", str(out), "-t", "grbl", "--against", str(drawing), "--report", str(report)
+    )
+    assert code == 0, err
+    assert "placed as the program's header says" in err and "tool diameter 3 mm" in err
+    assert json.loads(report.read_text())["against"]["overcut_um"] < 20.0
