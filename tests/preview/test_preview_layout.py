@@ -5,6 +5,7 @@ from __future__ import annotations
 import io
 import math
 import xml.etree.ElementTree as ET
+from typing import Any
 
 import numpy as np
 import pytest
@@ -253,36 +254,6 @@ def test_order_numbers_keep_clear_of_the_worst_points_label() -> None:
     assert shown - meets <= shown_clear
 
 
-def test_the_preview_keeps_the_order_numbers_clear_of_the_worst_point(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    # A verified job's picture: the order numbers are placed clear of the worst point's
-    # ring and of its label ("max … µm, line N"), which a number written over it misread.
-    from camtool.jobs.pipeline import post_drawing, verify_job
-    from camtool.post.registry import load_target
-    from camtool.preview import program_layers as pl
-    from camtool.toolpath.options import PlanOptions
-    from tests.verify.test_metrics_not_cut import R, plate
-
-    job = post_drawing(
-        plate(), load_target("grbl"), PlanOptions(offset="outside", tool_diameter=2 * R)
-    )
-    v = verify_job(job)
-    asked: list[object] = []
-    plain = pl.program_layers
-
-    def program_layers(*args: object, **kwargs: object) -> object:
-        asked.append(kwargs.get("clear"))
-        return plain(*args, **kwargs)  # type: ignore[arg-type]
-
-    monkeypatch.setattr(pl, "program_layers", program_layers)
-    render_preview(".svg", verification=v, drawing=job.placed, edge_radius_mm=R)
-    (clear,) = asked
-    wx, wy = v.deviation.at_mm
-    assert isinstance(clear, list) and len(clear) == 3  # the ring, its dot, the label
-    assert all(b[0] <= wx <= b[2] and b[1] <= wy <= b[3] for b in clear[:2])
-
-
 def test_not_cut_labels_keep_clear_of_the_order_numbers_and_the_worst_point() -> None:
     # Five tight corners 3 mm apart along a line: each label is asked for just up and to
     # the right of its diamond. A box over that strip (standing for the worst point's
@@ -309,13 +280,16 @@ def test_not_cut_labels_keep_clear_of_the_order_numbers_and_the_worst_point() ->
     assert sum(isinstance(s, Text) for s in clear.shapes) == 5  # moved aside, none hidden
 
 
-def test_the_preview_keeps_the_not_cut_labels_clear_of_the_worst_point_and_the_numbers(
+def test_the_preview_keeps_its_labels_clear_of_the_worst_point(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    # The plate with tight corners and a narrow region: its picture places the not-cut
-    # labels clear of the worst point's ring, dot and label and of every order number.
+    # A verified job's picture (the plate with tight corners and a narrow region): the
+    # order numbers are placed clear of the worst point's ring, dot and label ("max … µm,
+    # line N"), which a number written over it misread; the not-cut labels clear of those
+    # and of every order number.
     from camtool.jobs.pipeline import post_drawing, verify_job
     from camtool.post.registry import load_target
+    from camtool.preview import program_layers as pl
     from camtool.preview import trace_layers as tl
     from camtool.toolpath.options import PlanOptions
     from tests.verify.test_metrics_not_cut import R, plate
@@ -324,17 +298,22 @@ def test_the_preview_keeps_the_not_cut_labels_clear_of_the_worst_point_and_the_n
         plate(), load_target("grbl"), PlanOptions(offset="outside", tool_diameter=2 * R)
     )
     v = verify_job(job)
-    asked: list[object] = []
-    plain = tl.not_cut_layer
+    asked: dict[str, list[object]] = {"program": [], "not-cut": []}
 
-    def not_cut_layer(*args: object, **kwargs: object) -> object:
-        asked.append(kwargs.get("clear"))
-        return plain(*args, **kwargs)  # type: ignore[arg-type]
+    def spy(name: str, plain: Any) -> Any:
+        def call(*args: object, **kwargs: object) -> object:
+            asked[name].append(kwargs.get("clear"))
+            return plain(*args, **kwargs)
 
-    monkeypatch.setattr(tl, "not_cut_layer", not_cut_layer)
+        return call
+
+    monkeypatch.setattr(pl, "program_layers", spy("program", pl.program_layers))
+    monkeypatch.setattr(tl, "not_cut_layer", spy("not-cut", tl.not_cut_layer))
     groups = _groups(render_preview(".svg", verification=v, drawing=job.placed, edge_radius_mm=R))
-    (clear,) = asked
-    numbers = [t for t in groups["order"].iter(f"{NS}text")]
-    assert isinstance(clear, list) and len(clear) == 3 + len(numbers) and numbers
+    (clear,), (clear_too,) = asked["program"], asked["not-cut"]
     wx, wy = v.deviation.at_mm
+    assert isinstance(clear, list) and len(clear) == 3  # the ring, its dot, the label
     assert all(b[0] <= wx <= b[2] and b[1] <= wy <= b[3] for b in clear[:2])
+    numbers = list(groups["order"].iter(f"{NS}text"))
+    assert numbers and isinstance(clear_too, list)
+    assert clear_too[:3] == clear and len(clear_too) == 3 + len(numbers)
