@@ -25,6 +25,7 @@ from camtool.importers.svgcss import (
     normalize_styles,
     style_text,
 )
+from camtool.importers.svgcsstransform import move_css_transform
 from camtool.importers.svgmasks import (
     clip_paths_first,
     clip_viewports,
@@ -650,6 +651,7 @@ def _check(element: ET.Element, kind: str, viewport: tuple[float, float]) -> Non
     if kind == "path" and element.get("d") is None:
         element.set("d", "")  # no path data: nothing drawn (svgelements fails on a missing d)
     svgvalues.default_sizes(element, kind)
+    move_css_transform(element)
     svgvalues.fold_transform_origin(element, viewport)
     for attr in LENGTH_ATTRS.get(kind, ()):
         value = element.get(attr)
