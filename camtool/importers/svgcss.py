@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import re
 import xml.etree.ElementTree as ET
+from collections import Counter
 from dataclasses import dataclass
 
 from camtool.model.errors import InputError
@@ -67,6 +68,7 @@ _PRESENTATION = ("display", "visibility", "fill", "stroke")
 _COMPOUND = re.compile(r"(\*|[A-Za-z_][\w-]*)?((?:[#.][\w-]+)*)")
 _COMBINATOR_OR_COMPOUND = re.compile(r"\s*(>)\s*|\s+|([^\s>]+)")
 _HIDING = ("display:none", "visibility:hidden", "visibility:collapse")
+_IMPORT = re.compile(r"@import\b[^;{]*", re.IGNORECASE)
 
 
 def _css_rules(text: str) -> list[tuple[str, str]]:
@@ -79,7 +81,9 @@ def _css_rules(text: str) -> list[tuple[str, str]]:
         while end < len(text) and depth:
             depth += {"{": 1, "}": -1}.get(text[end], 0)
             end += 1
-        rules.append((text[at:opening].strip(), text[opening + 1 : end - 1]))
+        # a statement before it (@import url(a.css); @charset "x";) is no part of its selector
+        prelude = text[at:opening].rsplit(";", 1)[-1]
+        rules.append((prelude.strip(), text[opening + 1 : end - 1]))
         at = end
     return rules
 
@@ -340,8 +344,17 @@ def apply_style_sheets(
     for sheet in sheets:
         if sheet.get("type", "").strip().lower() not in ("", "text/css"):
             continue  # a sheet in another language: ignored (SVG 1.1 §6.16), as browsers do
+        ignored += _IMPORT.findall(_CSS_COMMENT.sub("", sheet.text or ""))  # another file's sheet
         for selectors, body in _css_rules(sheet.text or ""):
             if selectors.startswith("@"):
+                hiding = _media_hiding(selectors, body)
+                if hiding is not None:
+                    raise InputError(
+                        f"{name}: the <style> rule '{selectors}' hides what it selects on a "
+                        f"screen ({hiding}), but camtool does not apply rules inside "
+                        f"{selectors.split()[0]}, so those elements would be cut; put {hiding} "
+                        "on the elements themselves (a style attribute), or delete them"
+                    )
                 if not selectors.lower().startswith("@font-face"):  # a font styles nothing
                     ignored.append(selectors)
                 continue
@@ -372,6 +385,63 @@ def apply_style_sheets(
         f"{name}: {len(ignored)} <style> rule(s) not applied ({shown}): camtool applies types, "
         ".class, #id and their descendants; what they style is read without them"
     ]
+
+
+def check_variables(root: ET.Element, name: str) -> None:
+    """Refuse a custom property (``var(--x)``) where it decides whether an element shows.
+
+    camtool does not resolve CSS custom properties; in ``display``, ``visibility`` or
+    ``opacity`` (a style, after the sheets are applied, or an attribute) one may hide the
+    element in a viewer, and camtool would cut it. Run before the opacities are read
+    (``svgvalues.normalize_colours`` drops a value it cannot read).
+
+    Raises:
+        InputError: such a value, with the file, the element (``rect#id``, ``rect[2]``, as
+            the later checks name it) and what to do.
+    """
+    seen: Counter[str] = Counter()
+    for element in root.iter():
+        kind = local_name(element)
+        if kind is None:
+            continue
+        seen[kind] += 1
+        style = inline_style(element) if "var(" in element.get("style", "").lower() else {}
+        for prop in ("display", "visibility", "opacity"):
+            value = style.get(prop, element.get(prop))
+            if value is not None and "var(" in value.lower():
+                ident = element.get("id")
+                label = f"{kind}#{ident}" if ident else f"{kind}[{seen[kind]}]"
+                raise InputError(
+                    f"{name}: {label}: {prop}: {value.strip()} decides whether it shows, and "
+                    "camtool does not resolve CSS custom properties (var()); write the value "
+                    "itself"
+                )
+
+
+def _media_hiding(at_rule: str, body: str) -> str | None:
+    """The first hiding declaration of an at-rule's rules that a screen may apply, or ``None``.
+
+    ``@media print`` (or ``speech``) applies to no screen and hides nothing there; any other
+    media query (``screen``, ``all``, a width) may, as may ``@supports`` and ``@layer``.
+    """
+    words = at_rule.lower().split()
+    if words[0] in ("@font-face", "@page", "@keyframes", "@import", "@namespace", "@charset"):
+        return None
+    if words[0] == "@media" and all(_print_only(q) for q in " ".join(words[1:]).split(",")):
+        return None
+    for _, inner in _css_rules(body):
+        for k, v, _ in _declaration_list(inner):
+            if _hides(k, v):
+                return f"{k}:{v}"
+    return None
+
+
+def _print_only(query: str) -> bool:
+    """Whether the media query ``query`` (lower case) holds for print or speech alone."""
+    words = query.split()
+    if words[:1] == ["only"]:
+        words = words[1:]
+    return words[:1] in (["print"], ["speech"])
 
 
 def _hides(prop: str, value: str) -> bool:

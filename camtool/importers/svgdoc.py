@@ -20,6 +20,7 @@ from camtool.importers.options import check_expansion, entity_limit, layer_list
 from camtool.importers.svgcontent import hold_unrendered
 from camtool.importers.svgcss import (
     apply_style_sheets,
+    check_variables,
     inline_style,
     local_name,
     normalize_styles,
@@ -525,6 +526,7 @@ def prepare(
     parents = {child: parent for parent in root.iter() for child in parent}
     warnings += apply_style_sheets(root, parents, str(path))
     normalize_styles(root)
+    check_variables(root, str(path))
     svgvalues.resolve_percentages(root, viewport)
     svgvalues.resolve_paint_references(root)
     svgvalues.resolve_context_paints(root, parents)

@@ -1,0 +1,65 @@
+"""Style sheet rules and values camtool does not apply, where a viewer would hide a shape.
+
+Each expectation is what Chromium shows (its ``getComputedStyle`` on a screen, checked by
+hand on these documents): ``@media screen`` rules apply, ``@media print`` ones do not; a
+rule after an ``@import`` statement applies; ``var()`` resolves. camtool does not
+evaluate media queries or custom properties, so where one of them may hide a shape it
+refuses the drawing (a hidden shape cut is a wrong part), naming the rule or the element.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from camtool.importers.svg import read_svg
+from camtool.model.errors import InputError
+from tests.importers.svgutil import svg
+
+SHAPES = '<path id="x" class="x" d="M 0 0 L 1 0"/><path id="y" d="M 0 2 L 1 2"/>'
+
+
+@pytest.mark.parametrize(
+    "media", ["screen", "all", "(min-width: 10px)", "not print", "print, screen"]
+)
+def test_a_media_rule_that_may_hide_on_a_screen_is_refused(tmp_path: Path, media: str) -> None:
+    body = f"<style>@media {media} {{ .x {{ display: none }} }}</style>{SHAPES}"
+    rule = re.escape(f"'@media {media}' hides what it selects on a screen")
+    with pytest.raises(InputError, match=rule):
+        read_svg(svg(tmp_path, body))
+
+
+@pytest.mark.parametrize("media", ["print", "only print", "speech"])
+def test_a_print_rule_hides_nothing_on_a_screen(tmp_path: Path, media: str) -> None:
+    body = f"<style>@media {media} {{ .x {{ display: none }} }}</style>{SHAPES}"
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.source for c in drawing.contours] == ["path#x", "path#y"]
+    assert f"'@media {media}'" in drawing.warnings[0]
+
+
+def test_a_rule_after_an_import_statement_applies(tmp_path: Path) -> None:
+    # The sheet the @import names is not read (said in the warning); the rule after the
+    # statement is a rule of its own, which hides path#x.
+    body = "<style>@import url(other.css); .x { display: none }</style>" + SHAPES
+    drawing = read_svg(svg(tmp_path, body))
+    assert [c.source for c in drawing.contours] == ["path#y"]
+    assert "'@import url(other.css)'" in drawing.warnings[0]
+
+
+@pytest.mark.parametrize(
+    "style", ["display: var(--d)", "visibility:var(--v, hidden)", "opacity: VAR(--o, 0)"]
+)
+def test_a_custom_property_that_decides_whether_a_shape_shows_is_refused(
+    tmp_path: Path, style: str
+) -> None:
+    body = f"<style>.x {{ {style} }}</style>{SHAPES}"
+    with pytest.raises(InputError, match=r"path#x: .*does not resolve CSS custom properties"):
+        read_svg(svg(tmp_path, body))
+
+
+def test_a_custom_property_in_a_paint_is_read_as_before(tmp_path: Path) -> None:
+    # fill: var(--c, red) paints in a viewer; it hides nothing, so it is cut.
+    body = '<path id="x" d="M 0 0 L 1 0 L 1 1 Z" style="fill: var(--c, red)"/>'
+    assert [c.source for c in read_svg(svg(tmp_path, body)).contours] == ["path#x"]
