@@ -535,7 +535,11 @@ def prepare(
     check_use_cycles(root, str(path))
     check_size(root, str(path), max_entities)
     placed = frozenset(href(e)[1:] for e in root.iter() if local_name(e) == "use")
-    if symbols_as_viewports(root):
+    try:
+        replaced = symbols_as_viewports(root)
+    except ValueError as exc:
+        raise InputError(f"{path}: {exc}") from exc
+    if replaced:
         svgvalues.resolve_percentages(root, viewport)  # the new viewports' sizes
         parents = {child: parent for parent in root.iter() for child in parent}
     hold = ET.SubElement(root, tag(root, "defs"))

@@ -335,9 +335,10 @@ _SYMBOL_OWN = frozenset({"id", "x", "y", "width", "height", "refX", "refY"})
 def symbols_as_viewports(root: ET.Element) -> int:
     """Replace each ``<use>`` of a ``<symbol>``, or sizing an ``<svg>``, by what it stands for.
 
-    SVG 1.1 §5.6: the use becomes a ``<g>`` with its attributes (its ``transform``, style,
-    clip and mask), holding an ``<svg>`` viewport at the use's ``x``, ``y`` of its
-    ``width`` and ``height`` (100 % when not given), with the symbol's ``viewBox``,
+    SVG 2 §5.6: the use becomes a ``<g>`` with its attributes (its ``transform``, style,
+    clip and mask), holding an ``<svg>`` viewport placed and sized as
+    :func:`_symbol_viewport` says (the symbol's own ``x``, ``y``, ``width``, ``height``
+    count), with the symbol's ``viewBox``,
     ``preserveAspectRatio`` and style, holding copies of the symbol's children. The viewport
     clips unless ``overflow`` is visible (resvg's structure/symbol tests), which
     :func:`clip_viewports` then checks. A use with a ``width`` or ``height`` of an
@@ -349,6 +350,9 @@ def symbols_as_viewports(root: ET.Element) -> int:
 
     Returns:
         How many uses were replaced.
+
+    Raises:
+        ValueError: a symbol's ``x`` or ``y`` that cannot be added to its use's.
     """
     nested = any(e is not root for e in elements(root, "svg"))
     if not elements(root, "symbol") and not nested:
@@ -371,9 +375,7 @@ def symbols_as_viewports(root: ET.Element) -> int:
         if kind == "symbol":
             viewport = ET.SubElement(group, tag(root, "svg"))
             viewport.attrib.update({k: v for k, v in target.attrib.items() if k not in _SYMBOL_OWN})
-            viewport.attrib.update({"width": "100%", "height": "100%"})
-            viewport.attrib.update({k: v for k, v in use.attrib.items()
-                                    if k in ("x", "y", "width", "height")})  # fmt: skip
+            viewport.attrib.update(_symbol_viewport(use, target))
             viewport.extend(copy.deepcopy(child) for child in target)
         else:  # a copy of the <svg>, of the use's size, moved by the use's x and y
             try:
@@ -389,6 +391,39 @@ def symbols_as_viewports(root: ET.Element) -> int:
         parent.remove(use)
         done += 1
     return done
+
+
+def _symbol_viewport(use: ET.Element, symbol: ET.Element) -> dict[str, str]:
+    """``x``, ``y``, ``width``, ``height`` of the viewport a ``<use>`` of ``symbol`` makes.
+
+    SVG 2 §5.6 and §5.5: the size is the use's (``auto`` is none), else the symbol's own
+    ``width``/``height``, else 100 %; the symbol's own ``x``/``y`` place the viewport in the
+    use's coordinates, moved by the use's ``x``/``y`` (Chromium draws a symbol at x 10 used
+    at x 20 from 30; ``refX``/``refY`` it ignores, as here).
+
+    Raises:
+        ValueError: a symbol's ``x`` or ``y`` that cannot be added to the use's (a
+            percentage left unresolved on one of them).
+    """
+    out: dict[str, str] = {}
+    for key in ("width", "height"):
+        given = [e.get(key) for e in (use, symbol)]
+        out[key] = next((v for v in given if v and v.strip().lower() != "auto"), "100%")
+    for key in ("x", "y"):
+        mine, its = use.get(key), symbol.get(key)
+        if not its:
+            if mine:
+                out[key] = mine
+            continue
+        try:
+            out[key] = _added(mine, its)
+        except ValueError:
+            raise ValueError(
+                f"cannot place <symbol> {symbol.get('id')!r}: its {key} {its!r} and the "
+                f"<use>'s {mine!r} do not add up (a percentage); give the symbol's {key} in "
+                "user units"
+            ) from None
+    return out
 
 
 def _added(first: str | None, second: str | None) -> str:

@@ -475,6 +475,35 @@ def test_a_symbol_with_a_viewbox_is_placed_in_the_viewport_of_its_use(tmp_path: 
     assert contour.source == "use#u > rect#r"
 
 
+@pytest.mark.parametrize(
+    ("symbol", "use", "box"),
+    [
+        # SVG 2 §5.6: the symbol's own size when the use gives none (20 × 20 for its
+        # viewBox 0 0 10 10: the 10 × 5 rect at 20..40, 20..30)
+        ('width="20" height="20"', 'x="20" y="20"', (20, 20, 40, 30)),
+        # its x and y place the viewport, moved by the use's: 30, 25
+        ('x="10" y="5" width="20" height="20"', 'x="20" y="20"', (30, 25, 50, 35)),
+        # the use's size wins over the symbol's; its x and y still count
+        ('x="10" y="5" width="20" height="20"', 'x="20" y="20" width="40" height="40"',
+         (30, 25, 70, 45)),
+        # refX and refY move nothing (Chromium ignores them too)
+        ('refX="5" refY="5" width="20" height="20"', 'x="20" y="20"', (20, 20, 40, 30)),
+    ],
+)  # fmt: skip
+def test_a_symbols_own_place_and_size_count(
+    tmp_path: Path, symbol: str, use: str, box: tuple[float, ...]
+) -> None:
+    # Each box is what Chromium's getBBox gives for the document; before, the symbol's own
+    # x, y, width and height were dropped: the viewport sat at the use's x, y, 100 % wide.
+    body = (
+        f'<symbol id="s" viewBox="0 0 10 10" {symbol}><rect width="10" height="5" '
+        f'fill="red"/></symbol><use href="#s" {use}/>'
+    )
+    x0, y0, x1, y1 = box
+    (contour,) = read_svg(svg(tmp_path, body)).contours
+    assert contour.bbox() == pytest.approx((x0, 100 - y1, x1, 100 - y0), abs=1e-9)
+
+
 def read_or_refused(path: Path, read: bool, bbox: tuple[float, ...], refusal: str) -> None:
     """``path`` reads as one contour of ``bbox`` (``read``), else is refused (``refusal``)."""
     if read:
