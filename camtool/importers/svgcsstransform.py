@@ -33,6 +33,8 @@ _THREE_D = frozenset(
 )  # fmt: skip
 _ALONE = ("translate", "rotate", "scale")
 """CSS Transforms 2's properties of one transform each, which svgelements does not read."""
+_WORDS = ("transform", *_ALONE)
+"""Words a ``style`` holds when :func:`move_css_transform` has anything to do."""
 _DO = "apply the transform in the drawing program (Inkscape: Object > Transform)"
 
 
@@ -49,6 +51,9 @@ def move_css_transform(element: ET.Element) -> None:
     Raises:
         ValueError: what cannot be read so, named, with what to do.
     """
+    text = element.get("style", "")
+    if not any(word in text for word in _WORDS) and element.get("transform-box") is None:
+        return  # no transform, translate, rotate or scale property, no transform-box
     style = inline_style(element)
     for name in _ALONE:
         if name in style:
