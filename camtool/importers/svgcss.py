@@ -29,6 +29,7 @@ from __future__ import annotations
 import re
 import xml.etree.ElementTree as ET
 from collections import Counter
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 from camtool.model.errors import InputError
@@ -387,6 +388,21 @@ def apply_style_sheets(
     ]
 
 
+def labelled(root: ET.Element) -> Iterator[tuple[ET.Element, str, str]]:
+    """``(element, kind, label)`` of each SVG element under ``root``, in document order.
+
+    The label is how messages name it: ``rect#id``, else ``rect[n]``, the n-th of its kind.
+    """
+    seen: Counter[str] = Counter()
+    for element in root.iter():
+        kind = local_name(element)
+        if kind is None:
+            continue
+        seen[kind] += 1
+        ident = element.get("id")
+        yield element, kind, f"{kind}#{ident}" if ident else f"{kind}[{seen[kind]}]"
+
+
 def check_variables(root: ET.Element, name: str) -> None:
     """Refuse a custom property (``var(--x)``) where it decides whether an element shows.
 
@@ -399,18 +415,11 @@ def check_variables(root: ET.Element, name: str) -> None:
         InputError: such a value, with the file, the element (``rect#id``, ``rect[2]``, as
             the later checks name it) and what to do.
     """
-    seen: Counter[str] = Counter()
-    for element in root.iter():
-        kind = local_name(element)
-        if kind is None:
-            continue
-        seen[kind] += 1
+    for element, _, label in labelled(root):
         style = inline_style(element) if "var(" in element.get("style", "").lower() else {}
         for prop in ("display", "visibility", "opacity"):
             value = style.get(prop, element.get(prop))
             if value is not None and "var(" in value.lower():
-                ident = element.get("id")
-                label = f"{kind}#{ident}" if ident else f"{kind}[{seen[kind]}]"
                 raise InputError(
                     f"{name}: {label}: {prop}: {value.strip()} decides whether it shows, and "
                     "camtool does not resolve CSS custom properties (var()); write the value "

@@ -51,8 +51,8 @@ def move_css_transform(element: ET.Element) -> None:
     Raises:
         ValueError: what cannot be read so, named, with what to do.
     """
-    text = element.get("style", "")
-    if not any(word in text for word in _WORDS) and element.get("transform-box") is None:
+    written = element.get("style", "")
+    if not any(word in written for word in _WORDS) and element.get("transform-box") is None:
         return  # no transform, translate, rotate or scale property, no transform-box
     style = inline_style(element)
     for name in _ALONE:
@@ -158,31 +158,28 @@ def _scale(arg: str, text: str) -> float:
 
 
 def _length(arg: str, text: str) -> float:
-    value, unit = _parts(arg, text)
-    if unit in _PX:
-        return value * _PX[unit]
-    if not unit and value == 0.0:
-        return 0.0
-    if not unit:
-        raise ValueError(
-            f"{arg.strip()!r} in the CSS transform {text!r} has no unit, which CSS requires "
-            "(10px, 5mm) and a viewer ignores the transform without; write it"
-        )
-    raise ValueError(
-        f"{arg.strip()!r} in the CSS transform {text!r}: camtool reads lengths in px, mm, cm, "
-        f"Q, in, pt or pc (not {unit}); {_DO}"
-    )
+    """A CSS length in px (user units)."""
+    return _measured(arg, text, _PX, "10px, 5mm", "a length in px, mm, cm, Q, in, pt or pc")
 
 
 def _angle(arg: str, text: str) -> float:
+    """A CSS angle in degrees."""
+    return _measured(arg, text, _DEG, "30deg", "an angle in deg, grad, rad or turn")
+
+
+def _measured(arg: str, text: str, units: dict[str, float], example: str, what: str) -> float:
+    """``arg`` in the unit of ``units`` whose factor is 1; a bare 0 is 0 (CSS Values 4)."""
     value, unit = _parts(arg, text)
-    if unit in _DEG:
-        return value * _DEG[unit]
+    if unit in units:
+        return value * units[unit]
     if not unit and value == 0.0:
         return 0.0
     if not unit:
         raise ValueError(
             f"{arg.strip()!r} in the CSS transform {text!r} has no unit, which CSS requires "
-            "(30deg) and a viewer ignores the transform without; write it"
+            f"({example}) and a viewer ignores the transform without; write it"
         )
-    raise ValueError(f"{arg.strip()!r} in the CSS transform {text!r} is not an angle")
+    raise ValueError(
+        f"{arg.strip()!r} in the CSS transform {text!r} is not {what} (camtool reads no "
+        f"{unit}); {_DO}"
+    )

@@ -22,6 +22,7 @@ from camtool.importers.svgcss import (
     apply_style_sheets,
     check_variables,
     inline_style,
+    labelled,
     local_name,
     normalize_styles,
     style_text,
@@ -618,14 +619,7 @@ def _parse(path: Path) -> ET.Element:
 
 
 def _label_and_check(root: ET.Element, name: str, viewport: tuple[float, float]) -> None:
-    seen: Counter[str] = Counter()
-    for element in root.iter():
-        kind = local_name(element)
-        if kind is None:
-            continue
-        seen[kind] += 1
-        ident = element.get("id")
-        label = f"{kind}#{ident}" if ident else f"{kind}[{seen[kind]}]"
+    for element, kind, label in labelled(root):
         element.set(SOURCE_ATTR, label)
         if kind == "use":
             element.set(USE_ATTR, label)

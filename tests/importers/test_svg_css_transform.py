@@ -69,7 +69,7 @@ def test_a_style_sheets_transform_turns_about_the_viewports_centre(tmp_path: Pat
         ('style="transform: translate(10, 5)"', "has no unit, which CSS requires (10px, 5mm)"),
         ('style="transform: translate(10px 5px)"', "cannot read '10px 5px'"),
         ('style="transform: rotateX(30deg)"', "is 3D (rotatex)"),
-        ('style="transform: translate(10%, 0)"', "(not %)"),
+        ('style="transform: translate(10%, 0)"', "(camtool reads no %)"),
         ('style="transform: rotate(30deg); transform-box: fill-box"', "transform-box 'fill-box'"),
         ('transform="rotate(30)" style="transform-box: fill-box"', "transform-box 'fill-box'"),
         ('style="rotate: 30deg"', "the CSS property 'rotate'"),
