@@ -293,7 +293,8 @@ def read_chaining(code: str) -> tuple[float, float] | None:
     """``(--chain-tolerance, --close-gap)``, mm, a camtool header in ``code`` records.
 
     Written only when either is not the default: ``None`` then (the defaults hold), for
-    a value that is not a finite number ≥ 0, and without camtool's header.
+    a value outside ``post``'s range (0 to :data:`~camtool.toolpath.options.MAX_LENGTH_MM`),
+    and without camtool's header.
     """
     for line in _header(code):
         found = _CHAINING.search(line)

@@ -174,6 +174,7 @@ def _main_layers(c: Content, u: float, frame: BBox, pixel_mm: float) -> list[Lay
     worst = None
     if v is not None and v.deviation.block >= 0:
         worst = tl.worst_layer("worst", v, u, view=frame)
+    marks = [mark_box(s) for s in worst.shapes if isinstance(s, Text | Circle)] if worst else []
     program = []
     if c.program is not None:
         program = pl.program_layers(
@@ -183,9 +184,7 @@ def _main_layers(c: Content, u: float, frame: BBox, pixel_mm: float) -> list[Lay
             sections=c.sections,
             pixel_mm=pixel_mm,
             frame=frame,
-            clear=[mark_box(s) for s in worst.shapes if isinstance(s, Text | Circle)]
-            if worst
-            else [],
+            clear=marks,
         )
     layers.extend(layer for layer in program if layer.id == "tool-width")
     if v is not None:
@@ -195,7 +194,6 @@ def _main_layers(c: Content, u: float, frame: BBox, pixel_mm: float) -> list[Lay
     layers.extend(layer for layer in program if layer.id != "tool-width")
     layers.append(pl.zero_layer(frame, u))
     if v is not None and v.against is not None and v.against.not_cut:
-        marks = [mark_box(s) for s in worst.shapes if isinstance(s, Text | Circle)] if worst else []
         numbers = [mark_box(s) for layer in program for s in layer.shapes if isinstance(s, Text)]
         layers.append(tl.not_cut_layer("not-cut", v.against.not_cut, u, clear=marks + numbers))
     if worst is not None:
