@@ -434,8 +434,8 @@ def _media_hiding(at_rule: str, body: str) -> str | None:
     media query (``screen``, ``all``, a width) may, as may ``@supports`` and ``@layer``.
     """
     words = at_rule.lower().split()
-    if words[0] in ("@font-face", "@page", "@keyframes", "@import", "@namespace", "@charset"):
-        return None
+    if words[0].endswith("keyframes") or words[0] in ("@font-face", "@page", "@property"):
+        return None  # an animation's frames (@-webkit-keyframes too), a font, a page box
     if words[0] == "@media" and all(_print_only(q) for q in " ".join(words[1:]).split(",")):
         return None
     for _, inner in _css_rules(body):

@@ -39,6 +39,13 @@ def test_a_print_rule_hides_nothing_on_a_screen(tmp_path: Path, media: str) -> N
     assert f"'@media {media}'" in drawing.warnings[0]
 
 
+@pytest.mark.parametrize("rule", ["@keyframes fade", "@-webkit-keyframes fade"])
+def test_an_animations_frames_hide_nothing_in_a_still_picture(tmp_path: Path, rule: str) -> None:
+    # a frame at opacity 0 is a moment of an animation, not a rule that selects elements
+    body = f"<style>{rule} {{ 0% {{ opacity: 0 }} 100% {{ opacity: 1 }} }}</style>{SHAPES}"
+    assert [c.source for c in read_svg(svg(tmp_path, body)).contours] == ["path#x", "path#y"]
+
+
 def test_a_rule_after_an_import_statement_applies(tmp_path: Path) -> None:
     # The sheet the @import names is not read (said in the warning); the rule after the
     # statement is a rule of its own, which hides path#x.
