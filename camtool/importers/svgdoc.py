@@ -15,6 +15,8 @@ from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
+import svgelements as se
+
 from camtool.importers import svgcheck, svgvalues
 from camtool.importers.options import check_expansion, entity_limit, layer_list
 from camtool.importers.svgcontent import hold_unrendered
@@ -533,6 +535,7 @@ def prepare(
     svgvalues.resolve_context_paints(root, parents)
     svgvalues.normalize_colours(root)
     _label_and_check(root, str(path), viewport)
+    _check_root_transform(root, str(path))
     check_use_cycles(root, str(path))
     check_size(root, str(path), max_entities)
     placed = frozenset(href(e)[1:] for e in root.iter() if local_name(e) == "use")
@@ -629,6 +632,29 @@ def _label_and_check(root: ET.Element, name: str, viewport: tuple[float, float])
             _check(element, kind, viewport)
         except ValueError as exc:
             raise InputError(f"{name}: {label}: {exc}") from exc
+
+
+def _check_root_transform(root: ET.Element, name: str) -> None:
+    """Refuse a ``transform`` on the ``<svg>`` element itself that moves anything.
+
+    SVG 2 allows it, and viewers disagree on what it moves: a browser turns and moves the
+    whole page with it (about the page's centre: the outermost ``<svg>`` has a CSS box,
+    so its ``transform-origin`` is 50 % 50 %), svgelements the drawing on the page, other
+    programs nothing. Checked after the CSS ``transform`` property became the attribute.
+
+    Raises:
+        InputError: such a transform, with where to put it instead.
+    """
+    text = (root.get("transform") or "").strip()
+    if not text or se.Matrix(text).is_identity():
+        return
+    raise InputError(
+        f"{name}: the <svg> element itself has transform={text!r}, which a browser applies "
+        "to the whole page (turning it about its centre) and other programs to the drawing "
+        "on the page or not at all, so camtool cannot tell where the drawing lies; move the "
+        "attribute to a <g> around the drawing (a text editor, or Inkscape's Edit > XML "
+        "Editor), or remove it"
+    )
 
 
 def _check(element: ET.Element, kind: str, viewport: tuple[float, float]) -> None:

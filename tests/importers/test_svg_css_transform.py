@@ -80,3 +80,32 @@ def test_a_css_transform_camtool_cannot_draw_as_a_viewer_does_is_refused(
 ) -> None:
     with pytest.raises(InputError, match=r"rect\[1\]: .*" + re.escape(why)):
         _box(tmp_path, attrs)
+
+
+@pytest.mark.parametrize(
+    ("root", "refused"),
+    [
+        ('transform="rotate(90)"', True),
+        ('transform="translate(10 0)"', True),
+        ('style="transform: scale(2)"', True),
+        ('transform="translate(0 0)"', False),
+        ('style="transform: none"', False),
+    ],
+)
+def test_a_transform_on_the_svg_element_itself_is_refused(
+    tmp_path: Path, root: str, refused: bool
+) -> None:
+    # Chromium turns the whole page about its centre (the outermost <svg> has a CSS box:
+    # transform-origin 50 % 50 %), svgelements the drawing on the page: rotate(90) puts
+    # the rectangle at x 70…90 in one and at x −30…−10 in the other. One that moves
+    # nothing passes, and the rectangle is where it is drawn.
+    path = tmp_path / "t.svg"
+    path.write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" '
+        f'viewBox="0 0 100 100" {root}><rect x="10" y="10" width="20" height="10"/></svg>'
+    )
+    if refused:
+        with pytest.raises(InputError, match="the <svg> element itself has transform="):
+            read_drawing(path)
+    else:
+        assert read_drawing(path).bbox() == pytest.approx((10, 80, 30, 90))
