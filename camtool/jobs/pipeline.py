@@ -164,8 +164,10 @@ def post_path(
 
     progress(Step("reading", name=Path(path).name))
     program = read_gcode(path, reading=reading_for(target, plan))
-    with Path(path).open("rb") as file:  # read just now: its header, for the notes
-        head = file.read(HEADER_CHARS).decode("utf-8", "replace")
+    head = ""
+    if Path(path).is_file():  # read just now: its header, for the notes (a pipe is read once)
+        with Path(path).open("rb") as file:
+            head = file.read(HEADER_CHARS).decode("utf-8", "replace")
     return post_program(
         program,
         target,

@@ -284,3 +284,31 @@ def test_a_header_cut_short_at_the_line_limit_is_still_camtools(run: Any, tmp_pa
     assert code == 0, err
     assert "placed as the program's header says" in err and "tool diameter 3 mm" in err
     assert json.loads(report.read_text())["against"]["overcut_um"] < 20.0
+
+
+def test_a_program_read_from_a_pipe_is_read_once(tmp_path: Path) -> None:
+    # A named pipe (mkfifo part.nc, a shell's process substitution) can be read once: the
+    # header for the re-post's notes comes from a second look at a regular file only.
+    # Looking again at the pipe waited for a writer that never came (the post hung).
+    import os
+    import subprocess
+    import sys
+    import threading
+
+    program = tmp_path / "p.nc"
+    code = "(camtool 0.1.0: a.dxf for grbl)\nG21 G90\nG0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X10\nG0 Z5\nM2\n"
+    pipe, out = tmp_path / "pipe.nc", tmp_path / "o.ngc"
+    program.write_text(code)
+    os.mkfifo(pipe)
+    writer = threading.Thread(target=lambda: pipe.write_bytes(program.read_bytes()))
+    writer.start()
+    args = [sys.executable, "-m", "camtool", "post", str(pipe), "-t", "linuxcnc", "-o", str(out)]
+    try:
+        done = subprocess.run(args, capture_output=True, text=True, timeout=120, cwd=ROOT)
+    finally:
+        if writer.is_alive():  # the post never opened the pipe: let the writer finish
+            with open(pipe, "rb") as drain:
+                drain.read()
+        writer.join()
+    assert done.returncode == 0, done.stderr
+    assert "G1 X10.000" in out.read_text()
