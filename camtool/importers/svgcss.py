@@ -415,11 +415,12 @@ def check_variables(root: ET.Element, name: str) -> None:
         InputError: such a value, with the file, the element (``rect#id``, ``rect[2]``, as
             the later checks name it) and what to do.
     """
-    for element, _, label in labelled(root):
+    for element in root.iter():
         style = inline_style(element) if "var(" in element.get("style", "").lower() else {}
         for prop in ("display", "visibility", "opacity"):
             value = style.get(prop, element.get(prop))
             if value is not None and "var(" in value.lower():
+                label = next((t for e, _, t in labelled(root) if e is element), element.tag)
                 raise InputError(
                     f"{name}: {label}: {prop}: {value.strip()} decides whether it shows, and "
                     "camtool does not resolve CSS custom properties (var()); write the value "

@@ -217,7 +217,7 @@ def carried_notes(code: str) -> tuple[str, ...]:
     tool's comments are never taken.
     """
     texts: list[str] = []
-    for line in code[:HEADER_CHARS].lstrip("\ufeff").splitlines()[:HEADER_LINES]:
+    for line in _head_lines(code.lstrip("\ufeff")):
         text = _comment_of(line)
         if text is None:
             if line.strip() in ("", "%"):
@@ -356,8 +356,13 @@ def _header(code: str) -> list[str]:
     Else none: another tool's comment is never taken. Only the start of the text is split
     (a program of millions of lines is not).
     """
-    head = code[:HEADER_CHARS].splitlines()[:HEADER_LINES]
+    head = _head_lines(code)
     return head if any(_CAMTOOL.search(line) for line in head) else []
+
+
+def _head_lines(code: str) -> list[str]:
+    """The first :data:`HEADER_LINES` lines of ``code``, of its first :data:`HEADER_CHARS`."""
+    return code[:HEADER_CHARS].splitlines()[:HEADER_LINES]
 
 
 HEADER_LINES = 60

@@ -493,8 +493,8 @@ def test_a_symbol_with_a_viewbox_is_placed_in_the_viewport_of_its_use(tmp_path: 
 def test_a_symbols_own_place_and_size_count(
     tmp_path: Path, symbol: str, use: str, box: tuple[float, ...]
 ) -> None:
-    # Each box is what Chromium's getBBox gives for the document; before, the symbol's own
-    # x, y, width and height were dropped: the viewport sat at the use's x, y, 100 % wide.
+    # Each box is what Chromium's getBBox gives for the document; without the symbol's own
+    # x, y, width and height the viewport would sit at the use's x, y, 100 % wide.
     body = (
         f'<symbol id="s" viewBox="0 0 10 10" {symbol}><rect width="10" height="5" '
         f'fill="red"/></symbol><use href="#s" {use}/>'

@@ -4,8 +4,8 @@ Expected boxes from analysis: a 100 × 100 mm page with ``viewBox="0 0 100 100"`
 unit a mm, Y flipped: y_mm = 100 − y) and the rectangle x 10…30, y 10…20 transformed by
 CSS Transforms 1's matrices, about ``transform-origin`` (of the viewport for keywords,
 ``transform-box: view-box``). Chromium draws each of these the same (to 0.011 mm,
-sampling its ``getPointAtLength``); before, camtool turned shapes about the origin when the
-origin came with a CSS transform (up to 73 mm off).
+sampling its ``getPointAtLength``). A shape turned about (0, 0) instead of its
+``transform-origin`` would lie tens of millimetres away.
 """
 
 from __future__ import annotations

@@ -161,8 +161,8 @@ def test_a_reposted_program_keeps_what_its_header_says_of_the_cut(run: Any, tmp_
     # post --layers OUTLINE --offset outside (the 80 × 60 mm outline alone, with a 3 mm
     # tool), re-posted for LinuxCNC, then that for GRBL: re-posting moves nothing, so the
     # header's tool, offset and layers still hold, and verify --against compares the
-    # re-post as it compares the program it came from. Without them the whole drawing was
-    # compared at the tool centre: 31 500 µm (the holes, 25 mm in, and the tool's radius).
+    # re-post as it compares the program it came from. Without them the whole drawing would
+    # be compared at the tool centre: the holes 25 mm in, and the tool's radius, as error.
     first, again, third = tmp_path / "o.nc", tmp_path / "o.ngc", tmp_path / "o2.nc"
     report = tmp_path / "report.json"
     code, err = run("post", PART, "-t", "grbl", "--layers", "OUTLINE", *OPTIONS, "-o", str(first))
@@ -224,14 +224,16 @@ def test_verify_against_closes_the_gaps_post_closed(run: Any, tmp_path: Path) ->
     from camtool.jobs.header import read_chaining
 
     assert read_chaining(out.read_text()) == (0.01, 0.5)
-    for width, overcut in ((40, 4.6), (40.2, 200.0)):
+    # from analysis: the drawing it was posted from is overcut only by the dialect's
+    # rounding (0.5 µm) and GRBL's steps and interpolation (4 µm steps), under 20 µm; the
+    # drawing 0.2 mm wider by 200 µm and that same error
+    for width, overcut in ((40, 0.0), (40.2, 200.0)):
         args = ["verify", str(out), "-t", "grbl", "--against", str(drawing(width))]
         code, err = run(*args, "--report", str(report))
         assert code == 0, err
         assert "not compared" not in err
-        assert json.loads(report.read_text())["against"]["overcut_um"] == pytest.approx(
-            overcut, abs=5
-        )
+        got = json.loads(report.read_text())["against"]["overcut_um"]
+        assert overcut <= got + 20.0 and got < overcut + 20.0
     assert read_chaining("(chaining: ends within 0.1 mm joined, gaps up to 1 mm closed)") is None
 
 
@@ -289,7 +291,8 @@ def test_a_header_cut_short_at_the_line_limit_is_still_camtools(run: Any, tmp_pa
 def test_a_program_read_from_a_pipe_is_read_once(tmp_path: Path) -> None:
     # A named pipe (mkfifo part.nc, a shell's process substitution) can be read once: the
     # header for the re-post's notes comes from a second look at a regular file only.
-    # Looking again at the pipe waited for a writer that never came (the post hung).
+    # Looking again at the pipe would wait for a writer that never comes: the post would
+    # hang, and the timeout (a bound on a hang, not on speed) fails the test.
     import os
     import subprocess
     import sys
@@ -304,7 +307,7 @@ def test_a_program_read_from_a_pipe_is_read_once(tmp_path: Path) -> None:
     writer.start()
     args = [sys.executable, "-m", "camtool", "post", str(pipe), "-t", "linuxcnc", "-o", str(out)]
     try:
-        done = subprocess.run(args, capture_output=True, text=True, timeout=120, cwd=ROOT)
+        done = subprocess.run(args, capture_output=True, text=True, timeout=600, cwd=ROOT)
     finally:
         if writer.is_alive():  # the post never opened the pipe: let the writer finish
             with open(pipe, "rb") as drain:
