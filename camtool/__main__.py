@@ -29,11 +29,13 @@ def leave(code: int) -> NoReturn:
     the exit functions run (``atexit``: multiprocessing's children, tempfile's
     finalizers, a coverage run's data), then stdout and stderr are flushed; camtool
     writes its files in ``with`` blocks and flushes its stdout itself
-    (:mod:`camtool.cli.common`), so no buffer is left. While another thread runs, the
-    exit is Python's own (it waits for them). mypy leaves the same way, for the same
-    reason (``mypy.util.hard_exit``).
+    (:mod:`camtool.cli.common`), so no buffer is left. While another thread that is not a
+    daemon runs, the exit is Python's own (it waits for them); a daemon thread (the
+    progress line's timer, :mod:`camtool.cli.progress`) is left as Python's own exit
+    leaves it. mypy leaves the same way, for the same reason (``mypy.util.hard_exit``).
     """
-    if threading.active_count() > 1:
+    main = threading.main_thread()
+    if any(t is not main and not t.daemon for t in threading.enumerate()):
         sys.exit(code)
     atexit._run_exitfuncs()
     for stream in (sys.stdout, sys.stderr):

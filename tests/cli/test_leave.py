@@ -2,7 +2,8 @@
 
 :func:`camtool.__main__.leave` (issue 17: 0.15 s after a big verify): the exit functions
 run, buffered output reaches stdout and stderr, the exit code is the command's; with
-another thread alive it is Python's own exit, which waits for it.
+another thread alive it is Python's own exit, which waits for it, unless that thread is a
+daemon (the progress line's timer), which Python's own exit does not wait for either.
 """
 
 from __future__ import annotations
@@ -55,6 +56,24 @@ def test_leave_waits_for_a_thread_still_running() -> None:
     )
     assert done.returncode == 5
     assert done.stdout == "thread done\n"
+
+
+def test_a_daemon_thread_does_not_bring_back_the_teardown() -> None:
+    # the teardown clears the modules' globals, so the object's __del__ would print
+    done = _run(
+        """
+        import threading, time
+        from camtool.__main__ import leave
+        class Torn:
+            def __del__(self):
+                print("torn down", flush=True)
+        kept = Torn()
+        threading.Thread(target=time.sleep, args=(30,), daemon=True).start()
+        leave(6)
+        """
+    )
+    assert done.returncode == 6
+    assert "torn down" not in done.stdout
 
 
 def test_the_console_script_leaves_with_the_commands_code() -> None:
