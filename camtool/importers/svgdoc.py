@@ -36,7 +36,13 @@ from camtool.importers.svgmasks import (
     masks_as_clips,
     symbols_as_viewports,
 )
-from camtool.importers.svgpage import Affine, illustrator_version, page_matrix
+from camtool.importers.svgpage import (
+    INKSCAPE_VERSION,
+    Affine,
+    illustrator_version,
+    page_matrix,
+    top_level_layers,
+)
 from camtool.importers.svgskipped import count_skipped
 from camtool.importers.svgtree import (
     INKSCAPE_NS,
@@ -90,14 +96,35 @@ def _layer_name(element: ET.Element) -> str:
     return (
         element.get(_LABEL)
         or element.get(_LC_LAYER)
-        or element.get("id")
+        or element.get("data-name")
+        or _decoded_id(element.get("id"))
         or str(element.get(SOURCE_ATTR, "g"))
     )
 
 
 def _layer_names(layer: ET.Element) -> set[str]:
-    """The names ``--layers`` and a job's operations select ``layer`` by: label and id."""
-    return {n for n in (layer.get(_LABEL), layer.get(_LC_LAYER), layer.get("id")) if n}
+    """The names ``--layers`` and a job's operations select ``layer`` by: label and id.
+
+    An Illustrator or CorelDRAW layer also by its ``data-name`` and by its ``id`` with the
+    characters an id cannot hold written back (``Layer_x0020_1`` is ``Layer 1``).
+    """
+    names = (
+        layer.get(_LABEL),
+        layer.get(_LC_LAYER),
+        layer.get("data-name"),
+        layer.get("id"),
+        _decoded_id(layer.get("id")),
+    )
+    return {n for n in names if n}
+
+
+_ESCAPED = re.compile(r"_x([0-9A-Fa-f]{4})_")
+"""A character Illustrator and CorelDRAW cannot put in an ``id``, as they write it there."""
+
+
+def _decoded_id(text: str | None) -> str | None:
+    """``text`` with each ``_xHHHH_`` written back as its character (``_x0020_``: a space)."""
+    return None if text is None else _ESCAPED.sub(lambda m: chr(int(m[1], 16)), text)
 
 
 def _is_layer(element: ET.Element) -> bool:
@@ -105,6 +132,19 @@ def _is_layer(element: ET.Element) -> bool:
     return local_name(element) == "g" and (
         element.get(_GROUPMODE) == "layer" or bool(element.get(_LC_LAYER))
     )
+
+
+def _layers(root: ET.Element, top_level: bool) -> list[ET.Element]:
+    """The document's layers: Inkscape's and LibreCAD's marked groups.
+
+    Without them, in a file of a program whose layers are the root's groups
+    (``top_level``, :func:`~camtool.importers.svgpage.top_level_layers`), the ``<g>``
+    children of the ``<svg>`` element that have an ``id``.
+    """
+    layers = [e for e in root.iter() if _is_layer(e)]
+    if layers or not top_level or root.get(INKSCAPE_VERSION) is not None:
+        return layers
+    return [e for e in root if local_name(e) == "g" and e.get("id")]
 
 
 def select_layers(
@@ -115,8 +155,13 @@ def select_layers(
     name: str,
     warnings: list[str],
     shown: tuple[str, ...] = (),
+    *,
+    top_level: bool = False,
 ) -> None:
     """Mark layers with :data:`LAYER_ATTR`; keep only ``wanted`` ones (``None``: all).
+
+    ``top_level``: the file is of a program whose layers are the root's groups
+    (:func:`_layers`).
 
     Unselected drawn content moves into ``hold``; selected layers and their parents are
     shown. Without a selection, a hidden layer named in ``shown`` (by a job's operation,
@@ -126,7 +171,7 @@ def select_layers(
         InputError: a name in ``wanted`` matches no layer label or id (the message lists
             the layers there are).
     """
-    layers = [e for e in root.iter() if _is_layer(e)]
+    layers = _layers(root, top_level)
     for layer in layers:
         layer.set(LAYER_ATTR, _layer_name(layer))
     if wanted is None:
@@ -523,7 +568,8 @@ def prepare(
     """
     root = _parse(path)
     with path.open("rb") as file:
-        illustrator = illustrator_version(file.read(4096))
+        head = file.read(4096)
+    illustrator = illustrator_version(head)
     warnings: list[str] = []
     matrix, viewport, page = page_matrix(root, str(path), warnings, units, illustrator)
     parents = {child: parent for parent in root.iter() for child in parent}
@@ -549,7 +595,9 @@ def prepare(
     hold = ET.SubElement(root, tag(root, "defs"))
     parents[hold] = root
     counts: Counter[str] = Counter()
-    select_layers(root, layers, parents, hold, str(path), warnings, shown)
+    select_layers(
+        root, layers, parents, hold, str(path), warnings, shown, top_level=top_level_layers(head)
+    )
     choose_switches(root, parents, hold, str(path), counts)
     check_conditions(root, parents, hold, str(path), counts)
     fade_under_transparent(root)

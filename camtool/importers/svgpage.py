@@ -160,6 +160,20 @@ def illustrator_version(head: bytes) -> str | None:
     return None if match is None else match[1].decode("ascii")
 
 
+_COREL = re.compile(rb"<!--\s*Creator:\s*CorelDRAW")
+"""The comment CorelDRAW's SVG export writes before the root element."""
+
+
+def top_level_layers(head: bytes) -> bool:
+    """Whether ``head``, a file's first bytes, names a program whose layers are the root's groups.
+
+    Adobe Illustrator and CorelDRAW write each layer as a ``<g>`` child of the ``<svg>``
+    element, named by its ``id`` (Illustrator: ``data-name`` too where the name is no
+    valid id), with no mark of its own.
+    """
+    return _ILLUSTRATOR.search(head) is not None or _COREL.search(head) is not None
+
+
 def _illustrator_px(root: ET.Element, version: str | None, has_viewbox: bool) -> bool:
     """Whether the user units of a file Illustrator ``version`` wrote are its points.
 
