@@ -16,8 +16,10 @@ the presentation attribute (left where it is: svgelements ranks it below the sty
 sheet declarations the more specific selector wins, then the later one. Inheritance is
 svgelements' (it passes a group's style down).
 
-Selectors applied: compound selectors (``*``, a type, ``#id``, ``.class``, any together:
-``path.cut.outer``, ``rect#a``) joined by descendant (space) or child (``>``) combinators.
+Selectors applied: compound selectors (``*``, a type, ``#id``, ``.class``, ``:root``, any
+together: ``path.cut.outer``, ``rect#a``) joined by descendant (space) or child (``>``)
+combinators. Custom properties (``--ink``) are then resolved where ``var()`` uses them
+(:mod:`camtool.importers.svgvars`).
 Others (attributes ``[x]``, pseudo-classes ``:first-child``, sibling combinators ``+``/``~``,
 at-rules ``@media``) are not applied: :func:`apply_style_sheets` refuses such a rule if it
 hides what it selects, and names the others in a warning (``@font-face`` excepted: a font
@@ -66,7 +68,7 @@ _KEYWORDS = frozenset({"none", "hidden", "collapse", "visible", "inline", "block
 """Values read as keywords, any case (``NONE``); ``currentColor`` stays as svgelements knows it."""
 _IMPORTANT = re.compile(r"\s*!\s*important\s*$", re.IGNORECASE)
 _PRESENTATION = ("display", "visibility", "fill", "stroke")
-_COMPOUND = re.compile(r"(\*|[A-Za-z_][\w-]*)?((?:[#.][\w-]+)*)")
+_COMPOUND = re.compile(r"(\*|[A-Za-z_][\w-]*)?((?:[#.][\w-]+)*)(:root)?", re.IGNORECASE)
 _COMBINATOR_OR_COMPOUND = re.compile(r"\s*(>)\s*|\s+|([^\s>]+)")
 _HIDING = ("display:none", "visibility:hidden", "visibility:collapse")
 _IMPORT = re.compile(r"@import\b[^;{]*", re.IGNORECASE)
@@ -219,9 +221,12 @@ class _Compound:
     tag: str | None
     ids: frozenset[str]
     classes: frozenset[str]
+    root: bool = False  # :root, the document's root element
 
-    def matches(self, element: ET.Element, classes: frozenset[str]) -> bool:
+    def matches(self, element: ET.Element, classes: frozenset[str], is_root: bool) -> bool:
         if self.tag is not None and local_name(element) != self.tag:
+            return False
+        if self.root and not is_root:
             return False
         if self.ids and self.ids != {element.get("id")}:
             return False
@@ -251,6 +256,7 @@ def _compound(text: str) -> _Compound | None:
         None if tag in (None, "*") else tag,
         frozenset(n[1:] for n in names if n[0] == "#"),
         frozenset(n[1:] for n in names if n[0] == "."),
+        match.group(3) is not None,
     )
 
 
@@ -275,7 +281,7 @@ def _selector(text: str) -> _Selector | None:
     if not parts or pending_child:
         return None
     ids = sum(len(p.ids) for p in parts)
-    classes = sum(len(p.classes) for p in parts)
+    classes = sum(len(p.classes) + p.root for p in parts)
     tags = sum(p.tag is not None for p in parts)
     return _Selector(tuple(reversed(parts)), tuple(reversed(child)), (ids, classes, tags))
 
@@ -287,7 +293,7 @@ def _classes(element: ET.Element) -> frozenset[str]:
 def _matches(
     selector: _Selector, element: ET.Element, parents: dict[ET.Element, ET.Element], at: int = 0
 ) -> bool:
-    if not selector.parts[at].matches(element, _classes(element)):
+    if not selector.parts[at].matches(element, _classes(element), element not in parents):
         return False
     if at + 1 == len(selector.parts):
         return True
@@ -312,7 +318,10 @@ class _Rule:
 
 
 def apply_style_sheets(
-    root: ET.Element, parents: dict[ET.Element, ET.Element], name: str
+    root: ET.Element,
+    parents: dict[ET.Element, ET.Element],
+    name: str,
+    unapplied: set[str] | None = None,
 ) -> list[str]:
     """Apply every CSS ``<style>`` sheet to the elements' ``style`` attributes, then remove it.
 
@@ -325,6 +334,9 @@ def apply_style_sheets(
         root: the ``<svg>`` element.
         parents: each element's parent (the removed sheets are taken out of it).
         name: the file, for messages.
+        unapplied: given, the custom properties (``--ink``, in lower case) that a rule not
+            applied declares are added to it (:func:`camtool.importers.svgvars.resolve_variables`
+            refuses a value that needs one).
 
     Returns:
         A warning naming the rules not applied, if any (at-rules but ``@font-face``,
@@ -358,6 +370,7 @@ def apply_style_sheets(
                     )
                 if not selectors.lower().startswith("@font-face"):  # a font styles nothing
                     ignored.append(selectors)
+                    _custom_properties(body, unapplied, rules=True)
                 continue
             declarations = tuple(_declaration_list(body))
             for text in (s.strip() for s in selectors.split(",")):
@@ -370,10 +383,11 @@ def apply_style_sheets(
                     raise InputError(
                         f"{name}: the <style> rule '{text}' hides what it selects ({hiding}), "
                         "but camtool does not apply its selector (it applies types, .class, "
-                        "#id and their descendants), so those elements would be cut; put "
+                        "#id, :root and their descendants), so those elements would be cut; put "
                         f"{hiding} on the elements themselves (a style attribute), or delete them"
                     )
                 ignored.append(text)
+                _custom_properties(body, unapplied)
     for sheet in sheets:
         parents[sheet].remove(sheet)
         del parents[sheet]
@@ -384,8 +398,16 @@ def apply_style_sheets(
     shown = ", ".join(f"'{s}'" for s in ignored[:3]) + (" ..." if len(ignored) > 3 else "")
     return [
         f"{name}: {len(ignored)} <style> rule(s) not applied ({shown}): camtool applies types, "
-        ".class, #id and their descendants; what they style is read without them"
+        ".class, #id, :root and their descendants; what they style is read without them"
     ]
+
+
+def _custom_properties(body: str, into: set[str] | None, *, rules: bool = False) -> None:
+    """Add the custom properties ``body`` declares (a rule's; an at-rule's rules') to ``into``."""
+    if into is None:
+        return
+    bodies = [inner for _, inner in _css_rules(body)] if rules else [body]
+    into.update(k for text in bodies for k, _, _ in _declaration_list(text) if k.startswith("--"))
 
 
 def labelled(root: ET.Element) -> Iterator[tuple[ET.Element, str, str]]:
@@ -404,11 +426,11 @@ def labelled(root: ET.Element) -> Iterator[tuple[ET.Element, str, str]]:
 
 
 def check_variables(root: ET.Element, name: str) -> None:
-    """Refuse a custom property (``var(--x)``) where it decides whether an element shows.
+    """Refuse a ``var()`` left where it decides whether an element shows.
 
-    camtool does not resolve CSS custom properties; in ``display``, ``visibility`` or
-    ``opacity`` (a style, after the sheets are applied, or an attribute) one may hide the
-    element in a viewer, and camtool would cut it. Run before the opacities are read
+    The styles' are resolved before (:mod:`camtool.importers.svgvars`); one in the
+    ``display``, ``visibility`` or ``opacity`` attribute is not, and may hide the element
+    in a viewer, and camtool would cut it. Run before the opacities are read
     (``svgvalues.normalize_colours`` drops a value it cannot read).
 
     Raises:
@@ -423,8 +445,8 @@ def check_variables(root: ET.Element, name: str) -> None:
                 label = next((t for e, _, t in labelled(root) if e is element), element.tag)
                 raise InputError(
                     f"{name}: {label}: {prop}: {value.strip()} decides whether it shows, and "
-                    "camtool does not resolve CSS custom properties (var()); write the value "
-                    "itself"
+                    "camtool resolves custom properties (var()) in a style only; write the "
+                    "value itself, or put it in the element's style attribute"
                 )
 
 

@@ -59,6 +59,7 @@ from camtool.importers.svgtree import (
     tag,
 )
 from camtool.importers.svgvalues import LENGTH_ATTRS
+from camtool.importers.svgvars import resolve_variables
 from camtool.model.errors import InputError, not_a_file
 
 _GROUPMODE = f"{{{INKSCAPE_NS}}}groupmode"
@@ -573,7 +574,9 @@ def prepare(
     warnings: list[str] = []
     matrix, viewport, page = page_matrix(root, str(path), warnings, units, illustrator)
     parents = {child: parent for parent in root.iter() for child in parent}
-    warnings += apply_style_sheets(root, parents, str(path))
+    unapplied: set[str] = set()
+    warnings += apply_style_sheets(root, parents, str(path), unapplied)
+    resolve_variables(root, str(path), unapplied)
     normalize_styles(root)
     check_variables(root, str(path))
     svgvalues.resolve_percentages(root, viewport)

@@ -2,9 +2,9 @@
 
 Each expectation is what Chromium shows (its ``getComputedStyle`` on a screen, checked by
 hand on these documents): ``@media screen`` rules apply, ``@media print`` ones do not; a
-rule after an ``@import`` statement applies; ``var()`` resolves. camtool does not
-evaluate media queries or custom properties, so where one of them may hide a shape it
-refuses the drawing (a hidden shape cut is a wrong part), naming the rule or the element.
+rule after an ``@import`` statement applies. camtool does not evaluate media queries, so
+where one may hide a shape it refuses the drawing (a hidden shape cut is a wrong part),
+naming the rule (custom properties: tests/importers/test_svg_css_variables.py).
 """
 
 from __future__ import annotations
@@ -53,20 +53,3 @@ def test_a_rule_after_an_import_statement_applies(tmp_path: Path) -> None:
     drawing = read_svg(svg(tmp_path, body))
     assert [c.source for c in drawing.contours] == ["path#y"]
     assert "'@import url(other.css)'" in drawing.warnings[0]
-
-
-@pytest.mark.parametrize(
-    "style", ["display: var(--d)", "visibility:var(--v, hidden)", "opacity: VAR(--o, 0)"]
-)
-def test_a_custom_property_that_decides_whether_a_shape_shows_is_refused(
-    tmp_path: Path, style: str
-) -> None:
-    body = f"<style>.x {{ {style} }}</style>{SHAPES}"
-    with pytest.raises(InputError, match=r"path#x: .*does not resolve CSS custom properties"):
-        read_svg(svg(tmp_path, body))
-
-
-def test_a_custom_property_in_a_paint_is_read_as_before(tmp_path: Path) -> None:
-    # fill: var(--c, red) paints in a viewer; it hides nothing, so it is cut.
-    body = '<path id="x" d="M 0 0 L 1 0 L 1 1 Z" style="fill: var(--c, red)"/>'
-    assert [c.source for c in read_svg(svg(tmp_path, body)).contours] == ["path#x"]

@@ -476,7 +476,7 @@ def test_rules_that_hide_nothing_still_are_named(tmp_path: Path) -> None:
     assert [c.source for c in drawing.contours] == ["path#x", "path#y"]
     assert drawing.warnings == (
         f"{tmp_path / 't.svg'}: 4 <style> rule(s) not applied ('a:hover path', '@media print', "
-        "'path::selection' ...): camtool applies types, .class, #id and their descendants; "
+        "'path::selection' ...): camtool applies types, .class, #id, :root and their descendants; "
         "what they style is read without them",
     )
 

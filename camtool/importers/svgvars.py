@@ -1,0 +1,166 @@
+"""CSS custom properties (``--ink: none``) resolved where ``var()`` uses them in a style.
+
+svgelements reads ``fill: var(--ink)`` as a colour it does not know and draws the shape; a
+browser draws it as ``--ink`` says, ``none`` included. So, once the style sheets are in
+the ``style`` attributes (:func:`camtool.importers.svgcss.apply_style_sheets`), every
+``var()`` of a declaration is replaced by what it stands for, as CSS Custom Properties
+Level 1 says: a custom property is inherited (section 2), ``var(--name, fallback)`` takes
+the property's value, else the fallback (section 3); a declaration with a ``var()`` that has
+neither, or a cycle, is invalid at computed-value time and acts as ``unset`` (section 3.1),
+which :func:`camtool.importers.svgcss.normalize_styles` then resolves. Names are compared
+in lower case, as the style sheets' declarations are written. ``var()`` in a presentation
+attribute is not CSS there and is left (:func:`camtool.importers.svgcss.check_variables`).
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+
+from camtool.importers.svgcss import inline_style, labelled, style_text
+from camtool.model.errors import InputError
+
+DECIDING = frozenset(
+    {
+        "display",
+        "visibility",
+        "opacity",
+        "fill",
+        "stroke",
+        "fill-opacity",
+        "stroke-opacity",
+        "stroke-width",
+    }
+)
+"""Properties that decide whether a shape shows: a ``var()`` in one that needs a custom
+property a rule camtool does not apply may set is refused."""
+MAX_DEPTH = 32
+"""Nested substitutions followed (a custom property whose value uses another); deeper is
+invalid, as a cycle is."""
+MAX_LENGTH = 65_536
+"""Characters a substituted value may have: a longer one is invalid (browsers cap it too:
+values that double at each of 30 properties would be a gigabyte)."""
+
+
+class _Unapplied(Exception):
+    """A ``var()`` needs a custom property that a rule not applied declares."""
+
+    def __init__(self, name: str) -> None:
+        super().__init__(name)
+        self.name = name
+
+
+def resolve_variables(root: ET.Element, name: str, unapplied: set[str]) -> None:
+    """Replace each ``var()`` of the ``style`` attributes under ``root`` (see the module).
+
+    Args:
+        root: the ``<svg>`` element, its style sheets applied.
+        name: the file, for messages.
+        unapplied: custom properties (lower case) declared by style-sheet rules camtool
+            does not apply (:func:`~camtool.importers.svgcss.apply_style_sheets`).
+
+    Raises:
+        InputError: a property of :data:`DECIDING` uses a ``var()`` that is not defined
+            here and that such a rule may define, naming the element and the property.
+    """
+    stack: list[tuple[ET.Element, dict[str, str]]] = [(root, {})]
+    while stack:
+        element, inherited = stack.pop()
+        style = element.get("style")
+        scope = inherited
+        if style and "--" in style:
+            own = {k.lower(): v for k, v in inline_style(element).items() if k.startswith("--")}
+            scope = {**inherited, **own} if own else inherited
+        if style and "var(" in style.lower():
+            declared = inline_style(element)
+            for key, value in declared.items():
+                if key.startswith("--") or "var(" not in value.lower():
+                    continue
+                try:
+                    got = _substituted(value, scope, unapplied, 0, {})
+                except _Unapplied as exc:
+                    if key.lower() not in DECIDING:
+                        got = None
+                    else:
+                        label = next((t for e, _, t in labelled(root) if e is element), "")
+                        raise InputError(
+                            f"{name}: {label or element.tag}: {key}: {value} uses {exc.name}, "
+                            "which a <style> rule camtool does not apply sets, so it cannot "
+                            "tell whether the element shows; write the value itself, or set "
+                            f"{exc.name} in a rule of a type, .class, #id or :root"
+                        ) from None
+                declared[key] = "unset" if got is None else got
+            element.set("style", style_text(declared))
+        stack.extend((child, scope) for child in reversed(element))
+
+
+def _substituted(
+    value: str,
+    scope: dict[str, str],
+    unapplied: set[str],
+    depth: int,
+    known: dict[str, str | None],
+) -> str | None:
+    """``value`` with each ``var()`` replaced; ``None``: invalid (see the module).
+
+    ``known``: each custom property's substituted value once worked out (``None``: invalid,
+    or being worked out: a cycle), so each is worked out once however often it is used.
+
+    Raises:
+        _Unapplied: a ``var()`` without a value here nor a fallback names a property a rule
+            not applied declares.
+    """
+    if depth > MAX_DEPTH:
+        return None
+    out: list[str] = []
+    at = 0
+    while (start := value.lower().find("var(", at)) >= 0:
+        end = _closing(value, start + 4)
+        if end is None:
+            return None  # an unclosed var(: not a value CSS reads
+        out.append(value[at:start])
+        name, comma, fallback = _split_arguments(value[start + 4 : end])
+        name = name.strip().lower()
+        got = None
+        if name in known:
+            got = known[name]
+        elif name in scope and scope[name].strip().lower() != "initial":
+            known[name] = None  # a use of it while it is worked out is a cycle
+            got = known[name] = _substituted(scope[name], scope, unapplied, depth + 1, known)
+        if got is None and comma:
+            got = _substituted(fallback, scope, unapplied, depth + 1, known)
+        if got is None:
+            if name in unapplied and name not in scope:
+                raise _Unapplied(name)
+            return None
+        out.append(got.strip())
+        if sum(map(len, out)) > MAX_LENGTH:
+            return None
+        at = end + 1
+    out.append(value[at:])
+    return "".join(out).strip()
+
+
+def _closing(text: str, at: int) -> int | None:
+    """The index of the ``)`` that closes the bracket opened just before ``at``."""
+    depth = 1
+    for i in range(at, len(text)):
+        if text[i] == "(":
+            depth += 1
+        elif text[i] == ")":
+            depth -= 1
+            if depth == 0:
+                return i
+    return None
+
+
+def _split_arguments(text: str) -> tuple[str, bool, str]:
+    """``var()``'s arguments split at the first comma outside brackets: name, comma, fallback."""
+    depth = 0
+    for i, char in enumerate(text):
+        if char == "(":
+            depth += 1
+        elif char == ")":
+            depth -= 1
+        elif char == "," and depth == 0:
+            return text[:i], True, text[i + 1 :]
+    return text, False, ""
