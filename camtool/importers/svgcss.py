@@ -425,31 +425,6 @@ def labelled(root: ET.Element) -> Iterator[tuple[ET.Element, str, str]]:
         yield element, kind, f"{kind}#{ident}" if ident else f"{kind}[{seen[kind]}]"
 
 
-def check_variables(root: ET.Element, name: str) -> None:
-    """Refuse a ``var()`` left where it decides whether an element shows.
-
-    The styles' are resolved before (:mod:`camtool.importers.svgvars`); one in the
-    ``display``, ``visibility`` or ``opacity`` attribute is not, and may hide the element
-    in a viewer, and camtool would cut it. Run before the opacities are read
-    (``svgvalues.normalize_colours`` drops a value it cannot read).
-
-    Raises:
-        InputError: such a value, with the file, the element (``rect#id``, ``rect[2]``, as
-            the later checks name it) and what to do.
-    """
-    for element in root.iter():
-        style = inline_style(element) if "var(" in element.get("style", "").lower() else {}
-        for prop in ("display", "visibility", "opacity"):
-            value = style.get(prop, element.get(prop))
-            if value is not None and "var(" in value.lower():
-                label = next((t for e, _, t in labelled(root) if e is element), element.tag)
-                raise InputError(
-                    f"{name}: {label}: {prop}: {value.strip()} decides whether it shows, and "
-                    "camtool resolves custom properties (var()) in a style only; write the "
-                    "value itself, or put it in the element's style attribute"
-                )
-
-
 def _media_hiding(at_rule: str, body: str) -> str | None:
     """The first hiding declaration of an at-rule's rules that a screen may apply, or ``None``.
 

@@ -22,7 +22,6 @@ from camtool.importers.options import check_expansion, entity_limit, layer_list
 from camtool.importers.svgcontent import hold_unrendered
 from camtool.importers.svgcss import (
     apply_style_sheets,
-    check_variables,
     inline_style,
     labelled,
     local_name,
@@ -578,7 +577,6 @@ def prepare(
     warnings += apply_style_sheets(root, parents, str(path), unapplied)
     resolve_variables(root, str(path), unapplied)
     normalize_styles(root)
-    check_variables(root, str(path))
     svgvalues.resolve_percentages(root, viewport)
     svgvalues.resolve_paint_references(root)
     svgvalues.resolve_context_paints(root, parents)

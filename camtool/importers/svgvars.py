@@ -8,8 +8,10 @@ Level 1 says: a custom property is inherited (section 2), ``var(--name, fallback
 the property's value, else the fallback (section 3); a declaration with a ``var()`` that has
 neither, or a cycle, is invalid at computed-value time and acts as ``unset`` (section 3.1),
 which :func:`camtool.importers.svgcss.normalize_styles` then resolves. Names are compared
-in lower case, as the style sheets' declarations are written. ``var()`` in a presentation
-attribute is not CSS there and is left (:func:`camtool.importers.svgcss.check_variables`).
+in lower case, as the style sheets' declarations are written. A presentation attribute
+(``stroke="var(--ink)"``) is resolved the same way, as Chromium does; one that is invalid
+is removed (it ranks below every style declaration: the property is then inherited or
+initial, as ``unset`` makes it).
 """
 
 from __future__ import annotations
@@ -33,6 +35,16 @@ DECIDING = frozenset(
 )
 """Properties that decide whether a shape shows: a ``var()`` in one that needs a custom
 property a rule camtool does not apply may set is refused."""
+PRESENTATION = DECIDING | {
+    "color",
+    "fill-rule",
+    "stroke-linecap",
+    "stroke-linejoin",
+    "stroke-dasharray",
+    "stroke-dashoffset",
+    "stroke-miterlimit",
+}
+"""Presentation attributes whose ``var()`` is resolved."""
 MAX_DEPTH = 32
 """Nested substitutions followed (a custom property whose value uses another); deeper is
 invalid, as a cycle is."""
@@ -50,7 +62,7 @@ class _Unapplied(Exception):
 
 
 def resolve_variables(root: ET.Element, name: str, unapplied: set[str]) -> None:
-    """Replace each ``var()`` of the ``style`` attributes under ``root`` (see the module).
+    """Replace each ``var()`` of the styles and presentation attributes under ``root``.
 
     Args:
         root: the ``<svg>`` element, its style sheets applied.
@@ -73,24 +85,47 @@ def resolve_variables(root: ET.Element, name: str, unapplied: set[str]) -> None:
         if style and "var(" in style.lower():
             declared = inline_style(element)
             for key, value in declared.items():
-                if key.startswith("--") or "var(" not in value.lower():
-                    continue
-                try:
-                    got = _substituted(value, scope, unapplied, 0, {})
-                except _Unapplied as exc:
-                    if key.lower() not in DECIDING:
-                        got = None
-                    else:
-                        label = next((t for e, _, t in labelled(root) if e is element), "")
-                        raise InputError(
-                            f"{name}: {label or element.tag}: {key}: {value} uses {exc.name}, "
-                            "which a <style> rule camtool does not apply sets, so it cannot "
-                            "tell whether the element shows; write the value itself, or set "
-                            f"{exc.name} in a rule of a type, .class, #id or :root"
-                        ) from None
-                declared[key] = "unset" if got is None else got
+                if not key.startswith("--") and "var(" in value.lower():
+                    got = _resolved(root, element, key, value, scope, unapplied, name)
+                    declared[key] = "unset" if got is None else got
             element.set("style", style_text(declared))
+        for key in sorted(PRESENTATION.intersection(element.keys())):
+            value = element.get(key, "")
+            if "var(" in value.lower():
+                got = _resolved(root, element, key, value, scope, unapplied, name)
+                if got is None:
+                    del element.attrib[key]
+                else:
+                    element.set(key, got)
         stack.extend((child, scope) for child in reversed(element))
+
+
+def _resolved(
+    root: ET.Element,
+    element: ET.Element,
+    key: str,
+    value: str,
+    scope: dict[str, str],
+    unapplied: set[str],
+    name: str,
+) -> str | None:
+    """``value`` of ``element``'s ``key`` substituted (``None``: invalid).
+
+    Raises:
+        InputError: see :func:`resolve_variables`.
+    """
+    try:
+        return _substituted(value, scope, unapplied, 0, {})
+    except _Unapplied as exc:
+        if key.lower() not in DECIDING:
+            return None
+        label = next((t for e, _, t in labelled(root) if e is element), "")
+        raise InputError(
+            f"{name}: {label or element.tag}: {key}: {value} uses {exc.name}, which a <style> "
+            "rule camtool does not apply sets, so it cannot tell whether the element shows; "
+            f"write the value itself, or set {exc.name} in a rule of a type, .class, #id or "
+            ":root"
+        ) from None
 
 
 def _substituted(
