@@ -16,9 +16,11 @@ initial, as ``unset`` makes it).
 
 from __future__ import annotations
 
+import re
 import xml.etree.ElementTree as ET
 
-from camtool.importers.svgcss import inline_style, labelled, style_text
+from camtool.importers.svgcss import inline_style, labelled, local_name, style_text
+from camtool.importers.svgtree import href
 from camtool.model.errors import InputError
 
 DECIDING = frozenset(
@@ -53,6 +55,10 @@ MAX_LENGTH = 65_536
 values that double at each of 30 properties would be a gigabyte)."""
 
 
+_USED = re.compile(r"var\(\s*(--[^\s,)]+)", re.IGNORECASE)
+"""The custom property a ``var()`` names."""
+
+
 class _Unapplied(Exception):
     """A ``var()`` needs a custom property that a rule not applied declares."""
 
@@ -72,8 +78,11 @@ def resolve_variables(root: ET.Element, name: str, unapplied: set[str]) -> None:
 
     Raises:
         InputError: a property of :data:`DECIDING` uses a ``var()`` that is not defined
-            here and that such a rule may define, naming the element and the property.
+            here and that such a rule may define; or an element a ``<use>`` places uses one
+            that each clone would take from its own place (:class:`_Clones`). The message
+            names the element and the property.
     """
+    clones: _Clones | None = None
     stack: list[tuple[ET.Element, dict[str, str]]] = [(root, {})]
     while stack:
         element, inherited = stack.pop()
@@ -86,18 +95,70 @@ def resolve_variables(root: ET.Element, name: str, unapplied: set[str]) -> None:
             declared = inline_style(element)
             for key, value in declared.items():
                 if not key.startswith("--") and "var(" in value.lower():
+                    clones = clones or _Clones(root)
+                    clones.check(element, key, value, name)
                     got = _resolved(root, element, key, value, scope, unapplied, name)
                     declared[key] = "unset" if got is None else got
             element.set("style", style_text(declared))
         for key in sorted(PRESENTATION.intersection(element.keys())):
             value = element.get(key, "")
             if "var(" in value.lower():
+                clones = clones or _Clones(root)
+                clones.check(element, key, value, name)
                 got = _resolved(root, element, key, value, scope, unapplied, name)
                 if got is None:
                     del element.attrib[key]
                 else:
                     element.set(key, got)
         stack.extend((child, scope) for child in reversed(element))
+
+
+class _Clones:
+    """What ``<use>`` elements place, where a ``var()`` is each clone's own.
+
+    A clone inherits from its ``<use>``, not from where the element it copies stands (CSS
+    Scoping 1 §3.3.1, SVG 2 §5.6.1), so a custom property the copied element does not set
+    itself (on it or between it and the element the ``<use>`` names) may differ from clone
+    to clone; camtool resolves each element once, where it stands.
+    """
+
+    def __init__(self, root: ET.Element) -> None:
+        self.root = root
+        ids = {e.get("id"): e for e in root.iter() if e.get("id")}
+        self.parents = {child: parent for parent in root.iter() for child in parent}
+        self.placed: dict[ET.Element, ET.Element] = {}  # element -> the one a <use> names
+        for use in root.iter():
+            ref = href(use) if local_name(use) == "use" else ""
+            target = ids.get(ref[1:]) if ref.startswith("#") else None
+            for element in target.iter() if target is not None else ():
+                self.placed.setdefault(element, target)  # type: ignore[arg-type]
+        self.declared = {
+            k.lower() for e in root.iter() for k in inline_style(e) if k.startswith("--")
+        }
+
+    def check(self, element: ET.Element, key: str, value: str, name: str) -> None:
+        """Refuse ``key: value`` of ``element`` where clones may read it otherwise.
+
+        Raises:
+            InputError: ``element`` is (in) what a ``<use>`` places, and a property ``value``
+                uses is set somewhere in the document but not within what is placed.
+        """
+        top = self.placed.get(element)
+        if top is None:
+            return
+        within: set[str] = set()
+        node: ET.Element | None = element
+        while node is not None:
+            within |= {k.lower() for k in inline_style(node) if k.startswith("--")}
+            node = None if node is top else self.parents.get(node)
+        for used in (u.lower() for u in _USED.findall(value)):
+            if used in self.declared and used not in within:
+                label = next((t for e, _, t in labelled(self.root) if e is element), "")
+                raise InputError(
+                    f"{name}: {label or element.tag}: {key}: {value} is placed by a <use>, "
+                    f"whose clones take {used} from where each <use> stands, which camtool "
+                    f"does not follow; set {used} on the element itself, or write the value"
+                )
 
 
 def _resolved(

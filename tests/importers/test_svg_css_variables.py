@@ -125,3 +125,32 @@ def test_a_value_that_grows_at_each_property_is_invalid_past_a_length(tmp_path: 
         f'<path id="x" {SQUARE} fill="none" style="{chain}; --v16: abc; stroke: var(--v0, #00f)"/>'
     )
     assert _cut(tmp_path, body)["path#x"] == "#0000ff"
+
+
+def test_a_clone_s_var_from_where_its_use_stands_is_refused(tmp_path: Path) -> None:
+    # a clone inherits from its <use> (CSS Scoping 1 §3.3.1): one <use> paints nothing here,
+    # the other red; camtool resolves the copied path once, where it stands
+    body = (
+        f'<defs><path id="p" {SQUARE} fill="none" style="stroke: var(--ink)"/></defs>'
+        '<use xlink:href="#p" style="--ink: none"/>'
+        '<use xlink:href="#p" x="30" style="--ink: #ff0000"/>'
+    )
+    with pytest.raises(InputError, match=r"path#p: stroke: var\(--ink\) is placed by a <use>"):
+        read_svg(svg(tmp_path, body))
+
+
+@pytest.mark.parametrize(
+    ("style", "colour"),
+    [
+        ("--ink: #ff0000; stroke: var(--ink)", "#ff0000"),
+        ("stroke: var(--nope, #0000ff)", "#0000ff"),
+    ],
+)
+def test_a_clone_s_var_set_within_or_nowhere_is_resolved(
+    tmp_path: Path, style: str, colour: str
+) -> None:
+    body = (
+        f'<defs><path id="p" {SQUARE} fill="none" style="{style}"/></defs>'
+        '<use id="u" xlink:href="#p" x="30"/>'
+    )
+    assert {c.colour for c in read_svg(svg(tmp_path, body + OTHER)).contours} == {colour, "#000000"}
