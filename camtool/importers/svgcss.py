@@ -144,6 +144,31 @@ def normalize_styles(root: ET.Element) -> None:
             if value is not None and value != (word := value.strip().lower()) and word in _KEYWORDS:
                 element.set(attr, word)
         _css_wide_keywords(element)
+        _contents(element)
+
+
+_UNBOXED = frozenset({"g", "svg", "use"})
+"""Elements whose ``display: contents`` shows their content as without them (Chromium)."""
+
+
+def _contents(element: ET.Element) -> None:
+    """``display: contents`` on another SVG element is ``none``, as Chromium computes it.
+
+    CSS Display 3 §2.8 leaves SVG elements to SVG; Chromium unboxes ``<g>``, ``<svg>`` and
+    ``<use>`` and hides the rest (a ``<path>``, ``<a>``, ``<switch>``). svgelements knows
+    no ``contents`` and would draw them.
+    """
+    style = element.get("style")
+    if not (style and "contents" in style.lower()) and element.get("display") is None:
+        return
+    if local_name(element) in _UNBOXED:
+        return
+    declared = inline_style(element)
+    if declared.get("display", "").strip().lower() == "contents":
+        declared["display"] = "none"
+        element.set("style", style_text(declared))
+    if element.get("display", "").strip().lower() == "contents":
+        element.set("display", "none")
 
 
 _INITIAL = {
