@@ -159,16 +159,16 @@ def _contents(element: ET.Element) -> None:
     no ``contents`` and would draw them.
     """
     style = element.get("style")
-    if not (style and "contents" in style.lower()) and element.get("display") is None:
+    in_style = bool(style) and "contents" in str(style).lower()
+    in_attribute = element.get("display", "").strip().lower() == "contents"
+    if not (in_style or in_attribute) or local_name(element) in _UNBOXED:
         return
-    if local_name(element) in _UNBOXED:
-        return
+    if in_attribute:
+        element.set("display", "none")
     declared = inline_style(element)
     if declared.get("display", "").strip().lower() == "contents":
         declared["display"] = "none"
         element.set("style", style_text(declared))
-    if element.get("display", "").strip().lower() == "contents":
-        element.set("display", "none")
 
 
 _INITIAL = {

@@ -1,4 +1,4 @@
-"""CSS custom properties (``--ink: none``) resolved where ``var()`` uses them in a style.
+"""CSS custom properties (``--ink: none``) resolved where ``var()`` uses them.
 
 svgelements reads ``fill: var(--ink)`` as a colour it does not know and draws the shape; a
 browser draws it as ``--ink`` says, ``none`` included. So, once the style sheets are in
