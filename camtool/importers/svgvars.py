@@ -153,12 +153,16 @@ class _Clones:
             node = None if node is top else self.parents.get(node)
         for used in (u.lower() for u in _USED.findall(value)):
             if used in self.declared and used not in within:
-                label = next((t for e, _, t in labelled(self.root) if e is element), "")
                 raise InputError(
-                    f"{name}: {label or element.tag}: {key}: {value} is placed by a <use>, "
+                    f"{name}: {_label(self.root, element)}: {key}: {value} is placed by a <use>, "
                     f"whose clones take {used} from where each <use> stands, which camtool "
                     f"does not follow; set {used} on the element itself, or write the value"
                 )
+
+
+def _label(root: ET.Element, element: ET.Element) -> str:
+    """``element``'s name in messages (``path#a``, ``rect[2]``: :func:`labelled`'s)."""
+    return next((t for e, _, t in labelled(root) if e is element), str(element.tag))
 
 
 def _resolved(
@@ -180,9 +184,8 @@ def _resolved(
     except _Unapplied as exc:
         if key.lower() not in DECIDING:
             return None
-        label = next((t for e, _, t in labelled(root) if e is element), "")
         raise InputError(
-            f"{name}: {label or element.tag}: {key}: {value} uses {exc.name}, which a <style> "
+            f"{name}: {_label(root, element)}: {key}: {value} uses {exc.name}, which a <style> "
             "rule camtool does not apply sets, so it cannot tell whether the element shows; "
             f"write the value itself, or set {exc.name} in a rule of a type, .class, #id or "
             ":root"
@@ -208,12 +211,14 @@ def _substituted(
     if depth > MAX_DEPTH:
         return None
     out: list[str] = []
-    at = 0
-    while (start := value.lower().find("var(", at)) >= 0:
+    at = length = 0
+    lowered = value.lower()
+    while (start := lowered.find("var(", at)) >= 0:
         end = _closing(value, start + 4)
         if end is None:
             return None  # an unclosed var(: not a value CSS reads
         out.append(value[at:start])
+        length += start - at
         name, comma, fallback = _split_arguments(value[start + 4 : end])
         name = name.strip().lower()
         got = None
@@ -229,7 +234,8 @@ def _substituted(
                 raise _Unapplied(name)
             return None
         out.append(got.strip())
-        if sum(map(len, out)) > MAX_LENGTH:
+        length += len(out[-1])
+        if length > MAX_LENGTH:
             return None
         at = end + 1
     out.append(value[at:])
