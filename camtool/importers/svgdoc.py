@@ -36,8 +36,8 @@ from camtool.importers.svgmasks import (
     symbols_as_viewports,
 )
 from camtool.importers.svgpage import (
-    INKSCAPE_VERSION,
     Affine,
+    decoded_id,
     illustrator_version,
     page_matrix,
     top_level_layers,
@@ -97,7 +97,7 @@ def _layer_name(element: ET.Element) -> str:
         element.get(_LABEL)
         or element.get(_LC_LAYER)
         or element.get("data-name")
-        or _decoded_id(element.get("id"))
+        or decoded_id(element.get("id"))
         or str(element.get(SOURCE_ATTR, "g"))
     )
 
@@ -113,18 +113,9 @@ def _layer_names(layer: ET.Element) -> set[str]:
         layer.get(_LC_LAYER),
         layer.get("data-name"),
         layer.get("id"),
-        _decoded_id(layer.get("id")),
+        decoded_id(layer.get("id")),
     )
     return {n for n in names if n}
-
-
-_ESCAPED = re.compile(r"_x([0-9A-Fa-f]{4})_")
-"""A character Illustrator and CorelDRAW cannot put in an ``id``, as they write it there."""
-
-
-def _decoded_id(text: str | None) -> str | None:
-    """``text`` with each ``_xHHHH_`` written back as its character (``_x0020_``: a space)."""
-    return None if text is None else _ESCAPED.sub(lambda m: chr(int(m[1], 16)), text)
 
 
 def _is_layer(element: ET.Element) -> bool:
@@ -142,7 +133,7 @@ def _layers(root: ET.Element, top_level: bool) -> list[ET.Element]:
     children of the ``<svg>`` element that have an ``id``.
     """
     layers = [e for e in root.iter() if _is_layer(e)]
-    if layers or not top_level or root.get(INKSCAPE_VERSION) is not None:
+    if layers or not top_level:
         return layers
     return [e for e in root if local_name(e) == "g" and e.get("id")]
 
@@ -597,7 +588,14 @@ def prepare(
     parents[hold] = root
     counts: Counter[str] = Counter()
     select_layers(
-        root, layers, parents, hold, str(path), warnings, shown, top_level=top_level_layers(head)
+        root,
+        layers,
+        parents,
+        hold,
+        str(path),
+        warnings,
+        shown,
+        top_level=top_level_layers(head, root),
     )
     choose_switches(root, parents, hold, str(path), counts)
     check_conditions(root, parents, hold, str(path), counts)

@@ -164,14 +164,35 @@ _COREL = re.compile(rb"<!--\s*Creator:\s*CorelDRAW")
 """The comment CorelDRAW's SVG export writes before the root element."""
 
 
-def top_level_layers(head: bytes) -> bool:
-    """Whether ``head``, a file's first bytes, names a program whose layers are the root's groups.
+_ESCAPED = re.compile(r"_x([0-9A-Fa-f]{4})_")
+"""A character Illustrator and CorelDRAW cannot put in an ``id``, as they write it there."""
+
+
+def decoded_id(text: str | None) -> str | None:
+    """``text`` with each ``_xHHHH_`` written back as its character (``_x0020_``: a space).
+
+    Only a character a name may hold: a control character, a surrogate or a non-character
+    (``_x0000_``, ``_xD800_``, ``_xFFFF_``), which no XML attribute can carry, stays as written.
+    """
+    return None if text is None else _ESCAPED.sub(_character, text)
+
+
+def _character(match: re.Match[str]) -> str:
+    code = int(match[1], 16)
+    named = code >= 0x20 and code != 0x7F and not 0xD800 <= code <= 0xDFFF and code < 0xFFFE
+    return chr(code) if named else match[0]
+
+
+def top_level_layers(head: bytes, root: ET.Element) -> bool:
+    """Whether the file (``head``: its first bytes) is one whose layers are the root's groups.
 
     Adobe Illustrator and CorelDRAW write each layer as a ``<g>`` child of the ``<svg>``
     element, named by its ``id`` (Illustrator: ``data-name`` too where the name is no
-    valid id), with no mark of its own.
+    valid id), with no mark of its own. A file Inkscape saved again (``inkscape:version``)
+    has Inkscape's layers, or none.
     """
-    return _ILLUSTRATOR.search(head) is not None or _COREL.search(head) is not None
+    writer = _ILLUSTRATOR.search(head) is not None or _COREL.search(head) is not None
+    return writer and root.get(INKSCAPE_VERSION) is None
 
 
 def _illustrator_px(root: ET.Element, version: str | None, has_viewbox: bool) -> bool:

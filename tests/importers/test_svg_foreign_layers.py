@@ -101,3 +101,20 @@ def test_an_illustrator_icon_s_layers() -> None:
     assert len(chosen.contours) == len(everything.contours)
     with pytest.raises(InputError, match="nothing to cut in the selected layers"):
         read_drawing(KIG, ImportOptions(layers=("Layer_2",)))
+
+
+def test_an_id_escape_no_xml_name_can_hold_stays_as_written(tmp_path: Path) -> None:
+    # a NUL, a lone surrogate and a non-character cannot be in an XML attribute: kept as
+    # written (the layer name is an attribute camtool sets), the rest written back
+    path = tmp_path / "part.svg"
+    groups = "".join(
+        f'<g id="{ident}"><rect x="{10 + 20 * i}" y="10" width="5" height="5" fill="none" '
+        'stroke="#000"/></g>'
+        for i, ident in enumerate(["A_x0000_b", "C_xD800__x0029_", "E_xFFFF_", "F_x00E9_"])
+    )
+    path.write_text(
+        f'{ILLUSTRATOR}<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" '
+        f'viewBox="0 0 100 100">{groups}</svg>',
+        encoding="utf-8",
+    )
+    assert _layers(path) == ["A_x0000_b", "C_xD800_)", "E_xFFFF_", "F\u00e9"]
