@@ -346,7 +346,7 @@ def apply_style_sheets(
     root: ET.Element,
     parents: dict[ET.Element, ET.Element],
     name: str,
-    unapplied: set[str] | None = None,
+    unapplied: set[str],
 ) -> list[str]:
     """Apply every CSS ``<style>`` sheet to the elements' ``style`` attributes, then remove it.
 
@@ -359,7 +359,7 @@ def apply_style_sheets(
         root: the ``<svg>`` element.
         parents: each element's parent (the removed sheets are taken out of it).
         name: the file, for messages.
-        unapplied: given, the custom properties (``--ink``, in lower case) that a rule not
+        unapplied: the custom properties (``--ink``, in lower case) that a rule not
             applied declares are added to it (:func:`camtool.importers.svgvars.resolve_variables`
             refuses a value that needs one).
 
@@ -427,10 +427,8 @@ def apply_style_sheets(
     ]
 
 
-def _custom_properties(body: str, into: set[str] | None, *, rules: bool = False) -> None:
+def _custom_properties(body: str, into: set[str], *, rules: bool = False) -> None:
     """Add the custom properties ``body`` declares (a rule's; an at-rule's rules') to ``into``."""
-    if into is None:
-        return
     bodies = [inner for _, inner in _css_rules(body)] if rules else [body]
     into.update(k for text in bodies for k, _, _ in _declaration_list(text) if k.startswith("--"))
 
