@@ -16,7 +16,7 @@ from typing import Literal, cast
 from camtool import accel
 from camtool.accel.collector import paused
 from camtool.importers import gcode_ahead
-from camtool.importers.gcode_codes import BlockWords, CommandReader, Notes, unused_word
+from camtool.importers.gcode_codes import BlockWords, CommandReader, Notes, read_units, unused_word
 from camtool.importers.gcode_cycles import CYCLES, CycleState
 from camtool.importers.gcode_lexer import (
     Block,
@@ -374,8 +374,10 @@ class _Reader(StartRules):
 
     def _modes(self, w: BlockWords) -> None:
         """Everything a block sets before its motion (RS-274/NGC order of execution)."""
-        if (units := w.g_name("units")) is not None:
-            self.inch, self.units_seen = units == "G20", True
+        if (
+            inch := read_units(w, self.inch if self.units_seen else None, self.where())
+        ) is not None:
+            self.inch, self.units_seen = inch, True
         if (f := w.args.get("F")) is not None:
             if f.value < 0:
                 raise InputError(f"{self.where()}: negative feed {f}; feeds are > 0")

@@ -57,7 +57,7 @@ STATE = (
 """The reader's values a plain line reads besides its text (and the contour, counted on)."""
 
 
-_UNITS = re.compile(r"G0*2([01])(?![0-9.])", re.IGNORECASE)
+_UNITS = re.compile(r"G0*[27]([01])(?![0-9.])", re.IGNORECASE)
 _FEED = re.compile(r"F([0-9]*\.?[0-9]+)", re.IGNORECASE)
 _Z = re.compile(r"Z([+-]?[0-9]*\.?[0-9]+)", re.IGNORECASE)
 SEEN = 1_000_000
@@ -71,7 +71,7 @@ def seed(reader: PlainLines, text: str, position: int) -> None:
     the reader's side wherever a run can fit: a first move that depends on the start is
     the reader's to refuse, not the helper's.
 
-    A guess from the text (the last ``G20``/``G21``, ``F`` and ``Z`` word in the
+    A guess from the text (the last ``G20``/``G21`` or ``G70``/``G71``, ``F`` and ``Z`` word in the
     :data:`SEEN` characters before, comments and all): a program that sets them once, at
     its top, has no run the helper reads from its own values otherwise. A wrong guess only
     makes the runs read from it fail to fit.

@@ -78,6 +78,10 @@ G_CODES = MappingProxyType(
         ("G90.1 G91.1", "arc_distance", "read", ""),
         ("G94", "feed_mode", "read", ""),
         ("G20 G21", "units", "read", ""),
+        # DIN 66025's units codes, which Vectric's Mach2/3 posts write after G21 (G71) or
+        # G20 (G70); LinuxCNC and Fanuc lathes read G70/G71 with P, Q... as lathe cycles
+        ("G70", "units", "warn", "G70 read as G20 (inches), DIN 66025's units code"),
+        ("G71", "units", "warn", "G71 read as G21 (millimetres), DIN 66025's units code"),
         ("G4", "nonmodal", "read", ""),
         ("G28 G30", "nonmodal", "read", ""),
         ("G40", "cutter", "warn", "G40 (cutter compensation off) read as a no-op"),
@@ -322,6 +326,34 @@ class BlockWords:
         """Name of the block's G code of modal ``group``, if any."""
         code = self.g.get(group)
         return code.name if code else None
+
+
+def read_units(w: BlockWords, inch: bool | None, where: str) -> bool | None:
+    """Whether the block's units code makes the program inches (``None``: none in the block).
+
+    ``G70``/``G71`` (DIN 66025) are read as ``G20``/``G21``. ``inch`` is what the program
+    stated before (``None``: nothing yet).
+
+    Raises:
+        InputError: ``G70``/``G71`` with a lathe cycle's words (``P``, ``Q``, ``R``, ``I``,
+            ``K``), or against the units the program stated before.
+    """
+    units = w.g_name("units")
+    if units in ("G70", "G71"):
+        cycle = [str(w.args[letter]) for letter in "PQRIK" if letter in w.args]
+        if cycle:
+            raise InputError(
+                f"{where}: {units} with {cycle[0]} is a lathe cycle (LinuxCNC, Fanuc), which "
+                f"camtool does not read; alone, {units} is read as DIN 66025's units code"
+            )
+        if inch is not None and inch != (units == "G70"):
+            stated = "inches (G20)" if inch else "millimetres (G21)"
+            raise InputError(
+                f"{where}: {units} after the program stated {stated}: {units} is inches or "
+                "millimetres only on controls that read DIN 66025's units codes; give G20 or "
+                "G21 for the units the program is written in"
+            )
+    return None if units is None else units in ("G20", "G70")
 
 
 def lookup_code(word: Word, where: str) -> Code:
