@@ -14,7 +14,6 @@ of the reference (ezdxf's ``virtual_entities`` draws its frame too, AutoCAD only
 
 from __future__ import annotations
 
-import itertools
 import math
 from typing import Any
 
@@ -33,18 +32,11 @@ from tests.corpus.conftest import (
     load_manifest,
     skip_reason,
 )
+from tests.corpus.dxf_exact import densified
 
 MANIFEST = load_manifest()
 DXF = [f for f in corpus_files(MANIFEST) if f.lower().endswith(".dxf")]
 KINDS = ("LINE", "ARC", "CIRCLE", "ELLIPSE", "SPLINE", "LWPOLYLINE", "POLYLINE")
-
-
-def _dense(poly: np.ndarray, step: float) -> np.ndarray:
-    out = [poly[:1]]
-    for p, q in itertools.pairwise(poly):
-        n = max(1, int(math.dist(p, q) / step))
-        out.append(p + (q - p) * np.linspace(0.0, 1.0, n + 1)[1:, None])
-    return np.concatenate(out)
 
 
 def _reference(path: str, mm: float, step: float) -> np.ndarray:
@@ -75,7 +67,7 @@ def _reference(path: str, mm: float, step: float) -> np.ndarray:
             else:
                 continue
             if len(v):
-                pts.append(_dense(v * mm, step))
+                pts.append(densified(v * mm, step))
     return np.concatenate(pts) if pts else np.zeros((0, 2))
 
 
@@ -91,7 +83,7 @@ def _camtool(contours: Any, step: float) -> np.ndarray:
                     np.c_[s.centre[0] + s.radius * np.cos(a), s.centre[1] + s.radius * np.sin(a)]
                 )
             else:
-                pts.append(_dense(np.array([s.start, s.end]), step))
+                pts.append(densified(np.array([s.start, s.end]), step))
     return np.concatenate(pts) if pts else np.zeros((0, 2))
 
 
