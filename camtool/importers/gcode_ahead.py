@@ -71,10 +71,10 @@ def seed(reader: PlainLines, text: str, position: int) -> None:
     the reader's side wherever a run can fit: a first move that depends on the start is
     the reader's to refuse, not the helper's.
 
-    A guess from the text (the last ``G20``/``G21`` or ``G70``/``G71``, ``F`` and ``Z`` word in the
-    :data:`SEEN` characters before, comments and all): a program that sets them once, at
-    its top, has no run the helper reads from its own values otherwise. A wrong guess only
-    makes the runs read from it fail to fit.
+    A guess from the text (the last ``G20``/``G21`` or ``G70``/``G71``, ``F`` and ``Z``
+    word in the :data:`SEEN` characters before, comments and all): a program that sets them
+    once, at its top, has no run the helper reads from its own values otherwise. A wrong
+    guess only makes the runs read from it fail to fit.
     """
     reader.positioned = True  # by then the program has given X and Y (else no run fits)
     window = text[max(0, position - SEEN) : position]
