@@ -171,8 +171,8 @@ _ESCAPED = re.compile(r"_x([0-9A-Fa-f]{4})_")
 def decoded_id(text: str | None) -> str | None:
     """``text`` with each ``_xHHHH_`` written back as its character (``_x0020_``: a space).
 
-    Only a character a name may hold: a control character, a surrogate or a non-character
-    (``_x0000_``, ``_xD800_``, ``_xFFFF_``), which no XML attribute can carry, stays as written.
+    An escape of a character no XML attribute can carry (a control character, a surrogate or
+    a non-character: ``_x0000_``, ``_xD800_``, ``_xFFFF_``) stays as written.
     """
     return None if text is None else _ESCAPED.sub(_character, text)
 

@@ -43,7 +43,8 @@ def _vectric(units: str, din: str) -> str:
 @pytest.mark.parametrize(
     ("header", "meant"),
     [
-        ("G00G20G17G90G40G49G80\nG70G91.1\n", "G00G20G17G90G40G49G80\nG20G91.1\n"),
+        # as a Vectric Mach2/3 inch file begins (its N words too)
+        ("N100G00G20G17G90G40G49G80\nN110G70G91.1\n", "N100G00G20G17G90G40G49G80\nN110G20G91.1\n"),
         ("G00G21G17G90G40G49G80\nG71G91.1\n", "G00G21G17G90G40G49G80\nG21G91.1\n"),
         ("G00G17G90G40G49G80\nG70G91.1\n", "G00G17G90G40G49G80\nG20G91.1\n"),
     ],
